@@ -1,0 +1,88 @@
+"""The library API: ``load_rulebase(path)`` and a handle that evaluates and traces.
+
+>>> rb = load_rulebase()                      # the packaged MITOS rule base
+>>> rb.evaluate(road=78, size=45, position=4)  # doctest: +SKIP
+{'steering': 65.41..., 'speed': 32.42...}
+>>> rb.trace(road=78, size=45, position=4).render()  # doctest: +SKIP
+"""
+
+from __future__ import annotations
+
+import functools
+from pathlib import Path
+
+import numpy as np
+
+from .build import load_rules_file
+from .compile import CompiledRuleBase, compile_rulebase
+from .engine import Result, as_batch, evaluate
+from .model import RuleBase
+from .resources import DEFAULT_RULEBASE, packaged_path
+from .trace import Trace, trace_of
+
+
+def default_rulebase_path() -> Path:
+    """The packaged MITOS rule base (``rulebases/mitos.rules``)."""
+    return packaged_path("rulebases", DEFAULT_RULEBASE)
+
+
+def read_rulebase(path: str | Path | None = None) -> RuleBase:
+    """Read a rule base: a ``.rules`` file, or a foreign format chosen by extension."""
+    path = Path(path) if path is not None else default_rulebase_path()
+    suffix = path.suffix.lower()
+    if suffix in (".fcl", ".fis", ".fll"):
+        from .interop import read_foreign
+
+        return read_foreign(path)
+    return load_rules_file(path)
+
+
+class LoadedRuleBase:
+    """A rule base with one behavior compiled, ready to evaluate."""
+
+    def __init__(self, rulebase: RuleBase, behavior: str | None = None) -> None:
+        self.rulebase = rulebase
+        self.compiled: CompiledRuleBase = compile_rulebase(rulebase, behavior)
+
+    @property
+    def inputs(self) -> tuple[str, ...]:
+        return self.compiled.inputs
+
+    @property
+    def outputs(self) -> tuple[str, ...]:
+        return self.compiled.outputs
+
+    @property
+    def behaviors(self) -> tuple[str, ...]:
+        return tuple(b.name for b in self.rulebase.behaviors)
+
+    @functools.lru_cache(maxsize=None)
+    def behavior(self, name: str) -> "LoadedRuleBase":
+        """The same rule base with another behavior compiled (recalled by name alone)."""
+        return LoadedRuleBase(self.rulebase, name)
+
+    def run(self, X, **kwargs) -> Result:
+        """Evaluate a batch ``X[n, k]`` (columns in :attr:`inputs` order)."""
+        return evaluate(self.compiled, X, **kwargs)
+
+    def evaluate(self, **inputs) -> dict[str, float | np.ndarray]:
+        """Outputs for inputs given by name (floats, or arrays evaluated as one batch)."""
+        X = as_batch(self.compiled, inputs)
+        result = evaluate(self.compiled, X)
+        scalar = all(np.ndim(v) == 0 for v in inputs.values())
+        return {name: (float(result.outputs[0, j]) if scalar else result.outputs[:, j])
+                for j, name in enumerate(self.compiled.outputs)}
+
+    def trace(self, **inputs) -> Trace:
+        """The paper-style DOF trace of one evaluation."""
+        X = as_batch(self.compiled, inputs)
+        if X.shape[0] != 1:
+            from .errors import InputError
+
+            raise InputError("a trace takes one value per input")
+        return trace_of(evaluate(self.compiled, X))
+
+
+def load_rulebase(path: str | Path | None = None, behavior: str | None = None) -> LoadedRuleBase:
+    """Load and compile a rule base (default: the packaged MITOS rule base)."""
+    return LoadedRuleBase(read_rulebase(path), behavior)

@@ -1,0 +1,65 @@
+"""Reading and writing batches of inputs as CSV (``mitos eval --batch``)."""
+
+from __future__ import annotations
+
+import csv
+import io
+from typing import TextIO
+
+import numpy as np
+
+from .errors import InputError, Span, did_you_mean
+
+
+def read_batch(text: str, path: str, inputs: tuple[str, ...]) -> np.ndarray:
+    """``X[n, k]`` from CSV text whose header names every input (any column order)."""
+    lines = text.splitlines()
+    if not lines or not lines[0].strip():
+        raise InputError("the batch CSV is empty", span=Span(path, 1, 1),
+                         expected="a header naming the inputs: " + ",".join(inputs))
+    header = [h.strip() for h in next(csv.reader([lines[0]]))]
+    for h in header:
+        if h not in inputs:
+            raise InputError(f"batch column `{h}` is not an input of this behavior",
+                             span=Span.in_text(text, path, 1, lines[0].find(h) + 1),
+                             expected="columns " + ", ".join(inputs),
+                             hint=did_you_mean(h, inputs))
+    missing = [k for k in inputs if k not in header]
+    if missing:
+        raise InputError("the batch CSV has no column for " + ", ".join(missing),
+                         span=Span.in_text(text, path, 1, 1),
+                         expected="a header naming " + ", ".join(inputs))
+    body = [line for line in lines[1:] if line.strip()]
+    if not body:
+        return np.empty((0, len(inputs)))
+    try:
+        data = np.loadtxt(io.StringIO("\n".join(body)), delimiter=",", ndmin=2, dtype=float)
+    except ValueError:
+        _raise_bad_row(lines, path, len(header))
+    if data.shape[1] != len(header):
+        _raise_bad_row(lines, path, len(header))
+    order = [header.index(k) for k in inputs]
+    return np.ascontiguousarray(data[:, order])
+
+
+def _raise_bad_row(lines: list[str], path: str, width: int) -> None:
+    for n, line in enumerate(lines[1:], start=2):
+        if not line.strip():
+            continue
+        cells = next(csv.reader([line]))
+        if len(cells) != width:
+            raise InputError(f"row has {len(cells)} values, the header {width}",
+                             span=Span(path, n, 1, line))
+        for cell in cells:
+            try:
+                float(cell)
+            except ValueError:
+                raise InputError(f"`{cell.strip()}` is not a number",
+                                 span=Span(path, n, max(1, line.find(cell) + 1), line)) from None
+    raise InputError("the batch CSV could not be read", span=Span(path, 1, 1))
+
+
+def write_batch(out: TextIO, inputs, X: np.ndarray, outputs, Y: np.ndarray) -> None:
+    out.write(",".join(list(inputs) + list(outputs)) + "\n")
+    table = np.hstack([X, Y]) if len(X) else np.empty((0, len(inputs) + len(outputs)))
+    np.savetxt(out, table, delimiter=",", fmt="%.12g")

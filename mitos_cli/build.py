@@ -1,0 +1,186 @@
+"""From a parsed rule file to a checked :class:`RuleBase`.
+
+Here every name is resolved against the term sets: unknown variables, terms, hedges and
+behaviors get a "did you mean"; inputs may only appear in conditions and outputs only in
+actions; labels are unique within a behavior; ``use`` has no cycles; operator settings exist.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from . import operators as ops_mod
+from .errors import RuleBaseError, Span, TermSetError, unknown
+from .hedges import HEDGES
+from .model import And, Behavior, Consequent, Expr, Not, Or, Prop, Rule, RuleBase, Use
+from .parse import ParsedFile, parse_rules
+from .termset import load_termset
+from .terms import TermSet, Variable
+
+MAIN = "main"
+
+
+def load_rules_file(path: str | Path) -> RuleBase:
+    """Read, parse and check the rule file at ``path`` and the term sets it names."""
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except UnicodeDecodeError:
+        raise RuleBaseError(f"`{path}` is not a text file (it is not UTF-8)",
+                            span=Span(str(path), 1, 1)) from None
+    except OSError as exc:
+        raise RuleBaseError(f"cannot read rule file `{path}`: {exc.strerror or exc}") from None
+    parsed = parse_rules(text, str(path))
+    termsets = []
+    for name, span in parsed.terms:
+        target = path.parent / name
+        if not target.is_file():
+            raise TermSetError(f"term set `{name}` not found (looked for `{target}`)", span=span,
+                               hint="term-set paths are relative to the rule file")
+        termsets.append(load_termset(target))
+    return build_rulebase(parsed, tuple(termsets), tuple(n for n, _ in parsed.terms))
+
+
+def build_rulebase(parsed: ParsedFile, termsets: tuple[TermSet, ...],
+                   termset_paths: tuple[str, ...] = ()) -> RuleBase:
+    """Check ``parsed`` against ``termsets`` and return the rule base."""
+    if not termsets:
+        raise RuleBaseError("the rule file names no term set",
+                            span=Span.in_text(parsed.text, parsed.path, 1, 1),
+                            hint='add a line `terms "NAME.terms.yaml"` naming its YAML term set')
+    variables: dict[str, Variable] = {}
+    for ts in termsets:
+        for v in ts.variables:
+            if v.name in variables:
+                raise TermSetError(f"variable `{v.name}` is defined in two term sets", span=v.span)
+            variables[v.name] = v
+    behaviors = list(parsed.behaviors)
+    if parsed.rules or parsed.uses:
+        behaviors.insert(0, Behavior(MAIN, parsed.rules, parsed.uses, (), parsed.frozen))
+    elif parsed.frozen:
+        raise RuleBaseError("`frozen` outside a behavior names rules that do not exist")
+    if not behaviors:
+        raise RuleBaseError("the rule file has no rules",
+                            span=Span.in_text(parsed.text, parsed.path, 1, 1),
+                            hint="write a rule: `if road is WIDE then speed is FAST`")
+    names = [b.name for b in behaviors]
+    for b in behaviors:
+        if names.count(b.name) > 1:
+            raise RuleBaseError(f"behavior `{b.name}` is defined twice", span=b.span)
+    base_ops = ops_mod.resolve(parsed.operators)
+    for b in behaviors:
+        ops_mod.resolve(b.operators, base_ops)
+        _check_behavior(b, variables, names)
+    rb = RuleBase(parsed.path, termsets, tuple(behaviors), parsed.operators, termset_paths)
+    for b in behaviors:
+        _check_cycles(rb, b.name, ())
+    return rb
+
+
+def _check_behavior(b: Behavior, variables: dict[str, Variable], behaviors: list[str]) -> None:
+    labels: set[str] = set()
+    for rule in b.rules:
+        if rule.label:
+            if rule.label in labels:
+                raise RuleBaseError(f"rule label `{rule.label}` is used twice in behavior "
+                                    f"`{b.name}`", span=rule.span,
+                                    hint="give each rule its own label")
+            labels.add(rule.label)
+        check_rule(rule, variables)
+    for use in b.uses:
+        if use.behavior not in behaviors:
+            raise unknown("behavior", use.behavior, behaviors, span=use.span)
+        if use.condition is not None:
+            check_expr(use.condition, variables)
+        _check_weight(use.weight, use.span)
+    for label in b.frozen:
+        if label not in labels:
+            raise unknown(f"rule label in behavior `{b.name}`", label, labels, span=b.span)
+
+
+def check_rule(rule: Rule, variables: dict[str, Variable]) -> None:
+    """Raise when ``rule`` names something the term sets do not define."""
+    check_expr(rule.antecedent, variables)
+    seen: set[str] = set()
+    for c in rule.consequents:
+        _check_consequent(c, variables)
+        if c.var in seen:
+            raise RuleBaseError(f"the rule sets `{c.var}` twice", span=c.span)
+        seen.add(c.var)
+    _check_weight(rule.weight, rule.span)
+
+
+def _check_weight(weight: float, span: Span | None) -> None:
+    if not 0.0 <= weight <= 1.0:
+        raise RuleBaseError(f"a rule weight must lie in [0, 1], not {weight:g}", span=span)
+
+
+def _variable(name: str, role: str, variables: dict[str, Variable], span: Span | None) -> Variable:
+    v = variables.get(name)
+    if v is None:
+        pool = [n for n, var in variables.items() if var.role == role]
+        raise unknown(f"{role} variable", name, pool, span=span)
+    if v.role != role:
+        where = "a condition" if role == "input" else "an action"
+        raise RuleBaseError(f"`{name}` is an {v.role} variable and cannot appear in {where}",
+                            span=span)
+    return v
+
+
+def _check_hedges(hedges: tuple[str, ...], span: Span | None) -> None:
+    for h in hedges:
+        if h not in HEDGES:
+            raise unknown("hedge", h, HEDGES, span=span)
+
+
+def check_expr(expr: Expr, variables: dict[str, Variable]) -> None:
+    if isinstance(expr, Prop):
+        v = _variable(expr.var, "input", variables, expr.span)
+        v.term(expr.term, expr.span)
+        _check_hedges(expr.hedges, expr.span)
+    elif isinstance(expr, Not):
+        check_expr(expr.expr, variables)
+    elif isinstance(expr, (And, Or)):
+        for item in expr.items:
+            check_expr(item, variables)
+
+
+def _check_consequent(c: Consequent, variables: dict[str, Variable]) -> None:
+    v = _variable(c.var, "output", variables, c.span)
+    if c.term is not None:
+        v.term(c.term, c.span)
+        _check_hedges(c.hedges, c.span)
+    else:
+        lo, hi = v.universe
+        if not lo <= c.value <= hi:
+            raise RuleBaseError(f"{c.var} = {c.value:g} lies outside its universe "
+                                f"[{lo:g}, {hi:g}]", span=c.span)
+
+
+def _check_cycles(rb: RuleBase, name: str, stack: tuple[str, ...]) -> None:
+    if name in stack:
+        cycle = " -> ".join(stack + (name,))
+        raise RuleBaseError(f"behaviors use each other in a cycle: {cycle}",
+                            span=rb.behavior(stack[0]).span)
+    for use in rb.behavior(name).uses:
+        _check_cycles(rb, use.behavior, stack + (name,))
+
+
+def flatten(rb: RuleBase, name: str | None = None) -> list[tuple[str, Rule, tuple[Use, ...]]]:
+    """The rules a behavior evaluates: its own and those of the behaviors it uses.
+
+    Each comes with its display label (``avoid_obstacle/r4`` for used behaviors) and the
+    chain of ``use`` contexts that weight it.
+    """
+    out: list[tuple[str, Rule, tuple[Use, ...]]] = []
+
+    def walk(bname: str, prefix: str, contexts: tuple[Use, ...]) -> None:
+        b = rb.behavior(bname)
+        for i, rule in enumerate(b.rules):
+            label = rule.label or f"#{i + 1}"
+            out.append((prefix + label, rule, contexts))
+        for use in b.uses:
+            walk(use.behavior, prefix + use.behavior + "/", contexts + (use,))
+
+    walk(name or rb.default_behavior, "", ())
+    return out

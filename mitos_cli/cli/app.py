@@ -1,0 +1,46 @@
+"""The ``mitos`` command: registers the commands and turns errors into messages.
+
+Our own errors (:class:`MitosError`) print ``path:line:col: message`` and exit 1; usage errors
+exit 2 (Click's convention); anything else is a bug and keeps its traceback.
+"""
+
+from __future__ import annotations
+
+import sys
+
+import typer
+
+from ..errors import MitosError
+from . import eval_cmd
+
+app = typer.Typer(
+    name="mitos",
+    help="Instructible neurofuzzy motion planners: evaluate, check, simulate and teach "
+         "fuzzy rule bases.",
+    no_args_is_help=True,
+    add_completion=False,
+    pretty_exceptions_enable=False,
+    context_settings={"help_option_names": ["-h", "--help"]},
+)
+
+
+
+@app.callback()
+def _root() -> None:
+    """Instructible neurofuzzy motion planners: evaluate, check, simulate and teach fuzzy rule
+    bases. Rule files, term sets, worlds and lessons are documented in the README."""
+
+
+# One line per command; each module holds one command function.
+app.command("eval")(eval_cmd.eval_command)
+
+
+def main(argv: list[str] | None = None) -> None:
+    """Entry point of the console script and ``python -m mitos_cli``."""
+    try:
+        app(args=argv, prog_name="mitos", standalone_mode=True)
+    except MitosError as exc:
+        from .output import report_error
+
+        report_error(exc)
+        sys.exit(1)

@@ -1,0 +1,255 @@
+"""Compiling a behavior of a rule base into the arrays of a layered fuzzy-neuron network.
+
+The network has the layers the paper describes (Sec. 3):
+
+1. **membership layer**: one neuron per input term (eq. 15 and the other shapes);
+2. **literal layer**: hedges as activations (eqs. 10-11) and ``not`` as inhibitory input
+   (eqs. 8-9), only where a rule uses them;
+3. **AND / OR / NOT layers**: one T-norm (AND) or S-norm (OR) neuron per sub-expression and
+   per rule, computed level by level;
+4. **output layer**: DOFs times rule weights and ``use`` contexts, combined into the outputs.
+
+Every value lives in one column of a matrix ``V[n, columns]``; column 0 holds 0 and column 1
+holds 1 (the identities that pad n-ary neurons). The engine (:mod:`mitos_cli.engine`) walks
+the levels with one NumPy call per level and operator: never a Python loop over rules or
+samples.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from . import operators as ops_mod
+from .build import flatten
+from .model import And, Expr, Not, Or, Prop, Rule, RuleBase, Use, format_rule
+from .operators import Operators
+from .shapes import SHAPES, kernel_params
+from .terms import Term, Variable
+
+ZERO, ONE = 0, 1
+
+
+@dataclass(frozen=True)
+class NodeGroup:
+    """Neurons of one level that share an operator: ``V[:, out] = op(V[:, children])``."""
+
+    op: str                       # "and", "or", "not", "hedge:<names>" or "prod"
+    out: np.ndarray               # [m] output columns
+    children: np.ndarray          # [m, arity] input columns, padded with the identity column
+
+
+@dataclass(frozen=True)
+class ShapeGroup:
+    """Input terms of a non-linear shape, evaluated together."""
+
+    shape: str
+    cols: np.ndarray              # [g] columns in V (2 + term index)
+    inputs: np.ndarray            # [g] input column of each
+    params: np.ndarray            # [g, p]
+
+
+@dataclass(frozen=True)
+class CompiledRuleBase:
+    """A behavior as arrays. Rows of every batch are samples; columns are variables."""
+
+    rulebase: RuleBase
+    behavior: str
+    operators: Operators
+    inputs: tuple[str, ...]                 # input variables, in column order
+    universe: np.ndarray                    # [k, 2]
+    term_var: np.ndarray                    # [T] input column of each membership neuron
+    term_names: tuple[tuple[str, str], ...]  # [T] (variable, term)
+    linear: np.ndarray                      # [T] bool: piecewise-linear term
+    kernel: np.ndarray                      # [4, T] (b, s1, c, s2) of linear terms
+    shape_groups: tuple[ShapeGroup, ...]
+    levels: tuple[tuple[NodeGroup, ...], ...]
+    n_columns: int
+    rule_col: np.ndarray                    # [R] column holding each rule's antecedent
+    weight: np.ndarray                      # [R] rule weight x constant use weights
+    context: np.ndarray                     # [R, C] columns of use-conditions (1 = none)
+    labels: tuple[str, ...]
+    rules: tuple[Rule, ...]
+    outputs: tuple[str, ...]
+    cons_value: np.ndarray                  # [R, m] crisp consequent (0 where unset)
+    cons_mask: np.ndarray                   # [R, m] bool: the rule sets this output
+    cons_term: tuple[tuple[str | None, ...], ...]  # [R][m] output term named, if any
+    cons_hedges: tuple[tuple[tuple[str, ...], ...], ...]
+    default: np.ndarray                     # [m] value when no rule fires (nan = none)
+    variables: dict = field(repr=False, default_factory=dict)
+
+    @property
+    def n_rules(self) -> int:
+        return len(self.labels)
+
+    @property
+    def n_terms(self) -> int:
+        return len(self.term_names)
+
+    def input_variable(self, name: str) -> Variable:
+        return self.variables[name]
+
+    def output_variable(self, name: str) -> Variable:
+        return self.variables[name]
+
+    def rule_text(self, r: int) -> str:
+        return format_rule(self.rules[r], label=False)
+
+
+class _Builder:
+    """Allocates columns and collects node groups per level while walking expressions."""
+
+    def __init__(self, n_terms: int) -> None:
+        self.next_col = 2 + n_terms
+        self.nodes: dict[tuple, tuple[int, int]] = {}   # key -> (column, level)
+        self.pending: dict[tuple[int, str], list[tuple[int, list[int]]]] = {}
+
+    def node(self, key: tuple, op: str, children: list[tuple[int, int]]) -> tuple[int, int]:
+        if key in self.nodes:
+            return self.nodes[key]
+        level = 1 + max((lvl for _, lvl in children), default=0)
+        col = self.next_col
+        self.next_col += 1
+        self.pending.setdefault((level, op), []).append((col, [c for c, _ in children]))
+        self.nodes[key] = (col, level)
+        return col, level
+
+    def levels(self, tnorm_identity: int = ONE) -> tuple[tuple[NodeGroup, ...], ...]:
+        out: dict[int, list[NodeGroup]] = {}
+        for (level, op), items in sorted(self.pending.items()):
+            arity = max(len(ch) for _, ch in items)
+            pad = ZERO if op == "or" else ONE
+            children = np.full((len(items), arity), pad, dtype=np.intp)
+            for i, (_, ch) in enumerate(items):
+                children[i, :len(ch)] = ch
+            group = NodeGroup(op, np.array([c for c, _ in items], dtype=np.intp), children)
+            out.setdefault(level, []).append(group)
+        return tuple(tuple(out[k]) for k in sorted(out))
+
+
+def compile_rulebase(rb: RuleBase, behavior: str | None = None) -> CompiledRuleBase:
+    """Compile ``behavior`` (default: the rule base's first) into arrays."""
+    name = behavior or rb.default_behavior
+    b = rb.behavior(name)
+    operators = ops_mod.resolve(b.operators, ops_mod.resolve(rb.operators))
+    flat = flatten(rb, name)
+    variables = rb.variables
+
+    used_inputs: set[str] = set()
+    for _, rule, contexts in flat:
+        _collect_inputs(rule.antecedent, used_inputs)
+        for use in contexts:
+            if use.condition is not None:
+                _collect_inputs(use.condition, used_inputs)
+    inputs = tuple(v.name for v in variables.values() if v.name in used_inputs)
+    outputs = tuple(dict.fromkeys(c.var for _, rule, _ in flat for c in rule.consequents))
+    outputs = tuple(v.name for v in variables.values() if v.name in outputs)
+
+    # membership layer: every term of every used input
+    term_names: list[tuple[str, str]] = []
+    term_var: list[int] = []
+    terms: list[Term] = []
+    for k, vname in enumerate(inputs):
+        for t in variables[vname].terms:
+            term_names.append((vname, t.name))
+            term_var.append(k)
+            terms.append(t)
+    term_index = {key: i for i, key in enumerate(term_names)}
+    linear = np.array([t.corners is not None for t in terms], dtype=bool)
+    kernel = np.zeros((4, len(terms)))
+    for i, t in enumerate(terms):
+        if t.corners is not None:
+            kernel[:, i] = kernel_params(t.corners)
+    groups: dict[str, list[int]] = {}
+    for i, t in enumerate(terms):
+        if t.corners is None:
+            groups.setdefault(t.shape, []).append(i)
+    shape_groups = tuple(
+        ShapeGroup(shape, np.array([2 + i for i in idx], dtype=np.intp),
+                   np.array([term_var[i] for i in idx], dtype=np.intp),
+                   np.array([terms[i].params for i in idx], dtype=float).reshape(
+                       len(idx), len(SHAPES[shape].params)))
+        for shape, idx in groups.items())
+
+    builder = _Builder(len(terms))
+
+    def walk(expr: Expr) -> tuple[int, int]:
+        if isinstance(expr, Prop):
+            col = 2 + term_index[(expr.var, expr.term)]
+            ref = (col, 0)
+            if expr.hedges:
+                ref = builder.node(("hedge", expr.hedges, col), "hedge:" + " ".join(expr.hedges),
+                                   [ref])
+            if expr.negated:
+                ref = builder.node(("not", ref[0]), "not", [ref])
+            return ref
+        if isinstance(expr, Not):
+            inner = walk(expr.expr)
+            return builder.node(("not", inner[0]), "not", [inner])
+        op = "and" if isinstance(expr, And) else "or"
+        children = [walk(item) for item in expr.items]
+        if len(children) == 1:
+            return children[0]
+        return builder.node((op, tuple(c for c, _ in children)), op, children)
+
+    rule_col, weight, contexts, labels, rules = [], [], [], [], []
+    for label, rule, uses in flat:
+        rule_col.append(walk(rule.antecedent)[0])
+        w = rule.weight
+        ctx = []
+        for use in uses:
+            w *= use.weight
+            if use.condition is not None:
+                ctx.append(walk(use.condition)[0])
+        weight.append(w)
+        contexts.append(ctx)
+        labels.append(label)
+        rules.append(rule)
+    width = max((len(c) for c in contexts), default=0)
+    context = np.full((len(flat), width), ONE, dtype=np.intp)
+    for r, ctx in enumerate(contexts):
+        context[r, :len(ctx)] = ctx
+
+    m = len(outputs)
+    cons_value = np.zeros((len(flat), m))
+    cons_mask = np.zeros((len(flat), m), dtype=bool)
+    cons_term: list[list[str | None]] = [[None] * m for _ in flat]
+    cons_hedges: list[list[tuple[str, ...]]] = [[()] * m for _ in flat]
+    for r, (_, rule, _) in enumerate(flat):
+        for c in rule.consequents:
+            j = outputs.index(c.var)
+            cons_mask[r, j] = True
+            if c.term is not None:
+                cons_value[r, j] = variables[c.var].term(c.term).center
+                cons_term[r][j] = c.term
+                cons_hedges[r][j] = c.hedges
+            else:
+                cons_value[r, j] = c.value
+    default = np.array([np.nan if variables[o].default is None else variables[o].default
+                        for o in outputs], dtype=float)
+    universe = np.array([variables[v].universe for v in inputs], dtype=float).reshape(-1, 2)
+
+    return CompiledRuleBase(
+        rulebase=rb, behavior=name, operators=operators, inputs=inputs, universe=universe,
+        term_var=np.array(term_var, dtype=np.intp), term_names=tuple(term_names),
+        linear=linear, kernel=kernel, shape_groups=shape_groups, levels=builder.levels(),
+        n_columns=builder.next_col, rule_col=np.array(rule_col, dtype=np.intp),
+        weight=np.array(weight, dtype=float), context=context, labels=tuple(labels),
+        rules=tuple(rules), outputs=outputs, cons_value=cons_value, cons_mask=cons_mask,
+        cons_term=tuple(tuple(row) for row in cons_term),
+        cons_hedges=tuple(tuple(row) for row in cons_hedges), default=default,
+        variables=dict(variables))
+
+
+def _collect_inputs(expr: Expr, out: set[str]) -> None:
+    if isinstance(expr, Prop):
+        out.add(expr.var)
+    elif isinstance(expr, Not):
+        _collect_inputs(expr.expr, out)
+    else:
+        for item in expr.items:
+            _collect_inputs(item, out)
+
+
+__all__ = ["CompiledRuleBase", "NodeGroup", "ShapeGroup", "compile_rulebase", "Use"]

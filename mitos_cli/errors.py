@@ -1,0 +1,149 @@
+"""One error hierarchy for everything a user can get wrong.
+
+Every error a user can meet is a :class:`MitosError`. It carries where the problem is (a
+:class:`Span` with file, line, column and the offending source line), what was expected and a
+hint saying what to do next. The CLI prints :meth:`MitosError.render` and exits 1; anything that
+is not a ``MitosError`` is a bug and keeps its traceback.
+"""
+
+from __future__ import annotations
+
+import difflib
+from dataclasses import dataclass
+from typing import Iterable
+
+
+@dataclass(frozen=True)
+class Span:
+    """A position in a source file (1-based line and column)."""
+
+    path: str | None
+    line: int
+    column: int
+    source_line: str | None = None
+    end_column: int | None = None
+
+    def __str__(self) -> str:
+        where = self.path or "<input>"
+        return f"{where}:{self.line}:{self.column}"
+
+    @classmethod
+    def in_text(cls, text: str, path: str | None, line: int, column: int,
+                end_column: int | None = None) -> "Span":
+        """A span at ``line``/``column`` of ``text``, remembering that line for the caret."""
+        lines = text.splitlines()
+        source = lines[line - 1] if 0 < line <= len(lines) else None
+        return cls(path, line, column, source, end_column)
+
+
+class MitosError(Exception):
+    """An error in something the user wrote or asked for.
+
+    ``message`` says what is wrong, ``expected`` what would have been right, ``hint`` what to
+    do next. ``span`` points into the file when there is one.
+    """
+
+    kind = "error"
+
+    def __init__(self, message: str, *, span: Span | None = None, expected: str | None = None,
+                 hint: str | None = None) -> None:
+        super().__init__(message)
+        self.message = message
+        self.span = span
+        self.expected = expected
+        self.hint = hint
+
+    def render(self) -> str:
+        """The message as the CLI prints it: ``path:line:col: error: ...``, line, caret, hint."""
+        head = f"{self.span}: " if self.span else ""
+        out = [f"{head}{self.kind}: {self.message}"]
+        if self.span and self.span.source_line is not None:
+            src = self.span.source_line.rstrip("\n").expandtabs(4)
+            out.append(f"    {src}")
+            width = max(1, (self.span.end_column or self.span.column + 1) - self.span.column)
+            out.append("    " + " " * max(0, self.span.column - 1) + "^" * width)
+        if self.expected:
+            out.append(f"expected {self.expected}")
+        if self.hint:
+            out.append(f"hint: {self.hint}")
+        return "\n".join(out)
+
+    def __str__(self) -> str:
+        return self.render()
+
+
+class RuleSyntaxError(MitosError):
+    """A rule file, prompt line or lesson that does not parse."""
+
+    kind = "syntax error"
+
+
+class NameError_(MitosError):
+    """A name (variable, term, hedge, behavior, operator) that is not defined."""
+
+    kind = "unknown name"
+
+
+class TermSetError(MitosError):
+    """A term set (YAML) that is malformed or inconsistent."""
+
+    kind = "term set error"
+
+
+class RuleBaseError(MitosError):
+    """A rule base that parses but makes no sense (duplicate labels, cycles, ...)."""
+
+    kind = "rule base error"
+
+
+class InputError(MitosError):
+    """Bad input values for an evaluation (missing, NaN, non-numeric)."""
+
+    kind = "input error"
+
+
+class NoRuleFiredError(MitosError):
+    """No rule fired for some input and the output declares no default."""
+
+    kind = "no rule fired"
+
+
+class WorldError(MitosError):
+    """A world file that is malformed or impossible."""
+
+    kind = "world error"
+
+
+class LessonError(MitosError):
+    """A teaching command or lesson that cannot be carried out."""
+
+    kind = "lesson error"
+
+
+class FormatError(MitosError):
+    """A foreign file (FCL, FIS, FLL) that cannot be read or written."""
+
+    kind = "format error"
+
+
+def did_you_mean(name: str, candidates: Iterable[str]) -> str | None:
+    """The closest candidate to ``name`` as a hint, or ``None`` when nothing is close."""
+    pool = list(candidates)
+    close = difflib.get_close_matches(name, pool, n=1, cutoff=0.6)
+    if not close:
+        lowered = {c.lower(): c for c in pool}
+        hit = lowered.get(name.lower())
+        close = [hit] if hit else difflib.get_close_matches(name.lower(), list(lowered), n=1,
+                                                            cutoff=0.6)
+        close = [lowered.get(c, c) for c in close]
+    return f"did you mean `{close[0]}`?" if close else None
+
+
+def unknown(what: str, name: str, candidates: Iterable[str], *, span: Span | None = None,
+            cls: type[MitosError] = NameError_) -> MitosError:
+    """An "unknown X `name`" error with a did-you-mean hint and the list of valid names."""
+    pool = sorted(set(candidates))
+    hint = did_you_mean(name, pool)
+    listing = ", ".join(pool) if len(pool) <= 12 else ", ".join(pool[:12]) + ", ..."
+    expected = f"one of {listing}" if pool else None
+    return cls(f"unknown {what} `{name}`", span=span, expected=expected, hint=hint)

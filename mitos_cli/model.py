@@ -1,0 +1,176 @@
+"""The rule-base model: what a rule file means, as frozen dataclasses.
+
+The parser produces these with names as written; :func:`mitos_cli.build.build_rulebase`
+checks every name against the term sets (with "did you mean") before a :class:`RuleBase` is
+returned, so everything downstream may trust them. :func:`format_rule` writes a rule back in
+the rule language (``parse(format_rule(r)) == r``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Union
+
+from .errors import Span
+from .terms import TermSet, Variable
+
+
+@dataclass(frozen=True)
+class Prop:
+    """``var is [not] [hedge ...] TERM``: a membership, hedged then possibly negated."""
+
+    var: str
+    term: str
+    hedges: tuple[str, ...] = ()
+    negated: bool = False
+    span: Span | None = field(default=None, compare=False)
+
+
+@dataclass(frozen=True)
+class Not:
+    """``not (expr)``: the inhibitory input of eqs. 8-9, ``1 - x``."""
+
+    expr: "Expr"
+    span: Span | None = field(default=None, compare=False)
+
+
+@dataclass(frozen=True)
+class And:
+    items: tuple["Expr", ...]
+    span: Span | None = field(default=None, compare=False)
+
+
+@dataclass(frozen=True)
+class Or:
+    items: tuple["Expr", ...]
+    span: Span | None = field(default=None, compare=False)
+
+
+Expr = Union[Prop, Not, And, Or]
+
+
+@dataclass(frozen=True)
+class Consequent:
+    """``var is TERM`` (with optional hedges) or ``var is 70`` (a crisp value)."""
+
+    var: str
+    term: str | None = None
+    value: float | None = None
+    hedges: tuple[str, ...] = ()
+    span: Span | None = field(default=None, compare=False)
+
+
+@dataclass(frozen=True)
+class Rule:
+    label: str
+    antecedent: Expr
+    consequents: tuple[Consequent, ...]
+    weight: float = 1.0
+    span: Span | None = field(default=None, compare=False)
+
+
+@dataclass(frozen=True)
+class Use:
+    """``use BEHAVIOR [when CONDITION] [with W]``: fuzzy behavior blending."""
+
+    behavior: str
+    condition: Expr | None = None
+    weight: float = 1.0
+    span: Span | None = field(default=None, compare=False)
+
+
+@dataclass(frozen=True)
+class Setting:
+    """``key = value`` in an ``operators:`` line."""
+
+    key: str
+    value: str
+    span: Span | None = field(default=None, compare=False)
+
+
+@dataclass(frozen=True)
+class Behavior:
+    """A named group of rules (the paper's learned repertoire, recalled by name)."""
+
+    name: str
+    rules: tuple[Rule, ...] = ()
+    uses: tuple[Use, ...] = ()
+    operators: tuple[Setting, ...] = ()
+    frozen: tuple[str, ...] = ()
+    span: Span | None = field(default=None, compare=False)
+
+
+@dataclass(frozen=True)
+class RuleBase:
+    """A whole rule file: its term sets, file-level operators and behaviors.
+
+    The default behavior is the first one in the file (top-level rules form a behavior named
+    ``main``, which then comes first).
+    """
+
+    path: str | None
+    termsets: tuple[TermSet, ...]
+    behaviors: tuple[Behavior, ...]
+    operators: tuple[Setting, ...] = ()
+    termset_paths: tuple[str, ...] = ()
+
+    @property
+    def variables(self) -> dict[str, Variable]:
+        return {v.name: v for ts in self.termsets for v in ts.variables}
+
+    @property
+    def default_behavior(self) -> str:
+        return self.behaviors[0].name
+
+    def behavior(self, name: str | None = None) -> Behavior:
+        from .errors import unknown
+
+        name = name or self.default_behavior
+        for b in self.behaviors:
+            if b.name == name:
+                return b
+        raise unknown("behavior", name, [b.name for b in self.behaviors])
+
+
+def format_expr(expr: Expr, parent: str = "or") -> str:
+    """``expr`` in the rule language, with parentheses only where precedence needs them."""
+    if isinstance(expr, Prop):
+        words = (["not"] if expr.negated else []) + list(expr.hedges) + [expr.term]
+        return f"{expr.var} is {' '.join(words)}"
+    if isinstance(expr, Not):
+        inner = format_expr(expr.expr, "not")
+        return f"not {inner}"
+    op = "and" if isinstance(expr, And) else "or"
+    text = f" {op} ".join(format_expr(item, op) for item in expr.items)
+    needs = (parent == "and" and op == "or") or parent == "not"
+    return f"({text})" if needs else text
+
+
+def format_number(value: float) -> str:
+    """A number as short as it round-trips: 70, 0.8, 33.333333333333336."""
+    return repr(int(value)) if float(value).is_integer() and abs(value) < 1e15 else repr(value)
+
+
+def format_consequent(c: Consequent) -> str:
+    if c.term is None:
+        return f"{c.var} is {format_number(c.value)}"
+    return f"{c.var} is {' '.join(list(c.hedges) + [c.term])}"
+
+
+def format_rule(rule: Rule, label: bool = True) -> str:
+    """One rule in the rule language, on one line."""
+    head = f"{rule.label}: " if label and rule.label else ""
+    text = (f"{head}if {format_expr(rule.antecedent)} then "
+            + " and ".join(format_consequent(c) for c in rule.consequents))
+    if rule.weight != 1.0:
+        text += f" with {format_number(rule.weight)}"
+    return text
+
+
+def format_use(use: Use) -> str:
+    text = f"use {use.behavior}"
+    if use.condition is not None:
+        text += f" when {format_expr(use.condition)}"
+    if use.weight != 1.0:
+        text += f" with {format_number(use.weight)}"
+    return text

@@ -1,0 +1,97 @@
+"""The operator settings of a rule base or behavior (``operators: and = min, or = max, ...``).
+
+The default is the paper's: AND = min (eq. 17), OR = max, and the DOF-weighted average of crisp
+consequents (eqs. 18-19). A behavior's settings override the file's, key by key.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, fields, replace
+
+from . import norms
+from .errors import RuleBaseError, Span, unknown
+from .model import Setting
+
+INFERENCES = ("weighted_average", "weighted_sum", "mamdani")
+IMPLICATIONS = ("min", "product")
+DEFUZZIFIERS = ("centroid", "bisector", "mom", "som", "lom")
+
+
+@dataclass(frozen=True)
+class Operators:
+    """Which operators the neurons of a compiled behavior use."""
+
+    and_: str = "min"
+    or_: str = "max"
+    inference: str = "weighted_average"
+    implication: str = "min"
+    aggregation: str = "max"
+    defuzzify: str = "centroid"
+    resolution: int = 101
+
+    @property
+    def tnorm(self) -> norms.Norm:
+        return norms.lookup("tnorm", self.and_)
+
+    @property
+    def snorm(self) -> norms.Norm:
+        return norms.lookup("snorm", self.or_)
+
+    def describe(self) -> str:
+        text = f"and = {self.and_}, or = {self.or_}, inference = {self.inference}"
+        if self.inference == "mamdani":
+            text += (f", implication = {self.implication}, aggregation = {self.aggregation}, "
+                     f"defuzzify = {self.defuzzify}, resolution = {self.resolution}")
+        return text
+
+    def settings(self) -> dict[str, str]:
+        """The non-default settings as ``operators:`` keys (for writing a rule file back)."""
+        default = Operators()
+        out = {}
+        for f in fields(self):
+            value = getattr(self, f.name)
+            if value != getattr(default, f.name):
+                out[f.name.rstrip("_")] = str(value)
+        return out
+
+
+KEYS = {"and": "and_", "or": "or_", "inference": "inference", "implication": "implication",
+        "aggregation": "aggregation", "defuzzify": "defuzzify", "resolution": "resolution"}
+
+
+def _check(key: str, value: str, span: Span | None) -> str | int:
+    if key == "and":
+        try:
+            return norms.lookup("tnorm", value).name
+        except KeyError:
+            raise unknown("T-norm", value, norms.names("tnorm"), span=span) from None
+    if key in ("or", "aggregation"):
+        try:
+            return norms.lookup("snorm", value).name
+        except KeyError:
+            raise unknown("S-norm", value, norms.names("snorm"), span=span) from None
+    choices = {"inference": INFERENCES, "implication": IMPLICATIONS,
+               "defuzzify": DEFUZZIFIERS}.get(key)
+    if choices is not None:
+        if value not in choices:
+            raise unknown(key, value, choices, span=span)
+        return value
+    # resolution
+    try:
+        number = float(value)
+    except ValueError:
+        number = -1.0
+    if not number.is_integer() or not 3 <= number <= 100_000:
+        raise RuleBaseError(f"resolution must be a whole number from 3 to 100000, not {value}",
+                            span=span)
+    return int(number)
+
+
+def resolve(settings: tuple[Setting, ...], base: Operators | None = None) -> Operators:
+    """Apply ``operators:`` settings on top of ``base`` (the paper's defaults)."""
+    ops = base or Operators()
+    for s in settings:
+        if s.key not in KEYS:
+            raise unknown("operator setting", s.key, KEYS, span=s.span)
+        ops = replace(ops, **{KEYS[s.key]: _check(s.key, s.value, s.span)})
+    return ops

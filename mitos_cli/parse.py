@@ -1,0 +1,271 @@
+"""Parsing the rule language with Lark (LALR, linear time: no input can make it hang).
+
+:func:`parse_rules` turns text into a :class:`ParsedFile` of model objects whose names are not
+yet checked (that is :mod:`mitos_cli.build`'s job, outside Lark's callbacks). Lark's errors are
+translated into :class:`RuleSyntaxError` with ``path:line:col``, the line, a caret and what was
+expected, in words.
+"""
+
+from __future__ import annotations
+
+import functools
+from dataclasses import dataclass
+
+from lark import Lark, Token, Transformer, Tree, v_args
+from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken
+
+from .errors import RuleSyntaxError, Span
+from .model import And, Behavior, Consequent, Not, Or, Prop, Rule, Setting, Use
+from .resources import grammar_text
+
+#: How terminals are named in error messages.
+TERMINAL_WORDS = {
+    "NAME": "a name", "STRING": 'a quoted file name ("...")', "SIGNED_NUMBER": "a number",
+    "NOT": "`not`", "HEDGE": "a hedge (very, somewhat, more_or_less, extremely)", "COLON": "`:`", "COMMA": "`,`", "EQUAL": "`=`", "LPAR": "`(`",
+    "RPAR": "`)`", "$END": "the end of the input",
+}
+
+
+@functools.lru_cache(maxsize=None)
+def parser() -> Lark:
+    """The rule-language parser, built once (and cached on disk by Lark between runs)."""
+    return Lark(grammar_text(), parser="lalr", propagate_positions=True, maybe_placeholders=True,
+                start=["start", "rule", "expr"], cache=True)
+
+
+@dataclass(frozen=True)
+class ParsedFile:
+    """A rule file as written: term-set paths, file-level items, behaviors."""
+
+    text: str
+    path: str | None
+    terms: tuple[tuple[str, Span], ...] = ()
+    operators: tuple[Setting, ...] = ()
+    rules: tuple[Rule, ...] = ()
+    uses: tuple[Use, ...] = ()
+    frozen: tuple[str, ...] = ()
+    behaviors: tuple[Behavior, ...] = ()
+
+
+def _words(name: str) -> str:
+    if name in TERMINAL_WORDS:
+        return TERMINAL_WORDS[name]
+    if name.isupper() and name.isalpha():
+        return f"`{name.lower()}`"
+    return f"`{name}`"
+
+
+def _expected(names) -> str:
+    words = sorted({_words(n) for n in names if not n.startswith("__")})
+    if len(words) > 1:
+        return ", ".join(words[:-1]) + " or " + words[-1]
+    return words[0] if words else "something else"
+
+
+def _describe(token: Token) -> str:
+    if token.type == "$END":
+        return "the end of the input"
+    return f"`{token.value}`"
+
+
+def syntax_error(exc: UnexpectedInput, text: str, path: str | None) -> RuleSyntaxError:
+    """Lark's exception as a user-facing error (never ``$END`` or ``Token(...)``)."""
+    if isinstance(exc, UnexpectedCharacters):
+        line, column = exc.line, exc.column
+        char = text[exc.pos_in_stream] if exc.pos_in_stream < len(text) else ""
+        message = f"unexpected character `{char}`" if char.isprintable() else \
+            f"unexpected character {char!r}"
+        expected = _expected(exc.allowed) if exc.allowed else None
+        return RuleSyntaxError(message, span=Span.in_text(text, path, line, column),
+                               expected=expected)
+    if isinstance(exc, UnexpectedEOF) or (isinstance(exc, UnexpectedToken)
+                                          and exc.token.type == "$END"):
+        lines = text.rstrip().splitlines() or [""]
+        line = len(lines)
+        column = len(lines[-1]) + 1
+        expected = getattr(exc, "expected", None) or []
+        return RuleSyntaxError("unexpected end of the input",
+                               span=Span.in_text(text, path, line, column),
+                               expected=_expected(expected) if expected else None,
+                               hint="the last rule or behavior is incomplete (a behavior ends "
+                                    "with `end`)")
+    assert isinstance(exc, UnexpectedToken)
+    token = exc.token
+    span = Span.in_text(text, path, token.line, token.column,
+                        token.column + max(1, len(str(token.value))))
+    hint = None
+    expected = set(exc.expected)
+    if token.type == "NAME" and "IS" in expected:
+        hint = "a condition reads `variable is TERM`"
+    elif "THEN" in expected and token.type in ("NAME",):
+        hint = "join conditions with `and` / `or`, and start the actions with `then`"
+    return RuleSyntaxError(f"unexpected {_describe(token)}", span=span,
+                           expected=_expected(expected), hint=hint)
+
+
+def _span(meta, text: str, path: str | None) -> Span | None:
+    if getattr(meta, "empty", True):
+        return None
+    return Span.in_text(text, path, meta.line, meta.column, meta.end_column
+                        if meta.end_line == meta.line else None)
+
+
+class _ToModel(Transformer):
+    """Tree -> model objects. Only builds: names are checked later (Lark wraps errors here)."""
+
+    def __init__(self, text: str, path: str | None) -> None:
+        super().__init__()
+        self.text, self.path = text, path
+        self.counter = 0
+
+    def _s(self, meta) -> Span | None:
+        return _span(meta, self.text, self.path)
+
+    def number(self, items):
+        return float(items[0])
+
+    def NAME(self, token):
+        return token
+
+    @v_args(meta=True)
+    def proposition(self, meta, items):
+        var, *mods, term = items
+        negated = False
+        hedges = []
+        for m in mods:
+            if m.type == "NOT":
+                negated = not negated
+            else:
+                hedges.append(str(m))
+        return Prop(str(var), str(term), tuple(hedges), negated, self._s(meta))
+
+    @v_args(meta=True)
+    def negation(self, meta, items):
+        return Not(items[0], self._s(meta))
+
+    @v_args(meta=True)
+    def and_expr(self, meta, items):
+        flat = []
+        for item in items:
+            flat.extend(item.items if isinstance(item, And) else [item])
+        return And(tuple(flat), self._s(meta))
+
+    @v_args(meta=True)
+    def or_expr(self, meta, items):
+        flat = []
+        for item in items:
+            flat.extend(item.items if isinstance(item, Or) else [item])
+        return Or(tuple(flat), self._s(meta))
+
+    @v_args(meta=True)
+    def term_consequent(self, meta, items):
+        var, *mods, term = items
+        return Consequent(str(var), str(term), None, tuple(str(m) for m in mods), self._s(meta))
+
+    @v_args(meta=True)
+    def crisp_consequent(self, meta, items):
+        return Consequent(str(items[0]), None, float(items[1]), (), self._s(meta))
+
+    def label(self, items):
+        return str(items[0])
+
+    def weight(self, items):
+        return items[0]
+
+    @v_args(meta=True)
+    def rule(self, meta, items):
+        label, antecedent, *consequents, weight = items
+        for c in consequents:
+            if isinstance(c, tuple):
+                return c
+        return Rule(label or "", antecedent, tuple(consequents),
+                    1.0 if weight is None else weight, self._s(meta))
+
+    @v_args(meta=True)
+    def use_stmt(self, meta, items):
+        name, condition, weight = items
+        return Use(str(name), condition, 1.0 if weight is None else weight, self._s(meta))
+
+    def frozen_stmt(self, items):
+        return ("frozen", tuple(str(i) for i in items))
+
+    @v_args(meta=True)
+    def op_assign(self, meta, items):
+        value = items[1]
+        value = str(value) if isinstance(value, Token) else repr(value)
+        return Setting(str(items[0]), value, self._s(meta))
+
+    def operators_stmt(self, items):
+        return ("operators", tuple(items))
+
+    @v_args(meta=True)
+    def terms_stmt(self, meta, items):
+        spans = []
+        for tok in items:
+            spans.append((_unquote(tok), Span.in_text(self.text, self.path, tok.line,
+                                                      tok.column, tok.end_column)))
+        return ("terms", tuple(spans))
+
+    @v_args(meta=True)
+    def behavior(self, meta, items):
+        name, *body = items
+        return ("behavior", str(name), body, self._s(meta))
+
+
+def _unquote(token: Token) -> str:
+    import json
+
+    return json.loads(str(token))
+
+
+def parse_tree(text: str, path: str | None = None, start: str = "start") -> Tree:
+    try:
+        return parser().parse(text, start=start)
+    except UnexpectedInput as exc:
+        raise syntax_error(exc, text, path) from None
+
+
+def parse_rules(text: str, path: str | None = None) -> ParsedFile:
+    """Parse a whole rule file into model objects (names unchecked)."""
+    tree = parse_tree(text, path)
+    items = _ToModel(text, path).transform(tree).children
+    terms, operators, rules, uses, frozen, behaviors = [], [], [], [], [], []
+    for item in items:
+        _collect(item, terms, operators, rules, uses, frozen, behaviors)
+    return ParsedFile(text, path, tuple(terms), tuple(operators), tuple(rules), tuple(uses),
+                      tuple(frozen), tuple(behaviors))
+
+
+def _collect(item, terms, operators, rules, uses, frozen, behaviors) -> None:
+    if isinstance(item, Rule):
+        rules.append(item)
+    elif isinstance(item, Use):
+        uses.append(item)
+    elif isinstance(item, tuple) and item[0] == "error":
+        raise RuleSyntaxError(item[1], span=item[2])
+    elif item[0] == "terms":
+        terms.extend(item[1])
+    elif item[0] == "operators":
+        operators.extend(item[1])
+    elif item[0] == "frozen":
+        frozen.extend(item[1])
+    elif item[0] == "behavior":
+        _, name, body, span = item
+        b_rules, b_ops, b_uses, b_frozen = [], [], [], []
+        for sub in body:
+            _collect(sub, [], b_ops, b_rules, b_uses, b_frozen, [])
+        behaviors.append(Behavior(name, tuple(b_rules), tuple(b_uses),
+                                  tuple(b_ops), tuple(b_frozen), span))
+
+
+def parse_rule(text: str, path: str | None = None) -> Rule:
+    """Parse one rule (a prompt line)."""
+    result = _ToModel(text, path).transform(parse_tree(text, path, start="rule"))
+    if isinstance(result, tuple):
+        raise RuleSyntaxError(result[1], span=result[2])
+    return result
+
+
+def parse_expr(text: str, path: str | None = None):
+    """Parse a condition such as ``road is WIDE and not size is LARGE_SZ``."""
+    return _ToModel(text, path).transform(parse_tree(text, path, start="expr"))

@@ -1,0 +1,42 @@
+"""Where the grammar, the packaged rule bases and the packaged worlds live.
+
+In a wheel they are package data under ``mitos_cli/_data/`` (read with ``importlib.resources``,
+so they work from a zip too); in a source checkout they are the top-level ``grammar/``,
+``rulebases/`` and ``worlds/`` directories next to the package.
+"""
+
+from __future__ import annotations
+
+import importlib.resources
+from pathlib import Path
+from typing import Iterator
+
+DEFAULT_RULEBASE = "mitos.rules"
+DEFAULT_WORLD = "corridor.yaml"
+
+
+def data_dir(kind: str):
+    """The ``grammar``, ``rulebases`` or ``worlds`` directory as a Traversable."""
+    packaged = importlib.resources.files("mitos_cli") / "_data" / kind
+    if packaged.is_dir():
+        return packaged
+    return importlib.resources.files("mitos_cli") / ".." / kind
+
+
+def grammar_text(name: str = "mitos.lark") -> str:
+    return (data_dir("grammar") / name).read_text(encoding="utf-8")
+
+
+def packaged_path(kind: str, name: str) -> Path:
+    """A packaged file as a real filesystem path (extracted when the package is zipped)."""
+    resource = data_dir(kind) / name
+    if isinstance(resource, Path):
+        return resource.resolve()
+    stack = importlib.resources.as_file(resource)  # zip: extract to a temporary file
+    return Path(stack.__enter__())
+
+
+def packaged_names(kind: str, suffix: str) -> Iterator[str]:
+    for entry in sorted(data_dir(kind).iterdir(), key=lambda e: e.name):
+        if entry.name.endswith(suffix):
+            yield entry.name

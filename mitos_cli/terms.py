@@ -1,0 +1,119 @@
+"""Linguistic variables and their terms (the model side of a term set).
+
+A :class:`Variable` has a universe, a role (input or output) and terms; a :class:`Term` is a
+named membership function from :mod:`mitos_cli.shapes`. Both are frozen and validated when
+built, so a compiled rule base never meets a malformed one.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+from typing import Literal
+
+import numpy as np
+
+from .errors import Span, TermSetError, unknown
+from .shapes import SHAPES, Shape
+
+Role = Literal["input", "output"]
+
+
+@dataclass(frozen=True)
+class Term:
+    """A named fuzzy set: a shape and its parameters (in the shape's own order)."""
+
+    name: str
+    shape: str
+    params: tuple[float, ...]
+    span: Span | None = field(default=None, compare=False)
+    frozen: bool = False
+
+    @property
+    def kind(self) -> Shape:
+        return SHAPES[self.shape]
+
+    @property
+    def corners(self) -> tuple[float, float, float, float] | None:
+        """``(a, b, c, d)`` for piecewise-linear shapes, else ``None``."""
+        return self.kind.corners(self.params) if self.kind.corners else None
+
+    @property
+    def center(self) -> float:
+        """The crisp value the term stands for in a weighted-average consequent."""
+        return float(self.kind.center(self.params))
+
+    def membership(self, x) -> np.ndarray:
+        return self.kind.membership(x, self.params)
+
+    def with_params(self, params: tuple[float, ...]) -> "Term":
+        return replace(self, params=tuple(float(p) for p in params))
+
+
+@dataclass(frozen=True)
+class Variable:
+    """A linguistic variable: x1 road width, y1 steering, ..."""
+
+    name: str
+    role: Role
+    universe: tuple[float, float]
+    terms: tuple[Term, ...]
+    description: str = ""
+    unit: str = ""
+    default: float | None = None
+    span: Span | None = field(default=None, compare=False)
+
+    def __post_init__(self) -> None:
+        lo, hi = self.universe
+        if not lo < hi:
+            raise TermSetError(f"variable `{self.name}`: universe [{lo:g}, {hi:g}] is empty",
+                               span=self.span, hint="write `universe: [min, max]` with min < max")
+        seen: set[str] = set()
+        for term in self.terms:
+            if term.name in seen:
+                raise TermSetError(f"variable `{self.name}`: duplicate term `{term.name}`",
+                                   span=term.span)
+            seen.add(term.name)
+
+    @property
+    def term_names(self) -> tuple[str, ...]:
+        return tuple(t.name for t in self.terms)
+
+    def term(self, name: str, span: Span | None = None) -> Term:
+        for t in self.terms:
+            if t.name == name:
+                return t
+        raise unknown(f"term of `{self.name}`", name, self.term_names, span=span)
+
+    def index(self, name: str) -> int:
+        return self.term_names.index(name)
+
+    def with_terms(self, terms: tuple[Term, ...]) -> "Variable":
+        return replace(self, terms=terms)
+
+
+@dataclass(frozen=True)
+class TermSet:
+    """The variables of one YAML file."""
+
+    variables: tuple[Variable, ...]
+    path: str | None = None
+
+    def variable(self, name: str, span: Span | None = None) -> Variable:
+        for v in self.variables:
+            if v.name == name:
+                return v
+        raise unknown("variable", name, [v.name for v in self.variables], span=span)
+
+
+def check_term(term: Term, universe: tuple[float, float], variable: str) -> None:
+    """Raise :class:`TermSetError` when ``term`` is malformed for its variable."""
+    problem = term.kind.check(term.params)
+    if problem:
+        raise TermSetError(f"term `{variable}.{term.name}`: {problem}", span=term.span)
+    lo, hi = universe
+    center = term.center
+    if not lo <= center <= hi:
+        raise TermSetError(
+            f"term `{variable}.{term.name}`: its peak {center:g} lies outside the universe "
+            f"[{lo:g}, {hi:g}]", span=term.span,
+            hint="move the term or widen the variable's universe")

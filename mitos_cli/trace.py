@@ -1,0 +1,120 @@
+"""The degree-of-fulfilment trace of one evaluation, as the paper's sample run prints it.
+
+A :class:`Trace` is plain data (inputs with their memberships, the rules that fired with their
+DOFs, the crisp outputs); :meth:`Trace.render` writes it for people and :meth:`Trace.to_json`
+for machines (the ``mitos eval --json`` contract).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from .engine import Result
+
+
+@dataclass(frozen=True)
+class InputTrace:
+    name: str
+    value: float
+    unit: str
+    memberships: tuple[tuple[str, float], ...]
+    clamped: bool = False
+
+
+@dataclass(frozen=True)
+class RuleTrace:
+    label: str
+    text: str
+    dof: float
+
+
+@dataclass(frozen=True)
+class Trace:
+    rulebase: str
+    behavior: str
+    operators: str
+    n_rules: int
+    inputs: tuple[InputTrace, ...]
+    rules: tuple[RuleTrace, ...]          # fired rules only, in rule-base order
+    outputs: tuple[tuple[str, float, str], ...]
+
+    def to_json(self) -> dict:
+        return {
+            "rulebase": self.rulebase,
+            "inputs": {i.name: {"value": i.value, "memberships": dict(i.memberships)}
+                       for i in self.inputs},
+            "rules": [{"label": r.label, "text": r.text, "dof": r.dof} for r in self.rules],
+            "outputs": {name: value for name, value, _ in self.outputs},
+        }
+
+    def render(self, digits: int = 1) -> str:
+        """The paper's layout: fuzzified inputs, fired rules with DOFs, crisp outputs."""
+        def num(x: float) -> str:
+            return f"{x:.{digits}f}"
+
+        lines = [f"rule base {self.rulebase}, behavior {self.behavior} "
+                 f"({self.n_rules} rules; {self.operators})", "", "fuzzified inputs:"]
+        fuzzified = []
+        for i in self.inputs:
+            shown = [f"{t}/{num(mu)}" for t, mu in i.memberships if round(mu, digits) > 0]
+            fuzzified.append(f"{i.name} = ({', '.join(shown)})")
+        width = max(len(f) for f in fuzzified) if fuzzified else 0
+        for text, i in zip(fuzzified, self.inputs):
+            note = " (clamped to its universe)" if i.clamped else ""
+            lines.append(f"  {text.ljust(width)}   {i.name} = {i.value:g} {i.unit}".rstrip()
+                         + note)
+        lines += ["", f"rules fired ({len(self.rules)} of {self.n_rules}):"]
+        for r in self.rules:
+            lines.append(f"  {r.label}: {r.text}, DOF = {num(r.dof)}")
+        if not self.rules:
+            lines.append("  (none)")
+        lines += ["", "outputs:"]
+        for name, value, unit in self.outputs:
+            lines.append(f"  {name} = {num(value)} {unit}".rstrip())
+        return "\n".join(lines)
+
+
+def display_path(path: str | None) -> str:
+    """A rule-base path as users should read it: relative to here, or marked as packaged."""
+    import os
+    from pathlib import Path
+
+    from .resources import data_dir
+
+    if not path:
+        return "<rules>"
+    p = Path(path).resolve()
+    try:
+        packaged = Path(str(data_dir("rulebases"))).resolve()
+        if p.is_relative_to(packaged):
+            return f"rulebases/{p.relative_to(packaged).as_posix()} (packaged)"
+    except (OSError, ValueError):
+        pass
+    try:
+        return os.path.relpath(p)
+    except ValueError:
+        return str(path)
+
+
+def trace_of(result: Result, row: int = 0) -> Trace:
+    """The trace of sample ``row`` of an evaluation."""
+    c = result.compiled
+    inputs = []
+    t = 0
+    for k, name in enumerate(c.inputs):
+        var = c.variables[name]
+        mus = []
+        for term in var.terms:
+            mus.append((term.name, float(result.memberships[row, t])))
+            t += 1
+        lo, hi = var.universe
+        value = float(result.inputs[row, k])
+        inputs.append(InputTrace(name, value, var.unit, tuple(mus),
+                                 bool(result.clamped[k]) and value in (lo, hi)))
+    rules = tuple(RuleTrace(c.labels[r], c.rule_text(r), float(result.dof[row, r]))
+                  for r in range(c.n_rules) if result.dof[row, r] > 0)
+    outputs = tuple((name, float(result.outputs[row, j]), c.variables[name].unit)
+                    for j, name in enumerate(c.outputs))
+    path = display_path(c.rulebase.path)
+    return Trace(path, c.behavior, c.operators.describe(), c.n_rules, tuple(inputs), rules,
+                 outputs)

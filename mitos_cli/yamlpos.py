@@ -1,0 +1,125 @@
+"""YAML with source positions, so that every complaint about a term set or a world can name the
+file, the line and the key.
+
+Loading is ``yaml.SafeLoader`` underneath (nothing is ever evaluated as Python); mappings come
+back as :class:`YMap` and sequences as :class:`YList`, which remember where each key and value
+stood. Checking helpers (:func:`check_keys`, :func:`require`) raise the caller's error class with
+that position and a "did you mean" for unknown keys.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Iterable
+
+import yaml
+
+from .errors import MitosError, Span, did_you_mean
+
+
+class YMap(dict):
+    """A mapping that remembers the span of itself, of each key and of each value."""
+
+    span: Span
+    key_spans: dict
+    value_spans: dict
+
+    def key_span(self, key: str) -> Span:
+        return self.key_spans.get(key, self.span)
+
+    def value_span(self, key: str) -> Span:
+        return self.value_spans.get(key, self.key_span(key))
+
+
+class YList(list):
+    """A sequence that remembers the span of itself and of each item."""
+
+    span: Span
+    item_spans: list
+
+    def item_span(self, index: int) -> Span:
+        return self.item_spans[index] if index < len(self.item_spans) else self.span
+
+
+def _span(mark: Any, text: str, path: str | None) -> Span:
+    return Span.in_text(text, path, mark.line + 1, mark.column + 1)
+
+
+def _build_loader(text: str, path: str | None) -> type:
+    class Loader(yaml.SafeLoader):
+        pass
+
+    def construct_mapping(loader: Loader, node: yaml.MappingNode) -> YMap:
+        out = YMap()
+        out.span = _span(node.start_mark, text, path)
+        out.key_spans, out.value_spans = {}, {}
+        for key_node, value_node in node.value:
+            key = loader.construct_object(key_node, deep=True)
+            if not isinstance(key, (str, int, float, bool)) or key is None:
+                raise yaml.constructor.ConstructorError(
+                    None, None, "a mapping key must be a plain name", key_node.start_mark)
+            key = str(key)
+            if key in out:
+                raise yaml.constructor.ConstructorError(
+                    None, None, f"duplicate key `{key}`", key_node.start_mark)
+            out[key] = loader.construct_object(value_node, deep=True)
+            out.key_spans[key] = _span(key_node.start_mark, text, path)
+            out.value_spans[key] = _span(value_node.start_mark, text, path)
+        return out
+
+    def construct_sequence(loader: Loader, node: yaml.SequenceNode) -> YList:
+        out = YList(loader.construct_object(child, deep=True) for child in node.value)
+        out.span = _span(node.start_mark, text, path)
+        out.item_spans = [_span(child.start_mark, text, path) for child in node.value]
+        return out
+
+    Loader.add_constructor(yaml.resolver.BaseResolver.DEFAULT_MAPPING_TAG, construct_mapping)
+    Loader.add_constructor(yaml.resolver.BaseResolver.DEFAULT_SEQUENCE_TAG, construct_sequence)
+    return Loader
+
+
+def load(text: str, path: str | None, error: type[MitosError]) -> Any:
+    """Parse YAML ``text`` (from ``path``) into positioned values, raising ``error`` when bad."""
+    try:
+        return yaml.load(text, Loader=_build_loader(text, path))  # noqa: S506 (SafeLoader)
+    except yaml.MarkedYAMLError as exc:
+        mark = exc.problem_mark or exc.context_mark
+        span = _span(mark, text, path) if mark is not None else None
+        problem = exc.problem or exc.context or "malformed YAML"
+        raise error(f"invalid YAML: {problem}", span=span) from None
+    except yaml.YAMLError as exc:  # pragma: no cover - other YAML errors carry no mark
+        raise error(f"invalid YAML: {exc}", span=Span(path, 1, 1)) from None
+
+
+def check_keys(mapping: YMap, allowed: Iterable[str], error: type[MitosError],
+               what: str) -> None:
+    """Refuse keys of ``mapping`` not in ``allowed``, suggesting the closest one."""
+    allowed = list(allowed)
+    for key in mapping:
+        if key not in allowed:
+            raise error(f"unknown key `{key}` in {what}", span=mapping.key_span(key),
+                        expected="one of " + ", ".join(allowed),
+                        hint=did_you_mean(key, allowed))
+
+
+def require(mapping: YMap, key: str, error: type[MitosError], what: str) -> Any:
+    """The value of ``key``, or ``error`` naming the mapping's line when it is missing."""
+    if key not in mapping:
+        raise error(f"missing `{key}` in {what}", span=mapping.span,
+                    hint=f"add `{key}: ...` to {what}")
+    return mapping[key]
+
+
+def expect_map(value: Any, span: Span, error: type[MitosError], what: str) -> YMap:
+    if not isinstance(value, YMap):
+        raise error(f"{what} must be a mapping (`key: value` lines)", span=span)
+    return value
+
+
+def expect_number(value: Any, span: Span, error: type[MitosError], what: str) -> float:
+    """``value`` as a finite float, or ``error`` saying a number was expected."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise error(f"{what} must be a number, not `{value}`", span=span)
+    number = float(value)
+    if number != number or number in (float("inf"), float("-inf")):
+        raise error(f"{what} must be a finite number, not `{value}`", span=span)
+    return number
