@@ -17,6 +17,7 @@ samples.
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -50,7 +51,7 @@ class ShapeGroup:
     params: np.ndarray            # [g, p]
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class CompiledRuleBase:
     """A behavior as arrays. Rows of every batch are samples; columns are variables."""
 
@@ -78,6 +79,34 @@ class CompiledRuleBase:
     cons_hedges: tuple[tuple[tuple[str, ...], ...], ...]
     default: np.ndarray                     # [m] value when no rule fires (nan = none)
     variables: dict = field(repr=False, default_factory=dict)
+
+    @property
+    def kernel_columns(self) -> np.ndarray:
+        """The kernel as ``[4, T, 1]`` columns, to broadcast against ``[T, b]`` blocks."""
+        return self.kernel[:, :, None]
+
+    @property
+    def weighted(self) -> bool:
+        return bool((self.weight != 1.0).any())
+
+    @property
+    def sum_weights(self) -> np.ndarray:
+        """``[k, R]`` weights of the output layer's sums: one numerator per output, then one
+        denominator per distinct set of rules that set an output."""
+        return self._sums[0]
+
+    @property
+    def den_row(self) -> np.ndarray:
+        """Row of :attr:`sum_weights` holding each output's denominator."""
+        return self._sums[1]
+
+    @functools.cached_property
+    def _sums(self) -> tuple[np.ndarray, np.ndarray]:
+        masks = [tuple(self.cons_mask[:, j]) for j in range(len(self.outputs))]
+        distinct = list(dict.fromkeys(masks))
+        K = np.vstack([self.cons_value.T] + [np.array(d, dtype=float)[None] for d in distinct])
+        rows = np.array([len(self.outputs) + distinct.index(m) for m in masks], dtype=np.intp)
+        return K.reshape(-1, self.n_rules), rows
 
     @property
     def n_rules(self) -> int:

@@ -1,9 +1,10 @@
 """Evaluating a compiled rule base on a batch of inputs: a pure function of arrays.
 
 ``evaluate(compiled, X)`` takes ``X[n, k]`` (rows are samples, columns the compiled inputs) and
-returns memberships ``[n, T]``, DOFs ``[n, R]`` and outputs ``[n, m]``. All work is row-wise,
-so a single evaluation is exactly row 0 of a batch of one (bit for bit): sums run along the
-contiguous last axis, which NumPy reduces the same way for one row or a million.
+returns memberships ``[n, T]``, DOFs ``[n, R]`` and outputs ``[n, m]``. Internally a block of
+samples is ``V[neurons, b]``: each layer gathers whole rows (contiguous copies), and every
+operation is elementwise per sample, so a single evaluation is bit for bit the same as its row
+in any batch.
 """
 
 from __future__ import annotations
@@ -25,11 +26,13 @@ class Result:
 
     compiled: CompiledRuleBase
     inputs: np.ndarray        # [n, k] after clamping to the universes
-    memberships: np.ndarray   # [n, T]
-    dof: np.ndarray           # [n, R] degree of fulfilment of each rule (after weights)
+    memberships: np.ndarray | None   # [n, T] (None with detail=False)
+    dof: np.ndarray | None    # [n, R] degree of fulfilment of each rule (after weights)
     outputs: np.ndarray       # [n, m]
     clamped: np.ndarray       # [k] how many samples of each input were clamped
     values: np.ndarray | None = None  # [n, columns] every neuron's value (kept on request)
+
+    # memberships and dof are transposed views of [T, n] / [R, n] arrays (rows are samples).
 
     def output(self, name: str) -> np.ndarray:
         return self.outputs[:, self.compiled.outputs.index(name)]
@@ -96,100 +99,166 @@ def check_inputs(compiled: CompiledRuleBase, X: np.ndarray) -> tuple[np.ndarray,
     return X, clamped
 
 
-def memberships(compiled: CompiledRuleBase, X: np.ndarray, out: np.ndarray) -> None:
-    """Membership layer: fill ``out[:, 2:2+T]`` with every input term's membership."""
+#: Samples per block: one block's neuron values stay in the CPU cache. Every operation is
+#: column-wise (per sample), so results do not depend on the block size.
+BLOCK = 8192
+
+
+def memberships(compiled: CompiledRuleBase, Xt: np.ndarray, out: np.ndarray) -> None:
+    """Membership layer: fill rows ``2 .. 2+T`` of ``out[columns, b]`` from ``Xt[k, b]``."""
     T = compiled.n_terms
-    mu = out[:, 2:2 + T]
-    if compiled.linear.any():
-        b, s1, c, s2 = compiled.kernel
-        x = X[:, compiled.term_var]
-        rise = (x - b) * s1
+    if compiled.linear.all():
+        b, s1, c, s2 = compiled.kernel_columns
+        x = Xt[compiled.term_var]
+        rise = np.subtract(x, b, out=out[2:2 + T])
+        rise *= s1
         fall = np.subtract(c, x, out=x)
         fall *= s2
         np.minimum(rise, fall, out=rise)
         rise += 1.0
         np.clip(rise, 0.0, 1.0, out=rise)
-        mu[:] = rise
+        return
+    if compiled.linear.any():
+        idx = np.flatnonzero(compiled.linear)
+        b, s1, c, s2 = (k[idx] for k in compiled.kernel_columns)
+        x = Xt[compiled.term_var[idx]]
+        rise = (x - b) * s1
+        fall = (c - x) * s2
+        out[2 + idx] = np.clip(1.0 + np.minimum(rise, fall), 0.0, 1.0)
     for g in compiled.shape_groups:
         shape = SHAPES[g.shape]
-        x = X[:, g.inputs]
-        out[:, g.cols] = shape.fn(x, *(g.params[:, i] for i in range(g.params.shape[1])))
+        x = Xt[g.inputs]
+        out[g.cols] = shape.fn(x, *(g.params[:, i:i + 1] for i in range(g.params.shape[1])))
 
 
 def _apply_group(group, V: np.ndarray, tnorm: norms.Norm, snorm: norms.Norm) -> None:
+    """One layer's neurons of one operator: gather their inputs, aggregate, write outputs."""
     op = group.op
     ch = group.children
     if op == "not":
-        V[:, group.out] = 1.0 - V[:, ch[:, 0]]
+        V[group.out] = 1.0 - V[ch[:, 0]]
         return
     if op.startswith("hedge:"):
-        V[:, group.out] = hedge_mod.apply(tuple(op[6:].split()), V[:, ch[:, 0]])
+        V[group.out] = hedge_mod.apply(tuple(op[6:].split()), V[ch[:, 0]])
         return
     norm = tnorm if op == "and" else snorm
-    acc = V[:, ch[:, 0]]
-    for j in range(1, ch.shape[1]):     # loop over arity (a few), never over rules
-        if norm.fn is np.minimum or norm.fn is np.maximum:
-            norm.fn(acc, V[:, ch[:, j]], out=acc)
-        else:
-            acc = norm.fn(acc, V[:, ch[:, j]])
-    V[:, group.out] = acc
+    lo, hi = int(group.out[0]), int(group.out[-1]) + 1
+    contiguous = hi - lo == len(group.out)     # the compiler allocates a group's outputs in a row
+    acc = V[lo:hi] if contiguous else np.empty((len(group.out), V.shape[1]))
+    np.take(V, ch[:, 0], axis=0, out=acc)
+    if ch.shape[1] > 1:
+        scratch = np.empty_like(acc)
+        for j in range(1, ch.shape[1]):     # loop over arity (a few), never over rules
+            np.take(V, ch[:, j], axis=0, out=scratch)
+            if norm.fn is np.minimum or norm.fn is np.maximum:
+                norm.fn(acc, scratch, out=acc)
+            else:
+                acc[:] = norm.fn(acc, scratch)
+    if not contiguous:
+        V[group.out] = acc
 
 
-def evaluate(compiled: CompiledRuleBase, X, *, keep_values: bool = False,
-             strict: bool = True) -> Result:
-    """Evaluate the network on ``X[n, k]``.
-
-    With ``strict`` (the default) an output whose rules all have DOF 0 for some sample takes
-    the variable's ``default``, and without one raises :class:`NoRuleFiredError`; with
-    ``strict=False`` such outputs are NaN (for callers that report them themselves).
-    """
-    X, clamped = check_inputs(compiled, X)
-    n = X.shape[0]
-    V = np.empty((n, compiled.n_columns))
-    V[:, ZERO] = 0.0
-    V[:, ONE] = 1.0
-    memberships(compiled, X, V)
+def network_values(compiled: CompiledRuleBase, Xt: np.ndarray) -> np.ndarray:
+    """Every neuron's value ``V[columns, b]`` for inputs ``Xt[k, b]`` (one block)."""
+    V = np.empty((compiled.n_columns, Xt.shape[1]))
+    V[ZERO] = 0.0
+    V[ONE] = 1.0
+    memberships(compiled, Xt, V)
     tnorm, snorm = compiled.operators.tnorm, compiled.operators.snorm
     for level in compiled.levels:
         for group in level:
             _apply_group(group, V, tnorm, snorm)
-    dof = V[:, compiled.rule_col]
-    if compiled.context.shape[1]:
-        for j in range(compiled.context.shape[1]):   # depth of `use` nesting
-            dof *= V[:, compiled.context[:, j]]
-    if (compiled.weight != 1.0).any():
-        dof *= compiled.weight
-    outputs = infer(compiled, dof, X, strict=strict)
-    mu = V[:, 2:2 + compiled.n_terms]
-    return Result(compiled, X, mu if keep_values else mu.copy(), dof, outputs, clamped,
-                  V if keep_values else None)
+    return V
 
 
-def infer(compiled: CompiledRuleBase, dof: np.ndarray, X: np.ndarray, *,
-          strict: bool = True) -> np.ndarray:
-    """Output layer: combine the rules' DOFs into crisp outputs."""
-    method = compiled.operators.inference
-    if method == "mamdani":
+def rule_dof(compiled: CompiledRuleBase, V: np.ndarray) -> np.ndarray:
+    """DOFs ``[R, b]``: antecedent values times ``use`` contexts and rule weights."""
+    r0 = int(compiled.rule_col[0]) if compiled.n_rules else 0
+    if compiled.n_rules and (compiled.rule_col == np.arange(r0, r0 + compiled.n_rules)).all():
+        dof = V[r0:r0 + compiled.n_rules]           # a view: rules own a run of columns
+    else:
+        dof = V[compiled.rule_col]
+    if compiled.context.shape[1] or compiled.weighted:
+        dof = dof.copy()
+        for j in range(compiled.context.shape[1]):      # depth of `use` nesting
+            dof *= V[compiled.context[:, j]]
+        if compiled.weighted:
+            dof *= compiled.weight[:, None]
+    return dof
+
+
+def tree_sum(W: np.ndarray) -> np.ndarray:
+    """Sum ``W[k, R, b]`` over rules by halving (pairwise, padded with zeros).
+
+    Only elementwise additions, in an order fixed by ``R`` alone: one sample gives the same
+    bits alone or in any batch, on any NumPy. The loop runs log2(R) times.
+    """
+    size = W.shape[1]
+    while size > 1:
+        half = (size + 1) // 2
+        np.add(W[:, :size - half], W[:, half:size], out=W[:, :size - half])
+        size = half
+    return W[:, 0]
+
+
+def weighted_average(compiled: CompiledRuleBase, dof: np.ndarray) -> np.ndarray:
+    """Eqs. 18-19 for every output: ``sum(dof * y) / sum(dof)`` (NaN where nothing fired)."""
+    K = compiled.sum_weights                     # [k, R]: numerators, then denominators
+    W = np.multiply(dof[None], K[:, :, None])
+    sums = tree_sum(W)
+    m = len(compiled.outputs)
+    out = np.full((m, dof.shape[1]), np.nan)
+    if compiled.operators.inference == "weighted_sum":
+        return sums[:m].copy()
+    den = sums[compiled.den_row]
+    np.divide(sums[:m], den, out=out, where=den > 0)
+    return out
+
+
+def evaluate(compiled: CompiledRuleBase, X, *, detail: bool = True, keep_values: bool = False,
+             strict: bool = True) -> Result:
+    """Evaluate the network on ``X[n, k]``, in cache-sized blocks of samples.
+
+    ``detail`` keeps memberships and DOFs (``False`` returns only outputs, faster);
+    ``keep_values`` also keeps every neuron's value (for training and the rule viewer). With
+    ``strict`` (the default) an output whose rules all have DOF 0 for some sample takes the
+    variable's ``default``, and without one raises :class:`NoRuleFiredError`; with
+    ``strict=False`` such outputs are NaN (for callers that report them themselves).
+    """
+    X, clamped = check_inputs(compiled, X)
+    n = X.shape[0]
+    Xt = np.ascontiguousarray(X.T)
+    T, R = compiled.n_terms, compiled.n_rules
+    mu = np.empty((T, n)) if detail else None
+    dof = np.empty((R, n)) if detail else None
+    values = np.empty((compiled.n_columns, n)) if keep_values else None
+    out = np.empty((len(compiled.outputs), n))
+    for start in range(0, n, BLOCK):          # blocks of samples, each one vectorized pass
+        block = slice(start, min(start + BLOCK, n))
+        V = network_values(compiled, Xt[:, block])
+        d = rule_dof(compiled, V)
+        out[:, block] = infer(compiled, d)
+        if detail:
+            mu[:, block] = V[2:2 + T]
+            dof[:, block] = d
+        if keep_values:
+            values[:, block] = V
+    outputs = fill_defaults(compiled, out.T, X, strict)
+    return Result(compiled, X, mu.T if detail else None, dof.T if detail else None, outputs,
+                  clamped, values.T if keep_values else None)
+
+
+def infer(compiled: CompiledRuleBase, dof: np.ndarray) -> np.ndarray:
+    """Output layer: DOFs ``[R, b]`` -> outputs ``[m, b]`` (NaN where no rule fired)."""
+    if compiled.operators.inference == "mamdani":
         from .mamdani import mamdani_outputs
 
-        out = mamdani_outputs(compiled, dof)
-    else:
-        out = np.empty((dof.shape[0], len(compiled.outputs)))
-        for j in range(len(compiled.outputs)):          # loop over outputs (one or two)
-            mask = compiled.cons_mask[:, j]
-            weights = dof if mask.all() else dof * mask
-            num = (weights * compiled.cons_value[:, j]).sum(axis=1)
-            if method == "weighted_sum":
-                out[:, j] = num
-                continue
-            den = weights.sum(axis=1)
-            with np.errstate(invalid="ignore", divide="ignore"):
-                out[:, j] = np.where(den > 0, num / den, np.nan)
-    return fill_defaults(compiled, out, dof, X, strict)
+        return mamdani_outputs(compiled, dof)
+    return weighted_average(compiled, dof)
 
 
-def fill_defaults(compiled: CompiledRuleBase, out: np.ndarray, dof: np.ndarray,
-                  X: np.ndarray, strict: bool) -> np.ndarray:
+def fill_defaults(compiled: CompiledRuleBase, out: np.ndarray, X: np.ndarray,
+                  strict: bool) -> np.ndarray:
     """Where no rule fired (NaN), use the output's default or explain how to declare one."""
     empty = np.isnan(out)
     if not empty.any():
