@@ -40,9 +40,11 @@ def read_rulebase(path: str | Path | None = None) -> RuleBase:
 class LoadedRuleBase:
     """A rule base with one behavior compiled, ready to evaluate."""
 
-    def __init__(self, rulebase: RuleBase, behavior: str | None = None) -> None:
+    def __init__(self, rulebase: RuleBase, behavior: str | None = None,
+                 overrides: tuple = ()) -> None:
         self.rulebase = rulebase
-        self.compiled: CompiledRuleBase = compile_rulebase(rulebase, behavior)
+        self.overrides = tuple(overrides)
+        self.compiled: CompiledRuleBase = compile_rulebase(rulebase, behavior, self.overrides)
 
     @property
     def inputs(self) -> tuple[str, ...]:
@@ -59,7 +61,15 @@ class LoadedRuleBase:
     @functools.lru_cache(maxsize=None)
     def behavior(self, name: str) -> "LoadedRuleBase":
         """The same rule base with another behavior compiled (recalled by name alone)."""
-        return LoadedRuleBase(self.rulebase, name)
+        return LoadedRuleBase(self.rulebase, name, self.overrides)
+
+    def with_operators(self, **settings: str) -> "LoadedRuleBase":
+        """The same behavior compiled with other operators, e.g. ``with_operators(and_="product")``
+        (keys as in an ``operators:`` line; a trailing underscore is dropped)."""
+        from .model import Setting
+
+        extra = tuple(Setting(k.rstrip("_"), str(v)) for k, v in settings.items())
+        return LoadedRuleBase(self.rulebase, self.compiled.behavior, self.overrides + extra)
 
     def run(self, X, **kwargs) -> Result:
         """Evaluate a batch ``X[n, k]`` (columns in :attr:`inputs` order)."""

@@ -24,7 +24,7 @@ import numpy as np
 
 from . import operators as ops_mod
 from .build import flatten
-from .model import And, Expr, Not, Or, Prop, Rule, RuleBase, Use, format_rule
+from .model import And, Expr, Not, Or, Prop, Rule, RuleBase, Setting, Use, format_rule
 from .operators import Operators
 from .shapes import SHAPES, kernel_params
 from .terms import Term, Variable
@@ -79,6 +79,10 @@ class CompiledRuleBase:
     cons_hedges: tuple[tuple[tuple[str, ...], ...], ...]
     default: np.ndarray                     # [m] value when no rule fires (nan = none)
     variables: dict = field(repr=False, default_factory=dict)
+    #: [R, m, k + 1] Takagi-Sugeno consequents ``y = a . x + c`` (coefficients over
+    #: :attr:`inputs`, then the constant), only when some rule has a ``linear`` consequent;
+    #: constant consequents are rows with a = 0, unset outputs are all 0.
+    cons_linear: np.ndarray | None = None
 
     @property
     def kernel_columns(self) -> np.ndarray:
@@ -125,6 +129,13 @@ class CompiledRuleBase:
     def rule_text(self, r: int) -> str:
         return format_rule(self.rules[r], label=False)
 
+    @functools.cached_property
+    def mamdani(self):
+        """Sampled output terms for Mamdani inference (built once per compiled rule base)."""
+        from .mamdani import build_tables
+
+        return build_tables(self)
+
 
 class _Builder:
     """Allocates columns and collects node groups per level while walking expressions."""
@@ -157,11 +168,17 @@ class _Builder:
         return tuple(tuple(out[k]) for k in sorted(out))
 
 
-def compile_rulebase(rb: RuleBase, behavior: str | None = None) -> CompiledRuleBase:
-    """Compile ``behavior`` (default: the rule base's first) into arrays."""
+def compile_rulebase(rb: RuleBase, behavior: str | None = None,
+                     overrides: tuple[Setting, ...] = ()) -> CompiledRuleBase:
+    """Compile ``behavior`` (default: the rule base's first) into arrays.
+
+    ``overrides`` are operator settings applied last, over the file's and the behavior's (a
+    study of T-norms compiles the same rules with ``Setting("and", "product")`` and so on).
+    """
     name = behavior or rb.default_behavior
     b = rb.behavior(name)
-    operators = ops_mod.resolve(b.operators, ops_mod.resolve(rb.operators))
+    operators = ops_mod.resolve(overrides, ops_mod.resolve(b.operators,
+                                                           ops_mod.resolve(rb.operators)))
     flat = flatten(rb, name)
     variables = rb.variables
 
@@ -171,6 +188,21 @@ def compile_rulebase(rb: RuleBase, behavior: str | None = None) -> CompiledRuleB
         for use in contexts:
             if use.condition is not None:
                 _collect_inputs(use.condition, used_inputs)
+    linear_inputs = {}          # output variable -> the inputs its linear coefficients follow
+    for _, rule, _ in flat:
+        for c in rule.consequents:
+            if c.term is not None and variables[c.var].term(c.term).shape == "linear":
+                names = linear_inputs.setdefault(c.var, _termset_inputs(rb, c.var))
+                coefficients = variables[c.var].term(c.term).params[:-1]
+                used_inputs.update(n for n, a in zip(names, coefficients) if a != 0.0)
+                if operators.inference == "mamdani":
+                    from .errors import RuleBaseError
+
+                    raise RuleBaseError(
+                        f"`{c.var} is {c.term}` is a linear (Takagi-Sugeno) consequent, which "
+                        f"Mamdani inference cannot use", span=c.span or rule.span,
+                        hint="use `inference = weighted_average` (or weighted_sum), or give "
+                             f"`{c.var}` membership-shaped terms")
     inputs = tuple(v.name for v in variables.values() if v.name in used_inputs)
     outputs = tuple(dict.fromkeys(c.var for _, rule, _ in flat for c in rule.consequents))
     outputs = tuple(v.name for v in variables.values() if v.name in outputs)
@@ -255,6 +287,22 @@ def compile_rulebase(rb: RuleBase, behavior: str | None = None) -> CompiledRuleB
                 cons_hedges[r][j] = c.hedges
             else:
                 cons_value[r, j] = c.value
+    cons_linear = None
+    if linear_inputs:
+        cons_linear = np.zeros((len(flat), m, len(inputs) + 1))
+        cons_linear[:, :, -1] = cons_value
+        col = {name: i for i, name in enumerate(inputs)}
+        for r, (_, rule, _) in enumerate(flat):
+            for c in rule.consequents:
+                if c.var in linear_inputs and c.term is not None:
+                    term = variables[c.var].term(c.term)
+                    if term.shape == "linear":
+                        j = outputs.index(c.var)
+                        for name, a in zip(linear_inputs[c.var], term.params[:-1]):
+                            if a != 0.0:
+                                cons_linear[r, j, col[name]] = a
+                        cons_linear[r, j, -1] = term.params[-1]
+                        cons_value[r, j] = 0.0
     default = np.array([np.nan if variables[o].default is None else variables[o].default
                         for o in outputs], dtype=float)
     universe = np.array([variables[v].universe for v in inputs], dtype=float).reshape(-1, 2)
@@ -268,7 +316,16 @@ def compile_rulebase(rb: RuleBase, behavior: str | None = None) -> CompiledRuleB
         rules=tuple(rules), outputs=outputs, cons_value=cons_value, cons_mask=cons_mask,
         cons_term=tuple(tuple(row) for row in cons_term),
         cons_hedges=tuple(tuple(row) for row in cons_hedges), default=default,
-        variables=dict(variables))
+        variables=dict(variables), cons_linear=cons_linear)
+
+
+def _termset_inputs(rb: RuleBase, output: str) -> tuple[str, ...]:
+    """The input variables, in order, of the term set defining ``output`` (the coefficient
+    order of its ``linear`` terms, :data:`mitos_cli.shapes.LINEAR_LAYOUT`)."""
+    for ts in rb.termsets:
+        if any(v.name == output for v in ts.variables):
+            return tuple(v.name for v in ts.variables if v.role == "input")
+    return ()
 
 
 def _collect_inputs(expr: Expr, out: set[str]) -> None:
