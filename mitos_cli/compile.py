@@ -291,16 +291,16 @@ def compile_rulebase(rb: RuleBase, behavior: str | None = None,
     if linear_inputs:
         cons_linear = np.zeros((len(flat), m, len(inputs) + 1))
         cons_linear[:, :, -1] = cons_value
-        col = {name: i for i, name in enumerate(inputs)}
+        input_col = {var: i for i, var in enumerate(inputs)}
         for r, (_, rule, _) in enumerate(flat):
             for c in rule.consequents:
                 if c.var in linear_inputs and c.term is not None:
                     term = variables[c.var].term(c.term)
                     if term.shape == "linear":
                         j = outputs.index(c.var)
-                        for name, a in zip(linear_inputs[c.var], term.params[:-1]):
+                        for var, a in zip(linear_inputs[c.var], term.params[:-1]):
                             if a != 0.0:
-                                cons_linear[r, j, col[name]] = a
+                                cons_linear[r, j, input_col[var]] = a
                         cons_linear[r, j, -1] = term.params[-1]
                         cons_value[r, j] = 0.0
     default = np.array([np.nan if variables[o].default is None else variables[o].default

@@ -201,10 +201,34 @@ def tree_sum(W: np.ndarray) -> np.ndarray:
     return W[:, 0]
 
 
-def weighted_average(compiled: CompiledRuleBase, dof: np.ndarray) -> np.ndarray:
-    """Eqs. 18-19 for every output: ``sum(dof * y) / sum(dof)`` (NaN where nothing fired)."""
+def linear_consequents(compiled: CompiledRuleBase, Xt: np.ndarray) -> np.ndarray:
+    """Takagi-Sugeno consequents ``Y[m, R, b] = a . x + c`` of every rule and output.
+
+    A fixed left-to-right sum over the inputs (a handful), elementwise per sample: never a
+    matrix product, whose summation order could depend on the batch size.
+    """
+    A = compiled.cons_linear                     # [R, m, k + 1]
+    Y = np.empty((A.shape[1], A.shape[0], Xt.shape[1]))
+    Y[:] = A[:, :, -1].T[:, :, None]
+    for i in range(A.shape[2] - 1):
+        a = A[:, :, i].T                         # [m, R]
+        if a.any():
+            Y += a[:, :, None] * Xt[i]
+    return Y
+
+
+def weighted_average(compiled: CompiledRuleBase, dof: np.ndarray,
+                     Xt: np.ndarray | None = None) -> np.ndarray:
+    """Eqs. 18-19 for every output: ``sum(dof * y) / sum(dof)`` (NaN where nothing fired).
+
+    ``y`` is the rule's crisp consequent, or with linear consequents ``a . x + c`` for the
+    block's inputs ``Xt[k, b]``; ``weighted_sum`` skips the division.
+    """
     K = compiled.sum_weights                     # [k, R]: numerators, then denominators
     W = np.multiply(dof[None], K[:, :, None])
+    if compiled.cons_linear is not None:
+        m = len(compiled.outputs)
+        np.multiply(dof[None], linear_consequents(compiled, Xt), out=W[:m])
     sums = tree_sum(W)
     m = len(compiled.outputs)
     out = np.full((m, dof.shape[1]), np.nan)
@@ -237,7 +261,7 @@ def evaluate(compiled: CompiledRuleBase, X, *, detail: bool = True, keep_values:
         block = slice(start, min(start + BLOCK, n))
         V = network_values(compiled, Xt[:, block])
         d = rule_dof(compiled, V)
-        out[:, block] = infer(compiled, d)
+        out[:, block] = infer(compiled, d, Xt[:, block])
         if detail:
             mu[:, block] = V[2:2 + T]
             dof[:, block] = d
@@ -248,13 +272,19 @@ def evaluate(compiled: CompiledRuleBase, X, *, detail: bool = True, keep_values:
                   clamped, values.T if keep_values else None)
 
 
-def infer(compiled: CompiledRuleBase, dof: np.ndarray) -> np.ndarray:
-    """Output layer: DOFs ``[R, b]`` -> outputs ``[m, b]`` (NaN where no rule fired)."""
+def infer(compiled: CompiledRuleBase, dof: np.ndarray,
+          Xt: np.ndarray | None = None) -> np.ndarray:
+    """Output layer: DOFs ``[R, b]`` -> outputs ``[m, b]`` (NaN where no rule fired).
+
+    ``Xt[k, b]`` (the block's clamped inputs) is needed only by linear consequents.
+    """
     if compiled.operators.inference == "mamdani":
         from .mamdani import mamdani_outputs
 
         return mamdani_outputs(compiled, dof)
-    return weighted_average(compiled, dof)
+    if compiled.cons_linear is not None and Xt is None:
+        raise ValueError("linear consequents need the inputs: infer(compiled, dof, Xt)")
+    return weighted_average(compiled, dof, Xt)
 
 
 def fill_defaults(compiled: CompiledRuleBase, out: np.ndarray, X: np.ndarray,

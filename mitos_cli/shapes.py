@@ -62,6 +62,33 @@ def singleton(x, value):
     return np.where(np.isnan(x), np.nan, out)
 
 
+def linear(x, *params):
+    """Takagi-Sugeno linear consequent ``y = c_1 x_1 + ... + c_k x_k + constant``.
+
+    Not a membership function: ``x`` stacks the ``k`` inputs on its first axis (``x[i]`` is
+    input ``i``, any trailing shape) and ``params`` is ``(c_1, ..., c_k, constant)``, the
+    layout of :data:`LINEAR_LAYOUT`. The sum runs left to right, so it is elementwise and
+    deterministic per sample.
+    """
+    *coefficients, constant = params
+    x = np.asarray(x, dtype=float)
+    y = np.full(x.shape[1:], float(constant))
+    for c, xi in zip(coefficients, x):
+        if c != 0.0:
+            y = y + c * xi
+    return y
+
+
+#: Parameter layout of the ``linear`` shape (shared with the interop readers, which map
+#: fuzzylite's ``Linear`` term onto it): ``params = (c_1, ..., c_k, constant)``, one
+#: coefficient per **input variable of the term set that defines the term, in the order the
+#: term set lists them** (for a term set read from FLL/FIS: the engine's inputs in order),
+#: then the constant. The compiler maps the coefficients onto the compiled inputs by name;
+#: a missing coefficient is 0. Only output variables may have linear terms, and only the
+#: Takagi-Sugeno inferences (``weighted_average``, ``weighted_sum``) can use them.
+LINEAR_LAYOUT = "(c_1, ..., c_k, constant) over the term set's input variables, in order"
+
+
 def _ordered(names: tuple[str, ...]) -> Callable[[tuple[float, ...]], str | None]:
     def check(p: tuple[float, ...]) -> str | None:
         for (n1, v1), (n2, v2) in zip(zip(names, p), zip(names[1:], p[1:])):
@@ -126,6 +153,10 @@ register(Shape("right_shoulder", ("a", "b"), right_shoulder, _ordered(("a", "b")
                "0 up to a, rising to 1 at b and beyond"))
 register(Shape("singleton", ("value",), singleton, lambda p: None, None, lambda p: p[0],
                "a crisp value: 1 at value, 0 elsewhere"))
+register(Shape("linear", ("coefficients", "constant"), linear, lambda p: None, None,
+               lambda p: float("nan"),
+               "Takagi-Sugeno output y = sum of coefficient * input + constant "
+               "(params: LINEAR_LAYOUT)"))
 
 
 def kernel_params(corners: tuple[float, float, float, float]) -> tuple[float, float, float, float]:

@@ -111,8 +111,8 @@ def check_term(term: Term, universe: tuple[float, float], variable: str) -> None
     if problem:
         raise TermSetError(f"term `{variable}.{term.name}`: {problem}", span=term.span)
     lo, hi = universe
-    center = term.center
-    if not lo <= center <= hi:
+    center = term.center          # NaN for a linear (Takagi-Sugeno) consequent: no peak
+    if not np.isnan(center) and not lo <= center <= hi:
         raise TermSetError(
             f"term `{variable}.{term.name}`: its peak {center:g} lies outside the universe "
             f"[{lo:g}, {hi:g}]", span=term.span,

@@ -19,6 +19,11 @@ optionally ``description``, ``unit`` and (outputs) ``default``. A term is a mapp
         universe: [30, 150]
         default: 90
         terms: {LB: 30, LM: 50, LS: 70, ST: 90, RS: 110, RM: 130, RB: 150}
+
+Output terms may also be Takagi-Sugeno consequents: ``{shape: constant, value: 90}`` (the
+same as a bare number) or ``{shape: linear, coefficients: {road: 0.5, size: -1}, constant:
+90}``, i.e. ``y = 0.5 road - size + 90``; coefficients name input variables of this term set
+(missing ones are 0) and are stored in the layout of :data:`mitos_cli.shapes.LINEAR_LAYOUT`.
 """
 
 from __future__ import annotations
@@ -38,8 +43,10 @@ TRIANGLE_FORMS = {
     ("peak", "width"): "triangle_pw",
     ("left_width", "peak", "right_width"): "triangle_plr",
 }
-USER_SHAPES = sorted({"triangle", "trapezoid", "left_shoulder", "right_shoulder", "singleton"}
+USER_SHAPES = sorted({"triangle", "trapezoid", "left_shoulder", "right_shoulder", "singleton",
+                      "constant", "linear"}
                      | {n for n in SHAPES if not n.startswith("triangle_")})
+ALIASES = {"constant": "singleton"}     # Takagi-Sugeno's name for a crisp consequent
 
 
 def load_termset(path: str | Path) -> TermSet:
@@ -63,14 +70,18 @@ def parse_termset(text: str, path: str | None = None) -> TermSet:
     variables = yamlpos.require(data, "variables", TermSetError, "the term set")
     variables = yamlpos.expect_map(variables, data.value_span("variables"), TermSetError,
                                    "`variables`")
-    out = tuple(_variable(name, spec, variables.key_span(name), variables.value_span(name))
+    inputs = tuple(name for name, spec in variables.items()
+                   if isinstance(spec, YMap) and spec.get("role") == "input")
+    out = tuple(_variable(name, spec, variables.key_span(name), variables.value_span(name),
+                          inputs)
                 for name, spec in variables.items())
     if not out:
         raise TermSetError("the term set defines no variables", span=data.span)
     return TermSet(out, path)
 
 
-def _variable(name: str, spec: Any, key_span: Span, value_span: Span) -> Variable:
+def _variable(name: str, spec: Any, key_span: Span, value_span: Span,
+              inputs: tuple[str, ...] = ()) -> Variable:
     what = f"variable `{name}`"
     spec = yamlpos.expect_map(spec, value_span, TermSetError, what)
     yamlpos.check_keys(spec, VARIABLE_KEYS, TermSetError, what)
@@ -91,9 +102,16 @@ def _variable(name: str, spec: Any, key_span: Span, value_span: Span) -> Variabl
     terms_spec = yamlpos.expect_map(yamlpos.require(spec, "terms", TermSetError, what),
                                     spec.value_span("terms"), TermSetError, f"{what}: terms")
     terms = tuple(_term(tname, tspec, terms_spec.key_span(tname), terms_spec.value_span(tname),
-                        name) for tname, tspec in terms_spec.items())
+                        name, inputs) for tname, tspec in terms_spec.items())
     if not terms:
         raise TermSetError(f"{what} has no terms", span=spec.value_span("terms"))
+    if role == "input":
+        for term in terms:
+            if term.shape == "linear":
+                raise TermSetError(f"term `{name}.{term.name}`: a linear term is a Takagi-Sugeno "
+                                   f"consequent and belongs to an output variable",
+                                   span=term.span, hint="give input terms a membership shape "
+                                   "(triangle, trapezoid, left_shoulder, ...)")
     for term in terms:
         check_term(term, (lo, hi), name)
     default = None
@@ -114,7 +132,8 @@ def _variable(name: str, spec: Any, key_span: Span, value_span: Span) -> Variabl
                     str(text_of["unit"]), default, key_span)
 
 
-def _term(name: str, spec: Any, key_span: Span, value_span: Span, variable: str) -> Term:
+def _term(name: str, spec: Any, key_span: Span, value_span: Span, variable: str,
+          inputs: tuple[str, ...] = ()) -> Term:
     what = f"term `{variable}.{name}`"
     if isinstance(spec, (int, float)) and not isinstance(spec, bool):
         value = yamlpos.expect_number(spec, value_span, TermSetError, what)
@@ -126,6 +145,8 @@ def _term(name: str, spec: Any, key_span: Span, value_span: Span, variable: str)
                            expected="one of " + ", ".join(USER_SHAPES),
                            hint=did_you_mean(str(shape), USER_SHAPES))
     frozen = bool(spec.get("frozen", False))
+    if shape == "linear":
+        return _linear_term(what, name, spec, key_span, frozen, inputs)
     given = tuple(sorted(k for k in spec if k not in ("shape", "frozen")))
     if shape == "triangle":
         internal = TRIANGLE_FORMS.get(given)
@@ -134,7 +155,7 @@ def _term(name: str, spec: Any, key_span: Span, value_span: Span, variable: str)
                                f"`width`, or `peak`, `left_width` and `right_width`",
                                span=spec.span)
     else:
-        internal = shape
+        internal = ALIASES.get(shape, shape)
     kind = SHAPES[internal]
     if given == ("points",):
         points = spec["points"]
@@ -152,3 +173,26 @@ def _term(name: str, spec: Any, key_span: Span, value_span: Span, variable: str)
         params = tuple(yamlpos.expect_number(spec[p], spec.value_span(p), TermSetError,
                                              f"{what}: {p}") for p in kind.params)
     return Term(name, internal, params, key_span, frozen)
+
+
+def _linear_term(what: str, name: str, spec: YMap, key_span: Span, frozen: bool,
+                 inputs: tuple[str, ...]) -> Term:
+    """``{shape: linear, coefficients: {road: 0.5}, constant: 90}`` -> params
+    ``(c_1, ..., c_k, constant)`` over ``inputs`` (the term set's input variables)."""
+    yamlpos.check_keys(spec, ("shape", "frozen", "coefficients", "constant"), TermSetError, what)
+    constant = yamlpos.expect_number(yamlpos.require(spec, "constant", TermSetError, what),
+                                     spec.value_span("constant"), TermSetError,
+                                     f"{what}: constant")
+    coefficients = dict.fromkeys(inputs, 0.0)
+    if "coefficients" in spec:
+        given = yamlpos.expect_map(spec["coefficients"], spec.value_span("coefficients"),
+                                   TermSetError, f"{what}: coefficients")
+        for var, value in given.items():
+            if var not in coefficients:
+                raise TermSetError(f"{what}: `{var}` is not an input variable of this term set",
+                                   span=given.key_span(var),
+                                   expected="one of " + ", ".join(inputs) if inputs else None,
+                                   hint=did_you_mean(var, inputs))
+            coefficients[var] = yamlpos.expect_number(value, given.value_span(var),
+                                                      TermSetError, f"{what}: coefficient")
+    return Term(name, "linear", tuple(coefficients.values()) + (constant,), key_span, frozen)
