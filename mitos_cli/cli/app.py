@@ -11,7 +11,7 @@ import sys
 import typer
 
 from ..errors import MitosError
-from . import eval_cmd
+from . import check_cmd, eval_cmd
 
 app = typer.Typer(
     name="mitos",
@@ -33,6 +33,7 @@ def _root() -> None:
 
 # One line per command; each module holds one command function.
 app.command("eval")(eval_cmd.eval_command)
+app.command("check")(check_cmd.check_command)
 
 
 def main(argv: list[str] | None = None) -> None:

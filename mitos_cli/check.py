@@ -1,0 +1,500 @@
+"""Static analysis of a rule base (``mitos check``): what the rules leave out or say twice.
+
+:func:`check_rulebase` returns a :class:`Report` of :class:`Finding` objects, each with a
+severity, a message, the place in the rule file or term set it concerns (a :class:`Span`) and,
+for findings about the input space, the regions as boxes of input ranges. Nothing here prints.
+
+What is checked, per behavior (every behavior of the file unless one is named):
+
+====================  ==========  ==========================================================
+code                  severity    meaning
+====================  ==========  ==========================================================
+``no-rule-fires``     error       a region of the input space where no rule sets an output
+                                  that declares no ``default`` (``mitos eval`` fails there)
+``no-rule-fires``     warning     the same, but the output falls back to its ``default``
+``low-dof``           warning     a region where some rule fires but the total DOF of the
+                                  rules setting an output is below ``threshold``
+``conflict``          error       rules with the same antecedent and different consequents
+``duplicate``         warning     rules with the same antecedent and the same consequents
+``contradiction``     warning     an antecedent that asks for ``x is A`` and ``x is not A``
+``unreachable``       warning     a rule whose DOF is 0 at every sampled input
+``term-gap``          warning     a stretch of an input's universe where all its terms are 0
+``unused-term``       warning     an input term (or a whole input) that no rule uses
+``unconcluded-term``  info        an output term that no rule concludes
+====================  ==========  ==========================================================
+
+The input space is sampled on a grid: ``resolution`` evenly spaced points per input plus every
+corner point of its terms (where memberships start or stop being 0), capped at
+:data:`MAX_SAMPLES` points in all. The whole grid is one vectorized batch through
+:func:`mitos_cli.engine.evaluate`. Regions are reported as boxes of sampled values, e.g.
+``road in [0, 40] and size in [70, 100]``; an input left out of a box may take any value.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from .build import flatten
+from .compile import CompiledRuleBase, compile_rulebase
+from .engine import evaluate
+from .model import And, Consequent, Expr, Not, Or, Prop, Rule, RuleBase, format_expr
+from .errors import Span
+from .terms import Variable
+
+SEVERITIES = ("error", "warning", "info")
+#: Most grid points one behavior is sampled on (the per-input resolution shrinks to fit).
+MAX_SAMPLES = 300_000
+#: Regions listed per finding; the rest are counted.
+MAX_BOXES = 6
+#: Points per universe when looking for gaps between the terms of one input.
+GAP_RESOLUTION = 2001
+
+
+@dataclass(frozen=True)
+class Box:
+    """A box of the input space: ``ranges[var] = (lo, hi)``; inputs not named are free."""
+
+    ranges: tuple[tuple[str, float, float], ...]
+
+    def describe(self) -> str:
+        if not self.ranges:
+            return "everywhere"
+        parts = []
+        for name, lo, hi in self.ranges:
+            parts.append(f"{name} = {_num(lo)}" if lo == hi else
+                         f"{name} in [{_num(lo)}, {_num(hi)}]")
+        return " and ".join(parts)
+
+    def to_json(self) -> dict:
+        return {name: [lo, hi] for name, lo, hi in self.ranges}
+
+
+@dataclass(frozen=True)
+class Finding:
+    severity: str            # "error", "warning" or "info"
+    code: str
+    message: str
+    span: Span | None = None
+    behavior: str | None = None
+    hint: str | None = None
+    regions: tuple[Box, ...] = ()
+    more_regions: int = 0    # boxes not listed in ``regions``
+    share: float | None = None   # fraction of the grid the regions cover
+    uncovered: int = 0       # grid cells of a very ragged region left out of every box
+
+    def to_json(self) -> dict:
+        out = {"severity": self.severity, "code": self.code, "behavior": self.behavior,
+               "message": self.message,
+               "span": None if self.span is None else
+               {"path": self.span.path, "line": self.span.line, "column": self.span.column}}
+        if self.hint:
+            out["hint"] = self.hint
+        if self.regions or self.share is not None:
+            out["regions"] = [b.to_json() for b in self.regions]
+            out["more_regions"] = self.more_regions
+            out["uncovered_samples"] = self.uncovered
+            out["share"] = self.share
+        return out
+
+
+@dataclass(frozen=True)
+class GridInfo:
+    behavior: str
+    points: tuple[tuple[str, int], ...]    # samples per input
+    samples: int
+
+
+@dataclass(frozen=True)
+class Report:
+    rulebase: RuleBase
+    findings: tuple[Finding, ...]
+    grids: tuple[GridInfo, ...]
+    threshold: float
+    behaviors: tuple[str, ...] = field(default=())
+
+    def count(self, severity: str) -> int:
+        return sum(f.severity == severity for f in self.findings)
+
+    @property
+    def ok(self) -> bool:
+        """No error-level finding."""
+        return self.count("error") == 0
+
+
+def _num(x: float) -> str:
+    return f"{x:.6g}"
+
+
+# ---------------------------------------------------------------------------------------------
+# entry point
+
+def check_rulebase(rb: RuleBase, behavior: str | None = None, *, threshold: float = 0.1,
+                   resolution: int = 41) -> Report:
+    """Analyse ``behavior`` of ``rb`` (every behavior when ``None``)."""
+    names = [behavior] if behavior else [b.name for b in rb.behaviors]
+    findings: list[Finding] = []
+    grids: list[GridInfo] = []
+    for name in names:
+        rb.behavior(name)                       # unknown behavior: did-you-mean error
+        compiled = compile_rulebase(rb, name)
+        findings += _rule_pairs(rb, name)
+        findings += _contradictions(rb, name)
+        grid_findings, info = _sampled(compiled, threshold, resolution)
+        findings += grid_findings
+        grids.append(info)
+    findings += _term_gaps(rb)
+    findings += _unused_terms(rb)
+    order = {s: i for i, s in enumerate(SEVERITIES)}
+    findings.sort(key=lambda f: (order[f.severity], _span_key(f.span)))
+    return Report(rb, tuple(findings), tuple(grids), threshold, tuple(names))
+
+
+def _span_key(span: Span | None) -> tuple:
+    return ("", 0, 0) if span is None else (span.path or "", span.line, span.column)
+
+
+def _behavior_span(rb: RuleBase, name: str) -> Span | None:
+    span = rb.behavior(name).span
+    if span is None and rb.path:
+        span = Span(rb.path, 1, 1)
+    return span
+
+
+# ---------------------------------------------------------------------------------------------
+# rules compared with each other (conflicts, duplicates)
+
+def canonical(expr: Expr):
+    """A key equal for antecedents that differ only in the order of `and` / `or` items."""
+    if isinstance(expr, Prop):
+        return ("prop", expr.var, expr.term, expr.hedges, expr.negated)
+    if isinstance(expr, Not):
+        inner = canonical(expr.expr)
+        if inner[0] == "prop":                 # not (x is A) == x is not A
+            return inner[:4] + (not inner[4],)
+        if inner[0] == "not":
+            return inner[1]
+        return ("not", inner)
+    op = "and" if isinstance(expr, And) else "or"
+    items = set()
+    for item in expr.items:
+        key = canonical(item)
+        items.update(key[1] if key[0] == op else (key,))
+    if len(items) == 1:
+        return next(iter(items))
+    return (op, frozenset(items))
+
+
+def _consequents(rule: Rule) -> dict[str, Consequent]:
+    return {c.var: c for c in rule.consequents}
+
+
+def _same(a: Consequent, b: Consequent, variables: dict[str, Variable]) -> bool:
+    def value(c: Consequent) -> tuple:
+        if c.term is None:
+            return (None, c.value)
+        return (c.hedges, variables[c.var].term(c.term).center) if not c.hedges else \
+            (c.hedges, c.term)
+    return value(a) == value(b)
+
+
+def _show(c: Consequent) -> str:
+    from .model import format_consequent
+
+    return format_consequent(c)
+
+
+def _rule_pairs(rb: RuleBase, behavior: str) -> list[Finding]:
+    flat = flatten(rb, behavior)
+    groups: dict[object, list[int]] = {}
+    for i, (_, rule, contexts) in enumerate(flat):
+        key = (canonical(rule.antecedent),
+               tuple(canonical(u.condition) if u.condition is not None else None
+                     for u in contexts))
+        groups.setdefault(key, []).append(i)
+    variables = rb.variables
+    out = []
+    for members in groups.values():
+        for pos, j in enumerate(members[1:], start=1):
+            label_j, rule_j, _ = flat[j]
+            for i in members[:pos]:
+                label_i, rule_i, _ = flat[i]
+                ci, cj = _consequents(rule_i), _consequents(rule_j)
+                clash = [v for v in ci if v in cj and not _same(ci[v], cj[v], variables)]
+                where = f"`{label_j}` has the same antecedent as `{label_i}`"
+                if clash:
+                    says = "; ".join(f"{_show(ci[v])} vs {_show(cj[v])}" for v in clash)
+                    out.append(Finding(
+                        "error", "conflict", f"{where} but concludes differently: {says}",
+                        rule_j.span, behavior,
+                        hint="merge the two rules, or make their conditions differ"))
+                elif ci.keys() == cj.keys():
+                    extra = "" if rule_i.weight == rule_j.weight else \
+                        f" (weights {rule_i.weight:g} and {rule_j.weight:g})"
+                    out.append(Finding(
+                        "warning", "duplicate",
+                        f"{where} and the same consequents{extra}: it counts twice in the "
+                        f"weighted average", rule_j.span, behavior,
+                        hint=f"delete one of them, or give one rule a weight (`with 0.5`)"))
+                else:
+                    continue
+                break                         # report each rule against its first twin only
+    return out
+
+
+# ---------------------------------------------------------------------------------------------
+# contradictory antecedents
+
+def _literals(expr: Expr, negated: bool = False):
+    """The propositions an `and` chain requires, as (var, term, hedges, negated)."""
+    if isinstance(expr, Prop):
+        yield (expr.var, expr.term, expr.hedges, expr.negated != negated, expr)
+    elif isinstance(expr, Not) and isinstance(expr.expr, Prop):
+        yield from _literals(expr.expr, not negated)
+    elif isinstance(expr, And) and not negated:
+        for item in expr.items:
+            yield from _literals(item)
+
+
+def _contradictions(rb: RuleBase, behavior: str) -> list[Finding]:
+    out = []
+    for label, rule, _ in flatten(rb, behavior):
+        seen = {}
+        for var, term, hedges, neg, prop in _literals(rule.antecedent):
+            twin = seen.get((var, term, hedges, not neg))
+            literal = replace(prop, negated=neg)
+            twin = seen.get((var, term, hedges, not neg))
+            if twin is not None:
+                a, b = (twin, literal) if not twin.negated else (literal, twin)
+                out.append(Finding(
+                    "warning", "contradiction",
+                    f"`{label}` asks for `{format_expr(a)}` and `{format_expr(b)}` at once: its "
+                    f"DOF is min(mu, 1 - mu), at most 0.5, and 0 wherever `{var}` is fully "
+                    f"{term} or not {term} at all", prop.span or rule.span, behavior,
+                    hint="drop one of the two conditions"))
+                break
+            seen[(var, term, hedges, neg)] = literal
+    return out
+
+
+# ---------------------------------------------------------------------------------------------
+# the sampled input space
+
+def grid_axes(compiled: CompiledRuleBase, resolution: int,
+              max_samples: int = MAX_SAMPLES) -> list[np.ndarray]:
+    """Sample points per input: ``resolution`` even steps plus the terms' corner points,
+    with ``resolution`` lowered until the grid has at most ``max_samples`` points."""
+    k = len(compiled.inputs)
+    n = max(2, resolution)
+    while True:
+        axes = []
+        for name, (lo, hi) in zip(compiled.inputs, compiled.universe):
+            pts = [np.linspace(lo, hi, n)]
+            for term in compiled.variables[name].terms:
+                corners = term.corners
+                if corners is not None:
+                    pts.append([c for c in corners if lo <= c <= hi])
+                else:
+                    pts.append([term.center])
+            axes.append(np.unique(np.concatenate([np.asarray(p, float) for p in pts])))
+        total = int(np.prod([len(a) for a in axes])) if k else 1
+        if total <= max_samples or n <= 2:
+            return axes
+        n = max(2, int(n * (max_samples / total) ** (1.0 / k)) - 1)
+
+
+def _sampled(compiled: CompiledRuleBase, threshold: float,
+             resolution: int) -> tuple[list[Finding], GridInfo]:
+    axes = grid_axes(compiled, resolution)
+    shape = tuple(len(a) for a in axes)
+    mesh = np.meshgrid(*axes, indexing="ij")
+    X = np.stack([m.reshape(-1) for m in mesh], axis=1) if axes else np.zeros((1, 0))
+    result = evaluate(compiled, X, detail=True, strict=False)
+    dof = result.dof                                   # [n, R]
+    info = GridInfo(compiled.behavior, tuple(zip(compiled.inputs, shape)), X.shape[0])
+    out: list[Finding] = []
+    name = compiled.behavior
+    span = _behavior_span(compiled.rulebase, name)
+
+    # coverage, per output (grouping outputs that share the same gap)
+    total = dof @ compiled.cons_mask.astype(float)     # [n, m] total DOF per output
+    reported: dict[tuple, list[str]] = {}
+    for kind, mask_of in (("no-rule-fires", lambda t: t <= 0.0),
+                          ("low-dof", lambda t: (t > 0.0) & (t < threshold))):
+        reported.clear()
+        masks = {}
+        for j, out_name in enumerate(compiled.outputs):
+            mask = mask_of(total[:, j])
+            if not mask.any():
+                continue
+            has_default = not np.isnan(compiled.default[j])
+            key = (mask.tobytes(), has_default)
+            reported.setdefault(key, []).append(out_name)
+            masks[key] = mask
+        for key, outs in reported.items():
+            mask, has_default = masks[key], key[1]
+            boxes, uncovered = boxes_of(mask.reshape(shape), axes, compiled.inputs)
+            share = float(mask.mean())
+            what = " and ".join(f"`{o}`" for o in outs)
+            if kind == "no-rule-fires":
+                severity = "warning" if has_default else "error"
+                message = (f"behavior `{name}`: no rule sets {what} in "
+                           f"{_pct(share)} of the input space")
+                if has_default:
+                    values = ", ".join(
+                        f"{o} = {compiled.default[compiled.outputs.index(o)]:g}" for o in outs)
+                    message += f" (the default applies there: {values})"
+                    hint = "add rules that cover these inputs"
+                else:
+                    hint = (f"add rules that cover these inputs, or add `default: VALUE` to "
+                            f"{what} in the term set to define the output when no rule fires")
+            else:
+                severity = "warning"
+                message = (f"behavior `{name}`: the rules setting {what} fire with a total DOF "
+                           f"below {threshold:g} in {_pct(share)} of the input space")
+                hint = "widen the terms or add rules, so that more than a trace of a rule fires"
+            out.append(Finding(severity, kind, message, span, name, hint,
+                               tuple(boxes[:MAX_BOXES]), max(0, len(boxes) - MAX_BOXES), share,
+                               uncovered))
+
+    # rules that never fire
+    fires = (dof > 0.0).any(axis=0) if dof.shape[0] else np.zeros(compiled.n_rules, bool)
+    for r in np.flatnonzero(~fires):
+        rule = compiled.rules[r]
+        why = " (its weight is 0)" if rule.weight == 0 else ""
+        out.append(Finding(
+            "warning", "unreachable",
+            f"`{compiled.labels[r]}` never fires: its DOF is 0 at all {X.shape[0]:,} sampled "
+            f"inputs{why}", rule.span, name,
+            hint="its conditions cannot hold together; check the terms it names"))
+    return out, info
+
+
+def _pct(share: float) -> str:
+    pct = 100.0 * share
+    return f"{pct:.2g}%" if pct < 10 else f"{pct:.0f}%"
+
+
+def boxes_of(mask: np.ndarray, axes: list[np.ndarray], names: tuple[str, ...],
+             limit: int = 200) -> tuple[list[Box], int]:
+    """Cover the true cells of a k-dimensional grid mask with boxes, largest first.
+
+    Each box starts at the first uncovered true cell and grows along every axis in turn (up,
+    then down) while the grown box stays inside the mask; boxes may overlap. Ranges spanning a
+    whole axis are left out. Returns the boxes (at most ``limit``) and the number of true cells
+    they leave uncovered (0 unless the mask is too ragged for ``limit`` boxes).
+    """
+    remaining = mask.copy()
+    boxes: list[tuple[int, Box]] = []
+    while remaining.any() and len(boxes) < limit:
+        start = np.unravel_index(int(np.argmax(remaining)), mask.shape)
+        lo = list(start)
+        hi = [s + 1 for s in start]
+        for d in range(mask.ndim):
+            for step in (1, -1):
+                while True:
+                    if step == 1 and hi[d] >= mask.shape[d]:
+                        break
+                    if step == -1 and lo[d] <= 0:
+                        break
+                    sl = [slice(a, b) for a, b in zip(lo, hi)]
+                    sl[d] = slice(hi[d], hi[d] + 1) if step == 1 else slice(lo[d] - 1, lo[d])
+                    if not mask[tuple(sl)].all():
+                        break
+                    if step == 1:
+                        hi[d] += 1
+                    else:
+                        lo[d] -= 1
+        region = tuple(slice(a, b) for a, b in zip(lo, hi))
+        remaining[region] = False
+        ranges = tuple((names[d], float(axes[d][lo[d]]), float(axes[d][hi[d] - 1]))
+                       for d in range(mask.ndim)
+                       if not (lo[d] == 0 and hi[d] == mask.shape[d]))
+        size = int(np.prod([b - a for a, b in zip(lo, hi)]))
+        boxes.append((size, Box(ranges)))
+    boxes.sort(key=lambda sb: -sb[0])
+    return [b for _, b in boxes], int(remaining.sum())
+
+
+# ---------------------------------------------------------------------------------------------
+# term sets
+
+def _term_gaps(rb: RuleBase) -> list[Finding]:
+    out = []
+    for var in rb.variables.values():
+        if var.role != "input":
+            continue
+        lo, hi = var.universe
+        corners = [c for t in var.terms if t.corners for c in t.corners if lo <= c <= hi]
+        x = np.unique(np.concatenate([np.linspace(lo, hi, GAP_RESOLUTION), corners]))
+        top = np.max([t.membership(x) for t in var.terms], axis=0)
+        gap = top <= 0.0
+        for a, b in _runs(gap):
+            left, right = float(x[a]), float(x[b - 1])
+            # a gap between two sample points around a single zero is a touching point
+            where = f"at {var.name} = {_num(left)}" if left == right else \
+                f"for {var.name} in [{_num(left)}, {_num(right)}]"
+            out.append(Finding(
+                "warning", "term-gap",
+                f"input `{var.name}`: every term is 0 {where}", var.span, None,
+                hint="widen a neighbouring term (or add one) so that the terms cover the "
+                     "universe"))
+    return out
+
+
+def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
+    """``[start, stop)`` of the runs of True in a 1-D mask."""
+    padded = np.concatenate([[False], mask, [False]])
+    edges = np.flatnonzero(padded[1:] != padded[:-1])
+    return list(zip(edges[::2], edges[1::2]))
+
+
+def _terms_used(expr: Expr, out: set[tuple[str, str]]) -> None:
+    if isinstance(expr, Prop):
+        out.add((expr.var, expr.term))
+    elif isinstance(expr, Not):
+        _terms_used(expr.expr, out)
+    else:
+        for item in expr.items:
+            _terms_used(item, out)
+
+
+def _unused_terms(rb: RuleBase) -> list[Finding]:
+    used: set[tuple[str, str]] = set()
+    concluded: set[tuple[str, str]] = set()
+    for b in rb.behaviors:                  # a term used anywhere in the file is used
+        for rule in b.rules:
+            _terms_used(rule.antecedent, used)
+            for c in rule.consequents:
+                if c.term is not None:
+                    concluded.add((c.var, c.term))
+        for use in b.uses:
+            if use.condition is not None:
+                _terms_used(use.condition, used)
+    set_by_rules = {c.var for b in rb.behaviors for r in b.rules for c in r.consequents}
+    out = []
+    for var in rb.variables.values():
+        if var.role == "input":
+            names = [t for t in var.terms if (var.name, t.name) not in used]
+            if len(names) == len(var.terms):
+                out.append(Finding("warning", "unused-term",
+                                   f"input `{var.name}` is used by no rule", var.span, None,
+                                   hint="write rules that use it, or remove it"))
+                continue
+            for t in names:
+                out.append(Finding("warning", "unused-term",
+                                   f"input term `{var.name}.{t.name}` is used by no rule",
+                                   t.span, None,
+                                   hint="write a rule for it, or remove it from the term set"))
+        else:
+            names = [t.name for t in var.terms if (var.name, t.name) not in concluded]
+            if names and var.name in set_by_rules:
+                out.append(Finding("info", "unconcluded-term",
+                                   f"output `{var.name}`: no rule concludes "
+                                   + ", ".join(names), var.span, None))
+            elif var.name not in set_by_rules:
+                out.append(Finding("warning", "unused-term",
+                                   f"output `{var.name}` is set by no rule", var.span, None,
+                                   hint="write rules that set it, or remove it"))
+    return out

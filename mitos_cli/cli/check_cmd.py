@@ -1,0 +1,95 @@
+"""``mitos check``: static analysis of a rule base; exit 1 when it finds an error."""
+
+from __future__ import annotations
+
+import json
+import os
+from typing import Annotated, Optional
+
+import typer
+
+from .output import emit
+
+
+def show_path(path: str | None) -> str:
+    """A span's path as users should read it: relative when below the current directory."""
+    if not path:
+        return "<rules>"
+    try:
+        rel = os.path.relpath(path)
+    except ValueError:
+        return path
+    return path if rel.startswith("..") else rel
+
+
+def render(report, trace_path: str) -> str:
+    """The report for people: one ``path:line:col: severity: message`` block per finding."""
+    lines = []
+    for f in report.findings:
+        where = (f"{show_path(f.span.path)}:{f.span.line}:{f.span.column}: "
+                 if f.span else "")
+        lines.append(f"{where}{f.severity}: {f.message} [{f.code}]")
+        for box in f.regions:
+            lines.append(f"    {box.describe()}")
+        if f.more_regions:
+            lines.append(f"    ... and {f.more_regions} more region"
+                         + ("s" if f.more_regions > 1 else ""))
+        if f.uncovered:
+            lines.append(f"    ... and {f.uncovered} scattered samples")
+        if f.hint:
+            lines.append(f"    hint: {f.hint}")
+    grids = "; ".join(
+        f"`{g.behavior}` on " + " x ".join(f"{n} {name}" for name, n in g.points)
+        + f" = {g.samples:,} samples" for g in report.grids)
+    counts = [f"{report.count(s)} {s}{'s' if report.count(s) != 1 else ''}"
+              for s in ("error", "warning")] + [f"{report.count('info')} notes"
+                                                if report.count("info") != 1 else "1 note"]
+    if lines:
+        lines.append("")
+    lines.append(f"checked {trace_path}: {grids}")
+    lines.append(", ".join(counts) + (" - OK" if report.ok else ""))
+    return "\n".join(lines)
+
+
+def to_json(report, trace_path: str) -> dict:
+    return {
+        "rulebase": trace_path,
+        "ok": report.ok,
+        "threshold": report.threshold,
+        "behaviors": [{"name": g.behavior, "samples": g.samples,
+                       "grid": {name: n for name, n in g.points}} for g in report.grids],
+        "summary": {s: report.count(s) for s in ("error", "warning", "info")},
+        "findings": [f.to_json() for f in report.findings],
+    }
+
+
+def check_command(
+    rulebase: Annotated[Optional[str], typer.Argument(
+        metavar="[RULEBASE]",
+        help="Rule file (default: the packaged MITOS rule base).")] = None,
+    behavior: Annotated[Optional[str], typer.Option(
+        "--behavior", "-b", help="Check only this behavior (default: every behavior).")] = None,
+    threshold: Annotated[float, typer.Option(
+        "--threshold", "-t", min=0.0,
+        help="Report regions where the total DOF of an output's rules is below this.")] = 0.1,
+    resolution: Annotated[int, typer.Option(
+        "--resolution", "-n", min=2, max=10_000,
+        help="Grid points per input (plus the terms' corners; lowered to keep the grid at "
+             "most 300,000 samples).")] = 41,
+    as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
+) -> None:
+    """Check a rule base: coverage gaps, conflicts, duplicates, unreachable rules, unused
+    terms and gaps between terms. Exits 1 when an error-level problem is found."""
+    from ..api import read_rulebase
+    from ..check import check_rulebase
+    from ..trace import display_path
+
+    rb = read_rulebase(rulebase)
+    report = check_rulebase(rb, behavior, threshold=threshold, resolution=resolution)
+    name = display_path(rb.path)
+    if as_json:
+        emit(json.dumps(to_json(report, name), indent=2))
+    else:
+        emit(render(report, name))
+    if not report.ok:
+        raise typer.Exit(1)
