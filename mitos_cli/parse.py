@@ -98,9 +98,27 @@ def syntax_error(exc: UnexpectedInput, text: str, path: str | None) -> RuleSynta
     if token.type == "NAME" and "IS" in expected:
         hint = "a condition reads `variable is TERM`"
     elif "THEN" in expected and token.type in ("NAME",):
-        hint = "join conditions with `and` / `or`, and start the actions with `then`"
+        hint = _hedge_hint(text, token) or \
+            "join conditions with `and` / `or`, and start the actions with `then`"
     return RuleSyntaxError(f"unexpected {_describe(token)}", span=span,
                            expected=_expected(expected), hint=hint)
+
+
+def _hedge_hint(text: str, token: Token) -> str | None:
+    """``road is vary WIDE``: the word before the term was meant as a hedge."""
+    import re
+
+    from .errors import did_you_mean
+    from .hedges import HEDGES
+
+    before = re.search(r"\bis\s+(?:not\s+)?([A-Za-z_][\w\-]*)\s*$",
+                       text[:token.start_pos])
+    if before is None or before.group(1) in HEDGES:
+        return None
+    word = before.group(1)
+    close = did_you_mean(word, HEDGES)
+    return (f"`{word}` is not a hedge (hedges: {', '.join(HEDGES)})"
+            + (f"; {close}" if close else ""))
 
 
 def _span(meta, text: str, path: str | None) -> Span | None:
