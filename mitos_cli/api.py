@@ -78,10 +78,10 @@ class LoadedRuleBase:
     def evaluate(self, **inputs) -> dict[str, float | np.ndarray]:
         """Outputs for inputs given by name (floats, or arrays evaluated as one batch)."""
         X = as_batch(self.compiled, inputs)
-        result = evaluate(self.compiled, X)
-        scalar = all(np.ndim(v) == 0 for v in inputs.values())
-        return {name: (float(result.outputs[0, j]) if scalar else result.outputs[:, j])
-                for j, name in enumerate(self.compiled.outputs)}
+        result = evaluate(self.compiled, X, detail=False)
+        if X.shape[0] == 1 and all(np.ndim(v) == 0 for v in inputs.values()):
+            return dict(zip(self.compiled.outputs, result.outputs[0].tolist()))
+        return {name: result.outputs[:, j] for j, name in enumerate(self.compiled.outputs)}
 
     def trace(self, **inputs) -> Trace:
         """The paper-style DOF trace of one evaluation."""

@@ -130,11 +130,50 @@ class CompiledRuleBase:
         return format_rule(self.rules[r], label=False)
 
     @functools.cached_property
+    def plan(self) -> "Plan":
+        """Everything the engine's hot path needs, precomputed once."""
+        return _plan(self)
+
+    @functools.cached_property
     def mamdani(self):
         """Sampled output terms for Mamdani inference (built once per compiled rule base)."""
         from .mamdani import build_tables
 
         return build_tables(self)
+
+
+@dataclass(frozen=True)
+class Plan:
+    """Precomputed arrays and flags for :mod:`mitos_cli.engine` (derived, never edited)."""
+
+    n_terms: int
+    n_rules: int
+    lo: np.ndarray                     # [k] universe minima
+    hi: np.ndarray                     # [k] universe maxima
+    all_linear: bool
+    linear_rows: np.ndarray            # [L] terms evaluated by the linear kernel
+    term_var: np.ndarray               # [L] their input column
+    kernel: tuple[np.ndarray, ...]     # (b, s1, c, s2), each [L, 1], contiguous
+    rules: slice | np.ndarray          # where the rules' antecedents live in V
+    contexts: tuple[np.ndarray, ...]   # columns multiplying each rule's DOF (use nesting)
+    weight: np.ndarray | None          # [R, 1] rule weights, None when all are 1
+    sums: np.ndarray                   # [k, R, 1] output-layer weights (numerators, dens)
+    den_row: np.ndarray                # [m] row of ``sums`` with each output's denominator
+
+
+def _plan(c: "CompiledRuleBase") -> Plan:
+    rows = np.flatnonzero(c.linear)
+    r0 = int(c.rule_col[0]) if c.n_rules else 2
+    contiguous = bool((c.rule_col == np.arange(r0, r0 + c.n_rules)).all())
+    return Plan(
+        n_terms=c.n_terms, n_rules=c.n_rules,
+        lo=np.ascontiguousarray(c.universe[:, 0]), hi=np.ascontiguousarray(c.universe[:, 1]),
+        all_linear=bool(c.linear.all()), linear_rows=rows, term_var=c.term_var[rows],
+        kernel=tuple(np.ascontiguousarray(k[rows, None]) for k in c.kernel),
+        rules=slice(r0, r0 + c.n_rules) if contiguous else c.rule_col,
+        contexts=tuple(np.ascontiguousarray(c.context[:, j]) for j in range(c.context.shape[1])),
+        weight=c.weight[:, None].copy() if c.weighted else None,
+        sums=np.ascontiguousarray(c.sum_weights[:, :, None]), den_row=c.den_row)
 
 
 class _Builder:

@@ -46,6 +46,11 @@ def as_batch(compiled: CompiledRuleBase, columns: dict[str, object]) -> np.ndarr
     """
     from .errors import unknown
 
+    if len(columns) == len(compiled.inputs):   # numbers by name: one small array, no checks
+        try:
+            return np.array([[float(columns[k]) for k in compiled.inputs]])
+        except (KeyError, TypeError, ValueError):
+            pass                               # arrays, missing names or bad values: below
     for name in columns:
         if name not in compiled.inputs:
             known = [v.name for v in compiled.variables.values() if v.role == "input"]
@@ -80,23 +85,23 @@ def as_batch(compiled: CompiledRuleBase, columns: dict[str, object]) -> np.ndarr
     return X
 
 
-def check_inputs(compiled: CompiledRuleBase, X: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def check_inputs(compiled: CompiledRuleBase, X) -> tuple[np.ndarray, np.ndarray]:
     """Refuse NaN, clamp to each universe; return the clamped copy and clamp counts."""
-    X = np.array(X, dtype=float, copy=True, ndmin=2)
-    if X.ndim != 2 or X.shape[1] != len(compiled.inputs):
+    plan = compiled.plan
+    X = np.array(X, dtype=float, ndmin=2)
+    if X.ndim != 2 or X.shape[1] != len(plan.lo):
         raise InputError(f"expected inputs of shape [n, {len(compiled.inputs)}] "
                          f"({', '.join(compiled.inputs)}), not {X.shape}")
+    Xc = np.clip(X, plan.lo, plan.hi)
+    if not (Xc != X).any():                    # the common case: nothing to clamp, no NaN
+        return Xc, np.zeros(len(plan.lo), dtype=np.intp)
     bad = np.isnan(X)
     if bad.any():
         row, col = map(int, np.argwhere(bad)[0])
         where = f" (sample {row + 1})" if X.shape[0] > 1 else ""
         raise InputError(f"input `{compiled.inputs[col]}` is not a number (NaN){where}",
                          hint="give every input a finite number")
-    lo, hi = compiled.universe[:, 0], compiled.universe[:, 1]
-    clamped = ((X < lo) | (X > hi)).sum(axis=0)
-    if clamped.any():
-        np.clip(X, lo, hi, out=X)
-    return X, clamped
+    return Xc, (Xc != X).sum(axis=0)
 
 
 #: Samples per block: one block's neuron values stay in the CPU cache. Every operation is
@@ -105,26 +110,25 @@ BLOCK = 8192
 
 
 def memberships(compiled: CompiledRuleBase, Xt: np.ndarray, out: np.ndarray) -> None:
-    """Membership layer: fill rows ``2 .. 2+T`` of ``out[columns, b]`` from ``Xt[k, b]``."""
-    T = compiled.n_terms
-    if compiled.linear.all():
-        b, s1, c, s2 = compiled.kernel_columns
-        x = Xt[compiled.term_var]
-        rise = np.subtract(x, b, out=out[2:2 + T])
+    """Membership layer: fill rows ``2 .. 2+T`` of ``out[columns, b]`` from ``Xt[k, b]``.
+
+    Piecewise-linear terms share one kernel, ``clip(1 + min((x - b) s1, (c - x) s2), 0, 1)``
+    (see :func:`mitos_cli.shapes.kernel_params`); other shapes are evaluated per shape.
+    """
+    plan = compiled.plan
+    if len(plan.linear_rows):
+        b, s1, c, s2 = plan.kernel
+        x = Xt[plan.term_var]
+        rise = np.subtract(x, b, out=out[2:2 + plan.n_terms] if plan.all_linear else None)
         rise *= s1
         fall = np.subtract(c, x, out=x)
         fall *= s2
         np.minimum(rise, fall, out=rise)
+        np.minimum(rise, 0.0, out=rise)
         rise += 1.0
-        np.clip(rise, 0.0, 1.0, out=rise)
-        return
-    if compiled.linear.any():
-        idx = np.flatnonzero(compiled.linear)
-        b, s1, c, s2 = (k[idx] for k in compiled.kernel_columns)
-        x = Xt[compiled.term_var[idx]]
-        rise = (x - b) * s1
-        fall = (c - x) * s2
-        out[2 + idx] = np.clip(1.0 + np.minimum(rise, fall), 0.0, 1.0)
+        np.maximum(rise, 0.0, out=rise)
+        if not plan.all_linear:
+            out[2 + plan.linear_rows] = rise
     for g in compiled.shape_groups:
         shape = SHAPES[g.shape]
         x = Xt[g.inputs]
@@ -144,16 +148,15 @@ def _apply_group(group, V: np.ndarray, tnorm: norms.Norm, snorm: norms.Norm) -> 
     norm = tnorm if op == "and" else snorm
     lo, hi = int(group.out[0]), int(group.out[-1]) + 1
     contiguous = hi - lo == len(group.out)     # the compiler allocates a group's outputs in a row
-    acc = V[lo:hi] if contiguous else np.empty((len(group.out), V.shape[1]))
-    np.take(V, ch[:, 0], axis=0, out=acc)
-    if ch.shape[1] > 1:
-        scratch = np.empty_like(acc)
-        for j in range(1, ch.shape[1]):     # loop over arity (a few), never over rules
-            np.take(V, ch[:, j], axis=0, out=scratch)
-            if norm.fn is np.minimum or norm.fn is np.maximum:
-                norm.fn(acc, scratch, out=acc)
-            else:
-                acc[:] = norm.fn(acc, scratch)
+    inputs = V[ch]                             # [g, arity, b]: whole rows, copied
+    if norm.fn is np.minimum or norm.fn is np.maximum:
+        acc = norm.fn.reduce(inputs, axis=1, out=V[lo:hi] if contiguous else None)
+    else:
+        acc = inputs[:, 0]
+        for j in range(1, ch.shape[1]):        # loop over arity (a few), never over rules
+            acc = norm.fn(acc, inputs[:, j])
+        if contiguous:
+            V[lo:hi] = acc
     if not contiguous:
         V[group.out] = acc
 
@@ -161,29 +164,29 @@ def _apply_group(group, V: np.ndarray, tnorm: norms.Norm, snorm: norms.Norm) -> 
 def network_values(compiled: CompiledRuleBase, Xt: np.ndarray) -> np.ndarray:
     """Every neuron's value ``V[columns, b]`` for inputs ``Xt[k, b]`` (one block)."""
     V = np.empty((compiled.n_columns, Xt.shape[1]))
-    V[ZERO] = 0.0
-    V[ONE] = 1.0
+    V[:2] = _CONSTANTS
     memberships(compiled, Xt, V)
-    tnorm, snorm = compiled.operators.tnorm, compiled.operators.snorm
-    for level in compiled.levels:
-        for group in level:
-            _apply_group(group, V, tnorm, snorm)
+    if compiled.levels:
+        tnorm, snorm = compiled.operators.tnorm, compiled.operators.snorm
+        for level in compiled.levels:
+            for group in level:
+                _apply_group(group, V, tnorm, snorm)
     return V
+
+
+_CONSTANTS = np.array([[0.0], [1.0]])   # columns ZERO and ONE
 
 
 def rule_dof(compiled: CompiledRuleBase, V: np.ndarray) -> np.ndarray:
     """DOFs ``[R, b]``: antecedent values times ``use`` contexts and rule weights."""
-    r0 = int(compiled.rule_col[0]) if compiled.n_rules else 0
-    if compiled.n_rules and (compiled.rule_col == np.arange(r0, r0 + compiled.n_rules)).all():
-        dof = V[r0:r0 + compiled.n_rules]           # a view: rules own a run of columns
-    else:
-        dof = V[compiled.rule_col]
-    if compiled.context.shape[1] or compiled.weighted:
+    plan = compiled.plan
+    dof = V[plan.rules]                         # a view when the rules own a run of columns
+    if plan.contexts or plan.weight is not None:
         dof = dof.copy()
-        for j in range(compiled.context.shape[1]):      # depth of `use` nesting
-            dof *= V[compiled.context[:, j]]
-        if compiled.weighted:
-            dof *= compiled.weight[:, None]
+        for ctx in plan.contexts:                   # depth of `use` nesting
+            dof *= V[ctx]
+        if plan.weight is not None:
+            dof *= plan.weight
     return dof
 
 
@@ -224,18 +227,16 @@ def weighted_average(compiled: CompiledRuleBase, dof: np.ndarray,
     ``y`` is the rule's crisp consequent, or with linear consequents ``a . x + c`` for the
     block's inputs ``Xt[k, b]``; ``weighted_sum`` skips the division.
     """
-    K = compiled.sum_weights                     # [k, R]: numerators, then denominators
-    W = np.multiply(dof[None], K[:, :, None])
+    plan = compiled.plan
+    W = np.multiply(dof, plan.sums)              # [k, R, b]: numerators, then denominators
+    m = len(compiled.outputs)
     if compiled.cons_linear is not None:
-        m = len(compiled.outputs)
         np.multiply(dof[None], linear_consequents(compiled, Xt), out=W[:m])
     sums = tree_sum(W)
-    m = len(compiled.outputs)
-    out = np.full((m, dof.shape[1]), np.nan)
     if compiled.operators.inference == "weighted_sum":
         return sums[:m].copy()
-    den = sums[compiled.den_row]
-    np.divide(sums[:m], den, out=out, where=den > 0)
+    den = sums[plan.den_row]
+    out = np.divide(sums[:m], den, out=np.full((m, dof.shape[1]), np.nan), where=den > 0)
     return out
 
 
