@@ -38,6 +38,23 @@ def _safe_div(num, den, when_zero):
     return np.where(den == 0, when_zero, out)
 
 
+# The formulas below are the textbook ones rearranged so that, in floating point too, every
+# norm is exactly commutative (symmetric expressions) and has its identity exactly
+# (``T(a, 1) == a``, ``S(a, 0) == a``): the compiled network pads n-ary neurons with the
+# identity column, so a rounding there would change a rule's DOF. Tests: tests/test_norms.py.
+
+
+def _lukasiewicz(a, b):
+    # max(0, a + b - 1) as min - (1 - max): exact at b = 1 (``fl(fl(a + 1) - 1)`` is not a)
+    return np.maximum(0.0, np.minimum(a, b) - (1.0 - np.maximum(a, b)))
+
+
+def _probabilistic_sum(a, b):
+    # a + b - a b as hi + lo (1 - hi): exact at b = 0 and b = 1, no cancellation
+    hi = np.maximum(a, b)
+    return hi + np.minimum(a, b) * (1.0 - hi)
+
+
 def _drastic_product(a, b):
     return np.where(a == 1, b, np.where(b == 1, a, 0.0))
 
@@ -47,7 +64,8 @@ def _drastic_sum(a, b):
 
 
 def _einstein_product(a, b):
-    return (a * b) / (2.0 - (a + b - a * b))
+    # a b / (2 - (a + b - a b)) with the denominator as 1 + (1 - a)(1 - b): exact at b = 1
+    return (a * b) / (1.0 + (1.0 - a) * (1.0 - b))
 
 
 def _einstein_sum(a, b):
@@ -55,15 +73,20 @@ def _einstein_sum(a, b):
 
 
 def _hamacher_product(a, b):
-    return _safe_div(a * b, a + b - a * b, 0.0)
+    # a b / (a + b - a b); the denominator is the probabilistic sum (exactly 1 at b = 1)
+    return _safe_div(a * b, _probabilistic_sum(a, b), 0.0)
 
 
 def _hamacher_sum(a, b):
-    return _safe_div(a + b - 2.0 * a * b, 1.0 - a * b, 1.0)
+    # (a + b - 2 a b) / (1 - a b) with the numerator as a (1 - b) + b (1 - a): exactly a at
+    # b = 0 and exactly 1 at b = 1 (numerator and denominator round alike)
+    return _safe_div(a * (1.0 - b) + b * (1.0 - a), 1.0 - a * b, 1.0)
 
 
 def _nilpotent_minimum(a, b):
-    return np.where(a + b > 1.0, np.minimum(a, b), 0.0)
+    # a + b > 1 tested as lo > 1 - hi: for tiny a, fl(a + 1) > 1 is false and T(a, 1) would be 0
+    lo, hi = np.minimum(a, b), np.maximum(a, b)
+    return np.where(lo > 1.0 - hi, lo, 0.0)
 
 
 def _nilpotent_maximum(a, b):
@@ -83,7 +106,7 @@ for _norm in (
     Norm("min", "tnorm", np.minimum, "min(a, b)", "max", ("minimum",)),
     Norm("product", "tnorm", np.multiply, "a * b", "probabilistic_sum",
          ("algebraic_product", "prod")),
-    Norm("lukasiewicz", "tnorm", lambda a, b: np.maximum(0.0, a + b - 1.0),
+    Norm("lukasiewicz", "tnorm", _lukasiewicz,
          "max(0, a + b - 1)", "bounded_sum", ("bounded_difference", "bounded_product")),
     Norm("drastic", "tnorm", _drastic_product, "b if a = 1, a if b = 1, else 0", "drastic_sum",
          ("drastic_product",)),
@@ -94,7 +117,7 @@ for _norm in (
     Norm("nilpotent_minimum", "tnorm", _nilpotent_minimum, "min(a, b) if a + b > 1, else 0",
          "nilpotent_maximum", ("nilpotent_min",)),
     Norm("max", "snorm", np.maximum, "max(a, b)", "min", ("maximum",)),
-    Norm("probabilistic_sum", "snorm", lambda a, b: a + b - a * b, "a + b - a * b", "product",
+    Norm("probabilistic_sum", "snorm", _probabilistic_sum, "a + b - a * b", "product",
          ("algebraic_sum", "probor")),
     Norm("bounded_sum", "snorm", lambda a, b: np.minimum(1.0, a + b), "min(1, a + b)",
          "lukasiewicz", ("lukasiewicz_sum",)),
@@ -124,13 +147,38 @@ def names(kind: str) -> list[str]:
     return sorted(set(table) | {a for n in table.values() for a in n.aliases})
 
 
+def tree_reduce(norm: Norm, x: np.ndarray, axis: int = 0) -> np.ndarray:
+    """Fold ``norm`` over ``axis`` by halving: ``ceil(log2 n)`` vectorized steps, no Python
+    loop over the items (an S-norm over hundreds of rules in Mamdani aggregation).
+
+    Norms are associative, so this equals the left fold up to rounding for the rational
+    norms (Einstein, Hamacher) and exactly for the others; the order depends only on the
+    length of ``axis``, so a sample's result does not depend on the rest of the batch.
+    """
+    x = np.moveaxis(np.asarray(x, dtype=float), axis, 0)
+    if norm.fn is np.minimum or norm.fn is np.maximum:
+        return norm.fn.reduce(x, axis=0, initial=norm.identity)
+    size = x.shape[0]
+    if size == 0:
+        return np.full(x.shape[1:], norm.identity)
+    if size == 1:
+        return x[0].copy()
+    half = (size + 1) // 2
+    acc = x[:half].copy()                          # never write into the caller's array
+    acc[:size - half] = norm.fn(acc[:size - half], x[half:size])
+    size = half
+    while size > 1:
+        half = (size + 1) // 2
+        acc[:size - half] = norm.fn(acc[:size - half], acc[half:size])
+        size = half
+    return acc[0]
+
+
 def reduce(norm: Norm, x: np.ndarray, axis: int = -1) -> np.ndarray:
     """Fold ``norm`` over ``axis`` (left to right), as an n-ary AND or OR neuron does."""
     x = np.moveaxis(np.asarray(x, dtype=float), axis, 0)
-    if norm.fn is np.minimum:
-        return np.minimum.reduce(x, axis=0)
-    if norm.fn is np.maximum:
-        return np.maximum.reduce(x, axis=0)
+    if norm.fn is np.minimum or norm.fn is np.maximum:
+        return norm.fn.reduce(x, axis=0, initial=norm.identity)
     if x.shape[0] == 0:
         return np.full(x.shape[1:], norm.identity)
     acc = x[0]
