@@ -150,6 +150,8 @@ class Plan:
     n_rules: int
     lo: np.ndarray                     # [k] universe minima
     hi: np.ndarray                     # [k] universe maxima
+    lo_col: np.ndarray                 # [k, 1] the same as columns
+    hi_col: np.ndarray
     all_linear: bool
     linear_rows: np.ndarray            # [L] terms evaluated by the linear kernel
     term_var: np.ndarray               # [L] their input column
@@ -168,6 +170,8 @@ def _plan(c: "CompiledRuleBase") -> Plan:
     return Plan(
         n_terms=c.n_terms, n_rules=c.n_rules,
         lo=np.ascontiguousarray(c.universe[:, 0]), hi=np.ascontiguousarray(c.universe[:, 1]),
+        lo_col=np.ascontiguousarray(c.universe[:, :1]),
+        hi_col=np.ascontiguousarray(c.universe[:, 1:]),
         all_linear=bool(c.linear.all()), linear_rows=rows, term_var=c.term_var[rows],
         kernel=tuple(np.ascontiguousarray(k[rows, None]) for k in c.kernel),
         rules=slice(r0, r0 + c.n_rules) if contiguous else c.rule_col,
@@ -261,16 +265,16 @@ def compile_rulebase(rb: RuleBase, behavior: str | None = None,
     for i, t in enumerate(terms):
         if t.corners is not None:
             kernel[:, i] = kernel_params(t.corners)
-    groups: dict[str, list[int]] = {}
+    groups: dict[tuple[str, int], list[int]] = {}   # variadic shapes group by param count
     for i, t in enumerate(terms):
         if t.corners is None:
-            groups.setdefault(t.shape, []).append(i)
+            groups.setdefault((t.shape, len(t.params)), []).append(i)
     shape_groups = tuple(
         ShapeGroup(shape, np.array([2 + i for i in idx], dtype=np.intp),
                    np.array([term_var[i] for i in idx], dtype=np.intp),
                    np.array([terms[i].params for i in idx], dtype=float).reshape(
-                       len(idx), len(SHAPES[shape].params)))
-        for shape, idx in groups.items())
+                       len(idx), n_params))
+        for (shape, n_params), idx in groups.items())
 
     builder = _Builder(len(terms))
 

@@ -40,6 +40,30 @@ register(Hedge("somewhat", np.sqrt, _sqrt_derivative, "sqrt(x)"))
 register(Hedge("more_or_less", np.sqrt, _sqrt_derivative, "sqrt(x)"))
 
 
+# Hedges of fuzzylite (FLL and its FCL dialect). fuzzylite's `extremely` is Zadeh's contrast
+# intensification, not MITOS's x^3, so it is called `intensely` here (the readers and writers
+# translate the name).
+def _seldom(x):
+    with np.errstate(invalid="ignore"):
+        return np.where(x <= 0.5, np.sqrt(0.5 * x), 1.0 - np.sqrt(0.5 * (1.0 - x)))
+
+
+def _seldom_derivative(x):
+    with np.errstate(divide="ignore", invalid="ignore"):
+        d = np.where(x <= 0.5, 0.25 / np.sqrt(np.maximum(0.5 * x, 1e-300)),
+                     0.25 / np.sqrt(np.maximum(0.5 * (1.0 - x), 1e-300)))
+    return d
+
+
+register(Hedge("seldom", _seldom, _seldom_derivative,
+               "sqrt(x/2) if x <= 0.5, else 1 - sqrt((1 - x)/2)"))
+register(Hedge("intensely", lambda x: np.where(x <= 0.5, 2.0 * x * x, 1.0 - 2.0 * (1.0 - x) ** 2),
+               lambda x: np.where(x <= 0.5, 4.0 * x, 4.0 * (1.0 - x)),
+               "2x^2 if x <= 0.5, else 1 - 2(1 - x)^2 (fuzzylite's `extremely`)"))
+register(Hedge("any", lambda x: np.where(np.isnan(x), np.nan, 1.0), lambda x: np.zeros_like(x),
+               "1 (the term does not matter)"))
+
+
 def apply(names: tuple[str, ...], x: np.ndarray) -> np.ndarray:
     """Apply hedges written left to right (``very somewhat X`` = very(somewhat(X)))."""
     for name in reversed(names):

@@ -18,10 +18,12 @@ from .errors import RuleSyntaxError, Span
 from .model import And, Behavior, Consequent, Not, Or, Prop, Rule, Setting, Use
 from .resources import grammar_text
 
+HEDGE_NAMES = ("very", "somewhat", "more_or_less", "extremely", "seldom", "intensely", "any")
+
 #: How terminals are named in error messages.
 TERMINAL_WORDS = {
     "NAME": "a name", "STRING": 'a quoted file name ("...")', "SIGNED_NUMBER": "a number",
-    "NOT": "`not`", "HEDGE": "a hedge (very, somewhat, more_or_less, extremely)", "COLON": "`:`", "COMMA": "`,`", "EQUAL": "`=`", "LPAR": "`(`",
+    "NOT": "`not`", "HEDGE": "a hedge (" + ", ".join(HEDGE_NAMES) + ")", "COLON": "`:`", "COMMA": "`,`", "EQUAL": "`=`", "LPAR": "`(`",
     "RPAR": "`)`", "$END": "the end of the input",
 }
 

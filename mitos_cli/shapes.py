@@ -118,6 +118,7 @@ class Shape:
     corners: Callable[[tuple[float, ...]], tuple[float, float, float, float]] | None
     center: Callable[[tuple[float, ...]], float]
     doc: str
+    variadic: bool = False        # any number of params (``discrete``: x1, y1, ..., xn, yn)
 
     def membership(self, x, params) -> np.ndarray:
         return self.fn(x, *params)
@@ -177,3 +178,253 @@ def kernel_params(corners: tuple[float, float, float, float]) -> tuple[float, fl
     else:
         s2 = steep if d == c else 1.0 / (d - c)
     return b, s1, c, s2
+
+
+# --- Shapes of the foreign formats (FCL, MATLAB .fis, fuzzylite FLL) ---------------------------
+#
+# Formulas follow fuzzylite 8 (which follows MATLAB where both define a shape), so that files
+# read from those formats give the same memberships. Parameter names are MITOS's; the readers in
+# ``mitos_cli.interop`` map each format's order onto them. A NaN input gives NaN; +/-inf give the
+# shape's limits (1 beyond a shoulder, ramp or sigmoid plateau, 0 elsewhere).
+
+
+def _nan_of(x):
+    """1 where ``x`` is a number, NaN where it is NaN (multiplied into a membership)."""
+    return np.where(np.isnan(x), np.nan, 1.0)
+
+
+def rectangle(x, start, end):
+    """1 on ``[start, end]``, 0 elsewhere."""
+    return trapezoid(x, start, start, end, end)
+
+
+def ramp(x, start, end):
+    """0 at ``start``, rising (or falling, when ``end < start``) linearly to 1 at ``end``, and
+    1 beyond ``end``."""
+    x = np.asarray(x, dtype=float)
+    up = np.asarray(start) < np.asarray(end)
+    return np.where(up, trapezoid(x, start, end, INF, INF), trapezoid(x, -INF, -INF, end, start))
+
+
+def gaussian(x, mean, sigma):
+    """``exp(-(x - mean)^2 / (2 sigma^2))``."""
+    x = np.asarray(x, dtype=float)
+    with np.errstate(over="ignore"):
+        return np.exp(-np.square(x - mean) / (2.0 * np.square(sigma)))
+
+
+def gaussian2(x, mean1, sigma1, mean2, sigma2):
+    """Two-sided Gaussian (MATLAB ``gauss2mf``, fuzzylite ``GaussianProduct``): the left
+    Gaussian below ``mean1``, the right one above ``mean2``, 1 between (when ``mean1 <= mean2``)."""
+    x = np.asarray(x, dtype=float)
+    a = np.where(x < mean1, gaussian(x, mean1, sigma1), 1.0)
+    b = np.where(x > mean2, gaussian(x, mean2, sigma2), 1.0)
+    return _nan_of(x) * a * b
+
+
+def bell(x, center, width, slope):
+    """Generalized bell ``1 / (1 + |(x - center) / width|^(2 slope))`` (MATLAB ``gbellmf``)."""
+    x = np.asarray(x, dtype=float)
+    with np.errstate(over="ignore", divide="ignore", invalid="ignore"):
+        out = 1.0 / (1.0 + np.power(np.abs((x - center) / width), 2.0 * slope))
+    return np.where(np.isinf(x), 0.0, out)
+
+
+def sigmoid(x, inflection, slope):
+    """``1 / (1 + exp(-slope (x - inflection)))``: rising for slope > 0, falling for < 0."""
+    x = np.asarray(x, dtype=float)
+    with np.errstate(over="ignore", invalid="ignore"):
+        out = 1.0 / (1.0 + np.exp(-np.multiply(slope, x - inflection)))
+    return out
+
+
+def sigmoid_difference(x, left, rising, falling, right):
+    """``|sigmoid(left, rising) - sigmoid(right, falling)|`` (fuzzylite ``SigmoidDifference``;
+    MATLAB's ``dsigmf`` is the signed difference, the same wherever it is a membership)."""
+    return np.abs(sigmoid(x, left, rising) - sigmoid(x, right, falling))
+
+
+def sigmoid_product(x, left, rising, falling, right):
+    """``sigmoid(left, rising) * sigmoid(right, falling)`` (MATLAB ``psigmf``)."""
+    return sigmoid(x, left, rising) * sigmoid(x, right, falling)
+
+
+def s_shape(x, start, end):
+    """Smooth step from 0 at ``start`` to 1 at ``end`` (two parabolas; MATLAB ``smf``)."""
+    x = np.asarray(x, dtype=float)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        out = np.where(x <= start, 0.0, np.where(
+            x <= 0.5 * (np.add(start, end)), 2.0 * np.square((x - start) / np.subtract(end, start)),
+            np.where(x < end, 1.0 - 2.0 * np.square((x - end) / np.subtract(end, start)), 1.0)))
+    return _nan_of(x) * out
+
+
+def z_shape(x, start, end):
+    """Smooth step from 1 at ``start`` to 0 at ``end`` (MATLAB ``zmf``)."""
+    x = np.asarray(x, dtype=float)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        out = np.where(x <= start, 1.0, np.where(
+            x < 0.5 * (np.add(start, end)), 1.0 - 2.0 * np.square((x - start) / np.subtract(end, start)),
+            np.where(x < end, 2.0 * np.square((x - end) / np.subtract(end, start)), 0.0)))
+    return _nan_of(x) * out
+
+
+def pi_shape(x, a, b, c, d):
+    """``s_shape(a, b) * z_shape(c, d)`` (MATLAB ``pimf``)."""
+    return s_shape(x, a, b) * z_shape(x, c, d)
+
+
+def cosine(x, center, width):
+    """Raised cosine ``(1 + cos(2 pi (x - center) / width)) / 2`` on ``center +- width/2``."""
+    x = np.asarray(x, dtype=float)
+    with np.errstate(invalid="ignore"):
+        inside = np.isfinite(x) & (x >= center - 0.5 * np.asarray(width)) \
+            & (x <= center + 0.5 * np.asarray(width))
+        out = np.where(inside, 0.5 * (1.0 + np.cos(2.0 / np.asarray(width) * np.pi * (x - center))),
+                       0.0)
+    return _nan_of(x) * out
+
+
+def spike(x, center, width):
+    """``exp(-|10 (x - center) / width|)``: a sharp peak at ``center``."""
+    x = np.asarray(x, dtype=float)
+    return np.exp(-np.abs(10.0 / np.asarray(width) * (x - center)))
+
+
+def concave(x, inflection, end):
+    """Concave curve reaching 1 at ``end`` and 0.5 at ``inflection`` (increasing when
+    ``inflection <= end``, decreasing otherwise); 1 beyond ``end``."""
+    x = np.asarray(x, dtype=float)
+    i, e = np.asarray(inflection, dtype=float), np.asarray(end, dtype=float)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        out = np.where((i <= e) & (x < e), (e - i) / (2.0 * e - i - x),
+                       np.where((i >= e) & (x > e), (i - e) / (i - 2.0 * e + x), 1.0))
+    out = np.where(np.isinf(x) & (((i <= e) & (x < e)) | ((i >= e) & (x > e))), 0.0, out)
+    return _nan_of(x) * out
+
+
+def semi_ellipse(x, start, end):
+    """Upper half of an ellipse over ``[start, end]``, 1 at its middle."""
+    x = np.asarray(x, dtype=float)
+    s, e = np.minimum(start, end), np.maximum(start, end)
+    r = (e - s) / 2.0
+    with np.errstate(invalid="ignore"):
+        out = np.where((x >= s) & (x <= e), np.sqrt(np.maximum(r * r - np.square(x - (s + r)), 0.0))
+                       / r, 0.0)
+    return _nan_of(x) * out
+
+
+def arc(x, start, end):
+    """Quarter circle from 0 at ``start`` to 1 at ``end`` (fuzzylite ``Arc``), 1 beyond."""
+    x = np.asarray(x, dtype=float)
+    s, e = np.asarray(start, dtype=float), np.asarray(end, dtype=float)
+    r = e - s
+    with np.errstate(invalid="ignore"):
+        rising = (s < e) & (s <= x) & (x <= e)
+        falling = (s > e) & (e <= x) & (x <= s)
+        curve = np.sqrt(np.maximum(r * r - np.square(x - e), 0.0)) / np.abs(r)
+        out = np.where(rising | falling, curve, np.where(((s < e) & (x > e)) | ((s > e) & (x < e)),
+                                                         1.0, 0.0))
+    return _nan_of(x) * out
+
+
+def binary(x, start, direction):
+    """1 from ``start`` on towards ``direction`` (``+inf``: x >= start; ``-inf``: x <= start)."""
+    x = np.asarray(x, dtype=float)
+    s, d = np.asarray(start, dtype=float), np.asarray(direction, dtype=float)
+    out = np.where(((d > s) & (x >= s)) | ((d < s) & (x <= s)), 1.0, 0.0)
+    return _nan_of(x) * out
+
+
+def discrete(x, *points):
+    """Piecewise-linear through ``(x1, y1), ..., (xn, yn)`` (x ascending), constant beyond the
+    ends (``numpy.interp``). Vectorized over parameter rows: the loop runs over the n points."""
+    x = np.asarray(x, dtype=float)
+    xs, ys = points[0::2], points[1::2]
+    out = np.broadcast_to(np.asarray(ys[0], dtype=float), np.broadcast_shapes(
+        x.shape, np.shape(ys[0]))).copy()
+    with np.errstate(invalid="ignore", divide="ignore"):
+        for (x0, y0), (x1, y1) in zip(zip(xs, ys), zip(xs[1:], ys[1:])):
+            dx = np.subtract(x1, x0)
+            seg = np.where(dx > 0, y0 + (x - x0) * (np.subtract(y1, y0) / np.where(dx > 0, dx, 1.0)),
+                           y1)
+            out = np.where(x > x0, np.where(x >= x1, y1, seg), out)
+    return _nan_of(x) * out
+
+
+def _check_discrete(p: tuple[float, ...]) -> str | None:
+    if len(p) < 2 or len(p) % 2:
+        return f"needs pairs x1, y1, ..., xn, yn (an even number of values), not {len(p)}"
+    xs, ys = p[0::2], p[1::2]
+    if any(a > b for a, b in zip(xs, xs[1:])):
+        return "the x values must ascend"
+    if any(not 0.0 <= y <= 1.0 for y in ys):
+        return "memberships (y values) must lie in [0, 1]"
+    return None
+
+
+def _distinct(p: tuple[float, ...]) -> str | None:
+    return None if p[0] != p[1] else f"start and end must differ, not both {p[0]:g}"
+
+
+def _nonzero(i: int, what: str) -> Callable[[tuple[float, ...]], str | None]:
+    def check(p: tuple[float, ...]) -> str | None:
+        return None if p[i] != 0 and np.isfinite(p[i]) else f"{what} must be finite and non-zero"
+    return check
+
+
+def _sigmoid_center(p) -> float:
+    return p[0]
+
+
+def _discrete_center(p) -> float:
+    xs, ys = np.asarray(p[0::2]), np.asarray(p[1::2])
+    return float(xs[int(np.argmax(ys))])
+
+
+for _shape in (
+    Shape("rectangle", ("start", "end"), rectangle, _ordered(("start", "end")),
+          lambda p: (p[0], p[0], p[1], p[1]), lambda p: (p[0] + p[1]) / 2,
+          "1 from start to end, 0 elsewhere"),
+    Shape("ramp", ("start", "end"), ramp, _distinct,
+          lambda p: (p[0], p[1], INF, INF) if p[0] < p[1] else (-INF, -INF, p[1], p[0]),
+          lambda p: p[1], "0 at start, linear to 1 at end and beyond (falls when end < start)"),
+    Shape("gaussian", ("mean", "sigma"), gaussian, _nonzero(1, "sigma"), None, lambda p: p[0],
+          "exp(-(x - mean)^2 / (2 sigma^2))"),
+    Shape("gaussian2", ("mean1", "sigma1", "mean2", "sigma2"), gaussian2,
+          lambda p: _nonzero(1, "sigma1")(p) or _nonzero(3, "sigma2")(p), None,
+          lambda p: (p[0] + p[2]) / 2,
+          "two-sided Gaussian: left one below mean1, right one above mean2, 1 between"),
+    Shape("bell", ("center", "width", "slope"), bell, _nonzero(1, "width"), None,
+          lambda p: p[0], "generalized bell 1 / (1 + |(x - center) / width|^(2 slope))"),
+    Shape("sigmoid", ("inflection", "slope"), sigmoid, _nonzero(1, "slope"), None, _sigmoid_center,
+          "1 / (1 + exp(-slope (x - inflection)))"),
+    Shape("sigmoid_difference", ("left", "rising", "falling", "right"), sigmoid_difference,
+          lambda p: None, None, lambda p: (p[0] + p[3]) / 2,
+          "|sigmoid(left, rising) - sigmoid(right, falling)|"),
+    Shape("sigmoid_product", ("left", "rising", "falling", "right"), sigmoid_product,
+          lambda p: None, None, lambda p: (p[0] + p[3]) / 2,
+          "sigmoid(left, rising) * sigmoid(right, falling)"),
+    Shape("s_shape", ("start", "end"), s_shape, _ordered(("start", "end")), None,
+          lambda p: p[1], "smooth step from 0 at start to 1 at end"),
+    Shape("z_shape", ("start", "end"), z_shape, _ordered(("start", "end")), None,
+          lambda p: p[0], "smooth step from 1 at start to 0 at end"),
+    Shape("pi_shape", ("a", "b", "c", "d"), pi_shape, _ordered(("a", "b", "c", "d")), None,
+          lambda p: (p[1] + p[2]) / 2, "s_shape(a, b) * z_shape(c, d)"),
+    Shape("cosine", ("center", "width"), cosine, _nonzero(1, "width"), None, lambda p: p[0],
+          "raised cosine of the given width around center"),
+    Shape("spike", ("center", "width"), spike, _nonzero(1, "width"), None, lambda p: p[0],
+          "exp(-|10 (x - center) / width|)"),
+    Shape("concave", ("inflection", "end"), concave, _distinct, None, lambda p: p[1],
+          "concave curve: 0.5 at inflection, 1 at end and beyond"),
+    Shape("semi_ellipse", ("start", "end"), semi_ellipse, _distinct, None,
+          lambda p: (p[0] + p[1]) / 2, "upper half ellipse over [start, end]"),
+    Shape("arc", ("start", "end"), arc, _distinct, None, lambda p: p[1],
+          "quarter circle from 0 at start to 1 at end, 1 beyond"),
+    Shape("binary", ("start", "direction"), binary, _distinct, None, lambda p: p[0],
+          "1 from start towards direction (+inf or -inf), 0 elsewhere"),
+    Shape("discrete", ("x1", "y1", "xn", "yn"), discrete, _check_discrete, None,
+          _discrete_center, "piecewise linear through the points (x1, y1) ... (xn, yn)",
+          variadic=True),
+):
+    register(_shape)
