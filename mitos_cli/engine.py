@@ -86,22 +86,25 @@ def as_batch(compiled: CompiledRuleBase, columns: dict[str, object]) -> np.ndarr
 
 
 def check_inputs(compiled: CompiledRuleBase, X) -> tuple[np.ndarray, np.ndarray]:
-    """Refuse NaN, clamp to each universe; return the clamped copy and clamp counts."""
+    """Refuse NaN, clamp to each universe: ``X[n, k]`` -> (clamped ``Xt[k, n]``, counts)."""
     plan = compiled.plan
-    X = np.array(X, dtype=float, ndmin=2)
+    X = np.asarray(X, dtype=float)
+    if X.ndim == 1 and X.shape[0] == len(plan.lo):
+        X = X[None]
     if X.ndim != 2 or X.shape[1] != len(plan.lo):
         raise InputError(f"expected inputs of shape [n, {len(compiled.inputs)}] "
                          f"({', '.join(compiled.inputs)}), not {X.shape}")
-    Xc = np.clip(X, plan.lo, plan.hi)
-    if not (Xc != X).any():                    # the common case: nothing to clamp, no NaN
+    Xt = np.array(X.T, order="C")              # [k, n]: each input a contiguous row
+    Xc = np.clip(Xt, plan.lo_col, plan.hi_col)
+    if not (Xc != Xt).any():                   # the common case: nothing to clamp, no NaN
         return Xc, np.zeros(len(plan.lo), dtype=np.intp)
-    bad = np.isnan(X)
+    bad = np.isnan(Xt)
     if bad.any():
-        row, col = map(int, np.argwhere(bad)[0])
+        col, row = map(int, np.argwhere(bad)[0])
         where = f" (sample {row + 1})" if X.shape[0] > 1 else ""
         raise InputError(f"input `{compiled.inputs[col]}` is not a number (NaN){where}",
                          hint="give every input a finite number")
-    return Xc, (Xc != X).sum(axis=0)
+    return Xc, (Xc != Xt).sum(axis=1)
 
 
 #: Samples per block: one block's neuron values stay in the CPU cache. Every operation is
@@ -250,9 +253,9 @@ def evaluate(compiled: CompiledRuleBase, X, *, detail: bool = True, keep_values:
     variable's ``default``, and without one raises :class:`NoRuleFiredError`; with
     ``strict=False`` such outputs are NaN (for callers that report them themselves).
     """
-    X, clamped = check_inputs(compiled, X)
+    Xt, clamped = check_inputs(compiled, X)
+    X = Xt.T
     n = X.shape[0]
-    Xt = np.ascontiguousarray(X.T)
     T, R = compiled.n_terms, compiled.n_rules
     mu = np.empty((T, n)) if detail else None
     dof = np.empty((R, n)) if detail else None
