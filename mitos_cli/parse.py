@@ -118,9 +118,8 @@ def _hedge_hint(text: str, token: Token) -> str | None:
     if before is None or before.group(1) in HEDGES:
         return None
     word = before.group(1)
-    close = did_you_mean(word, HEDGES)
-    return (f"`{word}` is not a hedge (hedges: {', '.join(HEDGES)})"
-            + (f"; {close}" if close else ""))
+    close = did_you_mean(word, HEDGES)          # only a near miss is taken for a hedge
+    return f"`{word}` is not a hedge (hedges: {', '.join(HEDGES)}); {close}" if close else None
 
 
 def _span(meta, text: str, path: str | None) -> Span | None:
