@@ -1,0 +1,386 @@
+"""Every error a user can meet in the rule language, term sets, inputs and the CLI.
+
+Each test triggers one message and checks what the user reads: the position
+(``path:line:col``), the offending line with a caret, what was expected in words, a hint
+(did you mean ...), and never ``$END``, ``Token(`` or a traceback.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from mitos_cli import load_rulebase
+from mitos_cli.build import check_rule, load_rules_file
+from mitos_cli.cli.app import main
+from mitos_cli.errors import (InputError, MitosError, NameError_, NoRuleFiredError,
+                              RuleBaseError, RuleSyntaxError, TermSetError)
+from mitos_cli.model import Consequent, Prop, Rule
+
+ROOT = Path(__file__).resolve().parents[1]
+TERMS = (ROOT / "rulebases" / "mitos.terms.yaml").read_text(encoding="utf-8")
+GOOD_RULE = ("r1: if road is WIDE and size is SMALL_SZ and position is LEFT "
+             "then steering is RS and speed is MEDIUM")
+
+
+def write(tmp_path: Path, rules: str, terms: str = TERMS) -> Path:
+    (tmp_path / "t.terms.yaml").write_text(terms, encoding="utf-8")
+    path = tmp_path / "t.rules"
+    path.write_text('terms "t.terms.yaml"\n' + rules, encoding="utf-8")
+    return path
+
+
+def error_of(fn, cls=MitosError) -> MitosError:
+    with pytest.raises(cls) as info:
+        fn()
+    exc = info.value
+    text = exc.render()
+    for leak in ("$END", "Token(", "Traceback", "Tree(", "UnexpectedToken", "lark"):
+        assert leak not in text, text
+    return exc
+
+
+def caret_under(exc: MitosError) -> str:
+    """The text the caret points at (checks that line, column and caret agree)."""
+    lines = exc.render().splitlines()
+    src, caret = lines[1], lines[2]
+    assert src.startswith("    ") and set(caret.strip()) == {"^"}, exc.render()
+    start = caret.index("^")
+    return src[start:start + len(caret.strip())]
+
+
+# ---------------------------------------------------------------------------------------------
+# syntax errors
+
+
+@pytest.mark.parametrize("line, col, at, message, expected, hint", [
+    ("r1: if road WIDE then speed is SLOW", 13, "WIDE", "unexpected `WIDE`", "`is`",
+     "a condition reads `variable is TERM`"),
+    ("r1: if road is WIDE & size is SMALL_SZ then speed is SLOW", 21, "&",
+     "unexpected character `&`", None, None),
+    ("r1: if road is WIDE speed is SLOW", 21, "speed", "unexpected `speed`", "`then`",
+     "start the actions with `then`"),
+    ("r1: if road is vary WIDE then speed is SLOW", 21, "WIDE", "unexpected `WIDE`", "`then`",
+     "did you mean `very`?"),
+    ("r1: if road is WIDE then speed is SLOW with", 44, None, "unexpected end of the input",
+     "a number", "incomplete"),
+    ("r1: if road is WIDE then speed is", 34, None, "unexpected end of the input", "a name",
+     None),
+    ("r1: if (road is WIDE then speed is SLOW", 22, "then", "unexpected `then`", "`)`", None),
+    ("behavior b:\n  r1: if road is WIDE then speed is SLOW\n", 41, None,
+     "unexpected end of the input", "`end`", "a behavior ends with `end`"),
+])
+def test_syntax_errors(tmp_path, line, col, at, message, expected, hint):
+    path = write(tmp_path, line)
+    exc = error_of(lambda: load_rules_file(path), RuleSyntaxError)
+    text = exc.render()
+    lineno = 1 + line.rstrip("\n").count("\n") + 1
+    assert text.startswith(f"{path}:{lineno}:{col}: syntax error: {message}"), text
+    if at is not None:
+        assert caret_under(exc) == at
+    if expected:
+        assert text.splitlines()[3].startswith("expected ")
+        assert expected in text.splitlines()[3]
+    if hint:
+        assert "hint:" in text and hint in text
+
+
+def test_syntax_error_in_a_wrapped_rule_points_at_its_line(tmp_path):
+    path = write(tmp_path, "r1: if road is WIDE\n    and size SMALL_SZ\n    then speed is SLOW\n")
+    exc = error_of(lambda: load_rules_file(path), RuleSyntaxError)
+    assert str(exc.span) == f"{path}:3:14"
+    assert caret_under(exc) == "SMALL_SZ"
+
+
+def test_binary_file_is_refused(tmp_path):
+    path = tmp_path / "junk.rules"
+    path.write_bytes(b"\x89PNG\r\n\x1a\n\x00\xff\xfe")
+    exc = error_of(lambda: load_rules_file(path), RuleBaseError)
+    assert "not a text file" in exc.message and exc.span.path == str(path)
+
+
+def test_missing_rule_file():
+    exc = error_of(lambda: load_rules_file("no/such.rules"), RuleBaseError)
+    assert "cannot read rule file `no/such.rules`" in exc.message
+
+
+# ---------------------------------------------------------------------------------------------
+# unknown names: did you mean
+
+
+@pytest.mark.parametrize("rule, message, hint, at", [
+    ("r1: if raod is WIDE then speed is SLOW", "unknown input variable `raod`",
+     "did you mean `road`?", "raod is WIDE"),
+    ("r1: if road is WIDEE then speed is SLOW", "unknown term of `road` `WIDEE`",
+     "did you mean `WIDE`?", "road is WIDEE"),
+    ("r1: if road is WIDE then sped is SLOW", "unknown output variable `sped`",
+     "did you mean `speed`?", "sped is SLOW"),
+    ("r1: if road is WIDE then speed is SLWO", "unknown term of `speed` `SLWO`",
+     "did you mean `SLOW`?", "speed is SLWO"),
+    ("r1: if road is wide then speed is SLOW", "unknown term of `road` `wide`",
+     "did you mean `WIDE`?", "road is wide"),
+])
+def test_unknown_names(tmp_path, rule, message, hint, at):
+    path = write(tmp_path, rule)
+    exc = error_of(lambda: load_rules_file(path), NameError_)
+    assert exc.message == message
+    assert exc.hint == hint
+    assert str(exc.span) == f"{path}:2:{rule.index(at) + 1}"
+    assert caret_under(exc) == at
+    assert exc.expected.startswith("one of ")
+
+
+def test_unknown_hedge_through_the_api():
+    from mitos_cli.api import load_rulebase as lr
+
+    variables = lr().rulebase.variables
+    rule = Rule("r", Prop("road", "WIDE", ("vary",)), (Consequent("speed", "SLOW"),))
+    exc = error_of(lambda: check_rule(rule, variables), NameError_)
+    assert exc.message == "unknown hedge `vary`" and exc.hint == "did you mean `very`?"
+
+
+def test_unknown_behavior_in_use(tmp_path):
+    path = write(tmp_path, "behavior avoid:\n  " + GOOD_RULE + "\nend\n"
+                 "behavior go:\n  use avoud when road is WIDE\nend\n")
+    exc = error_of(lambda: load_rules_file(path), NameError_)
+    assert exc.message == "unknown behavior `avoud`" and exc.hint == "did you mean `avoid`?"
+    assert str(exc.span) == f"{path}:6:3"
+
+
+def test_unknown_behavior_in_load_rulebase():
+    exc = error_of(lambda: load_rulebase(behavior="avoid_obstacel"), NameError_)
+    assert exc.hint == "did you mean `avoid_obstacle`?"
+
+
+def test_output_in_a_condition(tmp_path):
+    path = write(tmp_path, "r1: if speed is SLOW then steering is LS")
+    exc = error_of(lambda: load_rules_file(path), RuleBaseError)
+    assert exc.message == "`speed` is an output variable and cannot appear in a condition"
+    assert caret_under(exc) == "speed is SLOW"
+
+
+def test_unknown_operator(tmp_path):
+    path = write(tmp_path, "operators: and = mni\n" + GOOD_RULE)
+    exc = error_of(lambda: load_rules_file(path), NameError_)
+    assert exc.message == "unknown T-norm `mni`" and exc.hint == "did you mean `min`?"
+    assert str(exc.span).endswith(":2:12")
+
+
+def test_duplicate_label(tmp_path):
+    path = write(tmp_path, GOOD_RULE + "\n" + GOOD_RULE)
+    exc = error_of(lambda: load_rules_file(path), RuleBaseError)
+    assert "rule label `r1` is used twice" in exc.message and exc.span.line == 3
+
+
+def test_rule_weight_out_of_range(tmp_path):
+    path = write(tmp_path, GOOD_RULE + " with 1.5")
+    exc = error_of(lambda: load_rules_file(path), RuleBaseError)
+    assert exc.message == "a rule weight must lie in [0, 1], not 1.5"
+
+
+def test_crisp_consequent_outside_universe(tmp_path):
+    path = write(tmp_path, "r1: if road is WIDE then steering is 200")
+    exc = error_of(lambda: load_rules_file(path), RuleBaseError)
+    assert exc.message == "steering = 200 lies outside its universe [30, 150]"
+
+
+def test_term_set_not_found(tmp_path):
+    path = tmp_path / "t.rules"
+    path.write_text('terms "nope.yaml"\n' + GOOD_RULE, encoding="utf-8")
+    exc = error_of(lambda: load_rules_file(path), TermSetError)
+    assert "term set `nope.yaml` not found" in exc.message and caret_under(exc) == '"nope.yaml"'
+
+
+def test_no_term_set(tmp_path):
+    path = tmp_path / "t.rules"
+    path.write_text(GOOD_RULE, encoding="utf-8")
+    exc = error_of(lambda: load_rules_file(path), RuleBaseError)
+    assert exc.message == "the rule file names no term set" and "terms \"" in exc.hint
+
+
+# ---------------------------------------------------------------------------------------------
+# bad term sets: each names the YAML file and line
+
+
+@pytest.mark.parametrize("old, new, marker, message", [
+    ("peak: 70, width: 30", "peak: 70, width: 0", "MEDIUM:", "term `road.MEDIUM`: width must be > 0"),
+    ("peak: 70, width: 30", "peak: 70, width: -3", "MEDIUM:", "width must be > 0, not -3"),
+    ("points: [40, 70]", "points: [70, 40]", "NARROW:",
+     "term `road.NARROW`: points must be in order, but a = 70 > b = 40"),
+    ("peak: 70, width: 30", "peak: 170, width: 30", "MEDIUM:",
+     "term `road.MEDIUM`: its peak 170 lies outside the universe [0, 160]"),
+    ("      WIDE:   {shape: right_shoulder, points: [70, 100]}",
+     "      WIDE:   {shape: right_shoulder, points: [70, 100]}\n"
+     "      MEDIUM: {shape: triangle, peak: 70, width: 30}", "MEDIUM: {shape: triangle, peak: 70, width: 30}",
+     "invalid YAML: duplicate key `MEDIUM`"),
+    ("    unit: in\n    role: input\n    universe: [0, 160]",
+     "    unti: in\n    role: input\n    universe: [0, 160]", "unti",
+     "unknown key `unti` in variable `road`"),
+    ("    unit: in\n    role: input\n    universe: [0, 160]",
+     "    unit: in\n    universe: [0, 160]", "description: width of the road", "missing `role` in variable `road`"),
+    ("universe: [0, 160]", "universe: [0, 160", "terms:", "invalid YAML: expected ',' or ']'"),
+    ("universe: [0, 160]", "universe: [160, 0]", "[160, 0]", "universe [160, 0] is empty"),
+    ("shape: left_shoulder", "shape: left_shouldr", "left_shouldr", "unknown shape `left_shouldr`"),
+    ("role: input\n    universe: [0, 160]", "role: inptu\n    universe: [0, 160]", "inptu",
+     "role must be `input` or `output`, not `inptu`"),
+    ("peak: 70, width: 30", "peak: abc, width: 30", "abc", "peak must be a number, not `abc`"),
+    ("default: 90", "default: 200", "default: 200", "default 200 lies outside the universe [30, 150]"),
+])
+def test_bad_term_sets(tmp_path, old, new, marker, message):
+    assert old in TERMS
+    bad = TERMS.replace(old, new, 1)
+    # the line the error must name: the first line with the marker after the change
+    start = bad.rfind("\n", 0, bad.index(new)) + 1
+    line = bad[:bad.index(marker, start if marker in bad[start:] else 0)].count("\n") + 1
+    path = write(tmp_path, GOOD_RULE, bad)
+    exc = error_of(lambda: load_rules_file(path), TermSetError)
+    assert exc.span.path == str(tmp_path / "t.terms.yaml")
+    assert exc.span.line == line, exc.render()
+    assert message in exc.message, exc.render()
+    assert exc.render().startswith(f"{tmp_path / 't.terms.yaml'}:{line}:")
+
+
+def test_unknown_key_suggests_the_right_one(tmp_path):
+    path = write(tmp_path, GOOD_RULE, TERMS.replace("unit: in", "unti: in", 1))
+    exc = error_of(lambda: load_rules_file(path), TermSetError)
+    assert exc.hint == "did you mean `unit`?" and exc.expected.startswith("one of description")
+
+
+def test_term_set_that_is_not_a_mapping(tmp_path):
+    path = write(tmp_path, GOOD_RULE, "- just\n- a list\n")
+    exc = error_of(lambda: load_rules_file(path), TermSetError)
+    assert "must be a mapping with a `variables:` key" in exc.message
+
+
+def test_yaml_is_never_evaluated(tmp_path):
+    evil = TERMS.replace("description: width of the road (corridor) ahead, x1",
+                         "description: !!python/object/apply:os.system ['echo pwned']")
+    path = write(tmp_path, GOOD_RULE, evil)
+    exc = error_of(lambda: load_rules_file(path), TermSetError)
+    assert exc.message.startswith("invalid YAML") and exc.span.line == 5
+
+
+# ---------------------------------------------------------------------------------------------
+# inputs
+
+
+@pytest.fixture(scope="module")
+def rb():
+    return load_rulebase()
+
+
+def test_nan_input(rb):
+    exc = error_of(lambda: rb.evaluate(road=math.nan, size=45, position=4), InputError)
+    assert exc.message == "input `road` is not a number (NaN)"
+
+
+def test_nan_in_a_batch_names_the_sample(rb):
+    X = np.array([[78, 45, 4], [78, np.nan, 4]])
+    exc = error_of(lambda: rb.run(X), InputError)
+    assert exc.message == "input `size` is not a number (NaN) (sample 2)"
+
+
+def test_non_numeric_input(rb):
+    exc = error_of(lambda: rb.evaluate(road="wide", size=45, position=4), InputError)
+    assert exc.message == "input `road` must be a number, not `wide`"
+
+
+def test_missing_input(rb):
+    exc = error_of(lambda: rb.evaluate(road=78), InputError)
+    assert exc.message == "missing input `size`, `position`"
+    assert exc.hint == "give them as size=VALUE position=VALUE"
+
+
+def test_unknown_input(rb):
+    exc = error_of(lambda: rb.evaluate(raod=78, size=45, position=4), InputError)
+    assert exc.message == "unknown input `raod`" and exc.hint == "did you mean `road`?"
+
+
+def test_no_rule_fired_without_default(tmp_path):
+    terms = TERMS.replace("    default: 90\n", "")
+    path = write(tmp_path, "r1: if road is WIDE then steering is RS and speed is SLOW", terms)
+    loaded = load_rulebase(path)
+    exc = error_of(lambda: loaded.evaluate(road=20), NoRuleFiredError)
+    assert exc.message == "no rule sets `steering` for road=20"
+    assert "add `default: VALUE` to the `steering` variable" in exc.hint
+
+
+def test_no_rule_fired_with_default_uses_it(tmp_path):
+    path = write(tmp_path, "r1: if road is WIDE then steering is RS and speed is SLOW")
+    assert load_rulebase(path).evaluate(road=20) == {"steering": 90.0, "speed": 0.0}
+
+
+def test_out_of_universe_is_clamped_and_warned(capsys):
+    with pytest.raises(SystemExit) as info:
+        main(["eval", "road=500", "size=45", "position=-80", "--json"])
+    assert info.value.code == 0
+    out, err = capsys.readouterr()
+    assert "warning: `road` outside its universe [0, 160] was clamped" in err
+    assert "warning: `position` outside its universe [-60, 60] was clamped" in err
+    assert '"value": 160.0' in out and '"value": -60.0' in out
+
+
+# ---------------------------------------------------------------------------------------------
+# the CLI: exit code 1 for user errors, 2 for usage errors
+
+
+def run_main(args, capsys):
+    with pytest.raises(SystemExit) as info:
+        main(args)
+    out, err = capsys.readouterr()
+    return info.value.code, out, err
+
+
+@pytest.mark.parametrize("args, message", [
+    (["eval", "road=78", "size=45", "position=x"], "input error: input `position` must be a "
+                                                   "number, not `x`"),
+    (["eval", "road=78", "size=45"], "input error: missing input `position`"),
+    (["eval", "road=nan", "size=45", "position=4"], "input `road` is not a number (NaN)"),
+    (["eval", "-b", "avoid", "road=78", "size=45", "position=4"],
+     "unknown behavior `avoid`"),
+    (["eval", "no/such.rules", "road=1"], "cannot read rule file `no/such.rules`"),
+    (["check", "no/such.rules"], "cannot read rule file `no/such.rules`"),
+])
+def test_cli_user_errors_exit_1(capsys, args, message):
+    code, out, err = run_main(args, capsys)
+    assert code == 1 and message in err and out == ""
+    assert "Traceback" not in err
+
+
+@pytest.mark.parametrize("args, message", [
+    (["eval", "--bogus"], "No such option"),
+    (["eval"], "give one NAME=VALUE per input"),
+    (["eval", "road=1", "road=2"], "input `road` is given twice"),
+    (["eval", "=1"], "has no input name"),
+    (["eval", "road=78", "extra"], "is neither the rule base"),
+    (["check", "--threshold", "-1"], "--threshold"),
+    (["check", "--resolution", "1"], "--resolution"),
+    (["frobnicate"], "No such command"),
+])
+def test_cli_usage_errors_exit_2(capsys, args, message):
+    code, out, err = run_main(args, capsys)
+    assert code == 2 and message in err
+
+
+def test_cli_syntax_error_through_a_real_process(tmp_path):
+    path = write(tmp_path, "r1: if road is WIDE then speed is\n")
+    proc = subprocess.run([sys.executable, "-m", "mitos_cli", "eval", str(path), "road=1"],
+                          capture_output=True, text=True, timeout=60)
+    assert proc.returncode == 1 and proc.stdout == ""
+    lines = proc.stderr.splitlines()
+    assert re.match(re.escape(str(path)) + r":2:34: syntax error: unexpected end of the input",
+                    lines[0])
+    assert lines[1] == "    r1: if road is WIDE then speed is" and lines[2].endswith("^")
+    assert "Traceback" not in proc.stderr
+
+
+def test_cli_usage_error_through_a_real_process():
+    proc = subprocess.run([sys.executable, "-m", "mitos_cli", "eval", "--json", "--nope"],
+                          capture_output=True, text=True, timeout=60)
+    assert proc.returncode == 2 and "No such option" in proc.stderr
