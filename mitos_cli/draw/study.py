@@ -1,0 +1,106 @@
+"""Plots of a comparison study: success rates with Wilson intervals, boxes of clearance.
+
+matplotlib is imported inside the functions (Agg backend), so importing this module is cheap.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+
+def _pyplot():
+    import matplotlib
+
+    matplotlib.use("Agg", force=False)
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def _short(world: str) -> str:
+    return Path(world).stem if "/" in world or world.endswith((".yaml", ".yml")) else world
+
+
+def success_bars(summaries, worlds: list[str], labels: list[str], path: str | Path) -> Path:
+    """Grouped bars: success rate per world (groups) and choice (bars), Wilson 95% whiskers.
+
+    ``summaries`` are :class:`mitos_cli.study.summary.Summary` objects.
+    """
+    import numpy as np
+
+    plt = _pyplot()
+    by_key = {(s.world, s.choice.label): s for s in summaries}
+    n_w, n_c = len(worlds), len(labels)
+    width = 0.8 / max(1, n_c)
+    fig, ax = plt.subplots(figsize=(max(6.0, 1.1 * n_w * n_c * 0.55 + 2.5), 4.2))
+    cmap = plt.get_cmap("tab10")
+    x = np.arange(n_w)
+    for j, label in enumerate(labels):
+        values, lo, hi = [], [], []
+        for w in worlds:
+            s = by_key.get((w, label))
+            r = s.rates["success"] if s is not None else None
+            if r is None or r.n == 0:
+                values.append(np.nan), lo.append(0.0), hi.append(0.0)
+                continue
+            v = r.k / r.n
+            values.append(100 * v), lo.append(100 * (v - r.lo)), hi.append(100 * (r.hi - v))
+        ax.bar(x + (j - (n_c - 1) / 2) * width, values, width * 0.92, label=label,
+               color=cmap(j % 10), yerr=[lo, hi], capsize=3, error_kw={"linewidth": 0.9})
+    ax.set_xticks(x)
+    ax.set_xticklabels([_short(w) for w in worlds], rotation=15 if n_w > 4 else 0)
+    ax.set_ylim(0, 105)
+    ax.set_ylabel("success rate (%)")
+    ax.set_title("Success rate per world (whiskers: Wilson 95% interval)")
+    ax.grid(axis="y", alpha=0.3)
+    ax.legend(fontsize=8, ncol=min(3, n_c), loc="upper center", bbox_to_anchor=(0.5, -0.12),
+              frameon=False)
+    fig.tight_layout()
+    return _save(fig, plt, path)
+
+
+def clearance_boxes(rows: list[dict], worlds: list[str], labels: list[str],
+                    label_of, path: str | Path) -> Path:
+    """One panel per world, one box per choice: minimum clearance (in) over all runs."""
+    plt = _pyplot()
+    n_w = len(worlds)
+    cols = min(3, n_w)
+    n_rows = -(-n_w // cols)
+    fig, axes = plt.subplots(n_rows, cols, figsize=(4.2 * cols, 3.4 * n_rows + 0.6),
+                             squeeze=False, sharey=False)
+    cmap = plt.get_cmap("tab10")
+    for k, world in enumerate(worlds):
+        ax = axes[k // cols][k % cols]
+        data = [[r["min_clearance_in"] for r in rows
+                 if r["world"] == world and label_of(r) == label] for label in labels]
+        positions = [j + 1 for j, d in enumerate(data) if d]
+        box = ax.boxplot([d for d in data if d], positions=positions, widths=0.6,
+                         patch_artist=True, showfliers=True,
+                         flierprops={"markersize": 3})
+        colours = [cmap(j % 10) for j, d in enumerate(data) if d]
+        for patch, colour in zip(box["boxes"], colours):
+            patch.set_facecolor(colour)
+            patch.set_alpha(0.75)
+        ax.axhline(0.0, color="black", linewidth=0.6, alpha=0.6)
+        ax.set_xticks(range(1, len(labels) + 1))
+        ax.set_xticklabels([str(j + 1) for j in range(len(labels))])
+        ax.set_title(_short(world), fontsize=10)
+        ax.set_ylabel("min clearance (in)")
+        ax.grid(axis="y", alpha=0.3)
+    for k in range(n_w, n_rows * cols):
+        axes[k // cols][k % cols].set_visible(False)
+    fig.suptitle("Minimum clearance over all runs (boxes: quartiles; whiskers: 1.5 IQR)",
+                 fontsize=11)
+    legend = "   ".join(f"{j + 1}: {label}" for j, label in enumerate(labels))
+    fig.text(0.5, 0.01, legend, ha="center", fontsize=8, wrap=True)
+    fig.tight_layout(rect=(0, 0.06, 1, 0.95))
+    return _save(fig, plt, path)
+
+
+def _save(fig, plt, path) -> Path:
+    path = Path(path)
+    tmp = path.with_name(path.stem + ".tmp" + path.suffix)
+    fig.savefig(tmp, dpi=110)
+    plt.close(fig)
+    tmp.replace(path)
+    return path

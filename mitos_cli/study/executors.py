@@ -1,0 +1,125 @@
+"""Where the tasks of a study run: in this process, in a process pool, or on Dask.
+
+Every executor is a generator of ``(task, result)`` pairs in the order they finish; the caller
+writes each one down at once. A task's result depends on the task alone (its seed is in it), so
+every executor gives the same results as a serial run, bit for bit; only the arrival order
+differs. Tasks travel in small chunks to keep the per-task overhead low while results still
+arrive often.
+"""
+
+from __future__ import annotations
+
+import functools
+import os
+from typing import Callable, Iterator, Sequence
+
+from .spec import Task
+from .store import StudyError
+
+TaskFn = Callable[[Task], dict]
+EXECUTORS = ("local", "dask")
+
+
+def default_workers() -> int:
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except AttributeError:              # not on Linux
+        return max(1, os.cpu_count() or 1)
+
+
+def run_chunk(fn: TaskFn, tasks: Sequence[Task]) -> list[tuple[Task, dict]]:
+    """Run a few tasks one after the other (what a worker does with one message)."""
+    return [(t, fn(t)) for t in tasks]
+
+
+def chunks(tasks: Sequence[Task], workers: int, most: int = 8) -> list[list[Task]]:
+    """Cut ``tasks`` into chunks: at least ~8 per worker for balance, at most ``most`` long."""
+    size = max(1, min(most, len(tasks) // (8 * workers)))
+    return [list(tasks[i:i + size]) for i in range(0, len(tasks), size)]
+
+
+def run_serial(fn: TaskFn, tasks: Sequence[Task]) -> Iterator[tuple[Task, dict]]:
+    for task in tasks:
+        yield task, fn(task)
+
+
+def run_local(fn: TaskFn, tasks: Sequence[Task], workers: int) -> Iterator[tuple[Task, dict]]:
+    """A process pool over ``workers`` processes (one worker: this process, no pool)."""
+    if workers <= 1 or len(tasks) <= 1:
+        yield from run_serial(fn, tasks)
+        return
+    from concurrent.futures import ProcessPoolExecutor, as_completed
+
+    pool = ProcessPoolExecutor(max_workers=workers)
+    try:
+        futures = [pool.submit(run_chunk, fn, c) for c in chunks(tasks, workers)]
+        for future in as_completed(futures):
+            yield from future.result()
+    finally:
+        # on an error or Ctrl-C: drop what has not started, do not wait for the rest
+        pool.shutdown(wait=False, cancel_futures=True)
+
+
+def dask_client(scheduler: str | None, workers: int):
+    """A ``distributed.Client`` to ``scheduler``, or to a new LocalCluster of ``workers``."""
+    try:
+        from distributed import Client, LocalCluster
+    except ImportError:
+        raise StudyError("the Dask executor needs dask.distributed, which is not installed",
+                         hint="pip install 'mitos[dask]', or use --executor local") from None
+    if scheduler:
+        try:
+            return Client(scheduler, timeout="10s")
+        except (OSError, TimeoutError, ValueError) as exc:
+            raise StudyError(f"cannot reach the Dask scheduler at {scheduler}: {exc}",
+                             hint="start one with `dask scheduler` (and `dask worker ADDR` "
+                                  "on each machine), or leave out --scheduler for a local "
+                                  "cluster") from None
+    cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
+                           dashboard_address=None)
+    return Client(cluster)
+
+
+def run_dask(fn: TaskFn, tasks: Sequence[Task], workers: int, scheduler: str | None = None,
+             client=None) -> Iterator[tuple[Task, dict]]:
+    """Run on Dask's distributed scheduler (``client`` given: use it and leave it open).
+
+    The workers of a remote cluster must have ``mitos`` installed and see the world files at
+    the paths given on the command line (a shared file system).
+    """
+    own = client is None
+    if own:
+        client = dask_client(scheduler, workers)
+    try:
+        from distributed import as_completed
+
+        n = workers if own and not scheduler else max(1, len(client.scheduler_info().get(
+            "workers", {})) or workers)
+        futures = client.map(functools.partial(run_chunk, fn), chunks(tasks, n), pure=False)
+        try:
+            for _future, part in as_completed(futures, with_results=True):
+                yield from part
+        finally:
+            client.cancel(futures)
+    finally:
+        if own:
+            cluster = getattr(client, "cluster", None)
+            client.close()
+            if cluster is not None:
+                cluster.close()
+
+
+def execute(fn: TaskFn, tasks: Sequence[Task], executor: str = "local",
+            workers: int | None = None, scheduler: str | None = None,
+            client=None) -> Iterator[tuple[Task, dict]]:
+    """``(task, result)`` pairs as the tasks finish, on the chosen executor."""
+    workers = workers or default_workers()
+    if not tasks:
+        return iter(())
+    if executor == "local":
+        return run_local(fn, tasks, workers)
+    if executor == "dask":
+        return run_dask(fn, tasks, workers, scheduler, client)
+    from ..errors import unknown
+
+    raise unknown("executor", executor, EXECUTORS)

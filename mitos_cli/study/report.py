@@ -1,0 +1,193 @@
+"""The study's tables: in the terminal (rich) and in ``report.md`` (Markdown, with the plots)."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+from .spec import Choice
+from .stats import Mean, Rate
+from .summary import ALL_WORLDS, METRICS, Rank, Summary
+
+RATE_COLUMNS = (("success", "success"), ("collision", "collision"), ("timeout", "timeout"),
+                ("stuck", "stuck"))
+TABLE_METRICS = ("time_s", "path_length_in", "min_clearance_in", "steering_total_variation_deg")
+
+
+def fmt_rate(r: Rate, ci: bool = True) -> str:
+    if r.n == 0:
+        return "-"
+    text = f"{100 * r.k / r.n:.0f}%"
+    return f"{text} [{100 * r.lo:.0f}, {100 * r.hi:.0f}]" if ci else text
+
+
+def _digits(value: float) -> int:
+    return 0 if abs(value) >= 100 else 1 if abs(value) >= 10 else 2
+
+
+def fmt_mean(m: Mean, ci: bool = True) -> str:
+    """``mean +- std [lo, hi]``; ``-`` without values, no interval with one value."""
+    if m.mean is None:
+        return "-"
+    d = _digits(m.mean)
+    if m.std is None:
+        return f"{m.mean:.{d}f} (n=1)"
+    text = f"{m.mean:.{d}f} ± {m.std:.{d}f}"
+    return f"{text} [{m.lo:.{d}f}, {m.hi:.{d}f}]" if ci else text
+
+
+def fmt_p(p: float | None) -> str:
+    if p is None:
+        return "leader"
+    return "< 0.001" if p < 0.001 else f"{p:.3f}"
+
+
+def _metric_heading(field: str) -> str:
+    for f, label, unit, which in METRICS:
+        if f == field:
+            return f"{label} ({unit})" + (" *" if which == "success" else "")
+    raise KeyError(field)
+
+
+def _world_name(world: str) -> str:
+    return world if world == ALL_WORLDS else Path(world).stem
+
+
+# -- terminal -------------------------------------------------------------------------------
+
+def rich_tables(summaries: list[Summary], ranks: list[Rank]):
+    """The per-combination table and the ranking as rich renderables."""
+    from rich.table import Table
+
+    table = Table(title="Outcomes per world and choice (95% intervals)", title_justify="left",
+                  caption="* successful runs only; rates: Wilson interval; means: t interval",
+                  caption_justify="left")
+    table.add_column("world", no_wrap=True)
+    table.add_column("choice", no_wrap=True)
+    table.add_column("n", justify="right")
+    for _f, heading in RATE_COLUMNS[:3]:
+        table.add_column(heading, justify="right")
+    for f in TABLE_METRICS:
+        table.add_column(_metric_heading(f), justify="right")
+    last = None
+    for s in summaries:
+        world = _world_name(s.world)
+        if last is not None and world != last:
+            table.add_section()
+        table.add_row(world if world != last else "", s.choice.label, str(s.n),
+                      *(fmt_rate(s.rates[f]) for f, _h in RATE_COLUMNS[:3]),
+                      *(fmt_mean(s.metrics[f]) for f in TABLE_METRICS))
+        last = world
+    ranking = Table(title=RANK_TITLE, title_justify="left")
+    for name, justify in (("#", "right"), ("choice", "left"), ("success", "right"),
+                          ("time to goal (s)", "right"), ("min clearance (in)", "right"),
+                          ("vs leader (+/-)", "right"), ("McNemar p", "right")):
+        ranking.add_column(name, justify=justify, no_wrap=name == "choice")
+    for r in ranks:
+        s = r.summary
+        ranking.add_row(str(r.place), s.choice.label, fmt_rate(s.rates["success"]),
+                        fmt_mean(s.metrics["time_s"], ci=False),
+                        fmt_mean(s.metrics["min_clearance_in"], ci=False),
+                        "-" if r.p_value is None else f"+{r.wins} / -{r.losses}",
+                        fmt_p(r.p_value))
+    return table, ranking
+
+
+RANK_TITLE = ("Ranking over all worlds: success rate, then time to goal, then clearance; "
+              "McNemar: paired runs vs the leader")
+
+
+# -- Markdown -------------------------------------------------------------------------------
+
+def _md_table(header: list[str], rows: list[list[str]], align: list[str]) -> str:
+    def esc(text: str) -> str:
+        return text.replace("|", "\\|")
+
+    lines = ["| " + " | ".join(esc(h) for h in header) + " |",
+             "| " + " | ".join("---:" if a == "r" else "---" for a in align) + " |"]
+    lines += ["| " + " | ".join(esc(c) for c in row) + " |" for row in rows]
+    return "\n".join(lines)
+
+
+def outcome_table_md(summaries: list[Summary]) -> str:
+    header = ["world", "choice", "n", *(h for _f, h in RATE_COLUMNS),
+              *(_metric_heading(f) for f in TABLE_METRICS)]
+    rows = [[_world_name(s.world), s.choice.label, str(s.n),
+             *(fmt_rate(s.rates[f]) for f, _h in RATE_COLUMNS),
+             *(fmt_mean(s.metrics[f]) for f in TABLE_METRICS)] for s in summaries]
+    return _md_table(header, rows, ["l", "l"] + ["r"] * (len(header) - 2))
+
+
+def ranking_md(ranks: list[Rank]) -> str:
+    header = ["#", "choice", "success [95% CI]", "time to goal (s) *", "min clearance (in)",
+              "runs won / lost vs leader", "McNemar p"]
+    rows = [[str(r.place), r.summary.choice.label, fmt_rate(r.summary.rates["success"]),
+             fmt_mean(r.summary.metrics["time_s"]),
+             fmt_mean(r.summary.metrics["min_clearance_in"]),
+             "-" if r.p_value is None else f"{r.wins} / {r.losses}", fmt_p(r.p_value)]
+            for r in ranks]
+    return _md_table(header, rows, ["r", "l", "r", "r", "r", "r", "r"])
+
+
+def render_markdown(manifest: dict, summaries: list[Summary], ranks: list[Rank],
+                    images: dict[str, str], n_rows: int, n_tasks: int) -> str:
+    """The whole ``report.md``."""
+    choices = manifest.get("choices", [])
+    worlds = manifest.get("worlds", [])
+    lines = [
+        "# MITOS comparison study",
+        "",
+        f"- worlds: {', '.join(f'`{w}`' for w in worlds)}",
+        f"- choices: {', '.join(f'`{c}`' for c in choices)}",
+        f"- runs per world and choice: {manifest.get('runs')}, seed {manifest.get('seed')}"
+        f" ({n_rows} of {n_tasks} runs finished)",
+        f"- rule base: `{manifest.get('rulebase') or 'packaged default'}`"
+        + (f", behavior `{manifest['behavior']}`" if manifest.get("behavior") else ""),
+        f"- command: `{manifest.get('command', 'mitos compare')}`",
+        "",
+        "**Paired comparison.** Run *r* of a world uses the same seed for every choice "
+        "(`SeedSequence(seed)` spawned per world, then per run), so all choices drive exactly "
+        "the same randomized worlds: obstacle placements and sensor noise are identical, only "
+        "the planner or its operators differ. The ranking compares each choice with the "
+        "leader run by run (exact McNemar test on the runs where exactly one of the two "
+        "succeeded).",
+        "",
+        "## Ranking",
+        "",
+        "Criterion: success rate over all worlds (higher first); ties broken by mean time to "
+        "goal over successful runs (lower first), then by mean minimum clearance (higher "
+        "first). A McNemar p above 0.05 means the data cannot tell that choice's success "
+        "rate from the leader's.",
+        "",
+        ranking_md(ranks),
+        "",
+        "## Outcomes per world and choice",
+        "",
+        "Rates with the Wilson 95% interval; metrics as mean ± std [95% t interval]. "
+        "Columns marked * use successful runs only; minimum clearance uses all runs.",
+        "",
+        outcome_table_md(summaries),
+        "",
+    ]
+    if images:
+        lines += ["## Plots", ""]
+        for title, name in images.items():
+            lines += [f"![{title}]({name})", ""]
+    return "\n".join(lines)
+
+
+def overlap_note(ranks: list[Rank]) -> str | None:
+    """A sentence naming the choices the data cannot separate from the leader (or None)."""
+    if len(ranks) < 2:
+        return None
+    tied = [r.summary.choice.label for r in ranks[1:]
+            if r.p_value is not None and not math.isnan(r.p_value) and r.p_value > 0.05]
+    if not tied:
+        return None
+    return (f"{len(tied)} of {len(ranks) - 1} choices are not distinguishable from the leader "
+            f"({ranks[0].summary.choice.label}) in success rate (McNemar p > 0.05): "
+            + ", ".join(tied))
+
+
+def choice_labels(choices: list[Choice]) -> list[str]:
+    return [c.label for c in choices]

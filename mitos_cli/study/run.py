@@ -1,0 +1,133 @@
+"""A study from start to finish: plan the tasks, skip the finished, run, record, summarize.
+
+>>> from mitos_cli.study import Study, run_study
+>>> study = Study(worlds=["worlds/corridor.yaml"], choices=make_choices(
+...     ["fuzzy", "potential_field"], ["min", "product"], [], []), runs=20, seed=1)
+>>> outcome = run_study(study, "out/")            # doctest: +SKIP
+"""
+
+from __future__ import annotations
+
+import functools
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Callable
+
+from .executors import TaskFn, execute
+from .spec import Choice, Task, expand
+from .store import ResultStore, key_of, row_of, rows_for
+from .summary import ALL_WORLDS, Rank, Summary, choice_of, rank, summaries
+
+
+@dataclass(frozen=True)
+class Study:
+    """What to compare: worlds x choices x runs, from one seed, with one rule base."""
+
+    worlds: list[str]
+    choices: list[Choice]
+    runs: int
+    seed: int
+    rulebase: str | None = None
+    behavior: str | None = None
+    command: str = "mitos compare"
+
+    def tasks(self) -> list[Task]:
+        return expand(self.worlds, self.choices, self.runs, self.seed)
+
+    def manifest(self) -> dict:
+        return {"worlds": list(self.worlds), "choices": [c.label for c in self.choices],
+                "runs": self.runs, "seed": self.seed, "rulebase": self.rulebase,
+                "behavior": self.behavior, "command": self.command}
+
+
+@dataclass
+class Outcome:
+    """What a study produced: the rows in task order and their summaries."""
+
+    study: Study
+    rows: list[dict]
+    n_tasks: int
+    skipped: int                           # finished before (``resume``)
+    executed: int                          # run now
+    summaries: list[Summary] = field(default_factory=list)
+    ranks: list[Rank] = field(default_factory=list)
+
+    @property
+    def complete(self) -> bool:
+        return len(self.rows) == self.n_tasks
+
+    def per_world(self) -> list[Summary]:
+        return [s for s in self.summaries if s.world != ALL_WORLDS]
+
+    def pooled(self) -> list[Summary]:
+        pooled = [s for s in self.summaries if s.world == ALL_WORLDS]
+        return pooled or self.per_world()
+
+
+def default_task_fn(study: Study) -> TaskFn:
+    """The simulator as a picklable task function."""
+    from .simtask import StudyContext, run_task
+
+    return functools.partial(run_task, StudyContext(study.rulebase, study.behavior))
+
+
+def run_study(study: Study, out_dir: str | Path, *, executor: str = "local",
+              workers: int | None = None, scheduler: str | None = None, resume: bool = False,
+              task_fn: TaskFn | None = None, client=None,
+              on_start: Callable[[int, int], None] | None = None,
+              on_result: Callable[[Task, dict], None] | None = None) -> Outcome:
+    """Run every unfinished task of ``study``, appending each result to ``out_dir/results.csv``
+    as it arrives, and summarize all finished rows (in task order, whatever the executor).
+
+    ``on_start(skipped, total)`` is called once, ``on_result(task, row)`` per finished task.
+    """
+    tasks = study.tasks()
+    fn = task_fn or default_task_fn(study)
+    with ResultStore(out_dir) as store:
+        previous = store.start(study.manifest(), resume=resume)
+        finished, todo = rows_for(tasks, previous)
+        if on_start is not None:
+            on_start(len(finished), len(tasks))
+        by_index: dict[int, dict] = {}
+        for task, result in execute(fn, todo, executor, workers, scheduler, client):
+            row = row_of(task, result)
+            store.append(row)
+            by_index[task.index] = row
+            if on_result is not None:
+                on_result(task, row)
+    done = {key_of(r): r for r in finished}
+    rows = []
+    for task in tasks:
+        row = by_index.get(task.index) or done.get(task.key)
+        if row is not None:
+            rows.append(row)
+    outcome = Outcome(study, rows, len(tasks), len(finished), len(by_index))
+    outcome.summaries = summaries(rows, study.worlds, study.choices)
+    outcome.ranks = rank(rows, outcome.pooled())
+    return outcome
+
+
+def write_report(outcome: Outcome, out_dir: str | Path, plots: bool = True) -> Path:
+    """``report.md`` (and its plots ``success.png``, ``clearance.png``) in ``out_dir``."""
+    from .report import render_markdown
+    from .store import write_atomic
+
+    out = Path(out_dir)
+    images: dict[str, str] = {}
+    if plots and outcome.rows:
+        from ..draw.study import clearance_boxes, success_bars
+
+        labels = [c.label for c in outcome.study.choices]
+        worlds = list(outcome.study.worlds)
+        pooled = [s for s in outcome.summaries if s.world == ALL_WORLDS]
+        success_bars(outcome.per_world() + pooled, worlds + ([ALL_WORLDS] if pooled else []),
+                     labels, out / "success.png")
+        clearance_boxes(outcome.rows, worlds, labels, lambda r: choice_of(r).label,
+                        out / "clearance.png")
+        images = {"Success rate per world and choice": "success.png",
+                  "Minimum clearance per world and choice": "clearance.png"}
+    text = render_markdown(outcome.study.manifest(), outcome.summaries, outcome.ranks, images,
+                           len(outcome.rows), outcome.n_tasks)
+    path = out / "report.md"
+    write_atomic(path, text)
+    return path

@@ -1,0 +1,195 @@
+"""``results.csv``: one row per finished run, written the moment it arrives.
+
+Each row is appended, flushed and fsync'ed, so a study that is killed (or whose worker dies)
+loses no finished result; ``--resume`` reads the rows back and skips their tasks. A row cut off
+by the kill (no final newline) is dropped and recomputed. Floats are written with ``repr``, so
+they read back bit for bit. ``study.json`` beside it records what the study was (seed, worlds,
+choices, runs, rule base).
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import os
+from pathlib import Path
+from typing import Iterable
+
+from ..errors import MitosError
+from .spec import KEY_FIELDS, Task
+
+#: what a run reports, in this order, after the key and the seed
+RESULT_FIELDS = ("outcome", "collisions", "time_s", "path_length_in", "min_clearance_in",
+                 "mean_speed_in_s", "steering_total_variation_deg", "ticks")
+FLOAT_FIELDS = frozenset({"time_s", "path_length_in", "min_clearance_in", "mean_speed_in_s",
+                          "steering_total_variation_deg"})
+INT_FIELDS = frozenset({"collisions", "ticks", "run", "seed"})
+COLUMNS = (*KEY_FIELDS, "seed", *RESULT_FIELDS)
+OUTCOMES = ("success", "collision", "timeout", "stuck")
+
+
+class StudyError(MitosError):
+    """A study directory that cannot be written or resumed."""
+
+    kind = "study error"
+
+
+def row_of(task: Task, result: dict) -> dict:
+    """The CSV row of a finished task: its key, its seed and the simulator's result."""
+    c = task.choice
+    row = {"world": task.world, "planner": c.planner, "and": c.and_, "or": c.or_,
+           "inference": c.inference, "run": task.run, "seed": task.seed}
+    for f in RESULT_FIELDS:
+        row[f] = result[f]
+    return row
+
+
+def key_of(row: dict) -> tuple[str, ...]:
+    return tuple(str(row[k]) for k in KEY_FIELDS)
+
+
+def _format(value) -> str:
+    if isinstance(value, float):
+        return repr(value)          # shortest string that reads back to the same double
+    return str(value)
+
+
+def _parse(field: str, text: str):
+    if field in FLOAT_FIELDS:
+        return float(text)
+    if field in INT_FIELDS:
+        return int(text)
+    return text
+
+
+class ResultStore:
+    """The results of one study directory."""
+
+    def __init__(self, directory: str | Path) -> None:
+        self.dir = Path(directory)
+        self.path = self.dir / "results.csv"
+        self.manifest_path = self.dir / "study.json"
+        self._file = None
+
+    # -- reading -----------------------------------------------------------------------------
+
+    def load(self) -> list[dict]:
+        """The finished rows (an unfinished last line is cut off the file and not returned)."""
+        if not self.path.exists():
+            return []
+        data = self.path.read_bytes()
+        if data and not data.endswith(b"\n"):       # killed in the middle of a row
+            data = data[: data.rfind(b"\n") + 1]
+            with open(self.path, "r+b") as fh:
+                fh.truncate(len(data))
+        text = data.decode("utf-8")
+        if not text:
+            return []
+        reader = csv.reader(io.StringIO(text, newline=""))
+        header = next(reader)
+        if tuple(header) != COLUMNS:
+            raise StudyError(f"{self.path} is not a results file of this version of mitos",
+                             expected="the columns " + ",".join(COLUMNS),
+                             hint="choose another output directory with -o")
+        rows = []
+        for line_no, values in enumerate(reader, start=2):
+            if len(values) != len(COLUMNS):
+                raise StudyError(f"{self.path}:{line_no}: expected {len(COLUMNS)} values, "
+                                 f"found {len(values)}",
+                                 hint="the file was edited by hand; remove that line")
+            try:
+                rows.append({f: _parse(f, v) for f, v in zip(COLUMNS, values)})
+            except ValueError:
+                raise StudyError(f"{self.path}:{line_no}: a value is not a number",
+                                 hint="the file was edited by hand; remove that line") from None
+        return rows
+
+    def manifest(self) -> dict | None:
+        if not self.manifest_path.exists():
+            return None
+        try:
+            return json.loads(self.manifest_path.read_text(encoding="utf-8"))
+        except (OSError, ValueError) as exc:
+            raise StudyError(f"cannot read {self.manifest_path}: {exc}") from None
+
+    # -- writing -----------------------------------------------------------------------------
+
+    def start(self, manifest: dict, *, resume: bool) -> list[dict]:
+        """Open the directory for a study; return the rows already finished (with ``resume``).
+
+        Without ``resume`` an existing ``results.csv`` with rows is an error rather than being
+        overwritten; with it, the study must have the same seed as the one that wrote the rows.
+        """
+        try:
+            self.dir.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            raise StudyError(f"cannot create the output directory {self.dir}: "
+                             f"{exc.strerror or exc}") from None
+        rows = self.load()
+        if rows and not resume:
+            raise StudyError(f"{self.path} already holds {len(rows)} results",
+                             hint="pass --resume to continue that study, or choose another "
+                                  "directory with -o")
+        old = self.manifest() if rows else None
+        if old is not None and old.get("seed") != manifest.get("seed"):
+            raise StudyError(f"{self.path} was made with --seed {old.get('seed')}, "
+                             f"not {manifest.get('seed')}",
+                             hint=f"resume with --seed {old.get('seed')}, or choose another "
+                                  "directory with -o")
+        write_atomic(self.manifest_path, json.dumps(manifest, indent=2) + "\n")
+        if not rows:
+            write_atomic(self.path, ",".join(COLUMNS) + "\n")
+        self._file = open(self.path, "a", encoding="utf-8", newline="")
+        return rows
+
+    def append(self, row: dict) -> None:
+        """Write one finished row and make it durable before returning."""
+        line = io.StringIO()
+        csv.writer(line, lineterminator="\n").writerow(_format(row[f]) for f in COLUMNS)
+        self._file.write(line.getvalue())
+        self._file.flush()
+        os.fsync(self._file.fileno())
+
+    def close(self) -> None:
+        if self._file is not None:
+            self._file.close()
+            self._file = None
+
+    def __enter__(self) -> "ResultStore":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+
+def write_atomic(path: Path, text: str) -> None:
+    """Write ``text`` to ``path`` through a temporary file and a rename."""
+    tmp = path.with_name(path.name + ".tmp")
+    with open(tmp, "w", encoding="utf-8", newline="") as fh:
+        fh.write(text)
+        fh.flush()
+        os.fsync(fh.fileno())
+    os.replace(tmp, path)
+
+
+def rows_for(tasks: Iterable[Task], rows: list[dict]) -> tuple[list[dict], list[Task]]:
+    """Split a study into the rows already finished (in task order) and the tasks to run.
+
+    A finished row whose seed differs from its task's means the worlds were given in another
+    order or the study was made with another seed: an error, never a silent mix.
+    """
+    done = {key_of(r): r for r in rows}
+    finished, todo = [], []
+    for task in tasks:
+        row = done.get(task.key)
+        if row is None:
+            todo.append(task)
+            continue
+        if row["seed"] != task.seed:
+            raise StudyError(
+                f"the finished run {task.run} of {task.world} ({task.choice.label}) was "
+                f"made with seed {row['seed']}, but this study gives it {task.seed}",
+                hint="give the worlds in the same order as the study being resumed")
+        finished.append(row)
+    return finished, todo

@@ -1,0 +1,123 @@
+"""From result rows to the study's numbers: per-combination summaries and the ranking.
+
+Which runs each figure uses:
+
+- rates (success, collision, timeout, stuck): all runs, Wilson 95% interval;
+- time to goal, path length, steering total variation, mean speed: successful runs only (how
+  well a choice drives when it gets there; a run cut short by a collision has a short path and
+  little steering, which would read as "better");
+- minimum clearance: all runs (a collision is clearance 0 or less, which is what a safety margin
+  should count).
+
+Ranking (pooled over all worlds): success rate, higher first; ties by mean time to goal, lower
+first; then by mean minimum clearance, higher first. Because every choice drives the same
+seeded runs, each choice's successes are compared with the leader's run by run with an exact
+McNemar test (two-sided), which says whether the difference in success could be chance.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from .spec import Choice
+from .stats import Mean, Rate, mean_interval, wilson
+from .store import OUTCOMES
+
+ALL_WORLDS = "all worlds"
+
+#: (field, label, unit, which runs: "success" or "all")
+METRICS = (
+    ("time_s", "time to goal", "s", "success"),
+    ("path_length_in", "path length", "in", "success"),
+    ("min_clearance_in", "min clearance", "in", "all"),
+    ("steering_total_variation_deg", "steering TV", "deg", "success"),
+    ("mean_speed_in_s", "mean speed", "in/s", "success"),
+)
+
+
+@dataclass(frozen=True)
+class Summary:
+    """The figures of one choice in one world (or pooled over all worlds)."""
+
+    world: str
+    choice: Choice
+    n: int
+    rates: dict[str, Rate]
+    metrics: dict[str, Mean]
+
+
+@dataclass(frozen=True)
+class Rank:
+    place: int
+    summary: Summary
+    paired_n: int            # runs both this choice and the leader drove
+    wins: int                # runs this choice succeeded in and the leader did not
+    losses: int              # runs the leader succeeded in and this choice did not
+    p_value: float | None    # exact McNemar, None for the leader itself
+
+
+def choice_of(row: dict) -> Choice:
+    return Choice(row["planner"], row["and"], row["or"], row["inference"])
+
+
+def summarize(world: str, choice: Choice, rows: list[dict]) -> Summary:
+    n = len(rows)
+    rates = {o: wilson(sum(r["outcome"] == o for r in rows), n) for o in OUTCOMES}
+    ok = [r for r in rows if r["outcome"] == "success"]
+    metrics = {f: mean_interval(r[f] for r in (ok if which == "success" else rows))
+               for f, _label, _unit, which in METRICS}
+    return Summary(world, choice, n, rates, metrics)
+
+
+def summaries(rows: list[dict], worlds: list[str], choices: list[Choice]) -> list[Summary]:
+    """One summary per (world, choice) in study order, then one per choice over all worlds."""
+    groups: dict[tuple[str, Choice], list[dict]] = {}
+    for r in rows:
+        groups.setdefault((r["world"], choice_of(r)), []).append(r)
+    out = [summarize(w, c, groups.get((w, c), [])) for w in worlds for c in choices]
+    if len(worlds) > 1:
+        for c in choices:
+            pooled = [r for w in worlds for r in groups.get((w, c), [])]
+            out.append(summarize(ALL_WORLDS, c, pooled))
+    return out
+
+
+def mcnemar(wins: int, losses: int) -> float:
+    """Exact two-sided McNemar p-value for ``wins`` vs ``losses`` discordant pairs."""
+    n = wins + losses
+    if n == 0:
+        return 1.0
+    k = min(wins, losses)
+    tail = sum(math.comb(n, i) for i in range(k + 1)) / 2.0 ** n
+    return min(1.0, 2.0 * tail)
+
+
+def _sort_key(s: Summary):
+    def num(m: Mean, sign: float) -> float:
+        return sign * m.mean if m.mean is not None else math.inf
+
+    success = s.rates["success"].value
+    return (-(success if success is not None else -1.0),
+            num(s.metrics["time_s"], 1.0), num(s.metrics["min_clearance_in"], -1.0),
+            s.choice.label)
+
+
+def rank(rows: list[dict], pooled: list[Summary]) -> list[Rank]:
+    """The choices ordered by the ranking criterion, each compared run by run with the leader."""
+    ordered = sorted(pooled, key=_sort_key)
+    if not ordered:
+        return []
+    success: dict[Choice, dict[tuple[str, int], bool]] = {}
+    for r in rows:
+        success.setdefault(choice_of(r), {})[(r["world"], r["run"])] = r["outcome"] == "success"
+    leader = success.get(ordered[0].choice, {})
+    out = []
+    for place, s in enumerate(ordered, start=1):
+        mine = success.get(s.choice, {})
+        common = [k for k in mine if k in leader]
+        wins = sum(mine[k] and not leader[k] for k in common)
+        losses = sum(leader[k] and not mine[k] for k in common)
+        p = None if place == 1 else mcnemar(wins, losses)
+        out.append(Rank(place, s, len(common), wins, losses, p))
+    return out

@@ -1,0 +1,230 @@
+"""The study machinery without the simulator: statistics, seeds, store, executors, resume."""
+
+from __future__ import annotations
+
+import functools
+import math
+import zlib
+
+import numpy as np
+import pytest
+
+from mitos_cli.errors import MitosError
+from mitos_cli.study import Study, make_choices, run_study
+from mitos_cli.study.executors import chunks, execute
+from mitos_cli.study.spec import Choice, expand, split_list, task_seeds
+from mitos_cli.study.stats import mean_interval, t_cdf, t_quantile, wilson
+from mitos_cli.study.store import ResultStore, StudyError
+from mitos_cli.study.summary import mcnemar, rank, summaries
+
+
+def fake_sim(task, log=None) -> dict:
+    """A deterministic stand-in for the simulator: a function of the seed and the choice."""
+    if log is not None:
+        log.append(task.index)
+    salt = zlib.crc32(task.choice.label.encode())
+    rng = np.random.default_rng([task.seed, salt])
+    u = rng.random()
+    outcome = "success" if u < 0.7 else "collision" if u < 0.85 else "timeout"
+    return {"outcome": outcome, "collisions": int(outcome == "collision"),
+            "time_s": float(10 + rng.random() * 5), "path_length_in": float(300 + rng.random()),
+            "min_clearance_in": float(rng.normal(8, 2)) / 3.0,
+            "mean_speed_in_s": float(30 + rng.random()),
+            "steering_total_variation_deg": float(rng.random() * 100), "ticks": 200}
+
+
+class Crash(Exception):
+    pass
+
+
+def crashing_sim(task, after: int, log: list):
+    if len(log) >= after:
+        raise Crash("killed")
+    return fake_sim(task, log)
+
+
+# -- statistics ----------------------------------------------------------------------------
+
+@pytest.mark.parametrize("df, expected", [(1, 12.706204736), (2, 4.302652730), (5, 2.570581836),
+                                          (10, 2.228138852), (30, 2.042272456),
+                                          (1000, 1.962339081)])
+def test_t_quantile_matches_tables(df, expected):
+    assert t_quantile(0.975, df) == pytest.approx(expected, abs=1e-8)
+    assert t_cdf(t_quantile(0.975, df), df) == pytest.approx(0.975, abs=1e-12)
+
+
+def test_wilson_interval():
+    r = wilson(5, 10)
+    assert (r.lo, r.hi) == (pytest.approx(0.236593, abs=1e-6), pytest.approx(0.763407, abs=1e-6))
+    assert wilson(0, 20).lo == 0.0 and 0.0 < wilson(0, 20).hi < 0.2
+    assert wilson(20, 20).hi == 1.0 and wilson(20, 20).lo > 0.8
+    assert math.isnan(wilson(0, 0).lo)
+
+
+def test_mean_interval_small_samples():
+    m = mean_interval([1.0, 2.0, 3.0])
+    assert m.mean == 2.0 and m.std == 1.0
+    assert m.hi - m.mean == pytest.approx(4.302652730 / math.sqrt(3))
+    assert mean_interval([]).mean is None
+    one = mean_interval([5.0])
+    assert one.mean == 5.0 and one.std is None and one.lo is None
+
+
+def test_mcnemar_exact():
+    assert mcnemar(0, 0) == 1.0
+    assert mcnemar(0, 6) == pytest.approx(2 / 64)
+    assert mcnemar(3, 3) == 1.0
+
+
+# -- choices and seeds ---------------------------------------------------------------------
+
+def test_choices_cross_and_dual():
+    cs = make_choices(["fuzzy", "potential_field"], ["min", "prod"], ["dual"], [])
+    assert [c.label for c in cs] == ["fuzzy and=min or=max", "fuzzy and=product or=probabilistic_sum",
+                                     "potential_field"]
+    assert len(make_choices(["fuzzy"], ["min", "product"], ["max", "bounded_sum"],
+                            ["weighted_average", "mamdani"])) == 8
+    assert split_list(" min, product,,min ") == ["min", "product"]
+
+
+@pytest.mark.parametrize("args, message, hint", [
+    ((["fuzzy"], ["einstien"], [], []), "unknown T-norm `einstien`", "einstein"),
+    ((["fuzzy"], ["min"], ["mx"], []), "unknown S-norm `mx`", "max"),
+    ((["fuzy"], [], [], []), "unknown planner `fuzy`", "fuzzy"),
+    ((["fuzzy"], [], [], ["mamdany"]), "unknown inference method `mamdany`", "mamdani"),
+])
+def test_choice_errors_say_did_you_mean(args, message, hint):
+    with pytest.raises(MitosError) as exc:
+        make_choices(*args)
+    assert message in exc.value.message and hint in (exc.value.hint or "")
+
+
+def test_seeds_are_paired_and_extend():
+    choices = make_choices(["fuzzy", "potential_field"], ["min", "product"], [], [])
+    tasks = expand(["a.yaml", "b.yaml"], choices, 4, seed=7)
+    assert len(tasks) == 2 * 3 * 4 and [t.index for t in tasks] == list(range(24))
+    by = {}
+    for t in tasks:
+        by.setdefault((t.world, t.run), set()).add(t.seed)
+    assert all(len(s) == 1 for s in by.values())               # every choice: same seed
+    assert len({next(iter(s)) for s in by.values()}) == 8      # distinct per (world, run)
+    # more runs later keep the first runs' seeds (SeedSequence children are keyed by index)
+    assert [row[:4] for row in task_seeds(7, 2, 10)] == task_seeds(7, 2, 4)
+    assert task_seeds(8, 2, 4) != task_seeds(7, 2, 4)
+
+
+def test_chunks_cover_every_task_once():
+    tasks = expand(["w"], [Choice("potential_field")], 100, 0)
+    parts = chunks(tasks, 2)
+    assert [t for p in parts for t in p] == tasks and max(map(len, parts)) <= 8
+
+
+# -- executors, store, resume --------------------------------------------------------------
+
+def small_study(runs=6) -> Study:
+    return Study(["w1.yaml", "w2.yaml"],
+                 make_choices(["fuzzy", "potential_field"], ["min", "einstein"], [], []),
+                 runs=runs, seed=3)
+
+
+def test_process_pool_equals_serial_bit_for_bit(tmp_path):
+    study = small_study()
+    serial = run_study(study, tmp_path / "s", workers=1, task_fn=fake_sim)
+    pooled = run_study(study, tmp_path / "p", workers=2, task_fn=fake_sim)
+    assert serial.rows == pooled.rows and len(serial.rows) == 36
+    # the files hold the same rows (arrival order may differ), floats read back exactly
+    a = ResultStore(tmp_path / "s").load()
+    b = ResultStore(tmp_path / "p").load()
+    key = lambda r: (r["world"], r["planner"], r["and"], r["run"])  # noqa: E731
+    assert sorted(a, key=key) == sorted(b, key=key) == sorted(serial.rows, key=key)
+
+
+def test_resume_recomputes_nothing_finished(tmp_path):
+    study = small_study()
+    log: list[int] = []
+    with pytest.raises(Crash):
+        run_study(study, tmp_path, workers=1, task_fn=functools.partial(crashing_sim, after=13,
+                                                                         log=log))
+    assert len(ResultStore(tmp_path).load()) == 13              # every finished run was kept
+    log2: list[int] = []
+    outcome = run_study(study, tmp_path, workers=1, resume=True,
+                        task_fn=functools.partial(fake_sim, log=log2))
+    assert outcome.skipped == 13 and outcome.executed == len(log2) == 36 - 13
+    assert set(log2).isdisjoint(log)
+    fresh = run_study(study, tmp_path / "fresh", workers=1, task_fn=fake_sim)
+    assert outcome.rows == fresh.rows
+
+
+def test_cut_off_last_line_is_recomputed(tmp_path):
+    study = small_study(runs=2)
+    run_study(study, tmp_path, workers=1, task_fn=fake_sim)
+    path = tmp_path / "results.csv"
+    data = path.read_bytes()
+    path.write_bytes(data[:-20])                                # killed in the middle of a row
+    log: list[int] = []
+    out = run_study(study, tmp_path, workers=1, resume=True,
+                    task_fn=functools.partial(fake_sim, log=log))
+    assert len(log) == 1 and out.complete
+    assert path.read_bytes() == data or len(ResultStore(tmp_path).load()) == len(out.rows)
+
+
+def test_existing_results_need_resume(tmp_path):
+    study = small_study(runs=1)
+    run_study(study, tmp_path, workers=1, task_fn=fake_sim)
+    with pytest.raises(StudyError) as exc:
+        run_study(study, tmp_path, workers=1, task_fn=fake_sim)
+    assert "already holds 6 results" in exc.value.message and "--resume" in exc.value.hint
+
+
+def test_resume_with_another_seed_is_refused(tmp_path):
+    run_study(small_study(runs=1), tmp_path, workers=1, task_fn=fake_sim)
+    other = Study(**{**small_study(runs=1).__dict__, "seed": 4})
+    with pytest.raises(StudyError) as exc:
+        run_study(other, tmp_path, workers=1, resume=True, task_fn=fake_sim)
+    assert "was made with --seed 3, not 4" in exc.value.message
+
+
+def test_resume_with_worlds_reordered_is_refused(tmp_path):
+    run_study(small_study(runs=1), tmp_path, workers=1, task_fn=fake_sim)
+    swapped = Study(**{**small_study(runs=1).__dict__, "worlds": ["w2.yaml", "w1.yaml"]})
+    with pytest.raises(StudyError) as exc:
+        run_study(swapped, tmp_path, workers=1, resume=True, task_fn=fake_sim)
+    assert "same order" in exc.value.hint
+
+
+def test_hand_edited_results_are_reported(tmp_path):
+    run_study(small_study(runs=1), tmp_path, workers=1, task_fn=fake_sim)
+    path = tmp_path / "results.csv"
+    lines = path.read_text().splitlines(keepends=True)
+    path.write_text("".join(lines[:2]) + "w1.yaml,fuzzy,min\n")
+    with pytest.raises(StudyError) as exc:
+        ResultStore(tmp_path).load()
+    assert "results.csv:3: expected 15 values, found 3" in exc.value.message
+    path.write_text("world,oops\n")
+    with pytest.raises(StudyError) as exc:
+        ResultStore(tmp_path).load()
+    assert "not a results file" in exc.value.message
+
+
+def test_unknown_executor():
+    with pytest.raises(MitosError) as exc:
+        list(execute(fake_sim, small_study(1).tasks(), "dusk"))
+    assert "unknown executor `dusk`" in exc.value.message and "dask" in exc.value.hint
+
+
+def test_summaries_and_ranking():
+    study = small_study(runs=10)
+    rows = [{"world": t.world, "planner": t.choice.planner, "and": t.choice.and_,
+             "or": t.choice.or_, "inference": t.choice.inference, "run": t.run, "seed": t.seed,
+             **fake_sim(t)} for t in study.tasks()]
+    s = summaries(rows, study.worlds, study.choices)
+    assert len(s) == 2 * 3 + 3 and s[-1].world == "all worlds" and s[-1].n == 20
+    ranks = rank(rows, [x for x in s if x.world == "all worlds"])
+    rates = [r.summary.rates["success"].value for r in ranks]
+    assert rates == sorted(rates, reverse=True) and ranks[0].p_value is None
+    for r in ranks[1:]:
+        assert r.paired_n == 20 and 0.0 < r.p_value <= 1.0
+    # time to goal uses successful runs only
+    t = s[0]
+    assert t.metrics["time_s"].n == t.rates["success"].k
+    assert t.metrics["min_clearance_in"].n == t.n
