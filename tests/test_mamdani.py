@@ -1,0 +1,214 @@
+"""Mamdani inference: implication, S-norm aggregation, the five defuzzifiers, singletons,
+hedged consequents, sub-blocking and bit identity of batches."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from mitos_cli import mamdani, norms
+from mitos_cli.api import load_rulebase, read_rulebase
+from mitos_cli.compile import compile_rulebase
+from mitos_cli.engine import evaluate
+from mitos_cli.errors import NoRuleFiredError
+from mitos_cli.hedges import HEDGES
+from mitos_cli.model import Setting
+
+TERMS = """\
+variables:
+  road:
+    role: input
+    universe: [0, 160]
+    terms:
+      NARROW: {shape: left_shoulder, points: [40, 70]}
+      MEDIUM: {shape: triangle, peak: 70, width: 30}
+      WIDE: {shape: right_shoulder, points: [70, 100]}
+  size:
+    role: input
+    universe: [0, 100]
+    terms:
+      SMALL: {shape: left_shoulder, points: [10, 40]}
+      LARGE: {shape: right_shoulder, points: [10, 70]}
+  speed:
+    role: output
+    universe: [0, 60]
+    terms:
+      SLOW: {shape: triangle, points: [0, 10, 30]}
+      MODERATE: {shape: trapezoid, points: [15, 25, 35, 45]}
+      FAST: {shape: right_shoulder, points: [35, 55]}
+      CRAWL: 5
+"""
+
+RULES = """\
+terms "m.terms.yaml"
+operators: inference = mamdani, {operators}
+if road is NARROW then speed is SLOW
+if road is MEDIUM and size is SMALL then speed is MODERATE
+if road is MEDIUM and size is LARGE then speed is SLOW with 0.8
+if road is WIDE and not size is LARGE then speed is FAST
+if road is WIDE and size is very LARGE then speed is somewhat MODERATE
+"""
+
+
+def write(tmp_path, operators="defuzzify = centroid", rules=RULES):
+    (tmp_path / "m.terms.yaml").write_text(TERMS)
+    path = tmp_path / "m.rules"
+    path.write_text(rules.format(operators=operators))
+    return path
+
+
+def reference(road, size, implication="min", aggregation="max", defuzzify="centroid",
+              resolution=101):
+    """Mamdani by the book, one sample, loops over rules: the test oracle."""
+    narrow = np.clip((70 - road) / 30, 0, 1)
+    medium = max(0.0, 1 - abs(road - 70) / 30)
+    wide = np.clip((road - 70) / 30, 0, 1)
+    small = np.clip((40 - size) / 30, 0, 1)
+    large = np.clip((size - 10) / 60, 0, 1)
+    x = 0 + (np.arange(resolution) + 0.5) * (60 / resolution)     # the documented grid
+    slow = np.clip(np.minimum(x / 10, (30 - x) / 20), 0, 1)
+    moderate = np.clip(np.minimum((x - 15) / 10, (45 - x) / 10), 0, 1)
+    fast = np.clip((x - 35) / 20, 0, 1)
+    rules = [(narrow, slow), (min(medium, small), moderate), (0.8 * min(medium, large), slow),
+             (min(wide, 1 - large), fast), (min(wide, large ** 2), np.sqrt(moderate))]
+    imp = np.minimum if implication == "min" else np.multiply
+    S = norms.lookup("snorm", aggregation)
+    y = np.zeros(resolution)
+    for d, mu in rules:
+        y = S(y, imp(d, mu))
+    if y.sum() == 0:
+        return np.nan
+    if defuzzify == "centroid":
+        return (x * y).sum() / y.sum()
+    if defuzzify == "bisector":
+        area = np.cumsum(y)
+        gap = np.abs(area / area[-1] - 0.5)
+        return x[gap == gap.min()].mean()
+    peak = (y > 0) & (y == y.max())
+    return {"mom": x[peak].mean(), "som": x[peak].min(), "lom": x[peak].max()}[defuzzify]
+
+
+SAMPLES = [(50, 30), (78, 45), (100, 65), (65, 5), (85, 20), (120, 90), (72.5, 39.9)]
+
+
+@pytest.mark.parametrize("defuzzify", ["centroid", "bisector", "mom", "som", "lom"])
+@pytest.mark.parametrize("implication", ["min", "product"])
+def test_matches_the_book_with_max(tmp_path, implication, defuzzify):
+    ops = f"implication = {implication}, defuzzify = {defuzzify}"
+    rb = load_rulebase(write(tmp_path, ops))
+    X = np.array(SAMPLES, dtype=float)
+    got = evaluate(rb.compiled, X).outputs[:, 0]
+    want = [reference(r, s, implication, "max", defuzzify) for r, s in SAMPLES]
+    np.testing.assert_allclose(got, want, rtol=0, atol=1e-9)
+
+
+@pytest.mark.parametrize("aggregation", sorted(norms.SNORMS))
+def test_every_snorm_aggregates(tmp_path, aggregation):
+    rb = load_rulebase(write(tmp_path, f"aggregation = {aggregation}, resolution = 201"))
+    X = np.array(SAMPLES, dtype=float)
+    got = evaluate(rb.compiled, X).outputs[:, 0]
+    want = [reference(r, s, "min", aggregation, "centroid", 201) for r, s in SAMPLES]
+    np.testing.assert_allclose(got, want, rtol=0, atol=1e-9)
+
+
+def test_grouping_rules_by_set_is_exact_for_max():
+    # max_r min(d_r, mu) == min(max_r d_r, mu): the shortcut the engine takes
+    rng = np.random.default_rng(np.random.SeedSequence(7))
+    d = rng.random((6, 50))
+    mu = rng.random(40)
+    full = mamdani.aggregate(d, np.repeat(mu[None], 6, axis=0), "min", norms.SNORMS["max"])
+    short = mamdani.aggregate(d.max(axis=0, keepdims=True), mu[None], "min",
+                              norms.SNORMS["max"])
+    assert (full == short).all()
+
+
+@pytest.mark.parametrize("aggregation", ["max", "einstein_sum"])
+def test_batch_row_equals_single_evaluation_bit_for_bit(tmp_path, monkeypatch, aggregation):
+    rb = load_rulebase(write(tmp_path, f"aggregation = {aggregation}, resolution = 301"))
+    rng = np.random.default_rng(np.random.SeedSequence(11))
+    X = np.column_stack([rng.uniform(0, 160, 700), rng.uniform(0, 100, 700)])
+    monkeypatch.setattr(mamdani, "MAX_BYTES", 64 * 301 * 8)      # many small sub-blocks
+    batch = evaluate(rb.compiled, X).outputs
+    for i in range(0, 700, 41):
+        assert (evaluate(rb.compiled, X[i:i + 1]).outputs == batch[i]).all()
+    monkeypatch.setattr(mamdani, "MAX_BYTES", 2 ** 30)            # one block
+    assert (evaluate(rb.compiled, X).outputs == batch).all()
+
+
+def test_sub_blocks_stay_under_the_memory_ceiling(tmp_path, monkeypatch):
+    rb = load_rulebase(write(tmp_path, "aggregation = probabilistic_sum, resolution = 1001"))
+    seen = []
+    real = mamdani.aggregate
+
+    def spy(dof, sets, implication, aggregation):
+        seen.append(dof.shape[0] * dof.shape[1] * sets.shape[1] * 8)
+        return real(dof, sets, implication, aggregation)
+
+    monkeypatch.setattr(mamdani, "aggregate", spy)
+    evaluate(rb.compiled, np.tile([[80.0, 30.0]], (5000, 1)), detail=False)
+    assert len(seen) > 1 and max(seen) <= mamdani.MAX_BYTES
+
+
+def test_tables_are_built_once_per_compiled_rule_base(tmp_path):
+    c = load_rulebase(write(tmp_path)).compiled
+    assert c.mamdani is c.mamdani
+    (table,) = c.mamdani
+    assert table.labels == ("SLOW", "MODERATE", "FAST", "somewhat MODERATE")
+    assert table.sets.shape == (4, 101)
+    assert table.grid[0] == pytest.approx(60 / 202) and table.grid[-1] == pytest.approx(60 - 60 / 202)
+    np.testing.assert_array_equal(table.sets[3], HEDGES["somewhat"].fn(table.sets[1]))
+
+
+def test_singleton_consequent_is_a_one_cell_spike(tmp_path):
+    rules = 'terms "m.terms.yaml"\noperators: inference = mamdani, {operators}\n' \
+            'if road is NARROW then speed is CRAWL\nif road is WIDE then speed is 42\n'
+    rb = load_rulebase(write(tmp_path, "resolution = 60", rules))
+    # cells of width 1: 5 lies on a cell boundary -> cell [5, 6), midpoint 5.5
+    assert rb.evaluate(road=10)["speed"] == 5.5
+    assert rb.evaluate(road=150)["speed"] == 42.5
+    # road 60: NARROW 1/3 -> CRAWL at 5.5; WIDE 0. Road 90: WIDE 2/3 only.
+    assert rb.evaluate(road=60)["speed"] == 5.5
+    # two spikes: the centroid is their DOF-weighted average
+    Y = np.zeros((1, 60))
+    Y[0, 5], Y[0, 42] = 0.25, 0.75
+    assert mamdani.defuzzify(Y, mamdani.grid(0, 60, 60), "centroid")[0] == pytest.approx(
+        0.25 * 5.5 + 0.75 * 42.5)
+
+
+def test_paper_rule_base_runs_mamdani_within_half_a_cell_of_weighted_average():
+    # singletons only and probabilistic-sum-free max aggregation with one rule per value:
+    # at road 100 (only WIDE), size 10, position -60 exactly one rule fires (r0: RS = 110)
+    rb = read_rulebase()
+    c = compile_rulebase(rb, overrides=(Setting("inference", "mamdani"),
+                                        Setting("resolution", "121")))
+    out = evaluate(c, np.array([[100.0, 10.0, -60.0]])).outputs[0]
+    assert abs(out[0] - 110) <= 0.5 * 120 / 121
+    assert abs(out[1] - 40) <= 0.5 * 60 / 121
+
+
+def test_nothing_fired_gives_default_or_error(tmp_path):
+    rules = 'terms "m.terms.yaml"\noperators: inference = mamdani, {operators}\n' \
+            'if road is NARROW and size is LARGE then speed is SLOW\n'
+    rb = load_rulebase(write(tmp_path, "defuzzify = mom", rules))
+    with pytest.raises(NoRuleFiredError, match="no rule sets `speed`"):
+        rb.evaluate(road=150, size=0)
+    out = evaluate(rb.compiled, np.array([[150.0, 0.0]]), strict=False).outputs
+    assert np.isnan(out).all()
+
+
+def test_empty_set_defuzzifies_to_nan():
+    x = mamdani.grid(0, 1, 5)
+    for method in ("centroid", "bisector", "mom", "som", "lom"):
+        assert np.isnan(mamdani.defuzzify(np.zeros((1, 5)), x, method)).all()
+
+
+def test_defuzzifiers_on_a_known_set():
+    x = mamdani.grid(0, 10, 10)                      # 0.5, 1.5, ..., 9.5
+    Y = np.array([[0, 0.2, 0.6, 0.6, 0.2, 0, 0, 0, 0, 0.0]])
+    assert mamdani.defuzzify(Y, x, "centroid")[0] == pytest.approx(3.0)
+    assert mamdani.defuzzify(Y, x, "mom")[0] == 3.0
+    assert mamdani.defuzzify(Y, x, "som")[0] == 2.5
+    assert mamdani.defuzzify(Y, x, "lom")[0] == 3.5
+    assert mamdani.defuzzify(Y, x, "bisector")[0] == 2.5   # cumulative area 0.8 of 1.6
+    with pytest.raises(ValueError):
+        mamdani.defuzzify(Y, x, "median")
