@@ -1,0 +1,268 @@
+"""``mitos plot``: membership plots, control surfaces and the rule viewer.
+
+With ``-o FILE.png`` or ``-o FILE.svg`` a picture is written (matplotlib, Agg canvas); with
+``--show`` a window opens where one can. Without either, the picture goes to the terminal:
+``plot terms`` draws the memberships in Unicode Braille, ``plot surface`` prints the surface as
+a table of output values, ``plot rules`` prints the rule viewer with bars. matplotlib is
+imported only when a picture file or window is asked for.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+from enum import Enum
+from pathlib import Path
+from typing import Annotated, Optional
+
+import typer
+
+from .eval_cmd import parse_values, split_args
+from .output import emit, err, warn
+
+FORMATS = ("png", "svg")
+RULE_SUFFIXES = (".rules", ".fcl", ".fis", ".fll")
+
+plot_app = typer.Typer(
+    name="plot",
+    help="Draw a rule base: membership plots, control surfaces, the rule viewer "
+         "(PNG/SVG with -o, a window with --show, else in the terminal).",
+    no_args_is_help=True,
+    context_settings={"help_option_names": ["-h", "--help"]},
+)
+
+
+class Style(str, Enum):
+    surface = "surface"
+    heatmap = "heatmap"
+
+
+def check_output(path: Optional[str]) -> Optional[str]:
+    """``-o`` must name a .png or .svg file (usage error otherwise)."""
+    if path is None:
+        return None
+    suffix = Path(path).suffix.lower().lstrip(".")
+    if suffix not in FORMATS:
+        raise typer.BadParameter(
+            f"`{path}` has {'extension .' + suffix if suffix else 'no extension'}; "
+            f"the picture formats are " + " and ".join(f".{f}" for f in FORMATS),
+            param_hint="'-o' / '--output'")
+    return path
+
+
+OutputOpt = Annotated[Optional[str], typer.Option(
+    "--output", "-o", metavar="FILE.png|FILE.svg", callback=check_output,
+    help="Write the picture to this file (format by extension: .png or .svg).")]
+ShowOpt = Annotated[bool, typer.Option(
+    "--show", help="Open the picture in a window (where a display is available).")]
+BehaviorOpt = Annotated[Optional[str], typer.Option(
+    "--behavior", "-b", help="Use this behavior (default: the file's first).")]
+
+
+def _wants_picture(output: Optional[str], show: bool) -> bool:
+    return output is not None or show
+
+
+def _done(output: Optional[str]) -> None:
+    if output is not None:
+        err(f"wrote {output}")
+
+
+def _use_color(color: Optional[bool]) -> bool:
+    if color is not None:
+        return color
+    return sys.stdout.isatty() and not os.environ.get("NO_COLOR")
+
+
+@plot_app.command("terms")
+def terms_command(
+    args: Annotated[Optional[list[str]], typer.Argument(
+        metavar="[RULEBASE] [NAME=VALUE]...",
+        help="Rule file (default: the packaged MITOS rule base), then values to mark, "
+             "e.g. road=78.")] = None,
+    var: Annotated[Optional[list[str]], typer.Option(
+        "--var", "-v", help="Draw only this variable (repeat for more).")] = None,
+    output: OutputOpt = None,
+    show: ShowOpt = False,
+    width: Annotated[Optional[int], typer.Option(
+        "--width", min=30, max=400,
+        help="Terminal plot width in characters (default: the terminal's, at most 100).")]
+    = None,
+    color: Annotated[Optional[bool], typer.Option(
+        "--color/--no-color", help="Colour the terminal plot (default: when stdout is a "
+                                   "terminal and NO_COLOR is unset).")] = None,
+) -> None:
+    """Membership plots: every term of each variable, with given values marked.
+
+    All variables on one sheet (the paper's Figures 5-9) unless --var picks some. Without -o or
+    --show the plot is drawn in the terminal with Unicode characters."""
+    from ..api import read_rulebase
+    from ..plotdata import sheet
+    from ..trace import display_path
+
+    path, texts = split_args(args or [])
+    rulebase = read_rulebase(path)
+    plots = sheet(rulebase, var, parse_values(texts))
+    for p in plots:
+        if p.clamped:
+            lo, hi = p.universe
+            warn(f"`{p.name}` outside its universe [{lo:g}, {hi:g}] was clamped")
+    if not _wants_picture(output, show):
+        from ..termplot import render_sheet
+
+        if width is None:
+            import shutil
+
+            width = min(shutil.get_terminal_size((80, 24)).columns, 100)
+        emit(render_sheet(plots, width=width, color=_use_color(color)))
+        return
+    from ..draw.terms import draw_sheet
+
+    where = display_path(rulebase.path)
+    title = (f"Term sets of {where}" if len(plots) > 1
+             else f"{plots[0].name} ({where})")
+    draw_sheet(plots, output, title=title, show=show)
+    _done(output)
+
+
+def _axis(text: str, option: str) -> tuple[str, Optional[tuple[float, float]]]:
+    """``road`` or ``road=40:100`` -> (name, range or None)."""
+    name, sep, rng = text.partition("=")
+    if not sep:
+        return name, None
+    lo, colon, hi = rng.partition(":")
+    try:
+        if not colon:
+            raise ValueError
+        return name, (float(lo), float(hi))
+    except ValueError:
+        raise typer.BadParameter(f"`{text}`: write NAME or NAME=LOW:HIGH, e.g. {name}=40:100",
+                                 param_hint=option) from None
+
+
+def _fixed(items: list[str]) -> dict[str, str]:
+    out: dict[str, str] = {}
+    for item in items:
+        name, sep, value = item.partition("=")
+        if not sep or not name:
+            raise typer.BadParameter(f"`{item}`: write NAME=VALUE, e.g. size=45",
+                                     param_hint="'--fix'")
+        if name in out:
+            raise typer.BadParameter(f"`{name}` is fixed twice", param_hint="'--fix'")
+        out[name] = value
+    return out
+
+
+def _surface_args(args: list[str]) -> tuple[Optional[str], Optional[str]]:
+    """``[RULEBASE] OUTPUT`` -> (rule-base path, output name); a lone argument that names a
+    rule file is the rule base."""
+    if len(args) > 2:
+        raise typer.BadParameter(f"expected [RULEBASE] OUTPUT, got {len(args)} arguments: "
+                                 + " ".join(args))
+    if len(args) == 2:
+        return args[0], args[1]
+    if len(args) == 1:
+        arg = args[0]
+        if Path(arg).suffix.lower() in RULE_SUFFIXES or Path(arg).is_file():
+            return arg, None
+        return None, arg
+    return None, None
+
+
+@plot_app.command("surface")
+def surface_command(
+    args: Annotated[Optional[list[str]], typer.Argument(
+        metavar="[RULEBASE] OUTPUT",
+        help="Rule file (default: the packaged MITOS rule base), then the output to draw "
+             "(may be left out when the rule base has one output).")] = None,
+    x: Annotated[str, typer.Option(
+        "--x", metavar="INPUT[=LOW:HIGH]",
+        help="Input on the x axis, optionally zoomed to LOW:HIGH.")] = ...,
+    y: Annotated[Optional[str], typer.Option(
+        "--y", metavar="INPUT[=LOW:HIGH]",
+        help="Input on the y axis (without it: a curve over --x).")] = None,
+    fix: Annotated[Optional[list[str]], typer.Option(
+        "--fix", metavar="NAME=VALUE",
+        help="Hold another input at a value (repeat; inputs not fixed are held at the "
+             "midpoint of their universe, with a note).")] = None,
+    resolution: Annotated[int, typer.Option(
+        "--resolution", "-n", min=2, max=1000, help="Grid points per axis.")] = 61,
+    style: Annotated[Style, typer.Option(
+        "--style", help="3-D surface or heat map with contours (two inputs).")]
+    = Style.surface,
+    output: OutputOpt = None,
+    show: ShowOpt = False,
+    behavior: BehaviorOpt = None,
+) -> None:
+    """Control surface: an output over one or two inputs, the others fixed.
+
+    The grid is computed in one batch. Without -o or --show the surface is printed as a table
+    of output values ("-" where no rule fires and the output has no default)."""
+    from ..api import load_rulebase
+    from ..plotdata import surface
+
+    path, out_name = _surface_args(args or [])
+    rb = load_rulebase(path, behavior)
+    if out_name is None:
+        if len(rb.outputs) != 1:
+            raise typer.BadParameter("name the OUTPUT to draw: one of " + ", ".join(rb.outputs))
+        out_name = rb.outputs[0]
+    x_name, x_range = _axis(x, "'--x'")
+    y_name, y_range = _axis(y, "'--y'") if y is not None else (None, None)
+    fixed = parse_values(_fixed(fix or []))
+    s = surface(rb.compiled, out_name, x_name, y_name, fixed, resolution, x_range, y_range)
+    for note in s.notes():
+        err(f"note: {note}")
+    if not _wants_picture(output, show):
+        from ..termplot import render_surface
+
+        emit(render_surface(s))
+        return
+    from ..draw.surface import draw_surface
+
+    draw_surface(s, output, style=style.value, show=show)
+    _done(output)
+
+
+@plot_app.command("rules")
+def rules_command(
+    args: Annotated[Optional[list[str]], typer.Argument(
+        metavar="[RULEBASE] NAME=VALUE...",
+        help="Rule file (default: the packaged MITOS rule base), then one NAME=VALUE per "
+             "input.")] = None,
+    output: OutputOpt = None,
+    show: ShowOpt = False,
+    behavior: BehaviorOpt = None,
+    max_rules: Annotated[int, typer.Option(
+        "--max-rules", min=1, max=500,
+        help="Draw at most this many fired rules (the strongest).")] = 30,
+) -> None:
+    """Rule viewer: each fired rule with its memberships, DOF and consequent.
+
+    For one input: every fired rule as a row, each output's aggregate and crisp result. Without
+    -o or --show the viewer is printed as text with bars."""
+    from ..api import load_rulebase
+    from ..plotdata import rule_view
+
+    path, texts = split_args(args or [])
+    rb = load_rulebase(path, behavior)
+    if not texts:
+        raise typer.BadParameter(
+            "give one NAME=VALUE per input: " + " ".join(f"{k}=..." for k in rb.inputs))
+    view = rule_view(rb.compiled, parse_values(texts))
+    for i in view.inputs:
+        if i.clamped:
+            lo, hi = i.universe
+            warn(f"`{i.name}` outside its universe [{lo:g}, {hi:g}] was clamped")
+    if not _wants_picture(output, show):
+        from ..termplot import render_rule_view
+
+        emit(render_rule_view(view))
+        return
+    from ..draw.rules import draw_rules
+
+    draw_rules(view, output, show=show, max_rows=max_rules)
+    _done(output)
+
+
+__all__ = ["plot_app"]

@@ -1,0 +1,106 @@
+"""Where a figure goes: a PNG or SVG file (the Agg canvas, no window, no pyplot state) or a
+window (``show``), and the one place that imports matplotlib for that.
+
+Figures for files are plain :class:`matplotlib.figure.Figure` objects on an Agg canvas, so
+drawing never touches pyplot's global figure list or backend; only :func:`new_figure` with
+``show=True`` imports pyplot, and it refuses with a clear message where no window can open.
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from pathlib import Path
+
+from ..errors import MitosError
+
+#: The file formats a picture can be written in, by extension.
+FORMATS = ("png", "svg")
+#: matplotlib backends that cannot open a window
+NON_INTERACTIVE = {"agg", "cairo", "pdf", "pgf", "ps", "svg", "template"}
+
+
+class DrawError(MitosError):
+    """A picture that cannot be drawn here (no matplotlib, no display, unwritable file)."""
+
+    kind = "error"
+
+
+def check_format(path: str | Path) -> str:
+    """The format of ``path`` by its extension; :class:`DrawError` unless png or svg."""
+    suffix = Path(path).suffix.lower().lstrip(".")
+    if suffix not in FORMATS:
+        raise DrawError(f"cannot write `{path}`: unknown picture format "
+                        f"`{suffix or '(no extension)'}`",
+                        expected="a file name ending in " + " or ".join(f".{f}" for f in FORMATS))
+    return suffix
+
+
+def _matplotlib():
+    try:
+        import matplotlib
+    except ImportError:
+        raise DrawError("drawing pictures needs matplotlib, which is not installed",
+                        hint="pip install 'mitos[plot]' (or pip install matplotlib)") from None
+    return matplotlib
+
+
+def new_figure(figsize: tuple[float, float], show: bool = False, **kwargs):
+    """A new figure: managed by pyplot (and an interactive backend) when ``show``, else a
+    bare Figure on an Agg canvas."""
+    _matplotlib()
+    if show:
+        import matplotlib.pyplot as plt
+
+        backend = plt.get_backend().lower()
+        if backend in NON_INTERACTIVE:
+            why = ("no display (DISPLAY is not set)"
+                   if os.name == "posix" and not os.environ.get("DISPLAY")
+                   and not os.environ.get("WAYLAND_DISPLAY") and os.uname().sysname == "Linux"
+                   else f"matplotlib's backend `{backend}` cannot open windows")
+            raise DrawError(f"cannot open a window: {why}",
+                            hint="write a file instead with -o FILE.png or -o FILE.svg")
+        return plt.figure(figsize=figsize, **kwargs)
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=figsize, **kwargs)
+    FigureCanvasAgg(fig)
+    return fig
+
+
+def finish(fig, path: str | Path | None = None, show: bool = False, dpi: int = 150):
+    """Save ``fig`` to ``path`` (atomically: a temporary file renamed into place), then show
+    it when asked. Returns the figure."""
+    if path is not None:
+        path = Path(path)
+        fmt = check_format(path)
+        directory = path.parent if str(path.parent) else Path(".")
+        try:
+            fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=f".{fmt}", dir=directory)
+        except OSError as exc:
+            raise DrawError(f"cannot write `{path}`: {exc.strerror or exc}") from None
+        import matplotlib
+
+        try:
+            with os.fdopen(fd, "wb") as fh, matplotlib.rc_context({"svg.hashsalt": "mitos"}):
+                fig.savefig(fh, format=fmt, dpi=dpi, bbox_inches="tight",
+                            metadata=_metadata(fmt))
+            os.replace(tmp, path)
+        except OSError as exc:
+            raise DrawError(f"cannot write `{path}`: {exc.strerror or exc}") from None
+        finally:
+            if os.path.exists(tmp):
+                os.unlink(tmp)
+    if show:
+        import matplotlib.pyplot as plt
+
+        plt.show()
+    return fig
+
+
+def _metadata(fmt: str) -> dict:
+    """No creation dates in the files, so the same picture is the same bytes."""
+    if fmt == "svg":
+        return {"Date": None}
+    return {"Software": None}

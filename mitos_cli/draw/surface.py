@@ -1,0 +1,143 @@
+"""Control surfaces: an output over two inputs (3-D surface or heat map with contours), or
+over one input (a curve), from a :class:`~mitos_cli.plotdata.Surface`.
+
+Where no rule sets the output and it has no default, the surface is NaN: drawn as a hatched,
+blank region with a legend entry saying so, never as a made-up number.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from ..plotdata import Surface
+from .output import finish, new_figure
+
+STYLES = ("surface", "heatmap")
+CMAP = "viridis"
+HATCH_COLOR = "#bbbbbb"
+
+
+def title_of(s: Surface) -> str:
+    over = s.x.name if s.y is None else f"{s.x.name} × {s.y.name}"
+    text = f"{s.output} over {over}"
+    if s.fixed:
+        text += f"  ({s.fixed_text})"
+    return text
+
+
+def _no_rule_patch():
+    from matplotlib.patches import Patch
+
+    return Patch(facecolor="white", edgecolor=HATCH_COLOR, hatch="///",
+                 label="no rule fires (no default)")
+
+
+def draw_curve(ax, s: Surface) -> None:
+    """One input: the output as a line; spans where nothing fires shaded and hatched."""
+    x, z = s.x.values, s.z
+    ax.plot(x, z, color="#1f77b4", linewidth=2.2, label=s.output)
+    mask = np.isnan(z)
+    if mask.any():
+        ax.fill_between(x, 0, 1, where=mask, transform=ax.get_xaxis_transform(),
+                        facecolor="none", edgecolor=HATCH_COLOR, hatch="///", linewidth=0,
+                        step="mid")
+        ax.legend(handles=[ax.lines[0], _no_rule_patch()], fontsize=8)
+    ax.set_xlim(x[0], x[-1])
+    ax.set_xlabel(s.x.label)
+    ax.set_ylabel(s.label)
+    ax.grid(True, color="#e6e6e6")
+    for side in ("top", "right"):
+        ax.spines[side].set_visible(False)
+
+
+def _levels(z: np.ndarray, n: int = 10) -> np.ndarray | None:
+    finite = z[np.isfinite(z)]
+    if finite.size == 0 or finite.min() == finite.max():
+        return None
+    from matplotlib.ticker import MaxNLocator
+
+    levels = MaxNLocator(n).tick_values(finite.min(), finite.max())
+    return levels[(levels > finite.min()) & (levels < finite.max())]
+
+
+def draw_heatmap(fig, ax, s: Surface) -> None:
+    """Heat map with labelled contour lines; masked (blank, hatched) where nothing fires."""
+    z = np.ma.masked_invalid(s.z)
+    X, Y = np.meshgrid(s.x.values, s.y.values)
+    ax.add_patch(_background(ax))
+    mesh = ax.pcolormesh(X, Y, z, cmap=CMAP, shading="gouraud" if not z.mask.any() else "nearest",
+                         rasterized=True)
+    levels = _levels(s.z)
+    if levels is not None and len(levels):
+        cs = ax.contour(X, Y, z, levels=levels, colors="white", linewidths=0.8, alpha=0.9)
+        ax.clabel(cs, fontsize=7.5, fmt="%g", inline=True)
+    bar = fig.colorbar(mesh, ax=ax, pad=0.02)
+    bar.set_label(s.label)
+    ax.set_xlabel(s.x.label)
+    ax.set_ylabel(s.y.label)
+    if z.mask.any():
+        ax.legend(handles=[_no_rule_patch()], loc="upper right", fontsize=8)
+
+
+def _background(ax):
+    """A hatched rectangle under the mesh: it shows through the masked cells."""
+    from matplotlib.patches import Rectangle
+
+    return Rectangle((0, 0), 1, 1, transform=ax.transAxes, facecolor="white",
+                     edgecolor=HATCH_COLOR, hatch="///", linewidth=0, zorder=0)
+
+
+def draw_surface3d(fig, ax, s: Surface) -> None:
+    """A shaded 3-D surface with its contours projected on the floor; masked cells are
+    left out (holes), and a note says so."""
+    X, Y = np.meshgrid(s.x.values, s.y.values)
+    z = np.ma.masked_invalid(s.z)
+    finite = s.z[np.isfinite(s.z)]
+    lo, hi = (float(finite.min()), float(finite.max())) if finite.size else (0.0, 1.0)
+    if lo == hi:
+        lo, hi = lo - 1, hi + 1
+    floor = lo - 0.25 * (hi - lo)
+    surf = ax.plot_surface(X, Y, z, cmap=CMAP, vmin=lo, vmax=hi, rstride=1, cstride=1,
+                           linewidth=0.15, edgecolor=(1, 1, 1, 0.25), antialiased=True)
+    if finite.size:
+        levels = _levels(s.z)
+        if levels is not None and len(levels):
+            ax.contour(X, Y, z, levels=levels, zdir="z", offset=floor, cmap=CMAP,
+                       linewidths=0.8)
+    ax.set_zlim(floor, hi + 0.02 * (hi - lo))
+    ax.set_xlabel(s.x.label, labelpad=8)
+    ax.set_ylabel(s.y.label, labelpad=8)
+    ax.set_zlabel(s.label, labelpad=8)
+    ax.view_init(elev=28, azim=-125)
+    bar = fig.colorbar(surf, ax=ax, shrink=0.6, pad=0.1)
+    bar.set_label(s.label)
+    if z.mask.any():
+        ax.text2D(0.0, 0.0, "holes: no rule fires and the output has no default",
+                  transform=ax.transAxes, fontsize=8, color="#555555")
+
+
+def draw_surface(s: Surface, path: str | Path | None = None, *, style: str = "surface",
+                 title: str | None = None, show: bool = False):
+    """Draw ``s`` (a curve when it has one input) to ``path`` (.png/.svg) and/or a window."""
+    if style not in STYLES:
+        raise ValueError(f"style must be one of {STYLES}, not {style!r}")
+    if s.y is None:
+        fig = new_figure((7.0, 4.2), show, layout="constrained")
+        ax = fig.subplots()
+        draw_curve(ax, s)
+    elif style == "heatmap":
+        fig = new_figure((7.6, 5.6), show, layout="constrained")
+        ax = fig.subplots()
+        draw_heatmap(fig, ax, s)
+    else:
+        fig = new_figure((8.4, 6.4), show)
+        ax = fig.add_subplot(projection="3d")
+        draw_surface3d(fig, ax, s)
+    heading = title or title_of(s)
+    if s.y is not None and style == "surface":
+        fig.suptitle(heading, fontsize=12, y=0.95)
+    else:
+        ax.set_title(heading, fontsize=11, loc="left")
+    return finish(fig, path, show)

@@ -1,0 +1,227 @@
+"""Membership plots: every term of a variable over its universe (the paper's Figures 5-9).
+
+:func:`draw_sheet` draws :class:`~mitos_cli.plotdata.VariablePlot` objects, one panel per
+variable (inputs first); :func:`draw_terms_before_after` shows how teaching moved the terms of
+one variable. matplotlib is imported only inside these functions (through
+:mod:`mitos_cli.draw.output`), never at import time.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Sequence
+
+from ..plotdata import VariablePlot, variable_plot
+from ..terms import Variable
+from .output import finish, new_figure
+
+#: term colours (matplotlib's tab10, colour-blind friendlier than the default cycle's order)
+COLORS = ("#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#17becf", "#8c564b",
+          "#e377c2", "#7f7f7f", "#bcbd22")
+VALUE_COLOR = "#222222"
+
+
+def color(i: int) -> str:
+    return COLORS[i % len(COLORS)]
+
+
+def style_axes(ax, plot: VariablePlot) -> None:
+    """Limits, labels and a light grid for a membership panel."""
+    lo, hi = plot.universe
+    # stems at the ends of the universe stay visible with a small margin
+    pad = 0.03 * (hi - lo) if any(c.kind == "singleton" for c in plot.curves) else 0.0
+    ax.set_xlim(lo - pad, hi + pad)
+    ax.set_ylim(-0.02, 1.24)
+    ax.set_yticks([0, 0.25, 0.5, 0.75, 1.0])
+    ax.set_xlabel(plot.axis_label)
+    ax.set_ylabel("membership μ")
+    ax.grid(True, color="#e6e6e6", linewidth=0.7)
+    ax.set_axisbelow(True)
+    for side in ("top", "right"):
+        ax.spines[side].set_visible(False)
+
+
+def draw_curves(ax, plot: VariablePlot, *, colors: Sequence[str] | None = None,
+                linestyle: str = "-", alpha: float = 1.0, fill: bool = True,
+                labels: bool = True) -> list:
+    """The terms of ``plot`` on ``ax`` (``colors[i]`` for curve ``i``, default the palette);
+    returns the artists, whose data are the curves'."""
+    artists = []
+    fig = ax.figure
+    inches = fig.get_size_inches()[0] * ax.get_position().width
+    heights = label_heights(plot, chars_across=inches * 72 / 7.5) if labels else {}
+    for i, curve in enumerate(plot.curves):
+        c = colors[i] if colors is not None else color(i)
+        if curve.kind == "curve":
+            (line,) = ax.plot(curve.x, curve.y, color=c, linewidth=2.0, linestyle=linestyle,
+                              alpha=alpha, label=curve.name, solid_joinstyle="miter")
+            artists.append(line)
+            if fill:
+                ax.fill_between(curve.x, curve.y, color=c, alpha=0.08 * alpha, linewidth=0)
+        elif curve.kind == "singleton":
+            stem = ax.vlines(curve.x, 0, curve.y, color=c, linewidth=2.2, linestyle=linestyle,
+                             alpha=alpha, label=curve.name)
+            ax.plot(curve.x, curve.y, "o", color=c, markersize=5, alpha=alpha)
+            artists.append(stem)
+        else:
+            continue
+        if labels:
+            ax.text(curve.label_x, heights[curve.name], curve.name, color=c, ha="center",
+                    va="bottom",
+                    fontsize=9, fontweight="bold")
+    linear = [c for c in plot.curves if c.kind == "linear"]
+    if linear:
+        text = "\n".join(f"{c.name}: {c.formula}" for c in linear)
+        ax.text(0.02, 0.95, "Takagi-Sugeno consequents\n" + text, transform=ax.transAxes,
+                va="top", fontsize=8, family="monospace",
+                bbox=dict(boxstyle="round", facecolor="white", edgecolor="#cccccc"))
+    return artists
+
+
+def label_heights(plot: VariablePlot, chars_across: float = 32.0) -> dict[str, float]:
+    """Where each term's name sits: 1.03, or a step higher when it would overlap the name
+    before it (names are about ``1 / chars_across`` of the axis wide per character)."""
+    lo, hi = plot.universe
+    per_char = (hi - lo) / chars_across
+    heights: dict[str, float] = {}
+    last_end = {0: -float("inf"), 1: -float("inf")}
+    for curve in sorted((c for c in plot.curves if c.kind != "linear"),
+                        key=lambda c: c.label_x):
+        half = (len(curve.name) + 1) * per_char / 2
+        level = 0 if curve.label_x - half >= last_end[0] else 1
+        if level == 1 and curve.label_x - half < last_end[1]:
+            level = 0
+        last_end[level] = curve.label_x + half
+        heights[curve.name] = 1.03 + 0.1 * level
+    return heights
+
+
+def mark_value(ax, plot: VariablePlot) -> None:
+    """The value as a dashed line, its memberships as dots with their numbers."""
+    if plot.value is None:
+        return
+    unit = f" {plot.unit}" if plot.unit else ""
+    ax.axvline(plot.value, color=VALUE_COLOR, linestyle="--", linewidth=1.2,
+               label=f"{plot.name} = {plot.value:g}{unit}", zorder=5)
+    lo, hi = plot.universe
+    right = plot.value < lo + 0.8 * (hi - lo)
+    names = [c.name for c in plot.curves]
+    for term, mu in plot.memberships:
+        if mu <= 0:
+            continue
+        c = color(names.index(term))
+        ax.plot([plot.value], [mu], "o", color=c, markeredgecolor="white", markersize=7,
+                zorder=6)
+        ax.annotate(f"{mu:.2f}", (plot.value, mu), xytext=(6 if right else -6, 0),
+                    textcoords="offset points", ha="left" if right else "right",
+                    va="center", fontsize=8.5, color=c, fontweight="bold", zorder=7)
+    ax.legend(loc="center right" if right else "center left", fontsize=8, frameon=True,
+              handles=[ax.lines[-1 - sum(1 for _, mu in plot.memberships if mu > 0)]])
+
+
+def panel_title(plot: VariablePlot) -> str:
+    role = "input" if plot.role == "input" else "output"
+    title = f"{plot.name} ({role})"
+    if plot.description:
+        title += f"\n{plot.description}"
+    return title
+
+
+def draw_panel(ax, plot: VariablePlot) -> list:
+    """One variable on one axes: terms, labels, the marked value and its memberships."""
+    style_axes(ax, plot)
+    artists = draw_curves(ax, plot)
+    mark_value(ax, plot)
+    ax.set_title(panel_title(plot), fontsize=10, loc="left")
+    return artists
+
+
+def draw_sheet(plots: Sequence[VariablePlot], path: str | Path | None = None, *,
+               title: str | None = None, show: bool = False, columns: int | None = None):
+    """All variables on one sheet (three panels a row, outputs on a row of their own when
+    they fit); written to ``path`` (.png or .svg) and/or shown. Returns the figure."""
+    plots = list(plots)
+    n = len(plots)
+    inputs = [p for p in plots if p.role == "input"]
+    outputs = [p for p in plots if p.role != "input"]
+    if columns is None:
+        columns = 1 if n == 1 else 2 if n in (2, 4) else 3
+    # inputs fill rows first; outputs start on a fresh row (Figures 5-7 above, 8-9 below)
+    slots: list[VariablePlot | None] = []
+    for group in (inputs, outputs):
+        if not group:
+            continue
+        slots += group + [None] * (-len(group) % columns)
+    rows = math.ceil(len(slots) / columns)
+    fig = new_figure((4.6 * columns if columns > 1 else 7.5, 3.3 * rows + 0.5), show,
+                     layout="constrained")
+    axes = fig.subplots(rows, columns, squeeze=False)
+    for ax, plot in zip(axes.flat, slots + [None] * (rows * columns - len(slots))):
+        if plot is None:
+            ax.set_visible(False)
+            continue
+        draw_panel(ax, plot)
+    if title:
+        fig.suptitle(title, fontsize=13, fontweight="bold")
+    return finish(fig, path, show)
+
+
+def draw_terms_before_after(variable_before: Variable, variable_after: Variable,
+                            path: str | Path | None, *, title: str | None = None,
+                            show: bool = False):
+    """Show how adaptation moved the terms of one variable.
+
+    ``variable_before`` and ``variable_after`` are :class:`mitos_cli.terms.Variable` objects
+    of the same variable (e.g. ``loaded.rulebase.variables["road"]`` before and after
+    ``teach``); ``path`` is the file to write (``.png`` or ``.svg``, chosen by extension;
+    ``None`` writes nothing). Before is drawn dashed and faint, after solid, each term in its
+    own colour; terms whose parameters changed are listed under the plot with their old and
+    new parameters. Returns the matplotlib figure. Raises :class:`mitos_cli.draw.output.
+    DrawError` (a ``MitosError``) for another extension or when matplotlib is missing.
+    """
+    before = variable_plot(variable_before)
+    after = variable_plot(variable_after)
+    changes = []
+    old = {t.name: t for t in variable_before.terms}
+    for t in variable_after.terms:
+        o = old.get(t.name)
+        if o is None:
+            changes.append(f"{t.name}: new")
+        elif o.params != t.params or o.shape != t.shape:
+            changes.append(f"{t.name}: {_params(o)} → {_params(t)}")
+    for name in old:
+        if name not in variable_after.term_names:
+            changes.append(f"{name}: removed")
+    fig = new_figure((8.0, 4.2 + 0.22 * len(changes)), show, layout="constrained")
+    ax = fig.subplots()
+    style_axes(ax, after)
+    # the same term keeps its colour in both: colour by the after-term's position
+    order = {c.name: i for i, c in enumerate(after.curves)}
+    extra = len(order)
+    for i, c in enumerate(before.curves):
+        if c.name not in order:
+            order[c.name] = extra
+            extra += 1
+    draw_curves(ax, before, colors=[color(order[c.name]) for c in before.curves],
+                linestyle="--", alpha=0.55, fill=False, labels=False)
+    draw_curves(ax, after, colors=[color(order[c.name]) for c in after.curves])
+    from matplotlib.lines import Line2D
+
+    ax.legend(handles=[Line2D([], [], color="#555555", linestyle="--", alpha=0.6,
+                              label="before"),
+                       Line2D([], [], color="#555555", linestyle="-", label="after")],
+              loc="center right", fontsize=8)
+    ax.set_title(title or f"{after.name}: terms before and after adaptation", loc="left",
+                 fontsize=11)
+    if changes:
+        ax.text(0.0, -0.2, "changed: " + "\n         ".join(changes), transform=ax.transAxes,
+                va="top", fontsize=8, family="monospace")
+    return finish(fig, path, show)
+
+
+def _params(term) -> str:
+    return "(" + ", ".join(f"{p:g}" for p in term.params) + ")"
+
+
+__all__ = ["draw_sheet", "draw_panel", "draw_terms_before_after"]
