@@ -1,0 +1,616 @@
+"""Learning by doing: neural adaptation of a behavior (the paper's eqs. 13-14).
+
+The instructor's examples ``(x_k, t_k)`` define ``Q = sum_k sum_j (y_j(x_k) - t_kj)^2`` over
+the outputs each example names. :func:`adapt` lowers ``Q`` by gradient steps on the
+membership functions' break points (peaks, widths, corner points) of the behavior's input
+terms and on the crisp values of its output terms, with exact gradients through the compiled
+network:
+
+* output layer (weighted average, eqs. 18-19): ``dy/dy_r = dof_r / S`` and
+  ``dy/d dof_r = (y_r - y) / S`` with ``S = sum_r dof_r``;
+* ``dof_r = antecedent_r * contexts_r * weight_r`` (product rule);
+* AND / OR neurons: min and max pass the gradient to the child that wins (the lowest
+  child index at ties, so the result is deterministic); product and probabilistic sum get
+  their exact partial derivatives; other norms are refused;
+* hedges (:mod:`mitos_cli.hedges` derivatives) and ``not`` (``-1``);
+* memberships: the derivative of each piecewise-linear edge w.r.t. its corner points; a
+  saturated membership (0 or 1) has derivative 0.
+
+**Parameterisation.** The corner points of a variable's terms are *knots*: points with the
+same value (a shoulder's end that is the next triangle's peak) are one knot, so shared break
+points stay tied and a partition stays a partition. The knots keep their order (a minimum gap
+of :data:`MIN_GAP` of the universe apart) and stay in the universe, so peaks stay ordered and
+widths positive; a symmetric triangle (``peak`` / ``width``) stays symmetric (a linear
+constraint; the gradient is projected onto the constraints' null space). Output values are
+knots too (ordered, in the universe). Frozen terms (``frozen: true``), the consequents of
+frozen rules (``frozen r4``) and shapes that are not piecewise linear keep their values.
+
+**The step** (eq. 14, ``w <- w - eta dQ/dw`` with ``eta`` in (0, 1)): parameters are measured
+in fractions of their universe, the projected gradient is normalised so that the parameter
+that moves most moves ``eta`` x :data:`STEP` of its universe, and the step is halved until
+``Q`` decreases and every constraint holds; so ``Q`` never increases. Learned values are
+rounded to a readable grid (``decimals``) and kept only if ``Q`` is still no worse.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+
+from .. import hedges as hedge_mod
+from ..compile import CompiledRuleBase
+from ..engine import evaluate
+from ..errors import LessonError
+from ..model import Consequent, Rule, RuleBase
+from ..shapes import kernel_params
+
+#: Fraction of a universe the most-moving parameter moves in one full step (times eta).
+STEP = 0.05
+#: Smallest distance between two knots of one variable, as a fraction of its universe.
+MIN_GAP = 0.005
+#: Step halvings tried per epoch before adaptation counts as converged.
+HALVINGS = 30
+#: Knots closer than this fraction of the universe are one (shared) break point.
+TIE = 1e-9
+
+#: Shapes whose corner points can be learned: params as functions of the corners (a, b, c, d).
+FROM_CORNERS: dict[str, Callable[[float, float, float, float], tuple[float, ...]]] = {
+    "triangle": lambda a, b, c, d: (a, b, d),
+    "triangle_pw": lambda a, b, c, d: (b, d - b),
+    "triangle_plr": lambda a, b, c, d: (b, b - a, d - b),
+    "trapezoid": lambda a, b, c, d: (a, b, c, d),
+    "left_shoulder": lambda a, b, c, d: (c, d),
+    "right_shoulder": lambda a, b, c, d: (a, b),
+}
+SUPPORTED_NORMS = {"and": ("min", "product"), "or": ("max", "probabilistic_sum")}
+
+
+@dataclass(frozen=True)
+class Knot:
+    """One learnable number: a break point of input terms or an output value."""
+
+    var: str
+    kind: str                    # "input" (term corners), "output" (a term's value), "crisp"
+    label: str                   # what it is, for people: "road: NARROW.b = MEDIUM.peak"
+
+
+@dataclass(frozen=True, eq=False)
+class Parameters:
+    """The learnable numbers of a compiled behavior and how they map onto its arrays."""
+
+    compiled: CompiledRuleBase
+    knots: tuple[Knot, ...]
+    values: np.ndarray           # [P] current values
+    scale: np.ndarray            # [P] universe width of each knot's variable
+    lo: np.ndarray               # [P] bounds
+    hi: np.ndarray
+    projector: np.ndarray        # [P, P] onto the free directions (scaled coordinates)
+    order: tuple[np.ndarray, ...]    # knots of one variable, in increasing order
+    corner_knot: np.ndarray      # [T, 4] knot of each corner of each input term (-1: none)
+    cons_knot: np.ndarray        # [R, m] knot of each rule's consequent value (-1: fixed)
+    decimals: np.ndarray         # [P] decimals of the readable grid
+    dependents: tuple[tuple[int, np.ndarray, np.ndarray], ...]   # see _round
+    frozen_reasons: tuple[str, ...] = ()
+
+    @property
+    def n_free(self) -> int:
+        return int(round(np.trace(self.projector)))
+
+
+# ---- building the parameterisation ------------------------------------------------------------
+
+def _owners(rb: RuleBase, name: str) -> list[tuple[str, int]]:
+    """(behavior, index of the rule in it) for each rule of ``flatten(rb, name)``, in order."""
+    out: list[tuple[str, int]] = []
+
+    def walk(bname: str) -> None:
+        b = rb.behavior(bname)
+        out.extend((bname, i) for i in range(len(b.rules)))
+        for use in b.uses:
+            walk(use.behavior)
+
+    walk(name)
+    return out
+
+
+def _decimals(width: float) -> int:
+    return int(max(0, 4 - math.floor(math.log10(width))))
+
+
+def parameterise(compiled: CompiledRuleBase) -> Parameters:
+    """The learnable numbers of ``compiled`` (its input terms and output values)."""
+    rb = compiled.rulebase
+    if compiled.operators.inference not in ("weighted_average", "weighted_sum"):
+        raise LessonError(
+            f"adaptation needs `inference = weighted_average` (or weighted_sum); behavior "
+            f"`{compiled.behavior}` uses {compiled.operators.inference}",
+            hint="adapt a weighted-average behavior, or write its operators line without "
+                 "`inference = mamdani`")
+    if compiled.cons_linear is not None:
+        raise LessonError("adaptation does not cover Takagi-Sugeno (linear) consequents",
+                          hint="give the outputs crisp values (numbers) to adapt them")
+    for op, names in SUPPORTED_NORMS.items():
+        norm = compiled.operators.tnorm if op == "and" else compiled.operators.snorm
+        if norm.name not in names:
+            raise LessonError(f"adaptation has gradients for `{op} = "
+                              f"{' / '.join(names)}`, not `{op} = {norm.name}`",
+                              hint="adapt with the paper's min / max operators")
+
+    knots: list[Knot] = []
+    values: list[float] = []
+    scale: list[float] = []
+    lo: list[float] = []
+    hi: list[float] = []
+    frozen_knot: list[bool] = []
+    order: list[np.ndarray] = []
+    reasons: list[str] = []
+    sym_rows: list[tuple[int, int, int]] = []        # (a, b, d): a + d - 2 b = 0
+    T = compiled.n_terms
+    corner_knot = np.full((T, 4), -1, dtype=np.intp)
+
+    def new_knot(knot: Knot, value: float, width: float, bounds: tuple[float, float],
+                 frozen: bool) -> int:
+        knots.append(knot)
+        values.append(value)
+        scale.append(width)
+        lo.append(bounds[0])
+        hi.append(bounds[1])
+        frozen_knot.append(frozen)
+        return len(knots) - 1
+
+    # input terms: tie equal corners of one variable into one knot
+    for k, vname in enumerate(compiled.inputs):
+        var = compiled.variables[vname]
+        ulo, uhi = var.universe
+        width = uhi - ulo
+        rows = [t for t in range(T) if compiled.term_var[t] == k]
+        points: list[tuple[float, int, int]] = []        # (value, term row, corner)
+        for t in rows:
+            term = var.term(compiled.term_names[t][1])
+            if term.shape not in FROM_CORNERS:
+                reasons.append(f"{vname}.{term.name}: shape `{term.shape}` is not learned")
+                continue
+            for ci, v in enumerate(term.corners):
+                if math.isfinite(v):
+                    points.append((v, t, ci))
+        points.sort()
+        ids: list[int] = []
+        names: dict[int, list[str]] = {}
+        last = None
+        for v, t, ci in points:
+            if last is None or abs(v - values[last]) > TIE * width:
+                last = new_knot(Knot(vname, "input", ""), v, width,
+                                (min(ulo, v), max(uhi, v)), False)
+                ids.append(last)
+                names[last] = []
+            corner_knot[t, ci] = last
+            term = var.term(compiled.term_names[t][1])
+            names[last].append(f"{term.name}.{_corner_name(term.shape, ci)}")
+            if term.frozen:
+                frozen_knot[last] = True
+        for i in ids:
+            knots[i] = Knot(vname, "input", f"{vname}: " + " = ".join(dict.fromkeys(names[i])))
+        if ids:
+            order.append(np.array(ids, dtype=np.intp))
+        for t in rows:
+            term = var.term(compiled.term_names[t][1])
+            if term.shape == "triangle_pw":
+                sym_rows.append((corner_knot[t, 0], corner_knot[t, 1], corner_knot[t, 3]))
+
+    # output values: every term of every output is a knot (ordered); crisp values per rule
+    owners = _owners(rb, compiled.behavior)
+    frozen_rules = {(b.name, label) for b in rb.behaviors for label in b.frozen}
+    R, m = compiled.cons_value.shape
+    cons_knot = np.full((R, m), -1, dtype=np.intp)
+    crisp: dict[tuple[str, int, int], int] = {}
+    for j, oname in enumerate(compiled.outputs):
+        var = compiled.variables[oname]
+        ulo, uhi = var.universe
+        width = uhi - ulo
+        term_knot: dict[str, int] = {}
+        singles = sorted((t.params[0], t.name) for t in var.terms if t.shape == "singleton")
+        ids = []
+        for v, tname in singles:
+            frozen = var.term(tname).frozen
+            term_knot[tname] = new_knot(Knot(oname, "output", f"{oname}: {tname}"), v, width,
+                                        (ulo, uhi), True)   # thawed below when a rule uses it
+            ids.append(term_knot[tname])
+            if frozen:
+                reasons.append(f"{oname}.{tname} is frozen")
+        if len(ids) > 1:
+            order.append(np.array(ids, dtype=np.intp))
+        used: set[int] = set()
+        locked: set[int] = set()
+        for r in range(R):
+            if not compiled.cons_mask[r, j]:
+                continue
+            owner, index = owners[r]
+            rule = rb.behavior(owner).rules[index]
+            is_frozen = (owner, rule.label) in frozen_rules
+            tname = compiled.cons_term[r][j]
+            if tname is not None:
+                if tname not in term_knot:
+                    reasons.append(f"{oname}.{tname}: shape "
+                                   f"`{var.term(tname).shape}` is not learned")
+                    continue
+                cons_knot[r, j] = term_knot[tname]
+                (locked if is_frozen else used).add(term_knot[tname])
+            else:
+                key = (owner, index, j)
+                if key not in crisp:
+                    crisp[key] = new_knot(
+                        Knot(oname, "crisp", f"{oname}: {owner}/{rule.label or '#' + str(index + 1)}"),
+                        float(compiled.cons_value[r, j]), width, (ulo, uhi), is_frozen)
+                cons_knot[r, j] = crisp[key]
+        for tname, i in term_knot.items():
+            frozen_knot[i] = i not in used or i in locked or var.term(tname).frozen
+
+    P = len(knots)
+    values_a = np.array(values, dtype=float)
+    frozen_a = np.array(frozen_knot, dtype=bool)
+    projector, dependents = _constraints(P, frozen_a, sym_rows)
+    scale_a = np.array(scale, dtype=float)
+    decimals = np.array([_decimals(w) for w in scale_a], dtype=int)
+    return Parameters(compiled, tuple(knots), values_a, scale_a, np.array(lo), np.array(hi),
+                      projector, tuple(order), corner_knot, cons_knot, decimals,
+                      dependents, tuple(dict.fromkeys(reasons)))
+
+
+def _corner_name(shape: str, corner: int) -> str:
+    names = {"triangle": "abbc", "triangle_pw": ("left", "peak", "peak", "right"),
+             "triangle_plr": ("left", "peak", "peak", "right"), "trapezoid": "abcd",
+             "left_shoulder": "--ab", "right_shoulder": "ab--"}
+    return names[shape][corner]
+
+
+def _constraints(P: int, frozen: np.ndarray, sym_rows) -> tuple[np.ndarray, tuple]:
+    """Projector onto the directions that keep frozen knots fixed and symmetric triangles
+    symmetric; and, for rounding, which knots follow from which (see :func:`_round`)."""
+    rows = []
+    for a, b, d in sym_rows:
+        row = np.zeros(P)
+        row[a] += 1.0
+        row[d] += 1.0
+        row[b] -= 2.0
+        rows.append(row)
+    for i in np.flatnonzero(frozen):
+        row = np.zeros(P)
+        row[i] = 1.0
+        rows.append(row)
+    if not rows:
+        return np.eye(P), ()
+    C = np.array(rows)
+    _, s, vt = np.linalg.svd(C)
+    rank = int((s > 1e-10).sum())
+    null = vt[rank:].T                                   # [P, F] orthonormal
+    projector = null @ null.T
+    projector[np.abs(projector) < 1e-13] = 0.0
+    # each symmetric triangle fixes one knot from the other two: its left corner, unless that
+    # one is frozen or already determined
+    dependents = []
+    taken = set(np.flatnonzero(frozen).tolist())
+    for a, b, d in sym_rows:
+        for dep, others, coef in ((a, (b, d), (2.0, -1.0)), (d, (b, a), (2.0, -1.0)),
+                                  (b, (a, d), (0.5, 0.5))):
+            if dep not in taken:
+                taken.add(dep)
+                dependents.append((dep, np.array(others, dtype=np.intp), np.array(coef)))
+                break
+    return projector, tuple(dependents)
+
+
+# ---- the network with other parameter values ---------------------------------------------------
+
+def kernel_of(p: Parameters, values: np.ndarray) -> np.ndarray:
+    """The compiled kernel ``[4, T]`` with the input terms' corners taken from ``values``."""
+    kernel = p.compiled.kernel.copy()
+    for t in np.flatnonzero((p.corner_knot >= 0).any(axis=1)):
+        corners = tuple(float(values[i]) if i >= 0 else orig for i, orig in
+                        zip(p.corner_knot[t], _orig_corners(p, t)))
+        kernel[:, t] = kernel_params(corners)
+    return kernel
+
+
+def _orig_corners(p: Parameters, t: int) -> tuple[float, float, float, float]:
+    var, name = p.compiled.term_names[t]
+    return p.compiled.variables[var].term(name).corners
+
+
+def with_values(p: Parameters, values: np.ndarray) -> CompiledRuleBase:
+    """The compiled behavior with ``values`` in place of its learnable numbers (no
+    recompilation: only the kernel and the consequent values change)."""
+    cons = p.compiled.cons_value.copy()
+    mask = p.cons_knot >= 0
+    cons[mask] = values[p.cons_knot[mask]]
+    return dataclasses.replace(p.compiled, kernel=kernel_of(p, values), cons_value=cons)
+
+
+def loss(compiled: CompiledRuleBase, X: np.ndarray, targets: np.ndarray) -> float:
+    """``Q = sum (y - t)^2`` over the given targets (NaN targets are not given)."""
+    y = evaluate(compiled, X, detail=False, strict=False).outputs
+    given = ~np.isnan(targets)
+    diff = np.where(given, y - np.where(given, targets, 0.0), 0.0)
+    diff = np.nan_to_num(diff)
+    return float(np.sum(diff * diff))
+
+
+def gradient(p: Parameters, values: np.ndarray, X: np.ndarray,
+             targets: np.ndarray) -> tuple[float, np.ndarray]:
+    """``Q`` and ``dQ/dvalues`` (exact, by backpropagation through the network)."""
+    c = with_values(p, values)
+    res = evaluate(c, X, keep_values=True, strict=False)
+    V = res.values.T                                 # [cols, n]
+    Xt = res.inputs.T                                # [k, n] clamped
+    n = V.shape[1]
+    dof = res.dof.T                                  # [R, n]
+    y = res.outputs.T                                # [m, n]
+    tgt = targets.T
+    given = ~np.isnan(tgt)
+    M = c.cons_mask.astype(float)                    # [R, m]
+    S = M.T @ dof                                    # [m, n]
+    fired = S > 0
+    err = np.where(given & fired, 2.0 * (y - np.where(given, tgt, 0.0)), 0.0)
+    diff = np.where(given, np.nan_to_num(y - np.where(given, tgt, 0.0)), 0.0)
+    Q = float(np.sum(diff * diff))
+    Yc = c.cons_value * M                            # [R, m]
+    if c.operators.inference == "weighted_sum":
+        gy = err
+        gdof = Yc @ gy
+    else:
+        gy = np.divide(err, S, out=np.zeros_like(err), where=fired)     # dQ/dy / S
+        gdof = Yc @ gy - M @ (gy * np.where(fired, y, 0.0))            # (y_r - y) / S
+    gcons = (dof @ gy.T) * M                         # [R, m]: dof_r / S
+
+    G = np.zeros_like(V)
+    # dof_r = V[rule_col] * prod V[context] * weight
+    ctx = c.context
+    w = c.weight[:, None]
+    base = V[c.rule_col]
+    ctx_vals = V[ctx.T] if ctx.shape[1] else np.ones((0, len(c.rule_col), n))
+    prod_ctx = np.prod(ctx_vals, axis=0) if ctx.shape[1] else 1.0
+    np.add.at(G, c.rule_col, gdof * w * prod_ctx)
+    for j in range(ctx.shape[1]):
+        others = np.prod(np.delete(ctx_vals, j, axis=0), axis=0)
+        np.add.at(G, ctx[:, j], gdof * w * base * others)
+    tnorm, snorm = c.operators.tnorm.name, c.operators.snorm.name
+    for level in reversed(c.levels):
+        for group in reversed(level):
+            _backward_group(group, V, G, tnorm, snorm)
+
+    grad = np.zeros(len(values))
+    # membership layer
+    T = c.n_terms
+    rows = np.flatnonzero((p.corner_knot >= 0).any(axis=1))
+    if rows.size:
+        corners = np.array([[values[i] if i >= 0 else o for i, o in
+                             zip(p.corner_knot[t], _orig_corners(p, t))] for t in rows])
+        dmu = _membership_grad(corners, Xt[c.term_var[rows]])      # [4, t, n]
+        gmu = G[2 + rows]                                           # [t, n]
+        gcorner = np.einsum("ctn,tn->tc", dmu, gmu)                 # [t, 4]
+        idx = p.corner_knot[rows]
+        ok = idx >= 0
+        np.add.at(grad, idx[ok], gcorner[ok])
+    ok = p.cons_knot >= 0
+    np.add.at(grad, p.cons_knot[ok], gcons[ok])
+    del T
+    return Q, grad
+
+
+def _backward_group(group, V: np.ndarray, G: np.ndarray, tnorm: str, snorm: str) -> None:
+    """Pass ``G[out]`` down to ``G[children]`` for one group of neurons."""
+    gout = G[group.out]                                  # [g, n]
+    ch = group.children                                  # [g, a]
+    op = group.op
+    if op == "not":
+        np.add.at(G, ch[:, 0], -gout)
+        return
+    if op.startswith("hedge:"):
+        names = op[6:].split()
+        x = V[ch[:, 0]]
+        d = np.ones_like(x)
+        for name in reversed(names):                     # innermost hedge first
+            h = hedge_mod.HEDGES[name]
+            d = d * h.derivative(x)
+            x = h.fn(x)
+        np.add.at(G, ch[:, 0], gout * d)
+        return
+    X = V[ch]                                            # [g, a, n]
+    g, a, n = X.shape
+    norm = tnorm if op in ("and", "prod") else snorm
+    if op == "prod":
+        norm = "product"
+    if norm in ("min", "max"):
+        sel = np.argmin(X, axis=1) if norm == "min" else np.argmax(X, axis=1)   # first at ties
+        local = (np.arange(a)[None, :, None] == sel[:, None, :]) * gout[:, None, :]
+    else:
+        F = X if norm == "product" else 1.0 - X
+        left = np.cumprod(np.concatenate([np.ones((g, 1, n)), F[:, :-1]], axis=1), axis=1)
+        right = np.cumprod(np.concatenate([np.ones((g, 1, n)), F[:, :0:-1]], axis=1),
+                           axis=1)[:, ::-1]
+        local = left * right * gout[:, None, :]         # prod of the others (exact, no division)
+    np.add.at(G, ch.reshape(-1), local.reshape(g * a, n))
+
+
+def _membership_grad(corners: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """``d mu / d (a, b, c, d)`` of piecewise-linear memberships: ``[4, t, n]``.
+
+    On the rising edge ``mu = (x - a) / (b - a)``, on the falling edge ``(d - x) / (d - c)``;
+    where the two meet (a triangle's peak) the rising edge counts; saturated memberships and
+    vertical edges have derivative 0.
+    """
+    A, B, C, D = (corners[:, i:i + 1] for i in range(4))
+    out = np.zeros((4,) + x.shape)
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+        has_rise = np.isfinite(A) & np.isfinite(B) & (B > A)
+        has_fall = np.isfinite(C) & np.isfinite(D) & (D > C)
+        rise = np.where(has_rise, (x - A) / np.where(has_rise, B - A, 1.0), np.inf)
+        fall = np.where(has_fall, (D - x) / np.where(has_fall, D - C, 1.0), np.inf)
+        on_rise = has_rise & (rise > 0) & (rise < 1) & (rise <= fall)
+        on_fall = has_fall & (fall > 0) & (fall < 1) & ~on_rise & (fall < rise)
+        wr = np.where(has_rise, B - A, 1.0) ** 2
+        wf = np.where(has_fall, D - C, 1.0) ** 2
+        out[0] = np.where(on_rise, (x - B) / wr, 0.0)
+        out[1] = np.where(on_rise, -(x - A) / wr, 0.0)
+        out[2] = np.where(on_fall, (D - x) / wf, 0.0)
+        out[3] = np.where(on_fall, (x - C) / wf, 0.0)
+    return out
+
+
+# ---- the descent ----------------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class Adaptation:
+    """What :func:`adapt` did: ``Q`` before, after each epoch, and the learned values."""
+
+    parameters: Parameters
+    values: np.ndarray
+    history: tuple[float, ...]       # Q before the first epoch, then after each epoch
+    converged: bool
+    interrupted: bool = False
+
+    @property
+    def q_before(self) -> float:
+        return self.history[0]
+
+    @property
+    def q_after(self) -> float:
+        return self.history[-1]
+
+    def changed(self) -> list[tuple[Knot, float, float]]:
+        p = self.parameters
+        return [(k, float(a), float(b)) for k, a, b in zip(p.knots, p.values, self.values)
+                if a != b]
+
+
+def feasible(p: Parameters, values: np.ndarray) -> bool:
+    """Knots inside their bounds and in their order, at least :data:`MIN_GAP` apart."""
+    if np.any(values < p.lo - 1e-12) or np.any(values > p.hi + 1e-12):
+        return False
+    for ids in p.order:
+        gap = MIN_GAP * p.scale[ids[0]]
+        orig = np.diff(p.values[ids])
+        need = np.minimum(gap, orig) * (1 - 1e-9)      # never stricter than the start
+        if np.any(np.diff(values[ids]) < need):
+            return False
+    return True
+
+
+def adapt(compiled: CompiledRuleBase, X: np.ndarray, targets: np.ndarray, *, epochs: int = 50,
+          rate: float = 0.5, on_epoch: Callable[[int, float], None] | None = None,
+          parameters: Parameters | None = None) -> Adaptation:
+    """Gradient descent on ``Q`` (eqs. 13-14): ``epochs`` full-batch steps of learning factor
+    ``rate`` in (0, 1), each halved until ``Q`` decreases inside the constraints."""
+    if not 0.0 < rate < 1.0:
+        raise LessonError(f"the learning factor must lie in (0, 1), not {rate:g}",
+                          hint="the paper's eta: try `rate 0.5`")
+    p = parameters or parameterise(compiled)
+    values = p.values.copy()
+    Q, grad = gradient(p, values, X, targets)
+    history = [Q]
+    step = 1.0
+    converged = False
+    interrupted = False
+    try:
+        for epoch in range(1, epochs + 1):
+            direction = -(p.projector @ (grad * p.scale))        # scaled coordinates
+            biggest = np.max(np.abs(direction)) if direction.size else 0.0
+            if biggest <= 1e-15 or Q <= 0.0:
+                converged = True
+                break
+            direction *= rate * STEP / biggest
+            accepted = False
+            for _ in range(HALVINGS):
+                candidate = values + step * direction * p.scale
+                if feasible(p, candidate):
+                    q_new = loss(with_values(p, candidate), X, targets)
+                    if q_new < Q:
+                        accepted = True
+                        break
+                step *= 0.5
+            if not accepted:
+                converged = True
+                break
+            values = candidate
+            Q, grad = gradient(p, values, X, targets)
+            history.append(Q)
+            step = min(1.0, step * 2.0)
+            if on_epoch is not None:
+                on_epoch(epoch, Q)
+    except KeyboardInterrupt:
+        interrupted = True            # keep what the completed epochs learned
+    values, q_final = _round(p, values, X, targets, history[0])
+    if q_final != history[-1]:
+        history.append(q_final)
+    return Adaptation(p, values, tuple(history), converged, interrupted)
+
+
+def _round(p: Parameters, values: np.ndarray, X: np.ndarray, targets: np.ndarray,
+           q_start: float) -> tuple[np.ndarray, float]:
+    """Learned values on a readable grid (a few decimals), constraints kept exactly; the
+    starting values when rounding would make ``Q`` worse than where it started."""
+    changed = values != p.values
+    if not changed.any():
+        return p.values.copy(), q_start
+    out = np.where(changed, np.round(values * 10.0 ** p.decimals) / 10.0 ** p.decimals, values)
+    for dep, others, coef in p.dependents:            # symmetric triangles stay symmetric
+        out[dep] = round(float(coef @ out[others]), int(p.decimals[dep]))
+    if not feasible(p, out):
+        return p.values.copy(), q_start
+    q = loss(with_values(p, out), X, targets)
+    if q > q_start:
+        return p.values.copy(), q_start
+    return out, q
+
+
+# ---- writing the learned values back into the model -------------------------------------------
+
+def learned_rulebase(p: Parameters, values: np.ndarray) -> RuleBase:
+    """The rule base with the learned values: terms with new parameters (in the form and
+    decimals the grid gives), rules with new crisp consequents."""
+    c = p.compiled
+    rb = c.rulebase
+    new_terms: dict[tuple[str, str], tuple[float, ...]] = {}
+    for t in np.flatnonzero((p.corner_knot >= 0).any(axis=1)):
+        var, name = c.term_names[t]
+        term = c.variables[var].term(name)
+        corners = [float(values[i]) if i >= 0 else o
+                   for i, o in zip(p.corner_knot[t], term.corners)]
+        dec = int(p.decimals[p.corner_knot[t][p.corner_knot[t] >= 0][0]])
+        params = tuple(round(v, dec) for v in FROM_CORNERS[term.shape](*corners))
+        if params != term.params:
+            new_terms[(var, name)] = params
+    for i, knot in enumerate(p.knots):
+        if knot.kind == "output" and values[i] != p.values[i]:
+            new_terms[(knot.var, knot.label.split(": ", 1)[1])] = (float(values[i]),)
+    termsets = tuple(dataclasses.replace(ts, variables=tuple(
+        v.with_terms(tuple(t.with_params(new_terms[(v.name, t.name)])
+                           if (v.name, t.name) in new_terms else t for t in v.terms))
+        for v in ts.variables)) for ts in rb.termsets)
+    owners = _owners(rb, c.behavior)
+    crisp: dict[tuple[str, int], dict[str, float]] = {}
+    for r, j in zip(*np.nonzero(p.cons_knot >= 0)):
+        i = p.cons_knot[r, j]
+        if p.knots[i].kind == "crisp" and values[i] != p.values[i]:
+            crisp.setdefault(owners[r], {})[c.outputs[j]] = float(values[i])
+    behaviors = []
+    for b in rb.behaviors:
+        rules = list(b.rules)
+        for (owner, index), new in crisp.items():
+            if owner == b.name:
+                rules[index] = _with_crisp(rules[index], new)
+        behaviors.append(dataclasses.replace(b, rules=tuple(rules)))
+    return dataclasses.replace(rb, termsets=termsets, behaviors=tuple(behaviors))
+
+
+def _with_crisp(rule: Rule, new: dict[str, float]) -> Rule:
+    cons = tuple(dataclasses.replace(c, value=new[c.var]) if c.term is None and c.var in new
+                 else c for c in rule.consequents)
+    return dataclasses.replace(rule, consequents=cons)
+
+
+__all__ = ["Adaptation", "Knot", "Parameters", "adapt", "feasible", "gradient",
+           "learned_rulebase", "loss", "parameterise", "with_values", "Consequent"]

@@ -1,0 +1,322 @@
+"""The teaching language: one line of ``mitos teach`` (prompt or lesson) -> a command object.
+
+The grammar (``grammar/teach.lark``) is appended to the rule language's and parsed by one
+LALR parser, so a rule, ``use``, ``frozen`` or ``operators:`` line at the prompt means exactly
+what it means in a rule file and gets the same error messages. Errors are
+:class:`~mitos_cli.errors.RuleSyntaxError` with ``path:line:col``, the line, a caret and what
+was expected, in words.
+"""
+
+from __future__ import annotations
+
+import functools
+import json
+from dataclasses import dataclass, field
+from typing import Union
+
+from lark import Lark, Token, Tree, v_args
+from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken
+
+from ..errors import RuleSyntaxError, Span
+from ..model import Rule, Setting, Use
+from ..parse import TERMINAL_WORDS, _ToModel
+from ..resources import grammar_text
+
+WORDS = dict(TERMINAL_WORDS, PATH="a file name", INT="a whole number", ARROW="`->`",
+             SHOW_WHAT="rules, terms, examples, behaviors or history", EQUAL="`=`",
+             SIGNED_NUMBER="a number")
+
+#: Every command word, for completion and ``help``.
+COMMAND_WORDS = ("behavior", "end", "use", "frozen", "operators", "eval", "correct", "simulate",
+                 "at", "adapt", "show", "undo", "save", "help", "quit", "exit")
+SHOW_WHAT = ("rules", "terms", "examples", "behaviors", "history")
+
+
+@functools.lru_cache(maxsize=None)
+def parser() -> Lark:
+    """One parser for the rule language plus the teaching commands, built once."""
+    text = grammar_text("mitos.lark") + "\n" + grammar_text("teach.lark")
+    return Lark(text, parser="lalr", propagate_positions=True, maybe_placeholders=True,
+                start="command", cache=True)
+
+
+# ---- command objects -------------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class TellRule:
+    rule: Rule
+
+
+@dataclass(frozen=True)
+class TellUse:
+    use: Use
+
+
+@dataclass(frozen=True)
+class TellFrozen:
+    labels: tuple[str, ...]
+
+
+@dataclass(frozen=True)
+class TellOperators:
+    settings: tuple[Setting, ...]
+
+
+@dataclass(frozen=True)
+class OpenBehavior:
+    name: str
+
+
+@dataclass(frozen=True)
+class CloseBehavior:
+    pass
+
+
+@dataclass(frozen=True)
+class Assign:
+    """``name=value`` with the span of the name (for "did you mean")."""
+
+    name: str
+    value: float
+    span: Span | None = field(default=None, compare=False)
+
+
+@dataclass(frozen=True)
+class Eval:
+    inputs: tuple[Assign, ...]
+
+
+@dataclass(frozen=True)
+class Correct:
+    inputs: tuple[Assign, ...]
+    targets: tuple[Assign, ...]
+
+
+@dataclass(frozen=True)
+class Simulate:
+    world: str
+    seed: float | None = None        # checked to be whole by the session
+
+
+@dataclass(frozen=True)
+class At:
+    start: float
+    stop: float | None
+    targets: tuple[Assign, ...]
+
+
+@dataclass(frozen=True)
+class Adapt:
+    epochs: float | None = None      # checked to be whole by the session
+    rate: float | None = None
+    plot: str | None = None
+
+
+@dataclass(frozen=True)
+class Show:
+    what: str
+    plot: str | None = None
+
+
+@dataclass(frozen=True)
+class Undo:
+    pass
+
+
+@dataclass(frozen=True)
+class Save:
+    path: str | None = None
+
+
+@dataclass(frozen=True)
+class Help:
+    topic: str | None = None
+
+
+@dataclass(frozen=True)
+class Quit:
+    pass
+
+
+Command = Union[TellRule, TellUse, TellFrozen, TellOperators, OpenBehavior, CloseBehavior, Eval,
+                Correct, Simulate, At, Adapt, Show, Undo, Save, Help, Quit]
+
+
+class _ToCommand(_ToModel):
+    """Tree -> command objects (the rule-language parts are the rule parser's own)."""
+
+    def command(self, items):
+        item = items[0]
+        if isinstance(item, Rule):
+            return TellRule(item)
+        if isinstance(item, Use):
+            return TellUse(item)
+        kind, value = item[0], item[1]
+        return TellFrozen(value) if kind == "frozen" else TellOperators(value)
+
+    def open_behavior(self, items):
+        return OpenBehavior(str(items[0]))
+
+    def close_behavior(self, items):
+        return CloseBehavior()
+
+    @v_args(meta=True)
+    def assignment(self, meta, items):
+        return Assign(str(items[0]), float(items[1]), self._s(meta))
+
+    def inputs(self, items):
+        return tuple(items)
+
+    targets = inputs
+
+    def eval_cmd(self, items):
+        return Eval(tuple(items))
+
+    def correct_cmd(self, items):
+        return Correct(items[0], items[2])
+
+    def filename(self, items):
+        token = items[0]
+        return json.loads(str(token)) if token.type == "STRING" else str(token)
+
+    def simulate_cmd(self, items):
+        return Simulate(items[0], items[1])
+
+    def time(self, items):
+        return float(items[0])
+
+    def at_cmd(self, items):
+        start, stop, *targets = items
+        return At(start, stop, tuple(targets))
+
+    def epochs(self, items):
+        return ("epochs", float(items[0]))
+
+    def rate(self, items):
+        return ("rate", float(items[0]))
+
+    def plot(self, items):
+        return ("plot", items[0])
+
+    def adapt_cmd(self, items):
+        return Adapt(**dict(items))
+
+    def show_cmd(self, items):
+        return Show(str(items[0]), items[1])
+
+    def undo_cmd(self, items):
+        return Undo()
+
+    def save_cmd(self, items):
+        return Save(items[0])
+
+    def help_cmd(self, items):
+        return Help(None if items[0] is None else str(items[0]))
+
+    def quit_cmd(self, items):
+        return Quit()
+
+
+def parse_command(line: str, path: str | None = None, lineno: int = 1) -> Command:
+    """Parse one command (``line`` may span several lines for a wrapped rule).
+
+    ``path`` and ``lineno`` place the command in its lesson file, so errors read
+    ``lesson.lesson:12:5``.
+    """
+    text = "\n" * (lineno - 1) + line
+    try:
+        tree = parser().parse(text)
+    except UnexpectedInput as exc:
+        raise _syntax_error(exc, text, path or "<prompt>") from None
+    result = _ToCommand(text, path).transform(tree)
+    if isinstance(result, Tree):            # pragma: no cover - every alternative is handled
+        raise RuleSyntaxError(f"cannot read `{line.strip()}`")
+    return result
+
+
+def incomplete(line: str) -> bool:
+    """True when ``line`` is the start of a rule that continues on the next line."""
+    try:
+        parser().parse(line)
+    except (UnexpectedEOF, UnexpectedToken) as exc:
+        at_end = isinstance(exc, UnexpectedEOF) or exc.token.type == "$END"
+        if not at_end:
+            return False
+        words = line.split()
+        return bool(words) and (words[0] == "if" or (words[0].endswith(":")
+                                                      and "if" in words[1:2]))
+    except UnexpectedInput:
+        return False
+    return False
+
+
+def _words(name: str) -> str:
+    if name in WORDS:
+        return WORDS[name]
+    if name.isupper() and name.isalpha():
+        return f"`{name.lower()}`"
+    return f"`{name}`"
+
+
+def _expected(names) -> str | None:
+    words = sorted({_words(n) for n in names if not n.startswith("__")})
+    if not words:
+        return None
+    return words[0] if len(words) == 1 else ", ".join(words[:-1]) + " or " + words[-1]
+
+
+FIRST_WORDS_HINT = ("a line is a rule (`if ... then ...`) or a command: " + ", ".join(
+    COMMAND_WORDS[:-1]) + " (type `help`)")
+
+
+def _syntax_error(exc: UnexpectedInput, text: str, path: str) -> RuleSyntaxError:
+    """Lark's exception in words: never ``$END`` or ``Token(...)``."""
+    lines = text.splitlines() or [""]
+    if isinstance(exc, UnexpectedCharacters):
+        char = text[exc.pos_in_stream] if exc.pos_in_stream < len(text) else ""
+        message = f"unexpected character `{char}`" if char.isprintable() else \
+            f"unexpected character {char!r}"
+        return RuleSyntaxError(message, span=Span.in_text(text, path, exc.line, exc.column),
+                               expected=_expected(exc.allowed or ()),
+                               hint=FIRST_WORDS_HINT if exc.column == 1 else None)
+    expected = set(getattr(exc, "expected", None) or ())
+    if isinstance(exc, UnexpectedEOF) or (isinstance(exc, UnexpectedToken)
+                                          and exc.token.type == "$END"):
+        line = len(text.rstrip().splitlines()) or 1
+        column = len(lines[line - 1]) + 1 if line <= len(lines) else 1
+        return RuleSyntaxError("the line ends too early",
+                               span=Span.in_text(text, path, line, column),
+                               expected=_expected(expected), hint=_eof_hint(text))
+    token: Token = exc.token
+    span = Span.in_text(text, path, token.line, token.column,
+                        token.column + max(1, len(str(token.value))))
+    hint = None
+    first = token.start_pos is not None and not text[:token.start_pos].strip()
+    if first:
+        hint = FIRST_WORDS_HINT
+    elif token.type == "NAME" and "IS" in expected:
+        hint = "a condition reads `variable is TERM`"
+    elif "EQUAL" in expected:
+        hint = "give values as NAME=VALUE, e.g. `road=78`"
+    return RuleSyntaxError(f"unexpected {_describe(token)}", span=span,
+                           expected=_expected(expected), hint=hint)
+
+
+def _describe(token: Token) -> str:
+    return "the end of the line" if token.type == "$END" else f"`{token.value}`"
+
+
+def _eof_hint(text: str) -> str | None:
+    words = text.split()
+    if not words:
+        return None
+    first = words[0]
+    if first == "correct":
+        return "write `correct INPUT=VALUE ... -> OUTPUT=VALUE ...`"
+    if first == "at":
+        return "write `at 12.5s OUTPUT=VALUE ...` (after `simulate WORLD`)"
+    if first in ("eval",):
+        return "give the inputs as NAME=VALUE, e.g. `eval road=78 size=45 position=4`"
+    if first == "simulate":
+        return "name a world file, e.g. `simulate worlds/figure4.yaml`"
+    return None
