@@ -1,0 +1,60 @@
+"""Reading and writing other fuzzy-logic formats: FCL (IEC 61131-7, jFuzzyLogic's and
+fuzzylite's dialects), MATLAB ``.fis``, fuzzylite FLL, and the MITOS rule language itself.
+
+``read_foreign(path)`` chooses the reader by extension and returns the same
+:class:`~mitos_cli.model.RuleBase` the rule language produces; ``write_foreign(rb, fmt)``
+writes one behavior in a format. What a format can say but MITOS cannot compute is refused with
+a :class:`~mitos_cli.errors.FormatError` at ``file:line`` naming the construct.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from ..errors import FormatError
+from ..model import RuleBase
+
+READERS = {".fcl": "fcl", ".fis": "fis", ".fll": "fll"}
+FORMATS = ("fcl", "fis", "fll")
+
+
+def read_foreign(path: str | Path) -> RuleBase:
+    """Read an ``.fcl``, ``.fis`` or ``.fll`` file into a rule base."""
+    path = Path(path)
+    kind = READERS.get(path.suffix.lower())
+    if kind is None:
+        raise FormatError(f"`{path}`: unknown format `{path.suffix}`",
+                          expected="a .fcl, .fis or .fll file")
+    if not path.is_file():
+        raise FormatError(f"`{path}` not found")
+    if kind == "fll":
+        from .fll import read_fll
+
+        return read_fll(path)
+    if kind == "fis":
+        from .fis import read_fis
+
+        return read_fis(path)
+    from .fcl import read_fcl
+
+    return read_fcl(path)
+
+
+def write_foreign(rb: RuleBase, fmt: str, behavior: str | None = None) -> str:
+    """One behavior of ``rb`` as ``fmt`` (``fcl``, ``fis`` or ``fll``) text."""
+    if fmt == "fll":
+        from .fll import write_fll
+
+        return write_fll(rb, behavior)
+    if fmt == "fis":
+        from .fis import write_fis
+
+        return write_fis(rb, behavior)
+    if fmt == "fcl":
+        from .fcl import write_fcl
+
+        return write_fcl(rb, behavior)
+    raise FormatError(f"unknown format `{fmt}`", expected="one of " + ", ".join(FORMATS))
+
+
+__all__ = ["FORMATS", "read_foreign", "write_foreign"]

@@ -1,0 +1,424 @@
+"""fuzzylite Language (FLL): reader and writer.
+
+An FLL file is a list of ``key: value`` lines in sections (``Engine``, ``InputVariable``,
+``OutputVariable``, ``RuleBlock``); ``#`` starts a comment. The structure is read line by line;
+the ``rule:`` lines are fuzzylite's rule language, parsed with ``grammar/fll_rule.lark``.
+
+Mapping (details and refusals in ``docs/interop.md``):
+
+- terms: every fuzzylite term type except ``Function`` (a free formula); a height other than 1
+  is refused; ``Constant`` -> ``singleton``, ``Linear`` -> ``linear`` (coefficients over the
+  engine's inputs, in order, as MITOS's ``linear`` layout).
+- ``default: nan`` -> no default (an output no rule sets is NaN / :class:`NoRuleFiredError`);
+  a number -> ``Variable.default``.
+- ``lock-previous: true`` (keep the last output when no rule fires: state between evaluations)
+  is refused; ``lock-range: true`` on an input is what MITOS always does (inputs are clamped to
+  their range); on an output it is accepted for Mamdani defuzzifiers, whose result lies in the
+  range anyway, and refused for weighted (Takagi-Sugeno) ones.
+- several rule blocks are merged when their operators agree, else refused; ``enabled: false``
+  is refused (MITOS has no disabled parts); activation ``General`` only.
+"""
+
+from __future__ import annotations
+
+import functools
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from lark import Lark
+from lark.exceptions import UnexpectedInput
+
+from ..errors import FormatError, Span, did_you_mean
+from ..model import Rule, RuleBase
+from ..model import format_number as _fmt_weight
+from ..terms import Term, Variable
+from . import common
+from .common import FLL, Settings, fmt_number
+from .ruletree import conclusion, expression
+
+SECTIONS = ("Engine", "InputVariable", "OutputVariable", "RuleBlock")
+KEYS = {
+    "Engine": ("description",),
+    "InputVariable": ("description", "enabled", "range", "lock-range", "term"),
+    "OutputVariable": ("description", "enabled", "range", "lock-range", "aggregation",
+                       "accumulation", "defuzzifier", "default", "lock-previous", "lock-valid",
+                       "term"),
+    "RuleBlock": ("description", "enabled", "conjunction", "disjunction", "implication",
+                  "activation", "rule"),
+}
+DEFAULT_RESOLUTION = 1000     # fuzzylite's IntegralDefuzzifier.default_resolution
+
+
+@functools.lru_cache(maxsize=None)
+def rule_parser() -> Lark:
+    from ..resources import grammar_text
+
+    return Lark(grammar_text("fll_rule.lark"), parser="lalr", propagate_positions=True,
+                maybe_placeholders=True)
+
+
+@dataclass
+class _Var:
+    role: str
+    name: str
+    span: Span
+    range: tuple[float, float] | None = None
+    terms: list = field(default_factory=list)          # (name, kind, values, span)
+    default: float | None = None
+    description: str = ""
+    lock_range: Span | None = None      # `lock-range: true` on an output
+
+
+def read_fll(path: str | Path) -> RuleBase:
+    path = Path(path)
+    return parse_fll(_read_text(path), str(path))
+
+
+def _read_text(path: Path) -> str:
+    try:
+        return path.read_text(encoding="utf-8")
+    except UnicodeDecodeError:
+        raise FormatError(f"`{path}` is not a text file (it is not UTF-8)") from None
+    except OSError as exc:
+        raise FormatError(f"cannot read `{path}`: {exc.strerror or exc}") from None
+
+
+def parse_fll(text: str, path: str | None = None) -> RuleBase:
+    """Read FLL ``text`` into a rule base (one behavior, ``main``)."""
+    settings = Settings()
+    variables: list[_Var] = []
+    rules: list[Rule] = []
+    section: str | None = None
+    current: _Var | None = None
+    engine_span = Span.in_text(text, path, 1, 1)
+    block_conj: dict = {}
+    pending_rules: list[tuple[str, int, int, dict]] = []
+
+    for lineno, raw in enumerate(text.splitlines(), 1):
+        line = raw.split("#", 1)[0].rstrip()
+        if not line.strip():
+            continue
+        indent = len(line) - len(line.lstrip())
+        key, sep, value = line.strip().partition(":")
+        col = indent + 1
+        span = Span.in_text(text, path, lineno, col, col + len(key))
+        vcol = indent + len(key) + 2 + (len(value) - len(value.lstrip()))
+        value = value.strip()
+        vspan = Span.in_text(text, path, lineno, vcol, vcol + max(1, len(value)))
+        if not sep:
+            raise FormatError(f"expected `key: value`, not `{line.strip()}`", span=span)
+        if key in SECTIONS:
+            section = key
+            current = None
+            if key == "Engine":
+                engine_span = span
+            elif key in ("InputVariable", "OutputVariable"):
+                if not value:
+                    raise FormatError(f"{key} needs a name", span=span)
+                current = _Var("input" if key == "InputVariable" else "output", value, vspan)
+                variables.append(current)
+            else:
+                block_conj = {"conjunction": None, "disjunction": None, "span": span}
+            continue
+        if section is None:
+            raise FormatError(f"`{key}` before any section", span=span,
+                              expected="Engine:, InputVariable:, OutputVariable: or RuleBlock:")
+        if key not in KEYS[section]:
+            raise FormatError(f"unknown {section} key `{key}`", span=span,
+                              expected="one of " + ", ".join(KEYS[section]),
+                              hint=did_you_mean(key, KEYS[section]))
+        if key == "description":
+            if current is not None:
+                current.description = value
+            continue
+        if key == "enabled":
+            if value != "true":
+                raise FormatError(f"`enabled: {value}`: MITOS has no disabled variables or rule "
+                                  f"blocks", span=vspan, hint="delete the part or enable it")
+            continue
+        if section in ("InputVariable", "OutputVariable"):
+            _variable_key(current, key, value, span, vspan, settings)
+        else:
+            if key == "rule":
+                pending_rules.append((value, lineno, vcol, block_conj))
+            else:
+                _block_key(key, value, vspan, settings, block_conj)
+
+    built = [_build_variable(v, [x.name for x in variables if x.role == "input"])
+             for v in variables]
+    by_name = {v.name: v for v in built}
+    for value, lineno, vcol, conj in pending_rules:
+        rules.append(_rule(value, text, path, lineno, vcol, by_name, conj, len(rules)))
+    if settings.sugeno:
+        _check_grouping(variables, rules, settings)
+        for v in variables:
+            if v.lock_range is not None:
+                raise FormatError(f"`lock-range: true` on the Takagi-Sugeno output `{v.name}` "
+                                  f"(clipping the output to its range) is not supported",
+                                  span=v.lock_range, hint="set `lock-range: false`")
+    return common.assemble(path, built, rules, settings, DEFAULT_RESOLUTION, engine_span)
+
+
+def _variable_key(v: _Var, key: str, value: str, span: Span, vspan: Span,
+                  settings: Settings) -> None:
+    words = value.split()
+    if key == "range":
+        if len(words) != 2:
+            raise FormatError("`range` takes two numbers: minimum and maximum", span=vspan)
+        lo, hi = (common.number(w, vspan) for w in words)
+        if not lo <= hi:
+            raise FormatError(f"range [{lo:g}, {hi:g}] is empty", span=vspan)
+        v.range = (lo, hi)
+    elif key == "term":
+        if len(words) < 2:
+            raise FormatError("`term` takes a name, a type and its parameters", span=vspan)
+        if words[1] in common.FORMULA_TERMS:
+            common.fuzzylite_term(words[0], words[1], [], 0, vspan)     # raises
+        v.terms.append((words[0], words[1], [common.number(w, vspan) for w in words[2:]], vspan))
+    elif key == "lock-range":
+        if value == "true" and v.role == "output":
+            v.lock_range = vspan
+    elif key in ("lock-previous", "lock-valid"):
+        if value == "true":
+            raise FormatError(f"`{key}: true` (keep the previous output when no rule fires) "
+                              f"needs state between evaluations, which MITOS does not keep",
+                              span=vspan, hint="set `default:` to the value to use instead")
+    elif key == "default":
+        d = common.number(value, vspan)
+        v.default = None if d != d else d
+    elif key in ("aggregation", "accumulation"):
+        if value != "none":
+            settings.set("aggregation", common.table_lookup(common.SNORMS, FLL, value,
+                                                            "aggregation", vspan), vspan,
+                          "aggregation")
+    elif key == "defuzzifier":
+        if not words:
+            raise FormatError("`defuzzifier` needs a name", span=vspan)
+        name = common.table_lookup(common.DEFUZZIFIERS, FLL, words[0], "defuzzifier", vspan)
+        settings.set("defuzzify", name, vspan, "defuzzifier")
+        if len(words) > 1:
+            if name in ("weighted_average", "weighted_sum"):
+                if words[1] == "Tsukamoto":
+                    raise FormatError("Tsukamoto inference is not supported", span=vspan)
+                if words[1] not in ("TakagiSugeno", "Automatic"):
+                    raise FormatError(f"unknown weighted defuzzifier type `{words[1]}`",
+                                      span=vspan, expected="TakagiSugeno or Automatic")
+            else:
+                res = common.number(words[1], vspan, "a resolution")
+                if not res.is_integer() or res < 3:
+                    raise FormatError(f"resolution must be a whole number >= 3, not {words[1]}",
+                                      span=vspan)
+                settings.set("resolution", int(res), vspan, "resolution")
+
+
+def _block_key(key: str, value: str, vspan: Span, settings: Settings, conj: dict) -> None:
+    if key == "conjunction":
+        if value != "none":
+            settings.set("and_", common.table_lookup(common.TNORMS, FLL, value, "conjunction",
+                                                     vspan), vspan, "conjunction")
+            conj["conjunction"] = value
+    elif key == "disjunction":
+        if value != "none":
+            settings.set("or_", common.table_lookup(common.SNORMS, FLL, value, "disjunction",
+                                                    vspan), vspan, "disjunction")
+            conj["disjunction"] = value
+    elif key == "implication":
+        if value != "none":
+            settings.set("implication", common.check_implication(
+                common.table_lookup(common.TNORMS, FLL, value, "implication", vspan), vspan),
+                vspan, "implication")
+    elif key == "activation":
+        name = value.split()[0] if value else ""
+        if name == "General":
+            return
+        if name in {n[FLL] for n in common.TNORMS.values()}:     # fuzzylite 5: the implication
+            _block_key("implication", name, vspan, settings, conj)
+            return
+        raise FormatError(f"activation `{value}` is not supported: MITOS activates every rule "
+                          f"(fuzzylite's `General`)", span=vspan,
+                          hint="First, Last, Highest, Lowest, Proportional and Threshold "
+                               "activations select rules; rewrite the rules instead")
+
+
+def _build_variable(v: _Var, inputs: list[str]) -> Variable:
+    if v.range is None:
+        raise FormatError(f"variable `{v.name}` has no `range`", span=v.span)
+    universe = v.range
+    if universe[0] == universe[1] and v.role == "output" and v.terms and all(
+            kind in ("Constant", "Linear") for _, kind, _, _ in v.terms):
+        universe = (-float("inf"), float("inf"))     # a Takagi-Sugeno output's range is unused
+    terms = []
+    for name, kind, values, span in v.terms:
+        if kind == "Linear" and v.role == "input":
+            raise FormatError(f"term `{v.name}.{name}`: Linear terms belong to outputs",
+                              span=span)
+        terms.append(common.fuzzylite_term(name, kind, list(values), len(inputs), span))
+    if not terms and v.role == "output":
+        raise FormatError(f"output variable `{v.name}` has no terms", span=v.span)
+    if not universe[0] < universe[1]:
+        raise FormatError(f"variable `{v.name}`: range [{universe[0]:g}, {universe[1]:g}] is "
+                          f"empty", span=v.span)
+    try:
+        return Variable(v.name, v.role, universe, tuple(terms), v.description, "", v.default,
+                        v.span)
+    except Exception as exc:                     # duplicate terms: TermSetError with a span
+        raise FormatError(getattr(exc, "message", str(exc)), span=v.span) from None
+
+
+def _rule(value: str, text: str, path: str | None, lineno: int, vcol: int,
+          variables: dict[str, Variable], conj: dict, index: int) -> Rule:
+    def span_of(node) -> Span:
+        meta = getattr(node, "meta", None)
+        column = getattr(node, "column", None) or (meta.column if meta and not meta.empty
+                                                   else 1)
+        end = getattr(node, "end_column", None) or (meta.end_column if meta and not meta.empty
+                                                    else column + 1)
+        return Span.in_text(text, path, lineno, vcol + column - 1, vcol + end - 1)
+
+    try:
+        tree = rule_parser().parse(value)
+    except UnexpectedInput as exc:
+        column = getattr(exc, "column", 1) or 1
+        expected = getattr(exc, "expected", None) or getattr(exc, "allowed", None)
+        raise FormatError("cannot read this rule", span=Span.in_text(
+            text, path, lineno, vcol + column - 1),
+            expected=("one of " + ", ".join(sorted(str(e).lower() for e in expected)))
+            if expected else None) from None
+    antecedent_tree, *rest = tree.children
+    weight_token = rest[-1]
+    conclusions = rest[:-1]
+    antecedent = expression(antecedent_tree, span_of, variables)
+    _check_operators(antecedent_tree, conj, span_of)
+    weight = common.number(str(weight_token), span_of(weight_token)) if weight_token else 1.0
+    span = Span.in_text(text, path, lineno, vcol, vcol + len(value))
+    return Rule(f"r{index + 1}", antecedent, tuple(conclusion(c, span_of) for c in conclusions),
+                weight, span)
+
+
+def _check_operators(tree, conj: dict, span_of) -> None:
+    """fuzzylite refuses `and` / `or` when the block's conjunction / disjunction is none."""
+    from lark import Tree
+
+    for sub in tree.iter_subtrees() if isinstance(tree, Tree) else ():
+        if sub.data == "and_expr" and conj.get("conjunction") is None:
+            raise FormatError("the rule uses `and` but its rule block's conjunction is none",
+                              span=span_of(sub), hint="set `conjunction:` in the RuleBlock")
+        if sub.data == "or_expr" and conj.get("disjunction") is None:
+            raise FormatError("the rule uses `or` but its rule block's disjunction is none",
+                              span=span_of(sub), hint="set `disjunction:` in the RuleBlock")
+
+
+def _check_grouping(variables: list[_Var], rules: list[Rule], settings: Settings) -> None:
+    """fuzzylite 8 aggregates the activations of one output term (weighted defuzzifiers) with
+    the output's aggregation; without one (``none``) it sums them, as MITOS does per rule."""
+    if settings.aggregation is None:
+        return
+    seen: dict[tuple[str, str], Span | None] = {}
+    for r in rules:
+        for c in r.consequents:
+            if (c.var, c.term) in seen:
+                raise FormatError(
+                    f"`{c.var} is {c.term}` is concluded by several rules while the output's "
+                    f"aggregation is `{settings.aggregation}`: fuzzylite then aggregates their "
+                    f"weights, MITOS sums them (as with `aggregation: none`)", span=c.span,
+                    hint="set `aggregation: none` for a Takagi-Sugeno output")
+            seen[(c.var, c.term)] = c.span
+
+
+# ---------------------------------------------------------------------------------------------
+# Writer
+
+
+def write_fll(rb: RuleBase, behavior: str | None = None) -> str:
+    """FLL text for one behavior of ``rb`` (reading it back gives the same outputs)."""
+    flat = common.flatten_for_export(rb, behavior)
+    ops = flat.operators
+    sugeno = ops.inference in ("weighted_average", "weighted_sum")
+    inputs = common.all_inputs(rb, flat)
+    out = [f"Engine: {flat.name}"]
+    for v in inputs:
+        out += [f"InputVariable: {v.name}"]
+        if v.description:
+            out.append(f"  description: {_one_line(v.description)}")
+        out += ["  enabled: true", f"  range: {fmt_number(v.universe[0])} "
+                f"{fmt_number(v.universe[1])}", "  lock-range: true"]
+        out += [f"  term: {t.name} {common.fuzzylite_term_text(t, v.name)}" for t in v.terms]
+    for v in flat.outputs:
+        out += [f"OutputVariable: {v.name}"]
+        if v.description:
+            out.append(f"  description: {_one_line(v.description)}")
+        out += ["  enabled: true", f"  range: {fmt_number(v.universe[0])} "
+                f"{fmt_number(v.universe[1])}", "  lock-range: false"]
+        if sugeno:
+            out.append("  aggregation: none")
+            kind = common.DEFUZZIFIERS[ops.inference][FLL]
+            out.append(f"  defuzzifier: {kind} TakagiSugeno")
+        else:
+            out.append(f"  aggregation: {common.foreign_name(common.SNORMS, FLL, ops.aggregation, 'S-norm')}")
+            kind = common.foreign_name(common.DEFUZZIFIERS, FLL, ops.defuzzify, "defuzzifier")
+            out.append(f"  defuzzifier: {kind} {ops.resolution}")
+        out.append(f"  default: {'nan' if v.default is None else fmt_number(v.default)}")
+        out.append("  lock-previous: false")
+        for t in v.terms:
+            out.append(f"  term: {t.name} {_output_term(rb, t, v, sugeno, inputs)}")
+    out += [f"RuleBlock: {flat.name}", "  enabled: true",
+            f"  conjunction: {common.foreign_name(common.TNORMS, FLL, ops.and_, 'T-norm')}",
+            f"  disjunction: {common.foreign_name(common.SNORMS, FLL, ops.or_, 'S-norm')}"]
+    if sugeno:
+        out.append("  implication: none")
+    else:
+        out.append(f"  implication: "
+                   f"{common.foreign_name(common.TNORMS, FLL, ops.implication, 'implication')}")
+    out.append("  activation: General")
+    for r in flat.rules:
+        out.append(f"  rule: {fuzzylite_rule_text(r, ops, 'fll')}")
+    return "\n".join(out) + "\n"
+
+
+def _one_line(text: str) -> str:
+    return " ".join(text.replace("#", "").split())
+
+
+def _output_term(rb: RuleBase, t: Term, v: Variable, sugeno: bool,
+                 inputs: tuple[Variable, ...]) -> str:
+    if sugeno:
+        if t.shape == "linear":
+            coefficients = common.linear_coefficients(rb, v.name, t)
+            values = [coefficients.get(i.name, 0.0) for i in inputs] + [t.params[-1]]
+            return "Linear " + " ".join(fmt_number(c) for c in values)
+        return f"Constant {fmt_number(t.center)}"     # weighted average uses the centre only
+    return common.fuzzylite_term_text(t, v.name)
+
+
+def fuzzylite_rule_text(rule: Rule, ops, dialect: str) -> str:
+    """A rule in fuzzylite's language (``dialect`` ``fll``: lower case; ``fcl``: upper-case
+    keywords). ``not (...)`` groups are pushed onto propositions when the operators are duals."""
+    from ..model import And, Not, Or, Prop
+
+    antecedent = rule.antecedent
+    if common.has_group_not(antecedent):
+        if not common.can_push_not(ops):
+            raise FormatError(f"rule `{rule.label}`: `not (...)` over a group cannot be written "
+                              f"in fuzzylite's language with and = {ops.and_}, or = {ops.or_} "
+                              f"(not De Morgan duals)", span=rule.span)
+        antecedent = common.push_not(antecedent)
+    kw = (lambda w: w.upper()) if dialect == "fcl" else (lambda w: w)
+
+    def expr(e, parent: str) -> str:
+        if isinstance(e, Prop):
+            words = (["not"] if e.negated else []) + [common.to_fuzzylite_hedge(h)
+                                                       for h in e.hedges] + [e.term]
+            return f"{e.var} {kw('is')} " + " ".join(kw(w) if w == "not" else w for w in words)
+        op = "and" if isinstance(e, And) else "or"
+        text = f" {kw(op)} ".join(expr(i, op) for i in e.items)
+        return f"({text})" if parent != op and parent != "top" else text
+
+    assert not isinstance(antecedent, Not)
+    cons = f" {kw('and')} ".join(
+        f"{c.var} {kw('is')} " + " ".join([common.to_fuzzylite_hedge(h) for h in c.hedges]
+                                          + [c.term])
+        for c in rule.consequents)
+    text = f"{kw('if')} {expr(antecedent, 'top')} {kw('then')} {cons}"
+    if rule.weight != 1.0:
+        text += f" {kw('with')} {_fmt_weight(rule.weight)}"
+    return text

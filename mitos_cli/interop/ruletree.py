@@ -1,0 +1,75 @@
+"""Rule text of fuzzylite's language (FLL ``rule:`` lines, FCL ``RULE n :`` lines) -> model.
+
+Both grammars (``grammar/fll_rule.lark`` and ``grammar/fcl.lark``) name their rule nodes the
+same way (``or_expr``, ``and_expr``, ``negation``, ``proposition``, ``bare_hedge``,
+``conclusion``), so one converter serves both. Positions are mapped back into the file, so an
+error points at the word in the file.
+"""
+
+from __future__ import annotations
+
+from typing import Callable
+
+from lark import Token, Tree
+
+from ..errors import FormatError, Span
+from ..model import And, Consequent, Expr, Not, Or, Prop
+from ..terms import Variable
+from .common import fuzzylite_hedge
+
+SpanOf = Callable[[object], Span]
+
+
+def expression(tree, span_of: SpanOf, variables: dict[str, Variable]) -> Expr:
+    """An antecedent tree as a MITOS expression."""
+    if isinstance(tree, Token):
+        raise FormatError(f"unexpected `{tree}`", span=span_of(tree))
+    kind = tree.data
+    if kind in ("or_expr", "and_expr"):
+        items = tuple(expression(c, span_of, variables) for c in tree.children
+                      if not isinstance(c, Token))
+        cls = Or if kind == "or_expr" else And
+        return cls(items, span_of(tree))
+    if kind == "negation":
+        return Not(expression(tree.children[-1], span_of, variables), span_of(tree))
+    if kind == "bare_hedge":
+        var, *words = tree.children
+        if [w.lower() for w in words] != ["any"]:
+            raise FormatError(f"`{var} is {' '.join(words)}` names no term", span=span_of(tree),
+                              hint="only `is any` may stand without a term")
+        v = variables.get(str(var))
+        if v is None:
+            return Prop(str(var), "", ("any",), False, span_of(tree))   # checked later
+        return Prop(v.name, v.terms[0].name, ("any",), False, span_of(tree))
+    if kind == "proposition":
+        var, *words, term = tree.children
+        negated, hedges = _words(words, span_of, tree, allow_not=True)
+        return Prop(str(var), str(term), hedges, negated, span_of(tree))
+    if len(tree.children) == 1:
+        return expression(tree.children[0], span_of, variables)
+    raise FormatError(f"unexpected `{kind}` in a rule", span=span_of(tree))
+
+
+def conclusion(tree: Tree, span_of: SpanOf) -> Consequent:
+    var, *words, term = tree.children
+    _, hedges = _words(words, span_of, tree, allow_not=False)
+    return Consequent(str(var), str(term), None, hedges, span_of(tree))
+
+
+def _words(words, span_of: SpanOf, tree, allow_not: bool) -> tuple[bool, tuple[str, ...]]:
+    negated = False
+    hedges = []
+    for i, w in enumerate(words):
+        word = str(w).lower()
+        if word == "not":
+            if not allow_not:
+                raise FormatError("`not` in a consequent (the complement of an output term) is "
+                                  "not supported", span=span_of(w))
+            if i != 0:
+                raise FormatError(f"`not` after a hedge (`{' '.join(map(str, words))}`) is not "
+                                  f"supported", span=span_of(w),
+                                  hint="write `not` first: `is not very TERM`")
+            negated = True
+            continue
+        hedges.append(fuzzylite_hedge(word, span_of(w)))
+    return negated, tuple(hedges)
