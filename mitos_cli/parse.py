@@ -232,9 +232,13 @@ class _ToModel(Transformer):
 
 
 def _unquote(token: Token) -> str:
+    """A quoted file name's text (JSON escapes; a malformed escape is kept as written)."""
     import json
 
-    return json.loads(str(token))
+    try:
+        return json.loads(str(token), strict=False)
+    except ValueError:          # `"a\q"`: the grammar allows escapes JSON does not
+        return str(token)[1:-1]
 
 
 def parse_tree(text: str, path: str | None = None, start: str = "start") -> Tree:

@@ -53,10 +53,16 @@ def load_termset(path: str | Path) -> TermSet:
     """Read and validate the term set at ``path``."""
     path = Path(path)
     try:
-        text = path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise TermSetError(f"cannot read term set `{path}`: {exc.__class__.__name__}: "
-                           f"{getattr(exc, 'strerror', None) or exc}") from None
+        data = path.read_bytes()
+    except OSError as exc:
+        raise TermSetError(f"cannot read term set `{path}`: {exc.strerror or exc}") from None
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        line = data.count(b"\n", 0, exc.start) + 1
+        column = exc.start - (data.rfind(b"\n", 0, exc.start) + 1) + 1
+        raise TermSetError(f"`{path}` is not a text file (byte 0x{data[exc.start]:02x} is not "
+                           f"UTF-8)", span=Span(str(path), line, column)) from None
     return parse_termset(text, str(path))
 
 

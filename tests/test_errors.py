@@ -384,3 +384,19 @@ def test_cli_usage_error_through_a_real_process():
     proc = subprocess.run([sys.executable, "-m", "mitos_cli", "eval", "--json", "--nope"],
                           capture_output=True, text=True, timeout=60)
     assert proc.returncode == 2 and "No such option" in proc.stderr
+
+
+def test_term_set_that_is_not_utf8(tmp_path):
+    path = write(tmp_path, GOOD_RULE)
+    (tmp_path / "t.terms.yaml").write_bytes(b"variables:\n  road:\xff\n")
+    exc = error_of(lambda: load_rules_file(path), TermSetError)
+    assert exc.message.endswith("is not a text file (byte 0xff is not UTF-8)")
+    assert (exc.span.line, exc.span.column) == (2, 8)
+
+
+def test_term_set_name_with_control_character_or_bad_escape(tmp_path):
+    for name in ('"a\x01b"', '"a\\qb"'):
+        path = tmp_path / "t.rules"
+        path.write_text(f"terms {name}\n" + GOOD_RULE, encoding="utf-8")
+        exc = error_of(lambda: load_rules_file(path), TermSetError)
+        assert "not found" in exc.message and exc.span.line == 1
