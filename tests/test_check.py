@@ -1,0 +1,235 @@
+"""``mitos check``: each kind of finding on a small rule base made to have it."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from mitos_cli.api import read_rulebase
+from mitos_cli.check import boxes_of, canonical, check_rulebase, grid_axes
+from mitos_cli.cli.app import main
+from mitos_cli.compile import compile_rulebase
+from mitos_cli.parse import parse_expr
+
+TERMS = """variables:
+  road:
+    role: input
+    universe: [0, 160]
+    terms:
+      NARROW: {shape: left_shoulder, points: [40, 60]}
+      MEDIUM: {shape: triangle, peak: 70, width: 20}
+      WIDE:   {shape: right_shoulder, points: [80, 100]}
+      HUGE:   {shape: right_shoulder, points: [140, 150]}
+  size:
+    role: input
+    universe: [0, 100]
+    terms:
+      SMALL: {shape: left_shoulder, points: [10, 40]}
+      LARGE: {shape: right_shoulder, points: [40, 70]}
+  steering:
+    role: output
+    universe: [30, 150]
+    terms: {LS: 70, ST: 90, RS: 110}
+  speed:
+    role: output
+    universe: [0, 60]
+    default: 0
+    terms: {SLOW: 20, FAST: 50}
+"""
+
+RULES = """terms "t.terms.yaml"
+r1: if road is NARROW and size is SMALL then steering is LS and speed is SLOW
+r2: if size is SMALL and road is NARROW then steering is RS and speed is SLOW
+r3: if road is MEDIUM then steering is ST and speed is FAST
+r4: if road is MEDIUM then steering is ST and speed is FAST
+r5: if road is NARROW and road is WIDE then steering is 95
+r6: if road is WIDE and not road is WIDE then steering is 95
+r7: if road is WIDE and size is LARGE then steering is 80
+"""
+
+
+@pytest.fixture()
+def flawed(tmp_path) -> Path:
+    (tmp_path / "t.terms.yaml").write_text(TERMS, encoding="utf-8")
+    path = tmp_path / "t.rules"
+    path.write_text(RULES, encoding="utf-8")
+    return path
+
+
+def by_code(report, code):
+    return [f for f in report.findings if f.code == code]
+
+
+def test_packaged_rule_base_passes():
+    report = check_rulebase(read_rulebase())
+    assert report.ok
+    assert report.count("error") == 0 and report.count("warning") == 0
+    # notes only: output terms the 27 rules never conclude
+    assert sorted(f.message for f in report.findings) == [
+        "output `speed`: no rule concludes STOP, FAST, TOP",
+        "output `steering`: no rule concludes LB, RB"]
+    assert report.grids[0].samples == np.prod([n for _, n in report.grids[0].points])
+
+
+def test_flawed_rule_base_findings(flawed):
+    report = check_rulebase(read_rulebase(flawed))
+    assert not report.ok
+    codes = sorted((f.severity, f.code) for f in report.findings)
+    assert codes == sorted([
+        ("error", "no-rule-fires"), ("warning", "no-rule-fires"), ("warning", "low-dof"),
+        ("error", "conflict"), ("warning", "duplicate"), ("warning", "unreachable"),
+        ("warning", "contradiction"), ("warning", "unused-term"), ("warning", "term-gap")])
+    assert report.findings[0].severity == "error"            # errors come first
+
+
+def test_coverage_gap_without_default_is_an_error(flawed):
+    report = check_rulebase(read_rulebase(flawed))
+    gap = [f for f in by_code(report, "no-rule-fires") if f.severity == "error"][0]
+    assert "no rule sets `steering`" in gap.message
+    assert "default: VALUE" in gap.hint
+    regions = [b.describe() for b in gap.regions]
+    # NARROW/SMALL rules need size < 40, r7 needs WIDE; r3 covers the MEDIUM road
+    assert regions == ["road in [0, 50] and size in [40, 100]",
+                       "road in [100, 160] and size in [0, 40]"]
+    assert gap.span.line == 1 and gap.span.path == str(flawed)
+    assert 0.3 < gap.share < 0.4
+
+
+def test_coverage_gap_with_default_is_a_warning(flawed):
+    report = check_rulebase(read_rulebase(flawed))
+    gap = [f for f in by_code(report, "no-rule-fires") if f.severity == "warning"][0]
+    assert "no rule sets `speed`" in gap.message and "speed = 0" in gap.message
+    assert [b.describe() for b in gap.regions] == ["road in [90, 160]",
+                                                  "road in [0, 50] and size in [40, 100]"]
+
+
+def test_low_total_dof(flawed):
+    low = by_code(check_rulebase(read_rulebase(flawed)), "low-dof")[0]
+    # r7 alone: LARGE(42.5) = 0.083 < 0.1 on the wide road
+    assert [b.describe() for b in low.regions] == ["road in [100, 160] and size = 42.5"]
+    assert by_code(check_rulebase(read_rulebase(flawed), threshold=0.0), "low-dof") == []
+
+
+def test_conflict_and_duplicate(flawed):
+    report = check_rulebase(read_rulebase(flawed))
+    conflict = by_code(report, "conflict")[0]
+    assert conflict.message == ("`r2` has the same antecedent as `r1` but concludes "
+                                "differently: steering is LS vs steering is RS")
+    assert conflict.span.line == 3
+    dup = by_code(report, "duplicate")[0]
+    assert dup.message.startswith("`r4` has the same antecedent as `r3` and the same")
+    assert dup.span.line == 5
+
+
+def test_unreachable_and_contradiction(flawed):
+    report = check_rulebase(read_rulebase(flawed))
+    unreachable = by_code(report, "unreachable")
+    assert [f.span.line for f in unreachable] == [6]          # NARROW and WIDE never overlap
+    assert "`r5` never fires" in unreachable[0].message
+    contradiction = by_code(report, "contradiction")[0]
+    assert "`road is WIDE` and `road is not WIDE`" in contradiction.message
+    assert (contradiction.span.line, contradiction.span.column) == (7, 29)
+
+
+def test_unused_terms_and_gaps(flawed):
+    report = check_rulebase(read_rulebase(flawed))
+    unused = by_code(report, "unused-term")[0]
+    assert unused.message == "input term `road.HUGE` is used by no rule"
+    assert unused.span.path.endswith("t.terms.yaml") and unused.span.line == 9
+    gap = by_code(report, "term-gap")[0]
+    assert gap.message == "input `size`: every term is 0 at size = 40"
+    # steering's terms LS, ST, RS are all concluded... but only LS, RS by r1/r2 and ST by r3
+    assert by_code(report, "unconcluded-term") == []
+
+
+def test_term_gap_over_a_range(tmp_path):
+    terms = TERMS.replace("[10, 40]", "[10, 20]").replace("[40, 70]", "[50, 70]")
+    (tmp_path / "t.terms.yaml").write_text(terms, encoding="utf-8")
+    (tmp_path / "t.rules").write_text(RULES, encoding="utf-8")
+    gaps = by_code(check_rulebase(read_rulebase(tmp_path / "t.rules")), "term-gap")
+    assert [g.message for g in gaps] == ["input `size`: every term is 0 for size in [20, 50]"]
+
+
+def test_one_behavior_only(tmp_path):
+    (tmp_path / "t.terms.yaml").write_text(TERMS, encoding="utf-8")
+    (tmp_path / "t.rules").write_text(
+        'terms "t.terms.yaml"\n'
+        "behavior full:\n  if road is NARROW or road is MEDIUM or road is WIDE "
+        "then steering is ST and speed is SLOW\nend\n"
+        "behavior part:\n  if road is WIDE then steering is LS\nend\n", encoding="utf-8")
+    rb = read_rulebase(tmp_path / "t.rules")
+    assert check_rulebase(rb, "full").ok
+    report = check_rulebase(rb)
+    assert not report.ok and {f.behavior for f in by_code(report, "no-rule-fires")} == {"part"}
+
+
+def test_canonical_antecedents():
+    same = [("road is A and size is B", "size is B and road is A"),
+            ("not road is A", "road is not A"),
+            ("road is A and (size is B and pos is C)", "pos is C and size is B and road is A"),
+            ("road is A or road is A", "road is A")]
+    for a, b in same:
+        assert canonical(parse_expr(a)) == canonical(parse_expr(b)), (a, b)
+    assert canonical(parse_expr("road is A and size is B")) != \
+        canonical(parse_expr("road is A or size is B"))
+
+
+def test_boxes_of_a_mask():
+    axes = [np.arange(5.0), np.arange(4.0) * 10]
+    mask = np.zeros((5, 4), bool)
+    mask[0:2, :] = True              # x in [0, 1], any y
+    mask[3:5, 1:3] = True            # x in [3, 4], y in [10, 20]
+    boxes, left = boxes_of(mask, axes, ("x", "y"))
+    assert left == 0
+    assert [b.describe() for b in boxes] == ["x in [0, 1]", "x in [3, 4] and y in [10, 20]"]
+    everything, _ = boxes_of(np.ones((5, 4), bool), axes, ("x", "y"))
+    assert [b.describe() for b in everything] == ["everywhere"]
+
+
+def test_grid_includes_corners_and_stays_capped():
+    compiled = compile_rulebase(read_rulebase())
+    axes = grid_axes(compiled, 41)
+    road = axes[compiled.inputs.index("road")]
+    assert {40.0, 70.0, 100.0} <= set(road) and road[0] == 0 and road[-1] == 160
+    small = grid_axes(compiled, 10_000, max_samples=1000)
+    assert np.prod([len(a) for a in small]) <= 1000 or all(len(a) <= 12 for a in small)
+
+
+# ---------------------------------------------------------------------------------------------
+# the command
+
+
+def run(args, capsys):
+    with pytest.raises(SystemExit) as info:
+        main(args)
+    out, err = capsys.readouterr()
+    return info.value.code, out, err
+
+
+def test_cli_exit_codes(flawed, capsys):
+    code, out, _ = run(["check", str(flawed)], capsys)
+    assert code == 1
+    assert f"{flawed}:3:1: error: `r2` has the same antecedent as `r1`" in out
+    assert out.rstrip().endswith("2 errors, 7 warnings, 0 notes")
+    code, out, _ = run(["check"], capsys)
+    assert code == 0 and out.rstrip().endswith("0 errors, 0 warnings, 2 notes - OK")
+
+
+def test_cli_json_matches_the_library(flawed, capsys):
+    code, out, _ = run(["check", str(flawed), "--json", "--threshold", "0.05"], capsys)
+    data = json.loads(out)
+    report = check_rulebase(read_rulebase(flawed), threshold=0.05)
+    assert code == 1 and data["ok"] is False and data["threshold"] == 0.05
+    assert data["findings"] == [f.to_json() for f in report.findings]
+    assert data["summary"] == {"error": 2, "warning": 6, "info": 0}
+    gap = data["findings"][0]
+    assert gap["code"] == "no-rule-fires" and gap["regions"][0] == {"road": [0.0, 50.0],
+                                                                    "size": [40.0, 100.0]}
+
+
+def test_cli_behavior_and_resolution(flawed, capsys):
+    code, out, _ = run(["check", str(flawed), "-b", "main", "--resolution", "5"], capsys)
+    assert code == 1 and "`main` on 12 road x 8 size = 96 samples" in out
