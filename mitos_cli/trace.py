@@ -41,6 +41,8 @@ class Trace:
     def to_json(self) -> dict:
         return {
             "rulebase": self.rulebase,
+            "behavior": self.behavior,
+            "operators": self.operators,
             "inputs": {i.name: {"value": i.value, "memberships": dict(i.memberships)}
                        for i in self.inputs},
             "rules": [{"label": r.label, "text": r.text, "dof": r.dof} for r in self.rules],

@@ -1,0 +1,92 @@
+"""``mitos operators``: every operator a rule file can select, with its formula and aliases."""
+
+from __future__ import annotations
+
+import json
+from typing import Annotated
+
+import typer
+
+from .output import emit
+
+INFERENCE = {
+    "weighted_average": "y = sum_r(dof_r * y_r) / sum_r(dof_r); y_r = the consequent's value "
+                        "(term centre) or a . x + c (linear); the paper's eqs. 18-19",
+    "weighted_sum": "y = sum_r(dof_r * y_r) (Takagi-Sugeno without normalisation)",
+    "mamdani": "y = defuzzify(S_r implication(dof_r, mu_r(y))) on `resolution` samples",
+}
+IMPLICATION = {
+    "min": "mu'(y) = min(dof, mu(y)) (clipping)",
+    "product": "mu'(y) = dof * mu(y) (scaling)",
+}
+DEFUZZIFY = {
+    "centroid": "sum(y mu(y)) / sum(mu(y)) over the samples (midpoint rule)",
+    "bisector": "the sample where the cumulative area is closest to half the total",
+    "mom": "mean of the samples where mu(y) is maximal",
+    "som": "smallest sample where mu(y) is maximal",
+    "lom": "largest sample where mu(y) is maximal",
+}
+
+
+def catalogue() -> dict[str, list[dict]]:
+    """Every operator by setting key: name, formula, aliases, default, dual."""
+    from .. import norms
+    from ..hedges import HEDGES
+    from ..operators import Operators
+
+    d = Operators()
+
+    def entry(name, formula, default, **extra):
+        return {"name": name, "formula": formula, "default": name == default, **extra}
+
+    return {
+        "and": [entry(n.name, n.formula, d.and_, aliases=list(n.aliases), dual=n.dual)
+                for n in norms.TNORMS.values()],
+        "or / aggregation": [entry(n.name, n.formula, d.or_, aliases=list(n.aliases),
+                                   dual=n.dual) for n in norms.SNORMS.values()],
+        "inference": [entry(k, v, d.inference) for k, v in INFERENCE.items()],
+        "implication": [entry(k, v, d.implication) for k, v in IMPLICATION.items()],
+        "defuzzify": [entry(k, v, d.defuzzify) for k, v in DEFUZZIFY.items()],
+        "hedges": [entry(h.name, h.formula, None) for h in HEDGES.values()],
+    }
+
+
+TITLES = {
+    "and": "T-norms (AND neurons)                    operators: and = NAME",
+    "or / aggregation": "S-norms (OR neurons, Mamdani aggregation)  operators: or = NAME, "
+                        "aggregation = NAME",
+    "inference": "inference methods (output layer)         operators: inference = NAME",
+    "implication": "Mamdani implication                      operators: implication = NAME",
+    "defuzzify": "Mamdani defuzzifiers                     operators: defuzzify = NAME, "
+                 "resolution = N (default {resolution})",
+    "hedges": "hedges (activations, eqs. 10-11)         `road is very WIDE`",
+}
+
+
+def render(cat: dict[str, list[dict]]) -> str:
+    from ..operators import Operators
+
+    lines = ["The paper's defaults: and = min, or = max, inference = weighted_average "
+             "(eqs. 17-19)."]
+    for key, entries in cat.items():
+        lines += ["", TITLES[key].format(resolution=Operators().resolution)]
+        width = max(len(e["name"]) for e in entries)
+        for e in entries:
+            notes = []
+            if e.get("aliases"):
+                notes.append("alias " + ", ".join(e["aliases"]))
+            if e.get("dual"):
+                notes.append(f"dual {e['dual']}")
+            if e["default"]:
+                notes.append("default")
+            tail = f"   [{'; '.join(notes)}]" if notes else ""
+            lines.append(f"  {e['name'].ljust(width)}  {e['formula']}{tail}")
+    return "\n".join(lines)
+
+
+def operators_command(
+    as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
+) -> None:
+    """List every T-norm, S-norm, inference method, implication, defuzzifier and hedge."""
+    cat = catalogue()
+    emit(json.dumps(cat, indent=2) if as_json else render(cat))
