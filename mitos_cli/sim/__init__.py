@@ -1,0 +1,52 @@
+"""``mitos simulate``: a kinematic corridor simulator that drives the compiled rule base.
+
+API (everything in inches, seconds, degrees)::
+
+    from mitos_cli.sim import load_world, simulate, run_many, FuzzyPlanner
+
+    world = load_world("worlds/figure4.yaml")      # WorldError with file:line:col when bad
+    result = simulate(world)                       # packaged rule base, behavior world.behavior
+    result = simulate(world, FuzzyPlanner("my.rules", "drive"), seed=3)
+    result.outcome          # "success" | "collision" | "timeout" | "stuck"
+    result.summary()        # the --json dict: world, seed, outcome, reached_goal, collisions,
+                            # time_s, path_length_in, min_clearance_in, mean_speed_in_s,
+                            # steering_total_variation_deg, ticks
+    result.t, result.pose[T, n, 3], result.speed[T, n], result.steering[T, n],
+    result.command[T, n, 2], result.ranges[T, n, B], result.clearance[T, n],
+    result.perceived["road"][T, n], result.true["road"][T, n], result.obstacles[T, O, 2]
+
+    runs = run_many([world], runs=20, seed=1, planner=None, workers=2)   # randomised runs
+    runs.table()            # per world: success / collision / timeout rates, mean +- std
+
+Modules: ``world`` (model), ``worldfile`` (YAML loader), ``pgm`` + ``gridmap`` (ROS map_server
+maps), ``staticmap`` (walls from corridors or grids), ``geometry``, ``kinematics`` (tricycle),
+``sensors`` (ray casting), ``obstacles`` (motion, randomisation), ``route`` (A*),
+``perception`` (readings -> rule inputs), ``planner`` (the planner protocol, FuzzyPlanner),
+``simulate`` (the loop), ``runs`` (many runs, process pool), ``export`` (CSV, traces),
+``live`` (terminal view). Drawing lives in ``mitos_cli.draw.world``.
+"""
+
+from __future__ import annotations
+
+__all__ = ["load_world", "simulate", "run_many", "FuzzyPlanner", "Planner", "Percepts",
+           "SimResult"]
+
+
+def __getattr__(name: str):
+    if name == "load_world":
+        from .worldfile import load_world
+
+        return load_world
+    if name in ("simulate", "SimResult"):
+        from . import simulate as mod
+
+        return getattr(mod, name)
+    if name == "run_many":
+        from .runs import run_many
+
+        return run_many
+    if name in ("FuzzyPlanner", "Planner", "Percepts"):
+        from . import planner
+
+        return getattr(planner, name)
+    raise AttributeError(name)

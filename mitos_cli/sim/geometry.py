@@ -1,0 +1,155 @@
+"""Plane geometry on arrays: segments, rectangles, rays and distances (inches, radians).
+
+Segments are rows ``[x0, y0, x1, y1]``; every function takes whole arrays and loops over
+nothing but a handful of fixed things (the four sides of a rectangle), never over beams, walls
+or cells.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+EPS = 1e-9
+
+
+def rect_corners(cx, cy, heading, length, width) -> np.ndarray:
+    """Corners ``[..., 4, 2]`` of rectangles centred at (cx, cy), long side along ``heading``
+    (rad), counter-clockwise from the rear right corner."""
+    cx, cy, heading = np.broadcast_arrays(*(np.asarray(a, float) for a in (cx, cy, heading)))
+    c, s = np.cos(heading), np.sin(heading)
+    hl = np.asarray(length, float) / 2.0
+    hw = np.asarray(width, float) / 2.0
+    local = np.array([[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]])
+    lx = local[:, 0] * hl[..., None] if np.ndim(hl) else local[:, 0] * hl
+    ly = local[:, 1] * hw[..., None] if np.ndim(hw) else local[:, 1] * hw
+    x = cx[..., None] + c[..., None] * lx - s[..., None] * ly
+    y = cy[..., None] + s[..., None] * lx + c[..., None] * ly
+    return np.stack([x, y], axis=-1)
+
+
+def polygon_segments(corners: np.ndarray) -> np.ndarray:
+    """Closed polygons ``[..., P, 2]`` -> their sides ``[... * P, 4]``."""
+    nxt = np.roll(corners, -1, axis=-2)
+    return np.concatenate([corners, nxt], axis=-1).reshape(-1, 4)
+
+
+def point_segment_distance(p: np.ndarray, seg: np.ndarray) -> np.ndarray:
+    """Distances ``[P, S]`` from points ``[P, 2]`` to segments ``[S, 4]``."""
+    a = seg[None, :, 0:2]
+    e = seg[None, :, 2:4] - a
+    d = p[:, None, :] - a
+    ee = np.einsum("psk,psk->ps", np.broadcast_to(e, d.shape), np.broadcast_to(e, d.shape))
+    t = np.clip(np.einsum("psk,psk->ps", d, np.broadcast_to(e, d.shape)) / np.maximum(ee, EPS),
+                0.0, 1.0)
+    closest = a + t[..., None] * e
+    return np.hypot(*(p[:, None, :] - closest).transpose(2, 0, 1))
+
+
+def _cross(ax, ay, bx, by):
+    return ax * by - ay * bx
+
+
+def segments_intersect(A: np.ndarray, B: np.ndarray) -> np.ndarray:
+    """Whether segments ``A[M, 4]`` and ``B[N, 4]`` cross or touch: ``[M, N]`` booleans."""
+    ax0, ay0, ax1, ay1 = (A[:, i, None] for i in range(4))
+    bx0, by0, bx1, by1 = (B[None, :, i] for i in range(4))
+    d1 = _cross(ax1 - ax0, ay1 - ay0, bx0 - ax0, by0 - ay0)
+    d2 = _cross(ax1 - ax0, ay1 - ay0, bx1 - ax0, by1 - ay0)
+    d3 = _cross(bx1 - bx0, by1 - by0, ax0 - bx0, ay0 - by0)
+    d4 = _cross(bx1 - bx0, by1 - by0, ax1 - bx0, ay1 - by0)
+    return (d1 * d2 <= 0) & (d3 * d4 <= 0) & ~((d1 == 0) & (d2 == 0) & (d3 == 0) & (d4 == 0))
+
+
+def segment_distance(A: np.ndarray, B: np.ndarray) -> np.ndarray:
+    """Distances ``[M, N]`` between segments ``A[M, 4]`` and ``B[N, 4]`` (0 when they cross)."""
+    if len(A) == 0 or len(B) == 0:
+        return np.full((len(A), len(B)), np.inf)
+    d = np.minimum(
+        np.minimum(point_segment_distance(A[:, 0:2], B), point_segment_distance(A[:, 2:4], B)),
+        np.minimum(point_segment_distance(B[:, 0:2], A), point_segment_distance(B[:, 2:4], A)).T)
+    return np.where(segments_intersect(A, B), 0.0, d)
+
+
+def points_in_polygon(points: np.ndarray, corners: np.ndarray) -> np.ndarray:
+    """Whether points ``[P, 2]`` lie inside convex CCW polygons ``[Q, K, 2]``: ``[P, Q]``."""
+    a = corners[None]                       # [1, Q, K, 2]
+    e = np.roll(corners, -1, axis=1)[None] - a
+    d = points[:, None, None, :] - a
+    return (_cross(e[..., 0], e[..., 1], d[..., 0], d[..., 1]) >= 0).all(axis=-1)
+
+
+def ray_segments(origin: np.ndarray, dirs: np.ndarray, seg: np.ndarray,
+                 max_range: float) -> np.ndarray:
+    """Range ``[B]`` along unit directions ``dirs[B, 2]`` from ``origin[2]`` (or ``[B, 2]``) to
+    the first of the segments ``seg[N, 4]``, ``max_range`` when none is hit closer."""
+    B = len(dirs)
+    if len(seg) == 0:
+        return np.full(B, max_range)
+    o = np.broadcast_to(np.asarray(origin, float), (B, 2))
+    px = seg[None, :, 0] - o[:, 0, None]
+    py = seg[None, :, 1] - o[:, 1, None]
+    ex = seg[None, :, 2] - seg[None, :, 0]
+    ey = seg[None, :, 3] - seg[None, :, 1]
+    dx, dy = dirs[:, 0, None], dirs[:, 1, None]
+    denom = _cross(dx, dy, ex, ey)
+    ok = np.abs(denom) > EPS
+    safe = np.where(ok, denom, 1.0)
+    t = _cross(px, py, ex, ey) / safe
+    s = _cross(px, py, dx, dy) / safe
+    hit = ok & (t >= 0.0) & (s >= 0.0) & (s <= 1.0)
+    return np.minimum(np.where(hit, t, np.inf).min(axis=1), max_range)
+
+
+def ray_circles(origin: np.ndarray, dirs: np.ndarray, centres: np.ndarray, radii: np.ndarray,
+                max_range: float) -> np.ndarray:
+    """Range ``[B]`` from ``origin`` along ``dirs[B, 2]`` to the first circle it enters."""
+    B = len(dirs)
+    if len(centres) == 0:
+        return np.full(B, max_range)
+    o = np.broadcast_to(np.asarray(origin, float), (B, 2))
+    m = o[:, None, :] - centres[None]                         # [B, C, 2]
+    b = np.einsum("bck,bk->bc", m, dirs)
+    c = np.einsum("bck,bck->bc", m, m) - radii[None] ** 2
+    disc = b * b - c
+    root = np.sqrt(np.maximum(disc, 0.0))
+    t = np.where(c <= 0.0, 0.0, -b - root)                   # inside: range 0
+    hit = (disc >= 0.0) & (t >= 0.0)
+    return np.minimum(np.where(hit, t, np.inf).min(axis=1), max_range)
+
+
+def clip_segment_outside(seg: np.ndarray, rects: np.ndarray, shrink: float = 1e-6) -> list:
+    """The pieces of one segment ``[4]`` that lie outside every rectangle ``[Q, 4, 2]``
+    (a piece on a rectangle's border counts as outside, so shared walls stay)."""
+    p0, p1 = seg[:2], seg[2:]
+    pieces = [(0.0, 1.0)]
+    for corners in rects:
+        centre = corners.mean(axis=0)
+        u = corners[1] - corners[0]
+        v = corners[3] - corners[0]
+        hl, hw = np.linalg.norm(u) / 2 - shrink, np.linalg.norm(v) / 2 - shrink
+        u, v = u / np.linalg.norm(u), v / np.linalg.norm(v)
+        t0, t1 = 0.0, 1.0
+        for axis, half in ((u, hl), (v, hw)):
+            a0 = float(np.dot(p0 - centre, axis))
+            da = float(np.dot(p1 - p0, axis))
+            if abs(da) < EPS:
+                if abs(a0) >= half:
+                    t0, t1 = 1.0, 0.0
+                continue
+            lo, hi = sorted(((-half - a0) / da, (half - a0) / da))
+            t0, t1 = max(t0, lo), min(t1, hi)
+        if t1 <= t0:
+            continue
+        cut = []
+        for a, b in pieces:
+            if b <= t0 or a >= t1:
+                cut.append((a, b))
+                continue
+            if a < t0:
+                cut.append((a, t0))
+            if b > t1:
+                cut.append((t1, b))
+        pieces = cut
+    length = float(np.hypot(*(p1 - p0)))
+    return [np.concatenate([p0 + a * (p1 - p0), p0 + b * (p1 - p0)]) for a, b in pieces
+            if (b - a) * length > 1e-6]

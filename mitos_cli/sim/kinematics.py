@@ -1,0 +1,74 @@
+"""The paper's tricycle: one front wheel that steers and drives, two rear wheels.
+
+With ``delta = steering - 90`` (deg) and drive speed ``v`` of the front wheel, the rear axle
+moves forward at ``v cos(delta)`` and the robot turns at ``v sin(delta) / wheelbase``, to the
+LEFT (counter-clockwise, positive yaw rate) when ``steering < 90``. The pose is the footprint
+centre, half a wheelbase ahead of the rear axle. All functions work on arrays of robots.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class Limits:
+    """Per-robot limits as arrays ``[n]`` (inches, seconds, degrees)."""
+
+    wheelbase: np.ndarray
+    steering_min: np.ndarray
+    steering_max: np.ndarray
+    straight: np.ndarray
+    max_rate: np.ndarray           # deg/s
+    max_speed: np.ndarray          # in/s
+    acceleration: np.ndarray       # in/s^2
+
+    @classmethod
+    def of(cls, robots) -> "Limits":
+        def col(attr):
+            return np.array([getattr(r, attr) for r in robots], dtype=float)
+
+        return cls(col("wheelbase"), col("steering_min"), col("steering_max"),
+                   col("steering_straight"), col("max_steering_rate"), col("max_speed"),
+                   col("acceleration"))
+
+
+def limit_commands(steering: np.ndarray, speed: np.ndarray, cmd_steering: np.ndarray,
+                   cmd_speed: np.ndarray, lim: Limits, dt: float) -> tuple[np.ndarray, np.ndarray]:
+    """The steering and speed actually reached after ``dt`` given the commands: clamped to the
+    steering range and top speed, moved at most ``max_rate * dt`` and ``acceleration * dt``."""
+    target = np.clip(cmd_steering, lim.steering_min, lim.steering_max)
+    step = lim.max_rate * dt
+    new_steering = steering + np.clip(target - steering, -step, step)
+    target_v = np.clip(cmd_speed, 0.0, lim.max_speed)
+    dv = lim.acceleration * dt
+    new_speed = speed + np.clip(target_v - speed, -dv, dv)
+    return new_steering, new_speed
+
+
+def advance(x: np.ndarray, y: np.ndarray, heading: np.ndarray, speed: np.ndarray,
+            steering: np.ndarray, lim: Limits, dt: float, substeps: int = 1):
+    """Integrate the pose over ``dt`` at constant speed and steering, in ``substeps`` exact arcs.
+
+    ``heading`` in radians (CCW from +x). Returns the new (x, y, heading) of the centre.
+    """
+    delta = np.deg2rad(steering - lim.straight)
+    forward = speed * np.cos(delta)                 # rear-axle speed, in/s
+    yaw_rate = -speed * np.sin(delta) / lim.wheelbase   # steering < 90 -> delta < 0 -> left
+    half = lim.wheelbase / 2.0
+    rx = x - half * np.cos(heading)
+    ry = y - half * np.sin(heading)
+    h = heading
+    h_dt = dt / substeps
+    for _ in range(substeps):
+        dh = yaw_rate * h_dt
+        # exact arc: chord length 2 R sin(dh / 2) along the mean heading (straight when dh -> 0)
+        chord = forward * h_dt * np.sinc(dh / (2.0 * np.pi))
+        mid = h + dh / 2.0
+        rx = rx + chord * np.cos(mid)
+        ry = ry + chord * np.sin(mid)
+        h = h + dh
+    h = np.remainder(h + np.pi, 2.0 * np.pi) - np.pi
+    return rx + half * np.cos(h), ry + half * np.sin(h), h

@@ -1,0 +1,158 @@
+"""From range readings to the rule base's inputs (the paper's x1, x2, x3 and what the other
+behaviors need).
+
+Frame: at the robot's projection onto its route, ``a`` runs along the route and ``b`` across it,
+positive to the RIGHT. The robot knows its pose (odometry) and the map it planned its route on,
+so a beam whose reading is clearly shorter than the map predicts has hit an obstacle; every
+other beam has hit a wall.
+
+Inputs (all floats, units in the names of ``mitos.terms.yaml`` / ``drive.terms.yaml``):
+
+``road`` (x1, in)
+    corridor width at the robot: nearest wall hit on the left plus nearest on the right among
+    beams that land within ``window`` of the robot along the route (``range`` for a side with
+    no wall in sight, e.g. at an intersection).
+``size`` (x2, in)
+    width across the route of the nearest *obstructing* object ahead: the obstacle hits within
+    ``cluster`` of the nearest one, each widened by half the beam spacing at its range (an
+    ultrasonic beam cannot tell where in its cone the echo came from). 0 when nothing obstructs.
+``position`` (x3, in)
+    lateral offset of that object's middle from the road centre (the route), positive to the
+    right. 0 when nothing obstructs.
+``obstacle`` (in)
+    distance along the route from the robot's front to that object; ``NO_OBSTACLE`` (200, the
+    far end of its universe) when nothing obstructs, so that ``obstacle is NEAR`` is 0 and the
+    blending switches avoid_obstacle off. An object *obstructs* when it is ahead, within
+    ``sight``, and its lateral extent overlaps the band the robot sweeps if it drives on
+    parallel to the route (its width plus ``band_margin`` on each side).
+``heading`` (deg)
+    bearing of the route point ``lookahead`` ahead, relative to the robot's heading, positive
+    to the right (steer right to reduce it).
+``lane`` (in)
+    lateral offset of the robot from its keep-right lane, a line ``min(road / 4, road / 2 -
+    width / 2 - lane_margin)`` right of the road centre; positive = right of the lane.
+``goal`` (in)
+    length of route left to the goal (at least the straight distance to it).
+
+:func:`truth` computes the same quantities from the true geometry (noise-free walls, exact
+obstacle outlines) for the trace.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .route import Route
+from .world import Robot
+
+NO_OBSTACLE = 200.0     # in: the `obstacle` distance when nothing obstructs
+INPUTS = ("road", "size", "position", "obstacle", "heading", "lane", "goal")
+
+
+@dataclass(frozen=True)
+class Settings:
+    lookahead: float = 40.0        # in: pure-pursuit point on the route
+    window: float = 24.0           # in: along-route half window for the road width
+    sight: float = 150.0           # in: how far ahead objects count
+    band_margin: float = 8.0       # in: added to each side of the swept band
+    cluster: float = 30.0          # in: hits this close to the nearest belong to its object
+    lane_margin: float = 6.0       # in: keep-right lane keeps this off the right wall
+    road_cap: float = 100.0        # in: road width used for the lane at wide openings
+
+
+@dataclass(frozen=True)
+class Frame:
+    """The robot on its route: arc length, lateral offset (right +), tangent, normal."""
+
+    s: float
+    e: float
+    t: np.ndarray                  # unit tangent
+    n: np.ndarray                  # unit normal to the right
+
+
+def frame(route: Route, p: np.ndarray, s_hint: float) -> Frame:
+    s, e, t = route.project(p, s_hint)
+    return Frame(s, e, t, np.array([t[1], -t[0]]))
+
+
+def _road(a, b, valid, window: float, far: float) -> tuple[float, float]:
+    side = valid & (np.abs(a) <= window)
+    left = -b[side & (b < 0)]
+    right = b[side & (b > 0)]
+    return (float(left.min()) if left.size else far), (float(right.min()) if right.size else far)
+
+
+def _obstruction(a, b, points, valid, widen, robot: Robot, f: Frame, cfg: Settings):
+    """(size, position, distance) of the nearest obstructing object among ``points``."""
+    half = robot.width / 2 + cfg.band_margin
+    ahead = valid & (a > 0) & (a < cfg.sight)
+    blocking = ahead & (b + widen > -half) & (b - widen < half)
+    if not blocking.any():
+        return 0.0, 0.0, NO_OBSTACLE
+    i = int(np.argmin(np.where(blocking, a, np.inf)))
+    near = ahead & (np.hypot(*(points - points[i]).T) <= cfg.cluster)
+    lo = float((b - widen)[near].min())
+    hi = float((b + widen)[near].max())
+    distance = max(0.0, float(a[near].min()) - robot.length / 2)
+    return hi - lo, f.e + (lo + hi) / 2, distance
+
+
+def _common(route: Route, p, heading: float, f: Frame, road: float, robot: Robot,
+            cfg: Settings) -> tuple[float, float, float]:
+    target = target_point(route, f, cfg)
+    d = target - p
+    bearing = math.degrees(math.atan2(d[1], d[0]) - heading)
+    bearing = (bearing + 180.0) % 360.0 - 180.0
+    road_l = min(road, cfg.road_cap)
+    offset = max(0.0, min(road_l / 4, road_l / 2 - robot.width / 2 - cfg.lane_margin))
+    goal = max(route.length - f.s, float(np.hypot(*(route.goal - p))))
+    return -bearing, f.e - offset, goal
+
+
+def target_point(route: Route, f: Frame, cfg: Settings) -> np.ndarray:
+    """The pursuit point: on the route a lookahead ahead; the goal itself over the last
+    lookahead of the route."""
+    if f.s + cfg.lookahead >= route.length:
+        return route.goal
+    return route.point_at(f.s + cfg.lookahead)
+
+
+def perceive(route: Route, f: Frame, pose: tuple[float, float, float], robot: Robot,
+             dirs: np.ndarray, measured: np.ndarray, expected: np.ndarray, max_range: float,
+             spacing: float, threshold: float, cfg: Settings = Settings()) -> dict[str, float]:
+    """The inputs from one robot's readings (see the module docstring)."""
+    p = np.array(pose[:2])
+    hits = p + measured[:, None] * dirs
+    rel = hits - p
+    a = rel @ f.t
+    b = rel @ f.n
+    valid = measured < max_range * 0.999
+    obstacle_hit = valid & (measured < expected - threshold)
+    left, right = _road(a, b, valid & ~obstacle_hit, cfg.window, max_range)
+    road = left + right
+    widen = measured * spacing / 2
+    size, position, distance = _obstruction(a, b, hits, obstacle_hit, widen, robot, f, cfg)
+    heading, lane, goal = _common(route, p, pose[2], f, road, robot, cfg)
+    return {"road": road, "size": size, "position": position, "obstacle": distance,
+            "heading": heading, "lane": lane, "goal": goal}
+
+
+def truth(route: Route, f: Frame, pose: tuple[float, float, float], robot: Robot,
+          side_ranges: tuple[float, float], outline: np.ndarray,
+          cfg: Settings = Settings()) -> dict[str, float]:
+    """The same inputs from the true geometry: ``side_ranges`` are exact distances to the walls
+    across the route (left, right), ``outline`` points on every obstacle and other robot."""
+    p = np.array(pose[:2])
+    road = side_ranges[0] + side_ranges[1]
+    rel = outline - p
+    a = rel @ f.t if len(outline) else np.zeros(0)
+    b = rel @ f.n if len(outline) else np.zeros(0)
+    valid = np.ones(len(outline), dtype=bool)
+    size, position, distance = _obstruction(a, b, outline, valid, np.zeros(len(outline)),
+                                            robot, f, cfg)
+    heading, lane, goal = _common(route, p, pose[2], f, road, robot, cfg)
+    return {"road": road, "size": size, "position": position, "obstacle": distance,
+            "heading": heading, "lane": lane, "goal": goal}

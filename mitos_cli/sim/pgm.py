@@ -1,0 +1,69 @@
+"""A small reader for PGM images (binary ``P5`` and ASCII ``P2``), enough for ROS maps.
+
+``read_pgm(path)`` returns the pixels as ``uint16`` ``[rows, cols]`` (row 0 = top of the image,
+as stored) and the maximum value. Errors are :class:`ValueError` with a plain message; the
+world loader turns them into a :class:`~mitos_cli.errors.WorldError` at the ``image:`` line.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+
+def _header(data: bytes, count: int) -> tuple[list[int], int]:
+    """The first ``count`` integers after the magic number, skipping ``#`` comments; returns
+    them and the offset just past the single whitespace byte that ends the header."""
+    values: list[int] = []
+    i = 2
+    while len(values) < count:
+        if i >= len(data):
+            raise ValueError("the PGM header is cut short")
+        c = data[i:i + 1]
+        if c == b"#":
+            while i < len(data) and data[i:i + 1] not in (b"\n", b"\r"):
+                i += 1
+        elif c.isspace():
+            i += 1
+        else:
+            start = i
+            while i < len(data) and data[i:i + 1].isdigit():
+                i += 1
+            if start == i:
+                raise ValueError(f"unexpected byte {c!r} in the PGM header")
+            values.append(int(data[start:i]))
+    return values, i + 1
+
+
+def parse_pgm(data: bytes) -> tuple[np.ndarray, int]:
+    magic = data[:2]
+    if magic not in (b"P5", b"P2"):
+        raise ValueError("not a PGM image (it does not start with P5 or P2)")
+    (width, height, maxval), offset = _header(data, 3)
+    if width <= 0 or height <= 0 or not 0 < maxval < 65536:
+        raise ValueError(f"bad PGM size {width} x {height} or maximum value {maxval}")
+    n = width * height
+    if magic == b"P5":
+        dtype = np.dtype(">u2") if maxval > 255 else np.dtype("u1")
+        body = np.frombuffer(data, dtype=dtype, count=-1, offset=offset)
+        if body.size < n:
+            raise ValueError(f"the PGM image holds {body.size} of its {n} pixels")
+        pixels = body[:n].astype(np.uint16)
+    else:
+        try:
+            pixels = np.array(data[offset - 1:].split(), dtype=np.int64)
+        except ValueError:
+            raise ValueError("the ASCII PGM image holds something that is not a number") from None
+        if pixels.size < n:
+            raise ValueError(f"the PGM image holds {pixels.size} of its {n} pixels")
+        pixels = pixels[:n]
+        if pixels.min(initial=0) < 0 or pixels.max(initial=0) > maxval:
+            raise ValueError(f"a PGM pixel lies outside 0..{maxval}")
+        pixels = pixels.astype(np.uint16)
+    return pixels.reshape(height, width), maxval
+
+
+def read_pgm(path: str | Path) -> tuple[np.ndarray, int]:
+    """Pixels ``[rows, cols]`` (top row first, as stored) and the image's maximum value."""
+    return parse_pgm(Path(path).read_bytes())

@@ -1,0 +1,293 @@
+"""The simulation loop: sense, perceive, plan (one batch for all robots), move; then verdict and
+metrics. Stepping never draws; the :class:`SimResult` holds every tick as arrays.
+
+Per tick ``k`` (time ``k * dt``): obstacles are placed at that time; each robot casts its beams,
+perceives its inputs and the true ones; a robot whose footprint touches anything has collided
+(the run ends); a robot within its goal's tolerance is done (it stops and stays as an obstacle);
+the planner evaluates all active robots in one batch; the kinematics apply the steering-rate and
+acceleration limits and integrate in ``substeps`` exact arcs. The run ends in ``success`` (every
+robot at its goal), ``collision``, ``stuck`` (a robot moved less than ``STUCK_DISTANCE`` in
+``STUCK_TIME``) or ``timeout``.
+
+Randomness: ``SeedSequence(seed).spawn(1 + robots)``: the first stream randomises the world
+(only when asked, for ``--runs``), then one stream of sensor noise per robot.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from . import kinematics, obstacles as obs_mod, perception, sensors
+from .geometry import point_segment_distance, polygon_segments, rect_corners, segment_distance
+from .planner import Percepts, Planner
+from .route import Route, plan_route
+from .staticmap import StaticMap, build_static
+from .world import World
+
+STUCK_TIME = 6.0        # s
+STUCK_DISTANCE = 3.0    # in
+OUTCOMES = ("success", "collision", "timeout", "stuck")
+
+
+@dataclass(frozen=True)
+class Scene:
+    """What does not change during a run: the walls and each robot's route."""
+
+    static: StaticMap
+    routes: tuple[Route, ...]
+
+    def __hash__(self) -> int:
+        return id(self)
+
+
+def prepare(world: World) -> Scene:
+    """Walls and routes (A* over the corridors or the grid) of a world."""
+    static = build_static(world)
+    routes = tuple(plan_route(static, world.corridors, a.start, a.goal,
+                              clearance=a.robot.width / 2 + a.robot.safety_margin)
+                   for a in world.agents)
+    return Scene(static, routes)
+
+
+@dataclass
+class SimResult:
+    """A finished run: verdict, metrics and every tick as arrays (``T`` ticks, ``n`` robots)."""
+
+    world: World
+    seed: int
+    planner: str
+    outcome: str
+    robot_outcomes: tuple[str, ...]
+    collisions: int
+    t: np.ndarray                  # [T] s
+    pose: np.ndarray               # [T, n, 3] x, y (in), heading (deg)
+    speed: np.ndarray              # [T, n] in/s
+    steering: np.ndarray           # [T, n] deg (the wheel's actual angle)
+    command: np.ndarray            # [T, n, 2] planner's steering and speed
+    ranges: np.ndarray             # [T, n, B] in (noisy readings)
+    perceived: dict[str, np.ndarray]   # name -> [T, n]
+    true: dict[str, np.ndarray]        # name -> [T, n]
+    clearance: np.ndarray          # [T, n] in, footprint to the nearest thing
+    obstacles: np.ndarray          # [T, O, 2] obstacle positions
+    routes: tuple[Route, ...] = ()
+    static: StaticMap | None = None
+    active: np.ndarray | None = None   # [T, n] robot still driving at that tick
+    metrics: dict = field(default_factory=dict)
+
+    @property
+    def ticks(self) -> int:
+        return len(self.t)
+
+    def summary(self) -> dict:
+        """The ``--json`` contract."""
+        return {"world": self.world.name, "seed": self.seed, "outcome": self.outcome,
+                "reached_goal": self.robot_outcomes[0] == "success", **self.metrics}
+
+
+def _metrics(res: SimResult, dt: float) -> dict:
+    xy = res.pose[:, 0, :2]
+    path = float(np.hypot(*np.diff(xy, axis=0).T).sum()) if len(xy) > 1 else 0.0
+    time_s = float(res.ticks * dt)
+    steer = res.steering[:, 0]
+    return {"collisions": int(res.collisions), "time_s": round(time_s, 6),
+            "path_length_in": path,
+            "min_clearance_in": float(res.clearance[:, 0].min()) if res.ticks else 0.0,
+            "mean_speed_in_s": path / time_s if time_s > 0 else 0.0,
+            "steering_total_variation_deg": float(np.abs(np.diff(steer)).sum()),
+            "ticks": int(res.ticks)}
+
+
+def _footprints(pose: np.ndarray, robots) -> np.ndarray:
+    return rect_corners(pose[:, 0], pose[:, 1], pose[:, 2],
+                        np.array([r.length for r in robots]), np.array([r.width for r in robots]))
+
+
+def _clearance(corners: np.ndarray, pose: np.ndarray, robot, walls: np.ndarray,
+               sides: np.ndarray, centres: np.ndarray, radii: np.ndarray) -> float:
+    """Distance from one footprint (corners ``[4, 2]``) to walls, sides and circles (<= 0:
+    touching)."""
+    fp = polygon_segments(corners)
+    best = math.inf
+    segs = np.concatenate([walls, sides]) if len(sides) else walls
+    if len(segs):
+        best = float(segment_distance(fp, segs).min())
+    if len(centres):
+        c, s = math.cos(pose[2]), math.sin(pose[2])
+        rel = centres - pose[:2]
+        lx = np.abs(rel[:, 0] * c + rel[:, 1] * s) - robot.length / 2
+        ly = np.abs(-rel[:, 0] * s + rel[:, 1] * c) - robot.width / 2
+        outside = np.hypot(np.maximum(lx, 0), np.maximum(ly, 0))
+        inside = np.minimum(np.maximum(lx, ly), 0)
+        best = min(best, float((outside + inside - radii).min()))
+    return best
+
+
+def simulate(world: World, planner: Planner | None = None, seed: int | None = None, *,
+             randomise: bool = False, scene: Scene | None = None,
+             on_tick=None) -> SimResult:
+    """Run ``world`` with ``planner`` (default: the packaged rule base's ``drive``) from
+    ``seed`` (default: the world's). ``randomise`` draws obstacle places and sensor noise from
+    the world's ranges first. ``on_tick(k, state)`` is called after each tick (``--live``)."""
+    if planner is None:
+        from .planner import FuzzyPlanner
+
+        planner = FuzzyPlanner(None, world.behavior)
+    seed = world.seed if seed is None else int(seed)
+    streams = [np.random.default_rng(s) for s in
+               np.random.SeedSequence(seed).spawn(1 + len(world.agents))]
+    if randomise:
+        world = obs_mod.randomised(world, streams[0])
+    scene = scene or prepare(world)
+    static, routes = scene.static, scene.routes
+    agents = world.agents
+    robots = [a.robot for a in agents]
+    n = len(agents)
+    lim = kinematics.Limits.of(robots)
+    sen = world.sensors
+    angles = sen.angles
+    B = len(angles)
+    spacing = (2 * math.pi / B if sen.layout == "ring"
+               else math.radians(sen.fov) / max(B - 1, 1))
+    spacing = min(spacing, 2 * math.tan(math.radians(sen.cone) / 2)) if sen.cone > 0 else 0.0
+    threshold = max(4.0, 3.0 * sen.noise)
+    reach = sen.range + max(max(r.length, r.width) for r in robots)
+    cfg = perception.Settings()
+
+    dt, sub = world.dt, world.substeps
+    steps = int(math.floor(world.time_limit / dt + 1e-9))
+    x = np.array([a.start.x for a in agents], float)
+    y = np.array([a.start.y for a in agents], float)
+    h = np.deg2rad(np.array([a.start.heading for a in agents], float))
+    v = np.zeros(n)
+    steer = lim.straight.copy()
+    s_hint = np.zeros(n)
+    active = np.ones(n, dtype=bool)
+    goals = np.array([[a.goal.x, a.goal.y] for a in agents], float)
+    tol = np.array([a.goal.tolerance for a in agents], float)
+
+    rec_pose, rec_v, rec_steer, rec_cmd, rec_rng, rec_clear, rec_obs, rec_act = ([] for _ in range(8))
+    rec_p = {k: [] for k in perception.INPUTS}
+    rec_t = {k: [] for k in perception.INPUTS}
+    outcomes = ["timeout"] * n
+    collided = 0
+    stuck_window = max(1, int(round(STUCK_TIME / dt)))
+    history: list[np.ndarray] = []
+
+    for k in range(steps):
+        t = k * dt
+        where = obs_mod.positions(world.obstacles, t)
+        centres, radii, circ_idx, rect_sides, _, _ = obs_mod.shapes_at(world.obstacles, where)
+        pose = np.stack([x, y, h], axis=1)
+        corners = _footprints(pose, robots)
+        robot_sides = polygon_segments(corners).reshape(n, 4, 4)
+        outline, _ = obs_mod.outline_points(world.obstacles, where)
+        ranges = np.zeros((n, B))
+        percepts_p = {key: np.zeros(n) for key in perception.INPUTS}
+        percepts_t = {key: np.zeros(n) for key in perception.INPUTS}
+        targets = np.zeros((n, 2))
+        clear = np.zeros(n)
+        for i in range(n):
+            others = np.concatenate([rect_sides] + [robot_sides[j] for j in range(n) if j != i])
+            walls = static.near(x[i], y[i], reach)
+            dirs = sensors.beam_directions(h[i], angles)
+            expected, true_r = sensors.cast(pose[i, :2], dirs, walls, others, centres, radii,
+                                            sen.range)
+            measured = sensors.add_noise(true_r, sen.noise, sen.range, streams[1 + i])
+            ranges[i] = measured
+            f = perception.frame(routes[i], pose[i, :2], s_hint[i])
+            s_hint[i] = f.s
+            p = perception.perceive(routes[i], f, (x[i], y[i], h[i]), robots[i], dirs, measured,
+                                    expected, sen.range, spacing, threshold, cfg)
+            side_dirs = np.stack([-f.n, f.n])
+            sides_lr = sensors.cast(pose[i, :2], side_dirs, walls, np.zeros((0, 4)),
+                                    np.zeros((0, 2)), np.zeros(0), 1e6)[0]
+            other_pts = [outline] + [corners[j] for j in range(n) if j != i]
+            tr = perception.truth(routes[i], f, (x[i], y[i], h[i]), robots[i],
+                                  (float(sides_lr[0]), float(sides_lr[1])),
+                                  np.concatenate(other_pts), cfg)
+            for key in perception.INPUTS:
+                percepts_p[key][i] = p[key]
+                percepts_t[key][i] = tr[key]
+            targets[i] = perception.target_point(routes[i], f, cfg)
+            clear[i] = _clearance(corners[i], pose[i], robots[i], walls, others, centres, radii)
+
+        hit = active & (clear <= 0.0)
+        arrived = active & (np.hypot(x - goals[:, 0], y - goals[:, 1]) <= tol)
+        for i in np.flatnonzero(arrived):
+            outcomes[i] = "success"
+        active &= ~arrived
+        cmd = np.zeros((n, 2))
+        cmd[:, 0] = lim.straight
+        if active.any():
+            idx = np.flatnonzero(active)
+            sub_p = Percepts({key: val[idx] for key, val in percepts_p.items()}, ranges[idx],
+                             angles, pose[idx], v[idx], targets[idx], goals[idx])
+            c_steer, c_speed = planner.plan(sub_p)
+            cmd[idx, 0], cmd[idx, 1] = c_steer, c_speed
+
+        rec_pose.append(np.stack([x, y, np.rad2deg(h)], axis=1))
+        rec_v.append(v.copy())
+        rec_steer.append(steer.copy())
+        rec_cmd.append(cmd)
+        rec_rng.append(ranges)
+        rec_clear.append(clear)
+        rec_obs.append(where)
+        rec_act.append(active.copy())
+        for key in perception.INPUTS:
+            rec_p[key].append(percepts_p[key])
+            rec_t[key].append(percepts_t[key])
+        if on_tick is not None:
+            on_tick(k, {"t": t, "pose": rec_pose[-1], "speed": v, "steering": steer,
+                        "inputs": percepts_p, "clearance": clear, "obstacles": where})
+
+        if hit.any():
+            collided = int(hit.sum())
+            for i in np.flatnonzero(hit):
+                outcomes[i] = "collision"
+            break
+        if not active.any():
+            break
+        # move: limits and exact arcs, substep by substep; stopped robots stay put
+        sdt = dt / sub
+        for _ in range(sub):
+            steer, v = kinematics.limit_commands(steer, v, cmd[:, 0],
+                                                 np.where(active, cmd[:, 1], 0.0), lim, sdt)
+            v = np.where(active, v, 0.0)
+            x, y, h = kinematics.advance(x, y, h, v, steer, lim, sdt, 1)
+        history.append(np.stack([x, y], axis=1))
+        if len(history) > stuck_window:
+            moved = np.hypot(*(history[-1] - history[-1 - stuck_window]).T)
+            stuck = active & (moved < STUCK_DISTANCE)
+            if stuck.any():
+                for i in np.flatnonzero(stuck):
+                    outcomes[i] = "stuck"
+                break
+
+    if "collision" in outcomes:
+        outcome = "collision"
+    elif all(o == "success" for o in outcomes):
+        outcome = "success"
+    elif "stuck" in outcomes:
+        outcome = "stuck"
+    else:
+        outcome = "timeout"
+    res = SimResult(
+        world=world, seed=seed, planner=getattr(planner, "name", type(planner).__name__),
+        outcome=outcome, robot_outcomes=tuple(outcomes), collisions=collided,
+        t=np.arange(len(rec_pose)) * dt, pose=np.array(rec_pose), speed=np.array(rec_v),
+        steering=np.array(rec_steer), command=np.array(rec_cmd), ranges=np.array(rec_rng),
+        perceived={key: np.array(val) for key, val in rec_p.items()},
+        true={key: np.array(val) for key, val in rec_t.items()},
+        clearance=np.array(rec_clear), obstacles=np.array(rec_obs).reshape(len(rec_pose), -1, 2),
+        routes=routes, static=static, active=np.array(rec_act))
+    res.metrics = _metrics(res, dt)
+    return res
+
+
+@functools.lru_cache(maxsize=8)
+def _cached_scene(world: World) -> Scene:
+    return prepare(world)

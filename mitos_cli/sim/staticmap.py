@@ -1,0 +1,135 @@
+"""The static map as walls: corridors carved out of solid space and/or an occupancy grid.
+
+:func:`build_static` turns a world's map into a :class:`StaticMap`: wall segments (what the
+sensors see and the robot can hit) and a ``free(points)`` test. Corridors are rectangles, one
+per polyline piece, stretched by half the width beyond each end so that corners and
+intersections fall out of their overlaps; a wall is every rectangle side minus what lies inside
+another rectangle. A grid's walls are the cell edges between blocked and free cells, merged
+into runs. With both, the corridors are carved into the grid first.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .geometry import clip_segment_outside, points_in_polygon, rect_corners
+from .world import Corridor, Grid, World
+
+
+def corridor_rects(corridors: tuple[Corridor, ...]) -> np.ndarray:
+    """Rectangles ``[Q, 4, 2]``: one per polyline piece, extended by width/2 at both ends."""
+    rects = []
+    for c in corridors:
+        pts = np.asarray(c.points, float)
+        for a, b in zip(pts[:-1], pts[1:]):
+            d = b - a
+            length = float(np.hypot(*d))
+            heading = float(np.arctan2(d[1], d[0]))
+            mid = (a + b) / 2
+            rects.append(rect_corners(mid[0], mid[1], heading, length + c.width, c.width))
+    return np.array(rects).reshape(-1, 4, 2)
+
+
+def corridor_walls(rects: np.ndarray) -> np.ndarray:
+    walls = []
+    for i, corners in enumerate(rects):
+        others = np.delete(rects, i, axis=0)
+        for k in range(4):
+            side = np.concatenate([corners[k], corners[(k + 1) % 4]])
+            walls.extend(clip_segment_outside(side, others))
+    return np.array(walls).reshape(-1, 4)
+
+
+def _runs(mask: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Runs of True along axis 1 of ``mask[L, W]``: (line, start, end) arrays (end exclusive)."""
+    L, W = mask.shape
+    padded = np.zeros((L, W + 2), dtype=np.int8)
+    padded[:, 1:-1] = mask
+    step = np.diff(padded, axis=1)
+    line_s, start = np.nonzero(step == 1)
+    line_e, end = np.nonzero(step == -1)
+    return line_s, start, end   # nonzero scans row-major, so starts and ends pair up
+
+
+def grid_walls(grid: Grid) -> np.ndarray:
+    """Cell edges between blocked and free cells (outside the grid counts as blocked)."""
+    blocked = np.pad(grid.occupied, 1, constant_values=True)
+    res, (ox, oy) = grid.resolution, grid.origin
+    # horizontal edges: between padded rows r and r+1, at y = oy + r * res
+    h = blocked[:-1, 1:-1] != blocked[1:, 1:-1]
+    r, c0, c1 = _runs(h)
+    horiz = np.stack([ox + c0 * res, oy + r * res, ox + c1 * res, oy + r * res], axis=1)
+    # vertical edges: between padded columns c and c+1, at x = ox + c * res
+    v = (blocked[1:-1, :-1] != blocked[1:-1, 1:]).T
+    c, r0, r1 = _runs(v)
+    vert = np.stack([ox + c * res, oy + r0 * res, ox + c * res, oy + r1 * res], axis=1)
+    return np.concatenate([horiz, vert]).astype(float)
+
+
+def carve(grid: Grid, rects: np.ndarray) -> Grid:
+    """The grid with every cell whose centre lies in a corridor made free."""
+    rows, cols = grid.occupied.shape
+    ys, xs = np.mgrid[0:rows, 0:cols]
+    centres = np.stack([grid.origin[0] + (xs.ravel() + 0.5) * grid.resolution,
+                        grid.origin[1] + (ys.ravel() + 0.5) * grid.resolution], axis=1)
+    inside = points_in_polygon(centres, rects).any(axis=1).reshape(rows, cols)
+    return Grid(grid.occupied & ~inside, grid.resolution, grid.origin, grid.source)
+
+
+@dataclass(frozen=True)
+class StaticMap:
+    """Walls ``[N, 4]`` with their bounding boxes, and what is free."""
+
+    walls: np.ndarray
+    rects: np.ndarray              # corridor rectangles [Q, 4, 2] (empty with a grid)
+    grid: Grid | None
+    bounds: tuple[float, float, float, float]    # xmin, ymin, xmax, ymax
+
+    def __hash__(self) -> int:
+        return id(self)
+
+    @property
+    def lo(self) -> np.ndarray:
+        return np.minimum(self.walls[:, 0:2], self.walls[:, 2:4])
+
+    def free(self, points: np.ndarray) -> np.ndarray:
+        """Whether each point ``[P, 2]`` lies in free space."""
+        points = np.atleast_2d(np.asarray(points, float))
+        if self.grid is not None:
+            g = self.grid
+            col = np.floor((points[:, 0] - g.origin[0]) / g.resolution).astype(np.int64)
+            row = np.floor((points[:, 1] - g.origin[1]) / g.resolution).astype(np.int64)
+            rows, cols = g.occupied.shape
+            inside = (row >= 0) & (row < rows) & (col >= 0) & (col < cols)
+            out = np.zeros(len(points), dtype=bool)
+            out[inside] = ~g.occupied[row[inside], col[inside]]
+            return out
+        return points_in_polygon(points, self.rects).any(axis=1)
+
+    def near(self, x: float, y: float, reach: float) -> np.ndarray:
+        """The walls whose bounding box comes within ``reach`` of (x, y)."""
+        w = self.walls
+        keep = ((np.minimum(w[:, 0], w[:, 2]) <= x + reach) &
+                (np.maximum(w[:, 0], w[:, 2]) >= x - reach) &
+                (np.minimum(w[:, 1], w[:, 3]) <= y + reach) &
+                (np.maximum(w[:, 1], w[:, 3]) >= y - reach))
+        return w[keep]
+
+
+def build_static(world: World) -> StaticMap:
+    rects = corridor_rects(world.corridors) if world.corridors else np.zeros((0, 4, 2))
+    grid = world.grid
+    if grid is not None:
+        if len(rects):
+            grid = carve(grid, rects)
+        walls = grid_walls(grid)
+        rows, cols = grid.occupied.shape
+        bounds = (grid.origin[0], grid.origin[1], grid.origin[0] + cols * grid.resolution,
+                  grid.origin[1] + rows * grid.resolution)
+        return StaticMap(walls, np.zeros((0, 4, 2)), grid, bounds)
+    walls = corridor_walls(rects)
+    pts = rects.reshape(-1, 2)
+    bounds = (*pts.min(axis=0), *pts.max(axis=0))
+    return StaticMap(walls, rects, None, tuple(float(b) for b in bounds))

@@ -1,0 +1,160 @@
+"""The world model: frozen dataclasses read from a world file by :mod:`.worldfile`.
+
+Units everywhere: inches, seconds, degrees (headings counter-clockwise from +x, the usual
+mathematical convention; steering 90 = straight, below 90 = left).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class Pose:
+    """A robot pose: the centre of its footprint (in) and its heading (deg, CCW from +x)."""
+
+    x: float
+    y: float
+    heading: float = 0.0
+
+
+@dataclass(frozen=True)
+class Goal:
+    x: float
+    y: float
+    tolerance: float = 12.0        # in: success when the footprint centre is this close
+
+
+@dataclass(frozen=True)
+class Robot:
+    """The paper's tricycle: one front wheel that steers and drives, two rear wheels."""
+
+    model: str = "tricycle"
+    wheelbase: float = 16.0        # in, rear axle to front wheel
+    length: float = 24.0           # in, footprint (a rectangle centred on the pose)
+    width: float = 18.0            # in
+    safety_margin: float = 2.0     # in: clearance below this counts as a near miss
+    steering_min: float = 30.0     # deg (wide left)
+    steering_max: float = 150.0    # deg (wide right)
+    steering_straight: float = 90.0
+    max_steering_rate: float = 180.0   # deg/s
+    max_speed: float = 60.0        # in/s
+    acceleration: float = 40.0     # in/s^2 (also the braking limit)
+
+
+@dataclass(frozen=True)
+class Sensors:
+    """Ultrasonic range sensors: a ``ring`` round the robot or a ``fan`` facing forward."""
+
+    layout: str = "ring"
+    count: int = 36
+    fov: float = 360.0             # deg covered (a ring always covers 360)
+    cone: float = 15.0             # deg, beam width (widens what one beam sees)
+    range: float = 150.0           # in
+    noise: float = 0.0             # in, standard deviation of the range noise
+
+    @property
+    def angles(self) -> np.ndarray:
+        """Beam directions relative to the heading (rad), clockwise order from the left."""
+        if self.layout == "ring":
+            return np.deg2rad(np.arange(self.count) * (360.0 / self.count))
+        half = np.deg2rad(self.fov) / 2.0
+        return np.linspace(half, -half, self.count) if self.count > 1 else np.zeros(1)
+
+
+@dataclass(frozen=True)
+class Corridor:
+    """A polyline of corridor centre points (in) carved ``width`` wide out of solid space."""
+
+    points: tuple[tuple[float, float], ...]
+    width: float
+
+
+@dataclass(frozen=True)
+class Grid:
+    """An occupancy grid: ``occupied[row, col]`` with row 0 at the bottom (y grows upward)."""
+
+    occupied: np.ndarray           # bool [rows, cols]
+    resolution: float              # in per cell
+    origin: tuple[float, float]    # in, lower-left corner of cell (0, 0)
+    source: str = ""
+
+    def __hash__(self) -> int:     # frozen dataclass with an array: hash by identity
+        return id(self)
+
+
+@dataclass(frozen=True)
+class Motion:
+    """How an obstacle moves: ``static``, ``velocity`` (in/s) or ``waypoints`` at ``speed``."""
+
+    kind: str = "static"
+    velocity: tuple[float, float] = (0.0, 0.0)
+    waypoints: tuple[tuple[float, float], ...] = ()
+    speed: float = 0.0
+    mode: str = "loop"             # waypoints: loop | ping-pong | stop
+
+
+@dataclass(frozen=True)
+class Obstacle:
+    """A circle (``radius``) or a rectangle (``length`` x ``width`` turned by ``angle``)."""
+
+    name: str
+    shape: str                     # circle | rectangle
+    x: float
+    y: float
+    radius: float = 0.0
+    length: float = 0.0
+    width: float = 0.0
+    angle: float = 0.0             # deg
+    motion: Motion = field(default_factory=Motion)
+
+
+@dataclass(frozen=True)
+class Jitter:
+    """A randomisation range for ``--runs``: uniform offsets added to an obstacle's place."""
+
+    obstacle: str
+    dx: tuple[float, float] = (0.0, 0.0)
+    dy: tuple[float, float] = (0.0, 0.0)
+
+
+@dataclass(frozen=True)
+class Randomise:
+    obstacles: tuple[Jitter, ...] = ()
+    sensor_noise: tuple[float, float] | None = None   # uniform range of the noise std (in)
+
+
+@dataclass(frozen=True)
+class Agent:
+    """One robot of the world with its start and goal (the first is "the" robot)."""
+
+    name: str
+    robot: Robot
+    start: Pose
+    goal: Goal
+
+
+@dataclass(frozen=True)
+class World:
+    name: str
+    path: str
+    seed: int
+    dt: float                      # s
+    time_limit: float              # s
+    substeps: int
+    agents: tuple[Agent, ...]
+    sensors: Sensors
+    corridors: tuple[Corridor, ...]
+    grid: Grid | None
+    obstacles: tuple[Obstacle, ...]
+    randomise: Randomise
+    behavior: str = "drive"
+
+    @property
+    def robot(self) -> Robot:
+        return self.agents[0].robot
+
+    def with_changes(self, **changes) -> "World":
+        return replace(self, **changes)

@@ -1,0 +1,329 @@
+"""World files (YAML) -> :class:`~.world.World`, with a position for every complaint.
+
+The format is documented in ``worlds/README.md``. Every error is a
+:class:`~mitos_cli.errors.WorldError` naming the file, line and column: unknown keys (with
+"did you mean"), missing fields, numbers out of range, a start or goal inside a wall, a map
+image that cannot be read.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+from .. import yamlpos
+from ..errors import Span, WorldError, unknown
+from ..yamlpos import YList, YMap
+from .world import (Agent, Corridor, Goal, Jitter, Motion, Obstacle, Pose, Randomise, Robot,
+                    Sensors, World)
+
+TOP_KEYS = ("name", "seed", "dt", "time_limit", "substeps", "behavior", "robot", "sensors",
+            "q_init", "q_goal", "map", "obstacles", "robots", "randomise")
+ROBOT_KEYS = ("model", "wheelbase", "footprint", "safety_margin", "steering", "max_speed",
+              "acceleration")
+STEERING_KEYS = ("min", "max", "straight", "max_rate")
+SENSOR_KEYS = ("layout", "count", "fov", "cone", "range", "noise")
+MAP_KEYS = ("corridors", "grid", "unknown")
+OBSTACLE_KEYS = ("name", "shape", "at", "radius", "length", "width", "angle", "velocity",
+                 "waypoints", "speed", "mode")
+AGENT_KEYS = ("name", "q_init", "q_goal", "robot")
+RANDOMISE_KEYS = ("obstacles", "sensor_noise")
+MODELS = ("tricycle",)
+LAYOUTS = ("ring", "fan")
+SHAPES = ("circle", "rectangle")
+MODES = ("loop", "ping-pong", "stop")
+
+
+class _Reader:
+    """Small typed accessors bound to one file."""
+
+    def __init__(self, path: str) -> None:
+        self.path = path
+
+    def mapping(self, value: Any, span: Span, what: str, keys: tuple[str, ...]) -> YMap:
+        m = yamlpos.expect_map(value, span, WorldError, what)
+        yamlpos.check_keys(m, keys, WorldError, what)
+        return m
+
+    def number(self, m: YMap, key: str, what: str, default: float | None = None, *,
+               positive: bool = False, minimum: float | None = None,
+               maximum: float | None = None) -> float:
+        if key not in m:
+            if default is None:
+                yamlpos.require(m, key, WorldError, what)
+            return float(default)
+        span = m.value_span(key)
+        x = yamlpos.expect_number(m[key], span, WorldError, f"`{key}` in {what}")
+        if positive and x <= 0:
+            raise WorldError(f"`{key}` in {what} must be positive, not {x:g}", span=span)
+        if minimum is not None and x < minimum:
+            raise WorldError(f"`{key}` in {what} must be at least {minimum:g}, not {x:g}",
+                             span=span)
+        if maximum is not None and x > maximum:
+            raise WorldError(f"`{key}` in {what} must be at most {maximum:g}, not {x:g}",
+                             span=span)
+        return x
+
+    def point(self, value: Any, span: Span, what: str) -> tuple[float, float]:
+        if not isinstance(value, list) or len(value) != 2:
+            raise WorldError(f"{what} must be a point [x, y] (inches)", span=span)
+        return tuple(yamlpos.expect_number(v, span, WorldError, what) for v in value)
+
+    def points(self, value: Any, span: Span, what: str, least: int) -> tuple:
+        if not isinstance(value, list) or len(value) < least:
+            raise WorldError(f"{what} must be a list of at least {least} points [x, y]",
+                             span=span)
+        spans = value.item_spans if isinstance(value, YList) else [span] * len(value)
+        return tuple(self.point(p, s, f"a point of {what}") for p, s in zip(value, spans))
+
+    def choice(self, m: YMap, key: str, options: tuple[str, ...], what: str,
+               default: str | None = None) -> str:
+        if key not in m:
+            if default is None:
+                yamlpos.require(m, key, WorldError, what)
+            return default
+        value = str(m[key])
+        if value not in options:
+            raise unknown(f"{key} in {what}", value, options, span=m.value_span(key),
+                          cls=WorldError)
+        return value
+
+    def range_pair(self, value: Any, span: Span, what: str) -> tuple[float, float]:
+        lo, hi = self.point(value, span, what)
+        if lo > hi:
+            raise WorldError(f"{what} must be [low, high] with low <= high", span=span)
+        return lo, hi
+
+
+def read_robot(r: _Reader, value: Any, span: Span, base: Robot | None = None) -> Robot:
+    m = r.mapping(value, span, "robot", ROBOT_KEYS)
+    d = base or Robot()
+    if base is None:
+        r.choice(m, "model", MODELS, "robot")
+    elif "model" in m:
+        r.choice(m, "model", MODELS, "robot")
+    fp = d.length, d.width
+    if "footprint" in m:
+        f = r.mapping(m["footprint"], m.value_span("footprint"), "robot footprint",
+                      ("length", "width"))
+        fp = (r.number(f, "length", "robot footprint", positive=True),
+              r.number(f, "width", "robot footprint", positive=True))
+    elif base is None:
+        yamlpos.require(m, "footprint", WorldError, "robot")
+    st = YMap()
+    st.span, st.key_spans, st.value_spans = m.span, {}, {}
+    if "steering" in m:
+        st = r.mapping(m["steering"], m.value_span("steering"), "robot steering", STEERING_KEYS)
+    smin = r.number(st, "min", "robot steering", d.steering_min, minimum=0, maximum=180)
+    smax = r.number(st, "max", "robot steering", d.steering_max, minimum=0, maximum=180)
+    straight = r.number(st, "straight", "robot steering", d.steering_straight)
+    if not smin < straight < smax:
+        raise WorldError(f"steering needs min < straight < max, not {smin:g} < {straight:g} "
+                         f"< {smax:g}", span=st.span)
+    return Robot(
+        model="tricycle",
+        wheelbase=r.number(m, "wheelbase", "robot", None if base is None else d.wheelbase,
+                           positive=True),
+        length=fp[0], width=fp[1],
+        safety_margin=r.number(m, "safety_margin", "robot", d.safety_margin, minimum=0),
+        steering_min=smin, steering_max=smax, steering_straight=straight,
+        max_steering_rate=r.number(st, "max_rate", "robot steering", d.max_steering_rate,
+                                   positive=True),
+        max_speed=r.number(m, "max_speed", "robot", d.max_speed, positive=True),
+        acceleration=r.number(m, "acceleration", "robot", d.acceleration, positive=True))
+
+
+def read_sensors(r: _Reader, value: Any, span: Span) -> Sensors:
+    m = r.mapping(value, span, "sensors", SENSOR_KEYS)
+    d = Sensors()
+    layout = r.choice(m, "layout", LAYOUTS, "sensors", d.layout)
+    count = r.number(m, "count", "sensors", d.count, minimum=1, maximum=720)
+    if count != int(count):
+        raise WorldError("`count` in sensors must be a whole number", span=m.value_span("count"))
+    return Sensors(layout, int(count),
+                   r.number(m, "fov", "sensors", 180.0 if layout == "fan" else 360.0,
+                            positive=True, maximum=360),
+                   r.number(m, "cone", "sensors", d.cone, minimum=0, maximum=90),
+                   r.number(m, "range", "sensors", d.range, positive=True),
+                   r.number(m, "noise", "sensors", d.noise, minimum=0))
+
+
+def read_pose(r: _Reader, value: Any, span: Span, what: str) -> Pose:
+    m = r.mapping(value, span, what, ("x", "y", "heading"))
+    return Pose(r.number(m, "x", what), r.number(m, "y", what), r.number(m, "heading", what, 0.0))
+
+
+def read_goal(r: _Reader, value: Any, span: Span, what: str) -> Goal:
+    m = r.mapping(value, span, what, ("x", "y", "tolerance"))
+    return Goal(r.number(m, "x", what), r.number(m, "y", what),
+                r.number(m, "tolerance", what, Goal.tolerance, positive=True))
+
+
+def read_obstacle(r: _Reader, value: Any, span: Span, index: int) -> Obstacle:
+    m = r.mapping(value, span, f"obstacle {index + 1}", OBSTACLE_KEYS)
+    name = str(m.get("name", f"obstacle{index + 1}"))
+    what = f"obstacle `{name}`"
+    shape = r.choice(m, "shape", SHAPES, what)
+    at = r.point(yamlpos.require(m, "at", WorldError, what), m.value_span("at"), f"`at` of {what}")
+    radius = length = width = angle = 0.0
+    if shape == "circle":
+        radius = r.number(m, "radius", what, positive=True)
+        for k in ("length", "width", "angle"):
+            if k in m:
+                raise WorldError(f"a circle has a `radius`, not a `{k}`", span=m.key_span(k))
+    else:
+        length = r.number(m, "length", what, positive=True)
+        width = r.number(m, "width", what, positive=True)
+        angle = r.number(m, "angle", what, 0.0)
+        if "radius" in m:
+            raise WorldError("a rectangle has `length` and `width`, not a `radius`",
+                             span=m.key_span("radius"))
+    motion = Motion()
+    if "velocity" in m and "waypoints" in m:
+        raise WorldError(f"{what} has both `velocity` and `waypoints`; give one",
+                         span=m.key_span("waypoints"))
+    if "velocity" in m:
+        motion = Motion("velocity", velocity=r.point(m["velocity"], m.value_span("velocity"),
+                                                     f"`velocity` of {what} (in/s)"))
+    elif "waypoints" in m:
+        wps = r.points(m["waypoints"], m.value_span("waypoints"), f"`waypoints` of {what}", 1)
+        motion = Motion("waypoints", waypoints=(at,) + wps,
+                        speed=r.number(m, "speed", what, positive=True),
+                        mode=r.choice(m, "mode", MODES, what, "loop"))
+    for k in ("speed", "mode"):
+        if k in m and motion.kind != "waypoints":
+            raise WorldError(f"`{k}` belongs to an obstacle with `waypoints`", span=m.key_span(k))
+    return Obstacle(name, shape, at[0], at[1], radius, length, width, angle, motion)
+
+
+def read_randomise(r: _Reader, value: Any, span: Span, names: list[str]) -> Randomise:
+    m = r.mapping(value, span, "randomise", RANDOMISE_KEYS)
+    jitters = []
+    if "obstacles" in m:
+        obs = r.mapping(m["obstacles"], m.value_span("obstacles"), "randomise obstacles",
+                        tuple(names))
+        for name, spec in obs.items():
+            j = r.mapping(spec, obs.value_span(name), f"randomise of `{name}`", ("dx", "dy"))
+            dx = r.range_pair(j["dx"], j.value_span("dx"), "dx") if "dx" in j else (0.0, 0.0)
+            dy = r.range_pair(j["dy"], j.value_span("dy"), "dy") if "dy" in j else (0.0, 0.0)
+            jitters.append(Jitter(name, dx, dy))
+    noise = None
+    if "sensor_noise" in m:
+        noise = r.range_pair(m["sensor_noise"], m.value_span("sensor_noise"), "sensor_noise")
+        if noise[0] < 0:
+            raise WorldError("sensor_noise must not be negative", span=m.value_span("sensor_noise"))
+    return Randomise(tuple(jitters), noise)
+
+
+def parse_world(text: str, path: str) -> World:
+    """Parse world YAML ``text`` (read from ``path``, which anchors relative map paths)."""
+    r = _Reader(path)
+    doc = yamlpos.load(text, path, WorldError)
+    top = r.mapping(doc, Span.in_text(text, path, 1, 1), "the world file", TOP_KEYS)
+    name = str(yamlpos.require(top, "name", WorldError, "the world file"))
+    seed = r.number(top, "seed", "the world file", 0.0, minimum=0)
+    if seed != int(seed):
+        raise WorldError("seed must be a whole number", span=top.value_span("seed"))
+    dt = r.number(top, "dt", "the world file", None, positive=True, maximum=1.0)
+    limit = r.number(top, "time_limit", "the world file", None, positive=True)
+    substeps = r.number(top, "substeps", "the world file", 1.0, minimum=1, maximum=100)
+    robot = read_robot(r, yamlpos.require(top, "robot", WorldError, "the world file"),
+                       top.value_span("robot"))
+    sensors = (read_sensors(r, top["sensors"], top.value_span("sensors"))
+               if "sensors" in top else Sensors())
+    start = read_pose(r, yamlpos.require(top, "q_init", WorldError, "the world file"),
+                      top.value_span("q_init"), "q_init")
+    goal = read_goal(r, yamlpos.require(top, "q_goal", WorldError, "the world file"),
+                     top.value_span("q_goal"), "q_goal")
+    agents = [Agent("robot", robot, start, goal)]
+    agent_spans = [(top.value_span("q_init"), top.value_span("q_goal"))]
+    for i, item in enumerate(top.get("robots") or []):
+        span = top["robots"].item_span(i)
+        a = r.mapping(item, span, f"robot {i + 2}", AGENT_KEYS)
+        aname = str(a.get("name", f"robot{i + 2}"))
+        arobot = (read_robot(r, a["robot"], a.value_span("robot"), robot) if "robot" in a
+                  else robot)
+        agents.append(Agent(aname, arobot,
+                            read_pose(r, yamlpos.require(a, "q_init", WorldError, f"robot `{aname}`"),
+                                      a.value_span("q_init"), f"q_init of `{aname}`"),
+                            read_goal(r, yamlpos.require(a, "q_goal", WorldError, f"robot `{aname}`"),
+                                      a.value_span("q_goal"), f"q_goal of `{aname}`")))
+        agent_spans.append((a.value_span("q_init"), a.value_span("q_goal")))
+
+    mp = r.mapping(yamlpos.require(top, "map", WorldError, "the world file"),
+                   top.value_span("map"), "map", MAP_KEYS)
+    corridors = []
+    for i, item in enumerate(mp.get("corridors") or []):
+        c = r.mapping(item, mp["corridors"].item_span(i), f"corridor {i + 1}", ("points", "width"))
+        pts = r.points(yamlpos.require(c, "points", WorldError, f"corridor {i + 1}"),
+                       c.value_span("points"), f"`points` of corridor {i + 1}", 2)
+        corridors.append(Corridor(pts, r.number(c, "width", f"corridor {i + 1}", positive=True)))
+    unknown_occupied = r.choice(mp, "unknown", ("occupied", "free"), "map", "occupied") == "occupied"
+    grid = None
+    if "grid" in mp:
+        from .gridmap import load_map_yaml
+
+        grid = load_map_yaml(Path(path).parent / str(mp["grid"]),
+                             unknown_occupied=unknown_occupied, where=mp.value_span("grid"))
+    if not corridors and grid is None:
+        raise WorldError("the map has neither `corridors` nor a `grid`", span=mp.span,
+                         hint="add `corridors: [{points: [[0, 0], [600, 0]], width: 70}]`")
+
+    obstacles = []
+    for i, item in enumerate(top.get("obstacles") or []):
+        obstacles.append(read_obstacle(r, item, top["obstacles"].item_span(i), i))
+    names = [o.name for o in obstacles]
+    for i, o in enumerate(obstacles):
+        if names.count(o.name) > 1:
+            raise WorldError(f"two obstacles are named `{o.name}`",
+                             span=top["obstacles"].item_span(i))
+    randomise = (read_randomise(r, top["randomise"], top.value_span("randomise"), names)
+                 if "randomise" in top else Randomise())
+    world = World(name, path, int(seed), dt, limit, int(substeps), tuple(agents), sensors,
+                  tuple(corridors), grid, tuple(obstacles), randomise,
+                  str(top.get("behavior", "drive")))
+    check_free(world, agent_spans)
+    return world
+
+
+def check_free(world: World, spans: list[tuple[Span, Span]]) -> None:
+    """Refuse a start or goal that lies inside a wall (outside every corridor)."""
+    import numpy as np
+
+    from .staticmap import build_static
+
+    static = build_static(world)
+    for agent, (s_span, g_span) in zip(world.agents, spans):
+        for what, p, span in (("start (q_init)", agent.start, s_span),
+                              ("goal (q_goal)", agent.goal, g_span)):
+            if not static.free(np.array([[p.x, p.y]]))[0]:
+                who = "" if agent.name == "robot" else f" of `{agent.name}`"
+                raise WorldError(f"the {what}{who} at ({p.x:g}, {p.y:g}) lies inside a wall",
+                                 span=span, hint="move it into a corridor (free space)")
+
+
+def load_world(path: str | Path) -> World:
+    """Read and check the world file at ``path``."""
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise WorldError(f"cannot read world file `{path}`: "
+                         f"{getattr(exc, 'strerror', None) or exc}") from None
+    return parse_world(text, str(path))
+
+
+def resolve_world_path(name: str | Path) -> Path:
+    """A world file as given, or else the packaged world of that name (``figure4.yaml``)."""
+    p = Path(name)
+    if p.exists():
+        return p
+    from ..resources import data_dir, packaged_path
+
+    for candidate in (p.name, p.name + ".yaml"):
+        if (data_dir("worlds") / candidate).is_file():
+            return packaged_path("worlds", candidate)
+    from ..resources import packaged_names
+
+    names = [n for n in packaged_names("worlds", ".yaml")]
+    raise unknown("world file", str(name), names, cls=WorldError)
