@@ -156,10 +156,12 @@ def _span_key(span: Span | None) -> tuple:
 
 
 def _behavior_span(rb: RuleBase, name: str) -> Span | None:
-    span = rb.behavior(name).span
-    if span is None and rb.path:
-        span = Span(rb.path, 1, 1)
-    return span
+    b = rb.behavior(name)
+    if b.span is not None:
+        return b.span
+    if b.rules and b.rules[0].span is not None:       # top-level rules: point at the first
+        return b.rules[0].span
+    return Span(rb.path, 1, 1) if rb.path else None
 
 
 # ---------------------------------------------------------------------------------------------
@@ -285,23 +287,30 @@ def grid_axes(compiled: CompiledRuleBase, resolution: int,
               max_samples: int = MAX_SAMPLES) -> list[np.ndarray]:
     """Sample points per input: ``resolution`` even steps plus the terms' corner points,
     with ``resolution`` lowered until the grid has at most ``max_samples`` points."""
-    k = len(compiled.inputs)
-    n = max(2, resolution)
-    while True:
+    def axes_for(n: int) -> list[np.ndarray]:
         axes = []
         for name, (lo, hi) in zip(compiled.inputs, compiled.universe):
             pts = [np.linspace(lo, hi, n)]
             for term in compiled.variables[name].terms:
                 corners = term.corners
-                if corners is not None:
-                    pts.append([c for c in corners if lo <= c <= hi])
-                else:
-                    pts.append([term.center])
+                pts.append([c for c in corners if lo <= c <= hi] if corners is not None
+                           else [term.center])
             axes.append(np.unique(np.concatenate([np.asarray(p, float) for p in pts])))
-        total = int(np.prod([len(a) for a in axes])) if k else 1
-        if total <= max_samples or n <= 2:
-            return axes
-        n = max(2, int(n * (max_samples / total) ** (1.0 / k)) - 1)
+        return axes
+
+    def size(axes: list[np.ndarray]) -> int:
+        return int(np.prod([len(a) for a in axes], dtype=float))
+
+    lo, hi = 2, max(2, resolution)
+    if size(axes_for(hi)) <= max_samples:
+        return axes_for(hi)
+    while hi - lo > 1:                       # the largest resolution that fits
+        mid = (lo + hi) // 2
+        if size(axes_for(mid)) <= max_samples:
+            lo = mid
+        else:
+            hi = mid
+    return axes_for(lo)
 
 
 def _sampled(compiled: CompiledRuleBase, threshold: float,

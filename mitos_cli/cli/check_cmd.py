@@ -59,8 +59,14 @@ def to_json(report, trace_path: str) -> dict:
         "behaviors": [{"name": g.behavior, "samples": g.samples,
                        "grid": {name: n for name, n in g.points}} for g in report.grids],
         "summary": {s: report.count(s) for s in ("error", "warning", "info")},
-        "findings": [f.to_json() for f in report.findings],
+        "findings": [_shown(f.to_json()) for f in report.findings],
     }
+
+
+def _shown(finding: dict) -> dict:
+    if finding["span"] is not None:
+        finding["span"]["path"] = show_path(finding["span"]["path"])
+    return finding
 
 
 def check_command(

@@ -1,0 +1,149 @@
+"""``mitos eval`` end to end: golden outputs and the --json / --batch contract.
+
+Golden cases live in ``tests/golden/<case>/``: ``cmd`` (one command line, run from the
+repository root in a fresh process), optional ``stdin``, and the expected ``stdout``.
+Regenerate them after a deliberate change with ``MITOS_UPDATE_GOLDEN=1 pytest
+tests/test_cli_eval.py`` and review the diff.
+"""
+
+from __future__ import annotations
+
+import io
+import json
+import os
+import shlex
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from mitos_cli import load_rulebase
+from mitos_cli.batch import read_batch
+from mitos_cli.cli.app import main
+
+ROOT = Path(__file__).resolve().parents[1]
+GOLDEN = ROOT / "tests" / "golden"
+CASES = sorted(p.name for p in GOLDEN.iterdir() if (p / "cmd").is_file())
+
+
+def run_cli(argv: list[str], stdin: str | None = None) -> subprocess.CompletedProcess:
+    env = dict(os.environ, COLUMNS="100", NO_COLOR="1")
+    return subprocess.run([sys.executable, "-m", "mitos_cli", *argv], cwd=ROOT, input=stdin,
+                          capture_output=True, text=True, timeout=120, env=env)
+
+
+@pytest.mark.parametrize("case", CASES)
+def test_golden(case):
+    folder = GOLDEN / case
+    argv = shlex.split((folder / "cmd").read_text(encoding="utf-8"))
+    assert argv[0] == "mitos"
+    stdin = (folder / "stdin").read_text(encoding="utf-8") if (folder / "stdin").exists() \
+        else None
+    proc = run_cli(argv[1:], stdin)
+    expected_code = int((folder / "exit_code").read_text()) if (folder / "exit_code").exists() \
+        else 0
+    if os.environ.get("MITOS_UPDATE_GOLDEN"):
+        (folder / "stdout").write_text(proc.stdout, encoding="utf-8")
+    assert proc.returncode == expected_code, proc.stderr
+    assert proc.stdout == (folder / "stdout").read_text(encoding="utf-8")
+    assert "Traceback" not in proc.stderr
+
+
+def run_main(args, capsys):
+    with pytest.raises(SystemExit) as info:
+        main(args)
+    out, err = capsys.readouterr()
+    return info.value.code, out, err
+
+
+@pytest.fixture(scope="module")
+def rb():
+    return load_rulebase()
+
+
+def test_json_matches_the_library(rb, capsys):
+    code, out, err = run_main(["eval", "road=78", "size=45", "position=4", "--json"], capsys)
+    assert code == 0 and err == ""
+    data = json.loads(out)
+    assert {"rulebase", "inputs", "rules", "outputs"} <= set(data)
+    trace = rb.trace(road=78, size=45, position=4)
+    assert data == json.loads(json.dumps(trace.to_json()))
+    assert data["outputs"] == rb.evaluate(road=78, size=45, position=4)
+    assert [r["label"] for r in data["rules"]] == ["r4", "r5", "r7", "r8", "r22", "r23", "r25",
+                                                   "r26"]
+    assert all(set(r) == {"label", "text", "dof"} and r["dof"] > 0 for r in data["rules"])
+    assert data["inputs"]["road"] == {"value": 78.0, "memberships": {
+        "NARROW": 0.0, "MEDIUM": pytest.approx(22 / 30), "WIDE": pytest.approx(8 / 30)}}
+
+
+def test_batch_equals_single_evaluations(rb, capsys, tmp_path):
+    rng = np.random.default_rng(np.random.SeedSequence(2))
+    lo, hi = rb.compiled.universe[:, 0], rb.compiled.universe[:, 1]
+    X = rng.uniform(lo, hi, size=(50, 3)).round(3)
+    csv = tmp_path / "in.csv"
+    csv.write_text("position,road,size\n" + "\n".join(
+        f"{p},{r},{s}" for r, s, p in X) + "\n", encoding="utf-8")
+    code, out, err = run_main(["eval", "--batch", str(csv)], capsys)
+    assert code == 0 and err == ""
+    header, *rows = out.splitlines()
+    assert header == "road,size,position,steering,speed"
+    table = np.loadtxt(io.StringIO("\n".join(rows)), delimiter=",")
+    assert np.array_equal(table[:, :3], X)
+    for row in table:
+        single = rb.evaluate(road=row[0], size=row[1], position=row[2])
+        assert row[3] == pytest.approx(single["steering"], rel=1e-11)
+        assert row[4] == pytest.approx(single["speed"], rel=1e-11)
+
+
+def test_batch_warns_about_clamping(capsys, tmp_path):
+    csv = tmp_path / "in.csv"
+    csv.write_text("road,size,position\n500,45,4\n78,45,4\n999,45,4\n", encoding="utf-8")
+    code, out, err = run_main(["eval", "--batch", str(csv)], capsys)
+    assert code == 0
+    assert err == "warning: `road` outside its universe [0, 160] was clamped (2 samples)\n"
+    rows = [line.split(",") for line in out.splitlines()[1:]]
+    assert [r[0] for r in rows] == ["500", "78", "999"]     # the inputs as given
+    assert rows[0][3:] == rows[2][3:]                          # both evaluated at road = 160
+
+
+@pytest.mark.parametrize("text, message", [
+    ("", "the batch CSV is empty"),
+    ("road,size,positon\n1,2,3\n", "batch column `positon` is not an input of this behavior"),
+    ("road,size\n1,2\n", "the batch CSV has no column for position"),
+    ("road,size,position\n1,2\n", "row has 2 values, the header 3"),
+    ("road,size,position\n1,2,x\n", "`x` is not a number"),
+    ("road,size,position\n1,nan,3\n", "input `size` is not a number (NaN)"),
+])
+def test_batch_errors(capsys, tmp_path, text, message):
+    csv = tmp_path / "in.csv"
+    csv.write_text(text, encoding="utf-8")
+    code, out, err = run_main(["eval", "--batch", str(csv)], capsys)
+    assert code == 1 and message in err and out == ""
+
+
+def test_batch_error_positions():
+    with pytest.raises(Exception) as info:
+        read_batch("road,size,position\n1,2,3\n4,five,6\n", "in.csv", ("road", "size", "position"))
+    assert str(info.value.span) == "in.csv:3:3"
+
+
+def test_batch_and_values_are_exclusive(capsys):
+    code, _, err = run_main(["eval", "--batch", "-", "road=1"], capsys)
+    assert code == 2 and "not both" in err
+
+
+def test_behavior_option(tmp_path, capsys):
+    terms = (ROOT / "rulebases" / "mitos.terms.yaml").read_text(encoding="utf-8")
+    (tmp_path / "t.terms.yaml").write_text(terms, encoding="utf-8")
+    (tmp_path / "t.rules").write_text(
+        'terms "t.terms.yaml"\nbehavior cruise:\n  if road is WIDE then speed is FAST\nend\n'
+        "behavior careful:\n  if road is WIDE then speed is SLOW\nend\n", encoding="utf-8")
+    outs = []
+    for extra in ([], ["--behavior", "careful"]):
+        code, out, _ = run_main(["eval", str(tmp_path / "t.rules"), "road=120", "--json",
+                                 *extra], capsys)
+        assert code == 0
+        outs.append(json.loads(out)["outputs"]["speed"])
+    assert outs == [50.0, 20.0]
