@@ -65,15 +65,23 @@ class OutputTable:
     starts: np.ndarray        # [t] start of each set's run in ``order`` (for reduceat)
 
 
-def grid(lo: float, hi: float, resolution: int) -> np.ndarray:
-    """The midpoints of ``resolution`` equal cells of ``[lo, hi]``."""
+def grid(lo: float, hi: float, resolution: int, sampling: str = "midpoints") -> np.ndarray:
+    """The midpoints of ``resolution`` equal cells of ``[lo, hi]`` (``sampling="endpoints"``:
+    ``resolution`` evenly spaced points from ``lo`` to ``hi``, as MATLAB's ``evalfis``)."""
+    if sampling == "endpoints":
+        return np.linspace(lo, hi, resolution)
     return lo + (np.arange(resolution) + 0.5) * ((hi - lo) / resolution)
 
 
-def spike(lo: float, hi: float, resolution: int, value: float) -> np.ndarray:
-    """A singleton at ``value`` as sampled set: 1 at the midpoint of the cell holding it."""
+def spike(lo: float, hi: float, resolution: int, value: float,
+          sampling: str = "midpoints") -> np.ndarray:
+    """A singleton at ``value`` as sampled set: 1 at the midpoint of the cell holding it (with
+    ``endpoints`` sampling: at the nearest sample point)."""
     row = np.zeros(resolution)
-    i = int(np.floor((value - lo) / ((hi - lo) / resolution)))
+    if sampling == "endpoints":
+        i = int(np.rint((value - lo) / (hi - lo) * (resolution - 1)))
+    else:
+        i = int(np.floor((value - lo) / ((hi - lo) / resolution)))
     row[min(max(i, 0), resolution - 1)] = 1.0
     return row
 
@@ -81,11 +89,12 @@ def spike(lo: float, hi: float, resolution: int, value: float) -> np.ndarray:
 def build_tables(compiled) -> tuple[OutputTable, ...]:
     """Sample every consequent set the rules use, per output (done once, then cached)."""
     res = compiled.operators.resolution
+    sampling = compiled.operators.sampling
     tables = []
     for j, name in enumerate(compiled.outputs):
         var = compiled.variables[name]
         lo, hi = var.universe
-        x = grid(lo, hi, res)
+        x = grid(lo, hi, res, sampling)
         rules = np.flatnonzero(compiled.cons_mask[:, j])
         keys: dict[tuple, int] = {}
         rows, labels, set_of = [], [], []
@@ -95,11 +104,11 @@ def build_tables(compiled) -> tuple[OutputTable, ...]:
             if key not in keys:
                 keys[key] = len(rows)
                 if term is None:
-                    rows.append(spike(lo, hi, res, key[1]))
+                    rows.append(spike(lo, hi, res, key[1], sampling))
                     labels.append(f"= {key[1]:g}")
                 else:
                     t = var.term(term)
-                    mu = (spike(lo, hi, res, t.params[0]) if t.shape == "singleton"
+                    mu = (spike(lo, hi, res, t.params[0], sampling) if t.shape == "singleton"
                           else np.asarray(t.membership(x), dtype=float))
                     rows.append(hedge_mod.apply(hedges, mu))
                     labels.append(" ".join(hedges + (term,)))

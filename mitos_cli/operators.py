@@ -15,6 +15,9 @@ from .model import Setting
 INFERENCES = ("weighted_average", "weighted_sum", "mamdani")
 IMPLICATIONS = ("min", "product")
 DEFUZZIFIERS = ("centroid", "bisector", "mom", "som", "lom")
+#: Where Mamdani outputs are sampled: cell midpoints (fuzzylite's rule, the default) or
+#: ``resolution`` evenly spaced points including both ends (MATLAB's ``evalfis``).
+SAMPLINGS = ("midpoints", "endpoints")
 
 
 @dataclass(frozen=True)
@@ -28,6 +31,7 @@ class Operators:
     aggregation: str = "max"
     defuzzify: str = "centroid"
     resolution: int = 101
+    sampling: str = "midpoints"
 
     @property
     def tnorm(self) -> norms.Norm:
@@ -42,6 +46,8 @@ class Operators:
         if self.inference == "mamdani":
             text += (f", implication = {self.implication}, aggregation = {self.aggregation}, "
                      f"defuzzify = {self.defuzzify}, resolution = {self.resolution}")
+            if self.sampling != "midpoints":
+                text += f", sampling = {self.sampling}"
         return text
 
     def settings(self) -> dict[str, str]:
@@ -56,7 +62,8 @@ class Operators:
 
 
 KEYS = {"and": "and_", "or": "or_", "inference": "inference", "implication": "implication",
-        "aggregation": "aggregation", "defuzzify": "defuzzify", "resolution": "resolution"}
+        "aggregation": "aggregation", "defuzzify": "defuzzify", "resolution": "resolution",
+        "sampling": "sampling"}
 
 
 def _check(key: str, value: str, span: Span | None) -> str | int:
@@ -71,7 +78,7 @@ def _check(key: str, value: str, span: Span | None) -> str | int:
         except KeyError:
             raise unknown("S-norm", value, norms.names("snorm"), span=span) from None
     choices = {"inference": INFERENCES, "implication": IMPLICATIONS,
-               "defuzzify": DEFUZZIFIERS}.get(key)
+               "defuzzify": DEFUZZIFIERS, "sampling": SAMPLINGS}.get(key)
     if choices is not None:
         if value not in choices:
             raise unknown(key, value, choices, span=span)

@@ -230,6 +230,7 @@ class Settings:
     aggregation: str | None = None
     defuzzify: str | None = None        # a DEFUZZIFIERS key
     resolution: int | None = None
+    sampling: str | None = None         # "endpoints" for MATLAB, else MITOS's midpoints
     spans: dict | None = None
 
     def set(self, key: str, value: str | int, span: Span | None, what: str) -> None:
@@ -260,6 +261,8 @@ class Settings:
             out.append(Setting("aggregation", self.aggregation or "max"))
             out.append(Setting("defuzzify", defuzz))
             out.append(Setting("resolution", str(self.resolution or default_resolution)))
+            if self.sampling:
+                out.append(Setting("sampling", self.sampling))
         return tuple(out)
 
     @property

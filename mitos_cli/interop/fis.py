@@ -1,0 +1,393 @@
+"""MATLAB Fuzzy Logic Toolbox ``.fis`` files: reader and writer.
+
+A ``.fis`` file is INI-like: ``[System]``, ``[Input1]`` ... ``[Output1]`` ... sections of
+``Key=value`` lines, then ``[Rules]`` with one line per rule in index form::
+
+    1 1, 1 (1) : 1      # input MF indices, output MF indices (weight) : 1 = AND, 2 = OR
+
+Index 0 means "not in this rule"; a negative input index means NOT (``1 - mu``). The format is
+not a language, so it is read line by line; every line keeps its number for errors.
+
+Mapping: ``trimf trapmf gaussmf gauss2mf gbellmf sigmf dsigmf psigmf pimf smf zmf linsmf linzmf
+constant linear``; ``and``: min, prod; ``or``: max, probor; ``imp``: min, prod; ``agg``: max,
+probor (``sum`` is refused); defuzzifiers centroid, bisector, mom, som, lom (Mamdani) and
+wtaver, wtsum (Sugeno). When no rule fires MATLAB returns the middle of the output range (with
+a warning); the reader makes that the output's ``default``. Custom MF functions, negative output
+indices (complemented consequents) and fractional indices are refused.
+
+Resolution: MATLAB's ``evalfis`` samples a Mamdani output at 101 evenly spaced points from the
+range's minimum to its maximum; the reader sets ``resolution = 101, sampling = endpoints``, which
+reproduces MATLAB's documented outputs (``docs/conformance.md``). The writer cannot record
+another resolution or sampling: a ``.fis`` file always means MATLAB's.
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+from ..errors import FormatError, Span, did_you_mean
+from ..model import And, Consequent, Or, Prop, Rule, RuleBase
+from ..terms import Term, Variable
+from . import common
+from .common import FIS, Settings, fmt_number
+
+DEFAULT_RESOLUTION = 101
+
+#: MATLAB MF type -> (MITOS shape, param count, MATLAB order -> MITOS order)
+MF_TYPES = {
+    "trimf": ("triangle", 3, (0, 1, 2)),
+    "trapmf": ("trapezoid", 4, (0, 1, 2, 3)),
+    "gaussmf": ("gaussian", 2, (1, 0)),                   # [sigma c]
+    "gauss2mf": ("gaussian2", 4, (1, 0, 3, 2)),           # [sig1 c1 sig2 c2]
+    "gbellmf": ("bell", 3, (2, 0, 1)),                    # [a b c] = width, slope, center
+    "sigmf": ("sigmoid", 2, (1, 0)),                      # [a c] = slope, inflection
+    "dsigmf": ("sigmoid_difference", 4, (1, 0, 2, 3)),    # [a1 c1 a2 c2]
+    "psigmf": ("sigmoid_product", 4, (1, 0, 2, 3)),
+    "pimf": ("pi_shape", 4, (0, 1, 2, 3)),
+    "smf": ("s_shape", 2, (0, 1)),
+    "zmf": ("z_shape", 2, (0, 1)),
+    "linsmf": ("ramp", 2, (0, 1)),
+    "linzmf": ("ramp", 2, (1, 0)),
+    "constant": ("singleton", 1, (0,)),
+}
+SYSTEM_KEYS = ("Name", "Type", "Version", "NumInputs", "NumOutputs", "NumRules", "AndMethod",
+               "OrMethod", "ImpMethod", "AggMethod", "DefuzzMethod")
+VAR_KEYS = ("Name", "Range", "NumMFs")
+
+
+def read_fis(path: str | Path) -> RuleBase:
+    from .fll import _read_text
+
+    path = Path(path)
+    return parse_fis(_read_text(path), str(path))
+
+
+def _sections(text: str, path: str | None):
+    """``[(name, span, [(key, value, span, vspan), ...]), ...]`` and the rule lines."""
+    sections: list = []
+    rules: list = []
+    for lineno, raw in enumerate(text.splitlines(), 1):
+        line = raw.strip()
+        if not line:
+            continue
+        span = Span.in_text(text, path, lineno, len(raw) - len(raw.lstrip()) + 1,
+                            len(raw.rstrip()) + 1)
+        if line.startswith("[") and line.endswith("]"):
+            sections.append((line[1:-1].strip(), span, []))
+            continue
+        if not sections:
+            raise FormatError("expected a section header such as `[System]`", span=span)
+        if sections[-1][0] == "Rules":
+            rules.append((line, lineno, span))
+            continue
+        key, sep, value = line.partition("=")
+        if not sep:
+            raise FormatError(f"expected `Key=value`, not `{line}`", span=span)
+        col = raw.index("=") + 2
+        vspan = Span.in_text(text, path, lineno, col, len(raw.rstrip()) + 1)
+        sections[-1][2].append((key.strip(), value.strip(), span, vspan))
+    return sections, rules
+
+
+def _string(value: str, vspan: Span) -> str:
+    if len(value) >= 2 and value[0] == value[-1] == "'":
+        return value[1:-1]
+    raise FormatError(f"expected a quoted text ('...'), not `{value}`", span=vspan)
+
+
+def _vector(value: str, vspan: Span) -> list[float]:
+    value = value.strip()
+    if not (value.startswith("[") and value.endswith("]")):
+        raise FormatError(f"expected numbers in brackets ([a b c]), not `{value}`", span=vspan)
+    return [common.number(w, vspan) for w in value[1:-1].replace(",", " ").split()]
+
+
+def parse_fis(text: str, path: str | None = None) -> RuleBase:
+    """Read ``.fis`` text into a rule base (one behavior, ``main``)."""
+    sections, rule_lines = _sections(text, path)
+    by_kind = {name: (span, items) for name, span, items in sections}
+    if "System" not in by_kind:
+        raise FormatError("the file has no [System] section",
+                          span=Span.in_text(text, path, 1, 1))
+    sys_span, sys_items = by_kind["System"]
+    system = {}
+    for key, value, span, vspan in sys_items:
+        if key not in SYSTEM_KEYS:
+            raise FormatError(f"unknown [System] key `{key}`", span=span,
+                              expected="one of " + ", ".join(SYSTEM_KEYS),
+                              hint=did_you_mean(key, SYSTEM_KEYS))
+        system[key] = (value, vspan)
+    kind = _string(*system.get("Type", ("'mamdani'", sys_span))).lower()
+    if kind not in ("mamdani", "sugeno"):
+        raise FormatError(f"FIS type `{kind}` is not supported", span=system["Type"][1],
+                          expected="mamdani or sugeno")
+    settings = Settings()
+
+    def method(key: str, table: dict, what: str, default: str) -> str | None:
+        value, vspan = system.get(key, (f"'{default}'", sys_span))
+        return common.table_lookup(table, FIS, _string(value, vspan), what, vspan)
+
+    settings.set("and_", method("AndMethod", common.TNORMS, "AND method", "min"), None, "and")
+    settings.set("or_", method("OrMethod", common.SNORMS, "OR method", "max"), None, "or")
+    defuzz = method("DefuzzMethod", common.DEFUZZIFIERS, "defuzzification method",
+                    "centroid" if kind == "mamdani" else "wtaver")
+    sugeno = defuzz in ("weighted_average", "weighted_sum")
+    if sugeno != (kind == "sugeno"):
+        raise FormatError(f"defuzzification `{_string(*system['DefuzzMethod'])}` does not fit a "
+                          f"{kind} system", span=system["DefuzzMethod"][1])
+    settings.set("defuzzify", defuzz, None, "defuzzifier")
+    if not sugeno:        # MATLAB ignores ImpMethod / AggMethod for Sugeno systems
+        settings.set("implication", common.check_implication(
+            method("ImpMethod", common.TNORMS, "implication method", "min"),
+            system.get("ImpMethod", ("", sys_span))[1]), None, "implication")
+        settings.set("aggregation", method("AggMethod", common.SNORMS, "aggregation method",
+                                           "max"), None, "aggregation")
+        settings.set("resolution", DEFAULT_RESOLUTION, None, "resolution")
+        settings.set("sampling", "endpoints", None, "sampling")
+
+    inputs = _variables(sections, "Input", "input", kind)
+    n_inputs = len(inputs)
+    outputs = _variables(sections, "Output", "output", kind, n_inputs)
+    for name, _, _ in sections:
+        if name not in ("System", "Rules") and not re.fullmatch(r"(Input|Output)\d+", name):
+            raise FormatError(f"unknown section [{name}]",
+                              span=next(s for n, s, _ in sections if n == name),
+                              expected="[System], [InputN], [OutputN] or [Rules]")
+    _check_count(system, "NumInputs", len(inputs), sys_span)
+    _check_count(system, "NumOutputs", len(outputs), sys_span)
+    variables = inputs + outputs
+    rules = [_rule(line, lineno, span, inputs, outputs, text, path, i)
+             for i, (line, lineno, span) in enumerate(rule_lines)]
+    _check_count(system, "NumRules", len(rules), sys_span)
+    return common.assemble(path, variables, rules, settings, DEFAULT_RESOLUTION, sys_span)
+
+
+def _check_count(system: dict, key: str, found: int, span: Span) -> None:
+    if key in system:
+        value, vspan = system[key]
+        if common.number(value, vspan) != found:
+            raise FormatError(f"{key}={value} but the file has {found}", span=vspan)
+
+
+def _variables(sections, prefix: str, role: str, kind: str, n_inputs: int = 0) -> list[Variable]:
+    found = [(int(name[len(prefix):]), span, items) for name, span, items in sections
+             if re.fullmatch(prefix + r"\d+", name)]
+    found.sort(key=lambda f: f[0])
+    for i, (number, span, _) in enumerate(found, 1):
+        if number != i:
+            raise FormatError(f"expected [{prefix}{i}], found [{prefix}{number}]", span=span)
+    return [_variable(span, items, role, kind, n_inputs) for _, span, items in found]
+
+
+def _variable(span: Span, items, role: str, kind: str, n_inputs: int) -> Variable:
+    values = {}
+    terms: list[Term] = []
+    for key, value, kspan, vspan in items:
+        if re.fullmatch(r"MF\d+", key):
+            terms.append(_mf(value, vspan, role, kind, n_inputs))
+        elif key in VAR_KEYS:
+            values[key] = (value, vspan)
+        else:
+            raise FormatError(f"unknown key `{key}`", span=kspan,
+                              expected="Name, Range, NumMFs or MFn",
+                              hint=did_you_mean(key, VAR_KEYS))
+    if "Name" not in values or "Range" not in values:
+        raise FormatError("a variable needs `Name` and `Range`", span=span)
+    name = _string(*values["Name"])
+    rng = _vector(*values["Range"])
+    if len(rng) != 2 or not rng[0] < rng[1]:
+        raise FormatError(f"`Range` must be [min max] with min < max", span=values["Range"][1])
+    if "NumMFs" in values and common.number(*values["NumMFs"]) != len(terms):
+        raise FormatError(f"NumMFs={values['NumMFs'][0]} but the variable has {len(terms)} MFs",
+                          span=values["NumMFs"][1])
+    if not terms and role == "output":
+        raise FormatError(f"output `{name}` has no membership functions", span=span)
+    default = (rng[0] + rng[1]) / 2 if role == "output" else None
+    try:
+        return Variable(name, role, (rng[0], rng[1]), tuple(terms), "", "", default,
+                        values["Name"][1])
+    except Exception as exc:
+        raise FormatError(getattr(exc, "message", str(exc)), span=span) from None
+
+
+def _mf(value: str, vspan: Span, role: str, kind: str, n_inputs: int) -> Term:
+    m = re.fullmatch(r"'([^']*)'\s*:\s*'([^']*)'\s*,\s*(\[.*\])", value.strip())
+    if not m:
+        raise FormatError("expected 'name':'type',[params]", span=vspan)
+    name, mf, params = m.group(1), m.group(2), _vector(m.group(3), vspan)
+    if mf == "linear":
+        if role != "output" or kind != "sugeno":
+            raise FormatError(f"MF `{name}`: `linear` belongs to Sugeno outputs", span=vspan)
+        if len(params) != n_inputs + 1:
+            raise FormatError(f"MF `{name}`: linear takes {n_inputs + 1} numbers (one per input "
+                              f"and a constant), not {len(params)}", span=vspan)
+        return common.make_term(name, "linear", tuple(params), vspan)
+    if mf not in MF_TYPES:
+        raise FormatError(f"MF `{name}`: membership function type `{mf}` is not supported",
+                          span=vspan, expected="one of " + ", ".join(list(MF_TYPES) + ["linear"]),
+                          hint=did_you_mean(mf, MF_TYPES))
+    shape, count, order = MF_TYPES[mf]
+    if len(params) != count:
+        raise FormatError(f"MF `{name}`: {mf} takes {count} numbers, not {len(params)}",
+                          span=vspan)
+    return common.make_term(name, shape, tuple(params[i] for i in order), vspan)
+
+
+def _rule(line: str, lineno: int, span: Span, inputs: list[Variable], outputs: list[Variable],
+          text: str, path: str | None, index: int) -> Rule:
+    m = re.fullmatch(r"([-\d.\s]+),([-\d.\s]+)\(\s*([-+\d.eE]+)\s*\)\s*:\s*(\d+)", line)
+    if not m:
+        raise FormatError("expected a rule `in1 in2 ..., out1 ... (weight) : 1|2`", span=span)
+    ins = [common.number(w, span) for w in m.group(1).split()]
+    outs = [common.number(w, span) for w in m.group(2).split()]
+    weight = common.number(m.group(3), span)
+    connection = int(m.group(4))
+    if len(ins) != len(inputs) or len(outs) != len(outputs):
+        raise FormatError(f"the rule lists {len(ins)} inputs and {len(outs)} outputs; the system "
+                          f"has {len(inputs)} and {len(outputs)}", span=span)
+    if connection not in (1, 2):
+        raise FormatError(f"connection {connection}: expected 1 (AND) or 2 (OR)", span=span)
+    props = []
+    for v, idx in zip(inputs, ins):
+        if idx != int(idx):
+            raise FormatError(f"MF index {idx:g}: fractional indices (hedges) are not supported",
+                              span=span)
+        if idx == 0:
+            continue
+        k = abs(int(idx))
+        if k > len(v.terms):
+            raise FormatError(f"`{v.name}` has {len(v.terms)} MFs, not {k}", span=span)
+        props.append(Prop(v.name, v.terms[k - 1].name, (), idx < 0, span))
+    cons = []
+    for v, idx in zip(outputs, outs):
+        if idx != int(idx) or idx < 0:
+            raise FormatError(f"output MF index {idx:g}: negative (complemented) or fractional "
+                              f"consequents are not supported", span=span)
+        if idx == 0:
+            continue
+        if idx > len(v.terms):
+            raise FormatError(f"`{v.name}` has {len(v.terms)} MFs, not {int(idx)}", span=span)
+        cons.append(Consequent(v.name, v.terms[int(idx) - 1].name, None, (), span))
+    if not props or not cons:
+        raise FormatError("the rule has no " + ("condition" if not props else "consequent"),
+                          span=span)
+    antecedent = props[0] if len(props) == 1 else (And if connection == 1 else Or)(
+        tuple(props), span)
+    return Rule(f"r{index + 1}", antecedent, tuple(cons), weight, span)
+
+
+# ---------------------------------------------------------------------------------------------
+# Writer
+
+
+def write_fis(rb: RuleBase, behavior: str | None = None) -> str:
+    """``.fis`` text for one behavior of ``rb``. Rules must be flat: propositions (possibly
+    negated, without hedges) joined all by AND or all by OR, as MATLAB's rule list is."""
+    flat = common.flatten_for_export(rb, behavior)
+    ops = flat.operators
+    sugeno = ops.inference in ("weighted_average", "weighted_sum")
+    inputs = common.all_inputs(rb, flat)
+    name = flat.name
+    lines = ["[System]", f"Name='{name}'", f"Type='{'sugeno' if sugeno else 'mamdani'}'",
+             "Version=2.0", f"NumInputs={len(inputs)}", f"NumOutputs={len(flat.outputs)}",
+             f"NumRules={len(flat.rules)}",
+             f"AndMethod='{common.foreign_name(common.TNORMS, FIS, ops.and_, 'AND method')}'",
+             f"OrMethod='{common.foreign_name(common.SNORMS, FIS, ops.or_, 'OR method')}'"]
+    if sugeno:
+        lines += ["ImpMethod='prod'", "AggMethod='sum'",
+                  f"DefuzzMethod='{common.DEFUZZIFIERS[ops.inference][FIS]}'"]
+    else:
+        if ops.resolution != DEFAULT_RESOLUTION:
+            pass        # MATLAB has no per-file resolution; documented in docs/interop.md
+        lines += [f"ImpMethod='{common.foreign_name(common.TNORMS, FIS, ops.implication, 'implication')}'",
+                  f"AggMethod='{common.foreign_name(common.SNORMS, FIS, ops.aggregation, 'aggregation')}'",
+                  f"DefuzzMethod='{common.foreign_name(common.DEFUZZIFIERS, FIS, ops.defuzzify, 'defuzzifier')}'"]
+    for i, v in enumerate(inputs, 1):
+        lines += ["", f"[Input{i}]"] + _var_lines(v, [_mf_text(t, v) for t in v.terms])
+    for i, v in enumerate(flat.outputs, 1):
+        mid = (v.universe[0] + v.universe[1]) / 2
+        if v.default is not None and v.default != mid:
+            raise FormatError(f"output `{v.name}`: default {v.default:g} cannot be written to "
+                              f".fis (MATLAB uses the middle of the range, {mid:g}, when no rule "
+                              f"fires)")
+        if sugeno:
+            mfs = []
+            for t in v.terms:
+                if t.shape == "linear":
+                    coefficients = common.linear_coefficients(rb, v.name, t)
+                    values = [coefficients.get(x.name, 0.0) for x in inputs] + [t.params[-1]]
+                    mfs.append(f"'{t.name}':'linear',[{' '.join(fmt_number(c) for c in values)}]")
+                else:
+                    mfs.append(f"'{t.name}':'constant',[{fmt_number(t.center)}]")
+        else:
+            mfs = [_mf_text(t, v) for t in v.terms]
+        lines += ["", f"[Output{i}]"] + _var_lines(v, mfs)
+    lines += ["", "[Rules]"]
+    for r in flat.rules:
+        lines.append(_rule_text(r, inputs, flat.outputs))
+    return "\n".join(lines) + "\n"
+
+
+def _var_lines(v: Variable, mfs: list[str]) -> list[str]:
+    lo, hi = v.universe
+    return [f"Name='{v.name}'", f"Range=[{fmt_number(lo)} {fmt_number(hi)}]",
+            f"NumMFs={len(mfs)}"] + [f"MF{i}={m}" for i, m in enumerate(mfs, 1)]
+
+
+INVERSE = {shape: (mf, order) for mf, (shape, _, order) in MF_TYPES.items() if mf != "linzmf"}
+
+
+def _mf_text(t: Term, v: Variable) -> str:
+    shape, p = t.shape, t.params
+    if shape in ("left_shoulder", "right_shoulder", "triangle_pw", "triangle_plr", "rectangle"):
+        a, b, c, d = t.corners
+        lo, hi = v.universe
+        # MATLAB trapmf has no infinite feet: put them just outside the universe
+        a = min(lo, b) - 1.0 if a == -float("inf") else a
+        b = a if b == -float("inf") else b
+        d = max(hi, c) + 1.0 if d == float("inf") else d
+        c = d if c == float("inf") else c
+        if shape in ("triangle_pw", "triangle_plr"):
+            return f"'{t.name}':'trimf',[{fmt_number(a)} {fmt_number(b)} {fmt_number(d)}]"
+        return f"'{t.name}':'trapmf',[{' '.join(fmt_number(x) for x in (a, b, c, d))}]"
+    if shape == "ramp" and p[0] > p[1]:
+        return f"'{t.name}':'linzmf',[{fmt_number(p[1])} {fmt_number(p[0])}]"
+    if shape not in INVERSE:
+        raise FormatError(f"term `{v.name}.{t.name}`: MATLAB has no `{shape}` membership "
+                          f"function")
+    mf, order = INVERSE[shape]
+    values = [0.0] * len(order)
+    for matlab_i, mitos_i in enumerate(order):
+        values[matlab_i] = p[mitos_i]
+    return f"'{t.name}':'{mf}',[{' '.join(fmt_number(x) for x in values)}]"
+
+
+def _rule_text(r: Rule, inputs, outputs) -> str:
+    e = r.antecedent
+    if isinstance(e, Prop):
+        props, connection = [e], 1
+    elif isinstance(e, (And, Or)) and all(isinstance(i, Prop) for i in e.items):
+        props, connection = list(e.items), 1 if isinstance(e, And) else 2
+    else:
+        raise FormatError(f"rule `{r.label}`: MATLAB rules join propositions all by AND or all "
+                          f"by OR; nested expressions cannot be written to .fis", span=r.span,
+                          hint="split the rule into several simpler rules")
+    index = {}
+    for p in props:
+        if p.hedges:
+            raise FormatError(f"rule `{r.label}`: hedges cannot be written to .fis", span=r.span)
+        if p.var in index:
+            raise FormatError(f"rule `{r.label}` tests `{p.var}` twice, which .fis cannot say",
+                              span=r.span)
+        v = next(v for v in inputs if v.name == p.var)
+        index[p.var] = (v.index(p.term) + 1) * (-1 if p.negated else 1)
+    outs = {}
+    for c in r.consequents:
+        if c.hedges:
+            raise FormatError(f"rule `{r.label}`: hedges cannot be written to .fis", span=r.span)
+        v = next(v for v in outputs if v.name == c.var)
+        outs[c.var] = v.index(c.term) + 1
+    ins = " ".join(str(index.get(v.name, 0)) for v in inputs)
+    outs_text = " ".join(str(outs.get(v.name, 0)) for v in outputs)
+    return f"{ins}, {outs_text} ({fmt_number(r.weight)}) : {connection}"
