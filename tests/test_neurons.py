@@ -12,7 +12,7 @@ from hypothesis import strategies as st
 from mitos_cli import neurons, norms
 from mitos_cli.api import load_rulebase, read_rulebase
 from mitos_cli.compile import compile_rulebase
-from mitos_cli.engine import check_inputs, network_values
+from mitos_cli.engine import network_values
 from mitos_cli.model import Setting
 
 FAST = settings(max_examples=60, deadline=None)
@@ -104,8 +104,7 @@ def test_compiled_and_layer_is_a_layer_of_and_neurons(tnorm):
     c = compile_rulebase(read_rulebase(), overrides=(Setting("and", tnorm),))
     rng = np.random.default_rng(np.random.SeedSequence(5))
     X = np.column_stack([rng.uniform(*u, 400) for u in c.universe])
-    Xc, _ = check_inputs(c, X)
-    V = network_values(c, np.ascontiguousarray(Xc.T))
+    V = network_values(c, np.ascontiguousarray(X.T))      # inputs inside their universes
     mu = V[2:2 + c.n_terms].T                                    # [b, T] membership layer
     index = {key: i for i, key in enumerate(c.term_names)}
     cols = np.array([[index[(p.var, p.term)] for p in rule.antecedent.items]
@@ -124,7 +123,7 @@ def test_not_and_hedges_are_inhibitory_inputs_and_activations(tmp_path):
     c = load_rulebase(tmp_path / "t.rules").compiled
     rng = np.random.default_rng(np.random.SeedSequence(6))
     X = np.column_stack([rng.uniform(*u, 300) for u in c.universe])
-    V = network_values(c, np.ascontiguousarray(check_inputs(c, X)[0].T))
+    V = network_values(c, np.ascontiguousarray(X.T))
     mu = dict(zip(c.term_names, V[2:2 + c.n_terms]))
     very_wide = neurons.neuron(mu["road", "WIDE"][:, None], norm="hamacher", activation="very")
     r1 = neurons.neuron(np.stack([very_wide, mu["size", "LARGE_SZ"]], axis=-1),
