@@ -152,10 +152,11 @@ def variable_plot(variable: Variable, value: float | None = None, *,
 
 
 def sheet(rulebase: RuleBase, names: list[str] | None = None,
-          values: dict[str, float] | None = None,
+          values: dict[str, float] | None = None, behavior: str | None = None,
           points: int = CURVE_POINTS) -> tuple[VariablePlot, ...]:
-    """The membership sheet: every variable of the rule base (inputs first, in file order), or
-    the ``names`` asked for, with ``values`` marked. Unknown names get a "did you mean"."""
+    """The membership sheet: every variable of the rule base (inputs first, in file order),
+    only those ``behavior`` uses, or the ``names`` asked for; ``values`` marked. Unknown
+    names get a "did you mean"."""
     variables = rulebase.variables
     values = dict(values or {})
     for name in list(names or []) + list(values):
@@ -165,6 +166,12 @@ def sheet(rulebase: RuleBase, names: list[str] | None = None,
         chosen = [variables[n] for n in dict.fromkeys(names)]
     else:
         chosen = sorted(variables.values(), key=lambda v: v.role != "input")
+        if behavior is not None:
+            from .compile import compile_rulebase
+
+            compiled = compile_rulebase(rulebase, behavior)
+            used = set(compiled.inputs) | set(compiled.outputs)
+            chosen = [v for v in chosen if v.name in used]
     return tuple(variable_plot(v, values.get(v.name), inputs=termset_inputs(rulebase, v.name),
                                points=points) for v in chosen)
 
@@ -347,6 +354,7 @@ class ConsequentView:
     hedges: tuple[str, ...]
     value: float              # the crisp consequent (for a linear term: at this input)
     implied: np.ndarray | None = None   # Mamdani: the rule's implied set over the output grid
+    full: np.ndarray | None = None      # Mamdani: the consequent set before implication
 
 
 @dataclass(frozen=True)
@@ -418,7 +426,10 @@ def props_of(expr: Expr) -> list[tuple[Prop, bool]]:
     return out
 
 
-def _prop_view(prop: Prop, variable: Variable, value: float, mu: float) -> PropView:
+def _prop_view(prop: Prop, inverted: bool, variable: Variable, mu: float) -> PropView:
+    """``inverted``: an enclosing ``not (...)`` applies, drawn as a negated proposition."""
+    if inverted:
+        prop = Prop(prop.var, prop.term, prop.hedges, not prop.negated)
     term = variable.term(prop.term)
     x = curve_grid(variable.universe, (term,))
     y = np.asarray(term.membership(x), dtype=float)
@@ -457,7 +468,6 @@ def rule_view(compiled: CompiledRuleBase, values: dict[str, float]) -> RuleView:
         mus = tuple((t.name, float(mu[term_index[(name, t.name)]])) for t in var.terms)
         inputs.append(InputValue(name, var.unit, v, bool(res.clamped[k]) and v in (lo, hi), mus,
                                  (float(lo), float(hi))))
-    xv = {i.name: i.value for i in inputs}
 
     crisp = compiled.cons_value
     if compiled.cons_linear is not None:
@@ -472,14 +482,13 @@ def rule_view(compiled: CompiledRuleBase, values: dict[str, float]) -> RuleView:
     for r in fired:
         rule = compiled.rules[r]
         props = []
-        for prop, _ in props_of(rule.antecedent):
-            var = compiled.variables[prop.var]
-            props.append(_prop_view(prop, var, xv[prop.var],
+        for prop, inverted in props_of(rule.antecedent):
+            props.append(_prop_view(prop, inverted, compiled.variables[prop.var],
                                     float(mu[term_index[(prop.var, prop.term)]])))
         cons = tuple(
             ConsequentView(out, compiled.cons_term[r][j], compiled.cons_hedges[r][j],
                            float(crisp[r, j]),
-                           None if sets is None else sets[0][j][r])
+                           *((None, None) if sets is None else sets[j][0][int(r)]))
             for j, out in enumerate(compiled.outputs) if compiled.cons_mask[r, j])
         rows.append(RuleRow(int(r), compiled.labels[r], compiled.rule_text(r), float(dof[r]),
                             tuple(props), cons))
@@ -492,7 +501,7 @@ def rule_view(compiled: CompiledRuleBase, values: dict[str, float]) -> RuleView:
         stems: tuple[tuple[float, float], ...] = ()
         grid = agg = None
         if mamdani:
-            grid, agg = sets[1], sets[2][j]
+            _, grid, agg = sets[j]
         else:
             summed: dict[float, float] = {}
             for r in np.flatnonzero(setting):
@@ -506,7 +515,20 @@ def rule_view(compiled: CompiledRuleBase, values: dict[str, float]) -> RuleView:
 
 
 def _mamdani_sets(compiled: CompiledRuleBase, dof: np.ndarray):
-    """``(implied[m][R, G] or None per rule, grid[m][G], aggregate[m][G])`` for one sample."""
-    from . import mamdani
+    """Per output ``j``: ``({rule: (implied set, consequent set)}, grid, aggregate)`` for one
+    sample's DOFs,
+    from the sampled consequent sets the engine uses (:mod:`mitos_cli.mamdani`)."""
+    from . import mamdani, norms
 
-    return mamdani.viewer_sets(compiled, dof)
+    ops = compiled.operators
+    aggregation = norms.lookup("snorm", ops.aggregation)
+    out = []
+    for table in compiled.mamdani:            # one per output
+        sets = table.sets[table.set_of]                           # [R_j, res]
+        d = dof[table.rules]
+        implied = mamdani.IMPLICATIONS[ops.implication](d[:, None], sets)
+        agg = (mamdani.aggregate(d[:, None], sets, ops.implication, aggregation)[0]
+               if len(table.rules) else np.zeros_like(table.grid))
+        out.append(({int(r): (implied[i], sets[i]) for i, r in enumerate(table.rules)},
+                    table.grid, agg))
+    return out

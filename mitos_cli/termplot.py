@@ -140,7 +140,7 @@ def render_variable(plot: VariablePlot, width: int = 72, height: int = 6,
                     color: bool = False) -> str:
     """One variable's terms as a Braille plot with labels, axes and the marked value."""
     margin = 5                               # "1.0 ┤"
-    cols = max(width - margin - 1, 20)
+    cols = max(width - margin, 20)
     canvas = Canvas(cols, height)
     for tag, curve in enumerate(plot.curves):
         _draw_curve(canvas, plot, curve, tag)
@@ -216,7 +216,14 @@ def _bar(value: float, width: int = 10) -> str:
     return text.ljust(width)
 
 
-def render_rule_view(view: RuleView) -> str:
+def _consequent_text(c) -> str:
+    if c.term is None:
+        return f"{c.output} is {c.value:g}"
+    text = f"{c.output} is {' '.join(c.hedges + (c.term,))}"
+    return text if c.implied is not None else f"{text} ({c.value:g})"
+
+
+def render_rule_view(view: RuleView, width: int = 72, color: bool = False) -> str:
     """The rule viewer as text: one block per fired rule with a bar per membership and DOF."""
     out = [f"behavior {view.behavior} ({view.n_rules} rules; {view.operators})", ""]
     for i in view.inputs:
@@ -225,16 +232,13 @@ def render_rule_view(view: RuleView) -> str:
         out.append(f"  {i.name} = {i.value:g}{unit}: {mus or 'no term holds it'}"
                    + (" (clamped to its universe)" if i.clamped else ""))
     out += ["", f"rules fired ({len(view.rows)} of {view.n_rules}):"]
-    width = max((len(p.text) for r in view.rows for p in r.props), default=0)
+    tw = max((len(p.text) for r in view.rows for p in r.props), default=0)
     lw = max((len(r.label) for r in view.rows), default=0)
     for row in view.rows:
-        cons = " and ".join(
-            f"{c.output} is {' '.join(c.hedges + (c.term,)) if c.term else ''}"
-            f"{'' if c.term else f'{c.value:g}'}" + (f" ({c.value:g})" if c.term else "")
-            for c in row.consequents)
+        cons = " and ".join(_consequent_text(c) for c in row.consequents)
         out.append(f"  {row.label.ljust(lw)}  DOF {row.dof:.2f} {_bar(row.dof)}  then {cons}")
         for p in row.props:
-            out.append(f"  {' ' * lw}    {p.text.ljust(width)}  {p.value:.2f} {_bar(p.value)}")
+            out.append(f"  {' ' * lw}    {p.text.ljust(tw)}  {p.value:.2f} {_bar(p.value)}")
     if not view.rows:
         out.append("  (none)")
     out += ["", "outputs:"]
@@ -245,10 +249,20 @@ def render_rule_view(view: RuleView) -> str:
             continue
         how = " (no rule fired: its default)" if o.defaulted else ""
         out.append(f"  {o.name} = {o.value:.2f}{unit}{how}")
+        if o.aggregate is not None:
+            out.append(_aggregate_plot(o, width, color))
         top = max((w for _, w in o.stems), default=1.0)
         for v, w in o.stems:
             out.append(f"    {v:8.2f}{unit}  summed DOF {w:.2f} {_bar(w / top)}")
     return "\n".join(out)
+
+
+def _aggregate_plot(o, width: int, color: bool) -> str:
+    """A Mamdani output's aggregated set as a small Braille plot with the result marked."""
+    curve = TermCurve("aggregate", "curve", o.grid, o.aggregate, o.value, o.value)
+    plot = VariablePlot(o.name, "output", o.unit, "", o.universe, (curve,), o.value)
+    lines = render_variable(plot, width=width - 4, height=5, color=color).splitlines()
+    return "\n".join("    " + line for line in lines[2:-1])   # no heading, labels, value line
 
 
 # ---------------------------------------------------------------- surfaces as tables

@@ -82,6 +82,8 @@ def terms_command(
              "e.g. road=78.")] = None,
     var: Annotated[Optional[list[str]], typer.Option(
         "--var", "-v", help="Draw only this variable (repeat for more).")] = None,
+    behavior: Annotated[Optional[str], typer.Option(
+        "--behavior", "-b", help="Draw only the variables this behavior uses.")] = None,
     output: OutputOpt = None,
     show: ShowOpt = False,
     width: Annotated[Optional[int], typer.Option(
@@ -102,7 +104,7 @@ def terms_command(
 
     path, texts = split_args(args or [])
     rulebase = read_rulebase(path)
-    plots = sheet(rulebase, var, parse_values(texts))
+    plots = sheet(rulebase, var, parse_values(texts), behavior)
     for p in plots:
         if p.clamped:
             lo, hi = p.universe
@@ -119,8 +121,12 @@ def terms_command(
     from ..draw.terms import draw_sheet
 
     where = display_path(rulebase.path)
-    title = (f"Term sets of {where}" if len(plots) > 1
-             else f"{plots[0].name} ({where})")
+    if len(plots) == 1:
+        title = f"{plots[0].name} ({where})"
+    elif behavior and not var:
+        title = f"Term sets of behavior {behavior} ({where})"
+    else:
+        title = f"Term sets of {where}"
     draw_sheet(plots, output, title=title, show=show)
     _done(output)
 

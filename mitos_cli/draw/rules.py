@@ -42,25 +42,31 @@ def draw_antecedent(ax, row: RuleRow, var: str, value: float, universe) -> None:
                         linewidth=0)
     ax.axvline(value, color=VALUE_COLOR, linewidth=1.1)
     ax.set_xlim(*universe)
-    label = " / ".join(f"{' '.join(('not',) * p.negated + p.hedges + (p.term,))} "
-                       f"{p.value:.2f}" for p in props)
-    ax.text(0.02, 0.96, label, transform=ax.transAxes, fontsize=7, va="top",
-            color="#333333")
+    _label(ax, " / ".join(f"{' '.join(('not',) * p.negated + p.hedges + (p.term,))} "
+                          f"{p.value:.2f}" for p in props))
+
+
+def _label(ax, text: str) -> None:
+    ax.text(0.02, 0.97, text, transform=ax.transAxes, fontsize=7, va="top", color="#333333",
+            bbox=dict(boxstyle="square,pad=0.1", facecolor="white", edgecolor="none",
+                      alpha=0.75), zorder=10)
 
 
 def draw_consequent(ax, row: RuleRow, out: OutputView) -> None:
     cons = [c for c in row.consequents if c.output == out.name]
     lo, hi = out.universe
     for c in cons:
+        name = " ".join(c.hedges + (c.term,)) if c.term else f"{c.value:g}"
         if c.implied is not None and out.grid is not None:
+            ax.plot(out.grid, c.full, color=TERM_COLOR, linewidth=1.0)
             ax.fill_between(out.grid, c.implied, color=OUT_COLOR, alpha=0.7, linewidth=0)
             ax.plot(out.grid, c.implied, color=OUT_COLOR, linewidth=0.8)
         else:
             ax.vlines([c.value], 0, [row.dof], color=OUT_COLOR, linewidth=2.4)
             ax.plot([c.value], [row.dof], "o", color=OUT_COLOR, markersize=3.5)
-        name = " ".join(c.hedges + (c.term,)) if c.term else f"{c.value:g}"
-        ax.text(0.02, 0.96, f"{name} ({c.value:g})" if c.term else name,
-                transform=ax.transAxes, fontsize=7, va="top", color="#333333")
+            if c.term:
+                name += f" ({c.value:g})"
+        _label(ax, name)
     pad = 0.03 * (hi - lo)
     ax.set_xlim(lo - pad, hi + pad)
 

@@ -1,0 +1,328 @@
+"""`mitos plot terms|surface|rules`: files written by extension, terminal output without
+matplotlib, and every user-facing error (exit 1 for ours, 2 for usage), for the packaged rule
+base and for imported FIS files (tests/data/interop/*.fis)."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from mitos_cli import plotdata
+from mitos_cli.api import load_rulebase
+from mitos_cli.cli.app import main
+
+DATA = Path(__file__).parent / "data" / "interop"
+SAMPLE = ["road=78", "size=45", "position=4"]
+PNG = b"\x89PNG\r\n\x1a\n"
+
+
+def run(args, capsys):
+    with pytest.raises(SystemExit) as exc:
+        main(args)
+    out, err = capsys.readouterr()
+    return exc.value.code or 0, out, err
+
+
+def is_svg(path: Path) -> bool:
+    text = path.read_text(encoding="utf-8")
+    return text.lstrip().startswith(("<?xml", "<svg")) and "</svg>" in text
+
+
+# ---------------------------------------------------------------- files
+
+
+@pytest.mark.parametrize("ext", ["png", "svg"])
+@pytest.mark.parametrize("command", [
+    ["terms", "-b", "avoid_obstacle", *SAMPLE],
+    ["surface", "steering", "--x", "road", "--y", "position", "--fix", "size=45", "-n", "12"],
+    ["surface", "steering", "--x", "road", "--y", "position=-15:15", "--fix", "size=45",
+     "-n", "12", "--style", "heatmap"],
+    ["surface", "speed", "--x", "road", "--fix", "size=45", "--fix", "position=4"],
+    ["rules", *SAMPLE],
+])
+def test_files_are_written_by_extension(tmp_path, capsys, command, ext):
+    path = tmp_path / f"picture.{ext.upper() if command[0] == 'rules' else ext}"
+    code, out, err = run(["plot", *command, "-o", str(path)], capsys)
+    assert code == 0, err
+    assert f"wrote {path}" in err and out == ""
+    if ext == "png":
+        assert path.read_bytes()[:8] == PNG
+    else:
+        assert is_svg(path)
+
+
+def test_svg_is_the_same_bytes_twice(tmp_path, capsys):
+    a, b = tmp_path / "a.svg", tmp_path / "b.svg"
+    for p in (a, b):
+        assert run(["plot", "terms", "--var", "road", "road=78", "-o", str(p)], capsys)[0] == 0
+    assert a.read_bytes() == b.read_bytes()
+
+
+# ---------------------------------------------------------------- terminal
+
+
+def test_terms_in_the_terminal_without_matplotlib():
+    code = ("import sys\n"
+            "from mitos_cli.cli.app import main\n"
+            "try:\n"
+            "    main(['plot', 'terms', '--var', 'road', 'road=78', '--width', '60'])\n"
+            "except SystemExit as e:\n"
+            "    assert not e.code, e.code\n"
+            "print('MPL', 'matplotlib' in sys.modules)\n")
+    env = {k: v for k, v in os.environ.items() if k != "NO_COLOR"}
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          env=env, timeout=60)
+    assert done.returncode == 0, done.stderr
+    out = done.stdout
+    assert out.rstrip().endswith("MPL False")
+    assert "NARROW" in out and "MEDIUM" in out and "WIDE" in out
+    assert "road = 78 in: MEDIUM 0.73, WIDE 0.27" in out
+    assert "\x1b[" not in out                          # not a terminal: no colour codes
+    plot_lines = [ln for ln in out.splitlines() if ln.startswith(("1.0 ┤", "0.0 ┤"))]
+    assert len(plot_lines) == 2 and all(len(ln) == 60 for ln in plot_lines)
+    assert any(0x2800 < ord(ch) <= 0x28FF for ch in plot_lines[0])   # Braille dots
+
+
+def test_terms_terminal_colour_on_request(capsys):
+    code, out, _ = run(["plot", "terms", "--var", "size", "--color", "--width", "50"], capsys)
+    assert code == 0 and "\x1b[" in out
+
+
+def test_surface_table_and_notes(capsys):
+    code, out, err = run(["plot", "surface", "steering", "--x", "road", "--y", "position",
+                          "-n", "5"], capsys)
+    assert code == 0
+    assert "note: `size` not fixed: held at 50, the midpoint of its universe" in err
+    lines = out.splitlines()
+    assert lines[0] == "steering [deg] (behavior avoid_obstacle; size = 50 in (midpoint))"
+    assert lines[1] == "rows: position [in], columns: road [in]"
+    rb = load_rulebase()
+    row = lines[6].split("│")             # title, axes, header, rule, -60, -30, then 0
+    assert row[0].strip() == "0"
+    expected = rb.evaluate(road=np.linspace(0, 160, 5), size=50.0, position=0.0)["steering"]
+    assert [float(v) for v in row[1].split()] == [round(v, 1) for v in expected]
+
+
+def test_surface_table_marks_no_rule(tmp_path, capsys):
+    from test_plotdata import GAP_RULES, GAP_TERMS
+
+    (tmp_path / "gap.terms.yaml").write_text(GAP_TERMS)
+    (tmp_path / "gap.rules").write_text(GAP_RULES)
+    code, out, err = run(["plot", "surface", str(tmp_path / "gap.rules"), "--x", "x",
+                          "--fix", "y=0.5", "-n", "11"], capsys)
+    assert code == 0
+    assert "no rule sets `out` at 3 of 11 grid points" in err
+    assert [ln.split()[-1] for ln in out.splitlines()[2:]] == \
+        ["10.0"] * 4 + ["-"] * 3 + ["90.0"] * 4
+
+
+def test_rules_as_text_match_eval(capsys):
+    code, out, _ = run(["plot", "rules", *SAMPLE], capsys)
+    assert code == 0
+    code, js, _ = run(["eval", *SAMPLE, "--json"], capsys)
+    trace = json.loads(js)
+    labels = [ln.split()[0] for ln in out.splitlines() if "DOF" in ln and "then" in ln]
+    assert labels == [r["label"] for r in trace["rules"]]
+    assert f"steering = {trace['outputs']['steering']:.2f} deg" in out
+
+
+# ---------------------------------------------------------------- errors
+
+
+@pytest.mark.parametrize("args, message", [
+    (["terms", "-o", "x.pdf"], "`x.pdf` has extension .pdf; the picture formats are .png and "
+                               ".svg"),
+    (["terms", "-o", "picture"], "`picture` has no extension"),
+    (["surface", "--x", "road"], "name the OUTPUT to draw: one of steering, speed"),
+    (["surface", "steering", "--x", "road=1"], "write NAME or NAME=LOW:HIGH"),
+    (["surface", "steering", "--x", "road", "--fix", "size"], "write NAME=VALUE"),
+    (["surface", "steering", "--x", "road", "--fix", "size=1", "--fix", "size=2"],
+     "`size` is fixed twice"),
+    (["surface", "a", "b", "c", "--x", "road"], "expected [RULEBASE] OUTPUT, got 3"),
+    (["surface", "steering"], "Missing option '--x'"),
+    (["rules"], "give one NAME=VALUE per input: road=... size=... position=..."),
+    (["rules", "road=1", "road=2"], "input `road` is given twice"),
+])
+def test_usage_errors_exit_2(capsys, args, message):
+    code, out, err = run(["plot", *args], capsys)
+    assert code == 2
+    assert message in " ".join(err.replace("│", " ").split())
+
+
+@pytest.mark.parametrize("args, message, hint", [
+    (["terms", "--var", "raod"], "unknown variable `raod`", "did you mean `road`?"),
+    (["terms", "road=wide"], "input `road` must be a number, not `wide`", None),
+    (["surface", "steerin", "--x", "road"], "unknown output `steerin`",
+     "did you mean `steering`?"),
+    (["surface", "steering", "--x", "rod"], "unknown input (--x) `rod`", "did you mean `road`?"),
+    (["surface", "steering", "--x", "road", "--y", "road"], "`road` is on both axes", None),
+    (["surface", "steering", "--x", "road", "--fix", "sise=3"], "unknown input (--fix) `sise`",
+     "did you mean `size`?"),
+    (["surface", "steering", "--x", "road", "--fix", "road=3"],
+     "`road` is on an axis and cannot also be fixed", None),
+    (["surface", "steering", "--x", "road=0:500"],
+     "range 0:500 of `road` is not inside its universe [0, 160]", None),
+    (["surface", "steering", "--x", "road", "--fix", "size=500"],
+     "--fix size=500 is outside its universe [0, 100]", None),
+    (["surface", "steering", "--x", "heading"],
+     "behavior `avoid_obstacle` does not use input `heading` (--x)", None),
+    (["rules", "road=78", "size=45", "positon=4"], "unknown input `positon`",
+     "did you mean `position`?"),
+    (["rules", "road=78", "size=45"], "missing input `position`", None),
+])
+def test_user_errors_exit_1(capsys, args, message, hint):
+    code, out, err = run(["plot", *args], capsys)
+    assert code == 1, err
+    assert message in err
+    if hint:
+        assert f"hint: {hint}" in err
+
+
+def test_show_without_a_display_exits_1():
+    env = {k: v for k, v in os.environ.items() if k not in ("DISPLAY", "WAYLAND_DISPLAY")}
+    env["MPLBACKEND"] = "Agg"
+    done = subprocess.run([sys.executable, "-m", "mitos_cli", "plot", "terms", "--var", "road",
+                           "--show"], capture_output=True, text=True, env=env, timeout=60)
+    assert done.returncode == 1
+    assert "error: cannot open a window" in done.stderr
+    assert "hint: write a file instead with -o FILE.png or -o FILE.svg" in done.stderr
+    assert "Traceback" not in done.stderr
+
+
+def test_unwritable_output_exits_1(tmp_path, capsys):
+    code, _, err = run(["plot", "terms", "--var", "road", "-o",
+                        str(tmp_path / "missing" / "t.png")], capsys)
+    assert code == 1 and "cannot write" in err
+
+
+def test_clamped_values_are_warned(capsys):
+    code, out, err = run(["plot", "terms", "--var", "road", "road=500"], capsys)
+    assert code == 0 and "warning: `road` outside its universe [0, 160] was clamped" in err
+    code, out, err = run(["plot", "rules", "road=500", "size=45", "position=4"], capsys)
+    assert code == 0 and "warning: `road` outside its universe [0, 160] was clamped" in err
+
+
+# ---------------------------------------------------------------- imported FIS files
+
+
+def _fis_files():
+    return sorted(DATA.glob("*.fis"))
+
+
+def _fis_reader_available() -> bool:
+    try:
+        import mitos_cli.interop.fis  # noqa: F401
+    except ImportError:
+        return False
+    return True
+
+
+fis = pytest.mark.skipif(not _fis_files() or not _fis_reader_available(),
+                         reason="no FIS reader in mitos_cli.interop yet (issue 6)")
+
+
+def _midpoints(rb) -> dict[str, float]:
+    return {name: float(np.mean(rb.compiled.universe[k])) + 0.37
+            for k, name in enumerate(rb.inputs)}
+
+
+@fis
+@pytest.mark.parametrize("path", _fis_files(), ids=lambda p: p.name)
+def test_fis_pictures_and_data(path, tmp_path, capsys):
+    rb = load_rulebase(path)
+    values = _midpoints(rb)
+    args = [f"{k}={v:g}" for k, v in values.items()]
+    # membership sheet: every variable of the file, curves = memberships
+    plots = plotdata.sheet(rb.rulebase)
+    assert {p.name for p in plots} == set(rb.rulebase.variables)
+    for plot in plots:
+        var = rb.rulebase.variables[plot.name]
+        for curve, term in zip(plot.curves, var.terms):
+            if curve.kind == "curve":
+                np.testing.assert_array_equal(curve.y, term.membership(curve.x))
+    # surface over the first two inputs = the engine at the same points
+    out = rb.outputs[0]
+    y = rb.inputs[1] if len(rb.inputs) > 1 else None
+    s = plotdata.surface(rb.compiled, out, rb.inputs[0], y, resolution=6)
+    grid = np.meshgrid(s.x.values, s.y.values) if y else (s.x.values,)
+    columns = {f.name: f.value for f in s.fixed}
+    columns[rb.inputs[0]] = grid[0].ravel()
+    if y:
+        columns[y] = grid[1].ravel()
+    expected = rb.evaluate(**columns)[out]
+    np.testing.assert_array_equal(s.z.ravel(), expected)
+    # rule viewer = eval's fired rules and DOFs
+    view = plotdata.rule_view(rb.compiled, values)
+    code, js, _ = run(["eval", str(path), *args, "--json"], capsys)
+    trace = json.loads(js)
+    assert [(r.label, r.dof) for r in view.rows] == \
+        [(r["label"], r["dof"]) for r in trace["rules"]]
+    # and the three commands write their files
+    commands = [["terms", str(path), *args[:1]],
+                ["surface", str(path), out, "--x", rb.inputs[0], "-n", "8"]
+                + (["--y", y] if y else []),
+                ["rules", str(path), *args]]
+    for i, command in enumerate(commands):
+        for ext in ("png", "svg"):
+            target = tmp_path / f"{i}.{ext}"
+            code, _, err = run(["plot", *command, "-o", str(target)], capsys)
+            assert code == 0, err
+            assert target.read_bytes()[:8] == PNG if ext == "png" else is_svg(target)
+
+
+FLL = """\
+Engine: mini
+InputVariable: dist
+  enabled: true
+  range: 0.000 10.000
+  lock-range: false
+  term: NEAR Triangle 0.000 0.000 5.000
+  term: FAR Ramp 3.000 10.000
+OutputVariable: power
+  enabled: true
+  range: 0.000 1.000
+  lock-range: false
+  aggregation: Maximum
+  defuzzifier: Centroid 200
+  default: nan
+  lock-previous: false
+  term: LOW Triangle 0.000 0.250 0.500
+  term: HIGH Triangle 0.500 0.750 1.000
+RuleBlock: rules
+  enabled: true
+  conjunction: Minimum
+  disjunction: Maximum
+  implication: Minimum
+  activation: General
+  rule: if dist is NEAR then power is LOW
+  rule: if dist is FAR then power is HIGH
+"""
+
+
+def test_imported_fll_file(tmp_path, capsys):
+    """An imported foreign file (fuzzylite FLL, whose reader is already in place): the same
+    pictures and data checks as for FIS, independent of the FIS reader."""
+    path = tmp_path / "mini.fll"
+    path.write_text(FLL)
+    rb = load_rulebase(path)
+    view = plotdata.rule_view(rb.compiled, {"dist": 4.0})
+    code, js, _ = run(["eval", str(path), "dist=4", "--json"], capsys)
+    trace = json.loads(js)
+    assert [(r.label, r.dof) for r in view.rows] == \
+        [(r["label"], r["dof"]) for r in trace["rules"]]
+    assert view.outputs[0].value == trace["outputs"]["power"]
+    assert view.outputs[0].aggregate is not None           # a Mamdani file: sets drawn
+    s = plotdata.surface(rb.compiled, "power", "dist", resolution=9)
+    np.testing.assert_array_equal(s.z, rb.evaluate(dist=s.x.values)["power"])
+    for command in (["terms", str(path), "dist=4"], ["surface", str(path), "--x", "dist"],
+                    ["rules", str(path), "dist=4"]):
+        target = tmp_path / f"{command[0]}.png"
+        code, _, err = run(["plot", *command, "-o", str(target)], capsys)
+        assert code == 0, err
+        assert target.read_bytes()[:8] == PNG

@@ -1,0 +1,184 @@
+"""The matplotlib drawings (mitos_cli.draw) carry the plotted data: line y-data are the
+memberships, the heat map's mesh is the surface grid, the rule viewer has one row per fired
+rule. No pixels are compared."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+pytest.importorskip("matplotlib")
+
+from mitos_cli import plotdata  # noqa: E402
+from mitos_cli.api import load_rulebase  # noqa: E402
+from mitos_cli.draw.output import DrawError, check_format  # noqa: E402
+from mitos_cli.draw.rules import draw_rules  # noqa: E402
+from mitos_cli.draw.surface import draw_surface  # noqa: E402
+from mitos_cli.draw.terms import draw_sheet, draw_terms_before_after  # noqa: E402
+
+SAMPLE = {"road": 78.0, "size": 45.0, "position": 4.0}
+
+
+@pytest.fixture(scope="module")
+def mitos():
+    return load_rulebase()
+
+
+def visible_axes(fig):
+    return [ax for ax in fig.axes if ax.get_visible() and not hasattr(ax, "_colorbar")
+            and ax.get_label() != "<colorbar>"]
+
+
+def test_sheet_lines_are_the_memberships(mitos):
+    plots = plotdata.sheet(mitos.rulebase, values=SAMPLE)
+    fig = draw_sheet(plots)
+    axes = visible_axes(fig)
+    assert len(axes) == len(plots)
+    for ax, plot in zip(axes, plots):
+        curves = [c for c in plot.curves if c.kind == "curve"]
+        lines = {line.get_label(): line for line in ax.lines}
+        for curve in curves:
+            line = lines[curve.name]
+            np.testing.assert_array_equal(line.get_xdata(), curve.x)
+            np.testing.assert_array_equal(line.get_ydata(), curve.y)
+        texts = {t.get_text() for t in ax.texts}
+        assert {c.name for c in plot.curves} <= texts               # every term labelled
+        assert plot.axis_label == ax.get_xlabel()
+        if plot.value is not None:
+            marker = lines[f"{plot.name} = {plot.value:g} {plot.unit}"]
+            assert list(marker.get_xdata()) == [plot.value, plot.value]
+            shown = {f"{mu:.2f}" for _, mu in plot.memberships if mu > 0}
+            assert shown <= texts                                    # memberships written
+        singletons = [c for c in plot.curves if c.kind == "singleton"]
+        if singletons:                                               # outputs: stems
+            segments = [seg for coll in ax.collections if hasattr(coll, "get_segments")
+                        for seg in coll.get_segments()]
+            tops = sorted(float(seg[0][0]) for seg in segments if len(seg) == 2
+                          and seg[1][1] == 1.0 and seg[0][0] == seg[1][0])
+            assert tops == sorted(c.center for c in singletons)
+
+
+def test_sheet_single_variable_and_file(mitos, tmp_path):
+    plots = plotdata.sheet(mitos.rulebase, ["size"], {"size": 45})
+    path = tmp_path / "size.svg"
+    fig = draw_sheet(plots, path)
+    assert len(visible_axes(fig)) == 1
+    assert path.read_text().lstrip().startswith(("<?xml", "<svg"))
+
+
+def test_heatmap_mesh_is_the_surface_grid(mitos):
+    s = plotdata.surface(mitos.compiled, "steering", "road", "position", {"size": 45},
+                         resolution=7)
+    fig = draw_surface(s, style="heatmap")
+    ax = fig.axes[0]
+    mesh = next(c for c in ax.collections if type(c).__name__ == "QuadMesh")
+    np.testing.assert_array_equal(np.asarray(mesh.get_array()).reshape(s.z.shape), s.z)
+    assert ax.get_xlabel() == "road [in]" and ax.get_ylabel() == "position [in]"
+    assert "size = 45 in" in ax.get_title(loc="left")
+
+
+def test_surface_3d_and_curve(mitos):
+    s = plotdata.surface(mitos.compiled, "speed", "road", "size", {"position": 4},
+                         resolution=6)
+    fig = draw_surface(s, style="surface")
+    ax = fig.axes[0]
+    assert ax.name == "3d" and ax.get_zlabel() == "speed [in/s]"
+    c = plotdata.surface(mitos.compiled, "speed", "road", None,
+                         {"position": 4, "size": 45}, resolution=6)
+    fig = draw_surface(c)
+    (line,) = [ln for ln in fig.axes[0].lines if ln.get_label() == "speed"]
+    np.testing.assert_array_equal(line.get_ydata(), c.z)
+    np.testing.assert_array_equal(line.get_xdata(), c.x.values)
+
+
+def test_masked_surface_says_so(tmp_path):
+    from test_plotdata import GAP_RULES, GAP_TERMS
+
+    (tmp_path / "gap.terms.yaml").write_text(GAP_TERMS)
+    (tmp_path / "gap.rules").write_text(GAP_RULES)
+    rb = load_rulebase(tmp_path / "gap.rules")
+    s = plotdata.surface(rb.compiled, "out", "x", "y", resolution=11)
+    fig = draw_surface(s, style="heatmap")
+    mesh = next(c for c in fig.axes[0].collections if type(c).__name__ == "QuadMesh")
+    arr = mesh.get_array()
+    assert np.ma.is_masked(arr) and arr.mask.reshape(s.z.shape).tolist() == \
+        s.no_rule.tolist()
+    legend = fig.axes[0].get_legend()
+    assert [t.get_text() for t in legend.get_texts()] == ["no rule fires (no default)"]
+    curve = plotdata.surface(rb.compiled, "out", "x", None, {"y": 0.5}, resolution=11)
+    fig = draw_surface(curve)
+    assert [t.get_text() for t in fig.axes[0].get_legend().get_texts()][-1] == \
+        "no rule fires (no default)"
+
+
+def test_rule_viewer_has_a_row_per_fired_rule(mitos):
+    view = plotdata.rule_view(mitos.compiled, SAMPLE)
+    fig = draw_rules(view)
+    ncols = len(view.inputs) + len(view.outputs)
+    assert len(fig.axes) == (len(view.rows) + 1) * ncols
+    rows = [t.get_text() for ax in fig.axes for t in ax.texts if "DOF" in t.get_text()]
+    assert rows == [f"{r.label}\nDOF {r.dof:.2f}" for r in view.rows]
+    titles = [ax.get_title() for ax in fig.axes if ax.get_title()]
+    assert "road = 78 in" in titles
+    assert f"steering = {view.outputs[0].value:.1f} deg" in titles
+    # the aggregate row's result lines sit at the crisp outputs
+    agg_axes = fig.axes[-len(view.outputs):]
+    for ax, out in zip(agg_axes, view.outputs):
+        xs = [ln.get_xdata()[0] for ln in ax.lines]
+        assert out.value in xs
+
+
+def test_rule_viewer_caps_rows(mitos):
+    view = plotdata.rule_view(mitos.compiled, SAMPLE)
+    fig = draw_rules(view, max_rows=3)
+    assert "the 5 weakest not shown" in fig._suptitle.get_text()
+    labels = [t.get_text().split("\n")[0] for ax in fig.axes for t in ax.texts
+              if "DOF" in t.get_text()]
+    assert labels == ["r4", "r22", "r25"]     # the 3 strongest (r4 before r7 at a tie)
+
+
+def test_before_after(mitos, tmp_path):
+    road = mitos.rulebase.variables["road"]
+    medium = road.term("MEDIUM")
+    after = road.with_terms(tuple(t.with_params((74.0, 34.0)) if t.name == "MEDIUM" else t
+                                  for t in road.terms))
+    path = tmp_path / "road.png"
+    fig = draw_terms_before_after(road, after, path)
+    assert path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    ax = fig.axes[0]
+    dashed = [ln for ln in ax.lines if ln.get_linestyle() == "--"]
+    solid = [ln for ln in ax.lines if ln.get_linestyle() == "-"]
+    assert len(dashed) == len(solid) == 3
+    before_medium = next(ln for ln in dashed if ln.get_label() == "MEDIUM")
+    after_medium = next(ln for ln in solid if ln.get_label() == "MEDIUM")
+    np.testing.assert_array_equal(before_medium.get_ydata(),
+                                  medium.membership(before_medium.get_xdata()))
+    assert max(after_medium.get_xdata()[after_medium.get_ydata() == 1.0]) == 74.0
+    assert any("MEDIUM: (70, 30) → (74, 34)" in t.get_text() for t in ax.texts)
+    assert before_medium.get_color() == after_medium.get_color()
+
+
+def test_formats():
+    assert check_format("a.PNG") == "png" and check_format("b.svg") == "svg"
+    with pytest.raises(DrawError) as exc:
+        check_format("c.pdf")
+    assert "unknown picture format `pdf`" in exc.value.message
+    assert exc.value.expected == "a file name ending in .png or .svg"
+
+
+def test_show_without_display_is_a_clear_error(monkeypatch, mitos):
+    import matplotlib
+
+    monkeypatch.delenv("DISPLAY", raising=False)
+    monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
+    if matplotlib.get_backend().lower() not in ("agg",):
+        pytest.skip("an interactive backend is configured here")
+    with pytest.raises(DrawError) as exc:
+        draw_sheet(plotdata.sheet(mitos.rulebase, ["road"]), show=True)
+    assert exc.value.message.startswith("cannot open a window")
+    assert "-o FILE.png" in exc.value.hint
+
+
+def test_unwritable_path_is_a_clear_error(mitos, tmp_path):
+    with pytest.raises(DrawError, match="cannot write"):
+        draw_sheet(plotdata.sheet(mitos.rulebase, ["road"]), tmp_path / "no" / "dir.png")
