@@ -1,0 +1,75 @@
+"""``mitos teach``: the teaching prompt, a scripted lesson, or a resumed session."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated, Optional
+
+import typer
+
+
+def teach_command(
+    rules: Annotated[Optional[str], typer.Argument(
+        metavar="[RULES]",
+        help="Rule file to teach (default: the packaged MITOS rule base).")] = None,
+    behavior: Annotated[Optional[str], typer.Option(
+        "--behavior", "-b", help="The behavior to teach first (default: the file's first).")]
+        = None,
+    lesson: Annotated[Optional[str], typer.Option(
+        "--lesson", "-l", metavar="FILE|-",
+        help="Run the commands of a lesson file (- for stdin) instead of the prompt; stop at "
+             "the first error (exit 1).")] = None,
+    save_as: Annotated[Optional[str], typer.Option(
+        "--save-as", "-o", metavar="OUT.rules",
+        help="Where `save` writes (OUT.rules and OUT.terms.yaml); a lesson saves there when it "
+             "ends. The original files are never overwritten unless you name them.")] = None,
+    resume: Annotated[bool, typer.Option(
+        "--resume", help="Continue the last teaching session here (or --session NAME) from "
+                         "its journal.")] = False,
+    session_name: Annotated[Optional[str], typer.Option(
+        "--session", metavar="NAME", help="The session to resume (a name under "
+                                          ".mitos/teach/).")] = None,
+) -> None:
+    """Teach a rule base: tell rules and behaviors, correct outputs, adapt, save."""
+    from ..api import default_rulebase_path
+    from ..teach.journal import Journal, find_session, new_session_dir
+    from ..teach.lesson import read_lesson, run_lesson
+    from ..teach.progress import epoch_progress
+    from ..teach.prompt import interact
+    from ..teach.session import Session
+    from .output import emit, err
+
+    if session_name is not None and not resume:
+        raise typer.BadParameter("--session names a session to resume: add --resume")
+    if resume:
+        if rules is not None or behavior is not None:
+            raise typer.BadParameter("--resume continues a session with its own rule file and "
+                                     "behavior; give neither RULES nor --behavior")
+        journal = Journal.open(find_session(session_name))
+        session = Session.resume(journal, out=emit, progress=epoch_progress)
+        if save_as is not None:
+            session.save_as = Path(save_as)
+        err(f"resumed session {journal.directory.name}: {len(journal.active())} changes, "
+            f"{len(session.state.examples)} examples, behavior {session.state.active}"
+            + (" (a torn last line of the journal was dropped)" if journal.skipped_tail
+               else ""))
+    else:
+        path = Path(rules) if rules is not None else default_rulebase_path()
+        if not path.is_file():
+            from ..errors import RuleBaseError
+
+            raise RuleBaseError(f"rule file `{path}` not found")
+        journal = Journal.create(new_session_dir(path.stem))
+        session = Session(path, behavior, journal, save_as, out=emit, progress=epoch_progress)
+        err(f"session {journal.directory.name} (journal in {journal.directory.as_posix()}; "
+            f"`mitos teach --resume` continues it)")
+    if lesson is not None:
+        text, name = read_lesson(lesson)
+        session.echo = emit
+        if lesson != "-":
+            session.base = Path(lesson).parent
+        run_lesson(session, text, name)
+        if session.save_as is not None and session.unsaved:
+            session.run("save")
+        return
+    interact(session, journal.directory / "history")

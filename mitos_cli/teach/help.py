@@ -1,0 +1,95 @@
+"""The ``help`` texts of the teaching prompt (one line per command, a paragraph per topic)."""
+
+from __future__ import annotations
+
+from ..errors import LessonError, unknown
+
+SUMMARY = """\
+Tell rules, correct outputs, let the robot adapt, save. Every change is journaled (`undo`).
+
+  if road is WIDE and position is LEFT then steering is RS    tell a rule (label it `r28: if ...`
+                                                 to name it; the same label replaces a rule)
+  behavior NAME   ...rules, use, frozen...   end    a named behavior, recalled by `use NAME`
+  use NAME                                       make NAME the active behavior
+  eval road=78 size=45 position=4                the DOF trace of the active behavior
+  correct road=78 size=45 position=4 -> steering=60 speed=20    an example of what you want
+  simulate worlds/figure4.yaml [seed N]          drive the active behavior through a world
+  at 12.5s steering=55   |   at 11s to 13s steering=55    corrections during that drive
+  adapt [epochs N] [rate ETA] [plot FILE]        learn from the examples (Q never increases)
+  show rules|terms|examples|behaviors|history [plot FILE]
+  undo        take back the last change
+  save [PATH] write the rule file and its term set (the original is kept unless named)
+  help TOPIC  more on one command (e.g. `help adapt`)
+  quit        leave (nothing is lost: `mitos teach --resume` continues)"""
+
+TOPICS = {
+    "rule": """\
+A rule in the rule language, on one line (or continued on the next lines):
+  r28: if road is NARROW and position is RIGHT then steering is LM and speed is SLOW
+It goes to the open behavior (between `behavior NAME` and `end`), else the active one. A rule
+with an existing label replaces that rule; without a label it gets the next free `rN`. The
+answer is the rule as understood, and any conflict: another rule with the same condition and
+different actions.""",
+    "behavior": """\
+behavior NAME     open a new behavior; the lines up to `end` are its rules, `use B [when C]
+                  [with W]` lines (blend behavior B, weighted by condition C) and `frozen` lines
+end               close it; it becomes the active behavior
+A behavior is recalled by its name alone: `use NAME` here, `--behavior NAME` in `mitos eval`,
+`behavior: NAME` in a world file.""",
+    "use": """\
+use NAME          make NAME the active behavior: `eval`, `correct`, `adapt`, `simulate` use it
+Inside `behavior ... end`, `use B when C` blends B into the behavior being told.""",
+    "frozen": """\
+frozen r4, r5     adaptation leaves the consequents of rules r4 and r5 of the open (or active)
+                  behavior alone. A term is frozen in the YAML term set with `frozen: true`.""",
+    "eval": """\
+eval road=78 size=45 position=4
+The fuzzified inputs, the rules that fire with their DOFs, and the outputs, as `mitos eval`.""",
+    "correct": """\
+correct road=78 size=45 position=4 -> steering=60 speed=20
+An example: for these inputs, these outputs. Outputs you leave out are not corrected.""",
+    "simulate": """\
+simulate WORLD [seed N]
+Drive the active behavior through a world file (a path, or the name of a packaged world) and
+keep the recorded run, so that `at` can correct it.""",
+    "at": """\
+at 12.5s steering=55          one example: what the robot perceived at 12.5 s, and the output
+                              it should have chosen
+at 11s to 13s steering=55     one example per recorded tick from 11 s to 13 s""",
+    "adapt": """\
+adapt [epochs N] [rate ETA] [plot FILE]
+Gradient descent on Q = sum_k (y(x_k) - t_k)^2 over the examples (the paper's eqs. 13-14),
+moving the break points of the active behavior's input terms and its output values. ETA in
+(0, 1) is the learning factor (default 0.5), N the number of epochs (default 50). Peaks stay
+ordered, widths positive, shared break points tied; every step is halved until Q decreases.
+Frozen terms and the consequents of frozen rules keep their values. Afterwards the changed
+terms are listed before -> after; `plot FILE` draws them (.png or .svg).""",
+    "show": """\
+show rules        the rules of the open (or active) behavior, new and changed ones marked
+show terms        the terms of its variables, with the values they had before
+show examples     the examples, with what the behavior answers now
+show behaviors    the behaviors (* active)
+show history      every change of this session (undone ones marked)
+show terms plot FILE   also draw the terms that changed, before and after""",
+    "undo": """\
+undo              take back the last change (a rule, an example, an adaptation, ...); repeat
+                  to walk further back. Saved files are not touched.""",
+    "save": """\
+save [PATH]       write PATH (default: the --save-as file) and its term set beside it
+                  (OUT.terms.yaml), changing only the numbers that were learned; the original
+                  files are overwritten only when you name them.""",
+    "quit": """\
+quit              leave the prompt (Ctrl-D too). Everything is in the journal under
+                  .mitos/teach/; `mitos teach --resume` continues where you left off.""",
+}
+ALIASES = {"if": "rule", "rules": "rule", "end": "behavior", "exit": "quit", "terms": "show",
+           "examples": "show", "history": "show", "behaviors": "show"}
+
+
+def help_text(topic: str | None = None) -> str:
+    if topic is None:
+        return SUMMARY
+    key = ALIASES.get(topic, topic)
+    if key not in TOPICS:
+        raise unknown("help topic", topic, TOPICS, cls=LessonError)
+    return TOPICS[key]

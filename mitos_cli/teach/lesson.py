@@ -1,0 +1,66 @@
+"""Scripted lessons: the prompt's commands from a file (or stdin), stopping at the first error.
+
+A lesson is one command per line; blank lines and ``#`` comments are skipped; a rule may
+continue on the following lines (as in a rule file). The first command that fails raises its
+:class:`~mitos_cli.errors.MitosError` with the lesson's ``path:line:col``, so a lesson is
+reproducible and testable (``mitos teach ... --lesson FILE`` exits 1).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Iterator
+
+from ..errors import MitosError, Span
+from .commands import incomplete
+from .session import Session
+
+
+def commands(text: str) -> Iterator[tuple[int, str]]:
+    """``(first line number, command text)`` for each command of a lesson."""
+    lines = text.splitlines()
+    i = 0
+    while i < len(lines):
+        line = lines[i]
+        start = i + 1
+        i += 1
+        if not line.strip() or line.lstrip().startswith("#"):
+            continue
+        while incomplete(line) and i < len(lines) and lines[i].strip() \
+                and not lines[i].lstrip().startswith("#"):
+            line += "\n" + lines[i]
+            i += 1
+        yield start, line
+
+
+def run_lesson(session: Session, text: str, path: str) -> bool:
+    """Run every command of ``text``; False when the lesson said ``quit``."""
+    for lineno, line in commands(text):
+        session.echo(f"{path}:{lineno}> {line.splitlines()[0]}")
+        try:
+            if not session.run(line, path, lineno):
+                return False
+        except MitosError as exc:
+            if exc.span is None or exc.span.path != path:
+                where = Span.in_text("\n" * (lineno - 1) + line, path, lineno, 1)
+                if exc.span is not None and exc.span.path in (None, "<prompt>"):
+                    where = Span.in_text("\n" * (lineno - 1) + line, path, lineno,
+                                         exc.span.column, exc.span.end_column)
+                exc.span = where
+            raise
+    return True
+
+
+def read_lesson(source: str) -> tuple[str, str]:
+    """The lesson text and the name to report (``-`` reads stdin)."""
+    import sys
+
+    from ..errors import LessonError
+
+    if source == "-":
+        return sys.stdin.read(), "<stdin>"
+    try:
+        return Path(source).read_text(encoding="utf-8"), source
+    except (OSError, UnicodeDecodeError) as exc:
+        raise LessonError(f"cannot read lesson `{source}`: "
+                          f"{getattr(exc, 'strerror', None) or exc}") from None

@@ -1,0 +1,134 @@
+"""The interactive teaching prompt: line editing, history and completion through ``readline``.
+
+``readline`` (the standard library's GNU readline / libedit binding) gives what a teaching
+prompt needs: editing, a history kept in the session directory (so ``--resume`` brings it back)
+and tab completion of command words, variable names, term names, behavior names and rule
+labels; no extra dependency. Without a terminal (a pipe) the prompt reads plain lines, which is
+how the tests drive it. A mistyped line prints what was expected and the prompt goes on;
+Ctrl-C cancels the line (or stops an adaptation, keeping the epochs done); Ctrl-D or ``quit``
+leaves, and everything told is already in the journal.
+"""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+from ..errors import MitosError
+from .commands import COMMAND_WORDS, SHOW_WHAT, incomplete
+from .session import Session
+
+
+class Completer:
+    """Completes the word under the cursor from what the session knows."""
+
+    def __init__(self, session: Session) -> None:
+        self.session = session
+        self.matches: list[str] = []
+
+    def words(self, line: str) -> list[str]:
+        rb = self.session.rulebase
+        tokens = line.split()
+        first = tokens[0] if tokens else ""
+        at_start = len(tokens) == 0 or (len(tokens) == 1 and not line.endswith(" "))
+        if at_start:
+            return list(COMMAND_WORDS) + ["if"]
+        if first == "show":
+            return list(SHOW_WHAT) + ["plot"]
+        if first == "help":
+            from .help import TOPICS
+
+            return list(TOPICS)
+        if first == "use":
+            return [b.name for b in rb.behaviors] + ["when", "with"]
+        if first == "adapt":
+            return ["epochs", "rate", "plot"]
+        if first == "frozen":
+            b = rb.behavior(self.session.focus)
+            return [r.label for r in b.rules if r.label]
+        if first in ("eval", "correct", "at"):
+            inputs = [f"{v.name}=" for v in rb.variables.values() if v.role == "input"]
+            outputs = [f"{v.name}=" for v in rb.variables.values() if v.role == "output"]
+            return outputs if first == "at" or "->" in tokens else inputs + ["->"]
+        # a rule: variables, then `is`, then that variable's terms and hedges
+        prev = tokens[-1] if line.endswith(" ") else (tokens[-2] if len(tokens) > 1 else "")
+        if prev in ("is", "not", "very", "somewhat", "more_or_less", "extremely"):
+            back = tokens if line.endswith(" ") else tokens[:-1]
+            var = next((t for t in reversed(back) if t in rb.variables), None)
+            terms = list(rb.variables[var].term_names) if var else []
+            return terms + ["not", "very", "somewhat", "more_or_less", "extremely"]
+        return list(rb.variables) + ["is", "and", "or", "not", "then", "with"]
+
+    def complete(self, text: str, state: int):
+        if state == 0:
+            import readline
+
+            line = readline.get_line_buffer()[:readline.get_endidx()]
+            self.matches = sorted(w for w in set(self.words(line)) if w.startswith(text))
+        return self.matches[state] if state < len(self.matches) else None
+
+
+def _setup_readline(session: Session, history: Path | None):
+    try:
+        import readline
+    except ImportError:                              # pragma: no cover - Windows without it
+        return None
+    readline.set_completer(Completer(session).complete)
+    readline.set_completer_delims(" \t\n")
+    if "libedit" in (readline.__doc__ or ""):        # macOS
+        readline.parse_and_bind("bind ^I rl_complete")
+    else:
+        readline.parse_and_bind("tab: complete")
+    readline.set_history_length(5000)
+    if history is not None and history.is_file():
+        try:
+            readline.read_history_file(str(history))
+        except OSError:
+            pass
+    return readline
+
+
+def prompt_text(session: Session) -> str:
+    block = session.state.block
+    return f"{session.state.active}/{block}> " if block else f"{session.state.active}> "
+
+
+def interact(session: Session, history: Path | None = None) -> None:
+    """Read and run commands until ``quit`` or end of input."""
+    tty = sys.stdin.isatty()
+    readline = _setup_readline(session, history) if tty else None
+    err = sys.stderr
+    session.out("MITOS teaching prompt: tell rules, correct, adapt, save. `help` lists the "
+                "commands; Ctrl-D or `quit` leaves (nothing is lost).")
+    try:
+        while True:
+            try:
+                line = input(prompt_text(session))
+                while incomplete(line):
+                    line += "\n" + input("... ")
+            except EOFError:
+                session.out("")
+                break
+            except KeyboardInterrupt:
+                print("^C  (the line is dropped; `quit` or Ctrl-D leaves)", file=err)
+                continue
+            if not line.strip() or line.lstrip().startswith("#"):
+                continue
+            if readline is not None and history is not None:
+                try:
+                    readline.append_history_file(1, str(history))
+                except (OSError, AttributeError):
+                    pass
+            try:
+                if not session.run(line):
+                    break
+            except MitosError as exc:
+                print(exc.render(), file=err)
+            except KeyboardInterrupt:
+                print("interrupted", file=err)
+            sys.stdout.flush()
+    finally:
+        if session.unsaved:
+            where = session.journal.directory.name
+            print(f"unsaved changes are kept in the journal; `mitos teach --resume` "
+                  f"(session {where}) continues, `save PATH` writes them", file=err)

@@ -1,0 +1,316 @@
+"""Saving a taught rule base so that it stays linguistic and ``git diff`` shows what was learned.
+
+The rule file and its YAML term sets are written back by *text surgery* on the originals:
+every label, comment and line break stays where it was; only the numbers that changed are
+replaced, at the positions the parsers recorded (Lark tokens for the rule file, ``yamlpos``
+spans for the YAML). Rules told again under an existing label replace that rule's text; new
+rules, ``use`` and ``frozen`` lines go before their behavior's ``end``; new behaviors are
+appended in the rule language. Every file is written atomically (a temporary file in the same
+directory, fsync, ``os.replace``).
+
+Saving under another name writes ``OUT.rules`` and its term set beside it as
+``OUT.terms.yaml`` (with several term sets, ``OUT.<original name>``), with the ``terms`` line
+updated; saving over the original rule file rewrites its term sets in place.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import tempfile
+from dataclasses import dataclass
+from pathlib import Path
+
+from lark import Token, Tree
+
+from .. import yamlpos
+from ..errors import LessonError, TermSetError
+from ..model import Behavior, RuleBase, format_number, format_rule, format_use
+from ..parse import parser as rule_parser
+from ..shapes import SHAPES
+from ..terms import Term
+
+NUMBER = re.compile(r"[-+]?(?:\d[\d_]*\.?\d*|\.\d+)(?:[eE][-+]?\d+)?")
+
+
+@dataclass(frozen=True)
+class Saved:
+    """What :func:`save_rulebase` wrote."""
+
+    rules: Path
+    termsets: tuple[Path, ...]
+    changes: tuple[str, ...]          # one line per change, for people
+
+
+def atomic_write(path: Path, text: str) -> None:
+    """Write ``text`` to ``path`` via a temporary file and ``os.replace`` (never half a file)."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8", newline="") as fh:
+            fh.write(text)
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        try:
+            os.unlink(tmp)
+        except OSError:
+            pass
+        raise
+
+
+def termset_targets(rules_target: Path, original_rules: Path,
+                    termset_paths: tuple[str, ...]) -> tuple[Path, ...]:
+    """Where the term sets go when the rule file is saved as ``rules_target``."""
+    if rules_target.resolve() == original_rules.resolve():
+        return tuple(original_rules.parent / p for p in termset_paths)
+    stem = rules_target.name[:-len(".rules")] if rules_target.name.endswith(".rules") \
+        else rules_target.stem
+    if len(termset_paths) == 1:
+        return (rules_target.parent / f"{stem}.terms.yaml",)
+    return tuple(rules_target.parent / f"{stem}.{Path(p).name}" for p in termset_paths)
+
+
+def save_rulebase(original: RuleBase, current: RuleBase, target: Path) -> Saved:
+    """Write ``current`` to ``target`` (and its term sets), as edits of ``original``'s files."""
+    if original.path is None:
+        raise LessonError("this rule base has no file to save from")
+    src = Path(original.path)
+    if src.suffix.lower() in (".fcl", ".fis", ".fll"):
+        raise LessonError(f"`{src.name}` is not in the rule language; saving keeps the rule "
+                          f"language only", hint="save to a `.rules` file after converting it")
+    targets = termset_targets(target, src, original.termset_paths)
+    changes: list[str] = []
+    texts = []
+    for ts_old, ts_new, rel, dest in zip(original.termsets, current.termsets,
+                                        original.termset_paths, targets):
+        text = (src.parent / rel).read_text(encoding="utf-8")
+        new_text, changed = edit_termset(text, str(src.parent / rel), ts_old, ts_new)
+        changes += changed
+        texts.append((dest, new_text))
+    rules_text = src.read_text(encoding="utf-8")
+    names = tuple(os.path.relpath(dest, target.parent).replace(os.sep, "/") for dest in targets)
+    new_rules, changed = edit_rules(rules_text, str(src), original, current, names)
+    changes += changed
+    for dest, text in texts:                       # term sets first: the rules name them
+        atomic_write(dest, text)
+    atomic_write(target, new_rules)
+    return Saved(target, tuple(d for d, _ in texts), tuple(changes))
+
+
+# ---- term sets ----------------------------------------------------------------------------------
+
+def _offsets(text: str) -> list[int]:
+    starts = [0]
+    for line in text.splitlines(keepends=True):
+        starts.append(starts[-1] + len(line))
+    return starts
+
+
+def edit_termset(text: str, path: str, old, new) -> tuple[str, list[str]]:
+    """``text`` with the parameters of every term that differs between ``old`` and ``new``
+    (term sets of the same variables and terms) replaced in place."""
+    data = yamlpos.load(text, path, TermSetError)
+    starts = _offsets(text)
+    edits: list[tuple[int, int, str]] = []
+    changes: list[str] = []
+    variables = data["variables"]
+    for v_old, v_new in zip(old.variables, new.variables):
+        spec = variables[v_old.name]
+        terms = spec["terms"]
+        for t_old, t_new in zip(v_old.terms, v_new.terms):
+            if t_old.params == t_new.params:
+                continue
+            spans = _param_spans(terms, t_old)
+            for span, a, b in zip(spans, t_old.params, t_new.params):
+                if a == b:
+                    continue
+                at = starts[span.line - 1] + span.column - 1
+                match = NUMBER.match(text, at)
+                if match is None:            # pragma: no cover - yamlpos pointed at a number
+                    raise LessonError(f"cannot find the number for `{v_old.name}."
+                                      f"{t_old.name}` in {path}:{span.line}")
+                edits.append((match.start(), match.end(), format_number(b)))
+            changes.append(f"{v_old.name}.{t_old.name}: {_params(t_old)} -> {_params(t_new)}")
+    return _apply(text, edits), changes
+
+
+def _params(term: Term) -> str:
+    return "(" + ", ".join(format_number(p) for p in term.params) + ")"
+
+
+def _param_spans(terms: yamlpos.YMap, term: Term) -> list:
+    """The YAML positions of ``term``'s parameters, in the shape's parameter order."""
+    spec = terms[term.name]
+    if not isinstance(spec, yamlpos.YMap):            # a bare number: a crisp output value
+        return [terms.value_span(term.name)]
+    if "points" in spec:
+        points = spec["points"]
+        return [points.item_span(i) for i in range(len(points))]
+    if "value" in spec and term.shape == "singleton":
+        return [spec.value_span("value")]
+    return [spec.value_span(p) for p in SHAPES[term.shape].params]
+
+
+def _apply(text: str, edits: list[tuple[int, int, str]]) -> str:
+    for start, end, new in sorted(edits, reverse=True):
+        text = text[:start] + new + text[end:]
+    return text
+
+
+# ---- the rule file --------------------------------------------------------------------------------
+
+@dataclass
+class _Place:
+    """Where a behavior's parts stand in the rule file."""
+
+    rules: dict                 # label -> (start, end, crisp number tokens by variable)
+    end_line_start: int | None  # offset of the line holding `end` (None: top level)
+    indent: str
+
+
+def _tokens(tree: Tree):
+    for node in tree.iter_subtrees_topdown():
+        for child in node.children:
+            if isinstance(child, Token):
+                yield node, child
+
+
+def _rule_place(tree: Tree) -> tuple[str, tuple[int, int, dict]]:
+    label = ""
+    crisp = {}
+    for child in tree.children:
+        if isinstance(child, Tree) and child.data == "label":
+            label = str(child.children[0])
+        if isinstance(child, Tree) and child.data == "crisp_consequent":
+            var = str(child.children[0])
+            number = child.children[1]
+            tok = number.children[0]
+            crisp[var] = (tok.start_pos, tok.end_pos)
+    return label, (tree.meta.start_pos, tree.meta.end_pos, crisp)
+
+
+def _places(text: str) -> tuple[dict[str, _Place], list[Token]]:
+    tree = rule_parser().parse(text, start="start")
+    places: dict[str, _Place] = {}
+    top = _Place({}, None, "")
+    terms_tokens: list[Token] = []
+    for item in tree.children:
+        if not isinstance(item, Tree):
+            continue
+        if item.data == "rule":
+            label, where = _rule_place(item)
+            top.rules[label] = where
+        elif item.data == "terms_stmt":
+            terms_tokens += [t for t in item.children if isinstance(t, Token)]
+        elif item.data == "behavior":
+            name = str(item.children[0])
+            rules = {}
+            indent = "    "
+            for sub in item.children[1:]:
+                if isinstance(sub, Tree) and sub.data == "rule":
+                    label, where = _rule_place(sub)
+                    rules[label] = where
+                    line_start = text.rfind("\n", 0, sub.meta.start_pos) + 1
+                    indent = text[line_start:sub.meta.start_pos]
+                    if indent.strip():
+                        indent = "    "
+            end_kw = item.meta.end_pos - len("end")
+            line_start = text.rfind("\n", 0, end_kw) + 1
+            if text[line_start:end_kw].strip():          # `end` shares its line: insert before it
+                line_start = end_kw
+            places[name] = _Place(rules, line_start, indent)
+    if top.rules:
+        places["main"] = top
+    return places, terms_tokens
+
+
+def edit_rules(text: str, path: str, original: RuleBase, current: RuleBase,
+               termset_names: tuple[str, ...]) -> tuple[str, list[str]]:
+    """The rule file ``text`` with ``current``'s differences from ``original`` written in."""
+    places, terms_tokens = _places(text)
+    edits: list[tuple[int, int, str]] = []
+    changes: list[str] = []
+    for tok, name in zip(terms_tokens, termset_names):
+        import json
+
+        if json.loads(str(tok)) != name:
+            edits.append((tok.start_pos, tok.end_pos, '"' + name + '"'))
+    appended: list[str] = []
+    old_behaviors = {b.name: b for b in original.behaviors}
+    for b in current.behaviors:
+        old = old_behaviors.get(b.name)
+        if old is None:
+            appended.append(_behavior_text(b))
+            changes.append(f"new behavior {b.name} ({len(b.rules)} rules)")
+            continue
+        place = places.get(b.name)
+        old_rules = {r.label: r for r in old.rules}
+        inserted: list[str] = []
+        for rule in b.rules:
+            before = old_rules.get(rule.label) if rule.label else None
+            if before is None:
+                inserted.append(format_rule(rule))
+                changes.append(f"{b.name}: new rule {format_rule(rule)}")
+                continue
+            if before == rule:
+                continue
+            start, end, crisp = place.rules[rule.label]
+            if _only_crisp_changed(before, rule) and all(c.var in crisp for c in rule.consequents
+                                                         if c.term is None):
+                for c_old, c_new in zip(before.consequents, rule.consequents):
+                    if c_old.value != c_new.value:
+                        s, e = crisp[c_new.var]
+                        edits.append((s, e, format_number(c_new.value)))
+            else:
+                edits.append((start, end, format_rule(rule)))
+            changes.append(f"{b.name}: {format_rule(rule)}")
+        for use in b.uses[len(old.uses):]:
+            inserted.append(format_use(use))
+            changes.append(f"{b.name}: {format_use(use)}")
+        new_ops = b.operators[len(old.operators):]
+        if new_ops:
+            inserted.append("operators: " + ", ".join(f"{o.key} = {o.value}" for o in new_ops))
+            changes.append(f"{b.name}: operators " + ", ".join(f"{o.key} = {o.value}"
+                                                               for o in new_ops))
+        new_frozen = [label for label in b.frozen if label not in old.frozen]
+        if new_frozen:
+            inserted.append("frozen " + ", ".join(new_frozen))
+            changes.append(f"{b.name}: frozen {', '.join(new_frozen)}")
+        if inserted:
+            if place is None or place.end_line_start is None:
+                appended += inserted                      # top-level rules: at the end
+            else:
+                block = "".join(place.indent + line + "\n" for line in inserted)
+                if text[place.end_line_start - 1:place.end_line_start] not in ("\n", ""):
+                    block = "\n" + block
+                edits.append((place.end_line_start, place.end_line_start, block))
+    out = _apply(text, edits)
+    if appended:
+        if not out.endswith("\n"):
+            out += "\n"
+        out += "\n# told in `mitos teach`\n" + "\n".join(appended) + "\n"
+    return out, changes
+
+
+def _only_crisp_changed(before, after) -> bool:
+    if before.label != after.label or before.antecedent != after.antecedent \
+            or before.weight != after.weight or len(before.consequents) != len(after.consequents):
+        return False
+    for a, b in zip(before.consequents, after.consequents):
+        if (a.var, a.term, a.hedges) != (b.var, b.term, b.hedges):
+            return False
+    return True
+
+
+def _behavior_text(b: Behavior) -> str:
+    lines = [f"behavior {b.name}:"]
+    if b.operators:
+        lines.append("    operators: " + ", ".join(f"{s.key} = {s.value}" for s in b.operators))
+    lines += ["    " + format_rule(r) for r in b.rules]
+    lines += ["    " + format_use(u) for u in b.uses]
+    if b.frozen:
+        lines.append("    frozen " + ", ".join(b.frozen))
+    lines.append("end")
+    return "\n".join(lines)

@@ -1,0 +1,99 @@
+"""A recorded simulation run that the instructor corrects with ``at 12.5s steering=55``.
+
+``simulate WORLD`` drives the session's *active* behavior through the world (the simulator of
+:mod:`mitos_cli.sim`, imported only here and only when asked); ``at`` turns what the robot
+perceived at a time (or in a time window) into examples.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import LessonError
+from ..model import RuleBase
+
+
+def world_path(name: str, base: Path | None = None) -> Path:
+    """A world file by path (relative to ``base``, then the working directory), or a packaged
+    world by name (``figure4`` or ``figure4.yaml``)."""
+    from ..resources import data_dir, packaged_path
+
+    for candidate in ([base / name] if base else []) + [Path(name)]:
+        if candidate.is_file():
+            return candidate
+    packaged = sorted(e.name for e in data_dir("worlds").iterdir() if e.name.endswith(".yaml"))
+    stem = Path(name).name
+    for file in (stem, stem + ".yaml"):
+        if file in packaged:
+            return packaged_path("worlds", file)
+    from ..errors import unknown
+
+    raise unknown("world", name, [p[:-5] for p in packaged], cls=LessonError)
+
+
+@dataclass
+class Recording:
+    """One run: its verdict and what the robot perceived at every tick."""
+
+    name: str
+    behavior: str
+    result: object                     # mitos_cli.sim.SimResult
+
+    @property
+    def t(self) -> np.ndarray:
+        return self.result.t
+
+    def time(self, row: int) -> float:
+        return float(self.t[row])
+
+    def describe(self) -> str:
+        s = self.result.summary()
+        return (f"{self.name} with behavior {self.behavior}: {s['outcome']} after "
+                f"{s['time_s']:g} s (min clearance {s['min_clearance_in']:.1f} in, "
+                f"{s['collisions']} collision{'s' if s['collisions'] != 1 else ''}); "
+                f"correct it with `at TIME OUTPUT=VALUE` (0 to {self.time(-1):g} s)")
+
+    def rows(self, start: float, stop: float | None) -> np.ndarray:
+        """Tick rows at ``start`` (the nearest) or from ``start`` to ``stop``."""
+        t = self.t
+        end = float(t[-1])
+        for value in (start, stop):
+            if value is not None and not -1e-9 <= value <= end + 1e-9:
+                raise LessonError(f"the run lasted 0 to {end:g} s; {value:g} s is outside it")
+        active = self.result.active[:, 0] if self.result.active is not None else \
+            np.ones(len(t), dtype=bool)
+        if stop is None:
+            return np.array([int(np.argmin(np.abs(t - start)))])
+        if stop < start:
+            raise LessonError(f"`at {start:g}s to {stop:g}s`: the window ends before it starts")
+        rows = np.flatnonzero((t >= start - 1e-9) & (t <= stop + 1e-9) & active)
+        if rows.size == 0:
+            raise LessonError(f"no recorded tick between {start:g} s and {stop:g} s")
+        return rows
+
+    def when(self, rows: np.ndarray) -> str:
+        if len(rows) == 1:
+            return f"at {self.time(rows[0]):g} s"
+        return f"from {self.time(rows[0]):g} s to {self.time(rows[-1]):g} s"
+
+    def inputs_at(self, row: int, names: tuple[str, ...]) -> dict:
+        missing = [n for n in names if n not in self.result.perceived]
+        if missing:
+            raise LessonError("the simulator does not perceive " + ", ".join(
+                f"`{m}`" for m in missing), hint="correct a behavior whose inputs the "
+                                                 "simulator measures (e.g. drive)")
+        return {n: float(self.result.perceived[n][row, 0]) for n in names}
+
+
+def run_world(name: str, rulebase: RuleBase, behavior: str, seed: int | None = None,
+              base: Path | None = None) -> Recording:
+    """Drive ``behavior`` of ``rulebase`` through the world ``name``."""
+    from ..sim import FuzzyPlanner, load_world, simulate
+
+    path = world_path(name, base)
+    world = load_world(path)
+    result = simulate(world, FuzzyPlanner(rulebase, behavior), seed=seed)
+    return Recording(Path(name).stem, behavior, result)
