@@ -11,7 +11,7 @@ import sys
 import typer
 
 from ..errors import MitosError
-from . import check_cmd, eval_cmd, operators_cmd, plot_cmd
+from . import check_cmd, eval_cmd, operators_cmd, plot_cmd, teach_cmd
 
 app = typer.Typer(
     name="mitos",
@@ -35,6 +35,7 @@ def _root() -> None:
 app.command("eval")(eval_cmd.eval_command)
 app.command("operators")(operators_cmd.operators_command)
 app.command("check")(check_cmd.check_command)
+app.command("teach")(teach_cmd.teach_command)
 app.add_typer(plot_cmd.plot_app, name="plot")
 
 
