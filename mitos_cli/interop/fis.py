@@ -298,8 +298,6 @@ def write_fis(rb: RuleBase, behavior: str | None = None) -> str:
         lines += ["ImpMethod='prod'", "AggMethod='sum'",
                   f"DefuzzMethod='{common.DEFUZZIFIERS[ops.inference][FIS]}'"]
     else:
-        if ops.resolution != DEFAULT_RESOLUTION:
-            pass        # MATLAB has no per-file resolution; documented in docs/interop.md
         lines += [f"ImpMethod='{common.foreign_name(common.TNORMS, FIS, ops.implication, 'implication')}'",
                   f"AggMethod='{common.foreign_name(common.SNORMS, FIS, ops.aggregation, 'aggregation')}'",
                   f"DefuzzMethod='{common.foreign_name(common.DEFUZZIFIERS, FIS, ops.defuzzify, 'defuzzifier')}'"]

@@ -1,0 +1,464 @@
+"""Fuzzy Control Language (IEC 61131-7): reader (jFuzzyLogic's and fuzzylite's dialects) and
+writer.
+
+The whole file is parsed with ``grammar/fcl.lark`` (LALR); this module turns the tree into
+MITOS's model. Both dialects are read:
+
+- terms: the standard point lists ``(x, y) ...`` (a list that is exactly a triangle, trapezoid
+  or shoulder becomes that shape, else ``discrete``), singletons ``TERM t := 5;``,
+  jFuzzyLogic's ``trian trape gauss gbell sigm dsigm`` and fuzzylite's class names
+  (``Triangle``, ``Gaussian``, ``Linear``, ...; every one but ``Function``);
+- ``ACCU`` in the RULEBLOCK (IEC, jFuzzyLogic) or in DEFUZZIFY (fuzzylite); ``ACT`` is the
+  implication; with only ``AND`` (or only ``OR``) given the other is its De Morgan dual, as
+  IEC 61131-7 says;
+- ``METHOD``: COG, COA (BIS), MM (MOM), LM (SOM), RM (LOM) for Mamdani; COGS (weighted
+  average of singletons) and COGSS (weighted sum) for Takagi-Sugeno;
+- ``DEFAULT := v`` -> ``Variable.default``; ``DEFAULT := nan`` -> none; ``| NC`` (no change:
+  keep the previous output) and ``LOCK : PREVIOUS`` need state and are refused; ``LOCK : RANGE``
+  is accepted for Mamdani outputs (a no-op there) and refused for Takagi-Sugeno ones;
+- hedges (fuzzylite's dialect) as in FLL; ``NOT (...)`` over groups.
+
+Without a ``RANGE``, a variable's range is the extent of its piecewise-linear terms.
+The writer writes the IEC / jFuzzyLogic dialect (point lists for piecewise-linear terms, ACCU in
+the rule block); shapes IEC has no notation for use jFuzzyLogic's or fuzzylite's names, which
+this reader reads back.
+"""
+
+from __future__ import annotations
+
+import functools
+from pathlib import Path
+
+from lark import Lark, Token, Tree
+from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken
+
+from .. import norms
+from ..errors import FormatError, Span, did_you_mean
+from ..model import And, Not, Or, Prop, Rule, RuleBase
+from ..terms import Term, Variable
+from . import common
+from .common import FCL, FLL, Settings, fmt_number
+from .ruletree import conclusion, expression
+
+DEFAULT_RESOLUTION = 1000
+
+#: jFuzzyLogic's shape names (lower case) -> (MITOS shape, count, FCL order -> MITOS order)
+JFUZZY_SHAPES = {
+    "trian": ("triangle", 3, (0, 1, 2)),
+    "trape": ("trapezoid", 4, (0, 1, 2, 3)),
+    "gauss": ("gaussian", 2, (0, 1)),
+    "gbell": ("bell", 3, (2, 0, 1)),               # a b mean = width, slope, center
+    "sigm": ("sigmoid", 2, (1, 0)),                # gain center
+    "dsigm": ("sigmoid_difference", 4, (1, 0, 2, 3)),   # gain1 center1 gain2 center2
+}
+
+
+@functools.lru_cache(maxsize=None)
+def parser() -> Lark:
+    from ..resources import grammar_text
+
+    return Lark(grammar_text("fcl.lark"), parser="lalr", propagate_positions=True,
+                maybe_placeholders=True)
+
+
+def read_fcl(path: str | Path) -> RuleBase:
+    from .fll import _read_text
+
+    path = Path(path)
+    return parse_fcl(_read_text(path), str(path))
+
+
+def _syntax_error(exc: UnexpectedInput, text: str, path: str | None) -> FormatError:
+    line, column = getattr(exc, "line", 1) or 1, getattr(exc, "column", 1) or 1
+    if isinstance(exc, UnexpectedEOF):
+        lines = text.splitlines() or [""]
+        line, column = len(lines), len(lines[-1]) + 1
+        what = "unexpected end of file"
+    elif isinstance(exc, UnexpectedToken):
+        what = f"unexpected `{exc.token}`"
+    elif isinstance(exc, UnexpectedCharacters):
+        char = text[exc.pos_in_stream] if exc.pos_in_stream < len(text) else ""
+        what = f"unexpected character `{char}`"
+    else:
+        what = "cannot read this"
+    expected = getattr(exc, "expected", None) or getattr(exc, "allowed", None) or ()
+    words = sorted({_word(e) for e in expected if not e.startswith("__")})
+    return FormatError(what, span=Span.in_text(text, path, line, column),
+                       expected=("one of " + ", ".join(words)) if words else None)
+
+
+def _word(terminal: str) -> str:
+    names = {"NAME": "a name", "SIGNED_NUMBER": "a number", "NAN": "nan", "INF": "inf",
+             "INT": "a number", "SEMICOLON": "`;`", "COLON": "`:`", "LPAR": "`(`",
+             "RPAR": "`)`", "COMMA": "`,`", "WORD": "a hedge", "OPTION_KEY": "METHOD/ACCU/AND/OR/ACT",
+             "$END": "the end of the file"}
+    if terminal in names:
+        return names[terminal]
+    return "`" + terminal.replace("_", " ").lower() + "`" if terminal.isupper() else terminal
+
+
+def parse_fcl(text: str, path: str | None = None) -> RuleBase:
+    """Read FCL ``text`` into a rule base (one behavior, ``main``)."""
+    try:
+        tree = parser().parse(text)
+    except UnexpectedInput as exc:
+        raise _syntax_error(exc, text, path) from None
+
+    def span_of(node) -> Span:
+        if isinstance(node, Token):
+            return Span.in_text(text, path, node.line, node.column, node.end_column)
+        meta = node.meta
+        if meta.empty:
+            return Span.in_text(text, path, 1, 1)
+        end = meta.end_column if meta.end_line == meta.line else None
+        return Span.in_text(text, path, meta.line, meta.column, end)
+
+    blocks = tree.children
+    if len(blocks) > 1:
+        raise FormatError(f"the file has {len(blocks)} function blocks; MITOS reads one",
+                          span=span_of(blocks[1]), hint="split the file, one block per file")
+    return _function_block(blocks[0], span_of)
+
+
+def _num(tree) -> float:
+    token = tree.children[0] if isinstance(tree, Tree) else tree
+    return float(str(token))
+
+
+def _function_block(fb: Tree, span_of) -> RuleBase:
+    declared: dict[str, tuple[str, Span, tuple[float, float] | None]] = {}
+    fuzzify, defuzzify, blocks = [], [], []
+    for item in fb.children[1:]:
+        if item.data in ("var_input", "var_output"):
+            role = "input" if item.data == "var_input" else "output"
+            for decl in item.children:
+                name, typ, rng = decl.children
+                if str(name) in declared:
+                    raise FormatError(f"variable `{name}` is declared twice", span=span_of(name))
+                if str(typ).upper() != "REAL":
+                    raise FormatError(f"variable `{name}`: type `{typ}` is not supported",
+                                      span=span_of(typ), expected="REAL")
+                r = (_num(rng.children[0]), _num(rng.children[1])) if rng is not None else None
+                declared[str(name)] = (role, span_of(name), r)
+        elif item.data == "fuzzify":
+            fuzzify.append(item)
+        elif item.data == "defuzzify":
+            defuzzify.append(item)
+        else:
+            blocks.append(item)
+    n_inputs = sum(1 for role, _, _ in declared.values() if role == "input")
+    settings = Settings()
+    locks: dict[str, Span] = {}
+    variables = {}
+    for node in fuzzify + defuzzify:
+        role = "input" if node.data == "fuzzify" else "output"
+        v = _variable(node, role, declared, settings, locks, n_inputs, span_of)
+        if v.name in variables:
+            raise FormatError(f"variable `{v.name}` is defined twice", span=v.span)
+        variables[v.name] = v
+    for name, (role, span, _) in declared.items():
+        if name not in variables:
+            kind = "FUZZIFY" if role == "input" else "DEFUZZIFY"
+            raise FormatError(f"variable `{name}` is declared but has no {kind} block",
+                              span=span)
+    conj: dict[str, bool] = {}
+    rules = []
+    for block in blocks:
+        for item in block.children[1:]:
+            if item.data == "option":
+                _option(item, settings, span_of, conj)
+    if settings.and_ and not settings.or_:
+        settings.or_ = norms.lookup("tnorm", settings.and_).dual
+    elif settings.or_ and not settings.and_:
+        settings.and_ = norms.lookup("snorm", settings.or_).dual
+    for block in blocks:
+        for item in block.children[1:]:
+            if item.data == "rule":
+                rules.append(_rule(item, variables, span_of, len(rules)))
+    if settings.sugeno:
+        for name, span in locks.items():
+            raise FormatError(f"`LOCK : RANGE` on the Takagi-Sugeno output `{name}` (clipping "
+                              f"the output to its range) is not supported", span=span)
+    ordered = [variables[n] for n in declared]
+    return common.assemble(span_of(fb).path, ordered, rules, settings, DEFAULT_RESOLUTION,
+                           span_of(fb))
+
+
+def _variable(node: Tree, role: str, declared, settings: Settings, locks: dict, n_inputs: int,
+              span_of) -> Variable:
+    name_token = node.children[0]
+    name = str(name_token)
+    if name not in declared:
+        raise FormatError(f"`{name}` is not declared in VAR_INPUT / VAR_OUTPUT",
+                          span=span_of(name_token), hint=did_you_mean(name, declared))
+    declared_role, _, universe = declared[name]
+    if declared_role != role:
+        raise FormatError(f"`{name}` is declared as an {declared_role} but has a "
+                          f"{'FUZZIFY' if role == 'input' else 'DEFUZZIFY'} block",
+                          span=span_of(name_token))
+    terms: list[Term] = []
+    default = None
+    for item in node.children[1:]:
+        kind = item.data
+        if kind == "term":
+            terms.append(_term(item, role, n_inputs, span_of))
+        elif kind == "range_item":
+            universe = (_num(item.children[0]), _num(item.children[1]))
+        elif kind == "option":
+            key = str(item.children[0]).upper()
+            if role == "input":
+                raise FormatError(f"`{key}` has no meaning in FUZZIFY", span=span_of(item))
+            _option(item, settings, span_of, {})
+        elif kind == "default_item":
+            value, flag = item.children
+            if flag is not None:
+                if str(flag).upper() == "NC":
+                    raise FormatError("`| NC` (no change: keep the previous output when no rule "
+                                      "fires) needs state between evaluations, which MITOS does "
+                                      "not keep", span=span_of(flag),
+                                      hint="give a plain `DEFAULT := value;`")
+                raise FormatError(f"unknown DEFAULT flag `{flag}`", span=span_of(flag),
+                                  expected="NC")
+            if isinstance(value, Token) and value.type == "NAME":
+                raise FormatError(f"DEFAULT must be a number, not `{value}`", span=span_of(value))
+            d = _num(value)
+            default = None if d != d else d
+        elif kind == "lock_item":
+            for word in item.children:
+                w = str(word).upper()
+                if w == "PREVIOUS":
+                    raise FormatError("`LOCK : PREVIOUS` (keep the previous output when no rule "
+                                      "fires) needs state between evaluations, which MITOS does "
+                                      "not keep", span=span_of(word))
+                if w != "RANGE":
+                    raise FormatError(f"unknown LOCK `{word}`", span=span_of(word),
+                                      expected="PREVIOUS or RANGE")
+                locks[name] = span_of(word)
+    if not terms:
+        raise FormatError(f"variable `{name}` has no terms", span=span_of(node))
+    if universe is None:
+        universe = _extent(terms, name, span_of(node))
+    lo, hi = universe
+    if not lo < hi:
+        raise FormatError(f"variable `{name}`: range [{lo:g}, {hi:g}] is empty",
+                          span=span_of(node))
+    try:
+        return Variable(name, role, (lo, hi), tuple(terms), "", "", default, span_of(name_token))
+    except Exception as exc:
+        raise FormatError(getattr(exc, "message", str(exc)), span=span_of(node)) from None
+
+
+def _extent(terms: list[Term], name: str, span: Span) -> tuple[float, float]:
+    xs = []
+    for t in terms:
+        if t.shape == "discrete":
+            xs += list(t.params[0::2])
+        elif t.corners is not None:
+            xs += [c for c in t.corners if abs(c) != float("inf")]
+        elif t.shape == "singleton":
+            xs.append(t.params[0])
+        else:
+            raise FormatError(f"variable `{name}` has no RANGE and its `{t.name}` term "
+                              f"({t.shape}) has no bounded support", span=span,
+                              hint="add `RANGE := (min .. max);`")
+    if not xs or min(xs) == max(xs):
+        raise FormatError(f"variable `{name}` has no RANGE and its terms do not span one",
+                          span=span, hint="add `RANGE := (min .. max);`")
+    return min(xs), max(xs)
+
+
+def _term(item: Tree, role: str, n_inputs: int, span_of) -> Term:
+    name_token, definition = item.children
+    name, span = str(name_token), span_of(item)
+    if definition.data == "singleton_def":
+        return common.make_term(name, "singleton", (_num(definition.children[0]),), span)
+    if definition.data == "points":
+        pts = [(_num(p.children[0]), _num(p.children[1])) for p in definition.children]
+        return _points_term(name, pts, span)
+    kind_token, *values = definition.children
+    kind = str(kind_token)
+    values = [_num(v) for v in values]
+    if kind.lower() in JFUZZY_SHAPES:
+        shape, count, order = JFUZZY_SHAPES[kind.lower()]
+        if len(values) != count:
+            raise FormatError(f"term `{name}`: {kind} takes {count} numbers, not {len(values)}",
+                              span=span)
+        return common.make_term(name, shape, tuple(values[i] for i in order), span)
+    by_lower = {k.lower(): k for k in common.FUZZYLITE_SHAPES} | {
+        k.lower(): k for k in common.FORMULA_TERMS}
+    if kind.lower() in by_lower:
+        fl_kind = by_lower[kind.lower()]
+        if fl_kind == "Linear" and role != "output":
+            raise FormatError(f"term `{name}`: Linear terms belong to outputs", span=span)
+        return common.fuzzylite_term(name, fl_kind, values, n_inputs, span)
+    known = sorted(JFUZZY_SHAPES) + sorted(common.FUZZYLITE_SHAPES)
+    raise FormatError(f"term `{name}`: unknown membership function `{kind}`", span=span,
+                      expected="a point list (x, y) ..., a number, or one of " + ", ".join(known),
+                      hint=did_you_mean(kind, known))
+
+
+def _points_term(name: str, pts: list[tuple[float, float]], span: Span) -> Term:
+    """A point list, as the simplest MITOS shape that draws exactly the same polyline."""
+    xs = [p[0] for p in pts]
+    ys = [p[1] for p in pts]
+    if any(a > b for a, b in zip(xs, xs[1:])):
+        raise FormatError(f"term `{name}`: the points' x values must ascend", span=span)
+    if len(set(xs)) == len(xs):
+        if ys == [0, 1, 0]:
+            return common.make_term(name, "triangle", tuple(xs), span)
+        if ys == [0, 1, 1, 0]:
+            return common.make_term(name, "trapezoid", tuple(xs), span)
+        if ys == [1, 0]:
+            return common.make_term(name, "left_shoulder", tuple(xs), span)
+        if ys == [0, 1]:
+            return common.make_term(name, "right_shoulder", tuple(xs), span)
+    if len(pts) == 1:
+        raise FormatError(f"term `{name}`: a point list needs at least two points", span=span,
+                          hint=f"for a singleton write `TERM {name} := {fmt_number(xs[0])};`")
+    return common.make_term(name, "discrete", tuple(v for p in pts for v in p), span)
+
+
+def _option(item: Tree, settings: Settings, span_of, conj: dict) -> None:
+    key_token, value_token, number = item.children
+    key, value, span = str(key_token).upper(), str(value_token), span_of(value_token)
+    if key == "AND":
+        settings.set("and_", _norm(common.TNORMS, value, "AND", span), span, "AND")
+    elif key == "OR":
+        settings.set("or_", _norm(common.SNORMS, value, "OR", span), span, "OR")
+    elif key in ("ACT", "IMPLICATION"):
+        settings.set("implication", common.check_implication(
+            _norm(common.TNORMS, value, "ACT", span), span), span, "ACT")
+    elif key == "ACTIVATION":
+        if value.lower() != "general":
+            raise FormatError(f"activation `{value}` is not supported: MITOS activates every "
+                              f"rule", span=span)
+    elif key == "ACCU":
+        settings.set("aggregation", _norm(common.SNORMS, value, "ACCU", span), span, "ACCU")
+    elif key == "METHOD":
+        method = _norm(common.DEFUZZIFIERS, value, "METHOD", span)
+        settings.set("defuzzify", method, span, "METHOD")
+        if number is not None:
+            res = _num(number)
+            if not res.is_integer() or res < 3:
+                raise FormatError(f"resolution must be a whole number >= 3, not "
+                                  f"{fmt_number(res)}", span=span_of(number))
+            settings.set("resolution", int(res), span_of(number), "resolution")
+
+
+def _norm(table: dict, value: str, what: str, span: Span) -> str:
+    """FCL's abbreviations (any case), or fuzzylite's class names."""
+    try:
+        return common.table_lookup(table, FCL, value, what, span, case=False)
+    except FormatError:
+        for mitos, names in table.items():
+            if names[FLL] == value:
+                return mitos
+        raise
+
+
+def _rule(item: Tree, variables: dict[str, Variable], span_of, index: int) -> Rule:
+    label_tree, antecedent_tree, *rest = item.children
+    weight_tree = rest[-1]
+    label = str(label_tree.children[0])
+    label = label if not label.isdigit() else f"r{label}"
+    antecedent = expression(antecedent_tree, span_of, variables)
+    weight = _num(weight_tree) if weight_tree is not None else 1.0
+    return Rule(label, antecedent, tuple(conclusion(c, span_of) for c in rest[:-1]), weight,
+                span_of(item))
+
+
+# ---------------------------------------------------------------------------------------------
+# Writer
+
+
+def write_fcl(rb: RuleBase, behavior: str | None = None) -> str:
+    """FCL text (IEC 61131-7 as jFuzzyLogic reads it) for one behavior of ``rb``."""
+    flat = common.flatten_for_export(rb, behavior)
+    ops = flat.operators
+    sugeno = ops.inference in ("weighted_average", "weighted_sum")
+    inputs = common.all_inputs(rb, flat)
+    out = [f"FUNCTION_BLOCK {flat.name}", "", "VAR_INPUT"]
+    out += [f"    {v.name} : REAL;" for v in inputs] + ["END_VAR", "", "VAR_OUTPUT"]
+    out += [f"    {v.name} : REAL;" for v in flat.outputs] + ["END_VAR", ""]
+    for v in inputs:
+        out.append(f"FUZZIFY {v.name}")
+        out.append(f"    RANGE := ({fmt_number(v.universe[0])} .. {fmt_number(v.universe[1])});")
+        out += [f"    TERM {t.name} := {_term_text(t, v)};" for t in v.terms]
+        out += ["END_FUZZIFY", ""]
+    for v in flat.outputs:
+        out.append(f"DEFUZZIFY {v.name}")
+        out.append(f"    RANGE := ({fmt_number(v.universe[0])} .. {fmt_number(v.universe[1])});")
+        for t in v.terms:
+            if sugeno and t.shape == "linear":
+                coefficients = common.linear_coefficients(rb, v.name, t)
+                values = [coefficients.get(x.name, 0.0) for x in inputs] + [t.params[-1]]
+                text = "Linear " + " ".join(fmt_number(c) for c in values)
+            elif sugeno:
+                text = fmt_number(t.center)
+            else:
+                text = _term_text(t, v)
+            out.append(f"    TERM {t.name} := {text};")
+        if sugeno:
+            out.append(f"    METHOD : {common.DEFUZZIFIERS[ops.inference][FCL]};")
+        else:
+            method = common.foreign_name(common.DEFUZZIFIERS, FCL, ops.defuzzify, "defuzzifier")
+            out.append(f"    METHOD : {method} {ops.resolution};")
+        out.append(f"    DEFAULT := {'nan' if v.default is None else fmt_number(v.default)};")
+        out += ["END_DEFUZZIFY", ""]
+    out.append(f"RULEBLOCK {flat.name}")
+    out.append(f"    AND : {common.foreign_name(common.TNORMS, FCL, ops.and_, 'T-norm')};")
+    out.append(f"    OR : {common.foreign_name(common.SNORMS, FCL, ops.or_, 'S-norm')};")
+    if not sugeno:
+        out.append(f"    ACT : {common.foreign_name(common.TNORMS, FCL, ops.implication, 'T-norm')};")
+        out.append(f"    ACCU : {common.foreign_name(common.SNORMS, FCL, ops.aggregation, 'S-norm')};")
+    for i, r in enumerate(flat.rules, 1):
+        out.append(f"    RULE {i} : {_rule_text(r)};")
+    out += ["END_RULEBLOCK", "", "END_FUNCTION_BLOCK"]
+    return "\n".join(out) + "\n"
+
+
+def _term_text(t: Term, v: Variable) -> str:
+    if t.shape == "singleton":
+        return fmt_number(t.params[0])
+    if t.shape == "discrete":
+        p = t.params
+        return " ".join(f"({fmt_number(x)}, {fmt_number(y)})" for x, y in zip(p[0::2], p[1::2]))
+    if t.corners is not None and t.shape not in ("rectangle", "ramp"):
+        pts = _corner_points(t.corners)
+        if pts is not None:
+            return " ".join(f"({fmt_number(x)}, {fmt_number(y)})" for x, y in pts)
+    return common.fuzzylite_term_text(t, v.name)
+
+
+def _corner_points(corners) -> list[tuple[float, float]] | None:
+    """The IEC point list drawing a trapezoid-family term exactly, or None (vertical edges)."""
+    a, b, c, d = corners
+    inf = float("inf")
+    if a == b == -inf and -inf < c < d < inf:
+        return [(c, 1.0), (d, 0.0)]
+    if c == d == inf and -inf < a < b < inf:
+        return [(a, 0.0), (b, 1.0)]
+    if -inf < a < b <= c < d < inf:
+        return [(a, 0.0), (b, 1.0), (d, 0.0)] if b == c else \
+            [(a, 0.0), (b, 1.0), (c, 1.0), (d, 0.0)]
+    return None
+
+
+def _rule_text(r: Rule) -> str:
+    def expr(e, parent: str) -> str:
+        if isinstance(e, Prop):
+            words = (["NOT"] if e.negated else []) + [common.to_fuzzylite_hedge(h)
+                                                       for h in e.hedges] + [e.term]
+            return f"{e.var} IS " + " ".join(words)
+        if isinstance(e, Not):
+            return f"NOT ({expr(e.expr, 'not')})"
+        op = "AND" if isinstance(e, And) else "OR"
+        text = f" {op} ".join(expr(i, op) for i in e.items)
+        return f"({text})" if parent not in ("top", op, "not") else text
+
+    cons = " AND ".join(f"{c.var} IS " + " ".join(
+        [common.to_fuzzylite_hedge(h) for h in c.hedges] + [c.term]) for c in r.consequents)
+    text = f"IF {expr(r.antecedent, 'top')} THEN {cons}"
+    if r.weight != 1.0:
+        text += f" WITH {fmt_number(r.weight)}"
+    return text
