@@ -95,6 +95,7 @@ class Parameters:
     decimals: np.ndarray         # [P] decimals of the readable grid
     dependents: tuple[tuple[int, np.ndarray, np.ndarray], ...]   # see _round
     frozen_reasons: tuple[str, ...] = ()
+    constraints: np.ndarray | None = None    # [c, P] rows that must stay 0 (ties, frozen)
 
     @property
     def n_free(self) -> int:
@@ -252,12 +253,12 @@ def parameterise(compiled: CompiledRuleBase) -> Parameters:
     P = len(knots)
     values_a = np.array(values, dtype=float)
     frozen_a = np.array(frozen_knot, dtype=bool)
-    projector, dependents = _constraints(P, frozen_a, sym_rows)
+    projector, dependents, rows = _constraints(P, frozen_a, sym_rows)
     scale_a = np.array(scale, dtype=float)
     decimals = np.array([_decimals(w) for w in scale_a], dtype=int)
     return Parameters(compiled, tuple(knots), values_a, scale_a, np.array(lo), np.array(hi),
                       projector, tuple(order), corner_knot, cons_knot, decimals,
-                      dependents, tuple(dict.fromkeys(reasons)))
+                      dependents, tuple(dict.fromkeys(reasons)), rows)
 
 
 def _corner_name(shape: str, corner: int) -> str:
@@ -267,7 +268,20 @@ def _corner_name(shape: str, corner: int) -> str:
     return names[shape][corner]
 
 
-def _constraints(P: int, frozen: np.ndarray, sym_rows) -> tuple[np.ndarray, tuple]:
+def _null_projector(C: np.ndarray) -> np.ndarray:
+    """Orthogonal projector onto the null space of the rows ``C``."""
+    P = C.shape[1]
+    if not len(C):
+        return np.eye(P)
+    _, s, vt = np.linalg.svd(C)
+    rank = int((s > 1e-10).sum())
+    null = vt[rank:].T                                   # [P, F] orthonormal
+    projector = null @ null.T
+    projector[np.abs(projector) < 1e-13] = 0.0
+    return projector
+
+
+def _constraints(P: int, frozen: np.ndarray, sym_rows) -> tuple[np.ndarray, tuple, np.ndarray]:
     """Projector onto the directions that keep frozen knots fixed and symmetric triangles
     symmetric; and, for rounding, which knots follow from which (see :func:`_round`)."""
     rows = []
@@ -281,14 +295,8 @@ def _constraints(P: int, frozen: np.ndarray, sym_rows) -> tuple[np.ndarray, tupl
         row = np.zeros(P)
         row[i] = 1.0
         rows.append(row)
-    if not rows:
-        return np.eye(P), ()
-    C = np.array(rows)
-    _, s, vt = np.linalg.svd(C)
-    rank = int((s > 1e-10).sum())
-    null = vt[rank:].T                                   # [P, F] orthonormal
-    projector = null @ null.T
-    projector[np.abs(projector) < 1e-13] = 0.0
+    C = np.array(rows).reshape(-1, P)
+    projector = _null_projector(C)
     # each symmetric triangle fixes one knot from the other two: its left corner, unless that
     # one is frozen or already determined
     dependents = []
@@ -300,7 +308,7 @@ def _constraints(P: int, frozen: np.ndarray, sym_rows) -> tuple[np.ndarray, tupl
                 taken.add(dep)
                 dependents.append((dep, np.array(others, dtype=np.intp), np.array(coef)))
                 break
-    return projector, tuple(dependents)
+    return projector, tuple(dependents), C
 
 
 # ---- the network with other parameter values ---------------------------------------------------
@@ -486,15 +494,48 @@ class Adaptation:
                 if a != b]
 
 
+def _need(p: Parameters, ids: np.ndarray) -> np.ndarray:
+    """Smallest allowed distances between consecutive knots of one variable."""
+    gap = MIN_GAP * p.scale[ids[0]]
+    return np.minimum(gap, np.diff(p.values[ids])) * (1 - 1e-9)     # never stricter than the start
+
+
+def descent_direction(p: Parameters, values: np.ndarray, grad: np.ndarray) -> np.ndarray:
+    """The projected steepest-descent direction (scaled coordinates) that does not push a knot
+    through a bound or a neighbour it already touches (active constraints held fixed)."""
+    g = grad * p.scale
+    base = p.constraints if p.constraints is not None else np.zeros((0, len(values)))
+    extra: list[np.ndarray] = []
+    projector = p.projector
+    for _ in range(len(values) + 1):
+        d = -(projector @ g)
+        tol = 1e-7 * p.scale
+        rows = []
+        for i in np.flatnonzero(((values - p.lo <= tol) & (d < 0))
+                                | ((p.hi - values <= tol) & (d > 0))):
+            row = np.zeros(len(values))
+            row[i] = 1.0
+            rows.append(row)
+        for ids in p.order:
+            close = np.diff(values[ids]) - _need(p, ids) <= tol[ids[1:]]
+            closing = np.diff(d[ids]) < 0
+            for k in np.flatnonzero(close & closing):
+                row = np.zeros(len(values))
+                row[ids[k]], row[ids[k + 1]] = -1.0, 1.0
+                rows.append(row)
+        if not rows:
+            return d
+        extra += rows
+        projector = _null_projector(np.vstack([base] + extra))
+    return np.zeros_like(values)                         # pragma: no cover - all blocked
+
+
 def feasible(p: Parameters, values: np.ndarray) -> bool:
     """Knots inside their bounds and in their order, at least :data:`MIN_GAP` apart."""
     if np.any(values < p.lo - 1e-12) or np.any(values > p.hi + 1e-12):
         return False
     for ids in p.order:
-        gap = MIN_GAP * p.scale[ids[0]]
-        orig = np.diff(p.values[ids])
-        need = np.minimum(gap, orig) * (1 - 1e-9)      # never stricter than the start
-        if np.any(np.diff(values[ids]) < need):
+        if np.any(np.diff(values[ids]) < _need(p, ids)):
             return False
     return True
 
@@ -516,7 +557,7 @@ def adapt(compiled: CompiledRuleBase, X: np.ndarray, targets: np.ndarray, *, epo
     interrupted = False
     try:
         for epoch in range(1, epochs + 1):
-            direction = -(p.projector @ (grad * p.scale))        # scaled coordinates
+            direction = descent_direction(p, values, grad)       # scaled coordinates
             biggest = np.max(np.abs(direction)) if direction.size else 0.0
             if biggest <= 1e-15 or Q <= 0.0:
                 converged = True

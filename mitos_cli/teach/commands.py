@@ -227,11 +227,33 @@ def parse_command(line: str, path: str | None = None, lineno: int = 1) -> Comman
     try:
         tree = parser().parse(text)
     except UnexpectedInput as exc:
-        raise _syntax_error(exc, text, path or "<prompt>") from None
+        raise _unknown_command(line, text, path or "<prompt>", lineno) \
+            or _syntax_error(exc, text, path or "<prompt>") from None
     result = _ToCommand(text, path).transform(tree)
     if isinstance(result, Tree):            # pragma: no cover - every alternative is handled
         raise RuleSyntaxError(f"cannot read `{line.strip()}`")
     return result
+
+
+def _unknown_command(line: str, text: str, path: str, lineno: int) -> RuleSyntaxError | None:
+    """"unknown command `corect`, did you mean `correct`?" when the first word is no command
+    (and not a rule label: ``r27: if ...``)."""
+    import re
+
+    from ..errors import did_you_mean
+
+    match = re.match(r"\s*([A-Za-z_][A-Za-z0-9_\-]*)(\s*:)?", line)
+    if match is None or match.group(2) or match.group(1) in COMMAND_WORDS + ("if",):
+        return None
+    word = match.group(1)
+    column = match.start(1) + 1
+    return RuleSyntaxError(f"unknown command `{word}`",
+                           span=Span.in_text(text, path, lineno, column, column + len(word)),
+                           expected="a rule (`if ... then ...`, or `LABEL: if ...`) or one of "
+                                    + ", ".join(COMMAND_WORDS),
+                           hint=(f"a rule label ends with a colon: `{word}: if ...`"
+                                 if line[match.end():].split()[:1] == ["if"] else
+                                 did_you_mean(word, COMMAND_WORDS + ("if",)) or "type `help`"))
 
 
 def incomplete(line: str) -> bool:

@@ -103,9 +103,9 @@ def interact(session: Session, history: Path | None = None) -> None:
     try:
         while True:
             try:
-                line = input(prompt_text(session))
+                line = input(prompt_text(session) if tty else "")
                 while incomplete(line):
-                    line += "\n" + input("... ")
+                    line += "\n" + input("... " if tty else "")
             except EOFError:
                 session.out("")
                 break

@@ -1,0 +1,204 @@
+"""Adaptation: exact gradients (vs finite differences), Q never increases, the term set keeps
+its shape (order, ties, symmetry, universe), frozen things stay."""
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+from mitos_cli.api import load_rulebase
+from mitos_cli.build import build_rulebase
+from mitos_cli.compile import compile_rulebase
+from mitos_cli.engine import evaluate
+from mitos_cli.errors import LessonError
+from mitos_cli.parse import parse_rules
+from mitos_cli.teach.adapt import (adapt, feasible, gradient, learned_rulebase, loss,
+                                   parameterise, with_values)
+from mitos_cli.termset import parse_termset
+
+TERMS = """
+variables:
+  x: {role: input, universe: [0, 10], terms: {
+      LO: {shape: left_shoulder, points: [2, 5]},
+      MID: {shape: triangle, points: [2, 5, 8]},
+      HI: {shape: right_shoulder, points: [5, 8]}}}
+  z: {role: input, universe: [0, 10], terms: {
+      A: {shape: trapezoid, points: [0, 1, 3, 6]},
+      B: {shape: triangle, left_width: 2, peak: 6, right_width: 3},
+      C: {shape: triangle, peak: 8, width: 1.5, frozen: true}}}
+  y: {role: output, universe: [0, 100], default: 50, terms: {S: 10, M: 50, L: 90}}
+"""
+RULES = """
+behavior b:
+  r1: if x is LO and z is A then y is S
+  r2: if x is MID or z is very B then y is M
+  r3: if x is HI and not z is C then y is L
+  r4: if x is somewhat MID and z is B then y is 70
+  frozen r1
+end
+"""
+
+
+def small(rules=RULES, terms=TERMS):
+    rb = build_rulebase(parse_rules(rules), (parse_termset(terms),), ("t.yaml",))
+    return compile_rulebase(rb, "b")
+
+
+def points(n, seed=0):
+    rng = np.random.default_rng(seed)
+    return rng.uniform(0, 10, (n, 2))
+
+
+def finite_differences(p, X, T, h=1e-6):
+    num = np.zeros(len(p.values))
+    for i in range(len(p.values)):
+        up, down = p.values.copy(), p.values.copy()
+        up[i] += h * p.scale[i]
+        down[i] -= h * p.scale[i]
+        num[i] = (loss(with_values(p, up), X, T) - loss(with_values(p, down), X, T)) / (
+            2 * h * p.scale[i])
+    return num
+
+
+def away_from_ties(compiled, X):
+    """Drop samples where a min/max or a membership is at a kink (within 1e-4)."""
+    V = evaluate(compiled, X, keep_values=True, strict=False).values
+    keep = np.ones(len(X), dtype=bool)
+    T = compiled.n_terms
+    mu = V[:, 2:2 + T]
+    keep &= ~np.any((np.abs(mu - 0) < 1e-4) & (mu > 0) | (np.abs(mu - 1) < 1e-4) & (mu < 1),
+                    axis=1)
+    for level in compiled.levels:
+        for g in level:
+            if g.op in ("and", "or") and g.children.shape[1] > 1:
+                vals = np.sort(V[:, g.children], axis=2)
+                if g.op == "and":
+                    tie = (vals[:, :, 1] - vals[:, :, 0] < 1e-4) & (vals[:, :, 0] > 1e-4)
+                else:
+                    tie = (vals[:, :, -1] - vals[:, :, -2] < 1e-4) & (vals[:, :, -1] > 1e-4)
+                keep &= ~np.any(tie, axis=1)
+    return X[keep]
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_gradient_matches_finite_differences_on_the_paper_rule_base(seed):
+    compiled = load_rulebase().compiled
+    p = parameterise(compiled)
+    rng = np.random.default_rng(seed)
+    X = np.column_stack([rng.uniform(0, 160, 300), rng.uniform(0, 100, 300),
+                         rng.uniform(-60, 60, 300)])
+    X = away_from_ties(compiled, X)
+    assert len(X) > 100
+    T = np.column_stack([rng.uniform(30, 150, len(X)), rng.uniform(0, 60, len(X))])
+    T[::3, 1] = np.nan                               # some examples correct steering only
+    _, g = gradient(p, p.values, X, T)
+    num = finite_differences(p, X, T)
+    assert np.any(g != 0)
+    np.testing.assert_allclose(g, num, rtol=1e-5, atol=1e-4 * np.abs(num).max())
+
+
+@pytest.mark.parametrize("seed", [3, 4])
+def test_gradient_through_hedges_not_or_crisp_and_products(seed):
+    for ops in ("", "operators: and = product, or = probabilistic_sum\n"):
+        compiled = small(ops + RULES)
+        p = parameterise(compiled)
+        X = away_from_ties(compiled, points(400, seed))
+        assert len(X) > 100
+        T = np.random.default_rng(seed).uniform(0, 100, (len(X), 1))
+        Q, g = gradient(p, p.values, X, T)
+        assert Q == pytest.approx(loss(compiled, X, T))
+        num = finite_differences(p, X, T)
+        np.testing.assert_allclose(g, num, rtol=1e-5, atol=1e-5 * np.abs(num).max())
+
+
+def test_ties_pass_the_gradient_to_the_lowest_index_deterministically():
+    compiled = small()
+    p = parameterise(compiled)
+    X = np.array([[5.0, 6.0], [5.0, 6.0]])           # memberships at their peaks: ties
+    T = np.array([[0.0], [0.0]])
+    a = gradient(p, p.values, X, T)[1]
+    b = gradient(p, p.values, X, T)[1]
+    assert np.array_equal(a, b) and np.all(np.isfinite(a))
+
+
+def test_q_decreases_on_a_synthetic_target_and_never_increases():
+    compiled = load_rulebase().compiled
+    p = parameterise(compiled)
+    truth = p.values.copy()
+    truth[1] += 4.0          # road: the shared NARROW.b = MEDIUM.peak = WIDE.a ...
+    truth[0] += 2.0          # ... and NARROW.a; MEDIUM stays symmetric through right = 104
+    truth[2] += 6.0
+    truth[11] -= 6.0         # steering LS
+    X = points(500) * np.array([16.0, 10.0]) if False else None
+    rng = np.random.default_rng(5)
+    X = np.column_stack([rng.uniform(0, 160, 500), rng.uniform(0, 100, 500),
+                         rng.uniform(-60, 60, 500)])
+    T = evaluate(with_values(p, truth), X).outputs
+    seen = []
+    result = adapt(compiled, X, T, epochs=60, rate=0.5, on_epoch=lambda e, q: seen.append(q))
+    history = np.array(result.history)
+    assert np.all(np.diff(history[:-1]) < 0)           # every epoch lowers Q
+    assert result.q_after <= result.q_before * 0.05
+    assert feasible(result.parameters, result.values)
+
+
+def test_constraints_hold_order_ties_symmetry_universe():
+    compiled = load_rulebase().compiled
+    rng = np.random.default_rng(6)
+    X = np.column_stack([rng.uniform(0, 160, 200), rng.uniform(0, 100, 200),
+                         rng.uniform(-60, 60, 200)])
+    T = np.column_stack([np.full(200, 35.0), np.full(200, 5.0)])   # an extreme target
+    result = adapt(compiled, X, T, epochs=80, rate=0.9)
+    rb = learned_rulebase(result.parameters, result.values)
+    for name in ("road", "size", "position"):
+        v = rb.variables[name]
+        lo_, mid, hi_ = v.terms
+        assert lo_.params[1] == mid.params[0]             # shared peak stays tied
+        assert hi_.params[0] == mid.params[0]
+        left = mid.params[0] - mid.params[1]
+        right = mid.params[0] + mid.params[1]
+        assert left == pytest.approx(lo_.params[0], abs=1e-9)    # symmetric triangle tied
+        assert right == pytest.approx(hi_.params[1], abs=1e-9)
+        assert mid.params[1] > 0
+        u0, u1 = v.universe
+        assert u0 <= left < mid.params[0] < right <= u1
+    values = [t.params[0] for t in rb.variables["steering"].terms]
+    assert values == sorted(values) and 30 <= values[0] and values[-1] <= 150
+
+
+def test_frozen_terms_and_frozen_rules_keep_their_values():
+    compiled = small()
+    p = parameterise(compiled)
+    X = points(300, 7)
+    T = np.full((300, 1), 20.0)
+    result = adapt(compiled, X, T, epochs=40)
+    rb = learned_rulebase(result.parameters, result.values)
+    assert rb.variables["z"].term("C").params == (8.0, 1.5)       # frozen: true
+    assert rb.variables["y"].term("S").params == (10.0,)         # only r1 (frozen) says S
+    assert rb.variables["y"].term("M").params != (50.0,)
+    assert result.q_after < result.q_before
+    labels = [k.label for k in p.knots]
+    assert any("B.peak" in x for x in labels)
+
+
+def test_refusals_are_clear():
+    with pytest.raises(LessonError, match="weighted_average"):
+        parameterise(small("operators: inference = mamdani\n" + RULES.replace(
+            "then y is 70", "then y is L")))
+    with pytest.raises(LessonError, match="not `and = lukasiewicz`"):
+        parameterise(small("operators: and = lukasiewicz\n" + RULES))
+    compiled = small()
+    with pytest.raises(LessonError, match=r"\(0, 1\)"):
+        adapt(compiled, points(5), np.zeros((5, 1)), rate=1.5)
+
+
+def test_vectorized_one_epoch_is_fast_enough_to_not_loop(benchmark=None):
+    compiled = load_rulebase().compiled
+    rng = np.random.default_rng(8)
+    X = np.column_stack([rng.uniform(0, 160, 1000), rng.uniform(0, 100, 1000),
+                         rng.uniform(-60, 60, 1000)])
+    T = np.column_stack([rng.uniform(30, 150, 1000), rng.uniform(0, 60, 1000)])
+    result = adapt(compiled, X, T, epochs=2)
+    assert len(result.history) >= 2
+    again = adapt(compiled, X, T, epochs=2)              # deterministic, bit for bit
+    assert np.array_equal(result.values, again.values)

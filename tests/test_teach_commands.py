@@ -1,0 +1,92 @@
+"""The teaching language: every command parses to its object; mistyped lines say what was
+expected, in words, at path:line:col."""
+
+import pytest
+
+from mitos_cli.errors import RuleSyntaxError
+from mitos_cli.teach import commands as c
+from mitos_cli.teach.commands import incomplete, parse_command
+
+
+@pytest.mark.parametrize("line, expected", [
+    ("behavior wider", c.OpenBehavior("wider")),
+    ("behavior wider:", c.OpenBehavior("wider")),
+    ("end", c.CloseBehavior()),
+    ("frozen r4, r5", c.TellFrozen(("r4", "r5"))),
+    ("eval road=78 size=45 position=-4",
+     c.Eval((c.Assign("road", 78), c.Assign("size", 45), c.Assign("position", -4)))),
+    ("correct road=78 size=45 position=4 -> steering=60 speed=20",
+     c.Correct((c.Assign("road", 78), c.Assign("size", 45), c.Assign("position", 4)),
+               (c.Assign("steering", 60), c.Assign("speed", 20)))),
+    ("simulate worlds/figure4.yaml", c.Simulate("worlds/figure4.yaml")),
+    ('simulate "my world.yaml" seed 3', c.Simulate("my world.yaml", 3)),
+    ("at 12.5s steering=55", c.At(12.5, None, (c.Assign("steering", 55),))),
+    ("at 11 to 13s steering=55 speed=10",
+     c.At(11, 13, (c.Assign("steering", 55), c.Assign("speed", 10)))),
+    ("adapt", c.Adapt()),
+    ("adapt epochs 20 rate 0.3 plot terms.png", c.Adapt(20, 0.3, "terms.png")),
+    ("show rules", c.Show("rules")),
+    ("show terms plot out/t.svg", c.Show("terms", "out/t.svg")),
+    ("undo", c.Undo()),
+    ("save", c.Save()),
+    ("save taught.rules", c.Save("taught.rules")),
+    ("help", c.Help()),
+    ("help adapt", c.Help("adapt")),
+    ("quit", c.Quit()),
+    ("exit", c.Quit()),
+])
+def test_commands_parse(line, expected):
+    assert parse_command(line) == expected
+
+
+def test_rule_lines_are_rules_of_the_rule_language():
+    cmd = parse_command("r27: if road is NARROW and not position is very RIGHT "
+                        "then steering is LM and speed is 15 with 0.5")
+    assert isinstance(cmd, c.TellRule)
+    assert cmd.rule.label == "r27" and cmd.rule.weight == 0.5
+    assert cmd.rule.consequents[1].value == 15
+    use = parse_command("use avoid_obstacle when obstacle is NEAR with 0.8")
+    assert isinstance(use, c.TellUse) and use.use.weight == 0.8
+    assert use.use.condition is not None
+    ops = parse_command("operators: and = product")
+    assert isinstance(ops, c.TellOperators) and ops.settings[0].value == "product"
+
+
+@pytest.mark.parametrize("line, message, expected, hint", [
+    ("corect road=1", "unknown command `corect`", "one of behavior", "did you mean `correct`?"),
+    ("r1 if road is WIDE then speed is SLOW", "unknown command `r1`", None,
+     "a rule label ends with a colon"),
+    ("eval road", "the line ends too early", "`=`", "eval road=78"),
+    ("eval road=x", "unexpected `x`", "a number", None),
+    ("correct road=1 steering=3", "the line ends too early", "`->`", "correct INPUT=VALUE"),
+    ("show rulez", "unexpected `rulez`", "rules, terms, examples, behaviors or history", None),
+    ("r1: if road WIDE then steering is LS", "unexpected `WIDE`", "`is`",
+     "variable is TERM"),
+    ("simulate", "the line ends too early", "a file name", "simulate worlds/figure4.yaml"),
+    ("at 12.5s", "the line ends too early", "a name", "at 12.5s OUTPUT=VALUE"),
+    ("behavior", "the line ends too early", "a name", None),
+    ("= 3", "unexpected `=`", "a name", "a line is a rule"),
+    ("adapt epochs", "the line ends too early", "a number", None),
+])
+def test_mistyped_lines_say_what_was_expected(line, message, expected, hint):
+    with pytest.raises(RuleSyntaxError) as info:
+        parse_command(line, "lesson.lesson", 7)
+    err = info.value
+    assert err.message == message
+    assert err.span.path == "lesson.lesson" and err.span.line == 7
+    if expected:
+        assert expected in err.expected
+    if hint:
+        assert hint in err.hint
+    text = err.render()
+    assert text.startswith("lesson.lesson:7:")
+    assert "$END" not in text and "Token(" not in text and "__ANON" not in text
+
+
+def test_a_rule_may_continue_on_the_next_line():
+    assert incomplete("r1: if road is WIDE")
+    assert incomplete("if road is WIDE and size is SMALL_SZ")
+    assert not incomplete("if road is WIDE then steering is LS")
+    assert not incomplete("eval road=")          # not a rule: an error, not a continuation
+    cmd = parse_command("r1: if road is WIDE\n    then steering is LS")
+    assert isinstance(cmd, c.TellRule)
