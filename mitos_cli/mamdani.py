@@ -45,8 +45,10 @@ import numpy as np
 from . import hedges as hedge_mod
 from . import norms
 
-#: Ceiling on the intermediate ``[rules, samples, resolution]`` array of one sub-block.
-MAX_BYTES = 8 * 2 ** 20
+#: Ceiling on the intermediate ``[rules, samples, resolution]`` array of one sub-block. Small
+#: enough to stay in cache: on the benchmark machine 1 MB ran about twice as fast as 8 MB and
+#: 4x as fast as 32 MB (benchmarks/bench_norms.py, resolution 101 and 1001).
+MAX_BYTES = 2 ** 20
 
 IMPLICATIONS = {"min": np.minimum, "product": np.multiply}
 
