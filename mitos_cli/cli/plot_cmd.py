@@ -57,6 +57,8 @@ ShowOpt = Annotated[bool, typer.Option(
     "--show", help="Open the picture in a window (where a display is available).")]
 BehaviorOpt = Annotated[Optional[str], typer.Option(
     "--behavior", "-b", help="Use this behavior (default: the file's first).")]
+TitleOpt = Annotated[Optional[str], typer.Option(
+    "--title", help="The picture's title (default: says what is drawn).")]
 
 
 def _wants_picture(output: Optional[str], show: bool) -> bool:
@@ -86,6 +88,7 @@ def terms_command(
         "--behavior", "-b", help="Draw only the variables this behavior uses.")] = None,
     output: OutputOpt = None,
     show: ShowOpt = False,
+    title: TitleOpt = None,
     width: Annotated[Optional[int], typer.Option(
         "--width", min=30, max=400,
         help="Terminal plot width in characters (default: the terminal's, at most 100).")]
@@ -120,13 +123,14 @@ def terms_command(
         return
     from ..draw.terms import draw_sheet
 
-    where = display_path(rulebase.path)
-    if len(plots) == 1:
-        title = f"{plots[0].name} ({where})"
-    elif behavior and not var:
-        title = f"Term sets of behavior {behavior} ({where})"
-    else:
-        title = f"Term sets of {where}"
+    if title is None:
+        where = display_path(rulebase.path)
+        if len(plots) == 1:
+            title = f"{plots[0].name}: {where}"
+        elif behavior and not var:
+            title = f"Term sets of behavior {behavior}: {where}"
+        else:
+            title = f"Term sets of {where}"
     draw_sheet(plots, output, title=title, show=show)
     _done(output)
 
@@ -198,6 +202,7 @@ def surface_command(
     = Style.surface,
     output: OutputOpt = None,
     show: ShowOpt = False,
+    title: TitleOpt = None,
     behavior: BehaviorOpt = None,
 ) -> None:
     """Control surface: an output over one or two inputs, the others fixed.
@@ -226,7 +231,7 @@ def surface_command(
         return
     from ..draw.surface import draw_surface
 
-    draw_surface(s, output, style=style.value, show=show)
+    draw_surface(s, output, style=style.value, show=show, title=title)
     _done(output)
 
 
@@ -238,6 +243,7 @@ def rules_command(
              "input.")] = None,
     output: OutputOpt = None,
     show: ShowOpt = False,
+    title: TitleOpt = None,
     behavior: BehaviorOpt = None,
     max_rules: Annotated[int, typer.Option(
         "--max-rules", min=1, max=500,
@@ -267,7 +273,7 @@ def rules_command(
         return
     from ..draw.rules import draw_rules
 
-    draw_rules(view, output, show=show, max_rows=max_rules)
+    draw_rules(view, output, show=show, max_rows=max_rules, title=title)
     _done(output)
 
 

@@ -9,7 +9,7 @@ drawing never touches pyplot's global figure list or backend; only :func:`new_fi
 from __future__ import annotations
 
 import os
-import tempfile
+import secrets
 from pathlib import Path
 
 from ..errors import MitosError
@@ -76,8 +76,10 @@ def finish(fig, path: str | Path | None = None, show: bool = False, dpi: int = 1
         path = Path(path)
         fmt = check_format(path)
         directory = path.parent if str(path.parent) else Path(".")
+        tmp = directory / f".{path.name}.{os.getpid()}.{secrets.token_hex(4)}.tmp"
         try:
-            fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=f".{fmt}", dir=directory)
+            # 0o666 less the umask, as for any new file (mkstemp would make it 0o600)
+            fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666)
         except OSError as exc:
             raise DrawError(f"cannot write `{path}`: {exc.strerror or exc}") from None
         import matplotlib

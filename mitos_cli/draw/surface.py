@@ -110,8 +110,8 @@ def draw_surface3d(fig, ax, s: Surface) -> None:
     ax.set_xlabel(s.x.label, labelpad=8)
     ax.set_ylabel(s.y.label, labelpad=8)
     ax.set_zlabel(s.label, labelpad=8)
-    ax.view_init(elev=28, azim=-125)
-    bar = fig.colorbar(surf, ax=ax, shrink=0.6, pad=0.1)
+    ax.view_init(elev=25, azim=-60)
+    bar = fig.colorbar(surf, ax=ax, shrink=0.55, pad=0.1)
     bar.set_label(s.label)
     if z.mask.any():
         ax.text2D(0.0, 0.0, "holes: no rule fires and the output has no default",
@@ -137,7 +137,7 @@ def draw_surface(s: Surface, path: str | Path | None = None, *, style: str = "su
         draw_surface3d(fig, ax, s)
     heading = title or title_of(s)
     if s.y is not None and style == "surface":
-        fig.suptitle(heading, fontsize=12, y=0.95)
+        fig.suptitle(heading, fontsize=12, y=0.9)
     else:
         ax.set_title(heading, fontsize=11, loc="left")
     return finish(fig, path, show)

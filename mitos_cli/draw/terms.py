@@ -12,6 +12,8 @@ import math
 from pathlib import Path
 from typing import Sequence
 
+import numpy as np
+
 from ..plotdata import VariablePlot, variable_plot
 from ..terms import Variable
 from .output import finish, new_figure
@@ -20,6 +22,8 @@ from .output import finish, new_figure
 COLORS = ("#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#17becf", "#8c564b",
           "#e377c2", "#7f7f7f", "#bcbd22")
 VALUE_COLOR = "#222222"
+LABEL_Y = 1.03          # term names sit just above the curves' tops ...
+LABEL_STEP = 0.1        # ... or one step higher where they would overlap
 
 
 def color(i: int) -> str:
@@ -32,7 +36,7 @@ def style_axes(ax, plot: VariablePlot) -> None:
     # stems at the ends of the universe stay visible with a small margin
     pad = 0.03 * (hi - lo) if any(c.kind == "singleton" for c in plot.curves) else 0.0
     ax.set_xlim(lo - pad, hi + pad)
-    ax.set_ylim(-0.02, 1.24)
+    ax.set_ylim(-0.02, 1.26)
     ax.set_yticks([0, 0.25, 0.5, 0.75, 1.0])
     ax.set_xlabel(plot.axis_label)
     ax.set_ylabel("membership μ")
@@ -48,9 +52,6 @@ def draw_curves(ax, plot: VariablePlot, *, colors: Sequence[str] | None = None,
     """The terms of ``plot`` on ``ax`` (``colors[i]`` for curve ``i``, default the palette);
     returns the artists, whose data are the curves'."""
     artists = []
-    fig = ax.figure
-    inches = fig.get_size_inches()[0] * ax.get_position().width
-    heights = label_heights(plot, chars_across=inches * 72 / 7.5) if labels else {}
     for i, curve in enumerate(plot.curves):
         c = colors[i] if colors is not None else color(i)
         if curve.kind == "curve":
@@ -67,9 +68,8 @@ def draw_curves(ax, plot: VariablePlot, *, colors: Sequence[str] | None = None,
         else:
             continue
         if labels:
-            ax.text(curve.label_x, heights[curve.name], curve.name, color=c, ha="center",
-                    va="bottom",
-                    fontsize=9, fontweight="bold")
+            ax.text(curve.label_x, LABEL_Y, curve.name, color=c, ha="center", va="bottom",
+                    fontsize=9, fontweight="bold", gid="term-label")
     linear = [c for c in plot.curves if c.kind == "linear"]
     if linear:
         text = "\n".join(f"{c.name}: {c.formula}" for c in linear)
@@ -79,28 +79,32 @@ def draw_curves(ax, plot: VariablePlot, *, colors: Sequence[str] | None = None,
     return artists
 
 
-def label_heights(plot: VariablePlot, chars_across: float = 32.0) -> dict[str, float]:
-    """Where each term's name sits: 1.03, or a step higher when it would overlap the name
-    before it (names are about ``1 / chars_across`` of the axis wide per character)."""
-    lo, hi = plot.universe
-    per_char = (hi - lo) / chars_across
-    heights: dict[str, float] = {}
-    last_end = {0: -float("inf"), 1: -float("inf")}
-    for curve in sorted((c for c in plot.curves if c.kind != "linear"),
-                        key=lambda c: c.label_x):
-        half = (len(curve.name) + 1) * per_char / 2
-        level = 0 if curve.label_x - half >= last_end[0] else 1
-        if level == 1 and curve.label_x - half < last_end[1]:
-            level = 0
-        last_end[level] = curve.label_x + half
-        heights[curve.name] = 1.03 + 0.1 * level
-    return heights
+def stagger_labels(fig) -> None:
+    """Lift a term label one step where it would overlap the one to its left, measured on the
+    laid-out figure (so long names such as MODERATE next to MEDIUM stay readable)."""
+    fig.draw_without_rendering()
+    renderer = fig.canvas.get_renderer()
+    for ax in fig.axes:
+        labels = sorted((t for t in ax.texts if t.get_gid() == "term-label"),
+                        key=lambda t: t.get_position()[0])
+        right_edge = [-np.inf, -np.inf]              # per level, in display pixels
+        for text in labels:
+            box = text.get_window_extent(renderer)
+            level = 0 if box.x0 > right_edge[0] + 2 else 1
+            if level == 1 and box.x0 <= right_edge[1] + 2:
+                level = 0
+            right_edge[level] = box.x1
+            if level:
+                x, y = text.get_position()
+                text.set_position((x, y + LABEL_STEP))
 
 
 def mark_value(ax, plot: VariablePlot) -> None:
     """The value as a dashed line, its memberships as dots with their numbers."""
     if plot.value is None:
         return
+    from matplotlib.patheffects import withStroke
+
     unit = f" {plot.unit}" if plot.unit else ""
     ax.axvline(plot.value, color=VALUE_COLOR, linestyle="--", linewidth=1.2,
                label=f"{plot.name} = {plot.value:g}{unit}", zorder=5)
@@ -115,7 +119,8 @@ def mark_value(ax, plot: VariablePlot) -> None:
                 zorder=6)
         ax.annotate(f"{mu:.2f}", (plot.value, mu), xytext=(6 if right else -6, 0),
                     textcoords="offset points", ha="left" if right else "right",
-                    va="center", fontsize=8.5, color=c, fontweight="bold", zorder=7)
+                    va="center", fontsize=8.5, color=c, fontweight="bold", zorder=7,
+                    path_effects=[withStroke(linewidth=3, foreground="white")])
     ax.legend(loc="center right" if right else "center left", fontsize=8, frameon=True,
               handles=[ax.lines[-1 - sum(1 for _, mu in plot.memberships if mu > 0)]])
 
@@ -138,32 +143,27 @@ def draw_panel(ax, plot: VariablePlot) -> list:
 
 
 def draw_sheet(plots: Sequence[VariablePlot], path: str | Path | None = None, *,
-               title: str | None = None, show: bool = False, columns: int | None = None):
-    """All variables on one sheet (three panels a row, outputs on a row of their own when
-    they fit); written to ``path`` (.png or .svg) and/or shown. Returns the figure."""
+               title: str | None = None, show: bool = False, columns: int = 3):
+    """All variables on one sheet: inputs in rows of up to ``columns`` panels, outputs on rows
+    of their own (the paper's Figures 5-7 above, 8-9 below), each row filling the width.
+    Written to ``path`` (.png or .svg) and/or shown; returns the figure."""
     plots = list(plots)
-    n = len(plots)
-    inputs = [p for p in plots if p.role == "input"]
-    outputs = [p for p in plots if p.role != "input"]
-    if columns is None:
-        columns = 1 if n == 1 else 2 if n in (2, 4) else 3
-    # inputs fill rows first; outputs start on a fresh row (Figures 5-7 above, 8-9 below)
-    slots: list[VariablePlot | None] = []
-    for group in (inputs, outputs):
-        if not group:
-            continue
-        slots += group + [None] * (-len(group) % columns)
-    rows = math.ceil(len(slots) / columns)
-    fig = new_figure((4.6 * columns if columns > 1 else 7.5, 3.3 * rows + 0.5), show,
+    rows: list[list[VariablePlot]] = []
+    for group in ([p for p in plots if p.role == "input"],
+                  [p for p in plots if p.role != "input"]):
+        rows += [group[i:i + columns] for i in range(0, len(group), columns)]
+    widest = max(len(r) for r in rows)
+    span = math.lcm(*(len(r) for r in rows))
+    fig = new_figure((4.6 * widest if widest > 1 else 7.5, 3.3 * len(rows) + 0.5), show,
                      layout="constrained")
-    axes = fig.subplots(rows, columns, squeeze=False)
-    for ax, plot in zip(axes.flat, slots + [None] * (rows * columns - len(slots))):
-        if plot is None:
-            ax.set_visible(False)
-            continue
-        draw_panel(ax, plot)
+    grid = fig.add_gridspec(len(rows), span)
+    for i, row in enumerate(rows):
+        step = span // len(row)
+        for k, plot in enumerate(row):
+            draw_panel(fig.add_subplot(grid[i, k * step:(k + 1) * step]), plot)
     if title:
         fig.suptitle(title, fontsize=13, fontweight="bold")
+    stagger_labels(fig)
     return finish(fig, path, show)
 
 
@@ -206,6 +206,7 @@ def draw_terms_before_after(variable_before: Variable, variable_after: Variable,
     draw_curves(ax, before, colors=[color(order[c.name]) for c in before.curves],
                 linestyle="--", alpha=0.55, fill=False, labels=False)
     draw_curves(ax, after, colors=[color(order[c.name]) for c in after.curves])
+    stagger_labels(fig)
     from matplotlib.lines import Line2D
 
     ax.legend(handles=[Line2D([], [], color="#555555", linestyle="--", alpha=0.6,
