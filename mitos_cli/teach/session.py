@@ -333,8 +333,7 @@ class Session:
         labels = [r.label for r in b.rules]
         for label in c.labels:
             if label not in labels:
-                raise unknown(f"rule label in behavior `{b.name}`", label, labels,
-                              cls=LessonError)
+                raise unknown(f"rule label in behavior `{b.name}`", label, labels)
         self.change("frozen", line, behavior=b.name, labels=list(c.labels))
         self.out(f"{b.name}: adaptation leaves the consequents of {', '.join(c.labels)} alone")
 

@@ -1,0 +1,135 @@
+"""Saving keeps the rule base linguistic: text surgery, atomic writes, round trip."""
+
+import shutil
+from pathlib import Path
+
+import pytest
+
+from mitos_cli.api import default_rulebase_path
+from mitos_cli.build import load_rules_file
+from mitos_cli.errors import LessonError
+from mitos_cli.teach.save import atomic_write, save_rulebase
+from mitos_cli.teach.session import Session
+
+RULEBASES = default_rulebase_path().parent
+
+
+@pytest.fixture
+def rules(tmp_path):
+    src = tmp_path / "src"
+    src.mkdir()
+    for f in RULEBASES.iterdir():
+        if f.is_file():
+            shutil.copy(f, src / f.name)
+    return src / "mitos.rules"
+
+
+def variables(rb):
+    return [v for ts in rb.termsets for v in ts.variables]
+
+
+def test_round_trip_load_save_load(rules, tmp_path):
+    rb = load_rules_file(rules)
+    out = tmp_path / "out" / "copy.rules"
+    saved = save_rulebase(rb, rb, out)
+    assert saved.changes == ()
+    again = load_rules_file(out)
+    assert again.behaviors == rb.behaviors
+    assert variables(again) == variables(rb)
+    original = rules.read_text().splitlines()
+    written = out.read_text().splitlines()
+    diff = [(a, b) for a, b in zip(original, written) if a != b]
+    assert len(original) == len(written) and len(diff) == 1       # only the `terms` line
+    assert diff[0][1] == 'terms "copy.mitos.terms.yaml", "copy.drive.terms.yaml"'
+    assert (out.parent / "copy.mitos.terms.yaml").read_text() == \
+        (rules.parent / "mitos.terms.yaml").read_text()
+
+
+def test_saving_over_the_original_rewrites_in_place(rules):
+    s = Session(rules, out=[].append)
+    s.run("correct road=78 size=45 position=4 -> steering=60")
+    s.run("adapt epochs 5")
+    s.run(f"save {rules}")
+    assert sorted(p.name for p in rules.parent.iterdir()) == [
+        "drive.terms.yaml", "mitos.rules", "mitos.terms.yaml"]
+    assert load_rules_file(rules).behaviors == s.rulebase.behaviors
+    assert variables(load_rules_file(rules)) == variables(s.rulebase)
+
+
+def test_changed_numbers_only(rules, tmp_path):
+    s = Session(rules, out=[].append)
+    s.run("correct road=78 size=45 position=4 -> steering=60 speed=20")
+    s.run("adapt epochs 10")
+    s.run("r25: if road is MEDIUM and size is MED_SZ and position is RIGHT "
+          "then steering is LB and speed is SLOW")
+    s.run("r30: if road is NARROW then speed is 12")
+    s.run("frozen r4")
+    s.run("behavior wider")
+    s.run("use avoid_obstacle when road is WIDE")
+    s.run("end")
+    out = tmp_path / "taught.rules"
+    s.run(f"save {out}")
+    before = (rules.parent / "mitos.terms.yaml").read_text().splitlines()
+    after = (tmp_path / "taught.mitos.terms.yaml").read_text().splitlines()
+    assert len(before) == len(after)
+    for a, b in zip(before, after):
+        if a != b:      # same line, same keys and comments: only numbers differ
+            assert [w for w in a.replace(",", " ").split() if not _number(w)] == \
+                   [w for w in b.replace(",", " ").split() if not _number(w)]
+    assert "# eq. 15: width 30 in" in "\n".join(after)
+    text = out.read_text()
+    assert "    r25: if road is MEDIUM and size is MED_SZ and position is RIGHT then steering " \
+           "is LB and speed is SLOW    # paper: y1 40, y2 30" in text
+    assert "    r30: if road is NARROW then speed is 12\n    frozen r4\nend" in text
+    assert text.rstrip().endswith("behavior wider:\n    use avoid_obstacle when road is WIDE\nend")
+    again = load_rules_file(out)
+    assert again.behaviors == s.rulebase.behaviors
+    assert variables(again) == variables(s.rulebase)
+
+
+def test_crisp_consequents_are_edited_in_place(tmp_path):
+    (tmp_path / "t.terms.yaml").write_text(
+        "variables:\n  x: {role: input, universe: [0, 10], terms: {"
+        "LO: {shape: left_shoulder, points: [2, 8]}, HI: {shape: right_shoulder, "
+        "points: [2, 8]}}}\n  y: {role: output, universe: [0, 100], terms: {A: 0}}\n")
+    (tmp_path / "t.rules").write_text(
+        'terms "t.terms.yaml"\n# comment\nr1: if x is LO\n   then y is 20   # low\n'
+        "r2: if x is HI then y is 80\n")
+    s = Session(tmp_path / "t.rules", out=[].append)
+    s.run("correct x=0 -> y=30")
+    s.run("correct x=10 -> y=70")
+    s.run("adapt epochs 30")
+    s.run(f"save {tmp_path / 'u.rules'}")
+    text = (tmp_path / "u.rules").read_text()
+    assert text.startswith('terms "u.terms.yaml"\n# comment\nr1: if x is LO\n   then y is ')
+    assert "   # low\n" in text
+    r1, r2 = load_rules_file(tmp_path / "u.rules").behaviors[0].rules
+    assert abs(r1.consequents[0].value - 30) < 1 and abs(r2.consequents[0].value - 70) < 1
+
+
+def test_save_mistakes(rules, tmp_path):
+    s = Session(rules, out=[].append)
+    with pytest.raises(LessonError, match="say where to save"):
+        s.run("save")
+
+
+def test_atomic_write_leaves_no_half_file(tmp_path, monkeypatch):
+    target = tmp_path / "a.rules"
+    target.write_text("old")
+
+    def boom(*a):
+        raise OSError("disk full")
+
+    monkeypatch.setattr("os.replace", boom)
+    with pytest.raises(OSError):
+        atomic_write(target, "new")
+    assert target.read_text() == "old"
+    assert [p.name for p in tmp_path.iterdir()] == ["a.rules"]
+
+
+def _number(word):
+    try:
+        float(word.strip("[]{}"))
+        return True
+    except ValueError:
+        return False

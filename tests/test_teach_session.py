@@ -1,0 +1,227 @@
+"""Every teaching command through the session (and its mistakes), undo and journal replay."""
+
+import json
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from mitos_cli.api import default_rulebase_path
+from mitos_cli.errors import LessonError, MitosError, NameError_, RuleBaseError
+from mitos_cli.teach.journal import Journal
+from mitos_cli.teach.session import Session
+
+RULEBASES = default_rulebase_path().parent
+
+
+@pytest.fixture
+def rules(tmp_path):
+    for f in RULEBASES.iterdir():
+        if f.is_file():
+            shutil.copy(f, tmp_path / f.name)
+    return tmp_path / "mitos.rules"
+
+
+def session(rules, tmp_path=None, journal=None):
+    out = []
+    s = Session(rules, journal=journal, out=out.append)
+    return s, out
+
+
+def say(s, out, line):
+    out.clear()
+    s.run(line)
+    return "\n".join(out)
+
+
+def test_a_told_rule_is_answered_as_understood_with_conflicts(rules):
+    s, out = session(rules)
+    text = say(s, out, "if road is  WIDE and size is SMALL_SZ and position is LEFT "
+                       "then steering is RM and speed is MEDIUM")
+    assert text.splitlines()[0] == ("r27: if road is WIDE and size is SMALL_SZ and position is "
+                                    "LEFT then steering is RM and speed is MEDIUM")
+    assert "added to avoid_obstacle (28 rules)" in text
+    assert "conflict: r0 has the same condition but says steering is RS, speed is MEDIUM" in text
+    text = say(s, out, "r27: if position is LEFT and road is WIDE and size is SMALL_SZ "
+                       "then steering is RS and speed is MEDIUM")
+    assert "replaces r27: if road is WIDE" in text and "note: r0 says the same" in text
+    assert len(s.rulebase.behavior("avoid_obstacle").rules) == 28
+
+
+def test_rule_mistakes_keep_the_session(rules):
+    s, out = session(rules)
+    with pytest.raises(NameError_) as info:
+        s.run("if road is WIDEE then steering is LS")
+    assert "did you mean `WIDE`?" in info.value.render()
+    with pytest.raises(RuleBaseError, match="output variable"):
+        s.run("if steering is LS then speed is SLOW")
+    assert len(s.rulebase.behavior("avoid_obstacle").rules) == 27
+    assert say(s, out, "eval road=78 size=45 position=4").endswith("speed = 32.4 in/s")
+
+
+def test_behavior_end_use_and_recall_by_name(rules):
+    s, out = session(rules)
+    assert "tell its rules" in say(s, out, "behavior careful")
+    assert s.focus == "careful"
+    say(s, out, "if road is NARROW then speed is CREEP")
+    say(s, out, "use avoid_obstacle when obstacle is NEAR")
+    with pytest.raises(LessonError, match="still open"):
+        s.run("behavior other")
+    with pytest.raises(LessonError, match="close it with `end` before saving"):
+        s.run("save x.rules")
+    assert "careful learned (1 rules, 1 uses)" in say(s, out, "end")
+    assert s.state.active == "careful"
+    assert "active behavior: avoid_obstacle" in say(s, out, "use avoid_obstacle")
+    with pytest.raises(LessonError, match="no behavior is open"):
+        s.run("end")
+    with pytest.raises(LessonError, match="exists already"):
+        s.run("behavior careful")
+    with pytest.raises(NameError_, match="unknown behavior `carefull`"):
+        s.run("use carefull")
+    with pytest.raises(LessonError, match="belongs inside a behavior"):
+        s.run("use careful when road is WIDE")
+    s.run("behavior empty")
+    with pytest.raises(LessonError, match="is empty"):
+        s.run("end")
+    s.run("undo")
+    s.run("behavior loop")
+    with pytest.raises(RuleBaseError, match="cycle"):
+        s.run("use loop")
+    s2, out2 = session(rules)
+    s2.run("behavior a")
+    s2.run("use avoid_obstacle")
+    s2.run("end")
+    s2.run("use avoid_obstacle")
+    s2.run("r99: if road is WIDE then speed is TOP")
+    s2.run("behavior b")
+    s2.run("use a")
+    s2.run("end")
+    assert s2.state.active == "b"
+
+
+def test_frozen_and_operators(rules):
+    s, out = session(rules)
+    assert "leaves the consequents of r4, r5 alone" in say(s, out, "frozen r4, r5")
+    assert s.rulebase.behavior("avoid_obstacle").frozen == ("r4", "r5")
+    with pytest.raises(NameError_, match="unknown rule label"):
+        s.run("frozen r77")
+    assert "operators: and = product" in say(s, out, "operators: and = product")
+    with pytest.raises(NameError_, match="T-norm"):
+        s.run("operators: and = minn")
+
+
+def test_eval_and_its_mistakes(rules):
+    s, out = session(rules)
+    text = say(s, out, "eval road=78 size=45 position=4")
+    assert "r25: if road is MEDIUM and size is MED_SZ and position is RIGHT" in text
+    assert "steering = 65.4 deg" in text
+    with pytest.raises(LessonError, match="missing input `position`"):
+        s.run("eval road=78 size=45")
+    with pytest.raises(LessonError) as info:
+        s.run("eval road=78 sise=45 position=4")
+    assert "did you mean `size`?" in info.value.render()
+    with pytest.raises(LessonError, match="given twice"):
+        s.run("eval road=78 road=80 size=45 position=4")
+    with pytest.raises(LessonError, match="does not use input `heading`"):
+        s.run("eval road=78 size=45 position=4 heading=3")
+
+
+def test_correct_adapt_and_show(rules, tmp_path):
+    s, out = session(rules)
+    text = say(s, out, "correct road=78 size=45 position=4 -> steering=60 speed=20")
+    assert text == ("example 1: road=78 size=45 position=4 -> steering=60 speed=20   "
+                    "(now steering=65.41 speed=32.42)")
+    with pytest.raises(LessonError, match=r"outside its universe \[30, 150\]"):
+        s.run("correct road=78 size=45 position=4 -> steering=10")
+    with pytest.raises(LessonError, match="output variable `steer`"):
+        s.run("correct road=78 size=45 position=4 -> steer=60")
+    say(s, out, "correct road=90 size=30 position=-3 -> steering=120")
+    y = [s._outputs(s.compiled(), [e.inputs])[0] for e in s.state.examples]
+    q0 = (y[0]["steering"] - 60) ** 2 + (y[0]["speed"] - 20) ** 2 + (y[1]["steering"] - 120) ** 2
+    text = say(s, out, "adapt epochs 15 rate 0.5")
+    assert f"epoch    0: Q = {q0:.6g}" in text
+    q = [float(x.split("Q = ")[1]) for x in text.splitlines() if x.startswith("  epoch")]
+    assert q == sorted(q, reverse=True) and q[-1] < 0.1 * q[0]
+    assert "changed (before -> after):" in text and "road.MEDIUM: peak 70, width 30  ->" in text
+    assert "(was peak 70, width 30)" in say(s, out, "show terms")
+    shown = say(s, out, "show examples")
+    assert "1  road=78 size=45 position=4 -> steering=60 speed=20   (now steering=" in shown
+    assert "* avoid_obstacle (27 rules)" in say(s, out, "show behaviors")
+    assert "r25: if road is MEDIUM" in say(s, out, "show rules")
+    history = say(s, out, "show history")
+    assert f"adapt epochs 15 rate 0.5   (Q {q0:.4g} ->" in history
+    with pytest.raises(LessonError, match="whole number"):
+        s.run("adapt epochs 2.5")
+    with pytest.raises(LessonError, match=r"\(0, 1\)"):
+        s.run("adapt rate 2")
+    with pytest.raises(LessonError, match="has no plot"):
+        s.run("show rules plot x.png")
+    png = tmp_path / "terms.png"
+    assert "plotted" in say(s, out, f"show terms plot {png}")
+    assert any(p.name.startswith("terms-") for p in tmp_path.iterdir())
+
+
+def test_adapt_without_examples_or_with_everything_frozen(rules):
+    s, out = session(rules)
+    with pytest.raises(LessonError, match="no examples for behavior `avoid_obstacle`"):
+        s.run("adapt")
+    with pytest.raises(LessonError, match="nothing to undo"):
+        s.run("undo")
+    with pytest.raises(LessonError, match="no simulation to correct yet"):
+        s.run("at 3s steering=80")
+
+
+def test_undo_walks_back_every_change(rules):
+    s, out = session(rules)
+    original = s.rulebase
+    s.run("r27: if road is NARROW then steering is LB")
+    s.run("correct road=78 size=45 position=4 -> steering=60")
+    s.run("adapt epochs 5")
+    changed = s.rulebase
+    assert changed.variables != original.variables
+    s.run("undo")
+    assert s.rulebase.variables == original.variables and len(s.state.examples) == 1
+    s.run("undo")
+    assert s.state.examples == []
+    assert "undone: r27: if road is NARROW" in say(s, out, "undo")
+    assert s.rulebase == original
+    with pytest.raises(LessonError, match="nothing to undo"):
+        s.run("undo")
+
+
+def test_journal_replay_rebuilds_the_same_state(rules, tmp_path):
+    journal = Journal.create(tmp_path / "session")
+    s, out = session(rules, journal=journal)
+    for line in ["r27: if road is NARROW then steering is LB", "behavior b",
+                 "if road is WIDE then speed is FAST", "end", "use avoid_obstacle",
+                 "correct road=78 size=45 position=4 -> steering=60", "adapt epochs 5",
+                 "frozen r4", "undo"]:
+        s.run(line)
+    lines = journal.path.read_text().splitlines()
+    assert all(json.loads(x)["seq"] == i for i, x in enumerate(lines, 1))
+    again = Session.resume(Journal.open(tmp_path / "session"), out=[].append)
+    assert again.rulebase == s.rulebase
+    assert again.state.examples == s.state.examples
+    assert again.state.active == s.state.active == "avoid_obstacle"
+
+
+def test_a_torn_last_journal_line_is_dropped(rules, tmp_path):
+    journal = Journal.create(tmp_path / "j")
+    s, _ = session(rules, journal=journal)
+    s.run("r27: if road is NARROW then steering is LB")
+    with open(journal.path, "a") as fh:
+        fh.write('{"seq": 3, "op": "rule", "beh')
+    j = Journal.open(tmp_path / "j")
+    assert j.skipped_tail and len(j.entries) == 2
+    assert Session.resume(j, out=[].append).rulebase == s.rulebase
+
+
+def test_help(rules):
+    s, out = session(rules)
+    assert "adapt [epochs N] [rate ETA]" in say(s, out, "help")
+    assert "Q = sum_k" in say(s, out, "help adapt")
+    with pytest.raises(LessonError) as info:
+        s.run("help adpt")
+    assert "did you mean `adapt`?" in info.value.render()
+    assert s.run("quit") is False
