@@ -1,0 +1,165 @@
+"""`mitos teach` as users run it: lessons (file and stdin), the prompt driven through its input
+stream, and a session killed with SIGKILL and resumed with nothing lost."""
+
+import json
+import os
+import select
+import shutil
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from mitos_cli.api import default_rulebase_path
+
+RULEBASES = default_rulebase_path().parent
+
+
+@pytest.fixture
+def work(tmp_path):
+    rules = tmp_path / "rb"
+    rules.mkdir()
+    for f in RULEBASES.iterdir():
+        if f.is_file():
+            shutil.copy(f, rules / f.name)
+    return tmp_path
+
+
+def mitos(*args, cwd, stdin=None):
+    env = dict(os.environ, PYTHONUNBUFFERED="1", COLUMNS="120")
+    return subprocess.run([sys.executable, "-m", "mitos_cli", *args], cwd=cwd, input=stdin,
+                          capture_output=True, text=True, env=env, timeout=120)
+
+
+LESSON = """\
+# a small lesson
+correct road=78 size=45 position=4 -> steering=60 speed=20
+r27: if road is NARROW and position is RIGHT
+     then steering is LM and speed is SLOW
+adapt epochs 5
+show rules
+"""
+
+
+def test_lesson_file_saves_as(work):
+    (work / "small.lesson").write_text(LESSON)
+    res = mitos("teach", "rb/mitos.rules", "--lesson", "small.lesson", "--save-as",
+                "out/taught.rules", cwd=work)
+    assert res.returncode == 0, res.stderr
+    assert "small.lesson:2> correct road=78" in res.stdout
+    assert "small.lesson:3> r27: if road is NARROW and position is RIGHT" in res.stdout
+    assert "added to avoid_obstacle (28 rules)" in res.stdout
+    assert "saved out/taught.rules, out/taught.mitos.terms.yaml" in res.stdout
+    text = (work / "out" / "taught.rules").read_text()
+    assert 'terms "taught.mitos.terms.yaml", "taught.drive.terms.yaml"' in text
+    assert "r27: if road is NARROW and position is RIGHT then steering is LM" in text
+    ev = mitos("eval", "out/taught.rules", "road=78", "size=45", "position=4", "--json",
+               cwd=work)
+    assert ev.returncode == 0
+    assert abs(json.loads(ev.stdout)["outputs"]["steering"] - 60) < 5
+    assert (work / "rb" / "mitos.rules").read_text() == (RULEBASES / "mitos.rules").read_text()
+
+
+def test_lesson_stops_at_the_first_error_with_file_and_line(work):
+    (work / "bad.lesson").write_text("eval road=78 size=45 position=4\n\n"
+                                     "correct road=78 sise=45 position=4 -> steering=60\n"
+                                     "adapt\n")
+    res = mitos("teach", "rb/mitos.rules", "--lesson", "bad.lesson", cwd=work)
+    assert res.returncode == 1
+    assert res.stderr.splitlines()[-5].startswith("bad.lesson:3:17: lesson error: unknown input "
+                                                  "variable `sise`")
+    assert "did you mean `size`?" in res.stderr
+    assert "bad.lesson:4>" not in res.stdout
+    (work / "syntax.lesson").write_text("show rules\nadapt epoch 5\n")
+    res = mitos("teach", "rb/mitos.rules", "--lesson", "syntax.lesson", cwd=work)
+    assert res.returncode == 1
+    assert "syntax.lesson:2:7: syntax error: unexpected `epoch`" in res.stderr
+    assert "expected `epochs`, `plot` or `rate`" in res.stderr
+
+
+def test_lesson_from_stdin(work):
+    res = mitos("teach", "rb/mitos.rules", "--lesson", "-", cwd=work,
+                stdin="eval road=78 size=45 position=4\nquit\nshow rules\n")
+    assert res.returncode == 0
+    assert "steering = 65.4 deg" in res.stdout and "<stdin>:3>" not in res.stdout
+
+
+def test_usage_errors(work):
+    res = mitos("teach", "--session", "x", cwd=work)
+    assert res.returncode == 2 and "add --resume" in res.stderr
+    res = mitos("teach", "--resume", cwd=work)
+    assert res.returncode == 1 and "no teaching session to resume" in res.stderr
+    res = mitos("teach", "nope.rules", cwd=work)
+    assert res.returncode == 1 and "not found" in res.stderr
+    res = mitos("teach", "rb/mitos.rules", "--lesson", "missing.lesson", cwd=work)
+    assert res.returncode == 1 and "cannot read lesson `missing.lesson`" in res.stderr
+
+
+def test_prompt_through_its_input_stream(work):
+    lines = ["help", "eval road=78 size=45 position=4", "corect road=1",
+             "correct road=78 size=45 position=4 -> steering=60",
+             "if road is WIDEE then steering is LS", "show examples", "adapt epochs 3",
+             "undo", "show history", "quit"]
+    res = mitos("teach", "rb/mitos.rules", cwd=work, stdin="\n".join(lines) + "\n")
+    assert res.returncode == 0, res.stderr
+    assert "unknown command `corect`" in res.stderr and "did you mean `correct`?" in res.stderr
+    assert "unknown term of `road` `WIDEE`" in res.stderr
+    assert "example 1: road=78 size=45 position=4 -> steering=60" in res.stdout
+    assert "undone: adapt epochs 3" in res.stdout
+    assert "adapt epochs 3   (Q" in res.stdout and "(undone)" in res.stdout
+    assert "unsaved changes are kept in the journal" in res.stderr
+
+
+class Prompt:
+    """A `mitos teach` process fed line by line, reading its answers as they come."""
+
+    def __init__(self, args, cwd):
+        env = dict(os.environ, PYTHONUNBUFFERED="1")
+        self.proc = subprocess.Popen([sys.executable, "-m", "mitos_cli", "teach", *args],
+                                     cwd=cwd, stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                                     stderr=subprocess.PIPE, text=True, env=env, bufsize=1)
+        self.seen = ""
+
+    def say(self, line, expect, timeout=60.0):
+        self.proc.stdin.write(line + "\n")
+        self.proc.stdin.flush()
+        end = time.monotonic() + timeout
+        while expect not in self.seen:
+            ready, _, _ = select.select([self.proc.stdout], [], [], max(0.0, end - time.monotonic()))
+            assert ready, f"no `{expect}` after `{line}`; got {self.seen[-500:]!r}"
+            chunk = os.read(self.proc.stdout.fileno(), 65536).decode()
+            assert chunk, f"the prompt ended; got {self.seen[-500:]!r}"
+            self.seen += chunk
+        return self.seen
+
+
+def test_killed_session_resumes_with_nothing_lost(work):
+    p = Prompt(["rb/mitos.rules"], work)
+    p.say("r27: if road is NARROW and position is RIGHT then steering is LM", "(28 rules)")
+    p.say("behavior careful", "tell its rules")
+    p.say("if road is NARROW then speed is CREEP", "added to careful")
+    p.say("end", "careful learned")
+    p.say("use avoid_obstacle", "active behavior: avoid_obstacle")
+    p.say("correct road=78 size=45 position=4 -> steering=60 speed=20", "example 1:")
+    p.say("correct road=90 size=30 position=-3 -> steering=120", "example 2:")
+    p.say("adapt epochs 4", "changed (before -> after)")
+    p.say("correct road=40 size=20 position=10 -> steering=50", "example 3:")
+    p.proc.send_signal(signal.SIGKILL)                     # mid-session, nothing saved
+    p.proc.wait(timeout=30)
+    assert p.proc.returncode == -signal.SIGKILL
+    res = mitos("teach", "--resume", "--lesson", "-", cwd=work,
+                stdin="show examples\nshow behaviors\nshow rules\nshow terms\n"
+                      "save out/resumed.rules\n")
+    assert res.returncode == 0, res.stderr
+    assert "resumed session mitos-" in res.stderr and "3 examples" in res.stderr
+    out = res.stdout
+    assert "1  road=78 size=45 position=4 -> steering=60 speed=20" in out
+    assert "3  road=40 size=20 position=10 -> steering=50" in out
+    assert "  careful (1 rules)" in out and "* avoid_obstacle (28 rules)" in out
+    assert "r27: if road is NARROW and position is RIGHT then steering is LM  (new)" in out
+    assert "(was peak 70, width 30)" in out                  # the adaptation is kept
+    text = (work / "out" / "resumed.rules").read_text()
+    assert "behavior careful:" in text and "r27: if road is NARROW" in text
