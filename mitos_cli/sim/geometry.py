@@ -35,14 +35,14 @@ def polygon_segments(corners: np.ndarray) -> np.ndarray:
 
 def point_segment_distance(p: np.ndarray, seg: np.ndarray) -> np.ndarray:
     """Distances ``[P, S]`` from points ``[P, 2]`` to segments ``[S, 4]``."""
-    a = seg[None, :, 0:2]
-    e = seg[None, :, 2:4] - a
-    d = p[:, None, :] - a
-    ee = np.einsum("psk,psk->ps", np.broadcast_to(e, d.shape), np.broadcast_to(e, d.shape))
-    t = np.clip(np.einsum("psk,psk->ps", d, np.broadcast_to(e, d.shape)) / np.maximum(ee, EPS),
-                0.0, 1.0)
-    closest = a + t[..., None] * e
-    return np.hypot(*(p[:, None, :] - closest).transpose(2, 0, 1))
+    ax, ay = seg[:, 0], seg[:, 1]
+    ex, ey = seg[:, 2] - ax, seg[:, 3] - ay
+    dx = p[:, 0, None] - ax
+    dy = p[:, 1, None] - ay
+    ee = np.maximum(ex * ex + ey * ey, EPS)
+    t = (dx * ex + dy * ey) / ee
+    np.clip(t, 0.0, 1.0, out=t)
+    return np.hypot(dx - t * ex, dy - t * ey)
 
 
 def _cross(ax, ay, bx, by):

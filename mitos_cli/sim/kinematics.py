@@ -35,16 +35,20 @@ class Limits:
                    col("acceleration"))
 
 
+def _clip(x, lo, hi):
+    return np.minimum(np.maximum(x, lo), hi)
+
+
 def limit_commands(steering: np.ndarray, speed: np.ndarray, cmd_steering: np.ndarray,
                    cmd_speed: np.ndarray, lim: Limits, dt: float) -> tuple[np.ndarray, np.ndarray]:
     """The steering and speed actually reached after ``dt`` given the commands: clamped to the
     steering range and top speed, moved at most ``max_rate * dt`` and ``acceleration * dt``."""
-    target = np.clip(cmd_steering, lim.steering_min, lim.steering_max)
+    target = _clip(cmd_steering, lim.steering_min, lim.steering_max)
     step = lim.max_rate * dt
-    new_steering = steering + np.clip(target - steering, -step, step)
-    target_v = np.clip(cmd_speed, 0.0, lim.max_speed)
+    new_steering = steering + _clip(target - steering, -step, step)
+    target_v = _clip(cmd_speed, 0.0, lim.max_speed)
     dv = lim.acceleration * dt
-    new_speed = speed + np.clip(target_v - speed, -dv, dv)
+    new_speed = speed + _clip(target_v - speed, -dv, dv)
     return new_steering, new_speed
 
 
@@ -65,10 +69,44 @@ def advance(x: np.ndarray, y: np.ndarray, heading: np.ndarray, speed: np.ndarray
     for _ in range(substeps):
         dh = yaw_rate * h_dt
         # exact arc: chord length 2 R sin(dh / 2) along the mean heading (straight when dh -> 0)
-        chord = forward * h_dt * np.sinc(dh / (2.0 * np.pi))
+        half_dh = dh / 2.0
+        safe = np.where(half_dh == 0.0, 1.0, half_dh)
+        chord = forward * h_dt * np.where(half_dh == 0.0, 1.0, np.sin(safe) / safe)
         mid = h + dh / 2.0
         rx = rx + chord * np.cos(mid)
         ry = ry + chord * np.sin(mid)
         h = h + dh
     h = np.remainder(h + np.pi, 2.0 * np.pi) - np.pi
     return rx + half * np.cos(h), ry + half * np.sin(h), h
+
+
+def step(x, y, heading, speed, steering, cmd_steering, cmd_speed, lim: Limits, dt: float,
+         substeps: int):
+    """One tick: in each of ``substeps`` equal parts of ``dt``, move the steering and speed
+    toward the commands within their limits, then drive an exact arc (the same arithmetic as
+    :func:`limit_commands` and :func:`advance`, fused). Returns (x, y, heading, speed,
+    steering)."""
+    sdt = dt / substeps
+    target = _clip(cmd_steering, lim.steering_min, lim.steering_max)
+    target_v = _clip(cmd_speed, 0.0, lim.max_speed)
+    d_steer = lim.max_rate * sdt
+    d_speed = lim.acceleration * sdt
+    half = lim.wheelbase / 2.0
+    rx = x - half * np.cos(heading)
+    ry = y - half * np.sin(heading)
+    h = heading
+    for _ in range(substeps):
+        steering = steering + _clip(target - steering, -d_steer, d_steer)
+        speed = speed + _clip(target_v - speed, -d_speed, d_speed)
+        delta = np.deg2rad(steering - lim.straight)
+        dh = -speed * np.sin(delta) / lim.wheelbase * sdt
+        half_dh = dh / 2.0
+        zero = half_dh == 0.0
+        ratio = np.where(zero, 1.0, np.sin(half_dh) / np.where(zero, 1.0, half_dh))
+        chord = speed * np.cos(delta) * sdt * ratio
+        mid = h + half_dh
+        rx = rx + chord * np.cos(mid)
+        ry = ry + chord * np.sin(mid)
+        h = h + dh
+    h = np.remainder(h + np.pi, 2.0 * np.pi) - np.pi
+    return rx + half * np.cos(h), ry + half * np.sin(h), h, speed, steering

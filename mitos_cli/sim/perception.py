@@ -33,6 +33,10 @@ Inputs (all floats, units in the names of ``mitos.terms.yaml`` / ``drive.terms.y
     width / 2 - lane_margin)`` right of the road centre; positive = right of the lane.
 ``goal`` (in)
     length of route left to the goal (at least the straight distance to it).
+``wall_left``, ``wall_right`` (in)
+    gap between the robot's side and the nearest wall hit on that side, among beams landing
+    from ``wall_behind`` behind to ``wall_ahead`` ahead of the robot's centre along the route
+    (``range`` when none): what keeps the robot off the walls while it avoids an obstacle.
 
 :func:`truth` computes the same quantities from the true geometry (noise-free walls, exact
 obstacle outlines) for the trace.
@@ -49,7 +53,8 @@ from .route import Route
 from .world import Robot
 
 NO_OBSTACLE = 200.0     # in: the `obstacle` distance when nothing obstructs
-INPUTS = ("road", "size", "position", "obstacle", "heading", "lane", "goal")
+INPUTS = ("road", "size", "position", "obstacle", "heading", "lane", "goal", "wall_left",
+          "wall_right")
 
 
 @dataclass(frozen=True)
@@ -61,6 +66,8 @@ class Settings:
     cluster: float = 30.0          # in: hits this close to the nearest belong to its object
     lane_margin: float = 6.0       # in: keep-right lane keeps this off the right wall
     road_cap: float = 100.0        # in: road width used for the lane at wide openings
+    wall_behind: float = 12.0      # in
+    wall_ahead: float = 48.0       # in
 
 
 @dataclass(frozen=True)
@@ -85,11 +92,19 @@ def _road(a, b, valid, window: float, far: float) -> tuple[float, float]:
     return (float(left.min()) if left.size else far), (float(right.min()) if right.size else far)
 
 
-def _obstruction(a, b, points, valid, widen, robot: Robot, f: Frame, cfg: Settings):
-    """(size, position, distance) of the nearest obstructing object among ``points``."""
+def _obstruction(a, b, points, valid, widen, robot: Robot, f: Frame, cfg: Settings,
+                 rel_heading):
+    """(size, position, distance) of the nearest obstructing object among ``points``.
+
+    ``rel_heading`` ``(ah, bh)``: the points in the robot's own frame (along and across its
+    heading). A point obstructs when it lies in the band swept along the route or in the band
+    swept along the robot's heading (so turning back toward an object it has not yet passed
+    brings it back)."""
     half = robot.width / 2 + cfg.band_margin
     ahead = valid & (a > 0) & (a < cfg.sight)
-    blocking = ahead & (b + widen > -half) & (b - widen < half)
+    ah, bh = rel_heading
+    blocking = ahead & (((b + widen > -half) & (b - widen < half)) |
+                        ((ah > 0) & (bh + widen > -half) & (bh - widen < half)))
     if not blocking.any():
         return 0.0, 0.0, NO_OBSTACLE
     i = int(np.argmin(np.where(blocking, a, np.inf)))
@@ -98,6 +113,22 @@ def _obstruction(a, b, points, valid, widen, robot: Robot, f: Frame, cfg: Settin
     hi = float((b + widen)[near].max())
     distance = max(0.0, float(a[near].min()) - robot.length / 2)
     return hi - lo, f.e + (lo + hi) / 2, distance
+
+
+def _own_frame(rel: np.ndarray, heading: float) -> tuple[np.ndarray, np.ndarray]:
+    """Points relative to the robot in its own frame: along the heading, and across it
+    (positive to the right)."""
+    c, s = math.cos(heading), math.sin(heading)
+    return rel @ np.array([c, s]), rel @ np.array([s, -c])
+
+
+def _walls(a, b, valid, robot: Robot, cfg: Settings, far: float) -> tuple[float, float]:
+    near = valid & (a >= -cfg.wall_behind) & (a <= cfg.wall_ahead)
+    left = -b[near & (b < 0)]
+    right = b[near & (b > 0)]
+    half = robot.width / 2
+    return ((float(left.min()) - half) if left.size else far), \
+           ((float(right.min()) - half) if right.size else far)
 
 
 def _common(route: Route, p, heading: float, f: Frame, road: float, robot: Robot,
@@ -134,17 +165,20 @@ def perceive(route: Route, f: Frame, pose: tuple[float, float, float], robot: Ro
     left, right = _road(a, b, valid & ~obstacle_hit, cfg.window, max_range)
     road = left + right
     widen = measured * spacing / 2
-    size, position, distance = _obstruction(a, b, hits, obstacle_hit, widen, robot, f, cfg)
+    size, position, distance = _obstruction(a, b, hits, obstacle_hit, widen, robot, f, cfg,
+                                            _own_frame(rel, pose[2]))
     heading, lane, goal = _common(route, p, pose[2], f, road, robot, cfg)
+    wl, wr = _walls(a, b, valid & ~obstacle_hit, robot, cfg, max_range)
     return {"road": road, "size": size, "position": position, "obstacle": distance,
-            "heading": heading, "lane": lane, "goal": goal}
+            "heading": heading, "lane": lane, "goal": goal, "wall_left": wl, "wall_right": wr}
 
 
 def truth(route: Route, f: Frame, pose: tuple[float, float, float], robot: Robot,
-          side_ranges: tuple[float, float], outline: np.ndarray,
+          side_ranges: tuple[float, float], outline: np.ndarray, wall_gaps: tuple[float, float],
           cfg: Settings = Settings()) -> dict[str, float]:
     """The same inputs from the true geometry: ``side_ranges`` are exact distances to the walls
-    across the route (left, right), ``outline`` points on every obstacle and other robot."""
+    across the route (left, right), ``outline`` points on every obstacle and other robot,
+    ``wall_gaps`` the noise-free wall gaps (from the map-predicted ranges)."""
     p = np.array(pose[:2])
     road = side_ranges[0] + side_ranges[1]
     rel = outline - p
@@ -152,7 +186,16 @@ def truth(route: Route, f: Frame, pose: tuple[float, float, float], robot: Robot
     b = rel @ f.n if len(outline) else np.zeros(0)
     valid = np.ones(len(outline), dtype=bool)
     size, position, distance = _obstruction(a, b, outline, valid, np.zeros(len(outline)),
-                                            robot, f, cfg)
+                                            robot, f, cfg, _own_frame(rel, pose[2]))
     heading, lane, goal = _common(route, p, pose[2], f, road, robot, cfg)
     return {"road": road, "size": size, "position": position, "obstacle": distance,
-            "heading": heading, "lane": lane, "goal": goal}
+            "heading": heading, "lane": lane, "goal": goal, "wall_left": wall_gaps[0],
+            "wall_right": wall_gaps[1]}
+
+
+def wall_gaps(route_frame: Frame, dirs: np.ndarray, expected: np.ndarray, robot: Robot,
+              max_range: float, cfg: Settings = Settings()) -> tuple[float, float]:
+    """Noise-free wall gaps from the map-predicted ranges (for :func:`truth`)."""
+    rel = expected[:, None] * dirs
+    valid = expected < max_range * 0.999
+    return _walls(rel @ route_frame.t, rel @ route_frame.n, valid, robot, cfg, max_range)

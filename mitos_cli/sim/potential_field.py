@@ -96,3 +96,39 @@ def field_command(params: PotentialFieldParams, target: np.ndarray, angles: np.n
     speed = max_speed * slow * turn * near_goal
     speed = np.where(clear_ahead <= p.stop_in, 0.0, np.maximum(speed, p.min_speed))
     return steering, np.minimum(speed, max_speed), phi
+
+
+class PotentialFieldPlanner:
+    """The potential field as a :class:`~mitos_cli.sim.planner.Planner` (picklable, stateless).
+
+    ``robot`` gives the footprint (to turn ranges into clearances) and the limits; in a world
+    with several robots every robot is taken to be this one (the shipped worlds use one model).
+    """
+
+    name = "potential_field"
+
+    def __init__(self, robot, sensor_range: float,
+                 params: PotentialFieldParams | None = None) -> None:
+        self.robot = robot
+        self.sensor_range = float(sensor_range)   # in: a reading this far saw nothing
+        self.params = params or PotentialFieldParams()
+
+    @classmethod
+    def for_world(cls, world, params: PotentialFieldParams | None = None):
+        return cls(world.agents[0].robot, world.sensors.range, params)
+
+    def plan(self, p) -> tuple[np.ndarray, np.ndarray]:
+        r = self.robot
+        n = len(p.pose)
+        x, y, h = p.pose[:, 0], p.pose[:, 1], p.pose[:, 2]
+        dx, dy = p.target[:, 0] - x, p.target[:, 1] - y
+        c, s = np.cos(h), np.sin(h)
+        target = np.stack([c * dx + s * dy, -s * dx + c * dy], axis=1)
+        goal_distance = np.hypot(p.goal[:, 0] - x, p.goal[:, 1] - y)
+        full = np.full(n, 1.0)
+        steering, speed, _phi = field_command(
+            self.params, target, p.beam_angles, p.ranges, self.sensor_range,
+            body_extent(p.beam_angles, r.length, r.width), goal_distance,
+            full * r.max_speed, full * r.steering_min, full * r.steering_max,
+            full * r.steering_straight)
+        return steering, speed

@@ -48,7 +48,7 @@ def prepare(world: World) -> Scene:
     """Walls and routes (A* over the corridors or the grid) of a world."""
     static = build_static(world)
     routes = tuple(plan_route(static, world.corridors, a.start, a.goal,
-                              clearance=a.robot.width / 2 + a.robot.safety_margin)
+                              clearance=a.robot.width / 2 + a.robot.safety_margin + 4.0)
                    for a in world.agents)
     return Scene(static, routes)
 
@@ -114,7 +114,12 @@ def _clearance(corners: np.ndarray, pose: np.ndarray, robot, walls: np.ndarray,
     best = math.inf
     segs = np.concatenate([walls, sides]) if len(sides) else walls
     if len(segs):
-        best = float(segment_distance(fp, segs).min())
+        # only segments that can be nearest: the footprint lies within its circumradius of
+        # the centre and holds a disc of half its width
+        d_c = point_segment_distance(pose[None, :2], segs)[0]
+        outer = math.hypot(robot.length, robot.width) / 2
+        cand = d_c - outer <= d_c.min() - robot.width / 2
+        best = float(segment_distance(fp, segs[cand]).min())
     if len(centres):
         c, s = math.cos(pose[2]), math.sin(pose[2])
         rel = centres - pose[:2]
@@ -169,6 +174,8 @@ def simulate(world: World, planner: Planner | None = None, seed: int | None = No
     goals = np.array([[a.goal.x, a.goal.y] for a in agents], float)
     tol = np.array([a.goal.tolerance for a in agents], float)
 
+    shape_outline, outline_owner = obs_mod.outline_points(
+        world.obstacles, np.zeros((len(world.obstacles), 2)))
     rec_pose, rec_v, rec_steer, rec_cmd, rec_rng, rec_clear, rec_obs, rec_act = ([] for _ in range(8))
     rec_p = {k: [] for k in perception.INPUTS}
     rec_t = {k: [] for k in perception.INPUTS}
@@ -184,7 +191,7 @@ def simulate(world: World, planner: Planner | None = None, seed: int | None = No
         pose = np.stack([x, y, h], axis=1)
         corners = _footprints(pose, robots)
         robot_sides = polygon_segments(corners).reshape(n, 4, 4)
-        outline, _ = obs_mod.outline_points(world.obstacles, where)
+        outline = shape_outline + where[outline_owner] if len(where) else shape_outline
         ranges = np.zeros((n, B))
         percepts_p = {key: np.zeros(n) for key in perception.INPUTS}
         percepts_t = {key: np.zeros(n) for key in perception.INPUTS}
@@ -208,7 +215,9 @@ def simulate(world: World, planner: Planner | None = None, seed: int | None = No
             other_pts = [outline] + [corners[j] for j in range(n) if j != i]
             tr = perception.truth(routes[i], f, (x[i], y[i], h[i]), robots[i],
                                   (float(sides_lr[0]), float(sides_lr[1])),
-                                  np.concatenate(other_pts), cfg)
+                                  np.concatenate(other_pts),
+                                  perception.wall_gaps(f, dirs, expected, robots[i], sen.range,
+                                                       cfg), cfg)
             for key in perception.INPUTS:
                 percepts_p[key][i] = p[key]
                 percepts_t[key][i] = tr[key]
@@ -252,12 +261,8 @@ def simulate(world: World, planner: Planner | None = None, seed: int | None = No
         if not active.any():
             break
         # move: limits and exact arcs, substep by substep; stopped robots stay put
-        sdt = dt / sub
-        for _ in range(sub):
-            steer, v = kinematics.limit_commands(steer, v, cmd[:, 0],
-                                                 np.where(active, cmd[:, 1], 0.0), lim, sdt)
-            v = np.where(active, v, 0.0)
-            x, y, h = kinematics.advance(x, y, h, v, steer, lim, sdt, 1)
+        x, y, h, v, steer = kinematics.step(x, y, h, np.where(active, v, 0.0), steer,
+                                            cmd[:, 0], cmd[:, 1], lim, dt, sub)
         history.append(np.stack([x, y], axis=1))
         if len(history) > stuck_window:
             moved = np.hypot(*(history[-1] - history[-1 - stuck_window]).T)
