@@ -32,65 +32,100 @@ class Norm:
         return self.fn(np.asarray(a, dtype=float), np.asarray(b, dtype=float))
 
 
-def _safe_div(num, den, when_zero):
-    with np.errstate(invalid="ignore", divide="ignore"):
-        out = num / den
-    return np.where(den == 0, when_zero, out)
+def _fresh(x) -> np.ndarray:
+    """``x`` (a new result) as an array that may be overwritten (NumPy returns scalars for 0-d)."""
+    return x if isinstance(x, np.ndarray) else np.asarray(x)
 
 
 # The formulas below are the textbook ones rearranged so that, in floating point too, every
 # norm is exactly commutative (symmetric expressions) and has its identity exactly
 # (``T(a, 1) == a``, ``S(a, 0) == a``): the compiled network pads n-ary neurons with the
 # identity column, so a rounding there would change a rule's DOF. Tests: tests/test_norms.py.
+# They work in place on their own temporaries (never on ``a`` or ``b``): the engine calls them
+# on blocks of thousands of samples, where each extra temporary costs.
 
 
 def _lukasiewicz(a, b):
     # max(0, a + b - 1) as min - (1 - max): exact at b = 1 (``fl(fl(a + 1) - 1)`` is not a)
-    return np.maximum(0.0, np.minimum(a, b) - (1.0 - np.maximum(a, b)))
+    lo, hi = _fresh(np.minimum(a, b)), _fresh(np.maximum(a, b))
+    np.subtract(1.0, hi, out=hi)
+    np.subtract(lo, hi, out=lo)
+    return np.maximum(lo, 0.0, out=lo)
 
 
 def _probabilistic_sum(a, b):
     # a + b - a b as hi + lo (1 - hi): exact at b = 0 and b = 1, no cancellation
-    hi = np.maximum(a, b)
-    return hi + np.minimum(a, b) * (1.0 - hi)
+    hi, lo = _fresh(np.maximum(a, b)), _fresh(np.minimum(a, b))
+    t = _fresh(np.subtract(1.0, hi))
+    np.multiply(t, lo, out=t)
+    return np.add(t, hi, out=t)
 
 
 def _drastic_product(a, b):
-    return np.where(a == 1, b, np.where(b == 1, a, 0.0))
+    # b if a = 1, a if b = 1, else 0: min(a, b) where max(a, b) = 1
+    lo = _fresh(np.minimum(a, b))
+    return np.multiply(lo, np.maximum(a, b) == 1.0, out=lo)
 
 
 def _drastic_sum(a, b):
-    return np.where(a == 0, b, np.where(b == 0, a, 1.0))
+    # b if a = 0, a if b = 0, else 1: max(a, b) where min(a, b) = 0
+    hi = _fresh(np.maximum(a, b))
+    np.copyto(hi, 1.0, where=np.minimum(a, b) != 0.0)
+    return hi
 
 
 def _einstein_product(a, b):
     # a b / (2 - (a + b - a b)) with the denominator as 1 + (1 - a)(1 - b): exact at b = 1
-    return (a * b) / (1.0 + (1.0 - a) * (1.0 - b))
+    den = _fresh(np.subtract(1.0, a))
+    np.multiply(den, np.subtract(1.0, b), out=den)
+    np.add(1.0, den, out=den)
+    num = _fresh(np.multiply(a, b))
+    return np.divide(num, den, out=num)
 
 
 def _einstein_sum(a, b):
-    return (a + b) / (1.0 + a * b)
+    den = _fresh(np.multiply(a, b))
+    np.add(1.0, den, out=den)
+    num = _fresh(np.add(a, b))
+    return np.divide(num, den, out=num)
 
 
 def _hamacher_product(a, b):
-    # a b / (a + b - a b); the denominator is the probabilistic sum (exactly 1 at b = 1)
-    return _safe_div(a * b, _probabilistic_sum(a, b), 0.0)
+    # a b / (a + b - a b), 0 at a = b = 0; the denominator is the probabilistic sum (exactly 1
+    # at b = 1), and where it is 0 so is the numerator
+    num = _fresh(np.multiply(a, b))
+    den = _probabilistic_sum(a, b)
+    return np.divide(num, den, out=num, where=den > 0.0)
 
 
 def _hamacher_sum(a, b):
-    # (a + b - 2 a b) / (1 - a b) with the numerator as a (1 - b) + b (1 - a): exactly a at
-    # b = 0 and exactly 1 at b = 1 (numerator and denominator round alike)
-    return _safe_div(a * (1.0 - b) + b * (1.0 - a), 1.0 - a * b, 1.0)
+    # (a + b - 2 a b) / (1 - a b), 1 at a = b = 1, with the numerator as a (1 - b) + b (1 - a):
+    # exactly a at b = 0 and exactly 1 at b = 1 (numerator and denominator round alike)
+    num = _fresh(np.multiply(a, np.subtract(1.0, b)))
+    np.add(num, np.multiply(b, np.subtract(1.0, a)), out=num)
+    den = _fresh(np.multiply(a, b))
+    np.subtract(1.0, den, out=den)
+    out = np.ones(np.shape(num))
+    return np.divide(num, den, out=out, where=den > 0.0)
 
 
 def _nilpotent_minimum(a, b):
     # a + b > 1 tested as lo > 1 - hi: for tiny a, fl(a + 1) > 1 is false and T(a, 1) would be 0
-    lo, hi = np.minimum(a, b), np.maximum(a, b)
-    return np.where(lo > 1.0 - hi, lo, 0.0)
+    lo, hi = _fresh(np.minimum(a, b)), _fresh(np.maximum(a, b))
+    np.subtract(1.0, hi, out=hi)
+    return np.multiply(lo, lo > hi, out=lo)
 
 
 def _nilpotent_maximum(a, b):
-    return np.where(a + b < 1.0, np.maximum(a, b), 1.0)
+    # max(a, b) if a + b < 1, else 1
+    hi = _fresh(np.maximum(a, b))
+    np.copyto(hi, 1.0, where=np.add(a, b) >= 1.0)
+    return hi
+
+
+def _bounded_sum(a, b):
+    s = _fresh(np.add(a, b))
+    return np.minimum(s, 1.0, out=s)
 
 
 TNORMS: dict[str, Norm] = {}
@@ -119,7 +154,7 @@ for _norm in (
     Norm("max", "snorm", np.maximum, "max(a, b)", "min", ("maximum",)),
     Norm("probabilistic_sum", "snorm", _probabilistic_sum, "a + b - a * b", "product",
          ("algebraic_sum", "probor")),
-    Norm("bounded_sum", "snorm", lambda a, b: np.minimum(1.0, a + b), "min(1, a + b)",
+    Norm("bounded_sum", "snorm", _bounded_sum, "min(1, a + b)",
          "lukasiewicz", ("lukasiewicz_sum",)),
     Norm("drastic_sum", "snorm", _drastic_sum, "b if a = 0, a if b = 0, else 1", "drastic"),
     Norm("einstein_sum", "snorm", _einstein_sum, "(a + b) / (1 + a * b)", "einstein"),
