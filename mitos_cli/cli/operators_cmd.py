@@ -19,6 +19,10 @@ IMPLICATION = {
     "min": "mu'(y) = min(dof, mu(y)) (clipping)",
     "product": "mu'(y) = dof * mu(y) (scaling)",
 }
+SAMPLING = {
+    "midpoints": "the midpoints of `resolution` equal cells (fuzzylite's integration rule)",
+    "endpoints": "`resolution` evenly spaced points including both ends (MATLAB's evalfis)",
+}
 DEFUZZIFY = {
     "centroid": "sum(y mu(y)) / sum(mu(y)) over the samples (midpoint rule)",
     "bisector": "the sample where the cumulative area is closest to half the total",
@@ -47,6 +51,7 @@ def catalogue() -> dict[str, list[dict]]:
         "inference": [entry(k, v, d.inference) for k, v in INFERENCE.items()],
         "implication": [entry(k, v, d.implication) for k, v in IMPLICATION.items()],
         "defuzzify": [entry(k, v, d.defuzzify) for k, v in DEFUZZIFY.items()],
+        "sampling": [entry(k, v, d.sampling) for k, v in SAMPLING.items()],
         "hedges": [entry(h.name, h.formula, None) for h in HEDGES.values()],
     }
 
@@ -59,6 +64,7 @@ TITLES = {
     "implication": "Mamdani implication                      operators: implication = NAME",
     "defuzzify": "Mamdani defuzzifiers                     operators: defuzzify = NAME, "
                  "resolution = N (default {resolution})",
+    "sampling": "Mamdani grid                             operators: sampling = NAME",
     "hedges": "hedges (activations, eqs. 10-11)         `road is very WIDE`",
 }
 
