@@ -679,6 +679,9 @@ def _example_text(inputs: dict, targets: dict, now: dict | None) -> str:
 
 
 def _q_lines(history: list[float], n: int, result) -> str:
+    rounding = history[-1] if result.rounded else None
+    if result.rounded:
+        history = history[:-1]
     epochs = len(history) - 1
     lines = [f"Q = sum (y - t)^2 over {n} example{'s' if n != 1 else ''}:"]
     shown = list(range(len(history)))
@@ -687,6 +690,9 @@ def _q_lines(history: list[float], n: int, result) -> str:
         shown = sorted(set(shown[::step]) | {len(shown) - 1})
     for i in shown:
         lines.append(f"  epoch {i:>4}: Q = {history[i]:.6g}")
+    if rounding is not None:
+        lines.append(f"  rounded  : Q = {rounding:.6g}   (learned values to a readable grid)")
+        history = history + [rounding]
     note = "converged" if result.converged else ("interrupted" if result.interrupted
                                                  else f"{epochs} epochs")
     lines.append(f"Q {history[0]:.6g} -> {history[-1]:.6g} ({note}; RMS error "

@@ -1,0 +1,149 @@
+"""Teaching benchmark: one adaptation epoch at 1,000 examples, and the Figure 4 lesson.
+
+Run from the repository root (one command)::
+
+    python benchmarks/bench_teach.py            # add --quick for a fast smoke run
+
+It measures, in one run, on the packaged MITOS rule base (behavior ``avoid_obstacle``, the
+paper's 27 rules, 23 learnable numbers):
+
+a. the exact gradient of ``Q`` over 1,000 examples (``teach.adapt.gradient``: one forward pass
+   keeping every neuron's value, one backward pass), against two peers computing the same
+   gradient: central finite differences through the engine (2 x 23 batch evaluations, what an
+   implementation without backpropagation does) and the same backward pass run example by
+   example (a Python loop over examples, what a non-vectorized implementation does);
+b. one adaptation epoch (gradient, projected step, step halving until ``Q`` decreases):
+   ``adapt(..., epochs=1)`` minus its fixed cost, i.e. the time of ``epochs=21`` minus
+   ``epochs=1`` divided by 20;
+c. the shipped lesson ``rulebases/lessons/wider-turn.lesson`` end to end (simulation of
+   ``worlds/figure4.yaml``, corrections, adaptation), in process, without a journal on disk.
+
+The peers are checked to agree with the analytic gradient before they are timed. Times are
+the median of repeats after a warm-up. Figures go to stdout; nothing is written to disk.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import platform
+import statistics
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+from mitos_cli import load_rulebase
+from mitos_cli.teach.adapt import adapt, gradient, loss, parameterise, with_values
+
+SEED = 20240611
+ROOT = Path(__file__).resolve().parent.parent
+
+
+def examples(n: int, seed: int = SEED) -> tuple[np.ndarray, np.ndarray]:
+    rng = np.random.default_rng(np.random.SeedSequence(seed))
+    X = np.column_stack([rng.uniform(0, 160, n), rng.uniform(0, 100, n),
+                         rng.uniform(-60, 60, n)])
+    T = np.column_stack([rng.uniform(30, 150, n), rng.uniform(0, 60, n)])
+    return X, T
+
+
+def median_time(fn, repeats: int) -> float:
+    fn()                                            # warm-up
+    times = []
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - t0)
+    return statistics.median(times)
+
+
+def finite_differences(p, X, T) -> np.ndarray:
+    g = np.zeros(len(p.values))
+    for i in range(len(p.values)):
+        h = 1e-6 * p.scale[i]
+        up, down = p.values.copy(), p.values.copy()
+        up[i] += h
+        down[i] -= h
+        g[i] = (loss(with_values(p, up), X, T) - loss(with_values(p, down), X, T)) / (2 * h)
+    return g
+
+
+def per_example(p, X, T) -> np.ndarray:
+    g = np.zeros(len(p.values))
+    for k in range(len(X)):
+        g += gradient(p, p.values, X[k:k + 1], T[k:k + 1])[1]
+    return g
+
+
+def lesson_time() -> float | None:
+    from mitos_cli.teach.lesson import run_lesson
+    from mitos_cli.teach.session import Session
+
+    lesson = ROOT / "rulebases" / "lessons" / "wider-turn.lesson"
+    if not lesson.is_file() or not (ROOT / "worlds" / "figure4.yaml").is_file():
+        return None
+    text = lesson.read_text(encoding="utf-8")
+
+    def run():
+        session = Session(ROOT / "rulebases" / "mitos.rules", out=lambda s: None)
+        session.base = ROOT
+        cwd = os.getcwd()
+        os.chdir(ROOT)
+        try:
+            run_lesson(session, "\n".join(line for line in text.splitlines()
+                                          if not line.lstrip().startswith("save")),
+                       str(lesson))
+        finally:
+            os.chdir(cwd)
+
+    return median_time(run, 2)
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--quick", action="store_true", help="fewer repeats (a smoke run)")
+    args = ap.parse_args()
+    repeats = 3 if args.quick else 15
+
+    compiled = load_rulebase().compiled
+    p = parameterise(compiled)
+    X, T = examples(1000)
+
+    q, g = gradient(p, p.values, X, T)
+    fd = finite_differences(p, X, T)
+    loop = per_example(p, X[:200], T[:200])
+    assert np.allclose(g, fd, rtol=1e-4, atol=1e-3 * np.abs(fd).max()), "peers disagree"
+    assert np.allclose(gradient(p, p.values, X[:200], T[:200])[1], loop, rtol=1e-9, atol=1e-6)
+
+    t_grad = median_time(lambda: gradient(p, p.values, X, T), repeats)
+    t_fd = median_time(lambda: finite_differences(p, X, T), max(3, repeats // 5))
+    t_loop = median_time(lambda: per_example(p, X[:200], T[:200]), 3) * 5   # 1,000 examples
+    t1 = median_time(lambda: adapt(compiled, X, T, epochs=1), max(3, repeats // 3))
+    t21 = median_time(lambda: adapt(compiled, X, T, epochs=21), 3)
+    t_epoch = (t21 - t1) / 20
+    t_lesson = lesson_time()
+
+    print(f"MITOS teaching benchmark, {time.strftime('%Y-%m-%d')}, {platform.machine()} "
+          f"{platform.processor() or ''}".rstrip() + f", {os.cpu_count()} cpus, "
+          f"Python {sys.version.split()[0]}, NumPy {np.__version__}")
+    print(f"rule base: {compiled.n_rules} rules, {compiled.n_columns} neurons, "
+          f"{len(p.values)} learnable numbers ({p.n_free} free); 1,000 examples, Q = {q:.6g}")
+    print()
+    print(f"{'what (1,000 examples)':<48}{'time':>12}{'vs MITOS':>12}")
+    rows = [("gradient, MITOS backpropagation", t_grad, 1.0),
+            ("gradient, finite differences (engine)", t_fd, t_fd / t_grad),
+            ("gradient, per-example loop (same code)", t_loop, t_loop / t_grad),
+            ("one adaptation epoch (step + halving)", t_epoch, None),
+            ("adapt(epochs=1) incl. setup and rounding", t1, None)]
+    for name, t, ratio in rows:
+        print(f"{name:<48}{t * 1e3:>10.2f} ms" + (f"{ratio:>11.1f}x" if ratio else ""))
+    if t_lesson is None:
+        print("wider-turn lesson: worlds/figure4.yaml or the lesson is missing (skipped)")
+    else:
+        print(f"{'wider-turn lesson end to end (no save)':<48}{t_lesson:>10.2f} s")
+
+
+if __name__ == "__main__":
+    main()
