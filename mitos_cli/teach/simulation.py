@@ -91,7 +91,9 @@ class Recording:
 def run_world(name: str, rulebase: RuleBase, behavior: str, seed: int | None = None,
               base: Path | None = None) -> Recording:
     """Drive ``behavior`` of ``rulebase`` through the world ``name``."""
-    from ..sim import FuzzyPlanner, load_world, simulate
+    from ..sim.planner import FuzzyPlanner
+    from ..sim.simulate import simulate
+    from ..sim.worldfile import load_world
 
     path = world_path(name, base)
     world = load_world(path)
