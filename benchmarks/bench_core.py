@@ -215,8 +215,12 @@ def machine() -> str:
                 break
     except OSError:
         pass
+    try:
+        load = "load average %.2f %.2f %.2f" % os.getloadavg()
+    except OSError:
+        load = "load average unknown"
     return (f"{os.cpu_count()} CPUs ({model}), Python {platform.python_version()}, "
-            f"NumPy {np.__version__}")
+            f"NumPy {np.__version__}; {load} at the start")
 
 
 def fmt_rate(x: float) -> str:
@@ -240,6 +244,7 @@ def main() -> None:
     single_n = 200 if args.quick else 2000
     runs = 3 if args.quick else 11
 
+    host = machine()
     rb = load_rulebase()
     c = rb.compiled
     rng = np.random.default_rng(np.random.SeedSequence(SEED))
@@ -308,7 +313,7 @@ def main() -> None:
     t_numpy = process_time([sys.executable, "-c", "import numpy"], runs)
 
     print(f"# MITOS core benchmark ({time.strftime('%Y-%m-%d')})")
-    print(f"machine: {machine()}")
+    print(f"machine: {host}")
     print(f"command: python benchmarks/bench_core.py{' --quick' if args.quick else ''}")
     print(f"batch: {n:,} random inputs, best of {repeats} after a warm-up; single: median of "
           f"{repeats} repeats of the mean over {single_n} (MITOS) / {len(pts[:max(50, single_n // 4)])}"
