@@ -185,7 +185,8 @@ def main() -> None:
 
     print(f"machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
           f"Python {platform.python_version()}, NumPy {np.__version__}, "
-          f"pyfuzzylite {fl.__version__}")
+          f"pyfuzzylite {fl.__version__}; {time.strftime('%Y-%m-%d')}; load average at start "
+          f"{os.getloadavg()[0]:.2f}")
     rng = np.random.default_rng(np.random.SeedSequence(args.seed))
     rb = read_rulebase()
     base = compile_rulebase(rb, "avoid_obstacle")
@@ -235,6 +236,7 @@ def main() -> None:
             print(f"  MITOS        {m:12,.0f}")
             print(f"  pyfuzzylite  {f:12,.0f}   MITOS is {m / f:6.1f}x faster")
             print(f"  scikit-fuzzy {s:12,.0f}   MITOS is {m / s:6.0f}x faster", flush=True)
+    print(f"\nload average at end {os.getloadavg()[0]:.2f}")
 
 
 if __name__ == "__main__":
