@@ -105,11 +105,15 @@ class TermSet:
         raise unknown("variable", name, [v.name for v in self.variables], span=span)
 
 
-def check_term(term: Term, universe: tuple[float, float], variable: str) -> None:
-    """Raise :class:`TermSetError` when ``term`` is malformed for its variable."""
+def check_term(term: Term, universe: tuple[float, float], variable: str,
+               peak_inside: bool = True) -> None:
+    """Raise :class:`TermSetError` when ``term`` is malformed for its variable (with
+    ``peak_inside``, also when its peak lies outside the universe: an output's crisp value)."""
     problem = term.kind.check(term.params)
     if problem:
         raise TermSetError(f"term `{variable}.{term.name}`: {problem}", span=term.span)
+    if not peak_inside:
+        return
     lo, hi = universe
     center = term.center          # NaN for a linear (Takagi-Sugeno) consequent: no peak
     if not np.isnan(center) and not lo <= center <= hi:

@@ -119,7 +119,9 @@ def _variable(name: str, spec: Any, key_span: Span, value_span: Span,
                                    span=term.span, hint="give input terms a membership shape "
                                    "(triangle, trapezoid, left_shoulder, ...)")
     for term in terms:
-        check_term(term, (lo, hi), name)
+        # an input term may peak outside the universe (a shoulder seen from inside it, as
+        # MATLAB and fuzzylite files often have); an output's crisp value may not
+        check_term(term, (lo, hi), name, peak_inside=role == "output")
     default = None
     if "default" in spec:
         if role != "output":
@@ -166,7 +168,9 @@ def _term(name: str, spec: Any, key_span: Span, value_span: Span, variable: str,
     if given == ("points",):
         points = spec["points"]
         pspan = spec.value_span("points")
-        if not isinstance(points, YList) or len(points) != len(kind.params):
+        if kind.variadic and isinstance(points, YList):      # discrete: x1, y1, ..., xn, yn
+            pass
+        elif not isinstance(points, YList) or len(points) != len(kind.params):
             raise TermSetError(f"{what}: `points` must list {len(kind.params)} numbers "
                                f"({', '.join(kind.params)})", span=pspan)
         params = tuple(yamlpos.expect_number(v, points.item_span(i), TermSetError,

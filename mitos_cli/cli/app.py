@@ -11,7 +11,7 @@ import sys
 import typer
 
 from ..errors import MitosError
-from . import check_cmd, eval_cmd, operators_cmd, plot_cmd, teach_cmd
+from . import check_cmd, convert_cmd, eval_cmd, export_cmd, operators_cmd, plot_cmd, teach_cmd
 
 app = typer.Typer(
     name="mitos",
@@ -33,6 +33,8 @@ def _root() -> None:
 
 # One line per command; each module holds one command function.
 app.command("eval")(eval_cmd.eval_command)
+app.command("convert")(convert_cmd.convert_command)
+app.command("export")(export_cmd.export_command)
 app.command("operators")(operators_cmd.operators_command)
 app.command("check")(check_cmd.check_command)
 app.command("teach")(teach_cmd.teach_command)

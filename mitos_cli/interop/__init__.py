@@ -57,4 +57,21 @@ def write_foreign(rb: RuleBase, fmt: str, behavior: str | None = None) -> str:
     raise FormatError(f"unknown format `{fmt}`", expected="one of " + ", ".join(FORMATS))
 
 
-__all__ = ["FORMATS", "read_foreign", "write_foreign"]
+def conversion_notes(rb: RuleBase, fmt: str, behavior: str | None = None) -> list[str]:
+    """What writing ``rb`` as ``fmt`` changes (it is written anyway; the CLI warns)."""
+    if fmt == "fis":
+        from .fis import notes
+
+        return notes(rb, behavior)
+    from ..operators import resolve
+
+    b = rb.behavior(behavior)
+    ops = resolve(b.operators, resolve(rb.operators))
+    if fmt in ("fcl", "fll") and ops.inference == "mamdani" and ops.sampling != "midpoints":
+        return [f"{fmt.upper()} Mamdani outputs are sampled at cell midpoints (fuzzylite's "
+                f"rule); this rule base samples at {ops.sampling} (MATLAB's), so results move "
+                f"by the discretisation"]
+    return []
+
+
+__all__ = ["FORMATS", "conversion_notes", "read_foreign", "write_foreign"]

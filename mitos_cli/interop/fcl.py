@@ -234,8 +234,10 @@ def _variable(node: Tree, role: str, declared, settings: Settings, locks: dict, 
                     raise FormatError(f"unknown LOCK `{word}`", span=span_of(word),
                                       expected="PREVIOUS or RANGE")
                 locks[name] = span_of(word)
-    if not terms:
-        raise FormatError(f"variable `{name}` has no terms", span=span_of(node))
+    if not terms and (role == "output" or universe is None):
+        raise FormatError(f"variable `{name}` has no terms", span=span_of(node),
+                          hint=None if role == "output" else "an input without terms (it only "
+                          "feeds linear consequents) needs `RANGE := (min .. max);`")
     if universe is None:
         universe = _extent(terms, name, span_of(node))
     lo, hi = universe

@@ -304,11 +304,6 @@ def write_fis(rb: RuleBase, behavior: str | None = None) -> str:
     for i, v in enumerate(inputs, 1):
         lines += ["", f"[Input{i}]"] + _var_lines(v, [_mf_text(t, v) for t in v.terms])
     for i, v in enumerate(flat.outputs, 1):
-        mid = (v.universe[0] + v.universe[1]) / 2
-        if v.default is not None and v.default != mid:
-            raise FormatError(f"output `{v.name}`: default {v.default:g} cannot be written to "
-                              f".fis (MATLAB uses the middle of the range, {mid:g}, when no rule "
-                              f"fires)")
         if sugeno:
             mfs = []
             for t in v.terms:
@@ -325,6 +320,25 @@ def write_fis(rb: RuleBase, behavior: str | None = None) -> str:
     for r in flat.rules:
         lines.append(_rule_text(r, inputs, flat.outputs))
     return "\n".join(lines) + "\n"
+
+
+def notes(rb: RuleBase, behavior: str | None = None) -> list[str]:
+    """What a .fis file cannot record about ``rb`` (printed as warnings by ``mitos convert``)."""
+    flat = common.flatten_for_export(rb, behavior)
+    ops = flat.operators
+    out = []
+    for v in flat.outputs:
+        mid = (v.universe[0] + v.universe[1]) / 2
+        if v.default != mid:
+            now = "NaN / an error" if v.default is None else f"{v.default:g}"
+            out.append(f"output `{v.name}`: when no rule fires MATLAB returns the middle of the "
+                       f"range ({mid:g}), not {now}")
+    if ops.inference == "mamdani" and (ops.resolution, ops.sampling) != (DEFAULT_RESOLUTION,
+                                                                         "endpoints"):
+        out.append(f"MATLAB samples Mamdani outputs at 101 points including the ends; this rule "
+                   f"base uses {ops.resolution} {ops.sampling}, so results move by the "
+                   f"discretisation")
+    return out
 
 
 def _var_lines(v: Variable, mfs: list[str]) -> list[str]:
@@ -356,7 +370,7 @@ def _mf_text(t: Term, v: Variable) -> str:
                           f"function")
     mf, order = INVERSE[shape]
     values = [0.0] * len(order)
-    for matlab_i, mitos_i in enumerate(order):
+    for mitos_i, matlab_i in enumerate(order):
         values[matlab_i] = p[mitos_i]
     return f"'{t.name}':'{mf}',[{' '.join(fmt_number(x) for x in values)}]"
 

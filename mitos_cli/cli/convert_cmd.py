@@ -1,0 +1,71 @@
+"""``mitos convert``: a rule base in another format (MITOS rules, FCL, FIS, FLL)."""
+
+from __future__ import annotations
+
+from enum import Enum
+from pathlib import Path
+from typing import Annotated, Optional
+
+import typer
+
+from .output import emit, err, warn
+
+
+class Target(str, Enum):
+    rules = "rules"
+    fcl = "fcl"
+    fis = "fis"
+    fll = "fll"
+
+
+def convert_command(
+    path: Annotated[Path, typer.Argument(
+        metavar="FILE", help="Rule base to convert (.rules, .fcl, .fis or .fll).")],
+    to: Annotated[Target, typer.Option(
+        "--to", help="Format to write: rules (NAME.rules + NAME.terms.yaml), fcl, fis or fll.",
+        case_sensitive=False)],
+    output: Annotated[Optional[Path], typer.Option(
+        "--output", "-o", metavar="OUT",
+        help="File to write (default: stdout; for --to rules: STEM.rules in the current "
+             "directory).")] = None,
+    behavior: Annotated[Optional[str], typer.Option(
+        "--behavior", "-b", help="Behavior to convert (default: the file's first).")] = None,
+) -> None:
+    """Convert a rule base between the MITOS rule language, FCL, MATLAB .fis and fuzzylite FLL.
+
+    Reading back what was written gives the same outputs; what the target format cannot say
+    is refused with the reason.
+    """
+    from ..api import read_rulebase
+    from ..interop.common import atomic_write
+
+    rb = read_rulebase(path)
+    if behavior is not None:
+        rb.behavior(behavior)                     # unknown behavior: did you mean
+    if to is Target.rules:
+        from ..interop.rules_writer import write_rules
+
+        rules_path = output if output is not None else Path.cwd() / f"{path.stem}.rules"
+        if rules_path.suffix != ".rules":
+            rules_path = rules_path.with_name(rules_path.name + ".rules")
+        terms_path = rules_path.with_name(rules_path.stem + ".terms.yaml")
+        for target in (rules_path, terms_path):
+            if target.resolve() == path.resolve():
+                raise typer.BadParameter(f"`{target}` would overwrite the input; give -o OUT")
+        rules_text, terms_text = write_rules(rb, terms_path.name, behavior, path.name)
+        atomic_write(terms_path, terms_text)
+        atomic_write(rules_path, rules_text)
+        err(f"wrote {rules_path} and {terms_path}")
+        return
+    from ..interop import conversion_notes, write_foreign
+
+    text = write_foreign(rb, to.value, behavior)
+    for note in conversion_notes(rb, to.value, behavior):
+        warn(note)
+    if output is None:
+        emit(text)
+    else:
+        if output.resolve() == path.resolve():
+            raise typer.BadParameter(f"`{output}` would overwrite the input")
+        atomic_write(output, text)
+        err(f"wrote {output}")

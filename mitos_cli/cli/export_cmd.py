@@ -1,0 +1,51 @@
+"""``mitos export``: a rule base as a self-contained C99 file or a NumPy-only Python module."""
+
+from __future__ import annotations
+
+from enum import Enum
+from pathlib import Path
+from typing import Annotated, Optional
+
+import typer
+
+from .output import emit, err
+
+
+class Language(str, Enum):
+    c = "c"
+    python = "python"
+
+
+def export_command(
+    path: Annotated[Path, typer.Argument(
+        metavar="FILE", help="Rule base to export (.rules, .fcl, .fis or .fll).")],
+    to: Annotated[Language, typer.Option(
+        "--to", help="c: one C99 file (no allocation, only libm); python: a NumPy-only "
+                     "module.", case_sensitive=False)],
+    output: Annotated[Optional[Path], typer.Option(
+        "--output", "-o", metavar="OUT", help="File to write (default: stdout).")] = None,
+    behavior: Annotated[Optional[str], typer.Option(
+        "--behavior", "-b", help="Behavior to export (default: the file's first).")] = None,
+    prefix: Annotated[str, typer.Option(
+        "--prefix", help="C names: PREFIX_eval, PREFIX_IN_<INPUT>, PREFIX_OUT_<OUTPUT>.")
+    ] = "mitos",
+) -> None:
+    """Export a rule base as code that computes its outputs from its inputs.
+
+    The C function is `int PREFIX_eval(const double in[], double out[])`; the Python module
+    has `evaluate(X)` for a batch `X[n, k]`. Both agree with `mitos eval` to rounding.
+    """
+    from ..api import load_rulebase
+    from ..interop.common import atomic_write
+    from ..interop.export import ident, to_c, to_python
+
+    if not ident(prefix) == prefix:
+        raise typer.BadParameter(f"--prefix `{prefix}` is not a C identifier")
+    rb = load_rulebase(path, behavior)
+    text = to_c(rb.compiled, prefix, path.name) if to is Language.c else \
+        to_python(rb.compiled, path.name)
+    if output is None:
+        emit(text)
+    else:
+        atomic_write(output, text if text.endswith("\n") else text + "\n")
+        err(f"wrote {output}")

@@ -1,0 +1,118 @@
+"""Writing a rule base as fresh MITOS files: ``NAME.rules`` and ``NAME.terms.yaml``.
+
+This writes new files from the model (for ``mitos convert --to rules``); the teaching loop has
+its own saver that keeps the comments of an existing file. One behavior is written, with its
+``use`` includes inlined, as top-level rules; operators that differ from MITOS's defaults go on
+an ``operators:`` line. Names the rule language cannot hold (reserved words, characters outside
+``[A-Za-z0-9_-]``) are refused with the name.
+"""
+
+from __future__ import annotations
+
+import re
+
+import numpy as np
+import yaml
+
+from ..errors import FormatError
+from ..model import Rule, RuleBase, format_rule
+from ..terms import Term, Variable
+from . import common
+
+NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_\-]*[A-Za-z0-9_]|[A-Za-z_]")
+RESERVED = {"if", "then", "is", "and", "or", "not", "with", "use", "when", "terms", "operators",
+            "behavior", "end", "frozen", "very", "somewhat", "more_or_less", "extremely",
+            "seldom", "intensely", "any"}
+
+
+def check_name(name: str, what: str) -> None:
+    if not NAME.fullmatch(name) or name in RESERVED:
+        why = "is a reserved word" if name in RESERVED else "has characters the rule language " \
+                                                               "does not allow in names"
+        raise FormatError(f"{what} `{name}` {why}",
+                          hint="rename it in the source file (letters, digits, `_` and `-`)")
+
+
+def write_rules(rb: RuleBase, termset_name: str, behavior: str | None = None,
+                source: str = "") -> tuple[str, str]:
+    """``(rules text, term-set YAML text)``; the rules file names ``termset_name``."""
+    flat = common.flatten_for_export(rb, behavior, crisp_terms=False)
+    inputs = common.all_inputs(rb, flat)
+    for v in inputs + flat.outputs:
+        check_name(v.name, "variable")
+        for t in v.terms:
+            check_name(t.name, f"term of `{v.name}`")
+    head = [f"# {flat.name}: written by `mitos convert`" + (f" from {source}" if source else ""),
+            "", f"terms {_quote(termset_name)}"]
+    settings = flat.operators.settings()
+    if settings:
+        head.append("operators: " + ", ".join(f"{k} = {v}" for k, v in settings.items()))
+    head.append("")
+    labels: set[str] = set()
+    lines = []
+    for i, r in enumerate(flat.rules):
+        label = r.label if NAME.fullmatch(r.label or "") and "/" not in r.label else f"r{i + 1}"
+        if label in labels or label in RESERVED:
+            label = common.unique_name(f"r{i + 1}", labels)
+        labels.add(label)
+        lines.append(format_rule(Rule(label, r.antecedent, r.consequents, r.weight), label=True))
+    return "\n".join(head + lines) + "\n", write_termset(rb, inputs, flat.outputs, source)
+
+
+def _quote(text: str) -> str:
+    return '"' + text.replace("\\", "\\\\").replace('"', '\\"') + '"'
+
+
+def _scalar(value) -> str:
+    if isinstance(value, str):
+        return yaml.safe_dump(value, default_flow_style=True, width=1 << 16).strip() \
+            .removesuffix("...").strip()
+    value = float(value)
+    if np.isinf(value):
+        return ".inf" if value > 0 else "-.inf"
+    return common.fmt_number(value)
+
+
+def write_termset(rb: RuleBase, inputs, outputs, source: str = "") -> str:
+    lines = [f"# Term set written by `mitos convert`" + (f" from {source}" if source else ""),
+             "variables:"]
+    input_names = [v.name for v in inputs]
+    for v in tuple(inputs) + tuple(outputs):
+        if not v.terms:
+            raise FormatError(f"input `{v.name}` has no terms (it only feeds linear "
+                              f"consequents); a YAML term set needs at least one term",
+                              hint="convert to FLL, FCL or FIS instead, which allow it")
+        lines.append(f"  {_scalar(v.name)}:")
+        if v.description:
+            lines.append(f"    description: {_scalar(v.description)}")
+        if v.unit:
+            lines.append(f"    unit: {_scalar(v.unit)}")
+        lines.append(f"    role: {v.role}")
+        lines.append(f"    universe: [{_scalar(v.universe[0])}, {_scalar(v.universe[1])}]")
+        if v.default is not None:
+            lines.append(f"    default: {_scalar(v.default)}")
+        lines.append("    terms:")
+        for t in v.terms:
+            lines.append(f"      {_scalar(t.name)}: {_term_spec(rb, v, t, input_names)}")
+    return "\n".join(lines) + "\n"
+
+
+def _term_spec(rb: RuleBase, v: Variable, t: Term, inputs: list[str]) -> str:
+    p = t.params
+    if t.shape == "singleton":
+        return _scalar(p[0])
+    if t.shape == "linear":
+        coefficients = common.linear_coefficients(rb, v.name, t)
+        given = ", ".join(f"{_scalar(n)}: {_scalar(a)}" for n, a in coefficients.items()
+                          if a != 0.0)
+        return f"{{shape: linear, coefficients: {{{given}}}, constant: {_scalar(p[-1])}}}"
+    frozen = ", frozen: true" if t.frozen else ""
+    if t.shape == "triangle_pw":
+        return f"{{shape: triangle, peak: {_scalar(p[0])}, width: {_scalar(p[1])}{frozen}}}"
+    if t.shape == "triangle_plr":
+        return (f"{{shape: triangle, peak: {_scalar(p[0])}, left_width: {_scalar(p[1])}, "
+                f"right_width: {_scalar(p[2])}{frozen}}}")
+    if t.shape == "binary" and np.isinf(p[1]):      # only the side matters: a finite one
+        p = (p[0], p[0] + (1.0 if p[1] > 0 else -1.0))
+    points = ", ".join(_scalar(x) for x in p)
+    return f"{{shape: {t.shape}, points: [{points}]{frozen}}}"
