@@ -202,3 +202,17 @@ def test_vectorized_one_epoch_is_fast_enough_to_not_loop(benchmark=None):
     assert len(result.history) >= 2
     again = adapt(compiled, X, T, epochs=2)              # deterministic, bit for bit
     assert np.array_equal(result.values, again.values)
+
+
+def test_gradient_through_use_contexts_of_the_drive_behavior():
+    compiled = load_rulebase(None, "drive").compiled
+    assert compiled.context.shape[1] >= 1                # blended behaviors
+    p = parameterise(compiled)
+    rng = np.random.default_rng(9)
+    X = np.column_stack([rng.uniform(*compiled.universe[k], 300)
+                         for k in range(len(compiled.inputs))])
+    X = away_from_ties(compiled, X)
+    T = np.column_stack([rng.uniform(30, 150, len(X)), rng.uniform(0, 60, len(X))])
+    _, g = gradient(p, p.values, X, T)
+    num = finite_differences(p, X, T)
+    np.testing.assert_allclose(g, num, rtol=1e-5, atol=1e-4 * np.abs(num).max())

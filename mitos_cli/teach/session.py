@@ -184,7 +184,6 @@ class Session:
         self.base: Path | None = None       # where a lesson's relative world paths start
         self.saved_seq = 0
         self.state = State(self.original, active)
-        self.lines: list[str] = []
         if not self.journal.entries:
             self.journal.append("start", rules=str(self.rules_path.resolve()),
                                 behavior=active, digest=files_digest(self.original),
@@ -246,7 +245,6 @@ class Session:
     def run(self, line: str, path: str | None = None, lineno: int = 1) -> bool:
         """Parse and execute one line; False after ``quit``."""
         command = cmd.parse_command(line, path, lineno)
-        self.lines.append(line.strip())
         return self.execute(command, line.strip())
 
     def execute(self, c, line: str = "") -> bool:
@@ -481,7 +479,7 @@ class Session:
             return
         self.change("adapt", line, behavior=compiled.behavior, terms=terms, crisp=crisp,
                     q=[history[0], history[-1]], epochs=epochs, rate=rate)
-        self.out(changed_table(before_rb, self.rulebase, crisp, before_rb))
+        self.out(changed_table(before_rb, self.rulebase, crisp))
         if result.parameters.frozen_reasons:
             self.out("not adapted: " + "; ".join(result.parameters.frozen_reasons))
         if c.plot is not None:
@@ -709,7 +707,7 @@ def _params_text(t) -> str:
     return ", ".join(f"{n} {format_number(v)}" for n, v in zip(names, t.params))
 
 
-def changed_table(before: RuleBase, after: RuleBase, crisp: list, _=None) -> str:
+def changed_table(before: RuleBase, after: RuleBase, crisp: list) -> str:
     lines = ["changed (before -> after):"]
     for v_old, v_new in zip(_variables(before), _variables(after)):
         for t_old, t_new in zip(v_old.terms, v_new.terms):
