@@ -154,8 +154,12 @@ def skfuzzy_system(compiled):
 
 
 def run_skfuzzy(sim, compiled, X):
-    for j, name in enumerate(compiled.inputs):
-        sim.input[name] = X[:, j].copy()
+    import warnings
+
+    with warnings.catch_warnings():    # "array shape differs from previous": all are replaced
+        warnings.simplefilter("ignore", UserWarning)
+        for j, name in enumerate(compiled.inputs):
+            sim.input[name] = X[:, j].copy()
     sim.compute()
     return np.column_stack([np.atleast_1d(sim.output[o]) for o in compiled.outputs])
 
