@@ -55,46 +55,66 @@ def _world_name(world: str) -> str:
 
 # -- terminal -------------------------------------------------------------------------------
 
+def _compact_rate(r: Rate) -> str:
+    if r.n == 0:
+        return "-"
+    return f"{100 * r.k / r.n:.0f}% [{100 * r.lo:.0f},{100 * r.hi:.0f}]"
+
+
+def _compact_mean(m: Mean) -> str:
+    if m.mean is None:
+        return "-"
+    d = _digits(m.mean)
+    return f"{m.mean:.{d}f}" if m.std is None else f"{m.mean:.{d}f}±{m.std:.{d}f}"
+
+
+TERMINAL_HEADINGS = {"time_s": "time s*", "path_length_in": "path in*",
+                     "min_clearance_in": "clear in", "steering_total_variation_deg": "steer TV*"}
+
+
 def rich_tables(summaries: list[Summary], ranks: list[Rank]):
-    """The per-combination table and the ranking as rich renderables."""
+    """The per-combination table and the ranking as rich renderables (compact: the metrics'
+    t intervals are in report.md)."""
+    from rich import box
     from rich.table import Table
 
-    table = Table(title="Outcomes per world and choice (95% intervals)", title_justify="left",
-                  caption="* successful runs only; rates: Wilson interval; means: t interval",
-                  caption_justify="left")
+    table = Table(title="Outcomes per world and choice", title_justify="left",
+                  caption="rates: % [Wilson 95%]; metrics: mean±std (t intervals in "
+                          "report.md); * successful runs only",
+                  caption_justify="left", box=box.SIMPLE_HEAD, pad_edge=False)
     table.add_column("world", no_wrap=True)
     table.add_column("choice", no_wrap=True)
     table.add_column("n", justify="right")
     for _f, heading in RATE_COLUMNS[:3]:
-        table.add_column(heading, justify="right")
+        table.add_column(heading, justify="right", no_wrap=True)
     for f in TABLE_METRICS:
-        table.add_column(_metric_heading(f), justify="right")
+        table.add_column(TERMINAL_HEADINGS[f], justify="right", no_wrap=True)
     last = None
     for s in summaries:
         world = _world_name(s.world)
         if last is not None and world != last:
             table.add_section()
         table.add_row(world if world != last else "", s.choice.label, str(s.n),
-                      *(fmt_rate(s.rates[f]) for f, _h in RATE_COLUMNS[:3]),
-                      *(fmt_mean(s.metrics[f]) for f in TABLE_METRICS))
+                      *(_compact_rate(s.rates[f]) for f, _h in RATE_COLUMNS[:3]),
+                      *(_compact_mean(s.metrics[f]) for f in TABLE_METRICS))
         last = world
-    ranking = Table(title=RANK_TITLE, title_justify="left")
-    for name, justify in (("#", "right"), ("choice", "left"), ("success", "right"),
-                          ("time to goal (s)", "right"), ("min clearance (in)", "right"),
-                          ("vs leader (+/-)", "right"), ("McNemar p", "right")):
-        ranking.add_column(name, justify=justify, no_wrap=name == "choice")
+    ranking = Table(title=RANK_TITLE, title_justify="left", box=box.SIMPLE_HEAD,
+                    pad_edge=False)
+    for name in ("#", "choice", "success", "time s*", "clear in", "won/lost", "McNemar p"):
+        ranking.add_column(name, justify="left" if name == "choice" else "right",
+                           no_wrap=True)
     for r in ranks:
         s = r.summary
-        ranking.add_row(str(r.place), s.choice.label, fmt_rate(s.rates["success"]),
-                        fmt_mean(s.metrics["time_s"], ci=False),
-                        fmt_mean(s.metrics["min_clearance_in"], ci=False),
-                        "-" if r.p_value is None else f"+{r.wins} / -{r.losses}",
+        ranking.add_row(str(r.place), s.choice.label, _compact_rate(s.rates["success"]),
+                        _compact_mean(s.metrics["time_s"]),
+                        _compact_mean(s.metrics["min_clearance_in"]),
+                        "-" if r.p_value is None else f"{r.wins}/{r.losses}",
                         fmt_p(r.p_value))
     return table, ranking
 
 
-RANK_TITLE = ("Ranking over all worlds: success rate, then time to goal, then clearance; "
-              "McNemar: paired runs vs the leader")
+RANK_TITLE = ("Ranking (all worlds): success rate, then time to goal, then clearance; "
+              "won/lost and McNemar p: paired runs vs the leader")
 
 
 # -- Markdown -------------------------------------------------------------------------------

@@ -46,17 +46,39 @@ def loaded_rulebase(path: str | None, behavior: str | None, overrides: tuple):
                           tuple(Setting(k, v) for k, v in overrides))
 
 
-def check_choice(choice: Choice, rulebase: str | None, behavior: str | None) -> None:
+def check_choice(choice: Choice, context: StudyContext, world_path: str) -> None:
     """Raise the user's error now (bad rule base, operator, behavior) rather than in a worker."""
-    if choice.planner == "fuzzy":
-        loaded_rulebase(rulebase, behavior, choice.overrides())
+    _planner(context, choice, world_path)
 
 
-def make_planner(context: StudyContext, choice: Choice, world):
-    """The planner of ``choice`` for ``world``."""
-    raise NotImplementedError("waiting for the simulator's Planner protocol")
+@functools.lru_cache(maxsize=32)
+def _scene(path: str):
+    """Walls and routes of a world: randomisation moves obstacles only, so they are shared."""
+    from ..sim.simulate import prepare
+
+    return prepare(_world(path))
+
+
+@functools.lru_cache(maxsize=64)
+def _planner(context: StudyContext, choice: Choice, path: str):
+    world = _world(path)
+    if choice.planner == "potential_field":
+        from ..sim.potential_field import PotentialFieldPlanner
+
+        return PotentialFieldPlanner.for_world(world)
+    from ..sim.planner import FuzzyPlanner
+
+    behavior = context.behavior or world.behavior
+    return FuzzyPlanner(loaded_rulebase(context.rulebase, behavior, choice.overrides()),
+                        behavior)
 
 
 def run_task(context: StudyContext, task: Task) -> dict:
-    """Simulate one task; return the fields of :data:`RESULT_FIELDS`."""
-    raise NotImplementedError("waiting for the simulator's simulate()")
+    """Simulate one task (the world randomised from the task's seed); return the fields of
+    :data:`RESULT_FIELDS`."""
+    from ..sim.simulate import simulate
+
+    world = _world(task.world)
+    result = simulate(world, _planner(context, task.choice, task.world), task.seed,
+                      randomise=True, scene=_scene(task.world))
+    return {"outcome": result.outcome, **{f: result.metrics[f] for f in RESULT_FIELDS[1:]}}

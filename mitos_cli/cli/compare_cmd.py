@@ -1,0 +1,151 @@
+"""``mitos compare``: a study of operator choices and planners over worlds x seeded runs."""
+
+from __future__ import annotations
+
+import shlex
+import sys
+from typing import Annotated, Optional
+
+import typer
+
+from .output import err, warn
+
+
+def compare_command(
+    worlds: Annotated[list[str], typer.Argument(
+        metavar="WORLDS...",
+        help="World files (or names of packaged worlds such as corridor.yaml).")],
+    and_: Annotated[str, typer.Option(
+        "--and", metavar="TNORMS",
+        help="T-norms of the fuzzy planner, comma-separated.")] = "min,product,lukasiewicz,einstein",
+    or_: Annotated[Optional[str], typer.Option(
+        "--or", metavar="SNORMS",
+        help="S-norms, comma-separated (crossed with --and); `dual` pairs each T-norm with "
+             "its De Morgan dual. Default: the rule base's.")] = None,
+    inference: Annotated[Optional[str], typer.Option(
+        "--inference", metavar="METHODS",
+        help="Inference methods: weighted_average, weighted_sum, mamdani. "
+             "Default: the rule base's.")] = None,
+    planner: Annotated[str, typer.Option(
+        "--planner", metavar="PLANNERS",
+        help="Planners to compare: fuzzy, potential_field.")] = "fuzzy,potential_field",
+    runs: Annotated[int, typer.Option(
+        "--runs", "-n", min=1, help="Randomized runs per world and choice.")] = 20,
+    seed: Annotated[int, typer.Option(
+        "--seed", min=0, help="Seed of the whole study (runs are paired across choices).")] = 1,
+    out: Annotated[str, typer.Option(
+        "--out", "-o", metavar="DIR",
+        help="Directory for results.csv, report.md and the plots.")] = "study",
+    executor: Annotated[str, typer.Option(
+        "--executor", metavar="local|dask",
+        help="local: a process pool on this machine; dask: dask.distributed.")] = "local",
+    workers: Annotated[Optional[int], typer.Option(
+        "--workers", "-j", min=1,
+        help="Processes (local) or LocalCluster workers (dask). Default: the cores.")] = None,
+    scheduler: Annotated[Optional[str], typer.Option(
+        "--scheduler", metavar="ADDR",
+        help="Dask scheduler address (tcp://host:8786); without it a LocalCluster.")] = None,
+    resume: Annotated[bool, typer.Option(
+        "--resume", help="Continue the study in DIR: skip every run already in results.csv."
+    )] = False,
+    rulebase: Annotated[Optional[str], typer.Option(
+        "--rulebase", metavar="PATH",
+        help="Rule base of the fuzzy planner (default: the packaged one).")] = None,
+    behavior: Annotated[Optional[str], typer.Option(
+        "--behavior", "-b", help="Behavior to drive with (default: the world's).")] = None,
+    plots: Annotated[bool, typer.Option(
+        "--plots/--no-plots", help="Draw the plots of report.md (needs matplotlib).")] = True,
+) -> None:
+    """Compare T-norms, S-norms, inference methods and planners over worlds and seeded runs.
+
+    Prints the table and the ranking; writes DIR/results.csv (one row per run, as it
+    finishes), DIR/report.md and its plots.
+    """
+    from ..study import Study, make_choices, run_study, write_report
+    from ..study.executors import EXECUTORS
+    from ..study.spec import split_list
+
+    if executor not in EXECUTORS:
+        raise typer.BadParameter(f"`{executor}` is not an executor; use local or dask",
+                                 param_hint="--executor")
+    if scheduler and executor != "dask":
+        raise typer.BadParameter("--scheduler needs --executor dask", param_hint="--scheduler")
+    planners = split_list(planner)
+    if not planners:
+        raise typer.BadParameter("name at least one planner", param_hint="--planner")
+    choices = make_choices(planners, split_list(and_), split_list(or_), split_list(inference))
+    paths = check_inputs(worlds, choices, rulebase, behavior)
+    study = Study(paths, choices, runs, seed, rulebase, behavior,
+                  command="mitos compare " + " ".join(shlex.quote(a) for a in sys.argv[1:]
+                                                      if a != "compare"))
+    outcome = run_with_progress(study, out, executor, workers, scheduler, resume)
+
+    from rich.console import Console
+
+    from ..study.report import overlap_note, rich_tables
+
+    console = Console(highlight=False, soft_wrap=False)
+    if not console.is_terminal:            # a file or a pipe: never cut the data short
+        console = Console(highlight=False, soft_wrap=False, width=160)
+    table, ranking = rich_tables(outcome.summaries, outcome.ranks)
+    console.print(table)
+    console.print(ranking)
+    note = overlap_note(outcome.ranks)
+    if note:
+        console.print(note, markup=False)
+    try:
+        report = write_report(outcome, out, plots=plots)
+    except ImportError:
+        warn("matplotlib is not installed: report.md has no plots "
+             "(pip install 'mitos[plot]')")
+        report = write_report(outcome, out, plots=False)
+    err(f"{outcome.executed} runs now, {outcome.skipped} from before; "
+        f"wrote {report.parent / 'results.csv'} and {report}")
+
+
+def check_inputs(worlds: list[str], choices, rulebase: str | None,
+                 behavior: str | None) -> list[str]:
+    """Read every world and compile every choice once here, so a mistake is reported before
+    any worker starts. Returns the world paths as the workers will open them."""
+    from ..sim.worldfile import load_world, resolve_world_path
+    from ..study.simtask import StudyContext, check_choice
+
+    paths = []
+    for name in worlds:
+        path = str(resolve_world_path(name))
+        load_world(path)
+        if path in paths:
+            raise typer.BadParameter(f"the world `{name}` is given twice")
+        paths.append(path)
+    context = StudyContext(rulebase, behavior)
+    for path in paths:
+        for choice in choices:
+            check_choice(choice, context, path)
+    return paths
+
+
+def run_with_progress(study, out, executor, workers, scheduler, resume):
+    """Run the study with a progress bar on stderr."""
+    from rich.console import Console
+    from rich.progress import (BarColumn, MofNCompleteColumn, Progress, TextColumn,
+                               TimeElapsedColumn, TimeRemainingColumn)
+
+    from ..study import run_study
+
+    console = Console(stderr=True)
+    with Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
+                  TimeElapsedColumn(), TimeRemainingColumn(), console=console,
+                  transient=True, disable=not console.is_terminal) as progress:
+        bar = progress.add_task(f"runs ({executor})", total=None)
+
+        def on_start(skipped: int, total: int) -> None:
+            progress.update(bar, total=total, completed=skipped)
+            if skipped:
+                console.print(f"resuming: {skipped} of {total} runs already in {out}",
+                              markup=False, highlight=False)
+
+        def on_result(task, row) -> None:
+            progress.advance(bar)
+
+        return run_study(study, out, executor=executor, workers=workers, scheduler=scheduler,
+                         resume=resume, on_start=on_start, on_result=on_result)
