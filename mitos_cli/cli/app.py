@@ -11,7 +11,7 @@ import sys
 import typer
 
 from ..errors import MitosError
-from . import check_cmd, convert_cmd, eval_cmd, export_cmd, operators_cmd, plot_cmd, teach_cmd
+from . import check_cmd, compare_cmd, convert_cmd, eval_cmd, export_cmd, operators_cmd, plot_cmd, teach_cmd
 
 app = typer.Typer(
     name="mitos",
@@ -38,6 +38,7 @@ app.command("export")(export_cmd.export_command)
 app.command("operators")(operators_cmd.operators_command)
 app.command("check")(check_cmd.check_command)
 app.command("teach")(teach_cmd.teach_command)
+app.command("compare")(compare_cmd.compare_command)
 app.add_typer(plot_cmd.plot_app, name="plot")
 
 
