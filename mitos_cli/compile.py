@@ -161,6 +161,49 @@ class Plan:
     weight: np.ndarray | None          # [R, 1] rule weights, None when all are 1
     sums: np.ndarray                   # [k, R, 1] output-layer weights (numerators, dens)
     den_row: np.ndarray                # [m] row of ``sums`` with each output's denominator
+    grids: dict                        # (level, group) -> Grid, for AND groups that are grids
+
+
+@dataclass(frozen=True)
+class Grid:
+    """An AND group whose neurons are every combination of some variables' terms, in
+    mixed-radix order (the paper's 27 rules): computed by broadcasting ``min`` over one
+    membership vector per variable instead of gathering each neuron's inputs."""
+
+    axes: tuple[np.ndarray, ...]       # membership columns per variable, outermost first
+    out: slice                         # the group's output columns (contiguous)
+    shape: tuple[int, ...]
+
+
+def _grid(group: NodeGroup, c: "CompiledRuleBase") -> Grid | None:
+    """The group as a :class:`Grid`, or ``None`` when it is not one."""
+    T = c.n_terms
+    ch = group.children
+    if group.op != "and" or not ((ch >= 2) & (ch < 2 + T)).all():
+        return None
+    out = group.out
+    if not (np.diff(out) == 1).all():
+        return None
+    var_of = c.term_var[ch - 2]                            # [g, arity]
+    if (np.sort(var_of, axis=1) != np.sort(var_of[:1], axis=1)).any():
+        return None
+    if len(set(var_of[0].tolist())) != ch.shape[1]:
+        return None
+    per_var = {int(v): ch[np.arange(len(ch)), np.argmax(var_of == v, axis=1)]
+               for v in var_of[0]}                          # var -> [g] its column per neuron
+    changes = {v: int((np.diff(cols) != 0).sum()) for v, cols in per_var.items()}
+    order = sorted(per_var, key=lambda v: changes[v])      # outermost changes least
+    axes = [np.array(list(dict.fromkeys(per_var[v].tolist())), dtype=np.intp) for v in order]
+    shape = tuple(len(a) for a in axes)
+    if int(np.prod(shape)) != len(out):
+        return None
+    index = np.zeros(len(out), dtype=np.intp)
+    for v, a in zip(order, axes):
+        pos = {int(col): i for i, col in enumerate(a)}
+        index = index * len(a) + np.array([pos[int(col)] for col in per_var[v]])
+    if not (index == np.arange(len(out))).all():
+        return None
+    return Grid(tuple(axes), slice(int(out[0]), int(out[-1]) + 1), shape)
 
 
 def _plan(c: "CompiledRuleBase") -> Plan:
@@ -177,7 +220,10 @@ def _plan(c: "CompiledRuleBase") -> Plan:
         rules=slice(r0, r0 + c.n_rules) if contiguous else c.rule_col,
         contexts=tuple(np.ascontiguousarray(c.context[:, j]) for j in range(c.context.shape[1])),
         weight=c.weight[:, None].copy() if c.weighted else None,
-        sums=np.ascontiguousarray(c.sum_weights[:, :, None]), den_row=c.den_row)
+        sums=np.ascontiguousarray(c.sum_weights[:, :, None]), den_row=c.den_row,
+        grids={} if c.operators.and_ != "min" else {
+            (i, j): grid for i, level in enumerate(c.levels) for j, group in enumerate(level)
+            if (grid := _grid(group, c)) is not None})
 
 
 class _Builder:

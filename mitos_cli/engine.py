@@ -171,10 +171,26 @@ def network_values(compiled: CompiledRuleBase, Xt: np.ndarray) -> np.ndarray:
     memberships(compiled, Xt, V)
     if compiled.levels:
         tnorm, snorm = compiled.operators.tnorm, compiled.operators.snorm
-        for level in compiled.levels:
-            for group in level:
-                _apply_group(group, V, tnorm, snorm)
+        grids = compiled.plan.grids
+        for i, level in enumerate(compiled.levels):
+            for j, group in enumerate(level):
+                grid = grids.get((i, j))
+                if grid is not None:
+                    _apply_grid(grid, V)
+                else:
+                    _apply_group(group, V, tnorm, snorm)
     return V
+
+
+def _apply_grid(grid, V: np.ndarray) -> None:
+    """AND neurons over every combination of terms: ``min`` broadcast over one membership
+    vector per variable (``t1 + t1 t2 + ...`` minima instead of gathers)."""
+    b = V.shape[1]
+    acc = V[grid.axes[0]]
+    for depth, axis in enumerate(grid.axes[1:], start=1):
+        last = depth == len(grid.axes) - 1
+        target = V[grid.out].reshape(grid.shape + (b,)) if last else None
+        acc = np.minimum(acc[..., None, :], V[axis], out=target)
 
 
 _CONSTANTS = np.array([[0.0], [1.0]])   # columns ZERO and ONE
