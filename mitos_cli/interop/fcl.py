@@ -70,7 +70,8 @@ def read_fcl(path: str | Path) -> RuleBase:
 
 def _syntax_error(exc: UnexpectedInput, text: str, path: str | None) -> FormatError:
     line, column = getattr(exc, "line", 1) or 1, getattr(exc, "column", 1) or 1
-    if isinstance(exc, UnexpectedEOF):
+    if isinstance(exc, UnexpectedEOF) or (isinstance(exc, UnexpectedToken)
+                                          and exc.token.type == "$END"):
         lines = text.splitlines() or [""]
         line, column = len(lines), len(lines[-1]) + 1
         what = "unexpected end of file"

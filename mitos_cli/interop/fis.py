@@ -74,7 +74,13 @@ def _sections(text: str, path: str | None):
         span = Span.in_text(text, path, lineno, len(raw) - len(raw.lstrip()) + 1,
                             len(raw.rstrip()) + 1)
         if line.startswith("[") and line.endswith("]"):
-            sections.append((line[1:-1].strip(), span, []))
+            name = line[1:-1].strip()
+            if name not in ("System", "Rules") and not re.fullmatch(r"(Input|Output)\d+", name):
+                raise FormatError(f"unknown section [{name}]", span=span,
+                                  expected="[System], [InputN], [OutputN] or [Rules]",
+                                  hint=did_you_mean(name, ("System", "Rules", "Input1",
+                                                           "Output1")))
+            sections.append((name, span, []))
             continue
         if not sections:
             raise FormatError("expected a section header such as `[System]`", span=span)
@@ -149,11 +155,6 @@ def parse_fis(text: str, path: str | None = None) -> RuleBase:
     inputs = _variables(sections, "Input", "input", kind)
     n_inputs = len(inputs)
     outputs = _variables(sections, "Output", "output", kind, n_inputs)
-    for name, _, _ in sections:
-        if name not in ("System", "Rules") and not re.fullmatch(r"(Input|Output)\d+", name):
-            raise FormatError(f"unknown section [{name}]",
-                              span=next(s for n, s, _ in sections if n == name),
-                              expected="[System], [InputN], [OutputN] or [Rules]")
     _check_count(system, "NumInputs", len(inputs), sys_span)
     _check_count(system, "NumOutputs", len(outputs), sys_span)
     variables = inputs + outputs

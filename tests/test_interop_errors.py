@@ -1,0 +1,373 @@
+"""Every refusal and error of the readers and writers, met once: message, line and column.
+
+Each case is a small file (built from a valid one by replacing a line) and the words the error
+must contain; the error must be a FormatError (or the build's own error for names) pointing at
+the right line.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from mitos_cli.errors import FormatError, MitosError
+from mitos_cli.interop import read_foreign, write_foreign
+from mitos_cli.interop.fcl import parse_fcl
+from mitos_cli.interop.fis import parse_fis
+from mitos_cli.interop.fll import parse_fll
+
+FLL = """\
+Engine: test
+InputVariable: a
+  enabled: true
+  range: 0 10
+  lock-range: false
+  term: low Triangle 0 2 5
+  term: high Triangle 5 8 10
+InputVariable: b
+  range: 0 1
+  term: small Ramp 1 0
+  term: big Ramp 0 1
+OutputVariable: y
+  range: 0 1
+  aggregation: Maximum
+  defuzzifier: Centroid 200
+  default: nan
+  lock-previous: false
+  term: off Triangle 0 0.25 0.5
+  term: on Triangle 0.5 0.75 1
+RuleBlock: main
+  conjunction: Minimum
+  disjunction: Maximum
+  implication: Minimum
+  activation: General
+  rule: if a is low and b is small then y is off
+  rule: if a is high or b is big then y is on with 0.5
+"""
+
+SUGENO = FLL.replace("  aggregation: Maximum\n", "  aggregation: none\n").replace(
+    "defuzzifier: Centroid 200", "defuzzifier: WeightedAverage TakagiSugeno").replace(
+    "term: off Triangle 0 0.25 0.5", "term: off Constant 0.2").replace(
+    "term: on Triangle 0.5 0.75 1", "term: on Linear 0.01 0.5 0.1").replace(
+    "implication: Minimum", "implication: none")
+
+
+def fll(old: str, new: str, base: str = FLL) -> str:
+    assert old in base, old
+    return base.replace(old, new, 1)
+
+
+def line_of(text: str, needle: str) -> int:
+    return next(i for i, line in enumerate(text.splitlines(), 1) if needle in line)
+
+
+FLL_CASES = [
+    ("term: low Triangle 0 2 5", "term low Triangle", "expected `key: value`"),
+    ("InputVariable: b", "InputVariable:", "InputVariable needs a name"),
+    ("Engine: test", "description: x\nEngine: test", "`description` before any section"),
+    ("  lock-range: false", "  lock-rnage: false", "unknown InputVariable key `lock-rnage`"),
+    ("  enabled: true", "  enabled: false", "MITOS has no disabled"),
+    ("  range: 0 10", "  range: 0", "`range` takes two numbers"),
+    ("  range: 0 10", "  range: 10 0", "range [10, 0] is empty"),
+    ("  range: 0 10", "  range: 0 ten", "expected a number, not `ten`"),
+    ("term: low Triangle 0 2 5", "term: low", "`term` takes a name, a type"),
+    ("  lock-previous: false", "  lock-previous: true", "needs state between evaluations"),
+    ("defuzzifier: Centroid 200", "defuzzifier:", "`defuzzifier` needs a name"),
+    ("defuzzifier: Centroid 200", "defuzzifier: Centroid 2.5", "resolution must be a whole"),
+    ("defuzzifier: Centroid 200", "defuzzifier: Centriod", "unknown defuzzifier `Centriod`"),
+    ("aggregation: Maximum", "aggregation: NormalizedSum", "normalized sum is not an S-norm"),
+    ("conjunction: Minimum", "conjunction: Minimun", "unknown conjunction `Minimun`"),
+    ("activation: General", "activation: Highest 2", "activation `Highest 2` is not supported"),
+    ("implication: Minimum", "implication: EinsteinProduct", "implication `einstein` is not"),
+    ("  range: 0 1\n  term: small", "  term: small", "variable `b` has no `range`"),
+    ("term: low Triangle 0 2 5", "term: low Linear 1 2 3", "Linear terms belong to outputs"),
+    ("term: low Triangle 0 2 5", "term: low Function x*x", "`Function` terms (a free formula)"),
+    ("term: low Triangle 0 2 5", "term: low Triangel 0 2 5", "unknown term type `Triangel`"),
+    ("term: low Triangle 0 2 5", "term: low Triangle 0 2", "Triangle takes 3 numbers, not 2"),
+    ("term: low Triangle 0 2 5", "term: low Triangle 0 2 5 0.5", "a term height (0.5)"),
+    ("term: low Triangle 0 2 5", "term: low Triangle 5 2 0", "points must be in order"),
+    ("term: high Triangle 5 8 10", "term: low Triangle 5 8 10", "duplicate term `low`"),
+    ("rule: if a is low and b", "rule: if a low and b", "cannot read this rule"),
+    ("conjunction: Minimum", "conjunction: none", "uses `and` but its rule block's conjunction"),
+    ("disjunction: Maximum", "disjunction: none", "uses `or` but its rule block's disjunction"),
+    ("rule: if a is low and b is small", "rule: if a is low and b is tiny",
+     "unknown term of `b` `tiny`"),
+    ("then y is off", "then a is off", "`a` is an input variable and cannot appear in an action"),
+    ("if a is low and b is small then", "if a is very not low and b is small then",
+     "`not` after a hedge"),
+    ("then y is off", "then y is not off", "`not` in a consequent"),
+    ("if a is low and b is small then", "if a is very and b is small then", "names no term"),
+    ("InputVariable: b\n  range: 0 1\n  term: small Ramp 1 0\n  term: big Ramp 0 1\n",
+     "InputVariable: b\n  range: 0 1\n  term: small Ramp 1 0\n  term: big Ramp 0 1\n"
+     "InputVariable: b\n  range: 0 1\n  term: x Ramp 0 1\n", "variable `b` is defined twice"),
+    ("  rule: if a is low and b is small then y is off\n"
+     "  rule: if a is high or b is big then y is on with 0.5\n", "", "the file has no rules"),
+    ("OutputVariable: y\n  range: 0 1\n  aggregation: Maximum\n  defuzzifier: Centroid 200\n"
+     "  default: nan\n  lock-previous: false\n  term: off Triangle 0 0.25 0.5\n"
+     "  term: on Triangle 0.5 0.75 1\n",
+     "OutputVariable: y\n  range: 0 1\n  defuzzifier: Centroid\n", "output variable `y` has no "
+     "terms"),
+    ("term: off Triangle 0 0.25 0.5", "term: off Linear 0 0 1", "linear terms need a weighted"),
+    ("defuzzifier: Centroid 200", "defuzzifier: WeightedAverage",
+     "is Tsukamoto inference, which MITOS does not support"),
+    ("defuzzifier: Centroid 200", "defuzzifier: WeightedAverage Tsukamoto",
+     "Tsukamoto inference is not supported"),
+    ("defuzzifier: Centroid 200", "defuzzifier: WeightedAverage Magic",
+     "unknown weighted defuzzifier type `Magic`"),
+]
+
+
+@pytest.mark.parametrize("old, new, words", FLL_CASES, ids=[c[2][:40] for c in FLL_CASES])
+def test_fll_errors(old: str, new: str, words: str) -> None:
+    text = fll(old, new)
+    with pytest.raises(MitosError) as info:
+        parse_fll(text, "bad.fll")
+    assert words in info.value.message, info.value.render()
+    span = info.value.span
+    assert span is not None and span.path == "bad.fll" and span.line >= 1
+
+
+def test_fll_error_points_at_the_line() -> None:
+    text = fll("term: low Triangle 0 2 5", "term: low Triangle 0 2 5 0.5")
+    with pytest.raises(FormatError) as info:
+        parse_fll(text, "bad.fll")
+    assert info.value.span.line == line_of(text, "0 2 5 0.5")
+    assert "bad.fll:6:" in info.value.render() and "^" in info.value.render()
+
+
+SUGENO_CASES = [
+    ("  aggregation: none", "  aggregation: Maximum\n  lock-range: true",
+     "`lock-range: true` on the Takagi-Sugeno output"),
+    ("  aggregation: none\n", "  aggregation: Maximum\n", "is concluded by several rules while"),
+    ("then y is off", "then y is very off", "hedges on a Takagi-Sugeno consequent"),
+    ("term: on Linear 0.01 0.5 0.1", "term: on Linear 0.5 0.1", "Linear takes one coefficient"),
+    ("defuzzifier: WeightedAverage TakagiSugeno", "defuzzifier: Centroid",
+     "linear terms need a weighted-average"),
+]
+
+
+@pytest.mark.parametrize("old, new, words", SUGENO_CASES, ids=[c[2][:40] for c in SUGENO_CASES])
+def test_fll_sugeno_errors(old: str, new: str, words: str) -> None:
+    base = SUGENO.replace("then y is on with 0.5", "then y is off") if "several" in words \
+        else SUGENO
+    with pytest.raises(FormatError) as info:
+        parse_fll(fll(old, new, base), "bad.fll")
+    assert words in info.value.message, info.value.render()
+
+
+def test_fll_conflicting_outputs() -> None:
+    text = FLL + SUGENO[SUGENO.index("OutputVariable"):SUGENO.index("RuleBlock")].replace(
+        "OutputVariable: y", "OutputVariable: z")
+    text = text.replace("RuleBlock: main", "RuleBlock: main", 1)
+    with pytest.raises(FormatError) as info:
+        parse_fll(text, "bad.fll")
+    assert "differs from `centroid` set at bad.fll:15" in info.value.message
+
+
+FIS = (Path(__file__).parent / "data" / "interop" / "tipper.fis").read_text()
+
+FIS_CASES = [
+    ("[System]", "System", "expected a section header"),
+    ("Name='tipper'", "Name", "expected `Key=value`"),
+    ("Version=2.0", "Versoin=2.0", "unknown [System] key `Versoin`"),
+    ("Type='mamdani'", "Type='tsk'", "FIS type `tsk` is not supported"),
+    ("Type='mamdani'", "Type=mamdani", "expected a quoted text"),
+    ("DefuzzMethod='centroid'", "DefuzzMethod='wtaver'", "does not fit a mamdani system"),
+    ("AndMethod='min'", "AndMethod='bounded'", "unknown AND method `bounded`"),
+    ("AggMethod='max'", "AggMethod='sum'", "MATLAB's `sum` aggregation"),
+    ("[Input2]", "[Input3]", "expected [Input2], found [Input3]"),
+    ("[Rules]", "[Ruels]", "unknown section [Ruels]"),
+    ("NumInputs=2", "NumInputs=3", "NumInputs=3 but the file has 2"),
+    ("NumRules=3", "NumRules=4", "NumRules=4 but the file has 3"),
+    ("NumMFs=2", "NumMfs=2", "unknown key `NumMfs`"),
+    ("Name='food'\n", "", "a variable needs `Name` and `Range`"),
+    ("Range=[0 30]", "Range=[30 0]", "`Range` must be [min max]"),
+    ("Range=[0 30]", "Range=0 30", "expected numbers in brackets"),
+    ("NumMFs=2", "NumMFs=5", "NumMFs=5 but the variable has 2"),
+    ("MF1='rancid':'trapmf',[0 0 1 3]", "MF1='rancid' 'trapmf' [0 0 1 3]",
+     "expected 'name':'type',[params]"),
+    ("MF1='rancid':'trapmf',[0 0 1 3]", "MF1='rancid':'trapezoid',[0 0 1 3]",
+     "membership function type `trapezoid` is not supported"),
+    ("MF1='rancid':'trapmf',[0 0 1 3]", "MF1='rancid':'trapmf',[0 0 1]",
+     "trapmf takes 4 numbers, not 3"),
+    ("MF1='rancid':'trapmf',[0 0 1 3]", "MF1='rancid':'linear',[0 0 1]",
+     "`linear` belongs to Sugeno outputs"),
+    ("MF1='rancid':'trapmf',[0 0 1 3]", "MF1='rancid':'trapmf',[0 0 1 x]", "expected a number"),
+    ("1 1, 1 (1) : 2", "1 1 1 (1) : 2", "expected a rule"),
+    ("1 1, 1 (1) : 2", "1 1 1, 1 (1) : 2", "the rule lists 3 inputs and 1 outputs"),
+    ("1 1, 1 (1) : 2", "1 1, 1 (1) : 3", "connection 3: expected 1 (AND) or 2 (OR)"),
+    ("1 1, 1 (1) : 2", "1.2 1, 1 (1) : 2", "fractional indices (hedges) are not supported"),
+    ("1 1, 1 (1) : 2", "4 1, 1 (1) : 2", "`service` has 3 MFs, not 4"),
+    ("1 1, 1 (1) : 2", "1 1, -1 (1) : 2", "negative (complemented)"),
+    ("1 1, 1 (1) : 2", "1 1, 4 (1) : 2", "`tip` has 3 MFs, not 4"),
+    ("1 1, 1 (1) : 2", "0 0, 1 (1) : 2", "the rule has no condition"),
+    ("1 1, 1 (1) : 2", "1 1, 0 (1) : 2", "the rule has no consequent"),
+]
+
+
+@pytest.mark.parametrize("old, new, words", FIS_CASES, ids=[c[2][:40] for c in FIS_CASES])
+def test_fis_errors(old: str, new: str, words: str) -> None:
+    assert old in FIS
+    text = FIS.replace(old, new, 1)
+    with pytest.raises(FormatError) as info:
+        parse_fis(text, "bad.fis")
+    assert words in info.value.message, info.value.render()
+    assert info.value.span is not None and info.value.span.path == "bad.fis"
+
+
+def test_fis_sugeno_linear_count_and_missing_system() -> None:
+    sugeno = FIS.replace("Type='mamdani'", "Type='sugeno'").replace(
+        "DefuzzMethod='centroid'", "DefuzzMethod='wtaver'").replace(
+        "MF1='cheap':'trimf',[0 5 10]", "MF1='cheap':'linear',[1 2]")
+    with pytest.raises(FormatError, match=r"linear takes 3 numbers"):
+        parse_fis(sugeno, "bad.fis")
+    with pytest.raises(FormatError, match=r"no \[System\] section"):
+        parse_fis(FIS[FIS.index("[Input1]"):], "bad.fis")
+    with pytest.raises(FormatError, match="output `tip` has no membership functions"):
+        parse_fis(FIS.replace("NumMFs=3\nMF1='cheap':'trimf',[0 5 10]\nMF2='average':'trimf',"
+                              "[10 15 20]\nMF3='generous':'trimf',[20 25 30]\n", ""), "bad.fis")
+
+
+FCL = (Path(__file__).parent / "data" / "interop" / "tipper_jfuzzylogic.fcl").read_text()
+
+FCL_CASES = [
+    ("END_FUNCTION_BLOCK", "END_FUNCTION_BLOCK\nFUNCTION_BLOCK two\nEND_FUNCTION_BLOCK",
+     "the file has 2 function blocks"),
+    ("END_FUNCTION_BLOCK", "", "unexpected end of file"),
+    ("METHOD : COG;", "METHOD : COG", "unexpected `DEFAULT`"),
+    ("TERM poor := (0, 1) (4, 0) ;", "TERM poor := (0, 1) (4, 0) $;", "unexpected character `$`"),
+    ("	food : REAL;", "	food : REAL;\n	food : REAL;", "variable `food` is declared twice"),
+    ("	food : REAL;", "	food : BOOL;", "type `BOOL` is not supported"),
+    ("FUZZIFY food", "FUZZIFY foood", "`foood` is not declared"),
+    ("DEFUZZIFY tip", "DEFUZZIFY food", "`food` is declared as an input but has a DEFUZZIFY"),
+    ("	tip : REAL;", "	tip : REAL;\n	tap : REAL;", "`tap` is declared but has no DEFUZZIFY"),
+    ("TERM rancid := (0, 1) (1, 1) (3,0) ;", "TERM rancid := (0, 1) (1, 1) (3,0) ;\n"
+     "	METHOD : COG;", "`METHOD` has no meaning in FUZZIFY"),
+    ("DEFAULT := 0;", "DEFAULT := 0 | NC;", "`| NC` (no change"),
+    ("DEFAULT := 0;", "DEFAULT := 0 | XX;", "unknown DEFAULT flag `XX`"),
+    ("DEFAULT := 0;", "DEFAULT := zero;", "DEFAULT must be a number, not `zero`"),
+    ("DEFAULT := 0;", "DEFAULT := 0;\n	LOCK : PREVIOUS;", "`LOCK : PREVIOUS`"),
+    ("DEFAULT := 0;", "DEFAULT := 0;\n	LOCK : FOREVER;", "unknown LOCK `FOREVER`"),
+    ("	TERM rancid := (0, 1) (1, 1) (3,0) ;\n	TERM delicious := (7,0) (9,1);\n", "",
+     "variable `food` has no terms"),
+    ("TERM rancid := (0, 1) (1, 1) (3,0) ;", "TERM rancid := gauss 0 1;",
+     "has no RANGE and its `rancid` term (gaussian)"),
+    ("	TERM rancid := (0, 1) (1, 1) (3,0) ;\n	TERM delicious := (7,0) (9,1);\n",
+     "	TERM rancid := 3;\n", "its terms do not span one"),
+    ("RANGE := (0 .. 30);", "RANGE := (30 .. 0);", "range [30, 0] is empty"),
+    ("TERM rancid := (0, 1) (1, 1) (3,0) ;", "TERM rancid := (0, 1) (3, 1) (1,0) ;",
+     "the points' x values must ascend"),
+    ("TERM rancid := (0, 1) (1, 1) (3,0) ;", "TERM rancid := (0, 1);",
+     "a point list needs at least two points"),
+    ("TERM cheap := trian 0 5 10;", "TERM cheap := train 0 5 10;",
+     "unknown membership function `train`"),
+    ("TERM cheap := trian 0 5 10;", "TERM cheap := trian 0 5;", "trian takes 3 numbers, not 2"),
+    ("TERM cheap := trian 0 5 10;", "TERM cheap := Triangle 0 5 10 0.5;", "a term height (0.5)"),
+    ("TERM rancid := (0, 1) (1, 1) (3,0) ;", "TERM rancid := Linear 1 2 3;",
+     "Linear terms belong to outputs"),
+    ("ACT : MIN;", "ACTIVATION : Highest;", "activation `Highest` is not supported"),
+    ("METHOD : COG;", "METHOD : COG 2.5;", "resolution must be a whole number"),
+    ("METHOD : COG;", "METHOD : CENTER;", "unknown METHOD `CENTER`"),
+    ("ACCU : MAX;", "ACCU : NSUM;", "normalized sum is not an S-norm"),
+    ("ACT : MIN;", "ACT : DPROD;", "implication `drastic` is not supported"),
+    ("RULE 2 : IF service IS good", "RULE 2 : IF service IS goood", "unknown term of `service`"),
+]
+
+
+@pytest.mark.parametrize("old, new, words", FCL_CASES, ids=[c[2][:40] for c in FCL_CASES])
+def test_fcl_errors(old: str, new: str, words: str) -> None:
+    assert old in FCL, old
+    text = FCL.replace(old, new, 1)
+    with pytest.raises(MitosError) as info:
+        parse_fcl(text, "bad.fcl")
+    assert words in info.value.message, info.value.render()
+    span = info.value.span
+    assert span is not None and span.path == "bad.fcl" and span.line >= 1
+
+
+def test_fcl_sugeno_lock_range() -> None:
+    text = (Path(__file__).parent / "data" / "interop" / "dimmer_fuzzylite.fcl").read_text()
+    text = text.replace("TERM LOW := Gaussian 0.000 0.200;", "TERM LOW := 0.1;").replace(
+        "TERM MEDIUM := Bell 0.500 0.250 3.000;", "TERM MEDIUM := 0.5;").replace(
+        "TERM HIGH := Sigmoid 0.750 20.000;", "TERM HIGH := 0.9;").replace(
+        "METHOD : COG;", "METHOD : COGS;\nLOCK : RANGE;").replace("ACCU : MAX;\n", "")
+    text = text.replace("then Power is LOW with 0.5", "then Power is LOW")
+    with pytest.raises(FormatError, match="`LOCK : RANGE` on the Takagi-Sugeno output"):
+        parse_fcl(text, "bad.fcl")
+    ok = parse_fcl(text.replace("LOCK : RANGE;\n", ""), "ok.fcl")
+    assert [s.value for s in ok.operators if s.key == "inference"] == ["weighted_average"]
+
+
+# ---------------------------------------------------------------------------------------------
+# Writers and dispatch
+
+
+def test_unknown_extension_and_missing_file(tmp_path: Path) -> None:
+    with pytest.raises(FormatError, match="unknown format `.xml`"):
+        read_foreign(tmp_path / "x.xml")
+    with pytest.raises(FormatError, match="not found"):
+        read_foreign(tmp_path / "x.fll")
+    with pytest.raises(FormatError, match="unknown format `yaml`"):
+        write_foreign(parse_fll(FLL), "yaml")
+
+
+def test_fis_writer_refusals() -> None:
+    nested = parse_fll(fll("rule: if a is low and b is small then y is off",
+                           "rule: if a is low and (b is small or a is high) then y is off"))
+    with pytest.raises(FormatError, match="nested expressions cannot be written to .fis"):
+        write_foreign(nested, "fis")
+    hedged = parse_fll(fll("if a is low and", "if a is very low and"))
+    with pytest.raises(FormatError, match="hedges cannot be written to .fis"):
+        write_foreign(hedged, "fis")
+    twice = parse_fll(fll("if a is low and b is small", "if a is low and a is high"))
+    with pytest.raises(FormatError, match="tests `a` twice"):
+        write_foreign(twice, "fis")
+    shapes = parse_fll(fll("term: low Triangle 0 2 5", "term: low Cosine 2 4"))
+    with pytest.raises(FormatError, match="MATLAB has no `cosine` membership function"):
+        write_foreign(shapes, "fis")
+    norm = parse_fll(fll("conjunction: Minimum", "conjunction: EinsteinProduct"))
+    with pytest.raises(FormatError, match="FIS has no AND method `einstein`"):
+        write_foreign(norm, "fis")
+
+
+def test_fuzzylite_writer_refusals(tmp_path: Path) -> None:
+    from mitos_cli.api import read_rulebase
+
+    (tmp_path / "t.terms.yaml").write_text(
+        "variables:\n  a: {role: input, universe: [0, 10], terms: {low: {shape: triangle, "
+        "points: [0, 2, 5]}, high: {shape: triangle, points: [5, 8, 10]}}}\n"
+        "  y: {role: output, universe: [0, 1], terms: {lo: 0.2, hi: 0.8}}\n")
+    (tmp_path / "t.rules").write_text(
+        'terms "t.terms.yaml"\noperators: and = product, or = max\n'
+        "r1: if not (a is low and a is high) then y is lo\n"
+        "r2: if a is extremely high then y is hi\n")
+    rb = read_rulebase(tmp_path / "t.rules")
+    with pytest.raises(FormatError, match="not De Morgan duals"):
+        write_foreign(rb, "fll")
+    (tmp_path / "t.rules").write_text('terms "t.terms.yaml"\n'
+                                      "r2: if a is extremely high then y is hi\n")
+    with pytest.raises(FormatError, match="fuzzylite has no hedge like MITOS's `extremely`"):
+        write_foreign(read_rulebase(tmp_path / "t.rules"), "fcl")
+    (tmp_path / "t.rules").write_text('terms "t.terms.yaml"\nbehavior inner:\n'
+                                      "  r1: if a is low then y is lo\nend\n"
+                                      "behavior outer:\n  use inner when a is high\nend\n")
+    with pytest.raises(FormatError, match="a conditional include cannot be written"):
+        write_foreign(read_rulebase(tmp_path / "t.rules"), "fll", "outer")
+
+
+def test_rules_writer_refusals() -> None:
+    from mitos_cli.interop.rules_writer import write_rules
+
+    reserved = parse_fll(FLL.replace("InputVariable: b", "InputVariable: end").replace(
+        "b is", "end is"))
+    with pytest.raises(FormatError, match="variable `end` is a reserved word"):
+        write_rules(reserved, "x.terms.yaml")
+    dotted = parse_fll(FLL.replace("term: low", "term: lo.w").replace("a is low", "a is lo.w"))
+    with pytest.raises(FormatError, match="has characters the rule language does not allow"):
+        write_rules(dotted, "x.terms.yaml")
+    bare = parse_fll(SUGENO.replace("  term: small Ramp 1 0\n  term: big Ramp 0 1\n", "")
+                     .replace("a is low and b is small", "a is low")
+                     .replace("a is high or b is big", "a is high"))
+    with pytest.raises(FormatError, match="input `b` has no terms"):
+        write_rules(bare, "x.terms.yaml")
