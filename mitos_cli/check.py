@@ -19,6 +19,7 @@ code                  severity    meaning
 ``contradiction``     warning     an antecedent that asks for ``x is A`` and ``x is not A``
 ``unreachable``       warning     a rule whose DOF is 0 at every sampled input
 ``term-gap``          warning     a stretch of an input's universe where all its terms are 0
+``term-outside``      warning     an input term that never reaches 1 inside the universe
 ``unused-term``       warning     an input term (or a whole input) that no rule uses
 ``unconcluded-term``  info        an output term that no rule concludes
 ====================  ==========  ==========================================================
@@ -310,7 +311,13 @@ def grid_axes(compiled: CompiledRuleBase, resolution: int,
             lo = mid
         else:
             hi = mid
-    return axes_for(lo)
+    axes = axes_for(lo)
+    if size(axes) > max_samples:             # many inputs: even the corners are too many;
+        per_axis = max(2, int(max_samples ** (1.0 / len(axes))))   # thin them evenly
+        axes = [a if len(a) <= per_axis else
+                a[np.unique(np.round(np.linspace(0, len(a) - 1, per_axis)).astype(int))]
+                for a in axes]
+    return axes
 
 
 def _sampled(compiled: CompiledRuleBase, threshold: float,
@@ -367,9 +374,12 @@ def _sampled(compiled: CompiledRuleBase, threshold: float,
                                tuple(boxes[:MAX_BOXES]), max(0, len(boxes) - MAX_BOXES), share,
                                uncovered))
 
-    # rules that never fire
+    # rules that never fire: only the behavior's own (a used behavior's rules are judged in
+    # their own behavior, on its own, finer grid; here a `when` condition may silence them)
     fires = (dof > 0.0).any(axis=0) if dof.shape[0] else np.zeros(compiled.n_rules, bool)
-    for r in np.flatnonzero(~fires):
+    own = np.array([not contexts for _, _, contexts in flatten(compiled.rulebase, name)],
+                   dtype=bool)
+    for r in np.flatnonzero(~fires & own):
         rule = compiled.rules[r]
         why = " (its weight is 0)" if rule.weight == 0 else ""
         out.append(Finding(
@@ -437,7 +447,15 @@ def _term_gaps(rb: RuleBase) -> list[Finding]:
         lo, hi = var.universe
         corners = [c for t in var.terms if t.corners for c in t.corners if lo <= c <= hi]
         x = np.unique(np.concatenate([np.linspace(lo, hi, GAP_RESOLUTION), corners]))
-        top = np.max([t.membership(x) for t in var.terms], axis=0)
+        mus = np.array([t.membership(x) for t in var.terms])
+        for term, mu in zip(var.terms, mus):
+            if mu.max() < 1.0:
+                out.append(Finding(
+                    "warning", "term-outside",
+                    f"input term `{var.name}.{term.name}` never reaches 1 inside the universe "
+                    f"[{_num(lo)}, {_num(hi)}] (at most {mu.max():.3g})", term.span, None,
+                    hint="move the term's peak into the universe, or widen the universe"))
+        top = mus.max(axis=0)
         gap = top <= 0.0
         for a, b in _runs(gap):
             left, right = float(x[a]), float(x[b - 1])

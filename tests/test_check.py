@@ -154,6 +154,17 @@ def test_term_gap_over_a_range(tmp_path):
     assert [g.message for g in gaps] == ["input `size`: every term is 0 for size in [20, 50]"]
 
 
+def test_term_peaking_outside_the_universe(tmp_path):
+    terms = TERMS.replace("HUGE:   {shape: right_shoulder, points: [140, 150]}",
+                          "HUGE:   {shape: triangle, peak: 170, width: 20}")
+    (tmp_path / "t.terms.yaml").write_text(terms, encoding="utf-8")
+    (tmp_path / "t.rules").write_text(RULES, encoding="utf-8")
+    (finding,) = by_code(check_rulebase(read_rulebase(tmp_path / "t.rules")), "term-outside")
+    assert finding.message == ("input term `road.HUGE` never reaches 1 inside the universe "
+                               "[0, 160] (at most 0.5)")
+    assert finding.span.line == 9 and finding.severity == "warning"
+
+
 def test_one_behavior_only(tmp_path):
     (tmp_path / "t.terms.yaml").write_text(TERMS, encoding="utf-8")
     (tmp_path / "t.rules").write_text(
@@ -165,6 +176,18 @@ def test_one_behavior_only(tmp_path):
     assert check_rulebase(rb, "full").ok
     report = check_rulebase(rb)
     assert not report.ok and {f.behavior for f in by_code(report, "no-rule-fires")} == {"part"}
+
+
+def test_used_rules_are_judged_in_their_own_behavior(tmp_path):
+    (tmp_path / "t.terms.yaml").write_text(TERMS, encoding="utf-8")
+    (tmp_path / "t.rules").write_text(
+        'terms "t.terms.yaml"\n'
+        "behavior wide:\n  w1: if road is WIDE then steering is RS\nend\n"
+        "behavior narrow:\n  n1: if road is NARROW then steering is LS\n"
+        "  use wide when road is NARROW\nend\n", encoding="utf-8")
+    report = check_rulebase(read_rulebase(tmp_path / "t.rules"), "narrow")
+    # `wide/w1` never fires inside `narrow` (NARROW and WIDE never overlap): not a rule defect
+    assert by_code(report, "unreachable") == []
 
 
 def test_canonical_antecedents():
@@ -197,6 +220,9 @@ def test_grid_includes_corners_and_stays_capped():
     assert {40.0, 70.0, 100.0} <= set(road) and road[0] == 0 and road[-1] == 160
     small = grid_axes(compiled, 10_000, max_samples=1000)
     assert 500 < np.prod([len(a) for a in small]) <= 1000
+    tiny = grid_axes(compiled, 41, max_samples=30)        # fewer than the corners alone
+    assert np.prod([len(a) for a in tiny]) <= 30
+    assert all(a[0] == u[0] and a[-1] == u[1] for a, u in zip(tiny, compiled.universe))
 
 
 # ---------------------------------------------------------------------------------------------

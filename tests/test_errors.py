@@ -213,8 +213,8 @@ def test_no_term_set(tmp_path):
     ("peak: 70, width: 30", "peak: 70, width: -3", "MEDIUM:", "width must be > 0, not -3"),
     ("points: [40, 70]", "points: [70, 40]", "NARROW:",
      "term `road.NARROW`: points must be in order, but a = 70 > b = 40"),
-    ("peak: 70, width: 30", "peak: 170, width: 30", "MEDIUM:",
-     "term `road.MEDIUM`: its peak 170 lies outside the universe [0, 160]"),
+    ("LB: 30", "LB: 10", "LB",
+     "term `steering.LB`: its peak 10 lies outside the universe [30, 150]"),
     ("      WIDE:   {shape: right_shoulder, points: [70, 100]}",
      "      WIDE:   {shape: right_shoulder, points: [70, 100]}\n"
      "      MEDIUM: {shape: triangle, peak: 70, width: 30}", "MEDIUM: {shape: triangle, peak: 70, width: 30}",
