@@ -17,8 +17,9 @@ Inputs (all floats, units in the names of ``mitos.terms.yaml`` / ``drive.terms.y
     ``cluster`` of the nearest one, each widened by half the beam spacing at its range (an
     ultrasonic beam cannot tell where in its cone the echo came from). 0 when nothing obstructs.
 ``position`` (x3, in)
-    lateral offset of that object's middle from the road centre (the route), positive to the
-    right. 0 when nothing obstructs.
+    lateral offset of that object's middle from the road centre, positive to the right,
+    measured across the route where the object stands (around a corner: across the next leg).
+    0 when nothing obstructs.
 ``obstacle`` (in)
     distance along the route from the robot's front to that object; ``NO_OBSTACLE`` (200, the
     far end of its universe) when nothing obstructs, so that ``obstacle is NEAR`` is 0 and the
@@ -36,7 +37,7 @@ Inputs (all floats, units in the names of ``mitos.terms.yaml`` / ``drive.terms.y
 ``wall_left``, ``wall_right`` (in)
     gap between the robot's side and the nearest wall hit on that side, among beams landing
     from ``wall_behind`` behind to ``wall_ahead`` ahead of the robot's centre along the route
-    (``range`` when none): what keeps the robot off the walls while it avoids an obstacle.
+    and beside it (at least half its width across; ``range`` when none): what keeps the robot off the walls while it avoids an obstacle.
 
 :func:`truth` computes the same quantities from the true geometry (noise-free walls, exact
 obstacle outlines) for the trace.
@@ -92,8 +93,8 @@ def _road(a, b, valid, window: float, far: float) -> tuple[float, float]:
     return (float(left.min()) if left.size else far), (float(right.min()) if right.size else far)
 
 
-def _obstruction(a, b, points, valid, widen, robot: Robot, f: Frame, cfg: Settings,
-                 rel_heading):
+def _obstruction(route: Route, a, b, points, valid, widen, robot: Robot, f: Frame,
+                 cfg: Settings, rel_heading):
     """(size, position, distance) of the nearest obstructing object among ``points``.
 
     ``rel_heading`` ``(ah, bh)``: the points in the robot's own frame (along and across its
@@ -109,10 +110,16 @@ def _obstruction(a, b, points, valid, widen, robot: Robot, f: Frame, cfg: Settin
         return 0.0, 0.0, NO_OBSTACLE
     i = int(np.argmin(np.where(blocking, a, np.inf)))
     near = ahead & (np.hypot(*(points - points[i]).T) <= cfg.cluster)
-    lo = float((b - widen)[near].min())
-    hi = float((b + widen)[near].max())
     distance = max(0.0, float(a[near].min()) - robot.length / 2)
-    return hi - lo, f.e + (lo + hi) / 2, distance
+    # size and position across the road where the object stands (around a corner that is
+    # the next leg of the route, not the robot's)
+    pts = points[near]
+    centre = pts.mean(axis=0)
+    s_o, e_o, t_o = route.project(centre, f.s, back=0.0, ahead=cfg.sight + cfg.cluster)
+    across = (pts - centre) @ np.array([t_o[1], -t_o[0]]) + e_o
+    lo = float((across - widen[near]).min())
+    hi = float((across + widen[near]).max())
+    return hi - lo, (lo + hi) / 2, distance
 
 
 def _own_frame(rel: np.ndarray, heading: float) -> tuple[np.ndarray, np.ndarray]:
@@ -123,10 +130,10 @@ def _own_frame(rel: np.ndarray, heading: float) -> tuple[np.ndarray, np.ndarray]
 
 
 def _walls(a, b, valid, robot: Robot, cfg: Settings, far: float) -> tuple[float, float]:
-    near = valid & (a >= -cfg.wall_behind) & (a <= cfg.wall_ahead)
+    half = robot.width / 2
+    near = valid & (a >= -cfg.wall_behind) & (a <= cfg.wall_ahead) & (np.abs(b) >= half)
     left = -b[near & (b < 0)]
     right = b[near & (b > 0)]
-    half = robot.width / 2
     return ((float(left.min()) - half) if left.size else far), \
            ((float(right.min()) - half) if right.size else far)
 
@@ -165,7 +172,7 @@ def perceive(route: Route, f: Frame, pose: tuple[float, float, float], robot: Ro
     left, right = _road(a, b, valid & ~obstacle_hit, cfg.window, max_range)
     road = left + right
     widen = measured * spacing / 2
-    size, position, distance = _obstruction(a, b, hits, obstacle_hit, widen, robot, f, cfg,
+    size, position, distance = _obstruction(route, a, b, hits, obstacle_hit, widen, robot, f, cfg,
                                             _own_frame(rel, pose[2]))
     heading, lane, goal = _common(route, p, pose[2], f, road, robot, cfg)
     wl, wr = _walls(a, b, valid & ~obstacle_hit, robot, cfg, max_range)
@@ -185,7 +192,7 @@ def truth(route: Route, f: Frame, pose: tuple[float, float, float], robot: Robot
     a = rel @ f.t if len(outline) else np.zeros(0)
     b = rel @ f.n if len(outline) else np.zeros(0)
     valid = np.ones(len(outline), dtype=bool)
-    size, position, distance = _obstruction(a, b, outline, valid, np.zeros(len(outline)),
+    size, position, distance = _obstruction(route, a, b, outline, valid, np.zeros(len(outline)),
                                             robot, f, cfg, _own_frame(rel, pose[2]))
     heading, lane, goal = _common(route, p, pose[2], f, road, robot, cfg)
     return {"road": road, "size": size, "position": position, "obstacle": distance,
