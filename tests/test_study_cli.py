@@ -1,0 +1,172 @@
+"""`mitos compare` end to end on a tiny world: table, CSV, report, executors, kill + --resume."""
+
+from __future__ import annotations
+
+import csv
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+from mitos_cli.cli.app import main
+from mitos_cli.study import Study, make_choices, run_study
+from mitos_cli.study.store import ResultStore
+
+ROOT = Path(__file__).resolve().parent.parent
+
+TINY = """\
+# a short corridor with one obstacle: a run takes about 120 ticks
+name: tiny
+seed: 1
+dt: 0.05
+time_limit: 15
+substeps: 2
+behavior: drive
+robot:
+  model: tricycle
+  wheelbase: 16
+  footprint: {length: 24, width: 18}
+  safety_margin: 2
+  steering: {min: 30, max: 150, straight: 90, max_rate: 180}
+  max_speed: 60
+  acceleration: 40
+sensors: {layout: ring, count: 24, cone: 15, range: 120, noise: 0.5}
+q_init: {x: 30, y: -10, heading: 0}
+q_goal: {x: 250, y: -10, tolerance: 12}
+map:
+  corridors:
+    - points: [[0, 0], [280, 0]]
+      width: 70
+obstacles:
+  - name: box
+    shape: circle
+    at: [150, -12]
+    radius: 9
+randomise:
+  obstacles:
+    box: {dx: [-30, 30], dy: [-10, 10]}
+  sensor_noise: [0, 1.5]
+"""
+
+
+@pytest.fixture(scope="module")
+def tiny(tmp_path_factory) -> str:
+    path = tmp_path_factory.mktemp("worlds") / "tiny.yaml"
+    path.write_text(TINY)
+    return str(path)
+
+
+class Ran:
+    def __init__(self, code: int, out: str, err: str) -> None:
+        self.exit_code, self.stdout, self.stderr = code, out, err
+        self.output = out + err
+
+
+@pytest.fixture
+def compare(capsys):
+    """``mitos compare ARGS`` in this process: exit code, stdout, stderr."""
+    def run(*args) -> Ran:
+        try:
+            main(["compare", *map(str, args)])
+            code = 0
+        except SystemExit as exc:
+            code = exc.code or 0
+        out, err = capsys.readouterr()
+        return Ran(code, out, err)
+    return run
+
+
+def read_rows(directory) -> list[dict]:
+    with open(Path(directory) / "results.csv", newline="") as fh:
+        return list(csv.DictReader(fh))
+
+
+def test_compare_writes_table_csv_and_report(tiny, tmp_path, compare):
+    out = tmp_path / "study"
+    r = compare(tiny, "--and", "min,product", "--runs", 2, "-o", out, "-j", 1)
+    assert r.exit_code == 0, r.output
+    assert "Outcomes per world and choice" in r.stdout and "Ranking" in r.stdout
+    for label in ("fuzzy and=min", "fuzzy and=product", "potential_field"):
+        assert label in r.output
+    rows = read_rows(out)
+    assert len(rows) == 6 and {row["outcome"] for row in rows} <= {
+        "success", "collision", "timeout", "stuck"}
+    report = (out / "report.md").read_text()
+    assert "Paired comparison" in report and "| fuzzy and=min |" in report
+    assert (out / "success.png").stat().st_size > 1000
+    assert (out / "clearance.png").stat().st_size > 1000
+    # paired: every choice drove run r with the same seed
+    seeds = {}
+    for row in rows:
+        seeds.setdefault(row["run"], set()).add(row["seed"])
+    assert all(len(s) == 1 for s in seeds.values())
+
+
+def test_real_simulator_pool_and_dask_equal_serial(tiny, tmp_path):
+    distributed = pytest.importorskip("distributed")
+    study = Study([tiny], make_choices(["fuzzy", "potential_field"], ["min", "einstein"], [],
+                                       []), runs=2, seed=5)
+    serial = run_study(study, tmp_path / "serial", workers=1)
+    pool = run_study(study, tmp_path / "pool", workers=2)
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                  dashboard_address=None) as cluster, \
+            distributed.Client(cluster) as client:
+        dask = run_study(study, tmp_path / "dask", executor="dask", client=client)
+    assert serial.rows == pool.rows == dask.rows and len(serial.rows) == 6
+
+
+def test_killed_sweep_resumes_without_recomputing(tiny, tmp_path):
+    out = tmp_path / "killed"
+    args = ["compare", tiny, "--and", "min,product", "--planner", "fuzzy", "--runs", "6",
+            "-j", "1", "-o", str(out), "--no-plots"]
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    proc = subprocess.Popen([sys.executable, "-m", "mitos_cli", *args], env=env,
+                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    results = out / "results.csv"
+    deadline = time.monotonic() + 60
+    try:
+        while time.monotonic() < deadline:
+            if results.exists() and results.read_text().count("\n") >= 4:   # header + 3 rows
+                break
+            time.sleep(0.02)
+    finally:
+        proc.send_signal(signal.SIGKILL)
+        proc.wait()
+    before = ResultStore(out).load()
+    assert 3 <= len(before) < 12, "the sweep should have been killed half-way"
+    r = subprocess.run([sys.executable, "-m", "mitos_cli", *args, "--resume"], env=env,
+                       capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0, r.stderr
+    assert f"resuming: {len(before)} of 12 runs already in" in r.stderr
+    assert f"{12 - len(before)} runs now, {len(before)} from before" in r.stderr
+    after = ResultStore(out).load()
+    keys = [(x["and"], x["run"]) for x in after]
+    assert len(after) == 12 and len(set(keys)) == 12          # nothing ran twice
+    assert after[:len(before)] == before                       # finished rows untouched
+
+
+def test_existing_results_need_resume(tiny, tmp_path, compare):
+    out = tmp_path / "s"
+    assert compare(tiny, "--and", "min", "--planner", "fuzzy", "--runs", 1, "-o", out, "-j", 1,
+                   "--no-plots").exit_code == 0
+    r = compare(tiny, "--and", "min", "--planner", "fuzzy", "--runs", 1, "-o", out, "-j", 1)
+    assert r.exit_code == 1 and "already holds 1 results" in r.stderr and "--resume" in r.stderr
+
+
+@pytest.mark.parametrize("args, code, words", [
+    (["worlds/corridr.yaml"], 1, "did you mean `corridor.yaml`"),
+    (["TINY", "--and", "einstien"], 1, "unknown T-norm `einstien`"),
+    (["TINY", "--planner", "potential"], 1, "did you mean `potential_field`"),
+    (["TINY", "--scheduler", "tcp://x:1"], 2, "--scheduler needs --executor dask"),
+    (["TINY", "--executor", "spark"], 2, "not an executor"),
+    (["TINY", "--behavior", "drve"], 1, "drive"),
+    (["TINY", "TINY"], 2, "given twice"),
+])
+def test_user_errors(tiny, tmp_path, compare, args, code, words):
+    r = compare(*[tiny if a == "TINY" else a for a in args], "-o", tmp_path / "e")
+    assert r.exit_code == code, r.output
+    assert words in r.output
+    assert not (tmp_path / "e" / "results.csv").exists()
