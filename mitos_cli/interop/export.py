@@ -425,16 +425,16 @@ def _c_defuzzify(method: str, res: int, j: int, fallback: str) -> list[str]:
                 "        }",
                 "        value = sum / count;",
                 "    }", *("    " + d for d in done), "}"]
-    return ["{", "    double top = 0.0, sum = 0.0, first = NAN, last = NAN, value = NAN;",
-            "    int count = 0;",
+    pick = {"mom": ["        double sum = 0.0;", "        int count = 0;",
+                    f"        for (i = 0; i < {res}; ++i) if (y[i] == top) {{ sum += grid[i]; "
+                    f"++count; }}", "        value = sum / count;"],
+            "som": [f"        for (i = 0; i < {res}; ++i) if (y[i] == top) {{ value = grid[i]; "
+                    f"break; }}"],
+            "lom": [f"        for (i = {res} - 1; i >= 0; --i) if (y[i] == top) {{ value = "
+                    f"grid[i]; break; }}"]}[method]
+    return ["{", "    double top = 0.0, value = NAN;",
             f"    for (i = 0; i < {res}; ++i) if (y[i] > top) top = y[i];",
-            "    if (top > 0.0) {",
-            f"        for (i = 0; i < {res}; ++i) if (y[i] == top) {{",
-            "            if (count == 0) first = grid[i];",
-            "            last = grid[i]; sum += grid[i]; ++count;",
-            "        }",
-            "        value = " + {"mom": "sum / count", "som": "first", "lom": "last"}[method] + ";",
-            "    }", *("    " + d for d in done), "}"]
+            "    if (top > 0.0) {", *pick, "    }", *("    " + d for d in done), "}"]
 
 
 # ---------------------------------------------------------------------------------------------
