@@ -72,6 +72,11 @@ class VariablePlot:
         return f"{self.name} [{self.unit}]" if self.unit else self.name
 
 
+def visible(mu: float) -> bool:
+    """Whether a membership is worth writing at two decimals (0.004 would print as 0.00)."""
+    return round(mu, 2) > 0
+
+
 def curve_grid(universe: tuple[float, float], terms: tuple[Term, ...] = (),
                points: int = CURVE_POINTS) -> np.ndarray:
     """``points`` samples of the universe plus every finite corner inside it, and the points

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .plotdata import RuleView, Surface, TermCurve, VariablePlot
+from .plotdata import RuleView, Surface, TermCurve, VariablePlot, visible
 
 BRAILLE = 0x2800
 #: dot (row, column) inside a cell -> bit of the Braille code point
@@ -188,7 +188,7 @@ def render_variable(plot: VariablePlot, width: int = 72, height: int = 6,
         marker[value_col // 2] = "▲"
         out.append(" " * margin + "".join(marker).rstrip())
         unit = f" {plot.unit}" if plot.unit else ""
-        shown = ", ".join(f"{t} {mu:.2f}" for t, mu in plot.memberships if mu > 0)
+        shown = ", ".join(f"{t} {mu:.2f}" for t, mu in plot.memberships if visible(mu))
         note = " (clamped to its universe)" if plot.clamped else ""
         line = f"{plot.name} = {plot.value:g}{unit}{note}"
         if plot.role == "input" or shown:
@@ -228,7 +228,7 @@ def render_rule_view(view: RuleView, width: int = 72, color: bool = False) -> st
     out = [f"behavior {view.behavior} ({view.n_rules} rules; {view.operators})", ""]
     for i in view.inputs:
         unit = f" {i.unit}" if i.unit else ""
-        mus = ", ".join(f"{t} {mu:.2f}" for t, mu in i.memberships if mu > 0)
+        mus = ", ".join(f"{t} {mu:.2f}" for t, mu in i.memberships if visible(mu))
         out.append(f"  {i.name} = {i.value:g}{unit}: {mus or 'no term holds it'}"
                    + (" (clamped to its universe)" if i.clamped else ""))
     out += ["", f"rules fired ({len(view.rows)} of {view.n_rules}):"]

@@ -47,7 +47,7 @@ def test_sheet_lines_are_the_memberships(mitos):
         if plot.value is not None:
             marker = lines[f"{plot.name} = {plot.value:g} {plot.unit}"]
             assert list(marker.get_xdata()) == [plot.value, plot.value]
-            shown = {f"{mu:.2f}" for _, mu in plot.memberships if mu > 0}
+            shown = {f"{mu:.2f}" for _, mu in plot.memberships if plotdata.visible(mu)}
             assert shown <= texts                                    # memberships written
         singletons = [c for c in plot.curves if c.kind == "singleton"]
         if singletons:                                               # outputs: stems
@@ -111,21 +111,53 @@ def test_masked_surface_says_so(tmp_path):
         "no rule fires (no default)"
 
 
+def by_gid(fig, gid):
+    return [a for ax in fig.axes for a in ax.get_children() if a.get_gid() == gid]
+
+
 def test_rule_viewer_has_a_row_per_fired_rule(mitos):
+    from mitos_cli.draw.rules import BAND
+
     view = plotdata.rule_view(mitos.compiled, SAMPLE)
     fig = draw_rules(view)
     ncols = len(view.inputs) + len(view.outputs)
-    assert len(fig.axes) == (len(view.rows) + 1) * ncols
+    assert len(fig.axes) == 2 * ncols                 # rule rows, then the aggregate row
     rows = [t.get_text() for ax in fig.axes for t in ax.texts if "DOF" in t.get_text()]
     assert rows == [f"{r.label}\nDOF {r.dof:.2f}" for r in view.rows]
     titles = [ax.get_title() for ax in fig.axes if ax.get_title()]
     assert "road = 78 in" in titles
     assert f"steering = {view.outputs[0].value:.1f} deg" in titles
-    # the aggregate row's result lines sit at the crisp outputs
-    agg_axes = fig.axes[-len(view.outputs):]
-    for ax, out in zip(agg_axes, view.outputs):
-        xs = [ln.get_xdata()[0] for ln in ax.lines]
-        assert out.value in xs
+    n = len(view.rows)
+    for k, row in enumerate(view.rows):
+        base = n - 1 - k                               # first rule on top
+        for p in row.props:                            # the fill reaches the membership
+            line, fill = by_gid(fig, f"{row.label}:{p.var}")
+            np.testing.assert_allclose(line.get_ydata(), base + BAND * p.y)
+            top = max(v[1] for path in fill.get_paths() for v in path.vertices)
+            assert top == pytest.approx(base + BAND * p.value)
+        for c in row.consequents:                      # a stem as high as the DOF
+            (stem,) = by_gid(fig, f"{row.label}:{c.output}")
+            ((x0, y0), (x1, y1)), = stem.get_segments()
+            assert x0 == x1 == c.value
+            assert (y0, y1) == pytest.approx((base, base + BAND * row.dof))
+    for out in view.outputs:                           # aggregate stems and the result line
+        stems = by_gid(fig, f"aggregate:{out.name}")
+        xs = sorted(float(seg[0][0]) for st in stems for seg in st.get_segments())
+        assert xs == [v for v, _ in out.stems]
+        (result,) = by_gid(fig, f"result:{out.name}")
+        assert list(result.get_xdata()) == [out.value, out.value]
+
+
+def test_rule_viewer_mamdani_sets(tmp_path):
+    from test_plotdata import write_mamdani
+
+    rb = load_rulebase(write_mamdani(tmp_path))
+    view = plotdata.rule_view(rb.compiled, {"road": 80, "size": 30})
+    fig = draw_rules(view)
+    (out,) = view.outputs
+    fill, line = by_gid(fig, "aggregate:speed")
+    np.testing.assert_array_equal(line.get_ydata(), out.aggregate)
+    np.testing.assert_array_equal(line.get_xdata(), out.grid)
 
 
 def test_rule_viewer_caps_rows(mitos):

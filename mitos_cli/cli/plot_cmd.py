@@ -76,7 +76,6 @@ def _use_color(color: Optional[bool]) -> bool:
     return sys.stdout.isatty() and not os.environ.get("NO_COLOR")
 
 
-@plot_app.command("terms")
 def terms_command(
     args: Annotated[Optional[list[str]], typer.Argument(
         metavar="[RULEBASE] [NAME=VALUE]...",
@@ -179,7 +178,6 @@ def _surface_args(args: list[str]) -> tuple[Optional[str], Optional[str]]:
     return None, None
 
 
-@plot_app.command("surface")
 def surface_command(
     args: Annotated[Optional[list[str]], typer.Argument(
         metavar="[RULEBASE] OUTPUT",
@@ -235,7 +233,6 @@ def surface_command(
     _done(output)
 
 
-@plot_app.command("rules")
 def rules_command(
     args: Annotated[Optional[list[str]], typer.Argument(
         metavar="[RULEBASE] NAME=VALUE...",
@@ -276,5 +273,18 @@ def rules_command(
     draw_rules(view, output, show=show, max_rows=max_rules, title=title)
     _done(output)
 
+
+def reflow(doc: str | None) -> str:
+    """A docstring as help text: paragraphs kept, the lines inside each joined (Typer's rich
+    help would otherwise keep the source's line breaks)."""
+    import inspect
+
+    paragraphs = inspect.cleandoc(doc or "").split("\n\n")
+    return "\n\n".join(" ".join(p.split()) for p in paragraphs)
+
+
+plot_app.command("terms", help=reflow(terms_command.__doc__))(terms_command)
+plot_app.command("surface", help=reflow(surface_command.__doc__))(surface_command)
+plot_app.command("rules", help=reflow(rules_command.__doc__))(rules_command)
 
 __all__ = ["plot_app"]

@@ -69,9 +69,10 @@ def new_figure(figsize: tuple[float, float], show: bool = False, **kwargs):
     return fig
 
 
-def finish(fig, path: str | Path | None = None, show: bool = False, dpi: int = 150):
+def finish(fig, path: str | Path | None = None, show: bool = False, dpi: int = 150,
+           tight: bool = True):
     """Save ``fig`` to ``path`` (atomically: a temporary file renamed into place), then show
-    it when asked. Returns the figure."""
+    it when asked; ``tight`` trims the margins (one more layout pass). Returns the figure."""
     if path is not None:
         path = Path(path)
         fmt = check_format(path)
@@ -86,7 +87,7 @@ def finish(fig, path: str | Path | None = None, show: bool = False, dpi: int = 1
 
         try:
             with os.fdopen(fd, "wb") as fh, matplotlib.rc_context({"svg.hashsalt": "mitos"}):
-                fig.savefig(fh, format=fmt, dpi=dpi, bbox_inches="tight",
+                fig.savefig(fh, format=fmt, dpi=dpi, bbox_inches="tight" if tight else None,
                             metadata=_metadata(fmt))
             os.replace(tmp, path)
         except OSError as exc:

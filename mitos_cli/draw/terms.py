@@ -14,7 +14,7 @@ from typing import Sequence
 
 import numpy as np
 
-from ..plotdata import VariablePlot, variable_plot
+from ..plotdata import VariablePlot, variable_plot, visible
 from ..terms import Variable
 from .output import finish, new_figure
 
@@ -106,13 +106,13 @@ def mark_value(ax, plot: VariablePlot) -> None:
     from matplotlib.patheffects import withStroke
 
     unit = f" {plot.unit}" if plot.unit else ""
-    ax.axvline(plot.value, color=VALUE_COLOR, linestyle="--", linewidth=1.2,
-               label=f"{plot.name} = {plot.value:g}{unit}", zorder=5)
+    line = ax.axvline(plot.value, color=VALUE_COLOR, linestyle="--", linewidth=1.2,
+                      label=f"{plot.name} = {plot.value:g}{unit}", zorder=5)
     lo, hi = plot.universe
     right = plot.value < lo + 0.8 * (hi - lo)
     names = [c.name for c in plot.curves]
     for term, mu in plot.memberships:
-        if mu <= 0:
+        if not visible(mu):
             continue
         c = color(names.index(term))
         ax.plot([plot.value], [mu], "o", color=c, markeredgecolor="white", markersize=7,
@@ -122,7 +122,7 @@ def mark_value(ax, plot: VariablePlot) -> None:
                     va="center", fontsize=8.5, color=c, fontweight="bold", zorder=7,
                     path_effects=[withStroke(linewidth=3, foreground="white")])
     ax.legend(loc="center right" if right else "center left", fontsize=8, frameon=True,
-              handles=[ax.lines[-1 - sum(1 for _, mu in plot.memberships if mu > 0)]])
+              handles=[line])
 
 
 def panel_title(plot: VariablePlot) -> str:
