@@ -1,0 +1,178 @@
+"""``mitos simulate``: drive a rule base through YAML worlds; verdict, metrics, traces, pictures."""
+
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+from typing import Annotated, Optional
+
+import typer
+
+from .output import emit, err
+
+REQUIRE = ("success",)
+
+
+def _verdict(res) -> str:
+    m = res.metrics
+    robot = res.world.robot
+    near = (f"; closer than the safety margin ({robot.safety_margin:g} in)"
+            if m["min_clearance_in"] < robot.safety_margin and res.outcome != "collision" else "")
+    others = ("" if len(res.robot_outcomes) == 1 else " (" + ", ".join(
+        f"{a.name} {o}" for a, o in zip(res.world.agents, res.robot_outcomes)) + ")")
+    return (f"{res.world.name}: {res.outcome.upper()}{others} after {m['time_s']:.2f} s "
+            f"(seed {res.seed}, {res.planner}); min clearance {m['min_clearance_in']:.1f} in"
+            f"{near}")
+
+
+def _table(rows: list[tuple[str, str]]) -> str:
+    width = max(len(k) for k, _ in rows)
+    return "\n".join(f"  {k.ljust(width)}  {v}" for k, v in rows)
+
+
+def _summary(res) -> str:
+    m = res.metrics
+    return _table([
+        ("outcome", res.outcome), ("reached goal", "yes" if res.robot_outcomes[0] == "success"
+                                   else "no"),
+        ("collisions", str(m["collisions"])), ("time", f"{m['time_s']:.2f} s"),
+        ("ticks", str(m["ticks"])), ("path length", f"{m['path_length_in']:.1f} in"),
+        ("mean speed", f"{m['mean_speed_in_s']:.1f} in/s"),
+        ("min clearance", f"{m['min_clearance_in']:.1f} in"),
+        ("steering total variation", f"{m['steering_total_variation_deg']:.0f} deg")])
+
+
+def _runs_table(runs) -> str:
+    head = ["world", "runs", "success", "collision", "timeout", "stuck", "time s",
+            "path in", "min clear in", "speed in/s"]
+    rows = [head]
+    for w in runs.worlds:
+        row = [w.world, str(len(w.summaries))]
+        row += [f"{100 * w.rate(o):.0f}%" for o in ("success", "collision", "timeout", "stuck")]
+        for key in ("time_s", "path_length_in", "min_clearance_in", "mean_speed_in_s"):
+            mean, std = w.stat(key)
+            row.append(f"{mean:.1f} ± {std:.1f}")
+        rows.append(row)
+    widths = [max(len(r[i]) for r in rows) for i in range(len(head))]
+    return "\n".join("  ".join(c.ljust(wd) if i == 0 else c.rjust(wd)
+                               for i, (c, wd) in enumerate(zip(r, widths))) for r in rows)
+
+
+def _write_text(path: Path, text: str) -> None:
+    import os
+    import tempfile
+
+    from ..errors import MitosError
+
+    directory = path.parent if str(path.parent) else Path(".")
+    try:
+        fd, tmp = tempfile.mkstemp(dir=directory, prefix=f".{path.name}.", suffix=".tmp")
+        with os.fdopen(fd, "w", encoding="utf-8", newline="") as fh:
+            fh.write(text)
+        os.replace(tmp, path)
+    except OSError as exc:
+        raise MitosError(f"cannot write `{path}`: {exc.strerror or exc}") from None
+
+
+def simulate_command(
+    worlds: Annotated[Optional[list[str]], typer.Argument(
+        metavar="[WORLD.yaml]...",
+        help="World files (default: the packaged corridor.yaml); names of packaged worlds "
+             "such as figure4.yaml work from anywhere.")] = None,
+    rulebase: Annotated[Optional[str], typer.Option(
+        "--rulebase", "-r", metavar="PATH", help="Rule base (default: the packaged one).")] = None,
+    behavior: Annotated[Optional[str], typer.Option(
+        "--behavior", "-b", help="Behavior that drives (default: the world's, else `drive`).")] = None,
+    seed: Annotated[Optional[int], typer.Option(
+        "--seed", min=0, help="Seed (default: the world's); with --runs, run j uses SEED+j.")] = None,
+    runs: Annotated[int, typer.Option(
+        "--runs", min=0, help="Randomised runs per world (obstacle places, sensor noise).")] = 0,
+    randomise: Annotated[bool, typer.Option(
+        "--randomise", help="Randomise this one run as run j of --runs does (replay it with "
+                            "--seed SEED+j).")] = False,
+    as_json: Annotated[bool, typer.Option("--json", help="Print JSON instead of the table.")] = False,
+    out: Annotated[Optional[Path], typer.Option(
+        "--out", "-o", metavar="FILE.csv", help="Write one CSV row per tick.")] = None,
+    trace: Annotated[bool, typer.Option(
+        "--trace", help="Print the paper-style DOF trace every --every ticks.")] = False,
+    every: Annotated[int, typer.Option("--every", min=1, help="Ticks between traces.")] = 20,
+    plot: Annotated[Optional[Path], typer.Option(
+        "--plot", metavar="FILE.png|FILE.svg", help="Draw the run (world, obstacles, path).")] = None,
+    live: Annotated[bool, typer.Option("--live", help="Show a terminal view while it runs.")] = False,
+    require: Annotated[Optional[str], typer.Option(
+        "--require", metavar="success", help="Exit 3 unless every run ends in this outcome.")] = None,
+    workers: Annotated[Optional[int], typer.Option(
+        "--workers", min=1, help="Processes for --runs (default: up to 2).")] = None,
+) -> None:
+    """Simulate the rule base driving a tricycle robot through corridor worlds."""
+    from ..resources import DEFAULT_WORLD
+    from ..sim.planner import FuzzyPlanner
+    from ..sim.worldfile import load_world, resolve_world_path
+
+    if require is not None and require not in REQUIRE:
+        raise typer.BadParameter(f"--require takes `success`, not `{require}`")
+    names = worlds or [DEFAULT_WORLD]
+    loaded = [load_world(resolve_world_path(n)) for n in names]
+    many = len(loaded) > 1 or runs > 0
+    if many and (out or plot or trace or live or randomise):
+        raise typer.BadParameter("--out, --plot, --trace, --live and --randomise work on one "
+                                 "world and one run; drop --runs or give one world")
+    if plot is not None:
+        from ..draw.output import check_format
+
+        check_format(plot)
+    planner = FuzzyPlanner(rulebase, behavior or loaded[0].behavior)
+
+    if many:
+        from ..sim.runs import run_many
+
+        result = run_many(loaded, runs, seed, planner, workers)
+        if as_json:
+            emit(json.dumps(result.to_json(), indent=2))
+        else:
+            emit(_runs_table(result))
+        failed = any(s["outcome"] != "success" for w in result.worlds for s in w.summaries)
+        if require and failed:
+            raise typer.Exit(3)
+        return
+
+    from ..sim.simulate import prepare, simulate
+
+    world = loaded[0]
+    scene = prepare(world)
+    if live:
+        from ..sim.live import LiveView
+
+        with LiveView(world, scene) as view:
+            res = simulate(world, planner, seed, randomise=randomise, scene=scene,
+                           on_tick=view.update)
+    else:
+        res = simulate(world, planner, seed, randomise=randomise, scene=scene)
+    if trace:
+        from ..sim.export import traces
+
+        text = traces(res, planner, every)
+        if as_json:
+            err(text)
+        else:
+            emit(text + "\n")
+    if out is not None:
+        from ..sim.export import csv_text
+
+        _write_text(out, csv_text(res, planner))
+    if plot is not None:
+        from ..draw.world import draw_run
+
+        draw_run(res, plot)
+    if as_json:
+        emit(json.dumps(res.summary(), indent=2))
+    else:
+        emit(_verdict(res))
+        emit(_summary(res))
+    for path, what in ((out, "ticks"), (plot, "picture")):
+        if path is not None:
+            err(f"wrote {what} to {path}")
+    if require and res.outcome != require:
+        raise typer.Exit(3)
+    sys.stdout.flush()

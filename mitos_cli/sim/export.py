@@ -1,0 +1,88 @@
+"""A finished run as a CSV (one row per tick and robot) and as paper-style DOF traces.
+
+Fired rules are not stored while stepping: the planner's inputs are, and the engine is exact
+row by row, so evaluating all recorded inputs again in one detailed batch gives the very DOFs
+the planner used (:meth:`FuzzyPlanner.explain`).
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+
+import numpy as np
+
+from .perception import INPUTS
+from .simulate import SimResult
+
+
+def explain(result: SimResult, planner, robot: int = 0):
+    """The detailed engine result for every tick of ``robot`` (rows = ticks), or None when the
+    planner is not a rule base."""
+    if not hasattr(planner, "explain"):
+        return None
+    return planner.explain({k: v[:, robot] for k, v in result.perceived.items()})
+
+
+def fired_text(detail, row: int, digits: int = 2) -> str:
+    c = detail.compiled
+    dof = detail.dof[row]
+    order = np.argsort(-dof, kind="stable")
+    return " ".join(f"{c.labels[r]}={dof[r]:.{digits}f}" for r in order if dof[r] > 0)
+
+
+def write_csv(result: SimResult, planner, out) -> None:
+    """Columns: tick, t, robot, x, y, heading, speed, steering, cmd_steering, cmd_speed,
+    clearance, range_0.., every perceived input, true_<input>, fired (``label=DOF`` by DOF)."""
+    n = result.pose.shape[1]
+    B = result.ranges.shape[2]
+    details = [explain(result, planner, i) for i in range(n)]
+    w = csv.writer(out, lineterminator="\n")
+    w.writerow(["tick", "t", "robot", "x", "y", "heading", "speed", "steering", "cmd_steering",
+                "cmd_speed", "clearance"] + [f"range_{b}" for b in range(B)] + list(INPUTS)
+               + [f"true_{k}" for k in INPUTS] + ["fired"])
+    names = [a.name for a in result.world.agents]
+    for k in range(result.ticks):
+        for i in range(n):
+            if result.active is not None and not result.active[k, i]:
+                continue
+            row = [k, f"{result.t[k]:.6g}", names[i],
+                   *(f"{v:.6g}" for v in result.pose[k, i]),
+                   f"{result.speed[k, i]:.6g}", f"{result.steering[k, i]:.6g}",
+                   *(f"{v:.6g}" for v in result.command[k, i]),
+                   f"{result.clearance[k, i]:.6g}",
+                   *(f"{v:.6g}" for v in result.ranges[k, i]),
+                   *(f"{result.perceived[key][k, i]:.6g}" for key in INPUTS),
+                   *(f"{result.true[key][k, i]:.6g}" for key in INPUTS),
+                   fired_text(details[i], k) if details[i] is not None else ""]
+            w.writerow(row)
+
+
+def csv_text(result: SimResult, planner) -> str:
+    buf = io.StringIO()
+    write_csv(result, planner, buf)
+    return buf.getvalue()
+
+
+def traces(result: SimResult, planner, every: int, digits: int = 1) -> str:
+    """The DOF trace every ``every`` ticks (and at the last tick) of the first robot, each
+    headed by the time, the pose and the perceived vs true inputs."""
+    from ..trace import trace_of
+
+    detail = explain(result, planner, 0)
+    if detail is None:
+        return f"(planner {result.planner} is not a rule base: no DOF trace)"
+    ticks = sorted(set(range(0, result.ticks, max(1, every))) | {result.ticks - 1})
+    blocks = []
+    for k in ticks:
+        if result.active is not None and not result.active[k, 0]:
+            continue
+        x, y, h = result.pose[k, 0]
+        head = (f"--- tick {k}, t = {result.t[k]:.2f} s: robot at ({x:.1f}, {y:.1f}) in, heading "
+                f"{h:.1f} deg, speed {result.speed[k, 0]:.1f} in/s, steering "
+                f"{result.steering[k, 0]:.1f} deg, clearance {result.clearance[k, 0]:.1f} in")
+        pt = "  perceived: " + ", ".join(f"{key} {result.perceived[key][k, 0]:.1f}"
+                                         for key in INPUTS)
+        tr = "  true:      " + ", ".join(f"{key} {result.true[key][k, 0]:.1f}" for key in INPUTS)
+        blocks.append("\n".join([head, pt, tr, "", trace_of(detail, k).render(digits)]))
+    return "\n\n".join(blocks)

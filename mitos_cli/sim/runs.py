@@ -1,0 +1,92 @@
+"""Many runs: randomised repetitions of worlds on a process pool, and their statistics.
+
+Run ``j`` of a world uses seed ``seed + j`` and draws its obstacle places and sensor noise from
+the world's ``randomise`` ranges, so any run can be replayed alone (``mitos simulate WORLD
+--seed S+j --randomise``). Each run is a pure function of (world, planner, seed): the results do
+not depend on the number of workers or on which worker ran what.
+"""
+
+from __future__ import annotations
+
+import math
+from concurrent.futures import ProcessPoolExecutor
+from dataclasses import dataclass
+
+import numpy as np
+
+from .simulate import OUTCOMES, prepare, simulate
+from .world import World
+
+METRICS = ("time_s", "path_length_in", "min_clearance_in", "mean_speed_in_s",
+           "steering_total_variation_deg")
+
+
+def _chunk(task: tuple[World, object, tuple[int, ...], bool]) -> list[dict]:
+    world, planner, seeds, randomise = task
+    scene = prepare(world)
+    return [simulate(world, planner, seed, randomise=randomise, scene=scene).summary()
+            for seed in seeds]
+
+
+@dataclass(frozen=True)
+class WorldRuns:
+    world: str
+    summaries: tuple[dict, ...]
+
+    def rate(self, outcome: str) -> float:
+        return sum(s["outcome"] == outcome for s in self.summaries) / len(self.summaries)
+
+    def stat(self, key: str) -> tuple[float, float]:
+        x = np.array([s[key] for s in self.summaries], dtype=float)
+        return float(x.mean()), float(x.std(ddof=1)) if len(x) > 1 else 0.0
+
+
+@dataclass(frozen=True)
+class Runs:
+    worlds: tuple[WorldRuns, ...]
+
+    def to_json(self) -> list[dict]:
+        out = []
+        for w in self.worlds:
+            row = {"world": w.world, "runs": len(w.summaries)}
+            row.update({f"{o}_rate": w.rate(o) for o in OUTCOMES})
+            for key in METRICS:
+                mean, std = w.stat(key)
+                row[key] = {"mean": mean, "std": std}
+            row["runs_detail"] = list(w.summaries)
+            out.append(row)
+        return out
+
+
+def default_workers() -> int:
+    import os
+
+    return max(1, min(2, os.cpu_count() or 1))
+
+
+def run_many(worlds: list[World], runs: int = 0, seed: int | None = None, planner=None,
+             workers: int | None = None) -> Runs:
+    """Run each world once (``runs=0``: its own seed, as written) or ``runs`` randomised times
+    (seeds ``seed + j``, default base: the world's seed), on ``workers`` processes."""
+    if planner is None:
+        from .planner import FuzzyPlanner
+
+        planner = FuzzyPlanner(None, worlds[0].behavior if worlds else "drive")
+    workers = default_workers() if workers is None else workers
+    tasks = []
+    for w in worlds:
+        base = w.seed if seed is None else seed
+        seeds = [base] if runs <= 0 else [base + j for j in range(runs)]
+        size = max(1, math.ceil(len(seeds) / (2 * workers)))
+        for i in range(0, len(seeds), size):
+            tasks.append((w, tuple(seeds[i:i + size]), i))
+    jobs = [(w, planner, chunk, runs > 0) for w, chunk, _ in tasks]
+    if workers > 1 and len(jobs) > 1:
+        with ProcessPoolExecutor(workers) as pool:
+            results = list(pool.map(_chunk, jobs))
+    else:
+        results = [_chunk(j) for j in jobs]
+    grouped: dict[int, list[dict]] = {}
+    for (w, _, _), res in zip(tasks, results):
+        grouped.setdefault(id(w), []).extend(res)
+    return Runs(tuple(WorldRuns(w.name, tuple(grouped[id(w)])) for w in worlds))
