@@ -12,6 +12,7 @@ import typer
 
 from ..errors import MitosError
 from . import check_cmd, compare_cmd, convert_cmd, eval_cmd, export_cmd, operators_cmd, plot_cmd, teach_cmd
+from . import simulate_cmd
 
 app = typer.Typer(
     name="mitos",
@@ -39,6 +40,7 @@ app.command("operators")(operators_cmd.operators_command)
 app.command("check")(check_cmd.check_command)
 app.command("teach")(teach_cmd.teach_command)
 app.command("compare")(compare_cmd.compare_command)
+app.command("simulate")(simulate_cmd.simulate_command)
 app.add_typer(plot_cmd.plot_app, name="plot")
 
 
