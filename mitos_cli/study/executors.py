@@ -44,20 +44,29 @@ def run_serial(fn: TaskFn, tasks: Sequence[Task]) -> Iterator[tuple[Task, dict]]
 
 
 def run_local(fn: TaskFn, tasks: Sequence[Task], workers: int) -> Iterator[tuple[Task, dict]]:
-    """A process pool over ``workers`` processes (one worker: this process, no pool)."""
+    """A pool of ``workers`` processes (one worker: this process, no pool).
+
+    On an error or Ctrl-C the workers are terminated at once (``Pool.terminate``) rather than
+    left to finish their chunks; every result that arrived is already on disk.
+    """
     if workers <= 1 or len(tasks) <= 1:
         yield from run_serial(fn, tasks)
         return
-    from concurrent.futures import ProcessPoolExecutor, as_completed
+    import multiprocessing
 
-    pool = ProcessPoolExecutor(max_workers=workers)
+    pool = multiprocessing.get_context().Pool(min(workers, len(tasks)))
+    finished = False
     try:
-        futures = [pool.submit(run_chunk, fn, c) for c in chunks(tasks, workers)]
-        for future in as_completed(futures):
-            yield from future.result()
+        for part in pool.imap_unordered(functools.partial(run_chunk, fn),
+                                        chunks(tasks, workers)):
+            yield from part
+        finished = True
     finally:
-        # on an error or Ctrl-C: drop what has not started, do not wait for the rest
-        pool.shutdown(wait=False, cancel_futures=True)
+        if finished:
+            pool.close()
+        else:
+            pool.terminate()
+        pool.join()
 
 
 def dask_client(scheduler: str | None, workers: int):
