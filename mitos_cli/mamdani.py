@@ -32,7 +32,8 @@ their DOFs (``max_r I(d_r, mu) = I(max_r d_r, mu)`` for a monotone implication, 
 the sampled work scales with the number of distinct consequent sets, not of rules; other
 S-norms reduce the ``[rules, samples, resolution]`` stack by a pairwise tree (log2 R vectorized
 steps). Samples are processed in sub-blocks so that no intermediate array exceeds
-:data:`MAX_BYTES`. Everything is elementwise per sample or a reduction along one sample's own
+:data:`MAX_BYTES` (when one sample's stack alone exceeds :data:`MAX_STACK_BYTES`, its rules
+are taken in chunks, joined by the same S-norm). Everything is elementwise per sample or a reduction along one sample's own
 row, so a single evaluation is bit for bit its row in a batch.
 """
 
@@ -186,6 +187,22 @@ def mamdani_outputs(compiled, dof: np.ndarray) -> np.ndarray:
         per = max(1, MAX_BYTES // (8 * sets.shape[0] * sets.shape[1]))
         for start in range(0, b, per):                # sub-blocks of samples
             block = slice(start, min(start + per, b))
-            Y = aggregate(D[:, block], sets, ops.implication, aggregation)
+            Y = _aggregate_chunked(D[:, block], sets, ops.implication, aggregation)
             out[j, block] = defuzzify(Y, table.grid, ops.defuzzify)
     return out
+
+
+#: Above this, even one sample's ``[rules, resolution]`` stack is built in chunks of rules
+#: (hundreds of rules at a resolution of tens of thousands, with a non-max aggregation).
+MAX_STACK_BYTES = 32 * 2 ** 20
+
+
+def _aggregate_chunked(dof, sets, implication, aggregation):
+    rules = max(1, MAX_STACK_BYTES // (8 * dof.shape[1] * sets.shape[1]))
+    if rules >= dof.shape[0]:
+        return aggregate(dof, sets, implication, aggregation)
+    Y = aggregate(dof[:rules], sets[:rules], implication, aggregation)
+    for r in range(rules, dof.shape[0], rules):     # chunks of rules, each one vectorized
+        Y = aggregation.fn(Y, aggregate(dof[r:r + rules], sets[r:r + rules], implication,
+                                        aggregation))
+    return Y

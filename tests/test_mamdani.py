@@ -212,3 +212,15 @@ def test_defuzzifiers_on_a_known_set():
     assert mamdani.defuzzify(Y, x, "bisector")[0] == 2.5   # cumulative area 0.8 of 1.6
     with pytest.raises(ValueError):
         mamdani.defuzzify(Y, x, "median")
+
+
+def test_huge_rule_stacks_are_built_in_chunks_of_rules(tmp_path, monkeypatch):
+    # one sample's [rules, resolution] stack above the ceiling: chunks of rules, same result
+    rb = load_rulebase(write(tmp_path, "aggregation = einstein_sum, resolution = 1001"))
+    X = np.array(SAMPLES, dtype=float)
+    whole = evaluate(rb.compiled, X).outputs
+    monkeypatch.setattr(mamdani, "MAX_STACK_BYTES", 2 * 1001 * 8)      # 2 rules per chunk
+    chunked = evaluate(rb.compiled, X).outputs
+    np.testing.assert_allclose(chunked, whole, rtol=0, atol=1e-12)
+    want = [reference(r, s, "min", "einstein_sum", "centroid", 1001) for r, s in SAMPLES]
+    np.testing.assert_allclose(chunked[:, 0], want, rtol=0, atol=1e-9)
