@@ -37,6 +37,7 @@ def convert_command(
     is refused with the reason.
     """
     from ..api import read_rulebase
+    from ..interop import conversion_notes, write_foreign
     from ..interop.common import atomic_write
 
     rb = read_rulebase(path)
@@ -53,12 +54,12 @@ def convert_command(
             if target.resolve() == path.resolve():
                 raise typer.BadParameter(f"`{target}` would overwrite the input; give -o OUT")
         rules_text, terms_text = write_rules(rb, terms_path.name, behavior, path.name)
+        for note in conversion_notes(rb, "rules", behavior):
+            warn(note)
         atomic_write(terms_path, terms_text)
         atomic_write(rules_path, rules_text)
         err(f"wrote {rules_path} and {terms_path}")
         return
-    from ..interop import conversion_notes, write_foreign
-
     text = write_foreign(rb, to.value, behavior)
     for note in conversion_notes(rb, to.value, behavior):
         warn(note)

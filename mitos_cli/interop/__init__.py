@@ -58,20 +58,26 @@ def write_foreign(rb: RuleBase, fmt: str, behavior: str | None = None) -> str:
 
 
 def conversion_notes(rb: RuleBase, fmt: str, behavior: str | None = None) -> list[str]:
-    """What writing ``rb`` as ``fmt`` changes (it is written anyway; the CLI warns)."""
-    if fmt == "fis":
-        from .fis import notes
-
-        return notes(rb, behavior)
+    """What writing ``rb`` as ``fmt`` (``rules`` included) leaves out or changes; the file is
+    written anyway and ``mitos convert`` prints these as warnings."""
     from ..operators import resolve
 
     b = rb.behavior(behavior)
+    out = []
+    if len(rb.behaviors) > 1:
+        others = ", ".join(x.name for x in rb.behaviors if x.name != b.name)
+        out.append(f"only behavior `{b.name}` is written (with the behaviors it uses); the "
+                   f"others ({others}) are not: choose one with --behavior")
+    if fmt == "fis":
+        from .fis import notes
+
+        return out + notes(rb, behavior)
     ops = resolve(b.operators, resolve(rb.operators))
     if fmt in ("fcl", "fll") and ops.inference == "mamdani" and ops.sampling != "midpoints":
-        return [f"{fmt.upper()} Mamdani outputs are sampled at cell midpoints (fuzzylite's "
-                f"rule); this rule base samples at {ops.sampling} (MATLAB's), so results move "
-                f"by the discretisation"]
-    return []
+        out.append(f"{fmt.upper()} Mamdani outputs are sampled at cell midpoints (fuzzylite's "
+                   f"rule); this rule base samples at {ops.sampling} (MATLAB's), so results "
+                   f"move by the discretisation")
+    return out
 
 
 __all__ = ["FORMATS", "conversion_notes", "read_foreign", "write_foreign"]

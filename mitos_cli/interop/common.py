@@ -391,9 +391,16 @@ def flatten_for_export(rb: RuleBase, behavior: str | None = None, *,
 
 
 def all_inputs(rb: RuleBase, flat: Flat) -> tuple[Variable, ...]:
-    """Every input variable of the rule base, in term-set order (writers list them all, so
-    that linear consequents keep their coefficients over the same inputs)."""
-    return tuple(v for v in rb.variables.values() if v.role == "input")
+    """The inputs a written file needs, in term-set order: those the rules test, and those a
+    linear consequent of the rules weighs (its coefficients are rewritten over these)."""
+    needed = {v.name for v in flat.inputs}
+    for r in flat.rules:
+        for c in r.consequents:
+            term = rb.variables[c.var].term(c.term) if c.term is not None else None
+            if term is not None and term.shape == "linear":
+                needed.update(n for n, a in linear_coefficients(rb, c.var, term).items()
+                              if a != 0.0)
+    return tuple(v for v in rb.variables.values() if v.role == "input" and v.name in needed)
 
 
 def linear_coefficients(rb: RuleBase, output: str, term: Term) -> dict[str, float]:
