@@ -264,10 +264,10 @@ def evaluate(compiled: CompiledRuleBase, X, *, detail: bool = True, keep_values:
     """Evaluate the network on ``X[n, k]``, in cache-sized blocks of samples.
 
     ``detail`` keeps memberships and DOFs (``False`` returns only outputs, faster);
-    ``keep_values`` also keeps every neuron's value (for training and the rule viewer). With
-    ``strict`` (the default) an output whose rules all have DOF 0 for some sample takes the
-    variable's ``default``, and without one raises :class:`NoRuleFiredError`; with
-    ``strict=False`` such outputs are NaN (for callers that report them themselves).
+    ``keep_values`` also keeps every neuron's value (for training and the rule viewer). An
+    output whose rules all have DOF 0 for some sample takes the variable's ``default``; when it
+    has none, ``strict`` (the default) raises :class:`NoRuleFiredError` and ``strict=False``
+    leaves NaN there (for callers that report such samples themselves).
     """
     Xt, clamped = check_inputs(compiled, X)
     X = Xt.T
