@@ -37,21 +37,25 @@ def is_svg(path: Path) -> bool:
 # ---------------------------------------------------------------- files
 
 
-@pytest.mark.parametrize("ext", ["png", "svg"])
-@pytest.mark.parametrize("command", [
-    ["terms", "-b", "avoid_obstacle", *SAMPLE],
-    ["surface", "steering", "--x", "road", "--y", "position", "--fix", "size=45", "-n", "12"],
-    ["surface", "steering", "--x", "road", "--y", "position=-15:15", "--fix", "size=45",
-     "-n", "12", "--style", "heatmap"],
-    ["surface", "speed", "--x", "road", "--fix", "size=45", "--fix", "position=4"],
-    ["rules", *SAMPLE],
-])
+SURFACE = ["surface", "steering", "--x", "road", "--y", "position", "--fix", "size=45", "-n", "12"]
+
+
+@pytest.mark.parametrize("command, ext", [
+    (["terms", "-b", "avoid_obstacle", *SAMPLE], "png"),
+    (["terms", "-b", "avoid_obstacle", *SAMPLE], "svg"),
+    (SURFACE, "png"),
+    (SURFACE[:5] + ["position=-15:15"] + SURFACE[6:] + ["--style", "heatmap"], "svg"),
+    (["surface", "speed", "--x", "road", "--fix", "size=45", "--fix", "position=4"], "png"),
+    (["rules", *SAMPLE], "PNG"),
+    (["rules", *SAMPLE], "svg"),
+], ids=["terms-png", "terms-svg", "surface-png", "heatmap-svg", "curve-png", "rules-PNG",
+        "rules-svg"])
 def test_files_are_written_by_extension(tmp_path, capsys, command, ext):
-    path = tmp_path / f"picture.{ext.upper() if command[0] == 'rules' else ext}"
+    path = tmp_path / f"picture.{ext}"
     code, out, err = run(["plot", *command, "-o", str(path)], capsys)
     assert code == 0, err
     assert f"wrote {path}" in err and out == ""
-    if ext == "png":
+    if ext.lower() == "png":
         assert path.read_bytes()[:8] == PNG
     else:
         assert is_svg(path)
@@ -268,12 +272,11 @@ def test_fis_pictures_and_data(path, tmp_path, capsys):
                 ["surface", str(path), out, "--x", rb.inputs[0], "-n", "8"]
                 + (["--y", y] if y else []),
                 ["rules", str(path), *args]]
-    for i, command in enumerate(commands):
-        for ext in ("png", "svg"):
-            target = tmp_path / f"{i}.{ext}"
-            code, _, err = run(["plot", *command, "-o", str(target)], capsys)
-            assert code == 0, err
-            assert target.read_bytes()[:8] == PNG if ext == "png" else is_svg(target)
+    for command, ext in zip(commands, ("png", "svg", "png")):
+        target = tmp_path / f"{command[0]}.{ext}"
+        code, _, err = run(["plot", *command, "-o", str(target)], capsys)
+        assert code == 0, err
+        assert target.read_bytes()[:8] == PNG if ext == "png" else is_svg(target)
 
 
 FLL = """\
