@@ -97,6 +97,25 @@ def test_convert_errors_exit_1_with_location(tmp_path: Path, capsys) -> None:
     assert code == 1 and "hedges cannot be written to .fis" in output
     code, _ = run_main(["convert", str(DATA / "tipper.fis"), "--to", "xml"], capsys)
     assert code == 2
+    code, output = run_main(["convert", str(DATA / "tipper.fis"), "--to", "fll", "-o",
+                             str(tmp_path / "missing" / "x.fll")], capsys)
+    assert code == 1 and "cannot write" in output and "No such file or directory" in output
+
+
+def test_convert_to_rules_keeps_behaviors_and_uses(tmp_path: Path) -> None:
+    out = tmp_path / "drive.rules"
+    result = runner.invoke(app, ["convert", str(ROOT / "rulebases" / "mitos.rules"), "--to",
+                                 "rules", "-b", "drive", "-o", str(out)])
+    assert result.exit_code == 0, result.output
+    text = out.read_text()
+    assert text.index("behavior drive:") < text.index("behavior follow_route:")
+    assert "use follow_route when" in text
+    a = load_rulebase(ROOT / "rulebases" / "mitos.rules", "drive")
+    b = load_rulebase(out)
+    assert a.inputs == b.inputs
+    rng = np.random.default_rng(np.random.SeedSequence(3).spawn(1)[0])
+    X = rng.uniform(a.compiled.universe[:, 0], a.compiled.universe[:, 1], (300, len(a.inputs)))
+    np.testing.assert_array_equal(a.run(X, strict=False).outputs, b.run(X, strict=False).outputs)
 
 
 def test_fuzzylite_dialect_fcl_matches_pyfuzzylite() -> None:

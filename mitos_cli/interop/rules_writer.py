@@ -35,28 +35,83 @@ def check_name(name: str, what: str) -> None:
 
 def write_rules(rb: RuleBase, termset_name: str, behavior: str | None = None,
                 source: str = "") -> tuple[str, str]:
-    """``(rules text, term-set YAML text)``; the rules file names ``termset_name``."""
-    flat = common.flatten_for_export(rb, behavior, crisp_terms=False)
+    """``(rules text, term-set YAML text)``; the rules file names ``termset_name``.
+
+    A behavior that uses no other is written as top-level rules; one that does is written with
+    the behaviors it uses (recursively) as ``behavior`` blocks, itself first (the default)."""
+    from ..build import flatten
+    from ..model import Use, format_use
+    from ..operators import resolve
+
+    name = behavior or rb.default_behavior
+    chosen = rb.behavior(name)
+    order: list = []
+
+    def visit(bname: str) -> None:
+        if bname in [b.name for b in order]:
+            return
+        b = rb.behavior(bname)
+        order.append(b)
+        for use in b.uses:
+            visit(use.behavior)
+
+    visit(name)
+    rules = [r for _, r, _ in flatten(rb, name)]
+    conditions = [u.condition for b in order for u in b.uses if u.condition is not None]
+    used_in = {p.var for r in rules for p in common.props(r.antecedent)}
+    used_in |= {p.var for c in conditions for p in common.props(c)}
+    used_out = {c.var for r in rules for c in r.consequents}
+    flat = common.Flat(name, tuple(v for v in rb.variables.values()
+                                   if v.role == "input" and v.name in used_in),
+                       tuple(v for v in rb.variables.values()
+                             if v.role == "output" and v.name in used_out),
+                       tuple(rules), resolve(chosen.operators, resolve(rb.operators)))
     inputs = common.all_inputs(rb, flat)
     for v in inputs + flat.outputs:
         check_name(v.name, "variable")
         for t in v.terms:
             check_name(t.name, f"term of `{v.name}`")
-    head = [f"# {flat.name}: written by `mitos convert`" + (f" from {source}" if source else ""),
+    head = [f"# {name}: written by `mitos convert`" + (f" from {source}" if source else ""),
             "", f"terms {_quote(termset_name)}"]
-    settings = flat.operators.settings()
-    if settings:
-        head.append("operators: " + ", ".join(f"{k} = {v}" for k, v in settings.items()))
+    file_settings = resolve(rb.operators).settings()
+    if len(order) == 1:                  # one behavior: its settings on the file's line
+        file_settings = flat.operators.settings()
+    if file_settings:
+        head.append("operators: " + ", ".join(f"{k} = {v}" for k, v in file_settings.items()))
     head.append("")
+    if len(order) == 1:
+        body = _rule_lines(chosen.rules, "")
+        if chosen.frozen:
+            body.append("frozen " + ", ".join(chosen.frozen))
+    else:
+        body = []
+        for b in order:
+            check_name(b.name, "behavior")
+            body.append(f"behavior {b.name}:")
+            if b.operators:
+                body.append("    operators: " + ", ".join(f"{s.key} = {s.value}"
+                                                          for s in b.operators))
+            body += ["    " + format_use(Use(u.behavior, u.condition, u.weight))
+                     for u in b.uses]
+            body += _rule_lines(b.rules, "    ")
+            if b.frozen:
+                body.append("    frozen " + ", ".join(b.frozen))
+            body += ["end", ""]
+    return "\n".join(head + body).rstrip("\n") + "\n", write_termset(rb, inputs, flat.outputs,
+                                                                      source)
+
+
+def _rule_lines(rules, indent: str) -> list[str]:
     labels: set[str] = set()
     lines = []
-    for i, r in enumerate(flat.rules):
-        label = r.label if NAME.fullmatch(r.label or "") and "/" not in r.label else f"r{i + 1}"
-        if label in labels or label in RESERVED:
+    for i, r in enumerate(rules):
+        label = r.label if NAME.fullmatch(r.label or "") and r.label not in RESERVED else ""
+        if not label or label in labels:
             label = common.unique_name(f"r{i + 1}", labels)
         labels.add(label)
-        lines.append(format_rule(Rule(label, r.antecedent, r.consequents, r.weight), label=True))
-    return "\n".join(head + lines) + "\n", write_termset(rb, inputs, flat.outputs, source)
+        lines.append(indent + format_rule(Rule(label, r.antecedent, r.consequents, r.weight),
+                                          label=True))
+    return lines
 
 
 def _quote(text: str) -> str:
