@@ -13,7 +13,6 @@ from pathlib import Path
 
 import numpy as np
 
-from .build import load_rules_file
 from .compile import CompiledRuleBase, compile_rulebase
 from .engine import Result, as_batch, evaluate
 from .model import RuleBase
@@ -34,6 +33,14 @@ def read_rulebase(path: str | Path | None = None) -> RuleBase:
         from .interop import read_foreign
 
         return read_foreign(path)
+    from .cache import cached_rulebase
+
+    return cached_rulebase(path, _load_rules_file)
+
+
+def _load_rules_file(path: Path) -> RuleBase:
+    from .build import load_rules_file      # the parser (Lark) and YAML load only on a miss
+
     return load_rules_file(path)
 
 

@@ -12,7 +12,8 @@ from pathlib import Path
 from . import operators as ops_mod
 from .errors import RuleBaseError, Span, TermSetError, unknown
 from .hedges import HEDGES
-from .model import And, Behavior, Consequent, Expr, Not, Or, Prop, Rule, RuleBase, Use
+from .model import (And, Behavior, Consequent, Expr, Not, Or, Prop, Rule, RuleBase, Use,
+                    flatten)  # noqa: F401 (flatten is re-exported)
 from .parse import ParsedFile, parse_rules
 from .termset import load_termset
 from .terms import TermSet, Variable
@@ -164,23 +165,3 @@ def _check_cycles(rb: RuleBase, name: str, stack: tuple[str, ...]) -> None:
                             span=rb.behavior(stack[0]).span)
     for use in rb.behavior(name).uses:
         _check_cycles(rb, use.behavior, stack + (name,))
-
-
-def flatten(rb: RuleBase, name: str | None = None) -> list[tuple[str, Rule, tuple[Use, ...]]]:
-    """The rules a behavior evaluates: its own and those of the behaviors it uses.
-
-    Each comes with its display label (``avoid_obstacle/r4`` for used behaviors) and the
-    chain of ``use`` contexts that weight it.
-    """
-    out: list[tuple[str, Rule, tuple[Use, ...]]] = []
-
-    def walk(bname: str, prefix: str, contexts: tuple[Use, ...]) -> None:
-        b = rb.behavior(bname)
-        for i, rule in enumerate(b.rules):
-            label = rule.label or f"#{i + 1}"
-            out.append((prefix + label, rule, contexts))
-        for use in b.uses:
-            walk(use.behavior, prefix + use.behavior + "/", contexts + (use,))
-
-    walk(name or rb.default_behavior, "", ())
-    return out

@@ -174,3 +174,23 @@ def format_use(use: Use) -> str:
     if use.weight != 1.0:
         text += f" with {format_number(use.weight)}"
     return text
+
+
+def flatten(rb: RuleBase, name: str | None = None) -> list[tuple[str, Rule, tuple[Use, ...]]]:
+    """The rules a behavior evaluates: its own and those of the behaviors it uses.
+
+    Each comes with its display label (``avoid_obstacle/r4`` for used behaviors) and the
+    chain of ``use`` contexts that weight it.
+    """
+    out: list[tuple[str, Rule, tuple[Use, ...]]] = []
+
+    def walk(bname: str, prefix: str, contexts: tuple[Use, ...]) -> None:
+        b = rb.behavior(bname)
+        for i, rule in enumerate(b.rules):
+            label = rule.label or f"#{i + 1}"
+            out.append((prefix + label, rule, contexts))
+        for use in b.uses:
+            walk(use.behavior, prefix + use.behavior + "/", contexts + (use,))
+
+    walk(name or rb.default_behavior, "", ())
+    return out

@@ -1,0 +1,77 @@
+"""The parsed-rule-base cache: a hit equals a fresh parse; any changed file is a miss."""
+
+from __future__ import annotations
+
+import pickle
+import shutil
+from pathlib import Path
+
+import pytest
+
+from mitos_cli import api, cache
+from mitos_cli.build import load_rules_file
+
+REPO = Path(__file__).resolve().parents[1]
+
+
+@pytest.fixture()
+def copy(tmp_path, monkeypatch):
+    monkeypatch.setenv("MITOS_CACHE_DIR", str(tmp_path / "cache"))
+    for name in ("mitos.rules", "mitos.terms.yaml", "drive.terms.yaml"):
+        shutil.copy(REPO / "rulebases" / name, tmp_path / name)
+    return tmp_path
+
+
+def entries(root: Path) -> list[Path]:
+    return sorted((root / "cache").glob("*.pickle"))
+
+
+def test_second_read_is_a_hit_and_equal(copy):
+    first = api.read_rulebase(copy / "mitos.rules")
+    assert len(entries(copy)) == 1
+    calls = []
+    second = cache.cached_rulebase(copy / "mitos.rules", lambda p: calls.append(p))
+    assert calls == [] and second == first == load_rules_file(copy / "mitos.rules")
+
+
+def test_a_changed_term_set_is_a_miss(copy):
+    api.read_rulebase(copy / "mitos.rules")
+    terms = copy / "mitos.terms.yaml"
+    terms.write_text(terms.read_text().replace("peak: 70, width: 30", "peak: 72, width: 30"))
+    rb = api.read_rulebase(copy / "mitos.rules")
+    assert rb.variables["road"].term("MEDIUM").params == (72.0, 30.0)
+
+
+def test_a_changed_rule_file_is_a_miss(copy):
+    api.read_rulebase(copy / "mitos.rules")
+    rules = copy / "mitos.rules"
+    rules.write_text(rules.read_text().replace("then steering is RS and speed is MEDIUM    # the",
+                                               "then steering is RM and speed is MEDIUM    # the"))
+    rb = api.read_rulebase(rules)
+    assert rb.behavior("avoid_obstacle").rules[0].consequents[0].term == "RM"
+    assert len(entries(copy)) == 2
+
+
+def test_a_corrupt_entry_is_a_miss(copy):
+    api.read_rulebase(copy / "mitos.rules")
+    (entry,) = entries(copy)
+    entry.write_bytes(b"not a pickle")
+    assert api.read_rulebase(copy / "mitos.rules") == load_rules_file(copy / "mitos.rules")
+    with open(entry, "rb") as fh:
+        pickle.load(fh)                      # rewritten with a good entry
+
+
+def test_off_disables_it(copy, monkeypatch):
+    monkeypatch.setenv("MITOS_CACHE_DIR", "off")
+    api.read_rulebase(copy / "mitos.rules")
+    assert not (copy / "cache").exists()
+
+
+def test_errors_are_not_cached(copy):
+    from mitos_cli.errors import RuleSyntaxError
+
+    (copy / "bad.rules").write_text('terms "mitos.terms.yaml"\nif road is then\n')
+    for _ in range(2):
+        with pytest.raises(RuleSyntaxError):
+            api.read_rulebase(copy / "bad.rules")
+    assert entries(copy) == []
