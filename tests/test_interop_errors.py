@@ -270,6 +270,7 @@ FCL_CASES = [
     ("METHOD : COG;", "METHOD : COG 2.5;", "resolution must be a whole number"),
     ("METHOD : COG;", "METHOD : CENTER;", "unknown METHOD `CENTER`"),
     ("ACCU : MAX;", "ACCU : NSUM;", "normalized sum is not an S-norm"),
+    ("METHOD : COG;", "METHOD : cogf;", "jFuzzyLogic's fast centre of gravity"),
     ("ACT : MIN;", "ACT : DPROD;", "implication `drastic` is not supported"),
     ("RULE 2 : IF service IS good", "RULE 2 : IF service IS goood", "unknown term of `service`"),
 ]

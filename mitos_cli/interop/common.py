@@ -67,6 +67,8 @@ UNSUPPORTED_NORMS = {
     "UNSUM": "the unbounded sum is not an S-norm MITOS computes",
     "SUM": "the unbounded sum is not an S-norm MITOS computes",
     "sum": "MATLAB's `sum` aggregation (unbounded) is not an S-norm MITOS computes",
+    "COGF": "jFuzzyLogic's fast centre of gravity (a coarser integration) is not supported; "
+            "COG is the exact one",
 }
 
 FLL, FIS, FCL = 0, 1, 2
@@ -83,9 +85,11 @@ def table_lookup(table: dict, fmt: int, name: str, what: str, span: Span | None,
     if fmt == FCL and name.upper() in FCL_ALIASES and FCL_ALIASES[name.upper()] in table:
         return FCL_ALIASES[name.upper()]
     pool = [n[fmt] for n in table.values() if n[fmt] is not None]
-    if name in UNSUPPORTED_NORMS:
-        raise FormatError(f"{what} `{name}` is not supported: {UNSUPPORTED_NORMS[name]}",
-                          span=span, expected="one of " + ", ".join(pool))
+    why = UNSUPPORTED_NORMS.get(name) or (UNSUPPORTED_NORMS.get(name.upper()) if fmt == FCL
+                                          else None)
+    if why:
+        raise FormatError(f"{what} `{name}` is not supported: {why}", span=span,
+                          expected="one of " + ", ".join(pool))
     raise FormatError(f"unknown {what} `{name}`", span=span, expected="one of " + ", ".join(pool),
                       hint=did_you_mean(name, pool))
 

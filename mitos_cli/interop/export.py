@@ -27,7 +27,7 @@ import numpy as np
 from ..build import flatten
 from ..compile import CompiledRuleBase
 from ..errors import FormatError
-from ..model import And, Expr, Not, Or, Prop
+from ..model import And, Expr, Not, Prop
 from ..shapes import kernel_params
 
 C_SHAPES = {

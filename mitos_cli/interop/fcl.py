@@ -34,7 +34,7 @@ from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput
 
 from .. import norms
 from ..errors import FormatError, Span, did_you_mean
-from ..model import And, Not, Or, Prop, Rule, RuleBase
+from ..model import And, Not, Prop, Rule, RuleBase
 from ..terms import Term, Variable
 from . import common
 from .common import FCL, FLL, Settings, fmt_number
@@ -58,7 +58,7 @@ def parser() -> Lark:
     from ..resources import grammar_text
 
     return Lark(grammar_text("fcl.lark"), parser="lalr", propagate_positions=True,
-                maybe_placeholders=True)
+                maybe_placeholders=True, cache=True)      # grammar analysis cached on disk
 
 
 def read_fcl(path: str | Path) -> RuleBase:

@@ -54,7 +54,7 @@ def rule_parser() -> Lark:
     from ..resources import grammar_text
 
     return Lark(grammar_text("fll_rule.lark"), parser="lalr", propagate_positions=True,
-                maybe_placeholders=True)
+                maybe_placeholders=True, cache=True)      # grammar analysis cached on disk
 
 
 @dataclass
@@ -393,7 +393,7 @@ def _output_term(rb: RuleBase, t: Term, v: Variable, sugeno: bool,
 def fuzzylite_rule_text(rule: Rule, ops, dialect: str) -> str:
     """A rule in fuzzylite's language (``dialect`` ``fll``: lower case; ``fcl``: upper-case
     keywords). ``not (...)`` groups are pushed onto propositions when the operators are duals."""
-    from ..model import And, Not, Or, Prop
+    from ..model import And, Not, Prop
 
     antecedent = rule.antecedent
     if common.has_group_not(antecedent):
