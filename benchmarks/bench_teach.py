@@ -127,7 +127,8 @@ def main() -> None:
 
     print(f"MITOS teaching benchmark, {time.strftime('%Y-%m-%d')}, {platform.machine()} "
           f"{platform.processor() or ''}".rstrip() + f", {os.cpu_count()} cpus, "
-          f"Python {sys.version.split()[0]}, NumPy {np.__version__}")
+          f"Python {sys.version.split()[0]}, NumPy {np.__version__}, load average "
+          f"{os.getloadavg()[0]:.1f}")
     print(f"rule base: {compiled.n_rules} rules, {compiled.n_columns} neurons, "
           f"{len(p.values)} learnable numbers ({p.n_free} free); 1,000 examples, Q = {q:.6g}")
     print()
