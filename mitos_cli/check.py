@@ -11,7 +11,8 @@ code                  severity    meaning
 ====================  ==========  ==========================================================
 ``no-rule-fires``     error       a region of the input space where no rule sets an output
                                   that declares no ``default`` (``mitos eval`` fails there)
-``no-rule-fires``     warning     the same, but the output falls back to its ``default``
+``no-rule-fires``     warning     the same, but the output falls back to its ``default`` (or
+                                  the inference is ``weighted_sum``, which gives 0 there)
 ``low-dof``           warning     a region where some rule fires but the total DOF of the
                                   rules setting an output is below ``threshold``
 ``conflict``          error       rules with the same antecedent and different consequents
@@ -353,11 +354,15 @@ def _sampled(compiled: CompiledRuleBase, threshold: float,
             boxes, uncovered = boxes_of(mask.reshape(shape), axes, compiled.inputs)
             share = float(mask.mean())
             what = " and ".join(f"`{o}`" for o in outs)
+            summed = compiled.operators.inference == "weighted_sum"
             if kind == "no-rule-fires":
-                severity = "warning" if has_default else "error"
+                severity = "warning" if has_default or summed else "error"
                 message = (f"behavior `{name}`: no rule sets {what} in "
                            f"{_pct(share)} of the input space")
-                if has_default:
+                if summed:                    # a weighted sum of nothing is 0, not an error
+                    message += " (the weighted sum is 0 there)"
+                    hint = "add rules that cover these inputs"
+                elif has_default:
                     values = ", ".join(
                         f"{o} = {compiled.default[compiled.outputs.index(o)]:g}" for o in outs)
                     message += f" (the default applies there: {values})"

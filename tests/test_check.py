@@ -107,6 +107,16 @@ def test_coverage_gap_with_default_is_a_warning(flawed):
                                                   "road in [0, 50] and size in [40, 100]"]
 
 
+def test_coverage_gap_with_weighted_sum_is_a_warning(tmp_path):
+    (tmp_path / "t.terms.yaml").write_text(TERMS, encoding="utf-8")
+    (tmp_path / "t.rules").write_text('terms "t.terms.yaml"\noperators: inference = '
+                                      "weighted_sum\nif road is WIDE then steering is RS\n",
+                                      encoding="utf-8")
+    report = check_rulebase(read_rulebase(tmp_path / "t.rules"))
+    (gap,) = by_code(report, "no-rule-fires")
+    assert report.ok and gap.severity == "warning" and "weighted sum is 0" in gap.message
+
+
 def test_low_total_dof(flawed):
     low = by_code(check_rulebase(read_rulebase(flawed)), "low-dof")[0]
     # r7 alone: LARGE(42.5) = 0.083 < 0.1 on the wide road
