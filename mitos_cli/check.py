@@ -197,9 +197,11 @@ def _consequents(rule: Rule) -> dict[str, Consequent]:
 def _same(a: Consequent, b: Consequent, variables: dict[str, Variable]) -> bool:
     def value(c: Consequent) -> tuple:
         if c.term is None:
-            return (None, c.value)
-        return (c.hedges, variables[c.var].term(c.term).center) if not c.hedges else \
-            (c.hedges, c.term)
+            return ("value", c.value)
+        center = variables[c.var].term(c.term).center
+        if c.hedges or center != center:     # hedged, or a linear (Takagi-Sugeno) term
+            return ("term", c.hedges, c.term)
+        return ("value", center)
     return value(a) == value(b)
 
 

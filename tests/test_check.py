@@ -200,6 +200,25 @@ def test_used_rules_are_judged_in_their_own_behavior(tmp_path):
     assert by_code(report, "unreachable") == []
 
 
+def test_takagi_sugeno_duplicates_are_not_conflicts(tmp_path):
+    (tmp_path / "t.terms.yaml").write_text(
+        "variables:\n  x:\n    role: input\n    universe: [0, 10]\n    terms:\n"
+        "      LO: {shape: left_shoulder, points: [2, 8]}\n"
+        "      HI: {shape: right_shoulder, points: [2, 8]}\n"
+        "  y:\n    role: output\n    universe: [0, 100]\n    terms:\n"
+        "      L: {shape: linear, coefficients: {x: 2}, constant: 1}\n"
+        "      M: {shape: linear, coefficients: {x: 3}, constant: 1}\n"
+        "      C: 5\n      D: 5\n", encoding="utf-8")
+    (tmp_path / "t.rules").write_text(
+        'terms "t.terms.yaml"\nr1: if x is LO then y is L\nr2: if x is LO then y is L\n'
+        "r3: if x is HI then y is C\nr4: if x is HI then y is D\n"
+        "r5: if x is not LO then y is M\nr6: if not x is LO then y is L\n", encoding="utf-8")
+    report = check_rulebase(read_rulebase(tmp_path / "t.rules"))
+    assert [(f.code, f.span.line) for f in report.findings
+            if f.code in ("duplicate", "conflict")] == [("conflict", 7), ("duplicate", 3),
+                                                       ("duplicate", 5)]
+
+
 def test_canonical_antecedents():
     same = [("road is A and size is B", "size is B and road is A"),
             ("not road is A", "road is not A"),
