@@ -190,3 +190,45 @@ def test_fis_reader_matches_fuzzylites_copy_of_the_same_system() -> None:
     header, table = read_fld(EXAMPLES / "mamdani" / "matlab" / "tipper.fld")
     got = evaluate(compile_rulebase(rb), table[:, :2], strict=False).outputs[:, 0]
     assert worst(got, table[:, header.index("tip")]) < 1e-6
+
+
+def test_dialect_details(tmp_path: Path) -> None:
+    # IEC / jFuzzyLogic: consequents joined by `,`
+    fcl = (DATA / "tipper_jfuzzylogic.fcl").read_text().replace(
+        "	tip : REAL;", "	tip : REAL;\n	tip2 : REAL;").replace(
+        "END_DEFUZZIFY", "END_DEFUZZIFY\nDEFUZZIFY tip2\n TERM a := trian 0 1 2;\n"
+        " METHOD : COG;\n RANGE := (0 .. 2);\nEND_DEFUZZIFY", 1).replace(
+        "THEN tip IS cheap;", "THEN tip IS cheap, tip2 IS a;")
+    from mitos_cli.interop.fcl import parse_fcl
+
+    rb = parse_fcl(fcl, "x.fcl")
+    assert [c.var for c in rb.behaviors[0].rules[0].consequents] == ["tip", "tip2"]
+    # MATLAB R2018b+ writes DisableStructuralChecks in [System]
+    fis = (DATA / "tipper.fis").read_text().replace("NumRules=3", "NumRules=3\n"
+                                                     "DisableStructuralChecks=0")
+    path = tmp_path / "new.fis"
+    path.write_text(fis)
+    assert load_rulebase(path).evaluate(service=2, food=1)["tip"] == pytest.approx(7.0169,
+                                                                                   abs=5e-5)
+
+
+def test_fis_writer_pushes_not_by_de_morgan(tmp_path: Path) -> None:
+    (tmp_path / "t.terms.yaml").write_text(
+        "variables:\n  a: {role: input, universe: [0, 10], terms: {low: {shape: triangle, "
+        "points: [0, 2, 5]}, high: {shape: triangle, points: [5, 8, 10]}}}\n"
+        "  b: {role: input, universe: [0, 10], terms: {low: {shape: triangle, "
+        "points: [0, 2, 5]}, high: {shape: triangle, points: [5, 8, 10]}}}\n"
+        "  y: {role: output, universe: [0, 1], terms: {lo: 0.2, hi: 0.8}}\n")
+    (tmp_path / "t.rules").write_text('terms "t.terms.yaml"\n'
+                                      "r1: if not (a is low and b is high) then y is lo\n"
+                                      "r2: if not a is high then y is hi\n")
+    rb = read_rulebase(tmp_path / "t.rules")
+    text = write_foreign(rb, "fis")
+    assert "-1 -2, 1 (1) : 2" in text                # not a.low OR not b.high
+    assert "-2 0, 2 (1) : 1" in text
+    (tmp_path / "back.fis").write_text(text)
+    rng = np.random.default_rng(np.random.SeedSequence(9).spawn(1)[0])
+    X = rng.uniform(0, 10, (200, 2))
+    a = load_rulebase(tmp_path / "t.rules").run(X, strict=False).outputs
+    b = load_rulebase(tmp_path / "back.fis").run(X, strict=False).outputs
+    np.testing.assert_allclose(a, b, rtol=0, atol=1e-12)

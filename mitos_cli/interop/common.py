@@ -461,12 +461,26 @@ def can_push_not(operators: ops_mod.Operators) -> bool:
 
 
 def has_group_not(expr: Expr) -> bool:
-    """Whether ``expr`` negates a compound (``not (a and b)``) anywhere."""
+    """Whether ``expr`` negates a compound (``not (a and b)``) anywhere, which needs De Morgan
+    to be pushed onto propositions (``not (a)`` alone is just a negated proposition)."""
     if isinstance(expr, Not):
-        return True
+        inner = expr.expr
+        while isinstance(inner, Not):
+            inner = inner.expr
+        return not isinstance(inner, Prop)
     if isinstance(expr, Prop):
         return False
     return any(has_group_not(i) for i in expr.items)
+
+
+def simple_nots(expr: Expr, rule: Rule, ops: ops_mod.Operators) -> Expr:
+    """``expr`` with every ``not`` on a proposition: direct for ``not (a)``, by De Morgan for
+    groups when the AND and OR norms are duals, else a FormatError."""
+    if has_group_not(expr) and not can_push_not(ops):
+        raise FormatError(f"rule `{rule.label}`: `not (...)` over a group cannot be written "
+                          f"with and = {ops.and_}, or = {ops.or_} (not De Morgan duals)",
+                          span=rule.span)
+    return push_not(expr)
 
 
 def atomic_write(path: str | Path, text: str) -> None:

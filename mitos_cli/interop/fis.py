@@ -52,7 +52,8 @@ MF_TYPES = {
     "constant": ("singleton", 1, (0,)),
 }
 SYSTEM_KEYS = ("Name", "Type", "Version", "NumInputs", "NumOutputs", "NumRules", "AndMethod",
-               "OrMethod", "ImpMethod", "AggMethod", "DefuzzMethod")
+               "OrMethod", "ImpMethod", "AggMethod", "DefuzzMethod",
+               "DisableStructuralChecks")     # MATLAB R2018b+; only affects MATLAB's editor
 VAR_KEYS = ("Name", "Range", "NumMFs")
 
 
@@ -319,6 +320,8 @@ def write_fis(rb: RuleBase, behavior: str | None = None) -> str:
         lines += ["", f"[Output{i}]"] + _var_lines(v, mfs)
     lines += ["", "[Rules]"]
     for r in flat.rules:
+        r = Rule(r.label, common.simple_nots(r.antecedent, r, ops), r.consequents, r.weight,
+                 r.span)
         lines.append(_rule_text(r, inputs, flat.outputs))
     return "\n".join(lines) + "\n"
 

@@ -395,13 +395,7 @@ def fuzzylite_rule_text(rule: Rule, ops, dialect: str) -> str:
     keywords). ``not (...)`` groups are pushed onto propositions when the operators are duals."""
     from ..model import And, Not, Prop
 
-    antecedent = rule.antecedent
-    if common.has_group_not(antecedent):
-        if not common.can_push_not(ops):
-            raise FormatError(f"rule `{rule.label}`: `not (...)` over a group cannot be written "
-                              f"in fuzzylite's language with and = {ops.and_}, or = {ops.or_} "
-                              f"(not De Morgan duals)", span=rule.span)
-        antecedent = common.push_not(antecedent)
+    antecedent = common.simple_nots(rule.antecedent, rule, ops)
     kw = (lambda w: w.upper()) if dialect == "fcl" else (lambda w: w)
 
     def expr(e, parent: str) -> str:
