@@ -41,8 +41,9 @@ import numpy as np
 from .build import flatten
 from .compile import CompiledRuleBase, compile_rulebase
 from .engine import evaluate
-from .model import And, Consequent, Expr, Not, Or, Prop, Rule, RuleBase, format_expr
 from .errors import Span
+from .model import (And, Consequent, Expr, Not, Prop, Rule, RuleBase, format_consequent,
+                    format_expr)
 from .terms import Variable
 
 SEVERITIES = ("error", "warning", "info")
@@ -205,12 +206,6 @@ def _same(a: Consequent, b: Consequent, variables: dict[str, Variable]) -> bool:
     return value(a) == value(b)
 
 
-def _show(c: Consequent) -> str:
-    from .model import format_consequent
-
-    return format_consequent(c)
-
-
 def _rule_pairs(rb: RuleBase, behavior: str) -> list[Finding]:
     flat = flatten(rb, behavior)
     groups: dict[object, list[int]] = {}
@@ -230,7 +225,7 @@ def _rule_pairs(rb: RuleBase, behavior: str) -> list[Finding]:
                 clash = [v for v in ci if v in cj and not _same(ci[v], cj[v], variables)]
                 where = f"`{label_j}` has the same antecedent as `{label_i}`"
                 if clash:
-                    says = "; ".join(f"{_show(ci[v])} vs {_show(cj[v])}" for v in clash)
+                    says = "; ".join(f"{format_consequent(ci[v])} vs {format_consequent(cj[v])}" for v in clash)
                     out.append(Finding(
                         "error", "conflict", f"{where} but concludes differently: {says}",
                         rule_j.span, behavior,
