@@ -225,7 +225,8 @@ def _rule_pairs(rb: RuleBase, behavior: str) -> list[Finding]:
                 clash = [v for v in ci if v in cj and not _same(ci[v], cj[v], variables)]
                 where = f"`{label_j}` has the same antecedent as `{label_i}`"
                 if clash:
-                    says = "; ".join(f"{format_consequent(ci[v])} vs {format_consequent(cj[v])}" for v in clash)
+                    says = "; ".join(f"{format_consequent(ci[v])} vs "
+                                     f"{format_consequent(cj[v])}" for v in clash)
                     out.append(Finding(
                         "error", "conflict", f"{where} but concludes differently: {says}",
                         rule_j.span, behavior,
