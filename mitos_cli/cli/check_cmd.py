@@ -85,7 +85,8 @@ def check_command(
     as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
 ) -> None:
     """Check a rule base: coverage gaps, conflicts, duplicates, unreachable rules, unused
-    terms and gaps between terms. Exits 1 when an error-level problem is found."""
+    terms and gaps between terms. Exits 1 on an error: inputs where no rule sets an output
+    that has no default, or rules with the same condition and different actions."""
     from ..api import read_rulebase
     from ..check import check_rulebase
     from ..trace import display_path
