@@ -1,6 +1,6 @@
 """`mitos plot terms|surface|rules`: files written by extension, terminal output without
 matplotlib, and every user-facing error (exit 1 for ours, 2 for usage), for the packaged rule
-base and for imported FIS files (tests/data/interop/*.fis)."""
+base and for imported FIS and FCL files (tests/data/interop/)."""
 
 from __future__ import annotations
 
@@ -212,23 +212,22 @@ def test_clamped_values_are_warned(capsys):
     assert code == 0 and "warning: `road` outside its universe [0, 160] was clamped" in err
 
 
-# ---------------------------------------------------------------- imported FIS files
+# ---------------------------------------------------------------- imported FIS / FCL files
 
 
-def _fis_files():
-    return sorted(DATA.glob("*.fis"))
+def _foreign_files():
+    return sorted(DATA.glob("*.fis")) + sorted(DATA.glob("*.fcl"))
 
 
-def _fis_reader_available() -> bool:
+def _reader_available(path: Path) -> bool:
+    """Whether mitos_cli.interop can read files like ``path`` yet (issue 6 adds the readers)."""
+    import importlib
+
     try:
-        import mitos_cli.interop.fis  # noqa: F401
+        importlib.import_module(f"mitos_cli.interop.{path.suffix[1:].lower()}")
     except ImportError:
         return False
     return True
-
-
-fis = pytest.mark.skipif(not _fis_files() or not _fis_reader_available(),
-                         reason="no FIS reader in mitos_cli.interop yet (issue 6)")
 
 
 def _midpoints(rb) -> dict[str, float]:
@@ -236,9 +235,10 @@ def _midpoints(rb) -> dict[str, float]:
             for k, name in enumerate(rb.inputs)}
 
 
-@fis
-@pytest.mark.parametrize("path", _fis_files(), ids=lambda p: p.name)
-def test_fis_pictures_and_data(path, tmp_path, capsys):
+@pytest.mark.parametrize("path", _foreign_files(), ids=lambda p: p.name)
+def test_imported_pictures_and_data(path, tmp_path, capsys):
+    if not _reader_available(path):
+        pytest.skip(f"no {path.suffix} reader in mitos_cli.interop yet (issue 6)")
     rb = load_rulebase(path)
     values = _midpoints(rb)
     args = [f"{k}={v:g}" for k, v in values.items()]
@@ -259,8 +259,10 @@ def test_fis_pictures_and_data(path, tmp_path, capsys):
     columns[rb.inputs[0]] = grid[0].ravel()
     if y:
         columns[y] = grid[1].ravel()
-    expected = rb.evaluate(**columns)[out]
-    np.testing.assert_array_equal(s.z.ravel(), expected)
+    from mitos_cli.engine import as_batch, evaluate
+
+    expected = evaluate(rb.compiled, as_batch(rb.compiled, columns), strict=False).output(out)
+    np.testing.assert_array_equal(s.z.ravel(), expected)      # NaN (no rule) included
     # rule viewer = eval's fired rules and DOFs
     view = plotdata.rule_view(rb.compiled, values)
     code, js, _ = run(["eval", str(path), *args, "--json"], capsys)
