@@ -42,6 +42,7 @@ def main() -> None:
           f"seed {args.seed}")
     print(f"machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
           f"Python {platform.python_version()}, {platform.system()}")
+    print(f"load average at start: {os.getloadavg()[0]:.2f} (1 min)")
 
     results = {}
     with tempfile.TemporaryDirectory() as tmp:
@@ -68,6 +69,7 @@ def main() -> None:
                   f"{n / (dask + start):8.1f} runs/s including it")
     rows = [r for _dt, r in results.values()]
     same = all(r == rows[0] for r in rows[1:])
+    print(f"load average at end: {os.getloadavg()[0]:.2f} (1 min)")
     print(f"rows identical across modes: {same}")
     print(f"speed-up vs 1 process: 2 processes {base / two:.2f}x"
           + (f", dask {base / dask:.2f}x" if not args.skip_dask else ""))

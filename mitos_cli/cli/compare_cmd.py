@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import shlex
-import sys
 from typing import Annotated, Optional
 
 import typer
@@ -75,9 +74,14 @@ def compare_command(
         raise typer.BadParameter("name at least one planner", param_hint="--planner")
     choices = make_choices(planners, split_list(and_), split_list(or_), split_list(inference))
     paths = check_inputs(worlds, choices, rulebase, behavior)
+    words = ["mitos", "compare", *worlds, "--and", and_, "--planner", planner]
+    for flag, value in (("--or", or_), ("--inference", inference), ("--rulebase", rulebase),
+                        ("--behavior", behavior)):
+        if value:
+            words += [flag, value]
+    words += ["--runs", str(runs), "--seed", str(seed), "-o", out]
     study = Study(paths, choices, runs, seed, rulebase, behavior,
-                  command="mitos compare " + " ".join(shlex.quote(a) for a in sys.argv[1:]
-                                                      if a != "compare"))
+                  command=" ".join(shlex.quote(w) for w in words))
     outcome = run_with_progress(study, out, executor, workers, scheduler, resume)
 
     from rich.console import Console

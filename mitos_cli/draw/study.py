@@ -32,7 +32,7 @@ def success_bars(summaries, worlds: list[str], labels: list[str], path: str | Pa
     by_key = {(s.world, s.choice.label): s for s in summaries}
     n_w, n_c = len(worlds), len(labels)
     width = 0.8 / max(1, n_c)
-    fig, ax = plt.subplots(figsize=(max(6.0, 1.1 * n_w * n_c * 0.55 + 2.5), 4.2))
+    fig, ax = plt.subplots(figsize=(min(14.0, max(6.0, 0.3 * n_w * n_c + 2.0)), 4.6))
     cmap = plt.get_cmap("tab10")
     x = np.arange(n_w)
     for j, label in enumerate(labels):
@@ -45,8 +45,13 @@ def success_bars(summaries, worlds: list[str], labels: list[str], path: str | Pa
                 continue
             v = r.k / r.n
             values.append(100 * v), lo.append(100 * (v - r.lo)), hi.append(100 * (r.hi - v))
-        ax.bar(x + (j - (n_c - 1) / 2) * width, values, width * 0.92, label=label,
-               color=cmap(j % 10), yerr=[lo, hi], capsize=3, error_kw={"linewidth": 0.9})
+        xs = x + (j - (n_c - 1) / 2) * width
+        ax.bar(xs, values, width * 0.92, label=label, color=cmap(j % 10), yerr=[lo, hi],
+               capsize=2, error_kw={"linewidth": 0.8})
+        for xi, v in zip(xs, values):
+            if v == 0:                      # an empty bar would be invisible
+                ax.text(xi, 1.0, "0", ha="center", va="bottom", fontsize=7,
+                        color=cmap(j % 10))
     ax.set_xticks(x)
     ax.set_xticklabels([_short(w) for w in worlds], rotation=15 if n_w > 4 else 0)
     ax.set_ylim(0, 105)
