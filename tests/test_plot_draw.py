@@ -186,7 +186,7 @@ def test_before_after(mitos, tmp_path):
     np.testing.assert_array_equal(before_medium.get_ydata(),
                                   medium.membership(before_medium.get_xdata()))
     assert max(after_medium.get_xdata()[after_medium.get_ydata() == 1.0]) == 74.0
-    assert any("MEDIUM: (70, 30) → (74, 34)" in t.get_text() for t in ax.texts)
+    assert any("MEDIUM: peak 70 → 74, width 30 → 34" in t.get_text() for t in ax.texts)
     assert before_medium.get_color() == after_medium.get_color()
 
 

@@ -82,7 +82,9 @@ def draw_curves(ax, plot: VariablePlot, *, colors: Sequence[str] | None = None,
 def stagger_labels(fig) -> None:
     """Lift a term label one step where it would overlap the one to its left, measured on the
     laid-out figure (so long names such as MODERATE next to MEDIUM stay readable)."""
-    fig.draw_without_rendering()
+    engine = fig.get_layout_engine()
+    if engine is not None:
+        engine.execute(fig)                     # place the axes as the saved figure has them
     renderer = fig.canvas.get_renderer()
     for ax in fig.axes:
         labels = sorted((t for t in ax.texts if t.get_gid() == "term-label"),
@@ -125,20 +127,23 @@ def mark_value(ax, plot: VariablePlot) -> None:
               handles=[line])
 
 
-def panel_title(plot: VariablePlot) -> str:
+def panel_title(plot: VariablePlot, width: int = 60) -> str:
+    """``road (input)`` and the description, wrapped at ``width`` characters."""
+    import textwrap
+
     role = "input" if plot.role == "input" else "output"
     title = f"{plot.name} ({role})"
     if plot.description:
-        title += f"\n{plot.description}"
+        title += "\n" + textwrap.fill(plot.description, width)
     return title
 
 
-def draw_panel(ax, plot: VariablePlot) -> list:
+def draw_panel(ax, plot: VariablePlot, title_width: int = 60) -> list:
     """One variable on one axes: terms, labels, the marked value and its memberships."""
     style_axes(ax, plot)
     artists = draw_curves(ax, plot)
     mark_value(ax, plot)
-    ax.set_title(panel_title(plot), fontsize=10, loc="left")
+    ax.set_title(panel_title(plot, title_width), fontsize=10, loc="left")
     return artists
 
 
@@ -159,12 +164,14 @@ def draw_sheet(plots: Sequence[VariablePlot], path: str | Path | None = None, *,
     grid = fig.add_gridspec(len(rows), span)
     for i, row in enumerate(rows):
         step = span // len(row)
+        inches = fig.get_size_inches()[0] / len(row)
         for k, plot in enumerate(row):
-            draw_panel(fig.add_subplot(grid[i, k * step:(k + 1) * step]), plot)
+            draw_panel(fig.add_subplot(grid[i, k * step:(k + 1) * step]), plot,
+                       title_width=int(inches * 12.5))     # ~ characters of 10 pt a panel
     if title:
         fig.suptitle(title, fontsize=13, fontweight="bold")
     stagger_labels(fig)
-    return finish(fig, path, show)
+    return finish(fig, path, show, tight=False)     # constrained layout sets the margins
 
 
 def draw_terms_before_after(variable_before: Variable, variable_after: Variable,
@@ -177,8 +184,9 @@ def draw_terms_before_after(variable_before: Variable, variable_after: Variable,
     ``teach``); ``path`` is the file to write (``.png`` or ``.svg``, chosen by extension;
     ``None`` writes nothing). Before is drawn dashed and faint, after solid, each term in its
     own colour; terms whose parameters changed are listed under the plot with their old and
-    new parameters. Returns the matplotlib figure. Raises :class:`mitos_cli.draw.output.
-    DrawError` (a ``MitosError``) for another extension or when matplotlib is missing.
+    new values (``MEDIUM: peak 70 → 74, width 30 → 34``). Returns the matplotlib figure.
+    Raises :class:`mitos_cli.draw.output.DrawError` (a ``MitosError``) for another extension
+    or when matplotlib is missing.
     """
     before = variable_plot(variable_before)
     after = variable_plot(variable_after)
@@ -188,8 +196,13 @@ def draw_terms_before_after(variable_before: Variable, variable_after: Variable,
         o = old.get(t.name)
         if o is None:
             changes.append(f"{t.name}: new")
-        elif o.params != t.params or o.shape != t.shape:
-            changes.append(f"{t.name}: {_params(o)} → {_params(t)}")
+        elif o.shape != t.shape:
+            changes.append(f"{t.name}: {o.shape} {_params(o)} → {t.shape} {_params(t)}")
+        elif o.params != t.params:
+            names = t.kind.params if len(t.kind.params) == len(t.params) else \
+                tuple(f"p{i + 1}" for i in range(len(t.params)))
+            changes.append(f"{t.name}: " + ", ".join(
+                f"{n} {a:g} → {b:g}" for n, a, b in zip(names, o.params, t.params) if a != b))
     for name in old:
         if name not in variable_after.term_names:
             changes.append(f"{name}: removed")
