@@ -163,3 +163,69 @@ def test_killed_session_resumes_with_nothing_lost(work):
     assert "(was peak 70, width 30)" in out                  # the adaptation is kept
     text = (work / "out" / "resumed.rules").read_text()
     assert "behavior careful:" in text and "r27: if road is NARROW" in text
+
+
+def test_prompt_in_a_terminal_completes_and_keeps_history(work):
+    """A real terminal (a pty): the prompt string, tab completion of commands, variables and
+    terms, Ctrl-C dropping a line, history across --resume."""
+    import fcntl
+    import pty
+    import termios
+
+    def controlling_terminal():              # the pty becomes the child's terminal (Ctrl-C)
+        os.setsid()
+        fcntl.ioctl(0, termios.TIOCSCTTY, 0)
+
+    def spawn(args):
+        master, slave = pty.openpty()
+        env = dict(os.environ, TERM="xterm", PYTHONUNBUFFERED="1", COLUMNS="120")
+        proc = subprocess.Popen([sys.executable, "-m", "mitos_cli", "teach", *args], cwd=work,
+                                stdin=slave, stdout=slave, stderr=slave, env=env,
+                                close_fds=True, preexec_fn=controlling_terminal)
+        os.close(slave)
+        return proc, master
+
+    def expect(master, text, seen, timeout=60.0):
+        end = time.monotonic() + timeout
+        while text not in seen[0]:
+            ready, _, _ = select.select([master], [], [], max(0.0, end - time.monotonic()))
+            assert ready, f"no {text!r}; got {seen[0][-400:]!r}"
+            try:
+                seen[0] += os.read(master, 65536).decode(errors="replace")
+            except OSError:
+                break
+        assert text in seen[0], seen[0][-400:]
+
+    proc, master = spawn(["rb/mitos.rules"])
+    seen = [""]
+    try:
+        expect(master, "avoid_obstacle> ", seen)
+        os.write(master, b"cor\t")
+        expect(master, "correct ", seen)
+        os.write(master, b"ro\t78 si\t45 pos\t4 -> st\t60\r")
+        expect(master, "example 1: road=78 size=45 position=4 -> steering=60", seen)
+        os.write(master, b"if road is W\t then steering is L\t\t")
+        expect(master, "LB", seen)
+        os.write(master, b"S\r")
+        expect(master, "(28 rules)\r\navoid_obstacle> ", seen)
+        os.write(master, b"eval road=1\x03")                   # Ctrl-C drops the line
+        expect(master, "Ctrl-D leaves)\r\navoid_obstacle> ", seen)
+        os.write(master, b"\x04")                              # Ctrl-D leaves
+        proc.wait(timeout=30)
+        assert proc.returncode == 0
+    finally:
+        proc.kill()
+        os.close(master)
+    history = next((work / ".mitos" / "teach").glob("*/history")).read_text()
+    assert "correct road=78 size=45 position=4 -> steering=60" in history
+    proc, master = spawn(["--resume"])
+    seen = [""]
+    try:
+        expect(master, "avoid_obstacle> ", seen)
+        os.write(master, b"\x1b[A\x1b[A\r")                   # up, up: the correction again
+        expect(master, "example 2: road=78 size=45 position=4 -> steering=60", seen)
+        os.write(master, b"quit\r")
+        proc.wait(timeout=30)
+    finally:
+        proc.kill()
+        os.close(master)

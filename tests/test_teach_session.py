@@ -225,3 +225,35 @@ def test_help(rules):
         s.run("help adpt")
     assert "did you mean `adapt`?" in info.value.render()
     assert s.run("quit") is False
+
+
+def test_simulate_and_at_and_their_mistakes(rules, tmp_path):
+    s, out = session(rules)
+    s.run("use drive")
+    text = say(s, out, "simulate corridor")                 # a packaged world by name
+    assert text.startswith("corridor with behavior drive: success after")
+    with pytest.raises(NameError_) as info:
+        s.run("simulate coridor")
+    assert "did you mean `corridor`?" in info.value.render()
+    with pytest.raises(LessonError, match="whole number"):
+        s.run("simulate corridor seed 1.5")
+    text = say(s, out, "at 2s steering=80")
+    assert text.startswith("1 example from corridor at 2 s (#1):")
+    text = say(s, out, "at 3s to 3.5s steering=85 speed=20")
+    assert text.startswith("11 examples from corridor from 3 s to 3.5 s (#2-12):")
+    assert "... (6 more: `show examples`)" in text
+    e = s.state.examples[1]
+    assert set(e.inputs) == set(s.compiled().inputs) and e.targets == {"steering": 85,
+                                                                        "speed": 20}
+    with pytest.raises(LessonError, match="outside it"):
+        s.run("at 999s steering=80")
+    with pytest.raises(LessonError, match="ends before it starts"):
+        s.run("at 4s to 3s steering=80")
+    with pytest.raises(LessonError, match="output variable `road`"):
+        s.run("at 3s road=80")
+    s.run("use avoid_obstacle")
+    s.run("undo")
+    text = say(s, out, f"adapt epochs 3 plot {tmp_path / 'a.svg'}")
+    assert "plotted" in text and list(tmp_path.glob("a*.svg"))
+    with pytest.raises(Exception, match="unknown picture format"):
+        s.run("adapt epochs 3 plot a.gif")

@@ -64,7 +64,8 @@ class Completer:
             import readline
 
             line = readline.get_line_buffer()[:readline.get_endidx()]
-            self.matches = sorted(w for w in set(self.words(line)) if w.startswith(text))
+            self.matches = sorted(w if w.endswith("=") else w + " "
+                                  for w in set(self.words(line)) if w.startswith(text))
         return self.matches[state] if state < len(self.matches) else None
 
 
@@ -80,9 +81,12 @@ def _setup_readline(session: Session, history: Path | None):
     else:
         readline.parse_and_bind("tab: complete")
     readline.set_history_length(5000)
-    if history is not None and history.is_file():
+    if history is not None:
         try:
-            readline.read_history_file(str(history))
+            if history.is_file():
+                readline.read_history_file(str(history))
+            else:
+                history.touch()                  # append_history_file needs the file
         except OSError:
             pass
     return readline
@@ -125,6 +129,7 @@ def interact(session: Session, history: Path | None = None) -> None:
             except MitosError as exc:
                 print(exc.render(), file=err)
             except KeyboardInterrupt:
+                session.replay()            # the state is exactly what the journal holds
                 print("interrupted", file=err)
             sys.stdout.flush()
     finally:

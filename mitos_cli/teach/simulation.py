@@ -31,7 +31,7 @@ def world_path(name: str, base: Path | None = None) -> Path:
             return packaged_path("worlds", file)
     from ..errors import unknown
 
-    raise unknown("world", name, [p[:-5] for p in packaged], cls=LessonError)
+    raise unknown("world", name, [p[:-5] for p in packaged])
 
 
 @dataclass
