@@ -34,10 +34,12 @@ Inputs (all floats, units in the names of ``mitos.terms.yaml`` / ``drive.terms.y
     width / 2 - lane_margin)`` right of the road centre; positive = right of the lane.
 ``goal`` (in)
     length of route left to the goal (at least the straight distance to it).
-``wall_left``, ``wall_right`` (in)
-    gap between the robot's side and the nearest wall hit on that side, among beams landing
-    from ``wall_behind`` behind to ``wall_ahead`` ahead of the robot's centre along the route
-    and beside it (at least half its width across; ``range`` when none): what keeps the robot off the walls while it avoids an obstacle.
+``gap_left``, ``gap_right`` (in)
+    gap between the robot's side and the nearest thing hit on that side: walls among beams
+    landing from ``wall_behind`` behind to ``wall_ahead`` ahead of the robot's centre along
+    the route, objects only while beside its body; all at least half its width across
+    (``range`` when none): what keeps the robot off the walls while it avoids an obstacle, and off an
+    obstacle it is passing once that is no longer ahead.
 
 :func:`truth` computes the same quantities from the true geometry (noise-free walls, exact
 obstacle outlines) for the trace.
@@ -54,8 +56,8 @@ from .route import Route
 from .world import Robot
 
 NO_OBSTACLE = 200.0     # in: the `obstacle` distance when nothing obstructs
-INPUTS = ("road", "size", "position", "obstacle", "heading", "lane", "goal", "wall_left",
-          "wall_right")
+INPUTS = ("road", "size", "position", "obstacle", "heading", "lane", "goal", "gap_left",
+          "gap_right")
 
 
 @dataclass(frozen=True)
@@ -68,7 +70,7 @@ class Settings:
     lane_margin: float = 6.0       # in: keep-right lane keeps this off the right wall
     road_cap: float = 100.0        # in: road width used for the lane at wide openings
     wall_behind: float = 12.0      # in
-    wall_ahead: float = 48.0       # in
+    wall_ahead: float = 36.0       # in
 
 
 @dataclass(frozen=True)
@@ -129,9 +131,14 @@ def _own_frame(rel: np.ndarray, heading: float) -> tuple[np.ndarray, np.ndarray]
     return rel @ np.array([c, s]), rel @ np.array([s, -c])
 
 
-def _walls(a, b, valid, robot: Robot, cfg: Settings, far: float) -> tuple[float, float]:
+def _walls(a, b, valid, robot: Robot, cfg: Settings, far: float,
+           objects=None) -> tuple[float, float]:
+    """Side gaps from points (a along, b across): walls count from ``wall_behind`` behind to
+    ``wall_ahead`` ahead, objects (``objects`` mask) only while beside the robot's body."""
     half = robot.width / 2
-    near = valid & (a >= -cfg.wall_behind) & (a <= cfg.wall_ahead) & (np.abs(b) >= half)
+    ahead = np.where(objects, robot.length / 2, cfg.wall_ahead) if objects is not None \
+        else cfg.wall_ahead
+    near = valid & (a >= -cfg.wall_behind) & (a <= ahead) & (np.abs(b) >= half)
     left = -b[near & (b < 0)]
     right = b[near & (b > 0)]
     return ((float(left.min()) - half) if left.size else far), \
@@ -175,17 +182,17 @@ def perceive(route: Route, f: Frame, pose: tuple[float, float, float], robot: Ro
     size, position, distance = _obstruction(route, a, b, hits, obstacle_hit, widen, robot, f, cfg,
                                             _own_frame(rel, pose[2]))
     heading, lane, goal = _common(route, p, pose[2], f, road, robot, cfg)
-    wl, wr = _walls(a, b, valid & ~obstacle_hit, robot, cfg, max_range)
+    wl, wr = _walls(a, b, valid, robot, cfg, max_range, obstacle_hit)
     return {"road": road, "size": size, "position": position, "obstacle": distance,
-            "heading": heading, "lane": lane, "goal": goal, "wall_left": wl, "wall_right": wr}
+            "heading": heading, "lane": lane, "goal": goal, "gap_left": wl, "gap_right": wr}
 
 
 def truth(route: Route, f: Frame, pose: tuple[float, float, float], robot: Robot,
-          side_ranges: tuple[float, float], outline: np.ndarray, wall_gaps: tuple[float, float],
+          side_ranges: tuple[float, float], outline: np.ndarray, gaps: tuple[float, float],
           cfg: Settings = Settings()) -> dict[str, float]:
     """The same inputs from the true geometry: ``side_ranges`` are exact distances to the walls
     across the route (left, right), ``outline`` points on every obstacle and other robot,
-    ``wall_gaps`` the noise-free wall gaps (from the map-predicted ranges)."""
+    ``gaps`` the noise-free side gaps (:func:`side_gaps`)."""
     p = np.array(pose[:2])
     road = side_ranges[0] + side_ranges[1]
     rel = outline - p
@@ -196,13 +203,18 @@ def truth(route: Route, f: Frame, pose: tuple[float, float, float], robot: Robot
                                             robot, f, cfg, _own_frame(rel, pose[2]))
     heading, lane, goal = _common(route, p, pose[2], f, road, robot, cfg)
     return {"road": road, "size": size, "position": position, "obstacle": distance,
-            "heading": heading, "lane": lane, "goal": goal, "wall_left": wall_gaps[0],
-            "wall_right": wall_gaps[1]}
+            "heading": heading, "lane": lane, "goal": goal, "gap_left": gaps[0],
+            "gap_right": gaps[1]}
 
 
-def wall_gaps(route_frame: Frame, dirs: np.ndarray, expected: np.ndarray, robot: Robot,
-              max_range: float, cfg: Settings = Settings()) -> tuple[float, float]:
-    """Noise-free wall gaps from the map-predicted ranges (for :func:`truth`)."""
-    rel = expected[:, None] * dirs
-    valid = expected < max_range * 0.999
-    return _walls(rel @ route_frame.t, rel @ route_frame.n, valid, robot, cfg, max_range)
+def side_gaps(route_frame: Frame, p: np.ndarray, dirs: np.ndarray, expected: np.ndarray,
+              outline: np.ndarray, robot: Robot, max_range: float,
+              cfg: Settings = Settings()) -> tuple[float, float]:
+    """Noise-free side gaps (for :func:`truth`): walls from the map-predicted ranges, objects
+    from their exact outlines."""
+    rel = np.concatenate([expected[:, None] * dirs, outline - p])
+    valid = np.concatenate([expected < max_range * 0.999, np.ones(len(outline), dtype=bool)])
+    objects = np.concatenate([np.zeros(len(expected), dtype=bool),
+                              np.ones(len(outline), dtype=bool)])
+    return _walls(rel @ route_frame.t, rel @ route_frame.n, valid, robot, cfg, max_range,
+                  objects)

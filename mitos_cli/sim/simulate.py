@@ -212,12 +212,11 @@ def simulate(world: World, planner: Planner | None = None, seed: int | None = No
             side_dirs = np.stack([-f.n, f.n])
             sides_lr = sensors.cast(pose[i, :2], side_dirs, walls, np.zeros((0, 4)),
                                     np.zeros((0, 2)), np.zeros(0), 1e6)[0]
-            other_pts = [outline] + [corners[j] for j in range(n) if j != i]
+            things = np.concatenate([outline] + [corners[j] for j in range(n) if j != i])
+            gaps = perception.side_gaps(f, pose[i, :2], dirs, expected, things, robots[i],
+                                        sen.range, cfg)
             tr = perception.truth(routes[i], f, (x[i], y[i], h[i]), robots[i],
-                                  (float(sides_lr[0]), float(sides_lr[1])),
-                                  np.concatenate(other_pts),
-                                  perception.wall_gaps(f, dirs, expected, robots[i], sen.range,
-                                                       cfg), cfg)
+                                  (float(sides_lr[0]), float(sides_lr[1])), things, gaps, cfg)
             for key in perception.INPUTS:
                 percepts_p[key][i] = p[key]
                 percepts_t[key][i] = tr[key]

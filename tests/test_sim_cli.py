@@ -1,0 +1,158 @@
+"""``mitos simulate``: the --json, --out, --plot, --trace and --require contract."""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+from pathlib import Path
+
+import pytest
+from typer.testing import CliRunner
+
+from mitos_cli.cli.app import app, main
+from mitos_cli.sim.perception import INPUTS
+
+RUNNER = CliRunner()
+KEYS = {"world", "seed", "outcome", "reached_goal", "collisions", "time_s", "path_length_in",
+        "min_clearance_in", "mean_speed_in_s", "steering_total_variation_deg", "ticks"}
+SHORT = """\
+name: short
+seed: 2
+dt: 0.05
+time_limit: 3
+robot:
+  model: tricycle
+  wheelbase: 16
+  footprint: {length: 24, width: 18}
+q_init: {x: 30, y: -10, heading: 0}
+q_goal: {x: 500, y: -10}
+map:
+  corridors:
+    - points: [[0, 0], [600, 0]]
+      width: 70
+obstacles:
+  - {name: box, shape: circle, at: [100, -12], radius: 8}
+"""
+
+
+@pytest.fixture()
+def short(tmp_path: Path) -> Path:
+    p = tmp_path / "short.yaml"
+    p.write_text(SHORT, encoding="utf-8")
+    return p
+
+
+def run(*args):
+    return RUNNER.invoke(app, ["simulate", *map(str, args)])
+
+
+def run_main(capsys, *args) -> tuple[int, str]:
+    """Through ``main``, which turns our errors into a message and exit 1."""
+    with pytest.raises(SystemExit) as info:
+        main(["simulate", *map(str, args)])
+    return info.value.code, capsys.readouterr().err
+
+
+def test_json_has_exactly_the_contract_keys(short):
+    res = run(short, "--json")
+    assert res.exit_code == 0, res.output
+    data = json.loads(res.stdout)
+    assert set(data) == KEYS
+    assert data["world"] == "short" and data["seed"] == 2 and data["outcome"] == "timeout"
+    assert data["ticks"] == 60 and isinstance(data["reached_goal"], bool)
+
+
+def test_json_matches_the_library(short):
+    from mitos_cli.sim.simulate import simulate
+    from mitos_cli.sim.worldfile import load_world
+
+    data = json.loads(run(short, "--json", "--seed", 4).stdout)
+    assert data == simulate(load_world(short), seed=4).summary()
+
+
+def test_human_output_is_a_verdict_and_a_table(short):
+    res = run(short)
+    assert res.exit_code == 0
+    first = res.stdout.splitlines()[0]
+    assert first.startswith("short: TIMEOUT after 3.00 s (seed 2, fuzzy:drive)")
+    assert "min clearance" in res.stdout and "path length" in res.stdout
+
+
+def test_out_writes_one_row_per_tick(short, tmp_path):
+    out = tmp_path / "run.csv"
+    res = run(short, "--out", out)
+    assert res.exit_code == 0
+    rows = list(csv.DictReader(io.StringIO(out.read_text())))
+    assert len(rows) == 60
+    head = rows[0].keys()
+    for col in ["t", "x", "y", "heading", "speed", "steering", "range_0", "range_35",
+                "fired", *INPUTS, *(f"true_{k}" for k in INPUTS)]:
+        assert col in head
+    assert "follow_route/" in rows[0]["fired"]
+
+
+@pytest.mark.parametrize("suffix, magic", [(".png", b"\x89PNG"), (".svg", b"<?xml")])
+def test_plot_writes_png_and_svg(short, tmp_path, suffix, magic):
+    pic = tmp_path / f"run{suffix}"
+    res = run(short, "--plot", pic)
+    assert res.exit_code == 0, res.output
+    assert pic.read_bytes().startswith(magic)
+
+
+def test_plot_refuses_an_unknown_format(short, tmp_path, capsys):
+    code, err = run_main(capsys, short, "--plot", tmp_path / "run.jpg")
+    assert code == 1 and "unknown picture format" in err
+
+
+def test_trace_every_n_ticks(short):
+    res = run(short, "--trace", "--every", 20)
+    assert res.exit_code == 0
+    assert res.stdout.count("--- tick ") == 4             # ticks 0, 20, 40 and the last
+    assert "rules fired" in res.stdout and "perceived:" in res.stdout and "true:" in res.stdout
+
+
+def test_require_success_exits_3_when_not_success(short):
+    assert run(short, "--require", "success").exit_code == 3
+    assert run(short).exit_code == 0
+
+
+def test_require_takes_only_success(short):
+    assert run(short, "--require", "collision").exit_code == 2
+
+
+def test_runs_print_a_table_of_rates(short):
+    res = run(short, short, "--json")
+    assert res.exit_code == 0
+    rows = json.loads(res.stdout)
+    assert len(rows) == 2 and rows[0]["timeout_rate"] == 1.0
+    assert set(rows[0]["time_s"]) == {"mean", "std"}
+    table = run(short, "--runs", 2, "--workers", 1).stdout
+    assert "success" in table.splitlines()[0] and "±" in table
+
+
+def test_per_run_outputs_need_one_run(short, tmp_path):
+    res = run(short, "--runs", 2, "--out", tmp_path / "x.csv")
+    assert res.exit_code == 2
+
+
+def test_a_bad_world_is_exit_1_with_position(tmp_path, capsys):
+    p = tmp_path / "bad.yaml"
+    p.write_text(SHORT.replace("dt: 0.05", "dtt: 0.05"), encoding="utf-8")
+    code, err = run_main(capsys, p)
+    assert code == 1
+    assert "bad.yaml:3:1" in err and "did you mean `dt`?" in err
+
+
+def test_a_rule_base_without_the_inputs_is_refused(short, tmp_path, capsys):
+    rules = tmp_path / "x.rules"
+    terms = tmp_path / "x.terms.yaml"
+    terms.write_text("variables:\n  speedometer:\n    role: input\n    universe: [0, 1]\n"
+                     "    terms: {LOW: {shape: left_shoulder, points: [0, 1]}}\n"
+                     "  steering:\n    role: output\n    universe: [30, 150]\n"
+                     "    terms: {ST: 90}\n  speed:\n    role: output\n    universe: [0, 60]\n"
+                     "    terms: {SLOW: 20}\n", encoding="utf-8")
+    rules.write_text('terms "x.terms.yaml"\nbehavior drive:\n  if speedometer is LOW then '
+                     'steering is ST and speed is SLOW\nend\n', encoding="utf-8")
+    code, err = run_main(capsys, short, "--rulebase", rules)
+    assert code == 1 and "does not perceive" in err

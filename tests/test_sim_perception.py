@@ -1,0 +1,69 @@
+"""Perception: the paper's inputs from geometry (true values) and from the beams."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from mitos_cli.sim import perception
+from mitos_cli.sim.perception import NO_OBSTACLE
+from mitos_cli.sim.route import Route
+from mitos_cli.sim.world import Robot
+
+ROUTE = Route.of([(0.0, 0.0), (600.0, 0.0)])
+ROBOT = Robot(length=24, width=18)
+
+
+def truth_at(x, y, outline):
+    f = perception.frame(ROUTE, np.array([x, y]), x)
+    return perception.truth(ROUTE, f, (x, y, 0.0), ROBOT, (35.0 + y, 35.0 - y),
+                            np.asarray(outline, float).reshape(-1, 2), (20.0, 20.0))
+
+
+def circle(cx, cy, r, n=32):
+    a = np.linspace(0, 2 * np.pi, n, endpoint=False)
+    return np.stack([cx + r * np.cos(a), cy + r * np.sin(a)], axis=1)
+
+
+def test_nothing_ahead_means_size_zero_and_no_obstacle():
+    t = truth_at(100, 0, np.zeros((0, 2)))
+    assert t["size"] == 0 and t["position"] == 0 and t["obstacle"] == NO_OBSTACLE
+    assert t["road"] == 70 and t["heading"] == pytest.approx(0.0)
+
+
+def test_an_obstacle_right_of_centre():
+    t = truth_at(100, 0, circle(200, -10, 9))          # -y is the robot's right
+    assert t["size"] == pytest.approx(18, abs=0.2)
+    assert t["position"] == pytest.approx(10, abs=0.1)
+    assert t["obstacle"] == pytest.approx(200 - 9 - 100 - 12, abs=0.2)
+
+
+def test_an_object_outside_the_swept_band_does_not_obstruct():
+    t = truth_at(100, 0, circle(200, 40, 5))
+    assert t["obstacle"] == NO_OBSTACLE
+
+
+def test_lane_and_heading_for_keep_right():
+    t = truth_at(100, 5, np.zeros((0, 2)))             # 5 in left of the centre
+    # keep-right lane: min(road / 4, road / 2 - width / 2 - 6) = 17.5 right of the centre
+    assert t["lane"] == pytest.approx(-5 - 17.5)
+    assert t["heading"] > 0                            # the route lies to the right
+
+
+def test_beams_see_the_obstacle_that_the_map_does_not_predict():
+    from mitos_cli.sim import sensors
+    from mitos_cli.sim.staticmap import corridor_rects, corridor_walls
+    from mitos_cli.sim.world import Corridor, Sensors
+
+    walls = corridor_walls(corridor_rects((Corridor(((0, 0), (600, 0)), 70),)))
+    sen = Sensors(count=72)
+    dirs = sensors.beam_directions(0.0, sen.angles)
+    p = np.array([100.0, 0.0])
+    expected, true = sensors.cast(p, dirs, walls, np.zeros((0, 4)), np.array([[180.0, -10.0]]),
+                                  np.array([9.0]), sen.range)
+    f = perception.frame(ROUTE, p, 100.0)
+    got = perception.perceive(ROUTE, f, (100.0, 0.0, 0.0), ROBOT, dirs, true, expected,
+                              sen.range, 2 * np.pi / 72, 4.0)
+    assert got["road"] == pytest.approx(70, abs=0.5)
+    assert got["obstacle"] == pytest.approx(180 - 9 - 100 - 12, abs=2)
+    assert 0 < got["position"] < 20 and 10 < got["size"] < 30       # right of centre, ~18

@@ -1,0 +1,81 @@
+"""Ray casting against known geometry, walls from corridors and grids, seeded noise."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from mitos_cli.sim import geometry, sensors
+from mitos_cli.sim.staticmap import corridor_rects, corridor_walls, grid_walls
+from mitos_cli.sim.world import Corridor, Grid, Sensors
+
+
+def walls_of(*corridors):
+    return corridor_walls(corridor_rects(tuple(corridors)))
+
+
+def test_rays_in_a_straight_corridor():
+    walls = walls_of(Corridor(((0, 0), (400, 0)), 70))
+    dirs = sensors.beam_directions(0.0, np.deg2rad([0, 90, 180, 270, 45]))
+    r = geometry.ray_segments(np.array([100.0, 0.0]), dirs, walls, 1000.0)
+    assert r[:4] == pytest.approx([335, 35, 135, 35])       # end walls 35 beyond the points
+    assert r[4] == pytest.approx(35 * math.sqrt(2))
+    assert geometry.ray_segments(np.zeros(2), dirs, walls, 20.0).max() == 20.0   # range cap
+
+
+def test_an_l_corner_is_open_inside_and_closed_outside():
+    walls = walls_of(Corridor(((0, 0), (200, 0), (200, 200)), 60))
+    up = geometry.ray_segments(np.array([200.0, 0.0]), np.array([[0.0, 1.0]]), walls, 1e3)
+    right = geometry.ray_segments(np.array([200.0, 0.0]), np.array([[1.0, 0.0]]), walls, 1e3)
+    assert up[0] == pytest.approx(230) and right[0] == pytest.approx(30)
+    assert not any(np.allclose(w, [170, 30, 200, 30]) for w in walls)   # no wall across
+
+
+def test_a_crossroads_has_openings_both_ways():
+    walls = walls_of(Corridor(((0, 0), (400, 0)), 60), Corridor(((200, -200), (200, 200)), 60))
+    dirs = sensors.beam_directions(0.0, np.deg2rad([0, 90, 180, 270]))
+    r = geometry.ray_segments(np.array([200.0, 0.0]), dirs, walls, 1e3)
+    assert r == pytest.approx([230, 230, 230, 230])
+
+
+def test_rays_hit_circles_and_rectangles():
+    dirs = np.array([[1.0, 0.0], [0.0, 1.0], [-1.0, 0.0]])
+    r = geometry.ray_circles(np.zeros(2), dirs, np.array([[50.0, 0.0]]), np.array([10.0]), 99.)
+    assert r == pytest.approx([40, 99, 99])
+    sides = geometry.polygon_segments(geometry.rect_corners(0.0, 30.0, 0.0, 20.0, 10.0))
+    r = geometry.ray_segments(np.zeros(2), dirs, sides, 99.0)
+    assert r == pytest.approx([99, 25, 99])
+
+
+def test_sensing_returns_map_and_true_ranges():
+    walls = walls_of(Corridor(((0, 0), (400, 0)), 70))
+    dirs = sensors.beam_directions(0.0, Sensors(count=4).angles)
+    expected, true = sensors.cast(np.array([100.0, 0.0]), dirs, walls, np.zeros((0, 4)),
+                                  np.array([[150.0, 0.0]]), np.array([5.0]), 150.0)
+    assert expected == pytest.approx([150, 35, 135, 35]) and true == pytest.approx([45, 35, 135, 35])
+
+
+def test_noise_is_seeded_and_keeps_no_echo_at_range():
+    r = np.array([10.0, 50.0, 150.0])
+    a = sensors.add_noise(r, 1.0, 150.0, np.random.default_rng(7))
+    b = sensors.add_noise(r, 1.0, 150.0, np.random.default_rng(7))
+    assert np.array_equal(a, b) and a[2] == 150.0 and not np.array_equal(a[:2], r[:2])
+
+
+def test_grid_walls_are_cell_edges_merged_into_runs():
+    occ = np.ones((5, 6), dtype=bool)
+    occ[1:4, 1:5] = False                      # a free 4 x 3 room inside
+    walls = grid_walls(Grid(occ, 10.0, (0.0, 0.0)))
+    assert len(walls) == 4                     # one merged run per side
+    r = geometry.ray_segments(np.array([25.0, 25.0]), np.array([[1.0, 0.0], [0.0, 1.0]]),
+                              walls, 1e3)
+    assert r == pytest.approx([25, 15])
+
+
+def test_ring_and_fan_layouts():
+    ring = Sensors(layout="ring", count=4).angles
+    assert np.rad2deg(ring) == pytest.approx([0, 90, 180, 270])
+    fan = Sensors(layout="fan", count=3, fov=180).angles
+    assert np.rad2deg(fan) == pytest.approx([90, 0, -90])

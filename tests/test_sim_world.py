@@ -1,0 +1,165 @@
+"""World files: every complaint names the file, line and column (one test per error)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from mitos_cli.errors import WorldError
+from mitos_cli.sim.worldfile import load_world, parse_world, resolve_world_path
+
+BASE = """\
+name: t
+seed: 1
+dt: 0.05
+time_limit: 10
+robot:
+  model: tricycle
+  wheelbase: 16
+  footprint: {length: 24, width: 18}
+q_init: {x: 30, y: 0, heading: 0}
+q_goal: {x: 300, y: 0}
+map:
+  corridors:
+    - points: [[0, 0], [400, 0]]
+      width: 70
+"""
+
+
+def error(text: str, path: str = "w.yaml") -> str:
+    with pytest.raises(WorldError) as info:
+        parse_world(text, path)
+    return info.value.render()
+
+
+def test_the_base_world_loads():
+    w = parse_world(BASE, "w.yaml")
+    assert w.name == "t" and w.robot.wheelbase == 16 and w.robot.max_speed == 60
+    assert w.agents[0].goal.tolerance == 12 and w.behavior == "drive"
+    assert w.corridors[0].width == 70
+
+
+def test_unknown_top_level_key_suggests_the_closest():
+    msg = error(BASE + "time_limt: 5\n")
+    assert "w.yaml:15:1" in msg and "unknown key `time_limt`" in msg
+    assert "did you mean `time_limit`?" in msg
+
+
+def test_unknown_robot_key_points_at_its_line():
+    msg = error(BASE.replace("  wheelbase: 16", "  wheelbas: 16"))
+    assert "w.yaml:7:3" in msg and "did you mean `wheelbase`?" in msg
+
+
+def test_missing_field_names_what_to_add():
+    msg = error(BASE.replace("q_goal: {x: 300, y: 0}\n", ""))
+    assert "missing `q_goal`" in msg and "w.yaml:1:1" in msg
+
+
+def test_missing_footprint():
+    msg = error(BASE.replace("  footprint: {length: 24, width: 18}\n", ""))
+    assert "missing `footprint` in robot" in msg and "w.yaml:6:3" in msg
+
+
+def test_start_inside_a_wall():
+    msg = error(BASE.replace("q_init: {x: 30, y: 0", "q_init: {x: 30, y: 50"))
+    assert "w.yaml:9:9" in msg and "start (q_init) at (30, 50) lies inside a wall" in msg
+
+
+def test_goal_inside_a_wall():
+    msg = error(BASE.replace("q_goal: {x: 300, y: 0}", "q_goal: {x: 500, y: 0}"))
+    assert "w.yaml:10:9" in msg and "goal (q_goal)" in msg and "inside a wall" in msg
+
+
+def test_unknown_obstacle_shape():
+    msg = error(BASE + "obstacles:\n  - {name: a, shape: circel, at: [100, 0], radius: 5}\n")
+    assert "w.yaml:16:" in msg and "did you mean `circle`?" in msg
+
+
+def test_velocity_and_waypoints_together():
+    msg = error(BASE + "obstacles:\n  - {name: a, shape: circle, at: [100, 0], radius: 5,"
+                       " velocity: [1, 0], waypoints: [[200, 0]], speed: 3}\n")
+    assert "both `velocity` and `waypoints`" in msg
+
+
+def test_randomise_names_an_unknown_obstacle():
+    msg = error(BASE + "obstacles:\n  - {name: box, shape: circle, at: [100, 0], radius: 5}\n"
+                       "randomise:\n  obstacles:\n    boxx: {dx: [-1, 1]}\n")
+    assert "w.yaml:19:5" in msg and "did you mean `box`?" in msg
+
+
+def test_a_number_that_is_not_one():
+    msg = error(BASE.replace("dt: 0.05", "dt: fast"))
+    assert "w.yaml:3:5" in msg and "must be a number" in msg
+
+
+def test_steering_limits_must_bracket_straight():
+    msg = error(BASE.replace("  wheelbase: 16\n", "  wheelbase: 16\n  steering: {min: 100}\n"))
+    assert "min < straight < max" in msg
+
+
+def test_invalid_yaml_has_a_position():
+    msg = error(BASE + "obstacles: [\n")
+    assert "invalid YAML" in msg and "w.yaml:" in msg
+
+
+def test_unreadable_map_image(tmp_path: Path):
+    (tmp_path / "map.yaml").write_text("image: missing.pgm\nresolution: 0.05\n"
+                                       "origin: [0, 0, 0]\n", encoding="utf-8")
+    world = tmp_path / "w.yaml"
+    world.write_text(BASE.replace("  corridors:\n    - points: [[0, 0], [400, 0]]\n"
+                                  "      width: 70\n", "  grid: map.yaml\n"), encoding="utf-8")
+    with pytest.raises(WorldError) as info:
+        load_world(world)
+    msg = info.value.render()
+    assert "map.yaml:1:8" in msg and "cannot read map image" in msg and "missing.pgm" in msg
+
+
+def test_a_map_image_that_is_not_a_pgm(tmp_path: Path):
+    (tmp_path / "map.pgm").write_bytes(b"\x89PNG not a pgm")
+    (tmp_path / "map.yaml").write_text("image: map.pgm\nresolution: 0.05\norigin: [0, 0, 0]\n",
+                                       encoding="utf-8")
+    world = tmp_path / "w.yaml"
+    world.write_text(BASE.replace("  corridors:\n    - points: [[0, 0], [400, 0]]\n"
+                                  "      width: 70\n", "  grid: map.yaml\n"), encoding="utf-8")
+    with pytest.raises(WorldError, match="not a PGM image"):
+        load_world(world)
+
+
+def test_a_rotated_map_is_refused(tmp_path: Path):
+    (tmp_path / "map.pgm").write_bytes(b"P5 2 2 255\n" + bytes([254, 254, 254, 254]))
+    (tmp_path / "map.yaml").write_text("image: map.pgm\nresolution: 0.05\n"
+                                       "origin: [0, 0, 3.14]\n", encoding="utf-8")
+    world = tmp_path / "w.yaml"
+    world.write_text(BASE.replace("  corridors:\n    - points: [[0, 0], [400, 0]]\n"
+                                  "      width: 70\n", "  grid: map.yaml\n"), encoding="utf-8")
+    with pytest.raises(WorldError) as info:
+        load_world(world)
+    assert "rotated" in info.value.render() and "map.yaml:3:9" in info.value.render()
+
+
+def test_unknown_map_key_in_map_yaml(tmp_path: Path):
+    (tmp_path / "map.yaml").write_text("image: m.pgm\nresolutoin: 0.05\n", encoding="utf-8")
+    world = tmp_path / "w.yaml"
+    world.write_text(BASE.replace("  corridors:\n    - points: [[0, 0], [400, 0]]\n"
+                                  "      width: 70\n", "  grid: map.yaml\n"), encoding="utf-8")
+    with pytest.raises(WorldError, match="did you mean `resolution`"):
+        load_world(world)
+
+
+def test_corridors_that_do_not_connect_start_and_goal():
+    from mitos_cli.sim.simulate import prepare
+
+    text = BASE.replace("    - points: [[0, 0], [400, 0]]\n      width: 70\n",
+                        "    - points: [[0, 0], [100, 0]]\n      width: 70\n"
+                        "    - points: [[200, 0], [400, 0]]\n      width: 70\n")
+    w = parse_world(text, "w.yaml")
+    with pytest.raises(WorldError, match="do not connect"):
+        prepare(w)
+
+
+def test_packaged_world_names_resolve_and_unknown_ones_suggest():
+    assert resolve_world_path("figure4.yaml").name == "figure4.yaml"
+    assert resolve_world_path("figure4").name == "figure4.yaml"
+    with pytest.raises(WorldError, match="did you mean `figure4.yaml`"):
+        resolve_world_path("figure5.yaml")
