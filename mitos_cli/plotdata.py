@@ -80,8 +80,12 @@ def visible(mu: float) -> bool:
 def curve_grid(universe: tuple[float, float], terms: tuple[Term, ...] = (),
                points: int = CURVE_POINTS) -> np.ndarray:
     """``points`` samples of the universe plus every finite corner inside it, and the points
-    just beside each corner, so that kinks and vertical edges land exactly on the grid."""
+    just beside each corner, so that kinks and vertical edges land exactly on the grid. When
+    every term is piecewise linear, the ends and corners alone draw them exactly (and keep
+    SVG files small)."""
     lo, hi = universe
+    if terms and all(t.corners is not None for t in terms):
+        points = 2
     extra = []
     for term in terms:
         corners = term.corners

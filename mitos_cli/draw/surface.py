@@ -100,7 +100,8 @@ def draw_surface3d(fig, ax, s: Surface) -> None:
         lo, hi = lo - 1, hi + 1
     floor = lo - 0.25 * (hi - lo)
     surf = ax.plot_surface(X, Y, z, cmap=CMAP, vmin=lo, vmax=hi, rstride=1, cstride=1,
-                           linewidth=0.15, edgecolor=(1, 1, 1, 0.25), antialiased=True)
+                           linewidth=0.15, edgecolor=(1, 1, 1, 0.25), antialiased=True,
+                           rasterized=True)     # an SVG keeps one image, not 3,600 polygons
     if finite.size:
         levels = _levels(s.z)
         if levels is not None and len(levels):
