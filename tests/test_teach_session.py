@@ -257,3 +257,14 @@ def test_simulate_and_at_and_their_mistakes(rules, tmp_path):
     assert "plotted" in text and list(tmp_path.glob("a*.svg"))
     with pytest.raises(Exception, match="unknown picture format"):
         s.run("adapt epochs 3 plot a.gif")
+
+
+def test_examples_belong_to_the_behavior_they_correct(rules):
+    s, out = session(rules)
+    s.run("correct road=78 size=45 position=4 -> steering=60")
+    s.run("use drive")
+    with pytest.raises(LessonError) as info:
+        s.run("adapt")
+    assert "the examples given so far correct avoid_obstacle: `use avoid_obstacle`" in \
+        info.value.render()
+    assert "[avoid_obstacle, correct]" in say(s, out, "show examples")

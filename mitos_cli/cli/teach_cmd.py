@@ -68,7 +68,12 @@ def teach_command(
         session.echo = emit
         if lesson != "-":
             session.base = Path(lesson).parent
-        run_lesson(session, text, name)
+        try:
+            run_lesson(session, text, name)
+        except KeyboardInterrupt:
+            err(f"interrupted: every change so far is in the journal; `mitos teach --resume "
+                f"--session {journal.directory.name}` continues")
+            raise typer.Exit(130) from None
         if session.save_as is not None and session.unsaved:
             session.run("save")
         return

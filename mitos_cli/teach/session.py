@@ -46,6 +46,7 @@ class Example:
     inputs: dict
     targets: dict
     source: str = ""
+    behavior: str = ""           # the behavior whose outputs the targets correct
 
 
 @dataclass
@@ -128,7 +129,8 @@ def apply(state: State, entry: dict) -> None:
     elif op == "activate":
         state.active = entry["behavior"]
     elif op == "examples":
-        state.examples += [Example(e["inputs"], e["targets"], e.get("source", ""))
+        state.examples += [Example(e["inputs"], e["targets"], e.get("source", ""),
+                                   entry.get("behavior", ""))
                            for e in entry["examples"]]
     elif op == "adapt":
         rb = _set_params(rb, entry["terms"])
@@ -424,14 +426,15 @@ class Session:
 
     def training_set(self, compiled: CompiledRuleBase) -> tuple[np.ndarray, np.ndarray]:
         """``X[n, k]`` and targets ``[n, m]`` (NaN: not given) from the usable examples."""
-        usable = [e for e in self.state.examples
-                  if all(k in e.inputs for k in compiled.inputs)
-                  and any(o in e.targets for o in compiled.outputs)]
+        usable = [e for e in self.state.examples if e.behavior == compiled.behavior]
         if not usable:
+            others = sorted({e.behavior for e in self.state.examples})
+            hint = (f"the examples given so far correct {', '.join(others)}: `use "
+                    f"{others[0]}` to adapt it" if others else
+                    "give corrections: `correct road=78 size=45 position=4 -> steering=60`, "
+                    "or `simulate WORLD` then `at 12.5s steering=55`")
             raise LessonError(f"no examples for behavior `{compiled.behavior}` to learn from",
-                              hint="give corrections: `correct road=78 size=45 position=4 -> "
-                                   "steering=60`, or `simulate WORLD` then `at 12.5s "
-                                   "steering=55`")
+                              hint=hint)
         X = np.array([[e.inputs[k] for k in compiled.inputs] for e in usable], dtype=float)
         T = np.array([[e.targets.get(o, np.nan) for o in compiled.outputs] for e in usable],
                      dtype=float)
@@ -588,14 +591,14 @@ class Session:
         lines = []
         try:
             compiled = self.compiled()
-            usable = [e for e in self.state.examples
-                      if all(k in e.inputs for k in compiled.inputs)]
+            usable = [e for e in self.state.examples if e.behavior == compiled.behavior]
             now = dict(zip(map(id, usable), self._outputs(compiled, [e.inputs for e in usable])))
         except MitosError:
             now = {}
         for i, e in enumerate(self.state.examples, 1):
+            where = ", ".join(x for x in (e.behavior, e.source) if x)
             lines.append(f"{i:>3}  {_example_text(e.inputs, e.targets, now.get(id(e)))}"
-                         + (f"   [{e.source}]" if e.source else ""))
+                         + (f"   [{where}]" if where else ""))
         return "\n".join(lines)
 
     def describe_behaviors(self) -> str:
