@@ -229,3 +229,11 @@ def test_prompt_in_a_terminal_completes_and_keeps_history(work):
     finally:
         proc.kill()
         os.close(master)
+
+
+def test_an_unwritable_directory_is_a_clear_error(work):
+    (work / ".mitos").write_text("not a directory")
+    res = mitos("teach", "rb/mitos.rules", "--lesson", "-", cwd=work, stdin="help\n")
+    assert res.returncode == 1
+    assert "cannot create the session directory .mitos/teach/ here" in res.stderr
+    assert "Traceback" not in res.stderr

@@ -32,15 +32,21 @@ def sessions_dir(base: Path | None = None) -> Path:
 def new_session_dir(stem: str, base: Path | None = None) -> Path:
     """A fresh directory ``.mitos/teach/<stem>-<date>-<time>[-n]``."""
     root = sessions_dir(base)
-    root.mkdir(parents=True, exist_ok=True)
     name = f"{stem}-{time.strftime('%Y%m%d-%H%M%S')}"
-    for n in range(1000):
-        candidate = root / (name if n == 0 else f"{name}-{n}")
-        try:
-            candidate.mkdir()
-            return candidate
-        except FileExistsError:
-            continue
+    try:
+        root.mkdir(parents=True, exist_ok=True)
+        for n in range(1000):
+            candidate = root / (name if n == 0 else f"{name}-{n}")
+            try:
+                candidate.mkdir()
+                return candidate
+            except FileExistsError:
+                continue
+    except OSError as exc:
+        raise LessonError(f"cannot create the session directory {ROOT}/ here: "
+                          f"{exc.strerror or exc}",
+                          hint="run `mitos teach` from a directory you can write to (the "
+                               "journal of the session lives there)") from None
     raise LessonError(f"cannot create a session directory in {root}")   # pragma: no cover
 
 
@@ -113,10 +119,14 @@ class Journal:
         """Add an entry and make it durable before returning."""
         entry = {"seq": self.next_seq, "op": op, **data}
         line = json.dumps(entry, ensure_ascii=False, separators=(",", ":")) + "\n"
-        with open(self.path, "a", encoding="utf-8") as fh:
-            fh.write(line)
-            fh.flush()
-            os.fsync(fh.fileno())
+        try:
+            with open(self.path, "a", encoding="utf-8") as fh:
+                fh.write(line)
+                fh.flush()
+                os.fsync(fh.fileno())
+        except OSError as exc:
+            raise LessonError(f"cannot write the journal {self.path}: "
+                              f"{exc.strerror or exc}; the change was not made") from None
         self.entries.append(entry)
         return entry
 
