@@ -237,3 +237,12 @@ def test_an_unwritable_directory_is_a_clear_error(work):
     assert res.returncode == 1
     assert "cannot create the session directory .mitos/teach/ here" in res.stderr
     assert "Traceback" not in res.stderr
+
+
+def test_prompt_continues_a_wrapped_rule_and_an_empty_line_ends_it(work):
+    res = mitos("teach", "rb/mitos.rules", cwd=work,
+                stdin="r30: if road is NARROW\nthen speed is CREEP\nif road is\n\nshow rules\n")
+    assert res.returncode == 0
+    assert "r30: if road is NARROW then speed is CREEP" in res.stdout
+    assert "<prompt>:1:11: syntax error: the line ends too early" in res.stderr
+    assert "r30: if road is NARROW then speed is CREEP  (new)" in res.stdout

@@ -108,8 +108,11 @@ def interact(session: Session, history: Path | None = None) -> None:
         while True:
             try:
                 line = input(prompt_text(session) if tty else "")
-                while incomplete(line):
-                    line += "\n" + input("... " if tty else "")
+                while incomplete(line):          # a rule continued on the next line
+                    more = input("... " if tty else "")
+                    if not more.strip():         # an empty line ends it (and says why)
+                        break
+                    line += "\n" + more
             except EOFError:
                 session.out("")
                 break
