@@ -45,7 +45,7 @@ from .. import hedges as hedge_mod
 from ..compile import CompiledRuleBase
 from ..engine import evaluate
 from ..errors import LessonError
-from ..model import Consequent, Rule, RuleBase
+from ..model import Rule, RuleBase
 from ..shapes import kernel_params
 
 #: Fraction of a universe the most-moving parameter moves in one full step (times eta).
@@ -391,7 +391,6 @@ def gradient(p: Parameters, values: np.ndarray, X: np.ndarray,
 
     grad = np.zeros(len(values))
     # membership layer
-    T = c.n_terms
     rows = np.flatnonzero((p.corner_knot >= 0).any(axis=1))
     if rows.size:
         corners = np.array([[values[i] if i >= 0 else o for i, o in
@@ -404,7 +403,6 @@ def gradient(p: Parameters, values: np.ndarray, X: np.ndarray,
         np.add.at(grad, idx[ok], gcorner[ok])
     ok = p.cons_knot >= 0
     np.add.at(grad, p.cons_knot[ok], gcons[ok])
-    del T
     return Q, grad
 
 
@@ -674,4 +672,4 @@ def _with_crisp(rule: Rule, new: dict[str, float]) -> Rule:
 
 
 __all__ = ["Adaptation", "Knot", "Parameters", "adapt", "feasible", "gradient",
-           "learned_rulebase", "loss", "parameterise", "with_values", "Consequent"]
+           "learned_rulebase", "loss", "parameterise", "with_values"]

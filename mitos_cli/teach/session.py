@@ -31,7 +31,7 @@ import numpy as np
 from ..build import check_expr, check_rule, load_rules_file
 from ..compile import CompiledRuleBase, compile_rulebase
 from ..errors import LessonError, MitosError, RuleBaseError, unknown
-from ..model import And, Behavior, Expr, Not, Or, Prop, Rule, RuleBase, format_expr, \
+from ..model import And, Behavior, Expr, Not, Prop, Rule, RuleBase, format_expr, \
     format_number, format_rule, format_use
 from ..operators import resolve
 from ..parse import parse_rule
