@@ -371,9 +371,24 @@ class RuleRow:
     index: int                # position in the compiled behavior
     label: str
     text: str
-    dof: float
+    dof: float                # the engine's DOF: antecedent x rule weight x `use` contexts
     props: tuple[PropView, ...]
     consequents: tuple[ConsequentView, ...]
+    antecedent: float = float("nan")   # the antecedent's value alone (eq. 17 for an AND)
+
+    @property
+    def factor(self) -> float:
+        """What the rule's weight and its behavior's ``use ... when`` contexts multiply the
+        antecedent by (1 for a plain rule)."""
+        return self.dof / self.antecedent if self.antecedent > 0 else 1.0
+
+    @property
+    def dof_text(self) -> str:
+        """``DOF 0.10``, or ``DOF 0.10 = 0.60 x 0.17`` when a weight or context scales it."""
+        text = f"DOF {self.dof:.2f}"
+        if abs(self.factor - 1.0) > 1e-12:
+            text += f" = {self.antecedent:.2f} × {self.factor:.2f}"
+        return text
 
 
 @dataclass(frozen=True)
@@ -464,7 +479,8 @@ def rule_view(compiled: CompiledRuleBase, values: dict[str, float]) -> RuleView:
     X = as_batch(compiled, values)
     if X.shape[0] != 1:
         raise InputError("the rule viewer takes one value per input")
-    res = evaluate(compiled, X, detail=True, strict=False)
+    res = evaluate(compiled, X, detail=True, keep_values=True, strict=False)
+    antecedent = res.values[0][compiled.rule_col]
     mu = res.memberships[0]
     dof = res.dof[0]
     term_index = {key: i for i, key in enumerate(compiled.term_names)}
@@ -500,7 +516,7 @@ def rule_view(compiled: CompiledRuleBase, values: dict[str, float]) -> RuleView:
                            *((None, None) if sets is None else sets[j][0][int(r)]))
             for j, out in enumerate(compiled.outputs) if compiled.cons_mask[r, j])
         rows.append(RuleRow(int(r), compiled.labels[r], compiled.rule_text(r), float(dof[r]),
-                            tuple(props), cons))
+                            tuple(props), cons, float(antecedent[r])))
 
     outputs = []
     for j, name in enumerate(compiled.outputs):

@@ -234,9 +234,11 @@ def render_rule_view(view: RuleView, width: int = 72, color: bool = False) -> st
     out += ["", f"rules fired ({len(view.rows)} of {view.n_rules}):"]
     tw = max((len(p.text) for r in view.rows for p in r.props), default=0)
     lw = max((len(r.label) for r in view.rows), default=0)
+    dw = max((len(r.dof_text) for r in view.rows), default=0)
     for row in view.rows:
         cons = " and ".join(_consequent_text(c) for c in row.consequents)
-        out.append(f"  {row.label.ljust(lw)}  DOF {row.dof:.2f} {_bar(row.dof)}  then {cons}")
+        out.append(f"  {row.label.ljust(lw)}  {row.dof_text.ljust(dw)} {_bar(row.dof)}  "
+                   f"then {cons}")
         for p in row.props:
             out.append(f"  {' ' * lw}    {p.text.ljust(tw)}  {p.value:.2f} {_bar(p.value)}")
     if not view.rows:

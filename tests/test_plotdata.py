@@ -278,6 +278,28 @@ def test_rule_view_hedges_and_negation_are_what_enters_the_rule(tmp_path):
     very = rows["#5"].props[1]
     assert very.hedges == ("very",) and very.value == pytest.approx(very.mu ** 2)
     assert rows["#3"].dof == pytest.approx(0.8 * min(p.value for p in rows["#3"].props))
+    assert rows["#3"].antecedent == min(p.value for p in rows["#3"].props)
+    assert rows["#3"].factor == pytest.approx(0.8)                # `with 0.8`
+    assert rows["#3"].dof_text == f"DOF {rows['#3'].dof:.2f} = 0.33 × 0.80"
+    assert rows["#2"].factor == 1.0 and rows["#2"].dof_text == f"DOF {rows['#2'].dof:.2f}"
+
+
+def test_rule_view_shows_use_contexts(mitos):
+    """In a blended behavior (`use X when C`), a row's DOF is its antecedent times the
+    context's degree: the viewer says so."""
+    if "drive" not in mitos.behaviors:
+        pytest.skip("the packaged rule base has no `drive` behavior")
+    drive = mitos.behavior("drive")
+    values = {name: float(np.mean(drive.compiled.universe[k]))
+              for k, name in enumerate(drive.inputs)}
+    values.update(road=78, size=45, position=4, obstacle=60)     # obstacle NEAR 0.83, FAR 0.17
+    view = plotdata.rule_view(drive.compiled, values)
+    result = evaluate(drive.compiled, as_batch(drive.compiled, values))
+    fired = np.flatnonzero(result.dof[0] > 0)
+    assert [r.index for r in view.rows] == fired.tolist()
+    for row in view.rows:
+        assert row.antecedent * row.factor == pytest.approx(row.dof, rel=1e-12)
+    assert any(row.factor < 1 and " × " in row.dof_text for row in view.rows)
 
 
 @pytest.mark.parametrize("implication, aggregation", [("min", "max"), ("product", "probabilistic_sum")])

@@ -144,7 +144,8 @@ def draw_rules(view: RuleView, path: str | Path | None = None, *, title: str | N
             ax.axhline(base, color="black", linewidth=0.8)
             draw_antecedent(ax, base, row, inp.name)
             if k == 0:
-                ax.text(-0.08, base + BAND / 2, f"{row.label}\nDOF {row.dof:.2f}",
+                ax.text(-0.08, base + BAND / 2, f"{row.label}\n" + row.dof_text.replace(
+                            " = ", "\n= "),
                         transform=ax.get_yaxis_transform(), ha="right", va="center",
                         fontsize=8)
         ax.axvline(inp.value, color=VALUE_COLOR, linewidth=1.1)
