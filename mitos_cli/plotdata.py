@@ -115,8 +115,7 @@ def linear_formula(term: Term, inputs: tuple[str, ...]) -> str:
     return f"y = {text}"
 
 
-def _term_curve(term: Term, x: np.ndarray, universe: tuple[float, float],
-                inputs: tuple[str, ...]) -> TermCurve:
+def _term_curve(term: Term, x: np.ndarray, inputs: tuple[str, ...]) -> TermCurve:
     if term.shape == "linear":
         empty = np.empty(0)
         return TermCurve(term.name, "linear", empty, empty, float("nan"), float("nan"),
@@ -144,7 +143,7 @@ def variable_plot(variable: Variable, value: float | None = None, *,
     """Sample every term of ``variable``; mark ``value`` (clamped to the universe, as the
     engine clamps inputs). ``inputs`` names the coefficients of ``linear`` terms."""
     x = curve_grid(variable.universe, variable.terms, points)
-    curves = tuple(_term_curve(t, x, variable.universe, inputs) for t in variable.terms)
+    curves = tuple(_term_curve(t, x, inputs) for t in variable.terms)
     mus: tuple[tuple[str, float], ...] = ()
     clamped = False
     if value is not None:

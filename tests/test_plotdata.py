@@ -302,7 +302,8 @@ def test_rule_view_shows_use_contexts(mitos):
     assert any(row.factor < 1 and " × " in row.dof_text for row in view.rows)
 
 
-@pytest.mark.parametrize("implication, aggregation", [("min", "max"), ("product", "probabilistic_sum")])
+@pytest.mark.parametrize("implication, aggregation",
+                         [("min", "max"), ("product", "probabilistic_sum")])
 def test_rule_view_mamdani_sets_and_crisp_result(tmp_path, implication, aggregation):
     rb = load_rulebase(write_mamdani(tmp_path, implication, aggregation))
     view = plotdata.rule_view(rb.compiled, {"road": 80, "size": 30})
