@@ -79,3 +79,14 @@ def test_ring_and_fan_layouts():
     assert np.rad2deg(ring) == pytest.approx([0, 90, 180, 270])
     fan = Sensors(layout="fan", count=3, fov=180).angles
     assert np.rad2deg(fan) == pytest.approx([90, 0, -90])
+
+
+def test_box_to_segment_distance_matches_the_polygon_distance():
+    rng = np.random.default_rng(3)
+    segs = rng.uniform(-40, 40, (400, 4))
+    box = geometry.polygon_segments(geometry.rect_corners(0.0, 0.0, 0.0, 24.0, 18.0))
+    slow = geometry.segment_distance(box, segs).min(axis=0)
+    inside = (np.abs(segs[:, 0]) < 12) & (np.abs(segs[:, 1]) < 9)
+    slow = np.where(inside, 0.0, slow)                   # a segment starting inside touches
+    fast = geometry.box_segment_distance(12.0, 9.0, segs)
+    assert fast == pytest.approx(slow, abs=1e-9)

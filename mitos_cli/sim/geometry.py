@@ -153,3 +153,29 @@ def clip_segment_outside(seg: np.ndarray, rects: np.ndarray, shrink: float = 1e-
     length = float(np.hypot(*(p1 - p0)))
     return [np.concatenate([p0 + a * (p1 - p0), p0 + b * (p1 - p0)]) for a, b in pieces
             if (b - a) * length > 1e-6]
+
+
+def box_segment_distance(hl: float, hw: float, seg: np.ndarray) -> np.ndarray:
+    """Distances ``[S]`` from the box ``[-hl, hl] x [-hw, hw]`` to segments ``[S, 4]`` given in
+    the box's frame (0 when a segment touches or crosses the box)."""
+    if len(seg) == 0:
+        return np.zeros(0)
+    x0, y0, x1, y1 = seg[:, 0], seg[:, 1], seg[:, 2], seg[:, 3]
+    # the endpoints' distances to the box
+    e0 = np.hypot(np.maximum(np.abs(x0) - hl, 0.0), np.maximum(np.abs(y0) - hw, 0.0))
+    e1 = np.hypot(np.maximum(np.abs(x1) - hl, 0.0), np.maximum(np.abs(y1) - hw, 0.0))
+    corners = np.array([[-hl, -hw], [hl, -hw], [hl, hw], [-hl, hw]])
+    c = point_segment_distance(corners, seg).min(axis=0)
+    d = np.minimum(np.minimum(e0, e1), c)
+    # crossing: Liang-Barsky clip of the segment against the box
+    dx, dy = x1 - x0, y1 - y0
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t0 = np.zeros(len(seg))
+        t1 = np.ones(len(seg))
+        for p, q in ((-dx, x0 + hl), (dx, hl - x0), (-dy, y0 + hw), (dy, hw - y0)):
+            r = q / p
+            par = p == 0
+            t0 = np.where(~par & (p < 0), np.maximum(t0, r), t0)
+            t1 = np.where(~par & (p > 0), np.minimum(t1, r), t1)
+            t1 = np.where(par & (q < 0), -1.0, t1)
+    return np.where(t0 <= t1, 0.0, d)

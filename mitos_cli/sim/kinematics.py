@@ -83,30 +83,27 @@ def advance(x: np.ndarray, y: np.ndarray, heading: np.ndarray, speed: np.ndarray
 def step(x, y, heading, speed, steering, cmd_steering, cmd_speed, lim: Limits, dt: float,
          substeps: int):
     """One tick: in each of ``substeps`` equal parts of ``dt``, move the steering and speed
-    toward the commands within their limits, then drive an exact arc (the same arithmetic as
-    :func:`limit_commands` and :func:`advance`, fused). Returns (x, y, heading, speed,
-    steering)."""
+    toward the commands within their limits, then drive an exact arc. All substeps at once:
+    rows ``k = 1..substeps`` of ``[substeps, n]`` arrays (the ramp toward a clipped target is
+    ``start + clip(target - start, -k d, k d)``). Returns (x, y, heading, speed, steering)."""
     sdt = dt / substeps
+    k = np.arange(1, substeps + 1, dtype=float)[:, None]
     target = _clip(cmd_steering, lim.steering_min, lim.steering_max)
     target_v = _clip(cmd_speed, 0.0, lim.max_speed)
-    d_steer = lim.max_rate * sdt
-    d_speed = lim.acceleration * sdt
+    d_steer = k * (lim.max_rate * sdt)
+    d_speed = k * (lim.acceleration * sdt)
+    steer_k = steering + _clip(target - steering, -d_steer, d_steer)
+    speed_k = speed + _clip(target_v - speed, -d_speed, d_speed)
+    delta = np.deg2rad(steer_k - lim.straight)
+    dh = -speed_k * np.sin(delta) / lim.wheelbase * sdt
+    half_dh = dh / 2.0
+    zero = half_dh == 0.0
+    ratio = np.where(zero, 1.0, np.sin(half_dh) / np.where(zero, 1.0, half_dh))
+    chord = speed_k * np.cos(delta) * sdt * ratio
+    h_after = heading + np.cumsum(dh, axis=0)
+    mid = h_after - half_dh
     half = lim.wheelbase / 2.0
-    rx = x - half * np.cos(heading)
-    ry = y - half * np.sin(heading)
-    h = heading
-    for _ in range(substeps):
-        steering = steering + _clip(target - steering, -d_steer, d_steer)
-        speed = speed + _clip(target_v - speed, -d_speed, d_speed)
-        delta = np.deg2rad(steering - lim.straight)
-        dh = -speed * np.sin(delta) / lim.wheelbase * sdt
-        half_dh = dh / 2.0
-        zero = half_dh == 0.0
-        ratio = np.where(zero, 1.0, np.sin(half_dh) / np.where(zero, 1.0, half_dh))
-        chord = speed * np.cos(delta) * sdt * ratio
-        mid = h + half_dh
-        rx = rx + chord * np.cos(mid)
-        ry = ry + chord * np.sin(mid)
-        h = h + dh
-    h = np.remainder(h + np.pi, 2.0 * np.pi) - np.pi
-    return rx + half * np.cos(h), ry + half * np.sin(h), h, speed, steering
+    rx = x - half * np.cos(heading) + (chord * np.cos(mid)).sum(axis=0)
+    ry = y - half * np.sin(heading) + (chord * np.sin(mid)).sum(axis=0)
+    h = np.remainder(h_after[-1] + np.pi, 2.0 * np.pi) - np.pi
+    return rx + half * np.cos(h), ry + half * np.sin(h), h, speed_k[-1], steer_k[-1]

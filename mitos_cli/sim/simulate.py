@@ -22,7 +22,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import kinematics, obstacles as obs_mod, perception, sensors
-from .geometry import point_segment_distance, polygon_segments, rect_corners, segment_distance
+from .geometry import box_segment_distance, polygon_segments, rect_corners
 from .planner import Percepts, Planner
 from .route import Route, plan_route
 from .staticmap import StaticMap, build_static
@@ -106,25 +106,24 @@ def _footprints(pose: np.ndarray, robots) -> np.ndarray:
                         np.array([r.length for r in robots]), np.array([r.width for r in robots]))
 
 
-def _clearance(corners: np.ndarray, pose: np.ndarray, robot, walls: np.ndarray,
-               sides: np.ndarray, centres: np.ndarray, radii: np.ndarray) -> float:
-    """Distance from one footprint (corners ``[4, 2]``) to walls, sides and circles (<= 0:
-    touching)."""
-    fp = polygon_segments(corners)
+def _clearance(pose: np.ndarray, robot, walls: np.ndarray, sides: np.ndarray,
+               centres: np.ndarray, radii: np.ndarray) -> float:
+    """Distance from one robot's footprint to walls, sides and circles (<= 0: touching),
+    computed in the footprint's own frame."""
+    c, s = math.cos(pose[2]), math.sin(pose[2])
+    hl, hw = robot.length / 2, robot.width / 2
     best = math.inf
     segs = np.concatenate([walls, sides]) if len(sides) else walls
     if len(segs):
-        # only segments that can be nearest: the footprint lies within its circumradius of
-        # the centre and holds a disc of half its width
-        d_c = point_segment_distance(pose[None, :2], segs)[0]
-        outer = math.hypot(robot.length, robot.width) / 2
-        cand = d_c - outer <= d_c.min() - robot.width / 2
-        best = float(segment_distance(fp, segs[cand]).min())
+        rel = segs - np.tile(pose[:2], 2)
+        local = np.empty_like(rel)
+        local[:, 0::2] = rel[:, 0::2] * c + rel[:, 1::2] * s
+        local[:, 1::2] = -rel[:, 0::2] * s + rel[:, 1::2] * c
+        best = float(box_segment_distance(hl, hw, local).min())
     if len(centres):
-        c, s = math.cos(pose[2]), math.sin(pose[2])
         rel = centres - pose[:2]
-        lx = np.abs(rel[:, 0] * c + rel[:, 1] * s) - robot.length / 2
-        ly = np.abs(-rel[:, 0] * s + rel[:, 1] * c) - robot.width / 2
+        lx = np.abs(rel[:, 0] * c + rel[:, 1] * s) - hl
+        ly = np.abs(-rel[:, 0] * s + rel[:, 1] * c) - hw
         outside = np.hypot(np.maximum(lx, 0), np.maximum(ly, 0))
         inside = np.minimum(np.maximum(lx, ly), 0)
         best = min(best, float((outside + inside - radii).min()))
@@ -221,7 +220,7 @@ def simulate(world: World, planner: Planner | None = None, seed: int | None = No
                 percepts_p[key][i] = p[key]
                 percepts_t[key][i] = tr[key]
             targets[i] = perception.target_point(routes[i], f, cfg)
-            clear[i] = _clearance(corners[i], pose[i], robots[i], walls, others, centres, radii)
+            clear[i] = _clearance(pose[i], robots[i], walls, others, centres, radii)
 
         hit = active & (clear <= 0.0)
         arrived = active & (np.hypot(x - goals[:, 0], y - goals[:, 1]) <= tol)

@@ -1,0 +1,115 @@
+"""Simulator speed: simulated ticks per second for one robot, where the time goes, and the wall
+time of ``--runs 100`` on one and two worker processes.
+
+    python benchmarks/bench_sim.py            # about a minute on 2 cores
+
+1. **one robot, 60 simulated seconds at dt = 0.05** (1200 ticks): the packaged corridor world
+   stretched to 2500 in so that the run never ends early; sensing (36 beams), perception, the
+   fuzzy planner (behavior ``drive``, 44 rules), kinematics (4 substeps). Best and median of 5.
+   Peers in the same run: the same loop with a constant planner (no rule evaluation), and the
+   planner's share of the tick measured by timing ``plan`` inside the loop.
+2. **--runs 100** of ``slalom.yaml`` (randomised obstacles and noise) through ``run_many`` with
+   1 and 2 workers; the two must give identical results.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import os
+import platform
+import statistics
+import time
+
+import numpy as np
+
+from mitos_cli.resources import packaged_path
+from mitos_cli.sim.planner import FuzzyPlanner
+from mitos_cli.sim.runs import run_many
+from mitos_cli.sim.simulate import prepare, simulate
+from mitos_cli.sim.world import Corridor, Goal
+from mitos_cli.sim.worldfile import load_world
+
+
+class Timed:
+    """A planner wrapper that adds up the time spent in ``plan``."""
+
+    def __init__(self, inner) -> None:
+        self.inner, self.name, self.seconds = inner, inner.name, 0.0
+
+    def plan(self, percepts):
+        t = time.perf_counter()
+        out = self.inner.plan(percepts)
+        self.seconds += time.perf_counter() - t
+        return out
+
+
+class Constant:
+    name = "constant"
+
+    def plan(self, percepts):
+        n = len(percepts.pose)
+        return np.full(n, 90.0), np.full(n, 35.0)
+
+
+def long_corridor():
+    w = load_world(packaged_path("worlds", "corridor.yaml"))
+    agent = dataclasses.replace(w.agents[0], goal=Goal(2470.0, -10.0, 12.0))
+    return dataclasses.replace(w, time_limit=60.0, agents=(agent,),
+                               corridors=(Corridor(((0.0, 0.0), (2500.0, 0.0)), 70.0),))
+
+
+def time_runs(world, planner, repeats: int = 5) -> tuple[list[float], object]:
+    scene = prepare(world)
+    simulate(world, planner, scene=scene)                 # warm-up
+    times, res = [], None
+    for _ in range(repeats):
+        t = time.perf_counter()
+        res = simulate(world, planner, scene=scene)
+        times.append(time.perf_counter() - t)
+    return times, res
+
+
+def main() -> None:
+    load = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
+    print(f"{platform.python_version()}, numpy {np.__version__}, {os.cpu_count()} CPUs, "
+          f"load average {load:.2f} at start")
+    world = long_corridor()
+    fuzzy = FuzzyPlanner(None, "drive")
+    times, res = time_runs(world, fuzzy)
+    assert res.ticks == 1200, res.ticks
+    best, med = min(times), statistics.median(times)
+    print(f"\n1. one robot, {res.ticks} ticks (60 s at dt 0.05), outcome {res.outcome}")
+    print(f"   fuzzy drive: best {best:.3f} s, median {med:.3f} s -> "
+          f"{res.ticks / best:,.0f} ticks/s ({1e6 * best / res.ticks:.0f} us/tick)")
+    ctimes, cres = time_runs(world, Constant())
+    cbest = min(ctimes)
+    print(f"   constant planner (no rules): best {cbest:.3f} s "
+          f"({1e6 * cbest / cres.ticks:.0f} us/tick)")
+    timed = Timed(fuzzy)
+    scene = prepare(world)
+    t = time.perf_counter()
+    simulate(world, timed, scene=scene)
+    total = time.perf_counter() - t
+    print(f"   rule evaluation (plan): {1e6 * timed.seconds / res.ticks:.0f} us/tick, "
+          f"{100 * timed.seconds / total:.0f}% of the tick")
+    print(f"   ratio fuzzy / constant loop: {best / cbest:.2f}x")
+
+    slalom = load_world(packaged_path("worlds", "slalom.yaml"))
+    print("\n2. --runs 100 of slalom.yaml")
+    walls = {}
+    results = {}
+    for workers in (1, 2):
+        t = time.perf_counter()
+        runs = run_many([slalom], runs=100, seed=1, planner=fuzzy, workers=workers)
+        walls[workers] = time.perf_counter() - t
+        results[workers] = runs.to_json()
+        w = runs.worlds[0]
+        ticks = sum(s["ticks"] for s in w.summaries)
+        print(f"   {workers} worker(s): {walls[workers]:.1f} s wall, {ticks} ticks, "
+              f"success {100 * w.rate('success'):.0f}%")
+    assert results[1] == results[2], "results depend on the number of workers"
+    print(f"   identical results with 1 and 2 workers; speed-up {walls[1] / walls[2]:.2f}x")
+
+
+if __name__ == "__main__":
+    main()
