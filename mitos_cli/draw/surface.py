@@ -99,7 +99,9 @@ def draw_surface3d(fig, ax, s: Surface) -> None:
     if lo == hi:
         lo, hi = lo - 1, hi + 1
     floor = lo - 0.25 * (hi - lo)
-    surf = ax.plot_surface(X, Y, z, cmap=CMAP, vmin=lo, vmax=hi, rstride=1, cstride=1,
+    # every grid point up to 120 per axis; beyond that matplotlib samples (1e4 polygons max)
+    surf = ax.plot_surface(X, Y, z, cmap=CMAP, vmin=lo, vmax=hi,
+                           rcount=min(len(s.y.values), 120), ccount=min(len(s.x.values), 120),
                            linewidth=0.15, edgecolor=(1, 1, 1, 0.25), antialiased=True,
                            rasterized=True)     # an SVG keeps one image, not 3,600 polygons
     if finite.size:
