@@ -185,6 +185,8 @@ def fuzzylite_term(name: str, kind: str, values: list[float], n_inputs: int,
         raise FormatError(f"term `{name}`: a term height ({height:g}) other than 1 is not "
                           f"supported", span=span,
                           hint="MITOS terms reach 1; scale the rule weights instead")
+    if shape == "rectangle":            # fuzzylite takes the ends in either order
+        values = sorted(values)
     return make_term(name, shape, tuple(values), span)
 
 
