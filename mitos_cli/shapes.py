@@ -252,7 +252,7 @@ def sigmoid_product(x, left, rising, falling, right):
 def s_shape(x, start, end):
     """Smooth step from 0 at ``start`` to 1 at ``end`` (two parabolas; MATLAB ``smf``)."""
     x = np.asarray(x, dtype=float)
-    with np.errstate(invalid="ignore", divide="ignore"):
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
         out = np.where(x <= start, 0.0, np.where(
             x <= 0.5 * (np.add(start, end)), 2.0 * np.square((x - start) / np.subtract(end, start)),
             np.where(x < end, 1.0 - 2.0 * np.square((x - end) / np.subtract(end, start)), 1.0)))
@@ -262,7 +262,7 @@ def s_shape(x, start, end):
 def z_shape(x, start, end):
     """Smooth step from 1 at ``start`` to 0 at ``end`` (MATLAB ``zmf``)."""
     x = np.asarray(x, dtype=float)
-    with np.errstate(invalid="ignore", divide="ignore"):
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
         out = np.where(x <= start, 1.0, np.where(
             x < 0.5 * (np.add(start, end)), 1.0 - 2.0 * np.square((x - start) / np.subtract(end, start)),
             np.where(x < end, 2.0 * np.square((x - end) / np.subtract(end, start)), 0.0)))
@@ -308,7 +308,7 @@ def semi_ellipse(x, start, end):
     x = np.asarray(x, dtype=float)
     s, e = np.minimum(start, end), np.maximum(start, end)
     r = (e - s) / 2.0
-    with np.errstate(invalid="ignore"):
+    with np.errstate(invalid="ignore", over="ignore"):
         out = np.where((x >= s) & (x <= e), np.sqrt(np.maximum(r * r - np.square(x - (s + r)), 0.0))
                        / r, 0.0)
     return _nan_of(x) * out
@@ -319,7 +319,7 @@ def arc(x, start, end):
     x = np.asarray(x, dtype=float)
     s, e = np.asarray(start, dtype=float), np.asarray(end, dtype=float)
     r = e - s
-    with np.errstate(invalid="ignore"):
+    with np.errstate(invalid="ignore", over="ignore"):
         rising = (s < e) & (s <= x) & (x <= e)
         falling = (s > e) & (e <= x) & (x <= s)
         curve = np.sqrt(np.maximum(r * r - np.square(x - e), 0.0)) / np.abs(r)
