@@ -140,10 +140,11 @@ def did_you_mean(name: str, candidates: Iterable[str]) -> str | None:
 
 
 def unknown(what: str, name: str, candidates: Iterable[str], *, span: Span | None = None,
-            cls: type[MitosError] = NameError_) -> MitosError:
-    """An "unknown X `name`" error with a did-you-mean hint and the list of valid names."""
+            cls: type[MitosError] = NameError_, owner: str | None = None) -> MitosError:
+    """An "unknown X `name` [of `owner`]" error with a did-you-mean hint and the valid names."""
     pool = sorted(set(candidates))
     hint = did_you_mean(name, pool)
     listing = ", ".join(pool) if len(pool) <= 12 else ", ".join(pool[:12]) + ", ..."
     expected = f"one of {listing}" if pool else None
-    return cls(f"unknown {what} `{name}`", span=span, expected=expected, hint=hint)
+    of = f" of `{owner}`" if owner else ""
+    return cls(f"unknown {what} `{name}`{of}", span=span, expected=expected, hint=hint)

@@ -82,7 +82,7 @@ class Variable:
         for t in self.terms:
             if t.name == name:
                 return t
-        raise unknown(f"term of `{self.name}`", name, self.term_names, span=span)
+        raise unknown("term", name, self.term_names, span=span, owner=self.name)
 
     def index(self, name: str) -> int:
         return self.term_names.index(name)
@@ -107,14 +107,26 @@ class TermSet:
 
 def check_term(term: Term, universe: tuple[float, float], variable: str,
                peak_inside: bool = True) -> None:
-    """Raise :class:`TermSetError` when ``term`` is malformed for its variable (with
-    ``peak_inside``, also when its peak lies outside the universe: an output's crisp value)."""
+    """Raise :class:`TermSetError` when ``term`` is malformed for its variable.
+
+    A piecewise-linear term must reach 1 somewhere inside the universe (its core may stick
+    out, as MATLAB's shower example's shoulders do); with ``peak_inside`` (outputs) its crisp
+    value must lie inside too. Smooth shapes (bells, sigmoids) may peak outside.
+    """
     problem = term.kind.check(term.params)
     if problem:
         raise TermSetError(f"term `{variable}.{term.name}`: {problem}", span=term.span)
+    lo, hi = universe
+    corners = term.corners
+    if corners is not None and (corners[2] < lo or corners[1] > hi):
+        where = (f"its peak {corners[1]:g}" if corners[1] == corners[2]
+                 else f"its core [{corners[1]:g}, {corners[2]:g}]")
+        raise TermSetError(
+            f"term `{variable}.{term.name}`: {where} lies outside the universe "
+            f"[{lo:g}, {hi:g}]", span=term.span,
+            hint="move the term or widen the variable's universe")
     if not peak_inside:
         return
-    lo, hi = universe
     center = term.center          # NaN for a linear (Takagi-Sugeno) consequent: no peak
     if not np.isnan(center) and not lo <= center <= hi:
         raise TermSetError(

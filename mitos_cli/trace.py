@@ -52,7 +52,10 @@ class Trace:
     def render(self, digits: int = 1) -> str:
         """The paper's layout: fuzzified inputs, fired rules with DOFs, crisp outputs."""
         def num(x: float) -> str:
-            return f"{x:.{digits}f}"
+            text = f"{x:.{digits}f}"
+            if x > 0 and float(text) == 0:       # a rule that fired, if only a little
+                text = f"{x:.{max(digits, 1)}g}"
+            return text
 
         lines = [f"rule base {self.rulebase}, behavior {self.behavior} "
                  f"({self.n_rules} rules; {self.operators})", "", "fuzzified inputs:"]

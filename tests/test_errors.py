@@ -117,13 +117,13 @@ def test_missing_rule_file():
 @pytest.mark.parametrize("rule, message, hint, at", [
     ("r1: if raod is WIDE then speed is SLOW", "unknown input variable `raod`",
      "did you mean `road`?", "raod is WIDE"),
-    ("r1: if road is WIDEE then speed is SLOW", "unknown term of `road` `WIDEE`",
+    ("r1: if road is WIDEE then speed is SLOW", "unknown term `WIDEE` of `road`",
      "did you mean `WIDE`?", "road is WIDEE"),
     ("r1: if road is WIDE then sped is SLOW", "unknown output variable `sped`",
      "did you mean `speed`?", "sped is SLOW"),
-    ("r1: if road is WIDE then speed is SLWO", "unknown term of `speed` `SLWO`",
+    ("r1: if road is WIDE then speed is SLWO", "unknown term `SLWO` of `speed`",
      "did you mean `SLOW`?", "speed is SLWO"),
-    ("r1: if road is wide then speed is SLOW", "unknown term of `road` `wide`",
+    ("r1: if road is wide then speed is SLOW", "unknown term `wide` of `road`",
      "did you mean `WIDE`?", "road is wide"),
 ])
 def test_unknown_names(tmp_path, rule, message, hint, at):
@@ -215,6 +215,8 @@ def test_no_term_set(tmp_path):
      "term `road.NARROW`: points must be in order, but a = 70 > b = 40"),
     ("LB: 30", "LB: 10", "LB",
      "term `steering.LB`: its peak 10 lies outside the universe [30, 150]"),
+    ("peak: 70, width: 30", "peak: 170, width: 30", "MEDIUM:",
+     "term `road.MEDIUM`: its peak 170 lies outside the universe [0, 160]"),
     ("      WIDE:   {shape: right_shoulder, points: [70, 100]}",
      "      WIDE:   {shape: right_shoulder, points: [70, 100]}\n"
      "      MEDIUM: {shape: triangle, peak: 70, width: 30}", "MEDIUM: {shape: triangle, peak: 70, width: 30}",

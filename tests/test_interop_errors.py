@@ -92,7 +92,7 @@ FLL_CASES = [
     ("conjunction: Minimum", "conjunction: none", "uses `and` but its rule block's conjunction"),
     ("disjunction: Maximum", "disjunction: none", "uses `or` but its rule block's disjunction"),
     ("rule: if a is low and b is small", "rule: if a is low and b is tiny",
-     "unknown term of `b` `tiny`"),
+     "unknown term `tiny` of `b`"),
     ("then y is off", "then a is off", "`a` is an input variable and cannot appear in an action"),
     ("if a is low and b is small then", "if a is very not low and b is small then",
      "`not` after a hedge"),
@@ -272,7 +272,7 @@ FCL_CASES = [
     ("ACCU : MAX;", "ACCU : NSUM;", "normalized sum is not an S-norm"),
     ("METHOD : COG;", "METHOD : cogf;", "jFuzzyLogic's fast centre of gravity"),
     ("ACT : MIN;", "ACT : DPROD;", "implication `drastic` is not supported"),
-    ("RULE 2 : IF service IS good", "RULE 2 : IF service IS goood", "unknown term of `service`"),
+    ("RULE 2 : IF service IS good", "RULE 2 : IF service IS goood", "of `service`"),
 ]
 
 

@@ -106,7 +106,7 @@ def test_prompt_through_its_input_stream(work):
     res = mitos("teach", "rb/mitos.rules", cwd=work, stdin="\n".join(lines) + "\n")
     assert res.returncode == 0, res.stderr
     assert "unknown command `corect`" in res.stderr and "did you mean `correct`?" in res.stderr
-    assert "unknown term of `road` `WIDEE`" in res.stderr
+    assert "unknown term `WIDEE` of `road`" in res.stderr
     assert "example 1: road=78 size=45 position=4 -> steering=60" in res.stdout
     assert "undone: adapt epochs 3" in res.stdout
     assert "adapt epochs 3   (Q" in res.stdout and "(undone)" in res.stdout
