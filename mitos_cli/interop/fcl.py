@@ -405,8 +405,11 @@ def write_fcl(rb: RuleBase, behavior: str | None = None) -> str:
             out.append(f"    METHOD : {common.DEFUZZIFIERS[ops.inference][FCL]};")
         else:
             method = common.foreign_name(common.DEFUZZIFIERS, FCL, ops.defuzzify, "defuzzifier")
-            out.append(f"    METHOD : {method} {ops.resolution};")
-        out.append(f"    DEFAULT := {'nan' if v.default is None else fmt_number(v.default)};")
+            # IEC has no resolution: written (fuzzylite-style) only when not the default 1000
+            res = "" if ops.resolution == DEFAULT_RESOLUTION else f" {ops.resolution}"
+            out.append(f"    METHOD : {method}{res};")
+        if v.default is not None:           # none: no DEFAULT line (the output is NaN)
+            out.append(f"    DEFAULT := {fmt_number(v.default)};")
         out += ["END_DEFUZZIFY", ""]
     out.append(f"RULEBLOCK {flat.name}")
     out.append(f"    AND : {common.foreign_name(common.TNORMS, FCL, ops.and_, 'T-norm')};")

@@ -356,7 +356,8 @@ def write_fll(rb: RuleBase, behavior: str | None = None) -> str:
         else:
             out.append(f"  aggregation: {common.foreign_name(common.SNORMS, FLL, ops.aggregation, 'S-norm')}")
             kind = common.foreign_name(common.DEFUZZIFIERS, FLL, ops.defuzzify, "defuzzifier")
-            out.append(f"  defuzzifier: {kind} {ops.resolution}")
+            res = "" if ops.resolution == DEFAULT_RESOLUTION else f" {ops.resolution}"
+            out.append(f"  defuzzifier: {kind}{res}")
         out.append(f"  default: {'nan' if v.default is None else fmt_number(v.default)}")
         out.append("  lock-previous: false")
         for t in v.terms:
