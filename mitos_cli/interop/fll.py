@@ -76,7 +76,7 @@ def read_fll(path: str | Path) -> RuleBase:
 
 def _read_text(path: Path) -> str:
     try:
-        return path.read_text(encoding="utf-8")
+        return path.read_text(encoding="utf-8-sig")     # a byte-order mark is not content
     except UnicodeDecodeError:
         raise FormatError(f"`{path}` is not a text file (it is not UTF-8)") from None
     except OSError as exc:

@@ -158,6 +158,8 @@ def _term_spec(rb: RuleBase, v: Variable, t: Term, inputs: list[str]) -> str:
         return _scalar(p[0])
     if t.shape == "linear":
         coefficients = common.linear_coefficients(rb, v.name, t)
+        if not any(coefficients.values()):          # y = constant: the same as a number
+            return _scalar(p[-1])
         given = ", ".join(f"{_scalar(n)}: {_scalar(a)}" for n, a in coefficients.items()
                           if a != 0.0)
         return f"{{shape: linear, coefficients: {{{given}}}, constant: {_scalar(p[-1])}}}"
