@@ -7,6 +7,8 @@ or cells.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 EPS = 1e-9
@@ -167,7 +169,19 @@ def box_segment_distance(hl: float, hw: float, seg: np.ndarray) -> np.ndarray:
     corners = np.array([[-hl, -hw], [hl, -hw], [hl, hw], [-hl, hw]])
     c = point_segment_distance(corners, seg).min(axis=0)
     d = np.minimum(np.minimum(e0, e1), c)
-    # crossing: Liang-Barsky clip of the segment against the box
+    # a segment can cross the box only if it passes within the box's half diagonal of a
+    # corner or an endpoint is inside; clip just those (Liang-Barsky)
+    maybe = d < math.hypot(hl, hw) * 2.0
+    if not maybe.any():
+        return d
+    out = d.copy()
+    out[maybe] = _box_crossing(hl, hw, seg[maybe], d[maybe])
+    return out
+
+
+def _box_crossing(hl: float, hw: float, seg: np.ndarray, d: np.ndarray) -> np.ndarray:
+    """``d`` with 0 where the segment crosses the box (Liang-Barsky clipping)."""
+    x0, y0, x1, y1 = seg[:, 0], seg[:, 1], seg[:, 2], seg[:, 3]
     dx, dy = x1 - x0, y1 - y0
     with np.errstate(divide="ignore", invalid="ignore"):
         t0 = np.zeros(len(seg))

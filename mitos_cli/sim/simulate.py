@@ -30,6 +30,7 @@ from .world import World
 
 STUCK_TIME = 6.0        # s
 STUCK_DISTANCE = 3.0    # in
+NEAR_SLACK = 24.0       # in: a robot's set of nearby walls is gathered again after this move
 OUTCOMES = ("success", "collision", "timeout", "stuck")
 
 
@@ -173,6 +174,8 @@ def simulate(world: World, planner: Planner | None = None, seed: int | None = No
     goals = np.array([[a.goal.x, a.goal.y] for a in agents], float)
     tol = np.array([a.goal.tolerance for a in agents], float)
 
+    near_at = [(math.inf, math.inf)] * n      # where each robot's wall set was gathered
+    near_walls = [np.zeros((0, 4))] * n
     shape_outline, outline_owner = obs_mod.outline_points(
         world.obstacles, np.zeros((len(world.obstacles), 2)))
     rec_pose, rec_v, rec_steer, rec_cmd, rec_rng, rec_clear, rec_obs, rec_act = ([] for _ in range(8))
@@ -188,8 +191,11 @@ def simulate(world: World, planner: Planner | None = None, seed: int | None = No
         where = obs_mod.positions(world.obstacles, t)
         centres, radii, circ_idx, rect_sides, _, _ = obs_mod.shapes_at(world.obstacles, where)
         pose = np.stack([x, y, h], axis=1)
-        corners = _footprints(pose, robots)
-        robot_sides = polygon_segments(corners).reshape(n, 4, 4)
+        if n > 1:                  # the other robots are obstacles to each robot
+            corners = _footprints(pose, robots)
+            robot_sides = polygon_segments(corners).reshape(n, 4, 4)
+        else:
+            corners = robot_sides = np.zeros((1, 4, 4))
         outline = shape_outline + where[outline_owner] if len(where) else shape_outline
         ranges = np.zeros((n, B))
         percepts_p = {key: np.zeros(n) for key in perception.INPUTS}
@@ -198,7 +204,10 @@ def simulate(world: World, planner: Planner | None = None, seed: int | None = No
         clear = np.zeros(n)
         for i in range(n):
             others = np.concatenate([rect_sides] + [robot_sides[j] for j in range(n) if j != i])
-            walls = static.near(x[i], y[i], reach)
+            if math.hypot(x[i] - near_at[i][0], y[i] - near_at[i][1]) > NEAR_SLACK:
+                near_at[i] = (x[i], y[i])
+                near_walls[i] = static.near(x[i], y[i], reach + NEAR_SLACK)
+            walls = near_walls[i]
             dirs = sensors.beam_directions(h[i], angles)
             expected, true_r = sensors.cast(pose[i, :2], dirs, walls, others, centres, radii,
                                             sen.range)
