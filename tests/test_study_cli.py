@@ -18,7 +18,7 @@ from mitos_cli.study.store import ResultStore
 ROOT = Path(__file__).resolve().parent.parent
 
 TINY = """\
-# a short corridor with one obstacle: a run takes about 120 ticks
+# a short corridor with one obstacle: about 8 simulated seconds to the goal
 name: tiny
 seed: 1
 dt: 0.05
@@ -105,22 +105,17 @@ def test_compare_writes_table_csv_and_report(tiny, tmp_path, compare):
     assert all(len(s) == 1 for s in seeds.values())
 
 
-def test_real_simulator_pool_and_dask_equal_serial(tiny, tmp_path):
-    distributed = pytest.importorskip("distributed")
-    study = Study([tiny], make_choices(["fuzzy", "potential_field"], ["min", "einstein"], [],
-                                       []), runs=2, seed=5)
+def test_real_simulator_pool_equals_serial(tiny, tmp_path):
+    study = Study([tiny], make_choices(["fuzzy", "potential_field"], ["einstein"], [], []),
+                  runs=2, seed=5)
     serial = run_study(study, tmp_path / "serial", workers=1)
     pool = run_study(study, tmp_path / "pool", workers=2)
-    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                                  dashboard_address=None) as cluster, \
-            distributed.Client(cluster) as client:
-        dask = run_study(study, tmp_path / "dask", executor="dask", client=client)
-    assert serial.rows == pool.rows == dask.rows and len(serial.rows) == 6
+    assert serial.rows == pool.rows and len(serial.rows) == 4
 
 
 def test_killed_sweep_resumes_without_recomputing(tiny, tmp_path):
     out = tmp_path / "killed"
-    args = ["compare", tiny, "--and", "min,product", "--planner", "fuzzy", "--runs", "6",
+    args = ["compare", tiny, "--and", "min,product", "--planner", "fuzzy", "--runs", "4",
             "-j", "1", "-o", str(out), "--no-plots"]
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
     proc = subprocess.Popen([sys.executable, "-m", "mitos_cli", *args], env=env,
@@ -136,15 +131,15 @@ def test_killed_sweep_resumes_without_recomputing(tiny, tmp_path):
         proc.send_signal(signal.SIGKILL)
         proc.wait()
     before = ResultStore(out).load()
-    assert 3 <= len(before) < 12, "the sweep should have been killed half-way"
+    assert 3 <= len(before) < 8, "the sweep should have been killed half-way"
     r = subprocess.run([sys.executable, "-m", "mitos_cli", *args, "--resume"], env=env,
                        capture_output=True, text=True, timeout=120)
     assert r.returncode == 0, r.stderr
-    assert f"resuming: {len(before)} of 12 runs already in" in r.stderr
-    assert f"{12 - len(before)} runs now, {len(before)} from before" in r.stderr
+    assert f"resuming: {len(before)} of 8 runs already in" in r.stderr
+    assert f"{8 - len(before)} runs now, {len(before)} from before" in r.stderr
     after = ResultStore(out).load()
     keys = [(x["and"], x["run"]) for x in after]
-    assert len(after) == 12 and len(set(keys)) == 12          # nothing ran twice
+    assert len(after) == 8 and len(set(keys)) == 8            # nothing ran twice
     assert after[:len(before)] == before                       # finished rows untouched
 
 

@@ -8,6 +8,7 @@ from mitos_cli.study import run_study
 
 distributed = pytest.importorskip("distributed")
 
+from test_study_cli import TINY  # noqa: E402
 from test_study_core import fake_sim, small_study  # noqa: E402
 
 
@@ -27,6 +28,18 @@ def test_dask_equals_local_bit_for_bit(tmp_path, client):
     assert dask.rows == local.rows                      # floats compared exactly
 
 
+def test_real_simulator_on_dask_equals_serial(tmp_path, client):
+    from mitos_cli.study import Study, make_choices
+
+    world = tmp_path / "tiny.yaml"
+    world.write_text(TINY)
+    study = Study([str(world)], make_choices(["fuzzy", "potential_field"], ["product"], [], []),
+                  runs=2, seed=5)
+    serial = run_study(study, tmp_path / "serial", workers=1)
+    dask = run_study(study, tmp_path / "dask", executor="dask", client=client)
+    assert dask.rows == serial.rows and len(serial.rows) == 4
+
+
 def test_dask_resume_skips_finished(tmp_path, client):
     study = small_study(runs=4)
     half = small_study(runs=2)
@@ -35,3 +48,13 @@ def test_dask_resume_skips_finished(tmp_path, client):
                     task_fn=fake_sim)
     assert (out.skipped, out.executed) == (12, 12)
     assert out.rows == run_study(study, tmp_path / "fresh", workers=1, task_fn=fake_sim).rows
+
+
+def test_unreachable_scheduler_is_a_clear_error():
+    from mitos_cli.study.executors import dask_client
+    from mitos_cli.study.store import StudyError
+
+    with pytest.raises(StudyError) as exc:
+        dask_client("tcp://127.0.0.1:9", 2, timeout="0.5s")
+    assert "cannot reach the Dask scheduler at tcp://127.0.0.1:9" in exc.value.message
+    assert "dask scheduler" in exc.value.hint

@@ -69,8 +69,9 @@ def run_local(fn: TaskFn, tasks: Sequence[Task], workers: int) -> Iterator[tuple
         pool.join()
 
 
-def dask_client(scheduler: str | None, workers: int):
-    """A ``distributed.Client`` to ``scheduler``, or to a new LocalCluster of ``workers``."""
+def dask_client(scheduler: str | None, workers: int, timeout: str = "10s"):
+    """A ``distributed.Client`` to ``scheduler`` (giving up after ``timeout``), or to a new
+    LocalCluster of ``workers`` processes."""
     try:
         from distributed import Client, LocalCluster
     except ImportError:
@@ -78,7 +79,7 @@ def dask_client(scheduler: str | None, workers: int):
                          hint="pip install 'mitos[dask]', or use --executor local") from None
     if scheduler:
         try:
-            return Client(scheduler, timeout="10s")
+            return Client(scheduler, timeout=timeout)
         except (OSError, TimeoutError, ValueError) as exc:
             raise StudyError(f"cannot reach the Dask scheduler at {scheduler}: {exc}",
                              hint="start one with `dask scheduler` (and `dask worker ADDR` "
@@ -102,8 +103,7 @@ def run_dask(fn: TaskFn, tasks: Sequence[Task], workers: int, scheduler: str | N
     try:
         from distributed import as_completed
 
-        n = workers if own and not scheduler else max(1, len(client.scheduler_info().get(
-            "workers", {})) or workers)
+        n = len(client.scheduler_info().get("workers", {})) or workers
         futures = client.map(functools.partial(run_chunk, fn), chunks(tasks, n), pure=False)
         try:
             for _future, part in as_completed(futures, with_results=True):
