@@ -115,6 +115,8 @@ FLL_CASES = [
      "Tsukamoto inference is not supported"),
     ("defuzzifier: Centroid 200", "defuzzifier: WeightedAverage Magic",
      "unknown weighted defuzzifier type `Magic`"),
+    ("term: off Triangle 0 0.25 0.5", "term: off Constant 0.25",
+     "fuzzylite's `Constant` is a flat membership"),
 ]
 
 
@@ -142,8 +144,9 @@ SUGENO_CASES = [
     ("  aggregation: none\n", "  aggregation: Maximum\n", "is concluded by several rules while"),
     ("then y is off", "then y is very off", "hedges on a Takagi-Sugeno consequent"),
     ("term: on Linear 0.01 0.5 0.1", "term: on Linear 0.5 0.1", "Linear takes one coefficient"),
-    ("defuzzifier: WeightedAverage TakagiSugeno", "defuzzifier: Centroid",
-     "linear terms need a weighted-average"),
+    ("defuzzifier: WeightedAverage TakagiSugeno\n  default: nan\n  lock-previous: false\n"
+     "  term: off Constant 0.2", "defuzzifier: Centroid\n  default: nan\n  lock-previous: "
+     "false\n  term: off Triangle 0 0.25 0.5", "linear terms need a weighted-average"),
 ]
 
 
@@ -330,6 +333,14 @@ def test_fis_writer_refusals() -> None:
     norm = parse_fll(fll("conjunction: Minimum", "conjunction: EinsteinProduct"))
     with pytest.raises(FormatError, match="FIS has no AND method `einstein`"):
         write_foreign(norm, "fis")
+
+
+def test_fll_writer_refuses_mamdani_singletons() -> None:
+    rb = parse_fcl((Path(__file__).parent / "data" / "interop" / "tipper_jfuzzylogic.fcl")
+                   .read_text().replace("TERM cheap := trian 0 5 10;", "TERM cheap := 5;"))
+    with pytest.raises(FormatError, match="fuzzylite has no singleton set for a Mamdani"):
+        write_foreign(rb, "fll")
+    assert "TERM cheap := 5;" in write_foreign(rb, "fcl")      # IEC has them
 
 
 def test_fuzzylite_writer_refusals(tmp_path: Path) -> None:

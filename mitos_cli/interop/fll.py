@@ -149,6 +149,15 @@ def parse_fll(text: str, path: str | None = None) -> RuleBase:
     by_name = {v.name: v for v in built}
     for value, lineno, vcol, conj in pending_rules:
         rules.append(_rule(value, text, path, lineno, vcol, by_name, conj, len(rules)))
+    if not settings.sugeno:
+        for v in variables:
+            for name, kind, _, span in v.terms:
+                if v.role == "output" and kind == "Constant":
+                    raise FormatError(
+                        f"term `{v.name}.{name}`: in a Mamdani output fuzzylite's `Constant` is "
+                        f"a flat membership of that height everywhere, which MITOS does not "
+                        f"support", span=span, hint="use a Rectangle or Triangle term, or a "
+                        "weighted-average defuzzifier for crisp consequents")
     if settings.sugeno:
         _check_grouping(variables, rules, settings)
         for v in variables:
@@ -388,6 +397,11 @@ def _output_term(rb: RuleBase, t: Term, v: Variable, sugeno: bool,
             values = [coefficients.get(i.name, 0.0) for i in inputs] + [t.params[-1]]
             return "Linear " + " ".join(fmt_number(c) for c in values)
         return f"Constant {fmt_number(t.center)}"     # weighted average uses the centre only
+    if t.shape == "singleton":
+        raise FormatError(f"term `{v.name}.{t.name}`: fuzzylite has no singleton set for a "
+                          f"Mamdani output (its `Constant` is a flat membership)",
+                          span=t.span, hint="use inference = weighted_average, or give the "
+                                            "output membership-shaped terms")
     return common.fuzzylite_term_text(t, v.name)
 
 
