@@ -176,10 +176,17 @@ def _function_block(fb: Tree, span_of) -> RuleBase:
         for item in block.children[1:]:
             if item.data == "rule":
                 rules.append(_rule(item, variables, span_of, len(rules)))
+    constants = locks.pop("constant terms", [])
     if settings.sugeno:
         for name, span in locks.items():
             raise FormatError(f"`LOCK : RANGE` on the Takagi-Sugeno output `{name}` (clipping "
                               f"the output to its range) is not supported", span=span)
+    else:
+        for name, term in constants:
+            raise FormatError(f"term `{name}.{term.name}`: in a Mamdani output fuzzylite's "
+                              f"`Constant` is a flat membership of that height everywhere, "
+                              f"which MITOS does not support", span=term.span,
+                              hint=f"for a singleton write `TERM {term.name} := value;`")
     ordered = [variables[n] for n in declared]
     return common.assemble(span_of(fb).path, ordered, rules, settings, DEFAULT_RESOLUTION,
                            span_of(fb))
@@ -203,6 +210,10 @@ def _variable(node: Tree, role: str, declared, settings: Settings, locks: dict, 
         kind = item.data
         if kind == "term":
             terms.append(_term(item, role, n_inputs, span_of))
+            definition = item.children[1]
+            if role == "output" and definition.data == "shape_def" and \
+                    str(definition.children[0]).lower() == "constant":
+                locks.setdefault("constant terms", []).append((name, terms[-1]))
         elif kind == "range_item":
             universe = (_num(item.children[0]), _num(item.children[1]))
         elif kind == "option":
