@@ -276,6 +276,8 @@ FCL_CASES = [
     ("METHOD : COG;", "METHOD : cogf;", "jFuzzyLogic's fast centre of gravity"),
     ("ACT : MIN;", "ACT : DPROD;", "implication `drastic` is not supported"),
     ("RULE 2 : IF service IS good", "RULE 2 : IF service IS goood", "of `service`"),
+    ("TERM cheap := trian 0 5 10;", "TERM cheap := Constant 5;",
+     "fuzzylite's `Constant` is a flat membership"),
 ]
 
 
