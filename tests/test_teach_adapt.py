@@ -99,7 +99,8 @@ def test_gradient_matches_finite_differences_on_the_paper_rule_base(seed):
 
 @pytest.mark.parametrize("seed", [3, 4])
 def test_gradient_through_hedges_not_or_crisp_and_products(seed):
-    for ops in ("", "operators: and = product, or = probabilistic_sum\n"):
+    for ops in ("", "operators: and = product, or = probabilistic_sum\n",
+                "operators: inference = weighted_sum\n"):
         compiled = small(ops + RULES)
         p = parameterise(compiled)
         X = away_from_ties(compiled, points(400, seed))
