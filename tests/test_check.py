@@ -166,12 +166,12 @@ def test_term_gap_over_a_range(tmp_path):
 
 def test_term_peaking_outside_the_universe(tmp_path):
     terms = TERMS.replace("HUGE:   {shape: right_shoulder, points: [140, 150]}",
-                          "HUGE:   {shape: triangle, peak: 170, width: 20}")
+                          "HUGE:   {shape: gaussian, mean: 180, sigma: 10}")
     (tmp_path / "t.terms.yaml").write_text(terms, encoding="utf-8")
     (tmp_path / "t.rules").write_text(RULES, encoding="utf-8")
     (finding,) = by_code(check_rulebase(read_rulebase(tmp_path / "t.rules")), "term-outside")
     assert finding.message == ("input term `road.HUGE` never reaches 1 inside the universe "
-                               "[0, 160] (at most 0.5)")
+                               "[0, 160] (at most 0.135)")
     assert finding.span.line == 9 and finding.severity == "warning"
 
 

@@ -86,7 +86,9 @@ def test_figure_3b_snorm_from_tnorm_neurons(tnorm, snorm, items):
     x = np.array(items)
     built = neurons.snorm_from_tnorm(x, tnorm.name)
     direct = neurons.neuron(x, norm=snorm.name)
-    assert built == pytest.approx(direct, abs=1e-12)
+    # 1e-9: Hamacher's sum divides by 1 - ab, which cancels near a = b = 1 (found at
+    # a ~ 0.49999, b = c ~ 0.99998: the two routes differ by 1.0e-12 there)
+    assert built == pytest.approx(direct, abs=1e-9)
 
 
 def test_figure_3b_batched():
