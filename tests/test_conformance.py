@@ -42,8 +42,6 @@ needs_fuzzylite = pytest.mark.skipif(EXAMPLES is None, reason="pyfuzzylite is no
 
 #: Engines MITOS refuses, and the words of the refusal (its cause).
 REFUSED = {
-    "hybrid/obstacle_avoidance.fll": "differs from",        # Mamdani and Sugeno outputs mixed
-    "hybrid/tipper.fll": "differs from",
     "mamdani/laundry.fll": "is an output variable and cannot appear in a condition",
     "mamdani/octave/investment_portfolio.fll": "implication `einstein` is not supported",
     "mamdani/simple_dimmer_chained.fll": "is an output variable and cannot appear",
@@ -69,14 +67,18 @@ def read_fld(path: Path) -> tuple[list[str], np.ndarray]:
 
 
 def mitos_outputs(fll: Path) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray]]:
-    """MITOS's outputs on the table's inputs, and the table's outputs, by name."""
-    compiled = compile_rulebase(read_rulebase(fll))
+    """MITOS's outputs on the table's inputs, and the table's outputs, by name (a hybrid
+    engine read as one behavior per rule block: each behavior gives its own outputs)."""
+    rb = read_rulebase(fll)
     header, table = read_fld(fll.with_suffix(".fld"))
     col = {name: i for i, name in enumerate(header)}
-    X = table[:, [col[name] for name in compiled.inputs]]
-    result = evaluate(compiled, X, strict=False, detail=False)
-    got = {name: result.outputs[:, j] for j, name in enumerate(compiled.outputs)}
-    return got, {name: table[:, col[name]] for name in compiled.outputs}
+    got = {}
+    for behavior in rb.behaviors:
+        compiled = compile_rulebase(rb, behavior.name)
+        X = table[:, [col[name] for name in compiled.inputs]]
+        result = evaluate(compiled, X, strict=False, detail=False)
+        got.update({name: result.outputs[:, j] for j, name in enumerate(compiled.outputs)})
+    return got, {name: table[:, col[name]] for name in got}
 
 
 def worst(got: np.ndarray, ref: np.ndarray) -> float:
@@ -119,6 +121,15 @@ def test_discrete_mismatch_is_the_tables_not_ours() -> None:
     theirs = np.asarray(engine.output_variables[0].value, dtype=float)
     assert worst(theirs, ref["steer"]) > TOLERANCE          # fuzzylite 8 vs its own table
     assert worst(got["steer"], theirs) < 1e-12               # MITOS vs fuzzylite 8
+
+
+@needs_fuzzylite
+def test_hybrid_engines_become_one_behavior_per_rule_block() -> None:
+    rb = read_rulebase(EXAMPLES / "hybrid" / "tipper.fll")
+    assert [b.name for b in rb.behaviors] == ["mamdani", "takagiSugeno"]
+    inference = {b.name: dict((s.key, s.value) for s in b.operators)["inference"]
+                 for b in rb.behaviors}
+    assert inference == {"mamdani": "mamdani", "takagiSugeno": "weighted_average"}
 
 
 @needs_fuzzylite

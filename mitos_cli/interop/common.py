@@ -286,18 +286,47 @@ def check_implication(name: str, span: Span | None) -> str:
 def assemble(path: str, variables: list[Variable], rules: list[Rule], settings: Settings,
              default_resolution: int, span: Span | None = None) -> RuleBase:
     """Check what a reader gathered and return the rule base (one behavior, ``main``)."""
+    return assemble_blocks(path, variables, [(MAIN, rules, settings)], default_resolution, span)
+
+
+def assemble_blocks(path: str, variables: list[Variable],
+                    blocks: list[tuple[str, list[Rule], Settings]], default_resolution: int,
+                    span: Span | None = None) -> RuleBase:
+    """The rule base of one or more rule blocks: one block gives behavior ``main`` with the
+    operators on the file; several (whose operators differ) give one behavior each, with its
+    own operators, the first being the default."""
     names = [v.name for v in variables]
     for v in variables:
         if names.count(v.name) > 1:
             raise FormatError(f"variable `{v.name}` is defined twice", span=v.span)
     if not any(v.role == "input" for v in variables):
         raise FormatError("the file defines no input variable", span=span)
-    if not rules:
+    if not any(rules for _, rules, _ in blocks):
         raise FormatError("the file has no rules", span=span)
     by_name = {v.name: v for v in variables}
+    behaviors = []
+    for name, rules, settings in blocks:
+        _check_block(rules, settings, by_name, len(blocks) == 1)
+        operators = settings.operators(default_resolution)
+        try:
+            ops_mod.resolve(operators)
+        except MitosError as exc:
+            raise FormatError(exc.message, span=span, expected=exc.expected,
+                              hint=exc.hint) from None
+        behaviors.append(Behavior(name, tuple(rules), (), operators))
+    termset = TermSet(tuple(variables), path)
+    if len(behaviors) == 1:
+        b = behaviors[0]
+        return RuleBase(path, (termset,), (Behavior(b.name, b.rules),), b.operators)
+    return RuleBase(path, (termset,), tuple(behaviors), ())
+
+
+def _check_block(rules: list[Rule], settings: Settings, by_name: dict[str, Variable],
+                 every_output: bool) -> None:
     sugeno = settings.sugeno
-    for v in variables:
-        if v.role != "output":
+    concluded = {c.var for r in rules for c in r.consequents}
+    for v in by_name.values():
+        if v.role != "output" or not (every_output or v.name in concluded):
             continue
         for t in v.terms:
             if sugeno and t.shape not in ("singleton", "linear"):
@@ -319,13 +348,6 @@ def assemble(path: str, variables: list[Variable], rules: list[Rule], settings: 
                 if c.hedges:
                     raise FormatError("hedges on a Takagi-Sugeno consequent are not supported",
                                       span=c.span)
-    operators = settings.operators(default_resolution)
-    try:
-        ops_mod.resolve(operators)
-    except MitosError as exc:
-        raise FormatError(exc.message, span=span, expected=exc.expected, hint=exc.hint) from None
-    termset = TermSet(tuple(variables), path)
-    return RuleBase(path, (termset,), (Behavior(MAIN, tuple(rules)),), operators)
 
 
 # ---------------------------------------------------------------------------------------------

@@ -28,6 +28,7 @@ from pathlib import Path
 from lark import Lark
 from lark.exceptions import UnexpectedInput
 
+from ..build import MAIN
 from ..errors import FormatError, Span, did_you_mean
 from ..model import Rule, RuleBase
 from ..model import format_number as _fmt_weight
@@ -57,6 +58,14 @@ def rule_parser() -> Lark:
                 maybe_placeholders=True, cache=True)      # grammar analysis cached on disk
 
 
+class _Record(list):
+    """Operator choices as written, ``(key, value, span, what)``, replayed into a
+    :class:`Settings` once it is known which outputs and blocks share one."""
+
+    def set(self, key: str, value, span: Span | None, what: str) -> None:
+        self.append((key, value, span, what))
+
+
 @dataclass
 class _Var:
     role: str
@@ -67,6 +76,17 @@ class _Var:
     default: float | None = None
     description: str = ""
     lock_range: Span | None = None      # `lock-range: true` on an output
+    record: _Record = field(default_factory=_Record)
+
+
+@dataclass
+class _Block:
+    name: str
+    span: Span
+    record: _Record = field(default_factory=_Record)
+    conj: dict = field(default_factory=lambda: {"conjunction": None, "disjunction": None})
+    lines: list = field(default_factory=list)           # (rule text, line, column)
+    rules: list = field(default_factory=list)
 
 
 def read_fll(path: str | Path) -> RuleBase:
@@ -83,16 +103,22 @@ def _read_text(path: Path) -> str:
         raise FormatError(f"cannot read `{path}`: {exc.strerror or exc}") from None
 
 
-def parse_fll(text: str, path: str | None = None) -> RuleBase:
-    """Read FLL ``text`` into a rule base (one behavior, ``main``)."""
+def _settings(blocks: list[_Block], outputs: list[_Var]) -> Settings:
     settings = Settings()
+    for part in list(blocks) + list(outputs):
+        for entry in part.record:
+            settings.set(*entry)
+    return settings
+
+
+def parse_fll(text: str, path: str | None = None) -> RuleBase:
+    """Read FLL ``text`` into a rule base: one behavior ``main``, or, when rule blocks need
+    different operators (fuzzylite's hybrid engines), one behavior per block."""
     variables: list[_Var] = []
-    rules: list[Rule] = []
+    blocks: list[_Block] = []
     section: str | None = None
     current: _Var | None = None
     engine_span = Span.in_text(text, path, 1, 1)
-    block_conj: dict = {}
-    pending_rules: list[tuple[str, int, int, dict]] = []
 
     for lineno, raw in enumerate(text.splitlines(), 1):
         line = raw.split("#", 1)[0].rstrip()
@@ -118,7 +144,7 @@ def parse_fll(text: str, path: str | None = None) -> RuleBase:
                 current = _Var("input" if key == "InputVariable" else "output", value, vspan)
                 variables.append(current)
             else:
-                block_conj = {"conjunction": None, "disjunction": None, "span": span}
+                blocks.append(_Block(value, span))
             continue
         if section is None:
             raise FormatError(f"`{key}` before any section", span=span,
@@ -137,18 +163,48 @@ def parse_fll(text: str, path: str | None = None) -> RuleBase:
                                   f"blocks", span=vspan, hint="delete the part or enable it")
             continue
         if section in ("InputVariable", "OutputVariable"):
-            _variable_key(current, key, value, span, vspan, settings)
+            _variable_key(current, key, value, span, vspan, current.record)
+        elif key == "rule":
+            blocks[-1].lines.append((value, lineno, vcol))
         else:
-            if key == "rule":
-                pending_rules.append((value, lineno, vcol, block_conj))
-            else:
-                _block_key(key, value, vspan, settings, block_conj)
+            _block_key(key, value, vspan, blocks[-1].record, blocks[-1].conj)
 
     built = [_build_variable(v, [x.name for x in variables if x.role == "input"])
              for v in variables]
     by_name = {v.name: v for v in built}
-    for value, lineno, vcol, conj in pending_rules:
-        rules.append(_rule(value, text, path, lineno, vcol, by_name, conj, len(rules)))
+    outputs = {v.name: v for v in variables if v.role == "output"}
+    for b in blocks:
+        b.rules = [_rule(value, text, path, lineno, vcol, by_name, b.conj, i)
+                   for i, (value, lineno, vcol) in enumerate(b.lines)]
+    blocks = [b for b in blocks if b.rules] or blocks[:1]
+    try:
+        groups = [(MAIN, [r for b in blocks for r in b.rules],
+                   _settings(blocks, list(outputs.values())))]
+        if len(blocks) > 1:
+            _relabel(groups[0][1])
+    except FormatError:
+        if len(blocks) < 2:
+            raise
+        groups = []                  # blocks with different operators: one behavior each
+        for i, b in enumerate(blocks):
+            concluded = {c.var for r in b.rules for c in r.consequents}
+            groups.append((b.name or f"block{i + 1}", b.rules,
+                           _settings([b], [outputs[n] for n in outputs if n in concluded])))
+    for _, rules, settings in groups:
+        concluded = {c.var for r in rules for c in r.consequents}
+        mine = [v for v in variables if v.role == "input" or v.name in concluded or
+                len(groups) == 1]
+        _check_outputs(mine, rules, settings)
+    return common.assemble_blocks(path, built, groups, DEFAULT_RESOLUTION, engine_span)
+
+
+def _relabel(rules: list[Rule]) -> None:
+    """Merged blocks: number the rules through (r1, r2, ...) so labels stay unique."""
+    for i, r in enumerate(rules):
+        rules[i] = Rule(f"r{i + 1}", r.antecedent, r.consequents, r.weight, r.span)
+
+
+def _check_outputs(variables: list[_Var], rules: list[Rule], settings: Settings) -> None:
     if not settings.sugeno:
         for v in variables:
             for name, kind, _, span in v.terms:
@@ -158,14 +214,13 @@ def parse_fll(text: str, path: str | None = None) -> RuleBase:
                         f"a flat membership of that height everywhere, which MITOS does not "
                         f"support", span=span, hint="use a Rectangle or Triangle term, or a "
                         "weighted-average defuzzifier for crisp consequents")
-    if settings.sugeno:
-        _check_grouping(variables, rules, settings)
-        for v in variables:
-            if v.lock_range is not None:
-                raise FormatError(f"`lock-range: true` on the Takagi-Sugeno output `{v.name}` "
-                                  f"(clipping the output to its range) is not supported",
-                                  span=v.lock_range, hint="set `lock-range: false`")
-    return common.assemble(path, built, rules, settings, DEFAULT_RESOLUTION, engine_span)
+        return
+    _check_grouping(variables, rules, settings)
+    for v in variables:
+        if v.lock_range is not None:
+            raise FormatError(f"`lock-range: true` on the Takagi-Sugeno output `{v.name}` "
+                              f"(clipping the output to its range) is not supported",
+                              span=v.lock_range, hint="set `lock-range: false`")
 
 
 def _variable_key(v: _Var, key: str, value: str, span: Span, vspan: Span,
