@@ -35,7 +35,7 @@ ZERO, ONE = 0, 1
 class NodeGroup:
     """Neurons of one level that share an operator: ``V[:, out] = op(V[:, children])``."""
 
-    op: str                       # "and", "or", "not", "hedge:<names>" or "prod"
+    op: str                       # "and", "or", "not" or "hedge:<names>"
     out: np.ndarray               # [m] output columns
     children: np.ndarray          # [m, arity] input columns, padded with the identity column
 
