@@ -52,6 +52,8 @@ from . import norms
 MAX_BYTES = 2 ** 20
 
 IMPLICATIONS = {"min": np.minimum, "product": np.multiply}
+IMPLICATIONS.update({name: (lambda a, b, norm=norm: norm(*np.broadcast_arrays(a, b)))
+                     for name, norm in norms.TNORMS.items() if name not in IMPLICATIONS})
 
 
 @dataclass(frozen=True)

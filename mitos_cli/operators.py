@@ -13,7 +13,9 @@ from .errors import RuleBaseError, Span, unknown
 from .model import Setting
 
 INFERENCES = ("weighted_average", "weighted_sum", "mamdani")
-IMPLICATIONS = ("min", "product")
+#: Mamdani implications: any T-norm (min and product are the classic ones; FLL files also use
+#: e.g. EinsteinProduct).
+IMPLICATIONS = tuple(norms.TNORMS)
 DEFUZZIFIERS = ("centroid", "bisector", "mom", "som", "lom")
 #: Where Mamdani outputs are sampled: cell midpoints (fuzzylite's rule, the default) or
 #: ``resolution`` evenly spaced points including both ends (MATLAB's ``evalfis``).

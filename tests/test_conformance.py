@@ -43,7 +43,6 @@ needs_fuzzylite = pytest.mark.skipif(EXAMPLES is None, reason="pyfuzzylite is no
 #: Engines MITOS refuses, and the words of the refusal (its cause).
 REFUSED = {
     "mamdani/laundry.fll": "is an output variable and cannot appear in a condition",
-    "mamdani/octave/investment_portfolio.fll": "implication `einstein` is not supported",
     "mamdani/simple_dimmer_chained.fll": "is an output variable and cannot appear",
     "mamdani/simple_dimmer_inverse.fll": "is an output variable and cannot appear",
     "takagi_sugeno/approximation.fll": "lock-previous: true",

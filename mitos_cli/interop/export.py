@@ -290,6 +290,9 @@ def to_c(compiled: CompiledRuleBase, prefix: str = "mitos", source: str = "") ->
     if ops.inference == "mamdani":
         out += ["static double aggregate(double a, double b) {",
                 f"    {C_NORMS[ops.aggregation]}", "}", ""]
+        if ops.implication not in ("min", "product"):
+            out += ["static double implication(double a, double b) {",
+                    f"    {C_NORMS[ops.implication]}", "}", ""]
     for h in p.hedges:
         out += [f"static double hedge_{h}(double x) {{", f"    {C_HEDGES[h]}", "}", ""]
     discrete = []
@@ -371,7 +374,7 @@ def _c_outputs(c: CompiledRuleBase, P: str) -> list[str]:
 
 def _c_mamdani(c: CompiledRuleBase, P: str) -> list[str]:
     ops = c.operators
-    imp = "d < s ? d : s" if ops.implication == "min" else "d * s"
+    imp = {"min": "d < s ? d : s", "product": "d * s"}.get(ops.implication, "implication(d, s)")
     out = []
     for j, table in enumerate(c.mamdani):
         name = c.outputs[j]
@@ -532,7 +535,7 @@ def _py_outputs(c: CompiledRuleBase) -> list[str]:
             sets = "[" + ", ".join("[" + ", ".join(num(v) for v in row) + "]"
                                    for row in table.sets) + "]"
             dofs = ", ".join(f"dof_{r}" for r in table.rules)
-            imp = "np.minimum(D, S)" if ops.implication == "min" else "D * S"
+            imp = f"(lambda a, b: {PY_NORMS[ops.implication]})(D, S)"
             agg = PY_NORMS[ops.aggregation]
             out += [f"        grid = np.array({grid})", f"        sets = np.array({sets})",
                     f"        D = np.stack([{dofs}])[:, :, None]",
