@@ -232,3 +232,28 @@ def test_fis_writer_pushes_not_by_de_morgan(tmp_path: Path) -> None:
     a = load_rulebase(tmp_path / "t.rules").run(X, strict=False).outputs
     b = load_rulebase(tmp_path / "back.fis").run(X, strict=False).outputs
     np.testing.assert_allclose(a, b, rtol=0, atol=1e-12)
+
+
+def test_fcl_rule_blocks_with_different_operators_become_behaviors() -> None:
+    from mitos_cli.interop.fcl import parse_fcl
+
+    from mitos_cli.errors import FormatError
+
+    text = (DATA / "tipper_jfuzzylogic.fcl").read_text().replace(
+        "	RULE 3 :", "END_RULEBLOCK\nRULEBLOCK gentle\n	AND : PROD;\n	RULE 3 :")
+    # both blocks conclude `tip`: their rules would feed one output with two AND operators
+    with pytest.raises(FormatError, match="AND `product` differs from `min`"):
+        parse_fcl(text, "two.fcl")
+    text = text.replace("	tip : REAL;", "	tip : REAL;\n	tip2 : REAL;").replace(
+        "END_DEFUZZIFY", "END_DEFUZZIFY\nDEFUZZIFY tip2\n TERM generous := trian 0 1 2;\n"
+        " METHOD : COG;\n RANGE := (0 .. 2);\nEND_DEFUZZIFY", 1).replace(
+        "THEN tip IS generous WITH 0.8", "THEN tip2 IS generous WITH 0.8").replace(
+        "AND service IS NOT excellent THEN tip IS average", "AND service IS NOT excellent "
+        "THEN tip2 IS generous")
+    rb = parse_fcl(text, "two.fcl")
+    assert [b.name for b in rb.behaviors] == ["No1", "gentle"]
+    ops = {b.name: dict((s.key, s.value) for s in b.operators) for b in rb.behaviors}
+    assert ops["No1"]["and"] == "min" and ops["gentle"]["and"] == "product"
+    assert ops["gentle"]["or"] == "probabilistic_sum"           # IEC: the dual of PROD
+    same = parse_fcl(text.replace("AND : PROD;", "AND : MIN;"), "one.fcl")
+    assert [b.name for b in same.behaviors] == ["main"] and len(same.behaviors[0].rules) == 4

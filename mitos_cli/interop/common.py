@@ -276,6 +276,37 @@ class Settings:
         return self.defuzzify in ("weighted_average", "weighted_sum")
 
 
+class Record(list):
+    """Operator choices as written, ``(key, value, span, what)``, kept per output and per rule
+    block and replayed into a :class:`Settings` once it is known which of them form one
+    behavior (see :func:`replay`)."""
+
+    def set(self, key: str, value, span: Span | None, what: str) -> None:
+        self.append((key, value, span, what))
+
+
+def replay(records) -> Settings:
+    """One :class:`Settings` from several records; a conflict raises FormatError."""
+    settings = Settings()
+    for record in records:
+        for entry in record:
+            settings.set(*entry)
+    return settings
+
+
+def disjoint_outputs(blocks: list[list[Rule]]) -> bool:
+    """Whether no output is concluded by two of the rule blocks (then blocks with different
+    operators are independent and may become separate behaviors; otherwise their rules feed
+    one output together, which one MITOS behavior with one set of operators cannot do)."""
+    seen: set[str] = set()
+    for rules in blocks:
+        mine = {c.var for r in rules for c in r.consequents}
+        if mine & seen:
+            return False
+        seen |= mine
+    return True
+
+
 def check_implication(name: str, span: Span | None) -> str:
     if name not in ops_mod.IMPLICATIONS:
         raise FormatError(f"implication `{name}` is not supported", span=span,

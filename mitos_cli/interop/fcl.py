@@ -37,7 +37,8 @@ from ..errors import FormatError, Span, did_you_mean
 from ..model import And, Not, Prop, Rule, RuleBase
 from ..terms import Term, Variable
 from . import common
-from .common import FCL, FLL, Settings, fmt_number
+from ..build import MAIN
+from .common import FCL, FLL, fmt_number
 from .ruletree import conclusion, expression
 
 DEFAULT_RESOLUTION = 1000
@@ -148,12 +149,14 @@ def _function_block(fb: Tree, span_of) -> RuleBase:
         else:
             blocks.append(item)
     n_inputs = sum(1 for role, _, _ in declared.values() if role == "input")
-    settings = Settings()
+    records: dict[str, common.Record] = {}           # per output: METHOD, ACCU
     locks: dict[str, Span] = {}
+    constants: list[tuple[str, Term]] = []
     variables = {}
     for node in fuzzify + defuzzify:
         role = "input" if node.data == "fuzzify" else "output"
-        v = _variable(node, role, declared, settings, locks, n_inputs, span_of)
+        record = records.setdefault(str(node.children[0]), common.Record())
+        v = _variable(node, role, declared, record, locks, constants, n_inputs, span_of)
         if v.name in variables:
             raise FormatError(f"variable `{v.name}` is defined twice", span=v.span)
         variables[v.name] = v
@@ -162,38 +165,65 @@ def _function_block(fb: Tree, span_of) -> RuleBase:
             kind = "FUZZIFY" if role == "input" else "DEFUZZIFY"
             raise FormatError(f"variable `{name}` is declared but has no {kind} block",
                               span=span)
-    conj: dict[str, bool] = {}
-    rules = []
+    parsed = []                                       # (name, record, rules) per RULEBLOCK
     for block in blocks:
+        record = common.Record()
         for item in block.children[1:]:
             if item.data == "option":
-                _option(item, settings, span_of, conj)
-    if settings.and_ and not settings.or_:
-        settings.or_ = norms.lookup("tnorm", settings.and_).dual
-    elif settings.or_ and not settings.and_:
-        settings.and_ = norms.lookup("snorm", settings.or_).dual
-    for block in blocks:
-        for item in block.children[1:]:
-            if item.data == "rule":
-                rules.append(_rule(item, variables, span_of, len(rules)))
-    constants = locks.pop("constant terms", [])
-    if settings.sugeno:
-        for name, span in locks.items():
-            raise FormatError(f"`LOCK : RANGE` on the Takagi-Sugeno output `{name}` (clipping "
-                              f"the output to its range) is not supported", span=span)
-    else:
-        for name, term in constants:
-            raise FormatError(f"term `{name}.{term.name}`: in a Mamdani output fuzzylite's "
-                              f"`Constant` is a flat membership of that height everywhere, "
-                              f"which MITOS does not support", span=term.span,
-                              hint=f"for a singleton write `TERM {term.name} := value;`")
+                _option(item, record, span_of, {})
+        keys = {key for key, *_ in record}
+        if "and_" in keys and "or_" not in keys:      # IEC: the other one is the dual
+            and_ = next(v for k, v, *_ in record if k == "and_")
+            record.set("or_", norms.lookup("tnorm", and_).dual, None, "OR")
+        elif "or_" in keys and "and_" not in keys:
+            or_ = next(v for k, v, *_ in record if k == "or_")
+            record.set("and_", norms.lookup("snorm", or_).dual, None, "AND")
+        rules = [_rule(item, variables, span_of, i) for i, item in
+                 enumerate(x for x in block.children[1:] if x.data == "rule")]
+        name = str(block.children[0]) if block.children[0] is not None else ""
+        parsed.append((name, record, rules))
+    parsed = [p for p in parsed if p[2]] or parsed[:1]
+    outputs = [n for n in declared if declared[n][0] == "output"]
+    try:
+        all_rules = [r for _, _, rules in parsed for r in rules]
+        if len({r.label for r in all_rules}) < len(all_rules):
+            all_rules = [Rule(f"r{i + 1}", r.antecedent, r.consequents, r.weight, r.span)
+                         for i, r in enumerate(all_rules)]
+        groups = [(MAIN, all_rules, common.replay([rec for _, rec, _ in parsed] +
+                                                  [records[n] for n in outputs]))]
+    except FormatError as conflict:
+        if len(parsed) < 2 or not common.disjoint_outputs([r for _, _, r in parsed]):
+            raise conflict
+        groups = []                  # blocks with different operators: one behavior each
+        for i, (name, record, rules) in enumerate(parsed):
+            concluded = {c.var for r in rules for c in r.consequents}
+            groups.append((name or f"block{i + 1}", rules,
+                           common.replay([record] + [records[n] for n in outputs
+                                                     if n in concluded])))
+    for _, rules, settings in groups:
+        concluded = {c.var for r in rules for c in r.consequents}
+        mine = (lambda n: n in concluded or len(groups) == 1)
+        if settings.sugeno:
+            for name, span in locks.items():
+                if mine(name):
+                    raise FormatError(f"`LOCK : RANGE` on the Takagi-Sugeno output `{name}` "
+                                      f"(clipping the output to its range) is not supported",
+                                      span=span)
+        else:
+            for name, term in constants:
+                if mine(name):
+                    raise FormatError(
+                        f"term `{name}.{term.name}`: in a Mamdani output fuzzylite's "
+                        f"`Constant` is a flat membership of that height everywhere, which "
+                        f"MITOS does not support", span=term.span,
+                        hint=f"for a singleton write `TERM {term.name} := value;`")
     ordered = [variables[n] for n in declared]
-    return common.assemble(span_of(fb).path, ordered, rules, settings, DEFAULT_RESOLUTION,
-                           span_of(fb))
+    return common.assemble_blocks(span_of(fb).path, ordered, groups, DEFAULT_RESOLUTION,
+                                  span_of(fb))
 
 
-def _variable(node: Tree, role: str, declared, settings: Settings, locks: dict, n_inputs: int,
-              span_of) -> Variable:
+def _variable(node: Tree, role: str, declared, settings: common.Record, locks: dict,
+              constants: list, n_inputs: int, span_of) -> Variable:
     name_token = node.children[0]
     name = str(name_token)
     if name not in declared:
@@ -213,7 +243,7 @@ def _variable(node: Tree, role: str, declared, settings: Settings, locks: dict, 
             definition = item.children[1]
             if role == "output" and definition.data == "shape_def" and \
                     str(definition.children[0]).lower() == "constant":
-                locks.setdefault("constant terms", []).append((name, terms[-1]))
+                constants.append((name, terms[-1]))
         elif kind == "range_item":
             universe = (_num(item.children[0]), _num(item.children[1]))
         elif kind == "option":
@@ -332,7 +362,7 @@ def _points_term(name: str, pts: list[tuple[float, float]], span: Span) -> Term:
     return common.make_term(name, "discrete", tuple(v for p in pts for v in p), span)
 
 
-def _option(item: Tree, settings: Settings, span_of, conj: dict) -> None:
+def _option(item: Tree, settings: common.Record, span_of, conj: dict) -> None:
     key_token, value_token, number = item.children
     key, value, span = str(key_token).upper(), str(value_token), span_of(value_token)
     if key == "AND":

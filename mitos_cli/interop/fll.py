@@ -58,14 +58,6 @@ def rule_parser() -> Lark:
                 maybe_placeholders=True, cache=True)      # grammar analysis cached on disk
 
 
-class _Record(list):
-    """Operator choices as written, ``(key, value, span, what)``, replayed into a
-    :class:`Settings` once it is known which outputs and blocks share one."""
-
-    def set(self, key: str, value, span: Span | None, what: str) -> None:
-        self.append((key, value, span, what))
-
-
 @dataclass
 class _Var:
     role: str
@@ -76,14 +68,14 @@ class _Var:
     default: float | None = None
     description: str = ""
     lock_range: Span | None = None      # `lock-range: true` on an output
-    record: _Record = field(default_factory=_Record)
+    record: common.Record = field(default_factory=common.Record)
 
 
 @dataclass
 class _Block:
     name: str
     span: Span
-    record: _Record = field(default_factory=_Record)
+    record: common.Record = field(default_factory=common.Record)
     conj: dict = field(default_factory=lambda: {"conjunction": None, "disjunction": None})
     lines: list = field(default_factory=list)           # (rule text, line, column)
     rules: list = field(default_factory=list)
@@ -101,14 +93,6 @@ def _read_text(path: Path) -> str:
         raise FormatError(f"`{path}` is not a text file (it is not UTF-8)") from None
     except OSError as exc:
         raise FormatError(f"cannot read `{path}`: {exc.strerror or exc}") from None
-
-
-def _settings(blocks: list[_Block], outputs: list[_Var]) -> Settings:
-    settings = Settings()
-    for part in list(blocks) + list(outputs):
-        for entry in part.record:
-            settings.set(*entry)
-    return settings
 
 
 def parse_fll(text: str, path: str | None = None) -> RuleBase:
@@ -179,17 +163,18 @@ def parse_fll(text: str, path: str | None = None) -> RuleBase:
     blocks = [b for b in blocks if b.rules] or blocks[:1]
     try:
         groups = [(MAIN, [r for b in blocks for r in b.rules],
-                   _settings(blocks, list(outputs.values())))]
+                   common.replay([b.record for b in blocks] + [v.record for v in outputs.values()]))]
         if len(blocks) > 1:
             _relabel(groups[0][1])
-    except FormatError:
-        if len(blocks) < 2:
-            raise
+    except FormatError as conflict:
+        if len(blocks) < 2 or not common.disjoint_outputs([b.rules for b in blocks]):
+            raise conflict
         groups = []                  # blocks with different operators: one behavior each
         for i, b in enumerate(blocks):
             concluded = {c.var for r in b.rules for c in r.consequents}
             groups.append((b.name or f"block{i + 1}", b.rules,
-                           _settings([b], [outputs[n] for n in outputs if n in concluded])))
+                           common.replay([b.record] + [outputs[n].record for n in outputs
+                                                        if n in concluded])))
     for _, rules, settings in groups:
         concluded = {c.var for r in rules for c in r.consequents}
         mine = [v for v in variables if v.role == "input" or v.name in concluded or
@@ -224,7 +209,7 @@ def _check_outputs(variables: list[_Var], rules: list[Rule], settings: Settings)
 
 
 def _variable_key(v: _Var, key: str, value: str, span: Span, vspan: Span,
-                  settings: Settings) -> None:
+                  settings: common.Record) -> None:
     words = value.split()
     if key == "range":
         if len(words) != 2:
@@ -275,7 +260,8 @@ def _variable_key(v: _Var, key: str, value: str, span: Span, vspan: Span,
                 settings.set("resolution", int(res), vspan, "resolution")
 
 
-def _block_key(key: str, value: str, vspan: Span, settings: Settings, conj: dict) -> None:
+def _block_key(key: str, value: str, vspan: Span, settings: common.Record,
+               conj: dict) -> None:
     if key == "conjunction":
         if value != "none":
             settings.set("and_", common.table_lookup(common.TNORMS, FLL, value, "conjunction",
