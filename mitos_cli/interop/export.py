@@ -385,7 +385,8 @@ def _c_mamdani(c: CompiledRuleBase, P: str) -> list[str]:
         grid = ", ".join(num(v) for v in table.grid)
         out.append(f"    {{   /* {name}: Mamdani, {res} samples */")
         out.append(f"        static const double grid[{res}] = {{{grid}}};")
-        out.append(f"        static const double sets[{len(table.sets)}][{res}] = {{\n{rows}\n        }};")
+        out.append(f"        static const double sets[{len(table.sets)}][{res}] = {{\n"
+                   f"{rows}\n        }};")
         dofs = ", ".join(f"dof_{r}" for r in table.rules)
         set_of = ", ".join(str(int(s)) for s in table.set_of)
         n = len(table.rules)

@@ -92,7 +92,8 @@ def _syntax_error(exc: UnexpectedInput, text: str, path: str | None) -> FormatEr
 def _word(terminal: str) -> str:
     names = {"NAME": "a name", "SIGNED_NUMBER": "a number", "NAN": "nan", "INF": "inf",
              "INT": "a number", "SEMICOLON": "`;`", "COLON": "`:`", "LPAR": "`(`",
-             "RPAR": "`)`", "COMMA": "`,`", "WORD": "a hedge", "OPTION_KEY": "METHOD/ACCU/AND/OR/ACT",
+             "RPAR": "`)`", "COMMA": "`,`", "WORD": "a hedge",
+             "OPTION_KEY": "METHOD/ACCU/AND/OR/ACT",
              "$END": "the end of the file"}
     if terminal in names:
         return names[terminal]
@@ -456,8 +457,9 @@ def write_fcl(rb: RuleBase, behavior: str | None = None) -> str:
     out.append(f"    AND : {common.foreign_name(common.TNORMS, FCL, ops.and_, 'T-norm')};")
     out.append(f"    OR : {common.foreign_name(common.SNORMS, FCL, ops.or_, 'S-norm')};")
     if not sugeno:
-        out.append(f"    ACT : {common.foreign_name(common.TNORMS, FCL, ops.implication, 'T-norm')};")
-        out.append(f"    ACCU : {common.foreign_name(common.SNORMS, FCL, ops.aggregation, 'S-norm')};")
+        act = common.foreign_name(common.TNORMS, FCL, ops.implication, "T-norm")
+        accu = common.foreign_name(common.SNORMS, FCL, ops.aggregation, "S-norm")
+        out += [f"    ACT : {act};", f"    ACCU : {accu};"]
     for i, r in enumerate(flat.rules, 1):
         out.append(f"    RULE {i} : {_rule_text(r)};")
     out += ["END_RULEBLOCK", "", "END_FUNCTION_BLOCK"]

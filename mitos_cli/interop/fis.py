@@ -300,9 +300,10 @@ def write_fis(rb: RuleBase, behavior: str | None = None) -> str:
         lines += ["ImpMethod='prod'", "AggMethod='sum'",
                   f"DefuzzMethod='{common.DEFUZZIFIERS[ops.inference][FIS]}'"]
     else:
-        lines += [f"ImpMethod='{common.foreign_name(common.TNORMS, FIS, ops.implication, 'implication')}'",
-                  f"AggMethod='{common.foreign_name(common.SNORMS, FIS, ops.aggregation, 'aggregation')}'",
-                  f"DefuzzMethod='{common.foreign_name(common.DEFUZZIFIERS, FIS, ops.defuzzify, 'defuzzifier')}'"]
+        imp = common.foreign_name(common.TNORMS, FIS, ops.implication, "implication")
+        agg = common.foreign_name(common.SNORMS, FIS, ops.aggregation, "aggregation")
+        defuzz = common.foreign_name(common.DEFUZZIFIERS, FIS, ops.defuzzify, "defuzzifier")
+        lines += [f"ImpMethod='{imp}'", f"AggMethod='{agg}'", f"DefuzzMethod='{defuzz}'"]
     for i, v in enumerate(inputs, 1):
         lines += ["", f"[Input{i}]"] + _var_lines(v, [_mf_text(t, v) for t in v.terms])
     for i, v in enumerate(flat.outputs, 1):

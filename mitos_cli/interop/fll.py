@@ -163,7 +163,8 @@ def parse_fll(text: str, path: str | None = None) -> RuleBase:
     blocks = [b for b in blocks if b.rules] or blocks[:1]
     try:
         groups = [(MAIN, [r for b in blocks for r in b.rules],
-                   common.replay([b.record for b in blocks] + [v.record for v in outputs.values()]))]
+                   common.replay([b.record for b in blocks]
+                                 + [v.record for v in outputs.values()]))]
         if len(blocks) > 1:
             _relabel(groups[0][1])
     except FormatError as conflict:
@@ -404,7 +405,8 @@ def write_fll(rb: RuleBase, behavior: str | None = None) -> str:
             kind = common.DEFUZZIFIERS[ops.inference][FLL]
             out.append(f"  defuzzifier: {kind} TakagiSugeno")
         else:
-            out.append(f"  aggregation: {common.foreign_name(common.SNORMS, FLL, ops.aggregation, 'S-norm')}")
+            aggregation = common.foreign_name(common.SNORMS, FLL, ops.aggregation, "S-norm")
+            out.append(f"  aggregation: {aggregation}")
             kind = common.foreign_name(common.DEFUZZIFIERS, FLL, ops.defuzzify, "defuzzifier")
             res = "" if ops.resolution == DEFAULT_RESOLUTION else f" {ops.resolution}"
             out.append(f"  defuzzifier: {kind}{res}")
