@@ -16,7 +16,7 @@ def draw_run(result, path: str | Path | None = None, *, footprint_every: float =
     """Draw ``result``; save to ``path`` (.png or .svg) and/or ``show``. Footprints every
     ``footprint_every`` seconds. Returns the figure."""
     from matplotlib.collections import LineCollection
-    from matplotlib.patches import Circle, Polygon, Rectangle
+    from matplotlib.patches import Circle, Polygon
 
     from ..sim.geometry import rect_corners
 
@@ -98,5 +98,4 @@ def draw_run(result, path: str | Path | None = None, *, footprint_every: float =
     ax.set_title(f"{world.name}: {result.outcome} after {m['time_s']:.1f} s "
                  f"(seed {result.seed}, min clearance {m['min_clearance_in']:.1f} in)",
                  fontsize=9)
-    del Rectangle
     return finish(fig, path, show)

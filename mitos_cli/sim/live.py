@@ -9,14 +9,19 @@ import numpy as np
 class LiveView:
     """Call :meth:`update` from ``simulate(on_tick=...)``; use as a context manager."""
 
-    def __init__(self, world, scene, every: int = 2, cols: int = 72, rows: int = 22) -> None:
+    def __init__(self, world, scene, every: int = 2, cols: int = 72) -> None:
         from rich.console import Console
         from rich.live import Live
 
         self.world, self.scene, self.every = world, scene, max(1, every)
         xmin, ymin, xmax, ymax = scene.static.bounds
+        pad = 0.04 * max(xmax - xmin, ymax - ymin)       # show the outer walls
+        xmin, ymin, xmax, ymax = xmin - pad, ymin - pad, xmax + pad, ymax + pad
         self.box = (xmin, ymin, xmax, ymax)
-        self.cols, self.rows = cols, rows
+        # a character is about twice as tall as wide
+        rows = int(round(cols * (ymax - ymin) / (xmax - xmin) / 2))
+        self.cols, self.rows = cols, min(max(rows, 5), 30)
+        rows = self.rows
         # the static background, once: a cell shows a wall when its centre is not free
         xs = xmin + (np.arange(cols) + 0.5) * (xmax - xmin) / cols
         ys = ymax - (np.arange(rows) + 0.5) * (ymax - ymin) / rows

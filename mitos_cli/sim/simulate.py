@@ -15,7 +15,6 @@ Randomness: ``SeedSequence(seed).spawn(1 + robots)``: the first stream randomise
 
 from __future__ import annotations
 
-import functools
 import math
 from dataclasses import dataclass, field
 
@@ -298,8 +297,3 @@ def simulate(world: World, planner: Planner | None = None, seed: int | None = No
         routes=routes, static=static, active=np.array(rec_act))
     res.metrics = _metrics(res, dt)
     return res
-
-
-@functools.lru_cache(maxsize=8)
-def _cached_scene(world: World) -> Scene:
-    return prepare(world)
