@@ -53,11 +53,17 @@ def _build_loader(text: str, path: str | None) -> type:
         out.span = _span(node.start_mark, text, path)
         out.key_spans, out.value_spans = {}, {}
         for key_node, value_node in node.value:
-            key = loader.construct_object(key_node, deep=True)
-            if not isinstance(key, (str, int, float, bool)) or key is None:
+            if not isinstance(key_node, yaml.ScalarNode):
                 raise yaml.constructor.ConstructorError(
                     None, None, "a mapping key must be a plain name", key_node.start_mark)
-            key = str(key)
+            if key_node.tag != "tag:yaml.org,2002:str":
+                # YAML 1.1 reads ON, off, yes, No, 1e3, ~ ... as booleans, numbers, null
+                kind = key_node.tag.rsplit(":", 1)[-1]
+                kind = {"bool": "true/false", "null": "null"}.get(kind, "a number")
+                raise yaml.constructor.ConstructorError(
+                    None, None, f"the key `{key_node.value}` reads as {kind} in YAML; "
+                    f"write it in quotes: \"{key_node.value}\"", key_node.start_mark)
+            key = loader.construct_object(key_node, deep=True)
             if key in out:
                 raise yaml.constructor.ConstructorError(
                     None, None, f"duplicate key `{key}`", key_node.start_mark)

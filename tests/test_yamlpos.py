@@ -1,0 +1,29 @@
+"""YAML with positions: keys YAML would silently turn into booleans or numbers are refused."""
+
+from __future__ import annotations
+
+import pytest
+
+from mitos_cli import yamlpos
+from mitos_cli.errors import TermSetError
+
+
+@pytest.mark.parametrize("key,kind", [("ON", "true/false"), ("no", "true/false"),
+                                      ("12", "a number"), ("1.5", "a number"), ("~", "null")])
+def test_non_string_keys_are_refused_with_a_hint(key, kind):
+    with pytest.raises(TermSetError) as info:
+        yamlpos.load(f"a:\n  {key}: 1\n", "f.yaml", TermSetError)
+    err = info.value
+    assert (err.span.path, err.span.line, err.span.column) == ("f.yaml", 2, 3)
+    assert f"the key `{key}` reads as {kind} in YAML; write it in quotes" in err.message
+
+
+def test_quoted_keys_and_positions():
+    data = yamlpos.load('a:\n  "ON": 1\n  b: [1, 2]\n', "f.yaml", TermSetError)
+    assert data["a"]["ON"] == 1
+    assert data["a"].key_span("b").line == 3 and data["a"]["b"].item_span(1).column == 10
+
+
+def test_duplicate_keys_are_refused():
+    with pytest.raises(TermSetError, match="duplicate key `a`"):
+        yamlpos.load("a: 1\na: 2\n", "f.yaml", TermSetError)
