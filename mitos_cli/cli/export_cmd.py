@@ -32,8 +32,9 @@ def export_command(
 ) -> None:
     """Export a rule base as code that computes its outputs from its inputs.
 
-    The C function is `int PREFIX_eval(const double in[], double out[])`; the Python module
-    has `evaluate(X)` for a batch `X[n, k]`. Both agree with `mitos eval` to rounding.
+    The C function is `int PREFIX_eval(const double *in, double *out)`; the Python module
+    has `evaluate(X)` for a batch X (one row per sample). Both agree with `mitos eval` to
+    rounding.
     """
     from ..api import load_rulebase
     from ..interop.common import atomic_write
