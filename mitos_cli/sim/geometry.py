@@ -169,9 +169,11 @@ def box_segment_distance(hl: float, hw: float, seg: np.ndarray) -> np.ndarray:
     corners = np.array([[-hl, -hw], [hl, -hw], [hl, hw], [-hl, hw]])
     c = point_segment_distance(corners, seg).min(axis=0)
     d = np.minimum(np.minimum(e0, e1), c)
-    # a segment can cross the box only if it passes within the box's half diagonal of a
-    # corner or an endpoint is inside; clip just those (Liang-Barsky)
-    maybe = d < math.hypot(hl, hw) * 2.0
+    # a segment can cross the box only if it passes within the box's half diagonal of its
+    # centre; clip just those (Liang-Barsky)
+    dx, dy = x1 - x0, y1 - y0
+    t = np.clip(-(x0 * dx + y0 * dy) / np.maximum(dx * dx + dy * dy, EPS), 0.0, 1.0)
+    maybe = np.hypot(x0 + t * dx, y0 + t * dy) <= math.hypot(hl, hw)
     if not maybe.any():
         return d
     out = d.copy()

@@ -20,7 +20,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import kinematics, obstacles as obs_mod, perception, sensors
+from . import geometry, kinematics, obstacles as obs_mod, perception, sensors
 from .geometry import box_segment_distance, polygon_segments, rect_corners
 from .planner import Percepts, Planner
 from .route import Route, plan_route
@@ -208,17 +208,18 @@ def simulate(world: World, planner: Planner | None = None, seed: int | None = No
                 near_walls[i] = static.near(x[i], y[i], reach + NEAR_SLACK)
             walls = near_walls[i]
             dirs = sensors.beam_directions(h[i], angles)
-            expected, true_r = sensors.cast(pose[i, :2], dirs, walls, others, centres, radii,
-                                            sen.range)
-            measured = sensors.add_noise(true_r, sen.noise, sen.range, streams[1 + i])
-            ranges[i] = measured
             f = perception.frame(routes[i], pose[i, :2], s_hint[i])
             s_hint[i] = f.s
+            # the beams, plus two exact rays across the route for the true road width
+            both = np.concatenate([dirs, [-f.n, f.n]])
+            expected, true_r = sensors.cast(pose[i, :2], both, walls, others, centres, radii,
+                                            sen.range)
+            sides_lr = geometry.ray_segments(pose[i, :2], both[B:], walls, 1e6)
+            expected, true_r = expected[:B], true_r[:B]
+            measured = sensors.add_noise(true_r, sen.noise, sen.range, streams[1 + i])
+            ranges[i] = measured
             p = perception.perceive(routes[i], f, (x[i], y[i], h[i]), robots[i], dirs, measured,
                                     expected, sen.range, spacing, threshold, cfg)
-            side_dirs = np.stack([-f.n, f.n])
-            sides_lr = sensors.cast(pose[i, :2], side_dirs, walls, np.zeros((0, 4)),
-                                    np.zeros((0, 2)), np.zeros(0), 1e6)[0]
             things = np.concatenate([outline] + [corners[j] for j in range(n) if j != i])
             gaps = perception.side_gaps(f, pose[i, :2], dirs, expected, things, robots[i],
                                         sen.range, cfg)
