@@ -104,6 +104,7 @@ def sugeno(tmp_path: Path, inference: str) -> Path:
 def fixtures(tmp_path: Path) -> list[Path]:
     files = [ROOT / "rulebases" / "mitos.rules", DATA / "tipper.fis",
              DATA / "tipper_jfuzzylogic.fcl", DATA / "dimmer_fuzzylite.fcl",
+             DATA / "robot_jfuzzylogic.fcl",
              sugeno(tmp_path, "weighted_average"), sugeno(tmp_path, "weighted_sum")]
     return files
 

@@ -77,14 +77,21 @@ def test_matlab_and_jfuzzylogic_orders() -> None:
     assert tuple((sig, c)[i] for i in matlab[2]) == (3.0, 1.2)
     np.testing.assert_allclose(gauss, np.exp(-(x - 3.0) ** 2 / (2 * 1.2 ** 2)), atol=1e-15)
     # gbellmf [a b c] and jFuzzyLogic's gbell a b mean are width, slope, center
-    for order in (MF_TYPES["gbellmf"][2], JFUZZY_SHAPES["gbell"][2]):
-        params = tuple((2.0, 4.0, 5.0)[i] for i in order)
+    for params in (tuple((2.0, 4.0, 5.0)[i] for i in MF_TYPES["gbellmf"][2]),
+                   JFUZZY_SHAPES["gbell"][2]((2.0, 4.0, 5.0))):
         assert params == (5.0, 2.0, 4.0)
         np.testing.assert_allclose(SHAPES["bell"].membership(x, params),
                                    1 / (1 + np.abs((x - 5) / 2) ** 8), atol=1e-15)
     # sigmf [a c] and jFuzzyLogic's sigm gain center: slope first
-    for order in (MF_TYPES["sigmf"][2], JFUZZY_SHAPES["sigm"][2]):
-        assert tuple((2.0, 3.0)[i] for i in order) == (3.0, 2.0)
+    assert tuple((2.0, 3.0)[i] for i in MF_TYPES["sigmf"][2]) == (3.0, 2.0)
+    assert JFUZZY_SHAPES["sigm"][2]((2.0, 3.0)) == (3.0, 2.0)
+    # jFuzzyLogic's COSINE net_max offset: (cos(pi (x - offset) / net_max) + 1) / 2 within
+    # offset +- net_max (its MembershipFunctionCosine), 0 outside
+    net_max, offset = 1.5, 3.0
+    want = np.where(np.abs(x - offset) <= net_max,
+                    (np.cos((x - offset) * np.pi / net_max) + 1) / 2, 0.0)
+    got = SHAPES["cosine"].membership(x, JFUZZY_SHAPES["cosine"][2]((net_max, offset)))
+    np.testing.assert_allclose(got, want, atol=1e-12)
     # linzmf [a b]: 1 below a falling to 0 at b
     ramp = SHAPES["ramp"].membership(np.array([0.0, 1.0, 1.5, 2.0, 3.0]),
                                      tuple((1.0, 2.0)[i] for i in MF_TYPES["linzmf"][2]))

@@ -6,7 +6,8 @@ MITOS's model. Both dialects are read:
 
 - terms: the standard point lists ``(x, y) ...`` (a list that is exactly a triangle, trapezoid
   or shoulder becomes that shape, else ``discrete``), singletons ``TERM t := 5;``,
-  jFuzzyLogic's ``trian trape gauss gbell sigm dsigm`` and fuzzylite's class names
+  jFuzzyLogic's ``trian trape gauss gauss2 gbell sigm dsigm cosine`` (any case) and
+  fuzzylite's class names
   (``Triangle``, ``Gaussian``, ``Linear``, ...; every one but ``Function``);
 - ``ACCU`` in the RULEBLOCK (IEC, jFuzzyLogic) or in DEFUZZIFY (fuzzylite); ``ACT`` is the
   implication; with only ``AND`` (or only ``OR``) given the other is its De Morgan dual, as
@@ -43,14 +44,17 @@ from .ruletree import conclusion, expression
 
 DEFAULT_RESOLUTION = 1000
 
-#: jFuzzyLogic's shape names (lower case) -> (MITOS shape, count, FCL order -> MITOS order)
+#: jFuzzyLogic's shape names (lower case) -> (MITOS shape, count, FCL params -> MITOS params)
 JFUZZY_SHAPES = {
-    "trian": ("triangle", 3, (0, 1, 2)),
-    "trape": ("trapezoid", 4, (0, 1, 2, 3)),
-    "gauss": ("gaussian", 2, (0, 1)),
-    "gbell": ("bell", 3, (2, 0, 1)),               # a b mean = width, slope, center
-    "sigm": ("sigmoid", 2, (1, 0)),                # gain center
-    "dsigm": ("sigmoid_difference", 4, (1, 0, 2, 3)),   # gain1 center1 gain2 center2
+    "trian": ("triangle", 3, lambda p: p),
+    "trape": ("trapezoid", 4, lambda p: p),
+    "gauss": ("gaussian", 2, lambda p: p),                            # mean stdev
+    "gauss2": ("gaussian2", 4, lambda p: p),                          # meanl stdevl meanr stdevr
+    "gbell": ("bell", 3, lambda p: (p[2], p[0], p[1])),              # a b mean
+    "sigm": ("sigmoid", 2, lambda p: (p[1], p[0])),                   # gain center
+    "dsigm": ("sigmoid_difference", 4, lambda p: (p[1], p[0], p[2], p[3])),  # g1 c1 g2 c2
+    # net_max offset: (1 + cos(pi (x - offset) / net_max)) / 2 on offset +- net_max
+    "cosine": ("cosine", 2, lambda p: (p[1], 2.0 * p[0])),
 }
 
 
@@ -323,12 +327,14 @@ def _term(item: Tree, role: str, n_inputs: int, span_of) -> Term:
     kind_token, *values = definition.children
     kind = str(kind_token)
     values = [_num(v) for v in values]
-    if kind.lower() in JFUZZY_SHAPES:
-        shape, count, order = JFUZZY_SHAPES[kind.lower()]
+    # fuzzylite's class names in their own spelling first: `Cosine c w` is fuzzylite's
+    # (center, width), `COSINE t c` jFuzzyLogic's (net_max, offset)
+    if kind.lower() in JFUZZY_SHAPES and kind not in common.FUZZYLITE_SHAPES:
+        shape, count, convert = JFUZZY_SHAPES[kind.lower()]
         if len(values) != count:
             raise FormatError(f"term `{name}`: {kind} takes {count} numbers, not {len(values)}",
                               span=span)
-        return common.make_term(name, shape, tuple(values[i] for i in order), span)
+        return common.make_term(name, shape, tuple(convert(tuple(values))), span)
     by_lower = {k.lower(): k for k in common.FUZZYLITE_SHAPES} | {
         k.lower(): k for k in common.FORMULA_TERMS}
     if kind.lower() in by_lower:
