@@ -204,3 +204,24 @@ def test_export_cli(tmp_path: Path) -> None:
     result = runner.invoke(app, ["export", str(DATA / "tipper.fis"), "--to", "c",
                                  "--prefix", "1x"])
     assert result.exit_code == 2 and "not a C identifier" in result.output
+
+
+@needs_cc
+def test_c_export_agrees_with_mitos_eval_command(tmp_path: Path) -> None:
+    """The same numbers as the command a user runs: `mitos eval ... --json`."""
+    import json
+
+    from typer.testing import CliRunner
+
+    cases = [(ROOT / "rulebases" / "mitos.rules", {"road": 78, "size": 45, "position": 4}),
+             (DATA / "tipper.fis", {"service": 2, "food": 1}),
+             (DATA / "robot_jfuzzylogic.fcl", {"dist": 0.4, "angle": 10})]
+    for path, inputs in cases:
+        result = CliRunner().invoke(app, ["eval", str(path), "--json"] +
+                                    [f"{k}={v}" for k, v in inputs.items()])
+        assert result.exit_code == 0, result.output
+        want = json.loads(result.stdout)["outputs"]
+        c = load_rulebase(path).compiled
+        X = np.array([[inputs[name] for name in c.inputs]], dtype=float)
+        got = run_c(c, X, tmp_path)[0]
+        assert dict(zip(c.outputs, got)) == pytest.approx(want, abs=TOLERANCE)
