@@ -88,11 +88,14 @@ def main() -> None:
           f"CPU {time_runs.cpu:.3f} s")
     empty = dataclasses.replace(world, obstacles=())
     ftimes, fres = time_runs(empty, fuzzy)
+    fcpu = time_runs.cpu
     ctimes, cres = time_runs(empty, Constant())
+    ccpu = time_runs.cpu
     assert fres.ticks == cres.ticks == 1200
     fbest, cbest = min(ftimes), min(ctimes)
-    print(f"   without the obstacle: fuzzy drive best {fbest:.3f} s, constant planner (no "
-          f"rules) best {cbest:.3f} s ({1e6 * cbest / cres.ticks:.0f} us/tick)")
+    print(f"   without the obstacle: fuzzy drive best {fbest:.3f} s (CPU {fcpu:.3f} s), "
+          f"constant planner (no rules) best {cbest:.3f} s (CPU {ccpu:.3f} s, "
+          f"{1e6 * ccpu / cres.ticks:.0f} us/tick)")
     timed = Timed(fuzzy)
     scene = prepare(world)
     t = time.perf_counter()
@@ -100,23 +103,27 @@ def main() -> None:
     total = time.perf_counter() - t
     print(f"   rule evaluation (plan): {1e6 * timed.seconds / res.ticks:.0f} us/tick, "
           f"{100 * timed.seconds / total:.0f}% of the tick")
-    print(f"   ratio fuzzy / constant loop (no obstacle): {fbest / cbest:.2f}x")
+    print(f"   ratio fuzzy / constant loop (no obstacle, CPU): {fcpu / ccpu:.2f}x")
 
     slalom = load_world(packaged_path("worlds", "slalom.yaml"))
     print("\n2. --runs 100 of slalom.yaml")
     walls = {}
     results = {}
     for workers in (1, 2):
-        t = time.perf_counter()
+        t, c0 = time.perf_counter(), os.times()
         runs = run_many([slalom], runs=100, seed=1, planner=fuzzy, workers=workers)
         walls[workers] = time.perf_counter() - t
+        c1 = os.times()
+        cpu = (c1.user - c0.user) + (c1.children_user - c0.children_user)
         results[workers] = runs.to_json()
         w = runs.worlds[0]
         ticks = sum(s["ticks"] for s in w.summaries)
-        print(f"   {workers} worker(s): {walls[workers]:.1f} s wall, {ticks} ticks, "
-              f"success {100 * w.rate('success'):.0f}%")
+        print(f"   {workers} worker(s): {walls[workers]:.1f} s wall, {cpu:.1f} s CPU (user, with "
+              f"workers), {ticks} ticks, success {100 * w.rate('success'):.0f}%")
     assert results[1] == results[2], "results depend on the number of workers"
-    print(f"   identical results with 1 and 2 workers; speed-up {walls[1] / walls[2]:.2f}x")
+    print(f"   identical results with 1 and 2 workers; wall-time speed-up {walls[1] / walls[2]:.2f}x")
+    load = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
+    print(f"load average {load:.2f} at the end")
 
 
 if __name__ == "__main__":
