@@ -25,7 +25,7 @@ import numpy as np
 from . import operators as ops_mod
 from .model import And, Expr, Not, Or, Prop, Rule, RuleBase, Setting, Use, flatten, format_rule
 from .operators import Operators
-from .shapes import SHAPES, kernel_params
+from .shapes import kernel_params
 from .terms import Term, Variable
 
 ZERO, ONE = 0, 1
