@@ -326,6 +326,7 @@ def fill_defaults(compiled: CompiledRuleBase, out: np.ndarray, X: np.ndarray,
             raise NoRuleFiredError(
                 f"no rule sets `{name}` for {values}" +
                 (f" ({int(col.sum())} of {len(col)} samples)" if len(col) > 1 else ""),
-                hint=f"add `default: VALUE` to the `{name}` variable in the term set to define "
+                hint=f"declare a default for `{name}` (`default: VALUE` on the variable in a YAML "
+                     f"term set, `DEFAULT := VALUE` in FCL, `default: VALUE` in FLL) to define "
                      f"the output when no rule fires, or add rules that cover these inputs")
     return out

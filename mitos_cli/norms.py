@@ -29,7 +29,9 @@ class Norm:
         return 1.0 if self.kind == "tnorm" else 0.0
 
     def __call__(self, a, b):
-        return self.fn(np.asarray(a, dtype=float), np.asarray(b, dtype=float))
+        # broadcast first: the formulas work in place on temporaries shaped like their inputs
+        a, b = np.broadcast_arrays(np.asarray(a, dtype=float), np.asarray(b, dtype=float))
+        return self.fn(a, b)
 
 
 def _fresh(x) -> np.ndarray:

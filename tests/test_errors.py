@@ -310,7 +310,7 @@ def test_no_rule_fired_without_default(tmp_path):
     loaded = load_rulebase(path)
     exc = error_of(lambda: loaded.evaluate(road=20), NoRuleFiredError)
     assert exc.message == "no rule sets `steering` for road=20"
-    assert "add `default: VALUE` to the `steering` variable" in exc.hint
+    assert "declare a default for `steering` (`default: VALUE` on the variable" in exc.hint
 
 
 def test_no_rule_fired_with_default_uses_it(tmp_path):
