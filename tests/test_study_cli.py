@@ -165,3 +165,8 @@ def test_user_errors(tiny, tmp_path, compare, args, code, words):
     assert r.exit_code == code, r.output
     assert words in r.output
     assert not (tmp_path / "e" / "results.csv").exists()
+
+
+def test_no_planner_is_a_usage_error(tiny, tmp_path, compare):
+    r = compare(tiny, "--planner", ",", "-o", tmp_path / "e")
+    assert r.exit_code == 2 and "name at least one planner" in r.output

@@ -228,3 +228,43 @@ def test_summaries_and_ranking():
     t = s[0]
     assert t.metrics["time_s"].n == t.rates["success"].k
     assert t.metrics["min_clearance_in"].n == t.n
+
+
+def test_non_numeric_value_in_results(tmp_path):
+    run_study(small_study(runs=1), tmp_path, workers=1, task_fn=fake_sim)
+    path = tmp_path / "results.csv"
+    lines = path.read_text().splitlines(keepends=True)
+    cells = lines[1].split(",")
+    cells[9] = "fast"                                          # time_s
+    lines[1] = ",".join(cells)
+    path.write_text("".join(lines))
+    with pytest.raises(StudyError) as exc:
+        ResultStore(tmp_path).load()
+    assert "results.csv:2: a value is not a number" in exc.value.message
+
+
+def test_output_directory_that_is_a_file(tmp_path):
+    target = tmp_path / "taken"
+    target.write_text("not a directory")
+    with pytest.raises(StudyError) as exc:
+        run_study(small_study(runs=1), target, workers=1, task_fn=fake_sim)
+    assert "cannot create the output directory" in exc.value.message
+
+
+def test_unreadable_manifest_on_resume(tmp_path):
+    run_study(small_study(runs=1), tmp_path, workers=1, task_fn=fake_sim)
+    (tmp_path / "study.json").write_text("{not json")
+    with pytest.raises(StudyError) as exc:
+        run_study(small_study(runs=1), tmp_path, workers=1, resume=True, task_fn=fake_sim)
+    assert "cannot read" in exc.value.message and "study.json" in exc.value.message
+
+
+def test_dask_missing_says_how_to_install(monkeypatch):
+    import sys
+
+    from mitos_cli.study.executors import dask_client
+
+    monkeypatch.setitem(sys.modules, "distributed", None)     # import distributed -> ImportError
+    with pytest.raises(StudyError) as exc:
+        dask_client(None, 2)
+    assert "needs dask.distributed" in exc.value.message and "mitos[dask]" in exc.value.hint
