@@ -149,6 +149,9 @@ def test_rules_as_text_match_eval(capsys):
     (["surface", "steering", "--x", "road", "--fix", "size=1", "--fix", "size=2"],
      "`size` is fixed twice"),
     (["surface", "a", "b", "c", "--x", "road"], "expected [RULEBASE] OUTPUT, got 3"),
+    (["surface", "steering", "--x", "road", "--fix", "size=45", "position=4"],
+     "`position=4` is not a rule base or an output; to hold several inputs, repeat --fix: "
+     "--fix position=4"),
     (["surface", "steering"], "Missing option '--x'"),
     (["rules"], "give one NAME=VALUE per input: road=... size=... position=..."),
     (["rules", "road=1", "road=2"], "input `road` is given twice"),

@@ -165,6 +165,11 @@ def _fixed(items: list[str]) -> dict[str, str]:
 def _surface_args(args: list[str]) -> tuple[Optional[str], Optional[str]]:
     """``[RULEBASE] OUTPUT`` -> (rule-base path, output name); a lone argument that names a
     rule file is the rule base."""
+    for arg in args:
+        if "=" in arg:          # `--fix size=45 position=4`: the second value fell out of --fix
+            raise typer.BadParameter(
+                f"`{arg}` is not a rule base or an output; to hold several inputs, repeat "
+                f"--fix: --fix {arg} (one --fix NAME=VALUE per input)")
     if len(args) > 2:
         raise typer.BadParameter(f"expected [RULEBASE] OUTPUT, got {len(args)} arguments: "
                                  + " ".join(args))
