@@ -1,8 +1,9 @@
 """The simulation loop: sense, perceive, plan (one batch for all robots), move; then verdict and
 metrics. Stepping never draws; the :class:`SimResult` holds every tick as arrays.
 
-Per tick ``k`` (time ``k * dt``): obstacles are placed at that time; each robot casts its beams,
-perceives its inputs and the true ones; a robot whose footprint touches anything has collided
+Per tick ``k`` (time ``k * dt``): obstacles are placed at that time; each robot casts its beams
+and perceives its inputs (the true values are computed afterwards, on demand, from the recorded
+poses: :func:`true_inputs`); a robot whose footprint touches anything has collided
 (the run ends); a robot within its goal's tolerance is done (it stops and stays as an obstacle);
 the planner evaluates all active robots in one batch; the kinematics apply the steering-rate and
 acceleration limits and integrate in ``substeps`` exact arcs. The run ends in ``success`` (every
@@ -70,13 +71,22 @@ class SimResult:
     command: np.ndarray            # [T, n, 2] planner's steering and speed
     ranges: np.ndarray             # [T, n, B] in (noisy readings)
     perceived: dict[str, np.ndarray]   # name -> [T, n]
-    true: dict[str, np.ndarray]        # name -> [T, n]
     clearance: np.ndarray          # [T, n] in, footprint to the nearest thing
     obstacles: np.ndarray          # [T, O, 2] obstacle positions
     routes: tuple[Route, ...] = ()
     static: StaticMap | None = None
     active: np.ndarray | None = None   # [T, n] robot still driving at that tick
+    progress: np.ndarray | None = None  # [T, n] arc length along each robot's route (in)
     metrics: dict = field(default_factory=dict)
+    _true: dict | None = field(default=None, repr=False)
+
+    @property
+    def true(self) -> dict[str, np.ndarray]:
+        """The inputs from the true geometry, name -> ``[T, n]`` (computed on first use from
+        the recorded poses and obstacle places: stepping does not need them)."""
+        if self._true is None:
+            self._true = true_inputs(self)
+        return self._true
 
     @property
     def ticks(self) -> int:
@@ -179,7 +189,7 @@ def simulate(world: World, planner: Planner | None = None, seed: int | None = No
         world.obstacles, np.zeros((len(world.obstacles), 2)))
     rec_pose, rec_v, rec_steer, rec_cmd, rec_rng, rec_clear, rec_obs, rec_act = ([] for _ in range(8))
     rec_p = {k: [] for k in perception.INPUTS}
-    rec_t = {k: [] for k in perception.INPUTS}
+    rec_s: list[np.ndarray] = []
     outcomes = ["timeout"] * n
     collided = 0
     stuck_window = max(1, int(round(STUCK_TIME / dt)))
@@ -198,7 +208,6 @@ def simulate(world: World, planner: Planner | None = None, seed: int | None = No
         outline = shape_outline + where[outline_owner] if len(where) else shape_outline
         ranges = np.zeros((n, B))
         percepts_p = {key: np.zeros(n) for key in perception.INPUTS}
-        percepts_t = {key: np.zeros(n) for key in perception.INPUTS}
         targets = np.zeros((n, 2))
         clear = np.zeros(n)
         for i in range(n):
@@ -210,24 +219,14 @@ def simulate(world: World, planner: Planner | None = None, seed: int | None = No
             dirs = sensors.beam_directions(h[i], angles)
             f = perception.frame(routes[i], pose[i, :2], s_hint[i])
             s_hint[i] = f.s
-            # the beams, plus two exact rays across the route for the true road width
-            both = np.concatenate([dirs, [-f.n, f.n]])
-            expected, true_r = sensors.cast(pose[i, :2], both, walls, others, centres, radii,
+            expected, true_r = sensors.cast(pose[i, :2], dirs, walls, others, centres, radii,
                                             sen.range)
-            sides_lr = geometry.ray_segments(pose[i, :2], both[B:], walls, 1e6)
-            expected, true_r = expected[:B], true_r[:B]
             measured = sensors.add_noise(true_r, sen.noise, sen.range, streams[1 + i])
             ranges[i] = measured
             p = perception.perceive(routes[i], f, (x[i], y[i], h[i]), robots[i], dirs, measured,
                                     expected, sen.range, spacing, threshold, cfg)
-            things = np.concatenate([outline] + [corners[j] for j in range(n) if j != i])
-            gaps = perception.side_gaps(f, pose[i, :2], dirs, expected, things, robots[i],
-                                        sen.range, cfg)
-            tr = perception.truth(routes[i], f, (x[i], y[i], h[i]), robots[i],
-                                  (float(sides_lr[0]), float(sides_lr[1])), things, gaps, cfg)
             for key in perception.INPUTS:
                 percepts_p[key][i] = p[key]
-                percepts_t[key][i] = tr[key]
             targets[i] = perception.target_point(routes[i], f, cfg)
             clear[i] = _clearance(pose[i], robots[i], walls, others, centres, radii)
 
@@ -253,9 +252,9 @@ def simulate(world: World, planner: Planner | None = None, seed: int | None = No
         rec_clear.append(clear)
         rec_obs.append(where)
         rec_act.append(active.copy())
+        rec_s.append(s_hint.copy())
         for key in perception.INPUTS:
             rec_p[key].append(percepts_p[key])
-            rec_t[key].append(percepts_t[key])
         if on_tick is not None:
             on_tick(k, {"t": t, "pose": rec_pose[-1], "speed": v, "steering": steer,
                         "inputs": percepts_p, "clearance": clear, "obstacles": where})
@@ -293,8 +292,44 @@ def simulate(world: World, planner: Planner | None = None, seed: int | None = No
         t=np.arange(len(rec_pose)) * dt, pose=np.array(rec_pose), speed=np.array(rec_v),
         steering=np.array(rec_steer), command=np.array(rec_cmd), ranges=np.array(rec_rng),
         perceived={key: np.array(val) for key, val in rec_p.items()},
-        true={key: np.array(val) for key, val in rec_t.items()},
         clearance=np.array(rec_clear), obstacles=np.array(rec_obs).reshape(len(rec_pose), -1, 2),
-        routes=routes, static=static, active=np.array(rec_act))
+        routes=routes, static=static, active=np.array(rec_act), progress=np.array(rec_s))
     res.metrics = _metrics(res, dt)
     return res
+
+
+def true_inputs(res: SimResult) -> dict[str, np.ndarray]:
+    """The rule inputs from the true geometry at every tick (noise-free map rays across the
+    route for the road, exact obstacle and robot outlines for the obstruction and the side
+    gaps), name -> ``[T, n]``."""
+    world, static = res.world, res.static
+    agents = world.agents
+    n = len(agents)
+    robots = [a.robot for a in agents]
+    sen = world.sensors
+    angles = sen.angles
+    reach = sen.range + max(max(r.length, r.width) for r in robots)
+    cfg = perception.Settings()
+    shape_outline, outline_owner = obs_mod.outline_points(
+        world.obstacles, np.zeros((len(world.obstacles), 2)))
+    out = {key: np.zeros((res.ticks, n)) for key in perception.INPUTS}
+    for k in range(res.ticks):
+        where = res.obstacles[k]
+        outline = shape_outline + where[outline_owner] if len(where) else shape_outline
+        pose = res.pose[k].copy()
+        pose[:, 2] = np.deg2rad(pose[:, 2])
+        corners = _footprints(pose, robots)
+        for i in range(n):
+            walls = static.near(pose[i, 0], pose[i, 1], reach)
+            f = perception.frame(res.routes[i], pose[i, :2], res.progress[k, i])
+            dirs = np.concatenate([sensors.beam_directions(pose[i, 2], angles), [-f.n, f.n]])
+            expected = geometry.ray_segments(pose[i, :2], dirs, walls, sen.range)
+            across = geometry.ray_segments(pose[i, :2], dirs[-2:], walls, 1e6)
+            things = np.concatenate([outline] + [corners[j] for j in range(n) if j != i])
+            gaps = perception.side_gaps(f, pose[i, :2], dirs[:-2], expected[:-2], things,
+                                        robots[i], sen.range, cfg)
+            tr = perception.truth(res.routes[i], f, tuple(pose[i]), robots[i],
+                                  (float(across[0]), float(across[1])), things, gaps, cfg)
+            for key in perception.INPUTS:
+                out[key][k, i] = tr[key]
+    return out
