@@ -289,3 +289,18 @@ def test_cli_json_matches_the_library(flawed, capsys):
 def test_cli_behavior_and_resolution(flawed, capsys):
     code, out, _ = run(["check", str(flawed), "-b", "main", "--resolution", "5"], capsys)
     assert code == 1 and "`main` on 12 road x 8 size = 96 samples" in out
+
+
+def test_help_reads_as_paragraphs(capsys):
+    """The command list shows one sentence; the help joins the docstring's lines (Typer's rich
+    help would keep the source's line breaks: "unused" alone at the end of a line)."""
+    code, out, _ = run(["--help"], capsys)
+    listing = " ".join(out.replace("│", " ").split())
+    assert "check Check a rule base: coverage gaps, conflicts, duplicates, dead rules, " \
+           "unused terms. teach" in listing
+    code, out, _ = run(["check", "--help"], capsys)
+    lines = [line.strip() for line in out.splitlines()]
+    assert "terms and gaps between terms. Exits 1 on an error: inputs where no rule sets an" \
+        not in lines
+    assert "Exits 1 on an error: inputs where no rule sets an output that has no default," \
+        in " ".join(lines)

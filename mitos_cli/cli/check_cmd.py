@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import inspect
 import json
 import os
 from typing import Annotated, Optional
@@ -84,9 +85,11 @@ def check_command(
              "most 300,000 samples).")] = 41,
     as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
 ) -> None:
-    """Check a rule base: coverage gaps, conflicts, duplicates, unreachable rules, unused
-    terms and gaps between terms. Exits 1 on an error: inputs where no rule sets an output
-    that has no default, or rules with the same condition and different actions."""
+    """Check a rule base: coverage gaps, conflicts, duplicates, dead rules, unused terms.
+
+    Also low total DOF, contradictions, and gaps between the terms of an input. Exits 1 on
+    an error: inputs where no rule sets an output that has no default, or rules with the
+    same condition and different actions."""
     from ..api import read_rulebase
     from ..check import check_rulebase
     from ..trace import display_path
@@ -100,3 +103,8 @@ def check_command(
         emit(render(report, name))
     if not report.ok:
         raise typer.Exit(1)
+
+
+# Typer's rich help keeps the docstring's line breaks: join the lines of each paragraph.
+check_command.__doc__ = "\n\n".join(
+    " ".join(p.split()) for p in inspect.cleandoc(check_command.__doc__ or "").split("\n\n"))
