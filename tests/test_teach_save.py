@@ -5,6 +5,8 @@ from pathlib import Path
 
 import pytest
 
+from mitos_cli.errors import MitosError
+
 from mitos_cli.api import default_rulebase_path
 from mitos_cli.build import load_rules_file
 from mitos_cli.errors import LessonError
@@ -121,7 +123,7 @@ def test_atomic_write_leaves_no_half_file(tmp_path, monkeypatch):
         raise OSError("disk full")
 
     monkeypatch.setattr("os.replace", boom)
-    with pytest.raises(OSError):
+    with pytest.raises(MitosError, match="cannot write .*a.rules.*: disk full"):
         atomic_write(target, "new")
     assert target.read_text() == "old"
     assert [p.name for p in tmp_path.iterdir()] == ["a.rules"]

@@ -9,7 +9,6 @@ drawing never touches pyplot's global figure list or backend; only :func:`new_fi
 from __future__ import annotations
 
 import os
-import secrets
 from pathlib import Path
 
 from ..errors import MitosError
@@ -76,25 +75,14 @@ def finish(fig, path: str | Path | None = None, show: bool = False, dpi: int = 1
     if path is not None:
         path = Path(path)
         fmt = check_format(path)
-        directory = path.parent if str(path.parent) else Path(".")
-        tmp = directory / f".{path.name}.{os.getpid()}.{secrets.token_hex(4)}.tmp"
-        try:
-            # 0o666 less the umask, as for any new file (mkstemp would make it 0o600)
-            fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666)
-        except OSError as exc:
-            raise DrawError(f"cannot write `{path}`: {exc.strerror or exc}") from None
         import matplotlib
 
-        try:
-            with os.fdopen(fd, "wb") as fh, matplotlib.rc_context({"svg.hashsalt": "mitos"}):
-                fig.savefig(fh, format=fmt, dpi=dpi, bbox_inches="tight" if tight else None,
-                            metadata=_metadata(fmt))
-            os.replace(tmp, path)
-        except OSError as exc:
-            raise DrawError(f"cannot write `{path}`: {exc.strerror or exc}") from None
-        finally:
-            if os.path.exists(tmp):
-                os.unlink(tmp)
+        from ..fileio import atomic_file
+
+        with atomic_file(path, binary=True, error=DrawError) as fh, \
+                matplotlib.rc_context({"svg.hashsalt": "mitos"}):
+            fig.savefig(fh, format=fmt, dpi=dpi, bbox_inches="tight" if tight else None,
+                        metadata=_metadata(fmt))
     if show:
         import matplotlib.pyplot as plt
 

@@ -11,8 +11,6 @@ other direction. Anything a format names that MITOS cannot compute exactly is re
 from __future__ import annotations
 
 import math
-import os
-import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -539,21 +537,8 @@ def simple_nots(expr: Expr, rule: Rule, ops: ops_mod.Operators) -> Expr:
 
 
 def atomic_write(path: str | Path, text: str) -> None:
-    """Write ``text`` to ``path`` through a temporary file and ``os.replace`` (atomic)."""
-    path = Path(path)
-    try:
-        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp",
-                                   dir=path.parent or ".")
-    except OSError as exc:
-        raise FormatError(f"cannot write `{path}`: {exc.strerror or exc}",
-                          hint="check that the directory exists and is writable") from None
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as f:
-            f.write(text)
-        os.replace(tmp, path)
-    except BaseException:
-        try:
-            os.unlink(tmp)
-        except OSError:
-            pass
-        raise
+    """Write ``text`` to ``path`` atomically (:func:`mitos_cli.fileio.atomic_write`)."""
+    from ..fileio import atomic_write as write
+
+    write(path, text, error=FormatError)
+

@@ -17,13 +17,13 @@ from __future__ import annotations
 
 import os
 import re
-import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
 from lark import Token, Tree
 
 from .. import yamlpos
+from ..fileio import atomic_write
 from ..errors import LessonError, TermSetError
 from ..model import Behavior, RuleBase, format_number, format_rule, format_use
 from ..parse import parser as rule_parser
@@ -40,24 +40,6 @@ class Saved:
     rules: Path
     termsets: tuple[Path, ...]
     changes: tuple[str, ...]          # one line per change, for people
-
-
-def atomic_write(path: Path, text: str) -> None:
-    """Write ``text`` to ``path`` via a temporary file and ``os.replace`` (never half a file)."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8", newline="") as fh:
-            fh.write(text)
-            fh.flush()
-            os.fsync(fh.fileno())
-        os.replace(tmp, path)
-    except BaseException:
-        try:
-            os.unlink(tmp)
-        except OSError:
-            pass
-        raise
 
 
 def termset_targets(rules_target: Path, original_rules: Path,
@@ -93,9 +75,13 @@ def save_rulebase(original: RuleBase, current: RuleBase, target: Path) -> Saved:
     names = tuple(os.path.relpath(dest, target.parent).replace(os.sep, "/") for dest in targets)
     new_rules, changed = edit_rules(rules_text, str(src), original, current, names)
     changes += changed
+    try:
+        target.parent.mkdir(parents=True, exist_ok=True)   # `save taught/new.rules`
+    except OSError as exc:
+        raise LessonError(f"cannot create `{target.parent}`: {exc.strerror or exc}") from None
     for dest, text in texts:                       # term sets first: the rules name them
-        atomic_write(dest, text)
-    atomic_write(target, new_rules)
+        atomic_write(dest, text, error=LessonError)
+    atomic_write(target, new_rules, error=LessonError)
     return Saved(target, tuple(d for d, _ in texts), tuple(changes))
 
 

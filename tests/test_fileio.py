@@ -1,0 +1,47 @@
+"""Atomic writes: the old file or the new one, never half; new files get the usual mode."""
+
+from __future__ import annotations
+
+import os
+
+import pytest
+
+from mitos_cli.errors import MitosError, TermSetError
+from mitos_cli.fileio import atomic_file, atomic_write
+
+
+def test_replaces_and_uses_the_umask(tmp_path):
+    target = tmp_path / "a.txt"
+    old = os.umask(0o022)
+    try:
+        atomic_write(target, "one")
+        atomic_write(target, b"two")
+    finally:
+        os.umask(old)
+    assert target.read_text() == "two"
+    assert target.stat().st_mode & 0o777 == 0o644
+    assert [p.name for p in tmp_path.iterdir()] == ["a.txt"]
+
+
+def test_an_error_inside_keeps_the_old_file(tmp_path):
+    target = tmp_path / "a.txt"
+    target.write_text("old")
+    with pytest.raises(RuntimeError):
+        with atomic_file(target) as fh:
+            fh.write("half")
+            raise RuntimeError("crash")
+    assert target.read_text() == "old" and len(list(tmp_path.iterdir())) == 1
+
+
+def test_a_missing_directory_is_the_callers_error(tmp_path):
+    with pytest.raises(TermSetError, match="cannot write .*nowhere.*No such file"):
+        atomic_write(tmp_path / "nowhere" / "a.txt", "x", error=TermSetError)
+
+
+def test_replace_failing_is_an_error_and_leaves_nothing(tmp_path, monkeypatch):
+    target = tmp_path / "a.txt"
+    target.write_text("old")
+    monkeypatch.setattr(os, "replace", lambda *a: (_ for _ in ()).throw(OSError("disk full")))
+    with pytest.raises(MitosError, match="disk full"):
+        atomic_write(target, "new")
+    assert target.read_text() == "old" and len(list(tmp_path.iterdir())) == 1
