@@ -134,6 +134,13 @@ def test_batch_and_values_are_exclusive(capsys):
     assert code == 2 and "not both" in err
 
 
+def test_batch_refuses_json(capsys):
+    """--batch writes CSV: --json beside it is refused, not silently ignored."""
+    code, out, err = run_main(["eval", "--batch", "-", "--json"], capsys)
+    assert code == 2 and out == "" and "--batch writes a CSV; --json is for one evaluation" \
+        in " ".join(err.replace("│", " ").split())
+
+
 def test_behavior_option(tmp_path, capsys):
     terms = (ROOT / "rulebases" / "mitos.terms.yaml").read_text(encoding="utf-8")
     (tmp_path / "t.terms.yaml").write_text(terms, encoding="utf-8")

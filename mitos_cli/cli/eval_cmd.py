@@ -81,6 +81,9 @@ def eval_command(
     if batch is not None:
         if values:
             raise typer.BadParameter("give either NAME=VALUE inputs or --batch, not both")
+        if as_json:
+            raise typer.BadParameter("--batch writes a CSV; --json is for one evaluation "
+                                     "(leave one of them out)")
         run_batch(rb, batch)
         return
     if not values:
