@@ -8,13 +8,14 @@ from pathlib import Path
 
 import numpy as np
 
-from .output import finish, new_figure
+from .output import _matplotlib, finish, new_figure
 
 
 def draw_run(result, path: str | Path | None = None, *, footprint_every: float = 1.0,
              show: bool = False):
     """Draw ``result``; save to ``path`` (.png or .svg) and/or ``show``. Footprints every
     ``footprint_every`` seconds. Returns the figure."""
+    _matplotlib()                      # a clear error, not a traceback, without matplotlib
     from matplotlib.collections import LineCollection
     from matplotlib.patches import Circle, Polygon
 
