@@ -185,8 +185,6 @@ def simulate(world: World, planner: Planner | None = None, seed: int | None = No
 
     near_at = [(math.inf, math.inf)] * n      # where each robot's wall set was gathered
     near_walls = [np.zeros((0, 4))] * n
-    shape_outline, outline_owner = obs_mod.outline_points(
-        world.obstacles, np.zeros((len(world.obstacles), 2)))
     rec_pose, rec_v, rec_steer, rec_cmd, rec_rng, rec_clear, rec_obs, rec_act = ([] for _ in range(8))
     rec_p = {k: [] for k in perception.INPUTS}
     rec_s: list[np.ndarray] = []
@@ -198,14 +196,10 @@ def simulate(world: World, planner: Planner | None = None, seed: int | None = No
     for k in range(steps):
         t = k * dt
         where = obs_mod.positions(world.obstacles, t)
-        centres, radii, circ_idx, rect_sides, _, _ = obs_mod.shapes_at(world.obstacles, where)
+        centres, radii, _, rect_sides, _, _ = obs_mod.shapes_at(world.obstacles, where)
         pose = np.stack([x, y, h], axis=1)
-        if n > 1:                  # the other robots are obstacles to each robot
-            corners = _footprints(pose, robots)
-            robot_sides = polygon_segments(corners).reshape(n, 4, 4)
-        else:
-            corners = robot_sides = np.zeros((1, 4, 4))
-        outline = shape_outline + where[outline_owner] if len(where) else shape_outline
+        robot_sides = (polygon_segments(_footprints(pose, robots)).reshape(n, 4, 4) if n > 1
+                       else np.zeros((1, 4, 4)))       # other robots are obstacles to each
         ranges = np.zeros((n, B))
         percepts_p = {key: np.zeros(n) for key in perception.INPUTS}
         targets = np.zeros((n, 2))
