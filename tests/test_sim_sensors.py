@@ -90,3 +90,13 @@ def test_box_to_segment_distance_matches_the_polygon_distance():
     slow = np.where(inside, 0.0, slow)                   # a segment starting inside touches
     fast = geometry.box_segment_distance(12.0, 9.0, segs)
     assert fast == pytest.approx(slow, abs=1e-9)
+
+
+def test_corridors_are_carved_into_a_grid():
+    from mitos_cli.sim.staticmap import carve
+
+    occ = np.ones((10, 20), dtype=bool)                   # solid 200 x 100 in
+    g = carve(Grid(occ, 10.0, (0.0, 0.0)), corridor_rects((Corridor(((20, 50), (180, 50)), 28),)))
+    free_rows = np.flatnonzero(~g.occupied.all(axis=1))
+    assert free_rows.tolist() == [4, 5]                   # y from 36 to 64: centres 45 and 55
+    assert np.flatnonzero(~g.occupied[4]).tolist() == list(range(1, 19))   # x from 6 to 194
