@@ -9,6 +9,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import numpy as np
+
 from .engine import Result
 
 
@@ -37,6 +39,7 @@ class Trace:
     inputs: tuple[InputTrace, ...]
     rules: tuple[RuleTrace, ...]          # fired rules only, in rule-base order
     outputs: tuple[tuple[str, float, str], ...]
+    defaulted: tuple[str, ...] = ()       # outputs no rule set: their `default` applies
 
     def to_json(self) -> dict:
         return {
@@ -75,7 +78,8 @@ class Trace:
             lines.append("  (none)")
         lines += ["", "outputs:"]
         for name, value, unit in self.outputs:
-            lines.append(f"  {name} = {num(value)} {unit}".rstrip())
+            note = "   (its default: no rule sets it here)" if name in self.defaulted else ""
+            lines.append(f"  {name} = {num(value)} {unit}".rstrip() + note)
         return "\n".join(lines)
 
 
@@ -120,6 +124,9 @@ def trace_of(result: Result, row: int = 0) -> Trace:
                   for r in range(c.n_rules) if result.dof[row, r] > 0)
     outputs = tuple((name, float(result.outputs[row, j]), c.variables[name].unit)
                     for j, name in enumerate(c.outputs))
+    fired = result.dof[row] > 0
+    defaulted = tuple(name for j, name in enumerate(c.outputs)
+                      if not np.isnan(c.default[j]) and not fired[c.cons_mask[:, j]].any())
     path = display_path(c.rulebase.path)
     return Trace(path, c.behavior, c.operators.describe(), c.n_rules, tuple(inputs), rules,
-                 outputs)
+                 outputs, defaulted)

@@ -154,3 +154,23 @@ def test_behavior_option(tmp_path, capsys):
         assert code == 0
         outs.append(json.loads(out)["outputs"]["speed"])
     assert outs == [50.0, 20.0]
+
+
+def test_trace_says_when_an_output_is_its_default(tmp_path, capsys):
+    """With `and = drastic` no rule fires at the sample run: both outputs are their defaults,
+    and the trace says so instead of printing 90 / 0 as if the rules had computed them."""
+    terms = (ROOT / "rulebases" / "mitos.terms.yaml").read_text(encoding="utf-8")
+    (tmp_path / "t.terms.yaml").write_text(terms, encoding="utf-8")
+    (tmp_path / "t.rules").write_text(
+        'terms "t.terms.yaml"\noperators: and = drastic\n'
+        "r1: if road is MEDIUM and size is MED_SZ then steering is LS and speed is SLOW\n"
+        "r2: if road is WIDE and size is SMALL_SZ then speed is FAST\n", encoding="utf-8")
+    code, out, _ = run_main(["eval", str(tmp_path / "t.rules"), "road=78", "size=45"], capsys)
+    assert code == 0
+    assert "steering = 90.0 deg   (its default: no rule sets it here)" in out
+    assert "speed = 0.0 in/s   (its default: no rule sets it here)" in out
+    code, out, _ = run_main(["eval", str(tmp_path / "t.rules"), "road=100", "size=5"], capsys)
+    assert "speed = 50.0 in/s\n" in out + "\n"                     # r2 fired: no note
+    assert "steering = 90.0 deg   (its default" in out              # nothing sets steering
+    code, out, _ = run_main(["eval", "road=78", "size=45", "position=4"], capsys)
+    assert "default" not in out
