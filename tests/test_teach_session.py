@@ -268,3 +268,19 @@ def test_examples_belong_to_the_behavior_they_correct(rules):
     assert "the examples given so far correct avoid_obstacle: `use avoid_obstacle`" in \
         info.value.render()
     assert "[avoid_obstacle, correct]" in say(s, out, "show examples")
+
+
+def test_save_to_a_directory_is_refused_before_writing(rules, tmp_path):
+    """`save /tmp` raised IsADirectoryError (a traceback that ended the session) after
+    writing the term sets beside the directory as `/tmp.mitos.terms.yaml`."""
+    s, out = session(rules)
+    s.run("correct road=78 size=45 position=4 -> steering=60")
+    folder = tmp_path / "out"
+    folder.mkdir()
+    before = sorted(tmp_path.iterdir())
+    with pytest.raises(LessonError) as info:
+        s.run(f"save {folder}")
+    assert "is a directory; save names the rule file to write" in info.value.render()
+    assert f"hint: save {(folder / 'taught.rules').as_posix()}" in info.value.render()
+    assert sorted(tmp_path.iterdir()) == before and not any(folder.iterdir())
+    assert say(s, out, f"save {folder / 'taught.rules'}").startswith("saved ")

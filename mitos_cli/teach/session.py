@@ -550,6 +550,9 @@ class Session:
         if self.state.block is not None:
             raise LessonError(f"behavior `{self.state.block}` is still open",
                               hint="close it with `end` before saving")
+        if target.is_dir():                 # checked before any term set is written beside it
+            raise LessonError(f"`{target}` is a directory; save names the rule file to write",
+                              hint=f"save {(target / 'taught.rules').as_posix()}")
         saved = save_rulebase(self.original, self.rulebase, target)
         entry = self.journal.append("save", path=str(target), line=line)
         self.saved_seq = entry["seq"]
