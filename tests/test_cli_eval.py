@@ -174,3 +174,13 @@ def test_trace_says_when_an_output_is_its_default(tmp_path, capsys):
     assert "steering = 90.0 deg   (its default" in out              # nothing sets steering
     code, out, _ = run_main(["eval", "road=78", "size=45", "position=4"], capsys)
     assert "default" not in out
+
+
+def test_an_input_without_its_equals_sign_is_a_usage_error(capsys):
+    """`road78` was read as a rule file: "cannot read rule file `road78`"."""
+    code, out, err = run_main(["eval", "road78", "size=45", "position=4"], capsys)
+    assert code == 2 and out == ""
+    assert "`road78` is neither a rule file nor NAME=VALUE" in " ".join(
+        err.replace("│", " ").split())
+    code, _, err = run_main(["eval", "missing.rules", "road=78"], capsys)
+    assert code == 1 and "cannot read rule file `missing.rules`" in err

@@ -72,6 +72,10 @@ def eval_command(
     from ..api import load_rulebase
 
     path, values = split_args(args or [])
+    if path is not None and Path(path).suffix.lower() not in (".rules", ".fcl", ".fis", ".fll") \
+            and not Path(path).exists():    # `mitos eval road78 size=45`: a lost `=`
+        raise typer.BadParameter(f"`{path}` is neither a rule file nor NAME=VALUE (no file "
+                                 f"of that name; write each input as NAME=VALUE)")
     rb = load_rulebase(path, behavior)
     if network:
         from ..network import describe_network
