@@ -27,7 +27,7 @@ import numpy as np
 from mitos_cli.resources import packaged_path
 from mitos_cli.sim.planner import FuzzyPlanner
 from mitos_cli.sim.runs import run_many
-from mitos_cli.sim.simulate import prepare, simulate
+from mitos_cli.sim.loop import prepare, simulate
 from mitos_cli.sim.world import Corridor, Goal
 from mitos_cli.sim.worldfile import load_world
 

@@ -64,7 +64,7 @@ def test_json_has_exactly_the_contract_keys(short):
 
 
 def test_json_matches_the_library(short):
-    from mitos_cli.sim.simulate import simulate
+    from mitos_cli.sim.loop import simulate
     from mitos_cli.sim.worldfile import load_world
 
     data = json.loads(run(short, "--json", "--seed", 4).stdout)

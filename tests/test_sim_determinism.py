@@ -8,7 +8,7 @@ import numpy as np
 
 from mitos_cli.sim.planner import FuzzyPlanner
 from mitos_cli.sim.runs import run_many
-from mitos_cli.sim.simulate import simulate
+from mitos_cli.sim.loop import simulate
 from mitos_cli.sim.worldfile import load_world
 from mitos_cli.resources import packaged_path
 
@@ -60,3 +60,12 @@ def test_the_planner_is_row_exact_so_recorded_dofs_are_the_ones_used():
     detail = planner.explain({k: v[:, 0] for k, v in res.perceived.items()})
     steering = detail.outputs[:, planner.compiled.outputs.index("steering")]
     assert np.array_equal(steering, res.command[:, 0, 0])
+
+
+def test_the_documented_api_imports():
+    # mitos_cli/sim/__init__.py documents `from mitos_cli.sim import simulate, load_world, ...`
+    from mitos_cli.sim import FuzzyPlanner, SimResult, load_world, run_many
+    from mitos_cli.sim import simulate as run
+
+    assert callable(run) and callable(load_world) and callable(run_many)
+    assert isinstance(FuzzyPlanner, type) and isinstance(SimResult, type)

@@ -148,7 +148,7 @@ def test_unknown_map_key_in_map_yaml(tmp_path: Path):
 
 
 def test_corridors_that_do_not_connect_start_and_goal():
-    from mitos_cli.sim.simulate import prepare
+    from mitos_cli.sim.loop import prepare
 
     text = BASE.replace("    - points: [[0, 0], [400, 0]]\n      width: 70\n",
                         "    - points: [[0, 0], [100, 0]]\n      width: 70\n"

@@ -20,7 +20,7 @@ pytestmark = pytest.mark.skipif(not (WORLDS / "figure4.yaml").is_file(),
 
 def drive(rulebase, world):
     from mitos_cli.sim.planner import FuzzyPlanner
-    from mitos_cli.sim.simulate import simulate
+    from mitos_cli.sim.loop import simulate
     from mitos_cli.sim.worldfile import load_world
 
     w = load_world(WORLDS / f"{world}.yaml")

@@ -137,7 +137,7 @@ def simulate_command(
             raise typer.Exit(3)
         return
 
-    from ..sim.simulate import prepare, simulate
+    from ..sim.loop import prepare, simulate
 
     world = loaded[0]
     scene = prepare(world)

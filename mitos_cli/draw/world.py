@@ -1,6 +1,6 @@
 """A simulated run as a picture, like the paper's Figures 4 and 10: the walls, the obstacles
 (moving ones with their tracks), the route, the path coloured by speed and the robot's footprint
-at intervals. Draws a finished :class:`~mitos_cli.sim.simulate.SimResult`; never steps."""
+at intervals. Draws a finished :class:`~mitos_cli.sim.loop.SimResult`; never steps."""
 
 from __future__ import annotations
 

@@ -22,7 +22,7 @@ Modules: ``world`` (model), ``worldfile`` (YAML loader), ``pgm`` + ``gridmap`` (
 maps), ``staticmap`` (walls from corridors or grids), ``geometry``, ``kinematics`` (tricycle),
 ``sensors`` (ray casting), ``obstacles`` (motion, randomisation), ``route`` (A*),
 ``perception`` (readings -> rule inputs), ``planner`` (the planner protocol, FuzzyPlanner),
-``simulate`` (the loop), ``runs`` (many runs, process pool), ``export`` (CSV, traces),
+``loop`` (the simulation loop: ``simulate``), ``runs`` (many runs, process pool), ``export`` (CSV, traces),
 ``live`` (terminal view). Drawing lives in ``mitos_cli.draw.world``.
 """
 
@@ -38,9 +38,9 @@ def __getattr__(name: str):
 
         return load_world
     if name in ("simulate", "SimResult"):
-        from . import simulate as mod
+        from . import loop
 
-        return getattr(mod, name)
+        return getattr(loop, name)
     if name == "run_many":
         from .runs import run_many
 

@@ -13,7 +13,7 @@ import io
 import numpy as np
 
 from .perception import INPUTS
-from .simulate import SimResult
+from .loop import SimResult
 
 
 def explain(result: SimResult, planner, robot: int = 0):

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .simulate import OUTCOMES, prepare, simulate
+from .loop import OUTCOMES, prepare, simulate
 from .world import World
 
 METRICS = ("time_s", "path_length_in", "min_clearance_in", "mean_speed_in_s",

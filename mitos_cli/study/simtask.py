@@ -54,7 +54,7 @@ def check_choice(choice: Choice, context: StudyContext, world_path: str) -> None
 @functools.lru_cache(maxsize=32)
 def _scene(path: str):
     """Walls and routes of a world: randomisation moves obstacles only, so they are shared."""
-    from ..sim.simulate import prepare
+    from ..sim.loop import prepare
 
     return prepare(_world(path))
 
@@ -76,7 +76,7 @@ def _planner(context: StudyContext, choice: Choice, path: str):
 def run_task(context: StudyContext, task: Task) -> dict:
     """Simulate one task (the world randomised from the task's seed); return the fields of
     :data:`RESULT_FIELDS`."""
-    from ..sim.simulate import simulate
+    from ..sim.loop import simulate
 
     world = _world(task.world)
     result = simulate(world, _planner(context, task.choice, task.world), task.seed,

@@ -92,7 +92,7 @@ def run_world(name: str, rulebase: RuleBase, behavior: str, seed: int | None = N
               base: Path | None = None) -> Recording:
     """Drive ``behavior`` of ``rulebase`` through the world ``name``."""
     from ..sim.planner import FuzzyPlanner
-    from ..sim.simulate import simulate
+    from ..sim.loop import simulate
     from ..sim.worldfile import load_world
 
     path = world_path(name, base)
