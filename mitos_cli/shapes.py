@@ -24,7 +24,7 @@ def trapezoid(x, a, b, c, d):
     """Trapezoid with feet ``a``, ``d`` and core ``[b, c]``; ``a = b = -inf`` or ``c = d = inf``
     make shoulders, ``a == b`` or ``c == d`` vertical edges."""
     x = np.asarray(x, dtype=float)
-    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore", under="ignore"):
         rise = np.where(x >= b, 1.0, np.where(x <= a, 0.0, (x - a) / np.subtract(b, a)))
         fall = np.where(x <= c, 1.0, np.where(x >= d, 0.0, (d - x) / np.subtract(d, c)))
     return np.minimum(rise, fall)
