@@ -60,19 +60,9 @@ def _runs_table(runs) -> str:
 
 
 def _write_text(path: Path, text: str) -> None:
-    import os
-    import tempfile
+    from ..fileio import atomic_write
 
-    from ..errors import MitosError
-
-    directory = path.parent if str(path.parent) else Path(".")
-    try:
-        fd, tmp = tempfile.mkstemp(dir=directory, prefix=f".{path.name}.", suffix=".tmp")
-        with os.fdopen(fd, "w", encoding="utf-8", newline="") as fh:
-            fh.write(text)
-        os.replace(tmp, path)
-    except OSError as exc:
-        raise MitosError(f"cannot write `{path}`: {exc.strerror or exc}") from None
+    atomic_write(path, text)
 
 
 def simulate_command(
