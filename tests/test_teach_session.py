@@ -284,3 +284,15 @@ def test_save_to_a_directory_is_refused_before_writing(rules, tmp_path):
     assert f"hint: save {(folder / 'taught.rules').as_posix()}" in info.value.render()
     assert sorted(tmp_path.iterdir()) == before and not any(folder.iterdir())
     assert say(s, out, f"save {folder / 'taught.rules'}").startswith("saved ")
+
+
+def test_errors_at_the_prompt_are_placed_at_prompt(rules):
+    """Syntax errors said `<prompt>:1:1`, checks of names `<input>:1:39`: one name for one
+    place."""
+    s, out = session(rules)
+    for line, column in [("correct road=78 size=45 position=4 -> steerin=60", 39),
+                         ("if road is NARROW then speed is SLOWW", 24),
+                         ("corect road=78", 1)]:
+        with pytest.raises(MitosError) as info:
+            s.run(line)
+        assert str(info.value.span) == f"<prompt>:1:{column}", line

@@ -229,7 +229,7 @@ def parse_command(line: str, path: str | None = None, lineno: int = 1) -> Comman
     except UnexpectedInput as exc:
         raise _unknown_command(line, text, path or "<prompt>", lineno) \
             or _syntax_error(exc, text, path or "<prompt>") from None
-    result = _ToCommand(text, path).transform(tree)
+    result = _ToCommand(text, path or "<prompt>").transform(tree)
     if isinstance(result, Tree):            # pragma: no cover - every alternative is handled
         raise RuleSyntaxError(f"cannot read `{line.strip()}`")
     return result
