@@ -96,6 +96,13 @@ def test_usage_errors(work):
     assert res.returncode == 1 and "not found" in res.stderr
     res = mitos("teach", "rb/mitos.rules", "--lesson", "missing.lesson", cwd=work)
     assert res.returncode == 1 and "cannot read lesson `missing.lesson`" in res.stderr
+    res = mitos("teach", "rb", cwd=work)
+    assert res.returncode == 1 and "`rb` is a directory, not a rule file" in res.stderr
+    res = mitos("teach", "rb/mitos.rules", "-b", "drvie", cwd=work)
+    assert res.returncode == 1 and "did you mean `drive`?" in res.stderr
+    # none of these mistakes left a session behind for `--resume` to pick
+    assert not (work / ".mitos" / "teach").exists() or \
+        not any((work / ".mitos" / "teach").iterdir())
 
 
 def test_prompt_through_its_input_stream(work):

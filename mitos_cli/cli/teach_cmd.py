@@ -39,6 +39,7 @@ def teach_command(
     from ..teach.session import Session
     from .output import emit, err
 
+    lesson_text = None
     if session_name is not None and not resume:
         raise typer.BadParameter("--session names a session to resume: add --resume")
     if resume:
@@ -58,13 +59,21 @@ def teach_command(
         if not path.is_file():
             from ..errors import RuleBaseError
 
-            raise RuleBaseError(f"rule file `{path}` not found")
+            raise RuleBaseError(f"`{path}` is a directory, not a rule file" if path.is_dir()
+                                else f"rule file `{path}` not found")
+        # A bad rule file, behavior or lesson is refused before a session exists: an empty
+        # session would be the newest, the one `mitos teach --resume` picks.
+        from ..api import load_rulebase
+
+        load_rulebase(path, behavior)
+        if lesson is not None:
+            lesson_text = read_lesson(lesson)
         journal = Journal.create(new_session_dir(path.stem))
         session = Session(path, behavior, journal, save_as, out=emit, progress=epoch_progress)
         err(f"session {journal.directory.name} (journal in {journal.directory.as_posix()}; "
             f"`mitos teach --resume` continues it)")
     if lesson is not None:
-        text, name = read_lesson(lesson)
+        text, name = lesson_text if lesson_text is not None else read_lesson(lesson)
         session.echo = emit
         if lesson != "-":
             session.base = Path(lesson).parent
