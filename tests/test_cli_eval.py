@@ -184,3 +184,24 @@ def test_an_input_without_its_equals_sign_is_a_usage_error(capsys):
         err.replace("│", " ").split())
     code, _, err = run_main(["eval", "missing.rules", "road=78"], capsys)
     assert code == 1 and "cannot read rule file `missing.rules`" in err
+
+
+def test_used_rules_take_the_operators_of_the_behavior_that_uses_them(tmp_path):
+    """docs/language.md: `cruise` (and = product) evaluates avoid_obstacle's rules with
+    product, so their DOFs there are not the ones avoid_obstacle alone gives."""
+    import re
+
+    from mitos_cli.api import load_rulebase
+
+    doc = (ROOT / "docs" / "language.md").read_text(encoding="utf-8")
+    rules_text, terms_text = re.findall(r"```\w*\n(.*?)```", doc, re.S)[:2]
+    (tmp_path / "corridor.rules").write_text(rules_text, encoding="utf-8")
+    (tmp_path / "corridor.terms.yaml").write_text(terms_text, encoding="utf-8")
+    x = dict(road=78.0, size=45.0, position=4.0)
+    alone = load_rulebase(str(tmp_path / "corridor.rules"), "avoid_obstacle").trace(**x)
+    used = load_rulebase(str(tmp_path / "corridor.rules"), "cruise").trace(**x)
+    a = {r.label: r.dof for r in alone.rules}
+    u = {r.label: r.dof for r in used.rules}
+    center, large = 3 / 7, (5 / 30) ** 2                   # CENTER(4), very LARGE_SZ(45)
+    assert a["r2"] == pytest.approx(min(center, large) * 0.8)
+    assert u["avoid_obstacle/r2"] == pytest.approx(center * large * 0.8)
