@@ -26,8 +26,17 @@ def default_rulebase_path() -> Path:
 
 
 def read_rulebase(path: str | Path | None = None) -> RuleBase:
-    """Read a rule base: a ``.rules`` file, or a foreign format chosen by extension."""
-    path = Path(path) if path is not None else default_rulebase_path()
+    """Read a rule base: a ``.rules`` file, or a foreign format chosen by extension.
+
+    A path that does not exist but names a packaged rule base (``rulebases/mitos.rules``,
+    ``mitos``) reads the packaged one, so the README's commands work from any directory.
+    """
+    from .resources import resolve
+
+    if path is None:
+        path = default_rulebase_path()
+    else:
+        path = resolve("rulebases", path, ".rules") or Path(path)
     suffix = path.suffix.lower()
     if suffix in (".fcl", ".fis", ".fll"):
         from .interop import read_foreign

@@ -40,3 +40,15 @@ def packaged_names(kind: str, suffix: str) -> Iterator[str]:
     for entry in sorted(data_dir(kind).iterdir(), key=lambda e: e.name):
         if entry.name.endswith(suffix):
             yield entry.name
+
+
+def resolve(kind: str, name: str | Path, suffix: str) -> Path | None:
+    """``name`` if it exists, else the packaged file of that name (``figure4`` ->
+    ``worlds/figure4.yaml``, ``rulebases/mitos.rules`` from anywhere), else ``None``."""
+    p = Path(name)
+    if p.exists():
+        return p
+    for candidate in (p.name, p.name + suffix):
+        if (data_dir(kind) / candidate).is_file():
+            return packaged_path(kind, candidate)
+    return None

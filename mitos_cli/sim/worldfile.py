@@ -315,15 +315,11 @@ def load_world(path: str | Path) -> World:
 
 def resolve_world_path(name: str | Path) -> Path:
     """A world file as given, or else the packaged world of that name (``figure4.yaml``)."""
-    p = Path(name)
-    if p.exists():
-        return p
-    from ..resources import data_dir, packaged_path
+    from ..resources import packaged_names, resolve
 
-    for candidate in (p.name, p.name + ".yaml"):
-        if (data_dir("worlds") / candidate).is_file():
-            return packaged_path("worlds", candidate)
-    from ..resources import packaged_names
+    found = resolve("worlds", name, ".yaml")
+    if found is not None:
+        return found
 
     names = [n for n in packaged_names("worlds", ".yaml")]
     raise unknown("world file", str(name), names, cls=WorldError)
