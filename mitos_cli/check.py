@@ -144,6 +144,7 @@ def check_rulebase(rb: RuleBase, behavior: str | None = None, *, threshold: floa
         compiled = compile_rulebase(rb, name)
         findings += _rule_pairs(rb, name)
         findings += _contradictions(rb, name)
+        findings += _idle_settings(rb, name, compiled)
         grid_findings, info = _sampled(compiled, threshold, resolution)
         findings += grid_findings
         grids.append(info)
@@ -152,6 +153,26 @@ def check_rulebase(rb: RuleBase, behavior: str | None = None, *, threshold: floa
     order = {s: i for i, s in enumerate(SEVERITIES)}
     findings.sort(key=lambda f: (order[f.severity], _span_key(f.span)))
     return Report(rb, tuple(findings), tuple(grids), threshold, tuple(names))
+
+
+#: operator settings that only Mamdani inference reads
+MAMDANI_ONLY = ("implication", "aggregation", "defuzzify", "resolution", "sampling")
+
+
+def _idle_settings(rb: RuleBase, name: str, compiled) -> list[Finding]:
+    """Settings that the behavior's inference method ignores (``defuzzify = lom`` without
+    ``inference = mamdani`` is almost certainly a mistake)."""
+    if compiled.operators.inference == "mamdani":
+        return []
+    out = []
+    for setting in tuple(rb.operators) + tuple(rb.behavior(name).operators):
+        if setting.key in MAMDANI_ONLY:
+            out.append(Finding(
+                "warning", "idle-setting",
+                f"`{setting.key} = {setting.value}` has no effect: behavior `{name}` uses "
+                f"{compiled.operators.inference} inference", setting.span, name,
+                "add `inference = mamdani` to the operators line, or remove the setting"))
+    return out
 
 
 def _span_key(span: Span | None) -> tuple:

@@ -304,3 +304,15 @@ def test_help_reads_as_paragraphs(capsys):
         not in lines
     assert "Exits 1 on an error: inputs where no rule sets an output that has no default," \
         in " ".join(lines)
+
+
+def test_settings_only_mamdani_reads_are_flagged(tmp_path):
+    (tmp_path / "t.terms.yaml").write_text(TERMS, encoding="utf-8")
+    (tmp_path / "t.rules").write_text(
+        'terms "t.terms.yaml"\noperators: defuzzify = lom, and = product\n'
+        "if road is NARROW or road is MEDIUM or road is WIDE "
+        "then steering is ST and speed is SLOW\n", encoding="utf-8")
+    (finding,) = by_code(check_rulebase(read_rulebase(tmp_path / "t.rules")), "idle-setting")
+    assert finding.severity == "warning" and finding.span.line == 2
+    assert finding.message == ("`defuzzify = lom` has no effect: behavior `main` uses "
+                               "weighted_average inference")
