@@ -197,11 +197,14 @@ def per_call(fn, args, repeats: int) -> float:
 
 
 def process_time(argv: list[str], runs: int) -> float:
-    subprocess.run(argv, check=True, capture_output=True)      # warm the file cache
+    # As installed: Python may write and use byte code (an inherited PYTHONDONTWRITEBYTECODE
+    # would make every run recompile MITOS's sources, which no installed copy does).
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
+    subprocess.run(argv, check=True, capture_output=True, env=env)   # byte code, file cache
     times = []
     for _ in range(runs):
         t0 = time.perf_counter()
-        subprocess.run(argv, check=True, capture_output=True)
+        subprocess.run(argv, check=True, capture_output=True, env=env)
         times.append(time.perf_counter() - t0)
     return statistics.median(times)
 
