@@ -318,7 +318,9 @@ def true_inputs(res: SimResult) -> dict[str, np.ndarray]:
             f = perception.frame(res.routes[i], pose[i, :2], res.progress[k, i])
             dirs = np.concatenate([sensors.beam_directions(pose[i, 2], angles), [-f.n, f.n]])
             expected = geometry.ray_segments(pose[i, :2], dirs, walls, sen.range)
-            across = geometry.ray_segments(pose[i, :2], dirs[-2:], walls, 1e6)
+            # across the route, to the walls within reach (an opening reads as the sensor
+            # range, as the perceived width does, not as a sentinel a million inches wide)
+            across = geometry.ray_segments(pose[i, :2], dirs[-2:], walls, sen.range)
             things = np.concatenate([outline] + [corners[j] for j in range(n) if j != i])
             gaps = perception.side_gaps(f, pose[i, :2], dirs[:-2], expected[:-2], things,
                                         robots[i], sen.range, cfg)
