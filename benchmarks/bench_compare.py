@@ -8,6 +8,10 @@ worlds/corridor.yaml = 4 T-norms + the potential-field baseline x 200 seeded run
 Each mode runs the same tasks through `run_study` (results.csv written and fsync'ed per row,
 as the command does) in a fresh directory; the rows of every mode are checked to be equal
 bit for bit. The Dask figure is given with and without the cluster's start-up.
+
+On a machine shared with other jobs wall-clock rates mostly measure the contention, so the
+script also reports CPU seconds per run (this process and its reaped children: the pool's
+workers, the Dask cluster's processes), which shows the executors' own overhead.
 """
 
 from __future__ import annotations
@@ -15,12 +19,22 @@ from __future__ import annotations
 import argparse
 import os
 import platform
+import resource
 import sys
 import tempfile
 import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
+
+
+def cpu_seconds() -> float:
+    """User + system CPU of this process and of its finished children."""
+    total = 0.0
+    for who in (resource.RUSAGE_SELF, resource.RUSAGE_CHILDREN):
+        r = resource.getrusage(who)
+        total += r.ru_utime + r.ru_stime
+    return total
 
 
 def main() -> None:
@@ -46,13 +60,14 @@ def main() -> None:
 
     results = {}
     with tempfile.TemporaryDirectory() as tmp:
-        def timed(name, **kw):
-            t0 = time.perf_counter()
+        def timed(name, cpu=True, **kw):
+            c0, t0 = cpu_seconds(), time.perf_counter()
             out = run_study(study, Path(tmp) / name, **kw)
             dt = time.perf_counter() - t0
             assert out.executed == n, (name, out.executed)
             results[name] = (dt, out.rows)
-            print(f"  {name:<28} {dt:8.2f} s   {n / dt:8.1f} runs/s", flush=True)
+            used = f"   {1000 * (cpu_seconds() - c0) / n:6.0f} ms CPU/run" if cpu else ""
+            print(f"  {name:<28} {dt:8.2f} s   {n / dt:8.1f} runs/s{used}", flush=True)
             return dt
 
         base = timed("1 process", workers=1)
@@ -60,13 +75,16 @@ def main() -> None:
         if not args.skip_dask:
             from distributed import Client, LocalCluster
 
-            t0 = time.perf_counter()
+            c0, t0 = cpu_seconds(), time.perf_counter()
             with LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
                               dashboard_address=None) as cluster, Client(cluster) as client:
                 start = time.perf_counter() - t0
-                dask = timed("dask, 2-worker LocalCluster", executor="dask", client=client)
+                dask = timed("dask, 2-worker LocalCluster", cpu=False, executor="dask",
+                             client=client)
+            used = 1000 * (cpu_seconds() - c0) / n
             print(f"  {'  + cluster start-up':<28} {start:8.2f} s   "
-                  f"{n / (dask + start):8.1f} runs/s including it")
+                  f"{n / (dask + start):8.1f} runs/s including it   {used:6.0f} ms CPU/run "
+                  f"(cluster processes included)")
     rows = [r for _dt, r in results.values()]
     same = all(r == rows[0] for r in rows[1:])
     print(f"load average at end: {os.getloadavg()[0]:.2f} (1 min)")
