@@ -215,7 +215,9 @@ def test_prompt_in_a_terminal_completes_and_keeps_history(work):
         expect(master, "LB", seen)
         os.write(master, b"S\r")
         expect(master, "(28 rules)\r\navoid_obstacle> ", seen)
-        os.write(master, b"eval road=1\x03")                   # Ctrl-C drops the line
+        os.write(master, b"eval road=1")
+        expect(master, "avoid_obstacle> eval road=1", seen)  # echoed: readline has the line
+        os.write(master, b"\x03")                              # Ctrl-C drops the line
         expect(master, "Ctrl-D leaves)\r\navoid_obstacle> ", seen)
         os.write(master, b"\x04")                              # Ctrl-D leaves
         proc.wait(timeout=30)
