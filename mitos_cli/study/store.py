@@ -165,12 +165,9 @@ class ResultStore:
 
 def write_atomic(path: Path, text: str) -> None:
     """Write ``text`` to ``path`` through a temporary file and a rename."""
-    tmp = path.with_name(path.name + ".tmp")
-    with open(tmp, "w", encoding="utf-8", newline="") as fh:
-        fh.write(text)
-        fh.flush()
-        os.fsync(fh.fileno())
-    os.replace(tmp, path)
+    from ..fileio import atomic_write
+
+    atomic_write(path, text, error=StudyError)
 
 
 def rows_for(tasks: Iterable[Task], rows: list[dict]) -> tuple[list[dict], list[Task]]:
