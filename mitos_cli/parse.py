@@ -49,9 +49,10 @@ class ParsedFile:
     behaviors: tuple[Behavior, ...] = ()
 
 
-def _words(name: str) -> str:
-    if name in TERMINAL_WORDS:
-        return TERMINAL_WORDS[name]
+def _words(name: str, words: dict[str, str] = TERMINAL_WORDS) -> str:
+    """A terminal's name as users read it (``THEN`` -> `` `then` ``, ``NAME`` -> a name)."""
+    if name in words:
+        return words[name]
     if name.isupper() and name.isalpha():
         return f"`{name.lower()}`"
     return f"`{name}`"

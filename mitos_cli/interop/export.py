@@ -340,24 +340,30 @@ def _c_discrete() -> str:
 }"""
 
 
+def _weighted_sums(c: CompiledRuleBase, j: int) -> tuple[str, str]:
+    """Output ``j``'s weighted sums as expressions over ``dof_<r>`` and ``x[i]``, the same
+    text in C and in Python: ``sum(dof * y)`` (``y`` crisp or linear) and ``sum(dof)``."""
+    terms = []
+    for r in np.flatnonzero(c.cons_mask[:, j]):
+        value = num(c.cons_value[r, j])
+        if c.cons_linear is not None:
+            parts = [num(c.cons_linear[r, j, -1])] + [
+                f"{num(a)} * x[{i}]" for i, a in enumerate(c.cons_linear[r, j, :-1])
+                if a != 0.0]
+            value = "(" + " + ".join(parts) + ")"
+        terms.append((f"dof_{r}", value))
+    numerator = " + ".join(f"{d} * {v}" for d, v in terms) or "0.0"
+    denominator = " + ".join(d for d, _ in terms) or "0.0"
+    return numerator, denominator
+
+
 def _c_outputs(c: CompiledRuleBase, P: str) -> list[str]:
     ops = c.operators
     out = []
     if ops.inference == "mamdani":
         return _c_mamdani(c, P)
     for j, name in enumerate(c.outputs):
-        rules = np.flatnonzero(c.cons_mask[:, j])
-        terms = []
-        for r in rules:
-            value = num(c.cons_value[r, j])
-            if c.cons_linear is not None:
-                parts = [num(c.cons_linear[r, j, -1])] + [
-                    f"{num(a)} * x[{i}]" for i, a in enumerate(c.cons_linear[r, j, :-1])
-                    if a != 0.0]
-                value = "(" + " + ".join(parts) + ")"
-            terms.append((f"dof_{r}", value))
-        numerator = " + ".join(f"{d} * {v}" for d, v in terms) or "0.0"
-        denominator = " + ".join(d for d, _ in terms) or "0.0"
+        numerator, denominator = _weighted_sums(c, j)
         default = c.default[j]
         fallback = "NAN" if np.isnan(default) else num(default)
         out.append(f"    {{   /* {name} */")
@@ -547,18 +553,7 @@ def _py_outputs(c: CompiledRuleBase) -> list[str]:
             out.append(f"        Y[:, {j}] = value")
     else:
         for j, name in enumerate(c.outputs):
-            rules = np.flatnonzero(c.cons_mask[:, j])
-            terms = []
-            for r in rules:
-                value = num(c.cons_value[r, j])
-                if c.cons_linear is not None:
-                    parts = [num(c.cons_linear[r, j, -1])] + [
-                        f"{num(a)} * x[{i}]" for i, a in enumerate(c.cons_linear[r, j, :-1])
-                        if a != 0.0]
-                    value = "(" + " + ".join(parts) + ")"
-                terms.append((f"dof_{r}", value))
-            numerator = " + ".join(f"{d} * {v}" for d, v in terms) or "0.0"
-            denominator = " + ".join(d for d, _ in terms) or "0.0"
+            numerator, denominator = _weighted_sums(c, j)
             out.append(f"    num = {numerator} + np.zeros(X.shape[0])")
             if ops.inference == "weighted_sum":
                 out.append(f"    Y[:, {j}] = num")

@@ -273,11 +273,9 @@ def incomplete(line: str) -> bool:
 
 
 def _words(name: str) -> str:
-    if name in WORDS:
-        return WORDS[name]
-    if name.isupper() and name.isalpha():
-        return f"`{name.lower()}`"
-    return f"`{name}`"
+    from ..parse import _words as words
+
+    return words(name, WORDS)
 
 
 def _expected(names) -> str | None:
