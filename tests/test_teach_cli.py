@@ -182,6 +182,9 @@ def test_prompt_in_a_terminal_completes_and_keeps_history(work):
     def controlling_terminal():              # the pty becomes the child's terminal (Ctrl-C)
         os.setsid()
         fcntl.ioctl(0, termios.TIOCSCTTY, 0)
+        # a test run started in the background inherits SIGINT ignored, and so would the
+        # prompt; a user's terminal delivers it
+        signal.signal(signal.SIGINT, signal.SIG_DFL)
 
     def spawn(args):
         master, slave = pty.openpty()
