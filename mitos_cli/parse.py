@@ -99,7 +99,13 @@ def syntax_error(exc: UnexpectedInput, text: str, path: str | None) -> RuleSynta
     hint = None
     expected = set(exc.expected)
     if token.type == "NAME" and "IS" in expected:
-        hint = "a condition reads `variable is TERM`"
+        before = _word_before(text, token)
+        if before in RESERVED:
+            # `if road is WIDE and then ...`: the keyword was read as a variable's name
+            hint = (f"`{before}` stands where a condition should be; a condition reads "
+                    f"`variable is TERM`")
+        else:
+            hint = "a condition reads `variable is TERM`"
     elif "THEN" in expected and token.type in ("NAME",):
         hint = _hedge_hint(text, token) or \
             "join conditions with `and` / `or`, and start the actions with `then`"
@@ -121,6 +127,20 @@ def _hedge_hint(text: str, token: Token) -> str | None:
     word = before.group(1)
     close = did_you_mean(word, HEDGES)          # only a near miss is taken for a hedge
     return f"`{word}` is not a hedge (hedges: {', '.join(HEDGES)}); {close}" if close else None
+
+
+#: words of the language that can also be read as names where a name is expected
+RESERVED = {"if", "then", "and", "or", "not", "is", "with", "use", "when", "end", "behavior",
+            "terms", "operators", "frozen"}
+
+
+def _word_before(text: str, token: Token) -> str:
+    """The word just before ``token`` on its line (for hints)."""
+    lines = text.splitlines()
+    if not 0 < token.line <= len(lines):
+        return ""
+    words = lines[token.line - 1][:token.column - 1].split()
+    return words[-1] if words else ""
 
 
 def _span(meta, text: str, path: str | None) -> Span | None:

@@ -402,3 +402,15 @@ def test_term_set_name_with_control_character_or_bad_escape(tmp_path):
         path.write_text(f"terms {name}\n" + GOOD_RULE, encoding="utf-8")
         exc = error_of(lambda: load_rules_file(path), TermSetError)
         assert "not found" in exc.message and exc.span.line == 1
+
+
+def test_a_keyword_where_a_condition_should_be(tmp_path):
+    (tmp_path / "t.terms.yaml").write_text(TERMS, encoding="utf-8")
+    (tmp_path / "t.rules").write_text('terms "t.terms.yaml"\n'
+                                      "r1: if road is WIDE and then steering is RS\n")
+    from mitos_cli.api import read_rulebase
+    from mitos_cli.errors import RuleSyntaxError
+
+    with pytest.raises(RuleSyntaxError) as info:
+        read_rulebase(tmp_path / "t.rules")
+    assert info.value.hint.startswith("`then` stands where a condition should be")
