@@ -232,6 +232,16 @@ class _Builder:
         self.next_col = 2 + n_terms
         self.nodes: dict[tuple, tuple[int, int]] = {}   # key -> (column, level)
         self.pending: dict[tuple[int, str], list[tuple[int, list[int]]]] = {}
+        self.negated_from: dict[int, tuple[int, int]] = {}   # not-node column -> its input
+
+    def negate(self, ref: tuple[int, int]) -> tuple[int, int]:
+        """``not`` of ``ref``; ``not not x`` is ``x`` itself, because ``1 - (1 - x)`` rounds a
+        tiny membership to 0 and would turn a barely firing rule into one that does not fire."""
+        if ref[0] in self.negated_from:
+            return self.negated_from[ref[0]]
+        out = self.node(("not", ref[0]), "not", [ref])
+        self.negated_from[out[0]] = ref
+        return out
 
     def node(self, key: tuple, op: str, children: list[tuple[int, int]]) -> tuple[int, int]:
         if key in self.nodes:
@@ -330,12 +340,9 @@ def compile_rulebase(rb: RuleBase, behavior: str | None = None,
             if expr.hedges:
                 ref = builder.node(("hedge", expr.hedges, col), "hedge:" + " ".join(expr.hedges),
                                    [ref])
-            if expr.negated:
-                ref = builder.node(("not", ref[0]), "not", [ref])
-            return ref
+            return builder.negate(ref) if expr.negated else ref
         if isinstance(expr, Not):
-            inner = walk(expr.expr)
-            return builder.node(("not", inner[0]), "not", [inner])
+            return builder.negate(walk(expr.expr))
         op = "and" if isinstance(expr, And) else "or"
         children = [walk(item) for item in expr.items]
         if len(children) == 1:

@@ -118,3 +118,21 @@ def test_random_rule_bases_round_trip(rb: RuleBase, tmp_path_factory) -> None:
         after = outputs(read_rulebase(path), X)
         np.testing.assert_allclose(after, before, rtol=0, atol=1e-9, equal_nan=True,
                                    err_msg=f"{fmt}:\n{path.read_text()}")
+
+
+def test_double_negation_is_the_membership_itself(tmp_path) -> None:
+    """``not (a is not A0)`` equals ``a is A0`` to the bit: computed as ``1 - (1 - mu)`` it
+    rounds a tiny membership far out on a Gaussian's tail to 0, so the rule stopped firing
+    (the output fell to its default) while the FLL writer's simplified rule still fired."""
+    a = Variable("a", "input", (0.0, 10.0), (Term("A0", "gaussian", (6.75, 0.7)),))
+    y = Variable("y", "output", (0.0, 10.0), (Term("Y0", "singleton", (0.0,)),), default=5.0)
+    plain = Prop("a", "A0")
+    doubled = Not(Prop("a", "A0", (), True))
+
+    def rb(expr):
+        rule = Rule("r1", expr, (Consequent("y", "Y0"),))
+        return RuleBase(None, (TermSet((a, y)),), (Behavior("main", (rule,)),), ())
+
+    X = np.array([[0.0, 0.0], [0.5, 0.0], [6.75, 0.0]])
+    np.testing.assert_array_equal(outputs(rb(doubled), X), outputs(rb(plain), X))
+    np.testing.assert_array_equal(outputs(rb(plain), X)[:, 0], [0.0, 0.0, 0.0])

@@ -207,16 +207,18 @@ def program(compiled: CompiledRuleBase) -> Program:
     used: set[str] = set()
     referenced: set[str] = set()
 
-    def expr(e: Expr) -> str:
+    def expr(e: Expr, negate: bool = False) -> str:
+        """C / Python text of ``e``, or of ``not e``; ``not not x`` is ``x`` exactly, as the
+        compiler has it (``1 - (1 - x)`` would round a tiny membership to 0)."""
         if isinstance(e, Prop):
             text = names[(e.var, e.term)]
             referenced.add(text)
             for h in reversed(e.hedges):
                 hedges.add(h)
                 text = f"hedge_{h}({text})"
-            return f"(1.0 - {text})" if e.negated else text
+            return f"(1.0 - {text})" if e.negated != negate else text
         if isinstance(e, Not):
-            return f"(1.0 - {expr(e.expr)})"
+            return expr(e.expr, not negate)
         fn = "tnorm" if isinstance(e, And) else "snorm"
         parts = [expr(i) for i in e.items]
         if len(parts) > 1:
@@ -224,7 +226,7 @@ def program(compiled: CompiledRuleBase) -> Program:
         acc = parts[0]
         for p in parts[1:]:
             acc = f"{fn}({acc}, {p})"
-        return acc
+        return f"(1.0 - {acc})" if negate else acc
 
     rules = []
     flat = flatten(compiled.rulebase, compiled.behavior)
