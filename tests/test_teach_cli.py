@@ -256,5 +256,23 @@ def test_prompt_continues_a_wrapped_rule_and_an_empty_line_ends_it(work):
                 stdin="r30: if road is NARROW\nthen speed is CREEP\nif road is\n\nshow rules\n")
     assert res.returncode == 0
     assert "r30: if road is NARROW then speed is CREEP" in res.stdout
-    assert "<prompt>:1:11: syntax error: the line ends too early" in res.stderr
+    assert "<prompt>:3:11: syntax error: the line ends too early" in res.stderr
     assert "r30: if road is NARROW then speed is CREEP  (new)" in res.stdout
+
+
+def test_prompt_errors_are_command_errors_at_the_prompts_line(work):
+    """A mistyped line at the prompt said `lesson error` at `<prompt>:1` whatever line it was:
+    it is a command error, placed at the line read (blank, comment and wrapped lines count)."""
+    res = mitos("teach", "rb/mitos.rules", cwd=work,
+                stdin="show rules\n\n# a comment\neval road=78 size=45 positon=4\n"
+                      "r30: if road is NARROW\nthen speed is CREEP\nundo\nundo\n")
+    assert res.returncode == 0
+    err = res.stderr.splitlines()
+    at = err.index("<prompt>:4:22: command error: unknown input variable `positon`")
+    assert err[at + 1:at + 5] == ["    eval road=78 size=45 positon=4",
+                                  "                         ^^^^^^^^^",
+                                  "expected one of position, road, size",
+                                  "hint: did you mean `position`?"]
+    at = err.index("<prompt>:8:1: command error: nothing to undo")
+    assert err[at + 1:at + 3] == ["    undo", "    ^"]
+    assert "lesson error" not in res.stderr

@@ -14,7 +14,7 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-from ..errors import MitosError
+from ..errors import LessonError, MitosError, Span
 from .commands import COMMAND_WORDS, SHOW_WHAT, incomplete
 from .session import Session
 
@@ -97,19 +97,41 @@ def prompt_text(session: Session) -> str:
     return f"{session.state.active}/{block}> " if block else f"{session.state.active}> "
 
 
+#: Where the prompt's lines are, in error messages (``<prompt>:LINE:COLUMN``).
+PROMPT = "<prompt>"
+
+
+def at_prompt(exc: MitosError, line: str, lineno: int) -> MitosError:
+    """``exc`` as the prompt reports it: a failed command is a ``command error`` (a lesson's
+    is a ``lesson error``), and an error with no position points at the line typed."""
+    if isinstance(exc, LessonError):
+        exc.kind = "command error"
+    if exc.span is None:
+        exc.span = Span.in_text("\n" * (lineno - 1) + line, PROMPT, lineno, 1)
+    return exc
+
+
 def interact(session: Session, history: Path | None = None) -> None:
-    """Read and run commands until ``quit`` or end of input."""
+    """Read and run commands until ``quit`` or end of input.
+
+    Lines are numbered as they are read (a wrapped rule takes several), so an error reads
+    ``<prompt>:LINE:COLUMN``: in commands piped on stdin, LINE is the line of the input.
+    """
     tty = sys.stdin.isatty()
     readline = _setup_readline(session, history) if tty else None
     err = sys.stderr
+    lines_read = 0
     session.out("MITOS teaching prompt: tell rules, correct, adapt, save. `help` lists the "
                 "commands; Ctrl-D or `quit` leaves (nothing is lost).")
     try:
         while True:
             try:
                 line = input(prompt_text(session) if tty else "")
+                lines_read += 1
+                lineno = lines_read
                 while incomplete(line):          # a rule continued on the next line
                     more = input("... " if tty else "")
+                    lines_read += 1
                     if not more.strip():         # an empty line ends it (and says why)
                         break
                     line += "\n" + more
@@ -127,10 +149,10 @@ def interact(session: Session, history: Path | None = None) -> None:
                 except (OSError, AttributeError):
                     pass
             try:
-                if not session.run(line):
+                if not session.run(line, PROMPT, lineno):
                     break
             except MitosError as exc:
-                print(exc.render(), file=err)
+                print(at_prompt(exc, line, lineno).render(), file=err)
             except KeyboardInterrupt:
                 session.replay()            # the state is exactly what the journal holds
                 print("interrupted", file=err)
