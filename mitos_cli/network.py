@@ -28,10 +28,7 @@ def _term_text(term) -> str:
         return f"{term.name} = {_fmt(term.params[0])}"
     if term.shape == "linear":
         return f"{term.name} = linear"
-    if term.shape.startswith("triangle_"):       # the paper's peak / width form
-        named = zip(term.kind.params, term.params)
-        return f"{term.name} triangle({', '.join(f'{k} {_fmt(v)}' for k, v in named)})"
-    return f"{term.name} {term.shape}({', '.join(_fmt(p) for p in term.params)})"
+    return f"{term.name} {term.shape_name}({term.params_text(_fmt)})"
 
 
 def _fan_in(children: np.ndarray) -> str:

@@ -17,6 +17,16 @@ from .shapes import SHAPES, Shape
 
 Role = Literal["input", "output"]
 
+#: Shapes a term set spells differently from the registry: every triangle is ``shape:
+#: triangle``, told apart by its parameters (docs/language.md); by its corners it takes
+#: ``points: [a, b, c]`` only.
+TERM_SET_SHAPES = {"triangle": "triangle", "triangle_pw": "triangle",
+                   "triangle_plr": "triangle"}
+
+
+def _number(value: float) -> str:
+    return f"{value:g}"
+
 
 @dataclass(frozen=True)
 class Term:
@@ -41,6 +51,25 @@ class Term:
     def center(self) -> float:
         """The crisp value the term stands for in a weighted-average consequent."""
         return float(self.kind.center(self.params))
+
+    @property
+    def shape_name(self) -> str:
+        """The shape as the term set writes it: ``triangle``, never ``triangle_pw``."""
+        return TERM_SET_SHAPES.get(self.shape, self.shape)
+
+    def params_text(self, number=_number) -> str:
+        """The parameters as the term set names them, for people: ``peak 70, width 30``,
+        ``a 40, b 70``, ``points [10, 40, 70]`` (a triangle by its corners or a ``discrete``
+        term), a singleton's value alone. ``number`` formats each value."""
+        p = self.params
+        if self.shape == "singleton":
+            return number(p[0])
+        if self.shape == "linear":                 # LINEAR_LAYOUT: coefficients..., constant
+            return (f"coefficients [{', '.join(number(v) for v in p[:-1])}], "
+                    f"constant {number(p[-1])}")
+        if self.shape == "triangle" or self.kind.variadic or len(p) != len(self.kind.params):
+            return f"points [{', '.join(number(v) for v in p)}]"
+        return ", ".join(f"{n} {number(v)}" for n, v in zip(self.kind.params, p))
 
     def membership(self, x) -> np.ndarray:
         return self.kind.membership(x, self.params)

@@ -35,6 +35,8 @@ def test_paper_network_layers():
                                     "36 neurons")
     assert "layer 1   9  membership neurons" in text
     assert "MEDIUM triangle(peak 70, width 30)" in text
+    assert "NARROW left_shoulder(a 40, b 70)" in text       # parameters named as in the YAML
+    assert "triangle_" not in text
     assert "layer 2  27  AND neurons, T-norm min (min(a, b)), 3 inputs" in text
     assert "layer 3   2  output neurons, weighted average" in text
     assert "steering: 27 rules, default 90" in text

@@ -296,3 +296,13 @@ def test_errors_at_the_prompt_are_placed_at_prompt(rules):
         with pytest.raises(MitosError) as info:
             s.run(line)
         assert str(info.value.span) == f"<prompt>:1:{column}", line
+
+
+def test_show_terms_names_shapes_as_the_term_set_writes_them(rules):
+    """`show terms` said `triangle_pw`, a registry name no term set can use."""
+    s, out = session(rules)
+    shown = say(s, out, "show terms").splitlines()
+    assert "  MEDIUM     triangle       peak 70, width 30" in shown
+    assert "  NARROW     left_shoulder  a 40, b 70" in shown
+    assert "  STOP       singleton      0" in shown
+    assert not [line for line in shown if "triangle_" in line]

@@ -197,7 +197,8 @@ def draw_terms_before_after(variable_before: Variable, variable_after: Variable,
         if o is None:
             changes.append(f"{t.name}: new")
         elif o.shape != t.shape:
-            changes.append(f"{t.name}: {o.shape} {_params(o)} → {t.shape} {_params(t)}")
+            changes.append(f"{t.name}: {o.shape_name} ({o.params_text()}) → {t.shape_name} "
+                           f"({t.params_text()})")
         elif o.params != t.params:
             names = t.kind.params if len(t.kind.params) == len(t.params) else \
                 tuple(f"p{i + 1}" for i in range(len(t.params)))
@@ -232,10 +233,6 @@ def draw_terms_before_after(variable_before: Variable, variable_after: Variable,
         ax.text(0.0, -0.2, "changed: " + "\n         ".join(changes), transform=ax.transAxes,
                 va="top", fontsize=8, family="monospace")
     return finish(fig, path, show)
-
-
-def _params(term) -> str:
-    return "(" + ", ".join(f"{p:g}" for p in term.params) + ")"
 
 
 __all__ = ["draw_sheet", "draw_panel", "draw_terms_before_after"]

@@ -705,12 +705,7 @@ def _q_lines(history: list[float], n: int, result) -> str:
 
 
 def _params_text(t) -> str:
-    from ..shapes import SHAPES
-
-    names = SHAPES[t.shape].params
-    if t.shape == "singleton":
-        return format_number(t.params[0])
-    return ", ".join(f"{n} {format_number(v)}" for n, v in zip(names, t.params))
+    return t.params_text(format_number)
 
 
 def changed_table(before: RuleBase, after: RuleBase, crisp: list) -> str:
@@ -741,5 +736,5 @@ def terms_table(original: RuleBase, current: RuleBase, names: list[str]) -> str:
             o = old[v.name].term(t.name) if v.name in old else None
             was = f"   (was {_params_text(o)})" if o is not None and o.params != t.params else ""
             frozen = "  [frozen]" if t.frozen else ""
-            lines.append(f"  {t.name:<10} {t.shape:<14} {_params_text(t)}{frozen}{was}")
+            lines.append(f"  {t.name:<10} {t.shape_name:<14} {_params_text(t)}{frozen}{was}")
     return "\n".join(lines)

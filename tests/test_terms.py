@@ -1,0 +1,44 @@
+"""Terms as users see them: the shape and parameters a term set writes, never the registry's
+internal names (``triangle_pw`` is the paper's eq. 15 triangle, written ``shape: triangle``)."""
+
+from __future__ import annotations
+
+import re
+
+import pytest
+
+from mitos_cli.termset import parse_termset
+
+TERMS = {
+    "PW": ("{shape: triangle, peak: 70, width: 30}", "triangle", "peak 70, width 30"),
+    "PLR": ("{shape: triangle, peak: 70, left_width: 10, right_width: 25}", "triangle",
+            "peak 70, left_width 10, right_width 25"),
+    "ABC": ("{shape: triangle, points: [10, 40, 70]}", "triangle", "points [10, 40, 70]"),
+    "TRAP": ("{shape: trapezoid, a: 1, b: 2, c: 3, d: 4}", "trapezoid", "a 1, b 2, c 3, d 4"),
+    "LS": ("{shape: left_shoulder, points: [40, 70]}", "left_shoulder", "a 40, b 70"),
+    "G": ("{shape: gaussian, mean: 50, sigma: 2.5}", "gaussian", "mean 50, sigma 2.5"),
+    "D": ("{shape: discrete, points: [0, 0, 50, 1, 100, 0]}", "discrete",
+          "points [0, 0, 50, 1, 100, 0]"),
+}
+
+
+def termset(terms: dict[str, str]):
+    body = "".join(f"      {name}: {spec}\n" for name, spec in terms.items())
+    return parse_termset("variables:\n  road:\n    role: input\n    universe: [0, 160]\n"
+                         f"    terms:\n{body}")
+
+
+@pytest.mark.parametrize("name", TERMS)
+def test_a_term_is_shown_as_its_term_set_writes_it(name):
+    spec, shape, params = TERMS[name]
+    term = termset({name: spec}).variables[0].term(name)
+    assert (term.shape_name, term.params_text()) == (shape, params)
+    # what is shown reads back as the same term
+    shown = re.sub(r"(\w+) ", r"\1: ", params)
+    again = termset({name: f"{{shape: {shape}, {shown}}}"}).variables[0].term(name)
+    assert (again.shape, again.params) == (term.shape, term.params)
+
+
+def test_a_singleton_shows_its_value_alone():
+    term = termset({"STOP": "{shape: singleton, value: 0.5}"}).variables[0].term("STOP")
+    assert (term.shape_name, term.params_text()) == ("singleton", "0.5")
