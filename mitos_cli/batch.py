@@ -9,6 +9,7 @@ from typing import TextIO
 import numpy as np
 
 from .errors import InputError, Span, did_you_mean
+from .words import plural
 
 
 def read_batch(text: str, path: str, inputs: tuple[str, ...]) -> np.ndarray:
@@ -48,7 +49,7 @@ def _raise_bad_row(lines: list[str], path: str, width: int) -> None:
             continue
         cells = next(csv.reader([line]))
         if len(cells) != width:
-            raise InputError(f"row has {len(cells)} values, the header {width}",
+            raise InputError(f"row has {plural(len(cells), 'value')}, the header {width}",
                              span=Span(path, n, 1, line))
         for cell in cells:
             try:

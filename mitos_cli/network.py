@@ -7,6 +7,7 @@ import numpy as np
 
 from . import hedges as hedge_mod
 from .compile import CompiledRuleBase
+from .words import plural
 
 INFERENCE_TEXT = {
     "weighted_average": "weighted average of the rules' consequents, sum(dof y) / sum(dof) "
@@ -17,10 +18,6 @@ INFERENCE_TEXT = {
 
 def _fmt(x: float) -> str:
     return f"{x:g}"
-
-
-def _n(count: int, word: str) -> str:
-    return f"{count} {word}{'' if count == 1 else 's'}"
 
 
 def _term_text(term) -> str:
@@ -34,7 +31,7 @@ def _term_text(term) -> str:
 def _fan_in(children: np.ndarray) -> str:
     counts = (children >= 2).sum(axis=1)          # columns 0 and 1 only pad
     lo, hi = int(counts.min()), int(counts.max())
-    return _n(lo, "input") if lo == hi else f"{lo}-{hi} inputs"
+    return plural(lo, "input") if lo == hi else f"{lo}-{hi} inputs"
 
 
 def _group_text(op: str, compiled: CompiledRuleBase) -> str:
@@ -56,8 +53,9 @@ def describe_network(compiled: CompiledRuleBase) -> str:
     """The layers of ``compiled`` as text, input side first."""
     c = compiled
     ops = c.operators
-    lines = [f"behavior {c.behavior}: {_n(len(c.inputs), 'input')}, {_n(c.n_rules, 'rule')}, "
-             f"{_n(len(c.outputs), 'output')}, {_n(c.n_columns - 2, 'neuron')}",
+    lines = [f"behavior {c.behavior}: {plural(len(c.inputs), 'input')}, "
+             f"{plural(c.n_rules, 'rule')}, "
+             f"{plural(len(c.outputs), 'output')}, {plural(c.n_columns - 2, 'neuron')}",
              f"operators: {ops.describe()}", ""]
     table: list[tuple[str, str, str]] = []
 
@@ -87,10 +85,10 @@ def describe_network(compiled: CompiledRuleBase) -> str:
     if ops.inference == "mamdani":
         row(f"layer {len(c.levels) + 2}", len(c.outputs),
             f"output neurons, Mamdani: implication {ops.implication}, aggregation {ops.aggregation}, "
-            f"defuzzify {ops.defuzzify} on {ops.resolution} samples")
+            f"defuzzify {ops.defuzzify} on {plural(ops.resolution, 'sample')}")
         for table_j in c.mamdani:
-            row("", "", f"  {table_j.name}: {_n(len(table_j.rules), 'rule')} -> "
-                f"{_n(len(table_j.labels), 'consequent set')} ({', '.join(table_j.labels)})")
+            row("", "", f"  {table_j.name}: {plural(len(table_j.rules), 'rule')} -> "
+                f"{plural(len(table_j.labels), 'consequent set')} ({', '.join(table_j.labels)})")
     else:
         kind = "Takagi-Sugeno, " if c.cons_linear is not None else ""
         row(f"layer {len(c.levels) + 2}", len(c.outputs),
@@ -99,7 +97,7 @@ def describe_network(compiled: CompiledRuleBase) -> str:
             n = int(c.cons_mask[:, j].sum())
             linear = 0 if c.cons_linear is None else int(
                 (c.cons_linear[:, j, :-1] != 0).any(axis=1).sum())
-            what = f"  {name}: {_n(n, 'rule')}"
+            what = f"  {name}: {plural(n, 'rule')}"
             if linear:
                 what += f", {linear} with linear consequents y = a . x + c"
             default = c.default[j]

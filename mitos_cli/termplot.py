@@ -12,6 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from .plotdata import RuleView, Surface, TermCurve, VariablePlot, visible
+from .words import plural
 
 BRAILLE = 0x2800
 #: dot (row, column) inside a cell -> bit of the Braille code point
@@ -225,7 +226,7 @@ def _consequent_text(c) -> str:
 
 def render_rule_view(view: RuleView, width: int = 72, color: bool = False) -> str:
     """The rule viewer as text: one block per fired rule with a bar per membership and DOF."""
-    out = [f"behavior {view.behavior} ({view.n_rules} rules; {view.operators})", ""]
+    out = [f"behavior {view.behavior} ({plural(view.n_rules, 'rule')}; {view.operators})", ""]
     for i in view.inputs:
         unit = f" {i.unit}" if i.unit else ""
         mus = ", ".join(f"{t} {mu:.2f}" for t, mu in i.memberships if visible(mu))

@@ -36,6 +36,7 @@ from .errors import Span, TermSetError, did_you_mean
 from .shapes import SHAPES
 from .terms import Term, TermSet, Variable, check_term
 from .yamlpos import YList, YMap
+from .words import plural
 
 VARIABLE_KEYS = ("description", "unit", "role", "universe", "terms", "default")
 TRIANGLE_FORMS = {
@@ -171,7 +172,7 @@ def _term(name: str, spec: Any, key_span: Span, value_span: Span, variable: str,
         if kind.variadic and isinstance(points, YList):      # discrete: x1, y1, ..., xn, yn
             pass
         elif not isinstance(points, YList) or len(points) != len(kind.params):
-            raise TermSetError(f"{what}: `points` must list {len(kind.params)} numbers "
+            raise TermSetError(f"{what}: `points` must list {plural(len(kind.params), 'number')} "
                                f"({', '.join(kind.params)})", span=pspan)
         params = tuple(yamlpos.expect_number(v, points.item_span(i), TermSetError,
                                              f"{what}: point") for i, v in enumerate(points))

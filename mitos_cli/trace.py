@@ -12,6 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .engine import Result
+from .words import plural
 
 
 @dataclass(frozen=True)
@@ -61,7 +62,7 @@ class Trace:
             return text
 
         lines = [f"rule base {self.rulebase}, behavior {self.behavior} "
-                 f"({self.n_rules} rules; {self.operators})", "", "fuzzified inputs:"]
+                 f"({plural(self.n_rules, 'rule')}; {self.operators})", "", "fuzzified inputs:"]
         fuzzified = []
         for i in self.inputs:
             shown = [f"{t}/{num(mu)}" for t, mu in i.memberships if round(mu, digits) > 0]

@@ -205,3 +205,17 @@ def test_used_rules_take_the_operators_of_the_behavior_that_uses_them(tmp_path):
     center, large = 3 / 7, (5 / 30) ** 2                   # CENTER(4), very LARGE_SZ(45)
     assert a["r2"] == pytest.approx(min(center, large) * 0.8)
     assert u["avoid_obstacle/r2"] == pytest.approx(center * large * 0.8)
+
+
+def test_counts_are_singular_for_one(tmp_path, capsys):
+    """The trace said "(1 rules; ...)" and a batch "(1 samples)"."""
+    terms = (ROOT / "rulebases" / "mitos.terms.yaml").read_text(encoding="utf-8")
+    (tmp_path / "t.terms.yaml").write_text(terms, encoding="utf-8")
+    (tmp_path / "t.rules").write_text(
+        'terms "t.terms.yaml"\nr1: if road is WIDE then speed is FAST\n', encoding="utf-8")
+    code, out, _ = run_main(["eval", str(tmp_path / "t.rules"), "road=120"], capsys)
+    assert code == 0 and "(1 rule; " in out
+    csv = tmp_path / "in.csv"
+    csv.write_text("road\n500\n78\n", encoding="utf-8")
+    code, out, err = run_main(["eval", str(tmp_path / "t.rules"), "--batch", str(csv)], capsys)
+    assert err == "warning: `road` outside its universe [0, 160] was clamped (1 sample)\n"

@@ -148,7 +148,7 @@ def test_existing_results_need_resume(tiny, tmp_path, compare):
     assert compare(tiny, "--and", "min", "--planner", "fuzzy", "--runs", 1, "-o", out, "-j", 1,
                    "--no-plots").exit_code == 0
     r = compare(tiny, "--and", "min", "--planner", "fuzzy", "--runs", 1, "-o", out, "-j", 1)
-    assert r.exit_code == 1 and "already holds 1 results" in r.stderr and "--resume" in r.stderr
+    assert r.exit_code == 1 and "already holds 1 result" in r.stderr and "--resume" in r.stderr
 
 
 @pytest.mark.parametrize("args, code, words", [

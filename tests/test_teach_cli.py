@@ -165,7 +165,7 @@ def test_killed_session_resumes_with_nothing_lost(work):
     out = res.stdout
     assert "1  road=78 size=45 position=4 -> steering=60 speed=20" in out
     assert "3  road=40 size=20 position=10 -> steering=50" in out
-    assert "  careful (1 rules)" in out and "* avoid_obstacle (28 rules)" in out
+    assert "  careful (1 rule)" in out and "* avoid_obstacle (28 rules)" in out
     assert "r27: if road is NARROW and position is RIGHT then steering is LM  (new)" in out
     assert "(was peak 70, width 30)" in out                  # the adaptation is kept
     text = (work / "out" / "resumed.rules").read_text()

@@ -70,7 +70,7 @@ def test_behavior_end_use_and_recall_by_name(rules):
         s.run("behavior other")
     with pytest.raises(LessonError, match="close it with `end` before saving"):
         s.run("save x.rules")
-    assert "careful learned (1 rules, 1 uses)" in say(s, out, "end")
+    assert "careful learned (1 rule, 1 use)" in say(s, out, "end")
     assert s.state.active == "careful"
     assert "active behavior: avoid_obstacle" in say(s, out, "use avoid_obstacle")
     with pytest.raises(LessonError, match="no behavior is open"):
@@ -306,3 +306,16 @@ def test_show_terms_names_shapes_as_the_term_set_writes_them(rules):
     assert "  NARROW     left_shoulder  a 40, b 70" in shown
     assert "  STOP       singleton      0" in shown
     assert not [line for line in shown if "triangle_" in line]
+
+
+def test_counts_of_one_are_singular(rules):
+    """A new behavior with one rule was "learned (1 rules, 0 uses)"."""
+    s, out = session(rules)
+    say(s, out, "behavior careful")
+    assert "added to careful (1 rule)" in say(s, out, "if road is NARROW then speed is CREEP")
+    assert "behavior careful learned (1 rule, 0 uses)" in say(s, out, "end")
+    assert "* careful (1 rule)" in say(s, out, "show behaviors")
+    assert say(s, out, "show rules").startswith("behavior careful (1 rule)")
+    say(s, out, "correct road=20 -> speed=15")
+    text = say(s, out, "adapt epochs 1")
+    assert "Q = sum (y - t)^2 over 1 example:" in text and "(1 epoch; RMS error" in text

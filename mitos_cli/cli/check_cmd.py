@@ -10,6 +10,7 @@ from typing import Annotated, Optional
 import typer
 
 from .output import emit
+from ..words import plural
 
 
 def show_path(path: str | None) -> str:
@@ -33,18 +34,16 @@ def render(report, trace_path: str) -> str:
         for box in f.regions:
             lines.append(f"    {box.describe()}")
         if f.more_regions:
-            lines.append(f"    ... and {f.more_regions} more region"
-                         + ("s" if f.more_regions > 1 else ""))
+            lines.append(f"    ... and {plural(f.more_regions, 'more region')}")
         if f.uncovered:
-            lines.append(f"    ... and {f.uncovered} scattered samples")
+            lines.append(f"    ... and {plural(f.uncovered, 'scattered sample')}")
         if f.hint:
             lines.append(f"    hint: {f.hint}")
     grids = "; ".join(
         f"`{g.behavior}` on " + " x ".join(f"{n} {name}" for name, n in g.points)
-        + f" = {g.samples:,} samples" for g in report.grids)
-    counts = [f"{report.count(s)} {s}{'s' if report.count(s) != 1 else ''}"
-              for s in ("error", "warning")] + [f"{report.count('info')} notes"
-                                                if report.count("info") != 1 else "1 note"]
+        + f" = {plural(g.samples, 'sample')}" for g in report.grids)
+    counts = [plural(report.count(s), word) for s, word in
+              (("error", "error"), ("warning", "warning"), ("info", "note"))]
     if lines:
         lines.append("")
     lines.append(f"checked {trace_path}: {grids}")

@@ -8,6 +8,7 @@ from typing import Annotated, Optional
 import typer
 
 from .output import err, warn
+from ..words import plural
 
 
 def compare_command(
@@ -103,7 +104,7 @@ def compare_command(
         warn("matplotlib is not installed: report.md has no plots "
              "(pip install 'mitos[plot]')")
         report = write_report(outcome, out, plots=False)
-    err(f"{outcome.executed} runs now, {outcome.skipped} from before; "
+    err(f"{plural(outcome.executed, 'run')} now, {outcome.skipped} from before; "
         f"wrote {report.parent / 'results.csv'} and {report}")
 
 
@@ -145,7 +146,7 @@ def run_with_progress(study, out, executor, workers, scheduler, resume):
         def on_start(skipped: int, total: int) -> None:
             progress.update(bar, total=total, completed=skipped)
             if skipped:
-                console.print(f"resuming: {skipped} of {total} runs already in {out}",
+                console.print(f"resuming: {skipped} of {plural(total, 'run')} already in {out}",
                               markup=False, highlight=False)
 
         def on_result(task, row) -> None:

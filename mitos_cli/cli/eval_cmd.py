@@ -11,6 +11,7 @@ import typer
 
 from ..errors import InputError
 from .output import emit, warn
+from ..words import plural
 
 
 def split_args(args: list[str]) -> tuple[Optional[str], dict[str, str]]:
@@ -48,7 +49,7 @@ def warn_clamped(result) -> None:
     for k, count in enumerate(result.clamped):
         if count:
             lo, hi = c.universe[k]
-            many = f" ({int(count)} samples)" if result.inputs.shape[0] > 1 else ""
+            many = f" ({plural(int(count), 'sample')})" if result.inputs.shape[0] > 1 else ""
             warn(f"`{c.inputs[k]}` outside its universe [{lo:g}, {hi:g}] was clamped{many}")
 
 

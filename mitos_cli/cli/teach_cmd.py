@@ -6,6 +6,7 @@ from pathlib import Path
 from typing import Annotated, Optional
 
 import typer
+from ..words import plural
 
 
 def teach_command(
@@ -50,8 +51,8 @@ def teach_command(
         session = Session.resume(journal, out=emit, progress=epoch_progress)
         if save_as is not None:
             session.save_as = Path(save_as)
-        err(f"resumed session {journal.directory.name}: {len(journal.active())} changes, "
-            f"{len(session.state.examples)} examples, behavior {session.state.active}"
+        err(f"resumed session {journal.directory.name}: {plural(len(journal.active()), 'change')}, "
+            f"{plural(len(session.state.examples), 'example')}, behavior {session.state.active}"
             + (" (a torn last line of the journal was dropped)" if journal.skipped_tail
                else ""))
     else:

@@ -22,6 +22,7 @@ import numpy as np
 
 from ..plotdata import OutputView, RuleRow, RuleView
 from .output import finish, new_figure
+from ..words import plural
 
 TERM_COLOR = "#1f77b4"
 FILL_COLOR = "#f2b134"
@@ -183,7 +184,7 @@ def draw_rules(view: RuleView, path: str | Path | None = None, *, title: str | N
         _bare(ax)
         ax.tick_params(axis="x", labelsize=7, length=2)
         draw_aggregate(ax, out)
-    heading = title or (f"Rule viewer: {len(view.rows)} of {view.n_rules} rules fired "
+    heading = title or (f"Rule viewer: {len(view.rows)} of {plural(view.n_rules, 'rule')} fired "
                         f"(behavior {view.behavior})")
     if hidden:
         heading += f"; the {hidden} weakest not shown"

@@ -20,6 +20,7 @@ from ..errors import FormatError, MitosError, Span, did_you_mean
 from ..model import And, Behavior, Consequent, Expr, Not, Or, Prop, Rule, RuleBase, Setting
 from ..shapes import SHAPES
 from ..terms import Term, TermSet, Variable
+from ..words import plural
 
 # ---------------------------------------------------------------------------------------------
 # Operators: MITOS name -> (FLL, FIS, FCL). None = the format has no name for it.
@@ -169,7 +170,7 @@ def fuzzylite_term(name: str, kind: str, values: list[float], n_inputs: int,
     if shape == "linear":
         if len(values) != n_inputs + 1:
             raise FormatError(f"term `{name}`: Linear takes one coefficient per input variable "
-                              f"({n_inputs}) and a constant, not {len(values)} numbers",
+                              f"({n_inputs}) and a constant, not {plural(len(values), 'number')}",
                               span=span)
     elif count is None:                       # Discrete: pairs, then an optional height
         if len(values) % 2:
@@ -177,7 +178,8 @@ def fuzzylite_term(name: str, kind: str, values: list[float], n_inputs: int,
     elif len(values) == count + 1:
         height = values.pop()
     elif len(values) != count:
-        raise FormatError(f"term `{name}`: {kind} takes {count} numbers, not {len(values)}",
+        raise FormatError(f"term `{name}`: {kind} takes {plural(count, 'number')}, "
+                          f"not {len(values)}",
                           span=span, expected=", ".join(SHAPES[shape].params))
     if height != 1.0:
         raise FormatError(f"term `{name}`: a term height ({height:g}) other than 1 is not "

@@ -41,6 +41,7 @@ from . import common
 from ..build import MAIN
 from .common import FCL, FLL, fmt_number
 from .ruletree import conclusion, expression
+from ..words import plural
 
 DEFAULT_RESOLUTION = 1000
 
@@ -332,7 +333,8 @@ def _term(item: Tree, role: str, n_inputs: int, span_of) -> Term:
     if kind.lower() in JFUZZY_SHAPES and kind not in common.FUZZYLITE_SHAPES:
         shape, count, convert = JFUZZY_SHAPES[kind.lower()]
         if len(values) != count:
-            raise FormatError(f"term `{name}`: {kind} takes {count} numbers, not {len(values)}",
+            raise FormatError(f"term `{name}`: {kind} takes {plural(count, 'number')}, "
+                              f"not {len(values)}",
                               span=span)
         return common.make_term(name, shape, tuple(convert(tuple(values))), span)
     by_lower = {k.lower(): k for k in common.FUZZYLITE_SHAPES} | {

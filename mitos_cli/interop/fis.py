@@ -31,6 +31,7 @@ from ..model import And, Consequent, Or, Prop, Rule, RuleBase
 from ..terms import Term, Variable
 from . import common
 from .common import FIS, Settings, fmt_number
+from ..words import plural
 
 DEFAULT_RESOLUTION = 101
 
@@ -222,8 +223,8 @@ def _mf(value: str, vspan: Span, role: str, kind: str, n_inputs: int) -> Term:
         if role != "output" or kind != "sugeno":
             raise FormatError(f"MF `{name}`: `linear` belongs to Sugeno outputs", span=vspan)
         if len(params) != n_inputs + 1:
-            raise FormatError(f"MF `{name}`: linear takes {n_inputs + 1} numbers (one per input "
-                              f"and a constant), not {len(params)}", span=vspan)
+            raise FormatError(f"MF `{name}`: linear takes {plural(n_inputs + 1, 'number')} (one "
+                              f"per input and a constant), not {len(params)}", span=vspan)
         return common.make_term(name, "linear", tuple(params), vspan)
     if mf not in MF_TYPES:
         raise FormatError(f"MF `{name}`: membership function type `{mf}` is not supported",
@@ -231,7 +232,7 @@ def _mf(value: str, vspan: Span, role: str, kind: str, n_inputs: int) -> Term:
                           hint=did_you_mean(mf, MF_TYPES))
     shape, count, order = MF_TYPES[mf]
     if len(params) != count:
-        raise FormatError(f"MF `{name}`: {mf} takes {count} numbers, not {len(params)}",
+        raise FormatError(f"MF `{name}`: {mf} takes {plural(count, 'number')}, not {len(params)}",
                           span=vspan)
     return common.make_term(name, shape, tuple(params[i] for i in order), vspan)
 
@@ -246,8 +247,9 @@ def _rule(line: str, lineno: int, span: Span, inputs: list[Variable], outputs: l
     weight = common.number(m.group(3), span)
     connection = int(m.group(4))
     if len(ins) != len(inputs) or len(outs) != len(outputs):
-        raise FormatError(f"the rule lists {len(ins)} inputs and {len(outs)} outputs; the system "
-                          f"has {len(inputs)} and {len(outputs)}", span=span)
+        raise FormatError(f"the rule lists {plural(len(ins), 'input')} and "
+                          f"{plural(len(outs), 'output')}; the system has {len(inputs)} and "
+                          f"{len(outputs)}", span=span)
     if connection not in (1, 2):
         raise FormatError(f"connection {connection}: expected 1 (AND) or 2 (OR)", span=span)
     props = []

@@ -10,6 +10,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+from ..words import plural
 
 
 def _header(data: bytes, count: int) -> tuple[list[int], int]:
@@ -48,7 +49,7 @@ def parse_pgm(data: bytes) -> tuple[np.ndarray, int]:
         dtype = np.dtype(">u2") if maxval > 255 else np.dtype("u1")
         body = np.frombuffer(data, dtype=dtype, count=-1, offset=offset)
         if body.size < n:
-            raise ValueError(f"the PGM image holds {body.size} of its {n} pixels")
+            raise ValueError(f"the PGM image holds {body.size} of its {plural(n, 'pixel')}")
         pixels = body[:n].astype(np.uint16)
     else:
         try:
@@ -56,7 +57,7 @@ def parse_pgm(data: bytes) -> tuple[np.ndarray, int]:
         except ValueError:
             raise ValueError("the ASCII PGM image holds something that is not a number") from None
         if pixels.size < n:
-            raise ValueError(f"the PGM image holds {pixels.size} of its {n} pixels")
+            raise ValueError(f"the PGM image holds {pixels.size} of its {plural(n, 'pixel')}")
         pixels = pixels[:n]
         if pixels.min(initial=0) < 0 or pixels.max(initial=0) > maxval:
             raise ValueError(f"a PGM pixel lies outside 0..{maxval}")

@@ -8,6 +8,7 @@ from pathlib import Path
 from .spec import Choice
 from .stats import Mean, Rate
 from .summary import ALL_WORLDS, METRICS, Rank, Summary
+from ..words import plural
 
 RATE_COLUMNS = (("success", "success"), ("collision", "collision"), ("timeout", "timeout"),
                 ("stuck", "stuck"))
@@ -160,7 +161,7 @@ def render_markdown(manifest: dict, summaries: list[Summary], ranks: list[Rank],
         f"- worlds: {', '.join(f'`{w}`' for w in worlds)}",
         f"- choices: {', '.join(f'`{c}`' for c in choices)}",
         f"- runs per world and choice: {manifest.get('runs')}, seed {manifest.get('seed')}"
-        f" ({n_rows} of {n_tasks} runs finished)",
+        f" ({n_rows} of {plural(n_tasks, 'run')} finished)",
         f"- rule base: `{manifest.get('rulebase') or 'packaged default'}`"
         + (f", behavior `{manifest['behavior']}`" if manifest.get("behavior") else ""),
         f"- command: `{manifest.get('command', 'mitos compare')}`",
@@ -204,7 +205,8 @@ def overlap_note(ranks: list[Rank]) -> str | None:
             if r.p_value is not None and not math.isnan(r.p_value) and r.p_value > 0.05]
     if not tied:
         return None
-    return (f"{len(tied)} of {len(ranks) - 1} choices are not distinguishable from the leader "
+    return (f"{len(tied)} of {plural(len(ranks) - 1, 'choice')} "
+            f"{'is' if len(tied) == 1 else 'are'} not distinguishable from the leader "
             f"({ranks[0].summary.choice.label}) in success rate (McNemar p > 0.05): "
             + ", ".join(tied))
 

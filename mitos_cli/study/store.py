@@ -18,6 +18,7 @@ from typing import Iterable
 
 from ..errors import MitosError
 from .spec import KEY_FIELDS, Task
+from ..words import plural
 
 #: what a run reports, in this order, after the key and the seed
 RESULT_FIELDS = ("outcome", "collisions", "time_s", "path_length_in", "min_clearance_in",
@@ -128,7 +129,7 @@ class ResultStore:
                              f"{exc.strerror or exc}") from None
         rows = self.load()
         if rows and not resume:
-            raise StudyError(f"{self.path} already holds {len(rows)} results",
+            raise StudyError(f"{self.path} already holds {plural(len(rows), 'result')}",
                              hint="pass --resume to continue that study, or choose another "
                                   "directory with -o")
         old = self.manifest() if rows else None

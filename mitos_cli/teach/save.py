@@ -29,6 +29,7 @@ from ..model import Behavior, RuleBase, format_number, format_rule, format_use
 from ..parse import parser as rule_parser
 from ..shapes import SHAPES
 from ..terms import Term
+from ..words import plural
 
 NUMBER = re.compile(r"[-+]?(?:\d[\d_]*\.?\d*|\.\d+)(?:[eE][-+]?\d+)?")
 
@@ -229,7 +230,7 @@ def edit_rules(text: str, path: str, original: RuleBase, current: RuleBase,
         old = old_behaviors.get(b.name)
         if old is None:
             appended.append(_behavior_text(b))
-            changes.append(f"new behavior {b.name} ({len(b.rules)} rules)")
+            changes.append(f"new behavior {b.name} ({plural(len(b.rules), 'rule')})")
             continue
         place = places.get(b.name)
         old_rules = {r.label: r for r in old.rules}

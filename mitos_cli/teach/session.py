@@ -35,6 +35,7 @@ from ..model import And, Behavior, Expr, Not, Prop, Rule, RuleBase, format_expr,
     format_number, format_rule, format_use
 from ..operators import resolve
 from ..parse import parse_rule
+from ..words import plural
 from . import commands as cmd
 from .journal import Journal, MemoryJournal
 
@@ -263,7 +264,7 @@ class Session:
         self.change("rule", line, behavior=b.name, text=format_rule(rule))
         head = f"{format_rule(rule)}"
         if before is None:
-            self.out(f"{head}\n  added to {b.name} ({len(b.rules) + 1} rules)")
+            self.out(f"{head}\n  added to {b.name} ({plural(len(b.rules) + 1, 'rule')})")
         else:
             self.out(f"{head}\n  replaces {format_rule(before)}")
         b = self.rulebase.behavior(b.name)
@@ -296,7 +297,8 @@ class Session:
             raise LessonError(f"behavior `{name}` is empty",
                               hint="tell it a rule or a `use` line before `end` (or `undo`)")
         self.change("end", line, activate=name)
-        self.out(f"behavior {name} learned ({len(b.rules)} rules, {len(b.uses)} uses); "
+        self.out(f"behavior {name} learned ({plural(len(b.rules), 'rule')}, "
+                 f"{plural(len(b.uses), 'use')}); "
                  f"it is now active (recall another by `use NAME`)")
 
     def _telluse(self, c: cmd.TellUse, line: str) -> None:
@@ -313,7 +315,7 @@ class Session:
             self.compiled(use.behavior)
             self.change("activate", line, behavior=use.behavior)
             b = self.rulebase.behavior(use.behavior)
-            self.out(f"active behavior: {use.behavior} ({len(b.rules)} rules"
+            self.out(f"active behavior: {use.behavior} ({plural(len(b.rules), 'rule')}"
                      + (f", uses {', '.join(u.behavior for u in b.uses)}" if b.uses else "")
                      + ")")
             return
@@ -416,7 +418,7 @@ class Session:
                      f"t={self.simulation.time(i):g}s"} for x, i in zip(inputs, rows)]
         self.change("examples", line, behavior=compiled.behavior, examples=examples)
         first = len(self.state.examples) - len(examples) + 1
-        self.out(f"{len(examples)} example{'s' if len(examples) != 1 else ''} from "
+        self.out(f"{plural(len(examples), 'example')} from "
                  f"{self.simulation.name} {when} (#{first}"
                  + (f"-{len(self.state.examples)}" if len(examples) > 1 else "") + "):")
         for x, y in list(zip(inputs, now))[:5]:
@@ -557,7 +559,7 @@ class Session:
         entry = self.journal.append("save", path=str(target), line=line)
         self.saved_seq = entry["seq"]
         files = ", ".join(str(p) for p in (saved.rules,) + saved.termsets)
-        self.out(f"saved {files}" + (f" ({len(saved.changes)} changes)" if saved.changes
+        self.out(f"saved {files}" + (f" ({plural(len(saved.changes), 'change')})" if saved.changes
                                      else " (no changes)"))
         for change in saved.changes:
             self.out(f"  {change}")
@@ -578,7 +580,7 @@ class Session:
             old = {r.label: r for r in self.original.behavior(b.name).rules}
         except MitosError:
             pass
-        lines = [f"behavior {b.name} ({len(b.rules)} rules)"
+        lines = [f"behavior {b.name} ({plural(len(b.rules), 'rule')})"
                  + ("  [open]" if self.state.block == b.name else "")]
         for r in b.rules:
             mark = "" if old.get(r.label) == r else ("  (new)" if r.label not in old
@@ -609,7 +611,7 @@ class Session:
         for b in self.rulebase.behaviors:
             mark = "*" if b.name == self.state.active else " "
             extra = f", uses {', '.join(u.behavior for u in b.uses)}" if b.uses else ""
-            lines.append(f"{mark} {b.name} ({len(b.rules)} rules{extra})"
+            lines.append(f"{mark} {b.name} ({plural(len(b.rules), 'rule')}{extra})"
                          + ("  [open]" if b.name == self.state.block else ""))
         return "\n".join(lines) + "\n(* active: `use NAME` recalls another)"
 
@@ -687,7 +689,7 @@ def _q_lines(history: list[float], n: int, result) -> str:
     if result.rounded:
         history = history[:-1]
     epochs = len(history) - 1
-    lines = [f"Q = sum (y - t)^2 over {n} example{'s' if n != 1 else ''}:"]
+    lines = [f"Q = sum (y - t)^2 over {plural(n, 'example')}:"]
     shown = list(range(len(history)))
     if len(shown) > 22:
         step = max(1, len(shown) // 20)
@@ -698,7 +700,7 @@ def _q_lines(history: list[float], n: int, result) -> str:
         lines.append(f"  rounded  : Q = {rounding:.6g}   (learned values to a readable grid)")
         history = history + [rounding]
     note = "converged" if result.converged else ("interrupted" if result.interrupted
-                                                 else f"{epochs} epochs")
+                                                 else plural(epochs, 'epoch'))
     lines.append(f"Q {history[0]:.6g} -> {history[-1]:.6g} ({note}; RMS error "
                  f"{(history[-1] / max(n, 1)) ** 0.5:.3g})")
     return "\n".join(lines)

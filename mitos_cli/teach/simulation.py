@@ -14,6 +14,7 @@ import numpy as np
 
 from ..errors import LessonError
 from ..model import RuleBase
+from ..words import plural
 
 
 def world_path(name: str, base: Path | None = None) -> Path:
@@ -53,7 +54,7 @@ class Recording:
         s = self.result.summary()
         return (f"{self.name} with behavior {self.behavior}: {s['outcome']} after "
                 f"{s['time_s']:g} s (min clearance {s['min_clearance_in']:.1f} in, "
-                f"{s['collisions']} collision{'s' if s['collisions'] != 1 else ''}); "
+                f"{plural(s['collisions'], 'collision')}); "
                 f"correct it with `at TIME OUTPUT=VALUE` (0 to {self.time(-1):g} s)")
 
     def rows(self, start: float, stop: float | None) -> np.ndarray:
