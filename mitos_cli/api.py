@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from .compile import CompiledRuleBase, compile_rulebase
-from .engine import Result, as_batch, evaluate
+from .engine import Result, as_batch, evaluate, evaluate_one
 from .model import RuleBase
 from .resources import DEFAULT_RULEBASE, packaged_path
 from .trace import Trace, trace_of
@@ -93,6 +93,14 @@ class LoadedRuleBase:
 
     def evaluate(self, **inputs) -> dict[str, float | np.ndarray]:
         """Outputs for inputs given by name (floats, or arrays evaluated as one batch)."""
+        c = self.compiled
+        if len(inputs) == len(c.inputs) and all(type(v) in (float, int) for v in inputs.values()):
+            try:                               # numbers by name: the one-sample path
+                values = [float(inputs[name]) for name in c.inputs]
+            except KeyError:
+                pass                           # a misspelt name: as_batch explains it
+            else:
+                return dict(zip(c.outputs, evaluate_one(c, values)))
         X = as_batch(self.compiled, inputs)
         result = evaluate(self.compiled, X, detail=False)
         if X.shape[0] == 1 and all(np.ndim(v) == 0 for v in inputs.values()):

@@ -134,6 +134,22 @@ class CompiledRuleBase:
         return _plan(self)
 
     @functools.cached_property
+    def scalar(self):
+        """The network as a Python function of one sample's floats (``None`` when it has no
+        exact scalar form): see :mod:`mitos_cli.scalar`. Written on first use."""
+        from .scalar import scalar_function
+
+        return scalar_function(self)
+
+    def __getstate__(self) -> dict:
+        """Pickled (for worker processes) without the derived caches: the scalar function
+        is generated code, and each process rebuilds what it uses."""
+        return {k: v for k, v in self.__dict__.items() if k not in ("scalar", "plan", "mamdani")}
+
+    def __setstate__(self, state: dict) -> None:
+        self.__dict__.update(state)
+
+    @functools.cached_property
     def mamdani(self):
         """Sampled output terms for Mamdani inference (built once per compiled rule base)."""
         from .mamdani import build_tables
@@ -155,6 +171,8 @@ class Plan:
     linear_rows: np.ndarray            # [L] terms evaluated by the linear kernel
     term_var: np.ndarray               # [L] their input column
     kernel: tuple[np.ndarray, ...]     # (b, s1, c, s2), each [L, 1], contiguous
+    plateaus: bool                     # some linear term is 1 between a rise and a fall
+    bounds: tuple[list[float], list[float]]   # lo, hi as Python floats (for one sample)
     rules: slice | np.ndarray          # where the rules' antecedents live in V
     contexts: tuple[np.ndarray, ...]   # columns multiplying each rule's DOF (use nesting)
     weight: np.ndarray | None          # [R, 1] rule weights, None when all are 1
@@ -216,6 +234,9 @@ def _plan(c: "CompiledRuleBase") -> Plan:
         hi_col=np.ascontiguousarray(c.universe[:, 1:]),
         all_linear=bool(c.linear.all()), linear_rows=rows, term_var=c.term_var[rows],
         kernel=tuple(np.ascontiguousarray(k[rows, None]) for k in c.kernel),
+        bounds=(c.universe[:, 0].tolist(), c.universe[:, 1].tolist()),
+        plateaus=bool(((c.kernel[0] < c.kernel[2]) & (c.kernel[1] > 0) & (c.kernel[3] > 0)
+                       )[rows].any()),
         rules=slice(r0, r0 + c.n_rules) if contiguous else c.rule_col,
         contexts=tuple(np.ascontiguousarray(c.context[:, j]) for j in range(c.context.shape[1])),
         weight=c.weight[:, None].copy() if c.weighted else None,

@@ -1,0 +1,213 @@
+"""One sample without NumPy: the compiled network as straight-line Python, for latency.
+
+A NumPy call costs about a microsecond however small its array, and one evaluation of the
+network is some forty of them. A robot's control loop (and the simulator, and ``teach``)
+evaluates one sample at a time, so for that case :func:`scalar_function` writes the network
+out as a Python function of floats: every neuron one line, in the order the engine computes
+them, with exactly the engine's operations in exactly its order. IEEE 754 makes ``+ - * /``,
+``sqrt``, ``min`` and ``max`` of doubles give the same bits in Python as in NumPy, so the
+function returns the same bits as the sample's row in a batch (property-tested).
+
+Operations outside that set (the non-linear membership shapes, which call ``exp`` and ``pow``,
+whose NumPy implementations may differ from the C library's in the last bit) and Mamdani
+inference have no scalar form: :func:`scalar_function` returns ``None`` and the engine keeps
+its NumPy path for them.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from typing import TYPE_CHECKING, Callable
+
+if TYPE_CHECKING:
+    from .compile import CompiledRuleBase
+
+#: Above this many neurons, writing and compiling the function costs more than it saves.
+MAX_COLUMNS = 4000
+
+ScalarFn = Callable[..., "tuple[float, ...] | None"]
+
+# Each norm as Python statements on floats ``a`` and ``b`` leaving ``r``, mirroring the NumPy
+# formulas of :mod:`mitos_cli.norms` operation by operation (see the comments there).
+_MIN = "r = a if a <= b else b"
+_MAX = "r = a if a >= b else b"
+_LO_HI = "lo = a if a <= b else b\nhi = a if a >= b else b"
+NORMS: dict[str, str] = {
+    "min": _MIN,
+    "max": _MAX,
+    "product": "r = a * b",
+    "lukasiewicz": _LO_HI + "\nr = lo - (1.0 - hi)\nr = r if r >= 0.0 else 0.0",
+    "probabilistic_sum": _LO_HI + "\nr = (1.0 - hi) * lo + hi",
+    "bounded_sum": "r = a + b\nr = r if r <= 1.0 else 1.0",
+    "drastic": _LO_HI + "\nr = lo * (1.0 if hi == 1.0 else 0.0)",
+    "drastic_sum": _LO_HI + "\nr = 1.0 if lo != 0.0 else hi",
+    "einstein": "r = (a * b) / (1.0 + (1.0 - a) * (1.0 - b))",
+    "einstein_sum": "r = (a + b) / (1.0 + a * b)",
+    "hamacher": _LO_HI + "\nden = (1.0 - hi) * lo + hi\nr = a * b\nr = r / den if den > 0.0 else r",
+    "hamacher_sum": "den = 1.0 - a * b\n"
+                    "r = (a * (1.0 - b) + b * (1.0 - a)) / den if den > 0.0 else 1.0",
+    "nilpotent_minimum": _LO_HI + "\nr = lo * (1.0 if lo > 1.0 - hi else 0.0)",
+    "nilpotent_maximum": "r = 1.0 if a + b >= 1.0 else (a if a >= b else b)",
+}
+
+# Hedges as statements on ``x`` leaving ``x`` (mitos_cli.hedges).
+HEDGES: dict[str, str] = {
+    "very": "x = x * x",
+    "extremely": "x = x * x * x",
+    "somewhat": "x = sqrt(x)",
+    "more_or_less": "x = sqrt(x)",
+    "seldom": "x = sqrt(0.5 * x) if x <= 0.5 else 1.0 - sqrt(0.5 * (1.0 - x))",
+    "intensely": "y = 1.0 - x\nx = 2.0 * x * x if x <= 0.5 else 1.0 - 2.0 * (y * y)",
+}
+
+
+class _Unsupported(Exception):
+    """The network uses an operation without an exact scalar form."""
+
+
+def scalar_function(c: CompiledRuleBase) -> ScalarFn | None:
+    """``f(x_1, ..., x_k)`` -> the outputs (NaN where no rule fired), or ``None`` for a NaN
+    input; ``None`` instead of a function when the network has no exact scalar form."""
+    try:
+        source = _source(c)
+    except _Unsupported:
+        return None
+    namespace: dict = {"sqrt": math.sqrt, "nan": math.nan, "inf": math.inf}
+    exec(compile(source, f"<mitos scalar network {c.behavior}>", "exec"), namespace)
+    fn = namespace["network"]
+    fn.source = source
+    return fn
+
+
+def _source(c: CompiledRuleBase) -> str:
+    ops = c.operators
+    if (c.shape_groups or ops.inference == "mamdani" or c.n_columns > MAX_COLUMNS
+            or ops.and_ not in NORMS or ops.or_ not in NORMS):
+        raise _Unsupported
+    plan = c.plan
+    k = len(c.inputs)
+    args = [f"x{i}" for i in range(k)]
+    lines = [f"def network({', '.join(args)}):"]
+    emit = lines.append
+    # inputs: NaN refused (the caller's NumPy path explains it), then clamped like np.maximum
+    # followed by np.minimum
+    emit(f"    if {' or '.join(f'{x} != {x}' for x in args)}:")
+    emit("        return None")
+    for i, x in enumerate(args):
+        lo, hi = float(plan.lo[i]), float(plan.hi[i])
+        emit(f"    {x} = {lo!r} if {x} < {lo!r} else {x}")
+        emit(f"    {x} = ({hi!r} if {x} > {hi!r} else {x}) + 0.0")   # -0.0 -> 0.0, as the engine
+    emit("    v0 = 0.0")
+    emit("    v1 = 1.0")
+    b, s1, cc, s2 = (col[:, 0].tolist() for col in plan.kernel)
+    for j, row in enumerate(plan.linear_rows.tolist()):
+        x = args[int(plan.term_var[j])]
+        emit(f"    r = ({x} - {b[j]!r}) * {s1[j]!r}")
+        emit(f"    f = ({cc[j]!r} - {x}) * {s2[j]!r}")
+        emit("    r = r if r <= f else f")
+        if plan.plateaus:
+            emit("    r = r if r <= 0.0 else 0.0")
+        emit("    r = r + 1.0")
+        emit(f"    v{2 + row} = r if r >= 0.0 else 0.0")
+    for i, level in enumerate(c.levels):
+        for j, group in enumerate(level):
+            grid = plan.grids.get((i, j))
+            if grid is not None:
+                _grid(grid, emit)
+            else:
+                _group(group, ops, emit)
+    _outputs(c, emit)
+    return "\n".join(lines) + "\n"
+
+
+def _statements(text: str, emit, **names: str) -> None:
+    """Emit a statement template with its operands bound: ``a``/``b``/``x`` become columns."""
+    prefix = "".join(f"{k} = {v}\n" for k, v in names.items())
+    for line in (prefix + text).splitlines():
+        emit("    " + line)
+
+
+def _grid(grid, emit) -> None:
+    """Every combination of the axes' memberships, folded with ``min`` outermost first (the
+    engine's broadcast order), in the group's mixed-radix column order."""
+    col = grid.out.start
+    for combo in itertools.product(*(a.tolist() for a in grid.axes)):
+        acc = f"v{combo[0]}"
+        for nxt in combo[1:]:
+            emit(f"    a = {acc}")
+            emit(f"    b = v{nxt}")
+            emit("    r = a if a <= b else b")
+            acc = "r"
+        emit(f"    v{col} = {acc}")
+        col += 1
+
+
+def _group(group, ops, emit) -> None:
+    op = group.op
+    children = group.children.tolist()
+    for out, ch in zip(group.out.tolist(), children):
+        if op == "not":
+            emit(f"    v{out} = 1.0 - v{ch[0]}")
+        elif op.startswith("hedge:"):
+            emit(f"    x = v{ch[0]}")
+            for name in reversed(op[6:].split()):
+                if name not in HEDGES:
+                    raise _Unsupported
+                _statements(HEDGES[name], emit)
+            emit(f"    v{out} = x")
+        else:                                   # a left fold over the padded children
+            template = NORMS[ops.and_ if op == "and" else ops.or_]
+            acc = f"v{ch[0]}"
+            for nxt in ch[1:]:
+                _statements(template, emit, a=acc, b=f"v{nxt}")
+                acc = "r"
+            emit(f"    v{out} = {acc}")
+
+
+def _outputs(c: CompiledRuleBase, emit) -> None:
+    """DOFs (contexts, then weights, as :func:`mitos_cli.engine.rule_dof`) and the weighted
+    sums by the engine's pairwise tree (:func:`mitos_cli.engine.tree_sum`)."""
+    plan = c.plan
+    R = c.n_rules
+    for r in range(R):
+        emit(f"    d{r} = v{int(c.rule_col[r])}")
+    for ctx in plan.contexts:
+        for r in range(R):
+            emit(f"    d{r} = d{r} * v{int(ctx[r])}")
+    if plan.weight is not None:
+        for r in range(R):
+            emit(f"    d{r} = d{r} * {float(plan.weight[r, 0])!r}")
+    m = len(c.outputs)
+    K = plan.sums[:, :, 0]
+    linear = c.cons_linear
+    used = [] if linear is None else [i for i in range(linear.shape[2] - 1)
+                                      if linear[:, :, i].any()]
+    sums = []
+    for row in range(K.shape[0]):
+        terms = []
+        for r in range(R):
+            if linear is not None and row < m:
+                y = f"{float(linear[r, row, -1])!r}"
+                for i in used:
+                    y = f"({y} + {float(linear[r, row, i])!r} * x{i})"
+                terms.append(f"(d{r} * {y})")
+            else:
+                terms.append(f"(d{r} * {float(K[row, r])!r})")
+        size = len(terms)
+        while size > 1:
+            half = (size + 1) // 2
+            for i in range(size - half):
+                terms[i] = f"({terms[i]} + {terms[i + half]})"
+            size = half
+        emit(f"    s{row} = {terms[0] if terms else '0.0'}")
+        sums.append(f"s{row}")
+    if c.operators.inference == "weighted_sum":
+        results = [sums[j] for j in range(m)]
+    else:
+        results = [f"({sums[j]} / {sums[int(c.den_row[j])]} if {sums[int(c.den_row[j])]} > 0.0 "
+                   f"else nan)" for j in range(m)]
+    emit(f"    return ({', '.join(results)},)")
+
+
+__all__ = ["scalar_function", "MAX_COLUMNS"]
