@@ -176,7 +176,7 @@ class Plan:
     rules: slice | np.ndarray          # where the rules' antecedents live in V
     contexts: tuple[np.ndarray, ...]   # columns multiplying each rule's DOF (use nesting)
     weight: np.ndarray | None          # [R, 1] rule weights, None when all are 1
-    sums: np.ndarray                   # [k, R, 1] output-layer weights (numerators, dens)
+    sums: np.ndarray                   # [R, k, 1] output-layer weights (numerators, dens)
     den_row: np.ndarray                # [m] row of ``sums`` with each output's denominator
     grids: dict                        # (level, group) -> Grid, for AND groups that are grids
 
@@ -240,7 +240,7 @@ def _plan(c: "CompiledRuleBase") -> Plan:
         rules=slice(r0, r0 + c.n_rules) if contiguous else c.rule_col,
         contexts=tuple(np.ascontiguousarray(c.context[:, j]) for j in range(c.context.shape[1])),
         weight=c.weight[:, None].copy() if c.weighted else None,
-        sums=np.ascontiguousarray(c.sum_weights[:, :, None]), den_row=c.den_row,
+        sums=np.ascontiguousarray(c.sum_weights.T[:, :, None]), den_row=c.den_row,
         grids={} if c.operators.and_ != "min" else {
             (i, j): grid for i, level in enumerate(c.levels) for j, group in enumerate(level)
             if (grid := _grid(group, c)) is not None})

@@ -9,8 +9,6 @@ in any batch.
 
 from __future__ import annotations
 
-import os
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
@@ -130,16 +128,6 @@ def _clamp(compiled: CompiledRuleBase, X: np.ndarray, first: int = 0,
 BLOCK = 8192
 
 
-def threads_for(n_blocks: int, threads: int | None = None) -> int:
-    """How many threads evaluate ``n_blocks`` blocks: ``threads``, else the environment's
-    ``MITOS_THREADS``, else one per CPU; never more than there are blocks. NumPy releases the
-    GIL inside its loops, and blocks are independent, so the results do not depend on it."""
-    if threads is None:
-        env = os.environ.get("MITOS_THREADS", "")
-        threads = int(env) if env.isdigit() and int(env) > 0 else (os.cpu_count() or 1)
-    return max(1, min(threads, n_blocks))
-
-
 def memberships(compiled: CompiledRuleBase, Xt: np.ndarray, out: np.ndarray) -> None:
     """Membership layer: fill rows ``2 .. 2+T`` of ``out[columns, b]`` from ``Xt[k, b]``.
 
@@ -244,17 +232,18 @@ def rule_dof(compiled: CompiledRuleBase, V: np.ndarray) -> np.ndarray:
 
 
 def tree_sum(W: np.ndarray) -> np.ndarray:
-    """Sum ``W[k, R, b]`` over rules by halving (pairwise, padded with zeros).
+    """Sum ``W[R, ...]`` over its first axis (the rules) by halving, pairwise.
 
     Only elementwise additions, in an order fixed by ``R`` alone: one sample gives the same
-    bits alone or in any batch, on any NumPy. The loop runs log2(R) times.
+    bits alone or in any batch, on any NumPy. The loop runs log2(R) times, each step adding
+    two contiguous halves.
     """
-    size = W.shape[1]
+    size = W.shape[0]
     while size > 1:
         half = (size + 1) // 2
-        np.add(W[:, :size - half], W[:, half:size], out=W[:, :size - half])
+        np.add(W[:size - half], W[half:size], out=W[:size - half])
         size = half
-    return W[:, 0]
+    return W[0]
 
 
 def linear_consequents(compiled: CompiledRuleBase, Xt: np.ndarray) -> np.ndarray:
@@ -281,10 +270,11 @@ def weighted_average(compiled: CompiledRuleBase, dof: np.ndarray,
     block's inputs ``Xt[k, b]``; ``weighted_sum`` skips the division.
     """
     plan = compiled.plan
-    W = np.multiply(dof, plan.sums)              # [k, R, b]: numerators, then denominators
+    W = np.multiply(dof[:, None], plan.sums)     # [R, k, b]: numerators, then denominators
     m = len(compiled.outputs)
     if compiled.cons_linear is not None:
-        np.multiply(dof[None], linear_consequents(compiled, Xt), out=W[:m])
+        np.multiply(dof[:, None], linear_consequents(compiled, Xt).transpose(1, 0, 2),
+                    out=W[:, :m])
     sums = tree_sum(W)
     if compiled.operators.inference == "weighted_sum":
         return sums[:m].copy()
@@ -294,15 +284,17 @@ def weighted_average(compiled: CompiledRuleBase, dof: np.ndarray,
 
 
 def evaluate(compiled: CompiledRuleBase, X, *, detail: bool = True, keep_values: bool = False,
-             strict: bool = True, threads: int | None = None) -> Result:
+             strict: bool = True) -> Result:
     """Evaluate the network on ``X[n, k]``, in cache-sized blocks of samples.
 
     ``detail`` keeps memberships and DOFs (``False`` returns only outputs, faster);
     ``keep_values`` also keeps every neuron's value (for training and the rule viewer). An
     output whose rules all have DOF 0 for some sample takes the variable's ``default``; when it
     has none, ``strict`` (the default) raises :class:`NoRuleFiredError` and ``strict=False``
-    leaves NaN there (for callers that report such samples themselves). Large batches spread
-    their blocks over ``threads`` (see :func:`threads_for`); the bits never depend on it.
+    leaves NaN there (for callers that report such samples themselves).
+
+    Blocks run one after the other: spreading them over threads was measured and gained
+    nothing on a 2-core machine (the layers stream through the shared cache, not the cores).
     """
     X = _rows(compiled, X)
     n, k = X.shape
@@ -312,7 +304,7 @@ def evaluate(compiled: CompiledRuleBase, X, *, detail: bool = True, keep_values:
             inputs, outputs = one
             return Result(compiled, np.array([inputs]), None, None, np.array([outputs]),
                           (np.array(inputs) != X[0]).astype(np.intp))
-    plan = compiled.plan                      # built once, before any thread asks for it
+    plan = compiled.plan
     T, R = plan.n_terms, plan.n_rules
     clamped_in = np.empty((k, n))
     mu = np.empty((T, n)) if detail else None
@@ -334,13 +326,7 @@ def evaluate(compiled: CompiledRuleBase, X, *, detail: bool = True, keep_values:
             values[:, block] = V
         return counts
 
-    starts = range(0, n, BLOCK)
-    workers = threads_for(len(starts), threads)
-    if workers == 1:
-        counts = [run(start) for start in starts]
-    else:
-        with ThreadPoolExecutor(workers) as pool:
-            counts = list(pool.map(run, starts))   # in order: the first NaN is reported
+    counts = [run(start) for start in range(0, n, BLOCK)]
     X = clamped_in.T
     outputs = fill_defaults(compiled, out.T, X, strict)
     return Result(compiled, X, mu.T if detail else None, dof.T if detail else None, outputs,

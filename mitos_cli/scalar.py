@@ -179,7 +179,7 @@ def _outputs(c: CompiledRuleBase, emit) -> None:
         for r in range(R):
             emit(f"    d{r} = d{r} * {float(plan.weight[r, 0])!r}")
     m = len(c.outputs)
-    K = plan.sums[:, :, 0]
+    K = plan.sums[:, :, 0].T                  # [k, R]
     linear = c.cons_linear
     used = [] if linear is None else [i for i in range(linear.shape[2] - 1)
                                       if linear[:, :, i].any()]
