@@ -6,6 +6,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from mitos_cli.resources import data_dir, packaged_names
@@ -62,3 +63,36 @@ def test_figure4_fails_at_obstacle_b_by_the_corner():
     x, y = res.pose[-1, 0, :2]
     b = next(o for o in w.obstacles if o.name == "B")
     assert abs(x - b.x) < 30 and abs(y - b.y) < 40       # at B, just around the corner
+
+
+class _Straight:
+    """Every robot drives straight ahead at one speed (a planner that never avoids)."""
+
+    name = "straight"
+
+    def __init__(self, steering: float = 90.0, speed: float = 30.0) -> None:
+        self.steering, self.speed = steering, speed
+
+    def plan(self, p):
+        n = len(p.pose)
+        return np.full(n, self.steering), np.full(n, self.speed)
+
+
+def test_contact_between_robots_reads_minus_the_penetration_depth():
+    """After a head-on contact in multirobot.yaml the clearance read 0.00 where an obstacle or
+    a wall reads minus how deep the footprint went in."""
+    from mitos_cli.sim.worldfile import parse_world
+
+    text = (Path(str(data_dir("worlds"))) / "multirobot.yaml").read_text()
+    text = text.replace("q_init: {x: 770, y: 10, heading: 180}",
+                        "q_init: {x: 400, y: -10, heading: 180}")       # the same lane
+    text = text.replace("at: [250, -20], radius: 8", "at: [700, 40], radius: 2")
+    res = simulate(parse_world(text, "headon.yaml"), _Straight())
+    assert res.robot_outcomes == ("collision", "collision")
+    gap = abs(res.pose[-1, 1, 0] - res.pose[-1, 0, 0]) - 24.0          # footprints 24 in long
+    assert gap < 0 and res.clearance[-1] == pytest.approx([gap, gap])
+    assert res.summary()["min_clearance_in"] == pytest.approx(gap)
+    # a wall: the same definition (the robot's corner through the wall)
+    res = simulate(parse_world(text, "wall.yaml"), _Straight(steering=60.0))
+    hit = res.robot_outcomes.index("collision")
+    assert res.clearance[-1, hit] < 0 and res.clearance[:-1, hit].min() > 0

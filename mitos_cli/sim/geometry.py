@@ -181,6 +181,38 @@ def box_segment_distance(hl: float, hw: float, seg: np.ndarray) -> np.ndarray:
     return out
 
 
+def box_polygon_depth(hl: float, hw: float, poly: np.ndarray) -> np.ndarray:
+    """How deep convex polygons ``[P, k, 2]`` (corners in order, in the box's frame; a segment
+    when ``k == 2``) reach into the box ``[-hl, hl] x [-hw, hw]``: the length of the shortest
+    move that separates them (separating axis theorem), 0 when they only touch or are apart.
+    A circle's depth is its radius minus the box's signed distance to its centre, the same
+    definition."""
+    if len(poly) == 0:
+        return np.zeros(0)
+    edges = np.roll(poly, -1, axis=1) - poly                            # [P, k, 2]
+    length = np.hypot(edges[..., 0], edges[..., 1])
+    normals = np.stack([-edges[..., 1], edges[..., 0]], axis=-1) \
+        / np.maximum(length, EPS)[..., None]
+    normals[length <= EPS] = (1.0, 0.0)              # a repeated corner adds no new axis
+    box_axes = np.broadcast_to(np.eye(2), (len(poly), 2, 2))
+    axes = np.concatenate([box_axes, normals], axis=1)                  # [P, A, 2]
+    proj = np.einsum("pad,pkd->pak", axes, poly)                        # [P, A, k]
+    radius = hl * np.abs(axes[..., 0]) + hw * np.abs(axes[..., 1])      # the box's, [P, A]
+    overlap = np.minimum(radius - proj.min(axis=-1), proj.max(axis=-1) + radius)
+    return np.maximum(overlap.min(axis=1), 0.0)
+
+
+def box_polygon_distance(hl: float, hw: float, poly: np.ndarray) -> np.ndarray:
+    """Signed distances ``[P]`` from the box ``[-hl, hl] x [-hw, hw]`` to convex polygons
+    ``[P, k, 2]`` in its frame: the gap when apart, minus the penetration depth
+    (:func:`box_polygon_depth`) when they overlap, also when one holds the other whole."""
+    if len(poly) == 0:
+        return np.zeros(0)
+    gap = box_segment_distance(hl, hw, polygon_segments(poly)).reshape(len(poly), -1).min(axis=1)
+    depth = box_polygon_depth(hl, hw, poly)
+    return np.where(depth > 0.0, -depth, gap)
+
+
 def _box_crossing(hl: float, hw: float, seg: np.ndarray, d: np.ndarray) -> np.ndarray:
     """``d`` with 0 where the segment crosses the box (Liang-Barsky clipping)."""
     x0, y0, x1, y1 = seg[:, 0], seg[:, 1], seg[:, 2], seg[:, 3]

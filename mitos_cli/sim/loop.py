@@ -22,7 +22,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import geometry, kinematics, obstacles as obs_mod, perception, sensors
-from .geometry import box_segment_distance, polygon_segments, rect_corners
+from .geometry import box_polygon_depth, box_polygon_distance, box_segment_distance, \
+    polygon_segments, rect_corners
 from .planner import Percepts, Planner
 from .route import Route, plan_route
 from .staticmap import StaticMap, build_static
@@ -116,20 +117,30 @@ def _footprints(pose: np.ndarray, robots) -> np.ndarray:
                         np.array([r.length for r in robots]), np.array([r.width for r in robots]))
 
 
-def _clearance(pose: np.ndarray, robot, walls: np.ndarray, sides: np.ndarray,
+def _clearance(pose: np.ndarray, robot, walls: np.ndarray, polygons: np.ndarray,
                centres: np.ndarray, radii: np.ndarray) -> float:
-    """Distance from one robot's footprint to walls, sides and circles (<= 0: touching),
-    computed in the footprint's own frame."""
+    """Signed distance from one robot's footprint to walls, rectangles and other robots
+    (``polygons [P, 4, 2]``) and circles, computed in the footprint's own frame: the gap when
+    apart, 0 touching, minus the penetration depth (the shortest move that separates them) when
+    overlapping, with one definition for every kind of thing."""
     c, s = math.cos(pose[2]), math.sin(pose[2])
     hl, hw = robot.length / 2, robot.width / 2
+
+    def local(points: np.ndarray) -> np.ndarray:        # [..., 2] world -> footprint frame
+        rel = points - pose[:2]
+        return np.stack([rel[..., 0] * c + rel[..., 1] * s,
+                         -rel[..., 0] * s + rel[..., 1] * c], axis=-1)
+
     best = math.inf
-    segs = np.concatenate([walls, sides]) if len(sides) else walls
-    if len(segs):
-        rel = segs - np.tile(pose[:2], 2)
-        local = np.empty_like(rel)
-        local[:, 0::2] = rel[:, 0::2] * c + rel[:, 1::2] * s
-        local[:, 1::2] = -rel[:, 0::2] * s + rel[:, 1::2] * c
-        best = float(box_segment_distance(hl, hw, local).min())
+    if len(walls):
+        ends = local(walls.reshape(-1, 2, 2))
+        d = box_segment_distance(hl, hw, ends.reshape(-1, 4))
+        crossing = d <= 0.0
+        if crossing.any():
+            d[crossing] = -box_polygon_depth(hl, hw, ends[crossing])
+        best = float(d.min())
+    if len(polygons):
+        best = min(best, float(box_polygon_distance(hl, hw, local(polygons)).min()))
     if len(centres):
         rel = centres - pose[:2]
         lx = np.abs(rel[:, 0] * c + rel[:, 1] * s) - hl
@@ -196,9 +207,10 @@ def simulate(world: World, planner: Planner | None = None, seed: int | None = No
     for k in range(steps):
         t = k * dt
         where = obs_mod.positions(world.obstacles, t)
-        centres, radii, _, rect_sides, _, _ = obs_mod.shapes_at(world.obstacles, where)
+        centres, radii, _, rect_sides, _, rect_box = obs_mod.shapes_at(world.obstacles, where)
         pose = np.stack([x, y, h], axis=1)
-        robot_sides = (polygon_segments(_footprints(pose, robots)).reshape(n, 4, 4) if n > 1
+        footprints = _footprints(pose, robots)
+        robot_sides = (polygon_segments(footprints).reshape(n, 4, 4) if n > 1
                        else np.zeros((1, 4, 4)))       # other robots are obstacles to each
         ranges = np.zeros((n, B))
         percepts_p = {key: np.zeros(n) for key in perception.INPUTS}
@@ -222,7 +234,8 @@ def simulate(world: World, planner: Planner | None = None, seed: int | None = No
             for key in perception.INPUTS:
                 percepts_p[key][i] = p[key]
             targets[i] = perception.target_point(routes[i], f, cfg)
-            clear[i] = _clearance(pose[i], robots[i], walls, others, centres, radii)
+            boxes = np.concatenate([rect_box, footprints[:i], footprints[i + 1:]])
+            clear[i] = _clearance(pose[i], robots[i], walls, boxes, centres, radii)
 
         hit = active & (clear <= 0.0)
         arrived = active & (np.hypot(x - goals[:, 0], y - goals[:, 1]) <= tol)
