@@ -31,7 +31,7 @@ from .terms import Term, Variable
 ZERO, ONE = 0, 1
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)   # holds arrays: identity, not ==
 class NodeGroup:
     """Neurons of one level that share an operator: ``V[:, out] = op(V[:, children])``."""
 
@@ -40,7 +40,7 @@ class NodeGroup:
     children: np.ndarray          # [m, arity] input columns, padded with the identity column
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class ShapeGroup:
     """Input terms of a non-linear shape, evaluated together."""
 
@@ -157,7 +157,7 @@ class CompiledRuleBase:
         return build_tables(self)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Plan:
     """Precomputed arrays and flags for :mod:`mitos_cli.engine` (derived, never edited)."""
 
@@ -181,7 +181,7 @@ class Plan:
     grids: dict                        # (level, group) -> Grid, for AND groups that are grids
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Grid:
     """An AND group whose neurons are every combination of some variables' terms, in
     mixed-radix order (the paper's 27 rules): computed by broadcasting ``min`` over one

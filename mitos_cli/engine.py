@@ -20,7 +20,7 @@ from .errors import InputError, NoRuleFiredError
 from .shapes import SHAPES
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)   # holds arrays: identity, not ==
 class Result:
     """What one batch evaluation computed (rows are samples)."""
 

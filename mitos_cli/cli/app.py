@@ -2,52 +2,77 @@
 
 Our own errors (:class:`MitosError`) print ``path:line:col: message`` and exit 1; usage errors
 exit 2 (Click's convention); anything else is a bug and keeps its traceback.
+
+Typer inspects the signature of every registered command (evaluating its annotations) before
+it runs any of them, and each command module imports what it needs. :func:`main` therefore
+builds the app with only the command it was asked for (about 30 ms less per ``mitos eval``);
+``mitos``, ``mitos --help`` and unknown commands get the whole app.
 """
 
 from __future__ import annotations
 
+import importlib
 import sys
 
 import typer
 
 from ..errors import MitosError
-from . import check_cmd, compare_cmd, convert_cmd, eval_cmd, export_cmd, operators_cmd, plot_cmd, teach_cmd
-from . import simulate_cmd
 
-app = typer.Typer(
-    name="mitos",
-    help="Instructible neurofuzzy motion planners: evaluate, check, simulate and teach "
-         "fuzzy rule bases.",
-    no_args_is_help=True,
-    add_completion=False,
-    pretty_exceptions_enable=False,
-    context_settings={"help_option_names": ["-h", "--help"]},
-)
+#: One line per command: its name -> (module in this package, command function or Typer app).
+COMMANDS: dict[str, tuple[str, str]] = {
+    "eval": ("eval_cmd", "eval_command"),
+    "convert": ("convert_cmd", "convert_command"),
+    "export": ("export_cmd", "export_command"),
+    "operators": ("operators_cmd", "operators_command"),
+    "check": ("check_cmd", "check_command"),
+    "teach": ("teach_cmd", "teach_command"),
+    "compare": ("compare_cmd", "compare_command"),
+    "simulate": ("simulate_cmd", "simulate_command"),
+    "plot": ("plot_cmd", "plot_app"),
+}
 
 
-
-@app.callback()
 def _root() -> None:
     """Instructible neurofuzzy motion planners: evaluate, check, simulate and teach fuzzy rule
     bases. Rule files, term sets, worlds and lessons are documented in the README."""
 
 
-# One line per command; each module holds one command function.
-app.command("eval")(eval_cmd.eval_command)
-app.command("convert")(convert_cmd.convert_command)
-app.command("export")(export_cmd.export_command)
-app.command("operators")(operators_cmd.operators_command)
-app.command("check")(check_cmd.check_command)
-app.command("teach")(teach_cmd.teach_command)
-app.command("compare")(compare_cmd.compare_command)
-app.command("simulate")(simulate_cmd.simulate_command)
-app.add_typer(plot_cmd.plot_app, name="plot")
+def build_app(only: str | None = None) -> typer.Typer:
+    """The ``mitos`` app with every command, or with just the command ``only``."""
+    app = typer.Typer(
+        name="mitos",
+        help="Instructible neurofuzzy motion planners: evaluate, check, simulate and teach "
+             "fuzzy rule bases.",
+        no_args_is_help=True,
+        add_completion=False,
+        pretty_exceptions_enable=False,
+        context_settings={"help_option_names": ["-h", "--help"]},
+    )
+    app.callback()(_root)
+    for name, (module, attr) in COMMANDS.items():
+        if only is not None and name != only:
+            continue
+        target = getattr(importlib.import_module(f".{module}", __package__), attr)
+        if isinstance(target, typer.Typer):
+            app.add_typer(target, name=name)
+        else:
+            app.command(name)(target)
+    return app
+
+
+def __getattr__(name: str):
+    if name == "app":                     # the whole app, for tests and embedding
+        return build_app()
+    raise AttributeError(name)
 
 
 def main(argv: list[str] | None = None) -> None:
     """Entry point of the console script and ``python -m mitos_cli``."""
+    args = sys.argv[1:] if argv is None else list(argv)
+    first = args[0] if args else None
+    app = build_app(first if first in COMMANDS else None)
     try:
-        app(args=argv, prog_name="mitos", standalone_mode=True)
+        app(args=args, prog_name="mitos", standalone_mode=True)
     except MitosError as exc:
         from .output import report_error
 

@@ -1,0 +1,36 @@
+"""The `mitos` app: every command is listed, and each invocation builds only its command."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+import typer.main
+
+from mitos_cli.cli.app import COMMANDS, build_app
+
+
+def run(*args: str) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "mitos_cli", *args], capture_output=True,
+                          text=True)
+
+
+def test_help_lists_every_command() -> None:
+    out = run("--help")
+    assert out.returncode == 0
+    for name in COMMANDS:
+        assert name in out.stdout
+
+
+def test_one_command_is_built_alone_and_runs() -> None:
+    group = typer.main.get_group(build_app("eval"))
+    assert sorted(group.commands) == ["eval"]
+    assert sorted(typer.main.get_group(build_app()).commands) == sorted(COMMANDS)
+    out = run("eval", "road=78", "size=45", "position=4")
+    assert out.returncode == 0 and "steering = 65.4 deg" in out.stdout
+
+
+def test_unknown_command_is_a_usage_error_with_a_suggestion() -> None:
+    out = run("evl", "road=78")
+    assert out.returncode == 2
+    assert "No such command 'evl'" in out.stderr and "Did you mean 'eval'?" in out.stderr
