@@ -143,12 +143,12 @@ def interact(session: Session, history: Path | None = None) -> None:
                 continue
             if not line.strip() or line.lstrip().startswith("#"):
                 continue
-            if readline is not None and history is not None:
-                try:
-                    readline.append_history_file(1, str(history))
-                except (OSError, AttributeError):
-                    pass
-            try:
+            try:                                 # Ctrl-C anywhere here keeps the session
+                if readline is not None and history is not None:
+                    try:
+                        readline.append_history_file(1, str(history))
+                    except (OSError, AttributeError):
+                        pass
                 if not session.run(line, PROMPT, lineno):
                     break
             except MitosError as exc:
