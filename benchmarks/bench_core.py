@@ -10,9 +10,12 @@ paper's 27 rules):
 a. batch throughput on 10^6 random inputs: ``engine.evaluate`` with ``detail=True`` (memberships
    and DOFs kept) and ``detail=False`` (outputs only), a hand-written NumPy kernel for exactly
    this rule base, and pyfuzzylite 8's vectorized ``Engine.process()`` on the same rules;
-b. single-evaluation latency: ``load_rulebase().evaluate(road=..., size=..., position=...)``,
-   pyfuzzylite (set three inputs, ``process()``, read two outputs) and simpful
-   (``set_variable`` x3, ``Sugeno_inference``);
+b. single-evaluation latency: ``load_rulebase().evaluate(road=..., size=..., position=...)``
+   (the network's scalar form, :mod:`mitos_cli.scalar`), the engine's array entry point with
+   one row (``evaluate(compiled, X[i:i+1], detail=False)``, the same scalar form plus the
+   ``Result`` arrays) and with memberships and DOFs (``detail=True``: the NumPy path, what the
+   trace of ``mitos eval`` uses); pyfuzzylite (set three inputs, ``process()``, read two
+   outputs) and simpful (``set_variable`` x3, ``Sugeno_inference``);
 c. whole-process time of ``mitos eval road=78 size=45 position=4`` against
    ``python -c "import numpy"`` (median of repeated runs).
 
@@ -291,6 +294,9 @@ def main() -> None:
     single = X[:single_n]
     lat_mitos = per_call(lambda r, s, p: rb.evaluate(road=r, size=s, position=p),
                          [tuple(map(float, x)) for x in single], repeats)
+    rows1 = [(X[i:i + 1],) for i in range(single_n)]
+    lat_row = per_call(lambda x: evaluate(c, x, detail=False), rows1, repeats)
+    lat_row_detail = per_call(lambda x: evaluate(c, x, detail=True), rows1, repeats)
     road_v, size_v, pos_v = (fl_engine.input_variable(nm) for nm in c.inputs)
     steer_v, speed_v = (fl_engine.output_variable(nm) for nm in c.outputs)
 
@@ -335,6 +341,10 @@ def main() -> None:
     print(f"| MITOS single, `load_rulebase().evaluate(...)` | {fmt_time(lat_mitos)} | "
           f"{lat_fl / lat_mitos:.0f}x faster than pyfuzzylite, "
           f"{lat_sf / lat_mitos:.0f}x faster than simpful |")
+    print(f"| MITOS single, `evaluate(compiled, X[i:i+1], detail=False)` | "
+          f"{fmt_time(lat_row)} | {lat_fl / lat_row:.0f}x faster than pyfuzzylite |")
+    print(f"| MITOS single, `evaluate(compiled, X[i:i+1], detail=True)` (NumPy path) | "
+          f"{fmt_time(lat_row_detail)} | {lat_fl / lat_row_detail:.0f}x faster than pyfuzzylite |")
     print(f"| pyfuzzylite {_version('fuzzylite')} single | {fmt_time(lat_fl)} | |")
     print(f"| simpful {_version('simpful')} single | {fmt_time(lat_sf)} | |")
     print(f"| `mitos eval road=78 size=45 position=4` (whole process) | {fmt_time(t_eval)} | "
