@@ -202,17 +202,32 @@ def box_polygon_depth(hl: float, hw: float, poly: np.ndarray) -> np.ndarray:
     return np.maximum(overlap.min(axis=1), 0.0)
 
 
-def box_polygon_distance(hl: float, hw: float, poly: np.ndarray) -> np.ndarray:
+def box_polygon_distance(hl: float, hw: float, poly: np.ndarray,
+                         side_gaps: np.ndarray | None = None) -> np.ndarray:
     """Signed distances ``[P]`` from the box ``[-hl, hl] x [-hw, hw]`` to convex polygons
     ``[P, k, 2]`` in its frame: the gap when apart, minus the penetration depth
-    (:func:`box_polygon_depth`) when they overlap, also when one holds the other whole."""
+    (:func:`box_polygon_depth`) when they overlap, also when one holds the other whole.
+
+    Two convex shapes overlap only if their sides cross (gap 0) or one holds the other: then
+    the box holds the polygon's first corner or the polygon holds the box's centre. Only those
+    polygons get the depth computed (the simulator asks this every tick). ``side_gaps``: the
+    box's distances to the polygons' sides (:func:`polygon_segments`), when already known."""
     if len(poly) == 0:
         return np.zeros(0)
-    gap = box_segment_distance(hl, hw, polygon_segments(poly)).reshape(len(poly), -1).min(axis=1)
-    depth = box_polygon_depth(hl, hw, poly)
-    return np.where(depth > 0.0, -depth, gap)
-
-
+    if side_gaps is None:
+        side_gaps = box_segment_distance(hl, hw, polygon_segments(poly))
+    gap = side_gaps.reshape(len(poly), -1).min(axis=1)
+    x, y = poly[..., 0], poly[..., 1]
+    ex, ey = np.roll(x, -1, axis=1) - x, np.roll(y, -1, axis=1) - y
+    side = x * ey - y * ex                                  # > 0: the centre left of a side
+    over = ((gap <= 0.0) | ((np.abs(x[:, 0]) <= hl) & (np.abs(y[:, 0]) <= hw))
+            | (side >= 0.0).all(axis=1) | (side <= 0.0).all(axis=1))
+    if not over.any():
+        return gap
+    out = gap.copy()
+    depth = box_polygon_depth(hl, hw, poly[over])
+    out[over] = np.where(depth > 0.0, -depth, gap[over])
+    return out
 def _box_crossing(hl: float, hw: float, seg: np.ndarray, d: np.ndarray) -> np.ndarray:
     """``d`` with 0 where the segment crosses the box (Liang-Barsky clipping)."""
     x0, y0, x1, y1 = seg[:, 0], seg[:, 1], seg[:, 2], seg[:, 3]

@@ -132,15 +132,19 @@ def _clearance(pose: np.ndarray, robot, walls: np.ndarray, polygons: np.ndarray,
                          -rel[..., 0] * s + rel[..., 1] * c], axis=-1)
 
     best = math.inf
-    if len(walls):
-        ends = local(walls.reshape(-1, 2, 2))
-        d = box_segment_distance(hl, hw, ends.reshape(-1, 4))
-        crossing = d <= 0.0
+    ends = local(walls.reshape(-1, 2, 2))
+    boxes = local(polygons)
+    d = box_segment_distance(hl, hw, np.concatenate([ends.reshape(-1, 4),
+                                                     polygon_segments(boxes)]))
+    if len(walls):                                      # one call for walls and box sides
+        w = d[:len(ends)]
+        crossing = w <= 0.0
         if crossing.any():
-            d[crossing] = -box_polygon_depth(hl, hw, ends[crossing])
-        best = float(d.min())
+            w[crossing] = -box_polygon_depth(hl, hw, ends[crossing])
+        best = float(w.min())
     if len(polygons):
-        best = min(best, float(box_polygon_distance(hl, hw, local(polygons)).min()))
+        sides = d[len(ends):]
+        best = min(best, float(box_polygon_distance(hl, hw, boxes, sides).min()))
     if len(centres):
         rel = centres - pose[:2]
         lx = np.abs(rel[:, 0] * c + rel[:, 1] * s) - hl
