@@ -15,7 +15,7 @@ import numpy as np
 
 from . import hedges as hedge_mod
 from . import norms
-from .compile import ONE, ZERO, CompiledRuleBase
+from .compile import CompiledRuleBase
 from .errors import InputError, NoRuleFiredError
 from .shapes import SHAPES
 

@@ -18,8 +18,9 @@ from mitos_cli.compile import compile_rulebase
 from mitos_cli.engine import evaluate
 from mitos_cli.interop import write_foreign
 from mitos_cli.interop.rules_writer import write_rules
-from mitos_cli.model import And, Behavior, Consequent, Not, Or, Prop, Rule, RuleBase, Setting
+from mitos_cli.model import Behavior, Consequent, Not, Prop, Rule, RuleBase, Setting
 from mitos_cli.terms import Term, TermSet, Variable
+from strategies import expressions
 
 SHAPES = {   # shape -> params on the universe [0, 10] drawn from sorted uniforms
     "triangle": 3, "trapezoid": 4, "gaussian": 2, "bell": 3, "sigmoid": 2, "s_shape": 2,
@@ -51,19 +52,6 @@ def terms(draw, prefix: str):
 
 
 @st.composite
-def expressions(draw, inputs, depth: int = 2):
-    if depth == 0 or draw(st.booleans()):
-        v = draw(st.sampled_from(inputs))
-        hedges = tuple(draw(st.lists(st.sampled_from(HEDGES), max_size=1)))
-        return Prop(v.name, draw(st.sampled_from(v.term_names)), hedges, draw(st.booleans()))
-    kind = draw(st.sampled_from(["and", "or", "not"]))
-    if kind == "not":
-        return Not(draw(expressions(inputs, depth - 1)))
-    items = tuple(draw(st.lists(expressions(inputs, depth - 1), min_size=2, max_size=3)))
-    return And(items) if kind == "and" else Or(items)
-
-
-@st.composite
 def rulebases(draw):
     a = Variable("a", "input", (0.0, 10.0), draw(terms("A")))
     b = Variable("b", "input", (0.0, 10.0), draw(terms("B")))
@@ -79,7 +67,7 @@ def rulebases(draw):
     rules = []
     for i in range(draw(st.integers(1, 6))):
         weight = draw(st.sampled_from([1.0, 0.5, 0.25]))
-        rules.append(Rule(f"r{i + 1}", draw(expressions((a, b))),
+        rules.append(Rule(f"r{i + 1}", draw(expressions((a, b), HEDGES)),
                           (Consequent("y", draw(st.sampled_from(y.term_names))),), weight))
     tnorm = draw(st.sampled_from(TNORMS))
     ops = [Setting("and", tnorm), Setting("or", DUAL[tnorm])]

@@ -13,11 +13,13 @@ from mitos_cli import load_rulebase
 from mitos_cli.compile import compile_rulebase
 from mitos_cli.engine import evaluate, evaluate_one
 from mitos_cli.errors import InputError, NoRuleFiredError
-from mitos_cli.model import And, Behavior, Consequent, Not, Or, Prop, Rule, RuleBase, Setting, Use
+from mitos_cli.model import Behavior, Consequent, Prop, Rule, RuleBase, Setting, Use
 from mitos_cli.norms import SNORMS, TNORMS
 from mitos_cli.scalar import HEDGES, NORMS
 from mitos_cli.terms import Term, TermSet, Variable
+from strategies import expressions
 
+HEDGE_NAMES = tuple(sorted(HEDGES))
 LINEAR_SHAPES = {"triangle": 3, "trapezoid": 4, "left_shoulder": 2, "right_shoulder": 2,
                  "triangle_pw": 2, "triangle_plr": 3}
 
@@ -38,19 +40,6 @@ def terms(draw, prefix: str) -> tuple[Term, ...]:
                   }.get(shape, tuple(xs[:LINEAR_SHAPES[shape]]))
         out.append(Term(f"{prefix}{i}", shape, tuple(float(p) for p in params)))
     return tuple(out)
-
-
-@st.composite
-def expressions(draw, inputs, depth: int = 2):
-    if depth == 0 or draw(st.booleans()):
-        v = draw(st.sampled_from(inputs))
-        hedges = tuple(draw(st.lists(st.sampled_from(sorted(HEDGES)), max_size=2)))
-        return Prop(v.name, draw(st.sampled_from(v.term_names)), hedges, draw(st.booleans()))
-    kind = draw(st.sampled_from(["and", "or", "not"]))
-    if kind == "not":
-        return Not(draw(expressions(inputs, depth - 1)))
-    items = tuple(draw(st.lists(expressions(inputs, depth - 1), min_size=2, max_size=3)))
-    return And(items) if kind == "and" else Or(items)
 
 
 @st.composite
@@ -78,14 +67,16 @@ def rulebases(draw) -> RuleBase:
             cons = [Consequent("y", draw(st.sampled_from(y.term_names)))]
             if draw(st.booleans()):
                 cons.append(Consequent("z", draw(st.sampled_from(z.term_names))))
-            rules.append(Rule(f"{prefix}{i}", draw(expressions((a, b))), tuple(cons),
+            antecedent = draw(expressions((a, b), HEDGE_NAMES, 2))
+            rules.append(Rule(f"{prefix}{i}", antecedent, tuple(cons),
                               draw(st.sampled_from([1.0, 0.5, 0.3]))))
         return tuple(rules)
 
     inner = Behavior("inner", rule_list("i"))
     uses = ()
     if draw(st.booleans()):                     # a `use ... when ... with ...` context
-        uses = (Use("inner", draw(expressions((a, b), 1)), draw(st.sampled_from([1.0, 0.7]))),)
+        condition = draw(expressions((a, b), HEDGE_NAMES, 2, 1))
+        uses = (Use("inner", condition, draw(st.sampled_from([1.0, 0.7]))),)
     main = Behavior("main", rule_list("r"), uses=uses)
     ops = (Setting("and", draw(st.sampled_from(sorted(TNORMS)))),
            Setting("or", draw(st.sampled_from(sorted(SNORMS)))),
