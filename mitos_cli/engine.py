@@ -215,7 +215,8 @@ def _apply_grid(grid, V: np.ndarray) -> None:
 
 
 _CONSTANTS = np.array([[0.0], [1.0]])   # columns ZERO and ONE
-_ZEROS = np.zeros((1, BLOCK))
+_ZEROS = np.zeros((1, BLOCK))           # the clip at 0 of the membership kernel
+_ZEROS.flags.writeable = False
 
 
 def rule_dof(compiled: CompiledRuleBase, V: np.ndarray) -> np.ndarray:
@@ -294,7 +295,7 @@ def evaluate(compiled: CompiledRuleBase, X, *, detail: bool = True, keep_values:
     leaves NaN there (for callers that report such samples themselves).
 
     Blocks run one after the other: spreading them over threads was measured and gained
-    nothing on a 2-core machine (the layers stream through the shared cache, not the cores).
+    nothing on a 2-core machine (each layer streams its rows through the shared cache).
     """
     X = _rows(compiled, X)
     n, k = X.shape
@@ -312,9 +313,11 @@ def evaluate(compiled: CompiledRuleBase, X, *, detail: bool = True, keep_values:
     values = np.empty((compiled.n_columns, n)) if keep_values else None
     out = np.empty((len(compiled.outputs), n))
 
-    def run(start: int) -> np.ndarray:        # one block: a vectorized pass over its samples
+    counts = np.zeros(k, dtype=np.intp)
+    for start in range(0, n, BLOCK):          # blocks of samples, each one vectorized pass
         block = slice(start, min(start + BLOCK, n))
-        Xt, counts = _clamp(compiled, X[block], start, n)
+        Xt, clamped = _clamp(compiled, X[block], start, n)
+        counts += clamped
         V = network_values(compiled, Xt)
         d = rule_dof(compiled, V)
         out[:, block] = infer(compiled, d, Xt)
@@ -324,14 +327,10 @@ def evaluate(compiled: CompiledRuleBase, X, *, detail: bool = True, keep_values:
             dof[:, block] = d
         if keep_values:
             values[:, block] = V
-        return counts
-
-    counts = [run(start) for start in range(0, n, BLOCK)]
     X = clamped_in.T
     outputs = fill_defaults(compiled, out.T, X, strict)
     return Result(compiled, X, mu.T if detail else None, dof.T if detail else None, outputs,
-                  np.sum(counts, axis=0) if counts else np.zeros(k, dtype=np.intp),
-                  values.T if keep_values else None)
+                  counts, values.T if keep_values else None)
 
 
 def evaluate_one(compiled: CompiledRuleBase, values: list[float],
