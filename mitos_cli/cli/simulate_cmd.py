@@ -16,44 +16,68 @@ REQUIRE = ("success",)
 
 def _verdict(res) -> str:
     m = res.metrics
-    robot = res.world.robot
-    near = (f"; closer than the safety margin ({robot.safety_margin:g} in)"
-            if m["min_clearance_in"] < robot.safety_margin and res.outcome != "collision" else "")
-    others = ("" if len(res.robot_outcomes) == 1 else " (" + ", ".join(
-        f"{a.name} {o}" for a, o in zip(res.world.agents, res.robot_outcomes)) + ")")
+    agents = res.world.agents
+    close = [a for a, r in zip(agents, res.robot_metrics)
+             if r["min_clearance_in"] < a.robot.safety_margin]
+    near = ""
+    if close and res.outcome != "collision":
+        who = f" ({close[0].name})" if len(agents) > 1 else ""
+        near = (f"; closer than the safety margin{who} "
+                f"({close[0].robot.safety_margin:g} in)")
+    others = ("" if len(agents) == 1 else " (" + ", ".join(
+        f"{a.name} {o}" for a, o in zip(agents, res.robot_outcomes)) + ")")
     return (f"{res.world.name}: {res.outcome.upper()}{others} after {m['time_s']:.2f} s "
             f"(seed {res.seed}, {res.planner}); min clearance {m['min_clearance_in']:.1f} in"
             f"{near}")
 
 
-def _table(rows: list[tuple[str, str]]) -> str:
-    width = max(len(k) for k, _ in rows)
-    return "\n".join(f"  {k.ljust(width)}  {v}" for k, v in rows)
+def _table(rows: list[tuple[str, ...]]) -> str:
+    widths = [max(len(r[i]) for r in rows) for i in range(len(rows[0]))]
+    return "\n".join(("  " + "  ".join(c.ljust(w) for c, w in zip(r, widths))).rstrip()
+                     for r in rows)
+
+
+_ROWS = (   # label, key, format (the overall figures, then each robot's)
+    ("outcome", "outcome", str), ("reached goal", "reached_goal", lambda v: "yes" if v else "no"),
+    ("collisions", "collisions", str), ("time", "time_s", lambda v: f"{v:.2f} s"),
+    ("ticks", "ticks", str), ("path length", "path_length_in", lambda v: f"{v:.1f} in"),
+    ("mean speed", "mean_speed_in_s", lambda v: f"{v:.1f} in/s"),
+    ("min clearance", "min_clearance_in", lambda v: f"{v:.1f} in"),
+    ("steering total variation", "steering_total_variation_deg", lambda v: f"{v:.0f} deg"))
 
 
 def _summary(res) -> str:
-    m = res.metrics
-    return _table([
-        ("outcome", res.outcome), ("reached goal", "yes" if res.robot_outcomes[0] == "success"
-                                   else "no"),
-        ("collisions", str(m["collisions"])), ("time", f"{m['time_s']:.2f} s"),
-        ("ticks", str(m["ticks"])), ("path length", f"{m['path_length_in']:.1f} in"),
-        ("mean speed", f"{m['mean_speed_in_s']:.1f} in/s"),
-        ("min clearance", f"{m['min_clearance_in']:.1f} in"),
-        ("steering total variation", f"{m['steering_total_variation_deg']:.0f} deg")])
+    """The figures over all robots; with several, a column per robot beside them (path and
+    steering variation are sums over the robots, the clearance the smallest)."""
+    overall = res.summary()
+    each = res.robot_metrics if len(res.robot_metrics) > 1 else ()
+    rows = [("", "all robots", *(r["name"] for r in each))] if each else []
+    for label, key, fmt in _ROWS:
+        cells = [fmt(overall[key])]
+        for r in each:
+            if key == "collisions":
+                cells.append(str(int(r["outcome"] == "collision")))
+            else:
+                cells.append(fmt(r[key]) if key in r else "")
+        rows.append((label, *cells))
+    return _table(rows)
 
 
 def _runs_table(runs) -> str:
+    """One row per world; under a world of several robots, one row per robot (its outcome
+    rates and figures: the world's row counts a run a success only if every robot's was)."""
     head = ["world", "runs", "success", "collision", "timeout", "stuck", "time s",
             "path in", "min clear in", "speed in/s"]
     rows = [head]
     for w in runs.worlds:
-        row = [w.world, str(len(w.summaries))]
-        row += [f"{100 * w.rate(o):.0f}%" for o in ("success", "collision", "timeout", "stuck")]
-        for key in ("time_s", "path_length_in", "min_clearance_in", "mean_speed_in_s"):
-            mean, std = w.stat(key)
-            row.append(f"{mean:.1f} ± {std:.1f}")
-        rows.append(row)
+        for label, r in [(w.world, w)] + [(f"  {x.world}", x) for x in w.robots]:
+            row = [label, str(len(r.summaries))]
+            row += [f"{100 * r.rate(o):.0f}%" for o in ("success", "collision", "timeout",
+                                                        "stuck")]
+            for key in ("time_s", "path_length_in", "min_clearance_in", "mean_speed_in_s"):
+                mean, std = r.stat(key)
+                row.append(f"{mean:.1f} ± {std:.1f}")
+            rows.append(row)
     widths = [max(len(r[i]) for r in rows) for i in range(len(head))]
     return "\n".join("  ".join(c.ljust(wd) if i == 0 else c.rjust(wd)
                                for i, (c, wd) in enumerate(zip(r, widths))) for r in rows)

@@ -78,7 +78,8 @@ class SimResult:
     static: StaticMap | None = None
     active: np.ndarray | None = None   # [T, n] robot still driving at that tick
     progress: np.ndarray | None = None  # [T, n] arc length along each robot's route (in)
-    metrics: dict = field(default_factory=dict)
+    metrics: dict = field(default_factory=dict)    # the run's figures over all robots
+    robot_metrics: tuple[dict, ...] = ()           # each robot's figures (name, outcome, ...)
     _true: dict | None = field(default=None, repr=False)
 
     @property
@@ -94,21 +95,55 @@ class SimResult:
         return len(self.t)
 
     def summary(self) -> dict:
-        """The ``--json`` contract."""
-        return {"world": self.world.name, "seed": self.seed, "outcome": self.outcome,
-                "reached_goal": self.robot_outcomes[0] == "success", **self.metrics}
+        """The ``--json`` contract: the run's figures over all robots and, when there are
+        several, each robot's under ``robots``."""
+        out = {"world": self.world.name, "seed": self.seed, "outcome": self.outcome,
+               "reached_goal": all(o == "success" for o in self.robot_outcomes),
+               **self.metrics}
+        if len(self.robot_metrics) > 1:
+            out["robots"] = [dict(m) for m in self.robot_metrics]
+        return out
+
+
+def _stop_ticks(res: SimResult) -> np.ndarray:
+    """``[n]`` ticks each robot drove: to the tick it stopped at its goal, else the whole run."""
+    stopped = ~res.active.reshape(res.ticks, len(res.robot_outcomes))
+    return np.where(stopped.any(axis=0), stopped.argmax(axis=0) + 1, res.ticks)
+
+
+def _robot_metrics(res: SimResult, dt: float) -> tuple[dict, ...]:
+    """Each robot's figures up to the tick it stopped (at its goal) or the run ended: its time,
+    path, mean speed over that time and steering variation; its clearance over the whole run
+    (a robot at its goal is still something the others can hit)."""
+    out = []
+    for i, (agent, outcome, ticks) in enumerate(zip(res.world.agents, res.robot_outcomes,
+                                                   _stop_ticks(res).tolist())):
+        xy = res.pose[:ticks, i, :2]
+        path = float(np.hypot(*np.diff(xy, axis=0).T).sum()) if len(xy) > 1 else 0.0
+        time_s = float(ticks * dt)
+        out.append({
+            "name": agent.name, "outcome": outcome, "reached_goal": outcome == "success",
+            "time_s": round(time_s, 6), "path_length_in": path,
+            "min_clearance_in": float(res.clearance[:, i].min()) if res.ticks else 0.0,
+            "mean_speed_in_s": path / time_s if time_s > 0 else 0.0,
+            "steering_total_variation_deg":
+                float(np.abs(np.diff(res.steering[:ticks, i])).sum())})
+    return tuple(out)
 
 
 def _metrics(res: SimResult, dt: float) -> dict:
-    xy = res.pose[:, 0, :2]
-    path = float(np.hypot(*np.diff(xy, axis=0).T).sum()) if len(xy) > 1 else 0.0
-    time_s = float(res.ticks * dt)
-    steer = res.steering[:, 0]
-    return {"collisions": int(res.collisions), "time_s": round(time_s, 6),
-            "path_length_in": path,
-            "min_clearance_in": float(res.clearance[:, 0].min()) if res.ticks else 0.0,
-            "mean_speed_in_s": path / time_s if time_s > 0 else 0.0,
-            "steering_total_variation_deg": float(np.abs(np.diff(steer)).sum()),
+    """The run's figures over all robots (one robot: its own): the time until the last robot
+    stopped, the path and the steering variation summed over the robots, the mean speed of
+    all the driving (total path over total driving time), the smallest clearance of any."""
+    each = res.robot_metrics
+    path = sum(m["path_length_in"] for m in each)
+    driving = float(_stop_ticks(res).sum() * dt)
+    return {"collisions": sum(m["outcome"] == "collision" for m in each),
+            "time_s": round(float(res.ticks * dt), 6), "path_length_in": path,
+            "min_clearance_in": min(m["min_clearance_in"] for m in each),
+            "mean_speed_in_s": path / driving if driving > 0 else 0.0,
+            "steering_total_variation_deg": sum(m["steering_total_variation_deg"]
+                                                for m in each),
             "ticks": int(res.ticks)}
 
 
@@ -305,6 +340,7 @@ def simulate(world: World, planner: Planner | None = None, seed: int | None = No
         perceived={key: np.array(val) for key, val in rec_p.items()},
         clearance=np.array(rec_clear), obstacles=np.array(rec_obs).reshape(len(rec_pose), -1, 2),
         routes=routes, static=static, active=np.array(rec_act), progress=np.array(rec_s))
+    res.robot_metrics = _robot_metrics(res, dt)
     res.metrics = _metrics(res, dt)
     return res
 

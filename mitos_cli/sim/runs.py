@@ -30,6 +30,8 @@ def _chunk(task: tuple[World, object, tuple[int, ...], bool]) -> list[dict]:
 
 @dataclass(frozen=True)
 class WorldRuns:
+    """One world's runs (or, from :attr:`robots`, one robot's: ``world`` is then its name)."""
+
     world: str
     summaries: tuple[dict, ...]
 
@@ -40,6 +42,24 @@ class WorldRuns:
         x = np.array([s[key] for s in self.summaries], dtype=float)
         return float(x.mean()), float(x.std(ddof=1)) if len(x) > 1 else 0.0
 
+    @property
+    def robots(self) -> tuple["WorldRuns", ...]:
+        """Each robot's runs (its outcome and figures per run) in a world of several robots;
+        ``()`` for one robot, whose runs are the world's."""
+        if not self.summaries or "robots" not in self.summaries[0]:
+            return ()
+        names = [r["name"] for r in self.summaries[0]["robots"]]
+        return tuple(WorldRuns(name, tuple(s["robots"][i] for s in self.summaries))
+                     for i, name in enumerate(names))
+
+    def figures(self) -> dict:
+        """Each outcome's rate and each metric's mean and std over the runs."""
+        row = {f"{o}_rate": self.rate(o) for o in OUTCOMES}
+        for key in METRICS:
+            mean, std = self.stat(key)
+            row[key] = {"mean": mean, "std": std}
+        return row
+
 
 @dataclass(frozen=True)
 class Runs:
@@ -48,11 +68,9 @@ class Runs:
     def to_json(self) -> list[dict]:
         out = []
         for w in self.worlds:
-            row = {"world": w.world, "runs": len(w.summaries)}
-            row.update({f"{o}_rate": w.rate(o) for o in OUTCOMES})
-            for key in METRICS:
-                mean, std = w.stat(key)
-                row[key] = {"mean": mean, "std": std}
+            row = {"world": w.world, "runs": len(w.summaries), **w.figures()}
+            if w.robots:
+                row["robots"] = [{"name": r.world, **r.figures()} for r in w.robots]
             row["runs_detail"] = list(w.summaries)
             out.append(row)
         return out
