@@ -1,0 +1,130 @@
+"""A world of several robots: the run's outcome and figures cover every robot, and each robot's
+own figures are reported beside them (``--json`` ``robots``, a table column, ``--runs`` rows)."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+from typer.testing import CliRunner
+
+from mitos_cli.cli.app import app
+from mitos_cli.sim.loop import simulate
+from mitos_cli.sim.worldfile import load_world, parse_world
+
+RUNNER = CliRunner()
+ROOT = Path(__file__).resolve().parents[1]
+ROBOT_KEYS = ["name", "outcome", "reached_goal", "time_s", "path_length_in", "min_clearance_in",
+              "mean_speed_in_s", "steering_total_variation_deg"]
+# Two robots in two separate corridors: `robot` starts 30 in from its goal and reaches it;
+# `second` is rammed from behind by a cart at 120 in/s it cannot outrun.
+REAR_END = """\
+name: rearend
+seed: 1
+dt: 0.05
+time_limit: 5
+robot:
+  model: tricycle
+  wheelbase: 16
+  footprint: {length: 24, width: 18}
+q_init: {x: 530, y: -15, heading: 0}
+q_goal: {x: 560, y: -15}
+robots:
+  - name: second
+    q_init: {x: 60, y: 185, heading: 0}
+    q_goal: {x: 560, y: 185}
+map:
+  corridors:
+    - points: [[0, 0], [600, 0]]
+      width: 70
+    - points: [[0, 200], [600, 200]]
+      width: 70
+obstacles:
+  - {name: ram, shape: rectangle, at: [-150, 185], length: 20, width: 20, velocity: [120, 0]}
+"""
+
+
+@pytest.fixture()
+def rear_end(tmp_path: Path) -> Path:
+    p = tmp_path / "rearend.yaml"
+    p.write_text(REAR_END, encoding="utf-8")
+    return p
+
+
+def run(*args):
+    res = RUNNER.invoke(app, ["simulate", *map(str, args)])
+    assert res.exit_code == 0, res.output
+    return res.stdout
+
+
+def test_the_second_robots_collision_is_the_runs(rear_end):
+    data = json.loads(run(rear_end, "--json"))
+    first, second = data["robots"]
+    assert [list(r) for r in data["robots"]] == [ROBOT_KEYS, ROBOT_KEYS]
+    assert (first["name"], first["outcome"], first["reached_goal"]) == ("robot", "success", True)
+    assert (second["name"], second["outcome"], second["reached_goal"]) == \
+        ("second", "collision", False)
+    assert data["outcome"] == "collision" and data["reached_goal"] is False
+    assert data["collisions"] == 1
+    # the run's clearance is the second robot's penetration, not the first robot's gap
+    assert first["min_clearance_in"] > 2.0
+    assert second["min_clearance_in"] < 0.0
+    assert data["min_clearance_in"] == second["min_clearance_in"]
+    res = simulate(load_world(rear_end))
+    assert res.summary() == data
+    assert second["min_clearance_in"] == res.clearance[-1, 1] == res.clearance.min()
+    # each robot's time is until it stopped at its goal or the run ended
+    assert first["time_s"] < data["time_s"] == second["time_s"] == res.ticks * 0.05
+    assert data["path_length_in"] == pytest.approx(first["path_length_in"]
+                                                   + second["path_length_in"])
+    driving = first["time_s"] + second["time_s"]
+    assert data["mean_speed_in_s"] == pytest.approx(data["path_length_in"] / driving)
+    assert data["steering_total_variation_deg"] == pytest.approx(
+        first["steering_total_variation_deg"] + second["steering_total_variation_deg"])
+
+
+def test_the_table_has_a_column_per_robot(rear_end):
+    lines = run(rear_end).splitlines()
+    assert lines[0].startswith("rearend: COLLISION (robot success, second collision) after ")
+    assert lines[1].split() == ["all", "robots", "robot", "second"]
+    rows = {line[:28].strip(): line[28:].split() for line in lines[2:]}
+    assert rows["outcome"] == ["collision", "success", "collision"]
+    assert rows["reached goal"] == ["no", "yes", "no"]
+    assert rows["collisions"] == ["1", "0", "1"]
+    clear = [float(v) for v in rows["min clearance"][::2]]
+    assert clear[0] == clear[2] < 0 < clear[1]
+
+
+def test_one_robot_timing_out_times_the_run_out(rear_end):
+    text = rear_end.read_text().replace("time_limit: 5", "time_limit: 2") \
+        .replace("velocity: [120, 0]", "velocity: [0, 0]")
+    data = simulate(parse_world(text, "slow.yaml")).summary()
+    assert [r["outcome"] for r in data["robots"]] == ["success", "timeout"]
+    assert data["outcome"] == "timeout" and data["reached_goal"] is False
+    assert data["collisions"] == 0 and data["min_clearance_in"] > 0
+
+
+def test_runs_count_a_run_a_success_only_if_every_robot_succeeded(rear_end):
+    rows = json.loads(run(rear_end, "--runs", 2, "--workers", 1, "--json"))
+    (row,) = rows
+    assert row["collision_rate"] == 1.0 and row["success_rate"] == 0.0
+    assert [(r["name"], r["success_rate"], r["collision_rate"]) for r in row["robots"]] == \
+        [("robot", 1.0, 0.0), ("second", 0.0, 1.0)]
+    detail = row["runs_detail"]
+    assert row["min_clearance_in"]["mean"] == pytest.approx(
+        sum(d["robots"][1]["min_clearance_in"] for d in detail) / 2)
+    table = run(rear_end, "--runs", 2, "--workers", 1).splitlines()
+    assert [line.split()[0] for line in table] == ["world", "rearend", "robot", "second"]
+    assert table[1].split()[2:4] == ["0%", "100%"] and table[2].split()[2] == "100%"
+
+
+def test_one_robot_json_has_no_robots_list_and_is_as_before():
+    """Single-robot output did not change with the multi-robot figures (byte for byte: the
+    golden case was recorded before them)."""
+    golden = ROOT / "tests" / "golden" / "simulate_corridor_json"
+    assert (golden / "cmd").read_text().split()[1:] == ["simulate", "worlds/corridor.yaml",
+                                                        "--json"]
+    data = simulate(load_world(ROOT / "worlds" / "corridor.yaml")).summary()
+    assert "robots" not in data
+    assert json.dumps(data, indent=2) + "\n" == (golden / "stdout").read_text()
