@@ -128,3 +128,16 @@ def test_one_robot_json_has_no_robots_list_and_is_as_before():
     data = simulate(load_world(ROOT / "worlds" / "corridor.yaml")).summary()
     assert "robots" not in data
     assert json.dumps(data, indent=2) + "\n" == (golden / "stdout").read_text()
+
+
+def test_two_robots_of_one_name_are_refused(tmp_path, capsys):
+    from mitos_cli.cli.app import main
+
+    p = tmp_path / "twins.yaml"
+    p.write_text(REAR_END.replace("name: second", "name: robot"), encoding="utf-8")
+    with pytest.raises(SystemExit) as info:
+        main(["simulate", str(p)])
+    err = capsys.readouterr().err
+    assert info.value.code == 1
+    assert f"{p}:12:11:" in err and "two robots are named `robot`" in err
+    assert "- name: robot" in err and "Traceback" not in err

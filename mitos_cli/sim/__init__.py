@@ -10,13 +10,15 @@ API (everything in inches, seconds, degrees)::
     result.outcome          # "success" | "collision" | "timeout" | "stuck"
     result.summary()        # the --json dict: world, seed, outcome, reached_goal, collisions,
                             # time_s, path_length_in, min_clearance_in, mean_speed_in_s,
-                            # steering_total_variation_deg, ticks
+                            # steering_total_variation_deg, ticks (over all robots), and with
+                            # several robots `robots`: each one's (result.robot_metrics)
     result.t, result.pose[T, n, 3], result.speed[T, n], result.steering[T, n],
     result.command[T, n, 2], result.ranges[T, n, B], result.clearance[T, n],
     result.perceived["road"][T, n], result.true["road"][T, n], result.obstacles[T, O, 2]
 
     runs = run_many([world], runs=20, seed=1, planner=None, workers=2)   # randomised runs
-    runs.table()            # per world: success / collision / timeout rates, mean +- std
+    runs.to_json()          # per world: outcome rates, each metric's mean and std
+    runs.worlds[0].rate("success"), runs.worlds[0].robots   # (several robots: each one's)
 
 Modules: ``world`` (model), ``worldfile`` (YAML loader), ``pgm`` + ``gridmap`` (ROS map_server
 maps), ``staticmap`` (walls from corridors or grids), ``geometry``, ``kinematics`` (tricycle),

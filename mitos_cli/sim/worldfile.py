@@ -241,6 +241,10 @@ def parse_world(text: str, path: str) -> World:
         span = top["robots"].item_span(i)
         a = r.mapping(item, span, f"robot {i + 2}", AGENT_KEYS)
         aname = str(a.get("name", f"robot{i + 2}"))
+        if any(b.name == aname for b in agents):
+            raise WorldError(f"two robots are named `{aname}` (the first robot is `robot`): "
+                             "give each a name of its own",
+                             span=a.value_span("name") if "name" in a else span)
         arobot = (read_robot(r, a["robot"], a.value_span("robot"), robot) if "robot" in a
                   else robot)
         agents.append(Agent(aname, arobot,
