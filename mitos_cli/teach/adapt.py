@@ -43,8 +43,9 @@ import numpy as np
 
 from .. import hedges as hedge_mod
 from ..compile import CompiledRuleBase
-from ..engine import evaluate
+from ..engine import evaluate, fill_defaults, infer
 from ..errors import LessonError
+from ..mamdani import OutputTable, spike
 from ..model import Rule, RuleBase
 from ..shapes import kernel_params
 
@@ -54,6 +55,9 @@ STEP = 0.05
 MIN_GAP = 0.005
 #: Step halvings tried per epoch before adaptation counts as converged.
 HALVINGS = 30
+#: Derived parameters (a width = right - peak) are rounded to this many decimals more than
+#: their knots' grid: the learned knots are on the grid already, this drops float noise.
+NOISE = 6
 #: Knots closer than this fraction of the universe are one (shared) break point.
 TIE = 1e-9
 
@@ -96,10 +100,23 @@ class Parameters:
     dependents: tuple[tuple[int, np.ndarray, np.ndarray], ...]   # see _round
     frozen_reasons: tuple[str, ...] = ()
     constraints: np.ndarray | None = None    # [c, P] rows that must stay 0 (ties, frozen)
+    #: (output, term) -> its knots: a singleton's value ``[i, -1, -1, -1]``, or (Mamdani) the
+    #: corners ``(a, b, c, d)`` of a piecewise-linear output set
+    out_terms: dict = dataclasses.field(default_factory=dict)
+    sets: tuple["SetSpec", ...] | None = None   # Mamdani: how to rebuild the output tables
 
     @property
     def n_free(self) -> int:
         return int(round(np.trace(self.projector)))
+
+
+@dataclass(frozen=True, eq=False)
+class SetSpec:
+    """One output's Mamdani table and, per row, what it samples: ``(term, hedges)``, or
+    ``(None, knot)`` for a crisp consequent."""
+
+    table: OutputTable
+    rows: tuple[tuple, ...]
 
 
 # ---- building the parameterisation ------------------------------------------------------------
@@ -125,18 +142,13 @@ def _decimals(width: float) -> int:
 def parameterise(compiled: CompiledRuleBase) -> Parameters:
     """The learnable numbers of ``compiled`` (its input terms and output values)."""
     rb = compiled.rulebase
-    if compiled.operators.inference not in ("weighted_average", "weighted_sum"):
-        raise LessonError(
-            f"adaptation needs `inference = weighted_average` (or weighted_sum); behavior "
-            f"`{compiled.behavior}` uses {compiled.operators.inference}",
-            hint="adapt a weighted-average behavior, or write its operators line without "
-                 "`inference = mamdani`")
+    mamdani = compiled.operators.inference == "mamdani"
     if compiled.cons_linear is not None:
         raise LessonError("adaptation does not cover Takagi-Sugeno (linear) consequents",
                           hint="give the outputs crisp values (numbers) to adapt them")
     for op, names in SUPPORTED_NORMS.items():
         norm = compiled.operators.tnorm if op == "and" else compiled.operators.snorm
-        if norm.name not in names:
+        if norm.name not in names and not mamdani:     # differences need no derivatives
             raise LessonError(f"adaptation has gradients for `{op} = "
                               f"{' / '.join(names)}`, not `{op} = {norm.name}`",
                               hint="adapt with the paper's min / max operators")
@@ -163,44 +175,55 @@ def parameterise(compiled: CompiledRuleBase) -> Parameters:
         frozen_knot.append(frozen)
         return len(knots) - 1
 
-    # input terms: tie equal corners of one variable into one knot
-    for k, vname in enumerate(compiled.inputs):
+    def tie_corners(vname: str, kind: str, items: list) -> dict:
+        """Knots for the corners of ``items`` ((key, term) of one variable): equal corners
+        are one knot; returns key -> [4] knot ids (-1: no such corner)."""
         var = compiled.variables[vname]
         ulo, uhi = var.universe
         width = uhi - ulo
-        rows = [t for t in range(T) if compiled.term_var[t] == k]
-        points: list[tuple[float, int, int]] = []        # (value, term row, corner)
-        for t in rows:
-            term = var.term(compiled.term_names[t][1])
-            if term.shape not in FROM_CORNERS:
-                reasons.append(f"{vname}.{term.name}: shape `{term.shape}` is not learned")
-                continue
-            for ci, v in enumerate(term.corners):
-                if math.isfinite(v):
-                    points.append((v, t, ci))
+        out: dict = {}
+        points: list[tuple[float, int, int]] = []        # (value, item, corner)
+        for n, (key, term) in enumerate(items):
+            out[key] = np.full(4, -1, dtype=np.intp)
+            points.extend((v, n, ci) for ci, v in enumerate(term.corners) if math.isfinite(v))
         points.sort()
         ids: list[int] = []
         names: dict[int, list[str]] = {}
         last = None
-        for v, t, ci in points:
+        for v, n, ci in points:
+            key, term = items[n]
             if last is None or abs(v - values[last]) > TIE * width:
-                last = new_knot(Knot(vname, "input", ""), v, width,
+                last = new_knot(Knot(vname, kind, ""), v, width,
                                 (min(ulo, v), max(uhi, v)), False)
                 ids.append(last)
                 names[last] = []
-            corner_knot[t, ci] = last
-            term = var.term(compiled.term_names[t][1])
+            out[key][ci] = last
             names[last].append(f"{term.name}.{_corner_name(term.shape, ci)}")
             if term.frozen:
                 frozen_knot[last] = True
         for i in ids:
-            knots[i] = Knot(vname, "input", f"{vname}: " + " = ".join(dict.fromkeys(names[i])))
+            knots[i] = Knot(vname, kind, f"{vname}: " + " = ".join(dict.fromkeys(names[i])))
         if ids:
             order.append(np.array(ids, dtype=np.intp))
-        for t in rows:
-            term = var.term(compiled.term_names[t][1])
+        for key, term in items:
             if term.shape == "triangle_pw":
-                sym_rows.append((corner_knot[t, 0], corner_knot[t, 1], corner_knot[t, 3]))
+                sym_rows.append((out[key][0], out[key][1], out[key][3]))
+        return out
+
+    # input terms: tie equal corners of one variable into one knot
+    for k, vname in enumerate(compiled.inputs):
+        var = compiled.variables[vname]
+        items = []
+        for t in range(T):
+            if compiled.term_var[t] != k:
+                continue
+            term = var.term(compiled.term_names[t][1])
+            if term.shape in FROM_CORNERS:
+                items.append((t, term))
+            else:
+                reasons.append(f"{vname}.{term.name}: shape `{term.shape}` is not learned")
+        for t, ids in tie_corners(vname, "input", items).items():
+            corner_knot[t] = ids
 
     # output values: every term of every output is a knot (ordered); crisp values per rule
     owners = _owners(rb, compiled.behavior)
@@ -208,6 +231,7 @@ def parameterise(compiled: CompiledRuleBase) -> Parameters:
     R, m = compiled.cons_value.shape
     cons_knot = np.full((R, m), -1, dtype=np.intp)
     crisp: dict[tuple[str, int, int], int] = {}
+    out_terms: dict[tuple[str, str], np.ndarray] = {}    # output term -> its knots
     for j, oname in enumerate(compiled.outputs):
         var = compiled.variables[oname]
         ulo, uhi = var.universe
@@ -224,8 +248,15 @@ def parameterise(compiled: CompiledRuleBase) -> Parameters:
                 reasons.append(f"{oname}.{tname} is frozen")
         if len(ids) > 1:
             order.append(np.array(ids, dtype=np.intp))
+        shaped: dict[str, np.ndarray] = {}           # Mamdani: output sets' corner knots
+        if mamdani:
+            shaped = tie_corners(oname, "shape", [(t.name, t) for t in var.terms
+                                                  if t.shape in FROM_CORNERS])
+            out_terms.update({(oname, tname): ids_ for tname, ids_ in shaped.items()})
         used: set[int] = set()
         locked: set[int] = set()
+        used_sets: set[str] = set()
+        locked_sets: set[str] = set()
         for r in range(R):
             if not compiled.cons_mask[r, j]:
                 continue
@@ -233,7 +264,9 @@ def parameterise(compiled: CompiledRuleBase) -> Parameters:
             rule = rb.behavior(owner).rules[index]
             is_frozen = (owner, rule.label) in frozen_rules
             tname = compiled.cons_term[r][j]
-            if tname is not None:
+            if tname is not None and tname in shaped:
+                (locked_sets if is_frozen else used_sets).add(tname)
+            elif tname is not None:
                 if tname not in term_knot:
                     reasons.append(f"{oname}.{tname}: shape "
                                    f"`{var.term(tname).shape}` is not learned")
@@ -249,6 +282,20 @@ def parameterise(compiled: CompiledRuleBase) -> Parameters:
                 cons_knot[r, j] = crisp[key]
         for tname, i in term_knot.items():
             frozen_knot[i] = i not in used or i in locked or var.term(tname).frozen
+            out_terms[(oname, tname)] = np.array([i, -1, -1, -1], dtype=np.intp)
+        # a corner of output sets moves when a rule that is not frozen concludes one of its
+        # sets and no frozen rule or frozen term holds it
+        thawed: dict[int, bool] = {}
+        for tname, ids_ in shaped.items():
+            for i in ids_[ids_ >= 0]:
+                ok = thawed.get(int(i), False) or tname in used_sets
+                thawed[int(i)] = ok
+        for tname, ids_ in shaped.items():
+            for i in ids_[ids_ >= 0]:
+                if tname in locked_sets or not thawed[int(i)]:
+                    frozen_knot[i] = True
+            if var.term(tname).frozen and tname in used_sets:
+                reasons.append(f"{oname}.{tname} is frozen")
 
     P = len(knots)
     values_a = np.array(values, dtype=float)
@@ -258,7 +305,34 @@ def parameterise(compiled: CompiledRuleBase) -> Parameters:
     decimals = np.array([_decimals(w) for w in scale_a], dtype=int)
     return Parameters(compiled, tuple(knots), values_a, scale_a, np.array(lo), np.array(hi),
                       projector, tuple(order), corner_knot, cons_knot, decimals,
-                      dependents, tuple(dict.fromkeys(reasons)), rows)
+                      dependents, tuple(dict.fromkeys(reasons)), rows, out_terms,
+                      _set_specs(compiled, cons_knot) if mamdani else None)
+
+
+def _set_specs(compiled: CompiledRuleBase, cons_knot: np.ndarray) -> tuple[SetSpec, ...]:
+    """How to rebuild each output's Mamdani table from knot values: the rows of the engine's
+    own table, except that every crisp consequent (``steering is 70``) gets a row of its own
+    (two rules with the same number may learn different ones). Exact: with ``max``
+    aggregation ``max_r min(d_r, s) = min(max_r d_r, s)``, and other S-norms take one set per
+    rule anyway."""
+    specs = []
+    for j, table in enumerate(compiled.mamdani):
+        keys: dict[tuple, int] = {}
+        set_of = []
+        for r in table.rules:                      # once per parameterisation, not per step
+            term = compiled.cons_term[r][j]
+            key = (term, compiled.cons_hedges[r][j]) if term is not None else \
+                (None, int(cons_knot[r, j]))
+            set_of.append(keys.setdefault(key, len(keys)))
+        set_of_a = np.array(set_of, dtype=np.intp)
+        order = np.argsort(set_of_a, kind="stable").astype(np.intp)
+        starts = np.searchsorted(set_of_a[order], np.arange(len(keys))).astype(np.intp)
+        labels = tuple(" ".join(k[1] + (k[0],)) if k[0] is not None else f"= crisp {k[1]}"
+                       for k in keys)
+        specs.append(SetSpec(dataclasses.replace(table, labels=labels, set_of=set_of_a,
+                                                 order=order, starts=starts),
+                             tuple(keys)))
+    return tuple(specs)
 
 
 def _corner_name(shape: str, corner: int) -> str:
@@ -334,21 +408,142 @@ def with_values(p: Parameters, values: np.ndarray) -> CompiledRuleBase:
     cons = p.compiled.cons_value.copy()
     mask = p.cons_knot >= 0
     cons[mask] = values[p.cons_knot[mask]]
-    return dataclasses.replace(p.compiled, kernel=kernel_of(p, values), cons_value=cons)
+    c = dataclasses.replace(p.compiled, kernel=kernel_of(p, values), cons_value=cons)
+    if p.sets is not None:
+        # the engine's cached Mamdani tables (a cached_property) of the new compiled object
+        c.__dict__["mamdani"] = output_tables(p, values)
+    return c
+
+
+def output_tables(p: Parameters, values: np.ndarray) -> tuple[OutputTable, ...]:
+    """The Mamdani output tables with the output sets' corners and values from ``values``:
+    each distinct consequent set sampled once on its grid (a few per output)."""
+    c = p.compiled
+    ops = c.operators
+    tables = []
+    for j, spec in enumerate(p.sets):
+        var = c.variables[c.outputs[j]]
+        lo, hi = var.universe
+        rows = []
+        for term, extra in spec.rows:
+            if term is None:                         # a crisp consequent: extra is its knot
+                rows.append(spike(lo, hi, ops.resolution, float(values[extra]), ops.sampling))
+                continue
+            t = _output_term(p, var, term, values)
+            mu = (spike(lo, hi, ops.resolution, t.params[0], ops.sampling)
+                  if t.shape == "singleton"
+                  else np.asarray(t.membership(spec.table.grid), dtype=float))
+            rows.append(hedge_mod.apply(extra, mu))
+        sets = np.array(rows, dtype=float).reshape(len(rows), ops.resolution)
+        tables.append(dataclasses.replace(spec.table, sets=sets))
+    return tuple(tables)
+
+
+def _output_term(p: Parameters, var, name: str, values: np.ndarray):
+    """Output term ``name`` with its knots' values (the term itself while they are unchanged,
+    so the starting point is the engine's own table, bit for bit)."""
+    term = var.term(name)
+    ids = p.out_terms.get((var.name, name))
+    if ids is None:
+        return term
+    mine = ids[ids >= 0]
+    if np.array_equal(values[mine], p.values[mine]):
+        return term
+    if term.shape == "singleton":
+        return term.with_params((float(values[ids[0]]),))
+    corners = [float(values[i]) if i >= 0 else o for i, o in zip(ids, term.corners)]
+    return term.with_params(FROM_CORNERS[term.shape](*corners))
 
 
 def loss(compiled: CompiledRuleBase, X: np.ndarray, targets: np.ndarray) -> float:
     """``Q = sum (y - t)^2`` over the given targets (NaN targets are not given)."""
-    y = evaluate(compiled, X, detail=False, strict=False).outputs
+    return _q(evaluate(compiled, X, detail=False, strict=False).outputs, targets)
+
+
+def _q(y: np.ndarray, targets: np.ndarray) -> float:
     given = ~np.isnan(targets)
     diff = np.where(given, y - np.where(given, targets, 0.0), 0.0)
     diff = np.nan_to_num(diff)
     return float(np.sum(diff * diff))
 
 
+# ---- Mamdani: central differences -------------------------------------------------------------
+
+#: Central-difference step for a centroid behavior, as a fraction of each parameter's universe.
+DIFF_STEP = 1e-3
+
+
+def difference_steps(p: Parameters) -> np.ndarray:
+    """The step ``h`` of each knot's central difference (in its own units).
+
+    A Mamdani output is computed on a grid of ``resolution`` samples of the output universe.
+    With ``centroid`` it is a continuous, piecewise-smooth function of every parameter (the
+    sampled sets move continuously with their corners), so a small step (:data:`DIFF_STEP` of
+    the universe) measures its slope. A singleton is a spike in the grid cell holding it, and
+    ``bisector`` / ``mom`` / ``som`` / ``lom`` pick grid samples: those outputs are step
+    functions whose derivative is 0 almost everywhere, so their differences are taken one grid
+    cell wide (the same fraction of the universe for input knots): the slope of ``Q`` at the
+    scale the outputs can resolve, which is what a descent step of a few per cent needs.
+    """
+    ops = p.compiled.operators
+    cells = ops.resolution - 1 if ops.sampling == "endpoints" else ops.resolution
+    rel = np.full(len(p.values), DIFF_STEP if ops.defuzzify == "centroid" else 1.0 / cells)
+    single = np.array([k.kind in ("output", "crisp") for k in p.knots], dtype=bool)
+    rel[single] = 1.0 / cells
+    return rel * p.scale
+
+
+def _room(p: Parameters, values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """How far each knot may move alone and keep its bounds and its order."""
+    low, high = p.lo.copy(), p.hi.copy()
+    for ids in p.order:                              # one per variable
+        need = _need(p, ids)
+        low[ids[1:]] = np.maximum(low[ids[1:]], values[ids[:-1]] + need)
+        high[ids[:-1]] = np.minimum(high[ids[:-1]], values[ids[1:]] - need)
+    return np.minimum(low, values), np.maximum(high, values)
+
+
+def difference_gradient(p: Parameters, values: np.ndarray, X: np.ndarray,
+                        targets: np.ndarray) -> tuple[float, np.ndarray]:
+    """``Q`` and its central-difference gradient, for Mamdani behaviors.
+
+    Each knot that may move is moved by ``+-h`` (:func:`difference_steps`; one-sided where
+    a bound or a neighbour is nearer) and ``Q`` is evaluated on the whole batch: a knot of an
+    input term needs the network again; a knot of an output set only the output layer on the
+    DOFs already computed. Cost per epoch: ``2 x`` (free knots) batch evaluations.
+    """
+    c = with_values(p, values)
+    res = evaluate(c, X, strict=False)
+    Q = _q(res.outputs, targets)
+    dof = res.dof.T                                  # [R, n]
+    Xc = res.inputs
+    h = difference_steps(p)
+    low, high = _room(p, values)
+    up = np.minimum(values + h, high)
+    down = np.maximum(values - h, low)
+    free = np.diag(p.projector) > 1e-12
+    grad = np.zeros(len(values))
+    for i in np.flatnonzero(free & (up > down)):     # parameters, never samples or rules
+        q = []
+        for v in (up[i], down[i]):
+            trial = values.copy()
+            trial[i] = v
+            moved = with_values(p, trial)
+            if p.knots[i].kind == "input":
+                q.append(loss(moved, X, targets))
+            else:
+                y = fill_defaults(moved, infer(moved, dof).T, Xc, False)
+                q.append(_q(y, targets))
+        grad[i] = (q[0] - q[1]) / (up[i] - down[i])
+    return Q, grad
+
+
 def gradient(p: Parameters, values: np.ndarray, X: np.ndarray,
              targets: np.ndarray) -> tuple[float, np.ndarray]:
-    """``Q`` and ``dQ/dvalues`` (exact, by backpropagation through the network)."""
+    """``Q`` and ``dQ/dvalues``: exact, by backpropagation through the network; for Mamdani
+    inference by central differences (:func:`difference_gradient`)."""
+    if p.sets is not None:
+        return difference_gradient(p, values, X, targets)
     c = with_values(p, values)
     res = evaluate(c, X, keep_values=True, strict=False)
     V = res.values.T                                 # [cols, n]
@@ -600,7 +795,7 @@ def adapt(compiled: CompiledRuleBase, X: np.ndarray, targets: np.ndarray, *, epo
     except KeyboardInterrupt:
         interrupted = True            # keep what the completed epochs learned
     q_learned = history[-1]
-    values, q_final = _round(p, values, X, targets, history[0])
+    values, q_final = _round(p, values, X, targets, history[0], q_learned)
     rounded = q_final != q_learned
     if rounded:
         history.append(q_final)
@@ -608,21 +803,24 @@ def adapt(compiled: CompiledRuleBase, X: np.ndarray, targets: np.ndarray, *, epo
 
 
 def _round(p: Parameters, values: np.ndarray, X: np.ndarray, targets: np.ndarray,
-           q_start: float) -> tuple[np.ndarray, float]:
-    """Learned values on a readable grid (a few decimals), constraints kept exactly; the
-    starting values when rounding would make ``Q`` worse than where it started."""
+           q_start: float, q_learned: float) -> tuple[np.ndarray, float]:
+    """Learned values on a readable grid (a few decimals), constraints kept exactly and ``Q``
+    no worse than where it started; when that grid breaks a constraint (two knots rounded
+    closer than :data:`MIN_GAP`) a grid one or two decimals finer; failing that, the learned
+    values as they are (never the starting values: that would throw the learning away)."""
     changed = values != p.values
     if not changed.any():
         return p.values.copy(), q_start
-    out = np.where(changed, np.round(values * 10.0 ** p.decimals) / 10.0 ** p.decimals, values)
-    for dep, others, coef in p.dependents:            # symmetric triangles stay symmetric
-        out[dep] = round(float(coef @ out[others]), int(p.decimals[dep]))
-    if not feasible(p, out):
-        return p.values.copy(), q_start
-    q = loss(with_values(p, out), X, targets)
-    if q > q_start:
-        return p.values.copy(), q_start
-    return out, q
+    for extra in range(3):
+        decimals = p.decimals + extra
+        out = np.where(changed, np.round(values * 10.0 ** decimals) / 10.0 ** decimals, values)
+        for dep, others, coef in p.dependents:        # symmetric triangles stay symmetric
+            out[dep] = round(float(coef @ out[others]), int(decimals[dep]))
+        if feasible(p, out):
+            q = loss(with_values(p, out), X, targets)
+            if q <= q_start:
+                return out, q
+    return values.copy(), q_learned
 
 
 # ---- writing the learned values back into the model -------------------------------------------
@@ -636,15 +834,28 @@ def learned_rulebase(p: Parameters, values: np.ndarray) -> RuleBase:
     for t in np.flatnonzero((p.corner_knot >= 0).any(axis=1)):
         var, name = c.term_names[t]
         term = c.variables[var].term(name)
+        mine = p.corner_knot[t][p.corner_knot[t] >= 0]
+        if np.array_equal(values[mine], p.values[mine]):
+            continue                        # untouched: keep its numbers as written
         corners = [float(values[i]) if i >= 0 else o
                    for i, o in zip(p.corner_knot[t], term.corners)]
         dec = int(p.decimals[p.corner_knot[t][p.corner_knot[t] >= 0][0]])
-        params = tuple(round(v, dec) for v in FROM_CORNERS[term.shape](*corners))
+        params = tuple(round(v, dec + NOISE) for v in FROM_CORNERS[term.shape](*corners))
         if params != term.params:
             new_terms[(var, name)] = params
     for i, knot in enumerate(p.knots):
         if knot.kind == "output" and values[i] != p.values[i]:
             new_terms[(knot.var, knot.label.split(": ", 1)[1])] = (float(values[i]),)
+    for (var, name), ids in p.out_terms.items():        # Mamdani output sets
+        term = c.variables[var].term(name)
+        mine = ids[ids >= 0]
+        if term.shape == "singleton" or np.array_equal(values[mine], p.values[mine]):
+            continue
+        corners = [float(values[i]) if i >= 0 else o for i, o in zip(ids, term.corners)]
+        dec = int(p.decimals[ids[ids >= 0][0]])
+        params = tuple(round(v, dec + NOISE) for v in FROM_CORNERS[term.shape](*corners))
+        if params != term.params:
+            new_terms[(var, name)] = params
     termsets = tuple(dataclasses.replace(ts, variables=tuple(
         v.with_terms(tuple(t.with_params(new_terms[(v.name, t.name)])
                            if (v.name, t.name) in new_terms else t for t in v.terms))
