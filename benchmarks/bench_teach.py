@@ -35,6 +35,8 @@ from pathlib import Path
 import numpy as np
 
 from mitos_cli import load_rulebase
+from mitos_cli.compile import compile_rulebase
+from mitos_cli.model import Setting
 from mitos_cli.teach.adapt import adapt, gradient, loss, parameterise, with_values
 
 SEED = 20240611
@@ -124,6 +126,14 @@ def main() -> None:
     t21 = median_time(lambda: adapt(compiled, X, T, epochs=21), 3)
     t_epoch = (t21 - t1) / 20
     t_lesson = lesson_time()
+    # the same rule base as a Mamdani behavior (min / max / centroid, resolution 101): central
+    # differences, 2 batch evaluations per free number
+    mamdani = compile_rulebase(compiled.rulebase, compiled.behavior,
+                               (Setting("inference", "mamdani"),))
+    pm = parameterise(mamdani)
+    tm1 = median_time(lambda: adapt(mamdani, X, T, epochs=1), 3)
+    tm11 = median_time(lambda: adapt(mamdani, X, T, epochs=11), 3)
+    tm_epoch = (tm11 - tm1) / 10
 
     print(f"MITOS teaching benchmark, {time.strftime('%Y-%m-%d')}, {platform.machine()} "
           f"{platform.processor() or ''}".rstrip() + f", {os.cpu_count()} cpus, "
@@ -137,9 +147,11 @@ def main() -> None:
             ("gradient, finite differences (engine)", t_fd, t_fd / t_grad),
             ("gradient, per-example loop (same code)", t_loop, t_loop / t_grad),
             ("one adaptation epoch (step + halving)", t_epoch, None),
-            ("adapt(epochs=1) incl. setup and rounding", t1, None)]
+            ("adapt(epochs=1) incl. setup and rounding", t1, None),
+            (f"one Mamdani epoch ({pm.n_free} free: differences)", tm_epoch, None)]
     for name, t, ratio in rows:
         print(f"{name:<48}{t * 1e3:>10.2f} ms" + (f"{ratio:>11.1f}x" if ratio else ""))
+    print(f"{'  Mamdani epoch / weighted-average epoch':<48}{tm_epoch / t_epoch:>12.1f}x")
     if t_lesson is None:
         print("wider-turn lesson: worlds/figure4.yaml or the lesson is missing (skipped)")
     else:

@@ -16,6 +16,11 @@ network:
 * memberships: the derivative of each piecewise-linear edge w.r.t. its corner points; a
   saturated membership (0 or 1) has derivative 0.
 
+**Mamdani behaviors** also learn the corner points of their output sets (tied, ordered and
+bounded like input knots), and their gradient is central differences over the parameters, one
+batch evaluation per moved parameter (:func:`difference_gradient`, steps in
+:func:`difference_steps`): any implication, aggregation and defuzzifier works.
+
 **Parameterisation.** The corner points of a variable's terms are *knots*: points with the
 same value (a shoulder's end that is the next triangle's peak) are one knot, so shared break
 points stay tied and a partition stays a partition. The knots keep their order (a minimum gap
@@ -277,7 +282,8 @@ def parameterise(compiled: CompiledRuleBase) -> Parameters:
                 key = (owner, index, j)
                 if key not in crisp:
                     crisp[key] = new_knot(
-                        Knot(oname, "crisp", f"{oname}: {owner}/{rule.label or '#' + str(index + 1)}"),
+                        Knot(oname, "crisp",
+                             f"{oname}: {owner}/{rule.label or '#' + str(index + 1)}"),
                         float(compiled.cons_value[r, j]), width, (ulo, uhi), is_frozen)
                 cons_knot[r, j] = crisp[key]
         for tname, i in term_knot.items():
