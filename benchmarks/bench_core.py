@@ -275,8 +275,6 @@ def main() -> None:
                                        evaluate(c, x[None], detail=False).outputs[0],
                                        rtol=1e-12, atol=1e-9)
 
-    rows = []   # (measurement, MITOS figure, peer, peer figure, ratio text)
-
     # (a) batch throughput
     t_detail = best_of(lambda: evaluate(c, X, detail=True), repeats)
     t_fast = best_of(lambda: evaluate(c, X, detail=False), repeats)

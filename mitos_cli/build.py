@@ -12,8 +12,7 @@ from pathlib import Path
 from . import operators as ops_mod
 from .errors import RuleBaseError, Span, TermSetError, unknown
 from .hedges import HEDGES
-from .model import (And, Behavior, Consequent, Expr, Not, Or, Prop, Rule, RuleBase, Use,
-                    flatten)  # noqa: F401 (flatten is re-exported)
+from .model import And, Behavior, Consequent, Expr, Not, Or, Prop, Rule, RuleBase
 from .parse import ParsedFile, parse_rules
 from .termset import load_termset
 from .terms import TermSet, Variable

@@ -38,7 +38,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from .build import flatten
+from .model import flatten
 from .compile import CompiledRuleBase, compile_rulebase
 from .engine import evaluate
 from .errors import Span
@@ -259,7 +259,7 @@ def _rule_pairs(rb: RuleBase, behavior: str) -> list[Finding]:
                         "warning", "duplicate",
                         f"{where} and the same consequents{extra}: it counts twice in the "
                         f"weighted average", rule_j.span, behavior,
-                        hint=f"delete one of them, or give one rule a weight (`with 0.5`)"))
+                        hint="delete one of them, or give one rule a weight (`with 0.5`)"))
                 else:
                     continue
                 break                         # report each rule against its first twin only

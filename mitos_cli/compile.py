@@ -23,7 +23,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import operators as ops_mod
-from .model import And, Expr, Not, Or, Prop, Rule, RuleBase, Setting, Use, flatten, format_rule
+from .model import And, Expr, Not, Prop, Rule, RuleBase, Setting, Use, flatten, format_rule
 from .operators import Operators
 from .shapes import kernel_params
 from .terms import Term, Variable

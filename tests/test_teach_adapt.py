@@ -1,7 +1,6 @@
 """Adaptation: exact gradients (vs finite differences), Q never increases, the term set keeps
 its shape (order, ties, symmetry, universe), frozen things stay."""
 
-import dataclasses
 
 import numpy as np
 import pytest
@@ -130,7 +129,6 @@ def test_q_decreases_on_a_synthetic_target_and_never_increases():
     truth[0] += 2.0          # ... and NARROW.a; MEDIUM stays symmetric through right = 104
     truth[2] += 6.0
     truth[11] -= 6.0         # steering LS
-    X = points(500) * np.array([16.0, 10.0]) if False else None
     rng = np.random.default_rng(5)
     X = np.column_stack([rng.uniform(0, 160, 500), rng.uniform(0, 100, 500),
                          rng.uniform(-60, 60, 500)])

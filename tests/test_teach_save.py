@@ -1,7 +1,6 @@
 """Saving keeps the rule base linguistic: text surgery, atomic writes, round trip."""
 
 import shutil
-from pathlib import Path
 
 import pytest
 

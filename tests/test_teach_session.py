@@ -2,9 +2,7 @@
 
 import json
 import shutil
-from pathlib import Path
 
-import numpy as np
 import pytest
 
 from mitos_cli.api import default_rulebase_path

@@ -61,7 +61,7 @@ def compare_command(
     Prints the table and the ranking; writes DIR/results.csv (one row per run, as it
     finishes), DIR/report.md and its plots.
     """
-    from ..study import Study, make_choices, run_study, write_report
+    from ..study import Study, make_choices, write_report
     from ..study.executors import EXECUTORS
     from ..study.spec import split_list
 

@@ -405,7 +405,7 @@ def flatten_for_export(rb: RuleBase, behavior: str | None = None, *,
     ``crisp_terms``, crisp consequents (``speed is 40``) become constant output terms named
     ``crisp_40`` (the formats have no crisp consequents).
     """
-    from ..build import flatten
+    from ..model import flatten
 
     name = behavior or rb.default_behavior
     b = rb.behavior(name)

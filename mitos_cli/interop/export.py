@@ -24,7 +24,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..build import flatten
+from ..model import flatten
 from ..compile import CompiledRuleBase
 from ..errors import FormatError
 from ..model import And, Expr, Not, Prop

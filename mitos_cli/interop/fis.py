@@ -200,7 +200,7 @@ def _variable(span: Span, items, role: str, kind: str, n_inputs: int) -> Variabl
     name = _string(*values["Name"])
     rng = _vector(*values["Range"])
     if len(rng) != 2 or not rng[0] < rng[1]:
-        raise FormatError(f"`Range` must be [min max] with min < max", span=values["Range"][1])
+        raise FormatError("`Range` must be [min max] with min < max", span=values["Range"][1])
     if "NumMFs" in values and common.number(*values["NumMFs"]) != len(terms):
         raise FormatError(f"NumMFs={values['NumMFs'][0]} but the variable has {len(terms)} MFs",
                           span=values["NumMFs"][1])

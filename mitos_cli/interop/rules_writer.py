@@ -39,7 +39,7 @@ def write_rules(rb: RuleBase, termset_name: str, behavior: str | None = None,
 
     A behavior that uses no other is written as top-level rules; one that does is written with
     the behaviors it uses (recursively) as ``behavior`` blocks, itself first (the default)."""
-    from ..build import flatten
+    from ..model import flatten
     from ..model import Use, format_use
     from ..operators import resolve
 
@@ -129,7 +129,7 @@ def _scalar(value) -> str:
 
 
 def write_termset(rb: RuleBase, inputs, outputs, source: str = "") -> str:
-    lines = [f"# Term set written by `mitos convert`" + (f" from {source}" if source else ""),
+    lines = ["# Term set written by `mitos convert`" + (f" from {source}" if source else ""),
              "variables:"]
     input_names = [v.name for v in inputs]
     for v in tuple(inputs) + tuple(outputs):
