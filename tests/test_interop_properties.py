@@ -81,9 +81,19 @@ def rulebases(draw):
 
 
 def outputs(rb: RuleBase, X: np.ndarray) -> np.ndarray:
+    return evaluated(rb, X)[0]
+
+
+def evaluated(rb: RuleBase, X: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Outputs ``[n, 1]`` and the largest rule DOF of each sample ``[n]``."""
     c = compile_rulebase(rb)
     cols = [("a", "b").index(name) for name in c.inputs]
-    return evaluate(c, X[:, cols], strict=False, detail=False).outputs
+    result = evaluate(c, X[:, cols], strict=False)
+    return result.outputs, result.dof.max(axis=1, initial=0.0)
+
+
+#: Below this DOF a rule "barely fires": whether it fires at all can hang on the last bit.
+BARELY = 1e-12
 
 
 @settings(max_examples=20, deadline=None, suppress_health_check=[HealthCheck.too_slow,
@@ -93,7 +103,7 @@ def test_random_rule_bases_round_trip(rb: RuleBase, tmp_path_factory) -> None:
     tmp = Path(tmp_path_factory.mktemp("rt"))
     rng = np.random.default_rng(np.random.SeedSequence(11).spawn(1)[0])
     X = rng.uniform(0, 10, size=(150, 2))
-    before = outputs(rb, X)
+    before, dof_before = evaluated(rb, X)
     for fmt in ("fll", "fcl", "rules"):
         if fmt == "rules":
             rules, term_set = write_rules(rb, "x.terms.yaml")
@@ -103,9 +113,17 @@ def test_random_rule_bases_round_trip(rb: RuleBase, tmp_path_factory) -> None:
         else:
             path = tmp / f"x.{fmt}"
             path.write_text(write_foreign(rb, fmt))
-        after = outputs(read_rulebase(path), X)
-        np.testing.assert_allclose(after, before, rtol=0, atol=1e-9, equal_nan=True,
-                                   err_msg=f"{fmt}:\n{path.read_text()}")
+        after, dof_after = evaluated(read_rulebase(path), X)
+        text = f"{fmt}:\n{path.read_text()}"
+        np.testing.assert_allclose(dof_after, dof_before, rtol=0, atol=1e-9, err_msg=text)
+        # Where nothing fires the output is the default; where a rule barely fires, a
+        # weighted average or a centroid (which do not shrink with the DOF). A writer's exact
+        # rewriting (De Morgan, `not not`) may round a DOF of 1e-17 to 0 or back, so those
+        # samples jump between the two; every other sample must agree.
+        sure = ((dof_before > BARELY) & (dof_after > BARELY)) | ((dof_before == 0)
+                                                                 & (dof_after == 0))
+        np.testing.assert_allclose(after[sure], before[sure], rtol=0, atol=1e-9,
+                                   equal_nan=True, err_msg=text)
 
 
 def test_double_negation_is_the_membership_itself(tmp_path) -> None:
