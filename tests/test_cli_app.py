@@ -34,3 +34,14 @@ def test_unknown_command_is_a_usage_error_with_a_suggestion() -> None:
     out = run("evl", "road=78")
     assert out.returncode == 2
     assert "No such command 'evl'" in out.stderr and "Did you mean 'eval'?" in out.stderr
+
+
+def test_version_is_the_package_version() -> None:
+    from pathlib import Path
+
+    from mitos_cli import __version__
+
+    out = run("--version")
+    assert out.returncode == 0 and out.stdout == f"mitos {__version__}\n"
+    pyproject = (Path(__file__).parent.parent / "pyproject.toml").read_text()
+    assert f'\nversion = "{__version__}"\n' in pyproject

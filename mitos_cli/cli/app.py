@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import importlib
 import sys
+from typing import Annotated
 
 import typer
 
@@ -32,7 +33,17 @@ COMMANDS: dict[str, tuple[str, str]] = {
 }
 
 
-def _root() -> None:
+def _show_version(value: bool) -> None:
+    if value:
+        from .. import __version__
+
+        print(f"mitos {__version__}")
+        raise typer.Exit()
+
+
+def _root(version: Annotated[bool, typer.Option(
+        "--version", callback=_show_version, is_eager=True,
+        help="Print the version and exit.")] = False) -> None:
     """Instructible neurofuzzy motion planners: evaluate, check, simulate and teach fuzzy rule
     bases. Rule files, term sets, worlds and lessons are documented in the README."""
 
