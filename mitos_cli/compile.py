@@ -142,9 +142,10 @@ class CompiledRuleBase:
         return scalar_function(self)
 
     def __getstate__(self) -> dict:
-        """Pickled (for worker processes) without the derived caches: the scalar function
-        is generated code, and each process rebuilds what it uses."""
-        return {k: v for k, v in self.__dict__.items() if k not in ("scalar", "plan", "mamdani")}
+        """Pickled (for worker processes) without the scalar function, which is generated
+        code; a process that needs it writes it again. (The Mamdani tables stay: adaptation
+        puts tables there that the terms alone do not give.)"""
+        return {k: v for k, v in self.__dict__.items() if k != "scalar"}
 
     def __setstate__(self, state: dict) -> None:
         self.__dict__.update(state)

@@ -152,3 +152,14 @@ def test_one_sample_errors_are_the_batch_errors() -> None:
         with pytest.raises(NoRuleFiredError, match="no rule sets `y`"):
             evaluate_one(c, [outside])
         assert np.isnan(evaluate_one(c, [outside], strict=False)[0])
+
+
+def test_a_compiled_rule_base_with_its_scalar_form_pickles() -> None:
+    """Worker processes receive compiled rule bases: the generated function is left out and
+    written again where it is used."""
+    import pickle
+
+    c = load_rulebase().compiled
+    assert c.scalar is not None
+    copy = pickle.loads(pickle.dumps(c))
+    assert evaluate_one(copy, [78.0, 45.0, 4.0]) == evaluate_one(c, [78.0, 45.0, 4.0])
