@@ -220,7 +220,16 @@ def test_prompt_in_a_terminal_completes_and_keeps_history(work):
         os.write(master, b"eval road=1")
         expect(master, "avoid_obstacle> eval road=1", seen)  # echoed: readline has the line
         os.write(master, b"\x03")                              # Ctrl-C drops the line
-        expect(master, "Ctrl-D leaves)\r\navoid_obstacle> ", seen)
+        try:
+            expect(master, "Ctrl-D leaves)\r\navoid_obstacle> ", seen, timeout=10)
+        except AssertionError:
+            # CPython's readline checks for signals only when one interrupts its wait for a
+            # key; a Ctrl-C that lands while it is still handling the previous key goes
+            # unnoticed until the line ends (seen in about 1 of 15 runs with four busy
+            # processes on 2 cores, never on an idle machine). A user presses it again; so
+            # does the test, and the prompt must answer that one.
+            os.write(master, b"\x03")
+            expect(master, "Ctrl-D leaves)\r\navoid_obstacle> ", seen)
         os.write(master, b"\x04")                              # Ctrl-D leaves
         proc.wait(timeout=30)
         assert proc.returncode == 0
