@@ -109,7 +109,8 @@ class CompiledRuleBase:
         distinct = list(dict.fromkeys(masks))
         K = np.vstack([self.cons_value.T] + [np.array(d, dtype=float)[None] for d in distinct])
         rows = np.array([len(self.outputs) + distinct.index(m) for m in masks], dtype=np.intp)
-        return K.reshape(-1, self.n_rules), rows
+        # (an explicit row count: with no rules, ``reshape(-1, 0)`` cannot infer it)
+        return K.reshape(len(self.outputs) + len(distinct), self.n_rules), rows
 
     @property
     def n_rules(self) -> int:
@@ -300,6 +301,12 @@ def compile_rulebase(rb: RuleBase, behavior: str | None = None,
     operators = ops_mod.resolve(overrides, ops_mod.resolve(b.operators,
                                                            ops_mod.resolve(rb.operators)))
     flat = flatten(rb, name)
+    if not flat:
+        from .errors import RuleBaseError
+
+        raise RuleBaseError(f"behavior `{name}` has no rules (nor uses a behavior that has)",
+                            span=b.span, hint=f"write a rule in `{name}`, or `use` a behavior "
+                                              "with rules")
     variables = rb.variables
 
     used_inputs: set[str] = set()

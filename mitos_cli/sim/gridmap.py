@@ -42,6 +42,16 @@ def classify(pixels: np.ndarray, maxval: int, *, negate: bool, occupied_thresh: 
     return np.ascontiguousarray(blocked[::-1])
 
 
+def _negate(spec: yamlpos.YMap) -> bool:
+    """``negate`` as map_server reads it: 0 or 1 (``false``/``true`` too). A quoted ``"0"``
+    is a string, which Python would take for true and silently invert the map: refused."""
+    value = spec.get("negate", 0)
+    if value in (0, 1) and not isinstance(value, float) or isinstance(value, bool):
+        return bool(value)
+    raise WorldError(f"negate must be 0 or 1, not `{value}`", span=spec.value_span("negate"),
+                     hint="write `negate: 0` (dark pixels are walls) or `negate: 1`, unquoted")
+
+
 def load_map_yaml(path: Path, *, unknown_occupied: bool = True,
                   where: Span | None = None) -> Grid:
     """Read a map_server ``map.yaml`` and its image into a :class:`Grid` in inches."""
@@ -70,9 +80,10 @@ def load_map_yaml(path: Path, *, unknown_occupied: bool = True,
         raise WorldError(f"the map's origin is rotated (yaw {yaw:g} rad); rotated maps are not "
                          f"supported", span=spec.value_span("origin"),
                          hint="rotate the image so that the yaw is 0, and adjust x and y")
-    negate = bool(spec.get("negate", 0))
-    occ_t = float(spec.get("occupied_thresh", 0.65))
-    free_t = float(spec.get("free_thresh", 0.196))
+    negate = _negate(spec)
+    occ_t, free_t = (yamlpos.expect_number(spec.get(key, default), spec.value_span(key),
+                                           WorldError, key)
+                     for key, default in (("occupied_thresh", 0.65), ("free_thresh", 0.196)))
     if not 0 <= free_t <= occ_t <= 1:
         raise WorldError("need 0 <= free_thresh <= occupied_thresh <= 1",
                          span=spec.value_span("free_thresh"))
