@@ -143,6 +143,15 @@ def _word_before(text: str, token: Token) -> str:
     return words[-1] if words else ""
 
 
+def shift(span: Span | None, lines: int) -> Span | None:
+    """``span`` moved down ``lines`` lines (text parsed alone, taken from a longer file)."""
+    if span is None or not lines:
+        return span
+    import dataclasses
+
+    return dataclasses.replace(span, line=span.line + lines)
+
+
 def _span(meta, text: str, path: str | None) -> Span | None:
     if getattr(meta, "empty", True):
         return None
@@ -153,13 +162,15 @@ def _span(meta, text: str, path: str | None) -> Span | None:
 class _ToModel(Transformer):
     """Tree -> model objects. Only builds: names are checked later (Lark wraps errors here)."""
 
-    def __init__(self, text: str, path: str | None) -> None:
+    def __init__(self, text: str, path: str | None, line_offset: int = 0) -> None:
         super().__init__()
         self.text, self.path = text, path
         self.counter = 0
+        self.line_offset = line_offset        # the text starts at this line + 1 of its file
 
     def _s(self, meta) -> Span | None:
-        return _span(meta, self.text, self.path)
+        span = _span(meta, self.text, self.path)
+        return shift(span, self.line_offset)
 
     def number(self, items):
         return float(items[0])
