@@ -23,8 +23,11 @@ def world_path(name: str, base: Path | None = None) -> Path:
     from ..resources import data_dir, packaged_path
 
     for candidate in ([base / name] if base else []) + [Path(name)]:
-        if candidate.is_file():
-            return candidate
+        try:
+            if candidate.is_file():
+                return candidate
+        except OSError:                 # a name the system cannot look up (too long): none
+            continue
     packaged = sorted(e.name for e in data_dir("worlds").iterdir() if e.name.endswith(".yaml"))
     stem = Path(name).name
     for file in (stem, stem + ".yaml"):
