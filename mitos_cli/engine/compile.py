@@ -22,9 +22,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..fuzzy import operators as ops_mod
+from ..lang import operators as ops_mod
 from ..lang.model import And, Expr, Not, Prop, Rule, RuleBase, Setting, Use, flatten, format_rule
-from ..fuzzy.operators import Operators
+from ..lang.operators import Operators
 from ..fuzzy.shapes import kernel_params
 from ..lang.terms import Term, Variable
 

@@ -16,7 +16,7 @@ import tempfile
 from pathlib import Path
 from typing import Callable
 
-from .. import __version__
+from .._version import __version__
 from .model import RuleBase
 
 _FORMAT = 1

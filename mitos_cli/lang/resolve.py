@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..fuzzy import operators as ops_mod
+from . import operators as ops_mod
 from ..errors import RuleBaseError, Span, TermSetError, unknown
 from ..fuzzy.hedges import HEDGES
 from .model import And, Behavior, Consequent, Expr, Not, Or, Prop, Rule, RuleBase
