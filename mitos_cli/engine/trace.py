@@ -42,6 +42,12 @@ class Trace:
     outputs: tuple[tuple[str, float, str], ...]
     defaulted: tuple[str, ...] = ()       # outputs no rule set: their `default` applies
 
+    def _repr_html_(self) -> str:
+        """A notebook shows the trace as the terminal does."""
+        import html
+
+        return f"<pre>{html.escape(self.render())}</pre>"
+
     def to_json(self) -> dict:
         return {
             "rulebase": self.rulebase,
