@@ -8,8 +8,10 @@ It measures, in one run, on the packaged MITOS rule base (behavior ``avoid_obsta
 paper's 27 rules):
 
 a. batch throughput on 10^6 random inputs: ``engine.evaluate`` with ``detail=True`` (memberships
-   and DOFs kept) and ``detail=False`` (outputs only), a hand-written NumPy kernel for exactly
-   this rule base, and pyfuzzylite 8's vectorized ``Engine.process()`` on the same rules;
+   and DOFs kept) and ``detail=False`` (outputs only), ``load_rulebase().evaluate(**columns)``
+   (arrays by name), a hand-written NumPy kernel for exactly this rule base, and pyfuzzylite
+   8's vectorized ``Engine.process()`` on the same rules; and the peak memory NumPy allocates
+   in one call of ``evaluate(**columns)`` and of the kernel (tracemalloc);
 b. single-evaluation latency: ``load_rulebase().evaluate(road=..., size=..., position=...)``
    (the network's scalar form, :mod:`mitos_cli.scalar`), the engine's array entry point with
    one row (``evaluate(compiled, X[i:i+1], detail=False)``, the same scalar form plus the
@@ -199,6 +201,21 @@ def per_call(fn, args, repeats: int) -> float:
     return statistics.median(means)
 
 
+def peak_memory(fn) -> int:
+    """Bytes NumPy allocated at the peak of one call (tracemalloc sees NumPy's buffers)."""
+    import tracemalloc
+
+    fn()
+    tracemalloc.start()
+    try:
+        result = fn()
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    del result
+    return peak
+
+
 def process_time(argv: list[str], runs: int) -> float:
     # As installed: Python may write and use byte code (an inherited PYTHONDONTWRITEBYTECODE
     # would make every run recompile MITOS's sources, which no installed copy does).
@@ -279,6 +296,10 @@ def main() -> None:
     t_detail = best_of(lambda: evaluate(c, X, detail=True), repeats)
     t_fast = best_of(lambda: evaluate(c, X, detail=False), repeats)
     t_kernel = best_of(lambda: kernel(X), repeats)
+    columns = {name: np.ascontiguousarray(X[:, j]) for j, name in enumerate(c.inputs)}
+    t_loaded = best_of(lambda: rb.evaluate(**columns), repeats)
+    mem_loaded = peak_memory(lambda: rb.evaluate(**columns))
+    mem_kernel = peak_memory(lambda: kernel(X))
 
     def fl_batch():
         fl_engine.input_values = X
@@ -286,6 +307,7 @@ def main() -> None:
         return fl_engine.output_values
     t_fl = best_of(fl_batch, max(2, repeats // 2))
     rate = {k: n / t for k, t in (("detail", t_detail), ("fast", t_fast), ("kernel", t_kernel),
+                                   ("loaded", t_loaded),
                                    ("fl", t_fl))}
 
     # (b) single-evaluation latency
@@ -333,7 +355,11 @@ def main() -> None:
     print(f"| MITOS batch, `evaluate(detail=False)` | {fmt_rate(rate['fast'])} eval/s | "
           f"{rate['fast'] / rate['kernel']:.2f}x the hand-written kernel, "
           f"{rate['fast'] / rate['fl']:.0f}x pyfuzzylite |")
+    print(f"| MITOS batch, `load_rulebase().evaluate(**columns)` | {fmt_rate(rate['loaded'])} "
+          f"eval/s | {rate['loaded'] / rate['kernel']:.2f}x the hand-written kernel |")
     print(f"| hand-written NumPy kernel (this rule base) | {fmt_rate(rate['kernel'])} eval/s | |")
+    print(f"| peak extra memory, `load_rulebase().evaluate(**columns)` | {mem_loaded / 1e6:.1f} MB "
+          f"| {mem_loaded / mem_kernel:.2f}x the kernel's {mem_kernel / 1e6:.1f} MB |")
     print(f"| pyfuzzylite {_version('fuzzylite')} vectorized `process()` | "
           f"{fmt_rate(rate['fl'])} eval/s | |")
     print(f"| MITOS single, `load_rulebase().evaluate(...)` | {fmt_time(lat_mitos)} | "

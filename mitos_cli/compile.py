@@ -179,6 +179,7 @@ class Plan:
     weight: np.ndarray | None          # [R, 1] rule weights, None when all are 1
     sums: np.ndarray                   # [R, k, 1] output-layer weights (numerators, dens)
     den_row: np.ndarray                # [m] row of ``sums`` with each output's denominator
+    sum_rows: tuple                    # per row of ``sums``: its weights [R, 1], None if all 1
     grids: dict                        # (level, group) -> Grid, for AND groups that are grids
 
 
@@ -242,6 +243,8 @@ def _plan(c: "CompiledRuleBase") -> Plan:
         contexts=tuple(np.ascontiguousarray(c.context[:, j]) for j in range(c.context.shape[1])),
         weight=c.weight[:, None].copy() if c.weighted else None,
         sums=np.ascontiguousarray(c.sum_weights.T[:, :, None]), den_row=c.den_row,
+        sum_rows=tuple(None if (w == 1.0).all() else np.ascontiguousarray(w[:, None])
+                       for w in c.sum_weights),
         grids={} if c.operators.and_ != "min" else {
             (i, j): grid for i, level in enumerate(c.levels) for j, group in enumerate(level)
             if (grid := _grid(group, c)) is not None})
