@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from mitos_cli import load_rulebase
-from mitos_cli.engine import BLOCK, evaluate, evaluate_columns, evaluate_one
+from mitos_cli.engine.evaluation import BLOCK, evaluate, evaluate_columns, evaluate_one
 from mitos_cli.errors import InputError, NoRuleFiredError
 
 ROOT = Path(__file__).resolve().parents[1]
