@@ -297,6 +297,9 @@ class Simulation:
         self._goals = np.array([[a.goal.x, a.goal.y] for a in world.agents], float)
         self._tol = np.array([a.goal.tolerance for a in world.agents], float)
         self._stuck_window = max(1, int(round(STUCK_TIME / self.dt)))
+        self._still = None
+        if not any(o.motion.kind in ("velocity", "waypoints") for o in world.obstacles):
+            self._still = self._obstacles_at(0.0)
 
     def _setup_state(self) -> None:
         agents, n = self.world.agents, self.n
@@ -402,18 +405,22 @@ class Simulation:
         stream) and the clearance of its footprint."""
         n, x, y, h = self.n, self._x, self._y, self._h
         t = self._k * self.dt
-        world, sen = self.world, self.world.sensors
-        where = obs_mod.positions(world.obstacles, t)
-        centres, radii, _, rect_sides, _, rect_box = obs_mod.shapes_at(world.obstacles, where)
+        sen = self.world.sensors
+        where, (centres, radii, _, rect_sides, _, rect_box) = self._obstacles_at(t)
         pose = np.stack([x, y, h], axis=1)
-        footprints = _footprints(pose, self.robots)
-        robot_sides = (polygon_segments(footprints).reshape(n, 4, 4) if n > 1
-                       else np.zeros((1, 4, 4)))       # other robots are obstacles to each
+        if n > 1:                                        # other robots are obstacles to each
+            footprints = _footprints(pose, self.robots)
+            robot_sides = polygon_segments(footprints).reshape(n, 4, 4)
         ranges = np.zeros((n, len(self.angles)))
         clear = np.zeros(n)
         self._dirs, self._expected = [], []
         for i in range(n):
-            others = np.concatenate([rect_sides] + [robot_sides[j] for j in range(n) if j != i])
+            if n > 1:
+                others = np.concatenate([rect_sides] + [robot_sides[j] for j in range(n)
+                                                        if j != i])
+                boxes = np.concatenate([rect_box, footprints[:i], footprints[i + 1:]])
+            else:
+                others, boxes = rect_sides, rect_box
             walls = self._walls_near(i)
             dirs = sensors.beam_directions(h[i], self.angles)
             expected, true_r = sensors.cast(pose[i, :2], dirs, walls, others, centres, radii,
@@ -421,10 +428,17 @@ class Simulation:
             ranges[i] = sensors.add_noise(true_r, sen.noise, sen.range, self._streams[1 + i])
             self._dirs.append(dirs)
             self._expected.append(expected)
-            boxes = np.concatenate([rect_box, footprints[:i], footprints[i + 1:]])
             clear[i] = _clearance(pose[i], self.robots[i], walls, boxes, centres, radii)
         return _Sensed(t, where, pose, ranges, {key: np.zeros(n) for key in perception.INPUTS},
                        np.zeros((n, 2)), clear)
+
+    def _obstacles_at(self, t: float):
+        """Obstacle places ``[O, 2]`` at time ``t`` and their shapes
+        (:func:`obstacles.shapes_at`); worked out once when nothing moves."""
+        if self._still is not None:
+            return self._still
+        where = obs_mod.positions(self.world.obstacles, t)
+        return where, obs_mod.shapes_at(self.world.obstacles, where)
 
     def _walls_near(self, i: int) -> np.ndarray:
         """Robot ``i``'s nearby walls, gathered again once it moved ``NEAR_SLACK`` away."""
