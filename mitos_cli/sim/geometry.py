@@ -181,8 +181,7 @@ def box_segment_distance(hl: float, hw: float, seg: np.ndarray) -> np.ndarray:
     # the endpoints' distances to the box
     e0 = np.hypot(np.maximum(np.abs(x0) - hl, 0.0), np.maximum(np.abs(y0) - hw, 0.0))
     e1 = np.hypot(np.maximum(np.abs(x1) - hl, 0.0), np.maximum(np.abs(y1) - hw, 0.0))
-    corners = np.array([[-hl, -hw], [hl, -hw], [hl, hw], [-hl, hw]])
-    c = point_segment_distance(corners, seg).min(axis=0)
+    c = point_segment_distance(_box_corners(hl, hw), seg).min(axis=0)
     d = np.minimum(np.minimum(e0, e1), c)
     # a segment can cross the box only if it passes within the box's half diagonal of its
     # centre; clip just those (Liang-Barsky)
@@ -193,6 +192,13 @@ def box_segment_distance(hl: float, hw: float, seg: np.ndarray) -> np.ndarray:
         return d
     out = d.copy()
     out[maybe] = _box_crossing(hl, hw, seg[maybe], d[maybe])
+    return out
+
+
+@functools.lru_cache(maxsize=64)
+def _box_corners(hl: float, hw: float) -> np.ndarray:
+    out = np.array([[-hl, -hw], [hl, -hw], [hl, hw], [-hl, hw]])
+    out.flags.writeable = False
     return out
 
 

@@ -163,8 +163,10 @@ def _clearance(pose: np.ndarray, robot, walls: np.ndarray, polygons: np.ndarray,
 
     def local(points: np.ndarray) -> np.ndarray:        # [..., 2] world -> footprint frame
         rel = points - pose[:2]
-        return np.stack([rel[..., 0] * c + rel[..., 1] * s,
-                         -rel[..., 0] * s + rel[..., 1] * c], axis=-1)
+        out = np.empty_like(rel)
+        out[..., 0] = rel[..., 0] * c + rel[..., 1] * s
+        out[..., 1] = -rel[..., 0] * s + rel[..., 1] * c
+        return out
 
     best = math.inf
     ends = local(walls.reshape(-1, 2, 2))
