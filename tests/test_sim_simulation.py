@@ -87,3 +87,12 @@ def test_the_verdicts_end_the_run():
         sim.step()
     assert sim.outcome == "collision" and sim.clearance[0] <= 0.0
     assert sim.result().collisions == 1
+
+
+def test_the_documented_example_runs():
+    import doctest
+
+    from mitos_cli.sim import loop
+
+    failures, tried = doctest.testmod(loop, verbose=False)
+    assert tried >= 5 and failures == 0
