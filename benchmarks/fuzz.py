@@ -243,7 +243,7 @@ def check_finite(compiled) -> None:
     """Evaluate ``compiled`` at the universe's corners, middle and random points: outputs must
     be finite (NaN only where no rule fired and no default is declared) and inside the
     output's universe."""
-    from mitos_cli.engine import evaluate
+    from mitos_cli.engine.evaluation import evaluate
     from mitos_cli.errors import MitosError
 
     lo, hi = compiled.universe[:, 0], compiled.universe[:, 1]
@@ -281,7 +281,7 @@ def _crisp_outside(compiled, j: int) -> bool:
 
 
 def evaluate_all(rb) -> None:
-    from mitos_cli.compile import compile_rulebase
+    from mitos_cli.engine.compile import compile_rulebase
 
     for b in rb.behaviors:
         if b.rules or b.uses:
@@ -304,9 +304,9 @@ class Kinds:
 
     # -- rule files ---------------------------------------------------------------------------
     def run_rules(self, text: str, _work: Path) -> None:
-        from mitos_cli.build import build_rulebase
-        from mitos_cli.parse import parse_rules
-        from mitos_cli.termset import load_termset
+        from mitos_cli.lang.resolve import build_rulebase
+        from mitos_cli.lang.parse import parse_rules
+        from mitos_cli.lang.termfile import load_termset
         from mitos_cli.errors import TermSetError
 
         path = str(self.rb_dir / "fuzz.rules")
@@ -323,9 +323,9 @@ class Kinds:
         evaluate_all(rb)
 
     def run_termset(self, text: str, _work: Path) -> None:
-        from mitos_cli.build import build_rulebase
-        from mitos_cli.parse import parse_rules
-        from mitos_cli.termset import load_termset, parse_termset
+        from mitos_cli.lang.resolve import build_rulebase
+        from mitos_cli.lang.parse import parse_rules
+        from mitos_cli.lang.termfile import load_termset, parse_termset
 
         ts = parse_termset(text, str(self.rb_dir / "fuzz.terms.yaml"))
         names = {v.name for v in ts.variables}
@@ -381,10 +381,10 @@ class Kinds:
         run_lesson(session, text, "fuzz.lesson")
 
     def run_batch(self, text: str, _work: Path) -> None:
-        from mitos_cli.batch import read_batch
+        from mitos_cli.engine.csvio import read_batch
 
         X = read_batch(text, "fuzz.csv", ("road", "size", "position"))
-        from mitos_cli.engine import check_inputs  # noqa: F401  (the CLI checks them next)
+        
 
     def run_journal(self, text: str, work: Path) -> None:
         from mitos_cli.teach.journal import Journal

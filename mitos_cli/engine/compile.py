@@ -311,7 +311,7 @@ def compile_rulebase(rb: RuleBase, behavior: str | None = None,
                                                            ops_mod.resolve(rb.operators)))
     flat = flatten(rb, name)
     if not flat:
-        from .errors import RuleBaseError
+        from ..errors import RuleBaseError
 
         raise RuleBaseError(f"behavior `{name}` has no rules (nor uses a behavior that has)",
                             span=b.span, hint=f"write a rule in `{name}`, or `use` a behavior "
