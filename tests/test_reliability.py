@@ -324,3 +324,19 @@ def test_fuzz_kind_has_no_foreign_exceptions(kinds, name):
         if outcome == "foreign" or outcome == "slow":
             bad.append((i, outcome, sig))
     assert not bad
+
+
+def test_one_wide_rule_does_not_pad_its_level(tmp_path):
+    from mitos_cli.lang.resolve import load_rules_file
+
+    (tmp_path / "mitos.terms.yaml").write_text(
+        (ROOT / "rulebases" / "mitos.terms.yaml").read_text())
+    wide = " and ".join("road is WIDE" if i % 2 else "size is SMALL_SZ" for i in range(10_000))
+    narrow = "\n".join(f"n{i}: if road is WIDE and size is SMALL_SZ and position is LEFT "
+                       f"then steering is {40 + i}" for i in range(27))
+    (tmp_path / "w.rules").write_text(f'terms "mitos.terms.yaml"\n{narrow}\n'
+                                      f"w: if {wide} then steering is 90\n")
+    compiled = compile_rulebase(load_rules_file(tmp_path / "w.rules"))
+    cells = sum(g.children.size for level in compiled.levels for g in level)
+    fan_in = sum(int((g.children >= 2).sum()) for level in compiled.levels for g in level)
+    assert cells <= 2 * fan_in + 64          # padding at most doubles a group, not x 370

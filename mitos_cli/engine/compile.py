@@ -288,14 +288,23 @@ class _Builder:
     def levels(self, tnorm_identity: int = ONE) -> tuple[tuple[NodeGroup, ...], ...]:
         out: dict[int, list[NodeGroup]] = {}
         for (level, op), items in sorted(self.pending.items()):
-            arity = max(len(ch) for _, ch in items)
-            pad = ZERO if op == "or" else ONE
-            children = np.full((len(items), arity), pad, dtype=np.intp)
-            for i, (_, ch) in enumerate(items):
-                children[i, :len(ch)] = ch
-            group = NodeGroup(op, np.array([c for c, _ in items], dtype=np.intp), children)
-            out.setdefault(level, []).append(group)
+            # neurons of similar fan-in share a group (fan-in up to a power of two), so one
+            # rule with 10,000 conditions does not pad every neuron of its level to 10,000
+            buckets: dict[int, list[tuple[int, list[int]]]] = {}
+            for item in items:
+                buckets.setdefault((len(item[1]) - 1).bit_length(), []).append(item)
+            for _, bucket in sorted(buckets.items()):
+                out.setdefault(level, []).append(_group(op, bucket))
         return tuple(tuple(out[k]) for k in sorted(out))
+
+
+def _group(op: str, items: list[tuple[int, list[int]]]) -> NodeGroup:
+    arity = max(len(ch) for _, ch in items)
+    pad = ZERO if op == "or" else ONE
+    children = np.full((len(items), arity), pad, dtype=np.intp)
+    for i, (_, ch) in enumerate(items):
+        children[i, :len(ch)] = ch
+    return NodeGroup(op, np.array([c for c, _ in items], dtype=np.intp), children)
 
 
 def compile_rulebase(rb: RuleBase, behavior: str | None = None,

@@ -22,7 +22,10 @@ MAIN = "main"
 
 def load_rules_file(path: str | Path) -> RuleBase:
     """Read, parse and check the rule file at ``path`` and the term sets it names."""
+    from ..fileio import finish_saves
+
     path = Path(path)
+    finish_saves(path, error=RuleBaseError)   # a set save a crash left half done
     try:
         text = path.read_text(encoding="utf-8")
     except UnicodeDecodeError:
