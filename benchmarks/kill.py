@@ -15,6 +15,11 @@ both the rule file and its term set); kills it with ``SIGKILL`` at a random mome
   before the kill (each lesson line echoed after it) is there, and the changes are a prefix of
   the reference run's.
 
+and, with ``--sweep``, kills ``mitos compare -o DIR`` (2 T-norms x 4 runs on a small world) at a
+random moment, runs ``--resume``, and checks that ``results.csv`` then holds every run once,
+that the rows written before the kill are untouched and that the rows are, bit for bit, those of
+an uninterrupted sweep.
+
 The test suite runs a few trials (``tests/test_reliability.py``); the figures in
 ``docs/reliability.md`` come from this command.
 """
@@ -164,11 +169,113 @@ def campaign(trials: int, seed: int, log=print) -> list[dict]:
         shutil.rmtree(base, ignore_errors=True)
 
 
+# ---- sweeps --------------------------------------------------------------------------------------
+
+TINY = """\
+name: tiny
+seed: 1
+dt: 0.05
+time_limit: 15
+substeps: 2
+behavior: drive
+robot:
+  model: tricycle
+  wheelbase: 16
+  footprint: {length: 24, width: 18}
+  safety_margin: 2
+  steering: {min: 30, max: 150, straight: 90, max_rate: 180}
+  max_speed: 60
+  acceleration: 40
+sensors: {layout: ring, count: 24, cone: 15, range: 120, noise: 0.5}
+q_init: {x: 30, y: -10, heading: 0}
+q_goal: {x: 250, y: -10, tolerance: 12}
+map:
+  corridors:
+    - points: [[0, 0], [280, 0]]
+      width: 70
+obstacles:
+  - name: box
+    shape: circle
+    at: [150, -12]
+    radius: 9
+randomise:
+  obstacles:
+    box: {dx: [-30, 30], dy: [-10, 10]}
+  sensor_noise: [0, 1.5]
+"""
+SWEEP_RUNS = 8
+
+
+def _sweep(work: Path, resume: bool = False) -> list[str]:
+    args = [sys.executable, "-m", "mitos_cli", "compare", "tiny.yaml", "--and", "min,product",
+            "--planner", "fuzzy", "--runs", str(SWEEP_RUNS // 2), "-j", "1", "-o", "out",
+            "--no-plots"]
+    return args + (["--resume"] if resume else [])
+
+
+def _rows(work: Path) -> list[str]:
+    path = work / "out" / "results.csv"
+    if not path.exists():
+        return []
+    lines = path.read_text().split("\n")
+    return [line for line in lines[1:-1] if line]      # whole rows only
+
+
+def sweep_trial(work: Path, whole: list[str], delay: float) -> dict:
+    (work / "tiny.yaml").write_text(TINY)
+    proc = subprocess.Popen(_sweep(work), cwd=work, stdout=subprocess.DEVNULL,
+                            stderr=subprocess.DEVNULL)
+    time.sleep(delay)
+    proc.send_signal(signal.SIGKILL)
+    proc.wait()
+    before = _rows(work)
+    r = subprocess.run(_sweep(work, resume=True), cwd=work, capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr[-500:]
+    after = _rows(work)
+    assert after[:len(before)] == before, "a row written before the kill changed"
+    assert len(after) == SWEEP_RUNS, f"{len(after)} rows, expected {SWEEP_RUNS}"
+    assert sorted(after) == sorted(whole), "the rows differ from an uninterrupted sweep's"
+    return {"before": len(before)}
+
+
+def sweep_campaign(trials: int, seed: int, log=print) -> list[dict]:
+    rng = random.Random(seed + 1)
+    base = Path(tempfile.mkdtemp(prefix="mitos-sweep-"))
+    try:
+        ref = base / "whole"
+        ref.mkdir()
+        (ref / "tiny.yaml").write_text(TINY)
+        t0 = time.perf_counter()
+        subprocess.run(_sweep(ref), cwd=ref, capture_output=True, check=True)
+        span = time.perf_counter() - t0
+        whole = _rows(ref)
+        results = []
+        for i in range(trials):
+            work = base / f"t{i}"
+            work.mkdir()
+            delay = rng.uniform(0.0, span)
+            result = sweep_trial(work, whole, delay)
+            results.append(result)
+            log(f"sweep {i + 1}: killed at {delay:.2f} s of {span:.2f} s with "
+                f"{result['before']} of {SWEEP_RUNS} rows written; resumed to {SWEEP_RUNS}")
+            shutil.rmtree(work, ignore_errors=True)
+        return results
+    finally:
+        shutil.rmtree(base, ignore_errors=True)
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--trials", type=int, default=50)
+    ap.add_argument("--sweep", action="store_true", help="kill sweeps instead of teaching")
     ap.add_argument("--seed", type=int, default=20261201)
     args = ap.parse_args(argv)
+    if args.sweep:
+        results = sweep_campaign(args.trials, args.seed)
+        counts = sorted({r["before"] for r in results})
+        print(f"\n{len(results)} kills, no violation; rows written before the kill: "
+              + ", ".join(f"{c} x{sum(r['before'] == c for r in results)}" for c in counts))
+        return 0
     results = campaign(args.trials, args.seed)
     saves = sorted({r["saved"] for r in results})
     print(f"\n{len(results)} kills, no violation; saved state on disk: "
