@@ -340,3 +340,38 @@ def test_one_wide_rule_does_not_pad_its_level(tmp_path):
     cells = sum(g.children.size for level in compiled.levels for g in level)
     fan_in = sum(int((g.children >= 2).sum()) for level in compiled.levels for g in level)
     assert cells <= 2 * fan_in + 64          # padding at most doubles a group, not x 370
+
+
+def test_teaching_killed_while_saving_keeps_a_whole_set(tmp_path, monkeypatch):
+    """One trial of ``benchmarks/kill.py`` (50 of them give the figures in the docs): the kill
+    lands at a random moment of a lesson that saves six times."""
+    import random
+
+    sys.path.insert(0, str(ROOT / "benchmarks"))
+    import kill
+
+    monkeypatch.chdir(tmp_path)
+    pairs, changes = kill.reference(tmp_path / "reference")
+    work = tmp_path / "trial"
+    work.mkdir()
+    result = kill.trial(work, pairs, changes, random.Random().uniform(1.5, 6.0))
+    assert 0 <= result["saved"] <= kill.ROUNDS
+
+
+def test_interrupted_set_save_is_finished_or_dropped(tmp_path):
+    from mitos_cli.fileio import _manifest, atomic_write_set, finish_saves
+
+    a, b = tmp_path / "x.rules", tmp_path / "x.terms.yaml"
+    atomic_write_set([(b, "old terms"), (a, "old rules")], a)
+    # a crash after the manifest: the next read carries the save out
+    (tmp_path / ".x.terms.yaml.999999.ab.tmp").write_text("new terms")
+    (tmp_path / ".x.rules.999999.cd.tmp").write_text("new rules")
+    _manifest(a).write_text('[[".x.terms.yaml.999999.ab.tmp", "x.terms.yaml"], '
+                            '[".x.rules.999999.cd.tmp", "x.rules"]]')
+    assert finish_saves(a)
+    assert (a.read_text(), b.read_text()) == ("new rules", "new terms")
+    # a crash before it: the old set stays and the temporary file goes
+    (tmp_path / ".x.rules.999999.ef.tmp").write_text("newer rules")
+    assert not finish_saves(a)
+    assert a.read_text() == "new rules"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["x.rules", "x.terms.yaml"]
