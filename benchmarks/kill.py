@@ -89,6 +89,7 @@ def _pair(work: Path) -> tuple[tuple[str, str], ...]:
 
 def trial(work: Path, pairs, changes, delay: float) -> dict:
     """One kill at ``delay`` seconds after the start; raises AssertionError on a violation."""
+    from mitos_cli.errors import LessonError
     from mitos_cli.fileio import finish_saves
     from mitos_cli.teach.journal import Journal, find_session
     from mitos_cli.teach.session import Session
@@ -117,8 +118,9 @@ def trial(work: Path, pairs, changes, delay: float) -> dict:
     os.chdir(work)
     try:
         journal = Journal.open(find_session(None, work))
-    except Exception:
-        assert acknowledged == 0, "no journal, though changes were acknowledged"
+    except LessonError as exc:            # killed before the session's first entry
+        assert acknowledged == 0, f"no session to resume ({exc.message}), though changes " \
+                                  f"were acknowledged"
         return {"saved": saved, "changes": 0, "torn": False}
     session = Session.resume(journal, out=lambda s: None)
     got = [(e["op"], e.get("line")) for e in session.journal.active()]

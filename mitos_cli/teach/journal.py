@@ -53,8 +53,10 @@ def new_session_dir(stem: str, base: Path | None = None) -> Path:
 def find_session(name: str | None, base: Path | None = None) -> Path:
     """The session called ``name``, or the most recently changed one."""
     root = sessions_dir(base)
-    found = sorted((p for p in root.glob("*/" + JOURNAL)), key=lambda p: p.stat().st_mtime) \
-        if root.is_dir() else []
+    # a session killed before its first entry was written has an empty journal: nothing to
+    # resume there, so the newest session is the newest with a journal that holds something
+    found = sorted((p for p in root.glob("*/" + JOURNAL) if p.stat().st_size),
+                   key=lambda p: p.stat().st_mtime) if root.is_dir() else []
     if name is not None:
         direct = Path(name)
         if (direct / JOURNAL).is_file():
