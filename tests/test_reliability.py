@@ -375,3 +375,14 @@ def test_interrupted_set_save_is_finished_or_dropped(tmp_path):
     assert not finish_saves(a)
     assert a.read_text() == "new rules"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["x.rules", "x.terms.yaml"]
+
+
+def test_frozen_outside_a_behavior_is_positioned():
+    from mitos_cli.lang.resolve import build_rulebase
+    from mitos_cli.lang.termfile import load_termset
+
+    text = 'terms "mitos.terms.yaml"\n\n  frozen r1\n'
+    ts = load_termset(ROOT / "rulebases" / "mitos.terms.yaml")
+    with pytest.raises(RuleBaseError) as info:
+        build_rulebase(parse_rules(text, "f.rules"), (ts,), ("mitos.terms.yaml",))
+    assert (info.value.span.line, info.value.span.column) == (3, 3)
