@@ -160,8 +160,8 @@ def campaign(trials: int, seed: int, log=print) -> list[dict]:
             delay = rng.uniform(start, span)
             result = trial(work, pairs, changes, delay)
             results.append(result)
-            log(f"trial {i + 1}: killed at {delay:.2f} s (lesson {start:.2f}-{span:.2f} s): save {result['saved']}"
-                f" on disk, {result['changes']} changes resumed"
+            log(f"trial {i + 1}: killed at {delay:.2f} s (lesson {start:.2f}-{span:.2f} s): "
+                f"save {result['saved']} on disk, {result['changes']} changes resumed"
                 + (" (torn last line dropped)" if result["torn"] else ""))
             os.chdir(cwd)
             shutil.rmtree(work, ignore_errors=True)

@@ -15,8 +15,16 @@ import pytest
 
 from mitos_cli.engine.compile import compile_rulebase
 from mitos_cli.engine.csvio import read_batch
-from mitos_cli.errors import InputError, LessonError, MitosError, RuleBaseError, RuleSyntaxError, \
-    Span, TermSetError, WorldError
+from mitos_cli.errors import (
+    InputError,
+    LessonError,
+    MitosError,
+    RuleBaseError,
+    RuleSyntaxError,
+    Span,
+    TermSetError,
+    WorldError,
+)
 from mitos_cli.lang import yamlpos
 from mitos_cli.lang.parse import parse_rules
 from mitos_cli.sim.gridmap import load_map_yaml
