@@ -198,10 +198,17 @@ class Session:
     def resume(cls, journal: Journal, out: Callable[[str], None] | None = None,
                progress: Callable | None = None, recover: bool = False) -> "Session":
         start = journal.entries[0] if journal.entries else None
+        first = Span(str(journal.path), journal.lines[0] if journal.lines else 1, 1)
         if start is None or start.get("op") != "start":
-            raise LessonError(f"{journal.path}: not a teaching journal (no start entry)")
-        session = cls(start["rules"], start["behavior"], journal, start.get("save_as"), out,
-                      progress)
+            raise LessonError("not a teaching journal (it does not begin with the session's "
+                              "start)", span=first)
+        try:
+            session = cls(start["rules"], start["behavior"], journal, start.get("save_as"),
+                          out, progress)
+        except MitosError as exc:       # the rule file or behavior the journal names
+            if exc.span is None:
+                exc.span = first
+            raise
         if files_digest(session.original) != start.get("digest"):
             session.out(f"warning: {start['rules']} or its term set changed since the session "
                         f"started; the journal's changes are applied to the files as they are now")
