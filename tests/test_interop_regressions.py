@@ -51,8 +51,8 @@ RuleBlock: b
 
 
 def test_rule_language_reads_a_name_beginning_with_a_hedge_as_a_name():
-    rb = parse_rules("if x is veryhigh then y is anyway\nif x is notable then y is somewhat_low\n"
-                     "if x is very high then y is low\n")
+    rb = parse_rules("behavior b:\n if x is veryhigh then y is anyway\n"
+                     " if x is notable then y is somewhat_low\n if x is very high then y is low\nend\n")
     a, b, c = rb.behaviors[0].rules
     assert (a.antecedent.term, a.antecedent.hedges) == ("veryhigh", ())
     assert a.consequents[0].term == "anyway"
