@@ -8,7 +8,7 @@ from typing import Annotated, Optional
 
 import typer
 
-from .output import emit, err, warn
+from .output import emit, err, warn, warn_notes
 
 
 class Target(str, Enum):
@@ -41,6 +41,7 @@ def convert_command(
     from ..interop.common import atomic_write
 
     rb = read_rulebase(path)
+    warn_notes(rb)
     if behavior is not None:
         rb.behavior(behavior)                     # unknown behavior: did you mean
     if to is Target.rules:

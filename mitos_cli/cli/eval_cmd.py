@@ -10,7 +10,7 @@ from typing import Annotated, Optional
 import typer
 
 from ..errors import InputError
-from .output import emit, warn
+from .output import emit, warn, warn_notes
 from ..words import plural
 
 
@@ -78,6 +78,7 @@ def eval_command(
         raise typer.BadParameter(f"`{path}` is neither a rule file nor NAME=VALUE (no file "
                                  f"of that name; write each input as NAME=VALUE)")
     rb = load_rulebase(path, behavior)
+    warn_notes(rb.rulebase)
     if network:
         from ..network import describe_network
 

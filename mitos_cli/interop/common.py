@@ -58,6 +58,14 @@ FCL_ALIASES = {"BIS": "bisector", "MOM": "mom", "SOM": "som", "LOM": "lom",
                "ALGEBRAIC_PRODUCT": "product", "PROBOR": "probabilistic_sum",
                "DMIN": "drastic", "DMAX": "drastic_sum", "NIPMIN": "nilpotent_minimum",
                "NIPMAX": "nilpotent_maximum", "EINSTEIN": "einstein", "HAMACHER": "hamacher"}
+#: The names Octave's fuzzy-logic-toolkit (and fuzzylite's .fis exporter) give the norms
+#: MATLAB has no name for.
+FIS_ALIASES = {"algebraic_product": "product", "bounded_difference": "lukasiewicz",
+               "drastic_product": "drastic", "einstein_product": "einstein",
+               "hamacher_product": "hamacher", "nilpotent_minimum": "nilpotent_minimum",
+               "algebraic_sum": "probabilistic_sum", "bounded_sum": "bounded_sum",
+               "drastic_sum": "drastic_sum", "einstein_sum": "einstein_sum",
+               "hamacher_sum": "hamacher_sum", "nilpotent_maximum": "nilpotent_maximum"}
 #: Names formats use for operators MITOS does not have (refused with this explanation).
 UNSUPPORTED_NORMS = {
     "NormalizedSum": "the normalized sum is not an S-norm MITOS computes",
@@ -83,6 +91,8 @@ def table_lookup(table: dict, fmt: int, name: str, what: str, span: Span | None,
             return mitos
     if fmt == FCL and name.upper() in FCL_ALIASES and FCL_ALIASES[name.upper()] in table:
         return FCL_ALIASES[name.upper()]
+    if fmt == FIS and FIS_ALIASES.get(name) in table:
+        return FIS_ALIASES[name]
     pool = [n[fmt] for n in table.values() if n[fmt] is not None]
     why = UNSUPPORTED_NORMS.get(name) or (UNSUPPORTED_NORMS.get(name.upper()) if fmt == FCL
                                           else None)

@@ -23,6 +23,7 @@ another resolution or sampling: a ``.fis`` file always means MATLAB's.
 
 from __future__ import annotations
 
+import dataclasses
 import re
 from pathlib import Path
 
@@ -55,7 +56,7 @@ MF_TYPES = {
 SYSTEM_KEYS = ("Name", "Type", "Version", "NumInputs", "NumOutputs", "NumRules", "AndMethod",
                "OrMethod", "ImpMethod", "AggMethod", "DefuzzMethod",
                "DisableStructuralChecks")     # MATLAB R2018b+; only affects MATLAB's editor
-VAR_KEYS = ("Name", "Range", "NumMFs")
+VAR_KEYS = ("Name", "Range", "NumMFs", "Enabled")     # Enabled=1: fuzzylite's exporter
 
 
 def read_fis(path: str | Path) -> RuleBase:
@@ -71,7 +72,7 @@ def _sections(text: str, path: str | None):
     rules: list = []
     for lineno, raw in enumerate(text.splitlines(), 1):
         line = raw.strip()
-        if not line:
+        if not line or line[0] in "%#":         # MATLAB's readfis skips % and # comment lines
             continue
         span = Span.in_text(text, path, lineno, len(raw) - len(raw.lstrip()) + 1,
                             len(raw.rstrip()) + 1)
@@ -131,10 +132,15 @@ def parse_fis(text: str, path: str | None = None) -> RuleBase:
         raise FormatError(f"FIS type `{kind}` is not supported", span=system["Type"][1],
                           expected="mamdani or sugeno")
     settings = Settings()
+    unset: dict[str, Span] = {}
 
     def method(key: str, table: dict, what: str, default: str) -> str | None:
         value, vspan = system.get(key, (f"'{default}'", sys_span))
-        return common.table_lookup(table, FIS, _string(value, vspan), what, vspan)
+        name = _string(value, vspan)
+        if not name:               # fuzzylite writes '' for an operator its rules never use
+            unset[key] = vspan
+            return default
+        return common.table_lookup(table, FIS, name, what, vspan)
 
     settings.set("and_", method("AndMethod", common.TNORMS, "AND method", "min"), None, "and")
     settings.set("or_", method("OrMethod", common.SNORMS, "OR method", "max"), None, "or")
@@ -154,16 +160,42 @@ def parse_fis(text: str, path: str | None = None) -> RuleBase:
         settings.set("resolution", DEFAULT_RESOLUTION, None, "resolution")
         settings.set("sampling", "endpoints", None, "sampling")
 
-    inputs = _variables(sections, "Input", "input", kind)
+    notes: list[str] = []
+    inputs = _variables(sections, "Input", "input", kind, notes)
     n_inputs = len(inputs)
-    outputs = _variables(sections, "Output", "output", kind, n_inputs)
+    outputs = _variables(sections, "Output", "output", kind, notes, n_inputs)
     _check_count(system, "NumInputs", len(inputs), sys_span)
     _check_count(system, "NumOutputs", len(outputs), sys_span)
     variables = inputs + outputs
     rules = [_rule(line, lineno, span, inputs, outputs, text, path, i)
              for i, (line, lineno, span) in enumerate(rule_lines)]
     _check_count(system, "NumRules", len(rules), sys_span)
-    return common.assemble(path, variables, rules, settings, DEFAULT_RESOLUTION, sys_span)
+    for key, connective in (("AndMethod", And), ("OrMethod", Or)):
+        used = next((r for r in rules if isinstance(r.antecedent, connective)), None)
+        if key in unset and used is not None:
+            raise FormatError(f"{key}='' but rule {used.label} joins its conditions with "
+                              f"{'AND' if connective is And else 'OR'}", span=used.span,
+                              hint=f"give {key} a method, e.g. "
+                                   f"'{'min' if connective is And else 'max'}'")
+    rb = common.assemble(path, variables, rules, settings, DEFAULT_RESOLUTION, sys_span)
+    return dataclasses.replace(rb, notes=tuple(notes))
+
+
+def _distinct_names(terms: list[Term], variable: str, notes: list[str]) -> list[Term]:
+    """Rules name MFs by index, so a .fis may repeat a name; MITOS names must differ: a repeat
+    gets a suffix (``low_2``) and a note."""
+    seen: set[str] = set()
+    out = []
+    for t in terms:
+        if t.name in seen:
+            new = common.unique_name(f"{t.name}_2" if not t.name.endswith("_2") else t.name,
+                                     seen | {x.name for x in terms})
+            notes.append(f"{t.span}: `{variable}` has two MFs named `{t.name}`; the second is "
+                         f"read as `{new}` (rules refer to MFs by index, so nothing else changes)")
+            t = Term(new, t.shape, t.params, t.span)
+        seen.add(t.name)
+        out.append(t)
+    return out
 
 
 def _check_count(system: dict, key: str, found: int, span: Span) -> None:
@@ -173,22 +205,28 @@ def _check_count(system: dict, key: str, found: int, span: Span) -> None:
             raise FormatError(f"{key}={value} but the file has {found}", span=vspan)
 
 
-def _variables(sections, prefix: str, role: str, kind: str, n_inputs: int = 0) -> list[Variable]:
+def _variables(sections, prefix: str, role: str, kind: str, notes: list[str],
+               n_inputs: int = 0) -> list[Variable]:
     found = [(int(name[len(prefix):]), span, items) for name, span, items in sections
              if re.fullmatch(prefix + r"\d+", name)]
     found.sort(key=lambda f: f[0])
     for i, (number, span, _) in enumerate(found, 1):
         if number != i:
             raise FormatError(f"expected [{prefix}{i}], found [{prefix}{number}]", span=span)
-    return [_variable(span, items, role, kind, n_inputs) for _, span, items in found]
+    return [_variable(span, items, role, kind, n_inputs, notes) for _, span, items in found]
 
 
-def _variable(span: Span, items, role: str, kind: str, n_inputs: int) -> Variable:
+def _variable(span: Span, items, role: str, kind: str, n_inputs: int,
+              notes: list[str]) -> Variable:
     values = {}
     terms: list[Term] = []
     for key, value, kspan, vspan in items:
         if re.fullmatch(r"MF\d+", key):
             terms.append(_mf(value, vspan, role, kind, n_inputs))
+        elif key == "Enabled":
+            if value.strip() != "1":
+                raise FormatError(f"`Enabled={value}`: MITOS has no disabled variables",
+                                  span=vspan, hint="delete the variable or enable it")
         elif key in VAR_KEYS:
             values[key] = (value, vspan)
         else:
@@ -198,6 +236,7 @@ def _variable(span: Span, items, role: str, kind: str, n_inputs: int) -> Variabl
     if "Name" not in values or "Range" not in values:
         raise FormatError("a variable needs `Name` and `Range`", span=span)
     name = _string(*values["Name"])
+    terms = _distinct_names(terms, name, notes)
     rng = _vector(*values["Range"])
     if len(rng) != 2 or not rng[0] < rng[1]:
         raise FormatError("`Range` must be [min max] with min < max", span=values["Range"][1])
@@ -231,6 +270,8 @@ def _mf(value: str, vspan: Span, role: str, kind: str, n_inputs: int) -> Term:
                           span=vspan, expected="one of " + ", ".join(list(MF_TYPES) + ["linear"]),
                           hint=did_you_mean(mf, MF_TYPES))
     shape, count, order = MF_TYPES[mf]
+    if len(params) > count and not any(params[count:]):
+        params = params[:count]        # old MATLAB files pad every list with zeros to one length
     if len(params) != count:
         raise FormatError(f"MF `{name}`: {mf} takes {plural(count, 'number')}, not {len(params)}",
                           span=vspan)
