@@ -12,15 +12,17 @@ from .errors import InputError, Span, did_you_mean
 from .words import plural
 
 
-def read_batch(text: str, path: str, inputs: tuple[str, ...]) -> np.ndarray:
-    """``X[n, k]`` from CSV text whose header names every input (any column order)."""
+def read_batch(text: str, path: str, inputs: tuple[str, ...],
+               unused: tuple[str, ...] = ()) -> np.ndarray:
+    """``X[n, k]`` from CSV text whose header names every input (any column order); columns
+    named in ``unused`` (inputs of the rule base its rules never test) are read and dropped."""
     lines = text.splitlines()
     if not lines or not lines[0].strip():
         raise InputError("the batch CSV is empty", span=Span(path, 1, 1),
                          expected="a header naming the inputs: " + ",".join(inputs))
     header = [h.strip() for h in next(csv.reader([lines[0]]))]
     for h in header:
-        if h not in inputs:
+        if h not in inputs and h not in unused:
             raise InputError(f"batch column `{h}` is not an input of this behavior",
                              span=Span.in_text(text, path, 1, lines[0].find(h) + 1),
                              expected="columns " + ", ".join(inputs),

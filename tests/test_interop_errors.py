@@ -253,8 +253,10 @@ FCL_CASES = [
     ("DEFAULT := 0;", "DEFAULT := 0;\n	LOCK : FOREVER;", "unknown LOCK `FOREVER`"),
     ("	TERM rancid := (0, 1) (1, 1) (3,0) ;\n	TERM delicious := (7,0) (9,1);\n", "",
      "variable `food` has no terms"),
-    ("TERM rancid := (0, 1) (1, 1) (3,0) ;", "TERM rancid := gauss 0 1;",
-     "has no RANGE and its `rancid` term (gaussian)"),
+    # a gauss term without RANGE gets jFuzzyLogic's estimate (mean -+ 4 sigma); a shape that
+    # jFuzzyLogic has no estimate for is still refused
+    ("TERM rancid := (0, 1) (1, 1) (3,0) ;", "TERM rancid := Spike 0 1;",
+     "has no RANGE and its `rancid` term (spike)"),
     ("	TERM rancid := (0, 1) (1, 1) (3,0) ;\n	TERM delicious := (7,0) (9,1);\n",
      "	TERM rancid := 3;\n", "its terms do not span one"),
     ("RANGE := (0 .. 30);", "RANGE := (30 .. 0);", "range [30, 0] is empty"),

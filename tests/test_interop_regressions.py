@@ -126,3 +126,99 @@ def test_fis_keeps_duplicate_mf_names_apart_and_says_so():
 def test_fis_padded_list_with_a_nonzero_extra_number_is_refused():
     with pytest.raises(MitosError, match="gbellmf takes 3 numbers, not 4"):
         parse_fis(FIS.replace("[3 2 0 0]", "[3 2 0 1]"), "small.fis")
+
+
+# ---------------------------------------------------------------------------------------------
+# jFuzzyLogic's FCL
+
+from typer.testing import CliRunner  # noqa: E402
+
+from mitos_cli.cli.app import app  # noqa: E402
+
+runner = CliRunner(env={"COLUMNS": "200", "NO_COLOR": "1"})
+
+JFUZZY = """\
+FUNCTION_BLOCK t
+VAR_INPUT
+    x : REAL RANGE := (0 .. 10);
+    unused : REAL;
+END_VAR
+VAR_OUTPUT
+    y : REAL;
+END_VAR
+FUZZIFY x
+    TERM low := gauss 2 1;
+    TERM high := gauss 8 1;
+END_FUZZIFY
+FUZZIFY unused
+    TERM a := sigm 2 5;
+END_FUZZIFY
+DEFUZZIFY y
+    TERM a := dsigm 4 2 1 6;
+    TERM b := gbell 2 3 8;
+    METHOD : COG;
+    DEFAULT := 0;
+END_DEFUZZIFY
+RULEBLOCK r
+    AND : MIN;
+    ACT : MIN;
+    ACCU : MAX;
+    RULE 1 : IF NOT x IS low THEN y IS b;
+    RULE 2 : IF x IS low THEN y IS a;
+END_RULEBLOCK
+END_FUNCTION_BLOCK
+"""
+
+
+def test_fcl_reads_not_before_a_proposition_and_range_in_var_input():
+    rb = parse_fcl(JFUZZY, "t.fcl")
+    from mitos_cli.model import Not, Prop
+
+    r1 = rb.behaviors[0].rules[0]
+    assert r1.antecedent == Not(Prop("x", "low"))
+    assert rb.variables["x"].universe == (0.0, 10.0)
+
+
+def test_fcl_derives_a_missing_range_from_unbounded_terms_as_jfuzzylogic():
+    rb = parse_fcl(JFUZZY, "t.fcl")
+    # sigm 2 5: 5 -+ 9/2; dsigm 4 2 1 6: [min(2 - 9/4, 6 - 9), max(2 + 9/4, 6 + 9)];
+    # gbell 2 3 8: 8 -+ 2 * 999^(1/6)
+    assert rb.variables["unused"].universe == (0.5, 9.5)
+    lo, hi = rb.variables["y"].universe
+    assert lo == pytest.approx(-3.0) and hi == pytest.approx(15.0)
+    assert any("`y` has no RANGE" in n and "t.fcl:16:1" in n for n in rb.notes)
+
+
+def test_fcl_dsigm_is_jfuzzylogics_clipped_difference():
+    rb = parse_fcl(JFUZZY, "t.fcl")
+    term = rb.variables["y"].term("a")
+    x = np.array([-2.0, 2.0, 6.0, 9.0, 12.0, np.nan])
+    s1 = 1 / (1 + np.exp(-4 * (x - 2)))
+    s2 = 1 / (1 + np.exp(-1 * (x - 6)))
+    from mitos_cli.shapes import SHAPES
+
+    got = SHAPES[term.shape].membership(x, term.params)
+    np.testing.assert_allclose(got[:-1], np.maximum(s1 - s2, 0)[:-1], rtol=0, atol=1e-15)
+    assert got[0] == 0.0 and np.isnan(got[-1])     # |s1 - s2| would give 3.4e-4 at -2
+
+
+def test_fcl_function_terms_and_multiple_blocks_are_refused_by_name():
+    text = JFUZZY.replace("TERM b := gbell 2 3 8;", "TERM b := FUNCTION (x * 2);")
+    with pytest.raises(MitosError) as info:
+        parse_fcl(text, "t.fcl")
+    assert "FUNCTION terms" in info.value.message and info.value.span.line == 18
+    with pytest.raises(MitosError) as info:
+        parse_fcl(JFUZZY + JFUZZY, "t.fcl")
+    assert "2 function blocks" in info.value.message and info.value.span.line == 30
+
+
+def test_batch_accepts_a_column_for_an_input_no_rule_tests(tmp_path: Path):
+    path = tmp_path / "t.fcl"
+    path.write_text(JFUZZY)
+    csv = tmp_path / "in.csv"
+    csv.write_text("x,unused\n1,2\n8,3\n")
+    result = runner.invoke(app, ["eval", str(path), "--batch", str(csv)])
+    assert result.exit_code == 0, result.output
+    assert result.stdout.splitlines()[0] == "x,y" and len(result.stdout.splitlines()) == 3
+    result = runner.invoke(app, ["eval", str(path), "x=1", "unused=2"])
+    assert result.exit_code == 0, result.output

@@ -98,13 +98,22 @@ def eval_command(
     from ..engine import as_batch, evaluate
     from ..trace import trace_of
 
-    result = evaluate(rb.compiled, as_batch(rb.compiled, parse_values(values)))
+    unused = unused_inputs(rb)
+    given = {k: v for k, v in parse_values(values).items() if k not in unused}
+    result = evaluate(rb.compiled, as_batch(rb.compiled, given))
     warn_clamped(result)
     trace = trace_of(result)
     if as_json:
         emit(json.dumps(trace.to_json(), indent=2))
     else:
         emit(trace.render(digits))
+
+
+def unused_inputs(rb) -> tuple[str, ...]:
+    """Inputs the file declares but the behavior's rules never test: a table of the file's
+    inputs may still give them (and their values change nothing)."""
+    return tuple(v.name for v in rb.rulebase.variables.values()
+                 if v.role == "input" and v.name not in rb.compiled.inputs)
 
 
 def run_batch(rb, source: str) -> None:
@@ -121,7 +130,7 @@ def run_batch(rb, source: str) -> None:
         except (OSError, UnicodeDecodeError) as exc:
             raise InputError(f"cannot read batch file `{source}`: "
                              f"{getattr(exc, 'strerror', None) or exc}") from None
-    X = read_batch(text, name, rb.compiled.inputs)
+    X = read_batch(text, name, rb.compiled.inputs, unused_inputs(rb))
     result = rb.run(X)
     warn_clamped(result)
     write_batch(sys.stdout, rb.compiled.inputs, np.asarray(X), rb.compiled.outputs,

@@ -49,6 +49,10 @@ C_SHAPES = {
     "sigmoid_difference": """static double mf_sigmoid_difference(double x, double l, double r, double f, double rt) {
     return fabs(1.0 / (1.0 + exp(-(r * (x - l)))) - 1.0 / (1.0 + exp(-(f * (x - rt)))));
 }""",
+    "clipped_sigmoid_difference": """static double mf_clipped_sigmoid_difference(double x, double l, double r, double f, double rt) {
+    double d = 1.0 / (1.0 + exp(-(r * (x - l)))) - 1.0 / (1.0 + exp(-(f * (x - rt))));
+    return d > 0.0 ? d : (d == d ? 0.0 : d);
+}""",
     "sigmoid_product": """static double mf_sigmoid_product(double x, double l, double r, double f, double rt) {
     return (1.0 / (1.0 + exp(-(r * (x - l))))) * (1.0 / (1.0 + exp(-(f * (x - rt)))));
 }""",
@@ -519,6 +523,7 @@ def _py_shapes(shapes) -> list[str]:
             return
         done.add(name)
         deps = {"pi_shape": ("s_shape", "z_shape"), "sigmoid_difference": ("sigmoid",),
+                "clipped_sigmoid_difference": ("sigmoid",),
                 "sigmoid_product": ("sigmoid",), "gaussian2": ("gaussian",),
                 "rectangle": ("trapezoid",), "ramp": ("trapezoid",)}.get(name, ())
         for d in deps:
