@@ -31,6 +31,7 @@ class Result:
     outputs: np.ndarray       # [n, m]
     clamped: np.ndarray       # [k] how many samples of each input were clamped
     values: np.ndarray | None = None  # [n, columns] every neuron's value (kept on request)
+    no_rule: np.ndarray | None = None  # [n, m] True where no rule set the output (before defaults)
 
     # memberships and dof are transposed views of [T, n] / [R, n] arrays (rows are samples).
 
@@ -328,9 +329,10 @@ def evaluate(compiled: CompiledRuleBase, X, *, detail: bool = True, keep_values:
         if keep_values:
             values[:, block] = V
     X = clamped_in.T
+    no_rule = np.isnan(out.T)
     outputs = fill_defaults(compiled, out.T, X, strict)
     return Result(compiled, X, mu.T if detail else None, dof.T if detail else None, outputs,
-                  counts, values.T if keep_values else None)
+                  counts, values.T if keep_values else None, no_rule)
 
 
 def evaluate_one(compiled: CompiledRuleBase, values: list[float],
@@ -375,6 +377,13 @@ def infer(compiled: CompiledRuleBase, dof: np.ndarray,
     return weighted_average(compiled, dof, Xt)
 
 
+def declares_nan(compiled: CompiledRuleBase, output: str) -> bool:
+    """Whether ``output`` declares NaN as its value when no rule fires (fuzzylite's
+    ``default: nan``, FCL's ``DEFAULT := nan``, a term set's ``default: .nan``)."""
+    v = compiled.variables.get(output)
+    return v is not None and v.default is not None and v.default != v.default
+
+
 def fill_defaults(compiled: CompiledRuleBase, out: np.ndarray, X: np.ndarray,
                   strict: bool) -> np.ndarray:
     """Where no rule fired (NaN), use the output's default or explain how to declare one."""
@@ -388,6 +397,8 @@ def fill_defaults(compiled: CompiledRuleBase, out: np.ndarray, X: np.ndarray,
         default = compiled.default[j]
         if not np.isnan(default):
             out[col, j] = default
+        elif declares_nan(compiled, name):
+            continue                           # the rule base asked for NaN here
         elif strict:
             row = int(np.argmax(col))
             values = ", ".join(f"{k}={X[row, i]:g}" for i, k in enumerate(compiled.inputs))

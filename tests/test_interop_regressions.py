@@ -222,3 +222,76 @@ def test_batch_accepts_a_column_for_an_input_no_rule_tests(tmp_path: Path):
     assert result.stdout.splitlines()[0] == "x,y" and len(result.stdout.splitlines()) == 3
     result = runner.invoke(app, ["eval", str(path), "x=1", "unused=2"])
     assert result.exit_code == 0, result.output
+
+
+# ---------------------------------------------------------------------------------------------
+# No rule fired in a batch
+
+DIMMER = """\
+Engine: dimmer
+InputVariable: light
+  range: 0 1
+  term: DARK Triangle 0.2 0.4 0.6
+  term: BRIGHT Triangle 0.4 0.6 0.8
+OutputVariable: power
+  range: 0 1
+  defuzzifier: WeightedAverage
+  default: nan
+  term: HIGH Constant 0.9
+  term: LOW Constant 0.1
+RuleBlock: b
+  conjunction: Minimum
+  disjunction: Maximum
+  rule: if light is DARK then power is HIGH
+  rule: if light is BRIGHT then power is LOW
+"""
+
+
+def batch(tmp_path: Path, fll: str, *options: str):
+    path = tmp_path / "dimmer.fll"
+    path.write_text(fll)
+    csv = tmp_path / "in.csv"
+    csv.write_text("light\n0.1\n0.4\n0.5\n0.9\n")
+    return runner.invoke(app, ["eval", str(path), "--batch", str(csv), *options])
+
+
+def test_batch_honours_a_declared_nan_default_and_counts_the_rows(tmp_path: Path):
+    result = batch(tmp_path, DIMMER)
+    assert result.exit_code == 0, result.output
+    assert result.stdout.splitlines() == ["light,power", "0.1,nan", "0.4,0.9", "0.5,0.5",
+                                          "0.9,nan"]
+    assert "no rule sets `power` in 2 rows of 4: the file's default (nan)" in result.stderr
+
+
+def test_batch_without_a_declared_default_stops_unless_asked(tmp_path: Path):
+    fll = DIMMER.replace("  default: nan\n", "")
+    result = batch(tmp_path, fll)
+    assert result.exit_code == 1 and "no rule sets `power` for light=0.1 (2 of 4 rows)" in \
+        str(result.exception) and "--on-no-rule" in result.exception.hint
+    result = batch(tmp_path, fll, "--on-no-rule", "nan")
+    assert result.exit_code == 0, result.output
+    assert result.stdout.splitlines() == ["light,power,no_rule", "0.1,nan,power", "0.4,0.9,",
+                                          "0.5,0.5,", "0.9,nan,power"]
+    result = batch(tmp_path, fll, "--on-no-rule", "skip")
+    assert result.stdout.splitlines() == ["light,power,no_rule", "0.4,0.9,", "0.5,0.5,"]
+    assert "in 2 rows of 4: left out" in result.stderr
+    result = batch(tmp_path, DIMMER.replace("default: nan", "default: 0.5"), "--on-no-rule",
+                   "default")
+    assert result.stdout.splitlines()[1] == "0.1,0.5,power"
+    result = batch(tmp_path, DIMMER, "--on-no-rule", "error")
+    assert result.exit_code == 1
+
+
+def test_api_gives_nan_only_where_the_rule_base_asked_for_it():
+    from mitos_cli.errors import NoRuleFiredError
+
+    rb = load_rulebase_text(DIMMER)
+    assert math.isnan(rb.evaluate(light=0.1)["power"])
+    with pytest.raises(NoRuleFiredError):
+        load_rulebase_text(DIMMER.replace("  default: nan\n", "")).evaluate(light=0.1)
+
+
+def load_rulebase_text(fll: str):
+    from mitos_cli.api import LoadedRuleBase
+
+    return LoadedRuleBase(parse_fll(fll, "dimmer.fll"))

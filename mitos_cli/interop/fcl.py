@@ -275,8 +275,7 @@ def _variable(node: Tree, role: str, declared, settings: common.Record, locks: d
                                   expected="NC")
             if isinstance(value, Token) and value.type == "NAME":
                 raise FormatError(f"DEFAULT must be a number, not `{value}`", span=span_of(value))
-            d = _num(value)
-            default = None if d != d else d
+            default = _num(value)              # nan: NaN when no rule fires, as asked
         elif kind == "lock_item":
             for word in item.children:
                 w = str(word).upper()

@@ -234,8 +234,7 @@ def _variable_key(v: _Var, key: str, value: str, span: Span, vspan: Span,
                               f"needs state between evaluations, which MITOS does not keep",
                               span=vspan, hint="set `default:` to the value to use instead")
     elif key == "default":
-        d = common.number(value, vspan)
-        v.default = None if d != d else d
+        v.default = common.number(value, vspan)     # nan: NaN when no rule fires, as asked
     elif key in ("aggregation", "accumulation"):
         if value != "none":
             settings.set("aggregation", common.table_lookup(common.SNORMS, FLL, value,

@@ -123,6 +123,8 @@ def _scalar(value) -> str:
         return yaml.safe_dump(value, default_flow_style=True, width=1 << 16).strip() \
             .removesuffix("...").strip()
     value = float(value)
+    if np.isnan(value):
+        return ".nan"
     if np.isinf(value):
         return ".inf" if value > 0 else "-.inf"
     return common.fmt_number(value)
