@@ -40,7 +40,7 @@ import numpy as np
 
 from .model import flatten
 from .compile import CompiledRuleBase, compile_rulebase
-from .engine import evaluate
+from .engine import declares_nan, evaluate
 from .errors import Span
 from .model import (And, Consequent, Expr, Not, Prop, Rule, RuleBase, format_consequent,
                     format_expr)
@@ -364,7 +364,8 @@ def _sampled(compiled: CompiledRuleBase, threshold: float,
             mask = mask_of(total[:, j])
             if not mask.any():
                 continue
-            has_default = not np.isnan(compiled.default[j])
+            # a declared `default: nan` is the rule base's own choice, as a number is
+            has_default = not np.isnan(compiled.default[j]) or declares_nan(compiled, out_name)
             key = (mask.tobytes(), has_default)
             reported.setdefault(key, []).append(out_name)
             masks[key] = mask
