@@ -295,3 +295,82 @@ def load_rulebase_text(fll: str):
     from mitos_cli.api import LoadedRuleBase
 
     return LoadedRuleBase(parse_fll(fll, "dimmer.fll"))
+
+
+# ---------------------------------------------------------------------------------------------
+# Numbers floating point cannot evaluate are refused where they are written
+
+TIPPER_FIS = (Path(__file__).parent / "data" / "interop" / "tipper.fis").read_text()
+
+
+@pytest.mark.parametrize("old, new, line, words", [
+    ("TERM bad := (0, 1) (4, 0);", "TERM bad := (4, 1) (NaN, 0);", 10, "must be a finite"),
+    ("TERM bad := (0, 1) (4, 0);", "TERM bad := (0, 1) (1e308, 0);", 10, "beyond"),
+    ("RANGE := (0 .. 10);", "RANGE := (0 .. inf);", 9, "the range is inf"),
+    ("DEFAULT := 5;", "DEFAULT := 50;", 15, "default 50 lies outside"),
+    ("DEFAULT := 5;", "DEFAULT := inf;", 15, "default is inf"),
+])
+def test_fcl_non_finite_and_extreme_numbers_are_refused(old, new, line, words):
+    text = """\
+FUNCTION_BLOCK f
+VAR_INPUT
+    x : REAL;
+END_VAR
+VAR_OUTPUT
+    y : REAL;
+END_VAR
+FUZZIFY x
+    RANGE := (0 .. 10);
+    TERM bad := (0, 1) (4, 0);
+    TERM good := (2, 0) (10, 1);
+END_FUZZIFY
+DEFUZZIFY y
+    TERM a := (0, 0) (5, 1) (10, 0);
+    DEFAULT := 5;
+    RANGE := (0 .. 10);
+END_DEFUZZIFY
+RULEBLOCK r
+    RULE 1 : IF x IS bad THEN y IS a;
+END_RULEBLOCK
+END_FUNCTION_BLOCK
+"""
+    assert old in text
+    parse_fcl(text, "f.fcl")
+    with pytest.raises(MitosError) as info:
+        parse_fcl(text.replace(old, new), "f.fcl")
+    assert words in info.value.message
+    assert info.value.span is not None and info.value.span.line in (line, 8, 13)
+
+
+@pytest.mark.parametrize("old, new, words", [
+    ("term: veryhigh Triangle 0 10 10", "term: veryhigh Trapezoid 0 1e309 inf inf",
+     "parameter 2 is inf"),
+    ("range: 0 10\n  defuzzifier", "range: 0 inf\n  defuzzifier", "the range is inf"),
+    ("default: nan", "default: 1000", "default 1000 lies outside its range [0, 10]"),
+    ("term: anyway Constant 8", "term: anyway Constant nan", "must be a finite"),
+])
+def test_fll_non_finite_and_out_of_range_numbers_are_refused(old, new, words):
+    assert old in FLL_HEDGE_PREFIX
+    with pytest.raises(MitosError) as info:
+        parse_fll(FLL_HEDGE_PREFIX.replace(old, new), "e.fll")
+    assert words in info.value.message and info.value.span is not None
+
+
+@pytest.mark.parametrize("old, new, words", [
+    ("Range=[0 30]", "Range=[0 inf]", "the range is inf"),
+    ("Range=[0 10]", "Range=[0 1e300]", "beyond"),
+    ("1 1, 1 (1) : 2", "9" * 400 + " 1, 1 (1) : 2", "is not an MF number"),
+    ("1 1, 1 (1) : 2", "1 1, 1.5 (1) : 2", "fractional"),
+    ("1 1, 1 (1) : 2", "1 1, 1 (1) : 99999999999999999999", "connection"),
+    ("1 1, 1 (1) : 2", "1 1, 1 (1e999) : 2", "weight"),
+])
+def test_fis_non_finite_and_extreme_numbers_are_refused(old, new, words):
+    assert old in TIPPER_FIS, old
+    with pytest.raises(MitosError) as info:
+        parse_fis(TIPPER_FIS.replace(old, new, 1), "tipper.fis")
+    assert words in info.value.message and info.value.span is not None
+
+
+def test_fis_section_numbers_too_long_for_int_are_refused():
+    with pytest.raises(MitosError, match="unknown section"):
+        parse_fis(TIPPER_FIS.replace("[Input1]", "[Input" + "9" * 5000 + "]"), "tipper.fis")

@@ -317,6 +317,54 @@ def disjoint_outputs(blocks: list[list[Rule]]) -> bool:
     return True
 
 
+#: The largest magnitude a foreign file's number may have. The engine multiplies at most two
+#: of them (a coefficient by an input, a sample point by a membership) and sums at most a
+#: million products, so every intermediate stays below 1e306, inside a double's range.
+LARGEST = 1e150
+
+#: Where an infinite parameter is meaningful, as (index, sign): the open end of a shoulder
+#: (fuzzylite writes ``Trapezoid -inf -inf c d``, ``Triangle -inf b c``) and the direction of
+#: a ``Binary`` term (``Binary 0.5 inf``).
+INFINITE_OK = {"trapezoid": {(0, -1), (1, -1), (2, 1), (3, 1)},
+               "triangle": {(0, -1), (2, 1)}, "binary": {(1, -1), (1, 1)}}
+
+
+def check_numbers(variables: list[Variable]) -> None:
+    """Refuse, with the position, what floating point cannot evaluate: NaN or infinite
+    parameters (but a shoulder's open end), ranges and defaults, numbers beyond
+    :data:`LARGEST`, and a default outside its output's range. So no NaN or infinity leaves
+    the engine unless the file asked for one (``default: nan``)."""
+    for v in variables:
+        lo, hi = v.universe
+        open_range = (lo, hi) == (-math.inf, math.inf) and v.role == "output" and all(
+            t.shape in ("singleton", "linear") for t in v.terms)   # an unused Sugeno range
+        if not open_range:
+            for end in (lo, hi):
+                _finite(end, f"variable `{v.name}`: the range", v.span)
+        for t in v.terms:
+            allowed = INFINITE_OK.get(t.shape, set())
+            for i, p in enumerate(t.params):
+                if math.isinf(p) and (i, 1 if p > 0 else -1) in allowed:
+                    continue
+                _finite(p, f"term `{v.name}.{t.name}`: parameter {i + 1}", t.span or v.span)
+        d = v.default
+        if d is not None and d == d:
+            _finite(d, f"output `{v.name}`: the default", v.span)
+            if not open_range and not lo <= d <= hi:
+                raise FormatError(f"output `{v.name}`: the default {d:g} lies outside its "
+                                  f"range [{lo:g}, {hi:g}]", span=v.span,
+                                  hint="give a default inside the range, or nan for none")
+
+
+def _finite(value: float, what: str, span: Span | None) -> None:
+    if not math.isfinite(value):
+        raise FormatError(f"{what} is {fmt_number(value)}: it must be a finite number",
+                          span=span)
+    if abs(value) > LARGEST:
+        raise FormatError(f"{what} is {value:g}: numbers beyond ±{LARGEST:g} cannot be "
+                          f"evaluated in floating point without overflow", span=span)
+
+
 def check_implication(name: str, span: Span | None) -> str:
     if name not in ops_mod.IMPLICATIONS:
         raise FormatError(f"implication `{name}` is not supported", span=span,
@@ -344,6 +392,7 @@ def assemble_blocks(path: str, variables: list[Variable],
         raise FormatError("the file defines no input variable", span=span)
     if not any(rules for _, rules, _ in blocks):
         raise FormatError("the file has no rules", span=span)
+    check_numbers(variables)
     by_name = {v.name: v for v in variables}
     behaviors = []
     for name, rules, settings in blocks:

@@ -24,6 +24,7 @@ another resolution or sampling: a ``.fis`` file always means MATLAB's.
 from __future__ import annotations
 
 import dataclasses
+import math
 import re
 from pathlib import Path
 
@@ -78,7 +79,8 @@ def _sections(text: str, path: str | None):
                             len(raw.rstrip()) + 1)
         if line.startswith("[") and line.endswith("]"):
             name = line[1:-1].strip()
-            if name not in ("System", "Rules") and not re.fullmatch(r"(Input|Output)\d+", name):
+            if name not in ("System", "Rules") and not re.fullmatch(r"(Input|Output)\d{1,9}",
+                                                                    name):
                 raise FormatError(f"unknown section [{name}]", span=span,
                                   expected="[System], [InputN], [OutputN] or [Rules]",
                                   hint=did_you_mean(name, ("System", "Rules", "Input1",
@@ -208,7 +210,7 @@ def _check_count(system: dict, key: str, found: int, span: Span) -> None:
 def _variables(sections, prefix: str, role: str, kind: str, notes: list[str],
                n_inputs: int = 0) -> list[Variable]:
     found = [(int(name[len(prefix):]), span, items) for name, span, items in sections
-             if re.fullmatch(prefix + r"\d+", name)]
+             if re.fullmatch(prefix + r"\d{1,9}", name)]
     found.sort(key=lambda f: f[0])
     for i, (number, span, _) in enumerate(found, 1):
         if number != i:
@@ -286,13 +288,16 @@ def _rule(line: str, lineno: int, span: Span, inputs: list[Variable], outputs: l
     ins = [common.number(w, span) for w in m.group(1).split()]
     outs = [common.number(w, span) for w in m.group(2).split()]
     weight = common.number(m.group(3), span)
-    connection = int(m.group(4))
+    connection = int(m.group(4)) if len(m.group(4)) < 10 else 0     # else refused below
     if len(ins) != len(inputs) or len(outs) != len(outputs):
         raise FormatError(f"the rule lists {plural(len(ins), 'input')} and "
                           f"{plural(len(outs), 'output')}; the system has {len(inputs)} and "
                           f"{len(outputs)}", span=span)
     if connection not in (1, 2):
         raise FormatError(f"connection {connection}: expected 1 (AND) or 2 (OR)", span=span)
+    for idx in ins + outs:
+        if not math.isfinite(idx) or abs(idx) > 1e9:
+            raise FormatError(f"MF index {fmt_number(idx)} is not an MF number", span=span)
     props = []
     for v, idx in zip(inputs, ins):
         if idx != int(idx):
