@@ -16,12 +16,12 @@ from mitos_cli.errors import MitosError
 from mitos_cli.interop.fcl import parse_fcl
 from mitos_cli.interop.fis import parse_fis
 from mitos_cli.interop.fll import parse_fll
-from mitos_cli.parse import parse_rules
+from mitos_cli.lang.parse import parse_rules
 
 
 def outputs(rb, **inputs):
-    from mitos_cli.compile import compile_rulebase
-    from mitos_cli.engine import as_batch, evaluate
+    from mitos_cli.engine.compile import compile_rulebase
+    from mitos_cli.engine.evaluation import as_batch, evaluate
 
     c = compile_rulebase(rb)
     return dict(zip(c.outputs, evaluate(c, as_batch(c, inputs), strict=False).outputs[0]))
@@ -172,7 +172,7 @@ END_FUNCTION_BLOCK
 
 def test_fcl_reads_not_before_a_proposition_and_range_in_var_input():
     rb = parse_fcl(JFUZZY, "t.fcl")
-    from mitos_cli.model import Not, Prop
+    from mitos_cli.lang.model import Not, Prop
 
     r1 = rb.behaviors[0].rules[0]
     assert r1.antecedent == Not(Prop("x", "low"))
@@ -195,7 +195,7 @@ def test_fcl_dsigm_is_jfuzzylogics_clipped_difference():
     x = np.array([-2.0, 2.0, 6.0, 9.0, 12.0, np.nan])
     s1 = 1 / (1 + np.exp(-4 * (x - 2)))
     s2 = 1 / (1 + np.exp(-1 * (x - 6)))
-    from mitos_cli.shapes import SHAPES
+    from mitos_cli.fuzzy.shapes import SHAPES
 
     got = SHAPES[term.shape].membership(x, term.params)
     np.testing.assert_allclose(got[:-1], np.maximum(s1 - s2, 0)[:-1], rtol=0, atol=1e-15)

@@ -95,7 +95,7 @@ def eval_command(
     rb = load_rulebase(path, behavior)
     warn_notes(rb.rulebase)
     if network:
-        from ..network import describe_network
+        from ..engine.describe import describe_network
 
         emit(describe_network(rb.compiled))
         return
@@ -112,8 +112,8 @@ def eval_command(
     if not values:
         raise typer.BadParameter(
             "give one NAME=VALUE per input: " + " ".join(f"{k}=..." for k in rb.inputs))
-    from ..engine import as_batch, evaluate
-    from ..trace import trace_of
+    from ..engine.evaluation import as_batch, evaluate
+    from ..engine.trace import trace_of
 
     unused = unused_inputs(rb)
     given = {k: v for k, v in parse_values(values).items() if k not in unused}
@@ -137,7 +137,7 @@ def run_batch(rb, source: str, on_no_rule: NoRule | None = None) -> None:
     """Read the CSV, evaluate all rows as one batch, write inputs and outputs as CSV."""
     import numpy as np
 
-    from ..batch import read_batch, write_batch
+    from ..engine.csvio import read_batch, write_batch
 
     if source == "-":
         text, name = sys.stdin.read(), "<stdin>"
@@ -160,7 +160,7 @@ def no_rule_policy(compiled, result, policy: NoRule):
     no rule set an output; a warning says how many rows each output's choice changed."""
     import numpy as np
 
-    from ..engine import declares_nan
+    from ..engine.evaluation import declares_nan
     from ..errors import NoRuleFiredError
 
     Y = result.outputs.copy()
