@@ -374,3 +374,80 @@ def test_fis_non_finite_and_extreme_numbers_are_refused(old, new, words):
 def test_fis_section_numbers_too_long_for_int_are_refused():
     with pytest.raises(MitosError, match="unknown section"):
         parse_fis(TIPPER_FIS.replace("[Input1]", "[Input" + "9" * 5000 + "]"), "tipper.fis")
+
+
+# ---------------------------------------------------------------------------------------------
+# Round trips and sampling
+
+HYPHEN_FIS = FIS.replace("Name='x'", "Name='LDL-Level'").replace("AndMethod='einstein_product'",
+                                                                   "AndMethod='min'")
+
+
+@pytest.mark.parametrize("fmt", ["fll", "fcl", "fis"])
+def test_hyphenated_and_reserved_names_are_mapped_to_legal_ones(fmt):
+    from mitos_cli.interop import conversion_notes, parse_foreign, write_foreign
+
+    rb = parse_fis(HYPHEN_FIS.replace("MF1='low'", "MF1='very'"), "h.fis")
+    back = parse_foreign(write_foreign(rb, fmt), fmt, f"h.{fmt}")
+    want = "LDL-Level" if fmt == "fis" else "LDL_Level"
+    assert [v.name for v in back.variables.values()][0] == want
+    notes = conversion_notes(rb, fmt)
+    if fmt != "fis":
+        assert any("`LDL-Level` is written as `LDL_Level`" in n for n in notes)
+        assert any("`LDL-Level.very` is written as `very_`" in n for n in notes)
+    for x in (1.0, 4.0, 9.0):         # FLL and FCL sample 1000 midpoints, .fis 101 ends
+        assert outputs(back, **{want: x})["y"] == pytest.approx(
+            outputs(rb, **{"LDL-Level": x})["y"], abs=0.05)
+
+
+def test_fll_shoulders_are_written_to_the_term_set_as_shoulders(tmp_path: Path):
+    from mitos_cli.interop.rules_writer import write_rules
+
+    text = FLL_HEDGE_PREFIX.replace("term: high Triangle 0 10 10",
+                                    "term: high Trapezoid -inf -inf 4 7")
+    rb = parse_fll(text.replace("rule: if x is notable then y is low\n", ""), "e.fll")
+    assert rb.variables["x"].term("high").shape == "left_shoulder"
+    rules, terms = write_rules(rb, "e.terms.yaml")
+    assert "left_shoulder" in terms and "inf" not in terms
+    (tmp_path / "e.rules").write_text(rules)
+    (tmp_path / "e.terms.yaml").write_text(terms)
+    assert read_rulebase(tmp_path / "e.rules").variables["x"].term("high").shape == \
+        "left_shoulder"
+
+
+def test_convert_warns_with_the_measured_difference(tmp_path: Path):
+    source = Path(__file__).parent / "data" / "interop" / "tipper.fis"
+    result = runner.invoke(app, ["convert", str(source), "--to", "fll", "-o",
+                                 str(tmp_path / "t.fll")])
+    assert result.exit_code == 0, result.output
+    assert "reading the written FLL back, `tip` moves by up to 0.01" in result.stderr
+    result = runner.invoke(app, ["convert", str(source), "--to", "fis", "-o",
+                                 str(tmp_path / "t.fis")])
+    assert "moves by" not in result.stderr          # .fis to .fis: unchanged
+
+
+def test_fidelity_chooses_the_reference_engines_sampling():
+    from mitos_cli.engine.mamdani import grid
+
+    assert grid(0.0, 10.0, 4, "left").tolist() == [0.0, 2.5, 5.0, 7.5]
+    source = Path(__file__).parent / "data" / "interop" / "tipper.fis"
+    got = {}
+    for engine in ("matlab", "jfuzzylogic", "fuzzylite"):
+        result = runner.invoke(app, ["eval", str(source), "service=2", "food=1", "--digits",
+                                     "6", "--fidelity", engine, "--json"])
+        assert result.exit_code == 0, result.output
+        import json
+
+        got[engine] = json.loads(result.stdout)["outputs"]
+    tip = {k: v["tip"] for k, v in got.items()}
+    assert tip["matlab"] == pytest.approx(7.0169, abs=5e-5)       # MATLAB's documented value
+    assert tip["jfuzzylogic"] != tip["matlab"] and tip["fuzzylite"] != tip["matlab"]
+    # the same as asking for jFuzzyLogic's grid (1000 left cell ends) by operator settings
+    rb = load_rulebase(source)
+    from mitos_cli.lang.model import Setting
+    from mitos_cli.api import LoadedRuleBase
+
+    fine = LoadedRuleBase(rb.rulebase, None, (Setting("resolution", "1000"),
+                                              Setting("sampling", "left")))
+    assert fine.evaluate(service=2.0, food=1.0)["tip"] == pytest.approx(tip["jfuzzylogic"],
+                                                                        abs=1e-9)

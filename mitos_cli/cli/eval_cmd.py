@@ -15,6 +15,14 @@ from .output import emit, warn, warn_notes
 from ..words import plural
 
 
+class Engine(str, enum.Enum):
+    """A reference engine whose sampling of Mamdani outputs ``--fidelity`` reproduces."""
+
+    matlab = "matlab"
+    jfuzzylogic = "jfuzzylogic"
+    fuzzylite = "fuzzylite"
+
+
 class NoRule(str, enum.Enum):
     """What ``eval --batch`` writes where no rule sets an output (see docs/interop.md)."""
 
@@ -83,6 +91,11 @@ def eval_command(
         help="With --batch, where no rule sets an output: error, default (the output's "
              "declared default, else an error; what happens without this option), nan, or "
              "skip the row. Given, it adds a `no_rule` column naming such outputs.")] = None,
+    fidelity: Annotated[Optional[Engine], typer.Option(
+        "--fidelity", case_sensitive=False,
+        help="Sample Mamdani outputs as this engine does, to reproduce its published tables: "
+             "matlab (101 points with both ends), jfuzzylogic (1000 left cell ends), "
+             "fuzzylite (cell midpoints, the file's resolution).")] = None,
 ) -> None:
     """Evaluate a rule base: fuzzified inputs, fired rules with DOFs, crisp outputs."""
     from ..api import load_rulebase
@@ -94,6 +107,12 @@ def eval_command(
                                  f"of that name; write each input as NAME=VALUE)")
     rb = load_rulebase(path, behavior)
     warn_notes(rb.rulebase)
+    if fidelity is not None:
+        from ..api import LoadedRuleBase
+        from ..interop.common import fidelity_settings
+
+        rb = LoadedRuleBase(rb.rulebase, behavior,
+                            fidelity_settings(rb.rulebase, fidelity.value, behavior))
     if network:
         from ..engine.describe import describe_network
 

@@ -197,6 +197,10 @@ def fuzzylite_term(name: str, kind: str, values: list[float], n_inputs: int,
                           hint="MITOS terms reach 1; scale the rule weights instead")
     if shape == "rectangle":            # fuzzylite takes the ends in either order
         values = sorted(values)
+    if shape == "trapezoid" and values[0] == values[1] == -math.inf:
+        shape, values = "left_shoulder", values[2:]         # `Trapezoid -inf -inf c d`
+    elif shape == "trapezoid" and values[2] == values[3] == math.inf:
+        shape, values = "right_shoulder", values[:2]        # `Trapezoid a b inf inf`
     return make_term(name, shape, tuple(values), span)
 
 
@@ -603,3 +607,130 @@ def atomic_write(path: str | Path, text: str) -> None:
 
     write(path, text, error=FormatError)
 
+
+
+# ---------------------------------------------------------------------------------------------
+# Names each format can hold
+
+#: A legal name per target format, and the words its rules reserve.
+NAME_PATTERNS = {
+    "fll": r"[A-Za-z_][A-Za-z0-9_.]*",
+    "fcl": r"[A-Za-z_][A-Za-z0-9_.]*",
+    "rules": r"[A-Za-z_]([A-Za-z0-9_\-]*[A-Za-z0-9_])?",
+    "fis": r"[^'\n]+",
+}
+_RULE_WORDS = {"if", "then", "and", "or", "not", "is", "with", "very", "somewhat", "seldom",
+               "extremely", "any"}
+RESERVED_NAMES = {
+    "fll": _RULE_WORDS,
+    "fcl": _RULE_WORDS | {"rule", "term", "range", "method", "default", "accu", "act",
+                          "lock", "end_var", "var_input", "var_output", "fuzzify",
+                          "defuzzify", "end_fuzzify", "end_defuzzify", "ruleblock",
+                          "end_ruleblock", "function_block", "end_function_block", "real"},
+    "rules": _RULE_WORDS | {"use", "when", "behavior", "end", "terms", "operators", "frozen",
+                            "more_or_less", "intensely"},
+    "fis": set(),
+}
+
+
+FORMAT_TITLES = {"fll": "FLL", "fcl": "FCL", "fis": "a .fis file", "rules": "the rule language"}
+
+
+def legal_names(rb: RuleBase, fmt: str) -> tuple[RuleBase, list[str]]:
+    """``rb`` with every variable and term name the format ``fmt`` cannot hold (``LDL-Level``
+    in FLL, ``service level`` in the rule language, a term named ``very``) mapped to a legal
+    one (``LDL_Level``), and a note per renamed name."""
+    import dataclasses
+    import re
+
+    pattern = re.compile(NAME_PATTERNS.get(fmt, NAME_PATTERNS["fll"]))
+    reserved = RESERVED_NAMES.get(fmt, set())
+
+    def legal(name: str, taken: set[str]) -> str:
+        if pattern.fullmatch(name) and name.lower() not in reserved:
+            return name
+        new = re.sub(r"[^A-Za-z0-9_]", "_", name) if fmt != "fis" else name.replace("'", "_")
+        if not new or not (new[0].isalpha() or new[0] == "_") and fmt != "fis":
+            new = "_" + new
+        if new.lower() in reserved:
+            new += "_"
+        return unique_name(new, taken)
+
+    notes: list[str] = []
+    var_map: dict[str, str] = {}
+    term_map: dict[tuple[str, str], str] = {}
+    all_vars = [v for ts in rb.termsets for v in ts.variables]
+    taken_vars = {v.name for v in all_vars}
+    for v in all_vars:
+        new = legal(v.name, taken_vars - {v.name})
+        if new != v.name:
+            var_map[v.name] = new
+            taken_vars.add(new)
+            notes.append(f"variable `{v.name}` is written as `{new}` ({FORMAT_TITLES[fmt]} "
+                         f"cannot name it `{v.name}`)")
+        taken_terms = set(v.term_names)
+        for t in v.terms:
+            new_t = legal(t.name, taken_terms - {t.name})
+            if new_t != t.name:
+                term_map[(v.name, t.name)] = new_t
+                taken_terms.add(new_t)
+                notes.append(f"term `{v.name}.{t.name}` is written as `{new_t}` "
+                             f"({FORMAT_TITLES[fmt]} cannot name it `{t.name}`)")
+    if not notes:
+        return rb, []
+
+    def var(name: str) -> str:
+        return var_map.get(name, name)
+
+    def term(v: str, t: str | None) -> str | None:
+        return None if t is None else term_map.get((v, t), t)
+
+    def expr(e: Expr) -> Expr:
+        if isinstance(e, Prop):
+            return dataclasses.replace(e, var=var(e.var), term=term(e.var, e.term))
+        if isinstance(e, Not):
+            return dataclasses.replace(e, expr=expr(e.expr))
+        return dataclasses.replace(e, items=tuple(expr(i) for i in e.items))
+
+    def rule(r: Rule) -> Rule:
+        return dataclasses.replace(r, antecedent=expr(r.antecedent), consequents=tuple(
+            dataclasses.replace(c, var=var(c.var), term=term(c.var, c.term))
+            for c in r.consequents))
+
+    termsets = tuple(TermSet(tuple(dataclasses.replace(
+        v, name=var(v.name), terms=tuple(dataclasses.replace(t, name=term(v.name, t.name))
+                                         for t in v.terms)) for v in ts.variables), ts.path)
+        for ts in rb.termsets)
+    behaviors = tuple(dataclasses.replace(
+        b, rules=tuple(rule(r) for r in b.rules),
+        uses=tuple(dataclasses.replace(u, condition=None if u.condition is None
+                                       else expr(u.condition)) for u in b.uses))
+        for b in rb.behaviors)
+    return dataclasses.replace(rb, termsets=termsets, behaviors=behaviors), notes
+
+
+# ---------------------------------------------------------------------------------------------
+# Fidelity to a format's reference engine
+
+#: How each reference engine samples a Mamdani output: (resolution, sampling); ``None`` keeps
+#: the file's resolution. MATLAB's ``evalfis``: 101 points including both ends; jFuzzyLogic:
+#: 1000 left cell ends; fuzzylite: the file's resolution (1000 by default), cell midpoints.
+FIDELITY = {"matlab": (101, "endpoints"), "jfuzzylogic": (1000, "left"),
+            "fuzzylite": (None, "midpoints")}
+
+
+def fidelity_settings(rb: RuleBase, engine: str, behavior: str | None = None
+                      ) -> tuple[Setting, ...]:
+    """Operator overrides that make ``rb``'s Mamdani outputs sample as ``engine`` does (none
+    for a weighted-average rule base, whose outputs are not sampled)."""
+    if engine not in FIDELITY:
+        raise FormatError(f"unknown engine `{engine}`", expected="one of " + ", ".join(FIDELITY),
+                          hint=did_you_mean(engine, FIDELITY))
+    b = rb.behavior(behavior)
+    ops = ops_mod.resolve(b.operators, ops_mod.resolve(rb.operators))
+    if ops.inference != "mamdani":
+        return ()
+    resolution, sampling = FIDELITY[engine]
+    if resolution is None:
+        resolution = 1000 if ops.sampling == "endpoints" else ops.resolution
+    return (Setting("resolution", str(resolution)), Setting("sampling", sampling))

@@ -42,7 +42,9 @@ def write_rules(rb: RuleBase, termset_name: str, behavior: str | None = None,
     from ..lang.model import flatten
     from ..lang.model import Use, format_use
     from ..lang.operators import resolve
+    from .common import legal_names
 
+    rb, _ = legal_names(rb, "rules")
     name = behavior or rb.default_behavior
     chosen = rb.behavior(name)
     order: list = []
