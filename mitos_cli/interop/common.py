@@ -204,6 +204,26 @@ def fuzzylite_term(name: str, kind: str, values: list[float], n_inputs: int,
     return make_term(name, shape, tuple(values), span)
 
 
+def distinct_names(terms: list[Term], variable: str, notes: list[str], why: str,
+                   keep_last: bool = False) -> list[Term]:
+    """A variable's terms with a repeated name suffixed (``low``, ``low_2``) and a note:
+    MITOS names must differ, while a .fis file (rules name MFs by index) and fuzzylite 8
+    (whose rules take the last term of a name) allow repeats. ``keep_last`` leaves the name to
+    the last of its terms, else to the first."""
+    seen: set[str] = set()
+    out = []
+    order = list(reversed(terms)) if keep_last else list(terms)
+    for t in order:
+        if t.name in seen:
+            new = unique_name(f"{t.name}_2", seen | {x.name for x in terms})
+            notes.append(f"{t.span}: `{variable}` has more than one term named `{t.name}`; "
+                         f"this one is read as `{new}` ({why})")
+            t = Term(new, t.shape, t.params, t.span)
+        seen.add(t.name)
+        out.append(t)
+    return list(reversed(out)) if keep_last else out
+
+
 def make_term(name: str, shape: str, params: tuple[float, ...], span: Span | None) -> Term:
     problem = SHAPES[shape].check(params)
     if problem:

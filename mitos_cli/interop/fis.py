@@ -183,22 +183,6 @@ def parse_fis(text: str, path: str | None = None) -> RuleBase:
     return dataclasses.replace(rb, notes=tuple(notes))
 
 
-def _distinct_names(terms: list[Term], variable: str, notes: list[str]) -> list[Term]:
-    """Rules name MFs by index, so a .fis may repeat a name; MITOS names must differ: a repeat
-    gets a suffix (``low_2``) and a note."""
-    seen: set[str] = set()
-    out = []
-    for t in terms:
-        if t.name in seen:
-            new = common.unique_name(f"{t.name}_2" if not t.name.endswith("_2") else t.name,
-                                     seen | {x.name for x in terms})
-            notes.append(f"{t.span}: `{variable}` has two MFs named `{t.name}`; the second is "
-                         f"read as `{new}` (rules refer to MFs by index, so nothing else changes)")
-            t = Term(new, t.shape, t.params, t.span)
-        seen.add(t.name)
-        out.append(t)
-    return out
-
 
 def _check_count(system: dict, key: str, found: int, span: Span) -> None:
     if key in system:
@@ -238,7 +222,8 @@ def _variable(span: Span, items, role: str, kind: str, n_inputs: int,
     if "Name" not in values or "Range" not in values:
         raise FormatError("a variable needs `Name` and `Range`", span=span)
     name = _string(*values["Name"])
-    terms = _distinct_names(terms, name, notes)
+    terms = common.distinct_names(terms, name, notes, "rules refer to MFs by index, so "
+                                  "nothing else changes")
     rng = _vector(*values["Range"])
     if len(rng) != 2 or not rng[0] < rng[1]:
         raise FormatError("`Range` must be [min max] with min < max", span=values["Range"][1])

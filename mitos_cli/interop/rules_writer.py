@@ -132,6 +132,28 @@ def _scalar(value) -> str:
     return common.fmt_number(value)
 
 
+def _written_universe(rb: RuleBase, v) -> tuple[float, float]:
+    """``v``'s universe, or for a weighted-average output without one (fuzzylite's
+    ``range: 0 0``) the interval its terms can reach over the inputs' universes, which a term
+    set needs and the weighted average never uses."""
+    lo, hi = v.universe
+    if np.isfinite(lo) and np.isfinite(hi):
+        return lo, hi
+    ends = []
+    for t in v.terms:
+        if t.shape == "linear":
+            coefficients = common.linear_coefficients(rb, v.name, t)
+            low = high = t.params[-1]
+            for name, a in coefficients.items():
+                a_lo, a_hi = (a * x for x in rb.variables[name].universe)
+                low, high = low + min(a_lo, a_hi), high + max(a_lo, a_hi)
+            ends += [low, high]
+        else:
+            ends.append(t.center)
+    lo, hi = min(ends), max(ends)
+    return (lo, hi) if lo < hi else (lo - 0.5, hi + 0.5)
+
+
 def write_termset(rb: RuleBase, inputs, outputs, source: str = "") -> str:
     lines = ["# Term set written by `mitos convert`" + (f" from {source}" if source else ""),
              "variables:"]
@@ -147,7 +169,8 @@ def write_termset(rb: RuleBase, inputs, outputs, source: str = "") -> str:
         if v.unit:
             lines.append(f"    unit: {_scalar(v.unit)}")
         lines.append(f"    role: {v.role}")
-        lines.append(f"    universe: [{_scalar(v.universe[0])}, {_scalar(v.universe[1])}]")
+        lo, hi = _written_universe(rb, v)
+        lines.append(f"    universe: [{_scalar(lo)}, {_scalar(hi)}]")
         if v.default is not None:
             lines.append(f"    default: {_scalar(v.default)}")
         lines.append("    terms:")
