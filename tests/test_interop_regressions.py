@@ -451,3 +451,13 @@ def test_fidelity_chooses_the_reference_engines_sampling():
                                               Setting("sampling", "left")))
     assert fine.evaluate(service=2.0, food=1.0)["tip"] == pytest.approx(tip["jfuzzylogic"],
                                                                         abs=1e-9)
+
+
+def test_fis_reads_fuzzylites_output_keys():
+    text = FIS.replace("AndMethod='einstein_product'", "AndMethod=''").replace(
+        "[Output1]\nName='y'", "[Output1]\nName='y'\nEnabled=1\nDefault=nan\nLockPrevious=0\n"
+        "LockRange=0")
+    rb = parse_fis(text.replace("2, 2 (1) : 1", "2, 2 (1) : 2"), "small.fis")
+    assert math.isnan(rb.variables["y"].default)             # the file asks for NaN
+    with pytest.raises(MitosError, match="LockPrevious=1"):
+        parse_fis(text.replace("LockPrevious=0", "LockPrevious=1"), "small.fis")

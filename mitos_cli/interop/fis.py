@@ -57,7 +57,8 @@ MF_TYPES = {
 SYSTEM_KEYS = ("Name", "Type", "Version", "NumInputs", "NumOutputs", "NumRules", "AndMethod",
                "OrMethod", "ImpMethod", "AggMethod", "DefuzzMethod",
                "DisableStructuralChecks")     # MATLAB R2018b+; only affects MATLAB's editor
-VAR_KEYS = ("Name", "Range", "NumMFs", "Enabled")     # Enabled=1: fuzzylite's exporter
+#: fuzzylite's exporter adds Enabled=1, and on outputs Default=, LockPrevious=, LockRange=
+VAR_KEYS = ("Name", "Range", "NumMFs", "Enabled", "Default", "LockPrevious", "LockRange")
 
 
 def read_fis(path: str | Path) -> RuleBase:
@@ -213,6 +214,15 @@ def _variable(span: Span, items, role: str, kind: str, n_inputs: int,
             if value.strip() != "1":
                 raise FormatError(f"`Enabled={value}`: MITOS has no disabled variables",
                                   span=vspan, hint="delete the variable or enable it")
+        elif key == "LockPrevious" and value.strip() != "0":
+            raise FormatError(f"`LockPrevious={value}` (keep the previous output when no rule "
+                              f"fires) needs state between evaluations, which MITOS does not "
+                              f"keep", span=vspan, hint="set `Default=` to the value to use")
+        elif key in ("Default", "LockRange") and role != "output":
+            raise FormatError(f"`{key}` belongs to outputs", span=kspan)
+        elif key == "LockRange" and value.strip() != "0" and kind == "sugeno":
+            raise FormatError("`LockRange=1` on a Sugeno output (clipping the output to its "
+                              "range) is not supported", span=vspan, hint="set LockRange=0")
         elif key in VAR_KEYS:
             values[key] = (value, vspan)
         else:
@@ -232,7 +242,9 @@ def _variable(span: Span, items, role: str, kind: str, n_inputs: int,
                           span=values["NumMFs"][1])
     if not terms and role == "output":
         raise FormatError(f"output `{name}` has no membership functions", span=span)
-    default = (rng[0] + rng[1]) / 2 if role == "output" else None
+    default = (rng[0] + rng[1]) / 2 if role == "output" else None     # MATLAB's choice
+    if "Default" in values:                      # fuzzylite's: nan when the file says so
+        default = common.number(*values["Default"])
     try:
         return Variable(name, role, (rng[0], rng[1]), tuple(terms), "", "", default,
                         values["Name"][1])
