@@ -86,7 +86,6 @@ FLL_CASES = [
     ("term: low Triangle 0 2 5", "term: low Triangle 0 2", "Triangle takes 3 numbers, not 2"),
     ("term: low Triangle 0 2 5", "term: low Triangle 0 2 5 0.5", "a term height (0.5)"),
     ("term: low Triangle 0 2 5", "term: low Triangle 5 2 0", "points must be in order"),
-    ("term: high Triangle 5 8 10", "term: low Triangle 5 8 10", "duplicate term `low`"),
     ("rule: if a is low and b", "rule: if a low and b", "cannot read this rule"),
     ("conjunction: Minimum", "conjunction: none", "uses `and` but its rule block's conjunction"),
     ("disjunction: Maximum", "disjunction: none", "uses `or` but its rule block's disjunction"),

@@ -461,3 +461,11 @@ def test_fis_reads_fuzzylites_output_keys():
     assert math.isnan(rb.variables["y"].default)             # the file asks for NaN
     with pytest.raises(MitosError, match="LockPrevious=1"):
         parse_fis(text.replace("LockPrevious=0", "LockPrevious=1"), "small.fis")
+
+
+def test_fll_repeated_term_names_mean_the_last_as_in_fuzzylite():
+    text = FLL_HEDGE_PREFIX.replace("term: high Triangle 0 10 10", "term: veryhigh Triangle 0 0 10")
+    rb = parse_fll(text.replace("rule: if x is notable then y is low\n", ""), "e.fll")
+    assert rb.variables["x"].term_names == ("veryhigh_2", "veryhigh")
+    assert rb.variables["x"].term("veryhigh").params == (0.0, 0.0, 10.0)   # the last one
+    assert any("e.fll:4:" in n and "`veryhigh_2`" in n for n in rb.notes)
