@@ -224,8 +224,8 @@ def octave_outputs(fis: Path, X: np.ndarray, tmp: Path) -> np.ndarray | None:
     np.savetxt(inputs, X, delimiter=",", fmt="%.17g")
     outputs.unlink(missing_ok=True)
     script = OCTAVE_SCRIPT.format(fis=fis, inputs=inputs, outputs=outputs)
-    proc = subprocess.run(["octave-cli", "--no-gui", "-q", "--eval", script],
-                          capture_output=True, text=True, timeout=300)
+    subprocess.run(["octave-cli", "--no-gui", "-q", "--eval", script], capture_output=True,
+                   text=True, timeout=300)
     if not outputs.exists():
         return None
     return np.loadtxt(outputs, delimiter=",", ndmin=2)
@@ -362,7 +362,7 @@ def main() -> None:
             all_files += sorted(map(Path, glob.glob(str(OCTAVE / "fuzzy-logic-toolkit*" /
                                                          "*.fis"))))
     rt = round_trips(all_files, tmp)
-    print(f"\n## 4. Round trips of every file that loads (each behavior, each other format)")
+    print("\n## 4. Round trips of every file that loads (each behavior, each other format)")
     for fmt in ("fcl", "fis", "fll", "rules"):
         c = {k[1]: v for k, v in rt["counts"].items() if k[0] == fmt}
         big = rt["largest"].get(fmt)

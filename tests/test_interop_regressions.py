@@ -444,8 +444,8 @@ def test_fidelity_chooses_the_reference_engines_sampling():
     assert tip["jfuzzylogic"] != tip["matlab"] and tip["fuzzylite"] != tip["matlab"]
     # the same as asking for jFuzzyLogic's grid (1000 left cell ends) by operator settings
     rb = load_rulebase(source)
-    from mitos_cli.lang.model import Setting
     from mitos_cli.api import LoadedRuleBase
+    from mitos_cli.lang.model import Setting
 
     fine = LoadedRuleBase(rb.rulebase, None, (Setting("resolution", "1000"),
                                               Setting("sampling", "left")))

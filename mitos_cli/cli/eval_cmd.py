@@ -135,7 +135,8 @@ def eval_command(
     from ..engine.trace import trace_of
 
     unused = unused_inputs(rb)
-    given = {k: v for k, v in parse_values(values).items() if k not in unused}
+    given: dict[str, object] = {k: v for k, v in parse_values(values).items()
+                                if k not in unused}
     result = evaluate(rb.compiled, as_batch(rb.compiled, given))
     warn_clamped(result)
     trace = trace_of(result)

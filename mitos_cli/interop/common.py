@@ -702,8 +702,8 @@ def legal_names(rb: RuleBase, fmt: str) -> tuple[RuleBase, list[str]]:
     def var(name: str) -> str:
         return var_map.get(name, name)
 
-    def term(v: str, t: str | None) -> str | None:
-        return None if t is None else term_map.get((v, t), t)
+    def term(v: str, t: str) -> str:
+        return term_map.get((v, t), t)
 
     def expr(e: Expr) -> Expr:
         if isinstance(e, Prop):
@@ -714,7 +714,8 @@ def legal_names(rb: RuleBase, fmt: str) -> tuple[RuleBase, list[str]]:
 
     def rule(r: Rule) -> Rule:
         return dataclasses.replace(r, antecedent=expr(r.antecedent), consequents=tuple(
-            dataclasses.replace(c, var=var(c.var), term=term(c.var, c.term))
+            dataclasses.replace(c, var=var(c.var),
+                                term=None if c.term is None else term(c.var, c.term))
             for c in r.consequents))
 
     termsets = tuple(TermSet(tuple(dataclasses.replace(
