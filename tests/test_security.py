@@ -152,3 +152,36 @@ def test_without_home_there_is_no_cache_and_it_says_why(monkeypatch):
         monkeypatch.delenv(name, raising=False)
     st = cache.status()
     assert st.path is None and not st.refused and "HOME" in st.reason
+
+
+# ---- a rule file pointing at a file that is not a term set -----------------------------------
+
+@pytest.mark.parametrize("secret", [
+    "root:$6$salt$hash:20228:0:99999:7:::\nsecond: line\n",     # YAML, but not a term set
+    "password = hunter2\n[section\n",                           # not YAML at all
+    "- just\n- a list\n",
+])
+def test_an_error_quotes_no_line_of_a_file_that_is_not_a_term_set(tmp_path, secret):
+    from mitos_cli.errors import TermSetError
+
+    (tmp_path / "private").write_text(secret)
+    rules = tmp_path / "r.rules"
+    rules.write_text(f'terms "{tmp_path / "private"}"\nif a is lo then y is hi\n')
+    with pytest.raises(TermSetError) as exc:
+        api.read_rulebase(rules)
+    shown = exc.value.render()
+    assert "is not a term set" in shown
+    for line in secret.splitlines():
+        assert line not in shown and line.split(":")[0] not in shown.split("\n", 1)[1]
+
+
+def test_a_term_set_still_shows_its_bad_line(tmp_path):
+    from mitos_cli.errors import TermSetError
+
+    (tmp_path / "t.terms.yaml").write_text("variables:\n  a: {role: input, universe: [0, 1], "
+                                           "terms: {lo: 1}}\n  : bad\n")
+    rules = tmp_path / "r.rules"
+    rules.write_text('terms "t.terms.yaml"\nif a is lo then a is lo\n')
+    with pytest.raises(TermSetError) as exc:
+        api.read_rulebase(rules)
+    assert "  : bad" in exc.value.render()
