@@ -6,6 +6,7 @@ from __future__ import annotations
 import os
 import socket
 import ssl
+from pathlib import Path
 
 import pytest
 
@@ -98,5 +99,9 @@ def test_a_stranger_cannot_reach_the_local_cluster(client):
         bare.check_hostname, bare.verify_mode = False, ssl.CERT_NONE
         with pytest.raises((ssl.SSLError, ConnectionError)):
             _handshake(address, bare)
+    # nothing of the workers' lies in a directory others may write
+    for worker in info["workers"].values():
+        scratch = Path(worker["local_directory"]).parents[1]
+        assert scratch.name.startswith("mitos-dask-") and scratch.stat().st_mode & 0o077 == 0
     # the owner's client still works, and its results are the serial run's (tests above)
     assert client.submit(sum, [1, 2]).result() == 3

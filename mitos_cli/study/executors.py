@@ -97,8 +97,14 @@ def local_cluster(workers: int):
     scheduler, nannies and workers listen on 127.0.0.1 only and speak mutual TLS with a
     certificate authority made for this cluster (``Security.temporary()``, in memory, handed
     to the workers as they start), so a connection without that certificate is refused
-    during the handshake.
+    during the handshake. The workers' scratch space (where Dask would spill pickled data) is
+    a fresh 0700 directory of this user's, not the shared ``$TMPDIR/dask-scratch-space``,
+    and is removed with the cluster.
     """
+    import shutil
+    import tempfile
+    import weakref
+
     from distributed import LocalCluster
 
     try:
@@ -108,8 +114,16 @@ def local_cluster(workers: int):
     except ImportError:
         raise StudyError("the local Dask cluster needs `cryptography` for its TLS certificates",
                          hint="pip install 'mitos[dask]', or use --executor local") from None
-    return LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                        dashboard_address=None, host="127.0.0.1", security=security)
+    scratch = tempfile.mkdtemp(prefix="mitos-dask-")
+    try:
+        cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
+                               dashboard_address=None, host="127.0.0.1", security=security,
+                               local_directory=scratch)
+    except BaseException:
+        shutil.rmtree(scratch, ignore_errors=True)
+        raise
+    weakref.finalize(cluster, shutil.rmtree, scratch, True)
+    return cluster
 
 
 def run_dask(fn: TaskFn, tasks: Sequence[Task], workers: int, scheduler: str | None = None,
