@@ -7,7 +7,7 @@ exported Python module must contain nothing but a docstring, ``import numpy``, c
 assignments and plain functions that use only names they bind (no ``__import__``, ``open``,
 ``os`` ...), and agree with the engine; the C file must compile with the system ``cc``, keep
 to ``#include <math.h>`` and ``#define``, define only ``PREFIX_eval`` and call nothing outside
-libm; the scalar form that :mod:`mitos_cli.scalar` ``exec``-s must be one function of floats.
+libm; the scalar form that :mod:`mitos_cli.engine.scalar` ``exec``-s must be one function of floats.
 """
 
 from __future__ import annotations
@@ -268,8 +268,8 @@ def assert_c_only_computes(texts: dict[str, str], d: Path) -> None:
 
 def check_exports(path: Path, d: Path, with_c: bool) -> None:
     """Every behavior of ``path``: Python and C exports only compute and agree."""
-    from mitos_cli import engine
-    from mitos_cli.scalar import scalar_function
+    from mitos_cli.engine import evaluation as engine
+    from mitos_cli.engine.scalar import scalar_function
 
     behaviors = [b.name for b in load_rulebase(path).rulebase.behaviors] or [None]
     c_texts = {}

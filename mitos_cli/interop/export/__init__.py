@@ -3,7 +3,7 @@
 Both backends (:mod:`.c`, :mod:`.python`) write the same straight-line program
 (:mod:`.program`): one membership per input term, one expression per rule, then the output
 layer. The arithmetic is MITOS's own (the same compiled kernel for piecewise-linear terms, the
-same norm formulas, Mamdani consequent sets sampled by :mod:`mitos_cli.mamdani` and stored as
+same norm formulas, Mamdani consequent sets sampled by :mod:`mitos_cli.engine.mamdani` and stored as
 tables), so the generated code agrees with ``mitos eval`` to rounding (the tests check 1e-9).
 
 Nothing read from a file is spliced into the code: names become checked identifiers

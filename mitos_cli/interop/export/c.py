@@ -18,7 +18,7 @@ import json
 
 import numpy as np
 
-from ...compile import CompiledRuleBase
+from ...engine.compile import CompiledRuleBase
 from ...errors import FormatError
 from ...words import plural
 from .program import PLAIN, Program, ident, num, program, unique_idents, weighted_sums

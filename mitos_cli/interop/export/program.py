@@ -14,9 +14,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ...compile import CompiledRuleBase
-from ...model import And, Expr, Not, Prop, flatten
-from ...shapes import kernel_params
+from ...engine.compile import CompiledRuleBase
+from ...lang.model import And, Expr, Not, Prop, flatten
+from ...fuzzy.shapes import kernel_params
 
 #: Text that may stand as it is in a C comment or a Python docstring.
 PLAIN = re.compile(r"[A-Za-z0-9_ .,:;+=@%()\[\]<>~^!#&|{}-]*")

@@ -1,7 +1,7 @@
 """The Python backend of ``mitos export``: one module that needs only NumPy.
 
 ``evaluate(X)`` maps inputs ``X[n, k]`` to outputs ``Y[n, m]`` with MITOS's own arithmetic
-(the shape functions are copied from :mod:`mitos_cli.shapes` by source). Names from the rule
+(the shape functions are copied from :mod:`mitos_cli.fuzzy.shapes` by source). Names from the rule
 base appear only as ``repr`` literals (``INPUTS``, ``OUTPUTS``), in the docstring through
 :func:`doc_text`, and in identifiers made by :mod:`.program`.
 """
@@ -12,7 +12,7 @@ import re
 
 import numpy as np
 
-from ...compile import CompiledRuleBase
+from ...engine.compile import CompiledRuleBase
 from ...words import plural
 from .program import PLAIN, Program, num, program, weighted_sums
 
@@ -119,7 +119,7 @@ def _py_shapes(shapes) -> list[str]:
     """NumPy shape functions: MITOS's own (copied by source) so results agree exactly."""
     import inspect
 
-    from ... import shapes as shapes_mod
+    from ...fuzzy import shapes as shapes_mod
 
     out = []
     done: set[str] = set()
