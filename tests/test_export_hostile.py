@@ -15,7 +15,6 @@ from __future__ import annotations
 import ast
 import importlib.util
 import itertools
-import os
 import re
 import shutil
 import subprocess
@@ -282,7 +281,7 @@ def check_exports(path: Path, d: Path, with_c: bool) -> None:
         spec = importlib.util.spec_from_file_location(module_path.stem, module_path)
         module = importlib.util.module_from_spec(spec)
         spec.loader.exec_module(module)
-        assert module.INPUTS == tuple(c.inputs) and module.OUTPUTS == tuple(c.outputs)
+        assert tuple(c.inputs) == module.INPUTS and tuple(c.outputs) == module.OUTPUTS
         X = np.linspace(c.universe[:, 0], c.universe[:, 1], 7)
         np.testing.assert_allclose(module.evaluate(X), engine.evaluate(c, X).outputs,
                                    atol=1e-9, equal_nan=True)

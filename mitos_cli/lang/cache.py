@@ -33,9 +33,10 @@ import secrets
 import stat
 import sys
 import tempfile
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Callable
+from typing import TYPE_CHECKING, Any
 
 from .._version import __version__
 from .model import RuleBase
@@ -93,7 +94,7 @@ def status() -> Status:
     return Status(where)
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def _warn(reason: str) -> None:
     """Say once per process why a configured cache directory is not used."""
     print(f"mitos: warning: {reason}", file=sys.stderr)

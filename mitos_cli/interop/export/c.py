@@ -38,10 +38,12 @@ C_SHAPES = {
     "sigmoid": """static double mf_sigmoid(double x, double inflection, double slope) {
     return 1.0 / (1.0 + exp(-(slope * (x - inflection))));
 }""",
-    "sigmoid_difference": """static double mf_sigmoid_difference(double x, double l, double r, double f, double rt) {
+    "sigmoid_difference": """static double mf_sigmoid_difference(double x, double l, double r, \
+double f, double rt) {
     return fabs(1.0 / (1.0 + exp(-(r * (x - l)))) - 1.0 / (1.0 + exp(-(f * (x - rt)))));
 }""",
-    "sigmoid_product": """static double mf_sigmoid_product(double x, double l, double r, double f, double rt) {
+    "sigmoid_product": """static double mf_sigmoid_product(double x, double l, double r, \
+double f, double rt) {
     return (1.0 / (1.0 + exp(-(r * (x - l))))) * (1.0 / (1.0 + exp(-(f * (x - rt)))));
 }""",
     "s_shape": """static double mf_s_shape(double x, double s, double e) {

@@ -15,8 +15,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...engine.compile import CompiledRuleBase
-from ...lang.model import And, Expr, Not, Prop, flatten
 from ...fuzzy.shapes import kernel_params
+from ...lang.model import And, Expr, Not, Prop, flatten
 
 #: Text that may stand as it is in a C comment or a Python docstring.
 PLAIN = re.compile(r"[A-Za-z0-9_ .,:;+=@%()\[\]<>~^!#&|{}-]*")

@@ -167,7 +167,7 @@ def _py_outputs(c: CompiledRuleBase) -> list[str]:
             out += ["        " + line for line in _py_defuzzify(ops.defuzzify)]
             out.append(f"        Y[:, {j}] = value")
     else:
-        for j, name in enumerate(c.outputs):
+        for j in range(len(c.outputs)):
             numerator, denominator = weighted_sums(c, j)
             out.append(f"    num = {numerator} + np.zeros(X.shape[0])")
             if ops.inference == "weighted_sum":
