@@ -186,3 +186,33 @@ def test_a_term_set_still_shows_its_bad_line(tmp_path):
     with pytest.raises(TermSetError) as exc:
         api.read_rulebase(rules)
     assert "  : bad" in exc.value.render()
+
+
+SECRETS = ["root:$6$salt$hash:20228:0:99999:7:::\nsecond: line\n", "password = hunter2\n[x\n"]
+
+
+@pytest.mark.parametrize("secret", SECRETS)
+def test_a_world_or_map_error_quotes_no_line_of_a_foreign_file(tmp_path, secret):
+    from mitos_cli.errors import WorldError
+    from mitos_cli.sim.worldfile import load_world
+
+    (tmp_path / "private").write_text(secret)
+    (tmp_path / "w.yaml").write_text(with_map(f"  grid: {tmp_path / 'private'}\n"))
+    for named in (tmp_path / "private",                       # a lesson's `simulate FILE`
+                  tmp_path / "w.yaml"):                         # a world's `grid: FILE`
+        with pytest.raises(WorldError) as exc:
+            load_world(named)
+        shown = exc.value.render()
+        assert "is not a" in shown
+        for line in secret.splitlines():
+            assert line not in shown and line.split(":")[0] not in shown.split("\n", 1)[1]
+
+
+def with_map(block: str) -> str:
+    """The packaged corridor world with its `map:` block replaced by ``block``."""
+    lines = (REPO / "worlds" / "corridor.yaml").read_text().split("\n")
+    i = lines.index("map:") + 1
+    j = i
+    while j < len(lines) and (lines[j].startswith(" ") or not lines[j].strip()):
+        j += 1
+    return "\n".join(lines[:i]) + "\n" + block + "\n".join(lines[j:])
