@@ -469,3 +469,19 @@ def test_fll_repeated_term_names_mean_the_last_as_in_fuzzylite():
     assert rb.variables["x"].term_names == ("veryhigh_2", "veryhigh")
     assert rb.variables["x"].term("veryhigh").params == (0.0, 0.0, 10.0)   # the last one
     assert any("e.fll:4:" in n and "`veryhigh_2`" in n for n in rb.notes)
+
+
+def test_exported_python_computes_jfuzzylogics_dsigm(tmp_path: Path):
+    import importlib.util
+
+    path = tmp_path / "t.fcl"
+    path.write_text(JFUZZY.replace("TERM low := gauss 2 1;", "TERM low := dsigm 4 2 1 6;"))
+    out = tmp_path / "t_py.py"
+    result = runner.invoke(app, ["export", str(path), "--to", "python", "-o", str(out)])
+    assert result.exit_code == 0, result.output
+    spec = importlib.util.spec_from_file_location("t_py", out)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    rb = load_rulebase(path)
+    X = np.linspace(0, 10, 41)[:, None]
+    np.testing.assert_allclose(module.evaluate(X)[:, 0], rb.run(X).outputs[:, 0], atol=1e-12)
