@@ -15,8 +15,8 @@ coverage           at every point of the universe the largest membership is at l
                    :data:`COVERAGE`
 distinguishable    two fuzzy sets of one variable have a Jaccard similarity
                    ``|A and B| / |A or B|`` (min / max, integrated over the universe) of at most
-                   :data:`SIMILARITY`; two crisp values lie at least :data:`DISTINCT` of the
-                   universe apart
+                   :data:`SIMILARITY`; two neighbouring crisp values lie at least
+                   :data:`DISTINCT` times the median distance of neighbouring values apart
 centre             when the terms are written mirror-symmetric about a point (an odd number
                    of terms; the first and last, second and second-last, ... are mirror
                    images, corner for corner), the middle term stays centred on that point
@@ -40,8 +40,9 @@ from .terms import Term, Variable
 COVERAGE = 0.5
 #: Largest Jaccard similarity two fuzzy sets of one variable may have.
 SIMILARITY = 0.5
-#: Least distance between two crisp terms of one variable, as a fraction of its universe.
-DISTINCT = 0.05
+#: Least distance between two neighbouring crisp terms of one variable, as a fraction of the
+#: median distance between its neighbouring crisp terms (steering 30, 50, ..., 150: 10 deg).
+DISTINCT = 0.5
 #: Points per universe on which the similarity integrals are taken (plus every corner).
 SIMILARITY_POINTS = 257
 #: Relative tolerance (of the universe width) for "at its point" and "in order".
@@ -109,6 +110,14 @@ def similarity(corners: np.ndarray, universe: tuple[float, float]) -> np.ndarray
 
     inter, union = area(both), area(either)
     return np.divide(inter, union, out=np.zeros_like(inter), where=union > 0)
+
+
+def least_distance(values: np.ndarray) -> float:
+    """How far apart neighbouring crisp values must stay: :data:`DISTINCT` times the median
+    distance between neighbours (0 for fewer than two values)."""
+    if len(values) < 2:
+        return 0.0
+    return float(DISTINCT * np.median(np.diff(np.sort(values))))
 
 
 def most_similar(corners: np.ndarray, universe: tuple[float, float]) -> tuple[float, int, int]:
@@ -224,11 +233,12 @@ def variable_issues(var: Variable) -> list[Issue]:
                     f"(similarity {s:.2f} > {SIMILARITY:g})"),
                     "move their peaks apart or narrow them (or merge them into one term)"))
     values = sorted((t.params[0], t.name) for t in crisp)
+    least = least_distance(np.array([v for v, _ in values]))
     for (v1, n1), (v2, n2) in zip(values, values[1:]):
-        if v2 - v1 < DISTINCT * width - TOLERANCE * width:
+        if v2 - v1 < least - TOLERANCE * width:
             out.append(Issue("indistinct", var.name, (n1, n2), (
                 f"`{var.name}.{n1}` ({_num(v1)}) and `{n2}` ({_num(v2)}) are hard to tell apart "
-                f"(closer than {DISTINCT:.0%} of the universe, {_num(DISTINCT * width)})"),
+                f"(closer than {_num(least)}, half the median distance of its values)"),
                 "move them apart, or merge them into one term"))
     out += _off_centre(var)
     return out

@@ -314,8 +314,8 @@ def parameterise(compiled: CompiledRuleBase, *, constrained: bool = True,
 
     ``constrained`` (the default) keeps the terms' meaning as well as their order
     (:mod:`mitos_cli.interpretability`): the middle term of mirror-symmetric terms held at
-    its point unless ``released`` names it, crisp output values :data:`~mitos_cli.
-    interpretability.DISTINCT` apart, inputs covered and their sets distinguishable.
+    its point unless ``released`` names it, neighbouring crisp output values at least
+    half their median distance apart, inputs covered and their sets distinguishable.
     ``frozen_terms`` are ``(variable, term)`` pairs kept as they are."""
     _supported(compiled)
     b = _Builder(compiled, constrained, frozenset(frozen_terms), frozenset(released))
@@ -358,7 +358,7 @@ def _input_knots(b: _Builder) -> np.ndarray:
 
 def _output_knots(b: _Builder) -> tuple[np.ndarray, dict]:
     """Output values: every crisp term of every output is a knot (ordered, at least
-    ``DISTINCT`` apart when constrained); crisp consequents one knot per rule; Mamdani output
+    ``least_distance`` apart when constrained); crisp consequents one knot per rule; Mamdani output
     sets' corners tied like an input's."""
     compiled = b.compiled
     R, m = compiled.cons_value.shape
@@ -399,7 +399,8 @@ def _crisp_terms(b: _Builder, oname: str) -> dict[str, int]:
             b.reasons.append(f"{oname}.{tname} is frozen")
     if len(ids) > 1:
         b.order.append(np.array(ids, dtype=np.intp))
-        b.order_gap.append(meaning.DISTINCT if b.constrained else MIN_GAP)
+        least = meaning.least_distance(np.array([b.values[i] for i in ids])) / (uhi - ulo)
+        b.order_gap.append(max(least, MIN_GAP) if b.constrained else MIN_GAP)
     if ids:
         b.hold(oname)
     return term_knot
@@ -899,7 +900,7 @@ def descent_direction(p: Parameters, values: np.ndarray, grad: np.ndarray) -> np
 
 def feasible(p: Parameters, values: np.ndarray) -> bool:
     """Knots inside their bounds and in their order, at least :data:`MIN_GAP` apart (crisp
-    output values ``DISTINCT``); each partition covered and distinguishable (when it moved)."""
+    output values half their median distance); each partition covered and distinguishable (when it moved)."""
     if np.any(values < p.lo - 1e-12) or np.any(values > p.hi + 1e-12):
         return False
     for k, ids in enumerate(p.order):

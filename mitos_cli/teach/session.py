@@ -13,6 +13,8 @@ transition), so replaying the journal's entries rebuilds the state exactly: that
 ``operators``   an ``operators:`` line in the open (or active) behavior
 ``activate``    ``use NAME`` at the top: the behavior taught and evaluated from now on
 ``examples``    corrections (``correct``, or ``at`` on a simulation): inputs and targets
+``freeze``      ``frozen heading.AHEAD``: terms adaptation keeps as they are
+``release``     ``unfrozen heading.AHEAD``: a freeze or a hold at a point lifted
 ``adapt``       learned term parameters and crisp values (with Q before and after)
 ==============  ==========================================================================
 """
@@ -58,6 +60,8 @@ class State:
     active: str
     block: str | None = None
     examples: list[Example] = field(default_factory=list)
+    frozen_terms: set = field(default_factory=set)      # (variable, term)
+    released: set = field(default_factory=set)          # (variable, term)
 
 
 # ---- pure state transitions ----------------------------------------------------------------
@@ -133,6 +137,14 @@ def apply(state: State, entry: dict) -> None:
         state.examples += [Example(e["inputs"], e["targets"], e.get("source", ""),
                                    entry.get("behavior", ""))
                            for e in entry["examples"]]
+    elif op == "freeze":
+        for var, term in entry["terms"]:
+            state.frozen_terms.add((var, term))
+            state.released.discard((var, term))
+    elif op == "release":
+        for var, term in entry["terms"]:
+            state.frozen_terms.discard((var, term))
+            state.released.add((var, term))
     elif op == "adapt":
         rb = _set_params(rb, entry["terms"])
         state.rulebase = _set_crisp(rb, entry.get("crisp", []))
@@ -339,6 +351,26 @@ class Session:
         self.change("frozen", line, behavior=b.name, labels=list(c.labels))
         self.out(f"{b.name}: adaptation leaves the consequents of {', '.join(c.labels)} alone")
 
+    def _term_refs(self, refs) -> list[list[str]]:
+        variables = self.rulebase.variables
+        for var, term in refs:
+            if var not in variables:
+                raise unknown("variable", var, list(variables), cls=LessonError)
+            variables[var].term(term)                    # unknown term: did you mean
+        return [list(r) for r in refs]
+
+    def _freezeterms(self, c: cmd.FreezeTerms, line: str) -> None:
+        terms = self._term_refs(c.terms)
+        self.change("freeze", line, terms=terms)
+        self.out("adaptation keeps " + ", ".join(f"{v}.{t}" for v, t in terms)
+                 + " as it is (`unfrozen` lets it move)")
+
+    def _releaseterms(self, c: cmd.ReleaseTerms, line: str) -> None:
+        terms = self._term_refs(c.terms)
+        self.change("release", line, terms=terms)
+        self.out("adaptation may move " + ", ".join(f"{v}.{t}" for v, t in terms)
+                 + " (no freeze, no hold at a point of symmetry)")
+
     def _telloperators(self, c: cmd.TellOperators, line: str) -> None:
         b = self.rulebase.behavior(self.focus)
         resolve(c.settings, resolve(b.operators, resolve(self.rulebase.operators)))
@@ -389,6 +421,63 @@ class Session:
                     examples=[{"inputs": inputs, "targets": targets, "source": "correct"}])
         self.out(f"example {len(self.state.examples)}: " + _example_text(inputs, targets, now))
 
+    def _said(self, said, compiled: CompiledRuleBase) -> tuple[cmd.Assign, ...]:
+        """``steering is very LM`` -> ``steering=40`` (the hedged term's value)."""
+        from .instructions import hedged
+
+        out = []
+        for t in said:
+            if t.name not in compiled.outputs:
+                raise unknown("output variable", t.name, compiled.outputs, span=t.span,
+                              cls=LessonError)
+            if t.term is None:
+                out.append(cmd.Assign(t.name, t.value, t.span))
+                continue
+            var = compiled.variables[t.name]
+            var.term(t.term, t.span)
+            out.append(cmd.Assign(t.name, hedged(var, t.term, t.hedges), t.span))
+        return tuple(out)
+
+    def _correctsaid(self, c: cmd.CorrectSaid, line: str) -> None:
+        compiled = self.compiled()
+        self._correct(cmd.Correct(c.inputs, self._said(c.targets, compiled)), line)
+
+    def _atsaid(self, c: cmd.AtSaid, line: str) -> None:
+        compiled = self.compiled()
+        self._at(cmd.At(c.start, c.stop, self._said(c.targets, compiled)), line)
+
+    def _atinstruction(self, c: cmd.AtInstruction, line: str) -> None:
+        from .instructions import Window, instruction, targets
+
+        try:
+            ins = instruction(c.words)
+        except LessonError as exc:
+            exc.span = c.span
+            raise
+        rec = self._recording()
+        compiled = self.compiled()
+        rows = rec.rows(c.start, c.stop)
+        inputs = [rec.inputs_at(i, compiled.inputs) for i in rows]
+        now = self._outputs(compiled, inputs)
+        window = Window({o: np.array([y[o] for y in now]) for o in compiled.outputs},
+                        {k: np.array([x[k] for x in inputs]) for k in compiled.inputs},
+                        compiled.variables)
+        wanted = targets(ins, window)
+        keep = np.flatnonzero(np.isfinite(wanted))
+        if keep.size == 0:
+            raise LessonError(f"`{ins.words}`: the robot went straight {rec.when(rows)}, so "
+                              "there is no turn to change", hint="name the window of a turn")
+        self.out(f"{ins.words}: {ins.meaning} ({ins.output} {_num(float(window.outputs[ins.output][keep[0]]))}"
+                 f" -> {_num(float(wanted[keep[0]]))} at {rec.time(rows[keep[0]]):g} s)")
+        self._add_window(compiled, rec, rows[keep], [inputs[i] for i in keep],
+                         [{ins.output: float(wanted[i])} for i in keep], line)
+
+    def _recording(self):
+        if self.simulation is None:
+            raise LessonError("no simulation to correct yet",
+                              hint="run `simulate WORLD` first, then `at 12.5s steering=55`")
+        return self.simulation
+
     def _outputs(self, compiled: CompiledRuleBase, inputs: list[dict]) -> list[dict]:
         from ..engine import evaluate
 
@@ -405,24 +494,26 @@ class Session:
         self.out(self.simulation.describe())
 
     def _at(self, c: cmd.At, line: str) -> None:
-        if self.simulation is None:
-            raise LessonError("no simulation to correct yet",
-                              hint="run `simulate WORLD` first, then `at 12.5s steering=55`")
+        rec = self._recording()
         compiled = self.compiled()
-        rows = self.simulation.rows(c.start, c.stop)
+        rows = rec.rows(c.start, c.stop)
         targets = self._values(c.targets, compiled.outputs, "output", compiled, False)
-        inputs = [self.simulation.inputs_at(i, compiled.inputs) for i in rows]
+        inputs = [rec.inputs_at(i, compiled.inputs) for i in rows]
+        self._add_window(compiled, rec, rows, inputs, [targets] * len(rows), line)
+
+    def _add_window(self, compiled: CompiledRuleBase, rec, rows, inputs: list[dict],
+                    targets: list[dict], line: str) -> None:
+        """Examples from ticks ``rows`` of the recorded run, journaled and shown."""
         now = self._outputs(compiled, inputs)
-        when = self.simulation.when(rows)
-        examples = [{"inputs": x, "targets": targets, "source": f"{self.simulation.name} "
-                     f"t={self.simulation.time(i):g}s"} for x, i in zip(inputs, rows)]
+        examples = [{"inputs": x, "targets": t, "source": f"{rec.name} t={rec.time(i):g}s"}
+                    for x, t, i in zip(inputs, targets, rows)]
         self.change("examples", line, behavior=compiled.behavior, examples=examples)
         first = len(self.state.examples) - len(examples) + 1
         self.out(f"{plural(len(examples), 'example')} from "
-                 f"{self.simulation.name} {when} (#{first}"
+                 f"{rec.name} {rec.when(rows)} (#{first}"
                  + (f"-{len(self.state.examples)}" if len(examples) > 1 else "") + "):")
-        for x, y in list(zip(inputs, now))[:5]:
-            self.out("  " + _example_text(x, targets, y))
+        for x, t, y in list(zip(inputs, targets, now))[:5]:
+            self.out("  " + _example_text(x, t, y))
         if len(examples) > 5:
             self.out(f"  ... ({len(examples) - 5} more: `show examples`)")
 
@@ -449,7 +540,8 @@ class Session:
         rate = 0.5 if c.rate is None else c.rate
         compiled = self.compiled()
         X, T = self.training_set(compiled)
-        params = parameterise(compiled)
+        params = parameterise(compiled, frozen_terms=self.state.frozen_terms,
+                              released=self.state.released)
         if params.n_free == 0:
             raise LessonError(f"nothing in behavior `{compiled.behavior}` may be adapted",
                               hint="every term and consequent it uses is frozen")
@@ -487,6 +579,10 @@ class Session:
         self.out(changed_table(before_rb, self.rulebase, crisp))
         if result.parameters.frozen_reasons:
             self.out("not adapted: " + "; ".join(result.parameters.frozen_reasons))
+        from .learned import in_words
+
+        self.out(in_words(before_rb, self.rulebase, result.parameters))
+        self.out(self.interpretability())
         if c.plot is not None:
             self._plot_terms(before_rb, self.rulebase, c.plot)
 
@@ -563,6 +659,17 @@ class Session:
                                      else " (no changes)"))
         for change in saved.changes:
             self.out(f"  {change}")
+        self.out(self.interpretability())
+
+    def interpretability(self) -> str:
+        """What ``mitos check`` says about the terms' meaning, for the prompt."""
+        from ..interpretability import rulebase_issues
+
+        issues = rulebase_issues(self.rulebase.variables.values())
+        if not issues:
+            return "interpretability: terms in order, universes covered, terms distinct, " \
+                   "centre terms on their points"
+        return "\n".join(["interpretability:"] + [f"  {i.message} ({i.hint})" for i in issues])
 
     def _help(self, c: cmd.Help, line: str) -> None:
         from .help import help_text
