@@ -161,6 +161,7 @@ class Adapt:
     epochs: float | None = None      # checked to be whole by the session
     rate: float | None = None
     plot: str | None = None
+    constrained: bool = True         # `unconstrained`: order and bounds only
 
 
 @dataclass(frozen=True)
@@ -280,6 +281,9 @@ class _ToCommand(_ToModel):
 
     def plot(self, items):
         return ("plot", items[0])
+
+    def unconstrained(self, items):
+        return ("constrained", False)
 
     def adapt_cmd(self, items):
         return Adapt(**dict(items))

@@ -540,8 +540,8 @@ class Session:
         rate = 0.5 if c.rate is None else c.rate
         compiled = self.compiled()
         X, T = self.training_set(compiled)
-        params = parameterise(compiled, frozen_terms=self.state.frozen_terms,
-                              released=self.state.released)
+        params = parameterise(compiled, constrained=c.constrained,
+                              frozen_terms=self.state.frozen_terms, released=self.state.released)
         if params.n_free == 0:
             raise LessonError(f"nothing in behavior `{compiled.behavior}` may be adapted",
                               hint="every term and consequent it uses is frozen")
