@@ -16,7 +16,8 @@ coverage           at every point of the universe the largest membership is at l
 distinguishable    two fuzzy sets of one variable have a Jaccard similarity
                    ``|A and B| / |A or B|`` (min / max, integrated over the universe) of at most
                    :data:`SIMILARITY`; two neighbouring crisp values lie at least
-                   :data:`DISTINCT` times the median distance of neighbouring values apart
+                   :data:`DISTINCT` times the spacing of as many evenly spread values
+                   (steering, 7 terms on [30, 150]: 10 deg apart)
 centre             when the terms are written mirror-symmetric about a point (an odd number
                    of terms; the first and last, second and second-last, ... are mirror
                    images, corner for corner), the middle term stays centred on that point
@@ -41,7 +42,7 @@ COVERAGE = 0.5
 #: Largest Jaccard similarity two fuzzy sets of one variable may have.
 SIMILARITY = 0.5
 #: Least distance between two neighbouring crisp terms of one variable, as a fraction of the
-#: median distance between its neighbouring crisp terms (steering 30, 50, ..., 150: 10 deg).
+#: spacing of as many values spread evenly over the universe (steering, 7 on [30, 150]: 10).
 DISTINCT = 0.5
 #: Points per universe on which the similarity integrals are taken (plus every corner).
 SIMILARITY_POINTS = 257
@@ -112,12 +113,12 @@ def similarity(corners: np.ndarray, universe: tuple[float, float]) -> np.ndarray
     return np.divide(inter, union, out=np.zeros_like(inter), where=union > 0)
 
 
-def least_distance(values: np.ndarray) -> float:
-    """How far apart neighbouring crisp values must stay: :data:`DISTINCT` times the median
-    distance between neighbours (0 for fewer than two values)."""
-    if len(values) < 2:
+def least_distance(count: int, universe: tuple[float, float]) -> float:
+    """How far apart ``count`` neighbouring crisp values must stay: :data:`DISTINCT` times
+    the spacing of ``count`` values spread evenly over the universe."""
+    if count < 2:
         return 0.0
-    return float(DISTINCT * np.median(np.diff(np.sort(values))))
+    return float(DISTINCT * (universe[1] - universe[0]) / (count - 1))
 
 
 def most_similar(corners: np.ndarray, universe: tuple[float, float]) -> tuple[float, int, int]:
@@ -233,12 +234,12 @@ def variable_issues(var: Variable) -> list[Issue]:
                     f"(similarity {s:.2f} > {SIMILARITY:g})"),
                     "move their peaks apart or narrow them (or merge them into one term)"))
     values = sorted((t.params[0], t.name) for t in crisp)
-    least = least_distance(np.array([v for v, _ in values]))
+    least = least_distance(len(values), var.universe)
     for (v1, n1), (v2, n2) in zip(values, values[1:]):
         if v2 - v1 < least - TOLERANCE * width:
             out.append(Issue("indistinct", var.name, (n1, n2), (
                 f"`{var.name}.{n1}` ({_num(v1)}) and `{n2}` ({_num(v2)}) are hard to tell apart "
-                f"(closer than {_num(least)}, half the median distance of its values)"),
+                f"(closer than {_num(least)}, half the spacing of evenly spread values)"),
                 "move them apart, or merge them into one term"))
     out += _off_centre(var)
     return out

@@ -289,8 +289,8 @@ class _Builder:
         return out
 
     def _hold_set(self, vname: str, items: list, out: dict) -> None:
-        """A held triangle keeps its peak and stays symmetric; a held trapezoid keeps its
-        corners."""
+        """A held triangle keeps its peak (its slopes may move: they are its neighbours'
+        peaks); a held trapezoid keeps its core."""
         held = self.hold(vname) if items else None
         if held is None:
             return
@@ -298,13 +298,8 @@ class _Builder:
         if key is None:
             return
         ids = out[key]
-        if held[0].shape in ("triangle", "triangle_plr") and ids[0] >= 0 and ids[3] >= 0:
-            self.frozen[ids[1]] = True
-            self.sym_rows.append((ids[0], ids[1], ids[3]))
-        elif held[0].shape == "triangle_pw":
-            self.frozen[ids[1]] = True
-        else:
-            for i in ids[ids >= 0]:
+        for i in ids[1:3]:
+            if i >= 0:
                 self.frozen[i] = True
 
 
@@ -315,7 +310,7 @@ def parameterise(compiled: CompiledRuleBase, *, constrained: bool = True,
     ``constrained`` (the default) keeps the terms' meaning as well as their order
     (:mod:`mitos_cli.interpretability`): the middle term of mirror-symmetric terms held at
     its point unless ``released`` names it, neighbouring crisp output values at least
-    half their median distance apart, inputs covered and their sets distinguishable.
+    half the spacing of evenly spread values apart, inputs covered and their sets distinguishable.
     ``frozen_terms`` are ``(variable, term)`` pairs kept as they are."""
     _supported(compiled)
     b = _Builder(compiled, constrained, frozenset(frozen_terms), frozenset(released))
@@ -399,7 +394,7 @@ def _crisp_terms(b: _Builder, oname: str) -> dict[str, int]:
             b.reasons.append(f"{oname}.{tname} is frozen")
     if len(ids) > 1:
         b.order.append(np.array(ids, dtype=np.intp))
-        least = meaning.least_distance(np.array([b.values[i] for i in ids])) / (uhi - ulo)
+        least = meaning.least_distance(len(ids), var.universe) / (uhi - ulo)
         b.order_gap.append(max(least, MIN_GAP) if b.constrained else MIN_GAP)
     if ids:
         b.hold(oname)
@@ -900,7 +895,7 @@ def descent_direction(p: Parameters, values: np.ndarray, grad: np.ndarray) -> np
 
 def feasible(p: Parameters, values: np.ndarray) -> bool:
     """Knots inside their bounds and in their order, at least :data:`MIN_GAP` apart (crisp
-    output values half their median distance); each partition covered and distinguishable (when it moved)."""
+    output values ``least_distance``); each partition covered and distinguishable (when it moved)."""
     if np.any(values < p.lo - 1e-12) or np.any(values > p.hi + 1e-12):
         return False
     for k, ids in enumerate(p.order):
@@ -915,10 +910,12 @@ def feasible(p: Parameters, values: np.ndarray) -> bool:
 
 def adapt(compiled: CompiledRuleBase, X: np.ndarray, targets: np.ndarray, *, epochs: int = 50,
           rate: float = 0.5, on_epoch: Callable[[int, float], None] | None = None,
-          parameters: Parameters | None = None, constrained: bool = True) -> Adaptation:
+          parameters: Parameters | None = None, constrained: bool = True,
+          on_values: Callable[[np.ndarray], None] | None = None) -> Adaptation:
     """Gradient descent on ``Q`` (eqs. 13-14): ``epochs`` full-batch steps of learning factor
     ``rate`` in (0, 1), each halved until ``Q`` decreases inside the constraints
-    (``parameters``, else :func:`parameterise` with ``constrained``)."""
+    (``parameters``, else :func:`parameterise` with ``constrained``). ``on_epoch`` hears
+    ``(epoch, Q)`` and ``on_values`` the values after each epoch."""
     if not 0.0 < rate < 1.0:
         raise LessonError(f"the learning factor must lie in (0, 1), not {rate:g}",
                           hint="the paper's eta: try `rate 0.5`")
@@ -958,6 +955,8 @@ def adapt(compiled: CompiledRuleBase, X: np.ndarray, targets: np.ndarray, *, epo
             step = min(1.0, step * 2.0)
             if on_epoch is not None:
                 on_epoch(epoch, Q)
+            if on_values is not None:
+                on_values(values)
     except KeyboardInterrupt:
         interrupted = True            # keep what the completed epochs learned
     q_learned = history[-1]
