@@ -44,8 +44,6 @@ SIMILARITY = 0.5
 #: Least distance between two neighbouring crisp terms of one variable, as a fraction of the
 #: spacing of as many values spread evenly over the universe (steering, 7 on [30, 150]: 10).
 DISTINCT = 0.5
-#: Points per universe on which the similarity integrals are taken (plus every corner).
-SIMILARITY_POINTS = 257
 #: Relative tolerance (of the universe width) for "at its point" and "in order".
 TOLERANCE = 1e-6
 
@@ -75,32 +73,35 @@ def memberships(corners: np.ndarray, x: np.ndarray) -> np.ndarray:
     return np.clip(np.minimum(rise, fall), 0.0, 1.0)
 
 
-def coverage(corners: np.ndarray, universe: tuple[float, float]) -> tuple[float, float]:
-    """The least largest-membership on the universe and where it is, exactly: the minimum of
-    the upper envelope of piecewise-linear functions lies at a corner, an end of the universe
-    or where a falling edge crosses a rising one."""
+def breakpoints(corners: np.ndarray, universe: tuple[float, float]) -> np.ndarray:
+    """Every point of the universe where the min or max of two of these piecewise-linear
+    terms can bend: its ends, the corners and where two sloped edges cross (sorted)."""
     lo, hi = universe
     a, b, c, d = corners.T
-    fall = np.isfinite(c) & np.isfinite(d) & (d > c)
     rise = np.isfinite(a) & np.isfinite(b) & (b > a)
-    ci, di = c[fall][:, None], d[fall][:, None]
-    aj, bj = a[rise][None, :], b[rise][None, :]
+    fall = np.isfinite(c) & np.isfinite(d) & (d > c)
+    # each sloped edge as mu = slope * x + offset
+    slope = np.concatenate([1.0 / (b[rise] - a[rise]), -1.0 / (d[fall] - c[fall])])
+    offset = np.concatenate([-a[rise] / (b[rise] - a[rise]), d[fall] / (d[fall] - c[fall])])
     with np.errstate(invalid="ignore", divide="ignore"):
-        cross = (di * (bj - aj) + aj * (di - ci)) / ((bj - aj) + (di - ci))
+        cross = (offset[None, :] - offset[:, None]) / (slope[:, None] - slope[None, :])
     x = np.concatenate([[lo, hi], corners[np.isfinite(corners)], cross.ravel()])
-    x = x[np.isfinite(x) & (x >= lo) & (x <= hi)]
+    return np.unique(x[np.isfinite(x) & (x >= lo) & (x <= hi)])
+
+
+def coverage(corners: np.ndarray, universe: tuple[float, float]) -> tuple[float, float]:
+    """The least largest-membership on the universe and where it is, exactly: the upper
+    envelope of piecewise-linear functions is smallest at one of its :func:`breakpoints`."""
+    x = breakpoints(corners, universe)
     top = memberships(corners, x).max(axis=0)
     k = int(np.argmin(top))
     return float(top[k]), float(x[k])
 
 
 def similarity(corners: np.ndarray, universe: tuple[float, float]) -> np.ndarray:
-    """Jaccard similarity ``[t, t]`` of every pair of terms (1 on the diagonal), integrated by
-    the trapezoid rule over :data:`SIMILARITY_POINTS` points of the universe and every
-    corner."""
-    lo, hi = universe
-    inner = corners[np.isfinite(corners) & (corners > lo) & (corners < hi)]
-    x = np.unique(np.concatenate([np.linspace(lo, hi, SIMILARITY_POINTS), inner]))
+    """Jaccard similarity ``[t, t]`` of every pair of terms (1 on the diagonal), exactly: the
+    trapezoid rule on the :func:`breakpoints`, between which min and max are linear."""
+    x = breakpoints(corners, universe)
     mu = memberships(corners, x)                                 # [t, n]
     both = np.minimum(mu[:, None, :], mu[None, :, :])
     either = np.maximum(mu[:, None, :], mu[None, :, :])

@@ -893,7 +893,7 @@ def descent_direction(p: Parameters, values: np.ndarray, grad: np.ndarray) -> np
     return np.zeros_like(values)                         # pragma: no cover - all blocked
 
 
-def feasible(p: Parameters, values: np.ndarray) -> bool:
+def feasible(p: Parameters, values: np.ndarray, partitions: bool = True) -> bool:
     """Knots inside their bounds and in their order, at least :data:`MIN_GAP` apart (crisp
     output values ``least_distance``); each partition covered and distinguishable (when it moved)."""
     if np.any(values < p.lo - 1e-12) or np.any(values > p.hi + 1e-12):
@@ -901,6 +901,11 @@ def feasible(p: Parameters, values: np.ndarray) -> bool:
     for k, ids in enumerate(p.order):
         if np.any(np.diff(values[ids]) < _need(p, ids, k)):
             return False
+    return not partitions or partitions_hold(p, values)
+
+
+def partitions_hold(p: Parameters, values: np.ndarray) -> bool:
+    """Coverage and distinguishability of every partition whose knots moved."""
     for part in p.partitions:
         mine = part.knot[part.knot >= 0]
         if not np.array_equal(values[mine], p.values[mine]) and not part.holds(values):
@@ -937,9 +942,9 @@ def adapt(compiled: CompiledRuleBase, X: np.ndarray, targets: np.ndarray, *, epo
             accepted = False
             for _ in range(HALVINGS):
                 candidate = values + step * direction * p.scale
-                if feasible(p, candidate):
+                if feasible(p, candidate, partitions=False):       # the cheap checks first
                     q_new = loss(with_values(p, candidate), X, targets)
-                    if q_new < Q:
+                    if q_new < Q and partitions_hold(p, candidate):
                         accepted = True
                         break
                 step *= 0.5
