@@ -176,3 +176,20 @@ def test_unknown_instruction_says_did_you_mean_and_lists_them():
 
 def test_scale_centre_is_the_mirror_point():
     assert scale_of(PAPER.variables["steering"]).centre == 3.0       # ST
+
+
+def test_an_unknown_instruction_at_the_prompt_names_its_place_and_the_list():
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1]
+    lesson = "use drive\nsimulate figure4\nat 13s to 14s make a wide turn\n"
+    res = subprocess.run([sys.executable, "-m", "mitos_cli", "teach", "rulebases/mitos.rules",
+                          "--lesson", "-"], cwd=root, input=lesson, capture_output=True,
+                         text=True, timeout=120)
+    assert res.returncode == 1
+    assert "<stdin>:3:1: lesson error: unknown instruction `make a wide turn`" in res.stderr
+    assert "did you mean `make a wider turn`?" in res.stderr
+    assert "`turn harder`, `turn less`, `make a wider turn`, `slow down`" in res.stderr
+    assert "Traceback" not in res.stderr
