@@ -122,6 +122,24 @@ def least_distance(count: int, universe: tuple[float, float]) -> float:
     return float(DISTINCT * (universe[1] - universe[0]) / (count - 1))
 
 
+def measures(corners: np.ndarray, universe: tuple[float, float]) -> tuple[float, float]:
+    """Coverage and the largest similarity of two different terms, on one evaluation of the
+    memberships at the breakpoints (what adaptation checks on every trial step)."""
+    x = breakpoints(corners, universe)
+    mu = memberships(corners, x)
+    cover = float(mu.max(axis=0).min())
+    if len(corners) < 2:
+        return cover, 0.0
+    dx = np.diff(x)
+    both = np.minimum(mu[:, None, :], mu[None, :, :])
+    either = np.maximum(mu[:, None, :], mu[None, :, :])
+    inter = ((both[..., 1:] + both[..., :-1]) * dx).sum(axis=-1)
+    union = ((either[..., 1:] + either[..., :-1]) * dx).sum(axis=-1)
+    sim = np.divide(inter, union, out=np.zeros_like(inter), where=union > 0)
+    np.fill_diagonal(sim, -1.0)
+    return cover, float(sim.max())
+
+
 def most_similar(corners: np.ndarray, universe: tuple[float, float]) -> tuple[float, int, int]:
     """The largest similarity of two different terms and which two."""
     s = similarity(corners, universe)

@@ -140,11 +140,10 @@ class Partition:
         return np.where(self.knot >= 0, values[np.maximum(self.knot, 0)], self.written)
 
     def holds(self, values: np.ndarray) -> bool:
-        c = self.corners(values)
-        if self.least_coverage is not None and \
-                meaning.coverage(c, self.universe)[0] < self.least_coverage - 1e-12:
+        cover, similar = meaning.measures(self.corners(values), self.universe)
+        if self.least_coverage is not None and cover < self.least_coverage - 1e-12:
             return False
-        return meaning.most_similar(c, self.universe)[0] <= self.most_similar + 1e-12
+        return similar <= self.most_similar + 1e-12
 
 
 def partition(var: str, universe: tuple[float, float], knot: np.ndarray, written: np.ndarray,
