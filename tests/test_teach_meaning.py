@@ -193,3 +193,24 @@ def test_an_unknown_instruction_at_the_prompt_names_its_place_and_the_list():
     assert "did you mean `make a wider turn`?" in res.stderr
     assert "`turn harder`, `turn less`, `make a wider turn`, `slow down`" in res.stderr
     assert "Traceback" not in res.stderr
+
+
+def test_outside_the_repository_packaged_rules_and_lessons_are_found_and_save_remembers(
+        tmp_path):
+    import subprocess
+    import sys
+
+    def teach(*args, stdin=None):
+        return subprocess.run([sys.executable, "-m", "mitos_cli", "teach", *args], cwd=tmp_path,
+                              input=stdin, capture_output=True, text=True, timeout=120)
+
+    res = teach("rulebases/mitos.rules", "--lesson", "-",
+                stdin="correct road=78 size=45 position=4 -> steering is LM\nsave a.rules\n")
+    assert res.returncode == 0, res.stderr
+    assert (tmp_path / "a.rules").is_file()
+    res = teach("--resume", stdin="correct road=78 size=45 position=4 -> steering=55\n"
+                                  "adapt epochs 2\nsave\n")
+    assert res.returncode == 0, res.stderr
+    assert "saved a.rules" in res.stdout                   # where the earlier `save` went
+    res = teach("--lesson", "no-such-lesson")
+    assert res.returncode == 1 and "cannot read lesson `no-such-lesson`" in res.stderr

@@ -56,7 +56,11 @@ def teach_command(
             + (" (a torn last line of the journal was dropped)" if journal.skipped_tail
                else ""))
     else:
+        from ..resources import resolve
+
         path = Path(rules) if rules is not None else default_rulebase_path()
+        if rules is not None and not path.exists():      # as eval and check: a packaged file
+            path = resolve("rulebases", rules, ".rules") or path
         if not path.is_file():
             from ..errors import RuleBaseError
 
@@ -77,7 +81,7 @@ def teach_command(
         text, name = lesson_text if lesson_text is not None else read_lesson(lesson)
         session.echo = emit
         if lesson != "-":
-            session.base = Path(lesson).parent
+            session.base = Path(name).parent
         try:
             run_lesson(session, text, name)
         except KeyboardInterrupt:

@@ -217,8 +217,10 @@ class Session:
             session.out(f"warning: {start['rules']} or its term set changed since the session "
                         f"started; the journal's changes are applied to the files as they are now")
         session.replay()
-        saves = [e["seq"] for e in journal.entries if e["op"] == "save"]
-        session.saved_seq = saves[-1] if saves else 0
+        saves = [e for e in journal.entries if e["op"] == "save"]
+        session.saved_seq = saves[-1]["seq"] if saves else 0
+        if saves:                                   # a bare `save` goes where the last went
+            session.save_as = Path(saves[-1]["path"])
         return session
 
     def replay(self) -> None:
@@ -654,6 +656,7 @@ class Session:
         saved = save_rulebase(self.original, self.rulebase, target)
         entry = self.journal.append("save", path=str(target), line=line)
         self.saved_seq = entry["seq"]
+        self.save_as = target                      # a later bare `save` goes here too
         files = ", ".join(str(p) for p in (saved.rules,) + saved.termsets)
         self.out(f"saved {files}" + (f" ({plural(len(saved.changes), 'change')})" if saved.changes
                                      else " (no changes)"))
