@@ -7,7 +7,7 @@ from pathlib import Path
 import pytest
 
 from mitos_cli.api import default_rulebase_path
-from mitos_cli.build import load_rules_file
+from mitos_cli.lang.resolve import load_rules_file
 from mitos_cli.resources import data_dir
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -90,7 +90,7 @@ def test_what_was_learned_is_linguistic(taught):
 
 
 def test_the_lesson_is_in_words_and_the_taught_rule_base_keeps_its_meaning(taught):
-    from mitos_cli.check import check_rulebase
+    from mitos_cli.engine.check import check_rulebase
 
     session, path, said = taught
     text = "\n".join(said)
@@ -109,7 +109,7 @@ def test_500_epochs_of_the_lesson_hold_order_coverage_and_points_at_every_epoch(
     reported by benchmarks/bench_teach.py (it is not within 10%: see docs/teach.md)."""
     import numpy as np
 
-    from mitos_cli import interpretability as meaning
+    from mitos_cli.lang import interpretability as meaning
     from mitos_cli.teach.adapt import adapt, learned_rulebase, parameterise
 
     session, _, _ = taught
@@ -134,6 +134,6 @@ def test_500_epochs_of_the_lesson_hold_order_coverage_and_points_at_every_epoch(
 
 
 def compile_untaught(session):
-    from mitos_cli.compile import compile_rulebase
+    from mitos_cli.engine.compile import compile_rulebase
 
     return compile_rulebase(session.original, "drive")

@@ -8,16 +8,16 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from mitos_cli import interpretability as meaning
+from mitos_cli.lang import interpretability as meaning
 from mitos_cli.api import default_rulebase_path
-from mitos_cli.build import build_rulebase, load_rules_file
-from mitos_cli.check import check_rulebase
-from mitos_cli.compile import compile_rulebase
+from mitos_cli.lang.resolve import build_rulebase, load_rules_file
+from mitos_cli.engine.check import check_rulebase
+from mitos_cli.engine.compile import compile_rulebase
 from mitos_cli.errors import LessonError
-from mitos_cli.parse import parse_rules
+from mitos_cli.lang.parse import parse_rules
 from mitos_cli.teach.adapt import adapt, feasible, learned_rulebase, parameterise
 from mitos_cli.teach.instructions import Window, hedged, instruction, scale_of, targets
-from mitos_cli.termset import parse_termset
+from mitos_cli.lang.termfile import parse_termset
 
 PAPER = load_rules_file(default_rulebase_path())
 AVOID = compile_rulebase(PAPER, "avoid_obstacle")

@@ -12,7 +12,7 @@ network:
 * AND / OR neurons: min and max pass the gradient to the child that wins (the lowest
   child index at ties, so the result is deterministic); product and probabilistic sum get
   their exact partial derivatives; other norms are refused;
-* hedges (:mod:`mitos_cli.hedges` derivatives) and ``not`` (``-1``);
+* hedges (:mod:`mitos_cli.fuzzy.hedges` derivatives) and ``not`` (``-1``);
 * memberships: the derivative of each piecewise-linear edge w.r.t. its corner points; a
   saturated membership (0 or 1) has derivative 0.
 
@@ -46,14 +46,14 @@ from typing import Callable
 
 import numpy as np
 
-from .. import hedges as hedge_mod
-from ..compile import CompiledRuleBase
-from ..engine import evaluate, fill_defaults, infer
+from ..fuzzy import hedges as hedge_mod
+from ..engine.compile import CompiledRuleBase
+from ..engine.evaluation import evaluate, fill_defaults, infer
 from ..errors import LessonError
-from .. import interpretability as meaning
-from ..mamdani import OutputTable, spike
-from ..model import Rule, RuleBase
-from ..shapes import kernel_params
+from ..engine.mamdani import OutputTable, spike
+from ..lang.model import Rule, RuleBase
+from ..fuzzy.shapes import kernel_params
+from ..lang import interpretability as meaning
 
 #: Fraction of a universe the most-moving parameter moves in one full step (times eta).
 STEP = 0.05
@@ -112,6 +112,8 @@ class Parameters:
     partitions: tuple["Partition", ...] = ()
     #: ``(variable, term, point)`` of the terms held at their point of symmetry
     held: tuple[tuple[str, str, float], ...] = ()
+    #: entries of ``order`` that are crisp output values (distinct by their current spread)
+    crisp_orders: tuple[int, ...] = ()
     #: (output, term) -> its knots: a singleton's value ``[i, -1, -1, -1]``, or (Mamdani) the
     #: corners ``(a, b, c, d)`` of a piecewise-linear output set
     out_terms: dict = dataclasses.field(default_factory=dict)
@@ -219,6 +221,7 @@ class _Builder:
     sym_rows: list = field(default_factory=list)        # (a, b, d): a + d - 2 b = 0
     partitions: list = field(default_factory=list)
     held: list = field(default_factory=list)
+    crisp_orders: list = field(default_factory=list)    # entries of ``order``: crisp values
 
     def new_knot(self, knot: Knot, value: float, width: float, bounds: tuple[float, float],
                  frozen: bool) -> int:
@@ -307,7 +310,7 @@ def parameterise(compiled: CompiledRuleBase, *, constrained: bool = True,
     """The learnable numbers of ``compiled`` (its input terms and output values).
 
     ``constrained`` (the default) keeps the terms' meaning as well as their order
-    (:mod:`mitos_cli.interpretability`): the middle term of mirror-symmetric terms held at
+    (:mod:`mitos_cli.lang.interpretability`): the middle term of mirror-symmetric terms held at
     its point unless ``released`` names it, neighbouring crisp output values at least
     half the spacing of evenly spread values apart, inputs covered and their sets distinguishable.
     ``frozen_terms`` are ``(variable, term)`` pairs kept as they are."""
@@ -325,7 +328,8 @@ def parameterise(compiled: CompiledRuleBase, *, constrained: bool = True,
                       np.array(b.lo), np.array(b.hi), projector, tuple(b.order), corner_knot,
                       cons_knot, decimals, dependents, tuple(dict.fromkeys(b.reasons)), rows,
                       order_gap=tuple(b.order_gap), partitions=tuple(b.partitions),
-                      held=tuple(b.held), out_terms=out_terms,
+                      held=tuple(b.held), crisp_orders=tuple(b.crisp_orders),
+                      out_terms=out_terms,
                       sets=_set_specs(compiled, cons_knot) if mamdani else None)
 
 
@@ -393,7 +397,9 @@ def _crisp_terms(b: _Builder, oname: str) -> dict[str, int]:
             b.reasons.append(f"{oname}.{tname} is frozen")
     if len(ids) > 1:
         b.order.append(np.array(ids, dtype=np.intp))
-        least = meaning.least_distance(len(ids), var.universe) / (uhi - ulo)
+        least = meaning.least_distance(np.array([b.values[i] for i in ids])) / (uhi - ulo)
+        if b.constrained:
+            b.crisp_orders.append(len(b.order) - 1)
         b.order_gap.append(max(least, MIN_GAP) if b.constrained else MIN_GAP)
     if ids:
         b.hold(oname)
@@ -899,6 +905,11 @@ def feasible(p: Parameters, values: np.ndarray, partitions: bool = True) -> bool
         return False
     for k, ids in enumerate(p.order):
         if np.any(np.diff(values[ids]) < _need(p, ids, k)):
+            return False
+    for k in p.crisp_orders:              # the distance check measures on the values as they are
+        ids = p.order[k]
+        need = np.minimum(meaning.least_distance(values[ids]), np.diff(p.values[ids]))
+        if np.any(np.diff(values[ids]) < need * (1 - 1e-9)):
             return False
     return not partitions or partitions_hold(p, values)
 

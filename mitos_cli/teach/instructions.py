@@ -36,8 +36,8 @@ from typing import Callable
 import numpy as np
 
 from ..errors import LessonError, did_you_mean
-from ..interpretability import mirror_point
-from ..terms import Variable
+from ..lang.interpretability import mirror_point
+from ..lang.terms import Variable
 
 #: Term steps each hedge moves a crisp target: + away from the scale's centre, - toward it.
 HEDGE_STEPS = {"very": 0.5, "extremely": 1.0, "somewhat": -0.5, "more_or_less": -0.5}

@@ -9,8 +9,8 @@ means something close to that neighbour.
 
 from __future__ import annotations
 
-from ..interpretability import centre
-from ..model import RuleBase
+from ..lang.interpretability import centre
+from ..lang.model import RuleBase
 
 #: Share of the distance to the next term beyond which a move "changes the meaning".
 MEANING_SHIFT = 0.5

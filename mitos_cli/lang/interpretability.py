@@ -16,8 +16,8 @@ coverage           at every point of the universe the largest membership is at l
 distinguishable    two fuzzy sets of one variable have a Jaccard similarity
                    ``|A and B| / |A or B|`` (min / max, integrated over the universe) of at most
                    :data:`SIMILARITY`; two neighbouring crisp values lie at least
-                   :data:`DISTINCT` times the spacing of as many evenly spread values
-                   (steering, 7 terms on [30, 150]: 10 deg apart)
+                   :data:`DISTINCT` times the spacing of as many values spread evenly
+                   from the smallest to the largest (steering 30 ... 150, 7 terms: 10 deg)
 centre             when the terms are written mirror-symmetric about a point (an odd number
                    of terms; the first and last, second and second-last, ... are mirror
                    images, corner for corner), the middle term stays centred on that point
@@ -42,7 +42,7 @@ COVERAGE = 0.5
 #: Largest Jaccard similarity two fuzzy sets of one variable may have.
 SIMILARITY = 0.5
 #: Least distance between two neighbouring crisp terms of one variable, as a fraction of the
-#: spacing of as many values spread evenly over the universe (steering, 7 on [30, 150]: 10).
+#: spacing of as many values spread evenly from the smallest to the largest (steering: 10).
 DISTINCT = 0.5
 #: Relative tolerance (of the universe width) for "at its point" and "in order".
 TOLERANCE = 1e-6
@@ -89,11 +89,17 @@ def breakpoints(corners: np.ndarray, universe: tuple[float, float]) -> np.ndarra
     return np.unique(x[np.isfinite(x) & (x >= lo) & (x <= hi)])
 
 
-def coverage(corners: np.ndarray, universe: tuple[float, float]) -> tuple[float, float]:
+def coverage(corners: np.ndarray, universe: tuple[float, float],
+             besides_gaps: bool = False) -> tuple[float, float]:
     """The least largest-membership on the universe and where it is, exactly: the upper
-    envelope of piecewise-linear functions is smallest at one of its :func:`breakpoints`."""
+    envelope of piecewise-linear functions is smallest at one of its :func:`breakpoints`.
+    ``besides_gaps``: the least above 0 (where no term is above 0 is a gap, reported apart)."""
     x = breakpoints(corners, universe)
     top = memberships(corners, x).max(axis=0)
+    if besides_gaps:
+        x, top = x[top > 0], top[top > 0]
+        if not len(top):
+            return 1.0, float(universe[0])
     k = int(np.argmin(top))
     return float(top[k]), float(x[k])
 
@@ -114,12 +120,12 @@ def similarity(corners: np.ndarray, universe: tuple[float, float]) -> np.ndarray
     return np.divide(inter, union, out=np.zeros_like(inter), where=union > 0)
 
 
-def least_distance(count: int, universe: tuple[float, float]) -> float:
-    """How far apart ``count`` neighbouring crisp values must stay: :data:`DISTINCT` times
-    the spacing of ``count`` values spread evenly over the universe."""
-    if count < 2:
+def least_distance(values: np.ndarray) -> float:
+    """How far apart neighbouring crisp ``values`` must stay: :data:`DISTINCT` times the
+    spacing of as many values spread evenly between the smallest and the largest."""
+    if len(values) < 2:
         return 0.0
-    return float(DISTINCT * (universe[1] - universe[0]) / (count - 1))
+    return float(DISTINCT * (np.max(values) - np.min(values)) / (len(values) - 1))
 
 
 def measures(corners: np.ndarray, universe: tuple[float, float]) -> tuple[float, float]:
@@ -238,7 +244,7 @@ def variable_issues(var: Variable) -> list[Issue]:
     if len(sets) >= 2 or (sets and var.role == "input"):
         corners = np.array([t.corners for t in sets], dtype=float)
         if var.role == "input":
-            low, where = coverage(corners, var.universe)
+            low, where = coverage(corners, var.universe, besides_gaps=True)   # see term-gap
             if low < COVERAGE - 1e-9:
                 out.append(Issue("coverage", var.name, (), (
                     f"`{var.name}` is covered only to {_num(low)} at {var.name} = "
@@ -253,7 +259,7 @@ def variable_issues(var: Variable) -> list[Issue]:
                     f"(similarity {s:.2f} > {SIMILARITY:g})"),
                     "move their peaks apart or narrow them (or merge them into one term)"))
     values = sorted((t.params[0], t.name) for t in crisp)
-    least = least_distance(len(values), var.universe)
+    least = least_distance(np.array([v for v, _ in values]))
     for (v1, n1), (v2, n2) in zip(values, values[1:]):
         if v2 - v1 < least - TOLERANCE * width:
             out.append(Issue("indistinct", var.name, (n1, n2), (
