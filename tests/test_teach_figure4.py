@@ -19,8 +19,8 @@ pytestmark = pytest.mark.skipif(not (WORLDS / "figure4.yaml").is_file(),
 
 
 def drive(rulebase, world):
-    from mitos_cli.sim.planner import FuzzyPlanner
     from mitos_cli.sim.loop import simulate
+    from mitos_cli.sim.planner import FuzzyPlanner
     from mitos_cli.sim.worldfile import load_world
 
     w = load_world(WORLDS / f"{world}.yaml")
@@ -107,7 +107,6 @@ def test_the_lesson_is_in_words_and_the_taught_rule_base_keeps_its_meaning(taugh
 def test_500_epochs_of_the_lesson_hold_order_coverage_and_points_at_every_epoch(taught):
     """The constraints at every epoch of a long run; Q against the unconstrained run is
     reported by benchmarks/bench_teach.py (it is not within 10%: see docs/teach.md)."""
-    import numpy as np
 
     from mitos_cli.lang import interpretability as meaning
     from mitos_cli.teach.adapt import adapt, learned_rulebase, parameterise

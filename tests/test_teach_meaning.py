@@ -8,16 +8,16 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from mitos_cli.lang import interpretability as meaning
 from mitos_cli.api import default_rulebase_path
-from mitos_cli.lang.resolve import build_rulebase, load_rules_file
 from mitos_cli.engine.check import check_rulebase
 from mitos_cli.engine.compile import compile_rulebase
 from mitos_cli.errors import LessonError
+from mitos_cli.lang import interpretability as meaning
 from mitos_cli.lang.parse import parse_rules
+from mitos_cli.lang.resolve import build_rulebase, load_rules_file
+from mitos_cli.lang.termfile import parse_termset
 from mitos_cli.teach.adapt import adapt, feasible, learned_rulebase, parameterise
 from mitos_cli.teach.instructions import Window, hedged, instruction, scale_of, targets
-from mitos_cli.lang.termfile import parse_termset
 
 PAPER = load_rules_file(default_rulebase_path())
 AVOID = compile_rulebase(PAPER, "avoid_obstacle")
@@ -161,7 +161,7 @@ def test_speed_and_wall_instructions():
     w = window([90, 90], speed=[25, 60], gap_left=[5, 40], gap_right=[40, 5])
     np.testing.assert_allclose(targets(instruction(("slow", "down")), w), [15, 50])
     np.testing.assert_allclose(targets(instruction(("speed", "up")), w), [35, 60])
-    np.testing.assert_allclose(targets(instruction(tuple("keep further from the wall".split())),
+    np.testing.assert_allclose(targets(instruction(tuple(["keep", "further", "from", "the", "wall"])),
                                        w), [110, 70])           # away from the nearer side
 
 

@@ -45,13 +45,22 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from ..lang.model import flatten
+from ..errors import Span
+from ..lang.model import (
+    And,
+    Consequent,
+    Expr,
+    Not,
+    Prop,
+    Rule,
+    RuleBase,
+    flatten,
+    format_consequent,
+    format_expr,
+)
+from ..lang.terms import Variable
 from .compile import CompiledRuleBase, compile_rulebase
 from .evaluation import evaluate
-from ..errors import Span
-from ..lang.model import (And, Consequent, Expr, Not, Prop, Rule, RuleBase, format_consequent,
-                    format_expr)
-from ..lang.terms import Variable
 
 SEVERITIES = ("error", "warning", "info")
 #: Most grid points one behavior is sampled on (the per-input resolution shrinks to fit).

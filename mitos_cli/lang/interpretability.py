@@ -163,9 +163,7 @@ def learnable(term: Term) -> bool:
 
 def core(term: Term) -> tuple[float, float]:
     """Where the term is 1: ``[b, c]`` of a piecewise-linear term, a crisp term's value."""
-    if term.shape == "singleton":
-        return (term.params[0], term.params[0])
-    a, b, c, d = term.corners
+    _, b, c, _ = _corners(term)
     return (b, c)
 
 
@@ -180,9 +178,13 @@ def centre(term: Term) -> float:
 
 
 def _corners(term: Term) -> tuple[float, float, float, float]:
+    """``(a, b, c, d)`` of a learnable term (a crisp term's value four times)."""
     if term.shape == "singleton":
-        return (term.params[0],) * 4
-    return term.corners
+        v = term.params[0]
+        return (v, v, v, v)
+    corners = term.corners
+    assert corners is not None, "only learnable terms are measured"
+    return corners
 
 
 def mirror_point(var: Variable) -> float | None:
@@ -219,7 +221,7 @@ def held_term(var: Variable) -> tuple[Term, float] | None:
     tol = TOLERANCE * (var.universe[1] - var.universe[0])
     if middle.shape == "singleton":
         return (middle, point) if abs(middle.params[0] - point) <= tol else None
-    a, b, c, d = middle.corners
+    a, b, c, d = _corners(middle)
     if abs(b + c - 2 * point) <= tol and abs(a + d - 2 * point) <= tol:
         return middle, point
     return None

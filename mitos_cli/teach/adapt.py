@@ -41,19 +41,19 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Callable
 
 import numpy as np
 
-from ..fuzzy import hedges as hedge_mod
 from ..engine.compile import CompiledRuleBase
 from ..engine.evaluation import evaluate, fill_defaults, infer
-from ..errors import LessonError
 from ..engine.mamdani import OutputTable, spike
-from ..lang.model import Rule, RuleBase
+from ..errors import LessonError
+from ..fuzzy import hedges as hedge_mod
 from ..fuzzy.shapes import kernel_params
 from ..lang import interpretability as meaning
+from ..lang.model import Rule, RuleBase
 
 #: Fraction of a universe the most-moving parameter moves in one full step (times eta).
 STEP = 0.05
@@ -109,7 +109,7 @@ class Parameters:
     #: least distance between neighbours of each ``order`` entry, as a fraction of the universe
     order_gap: tuple[float, ...] = ()
     #: the variables whose coverage and distinguishability are kept (nonlinear constraints)
-    partitions: tuple["Partition", ...] = ()
+    partitions: tuple[Partition, ...] = ()
     #: ``(variable, term, point)`` of the terms held at their point of symmetry
     held: tuple[tuple[str, str, float], ...] = ()
     #: entries of ``order`` that are crisp output values (distinct by their current spread)
@@ -117,7 +117,7 @@ class Parameters:
     #: (output, term) -> its knots: a singleton's value ``[i, -1, -1, -1]``, or (Mamdani) the
     #: corners ``(a, b, c, d)`` of a piecewise-linear output set
     out_terms: dict = dataclasses.field(default_factory=dict)
-    sets: tuple["SetSpec", ...] | None = None   # Mamdani: how to rebuild the output tables
+    sets: tuple[SetSpec, ...] | None = None   # Mamdani: how to rebuild the output tables
 
     @property
     def n_free(self) -> int:

@@ -33,7 +33,7 @@ COMMAND_WORDS = ("behavior", "end", "use", "frozen", "unfrozen", "operators", "e
 SHOW_WHAT = ("rules", "terms", "examples", "behaviors", "history")
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def parser() -> Lark:
     """One parser for the rule language plus the teaching commands, built once."""
     text = grammar_text("mitos.lark") + "\n" + grammar_text("teach.lark")

@@ -30,8 +30,8 @@ turns their targets into examples and shows them.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Callable
 
 import numpy as np
 

@@ -8,8 +8,8 @@ reproducible and testable (``mitos teach ... --lesson FILE`` exits 1).
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from pathlib import Path
-from typing import Iterator
 
 from ..errors import MitosError, Span
 from .commands import incomplete
@@ -56,7 +56,6 @@ def read_lesson(source: str) -> tuple[str, str]:
     import sys
 
     from ..errors import LessonError
-
     from ..resources import resolve
 
     if source == "-":

@@ -92,8 +92,8 @@ class Recording:
 def run_world(name: str, rulebase: RuleBase, behavior: str, seed: int | None = None,
               base: Path | None = None) -> Recording:
     """Drive ``behavior`` of ``rulebase`` through the world ``name``."""
-    from ..sim.planner import FuzzyPlanner
     from ..sim.loop import simulate
+    from ..sim.planner import FuzzyPlanner
     from ..sim.worldfile import load_world
 
     path = world_path(name, base)
