@@ -214,3 +214,20 @@ def test_outside_the_repository_packaged_rules_and_lessons_are_found_and_save_re
     assert "saved a.rules" in res.stdout                   # where the earlier `save` went
     res = teach("--lesson", "no-such-lesson")
     assert res.returncode == 1 and "cannot read lesson `no-such-lesson`" in res.stderr
+
+
+def test_simulation_corrections_name_the_robot():
+    from mitos_cli.teach.session import Session
+
+    said = []
+    s = Session(default_rulebase_path(), out=said.append)
+    s.run("use drive")
+    s.run("simulate multirobot robot oncoming")
+    assert "multirobot (robot oncoming) with behavior drive" in said[-1]
+    s.run("at 2s steering is ST")
+    first = s.state.examples[-1].inputs
+    s.run("simulate multirobot")
+    s.run("at 2s steering is ST")
+    assert s.state.examples[-1].inputs != first               # the other robot's perception
+    with pytest.raises(LessonError, match="did you mean `oncoming`"):
+        s.run("simulate multirobot robot oncomin")

@@ -147,6 +147,7 @@ class Correct:
 class Simulate:
     world: str
     seed: float | None = None        # checked to be whole by the session
+    robot: str | None = None         # which robot's run `at` corrects (default: the first)
 
 
 @dataclass(frozen=True)
@@ -264,7 +265,7 @@ class _ToCommand(_ToModel):
         return json.loads(str(token)) if token.type == "STRING" else str(token)
 
     def simulate_cmd(self, items):
-        return Simulate(items[0], items[1])
+        return Simulate(items[0], items[1], None if items[2] is None else str(items[2]))
 
     def time(self, items):
         return float(items[0])

@@ -371,7 +371,8 @@ class Session:
 
         seed = _whole(c.seed, "seed", 0) if c.seed is not None else None
         self.compiled()
-        self.simulation = run_world(c.world, self.rulebase, self.state.active, seed, self.base)
+        self.simulation = run_world(c.world, self.rulebase, self.state.active, seed, self.base,
+                                    c.robot)
         self.out(self.simulation.describe())
 
     def _at(self, c: cmd.At, line: str) -> None:
