@@ -35,7 +35,7 @@ def constraints_hold(compiled, p, values) -> None:
         assert meaning.centre(rb.variables[var].term(term)) == pytest.approx(point, abs=1e-9)
 
 
-@settings(max_examples=12, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=8, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(seed=st.integers(0, 10_000), n=st.integers(1, 30), behavior=st.sampled_from(["a", "f"]))
 def test_random_corrections_keep_order_coverage_distinctness_and_points(seed, n, behavior):
     compiled = AVOID if behavior == "a" else FOLLOW
