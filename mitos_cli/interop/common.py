@@ -18,6 +18,8 @@ from ..lang import operators as ops_mod
 from ..lang.resolve import MAIN, check_rule
 from ..errors import FormatError, MitosError, Span, did_you_mean
 from ..lang.model import And, Behavior, Consequent, Expr, Not, Or, Prop, Rule, RuleBase, Setting
+from ..fuzzy import norms as norm_registry
+from ..fuzzy.hedges import HEDGES, fuzzylite_names
 from ..fuzzy.shapes import SHAPES
 from ..lang.terms import Term, TermSet, Variable
 from ..words import plural
@@ -25,24 +27,8 @@ from ..words import plural
 # ---------------------------------------------------------------------------------------------
 # Operators: MITOS name -> (FLL, FIS, FCL). None = the format has no name for it.
 
-TNORMS = {
-    "min": ("Minimum", "min", "MIN"),
-    "product": ("AlgebraicProduct", "prod", "PROD"),
-    "lukasiewicz": ("BoundedDifference", None, "BDIF"),
-    "drastic": ("DrasticProduct", None, "DPROD"),
-    "einstein": ("EinsteinProduct", None, "EPROD"),
-    "hamacher": ("HamacherProduct", None, "HPROD"),
-    "nilpotent_minimum": ("NilpotentMinimum", None, "NMIN"),
-}
-SNORMS = {
-    "max": ("Maximum", "max", "MAX"),
-    "probabilistic_sum": ("AlgebraicSum", "probor", "ASUM"),
-    "bounded_sum": ("BoundedSum", None, "BSUM"),
-    "drastic_sum": ("DrasticSum", None, "DSUM"),
-    "einstein_sum": ("EinsteinSum", None, "ESUM"),
-    "hamacher_sum": ("HamacherSum", None, "HSUM"),
-    "nilpotent_maximum": ("NilpotentMaximum", None, "NMAX"),
-}
+TNORMS = {n.name: (n.fll, n.fis, n.fcl) for n in norm_registry.TNORMS.values()}
+SNORMS = {n.name: (n.fll, n.fis, n.fcl) for n in norm_registry.SNORMS.values()}
 #: Defuzzifiers of Mamdani inference; the two weighted ones are MITOS inferences.
 DEFUZZIFIERS = {
     "centroid": ("Centroid", "centroid", "COG"),
@@ -115,10 +101,8 @@ def foreign_name(table: dict, fmt: int, mitos: str, what: str) -> str:
 # ---------------------------------------------------------------------------------------------
 # Hedges: fuzzylite's names (FLL and its FCL dialect) -> MITOS's.
 
-FUZZYLITE_HEDGES = {"very": "very", "somewhat": "somewhat", "seldom": "seldom",
-                    "extremely": "intensely", "any": "any"}
-MITOS_TO_FUZZYLITE_HEDGES = {v: k for k, v in FUZZYLITE_HEDGES.items()}
-MITOS_TO_FUZZYLITE_HEDGES["more_or_less"] = "somewhat"      # the same function, sqrt(x)
+FUZZYLITE_HEDGES = fuzzylite_names()                     # fuzzylite's name -> MITOS's
+MITOS_TO_FUZZYLITE_HEDGES = {h.name: h.fuzzylite for h in HEDGES.values() if h.fuzzylite}
 
 
 def fuzzylite_hedge(name: str, span: Span | None) -> str:
@@ -639,16 +623,15 @@ NAME_PATTERNS = {
     "rules": r"[A-Za-z_]([A-Za-z0-9_\-]*[A-Za-z0-9_])?",
     "fis": r"[^'\n]+",
 }
-_RULE_WORDS = {"if", "then", "and", "or", "not", "is", "with", "very", "somewhat", "seldom",
-               "extremely", "any"}
+_RULE_WORDS = {"if", "then", "and", "or", "not", "is", "with"} | set(FUZZYLITE_HEDGES)
 RESERVED_NAMES = {
     "fll": _RULE_WORDS,
     "fcl": _RULE_WORDS | {"rule", "term", "range", "method", "default", "accu", "act",
                           "lock", "end_var", "var_input", "var_output", "fuzzify",
                           "defuzzify", "end_fuzzify", "end_defuzzify", "ruleblock",
                           "end_ruleblock", "function_block", "end_function_block", "real"},
-    "rules": _RULE_WORDS | {"use", "when", "behavior", "end", "terms", "operators", "frozen",
-                            "more_or_less", "intensely"},
+    "rules": _RULE_WORDS | {"use", "when", "behavior", "end", "terms", "operators", "frozen"}
+             | set(HEDGES),
     "fis": set(),
 }
 

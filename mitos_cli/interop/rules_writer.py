@@ -20,9 +20,7 @@ from ..lang.terms import Term, Variable
 from . import common
 
 NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_\-]*[A-Za-z0-9_]|[A-Za-z_]")
-RESERVED = {"if", "then", "is", "and", "or", "not", "with", "use", "when", "terms", "operators",
-            "behavior", "end", "frozen", "very", "somewhat", "more_or_less", "extremely",
-            "seldom", "intensely", "any"}
+RESERVED = common.RESERVED_NAMES["rules"]       # the rule language's keywords and hedge words
 
 
 def check_name(name: str, what: str) -> None:
