@@ -21,13 +21,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import geometry, kinematics, obstacles as obs_mod, perception, sensors
+from . import geometry, kinematics, knowledge, obstacles as obs_mod, perception, sensors
 from .geometry import box_polygon_depth, box_polygon_distance, box_segment_distance, \
     polygon_segments, rect_corners
 from .planner import Percepts, Planner
-from .route import Route, plan_route
+from .route import Route, grid_route, plan_route
 from .staticmap import StaticMap, build_static
-from .world import World
+from .world import Agent, World
 
 STUCK_TIME = 6.0        # s
 STUCK_DISTANCE = 3.0    # in
@@ -37,22 +37,41 @@ OUTCOMES = ("success", "collision", "timeout", "stuck")
 
 @dataclass(frozen=True)
 class Scene:
-    """What does not change during a run: the walls and each robot's route."""
+    """What a run starts from: the true walls, what the robots are given, each one's route."""
 
     static: StaticMap
     routes: tuple[Route, ...]
+    given: knowledge.Given | None = None
 
     def __hash__(self) -> int:
         return id(self)
 
 
+def clearances(world: World, agent: Agent) -> tuple[float, float]:
+    """The clearance (in) a route asks for (half the width, the safety margin and 4 in), and
+    the least it accepts where nothing wider leads to the goal (half the width and the margin,
+    or the world's ``route: {min_clearance}``)."""
+    r = agent.robot
+    least = r.width / 2 + r.safety_margin
+    if world.min_clearance is not None:
+        least = world.min_clearance
+    return max(r.width / 2 + r.safety_margin + 4.0, least), least
+
+
 def prepare(world: World) -> Scene:
-    """Walls and routes (A* over the corridors or the grid) of a world."""
+    """Walls, what the robots know and their routes (A* over the corridors or the grid they
+    are given; the truth's own with the default ``given``)."""
     static = build_static(world)
-    routes = tuple(plan_route(static, world.corridors, a.start, a.goal,
-                              clearance=a.robot.width / 2 + a.robot.safety_margin + 4.0)
-                   for a in world.agents)
-    return Scene(static, routes)
+    given = knowledge.given(world, static)
+    routes = []
+    for a in world.agents:
+        asked, least = clearances(world, a)
+        if given.plain:
+            routes.append(plan_route(static, world.corridors, a.start, a.goal, asked, least))
+        else:
+            known = StaticMap(given.walls, np.zeros((0, 4, 2)), given.grid, static.bounds)
+            routes.append(grid_route(known, a.start, a.goal, asked, minimum=least))
+    return Scene(static, tuple(routes), given)
 
 
 @dataclass
@@ -78,9 +97,18 @@ class SimResult:
     static: StaticMap | None = None
     active: np.ndarray | None = None   # [T, n] robot still driving at that tick
     progress: np.ndarray | None = None  # [T, n] arc length along each robot's route (in)
+    replanned: tuple[tuple[int, int, Route], ...] = ()   # (tick, robot, new route) in order
     metrics: dict = field(default_factory=dict)    # the run's figures over all robots
     robot_metrics: tuple[dict, ...] = ()           # each robot's figures (name, outcome, ...)
     _true: dict | None = field(default=None, repr=False)
+
+    def route_at(self, k: int, i: int) -> Route:
+        """The route robot ``i`` followed at tick ``k`` (its last replan up to then)."""
+        route = self.routes[i]
+        for tick, j, r in self.replanned:
+            if j == i and tick <= k:
+                route = r
+        return route
 
     @property
     def true(self) -> dict[str, np.ndarray]:
@@ -125,6 +153,7 @@ def _robot_metrics(res: SimResult, dt: float) -> tuple[dict, ...]:
             "name": agent.name, "outcome": outcome, "reached_goal": outcome == "success",
             "time_s": round(time_s, 6), "path_length_in": path,
             "min_clearance_in": float(res.clearance[:, i].min()) if res.ticks else 0.0,
+            "replans": sum(j == i for _, j, _ in res.replanned),
             "mean_speed_in_s": path / time_s if time_s > 0 else 0.0,
             "steering_total_variation_deg":
                 float(np.abs(np.diff(res.steering[:ticks, i])).sum())})
@@ -141,6 +170,7 @@ def _metrics(res: SimResult, dt: float) -> dict:
     return {"collisions": sum(m["outcome"] == "collision" for m in each),
             "time_s": round(float(res.ticks * dt), 6), "path_length_in": path,
             "min_clearance_in": min(m["min_clearance_in"] for m in each),
+            "replans": sum(m["replans"] for m in each),
             "mean_speed_in_s": path / driving if driving > 0 else 0.0,
             "steering_total_variation_deg": sum(m["steering_total_variation_deg"]
                                                 for m in each),
@@ -206,7 +236,14 @@ def simulate(world: World, planner: Planner | None = None, seed: int | None = No
     if randomise:
         world = obs_mod.randomised(world, streams[0])
     scene = scene or prepare(world)
-    static, routes = scene.static, scene.routes
+    static, given = scene.static, scene.given or knowledge.given(world, build_static(world))
+    routes = list(scene.routes)
+    plain = given.plain
+    maps: list[knowledge.RobotMap | None] = [None] * len(world.agents)
+    if given.knows == "none":
+        maps = [knowledge.RobotMap.of(given.grid) for _ in world.agents]
+    known_walls = StaticMap(given.walls, np.zeros((0, 4, 2)), None, static.bounds)
+    replanned: list[tuple[int, int, Route]] = []
     agents = world.agents
     robots = [a.robot for a in agents]
     n = len(agents)
@@ -235,6 +272,8 @@ def simulate(world: World, planner: Planner | None = None, seed: int | None = No
 
     near_at = [(math.inf, math.inf)] * n      # where each robot's wall set was gathered
     near_walls = [np.zeros((0, 4))] * n
+    near_known = [np.zeros((0, 4))] * n
+    asked = [clearances(world, a) for a in agents]
     rec_pose, rec_v, rec_steer, rec_cmd, rec_rng, rec_clear, rec_obs, rec_act = ([] for _ in range(8))
     rec_p = {k: [] for k in perception.INPUTS}
     rec_s: list[np.ndarray] = []
@@ -260,14 +299,29 @@ def simulate(world: World, planner: Planner | None = None, seed: int | None = No
             if math.hypot(x[i] - near_at[i][0], y[i] - near_at[i][1]) > NEAR_SLACK:
                 near_at[i] = (x[i], y[i])
                 near_walls[i] = static.near(x[i], y[i], reach + NEAR_SLACK)
+                if not plain and given.knows != "none":
+                    near_known[i] = known_walls.near(x[i], y[i], reach + NEAR_SLACK)
             walls = near_walls[i]
             dirs = sensors.beam_directions(h[i], angles)
             f = perception.frame(routes[i], pose[i, :2], s_hint[i])
             s_hint[i] = f.s
             expected, true_r = sensors.cast(pose[i, :2], dirs, walls, others, centres, radii,
                                             sen.range)
+            if not plain:
+                expected = knowledge.expected_ranges(given, maps[i], pose[i, :2], dirs,
+                                                     near_known[i], sen.range)
             measured = sensors.add_noise(true_r, sen.noise, sen.range, streams[1 + i])
             ranges[i] = measured
+            new = _learn(maps, i, given, static, world, pose[i, :2], dirs, measured, expected,
+                         sen.range, threshold)
+            if new and active[i]:
+                route = knowledge.replan(maps[i], routes[i], f.s, pose[i, :2], agents[i].goal, t,
+                                         *asked[i], cfg.sight)
+                if route is not None:
+                    routes[i] = route
+                    replanned.append((k, i, route))
+                    f = perception.frame(route, pose[i, :2], 0.0)
+                    s_hint[i] = f.s
             p = perception.perceive(routes[i], f, (x[i], y[i], h[i]), robots[i], dirs, measured,
                                     expected, sen.range, spacing, threshold, cfg)
             for key in perception.INPUTS:
@@ -339,10 +393,28 @@ def simulate(world: World, planner: Planner | None = None, seed: int | None = No
         steering=np.array(rec_steer), command=np.array(rec_cmd), ranges=np.array(rec_rng),
         perceived={key: np.array(val) for key, val in rec_p.items()},
         clearance=np.array(rec_clear), obstacles=np.array(rec_obs).reshape(len(rec_pose), -1, 2),
-        routes=routes, static=static, active=np.array(rec_act), progress=np.array(rec_s))
+        routes=scene.routes, static=static, active=np.array(rec_act), progress=np.array(rec_s),
+        replanned=tuple(replanned))
     res.robot_metrics = _robot_metrics(res, dt)
     res.metrics = _metrics(res, dt)
     return res
+
+
+def _learn(maps: list, i: int, given: knowledge.Given, static: StaticMap, world: World,
+           p: np.ndarray, dirs: np.ndarray, measured: np.ndarray, expected: np.ndarray,
+           max_range: float, threshold: float) -> bool:
+    """Mark on robot ``i``'s map what its readings show and its map does not (everything it
+    hits, with no map): whether anything was marked. Its map is made on first need."""
+    valid = measured < max_range * 0.999
+    seen = valid if given.knows == "none" else valid & (measured < expected - threshold)
+    if not seen.any():
+        return False
+    if maps[i] is None:
+        maps[i] = knowledge.RobotMap.of(knowledge.plan_grid(given, static, world))
+    hits = p + measured[seen, None] * dirs[seen]
+    before = len(maps[i].fresh)
+    maps[i].mark(hits, dirs[seen])
+    return len(maps[i].fresh) > before
 
 
 def true_inputs(res: SimResult) -> dict[str, np.ndarray]:
@@ -368,7 +440,8 @@ def true_inputs(res: SimResult) -> dict[str, np.ndarray]:
         corners = _footprints(pose, robots)
         for i in range(n):
             walls = static.near(pose[i, 0], pose[i, 1], reach)
-            f = perception.frame(res.routes[i], pose[i, :2], res.progress[k, i])
+            route = res.route_at(k, i)
+            f = perception.frame(route, pose[i, :2], res.progress[k, i])
             dirs = np.concatenate([sensors.beam_directions(pose[i, 2], angles), [-f.n, f.n]])
             expected = geometry.ray_segments(pose[i, :2], dirs, walls, sen.range)
             # across the route, to the walls within reach (an opening reads as the sensor
@@ -377,7 +450,7 @@ def true_inputs(res: SimResult) -> dict[str, np.ndarray]:
             things = np.concatenate([outline] + [corners[j] for j in range(n) if j != i])
             gaps = perception.side_gaps(f, pose[i, :2], dirs[:-2], expected[:-2], things,
                                         robots[i], sen.range, cfg)
-            tr = perception.truth(res.routes[i], f, tuple(pose[i]), robots[i],
+            tr = perception.truth(route, f, tuple(pose[i]), robots[i],
                                   (float(across[0]), float(across[1])), things, gaps, cfg)
             for key in perception.INPUTS:
                 out[key][k, i] = tr[key]

@@ -18,14 +18,15 @@ from .world import (Agent, Corridor, Goal, Jitter, Motion, Obstacle, Pose, Rando
                     Sensors, World)
 
 TOP_KEYS = ("name", "seed", "dt", "time_limit", "substeps", "behavior", "robot", "sensors",
-            "q_init", "q_goal", "map", "obstacles", "robots", "randomise")
+            "q_init", "q_goal", "map", "obstacles", "robots", "randomise", "route")
 ROBOT_KEYS = ("model", "wheelbase", "footprint", "safety_margin", "steering", "max_speed",
               "acceleration")
 STEERING_KEYS = ("min", "max", "straight", "max_rate")
 SENSOR_KEYS = ("layout", "count", "fov", "cone", "range", "noise")
-MAP_KEYS = ("corridors", "grid", "unknown")
+MAP_KEYS = ("corridors", "grid", "unknown", "given")
+ROUTE_KEYS = ("min_clearance",)
 OBSTACLE_KEYS = ("name", "shape", "at", "radius", "length", "width", "angle", "velocity",
-                 "waypoints", "speed", "mode")
+                 "waypoints", "speed", "mode", "known")
 AGENT_KEYS = ("name", "q_init", "q_goal", "robot")
 RANDOMISE_KEYS = ("obstacles", "sensor_noise")
 MODELS = ("tricycle",)
@@ -86,6 +87,15 @@ class _Reader:
         if value not in options:
             raise unknown(f"{key} in {what}", value, options, span=m.value_span(key),
                           cls=WorldError)
+        return value
+
+    def flag(self, m: YMap, key: str, what: str, default: bool) -> bool:
+        if key not in m:
+            return default
+        value = m[key]
+        if not isinstance(value, bool):
+            raise unknown(f"{key} in {what}", str(value), ("true", "false"),
+                          span=m.value_span(key), cls=WorldError)
         return value
 
     def range_pair(self, value: Any, span: Span, what: str) -> tuple[float, float]:
@@ -193,7 +203,12 @@ def read_obstacle(r: _Reader, value: Any, span: Span, index: int) -> Obstacle:
     for k in ("speed", "mode"):
         if k in m and motion.kind != "waypoints":
             raise WorldError(f"`{k}` belongs to an obstacle with `waypoints`", span=m.key_span(k))
-    return Obstacle(name, shape, at[0], at[1], radius, length, width, angle, motion)
+    known = r.flag(m, "known", what, False)
+    if known and motion.kind != "static":
+        raise WorldError(f"{what} moves, so it cannot be `known`: the robot's map holds only "
+                         "what stays put", span=m.value_span("known"),
+                         hint="drop `known: true`, or the `velocity` / `waypoints`")
+    return Obstacle(name, shape, at[0], at[1], radius, length, width, angle, motion, known)
 
 
 def read_randomise(r: _Reader, value: Any, span: Span, names: list[str]) -> Randomise:
@@ -272,6 +287,12 @@ def parse_world(text: str, path: str) -> World:
     if not corridors and grid is None:
         raise WorldError("the map has neither `corridors` nor a `grid`", span=mp.span,
                          hint="add `corridors: [{points: [[0, 0], [600, 0]], width: 70}]`")
+    knows, given = read_given(mp, path, unknown_occupied)
+    min_clearance = None
+    if "route" in top:
+        rt = r.mapping(top["route"], top.value_span("route"), "route", ROUTE_KEYS)
+        if "min_clearance" in rt:
+            min_clearance = r.number(rt, "min_clearance", "route", positive=True)
 
     obstacles = []
     for i, item in enumerate(top.get("obstacles") or []):
@@ -285,9 +306,29 @@ def parse_world(text: str, path: str) -> World:
                  if "randomise" in top else Randomise())
     world = World(name, path, int(seed), dt, limit, int(substeps), tuple(agents), sensors,
                   tuple(corridors), grid, tuple(obstacles), randomise,
-                  str(top.get("behavior", "drive")))
+                  str(top.get("behavior", "drive")), knows, given, min_clearance)
     check_free(world, agent_spans)
     return world
+
+
+def read_given(mp: YMap, path: str, unknown_occupied: bool):
+    """``map.given``: the robot's own map (a map_server YAML), ``none``, or (absent) the map."""
+    if "given" not in mp:
+        return "map", None
+    value = mp["given"]
+    span = mp.value_span("given")
+    if value is None or str(value).lower() in ("none", "null", "~"):
+        return "none", None
+    if not isinstance(value, str) or not value.strip():
+        raise WorldError("`given` in map must be a map_server YAML file or `none`", span=span,
+                         hint="`given: maps/office02_given.yaml`, or `given: none` for a robot "
+                              "with no map")
+    if not value.endswith((".yaml", ".yml")):
+        raise unknown("given in map", value, ("none", "PATH.yaml"), span=span, cls=WorldError)
+    from .gridmap import load_map_yaml
+
+    return "given", load_map_yaml(Path(path).parent / value, unknown_occupied=unknown_occupied,
+                                  where=span)
 
 
 def check_free(world: World, spans: list[tuple[Span, Span]]) -> None:
