@@ -12,7 +12,7 @@ from pathlib import Path
 from typing import Any
 
 from .. import yamlpos
-from ..errors import Span, WorldError, unknown
+from ..errors import NameError_, Span, WorldError, unknown
 from ..yamlpos import YList, YMap
 from .world import (Agent, Corridor, Goal, Jitter, Motion, Obstacle, Pose, Randomise, Robot,
                     Sensors, World)
@@ -358,13 +358,22 @@ def load_world(path: str | Path) -> World:
     return parse_world(text, str(path))
 
 
-def resolve_world_path(name: str | Path) -> Path:
-    """A world file as given, or else the packaged world of that name (``figure4.yaml``)."""
+class UnknownWorld(WorldError, NameError_):
+    """A world name that is neither a file nor a packaged world (an unknown name, of a world)."""
+
+    kind = "world error"
+
+
+def resolve_world_path(name: str | Path, base: Path | None = None) -> Path:
+    """The one way a world is found: a file as given (relative to ``base`` first, when a
+    lesson names it), else the packaged world of that name (``figure4`` or ``figure4.yaml``);
+    an unknown name gets the packaged names and a "did you mean"."""
     from ..resources import packaged_names, resolve
 
-    found = resolve("worlds", name, ".yaml")
+    found = resolve("worlds", name, ".yaml", base)
     if found is not None:
         return found
-
-    names = [n for n in packaged_names("worlds", ".yaml")]
-    raise unknown("world file", str(name), names, cls=WorldError)
+    names = list(packaged_names("worlds", ".yaml"))
+    if not str(name).endswith(".yaml"):
+        names = [n[:-len(".yaml")] for n in names]
+    raise unknown("world file", str(name), names, cls=UnknownWorld)
