@@ -2,9 +2,13 @@
 
 from __future__ import annotations
 
+from . import _moved
+
 __version__ = "0.1.0"
 
 __all__ = ["__version__", "load_rulebase"]
+
+_moved.install()   # 0.1's module paths, for one release (mitos_cli/_moved.py)
 
 
 def __getattr__(name: str):

@@ -29,7 +29,7 @@ MAX_COLUMNS = 4000
 ScalarFn = Callable[..., "tuple[float, ...] | None"]
 
 # Each norm as Python statements on floats ``a`` and ``b`` leaving ``r``, mirroring the NumPy
-# formulas of :mod:`mitos_cli.norms` operation by operation (see the comments there).
+# formulas of :mod:`mitos_cli.fuzzy.norms` operation by operation (see the comments there).
 _MIN = "r = a if a <= b else b"
 _MAX = "r = a if a >= b else b"
 _LO_HI = "lo = a if a <= b else b\nhi = a if a >= b else b"
@@ -51,7 +51,7 @@ NORMS: dict[str, str] = {
     "nilpotent_maximum": "r = 1.0 if a + b >= 1.0 else (a if a >= b else b)",
 }
 
-# Hedges as statements on ``x`` leaving ``x`` (mitos_cli.hedges).
+# Hedges as statements on ``x`` leaving ``x`` (mitos_cli.fuzzy.hedges).
 HEDGES: dict[str, str] = {
     "very": "x = x * x",
     "extremely": "x = x * x * x",
@@ -166,8 +166,8 @@ def _group(group, ops, emit) -> None:
 
 
 def _outputs(c: CompiledRuleBase, emit) -> None:
-    """DOFs (contexts, then weights, as :func:`mitos_cli.engine.rule_dof`) and the weighted
-    sums by the engine's pairwise tree (:func:`mitos_cli.engine.tree_sum`)."""
+    """DOFs (contexts, then weights, as :func:`mitos_cli.engine.evaluation.rule_dof`) and the weighted
+    sums by the engine's pairwise tree (:func:`mitos_cli.engine.evaluation.tree_sum`)."""
     plan = c.plan
     R = c.n_rules
     for r in range(R):

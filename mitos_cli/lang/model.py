@@ -1,6 +1,6 @@
 """The rule-base model: what a rule file means, as frozen dataclasses.
 
-The parser produces these with names as written; :func:`mitos_cli.build.build_rulebase`
+The parser produces these with names as written; :func:`mitos_cli.lang.resolve.build_rulebase`
 checks every name against the term sets (with "did you mean") before a :class:`RuleBase` is
 returned, so everything downstream may trust them. :func:`format_rule` writes a rule back in
 the rule language (``parse(format_rule(r)) == r``).
@@ -11,7 +11,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Union
 
-from .errors import Span
+from ..errors import Span
 from .terms import TermSet, Variable
 
 
@@ -123,7 +123,7 @@ class RuleBase:
         return self.behaviors[0].name
 
     def behavior(self, name: str | None = None) -> Behavior:
-        from .errors import unknown
+        from ..errors import unknown
 
         name = name or self.default_behavior
         for b in self.behaviors:

@@ -11,8 +11,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .engine import Result
-from .words import plural
+from .evaluation import Result
+from ..words import plural
 
 
 @dataclass(frozen=True)
@@ -89,7 +89,7 @@ def display_path(path: str | None) -> str:
     import os
     from pathlib import Path
 
-    from .resources import data_dir
+    from ..resources import data_dir
 
     if not path:
         return "<rules>"
