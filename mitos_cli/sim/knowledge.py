@@ -235,7 +235,7 @@ def replan(rmap: RobotMap, route: Route, s: float, p: np.ndarray, goal: Goal, t:
     rmap.checked_at = t
     if not route.near(fresh, s, clearance, sight).any():
         return None
-    if way_past(rmap, route, s, p, sight, clearance, minimum):
+    if way_past(rmap, route, s, p, sight, clearance, clearance):
         return None
     static = StaticMap(np.zeros((0, 4)), np.zeros((0, 4, 2)), rmap.grid, (0, 0, 0, 0))
     try:

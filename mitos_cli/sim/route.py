@@ -269,15 +269,19 @@ def _widest_way(free_c: np.ndarray, s: tuple[int, int], t: tuple[int, int]):
     return None
 
 
+NARROW_COST = 20.0      # extra cost per step (in steps) of a node closer than the asked clearance
+
+
 def grid_route(static: StaticMap, start: Pose, goal: Goal, clearance: float,
                cell: float = 6.0, minimum: float | None = None,
                occupied: np.ndarray | None = None, explain: bool = True) -> Route:
     """A* on nodes about ``cell`` inches apart, each kept at least ``clearance`` inches (the
     exact Euclidean distance) from the occupied cells, preferring the middle of the corridors.
-    Where no such way exists it tries again at ``minimum`` (a tighter squeeze: the robot's half
-    width plus its margin unless the world allows less); with no way even then it refuses,
-    naming the narrowest place of the widest way. ``occupied`` replaces the map's own cells
-    (what the robot knows, when that is not the map). ``explain=False`` skips the search for
+    Nodes closer than that but not closer than ``minimum`` (the robot's half width plus its
+    margin, unless the world allows a tighter squeeze) cost ``NARROW_COST`` times more, so the
+    route squeezes only where nothing wider leads on; with no way even at ``minimum`` it
+    refuses, naming the narrowest place of the widest way. ``occupied`` replaces the map's
+    own cells (what the robot knows, when that is not the map). ``explain=False`` skips the search for
     the narrowest place (replanning only needs to know that there is no way)."""
     g = static.grid
     occ = g.occupied if occupied is None else occupied
@@ -304,30 +308,29 @@ def grid_route(static: StaticMap, start: Pose, goal: Goal, clearance: float,
             raise WorldError(f"the {what} lies outside the map")
     moves = [(dr, dc, math.hypot(dr, dc)) for dr in (-1, 0, 1) for dc in (-1, 0, 1)
              if dr or dc]
-    penalty = np.clip(reach - node_c, 0.0, reach) / reach * 4.0
-    path = None
     floor = clearance if minimum is None else min(minimum, clearance)
-    for asked in dict.fromkeys((clearance, floor)):
-        blocked = node_c < asked
-        blocked[s] = blocked[t] = False      # the robot stands there: let the search leave it
+    # prefer the middle; a node closer than `clearance` (but not than `floor`) costs
+    # NARROW_COST times more, so the route squeezes through only where nothing wider leads on
+    penalty = (np.clip(reach - node_c, 0.0, reach) / reach * 4.0
+               + np.where(node_c < clearance, NARROW_COST, 0.0))
+    blocked = node_c < floor
+    blocked[s] = blocked[t] = False      # the robot stands there: let the search leave it
 
-        def neighbours(n: int, blocked=blocked):
-            r, c = divmod(n, C)
-            for dr, dc, step in moves:
-                rr, cc = r + dr, c + dc
-                if 0 <= rr < R and 0 <= cc < C and not blocked[rr, cc]:
-                    yield rr * C + cc, step * (1.0 + penalty[rr, cc])
+    def neighbours(n: int):
+        r, c = divmod(n, C)
+        for dr, dc, step in moves:
+            rr, cc = r + dr, c + dc
+            if 0 <= rr < R and 0 <= cc < C and not blocked[rr, cc]:
+                yield rr * C + cc, step * (1.0 + penalty[rr, cc])
 
-        path = _astar(neighbours, s[0] * C + s[1], t[0] * C + t[1], lambda n: (n // C, n % C))
-        if path is not None:
-            break
+    path = _astar(neighbours, s[0] * C + s[1], t[0] * C + t[1], lambda n: (n // C, n % C))
     if path is None:
         if not explain:
             raise NarrowPassage("no way to the goal on what the robot knows")
         raise _refusal(node_c, s, t, centre, floor)
     pts = np.array([centre(divmod(n, C)) for n in path])
     pts = np.vstack([[start.x, start.y], pts[1:-1], [goal.x, goal.y]])
-    pts = _simplify(pts, size * 0.75, field, asked)
+    pts = _simplify(pts, size * 0.75, field, clearance)
     return Route.of(pts, goal=(goal.x, goal.y))
 
 
