@@ -33,7 +33,7 @@ from .staticmap import StaticMap, carve, corridor_rects, grid_walls
 from .world import Goal, Grid, Pose, World
 
 RASTER = 2.0            # in: cells of the robot's map when the world gives no grid
-REPLAN_EVERY = 1.0      # s: the least time between two replanning checks
+REPLAN_EVERY = 0.5      # s: the least time between two replanning checks
 TUBE = 48.0             # in: how far from its route the robot looks for a way past
 
 
@@ -224,18 +224,36 @@ def way_past(rmap: RobotMap, route: Route, s: float, p: np.ndarray, ahead: float
     return True
 
 
+def _crosses(rmap: RobotMap, route: Route, s: float, p: np.ndarray, reach: float,
+             ahead: float) -> bool:
+    """Whether the route from ``s`` to ``s + ahead`` passes within ``reach`` of a cell the
+    robot has mapped (only cells within ``ahead + reach`` of it are looked at)."""
+    g = rmap.grid
+    lo, hi = p - ahead - reach, p + ahead + reach
+    window = _window(g, rmap.occupied, lo, hi).grid
+    r, c = np.nonzero(window.occupied)
+    if not len(r):
+        return False
+    cells = np.stack([window.origin[0] + (c + 0.5) * g.resolution,
+                      window.origin[1] + (r + 0.5) * g.resolution], axis=1)
+    return bool(route.near(cells, s, reach + g.resolution / 2, ahead).any())
+
+
 def replan(rmap: RobotMap, route: Route, s: float, p: np.ndarray, goal: Goal, t: float,
-           clearance: float, minimum: float, sight: float) -> Route | None:
+           clearance: float, minimum: float, sight: float, knows: str = "map") -> Route | None:
     """A new route from ``p`` when what the robot has sensed shuts the way ahead (see the
-    module docstring), else ``None``."""
+    module docstring), else ``None``. A robot with no map plans again whenever its route
+    ahead runs into what it has mapped: all it knows it learnt on the way."""
     if not rmap.fresh or t - rmap.checked_at < REPLAN_EVERY:
         return None
     fresh = np.concatenate(rmap.fresh)
     rmap.fresh.clear()
     rmap.checked_at = t
-    if not route.near(fresh, s, clearance, sight).any():
-        return None
-    if way_past(rmap, route, s, p, sight, clearance, clearance):
+    if knows == "none":
+        if not _crosses(rmap, route, s, p, minimum, sight):
+            return None
+    elif not route.near(fresh, s, clearance, sight).any() or \
+            way_past(rmap, route, s, p, sight, clearance, clearance):
         return None
     static = StaticMap(np.zeros((0, 4)), np.zeros((0, 4, 2)), rmap.grid, (0, 0, 0, 0))
     try:

@@ -316,7 +316,7 @@ def simulate(world: World, planner: Planner | None = None, seed: int | None = No
                          sen.range, threshold)
             if new and active[i]:
                 route = knowledge.replan(maps[i], routes[i], f.s, pose[i, :2], agents[i].goal, t,
-                                         *asked[i], cfg.sight)
+                                         *asked[i], cfg.sight, given.knows)
                 if route is not None:
                     routes[i] = route
                     replanned.append((k, i, route))
