@@ -179,9 +179,16 @@ def expected_ranges(g: Given, rmap: RobotMap | None, origin: np.ndarray, dirs: n
     else:
         out = ray_segments(origin, dirs, walls_near, max_range)
     if len(g.sides):
-        out = np.minimum(out, ray_segments(origin, dirs, g.sides, max_range))
+        lo = np.minimum(g.sides[:, :2], g.sides[:, 2:])
+        hi = np.maximum(g.sides[:, :2], g.sides[:, 2:])
+        near = ((lo <= origin + max_range) & (hi >= origin - max_range)).all(axis=1)
+        if near.any():
+            out = np.minimum(out, ray_segments(origin, dirs, g.sides[near], max_range))
     if len(g.centres):
-        out = np.minimum(out, ray_circles(origin, dirs, g.centres, g.radii, max_range))
+        near = np.hypot(*(g.centres - origin).T) <= max_range + g.radii
+        if near.any():
+            out = np.minimum(out, ray_circles(origin, dirs, g.centres[near], g.radii[near],
+                                              max_range))
     return out
 
 
