@@ -13,7 +13,8 @@ the robot has mapped itself so far (a grid ray-marched per beam).
 
 Replanning (:func:`replan`): at most once every ``REPLAN_EVERY`` seconds, and only when the
 robot has mapped something new within its clearance of the route ahead, it asks whether a way
-past is left within ``TUBE`` inches of the route up to ``sight`` ahead; when none is, it plans
+past is left within ``TUBE`` inches of the route up to ``sight`` ahead, at the route's floor
+clearance (half the robot's width plus its margin); when none is, it plans
 again from where it stands on everything it knows. A box in the lane leaves a way past and
 the rules drive round it; a shut door or a corridor full of boxes does not, and the route
 changes.
@@ -225,7 +226,8 @@ def way_past(rmap: RobotMap, route: Route, s: float, p: np.ndarray, ahead: float
     target = sample[int(np.argmax(beyond))]
     try:
         grid_route(window, Pose(float(p[0]), float(p[1])), Goal(float(target[0]),
-                   float(target[1])), clearance, minimum=minimum, explain=False)
+                   float(target[1])), clearance, minimum=minimum, explain=False,
+                   leave=clearance + 6.0)
     except NarrowPassage:
         return False
     return True
@@ -260,12 +262,13 @@ def replan(rmap: RobotMap, route: Route, s: float, p: np.ndarray, goal: Goal, t:
         if not _crosses(rmap, route, s, p, minimum, sight):
             return None
     elif not route.near(fresh, s, clearance, sight).any() or \
-            way_past(rmap, route, s, p, sight, clearance, clearance):
+            way_past(rmap, route, s, p, sight, clearance, minimum):
         return None
     static = StaticMap(np.zeros((0, 4)), np.zeros((0, 4, 2)), rmap.grid, (0, 0, 0, 0))
     try:
         new = grid_route(static, Pose(float(p[0]), float(p[1])), goal, clearance,
-                         minimum=minimum, occupied=rmap.occupied, explain=False)
+                         minimum=minimum, occupied=rmap.occupied, explain=False,
+                         leave=clearance + 6.0)
     except NarrowPassage:
         return None                # no way left on what it knows: drive on, the rules decide
     rmap.replans += 1

@@ -274,7 +274,8 @@ NARROW_COST = 20.0      # extra cost per step (in steps) of a node closer than t
 
 def grid_route(static: StaticMap, start: Pose, goal: Goal, clearance: float,
                cell: float = 6.0, minimum: float | None = None,
-               occupied: np.ndarray | None = None, explain: bool = True) -> Route:
+               occupied: np.ndarray | None = None, explain: bool = True,
+               leave: float = 0.0) -> Route:
     """A* on nodes about ``cell`` inches apart, each kept at least ``clearance`` inches (the
     exact Euclidean distance) from the occupied cells, preferring the middle of the corridors.
     Nodes closer than that but not closer than ``minimum`` (the robot's half width plus its
@@ -282,7 +283,9 @@ def grid_route(static: StaticMap, start: Pose, goal: Goal, clearance: float,
     route squeezes only where nothing wider leads on; with no way even at ``minimum`` it
     refuses, naming the narrowest place of the widest way. ``occupied`` replaces the map's
     own cells (what the robot knows, when that is not the map). ``explain=False`` skips the search for
-    the narrowest place (replanning only needs to know that there is no way)."""
+    the narrowest place (replanning only needs to know that there is no way). ``leave``:
+    within this many inches of the start, any node off the occupied cells is open (a robot
+    that replans beside what it is passing must be able to move off)."""
     g = static.grid
     occ = g.occupied if occupied is None else occupied
     reach = clearance + 36.0           # in: beyond this from the walls, the middle is as good
@@ -315,6 +318,12 @@ def grid_route(static: StaticMap, start: Pose, goal: Goal, clearance: float,
                + np.where(node_c < clearance, NARROW_COST, 0.0))
     blocked = node_c < floor
     blocked[s] = blocked[t] = False      # the robot stands there: let the search leave it
+    if leave > 0:
+        n = int(math.ceil(leave / size))
+        r0, c0 = max(s[0] - n, 0), max(s[1] - n, 0)
+        rr, cc = np.mgrid[r0:min(s[0] + n + 1, R), c0:min(s[1] + n + 1, C)]
+        near = (np.hypot(rr - s[0], cc - s[1]) * size <= leave) & (node_c[rr, cc] > 0)
+        blocked[rr[near], cc[near]] = False
 
     def neighbours(n: int):
         r, c = divmod(n, C)
