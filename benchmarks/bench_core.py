@@ -3,13 +3,16 @@
 Run from the repository root (one command)::
 
     python benchmarks/bench_core.py            # add --quick for a fast smoke run
+    python benchmarks/bench_core.py --startup  # only (c), 21 alternating runs of each
 
 It measures, in one run, on the packaged MITOS rule base (behavior ``avoid_obstacle``, the
 paper's 27 rules):
 
-a. batch throughput on 10^6 random inputs: ``engine.evaluate`` with ``detail=True`` (memberships
-   and DOFs kept) and ``detail=False`` (outputs only), a hand-written NumPy kernel for exactly
-   this rule base, and pyfuzzylite 8's vectorized ``Engine.process()`` on the same rules;
+a. batch throughput on 10^6 random inputs (best of 10 rounds that call each in turn): ``engine.evaluate`` with ``detail=True`` (memberships
+   and DOFs kept) and ``detail=False`` (outputs only), ``load_rulebase().evaluate(**columns)``
+   (arrays by name), a hand-written NumPy kernel for exactly this rule base, and pyfuzzylite
+   8's vectorized ``Engine.process()`` on the same rules; and the peak memory NumPy allocates
+   in one call of ``evaluate(**columns)`` and of the kernel (tracemalloc);
 b. single-evaluation latency: ``load_rulebase().evaluate(road=..., size=..., position=...)``
    (the network's scalar form, :mod:`mitos_cli.engine.scalar`), the engine's array entry point with
    one row (``evaluate(compiled, X[i:i+1], detail=False)``, the same scalar form plus the
@@ -176,6 +179,21 @@ def simpful_system(rb):
 # ---------------------------------------------------------------------------------------------
 # timing helpers
 
+def interleaved_best(fns: dict, repeats: int) -> dict:
+    """Best time of each function over ``repeats`` rounds that call every one in turn, so a
+    machine whose load changes during the run slows each of them alike (the ratios are what
+    the benchmark reports)."""
+    for fn in fns.values():
+        fn()                                       # warm-up
+    best = {name: float("inf") for name in fns}
+    for _ in range(repeats):
+        for name, fn in fns.items():
+            t0 = time.perf_counter()
+            fn()
+            best[name] = min(best[name], time.perf_counter() - t0)
+    return best
+
+
 def best_of(fn, repeats: int) -> float:
     fn()                                           # warm-up
     times = []
@@ -199,6 +217,21 @@ def per_call(fn, args, repeats: int) -> float:
     return statistics.median(means)
 
 
+def peak_memory(fn) -> int:
+    """Bytes NumPy allocated at the peak of one call (tracemalloc sees NumPy's buffers)."""
+    import tracemalloc
+
+    fn()
+    tracemalloc.start()
+    try:
+        result = fn()
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    del result
+    return peak
+
+
 def process_time(argv: list[str], runs: int) -> float:
     # As installed: Python may write and use byte code (an inherited PYTHONDONTWRITEBYTECODE
     # would make every run recompile MITOS's sources, which no installed copy does).
@@ -210,6 +243,23 @@ def process_time(argv: list[str], runs: int) -> float:
         subprocess.run(argv, check=True, capture_output=True, env=env)
         times.append(time.perf_counter() - t0)
     return statistics.median(times)
+
+
+def startup(runs: int) -> None:
+    """(c) alone, the two commands alternating so that the machine's drift hits both alike."""
+    mitos = str(Path(sys.executable).parent / "mitos")
+    commands = {"mitos": [mitos, "eval", "road=78", "size=45", "position=4"],
+                "numpy": [sys.executable, "-c", "import numpy"]}
+    times: dict[str, list[float]] = {k: [] for k in commands}
+    for _ in range(runs):
+        for name, argv in commands.items():
+            times[name].append(process_time(argv, 1))
+    t_eval, t_numpy = (statistics.median(times[k]) for k in commands)
+    print(f"# MITOS start-up ({time.strftime('%Y-%m-%d')}), {machine()}")
+    print(f"command: python benchmarks/bench_core.py --startup (median of {runs} alternating runs)")
+    print(f"| `mitos eval road=78 size=45 position=4` (whole process) | {fmt_time(t_eval)} | "
+          f"{t_eval / t_numpy:.2f}x `python -c \"import numpy\"` |")
+    print(f"| `python -c \"import numpy\"` (whole process) | {fmt_time(t_numpy)} | |")
 
 
 def machine() -> str:
@@ -244,7 +294,12 @@ def fmt_time(s: float) -> str:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--quick", action="store_true", help="small sizes, for a smoke run")
+    ap.add_argument("--startup", action="store_true",
+                    help="only the whole-process start-up of `mitos eval` against NumPy's import")
     args = ap.parse_args()
+    if args.startup:
+        startup(runs=21)
+        return
     n = 10**5 if args.quick else 10**6
     repeats = 3 if args.quick else 5
     single_n = 200 if args.quick else 2000
@@ -276,9 +331,15 @@ def main() -> None:
                                        rtol=1e-12, atol=1e-9)
 
     # (a) batch throughput
-    t_detail = best_of(lambda: evaluate(c, X, detail=True), repeats)
-    t_fast = best_of(lambda: evaluate(c, X, detail=False), repeats)
-    t_kernel = best_of(lambda: kernel(X), repeats)
+    columns = {name: np.ascontiguousarray(X[:, j]) for j, name in enumerate(c.inputs)}
+    batch = interleaved_best({"detail": lambda: evaluate(c, X, detail=True),
+                              "fast": lambda: evaluate(c, X, detail=False),
+                              "kernel": lambda: kernel(X),
+                              "loaded": lambda: rb.evaluate(**columns)}, 2 * repeats)
+    t_detail, t_fast, t_kernel, t_loaded = (batch[k] for k in ("detail", "fast", "kernel",
+                                                                "loaded"))
+    mem_loaded = peak_memory(lambda: rb.evaluate(**columns))
+    mem_kernel = peak_memory(lambda: kernel(X))
 
     def fl_batch():
         fl_engine.input_values = X
@@ -286,6 +347,7 @@ def main() -> None:
         return fl_engine.output_values
     t_fl = best_of(fl_batch, max(2, repeats // 2))
     rate = {k: n / t for k, t in (("detail", t_detail), ("fast", t_fast), ("kernel", t_kernel),
+                                   ("loaded", t_loaded),
                                    ("fl", t_fl))}
 
     # (b) single-evaluation latency
@@ -322,7 +384,7 @@ def main() -> None:
     print(f"# MITOS core benchmark ({time.strftime('%Y-%m-%d')})")
     print(f"machine: {host}")
     print(f"command: python benchmarks/bench_core.py{' --quick' if args.quick else ''}")
-    print(f"batch: {n:,} random inputs, best of {repeats} after a warm-up; single: median of "
+    print(f"batch: {n:,} random inputs, best of {2 * repeats} interleaved rounds after a warm-up; single: median of "
           f"{repeats} repeats of the mean over {single_n} (MITOS) / {len(pts[:max(50, single_n // 4)])}"
           f" (peers) calls; process: median of {runs} runs\n")
     print("| measurement | figure | ratio |")
@@ -333,7 +395,11 @@ def main() -> None:
     print(f"| MITOS batch, `evaluate(detail=False)` | {fmt_rate(rate['fast'])} eval/s | "
           f"{rate['fast'] / rate['kernel']:.2f}x the hand-written kernel, "
           f"{rate['fast'] / rate['fl']:.0f}x pyfuzzylite |")
+    print(f"| MITOS batch, `load_rulebase().evaluate(**columns)` | {fmt_rate(rate['loaded'])} "
+          f"eval/s | {rate['loaded'] / rate['kernel']:.2f}x the hand-written kernel |")
     print(f"| hand-written NumPy kernel (this rule base) | {fmt_rate(rate['kernel'])} eval/s | |")
+    print(f"| peak extra memory, `load_rulebase().evaluate(**columns)` | {mem_loaded / 1e6:.1f} MB "
+          f"| {mem_loaded / mem_kernel:.2f}x the kernel's {mem_kernel / 1e6:.1f} MB |")
     print(f"| pyfuzzylite {_version('fuzzylite')} vectorized `process()` | "
           f"{fmt_rate(rate['fl'])} eval/s | |")
     print(f"| MITOS single, `load_rulebase().evaluate(...)` | {fmt_time(lat_mitos)} | "

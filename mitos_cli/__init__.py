@@ -3,8 +3,7 @@
 from __future__ import annotations
 
 from . import _moved
-
-__version__ = "0.1.0"
+from ._version import __version__
 
 __all__ = ["__version__", "load_rulebase"]
 

@@ -22,7 +22,7 @@ MOVED = {
     "yamlpos": "lang.yamlpos", "cache": "lang.cache", "build": "lang.resolve",
     "termset": "lang.termfile",
     "shapes": "fuzzy.shapes", "hedges": "fuzzy.hedges", "norms": "fuzzy.norms",
-    "neurons": "fuzzy.neurons", "operators": "fuzzy.operators",
+    "neurons": "fuzzy.neurons", "operators": "lang.operators",
     "compile": "engine.compile", "scalar": "engine.scalar", "mamdani": "engine.mamdani",
     "trace": "engine.trace", "check": "engine.check", "network": "engine.describe",
     "batch": "engine.csvio", "plotdata": "draw.data", "termplot": "draw.terminal",

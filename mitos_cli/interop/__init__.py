@@ -60,7 +60,7 @@ def write_foreign(rb: RuleBase, fmt: str, behavior: str | None = None) -> str:
 def conversion_notes(rb: RuleBase, fmt: str, behavior: str | None = None) -> list[str]:
     """What writing ``rb`` as ``fmt`` (``rules`` included) leaves out or changes; the file is
     written anyway and ``mitos convert`` prints these as warnings."""
-    from ..fuzzy.operators import resolve
+    from ..lang.operators import resolve
 
     b = rb.behavior(behavior)
     out = []

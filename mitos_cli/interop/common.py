@@ -14,7 +14,7 @@ import math
 from dataclasses import dataclass
 from pathlib import Path
 
-from ..fuzzy import operators as ops_mod
+from ..lang import operators as ops_mod
 from ..lang.resolve import MAIN, check_rule
 from ..errors import FormatError, MitosError, Span, did_you_mean
 from ..lang.model import And, Behavior, Consequent, Expr, Not, Or, Prop, Rule, RuleBase, Setting

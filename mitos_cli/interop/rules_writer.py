@@ -41,7 +41,7 @@ def write_rules(rb: RuleBase, termset_name: str, behavior: str | None = None,
     the behaviors it uses (recursively) as ``behavior`` blocks, itself first (the default)."""
     from ..lang.model import flatten
     from ..lang.model import Use, format_use
-    from ..fuzzy.operators import resolve
+    from ..lang.operators import resolve
 
     name = behavior or rb.default_behavior
     chosen = rb.behavior(name)

@@ -15,10 +15,12 @@ from lark import Lark, Token, Transformer, Tree, v_args
 from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken
 
 from ..errors import RuleSyntaxError, Span
+from ..fuzzy.hedges import HEDGES
+from .cache import lark_parser
 from .model import And, Behavior, Consequent, Not, Or, Prop, Rule, Setting, Use
 from ..resources import grammar_text
 
-HEDGE_NAMES = ("very", "somewhat", "more_or_less", "extremely", "seldom", "intensely", "any")
+HEDGE_NAMES = tuple(HEDGES)          # the grammar's HEDGE words (tests/test_registries.py)
 
 #: How terminals are named in error messages.
 TERMINAL_WORDS = {
@@ -30,9 +32,9 @@ TERMINAL_WORDS = {
 
 @functools.lru_cache(maxsize=None)
 def parser() -> Lark:
-    """The rule-language parser, built once (and cached on disk by Lark between runs)."""
-    return Lark(grammar_text(), parser="lalr", propagate_positions=True, maybe_placeholders=True,
-                start=["start", "rule", "expr"], cache=True)
+    """The rule-language parser, built once per process (its analysis kept in :mod:`.cache`)."""
+    return lark_parser(grammar_text(), propagate_positions=True, maybe_placeholders=True,
+                       start=["start", "rule", "expr"])
 
 
 @dataclass(frozen=True)

@@ -18,7 +18,7 @@ import numpy as np
 
 from ..fuzzy import norms
 from ..errors import unknown
-from ..fuzzy.operators import INFERENCES
+from ..lang.operators import INFERENCES
 
 PLANNERS = ("fuzzy", "potential_field")
 

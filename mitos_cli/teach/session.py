@@ -33,7 +33,7 @@ from ..engine.compile import CompiledRuleBase, compile_rulebase
 from ..errors import LessonError, MitosError, RuleBaseError, unknown
 from ..lang.model import And, Behavior, Expr, Not, Prop, Rule, RuleBase, format_expr, \
     format_number, format_rule, format_use
-from ..fuzzy.operators import resolve
+from ..lang.operators import resolve
 from ..lang.parse import parse_rule
 from ..words import plural
 from . import commands as cmd

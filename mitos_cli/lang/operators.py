@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, fields, replace
 
-from . import norms
+from ..fuzzy import norms
 from ..errors import RuleBaseError, Span, unknown
 from ..lang.model import Setting
 
