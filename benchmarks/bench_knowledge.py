@@ -20,10 +20,10 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from mitos_cli.sim.loop import prepare, simulate            # noqa: E402
-from mitos_cli.sim.planner import FuzzyPlanner              # noqa: E402
-from mitos_cli.sim.world import Obstacle                    # noqa: E402
-from mitos_cli.sim.worldfile import load_world              # noqa: E402
+from mitos_cli.sim.loop import prepare, simulate  # noqa: E402
+from mitos_cli.sim.planner import FuzzyPlanner  # noqa: E402
+from mitos_cli.sim.world import Obstacle  # noqa: E402
+from mitos_cli.sim.worldfile import load_world  # noqa: E402
 
 POLES = 300
 

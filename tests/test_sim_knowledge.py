@@ -9,7 +9,9 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from hypothesis import given as hgiven, settings, strategies as st
+from hypothesis import given as hgiven
+from hypothesis import settings
+from hypothesis import strategies as st
 
 from mitos_cli.errors import WorldError
 from mitos_cli.sim.distance import distance_transform

@@ -24,8 +24,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..lang import yamlpos
 from ..errors import Span, WorldError
+from ..lang import yamlpos
 from .pgm import read_pgm
 from .world import Grid
 

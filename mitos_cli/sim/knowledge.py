@@ -102,7 +102,7 @@ def given(world: World, static: StaticMap) -> Given:
         grid = static.grid
         if known and grid is None:
             grid = _raster(static, world, RASTER, free=False)
-    elif world.knows == "given":
+    elif world.knows == "given" and world.given is not None:
         grid = world.given
         if world.corridors:
             grid = carve(grid, corridor_rects(world.corridors))
@@ -132,7 +132,7 @@ class RobotMap:
     replans: int = 0
 
     @classmethod
-    def of(cls, grid: Grid) -> "RobotMap":
+    def of(cls, grid: Grid) -> RobotMap:
         return cls(grid, grid.occupied.copy())
 
     def cells(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -175,7 +175,7 @@ def expected_ranges(g: Given, rmap: RobotMap | None, origin: np.ndarray, dirs: n
                     walls_near: np.ndarray, max_range: float) -> np.ndarray:
     """What the robot's map predicts along each beam: the given walls near it (the caller's
     set) and the known obstacles, or with no map what it has mapped itself."""
-    if g.knows == "none":
+    if g.knows == "none" and rmap is not None:
         out = rmap.ranges(origin, dirs, max_range)
     else:
         out = ray_segments(origin, dirs, walls_near, max_range)
@@ -193,18 +193,23 @@ def expected_ranges(g: Given, rmap: RobotMap | None, origin: np.ndarray, dirs: n
     return out
 
 
-def _window(grid: Grid, occupied: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> StaticMap:
-    """The part of a grid between two corners, as a map to plan on."""
+def _as_map(grid: Grid) -> StaticMap:
+    """A grid as a map to plan on (the planner needs only its cells)."""
+    rows, cols = grid.occupied.shape
+    x0, y0 = grid.origin
+    return StaticMap(np.zeros((0, 4)), np.zeros((0, 4, 2)), grid,
+                     (x0, y0, x0 + cols * grid.resolution, y0 + rows * grid.resolution))
+
+
+def _window(grid: Grid, occupied: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> Grid:
+    """The part of a grid (with cells ``occupied``) between two corners."""
     res, (ox, oy) = grid.resolution, grid.origin
     rows, cols = occupied.shape
     c0 = max(0, int((lo[0] - ox) // res))
     r0 = max(0, int((lo[1] - oy) // res))
     c1 = min(cols, int((hi[0] - ox) // res) + 1)
     r1 = min(rows, int((hi[1] - oy) // res) + 1)
-    sub = Grid(occupied[r0:r1, c0:c1], res, (ox + c0 * res, oy + r0 * res), grid.source)
-    bounds = (sub.origin[0], sub.origin[1], sub.origin[0] + (c1 - c0) * res,
-              sub.origin[1] + (r1 - r0) * res)
-    return StaticMap(np.zeros((0, 4)), np.zeros((0, 4, 2)), sub, bounds)
+    return Grid(occupied[r0:r1, c0:c1], res, (ox + c0 * res, oy + r0 * res), grid.source)
 
 
 def way_past(rmap: RobotMap, route: Route, s: float, p: np.ndarray, ahead: float,
@@ -217,15 +222,14 @@ def way_past(rmap: RobotMap, route: Route, s: float, p: np.ndarray, ahead: float
     sample = np.array([route.point_at(u) for u in along])
     lo = np.minimum(sample.min(axis=0), p) - TUBE
     hi = np.maximum(sample.max(axis=0), p) + TUBE
-    window = _window(rmap.grid, rmap.occupied, lo, hi)
-    g = window.grid
+    g = _window(rmap.grid, rmap.occupied, lo, hi)
     room = Clearance.of(g.occupied, g.resolution, g.origin, cap=minimum + 2 * g.resolution)
     beyond = (along >= end) & (room.at(sample) >= minimum)
     if not beyond.any():
         return False
     target = sample[int(np.argmax(beyond))]
     try:
-        grid_route(window, Pose(float(p[0]), float(p[1])), Goal(float(target[0]),
+        grid_route(_as_map(g), Pose(float(p[0]), float(p[1])), Goal(float(target[0]),
                    float(target[1])), clearance, minimum=minimum, explain=False,
                    leave=clearance + 6.0)
     except NarrowPassage:
@@ -239,7 +243,7 @@ def _crosses(rmap: RobotMap, route: Route, s: float, p: np.ndarray, reach: float
     robot has mapped (only cells within ``ahead + reach`` of it are looked at)."""
     g = rmap.grid
     lo, hi = p - ahead - reach, p + ahead + reach
-    window = _window(g, rmap.occupied, lo, hi).grid
+    window = _window(g, rmap.occupied, lo, hi)
     r, c = np.nonzero(window.occupied)
     if not len(r):
         return False
@@ -264,9 +268,8 @@ def replan(rmap: RobotMap, route: Route, s: float, p: np.ndarray, goal: Goal, t:
     elif not route.near(fresh, s, clearance, sight).any() or \
             way_past(rmap, route, s, p, sight, clearance, minimum):
         return None
-    static = StaticMap(np.zeros((0, 4)), np.zeros((0, 4, 2)), rmap.grid, (0, 0, 0, 0))
     try:
-        new = grid_route(static, Pose(float(p[0]), float(p[1])), goal, clearance,
+        new = grid_route(_as_map(rmap.grid), Pose(float(p[0]), float(p[1])), goal, clearance,
                          minimum=minimum, occupied=rmap.occupied, explain=False,
                          leave=clearance + 6.0)
     except NarrowPassage:

@@ -21,9 +21,15 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import geometry, kinematics, knowledge, obstacles as obs_mod, perception, sensors
-from .geometry import box_polygon_depth, box_polygon_distance, box_segment_distance, \
-    polygon_segments, rect_corners
+from . import geometry, kinematics, knowledge, perception, sensors
+from . import obstacles as obs_mod
+from .geometry import (
+    box_polygon_depth,
+    box_polygon_distance,
+    box_segment_distance,
+    polygon_segments,
+    rect_corners,
+)
 from .planner import Percepts, Planner
 from .route import Route, grid_route, plan_route
 from .staticmap import StaticMap, build_static
@@ -324,7 +330,7 @@ class Simulation:
 
     # -- set-up -----------------------------------------------------------------------------
 
-    def reset(self, seed: int | None = None) -> "Simulation":
+    def reset(self, seed: int | None = None) -> Simulation:
         """Start the run again from ``seed`` (default: the world's)."""
         world = self._given_world
         self.seed = world.seed if seed is None else int(seed)
@@ -382,7 +388,7 @@ class Simulation:
         self._routes = list(self.scene.routes)          # replanning replaces them
         self._replanned: list[tuple[int, int, Route]] = []
         self._maps: list[knowledge.RobotMap | None] = [None] * n
-        if self._given.knows == "none":
+        if self._given.knows == "none" and self._given.grid is not None:
             self._maps = [knowledge.RobotMap.of(self._given.grid) for _ in range(n)]
         self._history: list[np.ndarray] = []
         self._outcomes = ["timeout"] * n
@@ -532,8 +538,9 @@ class Simulation:
         routes, sen = self._routes, self.world.sensors
         for i in range(self.n):
             f = perception.frame(routes[i], s.pose[i, :2], self._s_hint[i])
-            if self._learn(i, s) and self._active[i]:
-                route = knowledge.replan(self._maps[i], routes[i], f.s, s.pose[i, :2],
+            rmap = self._maps[i] if self._learn(i, s) and self._active[i] else None
+            if rmap is not None:
+                route = knowledge.replan(rmap, routes[i], f.s, s.pose[i, :2],
                                          self.world.agents[i].goal, s.t, *self._asked[i],
                                          self._cfg.sight, self._given.knows)
                 if route is not None:
@@ -560,10 +567,10 @@ class Simulation:
                 else valid & (measured < self._expected[i] - self._threshold))
         if not seen.any():
             return False
-        if self._maps[i] is None:
-            self._maps[i] = knowledge.RobotMap.of(
-                knowledge.plan_grid(self._given, self.scene.static, self.world))
         rmap = self._maps[i]
+        if rmap is None:
+            rmap = self._maps[i] = knowledge.RobotMap.of(
+                knowledge.plan_grid(self._given, self.scene.static, self.world))
         before = len(rmap.fresh)
         rmap.mark(s.pose[i, :2] + measured[seen, None] * dirs[seen], dirs[seen])
         return len(rmap.fresh) > before

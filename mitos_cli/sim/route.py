@@ -30,7 +30,7 @@ class Route:
         return id(self)
 
     @classmethod
-    def of(cls, points, goal=None) -> "Route":
+    def of(cls, points, goal=None) -> Route:
         pts = np.asarray(points, float)
         keep = np.concatenate([[True], np.hypot(*np.diff(pts, axis=0).T) > 1e-9])
         pts = pts[keep]
@@ -193,7 +193,7 @@ class Clearance:
 
     @classmethod
     def of(cls, occupied: np.ndarray, resolution: float, origin: tuple[float, float],
-           cap: float | None = None) -> "Clearance":
+           cap: float | None = None) -> Clearance:
         """The field of a grid, exact up to ``cap`` inches (see :func:`distance_transform`)."""
         return cls(distance_transform(occupied, resolution, cap), resolution, origin)
 

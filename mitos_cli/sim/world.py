@@ -164,5 +164,5 @@ class World:
     def known_obstacles(self) -> tuple[Obstacle, ...]:
         return tuple(o for o in self.obstacles if o.known)
 
-    def with_changes(self, **changes) -> "World":
+    def with_changes(self, **changes) -> World:
         return replace(self, **changes)

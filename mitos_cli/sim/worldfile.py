@@ -11,11 +11,10 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from ..lang import yamlpos
 from ..errors import NameError_, Span, WorldError, unknown
+from ..lang import yamlpos
 from ..lang.yamlpos import YList, YMap
-from .world import (Agent, Corridor, Goal, Jitter, Motion, Obstacle, Pose, Randomise, Robot,
-                    Sensors, World)
+from .world import Agent, Corridor, Goal, Jitter, Motion, Obstacle, Pose, Randomise, Robot, Sensors, World
 
 TOP_KEYS = ("name", "seed", "dt", "time_limit", "substeps", "behavior", "robot", "sensors",
             "q_init", "q_goal", "map", "obstacles", "robots", "randomise", "route")
@@ -108,9 +107,7 @@ class _Reader:
 def read_robot(r: _Reader, value: Any, span: Span, base: Robot | None = None) -> Robot:
     m = r.mapping(value, span, "robot", ROBOT_KEYS)
     d = base or Robot()
-    if base is None:
-        r.choice(m, "model", MODELS, "robot")
-    elif "model" in m:
+    if base is None or "model" in m:
         r.choice(m, "model", MODELS, "robot")
     fp = d.length, d.width
     if "footprint" in m:
