@@ -43,7 +43,8 @@ _ROWS = (   # label, key, format (the overall figures, then each robot's)
     ("ticks", "ticks", str), ("path length", "path_length_in", lambda v: f"{v:.1f} in"),
     ("mean speed", "mean_speed_in_s", lambda v: f"{v:.1f} in/s"),
     ("min clearance", "min_clearance_in", lambda v: f"{v:.1f} in"),
-    ("steering total variation", "steering_total_variation_deg", lambda v: f"{v:.0f} deg"))
+    ("steering total variation", "steering_total_variation_deg", lambda v: f"{v:.0f} deg"),
+    ("replans", "replans", str))
 
 
 def _summary(res) -> str:

@@ -43,7 +43,7 @@ class WorldRuns:
         return float(x.mean()), float(x.std(ddof=1)) if len(x) > 1 else 0.0
 
     @property
-    def robots(self) -> tuple["WorldRuns", ...]:
+    def robots(self) -> tuple[WorldRuns, ...]:
         """Each robot's runs (its outcome and figures per run) in a world of several robots;
         ``()`` for one robot, whose runs are the world's."""
         if not self.summaries or "robots" not in self.summaries[0]:
