@@ -286,7 +286,7 @@ def simulate(world: World, planner: Planner | None = None, seed: int | None = No
         if active.any():
             idx = np.flatnonzero(active)
             sub_p = Percepts({key: val[idx] for key, val in percepts_p.items()}, ranges[idx],
-                             angles, pose[idx], v[idx], targets[idx], goals[idx])
+                             angles, pose[idx], v[idx], targets[idx], goals[idx], steer[idx])
             c_steer, c_speed = planner.plan(sub_p)
             cmd[idx, 0], cmd[idx, 1] = c_steer, c_speed
 
