@@ -11,7 +11,7 @@ a. batch throughput on 10^6 random inputs: ``engine.evaluate`` with ``detail=Tru
    and DOFs kept) and ``detail=False`` (outputs only), a hand-written NumPy kernel for exactly
    this rule base, and pyfuzzylite 8's vectorized ``Engine.process()`` on the same rules;
 b. single-evaluation latency: ``load_rulebase().evaluate(road=..., size=..., position=...)``
-   (the network's scalar form, :mod:`mitos_cli.scalar`), the engine's array entry point with
+   (the network's scalar form, :mod:`mitos_cli.engine.scalar`), the engine's array entry point with
    one row (``evaluate(compiled, X[i:i+1], detail=False)``, the same scalar form plus the
    ``Result`` arrays) and with memberships and DOFs (``detail=True``: the NumPy path, what the
    trace of ``mitos eval`` uses); pyfuzzylite (set three inputs, ``process()``, read two
@@ -40,7 +40,7 @@ from pathlib import Path
 import numpy as np
 
 from mitos_cli import load_rulebase
-from mitos_cli.engine import evaluate
+from mitos_cli.engine.evaluation import evaluate
 
 SEED = 20240611
 

@@ -90,7 +90,7 @@ class FuzzyPlanner:
         return np.column_stack([np.asarray(inputs[k], float) for k in self.compiled.inputs])
 
     def plan(self, percepts: Percepts) -> tuple[np.ndarray, np.ndarray]:
-        from ..engine import evaluate
+        from ..engine.evaluation import evaluate
 
         out = evaluate(self.compiled, self.matrix(percepts.inputs), detail=False).outputs
         return out[:, self._cols[0]], out[:, self._cols[1]]
@@ -98,7 +98,7 @@ class FuzzyPlanner:
     def explain(self, inputs: dict[str, np.ndarray]):
         """The detailed engine result (memberships, DOFs) for inputs ``[n]`` by name: rows are
         ticks or robots. Bit for bit what :meth:`plan` computed (the engine is row-exact)."""
-        from ..engine import evaluate
+        from ..engine.evaluation import evaluate
 
         return evaluate(self.compiled, self.matrix(inputs))
 

@@ -22,11 +22,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import operators as ops_mod
-from .model import And, Expr, Not, Prop, Rule, RuleBase, Setting, Use, flatten, format_rule
-from .operators import Operators
-from .shapes import kernel_params
-from .terms import Term, Variable
+from ..lang import operators as ops_mod
+from ..lang.model import And, Expr, Not, Prop, Rule, RuleBase, Setting, Use, flatten, format_rule
+from ..lang.operators import Operators
+from ..fuzzy.shapes import kernel_params
+from ..lang.terms import Term, Variable
 
 ZERO, ONE = 0, 1
 
@@ -83,6 +83,12 @@ class CompiledRuleBase:
     #: constant consequents are rows with a = 0, unset outputs are all 0.
     cons_linear: np.ndarray | None = None
 
+    def __repr__(self) -> str:   # the generated one prints every array (125,000 characters)
+        return (f"<CompiledRuleBase {self.behavior!r}: {len(self.inputs)} inputs "
+                f"({', '.join(self.inputs)}), {len(self.outputs)} outputs "
+                f"({', '.join(self.outputs)}), {self.n_rules} rules, {self.n_terms} terms, "
+                f"{len(self.levels)} levels, {self.n_columns} neurons; {self.operators.describe()}>")
+
     @property
     def kernel_columns(self) -> np.ndarray:
         """The kernel as ``[4, T, 1]`` columns, to broadcast against ``[T, b]`` blocks."""
@@ -136,7 +142,7 @@ class CompiledRuleBase:
     @functools.cached_property
     def scalar(self):
         """The network as a Python function of one sample's floats (``None`` when it has no
-        exact scalar form): see :mod:`mitos_cli.scalar`. Written on first use."""
+        exact scalar form): see :mod:`mitos_cli.engine.scalar`. Written on first use."""
         from .scalar import scalar_function
 
         return scalar_function(self)
@@ -316,7 +322,7 @@ def compile_rulebase(rb: RuleBase, behavior: str | None = None,
                 coefficients = variables[c.var].term(c.term).params[:-1]
                 used_inputs.update(n for n, a in zip(names, coefficients) if a != 0.0)
                 if operators.inference == "mamdani":
-                    from .errors import RuleBaseError
+                    from ..errors import RuleBaseError
 
                     raise RuleBaseError(
                         f"`{c.var} is {c.term}` is a linear (Takagi-Sugeno) consequent, which "
@@ -438,7 +444,7 @@ def compile_rulebase(rb: RuleBase, behavior: str | None = None,
 
 def _termset_inputs(rb: RuleBase, output: str) -> tuple[str, ...]:
     """The input variables, in order, of the term set defining ``output`` (the coefficient
-    order of its ``linear`` terms, :data:`mitos_cli.shapes.LINEAR_LAYOUT`)."""
+    order of its ``linear`` terms, :data:`mitos_cli.fuzzy.shapes.LINEAR_LAYOUT`)."""
     for ts in rb.termsets:
         if any(v.name == output for v in ts.variables):
             return tuple(v.name for v in ts.variables if v.role == "input")

@@ -1,6 +1,6 @@
 """What the pictures show, as plain data: term curves, control surfaces and rule-viewer rows.
 
-Every picture of :mod:`mitos_cli.draw` (and every terminal plot of :mod:`mitos_cli.termplot`)
+Every picture of :mod:`mitos_cli.draw` (and every terminal plot of :mod:`mitos_cli.draw.terminal`)
 draws one of the dataclasses built here, so what a picture says can be tested without
 matplotlib and without looking at pixels:
 
@@ -21,11 +21,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .compile import CompiledRuleBase
-from .errors import InputError, unknown
-from .hedges import apply as apply_hedges
-from .model import And, Expr, Not, Or, Prop, RuleBase, format_expr
-from .terms import Term, Variable
+from ..engine.compile import CompiledRuleBase
+from ..errors import InputError, unknown
+from ..fuzzy.hedges import apply as apply_hedges
+from ..lang.model import And, Expr, Not, Or, Prop, RuleBase, format_expr
+from ..lang.terms import Term, Variable
 
 #: Samples per term curve (corner points are added to these).
 CURVE_POINTS = 401
@@ -175,7 +175,7 @@ def sheet(rulebase: RuleBase, names: list[str] | None = None,
     else:
         chosen = sorted(variables.values(), key=lambda v: v.role != "input")
         if behavior is not None:
-            from .compile import compile_rulebase
+            from ..engine.compile import compile_rulebase
 
             compiled = compile_rulebase(rulebase, behavior)
             used = set(compiled.inputs) | set(compiled.outputs)
@@ -263,11 +263,11 @@ def surface(compiled: CompiledRuleBase, output: str, x: str, y: str | None = Non
     """The control surface of ``output`` over ``x`` (and ``y``), the other inputs fixed.
 
     Inputs not in ``fixed`` are held at the midpoint of their universe (:class:`Fixed` says
-    so). The whole grid is one batch through :func:`mitos_cli.engine.evaluate` with
+    so). The whole grid is one batch through :func:`mitos_cli.engine.evaluation.evaluate` with
     ``strict=False``: where no rule fires and the output has no default, ``z`` is NaN.
     ``x_range`` / ``y_range`` zoom into part of a universe.
     """
-    from .engine import evaluate
+    from ..engine.evaluation import evaluate
 
     if output not in compiled.outputs:
         raise unknown("output", output, compiled.outputs, cls=InputError)
@@ -471,9 +471,9 @@ def rule_view(compiled: CompiledRuleBase, values: dict[str, float]) -> RuleView:
     Memberships, DOFs and outputs are the engine's (the numbers ``mitos eval`` prints); the
     rows are the rules with DOF > 0 in rule-base order. For Mamdani inference each consequent
     carries the rule's implied output set and each output the aggregated set
-    (:mod:`mitos_cli.mamdani`).
+    (:mod:`mitos_cli.engine.mamdani`).
     """
-    from .engine import as_batch, evaluate
+    from ..engine.evaluation import as_batch, evaluate
 
     X = as_batch(compiled, values)
     if X.shape[0] != 1:
@@ -495,7 +495,7 @@ def rule_view(compiled: CompiledRuleBase, values: dict[str, float]) -> RuleView:
 
     crisp = compiled.cons_value
     if compiled.cons_linear is not None:
-        from .engine import linear_consequents
+        from ..engine.evaluation import linear_consequents
 
         crisp = linear_consequents(compiled, np.ascontiguousarray(res.inputs.T))[:, :, 0].T
     mamdani = compiled.operators.inference == "mamdani"
@@ -541,8 +541,9 @@ def rule_view(compiled: CompiledRuleBase, values: dict[str, float]) -> RuleView:
 def _mamdani_sets(compiled: CompiledRuleBase, dof: np.ndarray):
     """Per output ``j``: ``({rule: (implied set, consequent set)}, grid, aggregate)`` for one
     sample's DOFs,
-    from the sampled consequent sets the engine uses (:mod:`mitos_cli.mamdani`)."""
-    from . import mamdani, norms
+    from the sampled consequent sets the engine uses (:mod:`mitos_cli.engine.mamdani`)."""
+    from ..engine import mamdani
+    from ..fuzzy import norms
 
     ops = compiled.operators
     aggregation = norms.lookup("snorm", ops.aggregation)

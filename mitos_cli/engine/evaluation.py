@@ -13,11 +13,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import hedges as hedge_mod
-from . import norms
+from ..fuzzy import hedges as hedge_mod
+from ..fuzzy import norms
 from .compile import CompiledRuleBase
-from .errors import InputError, NoRuleFiredError
-from .shapes import SHAPES
+from ..errors import InputError, NoRuleFiredError
+from ..fuzzy.shapes import SHAPES
 
 
 @dataclass(frozen=True, eq=False)   # holds arrays: identity, not ==
@@ -34,6 +34,12 @@ class Result:
 
     # memberships and dof are transposed views of [T, n] / [R, n] arrays (rows are samples).
 
+    def __repr__(self) -> str:
+        kept = [k for k in ("memberships", "dof", "values") if getattr(self, k) is not None]
+        return (f"<Result of {self.compiled.behavior!r}: {len(self.outputs):,} samples x "
+                f"{len(self.compiled.outputs)} outputs ({', '.join(self.compiled.outputs)})"
+                f"{'; with ' + ', '.join(kept) if kept else ''}>")
+
     def output(self, name: str) -> np.ndarray:
         return self.outputs[:, self.compiled.outputs.index(name)]
 
@@ -44,7 +50,7 @@ def as_batch(compiled: CompiledRuleBase, columns: dict[str, object]) -> np.ndarr
     Every compiled input must be given; scalars broadcast against arrays. Names that the
     behavior does not use are refused with a "did you mean".
     """
-    from .errors import unknown
+    from ..errors import unknown
 
     if len(columns) == len(compiled.inputs):   # numbers by name: one small array, no checks
         try:
@@ -132,7 +138,7 @@ def memberships(compiled: CompiledRuleBase, Xt: np.ndarray, out: np.ndarray) -> 
     """Membership layer: fill rows ``2 .. 2+T`` of ``out[columns, b]`` from ``Xt[k, b]``.
 
     Piecewise-linear terms share one kernel, ``clip(1 + min((x - b) s1, (c - x) s2), 0, 1)``
-    (see :func:`mitos_cli.shapes.kernel_params`); other shapes are evaluated per shape. The
+    (see :func:`mitos_cli.fuzzy.shapes.kernel_params`); other shapes are evaluated per shape. The
     clip at 1 is skipped when no term has a plateau between two slopes (triangles and
     shoulders never exceed 1), and the clip at 0 takes a row of zeros: NumPy's ``maximum``
     with a Python scalar is about 1.5x slower than with an array.
@@ -337,7 +343,7 @@ def evaluate_one(compiled: CompiledRuleBase, values: list[float],
                  strict: bool = True) -> tuple[float, ...]:
     """The outputs for one sample (inputs in :attr:`CompiledRuleBase.inputs` order): the same
     bits as its row in :func:`evaluate`, through the network's scalar form where it has one
-    (:mod:`mitos_cli.scalar`, a few microseconds instead of some forty NumPy calls)."""
+    (:mod:`mitos_cli.engine.scalar`, a few microseconds instead of some forty NumPy calls)."""
     one = _evaluate_one(compiled, values)
     if one is not None:
         return one[1]
