@@ -190,8 +190,8 @@ def dwa_command(params: DWAParams, target: np.ndarray, speed: np.ndarray,
     clear = footprint_clearance(poses, points, seen, robot.length, robot.width)
     now = footprint_clearance(np.zeros((n, 1, 1, 3)), points, seen, robot.length,
                               robot.width)[:, 0, 0]                     # [n]
-    limit = np.minimum(p.collision_in, now - 0.5)[:, None, None]
-    close = clear < limit                                               # [n, S, T]
+    limit = np.minimum(p.collision_in, np.maximum(now - 0.5, 0.0))[:, None, None]
+    close = clear <= limit                                              # [n, S, T]
     hits = close.any(axis=2)
     # arc length travelled until the first pose that is too close (the whole horizon if none)
     steps = np.arange(1, p.rollout_steps + 1) / p.rollout_steps
