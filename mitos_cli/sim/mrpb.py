@@ -32,8 +32,8 @@ COMPLETE = ("maze", "narrow_graph", "office01add", "office02", "room02", "shoppi
             "track")
 PARTIALLY_UNKNOWN = {"office02_partially_unknown": "office02",
                      "shopping_mall_partially_unknown": "shopping_mall"}
-TIME_PER_M = 12.0          # s per metre of straight line (about 3 in/s over the crow's path)
-MIN_TIME_S = 120.0
+TIME_PER_M = 6.0           # s per metre of straight line (6.6 in/s over the crow's path)
+MIN_TIME_S = 60.0
 _POSE = r"\(\s*([-+0-9.eE]+)\s*,\s*([-+0-9.eE]+)\s*,\s*([-+0-9.eE]+)\s*\)"
 _TEST = re.compile(r"^\s*test\s+(\d+)\s*:\s*start\s*" + _POSE + r"\s*->\s*goal\s*" + _POSE
                    + r"\s*$")
