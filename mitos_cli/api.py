@@ -14,7 +14,8 @@ from pathlib import Path
 import numpy as np
 
 from .engine.compile import CompiledRuleBase, compile_rulebase
-from .engine.evaluation import Result, as_batch, evaluate, evaluate_one
+from .engine.evaluation import (Result, as_batch, as_columns, evaluate, evaluate_columns,
+                                evaluate_one)
 from .lang.model import RuleBase
 from .resources import DEFAULT_RULEBASE, packaged_path
 from .engine.trace import Trace, trace_of
@@ -106,11 +107,12 @@ class LoadedRuleBase:
                 pass                           # a misspelt name: as_batch explains it
             else:
                 return dict(zip(c.outputs, evaluate_one(c, values)))
-        X = as_batch(self.compiled, inputs)
-        result = evaluate(self.compiled, X, detail=False)
-        if X.shape[0] == 1 and all(np.ndim(v) == 0 for v in inputs.values()):
-            return dict(zip(self.compiled.outputs, result.outputs[0].tolist()))
-        return {name: result.outputs[:, j] for j, name in enumerate(self.compiled.outputs)}
+        Xt = as_columns(c, inputs)
+        if Xt.shape[1] == 1 and all(np.ndim(v) == 0 for v in inputs.values()):
+            result = evaluate(c, Xt.T, detail=False)
+            return dict(zip(c.outputs, result.outputs[0].tolist()))
+        out = evaluate_columns(c, Xt)
+        return {name: out[j] for j, name in enumerate(c.outputs)}
 
     def trace(self, **inputs) -> Trace:
         """The paper-style DOF trace of one evaluation."""
