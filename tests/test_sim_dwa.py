@@ -8,8 +8,7 @@ import numpy as np
 import pytest
 
 from mitos_cli.sim import kinematics
-from mitos_cli.sim.dwa import DWAParams, DWAPlanner, dwa_command, echo_points, \
-    footprint_clearance, rollouts
+from mitos_cli.sim.dwa import DWAParams, DWAPlanner, dwa_command, echo_points, footprint_clearance, rollouts
 from mitos_cli.sim.loop import simulate
 from mitos_cli.sim.world import Robot
 from mitos_cli.sim.worldfile import parse_world

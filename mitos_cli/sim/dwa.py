@@ -238,7 +238,7 @@ class DWAPlanner:
         self.params = params or DWAParams()
 
     @classmethod
-    def for_world(cls, world, params: DWAParams | None = None) -> "DWAPlanner":
+    def for_world(cls, world, params: DWAParams | None = None) -> DWAPlanner:
         return cls(world.agents[0].robot, world.sensors.range, world.dt, params)
 
     def plan(self, p) -> tuple[np.ndarray, np.ndarray]:

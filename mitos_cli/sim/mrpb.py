@@ -23,6 +23,7 @@ import dataclasses
 import math
 import re
 from pathlib import Path
+from typing import Any
 
 from ..errors import Span, WorldError
 from .gridmap import INCH_PER_M, load_map_yaml
@@ -73,7 +74,7 @@ def scenario_worlds(root: Path, name: str, robot: Robot | None = None,
     sensors = sensors or Sensors(noise=0.5)
     truth = PARTIALLY_UNKNOWN.get(name)
     grid = load_map_yaml(folder.parent / (truth or name) / "map.yaml")
-    extra = {}
+    extra: dict[str, Any] = {}
     if truth:
         if "given" not in {f.name for f in dataclasses.fields(World)}:
             raise WorldError(f"the partially unknown scenario `{name}` needs a world that is "

@@ -21,8 +21,9 @@ for all robots. A baseline (a potential field, say) implements the same ``plan``
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Callable, Protocol
+from typing import Protocol
 
 import numpy as np
 
