@@ -23,3 +23,17 @@ def test_reprs_are_one_line_with_the_sizes():
 def test_a_trace_shows_itself_in_a_notebook():
     html = load_rulebase().trace(road=78, size=45, position=4)._repr_html_()
     assert html.startswith("<pre>") and "steering = 65.4 deg" in html
+
+
+def test_a_finished_run_prints_a_line_and_draws_itself():
+    import pytest
+
+    from mitos_cli.resources import packaged_path
+    from mitos_cli.sim import load_world, simulate
+
+    result = simulate(load_world(str(packaged_path("worlds", "corridor.yaml"))))
+    text = repr(result)
+    assert "\n" not in text and len(text) < 200
+    assert "'corridor' seed 1" in text and "success after 18.5 s (370 ticks)" in text
+    pytest.importorskip("matplotlib")
+    assert result._repr_png_().startswith(b"\x89PNG")
