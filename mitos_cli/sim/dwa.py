@@ -24,11 +24,13 @@ for every robot at once:
    speed cannot be braked to a stop (at the acceleration limit) before the first pose that
    would be that close (Fox et al.'s admissible velocities).
 5. **Score.** ``heading_weight * heading + target_weight * progress + clearance_weight *
-   clearance + speed_weight * speed``, each term scaled to [0, 1] over the admissible samples
-   (as Fox et al. normalise): *heading* = how well the final heading points at the route point
-   ahead (1 aligned, 0 opposite), *progress* = how much closer the final pose is to that point,
-   *clearance* = the smallest clearance along the trajectory, saturated at ``clearance_cap_in``,
-   *speed* = the sample's speed. The best sample is commanded.
+   clearance + speed_weight * speed``: *heading* = how well the final heading points at the
+   route point ahead (1 aligned, 0 opposite), *progress* = how much closer the final pose is to
+   that point (pushed out along its bearing to the horizon's reach unless it is the goal),
+   *speed* = the sample's speed, these three scaled to [0, 1] over the admissible samples as
+   Fox et al. normalise; *clearance* = the smallest clearance along the trajectory over
+   ``clearance_cap_in`` (saturated at 1), absolute, so that a little more room where all is
+   tight does not weigh as much as a wall ahead. The best sample is commanded.
 6. **No admissible trajectory:** brake as hard as allowed and turn the wheel toward the
    clearest trajectory (ROS would start a recovery behavior; there is none here, so a robot
    boxed in ends ``stuck``).
@@ -53,8 +55,8 @@ class DWAParams:
     1.7 s; ``vx_samples`` 3 and ``vth_samples`` 20 -> 5 speeds x 15 wheel angles). The window
     spans ``window_s`` = 0.25 s, not one 0.05 s tick: in one tick the tricycle's wheel turns
     at most 9 deg, every sample is then a near-straight arc, and on the shipped worlds (2
-    runs each) the planner wedged itself beside the corridor's box or clipped a corner (4 of 14
-    runs ended in a collision, 5 stuck; with 0.25 s, 1 collision and 1 stuck). ``collision_in``
+    runs each of seven) the planner wedged itself beside the corridor's box or clipped a corner
+    (3 of 14 runs ended in a collision, 5 stuck; with 0.25 s, 1 collision and 2 stuck). ``collision_in``
     and ``clearance_weight`` were set in the same comparison; nothing was tuned on the
     benchmark's worlds.
     """
