@@ -55,10 +55,10 @@ class DWAParams:
     1.7 s; ``vx_samples`` 3 and ``vth_samples`` 20 -> 5 speeds x 15 wheel angles). The window
     spans ``window_s`` = 0.25 s, not one 0.05 s tick: in one tick the tricycle's wheel turns
     at most 9 deg, every sample is then a near-straight arc, and on the shipped worlds (2
-    runs each of seven) the planner wedged itself beside the corridor's box or clipped a corner
-    (3 of 14 runs ended in a collision, 5 stuck; with 0.25 s, 1 collision and 2 stuck). ``collision_in``
-    and ``clearance_weight`` were set in the same comparison; nothing was tuned on the
-    benchmark's worlds.
+    runs each of seven) the planner wedged itself beside the corridor's box or clipped a
+    corner (3 of 14 runs ended in a collision, 5 stuck; with 0.25 s, 1 collision and 2
+    stuck). ``collision_in`` and ``clearance_weight`` were set in the same comparison; nothing
+    was tuned on the benchmark's worlds.
     """
 
     horizon_s: float = 1.7          # s, how long each sampled command is held (sim_time)
