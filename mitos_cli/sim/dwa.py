@@ -57,8 +57,9 @@ class DWAParams:
     at most 9 deg, every sample is then a near-straight arc, and on the shipped worlds (2
     runs each of seven) the planner wedged itself beside the corridor's box or clipped a
     corner (3 of 14 runs ended in a collision, 5 stuck; with 0.25 s, 1 collision and 2
-    stuck). ``collision_in`` and ``clearance_weight`` were set in the same comparison; nothing
-    was tuned on the benchmark's worlds.
+    stuck). ``collision_in`` and ``clearance_weight`` were set in the same comparison. Nothing
+    was set on the BARN fields or MRPB's maps; the shipped worlds of that comparison are also
+    the bases of the benchmark's clutter suite (there without their clutter).
     """
 
     horizon_s: float = 1.7          # s, how long each sampled command is held (sim_time)
