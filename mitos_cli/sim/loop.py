@@ -594,7 +594,7 @@ class Simulation:
             idx = np.flatnonzero(self._active)
             sub = Percepts({key: val[idx] for key, val in s.inputs.items()}, s.ranges[idx],
                            self.angles, s.pose[idx], self._v[idx], s.targets[idx],
-                           self._goals[idx])
+                           self._goals[idx], self._steer[idx])
             c_steer, c_speed = self.planner.plan(sub)
             cmd[idx, 0], cmd[idx, 1] = c_steer, c_speed
         s.command = cmd
