@@ -314,7 +314,7 @@ class Simulation:
         self._active = np.ones(n, dtype=bool)
         self._near_at = [(math.inf, math.inf)] * n     # where each robot's wall set was gathered
         self._near_walls = [np.zeros((0, 4))] * n
-        self._history: list[np.ndarray] = []
+        self._history: list[tuple[np.ndarray, np.ndarray]] = []   # (x, y) after each move
         self._outcomes = ["timeout"] * n
         self._collided = 0
         self._k = 0
@@ -494,7 +494,7 @@ class Simulation:
         self._x, self._y, self._h, self._v, self._steer = kinematics.step(
             self._x, self._y, self._h, np.where(self._active, self._v, 0.0), self._steer,
             s.command[:, 0], s.command[:, 1], self.limits, self.dt, self.world.substeps)
-        self._history.append(np.stack([self._x, self._y], axis=1))
+        self._history.append((self._x, self._y))      # fresh arrays: never changed in place
 
     def _check_stuck(self) -> bool:
         """A driving robot that moved less than ``STUCK_DISTANCE`` in ``STUCK_TIME`` is stuck
@@ -502,7 +502,8 @@ class Simulation:
         history, window = self._history, self._stuck_window
         if len(history) <= window:
             return False
-        moved = np.hypot(*(history[-1] - history[-1 - window]).T)
+        (x1, y1), (x0, y0) = history[-1], history[-1 - window]
+        moved = np.hypot(x1 - x0, y1 - y0)
         stuck = self._active & (moved < STUCK_DISTANCE)
         for i in np.flatnonzero(stuck):
             self._outcomes[i] = "stuck"
