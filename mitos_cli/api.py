@@ -63,6 +63,11 @@ class LoadedRuleBase:
         self.overrides = tuple(overrides)
         self.compiled: CompiledRuleBase = compile_rulebase(rulebase, behavior, self.overrides)
 
+    def __repr__(self) -> str:
+        return (f"<LoadedRuleBase {self.rulebase.path or '(text)'}, behavior "
+                f"{self.compiled.behavior!r} of {len(self.behaviors)}: inputs "
+                f"{', '.join(self.inputs)} -> outputs {', '.join(self.outputs)}>")
+
     @property
     def inputs(self) -> tuple[str, ...]:
         return self.compiled.inputs

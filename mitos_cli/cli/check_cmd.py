@@ -91,7 +91,7 @@ def check_command(
     same condition and different actions."""
     from ..api import read_rulebase
     from ..engine.check import check_rulebase
-    from ..engine.trace import display_path
+    from ..resources import display_path
 
     rb = read_rulebase(rulebase)
     report = check_rulebase(rb, behavior, threshold=threshold, resolution=resolution)

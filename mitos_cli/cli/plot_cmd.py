@@ -102,7 +102,7 @@ def terms_command(
     --show the plot is drawn in the terminal with Unicode characters."""
     from ..api import read_rulebase
     from ..draw.data import sheet
-    from ..engine.trace import display_path
+    from ..resources import display_path
 
     path, texts = split_args(args or [])
     rulebase = read_rulebase(path)

@@ -83,6 +83,12 @@ class CompiledRuleBase:
     #: constant consequents are rows with a = 0, unset outputs are all 0.
     cons_linear: np.ndarray | None = None
 
+    def __repr__(self) -> str:   # the generated one prints every array (125,000 characters)
+        return (f"<CompiledRuleBase {self.behavior!r}: {len(self.inputs)} inputs "
+                f"({', '.join(self.inputs)}), {len(self.outputs)} outputs "
+                f"({', '.join(self.outputs)}), {self.n_rules} rules, {self.n_terms} terms, "
+                f"{len(self.levels)} levels, {self.n_columns} neurons; {self.operators.describe()}>")
+
     @property
     def kernel_columns(self) -> np.ndarray:
         """The kernel as ``[4, T, 1]`` columns, to broadcast against ``[T, b]`` blocks."""

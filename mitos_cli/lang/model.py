@@ -114,6 +114,12 @@ class RuleBase:
     operators: tuple[Setting, ...] = ()
     termset_paths: tuple[str, ...] = ()
 
+    def __repr__(self) -> str:   # the generated one spells out every rule and term
+        rules = sum(len(b.rules) for b in self.behaviors)
+        return (f"<RuleBase {self.path or '(text)'}: {len(self.behaviors)} behaviors "
+                f"({', '.join(b.name for b in self.behaviors)}), {rules} rules, "
+                f"{len(self.variables)} variables>")
+
     @property
     def variables(self) -> dict[str, Variable]:
         return {v.name: v for ts in self.termsets for v in ts.variables}

@@ -15,10 +15,11 @@ from lark import Lark, Token, Transformer, Tree, v_args
 from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken
 
 from ..errors import RuleSyntaxError, Span
+from ..fuzzy.hedges import HEDGES
 from .model import And, Behavior, Consequent, Not, Or, Prop, Rule, Setting, Use
 from ..resources import grammar_text
 
-HEDGE_NAMES = ("very", "somewhat", "more_or_less", "extremely", "seldom", "intensely", "any")
+HEDGE_NAMES = tuple(HEDGES)          # the grammar's HEDGE words (tests/test_registries.py)
 
 #: How terminals are named in error messages.
 TERMINAL_WORDS = {

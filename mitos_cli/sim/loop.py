@@ -94,6 +94,34 @@ class SimResult:
     def ticks(self) -> int:
         return len(self.t)
 
+    def __repr__(self) -> str:   # the generated one prints every array (144,000 characters)
+        m = self.metrics
+        robots = len(self.robot_outcomes)
+        return (f"<SimResult {self.world.name!r} seed {self.seed}, {self.planner}: {self.outcome} "
+                f"after {m.get('time_s', self.ticks * self.world.dt):g} s ({self.ticks} ticks"
+                f"{f', {robots} robots' if robots > 1 else ''}), path "
+                f"{m.get('path_length_in', 0.0):.1f} in, min clearance "
+                f"{m.get('min_clearance_in', 0.0):.1f} in>")
+
+    def _repr_png_(self) -> bytes | None:
+        """A notebook shows the run as ``--plot`` draws it (nothing without matplotlib)."""
+        try:
+            import io
+
+            from ..draw.world import draw_run
+        except ImportError:
+            return None
+        try:
+            fig = draw_run(self)
+        except Exception:  # noqa: BLE001 - a picture is a courtesy; the repr still shows
+            return None
+        buf = io.BytesIO()
+        fig.savefig(buf, format="png", dpi=80)
+        import matplotlib.pyplot as plt
+
+        plt.close(fig)
+        return buf.getvalue()
+
     def summary(self) -> dict:
         """The ``--json`` contract: the run's figures over all robots and, when there are
         several, each robot's under ``robots``."""
