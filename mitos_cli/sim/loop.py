@@ -250,7 +250,7 @@ class _Sensed:
     inputs: dict[str, np.ndarray]
     targets: np.ndarray
     clearance: np.ndarray
-    command: np.ndarray | None = None
+    command: np.ndarray             # [n, 2] filled by the plan stage
 
 
 class Simulation:
@@ -293,7 +293,7 @@ class Simulation:
 
     # -- set-up -----------------------------------------------------------------------------
 
-    def reset(self, seed: int | None = None) -> "Simulation":
+    def reset(self, seed: int | None = None) -> Simulation:
         """Start the run again from ``seed`` (default: the world's)."""
         world = self._given_world
         self.seed = world.seed if seed is None else int(seed)
@@ -460,7 +460,7 @@ class Simulation:
             self._expected.append(expected)
             clear[i] = _clearance(pose[i], self.robots[i], walls, boxes, centres, radii)
         return _Sensed(t, where, pose, ranges, {key: np.zeros(n) for key in perception.INPUTS},
-                       np.zeros((n, 2)), clear)
+                       np.zeros((n, 2)), clear, np.zeros((n, 2)))
 
     def _obstacles_at(self, t: float):
         """Obstacle places ``[O, 2]`` at time ``t`` and their shapes
@@ -505,7 +505,7 @@ class Simulation:
     def plan(self, s: _Sensed) -> None:
         """The planner's commands for the active robots, in one batch (the others: straight
         wheel, no speed)."""
-        cmd = np.zeros((self.n, 2))
+        cmd = s.command
         cmd[:, 0] = self.limits.straight
         if self._active.any():
             idx = np.flatnonzero(self._active)
@@ -514,7 +514,6 @@ class Simulation:
                            self._goals[idx])
             c_steer, c_speed = self.planner.plan(sub)
             cmd[idx, 0], cmd[idx, 1] = c_steer, c_speed
-        s.command = cmd
 
     def act(self, s: _Sensed) -> None:
         """Steering-rate and acceleration limits and exact arcs, substep by substep; stopped
