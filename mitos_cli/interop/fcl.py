@@ -34,6 +34,7 @@ from lark import Lark, Token, Tree
 from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken
 
 from ..fuzzy import norms
+from ..lang.cache import lark_parser
 from ..errors import FormatError, Span, did_you_mean
 from ..lang.model import And, Not, Prop, Rule, RuleBase
 from ..lang.terms import Term, Variable
@@ -63,8 +64,8 @@ JFUZZY_SHAPES = {
 def parser() -> Lark:
     from ..resources import grammar_text
 
-    return Lark(grammar_text("fcl.lark"), parser="lalr", propagate_positions=True,
-                maybe_placeholders=True, cache=True)      # grammar analysis cached on disk
+    return lark_parser(grammar_text("fcl.lark"), propagate_positions=True,
+                       maybe_placeholders=True)       # analysis kept in the private cache
 
 
 def read_fcl(path: str | Path) -> RuleBase:

@@ -29,6 +29,7 @@ from lark import Lark
 from lark.exceptions import UnexpectedInput
 
 from ..lang.resolve import MAIN
+from ..lang.cache import lark_parser
 from ..errors import FormatError, Span, did_you_mean
 from ..lang.model import Rule, RuleBase
 from ..lang.model import format_number as _fmt_weight
@@ -54,8 +55,8 @@ DEFAULT_RESOLUTION = 1000     # fuzzylite's IntegralDefuzzifier.default_resoluti
 def rule_parser() -> Lark:
     from ..resources import grammar_text
 
-    return Lark(grammar_text("fll_rule.lark"), parser="lalr", propagate_positions=True,
-                maybe_placeholders=True, cache=True)      # grammar analysis cached on disk
+    return lark_parser(grammar_text("fll_rule.lark"), propagate_positions=True,
+                       maybe_placeholders=True)       # analysis kept in the private cache
 
 
 @dataclass

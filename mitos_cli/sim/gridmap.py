@@ -50,7 +50,17 @@ def load_map_yaml(path: Path, *, unknown_occupied: bool = True,
     except (OSError, UnicodeDecodeError) as exc:
         raise WorldError(f"cannot read map file `{path}`: "
                          f"{getattr(exc, 'strerror', None) or exc}", span=where) from None
-    spec = yamlpos.load(text, str(path), WorldError)
+    # Until the file is known to be a map file, an error quotes nothing of it (docs/security.md).
+    named = path.suffix.lower() in (".yaml", ".yml")
+    try:
+        spec = yamlpos.load(text, str(path), WorldError)
+    except WorldError:
+        if named:
+            raise
+        spec = None
+    if not named and not (isinstance(spec, dict) and "image" in spec):
+        raise WorldError(f"`{path}` is not a map_server map file", span=Span(str(path), 1, 1),
+                         expected="a YAML file with `image:` and `resolution:`") from None
     spec = yamlpos.expect_map(spec, Span(str(path), 1, 1), WorldError, "a map file")
     yamlpos.check_keys(spec, MAP_KEYS, WorldError, "a map_server map file")
     what = f"map file `{path.name}`"

@@ -314,6 +314,16 @@ def load_world(path: str | Path) -> World:
     except (OSError, UnicodeDecodeError) as exc:
         raise WorldError(f"cannot read world file `{path}`: "
                          f"{getattr(exc, 'strerror', None) or exc}") from None
+    if path.suffix.lower() not in (".yaml", ".yml"):
+        # Until the file is known to be a world, an error quotes nothing of it (a lesson may
+        # name any file; docs/security.md).
+        try:
+            doc = yamlpos.load(text, str(path), WorldError)
+        except WorldError:
+            doc = None
+        if not (isinstance(doc, dict) and "map" in doc):
+            raise WorldError(f"`{path}` is not a world file", span=Span(str(path), 1, 1),
+                             expected="a YAML file with `map:` (see worlds/README.md)")
     return parse_world(text, str(path))
 
 

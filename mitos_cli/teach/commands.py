@@ -17,6 +17,7 @@ from typing import Union
 from lark import Lark, Token, Tree, v_args
 from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken
 
+from ..lang.cache import lark_parser
 from ..errors import RuleSyntaxError, Span
 from ..lang.model import Rule, Setting, Use
 from ..lang.parse import TERMINAL_WORDS, _ToModel
@@ -36,8 +37,7 @@ SHOW_WHAT = ("rules", "terms", "examples", "behaviors", "history")
 def parser() -> Lark:
     """One parser for the rule language plus the teaching commands, built once."""
     text = grammar_text("mitos.lark") + "\n" + grammar_text("teach.lark")
-    return Lark(text, parser="lalr", propagate_positions=True, maybe_placeholders=True,
-                start="command", cache=True)
+    return lark_parser(text, propagate_positions=True, maybe_placeholders=True, start="command")
 
 
 # ---- command objects -------------------------------------------------------------------------
