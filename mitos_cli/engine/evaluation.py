@@ -398,21 +398,10 @@ def evaluate_columns(compiled: CompiledRuleBase, Xt: np.ndarray, *,
         block = slice(start, min(start + BLOCK, n))
         Xc, _ = _clamp_columns(compiled, Xt[:, block], start, n)
         out[:, block] = infer(compiled, rule_dof(compiled, network_values(compiled, Xc)), Xc)
-    if np.isnan(out).any():
-        fill_defaults(compiled, out.T, _ClampedRows(compiled, Xt), strict)
+    if np.isnan(out).any():                  # rare: the clamped rows, for the message
+        rows = np.minimum(np.maximum(Xt.T, compiled.plan.lo), compiled.plan.hi) + 0.0
+        fill_defaults(compiled, out.T, rows, strict)
     return out
-
-
-class _ClampedRows:
-    """``X[row, i]`` of a batch given as columns, clamped on access (only for the message
-    about a sample no rule fired for)."""
-
-    def __init__(self, compiled: CompiledRuleBase, Xt: np.ndarray) -> None:
-        self.lo, self.hi, self.Xt = compiled.plan.lo, compiled.plan.hi, Xt
-
-    def __getitem__(self, key: tuple[int, int]) -> float:
-        row, i = key
-        return min(max(float(self.Xt[i, row]), self.lo[i]), self.hi[i]) + 0.0
 
 
 def evaluate_one(compiled: CompiledRuleBase, values: list[float],
