@@ -7,11 +7,13 @@ Run from the repository root (one command)::
 It measures, in one run, on the packaged MITOS rule base (behavior ``avoid_obstacle``, the
 paper's 27 rules):
 
-a. batch throughput on 10^6 random inputs: ``engine.evaluate`` with ``detail=True`` (memberships
-   and DOFs kept) and ``detail=False`` (outputs only), a hand-written NumPy kernel for exactly
-   this rule base, and pyfuzzylite 8's vectorized ``Engine.process()`` on the same rules;
+a. batch throughput on 10^6 random inputs (best of 10 rounds that call each in turn): ``engine.evaluate`` with ``detail=True`` (memberships
+   and DOFs kept) and ``detail=False`` (outputs only), ``load_rulebase().evaluate(**columns)``
+   (arrays by name), a hand-written NumPy kernel for exactly this rule base, and pyfuzzylite
+   8's vectorized ``Engine.process()`` on the same rules; and the peak memory NumPy allocates
+   in one call of ``evaluate(**columns)`` and of the kernel (tracemalloc);
 b. single-evaluation latency: ``load_rulebase().evaluate(road=..., size=..., position=...)``
-   (the network's scalar form, :mod:`mitos_cli.scalar`), the engine's array entry point with
+   (the network's scalar form, :mod:`mitos_cli.engine.scalar`), the engine's array entry point with
    one row (``evaluate(compiled, X[i:i+1], detail=False)``, the same scalar form plus the
    ``Result`` arrays) and with memberships and DOFs (``detail=True``: the NumPy path, what the
    trace of ``mitos eval`` uses); pyfuzzylite (set three inputs, ``process()``, read two
@@ -40,7 +42,7 @@ from pathlib import Path
 import numpy as np
 
 from mitos_cli import load_rulebase
-from mitos_cli.engine import evaluate
+from mitos_cli.engine.evaluation import evaluate
 
 SEED = 20240611
 
@@ -176,6 +178,21 @@ def simpful_system(rb):
 # ---------------------------------------------------------------------------------------------
 # timing helpers
 
+def interleaved_best(fns: dict, repeats: int) -> dict:
+    """Best time of each function over ``repeats`` rounds that call every one in turn, so a
+    machine whose load changes during the run slows each of them alike (the ratios are what
+    the benchmark reports)."""
+    for fn in fns.values():
+        fn()                                       # warm-up
+    best = {name: float("inf") for name in fns}
+    for _ in range(repeats):
+        for name, fn in fns.items():
+            t0 = time.perf_counter()
+            fn()
+            best[name] = min(best[name], time.perf_counter() - t0)
+    return best
+
+
 def best_of(fn, repeats: int) -> float:
     fn()                                           # warm-up
     times = []
@@ -197,6 +214,21 @@ def per_call(fn, args, repeats: int) -> float:
             fn(*a)
         means.append((time.perf_counter() - t0) / len(args))
     return statistics.median(means)
+
+
+def peak_memory(fn) -> int:
+    """Bytes NumPy allocated at the peak of one call (tracemalloc sees NumPy's buffers)."""
+    import tracemalloc
+
+    fn()
+    tracemalloc.start()
+    try:
+        result = fn()
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    del result
+    return peak
 
 
 def process_time(argv: list[str], runs: int) -> float:
@@ -276,9 +308,15 @@ def main() -> None:
                                        rtol=1e-12, atol=1e-9)
 
     # (a) batch throughput
-    t_detail = best_of(lambda: evaluate(c, X, detail=True), repeats)
-    t_fast = best_of(lambda: evaluate(c, X, detail=False), repeats)
-    t_kernel = best_of(lambda: kernel(X), repeats)
+    columns = {name: np.ascontiguousarray(X[:, j]) for j, name in enumerate(c.inputs)}
+    batch = interleaved_best({"detail": lambda: evaluate(c, X, detail=True),
+                              "fast": lambda: evaluate(c, X, detail=False),
+                              "kernel": lambda: kernel(X),
+                              "loaded": lambda: rb.evaluate(**columns)}, 2 * repeats)
+    t_detail, t_fast, t_kernel, t_loaded = (batch[k] for k in ("detail", "fast", "kernel",
+                                                                "loaded"))
+    mem_loaded = peak_memory(lambda: rb.evaluate(**columns))
+    mem_kernel = peak_memory(lambda: kernel(X))
 
     def fl_batch():
         fl_engine.input_values = X
@@ -286,6 +324,7 @@ def main() -> None:
         return fl_engine.output_values
     t_fl = best_of(fl_batch, max(2, repeats // 2))
     rate = {k: n / t for k, t in (("detail", t_detail), ("fast", t_fast), ("kernel", t_kernel),
+                                   ("loaded", t_loaded),
                                    ("fl", t_fl))}
 
     # (b) single-evaluation latency
@@ -322,7 +361,7 @@ def main() -> None:
     print(f"# MITOS core benchmark ({time.strftime('%Y-%m-%d')})")
     print(f"machine: {host}")
     print(f"command: python benchmarks/bench_core.py{' --quick' if args.quick else ''}")
-    print(f"batch: {n:,} random inputs, best of {repeats} after a warm-up; single: median of "
+    print(f"batch: {n:,} random inputs, best of {2 * repeats} interleaved rounds after a warm-up; single: median of "
           f"{repeats} repeats of the mean over {single_n} (MITOS) / {len(pts[:max(50, single_n // 4)])}"
           f" (peers) calls; process: median of {runs} runs\n")
     print("| measurement | figure | ratio |")
@@ -333,7 +372,11 @@ def main() -> None:
     print(f"| MITOS batch, `evaluate(detail=False)` | {fmt_rate(rate['fast'])} eval/s | "
           f"{rate['fast'] / rate['kernel']:.2f}x the hand-written kernel, "
           f"{rate['fast'] / rate['fl']:.0f}x pyfuzzylite |")
+    print(f"| MITOS batch, `load_rulebase().evaluate(**columns)` | {fmt_rate(rate['loaded'])} "
+          f"eval/s | {rate['loaded'] / rate['kernel']:.2f}x the hand-written kernel |")
     print(f"| hand-written NumPy kernel (this rule base) | {fmt_rate(rate['kernel'])} eval/s | |")
+    print(f"| peak extra memory, `load_rulebase().evaluate(**columns)` | {mem_loaded / 1e6:.1f} MB "
+          f"| {mem_loaded / mem_kernel:.2f}x the kernel's {mem_kernel / 1e6:.1f} MB |")
     print(f"| pyfuzzylite {_version('fuzzylite')} vectorized `process()` | "
           f"{fmt_rate(rate['fl'])} eval/s | |")
     print(f"| MITOS single, `load_rulebase().evaluate(...)` | {fmt_time(lat_mitos)} | "

@@ -35,7 +35,7 @@ ROOT = Path(__file__).parents[1]
 sys.path.insert(0, str(ROOT))
 
 from mitos_cli.api import load_rulebase, read_rulebase  # noqa: E402
-from mitos_cli.engine import evaluate  # noqa: E402
+from mitos_cli.engine.evaluation import evaluate  # noqa: E402
 from mitos_cli.interop import write_foreign  # noqa: E402
 from mitos_cli.interop.export import to_c, to_python  # noqa: E402
 

@@ -81,7 +81,7 @@ def mamdani_files(tmp: Path, resolution: int) -> Path:
 
 def fuzzylite_engine(compiled, conjunction: str, mamdani: bool):
     import fuzzylite as fl
-    from mitos_cli.model import format_rule
+    from mitos_cli.lang.model import format_rule
 
     lines = ["Engine: bench"]
     for name in compiled.inputs:
@@ -117,8 +117,8 @@ def skfuzzy_system(compiled):
     import skfuzzy as fuzz
     from skfuzzy import control as ctrl
 
-    from mitos_cli.mamdani import grid
-    from mitos_cli.model import And, Prop
+    from mitos_cli.engine.mamdani import grid
+    from mitos_cli.lang.model import And, Prop
 
     def mf(universe, term):
         a, b, c, d = corners(term)
@@ -183,9 +183,9 @@ def main() -> None:
     import fuzzylite as fl
 
     from mitos_cli.api import load_rulebase, read_rulebase
-    from mitos_cli.compile import compile_rulebase
-    from mitos_cli.engine import evaluate
-    from mitos_cli.model import Setting
+    from mitos_cli.engine.compile import compile_rulebase
+    from mitos_cli.engine.evaluation import evaluate
+    from mitos_cli.lang.model import Setting
 
     print(f"machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
           f"Python {platform.python_version()}, NumPy {np.__version__}, "

@@ -10,7 +10,11 @@ time of ``--runs 100`` on one and two worker processes.
    same corridor without its obstacle (the constant planner would hit it), and the planner's
    share of the tick measured by timing ``plan`` inside the loop. Times are wall times; the
    CPU time of the process is printed too (it is what a loaded machine distorts least).
-2. **--runs 100** of ``slalom.yaml`` (randomised obstacles and noise) through ``run_many`` with
+2. **one run of ``slalom.yaml`` and of ``office.yaml``** (their own seeds, to the goal): ticks per
+   second of CPU time (best of 5) against the aim of 5,000, and where a tick's time goes:
+   each stage of :class:`~mitos_cli.sim.loop.Simulation` (sense, perceive, check, plan, act,
+   recording and the stuck check) timed inside the loop.
+3. **--runs 100** of ``slalom.yaml`` (randomised obstacles and noise) through ``run_many`` with
    1 and 2 workers; the two must give identical results.
 """
 
@@ -27,7 +31,7 @@ import numpy as np
 from mitos_cli.resources import packaged_path
 from mitos_cli.sim.planner import FuzzyPlanner
 from mitos_cli.sim.runs import run_many
-from mitos_cli.sim.loop import prepare, simulate
+from mitos_cli.sim.loop import Simulation, prepare, simulate
 from mitos_cli.sim.world import Corridor, Goal
 from mitos_cli.sim.worldfile import load_world
 
@@ -43,6 +47,55 @@ class Timed:
         out = self.inner.plan(percepts)
         self.seconds += time.perf_counter() - t
         return out
+
+
+STAGES = ("sense", "perceive", "check", "plan", "act", "_record", "_check_stuck")
+
+
+class StageTimed(Simulation):
+    """A :class:`Simulation` that adds up the wall time of each stage."""
+
+    seconds: dict[str, float]
+
+
+def _timed_stage(name: str):
+    inner = getattr(Simulation, name)
+
+    def stage(self, *args):
+        t = time.perf_counter()
+        out = inner(self, *args)
+        self.seconds[name] = self.seconds.get(name, 0.0) + time.perf_counter() - t
+        return out
+    return stage
+
+
+for _name in STAGES:
+    setattr(StageTimed, _name, _timed_stage(_name))
+
+
+def one_run(world, planner, repeats: int = 5) -> None:
+    """Ticks per second of one run (CPU time, best of ``repeats``) and the stages' shares."""
+    scene = prepare(world)
+    simulate(world, planner, scene=scene)                 # warm-up
+    best_cpu, ticks = min((_cpu_of(world, planner, scene) for _ in range(repeats)))
+    sim = StageTimed(world, planner, scene=scene)
+    sim.seconds = {}
+    t = time.perf_counter()
+    while not sim.done:
+        sim.step()
+    total = time.perf_counter() - t
+    shares = ", ".join(f"{name.strip('_')} {1e6 * sim.seconds[name] / sim.ticks:.0f} us "
+                       f"({100 * sim.seconds[name] / total:.0f}%)" for name in STAGES)
+    print(f"   {world.name}: {ticks} ticks, {ticks / best_cpu:,.0f} ticks/s "
+          f"({1e6 * best_cpu / ticks:.0f} us/tick, CPU, best of {repeats}; aim 5,000: "
+          f"{ticks / best_cpu / 5000:.2f}x)")
+    print(f"     per tick: {shares}; loop total {1e6 * total / sim.ticks:.0f} us (wall)")
+
+
+def _cpu_of(world, planner, scene) -> tuple[float, int]:
+    c = time.process_time()
+    res = simulate(world, planner, scene=scene)
+    return time.process_time() - c, res.ticks
 
 
 class Constant:
@@ -106,7 +159,11 @@ def main() -> None:
     print(f"   ratio fuzzy / constant loop (no obstacle, CPU): {fcpu / ccpu:.2f}x")
 
     slalom = load_world(packaged_path("worlds", "slalom.yaml"))
-    print("\n2. --runs 100 of slalom.yaml")
+    print("\n2. one run, where the time goes")
+    for name in ("slalom.yaml", "office.yaml"):
+        one_run(load_world(packaged_path("worlds", name)), fuzzy)
+
+    print("\n3. --runs 100 of slalom.yaml")
     walls = {}
     results = {}
     for workers in (1, 2):

@@ -35,8 +35,8 @@ from pathlib import Path
 import numpy as np
 
 from mitos_cli import load_rulebase
-from mitos_cli.compile import compile_rulebase
-from mitos_cli.model import Setting
+from mitos_cli.engine.compile import compile_rulebase
+from mitos_cli.lang.model import Setting
 from mitos_cli.teach.adapt import adapt, gradient, loss, parameterise, with_values
 
 SEED = 20240611

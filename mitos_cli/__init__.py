@@ -2,9 +2,12 @@
 
 from __future__ import annotations
 
-__version__ = "0.1.0"
+from . import _moved
+from ._version import __version__
 
 __all__ = ["__version__", "load_rulebase"]
+
+_moved.install()   # 0.1's module paths, for one release (mitos_cli/_moved.py)
 
 
 def __getattr__(name: str):

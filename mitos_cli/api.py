@@ -13,11 +13,12 @@ from pathlib import Path
 
 import numpy as np
 
-from .compile import CompiledRuleBase, compile_rulebase
-from .engine import Result, as_batch, evaluate, evaluate_one
-from .model import RuleBase
+from .engine.compile import CompiledRuleBase, compile_rulebase
+from .engine.evaluation import (Result, as_batch, as_columns, evaluate, evaluate_columns,
+                                evaluate_one)
+from .lang.model import RuleBase
 from .resources import DEFAULT_RULEBASE, packaged_path
-from .trace import Trace, trace_of
+from .engine.trace import Trace, trace_of
 
 
 def default_rulebase_path() -> Path:
@@ -42,13 +43,13 @@ def read_rulebase(path: str | Path | None = None) -> RuleBase:
         from .interop import read_foreign
 
         return read_foreign(path)
-    from .cache import cached_rulebase
+    from .lang.cache import cached_rulebase
 
     return cached_rulebase(path, _load_rules_file)
 
 
 def _load_rules_file(path: Path) -> RuleBase:
-    from .build import load_rules_file      # the parser (Lark) and YAML load only on a miss
+    from .lang.resolve import load_rules_file      # the parser (Lark) and YAML load only on a miss
 
     return load_rules_file(path)
 
@@ -61,6 +62,11 @@ class LoadedRuleBase:
         self.rulebase = rulebase
         self.overrides = tuple(overrides)
         self.compiled: CompiledRuleBase = compile_rulebase(rulebase, behavior, self.overrides)
+
+    def __repr__(self) -> str:
+        return (f"<LoadedRuleBase {self.rulebase.path or '(text)'}, behavior "
+                f"{self.compiled.behavior!r} of {len(self.behaviors)}: inputs "
+                f"{', '.join(self.inputs)} -> outputs {', '.join(self.outputs)}>")
 
     @property
     def inputs(self) -> tuple[str, ...]:
@@ -82,7 +88,7 @@ class LoadedRuleBase:
     def with_operators(self, **settings: str) -> "LoadedRuleBase":
         """The same behavior compiled with other operators, e.g. ``with_operators(and_="product")``
         (keys as in an ``operators:`` line; a trailing underscore is dropped)."""
-        from .model import Setting
+        from .lang.model import Setting
 
         extra = tuple(Setting(k.rstrip("_"), str(v)) for k, v in settings.items())
         return LoadedRuleBase(self.rulebase, self.compiled.behavior, self.overrides + extra)
@@ -101,11 +107,12 @@ class LoadedRuleBase:
                 pass                           # a misspelt name: as_batch explains it
             else:
                 return dict(zip(c.outputs, evaluate_one(c, values)))
-        X = as_batch(self.compiled, inputs)
-        result = evaluate(self.compiled, X, detail=False)
-        if X.shape[0] == 1 and all(np.ndim(v) == 0 for v in inputs.values()):
-            return dict(zip(self.compiled.outputs, result.outputs[0].tolist()))
-        return {name: result.outputs[:, j] for j, name in enumerate(self.compiled.outputs)}
+        Xt = as_columns(c, inputs)
+        if Xt.shape[1] == 1 and all(np.ndim(v) == 0 for v in inputs.values()):
+            result = evaluate(c, Xt.T, detail=False)
+            return dict(zip(c.outputs, result.outputs[0].tolist()))
+        out = evaluate_columns(c, Xt)
+        return {name: out[j] for j, name in enumerate(c.outputs)}
 
     def trace(self, **inputs) -> Trace:
         """The paper-style DOF trace of one evaluation."""

@@ -52,3 +52,23 @@ def resolve(kind: str, name: str | Path, suffix: str) -> Path | None:
         if (data_dir(kind) / candidate).is_file():
             return packaged_path(kind, candidate)
     return None
+
+
+def display_path(path: str | None) -> str:
+    """A rule-base path as users should read it: relative to here, or marked as packaged."""
+    import os
+    from pathlib import Path
+
+    if not path:
+        return "<rules>"
+    p = Path(path).resolve()
+    try:
+        packaged = Path(str(data_dir("rulebases"))).resolve()
+        if p.is_relative_to(packaged):
+            return f"rulebases/{p.relative_to(packaged).as_posix()} (packaged)"
+    except (OSError, ValueError):
+        pass
+    try:
+        return os.path.relpath(p)
+    except ValueError:
+        return str(path)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from hypothesis import strategies as st
 
-from mitos_cli.model import And, Not, Or, Prop
+from mitos_cli.lang.model import And, Not, Or, Prop
 
 
 @st.composite

@@ -38,9 +38,9 @@ import pytest
 
 fl = pytest.importorskip("fuzzylite")
 
-from mitos_cli import norms  # noqa: E402
+from mitos_cli.fuzzy import norms  # noqa: E402
 from mitos_cli.api import load_rulebase  # noqa: E402
-from mitos_cli.engine import evaluate  # noqa: E402
+from mitos_cli.engine.evaluation import evaluate  # noqa: E402
 
 FL_TNORM = {"min": "Minimum", "product": "AlgebraicProduct", "lukasiewicz": "BoundedDifference",
             "drastic": "DrasticProduct", "einstein": "EinsteinProduct",
@@ -236,7 +236,7 @@ def test_mamdani_defuzzifiers(tmp_path, implication, defuzzify):
 def test_differences_are_the_documented_ones(tmp_path):
     # extremely: fuzzylite's contrast intensifier vs MITOS's cube
     x = np.array([0.2, 0.5, 0.8])
-    from mitos_cli.hedges import HEDGES
+    from mitos_cli.fuzzy.hedges import HEDGES
 
     assert np.allclose(fl.Extremely().hedge(x), [0.08, 0.5, 0.92])
     assert np.allclose(HEDGES["extremely"].fn(x), x ** 3)

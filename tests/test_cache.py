@@ -8,8 +8,9 @@ from pathlib import Path
 
 import pytest
 
-from mitos_cli import api, cache
-from mitos_cli.build import load_rules_file
+from mitos_cli import api
+from mitos_cli.lang import cache
+from mitos_cli.lang.resolve import load_rules_file
 
 REPO = Path(__file__).resolve().parents[1]
 

@@ -20,7 +20,7 @@ import numpy as np
 import pytest
 
 from mitos_cli import load_rulebase
-from mitos_cli.batch import read_batch
+from mitos_cli.engine.csvio import read_batch
 from mitos_cli.cli.app import main
 
 ROOT = Path(__file__).resolve().parents[1]

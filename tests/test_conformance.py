@@ -18,8 +18,8 @@ import numpy as np
 import pytest
 
 from mitos_cli.api import read_rulebase
-from mitos_cli.compile import compile_rulebase
-from mitos_cli.engine import evaluate
+from mitos_cli.engine.compile import compile_rulebase
+from mitos_cli.engine.evaluation import evaluate
 from mitos_cli.errors import FormatError
 
 DATA = Path(__file__).parent / "data" / "interop"

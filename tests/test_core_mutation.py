@@ -16,9 +16,9 @@ import numpy as np
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from mitos_cli.build import load_rules_file
-from mitos_cli.compile import compile_rulebase
-from mitos_cli.engine import evaluate
+from mitos_cli.lang.resolve import load_rules_file
+from mitos_cli.engine.compile import compile_rulebase
+from mitos_cli.engine.evaluation import evaluate
 from mitos_cli.errors import MitosError
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -9,12 +9,12 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from mitos_cli import compile as compile_mod
-from mitos_cli.build import build_rulebase
-from mitos_cli.compile import compile_rulebase
-from mitos_cli.engine import evaluate
-from mitos_cli.parse import parse_rules
-from mitos_cli.termset import parse_termset
+from mitos_cli.engine import compile as compile_mod
+from mitos_cli.lang.resolve import build_rulebase
+from mitos_cli.engine.compile import compile_rulebase
+from mitos_cli.engine.evaluation import evaluate
+from mitos_cli.lang.parse import parse_rules
+from mitos_cli.lang.termfile import parse_termset
 
 TERMS = """
 variables:
@@ -68,7 +68,7 @@ def test_partial_grid_falls_back():
 
 @pytest.mark.parametrize("op", ["product", "lukasiewicz"])
 def test_grid_only_for_min(op):
-    from mitos_cli.model import Setting
+    from mitos_cli.lang.model import Setting
 
     rb = rulebase(("a", "c"), {"a": VARS["a"], "c": VARS["c"]}, ("a", "c"))
     assert not compile_rulebase(rb, overrides=(Setting("and", op),)).plan.grids

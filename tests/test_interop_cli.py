@@ -175,10 +175,10 @@ def test_fis_reader_matches_fuzzylites_copy_of_the_same_system() -> None:
 
     if EXAMPLES is None:
         pytest.skip("pyfuzzylite is not installed")
-    from mitos_cli.compile import compile_rulebase
-    from mitos_cli.engine import evaluate
-    from mitos_cli.model import Setting
-    from mitos_cli.model import RuleBase
+    from mitos_cli.engine.compile import compile_rulebase
+    from mitos_cli.engine.evaluation import evaluate
+    from mitos_cli.lang.model import Setting
+    from mitos_cli.lang.model import RuleBase
 
     rb = read_rulebase(DATA / "tipper.fis")
     fuzzylite_ops = tuple(s for s in rb.operators if s.key not in ("resolution", "sampling")) + (

@@ -14,12 +14,12 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from mitos_cli.api import read_rulebase
-from mitos_cli.compile import compile_rulebase
-from mitos_cli.engine import evaluate
+from mitos_cli.engine.compile import compile_rulebase
+from mitos_cli.engine.evaluation import evaluate
 from mitos_cli.interop import write_foreign
 from mitos_cli.interop.rules_writer import write_rules
-from mitos_cli.model import Behavior, Consequent, Not, Prop, Rule, RuleBase, Setting
-from mitos_cli.terms import Term, TermSet, Variable
+from mitos_cli.lang.model import Behavior, Consequent, Not, Prop, Rule, RuleBase, Setting
+from mitos_cli.lang.terms import Term, TermSet, Variable
 from strategies import expressions
 
 SHAPES = {   # shape -> params on the universe [0, 10] drawn from sorted uniforms

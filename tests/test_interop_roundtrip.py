@@ -16,8 +16,8 @@ import numpy as np
 import pytest
 
 from mitos_cli.api import read_rulebase
-from mitos_cli.compile import compile_rulebase
-from mitos_cli.engine import evaluate
+from mitos_cli.engine.compile import compile_rulebase
+from mitos_cli.engine.evaluation import evaluate
 from mitos_cli.errors import FormatError
 from mitos_cli.interop import conversion_notes, write_foreign
 from mitos_cli.interop.rules_writer import write_rules

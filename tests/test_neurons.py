@@ -9,11 +9,11 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from mitos_cli import neurons, norms
+from mitos_cli.fuzzy import neurons, norms
 from mitos_cli.api import load_rulebase, read_rulebase
-from mitos_cli.compile import compile_rulebase
-from mitos_cli.engine import network_values
-from mitos_cli.model import Setting
+from mitos_cli.engine.compile import compile_rulebase
+from mitos_cli.engine.evaluation import network_values
+from mitos_cli.lang.model import Setting
 
 FAST = settings(max_examples=60, deadline=None)
 dyadic = st.integers(0, 2 ** 20).map(lambda k: k / 2 ** 20)

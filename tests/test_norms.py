@@ -19,7 +19,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from mitos_cli import norms
+from mitos_cli.fuzzy import norms
 
 TOL = 1e-12
 FAST = settings(max_examples=60, deadline=None)   # 14 norms x 9 laws: keep the suite quick

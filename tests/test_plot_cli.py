@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from mitos_cli import plotdata
+from mitos_cli.draw import data as plotdata
 from mitos_cli.api import load_rulebase
 from mitos_cli.cli.app import main
 
@@ -262,7 +262,7 @@ def test_imported_pictures_and_data(path, tmp_path, capsys):
     columns[rb.inputs[0]] = grid[0].ravel()
     if y:
         columns[y] = grid[1].ravel()
-    from mitos_cli.engine import as_batch, evaluate
+    from mitos_cli.engine.evaluation import as_batch, evaluate
 
     expected = evaluate(rb.compiled, as_batch(rb.compiled, columns), strict=False).output(out)
     np.testing.assert_array_equal(s.z.ravel(), expected)      # NaN (no rule) included

@@ -1,4 +1,4 @@
-"""What the pictures show (mitos_cli.plotdata), checked against the engine, without matplotlib:
+"""What the pictures show (mitos_cli.draw.data), checked against the engine, without matplotlib:
 term curves are the memberships, a surface grid is the engine's outputs at the same points,
 the rule viewer's rows are the rules and DOFs that `mitos eval` reports."""
 
@@ -9,10 +9,12 @@ import json
 import numpy as np
 import pytest
 
-from mitos_cli import mamdani, norms, plotdata
+from mitos_cli.engine import mamdani
+from mitos_cli.fuzzy import norms
+from mitos_cli.draw import data as plotdata
 from mitos_cli.api import load_rulebase
 from mitos_cli.cli.app import main
-from mitos_cli.engine import as_batch, evaluate
+from mitos_cli.engine.evaluation import as_batch, evaluate
 from mitos_cli.errors import InputError
 
 SAMPLE = {"road": 78.0, "size": 45.0, "position": 4.0}
@@ -160,7 +162,7 @@ def test_value_outside_universe_is_clamped_and_flagged(mitos):
 
 
 def test_linear_formula():
-    from mitos_cli.terms import Term
+    from mitos_cli.lang.terms import Term
 
     term = Term("T", "linear", (0.5, -1.0, 0.0, 90.0))
     assert plotdata.linear_formula(term, ("road", "size", "position")) == \

@@ -1,4 +1,4 @@
-"""The scalar form of the network (mitos_cli.scalar): one sample gives the same bits as its row
+"""The scalar form of the network (mitos_cli.engine.scalar): one sample gives the same bits as its row
 in a NumPy batch, for random rule bases over every norm, hedge and consequent kind it covers;
 what it does not cover falls back to the NumPy path, which explains bad input as before."""
 
@@ -10,13 +10,13 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from mitos_cli import load_rulebase
-from mitos_cli.compile import compile_rulebase
-from mitos_cli.engine import evaluate, evaluate_one
+from mitos_cli.engine.compile import compile_rulebase
+from mitos_cli.engine.evaluation import evaluate, evaluate_one
 from mitos_cli.errors import InputError, NoRuleFiredError
-from mitos_cli.model import Behavior, Consequent, Prop, Rule, RuleBase, Setting, Use
-from mitos_cli.norms import SNORMS, TNORMS
-from mitos_cli.scalar import HEDGES, NORMS
-from mitos_cli.terms import Term, TermSet, Variable
+from mitos_cli.lang.model import Behavior, Consequent, Prop, Rule, RuleBase, Setting, Use
+from mitos_cli.fuzzy.norms import SNORMS, TNORMS
+from mitos_cli.engine.scalar import HEDGES, NORMS
+from mitos_cli.lang.terms import Term, TermSet, Variable
 from strategies import expressions
 
 HEDGE_NAMES = tuple(sorted(HEDGES))

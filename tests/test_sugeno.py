@@ -8,10 +8,10 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from mitos_cli.api import load_rulebase
-from mitos_cli.engine import evaluate
+from mitos_cli.engine.evaluation import evaluate
 from mitos_cli.errors import RuleBaseError, TermSetError
-from mitos_cli.shapes import SHAPES, linear
-from mitos_cli.termset import parse_termset
+from mitos_cli.fuzzy.shapes import SHAPES, linear
+from mitos_cli.lang.termfile import parse_termset
 
 TERMS = """\
 variables:

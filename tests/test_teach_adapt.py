@@ -6,14 +6,14 @@ import numpy as np
 import pytest
 
 from mitos_cli.api import load_rulebase
-from mitos_cli.build import build_rulebase
-from mitos_cli.compile import compile_rulebase
-from mitos_cli.engine import evaluate
+from mitos_cli.lang.resolve import build_rulebase
+from mitos_cli.engine.compile import compile_rulebase
+from mitos_cli.engine.evaluation import evaluate
 from mitos_cli.errors import LessonError
-from mitos_cli.parse import parse_rules
+from mitos_cli.lang.parse import parse_rules
 from mitos_cli.teach.adapt import (adapt, feasible, gradient, learned_rulebase, loss,
                                    parameterise, with_values)
-from mitos_cli.termset import parse_termset
+from mitos_cli.lang.termfile import parse_termset
 
 TERMS = """
 variables:

@@ -7,7 +7,7 @@ from pathlib import Path
 import pytest
 
 from mitos_cli.api import default_rulebase_path
-from mitos_cli.build import load_rules_file
+from mitos_cli.lang.resolve import load_rules_file
 from mitos_cli.resources import data_dir
 
 ROOT = Path(__file__).resolve().parent.parent

@@ -5,14 +5,14 @@ frozen things stay, the same run gives the same bits; and a session adapts and s
 import numpy as np
 import pytest
 
-from mitos_cli.build import build_rulebase
-from mitos_cli.compile import compile_rulebase
-from mitos_cli.engine import evaluate
-from mitos_cli.parse import parse_rules
+from mitos_cli.lang.resolve import build_rulebase
+from mitos_cli.engine.compile import compile_rulebase
+from mitos_cli.engine.evaluation import evaluate
+from mitos_cli.lang.parse import parse_rules
 from mitos_cli.teach.adapt import (adapt, descent_direction, difference_steps, feasible,
                                    gradient, learned_rulebase, loss, parameterise, with_values)
 from mitos_cli.teach.session import Session
-from mitos_cli.termset import parse_termset
+from mitos_cli.lang.termfile import parse_termset
 
 TERMS = """
 variables:

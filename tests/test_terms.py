@@ -7,7 +7,7 @@ import re
 
 import pytest
 
-from mitos_cli.termset import parse_termset
+from mitos_cli.lang.termfile import parse_termset
 
 TERMS = {
     "PW": ("{shape: triangle, peak: 70, width: 30}", "triangle", "peak 70, width 30"),

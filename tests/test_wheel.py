@@ -16,7 +16,7 @@ from pathlib import Path
 import mitos_cli
 from mitos_cli import load_rulebase
 from mitos_cli.api import default_rulebase_path
-from mitos_cli.parse import parse_rule
+from mitos_cli.lang.parse import parse_rule
 from mitos_cli.resources import data_dir, grammar_text
 
 rb = load_rulebase()

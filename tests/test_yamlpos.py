@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from mitos_cli import yamlpos
+from mitos_cli.lang import yamlpos
 from mitos_cli.errors import TermSetError
 
 

@@ -35,7 +35,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
 
 def _show_version(value: bool) -> None:
     if value:
-        from .. import __version__
+        from .._version import __version__
 
         print(f"mitos {__version__}")
         raise typer.Exit()

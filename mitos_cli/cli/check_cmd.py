@@ -90,8 +90,8 @@ def check_command(
     an error: inputs where no rule sets an output that has no default, or rules with the
     same condition and different actions."""
     from ..api import read_rulebase
-    from ..check import check_rulebase
-    from ..trace import display_path
+    from ..engine.check import check_rulebase
+    from ..resources import display_path
 
     rb = read_rulebase(rulebase)
     report = check_rulebase(rb, behavior, threshold=threshold, resolution=resolution)

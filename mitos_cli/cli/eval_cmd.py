@@ -79,7 +79,7 @@ def eval_command(
                                  f"of that name; write each input as NAME=VALUE)")
     rb = load_rulebase(path, behavior)
     if network:
-        from ..network import describe_network
+        from ..engine.describe import describe_network
 
         emit(describe_network(rb.compiled))
         return
@@ -94,8 +94,8 @@ def eval_command(
     if not values:
         raise typer.BadParameter(
             "give one NAME=VALUE per input: " + " ".join(f"{k}=..." for k in rb.inputs))
-    from ..engine import as_batch, evaluate
-    from ..trace import trace_of
+    from ..engine.evaluation import as_batch, evaluate
+    from ..engine.trace import trace_of
 
     result = evaluate(rb.compiled, as_batch(rb.compiled, parse_values(values)))
     warn_clamped(result)
@@ -110,7 +110,7 @@ def run_batch(rb, source: str) -> None:
     """Read the CSV, evaluate all rows as one batch, write inputs and outputs as CSV."""
     import numpy as np
 
-    from ..batch import read_batch, write_batch
+    from ..engine.csvio import read_batch, write_batch
 
     if source == "-":
         text, name = sys.stdin.read(), "<stdin>"

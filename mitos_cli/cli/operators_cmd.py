@@ -34,9 +34,9 @@ DEFUZZIFY = {
 
 def catalogue() -> dict[str, list[dict]]:
     """Every operator by setting key: name, formula, aliases, default, dual."""
-    from .. import norms
-    from ..hedges import HEDGES
-    from ..operators import Operators
+    from ..fuzzy import norms
+    from ..fuzzy.hedges import HEDGES
+    from ..lang.operators import Operators
 
     d = Operators()
 
@@ -70,7 +70,7 @@ TITLES = {
 
 
 def render(cat: dict[str, list[dict]]) -> str:
-    from ..operators import Operators
+    from ..lang.operators import Operators
 
     lines = ["The paper's defaults: and = min, or = max, inference = weighted_average "
              "(eqs. 17-19)."]

@@ -101,8 +101,8 @@ def terms_command(
     All variables on one sheet (the paper's Figures 5-9) unless --var picks some. Without -o or
     --show the plot is drawn in the terminal with Unicode characters."""
     from ..api import read_rulebase
-    from ..plotdata import sheet
-    from ..trace import display_path
+    from ..draw.data import sheet
+    from ..resources import display_path
 
     path, texts = split_args(args or [])
     rulebase = read_rulebase(path)
@@ -112,7 +112,7 @@ def terms_command(
             lo, hi = p.universe
             warn(f"`{p.name}` outside its universe [{lo:g}, {hi:g}] was clamped")
     if not _wants_picture(output, show):
-        from ..termplot import render_sheet
+        from ..draw.terminal import render_sheet
 
         if width is None:
             import shutil
@@ -213,7 +213,7 @@ def surface_command(
     The grid is computed in one batch. Without -o or --show the surface is printed as a table
     of output values ("-" where no rule fires and the output has no default)."""
     from ..api import load_rulebase
-    from ..plotdata import surface
+    from ..draw.data import surface
 
     path, out_name = _surface_args(args or [])
     rb = load_rulebase(path, behavior)
@@ -228,7 +228,7 @@ def surface_command(
     for note in s.notes():
         err(f"note: {note}")
     if not _wants_picture(output, show):
-        from ..termplot import render_surface
+        from ..draw.terminal import render_surface
 
         emit(render_surface(s))
         return
@@ -256,7 +256,7 @@ def rules_command(
     For one input: every fired rule as a row, each output's aggregate and crisp result. Without
     -o or --show the viewer is printed as text with bars."""
     from ..api import load_rulebase
-    from ..plotdata import rule_view
+    from ..draw.data import rule_view
 
     path, texts = split_args(args or [])
     rb = load_rulebase(path, behavior)
@@ -269,7 +269,7 @@ def rules_command(
             lo, hi = i.universe
             warn(f"`{i.name}` outside its universe [{lo:g}, {hi:g}] was clamped")
     if not _wants_picture(output, show):
-        from ..termplot import render_rule_view
+        from ..draw.terminal import render_rule_view
 
         emit(render_rule_view(view))
         return

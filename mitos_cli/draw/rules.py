@@ -1,5 +1,5 @@
 """The rule viewer: one input, every fired rule as a row (MATLAB's ``ruleview``, drawn from a
-:class:`~mitos_cli.plotdata.RuleView`).
+:class:`~mitos_cli.draw.data.RuleView`).
 
 Columns are the inputs the fired rules test, then the outputs. In a rule's row, an input cell
 shows the term the rule tests (after hedges and ``not``) with the part up to its membership
@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..plotdata import OutputView, RuleRow, RuleView
+from .data import OutputView, RuleRow, RuleView
 from .output import finish, new_figure
 from ..words import plural
 

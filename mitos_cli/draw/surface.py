@@ -1,5 +1,5 @@
 """Control surfaces: an output over two inputs (3-D surface or heat map with contours), or
-over one input (a curve), from a :class:`~mitos_cli.plotdata.Surface`.
+over one input (a curve), from a :class:`~mitos_cli.draw.data.Surface`.
 
 Where no rule sets the output and it has no default, the surface is NaN: drawn as a hatched,
 blank region with a legend entry saying so, never as a made-up number.
@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..plotdata import Surface
+from .data import Surface
 from .output import finish, new_figure
 
 STYLES = ("surface", "heatmap")

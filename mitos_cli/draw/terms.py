@@ -1,6 +1,6 @@
 """Membership plots: every term of a variable over its universe (the paper's Figures 5-9).
 
-:func:`draw_sheet` draws :class:`~mitos_cli.plotdata.VariablePlot` objects, one panel per
+:func:`draw_sheet` draws :class:`~mitos_cli.draw.data.VariablePlot` objects, one panel per
 variable (inputs first); :func:`draw_terms_before_after` shows how teaching moved the terms of
 one variable. matplotlib is imported only inside these functions (through
 :mod:`mitos_cli.draw.output`), never at import time.
@@ -14,8 +14,8 @@ from typing import Sequence
 
 import numpy as np
 
-from ..plotdata import VariablePlot, variable_plot, visible
-from ..terms import Variable
+from .data import VariablePlot, variable_plot, visible
+from ..lang.terms import Variable
 from .output import finish, new_figure
 
 #: term colours (matplotlib's tab10, colour-blind friendlier than the default cycle's order)
@@ -179,7 +179,7 @@ def draw_terms_before_after(variable_before: Variable, variable_after: Variable,
                             show: bool = False):
     """Show how adaptation moved the terms of one variable.
 
-    ``variable_before`` and ``variable_after`` are :class:`mitos_cli.terms.Variable` objects
+    ``variable_before`` and ``variable_after`` are :class:`mitos_cli.lang.terms.Variable` objects
     of the same variable (e.g. ``loaded.rulebase.variables["road"]`` before and after
     ``teach``); ``path`` is the file to write (``.png`` or ``.svg``, chosen by extension;
     ``None`` writes nothing). Before is drawn dashed and faint, after solid, each term in its

@@ -2,7 +2,7 @@
 fuzzylite's dialects), MATLAB ``.fis``, fuzzylite FLL, and the MITOS rule language itself.
 
 ``read_foreign(path)`` chooses the reader by extension and returns the same
-:class:`~mitos_cli.model.RuleBase` the rule language produces; ``write_foreign(rb, fmt)``
+:class:`~mitos_cli.lang.model.RuleBase` the rule language produces; ``write_foreign(rb, fmt)``
 writes one behavior in a format. What a format can say but MITOS cannot compute is refused with
 a :class:`~mitos_cli.errors.FormatError` at ``file:line`` naming the construct.
 """
@@ -12,7 +12,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..errors import FormatError
-from ..model import RuleBase
+from ..lang.model import RuleBase
 
 READERS = {".fcl": "fcl", ".fis": "fis", ".fll": "fll"}
 FORMATS = ("fcl", "fis", "fll")
@@ -60,7 +60,7 @@ def write_foreign(rb: RuleBase, fmt: str, behavior: str | None = None) -> str:
 def conversion_notes(rb: RuleBase, fmt: str, behavior: str | None = None) -> list[str]:
     """What writing ``rb`` as ``fmt`` (``rules`` included) leaves out or changes; the file is
     written anyway and ``mitos convert`` prints these as warnings."""
-    from ..operators import resolve
+    from ..lang.operators import resolve
 
     b = rb.behavior(behavior)
     out = []

@@ -1,6 +1,6 @@
 """What the three foreign formats share: name tables, term construction, assembling a RuleBase.
 
-Every reader turns its file into MITOS's own model (:class:`~mitos_cli.model.RuleBase` with one
+Every reader turns its file into MITOS's own model (:class:`~mitos_cli.lang.model.RuleBase` with one
 term set and one behavior ``main``), so ``eval``, ``check``, ``simulate`` and ``teach`` never
 know where a rule base came from. The tables below are the single place where a foreign name
 (``AlgebraicProduct``, ``prod``, ``PROD``) meets MITOS's (``product``); writers use them in the
@@ -14,12 +14,12 @@ import math
 from dataclasses import dataclass
 from pathlib import Path
 
-from .. import operators as ops_mod
-from ..build import MAIN, check_rule
+from ..lang import operators as ops_mod
+from ..lang.resolve import MAIN, check_rule
 from ..errors import FormatError, MitosError, Span, did_you_mean
-from ..model import And, Behavior, Consequent, Expr, Not, Or, Prop, Rule, RuleBase, Setting
-from ..shapes import SHAPES
-from ..terms import Term, TermSet, Variable
+from ..lang.model import And, Behavior, Consequent, Expr, Not, Or, Prop, Rule, RuleBase, Setting
+from ..fuzzy.shapes import SHAPES
+from ..lang.terms import Term, TermSet, Variable
 from ..words import plural
 
 # ---------------------------------------------------------------------------------------------
@@ -405,7 +405,7 @@ def flatten_for_export(rb: RuleBase, behavior: str | None = None, *,
     ``crisp_terms``, crisp consequents (``speed is 40``) become constant output terms named
     ``crisp_40`` (the formats have no crisp consequents).
     """
-    from ..model import flatten
+    from ..lang.model import flatten
 
     name = behavior or rb.default_behavior
     b = rb.behavior(name)

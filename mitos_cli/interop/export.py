@@ -4,7 +4,7 @@ Both are generated from the same straight-line program: one membership per input
 expression per rule (the AND / OR / NOT / hedge neurons written out as calls of ``tnorm``,
 ``snorm`` and ``hedge_*``), then the output layer. The arithmetic is MITOS's own (the same
 compiled kernel for piecewise-linear terms, the same norm formulas, Mamdani consequent sets
-sampled by :mod:`mitos_cli.mamdani` and stored as tables), so the generated code agrees with
+sampled by :mod:`mitos_cli.engine.mamdani` and stored as tables), so the generated code agrees with
 ``mitos eval`` to rounding (the tests check 1e-9).
 
 The C file needs only ``<math.h>`` (link with ``-lm``), allocates nothing (fixed-size locals
@@ -24,11 +24,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..model import flatten
-from ..compile import CompiledRuleBase
+from ..lang.model import flatten
+from ..engine.compile import CompiledRuleBase
 from ..errors import FormatError
-from ..model import And, Expr, Not, Prop
-from ..shapes import kernel_params
+from ..lang.model import And, Expr, Not, Prop
+from ..fuzzy.shapes import kernel_params
 from ..words import plural
 
 C_SHAPES = {
@@ -509,7 +509,7 @@ def _py_shapes(shapes) -> list[str]:
     """NumPy shape functions: MITOS's own (copied by source) so results agree exactly."""
     import inspect
 
-    from .. import shapes as shapes_mod
+    from ..fuzzy import shapes as shapes_mod
 
     out = []
     done: set[str] = set()

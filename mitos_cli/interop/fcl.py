@@ -33,12 +33,12 @@ from pathlib import Path
 from lark import Lark, Token, Tree
 from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken
 
-from .. import norms
+from ..fuzzy import norms
 from ..errors import FormatError, Span, did_you_mean
-from ..model import And, Not, Prop, Rule, RuleBase
-from ..terms import Term, Variable
+from ..lang.model import And, Not, Prop, Rule, RuleBase
+from ..lang.terms import Term, Variable
 from . import common
-from ..build import MAIN
+from ..lang.resolve import MAIN
 from .common import FCL, FLL, fmt_number
 from .ruletree import conclusion, expression
 from ..words import plural

@@ -27,8 +27,8 @@ import re
 from pathlib import Path
 
 from ..errors import FormatError, Span, did_you_mean
-from ..model import And, Consequent, Or, Prop, Rule, RuleBase
-from ..terms import Term, Variable
+from ..lang.model import And, Consequent, Or, Prop, Rule, RuleBase
+from ..lang.terms import Term, Variable
 from . import common
 from .common import FIS, Settings, fmt_number
 from ..words import plural

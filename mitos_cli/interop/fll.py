@@ -28,11 +28,11 @@ from pathlib import Path
 from lark import Lark
 from lark.exceptions import UnexpectedInput
 
-from ..build import MAIN
+from ..lang.resolve import MAIN
 from ..errors import FormatError, Span, did_you_mean
-from ..model import Rule, RuleBase
-from ..model import format_number as _fmt_weight
-from ..terms import Term, Variable
+from ..lang.model import Rule, RuleBase
+from ..lang.model import format_number as _fmt_weight
+from ..lang.terms import Term, Variable
 from . import common
 from .common import FLL, Settings, fmt_number
 from .ruletree import conclusion, expression
@@ -451,7 +451,7 @@ def _output_term(rb: RuleBase, t: Term, v: Variable, sugeno: bool,
 def fuzzylite_rule_text(rule: Rule, ops, dialect: str) -> str:
     """A rule in fuzzylite's language (``dialect`` ``fll``: lower case; ``fcl``: upper-case
     keywords). ``not (...)`` groups are pushed onto propositions when the operators are duals."""
-    from ..model import And, Not, Prop
+    from ..lang.model import And, Not, Prop
 
     antecedent = common.simple_nots(rule.antecedent, rule, ops)
     kw = (lambda w: w.upper()) if dialect == "fcl" else (lambda w: w)

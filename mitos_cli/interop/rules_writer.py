@@ -15,8 +15,8 @@ import numpy as np
 import yaml
 
 from ..errors import FormatError
-from ..model import Rule, RuleBase, format_rule
-from ..terms import Term, Variable
+from ..lang.model import Rule, RuleBase, format_rule
+from ..lang.terms import Term, Variable
 from . import common
 
 NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_\-]*[A-Za-z0-9_]|[A-Za-z_]")
@@ -39,9 +39,9 @@ def write_rules(rb: RuleBase, termset_name: str, behavior: str | None = None,
 
     A behavior that uses no other is written as top-level rules; one that does is written with
     the behaviors it uses (recursively) as ``behavior`` blocks, itself first (the default)."""
-    from ..model import flatten
-    from ..model import Use, format_use
-    from ..operators import resolve
+    from ..lang.model import flatten
+    from ..lang.model import Use, format_use
+    from ..lang.operators import resolve
 
     name = behavior or rb.default_behavior
     chosen = rb.behavior(name)

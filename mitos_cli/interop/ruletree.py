@@ -13,8 +13,8 @@ from typing import Callable
 from lark import Token, Tree
 
 from ..errors import FormatError, Span
-from ..model import And, Consequent, Expr, Not, Or, Prop
-from ..terms import Variable
+from ..lang.model import And, Consequent, Expr, Not, Or, Prop
+from ..lang.terms import Variable
 from .common import fuzzylite_hedge
 
 SpanOf = Callable[[object], Span]

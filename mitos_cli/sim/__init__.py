@@ -16,6 +16,13 @@ API (everything in inches, seconds, degrees)::
     result.command[T, n, 2], result.ranges[T, n, B], result.clearance[T, n],
     result.perceived["road"][T, n], result.true["road"][T, n], result.obstacles[T, O, 2]
 
+    sim = Simulation(world, planner=None, seed=3)   # the same run, one tick at a time
+    while not sim.done:
+        tick = sim.step()          # a Tick: pose, speed, steering, command, ranges, inputs,
+                                   # clearance, obstacles, active, progress (rows are robots)
+    sim.pose, sim.speed, sim.clearance, sim.time, sim.outcome   # the state now
+    sim.result()                   # the SimResult simulate() returns
+
     runs = run_many([world], runs=20, seed=1, planner=None, workers=2)   # randomised runs
     runs.to_json()          # per world: outcome rates, each metric's mean and std
     runs.worlds[0].rate("success"), runs.worlds[0].robots   # (several robots: each one's)
@@ -24,13 +31,13 @@ Modules: ``world`` (model), ``worldfile`` (YAML loader), ``pgm`` + ``gridmap`` (
 maps), ``staticmap`` (walls from corridors or grids), ``geometry``, ``kinematics`` (tricycle),
 ``sensors`` (ray casting), ``obstacles`` (motion, randomisation), ``route`` (A*),
 ``perception`` (readings -> rule inputs), ``planner`` (the planner protocol, FuzzyPlanner),
-``loop`` (the simulation loop: ``simulate``), ``runs`` (many runs, process pool), ``export`` (CSV, traces),
+``loop`` (the steppable ``Simulation`` and ``simulate``, a loop over its ticks), ``runs`` (many runs, process pool), ``export`` (CSV, traces),
 ``live`` (terminal view). Drawing lives in ``mitos_cli.draw.world``.
 """
 
 from __future__ import annotations
 
-__all__ = ["load_world", "simulate", "run_many", "FuzzyPlanner", "Planner", "Percepts",
+__all__ = ["load_world", "simulate", "Simulation", "Tick", "run_many", "FuzzyPlanner", "Planner", "Percepts",
            "SimResult"]
 
 
@@ -39,7 +46,7 @@ def __getattr__(name: str):
         from .worldfile import load_world
 
         return load_world
-    if name in ("simulate", "SimResult"):
+    if name in ("simulate", "Simulation", "Tick", "SimResult"):
         from . import loop
 
         return getattr(loop, name)

@@ -67,7 +67,7 @@ def csv_text(result: SimResult, planner) -> str:
 def traces(result: SimResult, planner, every: int, digits: int = 1) -> str:
     """The DOF trace every ``every`` ticks (and at the last tick) of the first robot, each
     headed by the time, the pose and the perceived vs true inputs."""
-    from ..trace import trace_of
+    from ..engine.trace import trace_of
 
     detail = explain(result, planner, 0)
     if detail is None:

@@ -7,6 +7,7 @@ or cells.
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -31,8 +32,16 @@ def rect_corners(cx, cy, heading, length, width) -> np.ndarray:
 
 def polygon_segments(corners: np.ndarray) -> np.ndarray:
     """Closed polygons ``[..., P, 2]`` -> their sides ``[... * P, 4]``."""
-    nxt = np.roll(corners, -1, axis=-2)
+    nxt = corners[..., _following(corners.shape[-2]), :]          # np.roll(-1), cheaper
     return np.concatenate([corners, nxt], axis=-1).reshape(-1, 4)
+
+
+@functools.lru_cache(maxsize=None)
+def _following(k: int) -> np.ndarray:
+    """Index of the next corner of a closed polygon of ``k`` corners."""
+    out = (np.arange(k) + 1) % k
+    out.flags.writeable = False
+    return out
 
 
 def point_segment_distance(p: np.ndarray, seg: np.ndarray) -> np.ndarray:
@@ -84,9 +93,15 @@ def ray_segments(origin: np.ndarray, dirs: np.ndarray, seg: np.ndarray,
                  max_range: float) -> np.ndarray:
     """Range ``[B]`` along unit directions ``dirs[B, 2]`` from ``origin[2]`` (or ``[B, 2]``) to
     the first of the segments ``seg[N, 4]``, ``max_range`` when none is hit closer."""
-    B = len(dirs)
     if len(seg) == 0:
-        return np.full(B, max_range)
+        return np.full(len(dirs), max_range)
+    return np.minimum(ray_hits(origin, dirs, seg).min(axis=1), max_range)
+
+
+def ray_hits(origin: np.ndarray, dirs: np.ndarray, seg: np.ndarray) -> np.ndarray:
+    """``[B, N]``: how far along each ray segment ``seg[N, 4]`` is hit (``inf`` if not); each
+    entry depends on its ray and segment alone."""
+    B = len(dirs)
     o = np.broadcast_to(np.asarray(origin, float), (B, 2))
     px = seg[None, :, 0] - o[:, 0, None]
     py = seg[None, :, 1] - o[:, 1, None]
@@ -99,7 +114,7 @@ def ray_segments(origin: np.ndarray, dirs: np.ndarray, seg: np.ndarray,
     t = _cross(px, py, ex, ey) / safe
     s = _cross(px, py, dx, dy) / safe
     hit = ok & (t >= 0.0) & (s >= 0.0) & (s <= 1.0)
-    return np.minimum(np.where(hit, t, np.inf).min(axis=1), max_range)
+    return np.where(hit, t, np.inf)
 
 
 def ray_circles(origin: np.ndarray, dirs: np.ndarray, centres: np.ndarray, radii: np.ndarray,
@@ -166,8 +181,7 @@ def box_segment_distance(hl: float, hw: float, seg: np.ndarray) -> np.ndarray:
     # the endpoints' distances to the box
     e0 = np.hypot(np.maximum(np.abs(x0) - hl, 0.0), np.maximum(np.abs(y0) - hw, 0.0))
     e1 = np.hypot(np.maximum(np.abs(x1) - hl, 0.0), np.maximum(np.abs(y1) - hw, 0.0))
-    corners = np.array([[-hl, -hw], [hl, -hw], [hl, hw], [-hl, hw]])
-    c = point_segment_distance(corners, seg).min(axis=0)
+    c = point_segment_distance(_box_corners(hl, hw), seg).min(axis=0)
     d = np.minimum(np.minimum(e0, e1), c)
     # a segment can cross the box only if it passes within the box's half diagonal of its
     # centre; clip just those (Liang-Barsky)
@@ -181,6 +195,13 @@ def box_segment_distance(hl: float, hw: float, seg: np.ndarray) -> np.ndarray:
     return out
 
 
+@functools.lru_cache(maxsize=64)
+def _box_corners(hl: float, hw: float) -> np.ndarray:
+    out = np.array([[-hl, -hw], [hl, -hw], [hl, hw], [-hl, hw]])
+    out.flags.writeable = False
+    return out
+
+
 def box_polygon_depth(hl: float, hw: float, poly: np.ndarray) -> np.ndarray:
     """How deep convex polygons ``[P, k, 2]`` (corners in order, in the box's frame; a segment
     when ``k == 2``) reach into the box ``[-hl, hl] x [-hw, hw]``: the length of the shortest
@@ -189,7 +210,7 @@ def box_polygon_depth(hl: float, hw: float, poly: np.ndarray) -> np.ndarray:
     definition."""
     if len(poly) == 0:
         return np.zeros(0)
-    edges = np.roll(poly, -1, axis=1) - poly                            # [P, k, 2]
+    edges = poly[:, _following(poly.shape[1])] - poly                   # [P, k, 2]
     length = np.hypot(edges[..., 0], edges[..., 1])
     normals = np.stack([-edges[..., 1], edges[..., 0]], axis=-1) \
         / np.maximum(length, EPS)[..., None]
@@ -218,7 +239,8 @@ def box_polygon_distance(hl: float, hw: float, poly: np.ndarray,
         side_gaps = box_segment_distance(hl, hw, polygon_segments(poly))
     gap = side_gaps.reshape(len(poly), -1).min(axis=1)
     x, y = poly[..., 0], poly[..., 1]
-    ex, ey = np.roll(x, -1, axis=1) - x, np.roll(y, -1, axis=1) - y
+    nxt = _following(x.shape[1])
+    ex, ey = x[:, nxt] - x, y[:, nxt] - y
     side = x * ey - y * ex                                  # > 0: the centre left of a side
     over = ((gap <= 0.0) | ((np.abs(x[:, 0]) <= hl) & (np.abs(y[:, 0]) <= hw))
             | (side >= 0.0).all(axis=1) | (side <= 0.0).all(axis=1))

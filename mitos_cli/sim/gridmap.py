@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import yamlpos
+from ..lang import yamlpos
 from ..errors import Span, WorldError
 from .pgm import read_pgm
 from .world import Grid

@@ -94,6 +94,34 @@ class SimResult:
     def ticks(self) -> int:
         return len(self.t)
 
+    def __repr__(self) -> str:   # the generated one prints every array (144,000 characters)
+        m = self.metrics
+        robots = len(self.robot_outcomes)
+        return (f"<SimResult {self.world.name!r} seed {self.seed}, {self.planner}: {self.outcome} "
+                f"after {m.get('time_s', self.ticks * self.world.dt):g} s ({self.ticks} ticks"
+                f"{f', {robots} robots' if robots > 1 else ''}), path "
+                f"{m.get('path_length_in', 0.0):.1f} in, min clearance "
+                f"{m.get('min_clearance_in', 0.0):.1f} in>")
+
+    def _repr_png_(self) -> bytes | None:
+        """A notebook shows the run as ``--plot`` draws it (nothing without matplotlib)."""
+        try:
+            import io
+
+            from ..draw.world import draw_run
+        except ImportError:
+            return None
+        try:
+            fig = draw_run(self)
+        except Exception:  # noqa: BLE001 - a picture is a courtesy; the repr still shows
+            return None
+        buf = io.BytesIO()
+        fig.savefig(buf, format="png", dpi=80)
+        import matplotlib.pyplot as plt
+
+        plt.close(fig)
+        return buf.getvalue()
+
     def summary(self) -> dict:
         """The ``--json`` contract: the run's figures over all robots and, when there are
         several, each robot's under ``robots``."""
@@ -163,8 +191,10 @@ def _clearance(pose: np.ndarray, robot, walls: np.ndarray, polygons: np.ndarray,
 
     def local(points: np.ndarray) -> np.ndarray:        # [..., 2] world -> footprint frame
         rel = points - pose[:2]
-        return np.stack([rel[..., 0] * c + rel[..., 1] * s,
-                         -rel[..., 0] * s + rel[..., 1] * c], axis=-1)
+        out = np.empty_like(rel)
+        out[..., 0] = rel[..., 0] * c + rel[..., 1] * s
+        out[..., 1] = -rel[..., 0] * s + rel[..., 1] * c
+        return out
 
     best = math.inf
     ends = local(walls.reshape(-1, 2, 2))
@@ -190,159 +220,373 @@ def _clearance(pose: np.ndarray, robot, walls: np.ndarray, polygons: np.ndarray,
     return best
 
 
+@dataclass(frozen=True)
+class Tick:
+    """What one tick recorded, rows are robots: the state the robots were in when they sensed,
+    what they sensed and perceived, and what the planner commanded."""
+
+    k: int
+    t: float                        # s
+    pose: np.ndarray                # [n, 3] x, y (in), heading (deg)
+    speed: np.ndarray               # [n] in/s
+    steering: np.ndarray            # [n] deg (the wheel's actual angle)
+    command: np.ndarray             # [n, 2] planner's steering and speed
+    ranges: np.ndarray              # [n, B] in (noisy readings)
+    inputs: dict[str, np.ndarray]   # name -> [n] perceived rule inputs
+    clearance: np.ndarray           # [n] in
+    obstacles: np.ndarray           # [O, 2] obstacle positions
+    active: np.ndarray              # [n] robot still driving after this tick's verdict
+    progress: np.ndarray            # [n] arc length along each robot's route (in)
+
+
+@dataclass
+class _Sensed:
+    """One tick's sensing and perception, filled stage by stage (rows are robots)."""
+
+    t: float
+    where: np.ndarray
+    pose: np.ndarray
+    ranges: np.ndarray
+    inputs: dict[str, np.ndarray]
+    targets: np.ndarray
+    clearance: np.ndarray
+    command: np.ndarray | None = None
+
+
+class Simulation:
+    """One run of a world, stepped a tick at a time; :func:`simulate` is a loop over
+    :meth:`step`. Each tick runs the stages :meth:`sense` (obstacle places, beams, noise,
+    clearance), :meth:`perceive` (rule inputs), :meth:`check` (contact and arrival),
+    :meth:`plan` (one batch for the active robots) and :meth:`act` (kinematics), in that order,
+    then records a :class:`Tick`.
+
+    Drive the simulator from Python, with your own planner or inspecting each tick::
+
+        >>> from mitos_cli.sim import Simulation, load_world
+        >>> from mitos_cli.resources import packaged_path
+        >>> world = load_world(packaged_path("worlds", "corridor.yaml"))
+        >>> class Straight:                       # any object with `name` and `plan`
+        ...     name = "straight"
+        ...     def plan(self, p):                # p: Percepts, rows are active robots
+        ...         return np.full(len(p.pose), 90.0), np.full(len(p.pose), 20.0)
+        >>> sim = Simulation(world, planner=Straight(), seed=1)
+        >>> while not sim.done and sim.time < 2.0:
+        ...     tick = sim.step()
+        >>> sim.ticks, round(float(sim.pose[0, 0]), 1) > round(float(world.agents[0].start.x), 1)
+        (40, True)
+        >>> sim.result().ticks                    # the recorded arrays as a SimResult
+        40
+
+    ``result()`` may be called at any tick; a run that has not ended reports ``timeout``.
+    """
+
+    def __init__(self, world: World, planner: Planner | None = None, seed: int | None = None,
+                 *, randomise: bool = False, scene: Scene | None = None) -> None:
+        if planner is None:
+            from .planner import FuzzyPlanner
+
+            planner = FuzzyPlanner(None, world.behavior)
+        self.planner = planner
+        self.randomise = randomise
+        self._given_world, self._given_scene = world, scene
+        self.reset(seed)
+
+    # -- set-up -----------------------------------------------------------------------------
+
+    def reset(self, seed: int | None = None) -> "Simulation":
+        """Start the run again from ``seed`` (default: the world's)."""
+        world = self._given_world
+        self.seed = world.seed if seed is None else int(seed)
+        self._streams = [np.random.default_rng(s) for s in
+                         np.random.SeedSequence(self.seed).spawn(1 + len(world.agents))]
+        if self.randomise:
+            world = obs_mod.randomised(world, self._streams[0])
+        self.world = world
+        self.scene = self._given_scene or prepare(world)
+        self._setup_constants()
+        self._setup_state()
+        return self
+
+    def _setup_constants(self) -> None:
+        world = self.world
+        self.robots = [a.robot for a in world.agents]
+        self.n = len(self.robots)
+        self.limits = kinematics.Limits.of(self.robots)
+        sen = world.sensors
+        self.angles = sen.angles
+        beams = len(self.angles)
+        spacing = (2 * math.pi / beams if sen.layout == "ring"
+                   else math.radians(sen.fov) / max(beams - 1, 1))
+        self._spacing = (min(spacing, 2 * math.tan(math.radians(sen.cone) / 2))
+                         if sen.cone > 0 else 0.0)
+        self._threshold = max(4.0, 3.0 * sen.noise)
+        self._reach = sen.range + max(max(r.length, r.width) for r in self.robots)
+        self._cfg = perception.Settings()
+        self.dt = world.dt
+        self.steps = int(math.floor(world.time_limit / self.dt + 1e-9))
+        self._goals = np.array([[a.goal.x, a.goal.y] for a in world.agents], float)
+        self._tol = np.array([a.goal.tolerance for a in world.agents], float)
+        self._stuck_window = max(1, int(round(STUCK_TIME / self.dt)))
+        self._still = None
+        if not any(o.motion.kind in ("velocity", "waypoints") for o in world.obstacles):
+            self._still = self._obstacles_at(0.0)
+
+    def _setup_state(self) -> None:
+        agents, n = self.world.agents, self.n
+        self._x = np.array([a.start.x for a in agents], float)
+        self._y = np.array([a.start.y for a in agents], float)
+        self._h = np.deg2rad(np.array([a.start.heading for a in agents], float))
+        self._v = np.zeros(n)
+        self._steer = self.limits.straight.copy()
+        self._s_hint = np.zeros(n)
+        self._active = np.ones(n, dtype=bool)
+        self._near_at = [(math.inf, math.inf)] * n     # where each robot's wall set was gathered
+        self._near_walls = [np.zeros((0, 4))] * n
+        self._history: list[np.ndarray] = []
+        self._outcomes = ["timeout"] * n
+        self._collided = 0
+        self._k = 0
+        self._done = self.steps <= 0
+        self._hit = np.zeros(n, dtype=bool)
+        self.record: list[Tick] = []
+
+    # -- state ------------------------------------------------------------------------------
+
+    @property
+    def ticks(self) -> int:
+        """Ticks recorded so far."""
+        return len(self.record)
+
+    @property
+    def time(self) -> float:
+        """Time of the next tick (s)."""
+        return self._k * self.dt
+
+    @property
+    def pose(self) -> np.ndarray:
+        """``[n, 3]`` the robots' pose now: x, y (in), heading (deg)."""
+        return np.stack([self._x, self._y, np.rad2deg(self._h)], axis=1)
+
+    @property
+    def speed(self) -> np.ndarray:
+        """``[n]`` the robots' speed now (in/s)."""
+        return self._v.copy()
+
+    @property
+    def steering(self) -> np.ndarray:
+        """``[n]`` the wheels' angle now (deg, 90 straight)."""
+        return self._steer.copy()
+
+    @property
+    def active(self) -> np.ndarray:
+        """``[n]`` robots still driving."""
+        return self._active.copy()
+
+    @property
+    def clearance(self) -> np.ndarray:
+        """``[n]`` each robot's clearance at the last tick (in)."""
+        return self.record[-1].clearance if self.record else np.full(self.n, math.inf)
+
+    @property
+    def done(self) -> bool:
+        return self._done
+
+    @property
+    def robot_outcomes(self) -> tuple[str, ...]:
+        return tuple(self._outcomes)
+
+    @property
+    def outcome(self) -> str:
+        """``success`` (every robot at its goal), ``collision``, ``stuck`` or ``timeout``
+        (also while the run has not ended)."""
+        outcomes = self._outcomes
+        if "collision" in outcomes:
+            return "collision"
+        if all(o == "success" for o in outcomes):
+            return "success"
+        return "stuck" if "stuck" in outcomes else "timeout"
+
+    # -- one tick ---------------------------------------------------------------------------
+
+    def step(self) -> Tick:
+        """Advance one tick and return what it recorded."""
+        if self._done:
+            raise RuntimeError("the run has ended (reset() starts it again)")
+        s = self.sense()
+        self.perceive(s)
+        self.check(s)
+        self.plan(s)
+        tick = self._record(s)
+        if self._hit.any():
+            self._collided = int(self._hit.sum())
+            for i in np.flatnonzero(self._hit):
+                self._outcomes[i] = "collision"
+            self._done = True
+        elif not self._active.any():
+            self._done = True
+        else:
+            self.act(s)
+            self._k += 1
+            self._done = self._check_stuck() or self._k >= self.steps
+        return tick
+
+    def sense(self) -> _Sensed:
+        """Obstacle places at this tick's time, every robot's beams (noise from its own
+        stream) and the clearance of its footprint."""
+        n, x, y, h = self.n, self._x, self._y, self._h
+        t = self._k * self.dt
+        sen = self.world.sensors
+        where, (centres, radii, _, rect_sides, _, rect_box) = self._obstacles_at(t)
+        pose = np.stack([x, y, h], axis=1)
+        if n > 1:                                        # other robots are obstacles to each
+            footprints = _footprints(pose, self.robots)
+            robot_sides = polygon_segments(footprints).reshape(n, 4, 4)
+        ranges = np.zeros((n, len(self.angles)))
+        clear = np.zeros(n)
+        self._dirs, self._expected = [], []
+        for i in range(n):
+            if n > 1:
+                others = np.concatenate([rect_sides] + [robot_sides[j] for j in range(n)
+                                                        if j != i])
+                boxes = np.concatenate([rect_box, footprints[:i], footprints[i + 1:]])
+            else:
+                others, boxes = rect_sides, rect_box
+            walls = self._walls_near(i)
+            dirs = sensors.beam_directions(h[i], self.angles)
+            expected, true_r = sensors.cast(pose[i, :2], dirs, walls, others, centres, radii,
+                                            sen.range)
+            ranges[i] = sensors.add_noise(true_r, sen.noise, sen.range, self._streams[1 + i])
+            self._dirs.append(dirs)
+            self._expected.append(expected)
+            clear[i] = _clearance(pose[i], self.robots[i], walls, boxes, centres, radii)
+        return _Sensed(t, where, pose, ranges, {key: np.zeros(n) for key in perception.INPUTS},
+                       np.zeros((n, 2)), clear)
+
+    def _obstacles_at(self, t: float):
+        """Obstacle places ``[O, 2]`` at time ``t`` and their shapes
+        (:func:`obstacles.shapes_at`); worked out once when nothing moves."""
+        if self._still is not None:
+            return self._still
+        where = obs_mod.positions(self.world.obstacles, t)
+        return where, obs_mod.shapes_at(self.world.obstacles, where)
+
+    def _walls_near(self, i: int) -> np.ndarray:
+        """Robot ``i``'s nearby walls, gathered again once it moved ``NEAR_SLACK`` away."""
+        x, y = self._x[i], self._y[i]
+        if math.hypot(x - self._near_at[i][0], y - self._near_at[i][1]) > NEAR_SLACK:
+            self._near_at[i] = (x, y)
+            self._near_walls[i] = self.scene.static.near(x, y, self._reach + NEAR_SLACK)
+        return self._near_walls[i]
+
+    def perceive(self, s: _Sensed) -> None:
+        """The rule inputs and the route's target point of every robot from its readings."""
+        routes, sen = self.scene.routes, self.world.sensors
+        for i in range(self.n):
+            f = perception.frame(routes[i], s.pose[i, :2], self._s_hint[i])
+            self._s_hint[i] = f.s
+            p = perception.perceive(routes[i], f, (self._x[i], self._y[i], self._h[i]),
+                                    self.robots[i], self._dirs[i], s.ranges[i],
+                                    self._expected[i], sen.range, self._spacing,
+                                    self._threshold, self._cfg)
+            for key in perception.INPUTS:
+                s.inputs[key][i] = p[key]
+            s.targets[i] = perception.target_point(routes[i], f, self._cfg)
+
+    def check(self, s: _Sensed) -> None:
+        """Contact (clearance <= 0) and arrival; an arrived robot stops driving."""
+        active = self._active
+        self._hit = active & (s.clearance <= 0.0)
+        arrived = active & (np.hypot(self._x - self._goals[:, 0],
+                                     self._y - self._goals[:, 1]) <= self._tol)
+        for i in np.flatnonzero(arrived):
+            self._outcomes[i] = "success"
+        active &= ~arrived
+
+    def plan(self, s: _Sensed) -> None:
+        """The planner's commands for the active robots, in one batch (the others: straight
+        wheel, no speed)."""
+        cmd = np.zeros((self.n, 2))
+        cmd[:, 0] = self.limits.straight
+        if self._active.any():
+            idx = np.flatnonzero(self._active)
+            sub = Percepts({key: val[idx] for key, val in s.inputs.items()}, s.ranges[idx],
+                           self.angles, s.pose[idx], self._v[idx], s.targets[idx],
+                           self._goals[idx])
+            c_steer, c_speed = self.planner.plan(sub)
+            cmd[idx, 0], cmd[idx, 1] = c_steer, c_speed
+        s.command = cmd
+
+    def act(self, s: _Sensed) -> None:
+        """Steering-rate and acceleration limits and exact arcs, substep by substep; stopped
+        robots stay put."""
+        self._x, self._y, self._h, self._v, self._steer = kinematics.step(
+            self._x, self._y, self._h, np.where(self._active, self._v, 0.0), self._steer,
+            s.command[:, 0], s.command[:, 1], self.limits, self.dt, self.world.substeps)
+        self._history.append(np.stack([self._x, self._y], axis=1))
+
+    def _check_stuck(self) -> bool:
+        """A driving robot that moved less than ``STUCK_DISTANCE`` in ``STUCK_TIME`` is stuck
+        (the run ends)."""
+        history, window = self._history, self._stuck_window
+        if len(history) <= window:
+            return False
+        moved = np.hypot(*(history[-1] - history[-1 - window]).T)
+        stuck = self._active & (moved < STUCK_DISTANCE)
+        for i in np.flatnonzero(stuck):
+            self._outcomes[i] = "stuck"
+        return bool(stuck.any())
+
+    def _record(self, s: _Sensed) -> Tick:
+        tick = Tick(self._k, s.t, np.stack([self._x, self._y, np.rad2deg(self._h)], axis=1),
+                    self._v.copy(), self._steer.copy(), s.command, s.ranges, s.inputs,
+                    s.clearance, s.where, self._active.copy(), self._s_hint.copy())
+        self.record.append(tick)
+        return tick
+
+    # -- the recorded run -------------------------------------------------------------------
+
+    def result(self) -> SimResult:
+        """The recorded ticks as a :class:`SimResult` with the run's metrics."""
+        rec, dt, n = self.record, self.dt, self.n
+        T = len(rec)
+
+        def stack(attr: str, shape: tuple[int, ...]) -> np.ndarray:
+            return (np.array([getattr(r, attr) for r in rec]) if rec
+                    else np.zeros((0, *shape)))
+
+        res = SimResult(
+            world=self.world, seed=self.seed,
+            planner=getattr(self.planner, "name", type(self.planner).__name__),
+            outcome=self.outcome, robot_outcomes=tuple(self._outcomes),
+            collisions=self._collided, t=np.arange(T) * dt, pose=stack("pose", (n, 3)),
+            speed=stack("speed", (n,)), steering=stack("steering", (n,)),
+            command=stack("command", (n, 2)), ranges=stack("ranges", (n, len(self.angles))),
+            perceived={key: (np.array([r.inputs[key] for r in rec]) if rec
+                             else np.zeros((0, n))) for key in perception.INPUTS},
+            clearance=stack("clearance", (n,)),
+            obstacles=(np.array([r.obstacles for r in rec]).reshape(T, -1, 2) if rec
+                       else np.zeros((0, len(self.world.obstacles), 2))),
+            routes=self.scene.routes, static=self.scene.static, active=stack("active", (n,)),
+            progress=stack("progress", (n,)))
+        res.robot_metrics = _robot_metrics(res, dt)
+        res.metrics = _metrics(res, dt)
+        return res
+
+
 def simulate(world: World, planner: Planner | None = None, seed: int | None = None, *,
              randomise: bool = False, scene: Scene | None = None,
              on_tick=None) -> SimResult:
     """Run ``world`` with ``planner`` (default: the packaged rule base's ``drive``) from
     ``seed`` (default: the world's). ``randomise`` draws obstacle places and sensor noise from
     the world's ranges first. ``on_tick(k, state)`` is called after each tick (``--live``)."""
-    if planner is None:
-        from .planner import FuzzyPlanner
-
-        planner = FuzzyPlanner(None, world.behavior)
-    seed = world.seed if seed is None else int(seed)
-    streams = [np.random.default_rng(s) for s in
-               np.random.SeedSequence(seed).spawn(1 + len(world.agents))]
-    if randomise:
-        world = obs_mod.randomised(world, streams[0])
-    scene = scene or prepare(world)
-    static, routes = scene.static, scene.routes
-    agents = world.agents
-    robots = [a.robot for a in agents]
-    n = len(agents)
-    lim = kinematics.Limits.of(robots)
-    sen = world.sensors
-    angles = sen.angles
-    B = len(angles)
-    spacing = (2 * math.pi / B if sen.layout == "ring"
-               else math.radians(sen.fov) / max(B - 1, 1))
-    spacing = min(spacing, 2 * math.tan(math.radians(sen.cone) / 2)) if sen.cone > 0 else 0.0
-    threshold = max(4.0, 3.0 * sen.noise)
-    reach = sen.range + max(max(r.length, r.width) for r in robots)
-    cfg = perception.Settings()
-
-    dt, sub = world.dt, world.substeps
-    steps = int(math.floor(world.time_limit / dt + 1e-9))
-    x = np.array([a.start.x for a in agents], float)
-    y = np.array([a.start.y for a in agents], float)
-    h = np.deg2rad(np.array([a.start.heading for a in agents], float))
-    v = np.zeros(n)
-    steer = lim.straight.copy()
-    s_hint = np.zeros(n)
-    active = np.ones(n, dtype=bool)
-    goals = np.array([[a.goal.x, a.goal.y] for a in agents], float)
-    tol = np.array([a.goal.tolerance for a in agents], float)
-
-    near_at = [(math.inf, math.inf)] * n      # where each robot's wall set was gathered
-    near_walls = [np.zeros((0, 4))] * n
-    rec_pose, rec_v, rec_steer, rec_cmd, rec_rng, rec_clear, rec_obs, rec_act = ([] for _ in range(8))
-    rec_p = {k: [] for k in perception.INPUTS}
-    rec_s: list[np.ndarray] = []
-    outcomes = ["timeout"] * n
-    collided = 0
-    stuck_window = max(1, int(round(STUCK_TIME / dt)))
-    history: list[np.ndarray] = []
-
-    for k in range(steps):
-        t = k * dt
-        where = obs_mod.positions(world.obstacles, t)
-        centres, radii, _, rect_sides, _, rect_box = obs_mod.shapes_at(world.obstacles, where)
-        pose = np.stack([x, y, h], axis=1)
-        footprints = _footprints(pose, robots)
-        robot_sides = (polygon_segments(footprints).reshape(n, 4, 4) if n > 1
-                       else np.zeros((1, 4, 4)))       # other robots are obstacles to each
-        ranges = np.zeros((n, B))
-        percepts_p = {key: np.zeros(n) for key in perception.INPUTS}
-        targets = np.zeros((n, 2))
-        clear = np.zeros(n)
-        for i in range(n):
-            others = np.concatenate([rect_sides] + [robot_sides[j] for j in range(n) if j != i])
-            if math.hypot(x[i] - near_at[i][0], y[i] - near_at[i][1]) > NEAR_SLACK:
-                near_at[i] = (x[i], y[i])
-                near_walls[i] = static.near(x[i], y[i], reach + NEAR_SLACK)
-            walls = near_walls[i]
-            dirs = sensors.beam_directions(h[i], angles)
-            f = perception.frame(routes[i], pose[i, :2], s_hint[i])
-            s_hint[i] = f.s
-            expected, true_r = sensors.cast(pose[i, :2], dirs, walls, others, centres, radii,
-                                            sen.range)
-            measured = sensors.add_noise(true_r, sen.noise, sen.range, streams[1 + i])
-            ranges[i] = measured
-            p = perception.perceive(routes[i], f, (x[i], y[i], h[i]), robots[i], dirs, measured,
-                                    expected, sen.range, spacing, threshold, cfg)
-            for key in perception.INPUTS:
-                percepts_p[key][i] = p[key]
-            targets[i] = perception.target_point(routes[i], f, cfg)
-            boxes = np.concatenate([rect_box, footprints[:i], footprints[i + 1:]])
-            clear[i] = _clearance(pose[i], robots[i], walls, boxes, centres, radii)
-
-        hit = active & (clear <= 0.0)
-        arrived = active & (np.hypot(x - goals[:, 0], y - goals[:, 1]) <= tol)
-        for i in np.flatnonzero(arrived):
-            outcomes[i] = "success"
-        active &= ~arrived
-        cmd = np.zeros((n, 2))
-        cmd[:, 0] = lim.straight
-        if active.any():
-            idx = np.flatnonzero(active)
-            sub_p = Percepts({key: val[idx] for key, val in percepts_p.items()}, ranges[idx],
-                             angles, pose[idx], v[idx], targets[idx], goals[idx])
-            c_steer, c_speed = planner.plan(sub_p)
-            cmd[idx, 0], cmd[idx, 1] = c_steer, c_speed
-
-        rec_pose.append(np.stack([x, y, np.rad2deg(h)], axis=1))
-        rec_v.append(v.copy())
-        rec_steer.append(steer.copy())
-        rec_cmd.append(cmd)
-        rec_rng.append(ranges)
-        rec_clear.append(clear)
-        rec_obs.append(where)
-        rec_act.append(active.copy())
-        rec_s.append(s_hint.copy())
-        for key in perception.INPUTS:
-            rec_p[key].append(percepts_p[key])
+    sim = Simulation(world, planner, seed, randomise=randomise, scene=scene)
+    while not sim.done:
+        tick = sim.step()
         if on_tick is not None:
-            on_tick(k, {"t": t, "pose": rec_pose[-1], "speed": v, "steering": steer,
-                        "inputs": percepts_p, "clearance": clear, "obstacles": where})
-
-        if hit.any():
-            collided = int(hit.sum())
-            for i in np.flatnonzero(hit):
-                outcomes[i] = "collision"
-            break
-        if not active.any():
-            break
-        # move: limits and exact arcs, substep by substep; stopped robots stay put
-        x, y, h, v, steer = kinematics.step(x, y, h, np.where(active, v, 0.0), steer,
-                                            cmd[:, 0], cmd[:, 1], lim, dt, sub)
-        history.append(np.stack([x, y], axis=1))
-        if len(history) > stuck_window:
-            moved = np.hypot(*(history[-1] - history[-1 - stuck_window]).T)
-            stuck = active & (moved < STUCK_DISTANCE)
-            if stuck.any():
-                for i in np.flatnonzero(stuck):
-                    outcomes[i] = "stuck"
-                break
-
-    if "collision" in outcomes:
-        outcome = "collision"
-    elif all(o == "success" for o in outcomes):
-        outcome = "success"
-    elif "stuck" in outcomes:
-        outcome = "stuck"
-    else:
-        outcome = "timeout"
-    res = SimResult(
-        world=world, seed=seed, planner=getattr(planner, "name", type(planner).__name__),
-        outcome=outcome, robot_outcomes=tuple(outcomes), collisions=collided,
-        t=np.arange(len(rec_pose)) * dt, pose=np.array(rec_pose), speed=np.array(rec_v),
-        steering=np.array(rec_steer), command=np.array(rec_cmd), ranges=np.array(rec_rng),
-        perceived={key: np.array(val) for key, val in rec_p.items()},
-        clearance=np.array(rec_clear), obstacles=np.array(rec_obs).reshape(len(rec_pose), -1, 2),
-        routes=routes, static=static, active=np.array(rec_act), progress=np.array(rec_s))
-    res.robot_metrics = _robot_metrics(res, dt)
-    res.metrics = _metrics(res, dt)
-    return res
+            on_tick(tick.k, {"t": tick.t, "pose": tick.pose, "speed": tick.speed,
+                             "steering": tick.steering, "inputs": tick.inputs,
+                             "clearance": tick.clearance, "obstacles": tick.obstacles})
+    return sim.result()
 
 
 def true_inputs(res: SimResult) -> dict[str, np.ndarray]:

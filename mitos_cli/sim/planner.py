@@ -88,14 +88,18 @@ class FuzzyPlanner:
         return np.column_stack([np.asarray(inputs[k], float) for k in self.compiled.inputs])
 
     def plan(self, percepts: Percepts) -> tuple[np.ndarray, np.ndarray]:
-        from ..engine import evaluate
+        from ..engine.evaluation import evaluate, evaluate_one
 
-        out = evaluate(self.compiled, self.matrix(percepts.inputs), detail=False).outputs
+        inputs = percepts.inputs
+        if len(percepts.pose) == 1:             # one robot: the scalar form, same bits
+            out = evaluate_one(self.compiled, [float(inputs[k][0]) for k in self.compiled.inputs])
+            return np.array([out[self._cols[0]]]), np.array([out[self._cols[1]]])
+        out = evaluate(self.compiled, self.matrix(inputs), detail=False).outputs
         return out[:, self._cols[0]], out[:, self._cols[1]]
 
     def explain(self, inputs: dict[str, np.ndarray]):
         """The detailed engine result (memberships, DOFs) for inputs ``[n]`` by name: rows are
         ticks or robots. Bit for bit what :meth:`plan` computed (the engine is row-exact)."""
-        from ..engine import evaluate
+        from ..engine.evaluation import evaluate
 
         return evaluate(self.compiled, self.matrix(inputs))

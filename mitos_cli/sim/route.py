@@ -7,6 +7,7 @@ marriage of the fuzzy planner with roadmaps and cell decomposition).
 
 from __future__ import annotations
 
+import functools
 import heapq
 import math
 from dataclasses import dataclass
@@ -48,24 +49,38 @@ class Route:
         span = self.cum[i + 1] - self.cum[i]
         return self.points[i] + (s - self.cum[i]) / span * seg if span > 0 else self.points[i]
 
+    @functools.cached_property
+    def _segments(self) -> tuple[np.ndarray, ...]:
+        """Each segment's start ``a``, vector ``e``, squared length (at least 1e-12) and
+        length: the route does not change, so :meth:`project` does not recompute them."""
+        a = self.points[:-1]
+        e = self.points[1:] - a
+        ee = np.maximum((e * e).sum(axis=1), 1e-12)
+        return a, e, ee, np.sqrt(ee)
+
     def project(self, p: np.ndarray, s_hint: float, back: float = 24.0,
                 ahead: float = 120.0) -> tuple[float, float, np.ndarray]:
         """Arc length ``s``, signed lateral offset (positive RIGHT of the route) and unit
-        tangent at the route point nearest to ``p`` within ``[s_hint - back, s_hint + ahead]``."""
-        a, b = self.points[:-1], self.points[1:]
-        e = b - a
-        ee = np.maximum((e * e).sum(axis=1), 1e-12)
+        tangent at the route point nearest to ``p`` within ``[s_hint - back, s_hint + ahead]``.
+
+        Only the segments in that window are measured (elementwise, so each gets the bits it
+        would get among all); with none in it, the first segment answers."""
+        a, e, ee, root = self._segments
+        window = np.flatnonzero((self.cum[1:] >= s_hint - back) &
+                                (self.cum[:-1] <= s_hint + ahead))
+        if len(window) == 0:
+            window = np.zeros(1, dtype=np.intp)
+        elif len(window) < len(a):
+            a, e, ee, root = a[window], e[window], ee[window], root[window]
         t = np.clip(((p - a) * e).sum(axis=1) / ee, 0.0, 1.0)
         closest = a + t[:, None] * e
         d = np.hypot(*(p - closest).T)
-        s = self.cum[:-1] + t * np.sqrt(ee)
-        window = (self.cum[1:] >= s_hint - back) & (self.cum[:-1] <= s_hint + ahead)
-        d = np.where(window, d, np.inf)
         i = int(np.argmin(d))
+        s = self.cum[window[i]] + t[i] * root[i]
         tangent = e[i] / math.sqrt(ee[i])
         rel = p - closest[i]
         lateral = float(rel[0] * tangent[1] - rel[1] * tangent[0])   # right of the tangent
-        return float(s[i]), lateral, tangent
+        return float(s), lateral, tangent
 
 
 def _astar(neighbours, start: int, goal: int, pos) -> list[int] | None:

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .geometry import ray_circles, ray_segments
+from .geometry import ray_circles, ray_hits, ray_segments
 
 
 def beam_directions(heading: float, angles: np.ndarray) -> np.ndarray:
@@ -22,10 +22,16 @@ def cast(origin: np.ndarray, dirs: np.ndarray, walls: np.ndarray, sides: np.ndar
          centres: np.ndarray, radii: np.ndarray, max_range: float) -> tuple[np.ndarray, np.ndarray]:
     """Noise-free ranges ``[B]``: against the walls alone (what the map predicts) and against
     everything (walls, obstacle and robot sides, circles)."""
-    static = ray_segments(origin, dirs, walls, max_range)
-    moving = np.minimum(ray_segments(origin, dirs, sides, max_range),
-                        ray_circles(origin, dirs, centres, radii, max_range))
-    return static, np.minimum(static, moving)
+    if len(walls) and len(sides):           # one pass over walls and sides (min is exact)
+        t = ray_hits(origin, dirs, np.concatenate([walls, sides]))
+        static = np.minimum(t[:, :len(walls)].min(axis=1), max_range)
+        segments = np.minimum(t.min(axis=1), max_range)
+    else:
+        static = ray_segments(origin, dirs, walls, max_range)
+        segments = np.minimum(static, ray_segments(origin, dirs, sides, max_range))
+    if len(centres) == 0:
+        return static, segments
+    return static, np.minimum(segments, ray_circles(origin, dirs, centres, radii, max_range))
 
 
 def add_noise(ranges: np.ndarray, sigma: float, max_range: float,

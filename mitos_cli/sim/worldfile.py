@@ -11,9 +11,9 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from .. import yamlpos
+from ..lang import yamlpos
 from ..errors import Span, WorldError, unknown
-from ..yamlpos import YList, YMap
+from ..lang.yamlpos import YList, YMap
 from .world import (Agent, Corridor, Goal, Jitter, Motion, Obstacle, Pose, Randomise, Robot,
                     Sensors, World)
 

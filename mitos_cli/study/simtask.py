@@ -40,7 +40,7 @@ def _rulebase(path: str | None):
 def loaded_rulebase(path: str | None, behavior: str | None, overrides: tuple):
     """The rule base compiled with the choice's operators (``overrides``: (key, value) pairs)."""
     from ..api import LoadedRuleBase
-    from ..model import Setting
+    from ..lang.model import Setting
 
     return LoadedRuleBase(_rulebase(path), behavior,
                           tuple(Setting(k, v) for k, v in overrides))

@@ -16,9 +16,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .. import norms
+from ..fuzzy import norms
 from ..errors import unknown
-from ..operators import INFERENCES
+from ..lang.operators import INFERENCES
 
 PLANNERS = ("fuzzy", "potential_field")
 

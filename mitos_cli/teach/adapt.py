@@ -12,7 +12,7 @@ network:
 * AND / OR neurons: min and max pass the gradient to the child that wins (the lowest
   child index at ties, so the result is deterministic); product and probabilistic sum get
   their exact partial derivatives; other norms are refused;
-* hedges (:mod:`mitos_cli.hedges` derivatives) and ``not`` (``-1``);
+* hedges (:mod:`mitos_cli.fuzzy.hedges` derivatives) and ``not`` (``-1``);
 * memberships: the derivative of each piecewise-linear edge w.r.t. its corner points; a
   saturated membership (0 or 1) has derivative 0.
 
@@ -46,13 +46,13 @@ from typing import Callable
 
 import numpy as np
 
-from .. import hedges as hedge_mod
-from ..compile import CompiledRuleBase
-from ..engine import evaluate, fill_defaults, infer
+from ..fuzzy import hedges as hedge_mod
+from ..engine.compile import CompiledRuleBase
+from ..engine.evaluation import evaluate, fill_defaults, infer
 from ..errors import LessonError
-from ..mamdani import OutputTable, spike
-from ..model import Rule, RuleBase
-from ..shapes import kernel_params
+from ..engine.mamdani import OutputTable, spike
+from ..lang.model import Rule, RuleBase
+from ..fuzzy.shapes import kernel_params
 
 #: Fraction of a universe the most-moving parameter moves in one full step (times eta).
 STEP = 0.05

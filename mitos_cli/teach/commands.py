@@ -18,8 +18,8 @@ from lark import Lark, Token, Tree, v_args
 from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken
 
 from ..errors import RuleSyntaxError, Span
-from ..model import Rule, Setting, Use
-from ..parse import TERMINAL_WORDS, _ToModel
+from ..lang.model import Rule, Setting, Use
+from ..lang.parse import TERMINAL_WORDS, _ToModel
 from ..resources import grammar_text
 
 WORDS = dict(TERMINAL_WORDS, PATH="a file name", INT="a whole number", ARROW="`->`",
@@ -273,7 +273,7 @@ def incomplete(line: str) -> bool:
 
 
 def _words(name: str) -> str:
-    from ..parse import _words as words
+    from ..lang.parse import _words as words
 
     return words(name, WORDS)
 

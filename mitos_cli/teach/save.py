@@ -22,13 +22,13 @@ from pathlib import Path
 
 from lark import Token, Tree
 
-from .. import yamlpos
+from ..lang import yamlpos
 from ..fileio import atomic_write
 from ..errors import LessonError, TermSetError
-from ..model import Behavior, RuleBase, format_number, format_rule, format_use
-from ..parse import parser as rule_parser
-from ..shapes import SHAPES
-from ..terms import Term
+from ..lang.model import Behavior, RuleBase, format_number, format_rule, format_use
+from ..lang.parse import parser as rule_parser
+from ..fuzzy.shapes import SHAPES
+from ..lang.terms import Term
 from ..words import plural
 
 NUMBER = re.compile(r"[-+]?(?:\d[\d_]*\.?\d*|\.\d+)(?:[eE][-+]?\d+)?")

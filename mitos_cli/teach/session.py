@@ -28,13 +28,13 @@ from typing import Callable
 
 import numpy as np
 
-from ..build import check_expr, check_rule, load_rules_file
-from ..compile import CompiledRuleBase, compile_rulebase
+from ..lang.resolve import check_expr, check_rule, load_rules_file
+from ..engine.compile import CompiledRuleBase, compile_rulebase
 from ..errors import LessonError, MitosError, RuleBaseError, unknown
-from ..model import And, Behavior, Expr, Not, Prop, Rule, RuleBase, format_expr, \
+from ..lang.model import And, Behavior, Expr, Not, Prop, Rule, RuleBase, format_expr, \
     format_number, format_rule, format_use
-from ..operators import resolve
-from ..parse import parse_rule
+from ..lang.operators import resolve
+from ..lang.parse import parse_rule
 from ..words import plural
 from . import commands as cmd
 from .journal import Journal, MemoryJournal
@@ -373,8 +373,8 @@ class Session:
         return out
 
     def _eval(self, c: cmd.Eval, line: str) -> None:
-        from ..engine import as_batch, evaluate
-        from ..trace import trace_of
+        from ..engine.evaluation import as_batch, evaluate
+        from ..engine.trace import trace_of
 
         compiled = self.compiled()
         values = self._values(c.inputs, compiled.inputs, "input", compiled, True)
@@ -390,7 +390,7 @@ class Session:
         self.out(f"example {len(self.state.examples)}: " + _example_text(inputs, targets, now))
 
     def _outputs(self, compiled: CompiledRuleBase, inputs: list[dict]) -> list[dict]:
-        from ..engine import evaluate
+        from ..engine.evaluation import evaluate
 
         X = np.array([[x[k] for k in compiled.inputs] for x in inputs], dtype=float)
         y = evaluate(compiled, X, detail=False).outputs

@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import LessonError
-from ..model import RuleBase
+from ..lang.model import RuleBase
 from ..words import plural
 
 

@@ -23,7 +23,7 @@ optionally ``description``, ``unit`` and (outputs) ``default``. A term is a mapp
 Output terms may also be Takagi-Sugeno consequents: ``{shape: constant, value: 90}`` (the
 same as a bare number) or ``{shape: linear, coefficients: {road: 0.5, size: -1}, constant:
 90}``, i.e. ``y = 0.5 road - size + 90``; coefficients name input variables of this term set
-(missing ones are 0) and are stored in the layout of :data:`mitos_cli.shapes.LINEAR_LAYOUT`.
+(missing ones are 0) and are stored in the layout of :data:`mitos_cli.fuzzy.shapes.LINEAR_LAYOUT`.
 """
 
 from __future__ import annotations
@@ -32,11 +32,11 @@ from pathlib import Path
 from typing import Any
 
 from . import yamlpos
-from .errors import Span, TermSetError, did_you_mean
-from .shapes import SHAPES
+from ..errors import Span, TermSetError, did_you_mean
+from ..fuzzy.shapes import SHAPES
 from .terms import Term, TermSet, Variable, check_term
 from .yamlpos import YList, YMap
-from .words import plural
+from ..words import plural
 
 VARIABLE_KEYS = ("description", "unit", "role", "universe", "terms", "default")
 TRIANGLE_FORMS = {

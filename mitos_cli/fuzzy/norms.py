@@ -3,6 +3,11 @@
 Each norm is a vectorized binary function on arrays in [0, 1] with its formula and its De Morgan
 dual (eq. 12: ``S(a, b) = 1 - T(1 - a, 1 - b)``). :func:`reduce` folds a norm over an axis, so
 an n-ary AND neuron is ``reduce(tnorm, inputs, axis)``.
+
+A :class:`Norm` is the one registry entry for its operator: besides the NumPy function it
+carries the same formula as scalar Python statements (the engine's scalar form), as a C body
+and as a NumPy expression (the exports), the rule adaptation uses to differentiate it, and its
+names in FLL, ``.fis`` and FCL. Every consumer reads these fields; none keeps a table of its own.
 """
 
 from __future__ import annotations
@@ -23,6 +28,21 @@ class Norm:
     formula: str
     dual: str
     aliases: tuple[str, ...] = ()
+    #: Python statements on floats ``a``, ``b`` leaving ``r``: ``fn``'s operations in ``fn``'s
+    #: order, so the scalar form gives the same bits (engine/scalar.py)
+    scalar: str = ""
+    #: a C function body of ``double a, double b`` (``mitos export --to c``)
+    c: str = ""
+    #: a NumPy expression of arrays ``a``, ``b`` (``mitos export --to python``)
+    numpy: str = ""
+    #: the names fuzzylite's FLL, MATLAB's ``.fis`` and IEC 61131-7 FCL give it (None: none)
+    fll: str | None = None
+    fis: str | None = None
+    fcl: str | None = None
+    #: how adaptation differentiates an n-ary neuron of this norm: ``"select"`` (the gradient
+    #: goes to the winning input), ``"product"`` (the product of the others), ``"dual_product"``
+    #: (of the others' complements); None: not differentiated (teach/adapt.py)
+    gradient: str | None = None
 
     @property
     def identity(self) -> float:
@@ -139,33 +159,100 @@ def register(norm: Norm) -> Norm:
     return norm
 
 
+# Scalar forms share these two lines.
+_LO_HI = "lo = a if a <= b else b\nhi = a if a >= b else b"
+
 for _norm in (
-    Norm("min", "tnorm", np.minimum, "min(a, b)", "max", ("minimum",)),
+    Norm("min", "tnorm", np.minimum, "min(a, b)", "max", ("minimum",),
+         scalar="r = a if a <= b else b",
+         c="return a < b ? a : b;",
+         numpy="np.minimum(a, b)",
+         fll="Minimum", fis="min", fcl="MIN", gradient="select"),
     Norm("product", "tnorm", np.multiply, "a * b", "probabilistic_sum",
-         ("algebraic_product", "prod")),
+         ("algebraic_product", "prod"),
+         scalar="r = a * b",
+         c="return a * b;",
+         numpy="a * b",
+         fll="AlgebraicProduct", fis="prod", fcl="PROD", gradient="product"),
     Norm("lukasiewicz", "tnorm", _lukasiewicz,
-         "max(0, a + b - 1)", "bounded_sum", ("bounded_difference", "bounded_product")),
+         "max(0, a + b - 1)", "bounded_sum", ("bounded_difference", "bounded_product"),
+         scalar=_LO_HI + "\nr = lo - (1.0 - hi)\nr = r if r >= 0.0 else 0.0",
+         c="double lo = a < b ? a : b, hi = a < b ? b : a, t = lo - (1.0 - hi);\n"
+           "    return t > 0.0 ? t : 0.0;",
+         numpy="np.maximum(0.0, np.minimum(a, b) - (1.0 - np.maximum(a, b)))",
+         fll="BoundedDifference", fcl="BDIF"),
     Norm("drastic", "tnorm", _drastic_product, "b if a = 1, a if b = 1, else 0", "drastic_sum",
-         ("drastic_product",)),
+         ("drastic_product",),
+         scalar=_LO_HI + "\nr = lo * (1.0 if hi == 1.0 else 0.0)",
+         c="return a == 1.0 ? b : (b == 1.0 ? a : 0.0);",
+         numpy="np.where(a == 1.0, b, np.where(b == 1.0, a, 0.0))",
+         fll="DrasticProduct", fcl="DPROD"),
     Norm("einstein", "tnorm", _einstein_product, "a * b / (2 - (a + b - a * b))",
-         "einstein_sum", ("einstein_product",)),
+         "einstein_sum", ("einstein_product",),
+         scalar="r = (a * b) / (1.0 + (1.0 - a) * (1.0 - b))",
+         c="return (a * b) / (1.0 + (1.0 - a) * (1.0 - b));",
+         numpy="(a * b) / (1.0 + (1.0 - a) * (1.0 - b))",
+         fll="EinsteinProduct", fcl="EPROD"),
     Norm("hamacher", "tnorm", _hamacher_product, "a * b / (a + b - a * b), 0 at a = b = 0",
-         "hamacher_sum", ("hamacher_product",)),
+         "hamacher_sum", ("hamacher_product",),
+         scalar=_LO_HI + "\nden = (1.0 - hi) * lo + hi\nr = a * b\nr = r / den if den > 0.0 else r",
+         c="double hi = a < b ? b : a, lo = a < b ? a : b, d = hi + lo * (1.0 - hi);\n"
+           "    return d == 0.0 ? 0.0 : (a * b) / d;",
+         numpy="_div(a * b, np.maximum(a, b) + np.minimum(a, b) * (1.0 - np.maximum(a, b)), 0.0)",
+         fll="HamacherProduct", fcl="HPROD"),
     Norm("nilpotent_minimum", "tnorm", _nilpotent_minimum, "min(a, b) if a + b > 1, else 0",
-         "nilpotent_maximum", ("nilpotent_min",)),
-    Norm("max", "snorm", np.maximum, "max(a, b)", "min", ("maximum",)),
+         "nilpotent_maximum", ("nilpotent_min",),
+         scalar=_LO_HI + "\nr = lo * (1.0 if lo > 1.0 - hi else 0.0)",
+         c="double lo = a < b ? a : b, hi = a < b ? b : a;\n    return lo > 1.0 - hi ? lo : 0.0;",
+         numpy="np.where(np.minimum(a, b) > 1.0 - np.maximum(a, b), np.minimum(a, b), 0.0)",
+         fll="NilpotentMinimum", fcl="NMIN"),
+    Norm("max", "snorm", np.maximum, "max(a, b)", "min", ("maximum",),
+         scalar="r = a if a >= b else b",
+         c="return a < b ? b : a;",
+         numpy="np.maximum(a, b)",
+         fll="Maximum", fis="max", fcl="MAX", gradient="select"),
     Norm("probabilistic_sum", "snorm", _probabilistic_sum, "a + b - a * b", "product",
-         ("algebraic_sum", "probor")),
+         ("algebraic_sum", "probor"),
+         scalar=_LO_HI + "\nr = (1.0 - hi) * lo + hi",
+         c="double hi = a < b ? b : a, lo = a < b ? a : b;\n    return hi + lo * (1.0 - hi);",
+         numpy="np.maximum(a, b) + np.minimum(a, b) * (1.0 - np.maximum(a, b))",
+         fll="AlgebraicSum", fis="probor", fcl="ASUM", gradient="dual_product"),
     Norm("bounded_sum", "snorm", _bounded_sum, "min(1, a + b)",
-         "lukasiewicz", ("lukasiewicz_sum",)),
-    Norm("drastic_sum", "snorm", _drastic_sum, "b if a = 0, a if b = 0, else 1", "drastic"),
-    Norm("einstein_sum", "snorm", _einstein_sum, "(a + b) / (1 + a * b)", "einstein"),
+         "lukasiewicz", ("lukasiewicz_sum",),
+         scalar="r = a + b\nr = r if r <= 1.0 else 1.0",
+         c="double s = a + b;\n    return s < 1.0 ? s : 1.0;",
+         numpy="np.minimum(1.0, a + b)",
+         fll="BoundedSum", fcl="BSUM"),
+    Norm("drastic_sum", "snorm", _drastic_sum, "b if a = 0, a if b = 0, else 1", "drastic",
+         scalar=_LO_HI + "\nr = 1.0 if lo != 0.0 else hi",
+         c="return a == 0.0 ? b : (b == 0.0 ? a : 1.0);",
+         numpy="np.where(a == 0.0, b, np.where(b == 0.0, a, 1.0))",
+         fll="DrasticSum", fcl="DSUM"),
+    Norm("einstein_sum", "snorm", _einstein_sum, "(a + b) / (1 + a * b)", "einstein",
+         scalar="r = (a + b) / (1.0 + a * b)",
+         c="return (a + b) / (1.0 + a * b);",
+         numpy="(a + b) / (1.0 + a * b)",
+         fll="EinsteinSum", fcl="ESUM"),
     Norm("hamacher_sum", "snorm", _hamacher_sum,
-         "(a + b - 2 a b) / (1 - a b), 1 at a = b = 1", "hamacher"),
+         "(a + b - 2 a b) / (1 - a b), 1 at a = b = 1", "hamacher",
+         scalar="den = 1.0 - a * b\nr = (a * (1.0 - b) + b * (1.0 - a)) / den if den > 0.0 else 1.0",
+         c="double d = 1.0 - a * b;\n"
+           "    return d == 0.0 ? 1.0 : (a * (1.0 - b) + b * (1.0 - a)) / d;",
+         numpy="_div(a * (1.0 - b) + b * (1.0 - a), 1.0 - a * b, 1.0)",
+         fll="HamacherSum", fcl="HSUM"),
     Norm("nilpotent_maximum", "snorm", _nilpotent_maximum, "max(a, b) if a + b < 1, else 1",
-         "nilpotent_minimum", ("nilpotent_max",)),
+         "nilpotent_minimum", ("nilpotent_max",),
+         scalar="r = 1.0 if a + b >= 1.0 else (a if a >= b else b)",
+         c="return a + b < 1.0 ? (a < b ? b : a) : 1.0;",
+         numpy="np.where(a + b < 1.0, np.maximum(a, b), 1.0)",
+         fll="NilpotentMaximum", fcl="NMAX"),
 ):
     register(_norm)
+
+
+def get(name: str) -> Norm:
+    """The T- or S-norm of this canonical name (the two tables share no name)."""
+    return TNORMS[name] if name in TNORMS else SNORMS[name]
 
 
 def lookup(kind: str, name: str) -> Norm:

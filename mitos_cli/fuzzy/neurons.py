@@ -8,11 +8,11 @@ A neuron with inputs ``x_1 .. x_n`` in [0, 1]:
 3. **aggregation** (eq. 7): a T-norm (an AND neuron) or an S-norm (an OR neuron) folds the
    inputs, ``I = T(d_1, ..., d_n)``;
 4. **activation** (eqs. 10-11): a linguistic modifier, ``y = Phi(I)``: identity (the simplified
-   neuron), VERY = ``I^2``, MORE-OR-LESS = ``sqrt(I)`` (the hedges of :mod:`mitos_cli.hedges`).
+   neuron), VERY = ``I^2``, MORE-OR-LESS = ``sqrt(I)`` (the hedges of :mod:`mitos_cli.fuzzy.hedges`).
 
 Inputs stack on the last axis, so one call evaluates a neuron for a whole batch, and
 ``neuron(X[:, None, :], weights=W)`` with ``W[units, n]`` a whole layer. The compiled rule base
-(:mod:`mitos_cli.compile`) is a network of exactly these neurons with unit weights: membership
+(:mod:`mitos_cli.engine.compile`) is a network of exactly these neurons with unit weights: membership
 neurons, hedge neurons (activations), ``not`` (inhibitory inputs), AND and OR neurons; the
 folds run in the same order, so the values agree bit for bit (tests/test_neurons.py).
 """

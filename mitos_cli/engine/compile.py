@@ -22,11 +22,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import operators as ops_mod
-from .model import And, Expr, Not, Prop, Rule, RuleBase, Setting, Use, flatten, format_rule
-from .operators import Operators
-from .shapes import kernel_params
-from .terms import Term, Variable
+from ..lang import operators as ops_mod
+from ..lang.model import And, Expr, Not, Prop, Rule, RuleBase, Setting, Use, flatten, format_rule
+from ..lang.operators import Operators
+from ..fuzzy.shapes import kernel_params
+from ..lang.terms import Term, Variable
 
 ZERO, ONE = 0, 1
 
@@ -83,6 +83,12 @@ class CompiledRuleBase:
     #: constant consequents are rows with a = 0, unset outputs are all 0.
     cons_linear: np.ndarray | None = None
 
+    def __repr__(self) -> str:   # the generated one prints every array (125,000 characters)
+        return (f"<CompiledRuleBase {self.behavior!r}: {len(self.inputs)} inputs "
+                f"({', '.join(self.inputs)}), {len(self.outputs)} outputs "
+                f"({', '.join(self.outputs)}), {self.n_rules} rules, {self.n_terms} terms, "
+                f"{len(self.levels)} levels, {self.n_columns} neurons; {self.operators.describe()}>")
+
     @property
     def kernel_columns(self) -> np.ndarray:
         """The kernel as ``[4, T, 1]`` columns, to broadcast against ``[T, b]`` blocks."""
@@ -136,7 +142,7 @@ class CompiledRuleBase:
     @functools.cached_property
     def scalar(self):
         """The network as a Python function of one sample's floats (``None`` when it has no
-        exact scalar form): see :mod:`mitos_cli.scalar`. Written on first use."""
+        exact scalar form): see :mod:`mitos_cli.engine.scalar`. Written on first use."""
         from .scalar import scalar_function
 
         return scalar_function(self)
@@ -179,6 +185,7 @@ class Plan:
     weight: np.ndarray | None          # [R, 1] rule weights, None when all are 1
     sums: np.ndarray                   # [R, k, 1] output-layer weights (numerators, dens)
     den_row: np.ndarray                # [m] row of ``sums`` with each output's denominator
+    sum_rows: tuple                    # per row of ``sums``: its weights [R, 1], None if all 1
     grids: dict                        # (level, group) -> Grid, for AND groups that are grids
 
 
@@ -242,6 +249,8 @@ def _plan(c: "CompiledRuleBase") -> Plan:
         contexts=tuple(np.ascontiguousarray(c.context[:, j]) for j in range(c.context.shape[1])),
         weight=c.weight[:, None].copy() if c.weighted else None,
         sums=np.ascontiguousarray(c.sum_weights.T[:, :, None]), den_row=c.den_row,
+        sum_rows=tuple(None if (w == 1.0).all() else np.ascontiguousarray(w[:, None])
+                       for w in c.sum_weights),
         grids={} if c.operators.and_ != "min" else {
             (i, j): grid for i, level in enumerate(c.levels) for j, group in enumerate(level)
             if (grid := _grid(group, c)) is not None})
@@ -301,14 +310,36 @@ def compile_rulebase(rb: RuleBase, behavior: str | None = None,
                                                            ops_mod.resolve(rb.operators)))
     flat = flatten(rb, name)
     variables = rb.variables
+    inputs, outputs, linear_inputs = _used_variables(rb, flat, operators)
+    members = _membership_layer(inputs, variables)
+    builder = _Builder(len(members.terms))
+    ante = _antecedents(flat, builder, members.index)
+    cons = _consequents(flat, variables, inputs, outputs, linear_inputs)
+    default = np.array([np.nan if variables[o].default is None else variables[o].default
+                        for o in outputs], dtype=float)
+    universe = np.array([variables[v].universe for v in inputs], dtype=float).reshape(-1, 2)
+    return CompiledRuleBase(
+        rulebase=rb, behavior=name, operators=operators, inputs=inputs, universe=universe,
+        term_var=members.term_var, term_names=members.names, linear=members.linear,
+        kernel=members.kernel, shape_groups=members.shape_groups, levels=builder.levels(),
+        n_columns=builder.next_col, rule_col=ante.rule_col, weight=ante.weight,
+        context=ante.context, labels=ante.labels, rules=ante.rules, outputs=outputs,
+        cons_value=cons.value, cons_mask=cons.mask, cons_term=cons.term,
+        cons_hedges=cons.hedges, default=default, variables=dict(variables),
+        cons_linear=cons.linear)
 
+
+def _used_variables(rb: RuleBase, flat, operators: Operators):
+    """The inputs the rules read (in declaration order), the outputs they set, and for each
+    output with ``linear`` (Takagi-Sugeno) terms the inputs its coefficients follow."""
+    variables = rb.variables
     used_inputs: set[str] = set()
     for _, rule, contexts in flat:
         _collect_inputs(rule.antecedent, used_inputs)
         for use in contexts:
             if use.condition is not None:
                 _collect_inputs(use.condition, used_inputs)
-    linear_inputs = {}          # output variable -> the inputs its linear coefficients follow
+    linear_inputs: dict[str, tuple[str, ...]] = {}
     for _, rule, _ in flat:
         for c in rule.consequents:
             if c.term is not None and variables[c.var].term(c.term).shape == "linear":
@@ -316,7 +347,7 @@ def compile_rulebase(rb: RuleBase, behavior: str | None = None,
                 coefficients = variables[c.var].term(c.term).params[:-1]
                 used_inputs.update(n for n, a in zip(names, coefficients) if a != 0.0)
                 if operators.inference == "mamdani":
-                    from .errors import RuleBaseError
+                    from ..errors import RuleBaseError
 
                     raise RuleBaseError(
                         f"`{c.var} is {c.term}` is a linear (Takagi-Sugeno) consequent, which "
@@ -324,27 +355,36 @@ def compile_rulebase(rb: RuleBase, behavior: str | None = None,
                         hint="use `inference = weighted_average` (or weighted_sum), or give "
                              f"`{c.var}` membership-shaped terms")
     inputs = tuple(v.name for v in variables.values() if v.name in used_inputs)
-    outputs = tuple(dict.fromkeys(c.var for _, rule, _ in flat for c in rule.consequents))
-    outputs = tuple(v.name for v in variables.values() if v.name in outputs)
+    outputs = set(c.var for _, rule, _ in flat for c in rule.consequents)
+    return inputs, tuple(v.name for v in variables.values() if v.name in outputs), linear_inputs
 
-    # membership layer: every term of every used input
-    term_names: list[tuple[str, str]] = []
-    term_var: list[int] = []
-    terms: list[Term] = []
-    for k, vname in enumerate(inputs):
-        for t in variables[vname].terms:
-            term_names.append((vname, t.name))
-            term_var.append(k)
-            terms.append(t)
-    term_index = {key: i for i, key in enumerate(term_names)}
-    linear = np.array([t.corners is not None for t in terms], dtype=bool)
+
+@dataclass(frozen=True, eq=False)
+class _Members:
+    """The membership layer: every term of every used input, one neuron each."""
+
+    names: tuple[tuple[str, str], ...]     # [T] (variable, term)
+    terms: tuple[Term, ...]
+    term_var: np.ndarray                   # [T] input column of each
+    linear: np.ndarray                     # [T] piecewise-linear (the fast kernel)
+    kernel: np.ndarray                     # [4, T] (b, s1, c, s2) of the linear ones
+    shape_groups: tuple[ShapeGroup, ...]   # the others, grouped by shape and parameter count
+
+    @functools.cached_property
+    def index(self) -> dict[tuple[str, str], int]:
+        return {key: i for i, key in enumerate(self.names)}
+
+
+def _membership_layer(inputs: tuple[str, ...], variables) -> _Members:
+    names = tuple((v, t.name) for v in inputs for t in variables[v].terms)
+    terms = tuple(t for v in inputs for t in variables[v].terms)
+    term_var = [k for k, v in enumerate(inputs) for _ in variables[v].terms]
     kernel = np.zeros((4, len(terms)))
+    groups: dict[tuple[str, int], list[int]] = {}   # variadic shapes group by param count
     for i, t in enumerate(terms):
         if t.corners is not None:
             kernel[:, i] = kernel_params(t.corners)
-    groups: dict[tuple[str, int], list[int]] = {}   # variadic shapes group by param count
-    for i, t in enumerate(terms):
-        if t.corners is None:
+        else:
             groups.setdefault((t.shape, len(t.params)), []).append(i)
     shape_groups = tuple(
         ShapeGroup(shape, np.array([2 + i for i in idx], dtype=np.intp),
@@ -352,93 +392,120 @@ def compile_rulebase(rb: RuleBase, behavior: str | None = None,
                    np.array([terms[i].params for i in idx], dtype=float).reshape(
                        len(idx), n_params))
         for (shape, n_params), idx in groups.items())
+    return _Members(names, terms, np.array(term_var, dtype=np.intp),
+                    np.array([t.corners is not None for t in terms], dtype=bool), kernel,
+                    shape_groups)
 
-    builder = _Builder(len(terms))
 
-    def walk(expr: Expr) -> tuple[int, int]:
-        if isinstance(expr, Prop):
-            col = 2 + term_index[(expr.var, expr.term)]
-            ref = (col, 0)
-            if expr.hedges:
-                ref = builder.node(("hedge", expr.hedges, col), "hedge:" + " ".join(expr.hedges),
-                                   [ref])
-            return builder.negate(ref) if expr.negated else ref
-        if isinstance(expr, Not):
-            return builder.negate(walk(expr.expr))
-        op = "and" if isinstance(expr, And) else "or"
-        children = [walk(item) for item in expr.items]
-        if len(children) == 1:
-            return children[0]
-        return builder.node((op, tuple(c for c, _ in children)), op, children)
+@dataclass(frozen=True, eq=False)
+class _Antecedents:
+    rule_col: np.ndarray             # [R] column of each rule's antecedent
+    weight: np.ndarray               # [R] rule weight x constant use weights
+    context: np.ndarray              # [R, C] columns of use-conditions (1 = none)
+    labels: tuple[str, ...]
+    rules: tuple[Rule, ...]
 
-    rule_col, weight, contexts, labels, rules = [], [], [], [], []
-    for label, rule, uses in flat:
-        rule_col.append(walk(rule.antecedent)[0])
+
+def _walk(builder: "_Builder", term_index: dict, expr: Expr) -> tuple[int, int]:
+    """The (column, level) of ``expr``'s neuron, adding the neurons it needs to ``builder``
+    (a sub-expression used twice is one neuron)."""
+    if isinstance(expr, Prop):
+        col = 2 + term_index[(expr.var, expr.term)]
+        ref = (col, 0)
+        if expr.hedges:
+            ref = builder.node(("hedge", expr.hedges, col), "hedge:" + " ".join(expr.hedges),
+                               [ref])
+        return builder.negate(ref) if expr.negated else ref
+    if isinstance(expr, Not):
+        return builder.negate(_walk(builder, term_index, expr.expr))
+    op = "and" if isinstance(expr, And) else "or"
+    children = [_walk(builder, term_index, item) for item in expr.items]
+    if len(children) == 1:
+        return children[0]
+    return builder.node((op, tuple(c for c, _ in children)), op, children)
+
+
+def _antecedents(flat, builder: "_Builder", term_index: dict) -> _Antecedents:
+    """Every rule's antecedent and ``use`` conditions as neurons, and its weight."""
+    rule_col, weight, contexts = [], [], []
+    for _, rule, uses in flat:
+        rule_col.append(_walk(builder, term_index, rule.antecedent)[0])
         w = rule.weight
         ctx = []
         for use in uses:
             w *= use.weight
             if use.condition is not None:
-                ctx.append(walk(use.condition)[0])
+                ctx.append(_walk(builder, term_index, use.condition)[0])
         weight.append(w)
         contexts.append(ctx)
-        labels.append(label)
-        rules.append(rule)
     width = max((len(c) for c in contexts), default=0)
     context = np.full((len(flat), width), ONE, dtype=np.intp)
     for r, ctx in enumerate(contexts):
         context[r, :len(ctx)] = ctx
+    return _Antecedents(np.array(rule_col, dtype=np.intp), np.array(weight, dtype=float),
+                        context, tuple(label for label, _, _ in flat),
+                        tuple(rule for _, rule, _ in flat))
 
+
+@dataclass(frozen=True, eq=False)
+class _Consequents:
+    value: np.ndarray                # [R, m] crisp consequent (0 where unset or linear)
+    mask: np.ndarray                 # [R, m] the rule sets this output
+    term: tuple[tuple[str | None, ...], ...]
+    hedges: tuple[tuple[tuple[str, ...], ...], ...]
+    linear: np.ndarray | None        # [R, m, k + 1] Takagi-Sugeno consequents, if any
+
+
+def _consequents(flat, variables, inputs: tuple[str, ...], outputs: tuple[str, ...],
+                 linear_inputs: dict[str, tuple[str, ...]]) -> _Consequents:
+    """What each rule sets: a crisp value (a term's centre or a number), the term and hedges
+    it names, and, for ``linear`` terms, the coefficients over :data:`inputs`."""
     m = len(outputs)
-    cons_value = np.zeros((len(flat), m))
-    cons_mask = np.zeros((len(flat), m), dtype=bool)
-    cons_term: list[list[str | None]] = [[None] * m for _ in flat]
-    cons_hedges: list[list[tuple[str, ...]]] = [[()] * m for _ in flat]
+    value = np.zeros((len(flat), m))
+    mask = np.zeros((len(flat), m), dtype=bool)
+    term: list[list[str | None]] = [[None] * m for _ in flat]
+    hedges: list[list[tuple[str, ...]]] = [[()] * m for _ in flat]
     for r, (_, rule, _) in enumerate(flat):
         for c in rule.consequents:
             j = outputs.index(c.var)
-            cons_mask[r, j] = True
+            mask[r, j] = True
             if c.term is not None:
-                cons_value[r, j] = variables[c.var].term(c.term).center
-                cons_term[r][j] = c.term
-                cons_hedges[r][j] = c.hedges
+                value[r, j] = variables[c.var].term(c.term).center
+                term[r][j] = c.term
+                hedges[r][j] = c.hedges
             else:
-                cons_value[r, j] = c.value
-    cons_linear = None
-    if linear_inputs:
-        cons_linear = np.zeros((len(flat), m, len(inputs) + 1))
-        cons_linear[:, :, -1] = cons_value
-        input_col = {var: i for i, var in enumerate(inputs)}
-        for r, (_, rule, _) in enumerate(flat):
-            for c in rule.consequents:
-                if c.var in linear_inputs and c.term is not None:
-                    term = variables[c.var].term(c.term)
-                    if term.shape == "linear":
-                        j = outputs.index(c.var)
-                        for var, a in zip(linear_inputs[c.var], term.params[:-1]):
-                            if a != 0.0:
-                                cons_linear[r, j, input_col[var]] = a
-                        cons_linear[r, j, -1] = term.params[-1]
-                        cons_value[r, j] = 0.0
-    default = np.array([np.nan if variables[o].default is None else variables[o].default
-                        for o in outputs], dtype=float)
-    universe = np.array([variables[v].universe for v in inputs], dtype=float).reshape(-1, 2)
+                value[r, j] = c.value
+    linear = _linear_consequents(flat, variables, inputs, outputs, linear_inputs, value) \
+        if linear_inputs else None
+    return _Consequents(value, mask, tuple(tuple(row) for row in term),
+                        tuple(tuple(row) for row in hedges), linear)
 
-    return CompiledRuleBase(
-        rulebase=rb, behavior=name, operators=operators, inputs=inputs, universe=universe,
-        term_var=np.array(term_var, dtype=np.intp), term_names=tuple(term_names),
-        linear=linear, kernel=kernel, shape_groups=shape_groups, levels=builder.levels(),
-        n_columns=builder.next_col, rule_col=np.array(rule_col, dtype=np.intp),
-        weight=np.array(weight, dtype=float), context=context, labels=tuple(labels),
-        rules=tuple(rules), outputs=outputs, cons_value=cons_value, cons_mask=cons_mask,
-        cons_term=tuple(tuple(row) for row in cons_term),
-        cons_hedges=tuple(tuple(row) for row in cons_hedges), default=default,
-        variables=dict(variables), cons_linear=cons_linear)
+
+def _linear_consequents(flat, variables, inputs, outputs, linear_inputs,
+                        value: np.ndarray) -> np.ndarray:
+    """``[R, m, k + 1]``: constants as rows with a = 0; zeroes ``value`` where a rule's
+    consequent is linear (its centre means nothing there)."""
+    out = np.zeros((len(flat), len(outputs), len(inputs) + 1))
+    out[:, :, -1] = value
+    input_col = {var: i for i, var in enumerate(inputs)}
+    for r, (_, rule, _) in enumerate(flat):
+        for c in rule.consequents:
+            if c.var not in linear_inputs or c.term is None:
+                continue
+            term = variables[c.var].term(c.term)
+            if term.shape == "linear":
+                j = outputs.index(c.var)
+                for var, a in zip(linear_inputs[c.var], term.params[:-1]):
+                    if a != 0.0:
+                        out[r, j, input_col[var]] = a
+                out[r, j, -1] = term.params[-1]
+                value[r, j] = 0.0
+    return out
 
 
 def _termset_inputs(rb: RuleBase, output: str) -> tuple[str, ...]:
     """The input variables, in order, of the term set defining ``output`` (the coefficient
-    order of its ``linear`` terms, :data:`mitos_cli.shapes.LINEAR_LAYOUT`)."""
+    order of its ``linear`` terms, :data:`mitos_cli.fuzzy.shapes.LINEAR_LAYOUT`)."""
     for ts in rb.termsets:
         if any(v.name == output for v in ts.variables):
             return tuple(v.name for v in ts.variables if v.role == "input")

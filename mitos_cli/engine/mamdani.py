@@ -43,8 +43,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import hedges as hedge_mod
-from . import norms
+from ..fuzzy import hedges as hedge_mod
+from ..fuzzy import norms
 
 #: Ceiling on the intermediate ``[rules, samples, resolution]`` array of one sub-block. Small
 #: enough to stay in cache: on the benchmark machine 1 MB ran about twice as fast as 8 MB and

@@ -10,11 +10,11 @@ from __future__ import annotations
 from pathlib import Path
 
 from . import operators as ops_mod
-from .errors import RuleBaseError, Span, TermSetError, unknown
-from .hedges import HEDGES
+from ..errors import RuleBaseError, Span, TermSetError, unknown
+from ..fuzzy.hedges import HEDGES
 from .model import And, Behavior, Consequent, Expr, Not, Or, Prop, Rule, RuleBase
 from .parse import ParsedFile, parse_rules
-from .termset import load_termset
+from .termfile import load_termset
 from .terms import TermSet, Variable
 
 MAIN = "main"

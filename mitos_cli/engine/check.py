@@ -28,7 +28,7 @@ code                  severity    meaning
 The input space is sampled on a grid: ``resolution`` evenly spaced points per input plus every
 corner point of its terms (where memberships start or stop being 0), capped at
 :data:`MAX_SAMPLES` points in all. The whole grid is one vectorized batch through
-:func:`mitos_cli.engine.evaluate`. Regions are reported as boxes of sampled values, e.g.
+:func:`mitos_cli.engine.evaluation.evaluate`. Regions are reported as boxes of sampled values, e.g.
 ``road in [0, 40] and size in [70, 100]``; an input left out of a box may take any value.
 """
 
@@ -38,13 +38,13 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from .model import flatten
+from ..lang.model import flatten
 from .compile import CompiledRuleBase, compile_rulebase
-from .engine import evaluate
-from .errors import Span
-from .model import (And, Consequent, Expr, Not, Prop, Rule, RuleBase, format_consequent,
+from .evaluation import evaluate
+from ..errors import Span
+from ..lang.model import (And, Consequent, Expr, Not, Prop, Rule, RuleBase, format_consequent,
                     format_expr)
-from .terms import Variable
+from ..lang.terms import Variable
 
 SEVERITIES = ("error", "warning", "info")
 #: Most grid points one behavior is sampled on (the per-input resolution shrinks to fit).

@@ -5,9 +5,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import hedges as hedge_mod
+from ..fuzzy import hedges as hedge_mod
 from .compile import CompiledRuleBase
-from .words import plural
+from ..words import plural
 
 INFERENCE_TEXT = {
     "weighted_average": "weighted average of the rules' consequents, sum(dof y) / sum(dof) "

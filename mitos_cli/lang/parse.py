@@ -1,7 +1,7 @@
 """Parsing the rule language with Lark (LALR, linear time: no input can make it hang).
 
 :func:`parse_rules` turns text into a :class:`ParsedFile` of model objects whose names are not
-yet checked (that is :mod:`mitos_cli.build`'s job, outside Lark's callbacks). Lark's errors are
+yet checked (that is :mod:`mitos_cli.lang.resolve`'s job, outside Lark's callbacks). Lark's errors are
 translated into :class:`RuleSyntaxError` with ``path:line:col``, the line, a caret and what was
 expected, in words.
 """
@@ -14,11 +14,12 @@ from dataclasses import dataclass
 from lark import Lark, Token, Transformer, Tree, v_args
 from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken
 
-from .errors import RuleSyntaxError, Span
+from ..errors import RuleSyntaxError, Span
+from ..fuzzy.hedges import HEDGES
 from .model import And, Behavior, Consequent, Not, Or, Prop, Rule, Setting, Use
-from .resources import grammar_text
+from ..resources import grammar_text
 
-HEDGE_NAMES = ("very", "somewhat", "more_or_less", "extremely", "seldom", "intensely", "any")
+HEDGE_NAMES = tuple(HEDGES)          # the grammar's HEDGE words (tests/test_registries.py)
 
 #: How terminals are named in error messages.
 TERMINAL_WORDS = {
@@ -117,8 +118,8 @@ def _hedge_hint(text: str, token: Token) -> str | None:
     """``road is vary WIDE``: the word before the term was meant as a hedge."""
     import re
 
-    from .errors import did_you_mean
-    from .hedges import HEDGES
+    from ..errors import did_you_mean
+    from ..fuzzy.hedges import HEDGES
 
     before = re.search(r"\bis\s+(?:not\s+)?([A-Za-z_][\w\-]*)\s*$",
                        text[:token.start_pos])

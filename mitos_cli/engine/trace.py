@@ -11,8 +11,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .engine import Result
-from .words import plural
+from .evaluation import Result
+from ..resources import display_path
+from ..words import plural
 
 
 @dataclass(frozen=True)
@@ -41,6 +42,12 @@ class Trace:
     rules: tuple[RuleTrace, ...]          # fired rules only, in rule-base order
     outputs: tuple[tuple[str, float, str], ...]
     defaulted: tuple[str, ...] = ()       # outputs no rule set: their `default` applies
+
+    def _repr_html_(self) -> str:
+        """A notebook shows the trace as the terminal does."""
+        import html
+
+        return f"<pre>{html.escape(self.render())}</pre>"
 
     def to_json(self) -> dict:
         return {
@@ -82,28 +89,6 @@ class Trace:
             note = "   (its default: no rule sets it here)" if name in self.defaulted else ""
             lines.append(f"  {name} = {num(value)} {unit}".rstrip() + note)
         return "\n".join(lines)
-
-
-def display_path(path: str | None) -> str:
-    """A rule-base path as users should read it: relative to here, or marked as packaged."""
-    import os
-    from pathlib import Path
-
-    from .resources import data_dir
-
-    if not path:
-        return "<rules>"
-    p = Path(path).resolve()
-    try:
-        packaged = Path(str(data_dir("rulebases"))).resolve()
-        if p.is_relative_to(packaged):
-            return f"rulebases/{p.relative_to(packaged).as_posix()} (packaged)"
-    except (OSError, ValueError):
-        pass
-    try:
-        return os.path.relpath(p)
-    except ValueError:
-        return str(path)
 
 
 def trace_of(result: Result, row: int = 0) -> Trace:

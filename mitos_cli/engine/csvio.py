@@ -8,8 +8,8 @@ from typing import TextIO
 
 import numpy as np
 
-from .errors import InputError, Span, did_you_mean
-from .words import plural
+from ..errors import InputError, Span, did_you_mean
+from ..words import plural
 
 
 def read_batch(text: str, path: str, inputs: tuple[str, ...]) -> np.ndarray:

@@ -13,7 +13,7 @@ from typing import Any, Iterable
 
 import yaml
 
-from .errors import MitosError, Span, did_you_mean
+from ..errors import MitosError, Span, did_you_mean
 
 
 class YMap(dict):

@@ -8,9 +8,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass, fields, replace
 
-from . import norms
-from .errors import RuleBaseError, Span, unknown
-from .model import Setting
+from ..fuzzy import norms
+from ..errors import RuleBaseError, Span, unknown
+from ..lang.model import Setting
 
 INFERENCES = ("weighted_average", "weighted_sum", "mamdani")
 #: Mamdani implications: any T-norm (min and product are the classic ones; FLL files also use

@@ -20,6 +20,9 @@ import itertools
 import math
 from typing import TYPE_CHECKING, Callable
 
+from ..fuzzy.hedges import HEDGES as HEDGE_REGISTRY
+from ..fuzzy.norms import SNORMS, TNORMS
+
 if TYPE_CHECKING:
     from .compile import CompiledRuleBase
 
@@ -28,38 +31,11 @@ MAX_COLUMNS = 4000
 
 ScalarFn = Callable[..., "tuple[float, ...] | None"]
 
-# Each norm as Python statements on floats ``a`` and ``b`` leaving ``r``, mirroring the NumPy
-# formulas of :mod:`mitos_cli.norms` operation by operation (see the comments there).
-_MIN = "r = a if a <= b else b"
-_MAX = "r = a if a >= b else b"
-_LO_HI = "lo = a if a <= b else b\nhi = a if a >= b else b"
-NORMS: dict[str, str] = {
-    "min": _MIN,
-    "max": _MAX,
-    "product": "r = a * b",
-    "lukasiewicz": _LO_HI + "\nr = lo - (1.0 - hi)\nr = r if r >= 0.0 else 0.0",
-    "probabilistic_sum": _LO_HI + "\nr = (1.0 - hi) * lo + hi",
-    "bounded_sum": "r = a + b\nr = r if r <= 1.0 else 1.0",
-    "drastic": _LO_HI + "\nr = lo * (1.0 if hi == 1.0 else 0.0)",
-    "drastic_sum": _LO_HI + "\nr = 1.0 if lo != 0.0 else hi",
-    "einstein": "r = (a * b) / (1.0 + (1.0 - a) * (1.0 - b))",
-    "einstein_sum": "r = (a + b) / (1.0 + a * b)",
-    "hamacher": _LO_HI + "\nden = (1.0 - hi) * lo + hi\nr = a * b\nr = r / den if den > 0.0 else r",
-    "hamacher_sum": "den = 1.0 - a * b\n"
-                    "r = (a * (1.0 - b) + b * (1.0 - a)) / den if den > 0.0 else 1.0",
-    "nilpotent_minimum": _LO_HI + "\nr = lo * (1.0 if lo > 1.0 - hi else 0.0)",
-    "nilpotent_maximum": "r = 1.0 if a + b >= 1.0 else (a if a >= b else b)",
-}
-
-# Hedges as statements on ``x`` leaving ``x`` (mitos_cli.hedges).
-HEDGES: dict[str, str] = {
-    "very": "x = x * x",
-    "extremely": "x = x * x * x",
-    "somewhat": "x = sqrt(x)",
-    "more_or_less": "x = sqrt(x)",
-    "seldom": "x = sqrt(0.5 * x) if x <= 0.5 else 1.0 - sqrt(0.5 * (1.0 - x))",
-    "intensely": "y = 1.0 - x\nx = 2.0 * x * x if x <= 0.5 else 1.0 - 2.0 * (y * y)",
-}
+# The scalar forms are the registries' (fuzzy/norms.py, fuzzy/hedges.py): each norm as Python
+# statements on floats ``a`` and ``b`` leaving ``r``, each hedge on ``x`` leaving ``x``, mirroring
+# the NumPy formulas operation by operation.
+NORMS: dict[str, str] = {n.name: n.scalar for n in (*TNORMS.values(), *SNORMS.values())}
+HEDGES: dict[str, str] = {h.name: h.scalar for h in HEDGE_REGISTRY.values() if h.scalar}
 
 
 class _Unsupported(Exception):
@@ -166,8 +142,8 @@ def _group(group, ops, emit) -> None:
 
 
 def _outputs(c: CompiledRuleBase, emit) -> None:
-    """DOFs (contexts, then weights, as :func:`mitos_cli.engine.rule_dof`) and the weighted
-    sums by the engine's pairwise tree (:func:`mitos_cli.engine.tree_sum`)."""
+    """DOFs (contexts, then weights, as :func:`mitos_cli.engine.evaluation.rule_dof`) and the weighted
+    sums by the engine's pairwise tree (:func:`mitos_cli.engine.evaluation.tree_sum`)."""
     plan = c.plan
     R = c.n_rules
     for r in range(R):

@@ -1,6 +1,6 @@
 """The rule-base model: what a rule file means, as frozen dataclasses.
 
-The parser produces these with names as written; :func:`mitos_cli.build.build_rulebase`
+The parser produces these with names as written; :func:`mitos_cli.lang.resolve.build_rulebase`
 checks every name against the term sets (with "did you mean") before a :class:`RuleBase` is
 returned, so everything downstream may trust them. :func:`format_rule` writes a rule back in
 the rule language (``parse(format_rule(r)) == r``).
@@ -11,7 +11,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Union
 
-from .errors import Span
+from ..errors import Span
 from .terms import TermSet, Variable
 
 
@@ -114,6 +114,12 @@ class RuleBase:
     operators: tuple[Setting, ...] = ()
     termset_paths: tuple[str, ...] = ()
 
+    def __repr__(self) -> str:   # the generated one spells out every rule and term
+        rules = sum(len(b.rules) for b in self.behaviors)
+        return (f"<RuleBase {self.path or '(text)'}: {len(self.behaviors)} behaviors "
+                f"({', '.join(b.name for b in self.behaviors)}), {rules} rules, "
+                f"{len(self.variables)} variables>")
+
     @property
     def variables(self) -> dict[str, Variable]:
         return {v.name: v for ts in self.termsets for v in ts.variables}
@@ -123,7 +129,7 @@ class RuleBase:
         return self.behaviors[0].name
 
     def behavior(self, name: str | None = None) -> Behavior:
-        from .errors import unknown
+        from ..errors import unknown
 
         name = name or self.default_behavior
         for b in self.behaviors:

@@ -13,11 +13,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import hedges as hedge_mod
-from . import norms
+from ..fuzzy import hedges as hedge_mod
+from ..fuzzy import norms
 from .compile import CompiledRuleBase
-from .errors import InputError, NoRuleFiredError
-from .shapes import SHAPES
+from ..errors import InputError, NoRuleFiredError
+from ..fuzzy.shapes import SHAPES
 
 
 @dataclass(frozen=True, eq=False)   # holds arrays: identity, not ==
@@ -34,6 +34,12 @@ class Result:
 
     # memberships and dof are transposed views of [T, n] / [R, n] arrays (rows are samples).
 
+    def __repr__(self) -> str:
+        kept = [k for k in ("memberships", "dof", "values") if getattr(self, k) is not None]
+        return (f"<Result of {self.compiled.behavior!r}: {len(self.outputs):,} samples x "
+                f"{len(self.compiled.outputs)} outputs ({', '.join(self.compiled.outputs)})"
+                f"{'; with ' + ', '.join(kept) if kept else ''}>")
+
     def output(self, name: str) -> np.ndarray:
         return self.outputs[:, self.compiled.outputs.index(name)]
 
@@ -44,13 +50,25 @@ def as_batch(compiled: CompiledRuleBase, columns: dict[str, object]) -> np.ndarr
     Every compiled input must be given; scalars broadcast against arrays. Names that the
     behavior does not use are refused with a "did you mean".
     """
-    from .errors import unknown
-
     if len(columns) == len(compiled.inputs):   # numbers by name: one small array, no checks
         try:
             return np.array([[float(columns[k]) for k in compiled.inputs]])
         except (KeyError, TypeError, ValueError):
             pass                               # arrays, missing names or bad values: below
+    _check_names(compiled, columns)
+    return np.ascontiguousarray(_columns(compiled, columns).T)
+
+
+def as_columns(compiled: CompiledRuleBase, columns: dict[str, object]) -> np.ndarray:
+    """Like :func:`as_batch`, but ``Xt[k, n]``: one contiguous row per input (what the
+    engine works on, so a large batch is not copied into rows first)."""
+    _check_names(compiled, columns)
+    return _columns(compiled, columns)
+
+
+def _check_names(compiled: CompiledRuleBase, columns: dict[str, object]) -> None:
+    from ..errors import unknown
+
     for name in columns:
         if name not in compiled.inputs:
             known = [v.name for v in compiled.variables.values() if v.role == "input"]
@@ -63,6 +81,9 @@ def as_batch(compiled: CompiledRuleBase, columns: dict[str, object]) -> np.ndarr
         raise InputError("missing input " + ", ".join(f"`{m}`" for m in missing),
                          expected="a value for each of " + ", ".join(compiled.inputs),
                          hint="give them as " + " ".join(f"{k}=VALUE" for k in missing))
+
+
+def _columns(compiled: CompiledRuleBase, columns: dict[str, object]) -> np.ndarray:
     arrays = []
     for name in compiled.inputs:
         value = columns[name]
@@ -79,10 +100,10 @@ def as_batch(compiled: CompiledRuleBase, columns: dict[str, object]) -> np.ndarr
     if len(shape) > 1:
         raise InputError(f"inputs must be numbers or 1-D arrays, not of shape {shape}")
     n = shape[0] if shape else 1
-    X = np.empty((n, len(arrays)))
+    Xt = np.empty((len(arrays), n))
     for j, arr in enumerate(arrays):
-        X[:, j] = np.broadcast_to(arr, shape).reshape(-1) if shape else arr
-    return X
+        Xt[j] = np.broadcast_to(arr, shape).reshape(-1) if shape else arr
+    return Xt
 
 
 def check_inputs(compiled: CompiledRuleBase, X) -> tuple[np.ndarray, np.ndarray]:
@@ -107,9 +128,14 @@ def _clamp(compiled: CompiledRuleBase, X: np.ndarray, first: int = 0,
     """Rows ``X[b, k]`` -> clamped ``Xt[k, b]`` (each input a contiguous row) and how many
     samples of each input were clamped. ``first`` and ``total`` place the block in its batch
     for the message about a NaN."""
+    return _clamp_columns(compiled, X.T, first, total)
+
+
+def _clamp_columns(compiled: CompiledRuleBase, Xt: np.ndarray, first: int = 0,
+                   total: int | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`_clamp` of a block given as columns ``Xt[k, b]`` (any strides)."""
     plan = compiled.plan
-    Xt = np.array(X.T, order="C")
-    Xc = np.maximum(Xt, plan.lo_col)           # NaN stays NaN, and differs from itself
+    Xc = np.maximum(Xt, plan.lo_col, order="C")  # NaN stays NaN, and differs from itself
     np.minimum(Xc, plan.hi_col, out=Xc)
     Xc += 0.0     # -0.0 -> 0.0: which zero max(-0.0, 0.0) returns is NumPy's choice, per loop
     if not (Xc != Xt).any():                   # the common case: nothing to clamp, no NaN
@@ -117,7 +143,7 @@ def _clamp(compiled: CompiledRuleBase, X: np.ndarray, first: int = 0,
     bad = np.isnan(Xt)
     if bad.any():
         col, row = map(int, np.argwhere(bad)[0])
-        where = f" (sample {first + row + 1})" if (total or X.shape[0]) > 1 else ""
+        where = f" (sample {first + row + 1})" if (total or Xt.shape[1]) > 1 else ""
         raise InputError(f"input `{compiled.inputs[col]}` is not a number (NaN){where}",
                          hint="give every input a finite number")
     return Xc, (Xc != Xt).sum(axis=1)
@@ -132,7 +158,7 @@ def memberships(compiled: CompiledRuleBase, Xt: np.ndarray, out: np.ndarray) -> 
     """Membership layer: fill rows ``2 .. 2+T`` of ``out[columns, b]`` from ``Xt[k, b]``.
 
     Piecewise-linear terms share one kernel, ``clip(1 + min((x - b) s1, (c - x) s2), 0, 1)``
-    (see :func:`mitos_cli.shapes.kernel_params`); other shapes are evaluated per shape. The
+    (see :func:`mitos_cli.fuzzy.shapes.kernel_params`); other shapes are evaluated per shape. The
     clip at 1 is skipped when no term has a plateau between two slopes (triangles and
     shoulders never exceed 1), and the clip at 0 takes a row of zeros: NumPy's ``maximum``
     with a Python scalar is about 1.5x slower than with an array.
@@ -268,19 +294,40 @@ def weighted_average(compiled: CompiledRuleBase, dof: np.ndarray,
     """Eqs. 18-19 for every output: ``sum(dof * y) / sum(dof)`` (NaN where nothing fired).
 
     ``y`` is the rule's crisp consequent, or with linear consequents ``a . x + c`` for the
-    block's inputs ``Xt[k, b]``; ``weighted_sum`` skips the division.
+    block's inputs ``Xt[k, b]``; ``weighted_sum`` skips the division. Every sum is the
+    pairwise :func:`tree_sum` over the rules, so its bits do not depend on the batch.
     """
     plan = compiled.plan
-    W = np.multiply(dof[:, None], plan.sums)     # [R, k, b]: numerators, then denominators
     m = len(compiled.outputs)
     if compiled.cons_linear is not None:
+        W = np.multiply(dof[:, None], plan.sums)     # [R, k, b]: numerators, denominators
         np.multiply(dof[:, None], linear_consequents(compiled, Xt).transpose(1, 0, 2),
                     out=W[:, :m])
-    sums = tree_sum(W)
+        sums = tree_sum(W)
+    else:
+        sums = _constant_sums(plan, dof)
     if compiled.operators.inference == "weighted_sum":
         return sums[:m].copy()
     den = sums[plan.den_row]
-    out = np.divide(sums[:m], den, out=np.full((m, dof.shape[1]), np.nan), where=den > 0)
+    fired = den > 0
+    if fired.all():
+        return np.divide(sums[:m], den)
+    return np.divide(sums[:m], den, out=np.full((m, dof.shape[1]), np.nan), where=fired)
+
+
+def _constant_sums(plan, dof: np.ndarray) -> np.ndarray:
+    """``[k, b]``: each numerator and denominator row of the output layer, one at a time
+    through one ``[R, b]`` buffer that stays in cache (a loop over the few sums, never over
+    rules); a row of ones (a denominator) adds the DOFs themselves. The same products and
+    the same tree as summing ``dof[:, None] * plan.sums`` at once."""
+    buf = np.empty_like(dof)
+    out = np.empty((len(plan.sum_rows), dof.shape[1]))
+    for j, weights in enumerate(plan.sum_rows):
+        if weights is None:
+            np.copyto(buf, dof)
+        else:
+            np.multiply(dof, weights, out=buf)
+        out[j] = tree_sum(buf)
     return out
 
 
@@ -333,11 +380,43 @@ def evaluate(compiled: CompiledRuleBase, X, *, detail: bool = True, keep_values:
                   counts, values.T if keep_values else None)
 
 
+def evaluate_columns(compiled: CompiledRuleBase, Xt: np.ndarray, *,
+                     strict: bool = True) -> np.ndarray:
+    """The outputs ``[m, n]`` (one contiguous row per output) for inputs given as columns
+    ``Xt[k, n]``: :func:`evaluate` with ``detail=False``, bit for bit, without copying a large
+    batch into rows or keeping its clamped inputs (``load_rulebase().evaluate(**arrays)``)."""
+    Xt = np.asarray(Xt, dtype=float)
+    k, n = Xt.shape
+    if k != len(compiled.inputs):
+        raise InputError(f"expected {len(compiled.inputs)} input columns "
+                         f"({', '.join(compiled.inputs)}), not {k}")
+    out = np.empty((len(compiled.outputs), n))
+    for start in range(0, n, BLOCK):
+        block = slice(start, min(start + BLOCK, n))
+        Xc, _ = _clamp_columns(compiled, Xt[:, block], start, n)
+        out[:, block] = infer(compiled, rule_dof(compiled, network_values(compiled, Xc)), Xc)
+    if np.isnan(out).any():
+        fill_defaults(compiled, out.T, _ClampedRows(compiled, Xt), strict)
+    return out
+
+
+class _ClampedRows:
+    """``X[row, i]`` of a batch given as columns, clamped on access (only for the message
+    about a sample no rule fired for)."""
+
+    def __init__(self, compiled: CompiledRuleBase, Xt: np.ndarray) -> None:
+        self.lo, self.hi, self.Xt = compiled.plan.lo, compiled.plan.hi, Xt
+
+    def __getitem__(self, key: tuple[int, int]) -> float:
+        row, i = key
+        return min(max(float(self.Xt[i, row]), self.lo[i]), self.hi[i]) + 0.0
+
+
 def evaluate_one(compiled: CompiledRuleBase, values: list[float],
                  strict: bool = True) -> tuple[float, ...]:
     """The outputs for one sample (inputs in :attr:`CompiledRuleBase.inputs` order): the same
     bits as its row in :func:`evaluate`, through the network's scalar form where it has one
-    (:mod:`mitos_cli.scalar`, a few microseconds instead of some forty NumPy calls)."""
+    (:mod:`mitos_cli.engine.scalar`, a few microseconds instead of some forty NumPy calls)."""
     one = _evaluate_one(compiled, values)
     if one is not None:
         return one[1]

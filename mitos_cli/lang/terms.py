@@ -1,7 +1,7 @@
 """Linguistic variables and their terms (the model side of a term set).
 
 A :class:`Variable` has a universe, a role (input or output) and terms; a :class:`Term` is a
-named membership function from :mod:`mitos_cli.shapes`. Both are frozen and validated when
+named membership function from :mod:`mitos_cli.fuzzy.shapes`. Both are frozen and validated when
 built, so a compiled rule base never meets a malformed one.
 """
 
@@ -12,8 +12,8 @@ from typing import Literal
 
 import numpy as np
 
-from .errors import Span, TermSetError, unknown
-from .shapes import SHAPES, Shape
+from ..errors import Span, TermSetError, unknown
+from ..fuzzy.shapes import SHAPES, Shape
 
 Role = Literal["input", "output"]
 

@@ -16,7 +16,7 @@ import tempfile
 from pathlib import Path
 from typing import Callable
 
-from . import __version__
+from .._version import __version__
 from .model import RuleBase
 
 _FORMAT = 1
@@ -35,7 +35,7 @@ def _digest(data: bytes) -> str:
 
 
 def _key(path: Path, data: bytes) -> str:
-    from .resources import data_dir
+    from ..resources import data_dir
 
     grammar = (data_dir("grammar") / "mitos.lark").read_bytes()
     # The path as given and resolved: spans in the cached model quote the path as given.

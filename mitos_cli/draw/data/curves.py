@@ -1,0 +1,167 @@
+"""Term curves: every term of a variable sampled over its universe (corner points included, so
+piecewise-linear curves are drawn exactly), and the memberships of a marked value."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ...errors import InputError, unknown
+from ...lang.model import RuleBase
+from ...lang.terms import Term, Variable
+
+#: Samples per term curve (corner points are added to these).
+CURVE_POINTS = 401
+
+
+@dataclass(frozen=True)
+class TermCurve:
+    """One term of a variable, ready to draw.
+
+    ``kind`` is ``"curve"`` (a membership function sampled at ``x``), ``"singleton"`` (a crisp
+    output value: ``x = [center]``, ``y = [1]``, drawn as a stem) or ``"linear"`` (a
+    Takagi-Sugeno consequent, which has no membership function: ``formula`` says what it is).
+    ``label_x`` is where its name goes: the middle of its plateau inside the universe.
+    """
+
+    name: str
+    kind: str
+    x: np.ndarray
+    y: np.ndarray
+    center: float
+    label_x: float
+    formula: str = ""
+
+
+@dataclass(frozen=True)
+class VariablePlot:
+    """A variable's term set, with an optional value marked and its memberships."""
+
+    name: str
+    role: str
+    unit: str
+    description: str
+    universe: tuple[float, float]
+    curves: tuple[TermCurve, ...]
+    value: float | None = None
+    memberships: tuple[tuple[str, float], ...] = ()   # (term, mu) at ``value``, curves only
+    clamped: bool = False                             # ``value`` was outside the universe
+
+    @property
+    def axis_label(self) -> str:
+        return f"{self.name} [{self.unit}]" if self.unit else self.name
+
+
+def visible(mu: float) -> bool:
+    """Whether a membership is worth writing at two decimals (0.004 would print as 0.00)."""
+    return round(mu, 2) > 0
+
+
+def curve_grid(universe: tuple[float, float], terms: tuple[Term, ...] = (),
+               points: int = CURVE_POINTS) -> np.ndarray:
+    """``points`` samples of the universe plus every finite corner inside it, and the points
+    just beside each corner, so that kinks and vertical edges land exactly on the grid. When
+    every term is piecewise linear, the ends and corners alone draw them exactly (and keep
+    SVG files small)."""
+    lo, hi = universe
+    if terms and all(t.corners is not None for t in terms):
+        points = 2
+    extra = []
+    for term in terms:
+        corners = term.corners
+        if corners is None:
+            continue
+        for c in corners:
+            if np.isfinite(c) and lo <= c <= hi:
+                extra += [c, np.nextafter(c, -np.inf), np.nextafter(c, np.inf)]
+    x = np.concatenate([np.linspace(lo, hi, points), np.asarray(extra, dtype=float)])
+    return np.unique(np.clip(x, lo, hi))
+
+
+def linear_formula(term: Term, inputs: tuple[str, ...]) -> str:
+    """``y = 0.5 road - size + 90`` for a ``linear`` term over ``inputs`` (its term set's)."""
+    *coefficients, constant = term.params
+    parts = []
+    for name, a in zip(inputs, coefficients):
+        if a == 0:
+            continue
+        sign = "-" if a < 0 else "+"
+        mag = abs(a)
+        parts.append(f"{sign} {'' if mag == 1 else f'{mag:g} '}{name}")
+    if constant or not parts:
+        parts.append(f"{'-' if constant < 0 else '+'} {abs(constant):g}")
+    text = " ".join(parts)
+    text = text[2:] if text.startswith("+ ") else "-" + text[2:]
+    return f"y = {text}"
+
+
+def _term_curve(term: Term, x: np.ndarray, inputs: tuple[str, ...]) -> TermCurve:
+    if term.shape == "linear":
+        empty = np.empty(0)
+        return TermCurve(term.name, "linear", empty, empty, float("nan"), float("nan"),
+                         linear_formula(term, inputs))
+    if term.shape == "singleton":
+        c = term.center
+        return TermCurve(term.name, "singleton", np.array([c]), np.array([1.0]), c, c)
+    y = np.asarray(term.membership(x), dtype=float)
+    top = x[y >= y.max()] if y.size else x
+    label_x = float((top.min() + top.max()) / 2) if top.size else term.center
+    return TermCurve(term.name, "curve", x, y, term.center, label_x)
+
+
+def termset_inputs(rulebase: RuleBase, variable: str) -> tuple[str, ...]:
+    """The input variables of the term set that defines ``variable`` (the layout of its
+    ``linear`` terms' coefficients)."""
+    for ts in rulebase.termsets:
+        if any(v.name == variable for v in ts.variables):
+            return tuple(v.name for v in ts.variables if v.role == "input")
+    return ()
+
+
+def variable_plot(variable: Variable, value: float | None = None, *,
+                  inputs: tuple[str, ...] = (), points: int = CURVE_POINTS) -> VariablePlot:
+    """Sample every term of ``variable``; mark ``value`` (clamped to the universe, as the
+    engine clamps inputs). ``inputs`` names the coefficients of ``linear`` terms."""
+    x = curve_grid(variable.universe, variable.terms, points)
+    curves = tuple(_term_curve(t, x, inputs) for t in variable.terms)
+    mus: tuple[tuple[str, float], ...] = ()
+    clamped = False
+    if value is not None:
+        lo, hi = variable.universe
+        value = float(value)
+        if np.isnan(value):
+            raise InputError(f"`{variable.name}` must be a number, not NaN")
+        clamped = not lo <= value <= hi
+        value = min(max(value, lo), hi)
+        mus = tuple((t.name, float(t.membership(value))) for t in variable.terms
+                    if t.shape not in ("linear", "singleton"))
+    return VariablePlot(variable.name, variable.role, variable.unit, variable.description,
+                        tuple(variable.universe), curves, value, mus, clamped)
+
+
+def sheet(rulebase: RuleBase, names: list[str] | None = None,
+          values: dict[str, float] | None = None, behavior: str | None = None,
+          points: int = CURVE_POINTS) -> tuple[VariablePlot, ...]:
+    """The membership sheet: every variable of the rule base (inputs first, in file order),
+    only those ``behavior`` uses, or the ``names`` asked for; ``values`` marked. Unknown
+    names get a "did you mean"."""
+    variables = rulebase.variables
+    values = dict(values or {})
+    for name in list(names or []) + list(values):
+        if name not in variables:
+            raise unknown("variable", name, variables, cls=InputError)
+    if names:
+        chosen = [variables[n] for n in dict.fromkeys(names)]
+    else:
+        chosen = sorted(variables.values(), key=lambda v: v.role != "input")
+        if behavior is not None:
+            from ...engine.compile import compile_rulebase
+
+            compiled = compile_rulebase(rulebase, behavior)
+            used = set(compiled.inputs) | set(compiled.outputs)
+            chosen = [v for v in chosen if v.name in used]
+    return tuple(variable_plot(v, values.get(v.name), inputs=termset_inputs(rulebase, v.name),
+                               points=points) for v in chosen)
+
+

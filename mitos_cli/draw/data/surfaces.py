@@ -1,0 +1,158 @@
+"""Control surfaces: one output over a grid of one or two inputs with the others fixed, computed
+by the engine in one batch."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ...engine.compile import CompiledRuleBase
+from ...errors import InputError, unknown
+
+
+@dataclass(frozen=True)
+class Axis:
+    name: str
+    unit: str
+    values: np.ndarray
+
+    @property
+    def label(self) -> str:
+        return f"{self.name} [{self.unit}]" if self.unit else self.name
+
+
+@dataclass(frozen=True)
+class Fixed:
+    """An input held fixed while the surface varies the others."""
+
+    name: str
+    value: float
+    unit: str
+    defaulted: bool          # not given: the midpoint of its universe
+
+
+@dataclass(frozen=True)
+class Surface:
+    """``z`` = the output over ``x`` (a curve, ``z[nx]``) or over ``x`` and ``y``
+    (``z[ny, nx]``, rows follow ``y``). ``z`` is NaN where no rule sets the output and the
+    output has no default; :attr:`no_rule` is that mask."""
+
+    output: str
+    unit: str
+    x: Axis
+    y: Axis | None
+    z: np.ndarray
+    fixed: tuple[Fixed, ...]
+    behavior: str
+
+    @property
+    def no_rule(self) -> np.ndarray:
+        return np.isnan(self.z)
+
+    @property
+    def label(self) -> str:
+        return f"{self.output} [{self.unit}]" if self.unit else self.output
+
+    @property
+    def fixed_text(self) -> str:
+        return ", ".join(f"{f.name} = {f.value:g}{' ' + f.unit if f.unit else ''}"
+                         + (" (midpoint)" if f.defaulted else "") for f in self.fixed)
+
+    def notes(self) -> list[str]:
+        """What a user should be told: defaulted inputs, regions where nothing fires."""
+        out = [f"`{f.name}` not fixed: held at {f.value:g}, the midpoint of its universe "
+               f"(give --fix {f.name}=VALUE)" for f in self.fixed if f.defaulted]
+        n = int(self.no_rule.sum())
+        if n:
+            out.append(f"no rule sets `{self.output}` at {n} of {self.z.size} grid points "
+                       f"and it has no default: shown as a blank (masked) region")
+        return out
+
+
+def _input_axis(compiled: CompiledRuleBase, name: str, what: str) -> int:
+    if name in compiled.inputs:
+        return compiled.inputs.index(name)
+    known = [v.name for v in compiled.variables.values() if v.role == "input"]
+    if name in known:
+        raise InputError(f"behavior `{compiled.behavior}` does not use input `{name}` ({what})",
+                         expected="one of " + ", ".join(compiled.inputs))
+    raise unknown(f"input ({what})", name, compiled.inputs, cls=InputError)
+
+
+def surface(compiled: CompiledRuleBase, output: str, x: str, y: str | None = None,
+            fixed: dict[str, float] | None = None, resolution: int = 61,
+            x_range: tuple[float, float] | None = None,
+            y_range: tuple[float, float] | None = None) -> Surface:
+    """The control surface of ``output`` over ``x`` (and ``y``), the other inputs fixed.
+
+    Inputs not in ``fixed`` are held at the midpoint of their universe (:class:`Fixed` says
+    so). The whole grid is one batch through :func:`mitos_cli.engine.evaluation.evaluate` with
+    ``strict=False``: where no rule fires and the output has no default, ``z`` is NaN.
+    ``x_range`` / ``y_range`` zoom into part of a universe.
+    """
+    from ...engine.evaluation import evaluate
+
+    if output not in compiled.outputs:
+        raise unknown("output", output, compiled.outputs, cls=InputError)
+    if resolution < 2:
+        raise InputError(f"resolution must be at least 2, not {resolution}")
+    ix = _input_axis(compiled, x, "--x")
+    iy = _input_axis(compiled, y, "--y") if y is not None else None
+    if iy == ix:
+        raise InputError(f"`{x}` is on both axes", hint="choose two different inputs")
+    fixed = dict(fixed or {})
+    for name in fixed:
+        k = _input_axis(compiled, name, "--fix")
+        if k in (ix, iy):
+            raise InputError(f"`{name}` is on an axis and cannot also be fixed",
+                             hint=f"drop --fix {name}=...")
+
+    def axis(k: int, limits: tuple[float, float] | None) -> Axis:
+        lo, hi = compiled.universe[k]
+        if limits is not None:
+            a, b = limits
+            if not (lo <= a < b <= hi):
+                raise InputError(f"range {a:g}:{b:g} of `{compiled.inputs[k]}` is not inside "
+                                 f"its universe [{lo:g}, {hi:g}]",
+                                 hint="give LOW:HIGH with LOW < HIGH inside the universe")
+            lo, hi = a, b
+        var = compiled.variables[compiled.inputs[k]]
+        return Axis(var.name, var.unit, np.linspace(lo, hi, resolution))
+
+    ax_x = axis(ix, x_range)
+    ax_y = axis(iy, y_range) if iy is not None else None
+    held = []
+    for k, name in enumerate(compiled.inputs):
+        if k in (ix, iy):
+            continue
+        var = compiled.variables[name]
+        if name in fixed:
+            held.append(Fixed(name, float(fixed[name]), var.unit, False))
+        else:
+            lo, hi = compiled.universe[k]
+            held.append(Fixed(name, float((lo + hi) / 2), var.unit, True))
+    for f in held:
+        lo, hi = compiled.universe[compiled.inputs.index(f.name)]
+        if np.isnan(f.value) or not lo <= f.value <= hi:
+            raise InputError(f"--fix {f.name}={f.value:g} is outside its universe "
+                             f"[{lo:g}, {hi:g}]")
+
+    if ax_y is None:
+        X = np.empty((resolution, len(compiled.inputs)))
+        X[:, ix] = ax_x.values
+    else:
+        gx, gy = np.meshgrid(ax_x.values, ax_y.values)        # [ny, nx]
+        X = np.empty((gx.size, len(compiled.inputs)))
+        X[:, ix] = gx.ravel()
+        X[:, iy] = gy.ravel()
+    for f in held:
+        X[:, compiled.inputs.index(f.name)] = f.value
+    result = evaluate(compiled, X, detail=False, strict=False)
+    z = result.output(output)
+    if ax_y is not None:
+        z = z.reshape(len(ax_y.values), len(ax_x.values))
+    unit = compiled.variables[output].unit
+    return Surface(output, unit, ax_x, ax_y, z, tuple(held), compiled.behavior)
+
+

@@ -1,0 +1,1 @@
+"""Fuzzy logic itself: membership shapes, hedges, norms, the neuron, operator settings."""

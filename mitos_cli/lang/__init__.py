@@ -1,0 +1,1 @@
+"""The rule language: grammar access, parsing, the model, name resolution, term sets."""

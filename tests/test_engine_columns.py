@@ -1,0 +1,58 @@
+"""Arrays by name (``load_rulebase().evaluate(**columns)``) go through the engine as columns:
+the same bits as the rows of ``evaluate`` and as one sample alone, the same messages."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from mitos_cli import load_rulebase
+from mitos_cli.engine.evaluation import BLOCK, evaluate, evaluate_columns, evaluate_one
+from mitos_cli.errors import InputError, NoRuleFiredError
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def test_columns_give_the_bits_of_the_rows_and_of_one_sample():
+    rb = load_rulebase()
+    c = rb.compiled
+    rng = np.random.default_rng(5)
+    n = BLOCK + 37                                      # more than one block
+    X = rng.uniform(c.universe[:, 0] - 10, c.universe[:, 1] + 10, size=(n, 3))  # some clamped
+    rows = evaluate(c, X, detail=False).outputs
+    out = rb.evaluate(**{name: X[:, j] for j, name in enumerate(c.inputs)})
+    for j, name in enumerate(c.outputs):
+        assert np.array_equal(out[name], rows[:, j])
+    assert np.array_equal(evaluate_columns(c, X.T), rows.T)
+    for i in (0, 1, n - 1):
+        assert evaluate_one(c, X[i].tolist()) == tuple(rows[i].tolist())
+
+
+def test_a_scalar_broadcasts_and_a_sample_no_rule_fires_for_is_explained():
+    rb = load_rulebase()
+    out = rb.evaluate(road=np.array([78.0, 60.0]), size=45.0, position=4.0)
+    assert out["steering"].shape == (2,)
+    assert out["steering"][0] == rb.evaluate(road=78.0, size=45.0, position=4.0)["steering"]
+    with pytest.raises(InputError, match="sample 2"):
+        rb.evaluate(road=np.array([78.0, np.nan]), size=45.0, position=4.0)
+    with pytest.raises(InputError, match="did you mean"):
+        rb.evaluate(raod=np.array([78.0]), size=45.0, position=4.0)
+
+
+def test_no_rule_fired_names_the_sample_as_the_rows_path_does(tmp_path):
+    terms = (ROOT / "rulebases" / "mitos.terms.yaml").read_text(encoding="utf-8")
+    (tmp_path / "t.terms.yaml").write_text(terms.replace("    default: 90\n", ""),
+                                           encoding="utf-8")
+    rules = tmp_path / "t.rules"
+    rules.write_text('terms "t.terms.yaml"\n'
+                     "r1: if road is WIDE then steering is RS and speed is SLOW",
+                     encoding="utf-8")
+    rb = load_rulebase(rules)
+    with pytest.raises(NoRuleFiredError) as cols:
+        rb.evaluate(road=np.array([150.0, 20.0]))
+    with pytest.raises(NoRuleFiredError) as rows:
+        evaluate(rb.compiled, np.array([[150.0], [20.0]]), detail=False)
+    assert cols.value.message == rows.value.message == \
+        "no rule sets `steering` for road=20 (1 of 2 samples)"
