@@ -705,8 +705,11 @@ def true_inputs(res: SimResult) -> dict[str, np.ndarray]:
             things = np.concatenate([outline] + [corners[j] for j in range(n) if j != i])
             gaps = perception.side_gaps(f, pose[i, :2], dirs[:-2], expected[:-2], things,
                                         robots[i], sen.range, cfg)
+            seen = expected[:-2] < sen.range * 0.999
+            wall_points = pose[i, :2] + expected[:-2, None][seen] * dirs[:-2][seen]
             tr = perception.truth(route, f, tuple(pose[i]), robots[i],
-                                  (float(across[0]), float(across[1])), things, gaps, cfg)
+                                  (float(across[0]), float(across[1])), things, gaps, cfg,
+                                  wall_points)
             for key in perception.INPUTS:
                 out[key][k, i] = tr[key]
     return out
