@@ -90,14 +90,14 @@ class Journal:
         return self.directory / JOURNAL
 
     @classmethod
-    def create(cls, directory: Path) -> "Journal":
+    def create(cls, directory: Path) -> Journal:
         directory.mkdir(parents=True, exist_ok=True)
         journal = cls(directory)
         journal.path.touch()
         return journal
 
     @classmethod
-    def open(cls, directory: Path, recover: bool = False) -> "Journal":
+    def open(cls, directory: Path, recover: bool = False) -> Journal:
         """Read an existing journal.
 
         A torn last line (what ``kill -9`` during a write leaves: the change was never
