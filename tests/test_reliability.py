@@ -394,3 +394,9 @@ def test_frozen_outside_a_behavior_is_positioned():
     with pytest.raises(RuleBaseError) as info:
         build_rulebase(parse_rules(text, "f.rules"), (ts,), ("mitos.terms.yaml",))
     assert (info.value.span.line, info.value.span.column) == (3, 3)
+
+
+def test_batch_nan_cell_is_positioned():
+    with pytest.raises(InputError, match="input `size` is not a number") as info:
+        read_batch("road,size,position\n1,2,3\n\n4,nan,6\n", "b.csv", ("road", "size", "position"))
+    _positioned(info.value, 4)

@@ -47,6 +47,15 @@ def read_batch(text: str, path: str, inputs: tuple[str, ...],
         _raise_bad_row(lines, path, len(header))
     if data.shape[1] != len(header):
         _raise_bad_row(lines, path, len(header))
+    if np.isnan(data).any():            # the engine refuses NaN: say where it stands
+        r, c = (int(i) for i in np.argwhere(np.isnan(data))[0])
+        numbers = [n for n, line in enumerate(lines[1:], start=2) if line.strip()]
+        line = lines[numbers[r] - 1]
+        cell = _cells(line, path, numbers[r])[c].strip()
+        raise InputError(f"input `{header[c]}` is not a number (NaN)",
+                         span=Span(path, numbers[r], 1, line[:200]),
+                         hint=f"`{cell}` reads as NaN; give every input a finite value "
+                              "(out-of-range values are clamped to the universe)")
     order = [header.index(k) for k in inputs]
     return np.ascontiguousarray(data[:, order])
 
