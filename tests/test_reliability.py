@@ -400,3 +400,12 @@ def test_batch_nan_cell_is_positioned():
     with pytest.raises(InputError, match="input `size` is not a number") as info:
         read_batch("road,size,position\n1,2,3\n\n4,nan,6\n", "b.csv", ("road", "size", "position"))
     _positioned(info.value, 4)
+
+
+def test_adapt_epochs_are_bounded():
+    from mitos_cli.teach.session import Session
+
+    session = Session(ROOT / "rulebases" / "mitos.rules", out=lambda s: None)
+    session.run("correct road=78 size=45 position=4 -> steering=100")
+    with pytest.raises(LessonError, match="at most"):
+        session.run("adapt epochs 4e300")

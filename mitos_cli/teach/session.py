@@ -457,6 +457,9 @@ class Session:
         compiled = self.compiled()
         X, T = self.training_set(compiled)
         epochs = _whole(c.epochs, "epochs", 1) if c.epochs is not None else 50
+        if epochs > MAX_EPOCHS:         # 10^300 epochs is a hang, not a lesson
+            raise LessonError(f"at most {MAX_EPOCHS:,} epochs in one `adapt`, not {epochs:g}",
+                              hint="adapt again to go on from where it stopped")
         rate = 0.5 if c.rate is None else c.rate
         result = self._learn(c, compiled, X, T, epochs, rate)
         before = self.rulebase
@@ -638,6 +641,10 @@ def _next_label(b: Behavior) -> str:
         n += 1
     return f"r{n}"
 
+
+
+#: the most epochs one `adapt` runs (the paper's lesson needs 60; an epoch takes milliseconds)
+MAX_EPOCHS = 100_000
 
 
 def _whole(value: float, what: str, least: int) -> int:
