@@ -2,7 +2,7 @@
 
 Run from the repository root (one command each)::
 
-    python benchmarks/fuzz.py --quick                       # a short campaign (~1 min)
+    python benchmarks/fuzz.py --quick                       # a short campaign (150 per kind)
     python benchmarks/fuzz.py --per-format 10000 --out fuzz-found
 
 Each input kind (rule files, term-set YAML, world YAML, map YAML + PGM, FCL, ``.fis``, FLL,
