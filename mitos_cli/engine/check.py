@@ -60,7 +60,7 @@ from ..lang.model import (
 )
 from ..lang.terms import Variable
 from .compile import CompiledRuleBase, compile_rulebase
-from .evaluation import evaluate
+from .evaluation import declares_nan, evaluate
 
 SEVERITIES = ("error", "warning", "info")
 #: Most grid points one behavior is sampled on (the per-input resolution shrinks to fit).
@@ -381,7 +381,8 @@ def _sampled(compiled: CompiledRuleBase, threshold: float,
             mask = mask_of(total[:, j])
             if not mask.any():
                 continue
-            has_default = not np.isnan(compiled.default[j])
+            # a declared `default: nan` is the rule base's own choice, as a number is
+            has_default = not np.isnan(compiled.default[j]) or declares_nan(compiled, out_name)
             key = (mask.tobytes(), has_default)
             reported.setdefault(key, []).append(out_name)
             masks[key] = mask

@@ -51,6 +51,7 @@ from ..engine.evaluation import evaluate, fill_defaults, infer
 from ..engine.mamdani import OutputTable, spike
 from ..errors import LessonError
 from ..fuzzy import hedges as hedge_mod
+from ..fuzzy.norms import SNORMS, TNORMS, Norm
 from ..fuzzy.shapes import kernel_params
 from ..lang import interpretability as meaning
 from ..lang.model import Rule, RuleBase
@@ -76,7 +77,9 @@ FROM_CORNERS: dict[str, Callable[[float, float, float, float], tuple[float, ...]
     "left_shoulder": lambda a, b, c, d: (c, d),
     "right_shoulder": lambda a, b, c, d: (a, b),
 }
-SUPPORTED_NORMS = {"and": ("min", "product"), "or": ("max", "probabilistic_sum")}
+#: The norms adaptation differentiates: those whose registry entry says how (fuzzy/norms.py).
+SUPPORTED_NORMS = {"and": tuple(n.name for n in TNORMS.values() if n.gradient),
+                   "or": tuple(n.name for n in SNORMS.values() if n.gradient)}
 
 
 @dataclass(frozen=True)
@@ -195,7 +198,7 @@ def _supported(compiled: CompiledRuleBase) -> None:
         return                                       # differences need no derivatives
     for op, names in SUPPORTED_NORMS.items():
         norm = compiled.operators.tnorm if op == "and" else compiled.operators.snorm
-        if norm.name not in names:
+        if norm.gradient is None:
             raise LessonError(f"adaptation has gradients for `{op} = "
                               f"{' / '.join(names)}`, not `{op} = {norm.name}`",
                               hint="adapt with the paper's min / max operators")
@@ -739,7 +742,7 @@ def gradient(p: Parameters, values: np.ndarray, X: np.ndarray,
     for j in range(ctx.shape[1]):
         others = np.prod(np.delete(ctx_vals, j, axis=0), axis=0)
         _scatter_add(G, ctx[:, j], gdof * w * base * others)
-    tnorm, snorm = c.operators.tnorm.name, c.operators.snorm.name
+    tnorm, snorm = c.operators.tnorm, c.operators.snorm
     for level in reversed(c.levels):
         for group in reversed(level):
             _backward_group(group, V, G, tnorm, snorm)
@@ -770,7 +773,7 @@ def _scatter_add(G: np.ndarray, idx: np.ndarray, vals: np.ndarray) -> None:
     G[sorted_idx[starts]] += np.add.reduceat(vals[order], starts, axis=0)
 
 
-def _backward_group(group, V: np.ndarray, G: np.ndarray, tnorm: str, snorm: str) -> None:
+def _backward_group(group, V: np.ndarray, G: np.ndarray, tnorm: Norm, snorm: Norm) -> None:
     """Pass ``G[out]`` down to ``G[children]`` for one group of neurons."""
     gout = G[group.out]                                  # [g, n]
     ch = group.children                                  # [g, a]
@@ -790,19 +793,21 @@ def _backward_group(group, V: np.ndarray, G: np.ndarray, tnorm: str, snorm: str)
         return
     X = V[ch]                                            # [g, a, n]
     g, a, n = X.shape
-    norm = tnorm if op in ("and", "prod") else snorm
-    if op == "prod":
-        norm = "product"
-    if norm in ("min", "max"):
+    # how this norm's derivative goes (its registry entry); a `use` context multiplies
+    rule = "product" if op == "prod" else (tnorm if op == "and" else snorm).gradient
+    if rule is None:                                     # check_supported refuses these first
+        raise ValueError(f"no derivative for the norm of a `{op}` neuron")
+    if rule == "select":
+        smaller = op == "and"                            # min picks the smallest input
         best = X[:, 0].copy()
         sel = np.zeros((g, n), dtype=np.intp)
         for j in range(1, a):                            # arity (a few), never rules or samples
-            wins = X[:, j] < best if norm == "min" else X[:, j] > best    # ties: lowest index
+            wins = X[:, j] < best if smaller else X[:, j] > best    # ties: lowest index
             np.copyto(best, X[:, j], where=wins)
             sel[wins] = j
         local = (np.arange(a)[None, :, None] == sel[:, None, :]) * gout[:, None, :]
     else:
-        F = X if norm == "product" else 1.0 - X
+        F = X if rule == "product" else 1.0 - X          # "dual_product": of complements
         left = np.cumprod(np.concatenate([np.ones((g, 1, n)), F[:, :-1]], axis=1), axis=1)
         right = np.cumprod(np.concatenate([np.ones((g, 1, n)), F[:, :0:-1]], axis=1),
                            axis=1)[:, ::-1]

@@ -18,21 +18,12 @@ from ..words import plural
 
 
 def world_path(name: str, base: Path | None = None) -> Path:
-    """A world file by path (relative to ``base``, then the working directory), or a packaged
-    world by name (``figure4`` or ``figure4.yaml``)."""
-    from ..resources import data_dir, packaged_path
+    """A world by path (relative to ``base``, then the working directory) or a packaged world
+    by name: the simulator's one resolver,
+    :func:`mitos_cli.sim.worldfile.resolve_world_path`."""
+    from ..sim.worldfile import resolve_world_path
 
-    for candidate in ([base / name] if base else []) + [Path(name)]:
-        if candidate.is_file():
-            return candidate
-    packaged = sorted(e.name for e in data_dir("worlds").iterdir() if e.name.endswith(".yaml"))
-    stem = Path(name).name
-    for file in (stem, stem + ".yaml"):
-        if file in packaged:
-            return packaged_path("worlds", file)
-    from ..errors import unknown
-
-    raise unknown("world", name, [p[:-5] for p in packaged])
+    return resolve_world_path(name, base)
 
 
 @dataclass
