@@ -64,10 +64,11 @@ def conversion_notes(rb: RuleBase, fmt: str, behavior: str | None = None) -> lis
 
     b = rb.behavior(behavior)
     out = []
-    if len(rb.behaviors) > 1:
-        others = ", ".join(x.name for x in rb.behaviors if x.name != b.name)
+    written = _used(rb, b.name)
+    left_out = [x.name for x in rb.behaviors if x.name not in written]
+    if left_out:
         out.append(f"only behavior `{b.name}` is written (with the behaviors it uses); the "
-                   f"others ({others}) are not: choose one with --behavior")
+                   f"others ({', '.join(left_out)}) are not: choose one with --behavior")
     if fmt == "fis":
         from .fis import notes
 
@@ -78,6 +79,18 @@ def conversion_notes(rb: RuleBase, fmt: str, behavior: str | None = None) -> lis
                    f"rule); this rule base samples at {ops.sampling} (MATLAB's), so results "
                    f"move by the discretisation")
     return out
+
+
+def _used(rb: RuleBase, name: str) -> set[str]:
+    """``name`` and every behavior it uses, directly or through others."""
+    seen: set[str] = set()
+    todo = [name]
+    while todo:
+        current = todo.pop()
+        if current not in seen:
+            seen.add(current)
+            todo += [u.behavior for u in rb.behavior(current).uses]
+    return seen
 
 
 __all__ = ["FORMATS", "conversion_notes", "read_foreign", "write_foreign"]
