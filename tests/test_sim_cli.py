@@ -156,3 +156,20 @@ def test_a_rule_base_without_the_inputs_is_refused(short, tmp_path, capsys):
                      'steering is ST and speed is SLOW\nend\n', encoding="utf-8")
     code, err = run_main(capsys, short, "--rulebase", rules)
     assert code == 1 and "does not perceive" in err
+
+
+def test_json_says_near_miss_as_the_text_does(tmp_path):
+    text = (Path(__file__).parents[1] / "worlds" / "corridor.yaml").read_text()
+    world = tmp_path / "close.yaml"
+    world.write_text(text.replace("safety_margin: 2 ", "safety_margin: 6 "))
+    shown = CliRunner().invoke(app, ["simulate", str(world)])
+    assert shown.exit_code == 0 and "closer than the safety margin (6 in)" in shown.stdout
+    data = json.loads(CliRunner().invoke(app, ["simulate", str(world), "--json"]).stdout)
+    assert data["near_miss"] is True and data["outcome"] == "success"
+    data = json.loads(CliRunner().invoke(app, ["simulate", "corridor.yaml", "--json"]).stdout)
+    assert data["near_miss"] is False
+
+
+def test_one_run_shows_no_spread():
+    out = CliRunner().invoke(app, ["simulate", "corridor.yaml", "--runs", "1"]).stdout
+    assert "±" not in out and "18.3" in out
