@@ -9,6 +9,7 @@ in any batch.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
@@ -44,7 +45,7 @@ class Result:
         return self.outputs[:, self.compiled.outputs.index(name)]
 
 
-def as_batch(compiled: CompiledRuleBase, columns: dict[str, object]) -> np.ndarray:
+def as_batch(compiled: CompiledRuleBase, columns: Mapping[str, object]) -> np.ndarray:
     """Input arrays by variable name -> ``X[n, k]`` in the compiled column order.
 
     Every compiled input must be given; scalars broadcast against arrays. Names that the

@@ -20,6 +20,8 @@ import numpy as np
 
 from ...engine.compile import CompiledRuleBase
 from ...errors import FormatError
+from ...fuzzy.hedges import HEDGES
+from ...fuzzy.norms import SNORMS, TNORMS
 from ...words import plural
 from .program import PLAIN, Program, ident, num, program, unique_idents, weighted_sums
 
@@ -96,37 +98,9 @@ double f, double rt) {
 }""",
 }
 
-C_NORMS = {
-    "min": "return a < b ? a : b;",
-    "product": "return a * b;",
-    "lukasiewicz": "double lo = a < b ? a : b, hi = a < b ? b : a, t = lo - (1.0 - hi);\n"
-                   "    return t > 0.0 ? t : 0.0;",
-    "drastic": "return a == 1.0 ? b : (b == 1.0 ? a : 0.0);",
-    "einstein": "return (a * b) / (1.0 + (1.0 - a) * (1.0 - b));",
-    "hamacher": "double hi = a < b ? b : a, lo = a < b ? a : b, d = hi + lo * (1.0 - hi);\n"
-                "    return d == 0.0 ? 0.0 : (a * b) / d;",
-    "nilpotent_minimum": "double lo = a < b ? a : b, hi = a < b ? b : a;\n"
-                         "    return lo > 1.0 - hi ? lo : 0.0;",
-    "max": "return a < b ? b : a;",
-    "probabilistic_sum": "double hi = a < b ? b : a, lo = a < b ? a : b;\n"
-                         "    return hi + lo * (1.0 - hi);",
-    "bounded_sum": "double s = a + b;\n    return s < 1.0 ? s : 1.0;",
-    "drastic_sum": "return a == 0.0 ? b : (b == 0.0 ? a : 1.0);",
-    "einstein_sum": "return (a + b) / (1.0 + a * b);",
-    "hamacher_sum": "double d = 1.0 - a * b;\n"
-                    "    return d == 0.0 ? 1.0 : (a * (1.0 - b) + b * (1.0 - a)) / d;",
-    "nilpotent_maximum": "return a + b < 1.0 ? (a < b ? b : a) : 1.0;",
-}
+C_NORMS = {n.name: n.c for n in (*TNORMS.values(), *SNORMS.values())}   # fuzzy/norms.py
 
-C_HEDGES = {
-    "very": "return x * x;",
-    "extremely": "return x * x * x;",
-    "somewhat": "return sqrt(x);",
-    "more_or_less": "return sqrt(x);",
-    "seldom": "return x <= 0.5 ? sqrt(0.5 * x) : 1.0 - sqrt(0.5 * (1.0 - x));",
-    "intensely": "return x <= 0.5 ? 2.0 * x * x : 1.0 - 2.0 * (1.0 - x) * (1.0 - x);",
-    "any": "(void)x;\n    return 1.0;",
-}
+C_HEDGES = {h.name: h.c for h in HEDGES.values()}   # fuzzy/hedges.py
 
 
 def comment(text: str) -> str:

@@ -13,37 +13,14 @@ import re
 import numpy as np
 
 from ...engine.compile import CompiledRuleBase
+from ...fuzzy.hedges import HEDGES
+from ...fuzzy.norms import SNORMS, TNORMS
 from ...words import plural
 from .program import PLAIN, Program, num, program, weighted_sums
 
-PY_NORMS = {
-    "min": "np.minimum(a, b)",
-    "product": "a * b",
-    "lukasiewicz": "np.maximum(0.0, np.minimum(a, b) - (1.0 - np.maximum(a, b)))",
-    "drastic": "np.where(a == 1.0, b, np.where(b == 1.0, a, 0.0))",
-    "einstein": "(a * b) / (1.0 + (1.0 - a) * (1.0 - b))",
-    "hamacher": "_div(a * b, np.maximum(a, b) + np.minimum(a, b) * (1.0 - np.maximum(a, b)), "
-                "0.0)",
-    "nilpotent_minimum": "np.where(np.minimum(a, b) > 1.0 - np.maximum(a, b), np.minimum(a, b), "
-                         "0.0)",
-    "max": "np.maximum(a, b)",
-    "probabilistic_sum": "np.maximum(a, b) + np.minimum(a, b) * (1.0 - np.maximum(a, b))",
-    "bounded_sum": "np.minimum(1.0, a + b)",
-    "drastic_sum": "np.where(a == 0.0, b, np.where(b == 0.0, a, 1.0))",
-    "einstein_sum": "(a + b) / (1.0 + a * b)",
-    "hamacher_sum": "_div(a * (1.0 - b) + b * (1.0 - a), 1.0 - a * b, 1.0)",
-    "nilpotent_maximum": "np.where(a + b < 1.0, np.maximum(a, b), 1.0)",
-}
+PY_NORMS = {n.name: n.numpy for n in (*TNORMS.values(), *SNORMS.values())}   # fuzzy/norms.py
 
-PY_HEDGES = {
-    "very": "x * x",
-    "extremely": "x * x * x",
-    "somewhat": "np.sqrt(x)",
-    "more_or_less": "np.sqrt(x)",
-    "seldom": "np.where(x <= 0.5, np.sqrt(0.5 * x), 1.0 - np.sqrt(0.5 * np.maximum(1.0 - x, 0)))",
-    "intensely": "np.where(x <= 0.5, 2.0 * x * x, 1.0 - 2.0 * (1.0 - x) ** 2)",
-    "any": "np.where(np.isnan(x), np.nan, 1.0)",
-}
+PY_HEDGES = {h.name: h.numpy for h in HEDGES.values()}   # fuzzy/hedges.py
 
 
 def doc_text(text: str) -> str:
