@@ -15,7 +15,8 @@ from mitos_cli.sim.perception import INPUTS
 
 RUNNER = CliRunner()
 KEYS = {"world", "seed", "outcome", "reached_goal", "collisions", "time_s", "path_length_in",
-        "min_clearance_in", "mean_speed_in_s", "steering_total_variation_deg", "ticks"}
+        "min_clearance_in", "mean_speed_in_s", "steering_total_variation_deg", "ticks",
+        "near_miss"}
 SHORT = """\
 name: short
 seed: 2
@@ -68,6 +69,7 @@ def test_json_matches_the_library(short):
     from mitos_cli.sim.worldfile import load_world
 
     data = json.loads(run(short, "--json", "--seed", 4).stdout)
+    assert data.pop("near_miss") is False           # the command's one addition
     assert data == simulate(load_world(short), seed=4).summary()
 
 
