@@ -36,7 +36,7 @@ def polygon_segments(corners: np.ndarray) -> np.ndarray:
     return np.concatenate([corners, nxt], axis=-1).reshape(-1, 4)
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def _following(k: int) -> np.ndarray:
     """Index of the next corner of a closed polygon of ``k`` corners."""
     out = (np.arange(k) + 1) % k
