@@ -174,4 +174,5 @@ def test_json_says_near_miss_as_the_text_does(tmp_path):
 
 def test_one_run_shows_no_spread():
     out = CliRunner().invoke(app, ["simulate", "corridor.yaml", "--runs", "1"]).stdout
-    assert "±" not in out and "18.3" in out
+    row = out.splitlines()[1].split()
+    assert "±" not in out and row[0] == "corridor" and float(row[-1]) > 0
