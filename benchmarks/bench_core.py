@@ -384,9 +384,9 @@ def main() -> None:
     print(f"# MITOS core benchmark ({time.strftime('%Y-%m-%d')})")
     print(f"machine: {host}")
     print(f"command: python benchmarks/bench_core.py{' --quick' if args.quick else ''}")
-    print(f"batch: {n:,} random inputs, best of {2 * repeats} interleaved rounds after a warm-up; single: median of "
-          f"{repeats} repeats of the mean over {single_n} (MITOS) / {len(pts[:max(50, single_n // 4)])}"
-          f" (peers) calls; process: median of {runs} runs\n")
+    print(f"batch: {n:,} random inputs, best of {2 * repeats} interleaved rounds after a warm-up; "
+          f"single: median of {repeats} repeats of the mean over {single_n} (MITOS) / "
+          f"{len(pts[:max(50, single_n // 4)])} (peers) calls; process: median of {runs} runs\n")
     print("| measurement | figure | ratio |")
     print("| --- | ---: | --- |")
     print(f"| MITOS batch, `evaluate(detail=True)` | {fmt_rate(rate['detail'])} eval/s | "

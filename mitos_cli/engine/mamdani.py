@@ -74,9 +74,12 @@ class OutputTable:
 
 def grid(lo: float, hi: float, resolution: int, sampling: str = "midpoints") -> np.ndarray:
     """The midpoints of ``resolution`` equal cells of ``[lo, hi]`` (``sampling="endpoints"``:
-    ``resolution`` evenly spaced points from ``lo`` to ``hi``, as MATLAB's ``evalfis``)."""
+    ``resolution`` evenly spaced points from ``lo`` to ``hi``, as MATLAB's ``evalfis``;
+    ``"left"``: the cells' left ends, as jFuzzyLogic)."""
     if sampling == "endpoints":
         return np.linspace(lo, hi, resolution)
+    if sampling == "left":                    # jFuzzyLogic: the cells' left ends
+        return lo + np.arange(resolution) * ((hi - lo) / resolution)
     return lo + (np.arange(resolution) + 0.5) * ((hi - lo) / resolution)
 
 

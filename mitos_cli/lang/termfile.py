@@ -145,9 +145,13 @@ def _variable(name: str, spec: Any, key_span: Span, value_span: Span,
         if role != "output":
             raise TermSetError(f"{what}: only outputs take a `default`",
                                span=spec.key_span("default"))
-        default = yamlpos.expect_number(spec["default"], spec.value_span("default"),
-                                        TermSetError, f"{what}: default")
-        if not lo <= default <= hi:
+        value = spec["default"]
+        if isinstance(value, float) and value != value:
+            default = value            # `default: .nan`: no rule fired means NaN, as asked
+        else:
+            default = yamlpos.expect_number(value, spec.value_span("default"),
+                                            TermSetError, f"{what}: default")
+        if default == default and not lo <= default <= hi:
             raise TermSetError(f"{what}: default {default:g} lies outside the universe "
                                f"[{lo:g}, {hi:g}]", span=spec.value_span("default"))
     text_of = {k: spec.get(k, "") for k in ("description", "unit")}

@@ -286,7 +286,7 @@ class _Sensed:
     inputs: dict[str, np.ndarray]
     targets: np.ndarray
     clearance: np.ndarray
-    command: np.ndarray | None = None
+    command: np.ndarray             # [n, 2] filled by the plan stage
 
 
 class Simulation:
@@ -390,7 +390,7 @@ class Simulation:
         self._maps: list[knowledge.RobotMap | None] = [None] * n
         if self._given.knows == "none" and self._given.grid is not None:
             self._maps = [knowledge.RobotMap.of(self._given.grid) for _ in range(n)]
-        self._history: list[np.ndarray] = []
+        self._history: list[tuple[np.ndarray, np.ndarray]] = []   # (x, y) after each move
         self._outcomes = ["timeout"] * n
         self._collided = 0
         self._k = 0
@@ -511,7 +511,7 @@ class Simulation:
             self._expected.append(expected)
             clear[i] = _clearance(pose[i], self.robots[i], walls, boxes, centres, radii)
         return _Sensed(t, where, pose, ranges, {key: np.zeros(n) for key in perception.INPUTS},
-                       np.zeros((n, 2)), clear)
+                       np.zeros((n, 2)), clear, np.zeros((n, 2)))
 
     def _obstacles_at(self, t: float):
         """Obstacle places ``[O, 2]`` at time ``t`` and their shapes
@@ -588,16 +588,15 @@ class Simulation:
     def plan(self, s: _Sensed) -> None:
         """The planner's commands for the active robots, in one batch (the others: straight
         wheel, no speed)."""
-        cmd = np.zeros((self.n, 2))
+        cmd = s.command
         cmd[:, 0] = self.limits.straight
         if self._active.any():
             idx = np.flatnonzero(self._active)
             sub = Percepts({key: val[idx] for key, val in s.inputs.items()}, s.ranges[idx],
                            self.angles, s.pose[idx], self._v[idx], s.targets[idx],
-                           self._goals[idx])
+                           self._goals[idx], self._steer[idx])
             c_steer, c_speed = self.planner.plan(sub)
             cmd[idx, 0], cmd[idx, 1] = c_steer, c_speed
-        s.command = cmd
 
     def act(self, s: _Sensed) -> None:
         """Steering-rate and acceleration limits and exact arcs, substep by substep; stopped
@@ -605,7 +604,7 @@ class Simulation:
         self._x, self._y, self._h, self._v, self._steer = kinematics.step(
             self._x, self._y, self._h, np.where(self._active, self._v, 0.0), self._steer,
             s.command[:, 0], s.command[:, 1], self.limits, self.dt, self.world.substeps)
-        self._history.append(np.stack([self._x, self._y], axis=1))
+        self._history.append((self._x, self._y))      # fresh arrays: never changed in place
 
     def _check_stuck(self) -> bool:
         """A driving robot that moved less than ``STUCK_DISTANCE`` in ``STUCK_TIME`` is stuck
@@ -613,7 +612,8 @@ class Simulation:
         history, window = self._history, self._stuck_window
         if len(history) <= window:
             return False
-        moved = np.hypot(*(history[-1] - history[-1 - window]).T)
+        (x1, y1), (x0, y0) = history[-1], history[-1 - window]
+        moved = np.hypot(x1 - x0, y1 - y0)
         stuck = self._active & (moved < STUCK_DISTANCE)
         for i in np.flatnonzero(stuck):
             self._outcomes[i] = "stuck"
@@ -705,8 +705,11 @@ def true_inputs(res: SimResult) -> dict[str, np.ndarray]:
             things = np.concatenate([outline] + [corners[j] for j in range(n) if j != i])
             gaps = perception.side_gaps(f, pose[i, :2], dirs[:-2], expected[:-2], things,
                                         robots[i], sen.range, cfg)
+            seen = expected[:-2] < sen.range * 0.999
+            wall_points = pose[i, :2] + expected[:-2, None][seen] * dirs[:-2][seen]
             tr = perception.truth(route, f, tuple(pose[i]), robots[i],
-                                  (float(across[0]), float(across[1])), things, gaps, cfg)
+                                  (float(across[0]), float(across[1])), things, gaps, cfg,
+                                  wall_points)
             for key in perception.INPUTS:
                 out[key][k, i] = tr[key]
     return out

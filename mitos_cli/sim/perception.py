@@ -40,6 +40,27 @@ Inputs (all floats, units in the names of ``mitos.terms.yaml`` / ``drive.terms.y
     width / 2 - lane_margin)`` right of the road centre; positive = right of the lane.
 ``goal`` (in)
     length of route left to the goal (at least the straight distance to it).
+``front`` (in)
+    how far the robot can drive straight on before something its map does not show: from its
+    front to the first obstacle hit in the band its body sweeps along its heading,
+    ``way_margin`` added on each side; ``sight`` when none is there (see :func:`free_ways`).
+    Walls do not count: the route already keeps to the corridors.
+``opening`` (deg)
+    bearing of the way the robot should take, relative to its heading, positive to the right:
+    the way (every ``way_step`` within ``way_fov``, and the route's own bearing) that offers
+    the most progress toward the route: how far its body's band is clear of walls and
+    obstacles along it (up to ``way_reach``, scored in a band just clear of the body and in
+    one ``way_room`` roomier) times the cosine of its angle to the route's bearing
+    (``heading``; behind the robot, the side it lies on), plus ``way_room_weight`` times that
+    clear length (so that when every way is shut the roomiest wins), less ``way_turn_cost`` for
+    every degree it turns from the robot's heading (so it does not flip between two gaps).
+    Where the route's own bearing is clear, ``opening`` is ``heading``; in clutter it points
+    at the gap to take.
+``clutter`` (objects)
+    how many separate objects its map does not show the robot sees ahead within ``sight``:
+    runs of neighbouring beams hitting obstacles, split where two hits lie more than
+    ``clutter_gap`` apart (see :func:`clutter`). With one object at a time the paper's
+    repertoire avoids "the obstacle"; among several the ``drive`` behavior takes the opening.
 ``gap_left``, ``gap_right`` (in)
     gap between the robot's side and the nearest thing hit on that side: walls among beams
     landing from ``wall_behind`` behind to ``wall_ahead`` ahead of the robot's centre along
@@ -63,7 +84,7 @@ from .world import Robot
 
 NO_OBSTACLE = 200.0     # in: the `obstacle` distance when nothing obstructs
 INPUTS = ("road", "size", "position", "obstacle", "heading", "lane", "goal", "gap_left",
-          "gap_right")
+          "gap_right", "front", "opening", "clutter")
 
 
 @dataclass(frozen=True)
@@ -77,6 +98,14 @@ class Settings:
     road_cap: float = 100.0        # in: road width used for the lane at wide openings
     wall_behind: float = 12.0      # in
     wall_ahead: float = 36.0       # in
+    way_margin: float = 1.5        # in: a way is free when this clears each side of the body
+    way_room_weight: float = 0.1   # room counts this much beside progress (when all is shut)
+    way_room: float = 4.0          # in: the roomier band a way is also scored in
+    way_reach: float = 140.0       # in: a way clear this far (from the front) scores in full
+    way_step: float = 5.0          # deg: the ways tried, every step within +-way_fov / 2
+    way_fov: float = 180.0         # deg
+    clutter_gap: float = 12.0      # in: obstacle hits farther apart than this are two objects
+    way_turn_cost: float = 0.05    # in of progress given up per deg turned from the heading
 
 
 @dataclass(frozen=True)
@@ -137,6 +166,51 @@ def _own_frame(rel: np.ndarray, heading: float) -> tuple[np.ndarray, np.ndarray]
     return rel @ np.array([c, s]), rel @ np.array([s, -c])
 
 
+def free_ways(ah: np.ndarray, bh: np.ndarray, widen: np.ndarray, unknown: np.ndarray,
+              robot: Robot, cfg: Settings, route_bearing: float) -> tuple[float, float]:
+    """``(front, opening)`` from points ``(ah, bh)`` in the robot's own frame (along and
+    across its heading, right +) widened by ``widen`` (see the module docstring).
+
+    Every way tried is a direction from the robot's centre; its free length is the distance
+    along it to the nearest point inside the body's band, less half the body's length. All
+    ways at once: ``[ways, points]``."""
+    half = robot.width / 2 + cfg.way_margin
+    sight = cfg.sight
+    n = int(round(cfg.way_fov / 2 / cfg.way_step))
+    bearing = float(np.clip(route_bearing, -cfg.way_fov / 2, cfg.way_fov / 2))
+    ways = np.concatenate([[0.0, bearing], np.arange(-n, n + 1) * cfg.way_step])
+    phi = np.deg2rad(ways)[:, None]
+    along = ah * np.cos(phi) + bh * np.sin(phi)
+    across = np.abs(-ah * np.sin(phi) + bh * np.cos(phi)) - widen
+    ahead = along > 0
+    inside = ahead & (across < half)
+    front = float(np.clip(np.where(inside[0] & unknown, along[0], np.inf).min(initial=np.inf)
+                          - robot.length / 2, 0.0, sight))
+    # the progress each way offers toward the route's bearing (behind the robot: toward the
+    # side it lies on), in a band just clear of the body and in a roomy one, less a little
+    # for every degree turned
+    toward = np.clip(route_bearing, -90.0, 90.0)
+    score = -cfg.way_turn_cost * np.abs(ways)
+    for band in (half, half + cfg.way_room):
+        free = np.where(ahead & (across < band), along, np.inf).min(axis=1, initial=np.inf)
+        free -= robot.length / 2
+        free = np.clip(free, 0.0, cfg.way_reach)
+        score += 0.5 * free * (np.cos(np.deg2rad(ways - toward)) + cfg.way_room_weight)
+    best = int(np.argmax(score))
+    return front, float(ways[best])
+
+
+def clutter(hits: np.ndarray, unknown: np.ndarray, ah: np.ndarray, cfg: Settings) -> float:
+    """How many separate objects the map does not show are in view ahead: runs of
+    neighbouring beams that hit obstacles (in beam order), a run split where consecutive hits
+    lie more than ``clutter_gap`` apart, among hits ahead of the robot within ``sight``."""
+    idx = np.flatnonzero(unknown & (ah > 0) & (ah <= cfg.sight))
+    if not len(idx):
+        return 0.0
+    apart = np.hypot(*np.diff(hits[idx], axis=0).T) > cfg.clutter_gap
+    return float(1 + np.count_nonzero(apart | (np.diff(idx) > 1)))
+
+
 def _walls(a, b, valid, robot: Robot, cfg: Settings, far: float,
            objects=None) -> tuple[float, float]:
     """Side gaps from points (a along, b across): walls count from ``wall_behind`` behind to
@@ -193,16 +267,21 @@ def perceive(route: Route, f: Frame, pose: tuple[float, float, float], robot: Ro
                                             robot, f, cfg, _own_frame(rel, pose[2]))
     heading, lane, goal = _common(route, p, pose[2], f, road, robot, cfg)
     wl, wr = _walls(a, b, valid, robot, cfg, max_range, obstacle_hit)
+    ah, bh = _own_frame(rel[valid], pose[2])
+    front, opening = free_ways(ah, bh, widen[valid], obstacle_hit[valid], robot, cfg, heading)
+    objects = clutter(hits[valid], obstacle_hit[valid], ah, cfg)
     return {"road": road, "size": size, "position": position, "obstacle": distance,
-            "heading": heading, "lane": lane, "goal": goal, "gap_left": wl, "gap_right": wr}
+            "heading": heading, "lane": lane, "goal": goal, "gap_left": wl, "gap_right": wr,
+            "front": front, "opening": opening, "clutter": objects}
 
 
 def truth(route: Route, f: Frame, pose: tuple[float, float, float], robot: Robot,
           side_ranges: tuple[float, float], outline: np.ndarray, gaps: tuple[float, float],
-          cfg: Settings = Settings()) -> dict[str, float]:
+          cfg: Settings = Settings(), wall_points: np.ndarray | None = None) -> dict[str, float]:
     """The same inputs from the true geometry: ``side_ranges`` are exact distances to the walls
     across the route (left, right), ``outline`` points on every obstacle and other robot,
-    ``gaps`` the noise-free side gaps (:func:`side_gaps`)."""
+    ``gaps`` the noise-free side gaps (:func:`side_gaps`), ``wall_points`` where the beams
+    meet the walls (noise-free) for ``front`` and ``opening``."""
     p = np.array(pose[:2])
     road = side_ranges[0] + side_ranges[1]
     rel = outline - p
@@ -212,9 +291,14 @@ def truth(route: Route, f: Frame, pose: tuple[float, float, float], robot: Robot
     size, position, distance = _obstruction(route, a, b, outline, valid, np.zeros(len(outline)),
                                             robot, f, cfg, _own_frame(rel, pose[2]))
     heading, lane, goal = _common(route, p, pose[2], f, road, robot, cfg)
+    scan = outline if wall_points is None else np.concatenate([wall_points, outline])
+    ah, bh = _own_frame(scan - p, pose[2]) if len(scan) else (np.zeros(0), np.zeros(0))
+    unknown = np.arange(len(scan)) >= len(scan) - len(outline)
+    front, opening = free_ways(ah, bh, np.zeros(len(scan)), unknown, robot, cfg, heading)
+    objects = clutter(scan, unknown, ah, cfg)
     return {"road": road, "size": size, "position": position, "obstacle": distance,
             "heading": heading, "lane": lane, "goal": goal, "gap_left": gaps[0],
-            "gap_right": gaps[1]}
+            "gap_right": gaps[1], "front": front, "opening": opening, "clutter": objects}
 
 
 def side_gaps(route_frame: Frame, p: np.ndarray, dirs: np.ndarray, expected: np.ndarray,

@@ -44,6 +44,11 @@ C_SHAPES = {
 double f, double rt) {
     return fabs(1.0 / (1.0 + exp(-(r * (x - l)))) - 1.0 / (1.0 + exp(-(f * (x - rt)))));
 }""",
+    "clipped_sigmoid_difference": """static double mf_clipped_sigmoid_difference(double x, \
+double l, double r, double f, double rt) {
+    double d = 1.0 / (1.0 + exp(-(r * (x - l)))) - 1.0 / (1.0 + exp(-(f * (x - rt))));
+    return d > 0.0 ? d : (d == d ? 0.0 : d);
+}""",
     "sigmoid_product": """static double mf_sigmoid_product(double x, double l, double r, \
 double f, double rt) {
     return (1.0 / (1.0 + exp(-(r * (x - l))))) * (1.0 / (1.0 + exp(-(f * (x - rt)))));

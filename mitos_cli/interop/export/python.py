@@ -106,6 +106,7 @@ def _py_shapes(shapes) -> list[str]:
             return
         done.add(name)
         deps = {"pi_shape": ("s_shape", "z_shape"), "sigmoid_difference": ("sigmoid",),
+                "clipped_sigmoid_difference": ("sigmoid",),
                 "sigmoid_product": ("sigmoid",), "gaussian2": ("gaussian",),
                 "rectangle": ("trapezoid",), "ramp": ("trapezoid",)}.get(name, ())
         for d in deps:

@@ -1,0 +1,80 @@
+"""How the packaged ``drive`` behavior fares in clutter it does not know: success, collision,
+timeout and stuck rates over seeded BARN-style worlds (mitos_cli.sim.barn) and over the shipped
+worlds, with the obstacles unknown (only the range readings show them) or known (in the map).
+
+    python benchmarks/bench_drive.py --barn 100 --seed 1000      # the reported range
+    python benchmarks/bench_drive.py --barn 50 --seed 0 --known  # poles drawn in the map
+    python benchmarks/bench_drive.py --shipped --runs 20          # worlds/*.yaml
+    python benchmarks/bench_drive.py --barn 20 --rules my.rules   # another rule base
+
+Seeds 0-499 were used while the rules were written; report on 1000 and up (held out).
+"""
+
+from __future__ import annotations
+
+import argparse
+import collections
+import platform
+import time
+
+from mitos_cli.resources import packaged_path
+from mitos_cli.sim import barn
+from mitos_cli.sim.planner import FuzzyPlanner
+from mitos_cli.sim.runs import run_many
+from mitos_cli.sim.worldfile import load_world
+
+OUTCOMES = ("success", "collision", "timeout", "stuck")
+
+
+def rates(summaries: list[dict]) -> str:
+    n = len(summaries)
+    count = collections.Counter(s["outcome"] for s in summaries)
+    ok = [s["time_s"] for s in summaries if s["outcome"] == "success"]
+    mean_t = sum(ok) / len(ok) if ok else float("nan")
+    return (f"{n:4d} runs  " + "  ".join(f"{o} {count[o] / n:5.3f}" for o in OUTCOMES)
+            + f"  mean time to goal {mean_t:5.1f} s")
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--barn", type=int, default=0, help="BARN-style worlds to run")
+    ap.add_argument("--seed", type=int, default=1000, help="first BARN seed")
+    ap.add_argument("--known", action="store_true", help="poles drawn in the robot's map")
+    ap.add_argument("--shipped", action="store_true", help="the shipped worlds")
+    ap.add_argument("--runs", type=int, default=20, help="randomised runs per shipped world")
+    ap.add_argument("--rules", help="rule file (default: the packaged rule base)")
+    ap.add_argument("--workers", type=int)
+    ap.add_argument("--show", action="store_true", help="print each failed run")
+    args = ap.parse_args()
+    planner = FuzzyPlanner(args.rules, "drive")
+    print(f"# {platform.processor() or platform.machine()}, Python {platform.python_version()}")
+    if args.barn:
+        t0 = time.perf_counter()
+        worlds = barn.barn_worlds(args.barn, args.seed, known=args.known)
+        t1 = time.perf_counter()
+        res = run_many(worlds, planner=planner, workers=args.workers)
+        t2 = time.perf_counter()
+        runs = [w.summaries[0] for w in res.worlds]
+        kind = "known" if args.known else "unknown"
+        print(f"BARN-style, poles {kind}, seeds {args.seed}-{args.seed + args.barn - 1}: "
+              f"{rates(runs)}")
+        print(f"  (generated in {t1 - t0:.1f} s, run in {t2 - t1:.1f} s, "
+              f"{sum(s['ticks'] for s in runs) / (t2 - t1):.0f} ticks/s over all workers)")
+        if args.show:
+            for s in runs:
+                if s["outcome"] != "success":
+                    print(f"  {s['world']}: {s['outcome']} at {s['time_s']:.2f} s, "
+                          f"{s['path_length_in']:.0f} in driven")
+    if args.shipped:
+        names = ["corridor", "slalom", "moving", "intersection", "multirobot", "office",
+                 "figure4"]
+        worlds = [load_world(packaged_path("worlds", f"{n}.yaml")) for n in names]
+        own = run_many(worlds, planner=planner, workers=args.workers)
+        many = run_many(worlds, runs=args.runs, planner=planner, workers=args.workers)
+        for w, r in zip(own.worlds, many.worlds):
+            print(f"{w.world:14s} own seed: {w.summaries[0]['outcome']:9s} "
+                  f"--runs {args.runs}: {rates(list(r.summaries))}")
+
+
+if __name__ == "__main__":
+    main()

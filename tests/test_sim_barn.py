@@ -1,0 +1,104 @@
+"""BARN-style worlds: deterministic, a way through for the robot, start and goal free."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from mitos_cli.sim import barn
+from mitos_cli.sim.staticmap import build_static
+from mitos_cli.sim.worldfile import load_world
+
+
+def test_same_seed_same_world_other_seed_other_field():
+    a, b = barn.barn_world(7, 0.25, 3), barn.barn_world(7, 0.25, 3)
+    assert a == b or a.obstacles == b.obstacles
+    assert np.array_equal(barn.field(7, 0.25, 3).filled, barn.field(7, 0.25, 3).filled)
+    assert not np.array_equal(barn.field(7, 0.25, 3).filled, barn.field(8, 0.25, 3).filled)
+
+
+def test_barn_worlds_draw_difficulties_from_the_seed():
+    worlds = barn.barn_worlds(3, seed=100)
+    assert [w.seed for w in worlds] == [100, 101, 102]
+    assert [w.name for w in worlds] == [w.name for w in barn.barn_worlds(3, seed=100)]
+    fills = {barn.difficulty(s) for s in range(40)}
+    assert {f for f, _ in fills} == set(barn.FILLS)
+    assert {s for _, s in fills} == set(barn.SMOOTHINGS)
+
+
+def test_protocol_goal_ten_metres_ahead_within_one_metre_in_100_s():
+    w = barn.barn_world(1)
+    a = w.agents[0]
+    assert (a.start.x, a.start.y) == (0.0, 0.0)
+    assert a.goal.x == pytest.approx(393.7, abs=0.01) and a.goal.tolerance == pytest.approx(39.37, abs=0.01)
+    assert w.time_limit == 100.0
+    assert (w.robot.length, w.robot.width) == (20.0, 17.0)
+
+
+def test_the_smoothing_follows_the_thresholds():
+    f = np.zeros((5, 5), dtype=bool)
+    f[2, 2] = True                                     # alone: cleared
+    assert not barn.smooth(f, 1).any()
+    g = np.zeros((5, 5), dtype=bool)
+    g[1:4, 1:4] = True
+    g[2, 2] = False                                    # 8 filled neighbours: filled
+    assert barn.smooth(g, 1)[2, 2]
+
+
+@pytest.mark.parametrize("seed", [0, 3, 12])
+def test_a_way_through_exists_and_is_really_clear(seed):
+    f = barn.field(seed, *barn.difficulty(seed))
+    clearance = barn.JACKAL.width / 2 + barn.PASSAGE_MARGIN
+    assert barn.way_through(f.filled, clearance)
+    # the raster test against an exact distance: every free raster point is clear
+    free = ~barn.blocked_raster(f.filled, clearance)
+    step = barn.CELL / barn.RASTER
+    r, c = np.nonzero(free)
+    x = barn.FIELD_AHEAD + (c + 0.5) * step
+    y = -barn.FIELD / 2 + (r + 0.5) * step
+    boxes = barn.cell_boxes(f.filled)
+    dx = np.maximum(np.maximum(boxes[:, 0] - x[:, None], x[:, None] - boxes[:, 2]), 0)
+    dy = np.maximum(np.maximum(boxes[:, 1] - y[:, None], y[:, None] - boxes[:, 3]), 0)
+    assert np.hypot(dx, dy).min() >= clearance - step / 2
+
+
+def test_a_wall_across_the_field_has_no_way_through():
+    f = np.zeros((barn.CELLS, barn.CELLS), dtype=bool)
+    f[:, 10] = True
+    assert not barn.way_through(f, 9.5)
+    f[12:16, 10] = False                               # a 23.6 in door: 17 in robot passes
+    assert barn.way_through(f, 9.5)
+
+
+@pytest.mark.parametrize("known", [False, True])
+def test_start_and_goal_are_free_and_the_file_round_trips(tmp_path, known):
+    w = barn.barn_world(3, 0.3, 2, known=known)
+    static = build_static(w)
+    a = w.agents[0]
+    assert static.free(np.array([[a.start.x, a.start.y], [a.goal.x, a.goal.y]])).all()
+    out = tmp_path / "barn.yaml"
+    barn.write_world(w, out)
+    back = load_world(out)
+    assert back.name == w.name and back.agents == w.agents and back.sensors == w.sensors
+    if known:
+        assert back.grid is not None and np.array_equal(back.grid.occupied, w.grid.occupied)
+        assert back.grid.origin == pytest.approx(w.grid.origin)
+        assert not back.obstacles
+    else:
+        assert back.obstacles == w.obstacles and back.corridors == w.corridors
+
+
+def test_known_poles_lie_where_the_unknown_rectangles_are():
+    f = barn.field(5, 0.25, 3)
+    g = barn.grid(f.filled)
+    for o in barn.obstacles(f.filled)[:10]:
+        for x in np.linspace(o.x - o.length / 2 + 1, o.x + o.length / 2 - 1, 3):
+            col = int((x - g.origin[0]) // g.resolution)
+            row = int((o.y - g.origin[1]) // g.resolution)
+            assert g.occupied[row, col]
+
+
+def test_the_module_writes_a_world(tmp_path, capsys):
+    out = tmp_path / "w.yaml"
+    assert barn.main(["--seed", "4", "--out", str(out)]) == 0
+    assert load_world(out).seed == 4

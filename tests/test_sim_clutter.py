@@ -1,0 +1,79 @@
+"""Seeded clutter: the same seed gives the same objects, and a way past each stays open."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from mitos_cli.sim.clutter import FREE_WAY_IN, KINDS, clutter
+from mitos_cli.sim.loop import prepare
+from mitos_cli.sim.worldfile import parse_world
+
+HALL = """\
+name: hall
+dt: 0.05
+time_limit: 30
+robot: {model: tricycle, wheelbase: 16, footprint: {length: 24, width: 18}}
+q_init: {x: 30, y: 0, heading: 0}
+q_goal: {x: 1170, y: 0}
+map:
+  corridors:
+    - points: [[0, 0], [1200, 0]]
+      width: 80
+"""
+
+
+@pytest.fixture(scope="module")
+def hall():
+    world = parse_world(HALL, "hall.yaml")
+    return world, prepare(world)
+
+
+def draw(hall, seed, count=6, **kw):
+    world, scene = hall
+    return clutter(world, scene.static, scene.routes[0], np.random.default_rng(seed), count,
+                   **kw)
+
+
+def test_the_same_seed_gives_the_same_clutter(hall):
+    assert draw(hall, 7).obstacles == draw(hall, 7).obstacles
+    assert draw(hall, 7).obstacles != draw(hall, 8).obstacles
+
+
+def across(o) -> tuple[float, float]:
+    """Lowest and highest y of an object (the hall runs along x, so angle 0 or 180)."""
+    half = o.radius if o.shape == "circle" else o.width / 2
+    return o.y - half, o.y + half
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_every_object_leaves_the_free_way_and_stays_inside(hall, seed):
+    w = draw(hall, seed)
+    assert 1 <= len(w.obstacles) <= 6
+    for o in w.obstacles:
+        lo, hi = across(o)
+        assert -40 - 1e-6 <= lo and hi <= 40 + 1e-6
+        assert max(40 - hi, lo + 40) >= FREE_WAY_IN - 1e-6
+        assert o.name.split("_")[0] in {k.name for k in KINDS}
+
+
+def test_objects_keep_their_spacing_and_the_start_and_goal_free(hall):
+    w = draw(hall, 3, count=12)
+    xs = sorted(o.x for o in w.obstacles)
+    assert all(b - a >= 90 - 1e-6 for a, b in zip(xs, xs[1:]))
+    assert all(o.x - 30 >= 90 - 1e-6 and 1170 - o.x >= 90 - 1e-6 for o in w.obstacles)
+
+
+def test_a_way_wider_than_the_hall_places_nothing(hall):
+    assert draw(hall, 1, free_way_in=100.0).obstacles == ()
+
+
+def test_the_clutter_is_unknown_to_the_route(hall):
+    world, scene = hall
+    cluttered = draw(hall, 2)
+    again = prepare(cluttered)
+    assert np.array_equal(again.routes[0].points, scene.routes[0].points)
+    assert not any(getattr(o, "known", False) for o in cluttered.obstacles)
+    assert math.isclose(again.routes[0].length, scene.routes[0].length)
