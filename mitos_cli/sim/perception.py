@@ -48,8 +48,9 @@ Inputs (all floats, units in the names of ``mitos.terms.yaml`` / ``drive.terms.y
     (``heading``; behind the robot, the side it lies on), plus ``way_room_weight`` times that
     clear length (so that when every way is shut the roomiest wins), less ``way_turn_cost`` for
     every degree it turns from the robot's heading (so it does not flip between two gaps).
-    Where the route's own bearing is clear, ``opening`` is ``heading``; in clutter it points
-    at the gap to take.
+    Where the route's own bearing is clear, ``opening`` is ``heading`` (to within a degree or
+    two: a way nearer the heading may win by its lower turn cost); in clutter it points at
+    the gap to take.
 ``clutter`` (objects)
     how many separate objects its map does not show the robot sees ahead within ``sight``:
     runs of neighbouring beams hitting obstacles, split where two hits lie more than
