@@ -7,7 +7,8 @@ worlds/corridor.yaml = 4 T-norms + the potential-field baseline x 200 seeded run
 
 Each mode runs the same tasks through `run_study` (results.csv written and fsync'ed per row,
 as the command does) in a fresh directory; the rows of every mode are checked to be equal
-bit for bit. The Dask figure is given with and without the cluster's start-up.
+bit for bit. The Dask figure is given with and without the cluster's start-up; the cluster is
+the command's own (mutual TLS on 127.0.0.1, see docs/security.md).
 
 On a machine shared with other jobs wall-clock rates mostly measure the contention, so the
 script also reports CPU seconds per run (this process and its reaped children: the pool's
@@ -73,11 +74,14 @@ def main() -> None:
         base = timed("1 process", workers=1)
         two = timed("2 processes (local)", workers=2)
         if not args.skip_dask:
-            from distributed import Client, LocalCluster
+            from distributed import Client
+
+            from mitos_cli.study.executors import local_cluster
 
             c0, t0 = cpu_seconds(), time.perf_counter()
-            with LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                              dashboard_address=None) as cluster, Client(cluster) as client:
+            # the cluster `mitos compare --executor dask` starts (mutual TLS, 127.0.0.1)
+            with local_cluster(2) as cluster, \
+                    Client(cluster, security=cluster.security) as client:
                 start = time.perf_counter() - t0
                 dask = timed("dask, 2-worker LocalCluster", cpu=False, executor="dask",
                              client=client)

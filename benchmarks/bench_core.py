@@ -3,6 +3,7 @@
 Run from the repository root (one command)::
 
     python benchmarks/bench_core.py            # add --quick for a fast smoke run
+    python benchmarks/bench_core.py --startup  # only (c), 21 alternating runs of each
 
 It measures, in one run, on the packaged MITOS rule base (behavior ``avoid_obstacle``, the
 paper's 27 rules):
@@ -244,6 +245,23 @@ def process_time(argv: list[str], runs: int) -> float:
     return statistics.median(times)
 
 
+def startup(runs: int) -> None:
+    """(c) alone, the two commands alternating so that the machine's drift hits both alike."""
+    mitos = str(Path(sys.executable).parent / "mitos")
+    commands = {"mitos": [mitos, "eval", "road=78", "size=45", "position=4"],
+                "numpy": [sys.executable, "-c", "import numpy"]}
+    times: dict[str, list[float]] = {k: [] for k in commands}
+    for _ in range(runs):
+        for name, argv in commands.items():
+            times[name].append(process_time(argv, 1))
+    t_eval, t_numpy = (statistics.median(times[k]) for k in commands)
+    print(f"# MITOS start-up ({time.strftime('%Y-%m-%d')}), {machine()}")
+    print(f"command: python benchmarks/bench_core.py --startup (median of {runs} alternating runs)")
+    print(f"| `mitos eval road=78 size=45 position=4` (whole process) | {fmt_time(t_eval)} | "
+          f"{t_eval / t_numpy:.2f}x `python -c \"import numpy\"` |")
+    print(f"| `python -c \"import numpy\"` (whole process) | {fmt_time(t_numpy)} | |")
+
+
 def machine() -> str:
     model = platform.processor() or "unknown CPU"
     try:
@@ -276,7 +294,12 @@ def fmt_time(s: float) -> str:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--quick", action="store_true", help="small sizes, for a smoke run")
+    ap.add_argument("--startup", action="store_true",
+                    help="only the whole-process start-up of `mitos eval` against NumPy's import")
     args = ap.parse_args()
+    if args.startup:
+        startup(runs=21)
+        return
     n = 10**5 if args.quick else 10**6
     repeats = 3 if args.quick else 5
     single_n = 200 if args.quick else 2000
@@ -361,9 +384,9 @@ def main() -> None:
     print(f"# MITOS core benchmark ({time.strftime('%Y-%m-%d')})")
     print(f"machine: {host}")
     print(f"command: python benchmarks/bench_core.py{' --quick' if args.quick else ''}")
-    print(f"batch: {n:,} random inputs, best of {2 * repeats} interleaved rounds after a warm-up; single: median of "
-          f"{repeats} repeats of the mean over {single_n} (MITOS) / {len(pts[:max(50, single_n // 4)])}"
-          f" (peers) calls; process: median of {runs} runs\n")
+    print(f"batch: {n:,} random inputs, best of {2 * repeats} interleaved rounds after a warm-up; "
+          f"single: median of {repeats} repeats of the mean over {single_n} (MITOS) / "
+          f"{len(pts[:max(50, single_n // 4)])} (peers) calls; process: median of {runs} runs\n")
     print("| measurement | figure | ratio |")
     print("| --- | ---: | --- |")
     print(f"| MITOS batch, `evaluate(detail=True)` | {fmt_rate(rate['detail'])} eval/s | "

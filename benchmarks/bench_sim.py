@@ -29,9 +29,9 @@ import time
 import numpy as np
 
 from mitos_cli.resources import packaged_path
+from mitos_cli.sim.loop import Simulation, prepare, simulate
 from mitos_cli.sim.planner import FuzzyPlanner
 from mitos_cli.sim.runs import run_many
-from mitos_cli.sim.loop import Simulation, prepare, simulate
 from mitos_cli.sim.world import Corridor, Goal
 from mitos_cli.sim.worldfile import load_world
 
@@ -77,7 +77,7 @@ def one_run(world, planner, repeats: int = 5) -> None:
     """Ticks per second of one run (CPU time, best of ``repeats``) and the stages' shares."""
     scene = prepare(world)
     simulate(world, planner, scene=scene)                 # warm-up
-    best_cpu, ticks = min((_cpu_of(world, planner, scene) for _ in range(repeats)))
+    best_cpu, ticks = min(_cpu_of(world, planner, scene) for _ in range(repeats))
     sim = StageTimed(world, planner, scene=scene)
     sim.seconds = {}
     t = time.perf_counter()

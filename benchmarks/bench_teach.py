@@ -16,7 +16,13 @@ b. one adaptation epoch (gradient, projected step, step halving until ``Q`` decr
    ``adapt(..., epochs=1)`` minus its fixed cost, i.e. the time of ``epochs=21`` minus
    ``epochs=1`` divided by 20;
 c. the shipped lesson ``rulebases/lessons/wider-turn.lesson`` end to end (simulation of
-   ``worlds/figure4.yaml``, corrections, adaptation), in process, without a journal on disk.
+   ``worlds/figure4.yaml``, corrections, adaptation), in process, without a journal on disk;
+d. the cost of the interpretability constraints (held centre terms, crisp values apart,
+   coverage and distinguishability checked on every trial step): one constrained epoch against
+   one unconstrained epoch (``adapt(..., constrained=False)``: order and bounds only), at 1,000
+   examples, per epoch actually run (aim: < 1.2x);
+e. what the constraints cost in fit: ``Q`` after ``--epochs`` (500) epochs of the lesson's
+   examples, constrained against unconstrained (aim: within 10 %).
 
 The peers are checked to agree with the analytic gradient before they are timed. Times are
 the median of repeats after a warm-up. Figures go to stdout; nothing is written to disk.
@@ -106,6 +112,7 @@ def lesson_time() -> float | None:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="fewer repeats (a smoke run)")
+    ap.add_argument("--epochs", type=int, default=500, help="epochs of the lesson's examples")
     args = ap.parse_args()
     repeats = 3 if args.quick else 15
 
@@ -126,6 +133,7 @@ def main() -> None:
     t21 = median_time(lambda: adapt(compiled, X, T, epochs=21), 3)
     t_epoch = (t21 - t1) / 20
     t_lesson = lesson_time()
+    cost = {flag: epoch_time(compiled, X, T, flag, max(3, repeats // 5)) for flag in (True, False)}
     # the same rule base as a Mamdani behavior (min / max / centroid, resolution 101): central
     # differences, 2 batch evaluations per free number
     mamdani = compile_rulebase(compiled.rulebase, compiled.behavior,
@@ -156,6 +164,52 @@ def main() -> None:
         print("wider-turn lesson: worlds/figure4.yaml or the lesson is missing (skipped)")
     else:
         print(f"{'wider-turn lesson end to end (no save)':<48}{t_lesson:>10.2f} s")
+    print(f"{'one epoch, constrained (1,000 examples)':<48}{cost[True] * 1e3:>10.2f} ms")
+    print(f"{'one epoch, unconstrained (order, bounds)':<48}{cost[False] * 1e3:>10.2f} ms")
+    print(f"{'  constraint cost per epoch':<48}{cost[True] / cost[False]:>12.2f}x   (aim < 1.2x)")
+    fit = lesson_fit(args.epochs)
+    if fit is not None:
+        (qc, ec), (qu, eu) = fit
+        print(f"lesson examples, {args.epochs} epochs: Q constrained {qc:.6g} ({ec} epochs), "
+              f"unconstrained {qu:.6g} ({eu} epochs): {qc / qu:.2f}x   (aim <= 1.10x)")
+
+
+def epoch_time(compiled, X, T, constrained: bool, repeats: int) -> float:
+    """Seconds per epoch actually run: (epochs=21 - epochs=1) / the epochs between them."""
+    def timed(epochs):
+        times, runs = [], 0
+        for _ in range(repeats):
+            t0 = time.perf_counter()
+            r = adapt(compiled, X, T, epochs=epochs, constrained=constrained)
+            times.append(time.perf_counter() - t0)
+            runs = len(r.history) - 1 - r.rounded
+        return statistics.median(times), runs
+    (t1, n1), (t21, n21) = timed(1), timed(21)
+    return (t21 - t1) / max(n21 - n1, 1)
+
+
+def lesson_fit(epochs: int):
+    """``(Q, epochs run)`` after ``epochs`` epochs on the lesson's examples, constrained and
+    unconstrained (the lesson's corrections without its ``adapt`` line)."""
+    from mitos_cli.teach.lesson import commands
+    from mitos_cli.teach.session import Session
+
+    lesson = ROOT / "rulebases" / "lessons" / "wider-turn.lesson"
+    if not lesson.is_file():
+        return None
+    session = Session(ROOT / "rulebases" / "mitos.rules", out=lambda s: None)
+    session.base = ROOT
+    for _, line in commands(lesson.read_text(encoding="utf-8")):
+        if line.startswith("adapt"):
+            break
+        session.run(line)
+    compiled = session.compiled()
+    X, T = session.training_set(compiled)
+    out = []
+    for constrained in (True, False):
+        r = adapt(compiled, X, T, epochs=epochs, rate=0.5, constrained=constrained)
+        out.append((r.q_after, len(r.history) - 1 - r.rounded))
+    return out
 
 
 if __name__ == "__main__":

@@ -42,12 +42,14 @@ def packaged_names(kind: str, suffix: str) -> Iterator[str]:
             yield entry.name
 
 
-def resolve(kind: str, name: str | Path, suffix: str) -> Path | None:
-    """``name`` if it exists, else the packaged file of that name (``figure4`` ->
+def resolve(kind: str, name: str | Path, suffix: str, base: Path | None = None) -> Path | None:
+    """``name`` if it exists (first relative to ``base``, e.g. the lesson that names it, then
+    to the working directory), else the packaged file of that name (``figure4`` ->
     ``worlds/figure4.yaml``, ``rulebases/mitos.rules`` from anywhere), else ``None``."""
     p = Path(name)
-    if p.exists():
-        return p
+    for candidate in ([base / p] if base is not None else []) + [p]:
+        if candidate.is_file():
+            return candidate
     for candidate in (p.name, p.name + suffix):
         if (data_dir(kind) / candidate).is_file():
             return packaged_path(kind, candidate)

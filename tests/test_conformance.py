@@ -46,7 +46,6 @@ REFUSED = {
     "mamdani/simple_dimmer_chained.fll": "is an output variable and cannot appear",
     "mamdani/simple_dimmer_inverse.fll": "is an output variable and cannot appear",
     "takagi_sugeno/approximation.fll": "lock-previous: true",
-    "takagi_sugeno/matlab/juggler.fll": "duplicate term `out1mf`",
     "takagi_sugeno/octave/sugeno_tip_calculator.fll": "hedges on a Takagi-Sugeno consequent",
     "terms/function.fll": "`Function` terms (a free formula) are not supported",
     "tsukamoto/tsukamoto.fll": "Tsukamoto inference",

@@ -51,10 +51,16 @@ def terms(draw, prefix: str):
     return tuple(out)
 
 
+#: Term-name prefixes: hedge and keyword words of the three languages must stay whole words
+#: (`veryA0` is a term, not `very` + `A0`).
+PREFIXES = ("A", "very", "not", "any", "somewhat_", "extremely", "seldom", "if", "is", "then",
+            "with", "and", "or")
+
+
 @st.composite
 def rulebases(draw):
-    a = Variable("a", "input", (0.0, 10.0), draw(terms("A")))
-    b = Variable("b", "input", (0.0, 10.0), draw(terms("B")))
+    a = Variable("a", "input", (0.0, 10.0), draw(terms(draw(st.sampled_from(PREFIXES)))))
+    b = Variable("b", "input", (0.0, 10.0), draw(terms(draw(st.sampled_from(PREFIXES)) + "B")))
     mamdani = draw(st.booleans())
     if mamdani:
         y = Variable("y", "output", (0.0, 10.0), draw(terms("Y")), default=5.0)

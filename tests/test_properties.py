@@ -299,7 +299,13 @@ def test_operators_and_hedges_as_defined(points):
 
 RESERVED = {"if", "then", "and", "or", "not", "is", "with", "use", "when", "behavior", "end",
             "terms", "operators", "frozen", "very", "somewhat", "more_or_less", "extremely"}
-NAMES = st.from_regex(r"\A[A-Za-z_][A-Za-z0-9_]{0,7}\Z").filter(lambda s: s not in RESERVED)
+#: Names, many of them beginning with a reserved word (`veryhigh`, `not_far`, `iffy`, `any-x`):
+#: a hedge or keyword is a whole word, never the prefix of a name.
+NAMES = st.one_of(
+    st.from_regex(r"\A[A-Za-z_][A-Za-z0-9_]{0,7}\Z"),
+    st.builds(lambda w, rest: w + rest, st.sampled_from(sorted(RESERVED)),
+              st.from_regex(r"\A(-?[A-Za-z0-9_]){1,4}\Z")),
+).filter(lambda s: s not in RESERVED)
 
 
 def any_props():

@@ -15,7 +15,8 @@ from mitos_cli.sim.perception import INPUTS
 
 RUNNER = CliRunner()
 KEYS = {"world", "seed", "outcome", "reached_goal", "collisions", "time_s", "path_length_in",
-        "min_clearance_in", "mean_speed_in_s", "steering_total_variation_deg", "ticks"}
+        "min_clearance_in", "mean_speed_in_s", "steering_total_variation_deg", "ticks",
+        "replans"}
 SHORT = """\
 name: short
 seed: 2

@@ -84,3 +84,81 @@ def test_the_shipped_real_map_loads():
     g = load_map_yaml(packaged_path("worlds", "maps/mrpb_office02.yaml"))
     assert g.occupied.shape == (600, 600)
     assert 0.2 < g.occupied.mean() < 0.6
+
+
+# --- images Pillow reads, rotated origins ------------------------------------------------
+
+def _map(tmp_path: Path, image: str, origin: str = "[0.0, 0.0, 0.0]") -> Path:
+    y = tmp_path / "m.yaml"
+    y.write_text(f"image: {image}\nresolution: 0.0254\norigin: {origin}\nnegate: 0\n"
+                 "occupied_thresh: 0.65\nfree_thresh: 0.196\n", encoding="utf-8")
+    return y
+
+
+def test_a_png_map_reads_as_the_same_pgm(tmp_path):
+    Image = pytest.importorskip("PIL.Image")
+    px = np.array(PIXELS, dtype=np.uint8).reshape(3, 2)
+    Image.fromarray(px).save(tmp_path / "m.png")
+    (tmp_path / "m.pgm").write_bytes(b"P5 2 3 255\n" + px.tobytes())
+    png = load_map_yaml(_map(tmp_path, "m.png"))
+    pgm = load_map_yaml(_map(tmp_path, "m.pgm"))
+    assert png.occupied.tolist() == pgm.occupied.tolist()
+    Image.fromarray(np.stack([px] * 3, axis=-1)).convert("RGBA").save(tmp_path / "c.png")
+    assert load_map_yaml(_map(tmp_path, "c.png")).occupied.tolist() == pgm.occupied.tolist()
+
+
+def test_without_pillow_a_png_is_refused_with_what_to_install(tmp_path, monkeypatch):
+    import sys
+
+    (tmp_path / "m.png").write_bytes(b"\x89PNG\r\n\x1a\n")
+    monkeypatch.setitem(sys.modules, "PIL", None)
+    with pytest.raises(WorldError, match=r"needs Pillow: pip install 'mitos\[maps\]'") as exc:
+        load_map_yaml(_map(tmp_path, "m.png"))
+    assert exc.value.span.line == 1
+
+
+def test_a_file_that_is_no_image_is_refused_at_the_image_line(tmp_path):
+    pytest.importorskip("PIL")
+    (tmp_path / "m.png").write_bytes(b"not an image")
+    with pytest.raises(WorldError, match="does not recognise it as an image"):
+        load_map_yaml(_map(tmp_path, "m.png"))
+
+
+def test_a_half_turned_origin_puts_the_map_on_the_other_side(tmp_path):
+    # 2 x 3 pixels, one black pixel at the top left; turned half round about the origin (1 m, 2 m)
+    (tmp_path / "m.pgm").write_bytes(b"P5 2 3 255\n" + bytes([0, 254, 254, 254, 254, 254]))
+    g = load_map_yaml(_map(tmp_path, "m.pgm", f"[1.0, 2.0, {np.pi!r}]"))
+    assert g.origin == pytest.approx((1 / 0.0254 - 2, 2 / 0.0254 - 3))
+    # the black pixel was the top-left cell (x 0..1, y 2..3 in): now it covers x -1..0, y -3..-2
+    # relative to the origin, the bottom-right cell of the turned grid
+    assert np.argwhere(g.occupied).tolist() == [[0, 1]]
+
+
+def test_any_yaw_is_honoured_and_matches_the_exact_quarter_turn(tmp_path):
+    from mitos_cli.sim.gridmap import rotate
+
+    rng = np.random.default_rng(3)
+    blocked = rng.random((9, 13)) < 0.3
+    exact, o1 = rotate(blocked, 2.0, (10.0, -4.0), np.pi / 2)
+    resampled, o2 = rotate(blocked, 2.0, (10.0, -4.0), np.pi / 2 + 1e-7)
+    assert exact.shape == (13, 9) and o1 == pytest.approx(o2)
+    assert (resampled[:13, :9] == exact).all()
+    # a quarter turn to the left sends the map's +x axis to +y: its bottom row becomes the
+    # grid's right-hand column, read upward
+    assert (exact[:, -1] == blocked[0]).all()
+
+
+def test_a_yaw_of_3_14_as_in_the_stata_basement_map_is_turned_not_refused(tmp_path):
+    # 40 x 30 pixels of 1 in, one black pixel at image column 5, row 9 from the top
+    px = np.full((30, 40), 254, dtype=np.uint8)
+    px[9, 5] = 0
+    (tmp_path / "m.pgm").write_bytes(b"P5 40 30 255\n" + px.tobytes())
+    g = load_map_yaml(_map(tmp_path, "m.pgm", "[0.0, 0.0, 3.14]"))
+    c, s = np.cos(3.14), np.sin(3.14)
+    # the pixel's centre in the map's frame (in), turned by the yaw about the origin
+    mx, my = 5.5, 30 - 9 - 0.5
+    x, y = c * mx - s * my, s * mx + c * my
+    rows, cols = np.argwhere(g.occupied[1:-1, 1:-1]).T + 1       # inside the cover's edge
+    centres = np.stack([g.origin[0] + (cols + 0.5), g.origin[1] + (rows + 0.5)], axis=1)
+    assert len(centres) >= 1
+    assert np.hypot(centres[:, 0] - x, centres[:, 1] - y).min() < 0.71

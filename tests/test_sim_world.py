@@ -126,16 +126,15 @@ def test_a_map_image_that_is_not_a_pgm(tmp_path: Path):
         load_world(world)
 
 
-def test_a_rotated_map_is_refused(tmp_path: Path):
+def test_a_rotated_map_is_turned_about_its_origin(tmp_path: Path):
+    # rotated maps used to be refused; the yaw is now honoured (tests/test_sim_gridmap.py)
+    from mitos_cli.sim.gridmap import load_map_yaml
+
     (tmp_path / "map.pgm").write_bytes(b"P5 2 2 255\n" + bytes([254, 254, 254, 254]))
     (tmp_path / "map.yaml").write_text("image: map.pgm\nresolution: 0.05\n"
                                        "origin: [0, 0, 3.14]\n", encoding="utf-8")
-    world = tmp_path / "w.yaml"
-    world.write_text(BASE.replace("  corridors:\n    - points: [[0, 0], [400, 0]]\n"
-                                  "      width: 70\n", "  grid: map.yaml\n"), encoding="utf-8")
-    with pytest.raises(WorldError) as info:
-        load_world(world)
-    assert "rotated" in info.value.render() and "map.yaml:3:9" in info.value.render()
+    grid = load_map_yaml(tmp_path / "map.yaml")
+    assert grid.origin[0] < -3.9 and grid.origin[1] < -3.9     # it lies left of and below
 
 
 def test_unknown_map_key_in_map_yaml(tmp_path: Path):

@@ -1,6 +1,12 @@
-"""The Dask executor on a 2-worker LocalCluster gives the local executor's results bit for bit."""
+"""The Dask executor on a 2-worker LocalCluster gives the local executor's results bit for bit,
+and that cluster (the one ``mitos compare --executor dask`` starts) admits no other process."""
 
 from __future__ import annotations
+
+import os
+import socket
+import ssl
+from pathlib import Path
 
 import pytest
 
@@ -14,9 +20,9 @@ from test_study_core import fake_sim, small_study  # noqa: E402
 
 @pytest.fixture(scope="module")
 def client():
-    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                                  dashboard_address=None) as cluster, \
-            distributed.Client(cluster) as c:
+    from mitos_cli.study.executors import local_cluster
+
+    with local_cluster(2) as cluster, distributed.Client(cluster, security=cluster.security) as c:
         yield c
 
 
@@ -58,3 +64,44 @@ def test_unreachable_scheduler_is_a_clear_error():
         dask_client("tcp://127.0.0.1:9", 2, timeout="0.5s")
     assert "cannot reach the Dask scheduler at tcp://127.0.0.1:9" in exc.value.message
     assert "dask scheduler" in exc.value.hint
+
+
+@pytest.mark.filterwarnings("ignore:Port 8787 is already in use")
+def test_a_plain_local_cluster_runs_a_strangers_code():
+    """The attack on the cluster the Dask executor used to start: any local process that
+    finds the port connects and runs code."""
+    with distributed.LocalCluster(n_workers=1, processes=False, dashboard_address=None) as plain, \
+            distributed.Client(plain.scheduler_address, timeout="5s") as stranger:
+        assert stranger.run_on_scheduler(os.getpid) == os.getpid()
+
+
+def _handshake(address: str, context: ssl.SSLContext) -> None:
+    host, port = address.split("://")[1].rsplit(":", 1)
+    with socket.create_connection((host, int(port)), timeout=5) as raw, \
+            context.wrap_socket(raw, server_hostname=host) as tls:
+        tls.sendall(b"\0" * 8)                # TLS 1.3 reports a refused certificate here
+        if not tls.recv(1):
+            raise ConnectionResetError("closed")
+
+
+def test_a_stranger_cannot_reach_the_local_cluster(client):
+    from distributed.security import Security
+
+    info = client.scheduler_info()
+    addresses = [client.scheduler.address, *info["workers"]]
+    assert all(a.startswith("tls://127.0.0.1:") for a in addresses)
+    for address in addresses:
+        # a client with certificates of its own making is refused at the handshake
+        with pytest.raises(OSError):
+            distributed.Client(address, security=Security.temporary(), timeout="3s")
+        # and one that brings no certificate at all
+        bare = ssl.SSLContext(ssl.PROTOCOL_TLS_CLIENT)
+        bare.check_hostname, bare.verify_mode = False, ssl.CERT_NONE
+        with pytest.raises((ssl.SSLError, ConnectionError)):
+            _handshake(address, bare)
+    # nothing of the workers' lies in a directory others may write
+    for worker in info["workers"].values():
+        scratch = Path(worker["local_directory"]).parents[1]
+        assert scratch.name.startswith("mitos-dask-") and scratch.stat().st_mode & 0o077 == 0
+    # the owner's client still works, and its results are the serial run's (tests above)
+    assert client.submit(sum, [1, 2]).result() == 3

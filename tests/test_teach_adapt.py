@@ -123,8 +123,8 @@ def test_ties_pass_the_gradient_to_the_lowest_index_deterministically():
 
 def test_q_decreases_on_a_synthetic_target_and_never_increases():
     compiled = load_rulebase().compiled
-    p = parameterise(compiled)
-    truth = p.values.copy()
+    p = parameterise(compiled, constrained=False)      # the target moves road.MEDIUM, held
+    truth = p.values.copy()                            # at its point when constrained
     truth[1] += 4.0          # road: the shared NARROW.b = MEDIUM.peak = WIDE.a ...
     truth[0] += 2.0          # ... and NARROW.a; MEDIUM stays symmetric through right = 104
     truth[2] += 6.0
@@ -134,7 +134,8 @@ def test_q_decreases_on_a_synthetic_target_and_never_increases():
                          rng.uniform(-60, 60, 500)])
     T = evaluate(with_values(p, truth), X).outputs
     seen = []
-    result = adapt(compiled, X, T, epochs=60, rate=0.5, on_epoch=lambda e, q: seen.append(q))
+    result = adapt(compiled, X, T, epochs=60, rate=0.5, on_epoch=lambda e, q: seen.append(q),
+                   parameters=p)
     history = np.array(result.history)
     assert np.all(np.diff(history[:-1]) < 0)           # every epoch lowers Q
     assert result.q_after <= result.q_before * 0.05
@@ -170,7 +171,8 @@ def test_frozen_terms_and_frozen_rules_keep_their_values():
     p = parameterise(compiled)
     X = points(300, 7)
     T = np.full((300, 1), 20.0)
-    result = adapt(compiled, X, T, epochs=40)
+    released = parameterise(compiled, released={("y", "M")})   # M: held at 50 by default
+    result = adapt(compiled, X, T, epochs=40, parameters=released)
     rb = learned_rulebase(result.parameters, result.values)
     assert rb.variables["z"].term("C").params == (8.0, 1.5)       # frozen: true
     assert rb.variables["y"].term("S").params == (10.0,)         # only r1 (frozen) says S

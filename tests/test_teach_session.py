@@ -137,8 +137,8 @@ def test_correct_adapt_and_show(rules, tmp_path):
     say(s, out, "correct road=90 size=30 position=-3 -> steering=120")
     y = [s._outputs(s.compiled(), [e.inputs])[0] for e in s.state.examples]
     q0 = (y[0]["steering"] - 60) ** 2 + (y[0]["speed"] - 20) ** 2 + (y[1]["steering"] - 120) ** 2
-    text = say(s, out, "adapt epochs 15 rate 0.5")
-    assert f"epoch    0: Q = {q0:.6g}" in text
+    text = say(s, out, "adapt epochs 15 rate 0.5 unconstrained")  # two examples, fitted
+    assert f"epoch    0: Q = {q0:.6g}" in text                     # closely: far from meaning
     q = [float(x.split("Q = ")[1]) for x in text.splitlines() if x.startswith("  epoch")]
     assert q == sorted(q, reverse=True) and q[-1] < 0.1 * q[0]
     assert "changed (before -> after):" in text and "road.MEDIUM: peak 70, width 30  ->" in text
@@ -148,7 +148,7 @@ def test_correct_adapt_and_show(rules, tmp_path):
     assert "* avoid_obstacle (27 rules)" in say(s, out, "show behaviors")
     assert "r25: if road is MEDIUM" in say(s, out, "show rules")
     history = say(s, out, "show history")
-    assert f"adapt epochs 15 rate 0.5   (Q {q0:.4g} ->" in history
+    assert f"adapt epochs 15 rate 0.5 unconstrained   (Q {q0:.4g} ->" in history
     with pytest.raises(LessonError, match="whole number"):
         s.run("adapt epochs 2.5")
     with pytest.raises(LessonError, match=r"\(0, 1\)"):

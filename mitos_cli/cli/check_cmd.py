@@ -9,7 +9,7 @@ from typing import Annotated, Optional
 
 import typer
 
-from .output import emit
+from .output import emit, warn_notes
 from ..words import plural
 
 
@@ -94,6 +94,7 @@ def check_command(
     from ..resources import display_path
 
     rb = read_rulebase(rulebase)
+    warn_notes(rb)
     report = check_rulebase(rb, behavior, threshold=threshold, resolution=resolution)
     name = display_path(rb.path)
     if as_json:

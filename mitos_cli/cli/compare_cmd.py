@@ -28,7 +28,7 @@ def compare_command(
              "Default: the rule base's.")] = None,
     planner: Annotated[str, typer.Option(
         "--planner", metavar="PLANNERS",
-        help="Planners to compare: fuzzy, potential_field.")] = "fuzzy,potential_field",
+        help="Planners to compare: fuzzy, potential_field, dwa.")] = "fuzzy,potential_field",
     runs: Annotated[int, typer.Option(
         "--runs", "-n", min=1, help="Randomized runs per world and choice.")] = 20,
     seed: Annotated[int, typer.Option(

@@ -8,7 +8,7 @@ from typing import Annotated, Optional
 
 import typer
 
-from .output import emit, err, warn
+from .output import emit, err, warn, warn_notes
 
 
 class Target(str, Enum):
@@ -37,10 +37,11 @@ def convert_command(
     is refused with the reason.
     """
     from ..api import read_rulebase
-    from ..interop import conversion_notes, write_foreign
+    from ..interop import conversion_notes, parse_foreign, round_trip_difference, write_foreign
     from ..interop.common import atomic_write
 
     rb = read_rulebase(path)
+    warn_notes(rb)
     if behavior is not None:
         rb.behavior(behavior)                     # unknown behavior: did you mean
     if to is Target.rules:
@@ -58,10 +59,15 @@ def convert_command(
             warn(note)
         atomic_write(terms_path, terms_text)
         atomic_write(rules_path, rules_text)
+        for note in round_trip_difference(rb, read_rulebase(rules_path), "rules", behavior):
+            warn(note)
         err(f"wrote {rules_path} and {terms_path}")
         return
     text = write_foreign(rb, to.value, behavior)
     for note in conversion_notes(rb, to.value, behavior):
+        warn(note)
+    for note in round_trip_difference(rb, parse_foreign(text, to.value, str(output or "-")),
+                                      to.value, behavior):
         warn(note)
     if output is None:
         emit(text)

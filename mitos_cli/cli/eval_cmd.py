@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import enum
 import json
 import sys
 from pathlib import Path
@@ -10,8 +11,25 @@ from typing import Annotated, Optional
 import typer
 
 from ..errors import InputError
-from .output import emit, warn
+from .output import emit, warn, warn_notes
 from ..words import plural
+
+
+class Engine(str, enum.Enum):
+    """A reference engine whose sampling of Mamdani outputs ``--fidelity`` reproduces."""
+
+    matlab = "matlab"
+    jfuzzylogic = "jfuzzylogic"
+    fuzzylite = "fuzzylite"
+
+
+class NoRule(str, enum.Enum):
+    """What ``eval --batch`` writes where no rule sets an output (see docs/interop.md)."""
+
+    error = "error"          # stop, naming the first such row
+    default = "default"      # the output's declared default (a number or nan); else stop
+    nan = "nan"              # NaN, whatever the default
+    skip = "skip"            # leave the row out
 
 
 def split_args(args: list[str]) -> tuple[Optional[str], dict[str, str]]:
@@ -68,6 +86,16 @@ def eval_command(
         "--digits", min=0, max=12, help="Decimals in the trace (the paper prints 1).")] = 1,
     network: Annotated[bool, typer.Option(
         "--network", help="Print the compiled network of fuzzy neurons instead.")] = False,
+    on_no_rule: Annotated[Optional[NoRule], typer.Option(
+        "--on-no-rule", case_sensitive=False,
+        help="With --batch, where no rule sets an output: error, default (the output's "
+             "declared default, else an error; what happens without this option), nan, or "
+             "skip the row. Given, it adds a `no_rule` column naming such outputs.")] = None,
+    fidelity: Annotated[Optional[Engine], typer.Option(
+        "--fidelity", case_sensitive=False,
+        help="Sample Mamdani outputs as this engine does, to reproduce its published tables: "
+             "matlab (101 points with both ends), jfuzzylogic (1000 left cell ends), "
+             "fuzzylite (cell midpoints, the file's resolution).")] = None,
 ) -> None:
     """Evaluate a rule base: fuzzified inputs, fired rules with DOFs, crisp outputs."""
     from ..api import load_rulebase
@@ -78,6 +106,13 @@ def eval_command(
         raise typer.BadParameter(f"`{path}` is neither a rule file nor NAME=VALUE (no file "
                                  f"of that name; write each input as NAME=VALUE)")
     rb = load_rulebase(path, behavior)
+    warn_notes(rb.rulebase)
+    if fidelity is not None:
+        from ..api import LoadedRuleBase
+        from ..interop.common import fidelity_settings
+
+        rb = LoadedRuleBase(rb.rulebase, behavior,
+                            fidelity_settings(rb.rulebase, fidelity.value, behavior))
     if network:
         from ..engine.describe import describe_network
 
@@ -89,15 +124,20 @@ def eval_command(
         if as_json:
             raise typer.BadParameter("--batch writes a CSV; --json is for one evaluation "
                                      "(leave one of them out)")
-        run_batch(rb, batch)
+        run_batch(rb, batch, on_no_rule)
         return
+    if on_no_rule is not None:
+        raise typer.BadParameter("--on-no-rule applies to --batch")
     if not values:
         raise typer.BadParameter(
             "give one NAME=VALUE per input: " + " ".join(f"{k}=..." for k in rb.inputs))
     from ..engine.evaluation import as_batch, evaluate
     from ..engine.trace import trace_of
 
-    result = evaluate(rb.compiled, as_batch(rb.compiled, parse_values(values)))
+    unused = unused_inputs(rb)
+    given: dict[str, object] = {k: v for k, v in parse_values(values).items()
+                                if k not in unused}
+    result = evaluate(rb.compiled, as_batch(rb.compiled, given))
     warn_clamped(result)
     trace = trace_of(result)
     if as_json:
@@ -106,7 +146,14 @@ def eval_command(
         emit(trace.render(digits))
 
 
-def run_batch(rb, source: str) -> None:
+def unused_inputs(rb) -> tuple[str, ...]:
+    """Inputs the file declares but the behavior's rules never test: a table of the file's
+    inputs may still give them (and their values change nothing)."""
+    return tuple(v.name for v in rb.rulebase.variables.values()
+                 if v.role == "input" and v.name not in rb.compiled.inputs)
+
+
+def run_batch(rb, source: str, on_no_rule: NoRule | None = None) -> None:
     """Read the CSV, evaluate all rows as one batch, write inputs and outputs as CSV."""
     import numpy as np
 
@@ -120,8 +167,52 @@ def run_batch(rb, source: str) -> None:
         except (OSError, UnicodeDecodeError) as exc:
             raise InputError(f"cannot read batch file `{source}`: "
                              f"{getattr(exc, 'strerror', None) or exc}") from None
-    X = read_batch(text, name, rb.compiled.inputs)
-    result = rb.run(X)
+    X = read_batch(text, name, rb.compiled.inputs, unused_inputs(rb))
+    result = rb.run(X, strict=False, detail=False)
     warn_clamped(result)
-    write_batch(sys.stdout, rb.compiled.inputs, np.asarray(X), rb.compiled.outputs,
-                result.outputs)
+    Y, keep, flags = no_rule_policy(rb.compiled, result, on_no_rule or NoRule.default)
+    write_batch(sys.stdout, rb.compiled.inputs, np.asarray(X)[keep],
+                rb.compiled.outputs, Y[keep], None if on_no_rule is None else flags[keep])
+
+
+def no_rule_policy(compiled, result, policy: NoRule):
+    """``(outputs, rows to keep, no_rule column)`` after applying ``policy`` to the rows where
+    no rule set an output; a warning says how many rows each output's choice changed."""
+    import numpy as np
+
+    from ..engine.evaluation import declares_nan
+    from ..errors import NoRuleFiredError
+
+    Y = result.outputs.copy()
+    unset = result.no_rule if result.no_rule is not None else np.zeros(Y.shape, dtype=bool)
+    n = len(Y)
+    keep = np.ones(n, dtype=bool)
+    for j, out in enumerate(compiled.outputs):
+        rows = unset[:, j]
+        count = int(rows.sum())
+        if not count:
+            continue
+        declared = not np.isnan(compiled.default[j]) or declares_nan(compiled, out)
+        shown = "nan" if np.isnan(compiled.default[j]) else f"{compiled.default[j]:g}"
+        if policy is NoRule.error or (policy is NoRule.default and not declared):
+            row = int(np.argmax(rows))
+            values = ", ".join(f"{k}={result.inputs[row, i]:g}"
+                               for i, k in enumerate(compiled.inputs))
+            raise NoRuleFiredError(
+                f"no rule sets `{out}` for {values} ({count} of {n} rows)",
+                hint=("" if policy is NoRule.error else
+                      f"`{out}` declares no default. ") +
+                     "--on-no-rule default, nan or skip writes the other rows (docs/interop.md)")
+        if policy is NoRule.default:
+            warn(f"no rule sets `{out}` in {plural(count, 'row')} of {n}: the file's default "
+                 f"({shown}) is written there")
+        elif policy is NoRule.nan:
+            Y[rows, j] = np.nan
+            warn(f"no rule sets `{out}` in {plural(count, 'row')} of {n}: nan is written there")
+        else:
+            keep &= ~rows
+            warn(f"no rule sets `{out}` in {plural(count, 'row')} of {n}: left out")
+    flags = np.full(n, "", dtype=object)
+    for j, out in enumerate(compiled.outputs):
+        flags = np.where(unset[:, j], flags + (";" + out), flags)
+    return Y, keep, np.char.lstrip(flags.astype(str), ";") if n else flags

@@ -8,7 +8,7 @@ from typing import Annotated, Optional
 
 import typer
 
-from .output import emit, err
+from .output import emit, err, warn_notes
 
 
 class Language(str, Enum):
@@ -43,6 +43,7 @@ def export_command(
     if not ident(prefix) == prefix:
         raise typer.BadParameter(f"--prefix `{prefix}` is not a C identifier")
     rb = load_rulebase(path, behavior)
+    warn_notes(rb.rulebase)
     text = to_c(rb.compiled, prefix, path.name) if to is Language.c else \
         to_python(rb.compiled, path.name)
     if output is None:

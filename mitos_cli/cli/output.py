@@ -16,6 +16,12 @@ def warn(message: str) -> None:
     err(f"warning: {message}")
 
 
+def warn_notes(rulebase) -> None:
+    """What a foreign file's reader changed to make the file fit, one warning each."""
+    for note in getattr(rulebase, "notes", ()):
+        warn(note)
+
+
 def report_error(exc: MitosError) -> None:
     err(exc.render())
 

@@ -190,7 +190,7 @@ def surface_command(
              "(may be left out when the rule base has one output).")] = None,
     x: Annotated[str, typer.Option(
         "--x", metavar="INPUT[=LOW:HIGH]",
-        help="Input on the x axis, optionally zoomed to LOW:HIGH.")] = ...,
+        help="Input on the x axis, optionally zoomed to LOW:HIGH.")] = ...,  # type: ignore[assignment]  # Typer: required
     y: Annotated[Optional[str], typer.Option(
         "--y", metavar="INPUT[=LOW:HIGH]",
         help="Input on the y axis (without it: a curve over --x).")] = None,

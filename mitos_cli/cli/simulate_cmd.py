@@ -43,7 +43,8 @@ _ROWS = (   # label, key, format (the overall figures, then each robot's)
     ("ticks", "ticks", str), ("path length", "path_length_in", lambda v: f"{v:.1f} in"),
     ("mean speed", "mean_speed_in_s", lambda v: f"{v:.1f} in/s"),
     ("min clearance", "min_clearance_in", lambda v: f"{v:.1f} in"),
-    ("steering total variation", "steering_total_variation_deg", lambda v: f"{v:.0f} deg"))
+    ("steering total variation", "steering_total_variation_deg", lambda v: f"{v:.0f} deg"),
+    ("replans", "replans", str))
 
 
 def _summary(res) -> str:
@@ -118,14 +119,22 @@ def simulate_command(
         "--require", metavar="success", help="Exit 3 unless every run ends in this outcome.")] = None,
     workers: Annotated[Optional[int], typer.Option(
         "--workers", min=1, help="Processes for --runs (default: up to 2).")] = None,
+    planner_name: Annotated[str, typer.Option(
+        "--planner", metavar="NAME",
+        help="Who drives: fuzzy (the rule base), potential_field or dwa (baselines that "
+             "see the same readings and follow the same route).")] = "fuzzy",
 ) -> None:
     """Simulate the rule base driving a tricycle robot through corridor worlds."""
     from ..resources import DEFAULT_WORLD
-    from ..sim.planner import FuzzyPlanner
+    from ..sim.planner import make_planner, planner_kind
     from ..sim.worldfile import load_world, resolve_world_path
 
     if require is not None and require not in REQUIRE:
         raise typer.BadParameter(f"--require takes `success`, not `{require}`")
+    planner_kind(planner_name)                  # an unknown name fails before any file is read
+    if planner_name != "fuzzy" and (rulebase or behavior):
+        raise typer.BadParameter(f"--rulebase and --behavior choose the fuzzy planner's rules; "
+                                 f"`{planner_name}` has none", param_hint="--planner")
     names = worlds or [DEFAULT_WORLD]
     loaded = [load_world(resolve_world_path(n)) for n in names]
     many = len(loaded) > 1 or runs > 0
@@ -136,7 +145,7 @@ def simulate_command(
         from ..draw.output import check_format
 
         check_format(plot)
-    planner = FuzzyPlanner(rulebase, behavior or loaded[0].behavior)
+    planner = make_planner(planner_name, loaded[0], rulebase, behavior)
 
     if many:
         from ..sim.runs import run_many

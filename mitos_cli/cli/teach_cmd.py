@@ -3,31 +3,32 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated, Optional
+from typing import Annotated
 
 import typer
+
 from ..words import plural
 
 
 def teach_command(
-    rules: Annotated[Optional[str], typer.Argument(
+    rules: Annotated[str | None, typer.Argument(
         metavar="[RULES]",
         help="Rule file to teach (default: the packaged MITOS rule base).")] = None,
-    behavior: Annotated[Optional[str], typer.Option(
+    behavior: Annotated[str | None, typer.Option(
         "--behavior", "-b", help="The behavior to teach first (default: the file's first).")]
         = None,
-    lesson: Annotated[Optional[str], typer.Option(
+    lesson: Annotated[str | None, typer.Option(
         "--lesson", "-l", metavar="FILE|-",
         help="Run the commands of a lesson file (- for stdin) instead of the prompt; stop at "
              "the first error (exit 1).")] = None,
-    save_as: Annotated[Optional[str], typer.Option(
+    save_as: Annotated[str | None, typer.Option(
         "--save-as", "-o", metavar="OUT.rules",
         help="Where `save` writes (OUT.rules and OUT.terms.yaml); a lesson saves there when it "
              "ends. The original files are never overwritten unless you name them.")] = None,
     resume: Annotated[bool, typer.Option(
         "--resume", help="Continue the last teaching session here (or --session NAME) from "
                          "its journal.")] = False,
-    session_name: Annotated[Optional[str], typer.Option(
+    session_name: Annotated[str | None, typer.Option(
         "--session", metavar="NAME", help="The session to resume (a name under "
                                           ".mitos/teach/).")] = None,
 ) -> None:
@@ -56,7 +57,11 @@ def teach_command(
             + (" (a torn last line of the journal was dropped)" if journal.skipped_tail
                else ""))
     else:
+        from ..resources import resolve
+
         path = Path(rules) if rules is not None else default_rulebase_path()
+        if rules is not None and not path.exists():      # as eval and check: a packaged file
+            path = resolve("rulebases", rules, ".rules") or path
         if not path.is_file():
             from ..errors import RuleBaseError
 
@@ -77,7 +82,7 @@ def teach_command(
         text, name = lesson_text if lesson_text is not None else read_lesson(lesson)
         session.echo = emit
         if lesson != "-":
-            session.base = Path(lesson).parent
+            session.base = Path(name).parent
         try:
             run_lesson(session, text, name)
         except KeyboardInterrupt:

@@ -67,7 +67,7 @@ def draw_consequent(ax, base: float, row: RuleRow, out: OutputView) -> None:
     for c in (c for c in row.consequents if c.output == out.name):
         gid = f"{row.label}:{out.name}"
         name = " ".join(c.hedges + (c.term,)) if c.term else f"{c.value:g}"
-        if c.implied is not None and out.grid is not None:
+        if c.implied is not None and c.full is not None and out.grid is not None:
             ax.plot(out.grid, base + BAND * c.full, color=TERM_COLOR, linewidth=1.0, gid=gid)
             ax.fill_between(out.grid, base, base + BAND * c.implied, color=OUT_COLOR,
                             alpha=0.7, linewidth=0, gid=gid)

@@ -41,10 +41,14 @@ def success_bars(summaries, worlds: list[str], labels: list[str], path: str | Pa
             s = by_key.get((w, label))
             r = s.rates["success"] if s is not None else None
             if r is None or r.n == 0:
-                values.append(np.nan), lo.append(0.0), hi.append(0.0)
+                values.append(np.nan)
+                lo.append(0.0)
+                hi.append(0.0)
                 continue
             v = r.k / r.n
-            values.append(100 * v), lo.append(100 * (v - r.lo)), hi.append(100 * (r.hi - v))
+            values.append(100 * v)
+            lo.append(100 * (v - r.lo))
+            hi.append(100 * (r.hi - v))
         xs = x + (j - (n_c - 1) / 2) * width
         ax.bar(xs, values, width * 0.92, label=label, color=cmap(j % 10), yerr=[lo, hi],
                capsize=2, error_kw={"linewidth": 0.8})

@@ -64,6 +64,7 @@ def _levels(z: np.ndarray, n: int = 10) -> np.ndarray | None:
 
 def draw_heatmap(fig, ax, s: Surface) -> None:
     """Heat map with labelled contour lines; masked (blank, hatched) where nothing fires."""
+    assert s.y is not None, "a heat map has two inputs"
     z = np.ma.masked_invalid(s.z)
     X, Y = np.meshgrid(s.x.values, s.y.values)
     ax.add_patch(_background(ax))
@@ -92,6 +93,7 @@ def _background(ax):
 def draw_surface3d(fig, ax, s: Surface) -> None:
     """A shaded 3-D surface with its contours projected on the floor; masked cells are
     left out (holes), and a note says so."""
+    assert s.y is not None, "a surface has two inputs"
     X, Y = np.meshgrid(s.x.values, s.y.values)
     z = np.ma.masked_invalid(s.z)
     finite = s.z[np.isfinite(s.z)]

@@ -195,9 +195,8 @@ def render_variable(plot: VariablePlot, width: int = 72, height: int = 6,
         if plot.role == "input" or shown:
             line += f": {shown or 'no term holds it (all memberships 0)'}"
         out.append(" " * margin + line)
-    linear = [c for c in plot.curves if c.kind == "linear"]
-    for c in linear:
-        out.append(f"{' ' * margin}{c.name}: {c.formula} (Takagi-Sugeno, no membership curve)")
+    for curve in (c for c in plot.curves if c.kind == "linear"):
+        out.append(f"{' ' * margin}{curve.name}: {curve.formula} (Takagi-Sugeno, no membership curve)")
     return "\n".join(out)
 
 

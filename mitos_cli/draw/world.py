@@ -53,6 +53,7 @@ def draw_run(result, path: str | Path | None = None, *, footprint_every: float =
             ax.plot(xy[:, 0], xy[:, 1], color="#b5524a", lw=0.8, ls=":")
         for k, alpha in ((0, 0.25), (len(xy) - 1, 0.9)) if moving else ((len(xy) - 1, 0.9),):
             cx, cy = xy[k]
+            patch: Circle | Polygon
             if o.shape == "circle":
                 patch = Circle((cx, cy), o.radius)
             else:

@@ -23,7 +23,14 @@ code                  severity    meaning
 ``term-outside``      warning     an input term that never reaches 1 inside the universe
 ``unused-term``       warning     an input term (or a whole input) that no rule uses
 ``unconcluded-term``  info        an output term that no rule concludes
+``term-order``        warning     terms whose peaks (values) are not in the written order
+``coverage``          warning     a point of an input's universe where no term reaches 0.5
+``indistinct``        warning     two terms of a variable too alike to tell apart
+``off-centre``        warning     the middle of mirror-symmetric terms off their point
 ====================  ==========  ==========================================================
+
+The last four are the interpretability checks of :mod:`mitos_cli.lang.interpretability` (their
+thresholds are documented there); ``mitos teach`` runs them after ``adapt`` and ``save``.
 
 The input space is sampled on a grid: ``resolution`` evenly spaced points per input plus every
 corner point of its terms (where memberships start or stop being 0), capped at
@@ -38,13 +45,22 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from ..lang.model import flatten
-from .compile import CompiledRuleBase, compile_rulebase
-from .evaluation import evaluate
 from ..errors import Span
-from ..lang.model import (And, Consequent, Expr, Not, Prop, Rule, RuleBase, format_consequent,
-                    format_expr)
+from ..lang.model import (
+    And,
+    Consequent,
+    Expr,
+    Not,
+    Prop,
+    Rule,
+    RuleBase,
+    flatten,
+    format_consequent,
+    format_expr,
+)
 from ..lang.terms import Variable
+from .compile import CompiledRuleBase, compile_rulebase
+from .evaluation import declares_nan, evaluate
 
 SEVERITIES = ("error", "warning", "info")
 #: Most grid points one behavior is sampled on (the per-input resolution shrinks to fit).
@@ -150,6 +166,7 @@ def check_rulebase(rb: RuleBase, behavior: str | None = None, *, threshold: floa
         grids.append(info)
     findings += _term_gaps(rb)
     findings += _unused_terms(rb)
+    findings += _interpretability(rb)
     order = {s: i for i, s in enumerate(SEVERITIES)}
     findings.sort(key=lambda f: (order[f.severity], _span_key(f.span)))
     return Report(rb, tuple(findings), tuple(grids), threshold, tuple(names))
@@ -364,7 +381,8 @@ def _sampled(compiled: CompiledRuleBase, threshold: float,
             mask = mask_of(total[:, j])
             if not mask.any():
                 continue
-            has_default = not np.isnan(compiled.default[j])
+            # a declared `default: nan` is the rule base's own choice, as a number is
+            has_default = not np.isnan(compiled.default[j]) or declares_nan(compiled, out_name)
             key = (mask.tobytes(), has_default)
             reported.setdefault(key, []).append(out_name)
             masks[key] = mask
@@ -491,6 +509,18 @@ def _term_gaps(rb: RuleBase) -> list[Finding]:
                 f"input `{var.name}`: every term is 0 {where}", var.span, None,
                 hint="widen a neighbouring term (or add one) so that the terms cover the "
                      "universe"))
+    return out
+
+
+def _interpretability(rb: RuleBase) -> list[Finding]:
+    from ..lang.interpretability import variable_issues
+
+    out = []
+    for var in rb.variables.values():
+        for issue in variable_issues(var):
+            span = var.term(issue.terms[0]).span if issue.terms else var.span
+            out.append(Finding("warning", issue.code, issue.message, span, None,
+                               hint=issue.hint))
     return out
 
 

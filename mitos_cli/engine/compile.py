@@ -406,7 +406,7 @@ class _Antecedents:
     rules: tuple[Rule, ...]
 
 
-def _walk(builder: "_Builder", term_index: dict, expr: Expr) -> tuple[int, int]:
+def _walk(builder: _Builder, term_index: dict, expr: Expr) -> tuple[int, int]:
     """The (column, level) of ``expr``'s neuron, adding the neurons it needs to ``builder``
     (a sub-expression used twice is one neuron)."""
     if isinstance(expr, Prop):
@@ -425,7 +425,7 @@ def _walk(builder: "_Builder", term_index: dict, expr: Expr) -> tuple[int, int]:
     return builder.node((op, tuple(c for c, _ in children)), op, children)
 
 
-def _antecedents(flat, builder: "_Builder", term_index: dict) -> _Antecedents:
+def _antecedents(flat, builder: _Builder, term_index: dict) -> _Antecedents:
     """Every rule's antecedent and ``use`` conditions as neurons, and its weight."""
     rule_col, weight, contexts = [], [], []
     for _, rule, uses in flat:

@@ -12,15 +12,17 @@ from ..errors import InputError, Span, did_you_mean
 from ..words import plural
 
 
-def read_batch(text: str, path: str, inputs: tuple[str, ...]) -> np.ndarray:
-    """``X[n, k]`` from CSV text whose header names every input (any column order)."""
+def read_batch(text: str, path: str, inputs: tuple[str, ...],
+               unused: tuple[str, ...] = ()) -> np.ndarray:
+    """``X[n, k]`` from CSV text whose header names every input (any column order); columns
+    named in ``unused`` (inputs of the rule base its rules never test) are read and dropped."""
     lines = text.splitlines()
     if not lines or not lines[0].strip():
         raise InputError("the batch CSV is empty", span=Span(path, 1, 1),
                          expected="a header naming the inputs: " + ",".join(inputs))
     header = [h.strip() for h in next(csv.reader([lines[0]]))]
     for h in header:
-        if h not in inputs:
+        if h not in inputs and h not in unused:
             raise InputError(f"batch column `{h}` is not an input of this behavior",
                              span=Span.in_text(text, path, 1, lines[0].find(h) + 1),
                              expected="columns " + ", ".join(inputs),
@@ -60,7 +62,15 @@ def _raise_bad_row(lines: list[str], path: str, width: int) -> None:
     raise InputError("the batch CSV could not be read", span=Span(path, 1, 1))
 
 
-def write_batch(out: TextIO, inputs, X: np.ndarray, outputs, Y: np.ndarray) -> None:
-    out.write(",".join(list(inputs) + list(outputs)) + "\n")
+def write_batch(out: TextIO, inputs, X: np.ndarray, outputs, Y: np.ndarray,
+                no_rule: np.ndarray | None = None) -> None:
+    """Inputs and outputs as CSV; with ``no_rule`` (one text per row: the outputs no rule set,
+    joined by ``;``) a last column ``no_rule``."""
+    names = list(inputs) + list(outputs) + ([] if no_rule is None else ["no_rule"])
+    out.write(",".join(names) + "\n")
     table = np.hstack([X, Y]) if len(X) else np.empty((0, len(inputs) + len(outputs)))
-    np.savetxt(out, table, delimiter=",", fmt="%.12g")
+    if no_rule is None:
+        np.savetxt(out, table, delimiter=",", fmt="%.12g")
+        return
+    cells = np.column_stack([table.astype(object), np.asarray(no_rule, dtype=object)])
+    np.savetxt(out, cells, delimiter=",", fmt=["%.12g"] * table.shape[1] + ["%s"])

@@ -9,6 +9,7 @@ in any batch.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
@@ -31,6 +32,7 @@ class Result:
     outputs: np.ndarray       # [n, m]
     clamped: np.ndarray       # [k] how many samples of each input were clamped
     values: np.ndarray | None = None  # [n, columns] every neuron's value (kept on request)
+    no_rule: np.ndarray | None = None  # [n, m] True where no rule set the output (before defaults)
 
     # memberships and dof are transposed views of [T, n] / [R, n] arrays (rows are samples).
 
@@ -44,7 +46,7 @@ class Result:
         return self.outputs[:, self.compiled.outputs.index(name)]
 
 
-def as_batch(compiled: CompiledRuleBase, columns: dict[str, object]) -> np.ndarray:
+def as_batch(compiled: CompiledRuleBase, columns: Mapping[str, object]) -> np.ndarray:
     """Input arrays by variable name -> ``X[n, k]`` in the compiled column order.
 
     Every compiled input must be given; scalars broadcast against arrays. Names that the
@@ -375,9 +377,10 @@ def evaluate(compiled: CompiledRuleBase, X, *, detail: bool = True, keep_values:
         if keep_values:
             values[:, block] = V
     X = clamped_in.T
+    no_rule = np.isnan(out.T)
     outputs = fill_defaults(compiled, out.T, X, strict)
     return Result(compiled, X, mu.T if detail else None, dof.T if detail else None, outputs,
-                  counts, values.T if keep_values else None)
+                  counts, values.T if keep_values else None, no_rule)
 
 
 def evaluate_columns(compiled: CompiledRuleBase, Xt: np.ndarray, *,
@@ -395,21 +398,10 @@ def evaluate_columns(compiled: CompiledRuleBase, Xt: np.ndarray, *,
         block = slice(start, min(start + BLOCK, n))
         Xc, _ = _clamp_columns(compiled, Xt[:, block], start, n)
         out[:, block] = infer(compiled, rule_dof(compiled, network_values(compiled, Xc)), Xc)
-    if np.isnan(out).any():
-        fill_defaults(compiled, out.T, _ClampedRows(compiled, Xt), strict)
+    if np.isnan(out).any():                  # rare: the clamped rows, for the message
+        rows = np.minimum(np.maximum(Xt.T, compiled.plan.lo), compiled.plan.hi) + 0.0
+        fill_defaults(compiled, out.T, rows, strict)
     return out
-
-
-class _ClampedRows:
-    """``X[row, i]`` of a batch given as columns, clamped on access (only for the message
-    about a sample no rule fired for)."""
-
-    def __init__(self, compiled: CompiledRuleBase, Xt: np.ndarray) -> None:
-        self.lo, self.hi, self.Xt = compiled.plan.lo, compiled.plan.hi, Xt
-
-    def __getitem__(self, key: tuple[int, int]) -> float:
-        row, i = key
-        return min(max(float(self.Xt[i, row]), self.lo[i]), self.hi[i]) + 0.0
 
 
 def evaluate_one(compiled: CompiledRuleBase, values: list[float],
@@ -454,6 +446,13 @@ def infer(compiled: CompiledRuleBase, dof: np.ndarray,
     return weighted_average(compiled, dof, Xt)
 
 
+def declares_nan(compiled: CompiledRuleBase, output: str) -> bool:
+    """Whether ``output`` declares NaN as its value when no rule fires (fuzzylite's
+    ``default: nan``, FCL's ``DEFAULT := nan``, a term set's ``default: .nan``)."""
+    v = compiled.variables.get(output)
+    return v is not None and v.default is not None and v.default != v.default
+
+
 def fill_defaults(compiled: CompiledRuleBase, out: np.ndarray, X: np.ndarray,
                   strict: bool) -> np.ndarray:
     """Where no rule fired (NaN), use the output's default or explain how to declare one."""
@@ -467,6 +466,8 @@ def fill_defaults(compiled: CompiledRuleBase, out: np.ndarray, X: np.ndarray,
         default = compiled.default[j]
         if not np.isnan(default):
             out[col, j] = default
+        elif declares_nan(compiled, name):
+            continue                           # the rule base asked for NaN here
         elif strict:
             row = int(np.argmax(col))
             values = ", ".join(f"{k}={X[row, i]:g}" for i, k in enumerate(compiled.inputs))

@@ -41,6 +41,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from typing import Callable
+
 import numpy as np
 
 from ..fuzzy import hedges as hedge_mod
@@ -51,7 +53,7 @@ from ..fuzzy import norms
 #: 4x as fast as 32 MB (benchmarks/bench_norms.py, resolution 101 and 1001).
 MAX_BYTES = 2 ** 20
 
-IMPLICATIONS = {"min": np.minimum, "product": np.multiply}
+IMPLICATIONS: dict[str, Callable[..., np.ndarray]] = {"min": np.minimum, "product": np.multiply}
 IMPLICATIONS.update({name: (lambda a, b, norm=norm: norm(*np.broadcast_arrays(a, b)))
                      for name, norm in norms.TNORMS.items() if name not in IMPLICATIONS})
 
@@ -72,9 +74,12 @@ class OutputTable:
 
 def grid(lo: float, hi: float, resolution: int, sampling: str = "midpoints") -> np.ndarray:
     """The midpoints of ``resolution`` equal cells of ``[lo, hi]`` (``sampling="endpoints"``:
-    ``resolution`` evenly spaced points from ``lo`` to ``hi``, as MATLAB's ``evalfis``)."""
+    ``resolution`` evenly spaced points from ``lo`` to ``hi``, as MATLAB's ``evalfis``;
+    ``"left"``: the cells' left ends, as jFuzzyLogic)."""
     if sampling == "endpoints":
         return np.linspace(lo, hi, resolution)
+    if sampling == "left":                    # jFuzzyLogic: the cells' left ends
+        return lo + np.arange(resolution) * ((hi - lo) / resolution)
     return lo + (np.arange(resolution) + 0.5) * ((hi - lo) / resolution)
 
 
@@ -102,7 +107,9 @@ def build_tables(compiled) -> tuple[OutputTable, ...]:
         x = grid(lo, hi, res, sampling)
         rules = np.flatnonzero(compiled.cons_mask[:, j])
         keys: dict[tuple, int] = {}
-        rows, labels, set_of = [], [], []
+        rows: list[np.ndarray] = []
+        labels: list[str] = []
+        picks: list[int] = []
         for r in rules:
             term, hedges = compiled.cons_term[r][j], compiled.cons_hedges[r][j]
             key = (term, hedges) if term is not None else ("=", float(compiled.cons_value[r, j]))
@@ -117,8 +124,8 @@ def build_tables(compiled) -> tuple[OutputTable, ...]:
                           else np.asarray(t.membership(x), dtype=float))
                     rows.append(hedge_mod.apply(hedges, mu))
                     labels.append(" ".join(hedges + (term,)))
-            set_of.append(keys[key])
-        set_of = np.array(set_of, dtype=np.intp)
+            picks.append(keys[key])
+        set_of = np.array(picks, dtype=np.intp)
         order = np.argsort(set_of, kind="stable").astype(np.intp)
         starts = np.searchsorted(set_of[order], np.arange(len(rows))).astype(np.intp)
         sets = np.array(rows, dtype=float).reshape(len(rows), res)

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .evaluation import Result
+from .evaluation import Result, declares_nan
 from ..resources import display_path
 from ..words import plural
 
@@ -112,7 +112,8 @@ def trace_of(result: Result, row: int = 0) -> Trace:
                     for j, name in enumerate(c.outputs))
     fired = result.dof[row] > 0
     defaulted = tuple(name for j, name in enumerate(c.outputs)
-                      if not np.isnan(c.default[j]) and not fired[c.cons_mask[:, j]].any())
+                      if (not np.isnan(c.default[j]) or declares_nan(c, name))
+                      and not fired[c.cons_mask[:, j]].any())
     path = display_path(c.rulebase.path)
     return Trace(path, c.behavior, c.operators.describe(), c.n_rules, tuple(inputs), rules,
                  outputs, defaulted)

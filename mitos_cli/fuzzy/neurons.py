@@ -19,12 +19,14 @@ folds run in the same order, so the values agree bit for bit (tests/test_neurons
 
 from __future__ import annotations
 
+from typing import Callable
+
 import numpy as np
 
 from . import hedges as hedge_mod
 from . import norms
 
-SYNAPSES = {
+SYNAPSES: dict[str, tuple[Callable[..., np.ndarray], float, str]] = {
     "product": (np.multiply, 1.0, "d = x * w (eq. 5)"),
     "max": (np.maximum, 0.0, "d = x v w = max(x, w) (eq. 6)"),
 }

@@ -244,6 +244,13 @@ def sigmoid_difference(x, left, rising, falling, right):
     return np.abs(sigmoid(x, left, rising) - sigmoid(x, right, falling))
 
 
+def clipped_sigmoid_difference(x, left, rising, falling, right):
+    """``max(sigmoid(left, rising) - sigmoid(right, falling), 0)``: jFuzzyLogic's ``DSIGM``
+    (and Octave's ``dsigmf``); it differs from :func:`sigmoid_difference` where the second
+    sigmoid is the larger."""
+    return np.maximum(sigmoid(x, left, rising) - sigmoid(x, right, falling), 0.0)
+
+
 def sigmoid_product(x, left, rising, falling, right):
     """``sigmoid(left, rising) * sigmoid(right, falling)`` (MATLAB ``psigmf``)."""
     return sigmoid(x, left, rising) * sigmoid(x, right, falling)
@@ -402,6 +409,9 @@ for _shape in (
     Shape("sigmoid_difference", ("left", "rising", "falling", "right"), sigmoid_difference,
           lambda p: None, None, lambda p: (p[0] + p[3]) / 2,
           "|sigmoid(left, rising) - sigmoid(right, falling)|"),
+    Shape("clipped_sigmoid_difference", ("left", "rising", "falling", "right"),
+          clipped_sigmoid_difference, lambda p: None, None, lambda p: (p[0] + p[3]) / 2,
+          "max(sigmoid(left, rising) - sigmoid(right, falling), 0) (jFuzzyLogic's DSIGM)"),
     Shape("sigmoid_product", ("left", "rising", "falling", "right"), sigmoid_product,
           lambda p: None, None, lambda p: (p[0] + p[3]) / 2,
           "sigmoid(left, rising) * sigmoid(right, falling)"),

@@ -18,6 +18,8 @@ from ..lang import operators as ops_mod
 from ..lang.resolve import MAIN, check_rule
 from ..errors import FormatError, MitosError, Span, did_you_mean
 from ..lang.model import And, Behavior, Consequent, Expr, Not, Or, Prop, Rule, RuleBase, Setting
+from ..fuzzy import norms as norm_registry
+from ..fuzzy.hedges import HEDGES, fuzzylite_names
 from ..fuzzy.shapes import SHAPES
 from ..lang.terms import Term, TermSet, Variable
 from ..words import plural
@@ -25,24 +27,8 @@ from ..words import plural
 # ---------------------------------------------------------------------------------------------
 # Operators: MITOS name -> (FLL, FIS, FCL). None = the format has no name for it.
 
-TNORMS = {
-    "min": ("Minimum", "min", "MIN"),
-    "product": ("AlgebraicProduct", "prod", "PROD"),
-    "lukasiewicz": ("BoundedDifference", None, "BDIF"),
-    "drastic": ("DrasticProduct", None, "DPROD"),
-    "einstein": ("EinsteinProduct", None, "EPROD"),
-    "hamacher": ("HamacherProduct", None, "HPROD"),
-    "nilpotent_minimum": ("NilpotentMinimum", None, "NMIN"),
-}
-SNORMS = {
-    "max": ("Maximum", "max", "MAX"),
-    "probabilistic_sum": ("AlgebraicSum", "probor", "ASUM"),
-    "bounded_sum": ("BoundedSum", None, "BSUM"),
-    "drastic_sum": ("DrasticSum", None, "DSUM"),
-    "einstein_sum": ("EinsteinSum", None, "ESUM"),
-    "hamacher_sum": ("HamacherSum", None, "HSUM"),
-    "nilpotent_maximum": ("NilpotentMaximum", None, "NMAX"),
-}
+TNORMS = {n.name: (n.fll, n.fis, n.fcl) for n in norm_registry.TNORMS.values()}
+SNORMS = {n.name: (n.fll, n.fis, n.fcl) for n in norm_registry.SNORMS.values()}
 #: Defuzzifiers of Mamdani inference; the two weighted ones are MITOS inferences.
 DEFUZZIFIERS = {
     "centroid": ("Centroid", "centroid", "COG"),
@@ -58,6 +44,14 @@ FCL_ALIASES = {"BIS": "bisector", "MOM": "mom", "SOM": "som", "LOM": "lom",
                "ALGEBRAIC_PRODUCT": "product", "PROBOR": "probabilistic_sum",
                "DMIN": "drastic", "DMAX": "drastic_sum", "NIPMIN": "nilpotent_minimum",
                "NIPMAX": "nilpotent_maximum", "EINSTEIN": "einstein", "HAMACHER": "hamacher"}
+#: The names Octave's fuzzy-logic-toolkit (and fuzzylite's .fis exporter) give the norms
+#: MATLAB has no name for.
+FIS_ALIASES = {"algebraic_product": "product", "bounded_difference": "lukasiewicz",
+               "drastic_product": "drastic", "einstein_product": "einstein",
+               "hamacher_product": "hamacher", "nilpotent_minimum": "nilpotent_minimum",
+               "algebraic_sum": "probabilistic_sum", "bounded_sum": "bounded_sum",
+               "drastic_sum": "drastic_sum", "einstein_sum": "einstein_sum",
+               "hamacher_sum": "hamacher_sum", "nilpotent_maximum": "nilpotent_maximum"}
 #: Names formats use for operators MITOS does not have (refused with this explanation).
 UNSUPPORTED_NORMS = {
     "NormalizedSum": "the normalized sum is not an S-norm MITOS computes",
@@ -83,6 +77,8 @@ def table_lookup(table: dict, fmt: int, name: str, what: str, span: Span | None,
             return mitos
     if fmt == FCL and name.upper() in FCL_ALIASES and FCL_ALIASES[name.upper()] in table:
         return FCL_ALIASES[name.upper()]
+    if fmt == FIS and FIS_ALIASES.get(name) in table:
+        return FIS_ALIASES[name]
     pool = [n[fmt] for n in table.values() if n[fmt] is not None]
     why = UNSUPPORTED_NORMS.get(name) or (UNSUPPORTED_NORMS.get(name.upper()) if fmt == FCL
                                           else None)
@@ -105,10 +101,8 @@ def foreign_name(table: dict, fmt: int, mitos: str, what: str) -> str:
 # ---------------------------------------------------------------------------------------------
 # Hedges: fuzzylite's names (FLL and its FCL dialect) -> MITOS's.
 
-FUZZYLITE_HEDGES = {"very": "very", "somewhat": "somewhat", "seldom": "seldom",
-                    "extremely": "intensely", "any": "any"}
-MITOS_TO_FUZZYLITE_HEDGES = {v: k for k, v in FUZZYLITE_HEDGES.items()}
-MITOS_TO_FUZZYLITE_HEDGES["more_or_less"] = "somewhat"      # the same function, sqrt(x)
+FUZZYLITE_HEDGES = fuzzylite_names()                     # fuzzylite's name -> MITOS's
+MITOS_TO_FUZZYLITE_HEDGES = {h.name: h.fuzzylite for h in HEDGES.values() if h.fuzzylite}
 
 
 def fuzzylite_hedge(name: str, span: Span | None) -> str:
@@ -187,7 +181,31 @@ def fuzzylite_term(name: str, kind: str, values: list[float], n_inputs: int,
                           hint="MITOS terms reach 1; scale the rule weights instead")
     if shape == "rectangle":            # fuzzylite takes the ends in either order
         values = sorted(values)
+    if shape == "trapezoid" and values[0] == values[1] == -math.inf:
+        shape, values = "left_shoulder", values[2:]         # `Trapezoid -inf -inf c d`
+    elif shape == "trapezoid" and values[2] == values[3] == math.inf:
+        shape, values = "right_shoulder", values[:2]        # `Trapezoid a b inf inf`
     return make_term(name, shape, tuple(values), span)
+
+
+def distinct_names(terms: list[Term], variable: str, notes: list[str], why: str,
+                   keep_last: bool = False) -> list[Term]:
+    """A variable's terms with a repeated name suffixed (``low``, ``low_2``) and a note:
+    MITOS names must differ, while a .fis file (rules name MFs by index) and fuzzylite 8
+    (whose rules take the last term of a name) allow repeats. ``keep_last`` leaves the name to
+    the last of its terms, else to the first."""
+    seen: set[str] = set()
+    out = []
+    order = list(reversed(terms)) if keep_last else list(terms)
+    for t in order:
+        if t.name in seen:
+            new = unique_name(f"{t.name}_2", seen | {x.name for x in terms})
+            notes.append(f"{t.span}: `{variable}` has more than one term named `{t.name}`; "
+                         f"this one is read as `{new}` ({why})")
+            t = Term(new, t.shape, t.params, t.span)
+        seen.add(t.name)
+        out.append(t)
+    return list(reversed(out)) if keep_last else out
 
 
 def make_term(name: str, shape: str, params: tuple[float, ...], span: Span | None) -> Term:
@@ -307,6 +325,54 @@ def disjoint_outputs(blocks: list[list[Rule]]) -> bool:
     return True
 
 
+#: The largest magnitude a foreign file's number may have. The engine multiplies at most two
+#: of them (a coefficient by an input, a sample point by a membership) and sums at most a
+#: million products, so every intermediate stays below 1e306, inside a double's range.
+LARGEST = 1e150
+
+#: Where an infinite parameter is meaningful, as (index, sign): the open end of a shoulder
+#: (fuzzylite writes ``Trapezoid -inf -inf c d``, ``Triangle -inf b c``) and the direction of
+#: a ``Binary`` term (``Binary 0.5 inf``).
+INFINITE_OK = {"trapezoid": {(0, -1), (1, -1), (2, 1), (3, 1)},
+               "triangle": {(0, -1), (2, 1)}, "binary": {(1, -1), (1, 1)}}
+
+
+def check_numbers(variables: list[Variable]) -> None:
+    """Refuse, with the position, what floating point cannot evaluate: NaN or infinite
+    parameters (but a shoulder's open end), ranges and defaults, numbers beyond
+    :data:`LARGEST`, and a default outside its output's range. So no NaN or infinity leaves
+    the engine unless the file asked for one (``default: nan``)."""
+    for v in variables:
+        lo, hi = v.universe
+        open_range = (lo, hi) == (-math.inf, math.inf) and v.role == "output" and all(
+            t.shape in ("singleton", "linear") for t in v.terms)   # an unused Sugeno range
+        if not open_range:
+            for end in (lo, hi):
+                _finite(end, f"variable `{v.name}`: the range", v.span)
+        for t in v.terms:
+            allowed = INFINITE_OK.get(t.shape, set())
+            for i, p in enumerate(t.params):
+                if math.isinf(p) and (i, 1 if p > 0 else -1) in allowed:
+                    continue
+                _finite(p, f"term `{v.name}.{t.name}`: parameter {i + 1}", t.span or v.span)
+        d = v.default
+        if d is not None and d == d:
+            _finite(d, f"output `{v.name}`: the default", v.span)
+            if not open_range and not lo <= d <= hi:
+                raise FormatError(f"output `{v.name}`: the default {d:g} lies outside its "
+                                  f"range [{lo:g}, {hi:g}]", span=v.span,
+                                  hint="give a default inside the range, or nan for none")
+
+
+def _finite(value: float, what: str, span: Span | None) -> None:
+    if not math.isfinite(value):
+        raise FormatError(f"{what} is {fmt_number(value)}: it must be a finite number",
+                          span=span)
+    if abs(value) > LARGEST:
+        raise FormatError(f"{what} is {value:g}: numbers beyond ±{LARGEST:g} cannot be "
+                          f"evaluated in floating point without overflow", span=span)
+
+
 def check_implication(name: str, span: Span | None) -> str:
     if name not in ops_mod.IMPLICATIONS:
         raise FormatError(f"implication `{name}` is not supported", span=span,
@@ -334,6 +400,7 @@ def assemble_blocks(path: str, variables: list[Variable],
         raise FormatError("the file defines no input variable", span=span)
     if not any(rules for _, rules, _ in blocks):
         raise FormatError("the file has no rules", span=span)
+    check_numbers(variables)
     by_name = {v.name: v for v in variables}
     behaviors = []
     for name, rules, settings in blocks:
@@ -544,3 +611,130 @@ def atomic_write(path: str | Path, text: str) -> None:
 
     write(path, text, error=FormatError)
 
+
+
+# ---------------------------------------------------------------------------------------------
+# Names each format can hold
+
+#: A legal name per target format, and the words its rules reserve.
+NAME_PATTERNS = {
+    "fll": r"[A-Za-z_][A-Za-z0-9_.]*",
+    "fcl": r"[A-Za-z_][A-Za-z0-9_.]*",
+    "rules": r"[A-Za-z_]([A-Za-z0-9_\-]*[A-Za-z0-9_])?",
+    "fis": r"[^'\n]+",
+}
+_RULE_WORDS = {"if", "then", "and", "or", "not", "is", "with"} | set(FUZZYLITE_HEDGES)
+RESERVED_NAMES = {
+    "fll": _RULE_WORDS,
+    "fcl": _RULE_WORDS | {"rule", "term", "range", "method", "default", "accu", "act",
+                          "lock", "end_var", "var_input", "var_output", "fuzzify",
+                          "defuzzify", "end_fuzzify", "end_defuzzify", "ruleblock",
+                          "end_ruleblock", "function_block", "end_function_block", "real"},
+    "rules": _RULE_WORDS | {"use", "when", "behavior", "end", "terms", "operators", "frozen"}
+             | set(HEDGES),
+    "fis": set(),
+}
+
+
+FORMAT_TITLES = {"fll": "FLL", "fcl": "FCL", "fis": "a .fis file", "rules": "the rule language"}
+
+
+def legal_names(rb: RuleBase, fmt: str) -> tuple[RuleBase, list[str]]:
+    """``rb`` with every variable and term name the format ``fmt`` cannot hold (``LDL-Level``
+    in FLL, ``service level`` in the rule language, a term named ``very``) mapped to a legal
+    one (``LDL_Level``), and a note per renamed name."""
+    import dataclasses
+    import re
+
+    pattern = re.compile(NAME_PATTERNS.get(fmt, NAME_PATTERNS["fll"]))
+    reserved = RESERVED_NAMES.get(fmt, set())
+
+    def legal(name: str, taken: set[str]) -> str:
+        if pattern.fullmatch(name) and name.lower() not in reserved:
+            return name
+        new = re.sub(r"[^A-Za-z0-9_]", "_", name) if fmt != "fis" else name.replace("'", "_")
+        if not new or not (new[0].isalpha() or new[0] == "_") and fmt != "fis":
+            new = "_" + new
+        if new.lower() in reserved:
+            new += "_"
+        return unique_name(new, taken)
+
+    notes: list[str] = []
+    var_map: dict[str, str] = {}
+    term_map: dict[tuple[str, str], str] = {}
+    all_vars = [v for ts in rb.termsets for v in ts.variables]
+    taken_vars = {v.name for v in all_vars}
+    for v in all_vars:
+        new = legal(v.name, taken_vars - {v.name})
+        if new != v.name:
+            var_map[v.name] = new
+            taken_vars.add(new)
+            notes.append(f"variable `{v.name}` is written as `{new}` ({FORMAT_TITLES[fmt]} "
+                         f"cannot name it `{v.name}`)")
+        taken_terms = set(v.term_names)
+        for t in v.terms:
+            new_t = legal(t.name, taken_terms - {t.name})
+            if new_t != t.name:
+                term_map[(v.name, t.name)] = new_t
+                taken_terms.add(new_t)
+                notes.append(f"term `{v.name}.{t.name}` is written as `{new_t}` "
+                             f"({FORMAT_TITLES[fmt]} cannot name it `{t.name}`)")
+    if not notes:
+        return rb, []
+
+    def var(name: str) -> str:
+        return var_map.get(name, name)
+
+    def term(v: str, t: str) -> str:
+        return term_map.get((v, t), t)
+
+    def expr(e: Expr) -> Expr:
+        if isinstance(e, Prop):
+            return dataclasses.replace(e, var=var(e.var), term=term(e.var, e.term))
+        if isinstance(e, Not):
+            return dataclasses.replace(e, expr=expr(e.expr))
+        return dataclasses.replace(e, items=tuple(expr(i) for i in e.items))
+
+    def rule(r: Rule) -> Rule:
+        return dataclasses.replace(r, antecedent=expr(r.antecedent), consequents=tuple(
+            dataclasses.replace(c, var=var(c.var),
+                                term=None if c.term is None else term(c.var, c.term))
+            for c in r.consequents))
+
+    termsets = tuple(TermSet(tuple(dataclasses.replace(
+        v, name=var(v.name), terms=tuple(dataclasses.replace(t, name=term(v.name, t.name))
+                                         for t in v.terms)) for v in ts.variables), ts.path)
+        for ts in rb.termsets)
+    behaviors = tuple(dataclasses.replace(
+        b, rules=tuple(rule(r) for r in b.rules),
+        uses=tuple(dataclasses.replace(u, condition=None if u.condition is None
+                                       else expr(u.condition)) for u in b.uses))
+        for b in rb.behaviors)
+    return dataclasses.replace(rb, termsets=termsets, behaviors=behaviors), notes
+
+
+# ---------------------------------------------------------------------------------------------
+# Fidelity to a format's reference engine
+
+#: How each reference engine samples a Mamdani output: (resolution, sampling); ``None`` keeps
+#: the file's resolution. MATLAB's ``evalfis``: 101 points including both ends; jFuzzyLogic:
+#: 1000 left cell ends; fuzzylite: the file's resolution (1000 by default), cell midpoints.
+FIDELITY = {"matlab": (101, "endpoints"), "jfuzzylogic": (1000, "left"),
+            "fuzzylite": (None, "midpoints")}
+
+
+def fidelity_settings(rb: RuleBase, engine: str, behavior: str | None = None
+                      ) -> tuple[Setting, ...]:
+    """Operator overrides that make ``rb``'s Mamdani outputs sample as ``engine`` does (none
+    for a weighted-average rule base, whose outputs are not sampled)."""
+    if engine not in FIDELITY:
+        raise FormatError(f"unknown engine `{engine}`", expected="one of " + ", ".join(FIDELITY),
+                          hint=did_you_mean(engine, FIDELITY))
+    b = rb.behavior(behavior)
+    ops = ops_mod.resolve(b.operators, ops_mod.resolve(rb.operators))
+    if ops.inference != "mamdani":
+        return ()
+    resolution, sampling = FIDELITY[engine]
+    if resolution is None:
+        resolution = 1000 if ops.sampling == "endpoints" else ops.resolution
+    return (Setting("resolution", str(resolution)), Setting("sampling", sampling))

@@ -27,13 +27,17 @@ this reader reads back.
 
 from __future__ import annotations
 
+import dataclasses
 import functools
+import math
 from pathlib import Path
 
+import numpy as np
 from lark import Lark, Token, Tree
 from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken
 
 from ..fuzzy import norms
+from ..lang.cache import lark_parser
 from ..errors import FormatError, Span, did_you_mean
 from ..lang.model import And, Not, Prop, Rule, RuleBase
 from ..lang.terms import Term, Variable
@@ -53,7 +57,8 @@ JFUZZY_SHAPES = {
     "gauss2": ("gaussian2", 4, lambda p: p),                          # meanl stdevl meanr stdevr
     "gbell": ("bell", 3, lambda p: (p[2], p[0], p[1])),              # a b mean
     "sigm": ("sigmoid", 2, lambda p: (p[1], p[0])),                   # gain center
-    "dsigm": ("sigmoid_difference", 4, lambda p: (p[1], p[0], p[2], p[3])),  # g1 c1 g2 c2
+    # g1 c1 g2 c2: max(s1 - s2, 0), not fuzzylite's |s1 - s2|
+    "dsigm": ("clipped_sigmoid_difference", 4, lambda p: (p[1], p[0], p[2], p[3])),
     # net_max offset: (1 + cos(pi (x - offset) / net_max)) / 2 on offset +- net_max
     "cosine": ("cosine", 2, lambda p: (p[1], 2.0 * p[0])),
 }
@@ -63,8 +68,8 @@ JFUZZY_SHAPES = {
 def parser() -> Lark:
     from ..resources import grammar_text
 
-    return Lark(grammar_text("fcl.lark"), parser="lalr", propagate_positions=True,
-                maybe_placeholders=True, cache=True)      # grammar analysis cached on disk
+    return lark_parser(grammar_text("fcl.lark"), propagate_positions=True,
+                       maybe_placeholders=True)       # analysis kept in the private cache
 
 
 def read_fcl(path: str | Path) -> RuleBase:
@@ -156,13 +161,14 @@ def _function_block(fb: Tree, span_of) -> RuleBase:
             blocks.append(item)
     n_inputs = sum(1 for role, _, _ in declared.values() if role == "input")
     records: dict[str, common.Record] = {}           # per output: METHOD, ACCU
+    notes: list[str] = []
     locks: dict[str, Span] = {}
     constants: list[tuple[str, Term]] = []
     variables = {}
     for node in fuzzify + defuzzify:
         role = "input" if node.data == "fuzzify" else "output"
         record = records.setdefault(str(node.children[0]), common.Record())
-        v = _variable(node, role, declared, record, locks, constants, n_inputs, span_of)
+        v = _variable(node, role, declared, record, locks, constants, n_inputs, span_of, notes)
         if v.name in variables:
             raise FormatError(f"variable `{v.name}` is defined twice", span=v.span)
         variables[v.name] = v
@@ -224,12 +230,13 @@ def _function_block(fb: Tree, span_of) -> RuleBase:
                         f"MITOS does not support", span=term.span,
                         hint=f"for a singleton write `TERM {term.name} := value;`")
     ordered = [variables[n] for n in declared]
-    return common.assemble_blocks(span_of(fb).path, ordered, groups, DEFAULT_RESOLUTION,
-                                  span_of(fb))
+    rb = common.assemble_blocks(span_of(fb).path, ordered, groups, DEFAULT_RESOLUTION,
+                                span_of(fb))
+    return dataclasses.replace(rb, notes=tuple(notes))
 
 
 def _variable(node: Tree, role: str, declared, settings: common.Record, locks: dict,
-              constants: list, n_inputs: int, span_of) -> Variable:
+              constants: list, n_inputs: int, span_of, notes: list[str]) -> Variable:
     name_token = node.children[0]
     name = str(name_token)
     if name not in declared:
@@ -269,8 +276,7 @@ def _variable(node: Tree, role: str, declared, settings: common.Record, locks: d
                                   expected="NC")
             if isinstance(value, Token) and value.type == "NAME":
                 raise FormatError(f"DEFAULT must be a number, not `{value}`", span=span_of(value))
-            d = _num(value)
-            default = None if d != d else d
+            default = _num(value)              # nan: NaN when no rule fires, as asked
         elif kind == "lock_item":
             for word in item.children:
                 w = str(word).upper()
@@ -287,7 +293,7 @@ def _variable(node: Tree, role: str, declared, settings: common.Record, locks: d
                           hint=None if role == "output" else "an input without terms (it only "
                           "feeds linear consequents) needs `RANGE := (min .. max);`")
     if universe is None:
-        universe = _extent(terms, name, span_of(node))
+        universe = _extent(terms, name, span_of(node), notes)
     lo, hi = universe
     if not lo < hi:
         raise FormatError(f"variable `{name}`: range [{lo:g}, {hi:g}] is empty",
@@ -298,8 +304,31 @@ def _variable(node: Tree, role: str, declared, settings: common.Record, locks: d
         raise FormatError(getattr(exc, "message", str(exc)), span=span_of(node)) from None
 
 
-def _extent(terms: list[Term], name: str, span: Span) -> tuple[float, float]:
+#: Where jFuzzyLogic's ``estimateUniverse`` puts the ends of a term with unbounded support,
+#: on MITOS's parameters: the Gaussians' mean -+ 4 sigma, a bell's centre -+ width *
+#: 999^(1 / (2 slope)) (membership 0.001), a sigmoid's inflection -+ 9 / |slope|.
+UNIVERSE_ESTIMATES = {
+    "gaussian": lambda p: (p[0] - 4 * abs(p[1]), p[0] + 4 * abs(p[1])),
+    "gaussian2": lambda p: (p[0] - 4 * abs(p[1]), p[2] + 4 * abs(p[3])),
+    "bell": lambda p: (p[0] - abs(p[1]) * 999 ** (1 / (2 * p[2])),
+                       p[0] + abs(p[1]) * 999 ** (1 / (2 * p[2]))),
+    "sigmoid": lambda p: (p[0] - 9 / abs(p[1]), p[0] + 9 / abs(p[1])),
+    "sigmoid_difference": lambda p: (min(p[0] - 9 / abs(p[1]), p[3] - 9 / abs(p[2])),
+                                     max(p[0] + 9 / abs(p[1]), p[3] + 9 / abs(p[2]))),
+    "cosine": lambda p: (p[0] - abs(p[1]) / 2, p[0] + abs(p[1]) / 2),
+    "s_shape": lambda p: (p[0], p[1]), "z_shape": lambda p: (p[0], p[1]),
+    "pi_shape": lambda p: (p[0], p[3]),
+}
+UNIVERSE_ESTIMATES["clipped_sigmoid_difference"] = UNIVERSE_ESTIMATES["sigmoid_difference"]
+UNIVERSE_ESTIMATES["sigmoid_product"] = UNIVERSE_ESTIMATES["sigmoid_difference"]
+
+
+def _extent(terms: list[Term], name: str, span: Span,
+            notes: list[str] | None = None) -> tuple[float, float]:
+    """A variable's range from its terms when the file gives none, as jFuzzyLogic derives it:
+    the smallest interval holding every term's estimated support."""
     xs = []
+    estimated = []
     for t in terms:
         if t.shape == "discrete":
             xs += list(t.params[0::2])
@@ -307,10 +336,21 @@ def _extent(terms: list[Term], name: str, span: Span) -> tuple[float, float]:
             xs += [c for c in t.corners if abs(c) != float("inf")]
         elif t.shape == "singleton":
             xs.append(t.params[0])
+        elif t.shape in UNIVERSE_ESTIMATES:
+            with np.errstate(all="ignore"):
+                xs += list(UNIVERSE_ESTIMATES[t.shape](t.params))
+            estimated.append(t.name)
         else:
             raise FormatError(f"variable `{name}` has no RANGE and its `{t.name}` term "
                               f"({t.shape}) has no bounded support", span=span,
                               hint="add `RANGE := (min .. max);`")
+    if not all(math.isfinite(x) for x in xs):
+        raise FormatError(f"variable `{name}` has no RANGE and its terms give no finite one",
+                          span=span, hint="add `RANGE := (min .. max);`")
+    if estimated and notes is not None and xs and min(xs) < max(xs):
+        notes.append(f"{span}: `{name}` has no RANGE; its universe [{min(xs):g}, {max(xs):g}] "
+                     f"is derived from its terms ({', '.join(estimated)} unbounded) as "
+                     f"jFuzzyLogic estimates one")
     if not xs or min(xs) == max(xs):
         raise FormatError(f"variable `{name}` has no RANGE and its terms do not span one",
                           span=span, hint="add `RANGE := (min .. max);`")
@@ -322,6 +362,12 @@ def _term(item: Tree, role: str, n_inputs: int, span_of) -> Term:
     name, span = str(name_token), span_of(item)
     if definition.data == "singleton_def":
         return common.make_term(name, "singleton", (_num(definition.children[0]),), span)
+    if definition.data == "formula_def":
+        word = str(definition.children[0]).split()[0].split("(")[0]
+        raise FormatError(f"term `{name}`: {word} terms (a membership given by a formula) are "
+                          f"not supported", span=span_of(definition.children[0]),
+                          hint="replace the formula by one of the shapes (trian, trape, gauss, "
+                               "gbell, sigm, ...) or a point list")
     if definition.data == "points":
         pts = [(_num(p.children[0]), _num(p.children[1])) for p in definition.children]
         return _points_term(name, pts, span)
@@ -477,6 +523,9 @@ def write_fcl(rb: RuleBase, behavior: str | None = None) -> str:
 def _term_text(t: Term, v: Variable) -> str:
     if t.shape == "singleton":
         return fmt_number(t.params[0])
+    if t.shape == "clipped_sigmoid_difference":          # jFuzzyLogic's DSIGM g1 c1 g2 c2
+        left, rising, falling, right = t.params
+        return "DSIGM " + " ".join(fmt_number(x) for x in (rising, left, falling, right))
     if t.shape == "discrete":
         p = t.params
         return " ".join(f"({fmt_number(x)}, {fmt_number(y)})" for x, y in zip(p[0::2], p[1::2]))

@@ -23,6 +23,8 @@ another resolution or sampling: a ``.fis`` file always means MATLAB's.
 
 from __future__ import annotations
 
+import dataclasses
+import math
 import re
 from pathlib import Path
 
@@ -55,7 +57,8 @@ MF_TYPES = {
 SYSTEM_KEYS = ("Name", "Type", "Version", "NumInputs", "NumOutputs", "NumRules", "AndMethod",
                "OrMethod", "ImpMethod", "AggMethod", "DefuzzMethod",
                "DisableStructuralChecks")     # MATLAB R2018b+; only affects MATLAB's editor
-VAR_KEYS = ("Name", "Range", "NumMFs")
+#: fuzzylite's exporter adds Enabled=1, and on outputs Default=, LockPrevious=, LockRange=
+VAR_KEYS = ("Name", "Range", "NumMFs", "Enabled", "Default", "LockPrevious", "LockRange")
 
 
 def read_fis(path: str | Path) -> RuleBase:
@@ -71,13 +74,14 @@ def _sections(text: str, path: str | None):
     rules: list = []
     for lineno, raw in enumerate(text.splitlines(), 1):
         line = raw.strip()
-        if not line:
+        if not line or line[0] in "%#":         # MATLAB's readfis skips % and # comment lines
             continue
         span = Span.in_text(text, path, lineno, len(raw) - len(raw.lstrip()) + 1,
                             len(raw.rstrip()) + 1)
         if line.startswith("[") and line.endswith("]"):
             name = line[1:-1].strip()
-            if name not in ("System", "Rules") and not re.fullmatch(r"(Input|Output)\d+", name):
+            if name not in ("System", "Rules") and not re.fullmatch(r"(Input|Output)\d{1,9}",
+                                                                    name):
                 raise FormatError(f"unknown section [{name}]", span=span,
                                   expected="[System], [InputN], [OutputN] or [Rules]",
                                   hint=did_you_mean(name, ("System", "Rules", "Input1",
@@ -131,10 +135,15 @@ def parse_fis(text: str, path: str | None = None) -> RuleBase:
         raise FormatError(f"FIS type `{kind}` is not supported", span=system["Type"][1],
                           expected="mamdani or sugeno")
     settings = Settings()
+    unset: dict[str, Span] = {}
 
     def method(key: str, table: dict, what: str, default: str) -> str | None:
         value, vspan = system.get(key, (f"'{default}'", sys_span))
-        return common.table_lookup(table, FIS, _string(value, vspan), what, vspan)
+        name = _string(value, vspan)
+        if not name:               # fuzzylite writes '' for an operator its rules never use
+            unset[key] = vspan
+            return default
+        return common.table_lookup(table, FIS, name, what, vspan)
 
     settings.set("and_", method("AndMethod", common.TNORMS, "AND method", "min"), None, "and")
     settings.set("or_", method("OrMethod", common.SNORMS, "OR method", "max"), None, "or")
@@ -154,16 +163,26 @@ def parse_fis(text: str, path: str | None = None) -> RuleBase:
         settings.set("resolution", DEFAULT_RESOLUTION, None, "resolution")
         settings.set("sampling", "endpoints", None, "sampling")
 
-    inputs = _variables(sections, "Input", "input", kind)
+    notes: list[str] = []
+    inputs = _variables(sections, "Input", "input", kind, notes)
     n_inputs = len(inputs)
-    outputs = _variables(sections, "Output", "output", kind, n_inputs)
+    outputs = _variables(sections, "Output", "output", kind, notes, n_inputs)
     _check_count(system, "NumInputs", len(inputs), sys_span)
     _check_count(system, "NumOutputs", len(outputs), sys_span)
     variables = inputs + outputs
     rules = [_rule(line, lineno, span, inputs, outputs, text, path, i)
              for i, (line, lineno, span) in enumerate(rule_lines)]
     _check_count(system, "NumRules", len(rules), sys_span)
-    return common.assemble(path, variables, rules, settings, DEFAULT_RESOLUTION, sys_span)
+    for key, connective in (("AndMethod", And), ("OrMethod", Or)):
+        used = next((r for r in rules if isinstance(r.antecedent, connective)), None)
+        if key in unset and used is not None:
+            raise FormatError(f"{key}='' but rule {used.label} joins its conditions with "
+                              f"{'AND' if connective is And else 'OR'}", span=used.span,
+                              hint=f"give {key} a method, e.g. "
+                                   f"'{'min' if connective is And else 'max'}'")
+    rb = common.assemble(path, variables, rules, settings, DEFAULT_RESOLUTION, sys_span)
+    return dataclasses.replace(rb, notes=tuple(notes))
+
 
 
 def _check_count(system: dict, key: str, found: int, span: Span) -> None:
@@ -173,22 +192,37 @@ def _check_count(system: dict, key: str, found: int, span: Span) -> None:
             raise FormatError(f"{key}={value} but the file has {found}", span=vspan)
 
 
-def _variables(sections, prefix: str, role: str, kind: str, n_inputs: int = 0) -> list[Variable]:
+def _variables(sections, prefix: str, role: str, kind: str, notes: list[str],
+               n_inputs: int = 0) -> list[Variable]:
     found = [(int(name[len(prefix):]), span, items) for name, span, items in sections
-             if re.fullmatch(prefix + r"\d+", name)]
+             if re.fullmatch(prefix + r"\d{1,9}", name)]
     found.sort(key=lambda f: f[0])
     for i, (number, span, _) in enumerate(found, 1):
         if number != i:
             raise FormatError(f"expected [{prefix}{i}], found [{prefix}{number}]", span=span)
-    return [_variable(span, items, role, kind, n_inputs) for _, span, items in found]
+    return [_variable(span, items, role, kind, n_inputs, notes) for _, span, items in found]
 
 
-def _variable(span: Span, items, role: str, kind: str, n_inputs: int) -> Variable:
+def _variable(span: Span, items, role: str, kind: str, n_inputs: int,
+              notes: list[str]) -> Variable:
     values = {}
     terms: list[Term] = []
     for key, value, kspan, vspan in items:
         if re.fullmatch(r"MF\d+", key):
             terms.append(_mf(value, vspan, role, kind, n_inputs))
+        elif key == "Enabled":
+            if value.strip() != "1":
+                raise FormatError(f"`Enabled={value}`: MITOS has no disabled variables",
+                                  span=vspan, hint="delete the variable or enable it")
+        elif key == "LockPrevious" and value.strip() != "0":
+            raise FormatError(f"`LockPrevious={value}` (keep the previous output when no rule "
+                              f"fires) needs state between evaluations, which MITOS does not "
+                              f"keep", span=vspan, hint="set `Default=` to the value to use")
+        elif key in ("Default", "LockRange") and role != "output":
+            raise FormatError(f"`{key}` belongs to outputs", span=kspan)
+        elif key == "LockRange" and value.strip() != "0" and kind == "sugeno":
+            raise FormatError("`LockRange=1` on a Sugeno output (clipping the output to its "
+                              "range) is not supported", span=vspan, hint="set LockRange=0")
         elif key in VAR_KEYS:
             values[key] = (value, vspan)
         else:
@@ -198,6 +232,8 @@ def _variable(span: Span, items, role: str, kind: str, n_inputs: int) -> Variabl
     if "Name" not in values or "Range" not in values:
         raise FormatError("a variable needs `Name` and `Range`", span=span)
     name = _string(*values["Name"])
+    terms = common.distinct_names(terms, name, notes, "rules refer to MFs by index, so "
+                                  "nothing else changes")
     rng = _vector(*values["Range"])
     if len(rng) != 2 or not rng[0] < rng[1]:
         raise FormatError("`Range` must be [min max] with min < max", span=values["Range"][1])
@@ -206,7 +242,9 @@ def _variable(span: Span, items, role: str, kind: str, n_inputs: int) -> Variabl
                           span=values["NumMFs"][1])
     if not terms and role == "output":
         raise FormatError(f"output `{name}` has no membership functions", span=span)
-    default = (rng[0] + rng[1]) / 2 if role == "output" else None
+    default = (rng[0] + rng[1]) / 2 if role == "output" else None     # MATLAB's choice
+    if "Default" in values:                      # fuzzylite's: nan when the file says so
+        default = common.number(*values["Default"])
     try:
         return Variable(name, role, (rng[0], rng[1]), tuple(terms), "", "", default,
                         values["Name"][1])
@@ -231,6 +269,8 @@ def _mf(value: str, vspan: Span, role: str, kind: str, n_inputs: int) -> Term:
                           span=vspan, expected="one of " + ", ".join(list(MF_TYPES) + ["linear"]),
                           hint=did_you_mean(mf, MF_TYPES))
     shape, count, order = MF_TYPES[mf]
+    if len(params) > count and not any(params[count:]):
+        params = params[:count]        # old MATLAB files pad every list with zeros to one length
     if len(params) != count:
         raise FormatError(f"MF `{name}`: {mf} takes {plural(count, 'number')}, not {len(params)}",
                           span=vspan)
@@ -245,13 +285,16 @@ def _rule(line: str, lineno: int, span: Span, inputs: list[Variable], outputs: l
     ins = [common.number(w, span) for w in m.group(1).split()]
     outs = [common.number(w, span) for w in m.group(2).split()]
     weight = common.number(m.group(3), span)
-    connection = int(m.group(4))
+    connection = int(m.group(4)) if len(m.group(4)) < 10 else 0     # else refused below
     if len(ins) != len(inputs) or len(outs) != len(outputs):
         raise FormatError(f"the rule lists {plural(len(ins), 'input')} and "
                           f"{plural(len(outs), 'output')}; the system has {len(inputs)} and "
                           f"{len(outputs)}", span=span)
     if connection not in (1, 2):
         raise FormatError(f"connection {connection}: expected 1 (AND) or 2 (OR)", span=span)
+    for idx in ins + outs:
+        if not math.isfinite(idx) or abs(idx) > 1e9:
+            raise FormatError(f"MF index {fmt_number(idx)} is not an MF number", span=span)
     props = []
     for v, idx in zip(inputs, ins):
         if idx != int(idx):

@@ -21,6 +21,7 @@ Mapping (details and refusals in ``docs/interop.md``):
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -29,6 +30,7 @@ from lark import Lark
 from lark.exceptions import UnexpectedInput
 
 from ..lang.resolve import MAIN
+from ..lang.cache import lark_parser
 from ..errors import FormatError, Span, did_you_mean
 from ..lang.model import Rule, RuleBase
 from ..lang.model import format_number as _fmt_weight
@@ -54,8 +56,8 @@ DEFAULT_RESOLUTION = 1000     # fuzzylite's IntegralDefuzzifier.default_resoluti
 def rule_parser() -> Lark:
     from ..resources import grammar_text
 
-    return Lark(grammar_text("fll_rule.lark"), parser="lalr", propagate_positions=True,
-                maybe_placeholders=True, cache=True)      # grammar analysis cached on disk
+    return lark_parser(grammar_text("fll_rule.lark"), propagate_positions=True,
+                       maybe_placeholders=True)       # analysis kept in the private cache
 
 
 @dataclass
@@ -153,7 +155,8 @@ def parse_fll(text: str, path: str | None = None) -> RuleBase:
         else:
             _block_key(key, value, vspan, blocks[-1].record, blocks[-1].conj)
 
-    built = [_build_variable(v, [x.name for x in variables if x.role == "input"])
+    notes: list[str] = []
+    built = [_build_variable(v, [x.name for x in variables if x.role == "input"], notes)
              for v in variables]
     by_name = {v.name: v for v in built}
     outputs = {v.name: v for v in variables if v.role == "output"}
@@ -181,7 +184,8 @@ def parse_fll(text: str, path: str | None = None) -> RuleBase:
         mine = [v for v in variables if v.role == "input" or v.name in concluded or
                 len(groups) == 1]
         _check_outputs(mine, rules, settings)
-    return common.assemble_blocks(path, built, groups, DEFAULT_RESOLUTION, engine_span)
+    rb = common.assemble_blocks(path, built, groups, DEFAULT_RESOLUTION, engine_span)
+    return dataclasses.replace(rb, notes=tuple(notes))
 
 
 def _relabel(rules: list[Rule]) -> None:
@@ -234,8 +238,7 @@ def _variable_key(v: _Var, key: str, value: str, span: Span, vspan: Span,
                               f"needs state between evaluations, which MITOS does not keep",
                               span=vspan, hint="set `default:` to the value to use instead")
     elif key == "default":
-        d = common.number(value, vspan)
-        v.default = None if d != d else d
+        v.default = common.number(value, vspan)     # nan: NaN when no rule fires, as asked
     elif key in ("aggregation", "accumulation"):
         if value != "none":
             settings.set("aggregation", common.table_lookup(common.SNORMS, FLL, value,
@@ -291,7 +294,7 @@ def _block_key(key: str, value: str, vspan: Span, settings: common.Record,
                                "activations select rules; rewrite the rules instead")
 
 
-def _build_variable(v: _Var, inputs: list[str]) -> Variable:
+def _build_variable(v: _Var, inputs: list[str], notes: list[str]) -> Variable:
     if v.range is None:
         raise FormatError(f"variable `{v.name}` has no `range`", span=v.span)
     universe = v.range
@@ -306,6 +309,8 @@ def _build_variable(v: _Var, inputs: list[str]) -> Variable:
         terms.append(common.fuzzylite_term(name, kind, list(values), len(inputs), span))
     if not terms and v.role == "output":
         raise FormatError(f"output variable `{v.name}` has no terms", span=v.span)
+    terms = common.distinct_names(terms, v.name, notes, "rules naming it mean the last term "
+                                  "of that name, as in fuzzylite 8", keep_last=True)
     if not universe[0] < universe[1]:
         raise FormatError(f"variable `{v.name}`: range [{universe[0]:g}, {universe[1]:g}] is "
                           f"empty", span=v.span)

@@ -20,9 +20,7 @@ from ..lang.terms import Term, Variable
 from . import common
 
 NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_\-]*[A-Za-z0-9_]|[A-Za-z_]")
-RESERVED = {"if", "then", "is", "and", "or", "not", "with", "use", "when", "terms", "operators",
-            "behavior", "end", "frozen", "very", "somewhat", "more_or_less", "extremely",
-            "seldom", "intensely", "any"}
+RESERVED = common.RESERVED_NAMES["rules"]       # the rule language's keywords and hedge words
 
 
 def check_name(name: str, what: str) -> None:
@@ -42,7 +40,9 @@ def write_rules(rb: RuleBase, termset_name: str, behavior: str | None = None,
     from ..lang.model import flatten
     from ..lang.model import Use, format_use
     from ..lang.operators import resolve
+    from .common import legal_names
 
+    rb, _ = legal_names(rb, "rules")
     name = behavior or rb.default_behavior
     chosen = rb.behavior(name)
     order: list = []
@@ -123,9 +123,33 @@ def _scalar(value) -> str:
         return yaml.safe_dump(value, default_flow_style=True, width=1 << 16).strip() \
             .removesuffix("...").strip()
     value = float(value)
+    if np.isnan(value):
+        return ".nan"
     if np.isinf(value):
         return ".inf" if value > 0 else "-.inf"
     return common.fmt_number(value)
+
+
+def _written_universe(rb: RuleBase, v) -> tuple[float, float]:
+    """``v``'s universe, or for a weighted-average output without one (fuzzylite's
+    ``range: 0 0``) the interval its terms can reach over the inputs' universes, which a term
+    set needs and the weighted average never uses."""
+    lo, hi = v.universe
+    if np.isfinite(lo) and np.isfinite(hi):
+        return lo, hi
+    ends = []
+    for t in v.terms:
+        if t.shape == "linear":
+            coefficients = common.linear_coefficients(rb, v.name, t)
+            low = high = t.params[-1]
+            for name, a in coefficients.items():
+                a_lo, a_hi = (a * x for x in rb.variables[name].universe)
+                low, high = low + min(a_lo, a_hi), high + max(a_lo, a_hi)
+            ends += [low, high]
+        else:
+            ends.append(t.center)
+    lo, hi = min(ends), max(ends)
+    return (lo, hi) if lo < hi else (lo - 0.5, hi + 0.5)
 
 
 def write_termset(rb: RuleBase, inputs, outputs, source: str = "") -> str:
@@ -143,7 +167,8 @@ def write_termset(rb: RuleBase, inputs, outputs, source: str = "") -> str:
         if v.unit:
             lines.append(f"    unit: {_scalar(v.unit)}")
         lines.append(f"    role: {v.role}")
-        lines.append(f"    universe: [{_scalar(v.universe[0])}, {_scalar(v.universe[1])}]")
+        lo, hi = _written_universe(rb, v)
+        lines.append(f"    universe: [{_scalar(lo)}, {_scalar(hi)}]")
         if v.default is not None:
             lines.append(f"    default: {_scalar(v.default)}")
         lines.append("    terms:")

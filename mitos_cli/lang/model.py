@@ -113,6 +113,9 @@ class RuleBase:
     behaviors: tuple[Behavior, ...]
     operators: tuple[Setting, ...] = ()
     termset_paths: tuple[str, ...] = ()
+    #: What a reader of a foreign format changed to make the file fit (``file:line:col: ...``:
+    #: a renamed duplicate, a derived range); the CLI prints them as warnings.
+    notes: tuple[str, ...] = field(default=(), compare=False)
 
     def __repr__(self) -> str:   # the generated one spells out every rule and term
         rules = sum(len(b.rules) for b in self.behaviors)

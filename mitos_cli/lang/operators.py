@@ -17,9 +17,10 @@ INFERENCES = ("weighted_average", "weighted_sum", "mamdani")
 #: e.g. EinsteinProduct).
 IMPLICATIONS = tuple(norms.TNORMS)
 DEFUZZIFIERS = ("centroid", "bisector", "mom", "som", "lom")
-#: Where Mamdani outputs are sampled: cell midpoints (fuzzylite's rule, the default) or
-#: ``resolution`` evenly spaced points including both ends (MATLAB's ``evalfis``).
-SAMPLINGS = ("midpoints", "endpoints")
+#: Where Mamdani outputs are sampled: cell midpoints (fuzzylite's rule, the default),
+#: ``resolution`` evenly spaced points including both ends (MATLAB's ``evalfis``), or the
+#: cells' left ends (jFuzzyLogic's ``min + i (max - min) / resolution``).
+SAMPLINGS = ("midpoints", "endpoints", "left")
 
 
 @dataclass(frozen=True)

@@ -16,6 +16,7 @@ from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput
 
 from ..errors import RuleSyntaxError, Span
 from ..fuzzy.hedges import HEDGES
+from .cache import lark_parser
 from .model import And, Behavior, Consequent, Not, Or, Prop, Rule, Setting, Use
 from ..resources import grammar_text
 
@@ -31,9 +32,9 @@ TERMINAL_WORDS = {
 
 @functools.lru_cache(maxsize=None)
 def parser() -> Lark:
-    """The rule-language parser, built once (and cached on disk by Lark between runs)."""
-    return Lark(grammar_text(), parser="lalr", propagate_positions=True, maybe_placeholders=True,
-                start=["start", "rule", "expr"], cache=True)
+    """The rule-language parser, built once per process (its analysis kept in :mod:`.cache`)."""
+    return lark_parser(grammar_text(), propagate_positions=True, maybe_placeholders=True,
+                       start=["start", "rule", "expr"])
 
 
 @dataclass(frozen=True)

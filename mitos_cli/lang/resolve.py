@@ -150,7 +150,7 @@ def _check_consequent(c: Consequent, variables: dict[str, Variable]) -> None:
     if c.term is not None:
         v.term(c.term, c.span)
         _check_hedges(c.hedges, c.span)
-    else:
+    elif c.value is not None:
         lo, hi = v.universe
         if not lo <= c.value <= hi:
             raise RuleBaseError(f"{c.var} = {c.value:g} lies outside its universe "

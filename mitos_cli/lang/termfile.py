@@ -68,8 +68,25 @@ def load_termset(path: str | Path) -> TermSet:
 
 
 def parse_termset(text: str, path: str | None = None) -> TermSet:
-    """Build a :class:`TermSet` from YAML ``text``."""
-    data = yamlpos.load(text, path, TermSetError)
+    """Build a :class:`TermSet` from YAML ``text``.
+
+    A rule file names its term sets, and a rule file may come from someone else: until
+    ``path`` is known to hold a term set (it is named ``.yaml`` / ``.yml``, or it is a YAML
+    mapping with a ``variables:`` key) an error quotes nothing of it, so that ``terms
+    "/etc/shadow"`` cannot print a line of a file the user can read.
+    """
+    named = path is None or path.lower().endswith((".yaml", ".yml"))
+    try:
+        data = yamlpos.load(text, path, TermSetError)
+    except TermSetError:
+        if named:
+            raise
+        data = None
+    if not named and not (isinstance(data, YMap) and "variables" in data):
+        raise TermSetError(f"`{path}` is not a term set", span=Span(path, 1, 1),
+                           expected="a YAML file with a `variables:` key",
+                           hint="term sets are named NAME.terms.yaml; check the `terms` line "
+                                "of the rule file") from None
     top = Span.in_text(text, path, 1, 1)
     if not isinstance(data, YMap):
         raise TermSetError("a term set must be a mapping with a `variables:` key", span=top)
@@ -128,9 +145,13 @@ def _variable(name: str, spec: Any, key_span: Span, value_span: Span,
         if role != "output":
             raise TermSetError(f"{what}: only outputs take a `default`",
                                span=spec.key_span("default"))
-        default = yamlpos.expect_number(spec["default"], spec.value_span("default"),
-                                        TermSetError, f"{what}: default")
-        if not lo <= default <= hi:
+        value = spec["default"]
+        if isinstance(value, float) and value != value:
+            default = value            # `default: .nan`: no rule fired means NaN, as asked
+        else:
+            default = yamlpos.expect_number(value, spec.value_span("default"),
+                                            TermSetError, f"{what}: default")
+        if default == default and not lo <= default <= hi:
             raise TermSetError(f"{what}: default {default:g} lies outside the universe "
                                f"[{lo:g}, {hi:g}]", span=spec.value_span("default"))
     text_of = {k: spec.get(k, "") for k in ("description", "unit")}

@@ -12,8 +12,8 @@ import io
 
 import numpy as np
 
-from .perception import INPUTS
 from .loop import SimResult
+from .perception import INPUTS
 
 
 def explain(result: SimResult, planner, robot: int = 0):

@@ -36,7 +36,7 @@ def polygon_segments(corners: np.ndarray) -> np.ndarray:
     return np.concatenate([corners, nxt], axis=-1).reshape(-1, 4)
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def _following(k: int) -> np.ndarray:
     """Index of the next corner of a closed polygon of ``k`` corners."""
     out = (np.arange(k) + 1) % k
@@ -153,8 +153,9 @@ def clip_segment_outside(seg: np.ndarray, rects: np.ndarray, shrink: float = 1e-
                 if abs(a0) >= half:
                     t0, t1 = 1.0, 0.0
                 continue
-            lo, hi = sorted(((-half - a0) / da, (half - a0) / da))
-            t0, t1 = max(t0, lo), min(t1, hi)
+            ta, tb = float((-half - a0) / da), float((half - a0) / da)
+            lo, hi = (ta, tb) if ta <= tb else (tb, ta)
+            t0, t1 = (lo if lo > t0 else t0), (hi if hi < t1 else t1)
         if t1 <= t0:
             continue
         cut = []

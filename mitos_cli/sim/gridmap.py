@@ -1,4 +1,4 @@
-"""Occupancy grids in the ROS map_server convention (``map.yaml`` + PGM image).
+"""Occupancy grids in the ROS map_server convention (``map.yaml`` + an image).
 
 The YAML names the ``image`` (relative to the YAML), its ``resolution`` in metres per pixel, the
 ``origin`` ``[x, y, yaw]`` of the lower-left pixel in metres and radians, ``negate``,
@@ -6,8 +6,15 @@ The YAML names the ``image`` (relative to the YAML), its ``resolution`` in metre
 with ``negate: 1``); above ``occupied_thresh`` it is occupied, below ``free_thresh`` free, in
 between unknown. Unknown counts as occupied unless the world says ``unknown: free``: real SLAM
 maps often draw walls in unknown grey. Image rows run top to bottom, so they are flipped to put
-row 0 at the bottom. Metres become inches. A rotated origin (yaw not 0) is refused: turn the
-image instead.
+row 0 at the bottom. Metres become inches.
+
+The image is a PGM (read here, no dependency) or anything Pillow reads (PNG, BMP, TIFF, ...;
+Pillow is the optional extra ``mitos[maps]``, which matplotlib already brings): colour images
+are read as luminance, an alpha channel is ignored, as map_server does in its default
+``trinary`` mode. An origin with a yaw rotates the map about its origin: the grid the simulator
+keeps is axis-aligned, so a rotated map is resampled (nearest cell, same resolution) onto the
+axis-aligned cells covering it; a quarter, half or three-quarter turn is exact (no
+resampling), any other yaw moves walls by at most half a cell's diagonal.
 """
 
 from __future__ import annotations
@@ -17,8 +24,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..lang import yamlpos
 from ..errors import Span, WorldError
+from ..lang import yamlpos
 from .pgm import read_pgm
 from .world import Grid
 
@@ -42,6 +49,57 @@ def classify(pixels: np.ndarray, maxval: int, *, negate: bool, occupied_thresh: 
     return np.ascontiguousarray(blocked[::-1])
 
 
+def read_image(path: Path) -> tuple[np.ndarray, int]:
+    """Pixels ``[rows, cols]`` (top row first) and the maximum value of a map image."""
+    if path.suffix.lower() in (".pgm", ".pnm"):
+        return read_pgm(path)
+    try:
+        from PIL import Image, UnidentifiedImageError
+    except ImportError:
+        raise ImportError("reading a map image other than PGM needs Pillow: "
+                          "pip install 'mitos[maps]' (or convert the image to PGM)") from None
+    try:
+        with Image.open(path) as im:
+            if im.mode in ("I;16", "I;16B", "I;16L", "I"):
+                px = np.asarray(im, dtype=np.int64)
+                return px.clip(0, 65535).astype(np.uint16), 65535
+            return np.asarray(im.convert("L"), dtype=np.uint16), 255
+    except UnidentifiedImageError:
+        raise ValueError("Pillow does not recognise it as an image") from None
+    except Image.DecompressionBombError as exc:
+        raise ValueError(str(exc)) from None
+
+
+def rotate(blocked: np.ndarray, res: float, origin: tuple[float, float],
+           yaw: float) -> tuple[np.ndarray, tuple[float, float]]:
+    """A map whose lower-left pixel sits at ``origin``, turned by ``yaw`` (rad) about it, as
+    axis-aligned cells of the same size: the blocked cells and the new lower-left corner.
+    Cells the turned map does not cover are blocked (nothing is known there)."""
+    quarter = yaw / (math.pi / 2)
+    rows, cols = blocked.shape
+    corners = np.array([[0, 0], [cols, 0], [0, rows], [cols, rows]], float) * res
+    c, s = math.cos(yaw), math.sin(yaw)
+    if abs(quarter - round(quarter)) < 1e-9:
+        turns = int(round(quarter)) % 4
+        c, s = [(1, 0), (0, 1), (-1, 0), (0, -1)][turns]
+        turned = np.rot90(blocked, -turns)      # row 0 at the bottom: a turn to the left
+        lo = (corners @ np.array([[c, s], [-s, c]])).min(axis=0)
+        return np.ascontiguousarray(turned), (origin[0] + lo[0], origin[1] + lo[1])
+    placed = corners @ np.array([[c, s], [-s, c]])
+    lo, hi = placed.min(axis=0), placed.max(axis=0)
+    ncols, nrows = (int(math.ceil(v / res - 1e-6)) for v in hi - lo)
+    ys, xs = np.mgrid[0:nrows, 0:ncols]
+    px = lo[0] + (xs + 0.5) * res            # cell centres relative to the origin
+    py = lo[1] + (ys + 0.5) * res
+    mx, my = c * px + s * py, -s * px + c * py   # back into the map's own frame
+    col = np.floor(mx / res).astype(np.int64)
+    row = np.floor(my / res).astype(np.int64)
+    inside = (row >= 0) & (row < rows) & (col >= 0) & (col < cols)
+    out = np.ones((nrows, ncols), dtype=bool)
+    out[inside] = blocked[row[inside], col[inside]]
+    return out, (origin[0] + lo[0], origin[1] + lo[1])
+
+
 def load_map_yaml(path: Path, *, unknown_occupied: bool = True,
                   where: Span | None = None) -> Grid:
     """Read a map_server ``map.yaml`` and its image into a :class:`Grid` in inches."""
@@ -50,7 +108,17 @@ def load_map_yaml(path: Path, *, unknown_occupied: bool = True,
     except (OSError, UnicodeDecodeError) as exc:
         raise WorldError(f"cannot read map file `{path}`: "
                          f"{getattr(exc, 'strerror', None) or exc}", span=where) from None
-    spec = yamlpos.load(text, str(path), WorldError)
+    # Until the file is known to be a map file, an error quotes nothing of it (docs/security.md).
+    named = path.suffix.lower() in (".yaml", ".yml")
+    try:
+        spec = yamlpos.load(text, str(path), WorldError)
+    except WorldError:
+        if named:
+            raise
+        spec = None
+    if not named and not (isinstance(spec, dict) and "image" in spec):
+        raise WorldError(f"`{path}` is not a map_server map file", span=Span(str(path), 1, 1),
+                         expected="a YAML file with `image:` and `resolution:`") from None
     spec = yamlpos.expect_map(spec, Span(str(path), 1, 1), WorldError, "a map file")
     yamlpos.check_keys(spec, MAP_KEYS, WorldError, "a map_server map file")
     what = f"map file `{path.name}`"
@@ -66,10 +134,6 @@ def load_map_yaml(path: Path, *, unknown_occupied: bool = True,
                          span=spec.value_span("origin"))
     ox, oy, yaw = (yamlpos.expect_number(v, spec.value_span("origin"), WorldError, "origin")
                    for v in origin)
-    if abs(math.remainder(yaw, 2 * math.pi)) > 1e-9:
-        raise WorldError(f"the map's origin is rotated (yaw {yaw:g} rad); rotated maps are not "
-                         f"supported", span=spec.value_span("origin"),
-                         hint="rotate the image so that the yaw is 0, and adjust x and y")
     negate = bool(spec.get("negate", 0))
     occ_t = float(spec.get("occupied_thresh", 0.65))
     free_t = float(spec.get("free_thresh", 0.196))
@@ -78,7 +142,10 @@ def load_map_yaml(path: Path, *, unknown_occupied: bool = True,
                          span=spec.value_span("free_thresh"))
     image_path = path.parent / str(image)
     try:
-        pixels, maxval = read_pgm(image_path)
+        pixels, maxval = read_image(image_path)
+    except ImportError as exc:
+        raise WorldError(f"cannot read map image `{image_path}`: {exc}",
+                         span=spec.value_span("image")) from None
     except OSError as exc:
         raise WorldError(f"cannot read map image `{image_path}`: {exc.strerror or exc}",
                          span=spec.value_span("image"),
@@ -86,7 +153,10 @@ def load_map_yaml(path: Path, *, unknown_occupied: bool = True,
     except ValueError as exc:
         raise WorldError(f"cannot read map image `{image_path}`: {exc}",
                          span=spec.value_span("image"),
-                         hint="give a PGM image (P5 or P2)") from None
+                         hint="give a PGM (P5 or P2) or an image Pillow reads (PNG)") from None
     blocked = classify(pixels, maxval, negate=negate, occupied_thresh=occ_t,
                        free_thresh=free_t, unknown_occupied=unknown_occupied)
-    return Grid(blocked, res_m * INCH_PER_M, (ox * INCH_PER_M, oy * INCH_PER_M), str(path))
+    res, origin = res_m * INCH_PER_M, (ox * INCH_PER_M, oy * INCH_PER_M)
+    if abs(math.remainder(yaw, 2 * math.pi)) > 1e-12:
+        blocked, origin = rotate(blocked, res, origin, yaw)
+    return Grid(blocked, res, origin, str(path))

@@ -26,7 +26,7 @@ class Limits:
     acceleration: np.ndarray       # in/s^2
 
     @classmethod
-    def of(cls, robots) -> "Limits":
+    def of(cls, robots) -> Limits:
         def col(attr):
             return np.array([getattr(r, attr) for r in robots], dtype=float)
 

@@ -30,7 +30,7 @@ class LiveView:
         self.background = np.where(free, " ", "#")
         self.live = Live(console=Console(stderr=True), auto_refresh=False, transient=False)
 
-    def __enter__(self) -> "LiveView":
+    def __enter__(self) -> LiveView:
         self.live.__enter__()
         return self
 

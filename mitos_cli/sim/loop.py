@@ -21,13 +21,19 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import geometry, kinematics, obstacles as obs_mod, perception, sensors
-from .geometry import box_polygon_depth, box_polygon_distance, box_segment_distance, \
-    polygon_segments, rect_corners
+from . import geometry, kinematics, knowledge, perception, sensors
+from . import obstacles as obs_mod
+from .geometry import (
+    box_polygon_depth,
+    box_polygon_distance,
+    box_segment_distance,
+    polygon_segments,
+    rect_corners,
+)
 from .planner import Percepts, Planner
-from .route import Route, plan_route
+from .route import Route, grid_route, plan_route
 from .staticmap import StaticMap, build_static
-from .world import World
+from .world import Agent, World
 
 STUCK_TIME = 6.0        # s
 STUCK_DISTANCE = 3.0    # in
@@ -37,22 +43,41 @@ OUTCOMES = ("success", "collision", "timeout", "stuck")
 
 @dataclass(frozen=True)
 class Scene:
-    """What does not change during a run: the walls and each robot's route."""
+    """What a run starts from: the true walls, what the robots are given, each one's route."""
 
     static: StaticMap
     routes: tuple[Route, ...]
+    given: knowledge.Given | None = None
 
     def __hash__(self) -> int:
         return id(self)
 
 
+def clearances(world: World, agent: Agent) -> tuple[float, float]:
+    """The clearance (in) a route asks for (half the width, the safety margin and 4 in), and
+    the least it accepts where nothing wider leads to the goal (half the width and the margin,
+    or the world's ``route: {min_clearance}``)."""
+    r = agent.robot
+    least = r.width / 2 + r.safety_margin
+    if world.min_clearance is not None:
+        least = world.min_clearance
+    return max(r.width / 2 + r.safety_margin + 4.0, least), least
+
+
 def prepare(world: World) -> Scene:
-    """Walls and routes (A* over the corridors or the grid) of a world."""
+    """Walls, what the robots know and their routes (A* over the corridors or the grid they
+    are given; the truth's own with the default ``given``)."""
     static = build_static(world)
-    routes = tuple(plan_route(static, world.corridors, a.start, a.goal,
-                              clearance=a.robot.width / 2 + a.robot.safety_margin + 4.0)
-                   for a in world.agents)
-    return Scene(static, routes)
+    given = knowledge.given(world, static)
+    routes = []
+    for a in world.agents:
+        asked, least = clearances(world, a)
+        if given.plain:
+            routes.append(plan_route(static, world.corridors, a.start, a.goal, asked, least))
+        else:
+            known = StaticMap(given.walls, np.zeros((0, 4, 2)), given.grid, static.bounds)
+            routes.append(grid_route(known, a.start, a.goal, asked, minimum=least))
+    return Scene(static, tuple(routes), given)
 
 
 @dataclass
@@ -78,9 +103,18 @@ class SimResult:
     static: StaticMap | None = None
     active: np.ndarray | None = None   # [T, n] robot still driving at that tick
     progress: np.ndarray | None = None  # [T, n] arc length along each robot's route (in)
+    replanned: tuple[tuple[int, int, Route], ...] = ()   # (tick, robot, new route) in order
     metrics: dict = field(default_factory=dict)    # the run's figures over all robots
     robot_metrics: tuple[dict, ...] = ()           # each robot's figures (name, outcome, ...)
     _true: dict | None = field(default=None, repr=False)
+
+    def route_at(self, k: int, i: int) -> Route:
+        """The route robot ``i`` followed at tick ``k`` (its last replan up to then)."""
+        route = self.routes[i]
+        for tick, j, r in self.replanned:
+            if j == i and tick <= k:
+                route = r
+        return route
 
     @property
     def true(self) -> dict[str, np.ndarray]:
@@ -153,6 +187,7 @@ def _robot_metrics(res: SimResult, dt: float) -> tuple[dict, ...]:
             "name": agent.name, "outcome": outcome, "reached_goal": outcome == "success",
             "time_s": round(time_s, 6), "path_length_in": path,
             "min_clearance_in": float(res.clearance[:, i].min()) if res.ticks else 0.0,
+            "replans": sum(j == i for _, j, _ in res.replanned),
             "mean_speed_in_s": path / time_s if time_s > 0 else 0.0,
             "steering_total_variation_deg":
                 float(np.abs(np.diff(res.steering[:ticks, i])).sum())})
@@ -169,6 +204,7 @@ def _metrics(res: SimResult, dt: float) -> dict:
     return {"collisions": sum(m["outcome"] == "collision" for m in each),
             "time_s": round(float(res.ticks * dt), 6), "path_length_in": path,
             "min_clearance_in": min(m["min_clearance_in"] for m in each),
+            "replans": sum(m["replans"] for m in each),
             "mean_speed_in_s": path / driving if driving > 0 else 0.0,
             "steering_total_variation_deg": sum(m["steering_total_variation_deg"]
                                                 for m in each),
@@ -250,7 +286,7 @@ class _Sensed:
     inputs: dict[str, np.ndarray]
     targets: np.ndarray
     clearance: np.ndarray
-    command: np.ndarray | None = None
+    command: np.ndarray             # [n, 2] filled by the plan stage
 
 
 class Simulation:
@@ -258,7 +294,8 @@ class Simulation:
     :meth:`step`. Each tick runs the stages :meth:`sense` (obstacle places, beams, noise,
     clearance), :meth:`perceive` (rule inputs), :meth:`check` (contact and arrival),
     :meth:`plan` (one batch for the active robots) and :meth:`act` (kinematics), in that order,
-    then records a :class:`Tick`.
+    then records a :class:`Tick`. :meth:`perceive` also keeps each robot's own map and
+    replans its route when what it sensed shuts its way (:mod:`.knowledge`).
 
     Drive the simulator from Python, with your own planner or inspecting each tick::
 
@@ -293,7 +330,7 @@ class Simulation:
 
     # -- set-up -----------------------------------------------------------------------------
 
-    def reset(self, seed: int | None = None) -> "Simulation":
+    def reset(self, seed: int | None = None) -> Simulation:
         """Start the run again from ``seed`` (default: the world's)."""
         world = self._given_world
         self.seed = world.seed if seed is None else int(seed)
@@ -327,6 +364,11 @@ class Simulation:
         self._goals = np.array([[a.goal.x, a.goal.y] for a in world.agents], float)
         self._tol = np.array([a.goal.tolerance for a in world.agents], float)
         self._stuck_window = max(1, int(round(STUCK_TIME / self.dt)))
+        self._given = self.scene.given or knowledge.given(world, self.scene.static)
+        self._plain = self._given.plain
+        self._known_walls = StaticMap(self._given.walls, np.zeros((0, 4, 2)), None,
+                                      self.scene.static.bounds)
+        self._asked = [clearances(world, a) for a in world.agents]
         self._still = None
         if not any(o.motion.kind in ("velocity", "waypoints") for o in world.obstacles):
             self._still = self._obstacles_at(0.0)
@@ -342,7 +384,13 @@ class Simulation:
         self._active = np.ones(n, dtype=bool)
         self._near_at = [(math.inf, math.inf)] * n     # where each robot's wall set was gathered
         self._near_walls = [np.zeros((0, 4))] * n
-        self._history: list[np.ndarray] = []
+        self._near_known = [np.zeros((0, 4))] * n
+        self._routes = list(self.scene.routes)          # replanning replaces them
+        self._replanned: list[tuple[int, int, Route]] = []
+        self._maps: list[knowledge.RobotMap | None] = [None] * n
+        if self._given.knows == "none" and self._given.grid is not None:
+            self._maps = [knowledge.RobotMap.of(self._given.grid) for _ in range(n)]
+        self._history: list[tuple[np.ndarray, np.ndarray]] = []   # (x, y) after each move
         self._outcomes = ["timeout"] * n
         self._collided = 0
         self._k = 0
@@ -455,12 +503,15 @@ class Simulation:
             dirs = sensors.beam_directions(h[i], self.angles)
             expected, true_r = sensors.cast(pose[i, :2], dirs, walls, others, centres, radii,
                                             sen.range)
+            if not self._plain:                          # what the robot's own map predicts
+                expected = knowledge.expected_ranges(self._given, self._maps[i], pose[i, :2],
+                                                     dirs, self._near_known[i], sen.range)
             ranges[i] = sensors.add_noise(true_r, sen.noise, sen.range, self._streams[1 + i])
             self._dirs.append(dirs)
             self._expected.append(expected)
             clear[i] = _clearance(pose[i], self.robots[i], walls, boxes, centres, radii)
         return _Sensed(t, where, pose, ranges, {key: np.zeros(n) for key in perception.INPUTS},
-                       np.zeros((n, 2)), clear)
+                       np.zeros((n, 2)), clear, np.zeros((n, 2)))
 
     def _obstacles_at(self, t: float):
         """Obstacle places ``[O, 2]`` at time ``t`` and their shapes
@@ -476,13 +527,26 @@ class Simulation:
         if math.hypot(x - self._near_at[i][0], y - self._near_at[i][1]) > NEAR_SLACK:
             self._near_at[i] = (x, y)
             self._near_walls[i] = self.scene.static.near(x, y, self._reach + NEAR_SLACK)
+            if not self._plain and self._given.knows != "none":
+                self._near_known[i] = self._known_walls.near(x, y, self._reach + NEAR_SLACK)
         return self._near_walls[i]
 
     def perceive(self, s: _Sensed) -> None:
-        """The rule inputs and the route's target point of every robot from its readings."""
-        routes, sen = self.scene.routes, self.world.sensors
+        """The rule inputs and the route's target point of every robot from its readings;
+        first, what they show that its map does not is marked on the map it plans on, and
+        its route planned again if that shuts its way (:mod:`.knowledge`)."""
+        routes, sen = self._routes, self.world.sensors
         for i in range(self.n):
             f = perception.frame(routes[i], s.pose[i, :2], self._s_hint[i])
+            rmap = self._maps[i] if self._learn(i, s) and self._active[i] else None
+            if rmap is not None:
+                route = knowledge.replan(rmap, routes[i], f.s, s.pose[i, :2],
+                                         self.world.agents[i].goal, s.t, *self._asked[i],
+                                         self._cfg.sight, self._given.knows)
+                if route is not None:
+                    routes[i] = route
+                    self._replanned.append((self._k, i, route))
+                    f = perception.frame(route, s.pose[i, :2], 0.0)
             self._s_hint[i] = f.s
             p = perception.perceive(routes[i], f, (self._x[i], self._y[i], self._h[i]),
                                     self.robots[i], self._dirs[i], s.ranges[i],
@@ -491,6 +555,25 @@ class Simulation:
             for key in perception.INPUTS:
                 s.inputs[key][i] = p[key]
             s.targets[i] = perception.target_point(routes[i], f, self._cfg)
+
+    def _learn(self, i: int, s: _Sensed) -> bool:
+        """Mark on robot ``i``'s map what its readings show and its map does not (everything
+        it hits, with no map): whether anything new was marked. Its map is made on first
+        need."""
+        max_range = self.world.sensors.range
+        measured, dirs = s.ranges[i], self._dirs[i]
+        valid = measured < max_range * 0.999
+        seen = (valid if self._given.knows == "none"
+                else valid & (measured < self._expected[i] - self._threshold))
+        if not seen.any():
+            return False
+        rmap = self._maps[i]
+        if rmap is None:
+            rmap = self._maps[i] = knowledge.RobotMap.of(
+                knowledge.plan_grid(self._given, self.scene.static, self.world))
+        before = len(rmap.fresh)
+        rmap.mark(s.pose[i, :2] + measured[seen, None] * dirs[seen], dirs[seen])
+        return len(rmap.fresh) > before
 
     def check(self, s: _Sensed) -> None:
         """Contact (clearance <= 0) and arrival; an arrived robot stops driving."""
@@ -505,16 +588,15 @@ class Simulation:
     def plan(self, s: _Sensed) -> None:
         """The planner's commands for the active robots, in one batch (the others: straight
         wheel, no speed)."""
-        cmd = np.zeros((self.n, 2))
+        cmd = s.command
         cmd[:, 0] = self.limits.straight
         if self._active.any():
             idx = np.flatnonzero(self._active)
             sub = Percepts({key: val[idx] for key, val in s.inputs.items()}, s.ranges[idx],
                            self.angles, s.pose[idx], self._v[idx], s.targets[idx],
-                           self._goals[idx])
+                           self._goals[idx], self._steer[idx])
             c_steer, c_speed = self.planner.plan(sub)
             cmd[idx, 0], cmd[idx, 1] = c_steer, c_speed
-        s.command = cmd
 
     def act(self, s: _Sensed) -> None:
         """Steering-rate and acceleration limits and exact arcs, substep by substep; stopped
@@ -522,7 +604,7 @@ class Simulation:
         self._x, self._y, self._h, self._v, self._steer = kinematics.step(
             self._x, self._y, self._h, np.where(self._active, self._v, 0.0), self._steer,
             s.command[:, 0], s.command[:, 1], self.limits, self.dt, self.world.substeps)
-        self._history.append(np.stack([self._x, self._y], axis=1))
+        self._history.append((self._x, self._y))      # fresh arrays: never changed in place
 
     def _check_stuck(self) -> bool:
         """A driving robot that moved less than ``STUCK_DISTANCE`` in ``STUCK_TIME`` is stuck
@@ -530,7 +612,8 @@ class Simulation:
         history, window = self._history, self._stuck_window
         if len(history) <= window:
             return False
-        moved = np.hypot(*(history[-1] - history[-1 - window]).T)
+        (x1, y1), (x0, y0) = history[-1], history[-1 - window]
+        moved = np.hypot(x1 - x0, y1 - y0)
         stuck = self._active & (moved < STUCK_DISTANCE)
         for i in np.flatnonzero(stuck):
             self._outcomes[i] = "stuck"
@@ -567,7 +650,7 @@ class Simulation:
             obstacles=(np.array([r.obstacles for r in rec]).reshape(T, -1, 2) if rec
                        else np.zeros((0, len(self.world.obstacles), 2))),
             routes=self.scene.routes, static=self.scene.static, active=stack("active", (n,)),
-            progress=stack("progress", (n,)))
+            progress=stack("progress", (n,)), replanned=tuple(self._replanned))
         res.robot_metrics = _robot_metrics(res, dt)
         res.metrics = _metrics(res, dt)
         return res
@@ -612,7 +695,8 @@ def true_inputs(res: SimResult) -> dict[str, np.ndarray]:
         corners = _footprints(pose, robots)
         for i in range(n):
             walls = static.near(pose[i, 0], pose[i, 1], reach)
-            f = perception.frame(res.routes[i], pose[i, :2], res.progress[k, i])
+            route = res.route_at(k, i)
+            f = perception.frame(route, pose[i, :2], res.progress[k, i])
             dirs = np.concatenate([sensors.beam_directions(pose[i, 2], angles), [-f.n, f.n]])
             expected = geometry.ray_segments(pose[i, :2], dirs, walls, sen.range)
             # across the route, to the walls within reach (an opening reads as the sensor
@@ -623,7 +707,7 @@ def true_inputs(res: SimResult) -> dict[str, np.ndarray]:
                                         robots[i], sen.range, cfg)
             seen = expected[:-2] < sen.range * 0.999
             wall_points = pose[i, :2] + expected[:-2, None][seen] * dirs[:-2][seen]
-            tr = perception.truth(res.routes[i], f, tuple(pose[i]), robots[i],
+            tr = perception.truth(route, f, tuple(pose[i]), robots[i],
                                   (float(across[0]), float(across[1])), things, gaps, cfg,
                                   wall_points)
             for key in perception.INPUTS:

@@ -2,9 +2,15 @@
 behaviors need).
 
 Frame: at the robot's projection onto its route, ``a`` runs along the route and ``b`` across it,
-positive to the RIGHT. The robot knows its pose (odometry) and the map it planned its route on,
-so a beam whose reading is clearly shorter than the map predicts has hit an obstacle; every
-other beam has hit a wall.
+positive to the RIGHT. The robot knows its pose (odometry) and the map it planned its route on
+(:mod:`.knowledge`), so a beam whose reading is clearly shorter than that map predicts has hit
+an obstacle: an unknown box, an unknown wall, a corridor blocked by furniture. Every other beam
+has hit something drawn on its map (a wall, a door jamb, a pillar, a known obstacle), which the
+route already keeps its clearance from: it counts as a wall (``road``, ``gap_left``,
+``gap_right``), unless it stands within half the robot's width plus its safety margin of the
+route ahead (where the route squeezes by under ``route: {min_clearance}``, or runs through
+what a robot with no map has only now mapped): there it is in the robot's way and obstructs
+like an obstacle.
 
 Inputs (all floats, units in the names of ``mitos.terms.yaml`` / ``drive.terms.yaml``):
 
@@ -254,8 +260,12 @@ def perceive(route: Route, f: Frame, pose: tuple[float, float, float], robot: Ro
     left, right = _road(a, b, valid & ~obstacle_hit, cfg.window, max_range)
     road = left + right
     widen = measured * spacing / 2
-    size, position, distance = _obstruction(route, a, b, hits, obstacle_hit, widen, robot, f, cfg,
-                                            _own_frame(rel, pose[2]))
+    in_way = valid & ~obstacle_hit & (a > 0)
+    if in_way.any():       # drawn on the map, but where the robot's route would hit it
+        in_way[in_way] = route.near(hits[in_way], f.s, robot.width / 2 + robot.safety_margin,
+                                    cfg.sight)
+    size, position, distance = _obstruction(route, a, b, hits, obstacle_hit | in_way, widen,
+                                            robot, f, cfg, _own_frame(rel, pose[2]))
     heading, lane, goal = _common(route, p, pose[2], f, road, robot, cfg)
     wl, wr = _walls(a, b, valid, robot, cfg, max_range, obstacle_hit)
     ah, bh = _own_frame(rel[valid], pose[2])

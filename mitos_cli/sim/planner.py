@@ -21,12 +21,13 @@ for all robots. A baseline (a potential field, say) implements the same ``plan``
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Protocol
 
 import numpy as np
 
-from ..errors import RuleBaseError
+from ..errors import RuleBaseError, unknown
 
 
 @dataclass(frozen=True)
@@ -40,6 +41,8 @@ class Percepts:
     speed: np.ndarray              # [n] current speed (in/s)
     target: np.ndarray             # [n, 2] route point a lookahead ahead (in)
     goal: np.ndarray               # [n, 2] goal position (in)
+    steering: np.ndarray | None = None   # [n] the wheel's current angle (deg), for planners
+                                         # that search the commands reachable from it (DWA)
 
 
 class Planner(Protocol):
@@ -103,3 +106,52 @@ class FuzzyPlanner:
         from ..engine.evaluation import evaluate
 
         return evaluate(self.compiled, self.matrix(inputs))
+
+
+@dataclass(frozen=True)
+class PlannerKind:
+    """One entry of the planner registry: its name, what it is, and how to build it for a
+    world (``build(world, rulebase, behavior)``; only the fuzzy planner reads the last two)."""
+
+    name: str
+    summary: str
+    build: Callable[..., Planner]
+
+
+def _fuzzy(world, rulebase=None, behavior: str | None = None) -> Planner:
+    return FuzzyPlanner(rulebase, behavior or world.behavior)
+
+
+def _potential_field(world, rulebase=None, behavior: str | None = None) -> Planner:
+    from .potential_field import PotentialFieldPlanner
+
+    return PotentialFieldPlanner.for_world(world)
+
+
+def _dwa(world, rulebase=None, behavior: str | None = None) -> Planner:
+    from .dwa import DWAPlanner
+
+    return DWAPlanner.for_world(world)
+
+
+#: every planner the simulator, ``mitos simulate --planner`` and ``mitos compare`` know
+PLANNERS: dict[str, PlannerKind] = {k.name: k for k in (
+    PlannerKind("fuzzy", "the rule base's driving behavior (default: the packaged `drive`)",
+                _fuzzy),
+    PlannerKind("potential_field", "an artificial potential field (Khatib 1986)",
+                _potential_field),
+    PlannerKind("dwa", "a dynamic window (Fox et al. 1997; ROS's dwa_local_planner)", _dwa),
+)}
+
+
+def planner_kind(name: str) -> PlannerKind:
+    """The registry entry called ``name`` (an unknown name: an error with "did you mean")."""
+    try:
+        return PLANNERS[name]
+    except KeyError:
+        raise unknown("planner", name, PLANNERS) from None
+
+
+def make_planner(name: str, world, rulebase=None, behavior: str | None = None) -> Planner:
+    """The planner ``name`` built for ``world`` (the fuzzy one from ``rulebase``/``behavior``)."""
+    return planner_kind(name).build(world, rulebase, behavior)

@@ -15,6 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import WorldError
+from .distance import distance_transform
 from .staticmap import StaticMap
 from .world import Corridor, Goal, Pose
 
@@ -29,7 +30,7 @@ class Route:
         return id(self)
 
     @classmethod
-    def of(cls, points, goal=None) -> "Route":
+    def of(cls, points, goal=None) -> Route:
         pts = np.asarray(points, float)
         keep = np.concatenate([[True], np.hypot(*np.diff(pts, axis=0).T) > 1e-9])
         pts = pts[keep]
@@ -81,6 +82,21 @@ class Route:
         rel = p - closest[i]
         lateral = float(rel[0] * tangent[1] - rel[1] * tangent[0])   # right of the tangent
         return float(s), lateral, tangent
+
+
+    def near(self, points: np.ndarray, s: float, reach: float, ahead: float) -> np.ndarray:
+        """Which ``points [P, 2]`` lie within ``reach`` of the route between arc lengths ``s``
+        and ``s + ahead``."""
+        window = (self.cum[1:] >= s) & (self.cum[:-1] <= s + ahead)
+        a, b = self.points[:-1][window], self.points[1:][window]
+        if not len(a) or not len(points):
+            return np.zeros(len(points), dtype=bool)
+        e = b - a
+        ee = np.maximum((e * e).sum(axis=1), 1e-12)
+        rel = points[:, None] - a                                  # [P, M, 2]
+        t = np.clip((rel * e).sum(axis=2) / ee, 0.0, 1.0)
+        d = rel - t[..., None] * e
+        return (d * d).sum(axis=2).min(axis=1) <= reach * reach
 
 
 def _astar(neighbours, start: int, goal: int, pos) -> list[int] | None:
@@ -162,10 +178,56 @@ def corridor_route(corridors: tuple[Corridor, ...], start: Pose, goal: Goal) -> 
     return Route.of([coords[n] for n in path], goal=(goal.x, goal.y))
 
 
-def _simplify(points: np.ndarray, tol: float) -> np.ndarray:
-    """Douglas-Peucker."""
+@dataclass(frozen=True)
+class Clearance:
+    """Clearance of points from the occupied cells of a grid: the exact Euclidean distance
+    transform of the cell centres (:mod:`.distance`), read as the distance to the nearest
+    occupied cell treated as a disc of half a cell, never more than the truth at the point."""
+
+    dist: np.ndarray               # [rows, cols] in, centre to the nearest occupied centre
+    resolution: float
+    origin: tuple[float, float]
+
+    def __hash__(self) -> int:
+        return id(self)
+
+    @classmethod
+    def of(cls, occupied: np.ndarray, resolution: float, origin: tuple[float, float],
+           cap: float | None = None) -> Clearance:
+        """The field of a grid, exact up to ``cap`` inches (see :func:`distance_transform`)."""
+        return cls(distance_transform(occupied, resolution, cap), resolution, origin)
+
+    def at(self, points: np.ndarray) -> np.ndarray:
+        """A lower bound on the clearance (in) at each point ``[P, 2]`` (0 outside the grid):
+        the cell's distance less the point's offset from the cell centre and half a cell."""
+        pts = np.atleast_2d(np.asarray(points, float))
+        res, (ox, oy) = self.resolution, self.origin
+        col = np.floor((pts[:, 0] - ox) / res).astype(np.int64)
+        row = np.floor((pts[:, 1] - oy) / res).astype(np.int64)
+        rows, cols = self.dist.shape
+        inside = (row >= 0) & (row < rows) & (col >= 0) & (col < cols)
+        out = np.zeros(len(pts))
+        r, c = row[inside], col[inside]
+        centre = np.stack([ox + (c + 0.5) * res, oy + (r + 0.5) * res], axis=1)
+        off = np.hypot(*(pts[inside] - centre).T)
+        out[inside] = np.maximum(self.dist[r, c] - off - res / 2, 0.0)
+        return out
+
+    def along(self, a: np.ndarray, b: np.ndarray) -> float:
+        """The smallest clearance on the segment a-b, sampled every half cell."""
+        n = max(2, int(math.ceil(math.dist(a, b) / (self.resolution / 2))) + 1)
+        t = np.linspace(0.0, 1.0, n)[:, None]
+        return float(self.at(a + t * (b - a)).min())
+
+
+def _simplify(points: np.ndarray, tol: float, clearance: Clearance | None = None,
+              asked: float = 0.0) -> np.ndarray:
+    """Douglas-Peucker that keeps its word: a shortcut replaces a stretch of the path only if
+    it stays as far from the walls as the stretch did, or at least ``asked`` inches."""
     keep = np.zeros(len(points), dtype=bool)
     keep[[0, -1]] = True
+    own = (np.array([clearance.along(p, q) for p, q in zip(points[:-1], points[1:])])
+           if clearance is not None else None)
     stack = [(0, len(points) - 1)]
     while stack:
         i, j = stack.pop()
@@ -177,56 +239,106 @@ def _simplify(points: np.ndarray, tol: float) -> np.ndarray:
         mid = points[i + 1:j]
         d = np.abs(e[0] * (mid[:, 1] - a[1]) - e[1] * (mid[:, 0] - a[0])) / n
         k = int(np.argmax(d))
-        if d[k] > tol:
+        split = d[k] > tol
+        if not split and own is not None:
+            need = min(asked, float(own[i:j].min()))
+            split = clearance.along(a, b) < need
+            if split and d[k] <= 1e-9:
+                k = (j - i) // 2 - 1
+        if split:
             keep[i + 1 + k] = True
             stack += [(i, i + 1 + k), (i + 1 + k, j)]
     return points[keep]
 
 
+class NarrowPassage(WorldError):
+    """The only way to the goal is narrower than the robot needs (names the narrowest place)."""
+
+
+def _widest_way(free_c: np.ndarray, s: tuple[int, int], t: tuple[int, int]):
+    """The path from ``s`` to ``t`` whose narrowest cell is widest (a bottleneck Dijkstra over
+    the clearance ``free_c[R, C]``): that narrowest cell and its clearance, or None."""
+    R, C = free_c.shape
+    best = np.full(R * C, -1.0)
+    start = s[0] * C + s[1]
+    best[start] = free_c[s]
+    heap = [(-best[start], start)]
+    where = {start: start}
+    while heap:
+        neg, node = heapq.heappop(heap)
+        if -neg < best[node]:
+            continue
+        if node == t[0] * C + t[1]:
+            return divmod(where[node], C), -neg
+        r, c = divmod(node, C)
+        for dr in (-1, 0, 1):
+            for dc in (-1, 0, 1):
+                rr, cc = r + dr, c + dc
+                if (dr or dc) and 0 <= rr < R and 0 <= cc < C:
+                    m = min(-neg, free_c[rr, cc])
+                    nxt = rr * C + cc
+                    if m > best[nxt]:
+                        best[nxt] = m
+                        where[nxt] = where[node] if free_c[rr, cc] >= -neg else nxt
+                        heapq.heappush(heap, (-m, nxt))
+    return None
+
+
+NARROW_COST = 20.0      # extra cost per step (in steps) of a node closer than the asked clearance
+
+
 def grid_route(static: StaticMap, start: Pose, goal: Goal, clearance: float,
-               cell: float = 6.0) -> Route:
-    """A* on a coarse copy of the grid (cells of about ``cell`` inches), blocked where closer
-    than ``clearance`` to a wall, and preferring cells far from walls (so the route keeps to
-    the middle of the corridors)."""
+               cell: float = 6.0, minimum: float | None = None,
+               occupied: np.ndarray | None = None, explain: bool = True,
+               leave: float = 0.0) -> Route:
+    """A* on nodes about ``cell`` inches apart, each kept at least ``clearance`` inches (the
+    exact Euclidean distance) from the occupied cells, preferring the middle of the corridors.
+    Nodes closer than that but not closer than ``minimum`` (the robot's half width plus its
+    margin, unless the world allows a tighter squeeze) cost ``NARROW_COST`` times more, so the
+    route squeezes only where nothing wider leads on; with no way even at ``minimum`` it
+    refuses, naming the narrowest place of the widest way. ``occupied`` replaces the map's
+    own cells (what the robot knows, when that is not the map). ``explain=False`` skips the search for
+    the narrowest place (replanning only needs to know that there is no way). ``leave``:
+    within this many inches of the start, any node off the occupied cells is open (a robot
+    that replans beside what it is passing must be able to move off)."""
     g = static.grid
+    occ = g.occupied if occupied is None else occupied
+    reach = clearance + 36.0           # in: beyond this from the walls, the middle is as good
+    field = Clearance.of(occ, g.resolution, g.origin, cap=reach + 2 * g.resolution)
     k = max(1, int(round(cell / g.resolution)))
-    rows, cols = g.occupied.shape
+    rows, cols = occ.shape
     R, C = -(-rows // k), -(-cols // k)
-    padded = np.ones((R * k, C * k), dtype=bool)
-    padded[:rows, :cols] = g.occupied
-    coarse = padded.reshape(R, k, C, k).any(axis=(1, 3))
+    fr = np.minimum(np.arange(R) * k + k // 2, rows - 1)
+    fc = np.minimum(np.arange(C) * k + k // 2, cols - 1)
+    node_c = field.dist[np.ix_(fr, fc)] - g.resolution / 2     # clearance at each node (in)
     size = k * g.resolution
-    # brushfire: distance to the nearest blocked coarse cell, in cells, up to `reach`
-    reach = int(math.ceil((clearance + 36.0) / size))
-    dist = np.full((R, C), reach, dtype=float)
-    front = coarse.copy()
-    dist[front] = 0
-    for step in range(1, reach):
-        grown = front.copy()
-        grown[1:] |= front[:-1]
-        grown[:-1] |= front[1:]
-        grown[:, 1:] |= front[:, :-1]
-        grown[:, :-1] |= front[:, 1:]
-        new = grown & ~front
-        dist[new] = step
-        front = grown
-    blocked = dist * size < clearance
-    penalty = (reach - dist) / reach * 4.0
 
     def cell_of(x: float, y: float) -> tuple[int, int]:
         return (int((y - g.origin[1]) // size), int((x - g.origin[0]) // size))
 
     def centre(rc: tuple[int, int]) -> tuple[float, float]:
-        return (g.origin[0] + (rc[1] + 0.5) * size, g.origin[1] + (rc[0] + 0.5) * size)
+        return (g.origin[0] + (fc[rc[1]] + 0.5) * g.resolution,
+                g.origin[1] + (fr[rc[0]] + 0.5) * g.resolution)
 
     s, t = cell_of(start.x, start.y), cell_of(goal.x, goal.y)
     for rc, what in ((s, "start"), (t, "goal")):
         if not (0 <= rc[0] < R and 0 <= rc[1] < C):
             raise WorldError(f"the {what} lies outside the map")
-    free_s, free_t = blocked[s], blocked[t]
-    blocked[s] = blocked[t] = False       # the robot stands there: let the search leave it
     moves = [(dr, dc, math.hypot(dr, dc)) for dr in (-1, 0, 1) for dc in (-1, 0, 1)
              if dr or dc]
+    floor = clearance if minimum is None else min(minimum, clearance)
+    # prefer the middle; a node closer than `clearance` (but not than `floor`) costs
+    # NARROW_COST times more, so the route squeezes through only where nothing wider leads on
+    penalty = (np.clip(reach - node_c, 0.0, reach) / reach * 4.0
+               + np.where(node_c < clearance, NARROW_COST, 0.0))
+    blocked = node_c < floor
+    blocked[s] = blocked[t] = False      # the robot stands there: let the search leave it
+    if leave > 0:
+        n = int(math.ceil(leave / size))
+        r0, c0 = max(s[0] - n, 0), max(s[1] - n, 0)
+        rr, cc = np.mgrid[r0:min(s[0] + n + 1, R), c0:min(s[1] + n + 1, C)]
+        near = (np.hypot(rr - s[0], cc - s[1]) * size <= leave) & (node_c[rr, cc] > 0)
+        blocked[rr[near], cc[near]] = False
 
     def neighbours(n: int):
         r, c = divmod(n, C)
@@ -235,20 +347,39 @@ def grid_route(static: StaticMap, start: Pose, goal: Goal, clearance: float,
             if 0 <= rr < R and 0 <= cc < C and not blocked[rr, cc]:
                 yield rr * C + cc, step * (1.0 + penalty[rr, cc])
 
-    path = _astar(neighbours, s[0] * C + s[1], t[0] * C + t[1],
-                  lambda n: (n // C, n % C))
-    del free_s, free_t
+    path = _astar(neighbours, s[0] * C + s[1], t[0] * C + t[1], lambda n: (n // C, n % C))
     if path is None:
-        raise WorldError("no way through the map from the start to the goal for a robot this "
-                         "wide", hint="check the start and goal, or use `unknown: free`")
+        if not explain:
+            raise NarrowPassage("no way to the goal on what the robot knows")
+        raise _refusal(node_c, s, t, centre, floor)
     pts = np.array([centre(divmod(n, C)) for n in path])
-    pts = _simplify(pts, size * 0.75)
-    return Route.of(np.vstack([[start.x, start.y], pts[1:-1], [goal.x, goal.y]]),
-                    goal=(goal.x, goal.y))
+    pts = np.vstack([[start.x, start.y], pts[1:-1], [goal.x, goal.y]])
+    pts = _simplify(pts, size * 0.75, field, clearance)
+    return Route.of(pts, goal=(goal.x, goal.y))
+
+
+def _refusal(node_c: np.ndarray, s, t, centre, floor: float) -> WorldError:
+    free_c = np.maximum(node_c, 0.0)
+    free_c[s] = free_c[t] = np.inf
+    widest = _widest_way(free_c, s, t)
+    if widest is None or widest[1] <= 0:
+        return NarrowPassage("no way through the map from the start to the goal",
+                             hint="check the start and goal, or use `unknown: free`")
+    (r, c), gap = widest
+    x, y = centre((r, c))
+    return NarrowPassage(
+        f"the only way to the goal passes ({x:.0f}, {y:.0f}), where the robot's centre keeps "
+        f"{gap:.1f} in from the walls (a passage about {2 * gap:.0f} in wide); it needs "
+        f"{floor:.1f} in",
+        hint=f"widen the passage, or allow the squeeze with `route: {{min_clearance: "
+             f"{math.floor(gap * 10) / 10:g}}}`")
 
 
 def plan_route(static: StaticMap, corridors: tuple[Corridor, ...], start: Pose, goal: Goal,
-               clearance: float) -> Route:
+               clearance: float, minimum: float | None = None,
+               occupied: np.ndarray | None = None) -> Route:
+    """The route over the corridors' centre lines or, with a grid, A* on the grid (on
+    ``occupied`` when given: the cells the robot knows)."""
     if static.grid is None:
         return corridor_route(corridors, start, goal)
-    return grid_route(static, start, goal, clearance)
+    return grid_route(static, start, goal, clearance, minimum=minimum, occupied=occupied)

@@ -21,11 +21,14 @@ METRICS = ("time_s", "path_length_in", "min_clearance_in", "mean_speed_in_s",
            "steering_total_variation_deg")
 
 
-def _chunk(task: tuple[World, object, tuple[int, ...], bool]) -> list[dict]:
-    world, planner, seeds, randomise = task
+def _chunk(task: tuple) -> list[dict]:
+    world, planner, seeds, randomise, measure = task
     scene = prepare(world)
-    return [simulate(world, planner, seed, randomise=randomise, scene=scene).summary()
-            for seed in seeds]
+    out = []
+    for seed in seeds:
+        res = simulate(world, planner, seed, randomise=randomise, scene=scene)
+        out.append({**res.summary(), **(measure(res) if measure is not None else {})})
+    return out
 
 
 @dataclass(frozen=True)
@@ -43,7 +46,7 @@ class WorldRuns:
         return float(x.mean()), float(x.std(ddof=1)) if len(x) > 1 else 0.0
 
     @property
-    def robots(self) -> tuple["WorldRuns", ...]:
+    def robots(self) -> tuple[WorldRuns, ...]:
         """Each robot's runs (its outcome and figures per run) in a world of several robots;
         ``()`` for one robot, whose runs are the world's."""
         if not self.summaries or "robots" not in self.summaries[0]:
@@ -83,9 +86,11 @@ def default_workers() -> int:
 
 
 def run_many(worlds: list[World], runs: int = 0, seed: int | None = None, planner=None,
-             workers: int | None = None) -> Runs:
+             workers: int | None = None, measure=None) -> Runs:
     """Run each world once (``runs=0``: its own seed, as written) or ``runs`` randomised times
-    (seeds ``seed + j``, default base: the world's seed), on ``workers`` processes."""
+    (seeds ``seed + j``, default base: the world's seed), on ``workers`` processes.
+    ``measure(result) -> dict`` (a picklable function), when given, adds figures of its own to
+    each run's summary in the worker (a benchmark's scores from the ticks)."""
     if planner is None:
         from .planner import FuzzyPlanner
 
@@ -98,7 +103,7 @@ def run_many(worlds: list[World], runs: int = 0, seed: int | None = None, planne
         size = max(1, math.ceil(len(seeds) / (2 * workers)))
         for i in range(0, len(seeds), size):
             tasks.append((w, tuple(seeds[i:i + size]), i))
-    jobs = [(w, planner, chunk, runs > 0) for w, chunk, _ in tasks]
+    jobs = [(w, planner, chunk, runs > 0, measure) for w, chunk, _ in tasks]
     if workers > 1 and len(jobs) > 1:
         with ProcessPoolExecutor(workers) as pool:
             results = list(pool.map(_chunk, jobs))

@@ -131,5 +131,5 @@ def build_static(world: World) -> StaticMap:
         return StaticMap(walls, np.zeros((0, 4, 2)), grid, bounds)
     walls = corridor_walls(rects)
     pts = rects.reshape(-1, 2)
-    bounds = (*pts.min(axis=0), *pts.max(axis=0))
-    return StaticMap(walls, rects, None, tuple(float(b) for b in bounds))
+    (x0, y0), (x1, y1) = pts.min(axis=0), pts.max(axis=0)
+    return StaticMap(walls, rects, None, (float(x0), float(y0), float(x1), float(y1)))

@@ -109,6 +109,7 @@ class Obstacle:
     width: float = 0.0
     angle: float = 0.0             # deg
     motion: Motion = field(default_factory=Motion)
+    known: bool = False            # drawn on the robot's map (the route avoids it)
 
 
 @dataclass(frozen=True)
@@ -151,10 +152,17 @@ class World:
     obstacles: tuple[Obstacle, ...]
     randomise: Randomise
     behavior: str = "drive"
+    knows: str = "map"             # what the robot is given: the map itself ("map"), another
+    given: Grid | None = None      # grid ("given", this one), or nothing at all ("none")
+    min_clearance: float | None = None   # in: the tightest squeeze its route may make
 
     @property
     def robot(self) -> Robot:
         return self.agents[0].robot
 
-    def with_changes(self, **changes) -> "World":
+    @property
+    def known_obstacles(self) -> tuple[Obstacle, ...]:
+        return tuple(o for o in self.obstacles if o.known)
+
+    def with_changes(self, **changes) -> World:
         return replace(self, **changes)

@@ -11,21 +11,21 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
+from ..errors import NameError_, Span, WorldError, unknown
 from ..lang import yamlpos
-from ..errors import Span, WorldError, unknown
 from ..lang.yamlpos import YList, YMap
-from .world import (Agent, Corridor, Goal, Jitter, Motion, Obstacle, Pose, Randomise, Robot,
-                    Sensors, World)
+from .world import Agent, Corridor, Goal, Jitter, Motion, Obstacle, Pose, Randomise, Robot, Sensors, World
 
 TOP_KEYS = ("name", "seed", "dt", "time_limit", "substeps", "behavior", "robot", "sensors",
-            "q_init", "q_goal", "map", "obstacles", "robots", "randomise")
+            "q_init", "q_goal", "map", "obstacles", "robots", "randomise", "route")
 ROBOT_KEYS = ("model", "wheelbase", "footprint", "safety_margin", "steering", "max_speed",
               "acceleration")
 STEERING_KEYS = ("min", "max", "straight", "max_rate")
 SENSOR_KEYS = ("layout", "count", "fov", "cone", "range", "noise")
-MAP_KEYS = ("corridors", "grid", "unknown")
+MAP_KEYS = ("corridors", "grid", "unknown", "given")
+ROUTE_KEYS = ("min_clearance",)
 OBSTACLE_KEYS = ("name", "shape", "at", "radius", "length", "width", "angle", "velocity",
-                 "waypoints", "speed", "mode")
+                 "waypoints", "speed", "mode", "known")
 AGENT_KEYS = ("name", "q_init", "q_goal", "robot")
 RANDOMISE_KEYS = ("obstacles", "sensor_noise")
 MODELS = ("tricycle",)
@@ -88,6 +88,15 @@ class _Reader:
                           cls=WorldError)
         return value
 
+    def flag(self, m: YMap, key: str, what: str, default: bool) -> bool:
+        if key not in m:
+            return default
+        value = m[key]
+        if not isinstance(value, bool):
+            raise unknown(f"{key} in {what}", str(value), ("true", "false"),
+                          span=m.value_span(key), cls=WorldError)
+        return value
+
     def range_pair(self, value: Any, span: Span, what: str) -> tuple[float, float]:
         lo, hi = self.point(value, span, what)
         if lo > hi:
@@ -98,9 +107,7 @@ class _Reader:
 def read_robot(r: _Reader, value: Any, span: Span, base: Robot | None = None) -> Robot:
     m = r.mapping(value, span, "robot", ROBOT_KEYS)
     d = base or Robot()
-    if base is None:
-        r.choice(m, "model", MODELS, "robot")
-    elif "model" in m:
+    if base is None or "model" in m:
         r.choice(m, "model", MODELS, "robot")
     fp = d.length, d.width
     if "footprint" in m:
@@ -193,7 +200,12 @@ def read_obstacle(r: _Reader, value: Any, span: Span, index: int) -> Obstacle:
     for k in ("speed", "mode"):
         if k in m and motion.kind != "waypoints":
             raise WorldError(f"`{k}` belongs to an obstacle with `waypoints`", span=m.key_span(k))
-    return Obstacle(name, shape, at[0], at[1], radius, length, width, angle, motion)
+    known = r.flag(m, "known", what, False)
+    if known and motion.kind != "static":
+        raise WorldError(f"{what} moves, so it cannot be `known`: the robot's map holds only "
+                         "what stays put", span=m.value_span("known"),
+                         hint="drop `known: true`, or the `velocity` / `waypoints`")
+    return Obstacle(name, shape, at[0], at[1], radius, length, width, angle, motion, known)
 
 
 def read_randomise(r: _Reader, value: Any, span: Span, names: list[str]) -> Randomise:
@@ -272,6 +284,12 @@ def parse_world(text: str, path: str) -> World:
     if not corridors and grid is None:
         raise WorldError("the map has neither `corridors` nor a `grid`", span=mp.span,
                          hint="add `corridors: [{points: [[0, 0], [600, 0]], width: 70}]`")
+    knows, given = read_given(mp, path, unknown_occupied)
+    min_clearance = None
+    if "route" in top:
+        rt = r.mapping(top["route"], top.value_span("route"), "route", ROUTE_KEYS)
+        if "min_clearance" in rt:
+            min_clearance = r.number(rt, "min_clearance", "route", positive=True)
 
     obstacles = []
     for i, item in enumerate(top.get("obstacles") or []):
@@ -285,9 +303,29 @@ def parse_world(text: str, path: str) -> World:
                  if "randomise" in top else Randomise())
     world = World(name, path, int(seed), dt, limit, int(substeps), tuple(agents), sensors,
                   tuple(corridors), grid, tuple(obstacles), randomise,
-                  str(top.get("behavior", "drive")))
+                  str(top.get("behavior", "drive")), knows, given, min_clearance)
     check_free(world, agent_spans)
     return world
+
+
+def read_given(mp: YMap, path: str, unknown_occupied: bool):
+    """``map.given``: the robot's own map (a map_server YAML), ``none``, or (absent) the map."""
+    if "given" not in mp:
+        return "map", None
+    value = mp["given"]
+    span = mp.value_span("given")
+    if value is None or str(value).lower() in ("none", "null", "~"):
+        return "none", None
+    if not isinstance(value, str) or not value.strip():
+        raise WorldError("`given` in map must be a map_server YAML file or `none`", span=span,
+                         hint="`given: maps/office02_given.yaml`, or `given: none` for a robot "
+                              "with no map")
+    if not value.endswith((".yaml", ".yml")):
+        raise unknown("given in map", value, ("none", "PATH.yaml"), span=span, cls=WorldError)
+    from .gridmap import load_map_yaml
+
+    return "given", load_map_yaml(Path(path).parent / value, unknown_occupied=unknown_occupied,
+                                  where=span)
 
 
 def check_free(world: World, spans: list[tuple[Span, Span]]) -> None:
@@ -314,16 +352,35 @@ def load_world(path: str | Path) -> World:
     except (OSError, UnicodeDecodeError) as exc:
         raise WorldError(f"cannot read world file `{path}`: "
                          f"{getattr(exc, 'strerror', None) or exc}") from None
+    if path.suffix.lower() not in (".yaml", ".yml"):
+        # Until the file is known to be a world, an error quotes nothing of it (a lesson may
+        # name any file; docs/security.md).
+        try:
+            doc = yamlpos.load(text, str(path), WorldError)
+        except WorldError:
+            doc = None
+        if not (isinstance(doc, dict) and "map" in doc):
+            raise WorldError(f"`{path}` is not a world file", span=Span(str(path), 1, 1),
+                             expected="a YAML file with `map:` (see worlds/README.md)")
     return parse_world(text, str(path))
 
 
-def resolve_world_path(name: str | Path) -> Path:
-    """A world file as given, or else the packaged world of that name (``figure4.yaml``)."""
+class UnknownWorld(WorldError, NameError_):
+    """A world name that is neither a file nor a packaged world (an unknown name, of a world)."""
+
+    kind = "world error"
+
+
+def resolve_world_path(name: str | Path, base: Path | None = None) -> Path:
+    """The one way a world is found: a file as given (relative to ``base`` first, when a
+    lesson names it), else the packaged world of that name (``figure4`` or ``figure4.yaml``);
+    an unknown name gets the packaged names and a "did you mean"."""
     from ..resources import packaged_names, resolve
 
-    found = resolve("worlds", name, ".yaml")
+    found = resolve("worlds", name, ".yaml", base)
     if found is not None:
         return found
-
-    names = [n for n in packaged_names("worlds", ".yaml")]
-    raise unknown("world file", str(name), names, cls=WorldError)
+    names = list(packaged_names("worlds", ".yaml"))
+    if not str(name).endswith(".yaml"):
+        names = [n[:-len(".yaml")] for n in names]
+    raise unknown("world file", str(name), names, cls=UnknownWorld)

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import functools
 import os
-from typing import Callable, Iterator, Sequence
+from collections.abc import Callable, Iterator, Sequence
 
 from .spec import Task
 from .store import StudyError
@@ -73,7 +73,7 @@ def dask_client(scheduler: str | None, workers: int, timeout: str = "10s"):
     """A ``distributed.Client`` to ``scheduler`` (giving up after ``timeout``), or to a new
     LocalCluster of ``workers`` processes."""
     try:
-        from distributed import Client, LocalCluster
+        from distributed import Client
     except ImportError:
         raise StudyError("the Dask executor needs dask.distributed, which is not installed",
                          hint="pip install 'mitos[dask]', or use --executor local") from None
@@ -85,9 +85,45 @@ def dask_client(scheduler: str | None, workers: int, timeout: str = "10s"):
                              hint="start one with `dask scheduler` (and `dask worker ADDR` "
                                   "on each machine), or leave out --scheduler for a local "
                                   "cluster") from None
-    cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                           dashboard_address=None)
-    return Client(cluster)
+    cluster = local_cluster(workers)
+    return Client(cluster, security=cluster.security)
+
+
+def local_cluster(workers: int):
+    """A LocalCluster of ``workers`` processes that only this process and its workers can use.
+
+    Without ``security`` a LocalCluster accepts any connection on its port, and a client that
+    connects can run code in the workers: any account on the machine could. Here the
+    scheduler, nannies and workers listen on 127.0.0.1 only and speak mutual TLS with a
+    certificate authority made for this cluster (``Security.temporary()``, in memory, handed
+    to the workers as they start), so a connection without that certificate is refused
+    during the handshake. The workers' scratch space (where Dask would spill pickled data) is
+    a fresh 0700 directory of this user's, not the shared ``$TMPDIR/dask-scratch-space``,
+    and is removed with the cluster.
+    """
+    import shutil
+    import tempfile
+    import weakref
+
+    from distributed import LocalCluster
+
+    try:
+        from distributed.security import Security
+
+        security = Security.temporary()
+    except ImportError:
+        raise StudyError("the local Dask cluster needs `cryptography` for its TLS certificates",
+                         hint="pip install 'mitos[dask]', or use --executor local") from None
+    scratch = tempfile.mkdtemp(prefix="mitos-dask-")
+    try:
+        cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
+                               dashboard_address=None, host="127.0.0.1", security=security,
+                               local_directory=scratch)
+    except BaseException:
+        shutil.rmtree(scratch, ignore_errors=True)
+        raise
+    weakref.finalize(cluster, shutil.rmtree, scratch, True)
+    return cluster
 
 
 def run_dask(fn: TaskFn, tasks: Sequence[Task], workers: int, scheduler: str | None = None,

@@ -98,9 +98,9 @@ def run_study(study: Study, out_dir: str | Path, *, executor: str = "local",
     done = {key_of(r): r for r in finished}
     rows = []
     for task in tasks:
-        row = by_index.get(task.index) or done.get(task.key)
-        if row is not None:
-            rows.append(row)
+        found = by_index.get(task.index) or done.get(task.key)
+        if found is not None:
+            rows.append(found)
     outcome = Outcome(study, rows, len(tasks), len(finished), len(by_index))
     outcome.summaries = summaries(rows, study.worlds, study.choices)
     outcome.ranks = rank(rows, outcome.pooled())

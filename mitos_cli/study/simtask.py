@@ -61,16 +61,14 @@ def _scene(path: str):
 
 @functools.lru_cache(maxsize=64)
 def _planner(context: StudyContext, choice: Choice, path: str):
+    from ..sim.planner import make_planner
+
     world = _world(path)
-    if choice.planner == "potential_field":
-        from ..sim.potential_field import PotentialFieldPlanner
-
-        return PotentialFieldPlanner.for_world(world)
-    from ..sim.planner import FuzzyPlanner
-
+    if choice.planner != "fuzzy":
+        return make_planner(choice.planner, world)
     behavior = context.behavior or world.behavior
-    return FuzzyPlanner(loaded_rulebase(context.rulebase, behavior, choice.overrides()),
-                        behavior)
+    return make_planner("fuzzy", world,
+                        loaded_rulebase(context.rulebase, behavior, choice.overrides()), behavior)
 
 
 def run_task(context: StudyContext, task: Task) -> dict:

@@ -1,8 +1,8 @@
 """What a study runs: operator choices, tasks, and their seeds.
 
 A study is every combination of worlds x choices x runs. A :class:`Choice` is one planner with
-its operators (``fuzzy`` with a T-norm, S-norm and inference method; ``potential_field`` has
-none). A :class:`Task` is one simulation: world, choice, run index and seed.
+its operators (``fuzzy`` with a T-norm, S-norm and inference method; ``potential_field`` and
+``dwa`` have none). A :class:`Task` is one simulation: world, choice, run index and seed.
 
 Seeds: ``SeedSequence(seed).spawn(len(worlds))[w].spawn(runs)[r]`` gives the seed of run ``r``
 in world ``w``, whatever the choice. Every choice therefore drives exactly the same randomized
@@ -20,7 +20,9 @@ from ..fuzzy import norms
 from ..errors import unknown
 from ..lang.operators import INFERENCES
 
-PLANNERS = ("fuzzy", "potential_field")
+from ..sim.planner import PLANNERS as _REGISTRY
+
+PLANNERS = tuple(_REGISTRY)      # the simulator's planner registry, in its order
 
 #: the columns that identify a task in ``results.csv``
 KEY_FIELDS = ("world", "planner", "and", "or", "inference", "run")

@@ -14,7 +14,7 @@ import io
 import json
 import os
 from pathlib import Path
-from typing import Iterable
+from typing import Iterable, TextIO
 
 from ..errors import MitosError
 from .spec import KEY_FIELDS, Task
@@ -71,7 +71,7 @@ class ResultStore:
         self.dir = Path(directory)
         self.path = self.dir / "results.csv"
         self.manifest_path = self.dir / "study.json"
-        self._file = None
+        self._file: TextIO | None = None
 
     # -- reading -----------------------------------------------------------------------------
 
@@ -148,6 +148,8 @@ class ResultStore:
         """Write one finished row and make it durable before returning."""
         line = io.StringIO()
         csv.writer(line, lineterminator="\n").writerow(_format(row[f]) for f in COLUMNS)
+        if self._file is None:
+            raise RuntimeError("ResultStore.append before open")   # a programming error
         self._file.write(line.getvalue())
         self._file.flush()
         os.fsync(self._file.fileno())

@@ -41,18 +41,20 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from dataclasses import dataclass
-from typing import Callable
+from collections.abc import Callable
+from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..fuzzy import hedges as hedge_mod
 from ..engine.compile import CompiledRuleBase
 from ..engine.evaluation import evaluate, fill_defaults, infer
-from ..errors import LessonError
 from ..engine.mamdani import OutputTable, spike
-from ..lang.model import Rule, RuleBase
+from ..errors import LessonError
+from ..fuzzy import hedges as hedge_mod
+from ..fuzzy.norms import SNORMS, TNORMS, Norm
 from ..fuzzy.shapes import kernel_params
+from ..lang import interpretability as meaning
+from ..lang.model import Rule, RuleBase
 
 #: Fraction of a universe the most-moving parameter moves in one full step (times eta).
 STEP = 0.05
@@ -75,7 +77,9 @@ FROM_CORNERS: dict[str, Callable[[float, float, float, float], tuple[float, ...]
     "left_shoulder": lambda a, b, c, d: (c, d),
     "right_shoulder": lambda a, b, c, d: (a, b),
 }
-SUPPORTED_NORMS = {"and": ("min", "product"), "or": ("max", "probabilistic_sum")}
+#: The norms adaptation differentiates: those whose registry entry says how (fuzzy/norms.py).
+SUPPORTED_NORMS = {"and": tuple(n.name for n in TNORMS.values() if n.gradient),
+                   "or": tuple(n.name for n in SNORMS.values() if n.gradient)}
 
 
 @dataclass(frozen=True)
@@ -105,14 +109,55 @@ class Parameters:
     dependents: tuple[tuple[int, np.ndarray, np.ndarray], ...]   # see _round
     frozen_reasons: tuple[str, ...] = ()
     constraints: np.ndarray | None = None    # [c, P] rows that must stay 0 (ties, frozen)
+    #: least distance between neighbours of each ``order`` entry, as a fraction of the universe
+    order_gap: tuple[float, ...] = ()
+    #: the variables whose coverage and distinguishability are kept (nonlinear constraints)
+    partitions: tuple[Partition, ...] = ()
+    #: ``(variable, term, point)`` of the terms held at their point of symmetry
+    held: tuple[tuple[str, str, float], ...] = ()
+    #: entries of ``order`` that are crisp output values (distinct by their current spread)
+    crisp_orders: tuple[int, ...] = ()
     #: (output, term) -> its knots: a singleton's value ``[i, -1, -1, -1]``, or (Mamdani) the
     #: corners ``(a, b, c, d)`` of a piecewise-linear output set
     out_terms: dict = dataclasses.field(default_factory=dict)
-    sets: tuple["SetSpec", ...] | None = None   # Mamdani: how to rebuild the output tables
+    sets: tuple[SetSpec, ...] | None = None   # Mamdani: how to rebuild the output tables
 
     @property
     def n_free(self) -> int:
         return int(round(np.trace(self.projector)))
+
+
+@dataclass(frozen=True, eq=False)
+class Partition:
+    """The fuzzy sets of one variable, whose coverage and distinguishability adaptation keeps:
+    the knot of each corner (``-1``: the corner as written) and the least coverage and largest
+    similarity allowed (the documented thresholds, or the written values where those are
+    already worse: adaptation never has to repair what the instructor wrote)."""
+
+    var: str
+    universe: tuple[float, float]
+    knot: np.ndarray             # [t, 4]
+    written: np.ndarray          # [t, 4] corners as written
+    least_coverage: float | None     # None: not measured (an output's sets)
+    most_similar: float
+
+    def corners(self, values: np.ndarray) -> np.ndarray:
+        return np.where(self.knot >= 0, values[np.maximum(self.knot, 0)], self.written)
+
+    def holds(self, values: np.ndarray) -> bool:
+        cover, similar = meaning.measures(self.corners(values), self.universe)
+        if self.least_coverage is not None and cover < self.least_coverage - 1e-12:
+            return False
+        return similar <= self.most_similar + 1e-12
+
+
+def partition(var: str, universe: tuple[float, float], knot: np.ndarray, written: np.ndarray,
+              covered: bool) -> Partition:
+    """A :class:`Partition` with its thresholds (see there)."""
+    least = min(meaning.COVERAGE, meaning.coverage(written, universe)[0]) if covered else None
+    most = max(meaning.SIMILARITY, meaning.most_similar(written, universe)[0]) \
+        if len(written) > 1 else 1.0
+    return Partition(var, universe, knot, written, least, most)
 
 
 @dataclass(frozen=True, eq=False)
@@ -144,46 +189,72 @@ def _decimals(width: float) -> int:
     return int(max(0, 4 - math.floor(math.log10(width))))
 
 
-def parameterise(compiled: CompiledRuleBase) -> Parameters:
-    """The learnable numbers of ``compiled`` (its input terms and output values)."""
-    rb = compiled.rulebase
-    mamdani = compiled.operators.inference == "mamdani"
+def _supported(compiled: CompiledRuleBase) -> None:
+    """Refuse what adaptation has no gradient for."""
     if compiled.cons_linear is not None:
         raise LessonError("adaptation does not cover Takagi-Sugeno (linear) consequents",
                           hint="give the outputs crisp values (numbers) to adapt them")
+    if compiled.operators.inference == "mamdani":
+        return                                       # differences need no derivatives
     for op, names in SUPPORTED_NORMS.items():
         norm = compiled.operators.tnorm if op == "and" else compiled.operators.snorm
-        if norm.name not in names and not mamdani:     # differences need no derivatives
+        if norm.gradient is None:
             raise LessonError(f"adaptation has gradients for `{op} = "
                               f"{' / '.join(names)}`, not `{op} = {norm.name}`",
                               hint="adapt with the paper's min / max operators")
 
-    knots: list[Knot] = []
-    values: list[float] = []
-    scale: list[float] = []
-    lo: list[float] = []
-    hi: list[float] = []
-    frozen_knot: list[bool] = []
-    order: list[np.ndarray] = []
-    reasons: list[str] = []
-    sym_rows: list[tuple[int, int, int]] = []        # (a, b, d): a + d - 2 b = 0
-    T = compiled.n_terms
-    corner_knot = np.full((T, 4), -1, dtype=np.intp)
 
-    def new_knot(knot: Knot, value: float, width: float, bounds: tuple[float, float],
+@dataclass
+class _Builder:
+    """The knots of a parameterisation while :func:`parameterise` collects them."""
+
+    compiled: CompiledRuleBase
+    constrained: bool
+    frozen_terms: frozenset
+    released: frozenset
+    knots: list = field(default_factory=list)
+    values: list = field(default_factory=list)
+    scale: list = field(default_factory=list)
+    lo: list = field(default_factory=list)
+    hi: list = field(default_factory=list)
+    frozen: list = field(default_factory=list)
+    order: list = field(default_factory=list)
+    order_gap: list = field(default_factory=list)
+    reasons: list = field(default_factory=list)
+    sym_rows: list = field(default_factory=list)        # (a, b, d): a + d - 2 b = 0
+    partitions: list = field(default_factory=list)
+    held: list = field(default_factory=list)
+    crisp_orders: list = field(default_factory=list)    # entries of ``order``: crisp values
+
+    def new_knot(self, knot: Knot, value: float, width: float, bounds: tuple[float, float],
                  frozen: bool) -> int:
-        knots.append(knot)
-        values.append(value)
-        scale.append(width)
-        lo.append(bounds[0])
-        hi.append(bounds[1])
-        frozen_knot.append(frozen)
-        return len(knots) - 1
+        self.knots.append(knot)
+        self.values.append(value)
+        self.scale.append(width)
+        self.lo.append(bounds[0])
+        self.hi.append(bounds[1])
+        self.frozen.append(frozen)
+        return len(self.knots) - 1
 
-    def tie_corners(vname: str, kind: str, items: list) -> dict:
+    def term_frozen(self, vname: str, term) -> bool:
+        return term.frozen or (vname, term.name) in self.frozen_terms
+
+    def hold(self, vname: str):
+        """The term of ``vname`` held at its point of symmetry, if any (and not released)."""
+        if not self.constrained:
+            return None
+        held = meaning.held_term(self.compiled.variables[vname])
+        if held is None or (vname, held[0].name) in self.released:
+            return None
+        entry = (vname, held[0].name, float(held[1]))
+        if entry not in self.held:
+            self.held.append(entry)
+        return held
+
+    def tie_corners(self, vname: str, kind: str, items: list) -> dict:
         """Knots for the corners of ``items`` ((key, term) of one variable): equal corners
         are one knot; returns key -> [4] knot ids (-1: no such corner)."""
-        var = compiled.variables[vname]
+        var = self.compiled.variables[vname]
         ulo, uhi = var.universe
         width = uhi - ulo
         out: dict = {}
@@ -197,25 +268,79 @@ def parameterise(compiled: CompiledRuleBase) -> Parameters:
         last = None
         for v, n, ci in points:
             key, term = items[n]
-            if last is None or abs(v - values[last]) > TIE * width:
-                last = new_knot(Knot(vname, kind, ""), v, width,
-                                (min(ulo, v), max(uhi, v)), False)
+            if last is None or abs(v - self.values[last]) > TIE * width:
+                last = self.new_knot(Knot(vname, kind, ""), v, width,
+                                     (min(ulo, v), max(uhi, v)), False)
                 ids.append(last)
                 names[last] = []
             out[key][ci] = last
             names[last].append(f"{term.name}.{_corner_name(term.shape, ci)}")
-            if term.frozen:
-                frozen_knot[last] = True
+            if self.term_frozen(vname, term):
+                self.frozen[last] = True
         for i in ids:
-            knots[i] = Knot(vname, kind, f"{vname}: " + " = ".join(dict.fromkeys(names[i])))
+            self.knots[i] = Knot(vname, kind, f"{vname}: " + " = ".join(dict.fromkeys(names[i])))
         if ids:
-            order.append(np.array(ids, dtype=np.intp))
+            self.order.append(np.array(ids, dtype=np.intp))
+            self.order_gap.append(MIN_GAP)
         for key, term in items:
             if term.shape == "triangle_pw":
-                sym_rows.append((out[key][0], out[key][1], out[key][3]))
+                self.sym_rows.append((out[key][0], out[key][1], out[key][3]))
+        self._hold_set(vname, items, out)
+        if self.constrained and len(items) == len(var.terms) and items:
+            written = np.array([term.corners for _, term in items], dtype=float)
+            self.partitions.append(partition(vname, var.universe,
+                                             np.array([out[k] for k, _ in items]), written,
+                                             covered=kind == "input"))
         return out
 
-    # input terms: tie equal corners of one variable into one knot
+    def _hold_set(self, vname: str, items: list, out: dict) -> None:
+        """A held triangle keeps its peak (its slopes may move: they are its neighbours'
+        peaks); a held trapezoid keeps its core."""
+        held = self.hold(vname) if items else None
+        if held is None:
+            return
+        key = next((k for k, t in items if t.name == held[0].name), None)
+        if key is None:
+            return
+        ids = out[key]
+        for i in ids[1:3]:
+            if i >= 0:
+                self.frozen[i] = True
+
+
+def parameterise(compiled: CompiledRuleBase, *, constrained: bool = True,
+                 frozen_terms=frozenset(), released=frozenset()) -> Parameters:
+    """The learnable numbers of ``compiled`` (its input terms and output values).
+
+    ``constrained`` (the default) keeps the terms' meaning as well as their order
+    (:mod:`mitos_cli.lang.interpretability`): the middle term of mirror-symmetric terms held at
+    its point unless ``released`` names it, neighbouring crisp output values at least
+    half the spacing of evenly spread values apart, inputs covered and their sets distinguishable.
+    ``frozen_terms`` are ``(variable, term)`` pairs kept as they are."""
+    _supported(compiled)
+    b = _Builder(compiled, constrained, frozenset(frozen_terms), frozenset(released))
+    corner_knot = _input_knots(b)
+    cons_knot, out_terms = _output_knots(b)
+    P = len(b.knots)
+    frozen_a = np.array(b.frozen, dtype=bool)
+    projector, dependents, rows = _constraints(P, frozen_a, b.sym_rows)
+    scale_a = np.array(b.scale, dtype=float)
+    decimals = np.array([_decimals(w) for w in scale_a], dtype=int)
+    mamdani = compiled.operators.inference == "mamdani"
+    return Parameters(compiled, tuple(b.knots), np.array(b.values, dtype=float), scale_a,
+                      np.array(b.lo), np.array(b.hi), projector, tuple(b.order), corner_knot,
+                      cons_knot, decimals, dependents, tuple(dict.fromkeys(b.reasons)), rows,
+                      order_gap=tuple(b.order_gap), partitions=tuple(b.partitions),
+                      held=tuple(b.held), crisp_orders=tuple(b.crisp_orders),
+                      out_terms=out_terms,
+                      sets=_set_specs(compiled, cons_knot) if mamdani else None)
+
+
+def _input_knots(b: _Builder) -> np.ndarray:
+    """Input terms: equal corners of one variable tied into one knot; ``[T, 4]`` knot ids."""
+    compiled = b.compiled
+    T = compiled.n_terms
+    corner_knot = np.full((T, 4), -1, dtype=np.intp)
     for k, vname in enumerate(compiled.inputs):
         var = compiled.variables[vname]
         items = []
@@ -226,93 +351,125 @@ def parameterise(compiled: CompiledRuleBase) -> Parameters:
             if term.shape in FROM_CORNERS:
                 items.append((t, term))
             else:
-                reasons.append(f"{vname}.{term.name}: shape `{term.shape}` is not learned")
-        for t, ids in tie_corners(vname, "input", items).items():
+                b.reasons.append(f"{vname}.{term.name}: shape `{term.shape}` is not learned")
+        for t, ids in b.tie_corners(vname, "input", items).items():
             corner_knot[t] = ids
+    return corner_knot
 
-    # output values: every term of every output is a knot (ordered); crisp values per rule
-    owners = _owners(rb, compiled.behavior)
-    frozen_rules = {(b.name, label) for b in rb.behaviors for label in b.frozen}
+
+def _output_knots(b: _Builder) -> tuple[np.ndarray, dict]:
+    """Output values: every crisp term of every output is a knot (ordered, at least
+    ``least_distance`` apart when constrained); crisp consequents one knot per rule; Mamdani output
+    sets' corners tied like an input's."""
+    compiled = b.compiled
     R, m = compiled.cons_value.shape
     cons_knot = np.full((R, m), -1, dtype=np.intp)
-    crisp: dict[tuple[str, int, int], int] = {}
-    out_terms: dict[tuple[str, str], np.ndarray] = {}    # output term -> its knots
+    out_terms: dict[tuple[str, str], np.ndarray] = {}
+    rules = _rules_of(compiled)
     for j, oname in enumerate(compiled.outputs):
+        term_knot = _crisp_terms(b, oname)
+        shaped: dict[str, np.ndarray] = {}
+        if compiled.operators.inference == "mamdani":
+            var = compiled.variables[oname]
+            shaped = b.tie_corners(oname, "shape", [(t.name, t) for t in var.terms
+                                                    if t.shape in FROM_CORNERS])
+            out_terms.update({(oname, tname): ids for tname, ids in shaped.items()})
+        used, locked, used_sets, locked_sets = _consequent_knots(b, j, term_knot, shaped,
+                                                                 rules, cons_knot)
         var = compiled.variables[oname]
-        ulo, uhi = var.universe
-        width = uhi - ulo
-        term_knot: dict[str, int] = {}
-        singles = sorted((t.params[0], t.name) for t in var.terms if t.shape == "singleton")
-        ids = []
-        for v, tname in singles:
-            frozen = var.term(tname).frozen
-            term_knot[tname] = new_knot(Knot(oname, "output", f"{oname}: {tname}"), v, width,
-                                        (ulo, uhi), True)   # thawed below when a rule uses it
-            ids.append(term_knot[tname])
-            if frozen:
-                reasons.append(f"{oname}.{tname} is frozen")
-        if len(ids) > 1:
-            order.append(np.array(ids, dtype=np.intp))
-        shaped: dict[str, np.ndarray] = {}           # Mamdani: output sets' corner knots
-        if mamdani:
-            shaped = tie_corners(oname, "shape", [(t.name, t) for t in var.terms
-                                                  if t.shape in FROM_CORNERS])
-            out_terms.update({(oname, tname): ids_ for tname, ids_ in shaped.items()})
-        used: set[int] = set()
-        locked: set[int] = set()
-        used_sets: set[str] = set()
-        locked_sets: set[str] = set()
-        for r in range(R):
-            if not compiled.cons_mask[r, j]:
-                continue
-            owner, index = owners[r]
-            rule = rb.behavior(owner).rules[index]
-            is_frozen = (owner, rule.label) in frozen_rules
-            tname = compiled.cons_term[r][j]
-            if tname is not None and tname in shaped:
-                (locked_sets if is_frozen else used_sets).add(tname)
-            elif tname is not None:
-                if tname not in term_knot:
-                    reasons.append(f"{oname}.{tname}: shape "
-                                   f"`{var.term(tname).shape}` is not learned")
-                    continue
-                cons_knot[r, j] = term_knot[tname]
-                (locked if is_frozen else used).add(term_knot[tname])
-            else:
-                key = (owner, index, j)
-                if key not in crisp:
-                    crisp[key] = new_knot(
-                        Knot(oname, "crisp",
-                             f"{oname}: {owner}/{rule.label or '#' + str(index + 1)}"),
-                        float(compiled.cons_value[r, j]), width, (ulo, uhi), is_frozen)
-                cons_knot[r, j] = crisp[key]
+        held = {h[1] for h in b.held if h[0] == oname}
         for tname, i in term_knot.items():
-            frozen_knot[i] = i not in used or i in locked or var.term(tname).frozen
+            b.frozen[i] = (i not in used or i in locked or b.term_frozen(oname, var.term(tname))
+                           or tname in held)
             out_terms[(oname, tname)] = np.array([i, -1, -1, -1], dtype=np.intp)
-        # a corner of output sets moves when a rule that is not frozen concludes one of its
-        # sets and no frozen rule or frozen term holds it
-        thawed: dict[int, bool] = {}
-        for tname, ids_ in shaped.items():
-            for i in ids_[ids_ >= 0]:
-                ok = thawed.get(int(i), False) or tname in used_sets
-                thawed[int(i)] = ok
-        for tname, ids_ in shaped.items():
-            for i in ids_[ids_ >= 0]:
-                if tname in locked_sets or not thawed[int(i)]:
-                    frozen_knot[i] = True
-            if var.term(tname).frozen and tname in used_sets:
-                reasons.append(f"{oname}.{tname} is frozen")
+        _thaw_sets(b, oname, shaped, used_sets, locked_sets)
+    return cons_knot, out_terms
 
-    P = len(knots)
-    values_a = np.array(values, dtype=float)
-    frozen_a = np.array(frozen_knot, dtype=bool)
-    projector, dependents, rows = _constraints(P, frozen_a, sym_rows)
-    scale_a = np.array(scale, dtype=float)
-    decimals = np.array([_decimals(w) for w in scale_a], dtype=int)
-    return Parameters(compiled, tuple(knots), values_a, scale_a, np.array(lo), np.array(hi),
-                      projector, tuple(order), corner_knot, cons_knot, decimals,
-                      dependents, tuple(dict.fromkeys(reasons)), rows, out_terms,
-                      _set_specs(compiled, cons_knot) if mamdani else None)
+
+def _crisp_terms(b: _Builder, oname: str) -> dict[str, int]:
+    """One knot per crisp term of output ``oname`` (frozen until a rule is found using it)."""
+    var = b.compiled.variables[oname]
+    ulo, uhi = var.universe
+    term_knot: dict[str, int] = {}
+    ids = []
+    for v, tname in sorted((t.params[0], t.name) for t in var.terms if t.shape == "singleton"):
+        term_knot[tname] = b.new_knot(Knot(oname, "output", f"{oname}: {tname}"), v,
+                                      uhi - ulo, (ulo, uhi), True)
+        ids.append(term_knot[tname])
+        if b.term_frozen(oname, var.term(tname)):
+            b.reasons.append(f"{oname}.{tname} is frozen")
+    if len(ids) > 1:
+        b.order.append(np.array(ids, dtype=np.intp))
+        least = meaning.least_distance(np.array([b.values[i] for i in ids])) / (uhi - ulo)
+        if b.constrained:
+            b.crisp_orders.append(len(b.order) - 1)
+        b.order_gap.append(max(least, MIN_GAP) if b.constrained else MIN_GAP)
+    if ids:
+        b.hold(oname)
+    return term_knot
+
+
+def _rules_of(compiled: CompiledRuleBase) -> list[tuple[str, int, Rule, bool]]:
+    """(owner behavior, index, rule, frozen) of each compiled rule."""
+    rb = compiled.rulebase
+    frozen_rules = {(x.name, label) for x in rb.behaviors for label in x.frozen}
+    out = []
+    for owner, index in _owners(rb, compiled.behavior):
+        rule = rb.behavior(owner).rules[index]
+        out.append((owner, index, rule, (owner, rule.label) in frozen_rules))
+    return out
+
+
+def _consequent_knots(b: _Builder, j: int, term_knot: dict, shaped: dict, rules: list,
+                      cons_knot: np.ndarray) -> tuple[set, set, set, set]:
+    """Point each rule's consequent on output ``j`` at its knot (a crisp number gets one of
+    its own); which term knots and Mamdani sets rules that may change, or may not, use."""
+    compiled = b.compiled
+    oname = compiled.outputs[j]
+    var = compiled.variables[oname]
+    width = var.universe[1] - var.universe[0]
+    used: set[int] = set()
+    locked: set[int] = set()
+    used_sets: set[str] = set()
+    locked_sets: set[str] = set()
+    crisp: dict[tuple[str, int, int], int] = {}
+    for r, (owner, index, rule, is_frozen) in enumerate(rules):
+        if not compiled.cons_mask[r, j]:
+            continue
+        tname = compiled.cons_term[r][j]
+        if tname is not None and tname in shaped:
+            (locked_sets if is_frozen else used_sets).add(tname)
+        elif tname is not None:
+            if tname not in term_knot:
+                b.reasons.append(f"{oname}.{tname}: shape "
+                                 f"`{var.term(tname).shape}` is not learned")
+                continue
+            cons_knot[r, j] = term_knot[tname]
+            (locked if is_frozen else used).add(term_knot[tname])
+        else:
+            key = (owner, index, j)
+            if key not in crisp:
+                crisp[key] = b.new_knot(
+                    Knot(oname, "crisp", f"{oname}: {owner}/{rule.label or '#' + str(index + 1)}"),
+                    float(compiled.cons_value[r, j]), width, var.universe, is_frozen)
+            cons_knot[r, j] = crisp[key]
+    return used, locked, used_sets, locked_sets
+
+
+def _thaw_sets(b: _Builder, oname: str, shaped: dict, used_sets: set, locked_sets: set) -> None:
+    """A corner of output sets moves when a rule that is not frozen concludes one of its sets
+    and no frozen rule or frozen term holds it."""
+    var = b.compiled.variables[oname]
+    thawed: dict[int, bool] = {}
+    for tname, ids in shaped.items():
+        for i in ids[ids >= 0]:
+            thawed[int(i)] = thawed.get(int(i), False) or tname in used_sets
+    for tname, ids in shaped.items():
+        for i in ids[ids >= 0]:
+            if tname in locked_sets or not thawed[int(i)]:
+                b.frozen[i] = True
+        if b.term_frozen(oname, var.term(tname)) and tname in used_sets:
+            b.reasons.append(f"{oname}.{tname} is frozen")
 
 
 def _set_specs(compiled: CompiledRuleBase, cons_knot: np.ndarray) -> tuple[SetSpec, ...]:
@@ -502,8 +659,8 @@ def difference_steps(p: Parameters) -> np.ndarray:
 def _room(p: Parameters, values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """How far each knot may move alone and keep its bounds and its order."""
     low, high = p.lo.copy(), p.hi.copy()
-    for ids in p.order:                              # one per variable
-        need = _need(p, ids)
+    for k, ids in enumerate(p.order):                # one per variable
+        need = _need(p, ids, k)
         low[ids[1:]] = np.maximum(low[ids[1:]], values[ids[:-1]] + need)
         high[ids[:-1]] = np.minimum(high[ids[:-1]], values[ids[1:]] - need)
     return np.minimum(low, values), np.maximum(high, values)
@@ -585,7 +742,7 @@ def gradient(p: Parameters, values: np.ndarray, X: np.ndarray,
     for j in range(ctx.shape[1]):
         others = np.prod(np.delete(ctx_vals, j, axis=0), axis=0)
         _scatter_add(G, ctx[:, j], gdof * w * base * others)
-    tnorm, snorm = c.operators.tnorm.name, c.operators.snorm.name
+    tnorm, snorm = c.operators.tnorm, c.operators.snorm
     for level in reversed(c.levels):
         for group in reversed(level):
             _backward_group(group, V, G, tnorm, snorm)
@@ -616,7 +773,7 @@ def _scatter_add(G: np.ndarray, idx: np.ndarray, vals: np.ndarray) -> None:
     G[sorted_idx[starts]] += np.add.reduceat(vals[order], starts, axis=0)
 
 
-def _backward_group(group, V: np.ndarray, G: np.ndarray, tnorm: str, snorm: str) -> None:
+def _backward_group(group, V: np.ndarray, G: np.ndarray, tnorm: Norm, snorm: Norm) -> None:
     """Pass ``G[out]`` down to ``G[children]`` for one group of neurons."""
     gout = G[group.out]                                  # [g, n]
     ch = group.children                                  # [g, a]
@@ -636,19 +793,21 @@ def _backward_group(group, V: np.ndarray, G: np.ndarray, tnorm: str, snorm: str)
         return
     X = V[ch]                                            # [g, a, n]
     g, a, n = X.shape
-    norm = tnorm if op in ("and", "prod") else snorm
-    if op == "prod":
-        norm = "product"
-    if norm in ("min", "max"):
+    # how this norm's derivative goes (its registry entry); a `use` context multiplies
+    rule = "product" if op == "prod" else (tnorm if op == "and" else snorm).gradient
+    if rule is None:                                     # check_supported refuses these first
+        raise ValueError(f"no derivative for the norm of a `{op}` neuron")
+    if rule == "select":
+        smaller = op == "and"                            # min picks the smallest input
         best = X[:, 0].copy()
         sel = np.zeros((g, n), dtype=np.intp)
         for j in range(1, a):                            # arity (a few), never rules or samples
-            wins = X[:, j] < best if norm == "min" else X[:, j] > best    # ties: lowest index
+            wins = X[:, j] < best if smaller else X[:, j] > best    # ties: lowest index
             np.copyto(best, X[:, j], where=wins)
             sel[wins] = j
         local = (np.arange(a)[None, :, None] == sel[:, None, :]) * gout[:, None, :]
     else:
-        F = X if norm == "product" else 1.0 - X
+        F = X if rule == "product" else 1.0 - X          # "dual_product": of complements
         left = np.cumprod(np.concatenate([np.ones((g, 1, n)), F[:, :-1]], axis=1), axis=1)
         right = np.cumprod(np.concatenate([np.ones((g, 1, n)), F[:, :0:-1]], axis=1),
                            axis=1)[:, ::-1]
@@ -708,9 +867,9 @@ class Adaptation:
                 if a != b]
 
 
-def _need(p: Parameters, ids: np.ndarray) -> np.ndarray:
-    """Smallest allowed distances between consecutive knots of one variable."""
-    gap = MIN_GAP * p.scale[ids[0]]
+def _need(p: Parameters, ids: np.ndarray, k: int) -> np.ndarray:
+    """Smallest allowed distances between consecutive knots of ``p.order[k]``."""
+    gap = (p.order_gap[k] if p.order_gap else MIN_GAP) * p.scale[ids[0]]
     return np.minimum(gap, np.diff(p.values[ids])) * (1 - 1e-9)     # never stricter than the start
 
 
@@ -730,8 +889,8 @@ def descent_direction(p: Parameters, values: np.ndarray, grad: np.ndarray) -> np
             row = np.zeros(len(values))
             row[i] = 1.0
             rows.append(row)
-        for ids in p.order:
-            close = np.diff(values[ids]) - _need(p, ids) <= tol[ids[1:]]
+        for k, ids in enumerate(p.order):
+            close = np.diff(values[ids]) - _need(p, ids, k) <= tol[ids[1:]]
             closing = np.diff(d[ids]) < 0
             for k in np.flatnonzero(close & closing):
                 row = np.zeros(len(values))
@@ -744,25 +903,43 @@ def descent_direction(p: Parameters, values: np.ndarray, grad: np.ndarray) -> np
     return np.zeros_like(values)                         # pragma: no cover - all blocked
 
 
-def feasible(p: Parameters, values: np.ndarray) -> bool:
-    """Knots inside their bounds and in their order, at least :data:`MIN_GAP` apart."""
+def feasible(p: Parameters, values: np.ndarray, partitions: bool = True) -> bool:
+    """Knots inside their bounds and in their order, at least :data:`MIN_GAP` apart (crisp
+    output values ``least_distance``); each partition covered and distinguishable (when it moved)."""
     if np.any(values < p.lo - 1e-12) or np.any(values > p.hi + 1e-12):
         return False
-    for ids in p.order:
-        if np.any(np.diff(values[ids]) < _need(p, ids)):
+    for k, ids in enumerate(p.order):
+        if np.any(np.diff(values[ids]) < _need(p, ids, k)):
+            return False
+    for k in p.crisp_orders:              # the distance check measures on the values as they are
+        ids = p.order[k]
+        need = np.minimum(meaning.least_distance(values[ids]), np.diff(p.values[ids]))
+        if np.any(np.diff(values[ids]) < need * (1 - 1e-9)):
+            return False
+    return not partitions or partitions_hold(p, values)
+
+
+def partitions_hold(p: Parameters, values: np.ndarray) -> bool:
+    """Coverage and distinguishability of every partition whose knots moved."""
+    for part in p.partitions:
+        mine = part.knot[part.knot >= 0]
+        if not np.array_equal(values[mine], p.values[mine]) and not part.holds(values):
             return False
     return True
 
 
 def adapt(compiled: CompiledRuleBase, X: np.ndarray, targets: np.ndarray, *, epochs: int = 50,
           rate: float = 0.5, on_epoch: Callable[[int, float], None] | None = None,
-          parameters: Parameters | None = None) -> Adaptation:
+          parameters: Parameters | None = None, constrained: bool = True,
+          on_values: Callable[[np.ndarray], None] | None = None) -> Adaptation:
     """Gradient descent on ``Q`` (eqs. 13-14): ``epochs`` full-batch steps of learning factor
-    ``rate`` in (0, 1), each halved until ``Q`` decreases inside the constraints."""
+    ``rate`` in (0, 1), each halved until ``Q`` decreases inside the constraints
+    (``parameters``, else :func:`parameterise` with ``constrained``). ``on_epoch`` hears
+    ``(epoch, Q)`` and ``on_values`` the values after each epoch."""
     if not 0.0 < rate < 1.0:
         raise LessonError(f"the learning factor must lie in (0, 1), not {rate:g}",
                           hint="the paper's eta: try `rate 0.5`")
-    p = parameters or parameterise(compiled)
+    p = parameters or parameterise(compiled, constrained=constrained)
     values = p.values.copy()
     Q, grad = gradient(p, values, X, targets)
     history = [Q]
@@ -780,9 +957,9 @@ def adapt(compiled: CompiledRuleBase, X: np.ndarray, targets: np.ndarray, *, epo
             accepted = False
             for _ in range(HALVINGS):
                 candidate = values + step * direction * p.scale
-                if feasible(p, candidate):
+                if feasible(p, candidate, partitions=False):       # the cheap checks first
                     q_new = loss(with_values(p, candidate), X, targets)
-                    if q_new < Q:
+                    if q_new < Q and partitions_hold(p, candidate):
                         accepted = True
                         break
                 step *= 0.5
@@ -798,6 +975,8 @@ def adapt(compiled: CompiledRuleBase, X: np.ndarray, targets: np.ndarray, *, epo
             step = min(1.0, step * 2.0)
             if on_epoch is not None:
                 on_epoch(epoch, Q)
+            if on_values is not None:
+                on_values(values)
     except KeyboardInterrupt:
         interrupted = True            # keep what the completed epochs learned
     q_learned = history[-1]

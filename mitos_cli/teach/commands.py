@@ -17,6 +17,7 @@ from typing import Union
 from lark import Lark, Token, Tree, v_args
 from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken
 
+from ..lang.cache import lark_parser
 from ..errors import RuleSyntaxError, Span
 from ..lang.model import Rule, Setting, Use
 from ..lang.parse import TERMINAL_WORDS, _ToModel
@@ -27,17 +28,17 @@ WORDS = dict(TERMINAL_WORDS, PATH="a file name", INT="a whole number", ARROW="`-
              SIGNED_NUMBER="a number")
 
 #: Every command word, for completion and ``help``.
-COMMAND_WORDS = ("behavior", "end", "use", "frozen", "operators", "eval", "correct", "simulate",
+COMMAND_WORDS = ("behavior", "end", "use", "frozen", "unfrozen", "operators", "eval", "correct",
+                 "simulate",
                  "at", "adapt", "show", "undo", "save", "help", "quit", "exit")
 SHOW_WHAT = ("rules", "terms", "examples", "behaviors", "history")
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def parser() -> Lark:
     """One parser for the rule language plus the teaching commands, built once."""
     text = grammar_text("mitos.lark") + "\n" + grammar_text("teach.lark")
-    return Lark(text, parser="lalr", propagate_positions=True, maybe_placeholders=True,
-                start="command", cache=True)
+    return lark_parser(text, propagate_positions=True, maybe_placeholders=True, start="command")
 
 
 # ---- command objects -------------------------------------------------------------------------
@@ -55,6 +56,56 @@ class TellUse:
 @dataclass(frozen=True)
 class TellFrozen:
     labels: tuple[str, ...]
+
+
+@dataclass(frozen=True)
+class FreezeTerms:
+    """``frozen heading.AHEAD``: terms adaptation keeps as they are."""
+
+    terms: tuple[tuple[str, str], ...]
+    span: Span | None = field(default=None, compare=False)
+
+
+@dataclass(frozen=True)
+class ReleaseTerms:
+    """``unfrozen heading.AHEAD``: lift a term's freeze or its hold at its point."""
+
+    terms: tuple[tuple[str, str], ...]
+    span: Span | None = field(default=None, compare=False)
+
+
+@dataclass(frozen=True)
+class Said:
+    """``steering is very LM``: a target in words (``term`` None: a number)."""
+
+    name: str
+    term: str | None
+    hedges: tuple[str, ...]
+    value: float | None
+    span: Span | None = field(default=None, compare=False)
+
+
+@dataclass(frozen=True)
+class CorrectSaid:
+    inputs: tuple[Assign, ...]
+    targets: tuple[Said, ...]
+
+
+@dataclass(frozen=True)
+class AtSaid:
+    start: float
+    stop: float | None
+    targets: tuple[Said, ...]
+
+
+@dataclass(frozen=True)
+class AtInstruction:
+    """``at 13s to 14.5s make a wider turn``."""
+
+    start: float
+    stop: float | None
+    words: tuple[str, ...]
+    span: Span | None = field(default=None, compare=False)
 
 
 @dataclass(frozen=True)
@@ -96,6 +147,7 @@ class Correct:
 class Simulate:
     world: str
     seed: float | None = None        # checked to be whole by the session
+    robot: str | None = None         # which robot's run `at` corrects (default: the first)
 
 
 @dataclass(frozen=True)
@@ -110,6 +162,7 @@ class Adapt:
     epochs: float | None = None      # checked to be whole by the session
     rate: float | None = None
     plot: str | None = None
+    constrained: bool = True         # `unconstrained`: order and bounds only
 
 
 @dataclass(frozen=True)
@@ -139,7 +192,8 @@ class Quit:
 
 
 Command = Union[TellRule, TellUse, TellFrozen, TellOperators, OpenBehavior, CloseBehavior, Eval,
-                Correct, Simulate, At, Adapt, Show, Undo, Save, Help, Quit]
+                Correct, Simulate, At, Adapt, Show, Undo, Save, Help, Quit, FreezeTerms,
+                ReleaseTerms, CorrectSaid, AtSaid, AtInstruction]
 
 
 class _ToCommand(_ToModel):
@@ -169,6 +223,37 @@ class _ToCommand(_ToModel):
 
     targets = inputs
 
+    @v_args(meta=True)
+    def said(self, meta, items):
+        out = []
+        for c in items:
+            out.append(Said(c.var, c.term, tuple(c.hedges), c.value, getattr(c, "span", None)
+                            or self._s(meta)))
+        return tuple(out)
+
+    def term_ref(self, items):
+        return (str(items[0]), str(items[1]))
+
+    @v_args(meta=True)
+    def freeze_terms(self, meta, items):
+        return FreezeTerms(tuple(items), self._s(meta))
+
+    @v_args(meta=True)
+    def release_terms(self, meta, items):
+        return ReleaseTerms(tuple(items), self._s(meta))
+
+    def correct_said(self, items):
+        return CorrectSaid(items[0], items[2])
+
+    def at_said(self, items):
+        start, stop, said = items
+        return AtSaid(start, stop, said)
+
+    @v_args(meta=True)
+    def at_instruction(self, meta, items):
+        start, stop, *words = items
+        return AtInstruction(start, stop, tuple(str(w) for w in words), self._s(meta))
+
     def eval_cmd(self, items):
         return Eval(tuple(items))
 
@@ -180,7 +265,7 @@ class _ToCommand(_ToModel):
         return json.loads(str(token)) if token.type == "STRING" else str(token)
 
     def simulate_cmd(self, items):
-        return Simulate(items[0], items[1])
+        return Simulate(items[0], items[1], None if items[2] is None else str(items[2]))
 
     def time(self, items):
         return float(items[0])
@@ -197,6 +282,9 @@ class _ToCommand(_ToModel):
 
     def plot(self, items):
         return ("plot", items[0])
+
+    def unconstrained(self, items):
+        return ("constrained", False)
 
     def adapt_cmd(self, items):
         return Adapt(**dict(items))

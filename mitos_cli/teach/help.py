@@ -14,7 +14,9 @@ Tell rules, correct outputs, let the robot adapt, save. Every change is journale
   eval road=78 size=45 position=4                the DOF trace of the active behavior
   correct road=78 size=45 position=4 -> steering=60 speed=20    an example of what you want
   simulate worlds/figure4.yaml [seed N]          drive the active behavior through a world
-  at 12.5s steering=55   |   at 11s to 13s steering=55    corrections during that drive
+  at 12.5s steering=55   |   at 11s to 13s steering is LM    corrections during that drive
+  at 13s to 14.5s make a wider turn              ... or in words (`help at` lists them)
+  frozen heading.AHEAD  |  unfrozen heading.AHEAD    keep a term as it is, or let it move
   adapt [epochs N] [rate ETA] [plot FILE]        learn from the examples (Q never increases)
   show rules|terms|examples|behaviors|history [plot FILE]
   undo        take back the last change
@@ -41,29 +43,40 @@ use NAME          make NAME the active behavior: `eval`, `correct`, `adapt`, `si
 Inside `behavior ... end`, `use B when C` blends B into the behavior being told.""",
     "frozen": """\
 frozen r4, r5     adaptation leaves the consequents of rules r4 and r5 of the open (or active)
-                  behavior alone. A term is frozen in the YAML term set with `frozen: true`.""",
+                  behavior alone. A term is frozen in the YAML term set with `frozen: true`.
+frozen heading.AHEAD      adaptation leaves this term as it is (for the session)
+unfrozen heading.AHEAD    lift a freeze, or the hold of a centre term at its point""",
     "eval": """\
 eval road=78 size=45 position=4
 The fuzzified inputs, the rules that fire with their DOFs, and the outputs, as `mitos eval`.""",
     "correct": """\
 correct road=78 size=45 position=4 -> steering=60 speed=20
-An example: for these inputs, these outputs. Outputs you leave out are not corrected.""",
+correct road=78 size=45 position=4 -> steering is very LM and speed is SLOW
+An example: for these inputs, these outputs (numbers, or terms with hedges: `very` half a
+term further from the centre, `extremely` a whole term, `somewhat` half a term toward it).
+Outputs you leave out are not corrected.""",
     "simulate": """\
-simulate WORLD [seed N]
+simulate WORLD [seed N] [robot NAME]
 Drive the active behavior through a world file (a path, or the name of a packaged world) and
-keep the recorded run, so that `at` can correct it.""",
+keep the recorded run, so that `at` can correct it (robot NAME's run; default the first).""",
     "at": """\
 at 12.5s steering=55          one example: what the robot perceived at 12.5 s, and the output
                               it should have chosen
-at 11s to 13s steering=55     one example per recorded tick from 11 s to 13 s""",
+at 11s to 13s steering=55     one example per recorded tick from 11 s to 13 s
+at 11s to 13s steering is LM  the same, in words
+at 13s to 14.5s make a wider turn    an instruction: what the robot did, transformed; one of
+    turn harder, turn less, make a wider turn, slow down, speed up,
+    keep further from the wall, keep right (docs/teach.md defines each)""",
     "adapt": """\
-adapt [epochs N] [rate ETA] [plot FILE]
+adapt [epochs N] [rate ETA] [plot FILE] [unconstrained]
 Gradient descent on Q = sum_k (y(x_k) - t_k)^2 over the examples (the paper's eqs. 13-14),
 moving the break points of the active behavior's input terms and its output values. ETA in
 (0, 1) is the learning factor (default 0.5), N the number of epochs (default 50). Peaks stay
 ordered, widths positive, shared break points tied; every step is halved until Q decreases.
-Frozen terms and the consequents of frozen rules keep their values. Afterwards the changed
-terms are listed before -> after; `plot FILE` draws them (.png or .svg).""",
+Frozen terms and the consequents of frozen rules keep their values; the terms keep their
+meaning (order, coverage >= 0.5, distinct, centre terms at their point) unless
+`unconstrained`. Afterwards the changed terms are listed before -> after and in words, with
+the interpretability checks; `plot FILE` draws them (.png or .svg).""",
     "show": """\
 show rules        the rules of the open (or active) behavior, new and changed ones marked
 show terms        the terms of its variables, with the values they had before
@@ -83,6 +96,7 @@ quit              leave the prompt (Ctrl-D too). Everything is in the journal un
                   .mitos/teach/; `mitos teach --resume` continues where you left off.""",
 }
 ALIASES = {"if": "rule", "rules": "rule", "end": "behavior", "exit": "quit", "terms": "show",
+           "unfrozen": "frozen", "instructions": "at",
            "examples": "show", "history": "show", "behaviors": "show"}
 
 

@@ -84,14 +84,14 @@ class Journal:
         return self.directory / JOURNAL
 
     @classmethod
-    def create(cls, directory: Path) -> "Journal":
+    def create(cls, directory: Path) -> Journal:
         directory.mkdir(parents=True, exist_ok=True)
         journal = cls(directory)
         journal.path.touch()
         return journal
 
     @classmethod
-    def open(cls, directory: Path) -> "Journal":
+    def open(cls, directory: Path) -> Journal:
         """Read an existing journal (a last line cut short by a kill is dropped)."""
         journal = cls(directory)
         raw = journal.path.read_bytes()

@@ -8,8 +8,8 @@ reproducible and testable (``mitos teach ... --lesson FILE`` exits 1).
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from pathlib import Path
-from typing import Iterator
 
 from ..errors import MitosError, Span
 from .commands import incomplete
@@ -56,11 +56,17 @@ def read_lesson(source: str) -> tuple[str, str]:
     import sys
 
     from ..errors import LessonError
+    from ..resources import resolve
 
     if source == "-":
         return sys.stdin.read(), "<stdin>"
+    path = Path(source)
+    if not path.exists():                  # a packaged lesson by name: `--lesson wider-turn`
+        found = resolve("rulebases/lessons", source, ".lesson")
+        if found is not None:
+            path, source = found, str(found)
     try:
-        return Path(source).read_text(encoding="utf-8"), source
+        return path.read_text(encoding="utf-8"), source
     except (OSError, UnicodeDecodeError) as exc:
         raise LessonError(f"cannot read lesson `{source}`: "
                           f"{getattr(exc, 'strerror', None) or exc}") from None

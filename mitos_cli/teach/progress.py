@@ -8,8 +8,7 @@ class EpochProgress:
 
     def __init__(self, epochs: int) -> None:
         from rich.console import Console
-        from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, \
-            TimeElapsedColumn
+        from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
         console = Console(stderr=True)
         self.progress = Progress(TextColumn("adapting"), BarColumn(), MofNCompleteColumn(),

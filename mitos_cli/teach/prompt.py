@@ -15,6 +15,7 @@ import sys
 from pathlib import Path
 
 from ..errors import LessonError, MitosError, Span
+from ..fuzzy.hedges import HEDGES
 from .commands import COMMAND_WORDS, SHOW_WHAT, incomplete
 from .session import Session
 
@@ -52,11 +53,11 @@ class Completer:
             return outputs if first == "at" or "->" in tokens else inputs + ["->"]
         # a rule: variables, then `is`, then that variable's terms and hedges
         prev = tokens[-1] if line.endswith(" ") else (tokens[-2] if len(tokens) > 1 else "")
-        if prev in ("is", "not", "very", "somewhat", "more_or_less", "extremely"):
+        if prev in ("is", "not", *HEDGES):
             back = tokens if line.endswith(" ") else tokens[:-1]
             var = next((t for t in reversed(back) if t in rb.variables), None)
             terms = list(rb.variables[var].term_names) if var else []
-            return terms + ["not", "very", "somewhat", "more_or_less", "extremely"]
+            return terms + ["not", *HEDGES]
         return list(rb.variables) + ["is", "and", "or", "not", "then", "with"]
 
     def complete(self, text: str, state: int):

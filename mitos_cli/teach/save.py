@@ -22,12 +22,12 @@ from pathlib import Path
 
 from lark import Token, Tree
 
-from ..lang import yamlpos
-from ..fileio import atomic_write
 from ..errors import LessonError, TermSetError
+from ..fileio import atomic_write
+from ..fuzzy.shapes import SHAPES
+from ..lang import yamlpos
 from ..lang.model import Behavior, RuleBase, format_number, format_rule, format_use
 from ..lang.parse import parser as rule_parser
-from ..fuzzy.shapes import SHAPES
 from ..lang.terms import Term
 from ..words import plural
 

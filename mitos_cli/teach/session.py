@@ -13,6 +13,8 @@ transition), so replaying the journal's entries rebuilds the state exactly: that
 ``operators``   an ``operators:`` line in the open (or active) behavior
 ``activate``    ``use NAME`` at the top: the behavior taught and evaluated from now on
 ``examples``    corrections (``correct``, or ``at`` on a simulation): inputs and targets
+``freeze``      ``frozen heading.AHEAD``: terms adaptation keeps as they are
+``release``     ``unfrozen heading.AHEAD``: a freeze or a hold at a point lifted
 ``adapt``       learned term parameters and crisp values (with Q before and after)
 ==============  ==========================================================================
 """
@@ -20,127 +22,23 @@ transition), so replaying the journal's entries rebuilds the state exactly: that
 from __future__ import annotations
 
 import dataclasses
-import hashlib
 import re
-from dataclasses import dataclass, field
+from collections.abc import Callable
 from pathlib import Path
-from typing import Callable
 
 import numpy as np
 
-from ..lang.resolve import check_expr, check_rule, load_rules_file
 from ..engine.compile import CompiledRuleBase, compile_rulebase
 from ..errors import LessonError, MitosError, RuleBaseError, unknown
-from ..lang.model import And, Behavior, Expr, Not, Prop, Rule, RuleBase, format_expr, \
-    format_number, format_rule, format_use
+from ..lang.model import And, Behavior, Expr, Not, Prop, Rule, RuleBase, format_expr, format_rule, format_use
 from ..lang.operators import resolve
-from ..lang.parse import parse_rule
+from ..lang.resolve import check_expr, check_rule, load_rules_file
 from ..words import plural
 from . import commands as cmd
+from . import text
 from .journal import Journal, MemoryJournal
+from .state import State, apply, files_digest, learned_changes, variables
 
-
-@dataclass(frozen=True)
-class Example:
-    """One correction: input values by name and the outputs the instructor wanted."""
-
-    inputs: dict
-    targets: dict
-    source: str = ""
-    behavior: str = ""           # the behavior whose outputs the targets correct
-
-
-@dataclass
-class State:
-    """What a replay of the journal rebuilds."""
-
-    rulebase: RuleBase
-    active: str
-    block: str | None = None
-    examples: list[Example] = field(default_factory=list)
-
-
-# ---- pure state transitions ----------------------------------------------------------------
-
-def _replace_behavior(rb: RuleBase, b: Behavior) -> RuleBase:
-    behaviors = tuple(b if x.name == b.name else x for x in rb.behaviors)
-    if b.name not in [x.name for x in rb.behaviors]:
-        behaviors += (b,)
-    return dataclasses.replace(rb, behaviors=behaviors)
-
-
-def _put_rule(b: Behavior, rule: Rule) -> Behavior:
-    rules = list(b.rules)
-    for i, r in enumerate(rules):
-        if rule.label and r.label == rule.label:
-            rules[i] = rule
-            break
-    else:
-        rules.append(rule)
-    return dataclasses.replace(b, rules=tuple(rules))
-
-
-def _set_params(rb: RuleBase, terms: dict) -> RuleBase:
-    termsets = tuple(dataclasses.replace(ts, variables=tuple(
-        v.with_terms(tuple(t.with_params(tuple(terms[v.name][t.name]))
-                           if t.name in terms.get(v.name, {}) else t for t in v.terms))
-        for v in ts.variables)) for ts in rb.termsets)
-    return dataclasses.replace(rb, termsets=termsets)
-
-
-def _set_crisp(rb: RuleBase, crisp: list) -> RuleBase:
-    for owner, index, var, value in crisp:
-        b = rb.behavior(owner)
-        rule = b.rules[index]
-        cons = tuple(dataclasses.replace(c, value=float(value)) if c.var == var and c.term is None
-                     else c for c in rule.consequents)
-        rules = list(b.rules)
-        rules[index] = dataclasses.replace(rule, consequents=cons)
-        rb = _replace_behavior(rb, dataclasses.replace(b, rules=tuple(rules)))
-    return rb
-
-
-def apply(state: State, entry: dict) -> None:
-    """Apply one journal entry to ``state`` (no checks: entries were checked when told)."""
-    op = entry["op"]
-    rb = state.rulebase
-    if op == "rule":
-        rule = parse_rule(entry["text"])
-        state.rulebase = _replace_behavior(rb, _put_rule(rb.behavior(entry["behavior"]), rule))
-    elif op == "behavior":
-        state.rulebase = _replace_behavior(rb, Behavior(entry["name"]))
-        state.block = entry["name"]
-    elif op == "end":
-        state.block = None
-        if entry.get("activate"):
-            state.active = entry["activate"]
-    elif op == "use":
-        b = rb.behavior(entry["behavior"])
-        use = cmd.parse_command(entry["text"]).use
-        state.rulebase = _replace_behavior(rb, dataclasses.replace(b, uses=b.uses + (use,)))
-    elif op == "frozen":
-        b = rb.behavior(entry["behavior"])
-        labels = b.frozen + tuple(x for x in entry["labels"] if x not in b.frozen)
-        state.rulebase = _replace_behavior(rb, dataclasses.replace(b, frozen=labels))
-    elif op == "operators":
-        b = rb.behavior(entry["behavior"])
-        settings = cmd.parse_command(entry["text"]).settings
-        state.rulebase = _replace_behavior(rb, dataclasses.replace(
-            b, operators=b.operators + settings))
-    elif op == "activate":
-        state.active = entry["behavior"]
-    elif op == "examples":
-        state.examples += [Example(e["inputs"], e["targets"], e.get("source", ""),
-                                   entry.get("behavior", ""))
-                           for e in entry["examples"]]
-    elif op == "adapt":
-        rb = _set_params(rb, entry["terms"])
-        state.rulebase = _set_crisp(rb, entry.get("crisp", []))
-    else:                                        # pragma: no cover - journal from the future
-        raise LessonError(f"the journal holds an unknown change `{op}`")
-
-
-# ---- the session ----------------------------------------------------------------------------
 
 def _canonical(expr: Expr) -> str:
     """An antecedent written so that reordered ``and`` / ``or`` items compare equal."""
@@ -155,15 +53,6 @@ def _canonical(expr: Expr) -> str:
 def _consequents(rule: Rule) -> dict:
     return {c.var: (c.term, c.value, c.hedges) for c in rule.consequents}
 
-
-def files_digest(rb: RuleBase) -> str:
-    h = hashlib.sha256()
-    for path in [rb.path] + [str(Path(rb.path).parent / p) for p in rb.termset_paths]:
-        try:
-            h.update(Path(path).read_bytes())
-        except OSError:
-            pass
-    return h.hexdigest()[:16]
 
 
 class Session:
@@ -195,7 +84,7 @@ class Session:
     # -- resume ------------------------------------------------------------------------------
     @classmethod
     def resume(cls, journal: Journal, out: Callable[[str], None] | None = None,
-               progress: Callable | None = None) -> "Session":
+               progress: Callable | None = None) -> Session:
         start = journal.entries[0] if journal.entries else None
         if start is None or start.get("op") != "start":
             raise LessonError(f"{journal.path}: not a teaching journal (no start entry)")
@@ -205,8 +94,10 @@ class Session:
             session.out(f"warning: {start['rules']} or its term set changed since the session "
                         f"started; the journal's changes are applied to the files as they are now")
         session.replay()
-        saves = [e["seq"] for e in journal.entries if e["op"] == "save"]
-        session.saved_seq = saves[-1] if saves else 0
+        saves = [e for e in journal.entries if e["op"] == "save"]
+        session.saved_seq = saves[-1]["seq"] if saves else 0
+        if saves:                                   # a bare `save` goes where the last went
+            session.save_as = Path(saves[-1]["path"])
         return session
 
     def replay(self) -> None:
@@ -273,7 +164,7 @@ class Session:
             if other.label != rule.label and _canonical(other.antecedent) == key:
                 if _consequents(other) != _consequents(rule):
                     self.out(f"  conflict: {other.label} has the same condition but says "
-                             f"{', '.join(_say(x) for x in other.consequents)}")
+                             f"{', '.join(text.say(x) for x in other.consequents)}")
                 else:
                     self.out(f"  note: {other.label} says the same")
 
@@ -339,6 +230,26 @@ class Session:
         self.change("frozen", line, behavior=b.name, labels=list(c.labels))
         self.out(f"{b.name}: adaptation leaves the consequents of {', '.join(c.labels)} alone")
 
+    def _term_refs(self, refs) -> list[list[str]]:
+        variables = self.rulebase.variables
+        for var, term in refs:
+            if var not in variables:
+                raise unknown("variable", var, list(variables), cls=LessonError)
+            variables[var].term(term)                    # unknown term: did you mean
+        return [list(r) for r in refs]
+
+    def _freezeterms(self, c: cmd.FreezeTerms, line: str) -> None:
+        terms = self._term_refs(c.terms)
+        self.change("freeze", line, terms=terms)
+        self.out("adaptation keeps " + ", ".join(f"{v}.{t}" for v, t in terms)
+                 + " as it is (`unfrozen` lets it move)")
+
+    def _releaseterms(self, c: cmd.ReleaseTerms, line: str) -> None:
+        terms = self._term_refs(c.terms)
+        self.change("release", line, terms=terms)
+        self.out("adaptation may move " + ", ".join(f"{v}.{t}" for v, t in terms)
+                 + " (no freeze, no hold at a point of symmetry)")
+
     def _telloperators(self, c: cmd.TellOperators, line: str) -> None:
         b = self.rulebase.behavior(self.focus)
         resolve(c.settings, resolve(b.operators, resolve(self.rulebase.operators)))
@@ -387,7 +298,66 @@ class Session:
         now = self._outputs(compiled, [inputs])[0]
         self.change("examples", line, behavior=compiled.behavior,
                     examples=[{"inputs": inputs, "targets": targets, "source": "correct"}])
-        self.out(f"example {len(self.state.examples)}: " + _example_text(inputs, targets, now))
+        self.out(f"example {len(self.state.examples)}: " + text.example_text(inputs, targets, now))
+
+    def _said(self, said, compiled: CompiledRuleBase) -> tuple[cmd.Assign, ...]:
+        """``steering is very LM`` -> ``steering=40`` (the hedged term's value)."""
+        from .instructions import hedged
+
+        out = []
+        for t in said:
+            if t.name not in compiled.outputs:
+                raise unknown("output variable", t.name, compiled.outputs, span=t.span,
+                              cls=LessonError)
+            if t.term is None:
+                out.append(cmd.Assign(t.name, t.value, t.span))
+                continue
+            var = compiled.variables[t.name]
+            var.term(t.term, t.span)
+            out.append(cmd.Assign(t.name, hedged(var, t.term, t.hedges), t.span))
+        return tuple(out)
+
+    def _correctsaid(self, c: cmd.CorrectSaid, line: str) -> None:
+        compiled = self.compiled()
+        self._correct(cmd.Correct(c.inputs, self._said(c.targets, compiled)), line)
+
+    def _atsaid(self, c: cmd.AtSaid, line: str) -> None:
+        compiled = self.compiled()
+        self._at(cmd.At(c.start, c.stop, self._said(c.targets, compiled)), line)
+
+    def _atinstruction(self, c: cmd.AtInstruction, line: str) -> None:
+        from .instructions import Window, instruction, targets
+
+        try:
+            ins = instruction(c.words)
+        except LessonError as exc:
+            exc.span = c.span
+            raise
+        rec = self._recording()
+        compiled = self.compiled()
+        rows = rec.rows(c.start, c.stop)
+        inputs = [rec.inputs_at(i, compiled.inputs) for i in rows]
+        now = self._outputs(compiled, inputs)
+        window = Window({o: np.array([y[o] for y in now]) for o in compiled.outputs},
+                        {k: np.array([x[k] for x in inputs]) for k in compiled.inputs},
+                        compiled.variables)
+        wanted = targets(ins, window)
+        keep = np.flatnonzero(np.isfinite(wanted))
+        if keep.size == 0:
+            raise LessonError(f"`{ins.words}`: the robot went straight {rec.when(rows)}, so "
+                              "there is no turn to change", hint="name the window of a turn")
+        first = keep[0]
+        did = float(window.outputs[ins.output][first])
+        self.out(f"{ins.words}: {ins.meaning} ({ins.output} {text.num(did)} -> "
+                 f"{text.num(float(wanted[first]))} at {rec.time(rows[first]):g} s)")
+        self._add_window(compiled, rec, rows[keep], [inputs[i] for i in keep],
+                         [{ins.output: float(wanted[i])} for i in keep], line)
+
+    def _recording(self):
+        if self.simulation is None:
+            raise LessonError("no simulation to correct yet",
+                              hint="run `simulate WORLD` first, then `at 12.5s steering=55`")
+        return self.simulation
 
     def _outputs(self, compiled: CompiledRuleBase, inputs: list[dict]) -> list[dict]:
         from ..engine.evaluation import evaluate
@@ -401,28 +371,31 @@ class Session:
 
         seed = _whole(c.seed, "seed", 0) if c.seed is not None else None
         self.compiled()
-        self.simulation = run_world(c.world, self.rulebase, self.state.active, seed, self.base)
+        self.simulation = run_world(c.world, self.rulebase, self.state.active, seed, self.base,
+                                    c.robot)
         self.out(self.simulation.describe())
 
     def _at(self, c: cmd.At, line: str) -> None:
-        if self.simulation is None:
-            raise LessonError("no simulation to correct yet",
-                              hint="run `simulate WORLD` first, then `at 12.5s steering=55`")
+        rec = self._recording()
         compiled = self.compiled()
-        rows = self.simulation.rows(c.start, c.stop)
+        rows = rec.rows(c.start, c.stop)
         targets = self._values(c.targets, compiled.outputs, "output", compiled, False)
-        inputs = [self.simulation.inputs_at(i, compiled.inputs) for i in rows]
+        inputs = [rec.inputs_at(i, compiled.inputs) for i in rows]
+        self._add_window(compiled, rec, rows, inputs, [targets] * len(rows), line)
+
+    def _add_window(self, compiled: CompiledRuleBase, rec, rows, inputs: list[dict],
+                    targets: list[dict], line: str) -> None:
+        """Examples from ticks ``rows`` of the recorded run, journaled and shown."""
         now = self._outputs(compiled, inputs)
-        when = self.simulation.when(rows)
-        examples = [{"inputs": x, "targets": targets, "source": f"{self.simulation.name} "
-                     f"t={self.simulation.time(i):g}s"} for x, i in zip(inputs, rows)]
+        examples = [{"inputs": x, "targets": t, "source": f"{rec.name} t={rec.time(i):g}s"}
+                    for x, t, i in zip(inputs, targets, rows)]
         self.change("examples", line, behavior=compiled.behavior, examples=examples)
         first = len(self.state.examples) - len(examples) + 1
         self.out(f"{plural(len(examples), 'example')} from "
-                 f"{self.simulation.name} {when} (#{first}"
+                 f"{rec.name} {rec.when(rows)} (#{first}"
                  + (f"-{len(self.state.examples)}" if len(examples) > 1 else "") + "):")
-        for x, y in list(zip(inputs, now))[:5]:
-            self.out("  " + _example_text(x, targets, y))
+        for x, t, y in list(zip(inputs, targets, now))[:5]:
+            self.out("  " + text.example_text(x, t, y))
         if len(examples) > 5:
             self.out(f"  ... ({len(examples) - 5} more: `show examples`)")
 
@@ -443,13 +416,40 @@ class Session:
         return X, T
 
     def _adapt(self, c: cmd.Adapt, line: str) -> None:
-        from .adapt import adapt, learned_rulebase, parameterise
+        from .adapt import learned_rulebase
+        from .learned import in_words
 
-        epochs = _whole(c.epochs, "epochs", 1) if c.epochs is not None else 50
-        rate = 0.5 if c.rate is None else c.rate
         compiled = self.compiled()
         X, T = self.training_set(compiled)
-        params = parameterise(compiled)
+        epochs = _whole(c.epochs, "epochs", 1) if c.epochs is not None else 50
+        rate = 0.5 if c.rate is None else c.rate
+        result = self._learn(c, compiled, X, T, epochs, rate)
+        before = self.rulebase
+        terms, crisp = learned_changes(before, learned_rulebase(result.parameters,
+                                                                result.values))
+        history = [float(q) for q in result.history]
+        self.out(text.q_lines(history, len(X), result))
+        if not terms and not crisp:
+            self.out("nothing changed: Q cannot go lower from here with these examples")
+            return
+        self.change("adapt", line, behavior=compiled.behavior, terms=terms, crisp=crisp,
+                    q=[history[0], history[-1]], epochs=epochs, rate=rate)
+        self.out(text.changed_table(before, self.rulebase, crisp))
+        if result.parameters.frozen_reasons:
+            self.out("not adapted: " + "; ".join(result.parameters.frozen_reasons))
+        self.out(in_words(before, self.rulebase, result.parameters))
+        self.out(text.interpretability_text(self.rulebase))
+        if c.plot is not None:
+            self._plot_terms(before, self.rulebase, c.plot)
+
+    def _learn(self, c: cmd.Adapt, compiled: CompiledRuleBase, X: np.ndarray, T: np.ndarray,
+               epochs: int, rate: float):
+        """The descent itself, with the session's frozen and released terms and a progress
+        bar."""
+        from .adapt import adapt, parameterise
+
+        params = parameterise(compiled, constrained=c.constrained,
+                              frozen_terms=self.state.frozen_terms, released=self.state.released)
         if params.n_free == 0:
             raise LessonError(f"nothing in behavior `{compiled.behavior}` may be adapted",
                               hint="every term and consequent it uses is frozen")
@@ -459,43 +459,18 @@ class Session:
             check_format(c.plot)
         progress = self.progress(epochs) if self.progress else None
         try:
-            result = adapt(compiled, X, T, epochs=epochs, rate=rate, parameters=params,
-                           on_epoch=(progress.update if progress else None))
+            return adapt(compiled, X, T, epochs=epochs, rate=rate, parameters=params,
+                         on_epoch=(progress.update if progress else None))
         finally:
             if progress:
                 progress.close()
-        before_rb = self.rulebase
-        after = learned_rulebase(result.parameters, result.values)
-        terms = {}
-        for v_old, v_new in zip(_variables(before_rb), _variables(after)):
-            for t_old, t_new in zip(v_old.terms, v_new.terms):
-                if t_old.params != t_new.params:
-                    terms.setdefault(v_new.name, {})[t_new.name] = list(t_new.params)
-        crisp = []
-        for b_old, b_new in zip(before_rb.behaviors, after.behaviors):
-            for i, (r_old, r_new) in enumerate(zip(b_old.rules, b_new.rules)):
-                for c_old, c_new in zip(r_old.consequents, r_new.consequents):
-                    if c_old.value != c_new.value:
-                        crisp.append([b_new.name, i, c_new.var, c_new.value])
-        history = [float(q) for q in result.history]
-        self.out(_q_lines(history, len(X), result))
-        if not terms and not crisp:
-            self.out("nothing changed: Q cannot go lower from here with these examples")
-            return
-        self.change("adapt", line, behavior=compiled.behavior, terms=terms, crisp=crisp,
-                    q=[history[0], history[-1]], epochs=epochs, rate=rate)
-        self.out(changed_table(before_rb, self.rulebase, crisp))
-        if result.parameters.frozen_reasons:
-            self.out("not adapted: " + "; ".join(result.parameters.frozen_reasons))
-        if c.plot is not None:
-            self._plot_terms(before_rb, self.rulebase, c.plot)
 
     def _plot_terms(self, before: RuleBase, after: RuleBase, path: str) -> None:
         try:
             from ..draw.terms import draw_terms_before_after
         except ImportError:                          # pragma: no cover - optional module
             raise LessonError("plots need the drawing module (mitos_cli.draw)") from None
-        changed = [(a, b) for a, b in zip(_variables(before), _variables(after))
+        changed = [(a, b) for a, b in zip(variables(before), variables(after))
                    if a.terms != b.terms]
         if not changed:
             raise LessonError("no term has changed yet, so there is nothing to compare",
@@ -515,7 +490,7 @@ class Session:
         if c.what == "rules":
             self.out(self.describe_rules())
         elif c.what == "terms":
-            self.out(terms_table(self.original, self.rulebase, self._shown_variables()))
+            self.out(text.terms_table(self.original, self.rulebase, self._shownvariables()))
             if c.plot is not None:
                 self._plot_terms(self.original, self.rulebase, c.plot)
         elif c.what == "examples":
@@ -525,7 +500,7 @@ class Session:
         else:
             self.out(self.describe_history())
 
-    def _shown_variables(self) -> list[str]:
+    def _shownvariables(self) -> list[str]:
         try:
             c = self.compiled()
             return list(c.inputs) + list(c.outputs)
@@ -558,11 +533,16 @@ class Session:
         saved = save_rulebase(self.original, self.rulebase, target)
         entry = self.journal.append("save", path=str(target), line=line)
         self.saved_seq = entry["seq"]
+        self.save_as = target                      # a later bare `save` goes here too
         files = ", ".join(str(p) for p in (saved.rules,) + saved.termsets)
         self.out(f"saved {files}" + (f" ({plural(len(saved.changes), 'change')})" if saved.changes
                                      else " (no changes)"))
         for change in saved.changes:
             self.out(f"  {change}")
+        self.out(self.interpretability())
+
+    def interpretability(self) -> str:
+        return text.interpretability_text(self.rulebase)
 
     def _help(self, c: cmd.Help, line: str) -> None:
         from .help import help_text
@@ -574,21 +554,8 @@ class Session:
 
     # -- descriptions ------------------------------------------------------------------------
     def describe_rules(self) -> str:
-        b = self.rulebase.behavior(self.focus)
-        old = {}
-        try:
-            old = {r.label: r for r in self.original.behavior(b.name).rules}
-        except MitosError:
-            pass
-        lines = [f"behavior {b.name} ({plural(len(b.rules), 'rule')})"
-                 + ("  [open]" if self.state.block == b.name else "")]
-        for r in b.rules:
-            mark = "" if old.get(r.label) == r else ("  (new)" if r.label not in old
-                                                        else "  (changed)")
-            frozen = "  [frozen]" if r.label in b.frozen else ""
-            lines.append(f"  {format_rule(r)}{frozen}{mark}")
-        lines += [f"  {format_use(u)}" for u in b.uses]
-        return "\n".join(lines)
+        return text.rules_text(self.rulebase.behavior(self.focus), self.original,
+                               self.state.block)
 
     def describe_examples(self) -> str:
         if not self.state.examples:
@@ -602,41 +569,18 @@ class Session:
             now = {}
         for i, e in enumerate(self.state.examples, 1):
             where = ", ".join(x for x in (e.behavior, e.source) if x)
-            lines.append(f"{i:>3}  {_example_text(e.inputs, e.targets, now.get(id(e)))}"
+            lines.append(f"{i:>3}  {text.example_text(e.inputs, e.targets, now.get(id(e)))}"
                          + (f"   [{where}]" if where else ""))
         return "\n".join(lines)
 
     def describe_behaviors(self) -> str:
-        lines = []
-        for b in self.rulebase.behaviors:
-            mark = "*" if b.name == self.state.active else " "
-            extra = f", uses {', '.join(u.behavior for u in b.uses)}" if b.uses else ""
-            lines.append(f"{mark} {b.name} ({plural(len(b.rules), 'rule')}{extra})"
-                         + ("  [open]" if b.name == self.state.block else ""))
-        return "\n".join(lines) + "\n(* active: `use NAME` recalls another)"
+        return text.behaviors_text(self.rulebase, self.state.active, self.state.block)
 
     def describe_history(self) -> str:
-        undone = {e["of"] for e in self.journal.entries if e["op"] == "undo"}
-        lines = []
-        for e in self.journal.entries:
-            if e["op"] == "start":
-                lines.append(f"{e['seq']:>4}  started on {e['rules']} ({e['behavior']})")
-                continue
-            text = e.get("line") or e["op"]
-            if e["op"] == "adapt":
-                text += f"   (Q {e['q'][0]:.4g} -> {e['q'][1]:.4g})"
-            if e["op"] == "save":
-                text = f"save {e['path']}"
-            mark = "  (undone)" if e["seq"] in undone else ""
-            lines.append(f"{e['seq']:>4}  {text}{mark}")
-        return "\n".join(lines)
+        return text.history_text(self.journal.entries)
 
 
 # ---- small helpers ---------------------------------------------------------------------------
-
-def _variables(rb: RuleBase):
-    return [v for ts in rb.termsets for v in ts.variables]
-
 
 def _reaches(rb: RuleBase, start: str, target: str) -> bool:
     seen, stack = set(), [start]
@@ -660,83 +604,9 @@ def _next_label(b: Behavior) -> str:
     return f"r{n}"
 
 
-def _say(c) -> str:
-    if c.term is None:
-        return f"{c.var} is {format_number(c.value)}"
-    return f"{c.var} is {' '.join(c.hedges + (c.term,))}"
-
 
 def _whole(value: float, what: str, least: int) -> int:
     if value != int(value) or value < least:
         raise LessonError(f"{what} must be a whole number of at least {least}, not {value:g}")
     return int(value)
 
-
-def _num(x: float) -> str:
-    return f"{x:.4g}" if abs(x) < 1e4 else f"{x:.6g}"
-
-
-def _example_text(inputs: dict, targets: dict, now: dict | None) -> str:
-    text = " ".join(f"{k}={_num(v)}" for k, v in inputs.items()) + " -> " + \
-        " ".join(f"{k}={_num(v)}" for k, v in targets.items())
-    if now:
-        text += "   (now " + " ".join(f"{k}={_num(now[k])}" for k in targets if k in now) + ")"
-    return text
-
-
-def _q_lines(history: list[float], n: int, result) -> str:
-    rounding = history[-1] if result.rounded else None
-    if result.rounded:
-        history = history[:-1]
-    epochs = len(history) - 1
-    lines = [f"Q = sum (y - t)^2 over {plural(n, 'example')}:"]
-    shown = list(range(len(history)))
-    if len(shown) > 22:
-        step = max(1, len(shown) // 20)
-        shown = sorted(set(shown[::step]) | {len(shown) - 1})
-    for i in shown:
-        lines.append(f"  epoch {i:>4}: Q = {history[i]:.6g}")
-    if rounding is not None:
-        lines.append(f"  rounded  : Q = {rounding:.6g}   (learned values to a readable grid)")
-        history = history + [rounding]
-    note = "converged" if result.converged else ("interrupted" if result.interrupted
-                                                 else plural(epochs, 'epoch'))
-    lines.append(f"Q {history[0]:.6g} -> {history[-1]:.6g} ({note}; RMS error "
-                 f"{(history[-1] / max(n, 1)) ** 0.5:.3g})")
-    return "\n".join(lines)
-
-
-def _params_text(t) -> str:
-    return t.params_text(format_number)
-
-
-def changed_table(before: RuleBase, after: RuleBase, crisp: list) -> str:
-    lines = ["changed (before -> after):"]
-    for v_old, v_new in zip(_variables(before), _variables(after)):
-        for t_old, t_new in zip(v_old.terms, v_new.terms):
-            if t_old.params != t_new.params:
-                lines.append(f"  {v_new.name}.{t_new.name}: {_params_text(t_old)}  ->  "
-                             f"{_params_text(t_new)}")
-    for owner, index, var, value in crisp:
-        rule = before.behavior(owner).rules[index]
-        old = next(c.value for c in rule.consequents if c.var == var)
-        lines.append(f"  {owner}/{rule.label}: {var} is {format_number(old)}  ->  "
-                     f"{format_number(value)}")
-    return "\n".join(lines)
-
-
-def terms_table(original: RuleBase, current: RuleBase, names: list[str]) -> str:
-    old = {v.name: v for v in _variables(original)}
-    lines = []
-    for v in _variables(current):
-        if v.name not in names:
-            continue
-        lo, hi = v.universe
-        lines.append(f"{v.name} ({v.role}, [{format_number(lo)}, {format_number(hi)}]"
-                     + (f" {v.unit}" if v.unit else "") + ")")
-        for t in v.terms:
-            o = old[v.name].term(t.name) if v.name in old else None
-            was = f"   (was {_params_text(o)})" if o is not None and o.params != t.params else ""
-            frozen = "  [frozen]" if t.frozen else ""
-            lines.append(f"  {t.name:<10} {t.shape_name:<14} {_params_text(t)}{frozen}{was}")
-    return "\n".join(lines)

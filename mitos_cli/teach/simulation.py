@@ -18,21 +18,12 @@ from ..words import plural
 
 
 def world_path(name: str, base: Path | None = None) -> Path:
-    """A world file by path (relative to ``base``, then the working directory), or a packaged
-    world by name (``figure4`` or ``figure4.yaml``)."""
-    from ..resources import data_dir, packaged_path
+    """A world by path (relative to ``base``, then the working directory) or a packaged world
+    by name: the simulator's one resolver,
+    :func:`mitos_cli.sim.worldfile.resolve_world_path`."""
+    from ..sim.worldfile import resolve_world_path
 
-    for candidate in ([base / name] if base else []) + [Path(name)]:
-        if candidate.is_file():
-            return candidate
-    packaged = sorted(e.name for e in data_dir("worlds").iterdir() if e.name.endswith(".yaml"))
-    stem = Path(name).name
-    for file in (stem, stem + ".yaml"):
-        if file in packaged:
-            return packaged_path("worlds", file)
-    from ..errors import unknown
-
-    raise unknown("world", name, [p[:-5] for p in packaged])
+    return resolve_world_path(name, base)
 
 
 @dataclass
@@ -42,6 +33,8 @@ class Recording:
     name: str
     behavior: str
     result: object                     # mitos_cli.sim.SimResult
+    robot: int = 0                     # the column of the robot whose run is corrected
+    robot_name: str = ""
 
     @property
     def t(self) -> np.ndarray:
@@ -52,7 +45,8 @@ class Recording:
 
     def describe(self) -> str:
         s = self.result.summary()
-        return (f"{self.name} with behavior {self.behavior}: {s['outcome']} after "
+        who = f" (robot {self.robot_name})" if self.robot_name else ""
+        return (f"{self.name}{who} with behavior {self.behavior}: {s['outcome']} after "
                 f"{s['time_s']:g} s (min clearance {s['min_clearance_in']:.1f} in, "
                 f"{plural(s['collisions'], 'collision')}); "
                 f"correct it with `at TIME OUTPUT=VALUE` (0 to {self.time(-1):g} s)")
@@ -64,7 +58,7 @@ class Recording:
         for value in (start, stop):
             if value is not None and not -1e-9 <= value <= end + 1e-9:
                 raise LessonError(f"the run lasted 0 to {end:g} s; {value:g} s is outside it")
-        active = self.result.active[:, 0] if self.result.active is not None else \
+        active = self.result.active[:, self.robot] if self.result.active is not None else \
             np.ones(len(t), dtype=bool)
         if stop is None:
             return np.array([int(np.argmin(np.abs(t - start)))])
@@ -86,17 +80,25 @@ class Recording:
             raise LessonError("the simulator does not perceive " + ", ".join(
                 f"`{m}`" for m in missing), hint="correct a behavior whose inputs the "
                                                  "simulator measures (e.g. drive)")
-        return {n: float(self.result.perceived[n][row, 0]) for n in names}
+        return {n: float(self.result.perceived[n][row, self.robot]) for n in names}
 
 
 def run_world(name: str, rulebase: RuleBase, behavior: str, seed: int | None = None,
-              base: Path | None = None) -> Recording:
-    """Drive ``behavior`` of ``rulebase`` through the world ``name``."""
-    from ..sim.planner import FuzzyPlanner
+              base: Path | None = None, robot: str | None = None) -> Recording:
+    """Drive ``behavior`` of ``rulebase`` through the world ``name``; ``at`` then corrects
+    ``robot`` (a name of the world's robots; default the first)."""
     from ..sim.loop import simulate
+    from ..sim.planner import FuzzyPlanner
     from ..sim.worldfile import load_world
 
     path = world_path(name, base)
     world = load_world(path)
+    names = [a.name for a in world.agents]
+    if robot is not None and robot not in names:
+        from ..errors import unknown
+
+        raise unknown(f"robot of {Path(name).name}", robot, names, cls=LessonError)
+    index = names.index(robot) if robot is not None else 0
     result = simulate(world, FuzzyPlanner(rulebase, behavior), seed=seed)
-    return Recording(Path(name).stem, behavior, result)
+    return Recording(Path(name).stem, behavior, result, index,
+                     names[index] if len(names) > 1 else "")

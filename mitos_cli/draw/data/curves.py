@@ -137,7 +137,7 @@ def variable_plot(variable: Variable, value: float | None = None, *,
         mus = tuple((t.name, float(t.membership(value))) for t in variable.terms
                     if t.shape not in ("linear", "singleton"))
     return VariablePlot(variable.name, variable.role, variable.unit, variable.description,
-                        tuple(variable.universe), curves, value, mus, clamped)
+                        (variable.universe[0], variable.universe[1]), curves, value, mus, clamped)
 
 
 def sheet(rulebase: RuleBase, names: list[str] | None = None,

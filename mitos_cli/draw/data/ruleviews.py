@@ -159,6 +159,7 @@ def rule_view(compiled: CompiledRuleBase, values: dict[str, float]) -> RuleView:
     if X.shape[0] != 1:
         raise InputError("the rule viewer takes one value per input")
     res = evaluate(compiled, X, detail=True, keep_values=True, strict=False)
+    assert res.values is not None and res.memberships is not None and res.dof is not None
     antecedent = res.values[0][compiled.rule_col]
     mu = res.memberships[0]
     dof = res.dof[0]
@@ -204,7 +205,7 @@ def rule_view(compiled: CompiledRuleBase, values: dict[str, float]) -> RuleView:
         value = float(res.outputs[0, j])
         stems: tuple[tuple[float, float], ...] = ()
         grid = agg = None
-        if mamdani:
+        if sets is not None:
             _, grid, agg = sets[j]
         else:
             summed: dict[float, float] = {}

@@ -1,0 +1,137 @@
+"""What the C and Python writers share: a compiled behavior as a straight-line program.
+
+One membership per input term, one expression per rule (the AND / OR / NOT / hedge neurons
+written out as calls of ``tnorm``, ``snorm`` and ``hedge_*``), then the output layer's
+weighted sums. Names from the rule base reach the generated code only as identifiers made
+here of ``[A-Za-z0-9_]`` (unique within their kind, so two names that sanitise alike cannot
+share a variable) or, through the writers, as escaped text: a file never adds code.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+
+import numpy as np
+
+from ...engine.compile import CompiledRuleBase
+from ...fuzzy.shapes import kernel_params
+from ...lang.model import And, Expr, Not, Prop, flatten
+
+#: Text that may stand as it is in a C comment or a Python docstring.
+PLAIN = re.compile(r"[A-Za-z0-9_ .,:;+=@%()\[\]<>~^!#&|{}-]*")
+
+
+def num(value: float) -> str:
+    """A float literal valid in C and Python that reads back to the same double."""
+    value = float(value)
+    if np.isnan(value) or np.isinf(value):
+        raise ValueError(value)
+    text = repr(value)
+    return text if ("." in text or "e" in text or "n" in text) else text + ".0"
+
+
+def ident(name: str) -> str:
+    """``name`` as a C / Python identifier fragment: ``[A-Za-z0-9_]``, not starting with a
+    digit."""
+    out = re.sub(r"[^A-Za-z0-9_]", "_", name)
+    return out if out and not out[0].isdigit() else "_" + out
+
+
+def unique_idents(names, fold=str) -> list[str]:
+    """:func:`ident` of each name, ``_2``, ``_3`` ... appended where two would coincide
+    (after ``fold``: ``str.upper`` for C macros)."""
+    seen: set[str] = set()
+    out = []
+    for name in names:
+        base = candidate = ident(name)
+        n = 1
+        while fold(candidate) in seen:
+            n += 1
+            candidate = f"{base}_{n}"
+        seen.add(fold(candidate))
+        out.append(candidate)
+    return out
+
+
+@dataclass(frozen=True)
+class Program:
+    """The straight-line form of a compiled behavior, shared by the C and Python writers."""
+
+    compiled: CompiledRuleBase
+    terms: tuple            # (var index, column name, shape, params, kernel or None)
+    rules: tuple            # (column name, expression text, weight)
+    shapes: tuple           # non-linear shapes used
+    hedges: tuple           # hedges used
+    norms: tuple            # "tnorm" / "snorm" where some rule uses them, "kernel"
+
+
+def term_columns(compiled: CompiledRuleBase) -> dict[tuple[str, str], str]:
+    """``mu_<variable>_<term>`` for every input term, unique however the names sanitise."""
+    wanted = [f"{ident(var)}_{ident(term)}" for var, term in compiled.term_names]
+    return {key: f"mu_{col}" for key, col in zip(compiled.term_names, unique_idents(wanted))}
+
+
+def program(compiled: CompiledRuleBase) -> Program:
+    """Build the straight-line program of ``compiled``."""
+    names = term_columns(compiled)
+    hedges: set[str] = set()
+    used: set[str] = set()
+    referenced: set[str] = set()
+
+    def expr(e: Expr, negate: bool = False) -> str:
+        """C / Python text of ``e``, or of ``not e``; ``not not x`` is ``x`` exactly, as the
+        compiler has it (``1 - (1 - x)`` would round a tiny membership to 0)."""
+        if isinstance(e, Prop):
+            text = names[(e.var, e.term)]
+            referenced.add(text)
+            for h in reversed(e.hedges):
+                hedges.add(h)
+                text = f"hedge_{h}({text})"
+            return f"(1.0 - {text})" if e.negated != negate else text
+        if isinstance(e, Not):
+            return expr(e.expr, not negate)
+        fn = "tnorm" if isinstance(e, And) else "snorm"
+        parts = [expr(i) for i in e.items]
+        if len(parts) > 1:
+            used.add(fn)
+        acc = parts[0]
+        for p in parts[1:]:
+            acc = f"{fn}({acc}, {p})"
+        return f"(1.0 - {acc})" if negate else acc
+
+    rules = []
+    for r, (_, rule, uses) in enumerate(flatten(compiled.rulebase, compiled.behavior)):
+        text = expr(rule.antecedent)
+        for use in uses:
+            if use.condition is not None:
+                text = f"{text} * {expr(use.condition)}"
+        rules.append((f"dof_{r}", text, float(compiled.weight[r])))
+    terms = []
+    for i, key in enumerate(compiled.term_names):
+        term = compiled.variables[key[0]].term(key[1])
+        if names[key] in referenced:
+            kernel = kernel_params(term.corners) if term.corners is not None else None
+            terms.append((int(compiled.term_var[i]), names[key], term.shape, term.params, kernel))
+    shapes = {t[2] for t in terms if t[4] is None}
+    if any(t[4] is not None for t in terms):
+        used.add("kernel")
+    return Program(compiled, tuple(terms), tuple(rules), tuple(sorted(shapes)),
+                   tuple(sorted(hedges)), tuple(sorted(used)))
+
+
+def weighted_sums(c: CompiledRuleBase, j: int) -> tuple[str, str]:
+    """Output ``j``'s weighted sums as expressions over ``dof_<r>`` and ``x[i]``, the same
+    text in C and in Python: ``sum(dof * y)`` (``y`` crisp or linear) and ``sum(dof)``."""
+    terms = []
+    for r in np.flatnonzero(c.cons_mask[:, j]):
+        value = num(c.cons_value[r, j])
+        if c.cons_linear is not None:
+            parts = [num(c.cons_linear[r, j, -1])] + [
+                f"{num(a)} * x[{i}]" for i, a in enumerate(c.cons_linear[r, j, :-1])
+                if a != 0.0]
+            value = "(" + " + ".join(parts) + ")"
+        terms.append((f"dof_{r}", value))
+    numerator = " + ".join(f"{d} * {v}" for d, v in terms) or "0.0"
+    denominator = " + ".join(d for d, _ in terms) or "0.0"
+    return numerator, denominator

@@ -1,0 +1,320 @@
+"""What keeps a variable's terms meaning what their names say: order, coverage,
+distinguishability and a centre term held at its point.
+
+Interpretable neuro-fuzzy learning (Nauck and Kruse's NEFCON / NEFCLASS, Espinosa and
+Vandewalle, the survey of Gacto et al., 2011) keeps these properties while it adapts; this
+module measures them, for ``mitos check`` (:func:`findings`) and for the constraints of
+:mod:`mitos_cli.teach.adapt` (the array functions, which take the terms' corners as numbers).
+
+=================  =========================================================================
+property           held when
+=================  =========================================================================
+order              the terms' peaks or cores (a crisp term's value) follow the order in which
+                   the terms are written, increasing or decreasing, none equal
+coverage           at every point of the universe the largest membership is at least
+                   :data:`COVERAGE`
+distinguishable    two fuzzy sets of one variable have a Jaccard similarity
+                   ``|A and B| / |A or B|`` (min / max, integrated over the universe) of at most
+                   :data:`SIMILARITY`; two neighbouring crisp values lie at least
+                   :data:`DISTINCT` times the spacing of as many values spread evenly
+                   from the smallest to the largest (steering 30 ... 150, 7 terms: 10 deg)
+centre             when the terms are written mirror-symmetric about a point (an odd number
+                   of terms; the first and last, second and second-last, ... are mirror
+                   images, corner for corner), the middle term stays centred on that point
+                   (``heading.AHEAD`` at 0, ``steering.ST`` at 90)
+=================  =========================================================================
+
+Only piecewise-linear terms (triangles, trapezoids, shoulders) and crisp terms are measured;
+a variable with another shape (gaussian, ...) is left out of coverage and similarity.
+Everything here is pure and vectorized over terms and points.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .terms import Term, Variable
+
+#: Least largest-membership anywhere on an input's universe (a Ruspini partition has 0.5).
+COVERAGE = 0.5
+#: Largest Jaccard similarity two fuzzy sets of one variable may have.
+SIMILARITY = 0.5
+#: Least distance between two neighbouring crisp terms of one variable, as a fraction of the
+#: spacing of as many values spread evenly from the smallest to the largest (steering: 10).
+DISTINCT = 0.5
+#: Relative tolerance (of the universe width) for "at its point" and "in order".
+TOLERANCE = 1e-6
+
+
+@dataclass(frozen=True)
+class Issue:
+    """One interpretability problem of one variable."""
+
+    code: str          # "term-order", "coverage", "indistinct", "off-centre"
+    variable: str
+    terms: tuple[str, ...]
+    message: str
+    hint: str
+
+
+# ---- measures on corner arrays (what adaptation calls on every trial step) ---------------------
+
+def memberships(corners: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """``mu[t, n]`` of piecewise-linear terms given by their corners ``[t, 4]`` (``a <= b <= c
+    <= d``, infinite for a shoulder's open side) at the points ``x[n]``."""
+    a, b, c, d = (corners[:, i:i + 1] for i in range(4))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        rise = np.where(b > a, (x - a) / np.where(b > a, b - a, 1.0), np.where(x >= a, 1.0, 0.0))
+        fall = np.where(d > c, (d - x) / np.where(d > c, d - c, 1.0), np.where(x <= d, 1.0, 0.0))
+    rise = np.where(np.isneginf(a), 1.0, rise)
+    fall = np.where(np.isposinf(d), 1.0, fall)
+    return np.clip(np.minimum(rise, fall), 0.0, 1.0)
+
+
+def breakpoints(corners: np.ndarray, universe: tuple[float, float]) -> np.ndarray:
+    """Every point of the universe where the min or max of two of these piecewise-linear
+    terms can bend: its ends, the corners and where two sloped edges cross (sorted)."""
+    lo, hi = universe
+    a, b, c, d = corners.T
+    rise = np.isfinite(a) & np.isfinite(b) & (b > a)
+    fall = np.isfinite(c) & np.isfinite(d) & (d > c)
+    # each sloped edge as mu = slope * x + offset
+    slope = np.concatenate([1.0 / (b[rise] - a[rise]), -1.0 / (d[fall] - c[fall])])
+    offset = np.concatenate([-a[rise] / (b[rise] - a[rise]), d[fall] / (d[fall] - c[fall])])
+    with np.errstate(invalid="ignore", divide="ignore"):
+        cross = (offset[None, :] - offset[:, None]) / (slope[:, None] - slope[None, :])
+    x = np.concatenate([[lo, hi], corners[np.isfinite(corners)], cross.ravel()])
+    return np.unique(x[np.isfinite(x) & (x >= lo) & (x <= hi)])
+
+
+def coverage(corners: np.ndarray, universe: tuple[float, float],
+             besides_gaps: bool = False) -> tuple[float, float]:
+    """The least largest-membership on the universe and where it is, exactly: the upper
+    envelope of piecewise-linear functions is smallest at one of its :func:`breakpoints`.
+    ``besides_gaps``: the least above 0 (where no term is above 0 is a gap, reported apart)."""
+    x = breakpoints(corners, universe)
+    top = memberships(corners, x).max(axis=0)
+    if besides_gaps:
+        x, top = x[top > 0], top[top > 0]
+        if not len(top):
+            return 1.0, float(universe[0])
+    k = int(np.argmin(top))
+    return float(top[k]), float(x[k])
+
+
+def similarity(corners: np.ndarray, universe: tuple[float, float]) -> np.ndarray:
+    """Jaccard similarity ``[t, t]`` of every pair of terms (1 on the diagonal), exactly: the
+    trapezoid rule on the :func:`breakpoints`, between which min and max are linear."""
+    x = breakpoints(corners, universe)
+    mu = memberships(corners, x)                                 # [t, n]
+    both = np.minimum(mu[:, None, :], mu[None, :, :])
+    either = np.maximum(mu[:, None, :], mu[None, :, :])
+    dx = np.diff(x)
+
+    def area(m: np.ndarray) -> np.ndarray:
+        return ((m[..., 1:] + m[..., :-1]) * 0.5 * dx).sum(axis=-1)
+
+    inter, union = area(both), area(either)
+    return np.divide(inter, union, out=np.zeros_like(inter), where=union > 0)
+
+
+def least_distance(values: np.ndarray) -> float:
+    """How far apart neighbouring crisp ``values`` must stay: :data:`DISTINCT` times the
+    spacing of as many values spread evenly between the smallest and the largest."""
+    if len(values) < 2:
+        return 0.0
+    return float(DISTINCT * (np.max(values) - np.min(values)) / (len(values) - 1))
+
+
+def measures(corners: np.ndarray, universe: tuple[float, float]) -> tuple[float, float]:
+    """Coverage and the largest similarity of two different terms, on one evaluation of the
+    memberships at the breakpoints (what adaptation checks on every trial step)."""
+    x = breakpoints(corners, universe)
+    mu = memberships(corners, x)
+    cover = float(mu.max(axis=0).min())
+    if len(corners) < 2:
+        return cover, 0.0
+    dx = np.diff(x)
+    both = np.minimum(mu[:, None, :], mu[None, :, :])
+    either = np.maximum(mu[:, None, :], mu[None, :, :])
+    inter = ((both[..., 1:] + both[..., :-1]) * dx).sum(axis=-1)
+    union = ((either[..., 1:] + either[..., :-1]) * dx).sum(axis=-1)
+    sim = np.divide(inter, union, out=np.zeros_like(inter), where=union > 0)
+    np.fill_diagonal(sim, -1.0)
+    return cover, float(sim.max())
+
+
+def most_similar(corners: np.ndarray, universe: tuple[float, float]) -> tuple[float, int, int]:
+    """The largest similarity of two different terms and which two."""
+    s = similarity(corners, universe)
+    np.fill_diagonal(s, -1.0)
+    i, j = np.unravel_index(int(np.argmax(s)), s.shape)
+    return float(s[i, j]), int(i), int(j)
+
+
+# ---- what a variable's terms are --------------------------------------------------------------
+
+def learnable(term: Term) -> bool:
+    """Piecewise linear or crisp: the terms these measures (and adaptation) understand."""
+    return term.shape == "singleton" or term.corners is not None
+
+
+def core(term: Term) -> tuple[float, float]:
+    """Where the term is 1: ``[b, c]`` of a piecewise-linear term, a crisp term's value."""
+    _, b, c, _ = _corners(term)
+    return (b, c)
+
+
+def centre(term: Term) -> float:
+    """The point a term stands for: its core's middle, or a shoulder's inner core end."""
+    lo, hi = core(term)
+    if np.isinf(lo):
+        return hi
+    if np.isinf(hi):
+        return lo
+    return 0.5 * (lo + hi)
+
+
+def _corners(term: Term) -> tuple[float, float, float, float]:
+    """``(a, b, c, d)`` of a learnable term (a crisp term's value four times)."""
+    if term.shape == "singleton":
+        v = term.params[0]
+        return (v, v, v, v)
+    corners = term.corners
+    assert corners is not None, "only learnable terms are measured"
+    return corners
+
+
+def mirror_point(var: Variable) -> float | None:
+    """The point the terms are written mirror-symmetric about (an odd number of terms; the
+    i-th and the i-th from last are mirror images, corner for corner), else ``None``."""
+    terms = var.terms
+    n = len(terms)
+    if n < 3 or n % 2 == 0 or not all(learnable(t) for t in terms):
+        return None
+    tol = TOLERANCE * (var.universe[1] - var.universe[0])
+    point = None
+    for i in range(n // 2):
+        left, right = _corners(terms[i]), _corners(terms[n - 1 - i])
+        sums = [u + v for u, v in zip(left, reversed(right))]
+        finite = [s for s in sums if np.isfinite(s)]
+        if not finite or any(np.isfinite(u) != np.isfinite(v)
+                             for u, v in zip(left, reversed(right))):
+            return None
+        p = 0.5 * finite[0]
+        if any(abs(s - 2 * p) > tol for s in finite) or \
+                (point is not None and abs(p - point) > tol):
+            return None
+        point = p
+    return point
+
+
+def held_term(var: Variable) -> tuple[Term, float] | None:
+    """The middle term of a mirror-symmetric variable and its point, when it is written
+    symmetric about that point: what adaptation holds there unless released."""
+    point = mirror_point(var)
+    if point is None:
+        return None
+    middle = var.terms[len(var.terms) // 2]
+    tol = TOLERANCE * (var.universe[1] - var.universe[0])
+    if middle.shape == "singleton":
+        return (middle, point) if abs(middle.params[0] - point) <= tol else None
+    a, b, c, d = _corners(middle)
+    if abs(b + c - 2 * point) <= tol and abs(a + d - 2 * point) <= tol:
+        return middle, point
+    return None
+
+
+# ---- findings ----------------------------------------------------------------------------------
+
+def _num(x: float) -> str:
+    return f"{x:.4g}"
+
+
+def variable_issues(var: Variable) -> list[Issue]:
+    """Every interpretability problem of ``var``'s terms (nothing for a variable with fewer
+    than two terms, or with a shape these measures do not understand)."""
+    terms = [t for t in var.terms if learnable(t)]
+    if len(terms) < 2 or len(terms) != len(var.terms):
+        return []
+    out = _order(var)
+    crisp = [t for t in terms if t.shape == "singleton"]
+    sets = [t for t in terms if t.shape != "singleton"]
+    width = var.universe[1] - var.universe[0]
+    if len(sets) >= 2 or (sets and var.role == "input"):
+        corners = np.array([t.corners for t in sets], dtype=float)
+        if var.role == "input":
+            low, where = coverage(corners, var.universe, besides_gaps=True)   # see term-gap
+            if low < COVERAGE - 1e-9:
+                out.append(Issue("coverage", var.name, (), (
+                    f"`{var.name}` is covered only to {_num(low)} at {var.name} = "
+                    f"{_num(where)} (every point of the universe should belong to some term "
+                    f"at least {COVERAGE:g})"),
+                    "widen the neighbouring terms so that they overlap there"))
+        if len(sets) >= 2:
+            s, i, j = most_similar(corners, var.universe)
+            if s > SIMILARITY + 1e-9:
+                out.append(Issue("indistinct", var.name, (sets[i].name, sets[j].name), (
+                    f"`{var.name}.{sets[i].name}` and `{sets[j].name}` are hard to tell apart "
+                    f"(similarity {s:.2f} > {SIMILARITY:g})"),
+                    "move their peaks apart or narrow them (or merge them into one term)"))
+    values = sorted((t.params[0], t.name) for t in crisp)
+    least = least_distance(np.array([v for v, _ in values]))
+    for (v1, n1), (v2, n2) in zip(values, values[1:]):
+        if v2 - v1 < least - TOLERANCE * width:
+            out.append(Issue("indistinct", var.name, (n1, n2), (
+                f"`{var.name}.{n1}` ({_num(v1)}) and `{n2}` ({_num(v2)}) are hard to tell apart "
+                f"(closer than {_num(least)}, half the spacing of evenly spread values)"),
+                "move them apart, or merge them into one term"))
+    out += _off_centre(var)
+    return out
+
+
+def _order(var: Variable) -> list[Issue]:
+    centres = [centre(t) for t in var.terms]
+    steps = np.diff(centres)
+    tol = TOLERANCE * (var.universe[1] - var.universe[0])
+    if np.all(steps > tol) or np.all(steps < -tol):
+        return []
+    up = int(np.sum(steps > 0)) >= int(np.sum(steps < 0))
+    k = next(i for i, s in enumerate(steps) if (s <= tol if up else s >= -tol))
+    t1, t2 = var.terms[k], var.terms[k + 1]
+    return [Issue("term-order", var.name, (t1.name, t2.name), (
+        f"`{var.name}.{t2.name}` ({_num(centres[k + 1])}) is written after `{t1.name}` "
+        f"({_num(centres[k])}) but does not lie {'above' if up else 'below'} it: the terms "
+        f"are out of order"), "keep the terms in the order of their peaks, as they are "
+                             "written")]
+
+
+def _off_centre(var: Variable) -> list[Issue]:
+    """The middle term of terms that mirror each other about a point, but not on it."""
+    n = len(var.terms)
+    if n < 3 or n % 2 == 0:
+        return []
+    outer = Variable(var.name, var.role, var.universe,
+                     var.terms[:n // 2] + (_placeholder(var),) + var.terms[n // 2 + 1:])
+    point = mirror_point(outer)
+    middle = var.terms[n // 2]
+    tol = 1e-3 * (var.universe[1] - var.universe[0])
+    if point is None or abs(centre(middle) - point) <= tol:
+        return []
+    return [Issue("off-centre", var.name, (middle.name,), (
+        f"`{var.name}.{middle.name}` is centred on {_num(centre(middle))}, off the point "
+        f"{_num(point)} its neighbours mirror each other about"),
+        f"move it back to {_num(point)}")]
+
+
+def _placeholder(var: Variable) -> Term:
+    return Term("_", "singleton", (0.0,))
+
+
+def rulebase_issues(variables) -> list[Issue]:
+    """:func:`variable_issues` of each variable in turn."""
+    return [i for v in variables for i in variable_issues(v)]
+
+
+__all__ = ["COVERAGE", "DISTINCT", "SIMILARITY", "Issue", "centre", "core", "coverage",
+           "held_term", "memberships", "mirror_point", "most_similar", "rulebase_issues",
+           "similarity", "variable_issues"]

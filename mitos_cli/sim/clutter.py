@@ -1,0 +1,107 @@
+"""Seeded clutter: boxes, bins and trolleys the robot does not know, put in its way.
+
+:func:`clutter` adds ``count`` unknown obstacles along a robot's route, each standing against
+one side of the corridor (the side drawn at random, its distance from that wall at random)
+so that a way at least ``free_way_in`` wide stays open between it and the opposite wall. The
+width across is measured with rays along the route's normal to the walls of the world (the
+obstacles already in the world are kept at least ``spacing_in`` away, as are the start and
+the goal), at the object's middle and at both its ends along the route, and the narrowest of
+the three counts. A place where the corridor is too narrow for the object and the way is
+skipped; the next draw tries another. Objects are at least ``spacing_in`` apart along the
+route, so two of them never close the way between them.
+
+Everything comes from the generator passed in: the same seed gives the same clutter.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .geometry import ray_segments
+from .route import Route
+from .staticmap import StaticMap
+from .world import Obstacle, World
+
+
+@dataclass(frozen=True)
+class Kind:
+    """A kind of clutter: a ``length`` x ``width`` rectangle, or a circle when ``radius``."""
+
+    name: str
+    length: float = 0.0            # in, along the route
+    width: float = 0.0             # in, across it
+    radius: float = 0.0            # in
+
+    @property
+    def along(self) -> float:
+        return 2 * self.radius if self.radius else self.length
+
+    @property
+    def across(self) -> float:
+        return 2 * self.radius if self.radius else self.width
+
+
+#: what an office or a hospital corridor holds (inches)
+KINDS = (Kind("box", 16.0, 16.0), Kind("bin", radius=8.0), Kind("trolley", 30.0, 18.0))
+
+FREE_WAY_IN = 40.0         # in: the way left open past every object
+SPACING_IN = 90.0          # in: between objects, and from the start, the goal, other obstacles
+REACH_IN = 400.0           # in: how far across the route the walls are looked for
+MAX_TRIES = 40             # draws per object before giving up on it
+
+
+def widths_across(static: StaticMap, route: Route, s: float) -> tuple[float, float, float]:
+    """Free room to the left and to the right of the route at arc length ``s`` (in, to the
+    nearest wall along the normal) and the route's heading there (rad)."""
+    a, b = route.point_at(s - 1.0), route.point_at(s + 1.0)
+    heading = math.atan2(b[1] - a[1], b[0] - a[0])
+    p = route.point_at(s)
+    left = np.array([[-math.sin(heading), math.cos(heading)]])
+    dirs = np.vstack([left, -left])
+    walls = static.near(float(p[0]), float(p[1]), REACH_IN)
+    room = ray_segments(p, dirs, walls, REACH_IN)
+    return float(room[0]), float(room[1]), heading
+
+
+def clutter(world: World, static: StaticMap, route: Route, rng: np.random.Generator,
+            count: int, *, free_way_in: float = FREE_WAY_IN, spacing_in: float = SPACING_IN,
+            kinds: tuple[Kind, ...] = KINDS) -> World:
+    """``world`` with up to ``count`` unknown objects of ``kinds`` along ``route`` (see the
+    module's docstring); fewer when the route has no room for them."""
+    placed: list[Obstacle] = []
+    taken = [0.0, route.length]                                    # start and goal
+    others = np.array([[o.x, o.y] for o in world.obstacles]).reshape(-1, 2)
+    for k in range(count):
+        for _ in range(MAX_TRIES):
+            kind = kinds[int(rng.integers(len(kinds)))]
+            s = float(rng.uniform(0.0, route.length))
+            side = 1.0 if rng.random() < 0.5 else -1.0             # +1: against the left wall
+            u = float(rng.random())
+            if min(abs(s - t) for t in taken) < spacing_in:
+                continue
+            rooms = [widths_across(static, route, s + d * kind.along / 2) for d in (-1, 0, 1)]
+            left = min(r[0] for r in rooms)
+            right = min(r[1] for r in rooms)
+            slack = left + right - kind.across - free_way_in
+            if slack < 0:
+                continue
+            heading = rooms[1][2]
+            wall = left if side > 0 else right                     # room toward the wall
+            offset = side * (wall - kind.across / 2 - u * slack)   # centre, + = left
+            p = route.point_at(s)
+            x = float(p[0] - math.sin(heading) * offset)
+            y = float(p[1] + math.cos(heading) * offset)
+            if len(others) and np.hypot(*(others - (x, y)).T).min() < spacing_in:
+                continue
+            name = f"{kind.name}_{k + 1}"
+            if kind.radius:
+                placed.append(Obstacle(name, "circle", x, y, radius=kind.radius))
+            else:
+                placed.append(Obstacle(name, "rectangle", x, y, length=kind.length,
+                                       width=kind.width, angle=math.degrees(heading)))
+            taken.append(s)
+            break
+    return world.with_changes(obstacles=world.obstacles + tuple(placed))

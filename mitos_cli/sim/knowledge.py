@@ -1,0 +1,278 @@
+"""What the robot knows of its world, as opposed to what is there.
+
+The world file says what the robot is *given* (``map.given``): the map itself (the default),
+another map (MRPB's partially unknown scenarios: the same building without its furniture), or
+nothing (``given: none``), plus the obstacles marked ``known: true``. The simulator keeps the
+truth (:class:`~.staticmap.StaticMap`: sensors, collisions and clearance use it) and, per
+robot, a :class:`RobotMap`: the cells it plans on, which its own readings fill in as it drives.
+
+What the robot's map predicts decides what its readings mean (:mod:`.perception`): a beam
+clearly shorter than the map predicts has hit something the map does not show. With a map, the
+prediction is the given map's walls and the known obstacles' outlines; with no map, it is what
+the robot has mapped itself so far (a grid ray-marched per beam).
+
+Replanning (:func:`replan`): at most once every ``REPLAN_EVERY`` seconds, and only when the
+robot has mapped something new within its clearance of the route ahead, it asks whether a way
+past is left within ``TUBE`` inches of the route up to ``sight`` ahead, at the route's floor
+clearance (half the robot's width plus its margin); when none is, it plans
+again from where it stands on everything it knows. A box in the lane leaves a way past and
+the rules drive round it; a shut door or a corridor full of boxes does not, and the route
+changes.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from . import obstacles as obs_mod
+from .geometry import points_in_polygon, ray_circles, ray_segments
+from .route import Clearance, NarrowPassage, Route, grid_route
+from .staticmap import StaticMap, carve, corridor_rects, grid_walls
+from .world import Goal, Grid, Pose, World
+
+RASTER = 2.0            # in: cells of the robot's map when the world gives no grid
+REPLAN_EVERY = 0.5      # s: the least time between two replanning checks
+TUBE = 48.0             # in: how far from its route the robot looks for a way past
+
+
+@dataclass(frozen=True)
+class Given:
+    """What a world gives its robots: walls and shapes that predict the ranges, and the cells
+    the route is planned on (``None``: the corridors' centre lines, the truth itself)."""
+
+    knows: str                     # map | given | none
+    walls: np.ndarray              # [N, 4] walls of the given map (the truth's with `map`)
+    sides: np.ndarray              # [S, 4] sides of known rectangles
+    centres: np.ndarray            # [C, 2] known circles
+    radii: np.ndarray              # [C]
+    grid: Grid | None              # the cells to plan on, known obstacles drawn in
+
+    def __hash__(self) -> int:
+        return id(self)
+
+    @property
+    def plain(self) -> bool:
+        """The robot is given exactly the true map (today's worlds): nothing to add."""
+        return self.knows == "map" and not len(self.sides) and not len(self.centres)
+
+
+def _raster(static: StaticMap, world: World, res: float, free: bool) -> Grid:
+    """A grid over the truth's bounds: free everywhere, or the corridors carved out."""
+    x0, y0, x1, y1 = static.bounds
+    cols, rows = int(math.ceil((x1 - x0) / res)) + 2, int(math.ceil((y1 - y0) / res)) + 2
+    origin = (x0 - res, y0 - res)
+    grid = Grid(np.full((rows, cols), not free), res, origin, "")
+    if not free and world.corridors:
+        grid = carve(grid, corridor_rects(world.corridors))
+    return grid
+
+
+def _stamp(grid: Grid, world: World) -> Grid:
+    """The grid with every known obstacle's cells occupied."""
+    known = world.known_obstacles
+    if not known:
+        return grid
+    where = obs_mod.positions(known, 0.0)
+    centres, radii, _, _, _, corners = obs_mod.shapes_at(known, where)
+    rows, cols = grid.occupied.shape
+    ys, xs = np.mgrid[0:rows, 0:cols]
+    pts = np.stack([grid.origin[0] + (xs.ravel() + 0.5) * grid.resolution,
+                    grid.origin[1] + (ys.ravel() + 0.5) * grid.resolution], axis=1)
+    half = grid.resolution / 2
+    hit = np.zeros(len(pts), dtype=bool)
+    for c, r in zip(centres, radii):
+        hit |= np.hypot(*(pts - c).T) <= r + half
+    if len(corners):
+        grown = corners + np.sign(corners - corners.mean(axis=1, keepdims=True)) * half
+        hit |= points_in_polygon(pts, grown).any(axis=1)
+    return Grid(grid.occupied | hit.reshape(rows, cols), grid.resolution, grid.origin,
+                grid.source)
+
+
+def given(world: World, static: StaticMap) -> Given:
+    """What ``world`` gives its robots (the truth is ``static``)."""
+    known = world.known_obstacles
+    where = obs_mod.positions(known, 0.0)
+    centres, radii, _, sides, _, _ = obs_mod.shapes_at(known, where)
+    if world.knows == "map":
+        walls = static.walls
+        grid = static.grid
+        if known and grid is None:
+            grid = _raster(static, world, RASTER, free=False)
+    elif world.knows == "given" and world.given is not None:
+        grid = world.given
+        if world.corridors:
+            grid = carve(grid, corridor_rects(world.corridors))
+        walls = grid_walls(grid)
+    else:
+        res = static.grid.resolution if static.grid is not None else RASTER
+        grid = _raster(static, world, res, free=True)
+        walls = np.zeros((0, 4))
+    if grid is not None:
+        grid = _stamp(grid, world)
+    return Given(world.knows, walls, sides, centres, radii, grid)
+
+
+def plan_grid(g: Given, static: StaticMap, world: World) -> Grid:
+    """The cells a robot plans on once it must replan (the corridors rasterised if need be)."""
+    return g.grid if g.grid is not None else _raster(static, world, RASTER, free=False)
+
+
+@dataclass
+class RobotMap:
+    """One robot's map as it drives: the cells it plans on, with what it has sensed marked."""
+
+    grid: Grid
+    occupied: np.ndarray           # bool [rows, cols], the grid's cells plus the marks
+    fresh: list = field(default_factory=list)      # marks since the last check, [k, 2] each
+    checked_at: float = -math.inf  # s
+    replans: int = 0
+
+    @classmethod
+    def of(cls, grid: Grid) -> RobotMap:
+        return cls(grid, grid.occupied.copy())
+
+    def cells(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        g = self.grid
+        col = np.floor((points[:, 0] - g.origin[0]) / g.resolution).astype(np.int64)
+        row = np.floor((points[:, 1] - g.origin[1]) / g.resolution).astype(np.int64)
+        rows, cols = self.occupied.shape
+        inside = (row >= 0) & (row < rows) & (col >= 0) & (col < cols)
+        return row, col, inside
+
+    def mark(self, hits: np.ndarray, dirs: np.ndarray) -> None:
+        """Mark the cells just beyond each hit point (the echo came from there)."""
+        if not len(hits):
+            return
+        row, col, inside = self.cells(hits + dirs * (self.grid.resolution / 2))
+        row, col = row[inside], col[inside]
+        new = ~self.occupied[row, col]
+        if new.any():
+            self.occupied[row[new], col[new]] = True
+            g = self.grid
+            self.fresh.append(np.stack([g.origin[0] + (col[new] + 0.5) * g.resolution,
+                                        g.origin[1] + (row[new] + 0.5) * g.resolution], axis=1))
+
+    def ranges(self, origin: np.ndarray, dirs: np.ndarray, max_range: float) -> np.ndarray:
+        """Ranges ``[B]`` this map predicts: each beam marched in half cells to the first
+        occupied cell (``max_range`` when none)."""
+        step = self.grid.resolution / 2
+        s = np.arange(step, max_range + step, step)
+        pts = origin + s[:, None, None] * dirs[None]              # [S, B, 2]
+        row, col, inside = self.cells(pts.reshape(-1, 2))
+        occ = np.zeros(len(row), dtype=bool)
+        occ[inside] = self.occupied[row[inside], col[inside]]
+        occ = occ.reshape(len(s), len(dirs))
+        first = np.where(occ.any(axis=0), occ.argmax(axis=0), -1)
+        return np.where(first >= 0, np.minimum(s[np.maximum(first, 0)] - step / 2, max_range),
+                        max_range)
+
+
+def expected_ranges(g: Given, rmap: RobotMap | None, origin: np.ndarray, dirs: np.ndarray,
+                    walls_near: np.ndarray, max_range: float) -> np.ndarray:
+    """What the robot's map predicts along each beam: the given walls near it (the caller's
+    set) and the known obstacles, or with no map what it has mapped itself."""
+    if g.knows == "none" and rmap is not None:
+        out = rmap.ranges(origin, dirs, max_range)
+    else:
+        out = ray_segments(origin, dirs, walls_near, max_range)
+    if len(g.sides):
+        lo = np.minimum(g.sides[:, :2], g.sides[:, 2:])
+        hi = np.maximum(g.sides[:, :2], g.sides[:, 2:])
+        near = ((lo <= origin + max_range) & (hi >= origin - max_range)).all(axis=1)
+        if near.any():
+            out = np.minimum(out, ray_segments(origin, dirs, g.sides[near], max_range))
+    if len(g.centres):
+        near = np.hypot(*(g.centres - origin).T) <= max_range + g.radii
+        if near.any():
+            out = np.minimum(out, ray_circles(origin, dirs, g.centres[near], g.radii[near],
+                                              max_range))
+    return out
+
+
+def _as_map(grid: Grid) -> StaticMap:
+    """A grid as a map to plan on (the planner needs only its cells)."""
+    rows, cols = grid.occupied.shape
+    x0, y0 = grid.origin
+    return StaticMap(np.zeros((0, 4)), np.zeros((0, 4, 2)), grid,
+                     (x0, y0, x0 + cols * grid.resolution, y0 + rows * grid.resolution))
+
+
+def _window(grid: Grid, occupied: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> Grid:
+    """The part of a grid (with cells ``occupied``) between two corners."""
+    res, (ox, oy) = grid.resolution, grid.origin
+    rows, cols = occupied.shape
+    c0 = max(0, int((lo[0] - ox) // res))
+    r0 = max(0, int((lo[1] - oy) // res))
+    c1 = min(cols, int((hi[0] - ox) // res) + 1)
+    r1 = min(rows, int((hi[1] - oy) // res) + 1)
+    return Grid(occupied[r0:r1, c0:c1], res, (ox + c0 * res, oy + r0 * res), grid.source)
+
+
+def way_past(rmap: RobotMap, route: Route, s: float, p: np.ndarray, ahead: float,
+             clearance: float, minimum: float) -> bool:
+    """Whether the robot at ``p`` can still get, within ``TUBE`` of its route, to a route point
+    at least ``ahead`` inches on that is clear of what it knows (``minimum`` from it)."""
+    end = min(s + ahead, route.length)
+    last = min(end + 2 * TUBE, route.length)
+    along = np.arange(s, last + 3.0, 3.0).clip(max=last)
+    sample = np.array([route.point_at(u) for u in along])
+    lo = np.minimum(sample.min(axis=0), p) - TUBE
+    hi = np.maximum(sample.max(axis=0), p) + TUBE
+    g = _window(rmap.grid, rmap.occupied, lo, hi)
+    room = Clearance.of(g.occupied, g.resolution, g.origin, cap=minimum + 2 * g.resolution)
+    beyond = (along >= end) & (room.at(sample) >= minimum)
+    if not beyond.any():
+        return False
+    target = sample[int(np.argmax(beyond))]
+    try:
+        grid_route(_as_map(g), Pose(float(p[0]), float(p[1])), Goal(float(target[0]),
+                   float(target[1])), clearance, minimum=minimum, explain=False,
+                   leave=clearance + 6.0)
+    except NarrowPassage:
+        return False
+    return True
+
+
+def _crosses(rmap: RobotMap, route: Route, s: float, p: np.ndarray, reach: float,
+             ahead: float) -> bool:
+    """Whether the route from ``s`` to ``s + ahead`` passes within ``reach`` of a cell the
+    robot has mapped (only cells within ``ahead + reach`` of it are looked at)."""
+    g = rmap.grid
+    lo, hi = p - ahead - reach, p + ahead + reach
+    window = _window(g, rmap.occupied, lo, hi)
+    r, c = np.nonzero(window.occupied)
+    if not len(r):
+        return False
+    cells = np.stack([window.origin[0] + (c + 0.5) * g.resolution,
+                      window.origin[1] + (r + 0.5) * g.resolution], axis=1)
+    return bool(route.near(cells, s, reach + g.resolution / 2, ahead).any())
+
+
+def replan(rmap: RobotMap, route: Route, s: float, p: np.ndarray, goal: Goal, t: float,
+           clearance: float, minimum: float, sight: float, knows: str = "map") -> Route | None:
+    """A new route from ``p`` when what the robot has sensed shuts the way ahead (see the
+    module docstring), else ``None``. A robot with no map plans again whenever its route
+    ahead runs into what it has mapped: all it knows it learnt on the way."""
+    if not rmap.fresh or t - rmap.checked_at < REPLAN_EVERY:
+        return None
+    fresh = np.concatenate(rmap.fresh)
+    rmap.fresh.clear()
+    rmap.checked_at = t
+    if knows == "none":
+        if not _crosses(rmap, route, s, p, minimum, sight):
+            return None
+    elif not route.near(fresh, s, clearance, sight).any() or \
+            way_past(rmap, route, s, p, sight, clearance, minimum):
+        return None
+    try:
+        new = grid_route(_as_map(rmap.grid), Pose(float(p[0]), float(p[1])), goal, clearance,
+                         minimum=minimum, occupied=rmap.occupied, explain=False,
+                         leave=clearance + 6.0)
+    except NarrowPassage:
+        return None                # no way left on what it knows: drive on, the rules decide
+    rmap.replans += 1
+    return new

@@ -1,0 +1,92 @@
+"""MRPB 1.0's scenarios as worlds: a folder's ``map.yaml`` and the start/goal tests of its
+``tests.txt`` (Wen et al. 2021; the maps and tests are described in ``../shared/maps/SOURCES.md``
+of the source tree).
+
+``tests.txt`` holds lines ``test N: start (x, y, yaw) -> goal (x, y, yaw)`` in metres and
+radians in the map frame (``#`` starts a comment). Each test becomes a world with the packaged
+tricycle and ring of sonars, the goal within 12 in, and a time limit of ``TIME_PER_M`` seconds
+per metre of straight line from start to goal (at least ``MIN_TIME_S``).
+
+A *partially unknown* scenario (``NAME_partially_unknown``) drives in the complete building
+(``NAME``'s map) while the robot is given the folder's own map, which lacks the furniture; that
+needs a world that can hold a given map apart from the true one (``World.given``). Where the
+world model has no such field, :func:`scenario_worlds` says so with :class:`WorldError` and the
+caller can leave those scenarios out.
+
+Loading is the cost of reading the PGMs (600 x 600 to 760 x 760 pixels); :func:`scenario_worlds`
+reads each map once for all of its tests.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import re
+from pathlib import Path
+from typing import Any
+
+from ..errors import Span, WorldError
+from .gridmap import INCH_PER_M, load_map_yaml
+from .world import Agent, Goal, Pose, Randomise, Robot, Sensors, World
+
+COMPLETE = ("maze", "narrow_graph", "office01add", "office02", "room02", "shopping_mall",
+            "track")
+PARTIALLY_UNKNOWN = {"office02_partially_unknown": "office02",
+                     "shopping_mall_partially_unknown": "shopping_mall"}
+TIME_PER_M = 6.0           # s per metre of straight line (6.6 in/s over the crow's path)
+MIN_TIME_S = 60.0
+_POSE = r"\(\s*([-+0-9.eE]+)\s*,\s*([-+0-9.eE]+)\s*,\s*([-+0-9.eE]+)\s*\)"
+_TEST = re.compile(r"^\s*test\s+(\d+)\s*:\s*start\s*" + _POSE + r"\s*->\s*goal\s*" + _POSE
+                   + r"\s*$")
+
+
+def read_tests(path: Path) -> list[tuple[int, Pose, Pose]]:
+    """The tests of a ``tests.txt``: (number, start, goal) with poses in inches and degrees."""
+    try:
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise WorldError(f"cannot read MRPB tests `{path}`: "
+                         f"{getattr(exc, 'strerror', None) or exc}") from None
+    out = []
+    for i, line in enumerate(text.splitlines(), 1):
+        if not line.strip() or line.lstrip().startswith("#"):
+            continue
+        m = _TEST.match(line)
+        if not m:
+            raise WorldError("not an MRPB start/goal test", span=Span(str(path), i, 1, line),
+                             expected="`test N: start (x, y, yaw) -> goal (x, y, yaw)` in "
+                                      "metres and radians")
+        v = [float(g) for g in m.groups()[1:]]
+        out.append((int(m.group(1)),
+                    Pose(v[0] * INCH_PER_M, v[1] * INCH_PER_M, math.degrees(v[2])),
+                    Pose(v[3] * INCH_PER_M, v[4] * INCH_PER_M, math.degrees(v[5]))))
+    if not out:
+        raise WorldError(f"`{path}` holds no MRPB start/goal test", span=Span(str(path), 1, 1))
+    return out
+
+
+def scenario_worlds(root: Path, name: str, robot: Robot | None = None,
+                    sensors: Sensors | None = None) -> list[World]:
+    """One world per start/goal test of the scenario ``name`` under ``root`` (MRPB's folder
+    layout: ``root/NAME/map.yaml`` and ``root/NAME/tests.txt``)."""
+    folder = Path(root) / name
+    robot = robot or Robot()
+    sensors = sensors or Sensors(noise=0.5)
+    truth = PARTIALLY_UNKNOWN.get(name)
+    grid = load_map_yaml(folder.parent / (truth or name) / "map.yaml")
+    extra: dict[str, Any] = {}
+    if truth:
+        if "given" not in {f.name for f in dataclasses.fields(World)}:
+            raise WorldError(f"the partially unknown scenario `{name}` needs a world that is "
+                             f"given one map and drives in another (`map.given`)")
+        extra = {"knows": "given", "given": load_map_yaml(folder / "map.yaml")}
+    worlds = []
+    for number, start, goal in read_tests(folder / "tests.txt"):
+        crow = math.hypot(goal.x - start.x, goal.y - start.y) / INCH_PER_M
+        worlds.append(World(
+            name=f"mrpb/{name}#{number}", path=str(folder / "map.yaml"), seed=number, dt=0.05,
+            time_limit=max(MIN_TIME_S, TIME_PER_M * crow), substeps=4,
+            agents=(Agent("robot", robot, start, Goal(goal.x, goal.y, 12.0)),),
+            sensors=sensors, corridors=(), grid=grid, obstacles=(), randomise=Randomise(),
+            **extra))
+    return worlds

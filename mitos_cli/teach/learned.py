@@ -1,0 +1,66 @@
+"""What adaptation learned, said in the instructor's terms.
+
+One line per term that moved, by its centre (a crisp term's value, a fuzzy set's peak or core
+middle): ``steering.LS: 70 -> 62 deg, toward LM``; a term held at its point of symmetry says
+so (``heading.AHEAD: unchanged (held at 0)``). A term whose centre moved more than
+:data:`MEANING_SHIFT` of the way to its written neighbour on that side is flagged: it now
+means something close to that neighbour.
+"""
+
+from __future__ import annotations
+
+from ..lang.interpretability import centre
+from ..lang.model import RuleBase
+
+#: Share of the distance to the next term beyond which a move "changes the meaning".
+MEANING_SHIFT = 0.5
+
+
+def _num(x: float) -> str:
+    return f"{x:.4g}"
+
+
+def in_words(before: RuleBase, after: RuleBase, parameters) -> str:
+    """The learned changes of ``before`` -> ``after`` in words (``parameters``: what was
+    adapted and what was held)."""
+    held = {(v, t): point for v, t, point in parameters.held}
+    adapted = {k.var for k in parameters.knots}
+    lines = ["learned, in words:"]
+    old_vars = before.variables
+    for name, new in after.variables.items():
+        old = old_vars.get(name)
+        if old is None or name not in adapted:
+            continue
+        unit = f" {new.unit}" if new.unit else ""
+        order = sorted(old.terms, key=centre)
+        if old.terms == new.terms:
+            continue
+        for t_old, t_new in zip(old.terms, new.terms):
+            key = (name, t_new.name)
+            if key in held:
+                lines.append(f"  {name}.{t_new.name}: unchanged (held at {_num(held[key])}"
+                             f"{unit})")
+                continue
+            a, b = centre(t_old), centre(t_new)
+            if t_old.params == t_new.params:
+                continue
+            if a == b:
+                lines.append(f"  {name}.{t_new.name}: centre unchanged at {_num(a)}{unit}, "
+                             f"its slopes moved")
+                continue
+            i = order.index(t_old)
+            j = i + (1 if b > a else -1)
+            text = f"  {name}.{t_new.name}: {_num(a)} -> {_num(b)}{unit}"
+            if 0 <= j < len(order):
+                share = abs(b - a) / max(abs(centre(order[j]) - a), 1e-12)
+                text += f", toward {order[j].name}"
+                if share > MEANING_SHIFT:
+                    text += (f" ({share:.0%} of the way: it now means nearly what "
+                             f"{order[j].name} meant)")
+            lines.append(text)
+    if len(lines) == 1:
+        lines.append("  no term moved")
+    elif any("(held at" in x for x in lines):
+        lines.append("  (a held term is the centre of mirror-symmetric terms; `unfrozen "
+                     "VARIABLE.TERM` lets it move)")
+    return "\n".join(lines)

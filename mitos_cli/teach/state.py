@@ -1,0 +1,163 @@
+"""The state a teaching session rebuilds from its journal, and the pure transitions.
+
+Each change of a session is a journal entry (``{"op": ..., ...}``) applied by :func:`apply`,
+a pure state transition with no checks (entries were checked when told), so replaying the
+entries not undone over the original files rebuilds the state exactly: that is how ``undo``
+and ``mitos teach --resume`` work. The operations are listed in
+:mod:`mitos_cli.teach.session`.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import dataclasses
+import hashlib
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from ..errors import LessonError
+from ..lang.model import Behavior, Rule, RuleBase
+from ..lang.parse import parse_rule
+from . import commands as cmd
+
+
+@dataclass(frozen=True)
+class Example:
+    """One correction: input values by name and the outputs the instructor wanted."""
+
+    inputs: dict
+    targets: dict
+    source: str = ""
+    behavior: str = ""           # the behavior whose outputs the targets correct
+
+
+@dataclass
+class State:
+    """What a replay of the journal rebuilds."""
+
+    rulebase: RuleBase
+    active: str
+    block: str | None = None
+    examples: list[Example] = field(default_factory=list)
+    frozen_terms: set = field(default_factory=set)      # (variable, term)
+    released: set = field(default_factory=set)          # (variable, term)
+
+
+def _replace_behavior(rb: RuleBase, b: Behavior) -> RuleBase:
+    behaviors = tuple(b if x.name == b.name else x for x in rb.behaviors)
+    if b.name not in [x.name for x in rb.behaviors]:
+        behaviors += (b,)
+    return dataclasses.replace(rb, behaviors=behaviors)
+
+
+def _put_rule(b: Behavior, rule: Rule) -> Behavior:
+    rules = list(b.rules)
+    for i, r in enumerate(rules):
+        if rule.label and r.label == rule.label:
+            rules[i] = rule
+            break
+    else:
+        rules.append(rule)
+    return dataclasses.replace(b, rules=tuple(rules))
+
+
+def _set_params(rb: RuleBase, terms: dict) -> RuleBase:
+    termsets = tuple(dataclasses.replace(ts, variables=tuple(
+        v.with_terms(tuple(t.with_params(tuple(terms[v.name][t.name]))
+                           if t.name in terms.get(v.name, {}) else t for t in v.terms))
+        for v in ts.variables)) for ts in rb.termsets)
+    return dataclasses.replace(rb, termsets=termsets)
+
+
+def _set_crisp(rb: RuleBase, crisp: list) -> RuleBase:
+    for owner, index, var, value in crisp:
+        b = rb.behavior(owner)
+        rule = b.rules[index]
+        cons = tuple(dataclasses.replace(c, value=float(value)) if c.var == var and c.term is None
+                     else c for c in rule.consequents)
+        rules = list(b.rules)
+        rules[index] = dataclasses.replace(rule, consequents=cons)
+        rb = _replace_behavior(rb, dataclasses.replace(b, rules=tuple(rules)))
+    return rb
+
+
+def apply(state: State, entry: dict) -> None:
+    """Apply one journal entry to ``state`` (no checks: entries were checked when told)."""
+    op = entry["op"]
+    rb = state.rulebase
+    if op == "rule":
+        rule = parse_rule(entry["text"])
+        state.rulebase = _replace_behavior(rb, _put_rule(rb.behavior(entry["behavior"]), rule))
+    elif op == "behavior":
+        state.rulebase = _replace_behavior(rb, Behavior(entry["name"]))
+        state.block = entry["name"]
+    elif op == "end":
+        state.block = None
+        if entry.get("activate"):
+            state.active = entry["activate"]
+    elif op == "use":
+        b = rb.behavior(entry["behavior"])
+        use = cmd.parse_command(entry["text"]).use
+        state.rulebase = _replace_behavior(rb, dataclasses.replace(b, uses=b.uses + (use,)))
+    elif op == "frozen":
+        b = rb.behavior(entry["behavior"])
+        labels = b.frozen + tuple(x for x in entry["labels"] if x not in b.frozen)
+        state.rulebase = _replace_behavior(rb, dataclasses.replace(b, frozen=labels))
+    elif op == "operators":
+        b = rb.behavior(entry["behavior"])
+        settings = cmd.parse_command(entry["text"]).settings
+        state.rulebase = _replace_behavior(rb, dataclasses.replace(
+            b, operators=b.operators + settings))
+    elif op == "activate":
+        state.active = entry["behavior"]
+    elif op == "examples":
+        state.examples += [Example(e["inputs"], e["targets"], e.get("source", ""),
+                                   entry.get("behavior", ""))
+                           for e in entry["examples"]]
+    elif op == "freeze":
+        for var, term in entry["terms"]:
+            state.frozen_terms.add((var, term))
+            state.released.discard((var, term))
+    elif op == "release":
+        for var, term in entry["terms"]:
+            state.frozen_terms.discard((var, term))
+            state.released.add((var, term))
+    elif op == "adapt":
+        rb = _set_params(rb, entry["terms"])
+        state.rulebase = _set_crisp(rb, entry.get("crisp", []))
+    else:                                        # pragma: no cover - journal from the future
+        raise LessonError(f"the journal holds an unknown change `{op}`")
+
+
+
+
+def learned_changes(before: RuleBase, after: RuleBase) -> tuple[dict, list]:
+    """What an adaptation changed, as its journal entry keeps it: new term parameters
+    ``{variable: {term: params}}`` and crisp consequents ``[behavior, rule index, output,
+    value]``."""
+    terms: dict = {}
+    for v_old, v_new in zip(variables(before), variables(after)):
+        for t_old, t_new in zip(v_old.terms, v_new.terms):
+            if t_old.params != t_new.params:
+                terms.setdefault(v_new.name, {})[t_new.name] = list(t_new.params)
+    crisp = []
+    for b_old, b_new in zip(before.behaviors, after.behaviors):
+        for i, (r_old, r_new) in enumerate(zip(b_old.rules, b_new.rules)):
+            for c_old, c_new in zip(r_old.consequents, r_new.consequents):
+                if c_old.value != c_new.value:
+                    crisp.append([b_new.name, i, c_new.var, c_new.value])
+    return terms, crisp
+
+
+def variables(rb: RuleBase):
+    """Every variable of every term set, in file order."""
+    return [v for ts in rb.termsets for v in ts.variables]
+
+
+def files_digest(rb: RuleBase) -> str:
+    h = hashlib.sha256()
+    for path in [rb.path] + [str(Path(rb.path).parent / p) for p in rb.termset_paths]:
+        with contextlib.suppress(OSError):
+            h.update(Path(path).read_bytes())
+    return h.hexdigest()[:16]
+

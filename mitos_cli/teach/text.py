@@ -1,0 +1,143 @@
+"""The text a teaching session prints: examples, Q per epoch, changed terms, the rules,
+behaviors and history it shows. Pure functions of the state; the session prints them."""
+
+from __future__ import annotations
+
+import contextlib
+
+from ..lang.model import RuleBase, format_number, format_rule, format_use
+from ..words import plural
+from .state import variables
+
+
+def say(c) -> str:
+    if c.term is None:
+        return f"{c.var} is {format_number(c.value)}"
+    return f"{c.var} is {' '.join(c.hedges + (c.term,))}"
+
+
+
+def num(x: float) -> str:
+    return f"{x:.4g}" if abs(x) < 1e4 else f"{x:.6g}"
+
+
+def example_text(inputs: dict, targets: dict, now: dict | None) -> str:
+    text = " ".join(f"{k}={num(v)}" for k, v in inputs.items()) + " -> " + \
+        " ".join(f"{k}={num(v)}" for k, v in targets.items())
+    if now:
+        text += "   (now " + " ".join(f"{k}={num(now[k])}" for k in targets if k in now) + ")"
+    return text
+
+
+def q_lines(history: list[float], n: int, result) -> str:
+    rounding = history[-1] if result.rounded else None
+    if result.rounded:
+        history = history[:-1]
+    epochs = len(history) - 1
+    lines = [f"Q = sum (y - t)^2 over {plural(n, 'example')}:"]
+    shown = list(range(len(history)))
+    if len(shown) > 22:
+        step = max(1, len(shown) // 20)
+        shown = sorted(set(shown[::step]) | {len(shown) - 1})
+    for i in shown:
+        lines.append(f"  epoch {i:>4}: Q = {history[i]:.6g}")
+    if rounding is not None:
+        lines.append(f"  rounded  : Q = {rounding:.6g}   (learned values to a readable grid)")
+        history = history + [rounding]
+    note = "converged" if result.converged else ("interrupted" if result.interrupted
+                                                 else plural(epochs, 'epoch'))
+    lines.append(f"Q {history[0]:.6g} -> {history[-1]:.6g} ({note}; RMS error "
+                 f"{(history[-1] / max(n, 1)) ** 0.5:.3g})")
+    return "\n".join(lines)
+
+
+def params_text(t) -> str:
+    return t.params_text(format_number)
+
+
+def changed_table(before: RuleBase, after: RuleBase, crisp: list) -> str:
+    lines = ["changed (before -> after):"]
+    for v_old, v_new in zip(variables(before), variables(after)):
+        for t_old, t_new in zip(v_old.terms, v_new.terms):
+            if t_old.params != t_new.params:
+                lines.append(f"  {v_new.name}.{t_new.name}: {params_text(t_old)}  ->  "
+                             f"{params_text(t_new)}")
+    for owner, index, var, value in crisp:
+        rule = before.behavior(owner).rules[index]
+        old = next(c.value for c in rule.consequents if c.var == var)
+        lines.append(f"  {owner}/{rule.label}: {var} is {format_number(old)}  ->  "
+                     f"{format_number(value)}")
+    return "\n".join(lines)
+
+
+def terms_table(original: RuleBase, current: RuleBase, names: list[str]) -> str:
+    old = {v.name: v for v in variables(original)}
+    lines = []
+    for v in variables(current):
+        if v.name not in names:
+            continue
+        lo, hi = v.universe
+        lines.append(f"{v.name} ({v.role}, [{format_number(lo)}, {format_number(hi)}]"
+                     + (f" {v.unit}" if v.unit else "") + ")")
+        for t in v.terms:
+            o = old[v.name].term(t.name) if v.name in old else None
+            was = f"   (was {params_text(o)})" if o is not None and o.params != t.params else ""
+            frozen = "  [frozen]" if t.frozen else ""
+            lines.append(f"  {t.name:<10} {t.shape_name:<14} {params_text(t)}{frozen}{was}")
+    return "\n".join(lines)
+
+
+def rules_text(b, original: RuleBase, open_block: str | None) -> str:
+    """Behavior ``b``'s rules, new and changed ones (against ``original``) marked."""
+    from ..errors import MitosError
+
+    old = {}
+    with contextlib.suppress(MitosError):
+        old = {r.label: r for r in original.behavior(b.name).rules}
+    lines = [f"behavior {b.name} ({plural(len(b.rules), 'rule')})"
+             + ("  [open]" if open_block == b.name else "")]
+    for r in b.rules:
+        mark = "" if old.get(r.label) == r else ("  (new)" if r.label not in old
+                                                    else "  (changed)")
+        frozen = "  [frozen]" if r.label in b.frozen else ""
+        lines.append(f"  {format_rule(r)}{frozen}{mark}")
+    lines += [f"  {format_use(u)}" for u in b.uses]
+    return "\n".join(lines)
+
+
+def behaviors_text(rb: RuleBase, active: str, open_block: str | None) -> str:
+    lines = []
+    for b in rb.behaviors:
+        mark = "*" if b.name == active else " "
+        extra = f", uses {', '.join(u.behavior for u in b.uses)}" if b.uses else ""
+        lines.append(f"{mark} {b.name} ({plural(len(b.rules), 'rule')}{extra})"
+                     + ("  [open]" if b.name == open_block else ""))
+    return "\n".join(lines) + "\n(* active: `use NAME` recalls another)"
+
+
+def history_text(entries: list[dict]) -> str:
+    undone = {e["of"] for e in entries if e["op"] == "undo"}
+    lines = []
+    for e in entries:
+        if e["op"] == "start":
+            lines.append(f"{e['seq']:>4}  started on {e['rules']} ({e['behavior']})")
+            continue
+        text = e.get("line") or e["op"]
+        if e["op"] == "adapt":
+            text += f"   (Q {e['q'][0]:.4g} -> {e['q'][1]:.4g})"
+        if e["op"] == "save":
+            text = f"save {e['path']}"
+        mark = "  (undone)" if e["seq"] in undone else ""
+        lines.append(f"{e['seq']:>4}  {text}{mark}")
+    return "\n".join(lines)
+
+
+def interpretability_text(rb: RuleBase) -> str:
+    """What ``mitos check`` says about the terms' meaning, for the prompt."""
+    from ..lang.interpretability import rulebase_issues
+
+    issues = rulebase_issues(rb.variables.values())
+    if not issues:
+        return "interpretability: terms in order, universes covered, terms distinct, " \
+               "centre terms on their points"
+    return "\n".join(["interpretability:"] + [f"  {i.message} ({i.hint})" for i in issues])

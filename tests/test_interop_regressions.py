@@ -1,0 +1,487 @@
+"""Regression tests for foreign files that loaded wrongly or not at all, each on a small file
+of its own: names that begin with hedge words, MATLAB comments and padded parameters,
+jFuzzyLogic's FCL constructs, each format's shape definitions, non-finite numbers, and the
+batch's no-rule-fired policy."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from mitos_cli.api import load_rulebase, read_rulebase
+from mitos_cli.errors import MitosError
+from mitos_cli.interop.fcl import parse_fcl
+from mitos_cli.interop.fis import parse_fis
+from mitos_cli.interop.fll import parse_fll
+from mitos_cli.lang.parse import parse_rules
+
+
+def outputs(rb, **inputs):
+    from mitos_cli.engine.compile import compile_rulebase
+    from mitos_cli.engine.evaluation import as_batch, evaluate
+
+    c = compile_rulebase(rb)
+    return dict(zip(c.outputs, evaluate(c, as_batch(c, inputs), strict=False).outputs[0]))
+
+
+# ---------------------------------------------------------------------------------------------
+# Hedge words are whole words
+
+FLL_HEDGE_PREFIX = """\
+Engine: e
+InputVariable: x
+  range: 0 10
+  term: veryhigh Triangle 0 10 10
+  term: high Triangle 0 10 10
+OutputVariable: y
+  range: 0 10
+  defuzzifier: WeightedAverage
+  default: nan
+  term: anyway Constant 8
+  term: low Constant 2
+RuleBlock: b
+  conjunction: Minimum
+  disjunction: Maximum
+  rule: if x is veryhigh then y is anyway
+  rule: if x is notable then y is low
+"""
+
+
+def test_rule_language_reads_a_name_beginning_with_a_hedge_as_a_name():
+    rb = parse_rules("behavior b:\n if x is veryhigh then y is anyway\n"
+                     " if x is notable then y is somewhat_low\n if x is very high then y is low\nend\n")
+    a, b, c = rb.behaviors[0].rules
+    assert (a.antecedent.term, a.antecedent.hedges) == ("veryhigh", ())
+    assert a.consequents[0].term == "anyway"
+    assert (b.antecedent.term, b.antecedent.negated) == ("notable", False)
+    assert b.consequents[0].term == "somewhat_low"
+    assert (c.antecedent.term, c.antecedent.hedges) == ("high", ("very",))
+
+
+def test_fll_reads_a_name_beginning_with_a_hedge_as_a_name():
+    text = FLL_HEDGE_PREFIX.replace("rule: if x is notable then y is low\n", "")
+    rb = parse_fll(text)
+    rule = rb.behaviors[0].rules[0]
+    assert (rule.antecedent.term, rule.antecedent.hedges) == ("veryhigh", ())
+    assert outputs(rb, x=5.0)["y"] == pytest.approx(8.0)
+
+
+# ---------------------------------------------------------------------------------------------
+# MATLAB .fis as MATLAB and fuzzylite write it
+
+FIS = """\
+% $Revision: 1.1 $
+#Code automatically generated with fuzzylite
+[System]
+Name='small'
+Type='mamdani'
+NumInputs=1
+NumOutputs=1
+NumRules=2
+AndMethod='einstein_product'
+OrMethod='max'
+ImpMethod='min'
+AggMethod='max'
+DefuzzMethod='centroid'
+
+[Input1]
+Name='x'
+Range=[0 10]
+NumMFs=2
+MF1='low':'gbellmf',[3 2 0 0]
+MF2='low':'trimf',[0 10 10]
+
+[Output1]
+Name='y'
+Range=[0 10]
+NumMFs=2
+MF1='a':'trimf',[0 0 10]
+MF2='b':'trimf',[0 10 10]
+
+[Rules]
+% the two rules
+1, 1 (1) : 1
+2, 2 (1) : 1
+"""
+
+
+def test_fis_skips_comment_lines_and_reads_padded_lists_and_octave_names():
+    rb = parse_fis(FIS, "small.fis")
+    x = rb.variables["x"]
+    assert x.terms[0].shape == "bell" and x.terms[0].params == (0.0, 3.0, 2.0)
+    assert any(s.key == "and" and s.value == "einstein" for s in rb.operators)
+
+
+def test_fis_keeps_duplicate_mf_names_apart_and_says_so():
+    rb = parse_fis(FIS, "small.fis")
+    assert rb.variables["x"].term_names == ("low", "low_2")
+    r2 = rb.behaviors[0].rules[1]
+    assert (r2.antecedent.term, r2.consequents[0].term) == ("low_2", "b")
+    assert len(rb.notes) == 1 and "small.fis:20:" in rb.notes[0] and "`low_2`" in rb.notes[0]
+
+
+def test_fis_padded_list_with_a_nonzero_extra_number_is_refused():
+    with pytest.raises(MitosError, match="gbellmf takes 3 numbers, not 4"):
+        parse_fis(FIS.replace("[3 2 0 0]", "[3 2 0 1]"), "small.fis")
+
+
+# ---------------------------------------------------------------------------------------------
+# jFuzzyLogic's FCL
+
+from typer.testing import CliRunner  # noqa: E402
+
+from mitos_cli.cli.app import app  # noqa: E402
+
+runner = CliRunner(env={"COLUMNS": "200", "NO_COLOR": "1"})
+
+JFUZZY = """\
+FUNCTION_BLOCK t
+VAR_INPUT
+    x : REAL RANGE := (0 .. 10);
+    unused : REAL;
+END_VAR
+VAR_OUTPUT
+    y : REAL;
+END_VAR
+FUZZIFY x
+    TERM low := gauss 2 1;
+    TERM high := gauss 8 1;
+END_FUZZIFY
+FUZZIFY unused
+    TERM a := sigm 2 5;
+END_FUZZIFY
+DEFUZZIFY y
+    TERM a := dsigm 4 2 1 6;
+    TERM b := gbell 2 3 8;
+    METHOD : COG;
+    DEFAULT := 0;
+END_DEFUZZIFY
+RULEBLOCK r
+    AND : MIN;
+    ACT : MIN;
+    ACCU : MAX;
+    RULE 1 : IF NOT x IS low THEN y IS b;
+    RULE 2 : IF x IS low THEN y IS a;
+END_RULEBLOCK
+END_FUNCTION_BLOCK
+"""
+
+
+def test_fcl_reads_not_before_a_proposition_and_range_in_var_input():
+    rb = parse_fcl(JFUZZY, "t.fcl")
+    from mitos_cli.lang.model import Not, Prop
+
+    r1 = rb.behaviors[0].rules[0]
+    assert r1.antecedent == Not(Prop("x", "low"))
+    assert rb.variables["x"].universe == (0.0, 10.0)
+
+
+def test_fcl_derives_a_missing_range_from_unbounded_terms_as_jfuzzylogic():
+    rb = parse_fcl(JFUZZY, "t.fcl")
+    # sigm 2 5: 5 -+ 9/2; dsigm 4 2 1 6: [min(2 - 9/4, 6 - 9), max(2 + 9/4, 6 + 9)];
+    # gbell 2 3 8: 8 -+ 2 * 999^(1/6)
+    assert rb.variables["unused"].universe == (0.5, 9.5)
+    lo, hi = rb.variables["y"].universe
+    assert lo == pytest.approx(-3.0) and hi == pytest.approx(15.0)
+    assert any("`y` has no RANGE" in n and "t.fcl:16:1" in n for n in rb.notes)
+
+
+def test_fcl_dsigm_is_jfuzzylogics_clipped_difference():
+    rb = parse_fcl(JFUZZY, "t.fcl")
+    term = rb.variables["y"].term("a")
+    x = np.array([-2.0, 2.0, 6.0, 9.0, 12.0, np.nan])
+    s1 = 1 / (1 + np.exp(-4 * (x - 2)))
+    s2 = 1 / (1 + np.exp(-1 * (x - 6)))
+    from mitos_cli.fuzzy.shapes import SHAPES
+
+    got = SHAPES[term.shape].membership(x, term.params)
+    np.testing.assert_allclose(got[:-1], np.maximum(s1 - s2, 0)[:-1], rtol=0, atol=1e-15)
+    assert got[0] == 0.0 and np.isnan(got[-1])     # |s1 - s2| would give 3.4e-4 at -2
+
+
+def test_fcl_function_terms_and_multiple_blocks_are_refused_by_name():
+    text = JFUZZY.replace("TERM b := gbell 2 3 8;", "TERM b := FUNCTION (x * 2);")
+    with pytest.raises(MitosError) as info:
+        parse_fcl(text, "t.fcl")
+    assert "FUNCTION terms" in info.value.message and info.value.span.line == 18
+    with pytest.raises(MitosError) as info:
+        parse_fcl(JFUZZY + JFUZZY, "t.fcl")
+    assert "2 function blocks" in info.value.message and info.value.span.line == 30
+
+
+def test_batch_accepts_a_column_for_an_input_no_rule_tests(tmp_path: Path):
+    path = tmp_path / "t.fcl"
+    path.write_text(JFUZZY)
+    csv = tmp_path / "in.csv"
+    csv.write_text("x,unused\n1,2\n8,3\n")
+    result = runner.invoke(app, ["eval", str(path), "--batch", str(csv)])
+    assert result.exit_code == 0, result.output
+    assert result.stdout.splitlines()[0] == "x,y" and len(result.stdout.splitlines()) == 3
+    result = runner.invoke(app, ["eval", str(path), "x=1", "unused=2"])
+    assert result.exit_code == 0, result.output
+
+
+# ---------------------------------------------------------------------------------------------
+# No rule fired in a batch
+
+DIMMER = """\
+Engine: dimmer
+InputVariable: light
+  range: 0 1
+  term: DARK Triangle 0.2 0.4 0.6
+  term: BRIGHT Triangle 0.4 0.6 0.8
+OutputVariable: power
+  range: 0 1
+  defuzzifier: WeightedAverage
+  default: nan
+  term: HIGH Constant 0.9
+  term: LOW Constant 0.1
+RuleBlock: b
+  conjunction: Minimum
+  disjunction: Maximum
+  rule: if light is DARK then power is HIGH
+  rule: if light is BRIGHT then power is LOW
+"""
+
+
+def batch(tmp_path: Path, fll: str, *options: str):
+    path = tmp_path / "dimmer.fll"
+    path.write_text(fll)
+    csv = tmp_path / "in.csv"
+    csv.write_text("light\n0.1\n0.4\n0.5\n0.9\n")
+    return runner.invoke(app, ["eval", str(path), "--batch", str(csv), *options])
+
+
+def test_batch_honours_a_declared_nan_default_and_counts_the_rows(tmp_path: Path):
+    result = batch(tmp_path, DIMMER)
+    assert result.exit_code == 0, result.output
+    assert result.stdout.splitlines() == ["light,power", "0.1,nan", "0.4,0.9", "0.5,0.5",
+                                          "0.9,nan"]
+    assert "no rule sets `power` in 2 rows of 4: the file's default (nan)" in result.stderr
+
+
+def test_batch_without_a_declared_default_stops_unless_asked(tmp_path: Path):
+    fll = DIMMER.replace("  default: nan\n", "")
+    result = batch(tmp_path, fll)
+    assert result.exit_code == 1 and "no rule sets `power` for light=0.1 (2 of 4 rows)" in \
+        str(result.exception) and "--on-no-rule" in result.exception.hint
+    result = batch(tmp_path, fll, "--on-no-rule", "nan")
+    assert result.exit_code == 0, result.output
+    assert result.stdout.splitlines() == ["light,power,no_rule", "0.1,nan,power", "0.4,0.9,",
+                                          "0.5,0.5,", "0.9,nan,power"]
+    result = batch(tmp_path, fll, "--on-no-rule", "skip")
+    assert result.stdout.splitlines() == ["light,power,no_rule", "0.4,0.9,", "0.5,0.5,"]
+    assert "in 2 rows of 4: left out" in result.stderr
+    result = batch(tmp_path, DIMMER.replace("default: nan", "default: 0.5"), "--on-no-rule",
+                   "default")
+    assert result.stdout.splitlines()[1] == "0.1,0.5,power"
+    result = batch(tmp_path, DIMMER, "--on-no-rule", "error")
+    assert result.exit_code == 1
+
+
+def test_api_gives_nan_only_where_the_rule_base_asked_for_it():
+    from mitos_cli.errors import NoRuleFiredError
+
+    rb = load_rulebase_text(DIMMER)
+    assert math.isnan(rb.evaluate(light=0.1)["power"])
+    with pytest.raises(NoRuleFiredError):
+        load_rulebase_text(DIMMER.replace("  default: nan\n", "")).evaluate(light=0.1)
+
+
+def load_rulebase_text(fll: str):
+    from mitos_cli.api import LoadedRuleBase
+
+    return LoadedRuleBase(parse_fll(fll, "dimmer.fll"))
+
+
+# ---------------------------------------------------------------------------------------------
+# Numbers floating point cannot evaluate are refused where they are written
+
+TIPPER_FIS = (Path(__file__).parent / "data" / "interop" / "tipper.fis").read_text()
+
+
+@pytest.mark.parametrize("old, new, line, words", [
+    ("TERM bad := (0, 1) (4, 0);", "TERM bad := (4, 1) (NaN, 0);", 10, "must be a finite"),
+    ("TERM bad := (0, 1) (4, 0);", "TERM bad := (0, 1) (1e308, 0);", 10, "beyond"),
+    ("RANGE := (0 .. 10);", "RANGE := (0 .. inf);", 9, "the range is inf"),
+    ("DEFAULT := 5;", "DEFAULT := 50;", 15, "default 50 lies outside"),
+    ("DEFAULT := 5;", "DEFAULT := inf;", 15, "default is inf"),
+])
+def test_fcl_non_finite_and_extreme_numbers_are_refused(old, new, line, words):
+    text = """\
+FUNCTION_BLOCK f
+VAR_INPUT
+    x : REAL;
+END_VAR
+VAR_OUTPUT
+    y : REAL;
+END_VAR
+FUZZIFY x
+    RANGE := (0 .. 10);
+    TERM bad := (0, 1) (4, 0);
+    TERM good := (2, 0) (10, 1);
+END_FUZZIFY
+DEFUZZIFY y
+    TERM a := (0, 0) (5, 1) (10, 0);
+    DEFAULT := 5;
+    RANGE := (0 .. 10);
+END_DEFUZZIFY
+RULEBLOCK r
+    RULE 1 : IF x IS bad THEN y IS a;
+END_RULEBLOCK
+END_FUNCTION_BLOCK
+"""
+    assert old in text
+    parse_fcl(text, "f.fcl")
+    with pytest.raises(MitosError) as info:
+        parse_fcl(text.replace(old, new), "f.fcl")
+    assert words in info.value.message
+    assert info.value.span is not None and info.value.span.line in (line, 8, 13)
+
+
+@pytest.mark.parametrize("old, new, words", [
+    ("term: veryhigh Triangle 0 10 10", "term: veryhigh Trapezoid 0 1e309 inf inf",
+     "parameter 2 is inf"),
+    ("range: 0 10\n  defuzzifier", "range: 0 inf\n  defuzzifier", "the range is inf"),
+    ("default: nan", "default: 1000", "default 1000 lies outside its range [0, 10]"),
+    ("term: anyway Constant 8", "term: anyway Constant nan", "must be a finite"),
+])
+def test_fll_non_finite_and_out_of_range_numbers_are_refused(old, new, words):
+    assert old in FLL_HEDGE_PREFIX
+    with pytest.raises(MitosError) as info:
+        parse_fll(FLL_HEDGE_PREFIX.replace(old, new), "e.fll")
+    assert words in info.value.message and info.value.span is not None
+
+
+@pytest.mark.parametrize("old, new, words", [
+    ("Range=[0 30]", "Range=[0 inf]", "the range is inf"),
+    ("Range=[0 10]", "Range=[0 1e300]", "beyond"),
+    ("1 1, 1 (1) : 2", "9" * 400 + " 1, 1 (1) : 2", "is not an MF number"),
+    ("1 1, 1 (1) : 2", "1 1, 1.5 (1) : 2", "fractional"),
+    ("1 1, 1 (1) : 2", "1 1, 1 (1) : 99999999999999999999", "connection"),
+    ("1 1, 1 (1) : 2", "1 1, 1 (1e999) : 2", "weight"),
+])
+def test_fis_non_finite_and_extreme_numbers_are_refused(old, new, words):
+    assert old in TIPPER_FIS, old
+    with pytest.raises(MitosError) as info:
+        parse_fis(TIPPER_FIS.replace(old, new, 1), "tipper.fis")
+    assert words in info.value.message and info.value.span is not None
+
+
+def test_fis_section_numbers_too_long_for_int_are_refused():
+    with pytest.raises(MitosError, match="unknown section"):
+        parse_fis(TIPPER_FIS.replace("[Input1]", "[Input" + "9" * 5000 + "]"), "tipper.fis")
+
+
+# ---------------------------------------------------------------------------------------------
+# Round trips and sampling
+
+HYPHEN_FIS = FIS.replace("Name='x'", "Name='LDL-Level'").replace("AndMethod='einstein_product'",
+                                                                   "AndMethod='min'")
+
+
+@pytest.mark.parametrize("fmt", ["fll", "fcl", "fis"])
+def test_hyphenated_and_reserved_names_are_mapped_to_legal_ones(fmt):
+    from mitos_cli.interop import conversion_notes, parse_foreign, write_foreign
+
+    rb = parse_fis(HYPHEN_FIS.replace("MF1='low'", "MF1='very'"), "h.fis")
+    back = parse_foreign(write_foreign(rb, fmt), fmt, f"h.{fmt}")
+    want = "LDL-Level" if fmt == "fis" else "LDL_Level"
+    assert [v.name for v in back.variables.values()][0] == want
+    notes = conversion_notes(rb, fmt)
+    if fmt != "fis":
+        assert any("`LDL-Level` is written as `LDL_Level`" in n for n in notes)
+        assert any("`LDL-Level.very` is written as `very_`" in n for n in notes)
+    for x in (1.0, 4.0, 9.0):         # FLL and FCL sample 1000 midpoints, .fis 101 ends
+        assert outputs(back, **{want: x})["y"] == pytest.approx(
+            outputs(rb, **{"LDL-Level": x})["y"], abs=0.05)
+
+
+def test_fll_shoulders_are_written_to_the_term_set_as_shoulders(tmp_path: Path):
+    from mitos_cli.interop.rules_writer import write_rules
+
+    text = FLL_HEDGE_PREFIX.replace("term: high Triangle 0 10 10",
+                                    "term: high Trapezoid -inf -inf 4 7")
+    rb = parse_fll(text.replace("rule: if x is notable then y is low\n", ""), "e.fll")
+    assert rb.variables["x"].term("high").shape == "left_shoulder"
+    rules, terms = write_rules(rb, "e.terms.yaml")
+    assert "left_shoulder" in terms and "inf" not in terms
+    (tmp_path / "e.rules").write_text(rules)
+    (tmp_path / "e.terms.yaml").write_text(terms)
+    assert read_rulebase(tmp_path / "e.rules").variables["x"].term("high").shape == \
+        "left_shoulder"
+
+
+def test_convert_warns_with_the_measured_difference(tmp_path: Path):
+    source = Path(__file__).parent / "data" / "interop" / "tipper.fis"
+    result = runner.invoke(app, ["convert", str(source), "--to", "fll", "-o",
+                                 str(tmp_path / "t.fll")])
+    assert result.exit_code == 0, result.output
+    assert "reading the written FLL back, `tip` moves by up to 0.01" in result.stderr
+    result = runner.invoke(app, ["convert", str(source), "--to", "fis", "-o",
+                                 str(tmp_path / "t.fis")])
+    assert "moves by" not in result.stderr          # .fis to .fis: unchanged
+
+
+def test_fidelity_chooses_the_reference_engines_sampling():
+    from mitos_cli.engine.mamdani import grid
+
+    assert grid(0.0, 10.0, 4, "left").tolist() == [0.0, 2.5, 5.0, 7.5]
+    source = Path(__file__).parent / "data" / "interop" / "tipper.fis"
+    got = {}
+    for engine in ("matlab", "jfuzzylogic", "fuzzylite"):
+        result = runner.invoke(app, ["eval", str(source), "service=2", "food=1", "--digits",
+                                     "6", "--fidelity", engine, "--json"])
+        assert result.exit_code == 0, result.output
+        import json
+
+        got[engine] = json.loads(result.stdout)["outputs"]
+    tip = {k: v["tip"] for k, v in got.items()}
+    assert tip["matlab"] == pytest.approx(7.0169, abs=5e-5)       # MATLAB's documented value
+    assert tip["jfuzzylogic"] != tip["matlab"] and tip["fuzzylite"] != tip["matlab"]
+    # the same as asking for jFuzzyLogic's grid (1000 left cell ends) by operator settings
+    rb = load_rulebase(source)
+    from mitos_cli.api import LoadedRuleBase
+    from mitos_cli.lang.model import Setting
+
+    fine = LoadedRuleBase(rb.rulebase, None, (Setting("resolution", "1000"),
+                                              Setting("sampling", "left")))
+    assert fine.evaluate(service=2.0, food=1.0)["tip"] == pytest.approx(tip["jfuzzylogic"],
+                                                                        abs=1e-9)
+
+
+def test_fis_reads_fuzzylites_output_keys():
+    text = FIS.replace("AndMethod='einstein_product'", "AndMethod=''").replace(
+        "[Output1]\nName='y'", "[Output1]\nName='y'\nEnabled=1\nDefault=nan\nLockPrevious=0\n"
+        "LockRange=0")
+    rb = parse_fis(text.replace("2, 2 (1) : 1", "2, 2 (1) : 2"), "small.fis")
+    assert math.isnan(rb.variables["y"].default)             # the file asks for NaN
+    with pytest.raises(MitosError, match="LockPrevious=1"):
+        parse_fis(text.replace("LockPrevious=0", "LockPrevious=1"), "small.fis")
+
+
+def test_fll_repeated_term_names_mean_the_last_as_in_fuzzylite():
+    text = FLL_HEDGE_PREFIX.replace("term: high Triangle 0 10 10", "term: veryhigh Triangle 0 0 10")
+    rb = parse_fll(text.replace("rule: if x is notable then y is low\n", ""), "e.fll")
+    assert rb.variables["x"].term_names == ("veryhigh_2", "veryhigh")
+    assert rb.variables["x"].term("veryhigh").params == (0.0, 0.0, 10.0)   # the last one
+    assert any("e.fll:4:" in n and "`veryhigh_2`" in n for n in rb.notes)
+
+
+def test_exported_python_computes_jfuzzylogics_dsigm(tmp_path: Path):
+    import importlib.util
+
+    path = tmp_path / "t.fcl"
+    path.write_text(JFUZZY.replace("TERM low := gauss 2 1;", "TERM low := dsigm 4 2 1 6;"))
+    out = tmp_path / "t_py.py"
+    result = runner.invoke(app, ["export", str(path), "--to", "python", "-o", str(out)])
+    assert result.exit_code == 0, result.output
+    spec = importlib.util.spec_from_file_location("t_py", out)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    rb = load_rulebase(path)
+    X = np.linspace(0, 10, 41)[:, None]
+    np.testing.assert_allclose(module.evaluate(X)[:, 0], rb.run(X).outputs[:, 0], atol=1e-12)

@@ -1,0 +1,218 @@
+"""Nothing a user reads runs code: each attack is planted as it used to work, and runs nothing.
+
+1. Lark's ``cache=True`` unpickled ``$TMPDIR/.lark_cache_*.tmp``, which any account may plant;
+2. the rule-base cache unpickled whatever lay in its directory;
+(3. generated code and 4. the local Dask cluster have their own tests: test_export_hostile.py,
+test_study_dask.py.)
+"""
+
+from __future__ import annotations
+
+import hashlib
+import hmac
+import os
+import pickle
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from mitos_cli import api
+from mitos_cli.lang import cache
+from mitos_cli.lang.resolve import load_rules_file
+
+REPO = Path(__file__).resolve().parents[1]
+
+
+class Payload:
+    """A pickle that, when loaded, creates the file ``marker``: proof that code ran."""
+
+    def __init__(self, marker: Path):
+        self.marker = marker
+
+    def __reduce__(self):
+        return (exec, (f"open({str(self.marker)!r}, 'w').write('ran')",))
+
+
+def evil(marker: Path) -> bytes:
+    return pickle.dumps(Payload(marker))
+
+
+OLD_STYLE = """
+from lark import Lark
+from mitos_cli.resources import grammar_text
+Lark(grammar_text(), parser="lalr", propagate_positions=True, maybe_placeholders=True,
+     start=["start", "rule", "expr"], cache=True)
+"""
+
+
+def test_a_lark_cache_planted_in_tmpdir_runs_nothing(tmp_path):
+    tmpdir, marker = tmp_path / "tmp", tmp_path / "ran"
+    tmpdir.mkdir()
+    env = dict(os.environ, TMPDIR=str(tmpdir), MITOS_CACHE_DIR=str(tmp_path / "cache"))
+    # The attack: let Lark name its cache file, then replace what follows its hash line.
+    subprocess.run([sys.executable, "-c", OLD_STYLE], env=env, check=True)
+    (planted,) = tmpdir.glob(".lark_cache_*.tmp")
+    planted.write_bytes(planted.read_bytes().split(b"\n", 1)[0] + b"\n" + evil(marker))
+    subprocess.run([sys.executable, "-c", OLD_STYLE], env=env, check=True)
+    assert marker.exists()                              # how the parsers used to be built
+    marker.unlink()
+
+    done = subprocess.run([sys.executable, "-m", "mitos_cli", "eval", "road=78", "size=45",
+                           "position=4"], env=env, capture_output=True, text=True)
+    assert done.returncode == 0 and "steering" in done.stdout
+    assert not marker.exists()
+
+
+def test_no_parser_reads_or_writes_the_shared_temporary_directory(tmp_path):
+    tmpdir = tmp_path / "tmp"
+    tmpdir.mkdir()
+    env = dict(os.environ, TMPDIR=str(tmpdir), MITOS_CACHE_DIR=str(tmp_path / "cache"))
+    script = ("from mitos_cli import parse\nfrom mitos_cli.teach import commands\n"
+              "from mitos_cli.interop import fcl, fll\n"
+              "parse.parser(); commands.parser(); fcl.parser(); fll.rule_parser()\n")
+    for _ in range(2):                                   # building, then loading the analyses
+        subprocess.run([sys.executable, "-c", script], env=env, check=True)
+    assert list(tmpdir.iterdir()) == []
+    assert len(list((tmp_path / "cache").glob("grammar-*.pickle"))) == 4
+
+
+# ---- the rule-base cache ---------------------------------------------------------------------
+
+@pytest.fixture()
+def rules(tmp_path, monkeypatch):
+    monkeypatch.setenv("MITOS_CACHE_DIR", str(tmp_path / "cache"))
+    for name in ("mitos.rules", "mitos.terms.yaml", "drive.terms.yaml"):
+        shutil.copy(REPO / "rulebases" / name, tmp_path / name)
+    return tmp_path / "mitos.rules"
+
+
+def entry_of(rules: Path) -> Path:
+    return Path(os.environ["MITOS_CACHE_DIR"]) / cache.rulebase_entry(rules, rules.read_bytes())
+
+
+def test_a_planted_rulebase_entry_is_never_unpickled(rules, tmp_path):
+    marker = tmp_path / "ran"
+    api.read_rulebase(rules)                              # the directory and its key exist
+    entry = entry_of(rules)
+    entry.write_bytes(evil(marker))                       # untagged, as the old cache took it
+    assert api.read_rulebase(rules) == load_rules_file(rules)
+    forged = evil(marker)                                 # tagged with a key that is not ours
+    entry.write_bytes(hmac.new(b"k" * 32, entry.name.encode() + b"\0" + forged,
+                               hashlib.sha256).digest() + forged)
+    assert api.read_rulebase(rules) == load_rules_file(rules)
+    assert not marker.exists()
+
+
+def test_a_directory_others_can_write_is_refused_with_a_warning(rules, tmp_path, capsys):
+    marker, where = tmp_path / "ran", tmp_path / "cache"
+    where.mkdir(mode=0o700)
+    where.chmod(0o777)                # anyone may put a key and an entry tagged with it there
+    key = b"x" * 32
+    (where / "key").write_bytes(key)
+    (where / "key").chmod(0o600)
+    name = cache.rulebase_entry(rules, rules.read_bytes())
+    payload = evil(marker)
+    (where / name).write_bytes(cache._tag(key, name, payload) + payload)
+    cache._warn.cache_clear()
+    assert api.read_rulebase(rules) == load_rules_file(rules)
+    assert not marker.exists()
+    assert "writable by its group or others (mode 0777)" in capsys.readouterr().err
+    assert cache.status().path is None
+
+
+def test_a_directory_of_another_user_is_refused(rules, tmp_path, monkeypatch):
+    where = tmp_path / "cache"
+    where.mkdir(mode=0o700)
+    monkeypatch.setattr(os, "geteuid", lambda: where.stat().st_uid + 1)
+    st = cache.status()
+    assert st.path is None and st.refused and "belongs to another user" in st.reason
+
+
+def test_a_key_others_can_read_is_not_used(rules, tmp_path):
+    api.read_rulebase(rules)
+    key = tmp_path / "cache" / "key"
+    key.chmod(0o644)
+    entry = entry_of(rules)
+    assert cache.load_entry(entry.name) is None
+    assert api.read_rulebase(rules) == load_rules_file(rules)
+
+
+def test_the_directory_is_made_private(rules, tmp_path):
+    api.read_rulebase(rules)
+    where = tmp_path / "cache"
+    assert where.stat().st_mode & 0o777 == 0o700
+    assert (where / "key").stat().st_mode & 0o777 == 0o600
+    assert entry_of(rules).stat().st_mode & 0o077 == 0
+
+
+def test_without_home_there_is_no_cache_and_it_says_why(monkeypatch):
+    for name in ("MITOS_CACHE_DIR", "XDG_CACHE_HOME", "HOME"):
+        monkeypatch.delenv(name, raising=False)
+    st = cache.status()
+    assert st.path is None and not st.refused and "HOME" in st.reason
+
+
+# ---- a rule file pointing at a file that is not a term set -----------------------------------
+
+@pytest.mark.parametrize("secret", [
+    "root:$6$salt$hash:20228:0:99999:7:::\nsecond: line\n",     # YAML, but not a term set
+    "password = hunter2\n[section\n",                           # not YAML at all
+    "- just\n- a list\n",
+])
+def test_an_error_quotes_no_line_of_a_file_that_is_not_a_term_set(tmp_path, secret):
+    from mitos_cli.errors import TermSetError
+
+    (tmp_path / "private").write_text(secret)
+    rules = tmp_path / "r.rules"
+    rules.write_text(f'terms "{tmp_path / "private"}"\nif a is lo then y is hi\n')
+    with pytest.raises(TermSetError) as exc:
+        api.read_rulebase(rules)
+    shown = exc.value.render()
+    assert "is not a term set" in shown
+    for line in secret.splitlines():
+        assert line not in shown and line.split(":")[0] not in shown.split("\n", 1)[1]
+
+
+def test_a_term_set_still_shows_its_bad_line(tmp_path):
+    from mitos_cli.errors import TermSetError
+
+    (tmp_path / "t.terms.yaml").write_text("variables:\n  a: {role: input, universe: [0, 1], "
+                                           "terms: {lo: 1}}\n  : bad\n")
+    rules = tmp_path / "r.rules"
+    rules.write_text('terms "t.terms.yaml"\nif a is lo then a is lo\n')
+    with pytest.raises(TermSetError) as exc:
+        api.read_rulebase(rules)
+    assert "  : bad" in exc.value.render()
+
+
+SECRETS = ["root:$6$salt$hash:20228:0:99999:7:::\nsecond: line\n", "password = hunter2\n[x\n"]
+
+
+@pytest.mark.parametrize("secret", SECRETS)
+def test_a_world_or_map_error_quotes_no_line_of_a_foreign_file(tmp_path, secret):
+    from mitos_cli.errors import WorldError
+    from mitos_cli.sim.worldfile import load_world
+
+    (tmp_path / "private").write_text(secret)
+    (tmp_path / "w.yaml").write_text(with_map(f"  grid: {tmp_path / 'private'}\n"))
+    for named in (tmp_path / "private",                       # a lesson's `simulate FILE`
+                  tmp_path / "w.yaml"):                         # a world's `grid: FILE`
+        with pytest.raises(WorldError) as exc:
+            load_world(named)
+        shown = exc.value.render()
+        assert "is not a" in shown
+        for line in secret.splitlines():
+            assert line not in shown and line.split(":")[0] not in shown.split("\n", 1)[1]
+
+
+def with_map(block: str) -> str:
+    """The packaged corridor world with its `map:` block replaced by ``block``."""
+    lines = (REPO / "worlds" / "corridor.yaml").read_text().split("\n")
+    i = lines.index("map:") + 1
+    j = i
+    while j < len(lines) and (lines[j].startswith(" ") or not lines[j].strip()):
+        j += 1
+    return "\n".join(lines[:i]) + "\n" + block + "\n".join(lines[j:])

@@ -1,0 +1,117 @@
+"""The dynamic-window baseline: its rollouts, its obstacle cost, and a corridor run."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from mitos_cli.sim import kinematics
+from mitos_cli.sim.dwa import DWAParams, DWAPlanner, dwa_command, echo_points, footprint_clearance, rollouts
+from mitos_cli.sim.loop import simulate
+from mitos_cli.sim.world import Robot
+from mitos_cli.sim.worldfile import parse_world
+
+CORRIDOR = """\
+name: dwa-corridor
+seed: 3
+dt: 0.05
+time_limit: 20
+substeps: 2
+robot:
+  model: tricycle
+  wheelbase: 16
+  footprint: {length: 24, width: 18}
+sensors: {layout: ring, count: 24, cone: 15, range: 120, noise: 0.5}
+q_init: {x: 30, y: -10, heading: 0}
+q_goal: {x: 280, y: -10, tolerance: 12}
+map:
+  corridors:
+    - points: [[0, 0], [310, 0]]
+      width: 70
+obstacles:
+  - {name: box, shape: circle, at: [150, -12], radius: 9}
+"""
+
+
+@pytest.fixture(scope="module")
+def corridor_run():
+    world = parse_world(CORRIDOR, "dwa-corridor.yaml")
+    return world, simulate(world, DWAPlanner.for_world(world))
+
+
+def test_dwa_drives_past_the_box_to_the_goal(corridor_run):
+    world, res = corridor_run
+    assert res.outcome == "success", res.summary()
+    assert res.metrics["min_clearance_in"] > 0
+    assert res.planner == "dwa"
+
+
+def test_dwa_runs_replay_bit_for_bit(corridor_run):
+    world, res = corridor_run
+    short = world.with_changes(time_limit=2.0)
+    again = simulate(short, DWAPlanner.for_world(short))
+    k = again.ticks
+    assert np.array_equal(again.pose, res.pose[:k])
+    assert np.array_equal(again.command, res.command[:k])
+
+
+def test_a_rollout_of_a_reached_command_is_the_kinematics_arc():
+    robot = Robot()
+    v, s = np.array([[30.0, 45.0]]), np.array([[70.0, 120.0]])
+    poses = rollouts(np.array([30.0]), np.array([70.0]), v[:, :1], s[:, :1], robot, 1.0, 10)
+    lim = kinematics.Limits.of([robot])
+    x, y, h = np.zeros(1), np.zeros(1), np.zeros(1)
+    for k in range(10):
+        x, y, h = kinematics.advance(x, y, h, np.array([30.0]), np.array([70.0]), lim, 0.1)
+        assert poses[0, 0, k, 0] == pytest.approx(x[0], abs=1e-9)
+        assert poses[0, 0, k, 1] == pytest.approx(y[0], abs=1e-9)
+        assert poses[0, 0, k, 2] == pytest.approx(h[0], abs=1e-9)
+    assert poses[0, 0, -1, 2] > 0                     # steering below 90 turns left
+
+
+def test_a_rollout_ramps_within_the_limits():
+    robot = Robot()        # 40 in/s^2: from rest, 0.1 s at most 4 in/s, so under 0.4 in
+    poses = rollouts(np.zeros(1), np.array([90.0]), np.array([[60.0]]), np.array([[90.0]]),
+                     robot, 1.0, 10)
+    assert poses[0, 0, 0, 0] == pytest.approx(4.0 * 0.1)
+    assert poses[0, 0, -1, 0] == pytest.approx(sum(4.0 * k * 0.1 for k in range(1, 11)))
+
+
+def test_footprint_clearance_by_hand():
+    pose = np.zeros((1, 1, 1, 3))                                 # at the origin, facing +x
+    pts = np.array([[[20.0, 0.0], [0.0, -15.0], [16.0, 13.0], [3.0, 2.0]]])
+    for i, want in enumerate([8.0, 6.0, math.hypot(4.0, 4.0), 0.0]):
+        seen = np.zeros((1, 4), bool)
+        seen[0, i] = True
+        assert footprint_clearance(pose, pts, seen, 24.0, 18.0)[0, 0, 0] == pytest.approx(want)
+    assert footprint_clearance(pose, pts, np.zeros((1, 4), bool), 24.0, 18.0)[0, 0, 0] == math.inf
+
+
+def test_echoes_spread_over_the_beams_share_and_misses_are_not_points():
+    angles = np.deg2rad(np.arange(4) * 90.0)
+    pts, seen = echo_points(np.array([[50.0, 150.0, 150.0, 150.0]]), angles, 150.0, 3)
+    assert seen.tolist() == [[True] * 3 + [False] * 9]
+    assert np.hypot(pts[0, :3, 0], pts[0, :3, 1]) == pytest.approx([50.0] * 3)
+    assert np.degrees(np.arctan2(pts[0, :3, 1], pts[0, :3, 0])) == pytest.approx([-30, 0, 30])
+
+
+def test_a_wall_ahead_slows_it_and_open_space_speeds_it_up():
+    robot, angles = Robot(), np.deg2rad(np.arange(36) * 10.0)
+    wall = np.full((1, 36), 150.0)
+    wall[0, [34, 35, 0, 1, 2]] = 20.0                  # something 20 in ahead
+    args = (np.array([[200.0, 0.0]]), np.array([40.0]), np.array([90.0]))
+    _, slow = dwa_command(DWAParams(), *args, wall, angles, 150.0, robot, 0.05)
+    _, fast = dwa_command(DWAParams(), *args, np.full((1, 36), 150.0), angles, 150.0, robot,
+                          0.05)
+    assert slow[0] < 40.0 < fast[0]
+
+
+def test_boxed_in_it_brakes_and_the_window_bounds_the_wheel():
+    robot, angles = Robot(), np.deg2rad(np.arange(36) * 10.0)
+    steer, speed = dwa_command(DWAParams(), np.array([[200.0, 0.0]]), np.array([30.0]),
+                               np.array([90.0]), np.full((1, 36), 14.0), angles, 150.0, robot,
+                               0.05)
+    assert speed[0] == 0.0
+    assert abs(steer[0] - 90.0) <= robot.max_steering_rate * DWAParams().window_s + 1e-9

@@ -1,0 +1,294 @@
+"""What the robot knows apart from what is there: `map.given`, `known` obstacles, routes that
+keep their clearance, the refusal of passages too narrow, perception and replanning."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pytest
+from hypothesis import given as hgiven
+from hypothesis import settings
+from hypothesis import strategies as st
+
+from mitos_cli.errors import WorldError
+from mitos_cli.sim.distance import distance_transform
+from mitos_cli.sim.loop import prepare, simulate
+from mitos_cli.sim.route import NarrowPassage
+from mitos_cli.sim.worldfile import load_world, parse_world
+
+ROOT = Path(__file__).resolve().parents[1]
+
+BASE = """\
+name: t
+seed: 1
+dt: 0.05
+time_limit: {limit}
+robot:
+  model: tricycle
+  wheelbase: 16
+  footprint: {{length: 24, width: 18}}
+  safety_margin: 2
+sensors: {{layout: ring, count: 36, cone: 15, range: 150, noise: 0}}
+q_init: {{x: {sx}, y: {sy}, heading: 0}}
+q_goal: {{x: {gx}, y: {gy}}}
+"""
+
+
+def world_text(map_text: str, extra: str = "", limit: float = 10, start=(30, 0),
+               goal=(300, 0)) -> str:
+    return BASE.format(limit=limit, sx=start[0], sy=start[1], gx=goal[0],
+                       gy=goal[1]) + map_text + extra
+
+
+CORRIDOR = "map:\n  corridors:\n    - points: [[0, 0], [400, 0]]\n      width: 70\n"
+
+
+def error(text: str, path: str = "w.yaml") -> str:
+    with pytest.raises(WorldError) as info:
+        parse_world(text, path)
+    return info.value.render()
+
+
+# --- the world file ------------------------------------------------------------------------
+
+def test_obstacles_are_unknown_unless_said_known():
+    w = parse_world(world_text(CORRIDOR, "obstacles:\n"
+                               "  - {name: a, shape: circle, at: [150, 0], radius: 5}\n"
+                               "  - {name: b, shape: circle, at: [250, 20], radius: 5, "
+                               "known: true}\n"), "w.yaml")
+    assert [o.known for o in w.obstacles] == [False, True]
+    assert w.knows == "map" and w.given is None and w.min_clearance is None
+
+
+def test_a_misspelt_known_key_suggests_it():
+    text = error(world_text(CORRIDOR, "obstacles:\n"
+                            "  - {name: a, shape: circle, at: [150, 0], radius: 5, knwon: true}\n"))
+    assert "w.yaml:18:" in text and "unknown key `knwon`" in text and "did you mean `known`" in text
+
+
+def test_known_takes_true_or_false():
+    text = error(world_text(CORRIDOR, "obstacles:\n"
+                            "  - {name: a, shape: circle, at: [150, 0], radius: 5, known: ture}\n"))
+    assert "w.yaml:18:" in text and "unknown known in obstacle `a` `ture`" in text
+    assert "did you mean `true`" in text
+
+
+def test_a_moving_obstacle_cannot_be_known():
+    text = error(world_text(CORRIDOR, "obstacles:\n"
+                            "  - {name: cart, shape: circle, at: [150, 0], radius: 5,\n"
+                            "     velocity: [5, 0], known: true}\n"))
+    assert "w.yaml:19:" in text and "obstacle `cart` moves, so it cannot be `known`" in text
+
+
+def test_given_none_and_its_misspelling():
+    w = parse_world(world_text(CORRIDOR.replace("map:\n", "map:\n  given: none\n")), "w.yaml")
+    assert w.knows == "none"
+    text = error(world_text(CORRIDOR.replace("map:\n", "map:\n  given: nome\n")))
+    assert "w.yaml:14:10" in text and "did you mean `none`" in text
+
+
+def test_a_given_map_that_is_missing_is_named_where_it_is_written():
+    text = error(world_text(CORRIDOR.replace("map:\n", "map:\n  given: nowhere.yaml\n")))
+    assert "w.yaml:14:10" in text and "cannot read map file `nowhere.yaml`" in text
+
+
+def test_a_misspelt_map_or_route_key_suggests_it():
+    assert "did you mean `given`" in error(world_text(CORRIDOR.replace("map:\n",
+                                                                       "map:\n  givne: none\n")))
+    text = error(world_text(CORRIDOR, "route: {min_clerance: 8}\n"))
+    assert "w.yaml:17:9" in text and "did you mean `min_clearance`" in text
+    assert "must be positive" in error(world_text(CORRIDOR, "route: {min_clearance: -1}\n"))
+
+
+# --- grids drawn by hand -------------------------------------------------------------------
+
+def pgm(path: Path, free: np.ndarray) -> None:
+    """A map image with 1-in pixels: ``free[rows, cols]`` with row 0 at the BOTTOM."""
+    px = np.where(free[::-1], 254, 0).astype(np.uint8)
+    path.write_bytes(f"P5 {px.shape[1]} {px.shape[0]} 255\n".encode() + px.tobytes())
+    path.with_suffix(".yaml").write_text(f"image: {path.name}\nresolution: 0.0254\n"
+                                         "origin: [0.0, 0.0, 0.0]\n", encoding="utf-8")
+
+
+def hall(width: int = 80, length: int = 400) -> np.ndarray:
+    """A hall ``width`` in wide with 10-in walls all round."""
+    free = np.zeros((width + 20, length + 20), dtype=bool)
+    free[10:-10, 10:-10] = True
+    return free
+
+
+def door_map(door: int) -> np.ndarray:
+    """A hall 120 x 400 in cut in two at x = 200 by a wall with a door ``door`` in wide."""
+    free = hall(120)
+    free[:, 205:215] = False
+    mid = 10 + 60
+    free[mid - door // 2:mid - door // 2 + door, 205:215] = True
+    return free
+
+
+def grid_world(tmp_path: Path, truth: np.ndarray, given: np.ndarray | None = None,
+               extra: str = "", limit: float = 10, start=(40, 70), goal=(380, 70)) -> Path:
+    pgm(tmp_path / "truth.pgm", truth)
+    line = ""
+    if given is not None:
+        pgm(tmp_path / "given.pgm", given)
+        line = "  given: given.yaml\n"
+    w = tmp_path / "w.yaml"
+    w.write_text(world_text("map:\n  grid: truth.yaml\n" + line, extra, limit, start, goal),
+                 encoding="utf-8")
+    return w
+
+
+def occupied_distance(points: np.ndarray, free: np.ndarray) -> float:
+    """The exact distance from points to the nearest occupied 1-in pixel (a square): only
+    pixels with a free neighbour can be nearest."""
+    occ = np.pad(~free, 1, constant_values=True)
+    inner = occ[1:-1, 1:-1]
+    edge = inner & ~(occ[:-2, 1:-1] & occ[2:, 1:-1] & occ[1:-1, :-2] & occ[1:-1, 2:])
+    r, c = np.nonzero(edge)
+    lo = np.stack([c, r], axis=1).astype(float)
+    d = np.maximum(np.maximum(lo[None] - points[:, None], points[:, None] - lo[None] - 1), 0)
+    return float(np.hypot(d[..., 0], d[..., 1]).min())
+
+
+def dense(route_points: np.ndarray, step: float = 1.0) -> np.ndarray:
+    out = []
+    for a, b in zip(route_points[:-1], route_points[1:]):
+        n = max(2, int(math.dist(a, b) / step) + 1)
+        out.append(a + np.linspace(0, 1, n)[:, None] * (b - a))
+    return np.concatenate(out)
+
+
+# --- routes that keep their word -----------------------------------------------------------
+
+def test_the_route_through_a_narrow_door_keeps_its_euclidean_clearance(tmp_path):
+    free = door_map(30)               # 30 in: wider than 18 + 2 x 2, narrower than 18 + 2 x 7
+    world = load_world(grid_world(tmp_path, free, start=(40, 30), goal=(380, 110)))
+    route = prepare(world).routes[0]
+    pts = dense(route.points)
+    through = pts[(pts[:, 0] > 195) & (pts[:, 0] < 225)]
+    assert len(through)                                      # it goes through the door
+    # half the width plus the margin, measured exactly from the pixels' squares
+    assert occupied_distance(pts, free) >= 11.0 - 1e-9
+    # and from the walls of the hall, where there is room, the 15 in it asks for
+    away = pts[(np.abs(pts[:, 0] - 210) > 40) & (pts[:, 0] > 60) & (pts[:, 0] < 360)]
+    assert occupied_distance(away, free) >= 15.0 - 1e-9
+
+
+def test_simplification_never_cuts_a_corner_closer_than_the_path_it_replaces(tmp_path):
+    # an L-shaped way round a block: Douglas-Peucker alone cuts the inner corner
+    free = hall(200, 300)
+    free[10:150, 10:230] = False           # the block; the way runs above it and down its right
+    world = load_world(grid_world(tmp_path, free, start=(40, 180), goal=(270, 40), limit=1))
+    route = prepare(world).routes[0]
+    assert occupied_distance(dense(route.points), free) >= 15.0 - 1e-9
+
+
+def test_a_passage_narrower_than_the_robot_needs_is_refused_with_its_place(tmp_path):
+    world = grid_world(tmp_path, door_map(20))            # 20 in < 18 + 2 x 2
+    with pytest.raises(NarrowPassage) as info:
+        prepare(load_world(world))
+    text = info.value.render()
+    x, y = (float(v) for v in text.split("passes (")[1].split(")")[0].split(","))
+    assert 200 <= x <= 220 and 60 <= y <= 80                 # the door, at (210, 70)
+    assert "a passage about 19 in wide" in text
+    assert "it needs 11.0 in" in text and "route: {min_clearance:" in text
+
+
+def test_route_min_clearance_allows_the_squeeze(tmp_path):
+    world = load_world(grid_world(tmp_path, door_map(20), extra="route: {min_clearance: 8}\n"))
+    assert world.min_clearance == 8
+    pts = dense(prepare(world).routes[0].points)
+    assert occupied_distance(pts, door_map(20)) >= 8.0 - 1e-9
+
+
+@settings(max_examples=25, deadline=None)
+@hgiven(st.integers(1, 12), st.integers(1, 12), st.integers(0, 2 ** 32 - 1),
+        st.floats(0.0, 0.5))
+def test_the_distance_transform_is_exact(rows, cols, seed, density):
+    blocked = np.random.default_rng(seed).random((rows, cols)) < density
+    d = distance_transform(blocked, 2.0)
+    if not blocked.any():
+        assert np.isinf(d).all()
+        return
+    r, c = np.nonzero(blocked)
+    R, C = np.mgrid[0:rows, 0:cols]
+    brute = np.sqrt(((R[..., None] - r) ** 2 + (C[..., None] - c) ** 2).min(axis=-1)) * 2.0
+    assert np.array_equal(d, brute)
+    capped = distance_transform(blocked, 2.0, cap=5.0)
+    near = brute <= 5.0
+    assert np.array_equal(capped[near], brute[near]) and (capped[~near] >= 5.0).all()
+
+
+# --- perception: what the map does not show ------------------------------------------------
+
+def first_inputs(path: Path, ticks: int = 1) -> dict:
+    world = load_world(path)
+    res = simulate(replace(world, time_limit=ticks * world.dt))
+    return {k: v[:, 0] for k, v in res.perceived.items()}
+
+
+def test_an_unknown_wall_is_an_obstacle_and_a_known_one_is_not(tmp_path):
+    truth = hall(80)
+    truth[10:60, 150:160] = False           # a wall from the right side, 60 in of free hall left
+    unknown_wall = first_inputs(grid_world(tmp_path, truth, given=hall(80)))
+    assert unknown_wall["obstacle"][0] < 120 and unknown_wall["size"][0] > 20
+    assert unknown_wall["position"][0] > 0                  # it stands on the right
+    (tmp_path / "k").mkdir()
+    drawn = first_inputs(grid_world(tmp_path / "k", truth))
+    assert drawn["obstacle"][0] == 200 and drawn["size"][0] == 0
+
+
+def test_a_corridor_blocked_by_furniture_reads_as_one_wide_obstacle(tmp_path):
+    w = tmp_path / "w.yaml"
+    w.write_text(world_text(CORRIDOR, "obstacles:\n  - {name: sofa, shape: rectangle, "
+                            "at: [140, 0], length: 30, width: 70}\n"), encoding="utf-8")
+    p = first_inputs(w)
+    # ahead, in the robot's band and wider than the robot (what one cluster of echoes shows)
+    assert 50 < p["obstacle"][0] < 110 and p["size"][0] > 18 and abs(p["position"][0]) < 20
+
+
+def test_a_known_obstacle_is_on_the_map_the_route_goes_round_it(tmp_path):
+    w = tmp_path / "w.yaml"
+    w.write_text(world_text(CORRIDOR, "obstacles:\n  - {name: cabinet, shape: circle, "
+                            "at: [150, -10], radius: 12, known: true}\n"), encoding="utf-8")
+    world = load_world(w)
+    pts = dense(prepare(world).routes[0].points)
+    gap = np.hypot(pts[:, 0] - 150, pts[:, 1] + 10).min() - 12
+    assert gap >= 11.0                     # half the width and the margin (the route's floor)
+    p = first_inputs(w, ticks=30)
+    assert (p["obstacle"] == 200).all()    # drawn on its map, beside its route: a wall
+    unknown = tmp_path / "u.yaml"
+    unknown.write_text(w.read_text().replace(", known: true", ""), encoding="utf-8")
+    assert (first_inputs(unknown, ticks=30)["obstacle"] < 200).any()
+
+
+# --- replanning ----------------------------------------------------------------------------
+
+def test_the_robot_replans_when_boxes_shut_its_way_and_not_for_a_box_it_can_pass():
+    world = load_world(ROOT / "worlds" / "detour.yaml")
+    res = simulate(replace(world, time_limit=9.0))
+    assert res.metrics["replans"] == 1 and res.summary()["replans"] == 1
+    tick, robot, route = res.replanned[0]
+    assert robot == 0 and route.points[:, 1].max() > 200      # north round the loop
+    assert res.route_at(tick, 0) is route and res.route_at(0, 0) is res.routes[0]
+    corridor = simulate(load_world(ROOT / "worlds" / "corridor.yaml"))
+    assert corridor.metrics["replans"] == 0 and corridor.outcome == "success"
+
+
+def test_a_robot_with_no_map_maps_and_replans_round_a_corner(tmp_path):
+    w = tmp_path / "w.yaml"
+    w.write_text(world_text("map:\n  given: none\n  corridors:\n"
+                            "    - points: [[0, 0], [200, 0], [200, 260]]\n      width: 70\n",
+                            limit=9, goal=(200, 230)), encoding="utf-8")
+    blind = load_world(w)
+    res = simulate(blind)
+    first = dense(res.routes[0].points)
+    assert not res.static.free(first).all()   # it set off for the goal through the wall
+    assert res.metrics["replans"] >= 1 and res.outcome != "collision"
+    assert res.pose[-1, 0, 1] > 60         # round the corner, inside the corridor
+    again = simulate(blind)
+    assert np.array_equal(res.pose, again.pose)              # bit for bit

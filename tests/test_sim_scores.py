@@ -1,0 +1,70 @@
+"""BARN's score and MRPB's safety on hand-computed cases, and MRPB's test files."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from mitos_cli.errors import WorldError
+from mitos_cli.sim import mrpb
+from mitos_cli.sim.gridmap import INCH_PER_M
+from mitos_cli.sim.scores import BARN_SPEED_IN_S, barn_score, mrpb_safety, optimal_time
+
+
+def test_t_opt_is_the_path_over_two_metres_a_second():
+    assert BARN_SPEED_IN_S == pytest.approx(78.74015748)
+    assert optimal_time(10 * INCH_PER_M) == pytest.approx(5.0)
+
+
+@pytest.mark.parametrize("success, t, want", [
+    (True, 8.0, 0.5),          # faster than 2 t_opt: clipped up to 2 t_opt
+    (True, 10.0, 0.5),         # exactly 2 t_opt
+    (True, 20.0, 0.25),        # 4 t_opt
+    (True, 40.0, 0.125),       # 8 t_opt
+    (True, 90.0, 0.125),       # slower than 8 t_opt: clipped down to 8 t_opt
+    (False, 10.0, 0.0),        # no success, no score
+])
+def test_barn_score(success, t, want):
+    assert barn_score(success, t, 5.0) == pytest.approx(want)
+
+
+def test_mrpb_safety_is_the_fraction_of_time_below_the_distance():
+    assert mrpb_safety(np.array([10.0, 3.0, 5.0, 1.0]), 4.0) == 0.5
+    assert mrpb_safety(np.array([4.0, 4.0]), 4.0) == 0.0          # at the distance is safe
+    assert mrpb_safety(np.array([-0.5]), 4.0) == 1.0               # a contact is unsafe
+    assert mrpb_safety(np.array([]), 4.0) == 0.0
+
+
+def test_mrpb_tests_read_in_inches_and_degrees(tmp_path):
+    path = tmp_path / "tests.txt"
+    path.write_text("# comment\ntest 1: start (1.0, -2.0, 1.5708) -> goal (3.0, 0.0, 0.0)\n")
+    [(number, start, goal)] = mrpb.read_tests(path)
+    assert number == 1
+    assert (start.x, start.y) == pytest.approx((INCH_PER_M, -2 * INCH_PER_M))
+    assert start.heading == pytest.approx(90.0, abs=1e-3)
+    assert (goal.x, goal.y) == pytest.approx((3 * INCH_PER_M, 0.0))
+
+
+def test_a_bad_mrpb_test_line_is_positioned(tmp_path):
+    path = tmp_path / "tests.txt"
+    path.write_text("test 1: start (1, 2, 0) -> goal (3, 4, 0)\ntest 2: start (1, 2) -> (3, 4)\n")
+    with pytest.raises(WorldError) as info:
+        mrpb.read_tests(path)
+    err = info.value
+    assert err.span.line == 2 and "not an MRPB start/goal test" in str(err)
+
+
+def test_a_scenario_becomes_one_world_per_test(tmp_path):
+    folder = tmp_path / "box"
+    folder.mkdir()
+    pixels = np.full((40, 40), 254, np.uint8)
+    pixels[0, :] = pixels[-1, :] = pixels[:, 0] = pixels[:, -1] = 0
+    (folder / "map.pgm").write_bytes(b"P5\n40 40\n255\n" + pixels.tobytes())
+    (folder / "map.yaml").write_text("image: map.pgm\nresolution: 0.05\norigin: [-1, -1, 0]\n"
+                                     "negate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n")
+    (folder / "tests.txt").write_text("test 1: start (-0.5, 0, 0) -> goal (0.5, 0, 0)\n"
+                                      "test 2: start (0, -0.5, 1.57) -> goal (0, 0.5, 0)\n")
+    worlds = mrpb.scenario_worlds(tmp_path, "box")
+    assert [w.name for w in worlds] == ["mrpb/box#1", "mrpb/box#2"]
+    assert worlds[0].grid is worlds[1].grid                     # the map is read once
+    assert worlds[0].time_limit == mrpb.MIN_TIME_S

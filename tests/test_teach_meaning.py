@@ -1,0 +1,233 @@
+"""Teaching that keeps the meaning of the words: the constraints of adaptation (under random
+corrections), the interpretability findings, corrections in words and what was learned."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from mitos_cli.api import default_rulebase_path
+from mitos_cli.engine.check import check_rulebase
+from mitos_cli.engine.compile import compile_rulebase
+from mitos_cli.errors import LessonError
+from mitos_cli.lang import interpretability as meaning
+from mitos_cli.lang.parse import parse_rules
+from mitos_cli.lang.resolve import build_rulebase, load_rules_file
+from mitos_cli.lang.termfile import parse_termset
+from mitos_cli.teach.adapt import adapt, feasible, learned_rulebase, parameterise
+from mitos_cli.teach.instructions import Window, hedged, instruction, scale_of, targets
+
+PAPER = load_rules_file(default_rulebase_path())
+AVOID = compile_rulebase(PAPER, "avoid_obstacle")
+FOLLOW = compile_rulebase(PAPER, "follow_route")
+
+
+def constraints_hold(compiled, p, values) -> None:
+    """Order, coverage, distinctness and held points of the learned terms."""
+    rb = learned_rulebase(p, values)
+    assert feasible(p, values)
+    for name in compiled.inputs + compiled.outputs:
+        var = rb.variables[name]
+        assert meaning.variable_issues(var) == [], name
+    for var, term, point in p.held:
+        assert meaning.centre(rb.variables[var].term(term)) == pytest.approx(point, abs=1e-9)
+
+
+@settings(max_examples=8, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(seed=st.integers(0, 10_000), n=st.integers(1, 30), behavior=st.sampled_from(["a", "f"]))
+def test_random_corrections_keep_order_coverage_distinctness_and_points(seed, n, behavior):
+    compiled = AVOID if behavior == "a" else FOLLOW
+    rng = np.random.default_rng(seed)
+    lo = np.array([compiled.variables[k].universe[0] for k in compiled.inputs])
+    hi = np.array([compiled.variables[k].universe[1] for k in compiled.inputs])
+    X = rng.uniform(lo, hi, (n, len(lo)))
+    T = np.column_stack([rng.uniform(*compiled.variables[o].universe, n)
+                         for o in compiled.outputs])
+    T[rng.random(T.shape) < 0.3] = np.nan                   # outputs left out
+    p = parameterise(compiled)
+    seen = []
+    result = adapt(compiled, X, T, epochs=15, rate=0.9, parameters=p,
+                   on_values=lambda v: seen.append(v.copy()))
+    for v in seen + [result.values]:                       # every epoch, and the rounded end
+        constraints_hold(compiled, p, v)
+    epochs = result.history[:-1] if result.rounded else result.history
+    assert all(b < a for a, b in zip(epochs, epochs[1:]))  # Q never increases
+    assert result.q_after <= result.q_before
+
+
+def test_unconstrained_moves_what_constrained_holds():
+    X = np.array([[78.0, 45.0, 4.0], [90.0, 30.0, -3.0]])
+    T = np.array([[60.0, 20.0], [120.0, np.nan]])
+    free = adapt(AVOID, X, T, epochs=15, constrained=False)
+    held = adapt(AVOID, X, T, epochs=15)
+    assert free.q_after < held.q_after < held.q_before
+    names = {(v, t) for v, t, _ in held.parameters.held}
+    assert ("steering", "ST") in names and ("position", "CENTER") in names
+    released = parameterise(AVOID, released={("position", "CENTER")})
+    assert ("position", "CENTER") not in {(v, t) for v, t, _ in released.held}
+    frozen = parameterise(AVOID, frozen_terms={("steering", "LS")})
+    ls = next(i for i, k in enumerate(frozen.knots) if k.label == "steering: LS")
+    assert frozen.projector[ls, ls] == 0.0
+
+
+TERMS = """
+variables:
+  x:
+    role: input
+    universe: [0, 10]
+    terms:
+      A: {shape: triangle, points: [0, 2, 4]}
+      B: {shape: triangle, points: [2, 4, 6]}
+      C: {shape: triangle, points: [5, 8, 10]}
+  y: {role: output, universe: [0, 100], terms: {S: 10, M: 50, M2: 52, L: 90}}
+  z:
+    role: input
+    universe: [-10, 10]
+    terms:
+      NEG: {shape: left_shoulder, points: [-6, -2]}
+      MID: {shape: triangle, points: [-2, 1, 4]}
+      POS: {shape: right_shoulder, points: [2, 6]}
+  w:
+    role: input
+    universe: [0, 10]
+    terms:
+      P: {shape: triangle, points: [0, 5, 10]}
+      Q: {shape: triangle, points: [0.2, 5, 9.8]}
+  v:
+    role: input
+    universe: [0, 10]
+    terms:
+      HI: {shape: triangle, points: [4, 6, 8]}
+      LO: {shape: triangle, points: [0, 2, 4]}
+      MD: {shape: triangle, points: [2, 4, 6]}
+"""
+
+
+def test_check_reports_each_interpretability_problem():
+    rb = build_rulebase(parse_rules("behavior b:\n r1: if x is A and z is MID and w is P "
+                                    "and v is HI then y is S\nend\n"),
+                        (parse_termset(TERMS),), ("t.yaml",))
+    found = {(f.code, f.message.split("`")[1]) for f in check_rulebase(rb).findings}
+    assert ("coverage", "x") in found                      # between B (6) and C (5..8)
+    assert ("indistinct", "y.M") in found                 # 50 and 52
+    assert ("indistinct", "w.P") in found                 # two nearly equal triangles
+    assert ("term-order", "v.LO") in found                # written after HI, lies below it
+    assert ("off-centre", "z.MID") in found               # NEG / POS mirror about 0
+    assert not [f for f in check_rulebase(PAPER).findings
+                if f.code in ("term-order", "coverage", "indistinct", "off-centre")]
+
+
+def test_coverage_is_exact_at_a_crossing():
+    corners = np.array([[-np.inf, -np.inf, 0.0, 4.0], [2.0, 6.0, np.inf, np.inf]])
+    low, where = meaning.coverage(corners, (0.0, 10.0))
+    assert low == pytest.approx(0.25) and where == pytest.approx(3.0)   # (4 - x) / 4 = (x - 2) / 4
+
+
+def test_hedged_terms_move_along_the_scale():
+    steering = PAPER.variables["steering"]
+    assert hedged(steering, "LM", ()) == 50
+    assert hedged(steering, "LM", ("very",)) == 40                 # half a term further left
+    assert hedged(steering, "RM", ("extremely",)) == 150
+    assert hedged(steering, "LS", ("somewhat",)) == 80             # half a term toward ST
+    assert hedged(steering, "ST", ("very",)) == 90
+    with pytest.raises(LessonError, match="has no meaning"):
+        hedged(steering, "LM", ("seldom",))
+
+
+def window(steering, speed=None, gap_left=None, gap_right=None):
+    n = len(steering)
+    outputs = {"steering": np.array(steering, dtype=float)}
+    if speed is not None:
+        outputs["speed"] = np.array(speed, dtype=float)
+    inputs = {"gap_left": np.array(gap_left if gap_left else [50.0] * n),
+              "gap_right": np.array(gap_right if gap_right else [50.0] * n)}
+    return Window(outputs, inputs, PAPER.variables)
+
+
+@pytest.mark.parametrize("words, steering, expected", [
+    ("turn harder", [70, 85, 90, 110], [50, 65, np.nan, 130]),
+    ("turn less", [50, 85, 90, 130], [70, 90, 90, 110]),
+    ("make a wider turn", [77, 67, 70], [47, 47, 47]),
+    ("keep right", [90, 140], [110, 150]),
+])
+def test_steering_instructions_in_term_steps(words, steering, expected):
+    np.testing.assert_allclose(targets(instruction(tuple(words.split())), window(steering)),
+                               expected)
+
+
+def test_speed_and_wall_instructions():
+    w = window([90, 90], speed=[25, 60], gap_left=[5, 40], gap_right=[40, 5])
+    np.testing.assert_allclose(targets(instruction(("slow", "down")), w), [15, 50])
+    np.testing.assert_allclose(targets(instruction(("speed", "up")), w), [35, 60])
+    np.testing.assert_allclose(targets(instruction(tuple(["keep", "further", "from", "the", "wall"])),
+                                       w), [110, 70])           # away from the nearer side
+
+
+def test_unknown_instruction_says_did_you_mean_and_lists_them():
+    with pytest.raises(LessonError) as info:
+        instruction(("make", "a", "wide", "turn"))
+    text = str(info.value.render() if hasattr(info.value, "render") else info.value)
+    assert "unknown instruction `make a wide turn`" in text
+    assert info.value.hint == "did you mean `make a wider turn`?"
+    assert "`turn harder`" in info.value.expected and "`keep right`" in info.value.expected
+
+
+def test_scale_centre_is_the_mirror_point():
+    assert scale_of(PAPER.variables["steering"]).centre == 3.0       # ST
+
+
+def test_an_unknown_instruction_at_the_prompt_names_its_place_and_the_list():
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1]
+    lesson = "use drive\nsimulate figure4\nat 13s to 14s make a wide turn\n"
+    res = subprocess.run([sys.executable, "-m", "mitos_cli", "teach", "rulebases/mitos.rules",
+                          "--lesson", "-"], cwd=root, input=lesson, capture_output=True,
+                         text=True, timeout=120)
+    assert res.returncode == 1
+    assert "<stdin>:3:1: lesson error: unknown instruction `make a wide turn`" in res.stderr
+    assert "did you mean `make a wider turn`?" in res.stderr
+    assert "`turn harder`, `turn less`, `make a wider turn`, `slow down`" in res.stderr
+    assert "Traceback" not in res.stderr
+
+
+def test_outside_the_repository_packaged_rules_and_lessons_are_found_and_save_remembers(
+        tmp_path):
+    import subprocess
+    import sys
+
+    def teach(*args, stdin=None):
+        return subprocess.run([sys.executable, "-m", "mitos_cli", "teach", *args], cwd=tmp_path,
+                              input=stdin, capture_output=True, text=True, timeout=120)
+
+    res = teach("rulebases/mitos.rules", "--lesson", "-",
+                stdin="correct road=78 size=45 position=4 -> steering is LM\nsave a.rules\n")
+    assert res.returncode == 0, res.stderr
+    assert (tmp_path / "a.rules").is_file()
+    res = teach("--resume", stdin="correct road=78 size=45 position=4 -> steering=55\n"
+                                  "adapt epochs 2\nsave\n")
+    assert res.returncode == 0, res.stderr
+    assert "saved a.rules" in res.stdout                   # where the earlier `save` went
+    res = teach("--lesson", "no-such-lesson")
+    assert res.returncode == 1 and "cannot read lesson `no-such-lesson`" in res.stderr
+
+
+def test_simulation_corrections_name_the_robot():
+    from mitos_cli.teach.session import Session
+
+    said = []
+    s = Session(default_rulebase_path(), out=said.append)
+    s.run("use drive")
+    s.run("simulate multirobot robot oncoming")
+    assert "multirobot (robot oncoming) with behavior drive" in said[-1]
+    s.run("at 2s steering is ST")
+    first = s.state.examples[-1].inputs
+    s.run("simulate multirobot")
+    s.run("at 2s steering is ST")
+    assert s.state.examples[-1].inputs != first               # the other robot's perception
+    with pytest.raises(LessonError, match="did you mean `oncoming`"):
+        s.run("simulate multirobot robot oncomin")
