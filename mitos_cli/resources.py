@@ -50,9 +50,9 @@ def resolve(kind: str, name: str | Path, suffix: str, base: Path | None = None) 
     for candidate in ([base / p] if base is not None else []) + [p]:
         if candidate.is_file():
             return candidate
-    for candidate in (p.name, p.name + suffix):
-        if (data_dir(kind) / candidate).is_file():
-            return packaged_path(kind, candidate)
+    for filename in (p.name, p.name + suffix):
+        if (data_dir(kind) / filename).is_file():
+            return packaged_path(kind, filename)
     return None
 
 
