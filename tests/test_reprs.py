@@ -17,7 +17,7 @@ def test_reprs_are_one_line_with_the_sizes():
         assert "\n" not in text and len(text) < 300, text
     assert "27 rules" in repr(rb.compiled) and "and = min" in repr(rb.compiled)
     assert "1,000 samples x 2 outputs (steering, speed)" in repr(r)
-    assert "7 behaviors" in repr(rb.rulebase)
+    assert "8 behaviors" in repr(rb.rulebase)      # take_opening joined the packaged base
 
 
 def test_a_trace_shows_itself_in_a_notebook():
