@@ -77,21 +77,22 @@ def syntax_error(exc: UnexpectedInput, text: str, path: str | None) -> RuleSynta
     """Lark's exception as a user-facing error (never ``$END`` or ``Token(...)``)."""
     if isinstance(exc, UnexpectedCharacters):
         line, column = exc.line, exc.column
-        char = text[exc.pos_in_stream] if exc.pos_in_stream < len(text) else ""
+        pos: int = exc.pos_in_stream  # type: ignore[assignment]  # lark declares None; the lexer sets an int
+        char = text[pos] if pos < len(text) else ""
         message = f"unexpected character `{char}`" if char.isprintable() else \
             f"unexpected character {char!r}"
-        expected = _expected(exc.allowed) if exc.allowed else None
+        allowed = _expected(exc.allowed) if exc.allowed else None
         return RuleSyntaxError(message, span=Span.in_text(text, path, line, column),
-                               expected=expected)
+                               expected=allowed)
     if isinstance(exc, UnexpectedEOF) or (isinstance(exc, UnexpectedToken)
                                           and exc.token.type == "$END"):
         lines = text.rstrip().splitlines() or [""]
         line = len(lines)
         column = len(lines[-1]) + 1
-        expected = getattr(exc, "expected", None) or []
+        names = getattr(exc, "expected", None) or []
         return RuleSyntaxError("unexpected end of the input",
                                span=Span.in_text(text, path, line, column),
-                               expected=_expected(expected) if expected else None,
+                               expected=_expected(names) if names else None,
                                hint="the last rule or behavior is incomplete (a behavior ends "
                                     "with `end`)")
     assert isinstance(exc, UnexpectedToken)
@@ -139,29 +140,40 @@ RESERVED = {"if", "then", "and", "or", "not", "is", "with", "use", "when", "end"
 def _word_before(text: str, token: Token) -> str:
     """The word just before ``token`` on its line (for hints)."""
     lines = text.splitlines()
-    if not 0 < token.line <= len(lines):
+    if token.line is None or token.column is None or not 0 < token.line <= len(lines):
         return ""
     words = lines[token.line - 1][:token.column - 1].split()
     return words[-1] if words else ""
 
 
+def shift(span: Span | None, lines: int) -> Span | None:
+    """``span`` moved down ``lines`` lines (text parsed alone, taken from a longer file)."""
+    if span is None or not lines:
+        return span
+    import dataclasses
+
+    return dataclasses.replace(span, line=span.line + lines)
+
+
 def _span(meta, text: str, path: str | None) -> Span | None:
     if getattr(meta, "empty", True):
         return None
-    return Span.in_text(text, path, meta.line, meta.column, meta.end_column
-                        if meta.end_line == meta.line else None)
+    return Span.at(text, path, meta.start_pos, meta.line, meta.column, meta.end_column
+                   if meta.end_line == meta.line else None)
 
 
 class _ToModel(Transformer):
     """Tree -> model objects. Only builds: names are checked later (Lark wraps errors here)."""
 
-    def __init__(self, text: str, path: str | None) -> None:
+    def __init__(self, text: str, path: str | None, line_offset: int = 0) -> None:
         super().__init__()
         self.text, self.path = text, path
         self.counter = 0
+        self.line_offset = line_offset        # the text starts at this line + 1 of its file
 
     def _s(self, meta) -> Span | None:
-        return _span(meta, self.text, self.path)
+        span = _span(meta, self.text, self.path)
+        return shift(span, self.line_offset)
 
     def number(self, items):
         return float(items[0])
@@ -244,8 +256,8 @@ class _ToModel(Transformer):
     def terms_stmt(self, meta, items):
         spans = []
         for tok in items:
-            spans.append((_unquote(tok), Span.in_text(self.text, self.path, tok.line,
-                                                      tok.column, tok.end_column)))
+            spans.append((_unquote(tok), Span.at(self.text, self.path, tok.start_pos,
+                                                 tok.line, tok.column, tok.end_column)))
         return ("terms", tuple(spans))
 
     @v_args(meta=True)
@@ -264,25 +276,54 @@ def _unquote(token: Token) -> str:
         return str(token)[1:-1]
 
 
+#: how deep conditions may nest (`not (not (a or (b and ...)))`): far beyond any readable
+#: rule, and shallow enough for every later pass, which walks expressions recursively
+MAX_NESTING = 100
+
+
 def parse_tree(text: str, path: str | None = None, start: str = "start") -> Tree:
     try:
-        return parser().parse(text, start=start)
+        tree = parser().parse(text, start=start)
     except UnexpectedInput as exc:
         raise syntax_error(exc, text, path) from None
+    check_nesting(tree, text, path)
+    return tree
+
+
+def check_nesting(tree: Tree, text: str, path: str | None, limit: int = MAX_NESTING) -> None:
+    """Refuse a tree nested deeper than ``limit`` (walked without recursion), at the first
+    node past the limit."""
+    stack = [(tree, 0)]
+    while stack:
+        node, depth = stack.pop()
+        if depth > limit:
+            meta = node.meta
+            span = None if getattr(meta, "empty", True) else Span.at(
+                text, path, meta.start_pos, meta.line, meta.column)
+            raise RuleSyntaxError(f"conditions nested more than {limit} deep", span=span,
+                                  hint="split the condition into several rules, or drop "
+                                       "doubled `not`s and parentheses")
+        stack.extend((child, depth + 1) for child in node.children if isinstance(child, Tree))
 
 
 def parse_rules(text: str, path: str | None = None) -> ParsedFile:
     """Parse a whole rule file into model objects (names unchecked)."""
     tree = parse_tree(text, path)
     items = _ToModel(text, path).transform(tree).children
-    terms, operators, rules, uses, frozen, behaviors = [], [], [], [], [], []
+    terms: list[tuple[str, Span]] = []
+    operators: list[Setting] = []
+    rules: list[Rule] = []
+    uses: list[Use] = []
+    frozen: list[str] = []
+    behaviors: list[Behavior] = []
     for item in items:
         _collect(item, terms, operators, rules, uses, frozen, behaviors)
     return ParsedFile(text, path, tuple(terms), tuple(operators), tuple(rules), tuple(uses),
                       tuple(frozen), tuple(behaviors))
 
 
-def _collect(item, terms, operators, rules, uses, frozen, behaviors) -> None:
+def _collect(item, terms: list[tuple[str, Span]], operators: list[Setting], rules: list[Rule],
+             uses: list[Use], frozen: list[str], behaviors: list[Behavior]) -> None:
     if isinstance(item, Rule):
         rules.append(item)
     elif isinstance(item, Use):
@@ -297,7 +338,10 @@ def _collect(item, terms, operators, rules, uses, frozen, behaviors) -> None:
         frozen.extend(item[1])
     elif item[0] == "behavior":
         _, name, body, span = item
-        b_rules, b_ops, b_uses, b_frozen = [], [], [], []
+        b_rules: list[Rule] = []
+        b_ops: list[Setting] = []
+        b_uses: list[Use] = []
+        b_frozen: list[str] = []
         for sub in body:
             _collect(sub, [], b_ops, b_rules, b_uses, b_frozen, [])
         behaviors.append(Behavior(name, tuple(b_rules), tuple(b_uses),
