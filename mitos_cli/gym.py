@@ -24,7 +24,8 @@ as ``mitos simulate`` does (sensor noise, moving obstacles, replanning, the verd
 - **terminated** on the goal or a collision; **truncated** at the world's time limit, and when
   the simulator finds the robot stuck (it moved less than 3 in in 6 s). At truncation the
   observation is the last one perceived (the simulator senses no tick past its limit).
-- **info**: ``t`` (s simulated, as ``mitos simulate`` counts them: ticks times ``dt``), ``pose`` (x, y in, heading deg), ``clearance`` (in), ``outcome``.
+- **info**: ``t`` (s simulated, ticks times ``dt`` as ``mitos simulate`` counts them),
+  ``pose`` (x, y in, heading deg), ``clearance`` (in), ``outcome``.
 - **render_mode** ``rgb_array``: the map, the obstacles, the footprint and the trail as an RGB
   image (matplotlib's Agg canvas); ``human``: a window where a display is, else the terminal
   live view of ``mitos simulate --live`` on stderr.
@@ -242,7 +243,8 @@ class MitosEnv(gymnasium.Env):
 
     def _info(self) -> dict:
         sim = self.sim
-        return {"t": round(sim.ticks * sim.dt, 6), "pose": sim.pose[0], "clearance": float(sim.clearance[0]),
+        return {"t": round(sim.ticks * sim.dt, 6), "pose": sim.pose[0],
+                "clearance": float(sim.clearance[0]),
                 "outcome": sim.robot_outcomes[0] if sim.done else "driving"}
 
 

@@ -31,7 +31,7 @@ class RunFrame:
         w, h = xmax - xmin + 2 * pad, ymax - ymin + 2 * pad
         dpi = 80
         fw = width_px / dpi
-        fh = max(1.5, min(fw * h / w, 12.0)) + 0.3
+        fh = max(0.8, min(fw * h / w, 12.0)) + 0.3
         self.fig = new_figure((fw, fh), show=show, dpi=dpi)
         ax = self.ax = self.fig.add_axes((0.0, 0.0, 1.0, 1.0 - 0.3 / fh))
         ax.set_aspect("equal")
