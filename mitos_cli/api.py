@@ -43,8 +43,10 @@ def read_rulebase(path: str | Path | None = None) -> RuleBase:
         from .interop import read_foreign
 
         return read_foreign(path)
+    from .fileio import finish_saves
     from .lang.cache import cached_rulebase
 
+    finish_saves(path)              # a save of this rule base that a crash left half done
     return cached_rulebase(path, _load_rules_file)
 
 

@@ -9,6 +9,7 @@ is not a ``MitosError`` is a bug and keeps its traceback.
 from __future__ import annotations
 
 import difflib
+import re
 from dataclasses import dataclass
 from typing import Iterable
 
@@ -22,6 +23,8 @@ class Span:
     column: int
     source_line: str | None = None
     end_column: int | None = None
+    #: the column where ``source_line`` starts (a long line is kept only around the column)
+    source_start: int = 1
 
     def __str__(self) -> str:
         where = self.path or "<input>"
@@ -34,6 +37,42 @@ class Span:
         lines = text.splitlines()
         source = lines[line - 1] if 0 < line <= len(lines) else None
         return cls(path, line, column, source, end_column)
+
+    @classmethod
+    def at(cls, text: str, path: str | None, index: int, line: int, column: int,
+           end_column: int | None = None, breaks: "re.Pattern[str] | None" = None) -> "Span":
+        """A span at character ``index`` of ``text`` (which is at ``line``/``column``).
+
+        Finds the source line around ``index`` in time proportional to that line, not to the
+        text, so a reader can give every node of a large file a span (splitting the whole text
+        per node made parsing quadratic). Lines longer than :data:`SHOWN` keep only the part
+        around the column.
+        """
+        breaks = breaks or _NEWLINE
+        index = min(max(index, 0), len(text))
+        stop = breaks.search(text, index)
+        end = stop.start() if stop else len(text)
+        start, window = 0, 256
+        while True:
+            lo = max(0, index - window)
+            last = None
+            for last in breaks.finditer(text, lo, index):
+                pass
+            if last is not None:
+                start = last.end()
+                break
+            if lo == 0 or window > SHOWN:
+                start = lo
+                break
+            window *= 4
+        first = max(start, index - SHOWN // 2)
+        source = text[first:min(end, first + SHOWN)]
+        return cls(path, line, column, source, end_column, column - (index - first))
+
+
+#: how much of a long source line a span keeps (characters, around the column)
+SHOWN = 240
+_NEWLINE = re.compile(r"\n")
 
 
 class MitosError(Exception):
@@ -58,10 +97,13 @@ class MitosError(Exception):
         head = f"{self.span}: " if self.span else ""
         out = [f"{head}{self.kind}: {self.message}"]
         if self.span and self.span.source_line is not None:
-            src = self.span.source_line.rstrip("\n").expandtabs(4)
-            out.append(f"    {src}")
+            raw = self.span.source_line.rstrip("\r\n")
+            col = self.span.column - self.span.source_start      # 0-based in ``raw``
+            src = raw.expandtabs(4)
+            col = len(raw[:max(0, col)].expandtabs(4))
             width = max(1, (self.span.end_column or self.span.column + 1) - self.span.column)
-            out.append("    " + " " * max(0, self.span.column - 1) + "^" * width)
+            out.append(f"    {src}")
+            out.append("    " + " " * col + "^" * min(width, max(1, len(src) - col)))
         if self.expected:
             out.append(f"expected {self.expected}")
         if self.hint:

@@ -50,3 +50,110 @@ def atomic_write(path: str | Path, data: str | bytes,
     """Replace ``path`` with ``data`` (text as UTF-8) in one step."""
     with atomic_file(path, binary=isinstance(data, bytes), error=error) as fh:
         fh.write(data)
+
+
+# ---- several files as one set ------------------------------------------------------------------
+
+def _manifest(anchor: Path) -> Path:
+    return anchor.parent / f".{anchor.name}.saving.json"
+
+
+def atomic_write_set(files: list[tuple[Path, str | bytes]], anchor: Path,
+                     error: type[MitosError] = MitosError) -> None:
+    """Replace several files so that readers see the old set or the new set, whole.
+
+    Every new file is written beside its target and fsynced; then a manifest naming them
+    (``.ANCHOR.saving.json`` beside ``anchor``, the set's main file) is written atomically:
+    that rename is the moment the new set exists. The files are then renamed over their
+    targets and the manifest removed. A crash before the manifest leaves the old set (and
+    temporary files that :func:`finish_saves` removes); a crash after it leaves a manifest
+    that :func:`finish_saves` carries out on the next read or save.
+    """
+    import json
+
+    pending: list[tuple[Path, Path]] = []
+    try:
+        for path, data in files:
+            path = Path(path)
+            tmp = path.parent / f".{path.name}.{os.getpid()}.{secrets.token_hex(4)}.tmp"
+            try:
+                fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666)
+                pending.append((tmp, path))
+                with os.fdopen(fd, "wb") as fh:
+                    fh.write(data.encode("utf-8") if isinstance(data, str) else data)
+                    fh.flush()
+                    os.fsync(fh.fileno())
+            except OSError as exc:
+                raise error(f"cannot write `{path}`: {exc.strerror or exc}") from None
+        manifest = _manifest(Path(anchor))
+        atomic_write(manifest, json.dumps(
+            [[os.path.relpath(t, manifest.parent), os.path.relpath(p, manifest.parent)]
+             for t, p in pending]), error=error)
+    except BaseException:
+        for tmp, _ in pending:
+            with contextlib.suppress(OSError):
+                os.unlink(tmp)
+        raise
+    finish_saves(Path(anchor), error=error)
+
+
+def finish_saves(anchor: Path, error: type[MitosError] = MitosError) -> bool:
+    """Complete a set save that a crash interrupted after its manifest was written, and remove
+    temporary files of saves that died before it. True when something was completed."""
+    import json
+
+    anchor = Path(anchor)
+    _remove_orphans(anchor.parent)
+    manifest = _manifest(anchor)
+    try:
+        pairs = json.loads(manifest.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        return False
+    except (OSError, ValueError):              # torn manifest: its rename never happened
+        with contextlib.suppress(OSError):
+            manifest.unlink()
+        return False
+    base = manifest.parent
+    try:
+        for tmp, path in pairs:
+            with contextlib.suppress(FileNotFoundError):    # renamed already (by another)
+                os.replace(base / tmp, base / path)
+        with contextlib.suppress(FileNotFoundError):
+            manifest.unlink()
+    except OSError as exc:
+        raise error(f"cannot finish saving `{anchor}`: {exc.strerror or exc}") from None
+    return True
+
+
+def _remove_orphans(directory: Path) -> None:
+    """Temporary files of writers that are no longer running, unless a manifest names them."""
+    import json
+
+    try:
+        names = [p for p in directory.iterdir() if p.name.startswith(".")]
+    except OSError:
+        return
+    named: set[str] = set()
+    for m in (p for p in names if p.name.endswith(".saving.json")):
+        with contextlib.suppress(OSError, ValueError):
+            named.update(str((directory / t).resolve()) for t, _ in json.loads(m.read_text()))
+    for p in names:
+        parts = p.name.rsplit(".", 3)
+        if len(parts) != 4 or parts[3] != "tmp" or not parts[1].isdigit():
+            continue
+        if str(p.resolve()) in named or _alive(int(parts[1])):
+            continue
+        with contextlib.suppress(OSError):
+            p.unlink()
+
+
+def _alive(pid: int) -> bool:
+    if pid == os.getpid():
+        return True
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except OSError:
+        return True
+    return True

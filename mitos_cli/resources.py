@@ -48,12 +48,21 @@ def resolve(kind: str, name: str | Path, suffix: str, base: Path | None = None) 
     ``worlds/figure4.yaml``, ``rulebases/mitos.rules`` from anywhere), else ``None``."""
     p = Path(name)
     for candidate in ([base / p] if base is not None else []) + [p]:
-        if candidate.is_file():
+        if _is_file(candidate):
             return candidate
     for candidate in (p.name, p.name + suffix):
-        if (data_dir(kind) / candidate).is_file():
+        if _is_file(data_dir(kind) / candidate):
             return packaged_path(kind, candidate)
     return None
+
+
+def _is_file(path: Path) -> bool:
+    """``path.is_file()``, False for a name the system cannot look up (longer than 255
+    characters): such a name is simply not found, and the caller says so in words."""
+    try:
+        return path.is_file()
+    except OSError:
+        return False
 
 
 def display_path(path: str | None) -> str:

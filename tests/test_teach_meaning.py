@@ -231,3 +231,15 @@ def test_simulation_corrections_name_the_robot():
     assert s.state.examples[-1].inputs != first               # the other robot's perception
     with pytest.raises(LessonError, match="did you mean `oncoming`"):
         s.run("simulate multirobot robot oncomin")
+
+
+def test_the_measures_memberships_are_the_terms_own():
+    for var in PAPER.variables.values():
+        terms = [t for t in var.terms if t.corners is not None]
+        if not terms:
+            continue
+        corners = np.array([t.corners for t in terms], dtype=float)
+        x = np.unique(np.concatenate([np.linspace(*var.universe, 97),
+                                      corners[np.isfinite(corners)]]))
+        expected = np.array([t.membership(x) for t in terms])
+        np.testing.assert_allclose(meaning.memberships(corners, x), expected, atol=1e-12)

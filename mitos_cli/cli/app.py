@@ -12,6 +12,7 @@ builds the app with only the command it was asked for (about 30 ms less per ``mi
 from __future__ import annotations
 
 import importlib
+import errno
 import sys
 from typing import Annotated
 
@@ -89,3 +90,22 @@ def main(argv: list[str] | None = None) -> None:
 
         report_error(exc)
         sys.exit(1)
+    except OSError as exc:
+        # a path argument the system refuses to look up (a name over 255 characters): the
+        # user's input, not a bug, wherever in a command it was first used
+        if exc.errno not in (errno.ENAMETOOLONG, errno.ELOOP):
+            raise
+        from .output import report_error
+
+        report_error(path_error(exc))
+        sys.exit(1)
+
+
+def path_error(exc: OSError) -> MitosError:
+    """An ``OSError`` about a path the system cannot look up, in words."""
+    name = str(exc.filename) if exc.filename is not None else ""
+    shown = name if len(name) <= 80 else name[:40] + "..." + name[-30:]
+    if exc.errno == errno.ELOOP:
+        return MitosError(f"`{shown}`: too many levels of symbolic links")
+    return MitosError(f"the path `{shown}` is too long ({len(name):,} characters)",
+                      hint="each part of a path may have at most 255 characters")

@@ -31,6 +31,10 @@ def teach_command(
     session_name: Annotated[str | None, typer.Option(
         "--session", metavar="NAME", help="The session to resume (a name under "
                                           ".mitos/teach/).")] = None,
+    recover: Annotated[bool, typer.Option(
+        "--recover", help="With --resume: keep the changes before a damaged line of the "
+                          "journal and continue from there (the damaged journal is kept as "
+                          "journal.jsonl.damaged).")] = False,
 ) -> None:
     """Teach a rule base: tell rules and behaviors, correct outputs, adapt, save."""
     from ..api import default_rulebase_path
@@ -42,20 +46,25 @@ def teach_command(
     from .output import emit, err
 
     lesson_text = None
+    if recover and not resume:
+        raise typer.BadParameter("--recover applies to a resumed session: add --resume")
     if session_name is not None and not resume:
         raise typer.BadParameter("--session names a session to resume: add --resume")
     if resume:
         if rules is not None or behavior is not None:
             raise typer.BadParameter("--resume continues a session with its own rule file and "
                                      "behavior; give neither RULES nor --behavior")
-        journal = Journal.open(find_session(session_name))
-        session = Session.resume(journal, out=emit, progress=epoch_progress)
+        journal = Journal.open(find_session(session_name), recover=recover)
+        session = Session.resume(journal, out=emit, progress=epoch_progress, recover=recover)
         if save_as is not None:
             session.save_as = Path(save_as)
         err(f"resumed session {journal.directory.name}: {plural(len(journal.active()), 'change')}, "
             f"{plural(len(session.state.examples), 'example')}, behavior {session.state.active}"
-            + (" (a torn last line of the journal was dropped)" if journal.skipped_tail
-               else ""))
+            + (f"; the last change was incomplete (the journal was cut short during a write) "
+               f"and was dropped; the journal as it was is kept as {journal.aside}"
+               if journal.skipped_tail else "")
+            + (f"; recovered up to the damaged line {journal.recovered_at} of the journal "
+               f"(kept as {journal.aside})" if journal.recovered_at else ""))
     else:
         from ..resources import resolve
 

@@ -115,7 +115,8 @@ class CompiledRuleBase:
         distinct = list(dict.fromkeys(masks))
         K = np.vstack([self.cons_value.T] + [np.array(d, dtype=float)[None] for d in distinct])
         rows = np.array([len(self.outputs) + distinct.index(m) for m in masks], dtype=np.intp)
-        return K.reshape(-1, self.n_rules), rows
+        # (an explicit row count: with no rules, ``reshape(-1, 0)`` cannot infer it)
+        return K.reshape(len(self.outputs) + len(distinct), self.n_rules), rows
 
     @property
     def n_rules(self) -> int:
@@ -287,14 +288,23 @@ class _Builder:
     def levels(self, tnorm_identity: int = ONE) -> tuple[tuple[NodeGroup, ...], ...]:
         out: dict[int, list[NodeGroup]] = {}
         for (level, op), items in sorted(self.pending.items()):
-            arity = max(len(ch) for _, ch in items)
-            pad = ZERO if op == "or" else ONE
-            children = np.full((len(items), arity), pad, dtype=np.intp)
-            for i, (_, ch) in enumerate(items):
-                children[i, :len(ch)] = ch
-            group = NodeGroup(op, np.array([c for c, _ in items], dtype=np.intp), children)
-            out.setdefault(level, []).append(group)
+            # neurons of similar fan-in share a group (fan-in up to a power of two), so one
+            # rule with 10,000 conditions does not pad every neuron of its level to 10,000
+            buckets: dict[int, list[tuple[int, list[int]]]] = {}
+            for item in items:
+                buckets.setdefault((len(item[1]) - 1).bit_length(), []).append(item)
+            for _, bucket in sorted(buckets.items()):
+                out.setdefault(level, []).append(_group(op, bucket))
         return tuple(tuple(out[k]) for k in sorted(out))
+
+
+def _group(op: str, items: list[tuple[int, list[int]]]) -> NodeGroup:
+    arity = max(len(ch) for _, ch in items)
+    pad = ZERO if op == "or" else ONE
+    children = np.full((len(items), arity), pad, dtype=np.intp)
+    for i, (_, ch) in enumerate(items):
+        children[i, :len(ch)] = ch
+    return NodeGroup(op, np.array([c for c, _ in items], dtype=np.intp), children)
 
 
 def compile_rulebase(rb: RuleBase, behavior: str | None = None,
@@ -309,6 +319,12 @@ def compile_rulebase(rb: RuleBase, behavior: str | None = None,
     operators = ops_mod.resolve(overrides, ops_mod.resolve(b.operators,
                                                            ops_mod.resolve(rb.operators)))
     flat = flatten(rb, name)
+    if not flat:
+        from ..errors import RuleBaseError
+
+        raise RuleBaseError(f"behavior `{name}` has no rules (nor uses a behavior that has)",
+                            span=b.span, hint=f"write a rule in `{name}`, or `use` a behavior "
+                                              "with rules")
     variables = rb.variables
     inputs, outputs, linear_inputs = _used_variables(rb, flat, operators)
     members = _membership_layer(inputs, variables)

@@ -66,11 +66,12 @@ def memberships(corners: np.ndarray, x: np.ndarray) -> np.ndarray:
     <= d``, infinite for a shoulder's open side) at the points ``x[n]``."""
     a, b, c, d = (corners[:, i:i + 1] for i in range(4))
     with np.errstate(invalid="ignore", divide="ignore"):
-        rise = np.where(b > a, (x - a) / np.where(b > a, b - a, 1.0), np.where(x >= a, 1.0, 0.0))
-        fall = np.where(d > c, (d - x) / np.where(d > c, d - c, 1.0), np.where(x <= d, 1.0, 0.0))
-    rise = np.where(np.isneginf(a), 1.0, rise)
-    fall = np.where(np.isposinf(d), 1.0, fall)
-    return np.clip(np.minimum(rise, fall), 0.0, 1.0)
+        mu = np.fmin((x - a) / (b - a), (d - x) / (d - c))    # fmin: a NaN edge gives way
+    mu = np.clip(mu, 0.0, 1.0)
+    # NaN where both edges are NaN: an infinite corner (inf / inf) or x on a vertical edge
+    # (0 / 0), where the term is 1
+    mu[np.isnan(mu)] = 1.0
+    return mu
 
 
 def breakpoints(corners: np.ndarray, universe: tuple[float, float]) -> np.ndarray:

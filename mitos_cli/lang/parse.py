@@ -145,23 +145,34 @@ def _word_before(text: str, token: Token) -> str:
     return words[-1] if words else ""
 
 
+def shift(span: Span | None, lines: int) -> Span | None:
+    """``span`` moved down ``lines`` lines (text parsed alone, taken from a longer file)."""
+    if span is None or not lines:
+        return span
+    import dataclasses
+
+    return dataclasses.replace(span, line=span.line + lines)
+
+
 def _span(meta, text: str, path: str | None) -> Span | None:
     if getattr(meta, "empty", True):
         return None
-    return Span.in_text(text, path, meta.line, meta.column, meta.end_column
-                        if meta.end_line == meta.line else None)
+    return Span.at(text, path, meta.start_pos, meta.line, meta.column, meta.end_column
+                   if meta.end_line == meta.line else None)
 
 
 class _ToModel(Transformer):
     """Tree -> model objects. Only builds: names are checked later (Lark wraps errors here)."""
 
-    def __init__(self, text: str, path: str | None) -> None:
+    def __init__(self, text: str, path: str | None, line_offset: int = 0) -> None:
         super().__init__()
         self.text, self.path = text, path
         self.counter = 0
+        self.line_offset = line_offset        # the text starts at this line + 1 of its file
 
     def _s(self, meta) -> Span | None:
-        return _span(meta, self.text, self.path)
+        span = _span(meta, self.text, self.path)
+        return shift(span, self.line_offset)
 
     def number(self, items):
         return float(items[0])
@@ -244,8 +255,8 @@ class _ToModel(Transformer):
     def terms_stmt(self, meta, items):
         spans = []
         for tok in items:
-            spans.append((_unquote(tok), Span.in_text(self.text, self.path, tok.line,
-                                                      tok.column, tok.end_column)))
+            spans.append((_unquote(tok), Span.at(self.text, self.path, tok.start_pos,
+                                                 tok.line, tok.column, tok.end_column)))
         return ("terms", tuple(spans))
 
     @v_args(meta=True)
@@ -264,11 +275,34 @@ def _unquote(token: Token) -> str:
         return str(token)[1:-1]
 
 
+#: how deep conditions may nest (`not (not (a or (b and ...)))`): far beyond any readable
+#: rule, and shallow enough for every later pass, which walks expressions recursively
+MAX_NESTING = 100
+
+
 def parse_tree(text: str, path: str | None = None, start: str = "start") -> Tree:
     try:
-        return parser().parse(text, start=start)
+        tree = parser().parse(text, start=start)
     except UnexpectedInput as exc:
         raise syntax_error(exc, text, path) from None
+    check_nesting(tree, text, path)
+    return tree
+
+
+def check_nesting(tree: Tree, text: str, path: str | None, limit: int = MAX_NESTING) -> None:
+    """Refuse a tree nested deeper than ``limit`` (walked without recursion), at the first
+    node past the limit."""
+    stack = [(tree, 0)]
+    while stack:
+        node, depth = stack.pop()
+        if depth > limit:
+            meta = node.meta
+            span = None if getattr(meta, "empty", True) else Span.at(
+                text, path, meta.start_pos, meta.line, meta.column)
+            raise RuleSyntaxError(f"conditions nested more than {limit} deep", span=span,
+                                  hint="split the condition into several rules, or drop "
+                                       "doubled `not`s and parentheses")
+        stack.extend((child, depth + 1) for child in node.children if isinstance(child, Tree))
 
 
 def parse_rules(text: str, path: str | None = None) -> ParsedFile:

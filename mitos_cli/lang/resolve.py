@@ -22,7 +22,10 @@ MAIN = "main"
 
 def load_rules_file(path: str | Path) -> RuleBase:
     """Read, parse and check the rule file at ``path`` and the term sets it names."""
+    from ..fileio import finish_saves
+
     path = Path(path)
+    finish_saves(path, error=RuleBaseError)   # a set save a crash left half done
     try:
         text = path.read_text(encoding="utf-8")
     except UnicodeDecodeError:
@@ -58,7 +61,15 @@ def build_rulebase(parsed: ParsedFile, termsets: tuple[TermSet, ...],
     if parsed.rules or parsed.uses:
         behaviors.insert(0, Behavior(MAIN, parsed.rules, parsed.uses, (), parsed.frozen))
     elif parsed.frozen:
-        raise RuleBaseError("`frozen` outside a behavior names rules that do not exist")
+        import re
+
+        found = re.search(r"(?m)^[ \t]*(frozen)\b", parsed.text)
+        at = found.start(1) if found else 0
+        line = parsed.text.count("\n", 0, at) + 1
+        raise RuleBaseError("`frozen` outside a behavior names rules that do not exist",
+                            span=Span.at(parsed.text, parsed.path, at, line,
+                                         at - (parsed.text.rfind("\n", 0, at) + 1) + 1),
+                            hint="put `frozen LABEL, ...` inside the behavior of those rules")
     if not behaviors:
         raise RuleBaseError("the rule file has no rules",
                             span=Span.in_text(parsed.text, parsed.path, 1, 1),

@@ -9,6 +9,7 @@ that position and a "did you mean" for unknown keys.
 
 from __future__ import annotations
 
+import re
 from typing import Any, Iterable
 
 import yaml
@@ -40,13 +41,63 @@ class YList(list):
         return self.item_spans[index] if index < len(self.item_spans) else self.span
 
 
+#: what YAML counts as a line break (PyYAML's reader)
+BREAKS = re.compile("\r\n|[\n\r\x85\u2028\u2029]")
+
+
 def _span(mark: Any, text: str, path: str | None) -> Span:
-    return Span.in_text(text, path, mark.line + 1, mark.column + 1)
+    return Span.at(text, path, mark.index, mark.line + 1, mark.column + 1, breaks=BREAKS)
+
+
+#: deeper nesting than any of our formats needs (and than Python's recursion allows)
+MAX_DEPTH = 64
+
+
+def _refuse(problem: str, mark: Any) -> yaml.constructor.ConstructorError:
+    return yaml.constructor.ConstructorError(None, None, problem, mark)
 
 
 def _build_loader(text: str, path: str | None) -> type:
     class Loader(yaml.SafeLoader):
-        pass
+        """Safe loading without aliases, anchors, merge keys or tags (no format here has
+        them, and an alias bomb expands a few lines into billions of values), nested at most
+        :data:`MAX_DEPTH` deep, and with the constructors' own errors kept at their node."""
+
+        depth = 0
+
+        def compose_node(self, parent, index):
+            event = self.peek_event()
+            if isinstance(event, yaml.AliasEvent):
+                raise _refuse(f"aliases (`*{event.anchor}`) are not supported here; write "
+                              f"the value out", event.start_mark)
+            if getattr(event, "anchor", None) is not None:
+                raise _refuse(f"anchors (`&{event.anchor}`) are not supported here",
+                              event.start_mark)
+            tag = getattr(event, "tag", None)
+            if tag is not None and tag != "!" and not (
+                    isinstance(event, yaml.ScalarEvent) and not event.implicit[0]
+                    and tag == "tag:yaml.org,2002:str"):
+                shown = tag.replace("tag:yaml.org,2002:", "!!")
+                raise _refuse(f"YAML tags (`{shown}`) are not supported here",
+                              event.start_mark)
+            self.depth += 1
+            try:
+                if self.depth > MAX_DEPTH:
+                    raise _refuse(f"nested more than {MAX_DEPTH} levels deep",
+                                  event.start_mark)
+                return super().compose_node(parent, index)
+            finally:
+                self.depth -= 1
+
+        def construct_object(self, node, deep=False):
+            try:
+                return super().construct_object(node, deep)
+            except yaml.YAMLError:
+                raise
+            except (ValueError, TypeError, KeyError, AttributeError, OverflowError):
+                kind = node.tag.rsplit(":", 1)[-1]
+                raise _refuse(f"`{node.value}` cannot be read as {kind}", node.start_mark
+                              ) from None
 
     def construct_mapping(loader: Loader, node: yaml.MappingNode) -> YMap:
         out = YMap()
@@ -56,6 +107,10 @@ def _build_loader(text: str, path: str | None) -> type:
             if not isinstance(key_node, yaml.ScalarNode):
                 raise yaml.constructor.ConstructorError(
                     None, None, "a mapping key must be a plain name", key_node.start_mark)
+            if key_node.tag == "tag:yaml.org,2002:merge":
+                raise yaml.constructor.ConstructorError(
+                    None, None, "merge keys (`<<`) are not supported here; write the keys out",
+                    key_node.start_mark)
             if key_node.tag != "tag:yaml.org,2002:str":
                 # YAML 1.1 reads ON, off, yes, No, 1e3, ~ ... as booleans, numbers, null
                 kind = key_node.tag.rsplit(":", 1)[-1]
@@ -92,6 +147,13 @@ def load(text: str, path: str | None, error: type[MitosError]) -> Any:
         span = _span(mark, text, path) if mark is not None else None
         problem = exc.problem or exc.context or "malformed YAML"
         raise error(f"invalid YAML: {problem}", span=span) from None
+    except yaml.reader.ReaderError as exc:       # a character YAML does not allow
+        pos = min(exc.position, len(text))
+        line = text.count("\n", 0, pos) + 1
+        column = pos - (text.rfind("\n", 0, pos) + 1) + 1
+        char = chr(exc.character) if isinstance(exc.character, int) else exc.character
+        raise error(f"invalid YAML: character {char!r} is not allowed",
+                    span=Span.at(text, path, pos, line, column)) from None
     except yaml.YAMLError as exc:  # pragma: no cover - other YAML errors carry no mark
         raise error(f"invalid YAML: {exc}", span=Span(path, 1, 1)) from None
 
@@ -125,7 +187,11 @@ def expect_number(value: Any, span: Span, error: type[MitosError], what: str) ->
     """``value`` as a finite float, or ``error`` saying a number was expected."""
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         raise error(f"{what} must be a number, not `{value}`", span=span)
-    number = float(value)
+    try:
+        number = float(value)
+    except OverflowError:
+        raise error(f"{what} must be a finite number, not an integer of "
+                    f"{len(str(abs(value)))} digits", span=span) from None
     if number != number or number in (float("inf"), float("-inf")):
         raise error(f"{what} must be a finite number, not `{value}`", span=span)
     return number

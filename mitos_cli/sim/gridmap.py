@@ -49,8 +49,20 @@ def classify(pixels: np.ndarray, maxval: int, *, negate: bool, occupied_thresh: 
     return np.ascontiguousarray(blocked[::-1])
 
 
+def _negate(spec: yamlpos.YMap) -> bool:
+    """``negate`` as map_server reads it: 0 or 1 (``false``/``true`` too). A quoted ``"0"``
+    is a string, which Python would take for true and silently invert the map: refused."""
+    value = spec.get("negate", 0)
+    if value in (0, 1) and not isinstance(value, float) or isinstance(value, bool):
+        return bool(value)
+    raise WorldError(f"negate must be 0 or 1, not `{value}`", span=spec.value_span("negate"),
+                     hint="write `negate: 0` (dark pixels are walls) or `negate: 1`, unquoted")
+
+
 def read_image(path: Path) -> tuple[np.ndarray, int]:
     """Pixels ``[rows, cols]`` (top row first) and the maximum value of a map image."""
+    if path.exists() and not path.is_file():     # /dev/zero, a FIFO: would read without end
+        raise ValueError("it is not a regular file")
     if path.suffix.lower() in (".pgm", ".pnm"):
         return read_pgm(path)
     try:
@@ -134,9 +146,10 @@ def load_map_yaml(path: Path, *, unknown_occupied: bool = True,
                          span=spec.value_span("origin"))
     ox, oy, yaw = (yamlpos.expect_number(v, spec.value_span("origin"), WorldError, "origin")
                    for v in origin)
-    negate = bool(spec.get("negate", 0))
-    occ_t = float(spec.get("occupied_thresh", 0.65))
-    free_t = float(spec.get("free_thresh", 0.196))
+    negate = _negate(spec)
+    occ_t, free_t = (yamlpos.expect_number(spec.get(key, default), spec.value_span(key),
+                                           WorldError, key)
+                     for key, default in (("occupied_thresh", 0.65), ("free_thresh", 0.196)))
     if not 0 <= free_t <= occ_t <= 1:
         raise WorldError("need 0 <= free_thresh <= occupied_thresh <= 1",
                          span=spec.value_span("free_thresh"))

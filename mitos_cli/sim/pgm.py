@@ -46,6 +46,12 @@ def parse_pgm(data: bytes) -> tuple[np.ndarray, int]:
     if width <= 0 or height <= 0 or not 0 < maxval < 65536:
         raise ValueError(f"bad PGM size {width} x {height} or maximum value {maxval}")
     n = width * height
+    depth = 2 if maxval > 255 else 1
+    if magic == b"P5" and len(data) - offset < n * depth:   # before allocating anything
+        raise ValueError(f"the PGM image holds {(len(data) - offset) // depth:,} of its "
+                         f"{plural(n, 'pixel')}")
+    if magic == b"P2" and (len(data) - offset + 2) // 2 < n:  # at least "0 " per pixel
+        raise ValueError(f"the PGM image is too short for its {plural(n, 'pixel')}")
     if magic == b"P5":
         dtype = np.dtype(">u2") if maxval > 255 else np.dtype("u1")
         body = np.frombuffer(data, dtype=dtype, count=-1, offset=offset)
@@ -55,7 +61,7 @@ def parse_pgm(data: bytes) -> tuple[np.ndarray, int]:
     else:
         try:
             pixels = np.array(data[offset - 1:].split(), dtype=np.int64)
-        except ValueError:
+        except (ValueError, OverflowError):
             raise ValueError("the ASCII PGM image holds something that is not a number") from None
         if pixels.size < n:
             raise ValueError(f"the PGM image holds {pixels.size} of its {plural(n, 'pixel')}")
@@ -66,6 +72,20 @@ def parse_pgm(data: bytes) -> tuple[np.ndarray, int]:
     return pixels.reshape(height, width), maxval
 
 
+#: the largest image read (bytes): a 16-bit 8,000 x 8,000 map, far beyond any building
+MAX_BYTES = 128 << 20
+
+
 def read_pgm(path: str | Path) -> tuple[np.ndarray, int]:
-    """Pixels ``[rows, cols]`` (top row first, as stored) and the image's maximum value."""
-    return parse_pgm(Path(path).read_bytes())
+    """Pixels ``[rows, cols]`` (top row first, as stored) and the image's maximum value.
+
+    Only regular files are read, and at most :data:`MAX_BYTES` of them (``image: /dev/zero``
+    or a FIFO would otherwise be read without end)."""
+    path = Path(path)
+    if path.exists() and not path.is_file():
+        raise ValueError("it is not a regular file")
+    with open(path, "rb") as fh:
+        data = fh.read(MAX_BYTES + 1)
+    if len(data) > MAX_BYTES:
+        raise ValueError(f"it is larger than {MAX_BYTES >> 20} MB")
+    return parse_pgm(data)

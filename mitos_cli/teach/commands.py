@@ -20,7 +20,7 @@ from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput
 from ..lang.cache import lark_parser
 from ..errors import RuleSyntaxError, Span
 from ..lang.model import Rule, Setting, Use
-from ..lang.parse import TERMINAL_WORDS, _ToModel
+from ..lang.parse import TERMINAL_WORDS, _ToModel, check_nesting, shift
 from ..resources import grammar_text
 
 WORDS = dict(TERMINAL_WORDS, PATH="a file name", INT="a whole number", ARROW="`->`",
@@ -311,13 +311,18 @@ def parse_command(line: str, path: str | None = None, lineno: int = 1) -> Comman
     ``path`` and ``lineno`` place the command in its lesson file, so errors read
     ``lesson.lesson:12:5``.
     """
-    text = "\n" * (lineno - 1) + line
+    where = path or "<prompt>"
     try:
-        tree = parser().parse(text)
-    except UnexpectedInput as exc:
-        raise _unknown_command(line, text, path or "<prompt>", lineno) \
-            or _syntax_error(exc, text, path or "<prompt>") from None
-    result = _ToCommand(text, path or "<prompt>").transform(tree)
+        try:
+            tree = parser().parse(line)
+        except UnexpectedInput as exc:
+            raise _unknown_command(line, line, where, 1) \
+                or _syntax_error(exc, line, where) from None
+        check_nesting(tree, line, where)
+    except RuleSyntaxError as exc:        # parsed alone: put it at its line of the lesson
+        exc.span = shift(exc.span, lineno - 1)
+        raise
+    result = _ToCommand(line, where, lineno - 1).transform(tree)
     if isinstance(result, Tree):            # pragma: no cover - every alternative is handled
         raise RuleSyntaxError(f"cannot read `{line.strip()}`")
     return result

@@ -19,7 +19,7 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..errors import LessonError
+from ..errors import LessonError, Span
 
 ROOT = Path(".mitos") / "teach"
 JOURNAL = "journal.jsonl"
@@ -53,8 +53,10 @@ def new_session_dir(stem: str, base: Path | None = None) -> Path:
 def find_session(name: str | None, base: Path | None = None) -> Path:
     """The session called ``name``, or the most recently changed one."""
     root = sessions_dir(base)
-    found = sorted((p for p in root.glob("*/" + JOURNAL)), key=lambda p: p.stat().st_mtime) \
-        if root.is_dir() else []
+    # a session killed before its first entry was written has an empty journal: nothing to
+    # resume there, so the newest session is the newest with a journal that holds something
+    found = sorted((p for p in root.glob("*/" + JOURNAL) if p.stat().st_size),
+                   key=lambda p: p.stat().st_mtime) if root.is_dir() else []
     if name is not None:
         direct = Path(name)
         if (direct / JOURNAL).is_file():
@@ -78,6 +80,10 @@ class Journal:
     directory: Path
     entries: list[dict] = field(default_factory=list)
     skipped_tail: bool = False
+    #: the journal line of each entry (for messages about an entry)
+    lines: list[int] = field(default_factory=list)
+    #: the damaged line the session was recovered up to (``open(recover=True)``), if any
+    recovered_at: int | None = None
 
     @property
     def path(self) -> Path:
@@ -91,25 +97,62 @@ class Journal:
         return journal
 
     @classmethod
-    def open(cls, directory: Path) -> Journal:
-        """Read an existing journal (a last line cut short by a kill is dropped)."""
+    def open(cls, directory: Path, recover: bool = False) -> Journal:
+        """Read an existing journal.
+
+        A torn last line (what ``kill -9`` during a write leaves: the change was never
+        acknowledged) is dropped, and the file as it was is kept aside as
+        ``journal.jsonl.damaged``. A damaged line elsewhere is an error naming the journal's
+        path and line; with ``recover`` the session is kept up to that line instead (the
+        damaged file kept aside the same way).
+        """
         journal = cls(directory)
         raw = journal.path.read_bytes()
         lines = raw.split(b"\n")
+        offset = 0
         for i, line in enumerate(lines):
+            start, offset = offset, offset + len(line) + 1
             if not line.strip():
                 continue
-            try:
+            problem = _problem(line, journal.next_seq)
+            if problem is None:
                 journal.entries.append(json.loads(line))
-            except (json.JSONDecodeError, UnicodeDecodeError):
-                if i == len(lines) - 1:
-                    journal.skipped_tail = True
-                    with open(journal.path, "r+b") as fh:     # drop the torn line for good
-                        fh.truncate(len(raw) - len(line))
-                    break
-                raise LessonError(f"{journal.path}:{i + 1}: the journal is damaged "
-                                  f"(not JSON)") from None
+                journal.lines.append(i + 1)
+                continue
+            if i == len(lines) - 1:                # no newline after it: cut short by a kill
+                journal.skipped_tail = True
+            elif not recover:
+                shown = line[:120].decode("utf-8", "replace")
+                raise LessonError(f"the journal is damaged: {problem}",
+                                  span=Span(str(journal.path), i + 1, 1, shown),
+                                  hint="`mitos teach --resume --recover` continues the session "
+                                       f"with the changes before line {i + 1} (the damaged "
+                                       "journal is kept aside)")
+            else:
+                journal.recovered_at = i + 1
+            journal.cut(start, raw)
+            break
+        else:
+            if raw and not raw.endswith(b"\n"):   # whole, but its newline was never written
+                with open(journal.path, "ab") as fh:
+                    fh.write(b"\n")
         return journal
+
+    def cut(self, at: int, raw: bytes | None = None) -> None:
+        """Keep the journal as it is in ``journal.jsonl.damaged`` and truncate it at byte
+        ``at`` (the start of the first line not kept)."""
+        from ..fileio import atomic_write
+
+        raw = self.path.read_bytes() if raw is None else raw
+        atomic_write(self.aside, raw)
+        with open(self.path, "r+b") as fh:
+            fh.truncate(at)
+            fh.flush()
+            os.fsync(fh.fileno())
+
+    @property
+    def aside(self) -> Path:
+        return self.path.with_name(JOURNAL + ".damaged")
 
     @property
     def next_seq(self) -> int:
@@ -128,13 +171,49 @@ class Journal:
             raise LessonError(f"cannot write the journal {self.path}: "
                               f"{exc.strerror or exc}; the change was not made") from None
         self.entries.append(entry)
+        self.lines.append((self.lines[-1] + 1) if self.lines else 1)
         return entry
+
+    def line_of(self, entry: dict) -> int:
+        """The journal line of ``entry``."""
+        for e, line in zip(self.entries, self.lines):
+            if e is entry:
+                return line
+        return 0
 
     def active(self) -> list[dict]:
         """The change entries that were not undone, in order."""
         undone = {e["of"] for e in self.entries if e["op"] == "undo"}
         return [e for e in self.entries if e["seq"] not in undone and e["op"] not in
                 ("undo", "start", "save")]
+
+
+#: what each kind of entry must carry, and of which type
+FIELDS: dict[str, dict[str, type]] = {"start": {"rules": str, "behavior": str}, "rule": {"text": str, "behavior": str},
+          "behavior": {"name": str}, "end": {}, "use": {"text": str},
+          "frozen": {"labels": list, "behavior": str}, "operators": {"text": str,
+                                                                    "behavior": str},
+          "activate": {"behavior": str}, "examples": {"examples": list},
+          "adapt": {"terms": dict}, "undo": {"of": int}, "save": {}}
+
+
+def _problem(line: bytes, seq: int) -> str | None:
+    """What is wrong with one journal line (``None``: nothing)."""
+    try:
+        entry = json.loads(line)
+    except (ValueError, UnicodeDecodeError, RecursionError):
+        return "the line is not JSON"
+    if not isinstance(entry, dict):
+        return "the line is not a JSON object"
+    if entry.get("seq") != seq or type(entry.get("seq")) is not int:
+        return f"expected change number {seq}, found {entry.get('seq')!r}"
+    op = entry.get("op")
+    if op not in FIELDS:
+        return f"unknown change {op!r}"
+    for key, kind in FIELDS[op].items():
+        if not isinstance(entry.get(key), kind) or isinstance(entry.get(key), bool):
+            return f"the `{op}` change has no valid `{key}`"
+    return None
 
 
 class MemoryJournal(Journal):

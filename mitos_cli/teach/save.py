@@ -5,8 +5,9 @@ every label, comment and line break stays where it was; only the numbers that ch
 replaced, at the positions the parsers recorded (Lark tokens for the rule file, ``yamlpos``
 spans for the YAML). Rules told again under an existing label replace that rule's text; new
 rules, ``use`` and ``frozen`` lines go before their behavior's ``end``; new behaviors are
-appended in the rule language. Every file is written atomically (a temporary file in the same
-directory, fsync, ``os.replace``).
+appended in the rule language. The rule file and its term sets are written as one set
+(:func:`~mitos_cli.fileio.atomic_write_set`): after a crash they are the old files or the new
+ones, never a rule file of one save beside the term set of another.
 
 Saving under another name writes ``OUT.rules`` and its term set beside it as
 ``OUT.terms.yaml`` (with several term sets, ``OUT.<original name>``), with the ``terms`` line
@@ -23,7 +24,7 @@ from pathlib import Path
 from lark import Token, Tree
 
 from ..errors import LessonError, TermSetError
-from ..fileio import atomic_write
+from ..fileio import atomic_write, atomic_write_set, finish_saves  # noqa: F401 (re-exported)
 from ..fuzzy.shapes import SHAPES
 from ..lang import yamlpos
 from ..lang.model import Behavior, RuleBase, format_number, format_rule, format_use
@@ -80,9 +81,8 @@ def save_rulebase(original: RuleBase, current: RuleBase, target: Path) -> Saved:
         target.parent.mkdir(parents=True, exist_ok=True)   # `save taught/new.rules`
     except OSError as exc:
         raise LessonError(f"cannot create `{target.parent}`: {exc.strerror or exc}") from None
-    for dest, text in texts:                       # term sets first: the rules name them
-        atomic_write(dest, text, error=LessonError)
-    atomic_write(target, new_rules, error=LessonError)
+    finish_saves(target, error=LessonError)        # one a crash left half done
+    atomic_write_set(texts + [(target, new_rules)], target, error=LessonError)
     return Saved(target, tuple(d for d, _ in texts), tuple(changes))
 
 

@@ -22,6 +22,7 @@ transition), so replaying the journal's entries rebuilds the state exactly: that
 from __future__ import annotations
 
 import dataclasses
+import math
 import re
 from collections.abc import Callable
 from pathlib import Path
@@ -29,7 +30,7 @@ from pathlib import Path
 import numpy as np
 
 from ..engine.compile import CompiledRuleBase, compile_rulebase
-from ..errors import LessonError, MitosError, RuleBaseError, unknown
+from ..errors import LessonError, MitosError, RuleBaseError, Span, unknown
 from ..lang.model import And, Behavior, Expr, Not, Prop, Rule, RuleBase, format_expr, format_rule, format_use
 from ..lang.operators import resolve
 from ..lang.resolve import check_expr, check_rule, load_rules_file
@@ -84,26 +85,60 @@ class Session:
     # -- resume ------------------------------------------------------------------------------
     @classmethod
     def resume(cls, journal: Journal, out: Callable[[str], None] | None = None,
-               progress: Callable | None = None) -> Session:
+               progress: Callable | None = None, recover: bool = False) -> Session:
         start = journal.entries[0] if journal.entries else None
+        first = Span(str(journal.path), journal.lines[0] if journal.lines else 1, 1)
         if start is None or start.get("op") != "start":
-            raise LessonError(f"{journal.path}: not a teaching journal (no start entry)")
-        session = cls(start["rules"], start["behavior"], journal, start.get("save_as"), out,
-                      progress)
+            raise LessonError("not a teaching journal (it does not begin with the session's "
+                              "start)", span=first)
+        try:
+            session = cls(start["rules"], start["behavior"], journal, start.get("save_as"),
+                          out, progress)
+        except MitosError as exc:       # the rule file or behavior the journal names
+            if exc.span is None:
+                exc.span = first
+            raise
         if files_digest(session.original) != start.get("digest"):
             session.out(f"warning: {start['rules']} or its term set changed since the session "
                         f"started; the journal's changes are applied to the files as they are now")
-        session.replay()
+        session.replay(recover)
         saves = [e for e in journal.entries if e["op"] == "save"]
         session.saved_seq = saves[-1]["seq"] if saves else 0
         if saves:                                   # a bare `save` goes where the last went
             session.save_as = Path(saves[-1]["path"])
         return session
 
-    def replay(self) -> None:
+    def replay(self, recover: bool = False) -> None:
+        """Apply the journal's changes. One that cannot be applied (a journal edited by hand,
+        or rule files changed under it) is an error at its journal line; with ``recover``
+        the session keeps the changes before it and the journal is cut there."""
         self.state = State(self.original, self.start_behavior)
         for entry in self.journal.active():
-            apply(self.state, entry)
+            try:
+                apply(self.state, entry)
+            except (MitosError, KeyError, TypeError, ValueError, AttributeError,
+                    IndexError) as exc:
+                line = self.journal.line_of(entry)
+                why = exc.message if isinstance(exc, MitosError) else \
+                    f"{type(exc).__name__}: {exc}"
+                if not recover or not line:
+                    raise LessonError(
+                        f"change {entry.get('seq')} of the journal cannot be applied ({why})",
+                        span=Span(str(self.journal.path), line or 1, 1),
+                        hint="`mitos teach --resume --recover` continues the session with the "
+                             "changes before it (the journal is kept aside)") from None
+                self.journal.recovered_at = line
+                self._cut_journal(line)
+                return
+
+    def _cut_journal(self, line: int) -> None:
+        """Truncate the journal before ``line`` (kept whole aside) and forget later entries."""
+        raw = self.journal.path.read_bytes()
+        at = sum(len(x) + 1 for x in raw.split(b"\n")[:line - 1])
+        self.journal.cut(at, raw)
+        keep = [i for i, n in enumerate(self.journal.lines) if n < line]
+        self.journal.entries = [self.journal.entries[i] for i in keep]
+        self.journal.lines = [self.journal.lines[i] for i in keep]
 
     # -- helpers -------------------------------------------------------------------------------
     @property
@@ -422,6 +457,9 @@ class Session:
         compiled = self.compiled()
         X, T = self.training_set(compiled)
         epochs = _whole(c.epochs, "epochs", 1) if c.epochs is not None else 50
+        if epochs > MAX_EPOCHS:         # 10^300 epochs is a hang, not a lesson
+            raise LessonError(f"at most {MAX_EPOCHS:,} epochs in one `adapt`, not {epochs:g}",
+                              hint="adapt again to go on from where it stopped")
         rate = 0.5 if c.rate is None else c.rate
         result = self._learn(c, compiled, X, T, epochs, rate)
         before = self.rulebase
@@ -605,8 +643,12 @@ def _next_label(b: Behavior) -> str:
 
 
 
+#: the most epochs one `adapt` runs (the paper's lesson needs 60; an epoch takes milliseconds)
+MAX_EPOCHS = 100_000
+
+
 def _whole(value: float, what: str, least: int) -> int:
-    if value != int(value) or value < least:
+    if not math.isfinite(value) or value != int(value) or value < least:
         raise LessonError(f"{what} must be a whole number of at least {least}, not {value:g}")
     return int(value)
 

@@ -1,0 +1,790 @@
+"""Fuzzing campaign: every input kind MITOS reads, mutated, fed to the library's own readers.
+
+Run from the repository root (one command each)::
+
+    python benchmarks/fuzz.py --quick                       # a short campaign (150 per kind)
+    python benchmarks/fuzz.py --per-format 10000 --out fuzz-found
+
+Each input kind (rule files, term-set YAML, world YAML, map YAML + PGM, FCL, ``.fis``, FLL,
+teach commands, lessons, ``eval --batch`` CSV, teach journals) is seeded from the shipped files
+and ``tests/data``, mutated by grammar-aware mutators (tokens inserted, deleted, swapped and
+duplicated; keywords swapped; numbers replaced by ``nan``, ``inf``, ``-0``, ``1e308``, huge
+integers; truncation at a line; Unicode junk, CRLF, tabs, BOM; deep nesting; long lines; YAML
+anchors, aliases, tags and duplicate keys; PGM header and pixel bytes) and run in this process
+under a time limit (``SIGPROF`` after ``--limit`` CPU seconds: a hang is cut off and counted,
+never waited for; a worker stuck where the signal cannot reach is killed by the campaign). Every input
+is classified as
+
+- ``loaded``: read (and, for rule bases, evaluated) without complaint;
+- ``refused+pos``: a :class:`~mitos_cli.errors.MitosError` with ``file:line:col``;
+- ``refused``: a ``MitosError`` without a position (acceptable only where the input has no
+  lines: a command-line argument);
+- ``foreign``: any other exception, a bug; its signature is the type and the raising frame;
+- ``slow``: more than ``--slow`` CPU seconds (plus 0.01 s per KB of input), or cut off;
+- ``nonfinite``: a rule base that loads but gives ``inf`` or an undeclared ``NaN``, or an
+  output outside its universe.
+
+For each new foreign / slow / non-finite signature a minimal reproducer (lines, then
+characters, removed while the signature stays) is written to ``--out``. The table printed at
+the end is the one in ``docs/reliability.md``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import hashlib
+import json
+import math
+import os
+import random
+import re
+import resource
+import shutil
+import signal
+import sys
+import tempfile
+import time
+import traceback
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+SEED = 20261201
+
+OUTCOMES = ("loaded", "refused+pos", "refused", "foreign", "slow", "nonfinite")
+
+
+class Timeout(BaseException):
+    """Raised by the alarm inside an input that ran past the limit (not an ``Exception``, so
+    no ``except Exception`` in the code under test swallows it)."""
+
+
+class NonFinite(Exception):
+    """A loaded rule base evaluated to a non-finite number it did not declare."""
+
+
+# ---------------------------------------------------------------------------------------------
+# mutators
+
+NUMBERS = ("nan", "NaN", "inf", "-inf", "Infinity", "-0", "0", "1e308", "-1e308", "1e400",
+           "1e-320", "99999999999999999999999999999999999999", "1_000", "0x1F", "0b2", ".5",
+           "5.", "1e5.5", "-", "+", "1__e5")
+JUNK = ("\ufeff", "\u00e9", "\u2028", "\x00", "\x0b", "\x1c", "\t", "\r\n", "\r", "\u0301",
+        "\U0001F600", "\\", '"', "'", "#", ":", "{", "[", "]", "}", "&a", "*a", "!!python/name:os.system",
+        "<<: *a", "%", "@", "`")
+TOKEN = re.compile(r"[A-Za-z_][\w\-]*|[-+]?\d[\d_.eE+\-xXbB]*|\s+|.", re.S)
+
+
+def tokens(text: str) -> list[str]:
+    return TOKEN.findall(text)
+
+
+@dataclass
+class Mutator:
+    """Text mutations shared by all kinds, with a kind's vocabulary and nesting forms."""
+
+    words: tuple[str, ...]
+    nest: tuple[Callable[[int], str], ...] = ()
+
+    def __call__(self, rng: random.Random, text: str) -> str:
+        for _ in range(rng.choice((1, 1, 1, 2, 3))):
+            text = rng.choice(self.ops)(self, rng, text)
+        return text
+
+    def _tokens(self, rng, text):
+        toks = tokens(text) or [""]
+        return toks, rng.randrange(len(toks))
+
+    def insert(self, rng, text):
+        toks, i = self._tokens(rng, text)
+        toks.insert(i, rng.choice(self.words + NUMBERS + JUNK) + rng.choice(("", " ")))
+        return "".join(toks)
+
+    def delete(self, rng, text):
+        toks, i = self._tokens(rng, text)
+        del toks[i:i + rng.choice((1, 1, 2, 5))]
+        return "".join(toks)
+
+    def swap(self, rng, text):
+        toks, i = self._tokens(rng, text)
+        j = rng.randrange(len(toks))
+        toks[i], toks[j] = toks[j], toks[i]
+        return "".join(toks)
+
+    def duplicate(self, rng, text):
+        toks, i = self._tokens(rng, text)
+        n = rng.choice((1, 3, 20))
+        return "".join(toks[:i] + toks[i:i + n] * rng.choice((2, 3, 50)) + toks[i:])
+
+    def keyword(self, rng, text):
+        toks = tokens(text)
+        words = [i for i, t in enumerate(toks) if t[:1].isalpha()]
+        if not words:
+            return text
+        toks[rng.choice(words)] = rng.choice(self.words)
+        return "".join(toks)
+
+    def number(self, rng, text):
+        toks = tokens(text)
+        nums = [i for i, t in enumerate(toks) if t[:1].isdigit() or t[:1] in "+-" and len(t) > 1]
+        if not nums:
+            return text
+        toks[rng.choice(nums)] = rng.choice(NUMBERS)
+        return "".join(toks)
+
+    def truncate(self, rng, text):
+        lines = text.splitlines(keepends=True)
+        if not lines:
+            return text
+        cut = rng.randrange(len(lines))
+        head = "".join(lines[:cut])
+        return head + lines[cut][:rng.randrange(len(lines[cut]) + 1)]
+
+    def junk(self, rng, text):
+        i = rng.randrange(len(text) + 1)
+        return text[:i] + rng.choice(JUNK) + text[i:]
+
+    def whitespace(self, rng, text):
+        choice = rng.randrange(4)
+        if choice == 0:
+            return text.replace("\n", "\r\n")
+        if choice == 1:
+            return "\ufeff" + text
+        if choice == 2:
+            return text.replace("    ", "\t")
+        return text.replace("\n", "\r")
+
+    def nesting(self, rng, text):
+        if not self.nest:
+            return text
+        depth = rng.choice((50, 500, 3000, 20000))
+        deep = rng.choice(self.nest)(depth)
+        lines = text.splitlines(keepends=True)
+        i = rng.randrange(len(lines) + 1)
+        return "".join(lines[:i]) + deep + "\n" + "".join(lines[i:])
+
+    def long_line(self, rng, text):
+        toks, i = self._tokens(rng, text)
+        toks.insert(i, rng.choice(("x", "a" * 40 + " ", "9")) * rng.choice((300, 5000, 200000)))
+        return "".join(toks)
+
+    def lines(self, rng, text):
+        lines = text.splitlines(keepends=True)
+        if len(lines) < 2:
+            return text
+        i, j = rng.randrange(len(lines)), rng.randrange(len(lines))
+        if rng.random() < 0.5:
+            lines[i], lines[j] = lines[j], lines[i]
+        else:
+            lines.insert(i, lines[j])
+        return "".join(lines)
+
+    ops = (insert, delete, swap, duplicate, keyword, number, truncate, junk, whitespace,
+           nesting, long_line, lines)
+
+
+def yaml_mutator(words: tuple[str, ...]) -> Mutator:
+    """YAML: the text mutators plus anchors, aliases, merge keys, tags and duplicate keys."""
+    def alias_bomb(depth: int) -> str:
+        n = min(depth, 12)
+        rows = ["a0: &a0 [x, x, x, x, x, x, x, x, x, x]"]
+        rows += [f"a{i}: &a{i} [" + ", ".join([f"*a{i - 1}"] * 10) + "]" for i in range(1, n)]
+        return "\n".join(rows)
+
+    return Mutator(words + ("&a", "*a", "<<", "!!str", "!!int", "!!float", "!!binary",
+                            "!!timestamp", "!!set", "!!omap", "!!python/tuple", "~", "null",
+                            "yes", "No", "ON", "0o17", "0b2", "1_e5", "2001-12-14", "? "),
+                   (lambda d: "x: " + "[" * d + "]" * d,
+                    lambda d: "x: " + "{a: " * d + "1" + "}" * d,
+                    lambda d: "\n".join(" " * i + f"k{i}:" for i in range(min(d, 300))),
+                    lambda d: "\n".join("  " * i + "- " for i in range(min(d, 200))),
+                    alias_bomb,
+                    lambda d: "b: &b {x: 1}\nc:\n  <<: *b\n  y: 2",
+                    lambda d: "x: 1\nx: 2"))
+
+
+RULE_WORDS = ("if", "then", "and", "or", "not", "is", "with", "use", "when", "end", "behavior",
+              "terms", "operators", "frozen", "very", "somewhat", "any", "road", "size",
+              "position", "steering", "speed", "WIDE", "NARROW", "SMALL_SZ", "LEFT", "RS",
+              "MEDIUM", "min", "product", "and", "=", ":", ",", "(", ")", '"x.yaml"',
+              "inference", "defuzzify", "centroid", "mamdani", "r1:")
+RULE_NEST = (lambda d: "if " + "not " * d + "road is WIDE then speed is FAST",
+             lambda d: "if " + "(" * d + "road is WIDE" + ")" * d + " then speed is FAST",
+             lambda d: "if " + " and ".join(["road is WIDE"] * d) + " then speed is FAST",
+             lambda d: "\n".join(f"z{i}: if road is WIDE and size is SMALL_SZ then speed is SLOW"
+                                 for i in range(d)))
+
+
+# ---------------------------------------------------------------------------------------------
+# input kinds: seeds and the run of one input
+
+@dataclass
+class Kind:
+    name: str
+    seeds: list[tuple[str, str | bytes]]
+    mutate: Callable
+    run: Callable                      # (data, workdir) -> None, raises what it raises
+    ext: str = ".txt"
+    tried: int = 0
+    counts: dict = field(default_factory=lambda: dict.fromkeys(OUTCOMES, 0))
+
+
+def _shipped(*patterns: str) -> list[tuple[str, str]]:
+    out = []
+    for pattern in patterns:
+        for p in sorted(ROOT.glob(pattern)):
+            out.append((str(p.relative_to(ROOT)), p.read_text(encoding="utf-8")))
+    return out
+
+
+def check_finite(compiled) -> None:
+    """Evaluate ``compiled`` at the universe's corners, middle and random points: outputs must
+    be finite (NaN only where no rule fired and no default is declared) and inside the
+    output's universe."""
+    from mitos_cli.engine.evaluation import evaluate
+    from mitos_cli.errors import MitosError
+
+    lo, hi = compiled.universe[:, 0], compiled.universe[:, 1]
+    rng = np.random.default_rng(0)
+    X = np.vstack([lo, hi, (lo + hi) / 2, lo + (hi - lo) * rng.random((8, len(lo)))])
+    try:
+        res = evaluate(compiled, X, strict=False)
+    except MitosError:
+        return
+    Y = np.asarray(res.outputs, dtype=float)
+    Y = Y.reshape(len(X), -1)
+    for j, name in enumerate(compiled.outputs):
+        y = Y[:, j]
+        if np.isinf(y).any():
+            raise NonFinite(f"output `{name}` is infinite")
+        v = compiled.variables[name]
+        if np.isnan(y).any() and v.default is not None and not math.isnan(v.default):
+            raise NonFinite(f"output `{name}` is NaN though it declares a default")
+        lo_o, hi_o = v.universe
+        fin = y[np.isfinite(y)]
+        span = max(1.0, abs(hi_o - lo_o))
+        outside = fin.size and ((fin < lo_o - 1e-9 * span).any()
+                                or (fin > hi_o + 1e-9 * span).any())
+        if outside and compiled.cons_linear is None and not _crisp_outside(compiled, j):
+            raise NonFinite(f"output `{name}` = {fin.min():g}..{fin.max():g} lies outside "
+                            f"its universe {lo_o:g}..{hi_o:g}")
+
+
+def _crisp_outside(compiled, j: int) -> bool:
+    """A crisp consequent or a default outside the universe was written by the user: an output
+    there is what the rule base says, not a wrong number."""
+    lo, hi = compiled.variables[compiled.outputs[j]].universe
+    vals = compiled.cons_value[compiled.cons_mask[:, j], j]
+    d = compiled.default[j]
+    return bool(((vals < lo) | (vals > hi)).any() or (not math.isnan(d) and not lo <= d <= hi))
+
+
+def evaluate_all(rb) -> None:
+    from mitos_cli.engine.compile import compile_rulebase
+
+    for b in rb.behaviors:
+        if b.rules or b.uses:
+            check_finite(compile_rulebase(rb, b.name))
+
+
+class Kinds:
+    """Builds the input kinds once (seeds, term sets, a teaching session)."""
+
+    def __init__(self, work: Path, fresh: bool = True) -> None:
+        self.work = work
+        self.fresh = fresh
+        rb_dir = work / "rb"
+        if fresh:
+            shutil.copytree(ROOT / "rulebases", rb_dir)
+            shutil.copytree(ROOT / "worlds", work / "worlds")
+        self.rb_dir = rb_dir
+        self._termsets: dict[str, object] = {}
+        self._session = None
+        self._compiled = None
+
+    # -- rule files ---------------------------------------------------------------------------
+    def run_rules(self, text: str, _work: Path) -> None:
+        from mitos_cli.errors import TermSetError
+        from mitos_cli.lang.parse import parse_rules
+        from mitos_cli.lang.resolve import build_rulebase
+        from mitos_cli.lang.termfile import load_termset
+
+        path = str(self.rb_dir / "fuzz.rules")
+        parsed = parse_rules(text, path)
+        termsets = []
+        for name, span in parsed.terms:
+            target = self.rb_dir / name
+            if name not in ("mitos.terms.yaml", "drive.terms.yaml"):
+                raise TermSetError(f"term set `{name}` not found", span=span)
+            if name not in self._termsets:
+                self._termsets[name] = load_termset(target)
+            termsets.append(self._termsets[name])
+        rb = build_rulebase(parsed, tuple(termsets), tuple(n for n, _ in parsed.terms))
+        evaluate_all(rb)
+
+    def run_termset(self, text: str, _work: Path) -> None:
+        from mitos_cli.lang.parse import parse_rules
+        from mitos_cli.lang.resolve import build_rulebase
+        from mitos_cli.lang.termfile import load_termset, parse_termset
+
+        ts = parse_termset(text, str(self.rb_dir / "fuzz.terms.yaml"))
+        names = {v.name for v in ts.variables}
+        other = "drive.terms.yaml" if "road" in names else "mitos.terms.yaml"
+        if other not in self._termsets:
+            self._termsets[other] = load_termset(self.rb_dir / other)
+        rules = (self.rb_dir / "mitos.rules").read_text()
+        parsed = parse_rules(rules, str(self.rb_dir / "mitos.rules"))
+        evaluate_all(build_rulebase(parsed, (ts, self._termsets[other]),
+                                    ("fuzz.terms.yaml", other)))
+
+    def run_world(self, text: str, _work: Path) -> None:
+        from mitos_cli.sim.worldfile import parse_world
+
+        parse_world(text, str(self.work / "worlds" / "fuzz.yaml"))
+
+    def run_map(self, data: str | bytes, work: Path) -> None:
+        from mitos_cli.sim.gridmap import load_map_yaml
+
+        maps = self.work / "worlds" / "maps"
+        if isinstance(data, bytes):
+            (work / "m.pgm").write_bytes(data)
+            (work / "m.yaml").write_text("image: m.pgm\nresolution: 0.05\n"
+                                         "origin: [0.0, 0.0, 0.0]\n")
+            load_map_yaml(work / "m.yaml")
+        else:
+            (maps / "fuzz.yaml").write_text(data, encoding="utf-8", errors="surrogatepass")
+            load_map_yaml(maps / "fuzz.yaml")
+
+    def run_foreign(self, reader: str):
+        def run(text: str, _work: Path) -> None:
+            from mitos_cli.interop import fcl, fis, fll
+
+            parse = {"fcl": fcl.parse_fcl, "fis": fis.parse_fis, "fll": fll.parse_fll}[reader]
+            evaluate_all(parse(text, f"fuzz.{reader}"))
+        return run
+
+    def run_command(self, text: str, _work: Path) -> None:
+        from mitos_cli.teach.commands import parse_command
+
+        parse_command(text, "<prompt>")
+
+    def session(self, journal=None):
+        from mitos_cli.teach.session import Session
+
+        return Session(self.rb_dir / "mitos.rules", journal=journal, out=lambda s: None)
+
+    def run_lesson(self, text: str, _work: Path) -> None:
+        from mitos_cli.teach.lesson import run_lesson
+
+        session = self.session()
+        session.base = self.work
+        run_lesson(session, text, "fuzz.lesson")
+
+    def run_batch(self, text: str, _work: Path) -> None:
+        from mitos_cli.engine.csvio import read_batch
+
+        X = read_batch(text, "fuzz.csv", ("road", "size", "position"))
+        if len(X):                     # what `mitos eval --batch` does next
+            from mitos_cli.api import load_rulebase
+            from mitos_cli.engine.evaluation import evaluate
+
+            if self._compiled is None:
+                self._compiled = load_rulebase(self.rb_dir / "mitos.rules").compiled
+            evaluate(self._compiled, X, detail=False, strict=False)
+
+
+    def run_journal(self, text: str, work: Path) -> None:
+        from mitos_cli.teach.journal import Journal
+        from mitos_cli.teach.session import Session
+
+        d = work / "session"
+        d.mkdir(exist_ok=True)
+        (d / "journal.jsonl").write_text(text, encoding="utf-8", errors="surrogatepass")
+        Session.resume(Journal.open(d), out=lambda s: None)
+
+    # -- seeds --------------------------------------------------------------------------------
+    def journal_seeds(self) -> list[tuple[str, str]]:
+        from mitos_cli.teach.journal import Journal
+
+        d = self.work / "seed-session"
+        if not self.fresh:
+            return [("journal.jsonl", (d / "journal.jsonl").read_text())]
+        session = self.session(Journal.create(d))
+        for line in ("correct road=78 size=45 position=4 -> steering=100",
+                     "r28: if road is NARROW and position is RIGHT then steering is LS",
+                     "behavior turn:", "if road is WIDE then steering is RS", "end", "use avoid_obstacle",
+                     "operators: and = product", "undo",
+                     "correct road=20 size=10 position=-8 -> steering=40 speed=10"):
+            session.run(line)
+        return [("journal.jsonl", (d / "journal.jsonl").read_text())]
+
+    def build(self) -> list[Kind]:
+        rules = _shipped("rulebases/*.rules")
+        rules.append(("small.rules", 'terms "mitos.terms.yaml"\noperators: and = product\n'
+                      "behavior b:\n  r1: if (road is WIDE or not size is SMALL_SZ) and position"
+                      " is very LEFT\n     then steering is RS and speed is 20 with 0.5\nend\n"
+                      "use b when road is NARROW\n"))
+        termsets = _shipped("rulebases/*.terms.yaml")
+        worlds = _shipped("worlds/*.yaml")
+        maps = _shipped("worlds/maps/*.yaml")
+        pgm = (ROOT / "worlds" / "maps" / "mrpb_office02.pgm").read_bytes()
+        small_pgms = [("p5.pgm", b"P5\n# c\n4 3\n255\n" + bytes(range(0, 240, 20))),
+                      ("p2.pgm", b"P2\n3 2\n100\n0 50 100\n100 0 7\n"),
+                      ("p5-16.pgm", b"P5 2 2 65535\n" + bytes(8)),
+                      ("office.pgm", pgm)]
+        # the shipped lesson simulates twice and adapts for 60 epochs (seconds of real work
+        # that every mutation repeats): its commands are seeds of the command kind instead
+        lessons = []
+        lessons.append(("small.lesson", "correct road=78 size=45 position=4 -> steering=100\n"
+                        "r28: if road is NARROW and position is RIGHT\n  then steering is LS\n"
+                        "eval road=10 size=5 position=0\nshow rules\nadapt epochs 2\nundo\n"))
+        lessons.append(("drive.lesson", "use drive\nsimulate worlds/corridor.yaml\n"
+                        "at 1s to 2s steering=90\nadapt epochs 3\n"))
+        commands = [(f"cmd{i}", line) for i, line in enumerate((
+            "r28: if road is NARROW and position is RIGHT then steering is LS",
+            "correct road=78 size=45 position=4 -> steering=100 speed=20",
+            "eval road=10 size=5 position=0", "adapt epochs 60 rate 0.5", "undo",
+            "at 9s to 12.75s steering=90", "simulate worlds/figure4.yaml", "show rules",
+            "use drive when not road is WIDE with 0.5", "frozen r1, r2", "save x.rules",
+            "operators: and = product, or = max", "behavior turn:", "end", "help adapt",
+            "quit"))]
+        csvs = [("batch.csv", "road,size,position\n78,45,4\n10,5,-3\n 0.5 , 1e2 , -8\n"),
+                ("order.csv", "position,road,size\n4,78,45\n")]
+        fcl = _shipped("tests/data/interop/*.fcl")
+        fis = _shipped("tests/data/interop/*.fis")
+        fll = self.fll_seeds()
+        rule_mut = Mutator(RULE_WORDS, RULE_NEST)
+        ymut = yaml_mutator(("name", "inputs", "outputs", "terms", "universe", "default",
+                             "triangle", "trapezoid", "gaussian", "robot", "obstacles",
+                             "image", "resolution", "origin", "negate", "occupied_thresh",
+                             "free_thresh", "mode", "start", "goal", "map", "seed"))
+        fmut = Mutator(("VAR_INPUT", "VAR_OUTPUT", "END_VAR", "FUZZIFY", "END_FUZZIFY",
+                        "DEFUZZIFY", "TERM", ":=", "RULEBLOCK", "RULE", "IF", "THEN", "AND",
+                        "OR", "NOT", "Range", "NumMFs", "trimf", "trapmf", "gaussmf",
+                        "[Input1]", "[Rules]", "InputVariable:", "OutputVariable:", "term:",
+                        "Triangle", "Trapezoid", "range:", "default:", "rule:", "if", "then",
+                        "is", "and", "(", ")", ";", ",", "NaN", "inf"),
+                       (lambda d: "RULE 1 : IF " + "(" * d + "x IS a" + ")" * d + " THEN y IS b;",
+                        lambda d: "rule: if " + "not " * d + "x is a then y is b"))
+        tmut = Mutator(RULE_WORDS + ("correct", "eval", "adapt", "epochs", "rate", "undo",
+                                     "at", "s", "to", "simulate", "show", "save", "as", "help",
+                                     "quit", "=", "1e400s", "-1s", "nan"), RULE_NEST[:3])
+        cmut = Mutator(("road", "size", "position", ",", "\"", "\x00", "nan", "inf"),
+                       (lambda d: '"' + "x" * (200 * d) + '"',))
+        jmut = Mutator(("seq", "op", "rule", "examples", "undo", "of", "start", "text",
+                        "behavior", "inputs", "targets", "null", "true", "{", "}", "[", "]",
+                        ":", ",", '"', "adapt", "terms", "crisp"),
+                       (lambda d: '{"seq": 99, "op": "examples", "examples": ' + "[" * d
+                        + "]" * d + "}",))
+        k = self
+        return [
+            Kind("rule files", rules, rule_mut, k.run_rules, ".rules"),
+            Kind("term-set YAML", termsets, ymut, k.run_termset, ".terms.yaml"),
+            Kind("world YAML", worlds, ymut, k.run_world, ".yaml"),
+            Kind("map YAML + PGM", maps + small_pgms, ymut, k.run_map, ".yaml"),
+            Kind("FCL", fcl, fmut, k.run_foreign("fcl"), ".fcl"),
+            Kind(".fis", fis, fmut, k.run_foreign("fis"), ".fis"),
+            Kind("FLL", fll, fmut, k.run_foreign("fll"), ".fll"),
+            Kind("teach commands", commands, tmut, k.run_command, ".txt"),
+            Kind("lessons", lessons, tmut, k.run_lesson, ".lesson"),
+            Kind("eval --batch CSV", csvs, cmut, k.run_batch, ".csv"),
+            Kind("teach journals", self.journal_seeds(), jmut, k.run_journal, ".jsonl"),
+        ]
+
+    def fll_seeds(self) -> list[tuple[str, str]]:
+        from mitos_cli.api import read_rulebase
+        from mitos_cli.interop import fcl, fll
+
+        out = [("mitos.fll", fll.write_fll(read_rulebase(self.rb_dir / "mitos.rules")))]
+        for name, text in _shipped("tests/data/interop/*.fcl")[:2]:
+            # a seed the writer cannot express is simply not a seed
+            with contextlib.suppress(Exception):
+                out.append((name + ".fll", fll.write_fll(fcl.parse_fcl(text, name))))
+        return out
+
+
+def mutate_bytes(rng: random.Random, data: bytes) -> bytes:
+    """PGM: header numbers replaced (huge, zero, negative), bytes flipped, cut short."""
+    choice = rng.randrange(5)
+    if choice == 0:
+        head, _, rest = data.partition(b"\n")
+        fields = re.split(rb"(\s+)", data[:40])
+        nums = [i for i, f in enumerate(fields) if f.isdigit()]
+        if nums:
+            fields[rng.choice(nums)] = rng.choice((b"0", b"99999999999", b"4294967297",
+                                                   b"65536", b"1" * 40, b"-3", b"x"))
+        return b"".join(fields) + data[40:]
+    if choice == 1:
+        return data[:rng.randrange(len(data) + 1)]
+    if choice == 2:
+        b = bytearray(data)
+        for _ in range(rng.choice((1, 5, 50))):
+            b[rng.randrange(len(b))] = rng.randrange(256)
+        return bytes(b)
+    if choice == 3:
+        return data[:2] + rng.choice((b" # \n", b"\t", b"#", b"\r\n")) + data[2:]
+    return data + bytes(rng.randrange(256) for _ in range(rng.choice((1, 100))))
+
+
+# ---------------------------------------------------------------------------------------------
+# running and classifying
+
+def _alarm(signum, frame):
+    raise Timeout()
+
+
+def signature(exc: BaseException) -> str:
+    """Exception type and the innermost frame of the project (or of anything) that raised it."""
+    tb = traceback.extract_tb(exc.__traceback__)
+    ours = [f for f in tb if "mitos_cli" in f.filename] or list(tb)
+    f = ours[-1] if ours else None
+    where = f"{Path(f.filename).name}:{f.name}:{f.lineno}" if f else "?"
+    return f"{type(exc).__name__} at {where}"
+
+
+#: seconds a large input may take per KB beyond ``--slow`` (its size explains that much)
+PER_KB = 0.01
+
+
+def classify(kind: Kind, data, work: Path, limit: float, slow: float) -> tuple[str, str]:
+    from mitos_cli.errors import MitosError
+
+    allowance = len(data) / 1024 * PER_KB
+    limit, slow = limit + allowance, slow + allowance
+    # CPU time, not wall time: on a shared machine the wall clock measures the neighbours
+    signal.signal(signal.SIGPROF, _alarm)
+    t0 = time.process_time()
+    signal.setitimer(signal.ITIMER_PROF, limit)
+    try:
+        kind.run(data, work)
+        outcome, sig = "loaded", ""
+    except Timeout:
+        return "slow", "past the limit"
+    except MitosError as exc:
+        span = exc.span
+        outcome = "refused+pos" if span is not None and span.line >= 1 else "refused"
+        sig = exc.message[:60] if outcome == "refused" else ""
+    except NonFinite as exc:
+        outcome, sig = "nonfinite", str(exc).split("=")[0]
+    except RecursionError as exc:
+        outcome, sig = "foreign", signature(exc)
+    except Exception as exc:              # noqa: BLE001 - exactly what a campaign looks for
+        outcome, sig = "foreign", signature(exc)
+    except MemoryError as exc:
+        outcome, sig = "foreign", signature(exc)
+    finally:
+        signal.setitimer(signal.ITIMER_PROF, 0)
+    elapsed = time.process_time() - t0
+    if elapsed > slow and outcome != "foreign":
+        return "slow", "slower than allowed"
+    return outcome, sig
+
+
+def minimise(kind: Kind, data, work: Path, want: tuple[str, str], limit: float, slow: float,
+             budget: int = 150):
+    """Delta debugging by lines, then by characters, while the outcome and signature stay."""
+    if want[0] == "slow":
+        return data                    # shrinking a slow input is itself slow: keep it whole
+    tries = 0
+    deadline = time.perf_counter() + 30.0
+
+    def same(candidate) -> bool:
+        nonlocal tries
+        tries += 1
+        if time.perf_counter() > deadline:
+            tries = budget
+            return False
+        return classify(kind, candidate, work, limit, slow) == want
+
+    unit = b"\n" if isinstance(data, bytes) else "\n"
+    for sep in (unit, None):
+        parts = data.split(unit) if sep is not None else list(data)
+        n = 2
+        while len(parts) >= 2 and tries < budget:
+            chunk = max(1, len(parts) // n)
+            for start in range(0, len(parts), chunk):
+                cand_parts = parts[:start] + parts[start + chunk:]
+                join = (sep if sep is not None else unit[:0]).join(cand_parts)
+                if tries < budget and same(join):
+                    parts, n = cand_parts, max(n - 1, 2)
+                    break
+            else:
+                if chunk == 1:
+                    break
+                n = min(len(parts), n * 2)
+        data = (sep if sep is not None else unit[:0]).join(parts)
+    return data
+
+
+def make_input(kind: Kind, i: int, seed: int):
+    """Input ``i`` of ``kind``: the seeds first, then mutations; each from its own generator,
+    so any input can be made again alone (the watchdog does, for an input that hung)."""
+    name, base = kind.seeds[i % len(kind.seeds)]
+    if i < len(kind.seeds):
+        return name, base
+    rng = random.Random(f"{seed}-{kind.name}-{i}")
+    return name, (mutate_bytes(rng, base) if isinstance(base, bytes) else kind.mutate(rng, base))
+
+
+def _allowance(kind: Kind, i: int, seed: int) -> float:
+    return len(make_input(kind, i, seed)[1]) / 1024 * PER_KB
+
+
+def _worker(conn, kind_index: int, start: int, stop: int, seed: int, limit: float,
+            slow: float, work: Path) -> None:
+    """Runs inputs ``start..stop`` of one kind, announcing each before running it."""
+    resource.setrlimit(resource.RLIMIT_AS, (4 << 30, resource.RLIM_INFINITY))
+    os.chdir(work)                      # teaching writes `.mitos/` and saves here
+    kind = Kinds(work, fresh=False).build()[kind_index]
+    scratch = work / f"scratch-{os.getpid()}"
+    for i in range(start, stop):
+        _, data = make_input(kind, i, seed)
+        conn.send(("start", i))
+        scratch.mkdir(exist_ok=True)
+        outcome, sig = classify(kind, data, scratch, limit, slow)
+        shutil.rmtree(scratch, ignore_errors=True)
+        conn.send(("done", i, outcome, sig))
+    conn.send(("end",))
+
+
+def campaign(per_format: int, out: Path | None, limit: float, slow: float, only: str | None,
+             seed: int, log=print) -> list[Kind]:
+    """Run every kind's inputs in a worker process; a worker stuck in one input past twice
+    the limit (a hang the alarm cannot reach, inside C code) is killed, the input counted as
+    slow, and a new worker carries on after it."""
+    import multiprocessing as mp
+
+    ctx = mp.get_context("fork")
+    resource.setrlimit(resource.RLIMIT_AS, (4 << 30, resource.RLIM_INFINITY))
+    work = Path(tempfile.mkdtemp(prefix="mitos-fuzz-"))
+    cwd = os.getcwd()
+    os.chdir(work)
+    try:
+        kinds = Kinds(work).build()
+        seen: set[tuple[str, str, str]] = set()
+        for index, kind in enumerate(kinds):
+            if only and only.lower() not in kind.name.lower():
+                continue
+            t0 = time.perf_counter()
+            i = 0
+            while i < per_format:
+                parent, child = ctx.Pipe()
+                proc = ctx.Process(target=_worker, args=(child, index, i, per_format, seed,
+                                                         limit, slow, work), daemon=True)
+                proc.start()
+                child.close()
+                current = i
+                while True:
+                    if not parent.poll(6 * limit + 60 + 6 * _allowance(kind, current, seed)):
+                        proc.kill()
+                        proc.join()
+                        result = ("slow", "hung (no answer from the worker)")
+                        i = current + 1
+                        break
+                    try:
+                        msg = parent.recv()
+                    except EOFError:             # the worker died (out of memory, a signal)
+                        proc.join()
+                        result = ("foreign", f"worker died (exit {proc.exitcode})")
+                        i = current + 1
+                        break
+                    if msg[0] == "start":
+                        current = msg[1]
+                        continue
+                    if msg[0] == "end":
+                        result = None
+                        i = per_format
+                        break
+                    _, n, outcome, sig = msg
+                    _count(kind, n, outcome, sig, seen, out, seed, work, limit, slow, log)
+                if result is not None:
+                    _count(kind, current, *result, seen, out, seed, work, limit, slow, log)
+                proc.join()
+            log(f"{kind.name}: {kind.tried} inputs in {time.perf_counter() - t0:.1f} s "
+                + ", ".join(f"{k} {v}" for k, v in kind.counts.items() if v))
+        return kinds
+    finally:
+        os.chdir(cwd)
+        shutil.rmtree(work, ignore_errors=True)
+
+
+def _count(kind: Kind, i: int, outcome: str, sig: str, seen: set, out: Path | None, seed: int,
+           work: Path, limit: float, slow: float, log) -> None:
+    kind.tried += 1
+    kind.counts[outcome] += 1
+    key = (kind.name, outcome, sig)
+    if outcome in ("foreign", "slow", "nonfinite") and key not in seen:
+        seen.add(key)
+        name, data = make_input(kind, i, seed)
+        log(f"  {kind.name}: {outcome} {sig} (input {i}, from {name})")
+        if out is not None:
+            hung = sig.startswith(("hung", "worker"))
+            scratch = work / "scratch-min"
+            scratch.mkdir(exist_ok=True)
+            _write(out, kind, data, (outcome, sig), scratch, limit, slow, shrink=not hung)
+            shutil.rmtree(scratch, ignore_errors=True)
+
+
+def _write(out: Path, kind: Kind, data, want, scratch: Path, limit: float, slow: float,
+           shrink: bool = True) -> None:
+    small = minimise(kind, data, scratch, want, limit, slow) if shrink else data
+    out.mkdir(parents=True, exist_ok=True)
+    tag = hashlib.sha1(f"{kind.name}{want}".encode()).hexdigest()[:10]
+    stem = re.sub(r"\W+", "-", kind.name).strip("-")
+    ext = ".pgm" if isinstance(small, bytes) else kind.ext
+    target = out / f"{stem}-{tag}{ext}"
+    if isinstance(small, bytes):
+        target.write_bytes(small)
+    else:
+        target.write_text(small, encoding="utf-8", errors="surrogatepass")
+    target.with_suffix(target.suffix + ".json").write_text(json.dumps(
+        {"kind": kind.name, "outcome": want[0], "signature": want[1],
+         "bytes": len(small)}, indent=1) + "\n")
+
+
+def table(kinds: list[Kind]) -> str:
+    rows = ["| input | tried | loaded | refused with a position | refused without one | "
+            "foreign exception | slow | non-finite |", "|---|---:|---:|---:|---:|---:|---:|---:|"]
+    total = dict.fromkeys(OUTCOMES, 0)
+    tried = 0
+    for k in kinds:
+        if not k.tried:
+            continue
+        tried += k.tried
+        for o in OUTCOMES:
+            total[o] += k.counts[o]
+        rows.append(f"| {k.name} | {k.tried:,} | " + " | ".join(f"{k.counts[o]:,}"
+                                                                for o in OUTCOMES) + " |")
+    rows.append(f"| **all** | {tried:,} | " + " | ".join(f"{total[o]:,}" for o in OUTCOMES)
+                + " |")
+    return "\n".join(rows)
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--per-format", type=int, default=2000, help="inputs per input kind")
+    ap.add_argument("--quick", action="store_true", help="a short campaign (150 per kind)")
+    ap.add_argument("--out", type=Path, default=None,
+                    help="directory for minimal reproducers of new signatures")
+    ap.add_argument("--only", default=None, help="run only the kinds whose name contains this")
+    ap.add_argument("--limit", type=float, default=10.0, help="per-input time limit, seconds")
+    ap.add_argument("--slow", type=float, default=5.0, help="slower than this counts as slow")
+    ap.add_argument("--seed", type=int, default=SEED)
+    args = ap.parse_args(argv)
+    n = 150 if args.quick else args.per_format
+    t0 = time.perf_counter()
+    kinds = campaign(n, args.out, args.limit, args.slow, args.only, args.seed)
+    print()
+    print(table(kinds))
+    print(f"\n{sum(k.tried for k in kinds):,} inputs in {time.perf_counter() - t0:.0f} s "
+          f"(seed {args.seed}, limit {args.limit:g} s, slow above {args.slow:g} s)")
+    bad = sum(k.counts[o] for k in kinds for o in ("foreign", "slow", "nonfinite"))
+    return 1 if bad else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
