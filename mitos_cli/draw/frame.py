@@ -22,7 +22,6 @@ class RunFrame:
 
     def __init__(self, world, static, routes, *, width_px: int = 640, show: bool = False) -> None:
         _matplotlib()
-        from matplotlib.collections import LineCollection
         from matplotlib.patches import Circle, Polygon
 
         self.world = world
@@ -38,22 +37,7 @@ class RunFrame:
         ax.set_axis_off()
         ax.set_facecolor("#d9d9d9")
         self.fig.patch.set_facecolor("#d9d9d9")
-        if static.grid is not None:
-            g = static.grid
-            rows, cols = g.occupied.shape
-            ax.imshow(np.where(g.occupied, 0.55, 1.0), origin="lower", cmap="gray", vmin=0,
-                      vmax=1, extent=(g.origin[0], g.origin[0] + cols * g.resolution,
-                                      g.origin[1], g.origin[1] + rows * g.resolution),
-                      interpolation="nearest")
-        for corners in static.rects:
-            ax.add_patch(Polygon(corners, closed=True, facecolor="white", edgecolor="none"))
-        ax.add_collection(LineCollection(static.walls.reshape(-1, 2, 2), colors="black",
-                                         linewidths=1.0))
-        for route in routes:
-            ax.plot(route.points[:, 0], route.points[:, 1], ls="--", lw=0.7, color="#4a78b5")
-        for agent in world.agents:
-            ax.add_patch(Circle((agent.goal.x, agent.goal.y), agent.goal.tolerance, fill=False,
-                                edgecolor="#2f6b2f", lw=1.0, ls="--"))
+        draw_background(ax, world, static, routes)
         self._obstacles = []
         for o in world.obstacles:
             patch = (Circle((o.x, o.y), o.radius) if o.shape == "circle"
@@ -103,3 +87,26 @@ class RunFrame:
             import matplotlib.pyplot as plt
 
             plt.close(self.fig)
+
+
+def draw_background(ax, world, static, routes) -> None:
+    """What does not move: free space, walls, the routes and the goals."""
+    from matplotlib.collections import LineCollection
+    from matplotlib.patches import Circle, Polygon
+
+    if static.grid is not None:
+        g = static.grid
+        rows, cols = g.occupied.shape
+        ax.imshow(np.where(g.occupied, 0.55, 1.0), origin="lower", cmap="gray", vmin=0,
+                  vmax=1, extent=(g.origin[0], g.origin[0] + cols * g.resolution,
+                                  g.origin[1], g.origin[1] + rows * g.resolution),
+                  interpolation="nearest")
+    for corners in static.rects:
+        ax.add_patch(Polygon(corners, closed=True, facecolor="white", edgecolor="none"))
+    ax.add_collection(LineCollection(static.walls.reshape(-1, 2, 2), colors="black",
+                                     linewidths=1.0))
+    for route in routes:
+        ax.plot(route.points[:, 0], route.points[:, 1], ls="--", lw=0.7, color="#4a78b5")
+    for agent in world.agents:
+        ax.add_patch(Circle((agent.goal.x, agent.goal.y), agent.goal.tolerance, fill=False,
+                            edgecolor="#2f6b2f", lw=1.0, ls="--"))
