@@ -50,9 +50,9 @@ def resolve(kind: str, name: str | Path, suffix: str, base: Path | None = None) 
     for candidate in ([base / p] if base is not None else []) + [p]:
         if _is_file(candidate):
             return candidate
-    for candidate in (p.name, p.name + suffix):
-        if _is_file(data_dir(kind) / candidate):
-            return packaged_path(kind, candidate)
+    for filename in (p.name, p.name + suffix):
+        if _is_file(data_dir(kind) / filename):
+            return packaged_path(kind, filename)
     return None
 
 

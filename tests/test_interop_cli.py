@@ -257,3 +257,20 @@ def test_fcl_rule_blocks_with_different_operators_become_behaviors() -> None:
     assert ops["gentle"]["or"] == "probabilistic_sum"           # IEC: the dual of PROD
     same = parse_fcl(text.replace("AND : PROD;", "AND : MIN;"), "one.fcl")
     assert [b.name for b in same.behaviors] == ["main"] and len(same.behaviors[0].rules) == 4
+
+
+def test_convert_warns_only_of_behaviors_it_leaves_out(tmp_path: Path) -> None:
+    from mitos_cli.interop import conversion_notes
+
+    rb = read_rulebase(ROOT / "rulebases" / "mitos.rules")
+    assert not any("only behavior" in n for n in conversion_notes(rb, "rules", "drive"))
+    (note,) = [n for n in conversion_notes(rb, "rules", "cruise") if "only behavior" in n]
+    assert "drive" in note and "cruise)" not in note and "avoid_obstacle" in note
+    result = runner.invoke(app, ["convert", str(ROOT / "rulebases" / "mitos.rules"), "--to",
+                                 "rules", "-b", "drive", "-o", str(tmp_path / "d.rules")])
+    assert result.exit_code == 0 and "warning" not in result.output
+    original = load_rulebase(ROOT / "rulebases" / "mitos.rules", "drive")
+    c = original.compiled
+    inputs = {name: float(lo + 0.37 * (hi - lo)) for name, (lo, hi) in zip(c.inputs, c.universe)}
+    assert load_rulebase(tmp_path / "d.rules", "drive").evaluate(**inputs) == \
+        original.evaluate(**inputs)

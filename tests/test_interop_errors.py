@@ -311,8 +311,15 @@ def test_fcl_sugeno_lock_range() -> None:
 def test_unknown_extension_and_missing_file(tmp_path: Path) -> None:
     with pytest.raises(FormatError, match="unknown format `.xml`"):
         read_foreign(tmp_path / "x.xml")
-    with pytest.raises(FormatError, match="not found"):
+    # a missing file is not a format error: it is reported as for a .rules file
+    from mitos_cli.errors import RuleBaseError
+
+    with pytest.raises(RuleBaseError, match="cannot read rule file .*No such file"):
         read_foreign(tmp_path / "x.fll")
+    (tmp_path / "tipper.fll").write_text(FLL)
+    with pytest.raises(RuleBaseError) as exc:
+        read_foreign(tmp_path / "tiper.fll")
+    assert exc.value.hint == "did you mean `tipper.fll`?"
     with pytest.raises(FormatError, match="unknown format `yaml`"):
         write_foreign(parse_fll(FLL), "yaml")
 

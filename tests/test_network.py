@@ -98,6 +98,10 @@ def test_operators_command_json(capsys):
     assert [e["name"] for e in data["and"]] == list(norms.TNORMS)
     assert [e["name"] for e in data["or / aggregation"]] == list(norms.SNORMS)
     assert {e["name"] for e in data["inference"] if e["default"]} == {"weighted_average"}
+    # every T-norm is accepted as a Mamdani implication, so every one is listed as one
+    from mitos_cli.lang.operators import IMPLICATIONS
+
+    assert [e["name"] for e in data["implication"]] == list(IMPLICATIONS) == list(norms.TNORMS)
 
 
 def test_unknown_operator_in_a_rule_file(capsys, tmp_path):

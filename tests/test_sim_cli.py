@@ -16,7 +16,7 @@ from mitos_cli.sim.perception import INPUTS
 RUNNER = CliRunner()
 KEYS = {"world", "seed", "outcome", "reached_goal", "collisions", "time_s", "path_length_in",
         "min_clearance_in", "mean_speed_in_s", "steering_total_variation_deg", "ticks",
-        "replans"}
+        "replans", "near_miss"}
 SHORT = """\
 name: short
 seed: 2
@@ -69,6 +69,7 @@ def test_json_matches_the_library(short):
     from mitos_cli.sim.worldfile import load_world
 
     data = json.loads(run(short, "--json", "--seed", 4).stdout)
+    assert data.pop("near_miss") is False           # the command's one addition
     assert data == simulate(load_world(short), seed=4).summary()
 
 
@@ -157,3 +158,21 @@ def test_a_rule_base_without_the_inputs_is_refused(short, tmp_path, capsys):
                      'steering is ST and speed is SLOW\nend\n', encoding="utf-8")
     code, err = run_main(capsys, short, "--rulebase", rules)
     assert code == 1 and "does not perceive" in err
+
+
+def test_json_says_near_miss_as_the_text_does(tmp_path):
+    text = (Path(__file__).parents[1] / "worlds" / "corridor.yaml").read_text()
+    world = tmp_path / "close.yaml"
+    world.write_text(text.replace("safety_margin: 2 ", "safety_margin: 6 "))
+    shown = CliRunner().invoke(app, ["simulate", str(world)])
+    assert shown.exit_code == 0 and "closer than the safety margin (6 in)" in shown.stdout
+    data = json.loads(CliRunner().invoke(app, ["simulate", str(world), "--json"]).stdout)
+    assert data["near_miss"] is True and data["outcome"] == "success"
+    data = json.loads(CliRunner().invoke(app, ["simulate", "corridor.yaml", "--json"]).stdout)
+    assert data["near_miss"] is False
+
+
+def test_one_run_shows_no_spread():
+    out = CliRunner().invoke(app, ["simulate", "corridor.yaml", "--runs", "1"]).stdout
+    row = out.splitlines()[1].split()
+    assert "±" not in out and row[0] == "corridor" and float(row[-1]) > 0

@@ -275,6 +275,11 @@ def test_the_robot_replans_when_boxes_shut_its_way_and_not_for_a_box_it_can_pass
     tick, robot, route = res.replanned[0]
     assert robot == 0 and route.points[:, 1].max() > 200      # north round the loop
     assert res.route_at(tick, 0) is route and res.route_at(0, 0) is res.routes[0]
+    from mitos_cli.sim.export import traces
+    from mitos_cli.sim.planner import FuzzyPlanner
+
+    text = traces(res, FuzzyPlanner(None, world.behavior), every=10_000)
+    assert f"--- tick {tick}," in text and "replanned: what it sensed shuts the way ahead" in text
     corridor = simulate(load_world(ROOT / "worlds" / "corridor.yaml"))
     assert corridor.metrics["replans"] == 0 and corridor.outcome == "success"
 

@@ -62,7 +62,7 @@ def run(*args):
 def test_the_second_robots_collision_is_the_runs(rear_end):
     data = json.loads(run(rear_end, "--json"))
     first, second = data["robots"]
-    assert [list(r) for r in data["robots"]] == [ROBOT_KEYS, ROBOT_KEYS]
+    assert [list(r) for r in data["robots"]] == [ROBOT_KEYS + ["near_miss"]] * 2
     assert (first["name"], first["outcome"], first["reached_goal"]) == ("robot", "success", True)
     assert (second["name"], second["outcome"], second["reached_goal"]) == \
         ("second", "collision", False)
@@ -73,7 +73,10 @@ def test_the_second_robots_collision_is_the_runs(rear_end):
     assert second["min_clearance_in"] < 0.0
     assert data["min_clearance_in"] == second["min_clearance_in"]
     res = simulate(load_world(rear_end))
-    assert res.summary() == data
+    # the command's JSON is SimResult.summary() with near_miss beside each outcome
+    assert data["near_miss"] is False and [r.pop("near_miss") for r in data["robots"]] == \
+        [False, False]
+    assert res.summary() == {k: v for k, v in data.items() if k != "near_miss"}
     assert second["min_clearance_in"] == res.clearance[-1, 1] == res.clearance.min()
     # each robot's time is until it stopped at its goal or the run ended
     assert first["time_s"] < data["time_s"] == second["time_s"] == res.ticks * 0.05
@@ -128,7 +131,9 @@ def test_one_robot_json_has_no_robots_list_and_is_as_before():
                                                         "--json"]
     data = simulate(load_world(ROOT / "worlds" / "corridor.yaml")).summary()
     assert "robots" not in data
-    assert json.dumps(data, indent=2) + "\n" == (golden / "stdout").read_text()
+    # the command adds only `near_miss` (the text's "closer than the safety margin") to it
+    assert json.dumps(dict(data, near_miss=False), indent=2) + "\n" == \
+        (golden / "stdout").read_text()
 
 
 def test_two_robots_of_one_name_are_refused(tmp_path, capsys):

@@ -68,3 +68,22 @@ def test_a_scenario_becomes_one_world_per_test(tmp_path):
     assert [w.name for w in worlds] == ["mrpb/box#1", "mrpb/box#2"]
     assert worlds[0].grid is worlds[1].grid                     # the map is read once
     assert worlds[0].time_limit == mrpb.MIN_TIME_S
+
+
+def test_a_partially_unknown_scenario_is_given_its_map_and_drives_in_the_complete_one(
+        tmp_path):
+    for name, wall in (("office02", 20), ("office02_partially_unknown", None)):
+        folder = tmp_path / name
+        folder.mkdir()
+        pixels = np.full((40, 40), 254, np.uint8)
+        pixels[0, :] = pixels[-1, :] = pixels[:, 0] = pixels[:, -1] = 0
+        if wall:
+            pixels[wall, 30:] = 0                   # furniture the given map lacks
+        (folder / "map.pgm").write_bytes(b"P5\n40 40\n255\n" + pixels.tobytes())
+        (folder / "map.yaml").write_text("image: map.pgm\nresolution: 0.05\n"
+                                         "origin: [-1, -1, 0]\nnegate: 0\n"
+                                         "occupied_thresh: 0.65\nfree_thresh: 0.196\n")
+        (folder / "tests.txt").write_text("test 1: start (-0.5, 0, 0) -> goal (0.5, 0.5, 0)\n")
+    [w] = mrpb.scenario_worlds(tmp_path, "office02_partially_unknown")
+    assert w.knows == "given"
+    assert w.grid.occupied.sum() > w.given.occupied.sum()     # the truth holds the furniture

@@ -170,3 +170,24 @@ def test_user_errors(tiny, tmp_path, compare, args, code, words):
 def test_no_planner_is_a_usage_error(tiny, tmp_path, compare):
     r = compare(tiny, "--planner", ",", "-o", tmp_path / "e")
     assert r.exit_code == 2 and "name at least one planner" in r.output
+
+
+def test_compare_json_is_the_documented_object(tiny, tmp_path, monkeypatch, compare):
+    """The --json schema (docs/study.md), golden: tests/data/compare_tiny.json."""
+    import json
+    import shutil
+
+    monkeypatch.chdir(tmp_path)
+    shutil.copy(tiny, "tiny.yaml")
+    r = compare("tiny.yaml", "--and", "min,product", "--runs", 2, "-o", "st", "-j", 1,
+                "--no-plots", "--json")
+    assert r.exit_code == 0, r.output
+    data = json.loads(r.stdout)
+    golden = Path(__file__).parent / "data" / "compare_tiny.json"
+    if os.environ.get("MITOS_UPDATE_GOLDEN"):
+        golden.write_text(r.stdout)
+    assert data == json.loads(golden.read_text())
+    assert [s["choice"] for s in data["summaries"]] == data["choices"]
+    assert {k for s in data["summaries"] for k in s["rates"]} == {
+        "success", "collision", "timeout", "stuck"}
+    assert len(read_rows("st")) == data["tasks"] == data["executed"] == 6

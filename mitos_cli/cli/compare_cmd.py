@@ -7,7 +7,7 @@ from typing import Annotated, Optional
 
 import typer
 
-from .output import err, warn
+from .output import emit, err, warn
 from ..words import plural
 
 
@@ -55,6 +55,9 @@ def compare_command(
         "--behavior", "-b", help="Behavior to drive with (default: the world's).")] = None,
     plots: Annotated[bool, typer.Option(
         "--plots/--no-plots", help="Draw the plots of report.md (needs matplotlib).")] = True,
+    as_json: Annotated[bool, typer.Option(
+        "--json", help="Print one JSON object (the summaries and the ranking; schema in "
+                       "docs/study.md) instead of the tables.")] = False,
 ) -> None:
     """Compare T-norms, S-norms, inference methods and planners over worlds and seeded runs.
 
@@ -85,6 +88,23 @@ def compare_command(
                   command=" ".join(shlex.quote(w) for w in words))
     outcome = run_with_progress(study, out, executor, workers, scheduler, resume)
 
+    if as_json:
+        import json
+
+        emit(json.dumps(outcome_json(outcome, out), indent=2))
+    else:
+        _print_tables(outcome)
+    try:
+        report = write_report(outcome, out, plots=plots)
+    except ImportError:
+        warn("matplotlib is not installed: report.md has no plots "
+             "(pip install 'mitos[plot]')")
+        report = write_report(outcome, out, plots=False)
+    err(f"{plural(outcome.executed, 'run')} now, {outcome.skipped} from before; "
+        f"wrote {report.parent / 'results.csv'} and {report}")
+
+
+def _print_tables(outcome) -> None:
     from rich.console import Console
 
     from ..study.report import overlap_note, rich_tables
@@ -98,14 +118,43 @@ def compare_command(
     note = overlap_note(outcome.ranks)
     if note:
         console.print(note, markup=False)
-    try:
-        report = write_report(outcome, out, plots=plots)
-    except ImportError:
-        warn("matplotlib is not installed: report.md has no plots "
-             "(pip install 'mitos[plot]')")
-        report = write_report(outcome, out, plots=False)
-    err(f"{plural(outcome.executed, 'run')} now, {outcome.skipped} from before; "
-        f"wrote {report.parent / 'results.csv'} and {report}")
+
+
+def outcome_json(outcome, out: str) -> dict:
+    """The ``--json`` object: the study, a summary per world and choice (and pooled over
+    the worlds), and the ranking (docs/study.md, "compare --json")."""
+    def rate(r) -> dict:
+        return {"k": r.k, "n": r.n, "value": r.value, "lo": r.lo, "hi": r.hi}
+
+    def number(x: float | None) -> float | None:
+        return None if x is None or not math.isfinite(x) else x      # JSON has no inf / NaN
+
+    def mean(m) -> dict:
+        return {"n": m.n, "mean": number(m.mean), "std": number(m.std), "lo": number(m.lo),
+                "hi": number(m.hi)}
+
+    def summary(s) -> dict:
+        return {"world": s.world, "choice": s.choice.label, "runs": s.n,
+                "rates": {k: rate(v) for k, v in s.rates.items()},
+                "metrics": {k: mean(v) for k, v in s.metrics.items()}}
+
+    import math
+
+    from ..study.summary import ALL_WORLDS
+
+    study = outcome.study
+    return {
+        "command": study.command, "out": out, "seed": study.seed, "runs": study.runs,
+        "worlds": list(dict.fromkeys(s.world for s in outcome.summaries
+                                     if s.world != ALL_WORLDS)),
+        "choices": [c.label for c in study.choices],
+        "tasks": outcome.n_tasks, "executed": outcome.executed, "skipped": outcome.skipped,
+        "summaries": [summary(s) for s in outcome.summaries],
+        "ranking": [{"place": r.place, "choice": r.summary.choice.label,
+                     "success": rate(r.summary.rates["success"]), "paired_runs": r.paired_n,
+                     "wins": r.wins, "losses": r.losses, "p_value": r.p_value}
+                    for r in outcome.ranks],
+    }
 
 
 def check_inputs(worlds: list[str], choices, rulebase: str | None,

@@ -15,6 +15,7 @@ INFERENCE = {
     "weighted_sum": "y = sum_r(dof_r * y_r) (Takagi-Sugeno without normalisation)",
     "mamdani": "y = defuzzify(S_r implication(dof_r, mu_r(y))) on `resolution` samples",
 }
+#: The classic implications; any other T-norm T gives mu'(y) = T(dof, mu(y)).
 IMPLICATION = {
     "min": "mu'(y) = min(dof, mu(y)) (clipping)",
     "product": "mu'(y) = dof * mu(y) (scaling)",
@@ -49,7 +50,8 @@ def catalogue() -> dict[str, list[dict]]:
         "or / aggregation": [entry(n.name, n.formula, d.or_, aliases=list(n.aliases),
                                    dual=n.dual) for n in norms.SNORMS.values()],
         "inference": [entry(k, v, d.inference) for k, v in INFERENCE.items()],
-        "implication": [entry(k, v, d.implication) for k, v in IMPLICATION.items()],
+        "implication": [entry(n.name, IMPLICATION.get(n.name, f"mu'(y) = {n.name}(dof, mu(y))"),
+                              d.implication) for n in norms.TNORMS.values()],
         "defuzzify": [entry(k, v, d.defuzzify) for k, v in DEFUZZIFY.items()],
         "sampling": [entry(k, v, d.sampling) for k, v in SAMPLING.items()],
         "hedges": [entry(h.name, h.formula, None) for h in HEDGES.values()],
@@ -61,7 +63,7 @@ TITLES = {
     "or / aggregation": "S-norms (OR neurons, Mamdani aggregation)  operators: or = NAME, "
                         "aggregation = NAME",
     "inference": "inference methods (output layer)         operators: inference = NAME",
-    "implication": "Mamdani implication                      operators: implication = NAME",
+    "implication": "Mamdani implication (any T-norm)         operators: implication = NAME",
     "defuzzify": "Mamdani defuzzifiers                     operators: defuzzify = NAME, "
                  "resolution = N (default {resolution})",
     "sampling": "Mamdani grid                             operators: sampling = NAME",

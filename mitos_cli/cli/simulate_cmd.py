@@ -14,6 +14,22 @@ from .output import emit, err
 REQUIRE = ("success",)
 
 
+def _near_misses(res) -> list[bool]:
+    """Per robot: it came closer than its ``safety_margin`` and did not collide."""
+    return [r["min_clearance_in"] < a.robot.safety_margin and o != "collision"
+            for a, r, o in zip(res.world.agents, res.robot_metrics, res.robot_outcomes)]
+
+
+def _json_summary(res) -> dict:
+    """``res.summary()`` with ``near_miss`` (overall: any robot's) beside the outcome."""
+    data = res.summary()
+    near = _near_misses(res)
+    data["near_miss"] = any(near) and res.outcome != "collision"
+    for robot, flag in zip(data.get("robots", ()), near):
+        robot["near_miss"] = flag
+    return data
+
+
 def _verdict(res) -> str:
     m = res.metrics
     agents = res.world.agents
@@ -77,7 +93,7 @@ def _runs_table(runs) -> str:
                                                         "stuck")]
             for key in ("time_s", "path_length_in", "min_clearance_in", "mean_speed_in_s"):
                 mean, std = r.stat(key)
-                row.append(f"{mean:.1f} ± {std:.1f}")
+                row.append(f"{mean:.1f}" if len(r.summaries) == 1 else f"{mean:.1f} ± {std:.1f}")
             rows.append(row)
     widths = [max(len(r[i]) for r in rows) for i in range(len(head))]
     return "\n".join("  ".join(c.ljust(wd) if i == 0 else c.rjust(wd)
@@ -207,7 +223,7 @@ def simulate_command(
 
         frames = animate_run(res, animate, fps=fps, detail=explain(res, planner))
     if as_json:
-        emit(json.dumps(res.summary(), indent=2))
+        emit(json.dumps(_json_summary(res), indent=2))
     else:
         emit(_verdict(res))
         emit(_summary(res))

@@ -10,6 +10,35 @@ import typer
 from ..words import plural
 
 
+class Transcript:
+    """What a lesson printed, command by command, for ``--json``."""
+
+    def __init__(self) -> None:
+        self.commands: list[dict] = []
+        self.before: list[str] = []            # printed before the first command
+
+    def command(self, echoed: str) -> None:
+        """A lesson's echo ``path:line> text`` opens the next command's record."""
+        where, _, text = echoed.partition("> ")
+        line = where.rsplit(":", 1)[-1]
+        self.commands.append({"line": int(line) if line.isdigit() else None,
+                              "command": text if _ else echoed, "output": []})
+
+    def out(self, text: str) -> None:
+        target = self.commands[-1]["output"] if self.commands else self.before
+        target.extend(str(text).splitlines())
+
+    def to_json(self, session_dir: Path, session) -> str:
+        import json
+
+        state = session.state
+        return json.dumps({"session": session_dir.name,
+                           "journal": (session_dir / "journal.jsonl").as_posix(),
+                           "behavior": state.active, "examples": len(state.examples),
+                           "unsaved": bool(session.unsaved), "commands": self.commands},
+                          indent=2)
+
+
 def teach_command(
     rules: Annotated[str | None, typer.Argument(
         metavar="[RULES]",
@@ -35,6 +64,9 @@ def teach_command(
         "--recover", help="With --resume: keep the changes before a damaged line of the "
                           "journal and continue from there (the damaged journal is kept as "
                           "journal.jsonl.damaged).")] = False,
+    as_json: Annotated[bool, typer.Option(
+        "--json", help="With --lesson: print one JSON object (each command and what it "
+                       "printed; schema in docs/teach.md) instead of the transcript.")] = False,
 ) -> None:
     """Teach a rule base: tell rules and behaviors, correct outputs, adapt, save."""
     from ..api import default_rulebase_path
@@ -48,6 +80,10 @@ def teach_command(
     lesson_text = None
     if recover and not resume:
         raise typer.BadParameter("--recover applies to a resumed session: add --resume")
+    if as_json and lesson is None:
+        raise typer.BadParameter("--json reports a lesson: add --lesson FILE")
+    transcript = Transcript() if as_json else None
+    out = transcript.out if transcript is not None else emit      # what the session prints
     if session_name is not None and not resume:
         raise typer.BadParameter("--session names a session to resume: add --resume")
     if resume:
@@ -55,7 +91,7 @@ def teach_command(
             raise typer.BadParameter("--resume continues a session with its own rule file and "
                                      "behavior; give neither RULES nor --behavior")
         journal = Journal.open(find_session(session_name), recover=recover)
-        session = Session.resume(journal, out=emit, progress=epoch_progress, recover=recover)
+        session = Session.resume(journal, out=out, progress=epoch_progress, recover=recover)
         if save_as is not None:
             session.save_as = Path(save_as)
         err(f"resumed session {journal.directory.name}: {plural(len(journal.active()), 'change')}, "
@@ -84,12 +120,12 @@ def teach_command(
         if lesson is not None:
             lesson_text = read_lesson(lesson)
         journal = Journal.create(new_session_dir(path.stem))
-        session = Session(path, behavior, journal, save_as, out=emit, progress=epoch_progress)
+        session = Session(path, behavior, journal, save_as, out=out, progress=epoch_progress)
         err(f"session {journal.directory.name} (journal in {journal.directory.as_posix()}; "
             f"`mitos teach --resume` continues it)")
     if lesson is not None:
         text, name = lesson_text if lesson_text is not None else read_lesson(lesson)
-        session.echo = emit
+        session.echo = transcript.command if transcript is not None else emit
         if lesson != "-":
             session.base = Path(name).parent
         try:
@@ -99,6 +135,10 @@ def teach_command(
                 f"--session {journal.directory.name}` continues")
             raise typer.Exit(130) from None
         if session.save_as is not None and session.unsaved:
+            if transcript is not None:
+                transcript.command("save (the lesson ended with unsaved changes)")
             session.run("save")
+        if transcript is not None:
+            emit(transcript.to_json(journal.directory, session))
         return
     interact(session, journal.directory / "history")

@@ -43,6 +43,9 @@ def draw_run(result, path: str | Path | None = None, *, footprint_every: float =
     for route in result.routes:
         ax.plot(route.points[:, 0], route.points[:, 1], ls="--", lw=0.8, color="#4a78b5",
                 label="route" if route is result.routes[0] else None)
+    for n, (_, _, route) in enumerate(getattr(result, "replanned", ())):
+        ax.plot(route.points[:, 0], route.points[:, 1], ls="-.", lw=0.8, color="#7a4ab5",
+                label="replanned route" if n == 0 else None)
 
     # obstacles: where they started (faint, for moving ones), their tracks, where they ended
     track = result.obstacles                                  # [T, O, 2]

@@ -104,7 +104,7 @@ class Finding:
     uncovered: int = 0       # grid cells of a very ragged region left out of every box
 
     def to_json(self) -> dict:
-        out = {"severity": self.severity, "code": self.code, "behavior": self.behavior,
+        out: dict[str, object] = {"severity": self.severity, "code": self.code, "behavior": self.behavior,
                "message": self.message,
                "span": None if self.span is None else
                {"path": self.span.path, "line": self.span.line, "column": self.span.column}}
@@ -220,7 +220,7 @@ def canonical(expr: Expr):
             return inner[1]
         return ("not", inner)
     op = "and" if isinstance(expr, And) else "or"
-    items = set()
+    items: set[tuple] = set()
     for item in expr.items:
         key = canonical(item)
         items.update(key[1] if key[0] == op else (key,))
@@ -300,7 +300,7 @@ def _literals(expr: Expr, negated: bool = False):
 def _contradictions(rb: RuleBase, behavior: str) -> list[Finding]:
     out = []
     for label, rule, _ in flatten(rb, behavior):
-        seen = {}
+        seen: dict[tuple[str, str, tuple[str, ...], bool], Prop] = {}
         for var, term, hedges, neg, prop in _literals(rule.antecedent):
             twin = seen.get((var, term, hedges, not neg))
             literal = replace(prop, negated=neg)
@@ -328,7 +328,7 @@ def grid_axes(compiled: CompiledRuleBase, resolution: int,
     def axes_for(n: int) -> list[np.ndarray]:
         axes = []
         for name, (lo, hi) in zip(compiled.inputs, compiled.universe):
-            pts = [np.linspace(lo, hi, n)]
+            pts: list[np.ndarray | list[float]] = [np.linspace(lo, hi, n)]
             for term in compiled.variables[name].terms:
                 corners = term.corners
                 pts.append([c for c in corners if lo <= c <= hi] if corners is not None
@@ -365,6 +365,7 @@ def _sampled(compiled: CompiledRuleBase, threshold: float,
     X = np.stack([m.reshape(-1) for m in mesh], axis=1) if axes else np.zeros((1, 0))
     result = evaluate(compiled, X, detail=True, strict=False)
     dof = result.dof                                   # [n, R]
+    assert dof is not None                             # detail=True keeps the DOFs
     info = GridInfo(compiled.behavior, tuple(zip(compiled.inputs, shape)), X.shape[0])
     out: list[Finding] = []
     name = compiled.behavior
@@ -569,11 +570,11 @@ def _unused_terms(rb: RuleBase) -> list[Finding]:
                                    t.span, None,
                                    hint="write a rule for it, or remove it from the term set"))
         else:
-            names = [t.name for t in var.terms if (var.name, t.name) not in concluded]
-            if names and var.name in set_by_rules:
+            unconcluded = [t.name for t in var.terms if (var.name, t.name) not in concluded]
+            if unconcluded and var.name in set_by_rules:
                 out.append(Finding("info", "unconcluded-term",
                                    f"output `{var.name}`: no rule concludes "
-                                   + ", ".join(names), var.span, None))
+                                   + ", ".join(unconcluded), var.span, None))
             elif var.name not in set_by_rules:
                 out.append(Finding("warning", "unused-term",
                                    f"output `{var.name}` is set by no rule", var.span, None,

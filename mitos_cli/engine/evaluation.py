@@ -54,21 +54,22 @@ def as_batch(compiled: CompiledRuleBase, columns: Mapping[str, object]) -> np.nd
     """
     if len(columns) == len(compiled.inputs):   # numbers by name: one small array, no checks
         try:
-            return np.array([[float(columns[k]) for k in compiled.inputs]])
+            row = [float(columns[k]) for k in compiled.inputs]  # type: ignore[arg-type]  # anything is tried
+            return np.array([row])
         except (KeyError, TypeError, ValueError):
             pass                               # arrays, missing names or bad values: below
     _check_names(compiled, columns)
     return np.ascontiguousarray(_columns(compiled, columns).T)
 
 
-def as_columns(compiled: CompiledRuleBase, columns: dict[str, object]) -> np.ndarray:
+def as_columns(compiled: CompiledRuleBase, columns: Mapping[str, object]) -> np.ndarray:
     """Like :func:`as_batch`, but ``Xt[k, n]``: one contiguous row per input (what the
     engine works on, so a large batch is not copied into rows first)."""
     _check_names(compiled, columns)
     return _columns(compiled, columns)
 
 
-def _check_names(compiled: CompiledRuleBase, columns: dict[str, object]) -> None:
+def _check_names(compiled: CompiledRuleBase, columns: Mapping[str, object]) -> None:
     from ..errors import unknown
 
     for name in columns:
@@ -85,7 +86,7 @@ def _check_names(compiled: CompiledRuleBase, columns: dict[str, object]) -> None
                          hint="give them as " + " ".join(f"{k}=VALUE" for k in missing))
 
 
-def _columns(compiled: CompiledRuleBase, columns: dict[str, object]) -> np.ndarray:
+def _columns(compiled: CompiledRuleBase, columns: Mapping[str, object]) -> np.ndarray:
     arrays = []
     for name in compiled.inputs:
         value = columns[name]
@@ -282,6 +283,8 @@ def linear_consequents(compiled: CompiledRuleBase, Xt: np.ndarray) -> np.ndarray
     matrix product, whose summation order could depend on the batch size.
     """
     A = compiled.cons_linear                     # [R, m, k + 1]
+    if A is None:
+        raise ValueError(f"behavior `{compiled.behavior}` has no linear consequents")
     Y = np.empty((A.shape[1], A.shape[0], Xt.shape[1]))
     Y[:] = A[:, :, -1].T[:, :, None]
     for i in range(A.shape[2] - 1):
@@ -302,6 +305,8 @@ def weighted_average(compiled: CompiledRuleBase, dof: np.ndarray,
     plan = compiled.plan
     m = len(compiled.outputs)
     if compiled.cons_linear is not None:
+        if Xt is None:
+            raise ValueError("linear consequents need the inputs: weighted_average(compiled, dof, Xt)")
         W = np.multiply(dof[:, None], plan.sums)     # [R, k, b]: numerators, denominators
         np.multiply(dof[:, None], linear_consequents(compiled, Xt).transpose(1, 0, 2),
                     out=W[:, :m])
@@ -351,9 +356,9 @@ def evaluate(compiled: CompiledRuleBase, X, *, detail: bool = True, keep_values:
     if n == 1 and not (detail or keep_values):
         one = _evaluate_one(compiled, X[0].tolist())
         if one is not None:
-            inputs, outputs = one
-            return Result(compiled, np.array([inputs]), None, None, np.array([outputs]),
-                          (np.array(inputs) != X[0]).astype(np.intp))
+            one_in, one_out = one
+            return Result(compiled, np.array([one_in]), None, None, np.array([one_out]),
+                          (np.array(one_in) != X[0]).astype(np.intp))
     plan = compiled.plan
     T, R = plan.n_terms, plan.n_rules
     clamped_in = np.empty((k, n))
@@ -371,16 +376,16 @@ def evaluate(compiled: CompiledRuleBase, X, *, detail: bool = True, keep_values:
         d = rule_dof(compiled, V)
         out[:, block] = infer(compiled, d, Xt)
         clamped_in[:, block] = Xt
-        if detail:
+        if mu is not None and dof is not None:      # detail
             mu[:, block] = V[2:2 + T]
             dof[:, block] = d
-        if keep_values:
+        if values is not None:                      # keep_values
             values[:, block] = V
     X = clamped_in.T
     no_rule = np.isnan(out.T)
     outputs = fill_defaults(compiled, out.T, X, strict)
-    return Result(compiled, X, mu.T if detail else None, dof.T if detail else None, outputs,
-                  counts, values.T if keep_values else None, no_rule)
+    return Result(compiled, X, None if mu is None else mu.T, None if dof is None else dof.T,
+                  outputs, counts, None if values is None else values.T, no_rule)
 
 
 def evaluate_columns(compiled: CompiledRuleBase, Xt: np.ndarray, *,

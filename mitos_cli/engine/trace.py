@@ -93,6 +93,8 @@ class Trace:
 
 def trace_of(result: Result, row: int = 0) -> Trace:
     """The trace of sample ``row`` of an evaluation."""
+    if result.memberships is None or result.dof is None:
+        raise ValueError("a trace needs the memberships and DOFs: evaluate(..., detail=True)")
     c = result.compiled
     inputs = []
     t = 0

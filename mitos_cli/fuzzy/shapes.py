@@ -144,7 +144,7 @@ register(Shape("triangle_plr", ("peak", "left_width", "right_width"), triangle_p
                lambda p: (p[0] - p[1], p[0], p[0], p[0] + p[2]), lambda p: p[0],
                "eq. 15 with separate left and right widths"))
 register(Shape("trapezoid", ("a", "b", "c", "d"), trapezoid, _ordered(("a", "b", "c", "d")),
-               lambda p: tuple(p), lambda p: (p[1] + p[2]) / 2,
+               lambda p: (p[0], p[1], p[2], p[3]), lambda p: (p[1] + p[2]) / 2,
                "trapezoid: 0 at a, 1 from b to c, 0 at d"))
 register(Shape("left_shoulder", ("a", "b"), left_shoulder, _ordered(("a", "b")),
                lambda p: (-INF, -INF, p[0], p[1]), lambda p: p[0],

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..errors import FormatError
+from ..errors import FormatError, RuleBaseError, did_you_mean
 from ..lang.model import RuleBase
 
 READERS = {".fcl": "fcl", ".fis": "fis", ".fll": "fll"}
@@ -25,8 +25,11 @@ def read_foreign(path: str | Path) -> RuleBase:
     if kind is None:
         raise FormatError(f"`{path}`: unknown format `{path.suffix}`",
                           expected="a .fcl, .fis or .fll file")
-    if not path.is_file():
-        raise FormatError(f"`{path}` not found")
+    try:
+        path.open("rb").close()
+    except OSError as exc:
+        raise RuleBaseError(f"cannot read rule file `{path}`: {exc.strerror or exc}",
+                            hint=_nearby(path)) from None
     if kind == "fll":
         from .fll import read_fll
 
@@ -38,6 +41,16 @@ def read_foreign(path: str | Path) -> RuleBase:
     from .fcl import read_fcl
 
     return read_fcl(path)
+
+
+def _nearby(path: Path) -> str | None:
+    """``did you mean`` among the rule files beside ``path``, if one is close."""
+    try:
+        names = [p.name for p in (path.parent if str(path.parent) else Path(".")).iterdir()
+                 if p.suffix.lower() in (*READERS, ".rules")]
+    except OSError:
+        return None
+    return did_you_mean(path.name, names)
 
 
 def write_foreign(rb: RuleBase, fmt: str, behavior: str | None = None) -> str:
@@ -69,11 +82,12 @@ def conversion_notes(rb: RuleBase, fmt: str, behavior: str | None = None) -> lis
     from .common import legal_names
 
     b = rb.behavior(behavior)
+    written = _used(rb, b.name)
+    left_out = [x.name for x in rb.behaviors if x.name not in written]
     rb, out = legal_names(rb, fmt)
-    if len(rb.behaviors) > 1:
-        others = ", ".join(x.name for x in rb.behaviors if x.name != b.name)
+    if left_out:
         out.append(f"only behavior `{b.name}` is written (with the behaviors it uses); the "
-                   f"others ({others}) are not: choose one with --behavior")
+                   f"others ({', '.join(left_out)}) are not: choose one with --behavior")
     if fmt == "fis":
         from .fis import notes
 
@@ -148,6 +162,18 @@ def parse_foreign(text: str, fmt: str, path: str | None = None) -> RuleBase:
     from .fcl import parse_fcl
 
     return parse_fcl(text, path)
+
+
+def _used(rb: RuleBase, name: str) -> set[str]:
+    """``name`` and every behavior it uses, directly or through others."""
+    seen: set[str] = set()
+    todo = [name]
+    while todo:
+        current = todo.pop()
+        if current not in seen:
+            seen.add(current)
+            todo += [u.behavior for u in rb.behavior(current).uses]
+    return seen
 
 
 __all__ = ["FORMATS", "conversion_notes", "parse_foreign", "read_foreign",

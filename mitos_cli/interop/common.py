@@ -120,6 +120,15 @@ def to_fuzzylite_hedge(name: str) -> str:
     return MITOS_TO_FUZZYLITE_HEDGES[name]
 
 
+def concluded_term(c: Consequent) -> str:
+    """The output term an exported consequent names (:func:`flatten_for_export` has turned
+    crisp values into terms; the formats have no crisp consequents)."""
+    if c.term is None:
+        raise FormatError(f"`{c.var} is {c.value:g}`: the format has no crisp consequents",
+                          span=c.span)
+    return c.term
+
+
 # ---------------------------------------------------------------------------------------------
 # Terms: one table of fuzzylite names (FLL and fuzzylite's FCL dialect), params in MITOS order.
 
@@ -219,7 +228,9 @@ def fuzzylite_term_text(term: Term, variable: str) -> str:
     """``Kind p1 p2 ...`` for a MITOS term (FLL and fuzzylite's FCL)."""
     shape, p = term.shape, term.params
     if shape in ("left_shoulder", "right_shoulder", "triangle_pw", "triangle_plr"):
-        a, b, c, d = term.corners
+        corners = term.corners
+        assert corners is not None             # these four shapes are piecewise linear
+        a, b, c, d = corners
         return "Trapezoid " + " ".join(fmt_number(v) for v in (a, b, c, d)) if shape in (
             "left_shoulder", "right_shoulder") else "Triangle " + " ".join(
             fmt_number(v) for v in (a, b, d))
@@ -380,13 +391,13 @@ def check_implication(name: str, span: Span | None) -> str:
     return name
 
 
-def assemble(path: str, variables: list[Variable], rules: list[Rule], settings: Settings,
+def assemble(path: str | None, variables: list[Variable], rules: list[Rule], settings: Settings,
              default_resolution: int, span: Span | None = None) -> RuleBase:
     """Check what a reader gathered and return the rule base (one behavior, ``main``)."""
     return assemble_blocks(path, variables, [(MAIN, rules, settings)], default_resolution, span)
 
 
-def assemble_blocks(path: str, variables: list[Variable],
+def assemble_blocks(path: str | None, variables: list[Variable],
                     blocks: list[tuple[str, list[Rule], Settings]], default_resolution: int,
                     span: Span | None = None) -> RuleBase:
     """The rule base of one or more rule blocks: one block gives behavior ``main`` with the
@@ -501,6 +512,7 @@ def flatten_for_export(rb: RuleBase, behavior: str | None = None, *,
             cons = []
             for c in r.consequents:
                 if c.term is None:
+                    assert c.value is not None   # a consequent names a term or a crisp value
                     var = variables[c.var]
                     names = extra.setdefault(c.var, {})
                     if c.value not in names:

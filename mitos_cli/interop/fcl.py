@@ -40,7 +40,7 @@ from ..fuzzy import norms
 from ..lang.cache import lark_parser
 from ..errors import FormatError, Span, did_you_mean
 from ..lang.model import And, Not, Prop, Rule, RuleBase
-from ..lang.terms import Term, Variable
+from ..lang.terms import Role, Term, Variable
 from . import common
 from ..lang.resolve import MAIN
 from .common import FCL, FLL, fmt_number
@@ -89,7 +89,8 @@ def _syntax_error(exc: UnexpectedInput, text: str, path: str | None) -> FormatEr
     elif isinstance(exc, UnexpectedToken):
         what = f"unexpected `{exc.token}`"
     elif isinstance(exc, UnexpectedCharacters):
-        char = text[exc.pos_in_stream] if exc.pos_in_stream < len(text) else ""
+        pos: int = exc.pos_in_stream  # type: ignore[assignment]  # lark declares None; the lexer sets an int
+        char = text[pos] if pos < len(text) else ""
         what = f"unexpected character `{char}`"
     else:
         what = "cannot read this"
@@ -119,7 +120,7 @@ def parse_fcl(text: str, path: str | None = None) -> RuleBase:
 
     def span_of(node) -> Span:
         if isinstance(node, Token):
-            return Span.in_text(text, path, node.line, node.column, node.end_column)
+            return Span.in_text(text, path, node.line or 1, node.column or 1, node.end_column)
         meta = node.meta
         if meta.empty:
             return Span.in_text(text, path, 1, 1)
@@ -130,7 +131,9 @@ def parse_fcl(text: str, path: str | None = None) -> RuleBase:
     if len(blocks) > 1:
         raise FormatError(f"the file has {len(blocks)} function blocks; MITOS reads one",
                           span=span_of(blocks[1]), hint="split the file, one block per file")
-    return _function_block(blocks[0], span_of)
+    block = blocks[0]
+    assert isinstance(block, Tree)              # the grammar's function_block
+    return _function_block(block, span_of)
 
 
 def _num(tree) -> float:
@@ -139,11 +142,11 @@ def _num(tree) -> float:
 
 
 def _function_block(fb: Tree, span_of) -> RuleBase:
-    declared: dict[str, tuple[str, Span, tuple[float, float] | None]] = {}
+    declared: dict[str, tuple[Role, Span, tuple[float, float] | None]] = {}
     fuzzify, defuzzify, blocks = [], [], []
     for item in fb.children[1:]:
         if item.data in ("var_input", "var_output"):
-            role = "input" if item.data == "var_input" else "output"
+            role: Role = "input" if item.data == "var_input" else "output"
             for decl in item.children:
                 name, typ, rng = decl.children
                 if str(name) in declared:
@@ -235,7 +238,7 @@ def _function_block(fb: Tree, span_of) -> RuleBase:
     return dataclasses.replace(rb, notes=tuple(notes))
 
 
-def _variable(node: Tree, role: str, declared, settings: common.Record, locks: dict,
+def _variable(node: Tree, role: Role, declared, settings: common.Record, locks: dict,
               constants: list, n_inputs: int, span_of, notes: list[str]) -> Variable:
     name_token = node.children[0]
     name = str(name_token)
@@ -371,9 +374,9 @@ def _term(item: Tree, role: str, n_inputs: int, span_of) -> Term:
     if definition.data == "points":
         pts = [(_num(p.children[0]), _num(p.children[1])) for p in definition.children]
         return _points_term(name, pts, span)
-    kind_token, *values = definition.children
+    kind_token, *value_nodes = definition.children
     kind = str(kind_token)
-    values = [_num(v) for v in values]
+    values = [_num(v) for v in value_nodes]
     # fuzzylite's class names in their own spelling first: `Cosine c w` is fuzzylite's
     # (center, width), `COSINE t c` jFuzzyLogic's (net_max, offset)
     if kind.lower() in JFUZZY_SHAPES and kind not in common.FUZZYLITE_SHAPES:
@@ -563,7 +566,8 @@ def _rule_text(r: Rule) -> str:
         return f"({text})" if parent not in ("top", op, "not") else text
 
     cons = " AND ".join(f"{c.var} IS " + " ".join(
-        [common.to_fuzzylite_hedge(h) for h in c.hedges] + [c.term]) for c in r.consequents)
+        [common.to_fuzzylite_hedge(h) for h in c.hedges] + [common.concluded_term(c)])
+        for c in r.consequents)
     text = f"IF {expr(r.antecedent, 'top')} THEN {cons}"
     if r.weight != 1.0:
         text += f" WITH {fmt_number(r.weight)}"

@@ -30,7 +30,7 @@ from pathlib import Path
 
 from ..errors import FormatError, Span, did_you_mean
 from ..lang.model import And, Consequent, Or, Prop, Rule, RuleBase
-from ..lang.terms import Term, Variable
+from ..lang.terms import Role, Term, Variable
 from . import common
 from .common import FIS, Settings, fmt_number
 from ..words import plural
@@ -137,7 +137,7 @@ def parse_fis(text: str, path: str | None = None) -> RuleBase:
     settings = Settings()
     unset: dict[str, Span] = {}
 
-    def method(key: str, table: dict, what: str, default: str) -> str | None:
+    def method(key: str, table: dict, what: str, default: str) -> str:
         value, vspan = system.get(key, (f"'{default}'", sys_span))
         name = _string(value, vspan)
         if not name:               # fuzzylite writes '' for an operator its rules never use
@@ -192,7 +192,7 @@ def _check_count(system: dict, key: str, found: int, span: Span) -> None:
             raise FormatError(f"{key}={value} but the file has {found}", span=vspan)
 
 
-def _variables(sections, prefix: str, role: str, kind: str, notes: list[str],
+def _variables(sections, prefix: str, role: Role, kind: str, notes: list[str],
                n_inputs: int = 0) -> list[Variable]:
     found = [(int(name[len(prefix):]), span, items) for name, span, items in sections
              if re.fullmatch(prefix + r"\d{1,9}", name)]
@@ -203,7 +203,7 @@ def _variables(sections, prefix: str, role: str, kind: str, notes: list[str],
     return [_variable(span, items, role, kind, n_inputs, notes) for _, span, items in found]
 
 
-def _variable(span: Span, items, role: str, kind: str, n_inputs: int,
+def _variable(span: Span, items, role: Role, kind: str, n_inputs: int,
               notes: list[str]) -> Variable:
     values = {}
     terms: list[Term] = []
@@ -403,7 +403,9 @@ INVERSE = {shape: (mf, order) for mf, (shape, _, order) in MF_TYPES.items() if m
 def _mf_text(t: Term, v: Variable) -> str:
     shape, p = t.shape, t.params
     if shape in ("left_shoulder", "right_shoulder", "triangle_pw", "triangle_plr", "rectangle"):
-        a, b, c, d = t.corners
+        corners = t.corners
+        assert corners is not None             # these five shapes are piecewise linear
+        a, b, c, d = corners
         lo, hi = v.universe
         # MATLAB trapmf has no infinite feet: put them just outside the universe
         a = min(lo, b) - 1.0 if a == -float("inf") else a
@@ -430,7 +432,8 @@ def _rule_text(r: Rule, inputs, outputs) -> str:
     if isinstance(e, Prop):
         props, connection = [e], 1
     elif isinstance(e, (And, Or)) and all(isinstance(i, Prop) for i in e.items):
-        props, connection = list(e.items), 1 if isinstance(e, And) else 2
+        props = [i for i in e.items if isinstance(i, Prop)]     # all of them (checked above)
+        connection = 1 if isinstance(e, And) else 2
     else:
         raise FormatError(f"rule `{r.label}`: MATLAB rules join propositions all by AND or all "
                           f"by OR; nested expressions cannot be written to .fis", span=r.span,

@@ -26,7 +26,7 @@ import functools
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from lark import Lark
+from lark import Lark, Tree
 from lark.exceptions import UnexpectedInput
 
 from ..lang.resolve import MAIN
@@ -34,7 +34,7 @@ from ..lang.cache import lark_parser
 from ..errors import FormatError, Span, did_you_mean
 from ..lang.model import Rule, RuleBase
 from ..lang.model import format_number as _fmt_weight
-from ..lang.terms import Term, Variable
+from ..lang.terms import Role, Term, Variable
 from . import common
 from .common import FLL, Settings, fmt_number
 from .ruletree import conclusion, expression
@@ -62,7 +62,7 @@ def rule_parser() -> Lark:
 
 @dataclass
 class _Var:
-    role: str
+    role: Role
     name: str
     span: Span
     range: tuple[float, float] | None = None
@@ -149,6 +149,7 @@ def parse_fll(text: str, path: str | None = None) -> RuleBase:
                                   f"blocks", span=vspan, hint="delete the part or enable it")
             continue
         if section in ("InputVariable", "OutputVariable"):
+            assert current is not None          # set by its section's header line
             _variable_key(current, key, value, span, vspan, current.record)
         elif key == "rule":
             blocks[-1].lines.append((value, lineno, vcol))
@@ -342,7 +343,7 @@ def _rule(value: str, text: str, path: str | None, lineno: int, vcol: int,
             if expected else None) from None
     antecedent_tree, *rest = tree.children
     weight_token = rest[-1]
-    conclusions = rest[:-1]
+    conclusions = [c for c in rest[:-1] if isinstance(c, Tree)]   # all are (the grammar)
     antecedent = expression(antecedent_tree, span_of, variables)
     _check_operators(antecedent_tree, conj, span_of)
     weight = common.number(str(weight_token), span_of(weight_token)) if weight_token else 1.0
@@ -369,7 +370,7 @@ def _check_grouping(variables: list[_Var], rules: list[Rule], settings: Settings
     the output's aggregation; without one (``none``) it sums them, as MITOS does per rule."""
     if settings.aggregation is None:
         return
-    seen: dict[tuple[str, str], Span | None] = {}
+    seen: dict[tuple[str, str | None], Span | None] = {}
     for r in rules:
         for c in r.consequents:
             if (c.var, c.term) in seen:
@@ -473,7 +474,7 @@ def fuzzylite_rule_text(rule: Rule, ops, dialect: str) -> str:
     assert not isinstance(antecedent, Not)
     cons = f" {kw('and')} ".join(
         f"{c.var} {kw('is')} " + " ".join([common.to_fuzzylite_hedge(h) for h in c.hedges]
-                                          + [c.term])
+                                          + [common.concluded_term(c)])
         for c in rule.consequents)
     text = f"{kw('if')} {expr(antecedent, 'top')} {kw('then')} {cons}"
     if rule.weight != 1.0:

@@ -162,6 +162,7 @@ def format_number(value: float) -> str:
 
 def format_consequent(c: Consequent) -> str:
     if c.term is None:
+        assert c.value is not None  # a consequent names a term or a crisp value, never neither
         return f"{c.var} is {format_number(c.value)}"
     return f"{c.var} is {' '.join(list(c.hedges) + [c.term])}"
 

@@ -7,6 +7,7 @@ consequents (eqs. 18-19). A behavior's settings override the file's, key by key.
 from __future__ import annotations
 
 from dataclasses import dataclass, fields, replace
+from typing import Any
 
 from ..fuzzy import norms
 from ..errors import RuleBaseError, Span, unknown
@@ -103,5 +104,6 @@ def resolve(settings: tuple[Setting, ...], base: Operators | None = None) -> Ope
     for s in settings:
         if s.key not in KEYS:
             raise unknown("operator setting", s.key, KEYS, span=s.span)
-        ops = replace(ops, **{KEYS[s.key]: _check(s.key, s.value, s.span)})
+        change: dict[str, Any] = {KEYS[s.key]: _check(s.key, s.value, s.span)}  # field by name
+        ops = replace(ops, **change)
     return ops

@@ -77,21 +77,22 @@ def syntax_error(exc: UnexpectedInput, text: str, path: str | None) -> RuleSynta
     """Lark's exception as a user-facing error (never ``$END`` or ``Token(...)``)."""
     if isinstance(exc, UnexpectedCharacters):
         line, column = exc.line, exc.column
-        char = text[exc.pos_in_stream] if exc.pos_in_stream < len(text) else ""
+        pos: int = exc.pos_in_stream  # type: ignore[assignment]  # lark declares None; the lexer sets an int
+        char = text[pos] if pos < len(text) else ""
         message = f"unexpected character `{char}`" if char.isprintable() else \
             f"unexpected character {char!r}"
-        expected = _expected(exc.allowed) if exc.allowed else None
+        allowed = _expected(exc.allowed) if exc.allowed else None
         return RuleSyntaxError(message, span=Span.in_text(text, path, line, column),
-                               expected=expected)
+                               expected=allowed)
     if isinstance(exc, UnexpectedEOF) or (isinstance(exc, UnexpectedToken)
                                           and exc.token.type == "$END"):
         lines = text.rstrip().splitlines() or [""]
         line = len(lines)
         column = len(lines[-1]) + 1
-        expected = getattr(exc, "expected", None) or []
+        names = getattr(exc, "expected", None) or []
         return RuleSyntaxError("unexpected end of the input",
                                span=Span.in_text(text, path, line, column),
-                               expected=_expected(expected) if expected else None,
+                               expected=_expected(names) if names else None,
                                hint="the last rule or behavior is incomplete (a behavior ends "
                                     "with `end`)")
     assert isinstance(exc, UnexpectedToken)
@@ -139,7 +140,7 @@ RESERVED = {"if", "then", "and", "or", "not", "is", "with", "use", "when", "end"
 def _word_before(text: str, token: Token) -> str:
     """The word just before ``token`` on its line (for hints)."""
     lines = text.splitlines()
-    if not 0 < token.line <= len(lines):
+    if token.line is None or token.column is None or not 0 < token.line <= len(lines):
         return ""
     words = lines[token.line - 1][:token.column - 1].split()
     return words[-1] if words else ""
@@ -309,14 +310,20 @@ def parse_rules(text: str, path: str | None = None) -> ParsedFile:
     """Parse a whole rule file into model objects (names unchecked)."""
     tree = parse_tree(text, path)
     items = _ToModel(text, path).transform(tree).children
-    terms, operators, rules, uses, frozen, behaviors = [], [], [], [], [], []
+    terms: list[tuple[str, Span]] = []
+    operators: list[Setting] = []
+    rules: list[Rule] = []
+    uses: list[Use] = []
+    frozen: list[str] = []
+    behaviors: list[Behavior] = []
     for item in items:
         _collect(item, terms, operators, rules, uses, frozen, behaviors)
     return ParsedFile(text, path, tuple(terms), tuple(operators), tuple(rules), tuple(uses),
                       tuple(frozen), tuple(behaviors))
 
 
-def _collect(item, terms, operators, rules, uses, frozen, behaviors) -> None:
+def _collect(item, terms: list[tuple[str, Span]], operators: list[Setting], rules: list[Rule],
+             uses: list[Use], frozen: list[str], behaviors: list[Behavior]) -> None:
     if isinstance(item, Rule):
         rules.append(item)
     elif isinstance(item, Use):
@@ -331,7 +338,10 @@ def _collect(item, terms, operators, rules, uses, frozen, behaviors) -> None:
         frozen.extend(item[1])
     elif item[0] == "behavior":
         _, name, body, span = item
-        b_rules, b_ops, b_uses, b_frozen = [], [], [], []
+        b_rules: list[Rule] = []
+        b_ops: list[Setting] = []
+        b_uses: list[Use] = []
+        b_frozen: list[str] = []
         for sub in body:
             _collect(sub, [], b_ops, b_rules, b_uses, b_frozen, [])
         behaviors.append(Behavior(name, tuple(b_rules), tuple(b_uses),

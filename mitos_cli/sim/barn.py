@@ -39,8 +39,7 @@ from pathlib import Path
 import numpy as np
 
 from .gridmap import INCH_PER_M
-from .world import Agent, Corridor, Goal, Grid, Obstacle, Pose, Randomise, Robot, Sensors, \
-    World
+from .world import Agent, Corridor, Goal, Grid, Obstacle, Pose, Randomise, Robot, Sensors, World
 
 M = INCH_PER_M                 # in per metre
 CELLS = 30                     # the field is CELLS x CELLS cells
@@ -168,7 +167,7 @@ def field(seed: int, fill: float = 0.25, smoothing: int = 3, robot: Robot = JACK
 
 def _row_runs(filled: np.ndarray) -> list[tuple[int, int, int]]:
     """Runs of filled cells along each row: (row, first column, last column + 1)."""
-    out = []
+    out: list[tuple[int, int, int]] = []
     for r in range(filled.shape[0]):
         padded = np.concatenate([[0], filled[r].astype(np.int8), [0]])
         step = np.diff(padded)

@@ -65,14 +65,17 @@ def csv_text(result: SimResult, planner) -> str:
 
 
 def traces(result: SimResult, planner, every: int, digits: int = 1) -> str:
-    """The DOF trace every ``every`` ticks (and at the last tick) of the first robot, each
-    headed by the time, the pose and the perceived vs true inputs."""
+    """The DOF trace every ``every`` ticks (and at the last tick, and at each tick it
+    replanned) of the first robot, each headed by the time, the pose and the perceived vs true
+    inputs."""
     from ..engine.trace import trace_of
 
     detail = explain(result, planner, 0)
     if detail is None:
         return f"(planner {result.planner} is not a rule base: no DOF trace)"
-    ticks = sorted(set(range(0, result.ticks, max(1, every))) | {result.ticks - 1})
+    replans = {k: route for k, i, route in getattr(result, "replanned", ()) if i == 0}
+    ticks = sorted(set(range(0, result.ticks, max(1, every))) | {result.ticks - 1}
+                   | set(replans))
     blocks = []
     for k in ticks:
         if result.active is not None and not result.active[k, 0]:
@@ -84,5 +87,9 @@ def traces(result: SimResult, planner, every: int, digits: int = 1) -> str:
         pt = "  perceived: " + ", ".join(f"{key} {result.perceived[key][k, 0]:.1f}"
                                          for key in INPUTS)
         tr = "  true:      " + ", ".join(f"{key} {result.true[key][k, 0]:.1f}" for key in INPUTS)
-        blocks.append("\n".join([head, pt, tr, "", trace_of(detail, k).render(digits)]))
+        lines = [head, pt, tr]
+        if k in replans:
+            lines.append(f"  replanned: what it sensed shuts the way ahead; the new route "
+                         f"runs {replans[k].length:.0f} in to the goal")
+        blocks.append("\n".join([*lines, "", trace_of(detail, k).render(digits)]))
     return "\n\n".join(blocks)

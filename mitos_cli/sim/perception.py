@@ -54,8 +54,9 @@ Inputs (all floats, units in the names of ``mitos.terms.yaml`` / ``drive.terms.y
     (``heading``; behind the robot, the side it lies on), plus ``way_room_weight`` times that
     clear length (so that when every way is shut the roomiest wins), less ``way_turn_cost`` for
     every degree it turns from the robot's heading (so it does not flip between two gaps).
-    Where the route's own bearing is clear, ``opening`` is ``heading``; in clutter it points
-    at the gap to take.
+    Where the route's own bearing is clear, ``opening`` is ``heading`` (to within a degree or
+    two: a way nearer the heading may win by its lower turn cost); in clutter it points at
+    the gap to take.
 ``clutter`` (objects)
     how many separate objects its map does not show the robot sees ahead within ``sight``:
     runs of neighbouring beams hitting obstacles, split where two hits lie more than
@@ -104,7 +105,7 @@ class Settings:
     way_reach: float = 140.0       # in: a way clear this far (from the front) scores in full
     way_step: float = 5.0          # deg: the ways tried, every step within +-way_fov / 2
     way_fov: float = 180.0         # deg
-    clutter_gap: float = 12.0      # in: obstacle hits farther apart than this are two objects
+    clutter_gap: float = 24.0      # in: neighbouring hits farther apart: two objects
     way_turn_cost: float = 0.05    # in of progress given up per deg turned from the heading
 
 
@@ -200,15 +201,20 @@ def free_ways(ah: np.ndarray, bh: np.ndarray, widen: np.ndarray, unknown: np.nda
     return front, float(ways[best])
 
 
-def clutter(hits: np.ndarray, unknown: np.ndarray, ah: np.ndarray, cfg: Settings) -> float:
+def clutter(hits: np.ndarray, unknown: np.ndarray, ah: np.ndarray, cfg: Settings,
+            circular: bool = False) -> float:
     """How many separate objects the map does not show are in view ahead: runs of
-    neighbouring beams that hit obstacles (in beam order), a run split where consecutive hits
-    lie more than ``clutter_gap`` apart, among hits ahead of the robot within ``sight``."""
-    idx = np.flatnonzero(unknown & (ah > 0) & (ah <= cfg.sight))
-    if not len(idx):
+    neighbouring points (in beam order; ``circular`` for a ring, whose last beam neighbours
+    its first) that hit obstacles ahead within ``sight``, a run split where two neighbours
+    lie more than ``clutter_gap`` apart."""
+    seen = unknown & (ah > 0) & (ah <= cfg.sight)
+    if not seen.any():
         return 0.0
-    apart = np.hypot(*np.diff(hits[idx], axis=0).T) > cfg.clutter_gap
-    return float(1 + np.count_nonzero(apart | (np.diff(idx) > 1)))
+    close = np.hypot(*(hits - np.roll(hits, 1, axis=0)).T) <= cfg.clutter_gap
+    joined = seen & np.roll(seen, 1) & close       # point i continues the run of point i - 1
+    if not circular:
+        joined[0] = False
+    return float(max(1, np.count_nonzero(seen & ~joined)))
 
 
 def _walls(a, b, valid, robot: Robot, cfg: Settings, far: float,
@@ -269,7 +275,8 @@ def perceive(route: Route, f: Frame, pose: tuple[float, float, float], robot: Ro
     wl, wr = _walls(a, b, valid, robot, cfg, max_range, obstacle_hit)
     ah, bh = _own_frame(rel[valid], pose[2])
     front, opening = free_ways(ah, bh, widen[valid], obstacle_hit[valid], robot, cfg, heading)
-    objects = clutter(hits[valid], obstacle_hit[valid], ah, cfg)
+    ring = len(dirs) > 2 and float(dirs[0] @ dirs[-1]) >= float(dirs[0] @ dirs[1]) - 1e-9
+    objects = clutter(hits, valid & obstacle_hit, _own_frame(rel, pose[2])[0], cfg, ring)
     return {"road": road, "size": size, "position": position, "obstacle": distance,
             "heading": heading, "lane": lane, "goal": goal, "gap_left": wl, "gap_right": wr,
             "front": front, "opening": opening, "clutter": objects}

@@ -14,11 +14,14 @@ import dataclasses
 import hashlib
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TypeVar
 
 from ..errors import LessonError
 from ..lang.model import Behavior, Rule, RuleBase
 from ..lang.parse import parse_rule
 from . import commands as cmd
+
+_C = TypeVar("_C")
 
 
 @dataclass(frozen=True)
@@ -97,7 +100,7 @@ def apply(state: State, entry: dict) -> None:
             state.active = entry["activate"]
     elif op == "use":
         b = rb.behavior(entry["behavior"])
-        use = cmd.parse_command(entry["text"]).use
+        use = _journaled(entry, cmd.TellUse).use
         state.rulebase = _replace_behavior(rb, dataclasses.replace(b, uses=b.uses + (use,)))
     elif op == "frozen":
         b = rb.behavior(entry["behavior"])
@@ -105,7 +108,7 @@ def apply(state: State, entry: dict) -> None:
         state.rulebase = _replace_behavior(rb, dataclasses.replace(b, frozen=labels))
     elif op == "operators":
         b = rb.behavior(entry["behavior"])
-        settings = cmd.parse_command(entry["text"]).settings
+        settings = _journaled(entry, cmd.TellOperators).settings
         state.rulebase = _replace_behavior(rb, dataclasses.replace(
             b, operators=b.operators + settings))
     elif op == "activate":
@@ -149,6 +152,14 @@ def learned_changes(before: RuleBase, after: RuleBase) -> tuple[dict, list]:
     return terms, crisp
 
 
+def _journaled(entry: dict, kind: type[_C]) -> _C:
+    """The command a journal entry recorded, which must be of the entry's kind."""
+    parsed = cmd.parse_command(entry["text"])
+    if not isinstance(parsed, kind):
+        raise LessonError(f"the journal's `{entry['op']}` change holds `{entry['text']}`")
+    return parsed
+
+
 def variables(rb: RuleBase):
     """Every variable of every term set, in file order."""
     return [v for ts in rb.termsets for v in ts.variables]
@@ -156,6 +167,8 @@ def variables(rb: RuleBase):
 
 def files_digest(rb: RuleBase) -> str:
     h = hashlib.sha256()
+    if rb.path is None:                    # a rule base from text has no files
+        return h.hexdigest()[:16]
     for path in [rb.path] + [str(Path(rb.path).parent / p) for p in rb.termset_paths]:
         with contextlib.suppress(OSError):
             h.update(Path(path).read_bytes())
