@@ -76,7 +76,8 @@ def test_the_documented_example_reaches_the_goal_as_simulate_does(capsys):
     code = re.search(r"```python\n(.*?)```", page, re.S).group(1)
     scope: dict = {}
     exec(compile(code, "docs/gym.md", "exec"), scope)
-    assert capsys.readouterr().out.split() == ["success", "18.4", "15.28"]
+    printed = re.search(r"print\(.*\)\s+# (.*)", code).group(1)     # what the page says
+    assert capsys.readouterr().out.split() == printed.split()
     assert scope["terminated"] and not scope["truncated"]
     assert scope["reward"] >= mgym.GOAL_BONUS
     assert scope["info"]["t"] == scope["same"].metrics["time_s"]
