@@ -38,7 +38,7 @@ EXAMPLES = examples_dir()
 FILES = sorted(p.relative_to(EXAMPLES).as_posix() for p in EXAMPLES.rglob("*.fll")) \
     if EXAMPLES else []
 needs_fuzzylite = pytest.mark.skipif(EXAMPLES is None, reason="pyfuzzylite is not installed "
-                                     "(pip install -e '.[test]'); its examples are the reference")
+                                     "(pip install -e '.[test,agreement]'); its examples are the reference")
 
 #: Engines MITOS refuses, and the words of the refusal (its cause).
 REFUSED = {

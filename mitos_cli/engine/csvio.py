@@ -18,10 +18,10 @@ def read_batch(text: str, path: str, inputs: tuple[str, ...],
     named in ``unused`` (inputs of the rule base its rules never test) are read and dropped."""
     nul = text.find("\x00")
     if nul >= 0:
-        line = text.count("\n", 0, nul) + 1
+        lineno = text.count("\n", 0, nul) + 1
         column = nul - (text.rfind("\n", 0, nul) + 1) + 1
         raise InputError("the batch CSV holds a NUL byte (it is not a text file)",
-                         span=Span.at(text, path, nul, line, column))
+                         span=Span.at(text, path, nul, lineno, column))
     lines = text.splitlines()
     if not lines or not lines[0].strip():
         raise InputError("the batch CSV is empty", span=Span(path, 1, 1),

@@ -136,7 +136,7 @@ def expand(worlds: list[str], choices: list[Choice], runs: int, seed: int) -> li
     """All tasks of a study in their serial order: run-major, then world, then choice, so a
     sweep stopped half-way holds complete, paired runs of every world and choice."""
     seeds = task_seeds(seed, len(worlds), runs)
-    tasks = []
+    tasks: list[Task] = []
     for r in range(runs):
         for w, world in enumerate(worlds):
             for choice in choices:
