@@ -8,6 +8,7 @@ import dataclasses
 import numpy as np
 import pytest
 
+from mitos_cli.engine.evaluation import evaluate_one
 from mitos_cli.resources import packaged_path
 from mitos_cli.sim import Simulation, simulate
 from mitos_cli.sim.planner import FuzzyPlanner
@@ -96,3 +97,24 @@ def test_the_documented_example_runs():
 
     failures, tried = doctest.testmod(loop, verbose=False)
     assert tried >= 5 and failures == 0
+
+
+def test_a_command_from_outside_drives_the_same_run_as_the_planner():
+    """observe() then step(command): what an outside policy (the Gymnasium environment) does;
+    the planner's own commands given this way reproduce simulate() bit for bit."""
+    world = short("moving.yaml", 3.0)
+    planner = FuzzyPlanner(None, "drive")
+    sim = Simulation(world, planner, seed=5, randomise=True)
+    while not sim.done:
+        seen = sim.observe()
+        assert sim.observe() is seen                   # once per tick
+        out = evaluate_one(planner.compiled, [float(seen.inputs[k][0])
+                                              for k in planner.compiled.inputs])
+        cols = [planner.compiled.outputs.index(o) for o in ("steering", "speed")]
+        ending = sim.ending
+        sim.step(np.array([[out[cols[0]], out[cols[1]]]]))
+        assert not ending or sim.done
+    same_run(sim.result(), simulate(world, planner, 5, randomise=True))
+    assert sim.routes == sim.result().routes
+    with pytest.raises(RuntimeError, match="has ended"):
+        sim.observe()

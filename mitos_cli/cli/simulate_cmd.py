@@ -131,6 +131,13 @@ def simulate_command(
     plot: Annotated[Optional[Path], typer.Option(
         "--plot", metavar="FILE.png|FILE.svg", help="Draw the run (world, obstacles, path).")] = None,
     live: Annotated[bool, typer.Option("--live", help="Show a terminal view while it runs.")] = False,
+    animate: Annotated[Optional[Path], typer.Option(
+        "--animate", metavar="FILE.gif|FILE.mp4",
+        help="Write the run as an animation: map, footprint, sonar cones, trail, obstacles, "
+             "time and the fired rules' DOFs (.mp4 needs ffmpeg).")] = None,
+    fps: Annotated[float, typer.Option(
+        "--fps", min=0.1, max=60.0,
+        help="Animation frames per second of simulated time (plays in real time).")] = 10.0,
     require: Annotated[Optional[str], typer.Option(
         "--require", metavar="success", help="Exit 3 unless every run ends in this outcome.")] = None,
     workers: Annotated[Optional[int], typer.Option(
@@ -154,13 +161,18 @@ def simulate_command(
     names = worlds or [DEFAULT_WORLD]
     loaded = [load_world(resolve_world_path(n)) for n in names]
     many = len(loaded) > 1 or runs > 0
-    if many and (out or plot or trace or live or randomise):
-        raise typer.BadParameter("--out, --plot, --trace, --live and --randomise work on one "
+    if many and (out or plot or trace or live or randomise or animate):
+        raise typer.BadParameter("--out, --plot, --animate, --trace, --live and --randomise "
+                                 "work on one "
                                  "world and one run; drop --runs or give one world")
     if plot is not None:
         from ..draw.output import check_format
 
         check_format(plot)
+    if animate is not None:
+        from ..draw.animation import check_format as check_animation
+
+        check_animation(animate)
     planner = make_planner(planner_name, loaded[0], rulebase, behavior)
 
     if many:
@@ -204,12 +216,18 @@ def simulate_command(
         from ..draw.world import draw_run
 
         draw_run(res, plot)
+    frames = 0
+    if animate is not None:
+        from ..draw.animation import animate_run
+        from ..sim.export import explain
+
+        frames = animate_run(res, animate, fps=fps, detail=explain(res, planner))
     if as_json:
         emit(json.dumps(_json_summary(res), indent=2))
     else:
         emit(_verdict(res))
         emit(_summary(res))
-    for path, what in ((out, "ticks"), (plot, "picture")):
+    for path, what in ((out, "ticks"), (plot, "picture"), (animate, f"{frames} frames")):
         if path is not None:
             err(f"wrote {what} to {path}")
     if require and res.outcome != require:

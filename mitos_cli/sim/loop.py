@@ -396,6 +396,7 @@ class Simulation:
         self._k = 0
         self._done = self.steps <= 0
         self._hit = np.zeros(n, dtype=bool)
+        self._observed: _Sensed | None = None
         self.record: list[Tick] = []
 
     # -- state ------------------------------------------------------------------------------
@@ -456,14 +457,41 @@ class Simulation:
 
     # -- one tick ---------------------------------------------------------------------------
 
-    def step(self) -> Tick:
-        """Advance one tick and return what it recorded."""
+    @property
+    def routes(self) -> tuple[Route, ...]:
+        """Each robot's route now (its last replan)."""
+        return tuple(self._routes)
+
+    @property
+    def ending(self) -> bool:
+        """The observed tick ends the run whatever is commanded: a robot touches something or
+        every robot is at its goal (False before :meth:`observe`)."""
+        return self._observed is not None and bool(self._hit.any() or not self._active.any())
+
+    def observe(self) -> _Sensed:
+        """Sense, perceive and check the current tick, once; the next :meth:`step` goes on from
+        there. What a policy outside the simulator decides on: ``.inputs`` (name -> ``[n]``),
+        ``.ranges [n, B]``, ``.pose``, ``.clearance``."""
         if self._done:
             raise RuntimeError("the run has ended (reset() starts it again)")
-        s = self.sense()
-        self.perceive(s)
-        self.check(s)
-        self.plan(s)
+        if self._observed is None:
+            s = self.sense()
+            self.perceive(s)
+            self.check(s)
+            self._observed = s
+        return self._observed
+
+    def step(self, command: np.ndarray | None = None) -> Tick:
+        """Advance one tick and return what it recorded. ``command`` (``[n, 2]`` steering in
+        deg and speed in in/s) drives the active robots this tick instead of the planner."""
+        s = self.observe()
+        self._observed = None
+        if command is None:
+            self.plan(s)
+        else:
+            s.command[:] = np.asarray(command, float).reshape(self.n, 2)
+            s.command[~self._active] = np.stack([self.limits.straight, np.zeros(self.n)],
+                                                axis=1)[~self._active]
         tick = self._record(s)
         if self._hit.any():
             self._collided = int(self._hit.sum())

@@ -1,0 +1,171 @@
+"""A finished run as a moving picture (``mitos simulate --animate run.gif``): the map, each
+robot's footprint, sonar cones and trail, the obstacles where they are, the time and, for a
+rule-base planner, the fired rules' DOFs as a bar panel. GIF through Pillow (which matplotlib
+installs), MP4 through ffmpeg where it is on the PATH.
+
+Frames are taken from the recorded ticks at ``fps`` frames per second of simulated time: tick
+``k * step`` with ``step = round(1 / (fps * dt))`` (at least 1), plus the last tick, and the
+file plays at ``fps`` (real time).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from .frame import OBSTACLE_COLOUR, ROBOT_COLOUR, TRAIL_COLOUR, draw_background
+from .output import DrawError, _matplotlib, new_figure
+
+FORMATS = ("gif", "mp4")
+BARS = 8                    # fired rules shown, by DOF
+OTHER_ROBOTS = ("#d17a00", "#7b3fa0", "#008b8b", "#a0522d")
+
+
+def check_format(path: str | Path) -> str:
+    """``gif`` or ``mp4`` by the extension (mp4 only where ffmpeg is found)."""
+    suffix = Path(path).suffix.lower().lstrip(".")
+    if suffix not in FORMATS:
+        raise DrawError(f"cannot write `{path}`: unknown animation format "
+                        f"`{suffix or '(no extension)'}`",
+                        expected="a file name ending in .gif or .mp4")
+    if suffix == "mp4":
+        _matplotlib()
+        from matplotlib import animation
+
+        if not animation.writers.is_available("ffmpeg"):
+            raise DrawError(f"cannot write `{path}`: MP4 needs ffmpeg, which is not on the PATH",
+                            hint="install ffmpeg, or write a .gif (Pillow needs nothing more)")
+    return suffix
+
+
+def frame_ticks(ticks: int, dt: float, fps: float) -> np.ndarray:
+    """The recorded ticks drawn at ``fps`` frames per simulated second (and the last one)."""
+    if ticks == 0:
+        return np.zeros(0, dtype=int)
+    step = max(1, int(round(1.0 / (fps * dt))))
+    picked = np.arange(0, ticks, step)
+    return picked if picked[-1] == ticks - 1 else np.append(picked, ticks - 1)
+
+
+def animate_run(result, path: str | Path, *, fps: float = 10.0, detail=None,
+                width_px: int = 720) -> int:
+    """Write ``result`` as an animation to ``path``; ``detail`` is the planner's engine result
+    for robot 0 (rows = ticks, :func:`mitos_cli.sim.export.explain`) for the DOF panel.
+    Returns the number of frames written."""
+    fmt = check_format(path)
+    _matplotlib()
+    from matplotlib import animation
+    from matplotlib.collections import PatchCollection
+    from matplotlib.patches import Circle, Polygon, Rectangle, Wedge
+
+    from ..sim.geometry import rect_corners
+
+    world, static = result.world, result.static
+    xmin, ymin, xmax, ymax = static.bounds
+    pad = 20.0
+    w, h = xmax - xmin + 2 * pad, ymax - ymin + 2 * pad
+    dpi = 80
+    fw = width_px / dpi
+    map_h = max(1.0, min(fw * h / w, 9.0))
+    panel_h = 1.6 if detail is not None else 0.0
+    fh = map_h + panel_h + 0.35
+    fig = new_figure((fw, fh), dpi=dpi)
+    fig.patch.set_facecolor("white")
+    ax = fig.add_axes((0.0, (panel_h + 0.05) / fh, 1.0, map_h / fh))
+    ax.set_aspect("equal")
+    ax.set_axis_off()
+    ax.set_facecolor("#d9d9d9")
+    draw_background(ax, world, static, result.routes)
+    ax.set_xlim(xmin - pad, xmax + pad)
+    ax.set_ylim(ymin - pad, ymax + pad)
+    title = fig.text(0.01, 1.0 - 0.17 / fh, "", fontsize=10, va="center")
+
+    obstacles = []
+    for o in world.obstacles:
+        patch = (Circle((o.x, o.y), o.radius) if o.shape == "circle"
+                 else Polygon(np.zeros((4, 2)), closed=True))
+        patch.set(facecolor=OBSTACLE_COLOUR, edgecolor="#5c1f1a", lw=0.8, zorder=3)
+        ax.add_patch(patch)
+        obstacles.append((o, patch))
+    n = result.pose.shape[1]
+    colours = [ROBOT_COLOUR] + [OTHER_ROBOTS[i % len(OTHER_ROBOTS)] for i in range(n - 1)]
+    robots, trails = [], []
+    for i, agent in enumerate(world.agents):
+        (trail,) = ax.plot([], [], color=TRAIL_COLOUR if i == 0 else colours[i], lw=1.6,
+                           alpha=1.0 if i == 0 else 0.6, zorder=4)
+        body = Polygon(np.zeros((4, 2)), closed=True, facecolor=colours[i], edgecolor="black",
+                       lw=0.6, zorder=5)
+        ax.add_patch(body)
+        robots.append((agent.robot, body))
+        trails.append(trail)
+    cones = PatchCollection([], facecolor="#f2c14e", edgecolor="none", alpha=0.35, zorder=2)
+    ax.add_collection(cones)
+    cones.set_clip_path(Rectangle((xmin, ymin), xmax - xmin, ymax - ymin,
+                                  transform=ax.transData))     # no cone past the outer walls
+    sen = world.sensors
+    half_cone = max(sen.cone, 2.0) / 2
+
+    bars = texts = None
+    if detail is not None:
+        bax = fig.add_axes((0.01, 0.05 / fh, 0.98, (panel_h - 0.1) / fh))
+        bax.set_xlim(0, 1)
+        bax.set_ylim(BARS - 0.5, -1.3)
+        bax.set_axis_off()
+        bax.text(0.0, -1.0, "fired rules, by DOF (the bar's length: 0 to 1)", fontsize=7,
+                 va="center", color="#333333")
+        bars = bax.barh(range(BARS), np.zeros(BARS), color="#b8cbe6", height=0.8)
+        texts = [bax.text(0.003, slot, "", fontsize=7, va="center") for slot in range(BARS)]
+        compiled = detail.compiled
+
+    picked = frame_ticks(result.ticks, world.dt, fps)
+
+    def draw(k: int):
+        t = result.t[k]
+        title.set_text(f"{world.name}   t = {t:5.2f} s   ({result.planner})")
+        for (o, patch), (cx, cy) in zip(obstacles, result.obstacles[k].reshape(-1, 2)):
+            if isinstance(patch, Circle):
+                patch.set_center((cx, cy))
+            else:
+                patch.set_xy(rect_corners(cx, cy, np.deg2rad(o.angle), o.length, o.width))
+        wedges = []
+        for i, ((robot, body), trail) in enumerate(zip(robots, trails)):
+            x, y, heading = result.pose[k, i]
+            body.set_xy(rect_corners(x, y, np.deg2rad(heading), robot.length, robot.width))
+            trail.set_data(result.pose[:k + 1, i, 0], result.pose[:k + 1, i, 1])
+            for a, r in zip(np.rad2deg(sen.angles) + heading, result.ranges[k, i]):
+                wedges.append(Wedge((x, y), float(r), a - half_cone, a + half_cone))
+        cones.set_paths(wedges)
+        if bars is not None and texts is not None:
+            dof = detail.dof[k]
+            order = [r for r in np.argsort(-dof, kind="stable")[:BARS] if dof[r] > 0]
+            for slot, (bar, text) in enumerate(zip(bars, texts)):
+                r = order[slot] if slot < len(order) else None
+                bar.set_width(float(dof[r]) if r is not None else 0.0)
+                text.set_text(f"{dof[r]:.2f}  {compiled.labels[r]}: {compiled.rule_text(r)}"
+                              if r is not None else "")
+
+    writer = (animation.PillowWriter(fps=fps) if fmt == "gif"  # type: ignore[arg-type]
+              else animation.FFMpegWriter(fps=fps))  # type: ignore[arg-type]
+    _save(fig, draw, picked, writer, Path(path), fmt, dpi)
+    return len(picked)
+
+
+def _save(fig, draw, picked, writer, path: Path, fmt: str, dpi: int) -> None:
+    """One canvas draw per frame into matplotlib's writer. The writers want a file name:
+    write beside the target, then rename it into place (a stopped run leaves no half-written
+    animation)."""
+    import os
+
+    part = path.with_name(f".{path.name}.part.{fmt}")
+    try:
+        with writer.saving(fig, str(part), dpi):
+            for k in picked:
+                draw(int(k))
+                writer.grab_frame()
+        os.replace(part, path)
+    except OSError as exc:
+        raise DrawError(f"cannot write `{path}`: {exc.strerror or exc}") from None
+    finally:
+        if part.exists():
+            part.unlink()

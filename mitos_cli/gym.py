@@ -1,0 +1,280 @@
+"""Gymnasium environments of the simulator (``pip install 'mitos[gym]'``).
+
+Importing this module registers ``mitos/World-v0`` (any world file: ``gymnasium.make(
+"mitos/World-v0", world="path.yaml")``) and one environment per packaged single-robot world,
+named after its file (``mitos/Corridor-v0``, ``mitos/Slalom-v0``, ``mitos/Figure4-v0``, ...).
+``gymnasium.make("mitos_cli.gym:mitos/Corridor-v0")`` imports it on the way.
+
+Each step is one tick of :class:`mitos_cli.sim.Simulation` (``dt`` of the world, 0.05 s in the
+packaged ones), driven by the action instead of the planner; the simulator does everything else
+as ``mitos simulate`` does (sensor noise, moving obstacles, replanning, the verdict).
+
+- **observation**: the rule base's inputs as the robot perceives them, in the compiled order of
+  the behavior (``env.unwrapped.input_names``), clamped to each variable's universe (which is
+  what the rule base reads: the engine clamps the same way), a ``Box`` of ``float64`` with the
+  universes as bounds. With ``observe_ranges=True`` a ``Dict`` of ``inputs`` and ``ranges``
+  (the noisy sonar readings, ``[0, sensor range]`` inches, one per beam).
+- **action**: ``[steering (deg, 90 straight, below 90 left), speed (in/s)]`` in a ``Box`` over
+  the robot's steering limits and ``[0, max_speed]``; the kinematics clamp a command to those
+  limits and then apply the steering rate and acceleration limits (the command is recorded as
+  given, as the planner's is).
+- **reward**: ``PROGRESS_REWARD`` (0.01) per inch by which the route left to the goal shrank
+  in the step (a replanned, longer route counts as going back), ``COLLISION_PENALTY`` (-10) when
+  the robot touches something, ``GOAL_BONUS`` (+10) when it reaches its goal.
+- **terminated** on the goal or a collision; **truncated** at the world's time limit, and when
+  the simulator finds the robot stuck (it moved less than 3 in in 6 s). At truncation the
+  observation is the last one perceived (the simulator senses no tick past its limit).
+- **info**: ``t`` (s simulated, ticks times ``dt`` as ``mitos simulate`` counts them),
+  ``pose`` (x, y in, heading deg), ``clearance`` (in), ``outcome``.
+- **render_mode** ``rgb_array``: the map, the obstacles, the footprint and the trail as an RGB
+  image (matplotlib's Agg canvas); ``human``: a window where a display is, else the terminal
+  live view of ``mitos simulate --live`` on stderr.
+- **seeding**: ``reset(seed=s)`` runs the world from seed ``s`` (``SeedSequence(s)``, as
+  ``mitos simulate --seed s``): the same seed and actions give the same observations bit for
+  bit. ``reset()`` without a seed uses the world's on the first call and continues the
+  environment's own generator after.
+
+Worlds with several robots are refused (one agent acts). The fuzzy planner is the policy of
+``mitos simulate``: driving this environment with ``env.unwrapped.fuzzy_policy`` gives the
+same trajectory bit for bit (docs/gym.md).
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+try:
+    import gymnasium
+    from gymnasium import spaces
+except ImportError as exc:  # pragma: no cover - the extra is missing
+    from .errors import MitosError
+
+    raise MitosError("the Gymnasium environments need gymnasium, which is not installed",
+                     hint="pip install 'mitos[gym]'") from exc
+
+from .errors import WorldError
+
+PROGRESS_REWARD = 0.01      # per inch of route
+COLLISION_PENALTY = -10.0
+GOAL_BONUS = 10.0
+
+
+class _Commanded:
+    """The Simulation's planner slot while the environment drives: every command is given."""
+
+    name = "gym"
+
+    def plan(self, percepts):  # pragma: no cover - step() always passes the command
+        raise RuntimeError("the environment passes every command")
+
+
+class MitosEnv(gymnasium.Env):
+    """One robot of a world, stepped tick by tick (see the module's docstring)."""
+
+    metadata = {"render_modes": ["rgb_array", "human"], "render_fps": 20}
+
+    def __init__(self, world: str | Path = "corridor", *, rulebase: str | Path | None = None,
+                 behavior: str | None = None, observe_ranges: bool = False,
+                 render_mode: str | None = None) -> None:
+        from .sim.loop import Simulation
+        from .sim.planner import FuzzyPlanner
+        from .sim.worldfile import load_world, resolve_world_path
+
+        loaded = load_world(resolve_world_path(world))
+        if len(loaded.agents) != 1:
+            raise WorldError(f"world `{loaded.name}` has {len(loaded.agents)} robots; a "
+                             f"Gymnasium environment drives one",
+                             hint="give a world with one robot (no `robots:` list)")
+        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
+            raise ValueError(f"render_mode must be one of {self.metadata['render_modes']}, "
+                             f"not {render_mode!r}")
+        self.world = loaded
+        self.render_mode = render_mode
+        self.observe_ranges = observe_ranges
+        self.metadata = {**self.metadata, "render_fps": round(1.0 / loaded.dt)}
+        self.fuzzy = FuzzyPlanner(rulebase, behavior or loaded.behavior)
+        compiled = self.fuzzy.compiled
+        self.input_names: tuple[str, ...] = tuple(compiled.inputs)
+        self._lo = np.ascontiguousarray(compiled.universe[:, 0], dtype=np.float64)
+        self._hi = np.ascontiguousarray(compiled.universe[:, 1], dtype=np.float64)
+        inputs = spaces.Box(self._lo, self._hi, dtype=np.float64)
+        robot, sen = loaded.agents[0].robot, loaded.sensors
+        if observe_ranges:
+            beams = len(sen.angles)
+            self.observation_space: spaces.Space = spaces.Dict({
+                "inputs": inputs,
+                "ranges": spaces.Box(0.0, float(sen.range), (beams,), dtype=np.float64)})
+        else:
+            self.observation_space = inputs
+        self.action_space = spaces.Box(
+            np.array([robot.steering_min, 0.0]), np.array([robot.steering_max, robot.max_speed]),
+            dtype=np.float64)
+        self.sim = Simulation(loaded, _Commanded(), loaded.seed)
+        self._seeded = False
+        self._frame = None
+        self._live = None
+
+    # -- the policy mitos simulate uses -------------------------------------------------------
+
+    def fuzzy_policy(self, observation) -> np.ndarray:
+        """The rule base's command for ``observation``: what ``mitos simulate`` would do."""
+        x = observation["inputs"] if isinstance(observation, dict) else observation
+        from .engine.evaluation import evaluate_one
+
+        out = evaluate_one(self.fuzzy.compiled, [float(v) for v in x])
+        outputs = self.fuzzy.compiled.outputs
+        return np.array([out[outputs.index("steering")], out[outputs.index("speed")]])
+
+    # -- Gymnasium ----------------------------------------------------------------------------
+
+    def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
+        super().reset(seed=seed)
+        if seed is None:
+            seed = (int(self.np_random.integers(2**31)) if self._seeded else self.world.seed)
+        self._seeded = True
+        self.sim.reset(seed)
+        self._trail = [self.sim.pose[0, :2].copy()]
+        obs = self._observe()
+        self._remaining = self._left()
+        if self.render_mode == "human":
+            self.render()
+        return obs, self._info()
+
+    def step(self, action):
+        sim = self.sim
+        if sim.done:
+            raise RuntimeError("the episode has ended: call reset()")
+        command = np.asarray(action, dtype=np.float64).reshape(1, 2)
+        if not np.isfinite(command).all():
+            raise ValueError(f"the action must be finite numbers, not {action!r}")
+        sim.step(command)
+        if not sim.done:
+            self._trail.append(sim.pose[0, :2].copy())
+            obs = self._observe()
+            if sim.ending:                  # contact or arrival: the run ends at this tick
+                sim.step(command)
+        else:
+            obs = self._last_obs
+        left = self._left()
+        reward = PROGRESS_REWARD * (self._remaining - left)
+        self._remaining = left
+        outcome = sim.robot_outcomes[0] if sim.done else "driving"
+        terminated = outcome in ("success", "collision")
+        if outcome == "success":
+            reward += GOAL_BONUS
+        elif outcome == "collision":
+            reward += COLLISION_PENALTY
+        truncated = sim.done and not terminated
+        if self.render_mode == "human":
+            self.render()
+        return obs, float(reward), terminated, truncated, self._info()
+
+    def render(self):
+        if self.render_mode is None:
+            gymnasium.logger.warn("render() without a render_mode: give render_mode='rgb_array' "
+                                  "or 'human' to gymnasium.make")
+            return None
+        sim = self.sim
+        pose = sim.record[-1].pose[0] if sim.record else sim.pose[0]
+        obstacles = sim.record[-1].obstacles if sim.record else np.zeros((0, 2))
+        if self.render_mode == "human" and self._live is not None:
+            self._live.update(0, self._state())
+            return None
+        if self._frame is None:
+            from .draw.frame import RunFrame
+            from .draw.output import DrawError
+
+            try:
+                self._frame = RunFrame(self.world, sim.scene.static, sim.routes,
+                                       show=self.render_mode == "human")
+            except DrawError:
+                if self.render_mode != "human":
+                    raise
+                from .sim.live import LiveView
+
+                self._live = LiveView(self.world, sim.scene, every=1).__enter__()
+                self._live.update(0, self._state())
+                return None
+        if self.render_mode == "rgb_array":
+            return self._frame.rgb(pose, obstacles, self._trail, sim.time)
+        self._frame.update(pose, obstacles, self._trail, sim.time)
+        import matplotlib.pyplot as plt
+
+        plt.pause(0.001)
+        return None
+
+    def close(self) -> None:
+        if self._frame is not None:
+            self._frame.close()
+            self._frame = None
+        if self._live is not None:
+            self._live.__exit__(None, None, None)
+            self._live = None
+
+    # -- helpers ------------------------------------------------------------------------------
+
+    def _observe(self):
+        s = self.sim.observe()
+        x = np.array([s.inputs[k][0] for k in self.input_names], dtype=np.float64)
+        x = np.minimum(np.maximum(x, self._lo), self._hi)
+        obs: Any = x
+        if self.observe_ranges:
+            obs = {"inputs": x, "ranges": np.array(s.ranges[0], dtype=np.float64)}
+        self._last_obs = obs
+        return obs
+
+    def _left(self) -> float:
+        """Route left to the goal (in), along the robot's route now."""
+        sim = self.sim
+        progress = sim.record[-1].progress[0] if sim.record else 0.0
+        return max(0.0, sim.routes[0].length - float(progress))
+
+    def _state(self) -> dict:
+        sim = self.sim
+        last = sim.record[-1] if sim.record else None
+        return {"t": sim.time, "pose": sim.pose, "speed": sim.speed, "steering": sim.steering,
+                "inputs": last.inputs if last else {k: np.zeros(1) for k in self.input_names},
+                "clearance": sim.clearance,
+                "obstacles": last.obstacles if last else np.zeros((0, 2))}
+
+    def _info(self) -> dict:
+        sim = self.sim
+        return {"t": round(sim.ticks * sim.dt, 6), "pose": sim.pose[0],
+                "clearance": float(sim.clearance[0]),
+                "outcome": sim.robot_outcomes[0] if sim.done else "driving"}
+
+
+def env_name(world_file: str) -> str:
+    """``figure4.yaml`` -> ``mitos/Figure4-v0``."""
+    stem = Path(world_file).stem
+    return "mitos/" + "".join(part[:1].upper() + part[1:] for part in re.split(r"[_\-]", stem)) \
+        + "-v0"
+
+
+def register_envs() -> list[str]:
+    """Register ``mitos/World-v0`` and one environment per packaged single-robot world (a
+    world file with a ``robots:`` list has several); the names registered."""
+    from .resources import data_dir
+
+    names = []
+    if "mitos/World-v0" not in gymnasium.registry:
+        gymnasium.register("mitos/World-v0", entry_point="mitos_cli.gym:MitosEnv")
+    names.append("mitos/World-v0")
+    for entry in sorted(data_dir("worlds").iterdir(), key=lambda e: e.name):
+        if not entry.name.endswith(".yaml"):
+            continue
+        if re.search(r"^robots:", entry.read_text(encoding="utf-8"), re.MULTILINE):
+            continue
+        name = env_name(entry.name)
+        if name not in gymnasium.registry:
+            gymnasium.register(name, entry_point="mitos_cli.gym:MitosEnv",
+                               kwargs={"world": entry.name})
+        names.append(name)
+    return names
+
+
+ENVIRONMENTS = register_envs()

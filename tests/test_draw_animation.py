@@ -1,0 +1,75 @@
+"""``mitos simulate --animate``: the frame count at --fps, a decoded frame showing the robot,
+the formats refused with a clear message."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from mitos_cli.cli.app import app, main
+from mitos_cli.draw.animation import frame_ticks
+from mitos_cli.draw.frame import ROBOT_COLOUR
+from mitos_cli.resources import packaged_path
+
+PIL = pytest.importorskip("PIL.Image")
+RUNNER = CliRunner()
+
+
+def run_main(capsys, *args) -> tuple[int, str]:
+    """Through ``main``, which turns our errors into a message and exit 1."""
+    with pytest.raises(SystemExit) as info:
+        main(["simulate", *map(str, args)])
+    return info.value.code, capsys.readouterr().err
+
+
+@pytest.fixture
+def short_world(tmp_path):
+    """The packaged moving-obstacle world cut to 2 s (40 ticks)."""
+    text = packaged_path("worlds", "moving.yaml").read_text(encoding="utf-8")
+    path = tmp_path / "moving2.yaml"
+    path.write_text(text.replace("time_limit: 60", "time_limit: 2"), encoding="utf-8")
+    return path
+
+
+def test_frames_are_taken_at_fps_of_simulated_time():
+    assert frame_ticks(40, 0.05, 10).tolist() == list(range(0, 40, 2)) + [39]
+    assert frame_ticks(41, 0.05, 10).tolist() == list(range(0, 41, 2))
+    assert frame_ticks(40, 0.05, 2.5).tolist() == [0, 8, 16, 24, 32, 39]
+    assert frame_ticks(3, 0.05, 60).tolist() == [0, 1, 2]        # never finer than a tick
+    assert frame_ticks(0, 0.05, 10).tolist() == []
+
+
+def test_animate_writes_a_gif_of_the_run(short_world, tmp_path):
+    gif = tmp_path / "run.gif"
+    out = RUNNER.invoke(app, ["simulate", str(short_world), "--animate", str(gif),
+                              "--fps", "2.5"])
+    assert out.exit_code == 0, out.output
+    assert f"wrote 6 frames to {gif}" in out.output
+    with PIL.open(gif) as im:
+        assert im.n_frames == 6                                   # ticks 0, 8, 16, 24, 32, 39
+        assert im.info["duration"] == 400                         # ms: 2.5 frames per second
+        im.seek(3)
+        frame = np.asarray(im.convert("RGB")).astype(int)
+    robot = np.array([int(ROBOT_COLOUR[i:i + 2], 16) for i in (1, 3, 5)])
+    assert (np.abs(frame - robot).sum(axis=2) < 30).sum() > 20   # the footprint is drawn
+    assert not list(tmp_path.glob(".*.part.*"))
+
+
+def test_animate_refuses_other_formats_and_many_runs(short_world, tmp_path, capsys):
+    code, err = run_main(capsys, short_world, "--animate", tmp_path / "a.avi")
+    assert code == 1 and "unknown animation format `avi`" in err
+    assert "expected a file name ending in .gif or .mp4" in err
+    out = RUNNER.invoke(app, ["simulate", str(short_world), "--runs", "2", "--animate",
+                              str(tmp_path / "a.gif")])
+    assert out.exit_code == 2 and "--animate" in out.output
+
+
+def test_mp4_without_ffmpeg_says_so(short_world, tmp_path, monkeypatch, capsys):
+    from matplotlib import animation
+
+    monkeypatch.setattr(animation.writers, "is_available", lambda name: False)
+    code, err = run_main(capsys, short_world, "--animate", tmp_path / "a.mp4")
+    assert code == 1
+    assert "MP4 needs ffmpeg, which is not on the PATH" in err
+    assert "write a .gif" in err

@@ -1,0 +1,133 @@
+"""The Gymnasium environments: the checker, seeding, the fuzzy policy's trajectory equals
+``mitos simulate``'s, the spaces, the refusal of several robots, rendering."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+gymnasium = pytest.importorskip("gymnasium")
+
+from mitos_cli import gym as mgym  # noqa: E402
+from mitos_cli.errors import WorldError  # noqa: E402
+from mitos_cli.resources import packaged_path  # noqa: E402
+from mitos_cli.sim import load_world, simulate  # noqa: E402
+
+
+@pytest.fixture
+def short_world(tmp_path):
+    """The packaged slalom cut to 3 s (60 ticks), so a test run takes a fraction of a second."""
+    text = packaged_path("worlds", "slalom.yaml").read_text(encoding="utf-8")
+    path = tmp_path / "slalom3.yaml"
+    path.write_text(text.replace("time_limit: 60", "time_limit: 3"), encoding="utf-8")
+    return path
+
+
+def drive(env, seed, policy=None, limit=10_000):
+    obs, _ = env.reset(seed=seed)
+    seen, rewards = [obs], []
+    for _ in range(limit):
+        action = policy(obs) if policy else env.unwrapped.fuzzy_policy(obs)
+        obs, reward, terminated, truncated, info = env.step(action)
+        seen.append(obs)
+        rewards.append(reward)
+        if terminated or truncated:
+            return seen, rewards, terminated, truncated, info
+    raise AssertionError("the episode did not end")
+
+
+def test_every_packaged_single_robot_world_is_registered():
+    assert "mitos/World-v0" in mgym.ENVIRONMENTS
+    for name in ("mitos/Corridor-v0", "mitos/Slalom-v0", "mitos/Figure4-v0", "mitos/Office-v0"):
+        assert name in gymnasium.registry
+    assert "mitos/Multirobot-v0" not in gymnasium.registry
+    assert mgym.env_name("figure4.yaml") == "mitos/Figure4-v0"
+
+
+def test_passes_gymnasiums_checker(short_world):
+    from gymnasium.utils.env_checker import check_env
+
+    env = gymnasium.make("mitos/World-v0", world=str(short_world), render_mode="rgb_array")
+    check_env(env.unwrapped, skip_render_check=False)
+    env = gymnasium.make("mitos/World-v0", world=str(short_world), observe_ranges=True)
+    check_env(env.unwrapped)
+
+
+def test_fuzzy_policy_drives_the_trajectory_of_simulate_bit_for_bit(short_world):
+    env = gymnasium.make("mitos/World-v0", world=str(short_world))
+    _, rewards, terminated, truncated, info = drive(env, seed=4)
+    ran = env.unwrapped.sim.result()
+    ref = simulate(load_world(short_world), seed=4)
+    assert ran.ticks == ref.ticks == 60
+    assert np.array_equal(ran.pose, ref.pose)
+    assert np.array_equal(ran.command, ref.command)
+    assert (terminated, truncated, info["outcome"]) == (False, True, ref.outcome)
+    # the reward is the route's progress: 0.01 per inch of route left behind
+    left = ref.routes[0].length - ref.progress[-1, 0]
+    assert sum(rewards) == pytest.approx(0.01 * (ref.routes[0].length - left))
+
+
+def test_the_documented_example_reaches_the_goal_as_simulate_does(capsys):
+    """docs/gym.md's example, run as written: the goal, the bonus, simulate's trajectory."""
+    import re
+    from pathlib import Path
+
+    page = (Path(__file__).resolve().parents[1] / "docs" / "gym.md").read_text(encoding="utf-8")
+    code = re.search(r"```python\n(.*?)```", page, re.S).group(1)
+    scope: dict = {}
+    exec(compile(code, "docs/gym.md", "exec"), scope)
+    printed = re.search(r"print\(.*\)\s+# (.*)", code).group(1)     # what the page says
+    assert capsys.readouterr().out.split() == printed.split()
+    assert scope["terminated"] and not scope["truncated"]
+    assert scope["reward"] >= mgym.GOAL_BONUS
+    assert scope["info"]["t"] == scope["same"].metrics["time_s"]
+
+
+def test_a_collision_terminates_with_the_penalty(short_world):
+    env = gymnasium.make("mitos/World-v0", world=str(short_world))
+    # full speed, half left: into the corridor's wall after 1.6 s
+    _, rewards, terminated, _, info = drive(env, seed=1, policy=lambda obs: np.array([50.0, 60.0]))
+    assert terminated and info["outcome"] == "collision"
+    assert rewards[-1] <= mgym.COLLISION_PENALTY + 1.0
+
+
+def test_the_same_seed_gives_the_same_observations_and_another_seed_others(short_world):
+    env = gymnasium.make("mitos/World-v0", world=str(short_world), observe_ranges=True)
+    a = drive(env, seed=7)[0]
+    b = drive(env, seed=7)[0]
+    c = drive(env, seed=8)[0]
+    assert len(a) == len(b)
+    assert all(np.array_equal(x["inputs"], y["inputs"]) and np.array_equal(x["ranges"], y["ranges"])
+               for x, y in zip(a, b))
+    assert any(not np.array_equal(x["ranges"], y["ranges"]) for x, y in zip(a, c))
+
+
+def test_spaces_are_the_universes_and_the_robots_limits():
+    env = gymnasium.make("mitos/Corridor-v0")
+    u = env.unwrapped
+    assert u.input_names == tuple(u.fuzzy.compiled.inputs)
+    assert np.array_equal(env.observation_space.low, u.fuzzy.compiled.universe[:, 0])
+    robot = u.world.agents[0].robot
+    assert env.action_space.low.tolist() == [robot.steering_min, 0.0]
+    assert env.action_space.high.tolist() == [robot.steering_max, robot.max_speed]
+    obs, _ = env.reset(seed=1)
+    assert env.observation_space.contains(obs)     # the goal 540 in away reads as 400
+    with pytest.raises(ValueError, match="finite"):
+        env.step(np.array([np.nan, 10.0]))
+
+
+def test_several_robots_are_refused():
+    with pytest.raises(WorldError, match="has 2 robots; a Gymnasium environment drives one"):
+        gymnasium.make("mitos/World-v0", world="multirobot")
+
+
+def test_rgb_array_shows_the_robot(short_world):
+    env = gymnasium.make("mitos/World-v0", world=str(short_world), render_mode="rgb_array")
+    env.reset(seed=1)
+    for _ in range(10):
+        env.step(np.array([90.0, 40.0]))
+    frame = env.render()
+    assert frame.dtype == np.uint8 and frame.ndim == 3 and frame.shape[2] == 3
+    blue = np.array([0x1F, 0x5F, 0xBF])
+    assert (np.abs(frame.astype(int) - blue).sum(axis=2) < 6).sum() > 20
+    env.close()
