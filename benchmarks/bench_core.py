@@ -8,7 +8,8 @@ Run from the repository root (one command)::
 It measures, in one run, on the packaged MITOS rule base (behavior ``avoid_obstacle``, the
 paper's 27 rules):
 
-a. batch throughput on 10^6 random inputs (best of 10 rounds that call each in turn): ``engine.evaluate`` with ``detail=True`` (memberships
+a. batch throughput on 10^6 random inputs (best of 10 rounds that call each in turn):
+``engine.evaluate`` with ``detail=True`` (memberships
    and DOFs kept) and ``detail=False`` (outputs only), ``load_rulebase().evaluate(**columns)``
    (arrays by name), a hand-written NumPy kernel for exactly this rule base, and pyfuzzylite
    8's vectorized ``Engine.process()`` on the same rules; and the peak memory NumPy allocates
@@ -145,8 +146,7 @@ def fuzzylite_engine(rb):
 
 
 def simpful_system(rb):
-    from simpful import FuzzySystem, LinguisticVariable, FuzzySet, Trapezoidal_MF, \
-        Triangular_MF
+    from simpful import FuzzySet, FuzzySystem, LinguisticVariable, Trapezoidal_MF, Triangular_MF
 
     c = rb.compiled
     fs = FuzzySystem(show_banner=False)
@@ -272,7 +272,7 @@ def machine() -> str:
     except OSError:
         pass
     try:
-        load = "load average %.2f %.2f %.2f" % os.getloadavg()
+        load = "load average {:.2f} {:.2f} {:.2f}".format(*os.getloadavg())
     except OSError:
         load = "load average unknown"
     return (f"{os.cpu_count()} CPUs ({model}), Python {platform.python_version()}, "

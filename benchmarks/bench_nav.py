@@ -26,6 +26,7 @@ successful runs, BARN's score and MRPB's safety. Runs go through the simulator's
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import os
 import platform
@@ -67,10 +68,8 @@ def routable(worlds, known_twins=None):
             refused.append((w.name, exc.message if hasattr(exc, "message") else str(exc)))
             continue
         if known_twins:            # around the poles, if the route planner finds a way there
-            try:
+            with contextlib.suppress(MitosError):   # too tight for the route: the straight length
                 length = float(prepare(known_twins[i]).routes[0].length)
-            except MitosError:
-                pass               # too tight for the route's clearance: the straight length
         ok.append(w)
         lengths[w.name] = length
     return ok, lengths, refused

@@ -81,6 +81,7 @@ def mamdani_files(tmp: Path, resolution: int) -> Path:
 
 def fuzzylite_engine(compiled, conjunction: str, mamdani: bool):
     import fuzzylite as fl
+
     from mitos_cli.lang.model import format_rule
 
     lines = ["Engine: bench"]

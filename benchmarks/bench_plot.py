@@ -30,8 +30,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from bench_core import (_version, best_of, fmt_time, fuzzylite_engine,  # noqa: E402
-                        machine)
+from bench_core import _version, best_of, fmt_time, fuzzylite_engine, machine  # noqa: E402
 
 from mitos_cli import load_rulebase
 from mitos_cli.draw import data as plotdata  # noqa: E402

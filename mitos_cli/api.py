@@ -14,11 +14,10 @@ from pathlib import Path
 import numpy as np
 
 from .engine.compile import CompiledRuleBase, compile_rulebase
-from .engine.evaluation import (Result, as_batch, as_columns, evaluate, evaluate_columns,
-                                evaluate_one)
+from .engine.evaluation import Result, as_batch, as_columns, evaluate, evaluate_columns, evaluate_one
+from .engine.trace import Trace, trace_of
 from .lang.model import RuleBase
 from .resources import DEFAULT_RULEBASE, packaged_path
-from .engine.trace import Trace, trace_of
 
 
 def default_rulebase_path() -> Path:
@@ -51,7 +50,7 @@ def read_rulebase(path: str | Path | None = None) -> RuleBase:
 
 
 def _load_rules_file(path: Path) -> RuleBase:
-    from .lang.resolve import load_rules_file      # the parser (Lark) and YAML load only on a miss
+    from .lang.resolve import load_rules_file  # the parser (Lark) and YAML load only on a miss
 
     return load_rules_file(path)
 
@@ -82,12 +81,12 @@ class LoadedRuleBase:
     def behaviors(self) -> tuple[str, ...]:
         return tuple(b.name for b in self.rulebase.behaviors)
 
-    @functools.lru_cache(maxsize=None)
-    def behavior(self, name: str) -> "LoadedRuleBase":
+    @functools.cache  # noqa: B019 - a handful of behaviors, cached for the rule base's lifetime
+    def behavior(self, name: str) -> LoadedRuleBase:
         """The same rule base with another behavior compiled (recalled by name alone)."""
         return LoadedRuleBase(self.rulebase, name, self.overrides)
 
-    def with_operators(self, **settings: str) -> "LoadedRuleBase":
+    def with_operators(self, **settings: str) -> LoadedRuleBase:
         """The same behavior compiled with other operators, e.g. ``with_operators(and_="product")``
         (keys as in an ``operators:`` line; a trailing underscore is dropped)."""
         from .lang.model import Setting

@@ -10,8 +10,8 @@ from __future__ import annotations
 
 import difflib
 import re
+from collections.abc import Iterable
 from dataclasses import dataclass
-from typing import Iterable
 
 
 @dataclass(frozen=True)
@@ -32,7 +32,7 @@ class Span:
 
     @classmethod
     def in_text(cls, text: str, path: str | None, line: int, column: int,
-                end_column: int | None = None) -> "Span":
+                end_column: int | None = None) -> Span:
         """A span at ``line``/``column`` of ``text``, remembering that line for the caret."""
         lines = text.splitlines()
         source = lines[line - 1] if 0 < line <= len(lines) else None
@@ -40,7 +40,7 @@ class Span:
 
     @classmethod
     def at(cls, text: str, path: str | None, index: int, line: int, column: int,
-           end_column: int | None = None, breaks: "re.Pattern[str] | None" = None) -> "Span":
+           end_column: int | None = None, breaks: re.Pattern[str] | None = None) -> Span:
         """A span at character ``index`` of ``text`` (which is at ``line``/``column``).
 
         Finds the source line around ``index`` in time proportional to that line, not to the
@@ -56,7 +56,7 @@ class Span:
         while True:
             lo = max(0, index - window)
             last = None
-            for last in breaks.finditer(text, lo, index):
+            for last in breaks.finditer(text, lo, index):  # noqa: B007 - keep the last match
                 pass
             if last is not None:
                 start = last.end()

@@ -8,8 +8,8 @@ so they work from a zip too); in a source checkout they are the top-level ``gram
 from __future__ import annotations
 
 import importlib.resources
+from collections.abc import Iterator
 from pathlib import Path
-from typing import Iterator
 
 DEFAULT_RULEBASE = "mitos.rules"
 DEFAULT_WORLD = "corridor.yaml"

@@ -38,9 +38,9 @@ import pytest
 
 fl = pytest.importorskip("fuzzylite")
 
-from mitos_cli.fuzzy import norms  # noqa: E402
 from mitos_cli.api import load_rulebase  # noqa: E402
 from mitos_cli.engine.evaluation import evaluate  # noqa: E402
+from mitos_cli.fuzzy import norms  # noqa: E402
 
 FL_TNORM = {"min": "Minimum", "product": "AlgebraicProduct", "lukasiewicz": "BoundedDifference",
             "drastic": "DrasticProduct", "einstein": "EinsteinProduct",

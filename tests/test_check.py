@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 from mitos_cli.api import read_rulebase
-from mitos_cli.engine.check import boxes_of, canonical, check_rulebase, grid_axes
 from mitos_cli.cli.app import main
+from mitos_cli.engine.check import boxes_of, canonical, check_rulebase, grid_axes
 from mitos_cli.engine.compile import compile_rulebase
 from mitos_cli.lang.parse import parse_expr
 

@@ -20,8 +20,8 @@ import numpy as np
 import pytest
 
 from mitos_cli import load_rulebase
-from mitos_cli.engine.csvio import read_batch
 from mitos_cli.cli.app import main
+from mitos_cli.engine.csvio import read_batch
 
 ROOT = Path(__file__).resolve().parents[1]
 GOLDEN = ROOT / "tests" / "golden"

@@ -16,10 +16,10 @@ import numpy as np
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from mitos_cli.lang.resolve import load_rules_file
 from mitos_cli.engine.compile import compile_rulebase
 from mitos_cli.engine.evaluation import evaluate
 from mitos_cli.errors import MitosError
+from mitos_cli.lang.resolve import load_rules_file
 
 ROOT = Path(__file__).resolve().parents[1]
 RULES = (ROOT / "rulebases" / "mitos.rules").read_text(encoding="utf-8").replace(

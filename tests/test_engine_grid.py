@@ -10,10 +10,10 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from mitos_cli.engine import compile as compile_mod
-from mitos_cli.lang.resolve import build_rulebase
 from mitos_cli.engine.compile import compile_rulebase
 from mitos_cli.engine.evaluation import evaluate
 from mitos_cli.lang.parse import parse_rules
+from mitos_cli.lang.resolve import build_rulebase
 from mitos_cli.lang.termfile import parse_termset
 
 TERMS = """

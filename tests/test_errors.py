@@ -17,11 +17,18 @@ import numpy as np
 import pytest
 
 from mitos_cli import load_rulebase
-from mitos_cli.lang.resolve import check_rule, load_rules_file
 from mitos_cli.cli.app import main
-from mitos_cli.errors import (InputError, MitosError, NameError_, NoRuleFiredError,
-                              RuleBaseError, RuleSyntaxError, TermSetError)
+from mitos_cli.errors import (
+    InputError,
+    MitosError,
+    NameError_,
+    NoRuleFiredError,
+    RuleBaseError,
+    RuleSyntaxError,
+    TermSetError,
+)
 from mitos_cli.lang.model import Consequent, Prop, Rule
+from mitos_cli.lang.resolve import check_rule, load_rules_file
 
 ROOT = Path(__file__).resolve().parents[1]
 TERMS = (ROOT / "rulebases" / "mitos.terms.yaml").read_text(encoding="utf-8")

@@ -26,10 +26,9 @@ def test_replaces_and_uses_the_umask(tmp_path):
 def test_an_error_inside_keeps_the_old_file(tmp_path):
     target = tmp_path / "a.txt"
     target.write_text("old")
-    with pytest.raises(RuntimeError):
-        with atomic_file(target) as fh:
-            fh.write("half")
-            raise RuntimeError("crash")
+    with pytest.raises(RuntimeError), atomic_file(target) as fh:
+        fh.write("half")
+        raise RuntimeError("crash")
     assert target.read_text() == "old" and len(list(tmp_path.iterdir())) == 1
 
 

@@ -177,8 +177,7 @@ def test_fis_reader_matches_fuzzylites_copy_of_the_same_system() -> None:
         pytest.skip("pyfuzzylite is not installed")
     from mitos_cli.engine.compile import compile_rulebase
     from mitos_cli.engine.evaluation import evaluate
-    from mitos_cli.lang.model import Setting
-    from mitos_cli.lang.model import RuleBase
+    from mitos_cli.lang.model import RuleBase, Setting
 
     rb = read_rulebase(DATA / "tipper.fis")
     fuzzylite_ops = tuple(s for s in rb.operators if s.key not in ("resolution", "sampling")) + (
@@ -235,9 +234,8 @@ def test_fis_writer_pushes_not_by_de_morgan(tmp_path: Path) -> None:
 
 
 def test_fcl_rule_blocks_with_different_operators_become_behaviors() -> None:
-    from mitos_cli.interop.fcl import parse_fcl
-
     from mitos_cli.errors import FormatError
+    from mitos_cli.interop.fcl import parse_fcl
 
     text = (DATA / "tipper_jfuzzylogic.fcl").read_text().replace(
         "	RULE 3 :", "END_RULEBLOCK\nRULEBLOCK gentle\n	AND : PROD;\n	RULE 3 :")

@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from strategies import expressions
 
 from mitos_cli.api import read_rulebase
 from mitos_cli.engine.compile import compile_rulebase
@@ -20,7 +21,6 @@ from mitos_cli.interop import write_foreign
 from mitos_cli.interop.rules_writer import write_rules
 from mitos_cli.lang.model import Behavior, Consequent, Not, Prop, Rule, RuleBase, Setting
 from mitos_cli.lang.terms import Term, TermSet, Variable
-from strategies import expressions
 
 SHAPES = {   # shape -> params on the universe [0, 10] drawn from sorted uniforms
     "triangle": 3, "trapezoid": 4, "gaussian": 2, "bell": 3, "sigmoid": 2, "s_shape": 2,

@@ -7,10 +7,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from mitos_cli.fuzzy.shapes import SHAPES
 from mitos_cli.interop.common import FUZZYLITE_SHAPES, fuzzylite_term
 from mitos_cli.interop.fcl import JFUZZY_SHAPES
 from mitos_cli.interop.fis import MF_TYPES
-from mitos_cli.fuzzy.shapes import SHAPES
 
 fl = pytest.importorskip("fuzzylite", reason="pyfuzzylite is not installed")
 

@@ -6,12 +6,12 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from mitos_cli.engine import mamdani
-from mitos_cli.fuzzy import norms
 from mitos_cli.api import load_rulebase, read_rulebase
+from mitos_cli.engine import mamdani
 from mitos_cli.engine.compile import compile_rulebase
 from mitos_cli.engine.evaluation import evaluate
 from mitos_cli.errors import NoRuleFiredError
+from mitos_cli.fuzzy import norms
 from mitos_cli.fuzzy.hedges import HEDGES
 from mitos_cli.lang.model import Setting
 

@@ -8,11 +8,11 @@ from pathlib import Path
 
 import pytest
 
-from mitos_cli.fuzzy import norms
 from mitos_cli.api import load_rulebase, read_rulebase
 from mitos_cli.cli.app import main
-from mitos_cli.fuzzy.hedges import HEDGES
 from mitos_cli.engine.describe import describe_network
+from mitos_cli.fuzzy import norms
+from mitos_cli.fuzzy.hedges import HEDGES
 
 
 def run(capsys, *argv):

@@ -9,10 +9,10 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from mitos_cli.fuzzy import neurons, norms
 from mitos_cli.api import load_rulebase, read_rulebase
 from mitos_cli.engine.compile import compile_rulebase
 from mitos_cli.engine.evaluation import network_values
+from mitos_cli.fuzzy import neurons, norms
 from mitos_cli.lang.model import Setting
 
 FAST = settings(max_examples=60, deadline=None)

@@ -13,9 +13,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from mitos_cli.draw import data as plotdata
 from mitos_cli.api import load_rulebase
 from mitos_cli.cli.app import main
+from mitos_cli.draw import data as plotdata
 
 DATA = Path(__file__).parent / "data" / "interop"
 SAMPLE = ["road=78", "size=45", "position=4"]

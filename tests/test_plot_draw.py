@@ -9,8 +9,8 @@ import pytest
 
 pytest.importorskip("matplotlib")
 
-from mitos_cli.draw import data as plotdata  # noqa: E402
 from mitos_cli.api import load_rulebase  # noqa: E402
+from mitos_cli.draw import data as plotdata  # noqa: E402
 from mitos_cli.draw.output import DrawError, check_format  # noqa: E402
 from mitos_cli.draw.rules import draw_rules  # noqa: E402
 from mitos_cli.draw.surface import draw_surface  # noqa: E402

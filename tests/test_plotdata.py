@@ -9,13 +9,13 @@ import json
 import numpy as np
 import pytest
 
-from mitos_cli.engine import mamdani
-from mitos_cli.fuzzy import norms
-from mitos_cli.draw import data as plotdata
 from mitos_cli.api import load_rulebase
 from mitos_cli.cli.app import main
+from mitos_cli.draw import data as plotdata
+from mitos_cli.engine import mamdani
 from mitos_cli.engine.evaluation import as_batch, evaluate
 from mitos_cli.errors import InputError
+from mitos_cli.fuzzy import norms
 
 SAMPLE = {"road": 78.0, "size": 45.0, "position": 4.0}
 

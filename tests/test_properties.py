@@ -10,12 +10,12 @@ from hypothesis import assume as hypothesis_assume
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from mitos_cli.fuzzy import shapes
-from mitos_cli.lang.resolve import build_rulebase
 from mitos_cli.engine.compile import compile_rulebase
 from mitos_cli.engine.evaluation import BLOCK, evaluate
+from mitos_cli.fuzzy import shapes
 from mitos_cli.lang.model import And, Consequent, Not, Or, Prop, Rule, format_rule
 from mitos_cli.lang.parse import parse_rule, parse_rules
+from mitos_cli.lang.resolve import build_rulebase
 from mitos_cli.lang.termfile import parse_termset
 
 INF, NAN = math.inf, math.nan

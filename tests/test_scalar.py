@@ -8,16 +8,16 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from strategies import expressions
 
 from mitos_cli import load_rulebase
 from mitos_cli.engine.compile import compile_rulebase
 from mitos_cli.engine.evaluation import evaluate, evaluate_one
-from mitos_cli.errors import InputError, NoRuleFiredError
-from mitos_cli.lang.model import Behavior, Consequent, Prop, Rule, RuleBase, Setting, Use
-from mitos_cli.fuzzy.norms import SNORMS, TNORMS
 from mitos_cli.engine.scalar import HEDGES, NORMS
+from mitos_cli.errors import InputError, NoRuleFiredError
+from mitos_cli.fuzzy.norms import SNORMS, TNORMS
+from mitos_cli.lang.model import Behavior, Consequent, Prop, Rule, RuleBase, Setting, Use
 from mitos_cli.lang.terms import Term, TermSet, Variable
-from strategies import expressions
 
 HEDGE_NAMES = tuple(sorted(HEDGES))
 LINEAR_SHAPES = {"triangle": 3, "trapezoid": 4, "left_shoulder": 2, "right_shoulder": 2,

@@ -54,7 +54,7 @@ def test_every_object_leaves_the_free_way_and_stays_inside(hall, seed):
     assert 1 <= len(w.obstacles) <= 6
     for o in w.obstacles:
         lo, hi = across(o)
-        assert -40 - 1e-6 <= lo and hi <= 40 + 1e-6
+        assert lo >= -40 - 1e-6 and hi <= 40 + 1e-6
         assert max(40 - hi, lo + 40) >= FREE_WAY_IN - 1e-6
         assert o.name.split("_")[0] in {k.name for k in KINDS}
 

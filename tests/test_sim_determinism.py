@@ -6,11 +6,11 @@ import dataclasses
 
 import numpy as np
 
+from mitos_cli.resources import packaged_path
+from mitos_cli.sim.loop import simulate
 from mitos_cli.sim.planner import FuzzyPlanner
 from mitos_cli.sim.runs import run_many
-from mitos_cli.sim.loop import simulate
 from mitos_cli.sim.worldfile import load_world
-from mitos_cli.resources import packaged_path
 
 
 def short(name: str, seconds: float):

@@ -18,7 +18,7 @@ def corridor():
 
 def test_every_registered_planner_builds_and_names_itself(corridor):
     assert list(PLANNERS) == ["fuzzy", "potential_field", "dwa"]
-    assert STUDY_PLANNERS == tuple(PLANNERS)
+    assert tuple(PLANNERS) == STUDY_PLANNERS
     names = [make_planner(name, corridor).name for name in PLANNERS]
     assert names == ["fuzzy:drive", "potential_field", "dwa"]
 

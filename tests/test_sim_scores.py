@@ -12,7 +12,7 @@ from mitos_cli.sim.scores import BARN_SPEED_IN_S, barn_score, mrpb_safety, optim
 
 
 def test_t_opt_is_the_path_over_two_metres_a_second():
-    assert BARN_SPEED_IN_S == pytest.approx(78.74015748)
+    assert pytest.approx(78.74015748) == BARN_SPEED_IN_S
     assert optimal_time(10 * INCH_PER_M) == pytest.approx(5.0)
 
 

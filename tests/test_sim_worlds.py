@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 
 from mitos_cli.resources import data_dir, packaged_names
-from mitos_cli.sim.runs import run_many
 from mitos_cli.sim.loop import simulate
+from mitos_cli.sim.runs import run_many
 from mitos_cli.sim.worldfile import load_world
 
 WORLDS = [n for n in packaged_names("worlds", ".yaml")]

@@ -11,6 +11,7 @@ import time
 from pathlib import Path
 
 import pytest
+
 from mitos_cli.cli.app import main
 from mitos_cli.study import Study, make_choices, run_study
 from mitos_cli.study.store import ResultStore

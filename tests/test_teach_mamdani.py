@@ -5,14 +5,23 @@ frozen things stay, the same run gives the same bits; and a session adapts and s
 import numpy as np
 import pytest
 
-from mitos_cli.lang.resolve import build_rulebase
 from mitos_cli.engine.compile import compile_rulebase
 from mitos_cli.engine.evaluation import evaluate
 from mitos_cli.lang.parse import parse_rules
-from mitos_cli.teach.adapt import (adapt, descent_direction, difference_steps, feasible,
-                                   gradient, learned_rulebase, loss, parameterise, with_values)
-from mitos_cli.teach.session import Session
+from mitos_cli.lang.resolve import build_rulebase
 from mitos_cli.lang.termfile import parse_termset
+from mitos_cli.teach.adapt import (
+    adapt,
+    descent_direction,
+    difference_steps,
+    feasible,
+    gradient,
+    learned_rulebase,
+    loss,
+    parameterise,
+    with_values,
+)
+from mitos_cli.teach.session import Session
 
 TERMS = """
 variables:

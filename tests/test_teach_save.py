@@ -4,11 +4,9 @@ import shutil
 
 import pytest
 
-from mitos_cli.errors import MitosError
-
 from mitos_cli.api import default_rulebase_path
+from mitos_cli.errors import LessonError, MitosError
 from mitos_cli.lang.resolve import load_rules_file
-from mitos_cli.errors import LessonError
 from mitos_cli.teach.save import atomic_write, save_rulebase
 from mitos_cli.teach.session import Session
 

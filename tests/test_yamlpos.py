@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import pytest
 
-from mitos_cli.lang import yamlpos
 from mitos_cli.errors import TermSetError
+from mitos_cli.lang import yamlpos
 
 
 @pytest.mark.parametrize("key,kind", [("ON", "true/false"), ("no", "true/false"),

@@ -11,8 +11,8 @@ builds the app with only the command it was asked for (about 30 ms less per ``mi
 
 from __future__ import annotations
 
-import importlib
 import errno
+import importlib
 import sys
 from typing import Annotated
 

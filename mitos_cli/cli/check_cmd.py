@@ -9,9 +9,8 @@ from typing import Annotated, Optional
 
 import typer
 
-from .output import emit, warn_notes
 from ..words import plural
-
+from .output import emit, warn_notes
 
 
 def _finite(value: float) -> float:

@@ -7,8 +7,8 @@ from typing import Annotated, Optional
 
 import typer
 
-from .output import emit, err, warn
 from ..words import plural
+from .output import emit, err, warn
 
 
 def compare_command(
@@ -181,8 +181,14 @@ def check_inputs(worlds: list[str], choices, rulebase: str | None,
 def run_with_progress(study, out, executor, workers, scheduler, resume):
     """Run the study with a progress bar on stderr."""
     from rich.console import Console
-    from rich.progress import (BarColumn, MofNCompleteColumn, Progress, TextColumn,
-                               TimeElapsedColumn, TimeRemainingColumn)
+    from rich.progress import (
+        BarColumn,
+        MofNCompleteColumn,
+        Progress,
+        TextColumn,
+        TimeElapsedColumn,
+        TimeRemainingColumn,
+    )
 
     from ..study import run_study
 

@@ -11,8 +11,8 @@ from typing import Annotated, Optional
 import typer
 
 from ..errors import InputError
-from .output import emit, warn, warn_notes
 from ..words import plural
+from .output import emit, warn, warn_notes
 
 
 class Engine(str, enum.Enum):

@@ -20,9 +20,9 @@ from pathlib import Path
 
 import numpy as np
 
+from ..words import plural
 from .data import OutputView, RuleRow, RuleView
 from .output import finish, new_figure
-from ..words import plural
 
 TERM_COLOR = "#1f77b4"
 FILL_COLOR = "#f2b134"

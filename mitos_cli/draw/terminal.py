@@ -11,8 +11,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .data import RuleView, Surface, TermCurve, VariablePlot, visible
 from ..words import plural
+from .data import RuleView, Surface, TermCurve, VariablePlot, visible
 
 BRAILLE = 0x2800
 #: dot (row, column) inside a cell -> bit of the Braille code point

@@ -9,13 +9,13 @@ one variable. matplotlib is imported only inside these functions (through
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from pathlib import Path
-from typing import Sequence
 
 import numpy as np
 
-from .data import VariablePlot, variable_plot, visible
 from ..lang.terms import Variable
+from .data import VariablePlot, variable_plot, visible
 from .output import finish, new_figure
 
 #: term colours (matplotlib's tab10, colour-blind friendlier than the default cycle's order)
@@ -213,7 +213,7 @@ def draw_terms_before_after(variable_before: Variable, variable_after: Variable,
     # the same term keeps its colour in both: colour by the after-term's position
     order = {c.name: i for i, c in enumerate(after.curves)}
     extra = len(order)
-    for i, c in enumerate(before.curves):
+    for c in before.curves:
         if c.name not in order:
             order[c.name] = extra
             extra += 1

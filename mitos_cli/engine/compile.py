@@ -22,10 +22,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..fuzzy.shapes import kernel_params
 from ..lang import operators as ops_mod
 from ..lang.model import And, Expr, Not, Prop, Rule, RuleBase, Setting, Use, flatten, format_rule
 from ..lang.operators import Operators
-from ..fuzzy.shapes import kernel_params
 from ..lang.terms import Term, Variable
 
 ZERO, ONE = 0, 1
@@ -136,7 +136,7 @@ class CompiledRuleBase:
         return format_rule(self.rules[r], label=False)
 
     @functools.cached_property
-    def plan(self) -> "Plan":
+    def plan(self) -> Plan:
         """Everything the engine's hot path needs, precomputed once."""
         return _plan(self)
 
@@ -201,7 +201,7 @@ class Grid:
     shape: tuple[int, ...]
 
 
-def _grid(group: NodeGroup, c: "CompiledRuleBase") -> Grid | None:
+def _grid(group: NodeGroup, c: CompiledRuleBase) -> Grid | None:
     """The group as a :class:`Grid`, or ``None`` when it is not one."""
     T = c.n_terms
     ch = group.children
@@ -232,7 +232,7 @@ def _grid(group: NodeGroup, c: "CompiledRuleBase") -> Grid | None:
     return Grid(tuple(axes), slice(int(out[0]), int(out[-1]) + 1), shape)
 
 
-def _plan(c: "CompiledRuleBase") -> Plan:
+def _plan(c: CompiledRuleBase) -> Plan:
     rows = np.flatnonzero(c.linear)
     r0 = int(c.rule_col[0]) if c.n_rules else 2
     contiguous = bool((c.rule_col == np.arange(r0, r0 + c.n_rules)).all())

@@ -6,8 +6,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..fuzzy import hedges as hedge_mod
-from .compile import CompiledRuleBase
 from ..words import plural
+from .compile import CompiledRuleBase
 
 INFERENCE_TEXT = {
     "weighted_average": "weighted average of the rules' consequents, sum(dof y) / sum(dof) "

@@ -14,11 +14,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..errors import InputError, NoRuleFiredError
 from ..fuzzy import hedges as hedge_mod
 from ..fuzzy import norms
-from .compile import CompiledRuleBase
-from ..errors import InputError, NoRuleFiredError
 from ..fuzzy.shapes import SHAPES
+from .compile import CompiledRuleBase
 
 
 @dataclass(frozen=True, eq=False)   # holds arrays: identity, not ==

@@ -33,15 +33,15 @@ the sampled work scales with the number of distinct consequent sets, not of rule
 S-norms reduce the ``[rules, samples, resolution]`` stack by a pairwise tree (log2 R vectorized
 steps). Samples are processed in sub-blocks so that no intermediate array exceeds
 :data:`MAX_BYTES` (when one sample's stack alone exceeds :data:`MAX_STACK_BYTES`, its rules
-are taken in chunks, joined by the same S-norm). Everything is elementwise per sample or a reduction along one sample's own
+are taken in chunks, joined by the same S-norm). Everything is elementwise per sample or a reduction
+along one sample's own
 row, so a single evaluation is bit for bit its row in a batch.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
-
-from typing import Callable
 
 import numpy as np
 
@@ -163,7 +163,7 @@ def defuzzify(Y: np.ndarray, x: np.ndarray, method: str) -> np.ndarray:
         np.divide(np.where(ties, x, 0.0).sum(axis=1), count, out=out, where=ok & (count > 0))
         return out
     top = Y.max(axis=1, keepdims=True)
-    peak = (Y > 0) & (Y == top)
+    peak = (Y > 0) & (top == Y)
     ok = peak.any(axis=1)
     if method == "mom":
         np.divide(np.where(peak, x, 0.0).sum(axis=1), peak.sum(axis=1), out=out, where=ok)

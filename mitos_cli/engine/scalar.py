@@ -18,7 +18,8 @@ from __future__ import annotations
 
 import itertools
 import math
-from typing import TYPE_CHECKING, Callable
+from collections.abc import Callable
+from typing import TYPE_CHECKING
 
 from ..fuzzy.hedges import HEDGES as HEDGE_REGISTRY
 from ..fuzzy.norms import SNORMS, TNORMS

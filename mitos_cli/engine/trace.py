@@ -11,9 +11,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .evaluation import Result, declares_nan
 from ..resources import display_path
 from ..words import plural
+from .evaluation import Result, declares_nan
 
 
 @dataclass(frozen=True)

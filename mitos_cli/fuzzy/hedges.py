@@ -7,8 +7,8 @@ and cubes are products and the root is ``np.sqrt``, so they are exact and determ
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Callable
 
 import numpy as np
 

@@ -19,7 +19,7 @@ folds run in the same order, so the values agree bit for bit (tests/test_neurons
 
 from __future__ import annotations
 
-from typing import Callable
+from collections.abc import Callable
 
 import numpy as np
 

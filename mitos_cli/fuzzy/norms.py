@@ -12,8 +12,8 @@ names in FLL, ``.fis`` and FCL. Every consumer reads these fields; none keeps a 
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Callable
 
 import numpy as np
 

@@ -12,8 +12,8 @@ limits of the shape (1 under a shoulder, 0 elsewhere).
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Callable
 
 import numpy as np
 

@@ -78,7 +78,6 @@ def conversion_notes(rb: RuleBase, fmt: str, behavior: str | None = None) -> lis
     """What writing ``rb`` as ``fmt`` (``rules`` included) leaves out or changes; the file is
     written anyway and ``mitos convert`` prints these as warnings."""
     from ..lang.operators import resolve
-
     from .common import legal_names
 
     b = rb.behavior(behavior)

@@ -14,13 +14,13 @@ import math
 from dataclasses import dataclass
 from pathlib import Path
 
-from ..lang import operators as ops_mod
-from ..lang.resolve import MAIN, check_rule
 from ..errors import FormatError, MitosError, Span, did_you_mean
-from ..lang.model import And, Behavior, Consequent, Expr, Not, Or, Prop, Rule, RuleBase, Setting
 from ..fuzzy import norms as norm_registry
 from ..fuzzy.hedges import HEDGES, fuzzylite_names
 from ..fuzzy.shapes import SHAPES
+from ..lang import operators as ops_mod
+from ..lang.model import And, Behavior, Consequent, Expr, Not, Or, Prop, Rule, RuleBase, Setting
+from ..lang.resolve import MAIN, check_rule
 from ..lang.terms import Term, TermSet, Variable
 from ..words import plural
 

@@ -36,16 +36,16 @@ import numpy as np
 from lark import Lark, Token, Tree
 from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken
 
+from ..errors import FormatError, Span, did_you_mean
 from ..fuzzy import norms
 from ..lang.cache import lark_parser
-from ..errors import FormatError, Span, did_you_mean
 from ..lang.model import And, Not, Prop, Rule, RuleBase
-from ..lang.terms import Role, Term, Variable
-from . import common
 from ..lang.resolve import MAIN
+from ..lang.terms import Role, Term, Variable
+from ..words import plural
+from . import common
 from .common import FCL, FLL, fmt_number
 from .ruletree import conclusion, expression
-from ..words import plural
 
 DEFAULT_RESOLUTION = 1000
 
@@ -64,7 +64,7 @@ JFUZZY_SHAPES = {
 }
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def parser() -> Lark:
     from ..resources import grammar_text
 
@@ -217,7 +217,8 @@ def _function_block(fb: Tree, span_of) -> RuleBase:
                                                      if n in concluded])))
     for _, rules, settings in groups:
         concluded = {c.var for r in rules for c in r.consequents}
-        mine = (lambda n: n in concluded or len(groups) == 1)
+        def mine(n: str, concluded: set = concluded) -> bool:
+            return n in concluded or len(groups) == 1
         if settings.sugeno:
             for name, span in locks.items():
                 if mine(name):

@@ -31,9 +31,9 @@ from pathlib import Path
 from ..errors import FormatError, Span, did_you_mean
 from ..lang.model import And, Consequent, Or, Prop, Rule, RuleBase
 from ..lang.terms import Role, Term, Variable
+from ..words import plural
 from . import common
 from .common import FIS, Settings, fmt_number
-from ..words import plural
 
 DEFAULT_RESOLUTION = 101
 

@@ -29,11 +29,11 @@ from pathlib import Path
 from lark import Lark, Tree
 from lark.exceptions import UnexpectedInput
 
-from ..lang.resolve import MAIN
-from ..lang.cache import lark_parser
 from ..errors import FormatError, Span, did_you_mean
+from ..lang.cache import lark_parser
 from ..lang.model import Rule, RuleBase
 from ..lang.model import format_number as _fmt_weight
+from ..lang.resolve import MAIN
 from ..lang.terms import Role, Term, Variable
 from . import common
 from .common import FLL, Settings, fmt_number
@@ -52,7 +52,7 @@ KEYS = {
 DEFAULT_RESOLUTION = 1000     # fuzzylite's IntegralDefuzzifier.default_resolution
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def rule_parser() -> Lark:
     from ..resources import grammar_text
 

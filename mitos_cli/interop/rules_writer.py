@@ -37,8 +37,7 @@ def write_rules(rb: RuleBase, termset_name: str, behavior: str | None = None,
 
     A behavior that uses no other is written as top-level rules; one that does is written with
     the behaviors it uses (recursively) as ``behavior`` blocks, itself first (the default)."""
-    from ..lang.model import flatten
-    from ..lang.model import Use, format_use
+    from ..lang.model import Use, flatten, format_use
     from ..lang.operators import resolve
     from .common import legal_names
 

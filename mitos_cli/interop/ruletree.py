@@ -8,7 +8,7 @@ error points at the word in the file.
 
 from __future__ import annotations
 
-from typing import Callable
+from collections.abc import Callable
 
 from lark import Token, Tree
 

@@ -9,7 +9,6 @@ the rule language (``parse(format_rule(r)) == r``).
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Union
 
 from ..errors import Span
 from .terms import TermSet, Variable
@@ -30,23 +29,23 @@ class Prop:
 class Not:
     """``not (expr)``: the inhibitory input of eqs. 8-9, ``1 - x``."""
 
-    expr: "Expr"
+    expr: Expr
     span: Span | None = field(default=None, compare=False)
 
 
 @dataclass(frozen=True)
 class And:
-    items: tuple["Expr", ...]
+    items: tuple[Expr, ...]
     span: Span | None = field(default=None, compare=False)
 
 
 @dataclass(frozen=True)
 class Or:
-    items: tuple["Expr", ...]
+    items: tuple[Expr, ...]
     span: Span | None = field(default=None, compare=False)
 
 
-Expr = Union[Prop, Not, And, Or]
+Expr = Prop | Not | And | Or
 
 
 @dataclass(frozen=True)

@@ -9,8 +9,8 @@ from __future__ import annotations
 from dataclasses import dataclass, fields, replace
 from typing import Any
 
-from ..fuzzy import norms
 from ..errors import RuleBaseError, Span, unknown
+from ..fuzzy import norms
 from ..lang.model import Setting
 
 INFERENCES = ("weighted_average", "weighted_sum", "mamdani")

@@ -16,21 +16,22 @@ from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput
 
 from ..errors import RuleSyntaxError, Span
 from ..fuzzy.hedges import HEDGES
+from ..resources import grammar_text
 from .cache import lark_parser
 from .model import And, Behavior, Consequent, Not, Or, Prop, Rule, Setting, Use
-from ..resources import grammar_text
 
 HEDGE_NAMES = tuple(HEDGES)          # the grammar's HEDGE words (tests/test_registries.py)
 
 #: How terminals are named in error messages.
 TERMINAL_WORDS = {
     "NAME": "a name", "STRING": 'a quoted file name ("...")', "SIGNED_NUMBER": "a number",
-    "NOT": "`not`", "HEDGE": "a hedge (" + ", ".join(HEDGE_NAMES) + ")", "COLON": "`:`", "COMMA": "`,`", "EQUAL": "`=`", "LPAR": "`(`",
+    "NOT": "`not`", "HEDGE": "a hedge (" + ", ".join(HEDGE_NAMES) + ")", "COLON": "`:`",
+    "COMMA": "`,`", "EQUAL": "`=`", "LPAR": "`(`",
     "RPAR": "`)`", "$END": "the end of the input",
 }
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def parser() -> Lark:
     """The rule-language parser, built once per process (its analysis kept in :mod:`.cache`)."""
     return lark_parser(grammar_text(), propagate_positions=True, maybe_placeholders=True,

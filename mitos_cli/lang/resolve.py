@@ -9,9 +9,9 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from . import operators as ops_mod
 from ..errors import RuleBaseError, Span, TermSetError, unknown
 from ..fuzzy.hedges import HEDGES
+from . import operators as ops_mod
 from .model import And, Behavior, Consequent, Expr, Not, Or, Prop, Rule, RuleBase
 from .parse import ParsedFile, parse_rules
 from .termfile import load_termset

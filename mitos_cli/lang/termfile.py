@@ -31,12 +31,12 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from . import yamlpos
 from ..errors import Span, TermSetError, did_you_mean
 from ..fuzzy.shapes import SHAPES
+from ..words import plural
+from . import yamlpos
 from .terms import Term, TermSet, Variable, check_term
 from .yamlpos import YList, YMap
-from ..words import plural
 
 VARIABLE_KEYS = ("description", "unit", "role", "universe", "terms", "default")
 TRIANGLE_FORMS = {

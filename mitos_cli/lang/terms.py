@@ -74,7 +74,7 @@ class Term:
     def membership(self, x) -> np.ndarray:
         return self.kind.membership(x, self.params)
 
-    def with_params(self, params: tuple[float, ...]) -> "Term":
+    def with_params(self, params: tuple[float, ...]) -> Term:
         return replace(self, params=tuple(float(p) for p in params))
 
 
@@ -116,7 +116,7 @@ class Variable:
     def index(self, name: str) -> int:
         return self.term_names.index(name)
 
-    def with_terms(self, terms: tuple[Term, ...]) -> "Variable":
+    def with_terms(self, terms: tuple[Term, ...]) -> Variable:
         return replace(self, terms=terms)
 
 

@@ -10,7 +10,8 @@ that position and a "did you mean" for unknown keys.
 from __future__ import annotations
 
 import re
-from typing import Any, Iterable
+from collections.abc import Iterable
+from typing import Any
 
 import yaml
 

@@ -31,7 +31,8 @@ Modules: ``world`` (model), ``worldfile`` (YAML loader), ``pgm`` + ``gridmap`` (
 maps), ``staticmap`` (walls from corridors or grids), ``geometry``, ``kinematics`` (tricycle),
 ``sensors`` (ray casting), ``obstacles`` (motion, randomisation), ``route`` (A*),
 ``perception`` (readings -> rule inputs), ``planner`` (the planner protocol, FuzzyPlanner),
-``loop`` (the steppable ``Simulation`` and ``simulate``, a loop over its ticks), ``runs`` (many runs, process pool), ``export`` (CSV, traces),
+``loop`` (the steppable ``Simulation`` and ``simulate``, a loop over its ticks), ``runs`` (many
+runs, process pool), ``export`` (CSV, traces),
 ``live`` (terminal view). Drawing lives in ``mitos_cli.draw.world``.
 """
 

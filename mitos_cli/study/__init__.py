@@ -2,7 +2,7 @@
 
 | module | holds |
 | --- | --- |
-| `spec.py` | `Choice` (planner + T-norm / S-norm / inference), `Task`, `make_choices`, `expand`, paired seeds |
+| `spec.py` | `Choice` (planner + norms + inference), `Task`, `make_choices`, `expand`, paired seeds |
 | `simtask.py` | `run_task(context, task)`: one task through the simulator -> one flat result |
 | `executors.py` | `execute(fn, tasks, "local" / "dask", ...)`: serial, process pool, Dask |
 | `store.py` | `results.csv` written row by row (fsync), `--resume`, `study.json` |

@@ -5,10 +5,10 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
+from ..words import plural
 from .spec import Choice
 from .stats import Mean, Rate
 from .summary import ALL_WORLDS, METRICS, Rank, Summary
-from ..words import plural
 
 RATE_COLUMNS = (("success", "success"), ("collision", "collision"), ("timeout", "timeout"),
                 ("stuck", "stuck"))

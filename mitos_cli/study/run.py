@@ -9,9 +9,9 @@
 from __future__ import annotations
 
 import functools
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Callable
 
 from .executors import TaskFn, execute
 from .spec import Choice, Task, expand

@@ -16,10 +16,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..fuzzy import norms
 from ..errors import unknown
+from ..fuzzy import norms
 from ..lang.operators import INFERENCES
-
 from ..sim.planner import PLANNERS as _REGISTRY
 
 PLANNERS = tuple(_REGISTRY)      # the simulator's planner registry, in its order

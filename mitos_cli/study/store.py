@@ -13,12 +13,13 @@ import csv
 import io
 import json
 import os
+from collections.abc import Iterable
 from pathlib import Path
-from typing import Iterable, TextIO
+from typing import TextIO
 
 from ..errors import MitosError
-from .spec import KEY_FIELDS, Task
 from ..words import plural
+from .spec import KEY_FIELDS, Task
 
 #: what a run reports, in this order, after the key and the seed
 RESULT_FIELDS = ("outcome", "collisions", "time_s", "path_length_in", "min_clearance_in",
@@ -141,7 +142,8 @@ class ResultStore:
         write_atomic(self.manifest_path, json.dumps(manifest, indent=2) + "\n")
         if not rows:
             write_atomic(self.path, ",".join(COLUMNS) + "\n")
-        self._file = open(self.path, "a", encoding="utf-8", newline="")
+        # kept open across append() calls (one fsync'd line per finished run); close() closes it
+        self._file = open(self.path, "a", encoding="utf-8", newline="")  # noqa: SIM115
         return rows
 
     def append(self, row: dict) -> None:
@@ -159,7 +161,7 @@ class ResultStore:
             self._file.close()
             self._file = None
 
-    def __enter__(self) -> "ResultStore":
+    def __enter__(self) -> ResultStore:
         return self
 
     def __exit__(self, *exc) -> None:

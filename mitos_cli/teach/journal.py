@@ -189,7 +189,8 @@ class Journal:
 
 
 #: what each kind of entry must carry, and of which type
-FIELDS: dict[str, dict[str, type]] = {"start": {"rules": str, "behavior": str}, "rule": {"text": str, "behavior": str},
+FIELDS: dict[str, dict[str, type]] = {"start": {"rules": str, "behavior": str},
+                                      "rule": {"text": str, "behavior": str},
           "behavior": {"name": str}, "end": {}, "use": {"text": str},
           "frozen": {"labels": list, "behavior": str}, "operators": {"text": str,
                                                                     "behavior": str},

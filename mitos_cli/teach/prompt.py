@@ -11,6 +11,7 @@ leaves, and everything told is already in the journal.
 
 from __future__ import annotations
 
+import contextlib
 import sys
 from pathlib import Path
 
@@ -146,10 +147,8 @@ def interact(session: Session, history: Path | None = None) -> None:
                 continue
             try:                                 # Ctrl-C anywhere here keeps the session
                 if readline is not None and history is not None:
-                    try:
+                    with contextlib.suppress(OSError, AttributeError):
                         readline.append_history_file(1, str(history))
-                    except (OSError, AttributeError):
-                        pass
                 if not session.run(line, PROMPT, lineno):
                     break
             except MitosError as exc:
