@@ -95,8 +95,8 @@ class FuzzyPlanner:
 
         inputs = percepts.inputs
         if len(percepts.pose) == 1:             # one robot: the scalar form, same bits
-            out = evaluate_one(self.compiled, [float(inputs[k][0]) for k in self.compiled.inputs])
-            return np.array([out[self._cols[0]]]), np.array([out[self._cols[1]]])
+            one = evaluate_one(self.compiled, [float(inputs[k][0]) for k in self.compiled.inputs])
+            return np.array([one[self._cols[0]]]), np.array([one[self._cols[1]]])
         out = evaluate(self.compiled, self.matrix(inputs), detail=False).outputs
         return out[:, self._cols[0]], out[:, self._cols[1]]
 

@@ -140,8 +140,8 @@ def corridor_route(corridors: tuple[Corridor, ...], start: Pose, goal: Goal) -> 
                 splits[i].add(min(max(t, 0.0), 1.0))
                 splits[j].add(min(max(u, 0.0), 1.0))
     ends = []
-    for p in ((start.x, start.y), (goal.x, goal.y)):
-        p = np.asarray(p, float)
+    for xy in ((start.x, start.y), (goal.x, goal.y)):
+        p = np.asarray(xy, float)
         best = None
         for i, (a, b, _) in enumerate(segs):
             e = b - a
@@ -149,6 +149,9 @@ def corridor_route(corridors: tuple[Corridor, ...], start: Pose, goal: Goal) -> 
             dist = float(np.hypot(*(a + t * e - p)))
             if best is None or dist < best[0]:
                 best = (dist, i, t)
+        if best is None:
+            raise WorldError("the map has no corridors to route along",
+                             hint="add `corridors: [{points: [[0, 0], [600, 0]], width: 70}]`")
         splits[best[1]].add(best[2])
         ends.append(best)
     keys: dict[tuple, int] = {}
@@ -241,6 +244,7 @@ def _simplify(points: np.ndarray, tol: float, clearance: Clearance | None = None
         k = int(np.argmax(d))
         split = d[k] > tol
         if not split and own is not None:
+            assert clearance is not None        # `own` is measured only with a clearance
             need = min(asked, float(own[i:j].min()))
             split = clearance.along(a, b) < need
             if split and d[k] <= 1e-9:
@@ -302,6 +306,7 @@ def grid_route(static: StaticMap, start: Pose, goal: Goal, clearance: float,
     within this many inches of the start, any node off the occupied cells is open (a robot
     that replans beside what it is passing must be able to move off)."""
     g = static.grid
+    assert g is not None        # callers plan on a grid (plan_route checks; the rest build one)
     occ = g.occupied if occupied is None else occupied
     reach = clearance + 36.0           # in: beyond this from the walls, the middle is as good
     field = Clearance.of(occ, g.resolution, g.origin, cap=reach + 2 * g.resolution)

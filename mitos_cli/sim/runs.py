@@ -57,7 +57,7 @@ class WorldRuns:
 
     def figures(self) -> dict:
         """Each outcome's rate and each metric's mean and std over the runs."""
-        row = {f"{o}_rate": self.rate(o) for o in OUTCOMES}
+        row: dict[str, float | dict[str, float]] = {f"{o}_rate": self.rate(o) for o in OUTCOMES}
         for key in METRICS:
             mean, std = self.stat(key)
             row[key] = {"mean": mean, "std": std}

@@ -50,7 +50,7 @@ class _Reader:
                maximum: float | None = None) -> float:
         if key not in m:
             if default is None:
-                yamlpos.require(m, key, WorldError, what)
+                return yamlpos.require(m, key, WorldError, what)   # raises: `key` is missing
             return float(default)
         span = m.value_span(key)
         x = yamlpos.expect_number(m[key], span, WorldError, f"`{key}` in {what}")
@@ -67,7 +67,8 @@ class _Reader:
     def point(self, value: Any, span: Span, what: str) -> tuple[float, float]:
         if not isinstance(value, list) or len(value) != 2:
             raise WorldError(f"{what} must be a point [x, y] (inches)", span=span)
-        return tuple(yamlpos.expect_number(v, span, WorldError, what) for v in value)
+        x, y = (yamlpos.expect_number(v, span, WorldError, what) for v in value)
+        return x, y
 
     def points(self, value: Any, span: Span, what: str, least: int) -> tuple:
         if not isinstance(value, list) or len(value) < least:
@@ -80,7 +81,7 @@ class _Reader:
                default: str | None = None) -> str:
         if key not in m:
             if default is None:
-                yamlpos.require(m, key, WorldError, what)
+                return yamlpos.require(m, key, WorldError, what)   # raises: `key` is missing
             return default
         value = str(m[key])
         if value not in options:
