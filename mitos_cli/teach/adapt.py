@@ -554,9 +554,9 @@ def kernel_of(p: Parameters, values: np.ndarray) -> np.ndarray:
     """The compiled kernel ``[4, T]`` with the input terms' corners taken from ``values``."""
     kernel = p.compiled.kernel.copy()
     for t in np.flatnonzero((p.corner_knot >= 0).any(axis=1)):
-        corners = tuple(float(values[i]) if i >= 0 else orig for i, orig in
-                        zip(p.corner_knot[t], _orig_corners(p, t)))
-        kernel[:, t] = kernel_params(corners)
+        a, b, c, d = (float(values[i]) if i >= 0 else orig for i, orig in
+                      zip(p.corner_knot[t], _orig_corners(p, t)))
+        kernel[:, t] = kernel_params((a, b, c, d))
     return kernel
 
 
@@ -584,6 +584,7 @@ def output_tables(p: Parameters, values: np.ndarray) -> tuple[OutputTable, ...]:
     c = p.compiled
     ops = c.operators
     tables = []
+    assert p.sets is not None                        # its one caller checks: a Mamdani behavior
     for j, spec in enumerate(p.sets):
         var = c.variables[c.outputs[j]]
         lo, hi = var.universe
@@ -678,6 +679,7 @@ def difference_gradient(p: Parameters, values: np.ndarray, X: np.ndarray,
     c = with_values(p, values)
     res = evaluate(c, X, strict=False)
     Q = _q(res.outputs, targets)
+    assert res.dof is not None                       # detail=True, the default, keeps them
     dof = res.dof.T                                  # [R, n]
     Xc = res.inputs
     h = difference_steps(p)
@@ -709,6 +711,7 @@ def gradient(p: Parameters, values: np.ndarray, X: np.ndarray,
         return difference_gradient(p, values, X, targets)
     c = with_values(p, values)
     res = evaluate(c, X, keep_values=True, strict=False)
+    assert res.values is not None and res.dof is not None    # keep_values, detail (default)
     V = res.values.T                                 # [cols, n]
     Xt = res.inputs.T                                # [k, n] clamped
     n = V.shape[1]

@@ -386,7 +386,8 @@ def _syntax_error(exc: UnexpectedInput, text: str, path: str) -> RuleSyntaxError
     """Lark's exception in words: never ``$END`` or ``Token(...)``."""
     lines = text.splitlines() or [""]
     if isinstance(exc, UnexpectedCharacters):
-        char = text[exc.pos_in_stream] if exc.pos_in_stream < len(text) else ""
+        pos: int = exc.pos_in_stream  # type: ignore[assignment]  # lark declares None; the lexer sets an int
+        char = text[pos] if pos < len(text) else ""
         message = f"unexpected character `{char}`" if char.isprintable() else \
             f"unexpected character {char!r}"
         return RuleSyntaxError(message, span=Span.in_text(text, path, exc.line, exc.column),
@@ -400,7 +401,9 @@ def _syntax_error(exc: UnexpectedInput, text: str, path: str) -> RuleSyntaxError
         return RuleSyntaxError("the line ends too early",
                                span=Span.in_text(text, path, line, column),
                                expected=_expected(expected), hint=_eof_hint(text))
+    assert isinstance(exc, UnexpectedToken)      # the third kind, after the two above
     token: Token = exc.token
+    assert token.line is not None and token.column is not None   # the lexer places its tokens
     span = Span.in_text(text, path, token.line, token.column,
                         token.column + max(1, len(str(token.value))))
     hint = None

@@ -66,7 +66,7 @@ def save_rulebase(original: RuleBase, current: RuleBase, target: Path) -> Saved:
                           f"language only", hint="save to a `.rules` file after converting it")
     targets = termset_targets(target, src, original.termset_paths)
     changes: list[str] = []
-    texts = []
+    texts: list[tuple[Path, str | bytes]] = []
     for ts_old, ts_new, rel, dest in zip(original.termsets, current.termsets,
                                         original.termset_paths, targets):
         text = (src.parent / rel).read_text(encoding="utf-8")
@@ -173,7 +173,9 @@ def _rule_place(tree: Tree) -> tuple[str, tuple[int, int, dict]]:
         if isinstance(child, Tree) and child.data == "crisp_consequent":
             var = str(child.children[0])
             number = child.children[1]
+            assert isinstance(number, Tree)        # the grammar: `NAME "is" number`
             tok = number.children[0]
+            assert isinstance(tok, Token)          # the grammar: `number: SIGNED_NUMBER`
             crisp[var] = (tok.start_pos, tok.end_pos)
     return label, (tree.meta.start_pos, tree.meta.end_pos, crisp)
 
@@ -223,6 +225,7 @@ def edit_rules(text: str, path: str, original: RuleBase, current: RuleBase,
         import json
 
         if json.loads(str(tok)) != name:
+            assert tok.start_pos is not None and tok.end_pos is not None  # the lexer's tokens
             edits.append((tok.start_pos, tok.end_pos, '"' + name + '"'))
     appended: list[str] = []
     old_behaviors = {b.name: b for b in original.behaviors}
@@ -243,11 +246,16 @@ def edit_rules(text: str, path: str, original: RuleBase, current: RuleBase,
                 continue
             if before == rule:
                 continue
+            if place is None or rule.label not in place.rules:    # the file changed since
+                raise LessonError(f"{path} changed since the lesson began: rule "
+                                  f"`{rule.label}` of behavior {b.name} is no longer there",
+                                  hint="start the lesson again on the file as it is now")
             start, end, crisp = place.rules[rule.label]
             if _only_crisp_changed(before, rule) and all(c.var in crisp for c in rule.consequents
                                                          if c.term is None):
                 for c_old, c_new in zip(before.consequents, rule.consequents):
                     if c_old.value != c_new.value:
+                        assert c_new.value is not None   # same terms, so a crisp value changed
                         s, e = crisp[c_new.var]
                         edits.append((s, e, format_number(c_new.value)))
             else:

@@ -26,6 +26,7 @@ import math
 import re
 from collections.abc import Callable
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -39,6 +40,9 @@ from . import commands as cmd
 from . import text
 from .journal import Journal, MemoryJournal
 from .state import State, apply, files_digest, learned_changes, variables
+
+if TYPE_CHECKING:
+    from .simulation import Recording
 
 
 def _canonical(expr: Expr) -> str:
@@ -73,7 +77,7 @@ class Session:
         active = behavior or self.original.default_behavior
         self.original.behavior(active)              # unknown behavior: did you mean
         self.start_behavior = active
-        self.simulation = None
+        self.simulation: Recording | None = None
         self.base: Path | None = None       # where a lesson's relative world paths start
         self.saved_seq = 0
         self.state = State(self.original, active)
@@ -388,7 +392,7 @@ class Session:
         self._add_window(compiled, rec, rows[keep], [inputs[i] for i in keep],
                          [{ins.output: float(wanted[i])} for i in keep], line)
 
-    def _recording(self):
+    def _recording(self) -> Recording:
         if self.simulation is None:
             raise LessonError("no simulation to correct yet",
                               hint="run `simulate WORLD` first, then `at 12.5s steering=55`")

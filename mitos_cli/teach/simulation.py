@@ -9,12 +9,16 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..errors import LessonError
 from ..lang.model import RuleBase
 from ..words import plural
+
+if TYPE_CHECKING:
+    from ..sim.loop import SimResult
 
 
 def world_path(name: str, base: Path | None = None) -> Path:
@@ -32,7 +36,7 @@ class Recording:
 
     name: str
     behavior: str
-    result: object                     # mitos_cli.sim.SimResult
+    result: SimResult
     robot: int = 0                     # the column of the robot whose run is corrected
     robot_name: str = ""
 
