@@ -1,4 +1,5 @@
-"""The machine checks of how the code is kept: the import layers (pyproject's contract)."""
+"""The machine checks of how the code is kept (pyproject.toml holds each one's settings): ruff's
+rule set, mypy at the documented strictness, and the import-layer contract."""
 
 from __future__ import annotations
 
@@ -22,3 +23,14 @@ def test_stages_import_only_downward():
     out = run("lint-imports")
     assert out.returncode == 0, out.stdout[-3000:] + out.stderr[-2000:]
     assert "1 kept, 0 broken" in out.stdout
+
+
+def test_ruff_finds_nothing():
+    out = run("ruff", "check", "mitos_cli", "tests", "benchmarks")
+    assert out.returncode == 0, out.stdout[-4000:] + out.stderr[-2000:]
+
+
+def test_mypy_finds_nothing_in_the_package():
+    out = run("mypy")                      # files and strictness: [tool.mypy]
+    assert out.returncode == 0, out.stdout[-4000:] + out.stderr[-2000:]
+    assert "Success: no issues found" in out.stdout

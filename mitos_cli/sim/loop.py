@@ -169,6 +169,7 @@ class SimResult:
 
 def _stop_ticks(res: SimResult) -> np.ndarray:
     """``[n]`` ticks each robot drove: to the tick it stopped at its goal, else the whole run."""
+    assert res.active is not None, "Simulation.result() records who was active"
     stopped = ~res.active.reshape(res.ticks, len(res.robot_outcomes))
     return np.where(stopped.any(axis=0), stopped.argmax(axis=0) + 1, res.ticks)
 
@@ -705,6 +706,7 @@ def true_inputs(res: SimResult) -> dict[str, np.ndarray]:
     route for the road, exact obstacle and robot outlines for the obstruction and the side
     gaps), name -> ``[T, n]``."""
     world, static = res.world, res.static
+    assert static is not None and res.progress is not None, "Simulation.result() records both"
     agents = world.agents
     n = len(agents)
     robots = [a.robot for a in agents]

@@ -12,13 +12,12 @@ from __future__ import annotations
 import functools
 import json
 from dataclasses import dataclass, field
-from typing import Union
 
 from lark import Lark, Token, Tree, v_args
 from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken
 
-from ..lang.cache import lark_parser
 from ..errors import RuleSyntaxError, Span
+from ..lang.cache import lark_parser
 from ..lang.model import Rule, Setting, Use
 from ..lang.parse import TERMINAL_WORDS, _ToModel, check_nesting, shift
 from ..resources import grammar_text
@@ -191,9 +190,9 @@ class Quit:
     pass
 
 
-Command = Union[TellRule, TellUse, TellFrozen, TellOperators, OpenBehavior, CloseBehavior, Eval,
-                Correct, Simulate, At, Adapt, Show, Undo, Save, Help, Quit, FreezeTerms,
-                ReleaseTerms, CorrectSaid, AtSaid, AtInstruction]
+Command = (TellRule | TellUse | TellFrozen | TellOperators | OpenBehavior | CloseBehavior | Eval
+           | Correct | Simulate | At | Adapt | Show | Undo | Save | Help | Quit | FreezeTerms
+           | ReleaseTerms | CorrectSaid | AtSaid | AtInstruction)
 
 
 class _ToCommand(_ToModel):
