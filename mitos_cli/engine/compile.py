@@ -316,8 +316,7 @@ def compile_rulebase(rb: RuleBase, behavior: str | None = None,
     """
     name = behavior or rb.default_behavior
     b = rb.behavior(name)
-    operators = ops_mod.resolve(overrides, ops_mod.resolve(b.operators,
-                                                           ops_mod.resolve(rb.operators)))
+    operators = ops_mod.of_behavior(rb, b, tuple(overrides))
     flat = flatten(rb, name)
     if not flat:
         from ..errors import RuleBaseError

@@ -77,7 +77,7 @@ def write_foreign(rb: RuleBase, fmt: str, behavior: str | None = None) -> str:
 def conversion_notes(rb: RuleBase, fmt: str, behavior: str | None = None) -> list[str]:
     """What writing ``rb`` as ``fmt`` (``rules`` included) leaves out or changes; the file is
     written anyway and ``mitos convert`` prints these as warnings."""
-    from ..lang.operators import resolve
+    from ..lang.operators import of_behavior
     from .common import legal_names
 
     b = rb.behavior(behavior)
@@ -91,7 +91,7 @@ def conversion_notes(rb: RuleBase, fmt: str, behavior: str | None = None) -> lis
         from .fis import notes
 
         return out + notes(rb, behavior)
-    ops = resolve(b.operators, resolve(rb.operators))
+    ops = of_behavior(rb, b)
     if fmt in ("fcl", "fll") and ops.inference == "mamdani" and ops.sampling != "midpoints":
         out.append(f"{fmt.upper()} Mamdani outputs are sampled at cell midpoints (fuzzylite's "
                    f"rule); this rule base samples at {ops.sampling} (MATLAB's), so results "

@@ -487,7 +487,7 @@ def flatten_for_export(rb: RuleBase, behavior: str | None = None, *,
 
     name = behavior or rb.default_behavior
     b = rb.behavior(name)
-    operators = ops_mod.resolve(b.operators, ops_mod.resolve(rb.operators))
+    operators = ops_mod.of_behavior(rb, b)
     rules = []
     for label, rule, uses in flatten(rb, name):
         w = rule.weight
@@ -743,7 +743,7 @@ def fidelity_settings(rb: RuleBase, engine: str, behavior: str | None = None
         raise FormatError(f"unknown engine `{engine}`", expected="one of " + ", ".join(FIDELITY),
                           hint=did_you_mean(engine, FIDELITY))
     b = rb.behavior(behavior)
-    ops = ops_mod.resolve(b.operators, ops_mod.resolve(rb.operators))
+    ops = ops_mod.of_behavior(rb, b)
     if ops.inference != "mamdani":
         return ()
     resolution, sampling = FIDELITY[engine]

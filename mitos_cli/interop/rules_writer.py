@@ -38,7 +38,7 @@ def write_rules(rb: RuleBase, termset_name: str, behavior: str | None = None,
     A behavior that uses no other is written as top-level rules; one that does is written with
     the behaviors it uses (recursively) as ``behavior`` blocks, itself first (the default)."""
     from ..lang.model import Use, flatten, format_use
-    from ..lang.operators import resolve
+    from ..lang.operators import of_behavior, resolve
     from .common import legal_names
 
     rb, _ = legal_names(rb, "rules")
@@ -64,7 +64,7 @@ def write_rules(rb: RuleBase, termset_name: str, behavior: str | None = None,
                                    if v.role == "input" and v.name in used_in),
                        tuple(v for v in rb.variables.values()
                              if v.role == "output" and v.name in used_out),
-                       tuple(rules), resolve(chosen.operators, resolve(rb.operators)))
+                       tuple(rules), of_behavior(rb, chosen))
     inputs = common.all_inputs(rb, flat)
     for v in inputs + flat.outputs:
         check_name(v.name, "variable")

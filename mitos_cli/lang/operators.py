@@ -11,7 +11,7 @@ from typing import Any
 
 from ..errors import RuleBaseError, Span, unknown
 from ..fuzzy import norms
-from ..lang.model import Setting
+from ..lang.model import Behavior, RuleBase, Setting
 
 INFERENCES = ("weighted_average", "weighted_sum", "mamdani")
 #: Mamdani implications: any T-norm (min and product are the classic ones; FLL files also use
@@ -107,3 +107,9 @@ def resolve(settings: tuple[Setting, ...], base: Operators | None = None) -> Ope
         change: dict[str, Any] = {KEYS[s.key]: _check(s.key, s.value, s.span)}  # field by name
         ops = replace(ops, **change)
     return ops
+
+
+def of_behavior(rb: RuleBase, behavior: Behavior, overrides: tuple[Setting, ...] = ()) -> Operators:
+    """A behavior's operators: the paper's defaults, then the file's ``operators:`` line, then
+    the behavior's own, then ``overrides`` (a study's choices)."""
+    return resolve(overrides, resolve(behavior.operators, resolve(rb.operators)))
