@@ -83,7 +83,7 @@ def draw_run(result, path: str | Path | None = None, *, footprint_every: float =
                                  closed=True, fill=False, edgecolor="#555555", lw=0.5))
         if len(pose) > 1:
             segs = np.stack([pose[:-1, :2], pose[1:, :2]], axis=1)
-            line = LineCollection(segs, cmap="viridis", linewidths=2.2)
+            line = LineCollection(list(segs), cmap="viridis", linewidths=2.2)
             line.set_array(speed[:-1])
             line.set_clim(0, vmax)
             ax.add_collection(line)

@@ -163,9 +163,9 @@ class RobotMap:
         s = np.arange(step, max_range + step, step)
         pts = origin + s[:, None, None] * dirs[None]              # [S, B, 2]
         row, col, inside = self.cells(pts.reshape(-1, 2))
-        occ = np.zeros(len(row), dtype=bool)
-        occ[inside] = self.occupied[row[inside], col[inside]]
-        occ = occ.reshape(len(s), len(dirs))
+        hit = np.zeros(len(row), dtype=bool)
+        hit[inside] = self.occupied[row[inside], col[inside]]
+        occ = hit.reshape(len(s), len(dirs))
         first = np.where(occ.any(axis=0), occ.argmax(axis=0), -1)
         return np.where(first >= 0, np.minimum(s[np.maximum(first, 0)] - step / 2, max_range),
                         max_range)

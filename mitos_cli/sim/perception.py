@@ -214,7 +214,7 @@ def clutter(hits: np.ndarray, unknown: np.ndarray, ah: np.ndarray, cfg: Settings
     joined = seen & np.roll(seen, 1) & close       # point i continues the run of point i - 1
     if not circular:
         joined[0] = False
-    return float(max(1, np.count_nonzero(seen & ~joined)))
+    return float(max(1, int(np.count_nonzero(seen & ~joined))))
 
 
 def _walls(a, b, valid, robot: Robot, cfg: Settings, far: float,

@@ -106,7 +106,7 @@ class StaticMap:
             out = np.zeros(len(points), dtype=bool)
             out[inside] = ~g.occupied[row[inside], col[inside]]
             return out
-        return points_in_polygon(points, self.rects).any(axis=1)
+        return np.asarray(points_in_polygon(points, self.rects).any(axis=1))
 
     def near(self, x: float, y: float, reach: float) -> np.ndarray:
         """The walls whose bounding box comes within ``reach`` of (x, y)."""

@@ -553,7 +553,7 @@ def _constraints(P: int, frozen: np.ndarray, sym_rows) -> tuple[np.ndarray, tupl
 def kernel_of(p: Parameters, values: np.ndarray) -> np.ndarray:
     """The compiled kernel ``[4, T]`` with the input terms' corners taken from ``values``."""
     kernel = p.compiled.kernel.copy()
-    for t in np.flatnonzero((p.corner_knot >= 0).any(axis=1)):
+    for t in np.flatnonzero((p.corner_knot >= 0).any(axis=1)).tolist():
         a, b, c, d = (float(values[i]) if i >= 0 else orig for i, orig in
                       zip(p.corner_knot[t], _orig_corners(p, t)))
         kernel[:, t] = kernel_params((a, b, c, d))
@@ -755,7 +755,7 @@ def gradient(p: Parameters, values: np.ndarray, X: np.ndarray,
     rows = np.flatnonzero((p.corner_knot >= 0).any(axis=1))
     if rows.size:
         corners = np.array([[values[i] if i >= 0 else o for i, o in
-                             zip(p.corner_knot[t], _orig_corners(p, t))] for t in rows])
+                             zip(p.corner_knot[t], _orig_corners(p, t))] for t in rows.tolist()])
         dmu = _membership_grad(corners, Xt[c.term_var[rows]])      # [4, t, n]
         gmu = G[2 + rows]                                           # [t, n]
         gcorner = np.einsum("ctn,tn->tc", dmu, gmu)                 # [t, 4]
@@ -895,7 +895,7 @@ def descent_direction(p: Parameters, values: np.ndarray, grad: np.ndarray) -> np
         for k, ids in enumerate(p.order):
             close = np.diff(values[ids]) - _need(p, ids, k) <= tol[ids[1:]]
             closing = np.diff(d[ids]) < 0
-            for k in np.flatnonzero(close & closing):
+            for k in np.flatnonzero(close & closing).tolist():
                 row = np.zeros(len(values))
                 row[ids[k]], row[ids[k + 1]] = -1.0, 1.0
                 rows.append(row)

@@ -184,7 +184,7 @@ def rule_view(compiled: CompiledRuleBase, values: dict[str, float]) -> RuleView:
 
     fired = np.flatnonzero(dof > 0)
     rows = []
-    for r in fired:
+    for r in fired.tolist():
         rule = compiled.rules[r]
         props = []
         for prop, inverted in props_of(rule.antecedent):
