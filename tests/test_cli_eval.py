@@ -22,6 +22,7 @@ import pytest
 from mitos_cli import load_rulebase
 from mitos_cli.cli.app import main
 from mitos_cli.engine.csvio import read_batch
+from mitos_cli.errors import InputError
 
 ROOT = Path(__file__).resolve().parents[1]
 GOLDEN = ROOT / "tests" / "golden"
@@ -110,7 +111,9 @@ def test_batch_warns_about_clamping(capsys, tmp_path):
 
 @pytest.mark.parametrize("text, message", [
     ("", "the batch CSV is empty"),
-    ("road,size,positon\n1,2,3\n", "batch column `positon` is not an input of this behavior"),
+    ("road,size,positon\n1,2,3\n", "column `positon` is passed through as it is: did you mean "
+                                     "`position`?"),
+    ("road,size,road\n1,2,3\n", "batch column `road` is named twice (columns 1 and 3)"),
     ("road,size\n1,2\n", "the batch CSV has no column for position"),
     ("road,size,position\n1,2\n", "row has 2 values, the header 3"),
     ("road,size,position\n1,2,x\n", "`x` is not a number"),
@@ -121,6 +124,75 @@ def test_batch_errors(capsys, tmp_path, text, message):
     csv.write_text(text, encoding="utf-8")
     code, out, err = run_main(["eval", "--batch", str(csv)], capsys)
     assert code == 1 and message in err and out == ""
+
+
+def test_batch_passes_other_columns_through(capsys, tmp_path):
+    """Columns that are not inputs come out after the outputs as they went in (text, quotes,
+    empty cells); one named like an output is written as `given_NAME`."""
+    csv = tmp_path / "in.csv"
+    csv.write_text('id,road,size,note,position,steering\n'
+                   'a,78,45,"x, y",4,1\n'
+                   'b,100,65,,18,2\n', encoding="utf-8")
+    code, out, err = run_main(["eval", "--batch", str(csv)], capsys)
+    assert code == 0
+    assert "`steering` as `given_steering`" in err
+    lines = out.splitlines()
+    assert lines[0] == "road,size,position,steering,speed,id,note,given_steering"
+    assert lines[1].startswith("78,45,4,65.4112554113,32.4242424242,")
+    assert lines[1].endswith(',a,"x, y",1') and lines[2].endswith(",b,,2")
+
+
+def test_batch_reads_a_simulate_out_csv(capsys, tmp_path):
+    """`simulate --out` feeds `eval --batch -b drive`: the outputs are the planner's commands."""
+    import csv as csvmod
+
+    run = tmp_path / "run.csv"
+    code, _, _ = run_main(["simulate", str(ROOT / "worlds" / "corridor.yaml"), "--out",
+                           str(run)], capsys)
+    assert code == 0
+    code, out, _ = run_main(["eval", "-b", "drive", "--batch", str(run)], capsys)
+    assert code == 0
+    given = list(csvmod.DictReader(run.open(encoding="utf-8")))
+    got = list(csvmod.DictReader(out.splitlines()))
+    assert len(got) == len(given) and got[0]["pose_heading_deg"] == given[0]["pose_heading_deg"]
+    for a, b in zip(given, got):
+        assert float(b["steering"]) == pytest.approx(float(a["cmd_steering"]), abs=1e-3)
+        assert b["given_steering"] == a["steering"] and b["fired"] == a["fired"]
+
+
+@pytest.mark.parametrize("text, message, where", [
+    ("road,size,position\n1,2,3\n4,,6\n", "input `size` is empty in row 2 (column 2)",
+     "in.csv:3:3"),
+    ("id,road,size,position\nx,1,2,3\n\n\"q, r\",4,5,\n", "input `position` is empty in row 2",
+     "in.csv:4:12"),
+    ("road,size,position\n1,nan,3\n", "input `size` is not a number (NaN) in row 1", "in.csv:2:3"),
+    ("road,size,position,id\n1,2,x,a\n", "`x` is not a number (input `position`, row 1)",
+     "in.csv:2:5"),
+])
+def test_batch_cell_errors_name_column_row_and_position(text, message, where):
+    with pytest.raises(InputError) as info:
+        read_batch(text, "in.csv", ("road", "size", "position"))
+    assert message in str(info.value.message) and str(info.value.span) == where
+
+
+def test_batch_unused_inputs_and_no_rule_still_work(capsys, tmp_path):
+    """Inputs the behavior's rules never test (`size`, `position`) are read and come out
+    passed through; `--on-no-rule` still adds its `no_rule` column last, after them."""
+    terms = (ROOT / "rulebases" / "mitos.terms.yaml").read_text(encoding="utf-8")
+    (tmp_path / "t.terms.yaml").write_text(terms, encoding="utf-8")
+    (tmp_path / "t.rules").write_text(
+        'terms "t.terms.yaml"\nif road is WIDE then speed is FAST\n', encoding="utf-8")
+    csv = tmp_path / "in.csv"
+    csv.write_text("road,size,position,id\n120,45,4,a\n10,1,2,b\n", encoding="utf-8")
+    code, out, _ = run_main(["eval", str(tmp_path / "t.rules"), "--batch", str(csv),
+                             "--on-no-rule", "nan"], capsys)
+    assert code == 0
+    lines = out.splitlines()
+    assert lines[0] == "road,speed,size,position,id,no_rule"
+    assert lines[1].endswith(",45,4,a,") and lines[2].endswith(",1,2,b,speed")
+    code, out, _ = run_main(["eval", str(tmp_path / "t.rules"), "--batch", str(csv),
+                             "--on-no-rule", "skip"], capsys)
+    assert code == 0 and out.splitlines()[1:] == [out.splitlines()[1]]
 
 
 def test_batch_error_positions():

@@ -5,6 +5,7 @@ from __future__ import annotations
 import csv
 import io
 import json
+import re
 from pathlib import Path
 
 import pytest
@@ -88,10 +89,29 @@ def test_out_writes_one_row_per_tick(short, tmp_path):
     rows = list(csv.DictReader(io.StringIO(out.read_text())))
     assert len(rows) == 60
     head = rows[0].keys()
-    for col in ["t", "x", "y", "heading", "speed", "steering", "range_0", "range_35",
+    for col in ["t", "x", "y", "pose_heading_deg", "speed", "steering", "range_0", "range_35",
                 "fired", *INPUTS, *(f"true_{k}" for k in INPUTS)]:
         assert col in head
     assert "follow_route/" in rows[0]["fired"]
+
+
+def test_out_columns_are_unique_and_documented(short, tmp_path):
+    """Every column of --out has one name (the robot's heading is `pose_heading_deg`, the rule
+    input `heading` the route's bearing) and a row in worlds/README.md's table."""
+    out = tmp_path / "run.csv"
+    assert run(short, "--out", out).exit_code == 0
+    header = out.read_text().splitlines()[0].split(",")
+    assert len(header) == len(set(header))
+    assert header.count("heading") == 1 and "pose_heading_deg" in header
+    rows = list(csv.DictReader(io.StringIO(out.read_text())))
+    assert float(rows[0]["pose_heading_deg"]) == pytest.approx(0.0, abs=1e-6)
+    readme = (Path(__file__).parents[1] / "worlds" / "README.md").read_text()
+    table = readme.split("## The `--out` CSV")[1].split("\n## ")[0]
+    documented = set(re.findall(r"^\| `([a-z_<>0-9.]+)`", table, flags=re.M))
+    for col in header:
+        name = ("range_<b>" if col.startswith("range_") else
+                "true_<input>" if col.startswith("true_") else col)
+        assert name in documented, col
 
 
 @pytest.mark.parametrize("suffix, magic", [(".png", b"\x89PNG"), (".svg", b"<?xml")])

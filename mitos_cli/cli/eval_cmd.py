@@ -81,7 +81,8 @@ def eval_command(
     as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
     batch: Annotated[Optional[str], typer.Option(
         "--batch", metavar="FILE.csv|-",
-        help="Evaluate every row of a CSV whose header names the inputs; write a CSV.")] = None,
+        help="Evaluate every row of a CSV whose header names the inputs; write a CSV of the "
+             "inputs, the outputs and the CSV's other columns as they were.")] = None,
     digits: Annotated[int, typer.Option(
         "--digits", min=0, max=12, help="Decimals in the trace (the paper prints 1).")] = 1,
     network: Annotated[bool, typer.Option(
@@ -157,7 +158,7 @@ def run_batch(rb, source: str, on_no_rule: NoRule | None = None) -> None:
     """Read the CSV, evaluate all rows as one batch, write inputs and outputs as CSV."""
     import numpy as np
 
-    from ..engine.csvio import read_batch, write_batch
+    from ..engine.csvio import passed_names, read_table, write_batch
 
     if source == "-":
         text, name = sys.stdin.read(), "<stdin>"
@@ -167,12 +168,21 @@ def run_batch(rb, source: str, on_no_rule: NoRule | None = None) -> None:
         except (OSError, UnicodeDecodeError) as exc:
             raise InputError(f"cannot read batch file `{source}`: "
                              f"{getattr(exc, 'strerror', None) or exc}") from None
-    X = read_batch(text, name, rb.compiled.inputs, unused_inputs(rb))
+    batch = read_table(text, name, rb.compiled.inputs, unused_inputs(rb))
+    X = batch.X
     result = rb.run(X, strict=False, detail=False)
     warn_clamped(result)
     Y, keep, flags = no_rule_policy(rb.compiled, result, on_no_rule or NoRule.default)
+    taken = (*rb.compiled.inputs, *rb.compiled.outputs, *(() if on_no_rule is None
+                                                         else ("no_rule",)))
+    extra = passed_names(batch.extra, taken)
+    renamed = [f"`{a}` as `{b}`" for a, b in zip(batch.extra, extra) if a != b]
+    if renamed:
+        warn("passed-through " + plural(len(renamed), "column") + " renamed, the output CSV "
+             "has columns of those names: " + ", ".join(renamed))
     write_batch(sys.stdout, rb.compiled.inputs, np.asarray(X)[keep],
-                rb.compiled.outputs, Y[keep], None if on_no_rule is None else flags[keep])
+                rb.compiled.outputs, Y[keep], None if on_no_rule is None else flags[keep],
+                extra, [c for c, k in zip(batch.cells, keep) if k])
 
 
 def no_rule_policy(compiled, result, policy: NoRule):

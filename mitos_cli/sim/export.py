@@ -31,16 +31,30 @@ def fired_text(detail, row: int, digits: int = 2) -> str:
     return " ".join(f"{c.labels[r]}={dof[r]:.{digits}f}" for r in order if dof[r] > 0)
 
 
+POSE_COLUMNS = ("tick", "t", "robot", "x", "y", "pose_heading_deg", "speed", "steering",
+                "cmd_steering", "cmd_speed", "clearance")
+"""The columns before the ranges: tick (count), t (s), robot (its name), x, y (in),
+pose_heading_deg (the robot's heading, deg CCW from +x), speed (in/s), steering (deg, 90
+straight), cmd_steering (deg), cmd_speed (in/s), clearance (in). ``pose_heading_deg`` is not
+the rule input ``heading`` (the route's bearing relative to the robot, positive right)."""
+
+
+def columns(beams: int) -> list[str]:
+    """Every column of :func:`write_csv`, in order, for a robot with ``beams`` range sensors;
+    each name is unique, and the rule inputs keep their rule-base names (worlds/README.md has
+    the table with units)."""
+    return (list(POSE_COLUMNS) + [f"range_{b}" for b in range(beams)] + list(INPUTS)
+            + [f"true_{k}" for k in INPUTS] + ["fired"])
+
+
 def write_csv(result: SimResult, planner, out) -> None:
-    """Columns: tick, t, robot, x, y, heading, speed, steering, cmd_steering, cmd_speed,
-    clearance, range_0.., every perceived input, true_<input>, fired (``label=DOF`` by DOF)."""
+    """One row per tick and active robot, columns :func:`columns` (``fired``: ``label=DOF``
+    by DOF)."""
     n = result.pose.shape[1]
     B = result.ranges.shape[2]
     details = [explain(result, planner, i) for i in range(n)]
     w = csv.writer(out, lineterminator="\n")
-    w.writerow(["tick", "t", "robot", "x", "y", "heading", "speed", "steering", "cmd_steering",
-                "cmd_speed", "clearance"] + [f"range_{b}" for b in range(B)] + list(INPUTS)
-               + [f"true_{k}" for k in INPUTS] + ["fired"])
+    w.writerow(columns(B))
     names = [a.name for a in result.world.agents]
     for k in range(result.ticks):
         for i in range(n):
@@ -81,8 +95,8 @@ def traces(result: SimResult, planner, every: int, digits: int = 1) -> str:
         if result.active is not None and not result.active[k, 0]:
             continue
         x, y, h = result.pose[k, 0]
-        head = (f"--- tick {k}, t = {result.t[k]:.2f} s: robot at ({x:.1f}, {y:.1f}) in, heading "
-                f"{h:.1f} deg, speed {result.speed[k, 0]:.1f} in/s, steering "
+        head = (f"--- tick {k}, t = {result.t[k]:.2f} s: robot at ({x:.1f}, {y:.1f}) in, pose "
+                f"heading {h:.1f} deg, speed {result.speed[k, 0]:.1f} in/s, steering "
                 f"{result.steering[k, 0]:.1f} deg, clearance {result.clearance[k, 0]:.1f} in")
         pt = "  perceived: " + ", ".join(f"{key} {result.perceived[key][k, 0]:.1f}"
                                          for key in INPUTS)
