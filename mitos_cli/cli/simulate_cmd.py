@@ -83,14 +83,15 @@ def _summary(res) -> str:
 def _runs_table(runs) -> str:
     """One row per world; under a world of several robots, one row per robot (its outcome
     rates and figures: the world's row counts a run a success only if every robot's was)."""
-    head = ["world", "runs", "success", "collision", "timeout", "stuck", "time s",
-            "path in", "min clear in", "speed in/s"]
+    outcomes = ["success", "collision", "timeout", "stuck"]
+    if any(w.robots for w in runs.worlds):         # a robot's own outcome may be `stopped`
+        outcomes.append("stopped")
+    head = ["world", "runs", *outcomes, "time s", "path in", "min clear in", "speed in/s"]
     rows = [head]
     for w in runs.worlds:
         for label, r in [(w.world, w)] + [(f"  {x.world}", x) for x in w.robots]:
             row = [label, str(len(r.summaries))]
-            row += [f"{100 * r.rate(o):.0f}%" for o in ("success", "collision", "timeout",
-                                                        "stuck")]
+            row += [f"{100 * r.rate(o):.0f}%" if o in r.outcomes else "-" for o in outcomes]
             for key in ("time_s", "path_length_in", "min_clearance_in", "mean_speed_in_s"):
                 mean, std = r.stat(key)
                 row.append(f"{mean:.1f}" if len(r.summaries) == 1 else f"{mean:.1f} ± {std:.1f}")

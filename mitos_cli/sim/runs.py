@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .loop import OUTCOMES, prepare, simulate
+from .loop import OUTCOMES, ROBOT_OUTCOMES, prepare, simulate
 from .world import World
 
 METRICS = ("time_s", "path_length_in", "min_clearance_in", "mean_speed_in_s",
@@ -37,6 +37,7 @@ class WorldRuns:
 
     world: str
     summaries: tuple[dict, ...]
+    outcomes: tuple[str, ...] = OUTCOMES       # whose rates figures() gives (a robot: + stopped)
 
     def rate(self, outcome: str) -> float:
         return sum(s["outcome"] == outcome for s in self.summaries) / len(self.summaries)
@@ -52,12 +53,13 @@ class WorldRuns:
         if not self.summaries or "robots" not in self.summaries[0]:
             return ()
         names = [r["name"] for r in self.summaries[0]["robots"]]
-        return tuple(WorldRuns(name, tuple(s["robots"][i] for s in self.summaries))
-                     for i, name in enumerate(names))
+        return tuple(WorldRuns(name, tuple(s["robots"][i] for s in self.summaries),
+                               ROBOT_OUTCOMES) for i, name in enumerate(names))
 
     def figures(self) -> dict:
         """Each outcome's rate and each metric's mean and std over the runs."""
-        row: dict[str, float | dict[str, float]] = {f"{o}_rate": self.rate(o) for o in OUTCOMES}
+        row: dict[str, float | dict[str, float]] = {f"{o}_rate": self.rate(o)
+                                                         for o in self.outcomes}
         for key in METRICS:
             mean, std = self.stat(key)
             row[key] = {"mean": mean, "std": std}
