@@ -31,6 +31,16 @@ def _chunk(task: tuple) -> list[dict]:
     return out
 
 
+def trail(res) -> dict:
+    """A ``measure`` for :func:`run_many` (``--runs N --plot``): where each robot drove (its
+    ``[x, y]`` while driving, the colliding tick included), each robot's outcome, and where the
+    obstacles started in this run, under the key ``trail`` (not part of the JSON)."""
+    paths = [res.pose[res.active[:, i], i, :2].tolist() for i in range(len(res.robot_outcomes))]
+    return {"trail": {"paths": paths, "robot_outcomes": list(res.robot_outcomes),
+                      "t_end": float(res.t[-1]) if len(res.t) else 0.0,
+                      "obstacles": res.obstacles[0].tolist() if len(res.obstacles) else []}}
+
+
 @dataclass(frozen=True)
 class WorldRuns:
     """One world's runs (or, from :attr:`robots`, one robot's: ``world`` is then its name)."""
