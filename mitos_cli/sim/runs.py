@@ -33,9 +33,12 @@ def _chunk(task: tuple) -> list[dict]:
 
 def trail(res) -> dict:
     """A ``measure`` for :func:`run_many` (``--runs N --plot``): where each robot drove (its
-    ``[x, y]`` while driving, the colliding tick included), each robot's outcome, and where the
-    obstacles started in this run, under the key ``trail`` (not part of the JSON)."""
-    paths = [res.pose[res.active[:, i], i, :2].tolist() for i in range(len(res.robot_outcomes))]
+    ``[x, y]`` while driving and where it stopped: the colliding or arriving tick), each robot's
+    outcome, and where the obstacles started in this run, under the key ``trail`` (not part of
+    the JSON)."""
+    drove = res.active.copy()
+    drove[1:] |= res.active[:-1]                # the tick it arrived at (no longer active)
+    paths = [res.pose[drove[:, i], i, :2].tolist() for i in range(len(res.robot_outcomes))]
     return {"trail": {"paths": paths, "robot_outcomes": list(res.robot_outcomes),
                       "t_end": float(res.t[-1]) if len(res.t) else 0.0,
                       "obstacles": res.obstacles[0].tolist() if len(res.obstacles) else []}}
