@@ -109,6 +109,48 @@ def test_one_robot_timing_out_times_the_run_out(rear_end):
     assert data["collisions"] == 0 and data["min_clearance_in"] > 0
 
 
+def test_a_robot_still_driving_when_another_collides_reads_stopped(rear_end):
+    """Not `timeout` (its time had not run out): the run ended for the other's collision."""
+    text = rear_end.read_text().replace("q_init: {x: 530, y: -15", "q_init: {x: 60, y: -15")
+    data = simulate(parse_world(text, "far.yaml")).summary()
+    assert [r["outcome"] for r in data["robots"]] == ["stopped", "collision"]
+    assert data["outcome"] == "collision" and data["time_s"] < 5
+    rows = json.loads(run(_write(rear_end, text), "--runs", 1, "--workers", 1, "--json"))
+    assert [(r["name"], r["stopped_rate"]) for r in rows[0]["robots"]] == \
+        [("robot", 1.0), ("second", 0.0)]
+    assert "stopped_rate" not in rows[0]             # the run's outcome is never `stopped`
+    table = run(_write(rear_end, text), "--runs", 1, "--workers", 1).splitlines()
+    assert table[0].split()[2:7] == ["success", "collision", "timeout", "stuck", "stopped"]
+    assert table[1].split()[6] == "-" and table[2].split()[6] == "100%"
+
+
+def test_a_robot_still_driving_when_another_is_stuck_reads_stopped(rear_end):
+    import numpy as np
+
+    from mitos_cli.sim.loop import STUCK_TIME, Simulation
+
+    class FirstStands:                               # robot 0 never moves: stuck after 6 s
+        name = "first-stands"
+
+        def plan(self, p):
+            speed = np.where(np.arange(len(p.pose)) == 0, 0.0, 10.0)
+            return np.full(len(p.pose), 90.0), speed
+
+    text = rear_end.read_text().replace("time_limit: 5", "time_limit: 20") \
+        .replace("velocity: [120, 0]", "velocity: [0, 0]")
+    sim = Simulation(parse_world(text, "stand.yaml"), planner=FirstStands())
+    while not sim.done:
+        sim.step()
+    assert sim.robot_outcomes == ("stuck", "stopped") and sim.outcome == "stuck"
+    assert sim.time < STUCK_TIME + 1
+
+
+def _write(path: Path, text: str) -> Path:
+    out = path.with_name("variant.yaml")
+    out.write_text(text, encoding="utf-8")
+    return out
+
+
 def test_runs_count_a_run_a_success_only_if_every_robot_succeeded(rear_end):
     rows = json.loads(run(rear_end, "--runs", 2, "--workers", 1, "--json"))
     (row,) = rows

@@ -83,14 +83,15 @@ def _summary(res) -> str:
 def _runs_table(runs) -> str:
     """One row per world; under a world of several robots, one row per robot (its outcome
     rates and figures: the world's row counts a run a success only if every robot's was)."""
-    head = ["world", "runs", "success", "collision", "timeout", "stuck", "time s",
-            "path in", "min clear in", "speed in/s"]
+    outcomes = ["success", "collision", "timeout", "stuck"]
+    if any(w.robots for w in runs.worlds):         # a robot's own outcome may be `stopped`
+        outcomes.append("stopped")
+    head = ["world", "runs", *outcomes, "time s", "path in", "min clear in", "speed in/s"]
     rows = [head]
     for w in runs.worlds:
         for label, r in [(w.world, w)] + [(f"  {x.world}", x) for x in w.robots]:
             row = [label, str(len(r.summaries))]
-            row += [f"{100 * r.rate(o):.0f}%" for o in ("success", "collision", "timeout",
-                                                        "stuck")]
+            row += [f"{100 * r.rate(o):.0f}%" if o in r.outcomes else "-" for o in outcomes]
             for key in ("time_s", "path_length_in", "min_clearance_in", "mean_speed_in_s"):
                 mean, std = r.stat(key)
                 row.append(f"{mean:.1f}" if len(r.summaries) == 1 else f"{mean:.1f} ± {std:.1f}")
@@ -98,6 +99,22 @@ def _runs_table(runs) -> str:
     widths = [max(len(r[i]) for r in rows) for i in range(len(head))]
     return "\n".join("  ".join(c.ljust(wd) if i == 0 else c.rjust(wd)
                                for i, (c, wd) in enumerate(zip(r, widths))) for r in rows)
+
+
+def _draw_runs(result, world, plot: Path):
+    """Every run's path in one picture (``--runs N --plot``); the runs without their trails
+    (which are the picture's, not the table's or the JSON's)."""
+    from dataclasses import replace
+
+    from ..draw.data.overlay import runs_overlay
+    from ..draw.runs import draw_runs
+    from ..sim.loop import prepare
+
+    (w,) = result.worlds
+    names = [a.name for a in world.agents]
+    draw_runs(runs_overlay(w.world, w.summaries, names), world, prepare(world), plot)
+    bare = tuple({k: v for k, v in s.items() if k != "trail"} for s in w.summaries)
+    return replace(result, worlds=(replace(w, summaries=bare),))
 
 
 def _write_text(path: Path, text: str) -> None:
@@ -129,7 +146,9 @@ def simulate_command(
         "--trace", help="Print the paper-style DOF trace every --every ticks.")] = False,
     every: Annotated[int, typer.Option("--every", min=1, help="Ticks between traces.")] = 20,
     plot: Annotated[Optional[Path], typer.Option(
-        "--plot", metavar="FILE.png|FILE.svg", help="Draw the run (world, obstacles, path).")] = None,
+        "--plot", metavar="FILE.png|FILE.svg",
+        help="Draw the run (world, obstacles, path); with --runs, every run's path in one "
+             "picture, coloured by outcome.")] = None,
     live: Annotated[bool, typer.Option("--live", help="Show a terminal view while it runs.")] = False,
     animate: Annotated[Optional[Path], typer.Option(
         "--animate", metavar="FILE.gif|FILE.mp4",
@@ -161,10 +180,13 @@ def simulate_command(
     names = worlds or [DEFAULT_WORLD]
     loaded = [load_world(resolve_world_path(n)) for n in names]
     many = len(loaded) > 1 or runs > 0
-    if many and (out or plot or trace or live or randomise or animate):
-        raise typer.BadParameter("--out, --plot, --animate, --trace, --live and --randomise "
+    if many and (out or trace or live or randomise or animate):
+        raise typer.BadParameter("--out, --animate, --trace, --live and --randomise "
                                  "work on one "
                                  "world and one run; drop --runs or give one world")
+    if plot is not None and len(loaded) > 1:
+        raise typer.BadParameter("--plot draws one world (with --runs, all its runs in one "
+                                 "picture); give one world", param_hint="--plot")
     if plot is not None:
         from ..draw.output import check_format
 
@@ -176,13 +198,18 @@ def simulate_command(
     planner = make_planner(planner_name, loaded[0], rulebase, behavior)
 
     if many:
-        from ..sim.runs import run_many
+        from ..sim.runs import run_many, trail
 
-        result = run_many(loaded, runs, seed, planner, workers)
+        result = run_many(loaded, runs, seed, planner, workers,
+                          measure=trail if plot is not None else None)
+        if plot is not None:
+            result = _draw_runs(result, loaded[0], plot)
         if as_json:
             emit(json.dumps(result.to_json(), indent=2))
         else:
             emit(_runs_table(result))
+        if plot is not None:
+            err(f"wrote picture of {len(result.worlds[0].summaries)} runs to {plot}")
         failed = any(s["outcome"] != "success" for w in result.worlds for s in w.summaries)
         if require and failed:
             raise typer.Exit(3)

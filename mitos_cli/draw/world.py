@@ -10,23 +10,20 @@ import numpy as np
 
 from .output import _matplotlib, finish, new_figure
 
+PAD = 20.0      # in round the map
 
-def draw_run(result, path: str | Path | None = None, *, footprint_every: float = 1.0,
-             show: bool = False):
-    """Draw ``result``; save to ``path`` (.png or .svg) and/or ``show``. Footprints every
-    ``footprint_every`` seconds. Returns the figure."""
-    _matplotlib()                      # a clear error, not a traceback, without matplotlib
+
+def map_axes(static, *, show: bool = False, extra_width: float = 1.6):
+    """A figure sized to the map and its axes with the map drawn: solid space grey, the free
+    grid cells and corridors white, the walls black. Returns ``(fig, ax)``."""
     from matplotlib.collections import LineCollection
-    from matplotlib.patches import Circle, Polygon
+    from matplotlib.patches import Polygon
 
-    from ..sim.geometry import rect_corners
-
-    world, static = result.world, result.static
     xmin, ymin, xmax, ymax = static.bounds
-    pad = 20.0
-    width, height = xmax - xmin + 2 * pad, ymax - ymin + 2 * pad
+    width, height = xmax - xmin + 2 * PAD, ymax - ymin + 2 * PAD
     scale = 9.0 / max(width, height)
-    fig = new_figure((max(4.0, width * scale + 1.6), max(3.0, height * scale + 0.8)), show=show)
+    fig = new_figure((max(4.0, width * scale + extra_width), max(3.0, height * scale + 0.8)),
+                     show=show)
     ax = fig.add_subplot(1, 1, 1)
     ax.set_aspect("equal")
     ax.set_facecolor("#d9d9d9")
@@ -40,6 +37,27 @@ def draw_run(result, path: str | Path | None = None, *, footprint_every: float =
         ax.add_patch(Polygon(corners, closed=True, facecolor="white", edgecolor="none"))
     ax.add_collection(LineCollection(static.walls.reshape(-1, 2, 2), colors="black",
                                      linewidths=1.2))
+    ax.set_xlim(xmin - PAD, xmax + PAD)
+    ax.set_ylim(ymin - PAD, ymax + PAD)
+    ax.set_xlabel("x (in)")
+    ax.set_ylabel("y (in)")
+    return fig, ax
+
+
+def draw_run(result, path: str | Path | None = None, *, footprint_every: float = 1.0,
+             show: bool = False):
+    """Draw ``result``; save to ``path`` (.png or .svg) and/or ``show``. Footprints every
+    ``footprint_every`` seconds. Returns the figure."""
+    _matplotlib()                      # a clear error, not a traceback, without matplotlib
+    from matplotlib.collections import LineCollection
+    from matplotlib.patches import Circle, Polygon
+
+    from ..sim.geometry import rect_corners
+
+    world, static = result.world, result.static
+    xmin, ymin, xmax, ymax = static.bounds
+    pad = PAD
+    fig, ax = map_axes(static, show=show)
     for route in result.routes:
         ax.plot(route.points[:, 0], route.points[:, 1], ls="--", lw=0.8, color="#4a78b5",
                 label="route" if route is result.routes[0] else None)

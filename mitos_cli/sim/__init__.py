@@ -8,6 +8,7 @@ API (everything in inches, seconds, degrees)::
     result = simulate(world)                       # packaged rule base, behavior world.behavior
     result = simulate(world, FuzzyPlanner("my.rules", "drive"), seed=3)
     result.outcome          # "success" | "collision" | "timeout" | "stuck"
+                            # (a robot's own, in result.robot_outcomes: also "stopped")
     result.summary()        # the --json dict: world, seed, outcome, reached_goal, collisions,
                             # time_s, path_length_in, min_clearance_in, mean_speed_in_s,
                             # steering_total_variation_deg, ticks (over all robots), and with

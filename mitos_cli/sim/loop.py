@@ -8,7 +8,8 @@ poses: :func:`true_inputs`); a robot whose footprint touches anything has collid
 the planner evaluates all active robots in one batch; the kinematics apply the steering-rate and
 acceleration limits and integrate in ``substeps`` exact arcs. The run ends in ``success`` (every
 robot at its goal), ``collision``, ``stuck`` (a robot moved less than ``STUCK_DISTANCE`` in
-``STUCK_TIME``) or ``timeout``.
+``STUCK_TIME``) or ``timeout``; a robot still driving when another's collision or stuck ends
+the run reads ``stopped`` in its own outcome.
 
 Randomness: ``SeedSequence(seed).spawn(1 + robots)``: the first stream randomises the world
 (only when asked, for ``--runs``), then one stream of sensor noise per robot.
@@ -39,6 +40,9 @@ STUCK_TIME = 6.0        # s
 STUCK_DISTANCE = 3.0    # in
 NEAR_SLACK = 24.0       # in: a robot's set of nearby walls is gathered again after this move
 OUTCOMES = ("success", "collision", "timeout", "stuck")
+# a robot's own outcome may also be `stopped`: still driving when another robot's collision or
+# stuck ended the run (the run's outcome is then that collision or stuck)
+ROBOT_OUTCOMES = (*OUTCOMES, "stopped")
 
 
 @dataclass(frozen=True)
@@ -498,14 +502,26 @@ class Simulation:
             self._collided = int(self._hit.sum())
             for i in np.flatnonzero(self._hit):
                 self._outcomes[i] = "collision"
+            self._stop_the_others()
             self._done = True
         elif not self._active.any():
             self._done = True
         else:
             self.act(s)
             self._k += 1
-            self._done = self._check_stuck() or self._k >= self.steps
+            if self._check_stuck():
+                self._stop_the_others()
+                self._done = True
+            else:
+                self._done = self._k >= self.steps
         return tick
+
+    def _stop_the_others(self) -> None:
+        """The run ends for one robot's collision or stuck: the robots still driving read
+        ``stopped`` (not ``timeout``: their time had not run out)."""
+        for i in np.flatnonzero(self._active):
+            if self._outcomes[i] == "timeout":
+                self._outcomes[i] = "stopped"
 
     def sense(self) -> _Sensed:
         """Obstacle places at this tick's time, every robot's beams (noise from its own

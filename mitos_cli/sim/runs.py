@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .loop import OUTCOMES, prepare, simulate
+from .loop import OUTCOMES, ROBOT_OUTCOMES, prepare, simulate
 from .world import World
 
 METRICS = ("time_s", "path_length_in", "min_clearance_in", "mean_speed_in_s",
@@ -31,12 +31,26 @@ def _chunk(task: tuple) -> list[dict]:
     return out
 
 
+def trail(res) -> dict:
+    """A ``measure`` for :func:`run_many` (``--runs N --plot``): where each robot drove (its
+    ``[x, y]`` while driving and where it stopped: the colliding or arriving tick), each robot's
+    outcome, and where the obstacles started in this run, under the key ``trail`` (not part of
+    the JSON)."""
+    drove = res.active.copy()
+    drove[1:] |= res.active[:-1]                # the tick it arrived at (no longer active)
+    paths = [res.pose[drove[:, i], i, :2].tolist() for i in range(len(res.robot_outcomes))]
+    return {"trail": {"paths": paths, "robot_outcomes": list(res.robot_outcomes),
+                      "t_end": float(res.t[-1]) if len(res.t) else 0.0,
+                      "obstacles": res.obstacles[0].tolist() if len(res.obstacles) else []}}
+
+
 @dataclass(frozen=True)
 class WorldRuns:
     """One world's runs (or, from :attr:`robots`, one robot's: ``world`` is then its name)."""
 
     world: str
     summaries: tuple[dict, ...]
+    outcomes: tuple[str, ...] = OUTCOMES       # whose rates figures() gives (a robot: + stopped)
 
     def rate(self, outcome: str) -> float:
         return sum(s["outcome"] == outcome for s in self.summaries) / len(self.summaries)
@@ -52,12 +66,13 @@ class WorldRuns:
         if not self.summaries or "robots" not in self.summaries[0]:
             return ()
         names = [r["name"] for r in self.summaries[0]["robots"]]
-        return tuple(WorldRuns(name, tuple(s["robots"][i] for s in self.summaries))
-                     for i, name in enumerate(names))
+        return tuple(WorldRuns(name, tuple(s["robots"][i] for s in self.summaries),
+                               ROBOT_OUTCOMES) for i, name in enumerate(names))
 
     def figures(self) -> dict:
         """Each outcome's rate and each metric's mean and std over the runs."""
-        row: dict[str, float | dict[str, float]] = {f"{o}_rate": self.rate(o) for o in OUTCOMES}
+        row: dict[str, float | dict[str, float]] = {f"{o}_rate": self.rate(o)
+                                                         for o in self.outcomes}
         for key in METRICS:
             mean, std = self.stat(key)
             row[key] = {"mean": mean, "std": std}

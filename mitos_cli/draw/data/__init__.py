@@ -11,7 +11,10 @@ matplotlib and without looking at pixels:
 - :func:`surface` -> :class:`Surface`: one output over a grid of one or two inputs with the
   others fixed, computed by the engine in one batch;
 - :func:`rule_view` -> :class:`RuleView`: for one input, the fired rules with the memberships
-  of their propositions, their DOFs and consequents, and each output's aggregate and result.
+  of their propositions, their DOFs and consequents, and each output's aggregate and result;
+- ``overlay.runs_overlay`` -> ``RunsOverlay``: many runs of one world, paths by outcome,
+  counts and collisions (``simulate --runs N --plot``; imported from its module, since it
+  reads the simulator's outcomes).
 
 Nothing here imports matplotlib or prints.
 """
