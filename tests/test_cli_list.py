@@ -55,3 +55,9 @@ def test_every_packaged_file_is_listed_by_a_name_the_commands_accept():
 ])
 def test_first_comment_line(text, expected):
     assert first_comment_line(text) == expected
+
+
+def test_an_argument_is_a_usage_error(capsys):
+    code, out, err = run_main(["list", "worlds"], capsys)
+    assert code == 2 and out == ""
+    assert "unexpected extra argument" in err.lower()
