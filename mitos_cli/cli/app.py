@@ -31,6 +31,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "compare": ("compare_cmd", "compare_command"),
     "simulate": ("simulate_cmd", "simulate_command"),
     "plot": ("plot_cmd", "plot_app"),
+    "list": ("list_cmd", "list_command"),
 }
 
 

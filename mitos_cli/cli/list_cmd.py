@@ -1,0 +1,102 @@
+"""``mitos list``: the packaged worlds, rule bases and lessons, a line each.
+
+A world is described by its ``name`` and the first line of its leading comment, a rule base by
+its behaviors, a lesson by the first line of its leading comment. Each is listed by the name
+the commands accept (``mitos simulate corridor``, ``--rulebase mitos.rules``,
+``--lesson wider-turn``).
+"""
+
+from __future__ import annotations
+
+import json
+from typing import Annotated
+
+import typer
+
+from .output import emit
+
+#: Each section: its title in the listing, where the files are and the suffix they end in.
+SECTIONS = {
+    "worlds": ("worlds (mitos simulate NAME)", "worlds", ".yaml"),
+    "rulebases": ("rule bases (--rulebase NAME)", "rulebases", ".rules"),
+    "lessons": ("lessons (mitos teach --lesson NAME)", "rulebases/lessons", ".lesson"),
+}
+
+
+def first_comment_line(text: str) -> str:
+    """The first line of the comment a file starts with, without its ``#``; ``...`` marks a
+    sentence that goes on in the next comment line. Empty when the file starts otherwise."""
+    lines = [line.strip() for line in text.splitlines()]
+    lines = [line for line in lines if line]
+    for i, line in enumerate(lines):
+        if not line.startswith("#"):
+            return ""
+        words = line.lstrip("#").strip()
+        if not words:
+            continue
+        after = lines[i + 1].lstrip("#").strip() if i + 1 < len(lines) and \
+            lines[i + 1].startswith("#") else ""
+        return words + " ..." if after and not words.endswith((".", "!", "?", ":")) else words
+    return ""
+
+
+def _world(path) -> dict:
+    from ..errors import WorldError
+    from ..lang import yamlpos
+
+    text = path.read_text(encoding="utf-8")
+    data = yamlpos.load(text, str(path), WorldError)
+    name = data.get("name") if isinstance(data, dict) else None
+    return {"name": path.stem, "world_name": None if name is None else str(name),
+            "description": first_comment_line(text)}
+
+
+def _rulebase(path) -> dict:
+    from ..lang.resolve import load_rules_file
+
+    rb = load_rules_file(path)
+    return {"name": path.name, "behaviors": [b.name for b in rb.behaviors],
+            "description": "behaviors: " + ", ".join(b.name for b in rb.behaviors)}
+
+
+def _lesson(path) -> dict:
+    return {"name": path.stem,
+            "description": first_comment_line(path.read_text(encoding="utf-8"))}
+
+
+def catalogue() -> dict[str, list[dict]]:
+    """Every packaged world, rule base and lesson, by section, in file-name order."""
+    from ..resources import packaged_names, packaged_path
+
+    describe = {"worlds": _world, "rulebases": _rulebase, "lessons": _lesson}
+    return {key: [describe[key](packaged_path(folder, filename))
+                  for filename in packaged_names(folder, suffix)]
+            for key, (_, folder, suffix) in SECTIONS.items()}
+
+
+def render(cat: dict[str, list[dict]]) -> str:
+    lines: list[str] = []
+    width = max((len(e["name"]) for entries in cat.values() for e in entries), default=0)
+    for key, entries in cat.items():
+        if lines:
+            lines.append("")
+        lines.append(SECTIONS[key][0])
+        for e in entries:
+            description = e["description"] or "(no description)"
+            if key == "worlds" and e["world_name"] not in (None, e["name"]):
+                description = f"`{e['world_name']}`: {description}"
+            lines.append(f"  {e['name'].ljust(width)}  {description}")
+        if not entries:
+            lines.append("  (none)")
+    return "\n".join(lines)
+
+
+def list_command(
+    as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
+) -> None:
+    """List the packaged worlds, rule bases and lessons, a line each.
+
+    Example: `mitos list`, then `mitos simulate slalom`.
+    """
+    cat = catalogue()
+    emit(json.dumps(cat, indent=2) if as_json else render(cat))
