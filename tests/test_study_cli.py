@@ -18,39 +18,7 @@ from mitos_cli.study.store import ResultStore
 
 ROOT = Path(__file__).resolve().parent.parent
 
-TINY = """\
-# a short corridor with one obstacle: about 8 simulated seconds to the goal
-name: tiny
-seed: 1
-dt: 0.05
-time_limit: 15
-substeps: 2
-behavior: drive
-robot:
-  model: tricycle
-  wheelbase: 16
-  footprint: {length: 24, width: 18}
-  safety_margin: 2
-  steering: {min: 30, max: 150, straight: 90, max_rate: 180}
-  max_speed: 60
-  acceleration: 40
-sensors: {layout: ring, count: 24, cone: 15, range: 120, noise: 0.5}
-q_init: {x: 30, y: -10, heading: 0}
-q_goal: {x: 250, y: -10, tolerance: 12}
-map:
-  corridors:
-    - points: [[0, 0], [280, 0]]
-      width: 70
-obstacles:
-  - name: box
-    shape: circle
-    at: [150, -12]
-    radius: 9
-randomise:
-  obstacles:
-    box: {dx: [-30, 30], dy: [-10, 10]}
-  sensor_noise: [0, 1.5]
-"""
+TINY = (Path(__file__).parent / "data" / "tiny.yaml").read_text()   # also benchmarks/kill.py's
 
 
 @pytest.fixture(scope="module")
