@@ -34,18 +34,22 @@ from __future__ import annotations
 import argparse
 import contextlib
 import hashlib
+import io
 import json
 import math
 import os
 import random
 import re
 import resource
+import shlex
 import shutil
 import signal
+import subprocess
 import sys
 import tempfile
 import time
 import traceback
+import warnings
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -55,7 +59,9 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 SEED = 20261201
 
-OUTCOMES = ("loaded", "refused+pos", "refused", "foreign", "slow", "nonfinite")
+OUTCOMES = ("loaded", "refused+pos", "refused", "foreign", "slow", "nonfinite", "warning")
+#: outcomes that are defects (the campaign exits 1 if any input has one)
+BAD = ("foreign", "slow", "nonfinite", "warning")
 
 
 class Timeout(BaseException):
@@ -220,6 +226,84 @@ RULE_NEST = (lambda d: "if " + "not " * d + "road is WIDE then speed is FAST",
 
 
 # ---------------------------------------------------------------------------------------------
+# the command line: in this process (fast), or as a subprocess (spot checks)
+
+#: ``path:line:col: `` starting a line of stderr: a positioned message
+POSITIONED = re.compile(r"\S[^\n]{0,4000}?:\d{1,9}:\d{1,9}: ")
+
+
+def cli_in_process(argv: list[str], work: Path) -> tuple[int, str]:
+    """``mitos ARGV`` through the CLI's own ``main`` in this process, run in ``work``: the exit
+    code and stderr (stdout is captured and dropped). An exception escaping ``main``
+    propagates: it is what a user would see as a traceback."""
+    from mitos_cli.cli.app import main
+
+    out, err = io.StringIO(), io.StringIO()
+    cwd, stdin = os.getcwd(), sys.stdin
+    os.chdir(work)
+    sys.stdin = io.StringIO("")         # the prompt, `--lesson -`, `--batch -`: end of input
+    try:
+        with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+            try:
+                main(argv)
+                code = 0
+            except SystemExit as exc:
+                code = exc.code if isinstance(exc.code, int) else int(exc.code is not None)
+    finally:
+        os.chdir(cwd)
+        sys.stdin = stdin
+    return code, err.getvalue()
+
+
+def cli_subprocess(argv: list[str], work: Path, timeout: float) -> tuple[int, str]:
+    """``python -m mitos_cli ARGV`` in ``work``: what a user runs, for spot checks."""
+    env = dict(os.environ, PYTHONPATH=str(ROOT))
+    try:
+        r = subprocess.run([sys.executable, "-m", "mitos_cli", *argv], cwd=work, env=env,
+                           capture_output=True, text=True, errors="replace", timeout=timeout)
+    except subprocess.TimeoutExpired:
+        raise Timeout() from None
+    return r.returncode, r.stderr
+
+
+def cli_outcome(code: int, err: str) -> tuple[str, str]:
+    """The outcome of one ``mitos`` run from its exit code and stderr."""
+    if "Traceback (most recent call last)" in err:
+        return "foreign", "traceback: " + err.strip().splitlines()[-1][:70]
+    if "Warning: " in err:              # plain searches: a message may quote 200 KB of input
+        line = next(x for x in err.splitlines() if "Warning: " in x)
+        return "warning", line[max(0, line.index("Warning: ") - 20):][:80]
+    if code in (0, 3):                 # 3: `simulate --require success` not met
+        return "loaded", ""
+    if code == 1:
+        first = err.strip().splitlines()[0][:60] if err.strip() else "(no message)"
+        positioned = any(POSITIONED.match(x) for x in err.splitlines()[:3])
+        return ("refused+pos", "") if positioned else ("refused", first)
+    if code == 2:
+        return "refused", "usage error"
+    return "foreign", f"exit {code}"
+
+
+def via_cli(kind: Kind, how: str, limit: float) -> Callable:
+    """``kind.run`` replaced by the ``mitos`` command that reads the input."""
+    def run(data, work: Path):
+        argv = kind.argv(data, work)
+        if how == "subprocess":
+            return cli_outcome(*cli_subprocess(argv, work, timeout=3 * limit + 10))
+        return cli_outcome(*cli_in_process(argv, work))
+    return run
+
+
+def command_line(text: str) -> list[str]:
+    """A mutated command line as the shell would split it (NUL cannot be in an argument)."""
+    text = text.replace("\x00", "")
+    try:
+        return shlex.split(text)
+    except ValueError:                  # an unclosed quote: the shell would wait for more
+        return text.split()
+
+
+# ---------------------------------------------------------------------------------------------
 # input kinds: seeds and the run of one input
 
 @dataclass
@@ -227,9 +311,15 @@ class Kind:
     name: str
     seeds: list[tuple[str, str | bytes]]
     mutate: Callable
-    run: Callable                      # (data, workdir) -> None, raises what it raises
+    run: Callable                      # (data, workdir) -> None or an outcome; raises what it raises
     ext: str = ".txt"
+    #: with ``--via cli``: (data, workdir) -> the ``mitos`` arguments that read the input
+    #: (after writing it where they look); None where no command reads this kind alone
+    argv: Callable | None = None
     tried: int = 0
+    seconds: float = 0.0                          # wall clock, the kind's whole run
+    cpu: float = 0.0                              # CPU seconds inside the inputs
+    large: list = field(default_factory=list)     # (bytes, CPU seconds) of inputs >= LARGE
     counts: dict = field(default_factory=lambda: dict.fromkeys(OUTCOMES, 0))
 
 
@@ -406,6 +496,58 @@ class Kinds:
         (d / "journal.jsonl").write_text(text, encoding="utf-8", errors="surrogatepass")
         Session.resume(Journal.open(d), out=lambda s: None)
 
+    # -- the same inputs through the command line (``--via cli``) -------------------------------
+    def _file(self, where: Path, name: str, data) -> str:
+        path = where / name
+        if isinstance(data, bytes):
+            path.write_bytes(data)
+        else:
+            path.write_text(data, encoding="utf-8", errors="surrogatepass")
+        return str(path)
+
+    def argv_rules(self, text: str, _work: Path) -> list[str]:
+        # beside the shipped term sets, which a rule file names relative to itself
+        return ["check", self._file(self.rb_dir, "fuzz.rules", text), "-n", "5"]
+
+    def argv_foreign(self, ext: str) -> Callable:
+        def argv(text: str, work: Path) -> list[str]:
+            return ["check", self._file(work, "fuzz" + ext, text), "-n", "5"]
+        return argv
+
+    def argv_batch(self, text: str, work: Path) -> list[str]:
+        return ["eval", str(self.rb_dir / "mitos.rules"), "--batch",
+                self._file(work, "fuzz.csv", text)]
+
+    def argv_lesson(self, text: str, work: Path) -> list[str]:
+        # beside `worlds/`, which a lesson names relative to itself
+        return ["teach", str(self.rb_dir / "mitos.rules"), "--lesson",
+                self._file(self.work, "fuzz.lesson", text), "--save-as", str(work / "out.rules")]
+
+    def argv_journal(self, text: str, work: Path) -> list[str]:
+        d = work / ".mitos" / "teach" / "fuzz"
+        d.mkdir(parents=True)
+        self._file(d, "journal.jsonl", text)
+        return ["teach", "--resume", "--lesson", self._file(work, "end.lesson", "quit\n")]
+
+    # -- command-line arguments ---------------------------------------------------------------
+    #: the files a command line may name, copied into each input's own directory (a mutated
+    #: `-o` may overwrite any of them)
+    ARG_FILES = ("mitos.rules", "mitos.terms.yaml", "drive.terms.yaml")
+
+    def argv_args(self, text: str, work: Path) -> list[str]:
+        for name in self.ARG_FILES:
+            shutil.copyfile(self.rb_dir / name, work / name)
+        interop = ROOT / "tests" / "data" / "interop"
+        shutil.copyfile(interop / "robot_jfuzzylogic.fcl", work / "robot.fcl")
+        shutil.copyfile(interop / "tipper.fis", work / "tipper.fis")
+        (work / "batch.csv").write_text("road,size,position\n78,45,4\n10,5,-3\n")
+        (work / "small.lesson").write_text("correct road=78 size=45 position=4 -> steering=100\n"
+                                           "adapt epochs 2\nsave\n")
+        return command_line(text)
+
+    def run_args(self, text: str, work: Path) -> tuple[str, str]:
+        return cli_outcome(*cli_in_process(self.argv_args(text, work), work))
+
     # -- seeds --------------------------------------------------------------------------------
     def journal_seeds(self) -> list[tuple[str, str]]:
         from mitos_cli.teach.journal import Journal
@@ -480,19 +622,42 @@ class Kinds:
                         ":", ",", '"', "adapt", "terms", "crisp"),
                        (lambda d: '{"seq": 99, "op": "examples", "examples": ' + "[" * d
                         + "]" * d + "}",))
+        args = [(f"args{i}", line) for i, line in enumerate((
+            "eval mitos.rules road=78 size=45 position=4 --digits 2",
+            "eval mitos.rules --batch batch.csv --on-no-rule default --json",
+            "eval mitos.rules road=20 size=10 position=-8 --network",
+            "eval mitos.rules --fidelity matlab -b avoid road=78 size=45 position=4",
+            "check mitos.rules --threshold 0.2 --resolution 8 --json",
+            "convert robot.fcl --to rules -o out.rules",
+            "convert mitos.rules --to fll", "convert tipper.fis --to fcl -o out.fcl",
+            "export mitos.rules --to c -o out.c --prefix m", "export mitos.rules --to python",
+            "teach mitos.rules --lesson small.lesson --save-as out.rules",
+            "teach --resume --session x --recover", "operators", "list", "--version",
+            "eval --help"))]
+        amut = Mutator(("eval", "check", "convert", "export", "teach", "operators", "list",
+                        "--batch", "--json", "--digits", "--network", "--on-no-rule",
+                        "--fidelity", "--threshold", "-t", "--resolution", "-n", "--to", "-o",
+                        "--output", "--behavior", "-b", "--prefix", "--lesson", "--save-as",
+                        "--resume", "--recover", "--session", "-", "--", "road=", "size=1e400",
+                        "position=nan", "=", "mitos.rules", "batch.csv", "robot.fcl",
+                        "tipper.fis", "small.lesson", "fll", "fcl", "fis", "rules", "c",
+                        "python", "matlab", "fuzzylite", "nan", "skip", "default", "error",
+                        "x" * 300 + ".rules", "--help", "-h", "--version"))
         k = self
         return [
-            Kind("rule files", rules, rule_mut, k.run_rules, ".rules"),
+            Kind("rule files", rules, rule_mut, k.run_rules, ".rules", k.argv_rules),
             Kind("term-set YAML", termsets, ymut, k.run_termset, ".terms.yaml"),
             Kind("world YAML", worlds, ymut, k.run_world, ".yaml"),
             Kind("map YAML + PGM", maps + small_pgms, ymut, k.run_map, ".yaml"),
-            Kind("FCL", fcl, fmut, k.run_foreign("fcl"), ".fcl"),
-            Kind(".fis", fis, fmut, k.run_foreign("fis"), ".fis"),
-            Kind("FLL", fll, fmut, k.run_foreign("fll"), ".fll"),
+            Kind("FCL", fcl, fmut, k.run_foreign("fcl"), ".fcl", k.argv_foreign(".fcl")),
+            Kind(".fis", fis, fmut, k.run_foreign("fis"), ".fis", k.argv_foreign(".fis")),
+            Kind("FLL", fll, fmut, k.run_foreign("fll"), ".fll", k.argv_foreign(".fll")),
             Kind("teach commands", commands, tmut, k.run_command, ".txt"),
-            Kind("lessons", lessons, tmut, k.run_lesson, ".lesson"),
-            Kind("eval --batch CSV", csvs, cmut, k.run_batch, ".csv"),
-            Kind("teach journals", self.journal_seeds(), jmut, k.run_journal, ".jsonl"),
+            Kind("lessons", lessons, tmut, k.run_lesson, ".lesson", k.argv_lesson),
+            Kind("eval --batch CSV", csvs, cmut, k.run_batch, ".csv", k.argv_batch),
+            Kind("teach journals", self.journal_seeds(), jmut, k.run_journal, ".jsonl",
+                 k.argv_journal),
+            Kind("CLI arguments", args, amut, k.run_args, ".args", k.argv_args),
         ]
 
     def fll_seeds(self) -> list[tuple[str, str]]:
@@ -548,9 +713,13 @@ def signature(exc: BaseException) -> str:
 
 #: seconds a large input may take per KB beyond ``--slow`` (its size explains that much)
 PER_KB = 0.01
+#: inputs of at least this many bytes are "large": the table gives their CPU time per KB
+LARGE = 64 * 1024
 
 
-def classify(kind: Kind, data, work: Path, limit: float, slow: float) -> tuple[str, str]:
+def classify(kind: Kind, data, work: Path, limit: float, slow: float,
+             times: list[float] | None = None) -> tuple[str, str]:
+    """The outcome of one input and its signature; its CPU seconds are appended to ``times``."""
     from mitos_cli.errors import MitosError
 
     allowance = len(data) / 1024 * PER_KB
@@ -558,10 +727,13 @@ def classify(kind: Kind, data, work: Path, limit: float, slow: float) -> tuple[s
     # CPU time, not wall time: on a shared machine the wall clock measures the neighbours
     signal.signal(signal.SIGPROF, _alarm)
     t0 = time.process_time()
+    caught: list[warnings.WarningMessage] = []
     signal.setitimer(signal.ITIMER_PROF, limit)
     try:
-        kind.run(data, work)
-        outcome, sig = "loaded", ""
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            result = kind.run(data, work)
+        outcome, sig = result if result is not None else ("loaded", "")
     except Timeout:
         return "slow", "past the limit"
     except MitosError as exc:
@@ -579,8 +751,15 @@ def classify(kind: Kind, data, work: Path, limit: float, slow: float) -> tuple[s
     finally:
         signal.setitimer(signal.ITIMER_PROF, 0)
     elapsed = time.process_time() - t0
+    if times is not None:
+        times.append(elapsed)
     if elapsed > slow and outcome != "foreign":
         return "slow", "slower than allowed"
+    # a warning the user would see (NumPy's "invalid value", a deprecation): a defect too
+    leaked = [w for w in caught if issubclass(w.category, (RuntimeWarning, UserWarning))]
+    if leaked and outcome != "foreign":
+        w = leaked[0]
+        return "warning", f"{w.category.__name__} at {Path(w.filename).name}:{w.lineno}"
     return outcome, sig
 
 
@@ -634,25 +813,72 @@ def _allowance(kind: Kind, i: int, seed: int) -> float:
     return len(make_input(kind, i, seed)[1]) / 1024 * PER_KB
 
 
+def routed(kinds: list[Kind], via: str, limit: float) -> list[Kind]:
+    """The kinds as ``--via`` runs them: ``reader`` calls the library's readers, ``cli`` the
+    command line's ``main`` in this process, ``subprocess`` ``python -m mitos_cli``. A kind no
+    command reads alone (term sets, worlds, maps, single commands) keeps its reader."""
+    if via == "reader":
+        return kinds
+    for kind in kinds:
+        if kind.argv is not None and (via == "subprocess" or kind.name != "CLI arguments"):
+            kind.run = via_cli(kind, via, limit)
+    return kinds
+
+
+def share_rule_base(rb_dir: Path) -> None:
+    """Every teaching session of the campaign starts from the shipped rule base: read it once
+    per process, not once per input (its model is frozen; a changed file is read again)."""
+    from mitos_cli.teach import session as module
+
+    read = module.load_rules_file
+    shared = str((rb_dir / "mitos.rules").resolve())
+    cache: dict[tuple, object] = {}
+
+    def load(path):
+        p = Path(path)
+        if str(p.resolve()) != shared:
+            return read(path)
+        st = p.stat()
+        key = (st.st_mtime_ns, st.st_size)
+        if key not in cache:
+            cache.clear()
+            cache[key] = read(path)
+        return cache[key]
+
+    module.load_rules_file = load
+
+
+#: inputs per kind, as a fraction of ``--per-format``: a lesson simulates and adapts (about
+#: 0.2 s of real work each), so lessons get a quarter of the count
+SHARE = {"lessons": 0.25}
+
+
+def count_of(kind: Kind, per_format: int) -> int:
+    return max(1, int(per_format * SHARE.get(kind.name, 1.0)))
+
+
 def _worker(conn, kind_index: int, start: int, stop: int, seed: int, limit: float,
-            slow: float, work: Path) -> None:
+            slow: float, work: Path, via: str) -> None:
     """Runs inputs ``start..stop`` of one kind, announcing each before running it."""
     resource.setrlimit(resource.RLIMIT_AS, (4 << 30, resource.RLIM_INFINITY))
     os.chdir(work)                      # teaching writes `.mitos/` and saves here
-    kind = Kinds(work, fresh=False).build()[kind_index]
+    kinds = Kinds(work, fresh=False)
+    share_rule_base(kinds.rb_dir)
+    kind = routed(kinds.build(), via, limit)[kind_index]
     scratch = work / f"scratch-{os.getpid()}"
     for i in range(start, stop):
         _, data = make_input(kind, i, seed)
         conn.send(("start", i))
         scratch.mkdir(exist_ok=True)
-        outcome, sig = classify(kind, data, scratch, limit, slow)
+        times: list[float] = []
+        outcome, sig = classify(kind, data, scratch, limit, slow, times)
         shutil.rmtree(scratch, ignore_errors=True)
-        conn.send(("done", i, outcome, sig))
+        conn.send(("done", i, outcome, sig, times[0] if times else limit, len(data)))
     conn.send(("end",))
 
 
 def campaign(per_format: int, out: Path | None, limit: float, slow: float, only: str | None,
-             seed: int, log=print) -> list[Kind]:
+             seed: int, log=print, via: str = "reader") -> list[Kind]:
     """Run every kind's inputs in a worker process; a worker stuck in one input past twice
     the limit (a hang the alarm cannot reach, inside C code) is killed, the input counted as
     slow, and a new worker carries on after it."""
@@ -664,17 +890,22 @@ def campaign(per_format: int, out: Path | None, limit: float, slow: float, only:
     cwd = os.getcwd()
     os.chdir(work)
     try:
-        kinds = Kinds(work).build()
+        built = Kinds(work)
+        share_rule_base(built.rb_dir)
+        kinds = routed(built.build(), via, limit)
         seen: set[tuple[str, str, str]] = set()
         for index, kind in enumerate(kinds):
             if only and only.lower() not in kind.name.lower():
                 continue
+            if via != "reader" and kind.argv is None:
+                log(f"{kind.name}: no command reads it alone (run with --via reader)")
+                continue
             t0 = time.perf_counter()
-            i = 0
-            while i < per_format:
+            i, count = 0, count_of(kind, per_format)
+            while i < count:
                 parent, child = ctx.Pipe()
-                proc = ctx.Process(target=_worker, args=(child, index, i, per_format, seed,
-                                                         limit, slow, work), daemon=True)
+                proc = ctx.Process(target=_worker, args=(child, index, i, count, seed,
+                                                         limit, slow, work, via), daemon=True)
                 proc.start()
                 child.close()
                 current = i
@@ -697,14 +928,18 @@ def campaign(per_format: int, out: Path | None, limit: float, slow: float, only:
                         continue
                     if msg[0] == "end":
                         result = None
-                        i = per_format
+                        i = count
                         break
-                    _, n, outcome, sig = msg
+                    _, n, outcome, sig, cpu, size = msg
+                    kind.cpu += cpu
+                    if size >= LARGE:
+                        kind.large.append((size, cpu))
                     _count(kind, n, outcome, sig, seen, out, seed, work, limit, slow, log)
                 if result is not None:
                     _count(kind, current, *result, seen, out, seed, work, limit, slow, log)
                 proc.join()
-            log(f"{kind.name}: {kind.tried} inputs in {time.perf_counter() - t0:.1f} s "
+            kind.seconds = time.perf_counter() - t0
+            log(f"{kind.name}: {kind.tried} inputs in {kind.seconds:.1f} s "
                 + ", ".join(f"{k} {v}" for k, v in kind.counts.items() if v))
         return kinds
     finally:
@@ -748,20 +983,31 @@ def _write(out: Path, kind: Kind, data, want, scratch: Path, limit: float, slow:
 
 def table(kinds: list[Kind]) -> str:
     rows = ["| input | tried | loaded | refused with a position | refused without one | "
-            "foreign exception | slow | non-finite |", "|---|---:|---:|---:|---:|---:|---:|---:|"]
+            "foreign exception | slow | non-finite | warning | CPU s | large inputs: n, "
+            "largest, ms per KB (max) |", "|---|" + "---:|" * 11]
     total = dict.fromkeys(OUTCOMES, 0)
-    tried = 0
+    tried, cpu = 0, 0.0
     for k in kinds:
         if not k.tried:
             continue
         tried += k.tried
+        cpu += k.cpu
         for o in OUTCOMES:
             total[o] += k.counts[o]
         rows.append(f"| {k.name} | {k.tried:,} | " + " | ".join(f"{k.counts[o]:,}"
-                                                                for o in OUTCOMES) + " |")
+                                                                for o in OUTCOMES)
+                    + f" | {k.cpu:,.0f} | {_large(k.large)} |")
     rows.append(f"| **all** | {tried:,} | " + " | ".join(f"{total[o]:,}" for o in OUTCOMES)
-                + " |")
+                + f" | {cpu:,.0f} | |")
     return "\n".join(rows)
+
+
+def _large(large: list[tuple[int, float]]) -> str:
+    if not large:
+        return "0"
+    biggest = max(size for size, _ in large)
+    per_kb = max(cpu / (size / 1024) for size, cpu in large)
+    return f"{len(large):,}, {biggest / 1024:,.0f} KB, {per_kb * 1000:.2f}"
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -774,15 +1020,20 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--limit", type=float, default=10.0, help="per-input time limit, seconds")
     ap.add_argument("--slow", type=float, default=5.0, help="slower than this counts as slow")
     ap.add_argument("--seed", type=int, default=SEED)
+    ap.add_argument("--via", choices=("reader", "cli", "subprocess"), default="reader",
+                    help="reader: the library's readers; cli: `mitos`'s main in this process "
+                         "(stdout and stderr captured); subprocess: `python -m mitos_cli`, for "
+                         "spot checks")
     args = ap.parse_args(argv)
     n = 150 if args.quick else args.per_format
     t0 = time.perf_counter()
-    kinds = campaign(n, args.out, args.limit, args.slow, args.only, args.seed)
+    kinds = campaign(n, args.out, args.limit, args.slow, args.only, args.seed, via=args.via)
     print()
     print(table(kinds))
     print(f"\n{sum(k.tried for k in kinds):,} inputs in {time.perf_counter() - t0:.0f} s "
-          f"(seed {args.seed}, limit {args.limit:g} s, slow above {args.slow:g} s)")
-    bad = sum(k.counts[o] for k in kinds for o in ("foreign", "slow", "nonfinite"))
+          f"(seed {args.seed}, via {args.via}, limit {args.limit:g} s, slow above "
+          f"{args.slow:g} s; load average {os.getloadavg()[0]:.1f})")
+    bad = sum(k.counts[o] for k in kinds for o in BAD)
     return 1 if bad else 0
 
 

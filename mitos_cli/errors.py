@@ -72,6 +72,17 @@ class Span:
 
 #: how much of a long source line a span keeps (characters, around the column)
 SHOWN = 240
+#: a quoted piece of input in a message (`...`) too long to be read
+_QUOTED = re.compile(r"`([^`\n]{81,})`")
+
+
+def _shorten(match: re.Match[str]) -> str:
+    """A long quoted piece of a message as its start and end (a mutated file's 200,000-digit
+    number quoted whole buries the message)."""
+    quoted = match.group(1)
+    return f"`{quoted[:40]}...{quoted[-20:]}` ({len(quoted):,} characters)"
+
+
 _NEWLINE = re.compile(r"\n")
 
 
@@ -95,10 +106,13 @@ class MitosError(Exception):
     def render(self) -> str:
         """The message as the CLI prints it: ``path:line:col: error: ...``, line, caret, hint."""
         head = f"{self.span}: " if self.span else ""
-        out = [f"{head}{self.kind}: {self.message}"]
+        out = [f"{head}{self.kind}: {_QUOTED.sub(_shorten, self.message)}"]
         if self.span and self.span.source_line is not None:
             raw = self.span.source_line.rstrip("\r\n")
             col = self.span.column - self.span.source_start      # 0-based in ``raw``
+            if len(raw) > SHOWN:          # a very long line: only the part around the column
+                first = min(max(0, col - SHOWN // 2), len(raw) - SHOWN)
+                raw, col = raw[first:first + SHOWN], col - first
             src = raw.expandtabs(4)
             col = len(raw[:max(0, col)].expandtabs(4))
             width = max(1, (self.span.end_column or self.span.column + 1) - self.span.column)
