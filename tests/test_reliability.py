@@ -313,7 +313,7 @@ def kinds(tmp_path_factory):
 
 
 KIND_NAMES = ["rule files", "term-set YAML", "world YAML", "map YAML + PGM", "FCL", ".fis",
-              "FLL", "teach commands", "eval --batch CSV", "teach journals"]
+              "FLL", "teach commands", "eval --batch CSV", "teach journals", "CLI arguments"]
 
 
 @pytest.mark.parametrize("name", KIND_NAMES)
@@ -324,14 +324,40 @@ def test_fuzz_kind_has_no_foreign_exceptions(kinds, name):
     kind = next(k for k in all_kinds if k.name == name)
     os.chdir(work)
     bad = []
-    for i in range(25):
+    for i in range(10 if name == "CLI arguments" else 25):   # a whole command each: fewer
         _, data = fuzz.make_input(kind, i, fuzz.SEED + 7)
         scratch = work / "scratch"
         scratch.mkdir(exist_ok=True)
         outcome, sig = fuzz.classify(kind, data, scratch, 10.0, 5.0)
-        if outcome == "foreign" or outcome == "slow":
+        if outcome in fuzz.BAD:
             bad.append((i, outcome, sig))
     assert not bad
+
+
+def test_cli_route_classifies_what_the_user_sees(kinds, tmp_path):
+    """``--via cli``: the CLI's main in this process, its exit code and stderr classified."""
+    fuzz, _, _ = kinds
+    rules = tmp_path / "a.rules"
+    rules.write_text('terms "nowhere.terms.yaml"\n')
+    code, err = fuzz.cli_in_process(["check", str(rules)], tmp_path)
+    assert code == 1 and fuzz.cli_outcome(code, err) == ("refused+pos", "")
+    code, err = fuzz.cli_in_process(["eval", "--digits", "x"], tmp_path)
+    assert (code, fuzz.cli_outcome(code, err)) == (2, ("refused", "usage error"))
+    assert fuzz.cli_outcome(1, "Traceback (most recent call last):\n  ...\nKeyError: 'x'\n") \
+        == ("foreign", "traceback: KeyError: 'x'")
+    assert fuzz.cli_outcome(0, "f.py:3: RuntimeWarning: invalid value\n")[0] == "warning"
+
+
+def test_a_long_token_is_shortened_in_the_message(tmp_path):
+    """A 200,000-digit number in a rule file was quoted whole in the message and under a
+    200,000-caret line (and the campaign's classification of it was quadratic)."""
+    text = 'terms "mitos.terms.yaml"\noperators: and ' + "9" * 200_000 + "\n"
+    with pytest.raises(RuleSyntaxError) as info:
+        parse_rules(text, "big.rules")
+    shown = info.value.render().splitlines()
+    assert shown[0].startswith("big.rules:2:16: syntax error: unexpected `9999")
+    assert "(200,000 characters)" in shown[0] and len(shown[0]) < 200
+    assert max(len(line) for line in shown) < 300
 
 
 def test_one_wide_rule_does_not_pad_its_level(tmp_path):
@@ -409,3 +435,17 @@ def test_adapt_epochs_are_bounded():
     session.run("correct road=78 size=45 position=4 -> steering=100")
     with pytest.raises(LessonError, match="at most"):
         session.run("adapt epochs 4e300")
+
+
+def test_a_use_cycle_is_reported_at_the_use_that_closes_it(tmp_path):
+    """The cycle error pointed at the top level (`main`), which has no position."""
+    from mitos_cli.lang.resolve import load_rules_file
+
+    (tmp_path / "mitos.terms.yaml").write_text((ROOT / "rulebases" / "mitos.terms.yaml")
+                                               .read_text())
+    rules = tmp_path / "c.rules"
+    rules.write_text('terms "mitos.terms.yaml"\nbehavior b:\n  r1: if road is WIDE then '
+                     'steering is RS\n  use b\nend\nuse b\n')
+    with pytest.raises(RuleBaseError, match="in a cycle: main -> b -> b") as info:
+        load_rules_file(rules)
+    assert (info.value.span.line, info.value.span.column) == (4, 3)

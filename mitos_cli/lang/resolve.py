@@ -168,10 +168,13 @@ def _check_consequent(c: Consequent, variables: dict[str, Variable]) -> None:
                                 f"[{lo:g}, {hi:g}]", span=c.span)
 
 
-def _check_cycles(rb: RuleBase, name: str, stack: tuple[str, ...]) -> None:
+def _check_cycles(rb: RuleBase, name: str, stack: tuple[str, ...],
+                  span: Span | None = None) -> None:
+    """``span``: the ``use`` that led to ``name``; the one closing a cycle is reported (the
+    file's top level, ``main``, has no position of its own)."""
     if name in stack:
         cycle = " -> ".join(stack + (name,))
         raise RuleBaseError(f"behaviors use each other in a cycle: {cycle}",
-                            span=rb.behavior(stack[0]).span)
+                            span=span or rb.behavior(stack[0]).span)
     for use in rb.behavior(name).uses:
-        _check_cycles(rb, use.behavior, stack + (name,))
+        _check_cycles(rb, use.behavior, stack + (name,), use.span)
