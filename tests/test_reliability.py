@@ -449,3 +449,24 @@ def test_a_use_cycle_is_reported_at_the_use_that_closes_it(tmp_path):
     with pytest.raises(RuleBaseError, match="in a cycle: main -> b -> b") as info:
         load_rules_file(rules)
     assert (info.value.span.line, info.value.span.column) == (4, 3)
+
+
+def test_edges_too_narrow_for_a_float_slope_give_numbers_not_warnings(recwarn):
+    """FLL terms 1e-320 wide: an infinite slope (or 2 / width) times 0 at the corner was NaN,
+    with NumPy's "invalid value" / "overflow" warnings printed to the user."""
+    import numpy as np
+
+    from mitos_cli.fuzzy import shapes
+    from mitos_cli.interop.fll import parse_fll
+
+    assert shapes.gaussian(np.array([0.0, 1.0]), 0.0, 2.1e-321).tolist() == [1.0, 0.0]
+    assert shapes.cosine(np.array([-15.0, 0.0]), -15.0, 3.01e-318).tolist() == [1.0, 0.0]
+    rb = parse_fll("InputVariable: a\n  range: -45 45\n  term: ahead Triangle -20 0 1e-320\n"
+                   "OutputVariable: t\n  range: 0 1\n  term: hi Triangle 0 1 1\n"
+                   "RuleBlock: main\n  rule: if a is ahead then t is hi\n", "narrow.fll")
+    from mitos_cli.engine.evaluation import evaluate
+
+    res = evaluate(compile_rulebase(rb), np.array([[0.0], [-10.0], [1.0]]), strict=False)
+    dof = res.dof[:, 0]
+    assert dof.tolist() == [1.0, 0.5, 0.0]
+    assert not [w for w in recwarn if issubclass(w.category, RuntimeWarning)]

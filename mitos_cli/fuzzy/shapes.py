@@ -165,18 +165,19 @@ def kernel_params(corners: tuple[float, float, float, float]) -> tuple[float, fl
 
     ``mu = clip(1 + min((x - b) * s1, (c - x) * s2), 0, 1)``, which is finite for every finite
     ``x`` (inputs are clamped to the universe before they reach it). A missing edge (shoulder)
-    gets slope 0, a vertical edge a huge slope.
+    gets slope 0, a vertical edge a huge slope (so does an edge too narrow for its slope to be
+    a float, 1e-320 wide: an infinite slope times 0 at the corner would be NaN).
     """
     a, b, c, d = corners
     steep = 1e300
     if b == -INF:           # left shoulder: no rising edge
         b, s1 = c, 0.0
     else:
-        s1 = steep if b == a else 1.0 / (b - a)
+        s1 = steep if b == a else min(1.0 / (b - a), steep)
     if c == INF:            # right shoulder: no falling edge
         c, s2 = b, 0.0
     else:
-        s2 = steep if d == c else 1.0 / (d - c)
+        s2 = steep if d == c else min(1.0 / (d - c), steep)
     return b, s1, c, s2
 
 
@@ -207,10 +208,11 @@ def ramp(x, start, end):
 
 
 def gaussian(x, mean, sigma):
-    """``exp(-(x - mean)^2 / (2 sigma^2))``."""
+    """``exp(-(x - mean)^2 / (2 sigma^2))``, as ``((x - mean) / sigma)^2 / 2``: a sigma so
+    small that its square is 0 (2e-321) still gives 1 at the mean, not 0 / 0."""
     x = np.asarray(x, dtype=float)
     with np.errstate(over="ignore"):
-        return np.exp(-np.square(x - mean) / (2.0 * np.square(sigma)))
+        return np.exp(-0.5 * np.square((x - mean) / np.asarray(sigma)))
 
 
 def gaussian2(x, mean1, sigma1, mean2, sigma2):
@@ -284,11 +286,12 @@ def pi_shape(x, a, b, c, d):
 def cosine(x, center, width):
     """Raised cosine ``(1 + cos(2 pi (x - center) / width)) / 2`` on ``center +- width/2``."""
     x = np.asarray(x, dtype=float)
-    with np.errstate(invalid="ignore"):
+    with np.errstate(invalid="ignore", over="ignore"):      # outside: the 0 of np.where
         inside = np.isfinite(x) & (x >= center - 0.5 * np.asarray(width)) \
             & (x <= center + 0.5 * np.asarray(width))
-        out = np.where(inside, 0.5 * (1.0 + np.cos(2.0 / np.asarray(width) * np.pi * (x - center))),
-                       0.0)
+        # (x - center) / width first: 2 / width overflows for a width of 3e-318 (inf * 0)
+        out = np.where(inside, 0.5 * (1.0 + np.cos(2.0 * np.pi * ((x - center)
+                                                                 / np.asarray(width)))), 0.0)
     return _nan_of(x) * out
 
 
