@@ -57,6 +57,7 @@ from pathlib import Path
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))          # this tree's mitos_cli, not an installed one
 SEED = 20261201
 
 OUTCOMES = ("loaded", "refused+pos", "refused", "foreign", "slow", "nonfinite", "warning")
@@ -862,24 +863,26 @@ def share_rule_base(rb_dir: Path) -> None:
 
 
 #: inputs per kind, as a fraction of ``--per-format``: a lesson simulates and adapts (about
-#: 0.2 s of real work each), so lessons get a quarter of the count
-SHARE = {"lessons": 0.25}
+#: 0.2 CPU s of real work) and a command line runs a whole command (about 30 ms), so they get
+#: fewer; batch CSVs and journals (about 1 and 3 ms) more
+SHARE = {"lessons": 1 / 12, "CLI arguments": 1 / 3, "eval --batch CSV": 1.4,
+         "teach journals": 1.4}
 
 
 def count_of(kind: Kind, per_format: int) -> int:
     return max(1, int(per_format * SHARE.get(kind.name, 1.0)))
 
 
-def _worker(conn, kind_index: int, start: int, stop: int, seed: int, limit: float,
-            slow: float, work: Path, via: str) -> None:
-    """Runs inputs ``start..stop`` of one kind, announcing each before running it."""
+def _worker(conn, kind_index: int, start: int, stop: int, step: int, seed: int,
+            limit: float, slow: float, work: Path, via: str) -> None:
+    """Runs inputs ``start, start + step, ... < stop`` of one kind, announcing each first."""
     resource.setrlimit(resource.RLIMIT_AS, (4 << 30, resource.RLIM_INFINITY))
     os.chdir(work)                      # teaching writes `.mitos/` and saves here
     kinds = Kinds(work, fresh=False)
     share_rule_base(kinds.rb_dir)
     kind = routed(kinds.build(), via, limit)[kind_index]
     scratch = work / f"scratch-{os.getpid()}"
-    for i in range(start, stop):
+    for i in range(start, stop, step):
         _, data = make_input(kind, i, seed)
         conn.send(("start", i))
         scratch.mkdir(exist_ok=True)
@@ -891,7 +894,8 @@ def _worker(conn, kind_index: int, start: int, stop: int, seed: int, limit: floa
 
 
 def campaign(per_format: int, out: Path | None, limit: float, slow: float, only: str | None,
-             seed: int, log=print, via: str = "reader") -> list[Kind]:
+             seed: int, log=print, via: str = "reader",
+             shard: tuple[int, int] = (0, 1)) -> list[Kind]:
     """Run every kind's inputs in a worker process; a worker stuck in one input past twice
     the limit (a hang the alarm cannot reach, inside C code) is killed, the input counted as
     slow, and a new worker carries on after it."""
@@ -915,10 +919,10 @@ def campaign(per_format: int, out: Path | None, limit: float, slow: float, only:
                 log(f"{kind.name}: no command reads it alone (run with --via reader)")
                 continue
             t0 = time.perf_counter()
-            i, count = 0, count_of(kind, per_format)
+            (i, step), count = shard, count_of(kind, per_format)
             while i < count:
                 parent, child = ctx.Pipe()
-                proc = ctx.Process(target=_worker, args=(child, index, i, count, seed,
+                proc = ctx.Process(target=_worker, args=(child, index, i, count, step, seed,
                                                          limit, slow, work, via), daemon=True)
                 proc.start()
                 child.close()
@@ -928,14 +932,14 @@ def campaign(per_format: int, out: Path | None, limit: float, slow: float, only:
                         proc.kill()
                         proc.join()
                         result = ("slow", "hung (no answer from the worker)")
-                        i = current + 1
+                        i = current + step
                         break
                     try:
                         msg = parent.recv()
                     except EOFError:             # the worker died (out of memory, a signal)
                         proc.join()
                         result = ("foreign", f"worker died (exit {proc.exitcode})")
-                        i = current + 1
+                        i = current + step
                         break
                     if msg[0] == "start":
                         current = msg[1]
@@ -1038,6 +1042,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--limit", type=float, default=10.0, help="per-input time limit, seconds")
     ap.add_argument("--slow", type=float, default=5.0, help="slower than this counts as slow")
     ap.add_argument("--seed", type=int, default=SEED)
+    ap.add_argument("--shard", default="0/1", metavar="K/N",
+                    help="run only inputs K, K + N, K + 2N, ... of each kind (N campaigns in "
+                         "parallel cover them all)")
     ap.add_argument("--via", choices=("reader", "cli", "subprocess"), default="reader",
                     help="reader: the library's readers; cli: `mitos`'s main in this process "
                          "(stdout and stderr captured); subprocess: `python -m mitos_cli`, for "
@@ -1045,11 +1052,13 @@ def main(argv: list[str] | None = None) -> int:
     args = ap.parse_args(argv)
     n = 150 if args.quick else args.per_format
     t0 = time.perf_counter()
-    kinds = campaign(n, args.out, args.limit, args.slow, args.only, args.seed, via=args.via)
+    k, _, of = args.shard.partition("/")
+    kinds = campaign(n, args.out, args.limit, args.slow, args.only, args.seed, via=args.via,
+                     shard=(int(k), int(of or 1)))
     print()
     print(table(kinds))
     print(f"\n{sum(k.tried for k in kinds):,} inputs in {time.perf_counter() - t0:.0f} s "
-          f"(seed {args.seed}, via {args.via}, limit {args.limit:g} s, slow above "
+          f"(seed {args.seed}, via {args.via}, shard {args.shard}, limit {args.limit:g} s, slow above "
           f"{args.slow:g} s; load average {os.getloadavg()[0]:.1f})")
     bad = sum(k.counts[o] for k in kinds for o in BAD)
     return 1 if bad else 0

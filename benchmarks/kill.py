@@ -38,6 +38,8 @@ import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))          # this tree's mitos_cli, here and in the killed runs
+ENV = dict(os.environ, PYTHONPATH=str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", ""))
 ROUNDS = 6
 
 
@@ -95,7 +97,7 @@ def trial(work: Path, pairs, changes, delay: float) -> dict:
     from mitos_cli.teach.session import Session
 
     setup(work)
-    env = dict(os.environ, PYTHONUNBUFFERED="1")
+    env = dict(ENV, PYTHONUNBUFFERED="1")
     proc = subprocess.Popen([sys.executable, "-m", "mitos_cli", "teach", "rb/mitos.rules",
                              "--lesson", "k.lesson", "--save-as", "out.rules"], cwd=work,
                             stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, env=env)
@@ -137,7 +139,7 @@ def timing(work: Path) -> tuple[float, float]:
     proc = subprocess.Popen([sys.executable, "-m", "mitos_cli", "teach", "rb/mitos.rules",
                              "--lesson", "k.lesson", "--save-as", "out.rules"], cwd=work,
                             stdout=subprocess.PIPE, stderr=subprocess.DEVNULL,
-                            env=dict(os.environ, PYTHONUNBUFFERED="1"))
+                            env=dict(ENV, PYTHONUNBUFFERED="1"))
     start = None
     for raw in proc.stdout:
         if start is None and b"k.lesson:" in raw:
@@ -195,12 +197,13 @@ def _rows(work: Path) -> list[str]:
 def sweep_trial(work: Path, whole: list[str], delay: float) -> dict:
     (work / "tiny.yaml").write_text(TINY)
     proc = subprocess.Popen(_sweep(work), cwd=work, stdout=subprocess.DEVNULL,
-                            stderr=subprocess.DEVNULL)
+                            stderr=subprocess.DEVNULL, env=ENV)
     time.sleep(delay)
     proc.send_signal(signal.SIGKILL)
     proc.wait()
     before = _rows(work)
-    r = subprocess.run(_sweep(work, resume=True), cwd=work, capture_output=True, text=True)
+    r = subprocess.run(_sweep(work, resume=True), cwd=work, capture_output=True, text=True,
+                       env=ENV)
     assert r.returncode == 0, r.stderr[-500:]
     after = _rows(work)
     assert after[:len(before)] == before, "a row written before the kill changed"
@@ -217,7 +220,7 @@ def sweep_campaign(trials: int, seed: int, log=print) -> list[dict]:
         ref.mkdir()
         (ref / "tiny.yaml").write_text(TINY)
         t0 = time.perf_counter()
-        subprocess.run(_sweep(ref), cwd=ref, capture_output=True, check=True)
+        subprocess.run(_sweep(ref), cwd=ref, capture_output=True, check=True, env=ENV)
         span = time.perf_counter() - t0
         whole = _rows(ref)
         results = []

@@ -470,3 +470,24 @@ def test_edges_too_narrow_for_a_float_slope_give_numbers_not_warnings(recwarn):
     dof = res.dof[:, 0]
     assert dof.tolist() == [1.0, 0.5, 0.0]
     assert not [w for w in recwarn if issubclass(w.category, RuntimeWarning)]
+
+
+@pytest.mark.parametrize("header", ['positi"on,road,size45\n', 'position"road,,\n4,78,45\n'])
+def test_a_quote_inside_a_header_cell_is_positioned(header):
+    """A quote inside a cell (not at its start) is a character to the ``csv`` module, but the
+    column finder took it for an opening quote: ``IndexError`` instead of the message."""
+    with pytest.raises(InputError) as info:
+        read_batch(header, "q.csv", ("road", "size", "position"))
+    assert info.value.span.line == 1
+
+
+def test_cell_starts_agree_with_the_csv_module():
+    import csv
+    import random
+
+    from mitos_cli.engine.csvio import _starts
+
+    rng = random.Random(3)
+    for _ in range(2000):
+        line = "".join(rng.choice('ab",') for _ in range(rng.randrange(12)))
+        assert len(_starts(line)) == len(next(csv.reader([line]), [""])) or not line

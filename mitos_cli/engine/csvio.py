@@ -143,14 +143,21 @@ def _raise_bad_row(lines: list[str], path: str, header: list[str],
 
 
 def _starts(line: str) -> list[int]:
-    """The 1-based column where each cell of one CSV line starts (commas inside quotes do
-    not separate cells)."""
-    starts, quoted = [1], False
+    """The 1-based column where each cell of one CSV line starts, as the ``csv`` module splits
+    it: a quote opens a quoted cell only at the cell's start (``a"b,c`` is two cells), ``""``
+    inside one is a quote, and commas inside quotes do not separate cells."""
+    starts, quoted, fresh, closed = [1], False, True, -2
     for i, ch in enumerate(line):
-        if ch == '"':
-            quoted = not quoted
-        elif ch == "," and not quoted:
+        if quoted:
+            if ch == '"':
+                quoted, closed = False, i
+        elif ch == '"' and (fresh or closed == i - 1):
+            quoted = True
+        elif ch == ",":
             starts.append(i + 2)
+            fresh = True
+            continue
+        fresh = False
     return starts
 
 
