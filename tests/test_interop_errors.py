@@ -140,7 +140,6 @@ SUGENO_CASES = [
     ("  aggregation: none", "  aggregation: Maximum\n  lock-range: true",
      "`lock-range: true` on the Takagi-Sugeno output"),
     ("  aggregation: none\n", "  aggregation: Maximum\n", "is concluded by several rules while"),
-    ("then y is off", "then y is very off", "hedges on a Takagi-Sugeno consequent"),
     ("term: on Linear 0.01 0.5 0.1", "term: on Linear 0.5 0.1", "Linear takes one coefficient"),
     ("defuzzifier: WeightedAverage TakagiSugeno\n  default: nan\n  lock-previous: false\n"
      "  term: off Constant 0.2", "defuzzifier: Centroid\n  default: nan\n  lock-previous: "

@@ -118,6 +118,16 @@ class CompiledRuleBase:
         # (an explicit row count: with no rules, ``reshape(-1, 0)`` cannot infer it)
         return K.reshape(len(self.outputs) + len(distinct), self.n_rules), rows
 
+    @functools.cached_property
+    def hedged_outputs(self) -> tuple[int, ...]:
+        """Outputs of weighted inference with a hedged consequent (each hedges its rule's
+        weight, :func:`mitos_cli.engine.evaluation.weighted_average`); none under Mamdani,
+        where a hedge reshapes the consequent set."""
+        if self.operators.inference == "mamdani":
+            return ()
+        return tuple(j for j in range(len(self.outputs))
+                     if any(row[j] for row in self.cons_hedges))
+
     @property
     def n_rules(self) -> int:
         return len(self.labels)

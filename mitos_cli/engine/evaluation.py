@@ -313,6 +313,8 @@ def weighted_average(compiled: CompiledRuleBase, dof: np.ndarray,
         sums = tree_sum(W)
     else:
         sums = _constant_sums(plan, dof)
+    if compiled.hedged_outputs:
+        return _hedged_average(compiled, dof, Xt, sums)
     if compiled.operators.inference == "weighted_sum":
         return sums[:m].copy()
     den = sums[plan.den_row]
@@ -320,6 +322,32 @@ def weighted_average(compiled: CompiledRuleBase, dof: np.ndarray,
     if fired.all():
         return np.divide(sums[:m], den)
     return np.divide(sums[:m], den, out=np.full((m, dof.shape[1]), np.nan), where=fired)
+
+
+def _hedged_average(compiled: CompiledRuleBase, dof: np.ndarray, Xt: np.ndarray | None,
+                    sums: np.ndarray) -> np.ndarray:
+    """Weighted inference where consequents carry hedges (``then tip is very high``): the
+    hedge weights that rule's consequent by ``hedge(dof)`` (fuzzylite's reading; hedging a
+    singleton's set, Zadeh's reading, would change nothing). Outputs without hedges keep
+    their sums; a hedged one is summed again over its own weights (a loop over the few
+    distinct hedges of an output, never over rules)."""
+    m = len(compiled.outputs)
+    nums, dens = sums[:m].copy(), sums[compiled.plan.den_row].copy()
+    Y = linear_consequents(compiled, Xt) if compiled.cons_linear is not None and Xt is not None \
+        else None
+    for j in compiled.hedged_outputs:
+        D = dof * compiled.cons_mask[:, j, None]
+        column = [compiled.cons_hedges[r][j] for r in range(compiled.n_rules)]
+        for hedges in dict.fromkeys(h for h in column if h):
+            rows = np.array([h == hedges for h in column])
+            D[rows] = hedge_mod.apply(hedges, dof[rows])
+        y = Y[j] if Y is not None else compiled.cons_value[:, j, None]
+        dens[j] = tree_sum(D.copy())
+        nums[j] = tree_sum(np.multiply(D, y))
+    if compiled.operators.inference == "weighted_sum":
+        return nums
+    fired = dens > 0
+    return np.divide(nums, dens, out=np.full(nums.shape, np.nan), where=fired)
 
 
 def _constant_sums(plan, dof: np.ndarray) -> np.ndarray:

@@ -60,7 +60,7 @@ def scalar_function(c: CompiledRuleBase) -> ScalarFn | None:
 def _source(c: CompiledRuleBase) -> str:
     ops = c.operators
     if (c.shape_groups or ops.inference == "mamdani" or c.n_columns > MAX_COLUMNS
-            or ops.and_ not in NORMS or ops.or_ not in NORMS):
+            or c.hedged_outputs or ops.and_ not in NORMS or ops.or_ not in NORMS):
         raise _Unsupported
     plan = c.plan
     k = len(c.inputs)

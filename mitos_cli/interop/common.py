@@ -23,6 +23,7 @@ from ..lang.model import And, Behavior, Consequent, Expr, Not, Or, Prop, Rule, R
 from ..lang.resolve import MAIN, check_rule
 from ..lang.terms import Term, TermSet, Variable
 from ..words import plural
+from . import rewrite
 
 # ---------------------------------------------------------------------------------------------
 # Operators: MITOS name -> (FLL, FIS, FCL). None = the format has no name for it.
@@ -392,17 +393,20 @@ def check_implication(name: str, span: Span | None) -> str:
 
 
 def assemble(path: str | None, variables: list[Variable], rules: list[Rule], settings: Settings,
-             default_resolution: int, span: Span | None = None) -> RuleBase:
+             default_resolution: int, span: Span | None = None,
+             notes: list[str] | None = None) -> RuleBase:
     """Check what a reader gathered and return the rule base (one behavior, ``main``)."""
-    return assemble_blocks(path, variables, [(MAIN, rules, settings)], default_resolution, span)
+    return assemble_blocks(path, variables, [(MAIN, rules, settings)], default_resolution, span,
+                           notes)
 
 
 def assemble_blocks(path: str | None, variables: list[Variable],
                     blocks: list[tuple[str, list[Rule], Settings]], default_resolution: int,
-                    span: Span | None = None) -> RuleBase:
+                    span: Span | None = None, notes: list[str] | None = None) -> RuleBase:
     """The rule base of one or more rule blocks: one block gives behavior ``main`` with the
     operators on the file; several (whose operators differ) give one behavior each, with its
-    own operators, the first being the default."""
+    own operators, the first being the default. Chained outputs are restated first
+    (:func:`.rewrite.unchain`), with a line in ``notes``."""
     names = [v.name for v in variables]
     for v in variables:
         if names.count(v.name) > 1:
@@ -414,7 +418,12 @@ def assemble_blocks(path: str | None, variables: list[Variable],
     check_numbers(variables)
     by_name = {v.name: v for v in variables}
     behaviors = []
+    outputs = {v.name for v in variables if v.role == "output"}
     for name, rules, settings in blocks:
+        and_, or_ = settings.and_ or "min", settings.or_ or "max"
+        aggregation = settings.aggregation or (None if settings.sugeno else "max")
+        rules = rewrite.unchain(rules, outputs, and_, or_, aggregation,
+                                notes if notes is not None else [])
         _check_block(rules, settings, by_name, len(blocks) == 1)
         operators = settings.operators(default_resolution)
         try:
@@ -452,11 +461,6 @@ def _check_block(rules: list[Rule], settings: Settings, by_name: dict[str, Varia
         except MitosError as exc:
             raise FormatError(exc.message, span=exc.span or rule.span, expected=exc.expected,
                               hint=exc.hint) from None
-        if sugeno:
-            for c in rule.consequents:
-                if c.hedges:
-                    raise FormatError("hedges on a Takagi-Sugeno consequent are not supported",
-                                      span=c.span)
 
 
 # ---------------------------------------------------------------------------------------------

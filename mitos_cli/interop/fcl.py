@@ -45,7 +45,7 @@ from ..lang.terms import Role, Term, Variable
 from ..words import plural
 from . import common
 from .common import FCL, FLL, fmt_number
-from .ruletree import conclusion, expression
+from .ruletree import conclusions, expression
 
 DEFAULT_RESOLUTION = 1000
 
@@ -235,7 +235,7 @@ def _function_block(fb: Tree, span_of) -> RuleBase:
                         hint=f"for a singleton write `TERM {term.name} := value;`")
     ordered = [variables[n] for n in declared]
     rb = common.assemble_blocks(span_of(fb).path, ordered, groups, DEFAULT_RESOLUTION,
-                                span_of(fb))
+                                span_of(fb), notes)
     return dataclasses.replace(rb, notes=tuple(notes))
 
 
@@ -466,7 +466,7 @@ def _rule(item: Tree, variables: dict[str, Variable], span_of, index: int) -> Ru
     label = label if not label.isdigit() else f"r{label}"
     antecedent = expression(antecedent_tree, span_of, variables)
     weight = _num(weight_tree) if weight_tree is not None else 1.0
-    return Rule(label, antecedent, tuple(conclusion(c, span_of) for c in rest[:-1]), weight,
+    return Rule(label, antecedent, conclusions(rest[:-1], span_of), weight,
                 span_of(item))
 
 

@@ -180,7 +180,7 @@ def parse_fis(text: str, path: str | None = None) -> RuleBase:
                               f"{'AND' if connective is And else 'OR'}", span=used.span,
                               hint=f"give {key} a method, e.g. "
                                    f"'{'min' if connective is And else 'max'}'")
-    rb = common.assemble(path, variables, rules, settings, DEFAULT_RESOLUTION, sys_span)
+    rb = common.assemble(path, variables, rules, settings, DEFAULT_RESOLUTION, sys_span, notes)
     return dataclasses.replace(rb, notes=tuple(notes))
 
 

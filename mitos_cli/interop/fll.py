@@ -37,7 +37,8 @@ from ..lang.resolve import MAIN
 from ..lang.terms import Role, Term, Variable
 from . import common
 from .common import FLL, Settings, fmt_number
-from .ruletree import conclusion, expression
+from .ruletree import conclusions as conclusions_of
+from .ruletree import expression
 
 SECTIONS = ("Engine", "InputVariable", "OutputVariable", "RuleBlock")
 KEYS = {
@@ -185,7 +186,7 @@ def parse_fll(text: str, path: str | None = None) -> RuleBase:
         mine = [v for v in variables if v.role == "input" or v.name in concluded or
                 len(groups) == 1]
         _check_outputs(mine, rules, settings)
-    rb = common.assemble_blocks(path, built, groups, DEFAULT_RESOLUTION, engine_span)
+    rb = common.assemble_blocks(path, built, groups, DEFAULT_RESOLUTION, engine_span, notes)
     return dataclasses.replace(rb, notes=tuple(notes))
 
 
@@ -348,7 +349,7 @@ def _rule(value: str, text: str, path: str | None, lineno: int, vcol: int,
     _check_operators(antecedent_tree, conj, span_of)
     weight = common.number(str(weight_token), span_of(weight_token)) if weight_token else 1.0
     span = Span.in_text(text, path, lineno, vcol, vcol + len(value))
-    return Rule(f"r{index + 1}", antecedent, tuple(conclusion(c, span_of) for c in conclusions),
+    return Rule(f"r{index + 1}", antecedent, conclusions_of(conclusions, span_of),
                 weight, span)
 
 

