@@ -81,9 +81,9 @@ def unchain(rules: list[Rule], outputs: set[str], and_: str, or_: str,
         for c in rule.consequents:
             if c.term is None or c.var not in outputs:
                 continue
-            if rule.weight != 1.0 or c.hedges:
-                if any(p.var == c.var for r in rules for p in _props(r.antecedent)):
-                    raise FormatError(f"rule `{rule.label}` sets the chained output `{c.var}` "
+            if (rule.weight != 1.0 or c.hedges) and any(
+                    p.var == c.var for r in rules for p in _props(r.antecedent)):
+                raise FormatError(f"rule `{rule.label}` sets the chained output `{c.var}` "
                                       f"with a weight or hedge, which the rules testing it "
                                       f"would see: not supported", span=c.span or rule.span)
             sources.setdefault((c.var, c.term), []).append(antecedent)
