@@ -42,12 +42,7 @@ needs_fuzzylite = pytest.mark.skipif(EXAMPLES is None, reason="pyfuzzylite is no
 
 #: Engines MITOS refuses, and the words of the refusal (its cause).
 REFUSED = {
-    "mamdani/laundry.fll": "is an output variable and cannot appear in a condition",
-    "mamdani/simple_dimmer_chained.fll": "is an output variable and cannot appear",
-    "mamdani/simple_dimmer_inverse.fll": "is an output variable and cannot appear",
     "takagi_sugeno/approximation.fll": "lock-previous: true",
-    "takagi_sugeno/octave/sugeno_tip_calculator.fll": "hedges on a Takagi-Sugeno consequent",
-    "terms/function.fll": "`Function` terms (a free formula) are not supported",
     "tsukamoto/tsukamoto.fll": "Tsukamoto inference",
 }
 #: Engines MITOS reads whose table it does not match, and why (checked below).

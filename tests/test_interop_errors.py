@@ -81,7 +81,7 @@ FLL_CASES = [
     ("activation: General", "activation: Highest 2", "activation `Highest 2` is not supported"),
     ("  range: 0 1\n  term: small", "  term: small", "variable `b` has no `range`"),
     ("term: low Triangle 0 2 5", "term: low Linear 1 2 3", "Linear terms belong to outputs"),
-    ("term: low Triangle 0 2 5", "term: low Function x*x", "`Function` terms (a free formula)"),
+    ("term: low Triangle 0 2 5", "term: low Function y*y", "unknown name `y` in the formula"),
     ("term: low Triangle 0 2 5", "term: low Triangel 0 2 5", "unknown term type `Triangel`"),
     ("term: low Triangle 0 2 5", "term: low Triangle 0 2", "Triangle takes 3 numbers, not 2"),
     ("term: low Triangle 0 2 5", "term: low Triangle 0 2 5 0.5", "a term height (0.5)"),

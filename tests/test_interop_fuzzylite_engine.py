@@ -158,3 +158,89 @@ def test_hedged_sugeno_consequents_agree_with_fuzzylite():
     engine.process()
     theirs = np.column_stack([engine.output_variable(n).value for n in ("y", "z")])
     assert np.allclose(run(HEDGED, X[:, None]), theirs, atol=1e-12)
+
+
+# ---------------------------------------------------------------------------------------------
+# Function terms: a membership given by a formula of x, parsed (never eval'd)
+
+FUNCTION = """\
+Engine: function
+InputVariable: u
+  range: 0 1
+  term: bump Function 1 - 4 * (x - 0.5)^2
+  term: edge Function fabs(1 - 2*x) * lt(x, 0.5) + ge(x, 0.75) * (x - 0.75) * 4
+OutputVariable: y
+  range: 0 1
+  aggregation: Maximum
+  defuzzifier: Centroid 100
+  default: nan
+  term: low Function lt(x, 0.5) * (1 - 2 * x)
+  term: high Triangle 0.4 1 1
+RuleBlock: b
+  implication: Minimum
+  activation: General
+  rule: if u is bump then y is high
+  rule: if u is edge then y is low
+"""
+
+
+def test_function_terms_are_their_formulas_on_inputs_and_outputs():
+    from mitos_cli.fuzzy.formula import parse
+
+    rb = parse_fll(FUNCTION, "t.fll")
+    bump = rb.variables["u"].term("bump")
+    assert bump.shape == "formula" and bump.formula == parse("1 - 4 * (x - 0.5)^2")
+    x = np.array([0.0, 0.25, 0.5, 0.9])
+    assert np.allclose(bump.membership(x), 1 - 4 * (x - 0.5) ** 2, atol=0)
+    edge = rb.variables["u"].term("edge").membership(x)
+    assert np.allclose(edge, np.abs(1 - 2 * x) * (x < 0.5) + (x >= 0.75) * (x - 0.75) * 4)
+    fl = pytest.importorskip("fuzzylite")
+    engine = fl.FllImporter().from_string(FUNCTION)
+    X = np.linspace(0.01, 0.99, 30)
+    engine.input_variable("u").value = X
+    engine.process()
+    assert np.allclose(run(FUNCTION, X[:, None])[:, 0], engine.output_variable("y").value,
+                       atol=1e-12, equal_nan=True)
+
+
+@pytest.mark.parametrize("formula, column, words", [
+    ("1 - sin(x", 10, "expected `)`"),
+    ("1 - sine(x)", 5, "unknown name `sine`"),
+    ("x ** * 2", 6, "unexpected `*`"),
+    ("inputX / 2", 1, "unknown name `inputX`"),
+    ("x $ 2", 3, "cannot read `$`"),
+    ("(x + 1) 2", 9, "after a complete formula"),
+])
+def test_a_bad_formula_is_refused_at_its_column(formula, column, words):
+    text = FUNCTION.replace("1 - 4 * (x - 0.5)^2", formula)
+    with pytest.raises(FormatError) as info:
+        parse_fll(text, "t.fll")
+    assert words in info.value.message
+    start = text.splitlines()[3].index(formula) + 1
+    assert info.value.span.line == 4 and info.value.span.column == start + column - 1
+
+
+def test_a_formula_membership_outside_0_1_is_refused_at_evaluation():
+    from mitos_cli.errors import InputError
+
+    text = FUNCTION.replace("1 - 4 * (x - 0.5)^2", "2 * x")
+    with pytest.raises(InputError, match=r"gives 1\.8 at u = 0\.9"):
+        run(text, [[0.9]])
+
+
+def test_formula_terms_round_trip_through_fll_and_term_sets(tmp_path):
+    from mitos_cli.api import read_rulebase
+    from mitos_cli.interop import write_foreign
+    from mitos_cli.interop.rules_writer import write_rules
+
+    rb = parse_fll(FUNCTION, "t.fll")
+    X = np.linspace(0.01, 0.99, 30)[:, None]
+    want = run(FUNCTION, X)
+    assert np.array_equal(run(write_foreign(rb, "fll"), X), want, equal_nan=True)
+    rules, terms = write_rules(rb, "t.terms.yaml")
+    (tmp_path / "t.rules").write_text(rules)
+    (tmp_path / "t.terms.yaml").write_text(terms)
+    back = compile_rulebase(read_rulebase(tmp_path / "t.rules"))
+    assert np.array_equal(evaluate(back, X, strict=False).outputs, want, equal_nan=True)
+    with pytest.raises(FormatError, match="FCL has no formula terms"):
+        write_foreign(rb, "fcl")

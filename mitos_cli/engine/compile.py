@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..fuzzy.formula import Formula
 from ..fuzzy.shapes import kernel_params
 from ..lang import operators as ops_mod
 from ..lang.model import And, Expr, Not, Prop, Rule, RuleBase, Setting, Use, flatten, format_rule
@@ -48,6 +49,7 @@ class ShapeGroup:
     cols: np.ndarray              # [g] columns in V (2 + term index)
     inputs: np.ndarray            # [g] input column of each
     params: np.ndarray            # [g, p]
+    formula: Formula | None = None   # the one term of a ``formula`` group
 
 
 @dataclass(frozen=True, eq=False)
@@ -405,18 +407,19 @@ def _membership_layer(inputs: tuple[str, ...], variables) -> _Members:
     terms = tuple(t for v in inputs for t in variables[v].terms)
     term_var = [k for k, v in enumerate(inputs) for _ in variables[v].terms]
     kernel = np.zeros((4, len(terms)))
-    groups: dict[tuple[str, int], list[int]] = {}   # variadic shapes group by param count
+    # variadic shapes group by param count, formula terms by formula
+    groups: dict[tuple[str, int, Formula | None], list[int]] = {}
     for i, t in enumerate(terms):
         if t.corners is not None:
             kernel[:, i] = kernel_params(t.corners)
         else:
-            groups.setdefault((t.shape, len(t.params)), []).append(i)
+            groups.setdefault((t.shape, len(t.params), t.formula), []).append(i)
     shape_groups = tuple(
         ShapeGroup(shape, np.array([2 + i for i in idx], dtype=np.intp),
                    np.array([term_var[i] for i in idx], dtype=np.intp),
                    np.array([terms[i].params for i in idx], dtype=float).reshape(
-                       len(idx), n_params))
-        for (shape, n_params), idx in groups.items())
+                       len(idx), n_params), formula)
+        for (shape, n_params, formula), idx in groups.items())
     return _Members(names, terms, np.array(term_var, dtype=np.intp),
                     np.array([t.corners is not None for t in terms], dtype=bool), kernel,
                     shape_groups)

@@ -183,9 +183,27 @@ def memberships(compiled: CompiledRuleBase, Xt: np.ndarray, out: np.ndarray) -> 
         if not plan.all_linear:
             out[2 + plan.linear_rows] = rise
     for g in compiled.shape_groups:
-        shape = SHAPES[g.shape]
         x = Xt[g.inputs]
+        if g.formula is not None:
+            out[g.cols] = _formula_memberships(compiled, g, x)
+            continue
+        shape = SHAPES[g.shape]
         out[g.cols] = shape.fn(x, *(g.params[:, i:i + 1] for i in range(g.params.shape[1])))
+
+
+def _formula_memberships(compiled: CompiledRuleBase, g, x: np.ndarray) -> np.ndarray:
+    """A formula term's memberships; a value that is no degree (NaN, or outside [0, 1]) is
+    refused with the term and the input, never passed on (a hedge would turn it into NaN)."""
+    assert g.formula is not None
+    mu = g.formula(x)
+    bad = ~((mu >= 0.0) & (mu <= 1.0))
+    if bad.any():
+        row, col = map(int, np.argwhere(bad)[0])
+        var, term = compiled.term_names[int(g.cols[row]) - 2]
+        raise InputError(f"term `{var}.{term}` (formula `{g.formula.text}`) gives {mu[row, col]:g} "
+                         f"at {var} = {x[row, col]:g}: a membership degree lies in [0, 1]",
+                         hint="change the formula so it stays within [0, 1] on the universe")
+    return mu
 
 
 def _apply_group(group, V: np.ndarray, tnorm: norms.Norm, snorm: norms.Norm) -> None:

@@ -438,3 +438,14 @@ for _shape in (
           variadic=True),
 ):
     register(_shape)
+
+
+def _formula_fn(x, *params):
+    raise TypeError("a formula term is evaluated by its Formula (Term.membership), not by params")
+
+
+#: ``formula``: a membership function of ``x`` written as a formula (fuzzylite's ``Function``,
+#: :mod:`mitos_cli.fuzzy.formula`); the formula lives on the term, the params are empty.
+register(Shape("formula", (), _formula_fn, lambda p: None, None, lambda p: float("nan"),
+               "a membership function given by a formula of x (fuzzylite's Function)"))
+

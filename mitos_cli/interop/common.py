@@ -16,6 +16,7 @@ from pathlib import Path
 
 from ..errors import FormatError, MitosError, Span, did_you_mean
 from ..fuzzy import norms as norm_registry
+from ..fuzzy.formula import Formula
 from ..fuzzy.hedges import HEDGES, fuzzylite_names
 from ..fuzzy.shapes import SHAPES
 from ..lang import operators as ops_mod
@@ -119,6 +120,27 @@ def to_fuzzylite_hedge(name: str) -> str:
         raise FormatError(f"fuzzylite has no hedge like MITOS's `{name}` (x^3)",
                           hint="use `very` (x^2) or `intensely` (fuzzylite's `extremely`)")
     return MITOS_TO_FUZZYLITE_HEDGES[name]
+
+
+def written_consequents(rule: Rule) -> list[tuple[Consequent, tuple[str, ...]]]:
+    """A rule's consequents as fuzzylite's rule text must list them, each with the hedges to
+    write before its term: fuzzylite carries a consequent's hedges on to the ones after it
+    (:func:`.ruletree.conclusions`), so less-hedged consequents come first and each writes
+    only the hedges it adds. Hedges that cannot be carried that way are refused by name."""
+    ordered = sorted(rule.consequents, key=lambda c: len(c.hedges))
+    out = []
+    carried: tuple[str, ...] = ()
+    for c in ordered:
+        own = len(c.hedges) - len(carried)
+        if c.hedges[own:] != carried:
+            raise FormatError(f"rule `{rule.label}`: hedges `{' '.join(c.hedges)}` on `{c.var}` "
+                              f"and `{' '.join(carried)}` on another consequent cannot be "
+                              f"written in fuzzylite's rules, which carry a consequent's hedges "
+                              f"on to the consequents after it", span=rule.span,
+                              hint="split the rule in two")
+        out.append((c, c.hedges[:own]))
+        carried = c.hedges
+    return out
 
 
 def concluded_term(c: Consequent) -> str:
@@ -225,9 +247,16 @@ def make_term(name: str, shape: str, params: tuple[float, ...], span: Span | Non
     return Term(name, shape, tuple(float(p) for p in params), span)
 
 
+def formula_term(name: str, formula: Formula, span: Span | None) -> Term:
+    """fuzzylite's ``Function`` term: a membership given by a formula of ``x``."""
+    return Term(name, "formula", (), span, formula=formula)
+
+
 def fuzzylite_term_text(term: Term, variable: str) -> str:
     """``Kind p1 p2 ...`` for a MITOS term (FLL and fuzzylite's FCL)."""
     shape, p = term.shape, term.params
+    if term.formula is not None:
+        return f"Function {term.formula.text}"
     if shape in ("left_shoulder", "right_shoulder", "triangle_pw", "triangle_plr"):
         corners = term.corners
         assert corners is not None             # these four shapes are piecewise linear
@@ -447,6 +476,11 @@ def _check_block(rules: list[Rule], settings: Settings, by_name: dict[str, Varia
         if v.role != "output" or not (every_output or v.name in concluded):
             continue
         for t in v.terms:
+            if sugeno and t.formula is not None:
+                raise FormatError(
+                    f"output term `{v.name}.{t.name}`: a formula as a weighted-average "
+                    f"consequent (a function of the engine's variables) is not supported",
+                    span=t.span, hint="use Constant or Linear terms")
             if sugeno and t.shape not in ("singleton", "linear"):
                 raise FormatError(
                     f"output term `{v.name}.{t.name}`: a weighted-average output needs constant "

@@ -525,6 +525,9 @@ def write_fcl(rb: RuleBase, behavior: str | None = None) -> str:
 
 
 def _term_text(t: Term, v: Variable) -> str:
+    if t.formula is not None:
+        raise FormatError(f"term `{v.name}.{t.name}`: FCL has no formula terms (fuzzylite's "
+                          f"`Function`); write it to FLL or a term set")
     if t.shape == "singleton":
         return fmt_number(t.params[0])
     if t.shape == "clipped_sigmoid_difference":          # jFuzzyLogic's DSIGM g1 c1 g2 c2
@@ -567,8 +570,8 @@ def _rule_text(r: Rule) -> str:
         return f"({text})" if parent not in ("top", op, "not") else text
 
     cons = " AND ".join(f"{c.var} IS " + " ".join(
-        [common.to_fuzzylite_hedge(h) for h in c.hedges] + [common.concluded_term(c)])
-        for c in r.consequents)
+        [common.to_fuzzylite_hedge(h) for h in hedges] + [common.concluded_term(c)])
+        for c, hedges in common.written_consequents(r))
     text = f"IF {expr(r.antecedent, 'top')} THEN {cons}"
     if r.weight != 1.0:
         text += f" WITH {fmt_number(r.weight)}"

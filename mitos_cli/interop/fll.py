@@ -30,6 +30,7 @@ from lark import Lark, Tree
 from lark.exceptions import UnexpectedInput
 
 from ..errors import FormatError, Span, did_you_mean
+from ..fuzzy.formula import parse as parse_formula
 from ..lang.cache import lark_parser
 from ..lang.model import Rule, RuleBase
 from ..lang.model import format_number as _fmt_weight
@@ -228,8 +229,14 @@ def _variable_key(v: _Var, key: str, value: str, span: Span, vspan: Span,
     elif key == "term":
         if len(words) < 2:
             raise FormatError("`term` takes a name, a type and its parameters", span=vspan)
-        if words[1] in common.FORMULA_TERMS:
-            common.fuzzylite_term(words[0], words[1], [], 0, vspan)     # raises
+        if words[1] == "Function":            # the rest of the line is the formula
+            start = value.index("Function", len(words[0])) + len("Function")
+            text = value[start:]
+            fspan = dataclasses.replace(vspan, column=vspan.column + start
+                                        + len(text) - len(text.lstrip()), end_column=None)
+            formula = parse_formula(text.lstrip(), fspan, FormatError)
+            v.terms.append((words[0], "Function", formula, fspan))
+            return
         v.terms.append((words[0], words[1], [common.number(w, vspan) for w in words[2:]], vspan))
     elif key == "lock-range":
         if value == "true" and v.role == "output":
@@ -308,6 +315,9 @@ def _build_variable(v: _Var, inputs: list[str], notes: list[str]) -> Variable:
         if kind == "Linear" and v.role == "input":
             raise FormatError(f"term `{v.name}.{name}`: Linear terms belong to outputs",
                               span=span)
+        if kind == "Function":
+            terms.append(common.formula_term(name, values, span))
+            continue
         terms.append(common.fuzzylite_term(name, kind, list(values), len(inputs), span))
     if not terms and v.role == "output":
         raise FormatError(f"output variable `{v.name}` has no terms", span=v.span)
@@ -474,9 +484,9 @@ def fuzzylite_rule_text(rule: Rule, ops, dialect: str) -> str:
 
     assert not isinstance(antecedent, Not)
     cons = f" {kw('and')} ".join(
-        f"{c.var} {kw('is')} " + " ".join([common.to_fuzzylite_hedge(h) for h in c.hedges]
+        f"{c.var} {kw('is')} " + " ".join([common.to_fuzzylite_hedge(h) for h in hedges]
                                           + [common.concluded_term(c)])
-        for c in rule.consequents)
+        for c, hedges in common.written_consequents(rule))
     text = f"{kw('if')} {expr(antecedent, 'top')} {kw('then')} {cons}"
     if rule.weight != 1.0:
         text += f" {kw('with')} {_fmt_weight(rule.weight)}"

@@ -32,6 +32,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import Span, TermSetError, did_you_mean
+from ..fuzzy.formula import parse as parse_formula
 from ..fuzzy.shapes import SHAPES
 from ..words import plural
 from . import yamlpos
@@ -177,6 +178,8 @@ def _term(name: str, spec: Any, key_span: Span, value_span: Span, variable: str,
     frozen = bool(spec.get("frozen", False))
     if shape == "linear":
         return _linear_term(what, name, spec, key_span, frozen, inputs)
+    if shape == "formula":
+        return _formula_term(what, name, spec, key_span, frozen)
     given = tuple(sorted(k for k in spec if k not in ("shape", "frozen")))
     if shape == "triangle":
         internal = TRIANGLE_FORMS.get(given)
@@ -228,3 +231,15 @@ def _linear_term(what: str, name: str, spec: YMap, key_span: Span, frozen: bool,
             coefficients[var] = yamlpos.expect_number(value, given.value_span(var),
                                                       TermSetError, f"{what}: coefficient")
     return Term(name, "linear", tuple(coefficients.values()) + (constant,), key_span, frozen)
+
+
+def _formula_term(what: str, name: str, spec: YMap, key_span: Span, frozen: bool) -> Term:
+    """``{shape: formula, formula: "1 / (1 + x^2)"}``: a membership function of ``x``."""
+    yamlpos.check_keys(spec, ("shape", "formula", "frozen"), TermSetError, what)
+    text = yamlpos.require(spec, "formula", TermSetError, what)
+    if not isinstance(text, str):
+        raise TermSetError(f"{what}: `formula` must be a text, e.g. \"1 / (1 + x^2)\"",
+                           span=spec.value_span("formula"))
+    formula = parse_formula(text, spec.value_span("formula"), TermSetError)
+    return Term(name, "formula", (), key_span, frozen, formula=formula)
+

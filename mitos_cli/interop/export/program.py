@@ -15,6 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...engine.compile import CompiledRuleBase
+from ...errors import FormatError
 from ...fuzzy.shapes import kernel_params
 from ...lang.model import And, Expr, Not, Prop, flatten
 
@@ -113,6 +114,9 @@ def program(compiled: CompiledRuleBase) -> Program:
     for i, key in enumerate(compiled.term_names):
         term = compiled.variables[key[0]].term(key[1])
         if names[key] in referenced:
+            if term.formula is not None:
+                raise FormatError(f"term `{key[0]}.{key[1]}`: `mitos export` has no code for "
+                                  f"formula terms (`{term.formula.text}`)")
             kernel = kernel_params(term.corners) if term.corners is not None else None
             terms.append((int(compiled.term_var[i]), names[key], term.shape, term.params, kernel))
     shapes = {t[2] for t in terms if t[4] is None}
