@@ -58,9 +58,11 @@ def read_fld(path: Path) -> tuple[list[str], np.ndarray]:
 
 
 def worst(got: np.ndarray, ref: np.ndarray) -> float:
-    """Largest |difference|, NaN = NaN (no rule fired), NaN against a number = inf."""
-    both = np.isnan(got) & np.isnan(ref)
-    diff = np.abs(np.where(both, 0.0, got - ref))
+    """Largest |difference|, NaN = NaN (no rule fired), equal infinities equal (Tsukamoto),
+    NaN against a number = inf."""
+    both = (np.isnan(got) & np.isnan(ref)) | (got == ref)     # NaN = NaN, inf = inf
+    with np.errstate(invalid="ignore"):                      # inf - inf
+        diff = np.abs(np.where(both, 0.0, got - ref))
     return float(np.where(np.isnan(diff), np.inf, diff).max(initial=0.0))
 
 

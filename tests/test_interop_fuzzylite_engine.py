@@ -244,3 +244,70 @@ def test_formula_terms_round_trip_through_fll_and_term_sets(tmp_path):
     assert np.array_equal(evaluate(back, X, strict=False).outputs, want, equal_nan=True)
     with pytest.raises(FormatError, match="FCL has no formula terms"):
         write_foreign(rb, "fcl")
+
+
+# ---------------------------------------------------------------------------------------------
+# Tsukamoto inference: each monotonic consequent term inverted at its degree
+
+TSUKAMOTO = """\
+Engine: tsukamoto
+InputVariable: u
+  range: 0 1
+  term: low Triangle 0 0 1
+  term: high Triangle 0 1 1
+OutputVariable: y
+  range: 0 10
+  aggregation: none
+  defuzzifier: WeightedAverage
+  default: nan
+  term: down Ramp 10 0
+  term: up SShape 2 8
+RuleBlock: b
+  conjunction: Minimum
+  disjunction: Maximum
+  implication: none
+  activation: General
+  rule: if u is low then y is down
+  rule: if u is high then y is up
+"""
+
+
+def test_tsukamoto_inverts_each_term_at_its_degree():
+    rb = parse_fll(TSUKAMOTO, "t.fll")
+    c = compile_rulebase(rb)
+    assert c.operators.inference == "tsukamoto"        # inferred from the monotonic terms
+    u = 0.3
+    w_down, w_up = 1 - u, u
+    z_down = 10 - 10 * w_down                          # Ramp 10 0 at w
+    z_up = 8 - 6 * np.sqrt((1 - w_up) / 2) if w_up > 0.5 else 2 + 6 * np.sqrt(w_up / 2)
+    want = (w_down * z_down + w_up * z_up) / (w_down + w_up)
+    assert run(TSUKAMOTO, [[u]])[0, 0] == pytest.approx(want, abs=1e-12)
+    fl = pytest.importorskip("fuzzylite")
+    engine = fl.FllImporter().from_string(TSUKAMOTO)
+    X = np.linspace(0.05, 0.95, 19)
+    engine.input_variable("u").value = X
+    engine.process()
+    assert np.allclose(run(TSUKAMOTO, X[:, None])[:, 0], engine.output_variable("y").value,
+                       atol=1e-12)
+
+
+def test_tsukamoto_refuses_a_term_it_cannot_invert_and_formats_without_it():
+    from mitos_cli.interop import write_foreign
+
+    with pytest.raises(FormatError, match="Tsukamoto inference inverts monotonic terms"):
+        parse_fll(TSUKAMOTO.replace("WeightedAverage", "WeightedAverage Tsukamoto").replace(
+            "term: up SShape 2 8", "term: up Triangle 2 8 9"), "t.fll")
+    rb = parse_fll(TSUKAMOTO, "t.fll")
+    X = np.linspace(0, 1, 11)[:, None]
+    assert np.array_equal(run(write_foreign(rb, "fll"), X), run(TSUKAMOTO, X), equal_nan=True)
+    for fmt in ("fcl", "fis"):
+        with pytest.raises(FormatError, match="no Tsukamoto inference"):
+            write_foreign(rb, fmt)
+
+
+def test_tsukamoto_refuses_a_term_concluded_twice():
+    from mitos_cli.errors import RuleBaseError
+
+    text = TSUKAMOTO + "  rule: if u is very high then y is up\n"
+    with pytest.raises(RuleBaseError, match="their degrees add up and may pass 1"):
+        compile_rulebase(parse_fll(text, "t.fll"))

@@ -125,7 +125,7 @@ class CompiledRuleBase:
         """Outputs of weighted inference with a hedged consequent (each hedges its rule's
         weight, :func:`mitos_cli.engine.evaluation.weighted_average`); none under Mamdani,
         where a hedge reshapes the consequent set."""
-        if self.operators.inference == "mamdani":
+        if self.operators.inference not in ("weighted_average", "weighted_sum"):
             return ()
         return tuple(j for j in range(len(self.outputs))
                      if any(row[j] for row in self.cons_hedges))
@@ -168,6 +168,13 @@ class CompiledRuleBase:
 
     def __setstate__(self, state: dict) -> None:
         self.__dict__.update(state)
+
+    @functools.cached_property
+    def tsukamoto(self):
+        """Per output, its terms and the rules concluding each, for Tsukamoto inference."""
+        from .tsukamoto import build_plan
+
+        return build_plan(self)
 
     @functools.cached_property
     def mamdani(self):
@@ -367,8 +374,11 @@ def _used_variables(rb: RuleBase, flat, operators: Operators):
             if use.condition is not None:
                 _collect_inputs(use.condition, used_inputs)
     linear_inputs: dict[str, tuple[str, ...]] = {}
+    concluded: dict[tuple[str, str | None], Rule] = {}
     for _, rule, _ in flat:
         for c in rule.consequents:
+            if operators.inference == "tsukamoto":
+                _check_tsukamoto(c, rule, variables, concluded)
             if c.term is not None and variables[c.var].term(c.term).shape == "linear":
                 names = linear_inputs.setdefault(c.var, _termset_inputs(rb, c.var))
                 coefficients = variables[c.var].term(c.term).params[:-1]
@@ -529,6 +539,29 @@ def _linear_consequents(flat, variables, inputs, outputs, linear_inputs,
                 out[r, j, -1] = term.params[-1]
                 value[r, j] = 0.0
     return out
+
+
+def _check_tsukamoto(c, rule: Rule, variables, concluded: dict) -> None:
+    """Tsukamoto inference inverts each consequent's term: only monotonic ones have one, and
+    only at a degree in [0, 1], which a term concluded by several rules (their degrees are
+    summed, fuzzylite's rule) may exceed."""
+    from ..errors import RuleBaseError
+    from ..fuzzy.shapes import TSUKAMOTO
+
+    first = concluded.setdefault((c.var, c.term), rule)
+    if first is not rule:
+        raise RuleBaseError(
+            f"`{c.var} is {c.term}` is concluded by rules `{first.label}` and `{rule.label}`: "
+            f"under Tsukamoto inference their degrees add up and may pass 1, where the term "
+            f"has no inverse", span=c.span or rule.span,
+            hint="join the rules' conditions with `or` in one rule")
+
+    shape = variables[c.var].term(c.term).shape if c.term is not None else None
+    if shape not in TSUKAMOTO:
+        what = f"a `{shape}` term" if shape else "a crisp value"
+        raise RuleBaseError(
+            f"`{c.var} is {c.term or c.value}`: Tsukamoto inference needs a monotonic "
+            f"consequent term ({', '.join(TSUKAMOTO)}), not {what}", span=c.span or rule.span)
 
 
 def _termset_inputs(rb: RuleBase, output: str) -> tuple[str, ...]:

@@ -492,6 +492,10 @@ def infer(compiled: CompiledRuleBase, dof: np.ndarray,
         from .mamdani import mamdani_outputs
 
         return mamdani_outputs(compiled, dof)
+    if compiled.operators.inference == "tsukamoto":
+        from .tsukamoto import tsukamoto_outputs
+
+        return tsukamoto_outputs(compiled, dof)
     if compiled.cons_linear is not None and Xt is None:
         raise ValueError("linear consequents need the inputs: infer(compiled, dof, Xt)")
     return weighted_average(compiled, dof, Xt)

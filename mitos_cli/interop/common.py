@@ -18,7 +18,7 @@ from ..errors import FormatError, MitosError, Span, did_you_mean
 from ..fuzzy import norms as norm_registry
 from ..fuzzy.formula import Formula
 from ..fuzzy.hedges import HEDGES, fuzzylite_names
-from ..fuzzy.shapes import SHAPES
+from ..fuzzy.shapes import SHAPES, TSUKAMOTO
 from ..lang import operators as ops_mod
 from ..lang.model import And, Behavior, Consequent, Expr, Not, Or, Prop, Rule, RuleBase, Setting
 from ..lang.resolve import MAIN, check_rule
@@ -318,7 +318,7 @@ class Settings:
         if self.or_:
             out.append(Setting("or", self.or_))
         defuzz = self.defuzzify or "centroid"
-        if defuzz in ("weighted_average", "weighted_sum"):
+        if defuzz in ("weighted_average", "weighted_sum", "tsukamoto"):
             out.append(Setting("inference", defuzz))
         else:
             out.append(Setting("inference", "mamdani"))
@@ -332,7 +332,8 @@ class Settings:
 
     @property
     def sugeno(self) -> bool:
-        return self.defuzzify in ("weighted_average", "weighted_sum")
+        """Weighted inference (Takagi-Sugeno or Tsukamoto): no Mamdani settings."""
+        return self.defuzzify in ("weighted_average", "weighted_sum", "tsukamoto")
 
 
 class Record(list):
@@ -481,11 +482,17 @@ def _check_block(rules: list[Rule], settings: Settings, by_name: dict[str, Varia
                     f"output term `{v.name}.{t.name}`: a formula as a weighted-average "
                     f"consequent (a function of the engine's variables) is not supported",
                     span=t.span, hint="use Constant or Linear terms")
+            if settings.defuzzify == "tsukamoto":
+                if t.shape not in TSUKAMOTO:
+                    raise FormatError(f"output term `{v.name}.{t.name}`: Tsukamoto inference "
+                                      f"inverts monotonic terms ({', '.join(TSUKAMOTO)}), not "
+                                      f"a `{t.shape}` term", span=t.span)
+                continue
             if sugeno and t.shape not in ("singleton", "linear"):
                 raise FormatError(
                     f"output term `{v.name}.{t.name}`: a weighted-average output needs constant "
-                    f"or linear terms; a `{t.shape}` term there is Tsukamoto inference, which "
-                    f"MITOS does not support", span=t.span)
+                    f"or linear terms (Takagi-Sugeno) or monotonic ones (Tsukamoto: "
+                    f"{', '.join(TSUKAMOTO)}), not a `{t.shape}` term", span=t.span)
             if not sugeno and t.shape == "linear":
                 raise FormatError(f"output term `{v.name}.{t.name}`: linear terms need a "
                                   f"weighted-average (Takagi-Sugeno) defuzzifier", span=t.span)

@@ -478,6 +478,8 @@ def write_fcl(rb: RuleBase, behavior: str | None = None) -> str:
     """FCL text (IEC 61131-7 as jFuzzyLogic reads it) for one behavior of ``rb``."""
     flat = common.flatten_for_export(rb, behavior)
     ops = flat.operators
+    if ops.inference == "tsukamoto":
+        raise FormatError("FCL has no Tsukamoto inference; write it to FLL or a rule file")
     sugeno = ops.inference in ("weighted_average", "weighted_sum")
     inputs = common.all_inputs(rb, flat)
     out = [f"FUNCTION_BLOCK {flat.name}", "", "VAR_INPUT"]

@@ -333,6 +333,9 @@ def write_fis(rb: RuleBase, behavior: str | None = None) -> str:
     negated, without hedges) joined all by AND or all by OR, as MATLAB's rule list is."""
     flat = common.flatten_for_export(rb, behavior)
     ops = flat.operators
+    if ops.inference == "tsukamoto":
+        raise FormatError("MATLAB's .fis has no Tsukamoto inference; write it to FLL or a "
+                          "rule file")
     sugeno = ops.inference in ("weighted_average", "weighted_sum")
     inputs = common.all_inputs(rb, flat)
     name = flat.name

@@ -75,6 +75,8 @@ def term_columns(compiled: CompiledRuleBase) -> dict[tuple[str, str], str]:
 
 def program(compiled: CompiledRuleBase) -> Program:
     """Build the straight-line program of ``compiled``."""
+    if compiled.operators.inference == "tsukamoto":
+        raise FormatError("`mitos export` has no code for Tsukamoto inference")
     names = term_columns(compiled)
     hedges: set[str] = set()
     used: set[str] = set()
