@@ -93,7 +93,8 @@ def cli_batch(fll: Path, header: list[str], table: np.ndarray, behavior: str | N
     args = [sys.executable, "-m", "mitos_cli", "eval", str(fll), "--batch", str(csv)]
     if behavior:
         args += ["-b", behavior]
-    proc = subprocess.run(args, capture_output=True, text=True, cwd=tmp)
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}       # this checkout's MITOS, not another
+    proc = subprocess.run(args, capture_output=True, text=True, cwd=tmp, env=env)
     if proc.returncode != 0:
         raise RuntimeError(proc.stderr.strip().splitlines()[-1] if proc.stderr else "failed")
     lines = proc.stdout.splitlines()

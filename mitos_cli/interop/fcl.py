@@ -148,7 +148,8 @@ def _function_block(fb: Tree, span_of) -> RuleBase:
         if item.data in ("var_input", "var_output"):
             role: Role = "input" if item.data == "var_input" else "output"
             for decl in item.children:
-                name, typ, rng = decl.children
+                name, typ, rng, after = decl.children
+                rng = rng if rng is not None else after
                 if str(name) in declared:
                     raise FormatError(f"variable `{name}` is declared twice", span=span_of(name))
                 if str(typ).upper() != "REAL":
@@ -279,6 +280,11 @@ def _variable(node: Tree, role: Role, declared, settings: common.Record, locks: 
                 raise FormatError(f"unknown DEFAULT flag `{flag}`", span=span_of(flag),
                                   expected="NC")
             if isinstance(value, Token) and value.type == "NAME":
+                if str(value).upper() == "NC":
+                    raise FormatError("`DEFAULT := NC` (no change: keep the previous output "
+                                      "when no rule fires) needs state between evaluations, "
+                                      "which MITOS does not keep", span=span_of(value),
+                                      hint="give a number: `DEFAULT := value;`")
                 raise FormatError(f"DEFAULT must be a number, not `{value}`", span=span_of(value))
             default = _num(value)              # nan: NaN when no rule fires, as asked
         elif kind == "lock_item":
@@ -361,6 +367,21 @@ def _extent(terms: list[Term], name: str, span: Span,
     return min(xs), max(xs)
 
 
+def _no_variable(term: str, node, span_of) -> None:
+    """jFuzzyLogic lets a membership parameter be a variable's name (optimised by its
+    learning code); MITOS's terms have numbers."""
+    if isinstance(node, Token) and node.type == "NAME":
+        raise FormatError(f"term `{term}`: a parameter given by a variable (`{node}`) is not "
+                          f"supported", span=span_of(node), hint="write the number")
+
+
+def _point_values(term: str, points, span_of):
+    for p in points:
+        for v in p.children:
+            _no_variable(term, v, span_of)
+    return points
+
+
 def _term(item: Tree, role: str, n_inputs: int, span_of) -> Term:
     name_token, definition = item.children
     name, span = str(name_token), span_of(item)
@@ -372,10 +393,17 @@ def _term(item: Tree, role: str, n_inputs: int, span_of) -> Term:
                           f"not supported", span=span_of(definition.children[0]),
                           hint="replace the formula by one of the shapes (trian, trape, gauss, "
                                "gbell, sigm, ...) or a point list")
+    if definition.data == "singletons_def":
+        raise FormatError(f"term `{name}`: SINGLETONS terms (several weighted singletons in one "
+                          f"term) are not supported", span=span_of(definition.children[0]),
+                          hint="give each singleton its own term (`TERM t := value;`)")
     if definition.data == "points":
-        pts = [(_num(p.children[0]), _num(p.children[1])) for p in definition.children]
+        pts = [(_num(p.children[0]), _num(p.children[1])) for p in _point_values(
+            name, definition.children, span_of)]
         return _points_term(name, pts, span)
     kind_token, *value_nodes = definition.children
+    for v in value_nodes:
+        _no_variable(name, v, span_of)
     kind = str(kind_token)
     values = [_num(v) for v in value_nodes]
     # fuzzylite's class names in their own spelling first: `Cosine c w` is fuzzylite's
@@ -421,13 +449,19 @@ def _points_term(name: str, pts: list[tuple[float, float]], span: Span) -> Term:
     return common.make_term(name, "discrete", tuple(v for p in pts for v in p), span)
 
 
+#: Names that mean an S-norm after `OR :` (the same word after `AND :` is the T-norm).
+OR_ALIASES = {"EINSTEIN": "einstein_sum", "HAMACHER": "hamacher_sum"}
+
+
 def _option(item: Tree, settings: common.Record, span_of, conj: dict) -> None:
     key_token, value_token, number = item.children
     key, value, span = str(key_token).upper(), str(value_token), span_of(value_token)
     if key == "AND":
         settings.set("and_", _norm(common.TNORMS, value, "AND", span), span, "AND")
     elif key == "OR":
-        settings.set("or_", _norm(common.SNORMS, value, "OR", span), span, "OR")
+        # jFuzzyLogic's `OR : EINSTEIN;` is the Einstein sum (RuleConnectionMethodOrEinstein)
+        name = OR_ALIASES.get(value.upper()) or _norm(common.SNORMS, value, "OR", span)
+        settings.set("or_", name, span, "OR")
     elif key in ("ACT", "IMPLICATION"):
         settings.set("implication", common.check_implication(
             _norm(common.TNORMS, value, "ACT", span), span), span, "ACT")

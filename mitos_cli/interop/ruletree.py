@@ -41,6 +41,9 @@ def expression(tree, span_of: SpanOf, variables: dict[str, Variable]) -> Expr:
         if v is None:
             return Prop(str(var), "", ("any",), False, span_of(tree))   # checked later
         return Prop(v.name, v.terms[0].name, ("any",), False, span_of(tree))
+    if kind == "bare_variable":
+        raise FormatError(f"a condition without `IS` (`{tree.children[0]}`) is not supported",
+                          span=span_of(tree), expected=f"`{tree.children[0]} IS TERM`")
     if kind == "proposition":
         var, *words, term = tree.children
         negated, hedges = _words(words, span_of, tree, allow_not=True)
