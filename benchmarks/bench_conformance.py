@@ -2,6 +2,7 @@
 
     python benchmarks/bench_conformance.py            # everything (a few minutes)
     python benchmarks/bench_conformance.py --quick    # pyfuzzylite's examples only
+    python benchmarks/bench_conformance.py --quick --fcl-dir DIR   # and every .fcl under DIR
 
 1. pyfuzzylite's example engines (inside the installed package) through the command line,
    ``mitos eval X.fll --batch IN.csv [-b BEHAVIOR]``, against their ``.fld`` tables to 1e-6,
@@ -315,6 +316,22 @@ def round_trips(paths: list[Path], tmp: Path) -> dict:
 # ---------------------------------------------------------------------------------------------
 
 
+def part_fcl_dir(directory: Path) -> dict:
+    """Every ``.fcl`` under ``directory`` (e.g. a jFuzzyLogic checkout): it loads, or the
+    refusal names its construct (an "unexpected" token would be a reader's gap, not a refusal)."""
+    files = sorted(directory.rglob("*.fcl"))
+    rows = []
+    for path in files:
+        name = str(path.relative_to(directory))
+        try:
+            compile_rulebase(read_rulebase(path))
+        except MitosError as exc:
+            rows.append((name, "refused", refusal(exc), None))
+            continue
+        rows.append((name, "loaded", "", None))
+    return {"files": len(files), "rows": rows}
+
+
 def report_rows(title: str, part: dict) -> None:
     status = Counter(s for _, s, _, _ in part["rows"])
     print(f"\n## {title}: {part['files']} files")
@@ -336,6 +353,8 @@ def report_rows(title: str, part: dict) -> None:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="pyfuzzylite's examples only")
+    parser.add_argument("--fcl-dir", type=Path, metavar="DIR",
+                        help="also read every .fcl under DIR (e.g. a jFuzzyLogic checkout)")
     args = parser.parse_args()
     tmp = Path(tempfile.mkdtemp(prefix="mitos-conformance-"))
     all_files: list[Path] = []
@@ -364,6 +383,13 @@ def main() -> None:
                   f"({'matches' if part['tipper_ok'] else 'DIFFERS'})")
             all_files += sorted(map(Path, glob.glob(str(OCTAVE / "fuzzy-logic-toolkit*" /
                                                          "*.fis"))))
+    if args.fcl_dir:
+        part = part_fcl_dir(args.fcl_dir)
+        report_rows(f"5. FCL files under {args.fcl_dir}", part)
+        unexpected = [n for n, s, why, _ in part["rows"] if "unexpected" in why]
+        print(f"  refused without naming a construct: {len(unexpected)}"
+              + (f" ({', '.join(unexpected)})" if unexpected else ""))
+        all_files += sorted(args.fcl_dir.rglob("*.fcl"))
     rt = round_trips(all_files, tmp)
     print("\n## 4. Round trips of every file that loads (each behavior, each other format)")
     for fmt in ("fcl", "fis", "fll", "rules"):
