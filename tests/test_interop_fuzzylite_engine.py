@@ -311,3 +311,24 @@ def test_tsukamoto_refuses_a_term_concluded_twice():
     text = TSUKAMOTO + "  rule: if u is very high then y is up\n"
     with pytest.raises(RuleBaseError, match="their degrees add up and may pass 1"):
         compile_rulebase(parse_fll(text, "t.fll"))
+
+
+def test_fcl_cogs_over_monotonic_terms_is_tsukamoto():
+    from mitos_cli.interop.fcl import parse_fcl
+
+    text = """\
+FUNCTION_BLOCK t
+VAR_INPUT u : REAL; END_VAR
+VAR_OUTPUT y : REAL; END_VAR
+FUZZIFY u RANGE := (0 .. 1); TERM low := Triangle 0 0 1; TERM high := Triangle 0 1 1; END_FUZZIFY
+DEFUZZIFY y RANGE := (0 .. 10); TERM down := Ramp 10 0; TERM up := SShape 2 8;
+  METHOD : COGS; DEFAULT := nan; END_DEFUZZIFY
+RULEBLOCK b AND : MIN; RULE 1 : IF u IS low THEN y IS down; RULE 2 : IF u IS high THEN y IS up;
+END_RULEBLOCK
+END_FUNCTION_BLOCK
+"""
+    c = compile_rulebase(parse_fcl(text, "t.fcl"))
+    assert c.operators.inference == "tsukamoto"
+    X = np.linspace(0, 1, 11)[:, None]
+    assert np.array_equal(evaluate(c, X, strict=False, detail=False).outputs,
+                          run(TSUKAMOTO, X), equal_nan=True)

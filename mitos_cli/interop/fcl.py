@@ -38,6 +38,7 @@ from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput
 
 from ..errors import FormatError, Span, did_you_mean
 from ..fuzzy import norms
+from ..fuzzy.shapes import TSUKAMOTO
 from ..lang.cache import lark_parser
 from ..lang.model import And, Not, Prop, Rule, RuleBase
 from ..lang.resolve import MAIN
@@ -200,6 +201,8 @@ def _function_block(fb: Tree, span_of) -> RuleBase:
         parsed.append((name, record, rules))
     parsed = [p for p in parsed if p[2]] or parsed[:1]
     outputs = [n for n in declared if declared[n][0] == "output"]
+    for n in outputs:
+        _tsukamoto(records[n], variables[n], notes)
     try:
         all_rules = [r for _, _, rules in parsed for r in rules]
         if len({r.label for r in all_rules}) < len(all_rules):
@@ -238,6 +241,20 @@ def _function_block(fb: Tree, span_of) -> RuleBase:
     rb = common.assemble_blocks(span_of(fb).path, ordered, groups, DEFAULT_RESOLUTION,
                                 span_of(fb), notes)
     return dataclasses.replace(rb, notes=tuple(notes))
+
+
+def _tsukamoto(record: common.Record, v: Variable, notes: list[str]) -> None:
+    """`METHOD : COGS;` over monotonic terms is Tsukamoto inference, as fuzzylite's FCL
+    importer infers it (its weighted defuzzifiers' `Automatic` type)."""
+    if not v.terms or any(t.shape not in TSUKAMOTO for t in v.terms):
+        return
+    for i, (key, value, where, what) in enumerate(record):
+        if key == "defuzzify" and value == "weighted_average":
+            record[i] = (key, "tsukamoto", where, what)
+            if any(t.shape == "sigmoid" for t in v.terms):
+                notes.append(f"{where}: `{v.name}` inverts sigmoid terms (Tsukamoto inference); "
+                             f"a sigmoid reaches 1 only at infinity, so where a rule fires "
+                             f"fully the output is +-inf, as in fuzzylite")
 
 
 def _variable(node: Tree, role: Role, declared, settings: common.Record, locks: dict,

@@ -256,6 +256,10 @@ def _mf(value: str, vspan: Span, role: str, kind: str, n_inputs: int) -> Term:
     m = re.fullmatch(r"'([^']*)'\s*:\s*'([^']*)'\s*,\s*(\[.*\])", value.strip())
     if not m:
         raise FormatError("expected 'name':'type',[params]", span=vspan)
+    if m.group(2) == "function":          # fuzzylite's .fis extension: a formula
+        raise FormatError(f"MF `{m.group(1)}`: `function` MFs (fuzzylite's formula of the "
+                          f"engine's variables, `{m.group(3)[1:-1].strip()}`) are not supported",
+                          span=vspan)
     name, mf, params = m.group(1), m.group(2), _vector(m.group(3), vspan)
     if mf == "linear":
         if role != "output" or kind != "sugeno":
