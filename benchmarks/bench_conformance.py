@@ -343,7 +343,7 @@ def report_rows(title: str, part: dict) -> None:
             print(f"  differs  {name}: largest difference {error:.3g}")
         elif s == "match" and why:
             print(f"  match    {name} ({why})")
-        elif s in ("refused", "loaded", "cli error"):
+        elif s in ("refused", "loaded", "cli error") and why:
             print(f"  {s:8s} {name}: {why}")
     errors = [e for _, s, _, e in part["rows"] if s == "match"]
     if errors:
