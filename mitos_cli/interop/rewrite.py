@@ -84,8 +84,8 @@ def unchain(rules: list[Rule], outputs: set[str], and_: str, or_: str,
             if (rule.weight != 1.0 or c.hedges) and any(
                     p.var == c.var for r in rules for p in _props(r.antecedent)):
                 raise FormatError(f"rule `{rule.label}` sets the chained output `{c.var}` "
-                                      f"with a weight or hedge, which the rules testing it "
-                                      f"would see: not supported", span=c.span or rule.span)
+                                  f"with a weight or hedge, which the rules testing it would "
+                                  f"see: not supported", span=c.span or rule.span)
             sources.setdefault((c.var, c.term), []).append(antecedent)
         out.append(rule)
     if chained:
