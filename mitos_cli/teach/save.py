@@ -107,6 +107,10 @@ def edit_termset(text: str, path: str, old, new) -> tuple[str, list[str]]:
         spec = variables[v_old.name]
         terms = spec["terms"]
         for t_old, t_new in zip(v_old.terms, v_new.terms):
+            if t_old.frozen != t_new.frozen:
+                edits.append(_frozen_edit(text, starts, terms, t_old, t_new))
+                changes.append(f"{v_old.name}.{t_old.name}: "
+                               f"{'frozen' if t_new.frozen else 'no longer frozen'}")
             if t_old.params == t_new.params:
                 continue
             spans = _param_spans(terms, t_old)
@@ -121,6 +125,35 @@ def edit_termset(text: str, path: str, old, new) -> tuple[str, list[str]]:
                 edits.append((match.start(), match.end(), format_number(b)))
             changes.append(f"{v_old.name}.{t_old.name}: {_params(t_old)} -> {_params(t_new)}")
     return _apply(text, edits), changes
+
+
+def _frozen_edit(text: str, starts: list[int], terms: yamlpos.YMap, old: Term,
+                 new: Term) -> tuple[int, int, str]:
+    """The edit that writes ``new.frozen`` into ``old``'s YAML: the ``frozen:`` value
+    replaced, else the key added (to a flow mapping before its ``}``, to a block mapping as
+    its first line; a bare crisp value becomes ``{shape: singleton, value: V, frozen: true}``)."""
+    flag = "true" if new.frozen else "false"
+
+    def offset(span) -> int:
+        return starts[span.line - 1] + span.column - 1
+
+    spec = terms[old.name]
+    if not isinstance(spec, yamlpos.YMap):            # `LM: 50`
+        at = offset(terms.value_span(old.name))
+        match = NUMBER.match(text, at)
+        end = match.end() if match else at
+        return at, end, f"{{shape: singleton, value: {text[at:end]}, frozen: {flag}}}"
+    if "frozen" in spec:
+        at = offset(spec.value_span("frozen"))
+        end = at + len(re.match(r"[^\s,}#]*", text[at:]).group(0))   # type: ignore[union-attr]
+        return at, end, flag
+    end = offset(spec.end_span)
+    if text[:end].rstrip().endswith("}"):             # a flow mapping
+        close = text.rindex("}", 0, end)
+        return close, close, f", frozen: {flag}"
+    first = offset(spec.key_span(next(iter(spec))))
+    line_start = text.rfind("\n", 0, first) + 1
+    return line_start, line_start, f"{text[line_start:first]}frozen: {flag}\n"
 
 
 def _params(term: Term) -> str:

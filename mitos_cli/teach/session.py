@@ -281,7 +281,8 @@ class Session:
         terms = self._term_refs(c.terms)
         self.change("freeze", line, terms=terms)
         self.out("adaptation keeps " + ", ".join(f"{v}.{t}" for v, t in terms)
-                 + " as it is (`unfrozen` lets it move)")
+                 + (" as it is" if len(terms) == 1 else " as they are")
+                 + " (`unfrozen` lets it move; `save` writes `frozen: true`)")
 
     def _releaseterms(self, c: cmd.ReleaseTerms, line: str) -> None:
         terms = self._term_refs(c.terms)

@@ -121,10 +121,12 @@ def apply(state: State, entry: dict) -> None:
         for var, term in entry["terms"]:
             state.frozen_terms.add((var, term))
             state.released.discard((var, term))
+        state.rulebase = _set_frozen(state.rulebase, entry["terms"], True)
     elif op == "release":
         for var, term in entry["terms"]:
             state.frozen_terms.discard((var, term))
             state.released.add((var, term))
+        state.rulebase = _set_frozen(state.rulebase, entry["terms"], False)
     elif op == "adapt":
         rb = _set_params(rb, entry["terms"])
         state.rulebase = _set_crisp(rb, entry.get("crisp", []))
@@ -132,6 +134,17 @@ def apply(state: State, entry: dict) -> None:
         raise LessonError(f"the journal holds an unknown change `{op}`")
 
 
+
+
+def _set_frozen(rb: RuleBase, refs: list, frozen: bool) -> RuleBase:
+    """The rule base with the terms ``refs`` ([variable, term] pairs) frozen or not: the
+    freeze is part of the model, so ``save`` writes it (``frozen: true`` in the YAML)."""
+    names = {tuple(r) for r in refs}
+    termsets = tuple(dataclasses.replace(ts, variables=tuple(
+        v.with_terms(tuple(dataclasses.replace(t, frozen=frozen)
+                           if (v.name, t.name) in names else t for t in v.terms))
+        for v in ts.variables)) for ts in rb.termsets)
+    return dataclasses.replace(rb, termsets=termsets)
 
 
 def learned_changes(before: RuleBase, after: RuleBase) -> tuple[dict, list]:
