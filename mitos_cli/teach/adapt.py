@@ -140,11 +140,15 @@ class Partition:
     written: np.ndarray          # [t, 4] corners as written
     least_coverage: float | None     # None: not measured (an output's sets)
     most_similar: float
+    #: a tied Ruspini partition: it holds at every ordered point, so it is never measured
+    by_construction: bool = False
 
     def corners(self, values: np.ndarray) -> np.ndarray:
         return np.where(self.knot >= 0, values[np.maximum(self.knot, 0)], self.written)
 
     def holds(self, values: np.ndarray) -> bool:
+        if self.by_construction:
+            return True
         cover, similar = meaning.measures(self.corners(values), self.universe)
         if self.least_coverage is not None and cover < self.least_coverage - 1e-12:
             return False
@@ -157,7 +161,26 @@ def partition(var: str, universe: tuple[float, float], knot: np.ndarray, written
     least = min(meaning.COVERAGE, meaning.coverage(written, universe)[0]) if covered else None
     most = max(meaning.SIMILARITY, meaning.most_similar(written, universe)[0]) \
         if len(written) > 1 else 1.0
-    return Partition(var, universe, knot, written, least, most)
+    return Partition(var, universe, knot, written, least, most,
+                     by_construction=ruspini(knot, written, universe))
+
+
+def ruspini(knot: np.ndarray, written: np.ndarray, universe: tuple[float, float]) -> bool:
+    """Whether these sets stay a Ruspini partition (memberships summing to 1 everywhere)
+    however their knots move in order: written as one, and every sloped edge shares both its
+    knots with an edge of the other direction (a term's fall is its neighbour's rise). Such a
+    partition is covered to 0.5 at worst (where two edges cross) and two sets of it are at most
+    1/3 similar (over a shared edge of width L: |A and B| = L/4, |A or B| >= 3L/4), within the
+    thresholds by construction: adaptation then need not measure it."""
+    x = meaning.breakpoints(written, universe)
+    if not np.allclose(meaning.memberships(written, x).sum(axis=0), 1.0, atol=1e-9):
+        return False
+    a, b, c, d = written.T
+    rising = sorted((int(i), int(j)) for i, j, u, v in zip(knot[:, 0], knot[:, 1], a, b)
+                    if np.isfinite(u) and v > u)
+    falling = sorted((int(i), int(j)) for i, j, u, v in zip(knot[:, 2], knot[:, 3], c, d)
+                     if np.isfinite(v) and v > u)
+    return all(i >= 0 and j >= 0 for i, j in rising + falling) and rising == falling
 
 
 @dataclass(frozen=True, eq=False)
