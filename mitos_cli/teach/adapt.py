@@ -43,6 +43,7 @@ import dataclasses
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 
@@ -125,6 +126,38 @@ class Parameters:
     @property
     def n_free(self) -> int:
         return int(round(np.trace(self.projector)))
+
+    @cached_property
+    def neighbours(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(left, right, need)``: every pair of neighbouring knots of the ``order`` entries
+        and the least distance between them (:func:`_need`), as flat arrays, so that the
+        order check of every trial step is three array operations."""
+        if not self.order:
+            empty = np.zeros(0, dtype=np.intp)
+            return empty, empty, np.zeros(0)
+        left = np.concatenate([ids[:-1] for ids in self.order])
+        right = np.concatenate([ids[1:] for ids in self.order])
+        need = np.concatenate([_need(self, ids, k) for k, ids in enumerate(self.order)])
+        return left, right, need
+
+    @cached_property
+    def crisp_neighbours(self) -> tuple[np.ndarray, ...]:
+        """``(left, right, first, last, per, written)`` of the crisp ``order`` entries: their
+        neighbouring pairs, each pair's group's smallest and largest knot and the fraction
+        :data:`~mitos_cli.lang.interpretability.DISTINCT` / (values - 1) of the spread that
+        is its least distance, and the pair's distance as written (the bound where closer)."""
+        groups = [self.order[k] for k in self.crisp_orders]
+        if not groups:
+            empty = np.zeros(0, dtype=np.intp)
+            return empty, empty, empty, empty, np.zeros(0), np.zeros(0)
+
+        def each(fn):
+            return np.concatenate([fn(ids) for ids in groups])
+        return (each(lambda ids: ids[:-1]), each(lambda ids: ids[1:]),
+                each(lambda ids: np.full(len(ids) - 1, ids[0])),
+                each(lambda ids: np.full(len(ids) - 1, ids[-1])),
+                each(lambda ids: np.full(len(ids) - 1, meaning.DISTINCT / (len(ids) - 1))),
+                each(lambda ids: np.diff(self.values[ids])))
 
 
 @dataclass(frozen=True, eq=False)
@@ -934,14 +967,14 @@ def feasible(p: Parameters, values: np.ndarray, partitions: bool = True) -> bool
     output values ``least_distance``); each partition covered and distinguishable (when it moved)."""
     if np.any(values < p.lo - 1e-12) or np.any(values > p.hi + 1e-12):
         return False
-    for k, ids in enumerate(p.order):
-        if np.any(np.diff(values[ids]) < _need(p, ids, k)):
-            return False
-    for k in p.crisp_orders:              # the distance check measures on the values as they are
-        ids = p.order[k]
-        need = np.minimum(meaning.least_distance(values[ids]), np.diff(p.values[ids]))
-        if np.any(np.diff(values[ids]) < need * (1 - 1e-9)):
-            return False
+    left, right, need = p.neighbours
+    if np.any(values[right] - values[left] < need):
+        return False
+    # crisp values: meaning.least_distance on the values as they are (in order by now)
+    left, right, first, last, per, written = p.crisp_neighbours
+    need = np.minimum(per * (values[last] - values[first]), written)
+    if np.any(values[right] - values[left] < need * (1 - 1e-9)):
+        return False
     return not partitions or partitions_hold(p, values)
 
 
