@@ -3,9 +3,9 @@
 One line per term that moved, by its centre (a crisp term's value, a fuzzy set's peak or core
 middle): ``steering.LS: 70 -> 62 deg, toward LM``; a term held at its point of symmetry says
 so (``steering.ST: unchanged (held at 90)``; ``heading.AHEAD: held at 0, its slopes moved
-with its neighbours`` when its feet, shared with its neighbours' peaks, moved). A term whose centre moved more than
-:data:`MEANING_SHIFT` of the way to its written neighbour on that side is flagged: it now
-means something close to that neighbour.
+with its neighbours`` when its feet, shared with its neighbours' peaks, moved). A term whose
+centre moved more than :data:`MEANING_SHIFT` of the way to its written neighbour on that side
+is flagged: it now means something close to that neighbour.
 """
 
 from __future__ import annotations

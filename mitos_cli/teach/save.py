@@ -33,6 +33,8 @@ from ..lang.terms import Term
 from ..words import plural
 
 NUMBER = re.compile(r"[-+]?(?:\d[\d_]*\.?\d*|\.\d+)(?:[eE][-+]?\d+)?")
+#: a plain YAML scalar such as ``true`` (up to a space, comma, ``}`` or comment)
+SCALAR = re.compile(r"[^\s,}#]*")
 
 
 @dataclass(frozen=True)
@@ -145,8 +147,8 @@ def _frozen_edit(text: str, starts: list[int], terms: yamlpos.YMap, old: Term,
         return at, end, f"{{shape: singleton, value: {text[at:end]}, frozen: {flag}}}"
     if "frozen" in spec:
         at = offset(spec.value_span("frozen"))
-        end = at + len(re.match(r"[^\s,}#]*", text[at:]).group(0))   # type: ignore[union-attr]
-        return at, end, flag
+        scalar = SCALAR.match(text, at)
+        return at, scalar.end() if scalar else at, flag
     end = offset(spec.end_span)
     if text[:end].rstrip().endswith("}"):             # a flow mapping
         close = text.rindex("}", 0, end)
