@@ -188,3 +188,42 @@ def test_frozen_written_into_a_block_mapping_and_a_frozen_value_replaced():
         .replace("frozen: true}", "frozen: false}")
     assert changes == ["x.LOW: frozen", "x.HIGH: no longer frozen"]
     assert [t.frozen for t in parse_termset(written).variables[0].terms] == [True, False]
+
+
+def test_a_released_centre_term_stays_released_after_save(rules, tmp_path):
+    """`unfrozen position.CENTER` lifts its hold at 0: `save` writes `held: false`, the saved
+    rule base lets it move and `mitos check` does not call it off-centre."""
+    from mitos_cli.engine.check import check_rulebase
+    from mitos_cli.teach.journal import Journal
+
+    s = Session(rules, out=[].append, journal=Journal.create(tmp_path / "session"))
+    s.run("unfrozen position.CENTER, road.NARROW")       # NARROW has no point: nothing to write
+    s.run("correct road=78 size=45 position=2 -> steering=40")
+    s.run("correct road=78 size=45 position=-1 -> steering=120")
+    s.run("adapt epochs 20")
+    centre = s.rulebase.variables["position"].term("CENTER")
+    assert not centre.held and centre.params[0] != 0          # it moved off 0
+    assert s.rulebase.variables["road"].term("NARROW").held
+    assert Session.resume(Journal.open(tmp_path / "session"), out=[].append).rulebase \
+        == s.rulebase
+    s.run(f"save {tmp_path / 'out.rules'}")
+    text = (tmp_path / "out.mitos.terms.yaml").read_text()
+    assert "CENTER: {shape: triangle, peak: " in text and ", held: false}" in text
+    assert text.count("held:") == 1
+    saved = load_rules_file(tmp_path / "out.rules")
+    assert variables(saved) == variables(s.rulebase)
+    assert not {f.code for f in check_rulebase(saved).findings} & {"off-centre"}
+    p = Session(tmp_path / "out.rules", out=[].append)
+    from mitos_cli.teach.adapt import parameterise
+    assert ("position", "CENTER") not in {(v, t) for v, t, _ in parameterise(p.compiled()).held}
+
+
+def test_held_must_be_true_or_false():
+    from mitos_cli.errors import TermSetError
+    from mitos_cli.lang.termfile import parse_termset
+
+    text = ("variables:\n  x:\n    role: input\n    universe: [0, 10]\n    terms:\n"
+            "      MID: {shape: triangle, points: [2, 5, 8], held: maybe}\n")
+    with pytest.raises(TermSetError, match="`held` must be true or false") as err:
+        parse_termset(text, "x.yaml")
+    assert (err.value.span.line, err.value.span.column) == (6, 55)

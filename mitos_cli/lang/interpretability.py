@@ -21,7 +21,8 @@ distinguishable    two fuzzy sets of one variable have a Jaccard similarity
 centre             when the terms are written mirror-symmetric about a point (an odd number
                    of terms; the first and last, second and second-last, ... are mirror
                    images, corner for corner), the middle term stays centred on that point
-                   (``heading.AHEAD`` at 0, ``steering.ST`` at 90)
+                   (``heading.AHEAD`` at 0, ``steering.ST`` at 90), unless it is written
+                   with ``held: false``
 =================  =========================================================================
 
 Piecewise-linear terms (triangles, trapezoids, shoulders) are measured exactly, on the points
@@ -357,8 +358,8 @@ def _off_centre(var: Variable) -> list[Issue]:
     point = mirror_point(outer)
     middle = var.terms[n // 2]
     tol = 1e-3 * (var.universe[1] - var.universe[0])
-    if point is None or abs(centre(middle) - point) <= tol:
-        return []
+    if point is None or abs(centre(middle) - point) <= tol or not middle.held:
+        return []                                   # `held: false`: the instructor let it move
     return [Issue("off-centre", var.name, (middle.name,), (
         f"`{var.name}.{middle.name}` is centred on {_num(centre(middle))}, off the point "
         f"{_num(point)} its neighbours mirror each other about"),

@@ -300,7 +300,7 @@ class _Builder:
         if not self.constrained:
             return None
         held = meaning.held_term(self.compiled.variables[vname])
-        if held is None or (vname, held[0].name) in self.released:
+        if held is None or (vname, held[0].name) in self.released or not held[0].held:
             return None
         entry = (vname, held[0].name, float(held[1]))
         if entry not in self.held:
