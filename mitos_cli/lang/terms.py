@@ -38,6 +38,8 @@ class Term:
     params: tuple[float, ...]
     span: Span | None = field(default=None, compare=False)
     frozen: bool = False
+    #: ``held: false`` in the YAML: a centre term adaptation may move off its point of symmetry
+    held: bool = True
     #: the membership function of a ``formula`` term (its params are empty)
     formula: Formula | None = None
 
