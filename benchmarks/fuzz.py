@@ -3,11 +3,14 @@
 Run from the repository root (one command each)::
 
     python benchmarks/fuzz.py --quick                       # a short campaign (150 per kind)
-    python benchmarks/fuzz.py --per-format 10000 --out fuzz-found
+    python benchmarks/fuzz.py --per-format 9000 --out fuzz-found      # 100,950 inputs
+    python benchmarks/fuzz.py --per-format 9000 --shard 0/4           # a quarter of them
+    python benchmarks/fuzz.py --via cli --per-format 1000   # through `mitos`'s main, in process
+    python benchmarks/fuzz.py --via subprocess --per-format 30        # spot checks
 
 Each input kind (rule files, term-set YAML, world YAML, map YAML + PGM, FCL, ``.fis``, FLL,
-teach commands, lessons, ``eval --batch`` CSV, teach journals) is seeded from the shipped files
-and ``tests/data``, mutated by grammar-aware mutators (tokens inserted, deleted, swapped and
+teach commands, lessons, ``eval --batch`` CSV, teach journals, command-line arguments) is
+seeded from the shipped files and ``tests/data``, mutated by grammar-aware mutators (tokens inserted, deleted, swapped and
 duplicated; keywords swapped; numbers replaced by ``nan``, ``inf``, ``-0``, ``1e308``, huge
 integers; truncation at a line; Unicode junk, CRLF, tabs, BOM; deep nesting; long lines; YAML
 anchors, aliases, tags and duplicate keys; PGM header and pixel bytes) and run in this process
@@ -22,7 +25,9 @@ is classified as
 - ``foreign``: any other exception, a bug; its signature is the type and the raising frame;
 - ``slow``: more than ``--slow`` CPU seconds (plus 0.01 s per KB of input), or cut off;
 - ``nonfinite``: a rule base that loads but gives ``inf`` or an undeclared ``NaN``, or an
-  output outside its universe.
+  output outside its universe;
+- ``warning``: a ``RuntimeWarning`` or ``UserWarning`` (NumPy's "invalid value") that would
+  reach the user's terminal.
 
 For each new foreign / slow / non-finite signature a minimal reproducer (lines, then
 characters, removed while the signature stays) is written to ``--out``. The table printed at
