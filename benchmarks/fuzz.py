@@ -10,8 +10,8 @@ Run from the repository root (one command each)::
 
 Each input kind (rule files, term-set YAML, world YAML, map YAML + PGM, FCL, ``.fis``, FLL,
 teach commands, lessons, ``eval --batch`` CSV, teach journals, command-line arguments) is
-seeded from the shipped files and ``tests/data``, mutated by grammar-aware mutators (tokens inserted, deleted, swapped and
-duplicated; keywords swapped; numbers replaced by ``nan``, ``inf``, ``-0``, ``1e308``, huge
+seeded from the shipped files and ``tests/data``, mutated by grammar-aware mutators (tokens
+inserted, deleted, swapped and duplicated; keywords swapped; numbers replaced by ``nan``, ``inf``, ``-0``, ``1e308``, huge
 integers; truncation at a line; Unicode junk, CRLF, tabs, BOM; deep nesting; long lines; YAML
 anchors, aliases, tags and duplicate keys; PGM header and pixel bytes) and run in this process
 under a time limit (``SIGPROF`` after ``--limit`` CPU seconds: a hang is cut off and counted,
