@@ -11,12 +11,12 @@ Run from the repository root (one command each)::
 Each input kind (rule files, term-set YAML, world YAML, map YAML + PGM, FCL, ``.fis``, FLL,
 teach commands, lessons, ``eval --batch`` CSV, teach journals, command-line arguments) is
 seeded from the shipped files and ``tests/data``, mutated by grammar-aware mutators (tokens
-inserted, deleted, swapped and duplicated; keywords swapped; numbers replaced by ``nan``, ``inf``, ``-0``, ``1e308``, huge
-integers; truncation at a line; Unicode junk, CRLF, tabs, BOM; deep nesting; long lines; YAML
-anchors, aliases, tags and duplicate keys; PGM header and pixel bytes) and run in this process
-under a time limit (``SIGPROF`` after ``--limit`` CPU seconds: a hang is cut off and counted,
-never waited for; a worker stuck where the signal cannot reach is killed by the campaign). Every input
-is classified as
+inserted, deleted, swapped and duplicated; keywords swapped; numbers replaced by ``nan``,
+``inf``, ``-0``, ``1e308``, huge integers; truncation at a line; Unicode junk, CRLF, tabs, BOM;
+deep nesting; long lines; YAML anchors, aliases, tags and duplicate keys; PGM header and pixel
+bytes) and run in this process under a time limit (``SIGPROF`` after ``--limit`` CPU seconds: a
+hang is cut off and counted, never waited for; a worker stuck where the signal cannot reach is
+killed by the campaign). Every input is classified as
 
 - ``loaded``: read (and, for rule bases, evaluated) without complaint;
 - ``refused+pos``: a :class:`~mitos_cli.errors.MitosError` with ``file:line:col``;
