@@ -898,6 +898,30 @@ def _worker(conn, kind_index: int, start: int, stop: int, step: int, seed: int,
     conn.send(("end",))
 
 
+def _cpu_of(pid: int) -> float | None:
+    """CPU seconds process ``pid`` has used (Linux ``/proc``; None elsewhere)."""
+    try:
+        fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+        return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+    except (OSError, IndexError, ValueError):
+        return None
+
+
+def _answers(conn, pid: int, budget: float) -> bool:
+    """Whether the worker answers before it spends ``budget`` more CPU seconds (past its own
+    alarm: stuck in C code), or, where it spends none (blocked), 30 times that in wall time.
+    CPU, not wall time: on a loaded machine a niced worker gets a few percent of a core, and a
+    wall-clock watchdog counted a 20,000-rule file that loads in 8 CPU s as hung."""
+    start, began = _cpu_of(pid), time.monotonic()
+    while not conn.poll(2.0):
+        used = _cpu_of(pid)
+        if start is not None and used is not None and used - start > budget:
+            return False
+        if time.monotonic() - began > 30 * budget + 60:
+            return False
+    return True
+
+
 def campaign(per_format: int, out: Path | None, limit: float, slow: float, only: str | None,
              seed: int, log=print, via: str = "reader",
              shard: tuple[int, int] = (0, 1)) -> list[Kind]:
@@ -933,7 +957,8 @@ def campaign(per_format: int, out: Path | None, limit: float, slow: float, only:
                 child.close()
                 current = i
                 while True:
-                    if not parent.poll(6 * limit + 60 + 6 * _allowance(kind, current, seed)):
+                    if not _answers(parent, proc.pid, 2 * (limit + _allowance(kind, current,
+                                                                            seed))):
                         proc.kill()
                         proc.join()
                         result = ("slow", "hung (no answer from the worker)")
