@@ -72,8 +72,9 @@ class Span:
 
 #: how much of a long source line a span keeps (characters, around the column)
 SHOWN = 240
-#: a quoted piece of input in a message (`...`) too long to be read
-_QUOTED = re.compile(r"`([^`\n]{81,})`")
+#: a quoted token of input in a message (`...`, no spaces: the words between two quotes of
+#: one message are not a token) too long to be read
+_QUOTED = re.compile(r"`([^`\s]{81,})`")
 
 
 def _shorten(match: re.Match[str]) -> str:

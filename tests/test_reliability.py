@@ -491,3 +491,9 @@ def test_cell_starts_agree_with_the_csv_module():
     for _ in range(2000):
         line = "".join(rng.choice('ab",') for _ in range(rng.randrange(12)))
         assert len(_starts(line)) == len(next(csv.reader([line]), [""])) or not line
+
+
+def test_only_a_long_token_is_shortened_not_the_words_between_two_quotes():
+    words = "x " * 60
+    err = RuleSyntaxError(f"term `a` {words}is not a `b` term")
+    assert err.render() == f"syntax error: term `a` {words}is not a `b` term"
