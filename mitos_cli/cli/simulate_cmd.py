@@ -10,6 +10,7 @@ from typing import Annotated, Optional
 import typer
 
 from .output import emit, err
+from .progress import INTERRUPTED, progress_bar
 
 REQUIRE = ("success",)
 
@@ -117,6 +118,21 @@ def _draw_runs(result, world, plot: Path):
     return replace(result, worlds=(replace(w, summaries=bare),))
 
 
+def _run_many(loaded, runs, seed, planner, workers, plot, quiet):
+    """``run_many`` with a progress bar on a terminal. Returns the runs and, when Ctrl-C
+    stopped them, how many were asked for (``None`` otherwise): the finished ones are kept."""
+    from ..sim.runs import RunsInterrupted, run_many, trail
+
+    label = f"{len(loaded)} worlds" if len(loaded) > 1 else loaded[0].name
+    with progress_bar(f"simulate {label}", quiet=quiet) as bar:
+        try:
+            return run_many(loaded, runs, seed, planner, workers,
+                            measure=trail if plot is not None else None,
+                            on_progress=bar.update), None
+        except RunsInterrupted as stop:
+            return stop.runs, stop.total
+
+
 def _write_text(path: Path, text: str) -> None:
     from ..fileio import atomic_write
 
@@ -149,7 +165,12 @@ def simulate_command(
         "--plot", metavar="FILE.png|FILE.svg",
         help="Draw the run (world, obstacles, path); with --runs, every run's path in one "
              "picture, coloured by outcome.")] = None,
-    live: Annotated[bool, typer.Option("--live", help="Show a terminal view while it runs.")] = False,
+    live: Annotated[bool, typer.Option(
+        "--live", help="Show a terminal view on stderr while it runs, paced by --speed.")] = False,
+    speed: Annotated[Optional[float], typer.Option(
+        "--speed", min=0.0, metavar="X",
+        help="Real-time factor of --live (implies it): 1 real time (the default), 4 four "
+             "times faster, 0 as fast as it can.")] = None,
     animate: Annotated[Optional[Path], typer.Option(
         "--animate", metavar="FILE.gif|FILE.mp4",
         help="Write the run as an animation: map, footprint, sonar cones, trail, obstacles, "
@@ -177,13 +198,13 @@ def simulate_command(
     if planner_name != "fuzzy" and (rulebase or behavior):
         raise typer.BadParameter(f"--rulebase and --behavior choose the fuzzy planner's rules; "
                                  f"`{planner_name}` has none", param_hint="--planner")
+    live = live or speed is not None
     names = worlds or [DEFAULT_WORLD]
     loaded = [load_world(resolve_world_path(n)) for n in names]
     many = len(loaded) > 1 or runs > 0
     if many and (out or trace or live or randomise or animate):
-        raise typer.BadParameter("--out, --animate, --trace, --live and --randomise "
-                                 "work on one "
-                                 "world and one run; drop --runs or give one world")
+        raise typer.BadParameter("--out, --animate, --trace, --live, --speed and --randomise "
+                                 "work on one world and one run; drop --runs or give one world")
     if plot is not None and len(loaded) > 1:
         raise typer.BadParameter("--plot draws one world (with --runs, all its runs in one "
                                  "picture); give one world", param_hint="--plot")
@@ -198,10 +219,12 @@ def simulate_command(
     planner = make_planner(planner_name, loaded[0], rulebase, behavior)
 
     if many:
-        from ..sim.runs import run_many, trail
-
-        result = run_many(loaded, runs, seed, planner, workers,
-                          measure=trail if plot is not None else None)
+        result, stopped = _run_many(loaded, runs, seed, planner, workers, plot, as_json)
+        if stopped is not None:
+            if not result.worlds:
+                err(f"interrupted before any run finished (0 of {stopped}); nothing written")
+                raise typer.Exit(INTERRUPTED)
+            plot = plot if len(result.worlds) == len(loaded) else None
         if plot is not None:
             result = _draw_runs(result, loaded[0], plot)
         if as_json:
@@ -210,6 +233,11 @@ def simulate_command(
             emit(_runs_table(result))
         if plot is not None:
             err(f"wrote picture of {len(result.worlds[0].summaries)} runs to {plot}")
+        if stopped is not None:
+            done = sum(len(w.summaries) for w in result.worlds)
+            err(f"interrupted: the table has the {done} of {stopped} runs that had finished "
+                f"(seeds in runs_detail with --json)")
+            raise typer.Exit(INTERRUPTED)
         failed = any(s["outcome"] != "success" for w in result.worlds for s in w.summaries)
         if require and failed:
             raise typer.Exit(3)
@@ -222,9 +250,13 @@ def simulate_command(
     if live:
         from ..sim.live import LiveView
 
-        with LiveView(world, scene) as view:
-            res = simulate(world, planner, seed, randomise=randomise, scene=scene,
-                           on_tick=view.update)
+        try:
+            with LiveView(world, scene, speed=1.0 if speed is None else speed) as view:
+                res = simulate(world, planner, seed, randomise=randomise, scene=scene,
+                               on_tick=view.update)
+        except KeyboardInterrupt:
+            err("interrupted: nothing written (the view shows the last tick drawn)")
+            raise typer.Exit(INTERRUPTED) from None
     else:
         res = simulate(world, planner, seed, randomise=randomise, scene=scene)
     if trace:
