@@ -103,7 +103,7 @@ class LiveView:
             self.trail[cell] = True
         self.pacer.wait(state["t"])
         now = self.clock()
-        if self.last_draw is not None and now - self.last_draw < self.gap:
+        if self.last_draw is not None and now - self.last_draw < self.gap - 1e-9:
             self.pending = state
             return
         self.last_draw = now
