@@ -9,13 +9,14 @@ from typing import Annotated, Optional
 import typer
 
 from ..words import plural
+from . import complete
 from .output import emit, err, warn
 from .progress import INTERRUPTED, progress_bar
 
 
 def compare_command(
     worlds: Annotated[list[str], typer.Argument(
-        metavar="WORLDS...",
+        metavar="WORLDS...", autocompletion=complete.worlds,
         help="World files (or names of packaged worlds such as corridor.yaml).")],
     and_: Annotated[str, typer.Option(
         "--and", metavar="TNORMS",
@@ -32,7 +33,11 @@ def compare_command(
         "--planner", metavar="PLANNERS",
         help="Planners to compare: fuzzy, potential_field, dwa.")] = "fuzzy,potential_field",
     runs: Annotated[int, typer.Option(
-        "--runs", "-n", min=1, help="Randomized runs per world and choice.")] = 20,
+        "--runs", min=1,
+        help="Randomised runs per world and choice (a comparison needs many; `simulate` "
+             "runs a world once as written unless given --runs).")] = 20,
+    runs_n: Annotated[Optional[int], typer.Option(
+        "-n", min=1, hidden=True, help="The old spelling of --runs.")] = None,
     seed: Annotated[int, typer.Option(
         "--seed", min=0, help="Seed of the whole study (runs are paired across choices).")] = 1,
     out: Annotated[str, typer.Option(
@@ -51,7 +56,7 @@ def compare_command(
         "--resume", help="Continue the study in DIR: skip every run already in results.csv."
     )] = False,
     rulebase: Annotated[Optional[str], typer.Option(
-        "--rulebase", metavar="PATH",
+        "--rulebase", "-r", metavar="PATH",
         help="Rule base of the fuzzy planner (default: the packaged one).")] = None,
     behavior: Annotated[Optional[str], typer.Option(
         "--behavior", "-b", help="Behavior to drive with (default: the world's).")] = None,
@@ -66,6 +71,9 @@ def compare_command(
     Prints the table and the ranking; writes DIR/results.csv (one row per run, as it
     finishes), DIR/report.md and its plots.
     """
+    if runs_n is not None:
+        warn("`-n` is --resolution in `check` and `plot surface`; write --runs here")
+        runs = runs_n
     from ..study import Study, make_choices, write_report
     from ..study.executors import EXECUTORS
     from ..study.spec import split_list

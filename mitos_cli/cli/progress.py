@@ -4,8 +4,8 @@ words for Ctrl-C, which exits 130 as a shell expects of an interrupted command."
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from contextlib import contextmanager
-from typing import Iterator
 
 #: The exit code of a command stopped by Ctrl-C (128 + SIGINT), as shells report it.
 INTERRUPTED = 130

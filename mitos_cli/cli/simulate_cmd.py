@@ -9,6 +9,7 @@ from typing import Annotated, Optional
 
 import typer
 
+from . import complete
 from .output import emit, err
 from .progress import INTERRUPTED, progress_bar
 
@@ -141,7 +142,7 @@ def _write_text(path: Path, text: str) -> None:
 
 def simulate_command(
     worlds: Annotated[Optional[list[str]], typer.Argument(
-        metavar="[WORLD.yaml]...",
+        metavar="[WORLD.yaml]...", autocompletion=complete.worlds,
         help="World files (default: the packaged corridor.yaml); names of packaged worlds "
              "such as figure4.yaml work from anywhere.")] = None,
     rulebase: Annotated[Optional[str], typer.Option(
@@ -151,7 +152,9 @@ def simulate_command(
     seed: Annotated[Optional[int], typer.Option(
         "--seed", min=0, help="Seed (default: the world's); with --runs, run j uses SEED+j.")] = None,
     runs: Annotated[int, typer.Option(
-        "--runs", min=0, help="Randomised runs per world (obstacle places, sensor noise).")] = 0,
+        "--runs", min=0,
+        help="Randomised runs per world (obstacle places, sensor noise); 0: the world once, "
+             "as written (`compare` defaults to 20: it needs many).")] = 0,
     randomise: Annotated[bool, typer.Option(
         "--randomise", help="Randomise this one run as run j of --runs does (replay it with "
                             "--seed SEED+j).")] = False,
@@ -181,9 +184,9 @@ def simulate_command(
     require: Annotated[Optional[str], typer.Option(
         "--require", metavar="success", help="Exit 3 unless every run ends in this outcome.")] = None,
     workers: Annotated[Optional[int], typer.Option(
-        "--workers", min=1, help="Processes for --runs (default: up to 2).")] = None,
+        "--workers", "-j", min=1, help="Processes for --runs (default: up to 2).")] = None,
     planner_name: Annotated[str, typer.Option(
-        "--planner", metavar="NAME",
+        "--planner", metavar="NAME", autocompletion=complete.planners,
         help="Who drives: fuzzy (the rule base), potential_field or dwa (baselines that "
              "see the same readings and follow the same route).")] = "fuzzy",
 ) -> None:

@@ -10,7 +10,7 @@ the last tick is always drawn, so the view ends on the final state.
 from __future__ import annotations
 
 import time
-from typing import Callable
+from collections.abc import Callable
 
 import numpy as np
 
