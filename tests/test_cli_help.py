@@ -100,3 +100,10 @@ def test_the_readme_lists_the_exit_codes_of_the_help():
     codes = {int(row.split("|")[1]) for row in table.strip().splitlines()[1:]}
     helped = {c for name in EXAMPLES for c, _ in exit_codes(name)}
     assert codes == helped
+
+
+def test_the_epilog_fits_an_80_column_terminal():
+    from mitos_cli.cli.help import epilog
+
+    for name in EXAMPLES:
+        assert max(len(line) for line in epilog(name).splitlines()) <= 76, name

@@ -7,7 +7,8 @@ from __future__ import annotations
 import inspect
 
 #: Every command (``plot`` subcommands as ``plot terms``): example command lines, each with
-#: what it does. Tests parse each line with the command's own options.
+#: what it does. Tests parse each line with the command's own options and keep every line of
+#: the epilog within 76 columns (an 80-column terminal, with the help's margins).
 EXAMPLES: dict[str, tuple[tuple[str, str], ...]] = {
     "eval": (
         ("mitos eval road=78 size=45 position=4", "the paper's sample run"),
@@ -39,11 +40,11 @@ EXAMPLES: dict[str, tuple[tuple[str, str], ...]] = {
         ("mitos teach --resume", "continue the last session from its journal"),
     ),
     "compare": (
-        ("mitos compare corridor slalom --and min,product --runs 20 -o study",
-         "T-norms against the potential field"),
+        ("mitos compare corridor slalom --and min,product -o study",
+         "two T-norms and the potential field, 20 runs each"),
         ("mitos compare corridor --planner fuzzy,dwa --runs 10 -j 2 -o study",
          "two planners, two processes"),
-        ("mitos compare corridor slalom --and min,product --runs 20 -o study --resume",
+        ("mitos compare corridor slalom --and min,product -o study --resume",
          "go on after Ctrl-C"),
     ),
     "simulate": (
@@ -63,7 +64,7 @@ EXAMPLES: dict[str, tuple[tuple[str, str], ...]] = {
         ("mitos plot terms --var road -o road.png", "one variable, as a PNG"),
     ),
     "plot surface": (
-        ("mitos plot surface steering --x road --y position=-20:20 --fix size=45 -o s.png",
+        ("mitos plot surface steering --x road --y position --fix size=45 -o s.png",
          "a control surface"),
         ("mitos plot surface speed --x road --fix size=45 --fix position=4", "a curve, as text"),
     ),
@@ -76,31 +77,31 @@ EXAMPLES: dict[str, tuple[tuple[str, str], ...]] = {
 #: Exit codes: the ones every command has, then each command's own.
 EXIT_CODES: tuple[tuple[int, str], ...] = (
     (0, "done"),
-    (1, "a mistake in a file or a value: the message names the file, line and column"),
+    (1, "a mistake in a file or a value (the message says where and what)"),
     (2, "a usage error: an unknown option, a missing or malformed argument"),
 )
 OWN_EXIT_CODES: dict[str, tuple[tuple[int, str], ...]] = {
-    "check": ((1, "also: the rule base has an error (a coverage gap, a conflict)"),),
+    "check": ((1, "a mistake in a file or value, or an error in the rule base"),),
     "simulate": ((3, "with --require success: a run did not succeed"),
                  (130, "Ctrl-C: with --runs, the runs that finished are still reported")),
-    "compare": ((130, "Ctrl-C: the finished runs stay in DIR/results.csv (go on with "
-                      "--resume)"),),
-    "teach": ((130, "Ctrl-C: the journal keeps every change (go on with --resume)"),),
+    "compare": ((130, "Ctrl-C: the finished runs stay in DIR/results.csv (--resume)"),),
+    "teach": ((130, "Ctrl-C: the journal keeps every change (--resume)"),),
 }
 
 
 def exit_codes(command: str) -> tuple[tuple[int, str], ...]:
-    return EXIT_CODES + OWN_EXIT_CODES.get(command, ())
+    """The exit codes of ``command``, in order; its own meaning replaces the common one."""
+    codes = dict(EXIT_CODES) | dict(OWN_EXIT_CODES.get(command, ()))
+    return tuple(sorted(codes.items()))
 
 
 def epilog(command: str) -> str:
     """The end of ``mitos COMMAND --help``: examples, then exit codes (rich markup escaped)."""
     from rich.markup import escape
 
-    examples = EXAMPLES[command]
-    width = max(len(line) for line, _ in examples)
     lines = ["Examples:"]
-    lines += [f"  {line.ljust(width)}  # {what}" for line, what in examples]
+    for line, what in EXAMPLES[command]:          # as a shell session: copy, paste, run
+        lines += [f"  # {what}", f"  {line}"]
     lines += ["", "Exit codes:"]
     lines += [f"  {code:<3}  {meaning}" for code, meaning in exit_codes(command)]
     return escape("\n".join(lines))
