@@ -62,7 +62,7 @@ def test_help_ends_with_the_examples_and_exit_codes():
 
 def test_a_short_option_means_one_thing_in_every_command():
     meaning: dict[str, set[str]] = {}
-    for name, cmd in commands().items():
+    for cmd in commands().values():
         for param in cmd.params:
             if param.param_type_name != "option" or param.hidden:
                 continue

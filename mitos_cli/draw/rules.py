@@ -81,10 +81,11 @@ def draw_consequent(ax, base: float, row: RuleRow, out: OutputView) -> None:
     for c in (c for c in row.consequents if c.output == out.name):
         gid = f"{row.label}:{out.name}"
         name = " ".join(c.hedges + (c.term,)) if c.term else f"{c.value:g}"
-        mamdani = c.implied is not None and c.full is not None and out.grid is not None
-        if mamdani and spikes(out.grid, c.full) is not None:
+        sets = ((out.grid, c.full, c.implied) if out.grid is not None and c.full is not None
+                and c.implied is not None else None)      # Mamdani: the consequent's sets
+        if sets is not None and spikes(sets[0], sets[1]) is not None:
             # a singleton: its full height dotted, the implied height as a stem
-            top = float(np.max(c.implied))
+            top = float(np.max(sets[2]))
             ax.vlines([c.value], base, base + BAND, color=TERM_COLOR, linewidth=1.0,
                       linestyles=":", gid=gid)
             ax.vlines([c.value], base, base + BAND * top, color=OUT_COLOR, linewidth=2.4,
@@ -92,9 +93,10 @@ def draw_consequent(ax, base: float, row: RuleRow, out: OutputView) -> None:
             ax.plot([c.value], [base + BAND * top], "o", color=OUT_COLOR, markersize=3.5)
             if c.term:
                 name += f" ({c.value:g})"
-        elif mamdani:
-            ax.plot(out.grid, base + BAND * c.full, color=TERM_COLOR, linewidth=1.0, gid=gid)
-            ax.fill_between(out.grid, base, base + BAND * c.implied, color=OUT_COLOR,
+        elif sets is not None:
+            grid, full, implied = sets
+            ax.plot(grid, base + BAND * full, color=TERM_COLOR, linewidth=1.0, gid=gid)
+            ax.fill_between(grid, base, base + BAND * implied, color=OUT_COLOR,
                             alpha=0.7, linewidth=0, gid=gid)
         else:
             ax.vlines([c.value], base, base + BAND * row.dof, color=OUT_COLOR, linewidth=2.4,

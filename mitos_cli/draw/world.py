@@ -48,7 +48,7 @@ def time_marks(ax, t: np.ndarray, xy: np.ndarray, step: float, colour: str, *,
             continue
         placed.append(xy[k])
         ax.annotate(f"{t[k]:g} s", xy[k], fontsize=6.5, color=colour, zorder=6,
-                    **inward(ax, *xy[k], gap=4.0, above=above))
+                    **inward(ax, float(xy[k, 0]), float(xy[k, 1]), gap=4.0, above=above))
 
 
 def map_axes(static, *, show: bool = False, extra_width: float = 1.6):
