@@ -176,3 +176,29 @@ def test_ctrl_c_on_a_compare_pool_leaves_no_worker_tracebacks(tmp_path):
     assert proc.returncode == 130, err
     assert "Traceback" not in err and "ForkPoolWorker" not in err and "Process " not in err
     assert "interrupted:" in err and "--resume" in err
+
+
+def test_live_once_off_a_terminal_ends_with_the_last_frame(capsys):
+    code, out, err = run(capsys, "simulate", TINY, "--speed", 0)
+    assert code == 0 and "SUCCESS" in out
+    assert "(unpaced)" in err and err.count("t = ") == 1        # the last frame, once
+
+
+def test_gym_human_render_without_a_display_falls_back_to_the_terminal_view(monkeypatch,
+                                                                            capsys):
+    pytest.importorskip("gymnasium")
+    from mitos_cli import gym as mgym
+    from mitos_cli.draw import frame
+    from mitos_cli.draw.output import DrawError
+
+    def no_display(*args, **kwargs):
+        raise DrawError("cannot open a window: no display")
+
+    monkeypatch.setattr(frame, "RunFrame", no_display)
+    env = mgym.MitosEnv(TINY, render_mode="human")
+    env.reset(seed=1)
+    for _ in range(3):
+        env.step(env.fuzzy_policy(env.unwrapped._observe()))
+        assert env.render() is None
+    env.close()
+    assert "t =   0.15 s (unpaced)" in capsys.readouterr().err
