@@ -238,8 +238,9 @@ def simulate_command(
             err(f"wrote picture of {len(result.worlds[0].summaries)} runs to {plot}")
         if stopped is not None:
             done = sum(len(w.summaries) for w in result.worlds)
-            err(f"interrupted: the table has the {done} of {stopped} runs that had finished "
-                f"(seeds in runs_detail with --json)")
+            what = "the JSON has" if as_json else "the table has"
+            err(f"interrupted: {what} the {done} of {stopped} runs that had finished "
+                f"(their seeds: runs_detail in --json)")
             raise typer.Exit(INTERRUPTED)
         failed = any(s["outcome"] != "success" for w in result.worlds for s in w.summaries)
         if require and failed:
