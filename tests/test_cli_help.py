@@ -90,8 +90,6 @@ def test_completion_offers_packaged_worlds_and_planners():
     env.update(COMP_WORDS="mitos simulate --planner d", COMP_CWORD="3")
     assert subprocess.run(run, env=env, capture_output=True, text=True).stdout.split() == \
         ["dwa"]
-    env.update(COMP_WORDS="mitos simulate --sp", COMP_CWORD="2")
-    assert "--speed" in subprocess.run(run, env=env, capture_output=True, text=True).stdout
 
 
 def test_the_readme_lists_the_exit_codes_of_the_help():
