@@ -88,6 +88,8 @@ class LiveView:
         if self.pending is not None:               # end on the last tick, however it ended
             self._draw(self.pending)
         self.live.__exit__(*exc)
+        if not self.live.console.is_terminal:      # a file or pipe: end the frame's last line
+            self.live.console.line()
 
     def _cell(self, x: float, y: float):
         xmin, ymin, xmax, ymax = self.box
@@ -126,6 +128,8 @@ class LiveView:
                 grid[cell] = "R" if i == 0 else "r"
         inputs = state["inputs"]
         lines = ["".join(row) for row in grid]
+        lines.append("R robot" + ("  r other robots" if len(self.world.agents) > 1 else "")
+                     + "  G goal  o obstacle  . trail  # wall")
         pace = f"x{self.pacer.speed:g}" if self.pacer.speed else "unpaced"
         lines.append(f"t = {state['t']:6.2f} s ({pace})  speed {state['speed'][0]:5.1f} in/s  "
                      f"steering {state['steering'][0]:5.1f} deg  "
