@@ -23,7 +23,7 @@ def draw_runs(overlay, world, scene, path: str | Path | None = None, *, show: bo
     from matplotlib.patches import Circle, Polygon
 
     from ..sim.geometry import rect_corners
-    from .world import inward, map_axes
+    from .world import inward, map_axes, place_legend
 
     fig, ax = map_axes(scene.static, show=show, extra_width=0.4)
     for route in scene.routes:
@@ -64,7 +64,7 @@ def draw_runs(overlay, world, scene, path: str | Path | None = None, *, show: bo
         ax.annotate(agent.name if len(world.agents) > 1 else "goal",
                     (agent.goal.x, agent.goal.y), xytext=(6, -10), textcoords="offset points",
                     fontsize=8, color="#2f6b2f")
-    ax.legend(loc="best", fontsize=7, framealpha=0.85)
+    place_legend(ax, scene.static)
     seeds = overlay.seeds
     ax.set_title(f"{overlay.world}: {len(seeds)} runs (seeds {seeds[0]}..{seeds[-1]}), "
                  "paths by the run's outcome", fontsize=9)

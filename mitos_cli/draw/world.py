@@ -28,6 +28,17 @@ def inward(ax, x: float, y: float, gap: float = 7.0, above: bool | None = None) 
             "va": "bottom" if above else "top"}
 
 
+def place_legend(ax, static) -> None:
+    """The legend inside the map where there is room, under a long thin map (where inside it
+    would cover the corridor)."""
+    xmin, ymin, xmax, ymax = static.bounds
+    if xmax - xmin > 2 * (ymax - ymin):
+        ax.legend(loc="upper center", bbox_to_anchor=(0.5, 0.0), borderaxespad=4.5,
+                  ncol=4, fontsize=7, frameon=False)
+    else:
+        ax.legend(loc="best", fontsize=7, framealpha=0.85)
+
+
 def time_step(t_end: float, most: int = 6) -> float:
     """The round interval (s) that puts at most ``most`` time marks on a run of ``t_end`` s."""
     return next((s for s in TIME_STEPS if t_end / s <= most), TIME_STEPS[-1])
@@ -188,11 +199,7 @@ def draw_run(result, path: str | Path | None = None, *, footprint_every: float =
                     fontsize=8, color="#2f6b2f")
     if line is not None:
         fig.colorbar(line, ax=ax, shrink=0.7, label="speed (in/s)")
-    if xmax - xmin > 2 * (ymax - ymin):     # a long, thin map: the legend under it
-        ax.legend(loc="upper center", bbox_to_anchor=(0.5, 0.0), borderaxespad=4.5,
-                  ncol=4, fontsize=7, frameon=False)
-    else:
-        ax.legend(loc="best", fontsize=7, framealpha=0.85)
+    place_legend(ax, static)
     ax.set_xlim(xmin - pad, xmax + pad)
     ax.set_ylim(ymin - pad, ymax + pad)
     ax.set_xlabel("x (in)")
