@@ -22,8 +22,8 @@ METRICS = ("time_s", "path_length_in", "min_clearance_in", "mean_speed_in_s",
 
 
 def _chunk(task: tuple) -> tuple[int, list[dict]]:
-    index, world, planner, seeds, randomise, measure = task
-    scene = prepare(world)
+    index, world, planner, seeds, randomise, measure, scene = task
+    scene = scene if scene is not None else prepare(world)
     out = []
     for seed in seeds:
         res = simulate(world, planner, seed, randomise=randomise, scene=scene)
@@ -139,12 +139,16 @@ def run_many(worlds: list[World], runs: int = 0, seed: int | None = None, planne
     for w in worlds:
         base = w.seed if seed is None else seed
         seeds = [base] if runs <= 0 else [base + j for j in range(runs)]
-        # about 8 chunks a worker: a progress bar that moves, one route search per chunk
+        # about 8 chunks a worker, so that a progress bar moves; a world cut into several
+        # chunks has its map and routes prepared once, here, and sent along (a grid map's
+        # route search costs about as much as a run)
         size = max(1, math.ceil(len(seeds) / (8 * workers)))
+        scene = prepare(w) if len(seeds) > size else None
         for i in range(0, len(seeds), size):
-            tasks.append((w, tuple(seeds[i:i + size])))
-    jobs = [(k, w, planner, chunk, runs > 0, measure) for k, (w, chunk) in enumerate(tasks)]
-    total = sum(len(chunk) for _, chunk in tasks)
+            tasks.append((w, tuple(seeds[i:i + size]), scene))
+    jobs = [(k, w, planner, chunk, runs > 0, measure, scene)
+            for k, (w, chunk, scene) in enumerate(tasks)]
+    total = sum(len(chunk) for _, chunk, _ in tasks)
     results: list[list[dict] | None] = [None] * len(jobs)
     done = 0
     try:
@@ -183,7 +187,7 @@ def _execute(jobs: list[tuple], workers: int):
 def _group(worlds: list[World], tasks: list[tuple], results: list[list[dict] | None]) -> Runs:
     """Each world's finished runs in seed order (worlds with none left out when interrupted)."""
     grouped: dict[int, list[dict]] = {id(w): [] for w in worlds}
-    for (w, _), res in zip(tasks, results):
+    for (w, _, _), res in zip(tasks, results):
         if res is not None:
             grouped[id(w)].extend(res)
     return Runs(tuple(WorldRuns(w.name, tuple(grouped[id(w)])) for w in worlds
