@@ -187,7 +187,7 @@ def _term_spec(rb: RuleBase, v: Variable, t: Term, inputs: list[str]) -> str:
         given = ", ".join(f"{_scalar(n)}: {_scalar(a)}" for n, a in coefficients.items()
                           if a != 0.0)
         return f"{{shape: linear, coefficients: {{{given}}}, constant: {_scalar(p[-1])}}}"
-    frozen = ", frozen: true" if t.frozen else ""
+    frozen = (", frozen: true" if t.frozen else "") + ("" if t.held else ", held: false")
     if t.shape == "triangle_pw":
         return f"{{shape: triangle, peak: {_scalar(p[0])}, width: {_scalar(p[1])}{frozen}}}"
     if t.shape == "triangle_plr":

@@ -175,9 +175,14 @@ def _term(name: str, spec: Any, key_span: Span, value_span: Span, variable: str,
                            expected="one of " + ", ".join(USER_SHAPES),
                            hint=did_you_mean(str(shape), USER_SHAPES))
     frozen = bool(spec.get("frozen", False))
+    held = spec.get("held", True)
+    if not isinstance(held, bool):
+        raise TermSetError(f"{what}: `held` must be true or false, not `{held}`",
+                           span=spec.value_span("held"),
+                           hint="`held: false` lets adaptation move a centre term off its point")
     if shape == "linear":
         return _linear_term(what, name, spec, key_span, frozen, inputs)
-    given = tuple(sorted(k for k in spec if k not in ("shape", "frozen")))
+    given = tuple(sorted(k for k in spec if k not in ("shape", "frozen", "held")))
     if shape == "triangle":
         internal = TRIANGLE_FORMS.get(given)
         if internal is None:
@@ -198,13 +203,13 @@ def _term(name: str, spec: Any, key_span: Span, value_span: Span, variable: str,
         params = tuple(yamlpos.expect_number(v, points.item_span(i), TermSetError,
                                              f"{what}: point") for i, v in enumerate(points))
     else:
-        allowed = ("shape", "frozen", "points") + kind.params
+        allowed = ("shape", "frozen", "held", "points") + kind.params
         yamlpos.check_keys(spec, allowed, TermSetError, what)
         for p in kind.params:
             yamlpos.require(spec, p, TermSetError, what)
         params = tuple(yamlpos.expect_number(spec[p], spec.value_span(p), TermSetError,
                                              f"{what}: {p}") for p in kind.params)
-    return Term(name, internal, params, key_span, frozen)
+    return Term(name, internal, params, key_span, frozen, held)
 
 
 def _linear_term(what: str, name: str, spec: YMap, key_span: Span, frozen: bool,

@@ -37,6 +37,8 @@ class Term:
     params: tuple[float, ...]
     span: Span | None = field(default=None, compare=False)
     frozen: bool = False
+    #: ``held: false`` in the YAML: a centre term adaptation may move off its point of symmetry
+    held: bool = True
 
     @property
     def kind(self) -> Shape:
