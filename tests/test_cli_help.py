@@ -105,3 +105,12 @@ def test_the_epilog_fits_an_80_column_terminal():
 
     for name in EXAMPLES:
         assert max(len(line) for line in epilog(name).splitlines()) <= 76, name
+
+
+def test_the_completion_script_is_shown_for_bash(capsys):
+    from mitos_cli.cli.app import main
+
+    with pytest.raises(SystemExit) as info:
+        main(["--show-completion", "bash"])
+    assert info.value.code == 0
+    assert "complete -o default -F _mitos_completion mitos" in capsys.readouterr().out
