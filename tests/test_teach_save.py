@@ -227,3 +227,15 @@ def test_held_must_be_true_or_false():
     with pytest.raises(TermSetError, match="`held` must be true or false") as err:
         parse_termset(text, "x.yaml")
     assert (err.value.span.line, err.value.span.column) == (6, 55)
+
+
+def test_frozen_must_be_true_or_false():
+    """`frozen: "no"` is a string, and a string is truthy: refuse it rather than freeze."""
+    from mitos_cli.errors import TermSetError
+    from mitos_cli.lang.termfile import parse_termset
+
+    text = ("variables:\n  x:\n    role: input\n    universe: [0, 10]\n    terms:\n"
+            "      MID: {shape: triangle, points: [2, 5, 8], frozen: \"no\"}\n")
+    with pytest.raises(TermSetError, match="`frozen` must be true or false") as err:
+        parse_termset(text, "x.yaml")
+    assert err.value.span.line == 6

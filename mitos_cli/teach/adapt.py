@@ -250,6 +250,9 @@ def _supported(compiled: CompiledRuleBase) -> None:
     if compiled.cons_linear is not None:
         raise LessonError("adaptation does not cover Takagi-Sugeno (linear) consequents",
                           hint="give the outputs crisp values (numbers) to adapt them")
+    if compiled.operators.inference == "tsukamoto" or compiled.hedged_outputs:
+        raise LessonError("adaptation does not cover Tsukamoto inference or hedged "
+                          "weighted-average consequents (no gradient is derived for them)")
     if compiled.operators.inference == "mamdani":
         return                                       # differences need no derivatives
     for op, names in SUPPORTED_NORMS.items():
