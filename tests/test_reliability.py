@@ -497,3 +497,20 @@ def test_only_a_long_token_is_shortened_not_the_words_between_two_quotes():
     words = "x " * 60
     err = RuleSyntaxError(f"term `a` {words}is not a `b` term")
     assert err.render() == f"syntax error: term `a` {words}is not a `b` term"
+
+
+@pytest.mark.parametrize("change", ['"save_as": true', '"save_as": 3'])
+def test_a_journal_start_whose_save_path_is_not_a_path_is_named(tmp_path, monkeypatch, change):
+    """`"save_as": true` in a journal's first line was a TypeError in `Session`."""
+    from mitos_cli.teach.journal import Journal
+
+    monkeypatch.chdir(tmp_path)
+    d = tmp_path / "s"
+    d.mkdir()
+    rules = str(ROOT / "rulebases" / "mitos.rules")
+    (d / "journal.jsonl").write_text(json.dumps({"seq": 1, "op": "start", "rules": rules,
+                                                 "behavior": "avoid_obstacle"})[:-1]
+                                     + f", {change}}}\n" + '{"seq": 2, "op": "save"}\n')
+    with pytest.raises(LessonError, match="save_as` is not a path") as info:
+        Journal.open(d)
+    assert info.value.span.line == 1

@@ -221,6 +221,11 @@ def _problem(line: bytes, seq: int) -> str | None:
                 isinstance(ref, list) and len(ref) == 2 and all(isinstance(x, str) for x in ref)
                 for ref in refs):
             return f"the `{op}` change's `{key}` are not [variable, term] pairs"
+    # paths: a `save_as` of `true` was a TypeError, a save without its path a KeyError
+    if op == "start" and not isinstance(entry.get("save_as"), (str, type(None))):
+        return "the `start` change's `save_as` is not a path"
+    if op == "save" and not isinstance(entry.get("path"), str):
+        return "the `save` change has no valid `path`"
     return None
 
 
