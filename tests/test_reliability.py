@@ -514,3 +514,16 @@ def test_a_journal_start_whose_save_path_is_not_a_path_is_named(tmp_path, monkey
     with pytest.raises(LessonError, match="save_as` is not a path") as info:
         Journal.open(d)
     assert info.value.span.line == 1
+
+
+def test_a_start_far_outside_a_grid_map_is_outside_without_a_warning(recwarn):
+    """`q_init: {y: 1e38}` on a grid map: the cell index's int64 cast warned "invalid value"."""
+    import numpy as np
+
+    from mitos_cli.sim.staticmap import build_static
+    from mitos_cli.sim.worldfile import load_world
+
+    static = build_static(load_world(ROOT / "worlds" / "office.yaml"))
+    assert static.grid is not None
+    assert not static.free(np.array([[-275.0, 1e38], [-275.0, np.nan]])).any()
+    assert not [w for w in recwarn if issubclass(w.category, RuntimeWarning)]

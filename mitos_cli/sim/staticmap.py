@@ -99,10 +99,13 @@ class StaticMap:
         points = np.atleast_2d(np.asarray(points, float))
         if self.grid is not None:
             g = self.grid
-            col = np.floor((points[:, 0] - g.origin[0]) / g.resolution).astype(np.int64)
-            row = np.floor((points[:, 1] - g.origin[1]) / g.resolution).astype(np.int64)
+            colf = np.floor((points[:, 0] - g.origin[0]) / g.resolution)
+            rowf = np.floor((points[:, 1] - g.origin[1]) / g.resolution)
             rows, cols = g.occupied.shape
-            inside = (row >= 0) & (row < rows) & (col >= 0) & (col < cols)
+            # compared as floats: a point 1e38 away is outside, not an int64 cast gone wrong
+            inside = (rowf >= 0) & (rowf < rows) & (colf >= 0) & (colf < cols)
+            row = np.where(inside, rowf, 0).astype(np.int64)
+            col = np.where(inside, colf, 0).astype(np.int64)
             out = np.zeros(len(points), dtype=bool)
             out[inside] = ~g.occupied[row[inside], col[inside]]
             return out
