@@ -527,3 +527,17 @@ def test_a_start_far_outside_a_grid_map_is_outside_without_a_warning(recwarn):
     assert static.grid is not None
     assert not static.free(np.array([[-275.0, 1e38], [-275.0, np.nan]])).any()
     assert not [w for w in recwarn if issubclass(w.category, RuntimeWarning)]
+
+
+@pytest.mark.parametrize("key", ["obstacles", "robots"])
+def test_a_world_list_given_as_a_mapping_is_positioned(key):
+    """`obstacles:` followed by a mapping (one space of indentation lost) was an
+    AttributeError in the world reader."""
+    from mitos_cli.sim.worldfile import parse_world
+
+    text = (ROOT / "worlds" / "office.yaml").read_text()
+    text = text.replace("\n  - {name: trolley", "\n   {name: trolley", 1) \
+        if key == "obstacles" else text + "robots:\n  name: r2\n"
+    with pytest.raises(WorldError, match=f"`{key}` must be a list") as info:
+        parse_world(text, str(ROOT / "worlds" / "w.yaml"))   # the map beside it
+    assert info.value.span is not None and info.value.span.line > 1

@@ -228,6 +228,18 @@ def read_randomise(r: _Reader, value: Any, span: Span, names: list[str]) -> Rand
     return Randomise(tuple(jitters), noise)
 
 
+def _list(mapping, key: str):
+    """``mapping[key]`` as a list (absent or null: none); a mapping or a scalar there is an
+    error at it (``obstacles:`` followed by a mapping was an ``AttributeError``)."""
+    value = mapping.get(key)
+    if value is None:
+        return []
+    if not isinstance(value, YList):
+        raise WorldError(f"`{key}` must be a list", span=mapping.value_span(key),
+                         expected=f"one `- ...` item per line under `{key}:`")
+    return value
+
+
 def parse_world(text: str, path: str) -> World:
     """Parse world YAML ``text`` (read from ``path``, which anchors relative map paths)."""
     r = _Reader(path)
@@ -250,7 +262,7 @@ def parse_world(text: str, path: str) -> World:
                      top.value_span("q_goal"), "q_goal")
     agents = [Agent("robot", robot, start, goal)]
     agent_spans = [(top.value_span("q_init"), top.value_span("q_goal"))]
-    for i, item in enumerate(top.get("robots") or []):
+    for i, item in enumerate(_list(top, "robots")):
         span = top["robots"].item_span(i)
         a = r.mapping(item, span, f"robot {i + 2}", AGENT_KEYS)
         aname = str(a.get("name", f"robot{i + 2}"))
@@ -270,7 +282,7 @@ def parse_world(text: str, path: str) -> World:
     mp = r.mapping(yamlpos.require(top, "map", WorldError, "the world file"),
                    top.value_span("map"), "map", MAP_KEYS)
     corridors = []
-    for i, item in enumerate(mp.get("corridors") or []):
+    for i, item in enumerate(_list(mp, "corridors")):
         c = r.mapping(item, mp["corridors"].item_span(i), f"corridor {i + 1}", ("points", "width"))
         pts = r.points(yamlpos.require(c, "points", WorldError, f"corridor {i + 1}"),
                        c.value_span("points"), f"`points` of corridor {i + 1}", 2)
@@ -293,7 +305,7 @@ def parse_world(text: str, path: str) -> World:
             min_clearance = r.number(rt, "min_clearance", "route", positive=True)
 
     obstacles = []
-    for i, item in enumerate(top.get("obstacles") or []):
+    for i, item in enumerate(_list(top, "obstacles")):
         obstacles.append(read_obstacle(r, item, top["obstacles"].item_span(i), i))
     names = [o.name for o in obstacles]
     for i, o in enumerate(obstacles):
