@@ -301,15 +301,26 @@ def via_cli(kind: Kind, how: str, limit: float) -> Callable:
     """``kind.run`` replaced by the ``mitos`` command that reads the input."""
     def run(data, work: Path):
         argv = kind.argv(data, work)
+        if not possible(argv):
+            return "refused", "argument list too long (the system refuses to run it)"
         if how == "subprocess":
             return cli_outcome(*cli_subprocess(argv, work, timeout=3 * limit + 10))
         return cli_outcome(*cli_in_process(argv, work))
     return run
 
 
+def possible(argv: list[str]) -> bool:
+    """Whether the system would start a program with ``argv``: ``execve`` refuses (E2BIG) an
+    argument over 128 KB or a list over ``ARG_MAX``, so no user can give ``mitos`` one."""
+    return all(len(a.encode(errors="surrogatepass")) < 131072 for a in argv) and \
+        sum(len(a) + 1 for a in argv) < os.sysconf("SC_ARG_MAX")
+
+
 def command_line(text: str) -> list[str]:
     """A mutated command line as the shell would split it (NUL cannot be in an argument)."""
     text = text.replace("\x00", "")
+    if len(text) >= os.sysconf("SC_ARG_MAX"):
+        return text.split()             # too long to run anyway; shlex takes minutes on it
     try:
         return shlex.split(text)
     except ValueError:                  # an unclosed quote: the shell would wait for more
@@ -559,7 +570,10 @@ class Kinds:
         return command_line(text)
 
     def run_args(self, text: str, work: Path) -> tuple[str, str]:
-        return cli_outcome(*cli_in_process(self.argv_args(text, work), work))
+        argv = self.argv_args(text, work)
+        if not possible(argv):
+            return "refused", "argument list too long (the system refuses to run it)"
+        return cli_outcome(*cli_in_process(argv, work))
 
     # -- seeds --------------------------------------------------------------------------------
     def journal_seeds(self) -> list[tuple[str, str]]:
