@@ -36,8 +36,8 @@ maps), ``staticmap`` (walls from corridors or grids), ``geometry``, ``kinematics
 ``sensors`` (ray casting), ``obstacles`` (motion, randomisation), ``route`` (A*),
 ``perception`` (readings -> rule inputs), ``planner`` (the planner protocol, FuzzyPlanner),
 ``loop`` (the steppable ``Simulation`` and ``simulate``, a loop over its ticks), ``lockstep``
-(runs stepped together), ``runs`` (many runs, process pool, each worker's runs in lockstep), ``export`` (CSV, traces),
-``live`` (terminal view). Drawing lives in ``mitos_cli.draw.world``.
+(runs stepped together), ``runs`` (many runs, process pool, each worker's runs in lockstep),
+``export`` (CSV, traces), ``live`` (terminal view). Drawing lives in ``mitos_cli.draw.world``.
 """
 
 from __future__ import annotations
