@@ -62,6 +62,12 @@ Inputs (all floats, units in the names of ``mitos.terms.yaml`` / ``drive.terms.y
     runs of neighbouring beams hitting obstacles, split where two hits lie more than
     ``clutter_gap`` apart (see :func:`clutter`). With one object at a time the paper's
     repertoire avoids "the obstacle"; among several the ``drive`` behavior takes the opening.
+``nearest`` (in)
+    the gap between the robot's footprint and the nearest echo ahead of its centre and
+    within ``nearest_band`` of the band its body sweeps, whatever it hit (a wall, a door jamb, a pole, a box: drawn on its map or not), capped at
+    ``nearest_cap``: what its front corners will meet next (see :func:`nearest`). ``front``
+    sees only what the map does not show and only straight on; a jamb beside a door or a pole
+    by the corner of the body is in ``nearest``, so the ``drive`` behavior slows for it.
 ``gap_left``, ``gap_right`` (in)
     gap between the robot's side and the nearest thing hit on that side: walls among beams
     landing from ``wall_behind`` behind to ``wall_ahead`` ahead of the robot's centre along
@@ -85,7 +91,7 @@ from .world import Robot
 
 NO_OBSTACLE = 200.0     # in: the `obstacle` distance when nothing obstructs
 INPUTS = ("road", "size", "position", "obstacle", "heading", "lane", "goal", "gap_left",
-          "gap_right", "front", "opening", "clutter")
+          "gap_right", "front", "opening", "clutter", "nearest")
 
 
 @dataclass(frozen=True)
@@ -107,6 +113,8 @@ class Settings:
     way_fov: float = 180.0         # deg
     clutter_gap: float = 24.0      # in: neighbouring hits farther apart: two objects
     way_turn_cost: float = 0.05    # in of progress given up per deg turned from the heading
+    nearest_cap: float = 60.0      # in: `nearest` when nothing is that close
+    nearest_band: float = 10.0     # in: beside the body's band, echoes farther out do not count
 
 
 @dataclass(frozen=True)
@@ -201,6 +209,19 @@ def free_ways(ah: np.ndarray, bh: np.ndarray, widen: np.ndarray, unknown: np.nda
     return front, float(ways[best])
 
 
+def nearest(ah: np.ndarray, bh: np.ndarray, robot: Robot, cfg: Settings) -> float:
+    """The gap from the footprint (a ``length`` x ``width`` rectangle on the pose) to the
+    nearest of the points ``(ah, bh)`` (the robot's own frame) ahead of its centre and within
+    ``nearest_band`` of the band its body sweeps straight on (the walls of a corridor it
+    drives down do not count; a jamb it is about to pass, or a pole by its corner, do)."""
+    ahead = (ah > 0) & (np.abs(bh) < robot.width / 2 + cfg.nearest_band)
+    if not ahead.any():
+        return cfg.nearest_cap
+    dx = np.maximum(ah[ahead] - robot.length / 2, 0.0)
+    dy = np.maximum(np.abs(bh[ahead]) - robot.width / 2, 0.0)
+    return float(min(np.hypot(dx, dy).min(), cfg.nearest_cap))
+
+
 def clutter(hits: np.ndarray, unknown: np.ndarray, ah: np.ndarray, cfg: Settings,
             circular: bool = False) -> float:
     """How many separate objects the map does not show are in view ahead: runs of
@@ -279,7 +300,8 @@ def perceive(route: Route, f: Frame, pose: tuple[float, float, float], robot: Ro
     objects = clutter(hits, valid & obstacle_hit, _own_frame(rel, pose[2])[0], cfg, ring)
     return {"road": road, "size": size, "position": position, "obstacle": distance,
             "heading": heading, "lane": lane, "goal": goal, "gap_left": wl, "gap_right": wr,
-            "front": front, "opening": opening, "clutter": objects}
+            "front": front, "opening": opening, "clutter": objects,
+            "nearest": nearest(ah, bh, robot, cfg)}
 
 
 def truth(route: Route, f: Frame, pose: tuple[float, float, float], robot: Robot,
@@ -305,7 +327,8 @@ def truth(route: Route, f: Frame, pose: tuple[float, float, float], robot: Robot
     objects = clutter(scan, unknown, ah, cfg)
     return {"road": road, "size": size, "position": position, "obstacle": distance,
             "heading": heading, "lane": lane, "goal": goal, "gap_left": gaps[0],
-            "gap_right": gaps[1], "front": front, "opening": opening, "clutter": objects}
+            "gap_right": gaps[1], "front": front, "opening": opening, "clutter": objects,
+            "nearest": nearest(ah, bh, robot, cfg)}
 
 
 def side_gaps(route_frame: Frame, p: np.ndarray, dirs: np.ndarray, expected: np.ndarray,
