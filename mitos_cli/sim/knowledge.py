@@ -17,7 +17,9 @@ past is left within ``TUBE`` inches of the route up to ``sight`` ahead, at the r
 clearance (half the robot's width plus its margin); when none is, it plans
 again from where it stands on everything it knows. A box in the lane leaves a way past and
 the rules drive round it; a shut door or a corridor full of boxes does not, and the route
-changes.
+changes. Where no way keeps that floor, it takes one that keeps half its width and
+``SQUEEZE_MARGIN`` if there is one (a gap it fits, if only just) rather than drive on into
+what it sensed.
 """
 
 from __future__ import annotations
@@ -258,16 +260,20 @@ def _crosses(rmap: RobotMap, route: Route, s: float, p: np.ndarray, reach: float
 
 def replan(rmap: RobotMap, route: Route, s: float, p: np.ndarray, goal: Goal, t: float,
            clearance: float, minimum: float, sight: float, knows: str = "map") -> Route | None:
-    """A new route from ``p`` when its route ahead passes too close to what the robot has
-    sensed (see the module docstring), else ``None``. ``knows`` is kept for the callers: with
-    a map or without, what the robot sensed is its costmap, and the route keeps clear of it."""
+    """A new route from ``p`` when what the robot has sensed shuts the way ahead (see the
+    module docstring), else ``None``. A robot with no map plans again whenever its route
+    ahead runs into what it has mapped: all it knows it learnt on the way. Where no way keeps
+    ``minimum``, one that keeps the map's ``squeeze`` is taken if there is one."""
     if not rmap.fresh or t - rmap.checked_at < REPLAN_EVERY:
         return None
     fresh = np.concatenate(rmap.fresh)
     rmap.fresh.clear()
     rmap.checked_at = t
-    if not route.near(fresh, s, clearance + rmap.grid.resolution, sight).any() or \
-            not _crosses(rmap, route, s, p, minimum, sight):
+    if knows == "none":
+        if not _crosses(rmap, route, s, p, minimum, sight):
+            return None
+    elif not route.near(fresh, s, clearance, sight).any() or \
+            way_past(rmap, route, s, p, sight, clearance, minimum):
         return None
     floors = (minimum,) if not 0 < rmap.squeeze < minimum else (minimum, rmap.squeeze)
     for floor in floors:
