@@ -17,9 +17,7 @@ past is left within ``TUBE`` inches of the route up to ``sight`` ahead, at the r
 clearance (half the robot's width plus its margin); when none is, it plans
 again from where it stands on everything it knows. A box in the lane leaves a way past and
 the rules drive round it; a shut door or a corridor full of boxes does not, and the route
-changes. Where no way keeps that floor, it takes one that keeps half its width and
-``SQUEEZE_MARGIN`` if there is one (a gap it fits, if only just) rather than drive on into
-what it sensed.
+changes.
 """
 
 from __future__ import annotations
@@ -38,8 +36,6 @@ from .world import Goal, Grid, Pose, World
 RASTER = 2.0            # in: cells of the robot's map when the world gives no grid
 REPLAN_EVERY = 0.5      # s: the least time between two replanning checks
 TUBE = 48.0             # in: how far from its route the robot looks for a way past
-SQUEEZE_MARGIN = 1.0    # in: beyond half its width, the least a replanned route keeps from
-                        # what the robot sensed when no roomier way leads on
 
 
 @dataclass(frozen=True)
@@ -134,12 +130,10 @@ class RobotMap:
     fresh: list = field(default_factory=list)      # marks since the last check, [k, 2] each
     checked_at: float = -math.inf  # s
     replans: int = 0
-    squeeze: float = 0.0           # in: the least clearance a replanned route may keep when
-                                   # nothing roomier leads on (0: the route's own floor)
 
     @classmethod
-    def of(cls, grid: Grid, squeeze: float = 0.0) -> RobotMap:
-        return cls(grid, grid.occupied.copy(), squeeze=squeeze)
+    def of(cls, grid: Grid) -> RobotMap:
+        return cls(grid, grid.occupied.copy())
 
     def cells(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         g = self.grid
@@ -262,8 +256,7 @@ def replan(rmap: RobotMap, route: Route, s: float, p: np.ndarray, goal: Goal, t:
            clearance: float, minimum: float, sight: float, knows: str = "map") -> Route | None:
     """A new route from ``p`` when what the robot has sensed shuts the way ahead (see the
     module docstring), else ``None``. A robot with no map plans again whenever its route
-    ahead runs into what it has mapped: all it knows it learnt on the way. Where no way keeps
-    ``minimum``, one that keeps the map's ``squeeze`` is taken if there is one."""
+    ahead runs into what it has mapped: all it knows it learnt on the way."""
     if not rmap.fresh or t - rmap.checked_at < REPLAN_EVERY:
         return None
     fresh = np.concatenate(rmap.fresh)
@@ -275,14 +268,11 @@ def replan(rmap: RobotMap, route: Route, s: float, p: np.ndarray, goal: Goal, t:
     elif not route.near(fresh, s, clearance, sight).any() or \
             way_past(rmap, route, s, p, sight, clearance, minimum):
         return None
-    floors = (minimum,) if not 0 < rmap.squeeze < minimum else (minimum, rmap.squeeze)
-    for floor in floors:
-        try:
-            new = grid_route(_as_map(rmap.grid), Pose(float(p[0]), float(p[1])), goal,
-                             clearance, minimum=floor, occupied=rmap.occupied,
-                             explain=False, leave=clearance + 6.0)
-        except NarrowPassage:
-            continue
-        rmap.replans += 1
-        return new
-    return None                    # no way left on what it knows: drive on, the rules decide
+    try:
+        new = grid_route(_as_map(rmap.grid), Pose(float(p[0]), float(p[1])), goal, clearance,
+                         minimum=minimum, occupied=rmap.occupied, explain=False,
+                         leave=clearance + 6.0)
+    except NarrowPassage:
+        return None                # no way left on what it knows: drive on, the rules decide
+    rmap.replans += 1
+    return new

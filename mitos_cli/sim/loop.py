@@ -394,8 +394,7 @@ class Simulation:
         self._replanned: list[tuple[int, int, Route]] = []
         self._maps: list[knowledge.RobotMap | None] = [None] * n
         if self._given.knows == "none" and self._given.grid is not None:
-            self._maps = [knowledge.RobotMap.of(self._given.grid, self._squeeze(i))
-                          for i in range(n)]
+            self._maps = [knowledge.RobotMap.of(self._given.grid) for _ in range(n)]
         self._history: list[tuple[np.ndarray, np.ndarray]] = []   # (x, y) after each move
         self._outcomes = ["timeout"] * n
         self._collided = 0
@@ -602,14 +601,6 @@ class Simulation:
                 s.inputs[key][i] = p[key]
             s.targets[i] = perception.target_point(routes[i], f, self._cfg)
 
-    def _squeeze(self, i: int) -> float:
-        """The least clearance robot ``i``'s replanned routes may keep where nothing roomier
-        leads on: half its width and ``knowledge.SQUEEZE_MARGIN`` (or the world's own
-        ``route: {min_clearance}``, which already says how tight it may go)."""
-        if self.world.min_clearance is not None:
-            return 0.0
-        return self.robots[i].width / 2 + knowledge.SQUEEZE_MARGIN
-
     def _learn(self, i: int, s: _Sensed) -> bool:
         """Mark on robot ``i``'s map what its readings show and its map does not (everything
         it hits, with no map): whether anything new was marked. Its map is made on first
@@ -624,8 +615,7 @@ class Simulation:
         rmap = self._maps[i]
         if rmap is None:
             rmap = self._maps[i] = knowledge.RobotMap.of(
-                knowledge.plan_grid(self._given, self.scene.static, self.world),
-                self._squeeze(i))
+                knowledge.plan_grid(self._given, self.scene.static, self.world))
         before = len(rmap.fresh)
         rmap.mark(s.pose[i, :2] + measured[seen, None] * dirs[seen], dirs[seen])
         return len(rmap.fresh) > before
