@@ -97,6 +97,8 @@ INPUTS = ("road", "size", "position", "obstacle", "heading", "lane", "goal", "ga
 @dataclass(frozen=True)
 class Settings:
     lookahead: float = 40.0        # in: pure-pursuit point on the route
+    lookahead_min: float = 20.0    # in: the shortest lookahead of `heading` (in a door)
+    lookahead_per_road: float = 0.75   # `heading`'s lookahead per inch of road width
     window: float = 24.0           # in: along-route half window for the road width
     sight: float = 150.0           # in: how far ahead objects count
     band_margin: float = 8.0       # in: added to each side of the swept band
@@ -254,7 +256,7 @@ def _walls(a, b, valid, robot: Robot, cfg: Settings, far: float,
 
 def _common(route: Route, p, heading: float, f: Frame, road: float, robot: Robot,
             cfg: Settings) -> tuple[float, float, float]:
-    target = target_point(route, f, cfg)
+    target = target_point(route, f, cfg, steer_lookahead(road, cfg))
     d = target - p
     bearing = math.degrees(math.atan2(d[1], d[0]) - heading)
     bearing = (bearing + 180.0) % 360.0 - 180.0
@@ -264,12 +266,21 @@ def _common(route: Route, p, heading: float, f: Frame, road: float, robot: Robot
     return -bearing, f.e - offset, goal
 
 
-def target_point(route: Route, f: Frame, cfg: Settings) -> np.ndarray:
+def steer_lookahead(road: float, cfg: Settings) -> float:
+    """How far ahead the point ``heading`` aims at lies: ``lookahead``, shortened in a road
+    narrower than ``lookahead / lookahead_per_road`` (a door, a narrow passage) down to
+    ``lookahead_min``, so that the robot does not cut the corner before a door into its jamb."""
+    return min(cfg.lookahead, max(cfg.lookahead_min, cfg.lookahead_per_road * road))
+
+
+def target_point(route: Route, f: Frame, cfg: Settings,
+                 lookahead: float | None = None) -> np.ndarray:
     """The pursuit point: on the route a lookahead ahead; the goal itself over the last
     lookahead of the route."""
-    if f.s + cfg.lookahead >= route.length:
+    ahead = cfg.lookahead if lookahead is None else lookahead
+    if f.s + ahead >= route.length:
         return route.goal
-    return route.point_at(f.s + cfg.lookahead)
+    return route.point_at(f.s + ahead)
 
 
 def perceive(route: Route, f: Frame, pose: tuple[float, float, float], robot: Robot,
