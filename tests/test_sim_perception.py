@@ -106,3 +106,31 @@ def _percepts(inputs):
 
     z = np.zeros((1, 2))
     return Percepts(inputs, np.zeros((1, 1)), np.zeros(1), np.zeros((1, 3)), np.zeros(1), z, z)
+
+
+def test_heading_aims_nearer_in_a_narrow_road():
+    cfg = perception.Settings()
+    assert perception.steer_lookahead(80.0, cfg) == cfg.lookahead       # a corridor: 40 in
+    assert perception.steer_lookahead(32.0, cfg) == pytest.approx(24.0)  # a door
+    assert perception.steer_lookahead(5.0, cfg) == cfg.lookahead_min
+    bend = Route.of([(0.0, 0.0), (30.0, 0.0), (30.0, -100.0)])           # a right turn ahead
+    f = perception.frame(bend, np.array([0.0, 0.0]), 0.0)
+    wide = perception.target_point(bend, f, cfg)
+    narrow = perception.target_point(bend, f, cfg, perception.steer_lookahead(32.0, cfg))
+    assert wide[1] == pytest.approx(-10.0) and narrow[0] == pytest.approx(24.0)
+
+
+def test_keep_clear_steers_off_one_side_but_not_between_two_jambs():
+    from mitos_cli.sim.planner import FuzzyPlanner
+
+    planner = FuzzyPlanner(None, "drive")
+    door = dict(road=30, size=0, position=0, obstacle=200, heading=0, lane=0, goal=300,
+                gap_left=30, gap_right=30, front=150, opening=0, clutter=0, nearest=60)
+
+    def steering(**change):
+        x = {k: np.array([v], float) for k, v in {**door, **change}.items()}
+        return float(planner.plan(_percepts(x))[0][0])
+
+    assert steering() == pytest.approx(90.0)
+    assert steering(gap_left=2.0) > 100.0            # a wall close on the left: steer right
+    assert steering(gap_left=2.0, gap_right=3.0) == pytest.approx(90.0)   # a door: straight on
