@@ -64,10 +64,11 @@ Inputs (all floats, units in the names of ``mitos.terms.yaml`` / ``drive.terms.y
     repertoire avoids "the obstacle"; among several the ``drive`` behavior takes the opening.
 ``nearest`` (in)
     the gap between the robot's footprint and the nearest echo ahead of its centre and
-    within ``nearest_band`` of the band its body sweeps, whatever it hit (a wall, a door jamb, a pole, a box: drawn on its map or not), capped at
-    ``nearest_cap``: what its front corners will meet next (see :func:`nearest`). ``front``
-    sees only what the map does not show and only straight on; a jamb beside a door or a pole
-    by the corner of the body is in ``nearest``, so the ``drive`` behavior slows for it.
+    within ``nearest_band`` of the band its body sweeps, whatever it hit (a wall, a door
+    jamb, a pole, a box: drawn on its map or not), capped at ``nearest_cap``: what its front
+    corners will meet next (see :func:`nearest`). ``front`` sees only what the map does not
+    show and only straight on; a jamb beside a door or a pole by the corner of the body is in
+    ``nearest``, so the ``drive`` behavior slows for it.
 ``gap_left``, ``gap_right`` (in)
     gap between the robot's side and the nearest thing hit on that side: walls among beams
     landing from ``wall_behind`` behind to ``wall_ahead`` ahead of the robot's centre along
