@@ -297,3 +297,4 @@ def test_a_robot_with_no_map_maps_and_replans_round_a_corner(tmp_path):
     assert res.pose[-1, 0, 1] > 60         # round the corner, inside the corridor
     again = simulate(blind)
     assert np.array_equal(res.pose, again.pose)              # bit for bit
+
