@@ -67,6 +67,7 @@ def draw_run(result, path: str | Path | None = None, *, footprint_every: float =
 
     # obstacles: where they started (faint, for moving ones), their tracks, where they ended
     track = result.obstacles                                  # [T, O, 2]
+    named = _labelled(result)
     for j, o in enumerate(world.obstacles):
         xy = track[:, j] if len(track) else np.array([[o.x, o.y]])
         moving = np.ptp(xy, axis=0).max() > 1e-9 if len(xy) else False
@@ -81,8 +82,9 @@ def draw_run(result, path: str | Path | None = None, *, footprint_every: float =
                 patch = Polygon(rect_corners(cx, cy, np.deg2rad(o.angle), o.length, o.width))
             patch.set(facecolor="#b5524a", edgecolor="#5c1f1a", alpha=alpha, lw=0.8)
             ax.add_patch(patch)
-        ax.annotate(o.name, xy[-1], xytext=(6, 6), textcoords="offset points", fontsize=8,
-                    color="#5c1f1a")
+        if j in named:
+            ax.annotate(o.name, xy[-1], xytext=(6, 6), textcoords="offset points",
+                        fontsize=8, color="#5c1f1a")
 
     # robots: footprints at intervals, path coloured by speed, start and goal
     vmax = max(1.0, float(np.nanmax(result.speed)) if result.speed.size else 1.0)
@@ -122,3 +124,25 @@ def draw_run(result, path: str | Path | None = None, *, footprint_every: float =
                  f"(seed {result.seed}, min clearance {m['min_clearance_in']:.1f} in)",
                  fontsize=9)
     return finish(fig, path, show)
+
+
+LABEL_LIMIT = 12        # obstacles named on a plot; beyond this only the one hit is
+
+
+def _labelled(result) -> set[int]:
+    """The obstacles whose names help: all of a few, else only the one a robot hit (nearest
+    to where it stopped), so a generated field of a hundred poles is not written over."""
+    obstacles = result.world.obstacles
+    if len(obstacles) <= LABEL_LIMIT:
+        return set(range(len(obstacles)))
+    if result.outcome != "collision" or not len(result.obstacles) or not len(result.pose):
+        return set()
+    where = result.obstacles[-1]                                  # [O, 2]
+    size = np.array([o.radius if o.shape == "circle" else np.hypot(o.length, o.width) / 2
+                     for o in obstacles])
+    out = set()
+    for i, r in enumerate(result.robot_outcomes):
+        if r == "collision":
+            gap = np.hypot(*(where - result.pose[-1, i, :2]).T) - size
+            out.add(int(np.argmin(gap)))
+    return out
