@@ -341,6 +341,9 @@ class Simulation:
             world = obs_mod.randomised(world, self._streams[0])
         self.world = world
         self.scene = self._given_scene or prepare(world)
+        fresh = getattr(self.planner, "fresh", None)     # a planner with a memory: empty it
+        if fresh is not None:
+            self.planner = fresh()
         self._setup_constants()
         self._setup_state()
         return self
@@ -635,7 +638,7 @@ class Simulation:
             idx = np.flatnonzero(self._active)
             sub = Percepts({key: val[idx] for key, val in s.inputs.items()}, s.ranges[idx],
                            self.angles, s.pose[idx], self._v[idx], s.targets[idx],
-                           self._goals[idx], self._steer[idx])
+                           self._goals[idx], self._steer[idx], idx)
             c_steer, c_speed = self.planner.plan(sub)
             cmd[idx, 0], cmd[idx, 1] = c_steer, c_speed
 
