@@ -38,7 +38,7 @@ import os
 import platform
 import sys
 import time
-from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures import ProcessPoolExecutor, as_completed
 from pathlib import Path
 
 import numpy as np
@@ -108,7 +108,17 @@ def attempt(world, scene_of) -> tuple[Scene | None, str | None]:
 # --- tasks: a picklable description in, rows out -------------------------------------------
 
 def task(job: tuple) -> list[dict]:
-    """Rows ``{suite, world, order, length, refused, runs}`` of one task."""
+    """Rows ``{suite, world, length, refused, runs}`` of one task; a task that fails is one
+    row naming the error, so one broken world does not lose the whole run."""
+    try:
+        return _task(job)
+    except Exception as exc:            # noqa: BLE001 - reported in the table's notes
+        return [{"suite": job[0], "world": "/".join(str(x) for x in job[1:-1]),
+                 "error": f"{type(exc).__name__}: {exc}", "refused": None, "length": None,
+                 "runs": {}}]
+
+
+def _task(job: tuple) -> list[dict]:
     kind, planners = job[0], job[-1]
     rows = []
     if kind == "mrpb":
@@ -162,27 +172,33 @@ def jobs_for(suites, planners, root: str, n_barn: int, seed: int, draws: int) ->
     return out
 
 
-def run_all(jobs: list[tuple], workers: int, progress) -> list[dict]:
-    """Every task's rows, in the order of ``jobs`` whatever the order they finish in."""
+def run_all(jobs: list[tuple], workers: int, progress, keep=None) -> list[dict]:
+    """Every task's rows, in the order of ``jobs`` whatever the order they finish in;
+    ``keep(rows)`` is told each task's rows as it finishes (``--rows``)."""
     done: list[list[dict] | None] = [None] * len(jobs)
+
+    def finished(i: int, rows: list[dict], n: int) -> None:
+        done[i] = rows
+        if keep is not None:
+            keep(rows)
+        progress(n, len(jobs), jobs[i])
+
     if workers > 1 and len(jobs) > 1:
         with ProcessPoolExecutor(workers) as pool:
             futures = {pool.submit(task, j): i for i, j in enumerate(jobs)}
-            from concurrent.futures import as_completed
-
             for n, fut in enumerate(as_completed(futures), 1):
-                done[futures[fut]] = fut.result()
-                progress(n, len(jobs), jobs[futures[fut]])
+                finished(futures[fut], fut.result(), n)
     else:
         for i, j in enumerate(jobs):
-            done[i] = task(j)
-            progress(i + 1, len(jobs), j)
+            finished(i, task(j), i + 1)
     return [r for rows in done if rows for r in rows]
 
 
 def suite_results(rows: list[dict], suites, planners) -> tuple[dict, list[str]]:
     """Per suite and planner the figures, and the notes on refused routes (counted)."""
-    results, notes = {}, []
+    results: dict = {}
+    notes = [f"{r['suite']} task {r['world']} failed and is left out: {r['error']}"
+             for r in rows if r.get("error")]
     for suite in suites:
         mine = [r for r in rows if r["suite"] == suite]
         if not mine:
@@ -272,6 +288,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--ticks-obstacles", type=int, default=300,
                     help="unknown obstacles of the ticks line (300)")
     ap.add_argument("--json", type=Path, default=None, help="write the figures here too")
+    ap.add_argument("--rows", type=Path, default=None,
+                    help="append each finished task's rows here as JSON lines (a stopped run "
+                         "keeps what it measured)")
     args = ap.parse_args(argv)
     n_barn = args.worlds if args.worlds is not None else (10 if args.quick else 100)
     draws = args.draws if args.draws is not None else (2 if args.quick else 10)
@@ -295,7 +314,15 @@ def main(argv: list[str] | None = None) -> int:
 
         root = str(args.mrpb)
         jobs = jobs_for(suites, planners, root, n_barn, args.seed, draws)
-        rows = run_all(jobs, args.jobs, progress)
+        keep = None
+        if args.rows:
+            args.rows.write_text("", encoding="utf-8")
+
+            def keep(rows):
+                with args.rows.open("a", encoding="utf-8") as fh:
+                    fh.writelines(json.dumps(r) + "\n" for r in rows)
+
+        rows = run_all(jobs, args.jobs, progress, keep)
         results, notes = suite_results(rows, suites, planners)
         elapsed = time.perf_counter() - start
         ticks = ticks_line(planners, args.ticks_obstacles, args.seed) if "ticks" in suites \
