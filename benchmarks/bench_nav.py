@@ -113,7 +113,7 @@ def task(job: tuple) -> list[dict]:
     try:
         return _task(job)
     except Exception as exc:            # noqa: BLE001 - reported in the table's notes
-        return [{"suite": job[0], "world": "/".join(str(x) for x in job[1:-1]),
+        return [{"suite": job[0], "world": label(job),
                  "error": f"{type(exc).__name__}: {exc}", "refused": None, "length": None,
                  "runs": {}}]
 
@@ -156,20 +156,35 @@ def row(suite, w, scene, why, length, planners) -> dict:
 
 
 def jobs_for(suites, planners, root: str, n_barn: int, seed: int, draws: int) -> list[tuple]:
-    """The tasks, the longest first (MRPB's long tests, then clutter, then the fields)."""
-    out: list[tuple] = []
+    """The tasks, the suites interleaved (an MRPB test, a clutter draw, a field, ...): a run
+    stopped early has measured some of each, and MRPB's long tests do not all come last."""
+    by_suite: list[list[tuple]] = []
     if "mrpb" in suites:
+        tests = []
         for name in (*mrpb.COMPLETE, *mrpb.PARTIALLY_UNKNOWN):
-            tests = mrpb.read_tests(Path(root) / name / "tests.txt")
-            out += [("mrpb", root, name, i, planners) for i in range(len(tests))]
+            count = len(mrpb.read_tests(Path(root) / name / "tests.txt"))
+            tests += [("mrpb", root, name, i, planners) for i in range(count)]
+        by_suite.append(tests)
     if "clutter" in suites:
         n_bases = len(SHIPPED) + len(mrpb.read_tests(Path(root) / "office02" / "tests.txt"))
-        out += [("clutter", root, b, j, seed, planners)
-                for b in range(n_bases) for j in range(draws)]
+        by_suite.append([("clutter", root, b, j, seed, planners)
+                         for j in range(draws) for b in range(n_bases)])
     barn_suites = tuple(s for s in suites if s.startswith("barn"))
     if barn_suites:
-        out += [("barn", s, barn_suites, planners) for s in range(seed, seed + n_barn)]
+        by_suite.append([("barn", s, barn_suites, planners) for s in range(seed, seed + n_barn)])
+    out = []
+    for k in range(max((len(t) for t in by_suite), default=0)):
+        out += [t[k] for t in by_suite if k < len(t)]
     return out
+
+
+def label(job: tuple) -> str:
+    """A task in a few words, for the progress lines."""
+    if job[0] == "mrpb":
+        return f"mrpb {job[2]} #{job[3] + 1}"
+    if job[0] == "clutter":
+        return f"clutter base {job[2]} draw {job[3]}"
+    return f"barn field {job[1]}"
 
 
 def run_all(jobs: list[tuple], workers: int, progress, keep=None) -> list[dict]:
@@ -386,8 +401,7 @@ def main(argv: list[str] | None = None) -> int:
         start = time.perf_counter()
 
         def progress(done, total, job):
-            print(f"[{time.perf_counter() - start:7.1f} s] {done}/{total} tasks "
-                  f"({job[0]} {'/'.join(str(x) for x in job[1:-1] if not isinstance(x, tuple))})",
+            print(f"[{time.perf_counter() - start:7.1f} s] {done}/{total} tasks ({label(job)})",
                   file=sys.stderr, flush=True)
 
         if args.from_rows:
