@@ -396,7 +396,7 @@ def grid_route(static: StaticMap, start: Pose, goal: Goal, clearance: float,
     # an edge between two nodes keeps the floor too (nodes sit at their block's clearest
     # cell, so two clear nodes may face each other across a thin wall); edges that leave the
     # start, reach the goal or move off within `leave` are exempt, as those nodes are
-    edge = _edge_clearance(field, centre, fr.shape, moves)
+    edge = _edge_clearance(field, centre, (R, C), moves)
     loose = ~blocked & (node_c < floor)
     loose[s] = loose[t] = True
     ok = (edge >= floor) & ~blocked[None]
