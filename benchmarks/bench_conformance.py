@@ -2,6 +2,7 @@
 
     python benchmarks/bench_conformance.py            # everything (a few minutes)
     python benchmarks/bench_conformance.py --quick    # pyfuzzylite's examples only
+    python benchmarks/bench_conformance.py --quick --fcl-dir DIR   # and every .fcl under DIR
 
 1. pyfuzzylite's example engines (inside the installed package) through the command line,
    ``mitos eval X.fll --batch IN.csv [-b BEHAVIOR]``, against their ``.fld`` tables to 1e-6,
@@ -58,9 +59,11 @@ def read_fld(path: Path) -> tuple[list[str], np.ndarray]:
 
 
 def worst(got: np.ndarray, ref: np.ndarray) -> float:
-    """Largest |difference|, NaN = NaN (no rule fired), NaN against a number = inf."""
-    both = np.isnan(got) & np.isnan(ref)
-    diff = np.abs(np.where(both, 0.0, got - ref))
+    """Largest |difference|, NaN = NaN (no rule fired), equal infinities equal (Tsukamoto),
+    NaN against a number = inf."""
+    both = (np.isnan(got) & np.isnan(ref)) | (got == ref)     # NaN = NaN, inf = inf
+    with np.errstate(invalid="ignore"):                      # inf - inf
+        diff = np.abs(np.where(both, 0.0, got - ref))
     return float(np.where(np.isnan(diff), np.inf, diff).max(initial=0.0))
 
 
@@ -91,7 +94,8 @@ def cli_batch(fll: Path, header: list[str], table: np.ndarray, behavior: str | N
     args = [sys.executable, "-m", "mitos_cli", "eval", str(fll), "--batch", str(csv)]
     if behavior:
         args += ["-b", behavior]
-    proc = subprocess.run(args, capture_output=True, text=True, cwd=tmp)
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}       # this checkout's MITOS, not another
+    proc = subprocess.run(args, capture_output=True, text=True, cwd=tmp, env=env)
     if proc.returncode != 0:
         raise RuntimeError(proc.stderr.strip().splitlines()[-1] if proc.stderr else "failed")
     lines = proc.stdout.splitlines()
@@ -312,6 +316,22 @@ def round_trips(paths: list[Path], tmp: Path) -> dict:
 # ---------------------------------------------------------------------------------------------
 
 
+def part_fcl_dir(directory: Path) -> dict:
+    """Every ``.fcl`` under ``directory`` (e.g. a jFuzzyLogic checkout): it loads, or the
+    refusal names its construct (an "unexpected" token would be a reader's gap, not a refusal)."""
+    files = sorted(directory.rglob("*.fcl"))
+    rows = []
+    for path in files:
+        name = str(path.relative_to(directory))
+        try:
+            compile_rulebase(read_rulebase(path))
+        except MitosError as exc:
+            rows.append((name, "refused", refusal(exc), None))
+            continue
+        rows.append((name, "loaded", "", None))
+    return {"files": len(files), "rows": rows}
+
+
 def report_rows(title: str, part: dict) -> None:
     status = Counter(s for _, s, _, _ in part["rows"])
     print(f"\n## {title}: {part['files']} files")
@@ -323,7 +343,7 @@ def report_rows(title: str, part: dict) -> None:
             print(f"  differs  {name}: largest difference {error:.3g}")
         elif s == "match" and why:
             print(f"  match    {name} ({why})")
-        elif s in ("refused", "loaded", "cli error"):
+        elif s in ("refused", "loaded", "cli error") and why:
             print(f"  {s:8s} {name}: {why}")
     errors = [e for _, s, _, e in part["rows"] if s == "match"]
     if errors:
@@ -333,6 +353,8 @@ def report_rows(title: str, part: dict) -> None:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="pyfuzzylite's examples only")
+    parser.add_argument("--fcl-dir", type=Path, metavar="DIR",
+                        help="also read every .fcl under DIR (e.g. a jFuzzyLogic checkout)")
     args = parser.parse_args()
     tmp = Path(tempfile.mkdtemp(prefix="mitos-conformance-"))
     all_files: list[Path] = []
@@ -361,6 +383,13 @@ def main() -> None:
                   f"({'matches' if part['tipper_ok'] else 'DIFFERS'})")
             all_files += sorted(map(Path, glob.glob(str(OCTAVE / "fuzzy-logic-toolkit*" /
                                                          "*.fis"))))
+    if args.fcl_dir:
+        part = part_fcl_dir(args.fcl_dir)
+        report_rows(f"5. FCL files under {args.fcl_dir}", part)
+        unexpected = [n for n, s, why, _ in part["rows"] if "unexpected" in why]
+        print(f"  refused without naming a construct: {len(unexpected)}"
+              + (f" ({', '.join(unexpected)})" if unexpected else ""))
+        all_files += sorted(args.fcl_dir.rglob("*.fcl"))
     rt = round_trips(all_files, tmp)
     print("\n## 4. Round trips of every file that loads (each behavior, each other format)")
     for fmt in ("fcl", "fis", "fll", "rules"):

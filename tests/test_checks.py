@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import shutil
 import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -13,7 +14,8 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 def run(tool: str, *args: str) -> subprocess.CompletedProcess:
-    exe = shutil.which(tool)
+    # The interpreter's own scripts first: the suite may run from an unactivated venv.
+    exe = shutil.which(tool, path=str(Path(sys.executable).parent)) or shutil.which(tool)
     if exe is None:
         pytest.fail(f"{tool} is not installed: pip install -e '.[test]' installs it")
     return subprocess.run([exe, *args], cwd=ROOT, capture_output=True, text=True, timeout=300)

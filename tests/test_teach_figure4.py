@@ -97,7 +97,7 @@ def test_the_lesson_is_in_words_and_the_taught_rule_base_keeps_its_meaning(taugh
     lesson = LESSON.read_text(encoding="utf-8")
     assert "at 13s to 14.5s make a wider turn" in lesson and "steering=" not in lesson
     assert "make a wider turn: the hardest steering of the window, one term further" in text
-    assert "heading.AHEAD: unchanged (held at 0 deg)" in text
+    assert "heading.AHEAD: held at 0 deg, its slopes moved with its neighbours" in text
     assert "steering.ST: unchanged (held at 90 deg)" in text
     assert text.count("interpretability: terms in order, universes covered") == 2  # adapt, save
     codes = {f.code for f in check_rulebase(load_rules_file(path)).findings}

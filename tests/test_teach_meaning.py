@@ -243,3 +243,101 @@ def test_the_measures_memberships_are_the_terms_own():
                                       corners[np.isfinite(corners)]]))
         expected = np.array([t.membership(x) for t in terms])
         np.testing.assert_allclose(meaning.memberships(corners, x), expected, atol=1e-12)
+
+
+SMOOTH = """
+variables:
+  g:
+    role: input
+    universe: [0, 10]
+    terms:
+      LO: {shape: gaussian, mean: 0, sigma: 2.5}
+      MD: {shape: gaussian, mean: 5, sigma: 2.5}
+      HI: {shape: gaussian, mean: 10, sigma: 2.5}
+  n:
+    role: input
+    universe: [0, 10]
+    terms:
+      LO: {shape: gaussian, mean: 0, sigma: 1}
+      HI: {shape: gaussian, mean: 10, sigma: 1}
+  b:
+    role: input
+    universe: [3.5, 10]
+    terms:
+      P: {shape: bell, center: 5, width: 2, slope: 2}
+      Q: {shape: bell, center: 5.2, width: 2, slope: 2}
+      R: {shape: right_shoulder, points: [5.5, 7.5]}
+  s:
+    role: input
+    universe: [-5, 5]
+    terms:
+      NEG: {shape: sigmoid, inflection: 0, slope: -2}
+      POS: {shape: sigmoid, inflection: 0.5, slope: 2}
+  o:
+    role: input
+    universe: [-5, 5]
+    terms:
+      NEG: {shape: sigmoid, inflection: -1, slope: -2}
+      POS: {shape: sigmoid, inflection: 1, slope: 2}
+      MID: {shape: gaussian, mean: 0, sigma: 1}
+  y:
+    role: output
+    universe: [0, 100]
+    terms: {S: 50}
+"""
+
+
+def test_findings_for_every_shape_on_samples():
+    """Gaussians, bells and sigmoids are measured on RESOLUTION samples of the universe."""
+    rb = build_rulebase(parse_rules("behavior b:\n r1: if g is LO and n is LO and b is P "
+                                    "and s is NEG and o is POS then y is S\nend\n"),
+                        (parse_termset(SMOOTH),), ("t.yaml",))
+    v = rb.variables
+    assert meaning.variable_issues(v["g"]) == []            # covered to exp(-0.5) = 0.61
+    (cover,) = meaning.variable_issues(v["n"])
+    assert cover.code == "coverage" and "covered only to 3.727e-06 at n = 5" in cover.message
+    found = {(i.code, i.terms) for i in meaning.variable_issues(v["b"])}
+    assert found == {("indistinct", ("P", "Q"))}
+    (low,) = meaning.variable_issues(v["s"])                # NEG and POS cross at 0.25: 0.42
+    assert low.code == "coverage" and "at s = 0.25" in low.message
+    (order,) = meaning.variable_issues(v["o"])              # by the registry's centres
+    assert order.code == "term-order" and order.terms == ("POS", "MID")
+    codes = {f.code for f in check_rulebase(rb).findings}
+    assert {"coverage", "indistinct", "term-order"} <= codes
+
+
+def test_sampled_measures_agree_with_the_exact_ones():
+    """The samples hold the breakpoints, so piecewise-linear terms measure exactly as on the
+    breakpoints alone: the resolution only matters where smooth terms bend between samples."""
+    for var in PAPER.variables.values():
+        sets = [t for t in var.terms if t.corners is not None]
+        if len(sets) < 2:
+            continue
+        corners = np.array([t.corners for t in sets], dtype=float)
+        x = meaning.sample_points(sets, var.universe)
+        mu = meaning.sampled(sets, x)
+        np.testing.assert_allclose(meaning.similarity_on(mu, x),
+                                   meaning.similarity(corners, var.universe), atol=1e-12)
+        exact = meaning.coverage(corners, var.universe)[0]
+        assert meaning.coverage_on(mu, x, var.universe)[0] == pytest.approx(exact, abs=1e-12)
+
+
+@settings(max_examples=25, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1))
+def test_tied_ruspini_partitions_hold_at_every_ordered_point(seed):
+    """What adaptation does not measure (``by_construction``) holds wherever the knots go in
+    order: covered to 0.5, no two sets more than 1/3 alike."""
+    from mitos_cli.teach.adapt import ruspini
+
+    p = parameterise(compile_rulebase(PAPER, "drive"))
+    assert all(part.by_construction for part in p.partitions)
+    rng = np.random.default_rng(seed)
+    values = p.values.copy()
+    for ids in p.order:
+        lo, hi = p.lo[ids[0]], p.hi[ids[0]]
+        values[ids] = np.sort(rng.uniform(lo, hi, len(ids)))
+    for part in p.partitions:
+        cover, similar = meaning.measures(part.corners(values), part.universe)
+        assert cover >= 0.5 - 1e-9 and similar <= 1 / 3 + 1e-9, part.var
+    gappy = np.array([[-np.inf, -np.inf, 0.0, 4.0], [2.0, 6.0, np.inf, np.inf]])
+    assert not ruspini(np.array([[-1, -1, 0, 1], [2, 3, -1, -1]]), gappy, (0.0, 10.0))

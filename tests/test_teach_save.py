@@ -132,3 +132,110 @@ def _number(word):
         return True
     except ValueError:
         return False
+
+
+def test_frozen_terms_survive_save_load_and_the_journal(rules, tmp_path):
+    """`frozen VAR.TERM` is part of the model: the journal replays it, `save` writes
+    `frozen: true` (flow mapping, bare crisp value) and `unfrozen` of a term frozen in the
+    YAML writes `frozen: false`; loading the saved files gives the same terms."""
+    from mitos_cli.teach.journal import Journal
+
+    terms = rules.parent / "mitos.terms.yaml"
+    text = terms.read_text()
+    terms.write_text(text.replace("{shape: right_shoulder, points: [40, 70]}",
+                                  "{shape: right_shoulder, points: [40, 70], frozen: true}", 1))
+    before = {(v.name, t.name): t.frozen for v in variables(load_rules_file(rules))
+              for t in v.terms}
+    assert [k for k, f in before.items() if f] == [("size", "LARGE_SZ")]
+    s = Session(rules, out=[].append, journal=Journal.create(tmp_path / "session"))
+    s.run("frozen road.NARROW, steering.LS, position.CENTER")
+    s.run("unfrozen size.LARGE_SZ")
+    s.run("correct road=78 size=45 position=4 -> steering=60")
+    s.run("adapt epochs 5")
+    again = Session.resume(Journal.open(tmp_path / "session"), out=[].append)
+    assert again.rulebase == s.rulebase
+    s.run(f"save {tmp_path / 'out' / 'taught.rules'}")
+    saved = load_rules_file(tmp_path / "out" / "taught.rules")
+    frozen = {(v.name, t.name): t.frozen for v in variables(saved) for t in v.terms}
+    assert sorted(k for k, f in frozen.items() if f) == [
+        ("position", "CENTER"), ("road", "NARROW"), ("steering", "LS")]
+    assert variables(saved) == variables(s.rulebase)
+    # a new session on the saved files keeps the frozen terms where they are
+    s2 = Session(tmp_path / "out" / "taught.rules", out=[].append)
+    s2.run("correct road=78 size=45 position=4 -> steering=40")
+    s2.run("adapt epochs 5")
+    learned = {(v.name, t.name): t for v in variables(s2.rulebase) for t in v.terms}
+    saved_terms = {(v.name, t.name): t for v in variables(saved) for t in v.terms}
+    for key in [("position", "CENTER"), ("road", "NARROW"), ("steering", "LS")]:
+        assert learned[key].params == saved_terms[key].params
+
+
+def test_frozen_written_into_a_block_mapping_and_a_frozen_value_replaced():
+    import dataclasses
+
+    from mitos_cli.lang.termfile import parse_termset
+    from mitos_cli.teach.save import edit_termset
+
+    text = ("variables:\n  x:\n    role: input\n    universe: [0, 10]\n    terms:\n"
+            "      LOW:\n        shape: left_shoulder\n        points: [2, 5]   # kept\n"
+            "      HIGH: {shape: right_shoulder, points: [2, 5], frozen: true}\n")
+    old = parse_termset(text, "x.yaml")
+    flip = {"LOW": True, "HIGH": False}
+    new = dataclasses.replace(old, variables=tuple(v.with_terms(tuple(
+        dataclasses.replace(t, frozen=flip[t.name]) for t in v.terms)) for v in old.variables))
+    written, changes = edit_termset(text, "x.yaml", old, new)
+    assert written == text.replace("      LOW:\n", "      LOW:\n        frozen: true\n") \
+        .replace("frozen: true}", "frozen: false}")
+    assert changes == ["x.LOW: frozen", "x.HIGH: no longer frozen"]
+    assert [t.frozen for t in parse_termset(written).variables[0].terms] == [True, False]
+
+
+def test_a_released_centre_term_stays_released_after_save(rules, tmp_path):
+    """`unfrozen position.CENTER` lifts its hold at 0: `save` writes `held: false`, the saved
+    rule base lets it move and `mitos check` does not call it off-centre."""
+    from mitos_cli.engine.check import check_rulebase
+    from mitos_cli.teach.journal import Journal
+
+    s = Session(rules, out=[].append, journal=Journal.create(tmp_path / "session"))
+    s.run("unfrozen position.CENTER, road.NARROW")       # NARROW has no point: nothing to write
+    s.run("correct road=78 size=45 position=2 -> steering=40")
+    s.run("correct road=78 size=45 position=-1 -> steering=120")
+    s.run("adapt epochs 20")
+    centre = s.rulebase.variables["position"].term("CENTER")
+    assert not centre.held and centre.params[0] != 0          # it moved off 0
+    assert s.rulebase.variables["road"].term("NARROW").held
+    assert Session.resume(Journal.open(tmp_path / "session"), out=[].append).rulebase \
+        == s.rulebase
+    s.run(f"save {tmp_path / 'out.rules'}")
+    text = (tmp_path / "out.mitos.terms.yaml").read_text()
+    assert "CENTER: {shape: triangle, peak: " in text and ", held: false}" in text
+    assert text.count("held:") == 1
+    saved = load_rules_file(tmp_path / "out.rules")
+    assert variables(saved) == variables(s.rulebase)
+    assert not {f.code for f in check_rulebase(saved).findings} & {"off-centre"}
+    p = Session(tmp_path / "out.rules", out=[].append)
+    from mitos_cli.teach.adapt import parameterise
+    assert ("position", "CENTER") not in {(v, t) for v, t, _ in parameterise(p.compiled()).held}
+
+
+def test_held_must_be_true_or_false():
+    from mitos_cli.errors import TermSetError
+    from mitos_cli.lang.termfile import parse_termset
+
+    text = ("variables:\n  x:\n    role: input\n    universe: [0, 10]\n    terms:\n"
+            "      MID: {shape: triangle, points: [2, 5, 8], held: maybe}\n")
+    with pytest.raises(TermSetError, match="`held` must be true or false") as err:
+        parse_termset(text, "x.yaml")
+    assert (err.value.span.line, err.value.span.column) == (6, 55)
+
+
+def test_frozen_must_be_true_or_false():
+    """`frozen: "no"` is a string, and a string is truthy: refuse it rather than freeze."""
+    from mitos_cli.errors import TermSetError
+    from mitos_cli.lang.termfile import parse_termset
+
+    text = ("variables:\n  x:\n    role: input\n    universe: [0, 10]\n    terms:\n"
+            "      MID: {shape: triangle, points: [2, 5, 8], frozen: \"no\"}\n")
+    with pytest.raises(TermSetError, match="`frozen` must be true or false") as err:
+        parse_termset(text, "x.yaml")
+    assert err.value.span.line == 6

@@ -14,6 +14,9 @@ INFERENCE = {
                         "(term centre) or a . x + c (linear); the paper's eqs. 18-19",
     "weighted_sum": "y = sum_r(dof_r * y_r) (Takagi-Sugeno without normalisation)",
     "mamdani": "y = defuzzify(S_r implication(dof_r, mu_r(y))) on `resolution` samples",
+    "tsukamoto": "y = sum_t(w_t * z_t) / sum_t(w_t); w_t = sum of the dofs of the rules "
+                 "concluding term t, z_t = mu_t^-1(w_t) (monotonic terms only; fuzzylite's "
+                 "Tsukamoto)",
 }
 #: The classic implications; any other T-norm T gives mu'(y) = T(dof, mu(y)).
 IMPLICATION = {

@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..fuzzy.formula import Formula
 from ..fuzzy.shapes import kernel_params
 from ..lang import operators as ops_mod
 from ..lang.model import And, Expr, Not, Prop, Rule, RuleBase, Setting, Use, flatten, format_rule
@@ -48,6 +49,7 @@ class ShapeGroup:
     cols: np.ndarray              # [g] columns in V (2 + term index)
     inputs: np.ndarray            # [g] input column of each
     params: np.ndarray            # [g, p]
+    formula: Formula | None = None   # the one term of a ``formula`` group
 
 
 @dataclass(frozen=True, eq=False)
@@ -118,6 +120,16 @@ class CompiledRuleBase:
         # (an explicit row count: with no rules, ``reshape(-1, 0)`` cannot infer it)
         return K.reshape(len(self.outputs) + len(distinct), self.n_rules), rows
 
+    @functools.cached_property
+    def hedged_outputs(self) -> tuple[int, ...]:
+        """Outputs of weighted inference with a hedged consequent (each hedges its rule's
+        weight, :func:`mitos_cli.engine.evaluation.weighted_average`); none under Mamdani,
+        where a hedge reshapes the consequent set."""
+        if self.operators.inference not in ("weighted_average", "weighted_sum"):
+            return ()
+        return tuple(j for j in range(len(self.outputs))
+                     if any(row[j] for row in self.cons_hedges))
+
     @property
     def n_rules(self) -> int:
         return len(self.labels)
@@ -156,6 +168,13 @@ class CompiledRuleBase:
 
     def __setstate__(self, state: dict) -> None:
         self.__dict__.update(state)
+
+    @functools.cached_property
+    def tsukamoto(self):
+        """Per output, its terms and the rules concluding each, for Tsukamoto inference."""
+        from .tsukamoto import build_plan
+
+        return build_plan(self)
 
     @functools.cached_property
     def mamdani(self):
@@ -355,8 +374,11 @@ def _used_variables(rb: RuleBase, flat, operators: Operators):
             if use.condition is not None:
                 _collect_inputs(use.condition, used_inputs)
     linear_inputs: dict[str, tuple[str, ...]] = {}
+    concluded: dict[tuple[str, str | None], Rule] = {}
     for _, rule, _ in flat:
         for c in rule.consequents:
+            if operators.inference == "tsukamoto":
+                _check_tsukamoto(c, rule, variables, concluded)
             if c.term is not None and variables[c.var].term(c.term).shape == "linear":
                 names = linear_inputs.setdefault(c.var, _termset_inputs(rb, c.var))
                 coefficients = variables[c.var].term(c.term).params[:-1]
@@ -395,18 +417,19 @@ def _membership_layer(inputs: tuple[str, ...], variables) -> _Members:
     terms = tuple(t for v in inputs for t in variables[v].terms)
     term_var = [k for k, v in enumerate(inputs) for _ in variables[v].terms]
     kernel = np.zeros((4, len(terms)))
-    groups: dict[tuple[str, int], list[int]] = {}   # variadic shapes group by param count
+    # variadic shapes group by param count, formula terms by formula
+    groups: dict[tuple[str, int, Formula | None], list[int]] = {}
     for i, t in enumerate(terms):
         if t.corners is not None:
             kernel[:, i] = kernel_params(t.corners)
         else:
-            groups.setdefault((t.shape, len(t.params)), []).append(i)
+            groups.setdefault((t.shape, len(t.params), t.formula), []).append(i)
     shape_groups = tuple(
         ShapeGroup(shape, np.array([2 + i for i in idx], dtype=np.intp),
                    np.array([term_var[i] for i in idx], dtype=np.intp),
                    np.array([terms[i].params for i in idx], dtype=float).reshape(
-                       len(idx), n_params))
-        for (shape, n_params), idx in groups.items())
+                       len(idx), n_params), formula)
+        for (shape, n_params, formula), idx in groups.items())
     return _Members(names, terms, np.array(term_var, dtype=np.intp),
                     np.array([t.corners is not None for t in terms], dtype=bool), kernel,
                     shape_groups)
@@ -516,6 +539,29 @@ def _linear_consequents(flat, variables, inputs, outputs, linear_inputs,
                 out[r, j, -1] = term.params[-1]
                 value[r, j] = 0.0
     return out
+
+
+def _check_tsukamoto(c, rule: Rule, variables, concluded: dict) -> None:
+    """Tsukamoto inference inverts each consequent's term: only monotonic ones have one, and
+    only at a degree in [0, 1], which a term concluded by several rules (their degrees are
+    summed, fuzzylite's rule) may exceed."""
+    from ..errors import RuleBaseError
+    from ..fuzzy.shapes import TSUKAMOTO
+
+    first = concluded.setdefault((c.var, c.term), rule)
+    if first is not rule:
+        raise RuleBaseError(
+            f"`{c.var} is {c.term}` is concluded by rules `{first.label}` and `{rule.label}`: "
+            f"under Tsukamoto inference their degrees add up and may pass 1, where the term "
+            f"has no inverse", span=c.span or rule.span,
+            hint="join the rules' conditions with `or` in one rule")
+
+    shape = variables[c.var].term(c.term).shape if c.term is not None else None
+    if shape not in TSUKAMOTO:
+        what = f"a `{shape}` term" if shape else "a crisp value"
+        raise RuleBaseError(
+            f"`{c.var} is {c.term or c.value}`: Tsukamoto inference needs a monotonic "
+            f"consequent term ({', '.join(TSUKAMOTO)}), not {what}", span=c.span or rule.span)
 
 
 def _termset_inputs(rb: RuleBase, output: str) -> tuple[str, ...]:

@@ -13,6 +13,7 @@ INFERENCE_TEXT = {
     "weighted_average": "weighted average of the rules' consequents, sum(dof y) / sum(dof) "
                         "(eqs. 18-19)",
     "weighted_sum": "weighted sum of the rules' consequents, sum(dof y)",
+    "tsukamoto": "Tsukamoto: each term inverted at its summed degree w, sum(w z) / sum(w)",
 }
 
 

@@ -183,9 +183,27 @@ def memberships(compiled: CompiledRuleBase, Xt: np.ndarray, out: np.ndarray) -> 
         if not plan.all_linear:
             out[2 + plan.linear_rows] = rise
     for g in compiled.shape_groups:
-        shape = SHAPES[g.shape]
         x = Xt[g.inputs]
+        if g.formula is not None:
+            out[g.cols] = _formula_memberships(compiled, g, x)
+            continue
+        shape = SHAPES[g.shape]
         out[g.cols] = shape.fn(x, *(g.params[:, i:i + 1] for i in range(g.params.shape[1])))
+
+
+def _formula_memberships(compiled: CompiledRuleBase, g, x: np.ndarray) -> np.ndarray:
+    """A formula term's memberships; a value that is no degree (NaN, or outside [0, 1]) is
+    refused with the term and the input, never passed on (a hedge would turn it into NaN)."""
+    assert g.formula is not None
+    mu = g.formula(x)
+    bad = ~((mu >= 0.0) & (mu <= 1.0))
+    if bad.any():
+        row, col = map(int, np.argwhere(bad)[0])
+        var, term = compiled.term_names[int(g.cols[row]) - 2]
+        raise InputError(f"term `{var}.{term}` (formula `{g.formula.text}`) gives {mu[row, col]:g} "
+                         f"at {var} = {x[row, col]:g}: a membership degree lies in [0, 1]",
+                         hint="change the formula so it stays within [0, 1] on the universe")
+    return mu
 
 
 def _apply_group(group, V: np.ndarray, tnorm: norms.Norm, snorm: norms.Norm) -> None:
@@ -313,6 +331,8 @@ def weighted_average(compiled: CompiledRuleBase, dof: np.ndarray,
         sums = tree_sum(W)
     else:
         sums = _constant_sums(plan, dof)
+    if compiled.hedged_outputs:
+        return _hedged_average(compiled, dof, Xt, sums)
     if compiled.operators.inference == "weighted_sum":
         return sums[:m].copy()
     den = sums[plan.den_row]
@@ -320,6 +340,32 @@ def weighted_average(compiled: CompiledRuleBase, dof: np.ndarray,
     if fired.all():
         return np.divide(sums[:m], den)
     return np.divide(sums[:m], den, out=np.full((m, dof.shape[1]), np.nan), where=fired)
+
+
+def _hedged_average(compiled: CompiledRuleBase, dof: np.ndarray, Xt: np.ndarray | None,
+                    sums: np.ndarray) -> np.ndarray:
+    """Weighted inference where consequents carry hedges (``then tip is very high``): the
+    hedge weights that rule's consequent by ``hedge(dof)`` (fuzzylite's reading; hedging a
+    singleton's set, Zadeh's reading, would change nothing). Outputs without hedges keep
+    their sums; a hedged one is summed again over its own weights (a loop over the few
+    distinct hedges of an output, never over rules)."""
+    m = len(compiled.outputs)
+    nums, dens = sums[:m].copy(), sums[compiled.plan.den_row].copy()
+    Y = linear_consequents(compiled, Xt) if compiled.cons_linear is not None and Xt is not None \
+        else None
+    for j in compiled.hedged_outputs:
+        D = dof * compiled.cons_mask[:, j, None]
+        column = [compiled.cons_hedges[r][j] for r in range(compiled.n_rules)]
+        for hedges in dict.fromkeys(h for h in column if h):
+            rows = np.array([h == hedges for h in column])
+            D[rows] = hedge_mod.apply(hedges, dof[rows])
+        y = Y[j] if Y is not None else compiled.cons_value[:, j, None]
+        dens[j] = tree_sum(D.copy())
+        nums[j] = tree_sum(np.multiply(D, y))
+    if compiled.operators.inference == "weighted_sum":
+        return nums
+    fired = dens > 0
+    return np.divide(nums, dens, out=np.full(nums.shape, np.nan), where=fired)
 
 
 def _constant_sums(plan, dof: np.ndarray) -> np.ndarray:
@@ -446,6 +492,10 @@ def infer(compiled: CompiledRuleBase, dof: np.ndarray,
         from .mamdani import mamdani_outputs
 
         return mamdani_outputs(compiled, dof)
+    if compiled.operators.inference == "tsukamoto":
+        from .tsukamoto import tsukamoto_outputs
+
+        return tsukamoto_outputs(compiled, dof)
     if compiled.cons_linear is not None and Xt is None:
         raise ValueError("linear consequents need the inputs: infer(compiled, dof, Xt)")
     return weighted_average(compiled, dof, Xt)

@@ -45,6 +45,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..errors import TermSetError
 from ..fuzzy import hedges as hedge_mod
 from ..fuzzy import norms
 
@@ -122,6 +123,13 @@ def build_tables(compiled) -> tuple[OutputTable, ...]:
                     t = var.term(term)
                     mu = (spike(lo, hi, res, t.params[0], sampling) if t.shape == "singleton"
                           else np.asarray(t.membership(x), dtype=float))
+                    if t.formula is not None and not np.isfinite(mu).all():
+                        at = float(x[np.flatnonzero(~np.isfinite(mu))[0]])
+                        raise TermSetError(f"term `{name}.{term}`: its formula "
+                                           f"`{t.formula.text}` gives {mu[~np.isfinite(mu)][0]} "
+                                           f"at {name} = {at:g}", span=t.span,
+                                           hint="change the formula so it is defined on the "
+                                                "whole universe")
                     rows.append(hedge_mod.apply(hedges, mu))
                     labels.append(" ".join(hedges + (term,)))
             picks.append(keys[key])

@@ -59,8 +59,8 @@ def scalar_function(c: CompiledRuleBase) -> ScalarFn | None:
 
 def _source(c: CompiledRuleBase) -> str:
     ops = c.operators
-    if (c.shape_groups or ops.inference == "mamdani" or c.n_columns > MAX_COLUMNS
-            or ops.and_ not in NORMS or ops.or_ not in NORMS):
+    if (c.shape_groups or ops.inference in ("mamdani", "tsukamoto") or c.n_columns > MAX_COLUMNS
+            or c.hedged_outputs or ops.and_ not in NORMS or ops.or_ not in NORMS):
         raise _Unsupported
     plan = c.plan
     k = len(c.inputs)

@@ -438,3 +438,59 @@ for _shape in (
           variadic=True),
 ):
     register(_shape)
+
+
+def _formula_fn(x, *params):
+    raise TypeError("a formula term is evaluated by its Formula (Term.membership), not by params")
+
+
+#: ``formula``: a membership function of ``x`` written as a formula (fuzzylite's ``Function``,
+#: :mod:`mitos_cli.fuzzy.formula`); the formula lives on the term, the params are empty.
+register(Shape("formula", (), _formula_fn, lambda p: None, None, lambda p: float("nan"),
+               "a membership function given by a formula of x (fuzzylite's Function)"))
+
+
+
+# ---------------------------------------------------------------------------------------------
+# Tsukamoto inference: a monotonic output term's value at an activation degree w, z = mu^-1(w)
+# (fuzzylite's ``Term.tsukamoto``, heights 1). Where mu never reaches w (a sigmoid at w = 1, a
+# concave term at w = 0) the inverse is infinite, as in fuzzylite.
+
+
+def _ramp_inverse(w, start, end):
+    return start + (end - start) * w
+
+
+def _sigmoid_inverse(w, inflection, slope):
+    with np.errstate(divide="ignore"):
+        return inflection + np.log(1.0 / w - 1.0) / -slope
+
+
+def _s_shape_inverse(w, start, end):
+    with np.errstate(invalid="ignore"):
+        return np.where(w <= 0.5, start + (end - start) * np.sqrt(w / 2.0),
+                        end - (end - start) * np.sqrt((1.0 - w) / 2.0))
+
+
+def _z_shape_inverse(w, start, end):
+    with np.errstate(invalid="ignore"):
+        return np.where(w <= 0.5, end - (end - start) * np.sqrt(w / 2.0),
+                        start + (end - start) * np.sqrt((1.0 - w) / 2.0))
+
+
+def _concave_inverse(w, inflection, end):
+    with np.errstate(divide="ignore"):
+        return (inflection - end) / w + 2.0 * end - inflection
+
+
+def _arc_inverse(w, start, end):
+    r = end - start
+    sign = -1.0 if start < end else 1.0
+    return end + sign * np.sqrt(np.maximum(r * r - np.square(w * r), 0.0))
+
+
+#: Shapes Tsukamoto inference can invert, and their inverses ``fn(w, *params)``.
+TSUKAMOTO: dict[str, Callable[..., np.ndarray]] = {
+    "ramp": _ramp_inverse, "sigmoid": _sigmoid_inverse, "s_shape": _s_shape_inverse,
+    "z_shape": _z_shape_inverse, "concave": _concave_inverse, "arc": _arc_inverse,
+}

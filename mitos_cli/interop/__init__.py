@@ -129,8 +129,9 @@ def round_trip_difference(rb: RuleBase, written: RuleBase, fmt: str,
     for j1, name in enumerate(after.outputs):
         j0 = before.outputs.index(name)
         a, b = Y0[:, j0], Y1[:, j1]
-        both_nan = np.isnan(a) & np.isnan(b)
-        diff = np.where(both_nan, 0.0, np.abs(a - b))
+        same = (np.isnan(a) & np.isnan(b)) | (a == b)          # NaN = NaN, inf = inf
+        with np.errstate(invalid="ignore"):                   # inf - inf, masked out
+            diff = np.where(same, 0.0, np.abs(a - b))
         diff = np.where(np.isnan(diff), np.inf, diff)         # NaN on one side only
         worst = int(np.argmax(diff))
         v = renamed.variables[name]

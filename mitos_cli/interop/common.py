@@ -16,13 +16,15 @@ from pathlib import Path
 
 from ..errors import FormatError, MitosError, Span, did_you_mean
 from ..fuzzy import norms as norm_registry
+from ..fuzzy.formula import Formula
 from ..fuzzy.hedges import HEDGES, fuzzylite_names
-from ..fuzzy.shapes import SHAPES
+from ..fuzzy.shapes import SHAPES, TSUKAMOTO
 from ..lang import operators as ops_mod
 from ..lang.model import And, Behavior, Consequent, Expr, Not, Or, Prop, Rule, RuleBase, Setting
 from ..lang.resolve import MAIN, check_rule
 from ..lang.terms import Term, TermSet, Variable
 from ..words import plural
+from . import rewrite
 
 # ---------------------------------------------------------------------------------------------
 # Operators: MITOS name -> (FLL, FIS, FCL). None = the format has no name for it.
@@ -118,6 +120,27 @@ def to_fuzzylite_hedge(name: str) -> str:
         raise FormatError(f"fuzzylite has no hedge like MITOS's `{name}` (x^3)",
                           hint="use `very` (x^2) or `intensely` (fuzzylite's `extremely`)")
     return MITOS_TO_FUZZYLITE_HEDGES[name]
+
+
+def written_consequents(rule: Rule) -> list[tuple[Consequent, tuple[str, ...]]]:
+    """A rule's consequents as fuzzylite's rule text must list them, each with the hedges to
+    write before its term: fuzzylite carries a consequent's hedges on to the ones after it
+    (:func:`.ruletree.conclusions`), so less-hedged consequents come first and each writes
+    only the hedges it adds. Hedges that cannot be carried that way are refused by name."""
+    ordered = sorted(rule.consequents, key=lambda c: len(c.hedges))
+    out = []
+    carried: tuple[str, ...] = ()
+    for c in ordered:
+        own = len(c.hedges) - len(carried)
+        if c.hedges[own:] != carried:
+            raise FormatError(f"rule `{rule.label}`: hedges `{' '.join(c.hedges)}` on `{c.var}` "
+                              f"and `{' '.join(carried)}` on another consequent cannot be "
+                              f"written in fuzzylite's rules, which carry a consequent's hedges "
+                              f"on to the consequents after it", span=rule.span,
+                              hint="split the rule in two")
+        out.append((c, c.hedges[:own]))
+        carried = c.hedges
+    return out
 
 
 def concluded_term(c: Consequent) -> str:
@@ -224,9 +247,16 @@ def make_term(name: str, shape: str, params: tuple[float, ...], span: Span | Non
     return Term(name, shape, tuple(float(p) for p in params), span)
 
 
+def formula_term(name: str, formula: Formula, span: Span | None) -> Term:
+    """fuzzylite's ``Function`` term: a membership given by a formula of ``x``."""
+    return Term(name, "formula", (), span, formula=formula)
+
+
 def fuzzylite_term_text(term: Term, variable: str) -> str:
     """``Kind p1 p2 ...`` for a MITOS term (FLL and fuzzylite's FCL)."""
     shape, p = term.shape, term.params
+    if term.formula is not None:
+        return f"Function {term.formula.text}"
     if shape in ("left_shoulder", "right_shoulder", "triangle_pw", "triangle_plr"):
         corners = term.corners
         assert corners is not None             # these four shapes are piecewise linear
@@ -288,7 +318,7 @@ class Settings:
         if self.or_:
             out.append(Setting("or", self.or_))
         defuzz = self.defuzzify or "centroid"
-        if defuzz in ("weighted_average", "weighted_sum"):
+        if defuzz in ("weighted_average", "weighted_sum", "tsukamoto"):
             out.append(Setting("inference", defuzz))
         else:
             out.append(Setting("inference", "mamdani"))
@@ -302,7 +332,8 @@ class Settings:
 
     @property
     def sugeno(self) -> bool:
-        return self.defuzzify in ("weighted_average", "weighted_sum")
+        """Weighted inference (Takagi-Sugeno or Tsukamoto): no Mamdani settings."""
+        return self.defuzzify in ("weighted_average", "weighted_sum", "tsukamoto")
 
 
 class Record(list):
@@ -392,17 +423,20 @@ def check_implication(name: str, span: Span | None) -> str:
 
 
 def assemble(path: str | None, variables: list[Variable], rules: list[Rule], settings: Settings,
-             default_resolution: int, span: Span | None = None) -> RuleBase:
+             default_resolution: int, span: Span | None = None,
+             notes: list[str] | None = None) -> RuleBase:
     """Check what a reader gathered and return the rule base (one behavior, ``main``)."""
-    return assemble_blocks(path, variables, [(MAIN, rules, settings)], default_resolution, span)
+    return assemble_blocks(path, variables, [(MAIN, rules, settings)], default_resolution, span,
+                           notes)
 
 
 def assemble_blocks(path: str | None, variables: list[Variable],
                     blocks: list[tuple[str, list[Rule], Settings]], default_resolution: int,
-                    span: Span | None = None) -> RuleBase:
+                    span: Span | None = None, notes: list[str] | None = None) -> RuleBase:
     """The rule base of one or more rule blocks: one block gives behavior ``main`` with the
     operators on the file; several (whose operators differ) give one behavior each, with its
-    own operators, the first being the default."""
+    own operators, the first being the default. Chained outputs are restated first
+    (:func:`.rewrite.unchain`), with a line in ``notes``."""
     names = [v.name for v in variables]
     for v in variables:
         if names.count(v.name) > 1:
@@ -414,7 +448,12 @@ def assemble_blocks(path: str | None, variables: list[Variable],
     check_numbers(variables)
     by_name = {v.name: v for v in variables}
     behaviors = []
+    outputs = {v.name for v in variables if v.role == "output"}
     for name, rules, settings in blocks:
+        and_, or_ = settings.and_ or "min", settings.or_ or "max"
+        aggregation = settings.aggregation or (None if settings.sugeno else "max")
+        rules = rewrite.unchain(rules, outputs, and_, or_, aggregation,
+                                notes if notes is not None else [])
         _check_block(rules, settings, by_name, len(blocks) == 1)
         operators = settings.operators(default_resolution)
         try:
@@ -438,11 +477,22 @@ def _check_block(rules: list[Rule], settings: Settings, by_name: dict[str, Varia
         if v.role != "output" or not (every_output or v.name in concluded):
             continue
         for t in v.terms:
+            if sugeno and t.formula is not None:
+                raise FormatError(
+                    f"output term `{v.name}.{t.name}`: a formula as a weighted-average "
+                    f"consequent (a function of the engine's variables) is not supported",
+                    span=t.span, hint="use Constant or Linear terms")
+            if settings.defuzzify == "tsukamoto":
+                if t.shape not in TSUKAMOTO:
+                    raise FormatError(f"output term `{v.name}.{t.name}`: Tsukamoto inference "
+                                      f"inverts monotonic terms ({', '.join(TSUKAMOTO)}), not "
+                                      f"a `{t.shape}` term", span=t.span)
+                continue
             if sugeno and t.shape not in ("singleton", "linear"):
                 raise FormatError(
                     f"output term `{v.name}.{t.name}`: a weighted-average output needs constant "
-                    f"or linear terms; a `{t.shape}` term there is Tsukamoto inference, which "
-                    f"MITOS does not support", span=t.span)
+                    f"or linear terms (Takagi-Sugeno) or monotonic ones (Tsukamoto: "
+                    f"{', '.join(TSUKAMOTO)}), not a `{t.shape}` term", span=t.span)
             if not sugeno and t.shape == "linear":
                 raise FormatError(f"output term `{v.name}.{t.name}`: linear terms need a "
                                   f"weighted-average (Takagi-Sugeno) defuzzifier", span=t.span)
@@ -452,11 +502,6 @@ def _check_block(rules: list[Rule], settings: Settings, by_name: dict[str, Varia
         except MitosError as exc:
             raise FormatError(exc.message, span=exc.span or rule.span, expected=exc.expected,
                               hint=exc.hint) from None
-        if sugeno:
-            for c in rule.consequents:
-                if c.hedges:
-                    raise FormatError("hedges on a Takagi-Sugeno consequent are not supported",
-                                      span=c.span)
 
 
 # ---------------------------------------------------------------------------------------------

@@ -38,6 +38,7 @@ from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput
 
 from ..errors import FormatError, Span, did_you_mean
 from ..fuzzy import norms
+from ..fuzzy.shapes import TSUKAMOTO
 from ..lang.cache import lark_parser
 from ..lang.model import And, Not, Prop, Rule, RuleBase
 from ..lang.resolve import MAIN
@@ -45,7 +46,7 @@ from ..lang.terms import Role, Term, Variable
 from ..words import plural
 from . import common
 from .common import FCL, FLL, fmt_number
-from .ruletree import conclusion, expression
+from .ruletree import conclusions, expression
 
 DEFAULT_RESOLUTION = 1000
 
@@ -148,7 +149,8 @@ def _function_block(fb: Tree, span_of) -> RuleBase:
         if item.data in ("var_input", "var_output"):
             role: Role = "input" if item.data == "var_input" else "output"
             for decl in item.children:
-                name, typ, rng = decl.children
+                name, typ, rng, after = decl.children
+                rng = rng if rng is not None else after
                 if str(name) in declared:
                     raise FormatError(f"variable `{name}` is declared twice", span=span_of(name))
                 if str(typ).upper() != "REAL":
@@ -199,6 +201,8 @@ def _function_block(fb: Tree, span_of) -> RuleBase:
         parsed.append((name, record, rules))
     parsed = [p for p in parsed if p[2]] or parsed[:1]
     outputs = [n for n in declared if declared[n][0] == "output"]
+    for n in outputs:
+        _tsukamoto(records[n], variables[n], notes)
     try:
         all_rules = [r for _, _, rules in parsed for r in rules]
         if len({r.label for r in all_rules}) < len(all_rules):
@@ -235,8 +239,22 @@ def _function_block(fb: Tree, span_of) -> RuleBase:
                         hint=f"for a singleton write `TERM {term.name} := value;`")
     ordered = [variables[n] for n in declared]
     rb = common.assemble_blocks(span_of(fb).path, ordered, groups, DEFAULT_RESOLUTION,
-                                span_of(fb))
+                                span_of(fb), notes)
     return dataclasses.replace(rb, notes=tuple(notes))
+
+
+def _tsukamoto(record: common.Record, v: Variable, notes: list[str]) -> None:
+    """`METHOD : COGS;` over monotonic terms is Tsukamoto inference, as fuzzylite's FCL
+    importer infers it (its weighted defuzzifiers' `Automatic` type)."""
+    if not v.terms or any(t.shape not in TSUKAMOTO for t in v.terms):
+        return
+    for i, (key, value, where, what) in enumerate(record):
+        if key == "defuzzify" and value == "weighted_average":
+            record[i] = (key, "tsukamoto", where, what)
+            if any(t.shape == "sigmoid" for t in v.terms):
+                notes.append(f"{where}: `{v.name}` inverts sigmoid terms (Tsukamoto inference); "
+                             f"a sigmoid reaches 1 only at infinity, so where a rule fires "
+                             f"fully the output is +-inf, as in fuzzylite")
 
 
 def _variable(node: Tree, role: Role, declared, settings: common.Record, locks: dict,
@@ -279,6 +297,11 @@ def _variable(node: Tree, role: Role, declared, settings: common.Record, locks: 
                 raise FormatError(f"unknown DEFAULT flag `{flag}`", span=span_of(flag),
                                   expected="NC")
             if isinstance(value, Token) and value.type == "NAME":
+                if str(value).upper() == "NC":
+                    raise FormatError("`DEFAULT := NC` (no change: keep the previous output "
+                                      "when no rule fires) needs state between evaluations, "
+                                      "which MITOS does not keep", span=span_of(value),
+                                      hint="give a number: `DEFAULT := value;`")
                 raise FormatError(f"DEFAULT must be a number, not `{value}`", span=span_of(value))
             default = _num(value)              # nan: NaN when no rule fires, as asked
         elif kind == "lock_item":
@@ -361,6 +384,21 @@ def _extent(terms: list[Term], name: str, span: Span,
     return min(xs), max(xs)
 
 
+def _no_variable(term: str, node, span_of) -> None:
+    """jFuzzyLogic lets a membership parameter be a variable's name (optimised by its
+    learning code); MITOS's terms have numbers."""
+    if isinstance(node, Token) and node.type == "NAME":
+        raise FormatError(f"term `{term}`: a parameter given by a variable (`{node}`) is not "
+                          f"supported", span=span_of(node), hint="write the number")
+
+
+def _point_values(term: str, points, span_of):
+    for p in points:
+        for v in p.children:
+            _no_variable(term, v, span_of)
+    return points
+
+
 def _term(item: Tree, role: str, n_inputs: int, span_of) -> Term:
     name_token, definition = item.children
     name, span = str(name_token), span_of(item)
@@ -372,10 +410,17 @@ def _term(item: Tree, role: str, n_inputs: int, span_of) -> Term:
                           f"not supported", span=span_of(definition.children[0]),
                           hint="replace the formula by one of the shapes (trian, trape, gauss, "
                                "gbell, sigm, ...) or a point list")
+    if definition.data == "singletons_def":
+        raise FormatError(f"term `{name}`: SINGLETONS terms (several weighted singletons in one "
+                          f"term) are not supported", span=span_of(definition.children[0]),
+                          hint="give each singleton its own term (`TERM t := value;`)")
     if definition.data == "points":
-        pts = [(_num(p.children[0]), _num(p.children[1])) for p in definition.children]
+        pts = [(_num(p.children[0]), _num(p.children[1])) for p in _point_values(
+            name, definition.children, span_of)]
         return _points_term(name, pts, span)
     kind_token, *value_nodes = definition.children
+    for v in value_nodes:
+        _no_variable(name, v, span_of)
     kind = str(kind_token)
     values = [_num(v) for v in value_nodes]
     # fuzzylite's class names in their own spelling first: `Cosine c w` is fuzzylite's
@@ -421,13 +466,19 @@ def _points_term(name: str, pts: list[tuple[float, float]], span: Span) -> Term:
     return common.make_term(name, "discrete", tuple(v for p in pts for v in p), span)
 
 
+#: Names that mean an S-norm after `OR :` (the same word after `AND :` is the T-norm).
+OR_ALIASES = {"EINSTEIN": "einstein_sum", "HAMACHER": "hamacher_sum"}
+
+
 def _option(item: Tree, settings: common.Record, span_of, conj: dict) -> None:
     key_token, value_token, number = item.children
     key, value, span = str(key_token).upper(), str(value_token), span_of(value_token)
     if key == "AND":
         settings.set("and_", _norm(common.TNORMS, value, "AND", span), span, "AND")
     elif key == "OR":
-        settings.set("or_", _norm(common.SNORMS, value, "OR", span), span, "OR")
+        # jFuzzyLogic's `OR : EINSTEIN;` is the Einstein sum (RuleConnectionMethodOrEinstein)
+        name = OR_ALIASES.get(value.upper()) or _norm(common.SNORMS, value, "OR", span)
+        settings.set("or_", name, span, "OR")
     elif key in ("ACT", "IMPLICATION"):
         settings.set("implication", common.check_implication(
             _norm(common.TNORMS, value, "ACT", span), span), span, "ACT")
@@ -466,7 +517,7 @@ def _rule(item: Tree, variables: dict[str, Variable], span_of, index: int) -> Ru
     label = label if not label.isdigit() else f"r{label}"
     antecedent = expression(antecedent_tree, span_of, variables)
     weight = _num(weight_tree) if weight_tree is not None else 1.0
-    return Rule(label, antecedent, tuple(conclusion(c, span_of) for c in rest[:-1]), weight,
+    return Rule(label, antecedent, conclusions(rest[:-1], span_of), weight,
                 span_of(item))
 
 
@@ -478,6 +529,8 @@ def write_fcl(rb: RuleBase, behavior: str | None = None) -> str:
     """FCL text (IEC 61131-7 as jFuzzyLogic reads it) for one behavior of ``rb``."""
     flat = common.flatten_for_export(rb, behavior)
     ops = flat.operators
+    if ops.inference == "tsukamoto":
+        raise FormatError("FCL has no Tsukamoto inference; write it to FLL or a rule file")
     sugeno = ops.inference in ("weighted_average", "weighted_sum")
     inputs = common.all_inputs(rb, flat)
     out = [f"FUNCTION_BLOCK {flat.name}", "", "VAR_INPUT"]
@@ -525,6 +578,9 @@ def write_fcl(rb: RuleBase, behavior: str | None = None) -> str:
 
 
 def _term_text(t: Term, v: Variable) -> str:
+    if t.formula is not None:
+        raise FormatError(f"term `{v.name}.{t.name}`: FCL has no formula terms (fuzzylite's "
+                          f"`Function`); write it to FLL or a term set")
     if t.shape == "singleton":
         return fmt_number(t.params[0])
     if t.shape == "clipped_sigmoid_difference":          # jFuzzyLogic's DSIGM g1 c1 g2 c2
@@ -567,8 +623,8 @@ def _rule_text(r: Rule) -> str:
         return f"({text})" if parent not in ("top", op, "not") else text
 
     cons = " AND ".join(f"{c.var} IS " + " ".join(
-        [common.to_fuzzylite_hedge(h) for h in c.hedges] + [common.concluded_term(c)])
-        for c in r.consequents)
+        [common.to_fuzzylite_hedge(h) for h in hedges] + [common.concluded_term(c)])
+        for c, hedges in common.written_consequents(r))
     text = f"IF {expr(r.antecedent, 'top')} THEN {cons}"
     if r.weight != 1.0:
         text += f" WITH {fmt_number(r.weight)}"

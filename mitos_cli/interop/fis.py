@@ -180,7 +180,7 @@ def parse_fis(text: str, path: str | None = None) -> RuleBase:
                               f"{'AND' if connective is And else 'OR'}", span=used.span,
                               hint=f"give {key} a method, e.g. "
                                    f"'{'min' if connective is And else 'max'}'")
-    rb = common.assemble(path, variables, rules, settings, DEFAULT_RESOLUTION, sys_span)
+    rb = common.assemble(path, variables, rules, settings, DEFAULT_RESOLUTION, sys_span, notes)
     return dataclasses.replace(rb, notes=tuple(notes))
 
 
@@ -256,6 +256,10 @@ def _mf(value: str, vspan: Span, role: str, kind: str, n_inputs: int) -> Term:
     m = re.fullmatch(r"'([^']*)'\s*:\s*'([^']*)'\s*,\s*(\[.*\])", value.strip())
     if not m:
         raise FormatError("expected 'name':'type',[params]", span=vspan)
+    if m.group(2) == "function":          # fuzzylite's .fis extension: a formula
+        raise FormatError(f"MF `{m.group(1)}`: `function` MFs (fuzzylite's formula of the "
+                          f"engine's variables, `{m.group(3)[1:-1].strip()}`) are not supported",
+                          span=vspan)
     name, mf, params = m.group(1), m.group(2), _vector(m.group(3), vspan)
     if mf == "linear":
         if role != "output" or kind != "sugeno":
@@ -333,6 +337,9 @@ def write_fis(rb: RuleBase, behavior: str | None = None) -> str:
     negated, without hedges) joined all by AND or all by OR, as MATLAB's rule list is."""
     flat = common.flatten_for_export(rb, behavior)
     ops = flat.operators
+    if ops.inference == "tsukamoto":
+        raise FormatError("MATLAB's .fis has no Tsukamoto inference; write it to FLL or a "
+                          "rule file")
     sugeno = ops.inference in ("weighted_average", "weighted_sum")
     inputs = common.all_inputs(rb, flat)
     name = flat.name

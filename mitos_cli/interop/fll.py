@@ -30,6 +30,7 @@ from lark import Lark, Tree
 from lark.exceptions import UnexpectedInput
 
 from ..errors import FormatError, Span, did_you_mean
+from ..fuzzy.formula import parse as parse_formula
 from ..lang.cache import lark_parser
 from ..lang.model import Rule, RuleBase
 from ..lang.model import format_number as _fmt_weight
@@ -37,8 +38,11 @@ from ..lang.resolve import MAIN
 from ..lang.terms import Role, Term, Variable
 from . import common
 from .common import FLL, Settings, fmt_number
-from .ruletree import conclusion, expression
+from .ruletree import conclusions as conclusions_of
+from .ruletree import expression
 
+#: fuzzylite's monotonic terms, which its weighted defuzzifiers invert (Tsukamoto inference)
+TSUKAMOTO_KINDS = ("Ramp", "Sigmoid", "SShape", "ZShape", "Concave", "Arc")
 SECTIONS = ("Engine", "InputVariable", "OutputVariable", "RuleBlock")
 KEYS = {
     "Engine": ("description",),
@@ -71,6 +75,29 @@ class _Var:
     description: str = ""
     lock_range: Span | None = None      # `lock-range: true` on an output
     record: common.Record = field(default_factory=common.Record)
+    weighted_type: tuple[str, Span] | None = None   # a weighted defuzzifier's type, where
+
+
+def _tsukamoto(v: _Var, notes: list[str]) -> None:
+    """A weighted defuzzifier over monotonic terms is Tsukamoto inference: said so
+    (``WeightedAverage Tsukamoto``), or inferred from the terms as fuzzylite does
+    (``Automatic``, the default)."""
+    if v.weighted_type is None:
+        return
+    kind, span = v.weighted_type
+    monotonic = bool(v.terms) and all(k in TSUKAMOTO_KINDS for _, k, _, _ in v.terms)
+    if kind != "Tsukamoto" and not (kind == "Automatic" and monotonic):
+        return
+    for i, (key, value, where, what) in enumerate(v.record):
+        if key == "defuzzify":
+            if value == "weighted_sum":
+                raise FormatError("Tsukamoto inference with a weighted sum is not supported "
+                                  "(MITOS's Tsukamoto takes the weighted average)", span=where)
+            v.record[i] = (key, "tsukamoto", where, what)
+    if any(k == "Sigmoid" for _, k, _, _ in v.terms):
+        notes.append(f"{span}: `{v.name}` inverts Sigmoid terms (Tsukamoto inference); a sigmoid "
+                     f"reaches 1 only at infinity, so where a rule fires fully the output is "
+                     f"+-inf, as in fuzzylite")
 
 
 @dataclass
@@ -157,6 +184,8 @@ def parse_fll(text: str, path: str | None = None) -> RuleBase:
             _block_key(key, value, vspan, blocks[-1].record, blocks[-1].conj)
 
     notes: list[str] = []
+    for v in variables:
+        _tsukamoto(v, notes)
     built = [_build_variable(v, [x.name for x in variables if x.role == "input"], notes)
              for v in variables]
     by_name = {v.name: v for v in built}
@@ -185,7 +214,7 @@ def parse_fll(text: str, path: str | None = None) -> RuleBase:
         mine = [v for v in variables if v.role == "input" or v.name in concluded or
                 len(groups) == 1]
         _check_outputs(mine, rules, settings)
-    rb = common.assemble_blocks(path, built, groups, DEFAULT_RESOLUTION, engine_span)
+    rb = common.assemble_blocks(path, built, groups, DEFAULT_RESOLUTION, engine_span, notes)
     return dataclasses.replace(rb, notes=tuple(notes))
 
 
@@ -227,8 +256,14 @@ def _variable_key(v: _Var, key: str, value: str, span: Span, vspan: Span,
     elif key == "term":
         if len(words) < 2:
             raise FormatError("`term` takes a name, a type and its parameters", span=vspan)
-        if words[1] in common.FORMULA_TERMS:
-            common.fuzzylite_term(words[0], words[1], [], 0, vspan)     # raises
+        if words[1] == "Function":            # the rest of the line is the formula
+            start = value.index("Function", len(words[0])) + len("Function")
+            text = value[start:]
+            fspan = dataclasses.replace(vspan, column=vspan.column + start
+                                        + len(text) - len(text.lstrip()), end_column=None)
+            formula = parse_formula(text.lstrip(), fspan, FormatError)
+            v.terms.append((words[0], "Function", formula, fspan))
+            return
         v.terms.append((words[0], words[1], [common.number(w, vspan) for w in words[2:]], vspan))
     elif key == "lock-range":
         if value == "true" and v.role == "output":
@@ -249,14 +284,14 @@ def _variable_key(v: _Var, key: str, value: str, span: Span, vspan: Span,
         if not words:
             raise FormatError("`defuzzifier` needs a name", span=vspan)
         name = common.table_lookup(common.DEFUZZIFIERS, FLL, words[0], "defuzzifier", vspan)
+        if name in ("weighted_average", "weighted_sum"):
+            v.weighted_type = (words[1:2] or ["Automatic"])[0], vspan
         settings.set("defuzzify", name, vspan, "defuzzifier")
         if len(words) > 1:
             if name in ("weighted_average", "weighted_sum"):
-                if words[1] == "Tsukamoto":
-                    raise FormatError("Tsukamoto inference is not supported", span=vspan)
-                if words[1] not in ("TakagiSugeno", "Automatic"):
+                if words[1] not in ("TakagiSugeno", "Automatic", "Tsukamoto"):
                     raise FormatError(f"unknown weighted defuzzifier type `{words[1]}`",
-                                      span=vspan, expected="TakagiSugeno or Automatic")
+                                      span=vspan, expected="TakagiSugeno, Tsukamoto or Automatic")
             else:
                 res = common.number(words[1], vspan, "a resolution")
                 if not res.is_integer() or res < 3:
@@ -307,6 +342,9 @@ def _build_variable(v: _Var, inputs: list[str], notes: list[str]) -> Variable:
         if kind == "Linear" and v.role == "input":
             raise FormatError(f"term `{v.name}.{name}`: Linear terms belong to outputs",
                               span=span)
+        if kind == "Function":
+            terms.append(common.formula_term(name, values, span))
+            continue
         terms.append(common.fuzzylite_term(name, kind, list(values), len(inputs), span))
     if not terms and v.role == "output":
         raise FormatError(f"output variable `{v.name}` has no terms", span=v.span)
@@ -348,7 +386,7 @@ def _rule(value: str, text: str, path: str | None, lineno: int, vcol: int,
     _check_operators(antecedent_tree, conj, span_of)
     weight = common.number(str(weight_token), span_of(weight_token)) if weight_token else 1.0
     span = Span.in_text(text, path, lineno, vcol, vcol + len(value))
-    return Rule(f"r{index + 1}", antecedent, tuple(conclusion(c, span_of) for c in conclusions),
+    return Rule(f"r{index + 1}", antecedent, conclusions_of(conclusions, span_of),
                 weight, span)
 
 
@@ -390,7 +428,8 @@ def write_fll(rb: RuleBase, behavior: str | None = None) -> str:
     """FLL text for one behavior of ``rb`` (reading it back gives the same outputs)."""
     flat = common.flatten_for_export(rb, behavior)
     ops = flat.operators
-    sugeno = ops.inference in ("weighted_average", "weighted_sum")
+    tsukamoto = ops.inference == "tsukamoto"
+    sugeno = ops.inference in ("weighted_average", "weighted_sum") or tsukamoto
     inputs = common.all_inputs(rb, flat)
     out = [f"Engine: {flat.name}"]
     for v in inputs:
@@ -408,8 +447,11 @@ def write_fll(rb: RuleBase, behavior: str | None = None) -> str:
                 f"{fmt_number(v.universe[1])}", "  lock-range: false"]
         if sugeno:
             out.append("  aggregation: none")
-            kind = common.DEFUZZIFIERS[ops.inference][FLL]
-            out.append(f"  defuzzifier: {kind} TakagiSugeno")
+            if tsukamoto:
+                out.append("  defuzzifier: WeightedAverage Tsukamoto")
+            else:
+                kind = common.DEFUZZIFIERS[ops.inference][FLL]
+                out.append(f"  defuzzifier: {kind} TakagiSugeno")
         else:
             aggregation = common.foreign_name(common.SNORMS, FLL, ops.aggregation, "S-norm")
             out.append(f"  aggregation: {aggregation}")
@@ -419,7 +461,9 @@ def write_fll(rb: RuleBase, behavior: str | None = None) -> str:
         out.append(f"  default: {'nan' if v.default is None else fmt_number(v.default)}")
         out.append("  lock-previous: false")
         for t in v.terms:
-            out.append(f"  term: {t.name} {_output_term(rb, t, v, sugeno, inputs)}")
+            text = common.fuzzylite_term_text(t, v.name) if tsukamoto else \
+                _output_term(rb, t, v, sugeno, inputs)
+            out.append(f"  term: {t.name} {text}")
     out += [f"RuleBlock: {flat.name}", "  enabled: true",
             f"  conjunction: {common.foreign_name(common.TNORMS, FLL, ops.and_, 'T-norm')}",
             f"  disjunction: {common.foreign_name(common.SNORMS, FLL, ops.or_, 'S-norm')}"]
@@ -473,9 +517,9 @@ def fuzzylite_rule_text(rule: Rule, ops, dialect: str) -> str:
 
     assert not isinstance(antecedent, Not)
     cons = f" {kw('and')} ".join(
-        f"{c.var} {kw('is')} " + " ".join([common.to_fuzzylite_hedge(h) for h in c.hedges]
+        f"{c.var} {kw('is')} " + " ".join([common.to_fuzzylite_hedge(h) for h in hedges]
                                           + [common.concluded_term(c)])
-        for c in rule.consequents)
+        for c, hedges in common.written_consequents(rule))
     text = f"{kw('if')} {expr(antecedent, 'top')} {kw('then')} {cons}"
     if rule.weight != 1.0:
         text += f" {kw('with')} {_fmt_weight(rule.weight)}"

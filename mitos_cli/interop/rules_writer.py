@@ -9,6 +9,7 @@ an ``operators:`` line. Names the rule language cannot hold (reserved words, cha
 
 from __future__ import annotations
 
+import json
 import re
 
 import numpy as np
@@ -187,7 +188,10 @@ def _term_spec(rb: RuleBase, v: Variable, t: Term, inputs: list[str]) -> str:
         given = ", ".join(f"{_scalar(n)}: {_scalar(a)}" for n, a in coefficients.items()
                           if a != 0.0)
         return f"{{shape: linear, coefficients: {{{given}}}, constant: {_scalar(p[-1])}}}"
-    frozen = ", frozen: true" if t.frozen else ""
+    frozen = (", frozen: true" if t.frozen else "") + ("" if t.held else ", held: false")
+    if t.formula is not None:                      # a JSON string is a YAML string
+        return (f"{{shape: formula, formula: {json.dumps(t.formula.text)}"
+                f"{', frozen: true' if t.frozen else ''}}}")
     if t.shape == "triangle_pw":
         return f"{{shape: triangle, peak: {_scalar(p[0])}, width: {_scalar(p[1])}{frozen}}}"
     if t.shape == "triangle_plr":

@@ -41,6 +41,9 @@ def expression(tree, span_of: SpanOf, variables: dict[str, Variable]) -> Expr:
         if v is None:
             return Prop(str(var), "", ("any",), False, span_of(tree))   # checked later
         return Prop(v.name, v.terms[0].name, ("any",), False, span_of(tree))
+    if kind == "bare_variable":
+        raise FormatError(f"a condition without `IS` (`{tree.children[0]}`) is not supported",
+                          span=span_of(tree), expected=f"`{tree.children[0]} IS TERM`")
     if kind == "proposition":
         var, *words, term = tree.children
         negated, hedges = _words(words, span_of, tree, allow_not=True)
@@ -48,6 +51,20 @@ def expression(tree, span_of: SpanOf, variables: dict[str, Variable]) -> Expr:
     if len(tree.children) == 1:
         return expression(tree.children[0], span_of, variables)
     raise FormatError(f"unexpected `{kind}` in a rule", span=span_of(tree))
+
+
+def conclusions(trees, span_of: SpanOf) -> tuple[Consequent, ...]:
+    """A rule's consequents as fuzzylite computes them: its hedges change the rule's activation
+    degree for that consequent *and every one after it* (``Consequent.modify`` reassigns the
+    degree), so ``then a is very x and b is y`` hedges ``b`` too. Each consequent gets the
+    hedges accumulated so far, outermost first, which is what MITOS's hedge tuple means."""
+    out: list[Consequent] = []
+    carried: tuple[str, ...] = ()
+    for tree in trees:
+        c = conclusion(tree, span_of)
+        carried = c.hedges + carried
+        out.append(Consequent(c.var, c.term, c.value, carried, c.span))
+    return tuple(out)
 
 
 def conclusion(tree: Tree, span_of: SpanOf) -> Consequent:

@@ -21,12 +21,21 @@ distinguishable    two fuzzy sets of one variable have a Jaccard similarity
 centre             when the terms are written mirror-symmetric about a point (an odd number
                    of terms; the first and last, second and second-last, ... are mirror
                    images, corner for corner), the middle term stays centred on that point
-                   (``heading.AHEAD`` at 0, ``steering.ST`` at 90)
+                   (``heading.AHEAD`` at 0, ``steering.ST`` at 90), unless it is written
+                   with ``held: false``
 =================  =========================================================================
 
-Only piecewise-linear terms (triangles, trapezoids, shoulders) and crisp terms are measured;
-a variable with another shape (gaussian, ...) is left out of coverage and similarity.
-Everything here is pure and vectorized over terms and points.
+Piecewise-linear terms (triangles, trapezoids, shoulders) are measured exactly, on the points
+where their memberships bend (:func:`breakpoints`). A variable with any other shape of the
+registry (gaussian, bell, sigmoid, ``discrete``, ...) is measured on samples
+(:func:`sample_points`): :data:`RESOLUTION` evenly spaced points of the universe, plus the
+breakpoints of its piecewise-linear terms (so those stay exact) and every term's centre; the
+coverage is the least on those points and the similarity the trapezoid rule over them (on the
+universe of 1,000 intervals, a membership of slope at most ``s`` per universe-width can dip
+below its sampled value by at most ``s / 2,000`` between two samples). Such terms are ordered by
+the registry's centre (a gaussian's mean, a sigmoid's inflection); a term held at a point of
+symmetry is looked for among piecewise-linear terms only. Everything here is pure and
+vectorized over points (and over terms, for piecewise-linear ones).
 """
 
 from __future__ import annotations
@@ -46,6 +55,9 @@ SIMILARITY = 0.5
 DISTINCT = 0.5
 #: Relative tolerance (of the universe width) for "at its point" and "in order".
 TOLERANCE = 1e-6
+#: Evenly spaced points of the universe on which terms that are not piecewise linear are
+#: measured (plus the corners and centres of the variable's terms): 1,000 intervals.
+RESOLUTION = 1001
 
 
 @dataclass(frozen=True)
@@ -96,7 +108,13 @@ def coverage(corners: np.ndarray, universe: tuple[float, float],
     envelope of piecewise-linear functions is smallest at one of its :func:`breakpoints`.
     ``besides_gaps``: the least above 0 (where no term is above 0 is a gap, reported apart)."""
     x = breakpoints(corners, universe)
-    top = memberships(corners, x).max(axis=0)
+    return coverage_on(memberships(corners, x), x, universe, besides_gaps)
+
+
+def coverage_on(mu: np.ndarray, x: np.ndarray, universe: tuple[float, float],
+                besides_gaps: bool = False) -> tuple[float, float]:
+    """:func:`coverage` from the memberships ``mu[t, n]`` at the points ``x[n]``."""
+    top = mu.max(axis=0)
     if besides_gaps:
         x, top = x[top > 0], top[top > 0]
         if not len(top):
@@ -109,7 +127,12 @@ def similarity(corners: np.ndarray, universe: tuple[float, float]) -> np.ndarray
     """Jaccard similarity ``[t, t]`` of every pair of terms (1 on the diagonal), exactly: the
     trapezoid rule on the :func:`breakpoints`, between which min and max are linear."""
     x = breakpoints(corners, universe)
-    mu = memberships(corners, x)                                 # [t, n]
+    return similarity_on(memberships(corners, x), x)
+
+
+def similarity_on(mu: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """:func:`similarity` from the memberships ``mu[t, n]`` at the points ``x[n]`` (the
+    trapezoid rule over them)."""
     both = np.minimum(mu[:, None, :], mu[None, :, :])
     either = np.maximum(mu[:, None, :], mu[None, :, :])
     dx = np.diff(x)
@@ -149,10 +172,37 @@ def measures(corners: np.ndarray, universe: tuple[float, float]) -> tuple[float,
 
 def most_similar(corners: np.ndarray, universe: tuple[float, float]) -> tuple[float, int, int]:
     """The largest similarity of two different terms and which two."""
-    s = similarity(corners, universe)
+    return _most(similarity(corners, universe))
+
+
+def _most(s: np.ndarray) -> tuple[float, int, int]:
+    s = s.copy()
     np.fill_diagonal(s, -1.0)
     i, j = np.unravel_index(int(np.argmax(s)), s.shape)
     return float(s[i, j]), int(i), int(j)
+
+
+# ---- terms of any shape, on samples -------------------------------------------------------------
+
+def sample_points(terms, universe: tuple[float, float]) -> np.ndarray:
+    """Where terms of any shape are measured: :data:`RESOLUTION` evenly spaced points of the
+    universe, the :func:`breakpoints` of the piecewise-linear ones among ``terms`` (so they stay
+    exact) and every term's centre (sorted)."""
+    lo, hi = universe
+    linear = [t.corners for t in terms if t.corners is not None]
+    bends = breakpoints(np.array(linear, dtype=float), universe) if linear else np.zeros(0)
+    centres = np.array([t.center for t in terms], dtype=float)
+    x = np.concatenate([np.linspace(lo, hi, RESOLUTION), bends, centres])
+    return np.unique(x[np.isfinite(x) & (x >= lo) & (x <= hi)])
+
+
+def sampled(terms, x: np.ndarray) -> np.ndarray:
+    """``mu[t, n]`` of ``terms`` (any shape of the registry) at the points ``x[n]``, in
+    [0, 1] (a NaN membership counts as 0)."""
+    with np.errstate(all="ignore"):
+        mu = np.array([np.asarray(t.membership(x), dtype=float) * np.ones_like(x)
+                       for t in terms])                    # terms, never samples
+    return np.clip(np.nan_to_num(mu, nan=0.0), 0.0, 1.0)
 
 
 # ---- what a variable's terms are --------------------------------------------------------------
@@ -169,7 +219,10 @@ def core(term: Term) -> tuple[float, float]:
 
 
 def centre(term: Term) -> float:
-    """The point a term stands for: its core's middle, or a shoulder's inner core end."""
+    """The point a term stands for: its core's middle, or a shoulder's inner core end (any
+    other shape: the registry's centre, a gaussian's mean, a sigmoid's inflection)."""
+    if not learnable(term):
+        return term.center
     lo, hi = core(term)
     if np.isinf(lo):
         return hi
@@ -236,18 +289,24 @@ def _num(x: float) -> str:
 
 def variable_issues(var: Variable) -> list[Issue]:
     """Every interpretability problem of ``var``'s terms (nothing for a variable with fewer
-    than two terms, or with a shape these measures do not understand)."""
-    terms = [t for t in var.terms if learnable(t)]
-    if len(terms) < 2 or len(terms) != len(var.terms):
+    than two terms, or with Takagi-Sugeno linear consequents)."""
+    terms = list(var.terms)
+    if len(terms) < 2 or any(t.shape == "linear" for t in terms):
         return []
     out = _order(var)
     crisp = [t for t in terms if t.shape == "singleton"]
     sets = [t for t in terms if t.shape != "singleton"]
     width = var.universe[1] - var.universe[0]
     if len(sets) >= 2 or (sets and var.role == "input"):
-        corners = np.array([t.corners for t in sets], dtype=float)
+        if all(learnable(t) for t in sets):                     # exact
+            corners = np.array([t.corners for t in sets], dtype=float)
+            x = breakpoints(corners, var.universe)
+            mu = memberships(corners, x)
+        else:                                                   # any shape: on samples
+            x = sample_points(sets, var.universe)
+            mu = sampled(sets, x)
         if var.role == "input":
-            low, where = coverage(corners, var.universe, besides_gaps=True)   # see term-gap
+            low, where = coverage_on(mu, x, var.universe, besides_gaps=True)   # see term-gap
             if low < COVERAGE - 1e-9:
                 out.append(Issue("coverage", var.name, (), (
                     f"`{var.name}` is covered only to {_num(low)} at {var.name} = "
@@ -255,7 +314,7 @@ def variable_issues(var: Variable) -> list[Issue]:
                     f"at least {COVERAGE:g})"),
                     "widen the neighbouring terms so that they overlap there"))
         if len(sets) >= 2:
-            s, i, j = most_similar(corners, var.universe)
+            s, i, j = _most(similarity_on(mu, x))
             if s > SIMILARITY + 1e-9:
                 out.append(Issue("indistinct", var.name, (sets[i].name, sets[j].name), (
                     f"`{var.name}.{sets[i].name}` and `{sets[j].name}` are hard to tell apart "
@@ -292,15 +351,15 @@ def _order(var: Variable) -> list[Issue]:
 def _off_centre(var: Variable) -> list[Issue]:
     """The middle term of terms that mirror each other about a point, but not on it."""
     n = len(var.terms)
-    if n < 3 or n % 2 == 0:
+    if n < 3 or n % 2 == 0 or not all(learnable(t) for t in var.terms):
         return []
     outer = Variable(var.name, var.role, var.universe,
                      var.terms[:n // 2] + (_placeholder(var),) + var.terms[n // 2 + 1:])
     point = mirror_point(outer)
     middle = var.terms[n // 2]
     tol = 1e-3 * (var.universe[1] - var.universe[0])
-    if point is None or abs(centre(middle) - point) <= tol:
-        return []
+    if point is None or abs(centre(middle) - point) <= tol or not middle.held:
+        return []                                   # `held: false`: the instructor let it move
     return [Issue("off-centre", var.name, (middle.name,), (
         f"`{var.name}.{middle.name}` is centred on {_num(centre(middle))}, off the point "
         f"{_num(point)} its neighbours mirror each other about"),
@@ -316,6 +375,7 @@ def rulebase_issues(variables) -> list[Issue]:
     return [i for v in variables for i in variable_issues(v)]
 
 
-__all__ = ["COVERAGE", "DISTINCT", "SIMILARITY", "Issue", "centre", "core", "coverage",
-           "held_term", "memberships", "mirror_point", "most_similar", "rulebase_issues",
-           "similarity", "variable_issues"]
+__all__ = ["COVERAGE", "DISTINCT", "RESOLUTION", "SIMILARITY", "Issue", "centre", "core",
+           "coverage", "coverage_on", "held_term", "memberships", "mirror_point",
+           "most_similar", "rulebase_issues", "sample_points", "sampled", "similarity",
+           "similarity_on", "variable_issues"]

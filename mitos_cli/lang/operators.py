@@ -13,7 +13,7 @@ from ..errors import RuleBaseError, Span, unknown
 from ..fuzzy import norms
 from ..lang.model import Behavior, RuleBase, Setting
 
-INFERENCES = ("weighted_average", "weighted_sum", "mamdani")
+INFERENCES = ("weighted_average", "weighted_sum", "mamdani", "tsukamoto")
 #: Mamdani implications: any T-norm (min and product are the classic ones; FLL files also use
 #: e.g. EinsteinProduct).
 IMPLICATIONS = tuple(norms.TNORMS)

@@ -32,6 +32,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import Span, TermSetError, did_you_mean
+from ..fuzzy.formula import parse as parse_formula
 from ..fuzzy.shapes import SHAPES
 from ..words import plural
 from . import yamlpos
@@ -174,10 +175,15 @@ def _term(name: str, spec: Any, key_span: Span, value_span: Span, variable: str,
         raise TermSetError(f"{what}: unknown shape `{shape}`", span=spec.value_span("shape"),
                            expected="one of " + ", ".join(USER_SHAPES),
                            hint=did_you_mean(str(shape), USER_SHAPES))
-    frozen = bool(spec.get("frozen", False))
+    frozen = _flag(spec, "frozen", False, what,
+                   "`frozen: true` keeps adaptation from moving the term")
+    held = _flag(spec, "held", True, what,
+                 "`held: false` lets adaptation move a centre term off its point")
     if shape == "linear":
         return _linear_term(what, name, spec, key_span, frozen, inputs)
-    given = tuple(sorted(k for k in spec if k not in ("shape", "frozen")))
+    if shape == "formula":
+        return _formula_term(what, name, spec, key_span, frozen)
+    given = tuple(sorted(k for k in spec if k not in ("shape", "frozen", "held")))
     if shape == "triangle":
         internal = TRIANGLE_FORMS.get(given)
         if internal is None:
@@ -198,13 +204,22 @@ def _term(name: str, spec: Any, key_span: Span, value_span: Span, variable: str,
         params = tuple(yamlpos.expect_number(v, points.item_span(i), TermSetError,
                                              f"{what}: point") for i, v in enumerate(points))
     else:
-        allowed = ("shape", "frozen", "points") + kind.params
+        allowed = ("shape", "frozen", "held", "points") + kind.params
         yamlpos.check_keys(spec, allowed, TermSetError, what)
         for p in kind.params:
             yamlpos.require(spec, p, TermSetError, what)
         params = tuple(yamlpos.expect_number(spec[p], spec.value_span(p), TermSetError,
                                              f"{what}: {p}") for p in kind.params)
-    return Term(name, internal, params, key_span, frozen)
+    return Term(name, internal, params, key_span, frozen, held)
+
+
+def _flag(spec: YMap, key: str, default: bool, what: str, hint: str) -> bool:
+    """A yes/no key of a term: YAML's `true`/`false` only, since `"no"` would be truthy."""
+    value = spec.get(key, default)
+    if not isinstance(value, bool):
+        raise TermSetError(f"{what}: `{key}` must be true or false, not `{value}`",
+                           span=spec.value_span(key), hint=hint)
+    return value
 
 
 def _linear_term(what: str, name: str, spec: YMap, key_span: Span, frozen: bool,
@@ -228,3 +243,15 @@ def _linear_term(what: str, name: str, spec: YMap, key_span: Span, frozen: bool,
             coefficients[var] = yamlpos.expect_number(value, given.value_span(var),
                                                       TermSetError, f"{what}: coefficient")
     return Term(name, "linear", tuple(coefficients.values()) + (constant,), key_span, frozen)
+
+
+def _formula_term(what: str, name: str, spec: YMap, key_span: Span, frozen: bool) -> Term:
+    """``{shape: formula, formula: "1 / (1 + x^2)"}``: a membership function of ``x``."""
+    yamlpos.check_keys(spec, ("shape", "formula", "frozen"), TermSetError, what)
+    text = yamlpos.require(spec, "formula", TermSetError, what)
+    if not isinstance(text, str):
+        raise TermSetError(f"{what}: `formula` must be a text, e.g. \"1 / (1 + x^2)\"",
+                           span=spec.value_span("formula"))
+    formula = parse_formula(text, spec.value_span("formula"), TermSetError)
+    return Term(name, "formula", (), key_span, frozen, formula=formula)
+

@@ -13,6 +13,7 @@ from typing import Literal
 import numpy as np
 
 from ..errors import Span, TermSetError, unknown
+from ..fuzzy.formula import Formula
 from ..fuzzy.shapes import SHAPES, Shape
 
 Role = Literal["input", "output"]
@@ -37,6 +38,10 @@ class Term:
     params: tuple[float, ...]
     span: Span | None = field(default=None, compare=False)
     frozen: bool = False
+    #: ``held: false`` in the YAML: a centre term adaptation may move off its point of symmetry
+    held: bool = True
+    #: the membership function of a ``formula`` term (its params are empty)
+    formula: Formula | None = None
 
     @property
     def kind(self) -> Shape:
@@ -62,6 +67,8 @@ class Term:
         ``a 40, b 70``, ``points [10, 40, 70]`` (a triangle by its corners or a ``discrete``
         term), a singleton's value alone. ``number`` formats each value."""
         p = self.params
+        if self.formula is not None:
+            return f"formula {self.formula.text}"
         if self.shape == "singleton":
             return number(p[0])
         if self.shape == "linear":                 # LINEAR_LAYOUT: coefficients..., constant
@@ -72,6 +79,8 @@ class Term:
         return ", ".join(f"{n} {number(v)}" for n, v in zip(self.kind.params, p))
 
     def membership(self, x) -> np.ndarray:
+        if self.formula is not None:
+            return self.formula(x)
         return self.kind.membership(x, self.params)
 
     def with_params(self, params: tuple[float, ...]) -> Term:

@@ -22,6 +22,7 @@ class YMap(dict):
     """A mapping that remembers the span of itself, of each key and of each value."""
 
     span: Span
+    end_span: Span               # just after the mapping (after the `}` of a flow mapping)
     key_spans: dict
     value_spans: dict
 
@@ -103,6 +104,7 @@ def _build_loader(text: str, path: str | None) -> type:
     def construct_mapping(loader: Loader, node: yaml.MappingNode) -> YMap:
         out = YMap()
         out.span = _span(node.start_mark, text, path)
+        out.end_span = _span(node.end_mark, text, path)
         out.key_spans, out.value_spans = {}, {}
         for key_node, value_node in node.value:
             if not isinstance(key_node, yaml.ScalarNode):

@@ -43,6 +43,7 @@ import dataclasses
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 
@@ -126,6 +127,38 @@ class Parameters:
     def n_free(self) -> int:
         return int(round(np.trace(self.projector)))
 
+    @cached_property
+    def neighbours(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(left, right, need)``: every pair of neighbouring knots of the ``order`` entries
+        and the least distance between them (:func:`_need`), as flat arrays, so that the
+        order check of every trial step is three array operations."""
+        if not self.order:
+            empty = np.zeros(0, dtype=np.intp)
+            return empty, empty, np.zeros(0)
+        left = np.concatenate([ids[:-1] for ids in self.order])
+        right = np.concatenate([ids[1:] for ids in self.order])
+        need = np.concatenate([_need(self, ids, k) for k, ids in enumerate(self.order)])
+        return left, right, need
+
+    @cached_property
+    def crisp_neighbours(self) -> tuple[np.ndarray, ...]:
+        """``(left, right, first, last, per, written)`` of the crisp ``order`` entries: their
+        neighbouring pairs, each pair's group's smallest and largest knot and the fraction
+        :data:`~mitos_cli.lang.interpretability.DISTINCT` / (values - 1) of the spread that
+        is its least distance, and the pair's distance as written (the bound where closer)."""
+        groups = [self.order[k] for k in self.crisp_orders]
+        if not groups:
+            empty = np.zeros(0, dtype=np.intp)
+            return empty, empty, empty, empty, np.zeros(0), np.zeros(0)
+
+        def each(fn):
+            return np.concatenate([fn(ids) for ids in groups])
+        return (each(lambda ids: ids[:-1]), each(lambda ids: ids[1:]),
+                each(lambda ids: np.full(len(ids) - 1, ids[0])),
+                each(lambda ids: np.full(len(ids) - 1, ids[-1])),
+                each(lambda ids: np.full(len(ids) - 1, meaning.DISTINCT / (len(ids) - 1))),
+                each(lambda ids: np.diff(self.values[ids])))
+
 
 @dataclass(frozen=True, eq=False)
 class Partition:
@@ -140,11 +173,15 @@ class Partition:
     written: np.ndarray          # [t, 4] corners as written
     least_coverage: float | None     # None: not measured (an output's sets)
     most_similar: float
+    #: a tied Ruspini partition: it holds at every ordered point, so it is never measured
+    by_construction: bool = False
 
     def corners(self, values: np.ndarray) -> np.ndarray:
         return np.where(self.knot >= 0, values[np.maximum(self.knot, 0)], self.written)
 
     def holds(self, values: np.ndarray) -> bool:
+        if self.by_construction:
+            return True
         cover, similar = meaning.measures(self.corners(values), self.universe)
         if self.least_coverage is not None and cover < self.least_coverage - 1e-12:
             return False
@@ -157,7 +194,26 @@ def partition(var: str, universe: tuple[float, float], knot: np.ndarray, written
     least = min(meaning.COVERAGE, meaning.coverage(written, universe)[0]) if covered else None
     most = max(meaning.SIMILARITY, meaning.most_similar(written, universe)[0]) \
         if len(written) > 1 else 1.0
-    return Partition(var, universe, knot, written, least, most)
+    return Partition(var, universe, knot, written, least, most,
+                     by_construction=ruspini(knot, written, universe))
+
+
+def ruspini(knot: np.ndarray, written: np.ndarray, universe: tuple[float, float]) -> bool:
+    """Whether these sets stay a Ruspini partition (memberships summing to 1 everywhere)
+    however their knots move in order: written as one, and every sloped edge shares both its
+    knots with an edge of the other direction (a term's fall is its neighbour's rise). Such a
+    partition is covered to 0.5 at worst (where two edges cross) and two sets of it are at most
+    1/3 similar (over a shared edge of width L: |A and B| = L/4, |A or B| >= 3L/4), within the
+    thresholds by construction: adaptation then need not measure it."""
+    x = meaning.breakpoints(written, universe)
+    if not np.allclose(meaning.memberships(written, x).sum(axis=0), 1.0, atol=1e-9):
+        return False
+    a, b, c, d = written.T
+    rising = sorted((int(i), int(j)) for i, j, u, v in zip(knot[:, 0], knot[:, 1], a, b)
+                    if np.isfinite(u) and v > u)
+    falling = sorted((int(i), int(j)) for i, j, u, v in zip(knot[:, 2], knot[:, 3], c, d)
+                     if np.isfinite(v) and v > u)
+    return all(i >= 0 and j >= 0 for i, j in rising + falling) and rising == falling
 
 
 @dataclass(frozen=True, eq=False)
@@ -194,6 +250,9 @@ def _supported(compiled: CompiledRuleBase) -> None:
     if compiled.cons_linear is not None:
         raise LessonError("adaptation does not cover Takagi-Sugeno (linear) consequents",
                           hint="give the outputs crisp values (numbers) to adapt them")
+    if compiled.operators.inference == "tsukamoto" or compiled.hedged_outputs:
+        raise LessonError("adaptation does not cover Tsukamoto inference or hedged "
+                          "weighted-average consequents (no gradient is derived for them)")
     if compiled.operators.inference == "mamdani":
         return                                       # differences need no derivatives
     for op, names in SUPPORTED_NORMS.items():
@@ -244,7 +303,7 @@ class _Builder:
         if not self.constrained:
             return None
         held = meaning.held_term(self.compiled.variables[vname])
-        if held is None or (vname, held[0].name) in self.released:
+        if held is None or (vname, held[0].name) in self.released or not held[0].held:
             return None
         entry = (vname, held[0].name, float(held[1]))
         if entry not in self.held:
@@ -911,14 +970,14 @@ def feasible(p: Parameters, values: np.ndarray, partitions: bool = True) -> bool
     output values ``least_distance``); each partition covered and distinguishable (when it moved)."""
     if np.any(values < p.lo - 1e-12) or np.any(values > p.hi + 1e-12):
         return False
-    for k, ids in enumerate(p.order):
-        if np.any(np.diff(values[ids]) < _need(p, ids, k)):
-            return False
-    for k in p.crisp_orders:              # the distance check measures on the values as they are
-        ids = p.order[k]
-        need = np.minimum(meaning.least_distance(values[ids]), np.diff(p.values[ids]))
-        if np.any(np.diff(values[ids]) < need * (1 - 1e-9)):
-            return False
+    left, right, need = p.neighbours
+    if np.any(values[right] - values[left] < need):
+        return False
+    # crisp values: meaning.least_distance on the values as they are (in order by now)
+    left, right, first, last, per, written = p.crisp_neighbours
+    need = np.minimum(per * (values[last] - values[first]), written)
+    if np.any(values[right] - values[left] < need * (1 - 1e-9)):
+        return False
     return not partitions or partitions_hold(p, values)
 
 

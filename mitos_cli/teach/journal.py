@@ -195,7 +195,8 @@ FIELDS: dict[str, dict[str, type]] = {"start": {"rules": str, "behavior": str},
           "frozen": {"labels": list, "behavior": str}, "operators": {"text": str,
                                                                     "behavior": str},
           "activate": {"behavior": str}, "examples": {"examples": list},
-          "adapt": {"terms": dict}, "undo": {"of": int}, "save": {}}
+          "adapt": {"terms": dict}, "undo": {"of": int}, "save": {},
+          "freeze": {"terms": list}, "release": {"terms": list}}
 
 
 def _problem(line: bytes, seq: int) -> str | None:
@@ -214,6 +215,12 @@ def _problem(line: bytes, seq: int) -> str | None:
     for key, kind in FIELDS[op].items():
         if not isinstance(entry.get(key), kind) or isinstance(entry.get(key), bool):
             return f"the `{op}` change has no valid `{key}`"
+    for key in ("terms", "holds") if op in ("freeze", "release") else ():
+        refs = entry.get(key, [])
+        if not isinstance(refs, list) or not all(
+                isinstance(ref, list) and len(ref) == 2 and all(isinstance(x, str) for x in ref)
+                for ref in refs):
+            return f"the `{op}` change's `{key}` are not [variable, term] pairs"
     return None
 
 

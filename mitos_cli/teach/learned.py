@@ -2,9 +2,10 @@
 
 One line per term that moved, by its centre (a crisp term's value, a fuzzy set's peak or core
 middle): ``steering.LS: 70 -> 62 deg, toward LM``; a term held at its point of symmetry says
-so (``heading.AHEAD: unchanged (held at 0)``). A term whose centre moved more than
-:data:`MEANING_SHIFT` of the way to its written neighbour on that side is flagged: it now
-means something close to that neighbour.
+so (``steering.ST: unchanged (held at 90)``; ``heading.AHEAD: held at 0, its slopes moved
+with its neighbours`` when its feet, shared with its neighbours' peaks, moved). A term whose
+centre moved more than :data:`MEANING_SHIFT` of the way to its written neighbour on that side
+is flagged: it now means something close to that neighbour.
 """
 
 from __future__ import annotations
@@ -38,8 +39,11 @@ def in_words(before: RuleBase, after: RuleBase, parameters) -> str:
         for t_old, t_new in zip(old.terms, new.terms):
             key = (name, t_new.name)
             if key in held:
-                lines.append(f"  {name}.{t_new.name}: unchanged (held at {_num(held[key])}"
-                             f"{unit})")
+                moved = "" if t_old.params == t_new.params else \
+                    ", its slopes moved with its neighbours"
+                lines.append(f"  {name}.{t_new.name}: "
+                             + (f"held at {_num(held[key])}{unit}{moved}" if moved else
+                                f"unchanged (held at {_num(held[key])}{unit})"))
                 continue
             a, b = centre(t_old), centre(t_new)
             if t_old.params == t_new.params:
@@ -60,7 +64,7 @@ def in_words(before: RuleBase, after: RuleBase, parameters) -> str:
             lines.append(text)
     if len(lines) == 1:
         lines.append("  no term moved")
-    elif any("(held at" in x for x in lines):
+    elif any("held at" in x for x in lines):
         lines.append("  (a held term is the centre of mirror-symmetric terms; `unfrozen "
                      "VARIABLE.TERM` lets it move)")
     return "\n".join(lines)

@@ -33,6 +33,8 @@ from ..lang.terms import Term
 from ..words import plural
 
 NUMBER = re.compile(r"[-+]?(?:\d[\d_]*\.?\d*|\.\d+)(?:[eE][-+]?\d+)?")
+#: a plain YAML scalar such as ``true`` (up to a space, comma, ``}`` or comment)
+SCALAR = re.compile(r"[^\s,}#]*")
 
 
 @dataclass(frozen=True)
@@ -107,6 +109,15 @@ def edit_termset(text: str, path: str, old, new) -> tuple[str, list[str]]:
         spec = variables[v_old.name]
         terms = spec["terms"]
         for t_old, t_new in zip(v_old.terms, v_new.terms):
+            if (t_old.frozen, t_old.held) != (t_new.frozen, t_new.held):
+                edits += _flag_edits(text, starts, terms, t_old, t_new)
+            if t_old.frozen != t_new.frozen:
+                changes.append(f"{v_old.name}.{t_old.name}: "
+                               f"{'frozen' if t_new.frozen else 'no longer frozen'}")
+            if t_old.held != t_new.held:
+                changes.append(f"{v_old.name}.{t_old.name}: " + (
+                    "held at its point" if t_new.held else
+                    "free to move off its point (held: false)"))
             if t_old.params == t_new.params:
                 continue
             spans = _param_spans(terms, t_old)
@@ -121,6 +132,43 @@ def edit_termset(text: str, path: str, old, new) -> tuple[str, list[str]]:
                 edits.append((match.start(), match.end(), format_number(b)))
             changes.append(f"{v_old.name}.{t_old.name}: {_params(t_old)} -> {_params(t_new)}")
     return _apply(text, edits), changes
+
+
+def _flag_edits(text: str, starts: list[int], terms: yamlpos.YMap, old: Term,
+                new: Term) -> list[tuple[int, int, str]]:
+    """The edits that write ``new``'s ``frozen`` and ``held`` flags where they differ from
+    ``old``'s into its YAML: a flag's value replaced where it is written, else the keys added
+    (to a flow mapping before its ``}``, to a block mapping as its first lines; a bare crisp
+    value becomes ``{shape: singleton, value: V, frozen: true}``)."""
+    flags = {key: "true" if getattr(new, key) else "false" for key in ("frozen", "held")
+             if getattr(old, key) != getattr(new, key)}
+
+    def offset(span) -> int:
+        return starts[span.line - 1] + span.column - 1
+
+    spec = terms[old.name]
+    if not isinstance(spec, yamlpos.YMap):            # `LM: 50`
+        at = offset(terms.value_span(old.name))
+        match = NUMBER.match(text, at)
+        end = match.end() if match else at
+        pairs = "".join(f", {k}: {v}" for k, v in flags.items())
+        return [(at, end, f"{{shape: singleton, value: {text[at:end]}{pairs}}}")]
+    edits = []
+    for key in [k for k in flags if k in spec]:
+        at = offset(spec.value_span(key))
+        scalar = SCALAR.match(text, at)
+        edits.append((at, scalar.end() if scalar else at, flags.pop(key)))
+    if not flags:
+        return edits
+    end = offset(spec.end_span)
+    if text[:end].rstrip().endswith("}"):             # a flow mapping
+        close = text.rindex("}", 0, end)
+        return edits + [(close, close, "".join(f", {k}: {v}" for k, v in flags.items()))]
+    first = offset(spec.key_span(next(iter(spec))))
+    line_start = text.rfind("\n", 0, first) + 1
+    indent = text[line_start:first]
+    return edits + [(line_start, line_start,
+                     "".join(f"{indent}{k}: {v}\n" for k, v in flags.items()))]
 
 
 def _params(term: Term) -> str:

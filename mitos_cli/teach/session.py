@@ -32,6 +32,7 @@ import numpy as np
 
 from ..engine.compile import CompiledRuleBase, compile_rulebase
 from ..errors import LessonError, MitosError, RuleBaseError, Span, unknown
+from ..lang.interpretability import held_term
 from ..lang.model import And, Behavior, Expr, Not, Prop, Rule, RuleBase, format_expr, format_rule, format_use
 from ..lang.operators import resolve
 from ..lang.resolve import check_expr, check_rule, load_rules_file
@@ -281,11 +282,16 @@ class Session:
         terms = self._term_refs(c.terms)
         self.change("freeze", line, terms=terms)
         self.out("adaptation keeps " + ", ".join(f"{v}.{t}" for v, t in terms)
-                 + " as it is (`unfrozen` lets it move)")
+                 + (" as it is" if len(terms) == 1 else " as they are")
+                 + " (`unfrozen` lets it move; `save` writes `frozen: true`)")
 
     def _releaseterms(self, c: cmd.ReleaseTerms, line: str) -> None:
         terms = self._term_refs(c.terms)
-        self.change("release", line, terms=terms)
+        # the centre terms among them, as the files wrote them: `save` writes `held: false`
+        written = self.original.variables
+        holds = [[v, t] for v, t in terms if v in written
+                 and (held := held_term(written[v])) is not None and held[0].name == t]
+        self.change("release", line, terms=terms, holds=holds)
         self.out("adaptation may move " + ", ".join(f"{v}.{t}" for v, t in terms)
                  + " (no freeze, no hold at a point of symmetry)")
 

@@ -19,6 +19,7 @@ from typing import TypeVar
 from ..errors import LessonError
 from ..lang.model import Behavior, Rule, RuleBase
 from ..lang.parse import parse_rule
+from ..lang.terms import Term
 from . import commands as cmd
 
 _C = TypeVar("_C")
@@ -121,10 +122,13 @@ def apply(state: State, entry: dict) -> None:
         for var, term in entry["terms"]:
             state.frozen_terms.add((var, term))
             state.released.discard((var, term))
+        state.rulebase = _set_flags(state.rulebase, entry["terms"], frozen=True)
     elif op == "release":
         for var, term in entry["terms"]:
             state.frozen_terms.discard((var, term))
             state.released.add((var, term))
+        state.rulebase = _set_flags(state.rulebase, entry["terms"], frozen=False)
+        state.rulebase = _set_flags(state.rulebase, entry.get("holds", []), held=False)
     elif op == "adapt":
         rb = _set_params(rb, entry["terms"])
         state.rulebase = _set_crisp(rb, entry.get("crisp", []))
@@ -132,6 +136,23 @@ def apply(state: State, entry: dict) -> None:
         raise LessonError(f"the journal holds an unknown change `{op}`")
 
 
+
+
+def _set_flags(rb: RuleBase, refs: list, frozen: bool | None = None,
+               held: bool | None = None) -> RuleBase:
+    """The rule base with the terms ``refs`` ([variable, term] pairs) frozen or not, held at
+    their point or not (``None``: as they are): the flags are part of the model, so ``save``
+    writes them (``frozen: true``, ``held: false`` in the YAML)."""
+    names = {tuple(r) for r in refs}
+
+    def flagged(t: Term) -> Term:
+        return dataclasses.replace(t, frozen=t.frozen if frozen is None else frozen,
+                                   held=t.held if held is None else held)
+
+    termsets = tuple(dataclasses.replace(ts, variables=tuple(
+        v.with_terms(tuple(flagged(t) if (v.name, t.name) in names else t for t in v.terms))
+        for v in ts.variables)) for ts in rb.termsets)
+    return dataclasses.replace(rb, termsets=termsets)
 
 
 def learned_changes(before: RuleBase, after: RuleBase) -> tuple[dict, list]:

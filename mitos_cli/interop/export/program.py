@@ -15,6 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...engine.compile import CompiledRuleBase
+from ...errors import FormatError
 from ...fuzzy.shapes import kernel_params
 from ...lang.model import And, Expr, Not, Prop, flatten
 
@@ -74,6 +75,8 @@ def term_columns(compiled: CompiledRuleBase) -> dict[tuple[str, str], str]:
 
 def program(compiled: CompiledRuleBase) -> Program:
     """Build the straight-line program of ``compiled``."""
+    if compiled.operators.inference == "tsukamoto":
+        raise FormatError("`mitos export` has no code for Tsukamoto inference")
     names = term_columns(compiled)
     hedges: set[str] = set()
     used: set[str] = set()
@@ -100,6 +103,8 @@ def program(compiled: CompiledRuleBase) -> Program:
             acc = f"{fn}({acc}, {p})"
         return f"(1.0 - {acc})" if negate else acc
 
+    for j in compiled.hedged_outputs:         # hedged Takagi-Sugeno consequents
+        hedges.update(h for row in compiled.cons_hedges for h in row[j])
     rules = []
     for r, (_, rule, uses) in enumerate(flatten(compiled.rulebase, compiled.behavior)):
         text = expr(rule.antecedent)
@@ -111,6 +116,9 @@ def program(compiled: CompiledRuleBase) -> Program:
     for i, key in enumerate(compiled.term_names):
         term = compiled.variables[key[0]].term(key[1])
         if names[key] in referenced:
+            if term.formula is not None:
+                raise FormatError(f"term `{key[0]}.{key[1]}`: `mitos export` has no code for "
+                                  f"formula terms (`{term.formula.text}`)")
             kernel = kernel_params(term.corners) if term.corners is not None else None
             terms.append((int(compiled.term_var[i]), names[key], term.shape, term.params, kernel))
     shapes = {t[2] for t in terms if t[4] is None}
@@ -122,7 +130,8 @@ def program(compiled: CompiledRuleBase) -> Program:
 
 def weighted_sums(c: CompiledRuleBase, j: int) -> tuple[str, str]:
     """Output ``j``'s weighted sums as expressions over ``dof_<r>`` and ``x[i]``, the same
-    text in C and in Python: ``sum(dof * y)`` (``y`` crisp or linear) and ``sum(dof)``."""
+    text in C and in Python: ``sum(dof * y)`` (``y`` crisp or linear) and ``sum(dof)``, each
+    ``dof`` hedged where the consequent is."""
     terms = []
     for r in np.flatnonzero(c.cons_mask[:, j]):
         value = num(c.cons_value[r, j])
@@ -131,7 +140,11 @@ def weighted_sums(c: CompiledRuleBase, j: int) -> tuple[str, str]:
                 f"{num(a)} * x[{i}]" for i, a in enumerate(c.cons_linear[r, j, :-1])
                 if a != 0.0]
             value = "(" + " + ".join(parts) + ")"
-        terms.append((f"dof_{r}", value))
+        dof = f"dof_{r}"
+        if j in c.hedged_outputs:             # the hedge weights the rule (evaluation.py)
+            for h in reversed(c.cons_hedges[r][j]):
+                dof = f"hedge_{h}({dof})"
+        terms.append((dof, value))
     numerator = " + ".join(f"{d} * {v}" for d, v in terms) or "0.0"
     denominator = " + ".join(d for d, _ in terms) or "0.0"
     return numerator, denominator

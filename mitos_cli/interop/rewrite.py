@@ -1,0 +1,106 @@
+"""fuzzylite's chained engines restated exactly in MITOS's model, so the engine needs no new step.
+
+In fuzzylite a condition on an *output* (``if Power is LOW then InversePower is HIGH``) does
+not test a defuzzified value: it is the aggregated activation of that output's term so far,
+i.e. of the rules before it (in rule order) that conclude ``Power is LOW``, joined by the
+output's aggregation. :func:`unchain` writes the condition as the disjunction of those rules'
+conditions. Exact when the disjunction is the aggregation (or one rule concludes the term)
+and those rules have weight 1 and no hedge. A hedge on the chained condition is moved onto
+the propositions when the norms are min and max: for a non-decreasing hedge ``h``,
+``h(max(a, b)) = max(h(a), h(b))`` bit for bit (max returns one of its arguments).
+
+Anything outside those conditions is refused by name, at the rule.
+"""
+
+from __future__ import annotations
+
+from ..errors import FormatError
+from ..lang.model import And, Expr, Not, Or, Prop, Rule
+
+
+def push_hedges(expr: Expr, hedges: tuple[str, ...], and_: str, or_: str, rule: Rule,
+                why: str) -> Expr:
+    """``hedges`` applied to the value of ``expr``, written on its propositions."""
+    if not hedges:
+        return expr
+    if isinstance(expr, Prop):
+        if expr.negated:
+            raise FormatError(f"rule `{rule.label}`: {why} over `not` cannot be written as a "
+                              f"MITOS condition", span=rule.span)
+        return Prop(expr.var, expr.term, hedges + expr.hedges, False, expr.span)
+    if isinstance(expr, Not):
+        raise FormatError(f"rule `{rule.label}`: {why} over `not (...)` cannot be written as "
+                          f"a MITOS condition", span=rule.span)
+    norm = and_ if isinstance(expr, And) else or_
+    if len(expr.items) > 1 and norm not in ("min", "max"):
+        raise FormatError(f"rule `{rule.label}`: {why} needs the rule's "
+                          f"{'and' if isinstance(expr, And) else 'or'} to be min or max "
+                          f"(here `{norm}`), whose hedged value is the value of its hedged "
+                          f"operands", span=rule.span)
+    return type(expr)(tuple(push_hedges(i, hedges, and_, or_, rule, why) for i in expr.items),
+                      expr.span)
+
+
+def unchain(rules: list[Rule], outputs: set[str], and_: str, or_: str,
+            aggregation: str | None, notes: list[str]) -> list[Rule]:
+    """Rules whose conditions test outputs, rewritten to test the conditions of the earlier
+    rules that set those outputs' terms (fuzzylite's chained engines)."""
+    sources: dict[tuple[str, str], list[Expr]] = {}
+    out: list[Rule] = []
+    chained = 0
+
+    def expand(expr: Expr, rule: Rule) -> Expr:
+        if isinstance(expr, Prop):
+            if expr.var not in outputs:
+                return expr
+            found = sources.get((expr.var, expr.term), [])
+            if not found:
+                raise FormatError(f"rule `{rule.label}` tests `{expr.var} is {expr.term}`, "
+                                  f"which no rule before it sets (always 0 in fuzzylite)",
+                                  span=expr.span or rule.span,
+                                  hint="move the rules that set it before this one")
+            if len(found) > 1 and aggregation != or_:
+                raise FormatError(
+                    f"rule `{rule.label}` tests the output `{expr.var}`, which aggregates "
+                    f"{len(found)} rules with `{aggregation or 'the unbounded sum'}`; MITOS "
+                    f"can restate that only when the rule block's disjunction is the same "
+                    f"(here `{or_}`)", span=expr.span or rule.span)
+            joined = found[0] if len(found) == 1 else Or(tuple(found), expr.span)
+            hedged = push_hedges(joined, expr.hedges, and_, or_, rule,
+                                 "a hedge on a chained output")
+            return Not(hedged, expr.span) if expr.negated else hedged
+        if isinstance(expr, Not):
+            return Not(expand(expr.expr, rule), expr.span)
+        return type(expr)(tuple(expand(i, rule) for i in expr.items), expr.span)
+
+    for rule in rules:
+        antecedent = expand(rule.antecedent, rule)
+        if antecedent != rule.antecedent:
+            chained += 1
+            rule = Rule(rule.label, antecedent, rule.consequents, rule.weight, rule.span)
+        for c in rule.consequents:
+            if c.term is None or c.var not in outputs:
+                continue
+            if (rule.weight != 1.0 or c.hedges) and any(
+                    p.var == c.var for r in rules for p in _props(r.antecedent)):
+                raise FormatError(f"rule `{rule.label}` sets the chained output `{c.var}` "
+                                  f"with a weight or hedge, which the rules testing it would "
+                                  f"see: not supported", span=c.span or rule.span)
+            sources.setdefault((c.var, c.term), []).append(antecedent)
+        out.append(rule)
+    if chained:
+        notes.append(f"{rules[0].span.path if rules[0].span else '<input>'}: {chained} rules "
+                     f"test outputs (a chained engine): each such condition is read as the "
+                     f"conditions of the earlier rules that set that term, which is what "
+                     f"fuzzylite computes")
+    return out
+
+
+def _props(expr: Expr):
+    if isinstance(expr, Prop):
+        yield expr
+    elif isinstance(expr, Not):
+        yield from _props(expr.expr)
+    else:
+        for item in expr.items:
+            yield from _props(item)

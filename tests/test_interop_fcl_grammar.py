@@ -1,0 +1,118 @@
+"""Every construct of jFuzzyLogic's FCL grammar (its ANTLR ``Fcl.g``) either loads or is
+refused by name, at its position: one small file of our own, varied one construct at a time."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from mitos_cli.engine.compile import compile_rulebase
+from mitos_cli.engine.evaluation import evaluate
+from mitos_cli.errors import FormatError
+from mitos_cli.interop.fcl import parse_fcl
+
+BASE = """\
+(* an IEC comment *)
+/* a C comment */
+// a line comment
+FUNCTION_BLOCK probe
+VAR_INPUT
+    a : REAL;
+    b : REAL; RANGE := (0 .. 10);
+END_VAR
+VAR_OUTPUT
+    y : REAL;
+END_VAR
+FUZZIFY a
+    RANGE := (0 .. 10);
+    TERM low := (0, 1) (5, 0);
+    TERM high := TRIAN 0 10 10;
+END_FUZZIFY
+FUZZIFY b
+    TERM low := TRAPE 0 0 2 6;
+    TERM high := (4, 0) (10, 1);
+END_FUZZIFY
+DEFUZZIFY y
+    TERM lo := (0, 0) (2, 1) (4, 0);
+    TERM hi := (6, 0) (8, 1) (10, 0);
+    METHOD : COG;
+    DEFAULT := 0;
+    RANGE := (0 .. 10);
+END_DEFUZZIFY
+RULEBLOCK r
+    AND : MIN;
+    OR : MAX;
+    ACT : MIN;
+    ACCU : MAX;
+    RULE 1 : IF a IS low AND b IS low THEN y IS lo;
+    RULE 2 : IF a IS high OR b IS high THEN y IS hi;
+END_RULEBLOCK
+END_FUNCTION_BLOCK
+"""
+
+HIGH = "TERM high := TRIAN 0 10 10;"
+LOADS = [
+    (HIGH, "TERM high := GAUSS 8 2;"), (HIGH, "TERM high := GAUSS2 6 1 8 2;"),
+    (HIGH, "TERM high := GBELL 2 3 8;"), (HIGH, "TERM high := SIGM 2 5;"),
+    (HIGH, "TERM high := COSINE 3 7;"), (HIGH, "TERM high := DSIGM 2 4 2 8;"),
+    (HIGH, "TERM high := TRIAN 0 1e1 1E+1;"),
+    ("TERM lo := (0, 0) (2, 1) (4, 0);", "TERM lo := 2;"),
+    *[("METHOD : COG;", f"METHOD : {m};") for m in ("COA", "LM", "RM", "MM")],
+    *[("OR : MAX;", f"OR : {o};") for o in ("ASUM", "BSUM", "DMAX", "NIPMAX", "EINSTEIN")],
+    *[("AND : MIN;", f"AND : {o};") for o in ("PROD", "BDIF", "DMIN", "NIPMIN", "HAMACHER")],
+    ("ACT : MIN;", "ACT : PROD;"), ("ACCU : MAX;", "ACCU : BSUM;"),
+    ("ACCU : MAX;", "ACCU : PROBOR;"),
+    ("IF a IS low AND", "IF NOT a IS low AND"), ("IF a IS low AND", "IF a IS NOT low AND"),
+    ("IF a IS low AND b IS low THEN", "IF (a IS low AND b IS low) THEN"),
+    ("IF a IS low AND b IS low THEN", "IF NOT (a IS low OR b IS high) THEN"),
+    ("THEN y IS lo;", "THEN y IS lo WITH 0.5;"), ("RULE 1 :", "RULE first :"),
+    ("FUNCTION_BLOCK probe", "FUNCTION_BLOCK"),
+    ("    y : REAL;\n", "    y : REAL; RANGE := (0 .. 10);\n"),
+]
+REFUSED = [
+    (HIGH, "TERM high := FUNCTION 2 * (1 + 3);", "FUNCTION terms"),
+    ("TERM lo := (0, 0) (2, 1) (4, 0);", "TERM lo := SINGLETONS (1, 0.5) (2, 1);",
+     "SINGLETONS terms"),
+    (HIGH, "TERM high := TRIAN 0 mid 10;", "a parameter given by a variable (`mid`)"),
+    (HIGH, "TERM high := (0, 0) (mid, 1);", "a parameter given by a variable (`mid`)"),
+    ("DEFAULT := 0;", "DEFAULT := NC;", "`DEFAULT := NC` (no change"),
+    ("METHOD : COG;", "METHOD : COGF;", "fast centre of gravity"),
+    ("METHOD : COG;", "METHOD : COGS;", "not a `triangle` term"),
+    ("ACCU : MAX;", "ACCU : NSUM;", "the normalized sum"),
+    ("ACCU : MAX;", "ACCU : SUM;", "the unbounded sum"),
+    ("IF a IS low AND b IS low THEN", "IF a AND b IS low THEN", "a condition without `IS`"),
+    ("END_FUNCTION_BLOCK\n", "END_FUNCTION_BLOCK\nFUNCTION_BLOCK two\nEND_FUNCTION_BLOCK\n",
+     "MITOS reads one"),
+]
+
+
+def test_the_base_file_loads_and_evaluates():
+    c = compile_rulebase(parse_fcl(BASE, "probe.fcl"))
+    y = evaluate(c, np.array([[0.0, 0.0], [10.0, 10.0]]), detail=False).outputs[:, 0]
+    assert y == pytest.approx([2.0, 8.0], abs=1e-9)       # only `lo`, only `hi` fires
+
+
+@pytest.mark.parametrize("old, new", LOADS, ids=[n.strip()[:40] for _, n in LOADS])
+def test_construct_loads(old: str, new: str):
+    assert old in BASE
+    rb = parse_fcl(BASE.replace(old, new, 1), "probe.fcl")
+    compile_rulebase(rb)
+
+
+@pytest.mark.parametrize("old, new, words", REFUSED, ids=[w[:40] for _, _, w in REFUSED])
+def test_construct_is_refused_by_name(old: str, new: str, words: str):
+    assert old in BASE
+    text = BASE.replace(old, new, 1)
+    with pytest.raises(FormatError) as info:
+        parse_fcl(text, "probe.fcl")
+    assert words in info.value.message, info.value.render()
+    span = info.value.span
+    assert span is not None and span.path == "probe.fcl" and span.source_line is not None
+    assert span.source_line.strip() in text
+
+
+def test_einstein_after_or_is_the_einstein_sum():
+    rb = parse_fcl(BASE.replace("OR : MAX;", "OR : EINSTEIN;"), "probe.fcl")
+    assert compile_rulebase(rb).operators.or_ == "einstein_sum"
+    rb = parse_fcl(BASE.replace("AND : MIN;", "AND : HAMACHER;"), "probe.fcl")
+    assert compile_rulebase(rb).operators.and_ == "hamacher"

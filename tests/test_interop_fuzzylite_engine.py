@@ -1,0 +1,334 @@
+"""fuzzylite constructs beyond one rule block of plain rules, each on a small file of its own,
+checked against values worked out by hand from fuzzylite's definitions: chained outputs,
+hedged Takagi-Sugeno consequents (cumulative, as fuzzylite computes them), ``Function`` terms,
+Tsukamoto inference and ``lock-range`` / ``lock-previous``."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from mitos_cli.engine.compile import compile_rulebase
+from mitos_cli.engine.evaluation import evaluate
+from mitos_cli.errors import FormatError
+from mitos_cli.interop.fll import parse_fll
+
+
+def run(text: str, X, behavior: str | None = None) -> np.ndarray:
+    c = compile_rulebase(parse_fll(text, "t.fll"), behavior)
+    return evaluate(c, np.asarray(X, dtype=float), strict=False, detail=False).outputs
+
+
+# ---------------------------------------------------------------------------------------------
+# Chained outputs: a condition on an output is that term's aggregated activation so far
+
+CHAINED = """\
+Engine: chained
+InputVariable: x
+  range: 0 1
+  term: low Triangle 0 0 1
+  term: high Triangle 0 1 1
+OutputVariable: p
+  range: 0 1
+  aggregation: Maximum
+  defuzzifier: Centroid 200
+  default: nan
+  term: small Triangle 0 0 0.5
+  term: big Triangle 0.5 1 1
+OutputVariable: q
+  range: 0 1
+  aggregation: Maximum
+  defuzzifier: Centroid 200
+  default: nan
+  term: a Triangle 0 0 1
+  term: b Triangle 0 1 1
+RuleBlock: b
+  conjunction: Minimum
+  disjunction: Maximum
+  implication: Minimum
+  activation: General
+  rule: if x is low then p is small
+  rule: if x is high then p is big
+  rule: if x is very high then p is big
+  rule: if p is small then q is a
+  rule: if p is big then q is b
+"""
+
+
+def test_a_condition_on_an_output_is_its_terms_activation_so_far():
+    rb = parse_fll(CHAINED, "t.fll")
+    assert any("chained engine" in n for n in rb.notes)
+    by_hand = CHAINED.replace("if p is small", "if x is low").replace(
+        "if p is big", "if x is high or x is very high")
+    X = np.linspace(0, 1, 41)[:, None]
+    assert np.array_equal(run(CHAINED, X), run(by_hand, X), equal_nan=True)
+
+
+def test_chained_outputs_agree_with_fuzzylite():
+    fl = pytest.importorskip("fuzzylite")
+    engine = fl.FllImporter().from_string(CHAINED)
+    X = np.linspace(0, 1, 41)
+    engine.input_variable("x").value = X
+    engine.process()
+    theirs = np.column_stack([engine.output_variable(n).value for n in ("p", "q")])
+    assert np.allclose(run(CHAINED, X[:, None]), theirs, atol=1e-9, equal_nan=True)
+
+
+def test_a_chained_term_no_earlier_rule_sets_is_refused_by_name():
+    text = CHAINED.replace("  rule: if x is low then p is small\n", "") + \
+        "  rule: if x is low then p is small\n"
+    with pytest.raises(FormatError, match="which no rule before it sets"):
+        parse_fll(text, "t.fll")
+
+
+def test_a_chained_output_aggregated_unlike_the_disjunction_is_refused():
+    text = CHAINED.replace("aggregation: Maximum", "aggregation: AlgebraicSum")
+    with pytest.raises(FormatError, match="aggregates 2 rules with `probabilistic_sum`"):
+        parse_fll(text, "t.fll")
+
+
+# ---------------------------------------------------------------------------------------------
+# Hedged Takagi-Sugeno consequents hedge the rule's activation, cumulatively
+
+HEDGED = """\
+Engine: hedged
+InputVariable: x
+  range: 0 1
+  term: low Triangle 0 0 1
+  term: high Triangle 0 1 1
+OutputVariable: y
+  range: 0 10
+  aggregation: none
+  defuzzifier: WeightedAverage
+  default: nan
+  term: lo Constant 2
+  term: hi Constant 8
+OutputVariable: z
+  range: 0 10
+  aggregation: none
+  defuzzifier: WeightedAverage
+  default: nan
+  term: lo Constant 2
+  term: hi Constant 8
+RuleBlock: b
+  conjunction: EinsteinProduct
+  disjunction: Maximum
+  rule: if x is low then y is very lo and z is lo
+  rule: if x is high then y is hi and z is somewhat hi
+"""
+
+
+def test_a_hedged_sugeno_consequent_hedges_the_rule_weight_and_those_after_it():
+    x = 0.3
+    low, high = 1 - x, x
+    # rule 1: y sees very(low); z, after it, very(low) too (fuzzylite reassigns the degree)
+    y = (low ** 2 * 2 + high * 8) / (low ** 2 + high)
+    z = (low ** 2 * 2 + np.sqrt(high) * 8) / (low ** 2 + np.sqrt(high))
+    got = run(HEDGED, [[x], [0.0]])
+    assert got[0] == pytest.approx([y, z], abs=1e-12)
+    assert got[1] == pytest.approx([2.0, 2.0])
+    rb = parse_fll(HEDGED, "t.fll")
+    assert rb.behaviors[0].rules[0].consequents[1].hedges == ("very",)
+
+
+def test_hedged_sugeno_consequents_agree_in_the_scalar_form_and_the_exports(tmp_path):
+    import importlib.util
+
+    from mitos_cli.interop.export import to_python
+
+    c = compile_rulebase(parse_fll(HEDGED, "t.fll"))
+    assert c.scalar is None             # no exact scalar form: the NumPy path answers
+    path = tmp_path / "hedged.py"
+    path.write_text(to_python(c, "test"))
+    spec = importlib.util.spec_from_file_location("hedged", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    X = np.linspace(0.05, 1, 7)[:, None]
+    assert np.allclose(module.evaluate(X), evaluate(c, X, detail=False).outputs, atol=1e-12)
+
+
+def test_hedged_sugeno_consequents_agree_with_fuzzylite():
+    fl = pytest.importorskip("fuzzylite")
+    engine = fl.FllImporter().from_string(HEDGED.replace("  disjunction: Maximum\n",
+                                                         "  disjunction: Maximum\n"
+                                                         "  implication: none\n"
+                                                         "  activation: General\n"))
+    X = np.linspace(0.05, 1, 20)
+    engine.input_variable("x").value = X
+    engine.process()
+    theirs = np.column_stack([engine.output_variable(n).value for n in ("y", "z")])
+    assert np.allclose(run(HEDGED, X[:, None]), theirs, atol=1e-12)
+
+
+# ---------------------------------------------------------------------------------------------
+# Function terms: a membership given by a formula of x, parsed (never eval'd)
+
+FUNCTION = """\
+Engine: function
+InputVariable: u
+  range: 0 1
+  term: bump Function 1 - 4 * (x - 0.5)^2
+  term: edge Function fabs(1 - 2*x) * lt(x, 0.5) + ge(x, 0.75) * (x - 0.75) * 4
+OutputVariable: y
+  range: 0 1
+  aggregation: Maximum
+  defuzzifier: Centroid 100
+  default: nan
+  term: low Function lt(x, 0.5) * (1 - 2 * x)
+  term: high Triangle 0.4 1 1
+RuleBlock: b
+  implication: Minimum
+  activation: General
+  rule: if u is bump then y is high
+  rule: if u is edge then y is low
+"""
+
+
+def test_function_terms_are_their_formulas_on_inputs_and_outputs():
+    from mitos_cli.fuzzy.formula import parse
+
+    rb = parse_fll(FUNCTION, "t.fll")
+    bump = rb.variables["u"].term("bump")
+    assert bump.shape == "formula" and bump.formula == parse("1 - 4 * (x - 0.5)^2")
+    x = np.array([0.0, 0.25, 0.5, 0.9])
+    assert np.allclose(bump.membership(x), 1 - 4 * (x - 0.5) ** 2, atol=0)
+    edge = rb.variables["u"].term("edge").membership(x)
+    assert np.allclose(edge, np.abs(1 - 2 * x) * (x < 0.5) + (x >= 0.75) * (x - 0.75) * 4)
+    fl = pytest.importorskip("fuzzylite")
+    engine = fl.FllImporter().from_string(FUNCTION)
+    X = np.linspace(0.01, 0.99, 30)
+    engine.input_variable("u").value = X
+    engine.process()
+    assert np.allclose(run(FUNCTION, X[:, None])[:, 0], engine.output_variable("y").value,
+                       atol=1e-12, equal_nan=True)
+
+
+@pytest.mark.parametrize("formula, column, words", [
+    ("1 - sin(x", 10, "expected `)`"),
+    ("1 - sine(x)", 5, "unknown name `sine`"),
+    ("x ** * 2", 6, "unexpected `*`"),
+    ("inputX / 2", 1, "unknown name `inputX`"),
+    ("x $ 2", 3, "cannot read `$`"),
+    ("(x + 1) 2", 9, "after a complete formula"),
+])
+def test_a_bad_formula_is_refused_at_its_column(formula, column, words):
+    text = FUNCTION.replace("1 - 4 * (x - 0.5)^2", formula)
+    with pytest.raises(FormatError) as info:
+        parse_fll(text, "t.fll")
+    assert words in info.value.message
+    start = text.splitlines()[3].index(formula) + 1
+    assert info.value.span.line == 4 and info.value.span.column == start + column - 1
+
+
+def test_a_formula_membership_outside_0_1_is_refused_at_evaluation():
+    from mitos_cli.errors import InputError
+
+    text = FUNCTION.replace("1 - 4 * (x - 0.5)^2", "2 * x")
+    with pytest.raises(InputError, match=r"gives 1\.8 at u = 0\.9"):
+        run(text, [[0.9]])
+
+
+def test_formula_terms_round_trip_through_fll_and_term_sets(tmp_path):
+    from mitos_cli.api import read_rulebase
+    from mitos_cli.interop import write_foreign
+    from mitos_cli.interop.rules_writer import write_rules
+
+    rb = parse_fll(FUNCTION, "t.fll")
+    X = np.linspace(0.01, 0.99, 30)[:, None]
+    want = run(FUNCTION, X)
+    assert np.array_equal(run(write_foreign(rb, "fll"), X), want, equal_nan=True)
+    rules, terms = write_rules(rb, "t.terms.yaml")
+    (tmp_path / "t.rules").write_text(rules)
+    (tmp_path / "t.terms.yaml").write_text(terms)
+    back = compile_rulebase(read_rulebase(tmp_path / "t.rules"))
+    assert np.array_equal(evaluate(back, X, strict=False).outputs, want, equal_nan=True)
+    with pytest.raises(FormatError, match="FCL has no formula terms"):
+        write_foreign(rb, "fcl")
+
+
+# ---------------------------------------------------------------------------------------------
+# Tsukamoto inference: each monotonic consequent term inverted at its degree
+
+TSUKAMOTO = """\
+Engine: tsukamoto
+InputVariable: u
+  range: 0 1
+  term: low Triangle 0 0 1
+  term: high Triangle 0 1 1
+OutputVariable: y
+  range: 0 10
+  aggregation: none
+  defuzzifier: WeightedAverage
+  default: nan
+  term: down Ramp 10 0
+  term: up SShape 2 8
+RuleBlock: b
+  conjunction: Minimum
+  disjunction: Maximum
+  implication: none
+  activation: General
+  rule: if u is low then y is down
+  rule: if u is high then y is up
+"""
+
+
+def test_tsukamoto_inverts_each_term_at_its_degree():
+    rb = parse_fll(TSUKAMOTO, "t.fll")
+    c = compile_rulebase(rb)
+    assert c.operators.inference == "tsukamoto"        # inferred from the monotonic terms
+    u = 0.3
+    w_down, w_up = 1 - u, u
+    z_down = 10 - 10 * w_down                          # Ramp 10 0 at w
+    z_up = 8 - 6 * np.sqrt((1 - w_up) / 2) if w_up > 0.5 else 2 + 6 * np.sqrt(w_up / 2)
+    want = (w_down * z_down + w_up * z_up) / (w_down + w_up)
+    assert run(TSUKAMOTO, [[u]])[0, 0] == pytest.approx(want, abs=1e-12)
+    fl = pytest.importorskip("fuzzylite")
+    engine = fl.FllImporter().from_string(TSUKAMOTO)
+    X = np.linspace(0.05, 0.95, 19)
+    engine.input_variable("u").value = X
+    engine.process()
+    assert np.allclose(run(TSUKAMOTO, X[:, None])[:, 0], engine.output_variable("y").value,
+                       atol=1e-12)
+
+
+def test_tsukamoto_refuses_a_term_it_cannot_invert_and_formats_without_it():
+    from mitos_cli.interop import write_foreign
+
+    with pytest.raises(FormatError, match="Tsukamoto inference inverts monotonic terms"):
+        parse_fll(TSUKAMOTO.replace("WeightedAverage", "WeightedAverage Tsukamoto").replace(
+            "term: up SShape 2 8", "term: up Triangle 2 8 9"), "t.fll")
+    rb = parse_fll(TSUKAMOTO, "t.fll")
+    X = np.linspace(0, 1, 11)[:, None]
+    assert np.array_equal(run(write_foreign(rb, "fll"), X), run(TSUKAMOTO, X), equal_nan=True)
+    for fmt in ("fcl", "fis"):
+        with pytest.raises(FormatError, match="no Tsukamoto inference"):
+            write_foreign(rb, fmt)
+
+
+def test_tsukamoto_refuses_a_term_concluded_twice():
+    from mitos_cli.errors import RuleBaseError
+
+    text = TSUKAMOTO + "  rule: if u is very high then y is up\n"
+    with pytest.raises(RuleBaseError, match="their degrees add up and may pass 1"):
+        compile_rulebase(parse_fll(text, "t.fll"))
+
+
+def test_fcl_cogs_over_monotonic_terms_is_tsukamoto():
+    from mitos_cli.interop.fcl import parse_fcl
+
+    text = """\
+FUNCTION_BLOCK t
+VAR_INPUT u : REAL; END_VAR
+VAR_OUTPUT y : REAL; END_VAR
+FUZZIFY u RANGE := (0 .. 1); TERM low := Triangle 0 0 1; TERM high := Triangle 0 1 1; END_FUZZIFY
+DEFUZZIFY y RANGE := (0 .. 10); TERM down := Ramp 10 0; TERM up := SShape 2 8;
+  METHOD : COGS; DEFAULT := nan; END_DEFUZZIFY
+RULEBLOCK b AND : MIN; RULE 1 : IF u IS low THEN y IS down; RULE 2 : IF u IS high THEN y IS up;
+END_RULEBLOCK
+END_FUNCTION_BLOCK
+"""
+    c = compile_rulebase(parse_fcl(text, "t.fcl"))
+    assert c.operators.inference == "tsukamoto"
+    X = np.linspace(0, 1, 11)[:, None]
+    assert np.array_equal(evaluate(c, X, strict=False, detail=False).outputs,
+                          run(TSUKAMOTO, X), equal_nan=True)
