@@ -15,13 +15,17 @@ from __future__ import annotations
 import argparse
 import collections
 import platform
+import sys
 import time
+from pathlib import Path
 
-from mitos_cli.resources import packaged_path
-from mitos_cli.sim import barn
-from mitos_cli.sim.planner import FuzzyPlanner
-from mitos_cli.sim.runs import run_many
-from mitos_cli.sim.worldfile import load_world
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))   # this source tree first
+
+from mitos_cli.resources import packaged_path  # noqa: E402
+from mitos_cli.sim import barn  # noqa: E402
+from mitos_cli.sim.planner import FuzzyPlanner  # noqa: E402
+from mitos_cli.sim.runs import run_many  # noqa: E402
+from mitos_cli.sim.worldfile import load_world  # noqa: E402
 
 OUTCOMES = ("success", "collision", "timeout", "stuck")
 

@@ -196,7 +196,9 @@ class MitosEnv(gymnasium.Env):
                     raise
                 from .sim.live import LiveView
 
-                self._live = LiveView(self.world, sim.scene, every=1).__enter__()
+                # unpaced, every call drawn: the environment's caller sets the pace
+                self._live = LiveView(self.world, sim.scene, speed=0.0,
+                                      fps=float("inf")).__enter__()
                 self._live.update(0, self._state())
                 return None
         if self.render_mode == "rgb_array":

@@ -67,3 +67,70 @@ def test_beams_see_the_obstacle_that_the_map_does_not_predict():
     assert got["road"] == pytest.approx(70, abs=0.5)
     assert got["obstacle"] == pytest.approx(180 - 9 - 100 - 12, abs=2)
     assert 0 < got["position"] < 20 and 10 < got["size"] < 30       # right of centre, ~18
+
+
+def test_nearest_is_the_gap_from_the_body_to_the_nearest_echo_near_its_band():
+    cfg = perception.Settings()
+    # a jamb 4 in beside the body's side and 3 in ahead of its front corner: the corner gap
+    assert perception.nearest(np.array([12.0 + 3.0]), np.array([-(9.0 + 4.0)]), ROBOT,
+                              cfg) == pytest.approx(5.0)
+    # straight ahead: the distance from the front; behind the centre: nothing
+    assert perception.nearest(np.array([40.0, -20.0]), np.array([0.0, 0.0]), ROBOT,
+                              cfg) == pytest.approx(28.0)
+    assert perception.nearest(np.array([-5.0]), np.array([10.0]), ROBOT, cfg) == cfg.nearest_cap
+    # the walls of a corridor the robot drives down, 31 in beside it, do not count
+    assert perception.nearest(np.array([20.0, 60.0]), np.array([-40.0, 40.0]), ROBOT,
+                              cfg) == cfg.nearest_cap
+    t = truth_at(100, 0, circle(150, -14, 4, n=360))   # a pole right of the way ahead
+    assert t["nearest"] == pytest.approx(np.hypot(150 - 112, 14 - 9) - 4, abs=0.2)
+
+
+def test_the_drive_behavior_slows_as_the_nearest_echo_comes_close():
+    from mitos_cli.sim.planner import FuzzyPlanner
+
+    planner = FuzzyPlanner(None, "drive")
+    calm = dict(road=80, size=0, position=0, obstacle=200, heading=0, lane=0, goal=300,
+                gap_left=30, gap_right=30, front=150, opening=0, clutter=0)
+    in_clutter = dict(calm, clutter=5, front=100)
+    for inputs in (calm, in_clutter):
+        speeds = []
+        for gap in (60.0, 10.0, 7.0, 4.0, 1.0):
+            x = {k: np.array([v], float) for k, v in {**inputs, "nearest": gap}.items()}
+            speeds.append(float(planner.plan(_percepts(x))[1][0]))
+        assert speeds == sorted(speeds, reverse=True) and speeds[0] > speeds[-1] + 10
+        assert speeds[-1] <= 10.0 + 1e-9                  # creeping when the body is that close
+
+
+def _percepts(inputs):
+    from mitos_cli.sim.planner import Percepts
+
+    z = np.zeros((1, 2))
+    return Percepts(inputs, np.zeros((1, 1)), np.zeros(1), np.zeros((1, 3)), np.zeros(1), z, z)
+
+
+def test_heading_aims_nearer_in_a_narrow_road():
+    cfg = perception.Settings()
+    assert perception.steer_lookahead(80.0, cfg) == cfg.lookahead       # a corridor: 40 in
+    assert perception.steer_lookahead(32.0, cfg) == pytest.approx(24.0)  # a door
+    assert perception.steer_lookahead(5.0, cfg) == cfg.lookahead_min
+    bend = Route.of([(0.0, 0.0), (30.0, 0.0), (30.0, -100.0)])           # a right turn ahead
+    f = perception.frame(bend, np.array([0.0, 0.0]), 0.0)
+    wide = perception.target_point(bend, f, cfg)
+    narrow = perception.target_point(bend, f, cfg, perception.steer_lookahead(32.0, cfg))
+    assert wide[1] == pytest.approx(-10.0) and narrow[0] == pytest.approx(24.0)
+
+
+def test_keep_clear_steers_off_one_side_but_not_between_two_jambs():
+    from mitos_cli.sim.planner import FuzzyPlanner
+
+    planner = FuzzyPlanner(None, "drive")
+    door = dict(road=30, size=0, position=0, obstacle=200, heading=0, lane=0, goal=300,
+                gap_left=30, gap_right=30, front=150, opening=0, clutter=0, nearest=60)
+
+    def steering(**change):
+        x = {k: np.array([v], float) for k, v in {**door, **change}.items()}
+        return float(planner.plan(_percepts(x))[0][0])
+
+    assert steering() == pytest.approx(90.0)
+    assert steering(gap_left=2.0) > 100.0            # a wall close on the left: steer right
+    assert steering(gap_left=2.0, gap_right=3.0) == pytest.approx(90.0)   # a door: straight on

@@ -19,6 +19,7 @@ from typing import Annotated
 import typer
 
 from ..errors import MitosError
+from .help import epilog, paragraphs
 
 #: One line per command: its name -> (module in this package, command function or Typer app).
 COMMANDS: dict[str, tuple[str, str]] = {
@@ -57,7 +58,7 @@ def build_app(only: str | None = None) -> typer.Typer:
         help="Instructible neurofuzzy motion planners: evaluate, check, simulate and teach "
              "fuzzy rule bases.",
         no_args_is_help=True,
-        add_completion=False,
+        add_completion=True,
         pretty_exceptions_enable=False,
         context_settings={"help_option_names": ["-h", "--help"]},
     )
@@ -69,7 +70,7 @@ def build_app(only: str | None = None) -> typer.Typer:
         if isinstance(target, typer.Typer):
             app.add_typer(target, name=name)
         else:
-            app.command(name)(target)
+            app.command(name, help=paragraphs(target.__doc__), epilog=epilog(name))(target)
     return app
 
 

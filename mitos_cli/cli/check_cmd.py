@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import inspect
 import json
 import os
 from typing import Annotated, Optional
@@ -113,7 +112,3 @@ def check_command(
     if not report.ok:
         raise typer.Exit(1)
 
-
-# Typer's rich help keeps the docstring's line breaks: join the lines of each paragraph.
-check_command.__doc__ = "\n\n".join(
-    " ".join(p.split()) for p in inspect.cleandoc(check_command.__doc__ or "").split("\n\n"))

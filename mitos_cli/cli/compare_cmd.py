@@ -3,17 +3,20 @@
 from __future__ import annotations
 
 import shlex
+from pathlib import Path
 from typing import Annotated, Optional
 
 import typer
 
 from ..words import plural
+from . import complete
 from .output import emit, err, warn
+from .progress import INTERRUPTED, progress_bar
 
 
 def compare_command(
     worlds: Annotated[list[str], typer.Argument(
-        metavar="WORLDS...",
+        metavar="WORLDS...", autocompletion=complete.worlds,
         help="World files (or names of packaged worlds such as corridor.yaml).")],
     and_: Annotated[str, typer.Option(
         "--and", metavar="TNORMS",
@@ -30,7 +33,11 @@ def compare_command(
         "--planner", metavar="PLANNERS",
         help="Planners to compare: fuzzy, potential_field, dwa.")] = "fuzzy,potential_field",
     runs: Annotated[int, typer.Option(
-        "--runs", "-n", min=1, help="Randomized runs per world and choice.")] = 20,
+        "--runs", min=1,
+        help="Randomised runs per world and choice (a comparison needs many; `simulate` "
+             "runs a world once as written unless given --runs).")] = 20,
+    runs_n: Annotated[Optional[int], typer.Option(
+        "-n", min=1, hidden=True, help="The old spelling of --runs.")] = None,
     seed: Annotated[int, typer.Option(
         "--seed", min=0, help="Seed of the whole study (runs are paired across choices).")] = 1,
     out: Annotated[str, typer.Option(
@@ -49,7 +56,7 @@ def compare_command(
         "--resume", help="Continue the study in DIR: skip every run already in results.csv."
     )] = False,
     rulebase: Annotated[Optional[str], typer.Option(
-        "--rulebase", metavar="PATH",
+        "--rulebase", "-r", metavar="PATH",
         help="Rule base of the fuzzy planner (default: the packaged one).")] = None,
     behavior: Annotated[Optional[str], typer.Option(
         "--behavior", "-b", help="Behavior to drive with (default: the world's).")] = None,
@@ -64,6 +71,9 @@ def compare_command(
     Prints the table and the ranking; writes DIR/results.csv (one row per run, as it
     finishes), DIR/report.md and its plots.
     """
+    if runs_n is not None:
+        warn("`-n` is --resolution in `check` and `plot surface`; write --runs here")
+        runs = runs_n
     from ..study import Study, make_choices, write_report
     from ..study.executors import EXECUTORS
     from ..study.spec import split_list
@@ -86,7 +96,8 @@ def compare_command(
     words += ["--runs", str(runs), "--seed", str(seed), "-o", out]
     study = Study(paths, choices, runs, seed, rulebase, behavior,
                   command=" ".join(shlex.quote(w) for w in words))
-    outcome = run_with_progress(study, out, executor, workers, scheduler, resume)
+    outcome = run_with_progress(study, out, executor, workers, scheduler, resume,
+                                quiet=as_json)
 
     if as_json:
         import json
@@ -178,34 +189,31 @@ def check_inputs(worlds: list[str], choices, rulebase: str | None,
     return paths
 
 
-def run_with_progress(study, out, executor, workers, scheduler, resume):
-    """Run the study with a progress bar on stderr."""
-    from rich.console import Console
-    from rich.progress import (
-        BarColumn,
-        MofNCompleteColumn,
-        Progress,
-        TextColumn,
-        TimeElapsedColumn,
-        TimeRemainingColumn,
-    )
-
+def run_with_progress(study, out, executor, workers, scheduler, resume, quiet=False):
+    """Run the study with a progress bar on stderr (on a terminal, without ``--json``). On
+    Ctrl-C: say how many runs are kept in ``out`` and how to go on, and exit 130."""
     from ..study import run_study
 
-    console = Console(stderr=True)
-    with Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
-                  TimeElapsedColumn(), TimeRemainingColumn(), console=console,
-                  transient=True, disable=not console.is_terminal) as progress:
-        bar = progress.add_task(f"runs ({executor})", total=None)
-
+    kept = {"before": 0, "now": 0, "total": 0}
+    with progress_bar(f"runs ({executor})", quiet=quiet) as bar:
         def on_start(skipped: int, total: int) -> None:
-            progress.update(bar, total=total, completed=skipped)
+            kept.update(before=skipped, total=total)
+            bar.update(skipped, total)
             if skipped:
-                console.print(f"resuming: {skipped} of {plural(total, 'run')} already in {out}",
-                              markup=False, highlight=False)
+                bar.note(f"resuming: {skipped} of {plural(total, 'run')} already in {out}")
 
         def on_result(task, row) -> None:
-            progress.advance(bar)
+            kept["now"] += 1
+            bar.update(kept["before"] + kept["now"], kept["total"])
 
-        return run_study(study, out, executor=executor, workers=workers, scheduler=scheduler,
-                         resume=resume, on_start=on_start, on_result=on_result)
+        try:
+            return run_study(study, out, executor=executor, workers=workers,
+                             scheduler=scheduler, resume=resume, on_start=on_start,
+                             on_result=on_result)
+        except KeyboardInterrupt:
+            pass
+    done = kept["before"] + kept["now"]
+    err(f"interrupted: {done} of {plural(kept['total'], 'run')} kept in "
+        f"{Path(out) / 'results.csv'} ({kept['now']} now, {kept['before']} from before); "
+        f"go on with:\n  {study.command} --resume")
+    raise typer.Exit(INTERRUPTED)

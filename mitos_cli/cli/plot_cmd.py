@@ -18,6 +18,7 @@ from typing import Annotated, Optional
 import typer
 
 from .eval_cmd import parse_values, split_args
+from .help import epilog
 from .output import emit, err, warn
 
 FORMATS = ("png", "svg")
@@ -288,8 +289,11 @@ def reflow(doc: str | None) -> str:
     return "\n\n".join(" ".join(p.split()) for p in paragraphs)
 
 
-plot_app.command("terms", help=reflow(terms_command.__doc__))(terms_command)
-plot_app.command("surface", help=reflow(surface_command.__doc__))(surface_command)
-plot_app.command("rules", help=reflow(rules_command.__doc__))(rules_command)
+plot_app.command("terms", help=reflow(terms_command.__doc__),
+                 epilog=epilog("plot terms"))(terms_command)
+plot_app.command("surface", help=reflow(surface_command.__doc__),
+                 epilog=epilog("plot surface"))(surface_command)
+plot_app.command("rules", help=reflow(rules_command.__doc__),
+                 epilog=epilog("plot rules"))(rules_command)
 
 __all__ = ["plot_app"]

@@ -9,7 +9,9 @@ from typing import Annotated, Optional
 
 import typer
 
+from . import complete
 from .output import emit, err
+from .progress import INTERRUPTED, progress_bar
 
 REQUIRE = ("success",)
 
@@ -117,6 +119,21 @@ def _draw_runs(result, world, plot: Path):
     return replace(result, worlds=(replace(w, summaries=bare),))
 
 
+def _run_many(loaded, runs, seed, planner, workers, plot, quiet):
+    """``run_many`` with a progress bar on a terminal. Returns the runs and, when Ctrl-C
+    stopped them, how many were asked for (``None`` otherwise): the finished ones are kept."""
+    from ..sim.runs import RunsInterrupted, run_many, trail
+
+    label = f"{len(loaded)} worlds" if len(loaded) > 1 else loaded[0].name
+    with progress_bar(f"simulate {label}", quiet=quiet) as bar:
+        try:
+            return run_many(loaded, runs, seed, planner, workers,
+                            measure=trail if plot is not None else None,
+                            on_progress=bar.update), None
+        except RunsInterrupted as stop:
+            return stop.runs, stop.total
+
+
 def _write_text(path: Path, text: str) -> None:
     from ..fileio import atomic_write
 
@@ -125,7 +142,7 @@ def _write_text(path: Path, text: str) -> None:
 
 def simulate_command(
     worlds: Annotated[Optional[list[str]], typer.Argument(
-        metavar="[WORLD.yaml]...",
+        metavar="[WORLD.yaml]...", autocompletion=complete.worlds,
         help="World files (default: the packaged corridor.yaml); names of packaged worlds "
              "such as figure4.yaml work from anywhere.")] = None,
     rulebase: Annotated[Optional[str], typer.Option(
@@ -135,7 +152,9 @@ def simulate_command(
     seed: Annotated[Optional[int], typer.Option(
         "--seed", min=0, help="Seed (default: the world's); with --runs, run j uses SEED+j.")] = None,
     runs: Annotated[int, typer.Option(
-        "--runs", min=0, help="Randomised runs per world (obstacle places, sensor noise).")] = 0,
+        "--runs", min=0,
+        help="Randomised runs per world (obstacle places, sensor noise); 0: the world once, "
+             "as written (`compare` defaults to 20: it needs many).")] = 0,
     randomise: Annotated[bool, typer.Option(
         "--randomise", help="Randomise this one run as run j of --runs does (replay it with "
                             "--seed SEED+j).")] = False,
@@ -149,7 +168,12 @@ def simulate_command(
         "--plot", metavar="FILE.png|FILE.svg",
         help="Draw the run (world, obstacles, path); with --runs, every run's path in one "
              "picture, coloured by outcome.")] = None,
-    live: Annotated[bool, typer.Option("--live", help="Show a terminal view while it runs.")] = False,
+    live: Annotated[bool, typer.Option(
+        "--live", help="Show a terminal view on stderr while it runs, paced by --speed.")] = False,
+    speed: Annotated[Optional[float], typer.Option(
+        "--speed", min=0.0, metavar="X",
+        help="Real-time factor of --live (implies it): 1 real time (the default), 4 four "
+             "times faster, 0 as fast as it can.")] = None,
     animate: Annotated[Optional[Path], typer.Option(
         "--animate", metavar="FILE.gif|FILE.mp4",
         help="Write the run as an animation: map, footprint, sonar cones, trail, obstacles, "
@@ -160,9 +184,9 @@ def simulate_command(
     require: Annotated[Optional[str], typer.Option(
         "--require", metavar="success", help="Exit 3 unless every run ends in this outcome.")] = None,
     workers: Annotated[Optional[int], typer.Option(
-        "--workers", min=1, help="Processes for --runs (default: up to 2).")] = None,
+        "--workers", "-j", min=1, help="Processes for --runs (default: up to 2).")] = None,
     planner_name: Annotated[str, typer.Option(
-        "--planner", metavar="NAME",
+        "--planner", metavar="NAME", autocompletion=complete.planners,
         help="Who drives: fuzzy (the rule base), potential_field or dwa (baselines that "
              "see the same readings and follow the same route).")] = "fuzzy",
 ) -> None:
@@ -177,13 +201,13 @@ def simulate_command(
     if planner_name != "fuzzy" and (rulebase or behavior):
         raise typer.BadParameter(f"--rulebase and --behavior choose the fuzzy planner's rules; "
                                  f"`{planner_name}` has none", param_hint="--planner")
+    live = live or speed is not None
     names = worlds or [DEFAULT_WORLD]
     loaded = [load_world(resolve_world_path(n)) for n in names]
     many = len(loaded) > 1 or runs > 0
     if many and (out or trace or live or randomise or animate):
-        raise typer.BadParameter("--out, --animate, --trace, --live and --randomise "
-                                 "work on one "
-                                 "world and one run; drop --runs or give one world")
+        raise typer.BadParameter("--out, --animate, --trace, --live, --speed and --randomise "
+                                 "work on one world and one run; drop --runs or give one world")
     if plot is not None and len(loaded) > 1:
         raise typer.BadParameter("--plot draws one world (with --runs, all its runs in one "
                                  "picture); give one world", param_hint="--plot")
@@ -198,10 +222,12 @@ def simulate_command(
     planner = make_planner(planner_name, loaded[0], rulebase, behavior)
 
     if many:
-        from ..sim.runs import run_many, trail
-
-        result = run_many(loaded, runs, seed, planner, workers,
-                          measure=trail if plot is not None else None)
+        result, stopped = _run_many(loaded, runs, seed, planner, workers, plot, as_json)
+        if stopped is not None:
+            if not result.worlds:
+                err(f"interrupted before any run finished (0 of {stopped}); nothing written")
+                raise typer.Exit(INTERRUPTED)
+            plot = plot if len(result.worlds) == len(loaded) else None
         if plot is not None:
             result = _draw_runs(result, loaded[0], plot)
         if as_json:
@@ -210,6 +236,12 @@ def simulate_command(
             emit(_runs_table(result))
         if plot is not None:
             err(f"wrote picture of {len(result.worlds[0].summaries)} runs to {plot}")
+        if stopped is not None:
+            done = sum(len(w.summaries) for w in result.worlds)
+            what = "the JSON has" if as_json else "the table has"
+            err(f"interrupted: {what} the {done} of {stopped} runs that had finished "
+                f"(their seeds: runs_detail in --json)")
+            raise typer.Exit(INTERRUPTED)
         failed = any(s["outcome"] != "success" for w in result.worlds for s in w.summaries)
         if require and failed:
             raise typer.Exit(3)
@@ -222,9 +254,13 @@ def simulate_command(
     if live:
         from ..sim.live import LiveView
 
-        with LiveView(world, scene) as view:
-            res = simulate(world, planner, seed, randomise=randomise, scene=scene,
-                           on_tick=view.update)
+        try:
+            with LiveView(world, scene, speed=1.0 if speed is None else speed) as view:
+                res = simulate(world, planner, seed, randomise=randomise, scene=scene,
+                               on_tick=view.update)
+        except KeyboardInterrupt:
+            err("interrupted: nothing written (the view shows the last tick drawn)")
+            raise typer.Exit(INTERRUPTED) from None
     else:
         res = simulate(world, planner, seed, randomise=randomise, scene=scene)
     if trace:

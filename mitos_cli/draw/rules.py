@@ -31,6 +31,7 @@ VALUE_COLOR = "#d62728"
 MAX_ROWS = 30
 BAND = 0.8          # a row's curves span [base, base + BAND]; the rest is the gap to the next
 ROW_INCHES = 0.62
+GAP_INCHES = 0.34   # between the last rule and the aggregates
 
 
 def _bare(ax) -> None:
@@ -62,14 +63,40 @@ def draw_antecedent(ax, base: float, row: RuleRow, var: str) -> None:
                           f"{p.value:.2f}" for p in props))
 
 
+def spikes(grid: np.ndarray, y: np.ndarray, cells: int = 3) -> list[tuple[float, float]] | None:
+    """``(x, height)`` of each run of nonzero samples when every run is at most ``cells``
+    long: a Mamdani set made of singletons, which the engine samples as one-cell spikes and
+    which reads better as stems. ``None`` for a set with any wider part."""
+    on = np.concatenate([[False], y > 0, [False]])
+    edges = np.flatnonzero(np.diff(on.astype(np.int8)))
+    starts, ends = edges[::2], edges[1::2]
+    if len(starts) == 0 or np.any(ends - starts > cells):
+        return None
+    peaks = [a + int(np.argmax(y[a:b])) for a, b in zip(starts, ends)]
+    return [(float(grid[k]), float(y[k])) for k in peaks]
+
+
 def draw_consequent(ax, base: float, row: RuleRow, out: OutputView) -> None:
     """The consequent of ``row`` for ``out`` in the band at ``base``."""
     for c in (c for c in row.consequents if c.output == out.name):
         gid = f"{row.label}:{out.name}"
         name = " ".join(c.hedges + (c.term,)) if c.term else f"{c.value:g}"
-        if c.implied is not None and c.full is not None and out.grid is not None:
-            ax.plot(out.grid, base + BAND * c.full, color=TERM_COLOR, linewidth=1.0, gid=gid)
-            ax.fill_between(out.grid, base, base + BAND * c.implied, color=OUT_COLOR,
+        sets = ((out.grid, c.full, c.implied) if out.grid is not None and c.full is not None
+                and c.implied is not None else None)      # Mamdani: the consequent's sets
+        if sets is not None and spikes(sets[0], sets[1]) is not None:
+            # a singleton: its full height dotted, the implied height as a stem
+            top = float(np.max(sets[2]))
+            ax.vlines([c.value], base, base + BAND, color=TERM_COLOR, linewidth=1.0,
+                      linestyles=":", gid=gid)
+            ax.vlines([c.value], base, base + BAND * top, color=OUT_COLOR, linewidth=2.4,
+                      gid=gid)
+            ax.plot([c.value], [base + BAND * top], "o", color=OUT_COLOR, markersize=3.5)
+            if c.term:
+                name += f" ({c.value:g})"
+        elif sets is not None:
+            grid, full, implied = sets
+            ax.plot(grid, base + BAND * full, color=TERM_COLOR, linewidth=1.0, gid=gid)
+            ax.fill_between(grid, base, base + BAND * implied, color=OUT_COLOR,
                             alpha=0.7, linewidth=0, gid=gid)
         else:
             ax.vlines([c.value], base, base + BAND * row.dof, color=OUT_COLOR, linewidth=2.4,
@@ -84,7 +111,15 @@ def draw_aggregate(ax, out: OutputView) -> None:
     """An output's aggregate (summed DOFs or aggregated set) and its crisp result."""
     lo, hi = out.universe
     gid = f"aggregate:{out.name}"
-    if out.aggregate is not None and out.grid is not None:
+    stems = (spikes(out.grid, out.aggregate)
+             if out.aggregate is not None and out.grid is not None else None)
+    if stems is not None:                    # Mamdani over singletons: the heights as stems
+        for v, w in stems:
+            ax.vlines([v], 0, [w], color=OUT_COLOR, linewidth=2.4, gid=gid)
+            ax.text(v, w + 0.03, f"{w:.2f}", fontsize=6.5, ha="center", va="bottom",
+                    color="#333333")
+        ax.set_ylim(0, 1.25)
+    elif out.aggregate is not None and out.grid is not None:
         ax.fill_between(out.grid, out.aggregate, color=OUT_COLOR, alpha=0.7, linewidth=0,
                         gid=gid)
         ax.plot(out.grid, out.aggregate, color=OUT_COLOR, linewidth=0.8, gid=gid)
@@ -130,9 +165,12 @@ def draw_rules(view: RuleView, path: str | Path | None = None, *, title: str | N
     n = max(len(rows), 1)
     height = 1.6 + ROW_INCHES * (n + 1.3)
     fig = new_figure((1.4 + 2.3 * ncols, height), show)
+    # a fixed gap between the rules and the aggregates (room for the results' titles),
+    # whatever the number of rows: gridspec's hspace is a fraction of the mean axes height
+    span = height - 0.75 - 0.55
     grid = fig.add_gridspec(2, ncols, height_ratios=(n, 1.3), left=0.11, right=0.98,
-                            top=1 - 0.75 / height, bottom=0.55 / height, hspace=0.12,
-                            wspace=0.12)
+                            top=1 - 0.75 / height, bottom=0.55 / height,
+                            hspace=2 * GAP_INCHES / (span - GAP_INCHES), wspace=0.12)
     bases = [n - 1 - k for k in range(len(rows))]          # first rule on top
     for k, inp in enumerate(inputs):
         ax = fig.add_subplot(grid[0, k])

@@ -23,7 +23,7 @@ def draw_runs(overlay, world, scene, path: str | Path | None = None, *, show: bo
     from matplotlib.patches import Circle, Polygon
 
     from ..sim.geometry import rect_corners
-    from .world import map_axes
+    from .world import inward, map_axes, place_legend
 
     fig, ax = map_axes(scene.static, show=show, extra_width=0.4)
     for route in scene.routes:
@@ -52,10 +52,11 @@ def draw_runs(overlay, world, scene, path: str | Path | None = None, *, show: bo
         ax.plot(c.x, c.y, marker="x", ms=7, mew=1.6, color="black", zorder=5,
                 label="collision" if n == 0 else None)
     for x, y, count, first, last in overlay.collision_places():
-        when = f"{first:.1f} s" if count == 1 else f"{count}x, {first:.1f}-{last:.1f} s"
-        ax.annotate(when, (x, y), xytext=(7, -12), textcoords="offset points", fontsize=7,
-                    zorder=6, bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none",
-                                    "alpha": 0.8})
+        when = f"{first:.1f} s" if count == 1 else f"{count}×, {first:.1f}-{last:.1f} s"
+        # on the side facing the middle: a collision near a wall keeps its label in the map
+        ax.annotate(when, (x, y), fontsize=7, zorder=6, **inward(ax, x, y),
+                    bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none",
+                          "alpha": 0.8})
     for agent in world.agents:
         ax.plot(agent.start.x, agent.start.y, marker="o", color="#2f6b2f", ms=5, zorder=4)
         ax.add_patch(Circle((agent.goal.x, agent.goal.y), agent.goal.tolerance, fill=False,
@@ -63,7 +64,7 @@ def draw_runs(overlay, world, scene, path: str | Path | None = None, *, show: bo
         ax.annotate(agent.name if len(world.agents) > 1 else "goal",
                     (agent.goal.x, agent.goal.y), xytext=(6, -10), textcoords="offset points",
                     fontsize=8, color="#2f6b2f")
-    ax.legend(loc="best", fontsize=7, framealpha=0.85)
+    place_legend(ax, scene.static)
     seeds = overlay.seeds
     ax.set_title(f"{overlay.world}: {len(seeds)} runs (seeds {seeds[0]}..{seeds[-1]}), "
                  "paths by the run's outcome", fontsize=9)

@@ -85,7 +85,9 @@ def clearance_boxes(rows: list[dict], worlds: list[str], labels: list[str],
         positions = [j + 1 for j, d in enumerate(data) if d]
         box = ax.boxplot([d for d in data if d], positions=positions, widths=0.6,
                          patch_artist=True, showfliers=True,
-                         flierprops={"markersize": 3})
+                         flierprops={"markersize": 3},
+                         # black on every box colour (tab10's orange box hid an orange median)
+                         medianprops={"color": "black", "linewidth": 1.6})
         colours = [cmap(j % 10) for j, d in enumerate(data) if d]
         for patch, colour in zip(box["boxes"], colours):
             patch.set_facecolor(colour)

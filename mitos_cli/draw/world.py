@@ -11,6 +11,55 @@ import numpy as np
 from .output import _matplotlib, finish, new_figure
 
 PAD = 20.0      # in round the map
+#: a colour per robot where a world has several (the first is the footprint blue of the frames)
+ROBOT_COLOURS = ("#1f5fbf", "#d9731e", "#7a4ab5", "#1f9e89", "#c23b8a", "#8c6d31")
+TIME_STEPS = (1, 2, 5, 10, 15, 20, 30, 60, 120, 300, 600)     # s between time marks
+
+
+def inward(ax, x: float, y: float, gap: float = 7.0, above: bool | None = None) -> dict:
+    """``annotate`` arguments that put a label beside ``(x, y)`` on the side facing the middle
+    of the axes, so that a label near an edge is not cut off (or pressed against it);
+    ``above`` forces the vertical side."""
+    (x0, x1), (y0, y1) = ax.get_xlim(), ax.get_ylim()
+    right = x > (x0 + x1) / 2
+    above = y < (y0 + y1) / 2 if above is None else above
+    return {"xytext": (-gap if right else gap, gap if above else -gap),
+            "textcoords": "offset points", "ha": "right" if right else "left",
+            "va": "bottom" if above else "top"}
+
+
+def place_legend(ax, static) -> None:
+    """The legend inside the map where there is room, under a long thin map (where inside it
+    would cover the corridor)."""
+    xmin, ymin, xmax, ymax = static.bounds
+    if xmax - xmin > 2 * (ymax - ymin):
+        ax.legend(loc="upper center", bbox_to_anchor=(0.5, 0.0), borderaxespad=4.5,
+                  ncol=4, fontsize=7, frameon=False)
+    else:
+        ax.legend(loc="best", fontsize=7, framealpha=0.85)
+
+
+def time_step(t_end: float, most: int = 6) -> float:
+    """The round interval (s) that puts at most ``most`` time marks on a run of ``t_end`` s."""
+    return next((s for s in TIME_STEPS if t_end / s <= most), TIME_STEPS[-1])
+
+
+def time_marks(ax, t: np.ndarray, xy: np.ndarray, step: float, colour: str, *,
+               label: str | None = None, near: float = 0.0, above: bool | None = None) -> None:
+    """Dots on a track ``xy[T, 2]`` at every ``step`` s of ``t[T]``, each with its time; a label
+    is left out where it would fall within ``near`` in of an earlier one (a track that
+    doubles back) or of the track's end. Obstacles' times go above their dots, robots' below (``above``)."""
+    ks = [int(k) for k in np.searchsorted(t, np.arange(step, t[-1] + 1e-9, step))
+          if k < len(t)] if len(t) else []
+    placed: list[np.ndarray] = [xy[-1]] if len(xy) else []    # the end has its own label
+    for n, k in enumerate(ks):
+        ax.plot(*xy[k], marker="o", ms=3.5, mfc="white", mec=colour, mew=1.0, ls="none",
+                zorder=6, label=label if n == 0 else None)
+        if any(np.hypot(*(xy[k] - p)) < near for p in placed):
+            continue
+        placed.append(xy[k])
+        ax.annotate(f"{t[k]:g} s", xy[k], fontsize=6.5, color=colour, zorder=6,
+                    **inward(ax, float(xy[k, 0]), float(xy[k, 1]), gap=4.0, above=above))
 
 
 def map_axes(static, *, show: bool = False, extra_width: float = 1.6):
@@ -44,6 +93,15 @@ def map_axes(static, *, show: bool = False, extra_width: float = 1.6):
     return fig, ax
 
 
+def _drove(result, i: int) -> np.ndarray:
+    """The ticks robot ``i`` drove, and the one it stopped at (arrived or collided)."""
+    if result.active is None:
+        return np.ones(len(result.t), dtype=bool)
+    drove = result.active[:, i].copy()
+    drove[1:] |= result.active[:-1, i]
+    return drove
+
+
 def draw_run(result, path: str | Path | None = None, *, footprint_every: float = 1.0,
              show: bool = False):
     """Draw ``result``; save to ``path`` (.png or .svg) and/or ``show``. Footprints every
@@ -65,14 +123,23 @@ def draw_run(result, path: str | Path | None = None, *, footprint_every: float =
         ax.plot(route.points[:, 0], route.points[:, 1], ls="-.", lw=0.8, color="#7a4ab5",
                 label="replanned route" if n == 0 else None)
 
-    # obstacles: where they started (faint, for moving ones), their tracks, where they ended
+    # obstacles: where they started (faint, for moving ones), their tracks with time marks,
+    # where they ended
     track = result.obstacles                                  # [T, O, 2]
     named = _labelled(result)
+    t_end = float(result.t[-1]) if len(result.t) else 0.0
+    step = time_step(t_end)
+    near = 0.04 * max(xmax - xmin, ymax - ymin)
+    tracked: list[int] = []
     for j, o in enumerate(world.obstacles):
         xy = track[:, j] if len(track) else np.array([[o.x, o.y]])
         moving = np.ptp(xy, axis=0).max() > 1e-9 if len(xy) else False
         if moving:
-            ax.plot(xy[:, 0], xy[:, 1], color="#b5524a", lw=0.8, ls=":")
+            ax.plot(xy[:, 0], xy[:, 1], color="#b5524a", lw=0.8, ls=":",
+                    label="obstacle track" if not tracked else None)
+            time_marks(ax, result.t, xy, step, "#8a2f27", near=near, above=True,
+                       label="time marks (s)" if not tracked else None)
+            tracked.append(j)
         for k, alpha in ((0, 0.25), (len(xy) - 1, 0.9)) if moving else ((len(xy) - 1, 0.9),):
             cx, cy = xy[k]
             patch: Circle | Polygon
@@ -87,26 +154,45 @@ def draw_run(result, path: str | Path | None = None, *, footprint_every: float =
                         fontsize=8, color="#5c1f1a")
 
     # robots: footprints at intervals, path coloured by speed, start and goal
+    # one robot: its path coloured by speed; several: a colour and a legend entry each
+    several = len(world.agents) > 1
     vmax = max(1.0, float(np.nanmax(result.speed)) if result.speed.size else 1.0)
-    step = max(1, int(round(footprint_every / world.dt)))
+    every = max(1, int(round(footprint_every / world.dt)))
     line = None
     for i, agent in enumerate(world.agents):
-        alive = result.active[:, i] if result.active is not None else slice(None)
-        pose = result.pose[alive, i]
-        speed = result.speed[alive, i]
+        drove = _drove(result, i)
+        pose = result.pose[drove, i]
+        speed = result.speed[drove, i]
         if len(pose) == 0:
             continue
-        for k in list(range(0, len(pose), step)) + [len(pose) - 1]:
+        colour = ROBOT_COLOURS[i % len(ROBOT_COLOURS)] if several else "#555555"
+        for k in list(range(0, len(pose), every)) + [len(pose) - 1]:
             x, y, h = pose[k]
             ax.add_patch(Polygon(rect_corners(x, y, np.deg2rad(h), agent.robot.length,
                                               agent.robot.width),
-                                 closed=True, fill=False, edgecolor="#555555", lw=0.5))
-        if len(pose) > 1:
+                                 closed=True, fill=False, edgecolor=colour, lw=0.5,
+                                 alpha=0.6 if several else 1.0))
+        if several:
+            ax.plot(pose[:, 0], pose[:, 1], color=colour, lw=2.0,
+                    label=f"{agent.name}: {result.robot_outcomes[i]}")
+        elif len(pose) > 1:
             segs = np.stack([pose[:-1, :2], pose[1:, :2]], axis=1)
             line = LineCollection(list(segs), cmap="viridis", linewidths=2.2)
             line.set_array(speed[:-1])
             line.set_clim(0, vmax)
             ax.add_collection(line)
+        if tracked or several:           # where the robots were when the obstacles were there
+            time_marks(ax, result.t[drove], pose[:, :2], step,
+                       colour if several else "#333333", near=near, above=False,
+                       label=None if tracked else "time marks (s)" if i == 0 else None)
+        if result.robot_outcomes[i] == "collision":
+            x, y = pose[-1, :2]
+            ax.plot(x, y, marker="x", ms=9, mew=2.0, color="black", zorder=7, ls="none",
+                    label="collision" if "collision" not in result.robot_outcomes[:i] else None)
+            ax.annotate(f"collision at {result.robot_metrics[i]['time_s']:.2f} s", (x, y),
+                        fontsize=7.5, zorder=7, **inward(ax, x, y),
+                        bbox={"boxstyle": "round,pad=0.2", "fc": "white", "ec": "none",
+                              "alpha": 0.85})
         ax.plot(agent.start.x, agent.start.y, marker="o", color="#2f6b2f", ms=5)
         ax.add_patch(Circle((agent.goal.x, agent.goal.y), agent.goal.tolerance, fill=False,
                             edgecolor="#2f6b2f", lw=1.0, ls="--"))
@@ -115,12 +201,13 @@ def draw_run(result, path: str | Path | None = None, *, footprint_every: float =
                     fontsize=8, color="#2f6b2f")
     if line is not None:
         fig.colorbar(line, ax=ax, shrink=0.7, label="speed (in/s)")
+    place_legend(ax, static)
     ax.set_xlim(xmin - pad, xmax + pad)
     ax.set_ylim(ymin - pad, ymax + pad)
     ax.set_xlabel("x (in)")
     ax.set_ylabel("y (in)")
     m = result.metrics
-    ax.set_title(f"{world.name}: {result.outcome} after {m['time_s']:.1f} s "
+    ax.set_title(f"{world.name}: {result.outcome} after {m['time_s']:.2f} s "
                  f"(seed {result.seed}, min clearance {m['min_clearance_in']:.1f} in)",
                  fontsize=9)
     return finish(fig, path, show)

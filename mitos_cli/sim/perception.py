@@ -62,6 +62,13 @@ Inputs (all floats, units in the names of ``mitos.terms.yaml`` / ``drive.terms.y
     runs of neighbouring beams hitting obstacles, split where two hits lie more than
     ``clutter_gap`` apart (see :func:`clutter`). With one object at a time the paper's
     repertoire avoids "the obstacle"; among several the ``drive`` behavior takes the opening.
+``nearest`` (in)
+    the gap between the robot's footprint and the nearest echo ahead of its centre and
+    within ``nearest_band`` of the band its body sweeps, whatever it hit (a wall, a door
+    jamb, a pole, a box: drawn on its map or not), capped at ``nearest_cap``: what its front
+    corners will meet next (see :func:`nearest`). ``front`` sees only what the map does not
+    show and only straight on; a jamb beside a door or a pole by the corner of the body is in
+    ``nearest``, so the ``drive`` behavior slows for it.
 ``gap_left``, ``gap_right`` (in)
     gap between the robot's side and the nearest thing hit on that side: walls among beams
     landing from ``wall_behind`` behind to ``wall_ahead`` ahead of the robot's centre along
@@ -85,12 +92,14 @@ from .world import Robot
 
 NO_OBSTACLE = 200.0     # in: the `obstacle` distance when nothing obstructs
 INPUTS = ("road", "size", "position", "obstacle", "heading", "lane", "goal", "gap_left",
-          "gap_right", "front", "opening", "clutter")
+          "gap_right", "front", "opening", "clutter", "nearest")
 
 
 @dataclass(frozen=True)
 class Settings:
     lookahead: float = 40.0        # in: pure-pursuit point on the route
+    lookahead_min: float = 20.0    # in: the shortest lookahead of `heading` (in a door)
+    lookahead_per_road: float = 0.75   # `heading`'s lookahead per inch of road width
     window: float = 24.0           # in: along-route half window for the road width
     sight: float = 150.0           # in: how far ahead objects count
     band_margin: float = 8.0       # in: added to each side of the swept band
@@ -107,6 +116,8 @@ class Settings:
     way_fov: float = 180.0         # deg
     clutter_gap: float = 24.0      # in: neighbouring hits farther apart: two objects
     way_turn_cost: float = 0.05    # in of progress given up per deg turned from the heading
+    nearest_cap: float = 60.0      # in: `nearest` when nothing is that close
+    nearest_band: float = 10.0     # in: beside the body's band, echoes farther out do not count
 
 
 @dataclass(frozen=True)
@@ -201,6 +212,19 @@ def free_ways(ah: np.ndarray, bh: np.ndarray, widen: np.ndarray, unknown: np.nda
     return front, float(ways[best])
 
 
+def nearest(ah: np.ndarray, bh: np.ndarray, robot: Robot, cfg: Settings) -> float:
+    """The gap from the footprint (a ``length`` x ``width`` rectangle on the pose) to the
+    nearest of the points ``(ah, bh)`` (the robot's own frame) ahead of its centre and within
+    ``nearest_band`` of the band its body sweeps straight on (the walls of a corridor it
+    drives down do not count; a jamb it is about to pass, or a pole by its corner, do)."""
+    ahead = (ah > 0) & (np.abs(bh) < robot.width / 2 + cfg.nearest_band)
+    if not ahead.any():
+        return cfg.nearest_cap
+    dx = np.maximum(ah[ahead] - robot.length / 2, 0.0)
+    dy = np.maximum(np.abs(bh[ahead]) - robot.width / 2, 0.0)
+    return float(min(np.hypot(dx, dy).min(), cfg.nearest_cap))
+
+
 def clutter(hits: np.ndarray, unknown: np.ndarray, ah: np.ndarray, cfg: Settings,
             circular: bool = False) -> float:
     """How many separate objects the map does not show are in view ahead: runs of
@@ -233,7 +257,7 @@ def _walls(a, b, valid, robot: Robot, cfg: Settings, far: float,
 
 def _common(route: Route, p, heading: float, f: Frame, road: float, robot: Robot,
             cfg: Settings) -> tuple[float, float, float]:
-    target = target_point(route, f, cfg)
+    target = target_point(route, f, cfg, steer_lookahead(road, cfg))
     d = target - p
     bearing = math.degrees(math.atan2(d[1], d[0]) - heading)
     bearing = (bearing + 180.0) % 360.0 - 180.0
@@ -243,12 +267,21 @@ def _common(route: Route, p, heading: float, f: Frame, road: float, robot: Robot
     return -bearing, f.e - offset, goal
 
 
-def target_point(route: Route, f: Frame, cfg: Settings) -> np.ndarray:
+def steer_lookahead(road: float, cfg: Settings) -> float:
+    """How far ahead the point ``heading`` aims at lies: ``lookahead``, shortened in a road
+    narrower than ``lookahead / lookahead_per_road`` (a door, a narrow passage) down to
+    ``lookahead_min``, so that the robot does not cut the corner before a door into its jamb."""
+    return min(cfg.lookahead, max(cfg.lookahead_min, cfg.lookahead_per_road * road))
+
+
+def target_point(route: Route, f: Frame, cfg: Settings,
+                 lookahead: float | None = None) -> np.ndarray:
     """The pursuit point: on the route a lookahead ahead; the goal itself over the last
     lookahead of the route."""
-    if f.s + cfg.lookahead >= route.length:
+    ahead = cfg.lookahead if lookahead is None else lookahead
+    if f.s + ahead >= route.length:
         return route.goal
-    return route.point_at(f.s + cfg.lookahead)
+    return route.point_at(f.s + ahead)
 
 
 def perceive(route: Route, f: Frame, pose: tuple[float, float, float], robot: Robot,
@@ -279,7 +312,8 @@ def perceive(route: Route, f: Frame, pose: tuple[float, float, float], robot: Ro
     objects = clutter(hits, valid & obstacle_hit, _own_frame(rel, pose[2])[0], cfg, ring)
     return {"road": road, "size": size, "position": position, "obstacle": distance,
             "heading": heading, "lane": lane, "goal": goal, "gap_left": wl, "gap_right": wr,
-            "front": front, "opening": opening, "clutter": objects}
+            "front": front, "opening": opening, "clutter": objects,
+            "nearest": nearest(ah, bh, robot, cfg)}
 
 
 def truth(route: Route, f: Frame, pose: tuple[float, float, float], robot: Robot,
@@ -305,7 +339,8 @@ def truth(route: Route, f: Frame, pose: tuple[float, float, float], robot: Robot
     objects = clutter(scan, unknown, ah, cfg)
     return {"road": road, "size": size, "position": position, "obstacle": distance,
             "heading": heading, "lane": lane, "goal": goal, "gap_left": gaps[0],
-            "gap_right": gaps[1], "front": front, "opening": opening, "clutter": objects}
+            "gap_right": gaps[1], "front": front, "opening": opening, "clutter": objects,
+            "nearest": nearest(ah, bh, robot, cfg)}
 
 
 def side_gaps(route_frame: Frame, p: np.ndarray, dirs: np.ndarray, expected: np.ndarray,

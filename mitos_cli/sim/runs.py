@@ -9,7 +9,7 @@ not depend on the number of workers or on which worker ran what.
 from __future__ import annotations
 
 import math
-from concurrent.futures import ProcessPoolExecutor
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -21,14 +21,22 @@ METRICS = ("time_s", "path_length_in", "min_clearance_in", "mean_speed_in_s",
            "steering_total_variation_deg")
 
 
-def _chunk(task: tuple) -> list[dict]:
-    world, planner, seeds, randomise, measure = task
-    scene = prepare(world)
+def _chunk(task: tuple) -> tuple[int, list[dict]]:
+    index, world, planner, seeds, randomise, measure, scene = task
+    scene = scene if scene is not None else prepare(world)
     out = []
     for seed in seeds:
         res = simulate(world, planner, seed, randomise=randomise, scene=scene)
         out.append({**res.summary(), **(measure(res) if measure is not None else {})})
-    return out
+    return index, out
+
+
+def ignore_interrupts() -> None:
+    """A pool worker's initializer: Ctrl-C reaches the whole process group, and only the
+    parent should answer it (the workers are terminated; no ``Process ForkPoolWorker-1:``)."""
+    import signal
+
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
 def trail(res) -> dict:
@@ -100,12 +108,28 @@ def default_workers() -> int:
     return max(1, min(2, os.cpu_count() or 1))
 
 
+class RunsInterrupted(KeyboardInterrupt):
+    """Ctrl-C during :func:`run_many`: ``runs`` holds the runs that had finished (each world's
+    in seed order; a world with none is left out), ``total`` how many were asked for."""
+
+    def __init__(self, runs: Runs, total: int) -> None:
+        super().__init__()
+        self.runs, self.total = runs, total
+
+    @property
+    def finished(self) -> int:
+        return sum(len(w.summaries) for w in self.runs.worlds)
+
+
 def run_many(worlds: list[World], runs: int = 0, seed: int | None = None, planner=None,
-             workers: int | None = None, measure=None) -> Runs:
+             workers: int | None = None, measure=None,
+             on_progress: Callable[[int, int], None] | None = None) -> Runs:
     """Run each world once (``runs=0``: its own seed, as written) or ``runs`` randomised times
     (seeds ``seed + j``, default base: the world's seed), on ``workers`` processes.
     ``measure(result) -> dict`` (a picklable function), when given, adds figures of its own to
-    each run's summary in the worker (a benchmark's scores from the ticks)."""
+    each run's summary in the worker (a benchmark's scores from the ticks).
+    ``on_progress(done, total)`` is called as runs finish (a progress bar). Ctrl-C terminates
+    the workers and raises :class:`RunsInterrupted` with the runs that had finished."""
     if planner is None:
         from .planner import FuzzyPlanner
 
@@ -115,16 +139,56 @@ def run_many(worlds: list[World], runs: int = 0, seed: int | None = None, planne
     for w in worlds:
         base = w.seed if seed is None else seed
         seeds = [base] if runs <= 0 else [base + j for j in range(runs)]
-        size = max(1, math.ceil(len(seeds) / (2 * workers)))
+        # about 8 chunks a worker, so that a progress bar moves; a world cut into several
+        # chunks has its map and routes prepared once, here, and sent along (a grid map's
+        # route search costs about as much as a run)
+        size = max(1, math.ceil(len(seeds) / (8 * workers)))
+        scene = prepare(w) if len(seeds) > size else None
         for i in range(0, len(seeds), size):
-            tasks.append((w, tuple(seeds[i:i + size]), i))
-    jobs = [(w, planner, chunk, runs > 0, measure) for w, chunk, _ in tasks]
-    if workers > 1 and len(jobs) > 1:
-        with ProcessPoolExecutor(workers) as pool:
-            results = list(pool.map(_chunk, jobs))
-    else:
-        results = [_chunk(j) for j in jobs]
-    grouped: dict[int, list[dict]] = {}
+            tasks.append((w, tuple(seeds[i:i + size]), scene))
+    jobs = [(k, w, planner, chunk, runs > 0, measure, scene)
+            for k, (w, chunk, scene) in enumerate(tasks)]
+    total = sum(len(chunk) for _, chunk, _ in tasks)
+    results: list[list[dict] | None] = [None] * len(jobs)
+    done = 0
+    try:
+        for k, res in _execute(jobs, workers):
+            results[k] = res
+            done += len(res)
+            if on_progress is not None:
+                on_progress(done, total)
+    except KeyboardInterrupt:
+        raise RunsInterrupted(_group(worlds, tasks, results), total) from None
+    return _group(worlds, tasks, results)
+
+
+def _execute(jobs: list[tuple], workers: int):
+    """``(index, summaries)`` of each chunk as it finishes: in this process, or on a pool
+    that is terminated at once on Ctrl-C or an error."""
+    if workers <= 1 or len(jobs) <= 1:
+        yield from map(_chunk, jobs)
+        return
+    import multiprocessing
+
+    pool = multiprocessing.get_context().Pool(min(workers, len(jobs)),
+                                              initializer=ignore_interrupts)
+    finished = False
+    try:
+        yield from pool.imap_unordered(_chunk, jobs)
+        finished = True
+    finally:
+        if finished:
+            pool.close()
+        else:
+            pool.terminate()
+        pool.join()
+
+
+def _group(worlds: list[World], tasks: list[tuple], results: list[list[dict] | None]) -> Runs:
+    """Each world's finished runs in seed order (worlds with none left out when interrupted)."""
+    grouped: dict[int, list[dict]] = {id(w): [] for w in worlds}
     for (w, _, _), res in zip(tasks, results):
-        grouped.setdefault(id(w), []).extend(res)
-    return Runs(tuple(WorldRuns(w.name, tuple(grouped[id(w)])) for w in worlds))
+        if res is not None:
+            grouped[id(w)].extend(res)
+    return Runs(tuple(WorldRuns(w.name, tuple(grouped[id(w)])) for w in worlds
+                      if grouped[id(w)]))

@@ -54,7 +54,10 @@ def run_local(fn: TaskFn, tasks: Sequence[Task], workers: int) -> Iterator[tuple
         return
     import multiprocessing
 
-    pool = multiprocessing.get_context().Pool(min(workers, len(tasks)))
+    from ..sim.runs import ignore_interrupts
+
+    pool = multiprocessing.get_context().Pool(min(workers, len(tasks)),
+                                              initializer=ignore_interrupts)
     finished = False
     try:
         for part in pool.imap_unordered(functools.partial(run_chunk, fn),

@@ -1,0 +1,116 @@
+"""Every command's ``--help``: examples that parse with the command's own options and name
+files that exist, the exit codes, one meaning per short option, and shell completion."""
+
+from __future__ import annotations
+
+import os
+import shlex
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+import typer.main
+
+from mitos_cli.cli.app import COMMANDS, build_app
+from mitos_cli.cli.help import EXAMPLES, exit_codes
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+def commands() -> dict:
+    """Every command by its name after ``mitos`` (``plot terms`` for a subcommand)."""
+    group = typer.main.get_group(build_app())
+    out = {}
+    for name, cmd in group.commands.items():
+        if hasattr(cmd, "commands"):           # a group (Typer's own Click)
+            out.update({f"{name} {sub}": c for sub, c in cmd.commands.items()})
+        else:
+            out[name] = cmd
+    return out
+
+
+def test_every_command_has_examples_and_exit_codes():
+    every = commands()
+    assert set(every) == set(EXAMPLES)
+    assert {name.split()[0] for name in every} == set(COMMANDS)
+    for name, cmd in every.items():
+        assert "Examples:" in cmd.epilog and "Exit codes:" in cmd.epilog, name
+        assert [c for c, _ in exit_codes(name)][:3] == [0, 1, 2]
+
+
+@pytest.mark.parametrize("name", sorted(EXAMPLES))
+def test_examples_parse_and_name_files_that_exist(name):
+    cmd = commands()[name]
+    for line, _ in EXAMPLES[name]:
+        words = shlex.split(line.split(">")[0])
+        assert words[:1 + name.count(" ") + 1] == ["mitos", *name.split()], line
+        args = words[1 + name.count(" ") + 1:]
+        cmd.make_context(f"mitos {name}", list(args))          # a usage error raises here
+        for word in args:
+            if "/" in word and not word.startswith("-") and "=" not in word:
+                assert (ROOT / word).exists(), f"{line}: {word} does not exist"
+
+
+def test_help_ends_with_the_examples_and_exit_codes():
+    env = {**os.environ, "COLUMNS": "120", "PYTHONPATH": str(ROOT)}
+    out = subprocess.run([sys.executable, "-m", "mitos_cli", "simulate", "--help"],
+                         capture_output=True, text=True, env=env, cwd=ROOT).stdout
+    assert "mitos simulate slalom --live --speed 4" in out
+    assert "130  Ctrl-C: with --runs, the runs that finished are still reported" in out
+
+
+def test_a_short_option_means_one_thing_in_every_command():
+    meaning: dict[str, set[str]] = {}
+    for cmd in commands().values():
+        for param in cmd.params:
+            if param.param_type_name != "option" or param.hidden:
+                continue
+            longs = [o for o in param.opts if o.startswith("--")]
+            for short in (o for o in param.opts if not o.startswith("--")):
+                meaning.setdefault(short, set()).update(longs)
+    clashes = {s: m for s, m in meaning.items() if len(m) > 1}
+    assert clashes == {"-o": {"--out", "--output", "--save-as"}}   # -o: where it writes
+    assert meaning["-n"] == {"--resolution"} and meaning["-j"] == {"--workers"}
+    assert meaning["-r"] == {"--rulebase"} and meaning["-b"] == {"--behavior"}
+
+
+def test_the_old_spelling_of_compare_runs_still_works(tmp_path, capsys):
+    cmd = commands()["compare"]
+    ctx = cmd.make_context("mitos compare", ["corridor", "-n", "3", "-o", str(tmp_path)])
+    assert ctx.params["runs_n"] == 3
+
+
+def test_completion_offers_packaged_worlds_and_planners():
+    env = {**os.environ, "PYTHONPATH": str(ROOT), "_MITOS_COMPLETE": "complete_bash",
+           "COMP_WORDS": "mitos simulate fig", "COMP_CWORD": "2"}
+    run = [sys.executable, "-m", "mitos_cli"]
+    assert subprocess.run(run, env=env, capture_output=True, text=True).stdout.split() == \
+        ["figure4"]
+    env.update(COMP_WORDS="mitos simulate --planner d", COMP_CWORD="3")
+    assert subprocess.run(run, env=env, capture_output=True, text=True).stdout.split() == \
+        ["dwa"]
+
+
+def test_the_readme_lists_the_exit_codes_of_the_help():
+    readme = (ROOT / "README.md").read_text()
+    table = readme.split("| exit code | meaning |")[1].split("\n\n")[0]
+    codes = {int(row.split("|")[1]) for row in table.strip().splitlines()[1:]}
+    helped = {c for name in EXAMPLES for c, _ in exit_codes(name)}
+    assert codes == helped
+
+
+def test_the_epilog_fits_an_80_column_terminal():
+    from mitos_cli.cli.help import epilog
+
+    for name in EXAMPLES:
+        assert max(len(line) for line in epilog(name).splitlines()) <= 76, name
+
+
+def test_the_completion_script_is_shown_for_bash(capsys):
+    from mitos_cli.cli.app import main
+
+    with pytest.raises(SystemExit) as info:
+        main(["--show-completion", "bash"])
+    assert info.value.code == 0
+    assert "complete -o default -F _mitos_completion mitos" in capsys.readouterr().out

@@ -1,0 +1,204 @@
+"""Watching long commands: ``--live`` paced by ``--speed``, progress bars only on a terminal,
+and Ctrl-C on ``simulate --runs`` and ``compare`` (what finished is kept, exit 130)."""
+
+from __future__ import annotations
+
+import io
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+from rich.console import Console
+
+from mitos_cli.cli.app import main
+from mitos_cli.cli.progress import INTERRUPTED, progress_bar
+from mitos_cli.sim import runs as runs_mod
+from mitos_cli.sim.live import LiveView, Pacer
+from mitos_cli.sim.loop import prepare, simulate
+from mitos_cli.sim.worldfile import load_world
+
+ROOT = Path(__file__).resolve().parent.parent
+TINY = Path(__file__).parent / "data" / "tiny.yaml"
+
+
+class FakeClock:
+    """A wall clock that only moves when slept on (or by ``step`` per reading)."""
+
+    def __init__(self, step: float = 0.0) -> None:
+        self.now, self.step, self.slept = 100.0, step, 0.0
+
+    def __call__(self) -> float:
+        self.now += self.step
+        return self.now
+
+    def sleep(self, dt: float) -> None:
+        self.now += dt
+        self.slept += dt
+
+
+def run(capsys, *args) -> tuple[int, str, str]:
+    try:
+        main([*map(str, args)])
+        code = 0
+    except SystemExit as exc:
+        code = exc.code or 0
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+@pytest.mark.parametrize("speed, due", [(1.0, 2.0), (4.0, 0.5), (0.0, 0.0)])
+def test_pacer_holds_a_run_to_its_real_time_factor(speed, due):
+    clock = FakeClock()
+    pacer = Pacer(speed, clock, clock.sleep)
+    assert pacer.wait(0.05) == 0.0                   # the first tick is due at once
+    for k in range(2, 42):
+        pacer.wait(0.05 * k)
+    assert clock.slept == pytest.approx(due, abs=1e-9)
+
+
+def test_pacer_refuses_a_negative_or_nan_speed():
+    for bad in (-1.0, float("nan")):
+        with pytest.raises(ValueError):
+            Pacer(bad)
+
+
+def test_live_view_paces_caps_its_frames_and_ends_on_the_last_tick():
+    world = load_world(TINY)
+    scene = prepare(world)
+    clock = FakeClock()
+    screen = io.StringIO()
+    with LiveView(world, scene, speed=2.0, fps=10.0, console=Console(file=screen, width=80),
+                  clock=clock, sleep=clock.sleep) as view:
+        res = simulate(world, seed=1, scene=scene, on_tick=view.update)
+    t_end = float(res.t[-1])
+    assert clock.slept == pytest.approx((t_end - float(res.t[0])) / 2, abs=1e-6)
+    # 10 frames a wall second over t_end / 2 wall seconds, and the last tick
+    assert view.frames <= int(t_end / 2 * 10) + 2 and view.frames >= int(t_end / 2 * 10) - 1
+    last = screen.getvalue()
+    assert f"t = {t_end:6.2f} s (x2)" in last and "R" in last and "#" in last
+
+
+def test_speed_implies_live_and_is_one_run_only(capsys):
+    code, _, err = run(capsys, "simulate", TINY, "--runs", 2, "--speed", 4)
+    assert code == 2 and "--speed" in err
+    code, _, err = run(capsys, "simulate", TINY, "--speed", -1)
+    assert code == 2
+
+
+def test_progress_bar_is_silent_off_a_terminal(capsys):
+    with progress_bar("runs") as bar:                # pytest's stderr is not a terminal
+        bar.update(1, 2)
+        assert bar.progress is None
+    with progress_bar("runs", quiet=True) as bar:
+        assert bar.progress is None
+    assert capsys.readouterr().err == ""
+
+
+def test_run_many_reports_progress_and_keeps_what_finished_on_ctrl_c(monkeypatch):
+    world = load_world(TINY)
+    seen = []
+    result = runs_mod.run_many([world], runs=2, seed=4, workers=1,
+                               on_progress=lambda d, t: seen.append((d, t)))
+    assert seen == [(1, 2), (2, 2)]
+    real, calls = runs_mod._chunk, []
+
+    def second_is_interrupted(job):
+        calls.append(job)
+        if len(calls) == 2:
+            raise KeyboardInterrupt
+        return real(job)
+
+    monkeypatch.setattr(runs_mod, "_chunk", second_is_interrupted)
+    with pytest.raises(runs_mod.RunsInterrupted) as stop:
+        runs_mod.run_many([world], runs=2, seed=4, workers=1)
+    assert stop.value.finished == 1 and stop.value.total == 2
+    assert stop.value.runs.worlds[0].summaries == result.worlds[0].summaries[:1]
+
+
+def test_simulate_runs_ctrl_c_prints_the_finished_runs_and_exits_130(capsys, monkeypatch):
+    world = load_world(TINY)
+    done = runs_mod.run_many([world], runs=2, seed=1, workers=1)
+
+    def interrupted(*args, **kwargs):
+        raise runs_mod.RunsInterrupted(done, 5)
+
+    monkeypatch.setattr(runs_mod, "run_many", interrupted)
+    code, out, err = run(capsys, "simulate", TINY, "--runs", 5)
+    assert code == INTERRUPTED == 130
+    assert out.splitlines()[1].split()[:2] == ["tiny", "2"]
+    assert "interrupted: the table has the 2 of 5 runs that had finished" in err
+
+
+def test_compare_ctrl_c_says_what_is_kept_and_how_to_resume(capsys, monkeypatch, tmp_path):
+    import mitos_cli.study as study_mod
+
+    def interrupted(study, out, *, on_start, on_result, **kwargs):
+        on_start(1, 6)
+        on_result(None, {})
+        on_result(None, {})
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(study_mod, "run_study", interrupted)
+    code, _, err = run(capsys, "compare", TINY, "--and", "min,product", "--runs", 2,
+                       "-o", tmp_path / "s")
+    assert code == 130 and "Traceback" not in err
+    assert f"interrupted: 3 of 6 runs kept in {tmp_path / 's' / 'results.csv'}" in err
+    assert "(2 now, 1 from before)" in err and err.rstrip().endswith("--resume")
+
+
+@pytest.mark.skipif(not hasattr(os, "killpg"), reason="process groups")
+def test_ctrl_c_on_a_compare_pool_leaves_no_worker_tracebacks(tmp_path):
+    """A real Ctrl-C reaches the whole process group, workers included."""
+    out = tmp_path / "s"
+    args = [sys.executable, "-m", "mitos_cli", "compare", str(TINY), "--and", "min,product",
+            "--planner", "fuzzy", "--runs", "6", "-o", str(out), "-j", "2", "--no-plots"]
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    proc = subprocess.Popen(args, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            text=True, start_new_session=True)
+    try:
+        deadline = time.monotonic() + 60
+        csv_file = out / "results.csv"
+        while time.monotonic() < deadline and proc.poll() is None:
+            if csv_file.exists() and len(csv_file.read_text().splitlines()) >= 2:
+                break
+            time.sleep(0.02)
+        os.killpg(proc.pid, signal.SIGINT)
+        _, err = proc.communicate(timeout=60)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    if proc.returncode == 0:
+        pytest.skip("the study finished before Ctrl-C arrived")
+    assert proc.returncode == 130, err
+    assert "Traceback" not in err and "ForkPoolWorker" not in err and "Process " not in err
+    assert "interrupted:" in err and "--resume" in err
+
+
+def test_live_once_off_a_terminal_ends_with_the_last_frame(capsys):
+    code, out, err = run(capsys, "simulate", TINY, "--speed", 0)
+    assert code == 0 and "SUCCESS" in out
+    assert "(unpaced)" in err and err.count("t = ") == 1        # the last frame, once
+
+
+def test_gym_human_render_without_a_display_falls_back_to_the_terminal_view(monkeypatch,
+                                                                            capsys):
+    pytest.importorskip("gymnasium")
+    from mitos_cli import gym as mgym
+    from mitos_cli.draw import frame
+    from mitos_cli.draw.output import DrawError
+
+    def no_display(*args, **kwargs):
+        raise DrawError("cannot open a window: no display")
+
+    monkeypatch.setattr(frame, "RunFrame", no_display)
+    env = mgym.MitosEnv(TINY, render_mode="human")
+    env.reset(seed=1)
+    for _ in range(3):
+        env.step(env.fuzzy_policy(env.unwrapped._observe()))
+        assert env.render() is None
+    env.close()
+    assert "t =   0.15 s (unpaced)" in capsys.readouterr().err

@@ -1,0 +1,138 @@
+"""Pictures that explain themselves: time marks on moving things, a colour and legend entry per
+robot, a collision's marker and time, labels that stay inside the map, singleton stems in the
+Mamdani rule viewer and visible medians in the study's boxes."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+pytest.importorskip("matplotlib")
+
+from mitos_cli.draw import rules as rules_draw  # noqa: E402
+from mitos_cli.draw.world import ROBOT_COLOURS, draw_run, inward, time_step  # noqa: E402
+from mitos_cli.sim.loop import simulate  # noqa: E402
+from mitos_cli.sim.worldfile import load_world  # noqa: E402
+
+# two robots passing in a short corridor, a box sliding toward them: about 5 s
+WORLD = """\
+name: meet
+seed: 2
+dt: 0.05
+time_limit: 5
+robot:
+  model: tricycle
+  wheelbase: 16
+  footprint: {length: 24, width: 18}
+q_init: {x: 30, y: -12, heading: 0}
+q_goal: {x: 330, y: -12, tolerance: 12}
+robots:
+  - name: other
+    q_init: {x: 330, y: 12, heading: 180}
+    q_goal: {x: 30, y: 12, tolerance: 12}
+map:
+  corridors:
+    - points: [[0, 0], [360, 0]]
+      width: 90
+obstacles:
+  - {name: slider, shape: circle, at: [200, 35], radius: 5, velocity: [-10, 0]}
+"""
+
+
+@pytest.fixture(scope="module")
+def meeting(tmp_path_factory):
+    path = tmp_path_factory.mktemp("w") / "meet.yaml"
+    path.write_text(WORLD)
+    return simulate(load_world(path))
+
+
+def texts(fig) -> list[str]:
+    return [t.get_text() for ax in fig.axes for t in ax.texts]
+
+
+def test_time_steps_are_round_and_few():
+    assert [time_step(t) for t in (4.0, 5.0, 27.05, 60.0, 400.0)] == [1, 1, 5, 10, 120]
+
+
+def test_labels_near_an_edge_face_the_middle():
+    from mitos_cli.draw.output import new_figure
+
+    ax = new_figure((4, 3)).add_subplot(1, 1, 1)
+    ax.set_xlim(0, 100)
+    ax.set_ylim(0, 100)
+    right = inward(ax, 95, 5)
+    assert right["ha"] == "right" and right["xytext"][0] < 0 and right["va"] == "bottom"
+    left = inward(ax, 5, 95)
+    assert left["ha"] == "left" and left["xytext"][0] > 0 and left["va"] == "top"
+    assert inward(ax, 5, 5, above=False)["va"] == "top"
+
+
+def test_several_robots_get_a_colour_each_and_moving_things_time_marks(meeting):
+    fig = draw_run(meeting)
+    (ax,) = [a for a in fig.axes if a.get_legend() is not None]
+    legend = [t.get_text() for t in ax.get_legend().get_texts()]
+    for i, name in enumerate(("robot", "other")):
+        assert f"{name}: {meeting.robot_outcomes[i]}" in legend
+        line = next(ln for ln in ax.lines if ln.get_label().startswith(f"{name}:"))
+        assert line.get_color() == ROBOT_COLOURS[i]
+    assert "obstacle track" in legend and "time marks (s)" in legend
+    marks = [t for t in texts(fig) if t.endswith(" s") and t[:-2].isdigit()]
+    # the slider's track and both robots' paths, every second (the labels near a track's end
+    # left out): at least one mark each, all whole seconds within the run
+    assert len(marks) >= 3 and all(1 <= int(m[:-2]) <= meeting.t[-1] for m in marks)
+    assert not any(c.get_label() == "speed (in/s)" for c in fig.axes)   # no speed colourbar
+
+
+def test_a_collision_is_marked_with_its_time():
+    result = simulate(load_world("worlds/figure4.yaml"))
+    fig = draw_run(result)
+    assert result.outcome == "collision"
+    assert f"collision at {result.metrics['time_s']:.2f} s" in texts(fig)
+    ax = fig.axes[0]
+    (x_mark,) = [ln for ln in ax.lines if ln.get_marker() == "x"]
+    assert np.allclose(x_mark.get_xydata()[0], result.pose[-1, 0, :2])
+
+
+def test_singletons_are_found_and_wide_sets_are_not():
+    grid = np.linspace(0, 10, 101)
+    y = np.zeros_like(grid)
+    y[30], y[70:72] = 0.4, (0.2, 0.9)
+    assert rules_draw.spikes(grid, y) == [(3.0, 0.4), (pytest.approx(7.1), 0.9)]
+    y[10:20] = 0.5
+    assert rules_draw.spikes(grid, y) is None
+    assert rules_draw.spikes(grid, np.zeros_like(grid)) is None
+
+
+def test_mamdani_viewer_draws_singletons_as_stems_under_their_titles():
+    from mitos_cli import load_rulebase
+    from mitos_cli.draw.data import rule_view
+
+    rb = load_rulebase().with_operators(inference="mamdani")
+    # one rule fires (r0: RS 110, MEDIUM 40): the case whose titles overlapped the row above
+    view = rule_view(rb.compiled, {"road": 150.0, "size": 5.0, "position": -50.0})
+    fig = rules_draw.draw_rules(view)
+    (ax,) = [a for a in fig.axes if any(c.get_gid() == "aggregate:steering"
+                                        for c in a.collections)]
+    stems = [c for c in ax.collections if c.get_gid() == "aggregate:steering"]
+    (segment,) = [seg for c in stems for seg in c.get_segments()]
+    assert segment[0][0] == pytest.approx(110, abs=1.5) and segment[1][1] == pytest.approx(1.0)
+    (row,) = [c for a in fig.axes for c in a.collections if c.get_gid() == "r0:steering"
+              and len(c.get_segments()[0]) == 2 and c.get_linestyle()[0][1] is None]
+    assert row.get_segments()[0][0][0] == 110.0          # the singleton's own value
+    fig.canvas.draw()
+    title = ax.title.get_window_extent()
+    above = [a for a in fig.axes if a.get_position().y0 > ax.get_position().y1]
+    assert title.y1 <= min(a.get_window_extent().y0 for a in above)
+
+
+def test_study_boxes_have_black_medians(tmp_path, monkeypatch):
+    from mitos_cli.draw import study
+
+    rows = [{"world": "w", "min_clearance_in": v, "c": c}
+            for c in ("a", "b") for v in (1.0, 2.0, 3.0, 4.0)]
+    seen = {}
+    monkeypatch.setattr(study, "_save", lambda fig, plt, path: seen.setdefault("fig", fig))
+    study.clearance_boxes(rows, ["w"], ["a", "b"], lambda r: r["c"], tmp_path / "c.png")
+    medians = [ln for ln in seen["fig"].axes[0].lines if len(ln.get_xdata()) == 2 and
+               ln.get_ydata()[0] == ln.get_ydata()[1] == 2.5]
+    assert len(medians) == 2 and all(ln.get_color() == "black" for ln in medians)
