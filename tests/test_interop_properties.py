@@ -126,9 +126,14 @@ def test_random_rule_bases_round_trip(rb: RuleBase, tmp_path_factory) -> None:
         # weighted average or a centroid (which do not shrink with the DOF). A writer's exact
         # rewriting (De Morgan, `not not`) may round a DOF of 1e-17 to 0 or back, so those
         # samples jump between the two; every other sample must agree.
+        # The bisector is the sample nearest half the area: where two samples tie (a set
+        # flat across the middle), a DOF that differs in its last bit picks the other one,
+        # so a bisector may move by one step of the 200-sample grid over [0, 10].
         sure = ((dof_before > BARELY) & (dof_after > BARELY)) | ((dof_before == 0)
                                                                  & (dof_after == 0))
-        np.testing.assert_allclose(after[sure], before[sure], rtol=0, atol=1e-9,
+        bisector = ("defuzzify", "bisector") in {(o.key, o.value) for o in rb.operators}
+        np.testing.assert_allclose(after[sure], before[sure], rtol=0,
+                                   atol=10 / 200 + 1e-9 if bisector else 1e-9,
                                    equal_nan=True, err_msg=text)
 
 

@@ -130,3 +130,17 @@ def test_corridors_are_carved_into_a_grid():
     free_rows = np.flatnonzero(~g.occupied.all(axis=1))
     assert free_rows.tolist() == [4, 5]                   # y from 36 to 64: centres 45 and 55
     assert np.flatnonzero(~g.occupied[4]).tolist() == list(range(1, 19))   # x from 6 to 194
+
+
+def test_one_origin_and_the_same_origin_per_beam_hit_alike_bit_for_bit():
+    rng = np.random.default_rng(3)
+    for _ in range(50):
+        o = rng.uniform(-100, 100, 2)
+        a = rng.uniform(0, 2 * math.pi, 24)
+        dirs = np.stack([np.cos(a), np.sin(a)], axis=1)
+        seg = rng.uniform(-150, 150, (20, 4))
+        seg[:5, 2] = seg[:5, 0]                           # some vertical sides
+        one = geometry.ray_hits(o, dirs, seg)
+        per_beam = geometry.ray_hits(np.tile(o, (24, 1)), dirs, seg)
+        assert one.shape == (24, 20) and one.tobytes() == per_beam.tobytes()
+        assert np.isfinite(one).any()

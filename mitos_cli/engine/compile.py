@@ -197,6 +197,7 @@ class Plan:
     all_linear: bool
     linear_rows: np.ndarray            # [L] terms evaluated by the linear kernel
     term_var: np.ndarray               # [L] their input column
+    input_rows: tuple[tuple[int, int], ...]   # [k] each input's run of term rows
     kernel: tuple[np.ndarray, ...]     # (b, s1, c, s2), each [L, 1], contiguous
     plateaus: bool                     # some linear term is 1 between a rise and a fall
     bounds: tuple[list[float], list[float]]   # lo, hi as Python floats (for one sample)
@@ -261,6 +262,9 @@ def _plan(c: CompiledRuleBase) -> Plan:
         lo_col=np.ascontiguousarray(c.universe[:, :1]),
         hi_col=np.ascontiguousarray(c.universe[:, 1:]),
         all_linear=bool(c.linear.all()), linear_rows=rows, term_var=c.term_var[rows],
+        input_rows=tuple((int(np.searchsorted(c.term_var, k)),
+                          int(np.searchsorted(c.term_var, k, side="right")))
+                         for k in range(len(c.inputs))),
         kernel=tuple(np.ascontiguousarray(k[rows, None]) for k in c.kernel),
         bounds=(c.universe[:, 0].tolist(), c.universe[:, 1].tolist()),
         plateaus=bool(((c.kernel[0] < c.kernel[2]) & (c.kernel[1] > 0) & (c.kernel[3] > 0)

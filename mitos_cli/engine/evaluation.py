@@ -169,10 +169,16 @@ def memberships(compiled: CompiledRuleBase, Xt: np.ndarray, out: np.ndarray) -> 
     plan = compiled.plan
     if len(plan.linear_rows):
         b, s1, c, s2 = plan.kernel
-        x = Xt[plan.term_var]
-        rise = np.subtract(x, b, out=out[2:2 + plan.n_terms] if plan.all_linear else None)
+        if plan.all_linear:            # each input's terms are a run of rows: no gather of x
+            rise, fall = out[2:2 + plan.n_terms], np.empty((plan.n_terms, Xt.shape[1]))
+            for v, (lo, hi) in enumerate(plan.input_rows):   # a loop over the inputs
+                np.subtract(Xt[v], b[lo:hi], out=rise[lo:hi])
+                np.subtract(c[lo:hi], Xt[v], out=fall[lo:hi])
+        else:
+            x = Xt[plan.term_var]
+            rise = np.subtract(x, b)
+            fall = np.subtract(c, x, out=x)
         rise *= s1
-        fall = np.subtract(c, x, out=x)
         fall *= s2
         np.minimum(rise, fall, out=rise)
         if plan.plateaus:
@@ -369,19 +375,31 @@ def _hedged_average(compiled: CompiledRuleBase, dof: np.ndarray, Xt: np.ndarray 
 
 
 def _constant_sums(plan, dof: np.ndarray) -> np.ndarray:
-    """``[k, b]``: each numerator and denominator row of the output layer, one at a time
-    through one ``[R, b]`` buffer that stays in cache (a loop over the few sums, never over
-    rules); a row of ones (a denominator) adds the DOFs themselves. The same products and
-    the same tree as summing ``dof[:, None] * plan.sums`` at once."""
-    buf = np.empty_like(dof)
-    out = np.empty((len(plan.sum_rows), dof.shape[1]))
+    """``[k, b]``: each numerator and denominator row of the output layer by the pairwise
+    :func:`tree_sum` over the rules (a loop over the few sums, never over rules). The first
+    halving step reads the DOFs directly, products formed in place (a row of ones, a
+    denominator, adds the DOFs themselves, with no copy); the later steps run on every sum at
+    once. The same products and the same tree as summing ``dof[:, None] * plan.sums``."""
+    R, b = dof.shape
+    if R < 2:
+        return np.multiply(dof, plan.sums[:, :, 0].T)
+    half = (R + 1) // 2
+    low = R - half                       # rules i < low pair with i + half; an odd one stays
+    S = np.empty((half, len(plan.sum_rows), b))
+    tmp = None
     for j, weights in enumerate(plan.sum_rows):
+        row = S[:, j]
         if weights is None:
-            np.copyto(buf, dof)
+            np.add(dof[:low], dof[half:], out=row[:low])
+            if low < half:
+                row[low] = dof[low]
         else:
-            np.multiply(dof, weights, out=buf)
-        out[j] = tree_sum(buf)
-    return out
+            np.multiply(dof[:half], weights[:half], out=row)
+            if tmp is None:
+                tmp = np.empty((low, b))
+            np.multiply(dof[half:], weights[half:], out=tmp)
+            np.add(row[:low], tmp, out=row[:low])
+    return tree_sum(S)
 
 
 def evaluate(compiled: CompiledRuleBase, X, *, detail: bool = True, keep_values: bool = False,

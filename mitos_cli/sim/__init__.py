@@ -24,6 +24,9 @@ API (everything in inches, seconds, degrees)::
     sim.pose, sim.speed, sim.clearance, sim.time, sim.outcome   # the state now
     sim.result()                   # the SimResult simulate() returns
 
+    results = run_lockstep(world, None, seeds=range(64), randomise=True)  # runs stepped
+                            # together: one rule evaluation per tick for all, each run's bits
+                            # those it has alone (Lockstep: the same, a tick at a time)
     runs = run_many([world], runs=20, seed=1, planner=None, workers=2)   # randomised runs
     runs.to_json()          # per world: outcome rates, each metric's mean and std
     runs.worlds[0].rate("success"), runs.worlds[0].robots   # (several robots: each one's)
@@ -32,15 +35,15 @@ Modules: ``world`` (model), ``worldfile`` (YAML loader), ``pgm`` + ``gridmap`` (
 maps), ``staticmap`` (walls from corridors or grids), ``geometry``, ``kinematics`` (tricycle),
 ``sensors`` (ray casting), ``obstacles`` (motion, randomisation), ``route`` (A*),
 ``perception`` (readings -> rule inputs), ``planner`` (the planner protocol, FuzzyPlanner),
-``loop`` (the steppable ``Simulation`` and ``simulate``, a loop over its ticks), ``runs`` (many
-runs, process pool), ``export`` (CSV, traces),
-``live`` (terminal view). Drawing lives in ``mitos_cli.draw.world``.
+``loop`` (the steppable ``Simulation`` and ``simulate``, a loop over its ticks), ``lockstep``
+(runs stepped together), ``runs`` (many runs, process pool, each worker's runs in lockstep),
+``export`` (CSV, traces), ``live`` (terminal view). Drawing lives in ``mitos_cli.draw.world``.
 """
 
 from __future__ import annotations
 
 __all__ = ["load_world", "simulate", "Simulation", "Tick", "run_many", "FuzzyPlanner", "Planner", "Percepts",
-           "SimResult"]
+           "SimResult", "Lockstep", "run_lockstep"]
 
 
 def __getattr__(name: str):
@@ -52,6 +55,10 @@ def __getattr__(name: str):
         from . import loop
 
         return getattr(loop, name)
+    if name in ("Lockstep", "run_lockstep"):
+        from . import lockstep
+
+        return getattr(lockstep, name)
     if name == "run_many":
         from .runs import run_many
 

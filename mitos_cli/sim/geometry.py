@@ -101,10 +101,14 @@ def ray_segments(origin: np.ndarray, dirs: np.ndarray, seg: np.ndarray,
 def ray_hits(origin: np.ndarray, dirs: np.ndarray, seg: np.ndarray) -> np.ndarray:
     """``[B, N]``: how far along each ray segment ``seg[N, 4]`` is hit (``inf`` if not); each
     entry depends on its ray and segment alone."""
-    B = len(dirs)
-    o = np.broadcast_to(np.asarray(origin, float), (B, 2))
-    px = seg[None, :, 0] - o[:, 0, None]
-    py = seg[None, :, 1] - o[:, 1, None]
+    o = np.asarray(origin, float)
+    if o.ndim == 1:                 # one origin: [1, N] offsets, broadcast over the beams
+        px = seg[None, :, 0] - o[0]
+        py = seg[None, :, 1] - o[1]
+    else:
+        o = np.broadcast_to(o, (len(dirs), 2))
+        px = seg[None, :, 0] - o[:, 0, None]
+        py = seg[None, :, 1] - o[:, 1, None]
     ex = seg[None, :, 2] - seg[None, :, 0]
     ey = seg[None, :, 3] - seg[None, :, 1]
     dx, dy = dirs[:, 0, None], dirs[:, 1, None]

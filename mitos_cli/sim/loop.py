@@ -401,6 +401,7 @@ class Simulation:
         self._done = self.steps <= 0
         self._hit = np.zeros(n, dtype=bool)
         self._observed: _Sensed | None = None
+        self._deciding: _Sensed | None = None
         self.record: list[Tick] = []
 
     # -- state ------------------------------------------------------------------------------
@@ -488,6 +489,16 @@ class Simulation:
     def step(self, command: np.ndarray | None = None) -> Tick:
         """Advance one tick and return what it recorded. ``command`` (``[n, 2]`` steering in
         deg and speed in in/s) drives the active robots this tick instead of the planner."""
+        tick, moves = self.decide(command)
+        if moves:
+            self.act(self.decided)
+            self.moved()
+        return tick
+
+    def decide(self, command: np.ndarray | None = None) -> tuple[Tick, bool]:
+        """The first half of :meth:`step`: observe, plan (or take ``command``), record the tick
+        and the verdict; whether the robots move now (:meth:`act`, then :meth:`moved`; runs
+        stepped in lockstep move all their robots in one batch between the two)."""
         s = self.observe()
         self._observed = None
         if command is None:
@@ -506,14 +517,25 @@ class Simulation:
         elif not self._active.any():
             self._done = True
         else:
-            self.act(s)
-            self._k += 1
-            if self._check_stuck():
-                self._stop_the_others()
-                self._done = True
-            else:
-                self._done = self._k >= self.steps
-        return tick
+            self._deciding = s
+            return tick, True
+        return tick, False
+
+    @property
+    def decided(self) -> _Sensed:
+        """The tick :meth:`decide` recorded last (what :meth:`act` moves by)."""
+        assert self._deciding is not None, "decide() first"
+        return self._deciding
+
+    def moved(self) -> None:
+        """The second half of :meth:`step`, after :meth:`act`: the next tick, or the end of
+        the run (stuck, or out of time)."""
+        self._k += 1
+        if self._check_stuck():
+            self._stop_the_others()
+            self._done = True
+        else:
+            self._done = self._k >= self.steps
 
     def _stop_the_others(self) -> None:
         """The run ends for one robot's collision or stuck: the robots still driving read
@@ -645,10 +667,23 @@ class Simulation:
     def act(self, s: _Sensed) -> None:
         """Steering-rate and acceleration limits and exact arcs, substep by substep; stopped
         robots stay put."""
-        self._x, self._y, self._h, self._v, self._steer = kinematics.step(
-            self._x, self._y, self._h, np.where(self._active, self._v, 0.0), self._steer,
-            s.command[:, 0], s.command[:, 1], self.limits, self.dt, self.world.substeps)
-        self._history.append((self._x, self._y))      # fresh arrays: never changed in place
+        self.move_to(*kinematics.step(*self.motion(s), self.limits, self.dt,
+                                      self.world.substeps))
+
+    def motion(self, s: _Sensed | None = None) -> tuple[np.ndarray, ...]:
+        """What :func:`kinematics.step` moves from, ``[n]`` each: x, y, heading, speed (0 for
+        a stopped robot), steering, and the commanded steering and speed (of ``s``, default:
+        the tick :meth:`decide` just recorded)."""
+        s = self.decided if s is None else s
+        return (self._x, self._y, self._h, np.where(self._active, self._v, 0.0), self._steer,
+                s.command[:, 0], s.command[:, 1])
+
+    def move_to(self, x: np.ndarray, y: np.ndarray, h: np.ndarray, v: np.ndarray,
+                steer: np.ndarray) -> None:
+        """The robots' state after :func:`kinematics.step` (fresh arrays, never changed in
+        place: the history keeps them)."""
+        self._x, self._y, self._h, self._v, self._steer = x, y, h, v, steer
+        self._history.append((x, y))
 
     def _check_stuck(self) -> bool:
         """A driving robot that moved less than ``STUCK_DISTANCE`` in ``STUCK_TIME`` is stuck

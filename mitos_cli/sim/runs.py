@@ -14,7 +14,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .loop import OUTCOMES, ROBOT_OUTCOMES, prepare, simulate
+from .lockstep import run_lockstep
+from .loop import OUTCOMES, ROBOT_OUTCOMES, prepare
 from .world import World
 
 METRICS = ("time_s", "path_length_in", "min_clearance_in", "mean_speed_in_s",
@@ -22,13 +23,13 @@ METRICS = ("time_s", "path_length_in", "min_clearance_in", "mean_speed_in_s",
 
 
 def _chunk(task: tuple) -> tuple[int, list[dict]]:
+    """One worker's runs of a world, stepped in lockstep (:mod:`.lockstep`: each run's bits
+    are those it has alone)."""
     index, world, planner, seeds, randomise, measure, scene = task
     scene = scene if scene is not None else prepare(world)
-    out = []
-    for seed in seeds:
-        res = simulate(world, planner, seed, randomise=randomise, scene=scene)
-        out.append({**res.summary(), **(measure(res) if measure is not None else {})})
-    return index, out
+    return index, [{**res.summary(), **(measure(res) if measure is not None else {})}
+                   for res in run_lockstep(world, planner, seeds, randomise=randomise,
+                                           scene=scene)]
 
 
 def ignore_interrupts() -> None:

@@ -1,0 +1,119 @@
+"""Runs in lockstep: independent runs of one world stepped together, tick by tick.
+
+Each tick every run still going observes on its own (sense, perceive, check: the code of a run
+alone, :class:`~mitos_cli.sim.loop.Simulation`); then the fuzzy planner's rule network is
+evaluated once for the active robots of every run (one engine batch: the engine gives each row
+the bits it gives alone), and the robots of every run move in one batch of kinematics
+(elementwise per robot). Runs that end drop out. Each run's ticks, trajectory and summary are
+bit for bit those of the same run alone, whatever the batch (``tests/test_sim_lockstep.py``).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import fields
+
+import numpy as np
+
+from . import kinematics
+from .loop import Scene, SimResult, Simulation
+from .planner import FuzzyPlanner, Planner
+from .world import World
+
+#: Runs stepped together by default: enough to make the batched calls worth their set-up,
+#: few enough that the runs' recorded ticks stay small.
+BATCH = 64
+
+
+class Lockstep:
+    """Runs of ``world`` from ``seeds`` stepped together (``randomise``: each run draws its
+    obstacle places and sensor noise from its seed, as ``simulate(..., randomise=True)``)."""
+
+    def __init__(self, world: World, planner: Planner | None = None,
+                 seeds: Sequence[int] = (), *, randomise: bool = False,
+                 scene: Scene | None = None) -> None:
+        if planner is None:
+            planner = FuzzyPlanner(None, world.behavior)
+        self.planner = planner
+        self.runs = [Simulation(world, planner, seed, randomise=randomise, scene=scene)
+                     for seed in seeds]
+
+    @property
+    def done(self) -> bool:
+        return all(run.done for run in self.runs)
+
+    def step(self) -> None:
+        """One tick of every run still going."""
+        live = [run for run in self.runs if not run.done]
+        commands = self._commands(live)
+        moving = []
+        for run, command in zip(live, commands):
+            _, moves = run.decide(command)
+            if moves:
+                moving.append(run)
+        if moving:
+            _move_together(moving)
+
+    def results(self) -> list[SimResult]:
+        """Step until every run has ended; each run's :class:`SimResult`, in seed order."""
+        while not self.done:
+            self.step()
+        return [run.result() for run in self.runs]
+
+    def _commands(self, live: list[Simulation]) -> list[np.ndarray | None]:
+        """Each run's commands ``[n, 2]`` from one evaluation of the rule network for the
+        active robots of all of them (``None``: the run plans itself, as planners other than
+        the fuzzy one do, whose rows need not be independent of the batch)."""
+        planner = self.planner
+        if not isinstance(planner, FuzzyPlanner) or not live:
+            return [None] * len(live)
+        seen = [run.observe() for run in live]
+        active = [run.active for run in live]
+        compiled = planner.compiled
+        X = np.empty((sum(int(a.sum()) for a in active), len(compiled.inputs)))
+        for j, key in enumerate(compiled.inputs):
+            X[:, j] = np.concatenate([s.inputs[key][a] for s, a in zip(seen, active)])
+        if len(X) == 0:
+            return [None] * len(live)
+        from ..engine.evaluation import evaluate
+
+        out = evaluate(compiled, X, detail=False).outputs
+        steer, speed = (out[:, compiled.outputs.index(k)] for k in ("steering", "speed"))
+        commands: list[np.ndarray | None] = []
+        row = 0
+        for run, a in zip(live, active):
+            cmd = np.zeros((run.n, 2))
+            rows = int(a.sum())
+            cmd[a, 0], cmd[a, 1] = steer[row:row + rows], speed[row:row + rows]
+            row += rows
+            commands.append(cmd)
+        return commands
+
+
+def _move_together(runs: list[Simulation]) -> None:
+    """:meth:`Simulation.act` for every robot of ``runs`` in one call of the kinematics."""
+    parts = [run.motion() for run in runs]
+    state = [np.concatenate([p[j] for p in parts]) for j in range(len(parts[0]))]
+    limits = kinematics.Limits(*(np.concatenate([getattr(run.limits, f.name) for run in runs])
+                                 for f in fields(kinematics.Limits)))
+    world = runs[0].world
+    after = kinematics.step(*state, limits, world.dt, world.substeps)
+    start = 0
+    for run in runs:
+        stop = start + run.n
+        run.move_to(*(a[start:stop] for a in after))
+        run.moved()
+        start = stop
+
+
+def run_lockstep(world: World, planner: Planner | None, seeds: Sequence[int], *,
+                 randomise: bool = False, scene: Scene | None = None,
+                 batch: int = BATCH) -> list[SimResult]:
+    """The runs of ``world`` from ``seeds``, ``batch`` at a time in lockstep: the same results,
+    bit for bit, as ``[simulate(world, planner, s, randomise=randomise, scene=scene) for s in
+    seeds]``."""
+    out: list[SimResult] = []
+    for i in range(0, len(seeds), max(1, batch)):
+        out += Lockstep(world, planner, seeds[i:i + batch], randomise=randomise,
+                        scene=scene).results()
+    return out

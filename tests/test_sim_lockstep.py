@@ -1,0 +1,65 @@
+"""Runs in lockstep give every run the bits it has alone, whatever the batch."""
+
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+
+import pytest
+
+from mitos_cli.resources import packaged_path
+from mitos_cli.sim.lockstep import Lockstep, run_lockstep
+from mitos_cli.sim.loop import prepare, simulate
+from mitos_cli.sim.planner import FuzzyPlanner, make_planner
+from mitos_cli.sim.worldfile import load_world
+
+WORLDS = ("corridor", "slalom", "moving", "intersection", "multirobot", "office", "detour",
+          "figure4")
+TINY = Path(__file__).parent / "data" / "tiny.yaml"
+
+
+def recorded(res) -> dict:
+    out = {key: getattr(res, key) for key in ("t", "pose", "speed", "steering", "command",
+                                               "ranges", "clearance", "obstacles", "active",
+                                               "progress")}
+    out.update({f"p_{k}": v for k, v in res.perceived.items()})
+    return out
+
+
+def assert_same_run(a, b) -> None:
+    assert a.ticks == b.ticks
+    for key, value in recorded(a).items():
+        other = recorded(b)[key]
+        assert value.shape == other.shape and value.tobytes() == other.tobytes(), key
+    assert a.summary() == b.summary()
+    assert [(k, i) for k, i, _ in a.replanned] == [(k, i) for k, i, _ in b.replanned]
+
+
+@pytest.mark.parametrize("name", WORLDS)
+def test_each_shipped_world_runs_alone_and_in_a_batch_alike(name):
+    world = dataclasses.replace(load_world(packaged_path("worlds", f"{name}.yaml")),
+                                time_limit=1.0)
+    planner, scene = FuzzyPlanner(None, world.behavior), prepare(world)
+    seeds = [world.seed, world.seed + 7]
+    together = run_lockstep(world, planner, seeds, randomise=True, scene=scene)
+    for seed, res in zip(seeds, together):
+        assert_same_run(simulate(world, planner, seed, randomise=True, scene=scene), res)
+
+
+def test_runs_that_end_at_different_ticks_drop_out_and_the_rest_go_on():
+    world = load_world(TINY)
+    planner, scene = FuzzyPlanner(None, world.behavior), prepare(world)
+    seeds = [3, 5]
+    alone = [simulate(world, planner, s, randomise=True, scene=scene) for s in seeds]
+    assert len({r.ticks for r in alone}) > 1              # they do end at different ticks
+    for a, b in zip(alone, run_lockstep(world, planner, seeds, randomise=True, scene=scene)):
+        assert_same_run(a, b)
+
+
+def test_a_planner_other_than_the_fuzzy_one_plans_each_run_itself():
+    world = dataclasses.replace(load_world(TINY), time_limit=1.0)
+    planner = make_planner("potential_field", world)
+    lock = Lockstep(world, planner, [1, 2], randomise=True)
+    for seed, res in zip([1, 2], lock.results()):
+        assert_same_run(simulate(world, planner, seed, randomise=True), res)
+    assert lock.done
