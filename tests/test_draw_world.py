@@ -49,3 +49,34 @@ def test_readme_main_job_installs_what_its_picture_needs():
     command = next(line for line in readme.splitlines()
                    if line.startswith("python3 -m venv") and "mitos simulate" in line)
     assert "--plot" in command and 'pip install ".[plot]"' in command, command
+
+
+def test_a_generated_field_is_not_written_over_with_its_pole_names():
+    pytest.importorskip("matplotlib")
+    from mitos_cli.draw.world import draw_run
+    from mitos_cli.sim import barn
+    from mitos_cli.sim.loop import simulate
+
+    w = barn.barn_world(0, 0.25, 3).with_changes(time_limit=0.5)
+    assert len(w.obstacles) > 12
+    fig = draw_run(simulate(w, None, w.seed))
+    names = {o.name for o in w.obstacles}
+    assert not [t for t in fig.axes[0].texts if t.get_text() in names]
+
+
+def test_in_a_crowd_only_the_obstacle_hit_is_named():
+    from types import SimpleNamespace
+
+    import numpy as np
+
+    from mitos_cli.draw.world import _labelled
+    from mitos_cli.sim import barn
+
+    w = barn.barn_world(0, 0.25, 3)
+    where = np.array([[o.x, o.y] for o in w.obstacles])[None]          # [1, O, 2]
+    hit = 7
+    pose = np.array([[[where[0, hit, 0], where[0, hit, 1], 0.0]]])     # where it struck
+    run = SimpleNamespace(world=w, outcome="collision", obstacles=where, pose=pose,
+                          robot_outcomes=("collision",))
+    assert _labelled(run) == {hit}
+    assert _labelled(SimpleNamespace(**{**vars(run), "outcome": "success"})) == set()

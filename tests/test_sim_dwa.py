@@ -115,3 +115,28 @@ def test_boxed_in_it_brakes_and_the_window_bounds_the_wheel():
                                0.05)
     assert speed[0] == 0.0
     assert abs(steer[0] - 90.0) <= robot.max_steering_rate * DWAParams().window_s + 1e-9
+
+
+def test_the_costmap_remembers_behind_the_fan_and_clears_what_a_beam_sees_through():
+    from mitos_cli.sim.dwa import Costmap
+
+    p = DWAParams()
+    angles = np.deg2rad(np.linspace(45, -45, 19))            # a forward fan
+    cm = Costmap.empty()
+    ranges = np.full(19, 150.0)
+    ranges[9] = 40.0                                          # a pole dead ahead
+    cm.update(p, np.array([0.0, 0.0, 0.0]), ranges, angles, 150.0)
+    assert len(cm.points) and np.allclose(cm.points[:, 0], 40.0, atol=1.0)
+    cm.update(p, np.array([0.0, 0.0, math.pi]), np.full(19, 150.0), angles, 150.0)
+    assert len(cm.points)                                     # turned away: still there
+    cm.update(p, np.array([0.0, 0.0, 0.0]), np.full(19, 150.0), angles, 150.0)
+    assert not len(cm.points)                                 # seen through: cleared
+
+
+def test_a_fresh_planner_remembers_nothing_and_runs_replay(corridor_run):
+    world, res = corridor_run
+    planner = DWAPlanner.for_world(world)
+    first = simulate(world, planner)
+    assert not planner._maps                                  # the run used a fresh copy
+    again = simulate(world, planner)
+    assert np.array_equal(first.pose, again.pose) and np.array_equal(first.pose, res.pose)

@@ -298,3 +298,13 @@ def test_a_robot_with_no_map_maps_and_replans_round_a_corner(tmp_path):
     again = simulate(blind)
     assert np.array_equal(res.pose, again.pose)              # bit for bit
 
+
+@pytest.mark.parametrize("width", [23, 24])
+def test_a_door_with_an_inch_to_spare_is_found_wherever_its_centre_falls(tmp_path, width):
+    """The route's nodes sit at the clearest cell of their block, so a door the robot fits
+    with half an inch to spare on each side is taken, whatever its offset from the lattice."""
+    free = door_map(width)
+    world = load_world(grid_world(tmp_path, free, start=(40, 30), goal=(380, 110)))
+    pts = dense(prepare(world).routes[0].points)
+    assert len(pts[(pts[:, 0] > 195) & (pts[:, 0] < 225)])
+    assert occupied_distance(pts, free) >= 11.0 - 1e-9

@@ -8,7 +8,10 @@ import pytest
 from mitos_cli.errors import WorldError
 from mitos_cli.sim import mrpb
 from mitos_cli.sim.gridmap import INCH_PER_M
+from mitos_cli.sim.loop import prepare
+from mitos_cli.sim.route import NarrowPassage
 from mitos_cli.sim.scores import BARN_SPEED_IN_S, barn_score, mrpb_safety, optimal_time
+from mitos_cli.sim.world import Robot
 
 
 def test_t_opt_is_the_path_over_two_metres_a_second():
@@ -87,3 +90,42 @@ def test_a_partially_unknown_scenario_is_given_its_map_and_drives_in_the_complet
     [w] = mrpb.scenario_worlds(tmp_path, "office02_partially_unknown")
     assert w.knows == "given"
     assert w.grid.occupied.sum() > w.given.occupied.sum()     # the truth holds the furniture
+
+
+def _scenario(root, name, pixels, test="test 1: start (-0.6, 0, 0) -> goal (0.6, 0, 0)\n"):
+    folder = root / name
+    folder.mkdir()
+    (folder / "map.pgm").write_bytes(b"P5\n40 40\n255\n" + pixels.astype(np.uint8).tobytes())
+    (folder / "map.yaml").write_text("image: map.pgm\nresolution: 0.05\norigin: [-1, -1, 0]\n"
+                                     "negate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n")
+    (folder / "tests.txt").write_text(test)
+
+
+def test_the_given_maps_unknown_cells_are_planned_through_and_the_truths_are_walls(tmp_path):
+    """MRPB's given maps draw the missing furniture's area unknown (205), goals inside it."""
+    truth = np.full((40, 40), 254)
+    truth[0, :] = truth[-1, :] = truth[:, 0] = truth[:, -1] = 0
+    truth[:3, :] = truth[-3:, :] = 205                   # unknown beyond the walls: blocked
+    given = truth.copy()
+    given[10:30, 18:] = 205                              # where the furniture stands
+    _scenario(tmp_path, "office02", truth)
+    _scenario(tmp_path, "office02_partially_unknown", given)
+    [w] = mrpb.scenario_worlds(tmp_path, "office02_partially_unknown")
+    assert not w.given.occupied[10:30, 18:-1].any()      # unknown: free to plan through
+    assert w.grid.occupied[-3:].all() and w.grid.occupied[:3].all()
+    route = prepare(w).routes[0]
+    assert route.length == pytest.approx(1.2 * INCH_PER_M, abs=1.0)
+
+
+def test_mrpb_drives_a_robot_of_mrpbs_size_through_its_22_in_gap(tmp_path):
+    """track's only way is 0.56 m wide: MRPB's Pioneer passes it, the packaged tricycle not."""
+    pixels = np.full((40, 40), 254)
+    pixels[0, :] = pixels[-1, :] = pixels[:, 0] = pixels[:, -1] = 0
+    pixels[:, 20] = 0
+    pixels[15:26, 20] = 254                             # an 11-pixel gap: 0.55 m, 21.7 in
+    _scenario(tmp_path, "track", pixels)
+    [w] = mrpb.scenario_worlds(tmp_path, "track")
+    assert w.agents[0].robot == mrpb.PIONEER
+    assert prepare(w).routes[0].length > 1.2 * INCH_PER_M
+    with pytest.raises(NarrowPassage, match="22 in wide"):
+        prepare(mrpb.scenario_worlds(tmp_path, "track", robot=Robot())[0])

@@ -126,6 +126,7 @@ def draw_run(result, path: str | Path | None = None, *, footprint_every: float =
     # obstacles: where they started (faint, for moving ones), their tracks with time marks,
     # where they ended
     track = result.obstacles                                  # [T, O, 2]
+    named = _labelled(result)
     t_end = float(result.t[-1]) if len(result.t) else 0.0
     step = time_step(t_end)
     near = 0.04 * max(xmax - xmin, ymax - ymin)
@@ -148,8 +149,9 @@ def draw_run(result, path: str | Path | None = None, *, footprint_every: float =
                 patch = Polygon(rect_corners(cx, cy, np.deg2rad(o.angle), o.length, o.width))
             patch.set(facecolor="#b5524a", edgecolor="#5c1f1a", alpha=alpha, lw=0.8)
             ax.add_patch(patch)
-        ax.annotate(o.name, xy[-1], xytext=(6, 6), textcoords="offset points", fontsize=8,
-                    color="#5c1f1a")
+        if j in named:
+            ax.annotate(o.name, xy[-1], xytext=(6, 6), textcoords="offset points",
+                        fontsize=8, color="#5c1f1a")
 
     # robots: footprints at intervals, path coloured by speed, start and goal
     # one robot: its path coloured by speed; several: a colour and a legend entry each
@@ -209,3 +211,25 @@ def draw_run(result, path: str | Path | None = None, *, footprint_every: float =
                  f"(seed {result.seed}, min clearance {m['min_clearance_in']:.1f} in)",
                  fontsize=9)
     return finish(fig, path, show)
+
+
+LABEL_LIMIT = 12        # obstacles named on a plot; beyond this only the one hit is
+
+
+def _labelled(result) -> set[int]:
+    """The obstacles whose names help: all of a few, else only the one a robot hit (nearest
+    to where it stopped), so a generated field of a hundred poles is not written over."""
+    obstacles = result.world.obstacles
+    if len(obstacles) <= LABEL_LIMIT:
+        return set(range(len(obstacles)))
+    if result.outcome != "collision" or not len(result.obstacles) or not len(result.pose):
+        return set()
+    where = result.obstacles[-1]                                  # [O, 2]
+    size = np.array([o.radius if o.shape == "circle" else np.hypot(o.length, o.width) / 2
+                     for o in obstacles])
+    out = set()
+    for i, r in enumerate(result.robot_outcomes):
+        if r == "collision":
+            gap = np.hypot(*(where - result.pose[-1, i, :2]).T) - size
+            out.add(int(np.argmin(gap)))
+    return out

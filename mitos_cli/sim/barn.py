@@ -4,7 +4,11 @@ After Perille et al., "Benchmarking Metric Ground Navigation" (BARN, 2020): a fi
 cells of 0.15 m is filled at random with a *fill percentage*, then smoothed by a cellular
 automaton for a number of *smoothing iterations* (a cell with at least ``FILL_THRESHOLD`` of its
 8 neighbours filled becomes filled, one with at most ``CLEAR_THRESHOLD`` becomes free, the rest
-keep their state); a field with no way through for the robot is drawn again. The robot is
+keep their state); a field with no way through for the robot is drawn again. "A way through"
+is the route planner's own: the least clearance a route accepts for the robot
+(:func:`.route.clearances`: half its width and its safety margin), kept by a route that
+:func:`.route.grid_route` finds on the field drawn as a map, so every known field has a route
+and the unknown field's poles leave the robot that same way. The robot is
 Jackal-sized (20 x 17 in), starts in front of the field, and must reach a goal 10 m ahead
 (within 1 m) in 100 s, as BARN's protocol has it.
 
@@ -39,6 +43,8 @@ from pathlib import Path
 import numpy as np
 
 from .gridmap import INCH_PER_M
+from .route import NarrowPassage, clearances, grid_route
+from .staticmap import StaticMap
 from .world import Agent, Corridor, Goal, Grid, Obstacle, Pose, Randomise, Robot, Sensors, World
 
 M = INCH_PER_M                 # in per metre
@@ -55,8 +61,7 @@ FILL_THRESHOLD = 5             # filled neighbours that fill a cell
 CLEAR_THRESHOLD = 1            # filled neighbours (or fewer) that clear a cell
 FILLS = (0.15, 0.20, 0.25, 0.30)
 SMOOTHINGS = (2, 3, 4)
-PASSAGE_MARGIN = 1.0           # in: the way through keeps half the width plus this off poles
-MAX_DRAWS = 200                # fields drawn before giving up on a way through
+MAX_DRAWS = 2000               # fields drawn before giving up on a way through
 
 JACKAL = Robot(wheelbase=13.0, length=20.0, width=17.0)   # 0.508 x 0.430 m
 LIDAR = Sensors(layout="fan", count=109, fov=270.0, cone=0.0, range=150.0, noise=0.5)
@@ -148,18 +153,37 @@ def way_through(filled: np.ndarray, clearance: float) -> bool:
         reached = grown
 
 
+def routable(filled: np.ndarray, robot: Robot = JACKAL) -> bool:
+    """Whether the route planner finds a way from the start to the goal through the field
+    drawn as a map, keeping at least the least clearance it accepts for ``robot``."""
+    g = grid(filled)
+    rows, cols = g.occupied.shape
+    bounds = (g.origin[0], g.origin[1], g.origin[0] + cols * g.resolution,
+              g.origin[1] + rows * g.resolution)
+    static = StaticMap(np.zeros((0, 4)), np.zeros((0, 4, 2)), g, bounds)
+    asked, least = clearances(robot)
+    try:
+        grid_route(static, Pose(0.0, 0.0), Goal(GOAL_AHEAD, 0.0), asked, minimum=least,
+                   explain=False)
+    except NarrowPassage:
+        return False
+    return True
+
+
 def field(seed: int, fill: float = 0.25, smoothing: int = 3, robot: Robot = JACKAL) -> Field:
-    """A field with a way through for ``robot`` (its half width plus ``PASSAGE_MARGIN``): drawn
-    from ``SeedSequence(seed)`` until one has it."""
+    """A field with a way through for ``robot`` (see the module docstring): drawn from
+    ``SeedSequence(seed)`` until one has it. The raster test of a disc of the least clearance
+    (:func:`way_through`) is the quick, exact geometric filter; the route planner's own
+    search (:func:`routable`) has the last word, so the two cannot disagree."""
     if not 0.0 <= fill < 1.0:
         raise ValueError(f"fill must lie in [0, 1), not {fill}")
     if smoothing < 0:
         raise ValueError(f"smoothing must be at least 0, not {smoothing}")
     rng = np.random.default_rng(np.random.SeedSequence(seed))
-    clearance = robot.width / 2 + PASSAGE_MARGIN
+    clearance = clearances(robot)[1]
     for draw in range(1, MAX_DRAWS + 1):
         f = smooth(rng.random((CELLS, CELLS)) < fill, smoothing)
-        if way_through(f, clearance):
+        if way_through(f, clearance) and routable(f, robot):
             return Field(f, fill, smoothing, seed, draw)
     raise ValueError(f"no field with a way through in {MAX_DRAWS} draws "
                      f"(fill {fill}, smoothing {smoothing}): lower the fill")
@@ -188,15 +212,22 @@ def obstacles(filled: np.ndarray) -> tuple[Obstacle, ...]:
     return tuple(out)
 
 
+MAP_FINE = 4                   # map cells per field cell side (0.0375 m, 1.48 in)
+
+
 def grid(filled: np.ndarray) -> Grid:
-    """The walls and the poles as an occupancy grid of 0.15 m cells (row 0 at the bottom)."""
+    """The walls and the poles as an occupancy grid (row 0 at the bottom) of cells a quarter
+    of a pole's side: the same squares, on cells fine enough for the route to find a way the
+    robot fits with an inch to spare (:func:`routable`)."""
     before = int(np.ceil((BEHIND + FIELD_AHEAD) / CELL))     # columns before the field
     total = before + int(np.ceil((GOAL_AHEAD + BEYOND - FIELD_AHEAD) / CELL))
     occ = np.zeros((CELLS + 2, total), dtype=bool)
     occ[0, :] = occ[-1, :] = True                      # the side walls
     occ[1:-1, before:before + CELLS] = filled
     origin = (FIELD_AHEAD - before * CELL, -FIELD / 2 - CELL)
-    return Grid(occ, CELL, (round(origin[0], 6), round(origin[1], 6)), source="barn")
+    fine = np.kron(occ, np.ones((MAP_FINE, MAP_FINE), dtype=bool))
+    return Grid(fine, CELL / MAP_FINE, (round(origin[0], 6), round(origin[1], 6)),
+                source="barn")
 
 
 def barn_world(seed: int, fill: float = 0.25, smoothing: int = 3, *, known: bool = False,

@@ -74,6 +74,15 @@ class DWAParams:
     collision_in: float = 3.0       # in: closer than this to an echo counts as a collision
     echo_points: int = 3            # points per echo, spread over the beam's share of the ring
     window_s: float | None = 0.25   # s the window spans (None: one control period, the tick)
+    # the local costmap (MRPB's move_base: a rolling window of 5.5 m at 0.05 m, an obstacle
+    # layer that marks echoes within obstacle_range 3 m and clears along each beam)
+    memory: bool = True             # remember echoes (False: the current scan only)
+    memory_cell_in: float = 0.05 / 0.0254   # one remembered point per cell (resolution)
+    memory_window_in: float = 2.75 / 0.0254  # kept within half the rolling window (5.5 m)
+    mark_range_in: float = 3.0 / 0.0254     # echoes nearer than this are marked
+    # recovery (move_base's clear-costmap recovery): after this long with no admissible
+    # trajectory, the memory is cleared to the current scan (an aggressive reset)
+    recovery_s: float = 2.0
 
 
 def _window(current: np.ndarray, step: np.ndarray, lo: np.ndarray, hi: np.ndarray,
@@ -165,13 +174,42 @@ def _scaled(x: np.ndarray, ok: np.ndarray) -> np.ndarray:
 
 def dwa_command(params: DWAParams, target: np.ndarray, speed: np.ndarray,
                 steering: np.ndarray, ranges: np.ndarray, angles: np.ndarray,
-                max_range: float, robot, dt: float) -> tuple[np.ndarray, np.ndarray]:
+                max_range: float, robot, dt: float,
+                memory: list[np.ndarray] | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Commanded (wheel angle [n] deg, speed [n] in/s) for ``n`` robots at once.
 
     ``target [n, 2]`` the route point ahead in the robot frame (in, x ahead, y left);
     ``speed``/``steering [n]`` the current ones; ``ranges [n, B]`` the readings at beam
-    ``angles [B]`` (rad, CCW); ``robot`` the footprint and limits; ``dt`` the control period.
+    ``angles [B]`` (rad, CCW); ``robot`` the footprint and limits; ``dt`` the control period;
+    ``memory``: each robot's remembered points in its frame (:class:`Costmap`), which then
+    stand for the echoes nearer than ``mark_range_in``.
     """
+    out_s, out_v, _ = _command(params, target, speed, steering, ranges, angles, max_range,
+                               robot, dt, memory)
+    return out_s, out_v
+
+
+def _obstacles(params: DWAParams, ranges: np.ndarray, angles: np.ndarray, max_range: float,
+               memory: list[np.ndarray] | None) -> tuple[np.ndarray, np.ndarray]:
+    """Obstacle points ``[n, P, 2]`` in each robot's frame and which are real ``[n, P]``: the
+    current echoes, or the remembered points and the echoes beyond the marking range."""
+    points, seen = echo_points(ranges, angles, max_range, params.echo_points)
+    if memory is None:
+        return points, seen
+    seen = seen & (np.repeat(ranges, params.echo_points, axis=1) >= params.mark_range_in)
+    m = max((len(x) for x in memory), default=0)
+    extra = np.zeros((len(memory), m, 2))
+    real = np.zeros((len(memory), m), dtype=bool)
+    for i, x in enumerate(memory):
+        extra[i, :len(x)] = x
+        real[i, :len(x)] = True
+    return np.concatenate([points, extra], axis=1), np.concatenate([seen, real], axis=1)
+
+
+def _command(params: DWAParams, target: np.ndarray, speed: np.ndarray, steering: np.ndarray,
+             ranges: np.ndarray, angles: np.ndarray, max_range: float, robot, dt: float,
+             memory: list[np.ndarray] | None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`dwa_command`, and which robots had no admissible trajectory."""
     p = params
     n = len(speed)
     full = np.ones(n)
@@ -184,7 +222,7 @@ def dwa_command(params: DWAParams, target: np.ndarray, speed: np.ndarray,
     v = np.repeat(vs, W, axis=1)                                        # [n, S] speed-major
     s = np.tile(ss, (1, V))
     poses = rollouts(speed, steering, v, s, robot, p.horizon_s, p.rollout_steps)
-    points, seen = echo_points(ranges, angles, max_range, p.echo_points)
+    points, seen = _obstacles(p, ranges, angles, max_range, memory)
     # an echo farther than any rollout's end plus the body and the clearance cap cannot
     # change a score: leave it out (most of a corridor's far walls)
     reach = vs[:, -1] * p.horizon_s + np.hypot(robot.length, robot.width) / 2 \
@@ -220,15 +258,65 @@ def dwa_command(params: DWAParams, target: np.ndarray, speed: np.ndarray,
     out_s = np.where(stuck, s[rows, np.argmax(np.where(np.isfinite(room), room, 1e9), axis=1)],
                      s[rows, best])
     out_v = np.where(stuck, 0.0, v[rows, best])
-    return out_s, out_v
+    return out_s, out_v, stuck
+
+
+@dataclass
+class Costmap:
+    """What one robot's DWA remembers: echo points in the world frame, one per cell, marked
+    when seen and cleared when a later beam passes through them (ROS's obstacle layer)."""
+
+    points: np.ndarray                 # [M, 2] world frame (in)
+    blocked_s: float = 0.0             # how long no trajectory has been admissible
+
+    @classmethod
+    def empty(cls) -> Costmap:
+        return cls(np.zeros((0, 2)))
+
+    def update(self, params: DWAParams, pose: np.ndarray, ranges: np.ndarray,
+               angles: np.ndarray, max_range: float) -> None:
+        """Clear what the beams now see through, mark what they hit, keep the window."""
+        x, y, h = pose
+        c, s = np.cos(h), np.sin(h)
+        pts = self.points
+        if len(pts):
+            rel = pts - (x, y)
+            dist = np.hypot(rel[:, 0], rel[:, 1])
+            bearing = np.arctan2(rel[:, 1], rel[:, 0]) - h
+            diff = np.angle(np.exp(1j * (bearing[:, None] - angles[None, :])))
+            beam = np.argmin(np.abs(diff), axis=1)
+            spacing = 2 * np.pi / len(angles) if len(angles) > 1 else np.pi
+            if len(angles) > 1:
+                spacing = float(np.min(np.abs(np.diff(np.unwrap(angles))))) or spacing
+            covered = np.abs(diff[np.arange(len(pts)), beam]) <= spacing / 2
+            through = covered & (ranges[beam] > dist + params.memory_cell_in)
+            near = np.maximum(np.abs(rel[:, 0]), np.abs(rel[:, 1])) <= params.memory_window_in
+            pts = pts[~through & near]
+        local, seen = echo_points(ranges[None], angles, max_range, params.echo_points)
+        local = local[0][seen[0] & (np.repeat(ranges, params.echo_points)
+                                    < params.mark_range_in)]
+        new = np.stack([x + c * local[:, 0] - s * local[:, 1],
+                        y + s * local[:, 0] + c * local[:, 1]], axis=1)
+        both = np.concatenate([new, pts])             # newest first: it wins its cell
+        cells = np.floor(both / params.memory_cell_in).astype(np.int64)
+        _, first = np.unique(cells, axis=0, return_index=True)
+        self.points = both[np.sort(first)]
+
+    def local(self, pose: np.ndarray) -> np.ndarray:
+        """The remembered points ``[M, 2]`` in the robot's frame (x ahead, y left)."""
+        x, y, h = pose
+        c, s = np.cos(h), np.sin(h)
+        rel = self.points - (x, y)
+        return np.stack([c * rel[:, 0] + s * rel[:, 1], -s * rel[:, 0] + c * rel[:, 1]], axis=1)
 
 
 class DWAPlanner:
-    """The dynamic window as a :class:`~mitos_cli.sim.planner.Planner` (picklable, stateless).
+    """The dynamic window as a :class:`~mitos_cli.sim.planner.Planner` (picklable).
 
     ``robot`` gives the footprint and the limits, ``dt`` the control period (the world's tick);
     in a world of several robots every robot is taken to be this one, as the potential field
-    does.
+    does. Its memory (:class:`Costmap`, one per robot) lives for one run: the simulator asks
+    for a :meth:`fresh` planner at the start of every run, so runs replay bit for bit.
     """
 
     name = "dwa"
@@ -239,10 +327,41 @@ class DWAPlanner:
         self.sensor_range = float(sensor_range)
         self.dt = float(dt)
         self.params = params or DWAParams()
+        self._maps: dict[int, Costmap] = {}
 
     @classmethod
     def for_world(cls, world, params: DWAParams | None = None) -> DWAPlanner:
         return cls(world.agents[0].robot, world.sensors.range, world.dt, params)
+
+    def fresh(self) -> DWAPlanner:
+        """The same planner with nothing remembered (a run's start)."""
+        return DWAPlanner(self.robot, self.sensor_range, self.dt, self.params)
+
+    def _memory(self, p) -> list[np.ndarray] | None:
+        """Each robot's costmap brought up to date with its readings, in its frame."""
+        if not self.params.memory:
+            return None
+        robots = range(len(p.pose)) if p.robots is None else p.robots.tolist()
+        angles = np.asarray(p.beam_angles, float)
+        out = []
+        for row, i in enumerate(robots):
+            cm = self._maps.setdefault(int(i), Costmap.empty())
+            cm.update(self.params, p.pose[row], np.asarray(p.ranges[row], float), angles,
+                      self.sensor_range)
+            out.append(cm.local(p.pose[row]))
+        return out
+
+    def _recover(self, p, stuck: np.ndarray) -> None:
+        """move_base's clear-costmap recovery: blocked for ``recovery_s``, a robot forgets
+        all but what its current scan shows."""
+        if not self.params.memory:
+            return
+        robots = range(len(p.pose)) if p.robots is None else p.robots.tolist()
+        for row, i in enumerate(robots):
+            cm = self._maps[int(i)]
+            cm.blocked_s = cm.blocked_s + self.dt if stuck[row] else 0.0
+            if cm.blocked_s >= self.params.recovery_s:
+                cm.points, cm.blocked_s = np.zeros((0, 2)), 0.0
 
     def plan(self, p) -> tuple[np.ndarray, np.ndarray]:
         n = len(p.pose)
@@ -261,6 +380,9 @@ class DWAPlanner:
         target = target * scale[:, None]
         steering = (np.full(n, self.robot.steering_straight) if p.steering is None
                     else np.asarray(p.steering, float))
-        return dwa_command(self.params, target, np.asarray(p.speed, float), steering,
-                           np.asarray(p.ranges, float), np.asarray(p.beam_angles, float),
-                           self.sensor_range, self.robot, self.dt)
+        out_s, out_v, stuck = _command(
+            self.params, target, np.asarray(p.speed, float), steering,
+            np.asarray(p.ranges, float), np.asarray(p.beam_angles, float), self.sensor_range,
+            self.robot, self.dt, self._memory(p))
+        self._recover(p, stuck)
+        return out_s, out_v

@@ -33,6 +33,7 @@ from .geometry import (
 )
 from .planner import Percepts, Planner
 from .route import Route, grid_route, plan_route
+from .route import clearances as route_clearances
 from .staticmap import StaticMap, build_static
 from .world import Agent, World
 
@@ -58,14 +59,9 @@ class Scene:
 
 
 def clearances(world: World, agent: Agent) -> tuple[float, float]:
-    """The clearance (in) a route asks for (half the width, the safety margin and 4 in), and
-    the least it accepts where nothing wider leads to the goal (half the width and the margin,
-    or the world's ``route: {min_clearance}``)."""
-    r = agent.robot
-    least = r.width / 2 + r.safety_margin
-    if world.min_clearance is not None:
-        least = world.min_clearance
-    return max(r.width / 2 + r.safety_margin + 4.0, least), least
+    """The clearance (in) ``agent``'s route asks for and the least it accepts
+    (:func:`.route.clearances`, with the world's ``route: {min_clearance}``)."""
+    return route_clearances(agent.robot, world.min_clearance)
 
 
 def prepare(world: World) -> Scene:
@@ -345,6 +341,9 @@ class Simulation:
             world = obs_mod.randomised(world, self._streams[0])
         self.world = world
         self.scene = self._given_scene or prepare(world)
+        fresh = getattr(self.planner, "fresh", None)     # a planner with a memory: empty it
+        if fresh is not None:
+            self.planner = fresh()
         self._setup_constants()
         self._setup_state()
         return self
@@ -661,7 +660,7 @@ class Simulation:
             idx = np.flatnonzero(self._active)
             sub = Percepts({key: val[idx] for key, val in s.inputs.items()}, s.ranges[idx],
                            self.angles, s.pose[idx], self._v[idx], s.targets[idx],
-                           self._goals[idx], self._steer[idx])
+                           self._goals[idx], self._steer[idx], idx)
             c_steer, c_speed = self.planner.plan(sub)
             cmd[idx, 0], cmd[idx, 1] = c_steer, c_speed
 

@@ -6,7 +6,10 @@ steering (deg, 90 = straight, below 90 = left) and speed (in/s) as arrays ``[n]`
 limits (steering range and rate, top speed, acceleration) are applied afterwards by the
 kinematics, so a planner may ask for anything. A planner must be a pure function of its
 percepts (keep no hidden state, or the simulation is no longer reproducible from the trace) and
-picklable (``run_many`` sends it to worker processes).
+picklable (``run_many`` sends it to worker processes). A planner that remembers within a run
+(DWA's costmap) has a method ``fresh()`` giving a copy with nothing remembered: the simulator
+calls it at the start of every run, so what it remembers is a function of the run's own
+percepts and runs still replay bit for bit.
 
 :class:`FuzzyPlanner` evaluates a compiled behavior of a rule base on the fuzzy inputs, one batch
 for all robots. A baseline (a potential field, say) implements the same ``plan`` using
@@ -43,6 +46,8 @@ class Percepts:
     goal: np.ndarray               # [n, 2] goal position (in)
     steering: np.ndarray | None = None   # [n] the wheel's current angle (deg), for planners
                                          # that search the commands reachable from it (DWA)
+    robots: np.ndarray | None = None     # [n] which robot of the world each row is (rows
+                                         # are the robots still driving)
 
 
 class Planner(Protocol):

@@ -17,7 +17,7 @@ import numpy as np
 from ..errors import WorldError
 from .distance import distance_transform
 from .staticmap import StaticMap
-from .world import Corridor, Goal, Pose
+from .world import Corridor, Goal, Pose, Robot
 
 
 @dataclass(frozen=True)
@@ -216,6 +216,19 @@ class Clearance:
         out[inside] = np.maximum(self.dist[r, c] - off - res / 2, 0.0)
         return out
 
+    def cells(self, points: np.ndarray) -> np.ndarray:
+        """The clearance (in) of the centre of the cell holding each point ``[P, 2]`` (what
+        a route node there keeps; 0 outside the grid)."""
+        pts = np.atleast_2d(np.asarray(points, float))
+        res, (ox, oy) = self.resolution, self.origin
+        col = np.floor((pts[:, 0] - ox) / res).astype(np.int64)
+        row = np.floor((pts[:, 1] - oy) / res).astype(np.int64)
+        rows, cols = self.dist.shape
+        inside = (row >= 0) & (row < rows) & (col >= 0) & (col < cols)
+        out = np.zeros(len(pts))
+        out[inside] = np.maximum(self.dist[row[inside], col[inside]] - res / 2, 0.0)
+        return out
+
     def along(self, a: np.ndarray, b: np.ndarray) -> float:
         """The smallest clearance on the segment a-b, sampled every half cell."""
         n = max(2, int(math.ceil(math.dist(a, b) / (self.resolution / 2))) + 1)
@@ -259,15 +272,18 @@ class NarrowPassage(WorldError):
     """The only way to the goal is narrower than the robot needs (names the narrowest place)."""
 
 
-def _widest_way(free_c: np.ndarray, s: tuple[int, int], t: tuple[int, int]):
-    """The path from ``s`` to ``t`` whose narrowest cell is widest (a bottleneck Dijkstra over
-    the clearance ``free_c[R, C]``): that narrowest cell and its clearance, or None."""
+def _widest_way(free_c: np.ndarray, s: tuple[int, int], t: tuple[int, int],
+                edge: np.ndarray | None = None):
+    """The path from ``s`` to ``t`` whose narrowest place is widest (a bottleneck Dijkstra over
+    the clearance ``free_c[R, C]`` of the nodes and ``edge[8, R, C]`` of the steps between
+    them): the node at that narrowest place and its clearance, or None."""
     R, C = free_c.shape
     best = np.full(R * C, -1.0)
     start = s[0] * C + s[1]
     best[start] = free_c[s]
     heap = [(-best[start], start)]
     where = {start: start}
+    steps = [(dr, dc) for dr in (-1, 0, 1) for dc in (-1, 0, 1) if dr or dc]
     while heap:
         neg, node = heapq.heappop(heap)
         if -neg < best[node]:
@@ -275,17 +291,50 @@ def _widest_way(free_c: np.ndarray, s: tuple[int, int], t: tuple[int, int]):
         if node == t[0] * C + t[1]:
             return divmod(where[node], C), -neg
         r, c = divmod(node, C)
-        for dr in (-1, 0, 1):
-            for dc in (-1, 0, 1):
-                rr, cc = r + dr, c + dc
-                if (dr or dc) and 0 <= rr < R and 0 <= cc < C:
-                    m = min(-neg, free_c[rr, cc])
-                    nxt = rr * C + cc
-                    if m > best[nxt]:
-                        best[nxt] = m
-                        where[nxt] = where[node] if free_c[rr, cc] >= -neg else nxt
-                        heapq.heappush(heap, (-m, nxt))
+        for m, (dr, dc) in enumerate(steps):
+            rr, cc = r + dr, c + dc
+            if 0 <= rr < R and 0 <= cc < C:
+                here = free_c[rr, cc] if edge is None else min(free_c[rr, cc], edge[m, r, c])
+                width = min(-neg, here)
+                nxt = rr * C + cc
+                if width > best[nxt]:
+                    best[nxt] = width
+                    where[nxt] = where[node] if here >= -neg else nxt
+                    heapq.heappush(heap, (-width, nxt))
     return None
+
+
+ROOM = 4.0              # in a route asks for beyond the least it accepts, where it can
+
+
+def clearances(robot: Robot, min_clearance: float | None = None) -> tuple[float, float]:
+    """What "the robot fits" means, for the route planner and the worlds that promise a way:
+    the clearance (in) a route asks for (half the width, the safety margin and ``ROOM``) and
+    the least it accepts where nothing wider leads to the goal (half the width and the
+    margin, or a world's ``route: {min_clearance}``)."""
+    least = robot.width / 2 + robot.safety_margin
+    if min_clearance is not None:
+        least = min_clearance
+    return max(robot.width / 2 + robot.safety_margin + ROOM, least), least
+
+
+def _nodes(dist: np.ndarray, k: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """One node per block of ``k`` x ``k`` cells, at the block's clearest cell (the one
+    nearest the block's middle among equals): its row, column ``[R, C]`` and distance. A node
+    fixed at the block's middle would miss a passage's centre line by up to half a block and
+    refuse a passage the robot fits with a few inches to spare."""
+    rows, cols = dist.shape
+    R, C = -(-rows // k), -(-cols // k)
+    padded = np.full((R * k, C * k), -np.inf)
+    padded[:rows, :cols] = dist
+    off = np.arange(k) - (k - 1) / 2
+    tie = 1e-6 * np.hypot(off[:, None], off[None, :])          # prefer the middle
+    blocks = padded.reshape(R, k, C, k).transpose(0, 2, 1, 3) - tie
+    best = blocks.reshape(R, C, k * k).argmax(axis=2)
+    br, bc = np.divmod(best, k)
+    fr = np.arange(R)[:, None] * k + br
+    fc = np.arange(C)[None, :] * k + bc
+    return fr, fc, padded[fr, fc]
 
 
 NARROW_COST = 20.0      # extra cost per step (in steps) of a node closer than the asked clearance
@@ -313,17 +362,16 @@ def grid_route(static: StaticMap, start: Pose, goal: Goal, clearance: float,
     k = max(1, int(round(cell / g.resolution)))
     rows, cols = occ.shape
     R, C = -(-rows // k), -(-cols // k)
-    fr = np.minimum(np.arange(R) * k + k // 2, rows - 1)
-    fc = np.minimum(np.arange(C) * k + k // 2, cols - 1)
-    node_c = field.dist[np.ix_(fr, fc)] - g.resolution / 2     # clearance at each node (in)
+    fr, fc, node_c = _nodes(field.dist, k)
+    node_c = node_c - g.resolution / 2                         # clearance at each node (in)
     size = k * g.resolution
 
     def cell_of(x: float, y: float) -> tuple[int, int]:
         return (int((y - g.origin[1]) // size), int((x - g.origin[0]) // size))
 
     def centre(rc: tuple[int, int]) -> tuple[float, float]:
-        return (g.origin[0] + (fc[rc[1]] + 0.5) * g.resolution,
-                g.origin[1] + (fr[rc[0]] + 0.5) * g.resolution)
+        return (g.origin[0] + (fc[rc] + 0.5) * g.resolution,
+                g.origin[1] + (fr[rc] + 0.5) * g.resolution)
 
     s, t = cell_of(start.x, start.y), cell_of(goal.x, goal.y)
     for rc, what in ((s, "start"), (t, "goal")):
@@ -345,28 +393,69 @@ def grid_route(static: StaticMap, start: Pose, goal: Goal, clearance: float,
         near = (np.hypot(rr - s[0], cc - s[1]) * size <= leave) & (node_c[rr, cc] > 0)
         blocked[rr[near], cc[near]] = False
 
+    # an edge between two nodes keeps the floor too (nodes sit at their block's clearest
+    # cell, so two clear nodes may face each other across a thin wall); edges that leave the
+    # start, reach the goal or move off within `leave` are exempt, as those nodes are
+    edge = _edge_clearance(field, centre, (R, C), moves)
+    loose = ~blocked & (node_c < floor)
+    loose[s] = loose[t] = True
+    ok = (edge >= floor) & ~blocked[None]
+    narrow = (edge < clearance) & (node_c >= clearance)[None]
+
     def neighbours(n: int):
         r, c = divmod(n, C)
-        for dr, dc, step in moves:
+        for m, (dr, dc, step) in enumerate(moves):
             rr, cc = r + dr, c + dc
-            if 0 <= rr < R and 0 <= cc < C and not blocked[rr, cc]:
-                yield rr * C + cc, step * (1.0 + penalty[rr, cc])
+            if 0 <= rr < R and 0 <= cc < C and not blocked[rr, cc] and (
+                    ok[m, r, c] or loose[r, c] or loose[rr, cc]):
+                yield rr * C + cc, step * (1.0 + penalty[rr, cc]
+                                           + (NARROW_COST if narrow[m, r, c] else 0.0))
 
     path = _astar(neighbours, s[0] * C + s[1], t[0] * C + t[1], lambda n: (n // C, n % C))
     if path is None:
         if not explain:
             raise NarrowPassage("no way to the goal on what the robot knows")
-        raise _refusal(node_c, s, t, centre, floor)
+        raise _refusal(node_c, s, t, centre, floor, edge)
     pts = np.array([centre(divmod(n, C)) for n in path])
     pts = np.vstack([[start.x, start.y], pts[1:-1], [goal.x, goal.y]])
     pts = _simplify(pts, size * 0.75, field, clearance)
     return Route.of(pts, goal=(goal.x, goal.y))
 
 
-def _refusal(node_c: np.ndarray, s, t, centre, floor: float) -> WorldError:
+def _edge_clearance(field: Clearance, centre, shape: tuple[int, int],
+                    moves: list[tuple[int, int, float]]) -> np.ndarray:
+    """The smallest clearance ``[len(moves), R, C]`` on the segment from each node to its
+    neighbour in each move, sampled every half cell or closer and measured as the nodes are
+    (:meth:`Clearance.cells`; ``-inf`` off the grid)."""
+    R, C = shape
+    x, y = centre((slice(None), slice(None)))
+    xy = np.stack([x, y], axis=-1)                             # [R, C, 2]
+    out = np.full((len(moves), R, C), -np.inf)
+    step = math.dist(xy[0, 0], xy[min(1, R - 1), min(1, C - 1)]) if R * C > 1 else 1.0
+    t = np.linspace(0.0, 1.0, max(3, int(math.ceil(2 * step / field.resolution)) + 1))
+    for m, (dr, dc, _) in enumerate(moves):
+        src = (slice(max(0, -dr), R - max(0, dr)), slice(max(0, -dc), C - max(0, dc)))
+        dst = (slice(max(0, dr), R + min(0, dr)), slice(max(0, dc), C + min(0, dc)))
+        a, b = xy[src], xy[dst]
+        pts = a[..., None, :] + t[:, None] * (b - a)[..., None, :]
+        out[m][src] = field.cells(pts.reshape(-1, 2)).reshape(pts.shape[:-1]).min(axis=-1)
+    return out
+
+
+def _refusal(node_c: np.ndarray, s, t, centre, floor: float,
+             edge: np.ndarray | None = None) -> WorldError:
     free_c = np.maximum(node_c, 0.0)
     free_c[s] = free_c[t] = np.inf
-    widest = _widest_way(free_c, s, t)
+    if edge is not None:        # the steps out of the start and into the goal are exempt
+        edge = np.maximum(edge, 0.0)
+        edge[:, s[0], s[1]] = np.inf
+        R, C = free_c.shape
+        for m, (dr, dc) in enumerate((dr, dc) for dr in (-1, 0, 1) for dc in (-1, 0, 1)
+                                     if dr or dc):
+            r, c = t[0] - dr, t[1] - dc
+            if 0 <= r < R and 0 <= c < C:
+                edge[m, r, c] = np.inf
+    widest = _widest_way(free_c, s, t, edge)
     if widest is None or widest[1] <= 0:
         return NarrowPassage("no way through the map from the start to the goal",
                              hint="check the start and goal, or use `unknown: free`")

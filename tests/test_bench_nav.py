@@ -1,0 +1,60 @@
+"""The navigation benchmark's bookkeeping: tasks interleaved, rows scored in task order, notes
+counted from the rows (no simulation here; the runs are the benchmark's)."""
+
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT / "benchmarks"))
+bench_nav = pytest.importorskip("bench_nav")
+
+
+def mrpb_root(tmp_path: Path) -> str:
+    for name in ("maze", "office02"):
+        (tmp_path / name).mkdir()
+        (tmp_path / name / "tests.txt").write_text(
+            "test 1: start (0, 0, 0) -> goal (1, 0, 0)\ntest 2: start (0, 0, 0) -> goal (2, 0, 0)\n")
+    return str(tmp_path)
+
+
+def test_tasks_interleave_the_suites(tmp_path, monkeypatch):
+    monkeypatch.setattr(bench_nav.mrpb, "COMPLETE", ("maze",))
+    monkeypatch.setattr(bench_nav.mrpb, "PARTIALLY_UNKNOWN", {})
+    jobs = bench_nav.jobs_for(("mrpb", "barn-unknown", "clutter"), ("fuzzy",),
+                              mrpb_root(tmp_path), 3, 0, 1)
+    kinds = [j[0] for j in jobs]
+    assert kinds[:3] == ["mrpb", "clutter", "barn"]
+    assert kinds.count("mrpb") == 2 and kinds.count("barn") == 3
+    assert kinds.count("clutter") == len(bench_nav.SHIPPED) + 2
+
+
+def run(outcome, t=10.0):
+    return {"outcome": outcome, "time_s": t, "mrpb_safety": 0.1}
+
+
+def test_refused_and_failed_tasks_are_counted_in_generated_notes(tmp_path, capsys):
+    rows = [
+        {"suite": "mrpb", "world": "a", "refused": None, "length": 787.4,
+         "runs": {"fuzzy": run("success"), "dwa": run("stuck")}},
+        {"suite": "mrpb", "world": "b", "refused": "the only way passes (1, 2)",
+         "length": None, "runs": {}},
+        {"suite": "barn", "world": "barn field 3", "error": "ValueError: no field",
+         "refused": None, "length": None, "runs": {}},
+    ]
+    results, notes = bench_nav.suite_results(rows, ("mrpb",), ("fuzzy", "dwa"))
+    fuzzy = results["mrpb"]["fuzzy"]
+    assert fuzzy["runs"] == 2 and fuzzy["success_rate"] == 0.5 and fuzzy["no route_rate"] == 0.5
+    assert results["mrpb"]["dwa"]["stuck_rate"] == 0.5
+    assert any("barn field 3 failed" in n for n in notes)
+    assert any(n.startswith("mrpb: 1 of 2 without a route: b (") for n in notes)
+    kept = tmp_path / "rows.jsonl"
+    kept.write_text("".join(json.dumps(r) + "\n" for r in rows))
+    assert bench_nav.main(["--from-rows", str(kept), "--suites", "mrpb",
+                           "--planners", "fuzzy,dwa"]) == 0
+    out = capsys.readouterr().out
+    assert "| MRPB: every test reached by the fuzzy planner | 1 of 2 | no |" in out
