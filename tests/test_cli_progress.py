@@ -98,6 +98,28 @@ def test_progress_bar_is_silent_off_a_terminal(capsys):
     assert capsys.readouterr().err == ""
 
 
+def test_progress_lines_off_a_terminal_every_few_percent(capsys):
+    """``compare`` piped to a log: a plain line each 5% (and at the end), none with --json."""
+    with progress_bar("runs (local)", lines=True) as bar:
+        for done in range(0, 41):
+            bar.update(done, 40)
+    lines = capsys.readouterr().err.splitlines()
+    assert lines[0] == "runs (local): 0 of 40 (0%)" and lines[-1] == "runs (local): 40 of 40 (100%)"
+    assert len(lines) == 21 and "runs (local): 2 of 40 (5%)" in lines
+    with progress_bar("runs (local)", quiet=True, lines=True) as bar:
+        bar.update(40, 40)
+    assert capsys.readouterr().err == ""
+
+
+def test_compare_piped_prints_progress_lines(capsys, tmp_path):
+    code, _, err = run(capsys, "compare", TINY, "--runs", 2, "--out", tmp_path / "study")
+    assert code == 0
+    shown = [line for line in err.splitlines() if line.startswith("runs (local): ")]
+    total = shown[0].split(" of ")[1].split()[0]
+    assert shown[0] == f"runs (local): 0 of {total} (0%)"
+    assert shown[-1] == f"runs (local): {total} of {total} (100%)"
+
+
 def test_run_many_reports_progress_and_keeps_what_finished_on_ctrl_c(monkeypatch):
     world = load_world(TINY)
     seen = []

@@ -190,12 +190,13 @@ def check_inputs(worlds: list[str], choices, rulebase: str | None,
 
 
 def run_with_progress(study, out, executor, workers, scheduler, resume, quiet=False):
-    """Run the study with a progress bar on stderr (on a terminal, without ``--json``). On
-    Ctrl-C: say how many runs are kept in ``out`` and how to go on, and exit 130."""
+    """Run the study with a progress bar on stderr (on a terminal, without ``--json``; piped,
+    a line every few percent). On Ctrl-C: say how many runs are kept in ``out`` and how to go
+    on, and exit 130."""
     from ..study import run_study
 
     kept = {"before": 0, "now": 0, "total": 0}
-    with progress_bar(f"runs ({executor})", quiet=quiet) as bar:
+    with progress_bar(f"runs ({executor})", quiet=quiet, lines=True) as bar:
         def on_start(skipped: int, total: int) -> None:
             kept.update(before=skipped, total=total)
             bar.update(skipped, total)

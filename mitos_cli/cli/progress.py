@@ -1,6 +1,7 @@
 """Progress of long commands (``simulate --runs``, ``compare``): a rich bar on stderr when
-stderr is a terminal, nothing otherwise (a pipe or a file gets only the result), and the
-words for Ctrl-C, which exits 130 as a shell expects of an interrupted command."""
+stderr is a terminal; otherwise nothing, or for a command that asks for it (``compare``, whose
+sweeps run for minutes into a log) a plain line every few percent; and the words for Ctrl-C,
+which exits 130 as a shell expects of an interrupted command."""
 
 from __future__ import annotations
 
@@ -11,18 +12,31 @@ from contextlib import contextmanager
 INTERRUPTED = 130
 
 
-class Bar:
-    """What a command tells the bar: :meth:`update` ``(done, total)`` and :meth:`note`."""
+#: Off a terminal, a progress line each time this many more percent are done.
+LINE_EVERY_PERCENT = 5
 
-    def __init__(self, progress, console) -> None:
-        self.progress, self.console = progress, console
+
+class Bar:
+    """What a command tells the bar: :meth:`update` ``(done, total)`` and :meth:`note`.
+    Without a rich progress, ``lines`` prints ``what: done of total (p%)`` every few
+    percent instead (nothing when it is false)."""
+
+    def __init__(self, progress, console, lines: bool = False) -> None:
+        self.progress, self.console, self.lines = progress, console, lines
         self.task = progress.add_task("", total=None) if progress is not None else None
+        self.what, self.shown = "", -1
 
     def update(self, done: int, total: int) -> None:
         if self.progress is not None:
             self.progress.update(self.task, completed=done, total=total)
+        elif self.lines and total > 0:
+            step = done * 100 // total // LINE_EVERY_PERCENT
+            if step > self.shown:
+                self.shown = step
+                self.note(f"{self.what}: {done} of {total} ({done * 100 // total}%)")
 
     def describe(self, text: str) -> None:
+        self.what = text
         if self.progress is not None:
             self.progress.update(self.task, description=text)
 
@@ -32,14 +46,17 @@ class Bar:
 
 
 @contextmanager
-def progress_bar(description: str, quiet: bool = False) -> Iterator[Bar]:
-    """A bar labelled ``description`` while the block runs; none when ``quiet`` (``--json``)
-    or when stderr is not a terminal. It disappears when the block ends."""
+def progress_bar(description: str, quiet: bool = False, lines: bool = False) -> Iterator[Bar]:
+    """A bar labelled ``description`` while the block runs; none when ``quiet`` (``--json``).
+    Off a terminal, plain lines every few percent if ``lines``, else nothing. The bar
+    disappears when the block ends."""
     from rich.console import Console
 
     console = Console(stderr=True, highlight=False)
     if quiet or not console.is_terminal:
-        yield Bar(None, console)
+        bar = Bar(None, console, lines=lines and not quiet)
+        bar.describe(description)
+        yield bar
         return
     from rich.progress import (
         BarColumn,
