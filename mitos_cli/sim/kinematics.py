@@ -13,6 +13,12 @@ from dataclasses import dataclass
 import numpy as np
 
 
+#: What :func:`step` moves from, ``[n]`` each: x, y, heading, speed, steering, and the
+#: commanded steering and speed.
+Motion = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray,
+               np.ndarray]
+
+
 @dataclass(frozen=True)
 class Limits:
     """Per-robot limits as arrays ``[n]`` (inches, seconds, degrees)."""

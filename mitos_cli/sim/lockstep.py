@@ -93,11 +93,13 @@ class Lockstep:
 def _move_together(runs: list[Simulation]) -> None:
     """:meth:`Simulation.act` for every robot of ``runs`` in one call of the kinematics."""
     parts = [run.motion() for run in runs]
-    state = [np.concatenate([p[j] for p in parts]) for j in range(len(parts[0]))]
+    x, y, h, v, steer, c_steer, c_speed = (np.concatenate([p[j] for p in parts])
+                                           for j in range(7))
     limits = kinematics.Limits(*(np.concatenate([getattr(run.limits, f.name) for run in runs])
                                  for f in fields(kinematics.Limits)))
     world = runs[0].world
-    after = kinematics.step(*state, limits, world.dt, world.substeps)
+    after = kinematics.step(x, y, h, v, steer, c_steer, c_speed, limits, world.dt,
+                            world.substeps)
     start = 0
     for run in runs:
         stop = start + run.n

@@ -670,7 +670,7 @@ class Simulation:
         self.move_to(*kinematics.step(*self.motion(s), self.limits, self.dt,
                                       self.world.substeps))
 
-    def motion(self, s: _Sensed | None = None) -> tuple[np.ndarray, ...]:
+    def motion(self, s: _Sensed | None = None) -> kinematics.Motion:
         """What :func:`kinematics.step` moves from, ``[n]`` each: x, y, heading, speed (0 for
         a stopped robot), steering, and the commanded steering and speed (of ``s``, default:
         the tick :meth:`decide` just recorded)."""
