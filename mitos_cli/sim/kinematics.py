@@ -12,7 +12,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-
 #: What :func:`step` moves from, ``[n]`` each: x, y, heading, speed, steering, and the
 #: commanded steering and speed.
 Motion = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray,
