@@ -541,3 +541,35 @@ def test_a_world_list_given_as_a_mapping_is_positioned(key):
     with pytest.raises(WorldError, match=f"`{key}` must be a list") as info:
         parse_world(text, str(ROOT / "worlds" / "w.yaml"))   # the map beside it
     assert info.value.span is not None and info.value.span.line > 1
+
+
+TINY_WORLD = Path(__file__).parent / "data" / "tiny.yaml"
+
+
+@pytest.mark.parametrize("old, new, col", [
+    ("[[0, 0], [280, 0]]", "[[0, 0], [280, 1.0e+37]]", 24),
+    ("width: 70", "width: 8.0e+178", 14),
+])
+def test_world_numbers_too_large_for_the_geometry_are_refused(tmp_path, old, new, col):
+    """A coordinate or width of 1e37 in made the wall geometry divide inf by inf (NumPy's
+    'invalid value' warning, then NaN walls); the reader refuses beyond 1e7 in."""
+    import warnings
+
+    from mitos_cli.errors import WorldError
+    from mitos_cli.sim.worldfile import load_world
+
+    path = tmp_path / "big.yaml"
+    path.write_text(TINY_WORLD.read_text().replace(old, new))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(WorldError, match=r"within ±1e\+07") as err:
+            load_world(path)
+    assert (err.value.span.line, err.value.span.column) == (21 if "[" in old else 22, col)
+
+
+def test_world_seed_may_be_large(tmp_path):
+    from mitos_cli.sim.worldfile import load_world
+
+    path = tmp_path / "seeded.yaml"
+    path.write_text(TINY_WORLD.read_text().replace("seed: 1\n", "seed: 20261202123\n"))
+    assert load_world(path).seed == 20261202123

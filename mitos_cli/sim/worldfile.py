@@ -34,6 +34,18 @@ SHAPES = ("circle", "rectangle")
 MODES = ("loop", "ping-pong", "stop")
 
 
+#: The largest magnitude of any number in a world (inches, seconds, degrees): 1e7 in is
+#: 254 km, larger than any building, and squares of larger coordinates lose the geometry.
+LARGEST = 1e7
+
+
+def _sane(x: float, span: Span, what: str) -> float:
+    if abs(x) > LARGEST:
+        raise WorldError(f"{what} must be within ±{LARGEST:g}, not {x:g}", span=span,
+                         hint="world lengths are in inches: 1e7 in is 254 km")
+    return x
+
+
 class _Reader:
     """Small typed accessors bound to one file."""
 
@@ -47,13 +59,15 @@ class _Reader:
 
     def number(self, m: YMap, key: str, what: str, default: float | None = None, *,
                positive: bool = False, minimum: float | None = None,
-               maximum: float | None = None) -> float:
+               maximum: float | None = None, sane: bool = True) -> float:
         if key not in m:
             if default is None:
                 return yamlpos.require(m, key, WorldError, what)   # raises: `key` is missing
             return float(default)
         span = m.value_span(key)
         x = yamlpos.expect_number(m[key], span, WorldError, f"`{key}` in {what}")
+        if sane:
+            _sane(x, span, f"`{key}` in {what}")
         if positive and x <= 0:
             raise WorldError(f"`{key}` in {what} must be positive, not {x:g}", span=span)
         if minimum is not None and x < minimum:
@@ -67,7 +81,8 @@ class _Reader:
     def point(self, value: Any, span: Span, what: str) -> tuple[float, float]:
         if not isinstance(value, list) or len(value) != 2:
             raise WorldError(f"{what} must be a point [x, y] (inches)", span=span)
-        x, y = (yamlpos.expect_number(v, span, WorldError, what) for v in value)
+        x, y = (_sane(yamlpos.expect_number(v, span, WorldError, what), span, what)
+                for v in value)
         return x, y
 
     def points(self, value: Any, span: Span, what: str, least: int) -> tuple:
@@ -246,7 +261,7 @@ def parse_world(text: str, path: str) -> World:
     doc = yamlpos.load(text, path, WorldError)
     top = r.mapping(doc, Span.in_text(text, path, 1, 1), "the world file", TOP_KEYS)
     name = str(yamlpos.require(top, "name", WorldError, "the world file"))
-    seed = r.number(top, "seed", "the world file", 0.0, minimum=0)
+    seed = r.number(top, "seed", "the world file", 0.0, minimum=0, sane=False)
     if seed != int(seed):
         raise WorldError("seed must be a whole number", span=top.value_span("seed"))
     dt = r.number(top, "dt", "the world file", None, positive=True, maximum=1.0)
