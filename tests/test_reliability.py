@@ -573,3 +573,29 @@ def test_world_seed_may_be_large(tmp_path):
     path = tmp_path / "seeded.yaml"
     path.write_text(TINY_WORLD.read_text().replace("seed: 1\n", "seed: 20261202123\n"))
     assert load_world(path).seed == 20261202123
+
+
+def test_a_vertical_edge_on_a_huge_universe_does_not_warn(tmp_path):
+    """A trapezoid's vertical edge (slope capped at 1e300) times a distance of 1e38 overflows
+    to inf, which the membership clips to 0 or 1: the right answer, without NumPy's warning."""
+    import warnings
+
+    import numpy as np
+
+    from mitos_cli.api import read_rulebase
+    from mitos_cli.engine.compile import compile_rulebase
+    from mitos_cli.engine.evaluation import evaluate
+
+    path = tmp_path / "wide.fis"
+    path.write_text("[System]\nName='wide'\nType='mamdani'\n[Input1]\nName='food'\n"
+                    "Range=[0 99999999999999999999999999999999999999]\n"
+                    "MF1='rancid':'trapmf',[0 0 1 3]\nMF2='delicious':'trapmf',[7 9 10 10]\n"
+                    "[Output1]\nName='tip'\nRange=[0 30]\nMF1='cheap':'trimf',[0 5 10]\n"
+                    "MF2='generous':'trimf',[20 25 30]\n[Rules]\n1, 1 (1) : 1\n2, 2 (1) : 1\n")
+    rb = read_rulebase(path)
+    X = np.array([[0.5], [9.5], [10.0], [5e37], [1e38]])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        out = evaluate(compile_rulebase(rb), X, strict=False).outputs[:, 0]
+    assert np.all(np.isfinite(out[:3]))
+    assert np.isclose(out[1], 25.0, atol=0.5) and np.isclose(out[0], 5.0, atol=0.5)

@@ -178,8 +178,9 @@ def memberships(compiled: CompiledRuleBase, Xt: np.ndarray, out: np.ndarray) -> 
             x = Xt[plan.term_var]
             rise = np.subtract(x, b)
             fall = np.subtract(c, x, out=x)
-        rise *= s1
-        fall *= s2
+        with np.errstate(over="ignore"):   # a slope x distance past 1e308 is inf: clipped to 0 or 1
+            rise *= s1
+            fall *= s2
         np.minimum(rise, fall, out=rise)
         if plan.plateaus:
             np.minimum(rise, 0.0, out=rise)
