@@ -203,12 +203,8 @@ class Clearance:
     def at(self, points: np.ndarray) -> np.ndarray:
         """A lower bound on the clearance (in) at each point ``[P, 2]`` (0 outside the grid):
         the cell's distance less the point's offset from the cell centre and half a cell."""
-        pts = np.atleast_2d(np.asarray(points, float))
+        pts, row, col, inside = self._cell_of(points)
         res, (ox, oy) = self.resolution, self.origin
-        col = np.floor((pts[:, 0] - ox) / res).astype(np.int64)
-        row = np.floor((pts[:, 1] - oy) / res).astype(np.int64)
-        rows, cols = self.dist.shape
-        inside = (row >= 0) & (row < rows) & (col >= 0) & (col < cols)
         out = np.zeros(len(pts))
         r, c = row[inside], col[inside]
         centre = np.stack([ox + (c + 0.5) * res, oy + (r + 0.5) * res], axis=1)
@@ -219,15 +215,21 @@ class Clearance:
     def cells(self, points: np.ndarray) -> np.ndarray:
         """The clearance (in) of the centre of the cell holding each point ``[P, 2]`` (what
         a route node there keeps; 0 outside the grid)."""
+        pts, row, col, inside = self._cell_of(points)
+        out = np.zeros(len(pts))
+        out[inside] = np.maximum(self.dist[row[inside], col[inside]] - self.resolution / 2, 0.0)
+        return out
+
+    def _cell_of(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray,
+                                                   np.ndarray]:
+        """Points ``[P, 2]`` as floats, their cells' rows and columns, and which are inside."""
         pts = np.atleast_2d(np.asarray(points, float))
         res, (ox, oy) = self.resolution, self.origin
         col = np.floor((pts[:, 0] - ox) / res).astype(np.int64)
         row = np.floor((pts[:, 1] - oy) / res).astype(np.int64)
         rows, cols = self.dist.shape
         inside = (row >= 0) & (row < rows) & (col >= 0) & (col < cols)
-        out = np.zeros(len(pts))
-        out[inside] = np.maximum(self.dist[row[inside], col[inside]] - res / 2, 0.0)
-        return out
+        return pts, row, col, inside
 
     def along(self, a: np.ndarray, b: np.ndarray) -> float:
         """The smallest clearance on the segment a-b, sampled every half cell."""
