@@ -599,3 +599,20 @@ def test_a_vertical_edge_on_a_huge_universe_does_not_warn(tmp_path):
         out = evaluate(compile_rulebase(rb), X, strict=False).outputs[:, 0]
     assert np.all(np.isfinite(out[:3]))
     assert np.isclose(out[1], 25.0, atol=0.5) and np.isclose(out[0], 5.0, atol=0.5)
+
+
+def test_a_hash_in_a_batch_row_is_a_bad_value_not_a_comment(tmp_path):
+    """NumPy's loadtxt took `#` for a comment: a row `#` gave its 'no data' warning, and
+    `2,80,30 # note` lost its note silently; every row is data, as with extra columns."""
+    import warnings
+
+    from mitos_cli.errors import InputError
+
+    for body, where in (("#\n", (2, 1)), ("1,70,20\n2,80,30 # note\n", (3, 6))):
+        path = tmp_path / "hash.csv"
+        path.write_text("position,road,size\n" + body)
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            with pytest.raises(InputError) as err:
+                read_batch(path.read_text(), str(path), ("position", "road", "size"))
+        assert (err.value.span.line, err.value.span.column) == where

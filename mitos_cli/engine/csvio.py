@@ -81,7 +81,7 @@ def read_table(text: str, path: str, inputs: tuple[str, ...],
     if not extra:
         try:
             data = np.loadtxt(io.StringIO("\n".join(body)), delimiter=",", ndmin=2,
-                              dtype=float)
+                              dtype=float, comments=None)   # `#` is not a number here either
         except ValueError:
             _raise_bad_row(lines, path, header, order)
         if data.shape[1] != len(header):
