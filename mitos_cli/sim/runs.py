@@ -169,13 +169,18 @@ def _execute(jobs: list[tuple], workers: int):
     if workers <= 1 or len(jobs) <= 1:
         yield from map(_chunk, jobs)
         return
+    yield from pool_unordered(_chunk, jobs, min(workers, len(jobs)))
+
+
+def pool_unordered(fn, items: list, workers: int):
+    """``fn(item)`` for each item on a pool of ``workers`` processes, in the order they
+    finish; on Ctrl-C or an error the workers are terminated at once, not left to finish."""
     import multiprocessing
 
-    pool = multiprocessing.get_context().Pool(min(workers, len(jobs)),
-                                              initializer=ignore_interrupts)
+    pool = multiprocessing.get_context().Pool(workers, initializer=ignore_interrupts)
     finished = False
     try:
-        yield from pool.imap_unordered(_chunk, jobs)
+        yield from pool.imap_unordered(fn, items)
         finished = True
     finally:
         if finished:

@@ -52,24 +52,11 @@ def run_local(fn: TaskFn, tasks: Sequence[Task], workers: int) -> Iterator[tuple
     if workers <= 1 or len(tasks) <= 1:
         yield from run_serial(fn, tasks)
         return
-    import multiprocessing
+    from ..sim.runs import pool_unordered
 
-    from ..sim.runs import ignore_interrupts
-
-    pool = multiprocessing.get_context().Pool(min(workers, len(tasks)),
-                                              initializer=ignore_interrupts)
-    finished = False
-    try:
-        for part in pool.imap_unordered(functools.partial(run_chunk, fn),
-                                        chunks(tasks, workers)):
-            yield from part
-        finished = True
-    finally:
-        if finished:
-            pool.close()
-        else:
-            pool.terminate()
-        pool.join()
+    for part in pool_unordered(functools.partial(run_chunk, fn), chunks(tasks, workers),
+                               min(workers, len(tasks))):
+        yield from part
 
 
 def dask_client(scheduler: str | None, workers: int, timeout: str = "10s"):
