@@ -108,11 +108,11 @@ class LoadedRuleBase:
                 pass                           # a misspelt name: as_batch explains it
             else:
                 return dict(zip(c.outputs, evaluate_one(c, values)))
-        Xt = as_columns(c, inputs)
-        if Xt.shape[1] == 1 and all(np.ndim(v) == 0 for v in inputs.values()):
-            result = evaluate(c, Xt.T, detail=False)
+        columns = as_columns(c, inputs)
+        if all(np.ndim(v) == 0 for v in inputs.values()):
+            result = evaluate(c, np.array([columns]).reshape(1, -1), detail=False)
             return dict(zip(c.outputs, result.outputs[0].tolist()))
-        out = evaluate_columns(c, Xt)
+        out = evaluate_columns(c, columns)
         return {name: out[j] for j, name in enumerate(c.outputs)}
 
     def trace(self, **inputs) -> Trace:

@@ -208,6 +208,8 @@ class Plan:
     den_row: np.ndarray                # [m] row of ``sums`` with each output's denominator
     sum_rows: tuple                    # per row of ``sums``: its weights [R, 1], None if all 1
     grids: dict                        # (level, group) -> Grid, for AND groups that are grids
+    #: the batch path for a rule base that is one grid (:class:`GridBatch`), or None
+    grid_batch: GridBatch | None = None
 
 
 @dataclass(frozen=True, eq=False)
@@ -252,10 +254,83 @@ def _grid(group: NodeGroup, c: CompiledRuleBase) -> Grid | None:
     return Grid(tuple(axes), slice(int(out[0]), int(out[-1]) + 1), shape)
 
 
+@dataclass(frozen=True, eq=False)
+class GridBatch:
+    """The constants of the batch path for a behavior whose rules are exactly one
+    :class:`Grid` (every combination of its inputs' terms, the paper's 27 rules) with
+    piecewise-linear terms, crisp consequents and weighted inference
+    (:func:`mitos_cli.engine.evaluation.evaluate_columns`).
+
+    That path computes only the grid's memberships and DOFs, with the engine's operations in
+    its order, in a few NumPy calls per block over preallocated buffers: each input's terms
+    are one row of ``[k, t]`` (padded to the longest input's ``t`` with a copy of its first
+    term, whose row is never read), in the order the grid's axis lists them.
+    """
+
+    B: np.ndarray                      # [k, t, 1] kernel b of each input's terms
+    C: np.ndarray                      # [k, t, 1] kernel c
+    S: np.ndarray                      # [2, k * t, 1] the slopes s1 (rise) and s2 (fall)
+    axes: tuple[tuple[int, int], ...]  # (input, terms) of each grid axis, outermost first
+    shape: tuple[int, ...]             # the grid's shape (its rules in mixed-radix order)
+    plateaus: bool                     # clip at 1 (some term is 1 between a rise and a fall)
+    overflow: bool                     # a slope times a distance may pass 1e308
+    weight: np.ndarray | None          # [R, 1] rule weights, None when all are 1
+    Kw: np.ndarray                     # [R, w, 1] weights of the sums that have some (not 1)
+    ones: int                          # sums whose weights are all 1 (after the ``w`` others)
+    num: tuple[int, ...]               # [m] each output's numerator among the sums ...
+    den: tuple[int, ...]               # [m] ... and its denominator (weighted rows, then ones)
+    weighted_sum: bool                 # inference = weighted_sum: no division
+
+
+def _grid_batch(c: CompiledRuleBase, grids: dict, rules, weight, sum_rows) -> GridBatch | None:
+    """The :class:`GridBatch` of ``c``, or None when its rules are not exactly one grid."""
+    if (c.operators.inference not in ("weighted_average", "weighted_sum")
+            or c.cons_linear is not None or c.hedged_outputs or c.shape_groups
+            or c.context.shape[1] or len(c.levels) != 1
+            or len(c.levels[0]) != 1 or (0, 0) not in grids):
+        return None
+    grid = grids[(0, 0)]
+    if not isinstance(rules, slice) or rules != grid.out or len(grid.axes) < 2:
+        return None
+    var_of = [int(c.term_var[int(cols[0]) - 2]) for cols in grid.axes]
+    if sorted(var_of) != list(range(len(c.inputs))):
+        return None                    # (every input is one axis of the grid)
+    k, t = len(c.inputs), max(len(cols) for cols in grid.axes)
+    rows = np.zeros((k, t), dtype=np.intp)       # term index of each [input, row]
+    for v, cols in zip(var_of, grid.axes):
+        rows[v] = cols[0] - 2
+        rows[v, :len(cols)] = cols - 2
+    kb, s1, kc, s2 = (c.kernel[i][rows][:, :, None] for i in range(4))
+    lo, hi = c.universe[:, :1, None], c.universe[:, 1:, None]
+    with np.errstate(over="ignore", invalid="ignore"):   # a bound past 1e308 is inf: may overflow
+        reach = np.maximum(np.abs(s1), np.abs(s2)) * (np.abs(hi - kb) + np.abs(hi - kc)
+                                                      + np.abs(lo - kb) + np.abs(lo - kc))
+    weighted = [j for j, w in enumerate(sum_rows) if w is not None]
+    ones = [j for j, w in enumerate(sum_rows) if w is None]
+    position = {j: i for i, j in enumerate(weighted + ones)}
+    return GridBatch(
+        B=np.ascontiguousarray(kb), C=np.ascontiguousarray(kc),
+        S=np.ascontiguousarray(np.stack([s1, s2]).reshape(2, k * t, 1)),
+        axes=tuple((v, len(cols)) for v, cols in zip(var_of, grid.axes)), shape=grid.shape,
+        plateaus=bool(((kb < kc) & (s1 > 0) & (s2 > 0)).any()),
+        overflow=not bool((reach < 1e300).all()), weight=weight,
+        Kw=np.ascontiguousarray(c.sum_weights[weighted].T[:, :, None]), ones=len(ones),
+        num=tuple(position[j] for j in range(len(c.outputs))),
+        den=tuple(position[int(j)] for j in c.den_row),
+        weighted_sum=c.operators.inference == "weighted_sum")
+
+
 def _plan(c: CompiledRuleBase) -> Plan:
     rows = np.flatnonzero(c.linear)
     r0 = int(c.rule_col[0]) if c.n_rules else 2
     contiguous = bool((c.rule_col == np.arange(r0, r0 + c.n_rules)).all())
+    rules = slice(r0, r0 + c.n_rules) if contiguous else c.rule_col
+    weight = c.weight[:, None].copy() if c.weighted else None
+    sum_rows = tuple(None if (w == 1.0).all() else np.ascontiguousarray(w[:, None])
+                     for w in c.sum_weights)
+    grids = {} if c.operators.and_ != "min" else {
+        (i, j): grid for i, level in enumerate(c.levels) for j, group in enumerate(level)
+        if (grid := _grid(group, c)) is not None}
     return Plan(
         n_terms=c.n_terms, n_rules=c.n_rules,
         lo=np.ascontiguousarray(c.universe[:, 0]), hi=np.ascontiguousarray(c.universe[:, 1]),
@@ -269,15 +344,11 @@ def _plan(c: CompiledRuleBase) -> Plan:
         bounds=(c.universe[:, 0].tolist(), c.universe[:, 1].tolist()),
         plateaus=bool(((c.kernel[0] < c.kernel[2]) & (c.kernel[1] > 0) & (c.kernel[3] > 0)
                        )[rows].any()),
-        rules=slice(r0, r0 + c.n_rules) if contiguous else c.rule_col,
+        rules=rules,
         contexts=tuple(np.ascontiguousarray(c.context[:, j]) for j in range(c.context.shape[1])),
-        weight=c.weight[:, None].copy() if c.weighted else None,
-        sums=np.ascontiguousarray(c.sum_weights.T[:, :, None]), den_row=c.den_row,
-        sum_rows=tuple(None if (w == 1.0).all() else np.ascontiguousarray(w[:, None])
-                       for w in c.sum_weights),
-        grids={} if c.operators.and_ != "min" else {
-            (i, j): grid for i, level in enumerate(c.levels) for j, group in enumerate(level)
-            if (grid := _grid(group, c)) is not None})
+        weight=weight, sums=np.ascontiguousarray(c.sum_weights.T[:, :, None]), den_row=c.den_row,
+        sum_rows=sum_rows, grids=grids,
+        grid_batch=_grid_batch(c, grids, rules, weight, sum_rows))
 
 
 class _Builder:
