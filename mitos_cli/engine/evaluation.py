@@ -162,6 +162,12 @@ def _clamp_columns(compiled: CompiledRuleBase, Xt: np.ndarray, first: int = 0,
 #: column-wise (per sample), so results do not depend on the block size.
 BLOCK = 8192
 
+#: Elements between the rows of a buffer whose halves are added in place. NumPy 1.x takes its
+#: scalar loop, at twice the time, when an input ends exactly where the output begins (so
+#: ``np.add(W[:h], W[h:], out=W[:h])`` on a contiguous ``W``); rows a cache line apart are
+#: never adjacent. (NumPy 2 has no such case.)
+_GAP = 8
+
 
 def memberships(compiled: CompiledRuleBase, Xt: np.ndarray, out: np.ndarray) -> None:
     """Membership layer: fill rows ``2 .. 2+T`` of ``out[columns, b]`` from ``Xt[k, b]``.
@@ -497,12 +503,6 @@ def evaluate_columns(compiled: CompiledRuleBase, Xt, *, strict: bool = True) -> 
 #: Samples per block of :func:`_grid_columns`.
 GRID_BLOCK = 8192
 
-#: Elements between the rows of a buffer whose halves are added in place. NumPy 1.x takes its
-#: scalar loop, at twice the time, when an input ends exactly where the output begins (so
-#: ``np.add(W[:h], W[h:], out=W[:h])`` on a contiguous ``W``); rows a cache line apart are
-#: never adjacent. (NumPy 2 has no such case.)
-_GAP = 8
-
 
 class _GridBlock:
     """The buffers of one block of :func:`_grid_columns` (``w`` samples) and every view of
@@ -518,7 +518,7 @@ class _GridBlock:
         RF = np.empty((2, k * t + 1, w))
         self.RF = RF[:, :k * t]
         self.rise, self.fall = (RF[i, :k * t].reshape(k, t, w) for i in (0, 1))
-        self.zeros = np.zeros((k, t, w))       # the clips at 0 and 1, against an array
+        self.zeros = np.zeros((1, 1, w))       # the clips at 0 and 1: one row, broadcast
         self.M = self.rise
         self.Xb = self.X[:, None, :]
         self.axes = [self.M[v, :size] for v, size in g.axes]
@@ -583,15 +583,20 @@ def _grid_columns(compiled: CompiledRuleBase, g, columns: list, out: np.ndarray)
         for start in range(0, n, block):
             end = min(start + block, n)
             b = full if end - start == block else _GridBlock(g, end - start)
-            for v, x in enumerate(columns):
-                b.X[v] = x[start:end]
-            if not inside:
-                Xc, _ = _clamp_columns(compiled, b.X, start, n)
-                b.X[...] = Xc
             # memberships: the linear kernel (memberships())
             M = b.M
-            np.subtract(b.Xb, g.B, out=b.rise)
-            np.subtract(g.C, b.Xb, out=b.fall)
+            if inside:
+                for v, x in enumerate(columns):
+                    xv = x[start:end]
+                    np.subtract(xv, g.B[v], out=b.rise[v])
+                    np.subtract(g.C[v], xv, out=b.fall[v])
+            else:
+                for v, x in enumerate(columns):
+                    b.X[v] = x[start:end]
+                Xc, _ = _clamp_columns(compiled, b.X, start, n)
+                b.X[...] = Xc
+                np.subtract(b.Xb, g.B, out=b.rise)
+                np.subtract(g.C, b.Xb, out=b.fall)
             if g.overflow:
                 with np.errstate(over="ignore"):
                     b.RF *= g.S
