@@ -85,7 +85,7 @@ def batches(draw, k: int):
 @given(rb=grids(), data=st.data())
 def test_the_grid_path_gives_the_bits_of_the_general_path(rb, data):
     c = compile_rulebase(rb, "main")
-    assert c.plan.grid_batch is not None, "one grid of linear terms takes the grid path"
+    assert c.grid_batch is not None, "one grid of linear terms takes the grid path"
     X = data.draw(batches(len(c.inputs)))
     rows = evaluate(c, X, detail=False, strict=False).outputs          # the general path
     inside = np.clip(X, c.universe[:, 0], c.universe[:, 1])
@@ -115,7 +115,7 @@ def grid_block(block: int):
 def test_the_packaged_rule_base_takes_the_grid_path_in_any_batch():
     rb = load_rulebase()
     c = rb.compiled
-    assert c.plan.grid_batch is not None
+    assert c.grid_batch is not None
     rng = np.random.default_rng(11)
     X = rng.uniform(c.universe[:, 0] - 5, c.universe[:, 1] + 5, size=(3 * 8192 + 5, 3))
     X[:4] = [[-0.0, 0.0, -0.0], [100.0, 100.0, 7.0], [0.0, 0.0, -7.0], [50.5, -0.0, 0.0]]
@@ -164,7 +164,7 @@ def test_plateaus_vertical_edges_and_weights_on_a_lattice(inference):
     rb = RuleBase(None, (TermSet((a, b, y)),), (Behavior("main", rules),),
                   (Setting("inference", inference),))
     c = compile_rulebase(rb, "main")
-    assert c.plan.grid_batch is not None and c.plan.grid_batch.plateaus
+    assert c.grid_batch is not None and c.grid_batch.plateaus
     grid = np.array(np.meshgrid(np.arange(-1.0, 11.0, 0.125), np.arange(-6.0, 6.0, 0.125)))
     X = np.vstack([grid.reshape(2, -1).T, [[-0.0, -0.0], [4.0, -0.0], [0.0, 0.0]]])
     rows = evaluate(c, X, detail=False).outputs

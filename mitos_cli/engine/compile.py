@@ -153,6 +153,13 @@ class CompiledRuleBase:
         return _plan(self)
 
     @functools.cached_property
+    def grid_batch(self) -> GridBatch | None:
+        """The constants of the batch path of a behavior whose rules are one grid, or None
+        (:class:`GridBatch`; made on the first batch, so one evaluation never pays for it)."""
+        plan = self.plan
+        return _grid_batch(self, plan.grids, plan.rules, plan.weight, plan.sum_rows)
+
+    @functools.cached_property
     def scalar(self):
         """The network as a Python function of one sample's floats (``None`` when it has no
         exact scalar form): see :mod:`mitos_cli.engine.scalar`. Written on first use."""
@@ -208,8 +215,6 @@ class Plan:
     den_row: np.ndarray                # [m] row of ``sums`` with each output's denominator
     sum_rows: tuple                    # per row of ``sums``: its weights [R, 1], None if all 1
     grids: dict                        # (level, group) -> Grid, for AND groups that are grids
-    #: the batch path for a rule base that is one grid (:class:`GridBatch`), or None
-    grid_batch: GridBatch | None = None
 
 
 @dataclass(frozen=True, eq=False)
@@ -347,8 +352,7 @@ def _plan(c: CompiledRuleBase) -> Plan:
         rules=rules,
         contexts=tuple(np.ascontiguousarray(c.context[:, j]) for j in range(c.context.shape[1])),
         weight=weight, sums=np.ascontiguousarray(c.sum_weights.T[:, :, None]), den_row=c.den_row,
-        sum_rows=sum_rows, grids=grids,
-        grid_batch=_grid_batch(c, grids, rules, weight, sum_rows))
+        sum_rows=sum_rows, grids=grids)
 
 
 class _Builder:

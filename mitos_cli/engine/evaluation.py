@@ -482,7 +482,7 @@ def evaluate_columns(compiled: CompiledRuleBase, Xt, *, strict: bool = True) -> 
                          + ", ".join(str(x.shape) for x in columns))
     n = columns[0].shape[0] if columns else 0
     out = np.empty((len(compiled.outputs), n))
-    grid = compiled.plan.grid_batch
+    grid = compiled.grid_batch
     if grid is not None and n:
         unfired = _grid_columns(compiled, grid, columns, out)
     else:
