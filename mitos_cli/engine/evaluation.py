@@ -398,7 +398,7 @@ def _constant_sums(plan, dof: np.ndarray) -> np.ndarray:
         return np.multiply(dof, plan.sums[:, :, 0].T)
     half = (R + 1) // 2
     low = R - half                       # rules i < low pair with i + half; an odd one stays
-    S = np.empty((half, len(plan.sum_rows), b))
+    S = np.empty((half, len(plan.sum_rows), b + _GAP))[:, :, :b]     # rows apart: see _GAP
     tmp = None
     for j, weights in enumerate(plan.sum_rows):
         row = S[:, j]
