@@ -4,6 +4,7 @@ Run from the repository root (one command)::
 
     python benchmarks/bench_core.py            # add --quick for a fast smoke run
     python benchmarks/bench_core.py --startup  # only (c), 21 alternating runs of each
+    python benchmarks/bench_core.py --against main  # this tree against main's, one process
 
 It measures, in one run, on the packaged MITOS rule base (behavior ``avoid_obstacle``, the
 paper's 27 rules):
@@ -262,6 +263,123 @@ def startup(runs: int) -> None:
     print(f"| `python -c \"import numpy\"` (whole process) | {fmt_time(t_numpy)} | |")
 
 
+def _package_of(rev: str, into: Path):
+    """The ``mitos_cli`` package of git revision ``rev`` (its tree exported into ``into``),
+    imported alongside this tree's: ``sys.modules`` is swapped for the import and back."""
+    root = Path(__file__).resolve().parents[1]
+    archive = subprocess.run(["git", "-C", str(root), "archive", rev, "mitos_cli", "rulebases",
+                              "grammar"], check=True, capture_output=True).stdout
+    subprocess.run(["tar", "-x", "-C", str(into)], input=archive, check=True)
+    ours = {k: m for k, m in sys.modules.items() if k == "mitos_cli" or k.startswith("mitos_cli.")}
+    for k in ours:
+        del sys.modules[k]
+    sys.path.insert(0, str(into))
+    try:
+        import mitos_cli as theirs
+
+        theirs.load_rulebase().evaluate(road=78.0, size=45.0, position=4.0)  # lazy imports too
+    finally:
+        sys.path.remove(str(into))
+        for k in [k for k in sys.modules if k == "mitos_cli" or k.startswith("mitos_cli.")]:
+            del sys.modules[k]
+        sys.modules.update(ours)
+    assert Path(theirs.__file__).is_relative_to(into), theirs.__file__
+    return theirs
+
+
+def against(rev: str, quick: bool = False) -> None:
+    """This tree's column batch (``load_rulebase().evaluate(**columns)``) against ``rev``'s and
+    the kernel, interleaved in one process (best of the rounds, wall and CPU time); peak memory
+    of each; one evaluation by name (median of rounds that alternate the two trees); and the
+    whole-process start-up of ``mitos eval`` from each tree against ``import numpy``
+    (alternating runs, ``rev``'s tree first on ``PYTHONPATH``, run outside the repository)."""
+    import tempfile
+
+    host = machine()
+    n, rounds, single_n, runs = (10**5, 5, 200, 5) if quick else (10**6, 20, 2000, 21)
+    with tempfile.TemporaryDirectory() as tmp:
+        theirs = _package_of(rev, Path(tmp))
+        rb, old = load_rulebase(), theirs.load_rulebase()
+        c = rb.compiled
+        rng = np.random.default_rng(np.random.SeedSequence(SEED))
+        X = rng.uniform(c.universe[:, 0], c.universe[:, 1], size=(n, len(c.inputs)))
+        columns = {name: np.ascontiguousarray(X[:, j]) for j, name in enumerate(c.inputs)}
+        kernel = PaperKernel(rb)
+        a, b = old.evaluate(**columns), rb.evaluate(**columns)
+        assert all(np.array_equal(a[o].view(np.uint64), b[o].view(np.uint64)) for o in c.outputs)
+        fns = {"kernel": lambda: kernel(X), rev: lambda: old.evaluate(**columns),
+               "this tree": lambda: rb.evaluate(**columns)}
+        wall = {k: float("inf") for k in fns}
+        cpu = dict(wall)
+        for fn in fns.values():
+            fn()
+        for _ in range(rounds):
+            for name, fn in fns.items():
+                t0, c0 = time.perf_counter(), time.process_time()
+                fn()
+                cpu[name] = min(cpu[name], time.process_time() - c0)
+                wall[name] = min(wall[name], time.perf_counter() - t0)
+        memory = {name: peak_memory(fn) for name, fn in fns.items()}
+
+        pts = [tuple(map(float, x)) for x in X[:single_n]]
+        single: dict[str, list[float]] = {rev: [], "this tree": []}
+        for _ in range(rounds):
+            for name, loaded in ((rev, old), ("this tree", rb)):
+                ev = loaded.evaluate
+                t0 = time.perf_counter()
+                for r, s_, p in pts:
+                    ev(road=r, size=s_, position=p)
+                single[name].append((time.perf_counter() - t0) / len(pts))
+
+        env = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
+        code = "import sys; from mitos_cli.cli.app import main; sys.argv[0] = 'mitos'; sys.exit(main())"
+        evalargs = ["eval", "road=78", "size=45", "position=4"]
+        commands = {rev: ([sys.executable, "-c", code, *evalargs], dict(env, PYTHONPATH=tmp)),
+                    "this tree": ([sys.executable, "-c", code, *evalargs],
+                                  dict(env, PYTHONPATH=str(Path(__file__).resolve().parents[1]))),
+                    "numpy": ([sys.executable, "-c", "import numpy"], env)}
+        printed = {k: subprocess.run(argv, check=True, capture_output=True, env=e, cwd=tmp).stdout
+                   for k, (argv, e) in commands.items()}
+        assert printed[rev] == printed["this tree"]
+        times: dict[str, list[float]] = {k: [] for k in commands}
+        for _ in range(runs):
+            for name, (argv, e) in commands.items():
+                t0 = time.perf_counter()
+                subprocess.run(argv, check=True, capture_output=True, env=e, cwd=tmp)
+                times[name].append(time.perf_counter() - t0)
+
+    print(f"# MITOS core benchmark against {rev} ({time.strftime('%Y-%m-%d')})")
+    print(f"machine: {host}")
+    print(f"command: python benchmarks/bench_core.py --against {rev}{' --quick' if quick else ''}")
+    print(f"batch: {n:,} random inputs, best of {rounds} interleaved rounds (wall; CPU time of the "
+          f"process in brackets); single: median of {rounds} alternating rounds of {single_n} calls; "
+          f"process: median of {runs} alternating runs\n")
+    print(f"| measurement | {rev} | this tree |")
+    print("| --- | ---: | ---: |")
+    for label, key in (("batch, `load_rulebase().evaluate(**columns)` / kernel", "ratio"),
+                       ("batch, eval/s", "rate"), ("peak extra memory / kernel's", "mem")):
+        cells = []
+        for name in (rev, "this tree"):
+            if key == "ratio":
+                cells.append(f"{wall['kernel'] / wall[name]:.2f}x ({cpu['kernel'] / cpu[name]:.2f}x)")
+            elif key == "rate":
+                cells.append(f"{fmt_rate(n / wall[name])} ({fmt_rate(n / cpu[name])})")
+            else:
+                cells.append(f"{memory[name] / 1e6:.1f} / {memory['kernel'] / 1e6:.1f} MB "
+                             f"({memory[name] / memory['kernel']:.2f}x)")
+        print(f"| {label} | {cells[0]} | {cells[1]} |")
+    print(f"| hand-written kernel, eval/s | {fmt_rate(n / wall['kernel'])} "
+          f"({fmt_rate(n / cpu['kernel'])}) | |")
+    print(f"| one evaluation, `load_rulebase().evaluate(road=..., ...)` | "
+          f"{fmt_time(statistics.median(single[rev]))} | "
+          f"{fmt_time(statistics.median(single['this tree']))} |")
+    med = {k: statistics.median(v) for k, v in times.items()}
+    print(f"| `mitos eval road=78 size=45 position=4` / `python -c \"import numpy\"` | "
+          f"{med[rev] / med['numpy']:.2f}x ({fmt_time(med[rev])}) | "
+          f"{med['this tree'] / med['numpy']:.2f}x ({fmt_time(med['this tree'])}) |")
+    print(f"\n{_load()} at the end")
+
+
 def machine() -> str:
     model = platform.processor() or "unknown CPU"
     try:
@@ -271,12 +389,8 @@ def machine() -> str:
                 break
     except OSError:
         pass
-    try:
-        load = "load average {:.2f} {:.2f} {:.2f}".format(*os.getloadavg())
-    except OSError:
-        load = "load average unknown"
     return (f"{os.cpu_count()} CPUs ({model}), Python {platform.python_version()}, "
-            f"NumPy {np.__version__}; {load} at the start")
+            f"NumPy {np.__version__}; {_load()} at the start")
 
 
 def fmt_rate(x: float) -> str:
@@ -296,9 +410,15 @@ def main() -> None:
     ap.add_argument("--quick", action="store_true", help="small sizes, for a smoke run")
     ap.add_argument("--startup", action="store_true",
                     help="only the whole-process start-up of `mitos eval` against NumPy's import")
+    ap.add_argument("--against", metavar="REV",
+                    help="only the column batch, one evaluation and start-up of this tree against "
+                         "git revision REV's (e.g. main), in one process, rounds interleaved")
     args = ap.parse_args()
     if args.startup:
         startup(runs=21)
+        return
+    if args.against:
+        against(args.against, quick=args.quick)
         return
     n = 10**5 if args.quick else 10**6
     repeats = 3 if args.quick else 5
@@ -396,10 +516,11 @@ def main() -> None:
           f"{rate['fast'] / rate['kernel']:.2f}x the hand-written kernel, "
           f"{rate['fast'] / rate['fl']:.0f}x pyfuzzylite |")
     print(f"| MITOS batch, `load_rulebase().evaluate(**columns)` | {fmt_rate(rate['loaded'])} "
-          f"eval/s | {rate['loaded'] / rate['kernel']:.2f}x the hand-written kernel |")
+          f"eval/s | **{rate['loaded'] / rate['kernel']:.2f}x the hand-written kernel** "
+          f"(aim >= 1.0x) |")
     print(f"| hand-written NumPy kernel (this rule base) | {fmt_rate(rate['kernel'])} eval/s | |")
     print(f"| peak extra memory, `load_rulebase().evaluate(**columns)` | {mem_loaded / 1e6:.1f} MB "
-          f"| {mem_loaded / mem_kernel:.2f}x the kernel's {mem_kernel / 1e6:.1f} MB |")
+          f"| {mem_loaded / mem_kernel:.2f}x the kernel's {mem_kernel / 1e6:.1f} MB (aim <= 1.0x) |")
     print(f"| pyfuzzylite {_version('fuzzylite')} vectorized `process()` | "
           f"{fmt_rate(rate['fl'])} eval/s | |")
     print(f"| MITOS single, `load_rulebase().evaluate(...)` | {fmt_time(lat_mitos)} | "
@@ -414,6 +535,14 @@ def main() -> None:
     print(f"| `mitos eval road=78 size=45 position=4` (whole process) | {fmt_time(t_eval)} | "
           f"{t_eval / t_numpy:.2f}x `python -c \"import numpy\"` |")
     print(f"| `python -c \"import numpy\"` (whole process) | {fmt_time(t_numpy)} | |")
+    print(f"\n{_load()} at the end")
+
+
+def _load() -> str:
+    try:
+        return "load average {:.2f} {:.2f} {:.2f}".format(*os.getloadavg())
+    except OSError:
+        return "load average unknown"
 
 
 def _version(dist: str) -> str:
