@@ -281,7 +281,7 @@ class GridBatch:
     overflow: bool                     # a slope times a distance may pass 1e308
     weight: np.ndarray | None          # [R, 1] rule weights, None when all are 1
     Kw: np.ndarray                     # [R, w, 1] weights of the sums that have some (not 1)
-    ones: int                          # sums whose weights are all 1 (after the ``w`` others)
+    ones: int                          # 1: the last sum's weights are all 1 (a denominator)
     num: tuple[int, ...]               # [m] each output's numerator among the sums ...
     den: tuple[int, ...]               # [m] ... and its denominator (weighted rows, then ones)
     weighted_sum: bool                 # inference = weighted_sum: no division
@@ -312,6 +312,8 @@ def _grid_batch(c: CompiledRuleBase, grids: dict, rules, weight, sum_rows) -> Gr
                                                       + np.abs(lo - kb) + np.abs(lo - kc))
     weighted = [j for j, w in enumerate(sum_rows) if w is not None]
     ones = [j for j, w in enumerate(sum_rows) if w is None]
+    weighted += ones[1:]               # another sum of all-1 weights: its products are the DOFs
+    ones = ones[:1]
     position = {j: i for i, j in enumerate(weighted + ones)}
     return GridBatch(
         B=np.ascontiguousarray(kb), C=np.ascontiguousarray(kc),

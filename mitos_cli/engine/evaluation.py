@@ -511,8 +511,6 @@ class _GridBlock:
     def __init__(self, g, w: int) -> None:
         k, t = g.B.shape[:2]
         R, nw = g.Kw.shape[:2]
-        half = (R + 1) // 2
-        low = R - half
         self.X = np.empty((k, w))              # the block's (clamped) inputs
         # rises and falls, then the memberships (a row apart: see _GAP)
         RF = np.empty((2, k * t + 1, w))
@@ -522,31 +520,30 @@ class _GridBlock:
         self.M = self.rise
         self.Xb = self.X[:, None, :]
         self.axes = [self.M[v, :size] for v, size in g.axes]
-        # the grid's minima, outermost axis first; the last fills the DOFs [R, w]
-        self.D = np.empty((R, w))
+        # every rule's terms of the sums [R, sums, w], the rows a cache line apart (_GAP): the
+        # weighted sums' products, then the sum of all-1 weights (the denominator) whose terms
+        # are the DOFs themselves, so the grid writes them there (without one, a column more)
+        nsum = nw + g.ones
+        P = np.empty((R, nsum + 1 - g.ones, w + _GAP))[:, :, :w]
+        self.D = D = P[:, nw]
+        # the grid's minima, outermost axis first; the last fills the DOFs
         self.grid = []
         acc = self.axes[0]
         for depth, axis in enumerate(self.axes[1:], start=1):
             shape = g.shape[:depth + 1] + (w,)
-            target = self.D.reshape(shape) if depth == len(self.axes) - 1 else np.empty(shape)
+            target = D.reshape(shape) if depth == len(self.axes) - 1 else np.empty(shape)
+            assert depth < len(self.axes) - 1 or np.may_share_memory(target, D)   # a view
             self.grid.append((acc[..., None, :], axis, target))
             acc = target
-        # the sums' first halving step: weighted products of both halves of the rules, then
-        # their pairs; sums of all-1 weights (denominators) add the DOFs' halves directly
-        self.P = np.empty((half, nw + g.ones, w + _GAP))[:, :, :w]
-        P2 = np.empty((low, nw, w))
-        D = self.D
-        self.products = [(D[:half, None, :], g.Kw[:half], self.P[:, :nw]),
-                         (D[half:, None, :], g.Kw[half:], P2)]
-        self.first = [(D[:low], D[half:], self.P[:low, j]) for j in range(nw, nw + g.ones)]
-        self.first.append((self.P[:low, :nw], P2, self.P[:low, :nw]))
-        self.carry = [(D[low], self.P[low, j]) for j in range(nw, nw + g.ones)] \
-            if low < half else []
+        self.products = (D[:, None, :], g.Kw, P[:, :nw])
+        # tree_sum() over the rules, on every sum at once: the first step pairs rule i with
+        # i + half, the later ones halve what is left
+        self.P = P = P[:, :nsum]
         self.tree = []
-        size = half
-        while size > 1:                        # the later steps of tree_sum, on every sum
+        size = R
+        while size > 1:
             h = (size + 1) // 2
-            self.tree.append((self.P[:size - h], self.P[h:size]))
+            self.tree.append((P[:size - h], P[h:size]))
             size = h
         sums = self.P[0]
         self.nums = [sums[j] for j in g.num]
@@ -611,12 +608,7 @@ def _grid_columns(compiled: CompiledRuleBase, g, columns: list, out: np.ndarray)
                 np.minimum(acc, axis, out=target)
             if g.weight is not None:                    # rule_dof()
                 b.D *= g.weight
-            for dof, weights, target in b.products:     # _constant_sums()
-                np.multiply(dof, weights, out=target)
-            for x, y, target in b.first:
-                np.add(x, y, out=target)
-            for x, target in b.carry:
-                target[...] = x
+            np.multiply(*b.products)                    # _constant_sums()
             for x, y in b.tree:
                 np.add(x, y, out=x)
             # weighted_average()
