@@ -112,7 +112,7 @@ def _column_list(compiled: CompiledRuleBase, columns: Mapping[str, object]) -> l
     if len(shape) > 1:
         raise InputError(f"inputs must be numbers or 1-D arrays, not of shape {shape}")
     n = shape[0] if shape else 1
-    return [np.broadcast_to(arr, (n,)) for arr in arrays]
+    return [arr if arr.shape == (n,) else np.broadcast_to(arr, (n,)) for arr in arrays]
 
 
 def check_inputs(compiled: CompiledRuleBase, X) -> tuple[np.ndarray, np.ndarray]:
@@ -505,36 +505,44 @@ GRID_BLOCK = 8192
 
 
 class _GridBlock:
-    """The buffers of one block of :func:`_grid_columns` (``w`` samples) and every view of
-    them the block's NumPy calls take, made once per call for the full blocks."""
+    """The views of one block of :func:`_grid_columns` (``w`` samples) that its NumPy calls
+    take, into the buffers of ``like`` (a block at least as wide: the batch's last, shorter
+    block uses the full blocks' memory) or new ones. Made once per call for the full blocks.
+    """
 
-    def __init__(self, g, w: int) -> None:
+    def __init__(self, g, w: int, like: _GridBlock | None = None) -> None:
         k, t = g.B.shape[:2]
         R, nw = g.Kw.shape[:2]
-        self.X = np.empty((k, w))              # the block's (clamped) inputs
-        # rises and falls, then the memberships (a row apart: see _GAP)
-        RF = np.empty((2, k * t + 1, w))
-        self.RF = RF[:, :k * t]
-        self.rise, self.fall = (RF[i, :k * t].reshape(k, t, w) for i in (0, 1))
-        self.zeros = np.zeros((1, 1, w))       # the clips at 0 and 1: one row, broadcast
-        self.M = self.rise
+        if like is None:
+            # rises and falls (a row apart: see _GAP), then the memberships; every rule's
+            # terms of the sums [R, sums, w], rows a cache line apart: the weighted sums'
+            # products, then the sum of all-1 weights (the denominator), whose terms are the
+            # DOFs themselves, so the grid writes them there (without one, a column more)
+            self.buffers = (np.empty((k, w)), np.empty((2, k * t + 1, w)), np.zeros(w),
+                            [np.empty(g.shape[:d + 1] + (w,)) for d in range(1, len(g.axes) - 1)],
+                            np.empty((R, nw + 1, w + _GAP)))
+        else:
+            self.buffers = like.buffers
+        X, RF, zeros, inner, P = self.buffers
+        self.X = X[:, :w]                      # the block's (clamped) inputs
         self.Xb = self.X[:, None, :]
+        self.RF = RF[:, :k * t, :w]
+        self.rise, self.fall = (RF[i, :k * t, :w].reshape(k, t, w) for i in (0, 1))
+        self.zeros = zeros[:w]                 # the clips at 0 and 1: one row, broadcast
+        self.M = self.rise
         self.axes = [self.M[v, :size] for v, size in g.axes]
-        # every rule's terms of the sums [R, sums, w], the rows a cache line apart (_GAP): the
-        # weighted sums' products, then the sum of all-1 weights (the denominator) whose terms
-        # are the DOFs themselves, so the grid writes them there (without one, a column more)
         nsum = nw + g.ones
-        P = np.empty((R, nsum + 1 - g.ones, w + _GAP))[:, :, :w]
+        P = P[:, :, :w]
         self.D = D = P[:, nw]
         # the grid's minima, outermost axis first; the last fills the DOFs
         self.grid = []
         acc = self.axes[0]
         for depth, axis in enumerate(self.axes[1:], start=1):
             shape = g.shape[:depth + 1] + (w,)
-            target = D.reshape(shape) if depth == len(self.axes) - 1 else np.empty(shape)
-            assert depth < len(self.axes) - 1 or np.may_share_memory(target, D)   # a view
+            target = D.reshape(shape) if depth == len(self.axes) - 1 else inner[depth - 1][..., :w]
             self.grid.append((acc[..., None, :], axis, target))
             acc = target
+        assert np.may_share_memory(self.grid[-1][2], D) and np.may_share_memory(self.M, RF)
         self.products = (D[:, None, :], g.Kw, P[:, :nw])
         # tree_sum() over the rules, on every sum at once: the first step pairs rule i with
         # i + half, the later ones halve what is left
@@ -563,23 +571,25 @@ def _grid_columns(compiled: CompiledRuleBase, g, columns: list, out: np.ndarray)
     batch) are not clamped block by block; that skips only the clamp's ``+ 0.0``, which
     turns an input of -0.0 into 0.0, and a membership is the same for both (either zero,
     through ``x - b`` or ``c - x`` and the slope, reaches ``1 + min(...)`` only as a zero
-    that the ``+ 1`` absorbs). NumPy's ufunc buffer is set to the block's width: with the
-    default (8,192 elements), a broadcast operand over a shorter row is copied through the
-    buffer, at twice the time of the call.
+    that the ``+ 1`` absorbs). NumPy's ufunc buffer is set to the narrowest block's width:
+    with the default (8,192 elements), a broadcast operand over a shorter row is copied through
+    the buffer, at twice the time of the call (a batch under 8,192 samples, a short last block).
     """
     plan = compiled.plan
     n = out.shape[1]
     lo, hi = plan.bounds
     inside = all(lo[v] <= x.min() and x.max() <= hi[v]      # NaN fails both
                  for v, x in enumerate(columns))
-    block = min(GRID_BLOCK, n)
+    count = -(-n // GRID_BLOCK)
+    block = -(-n // count)                     # blocks of one width, the last no wider
+    last = n - (count - 1) * block
     full = _GridBlock(g, block)
     unfired = False
-    old = np.setbufsize(max(16, block - block % 16))
+    old = np.setbufsize(max(16, last - last % 16))
     try:
         for start in range(0, n, block):
             end = min(start + block, n)
-            b = full if end - start == block else _GridBlock(g, end - start)
+            b = full if end - start == block else _GridBlock(g, end - start, full)
             # memberships: the linear kernel (memberships())
             M = b.M
             if inside:
