@@ -264,26 +264,25 @@ def startup(runs: int) -> None:
 
 
 def _package_of(rev: str, into: Path):
-    """The ``mitos_cli`` package of git revision ``rev`` (its tree exported into ``into``),
-    imported alongside this tree's: ``sys.modules`` is swapped for the import and back."""
+    """The ``mitos_cli`` package of git revision ``rev``, imported alongside this tree's: its
+    tree is exported into ``into`` (for a process of its own) and its package copied there as
+    ``mitos_cli_rev``, whose imports of itself are all relative (its data files, the grammar
+    and the rule bases, are read from the installed ``mitos_cli``)."""
+    import importlib
+    import shutil
+
     root = Path(__file__).resolve().parents[1]
     archive = subprocess.run(["git", "-C", str(root), "archive", rev, "mitos_cli", "rulebases",
                               "grammar"], check=True, capture_output=True).stdout
     subprocess.run(["tar", "-x", "-C", str(into)], input=archive, check=True)
-    ours = {k: m for k, m in sys.modules.items() if k == "mitos_cli" or k.startswith("mitos_cli.")}
-    for k in ours:
-        del sys.modules[k]
-    sys.path.insert(0, str(into))
+    alias = into / "alias"
+    shutil.copytree(into / "mitos_cli", alias / "mitos_cli_rev")
+    sys.path.insert(0, str(alias))
     try:
-        import mitos_cli as theirs
-
-        theirs.load_rulebase().evaluate(road=78.0, size=45.0, position=4.0)  # lazy imports too
+        theirs = importlib.import_module("mitos_cli_rev")
     finally:
-        sys.path.remove(str(into))
-        for k in [k for k in sys.modules if k == "mitos_cli" or k.startswith("mitos_cli.")]:
-            del sys.modules[k]
-        sys.modules.update(ours)
-    assert Path(theirs.__file__).is_relative_to(into), theirs.__file__
+        sys.path.remove(str(alias))
+    assert Path(theirs.__file__).is_relative_to(alias), theirs.__file__
     return theirs
 
 
@@ -299,7 +298,15 @@ def against(rev: str, quick: bool = False) -> None:
     n, rounds, single_n, runs = (10**5, 5, 200, 5) if quick else (10**6, 20, 2000, 21)
     with tempfile.TemporaryDirectory() as tmp:
         theirs = _package_of(rev, Path(tmp))
-        rb, old = load_rulebase(), theirs.load_rulebase()
+        saved = os.environ.get("MITOS_CACHE_DIR")
+        os.environ["MITOS_CACHE_DIR"] = "off"    # the cache pickles this tree's classes
+        try:
+            old = theirs.load_rulebase()
+        finally:
+            os.environ.pop("MITOS_CACHE_DIR")
+            if saved is not None:
+                os.environ["MITOS_CACHE_DIR"] = saved
+        rb = load_rulebase()
         c = rb.compiled
         rng = np.random.default_rng(np.random.SeedSequence(SEED))
         X = rng.uniform(c.universe[:, 0], c.universe[:, 1], size=(n, len(c.inputs)))
