@@ -35,7 +35,7 @@ from .planner import Percepts, Planner
 from .route import Route, grid_route, plan_route
 from .route import clearances as route_clearances
 from .staticmap import StaticMap, build_static
-from .world import Agent, World
+from .world import Agent, Grid, World
 
 STUCK_TIME = 6.0        # s
 STUCK_DISTANCE = 3.0    # in
@@ -53,6 +53,7 @@ class Scene:
     static: StaticMap
     routes: tuple[Route, ...]
     given: knowledge.Given | None = None
+    plan_grid: Grid | None = None      # the cells each robot's own map starts from
 
     def __hash__(self) -> int:
         return id(self)
@@ -77,7 +78,7 @@ def prepare(world: World) -> Scene:
         else:
             known = StaticMap(given.walls, np.zeros((0, 4, 2)), given.grid, static.bounds)
             routes.append(grid_route(known, a.start, a.goal, asked, minimum=least))
-    return Scene(static, tuple(routes), given)
+    return Scene(static, tuple(routes), given, knowledge.plan_grid(given, static, world))
 
 
 @dataclass
@@ -391,9 +392,9 @@ class Simulation:
         self._near_known = [np.zeros((0, 4))] * n
         self._routes = list(self.scene.routes)          # replanning replaces them
         self._replanned: list[tuple[int, int, Route]] = []
-        self._maps: list[knowledge.RobotMap | None] = [None] * n
-        if self._given.knows == "none" and self._given.grid is not None:
-            self._maps = [knowledge.RobotMap.of(self._given.grid) for _ in range(n)]
+        grid = self.scene.plan_grid or knowledge.plan_grid(self._given, self.scene.static,
+                                                           self.world)
+        self._maps = [knowledge.RobotMap.of(grid) for _ in range(n)]
         self._history: list[tuple[np.ndarray, np.ndarray]] = []   # (x, y) after each move
         self._outcomes = ["timeout"] * n
         self._collided = 0
@@ -604,39 +605,44 @@ class Simulation:
         routes, sen = self._routes, self.world.sensors
         for i in range(self.n):
             f = perception.frame(routes[i], s.pose[i, :2], self._s_hint[i])
-            rmap = self._maps[i] if self._learn(i, s) and self._active[i] else None
-            if rmap is not None:
+            rmap = self._maps[i]
+            if self._learn(i, s) and self._active[i]:
                 route = knowledge.replan(rmap, routes[i], f.s, s.pose[i, :2],
                                          self.world.agents[i].goal, s.t, *self._asked[i],
-                                         self._cfg.sight, self._given.knows)
+                                         self._cfg.sight, self.world.replan)
                 if route is not None:
                     routes[i] = route
                     self._replanned.append((self._k, i, route))
                     f = perception.frame(route, s.pose[i, :2], 0.0)
             self._s_hint[i] = f.s
+            least = self._asked[i][1]
+            cells = rmap.near(s.pose[i, :2], self._cfg.lookahead + least)
+            radius = rmap.grid.resolution / 2
+            ahead = perception.clear_lookahead(routes[i], f, s.pose[i, :2], cells, radius,
+                                               least + self._cfg.lookahead_room, self._cfg)
+            room = perception.route_room(f, s.pose[i, :2], cells, radius, least)
             p = perception.perceive(routes[i], f, (self._x[i], self._y[i], self._h[i]),
                                     self.robots[i], self._dirs[i], s.ranges[i],
                                     self._expected[i], sen.range, self._spacing,
-                                    self._threshold, self._cfg)
+                                    self._threshold, self._cfg, ahead, room)
             for key in perception.INPUTS:
                 s.inputs[key][i] = p[key]
-            s.targets[i] = perception.target_point(routes[i], f, self._cfg)
+            s.targets[i] = perception.target_point(routes[i], f, self._cfg, ahead)
 
     def _learn(self, i: int, s: _Sensed) -> bool:
         """Mark on robot ``i``'s map what its readings show and its map does not (everything
         it hits, with no map): whether anything new was marked. Its map is made on first
         need."""
-        max_range = self.world.sensors.range
+        sen = self.world.sensors
+        max_range = sen.range
         measured, dirs = s.ranges[i], self._dirs[i]
+        rmap = self._maps[i]
+        rmap.clear(s.pose[i, :2], dirs, measured, max_range)
         valid = measured < max_range * 0.999
         seen = (valid if self._given.knows == "none"
                 else valid & (measured < self._expected[i] - self._threshold))
         if not seen.any():
             return False
-        rmap = self._maps[i]
-        if rmap is None:
-            rmap = self._maps[i] = knowledge.RobotMap.of(
-                knowledge.plan_grid(self._given, self.scene.static, self.world))
         before = len(rmap.fresh)
         rmap.mark(s.pose[i, :2] + measured[seen, None] * dirs[seen], dirs[seen])
         return len(rmap.fresh) > before
@@ -764,6 +770,7 @@ def true_inputs(res: SimResult) -> dict[str, np.ndarray]:
     angles = sen.angles
     reach = sen.range + max(max(r.length, r.width) for r in robots)
     cfg = perception.Settings()
+    least = [clearances(world, a)[1] for a in agents]
     shape_outline, outline_owner = obs_mod.outline_points(
         world.obstacles, np.zeros((len(world.obstacles), 2)))
     out = {key: np.zeros((res.ticks, n)) for key in perception.INPUTS}
@@ -787,9 +794,13 @@ def true_inputs(res: SimResult) -> dict[str, np.ndarray]:
                                         robots[i], sen.range, cfg)
             seen = expected[:-2] < sen.range * 0.999
             wall_points = pose[i, :2] + expected[:-2, None][seen] * dirs[:-2][seen]
+            known = np.concatenate([wall_points, things])
+            ahead = perception.clear_lookahead(route, f, pose[i, :2], known, 0.0,
+                                               least[i] + cfg.lookahead_room, cfg)
+            room = perception.route_room(f, pose[i, :2], known, 0.0, least[i])
             tr = perception.truth(route, f, tuple(pose[i]), robots[i],
                                   (float(across[0]), float(across[1])), things, gaps, cfg,
-                                  wall_points)
+                                  wall_points, ahead, room)
             for key in perception.INPUTS:
                 out[key][k, i] = tr[key]
     return out

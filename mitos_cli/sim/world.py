@@ -137,6 +137,10 @@ class Agent:
     goal: Goal
 
 
+#: ``route: {replan}``: when a robot plans its route again (:func:`.knowledge.replan`)
+REPLANS = ("clearance", "blocked", "never")
+
+
 @dataclass(frozen=True)
 class World:
     name: str
@@ -155,6 +159,7 @@ class World:
     knows: str = "map"             # what the robot is given: the map itself ("map"), another
     given: Grid | None = None      # grid ("given", this one), or nothing at all ("none")
     min_clearance: float | None = None   # in: the tightest squeeze its route may make
+    replan: str = "clearance"      # when the route is planned again: one of REPLANS
 
     @property
     def robot(self) -> Robot:
