@@ -149,9 +149,9 @@ class RobotMap:
         inside = (row >= 0) & (row < rows) & (col >= 0) & (col < cols)
         return row, col, inside
 
-    def near(self, p: np.ndarray, reach: float) -> np.ndarray:
+    def near(self, p: np.ndarray, reach: float, given: bool = False) -> np.ndarray:
         """The centres ``[P, 2]`` of the occupied cells in the square of half side ``reach``
-        around ``p``."""
+        around ``p`` (``given``: of the cells it was given, without its marks)."""
         g = self.grid
         res, (ox, oy) = g.resolution, g.origin
         rows, cols = self.occupied.shape
@@ -159,7 +159,8 @@ class RobotMap:
         r0 = min(max(int((p[1] - reach - oy) // res), 0), rows)
         c1 = min(max(int((p[0] + reach - ox) // res) + 1, 0), cols)
         r1 = min(max(int((p[1] + reach - oy) // res) + 1, 0), rows)
-        r, c = np.nonzero(self.occupied[r0:r1, c0:c1])
+        cells = self.grid.occupied if given else self.occupied
+        r, c = np.nonzero(cells[r0:r1, c0:c1])
         return np.stack([ox + (c + c0 + 0.5) * res, oy + (r + r0 + 0.5) * res], axis=1)
 
     def clear(self, origin: np.ndarray, dirs: np.ndarray, measured: np.ndarray,

@@ -616,7 +616,9 @@ class Simulation:
                     f = perception.frame(route, s.pose[i, :2], 0.0)
             self._s_hint[i] = f.s
             least = self._asked[i][1]
-            cells = rmap.near(s.pose[i, :2], self._cfg.lookahead + least)
+            # what the route keeps clear of: the marks too, where it is replanned round them
+            cells = rmap.near(s.pose[i, :2], self._cfg.lookahead + least,
+                              given=self.world.replan != "clearance")
             radius = rmap.grid.resolution / 2
             ahead = perception.clear_lookahead(routes[i], f, s.pose[i, :2], cells, radius,
                                                least + self._cfg.lookahead_room, self._cfg)
