@@ -283,7 +283,8 @@ def way_past(rmap: RobotMap, route: Route, s: float, p: np.ndarray, ahead: float
 
 
 def replan(rmap: RobotMap, route: Route, s: float, p: np.ndarray, goal: Goal, t: float,
-           clearance: float, minimum: float, sight: float, when: str = "clearance") -> Route | None:
+           clearance: float, minimum: float, sight: float, when: str = "clearance",
+           heading: float = 0.0, behind: float = 0.0) -> Route | None:
     """A new route from ``p`` when what the robot has newly sensed invalidates the route ahead
     (``when``: see the module docstring), else ``None``."""
     if when == "never" or not rmap.fresh or t - rmap.checked_at < REPLAN_EVERY:
@@ -299,9 +300,9 @@ def replan(rmap: RobotMap, route: Route, s: float, p: np.ndarray, goal: Goal, t:
             way_past(rmap, route, s, p, sight, clearance, minimum):
         return None
     try:
-        new = grid_route(_as_map(rmap.grid), Pose(float(p[0]), float(p[1])), goal, clearance,
-                         minimum=minimum, occupied=rmap.occupied, explain=False,
-                         leave=clearance + 6.0)
+        new = grid_route(_as_map(rmap.grid), Pose(float(p[0]), float(p[1]), heading), goal,
+                         clearance, minimum=minimum, occupied=rmap.occupied, explain=False,
+                         leave=clearance + 6.0, behind=behind)
     except NarrowPassage:
         return None                # no way left on what it knows: drive on, the rules decide
     rmap.replans += 1

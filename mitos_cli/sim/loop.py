@@ -39,6 +39,7 @@ from .world import Agent, Grid, World
 
 STUCK_TIME = 6.0        # s
 STUCK_DISTANCE = 3.0    # in
+BEHIND = 30.0           # in: a replanned route that starts this near behind the robot costs more
 NEAR_SLACK = 24.0       # in: a robot's set of nearby walls is gathered again after this move
 OUTCOMES = ("success", "collision", "timeout", "stuck")
 # a robot's own outcome may also be `stopped`: still driving when another robot's collision or
@@ -609,7 +610,8 @@ class Simulation:
             if self._learn(i, s) and self._active[i]:
                 route = knowledge.replan(rmap, routes[i], f.s, s.pose[i, :2],
                                          self.world.agents[i].goal, s.t, *self._asked[i],
-                                         self._cfg.sight, self.world.replan)
+                                         self._cfg.sight, self.world.replan,
+                                         math.degrees(self._h[i]), BEHIND)
                 if route is not None:
                     routes[i] = route
                     self._replanned.append((self._k, i, route))

@@ -345,7 +345,7 @@ NARROW_COST = 20.0      # extra cost per step (in steps) of a node closer than t
 def grid_route(static: StaticMap, start: Pose, goal: Goal, clearance: float,
                cell: float = 6.0, minimum: float | None = None,
                occupied: np.ndarray | None = None, explain: bool = True,
-               leave: float = 0.0) -> Route:
+               leave: float = 0.0, behind: float = 0.0) -> Route:
     """A* on nodes about ``cell`` inches apart, each kept at least ``clearance`` inches (the
     exact Euclidean distance) from the occupied cells, preferring the middle of the corridors.
     Nodes closer than that but not closer than ``minimum`` (the robot's half width plus its
@@ -386,6 +386,12 @@ def grid_route(static: StaticMap, start: Pose, goal: Goal, clearance: float,
     # NARROW_COST times more, so the route squeezes through only where nothing wider leads on
     penalty = (np.clip(reach - node_c, 0.0, reach) / reach * 4.0
                + np.where(node_c < clearance, NARROW_COST, 0.0))
+    if behind > 0:      # a tricycle cannot turn on the spot: the way back costs a squeeze
+        x, y = centre((slice(None), slice(None)))
+        h = math.radians(start.heading)
+        rx, ry = x - start.x, y - start.y
+        back = (rx * math.cos(h) + ry * math.sin(h) < 0) & (np.hypot(rx, ry) <= behind)
+        penalty = penalty + np.where(back, NARROW_COST, 0.0)
     blocked = node_c < floor
     blocked[s] = blocked[t] = False      # the robot stands there: let the search leave it
     if leave > 0:

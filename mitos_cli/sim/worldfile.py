@@ -14,8 +14,20 @@ from typing import Any
 from ..errors import NameError_, Span, WorldError, unknown
 from ..lang import yamlpos
 from ..lang.yamlpos import YList, YMap
-from .world import (REPLANS, Agent, Corridor, Goal, Jitter, Motion, Obstacle, Pose, Randomise, Robot,
-                    Sensors, World)
+from .world import (
+    REPLANS,
+    Agent,
+    Corridor,
+    Goal,
+    Jitter,
+    Motion,
+    Obstacle,
+    Pose,
+    Randomise,
+    Robot,
+    Sensors,
+    World,
+)
 
 TOP_KEYS = ("name", "seed", "dt", "time_limit", "substeps", "behavior", "robot", "sensors",
             "q_init", "q_goal", "map", "obstacles", "robots", "randomise", "route")
