@@ -136,10 +136,20 @@ class RobotMap:
     fresh: list = field(default_factory=list)      # marks since the last check, [k, 2] each
     checked_at: float = -math.inf  # s
     replans: int = 0
+    planned: np.ndarray | None = None   # the cells the route was last planned on (None: given)
 
     @classmethod
     def of(cls, grid: Grid) -> RobotMap:
         return cls(grid, grid.occupied.copy())
+
+    def accounted(self, points: np.ndarray) -> np.ndarray:
+        """Which points ``[P, 2]`` lie in cells the robot's route was planned round (its map
+        when it last planned: the given cells, and what it had marked by then)."""
+        row, col, inside = self.cells(points)
+        out = np.zeros(len(points), dtype=bool)
+        cells = self.grid.occupied if self.planned is None else self.planned
+        out[inside] = cells[row[inside], col[inside]]
+        return out
 
     def cells(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         g = self.grid
@@ -306,4 +316,5 @@ def replan(rmap: RobotMap, route: Route, s: float, p: np.ndarray, goal: Goal, t:
     except NarrowPassage:
         return None                # no way left on what it knows: drive on, the rules decide
     rmap.replans += 1
+    rmap.planned = rmap.occupied.copy()
     return new

@@ -628,10 +628,20 @@ class Simulation:
             p = perception.perceive(routes[i], f, (self._x[i], self._y[i], self._h[i]),
                                     self.robots[i], self._dirs[i], s.ranges[i],
                                     self._expected[i], sen.range, self._spacing,
-                                    self._threshold, self._cfg, ahead, room)
+                                    self._threshold, self._cfg, ahead, room,
+                                    self._kept(i, s, least))
             for key in perception.INPUTS:
                 s.inputs[key][i] = p[key]
             s.targets[i] = perception.target_point(routes[i], f, self._cfg, ahead)
+
+    def _kept(self, i: int, s: _Sensed, least: float) -> tuple[float, np.ndarray] | None:
+        """Where robot ``i``'s route is replanned round what it senses: the least clearance
+        it keeps, and which of its readings hit cells the route was planned round."""
+        if self.world.replan != "clearance":
+            return None
+        rmap, dirs = self._maps[i], self._dirs[i]
+        hits = s.pose[i, :2] + s.ranges[i, :, None] * dirs + dirs * (rmap.grid.resolution / 2)
+        return least, rmap.accounted(hits)
 
     def _learn(self, i: int, s: _Sensed) -> bool:
         """Mark on robot ``i``'s map what its readings show and its map does not (everything

@@ -145,7 +145,7 @@ def _road(a, b, valid, window: float, far: float) -> tuple[float, float]:
 
 
 def _obstruction(route: Route, a, b, points, valid, widen, robot: Robot, f: Frame,
-                 cfg: Settings, rel_heading):
+                 cfg: Settings, rel_heading, kept: tuple[float, np.ndarray] | None = None):
     """(size, position, distance) of the nearest obstructing object among ``points``.
 
     ``rel_heading`` ``(ah, bh)``: the points in the robot's own frame (along and across its
@@ -157,6 +157,12 @@ def _obstruction(route: Route, a, b, points, valid, widen, robot: Robot, f: Fram
     ah, bh = rel_heading
     blocking = ahead & (((b + widen > -half) & (b - widen < half)) |
                         ((ah > 0) & (bh + widen > -half) & (bh - widen < half)))
+    if kept is not None:    # what the route was planned round obstructs only within its word
+        least, planned = kept
+        round_ = blocking & planned
+        if round_.any():
+            blocking[round_] = (route.distance(points[round_], f.s, cfg.sight)
+                                - widen[round_] < least)
     if not blocking.any():
         return 0.0, 0.0, NO_OBSTACLE
     i = int(np.argmin(np.where(blocking, a, np.inf)))
@@ -320,10 +326,14 @@ def target_point(route: Route, f: Frame, cfg: Settings,
 def perceive(route: Route, f: Frame, pose: tuple[float, float, float], robot: Robot,
              dirs: np.ndarray, measured: np.ndarray, expected: np.ndarray, max_range: float,
              spacing: float, threshold: float, cfg: Settings = Settings(),
-             lookahead: float | None = None, room: float = math.inf) -> dict[str, float]:
+             lookahead: float | None = None, room: float = math.inf,
+             kept: tuple[float, np.ndarray] | None = None) -> dict[str, float]:
     """The inputs from one robot's readings (see the module docstring); ``lookahead``: of
     ``heading`` (:func:`clear_lookahead`; default ``cfg.lookahead``); ``room``: how far the
-    keep-right lane may lie off the route (:func:`route_room`)."""
+    keep-right lane may lie off the route (:func:`route_room`); ``kept``: where the route is
+    replanned round what the robot senses, the least clearance it keeps and which readings
+    hit what it was planned round (``[B]``): those obstruct only within that clearance of
+    the route, not anywhere in the band ahead."""
     p = np.array(pose[:2])
     hits = p + measured[:, None] * dirs
     rel = hits - p
@@ -339,7 +349,7 @@ def perceive(route: Route, f: Frame, pose: tuple[float, float, float], robot: Ro
         in_way[in_way] = route.near(hits[in_way], f.s, robot.width / 2 + robot.safety_margin,
                                     cfg.sight)
     size, position, distance = _obstruction(route, a, b, hits, obstacle_hit | in_way, widen,
-                                            robot, f, cfg, _own_frame(rel, pose[2]))
+                                            robot, f, cfg, _own_frame(rel, pose[2]), kept)
     heading, lane, goal = _common(route, p, pose[2], f, road, robot, cfg,
                                   cfg.lookahead if lookahead is None else lookahead, room)
     wl, wr = _walls(a, b, valid, robot, cfg, max_range, obstacle_hit)
