@@ -22,7 +22,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import geometry, kinematics, knowledge, perception, sensors
+from . import geometry, kinematics, knowledge, perception, safety, sensors
 from . import obstacles as obs_mod
 from .geometry import (
     box_polygon_depth,
@@ -375,6 +375,8 @@ class Simulation:
         self._known_walls = StaticMap(self._given.walls, np.zeros((0, 4, 2)), None,
                                       self.scene.static.bounds)
         self._asked = [clearances(world, a) for a in world.agents]
+        self._body = [math.hypot(r.length, r.width) for r in self.robots]   # in: a diagonal
+        self._safety = safety.Settings()
         self._still = None
         if not any(o.motion.kind in ("velocity", "waypoints") for o in world.obstacles):
             self._still = self._obstacles_at(0.0)
@@ -397,6 +399,7 @@ class Simulation:
                                                            self.world)
         self._maps = [knowledge.RobotMap.of(grid) for _ in range(n)]
         self._history: list[tuple[np.ndarray, np.ndarray]] = []   # (x, y) after each move
+        self._recovery = [safety.Recovery() for _ in range(n)]
         self._outcomes = ["timeout"] * n
         self._collided = 0
         self._k = 0
@@ -509,6 +512,7 @@ class Simulation:
             s.command[:] = np.asarray(command, float).reshape(self.n, 2)
             s.command[~self._active] = np.stack([self.limits.straight, np.zeros(self.n)],
                                                 axis=1)[~self._active]
+        self._guard(s)
         tick = self._record(s)
         if self._hit.any():
             self._collided = int(self._hit.sum())
@@ -683,6 +687,53 @@ class Simulation:
                            self._goals[idx], self._steer[idx], idx)
             c_steer, c_speed = self.planner.plan(sub)
             cmd[idx, 0], cmd[idx, 1] = c_steer, c_speed
+
+    def _guard(self, s: _Sensed) -> None:
+        """The robot's own safety on every active robot's command (:mod:`.safety`): the brake,
+        and backing out of a pocket when it has held the robot too long."""
+        cfg, dt = self._safety, self.dt
+        for i in np.flatnonzero(self._active):
+            robot = self.robots[i]
+            if not robot.brake:
+                continue
+            rec, rmap = self._recovery[i], self._maps[i]
+            pose = (float(self._x[i]), float(self._y[i]), float(self._h[i]))
+            cells = rmap.near(s.pose[i, :2], cfg.reach + self._body[i])
+            radius = rmap.grid.resolution / 2
+            straight = robot.steering_straight
+
+            def free(wheel: float, backward: bool) -> float:
+                return safety.free_travel(cells, radius, pose, robot, wheel - straight,
+                                          backward, cfg.reach, cfg.step)
+
+            if rec.left > 0:                                 # backing out
+                rec.left -= dt
+                back = free(rec.wheel, True)
+                if back > cfg.margin:
+                    s.command[i] = (rec.wheel, -min(robot.max_reverse,
+                                                    safety.brake(back, robot.acceleration,
+                                                                 cfg.margin)))
+                    continue
+                rec.left = 0.0
+            want = float(s.command[i, 1])
+            turn = robot.max_steering_rate * dt
+            wheel = float(np.clip(s.command[i, 0], robot.steering_min, robot.steering_max))
+            wheel = float(self._steer[i] + np.clip(wheel - self._steer[i], -turn, turn))
+            limit = safety.brake(free(wheel, want < 0), robot.acceleration, cfg.margin)
+            if abs(want) > limit:
+                s.command[i, 1] = math.copysign(limit, want)
+            held = abs(want) > cfg.want and limit < cfg.want
+            rec.held = rec.held + dt if held else 0.0
+            if rec.held < cfg.patience or robot.max_reverse <= 0:
+                continue
+            # the route's side: back out on the other lock, which swings the nose toward it
+            lock = robot.steering_min if s.inputs["heading"][i] > 0 else robot.steering_max
+            for wheel in (lock, straight):
+                if free(wheel, True) >= cfg.back_room:
+                    rec.left, rec.wheel, rec.held = cfg.back_time, wheel, 0.0
+                    rec.count += 1
+                    s.command[i] = (wheel, -robot.max_reverse)
+                    break
 
     def act(self, s: _Sensed) -> None:
         """Steering-rate and acceleration limits and exact arcs, substep by substep; stopped

@@ -42,6 +42,8 @@ class Robot:
     max_steering_rate: float = 180.0   # deg/s
     max_speed: float = 60.0        # in/s
     acceleration: float = 40.0     # in/s^2 (also the braking limit)
+    max_reverse: float = 15.0      # in/s: the front wheel drives backward too (0: it cannot)
+    brake: bool = True             # the emergency brake and backing out (sim/safety.py)
 
 
 @dataclass(frozen=True)

@@ -32,7 +32,7 @@ from .world import (
 TOP_KEYS = ("name", "seed", "dt", "time_limit", "substeps", "behavior", "robot", "sensors",
             "q_init", "q_goal", "map", "obstacles", "robots", "randomise", "route")
 ROBOT_KEYS = ("model", "wheelbase", "footprint", "safety_margin", "steering", "max_speed",
-              "acceleration")
+              "acceleration", "max_reverse", "brake")
 STEERING_KEYS = ("min", "max", "straight", "max_rate")
 SENSOR_KEYS = ("layout", "count", "fov", "cone", "range", "noise")
 MAP_KEYS = ("corridors", "grid", "unknown", "given")
@@ -166,7 +166,9 @@ def read_robot(r: _Reader, value: Any, span: Span, base: Robot | None = None) ->
         max_steering_rate=r.number(st, "max_rate", "robot steering", d.max_steering_rate,
                                    positive=True),
         max_speed=r.number(m, "max_speed", "robot", d.max_speed, positive=True),
-        acceleration=r.number(m, "acceleration", "robot", d.acceleration, positive=True))
+        acceleration=r.number(m, "acceleration", "robot", d.acceleration, positive=True),
+        max_reverse=r.number(m, "max_reverse", "robot", d.max_reverse, minimum=0),
+        brake=r.flag(m, "brake", "robot", d.brake))
 
 
 def read_sensors(r: _Reader, value: Any, span: Span) -> Sensors:
