@@ -142,13 +142,20 @@ class RobotMap:
     def of(cls, grid: Grid) -> RobotMap:
         return cls(grid, grid.occupied.copy())
 
-    def accounted(self, points: np.ndarray) -> np.ndarray:
-        """Which points ``[P, 2]`` lie in cells the robot's route was planned round (its map
-        when it last planned: the given cells, and what it had marked by then)."""
-        row, col, inside = self.cells(points)
-        out = np.zeros(len(points), dtype=bool)
+    def accounted(self, points: np.ndarray, reach: int = 2) -> np.ndarray:
+        """Which points ``[P, 2]`` lie within ``reach`` cells of a cell the robot's route was
+        planned round (its map when it last planned: the given cells, and what it had marked
+        by then): an echo from the same object a little further along its side, as the robot
+        sees it from another angle, is the object the route went round, not a new one."""
+        row, col, _ = self.cells(points)
         cells = self.grid.occupied if self.planned is None else self.planned
-        out[inside] = cells[row[inside], col[inside]]
+        rows, cols = cells.shape
+        out = np.zeros(len(points), dtype=bool)
+        for dr in range(-reach, reach + 1):
+            for dc in range(-reach, reach + 1):
+                r, c = row + dr, col + dc
+                inside = (r >= 0) & (r < rows) & (c >= 0) & (c < cols)
+                out[inside] |= cells[r[inside], c[inside]]
         return out
 
     def cells(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
