@@ -106,6 +106,7 @@ class SimResult:
     active: np.ndarray | None = None   # [T, n] robot still driving at that tick
     progress: np.ndarray | None = None  # [T, n] arc length along each robot's route (in)
     replanned: tuple[tuple[int, int, Route], ...] = ()   # (tick, robot, new route) in order
+    backed_out: tuple[tuple[int, int], ...] = ()   # (tick, robot) each backing-out began
     metrics: dict = field(default_factory=dict)    # the run's figures over all robots
     robot_metrics: tuple[dict, ...] = ()           # each robot's figures (name, outcome, ...)
     _true: dict | None = field(default=None, repr=False)
@@ -191,6 +192,7 @@ def _robot_metrics(res: SimResult, dt: float) -> tuple[dict, ...]:
             "time_s": round(time_s, 6), "path_length_in": path,
             "min_clearance_in": float(res.clearance[:, i].min()) if res.ticks else 0.0,
             "replans": sum(j == i for _, j, _ in res.replanned),
+            "backouts": sum(j == i for _, j in res.backed_out),
             "mean_speed_in_s": path / time_s if time_s > 0 else 0.0,
             "steering_total_variation_deg":
                 float(np.abs(np.diff(res.steering[:ticks, i])).sum())})
@@ -208,6 +210,7 @@ def _metrics(res: SimResult, dt: float) -> dict:
             "time_s": round(float(res.ticks * dt), 6), "path_length_in": path,
             "min_clearance_in": min(m["min_clearance_in"] for m in each),
             "replans": sum(m["replans"] for m in each),
+            "backouts": sum(m["backouts"] for m in each),
             "mean_speed_in_s": path / driving if driving > 0 else 0.0,
             "steering_total_variation_deg": sum(m["steering_total_variation_deg"]
                                                 for m in each),
@@ -400,6 +403,7 @@ class Simulation:
         self._maps = [knowledge.RobotMap.of(grid) for _ in range(n)]
         self._history: list[tuple[np.ndarray, np.ndarray]] = []   # (x, y) after each move
         self._recovery = [safety.Recovery() for _ in range(n)]
+        self._backed: list[tuple[int, int]] = []
         self._outcomes = ["timeout"] * n
         self._collided = 0
         self._k = 0
@@ -731,7 +735,7 @@ class Simulation:
             for wheel in (lock, straight):
                 if free(wheel, True) >= cfg.back_room:
                     rec.left, rec.wheel, rec.held = cfg.back_time, wheel, 0.0
-                    rec.count += 1
+                    self._backed.append((self._k, int(i)))
                     s.command[i] = (wheel, -robot.max_reverse)
                     break
 
@@ -800,7 +804,8 @@ class Simulation:
             obstacles=(np.array([r.obstacles for r in rec]).reshape(T, -1, 2) if rec
                        else np.zeros((0, len(self.world.obstacles), 2))),
             routes=self.scene.routes, static=self.scene.static, active=stack("active", (n,)),
-            progress=stack("progress", (n,)), replanned=tuple(self._replanned))
+            progress=stack("progress", (n,)), replanned=tuple(self._replanned),
+            backed_out=tuple(self._backed))
         res.robot_metrics = _robot_metrics(res, dt)
         res.metrics = _metrics(res, dt)
         return res

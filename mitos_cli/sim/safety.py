@@ -85,4 +85,3 @@ class Recovery:
     held: float = 0.0              # s the brake has held it while its planner wanted to go
     left: float = 0.0              # s of backing out left
     wheel: float = 90.0            # deg: the lock it backs out on
-    count: int = 0                 # backings-out so far
