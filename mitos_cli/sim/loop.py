@@ -695,49 +695,20 @@ class Simulation:
     def _guard(self, s: _Sensed) -> None:
         """The robot's own safety on every active robot's command (:mod:`.safety`): the brake,
         and backing out of a pocket when it has held the robot too long."""
-        cfg, dt = self._safety, self.dt
+        cfg = self._safety
         for i in np.flatnonzero(self._active):
-            robot = self.robots[i]
+            robot, rmap = self.robots[i], self._maps[i]
             if not robot.brake:
                 continue
-            rec, rmap = self._recovery[i], self._maps[i]
-            pose = (float(self._x[i]), float(self._y[i]), float(self._h[i]))
-            cells = rmap.near(s.pose[i, :2], cfg.reach + self._body[i])
-            radius = rmap.grid.resolution / 2
-            straight = robot.steering_straight
-
-            def free(wheel: float, backward: bool) -> float:
-                return safety.free_travel(cells, radius, pose, robot, wheel - straight,
-                                          backward, cfg.reach, cfg.step)
-
-            if rec.left > 0:                                 # backing out
-                rec.left -= dt
-                back = free(rec.wheel, True)
-                if back > cfg.margin:
-                    s.command[i] = (rec.wheel, -min(robot.max_reverse,
-                                                    safety.brake(back, robot.acceleration,
-                                                                 cfg.margin)))
-                    continue
-                rec.left = 0.0
-            want = float(s.command[i, 1])
-            turn = robot.max_steering_rate * dt
-            wheel = float(np.clip(s.command[i, 0], robot.steering_min, robot.steering_max))
-            wheel = float(self._steer[i] + np.clip(wheel - self._steer[i], -turn, turn))
-            limit = safety.brake(free(wheel, want < 0), robot.acceleration, cfg.margin)
-            if abs(want) > limit:
-                s.command[i, 1] = math.copysign(limit, want)
-            held = abs(want) > cfg.want and limit < cfg.want
-            rec.held = rec.held + dt if held else 0.0
-            if rec.held < cfg.patience or robot.max_reverse <= 0:
-                continue
-            # the route's side: back out on the other lock, which swings the nose toward it
-            lock = robot.steering_min if s.inputs["heading"][i] > 0 else robot.steering_max
-            for wheel in (lock, straight):
-                if free(wheel, True) >= cfg.back_room:
-                    rec.left, rec.wheel, rec.held = cfg.back_time, wheel, 0.0
-                    self._backed.append((self._k, int(i)))
-                    s.command[i] = (wheel, -robot.max_reverse)
-                    break
+            body = safety.Body(robot, (float(self._x[i]), float(self._y[i]), float(self._h[i])),
+                               float(self._steer[i]),
+                               rmap.near(s.pose[i, :2], cfg.reach + self._body[i]),
+                               rmap.grid.resolution / 2, float(s.inputs["heading"][i]))
+            carried, backs = safety.guard((float(s.command[i, 0]), float(s.command[i, 1])),
+                                          body, self._recovery[i], self.dt, cfg)
+            s.command[i] = carried
+            if backs:
+                self._backed.append((self._k, int(i)))
 
     def act(self, s: _Sensed) -> None:
         """Steering-rate and acceleration limits and exact arcs, substep by substep; stopped

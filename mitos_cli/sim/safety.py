@@ -85,3 +85,55 @@ class Recovery:
     held: float = 0.0              # s the brake has held it while its planner wanted to go
     left: float = 0.0              # s of backing out left
     wheel: float = 90.0            # deg: the lock it backs out on
+
+
+@dataclass(frozen=True)
+class Body:
+    """What the guard needs of one robot at one tick: its pose (x, y in, heading rad), its
+    wheel's angle now (deg), the cells it knows are occupied near it (``[P, 2]``, discs of
+    ``radius``) and the side its route lies on (``heading`` input: positive right)."""
+
+    robot: Robot
+    pose: tuple[float, float, float]
+    wheel: float
+    cells: np.ndarray
+    radius: float
+    route_side: float
+
+    def free(self, wheel: float, backward: bool, cfg: Settings) -> float:
+        """Free travel with the wheel at ``wheel`` (deg, 90 straight), forward or backward."""
+        return free_travel(self.cells, self.radius, self.pose, self.robot,
+                           wheel - self.robot.steering_straight, backward, cfg.reach, cfg.step)
+
+
+def guard(command: tuple[float, float], body: Body, rec: Recovery, dt: float,
+          cfg: Settings = Settings()) -> tuple[tuple[float, float], bool]:
+    """The command the robot carries out (steering deg, speed in/s) and whether it begins to
+    back out now, from its planner's ``command``: a backing-out under way goes on while the
+    way behind is free; otherwise the brake holds the speed to what the arc the wheel will be
+    on allows, and a robot held ``patience`` seconds against its planner's wish backs out
+    (on the lock that swings its nose toward its route, else straight), if it has the room.
+    ``rec`` is updated."""
+    robot = body.robot
+    if rec.left > 0:
+        rec.left -= dt
+        back = body.free(rec.wheel, True, cfg)
+        if back > cfg.margin:
+            return (rec.wheel, -min(robot.max_reverse,
+                                    brake(back, robot.acceleration, cfg.margin))), False
+        rec.left = 0.0
+    steer, want = command
+    turn = robot.max_steering_rate * dt
+    target = min(max(steer, robot.steering_min), robot.steering_max)
+    wheel = body.wheel + min(max(target - body.wheel, -turn), turn)
+    limit = brake(body.free(wheel, want < 0, cfg), robot.acceleration, cfg.margin)
+    speed = math.copysign(limit, want) if abs(want) > limit else want
+    rec.held = rec.held + dt if abs(want) > cfg.want and limit < cfg.want else 0.0
+    if rec.held < cfg.patience or robot.max_reverse <= 0:
+        return (steer, speed), False
+    lock = robot.steering_min if body.route_side > 0 else robot.steering_max
+    for wheel in (lock, robot.steering_straight):
+        if body.free(wheel, True, cfg) >= cfg.back_room:
+            rec.left, rec.wheel, rec.held = cfg.back_time, wheel, 0.0
+            return (wheel, -robot.max_reverse), True
+    return (steer, speed), False
