@@ -15,9 +15,11 @@ as ``mitos simulate`` does (sensor noise, moving obstacles, replanning, the verd
   universes as bounds. With ``observe_ranges=True`` a ``Dict`` of ``inputs`` and ``ranges``
   (the noisy sonar readings, ``[0, sensor range]`` inches, one per beam).
 - **action**: ``[steering (deg, 90 straight, below 90 left), speed (in/s)]`` in a ``Box`` over
-  the robot's steering limits and ``[0, max_speed]``; the kinematics clamp a command to those
-  limits and then apply the steering rate and acceleration limits (the command is recorded as
-  given, as the planner's is).
+  the robot's steering limits and ``[-max_reverse, max_speed]`` (below 0 it drives backward);
+  the robot's own brake (:mod:`.sim.safety`; ``robot: {brake: false}`` takes it away) holds
+  the speed to what it can stop from before its body touches what it knows, and backs out of
+  a pocket it has held it in; the kinematics clamp a command to the limits and then apply the
+  steering rate and acceleration limits (the command is recorded as the robot carried it out).
 - **reward**: ``PROGRESS_REWARD`` (0.01) per inch by which the route left to the goal shrank
   in the step (a replanned, longer route counts as going back), ``COLLISION_PENALTY`` (-10) when
   the robot touches something, ``GOAL_BONUS`` (+10) when it reaches its goal.
@@ -111,7 +113,8 @@ class MitosEnv(gymnasium.Env):
         else:
             self.observation_space = inputs
         self.action_space = spaces.Box(
-            np.array([robot.steering_min, 0.0]), np.array([robot.steering_max, robot.max_speed]),
+            np.array([robot.steering_min, -robot.max_reverse]),
+            np.array([robot.steering_max, robot.max_speed]),
             dtype=np.float64)
         self.sim = Simulation(loaded, _Commanded(), loaded.seed)
         self._seeded = False

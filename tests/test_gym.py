@@ -62,8 +62,10 @@ def test_fuzzy_policy_drives_the_trajectory_of_simulate_bit_for_bit(short_world)
     assert np.array_equal(ran.pose, ref.pose)
     assert np.array_equal(ran.command, ref.command)
     assert (terminated, truncated, info["outcome"]) == (False, True, ref.outcome)
-    # the reward is the route's progress: 0.01 per inch of route left behind
-    left = ref.routes[0].length - ref.progress[-1, 0]
+    # the reward is the route's progress: 0.01 per inch by which the route left shrank (the
+    # route the robot follows at each tick: a replanned one from its replanning on)
+    k = ref.ticks - 1
+    left = ref.route_at(k, 0).length - ref.progress[k, 0]
     assert sum(rewards) == pytest.approx(0.01 * (ref.routes[0].length - left))
 
 
@@ -83,7 +85,19 @@ def test_the_documented_example_reaches_the_goal_as_simulate_does(capsys):
     assert scope["info"]["t"] == scope["same"].metrics["time_s"]
 
 
+def test_the_brake_stops_a_policy_short_of_the_wall(short_world):
+    env = gymnasium.make("mitos/World-v0", world=str(short_world))
+    # full speed, half left: the robot's own brake stops it short of the corridor's wall
+    _, _, terminated, _, info = drive(env, seed=1, policy=lambda obs: np.array([50.0, 60.0]))
+    assert not terminated or info["outcome"] != "collision"
+    run = env.unwrapped.sim.result()
+    assert run.clearance.min() > 0.0 and run.speed[-1, 0] < 1.0
+
+
 def test_a_collision_terminates_with_the_penalty(short_world):
+    text = short_world.read_text(encoding="utf-8")
+    short_world.write_text(text.replace("  acceleration: 40", "  acceleration: 40\n  brake: false"),
+                           encoding="utf-8")
     env = gymnasium.make("mitos/World-v0", world=str(short_world))
     # full speed, half left: into the corridor's wall after 1.6 s
     _, rewards, terminated, _, info = drive(env, seed=1, policy=lambda obs: np.array([50.0, 60.0]))
@@ -108,7 +122,7 @@ def test_spaces_are_the_universes_and_the_robots_limits():
     assert u.input_names == tuple(u.fuzzy.compiled.inputs)
     assert np.array_equal(env.observation_space.low, u.fuzzy.compiled.universe[:, 0])
     robot = u.world.agents[0].robot
-    assert env.action_space.low.tolist() == [robot.steering_min, 0.0]
+    assert env.action_space.low.tolist() == [robot.steering_min, -robot.max_reverse]
     assert env.action_space.high.tolist() == [robot.steering_max, robot.max_speed]
     obs, _ = env.reset(seed=1)
     assert env.observation_space.contains(obs)     # the goal 540 in away reads as 400

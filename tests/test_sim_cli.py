@@ -17,7 +17,7 @@ from mitos_cli.sim.perception import INPUTS
 RUNNER = CliRunner()
 KEYS = {"world", "seed", "outcome", "reached_goal", "collisions", "time_s", "path_length_in",
         "min_clearance_in", "mean_speed_in_s", "steering_total_variation_deg", "ticks",
-        "replans", "near_miss"}
+        "replans", "backouts", "near_miss"}
 SHORT = """\
 name: short
 seed: 2

@@ -268,8 +268,8 @@ def test_a_known_obstacle_is_on_the_map_the_route_goes_round_it(tmp_path):
 
 # --- replanning ----------------------------------------------------------------------------
 
-def test_the_robot_replans_when_boxes_shut_its_way_and_not_for_a_box_it_can_pass():
-    world = load_world(ROOT / "worlds" / "detour.yaml")
+def test_replan_blocked_plans_again_when_boxes_shut_its_way_and_not_for_a_box_it_can_pass():
+    world = replace(load_world(ROOT / "worlds" / "detour.yaml"), replan="blocked")
     res = simulate(replace(world, time_limit=9.0))
     assert res.metrics["replans"] == 1 and res.summary()["replans"] == 1
     tick, robot, route = res.replanned[0]
@@ -279,9 +279,34 @@ def test_the_robot_replans_when_boxes_shut_its_way_and_not_for_a_box_it_can_pass
     from mitos_cli.sim.planner import FuzzyPlanner
 
     text = traces(res, FuzzyPlanner(None, world.behavior), every=10_000)
-    assert f"--- tick {tick}," in text and "replanned: what it sensed shuts the way ahead" in text
-    corridor = simulate(load_world(ROOT / "worlds" / "corridor.yaml"))
-    assert corridor.metrics["replans"] == 0 and corridor.outcome == "success"
+    assert f"--- tick {tick}," in text and "replanned: what it sensed lies in the way" in text
+    corridor = replace(load_world(ROOT / "worlds" / "corridor.yaml"), replan="blocked")
+    res = simulate(corridor)
+    assert res.metrics["replans"] == 0 and res.outcome == "success"
+
+
+def test_by_default_the_route_is_replanned_round_what_comes_within_its_clearance():
+    corridor = load_world(ROOT / "worlds" / "corridor.yaml")
+    assert corridor.replan == "clearance"
+    res = simulate(corridor)
+    assert res.outcome == "success" and res.metrics["replans"] >= 1
+    box = corridor.obstacles[0]
+    least = corridor.robot.width / 2 + corridor.robot.safety_margin
+    for tick, _, route in res.replanned:        # each new route goes round the box it saw
+        pts = dense(route.points)
+        ahead = pts[pts[:, 0] > res.pose[tick, 0, 0] + 30]
+        gap = np.hypot(ahead[:, 0] - box.x, ahead[:, 1] - box.y).min() - box.radius
+        assert gap >= least - 2.0              # the box's cells are marked 2 in cells
+    never = simulate(replace(corridor, replan="never"))
+    assert never.metrics["replans"] == 0
+
+
+def test_a_route_key_replan_takes_three_words(tmp_path):
+    w = tmp_path / "w.yaml"
+    w.write_text(world_text(CORRIDOR, "route: {replan: sometimes}\n"), encoding="utf-8")
+    with pytest.raises(WorldError) as err:
+        load_world(w)
+    assert "clearance" in str(err.value) and ":" in str(err.value)
 
 
 def test_a_robot_with_no_map_maps_and_replans_round_a_corner(tmp_path):

@@ -16,7 +16,7 @@ from mitos_cli.sim.worldfile import load_world, parse_world
 RUNNER = CliRunner()
 ROOT = Path(__file__).resolve().parents[1]
 ROBOT_KEYS = ["name", "outcome", "reached_goal", "time_s", "path_length_in", "min_clearance_in",
-              "replans",
+              "replans", "backouts",
               "mean_speed_in_s", "steering_total_variation_deg"]
 # Two robots in two separate corridors: `robot` starts 30 in from its goal and reaches it;
 # `second` is rammed from behind by a cart at 120 in/s it cannot outrun.

@@ -108,16 +108,50 @@ def _percepts(inputs):
     return Percepts(inputs, np.zeros((1, 1)), np.zeros(1), np.zeros((1, 3)), np.zeros(1), z, z)
 
 
-def test_heading_aims_nearer_in_a_narrow_road():
+def test_the_lookahead_shortens_where_the_chord_to_the_route_would_cut_a_corner():
     cfg = perception.Settings()
-    assert perception.steer_lookahead(80.0, cfg) == cfg.lookahead       # a corridor: 40 in
-    assert perception.steer_lookahead(32.0, cfg) == pytest.approx(24.0)  # a door
-    assert perception.steer_lookahead(5.0, cfg) == cfg.lookahead_min
     bend = Route.of([(0.0, 0.0), (30.0, 0.0), (30.0, -100.0)])           # a right turn ahead
     f = perception.frame(bend, np.array([0.0, 0.0]), 0.0)
-    wide = perception.target_point(bend, f, cfg)
-    narrow = perception.target_point(bend, f, cfg, perception.steer_lookahead(32.0, cfg))
-    assert wide[1] == pytest.approx(-10.0) and narrow[0] == pytest.approx(24.0)
+    p = np.array([0.0, 0.0])
+    assert perception.clear_lookahead(bend, f, p, np.zeros((0, 2)), 1.0, 12.0, cfg) == 40.0
+    jamb = np.array([[24.0, -8.0]])                         # inside the bend
+    ahead = perception.clear_lookahead(bend, f, p, jamb, 1.0, 6.0, cfg)
+    assert cfg.lookahead_min <= ahead < cfg.lookahead
+    q = perception.target_point(bend, f, cfg, ahead)        # the chord it kept stays clear
+    t = np.clip(jamb[0] @ q / (q @ q), 0, 1)
+    assert np.hypot(*(jamb[0] - t * q)) - 1.0 >= 6.0
+    farther = perception.target_point(bend, f, cfg, ahead + cfg.lookahead_step)
+    t = np.clip(jamb[0] @ farther / (farther @ farther), 0, 1)
+    assert np.hypot(*(jamb[0] - t * farther)) - 1.0 < 6.0     # one step on, it cuts in
+
+
+@pytest.mark.parametrize("bearing", [-80.0, -30.0, -5.0, 0.0, 12.0, 60.0])
+def test_heading_is_the_bearing_at_the_usual_lookahead_and_as_sharp_as_a_nearer_point_needs(
+        bearing):
+    cfg = perception.Settings()
+    route = Route.of([(0.0, 0.0), (600.0, 0.0)])
+    f = perception.frame(route, np.array([0.0, 0.0]), 0.0)
+    p = np.array([0.0, 0.0])
+    assert perception.pursuit(route, f, p, bearing, cfg, cfg.lookahead) == pytest.approx(bearing)
+    near = perception.pursuit(route, f, p, bearing, cfg, 10.0)   # a quarter as far: 4x the sine
+    expect = np.degrees(np.arcsin(min(1.0, 4 * np.sin(np.radians(abs(bearing))))))
+    assert near == pytest.approx(np.copysign(expect, bearing) if bearing else 0.0)
+    assert abs(near) >= abs(bearing)
+    assert perception.pursuit(route, f, p, 135.0, cfg, 10.0) == 135.0   # behind: as it is
+
+
+def test_the_keep_right_lane_stays_within_the_routes_room():
+    cfg = perception.Settings()
+    route = Route.of([(0.0, 0.0), (600.0, 0.0)])
+    p = np.array([100.0, 0.0])
+    f = perception.frame(route, p, 100.0)
+    assert perception.route_room(f, p, np.zeros((0, 2)), 1.0, 11.0) == np.inf
+    room = perception.route_room(f, p, np.array([[100.0, -15.0]]), 1.0, 11.0)
+    assert room == pytest.approx(3.0)                     # 15 less the cell and the least
+    wide = perception._common(route, p, 0.0, f, 70.0, ROBOT, cfg, 40.0, np.inf)[1]
+    tight = perception._common(route, p, 0.0, f, 70.0, ROBOT, cfg, 40.0, room)[1]
+    assert wide == pytest.approx(-min(70 / 4, 35 - 9 - cfg.lane_margin))
+    assert tight == pytest.approx(-3.0)                   # the lane only 3 in right of the route
 
 
 def test_keep_clear_steers_off_one_side_but_not_between_two_jambs():

@@ -87,6 +87,7 @@ def test_contact_between_robots_reads_minus_the_penetration_depth():
     text = text.replace("q_init: {x: 770, y: 10, heading: 180}",
                         "q_init: {x: 400, y: -10, heading: 180}")       # the same lane
     text = text.replace("at: [250, -20], radius: 8", "at: [700, 40], radius: 2")
+    text = text.replace("  acceleration: 40", "  acceleration: 40\n  brake: false", 1)  # let them meet
     res = simulate(parse_world(text, "headon.yaml"), _Straight())
     assert res.robot_outcomes == ("collision", "collision")
     gap = abs(res.pose[-1, 1, 0] - res.pose[-1, 0, 0]) - 24.0          # footprints 24 in long

@@ -62,7 +62,7 @@ _ROWS = (   # label, key, format (the overall figures, then each robot's)
     ("mean speed", "mean_speed_in_s", lambda v: f"{v:.1f} in/s"),
     ("min clearance", "min_clearance_in", lambda v: f"{v:.1f} in"),
     ("steering total variation", "steering_total_variation_deg", lambda v: f"{v:.0f} deg"),
-    ("replans", "replans", str))
+    ("replans", "replans", str), ("backed out", "backouts", str))
 
 
 def _summary(res) -> str:

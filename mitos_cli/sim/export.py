@@ -103,7 +103,7 @@ def traces(result: SimResult, planner, every: int, digits: int = 1) -> str:
         tr = "  true:      " + ", ".join(f"{key} {result.true[key][k, 0]:.1f}" for key in INPUTS)
         lines = [head, pt, tr]
         if k in replans:
-            lines.append(f"  replanned: what it sensed shuts the way ahead; the new route "
+            lines.append(f"  replanned: what it sensed lies in the way ahead; the new route "
                          f"runs {replans[k].length:.0f} in to the goal")
         blocks.append("\n".join([*lines, "", trace_of(detail, k).render(digits)]))
     return "\n\n".join(blocks)

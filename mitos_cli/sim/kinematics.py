@@ -29,6 +29,7 @@ class Limits:
     max_rate: np.ndarray           # deg/s
     max_speed: np.ndarray          # in/s
     acceleration: np.ndarray       # in/s^2
+    max_reverse: np.ndarray        # in/s, backward
 
     @classmethod
     def of(cls, robots) -> Limits:
@@ -37,7 +38,7 @@ class Limits:
 
         return cls(col("wheelbase"), col("steering_min"), col("steering_max"),
                    col("steering_straight"), col("max_steering_rate"), col("max_speed"),
-                   col("acceleration"))
+                   col("acceleration"), col("max_reverse"))
 
 
 def _clip(x, lo, hi):
@@ -51,7 +52,7 @@ def limit_commands(steering: np.ndarray, speed: np.ndarray, cmd_steering: np.nda
     target = _clip(cmd_steering, lim.steering_min, lim.steering_max)
     step = lim.max_rate * dt
     new_steering = steering + _clip(target - steering, -step, step)
-    target_v = _clip(cmd_speed, 0.0, lim.max_speed)
+    target_v = _clip(cmd_speed, -lim.max_reverse, lim.max_speed)
     dv = lim.acceleration * dt
     new_speed = speed + _clip(target_v - speed, -dv, dv)
     return new_steering, new_speed
@@ -94,7 +95,7 @@ def step(x, y, heading, speed, steering, cmd_steering, cmd_speed, lim: Limits, d
     sdt = dt / substeps
     k = np.arange(1, substeps + 1, dtype=float)[:, None]
     target = _clip(cmd_steering, lim.steering_min, lim.steering_max)
-    target_v = _clip(cmd_speed, 0.0, lim.max_speed)
+    target_v = _clip(cmd_speed, -lim.max_reverse, lim.max_speed)
     d_steer = k * (lim.max_rate * sdt)
     d_speed = k * (lim.acceleration * sdt)
     steer_k = steering + _clip(target - steering, -d_steer, d_steer)

@@ -11,13 +11,19 @@ clearly shorter than the map predicts has hit something the map does not show. W
 prediction is the given map's walls and the known obstacles' outlines; with no map, it is what
 the robot has mapped itself so far (a grid ray-marched per beam).
 
-Replanning (:func:`replan`): at most once every ``REPLAN_EVERY`` seconds, and only when the
-robot has mapped something new within its clearance of the route ahead, it asks whether a way
-past is left within ``TUBE`` inches of the route up to ``sight`` ahead, at the route's floor
-clearance (half the robot's width plus its margin); when none is, it plans
-again from where it stands on everything it knows. A box in the lane leaves a way past and
-the rules drive round it; a shut door or a corridor full of boxes does not, and the route
-changes.
+Replanning (:func:`replan`), at most once every ``REPLAN_EVERY`` seconds, as the world's
+``route: {replan}`` says:
+
+- ``clearance`` (the default): whenever the robot has mapped something new within the least
+  clearance its route accepts (half its width plus its margin) of the route ahead, up to
+  ``sight``, it plans again from where it stands on everything it knows, as a global planner
+  on a costmap does. The route keeps its word about what the robot has seen: it never leads
+  the body through something the robot knows is there;
+- ``blocked``: only when no way past is left within ``TUBE`` inches of the route ahead at
+  that least clearance (a shut door, a corridor full of boxes); a box in the lane leaves a way
+  past, and the rules alone drive round it;
+- ``never``: the route stays as it was planned at the start (the paper's robot, which had no
+  map to learn into).
 """
 
 from __future__ import annotations
@@ -130,10 +136,27 @@ class RobotMap:
     fresh: list = field(default_factory=list)      # marks since the last check, [k, 2] each
     checked_at: float = -math.inf  # s
     replans: int = 0
+    planned: np.ndarray | None = None   # the cells the route was last planned on (None: given)
 
     @classmethod
     def of(cls, grid: Grid) -> RobotMap:
         return cls(grid, grid.occupied.copy())
+
+    def accounted(self, points: np.ndarray, reach: int = 2) -> np.ndarray:
+        """Which points ``[P, 2]`` lie within ``reach`` cells of a cell the robot's route was
+        planned round (its map when it last planned: the given cells, and what it had marked
+        by then): an echo from the same object a little further along its side, as the robot
+        sees it from another angle, is the object the route went round, not a new one."""
+        row, col, _ = self.cells(points)
+        cells = self.grid.occupied if self.planned is None else self.planned
+        rows, cols = cells.shape
+        out = np.zeros(len(points), dtype=bool)
+        for dr in range(-reach, reach + 1):
+            for dc in range(-reach, reach + 1):
+                r, c = row + dr, col + dc
+                inside = (r >= 0) & (r < rows) & (c >= 0) & (c < cols)
+                out[inside] |= cells[r[inside], c[inside]]
+        return out
 
     def cells(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         g = self.grid
@@ -142,6 +165,45 @@ class RobotMap:
         rows, cols = self.occupied.shape
         inside = (row >= 0) & (row < rows) & (col >= 0) & (col < cols)
         return row, col, inside
+
+    def near(self, p: np.ndarray, reach: float, given: bool = False) -> np.ndarray:
+        """The centres ``[P, 2]`` of the occupied cells in the square of half side ``reach``
+        around ``p`` (``given``: of the cells it was given, without its marks)."""
+        g = self.grid
+        res, (ox, oy) = g.resolution, g.origin
+        rows, cols = self.occupied.shape
+        c0 = min(max(int((p[0] - reach - ox) // res), 0), cols)
+        r0 = min(max(int((p[1] - reach - oy) // res), 0), rows)
+        c1 = min(max(int((p[0] + reach - ox) // res) + 1, 0), cols)
+        r1 = min(max(int((p[1] + reach - oy) // res) + 1, 0), rows)
+        cells = self.grid.occupied if given else self.occupied
+        r, c = np.nonzero(cells[r0:r1, c0:c1])
+        return np.stack([ox + (c + c0 + 0.5) * res, oy + (r + r0 + 0.5) * res], axis=1)
+
+    def clear(self, origin: np.ndarray, dirs: np.ndarray, measured: np.ndarray,
+              max_range: float) -> None:
+        """Free the cells the robot marked that a beam now passes through short of its echo
+        (something that moved on, or a mark a noisy reading put in the way): a beam is a ray
+        (:mod:`.sensors`), so a cell is seen through when the ray crosses it, within half a
+        cell of its centre, a cell or more before the reading. Cells the robot was given stay
+        as given."""
+        g = self.grid
+        res, (ox, oy) = g.resolution, g.origin
+        rows, cols = self.occupied.shape
+        c0 = min(max(int((origin[0] - max_range - ox) // res), 0), cols)
+        r0 = min(max(int((origin[1] - max_range - oy) // res), 0), rows)
+        c1 = min(max(int((origin[0] + max_range - ox) // res) + 1, 0), cols)
+        r1 = min(max(int((origin[1] + max_range - oy) // res) + 1, 0), rows)
+        window = (slice(r0, r1), slice(c0, c1))
+        r, c = np.nonzero(self.occupied[window] & ~g.occupied[window])
+        if not len(r):
+            return
+        rel = np.stack([ox + (c + c0 + 0.5) * res, oy + (r + r0 + 0.5) * res], axis=1) - origin
+        along = rel @ dirs.T                                       # [P, B]
+        across = np.abs(rel[:, :1] * dirs[:, 1] - rel[:, 1:] * dirs[:, 0])
+        through = ((along > 0) & (along < np.minimum(measured, max_range) - res)
+                   & (across < res / 2)).any(axis=1)
+        self.occupied[r[through] + r0, c[through] + c0] = False
 
     def mark(self, hits: np.ndarray, dirs: np.ndarray) -> None:
         """Mark the cells just beyond each hit point (the echo came from there)."""
@@ -237,42 +299,29 @@ def way_past(rmap: RobotMap, route: Route, s: float, p: np.ndarray, ahead: float
     return True
 
 
-def _crosses(rmap: RobotMap, route: Route, s: float, p: np.ndarray, reach: float,
-             ahead: float) -> bool:
-    """Whether the route from ``s`` to ``s + ahead`` passes within ``reach`` of a cell the
-    robot has mapped (only cells within ``ahead + reach`` of it are looked at)."""
-    g = rmap.grid
-    lo, hi = p - ahead - reach, p + ahead + reach
-    window = _window(g, rmap.occupied, lo, hi)
-    r, c = np.nonzero(window.occupied)
-    if not len(r):
-        return False
-    cells = np.stack([window.origin[0] + (c + 0.5) * g.resolution,
-                      window.origin[1] + (r + 0.5) * g.resolution], axis=1)
-    return bool(route.near(cells, s, reach + g.resolution / 2, ahead).any())
-
-
 def replan(rmap: RobotMap, route: Route, s: float, p: np.ndarray, goal: Goal, t: float,
-           clearance: float, minimum: float, sight: float, knows: str = "map") -> Route | None:
-    """A new route from ``p`` when what the robot has sensed shuts the way ahead (see the
-    module docstring), else ``None``. A robot with no map plans again whenever its route
-    ahead runs into what it has mapped: all it knows it learnt on the way."""
-    if not rmap.fresh or t - rmap.checked_at < REPLAN_EVERY:
+           clearance: float, minimum: float, sight: float, when: str = "clearance",
+           heading: float = 0.0, behind: float = 0.0) -> Route | None:
+    """A new route from ``p`` when what the robot has newly sensed invalidates the route ahead
+    (``when``: see the module docstring), else ``None``."""
+    if when == "never" or not rmap.fresh or t - rmap.checked_at < REPLAN_EVERY:
         return None
     fresh = np.concatenate(rmap.fresh)
     rmap.fresh.clear()
     rmap.checked_at = t
-    if knows == "none":
-        if not _crosses(rmap, route, s, p, minimum, sight):
+    reach = minimum + rmap.grid.resolution / 2          # a mark is a cell, not its centre
+    if when == "clearance":
+        if not route.near(fresh, s, reach, sight).any():
             return None
     elif not route.near(fresh, s, clearance, sight).any() or \
             way_past(rmap, route, s, p, sight, clearance, minimum):
         return None
     try:
-        new = grid_route(_as_map(rmap.grid), Pose(float(p[0]), float(p[1])), goal, clearance,
-                         minimum=minimum, occupied=rmap.occupied, explain=False,
-                         leave=clearance + 6.0)
+        new = grid_route(_as_map(rmap.grid), Pose(float(p[0]), float(p[1]), heading), goal,
+                         clearance, minimum=minimum, occupied=rmap.occupied, explain=False,
+                         leave=clearance + 6.0, behind=behind)
     except NarrowPassage:
         return None                # no way left on what it knows: drive on, the rules decide
     rmap.replans += 1
+    rmap.planned = rmap.occupied.copy()
     return new

@@ -22,7 +22,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import geometry, kinematics, knowledge, perception, sensors
+from . import geometry, kinematics, knowledge, perception, safety, sensors
 from . import obstacles as obs_mod
 from .geometry import (
     box_polygon_depth,
@@ -35,10 +35,11 @@ from .planner import Percepts, Planner
 from .route import Route, grid_route, plan_route
 from .route import clearances as route_clearances
 from .staticmap import StaticMap, build_static
-from .world import Agent, World
+from .world import Agent, Grid, World
 
 STUCK_TIME = 6.0        # s
 STUCK_DISTANCE = 3.0    # in
+BEHIND = 30.0           # in: a replanned route that starts this near behind the robot costs more
 NEAR_SLACK = 24.0       # in: a robot's set of nearby walls is gathered again after this move
 OUTCOMES = ("success", "collision", "timeout", "stuck")
 # a robot's own outcome may also be `stopped`: still driving when another robot's collision or
@@ -53,6 +54,7 @@ class Scene:
     static: StaticMap
     routes: tuple[Route, ...]
     given: knowledge.Given | None = None
+    plan_grid: Grid | None = None      # the cells each robot's own map starts from
 
     def __hash__(self) -> int:
         return id(self)
@@ -77,7 +79,7 @@ def prepare(world: World) -> Scene:
         else:
             known = StaticMap(given.walls, np.zeros((0, 4, 2)), given.grid, static.bounds)
             routes.append(grid_route(known, a.start, a.goal, asked, minimum=least))
-    return Scene(static, tuple(routes), given)
+    return Scene(static, tuple(routes), given, knowledge.plan_grid(given, static, world))
 
 
 @dataclass
@@ -104,6 +106,7 @@ class SimResult:
     active: np.ndarray | None = None   # [T, n] robot still driving at that tick
     progress: np.ndarray | None = None  # [T, n] arc length along each robot's route (in)
     replanned: tuple[tuple[int, int, Route], ...] = ()   # (tick, robot, new route) in order
+    backed_out: tuple[tuple[int, int], ...] = ()   # (tick, robot) each backing-out began
     metrics: dict = field(default_factory=dict)    # the run's figures over all robots
     robot_metrics: tuple[dict, ...] = ()           # each robot's figures (name, outcome, ...)
     _true: dict | None = field(default=None, repr=False)
@@ -189,6 +192,7 @@ def _robot_metrics(res: SimResult, dt: float) -> tuple[dict, ...]:
             "time_s": round(time_s, 6), "path_length_in": path,
             "min_clearance_in": float(res.clearance[:, i].min()) if res.ticks else 0.0,
             "replans": sum(j == i for _, j, _ in res.replanned),
+            "backouts": sum(j == i for _, j in res.backed_out),
             "mean_speed_in_s": path / time_s if time_s > 0 else 0.0,
             "steering_total_variation_deg":
                 float(np.abs(np.diff(res.steering[:ticks, i])).sum())})
@@ -206,6 +210,7 @@ def _metrics(res: SimResult, dt: float) -> dict:
             "time_s": round(float(res.ticks * dt), 6), "path_length_in": path,
             "min_clearance_in": min(m["min_clearance_in"] for m in each),
             "replans": sum(m["replans"] for m in each),
+            "backouts": sum(m["backouts"] for m in each),
             "mean_speed_in_s": path / driving if driving > 0 else 0.0,
             "steering_total_variation_deg": sum(m["steering_total_variation_deg"]
                                                 for m in each),
@@ -373,6 +378,8 @@ class Simulation:
         self._known_walls = StaticMap(self._given.walls, np.zeros((0, 4, 2)), None,
                                       self.scene.static.bounds)
         self._asked = [clearances(world, a) for a in world.agents]
+        self._body = [math.hypot(r.length, r.width) for r in self.robots]   # in: a diagonal
+        self._safety = safety.Settings()
         self._still = None
         if not any(o.motion.kind in ("velocity", "waypoints") for o in world.obstacles):
             self._still = self._obstacles_at(0.0)
@@ -391,10 +398,12 @@ class Simulation:
         self._near_known = [np.zeros((0, 4))] * n
         self._routes = list(self.scene.routes)          # replanning replaces them
         self._replanned: list[tuple[int, int, Route]] = []
-        self._maps: list[knowledge.RobotMap | None] = [None] * n
-        if self._given.knows == "none" and self._given.grid is not None:
-            self._maps = [knowledge.RobotMap.of(self._given.grid) for _ in range(n)]
+        grid = self.scene.plan_grid or knowledge.plan_grid(self._given, self.scene.static,
+                                                           self.world)
+        self._maps = [knowledge.RobotMap.of(grid) for _ in range(n)]
         self._history: list[tuple[np.ndarray, np.ndarray]] = []   # (x, y) after each move
+        self._recovery = [safety.Recovery() for _ in range(n)]
+        self._backed: list[tuple[int, int]] = []
         self._outcomes = ["timeout"] * n
         self._collided = 0
         self._k = 0
@@ -507,6 +516,7 @@ class Simulation:
             s.command[:] = np.asarray(command, float).reshape(self.n, 2)
             s.command[~self._active] = np.stack([self.limits.straight, np.zeros(self.n)],
                                                 axis=1)[~self._active]
+        self._guard(s)
         tick = self._record(s)
         if self._hit.any():
             self._collided = int(self._hit.sum())
@@ -604,39 +614,57 @@ class Simulation:
         routes, sen = self._routes, self.world.sensors
         for i in range(self.n):
             f = perception.frame(routes[i], s.pose[i, :2], self._s_hint[i])
-            rmap = self._maps[i] if self._learn(i, s) and self._active[i] else None
-            if rmap is not None:
+            rmap = self._maps[i]
+            if self._learn(i, s) and self._active[i]:
                 route = knowledge.replan(rmap, routes[i], f.s, s.pose[i, :2],
                                          self.world.agents[i].goal, s.t, *self._asked[i],
-                                         self._cfg.sight, self._given.knows)
+                                         self._cfg.sight, self.world.replan,
+                                         math.degrees(self._h[i]), BEHIND)
                 if route is not None:
                     routes[i] = route
                     self._replanned.append((self._k, i, route))
                     f = perception.frame(route, s.pose[i, :2], 0.0)
             self._s_hint[i] = f.s
+            least = self._asked[i][1]
+            # what the route keeps clear of: the marks too, where it is replanned round them
+            cells = rmap.near(s.pose[i, :2], self._cfg.lookahead + least,
+                              given=self.world.replan != "clearance")
+            radius = rmap.grid.resolution / 2
+            ahead = perception.clear_lookahead(routes[i], f, s.pose[i, :2], cells, radius,
+                                               least + self._cfg.lookahead_room, self._cfg)
+            room = perception.route_room(f, s.pose[i, :2], cells, radius, least)
             p = perception.perceive(routes[i], f, (self._x[i], self._y[i], self._h[i]),
                                     self.robots[i], self._dirs[i], s.ranges[i],
                                     self._expected[i], sen.range, self._spacing,
-                                    self._threshold, self._cfg)
+                                    self._threshold, self._cfg, ahead, room,
+                                    self._kept(i, s, least))
             for key in perception.INPUTS:
                 s.inputs[key][i] = p[key]
-            s.targets[i] = perception.target_point(routes[i], f, self._cfg)
+            s.targets[i] = perception.target_point(routes[i], f, self._cfg, ahead)
+
+    def _kept(self, i: int, s: _Sensed, least: float) -> tuple[float, np.ndarray] | None:
+        """Where robot ``i``'s route is replanned round what it senses: the least clearance
+        it keeps, and which of its readings hit cells the route was planned round."""
+        if self.world.replan != "clearance":
+            return None
+        rmap, dirs = self._maps[i], self._dirs[i]
+        hits = s.pose[i, :2] + s.ranges[i, :, None] * dirs + dirs * (rmap.grid.resolution / 2)
+        return least, rmap.accounted(hits)
 
     def _learn(self, i: int, s: _Sensed) -> bool:
         """Mark on robot ``i``'s map what its readings show and its map does not (everything
         it hits, with no map): whether anything new was marked. Its map is made on first
         need."""
-        max_range = self.world.sensors.range
+        sen = self.world.sensors
+        max_range = sen.range
         measured, dirs = s.ranges[i], self._dirs[i]
+        rmap = self._maps[i]
+        rmap.clear(s.pose[i, :2], dirs, measured, max_range)
         valid = measured < max_range * 0.999
         seen = (valid if self._given.knows == "none"
                 else valid & (measured < self._expected[i] - self._threshold))
         if not seen.any():
             return False
-        rmap = self._maps[i]
-        if rmap is None:
-            rmap = self._maps[i] = knowledge.RobotMap.of(
-                knowledge.plan_grid(self._given, self.scene.static, self.world))
         before = len(rmap.fresh)
         rmap.mark(s.pose[i, :2] + measured[seen, None] * dirs[seen], dirs[seen])
         return len(rmap.fresh) > before
@@ -663,6 +691,24 @@ class Simulation:
                            self._goals[idx], self._steer[idx], idx)
             c_steer, c_speed = self.planner.plan(sub)
             cmd[idx, 0], cmd[idx, 1] = c_steer, c_speed
+
+    def _guard(self, s: _Sensed) -> None:
+        """The robot's own safety on every active robot's command (:mod:`.safety`): the brake,
+        and backing out of a pocket when it has held the robot too long."""
+        cfg = self._safety
+        for i in np.flatnonzero(self._active):
+            robot, rmap = self.robots[i], self._maps[i]
+            if not robot.brake:
+                continue
+            body = safety.Body(robot, (float(self._x[i]), float(self._y[i]), float(self._h[i])),
+                               float(self._steer[i]),
+                               rmap.near(s.pose[i, :2], cfg.reach + self._body[i]),
+                               rmap.grid.resolution / 2, float(s.inputs["heading"][i]))
+            carried, backs = safety.guard((float(s.command[i, 0]), float(s.command[i, 1])),
+                                          body, self._recovery[i], self.dt, cfg)
+            s.command[i] = carried
+            if backs:
+                self._backed.append((self._k, int(i)))
 
     def act(self, s: _Sensed) -> None:
         """Steering-rate and acceleration limits and exact arcs, substep by substep; stopped
@@ -729,7 +775,8 @@ class Simulation:
             obstacles=(np.array([r.obstacles for r in rec]).reshape(T, -1, 2) if rec
                        else np.zeros((0, len(self.world.obstacles), 2))),
             routes=self.scene.routes, static=self.scene.static, active=stack("active", (n,)),
-            progress=stack("progress", (n,)), replanned=tuple(self._replanned))
+            progress=stack("progress", (n,)), replanned=tuple(self._replanned),
+            backed_out=tuple(self._backed))
         res.robot_metrics = _robot_metrics(res, dt)
         res.metrics = _metrics(res, dt)
         return res
@@ -764,6 +811,7 @@ def true_inputs(res: SimResult) -> dict[str, np.ndarray]:
     angles = sen.angles
     reach = sen.range + max(max(r.length, r.width) for r in robots)
     cfg = perception.Settings()
+    least = [clearances(world, a)[1] for a in agents]
     shape_outline, outline_owner = obs_mod.outline_points(
         world.obstacles, np.zeros((len(world.obstacles), 2)))
     out = {key: np.zeros((res.ticks, n)) for key in perception.INPUTS}
@@ -787,9 +835,13 @@ def true_inputs(res: SimResult) -> dict[str, np.ndarray]:
                                         robots[i], sen.range, cfg)
             seen = expected[:-2] < sen.range * 0.999
             wall_points = pose[i, :2] + expected[:-2, None][seen] * dirs[:-2][seen]
+            known = np.concatenate([wall_points, things])
+            ahead = perception.clear_lookahead(route, f, pose[i, :2], known, 0.0,
+                                               least[i] + cfg.lookahead_room, cfg)
+            room = perception.route_room(f, pose[i, :2], known, 0.0, least[i])
             tr = perception.truth(route, f, tuple(pose[i]), robots[i],
                                   (float(across[0]), float(across[1])), things, gaps, cfg,
-                                  wall_points)
+                                  wall_points, ahead, room)
             for key in perception.INPUTS:
                 out[key][k, i] = tr[key]
     return out

@@ -97,9 +97,11 @@ INPUTS = ("road", "size", "position", "obstacle", "heading", "lane", "goal", "ga
 
 @dataclass(frozen=True)
 class Settings:
-    lookahead: float = 40.0        # in: pure-pursuit point on the route
-    lookahead_min: float = 20.0    # in: the shortest lookahead of `heading` (in a door)
-    lookahead_per_road: float = 0.75   # `heading`'s lookahead per inch of road width
+    lookahead: float = 40.0        # in: pure-pursuit point on the route, where the way is clear
+    lookahead_min: float = 8.0     # in: the shortest lookahead of `heading` (a tight gap)
+    lookahead_step: float = 4.0    # in: the lookaheads tried, from the shortest up
+    lookahead_room: float = 1.5    # in: the chord to the route point keeps the route's least
+                                   # clearance plus this from what the robot knows
     window: float = 24.0           # in: along-route half window for the road width
     sight: float = 150.0           # in: how far ahead objects count
     band_margin: float = 8.0       # in: added to each side of the swept band
@@ -143,7 +145,7 @@ def _road(a, b, valid, window: float, far: float) -> tuple[float, float]:
 
 
 def _obstruction(route: Route, a, b, points, valid, widen, robot: Robot, f: Frame,
-                 cfg: Settings, rel_heading):
+                 cfg: Settings, rel_heading, kept: tuple[float, np.ndarray] | None = None):
     """(size, position, distance) of the nearest obstructing object among ``points``.
 
     ``rel_heading`` ``(ah, bh)``: the points in the robot's own frame (along and across its
@@ -155,6 +157,12 @@ def _obstruction(route: Route, a, b, points, valid, widen, robot: Robot, f: Fram
     ah, bh = rel_heading
     blocking = ahead & (((b + widen > -half) & (b - widen < half)) |
                         ((ah > 0) & (bh + widen > -half) & (bh - widen < half)))
+    if kept is not None:    # what the route was planned round obstructs only within its word
+        least, planned = kept
+        round_ = blocking & planned
+        if round_.any():
+            blocking[round_] = (route.distance(points[round_], f.s, cfg.sight)
+                                - widen[round_] < least)
     if not blocking.any():
         return 0.0, 0.0, NO_OBSTACLE
     i = int(np.argmin(np.where(blocking, a, np.inf)))
@@ -256,22 +264,53 @@ def _walls(a, b, valid, robot: Robot, cfg: Settings, far: float,
 
 
 def _common(route: Route, p, heading: float, f: Frame, road: float, robot: Robot,
-            cfg: Settings) -> tuple[float, float, float]:
-    target = target_point(route, f, cfg, steer_lookahead(road, cfg))
+            cfg: Settings, lookahead: float, room: float) -> tuple[float, float, float]:
+    target = target_point(route, f, cfg, lookahead)
     d = target - p
     bearing = math.degrees(math.atan2(d[1], d[0]) - heading)
     bearing = (bearing + 180.0) % 360.0 - 180.0
     road_l = min(road, cfg.road_cap)
-    offset = max(0.0, min(road_l / 4, road_l / 2 - robot.width / 2 - cfg.lane_margin))
+    offset = max(0.0, min(road_l / 4, road_l / 2 - robot.width / 2 - cfg.lane_margin, room))
     goal = max(route.length - f.s, float(np.hypot(*(route.goal - p))))
     return -bearing, f.e - offset, goal
 
 
-def steer_lookahead(road: float, cfg: Settings) -> float:
-    """How far ahead the point ``heading`` aims at lies: ``lookahead``, shortened in a road
-    narrower than ``lookahead / lookahead_per_road`` (a door, a narrow passage) down to
-    ``lookahead_min``, so that the robot does not cut the corner before a door into its jamb."""
-    return min(cfg.lookahead, max(cfg.lookahead_min, cfg.lookahead_per_road * road))
+def clear_lookahead(route: Route, f: Frame, p: np.ndarray, cells: np.ndarray, radius: float,
+                    need: float, cfg: Settings) -> float:
+    """How far ahead the point ``heading`` aims at lies: the farthest of the lookaheads from
+    ``lookahead_min`` to ``lookahead`` (every ``lookahead_step``) such that the straight line
+    from the robot to that route point, and to every nearer one, keeps ``need`` inches from
+    the occupied ``cells [P, 2]`` (discs of ``radius``): what the robot knows is there. A
+    pure-pursuit point farther ahead than the way is straight cuts the corner the route
+    bends round (into a door jamb, a pole the route squeezes past); where the way is clear it
+    lies at ``lookahead`` and the robot drives smoothly."""
+    ahead = np.arange(cfg.lookahead_min, cfg.lookahead + 1e-9, cfg.lookahead_step)
+    if not len(cells):
+        return float(ahead[-1])
+    q = np.array([target_point(route, f, cfg, float(a)) for a in ahead])      # [J, 2]
+    e = q - p
+    ee = np.maximum((e * e).sum(axis=1), 1e-12)
+    rel = cells - p                                                           # [P, 2]
+    t = np.clip((rel @ e.T) / ee, 0.0, 1.0)                                   # [P, J]
+    dx = rel[:, 0, None] - t * e[:, 0]
+    dy = rel[:, 1, None] - t * e[:, 1]
+    clear = np.hypot(dx, dy).min(axis=0) - radius >= need                    # [J]
+    if clear.all():
+        return float(ahead[-1])
+    k = int(np.argmin(clear))
+    return float(ahead[max(k - 1, 0)])
+
+
+def route_room(f: Frame, p: np.ndarray, cells: np.ndarray, radius: float,
+               least: float) -> float:
+    """How far the robot may stray from its route where it stands before its body comes
+    within its least clearance of what it knows: the distance from the route point beside
+    it to the nearest occupied cell (``cells [P, 2]``, discs of ``radius``) less ``least``
+    (at least 0; ``inf`` with nothing known near)."""
+    if not len(cells):
+        return math.inf
+    c = p - f.e * f.n
+    return max(0.0, float(np.hypot(*(cells - c).T).min()) - radius - least)
 
 
 def target_point(route: Route, f: Frame, cfg: Settings,
@@ -286,8 +325,15 @@ def target_point(route: Route, f: Frame, cfg: Settings,
 
 def perceive(route: Route, f: Frame, pose: tuple[float, float, float], robot: Robot,
              dirs: np.ndarray, measured: np.ndarray, expected: np.ndarray, max_range: float,
-             spacing: float, threshold: float, cfg: Settings = Settings()) -> dict[str, float]:
-    """The inputs from one robot's readings (see the module docstring)."""
+             spacing: float, threshold: float, cfg: Settings = Settings(),
+             lookahead: float | None = None, room: float = math.inf,
+             kept: tuple[float, np.ndarray] | None = None) -> dict[str, float]:
+    """The inputs from one robot's readings (see the module docstring); ``lookahead``: of
+    ``heading`` (:func:`clear_lookahead`; default ``cfg.lookahead``); ``room``: how far the
+    keep-right lane may lie off the route (:func:`route_room`); ``kept``: where the route is
+    replanned round what the robot senses, the least clearance it keeps and which readings
+    hit what it was planned round (``[B]``): those obstruct only within that clearance of
+    the route, not anywhere in the band ahead."""
     p = np.array(pose[:2])
     hits = p + measured[:, None] * dirs
     rel = hits - p
@@ -303,22 +349,42 @@ def perceive(route: Route, f: Frame, pose: tuple[float, float, float], robot: Ro
         in_way[in_way] = route.near(hits[in_way], f.s, robot.width / 2 + robot.safety_margin,
                                     cfg.sight)
     size, position, distance = _obstruction(route, a, b, hits, obstacle_hit | in_way, widen,
-                                            robot, f, cfg, _own_frame(rel, pose[2]))
-    heading, lane, goal = _common(route, p, pose[2], f, road, robot, cfg)
+                                            robot, f, cfg, _own_frame(rel, pose[2]), kept)
+    heading, lane, goal = _common(route, p, pose[2], f, road, robot, cfg,
+                                  cfg.lookahead if lookahead is None else lookahead, room)
     wl, wr = _walls(a, b, valid, robot, cfg, max_range, obstacle_hit)
     ah, bh = _own_frame(rel[valid], pose[2])
     front, opening = free_ways(ah, bh, widen[valid], obstacle_hit[valid], robot, cfg, heading)
     ring = len(dirs) > 2 and float(dirs[0] @ dirs[-1]) >= float(dirs[0] @ dirs[1]) - 1e-9
     objects = clutter(hits, valid & obstacle_hit, _own_frame(rel, pose[2])[0], cfg, ring)
     return {"road": road, "size": size, "position": position, "obstacle": distance,
-            "heading": heading, "lane": lane, "goal": goal, "gap_left": wl, "gap_right": wr,
+            "heading": pursuit(route, f, p, heading, cfg, lookahead), "lane": lane,
+            "goal": goal, "gap_left": wl, "gap_right": wr,
             "front": front, "opening": opening, "clutter": objects,
             "nearest": nearest(ah, bh, robot, cfg)}
 
 
+def pursuit(route: Route, f: Frame, p: np.ndarray, bearing: float, cfg: Settings,
+            lookahead: float | None) -> float:
+    """``heading``: the bearing of the route point ``lookahead`` ahead, as the bearing of a
+    point at the usual ``cfg.lookahead`` that asks for the same turn. Pure pursuit turns on an
+    arc of curvature ``2 sin(bearing) / distance``: a point a quarter as far off asks for the
+    turn of one at the usual distance with four times the sine. Where the way is clear (the
+    point at the usual lookahead) it is the bearing itself; in a tight gap, where the point
+    lies nearer, the rules steer as hard as the nearer point needs. A point behind the robot
+    (90 deg or more) keeps its bearing."""
+    if abs(bearing) >= 90.0:
+        return bearing
+    target = target_point(route, f, cfg, cfg.lookahead if lookahead is None else lookahead)
+    distance = max(float(np.hypot(*(target - p))), 1e-9)
+    sine = min(1.0, cfg.lookahead / distance * math.sin(math.radians(abs(bearing))))
+    return math.copysign(math.degrees(math.asin(sine)), bearing)
+
+
 def truth(route: Route, f: Frame, pose: tuple[float, float, float], robot: Robot,
           side_ranges: tuple[float, float], outline: np.ndarray, gaps: tuple[float, float],
-          cfg: Settings = Settings(), wall_points: np.ndarray | None = None) -> dict[str, float]:
+          cfg: Settings = Settings(), wall_points: np.ndarray | None = None,
+          lookahead: float | None = None, room: float = math.inf) -> dict[str, float]:
     """The same inputs from the true geometry: ``side_ranges`` are exact distances to the walls
     across the route (left, right), ``outline`` points on every obstacle and other robot,
     ``gaps`` the noise-free side gaps (:func:`side_gaps`), ``wall_points`` where the beams
@@ -331,15 +397,17 @@ def truth(route: Route, f: Frame, pose: tuple[float, float, float], robot: Robot
     valid = np.ones(len(outline), dtype=bool)
     size, position, distance = _obstruction(route, a, b, outline, valid, np.zeros(len(outline)),
                                             robot, f, cfg, _own_frame(rel, pose[2]))
-    heading, lane, goal = _common(route, p, pose[2], f, road, robot, cfg)
+    heading, lane, goal = _common(route, p, pose[2], f, road, robot, cfg,
+                                  cfg.lookahead if lookahead is None else lookahead, room)
     scan = outline if wall_points is None else np.concatenate([wall_points, outline])
     ah, bh = _own_frame(scan - p, pose[2]) if len(scan) else (np.zeros(0), np.zeros(0))
     unknown = np.arange(len(scan)) >= len(scan) - len(outline)
     front, opening = free_ways(ah, bh, np.zeros(len(scan)), unknown, robot, cfg, heading)
     objects = clutter(scan, unknown, ah, cfg)
     return {"road": road, "size": size, "position": position, "obstacle": distance,
-            "heading": heading, "lane": lane, "goal": goal, "gap_left": gaps[0],
-            "gap_right": gaps[1], "front": front, "opening": opening, "clutter": objects,
+            "heading": pursuit(route, f, p, heading, cfg, lookahead), "lane": lane,
+            "goal": goal, "gap_left": gaps[0], "gap_right": gaps[1], "front": front,
+            "opening": opening, "clutter": objects,
             "nearest": nearest(ah, bh, robot, cfg)}
 
 

@@ -87,16 +87,21 @@ class Route:
     def near(self, points: np.ndarray, s: float, reach: float, ahead: float) -> np.ndarray:
         """Which ``points [P, 2]`` lie within ``reach`` of the route between arc lengths ``s``
         and ``s + ahead``."""
+        return self.distance(points, s, ahead) <= reach
+
+    def distance(self, points: np.ndarray, s: float, ahead: float) -> np.ndarray:
+        """The distance ``[P]`` of each point from the route between arc lengths ``s`` and
+        ``s + ahead`` (``inf`` with no route there)."""
         window = (self.cum[1:] >= s) & (self.cum[:-1] <= s + ahead)
         a, b = self.points[:-1][window], self.points[1:][window]
         if not len(a) or not len(points):
-            return np.zeros(len(points), dtype=bool)
+            return np.full(len(points), np.inf)
         e = b - a
         ee = np.maximum((e * e).sum(axis=1), 1e-12)
         rel = points[:, None] - a                                  # [P, M, 2]
         t = np.clip((rel * e).sum(axis=2) / ee, 0.0, 1.0)
         d = rel - t[..., None] * e
-        return (d * d).sum(axis=2).min(axis=1) <= reach * reach
+        return np.sqrt((d * d).sum(axis=2).min(axis=1))
 
 
 def _astar(neighbours, start: int, goal: int, pos) -> list[int] | None:
@@ -345,7 +350,7 @@ NARROW_COST = 20.0      # extra cost per step (in steps) of a node closer than t
 def grid_route(static: StaticMap, start: Pose, goal: Goal, clearance: float,
                cell: float = 6.0, minimum: float | None = None,
                occupied: np.ndarray | None = None, explain: bool = True,
-               leave: float = 0.0) -> Route:
+               leave: float = 0.0, behind: float = 0.0) -> Route:
     """A* on nodes about ``cell`` inches apart, each kept at least ``clearance`` inches (the
     exact Euclidean distance) from the occupied cells, preferring the middle of the corridors.
     Nodes closer than that but not closer than ``minimum`` (the robot's half width plus its
@@ -386,6 +391,13 @@ def grid_route(static: StaticMap, start: Pose, goal: Goal, clearance: float,
     # NARROW_COST times more, so the route squeezes through only where nothing wider leads on
     penalty = (np.clip(reach - node_c, 0.0, reach) / reach * 4.0
                + np.where(node_c < clearance, NARROW_COST, 0.0))
+    if behind > 0:      # a tricycle cannot turn on the spot: the way back costs a squeeze
+        x = g.origin[0] + (fc + 0.5) * g.resolution
+        y = g.origin[1] + (fr + 0.5) * g.resolution
+        h = math.radians(start.heading)
+        rx, ry = x - start.x, y - start.y
+        back = (rx * math.cos(h) + ry * math.sin(h) < 0) & (np.hypot(rx, ry) <= behind)
+        penalty = penalty + np.where(back, NARROW_COST, 0.0)
     blocked = node_c < floor
     blocked[s] = blocked[t] = False      # the robot stands there: let the search leave it
     if leave > 0:

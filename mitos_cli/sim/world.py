@@ -42,6 +42,8 @@ class Robot:
     max_steering_rate: float = 180.0   # deg/s
     max_speed: float = 60.0        # in/s
     acceleration: float = 40.0     # in/s^2 (also the braking limit)
+    max_reverse: float = 15.0      # in/s: the front wheel drives backward too (0: it cannot)
+    brake: bool = True             # the emergency brake and backing out (sim/safety.py)
 
 
 @dataclass(frozen=True)
@@ -137,6 +139,10 @@ class Agent:
     goal: Goal
 
 
+#: ``route: {replan}``: when a robot plans its route again (:func:`.knowledge.replan`)
+REPLANS = ("clearance", "blocked", "never")
+
+
 @dataclass(frozen=True)
 class World:
     name: str
@@ -155,6 +161,7 @@ class World:
     knows: str = "map"             # what the robot is given: the map itself ("map"), another
     given: Grid | None = None      # grid ("given", this one), or nothing at all ("none")
     min_clearance: float | None = None   # in: the tightest squeeze its route may make
+    replan: str = "clearance"      # when the route is planned again: one of REPLANS
 
     @property
     def robot(self) -> Robot:

@@ -14,16 +14,29 @@ from typing import Any
 from ..errors import NameError_, Span, WorldError, unknown
 from ..lang import yamlpos
 from ..lang.yamlpos import YList, YMap
-from .world import Agent, Corridor, Goal, Jitter, Motion, Obstacle, Pose, Randomise, Robot, Sensors, World
+from .world import (
+    REPLANS,
+    Agent,
+    Corridor,
+    Goal,
+    Jitter,
+    Motion,
+    Obstacle,
+    Pose,
+    Randomise,
+    Robot,
+    Sensors,
+    World,
+)
 
 TOP_KEYS = ("name", "seed", "dt", "time_limit", "substeps", "behavior", "robot", "sensors",
             "q_init", "q_goal", "map", "obstacles", "robots", "randomise", "route")
 ROBOT_KEYS = ("model", "wheelbase", "footprint", "safety_margin", "steering", "max_speed",
-              "acceleration")
+              "acceleration", "max_reverse", "brake")
 STEERING_KEYS = ("min", "max", "straight", "max_rate")
 SENSOR_KEYS = ("layout", "count", "fov", "cone", "range", "noise")
 MAP_KEYS = ("corridors", "grid", "unknown", "given")
-ROUTE_KEYS = ("min_clearance",)
+ROUTE_KEYS = ("min_clearance", "replan")
 OBSTACLE_KEYS = ("name", "shape", "at", "radius", "length", "width", "angle", "velocity",
                  "waypoints", "speed", "mode", "known")
 AGENT_KEYS = ("name", "q_init", "q_goal", "robot")
@@ -153,7 +166,9 @@ def read_robot(r: _Reader, value: Any, span: Span, base: Robot | None = None) ->
         max_steering_rate=r.number(st, "max_rate", "robot steering", d.max_steering_rate,
                                    positive=True),
         max_speed=r.number(m, "max_speed", "robot", d.max_speed, positive=True),
-        acceleration=r.number(m, "acceleration", "robot", d.acceleration, positive=True))
+        acceleration=r.number(m, "acceleration", "robot", d.acceleration, positive=True),
+        max_reverse=r.number(m, "max_reverse", "robot", d.max_reverse, minimum=0),
+        brake=r.flag(m, "brake", "robot", d.brake))
 
 
 def read_sensors(r: _Reader, value: Any, span: Span) -> Sensors:
@@ -313,11 +328,12 @@ def parse_world(text: str, path: str) -> World:
         raise WorldError("the map has neither `corridors` nor a `grid`", span=mp.span,
                          hint="add `corridors: [{points: [[0, 0], [600, 0]], width: 70}]`")
     knows, given = read_given(mp, path, unknown_occupied)
-    min_clearance = None
+    min_clearance, replan = None, "clearance"
     if "route" in top:
         rt = r.mapping(top["route"], top.value_span("route"), "route", ROUTE_KEYS)
         if "min_clearance" in rt:
             min_clearance = r.number(rt, "min_clearance", "route", positive=True)
+        replan = r.choice(rt, "replan", REPLANS, "route", "clearance")
 
     obstacles = []
     for i, item in enumerate(_list(top, "obstacles")):
@@ -331,7 +347,7 @@ def parse_world(text: str, path: str) -> World:
                  if "randomise" in top else Randomise())
     world = World(name, path, int(seed), dt, limit, int(substeps), tuple(agents), sensors,
                   tuple(corridors), grid, tuple(obstacles), randomise,
-                  str(top.get("behavior", "drive")), knows, given, min_clearance)
+                  str(top.get("behavior", "drive")), knows, given, min_clearance, replan)
     check_free(world, agent_spans)
     return world
 

@@ -1,0 +1,139 @@
+"""The robot's own safety, whatever its planner commands: an emergency brake, and backing out
+of a pocket.
+
+A planner (the fuzzy rules, a potential field, DWA, a user's own) commands a wheel angle and a
+speed; the tricycle then sweeps its body along an arc, and a corner it turns into a pole is a
+collision that no rule saw coming (the rules read ranges along bands, not arcs). Two things
+every robot of this kind carries, applied to every command (``robot: {brake: false}`` takes
+them away, as the paper's robot had none):
+
+- **the brake** (:func:`brake`): the robot goes no faster than it can stop, at its
+  acceleration, within the free travel of the arc its wheel is set to, keeping ``margin`` from
+  everything it knows is there (its map: what it was given and what it has sensed, which its
+  readings keep up to date). Where the arc is shut the robot stops.
+- **backing out** (:class:`Recovery`): held by the brake for ``patience`` seconds while its
+  planner wants to go on, the robot backs out for ``back_time`` seconds on the opposite lock
+  (which swings its nose toward the side its route lies on), as far as the way behind is
+  free, then hands back to its planner. A tricycle cannot turn on the spot; this is how it
+  turns in a pocket (ROS's ``move_base`` recovers the same way: clear, back up, try again).
+
+The sweep (:func:`free_travel`) moves the footprint along the exact arc about the rear axle.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .world import Robot
+
+
+@dataclass(frozen=True)
+class Settings:
+    margin: float = 1.0            # in: the body keeps this from what the robot knows
+    reach: float = 30.0            # in: how far along its arc the brake looks
+    step: float = 1.0              # in: the sweep's step along the rear axle's path
+    patience: float = 1.0          # s: held to a stop this long, the robot backs out
+    back_time: float = 1.5         # s: how long one backing-out lasts
+    back_room: float = 4.0         # in: it backs out only with this much free behind
+    want: float = 2.0              # in/s: a planner asking for more than this wants to go on
+
+
+def free_travel(cells: np.ndarray, radius: float, pose: tuple[float, float, float],
+                robot: Robot, delta: float, backward: bool, reach: float,
+                step: float = 1.0) -> float:
+    """How far (in, along the rear axle's path) the robot can drive from ``pose`` (x, y, heading
+    in rad) with its wheel held ``delta`` degrees off straight (positive right), forward or
+    ``backward``, before its footprint touches one of the occupied ``cells [P, 2]`` (discs of
+    ``radius``); ``reach`` when it can drive that far, 0 when it touches one already."""
+    x, y, h = pose
+    if not len(cells):
+        return reach
+    wb, hl, hw = robot.wheelbase, robot.length / 2 + radius, robot.width / 2 + radius
+    u = np.arange(0.0, reach + step / 2, step) * (-1.0 if backward else 1.0)   # [K]
+    k = -math.tan(math.radians(delta)) / wb          # rad per inch of the rear axle's path
+    hk = h + k * u
+    if abs(k) > 1e-9:
+        rx = x - wb / 2 * math.cos(h) + (np.sin(hk) - math.sin(h)) / k
+        ry = y - wb / 2 * math.sin(h) + (math.cos(h) - np.cos(hk)) / k
+    else:
+        rx = x - wb / 2 * math.cos(h) + u * math.cos(h)
+        ry = y - wb / 2 * math.sin(h) + u * math.sin(h)
+    c, s = np.cos(hk), np.sin(hk)
+    dx = cells[:, 0, None] - (rx + wb / 2 * c)
+    dy = cells[:, 1, None] - (ry + wb / 2 * s)
+    inside = (np.abs(dx * c + dy * s) <= hl) & (np.abs(dy * c - dx * s) <= hw)     # [P, K]
+    hit = inside.any(axis=0)
+    if not hit.any():
+        return reach
+    return float(max(int(np.argmax(hit)) - 1, 0) * step)
+
+
+def brake(free: float, acceleration: float, margin: float) -> float:
+    """The fastest (in/s) a robot may drive that can stop at ``acceleration`` within ``free``
+    inches less ``margin``."""
+    return math.sqrt(2.0 * acceleration * max(free - margin, 0.0))
+
+
+@dataclass
+class Recovery:
+    """One robot's backing out: how long the brake has held it, and the backing-out under way
+    (seconds left and the wheel angle)."""
+
+    held: float = 0.0              # s the brake has held it while its planner wanted to go
+    left: float = 0.0              # s of backing out left
+    wheel: float = 90.0            # deg: the lock it backs out on
+
+
+@dataclass(frozen=True)
+class Body:
+    """What the guard needs of one robot at one tick: its pose (x, y in, heading rad), its
+    wheel's angle now (deg), the cells it knows are occupied near it (``[P, 2]``, discs of
+    ``radius``) and the side its route lies on (``heading`` input: positive right)."""
+
+    robot: Robot
+    pose: tuple[float, float, float]
+    wheel: float
+    cells: np.ndarray
+    radius: float
+    route_side: float
+
+    def free(self, wheel: float, backward: bool, cfg: Settings) -> float:
+        """Free travel with the wheel at ``wheel`` (deg, 90 straight), forward or backward."""
+        return free_travel(self.cells, self.radius, self.pose, self.robot,
+                           wheel - self.robot.steering_straight, backward, cfg.reach, cfg.step)
+
+
+def guard(command: tuple[float, float], body: Body, rec: Recovery, dt: float,
+          cfg: Settings = Settings()) -> tuple[tuple[float, float], bool]:
+    """The command the robot carries out (steering deg, speed in/s) and whether it begins to
+    back out now, from its planner's ``command``: a backing-out under way goes on while the
+    way behind is free; otherwise the brake holds the speed to what the arc the wheel will be
+    on allows, and a robot held ``patience`` seconds against its planner's wish backs out
+    (on the lock that swings its nose toward its route, else straight), if it has the room.
+    ``rec`` is updated."""
+    robot = body.robot
+    if rec.left > 0:
+        rec.left -= dt
+        back = body.free(rec.wheel, True, cfg)
+        if back > cfg.margin:
+            return (rec.wheel, -min(robot.max_reverse,
+                                    brake(back, robot.acceleration, cfg.margin))), False
+        rec.left = 0.0
+    steer, want = command
+    turn = robot.max_steering_rate * dt
+    target = min(max(steer, robot.steering_min), robot.steering_max)
+    wheel = body.wheel + min(max(target - body.wheel, -turn), turn)
+    limit = brake(body.free(wheel, want < 0, cfg), robot.acceleration, cfg.margin)
+    speed = math.copysign(limit, want) if abs(want) > limit else want
+    rec.held = rec.held + dt if abs(want) > cfg.want and limit < cfg.want else 0.0
+    if rec.held < cfg.patience or robot.max_reverse <= 0:
+        return (steer, speed), False
+    lock = robot.steering_min if body.route_side > 0 else robot.steering_max
+    for wheel in (lock, robot.steering_straight):
+        if body.free(wheel, True, cfg) >= cfg.back_room:
+            rec.left, rec.wheel, rec.held = cfg.back_time, wheel, 0.0
+            return (wheel, -robot.max_reverse), True
+    return (steer, speed), False

@@ -1,0 +1,100 @@
+"""The robot's own safety (sim/safety.py): the sweep of its body along an arc, the brake, and
+backing out of a pocket; and in a run: it stops short of a wall a policy drives it at."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from mitos_cli.sim import safety
+from mitos_cli.sim.world import Robot
+
+ROBOT = Robot(wheelbase=16.0, length=24.0, width=18.0)
+AT = (0.0, 0.0, 0.0)           # x, y (in), heading (rad): facing +x
+
+
+def test_straight_on_the_body_meets_a_cell_ahead_after_the_gap():
+    cell = np.array([[40.0, 0.0]])                      # 40 in ahead of the centre
+    free = safety.free_travel(cell, 0.0, AT, ROBOT, 0.0, False, 60.0, 1.0)
+    assert free == pytest.approx(40.0 - 12.0 - 1.0, abs=1.0)   # front at 12 in, one step back
+    assert safety.free_travel(cell, 0.0, AT, ROBOT, 0.0, True, 60.0, 1.0) == 60.0  # behind: free
+    assert safety.free_travel(np.zeros((0, 2)), 0.0, AT, ROBOT, 0.0, False, 30.0) == 30.0
+    assert safety.free_travel(np.array([[5.0, 0.0]]), 0.0, AT, ROBOT, 0.0, False, 30.0) == 0.0
+
+
+def test_a_turn_sweeps_a_corner_into_what_a_straight_band_misses():
+    pole = np.array([[14.0, -12.0]])                    # right of the front corner, off the band
+    assert safety.free_travel(pole, 0.0, AT, ROBOT, 0.0, False, 30.0) == 30.0
+    right = safety.free_travel(pole, 0.0, AT, ROBOT, 60.0, False, 30.0)     # full lock right
+    left = safety.free_travel(pole, 0.0, AT, ROBOT, -60.0, False, 30.0)
+    assert right < 10.0 and left == 30.0
+
+
+@pytest.mark.parametrize("delta", [-60.0, -20.0, 0.0, 35.0])
+def test_the_sweep_follows_the_tricycles_arc_about_the_rear_axle(delta):
+    """The pose after driving the rear axle ``u`` inches is the kinematics' own (a cell placed
+    just ahead of that pose's front is met there, not before)."""
+    from mitos_cli.sim import kinematics
+
+    lim = kinematics.Limits.of([ROBOT])
+    steering = np.array([90.0 + delta])
+    v = 10.0 / math.cos(math.radians(delta))            # rear axle at 10 in/s
+    x, y, h = kinematics.advance(np.zeros(1), np.zeros(1), np.zeros(1), np.array([v]), steering,
+                                 lim, 2.0, 64)           # 20 in of the rear axle's path
+    ahead = np.array([[x[0] + 12.5 * math.cos(h[0]), y[0] + 12.5 * math.sin(h[0])]])
+    free = safety.free_travel(ahead, 0.0, AT, ROBOT, delta, False, 40.0, 0.5)
+    assert 19.0 <= free <= 20.5
+
+
+def test_the_brake_lets_the_robot_stop_within_the_free_travel():
+    assert safety.brake(50.0, 40.0, 1.0) == pytest.approx(math.sqrt(2 * 40 * 49))
+    assert safety.brake(0.5, 40.0, 1.0) == 0.0
+    v = safety.brake(20.0, 40.0, 1.0)
+    assert v * v / (2 * 40.0) == pytest.approx(19.0)    # its stopping distance is the gap
+
+
+def body(cells, side=1.0, wheel=90.0):
+    return safety.Body(ROBOT, AT, wheel, np.asarray(cells, float).reshape(-1, 2), 1.0, side)
+
+
+def test_the_guard_brakes_and_after_its_patience_backs_out_toward_the_route():
+    cfg = safety.Settings()
+    wall = [[14.5, y] for y in np.arange(-20.0, 21.0, 2.0)]     # just ahead of the front
+    rec = safety.Recovery()
+    (steer, speed), backs = safety.guard((90.0, 30.0), body(wall), rec, 0.05, cfg)
+    assert speed < cfg.want and not backs                         # braked, not yet backing
+    ticks = 1
+    while not backs:
+        (steer, speed), backs = safety.guard((90.0, 30.0), body(wall), rec, 0.05, cfg)
+        ticks += 1
+    assert ticks * 0.05 == pytest.approx(cfg.patience, abs=0.051)
+    assert speed == -ROBOT.max_reverse and steer == ROBOT.steering_min   # route right: wheel left
+    (steer, speed), again = safety.guard((90.0, 30.0), body(wall), rec, 0.05, cfg)
+    assert speed < 0 and steer == ROBOT.steering_min and not again      # it goes on backing
+
+
+def test_no_backing_out_without_room_behind_or_without_a_reverse_gear():
+    cfg = safety.Settings()
+    boxed = [[x, y] for x in (-14.5, 14.5) for y in np.arange(-20.0, 21.0, 2.0)]
+    rec = safety.Recovery()
+    for _ in range(60):
+        (_, speed), backs = safety.guard((90.0, 30.0), body(boxed), rec, 0.05, cfg)
+        assert not backs and speed < cfg.want
+    forward_only = Robot(wheelbase=16.0, length=24.0, width=18.0, max_reverse=0.0)
+    b = safety.Body(forward_only, AT, 90.0, np.array([[14.5, 0.0]]), 1.0, 1.0)
+    rec = safety.Recovery()
+    assert not any(safety.guard((90.0, 30.0), b, rec, 0.05, cfg)[1] for _ in range(60))
+
+
+def test_a_robot_stops_short_of_a_wall_its_command_drives_it_at():
+    from mitos_cli.resources import packaged_path
+    from mitos_cli.sim import Simulation, load_world
+
+    world = load_world(packaged_path("worlds", "corridor.yaml"))
+    sim = Simulation(world, seed=1)
+    while not sim.done and sim.time < 4.0:
+        sim.step(np.array([[40.0, 60.0]]))               # hard left at full speed
+    res = sim.result()
+    assert res.outcome != "collision" and res.clearance.min() > 0.0
