@@ -28,6 +28,7 @@ Replanning (:func:`replan`), at most once every ``REPLAN_EVERY`` seconds, as the
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass, field
 
@@ -127,6 +128,30 @@ def plan_grid(g: Given, static: StaticMap, world: World) -> Grid:
     return g.grid if g.grid is not None else _raster(static, world, RASTER, free=False)
 
 
+def _dilated(cells: np.ndarray, reach: int) -> np.ndarray:
+    """``[rows + 2 reach, cols + 2 reach]``: whether a cell (row ``i - reach``, column
+    ``j - reach``, inside the grid or up to ``reach`` outside it) lies within ``reach`` cells
+    (the square) of an occupied one of ``cells``: ORs of shifted copies, along the rows and
+    then along the columns."""
+    rows, cols = cells.shape
+    padded = np.zeros((rows + 4 * reach, cols + 4 * reach), dtype=bool)
+    padded[2 * reach:2 * reach + rows, 2 * reach:2 * reach + cols] = cells
+    across = np.zeros((rows + 4 * reach, cols + 2 * reach), dtype=bool)
+    for b in range(2 * reach + 1):
+        across |= padded[:, b:b + cols + 2 * reach]
+    out = np.zeros((rows + 2 * reach, cols + 2 * reach), dtype=bool)
+    for a in range(2 * reach + 1):
+        out |= across[a:a + rows + 2 * reach]
+    return out
+
+
+@functools.lru_cache(maxsize=4)
+def _given_dilated(grid: Grid, reach: int) -> np.ndarray:
+    """:func:`_dilated` of a given grid's cells, shared by every robot and run that plans on
+    it (a grid is never changed)."""
+    return _dilated(grid.occupied, reach)
+
+
 @dataclass
 class RobotMap:
     """One robot's map as it drives: the cells it plans on, with what it has sensed marked."""
@@ -137,6 +162,7 @@ class RobotMap:
     checked_at: float = -math.inf  # s
     replans: int = 0
     planned: np.ndarray | None = None   # the cells the route was last planned on (None: given)
+    _around: tuple | None = field(default=None, repr=False)   # (planned, reach, its dilation)
 
     @classmethod
     def of(cls, grid: Grid) -> RobotMap:
@@ -148,14 +174,17 @@ class RobotMap:
         by then): an echo from the same object a little further along its side, as the robot
         sees it from another angle, is the object the route went round, not a new one."""
         row, col, _ = self.cells(points)
-        cells = self.grid.occupied if self.planned is None else self.planned
-        rows, cols = cells.shape
+        if self.planned is None:
+            near = _given_dilated(self.grid, reach)
+        else:               # the cells it planned on do not change until it plans again
+            if self._around is None or self._around[0] is not self.planned \
+                    or self._around[1] != reach:
+                self._around = (self.planned, reach, _dilated(self.planned, reach))
+            near = self._around[2]
+        r, c = row + reach, col + reach
+        inside = (r >= 0) & (r < near.shape[0]) & (c >= 0) & (c < near.shape[1])
         out = np.zeros(len(points), dtype=bool)
-        for dr in range(-reach, reach + 1):
-            for dc in range(-reach, reach + 1):
-                r, c = row + dr, col + dc
-                inside = (r >= 0) & (r < rows) & (c >= 0) & (c < cols)
-                out[inside] |= cells[r[inside], c[inside]]
+        out[inside] = near[r[inside], c[inside]]
         return out
 
     def cells(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

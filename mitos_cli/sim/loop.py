@@ -630,17 +630,17 @@ class Simulation:
             cells = rmap.near(s.pose[i, :2], self._cfg.lookahead + least,
                               given=self.world.replan != "clearance")
             radius = rmap.grid.resolution / 2
-            ahead = perception.clear_lookahead(routes[i], f, s.pose[i, :2], cells, radius,
-                                               least + self._cfg.lookahead_room, self._cfg)
+            ahead, target = perception.pursuit_point(routes[i], f, s.pose[i, :2], cells, radius,
+                                                     least + self._cfg.lookahead_room, self._cfg)
             room = perception.route_room(f, s.pose[i, :2], cells, radius, least)
             p = perception.perceive(routes[i], f, (self._x[i], self._y[i], self._h[i]),
                                     self.robots[i], self._dirs[i], s.ranges[i],
                                     self._expected[i], sen.range, self._spacing,
                                     self._threshold, self._cfg, ahead, room,
-                                    self._kept(i, s, least))
+                                    self._kept(i, s, least), target)
             for key in perception.INPUTS:
                 s.inputs[key][i] = p[key]
-            s.targets[i] = perception.target_point(routes[i], f, self._cfg, ahead)
+            s.targets[i] = target
 
     def _kept(self, i: int, s: _Sensed, least: float) -> tuple[float, np.ndarray] | None:
         """Where robot ``i``'s route is replanned round what it senses: the least clearance

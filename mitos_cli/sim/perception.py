@@ -82,6 +82,7 @@ obstacle outlines) for the trace.
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -130,6 +131,23 @@ class Frame:
     e: float
     t: np.ndarray                  # unit tangent
     n: np.ndarray                  # unit normal to the right
+
+
+try:                                    # the ufunc np.clip calls, without its wrapper
+    from numpy._core.umath import clip as _clip
+except ImportError:                     # NumPy 1.x
+    from numpy.core.umath import clip as _clip
+
+
+def clip(x: float, lo: float, hi: float) -> float:
+    """``np.clip`` of one float, as its ufunc does it (equal bounds and signed zeros keep
+    ``x``; NaN stays NaN) without the array round trip."""
+    if x != x:
+        return x
+    y = x if x >= lo else lo
+    if y != y:
+        return y
+    return y if y <= hi else hi
 
 
 def frame(route: Route, p: np.ndarray, s_hint: float) -> Frame:
@@ -193,31 +211,50 @@ def free_ways(ah: np.ndarray, bh: np.ndarray, widen: np.ndarray, unknown: np.nda
 
     Every way tried is a direction from the robot's centre; its free length is the distance
     along it to the nearest point inside the body's band, less half the body's length. All
-    ways at once: ``[ways, points]``."""
+    ways at once: ``[ways, points]``, both bands at once: ``[2, ways, points]``."""
     half = robot.width / 2 + cfg.way_margin
-    sight = cfg.sight
-    n = int(round(cfg.way_fov / 2 / cfg.way_step))
-    bearing = float(np.clip(route_bearing, -cfg.way_fov / 2, cfg.way_fov / 2))
-    ways = np.concatenate([[0.0, bearing], np.arange(-n, n + 1) * cfg.way_step])
+    ways = _ways(cfg).copy()
+    ways[1] = clip(route_bearing, -cfg.way_fov / 2, cfg.way_fov / 2)
     phi = np.deg2rad(ways)[:, None]
-    along = ah * np.cos(phi) + bh * np.sin(phi)
-    across = np.abs(-ah * np.sin(phi) + bh * np.cos(phi)) - widen
+    cos, sin = np.cos(phi), np.sin(phi)
+    along = ah * cos + bh * sin
+    across = np.abs(-ah * sin + bh * cos) - widen
     ahead = along > 0
-    inside = ahead & (across < half)
-    front = float(np.clip(np.where(inside[0] & unknown, along[0], np.inf).min(initial=np.inf)
-                          - robot.length / 2, 0.0, sight))
+    inside = ahead & (across < _bands(cfg, half))                      # [2, ways, points]
+    front = float(np.where(inside[0, 0] & unknown, along[0], np.inf).min(initial=np.inf))
+    front = clip(front - robot.length / 2, 0.0, cfg.sight)
     # the progress each way offers toward the route's bearing (behind the robot: toward the
     # side it lies on), in a band just clear of the body and in a roomy one, less a little
     # for every degree turned
-    toward = np.clip(route_bearing, -90.0, 90.0)
+    toward = clip(route_bearing, -90.0, 90.0)
     score = -cfg.way_turn_cost * np.abs(ways)
-    for band in (half, half + cfg.way_room):
-        free = np.where(ahead & (across < band), along, np.inf).min(axis=1, initial=np.inf)
-        free -= robot.length / 2
-        free = np.clip(free, 0.0, cfg.way_reach)
-        score += 0.5 * free * (np.cos(np.deg2rad(ways - toward)) + cfg.way_room_weight)
-    best = int(np.argmax(score))
+    weight = np.cos(np.deg2rad(ways - toward)) + cfg.way_room_weight
+    free = np.where(inside, along, np.inf).min(axis=2, initial=np.inf)
+    free -= robot.length / 2
+    free = _clip(free, 0.0, cfg.way_reach)
+    gain = 0.5 * free * weight
+    score += gain[0]
+    score += gain[1]
+    best = int(score.argmax())
     return front, float(ways[best])
+
+
+@functools.lru_cache(maxsize=8)
+def _ways(cfg: Settings) -> np.ndarray:
+    """The ways :func:`free_ways` tries: straight on, the route's bearing (a place for it),
+    then every ``way_step`` within ``way_fov``."""
+    n = int(round(cfg.way_fov / 2 / cfg.way_step))
+    out = np.concatenate([[0.0, 0.0], np.arange(-n, n + 1) * cfg.way_step])
+    out.flags.writeable = False
+    return out
+
+
+@functools.lru_cache(maxsize=8)
+def _bands(cfg: Settings, half: float) -> np.ndarray:
+    """``[2, 1, 1]``: the half widths of the two bands a way is scored in."""
+    out = np.array([half, half + cfg.way_room])[:, None, None]
+    out.flags.writeable = False
+    return out
 
 
 def nearest(ah: np.ndarray, bh: np.ndarray, robot: Robot, cfg: Settings) -> float:
@@ -242,11 +279,21 @@ def clutter(hits: np.ndarray, unknown: np.ndarray, ah: np.ndarray, cfg: Settings
     seen = unknown & (ah > 0) & (ah <= cfg.sight)
     if not seen.any():
         return 0.0
-    close = np.hypot(*(hits - np.roll(hits, 1, axis=0)).T) <= cfg.clutter_gap
-    joined = seen & np.roll(seen, 1) & close       # point i continues the run of point i - 1
+    before = _previous(len(hits))                  # np.roll(..., 1), cheaper
+    gap = hits - hits[before]
+    close = np.hypot(gap[:, 0], gap[:, 1]) <= cfg.clutter_gap
+    joined = seen & seen[before] & close           # point i continues the run of point i - 1
     if not circular:
         joined[0] = False
     return float(max(1, int(np.count_nonzero(seen & ~joined))))
+
+
+@functools.lru_cache(maxsize=8)
+def _previous(k: int) -> np.ndarray:
+    """Index of the point before each of ``k`` (the last before the first)."""
+    out = (np.arange(k) - 1) % k
+    out.flags.writeable = False
+    return out
 
 
 def _walls(a, b, valid, robot: Robot, cfg: Settings, far: float,
@@ -264,8 +311,7 @@ def _walls(a, b, valid, robot: Robot, cfg: Settings, far: float,
 
 
 def _common(route: Route, p, heading: float, f: Frame, road: float, robot: Robot,
-            cfg: Settings, lookahead: float, room: float) -> tuple[float, float, float]:
-    target = target_point(route, f, cfg, lookahead)
+            cfg: Settings, target: np.ndarray, room: float) -> tuple[float, float, float]:
     d = target - p
     bearing = math.degrees(math.atan2(d[1], d[0]) - heading)
     bearing = (bearing + 180.0) % 360.0 - 180.0
@@ -284,21 +330,27 @@ def clear_lookahead(route: Route, f: Frame, p: np.ndarray, cells: np.ndarray, ra
     pure-pursuit point farther ahead than the way is straight cuts the corner the route
     bends round (into a door jamb, a pole the route squeezes past); where the way is clear it
     lies at ``lookahead`` and the robot drives smoothly."""
-    ahead = np.arange(cfg.lookahead_min, cfg.lookahead + 1e-9, cfg.lookahead_step)
+    return pursuit_point(route, f, p, cells, radius, need, cfg)[0]
+
+
+def pursuit_point(route: Route, f: Frame, p: np.ndarray, cells: np.ndarray, radius: float,
+                  need: float, cfg: Settings) -> tuple[float, np.ndarray]:
+    """:func:`clear_lookahead` and the route point that far ahead (:func:`target_point`)."""
+    ahead = _lookaheads(cfg)
     if not len(cells):
-        return float(ahead[-1])
-    q = np.array([target_point(route, f, cfg, float(a)) for a in ahead])      # [J, 2]
+        return float(ahead[-1]), target_point(route, f, cfg, float(ahead[-1]))
+    q = target_points(route, f, ahead)                                        # [J, 2]
     e = q - p
     ee = np.maximum((e * e).sum(axis=1), 1e-12)
     rel = cells - p                                                           # [P, 2]
-    t = np.clip((rel @ e.T) / ee, 0.0, 1.0)                                   # [P, J]
+    t = _clip((rel @ e.T) / ee, 0.0, 1.0)                                     # [P, J]
     dx = rel[:, 0, None] - t * e[:, 0]
     dy = rel[:, 1, None] - t * e[:, 1]
     clear = np.hypot(dx, dy).min(axis=0) - radius >= need                    # [J]
     if clear.all():
-        return float(ahead[-1])
-    k = int(np.argmin(clear))
-    return float(ahead[max(k - 1, 0)])
+        return float(ahead[-1]), q[-1]
+    k = max(int(clear.argmin()) - 1, 0)
+    return float(ahead[k]), q[k]
 
 
 def route_room(f: Frame, p: np.ndarray, cells: np.ndarray, radius: float,
@@ -311,6 +363,22 @@ def route_room(f: Frame, p: np.ndarray, cells: np.ndarray, radius: float,
         return math.inf
     c = p - f.e * f.n
     return max(0.0, float(np.hypot(*(cells - c).T).min()) - radius - least)
+
+
+@functools.lru_cache(maxsize=8)
+def _lookaheads(cfg: Settings) -> np.ndarray:
+    """The lookaheads :func:`clear_lookahead` tries, shortest first."""
+    out = np.arange(cfg.lookahead_min, cfg.lookahead + 1e-9, cfg.lookahead_step)
+    out.flags.writeable = False
+    return out
+
+
+def target_points(route: Route, f: Frame, ahead: np.ndarray) -> np.ndarray:
+    """:func:`target_point` for every lookahead of ``ahead [J]`` at once, ``[J, 2]``."""
+    s = f.s + ahead
+    out = route.points_at(s)
+    out[s >= route.length] = route.goal
+    return out
 
 
 def target_point(route: Route, f: Frame, cfg: Settings,
@@ -327,13 +395,17 @@ def perceive(route: Route, f: Frame, pose: tuple[float, float, float], robot: Ro
              dirs: np.ndarray, measured: np.ndarray, expected: np.ndarray, max_range: float,
              spacing: float, threshold: float, cfg: Settings = Settings(),
              lookahead: float | None = None, room: float = math.inf,
-             kept: tuple[float, np.ndarray] | None = None) -> dict[str, float]:
+             kept: tuple[float, np.ndarray] | None = None,
+             target: np.ndarray | None = None) -> dict[str, float]:
     """The inputs from one robot's readings (see the module docstring); ``lookahead``: of
     ``heading`` (:func:`clear_lookahead`; default ``cfg.lookahead``); ``room``: how far the
     keep-right lane may lie off the route (:func:`route_room`); ``kept``: where the route is
     replanned round what the robot senses, the least clearance it keeps and which readings
     hit what it was planned round (``[B]``): those obstruct only within that clearance of
-    the route, not anywhere in the band ahead."""
+    the route, not anywhere in the band ahead; ``target``: the route point ``lookahead``
+    ahead (:func:`target_point`), when the caller has it."""
+    if target is None:
+        target = target_point(route, f, cfg, cfg.lookahead if lookahead is None else lookahead)
     p = np.array(pose[:2])
     hits = p + measured[:, None] * dirs
     rel = hits - p
@@ -348,24 +420,24 @@ def perceive(route: Route, f: Frame, pose: tuple[float, float, float], robot: Ro
     if in_way.any():       # drawn on the map, but where the robot's route would hit it
         in_way[in_way] = route.near(hits[in_way], f.s, robot.width / 2 + robot.safety_margin,
                                     cfg.sight)
+    own = _own_frame(rel, pose[2])
     size, position, distance = _obstruction(route, a, b, hits, obstacle_hit | in_way, widen,
-                                            robot, f, cfg, _own_frame(rel, pose[2]), kept)
-    heading, lane, goal = _common(route, p, pose[2], f, road, robot, cfg,
-                                  cfg.lookahead if lookahead is None else lookahead, room)
+                                            robot, f, cfg, own, kept)
+    heading, lane, goal = _common(route, p, pose[2], f, road, robot, cfg, target, room)
     wl, wr = _walls(a, b, valid, robot, cfg, max_range, obstacle_hit)
     ah, bh = _own_frame(rel[valid], pose[2])
     front, opening = free_ways(ah, bh, widen[valid], obstacle_hit[valid], robot, cfg, heading)
     ring = len(dirs) > 2 and float(dirs[0] @ dirs[-1]) >= float(dirs[0] @ dirs[1]) - 1e-9
-    objects = clutter(hits, valid & obstacle_hit, _own_frame(rel, pose[2])[0], cfg, ring)
+    objects = clutter(hits, valid & obstacle_hit, own[0], cfg, ring)
     return {"road": road, "size": size, "position": position, "obstacle": distance,
-            "heading": pursuit(route, f, p, heading, cfg, lookahead), "lane": lane,
+            "heading": pursuit(route, f, p, heading, cfg, lookahead, target), "lane": lane,
             "goal": goal, "gap_left": wl, "gap_right": wr,
             "front": front, "opening": opening, "clutter": objects,
             "nearest": nearest(ah, bh, robot, cfg)}
 
 
 def pursuit(route: Route, f: Frame, p: np.ndarray, bearing: float, cfg: Settings,
-            lookahead: float | None) -> float:
+            lookahead: float | None, target: np.ndarray | None = None) -> float:
     """``heading``: the bearing of the route point ``lookahead`` ahead, as the bearing of a
     point at the usual ``cfg.lookahead`` that asks for the same turn. Pure pursuit turns on an
     arc of curvature ``2 sin(bearing) / distance``: a point a quarter as far off asks for the
@@ -375,7 +447,8 @@ def pursuit(route: Route, f: Frame, p: np.ndarray, bearing: float, cfg: Settings
     (90 deg or more) keeps its bearing."""
     if abs(bearing) >= 90.0:
         return bearing
-    target = target_point(route, f, cfg, cfg.lookahead if lookahead is None else lookahead)
+    if target is None:
+        target = target_point(route, f, cfg, cfg.lookahead if lookahead is None else lookahead)
     distance = max(float(np.hypot(*(target - p))), 1e-9)
     sine = min(1.0, cfg.lookahead / distance * math.sin(math.radians(abs(bearing))))
     return math.copysign(math.degrees(math.asin(sine)), bearing)
@@ -397,15 +470,15 @@ def truth(route: Route, f: Frame, pose: tuple[float, float, float], robot: Robot
     valid = np.ones(len(outline), dtype=bool)
     size, position, distance = _obstruction(route, a, b, outline, valid, np.zeros(len(outline)),
                                             robot, f, cfg, _own_frame(rel, pose[2]))
-    heading, lane, goal = _common(route, p, pose[2], f, road, robot, cfg,
-                                  cfg.lookahead if lookahead is None else lookahead, room)
+    target = target_point(route, f, cfg, cfg.lookahead if lookahead is None else lookahead)
+    heading, lane, goal = _common(route, p, pose[2], f, road, robot, cfg, target, room)
     scan = outline if wall_points is None else np.concatenate([wall_points, outline])
     ah, bh = _own_frame(scan - p, pose[2]) if len(scan) else (np.zeros(0), np.zeros(0))
     unknown = np.arange(len(scan)) >= len(scan) - len(outline)
     front, opening = free_ways(ah, bh, np.zeros(len(scan)), unknown, robot, cfg, heading)
     objects = clutter(scan, unknown, ah, cfg)
     return {"road": road, "size": size, "position": position, "obstacle": distance,
-            "heading": pursuit(route, f, p, heading, cfg, lookahead), "lane": lane,
+            "heading": pursuit(route, f, p, heading, cfg, lookahead, target), "lane": lane,
             "goal": goal, "gap_left": gaps[0], "gap_right": gaps[1], "front": front,
             "opening": opening, "clutter": objects,
             "nearest": nearest(ah, bh, robot, cfg)}

@@ -50,6 +50,22 @@ class Route:
         span = self.cum[i + 1] - self.cum[i]
         return self.points[i] + (s - self.cum[i]) / span * seg if span > 0 else self.points[i]
 
+    def points_at(self, s: np.ndarray) -> np.ndarray:
+        """:meth:`point_at` of every arc length of ``s [K]`` at once, ``[K, 2]``: the same
+        clamp, segment and arithmetic, element by element, so the same bits."""
+        s = np.asarray(s, float)
+        length = self.length
+        s = np.where(0.0 > s, 0.0, s)                  # max(s, 0.0), then min(s, length),
+        s = np.where(length < s, length, s)            # as Python's max and min pick
+        i = np.minimum(np.searchsorted(self.cum, s, side="right") - 1, len(self.points) - 2)
+        start = self.points[i]
+        span = self.cum[i + 1] - self.cum[i]
+        ok = span > 0
+        frac = (s[ok] - self.cum[i[ok]]) / span[ok]
+        out = start.copy()
+        out[ok] = start[ok] + frac[:, None] * (self.points[i[ok] + 1] - start[ok])
+        return out
+
     @functools.cached_property
     def _segments(self) -> tuple[np.ndarray, ...]:
         """Each segment's start ``a``, vector ``e``, squared length (at least 1e-12) and
