@@ -14,6 +14,22 @@ import numpy as np
 
 EPS = 1e-9
 
+try:                                    # the ufunc np.clip calls, without its wrapper
+    from numpy._core.umath import clip as clip_arrays
+except ImportError:                     # NumPy 1.x
+    from numpy.core.umath import clip as clip_arrays
+
+
+def clip(x: float, lo: float, hi: float) -> float:
+    """``np.clip`` of one float, as its ufunc does it (equal bounds and signed zeros keep
+    ``x``; NaN stays NaN) without the array round trip."""
+    if x != x:
+        return x
+    y = x if x >= lo else lo
+    if y != y:
+        return y
+    return y if y <= hi else hi
+
 
 def rect_corners(cx, cy, heading, length, width) -> np.ndarray:
     """Corners ``[..., 4, 2]`` of rectangles centred at (cx, cy), long side along ``heading``
@@ -52,7 +68,7 @@ def point_segment_distance(p: np.ndarray, seg: np.ndarray) -> np.ndarray:
     dy = p[:, 1, None] - ay
     ee = np.maximum(ex * ex + ey * ey, EPS)
     t = (dx * ex + dy * ey) / ee
-    np.clip(t, 0.0, 1.0, out=t)
+    clip_arrays(t, 0.0, 1.0, out=t)
     return np.hypot(dx - t * ex, dy - t * ey)
 
 
@@ -98,9 +114,27 @@ def ray_segments(origin: np.ndarray, dirs: np.ndarray, seg: np.ndarray,
     return np.minimum(ray_hits(origin, dirs, seg).min(axis=1), max_range)
 
 
-def ray_hits(origin: np.ndarray, dirs: np.ndarray, seg: np.ndarray) -> np.ndarray:
+class SegmentSet:
+    """Segments ``[N, 4]`` with their vectors ``ex``, ``ey`` (``[1, N]``, end minus start), for
+    casting rays against the same segments tick after tick (:func:`ray_hits`)."""
+
+    __slots__ = ("seg", "ex", "ey")
+
+    def __init__(self, seg: np.ndarray) -> None:
+        self.seg = seg
+        self.ex = seg[None, :, 2] - seg[None, :, 0]
+        self.ey = seg[None, :, 3] - seg[None, :, 1]
+
+    def __len__(self) -> int:
+        return len(self.seg)
+
+
+def ray_hits(origin: np.ndarray, dirs: np.ndarray, seg: np.ndarray | SegmentSet) -> np.ndarray:
     """``[B, N]``: how far along each ray segment ``seg[N, 4]`` is hit (``inf`` if not); each
     entry depends on its ray and segment alone."""
+    if not isinstance(seg, SegmentSet):
+        seg = SegmentSet(seg)
+    ex, ey, seg = seg.ex, seg.ey, seg.seg
     o = np.asarray(origin, float)
     if o.ndim == 1:                 # one origin: [1, N] offsets, broadcast over the beams
         px = seg[None, :, 0] - o[0]
@@ -109,8 +143,6 @@ def ray_hits(origin: np.ndarray, dirs: np.ndarray, seg: np.ndarray) -> np.ndarra
         o = np.broadcast_to(o, (len(dirs), 2))
         px = seg[None, :, 0] - o[:, 0, None]
         py = seg[None, :, 1] - o[:, 1, None]
-    ex = seg[None, :, 2] - seg[None, :, 0]
-    ey = seg[None, :, 3] - seg[None, :, 1]
     dx, dy = dirs[:, 0, None], dirs[:, 1, None]
     denom = _cross(dx, dy, ex, ey)
     ok = np.abs(denom) > EPS
@@ -123,14 +155,21 @@ def ray_hits(origin: np.ndarray, dirs: np.ndarray, seg: np.ndarray) -> np.ndarra
 
 def ray_circles(origin: np.ndarray, dirs: np.ndarray, centres: np.ndarray, radii: np.ndarray,
                 max_range: float) -> np.ndarray:
-    """Range ``[B]`` from ``origin`` along ``dirs[B, 2]`` to the first circle it enters."""
+    """Range ``[B]`` from ``origin`` (``[2]``, or one per beam ``[B, 2]``) along ``dirs[B, 2]``
+    to the first circle it enters."""
     B = len(dirs)
     if len(centres) == 0:
         return np.full(B, max_range)
-    o = np.broadcast_to(np.asarray(origin, float), (B, 2))
-    m = o[:, None, :] - centres[None]                         # [B, C, 2]
-    b = np.einsum("bck,bk->bc", m, dirs)
-    c = np.einsum("bck,bck->bc", m, m) - radii[None] ** 2
+    o = np.asarray(origin, float)
+    if o.ndim == 1:                 # one origin: its offsets from the centres, [C]
+        mx, my = o[0] - centres[:, 0], o[1] - centres[:, 1]
+    else:
+        o = np.broadcast_to(o, (B, 2))
+        mx = o[:, 0, None] - centres[None, :, 0]
+        my = o[:, 1, None] - centres[None, :, 1]
+    # the dot products as np.einsum sums them: from 0, so a sum of -0.0 reads +0.0
+    b = mx * dirs[:, 0, None] + my * dirs[:, 1, None] + 0.0                # [B, C]
+    c = mx * mx + my * my - radii ** 2
     disc = b * b - c
     root = np.sqrt(np.maximum(disc, 0.0))
     t = np.where(c <= 0.0, 0.0, -b - root)                   # inside: range 0
@@ -191,7 +230,7 @@ def box_segment_distance(hl: float, hw: float, seg: np.ndarray) -> np.ndarray:
     # a segment can cross the box only if it passes within the box's half diagonal of its
     # centre; clip just those (Liang-Barsky)
     dx, dy = x1 - x0, y1 - y0
-    t = np.clip(-(x0 * dx + y0 * dy) / np.maximum(dx * dx + dy * dy, EPS), 0.0, 1.0)
+    t = clip_arrays(-(x0 * dx + y0 * dy) / np.maximum(dx * dx + dy * dy, EPS), 0.0, 1.0)
     maybe = np.hypot(x0 + t * dx, y0 + t * dy) <= math.hypot(hl, hw)
     if not maybe.any():
         return d

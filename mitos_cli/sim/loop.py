@@ -223,11 +223,17 @@ def _footprints(pose: np.ndarray, robots) -> np.ndarray:
 
 
 def _clearance(pose: np.ndarray, robot, walls: np.ndarray, polygons: np.ndarray,
-               centres: np.ndarray, radii: np.ndarray) -> float:
+               centres: np.ndarray, radii: np.ndarray,
+               discs: tuple[np.ndarray, np.ndarray] | None = None) -> float:
     """Signed distance from one robot's footprint to walls, rectangles and other robots
     (``polygons [P, 4, 2]``) and circles, computed in the footprint's own frame: the gap when
     apart, 0 touching, minus the penetration depth (the shortest move that separates them) when
-    overlapping, with one definition for every kind of thing."""
+    overlapping, with one definition for every kind of thing.
+
+    Each distance depends on its own thing alone, so a polygon or circle that cannot come
+    nearer than the walls is not measured: its distance is at least the gap between the
+    footprint's circumscribed disc and its own (``discs``: centres and radii of the polygons'
+    discs, :func:`_enclosing` by default), and the minimum stays what it is."""
     c, s = math.cos(pose[2]), math.sin(pose[2])
     hl, hw = robot.length / 2, robot.width / 2
 
@@ -239,27 +245,42 @@ def _clearance(pose: np.ndarray, robot, walls: np.ndarray, polygons: np.ndarray,
         return out
 
     best = math.inf
-    ends = local(walls.reshape(-1, 2, 2))
-    boxes = local(polygons)
-    d = box_segment_distance(hl, hw, np.concatenate([ends.reshape(-1, 4),
-                                                     polygon_segments(boxes)]))
-    if len(walls):                                      # one call for walls and box sides
-        w = d[:len(ends)]
+    if len(walls):
+        ends = local(walls.reshape(-1, 2, 2))
+        w = box_segment_distance(hl, hw, ends.reshape(-1, 4))
         crossing = w <= 0.0
         if crossing.any():
             w[crossing] = -box_polygon_depth(hl, hw, ends[crossing])
         best = float(w.min())
+    # a thing whose disc lies farther from the footprint's disc than the walls cannot be the
+    # nearest (1e-6 in of slack for the rounding of either side)
+    reach = best + math.hypot(hl, hw) + 1e-6
     if len(polygons):
-        sides = d[len(ends):]
-        best = min(best, float(box_polygon_distance(hl, hw, boxes, sides).min()))
+        middle, radius = _enclosing(polygons) if discs is None else discs
+        near = np.hypot(middle[:, 0] - pose[0], middle[:, 1] - pose[1]) - radius <= reach
+        if near.any():
+            boxes = local(polygons if near.all() else polygons[near])
+            sides = box_segment_distance(hl, hw, polygon_segments(boxes))
+            best = min(best, float(box_polygon_distance(hl, hw, boxes, sides).min()))
     if len(centres):
         rel = centres - pose[:2]
-        lx = np.abs(rel[:, 0] * c + rel[:, 1] * s) - hl
-        ly = np.abs(-rel[:, 0] * s + rel[:, 1] * c) - hw
-        outside = np.hypot(np.maximum(lx, 0), np.maximum(ly, 0))
-        inside = np.minimum(np.maximum(lx, ly), 0)
-        best = min(best, float((outside + inside - radii).min()))
+        near = np.hypot(rel[:, 0], rel[:, 1]) - radii <= reach
+        if near.any():
+            rel, r = (rel, radii) if near.all() else (rel[near], radii[near])
+            lx = np.abs(rel[:, 0] * c + rel[:, 1] * s) - hl
+            ly = np.abs(-rel[:, 0] * s + rel[:, 1] * c) - hw
+            outside = np.hypot(np.maximum(lx, 0), np.maximum(ly, 0))
+            inside = np.minimum(np.maximum(lx, ly), 0)
+            best = min(best, float((outside + inside - r).min()))
     return best
+
+
+def _enclosing(polygons: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Discs holding convex polygons ``[P, k, 2]``: their corners' mean and the farthest
+    corner's distance from it, plus 1e-6 in for rounding (``[P, 2]``, ``[P]``)."""
+    middle = polygons.mean(axis=1)
+    off = polygons - middle[:, None]
+    return middle, np.hypot(off[..., 0], off[..., 1]).max(axis=1) + 1e-6
 
 
 @dataclass(frozen=True)
@@ -381,8 +402,10 @@ class Simulation:
         self._body = [math.hypot(r.length, r.width) for r in self.robots]   # in: a diagonal
         self._safety = safety.Settings()
         self._still = None
+        self._still_discs = None          # discs round the still rectangles (_clearance)
         if not any(o.motion.kind in ("velocity", "waypoints") for o in world.obstacles):
             self._still = self._obstacles_at(0.0)
+            self._still_discs = _enclosing(self._still[1][5])
 
     def _setup_state(self) -> None:
         agents, n = self.world.agents, self.n
@@ -396,6 +419,7 @@ class Simulation:
         self._near_at = [(math.inf, math.inf)] * n     # where each robot's wall set was gathered
         self._near_walls = [np.zeros((0, 4))] * n
         self._near_known = [np.zeros((0, 4))] * n
+        self._cast_with: list[tuple | None] = [None] * n
         self._routes = list(self.scene.routes)          # replanning replaces them
         self._replanned: list[tuple[int, int, Route]] = []
         grid = self.scene.plan_grid or knowledge.plan_grid(self._given, self.scene.static,
@@ -573,21 +597,32 @@ class Simulation:
                 others = np.concatenate([rect_sides] + [robot_sides[j] for j in range(n)
                                                         if j != i])
                 boxes = np.concatenate([rect_box, footprints[:i], footprints[i + 1:]])
+                discs = None
             else:
                 others, boxes = rect_sides, rect_box
+                discs = self._still_discs
             walls = self._walls_near(i)
             dirs = sensors.beam_directions(h[i], self.angles)
             expected, true_r = sensors.cast(pose[i, :2], dirs, walls, others, centres, radii,
-                                            sen.range)
+                                            sen.range, self._joined(i, walls, others))
             if not self._plain:                          # what the robot's own map predicts
                 expected = knowledge.expected_ranges(self._given, self._maps[i], pose[i, :2],
                                                      dirs, self._near_known[i], sen.range)
             ranges[i] = sensors.add_noise(true_r, sen.noise, sen.range, self._streams[1 + i])
             self._dirs.append(dirs)
             self._expected.append(expected)
-            clear[i] = _clearance(pose[i], self.robots[i], walls, boxes, centres, radii)
+            clear[i] = _clearance(pose[i], self.robots[i], walls, boxes, centres, radii, discs)
         return _Sensed(t, where, pose, ranges, {key: np.zeros(n) for key in perception.INPUTS},
                        np.zeros((n, 2)), clear, np.zeros((n, 2)))
+
+    def _joined(self, i: int, walls: np.ndarray, sides: np.ndarray) -> geometry.SegmentSet:
+        """Robot ``i``'s nearby walls and the obstacle sides as one set of segments, kept
+        while both are the same arrays (still obstacles, no new walls gathered)."""
+        kept = self._cast_with[i]
+        if kept is None or kept[0] is not walls or kept[1] is not sides:
+            kept = self._cast_with[i] = (walls, sides,
+                                         geometry.SegmentSet(np.concatenate([walls, sides])))
+        return kept[2]
 
     def _obstacles_at(self, t: float):
         """Obstacle places ``[O, 2]`` at time ``t`` and their shapes

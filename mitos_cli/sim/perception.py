@@ -88,6 +88,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .geometry import clip, clip_arrays
 from .route import Route
 from .world import Robot
 
@@ -131,23 +132,6 @@ class Frame:
     e: float
     t: np.ndarray                  # unit tangent
     n: np.ndarray                  # unit normal to the right
-
-
-try:                                    # the ufunc np.clip calls, without its wrapper
-    from numpy._core.umath import clip as _clip
-except ImportError:                     # NumPy 1.x
-    from numpy.core.umath import clip as _clip
-
-
-def clip(x: float, lo: float, hi: float) -> float:
-    """``np.clip`` of one float, as its ufunc does it (equal bounds and signed zeros keep
-    ``x``; NaN stays NaN) without the array round trip."""
-    if x != x:
-        return x
-    y = x if x >= lo else lo
-    if y != y:
-        return y
-    return y if y <= hi else hi
 
 
 def frame(route: Route, p: np.ndarray, s_hint: float) -> Frame:
@@ -231,7 +215,7 @@ def free_ways(ah: np.ndarray, bh: np.ndarray, widen: np.ndarray, unknown: np.nda
     weight = np.cos(np.deg2rad(ways - toward)) + cfg.way_room_weight
     free = np.where(inside, along, np.inf).min(axis=2, initial=np.inf)
     free -= robot.length / 2
-    free = _clip(free, 0.0, cfg.way_reach)
+    free = clip_arrays(free, 0.0, cfg.way_reach)
     gain = 0.5 * free * weight
     score += gain[0]
     score += gain[1]
@@ -343,7 +327,7 @@ def pursuit_point(route: Route, f: Frame, p: np.ndarray, cells: np.ndarray, radi
     e = q - p
     ee = np.maximum((e * e).sum(axis=1), 1e-12)
     rel = cells - p                                                           # [P, 2]
-    t = _clip((rel @ e.T) / ee, 0.0, 1.0)                                     # [P, J]
+    t = clip_arrays((rel @ e.T) / ee, 0.0, 1.0)                               # [P, J]
     dx = rel[:, 0, None] - t * e[:, 0]
     dy = rel[:, 1, None] - t * e[:, 1]
     clear = np.hypot(dx, dy).min(axis=0) - radius >= need                    # [J]

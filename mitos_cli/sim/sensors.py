@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .geometry import ray_circles, ray_hits, ray_segments
+from .geometry import SegmentSet, clip_arrays, ray_circles, ray_hits, ray_segments
 
 
 def beam_directions(heading: float, angles: np.ndarray) -> np.ndarray:
@@ -19,11 +19,14 @@ def beam_directions(heading: float, angles: np.ndarray) -> np.ndarray:
 
 
 def cast(origin: np.ndarray, dirs: np.ndarray, walls: np.ndarray, sides: np.ndarray,
-         centres: np.ndarray, radii: np.ndarray, max_range: float) -> tuple[np.ndarray, np.ndarray]:
+         centres: np.ndarray, radii: np.ndarray, max_range: float,
+         joined: SegmentSet | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Noise-free ranges ``[B]``: against the walls alone (what the map predicts) and against
-    everything (walls, obstacle and robot sides, circles)."""
+    everything (walls, obstacle and robot sides, circles). ``joined``: the walls and the sides
+    as one :class:`~.geometry.SegmentSet` (the caller keeps it while neither changes)."""
     if len(walls) and len(sides):           # one pass over walls and sides (min is exact)
-        t = ray_hits(origin, dirs, np.concatenate([walls, sides]))
+        t = ray_hits(origin, dirs, joined if joined is not None
+                     else SegmentSet(np.concatenate([walls, sides])))
         static = np.minimum(t[:, :len(walls)].min(axis=1), max_range)
         segments = np.minimum(t.min(axis=1), max_range)
     else:
@@ -40,5 +43,5 @@ def add_noise(ranges: np.ndarray, sigma: float, max_range: float,
     ``range`` (an ultrasonic sensor reports no echo, not a noisy one)."""
     if sigma <= 0:
         return ranges
-    noisy = np.clip(ranges + rng.normal(0.0, sigma, ranges.shape), 0.0, max_range)
+    noisy = clip_arrays(ranges + rng.normal(0.0, sigma, ranges.shape), 0.0, max_range)
     return np.where(ranges >= max_range, max_range, noisy)
