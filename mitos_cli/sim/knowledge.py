@@ -145,6 +145,29 @@ def _dilated(cells: np.ndarray, reach: int) -> np.ndarray:
     return out
 
 
+@functools.lru_cache(maxsize=8)
+def _centre_lines(grid: Grid) -> tuple[np.ndarray, np.ndarray]:
+    """The x of every column's cell centres and the y of every row's (``ox + (j + 0.5) *
+    res``, the arithmetic :meth:`RobotMap.near` did cell by cell, so the same bits)."""
+    rows, cols = grid.occupied.shape
+    res, (ox, oy) = grid.resolution, grid.origin
+    xs = ox + (np.arange(cols) + 0.5) * res
+    ys = oy + (np.arange(rows) + 0.5) * res
+    xs.flags.writeable = ys.flags.writeable = False
+    return xs, ys
+
+
+def _centres_of(grid: Grid, window: np.ndarray, r0: int, c0: int) -> np.ndarray:
+    """The centres ``[P, 2]`` of the set cells of ``window``, a part of ``grid``'s cells
+    from row ``r0`` and column ``c0`` (in row-major order, as ``np.nonzero`` gives them)."""
+    r, c = np.nonzero(window)
+    xs, ys = _centre_lines(grid)
+    out = np.empty((len(r), 2))
+    out[:, 0] = xs[c + c0]
+    out[:, 1] = ys[r + r0]
+    return out
+
+
 @functools.lru_cache(maxsize=4)
 def _given_dilated(grid: Grid, reach: int) -> np.ndarray:
     """:func:`_dilated` of a given grid's cells, shared by every robot and run that plans on
@@ -162,11 +185,13 @@ class RobotMap:
     checked_at: float = -math.inf  # s
     replans: int = 0
     planned: np.ndarray | None = None   # the cells the route was last planned on (None: given)
+    marks: np.ndarray | None = None     # bool [rows, cols]: the cells it marked (not given)
+    marked: int = 0                     # how many there are
     _around: tuple | None = field(default=None, repr=False)   # (planned, reach, its dilation)
 
     @classmethod
     def of(cls, grid: Grid) -> RobotMap:
-        return cls(grid, grid.occupied.copy())
+        return cls(grid, grid.occupied.copy(), marks=np.zeros(grid.occupied.shape, dtype=bool))
 
     def accounted(self, points: np.ndarray, reach: int = 2) -> np.ndarray:
         """Which points ``[P, 2]`` lie within ``reach`` cells of a cell the robot's route was
@@ -206,8 +231,7 @@ class RobotMap:
         c1 = min(max(int((p[0] + reach - ox) // res) + 1, 0), cols)
         r1 = min(max(int((p[1] + reach - oy) // res) + 1, 0), rows)
         cells = self.grid.occupied if given else self.occupied
-        r, c = np.nonzero(cells[r0:r1, c0:c1])
-        return np.stack([ox + (c + c0 + 0.5) * res, oy + (r + r0 + 0.5) * res], axis=1)
+        return _centres_of(self.grid, cells[r0:r1, c0:c1], r0, c0)
 
     def clear(self, origin: np.ndarray, dirs: np.ndarray, measured: np.ndarray,
               max_range: float) -> None:
@@ -216,6 +240,8 @@ class RobotMap:
         (:mod:`.sensors`), so a cell is seen through when the ray crosses it, within half a
         cell of its centre, a cell or more before the reading. Cells the robot was given stay
         as given."""
+        if not self.marked:
+            return
         g = self.grid
         res, (ox, oy) = g.resolution, g.origin
         rows, cols = self.occupied.shape
@@ -223,16 +249,21 @@ class RobotMap:
         r0 = min(max(int((origin[1] - max_range - oy) // res), 0), rows)
         c1 = min(max(int((origin[0] + max_range - ox) // res) + 1, 0), cols)
         r1 = min(max(int((origin[1] + max_range - oy) // res) + 1, 0), rows)
-        window = (slice(r0, r1), slice(c0, c1))
-        r, c = np.nonzero(self.occupied[window] & ~g.occupied[window])
+        assert self.marks is not None
+        r, c = np.nonzero(self.marks[r0:r1, c0:c1])
         if not len(r):
             return
-        rel = np.stack([ox + (c + c0 + 0.5) * res, oy + (r + r0 + 0.5) * res], axis=1) - origin
+        xs, ys = _centre_lines(g)
+        rel = np.stack([xs[c + c0], ys[r + r0]], axis=1) - origin
         along = rel @ dirs.T                                       # [P, B]
         across = np.abs(rel[:, :1] * dirs[:, 1] - rel[:, 1:] * dirs[:, 0])
         through = ((along > 0) & (along < np.minimum(measured, max_range) - res)
                    & (across < res / 2)).any(axis=1)
-        self.occupied[r[through] + r0, c[through] + c0] = False
+        if through.any():
+            seen = (r[through] + r0, c[through] + c0)
+            self.occupied[seen] = False
+            self.marks[seen] = False
+            self.marked -= len(seen[0])
 
     def mark(self, hits: np.ndarray, dirs: np.ndarray) -> None:
         """Mark the cells just beyond each hit point (the echo came from there)."""
@@ -243,6 +274,9 @@ class RobotMap:
         new = ~self.occupied[row, col]
         if new.any():
             self.occupied[row[new], col[new]] = True
+            assert self.marks is not None
+            self.marks[row[new], col[new]] = True
+            self.marked += len(np.unique(row[new] * self.marks.shape[1] + col[new]))
             g = self.grid
             self.fresh.append(np.stack([g.origin[0] + (col[new] + 0.5) * g.resolution,
                                         g.origin[1] + (row[new] + 0.5) * g.resolution], axis=1))

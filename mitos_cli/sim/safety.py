@@ -22,6 +22,7 @@ The sweep (:func:`free_travel`) moves the footprint along the exact arc about th
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -47,28 +48,47 @@ def free_travel(cells: np.ndarray, radius: float, pose: tuple[float, float, floa
     """How far (in, along the rear axle's path) the robot can drive from ``pose`` (x, y, heading
     in rad) with its wheel held ``delta`` degrees off straight (positive right), forward or
     ``backward``, before its footprint touches one of the occupied ``cells [P, 2]`` (discs of
-    ``radius``); ``reach`` when it can drive that far, 0 when it touches one already."""
+    ``radius``); ``reach`` when it can drive that far, 0 when it touches one already.
+
+    Only the cells in the box the footprint's circumscribed disc sweeps are tested: a cell
+    outside it is inside no footprint along the arc (1e-6 in of slack for rounding), and each
+    cell's test is its own."""
     x, y, h = pose
     if not len(cells):
         return reach
     wb, hl, hw = robot.wheelbase, robot.length / 2 + radius, robot.width / 2 + radius
-    u = np.arange(0.0, reach + step / 2, step) * (-1.0 if backward else 1.0)   # [K]
+    u = _path(reach, step, backward)                 # [K]
     k = -math.tan(math.radians(delta)) / wb          # rad per inch of the rear axle's path
     hk = h + k * u
+    c, s = np.cos(hk), np.sin(hk)
     if abs(k) > 1e-9:
-        rx = x - wb / 2 * math.cos(h) + (np.sin(hk) - math.sin(h)) / k
-        ry = y - wb / 2 * math.sin(h) + (math.cos(h) - np.cos(hk)) / k
+        rx = x - wb / 2 * math.cos(h) + (s - math.sin(h)) / k
+        ry = y - wb / 2 * math.sin(h) + (math.cos(h) - c) / k
     else:
         rx = x - wb / 2 * math.cos(h) + u * math.cos(h)
         ry = y - wb / 2 * math.sin(h) + u * math.sin(h)
-    c, s = np.cos(hk), np.sin(hk)
-    dx = cells[:, 0, None] - (rx + wb / 2 * c)
-    dy = cells[:, 1, None] - (ry + wb / 2 * s)
+    cx, cy = rx + wb / 2 * c, ry + wb / 2 * s        # the footprint's centre at each step
+    disc = math.hypot(hl, hw) + 1e-6
+    px, py = cells[:, 0], cells[:, 1]
+    swept = ((px >= cx.min() - disc) & (px <= cx.max() + disc)
+             & (py >= cy.min() - disc) & (py <= cy.max() + disc))
+    if not swept.any():
+        return reach
+    px, py = px[swept, None], py[swept, None]
+    dx, dy = px - cx, py - cy
     inside = (np.abs(dx * c + dy * s) <= hl) & (np.abs(dy * c - dx * s) <= hw)     # [P, K]
     hit = inside.any(axis=0)
     if not hit.any():
         return reach
-    return float(max(int(np.argmax(hit)) - 1, 0) * step)
+    return float(max(int(hit.argmax()) - 1, 0) * step)
+
+
+@functools.lru_cache(maxsize=16)
+def _path(reach: float, step: float, backward: bool) -> np.ndarray:
+    """``[K]`` the rear axle's signed travel at each step of the sweep."""
+    out = np.arange(0.0, reach + step / 2, step) * (-1.0 if backward else 1.0)
+    out.flags.writeable = False
+    return out
 
 
 def brake(free: float, acceleration: float, margin: float) -> float:
