@@ -356,7 +356,7 @@ def way_past(rmap: RobotMap, route: Route, s: float, p: np.ndarray, ahead: float
     try:
         grid_route(_as_map(g), Pose(float(p[0]), float(p[1])), Goal(float(target[0]),
                    float(target[1])), clearance, minimum=minimum, explain=False,
-                   leave=clearance + 6.0)
+                   leave=clearance + 6.0, keep=False)
     except NarrowPassage:
         return False
     return True

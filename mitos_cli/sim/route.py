@@ -15,9 +15,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import WorldError
-from .distance import distance_transform
+from .distance import _capped, distance_transform
 from .staticmap import StaticMap
-from .world import Corridor, Goal, Pose, Robot
+from .world import Corridor, Goal, Grid, Pose, Robot
 
 
 @dataclass(frozen=True)
@@ -366,7 +366,7 @@ NARROW_COST = 20.0      # extra cost per step (in steps) of a node closer than t
 def grid_route(static: StaticMap, start: Pose, goal: Goal, clearance: float,
                cell: float = 6.0, minimum: float | None = None,
                occupied: np.ndarray | None = None, explain: bool = True,
-               leave: float = 0.0, behind: float = 0.0) -> Route:
+               leave: float = 0.0, behind: float = 0.0, keep: bool = True) -> Route:
     """A* on nodes about ``cell`` inches apart, each kept at least ``clearance`` inches (the
     exact Euclidean distance) from the occupied cells, preferring the middle of the corridors.
     Nodes closer than that but not closer than ``minimum`` (the robot's half width plus its
@@ -376,16 +376,17 @@ def grid_route(static: StaticMap, start: Pose, goal: Goal, clearance: float,
     own cells (what the robot knows, when that is not the map). ``explain=False`` skips the search for
     the narrowest place (replanning only needs to know that there is no way). ``leave``:
     within this many inches of the start, any node off the occupied cells is open (a robot
-    that replans beside what it is passing must be able to move off)."""
+    that replans beside what it is passing must be able to move off). ``keep``: keep what
+    the search works out from the grid's own cells for the next search on the same grid
+    (:func:`_prepared`; not for a grid made for one search)."""
     g = static.grid
     assert g is not None        # callers plan on a grid (plan_route checks; the rest build one)
     occ = g.occupied if occupied is None else occupied
     reach = clearance + 36.0           # in: beyond this from the walls, the middle is as good
-    field = Clearance.of(occ, g.resolution, g.origin, cap=reach + 2 * g.resolution)
     k = max(1, int(round(cell / g.resolution)))
     rows, cols = occ.shape
     R, C = -(-rows // k), -(-cols // k)
-    fr, fc, node_c = _nodes(field.dist, k)
+    field, (fr, fc, node_c), edge = _prepared(g, occ, reach + 2 * g.resolution, k, keep)
     node_c = node_c - g.resolution / 2                         # clearance at each node (in)
     size = k * g.resolution
 
@@ -400,8 +401,7 @@ def grid_route(static: StaticMap, start: Pose, goal: Goal, clearance: float,
     for rc, what in ((s, "start"), (t, "goal")):
         if not (0 <= rc[0] < R and 0 <= rc[1] < C):
             raise WorldError(f"the {what} lies outside the map")
-    moves = [(dr, dc, math.hypot(dr, dc)) for dr in (-1, 0, 1) for dc in (-1, 0, 1)
-             if dr or dc]
+    moves = MOVES
     floor = clearance if minimum is None else min(minimum, clearance)
     # prefer the middle; a node closer than `clearance` (but not than `floor`) costs
     # NARROW_COST times more, so the route squeezes through only where nothing wider leads on
@@ -426,22 +426,14 @@ def grid_route(static: StaticMap, start: Pose, goal: Goal, clearance: float,
     # an edge between two nodes keeps the floor too (nodes sit at their block's clearest
     # cell, so two clear nodes may face each other across a thin wall); edges that leave the
     # start, reach the goal or move off within `leave` are exempt, as those nodes are
-    edge = _edge_clearance(field, centre, (R, C), moves)
     loose = ~blocked & (node_c < floor)
     loose[s] = loose[t] = True
     ok = (edge >= floor) & ~blocked[None]
     narrow = (edge < clearance) & (node_c >= clearance)[None]
 
-    def neighbours(n: int):
-        r, c = divmod(n, C)
-        for m, (dr, dc, step) in enumerate(moves):
-            rr, cc = r + dr, c + dc
-            if 0 <= rr < R and 0 <= cc < C and not blocked[rr, cc] and (
-                    ok[m, r, c] or loose[r, c] or loose[rr, cc]):
-                yield rr * C + cc, step * (1.0 + penalty[rr, cc]
-                                           + (NARROW_COST if narrow[m, r, c] else 0.0))
-
-    path = _astar(neighbours, s[0] * C + s[1], t[0] * C + t[1], lambda n: (n // C, n % C))
+    allowed, costs = _steps(moves, blocked, ok, loose, penalty, narrow)
+    path = _grid_astar(allowed, costs, [dr * C + dc for dr, dc, _ in moves], C,
+                       s[0] * C + s[1], t[0] * C + t[1])
     if path is None:
         if not explain:
             raise NarrowPassage("no way to the goal on what the robot knows")
@@ -452,24 +444,166 @@ def grid_route(static: StaticMap, start: Pose, goal: Goal, clearance: float,
     return Route.of(pts, goal=(goal.x, goal.y))
 
 
-def _edge_clearance(field: Clearance, centre, shape: tuple[int, int],
-                    moves: list[tuple[int, int, float]]) -> np.ndarray:
-    """The smallest clearance ``[len(moves), R, C]`` on the segment from each node to its
-    neighbour in each move, sampled every half cell or closer and measured as the nodes are
-    (:meth:`Clearance.cells`; ``-inf`` off the grid)."""
-    R, C = shape
-    x, y = centre((slice(None), slice(None)))
-    xy = np.stack([x, y], axis=-1)                             # [R, C, 2]
-    out = np.full((len(moves), R, C), -np.inf)
-    step = math.dist(xy[0, 0], xy[min(1, R - 1), min(1, C - 1)]) if R * C > 1 else 1.0
-    t = np.linspace(0.0, 1.0, max(3, int(math.ceil(2 * step / field.resolution)) + 1))
-    for m, (dr, dc, _) in enumerate(moves):
+def _steps(moves: list[tuple[int, int, float]], blocked: np.ndarray, ok: np.ndarray,
+           loose: np.ndarray, penalty: np.ndarray,
+           narrow: np.ndarray) -> tuple[memoryview, memoryview]:
+    """Every step of the node grid ``[R, C]`` at once, flat (move ``m`` from node ``n`` at
+    ``m * R * C + n``): whether it may be taken (onto the grid, onto a node not blocked, along
+    an edge that keeps the floor or from or to a loose node) and its cost, ``step * (1 +
+    penalty + NARROW_COST where the edge is narrow)`` in that order, as A* added it up; as
+    flat memoryviews, whose items read as Python ints and floats."""
+    R, C = blocked.shape
+    allowed = np.zeros((len(moves), R, C), dtype=bool)
+    costs = np.zeros((len(moves), R, C))
+    for m, (dr, dc, step) in enumerate(moves):
         src = (slice(max(0, -dr), R - max(0, dr)), slice(max(0, -dc), C - max(0, dc)))
         dst = (slice(max(0, dr), R + min(0, dr)), slice(max(0, dc), C + min(0, dc)))
-        a, b = xy[src], xy[dst]
+        allowed[m][src] = ~blocked[dst] & (ok[m][src] | loose[src] | loose[dst])
+        costs[m][src] = step * (1.0 + penalty[dst] + np.where(narrow[m][src], NARROW_COST, 0.0))
+    return allowed.view(np.uint8).reshape(-1).data, costs.reshape(-1).data
+
+
+def _grid_astar(allowed: memoryview, costs: memoryview, offsets: list[int], C: int, start: int,
+                goal: int) -> list[int] | None:
+    """:func:`_astar` over the node grid with the steps of :func:`_steps` (the same pushes in
+    the same order, so the same path), without a Python call per neighbour."""
+    size = len(costs) // len(offsets)
+    gr, gc = divmod(goal, C)
+    frontier = [(0.0, 0, start)]
+    came = {start: -1}
+    cost = {start: 0.0}
+    tie = 0
+    moves = [(m * size, off) for m, off in enumerate(offsets)]
+    while frontier:
+        _, _, node = heapq.heappop(frontier)
+        if node == goal:
+            path = [node]
+            while came[path[-1]] != -1:
+                path.append(came[path[-1]])
+            return path[::-1]
+        here = cost[node]
+        for base, off in moves:
+            if allowed[base + node]:
+                nxt = node + off
+                c = here + costs[base + node]
+                if c < cost.get(nxt, math.inf):
+                    cost[nxt] = c
+                    came[nxt] = node
+                    tie += 1
+                    heapq.heappush(frontier, (c + math.dist((nxt // C, nxt % C), (gr, gc)),
+                                              tie, nxt))
+    return None
+
+
+def _samples(field: Clearance, xy: np.ndarray) -> np.ndarray:
+    """Where along a step its clearance is sampled: every half cell or closer over the
+    distance from node (0, 0) to node (1, 1)."""
+    R, C = xy.shape[:2]
+    step = math.dist(xy[0, 0], xy[min(1, R - 1), min(1, C - 1)]) if R * C > 1 else 1.0
+    return np.linspace(0.0, 1.0, max(3, int(math.ceil(2 * step / field.resolution)) + 1))
+
+
+def _edges_from(out: np.ndarray, field: Clearance, xy: np.ndarray, t: np.ndarray,
+                moves: tuple[tuple[int, int, float], ...], rows: tuple[int, int],
+                cols: tuple[int, int]) -> None:
+    """Fill ``out [len(moves), R, C]`` with the smallest clearance on each step from the
+    nodes in ``rows`` x ``cols`` (half-open ranges of node rows and columns) to its neighbour
+    in each move, sampled at ``t`` along it and measured as the nodes are
+    (:meth:`Clearance.cells`); each step's clearance is its own samples' alone, so any part
+    gives the bits of the whole. Steps off the grid are left as they are (``-inf``)."""
+    R, C = xy.shape[:2]
+    for m, (dr, dc, _) in enumerate(moves):
+        r0, r1 = max(rows[0], -dr, 0), min(rows[1], R - dr, R)
+        c0, c1 = max(cols[0], -dc, 0), min(cols[1], C - dc, C)
+        if r0 >= r1 or c0 >= c1:
+            continue
+        a, b = xy[r0:r1, c0:c1], xy[r0 + dr:r1 + dr, c0 + dc:c1 + dc]
         pts = a[..., None, :] + t[:, None] * (b - a)[..., None, :]
-        out[m][src] = field.cells(pts.reshape(-1, 2)).reshape(pts.shape[:-1]).min(axis=-1)
-    return out
+        out[m, r0:r1, c0:c1] = field.cells(pts.reshape(-1, 2)).reshape(pts.shape[:-1]).min(
+            axis=-1)
+
+
+MOVES = tuple((dr, dc, math.hypot(dr, dc)) for dr in (-1, 0, 1) for dc in (-1, 0, 1)
+              if dr or dc)
+
+
+@functools.lru_cache(maxsize=4)
+def _planned_on(grid: Grid, cap: float, k: int):
+    """What :func:`grid_route` works out from a grid's own cells before it searches: the
+    clearance field (exact up to ``cap``), the nodes (blocks of ``k`` cells), every step's
+    clearance and where along a step it is sampled. Kept (read-only): every run of a world
+    plans on the same grid, and a robot's map differs from it only round what it has marked
+    (:func:`_prepared`)."""
+    field = Clearance.of(grid.occupied, grid.resolution, grid.origin, cap=cap)
+    nodes = _nodes(field.dist, k)
+    xy = _node_xy(grid, nodes)
+    t = _samples(field, xy)
+    edge = np.full((len(MOVES), *xy.shape[:2]), -np.inf)
+    _edges_from(edge, field, xy, t, MOVES, (0, xy.shape[0]), (0, xy.shape[1]))
+    for a in (field.dist, *nodes, edge):
+        a.flags.writeable = False
+    return field, nodes, edge, len(t)
+
+
+def _node_xy(grid: Grid, nodes) -> np.ndarray:
+    """``[R, C, 2]`` the nodes' cell centres (as :func:`grid_route`'s ``centre``)."""
+    fr, fc, _ = nodes
+    return np.stack([grid.origin[0] + (fc + 0.5) * grid.resolution,
+                     grid.origin[1] + (fr + 0.5) * grid.resolution], axis=-1)
+
+
+def _prepared(grid: Grid, occ: np.ndarray, cap: float, k: int, keep: bool = True):
+    """The clearance field, the nodes and every step's clearance (:func:`_planned_on`) for
+    the cells ``occ`` (the grid's own, or a robot's map of it): from the grid's own, worked
+    out again only where the cells that differ can reach. The capped field at a cell depends
+    on the cells within ``n`` cells of it each way (:func:`.distance._capped`), a node on its
+    block's field, a step's clearance on its two nodes and the cells between them (which lie
+    in the two nodes' blocks): the rest keeps its bits."""
+    res = grid.resolution
+    n = int(math.ceil(cap / res))
+    rows, cols = occ.shape
+    if not keep or occ is not grid.occupied and (not occ.any() or not grid.occupied.any()
+                                                 or n >= max(rows, cols)):
+        field = Clearance.of(occ, res, grid.origin, cap=cap)      # no shortcut applies
+        nodes = _nodes(field.dist, k)
+        xy = _node_xy(grid, nodes)
+        edge = np.full((len(MOVES), *xy.shape[:2]), -np.inf)
+        _edges_from(edge, field, xy, _samples(field, xy), MOVES, (0, xy.shape[0]),
+                    (0, xy.shape[1]))
+        return field, nodes, edge
+    base_field, base_nodes, base_edge, samples = _planned_on(grid, cap, k)
+    diff = occ != grid.occupied
+    changed_rows = np.flatnonzero(diff.any(axis=1))
+    if not len(changed_rows):
+        return base_field, base_nodes, base_edge
+    changed_cols = np.flatnonzero(diff.any(axis=0))
+    # the field where it can differ (n cells round the changed ones), from n more round that
+    d0, d1 = max(int(changed_rows[0]) - n, 0), min(int(changed_rows[-1]) + 1 + n, rows)
+    e0, e1 = max(int(changed_cols[0]) - n, 0), min(int(changed_cols[-1]) + 1 + n, cols)
+    f0, f1 = max(d0 - n, 0), min(d1 + n, rows)
+    g0, g1 = max(e0 - n, 0), min(e1 + n, cols)
+    dist = base_field.dist.copy()
+    part = np.sqrt(_capped(occ[f0:f1, g0:g1], n)) * res
+    dist[d0:d1, e0:e1] = part[d0 - f0:d1 - f0, e0 - g0:e1 - g0]
+    field = Clearance(dist, res, grid.origin)
+    # the nodes of the blocks that overlap it
+    b0, b1, c0, c1 = d0 // k, -(-d1 // k), e0 // k, -(-e1 // k)
+    fr, fc, node_d = (a.copy() for a in base_nodes)
+    sub = _nodes(dist[b0 * k:b1 * k, c0 * k:c1 * k], k)
+    fr[b0:b1, c0:c1] = sub[0] + b0 * k
+    fc[b0:b1, c0:c1] = sub[1] + c0 * k
+    node_d[b0:b1, c0:c1] = sub[2]
+    nodes = (fr, fc, node_d)
+    xy = _node_xy(grid, nodes)
+    R, C = fr.shape
+    t = _samples(field, xy)
+    edge = base_edge.copy()
+    if len(t) != samples:                # node (0, 0) or (1, 1) moved: every step again
+        _edges_from(edge, field, xy, t, MOVES, (0, R), (0, C))
+    else:                                # the steps from a node within a block of those
+        _edges_from(edge, field, xy, t, MOVES, (max(b0 - 1, 0), min(b1 + 1, R)),
+                    (max(c0 - 1, 0), min(c1 + 1, C)))
+    return field, nodes, edge
 
 
 def _refusal(node_c: np.ndarray, s, t, centre, floor: float,
