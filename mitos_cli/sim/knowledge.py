@@ -185,13 +185,13 @@ class RobotMap:
     checked_at: float = -math.inf  # s
     replans: int = 0
     planned: np.ndarray | None = None   # the cells the route was last planned on (None: given)
-    marks: np.ndarray | None = None     # bool [rows, cols]: the cells it marked (not given)
-    marked: int = 0                     # how many there are
+    marks: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
+    # the cells it marked (none given), as row * cols + col, ascending (row-major order)
     _around: tuple | None = field(default=None, repr=False)   # (planned, reach, its dilation)
 
     @classmethod
     def of(cls, grid: Grid) -> RobotMap:
-        return cls(grid, grid.occupied.copy(), marks=np.zeros(grid.occupied.shape, dtype=bool))
+        return cls(grid, grid.occupied.copy())
 
     def accounted(self, points: np.ndarray, reach: int = 2) -> np.ndarray:
         """Which points ``[P, 2]`` lie within ``reach`` cells of a cell the robot's route was
@@ -240,7 +240,7 @@ class RobotMap:
         (:mod:`.sensors`), so a cell is seen through when the ray crosses it, within half a
         cell of its centre, a cell or more before the reading. Cells the robot was given stay
         as given."""
-        if not self.marked:
+        if not len(self.marks):
             return
         g = self.grid
         res, (ox, oy) = g.resolution, g.origin
@@ -249,21 +249,21 @@ class RobotMap:
         r0 = min(max(int((origin[1] - max_range - oy) // res), 0), rows)
         c1 = min(max(int((origin[0] + max_range - ox) // res) + 1, 0), cols)
         r1 = min(max(int((origin[1] + max_range - oy) // res) + 1, 0), rows)
-        assert self.marks is not None
-        r, c = np.nonzero(self.marks[r0:r1, c0:c1])
-        if not len(r):
+        # the marks in that window, in the row-major order np.nonzero would give them
+        r, c = np.divmod(self.marks, cols)
+        window = (r >= r0) & (r < r1) & (c >= c0) & (c < c1)
+        if not window.any():
             return
+        r, c = r[window], c[window]
         xs, ys = _centre_lines(g)
-        rel = np.stack([xs[c + c0], ys[r + r0]], axis=1) - origin
+        rel = np.stack([xs[c], ys[r]], axis=1) - origin
         along = rel @ dirs.T                                       # [P, B]
         across = np.abs(rel[:, :1] * dirs[:, 1] - rel[:, 1:] * dirs[:, 0])
         through = ((along > 0) & (along < np.minimum(measured, max_range) - res)
                    & (across < res / 2)).any(axis=1)
         if through.any():
-            seen = (r[through] + r0, c[through] + c0)
-            self.occupied[seen] = False
-            self.marks[seen] = False
-            self.marked -= len(seen[0])
+            self.occupied[r[through], c[through]] = False
+            self.marks = np.delete(self.marks, np.flatnonzero(window)[through])
 
     def mark(self, hits: np.ndarray, dirs: np.ndarray) -> None:
         """Mark the cells just beyond each hit point (the echo came from there)."""
@@ -274,9 +274,7 @@ class RobotMap:
         new = ~self.occupied[row, col]
         if new.any():
             self.occupied[row[new], col[new]] = True
-            assert self.marks is not None
-            self.marks[row[new], col[new]] = True
-            self.marked += len(np.unique(row[new] * self.marks.shape[1] + col[new]))
+            self.marks = np.union1d(self.marks, row[new] * self.occupied.shape[1] + col[new])
             g = self.grid
             self.fresh.append(np.stack([g.origin[0] + (col[new] + 0.5) * g.resolution,
                                         g.origin[1] + (row[new] + 0.5) * g.resolution], axis=1))
