@@ -41,6 +41,39 @@ class Limits:
                    col("acceleration"), col("max_reverse"))
 
 
+@dataclass(frozen=True)
+class _Ramp:
+    """What :func:`step` derives from the limits alone, ``[substeps, n]`` or ``[n]``: how far
+    the wheel and the speed may have moved after each substep (up and down), the top speed
+    backward (negative) and half the wheelbase."""
+
+    steer_up: np.ndarray
+    steer_down: np.ndarray
+    speed_up: np.ndarray
+    speed_down: np.ndarray
+    reverse: np.ndarray
+    half: np.ndarray
+
+
+_RAMPS: dict[int, tuple[Limits, float, int, _Ramp]] = {}
+
+
+def _ramp(lim: Limits, dt: float, substeps: int) -> _Ramp:
+    """:class:`_Ramp` of ``lim``, kept for the last few limits (a run's do not change)."""
+    kept = _RAMPS.get(id(lim))
+    if kept is not None and kept[0] is lim and kept[1] == dt and kept[2] == substeps:
+        return kept[3]
+    sdt = dt / substeps
+    k = np.arange(1, substeps + 1, dtype=float)[:, None]
+    d_steer = k * (lim.max_rate * sdt)
+    d_speed = k * (lim.acceleration * sdt)
+    ramp = _Ramp(d_steer, -d_steer, d_speed, -d_speed, -lim.max_reverse, lim.wheelbase / 2.0)
+    if len(_RAMPS) >= 16:
+        del _RAMPS[next(iter(_RAMPS))]
+    _RAMPS[id(lim)] = (lim, dt, substeps, ramp)
+    return ramp
+
+
 def _clip(x, lo, hi):
     return np.minimum(np.maximum(x, lo), hi)
 
@@ -93,13 +126,11 @@ def step(x, y, heading, speed, steering, cmd_steering, cmd_speed, lim: Limits, d
     rows ``k = 1..substeps`` of ``[substeps, n]`` arrays (the ramp toward a clipped target is
     ``start + clip(target - start, -k d, k d)``). Returns (x, y, heading, speed, steering)."""
     sdt = dt / substeps
-    k = np.arange(1, substeps + 1, dtype=float)[:, None]
+    ramp = _ramp(lim, dt, substeps)
     target = _clip(cmd_steering, lim.steering_min, lim.steering_max)
-    target_v = _clip(cmd_speed, -lim.max_reverse, lim.max_speed)
-    d_steer = k * (lim.max_rate * sdt)
-    d_speed = k * (lim.acceleration * sdt)
-    steer_k = steering + _clip(target - steering, -d_steer, d_steer)
-    speed_k = speed + _clip(target_v - speed, -d_speed, d_speed)
+    target_v = _clip(cmd_speed, ramp.reverse, lim.max_speed)
+    steer_k = steering + _clip(target - steering, ramp.steer_down, ramp.steer_up)
+    speed_k = speed + _clip(target_v - speed, ramp.speed_down, ramp.speed_up)
     delta = np.deg2rad(steer_k - lim.straight)
     dh = -speed_k * np.sin(delta) / lim.wheelbase * sdt
     half_dh = dh / 2.0
@@ -108,7 +139,7 @@ def step(x, y, heading, speed, steering, cmd_steering, cmd_speed, lim: Limits, d
     chord = speed_k * np.cos(delta) * sdt * ratio
     h_after = heading + np.cumsum(dh, axis=0)
     mid = h_after - half_dh
-    half = lim.wheelbase / 2.0
+    half = ramp.half
     rx = x - half * np.cos(heading) + (chord * np.cos(mid)).sum(axis=0)
     ry = y - half * np.sin(heading) + (chord * np.sin(mid)).sum(axis=0)
     h = np.remainder(h_after[-1] + np.pi, 2.0 * np.pi) - np.pi

@@ -253,8 +253,9 @@ def _clearance(pose: np.ndarray, robot, walls: np.ndarray, polygons: np.ndarray,
             w[crossing] = -box_polygon_depth(hl, hw, ends[crossing])
         best = float(w.min())
     # a thing whose disc lies farther from the footprint's disc than the walls cannot be the
-    # nearest (1e-6 in of slack for the rounding of either side)
-    reach = best + math.hypot(hl, hw) + 1e-6
+    # nearest (1e-6 in of slack for the rounding of either side); only while no wall touches
+    # the footprint, so that whatever may overlap it is measured as before, all together
+    reach = best + math.hypot(hl, hw) + 1e-6 if best > 0.0 else math.inf
     if len(polygons):
         middle, radius = _enclosing(polygons) if discs is None else discs
         near = np.hypot(middle[:, 0] - pose[0], middle[:, 1] - pose[1]) - radius <= reach
@@ -721,9 +722,13 @@ class Simulation:
         cmd[:, 0] = self.limits.straight
         if self._active.any():
             idx = np.flatnonzero(self._active)
-            sub = Percepts({key: val[idx] for key, val in s.inputs.items()}, s.ranges[idx],
-                           self.angles, s.pose[idx], self._v[idx], s.targets[idx],
-                           self._goals[idx], self._steer[idx], idx)
+
+            def rows(a: np.ndarray) -> np.ndarray:      # a copy of the active robots' rows
+                return a.copy() if len(idx) == self.n else a[idx]
+
+            sub = Percepts({key: rows(val) for key, val in s.inputs.items()}, rows(s.ranges),
+                           self.angles, rows(s.pose), rows(self._v), rows(s.targets),
+                           rows(self._goals), rows(self._steer), idx)
             c_steer, c_speed = self.planner.plan(sub)
             cmd[idx, 0], cmd[idx, 1] = c_steer, c_speed
 

@@ -16,6 +16,7 @@ import numpy as np
 
 from ..errors import WorldError
 from .distance import _capped, distance_transform
+from .geometry import clip_arrays
 from .staticmap import StaticMap
 from .world import Corridor, Goal, Grid, Pose, Robot
 
@@ -83,22 +84,29 @@ class Route:
         Only the segments in that window are measured (elementwise, so each gets the bits it
         would get among all); with none in it, the first segment answers."""
         a, e, ee, root = self._segments
-        window = np.flatnonzero((self.cum[1:] >= s_hint - back) &
-                                (self.cum[:-1] <= s_hint + ahead))
-        if len(window) == 0:
-            window = np.zeros(1, dtype=np.intp)
-        elif len(window) < len(a):
-            a, e, ee, root = a[window], e[window], ee[window], root[window]
-        t = np.clip(((p - a) * e).sum(axis=1) / ee, 0.0, 1.0)
+        first, stop = self._window(s_hint - back, s_hint + ahead)
+        if first >= stop:
+            first, stop = 0, 1
+        if stop - first < len(a):
+            a, e, ee, root = a[first:stop], e[first:stop], ee[first:stop], root[first:stop]
+        t = clip_arrays(((p - a) * e).sum(axis=1) / ee, 0.0, 1.0)
         closest = a + t[:, None] * e
         d = np.hypot(*(p - closest).T)
-        i = int(np.argmin(d))
-        s = self.cum[window[i]] + t[i] * root[i]
+        i = int(d.argmin())
+        s = self.cum[first + i] + t[i] * root[i]
         tangent = e[i] / math.sqrt(ee[i])
         rel = p - closest[i]
         lateral = float(rel[0] * tangent[1] - rel[1] * tangent[0])   # right of the tangent
         return float(s), lateral, tangent
 
+
+    def _window(self, lo: float, hi: float) -> tuple[int, int]:
+        """The segments ``first:stop`` that reach arc length ``lo`` and start by ``hi`` (those
+        with ``cum[j + 1] >= lo`` and ``cum[j] <= hi``: arc length never decreases along the
+        route, so they are one run of segments)."""
+        cum = self.cum
+        return (int(np.searchsorted(cum[1:], lo, side="left")),
+                int(np.searchsorted(cum[:-1], hi, side="right")))
 
     def near(self, points: np.ndarray, s: float, reach: float, ahead: float) -> np.ndarray:
         """Which ``points [P, 2]`` lie within ``reach`` of the route between arc lengths ``s``
@@ -108,14 +116,14 @@ class Route:
     def distance(self, points: np.ndarray, s: float, ahead: float) -> np.ndarray:
         """The distance ``[P]`` of each point from the route between arc lengths ``s`` and
         ``s + ahead`` (``inf`` with no route there)."""
-        window = (self.cum[1:] >= s) & (self.cum[:-1] <= s + ahead)
-        a, b = self.points[:-1][window], self.points[1:][window]
-        if not len(a) or not len(points):
+        first, stop = self._window(s, s + ahead)
+        if first >= stop or not len(points):
             return np.full(len(points), np.inf)
+        a, b = self.points[first:stop], self.points[first + 1:stop + 1]
         e = b - a
         ee = np.maximum((e * e).sum(axis=1), 1e-12)
         rel = points[:, None] - a                                  # [P, M, 2]
-        t = np.clip((rel * e).sum(axis=2) / ee, 0.0, 1.0)
+        t = clip_arrays((rel * e).sum(axis=2) / ee, 0.0, 1.0)
         d = rel - t[..., None] * e
         return np.sqrt((d * d).sum(axis=2).min(axis=1))
 
