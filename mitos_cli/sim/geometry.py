@@ -72,7 +72,7 @@ def point_segment_distance(p: np.ndarray, seg: np.ndarray) -> np.ndarray:
     return np.hypot(dx - t * ex, dy - t * ey)
 
 
-def _cross(ax, ay, bx, by):
+def cross(ax, ay, bx, by):
     return ax * by - ay * bx
 
 
@@ -80,10 +80,10 @@ def segments_intersect(A: np.ndarray, B: np.ndarray) -> np.ndarray:
     """Whether segments ``A[M, 4]`` and ``B[N, 4]`` cross or touch: ``[M, N]`` booleans."""
     ax0, ay0, ax1, ay1 = (A[:, i, None] for i in range(4))
     bx0, by0, bx1, by1 = (B[None, :, i] for i in range(4))
-    d1 = _cross(ax1 - ax0, ay1 - ay0, bx0 - ax0, by0 - ay0)
-    d2 = _cross(ax1 - ax0, ay1 - ay0, bx1 - ax0, by1 - ay0)
-    d3 = _cross(bx1 - bx0, by1 - by0, ax0 - bx0, ay0 - by0)
-    d4 = _cross(bx1 - bx0, by1 - by0, ax1 - bx0, ay1 - by0)
+    d1 = cross(ax1 - ax0, ay1 - ay0, bx0 - ax0, by0 - ay0)
+    d2 = cross(ax1 - ax0, ay1 - ay0, bx1 - ax0, by1 - ay0)
+    d3 = cross(bx1 - bx0, by1 - by0, ax0 - bx0, ay0 - by0)
+    d4 = cross(bx1 - bx0, by1 - by0, ax1 - bx0, ay1 - by0)
     return (d1 * d2 <= 0) & (d3 * d4 <= 0) & ~((d1 == 0) & (d2 == 0) & (d3 == 0) & (d4 == 0))
 
 
@@ -102,7 +102,7 @@ def points_in_polygon(points: np.ndarray, corners: np.ndarray) -> np.ndarray:
     a = corners[None]                       # [1, Q, K, 2]
     e = np.roll(corners, -1, axis=1)[None] - a
     d = points[:, None, None, :] - a
-    return (_cross(e[..., 0], e[..., 1], d[..., 0], d[..., 1]) >= 0).all(axis=-1)
+    return (cross(e[..., 0], e[..., 1], d[..., 0], d[..., 1]) >= 0).all(axis=-1)
 
 
 def ray_segments(origin: np.ndarray, dirs: np.ndarray, seg: np.ndarray,
@@ -114,27 +114,9 @@ def ray_segments(origin: np.ndarray, dirs: np.ndarray, seg: np.ndarray,
     return np.minimum(ray_hits(origin, dirs, seg).min(axis=1), max_range)
 
 
-class SegmentSet:
-    """Segments ``[N, 4]`` with their vectors ``ex``, ``ey`` (``[1, N]``, end minus start), for
-    casting rays against the same segments tick after tick (:func:`ray_hits`)."""
-
-    __slots__ = ("seg", "ex", "ey")
-
-    def __init__(self, seg: np.ndarray) -> None:
-        self.seg = seg
-        self.ex = seg[None, :, 2] - seg[None, :, 0]
-        self.ey = seg[None, :, 3] - seg[None, :, 1]
-
-    def __len__(self) -> int:
-        return len(self.seg)
-
-
-def ray_hits(origin: np.ndarray, dirs: np.ndarray, seg: np.ndarray | SegmentSet) -> np.ndarray:
+def ray_hits(origin: np.ndarray, dirs: np.ndarray, seg: np.ndarray) -> np.ndarray:
     """``[B, N]``: how far along each ray segment ``seg[N, 4]`` is hit (``inf`` if not); each
     entry depends on its ray and segment alone."""
-    if not isinstance(seg, SegmentSet):
-        seg = SegmentSet(seg)
-    ex, ey, seg = seg.ex, seg.ey, seg.seg
     o = np.asarray(origin, float)
     if o.ndim == 1:                 # one origin: [1, N] offsets, broadcast over the beams
         px = seg[None, :, 0] - o[0]
@@ -143,12 +125,14 @@ def ray_hits(origin: np.ndarray, dirs: np.ndarray, seg: np.ndarray | SegmentSet)
         o = np.broadcast_to(o, (len(dirs), 2))
         px = seg[None, :, 0] - o[:, 0, None]
         py = seg[None, :, 1] - o[:, 1, None]
+    ex = seg[None, :, 2] - seg[None, :, 0]
+    ey = seg[None, :, 3] - seg[None, :, 1]
     dx, dy = dirs[:, 0, None], dirs[:, 1, None]
-    denom = _cross(dx, dy, ex, ey)
+    denom = cross(dx, dy, ex, ey)
     ok = np.abs(denom) > EPS
     safe = np.where(ok, denom, 1.0)
-    t = _cross(px, py, ex, ey) / safe
-    s = _cross(px, py, dx, dy) / safe
+    t = cross(px, py, ex, ey) / safe
+    s = cross(px, py, dx, dy) / safe
     hit = ok & (t >= 0.0) & (s >= 0.0) & (s <= 1.0)
     return np.where(hit, t, np.inf)
 
@@ -282,18 +266,25 @@ def box_polygon_distance(hl: float, hw: float, poly: np.ndarray,
     if side_gaps is None:
         side_gaps = box_segment_distance(hl, hw, polygon_segments(poly))
     gap = side_gaps.reshape(len(poly), -1).min(axis=1)
-    x, y = poly[..., 0], poly[..., 1]
-    nxt = _following(x.shape[1])
-    ex, ey = x[:, nxt] - x, y[:, nxt] - y
-    side = x * ey - y * ex                                  # > 0: the centre left of a side
-    over = ((gap <= 0.0) | ((np.abs(x[:, 0]) <= hl) & (np.abs(y[:, 0]) <= hw))
-            | (side >= 0.0).all(axis=1) | (side <= 0.0).all(axis=1))
+    over = polygon_overlaps(hl, hw, poly, gap)
     if not over.any():
         return gap
     out = gap.copy()
     depth = box_polygon_depth(hl, hw, poly[over])
     out[over] = np.where(depth > 0.0, -depth, gap[over])
     return out
+def polygon_overlaps(hl: float, hw: float, poly: np.ndarray, gap: np.ndarray) -> np.ndarray:
+    """``[P]``: which convex polygons ``[P, k, 2]`` (in the box's frame, at ``gap [P]`` from
+    it when apart) may overlap the box ``[-hl, hl] x [-hw, hw]``: their sides touch it, the
+    box holds their first corner, or they hold its centre."""
+    x, y = poly[..., 0], poly[..., 1]
+    nxt = _following(x.shape[1])
+    ex, ey = x[:, nxt] - x, y[:, nxt] - y
+    side = x * ey - y * ex                                  # > 0: the centre left of a side
+    return ((gap <= 0.0) | ((np.abs(x[:, 0]) <= hl) & (np.abs(y[:, 0]) <= hw))
+            | (side >= 0.0).all(axis=1) | (side <= 0.0).all(axis=1))
+
+
 def _box_crossing(hl: float, hw: float, seg: np.ndarray, d: np.ndarray) -> np.ndarray:
     """``d`` with 0 where the segment crosses the box (Liang-Barsky clipping)."""
     x0, y0, x1, y1 = seg[:, 0], seg[:, 1], seg[:, 2], seg[:, 3]

@@ -15,7 +15,7 @@ from dataclasses import fields
 
 import numpy as np
 
-from . import kinematics
+from . import kinematics, rows
 from .loop import Scene, SimResult, Simulation
 from .planner import FuzzyPlanner, Planner
 from .world import World
@@ -45,7 +45,7 @@ class Lockstep:
     def step(self) -> None:
         """One tick of every run still going."""
         live = [run for run in self.runs if not run.done]
-        commands = self._commands(live)
+        commands = self._commands(live, _observe_together(live))
         moving = []
         for run, command in zip(live, commands):
             _, moves = run.decide(command)
@@ -60,14 +60,13 @@ class Lockstep:
             self.step()
         return [run.result() for run in self.runs]
 
-    def _commands(self, live: list[Simulation]) -> list[np.ndarray | None]:
+    def _commands(self, live: list[Simulation], seen: list) -> list[np.ndarray | None]:
         """Each run's commands ``[n, 2]`` from one evaluation of the rule network for the
         active robots of all of them (``None``: the run plans itself, as planners other than
         the fuzzy one do, whose rows need not be independent of the batch)."""
         planner = self.planner
         if not isinstance(planner, FuzzyPlanner) or not live:
             return [None] * len(live)
-        seen = [run.observe() for run in live]
         active = [run.active for run in live]
         compiled = planner.compiled
         X = np.empty((sum(int(a.sum()) for a in active), len(compiled.inputs)))
@@ -83,11 +82,28 @@ class Lockstep:
         row = 0
         for run, a in zip(live, active):
             cmd = np.zeros((run.n, 2))
-            rows = int(a.sum())
-            cmd[a, 0], cmd[a, 1] = steer[row:row + rows], speed[row:row + rows]
-            row += rows
+            count = int(a.sum())
+            cmd[a, 0], cmd[a, 1] = steer[row:row + count], speed[row:row + count]
+            row += count
             commands.append(cmd)
         return commands
+
+
+def _observe_together(runs: list[Simulation]) -> list:
+    """:meth:`Simulation.observe` of every run, their robots' beams and clearance sensed in
+    one :func:`.rows.sense` (each row the bits of its robot alone)."""
+    fresh = [run for run in runs if not run.observed]
+    if len(fresh) > 1:
+        parts, spans = [], []
+        for run in fresh:
+            mine = run.sense_rows()
+            spans.append((len(parts), len(parts) + len(mine)))
+            parts += mine
+        world = fresh[0].world
+        got = rows.sense(parts, fresh[0].angles, world.sensors.range)
+        for run, (start, stop) in zip(fresh, spans):
+            run.observe(got.part(start, stop))
+    return [run.observe() for run in runs]
 
 
 def _move_together(runs: list[Simulation]) -> None:

@@ -22,15 +22,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import geometry, kinematics, knowledge, perception, safety, sensors
+from . import geometry, kinematics, knowledge, perception, rows, safety, sensors
 from . import obstacles as obs_mod
-from .geometry import (
-    box_polygon_depth,
-    box_polygon_distance,
-    box_segment_distance,
-    polygon_segments,
-    rect_corners,
-)
+from .geometry import polygon_segments, rect_corners
 from .planner import Percepts, Planner
 from .route import Route, grid_route, plan_route
 from .route import clearances as route_clearances
@@ -222,68 +216,6 @@ def _footprints(pose: np.ndarray, robots) -> np.ndarray:
                         np.array([r.length for r in robots]), np.array([r.width for r in robots]))
 
 
-def _clearance(pose: np.ndarray, robot, walls: np.ndarray, polygons: np.ndarray,
-               centres: np.ndarray, radii: np.ndarray,
-               discs: tuple[np.ndarray, np.ndarray] | None = None) -> float:
-    """Signed distance from one robot's footprint to walls, rectangles and other robots
-    (``polygons [P, 4, 2]``) and circles, computed in the footprint's own frame: the gap when
-    apart, 0 touching, minus the penetration depth (the shortest move that separates them) when
-    overlapping, with one definition for every kind of thing.
-
-    Each distance depends on its own thing alone, so a polygon or circle that cannot come
-    nearer than the walls is not measured: its distance is at least the gap between the
-    footprint's circumscribed disc and its own (``discs``: centres and radii of the polygons'
-    discs, :func:`_enclosing` by default), and the minimum stays what it is."""
-    c, s = math.cos(pose[2]), math.sin(pose[2])
-    hl, hw = robot.length / 2, robot.width / 2
-
-    def local(points: np.ndarray) -> np.ndarray:        # [..., 2] world -> footprint frame
-        rel = points - pose[:2]
-        out = np.empty_like(rel)
-        out[..., 0] = rel[..., 0] * c + rel[..., 1] * s
-        out[..., 1] = -rel[..., 0] * s + rel[..., 1] * c
-        return out
-
-    best = math.inf
-    if len(walls):
-        ends = local(walls.reshape(-1, 2, 2))
-        w = box_segment_distance(hl, hw, ends.reshape(-1, 4))
-        crossing = w <= 0.0
-        if crossing.any():
-            w[crossing] = -box_polygon_depth(hl, hw, ends[crossing])
-        best = float(w.min())
-    # a thing whose disc lies farther from the footprint's disc than the walls cannot be the
-    # nearest (1e-6 in of slack for the rounding of either side); only while no wall touches
-    # the footprint, so that whatever may overlap it is measured as before, all together
-    reach = best + math.hypot(hl, hw) + 1e-6 if best > 0.0 else math.inf
-    if len(polygons):
-        middle, radius = _enclosing(polygons) if discs is None else discs
-        near = np.hypot(middle[:, 0] - pose[0], middle[:, 1] - pose[1]) - radius <= reach
-        if near.any():
-            boxes = local(polygons if near.all() else polygons[near])
-            sides = box_segment_distance(hl, hw, polygon_segments(boxes))
-            best = min(best, float(box_polygon_distance(hl, hw, boxes, sides).min()))
-    if len(centres):
-        rel = centres - pose[:2]
-        near = np.hypot(rel[:, 0], rel[:, 1]) - radii <= reach
-        if near.any():
-            rel, r = (rel, radii) if near.all() else (rel[near], radii[near])
-            lx = np.abs(rel[:, 0] * c + rel[:, 1] * s) - hl
-            ly = np.abs(-rel[:, 0] * s + rel[:, 1] * c) - hw
-            outside = np.hypot(np.maximum(lx, 0), np.maximum(ly, 0))
-            inside = np.minimum(np.maximum(lx, ly), 0)
-            best = min(best, float((outside + inside - r).min()))
-    return best
-
-
-def _enclosing(polygons: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Discs holding convex polygons ``[P, k, 2]``: their corners' mean and the farthest
-    corner's distance from it, plus 1e-6 in for rounding (``[P, 2]``, ``[P]``)."""
-    middle = polygons.mean(axis=1)
-    off = polygons - middle[:, None]
-    return middle, np.hypot(off[..., 0], off[..., 1]).max(axis=1) + 1e-6
-
-
 @dataclass(frozen=True)
 class Tick:
     """What one tick recorded, rows are robots: the state the robots were in when they sensed,
@@ -403,10 +335,10 @@ class Simulation:
         self._body = [math.hypot(r.length, r.width) for r in self.robots]   # in: a diagonal
         self._safety = safety.Settings()
         self._still = None
-        self._still_discs = None          # discs round the still rectangles (_clearance)
+        self._still_discs = None        # discs round the still rectangles (rows.SenseRow)
         if not any(o.motion.kind in ("velocity", "waypoints") for o in world.obstacles):
             self._still = self._obstacles_at(0.0)
-            self._still_discs = _enclosing(self._still[1][5])
+            self._still_discs = rows.discs(self._still[1][5])
 
     def _setup_state(self) -> None:
         agents, n = self.world.agents, self.n
@@ -507,18 +439,24 @@ class Simulation:
         every robot is at its goal (False before :meth:`observe`)."""
         return self._observed is not None and bool(self._hit.any() or not self._active.any())
 
-    def observe(self) -> _Sensed:
+    def observe(self, sensed: rows.Sensed | None = None) -> _Sensed:
         """Sense, perceive and check the current tick, once; the next :meth:`step` goes on from
         there. What a policy outside the simulator decides on: ``.inputs`` (name -> ``[n]``),
-        ``.ranges [n, B]``, ``.pose``, ``.clearance``."""
+        ``.ranges [n, B]``, ``.pose``, ``.clearance``. ``sensed``: this tick's rows of
+        :func:`.rows.sense` for :meth:`sense_rows` (runs in lockstep sense together)."""
         if self._done:
             raise RuntimeError("the run has ended (reset() starts it again)")
         if self._observed is None:
-            s = self.sense()
+            s = self.sense() if sensed is None else self.sensed(sensed)
             self.perceive(s)
             self.check(s)
             self._observed = s
         return self._observed
+
+    @property
+    def observed(self) -> bool:
+        """Whether this tick has been observed (:meth:`observe`) and not yet decided."""
+        return self._observed is not None
 
     def step(self, command: np.ndarray | None = None) -> Tick:
         """Advance one tick and return what it recorded. ``command`` (``[n, 2]`` steering in
@@ -581,48 +519,58 @@ class Simulation:
 
     def sense(self) -> _Sensed:
         """Obstacle places at this tick's time, every robot's beams (noise from its own
-        stream) and the clearance of its footprint."""
+        stream) and the clearance of its footprint (:mod:`.rows`: all robots at once)."""
+        return self.sensed(rows.sense(self.sense_rows(), self.angles, self.world.sensors.range))
+
+    def sense_rows(self) -> list[rows.SenseRow]:
+        """What each robot senses with at this tick (:func:`.rows.sense` senses them; runs in
+        lockstep sense the robots of all their runs together)."""
         n, x, y, h = self.n, self._x, self._y, self._h
-        t = self._k * self.dt
         sen = self.world.sensors
-        where, (centres, radii, _, rect_sides, _, rect_box) = self._obstacles_at(t)
-        pose = np.stack([x, y, h], axis=1)
+        where, (centres, radii, _, rect_sides, _, rect_box) = self._obstacles_at(self.time)
+        self._where = where
         if n > 1:                                        # other robots are obstacles to each
-            footprints = _footprints(pose, self.robots)
+            footprints = _footprints(np.stack([x, y, h], axis=1), self.robots)
             robot_sides = polygon_segments(footprints).reshape(n, 4, 4)
-        ranges = np.zeros((n, len(self.angles)))
-        clear = np.zeros(n)
-        self._dirs, self._expected = [], []
+        out = []
         for i in range(n):
             if n > 1:
                 others = np.concatenate([rect_sides] + [robot_sides[j] for j in range(n)
                                                         if j != i])
                 boxes = np.concatenate([rect_box, footprints[:i], footprints[i + 1:]])
-                discs = None
+                discs = rows.discs(boxes)
             else:
-                others, boxes = rect_sides, rect_box
-                discs = self._still_discs
+                others, boxes, discs = rect_sides, rect_box, self._still_discs
+                if discs is None:
+                    discs = rows.discs(boxes)
             walls = self._walls_near(i)
-            dirs = sensors.beam_directions(h[i], self.angles)
-            expected, true_r = sensors.cast(pose[i, :2], dirs, walls, others, centres, radii,
-                                            sen.range, self._joined(i, walls, others))
-            if not self._plain:                          # what the robot's own map predicts
-                expected = knowledge.expected_ranges(self._given, self._maps[i], pose[i, :2],
-                                                     dirs, self._near_known[i], sen.range)
-            ranges[i] = sensors.add_noise(true_r, sen.noise, sen.range, self._streams[1 + i])
-            self._dirs.append(dirs)
-            self._expected.append(expected)
-            clear[i] = _clearance(pose[i], self.robots[i], walls, boxes, centres, radii, discs)
-        return _Sensed(t, where, pose, ranges, {key: np.zeros(n) for key in perception.INPUTS},
-                       np.zeros((n, 2)), clear, np.zeros((n, 2)))
+            out.append(rows.SenseRow(float(x[i]), float(y[i]), float(h[i]), self.robots[i],
+                                     walls, self._joined(i, walls, others), boxes, discs,
+                                     centres, radii, sen.noise, self._streams[1 + i]))
+        return out
 
-    def _joined(self, i: int, walls: np.ndarray, sides: np.ndarray) -> geometry.SegmentSet:
-        """Robot ``i``'s nearby walls and the obstacle sides as one set of segments, kept
-        while both are the same arrays (still obstacles, no new walls gathered)."""
+    def sensed(self, got: rows.Sensed) -> _Sensed:
+        """The tick's :class:`_Sensed` from its robots' rows of :func:`.rows.sense`, with what
+        each robot's own map predicts along its beams."""
+        n = self.n
+        pose = np.stack([self._x, self._y, self._h], axis=1)
+        self._dirs = list(got.dirs)
+        if self._plain:
+            self._expected = list(got.static)
+        else:                                            # what the robot's own map predicts
+            self._expected = [knowledge.expected_ranges(
+                self._given, self._maps[i], pose[i, :2], self._dirs[i], self._near_known[i],
+                self.world.sensors.range) for i in range(n)]
+        return _Sensed(self.time, self._where, pose, got.ranges,
+                       {key: np.zeros(n) for key in perception.INPUTS}, np.zeros((n, 2)),
+                       got.clearance, np.zeros((n, 2)))
+
+    def _joined(self, i: int, walls: np.ndarray, sides: np.ndarray) -> np.ndarray:
+        """Robot ``i``'s nearby walls and then the obstacle sides as one array, kept while
+        both are the same arrays (still obstacles, no new walls gathered)."""
         kept = self._cast_with[i]
         if kept is None or kept[0] is not walls or kept[1] is not sides:
-            kept = self._cast_with[i] = (walls, sides,
-                                         geometry.SegmentSet(np.concatenate([walls, sides])))
+            kept = self._cast_with[i] = (walls, sides, np.concatenate([walls, sides]))
         return kept[2]
 
     def _obstacles_at(self, t: float):

@@ -56,7 +56,7 @@ class Route:
         clamp, segment and arithmetic, element by element, so the same bits."""
         s = np.asarray(s, float)
         length = self.length
-        s = np.where(0.0 > s, 0.0, s)                  # max(s, 0.0), then min(s, length),
+        s = np.where(s < 0.0, 0.0, s)                  # max(s, 0.0), then min(s, length),
         s = np.where(length < s, length, s)            # as Python's max and min pick
         i = np.minimum(np.searchsorted(self.cum, s, side="right") - 1, len(self.points) - 2)
         start = self.points[i]

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .geometry import SegmentSet, clip_arrays, ray_circles, ray_hits, ray_segments
+from .geometry import clip_arrays, ray_circles, ray_hits, ray_segments
 
 
 def beam_directions(heading: float, angles: np.ndarray) -> np.ndarray:
@@ -19,14 +19,12 @@ def beam_directions(heading: float, angles: np.ndarray) -> np.ndarray:
 
 
 def cast(origin: np.ndarray, dirs: np.ndarray, walls: np.ndarray, sides: np.ndarray,
-         centres: np.ndarray, radii: np.ndarray, max_range: float,
-         joined: SegmentSet | None = None) -> tuple[np.ndarray, np.ndarray]:
+         centres: np.ndarray, radii: np.ndarray, max_range: float) -> tuple[np.ndarray, np.ndarray]:
     """Noise-free ranges ``[B]``: against the walls alone (what the map predicts) and against
-    everything (walls, obstacle and robot sides, circles). ``joined``: the walls and the sides
-    as one :class:`~.geometry.SegmentSet` (the caller keeps it while neither changes)."""
+    everything (walls, obstacle and robot sides, circles). (The simulator casts every robot's
+    beams at once, :mod:`.rows`, with this arithmetic.)"""
     if len(walls) and len(sides):           # one pass over walls and sides (min is exact)
-        t = ray_hits(origin, dirs, joined if joined is not None
-                     else SegmentSet(np.concatenate([walls, sides])))
+        t = ray_hits(origin, dirs, np.concatenate([walls, sides]))
         static = np.minimum(t[:, :len(walls)].min(axis=1), max_range)
         segments = np.minimum(t.min(axis=1), max_range)
     else:

@@ -1,0 +1,259 @@
+"""Sensing many robots at once: one row per robot, of one run or of many runs stepped together
+(:mod:`.lockstep`).
+
+Each row's beams, readings and clearance are the arithmetic of one robot alone, element by
+element over ``[rows, ...]`` arrays: every operation here is elementwise or an exact minimum,
+so a row gets the bits it gets alone, whatever the other rows. Rows have different numbers of
+nearby walls; they are padded with zero-length segments (a ray never hits one) and the padding
+is masked out of every minimum. Rows sensed together have as many obstacles each (the robots
+of runs of one world). Calls that may round by their operands' shape (the penetration depth's
+``einsum``) are made row by row, on exactly the operands a robot alone passes.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .geometry import (
+    EPS,
+    box_polygon_depth,
+    box_segment_distance,
+    clip_arrays,
+    cross,
+    polygon_overlaps,
+    polygon_segments,
+)
+from .world import Robot
+
+
+@dataclass
+class SenseRow:
+    """What one robot senses with at one tick: where it is, what is near it, its noise."""
+
+    x: float
+    y: float
+    heading: float                 # rad
+    robot: Robot
+    walls: np.ndarray              # [W, 4] the walls near it
+    segments: np.ndarray           # [W + S, 4] those walls, then obstacle and robots' sides
+    boxes: np.ndarray              # [P, 4, 2] rectangles and other robots' footprints
+    discs: tuple[np.ndarray, np.ndarray]   # [P, 2], [P]: discs holding them (:func:`discs`)
+    centres: np.ndarray            # [C, 2] circles
+    radii: np.ndarray              # [C]
+    noise: float                   # in, standard deviation of its readings' noise
+    rng: np.random.Generator       # its own stream of noise
+
+
+@dataclass
+class Sensed:
+    """Every row's beams: directions ``[R, B, 2]``, what the walls alone give ``[R, B]`` (what
+    the map predicts), the noisy readings ``[R, B]`` and the footprint's clearance ``[R]``."""
+
+    dirs: np.ndarray
+    static: np.ndarray
+    ranges: np.ndarray
+    clearance: np.ndarray
+
+    def part(self, start: int, stop: int) -> Sensed:
+        """Rows ``start:stop`` (one run's robots; the readings and clearance copied, as the
+        run records them)."""
+        return Sensed(self.dirs[start:stop], self.static[start:stop],
+                      self.ranges[start:stop].copy(), self.clearance[start:stop].copy())
+
+
+def discs(polygons: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Discs holding convex polygons ``[P, k, 2]``: their corners' mean and the farthest
+    corner's distance from it, plus 1e-6 in for rounding (``[P, 2]``, ``[P]``)."""
+    middle = polygons.mean(axis=1)
+    off = polygons - middle[:, None]
+    return middle, np.hypot(off[..., 0], off[..., 1]).max(axis=1, initial=0.0) + 1e-6
+
+
+def sense(rows: list[SenseRow], angles: np.ndarray, max_range: float) -> Sensed:
+    """The beams of every row (:func:`.sensors.cast`, :func:`.sensors.add_noise`) and the
+    clearance of its footprint, row by row the bits of one robot alone."""
+    if any(r.boxes.shape != rows[0].boxes.shape or len(r.centres) != len(rows[0].centres)
+           for r in rows):
+        raise ValueError("rows sensed together have as many obstacles each")
+    heading = np.array([r.heading for r in rows])
+    origin = np.array([(r.x, r.y) for r in rows])
+    a = heading[:, None] + angles
+    dirs = np.stack([np.cos(a), np.sin(a)], axis=2)                     # [R, B, 2]
+    static, hit = _cast(rows, origin, dirs, max_range)
+    ranges = _noisy(rows, hit, max_range)
+    return Sensed(dirs, static, ranges, _clearance(rows, origin, heading))
+
+
+def _stacked(arrays: list[np.ndarray], width: int | None = None) -> np.ndarray:
+    """``[R, width, ...]``: the arrays one above the other, each padded with zeros to
+    ``width`` rows (a view of the one array, when there is one that needs no padding)."""
+    width = len(arrays[0]) if width is None else width
+    if len(arrays) == 1 and len(arrays[0]) == width:
+        return arrays[0][None]
+    out = np.zeros((len(arrays), width, *arrays[0].shape[1:]))
+    for i, a in enumerate(arrays):
+        out[i, :len(a)] = a
+    return out
+
+
+def _cast(rows: list[SenseRow], origin: np.ndarray, dirs: np.ndarray,
+          max_range: float) -> tuple[np.ndarray, np.ndarray]:
+    """Noise-free ranges ``[R, B]``: to the walls alone, and to everything (walls, sides and
+    circles): :func:`.geometry.ray_hits` and :func:`.geometry.ray_circles`, per element."""
+    walls = [len(r.walls) for r in rows]
+    total = [len(r.segments) for r in rows]
+    seg = _stacked([r.segments for r in rows], max(total))              # [R, N, 4]
+    ex = seg[:, None, :, 2] - seg[:, None, :, 0]                        # [R, 1, N]
+    ey = seg[:, None, :, 3] - seg[:, None, :, 1]
+    px = seg[:, None, :, 0] - origin[:, None, None, 0]
+    py = seg[:, None, :, 1] - origin[:, None, None, 1]
+    dx, dy = dirs[..., 0, None], dirs[..., 1, None]                     # [R, B, 1]
+    denom = cross(dx, dy, ex, ey)
+    ok = np.abs(denom) > EPS
+    safe = np.where(ok, denom, 1.0)
+    t = cross(px, py, ex, ey) / safe
+    s = cross(px, py, dx, dy) / safe
+    t = np.where(ok & (t >= 0.0) & (s >= 0.0) & (s <= 1.0), t, np.inf)  # [R, B, N]
+    hit = np.minimum(t.min(axis=2, initial=np.inf), max_range)
+    if walls == total:                                  # no sides: the walls are all there is
+        static = hit
+    elif min(walls) == max(walls):                      # the walls come first in every row
+        static = np.minimum(t[..., :walls[0]].min(axis=2, initial=np.inf), max_range)
+    else:
+        is_wall = np.arange(seg.shape[1]) < np.array(walls)[:, None]
+        static = np.minimum(np.where(is_wall[:, None], t, np.inf).min(axis=2, initial=np.inf),
+                            max_range)
+    if not len(rows[0].centres):
+        return static, hit
+    return static, np.minimum(hit, _circles(rows, origin, dirs, max_range))
+
+
+def _circles(rows: list[SenseRow], origin: np.ndarray, dirs: np.ndarray,
+             max_range: float) -> np.ndarray:
+    """:func:`.geometry.ray_circles` of every row, ``[R, B]``."""
+    centres = _stacked([r.centres for r in rows])                       # [R, C, 2]
+    radii = _stacked([r.radii for r in rows])                           # [R, C]
+    mx = origin[:, 0, None] - centres[..., 0]                           # [R, C]
+    my = origin[:, 1, None] - centres[..., 1]
+    b = mx[:, None] * dirs[..., 0, None] + my[:, None] * dirs[..., 1, None] + 0.0
+    c = (mx * mx + my * my - radii ** 2)[:, None]                       # [R, 1, C]
+    disc = b * b - c
+    root = np.sqrt(np.maximum(disc, 0.0))
+    t = np.where(c <= 0.0, 0.0, -b - root)
+    hit = (disc >= 0.0) & (t >= 0.0)
+    return np.minimum(np.where(hit, t, np.inf).min(axis=2), max_range)
+
+
+def _noisy(rows: list[SenseRow], ranges: np.ndarray, max_range: float) -> np.ndarray:
+    """:func:`.sensors.add_noise` of every row, each from its own stream (rows without noise
+    keep their ranges as they are)."""
+    noisy = [r.noise > 0 for r in rows]
+    if not any(noisy):
+        return ranges
+    draws = _stacked([r.rng.normal(0.0, r.noise, ranges.shape[1]) if n
+                      else np.zeros(ranges.shape[1]) for r, n in zip(rows, noisy)])
+    out = np.where(ranges >= max_range, max_range, clip_arrays(ranges + draws, 0.0, max_range))
+    return out if all(noisy) else np.where(np.array(noisy)[:, None], out, ranges)
+
+
+def _clearance(rows: list[SenseRow], origin: np.ndarray, heading: np.ndarray) -> np.ndarray:
+    """The clearance of every row ``[R]`` (rows of one footprint together): the signed
+    distance from its footprint to walls, polygons and circles, computed in the footprint's
+    own frame (the gap when apart, 0 touching, minus the penetration depth when
+    overlapping)."""
+    groups: dict[tuple[float, float], list[int]] = {}
+    for i, r in enumerate(rows):
+        groups.setdefault((r.robot.length / 2, r.robot.width / 2), []).append(i)
+    if len(groups) == 1:
+        (hl, hw), _ = groups.popitem()
+        return _group_clearance(rows, origin, heading, hl, hw)
+    out = np.empty(len(rows))
+    for (hl, hw), idx in groups.items():
+        out[idx] = _group_clearance([rows[i] for i in idx], origin[idx], heading[idx], hl, hw)
+    return out
+
+
+class _Frames:
+    """Rows' footprint frames: points of rows ``idx`` as seen from their footprints."""
+
+    def __init__(self, origin: np.ndarray, heading: np.ndarray) -> None:
+        self.origin = origin
+        self.c = np.array([math.cos(h) for h in heading])[:, None]      # as one robot's
+        self.s = np.array([math.sin(h) for h in heading])[:, None]
+
+    def local(self, points: np.ndarray, idx=slice(None)) -> np.ndarray:
+        """``[r, K, 2]`` world points of rows ``idx`` in their footprints' frames."""
+        rel = points - self.origin[idx, None]
+        c, s = self.c[idx], self.s[idx]
+        out = np.empty_like(rel)
+        out[..., 0] = rel[..., 0] * c + rel[..., 1] * s
+        out[..., 1] = -rel[..., 0] * s + rel[..., 1] * c
+        return out
+
+
+def _group_clearance(rows: list[SenseRow], origin: np.ndarray, heading: np.ndarray,
+                     hl: float, hw: float) -> np.ndarray:
+    """The clearance of rows with the same footprint ``[-hl, hl] x [-hw, hw]``. A thing whose
+    enclosing disc lies farther from the footprint's than the walls cannot be the nearest
+    (1e-6 in of slack for rounding); rows with none nearer skip that kind of thing, but only
+    while no wall touches the footprint (whatever may overlap it is measured together, as
+    one robot alone does)."""
+    frames = _Frames(origin, heading)
+    best = _walls(rows, frames, hl, hw)
+    reach = np.where(best > 0.0, best + math.hypot(hl, hw) + 1e-6, np.inf)[:, None]
+    if len(rows[0].boxes):
+        middle, radius = _stacked([r.discs[0] for r in rows]), _stacked([r.discs[1] for r in rows])
+        away = middle - origin[:, None]
+        near = np.flatnonzero((np.hypot(away[..., 0], away[..., 1]) - radius <= reach).any(axis=1))
+        if len(near):
+            shape = rows[0].boxes.shape
+            world = _stacked([rows[i].boxes for i in near]).reshape(len(near), -1, 2)
+            boxes = frames.local(world, near).reshape(len(near), *shape)
+            best[near] = np.minimum(best[near], _polygons(hl, hw, boxes).min(axis=1))
+    if len(rows[0].centres):
+        rel = _stacked([r.centres for r in rows]) - origin[:, None]      # [R, C, 2]
+        radii = _stacked([r.radii for r in rows])
+        near = np.flatnonzero((np.hypot(rel[..., 0], rel[..., 1]) - radii <= reach).any(axis=1))
+        if len(near):
+            rel, radii, c, s = rel[near], radii[near], frames.c[near], frames.s[near]
+            lx = np.abs(rel[..., 0] * c + rel[..., 1] * s) - hl
+            ly = np.abs(-rel[..., 0] * s + rel[..., 1] * c) - hw
+            outside = np.hypot(np.maximum(lx, 0), np.maximum(ly, 0))
+            inside = np.minimum(np.maximum(lx, ly), 0)
+            best[near] = np.minimum(best[near], (outside + inside - radii).min(axis=1))
+    return best
+
+
+def _walls(rows: list[SenseRow], frames: _Frames, hl: float, hw: float) -> np.ndarray:
+    """``[R]``: the signed distance from each row's footprint to its nearest wall (``inf``
+    with none); the depth of walls that cross it row by row."""
+    counts = [len(r.walls) for r in rows]
+    width = max(counts)
+    if not width:
+        return np.full(len(rows), np.inf)
+    walls = _stacked([r.walls for r in rows], width)
+    ends = frames.local(walls.reshape(len(rows), -1, 2)).reshape(len(rows), -1, 2, 2)
+    w = box_segment_distance(hl, hw, ends.reshape(-1, 4)).reshape(len(rows), -1)
+    real = None if min(counts) == width else np.arange(width) < np.array(counts)[:, None]
+    crossing = w <= 0.0 if real is None else real & (w <= 0.0)
+    for i in np.flatnonzero(crossing.any(axis=1)):
+        mine = crossing[i, :counts[i]]
+        w[i, :counts[i]][mine] = -box_polygon_depth(hl, hw, ends[i, :counts[i]][mine])
+    return (w if real is None else np.where(real, w, np.inf)).min(axis=1, initial=np.inf)
+
+
+def _polygons(hl: float, hw: float, boxes: np.ndarray) -> np.ndarray:
+    """:func:`.geometry.box_polygon_distance` of every row's polygons ``[R, P, k, 2]`` (in
+    the footprint's frame), ``[R, P]``; the depth of those that may overlap row by row."""
+    R, P = boxes.shape[:2]
+    flat = boxes.reshape(R * P, *boxes.shape[2:])
+    gap = box_segment_distance(hl, hw, polygon_segments(flat)).reshape(R * P, -1).min(axis=1)
+    over = polygon_overlaps(hl, hw, flat, gap).reshape(R, P)
+    gap = gap.reshape(R, P)
+    for i in np.flatnonzero(over.any(axis=1)):
+        depth = box_polygon_depth(hl, hw, boxes[i][over[i]])
+        gap[i, over[i]] = np.where(depth > 0.0, -depth, gap[i, over[i]])
+    return gap
