@@ -15,7 +15,7 @@ from dataclasses import fields
 
 import numpy as np
 
-from . import kinematics, rows
+from . import kinematics, perception, rows
 from .loop import Scene, SimResult, Simulation
 from .planner import FuzzyPlanner, Planner
 from .world import World
@@ -90,8 +90,10 @@ class Lockstep:
 
 
 def _observe_together(runs: list[Simulation]) -> list:
-    """:meth:`Simulation.observe` of every run, their robots' beams and clearance sensed in
-    one :func:`.rows.sense` (each row the bits of its robot alone)."""
+    """:meth:`Simulation.observe` of every run: their robots' beams and clearance sensed in
+    one :func:`.rows.sense`, their inputs perceived in one :func:`.perception.perceive_rows`
+    (each row the bits of its robot alone); what each robot's map and route need, run by
+    run."""
     fresh = [run for run in runs if not run.observed]
     if len(fresh) > 1:
         parts, spans = [], []
@@ -101,8 +103,16 @@ def _observe_together(runs: list[Simulation]) -> list:
             parts += mine
         world = fresh[0].world
         got = rows.sense(parts, fresh[0].angles, world.sensors.range)
+        ticks, sights = [], []
         for run, (start, stop) in zip(fresh, spans):
-            run.observe(got.part(start, stop))
+            s = run.sensed(got.part(start, stop))
+            mine_ = run.sights(s)
+            ticks.append((run, s, mine_, start, stop))
+            sights += mine_
+        inputs = perception.perceive_rows(sights, world.sensors.range, fresh[0].settings)
+        for run, s, mine_, start, stop in ticks:
+            run.perceived(s, mine_, {k: v[start:stop] for k, v in inputs.items()})
+            run.conclude(s)
     return [run.observe() for run in runs]
 
 

@@ -449,9 +449,19 @@ class Simulation:
         if self._observed is None:
             s = self.sense() if sensed is None else self.sensed(sensed)
             self.perceive(s)
-            self.check(s)
-            self._observed = s
+            self.conclude(s)
         return self._observed
+
+    def conclude(self, s: _Sensed) -> None:
+        """The last stage of :meth:`observe`, once ``s`` is sensed and perceived: the check;
+        ``s`` is then this tick's observation."""
+        self.check(s)
+        self._observed = s
+
+    @property
+    def settings(self) -> perception.Settings:
+        """The perception settings its robots perceive with."""
+        return self._cfg
 
     @property
     def observed(self) -> bool:
@@ -594,8 +604,17 @@ class Simulation:
     def perceive(self, s: _Sensed) -> None:
         """The rule inputs and the route's target point of every robot from its readings;
         first, what they show that its map does not is marked on the map it plans on, and
-        its route planned again if that shuts its way (:mod:`.knowledge`)."""
-        routes, sen = self._routes, self.world.sensors
+        its route planned again if that shuts its way (:mod:`.knowledge`). All robots'
+        inputs at once (:func:`.perception.perceive_rows`)."""
+        sights = self.sights(s)
+        self.perceived(s, sights, perception.perceive_rows(sights, self.world.sensors.range,
+                                                           self._cfg))
+
+    def sights(self, s: _Sensed) -> list[perception.Sight]:
+        """Each robot's :class:`.perception.Sight` at tick ``s``: where it is on its route,
+        its map updated from its readings (and its route replanned if need be), how far
+        ahead it aims and what it keeps clear of."""
+        routes, out = self._routes, []
         for i in range(self.n):
             f = perception.frame(routes[i], s.pose[i, :2], self._s_hint[i])
             rmap = self._maps[i]
@@ -617,14 +636,20 @@ class Simulation:
             ahead, target = perception.pursuit_point(routes[i], f, s.pose[i, :2], cells, radius,
                                                      least + self._cfg.lookahead_room, self._cfg)
             room = perception.route_room(f, s.pose[i, :2], cells, radius, least)
-            p = perception.perceive(routes[i], f, (self._x[i], self._y[i], self._h[i]),
-                                    self.robots[i], self._dirs[i], s.ranges[i],
-                                    self._expected[i], sen.range, self._spacing,
-                                    self._threshold, self._cfg, ahead, room,
-                                    self._kept(i, s, least), target)
-            for key in perception.INPUTS:
-                s.inputs[key][i] = p[key]
-            s.targets[i] = target
+            out.append(perception.Sight(
+                routes[i], f, (float(self._x[i]), float(self._y[i]), float(self._h[i])),
+                self.robots[i], self._dirs[i], s.ranges[i], self._expected[i], self._spacing,
+                self._threshold, ahead, room, self._kept(i, s, least), target))
+        return out
+
+    def perceived(self, s: _Sensed, sights: list[perception.Sight],
+                  inputs: dict[str, np.ndarray]) -> None:
+        """Record the robots' inputs (their rows of :func:`.perception.perceive_rows`) and
+        target points in tick ``s``."""
+        for key in perception.INPUTS:
+            s.inputs[key][:] = inputs[key]
+        for i, sight in enumerate(sights):
+            s.targets[i] = sight.target
 
     def _kept(self, i: int, s: _Sensed, least: float) -> tuple[float, np.ndarray] | None:
         """Where robot ``i``'s route is replanned round what it senses: the least clearance

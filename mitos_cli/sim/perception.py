@@ -88,7 +88,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .geometry import clip, clip_arrays
+from .geometry import clip_arrays
 from .route import Route
 from .world import Robot
 
@@ -140,33 +140,66 @@ def frame(route: Route, p: np.ndarray, s_hint: float) -> Frame:
 
 
 def _road(a, b, valid, window: float, far: float) -> tuple[float, float]:
+    left, right = _road_rows(a[None], b[None], valid[None], window, far)
+    return float(left[0]), float(right[0])
+
+
+def _road_rows(a, b, valid, window: float, far: float) -> tuple[np.ndarray, np.ndarray]:
+    """Each row's nearest wall on the left and on the right among points ``[R, K]`` within
+    ``window`` along the route (``far`` with none)."""
     side = valid & (np.abs(a) <= window)
-    left = -b[side & (b < 0)]
-    right = b[side & (b > 0)]
-    return (float(left.min()) if left.size else far), (float(right.min()) if right.size else far)
+    return _least(side & (b < 0), -b, far), _least(side & (b > 0), b, far)
+
+
+def _least(mask: np.ndarray, values: np.ndarray, none: float) -> np.ndarray:
+    """``[R]``: each row's least of ``values [R, K]`` where ``mask`` (``none`` where none)."""
+    return np.where(mask.any(axis=1), np.where(mask, values, np.inf).min(axis=1, initial=np.inf),
+                    none)
 
 
 def _obstruction(route: Route, a, b, points, valid, widen, robot: Robot, f: Frame,
                  cfg: Settings, rel_heading, kept: tuple[float, np.ndarray] | None = None):
-    """(size, position, distance) of the nearest obstructing object among ``points``.
-
-    ``rel_heading`` ``(ah, bh)``: the points in the robot's own frame (along and across its
-    heading). A point obstructs when it lies in the band swept along the route or in the band
-    swept along the robot's heading (so turning back toward an object it has not yet passed
-    brings it back)."""
-    half = robot.width / 2 + cfg.band_margin
-    ahead = valid & (a > 0) & (a < cfg.sight)
+    """(size, position, distance) of the nearest obstructing object among ``points``
+    (:func:`_obstruction_rows` of one row)."""
     ah, bh = rel_heading
+    size, position, distance = _obstruction_rows(
+        [route], [f], a[None], b[None], points[None], valid[None], widen[None], [robot], cfg,
+        ah[None], bh[None], [kept])
+    return float(size[0]), float(position[0]), float(distance[0])
+
+
+def _obstruction_rows(routes: list[Route], frames: list[Frame], a, b, points, valid, widen,
+                      robots: list[Robot], cfg: Settings, ah, bh,
+                      kept: list[tuple[float, np.ndarray] | None]):
+    """Each row's ``(size, position, distance)`` of the nearest obstructing object among its
+    ``points [R, K, 2]`` (``a``, ``b``: along and across its route; ``ah``, ``bh``: along and
+    across its heading). A point obstructs when it lies in the band swept along the route or
+    in the band swept along the robot's heading (so turning back toward an object it has not
+    yet passed brings it back)."""
+    half = np.array([r.width / 2 + cfg.band_margin for r in robots])[:, None]
+    ahead = valid & (a > 0) & (a < cfg.sight)
     blocking = ahead & (((b + widen > -half) & (b - widen < half)) |
                         ((ah > 0) & (bh + widen > -half) & (bh - widen < half)))
-    if kept is not None:    # what the route was planned round obstructs only within its word
-        least, planned = kept
-        round_ = blocking & planned
+    for i, word in enumerate(kept):     # what the route was planned round obstructs only
+        if word is None:                # within its word
+            continue
+        least, planned = word
+        round_ = blocking[i] & planned
         if round_.any():
-            blocking[round_] = (route.distance(points[round_], f.s, cfg.sight)
-                                - widen[round_] < least)
-    if not blocking.any():
-        return 0.0, 0.0, NO_OBSTACLE
+            blocking[i, round_] = (routes[i].distance(points[i, round_], frames[i].s, cfg.sight)
+                                   - widen[i, round_] < least)
+    size, position = np.zeros(len(routes)), np.zeros(len(routes))
+    distance = np.full(len(routes), NO_OBSTACLE)
+    for i in np.flatnonzero(blocking.any(axis=1)):
+        size[i], position[i], distance[i] = _object(
+            routes[i], frames[i], a[i], points[i], ahead[i], blocking[i], widen[i], robots[i], cfg)
+    return size, position, distance
+
+
+def _object(route: Route, f: Frame, a, points, ahead, blocking, widen, robot: Robot,
+            cfg: Settings) -> tuple[float, float, float]:
+    """(size, position, distance) of the object the nearest blocking point belongs to: the
+    points ahead within ``cluster`` of it."""
     i = int(np.argmin(np.where(blocking, a, np.inf)))
     near = ahead & (np.hypot(*(points - points[i]).T) <= cfg.cluster)
     distance = max(0.0, float(a[near].min()) - robot.length / 2)
@@ -191,36 +224,47 @@ def _own_frame(rel: np.ndarray, heading: float) -> tuple[np.ndarray, np.ndarray]
 def free_ways(ah: np.ndarray, bh: np.ndarray, widen: np.ndarray, unknown: np.ndarray,
               robot: Robot, cfg: Settings, route_bearing: float) -> tuple[float, float]:
     """``(front, opening)`` from points ``(ah, bh)`` in the robot's own frame (along and
-    across its heading, right +) widened by ``widen`` (see the module docstring).
+    across its heading, right +) widened by ``widen`` (see the module docstring;
+    :func:`free_ways_rows` of one row)."""
+    front, opening = free_ways_rows(ah[None], bh[None], widen[None], unknown[None], [robot],
+                                    cfg, np.array([route_bearing], dtype=float))
+    return float(front[0]), float(opening[0])
 
-    Every way tried is a direction from the robot's centre; its free length is the distance
-    along it to the nearest point inside the body's band, less half the body's length. All
-    ways at once: ``[ways, points]``, both bands at once: ``[2, ways, points]``."""
-    half = robot.width / 2 + cfg.way_margin
-    ways = _ways(cfg).copy()
-    ways[1] = clip(route_bearing, -cfg.way_fov / 2, cfg.way_fov / 2)
-    phi = np.deg2rad(ways)[:, None]
+
+def free_ways_rows(ah: np.ndarray, bh: np.ndarray, widen: np.ndarray, unknown: np.ndarray,
+                   robots: list[Robot], cfg: Settings,
+                   route_bearing: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Each row's ``(front, opening)`` from its points ``[R, K]``. Every way tried is a
+    direction from the robot's centre; its free length is the distance along it to the
+    nearest point inside the body's band, less half the body's length. All at once:
+    ``[rows, bands, ways, points]``. A point at the robot's centre (``ah = bh = 0``, the
+    padding of a row with fewer points) is ahead on no way."""
+    half = np.array([r.width / 2 + cfg.way_margin for r in robots])
+    length = np.array([r.length / 2 for r in robots])
+    ways = np.repeat(_ways(cfg)[None], len(robots), axis=0)             # [R, W]
+    ways[:, 1] = clip_arrays(route_bearing, -cfg.way_fov / 2, cfg.way_fov / 2)
+    phi = np.deg2rad(ways)[..., None]
     cos, sin = np.cos(phi), np.sin(phi)
-    along = ah * cos + bh * sin
-    across = np.abs(-ah * sin + bh * cos) - widen
-    ahead = along > 0
-    inside = ahead & (across < _bands(cfg, half))                      # [2, ways, points]
-    front = float(np.where(inside[0, 0] & unknown, along[0], np.inf).min(initial=np.inf))
-    front = clip(front - robot.length / 2, 0.0, cfg.sight)
+    ah, bh = ah[:, None], bh[:, None]
+    along = ah * cos + bh * sin                                         # [R, W, K]
+    across = np.abs(-ah * sin + bh * cos) - widen[:, None]
+    bands = np.stack([half, half + cfg.way_room], axis=1)[:, :, None, None]
+    inside = (along > 0)[:, None] & (across[:, None] < bands)          # [R, 2, W, K]
+    front = np.where(inside[:, 0, 0] & unknown, along[:, 0], np.inf).min(axis=1, initial=np.inf)
+    front = clip_arrays(front - length, 0.0, cfg.sight)
     # the progress each way offers toward the route's bearing (behind the robot: toward the
     # side it lies on), in a band just clear of the body and in a roomy one, less a little
     # for every degree turned
-    toward = clip(route_bearing, -90.0, 90.0)
+    toward = clip_arrays(route_bearing, -90.0, 90.0)
     score = -cfg.way_turn_cost * np.abs(ways)
-    weight = np.cos(np.deg2rad(ways - toward)) + cfg.way_room_weight
-    free = np.where(inside, along, np.inf).min(axis=2, initial=np.inf)
-    free -= robot.length / 2
+    weight = np.cos(np.deg2rad(ways - toward[:, None])) + cfg.way_room_weight
+    free = np.where(inside, along[:, None], np.inf).min(axis=3, initial=np.inf)   # [R, 2, W]
+    free -= length[:, None, None]
     free = clip_arrays(free, 0.0, cfg.way_reach)
-    gain = 0.5 * free * weight
-    score += gain[0]
-    score += gain[1]
-    best = int(score.argmax())
-    return front, float(ways[best])
+    gain = 0.5 * free * weight[:, None]
+    score += gain[:, 0]
+    score += gain[:, 1]
+    return front, ways[np.arange(len(robots)), score.argmax(axis=1)]
 
 
 @functools.lru_cache(maxsize=8)
@@ -233,25 +277,26 @@ def _ways(cfg: Settings) -> np.ndarray:
     return out
 
 
-@functools.lru_cache(maxsize=8)
-def _bands(cfg: Settings, half: float) -> np.ndarray:
-    """``[2, 1, 1]``: the half widths of the two bands a way is scored in."""
-    out = np.array([half, half + cfg.way_room])[:, None, None]
-    out.flags.writeable = False
-    return out
-
-
 def nearest(ah: np.ndarray, bh: np.ndarray, robot: Robot, cfg: Settings) -> float:
     """The gap from the footprint (a ``length`` x ``width`` rectangle on the pose) to the
     nearest of the points ``(ah, bh)`` (the robot's own frame) ahead of its centre and within
     ``nearest_band`` of the band its body sweeps straight on (the walls of a corridor it
     drives down do not count; a jamb it is about to pass, or a pole by its corner, do)."""
-    ahead = (ah > 0) & (np.abs(bh) < robot.width / 2 + cfg.nearest_band)
-    if not ahead.any():
-        return cfg.nearest_cap
-    dx = np.maximum(ah[ahead] - robot.length / 2, 0.0)
-    dy = np.maximum(np.abs(bh[ahead]) - robot.width / 2, 0.0)
-    return float(min(np.hypot(dx, dy).min(), cfg.nearest_cap))
+    return float(nearest_rows(ah[None], bh[None], [robot], cfg)[0])
+
+
+def nearest_rows(ah: np.ndarray, bh: np.ndarray, robots: list[Robot],
+                 cfg: Settings) -> np.ndarray:
+    """:func:`nearest` of every row of points ``[R, K]`` (a point at the robot's centre, the
+    padding, is not ahead)."""
+    half = np.array([r.width / 2 for r in robots])[:, None]
+    band = np.array([r.width / 2 + cfg.nearest_band for r in robots])[:, None]
+    length = np.array([r.length / 2 for r in robots])[:, None]
+    ahead = (ah > 0) & (np.abs(bh) < band)
+    dx = np.maximum(ah - length, 0.0)
+    dy = np.maximum(np.abs(bh) - half, 0.0)
+    gap = _least(ahead, np.hypot(dx, dy), cfg.nearest_cap)
+    return np.where(cfg.nearest_cap < gap, cfg.nearest_cap, gap)      # min(gap, cap)
 
 
 def clutter(hits: np.ndarray, unknown: np.ndarray, ah: np.ndarray, cfg: Settings,
@@ -260,16 +305,23 @@ def clutter(hits: np.ndarray, unknown: np.ndarray, ah: np.ndarray, cfg: Settings
     neighbouring points (in beam order; ``circular`` for a ring, whose last beam neighbours
     its first) that hit obstacles ahead within ``sight``, a run split where two neighbours
     lie more than ``clutter_gap`` apart."""
+    return float(clutter_rows(hits[None], unknown[None], ah[None], cfg,
+                              np.array([circular]))[0])
+
+
+def clutter_rows(hits: np.ndarray, unknown: np.ndarray, ah: np.ndarray, cfg: Settings,
+                 circular: np.ndarray) -> np.ndarray:
+    """:func:`clutter` of every row of points ``[R, K, 2]`` (``circular [R]``)."""
     seen = unknown & (ah > 0) & (ah <= cfg.sight)
     if not seen.any():
-        return 0.0
-    before = _previous(len(hits))                  # np.roll(..., 1), cheaper
-    gap = hits - hits[before]
-    close = np.hypot(gap[:, 0], gap[:, 1]) <= cfg.clutter_gap
-    joined = seen & seen[before] & close           # point i continues the run of point i - 1
-    if not circular:
-        joined[0] = False
-    return float(max(1, int(np.count_nonzero(seen & ~joined))))
+        return np.zeros(len(seen))
+    before = _previous(hits.shape[1])              # np.roll(..., 1), cheaper
+    gap = hits - hits[:, before]
+    close = np.hypot(gap[..., 0], gap[..., 1]) <= cfg.clutter_gap
+    joined = seen & seen[:, before] & close        # point i continues the run of point i - 1
+    joined[:, 0] &= circular
+    count = np.count_nonzero(seen & ~joined, axis=1)
+    return np.where(seen.any(axis=1), np.maximum(count, 1), 0).astype(float)
 
 
 @functools.lru_cache(maxsize=8)
@@ -284,14 +336,26 @@ def _walls(a, b, valid, robot: Robot, cfg: Settings, far: float,
            objects=None) -> tuple[float, float]:
     """Side gaps from points (a along, b across): walls count from ``wall_behind`` behind to
     ``wall_ahead`` ahead, objects (``objects`` mask) only while beside the robot's body."""
-    half = robot.width / 2
-    ahead = np.where(objects, robot.length / 2, cfg.wall_ahead) if objects is not None \
-        else cfg.wall_ahead
+    left, right = _walls_rows(a[None], b[None], valid[None], [robot], cfg, far,
+                              None if objects is None else objects[None])
+    return float(left[0]), float(right[0])
+
+
+def _walls_rows(a, b, valid, robots: list[Robot], cfg: Settings, far: float,
+                objects=None) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`_walls` of every row of points ``[R, K]``."""
+    half = np.array([r.width / 2 for r in robots])[:, None]
+    if objects is None:
+        ahead = cfg.wall_ahead
+    else:
+        ahead = np.where(objects, np.array([r.length / 2 for r in robots])[:, None],
+                         cfg.wall_ahead)
     near = valid & (a >= -cfg.wall_behind) & (a <= ahead) & (np.abs(b) >= half)
-    left = -b[near & (b < 0)]
-    right = b[near & (b > 0)]
-    return ((float(left.min()) - half) if left.size else far), \
-           ((float(right.min()) - half) if right.size else far)
+    left, right = near & (b < 0), near & (b > 0)
+    return (np.where(left.any(axis=1), np.where(left, -b, np.inf).min(axis=1, initial=np.inf)
+                     - half[:, 0], far),
+            np.where(right.any(axis=1), np.where(right, b, np.inf).min(axis=1, initial=np.inf)
+                     - half[:, 0], far))
 
 
 def _common(route: Route, p, heading: float, f: Frame, road: float, robot: Robot,
@@ -387,37 +451,98 @@ def perceive(route: Route, f: Frame, pose: tuple[float, float, float], robot: Ro
     replanned round what the robot senses, the least clearance it keeps and which readings
     hit what it was planned round (``[B]``): those obstruct only within that clearance of
     the route, not anywhere in the band ahead; ``target``: the route point ``lookahead``
-    ahead (:func:`target_point`), when the caller has it."""
+    ahead (:func:`target_point`), when the caller has it. (:func:`perceive_rows` of one.)"""
+    ahead = cfg.lookahead if lookahead is None else lookahead
     if target is None:
-        target = target_point(route, f, cfg, cfg.lookahead if lookahead is None else lookahead)
-    p = np.array(pose[:2])
-    hits = p + measured[:, None] * dirs
-    rel = hits - p
-    a = rel @ f.t
-    b = rel @ f.n
+        target = target_point(route, f, cfg, ahead)
+    sight = Sight(route, f, (float(pose[0]), float(pose[1]), float(pose[2])), robot, dirs,
+                  measured, expected, spacing, threshold, ahead, room, kept, target)
+    out = perceive_rows([sight], max_range, cfg)
+    return {key: float(value[0]) for key, value in out.items()}
+
+
+@dataclass
+class Sight:
+    """What one robot perceives from at one tick (:func:`perceive_rows`)."""
+
+    route: Route
+    f: Frame
+    pose: tuple[float, float, float]   # x, y (in), heading (rad)
+    robot: Robot
+    dirs: np.ndarray               # [B, 2] its beams
+    measured: np.ndarray           # [B] its readings
+    expected: np.ndarray           # [B] what its map predicts
+    spacing: float                 # its beams' spacing (an echo is widened by half of it)
+    threshold: float               # in: a reading this much shorter than expected is news
+    lookahead: float               # of ``heading`` (:func:`clear_lookahead`)
+    room: float                    # how far the lane may lie off the route (:func:`route_room`)
+    kept: tuple[float, np.ndarray] | None   # see :func:`perceive`
+    target: np.ndarray             # [2] the route point ``lookahead`` ahead
+
+
+def perceive_rows(rows: list[Sight], max_range: float,
+                  cfg: Settings = Settings()) -> dict[str, np.ndarray]:
+    """The inputs of every row (``[R]`` each, :data:`INPUTS`), each row's the bits of
+    :func:`perceive` for that robot alone: the beams' arithmetic over ``[R, B]`` arrays,
+    elementwise, with exact minima; what depends on a row's route, its map or a matrix
+    product of its own beams row by row."""
+    robots = [r.robot for r in rows]
+    p = np.array([r.pose[:2] for r in rows])                            # [R, 2]
+    dirs = _stack([r.dirs for r in rows])
+    measured = _stack([r.measured for r in rows])
+    hits = p[:, None] + measured[..., None] * dirs                      # [R, B, 2]
+    rel = hits - p[:, None]
+    a = np.matmul(rel, _stack([r.f.t for r in rows])[..., None])[..., 0]   # rel @ f.t, rows
+    b = np.matmul(rel, _stack([r.f.n for r in rows])[..., None])[..., 0]
     valid = measured < max_range * 0.999
-    obstacle_hit = valid & (measured < expected - threshold)
-    left, right = _road(a, b, valid & ~obstacle_hit, cfg.window, max_range)
+    threshold = np.array([r.threshold for r in rows])[:, None]
+    obstacle_hit = valid & (measured < _stack([r.expected for r in rows]) - threshold)
+    left, right = _road_rows(a, b, valid & ~obstacle_hit, cfg.window, max_range)
     road = left + right
-    widen = measured * spacing / 2
+    widen = measured * np.array([r.spacing for r in rows])[:, None] / 2
     in_way = valid & ~obstacle_hit & (a > 0)
-    if in_way.any():       # drawn on the map, but where the robot's route would hit it
-        in_way[in_way] = route.near(hits[in_way], f.s, robot.width / 2 + robot.safety_margin,
-                                    cfg.sight)
-    own = _own_frame(rel, pose[2])
-    size, position, distance = _obstruction(route, a, b, hits, obstacle_hit | in_way, widen,
-                                            robot, f, cfg, own, kept)
-    heading, lane, goal = _common(route, p, pose[2], f, road, robot, cfg, target, room)
-    wl, wr = _walls(a, b, valid, robot, cfg, max_range, obstacle_hit)
-    ah, bh = _own_frame(rel[valid], pose[2])
-    front, opening = free_ways(ah, bh, widen[valid], obstacle_hit[valid], robot, cfg, heading)
-    ring = len(dirs) > 2 and float(dirs[0] @ dirs[-1]) >= float(dirs[0] @ dirs[1]) - 1e-9
-    objects = clutter(hits, valid & obstacle_hit, own[0], cfg, ring)
+    for i in np.flatnonzero(in_way.any(axis=1)):    # drawn on the map, but where the
+        r = rows[i]                                 # robot's route would hit it
+        in_way[i, in_way[i]] = r.route.near(hits[i][in_way[i]], r.f.s,
+                                            r.robot.width / 2 + r.robot.safety_margin, cfg.sight)
+    ah, bh, valid_ah, valid_bh = _own_frames(rows, rel, valid)
+    size, position, distance = _obstruction_rows(
+        [r.route for r in rows], [r.f for r in rows], a, b, hits, obstacle_hit | in_way,
+        widen, robots, cfg, ah, bh, [r.kept for r in rows])
+    common = np.array([_common(r.route, p[i], r.pose[2], r.f, float(road[i]), r.robot, cfg,
+                               r.target, r.room) for i, r in enumerate(rows)])
+    heading = common[:, 0]
+    wl, wr = _walls_rows(a, b, valid, robots, cfg, max_range, obstacle_hit)
+    front, opening = free_ways_rows(valid_ah, valid_bh, widen, obstacle_hit, robots, cfg, heading)
+    ring = np.array([len(r.dirs) > 2 and float(r.dirs[0] @ r.dirs[-1])
+                     >= float(r.dirs[0] @ r.dirs[1]) - 1e-9 for r in rows])
     return {"road": road, "size": size, "position": position, "obstacle": distance,
-            "heading": pursuit(route, f, p, heading, cfg, lookahead, target), "lane": lane,
-            "goal": goal, "gap_left": wl, "gap_right": wr,
-            "front": front, "opening": opening, "clutter": objects,
-            "nearest": nearest(ah, bh, robot, cfg)}
+            "heading": np.array([pursuit(r.route, r.f, p[i], heading[i], cfg, r.lookahead,
+                                         r.target) for i, r in enumerate(rows)]),
+            "lane": common[:, 1], "goal": common[:, 2], "gap_left": wl, "gap_right": wr,
+            "front": front, "opening": opening,
+            "clutter": clutter_rows(hits, valid & obstacle_hit, ah, cfg, ring),
+            "nearest": nearest_rows(valid_ah, valid_bh, robots, cfg)}
+
+
+def _stack(arrays: list[np.ndarray]) -> np.ndarray:
+    """The arrays one above the other (a view of the one, when there is one)."""
+    return arrays[0][None] if len(arrays) == 1 else np.stack(arrays)
+
+
+def _own_frames(rows: list[Sight], rel: np.ndarray,
+                valid: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The points ``rel [R, B, 2]`` in each robot's own frame (:func:`_own_frame`): all of
+    them, and the valid ones alone (as a robot alone computes them, from those points only;
+    the others read 0, the robot's centre)."""
+    cs = np.array([(math.cos(r.pose[2]), math.sin(r.pose[2])) for r in rows])   # [R, 2]
+    along = np.matmul(rel, cs[..., None])[..., 0]                       # rel @ [c, s]
+    across = np.matmul(rel, np.stack([cs[:, 1], -cs[:, 0]], axis=1)[..., None])[..., 0]
+    valid_along, valid_across = np.zeros(valid.shape), np.zeros(valid.shape)
+    for i, r in enumerate(rows):
+        valid_along[i, valid[i]], valid_across[i, valid[i]] = _own_frame(rel[i][valid[i]],
+                                                                         r.pose[2])
+    return along, across, valid_along, valid_across
 
 
 def pursuit(route: Route, f: Frame, p: np.ndarray, bearing: float, cfg: Settings,
