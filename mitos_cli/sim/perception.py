@@ -176,7 +176,7 @@ def _obstruction_rows(routes: list[Route], frames: list[Frame], a, b, points, va
     across its heading). A point obstructs when it lies in the band swept along the route or
     in the band swept along the robot's heading (so turning back toward an object it has not
     yet passed brings it back)."""
-    half = np.array([r.width / 2 + cfg.band_margin for r in robots])[:, None]
+    half = _bodies(tuple(robots), cfg)["band"]
     ahead = valid & (a > 0) & (a < cfg.sight)
     blocking = ahead & (((b + widen > -half) & (b - widen < half)) |
                         ((ah > 0) & (bh + widen > -half) & (bh - widen < half)))
@@ -239,8 +239,8 @@ def free_ways_rows(ah: np.ndarray, bh: np.ndarray, widen: np.ndarray, unknown: n
     nearest point inside the body's band, less half the body's length. All at once:
     ``[rows, bands, ways, points]``. A point at the robot's centre (``ah = bh = 0``, the
     padding of a row with fewer points) is ahead on no way."""
-    half = np.array([r.width / 2 + cfg.way_margin for r in robots])
-    length = np.array([r.length / 2 for r in robots])
+    body = _bodies(tuple(robots), cfg)
+    length = body["length"][:, 0]
     ways = np.repeat(_ways(cfg)[None], len(robots), axis=0)             # [R, W]
     ways[:, 1] = clip_arrays(route_bearing, -cfg.way_fov / 2, cfg.way_fov / 2)
     phi = np.deg2rad(ways)[..., None]
@@ -248,7 +248,7 @@ def free_ways_rows(ah: np.ndarray, bh: np.ndarray, widen: np.ndarray, unknown: n
     ah, bh = ah[:, None], bh[:, None]
     along = ah * cos + bh * sin                                         # [R, W, K]
     across = np.abs(-ah * sin + bh * cos) - widen[:, None]
-    bands = np.stack([half, half + cfg.way_room], axis=1)[:, :, None, None]
+    bands = body["bands"]
     inside = (along > 0)[:, None] & (across[:, None] < bands)          # [R, 2, W, K]
     front = np.where(inside[:, 0, 0] & unknown, along[:, 0], np.inf).min(axis=1, initial=np.inf)
     front = clip_arrays(front - length, 0.0, cfg.sight)
@@ -289,9 +289,8 @@ def nearest_rows(ah: np.ndarray, bh: np.ndarray, robots: list[Robot],
                  cfg: Settings) -> np.ndarray:
     """:func:`nearest` of every row of points ``[R, K]`` (a point at the robot's centre, the
     padding, is not ahead)."""
-    half = np.array([r.width / 2 for r in robots])[:, None]
-    band = np.array([r.width / 2 + cfg.nearest_band for r in robots])[:, None]
-    length = np.array([r.length / 2 for r in robots])[:, None]
+    body = _bodies(tuple(robots), cfg)
+    half, band, length = body["half"], body["near"], body["length"]
     ahead = (ah > 0) & (np.abs(bh) < band)
     dx = np.maximum(ah - length, 0.0)
     dy = np.maximum(np.abs(bh) - half, 0.0)
@@ -344,12 +343,10 @@ def _walls(a, b, valid, robot: Robot, cfg: Settings, far: float,
 def _walls_rows(a, b, valid, robots: list[Robot], cfg: Settings, far: float,
                 objects=None) -> tuple[np.ndarray, np.ndarray]:
     """:func:`_walls` of every row of points ``[R, K]``."""
-    half = np.array([r.width / 2 for r in robots])[:, None]
-    if objects is None:
-        ahead = cfg.wall_ahead
-    else:
-        ahead = np.where(objects, np.array([r.length / 2 for r in robots])[:, None],
-                         cfg.wall_ahead)
+    body = _bodies(tuple(robots), cfg)
+    half = body["half"]
+    ahead = cfg.wall_ahead if objects is None else np.where(objects, body["length"],
+                                                            cfg.wall_ahead)
     near = valid & (a >= -cfg.wall_behind) & (a <= ahead) & (np.abs(b) >= half)
     left, right = near & (b < 0), near & (b > 0)
     return (np.where(left.any(axis=1), np.where(left, -b, np.inf).min(axis=1, initial=np.inf)
@@ -523,6 +520,28 @@ def perceive_rows(rows: list[Sight], max_range: float,
             "front": front, "opening": opening,
             "clutter": clutter_rows(hits, valid & obstacle_hit, ah, cfg, ring),
             "nearest": nearest_rows(valid_ah, valid_bh, robots, cfg)}
+
+
+@functools.lru_cache(maxsize=64)
+def _bodies(robots: tuple[Robot, ...], cfg: Settings) -> dict[str, np.ndarray]:
+    """The robots' measures perception works with, ``[R, 1]`` each (read-only): half the
+    width (``half``), half the length (``length``), the half width of the band an object
+    obstructs in (``band``), of a way (``way``) and of the band ``nearest`` looks in
+    (``near``), each the one robot's arithmetic; and both bands a way is scored in,
+    ``[R, 2, 1, 1]``."""
+    def column(values) -> np.ndarray:
+        return np.array(list(values), dtype=float)[:, None]
+
+    out = {"half": column(r.width / 2 for r in robots),
+           "length": column(r.length / 2 for r in robots),
+           "band": column(r.width / 2 + cfg.band_margin for r in robots),
+           "way": column(r.width / 2 + cfg.way_margin for r in robots),
+           "near": column(r.width / 2 + cfg.nearest_band for r in robots)}
+    way = out["way"][:, 0]
+    out["bands"] = np.stack([way, way + cfg.way_room], axis=1)[:, :, None, None]
+    for a in out.values():
+        a.flags.writeable = False
+    return out
 
 
 def _stack(arrays: list[np.ndarray]) -> np.ndarray:
