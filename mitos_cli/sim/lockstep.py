@@ -37,6 +37,7 @@ class Lockstep:
         self.planner = planner
         self.runs = [Simulation(world, planner, seed, randomise=randomise, scene=scene)
                      for seed in seeds]
+        self._limits: list = []                  # the runs that last moved and their limits
 
     @property
     def done(self) -> bool:
@@ -52,7 +53,7 @@ class Lockstep:
             if moves:
                 moving.append(run)
         if moving:
-            _move_together(moving)
+            _move_together(moving, self._limits)
 
     def results(self) -> list[SimResult]:
         """Step until every run has ended; each run's :class:`SimResult`, in seed order."""
@@ -116,13 +117,24 @@ def _observe_together(runs: list[Simulation]) -> list:
     return [run.observe() for run in runs]
 
 
-def _move_together(runs: list[Simulation]) -> None:
-    """:meth:`Simulation.act` for every robot of ``runs`` in one call of the kinematics."""
+def _limits(runs: list[Simulation], kept: list) -> kinematics.Limits:
+    """The limits of the robots of ``runs``, one after the other; ``kept`` holds the last
+    (the same runs moving together keep the same limits, whose ramps the kinematics then
+    derives once)."""
+    if not kept or len(kept[0]) != len(runs) or any(a is not b for a, b in zip(kept[0], runs)):
+        kept[:] = [list(runs), kinematics.Limits(*(
+            np.concatenate([getattr(run.limits, f.name) for run in runs])
+            for f in fields(kinematics.Limits)))]
+    return kept[1]
+
+
+def _move_together(runs: list[Simulation], kept: list) -> None:
+    """:meth:`Simulation.act` for every robot of ``runs`` in one call of the kinematics
+    (``kept``: the last limits, :func:`_limits`)."""
     parts = [run.motion() for run in runs]
     x, y, h, v, steer, c_steer, c_speed = (np.concatenate([p[j] for p in parts])
                                            for j in range(7))
-    limits = kinematics.Limits(*(np.concatenate([getattr(run.limits, f.name) for run in runs])
-                                 for f in fields(kinematics.Limits)))
+    limits = _limits(runs, kept)
     world = runs[0].world
     after = kinematics.step(x, y, h, v, steer, c_steer, c_speed, limits, world.dt,
                             world.substeps)

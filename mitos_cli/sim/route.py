@@ -266,6 +266,27 @@ class Clearance:
         t = np.linspace(0.0, 1.0, n)[:, None]
         return float(self.at(a + t * (b - a)).min())
 
+    def along_path(self, points: np.ndarray) -> np.ndarray:
+        """:meth:`along` of every segment of the polyline ``points [M, 2]`` at once, ``[M - 1]``
+        (each segment's samples and their minimum as :meth:`along` takes them)."""
+        if len(points) < 2:
+            return np.zeros(0)
+        a, step = points[:-1], points[1:] - points[:-1]
+        counts = [max(2, int(math.ceil(math.dist(p, q) / (self.resolution / 2))) + 1)
+                  for p, q in zip(points[:-1], points[1:])]
+        t = np.concatenate([_samples_of(n) for n in counts])[:, None]
+        which = np.repeat(np.arange(len(a)), counts)
+        room = self.at(a[which] + t * step[which])
+        return np.minimum.reduceat(room, np.cumsum([0] + counts[:-1]))
+
+
+@functools.lru_cache(maxsize=256)
+def _samples_of(n: int) -> np.ndarray:
+    """``np.linspace(0, 1, n)``, kept (read-only)."""
+    out = np.linspace(0.0, 1.0, n)
+    out.flags.writeable = False
+    return out
+
 
 def _simplify(points: np.ndarray, tol: float, clearance: Clearance | None = None,
               asked: float = 0.0) -> np.ndarray:
@@ -273,8 +294,7 @@ def _simplify(points: np.ndarray, tol: float, clearance: Clearance | None = None
     it stays as far from the walls as the stretch did, or at least ``asked`` inches."""
     keep = np.zeros(len(points), dtype=bool)
     keep[[0, -1]] = True
-    own = (np.array([clearance.along(p, q) for p, q in zip(points[:-1], points[1:])])
-           if clearance is not None else None)
+    own = clearance.along_path(points) if clearance is not None else None
     stack = [(0, len(points) - 1)]
     while stack:
         i, j = stack.pop()
