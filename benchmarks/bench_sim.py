@@ -2,6 +2,7 @@
 time of ``--runs 100`` on one and two worker processes.
 
     python benchmarks/bench_sim.py                # sections 1-4, a few minutes on 2 cores
+    python benchmarks/bench_sim.py --only 2,4 --against main   # this tree and main's, one process
     python benchmarks/bench_sim.py --only 5       # 1,000 randomised slalom runs, two ways
     python benchmarks/bench_sim.py --only 4,5 --runs 200
 
@@ -14,27 +15,41 @@ time of ``--runs 100`` on one and two worker processes.
    CPU time of the process is printed too (it is what a loaded machine distorts least).
 2. **one run of ``slalom.yaml`` and of ``office.yaml``** (their own seeds, to the goal): ticks per
    second of CPU time (best of 5) against the aim of 5,000, and where a tick's time goes:
-   each stage of :class:`~mitos_cli.sim.loop.Simulation` (sense, perceive, check, plan, act,
-   recording and the stuck check) timed inside the loop.
+   each stage of :class:`~mitos_cli.sim.loop.Simulation` timed inside the loop (sense: beams,
+   noise and clearance; map and route: what the robot marks and clears on its map, its
+   replanning, the lookahead and its route's room; inputs: the rule inputs from the readings;
+   check; plan: the rule evaluation; brake: the robot's own guard; act: the kinematics;
+   record and the stuck check). With ``--against REV``: this tree and git revision ``REV``'s
+   (imported as ``mitos_cli_rev``) in interleaved rounds of one process, best CPU time of
+   each, and both must give the same run (summary and every pose).
 3. **--runs 100** of ``slalom.yaml`` (randomised obstacles and noise) through ``run_many`` with
    1 and 2 workers; the two must give identical results.
 4. **time per robot-tick in lockstep** (:mod:`mitos_cli.sim.lockstep`) at batch sizes 1, 16,
    256 and 1,024: that many randomised runs of ``slalom.yaml`` cut to 2 simulated seconds (40
    ticks each), stepped together, CPU time per robot-tick; the peer in the same run is the same
    16 runs each simulated alone (``simulate``), and every batch's results must equal theirs.
+   With ``--against REV``: REV's tree at the same batch sizes, rounds interleaved.
 5. **1,000 randomised runs of ``slalom.yaml`` on 2 workers** (``--runs`` to change the number):
    ``run_many`` (each worker steps its runs in lockstep) against the runs simulated one by one
-   on the same 2 processes; the outcome table and every run's summary must be equal.
+   on the same 2 processes; the outcome tables and every run's summary must be equal.
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import dataclasses
+import importlib
+import math
 import os
 import platform
+import shutil
 import statistics
+import subprocess
+import sys
+import tempfile
 import time
+from pathlib import Path
 
 import numpy as np
 
@@ -60,7 +75,11 @@ class Timed:
         return out
 
 
-STAGES = ("sense", "perceive", "check", "plan", "act", "_record", "_check_stuck")
+STAGES = ("sense", "perceive", "sights", "check", "plan", "_guard", "act", "_record",
+          "_check_stuck")
+SHOWN = {"sense": "sense", "sights": "map and route", "perceive": "inputs", "check": "check",
+         "plan": "plan", "_guard": "brake", "act": "act", "_record": "record",
+         "_check_stuck": "stuck check"}
 
 
 class StageTimed(Simulation):
@@ -89,18 +108,78 @@ def one_run(world, planner, repeats: int = 5) -> None:
     scene = prepare(world)
     simulate(world, planner, scene=scene)                 # warm-up
     best_cpu, ticks = min(_cpu_of(world, planner, scene) for _ in range(repeats))
+    print(f"   {world.name}: {ticks} ticks, {ticks / best_cpu:,.0f} ticks/s "
+          f"({1e6 * best_cpu / ticks:.0f} us/tick, CPU, best of {repeats}; aim 5,000: "
+          f"{ticks / best_cpu / 5000:.2f}x)")
+    _stages(world, planner, scene)
+
+
+def _stages(world, planner, scene) -> None:
+    """Where a tick's time goes: each stage timed inside the loop (wall time; the map and
+    route stage is inside the perception stage, shown apart)."""
     sim = StageTimed(world, planner, scene=scene)
     sim.seconds = {}
     t = time.perf_counter()
     while not sim.done:
         sim.step()
     total = time.perf_counter() - t
-    shares = ", ".join(f"{name.strip('_')} {1e6 * sim.seconds[name] / sim.ticks:.0f} us "
-                       f"({100 * sim.seconds[name] / total:.0f}%)" for name in STAGES)
-    print(f"   {world.name}: {ticks} ticks, {ticks / best_cpu:,.0f} ticks/s "
-          f"({1e6 * best_cpu / ticks:.0f} us/tick, CPU, best of {repeats}; aim 5,000: "
-          f"{ticks / best_cpu / 5000:.2f}x)")
+    spent = dict(sim.seconds)
+    spent["perceive"] -= spent.get("sights", 0.0)
+    shares = ", ".join(f"{SHOWN[name]} {1e6 * spent.get(name, 0.0) / sim.ticks:.0f} us "
+                       f"({100 * spent.get(name, 0.0) / total:.0f}%)" for name in STAGES)
     print(f"     per tick: {shares}; loop total {1e6 * total / sim.ticks:.0f} us (wall)")
+
+
+def against_runs(rev: str, theirs, planner_name: str = "drive", rounds: int = 7) -> None:
+    """Section 2 against git revision ``rev``'s tree (the package ``theirs``): one run of each
+    world by each tree in interleaved rounds, best CPU time of each; both give the same run."""
+    setups = {}
+    for name in ("slalom.yaml", "office.yaml"):
+        for tree, pkg in (("this tree", "mitos_cli"), (rev, theirs.__name__)):
+            wf = importlib.import_module(pkg + ".sim.worldfile")
+            loop = importlib.import_module(pkg + ".sim.loop")
+            world = wf.load_world(packaged_path("worlds", name))
+            fuzzy = importlib.import_module(pkg + ".sim.planner").FuzzyPlanner(None, planner_name)
+            scene = loop.prepare(world)
+            setups[name, tree] = (loop, world, fuzzy, scene, loop.simulate(world, fuzzy,
+                                                                           scene=scene))
+    best: dict[tuple[str, str], float] = {}
+    for _ in range(rounds):
+        for key, (loop, world, fuzzy, scene, _) in setups.items():
+            c = time.process_time()
+            loop.simulate(world, fuzzy, scene=scene)
+            best[key] = min(best.get(key, math.inf), time.process_time() - c)
+    for name in ("slalom.yaml", "office.yaml"):
+        mine, old = setups[name, "this tree"][4], setups[name, rev][4]
+        assert mine.summary() == old.summary() and mine.pose.tobytes() == old.pose.tobytes(), \
+            f"{name}: this tree's run differs from {rev}'s"
+        rates = {tree: mine.ticks / best[name, tree] for tree in ("this tree", rev)}
+        print(f"   {name[:-5]}: {mine.ticks} ticks, this tree {rates['this tree']:,.0f} ticks/s "
+              f"({1e6 / rates['this tree']:.0f} us/tick), {rev} {rates[rev]:,.0f} ticks/s "
+              f"({1e6 / rates[rev]:.0f} us/tick): {rates['this tree'] / rates[rev]:.2f}x; "
+              f"aim 5,000: {rates['this tree'] / 5000:.2f}x (CPU, best of {rounds} "
+              f"interleaved rounds; the same run from both trees)")
+        loop, world, fuzzy, scene, _ = setups[name, "this tree"]
+        _stages(world, fuzzy, scene)
+
+
+def _package_of(rev: str, into: Path):
+    """The ``mitos_cli`` package of git revision ``rev`` as ``mitos_cli_rev``, imported beside
+    this tree's (its imports of itself are relative; the worlds and rule bases are read from
+    the installed ``mitos_cli``)."""
+    root = Path(__file__).resolve().parents[1]
+    archive = subprocess.run(["git", "-C", str(root), "archive", rev, "mitos_cli"], check=True,
+                             capture_output=True).stdout
+    subprocess.run(["tar", "-x", "-C", str(into)], input=archive, check=True)
+    alias = into / "alias"
+    shutil.copytree(into / "mitos_cli", alias / "mitos_cli_rev")
+    sys.path.insert(0, str(alias))
+    try:
+        theirs = importlib.import_module("mitos_cli_rev")
+    finally:
+        sys.path.remove(str(alias))
+    assert Path(theirs.__file__).is_relative_to(alias), theirs.__file__
+    return theirs
 
 
 def _cpu_of(world, planner, scene) -> tuple[float, int]:
@@ -141,24 +220,44 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--only", default="1,2,3,4", help="sections to run (default 1,2,3,4)")
     ap.add_argument("--runs", type=int, default=1000, help="runs of section 5 (1000)")
+    ap.add_argument("--against", metavar="REV", help="sections 2 and 4: this tree and git "
+                    "revision REV's, interleaved in one process")
     args = ap.parse_args()
     sections = {int(x) for x in args.only.split(",")}
-    print(f"{platform.python_version()}, numpy {np.__version__}, {os.cpu_count()} CPUs, "
+    print(f"{platform.python_version()}, numpy {np.__version__}, {_cpus()}, "
           f"load average {_load():.2f} at start")
     fuzzy = FuzzyPlanner(None, "drive")
-    if 1 in sections:
-        single_robot(fuzzy)
-    if 2 in sections:
-        print("\n2. one run, where the time goes")
-        for name in ("slalom.yaml", "office.yaml"):
-            one_run(load_world(packaged_path("worlds", name)), fuzzy)
-    if 3 in sections:
-        hundred_runs(fuzzy)
-    if 4 in sections:
-        batch_sizes(fuzzy)
-    if 5 in sections:
-        thousand_runs(fuzzy, args.runs)
+    with tempfile.TemporaryDirectory() as tmp:
+        theirs = None
+        if args.against:
+            os.environ["MITOS_CACHE_DIR"] = "off"    # the cache pickles one tree's classes
+            theirs = _package_of(args.against, Path(tmp))
+        if 1 in sections:
+            single_robot(fuzzy)
+        if 2 in sections:
+            print("\n2. one run, where the time goes")
+            if theirs is not None:
+                against_runs(args.against, theirs)
+            else:
+                for name in ("slalom.yaml", "office.yaml"):
+                    one_run(load_world(packaged_path("worlds", name)), fuzzy)
+        if 3 in sections:
+            hundred_runs(fuzzy)
+        if 4 in sections:
+            batch_sizes(fuzzy, args.against, theirs)
+        if 5 in sections:
+            thousand_runs(fuzzy, args.runs)
     print(f"load average {_load():.2f} at the end")
+
+
+def _cpus() -> str:
+    model = platform.processor() or "unknown CPU"
+    with contextlib.suppress(OSError):
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                model = line.split(":", 1)[1].strip()
+                break
+    return f"{os.cpu_count()} CPUs ({model})"
 
 
 def _load() -> float:
@@ -214,8 +313,9 @@ def hundred_runs(fuzzy) -> None:
     print(f"   identical results with 1 and 2 workers; wall-time speed-up {walls[1] / walls[2]:.2f}x")
 
 
-def batch_sizes(fuzzy) -> None:
-    """Section 4: CPU time per robot-tick of runs stepped together, by batch size."""
+def batch_sizes(fuzzy, rev: str | None = None, theirs=None) -> None:
+    """Section 4: CPU time per robot-tick of runs stepped together, by batch size (with
+    ``rev``: also its tree's, the two interleaved batch by batch)."""
     world = dataclasses.replace(load_world(packaged_path("worlds", "slalom.yaml")),
                                 time_limit=2.0)
     scene = prepare(world)
@@ -225,6 +325,16 @@ def batch_sizes(fuzzy) -> None:
     alone = [simulate(world, fuzzy, s, randomise=True, scene=scene) for s in seeds]
     base = (time.process_time() - c) / sum(r.ticks * len(r.robot_outcomes) for r in alone)
     print(f"   16 runs, each alone (simulate): {1e6 * base:.0f} us per robot-tick")
+    old = None
+    if theirs is not None:
+        loop = importlib.import_module(theirs.__name__ + ".sim.loop")
+        old_world = dataclasses.replace(importlib.import_module(
+            theirs.__name__ + ".sim.worldfile").load_world(packaged_path("worlds",
+                                                                         "slalom.yaml")),
+            time_limit=2.0)
+        old = (importlib.import_module(theirs.__name__ + ".sim.lockstep").run_lockstep,
+               old_world, importlib.import_module(theirs.__name__ + ".sim.planner")
+               .FuzzyPlanner(None, "drive"), loop.prepare(old_world))
     for size in (1, 16, 256, 1024):
         runs = list(range(max(size, 16)))
         c = time.process_time()
@@ -232,8 +342,18 @@ def batch_sizes(fuzzy) -> None:
         per = (time.process_time() - c) / sum(r.ticks * len(r.robot_outcomes) for r in res)
         for a, b in zip(alone, res):
             assert a.summary() == b.summary() and a.pose.tobytes() == b.pose.tobytes()
-        print(f"   batch {size:5d} ({len(runs)} runs): {1e6 * per:.0f} us per robot-tick, "
-              f"{base / per:.2f}x the runs alone")
+        line = (f"   batch {size:5d} ({len(runs)} runs): {1e6 * per:.0f} us per robot-tick, "
+                f"{base / per:.2f}x the runs alone")
+        if old is not None:
+            lockstep, old_world, old_fuzzy, old_scene = old
+            c = time.process_time()
+            theirs_res = lockstep(old_world, old_fuzzy, runs, randomise=True, scene=old_scene,
+                                  batch=size)
+            old_per = (time.process_time() - c) / sum(r.ticks * len(r.robot_outcomes)
+                                                       for r in theirs_res)
+            assert [r.summary() for r in theirs_res] == [r.summary() for r in res]
+            line += f"; {rev}: {1e6 * old_per:.0f} us ({old_per / per:.2f}x slower, same runs)"
+        print(line)
 
 
 def _alone(task) -> list[dict]:

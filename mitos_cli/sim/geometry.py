@@ -14,21 +14,21 @@ import numpy as np
 
 EPS = 1e-9
 
-try:                                    # the ufunc np.clip calls, without its wrapper
-    from numpy._core.umath import clip as clip_arrays
-except ImportError:                     # NumPy 1.x
-    from numpy.core.umath import clip as clip_arrays
+
+def _clip_ufunc() -> np.ufunc:
+    """The ufunc ``np.clip`` calls, to call it without its Python wrapper (NumPy 2 keeps it in
+    ``numpy._core.umath``, NumPy 1 in ``numpy.core.umath``)."""
+    import importlib
+
+    for name in ("numpy._core.umath", "numpy.core.umath"):
+        try:
+            return importlib.import_module(name).clip
+        except (ImportError, AttributeError):
+            continue
+    raise ImportError("this NumPy has no clip ufunc")
 
 
-def clip(x: float, lo: float, hi: float) -> float:
-    """``np.clip`` of one float, as its ufunc does it (equal bounds and signed zeros keep
-    ``x``; NaN stays NaN) without the array round trip."""
-    if x != x:
-        return x
-    y = x if x >= lo else lo
-    if y != y:
-        return y
-    return y if y <= hi else hi
+clip_arrays: np.ufunc = _clip_ufunc()
 
 
 def rect_corners(cx, cy, heading, length, width) -> np.ndarray:

@@ -97,7 +97,8 @@ def _observe_together(runs: list[Simulation]) -> list:
     run."""
     fresh = [run for run in runs if not run.observed]
     if len(fresh) > 1:
-        parts, spans = [], []
+        parts: list[rows.SenseRow] = []
+        spans = []
         for run in fresh:
             mine = run.sense_rows()
             spans.append((len(parts), len(parts) + len(mine)))

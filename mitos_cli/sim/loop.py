@@ -450,6 +450,7 @@ class Simulation:
             s = self.sense() if sensed is None else self.sensed(sensed)
             self.perceive(s)
             self.conclude(s)
+        assert self._observed is not None
         return self._observed
 
     def conclude(self, s: _Sensed) -> None:
@@ -548,11 +549,10 @@ class Simulation:
                 others = np.concatenate([rect_sides] + [robot_sides[j] for j in range(n)
                                                         if j != i])
                 boxes = np.concatenate([rect_box, footprints[:i], footprints[i + 1:]])
-                discs = rows.discs(boxes)
             else:
-                others, boxes, discs = rect_sides, rect_box, self._still_discs
-                if discs is None:
-                    discs = rows.discs(boxes)
+                others, boxes = rect_sides, rect_box
+            discs = (self._still_discs if n == 1 and self._still_discs is not None
+                     else rows.discs(boxes))
             walls = self._walls_near(i)
             out.append(rows.SenseRow(float(x[i]), float(y[i]), float(h[i]), self.robots[i],
                                      walls, self._joined(i, walls, others), boxes, discs,

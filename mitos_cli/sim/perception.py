@@ -190,9 +190,9 @@ def _obstruction_rows(routes: list[Route], frames: list[Frame], a, b, points, va
                                    - widen[i, round_] < least)
     size, position = np.zeros(len(routes)), np.zeros(len(routes))
     distance = np.full(len(routes), NO_OBSTACLE)
-    for i in np.flatnonzero(blocking.any(axis=1)):
-        size[i], position[i], distance[i] = _object(
-            routes[i], frames[i], a[i], points[i], ahead[i], blocking[i], widen[i], robots[i], cfg)
+    for j in np.flatnonzero(blocking.any(axis=1)):
+        size[j], position[j], distance[j] = _object(
+            routes[j], frames[j], a[j], points[j], ahead[j], blocking[j], widen[j], robots[j], cfg)
     return size, position, distance
 
 

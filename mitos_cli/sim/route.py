@@ -10,6 +10,7 @@ from __future__ import annotations
 import functools
 import heapq
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -472,7 +473,7 @@ def grid_route(static: StaticMap, start: Pose, goal: Goal, clearance: float,
     return Route.of(pts, goal=(goal.x, goal.y))
 
 
-def _steps(moves: list[tuple[int, int, float]], blocked: np.ndarray, ok: np.ndarray,
+def _steps(moves: Sequence[tuple[int, int, float]], blocked: np.ndarray, ok: np.ndarray,
            loose: np.ndarray, penalty: np.ndarray,
            narrow: np.ndarray) -> tuple[memoryview, memoryview]:
     """Every step of the node grid ``[R, C]`` at once, flat (move ``m`` from node ``n`` at

@@ -153,7 +153,7 @@ def _noisy(rows: list[SenseRow], ranges: np.ndarray, max_range: float) -> np.nda
     noisy = [r.noise > 0 for r in rows]
     if not any(noisy):
         return ranges
-    draws = _stacked([r.rng.normal(0.0, r.noise, ranges.shape[1]) if n
+    draws = _stacked([np.asarray(r.rng.normal(0.0, r.noise, ranges.shape[1])) if n
                       else np.zeros(ranges.shape[1]) for r, n in zip(rows, noisy)])
     out = np.where(ranges >= max_range, max_range, clip_arrays(ranges + draws, 0.0, max_range))
     return out if all(noisy) else np.where(np.array(noisy)[:, None], out, ranges)

@@ -1,0 +1,272 @@
+"""The simulator's faster paths give the bits of the plain ones they replace: each test holds a
+fast path against the straightforward code it stands for (written out here) or against itself
+on one row, on random inputs."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+import pytest
+
+from mitos_cli.resources import packaged_path
+from mitos_cli.sim import geometry, knowledge, perception, route, rows, safety
+from mitos_cli.sim.loop import Simulation, prepare
+from mitos_cli.sim.planner import FuzzyPlanner
+from mitos_cli.sim.world import Grid, Robot
+from mitos_cli.sim.worldfile import load_world
+
+
+def same(a, b) -> bool:
+    a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
+    return a.shape == b.shape and a.tobytes() == b.tobytes()
+
+
+def test_the_clip_ufunc_is_np_clip_signed_zeros_and_nan_included():
+    values = [math.nan, -math.inf, math.inf, 0.0, -0.0, 1.0, -1.0, 90.0, 5e-324]
+    for x in values:
+        for lo in values:
+            for hi in values:
+                assert same(geometry.clip_arrays(np.array([x]), lo, hi)[0], np.clip(x, lo, hi))
+
+
+def test_ray_circles_sums_as_einsum_did():
+    rng = np.random.default_rng(1)
+    for _ in range(200):
+        origin = rng.uniform(-300, 300, 2)
+        centres = origin + rng.uniform(-160, 160, (int(rng.integers(1, 5)), 2))
+        if rng.random() < 0.2:
+            centres[0] = origin                          # a beam from a circle's centre
+        radii = rng.uniform(0, 20, len(centres))
+        a = rng.uniform(0, 2 * np.pi) + np.deg2rad(np.arange(0, 360, 10))
+        if rng.random() < 0.2:
+            a = np.deg2rad(np.arange(0, 360, 90))        # beams along the axes: zero products
+        dirs = np.stack([np.cos(a), np.sin(a)], axis=1)
+        m = np.broadcast_to(origin, (len(dirs), 2))[:, None, :] - centres[None]
+        b = np.einsum("bck,bk->bc", m, dirs)
+        c = np.einsum("bck,bck->bc", m, m) - radii[None] ** 2
+        disc = b * b - c
+        t = np.where(c <= 0.0, 0.0, -b - np.sqrt(np.maximum(disc, 0.0)))
+        want = np.minimum(np.where((disc >= 0.0) & (t >= 0.0), t, np.inf).min(axis=1), 150.0)
+        assert same(geometry.ray_circles(origin, dirs, centres, radii, 150.0), want)
+
+
+def test_points_at_is_point_at_for_every_arc_length():
+    rng = np.random.default_rng(2)
+    for k in range(300):
+        pts = np.cumsum(rng.normal(0, 30, (int(rng.integers(2, 8)), 2)), axis=0)
+        r = route.Route.of(pts)
+        if k % 7 == 0:                                   # a zero-length segment kept as given
+            r = route.Route(np.vstack([r.points[:1], r.points]), np.concatenate([[0.0], r.cum]),
+                            r.goal)
+        s = np.concatenate([rng.uniform(-20, r.length + 20, 12), [0.0, -0.0, r.length, r.cum[1]]])
+        assert same(r.points_at(s), [r.point_at(float(u)) for u in s])
+
+
+def test_a_routes_own_clearance_along_every_segment_at_once():
+    rng = np.random.default_rng(3)
+    occupied = rng.random((40, 50)) < 0.05
+    field = route.Clearance.of(occupied, 2.0, (-10.0, -5.0), cap=30.0)
+    for _ in range(50):
+        pts = rng.uniform(-20, 100, (int(rng.integers(2, 9)), 2))
+        want = [field.along(p, q) for p, q in zip(pts[:-1], pts[1:])]
+        assert same(field.along_path(pts), want)
+
+
+def accounted_cell_by_cell(rmap: knowledge.RobotMap, points: np.ndarray, reach: int = 2):
+    """RobotMap.accounted as it was written: the (2 reach + 1)^2 neighbours looked up one
+    offset at a time."""
+    row, col, _ = rmap.cells(points)
+    cells = rmap.grid.occupied if rmap.planned is None else rmap.planned
+    rows_, cols_ = cells.shape
+    out = np.zeros(len(points), dtype=bool)
+    for dr in range(-reach, reach + 1):
+        for dc in range(-reach, reach + 1):
+            r, c = row + dr, col + dc
+            inside = (r >= 0) & (r < rows_) & (c >= 0) & (c < cols_)
+            out[inside] |= cells[r[inside], c[inside]]
+    return out
+
+
+def test_accounted_looks_up_a_dilation_with_the_same_answer():
+    rng = np.random.default_rng(4)
+    grid = Grid(rng.random((30, 40)) < 0.03, 2.0, (-7.0, 3.0))
+    rmap = knowledge.RobotMap.of(grid)
+    for k in range(40):
+        if k == 20:
+            rmap.planned = rng.random((30, 40)) < 0.05
+        pts = rng.uniform([-20, -10], [100, 80], (60, 2))
+        assert same(rmap.accounted(pts), accounted_cell_by_cell(rmap, pts))
+
+
+def clear_by_scanning(occupied: np.ndarray, given: np.ndarray, grid: Grid, origin, dirs,
+                      measured, max_range: float) -> None:
+    """RobotMap.clear as it was written: its window scanned for marked cells."""
+    res, (ox, oy) = grid.resolution, grid.origin
+    rows_, cols_ = occupied.shape
+    c0 = min(max(int((origin[0] - max_range - ox) // res), 0), cols_)
+    r0 = min(max(int((origin[1] - max_range - oy) // res), 0), rows_)
+    c1 = min(max(int((origin[0] + max_range - ox) // res) + 1, 0), cols_)
+    r1 = min(max(int((origin[1] + max_range - oy) // res) + 1, 0), rows_)
+    window = (slice(r0, r1), slice(c0, c1))
+    r, c = np.nonzero(occupied[window] & ~given[window])
+    if not len(r):
+        return
+    rel = np.stack([ox + (c + c0 + 0.5) * res, oy + (r + r0 + 0.5) * res], axis=1) - origin
+    along = rel @ dirs.T
+    across = np.abs(rel[:, :1] * dirs[:, 1] - rel[:, 1:] * dirs[:, 0])
+    through = ((along > 0) & (along < np.minimum(measured, max_range) - res)
+               & (across < res / 2)).any(axis=1)
+    occupied[r[through] + r0, c[through] + c0] = False
+
+
+def test_a_maps_marks_kept_as_a_list_clear_as_a_scan_of_its_window_did():
+    rng = np.random.default_rng(5)
+    grid = Grid(rng.random((60, 80)) < 0.02, 2.0, (0.0, 0.0))
+    rmap = knowledge.RobotMap.of(grid)
+    reference = grid.occupied.copy()
+    angles = np.deg2rad(np.arange(0, 360, 10))
+    for _ in range(60):
+        origin = rng.uniform([10, 10], [150, 110])
+        dirs = np.stack([np.cos(angles), np.sin(angles)], axis=1)
+        measured = rng.uniform(0, 60, len(dirs))
+        hits = origin + measured[:, None] * dirs
+        seen = rng.random(len(dirs)) < 0.5
+        rmap.mark(hits[seen], dirs[seen])
+        row, col, inside = rmap.cells(hits[seen] + dirs[seen] * 1.0)
+        reference[row[inside], col[inside]] = True
+        clear_by_scanning(reference, grid.occupied, grid, origin, dirs, measured, 40.0)
+        rmap.clear(origin, dirs, measured, 40.0)
+        assert np.array_equal(rmap.occupied, reference)
+        assert np.array_equal(np.flatnonzero(reference & ~grid.occupied), rmap.marks)
+
+
+def free_travel_over_every_cell(cells, radius, pose, robot, delta, backward, reach, step=1.0):
+    """safety.free_travel as it was written: every cell tested at every step."""
+    x, y, h = pose
+    if not len(cells):
+        return reach
+    wb, hl, hw = robot.wheelbase, robot.length / 2 + radius, robot.width / 2 + radius
+    u = np.arange(0.0, reach + step / 2, step) * (-1.0 if backward else 1.0)
+    k = -math.tan(math.radians(delta)) / wb
+    hk = h + k * u
+    if abs(k) > 1e-9:
+        rx = x - wb / 2 * math.cos(h) + (np.sin(hk) - math.sin(h)) / k
+        ry = y - wb / 2 * math.sin(h) + (math.cos(h) - np.cos(hk)) / k
+    else:
+        rx = x - wb / 2 * math.cos(h) + u * math.cos(h)
+        ry = y - wb / 2 * math.sin(h) + u * math.sin(h)
+    c, s = np.cos(hk), np.sin(hk)
+    dx = cells[:, 0, None] - (rx + wb / 2 * c)
+    dy = cells[:, 1, None] - (ry + wb / 2 * s)
+    inside = (np.abs(dx * c + dy * s) <= hl) & (np.abs(dy * c - dx * s) <= hw)
+    hit = inside.any(axis=0)
+    if not hit.any():
+        return reach
+    return float(max(int(np.argmax(hit)) - 1, 0) * step)
+
+
+def test_the_brakes_sweep_tests_only_the_cells_its_disc_sweeps_with_the_same_answer():
+    rng = np.random.default_rng(6)
+    robot = Robot()
+    for _ in range(400):
+        pose = (float(rng.uniform(-5, 5)), float(rng.uniform(-5, 5)), float(rng.uniform(-4, 4)))
+        cells = rng.uniform(-70, 70, (int(rng.integers(0, 300)), 2))
+        delta = float(rng.choice([0.0, rng.uniform(-60, 60)]))
+        backward = bool(rng.random() < 0.3)
+        assert same(safety.free_travel(cells, 1.0, pose, robot, delta, backward, 30.0),
+                    free_travel_over_every_cell(cells, 1.0, pose, robot, delta, backward, 30.0))
+
+
+def test_the_prepared_search_patches_only_round_the_changed_cells():
+    world = load_world(packaged_path("worlds", "slalom.yaml"))
+    grid = prepare(world).plan_grid
+    rng = np.random.default_rng(7)
+    for k in range(8):
+        occ = grid.occupied.copy()
+        r = rng.integers(0, occ.shape[0], int(rng.integers(1, 20)))
+        c = rng.integers(0, occ.shape[1], len(r))
+        if k == 3:                                       # round node (0, 0) and (1, 1)
+            r, c = r % 5, c % 5
+        occ[r, c] = ~occ[r, c] if k % 2 else True
+        patched = route._prepared(grid, occ, 50.0, 3)
+        whole = route._prepared(grid, occ, 50.0, 3, keep=False)
+        assert same(patched[0].dist, whole[0].dist)
+        assert all(same(a, b) for a, b in zip(patched[1], whole[1]))
+        assert same(patched[2], whole[2])
+
+
+def test_a_star_over_flat_tables_takes_the_generic_searchs_path():
+    rng = np.random.default_rng(8)
+    for _ in range(30):
+        R, C = int(rng.integers(3, 15)), int(rng.integers(3, 15))
+        blocked = rng.random((R, C)) < 0.25
+        ok = rng.random((8, R, C)) < 0.8
+        loose = rng.random((R, C)) < 0.1
+        narrow = rng.random((8, R, C)) < 0.2
+        penalty = rng.uniform(0, 5, (R, C))
+        s, t = (0, 0), (R - 1, C - 1)
+        blocked[s] = blocked[t] = False
+
+        def neighbours(n: int):
+            r, c = divmod(n, C)
+            for m, (dr, dc, step) in enumerate(route.MOVES):
+                rr, cc = r + dr, c + dc
+                if 0 <= rr < R and 0 <= cc < C and not blocked[rr, cc] and (
+                        ok[m, r, c] or loose[r, c] or loose[rr, cc]):
+                    yield rr * C + cc, step * (1.0 + penalty[rr, cc]
+                                               + (route.NARROW_COST if narrow[m, r, c] else 0.0))
+
+        want = route._astar(neighbours, 0, t[0] * C + t[1], lambda n: (n // C, n % C))
+        allowed, costs = route._steps(list(route.MOVES), blocked, ok, loose, penalty, narrow)
+        got = route._grid_astar(allowed, costs, [dr * C + dc for dr, dc, _ in route.MOVES], C,
+                                0, t[0] * C + t[1])
+        assert got == want
+
+
+def running(name: str, runs: int = 3, ticks: int = 120) -> list[Simulation]:
+    """``runs`` randomised runs of a shipped world, stepped ``ticks`` times."""
+    world = load_world(packaged_path("worlds", name))
+    planner, scene = FuzzyPlanner(None, world.behavior), prepare(world)
+    out = []
+    for seed in range(1, runs + 1):
+        sim = Simulation(world, planner, seed, randomise=True, scene=scene)
+        for _ in range(ticks):
+            if not sim.done:
+                sim.step()
+        out.append(sim)
+    return [sim for sim in out if not sim.done]
+
+
+@pytest.mark.parametrize("name", ["slalom.yaml", "office.yaml", "multirobot.yaml"])
+def test_robots_sensed_together_get_the_bits_they_get_alone(name):
+    sims = running(name)
+    parts = [row for sim in sims for row in sim.sense_rows()]
+    assert len(parts) > 1
+    angles, max_range = sims[0].angles, sims[0].world.sensors.range
+    parts[0] = dataclasses.replace(parts[0], noise=0.0)       # a row without noise among them
+
+    def streams(k: int) -> list[rows.SenseRow]:               # each row's noise from seed k + i
+        return [dataclasses.replace(row, rng=np.random.default_rng(k + i))
+                for i, row in enumerate(parts)]
+
+    together = rows.sense(streams(100), angles, max_range)
+    for i, row in enumerate(streams(100)):
+        alone = rows.sense([row], angles, max_range)
+        for key in ("dirs", "static", "ranges", "clearance"):
+            assert same(getattr(alone, key)[0], getattr(together, key)[i]), (i, key)
+
+
+@pytest.mark.parametrize("name", ["slalom.yaml", "office.yaml", "detour.yaml"])
+def test_robots_perceived_together_get_the_bits_they_get_alone(name):
+    sims = running(name)
+    sights = []
+    for sim in sims:
+        sights += sim.sights(sim.sense())
+    cfg = sims[0].settings
+    together = perception.perceive_rows(sights, sims[0].world.sensors.range, cfg)
+    for i, sight in enumerate(sights):
+        alone = perception.perceive_rows([sight], sims[0].world.sensors.range, cfg)
+        for key in perception.INPUTS:
+            assert same(alone[key][0], together[key][i]), key
