@@ -160,7 +160,7 @@ def _centre_lines(grid: Grid) -> tuple[np.ndarray, np.ndarray]:
 def _centres_of(grid: Grid, window: np.ndarray, r0: int, c0: int) -> np.ndarray:
     """The centres ``[P, 2]`` of the set cells of ``window``, a part of ``grid``'s cells
     from row ``r0`` and column ``c0`` (in row-major order, as ``np.nonzero`` gives them)."""
-    r, c = np.nonzero(window)
+    r, c = window.nonzero()
     xs, ys = _centre_lines(grid)
     out = np.empty((len(r), 2))
     out[:, 0] = xs[c + c0]
@@ -256,7 +256,9 @@ class RobotMap:
             return
         r, c = r[window], c[window]
         xs, ys = _centre_lines(g)
-        rel = np.stack([xs[c], ys[r]], axis=1) - origin
+        rel = np.empty((len(r), 2))
+        rel[:, 0], rel[:, 1] = xs[c], ys[r]
+        rel -= origin
         along = rel @ dirs.T                                       # [P, B]
         across = np.abs(rel[:, :1] * dirs[:, 1] - rel[:, 1:] * dirs[:, 0])
         through = ((along > 0) & (along < np.minimum(measured, max_range) - res)

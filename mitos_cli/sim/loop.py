@@ -216,6 +216,14 @@ def _footprints(pose: np.ndarray, robots) -> np.ndarray:
                         np.array([r.length for r in robots]), np.array([r.width for r in robots]))
 
 
+def _columns(*columns: np.ndarray) -> np.ndarray:
+    """``np.stack(columns, axis=1)``, without its Python set-up (a tick makes a few)."""
+    out = np.empty((len(columns[0]), len(columns)))
+    for j, column in enumerate(columns):
+        out[:, j] = column
+    return out
+
+
 @dataclass(frozen=True)
 class Tick:
     """What one tick recorded, rows are robots: the state the robots were in when they sensed,
@@ -488,8 +496,9 @@ class Simulation:
             self.plan(s)
         else:
             s.command[:] = np.asarray(command, float).reshape(self.n, 2)
-            s.command[~self._active] = np.stack([self.limits.straight, np.zeros(self.n)],
-                                                axis=1)[~self._active]
+            if not self._active.all():
+                s.command[~self._active] = np.stack([self.limits.straight, np.zeros(self.n)],
+                                                    axis=1)[~self._active]
         self._guard(s)
         tick = self._record(s)
         if self._hit.any():
@@ -563,7 +572,7 @@ class Simulation:
         """The tick's :class:`_Sensed` from its robots' rows of :func:`.rows.sense`, with what
         each robot's own map predicts along its beams."""
         n = self.n
-        pose = np.stack([self._x, self._y, self._h], axis=1)
+        pose = _columns(self._x, self._y, self._h)
         self._dirs = list(got.dirs)
         if self._plain:
             self._expected = list(got.static)
@@ -758,7 +767,7 @@ class Simulation:
         return bool(stuck.any())
 
     def _record(self, s: _Sensed) -> Tick:
-        tick = Tick(self._k, s.t, np.stack([self._x, self._y, np.rad2deg(self._h)], axis=1),
+        tick = Tick(self._k, s.t, _columns(self._x, self._y, np.rad2deg(self._h)),
                     self._v.copy(), self._steer.copy(), s.command, s.ranges, s.inputs,
                     s.clearance, s.where, self._active.copy(), self._s_hint.copy())
         self.record.append(tick)

@@ -200,7 +200,7 @@ def _object(route: Route, f: Frame, a, points, ahead, blocking, widen, robot: Ro
             cfg: Settings) -> tuple[float, float, float]:
     """(size, position, distance) of the object the nearest blocking point belongs to: the
     points ahead within ``cluster`` of it."""
-    i = int(np.argmin(np.where(blocking, a, np.inf)))
+    i = int(np.where(blocking, a, np.inf).argmin())
     near = ahead & (np.hypot(*(points - points[i]).T) <= cfg.cluster)
     distance = max(0.0, float(a[near].min()) - robot.length / 2)
     # size and position across the road where the object stands (around a corner that is
