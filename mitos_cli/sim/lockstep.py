@@ -1,12 +1,16 @@
 """Runs in lockstep: independent runs of one world stepped together, tick by tick.
 
-Each tick every run still going observes on its own (sense, perceive, check: the code of a run
-alone, :class:`~mitos_cli.sim.loop.Simulation`); then the fuzzy planner's rule network is
-evaluated once for the active robots of every run (one engine batch: the engine gives each row
-the bits it gives alone), and the robots of every run move in one batch of kinematics
-(elementwise per robot). Runs that end drop out. Each run's ticks, trajectory and summary are
-bit for bit those of the same run alone, whatever the batch (``tests/test_sim_lockstep.py``).
-"""
+Each tick the robots of every run still going are sensed in one pass (:func:`.rows.sense`:
+beams, noise from each robot's own stream, clearance) and their rule inputs perceived in one
+pass (:func:`.perception.perceive_rows`); what a robot's own map and route need (marking and
+clearing its map, replanning, the lookahead) and its check are done run by run, with the code
+of a run alone (:class:`~mitos_cli.sim.loop.Simulation`). Then the fuzzy planner's rule network
+is evaluated once for the active robots of every run (one engine batch: the engine gives each
+row the bits it gives alone), each run's brake checks its commands, and the robots of every run
+move in one batch of kinematics (elementwise per robot). Runs that end drop out. Every batched
+stage is elementwise per robot or an exact minimum, so each run's ticks, trajectory and summary
+are bit for bit those of the same run alone, whatever the batch
+(``tests/test_sim_lockstep.py``, ``tests/test_sim_same_bits.py``)."""
 
 from __future__ import annotations
 
