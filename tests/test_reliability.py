@@ -616,3 +616,25 @@ def test_a_hash_in_a_batch_row_is_a_bad_value_not_a_comment(tmp_path):
             with pytest.raises(InputError) as err:
                 read_batch(path.read_text(), str(path), ("position", "road", "size"))
         assert (err.value.span.line, err.value.span.column) == where
+
+
+@pytest.mark.parametrize("line, words", [
+    # the campaign's minimal reproducer (seed 20261203): `op` is an array
+    (b'{"seq":1,"opes":"/","op":[{"ts":{"st":10},"soe":"correct"}]}', "is a JSON array"),
+    (b'{"seq":1,"op":{"start":1}}', "is a JSON object"),
+    (b'{"seq":1,"op":5}', "is 5, not a string"),
+    (b'{"seq":1}', "is missing"),
+    (b'{"seq":[' + b"1," * 50000 + b'1],"op":"start"}', "found a JSON array"),
+])
+def test_a_journal_change_name_that_is_not_a_string_is_named(tmp_path, line, words):
+    """`"op": [...]` (an unhashable value) was a TypeError in `journal._problem`; the message
+    also quotes a long value only by its JSON type."""
+    from mitos_cli.teach.journal import Journal
+
+    d = tmp_path / "s"
+    d.mkdir()
+    (d / "journal.jsonl").write_bytes(line + b"\n" + b'{"seq": 2, "op": "save"}\n')
+    with pytest.raises(LessonError, match="damaged") as info:
+        Journal.open(d)
+    assert words in info.value.message and len(info.value.message) < 200
+    assert info.value.span.path == str(d / "journal.jsonl") and info.value.span.line == 1
