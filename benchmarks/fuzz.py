@@ -4,6 +4,7 @@ Run from the repository root (one command each)::
 
     python benchmarks/fuzz.py --quick                       # a short campaign (150 per kind)
     python benchmarks/fuzz.py --per-format 9000 --out fuzz-found      # 100,950 inputs
+    python benchmarks/fuzz.py --per-format 9000 --jobs 2 --out fuzz-found  # on 2 cores
     python benchmarks/fuzz.py --per-format 9000 --shard 0/4           # a quarter of them
     python benchmarks/fuzz.py --via cli --per-format 1000   # through `mitos`'s main, in process
     python benchmarks/fuzz.py --via subprocess --per-format 30        # spot checks
@@ -1001,8 +1002,10 @@ def campaign(per_format: int, out: Path | None, limit: float, slow: float, only:
                     _count(kind, current, *result, seen, out, seed, work, limit, slow, log)
                 proc.join()
             kind.seconds = time.perf_counter() - t0
+            LOADS.append(os.getloadavg()[0])
             log(f"{kind.name}: {kind.tried} inputs in {kind.seconds:.1f} s "
-                + ", ".join(f"{k} {v}" for k, v in kind.counts.items() if v))
+                + ", ".join(f"{k} {v}" for k, v in kind.counts.items() if v)
+                + f" (load average {LOADS[-1]:.1f})")
         return kinds
     finally:
         os.chdir(cwd)
@@ -1037,13 +1040,15 @@ def _write(out: Path, kind: Kind, data, want, scratch: Path, limit: float, slow:
     stem = re.sub(r"\W+", "-", kind.name).strip("-")
     ext = ".pgm" if isinstance(small, bytes) else kind.ext
     target = out / f"{stem}-{tag}{ext}"
-    if isinstance(small, bytes):
-        target.write_bytes(small)
-    else:
-        target.write_text(small, encoding="utf-8", errors="surrogatepass")
-    target.with_suffix(target.suffix + ".json").write_text(json.dumps(
-        {"kind": kind.name, "outcome": want[0], "signature": want[1],
-         "bytes": len(small)}, indent=1) + "\n")
+    raw = small if isinstance(small, bytes) else small.encode("utf-8", "surrogatepass")
+    meta = json.dumps({"kind": kind.name, "outcome": want[0], "signature": want[1],
+                       "bytes": len(small)}, indent=1) + "\n"
+    # whole files only: the shards of `--jobs` may find the same signature at once
+    for path, content in ((target, raw), (target.with_suffix(target.suffix + ".json"),
+                                          meta.encode())):
+        tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+        tmp.write_bytes(content)
+        os.replace(tmp, path)
 
 
 def table(kinds: list[Kind]) -> str:
@@ -1075,6 +1080,85 @@ def _large(large: list[tuple[int, float]]) -> str:
     return f"{len(large):,}, {biggest / 1024:,.0f} KB, {per_kb * 1000:.2f}"
 
 
+#: the 1-minute load average at the start and at each kind's end (the table's "load")
+LOADS: list[float] = []
+#: shards of ``--jobs`` that died without their table (the campaign then fails)
+LOST: list[int] = []
+
+
+def shard_of(text: str) -> tuple[int, int]:
+    """``K/N`` with 0 <= K < N (``2/2`` would silently skip input 0 and run half of shard 0)."""
+    k, sep, n = text.partition("/")
+    try:
+        pair = (int(k), int(n) if sep else 1)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected K/N, found {text!r}") from None
+    if not 0 <= pair[0] < pair[1]:
+        raise argparse.ArgumentTypeError(f"expected K/N with 0 <= K < N, found {text!r} "
+                                         f"(shards are numbered from 0)")
+    return pair
+
+
+def summary(kinds: list[Kind]) -> list[dict]:
+    """What a shard sends back to ``--jobs``: each kind's counts and times."""
+    return [{"name": k.name, "tried": k.tried, "counts": k.counts, "cpu": k.cpu,
+             "seconds": k.seconds, "large": k.large} for k in kinds]
+
+
+def merged(parts: list[list[dict]]) -> list[Kind]:
+    """The shards' summaries as one campaign's kinds (in the kinds' order)."""
+    kinds: dict[str, Kind] = {}
+    for part in parts:
+        for d in part:
+            k = kinds.setdefault(d["name"], Kind(d["name"], [], None, None))
+            k.tried += d["tried"]
+            k.cpu += d["cpu"]
+            k.seconds = max(k.seconds, d["seconds"])
+            k.large.extend(tuple(x) for x in d["large"])
+            for o, v in d["counts"].items():
+                k.counts[o] += v
+    return list(kinds.values())
+
+
+def _shard(conn, k: int, n: int, args) -> None:
+    """One shard of ``--jobs``: its campaign, its log lines prefixed with ``[K/N]``."""
+    def log(line: str) -> None:
+        print(f"[{k}/{n}] {line}", flush=True)
+
+    kinds = campaign(args.n, args.out, args.limit, args.slow, args.only, args.seed, log=log,
+                     via=args.via, shard=(k, n))
+    conn.send((summary(kinds), LOADS))
+    conn.close()
+
+
+def run_jobs(args) -> list[Kind]:
+    """``--jobs N``: shards 0/N .. N-1/N in N processes at once, their tables summed."""
+    import multiprocessing as mp
+
+    ctx = mp.get_context("fork")
+    procs = []
+    for k in range(args.jobs):
+        parent, child = ctx.Pipe(duplex=False)
+        proc = ctx.Process(target=_shard, args=(child, k, args.jobs, args))
+        proc.start()
+        child.close()
+        procs.append((proc, parent))
+    parts = []
+    for k, (proc, parent) in enumerate(procs):
+        try:
+            part, loads = parent.recv()
+        except EOFError:                 # the shard died: the table says it is short
+            proc.join()
+            print(f"[{k}/{args.jobs}] ended without its table (exit {proc.exitcode}); the "
+                  "table below lacks its inputs", flush=True)
+            LOST.append(k)
+            continue
+        parts.append(part)
+        LOADS.extend(loads)
+        proc.join()
+    return merged(parts)
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--per-format", type=int, default=2000, help="inputs per input kind")
@@ -1086,27 +1170,46 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--limit", type=float, default=10.0, help="per-input time limit, seconds")
     ap.add_argument("--slow", type=float, default=5.0, help="slower than this counts as slow")
     ap.add_argument("--seed", type=int, default=SEED)
-    ap.add_argument("--shard", default="0/1", metavar="K/N",
-                    help="run only inputs K, K + N, K + 2N, ... of each kind (N campaigns in "
-                         "parallel cover them all)")
+    ap.add_argument("--shard", type=shard_of, default=(0, 1), metavar="K/N",
+                    help="run only inputs K, K + N, K + 2N, ... of each kind, 0 <= K < N (N "
+                         "campaigns in parallel cover them all)")
+    ap.add_argument("--jobs", type=int, default=1, metavar="N",
+                    help="run the N shards 0/N .. N-1/N at once in N processes and print their "
+                         "summed table (one worker each: N cores)")
     ap.add_argument("--via", choices=("reader", "cli", "subprocess"), default="reader",
                     help="reader: the library's readers; cli: `mitos`'s main in this process "
                          "(stdout and stderr captured); subprocess: `python -m mitos_cli`, for "
                          "spot checks")
     args = ap.parse_args(argv)
-    n = 150 if args.quick else args.per_format
+    if args.jobs < 1:
+        ap.error("--jobs must be at least 1")
+    if args.jobs > 1 and args.shard != (0, 1):
+        ap.error("--jobs runs every shard itself: give --jobs or --shard, not both")
+    args.n = 150 if args.quick else args.per_format
     t0 = time.perf_counter()
-    k, _, of = args.shard.partition("/")
-    kinds = campaign(n, args.out, args.limit, args.slow, args.only, args.seed, via=args.via,
-                     shard=(int(k), int(of or 1)))
+    LOADS.append(os.getloadavg()[0])
+    if args.jobs > 1:
+        kinds = run_jobs(args)
+        shard = f"{args.jobs} shards at once"
+    else:
+        kinds = campaign(args.n, args.out, args.limit, args.slow, args.only, args.seed,
+                         via=args.via, shard=args.shard)
+        shard = "shard {}/{}".format(*args.shard)
+    LOADS.append(os.getloadavg()[0])
+    wall = time.perf_counter() - t0
+    own = resource.getrusage(resource.RUSAGE_SELF)
+    children = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = own.ru_utime + own.ru_stime + children.ru_utime + children.ru_stime
     print()
     print(table(kinds))
-    print(f"\n{sum(k.tried for k in kinds):,} inputs in {time.perf_counter() - t0:.0f} s "
-          f"(seed {args.seed}, via {args.via}, shard {args.shard}, limit {args.limit:g} s, slow above "
-          f"{args.slow:g} s; load average {os.getloadavg()[0]:.1f})")
-    bad = sum(k.counts[o] for k in kinds for o in BAD)
-    return 1 if bad else 0
-
+    bad = {o: sum(k.counts[o] for k in kinds) for o in BAD}
+    print(f"\n{sum(k.tried for k in kinds):,} inputs in {wall:.0f} s of wall time, "
+          f"{cpu:.0f} CPU s in all ({sum(k.cpu for k in kinds):.0f} inside the inputs); "
+          + ", ".join(f"{o} {v}" for o, v in bad.items())
+          + f"\n(seed {args.seed}, via {args.via}, {shard}, limit {args.limit:g} s, slow above "
+          f"{args.slow:g} s; 1-minute load average {min(LOADS):.1f} to {max(LOADS):.1f} at the "
+          f"start, the kinds' ends and the end)")
+    return 1 if any(bad.values()) or LOST else 0
 
 if __name__ == "__main__":
     sys.exit(main())

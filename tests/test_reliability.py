@@ -334,6 +334,22 @@ def test_fuzz_kind_has_no_foreign_exceptions(kinds, name):
     assert not bad
 
 
+def test_campaign_shards_are_numbered_from_zero_and_sum_to_one_campaign(kinds):
+    """`--shard 2/2` used to run inputs 2, 4, ... (input 0 of every kind skipped): refused;
+    `--jobs` sums its shards' tables."""
+    import argparse
+
+    fuzz, _, _ = kinds
+    assert fuzz.shard_of("1/2") == (1, 2) and fuzz.shard_of("0") == (0, 1)
+    for bad in ("2/2", "-1/2", "x", "1/0"):
+        with pytest.raises(argparse.ArgumentTypeError):
+            fuzz.shard_of(bad)
+    part = [{"name": "FLL", "tried": 3, "counts": dict.fromkeys(fuzz.OUTCOMES, 1), "cpu": 0.5,
+             "seconds": 2.0, "large": [(70000, 0.1)]}]
+    (fll,) = fuzz.merged([part, part])
+    assert (fll.tried, fll.counts["foreign"], fll.cpu, len(fll.large)) == (6, 2, 1.0, 2)
+
+
 def test_cli_route_classifies_what_the_user_sees(kinds, tmp_path):
     """``--via cli``: the CLI's main in this process, its exit code and stderr classified."""
     fuzz, _, _ = kinds
