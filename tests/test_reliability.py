@@ -654,3 +654,47 @@ def test_a_journal_change_name_that_is_not_a_string_is_named(tmp_path, line, wor
         Journal.open(d)
     assert words in info.value.message and len(info.value.message) < 200
     assert info.value.span.path == str(d / "journal.jsonl") and info.value.span.line == 1
+
+
+# ---- large files: time in proportion (found by timing growing files after the seed-20261203 campaign)
+
+def _chain_fll(outputs: int, condition: str) -> str:
+    """A fuzzylite chained engine: `y0` from the input, each `yI` from `y(I-1)`."""
+    lines = ["Engine: chain", "InputVariable: x", "  range: 0 1", "  term: A Triangle 0 0.5 1"]
+    for i in range(outputs):
+        lines += [f"OutputVariable: y{i}", "  range: 0 1", "  aggregation: Maximum",
+                  "  defuzzifier: Centroid 100", "  default: 0.5", "  term: A Triangle 0 0.5 1"]
+    lines += ["RuleBlock: main", "  conjunction: Minimum", "  disjunction: Maximum",
+              "  implication: Minimum", "  activation: General", "  rule: if x is A then y0 is A"]
+    lines += [f"  rule: if {condition.format(p=f'y{i - 1}')} then y{i} is A"
+              for i in range(1, outputs)]
+    return "\n".join(lines) + "\n"
+
+
+def test_a_chain_that_doubles_at_each_step_is_refused_not_written_out():
+    """Each rule testing the previous output twice: 2^k propositions written out (22 rules of
+    2 KB took 6 s, 30 rules hours). Refused at the test that crosses a million."""
+    from mitos_cli.errors import FormatError
+    from mitos_cli.interop.fll import parse_fll
+
+    t0 = time.process_time()
+    with pytest.raises(FormatError, match="more than 1,000,000 propositions") as info:
+        parse_fll(_chain_fll(22, "{p} is A and {p} is A"), "chain.fll")
+    assert time.process_time() - t0 < 5
+    assert info.value.span.source_line.strip() == "rule: if y18 is A and y18 is A then y19 is A"
+    assert info.value.span.column == 25         # the test of `y18` that crosses the bound
+    parse_fll(_chain_fll(12, "{p} is A and {p} is A"), "chain.fll")   # 2^12: read
+
+
+def test_a_chain_that_nests_deeper_than_rules_may_is_refused():
+    """A chain of 300 rules each adding a level: the restated condition nested 300 deep (1,000
+    was a RecursionError in `resolve.check_expr`)."""
+    from mitos_cli.errors import FormatError
+    from mitos_cli.interop.fll import parse_fll
+
+    for outputs in (300, 1000):
+        with pytest.raises(FormatError, match="nests 101 deep, more than 100") as info:
+            parse_fll(_chain_fll(outputs, "{p} is A and x is A"), "chain.fll")
+        assert "then y100 is A" in info.value.span.source_line
+    parse_fll(_chain_fll(60, "{p} is A and x is A"), "chain.fll")
+
