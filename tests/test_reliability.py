@@ -698,3 +698,61 @@ def test_a_chain_that_nests_deeper_than_rules_may_is_refused():
         assert "then y100 is A" in info.value.span.source_line
     parse_fll(_chain_fll(60, "{p} is A and x is A"), "chain.fll")
 
+
+def _cost(read, text: str) -> float:
+    t0 = time.process_time()
+    read(text)
+    return time.process_time() - t0
+
+
+@pytest.mark.parametrize("fmt", ["fll", "fis", "fcl"])
+def test_reading_a_foreign_file_is_linear_in_its_rules(fmt):
+    """Every line's (FLL, `.fis`) or node's (FCL) span split the whole text again (8,000 FLL
+    rules took 50 s); a rule WITH a weight looked at every rule (8,000 FCL rules, 2 minutes)."""
+    from mitos_cli.api import read_rulebase
+    from mitos_cli.interop import fcl, fis, fll
+
+    interop = ROOT / "tests" / "data" / "interop"
+    if fmt == "fll":
+        seed = fll.write_fll(read_rulebase(ROOT / "rulebases" / "mitos.rules"))
+        rule = next(x for x in seed.splitlines() if x.strip().startswith("rule:")) + "\n"
+
+        def text(n):
+            return seed.replace(rule, rule * n, 1)
+        read = fll.parse_fll
+    elif fmt == "fis":
+        seed = (interop / "tipper.fis").read_text()
+        rule = seed[seed.index("[Rules]"):].splitlines()[1] + "\n"
+
+        def text(n):
+            return seed.replace("NumRules=3", f"NumRules={n + 3}").rstrip("\n") + "\n" + rule * n
+        read = fis.parse_fis
+    else:
+        seed = (interop / "robot_jfuzzylogic.fcl").read_text()
+
+        def text(n):
+            return seed.replace("END_RULEBLOCK", "".join(
+                f"RULE {k + 100} : IF dist IS near AND angle IS right THEN turn IS hard_left "
+                f", speed IS slow WITH 0.9;\n" for k in range(n)) + "END_RULEBLOCK")
+        read = fcl.parse_fcl
+    small_text, large_text = text(250), text(2000)
+    _cost(read, small_text)
+    small = min(_cost(read, small_text) for _ in range(2))
+    large = min(_cost(read, large_text) for _ in range(2))
+    assert large < 8 * small * 2.5          # 8x the rules: linear, with room for noise
+
+
+def test_a_span_on_a_long_line_looks_only_around_its_column():
+    """`Span.at` searched for the end of the line from the node: a node per condition of one
+    line of 80,000 conditions (1.3 MB) made parsing it take 20 s."""
+    short, long = "x" * 1_000, "x" * 4_000_000
+
+    def cost(text):
+        t0 = time.process_time()
+        for i in range(300):
+            Span.at(text, "f", i, 1, i + 1)
+        return time.process_time() - t0
+
+    cost(short)
+    assert min(cost(long) for _ in range(2)) < 10 * min(cost(short) for _ in range(2)) + 0.05
+    assert Span.at(long, "f", 10, 1, 11).source_line == "x" * 240
