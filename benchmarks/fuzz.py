@@ -102,10 +102,14 @@ class Mutator:
 
     words: tuple[str, ...]
     nest: tuple[Callable[[int], str], ...] = ()
+    #: whether a line may be repeated thousands of times (:meth:`repeat`): for kinds whose
+    #: lines declare (rules, terms, CSV rows), not for lessons, where each line is work
+    many: bool = False
 
     def __call__(self, rng: random.Random, text: str) -> str:
+        ops = self.ops + (Mutator.repeat,) if self.many else self.ops
         for _ in range(rng.choice((1, 1, 1, 2, 3))):
-            text = rng.choice(self.ops)(self, rng, text)
+            text = rng.choice(ops)(self, rng, text)
         return text
 
     def _tokens(self, rng, text):
@@ -203,6 +207,17 @@ class Mutator:
             lines.insert(i, lines[j])
         return "".join(lines)
 
+    def repeat(self, rng, text):
+        """One line repeated up to 20,000 times: a file of many rules (readers that did
+        per-line work over the whole text were quadratic in it)."""
+        lines = text.splitlines(keepends=True)
+        if not lines:
+            return text
+        i = rng.randrange(len(lines))
+        line = lines[i] if lines[i].endswith(("\n", "\r")) else lines[i] + "\n"
+        n = min(self.size(rng, (10, 200, 2000), 20000), REPEATED // len(line))
+        return "".join(lines[:i] + [line] * max(n, 1) + lines[i + 1:])
+
     ops = (insert, delete, swap, duplicate, keyword, number, truncate, junk, whitespace,
            nesting, long_line, lines)
 
@@ -225,6 +240,24 @@ def yaml_mutator(words: tuple[str, ...]) -> Mutator:
                     alias_bomb,
                     lambda d: "b: &b {x: 1}\nc:\n  <<: *b\n  y: 2",
                     lambda d: "x: 1\nx: 2"))
+
+
+#: the most characters :meth:`Mutator.repeat` makes of one line (a long line repeated
+#: 20,000 times would be gigabytes; other large inputs are up to about 8 MB)
+REPEATED = 8_000_000
+
+#: a fuzzylite chained engine (rules testing outputs), which the readers restate
+CHAIN_FLL = "\n".join((
+    "Engine: chain", "InputVariable: x", "  range: 0 1", "  term: A Triangle 0 0.5 1",
+    "  term: B Triangle 0.5 1 1.5", *(line for i in range(3) for line in (
+        f"OutputVariable: y{i}", "  range: 0 1", "  aggregation: Maximum",
+        "  defuzzifier: Centroid 100", "  default: 0.5", "  term: A Triangle 0 0.5 1",
+        "  term: B Triangle 0.5 1 1.5")),
+    "RuleBlock: main", "  conjunction: Minimum", "  disjunction: Maximum",
+    "  implication: Minimum", "  activation: General", "  rule: if x is A then y0 is A",
+    "  rule: if x is B then y0 is B", "  rule: if y0 is A and x is B then y1 is A",
+    "  rule: if y0 is B or y0 is A then y1 is B", "  rule: if y1 is A and y0 is A then y2 is B",
+    "  rule: if y1 is very B then y2 is A with 0.5")) + "\n"
 
 
 RULE_WORDS = ("if", "then", "and", "or", "not", "is", "with", "use", "when", "end", "behavior",
@@ -627,7 +660,7 @@ class Kinds:
         fcl = _shipped("tests/data/interop/*.fcl")
         fis = _shipped("tests/data/interop/*.fis")
         fll = self.fll_seeds()
-        rule_mut = Mutator(RULE_WORDS, RULE_NEST)
+        rule_mut = Mutator(RULE_WORDS, RULE_NEST, many=True)
         ymut = yaml_mutator(("name", "inputs", "outputs", "terms", "universe", "default",
                              "triangle", "trapezoid", "gaussian", "robot", "obstacles",
                              "image", "resolution", "origin", "negate", "occupied_thresh",
@@ -639,12 +672,12 @@ class Kinds:
                         "Triangle", "Trapezoid", "range:", "default:", "rule:", "if", "then",
                         "is", "and", "(", ")", ";", ",", "NaN", "inf"),
                        (lambda d: "RULE 1 : IF " + "(" * d + "x IS a" + ")" * d + " THEN y IS b;",
-                        lambda d: "rule: if " + "not " * d + "x is a then y is b"))
+                        lambda d: "rule: if " + "not " * d + "x is a then y is b"), many=True)
         tmut = Mutator(RULE_WORDS + ("correct", "eval", "adapt", "epochs", "rate", "undo",
                                      "at", "s", "to", "simulate", "show", "save", "as", "help",
                                      "quit", "=", "1e400s", "-1s", "nan"), RULE_NEST[:3])
         cmut = Mutator(("road", "size", "position", ",", "\"", "\x00", "nan", "inf"),
-                       (lambda d: '"' + "x" * (200 * d) + '"',))
+                       (lambda d: '"' + "x" * (200 * d) + '"',), many=True)
         jmut = Mutator(("seq", "op", "rule", "examples", "undo", "of", "start", "text",
                         "behavior", "inputs", "targets", "null", "true", "{", "}", "[", "]",
                         ":", ",", '"', "adapt", "terms", "crisp"),
@@ -692,7 +725,8 @@ class Kinds:
         from mitos_cli.api import read_rulebase
         from mitos_cli.interop import fcl, fll
 
-        out = [("mitos.fll", fll.write_fll(read_rulebase(self.rb_dir / "mitos.rules")))]
+        out = [("mitos.fll", fll.write_fll(read_rulebase(self.rb_dir / "mitos.rules"))),
+               ("chain.fll", CHAIN_FLL)]
         for name, text in _shipped("tests/data/interop/*.fcl")[:2]:
             # a seed the writer cannot express is simply not a seed
             with contextlib.suppress(Exception):
