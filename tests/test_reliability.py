@@ -801,3 +801,49 @@ def test_a_told_rule_names_at_most_five_rules_with_its_condition():
         "  note: z1 says the same", "  conflict: z2 has the same condition but says speed is 20"]
     assert [r.label for r in session.rulebase.behavior("avoid_obstacle").rules][-9:] == \
         [f"z{k}" for k in range(9)]
+
+
+def test_looking_up_a_behavior_does_not_walk_them_all():
+    """`RuleBase.behavior` walked the behaviors: a file of 8,000 behaviors spent 3.7 s there."""
+    from mitos_cli.lang.model import Behavior, RuleBase
+
+    rb = RuleBase(None, (), tuple(Behavior(f"b{i}") for i in range(20_000)) + (Behavior("b0"),))
+    t0 = time.process_time()
+    assert all(rb.behavior(f"b{i}").name == f"b{i}" for i in range(20_000))
+    assert time.process_time() - t0 < 2.0           # walking them: 200 million steps
+    assert rb.behavior("b0") is rb.behaviors[0] and rb.behavior() is rb.behaviors[0]
+    with pytest.raises(MitosError, match="unknown behavior `b20000`"):
+        rb.behavior("b20000")
+
+
+def test_reading_many_fll_variables_is_linear():
+    """The input names were listed again for each variable (8,000 variables: 2.4 s)."""
+    from mitos_cli.interop.fll import parse_fll
+
+    def text(n):
+        out = ["Engine: many"] + [x for i in range(n) for x in (
+            f"InputVariable: x{i}", "  range: 0 1", "  term: A Triangle 0 0.5 1")]
+        out += ["OutputVariable: y", "  range: 0 1", "  term: A Triangle 0 0.5 1",
+                "RuleBlock: main"] + [f"  rule: if x{i} is A then y is A" for i in range(n)]
+        return "\n".join(out) + "\n"
+
+    small_text, large_text = text(750), text(6000)
+    _cost(parse_fll, small_text)
+    small = min(_cost(parse_fll, small_text) for _ in range(2))
+    assert _cost(parse_fll, large_text) < 8 * small * 2.5
+
+
+@pytest.mark.parametrize("names, line", [(["a", "b", "a"], 1), (["a", "b", "b"], 2)])
+def test_duplicate_obstacle_names_are_named_at_the_first(tmp_path, names, line):
+    """The check counts names once (a count per obstacle was N^2); it still names the first
+    obstacle whose name is used twice."""
+    from mitos_cli.sim.worldfile import parse_world
+
+    corridor = (ROOT / "worlds" / "corridor.yaml").read_text()
+    items = "".join(f"  - {{name: {n}, shape: circle, at: [{100 + 40 * i}, 20], radius: 2}}\n"
+                    for i, n in enumerate(names))
+    text = corridor.replace("obstacles:\n", "obstacles:\n" + items, 1)
+    first = text.splitlines().index("obstacles:") + 1
+    with pytest.raises(WorldError, match=f"two obstacles are named `{names[line - 1]}`") as info:
+        parse_world(text, str(tmp_path / "w.yaml"))
+    assert info.value.span.line == first + line

@@ -11,6 +11,7 @@ other direction. Anything a format names that MITOS cannot compute exactly is re
 from __future__ import annotations
 
 import math
+from collections import Counter
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -437,9 +438,9 @@ def assemble_blocks(path: str | None, variables: list[Variable],
     operators on the file; several (whose operators differ) give one behavior each, with its
     own operators, the first being the default. Chained outputs are restated first
     (:func:`.rewrite.unchain`), with a line in ``notes``."""
-    names = [v.name for v in variables]
+    counts = Counter(v.name for v in variables)     # a count per variable was N^2
     for v in variables:
-        if names.count(v.name) > 1:
+        if counts[v.name] > 1:
             raise FormatError(f"variable `{v.name}` is defined twice", span=v.span)
     if not any(v.role == "input" for v in variables):
         raise FormatError("the file defines no input variable", span=span)
