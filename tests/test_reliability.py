@@ -847,3 +847,24 @@ def test_duplicate_obstacle_names_are_named_at_the_first(tmp_path, names, line):
     with pytest.raises(WorldError, match=f"two obstacles are named `{names[line - 1]}`") as info:
         parse_world(text, str(tmp_path / "w.yaml"))
     assert info.value.span.line == first + line
+
+
+def test_repeated_term_names_are_renamed_in_linear_time():
+    """A `.fis` MF or an FLL term repeated 20,000 times (the seed-20261203 campaign's 16 slow
+    inputs): each repeat gathered every name again and tried every suffix an earlier repeat
+    had taken (60 s); the names are the same as before."""
+    from mitos_cli.interop.common import distinct_names
+    from mitos_cli.lang.terms import Term
+
+    terms = [Term("low", "triangle", (0.0, 1.0, 2.0)) for _ in range(4)] + \
+        [Term("low_2_2", "triangle", (0.0, 1.0, 2.0))]
+    notes: list[str] = []
+    assert [t.name for t in distinct_names(terms, "x", notes, "why")] == \
+        ["low", "low_2", "low_2_3", "low_2_4", "low_2_2"]
+    assert [t.name for t in distinct_names(terms[:3], "x", [], "why", keep_last=True)] == \
+        ["low_2_2", "low_2", "low"]
+    many = [Term("low", "triangle", (0.0, 1.0, 2.0))] * 20_000
+    t0 = time.process_time()
+    names = [t.name for t in distinct_names(many, "x", notes, "why")]
+    assert time.process_time() - t0 < 2.0
+    assert len(set(names)) == 20_000 and names[-1] == "low_2_19999"
