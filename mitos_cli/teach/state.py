@@ -54,15 +54,28 @@ def _replace_behavior(rb: RuleBase, b: Behavior) -> RuleBase:
     return dataclasses.replace(rb, behaviors=behaviors)
 
 
+#: the rules tuple :func:`_put_rule` made last and its labels' positions: the next rule put
+#: into that tuple finds its label without walking every rule (a lesson telling N rules was
+#: N^2 here). One entry, handed on to the new tuple; any other tuple builds its own.
+_positions: tuple[tuple[Rule, ...], dict[str, int]] = ((), {})
+
+
 def _put_rule(b: Behavior, rule: Rule) -> Behavior:
-    rules = list(b.rules)
-    for i, r in enumerate(rules):
-        if rule.label and r.label == rule.label:
-            rules[i] = rule
-            break
+    """``b`` with ``rule`` in place of the first rule with its label, or added at the end."""
+    global _positions
+    rules, positions = _positions
+    if rules is not b.rules:
+        positions = {}
+        for i, r in enumerate(b.rules):
+            positions.setdefault(r.label, i)
+    at = positions.get(rule.label) if rule.label else None
+    if at is None:
+        new = b.rules + (rule,)
+        positions.setdefault(rule.label, len(b.rules))
     else:
-        rules.append(rule)
-    return dataclasses.replace(b, rules=tuple(rules))
+        new = b.rules[:at] + (rule,) + b.rules[at + 1:]
+    _positions = (new, positions)
+    return dataclasses.replace(b, rules=new)
 
 
 def _set_params(rb: RuleBase, terms: dict) -> RuleBase:
