@@ -45,6 +45,10 @@ class State:
     examples: list[Example] = field(default_factory=list)
     frozen_terms: set = field(default_factory=set)      # (variable, term)
     released: set = field(default_factory=set)          # (variable, term)
+    # the rules tuple _put_rule made last and its labels' positions, so that the next rule put
+    # into that tuple finds its label without walking every rule (a lesson telling N rules was
+    # N^2): one entry, handed on to the new tuple; any other tuple builds its own
+    labels: tuple[tuple[Rule, ...], dict[str, int]] = ((), {})
 
 
 def _replace_behavior(rb: RuleBase, b: Behavior) -> RuleBase:
@@ -54,16 +58,10 @@ def _replace_behavior(rb: RuleBase, b: Behavior) -> RuleBase:
     return dataclasses.replace(rb, behaviors=behaviors)
 
 
-#: the rules tuple :func:`_put_rule` made last and its labels' positions: the next rule put
-#: into that tuple finds its label without walking every rule (a lesson telling N rules was
-#: N^2 here). One entry, handed on to the new tuple; any other tuple builds its own.
-_positions: tuple[tuple[Rule, ...], dict[str, int]] = ((), {})
-
-
-def _put_rule(b: Behavior, rule: Rule) -> Behavior:
-    """``b`` with ``rule`` in place of the first rule with its label, or added at the end."""
-    global _positions
-    rules, positions = _positions
+def _put_rule(state: State, b: Behavior, rule: Rule) -> Behavior:
+    """``b`` with ``rule`` in place of the first rule with its label, or added at the end
+    (``state.labels`` remembers the labels' positions in the tuple it makes)."""
+    rules, positions = state.labels
     if rules is not b.rules:
         positions = {}
         for i, r in enumerate(b.rules):
@@ -74,7 +72,7 @@ def _put_rule(b: Behavior, rule: Rule) -> Behavior:
         positions.setdefault(rule.label, len(b.rules))
     else:
         new = b.rules[:at] + (rule,) + b.rules[at + 1:]
-    _positions = (new, positions)
+    state.labels = (new, positions)
     return dataclasses.replace(b, rules=new)
 
 
@@ -104,7 +102,8 @@ def apply(state: State, entry: dict) -> None:
     rb = state.rulebase
     if op == "rule":
         rule = parse_rule(entry["text"])
-        state.rulebase = _replace_behavior(rb, _put_rule(rb.behavior(entry["behavior"]), rule))
+        state.rulebase = _replace_behavior(rb, _put_rule(state, rb.behavior(entry["behavior"]),
+                                                         rule))
     elif op == "behavior":
         state.rulebase = _replace_behavior(rb, Behavior(entry["name"]))
         state.block = entry["name"]
