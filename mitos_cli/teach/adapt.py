@@ -1031,14 +1031,14 @@ def adapt(compiled: CompiledRuleBase, X: np.ndarray, targets: np.ndarray, *, epo
             values = candidate
             Q, grad = gradient(p, values, X, targets)
             history.append(Q)
-            if history[-2] - Q <= 1e-9 * history[0]:
-                converged = True                     # no longer worth a step
-                break
-            step = min(1.0, step * 2.0)
             if on_epoch is not None:
                 on_epoch(epoch, Q)
             if on_values is not None:
                 on_values(values)
+            if history[-2] - Q <= 1e-9 * history[0]:
+                converged = True                     # no longer worth a step
+                break
+            step = min(1.0, step * 2.0)
     except KeyboardInterrupt:
         interrupted = True            # keep what the completed epochs learned
     q_learned = history[-1]
