@@ -1111,7 +1111,8 @@ def _round(p: Parameters, values: np.ndarray, X: np.ndarray, targets: np.ndarray
         return p.values.copy(), q_start
     for extra in range(3):
         decimals = p.decimals + extra
-        out = np.where(changed, np.round(values * 10.0 ** decimals) / 10.0 ** decimals, values)
+        out = np.where(changed, np.round(values * 10.0 ** decimals) / 10.0 ** decimals,
+                       values) + 0.0             # + 0.0: a knot rounded to -0.0 is 0
         for dep, others, coef in p.dependents:        # symmetric triangles stay symmetric
             out[dep] = round(float(coef @ out[others]), int(decimals[dep]))
         if feasible(p, out):
