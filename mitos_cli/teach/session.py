@@ -126,6 +126,11 @@ class Session:
                  out: Callable[[str], None] | None = None,
                  progress: Callable | None = None) -> None:
         self.rules_path = Path(rules_path)
+        if not self.rules_path.exists():
+            # as `mitos teach` and read_rulebase: a packaged rule base by its path or name
+            from ..resources import resolve
+
+            self.rules_path = resolve("rulebases", rules_path, ".rules") or self.rules_path
         self.original = load_rules_file(self.rules_path)
         self.journal = journal if journal is not None else MemoryJournal()
         self.save_as = Path(save_as) if save_as is not None else None

@@ -142,12 +142,37 @@ def apply(state: State, entry: dict) -> None:
         state.rulebase = _set_flags(state.rulebase, entry["terms"], frozen=False)
         state.rulebase = _set_flags(state.rulebase, entry.get("holds", []), held=False)
     elif op == "adapt":
-        rb = _set_params(rb, entry["terms"])
-        state.rulebase = _set_crisp(rb, entry.get("crisp", []))
+        learned = _set_params(rb, entry["terms"])
+        state.rulebase = _keep_holds(rb, _set_crisp(learned, entry.get("crisp", [])))
     else:                                        # pragma: no cover - journal from the future
         raise LessonError(f"the journal holds an unknown change `{op}`")
 
 
+
+
+def _keep_holds(before: RuleBase, after: RuleBase) -> RuleBase:
+    """``after`` with each centre term held in ``before`` (by the symmetry of its neighbours)
+    written with its point (``held_at``) where ``after``'s terms are no longer symmetric
+    about it: the hold outlives the symmetry adaptation moved, in the next ``adapt`` and in
+    the saved files (``held: 90``), and ``mitos check`` can tell it moved."""
+    from ..lang.interpretability import TOLERANCE, held_term
+
+    pinned: dict[tuple[str, str], float] = {}
+    for old, new in zip(variables(before), variables(after)):
+        held = held_term(old)
+        if held is None or not held[0].held or held[0].held_at is not None:
+            continue
+        still = held_term(new)
+        tol = TOLERANCE * (old.universe[1] - old.universe[0])
+        if still is None or still[0].name != held[0].name or abs(still[1] - held[1]) > tol:
+            pinned[(old.name, held[0].name)] = float(held[1])
+    if not pinned:
+        return after
+    termsets = tuple(dataclasses.replace(ts, variables=tuple(
+        v.with_terms(tuple(dataclasses.replace(t, held_at=pinned[(v.name, t.name)])
+                           if (v.name, t.name) in pinned else t for t in v.terms))
+        for v in ts.variables)) for ts in after.termsets)
+    return dataclasses.replace(after, termsets=termsets)
 
 
 def _set_flags(rb: RuleBase, refs: list, frozen: bool | None = None,
