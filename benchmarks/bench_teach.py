@@ -21,13 +21,15 @@ c. the shipped lesson ``rulebases/lessons/wider-turn.lesson`` end to end (simula
 d. the cost of the interpretability constraints (held centre terms, crisp values apart,
    coverage and distinguishability checked on every trial step): one constrained epoch against
    one unconstrained epoch (``adapt(..., constrained=False)``: order and bounds only), at 1,000
-   examples, per epoch actually run, the fastest of the repeats (aim: < 1.2x); and, robust to
-   other load, the checks counted per epoch times the fastest check (a tied Ruspini partition,
-   as all of the packaged ones are, holds by construction and is not measured);
+   examples, each epoch timed on its own, the median of a run, the least of alternated
+   repeats (aim: < 1.2x), with the trial steps per epoch of each; and, robust to other load,
+   the checks counted per epoch times the fastest check (a tied Ruspini partition, as all of
+   the packaged ones are, holds by construction and is not measured);
 e. what the constraints cost in fit: ``Q`` after ``--epochs`` (500) epochs of the lesson's
    examples, constrained against unconstrained (aim: within 10 %); and where the cost lies:
    the same run with every centre term released (``unfrozen``: order, coverage and
-   distinctness only), and with only ``heading.AHEAD`` or only ``steering.ST`` released.
+   distinctness only), with only ``heading.AHEAD`` or only ``steering.ST`` released, and with
+   both. ``--epochs 20000`` runs each to convergence (every run stops earlier).
 
 The peers are checked to agree with the analytic gradient before they are timed. Times are
 the median of repeats after a warm-up. Figures go to stdout; nothing is written to disk.
@@ -36,6 +38,7 @@ the median of repeats after a warm-up. Figures go to stdout; nothing is written 
 from __future__ import annotations
 
 import argparse
+import math
 import os
 import platform
 import statistics
@@ -138,7 +141,7 @@ def main() -> None:
     t21 = median_time(lambda: adapt(compiled, X, T, epochs=21), 3)
     t_epoch = (t21 - t1) / 20
     t_lesson = lesson_time()
-    cost = {flag: epoch_time(compiled, X, T, flag, max(3, repeats // 5)) for flag in (True, False)}
+    cost, trials = epoch_time(compiled, X, T, max(3, repeats // 3))
     # the same rule base as a Mamdani behavior (min / max / centroid, resolution 101): central
     # differences, 2 batch evaluations per free number
     mamdani = compile_rulebase(compiled.rulebase, compiled.behavior,
@@ -169,8 +172,10 @@ def main() -> None:
         print("wider-turn lesson: worlds/figure4.yaml or the lesson is missing (skipped)")
     else:
         print(f"{'wider-turn lesson end to end (no save)':<48}{t_lesson:>10.2f} s")
-    print(f"{'one epoch, constrained (1,000 examples)':<48}{cost[True] * 1e3:>10.2f} ms")
-    print(f"{'one epoch, unconstrained (order, bounds)':<48}{cost[False] * 1e3:>10.2f} ms")
+    print(f"{'one epoch, constrained (1,000 examples)':<48}{cost[True] * 1e3:>10.2f} ms   "
+          f"({trials[True]:.2f} trial steps per epoch)")
+    print(f"{'one epoch, unconstrained (order, bounds)':<48}{cost[False] * 1e3:>10.2f} ms   "
+          f"({trials[False]:.2f} trial steps per epoch)")
     print(f"{'  constraint cost per epoch':<48}{cost[True] / cost[False]:>12.2f}x   (aim < 1.2x)")
     work, calls = constraint_work(compiled, X, T)
     print(f"{'  constraint checks per epoch (counted)':<48}{work * 1e3:>10.2f} ms   "
@@ -178,25 +183,48 @@ def main() -> None:
     fit = lesson_fit(args.epochs)
     if fit is not None:
         (qc, ec), (qu, eu), released = fit
-        print(f"lesson examples, {args.epochs} epochs: Q constrained {qc:.6g} ({ec} epochs), "
-              f"unconstrained {qu:.6g} ({eu} epochs): {qc / qu:.2f}x   (aim <= 1.10x)")
-        for what, q in released:
-            print(f"  constrained, {what + ' released:':<40}Q {q:>10.6g}  {q / qu:.2f}x")
+        print(f"lesson examples, {args.epochs} epochs: Q constrained {qc:.6g} ({ran(ec)}), "
+              f"unconstrained {qu:.6g} ({ran(eu)}): {qc / qu:.2f}x   (aim <= 1.10x)")
+        for what, (q, e) in released:
+            print(f"  constrained, {what + ' released:':<44}Q {q:>10.6g}  {q / qu:.2f}x"
+                  f"   ({ran(e)})")
 
 
-def epoch_time(compiled, X, T, constrained: bool, repeats: int) -> float:
-    """Seconds per epoch actually run: (epochs=21 - epochs=1) / the epochs between them, each
-    the fastest of ``repeats`` (the least disturbed by other load on a shared machine)."""
-    def timed(epochs):
-        times, runs = [], 0
-        for _ in range(repeats):
-            t0 = time.perf_counter()
-            r = adapt(compiled, X, T, epochs=epochs, constrained=constrained)
-            times.append(time.perf_counter() - t0)
-            runs = len(r.history) - 1 - r.rounded
-        return min(times), runs
-    (t1, n1), (t21, n21) = timed(1), timed(21)
-    return (t21 - t1) / max(n21 - n1, 1)
+def ran(epochs: tuple[int, bool]) -> str:
+    """``412 epochs, converged`` or ``500 epochs``."""
+    n, converged = epochs
+    return f"{n} epochs" + (", converged" if converged else "")
+
+
+def epoch_time(compiled, X, T, repeats: int, epochs: int = 41) -> tuple[dict, dict]:
+    """Seconds per epoch, constrained (``True``) and unconstrained (``False``): each epoch timed
+    on its own (from one epoch's end to the next's, by ``on_epoch``: the direction, the trial
+    steps and the gradient), the median over an ``epochs`` run, the two runs alternated
+    ``repeats`` times and the least median kept (the least disturbed by other load on a shared
+    machine); and the trial steps (``Q`` evaluations) per epoch of each run, which a
+    constraint could raise by cutting steps."""
+    from mitos_cli.teach import adapt as module
+
+    best = {True: math.inf, False: math.inf}
+    trials = {}
+    real_loss = module.loss
+    for _ in range(repeats):
+        for constrained in (True, False):
+            stamps, calls = [], [0]
+
+            def counted(*a, **k):
+                calls[0] += 1
+                return real_loss(*a, **k)
+
+            module.loss = counted
+            try:
+                adapt(compiled, X, T, epochs=epochs, constrained=constrained,
+                      on_epoch=lambda e, q: stamps.append(time.perf_counter()))
+            finally:
+                module.loss = real_loss
+            best[constrained] = min(best[constrained], statistics.median(np.diff(stamps)))
+            trials[constrained] = (calls[0] - 1) / len(stamps)    # less the rounding's Q
+    return best, trials
 
 
 def constraint_work(compiled, X, T) -> tuple[float, float]:
@@ -253,17 +281,19 @@ def lesson_fit(epochs: int):
         session.run(line)
     compiled = session.compiled()
     X, T = session.training_set(compiled)
-    out: list = []
-    for constrained in (True, False):
-        r = adapt(compiled, X, T, epochs=epochs, rate=0.5, constrained=constrained)
-        out.append((r.q_after, len(r.history) - 1 - r.rounded))
+    def run(**kw):
+        r = adapt(compiled, X, T, epochs=epochs, rate=0.5, **kw)
+        return r.q_after, (len(r.history) - 1 - r.rounded, r.converged)
+
+    out: list = [run(constrained=True), run(constrained=False)]
     held = [(v, t) for v, t, _ in parameterise(compiled).held]
     released = []
     for what, names in (("every centre term", held), ("heading.AHEAD", [("heading", "AHEAD")]),
-                        ("steering.ST", [("steering", "ST")])):
-        p = parameterise(compiled, released=frozenset(names))
-        released.append((what, adapt(compiled, X, T, epochs=epochs, rate=0.5,
-                                     parameters=p).q_after))
+                        ("steering.ST", [("steering", "ST")]),
+                        ("heading.AHEAD and steering.ST",
+                         [("heading", "AHEAD"), ("steering", "ST")])):
+        released.append((what, run(parameters=parameterise(compiled,
+                                                            released=frozenset(names)))))
     out.append(released)
     return out
 

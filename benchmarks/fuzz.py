@@ -4,6 +4,7 @@ Run from the repository root (one command each)::
 
     python benchmarks/fuzz.py --quick                       # a short campaign (150 per kind)
     python benchmarks/fuzz.py --per-format 9000 --out fuzz-found      # 100,950 inputs
+    python benchmarks/fuzz.py --per-format 9000 --jobs 2 --out fuzz-found  # on 2 cores
     python benchmarks/fuzz.py --per-format 9000 --shard 0/4           # a quarter of them
     python benchmarks/fuzz.py --via cli --per-format 1000   # through `mitos`'s main, in process
     python benchmarks/fuzz.py --via subprocess --per-format 30        # spot checks
@@ -101,10 +102,14 @@ class Mutator:
 
     words: tuple[str, ...]
     nest: tuple[Callable[[int], str], ...] = ()
+    #: whether a line may be repeated thousands of times (:meth:`repeat`): for kinds whose
+    #: lines declare (rules, terms, CSV rows), not for lessons, where each line is work
+    many: bool = False
 
     def __call__(self, rng: random.Random, text: str) -> str:
+        ops = self.ops + (Mutator.repeat,) if self.many else self.ops
         for _ in range(rng.choice((1, 1, 1, 2, 3))):
-            text = rng.choice(self.ops)(self, rng, text)
+            text = rng.choice(ops)(self, rng, text)
         return text
 
     def _tokens(self, rng, text):
@@ -202,6 +207,17 @@ class Mutator:
             lines.insert(i, lines[j])
         return "".join(lines)
 
+    def repeat(self, rng, text):
+        """One line repeated up to 20,000 times: a file of many rules (readers that did
+        per-line work over the whole text were quadratic in it)."""
+        lines = text.splitlines(keepends=True)
+        if not lines:
+            return text
+        i = rng.randrange(len(lines))
+        line = lines[i] if lines[i].endswith(("\n", "\r")) else lines[i] + "\n"
+        n = min(self.size(rng, (10, 200, 2000), 20000), REPEATED // len(line))
+        return "".join(lines[:i] + [line] * max(n, 1) + lines[i + 1:])
+
     ops = (insert, delete, swap, duplicate, keyword, number, truncate, junk, whitespace,
            nesting, long_line, lines)
 
@@ -224,6 +240,24 @@ def yaml_mutator(words: tuple[str, ...]) -> Mutator:
                     alias_bomb,
                     lambda d: "b: &b {x: 1}\nc:\n  <<: *b\n  y: 2",
                     lambda d: "x: 1\nx: 2"))
+
+
+#: the most characters :meth:`Mutator.repeat` makes of one line (a long line repeated
+#: 20,000 times would be gigabytes; other large inputs are up to about 8 MB)
+REPEATED = 8_000_000
+
+#: a fuzzylite chained engine (rules testing outputs), which the readers restate
+CHAIN_FLL = "\n".join((
+    "Engine: chain", "InputVariable: x", "  range: 0 1", "  term: A Triangle 0 0.5 1",
+    "  term: B Triangle 0.5 1 1.5", *(line for i in range(3) for line in (
+        f"OutputVariable: y{i}", "  range: 0 1", "  aggregation: Maximum",
+        "  defuzzifier: Centroid 100", "  default: 0.5", "  term: A Triangle 0 0.5 1",
+        "  term: B Triangle 0.5 1 1.5")),
+    "RuleBlock: main", "  conjunction: Minimum", "  disjunction: Maximum",
+    "  implication: Minimum", "  activation: General", "  rule: if x is A then y0 is A",
+    "  rule: if x is B then y0 is B", "  rule: if y0 is A and x is B then y1 is A",
+    "  rule: if y0 is B or y0 is A then y1 is B", "  rule: if y1 is A and y0 is A then y2 is B",
+    "  rule: if y1 is very B then y2 is A with 0.5")) + "\n"
 
 
 RULE_WORDS = ("if", "then", "and", "or", "not", "is", "with", "use", "when", "end", "behavior",
@@ -626,7 +660,7 @@ class Kinds:
         fcl = _shipped("tests/data/interop/*.fcl")
         fis = _shipped("tests/data/interop/*.fis")
         fll = self.fll_seeds()
-        rule_mut = Mutator(RULE_WORDS, RULE_NEST)
+        rule_mut = Mutator(RULE_WORDS, RULE_NEST, many=True)
         ymut = yaml_mutator(("name", "inputs", "outputs", "terms", "universe", "default",
                              "triangle", "trapezoid", "gaussian", "robot", "obstacles",
                              "image", "resolution", "origin", "negate", "occupied_thresh",
@@ -638,12 +672,12 @@ class Kinds:
                         "Triangle", "Trapezoid", "range:", "default:", "rule:", "if", "then",
                         "is", "and", "(", ")", ";", ",", "NaN", "inf"),
                        (lambda d: "RULE 1 : IF " + "(" * d + "x IS a" + ")" * d + " THEN y IS b;",
-                        lambda d: "rule: if " + "not " * d + "x is a then y is b"))
+                        lambda d: "rule: if " + "not " * d + "x is a then y is b"), many=True)
         tmut = Mutator(RULE_WORDS + ("correct", "eval", "adapt", "epochs", "rate", "undo",
                                      "at", "s", "to", "simulate", "show", "save", "as", "help",
                                      "quit", "=", "1e400s", "-1s", "nan"), RULE_NEST[:3])
         cmut = Mutator(("road", "size", "position", ",", "\"", "\x00", "nan", "inf"),
-                       (lambda d: '"' + "x" * (200 * d) + '"',))
+                       (lambda d: '"' + "x" * (200 * d) + '"',), many=True)
         jmut = Mutator(("seq", "op", "rule", "examples", "undo", "of", "start", "text",
                         "behavior", "inputs", "targets", "null", "true", "{", "}", "[", "]",
                         ":", ",", '"', "adapt", "terms", "crisp"),
@@ -691,7 +725,8 @@ class Kinds:
         from mitos_cli.api import read_rulebase
         from mitos_cli.interop import fcl, fll
 
-        out = [("mitos.fll", fll.write_fll(read_rulebase(self.rb_dir / "mitos.rules")))]
+        out = [("mitos.fll", fll.write_fll(read_rulebase(self.rb_dir / "mitos.rules"))),
+               ("chain.fll", CHAIN_FLL)]
         for name, text in _shipped("tests/data/interop/*.fcl")[:2]:
             # a seed the writer cannot express is simply not a seed
             with contextlib.suppress(Exception):
@@ -1001,8 +1036,10 @@ def campaign(per_format: int, out: Path | None, limit: float, slow: float, only:
                     _count(kind, current, *result, seen, out, seed, work, limit, slow, log)
                 proc.join()
             kind.seconds = time.perf_counter() - t0
+            LOADS.append(os.getloadavg()[0])
             log(f"{kind.name}: {kind.tried} inputs in {kind.seconds:.1f} s "
-                + ", ".join(f"{k} {v}" for k, v in kind.counts.items() if v))
+                + ", ".join(f"{k} {v}" for k, v in kind.counts.items() if v)
+                + f" (load average {LOADS[-1]:.1f})")
         return kinds
     finally:
         os.chdir(cwd)
@@ -1037,13 +1074,15 @@ def _write(out: Path, kind: Kind, data, want, scratch: Path, limit: float, slow:
     stem = re.sub(r"\W+", "-", kind.name).strip("-")
     ext = ".pgm" if isinstance(small, bytes) else kind.ext
     target = out / f"{stem}-{tag}{ext}"
-    if isinstance(small, bytes):
-        target.write_bytes(small)
-    else:
-        target.write_text(small, encoding="utf-8", errors="surrogatepass")
-    target.with_suffix(target.suffix + ".json").write_text(json.dumps(
-        {"kind": kind.name, "outcome": want[0], "signature": want[1],
-         "bytes": len(small)}, indent=1) + "\n")
+    raw = small if isinstance(small, bytes) else small.encode("utf-8", "surrogatepass")
+    meta = json.dumps({"kind": kind.name, "outcome": want[0], "signature": want[1],
+                       "bytes": len(small)}, indent=1) + "\n"
+    # whole files only: the shards of `--jobs` may find the same signature at once
+    for path, content in ((target, raw), (target.with_suffix(target.suffix + ".json"),
+                                          meta.encode())):
+        tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+        tmp.write_bytes(content)
+        os.replace(tmp, path)
 
 
 def table(kinds: list[Kind]) -> str:
@@ -1075,6 +1114,85 @@ def _large(large: list[tuple[int, float]]) -> str:
     return f"{len(large):,}, {biggest / 1024:,.0f} KB, {per_kb * 1000:.2f}"
 
 
+#: the 1-minute load average at the start and at each kind's end (the table's "load")
+LOADS: list[float] = []
+#: shards of ``--jobs`` that died without their table (the campaign then fails)
+LOST: list[int] = []
+
+
+def shard_of(text: str) -> tuple[int, int]:
+    """``K/N`` with 0 <= K < N (``2/2`` would silently skip input 0 and run half of shard 0)."""
+    k, sep, n = text.partition("/")
+    try:
+        pair = (int(k), int(n) if sep else 1)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected K/N, found {text!r}") from None
+    if not 0 <= pair[0] < pair[1]:
+        raise argparse.ArgumentTypeError(f"expected K/N with 0 <= K < N, found {text!r} "
+                                         f"(shards are numbered from 0)")
+    return pair
+
+
+def summary(kinds: list[Kind]) -> list[dict]:
+    """What a shard sends back to ``--jobs``: each kind's counts and times."""
+    return [{"name": k.name, "tried": k.tried, "counts": k.counts, "cpu": k.cpu,
+             "seconds": k.seconds, "large": k.large} for k in kinds]
+
+
+def merged(parts: list[list[dict]]) -> list[Kind]:
+    """The shards' summaries as one campaign's kinds (in the kinds' order)."""
+    kinds: dict[str, Kind] = {}
+    for part in parts:
+        for d in part:
+            k = kinds.setdefault(d["name"], Kind(d["name"], [], None, None))
+            k.tried += d["tried"]
+            k.cpu += d["cpu"]
+            k.seconds = max(k.seconds, d["seconds"])
+            k.large.extend(tuple(x) for x in d["large"])
+            for o, v in d["counts"].items():
+                k.counts[o] += v
+    return list(kinds.values())
+
+
+def _shard(conn, k: int, n: int, args) -> None:
+    """One shard of ``--jobs``: its campaign, its log lines prefixed with ``[K/N]``."""
+    def log(line: str) -> None:
+        print(f"[{k}/{n}] {line}", flush=True)
+
+    kinds = campaign(args.n, args.out, args.limit, args.slow, args.only, args.seed, log=log,
+                     via=args.via, shard=(k, n))
+    conn.send((summary(kinds), LOADS))
+    conn.close()
+
+
+def run_jobs(args) -> list[Kind]:
+    """``--jobs N``: shards 0/N .. N-1/N in N processes at once, their tables summed."""
+    import multiprocessing as mp
+
+    ctx = mp.get_context("fork")
+    procs = []
+    for k in range(args.jobs):
+        parent, child = ctx.Pipe(duplex=False)
+        proc = ctx.Process(target=_shard, args=(child, k, args.jobs, args))
+        proc.start()
+        child.close()
+        procs.append((proc, parent))
+    parts = []
+    for k, (proc, parent) in enumerate(procs):
+        try:
+            part, loads = parent.recv()
+        except EOFError:                 # the shard died: the table says it is short
+            proc.join()
+            print(f"[{k}/{args.jobs}] ended without its table (exit {proc.exitcode}); the "
+                  "table below lacks its inputs", flush=True)
+            LOST.append(k)
+            continue
+        parts.append(part)
+        LOADS.extend(loads)
+        proc.join()
+    return merged(parts)
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--per-format", type=int, default=2000, help="inputs per input kind")
@@ -1086,27 +1204,46 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--limit", type=float, default=10.0, help="per-input time limit, seconds")
     ap.add_argument("--slow", type=float, default=5.0, help="slower than this counts as slow")
     ap.add_argument("--seed", type=int, default=SEED)
-    ap.add_argument("--shard", default="0/1", metavar="K/N",
-                    help="run only inputs K, K + N, K + 2N, ... of each kind (N campaigns in "
-                         "parallel cover them all)")
+    ap.add_argument("--shard", type=shard_of, default=(0, 1), metavar="K/N",
+                    help="run only inputs K, K + N, K + 2N, ... of each kind, 0 <= K < N (N "
+                         "campaigns in parallel cover them all)")
+    ap.add_argument("--jobs", type=int, default=1, metavar="N",
+                    help="run the N shards 0/N .. N-1/N at once in N processes and print their "
+                         "summed table (one worker each: N cores)")
     ap.add_argument("--via", choices=("reader", "cli", "subprocess"), default="reader",
                     help="reader: the library's readers; cli: `mitos`'s main in this process "
                          "(stdout and stderr captured); subprocess: `python -m mitos_cli`, for "
                          "spot checks")
     args = ap.parse_args(argv)
-    n = 150 if args.quick else args.per_format
+    if args.jobs < 1:
+        ap.error("--jobs must be at least 1")
+    if args.jobs > 1 and args.shard != (0, 1):
+        ap.error("--jobs runs every shard itself: give --jobs or --shard, not both")
+    args.n = 150 if args.quick else args.per_format
     t0 = time.perf_counter()
-    k, _, of = args.shard.partition("/")
-    kinds = campaign(n, args.out, args.limit, args.slow, args.only, args.seed, via=args.via,
-                     shard=(int(k), int(of or 1)))
+    LOADS.append(os.getloadavg()[0])
+    if args.jobs > 1:
+        kinds = run_jobs(args)
+        shard = f"{args.jobs} shards at once"
+    else:
+        kinds = campaign(args.n, args.out, args.limit, args.slow, args.only, args.seed,
+                         via=args.via, shard=args.shard)
+        shard = "shard {}/{}".format(*args.shard)
+    LOADS.append(os.getloadavg()[0])
+    wall = time.perf_counter() - t0
+    own = resource.getrusage(resource.RUSAGE_SELF)
+    children = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = own.ru_utime + own.ru_stime + children.ru_utime + children.ru_stime
     print()
     print(table(kinds))
-    print(f"\n{sum(k.tried for k in kinds):,} inputs in {time.perf_counter() - t0:.0f} s "
-          f"(seed {args.seed}, via {args.via}, shard {args.shard}, limit {args.limit:g} s, slow above "
-          f"{args.slow:g} s; load average {os.getloadavg()[0]:.1f})")
-    bad = sum(k.counts[o] for k in kinds for o in BAD)
-    return 1 if bad else 0
-
+    bad = {o: sum(k.counts[o] for k in kinds) for o in BAD}
+    print(f"\n{sum(k.tried for k in kinds):,} inputs in {wall:.0f} s of wall time, "
+          f"{cpu:.0f} CPU s in all ({sum(k.cpu for k in kinds):.0f} inside the inputs); "
+          + ", ".join(f"{o} {v}" for o, v in bad.items())
+          + f"\n(seed {args.seed}, via {args.via}, {shard}, limit {args.limit:g} s, slow above "
+          f"{args.slow:g} s; 1-minute load average {min(LOADS):.1f} to {max(LOADS):.1f} at the "
+          f"start, the kinds' ends and the end)")
+    return 1 if any(bad.values()) or LOST else 0
 
 if __name__ == "__main__":
     sys.exit(main())

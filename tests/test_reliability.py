@@ -334,6 +334,22 @@ def test_fuzz_kind_has_no_foreign_exceptions(kinds, name):
     assert not bad
 
 
+def test_campaign_shards_are_numbered_from_zero_and_sum_to_one_campaign(kinds):
+    """`--shard 2/2` used to run inputs 2, 4, ... (input 0 of every kind skipped): refused;
+    `--jobs` sums its shards' tables."""
+    import argparse
+
+    fuzz, _, _ = kinds
+    assert fuzz.shard_of("1/2") == (1, 2) and fuzz.shard_of("0") == (0, 1)
+    for bad in ("2/2", "-1/2", "x", "1/0"):
+        with pytest.raises(argparse.ArgumentTypeError):
+            fuzz.shard_of(bad)
+    part = [{"name": "FLL", "tried": 3, "counts": dict.fromkeys(fuzz.OUTCOMES, 1), "cpu": 0.5,
+             "seconds": 2.0, "large": [(70000, 0.1)]}]
+    (fll,) = fuzz.merged([part, part])
+    assert (fll.tried, fll.counts["foreign"], fll.cpu, len(fll.large)) == (6, 2, 1.0, 2)
+
+
 def test_cli_route_classifies_what_the_user_sees(kinds, tmp_path):
     """``--via cli``: the CLI's main in this process, its exit code and stderr classified."""
     fuzz, _, _ = kinds
@@ -616,3 +632,239 @@ def test_a_hash_in_a_batch_row_is_a_bad_value_not_a_comment(tmp_path):
             with pytest.raises(InputError) as err:
                 read_batch(path.read_text(), str(path), ("position", "road", "size"))
         assert (err.value.span.line, err.value.span.column) == where
+
+
+@pytest.mark.parametrize("line, words", [
+    # the campaign's minimal reproducer (seed 20261203): `op` is an array
+    (b'{"seq":1,"opes":"/","op":[{"ts":{"st":10},"soe":"correct"}]}', "is a JSON array"),
+    (b'{"seq":1,"op":{"start":1}}', "is a JSON object"),
+    (b'{"seq":1,"op":5}', "is 5, not a string"),
+    (b'{"seq":1}', "is missing"),
+    (b'{"seq":[' + b"1," * 50000 + b'1],"op":"start"}', "found a JSON array"),
+])
+def test_a_journal_change_name_that_is_not_a_string_is_named(tmp_path, line, words):
+    """`"op": [...]` (an unhashable value) was a TypeError in `journal._problem`; the message
+    also quotes a long value only by its JSON type."""
+    from mitos_cli.teach.journal import Journal
+
+    d = tmp_path / "s"
+    d.mkdir()
+    (d / "journal.jsonl").write_bytes(line + b"\n" + b'{"seq": 2, "op": "save"}\n')
+    with pytest.raises(LessonError, match="damaged") as info:
+        Journal.open(d)
+    assert words in info.value.message and len(info.value.message) < 200
+    assert info.value.span.path == str(d / "journal.jsonl") and info.value.span.line == 1
+
+
+# ---- large files: time in proportion (found by timing growing files after the seed-20261203 campaign)
+
+def _chain_fll(outputs: int, condition: str) -> str:
+    """A fuzzylite chained engine: `y0` from the input, each `yI` from `y(I-1)`."""
+    lines = ["Engine: chain", "InputVariable: x", "  range: 0 1", "  term: A Triangle 0 0.5 1"]
+    for i in range(outputs):
+        lines += [f"OutputVariable: y{i}", "  range: 0 1", "  aggregation: Maximum",
+                  "  defuzzifier: Centroid 100", "  default: 0.5", "  term: A Triangle 0 0.5 1"]
+    lines += ["RuleBlock: main", "  conjunction: Minimum", "  disjunction: Maximum",
+              "  implication: Minimum", "  activation: General", "  rule: if x is A then y0 is A"]
+    lines += [f"  rule: if {condition.format(p=f'y{i - 1}')} then y{i} is A"
+              for i in range(1, outputs)]
+    return "\n".join(lines) + "\n"
+
+
+def test_a_chain_that_doubles_at_each_step_is_refused_not_written_out():
+    """Each rule testing the previous output twice: 2^k propositions written out (22 rules, a
+    5 KB file, took 6 s; 30 rules would take hours). Refused at the test crossing a million."""
+    from mitos_cli.errors import FormatError
+    from mitos_cli.interop.fll import parse_fll
+
+    t0 = time.process_time()
+    with pytest.raises(FormatError, match="more than 1,000,000 propositions") as info:
+        parse_fll(_chain_fll(22, "{p} is A and {p} is A"), "chain.fll")
+    assert time.process_time() - t0 < 5
+    assert info.value.span.source_line.strip() == "rule: if y18 is A and y18 is A then y19 is A"
+    assert info.value.span.column == 25         # the test of `y18` that crosses the bound
+    parse_fll(_chain_fll(12, "{p} is A and {p} is A"), "chain.fll")   # 2^12: read
+
+
+def test_a_chain_that_nests_deeper_than_rules_may_is_refused():
+    """A chain of 300 rules each adding a level: the restated condition nested 300 deep (1,000
+    was a RecursionError in `resolve.check_expr`)."""
+    from mitos_cli.errors import FormatError
+    from mitos_cli.interop.fll import parse_fll
+
+    for outputs in (300, 1000):
+        with pytest.raises(FormatError, match="nests 101 deep, more than 100") as info:
+            parse_fll(_chain_fll(outputs, "{p} is A and x is A"), "chain.fll")
+        assert "then y100 is A" in info.value.span.source_line
+    parse_fll(_chain_fll(60, "{p} is A and x is A"), "chain.fll")
+
+
+def _cost(read, text: str) -> float:
+    t0 = time.process_time()
+    read(text)
+    return time.process_time() - t0
+
+
+@pytest.mark.parametrize("fmt", ["fll", "fis", "fcl"])
+def test_reading_a_foreign_file_is_linear_in_its_rules(fmt):
+    """Every line's (FLL, `.fis`) or node's (FCL) span split the whole text again (8,000 FLL
+    rules took 50 s); a rule WITH a weight looked at every rule (8,000 FCL rules, 2 minutes)."""
+    from mitos_cli.api import read_rulebase
+    from mitos_cli.interop import fcl, fis, fll
+
+    interop = ROOT / "tests" / "data" / "interop"
+    if fmt == "fll":
+        seed = fll.write_fll(read_rulebase(ROOT / "rulebases" / "mitos.rules"))
+        rule = next(x for x in seed.splitlines() if x.strip().startswith("rule:")) + "\n"
+
+        def text(n):
+            return seed.replace(rule, rule * n, 1)
+        read = fll.parse_fll
+    elif fmt == "fis":
+        seed = (interop / "tipper.fis").read_text()
+        rule = seed[seed.index("[Rules]"):].splitlines()[1] + "\n"
+
+        def text(n):
+            return seed.replace("NumRules=3", f"NumRules={n + 3}").rstrip("\n") + "\n" + rule * n
+        read = fis.parse_fis
+    else:
+        seed = (interop / "robot_jfuzzylogic.fcl").read_text()
+
+        def text(n):
+            return seed.replace("END_RULEBLOCK", "".join(
+                f"RULE {k + 100} : IF dist IS near AND angle IS right THEN turn IS hard_left "
+                f", speed IS slow WITH 0.9;\n" for k in range(n)) + "END_RULEBLOCK")
+        read = fcl.parse_fcl
+    small_text, large_text = text(250), text(2000)
+    _cost(read, small_text)
+    small = min(_cost(read, small_text) for _ in range(2))
+    large = min(_cost(read, large_text) for _ in range(2))
+    assert large < 8 * small * 2.5          # 8x the rules: linear, with room for noise
+
+
+def test_a_span_on_a_long_line_looks_only_around_its_column():
+    """`Span.at` searched for the end of the line from the node: a node per condition of one
+    line of 80,000 conditions (1.3 MB) made parsing it take 20 s."""
+    short, long = "x" * 1_000, "x" * 4_000_000
+
+    def cost(text):
+        t0 = time.process_time()
+        for i in range(300):
+            Span.at(text, "f", i, 1, i + 1)
+        return time.process_time() - t0
+
+    cost(short)
+    assert min(cost(long) for _ in range(2)) < 10 * min(cost(short) for _ in range(2)) + 0.05
+    assert Span.at(long, "f", 10, 1, 11).source_line == "x" * 240
+
+
+def _lesson_cost(n: int) -> float:
+    from mitos_cli.teach.lesson import run_lesson
+    from mitos_cli.teach.session import Session
+
+    session = Session(ROOT / "rulebases" / "mitos.rules", out=lambda s: None)
+    text = "".join(f"if road is WIDE and size is SMALL_SZ then speed is {k % 7 * 10}\n"
+                   if k % 2 else f"z{k}: if road is NARROW and position is LEFT then speed is 20\n"
+                   for k in range(n))
+    t0 = time.process_time()
+    run_lesson(session, text, "many.lesson")
+    return time.process_time() - t0
+
+
+def test_telling_many_rules_is_linear():
+    """Each told rule walked every rule to find its label, a free label and the rules with its
+    condition (written out again for each), and `state._put_rule` copied the rules in a Python
+    loop: 4,000 rules took 32 s, 16,000 (1 MB) would take minutes; now about 9 s."""
+    _lesson_cost(50)
+    small, large = min(_lesson_cost(250) for _ in range(2)), _lesson_cost(2000)
+    assert large < 8 * small * 2.5          # 8x the rules: linear, with room for noise
+
+
+def test_a_told_rule_names_at_most_five_rules_with_its_condition():
+    from mitos_cli.teach.session import Session
+
+    out: list[str] = []
+    session = Session(ROOT / "rulebases" / "mitos.rules", out=out.append)
+    for k in range(8):
+        session.run(f"z{k}: if road is NARROW and position is LEFT then speed is {20 + k % 2}")
+    out.clear()
+    session.run("z8: if position is LEFT and road is NARROW then speed is 20")
+    lines = "\n".join(out).splitlines()
+    assert lines[2:] == ["  note: z0 says the same",
+                         "  conflict: z1 has the same condition but says speed is 21",
+                         "  note: z2 says the same",
+                         "  conflict: z3 has the same condition but says speed is 21",
+                         "  note: z4 says the same", "  and 3 more rules with the same condition"]
+    out.clear()                             # replaced in place: the others keep their order
+    session.run("z0: if road is NARROW and position is LEFT then speed is 21")
+    assert "\n".join(out).splitlines()[2:4] == [
+        "  note: z1 says the same", "  conflict: z2 has the same condition but says speed is 20"]
+    assert [r.label for r in session.rulebase.behavior("avoid_obstacle").rules][-9:] == \
+        [f"z{k}" for k in range(9)]
+
+
+def test_looking_up_a_behavior_does_not_walk_them_all():
+    """`RuleBase.behavior` walked the behaviors: a file of 8,000 behaviors spent 3.7 s there."""
+    from mitos_cli.lang.model import Behavior, RuleBase
+
+    rb = RuleBase(None, (), tuple(Behavior(f"b{i}") for i in range(20_000)) + (Behavior("b0"),))
+    t0 = time.process_time()
+    assert all(rb.behavior(f"b{i}").name == f"b{i}" for i in range(20_000))
+    assert time.process_time() - t0 < 2.0           # walking them: 200 million steps
+    assert rb.behavior("b0") is rb.behaviors[0] and rb.behavior() is rb.behaviors[0]
+    with pytest.raises(MitosError, match="unknown behavior `b20000`"):
+        rb.behavior("b20000")
+
+
+def test_reading_many_fll_variables_is_linear():
+    """The input names were listed again for each variable (8,000 variables: 2.4 s)."""
+    from mitos_cli.interop.fll import parse_fll
+
+    def text(n):
+        out = ["Engine: many"] + [x for i in range(n) for x in (
+            f"InputVariable: x{i}", "  range: 0 1", "  term: A Triangle 0 0.5 1")]
+        out += ["OutputVariable: y", "  range: 0 1", "  term: A Triangle 0 0.5 1",
+                "RuleBlock: main"] + [f"  rule: if x{i} is A then y is A" for i in range(n)]
+        return "\n".join(out) + "\n"
+
+    small_text, large_text = text(750), text(6000)
+    _cost(parse_fll, small_text)
+    small = min(_cost(parse_fll, small_text) for _ in range(2))
+    assert _cost(parse_fll, large_text) < 8 * small * 2.5
+
+
+@pytest.mark.parametrize("names, line", [(["a", "b", "a"], 1), (["a", "b", "b"], 2)])
+def test_duplicate_obstacle_names_are_named_at_the_first(tmp_path, names, line):
+    """The check counts names once (a count per obstacle was N^2); it still names the first
+    obstacle whose name is used twice."""
+    from mitos_cli.sim.worldfile import parse_world
+
+    corridor = (ROOT / "worlds" / "corridor.yaml").read_text()
+    items = "".join(f"  - {{name: {n}, shape: circle, at: [{100 + 40 * i}, 20], radius: 2}}\n"
+                    for i, n in enumerate(names))
+    text = corridor.replace("obstacles:\n", "obstacles:\n" + items, 1)
+    first = text.splitlines().index("obstacles:") + 1
+    with pytest.raises(WorldError, match=f"two obstacles are named `{names[line - 1]}`") as info:
+        parse_world(text, str(tmp_path / "w.yaml"))
+    assert info.value.span.line == first + line
+
+
+def test_repeated_term_names_are_renamed_in_linear_time():
+    """A `.fis` MF or an FLL term repeated 20,000 times (the seed-20261203 campaign's 16 slow
+    inputs): each repeat gathered every name again and tried every suffix an earlier repeat
+    had taken (60 s); the names are the same as before."""
+    from mitos_cli.interop.common import distinct_names
+    from mitos_cli.lang.terms import Term
+
+    terms = [Term("low", "triangle", (0.0, 1.0, 2.0)) for _ in range(4)] + \
+        [Term("low_2_2", "triangle", (0.0, 1.0, 2.0))]
+    notes: list[str] = []
+    assert [t.name for t in distinct_names(terms, "x", notes, "why")] == \
+        ["low", "low_2", "low_2_3", "low_2_4", "low_2_2"]
+    assert [t.name for t in distinct_names(terms[:3], "x", [], "why", keep_last=True)] == \
+        ["low_2_2", "low_2", "low"]
+    many = [Term("low", "triangle", (0.0, 1.0, 2.0))] * 20_000
+    t0 = time.process_time()
+    names = [t.name for t in distinct_names(many, "x", notes, "why")]
+    assert time.process_time() - t0 < 2.0
+    assert len(set(names)) == 20_000 and names[-1] == "low_2_19999"

@@ -214,3 +214,31 @@ def test_gradient_through_use_contexts_of_the_drive_behavior():
     _, g = gradient(p, p.values, X, T)
     num = finite_differences(p, X, T)
     np.testing.assert_allclose(g, num, rtol=1e-5, atol=1e-4 * np.abs(num).max())
+
+
+def test_examples_on_a_corner_give_the_slope_of_the_side_where_q_falls():
+    """`clutter` = 1 on SPARSE / DENSE's knot at 1: the membership has a kink there, and a
+    slope of 0 (the two-sided derivative does not exist) hid from the descent that moving the
+    knot down lowers Q. The one-sided slope of the falling side is what `gradient` gives, and
+    finite differences on that side agree; `adapt` moves the knot."""
+    terms = ("variables:\n  n: {role: input, universe: [0, 20], terms: {\n"
+             "      FEW: {shape: left_shoulder, points: [1, 3]},\n"
+             "      MANY: {shape: right_shoulder, points: [1, 3]}}}\n"
+             "  y: {role: output, universe: [0, 100], terms: {S: 10, L: 90}}\n")
+    rules = "behavior b:\n  r1: if n is FEW then y is S\n  r2: if n is MANY then y is L\nend\n"
+    c = small(rules, terms)
+    p = parameterise(c)
+    X = np.array([[1.0], [1.0], [0.0]])                 # two on the knot at 1
+    T = np.array([[30.0], [30.0], [10.0]])
+    knot = next(i for i, k in enumerate(p.knots) if k.label == "n: FEW.a = MANY.a")
+    q, g = gradient(p, p.values, X, T)
+    h = 1e-6
+    down = p.values.copy()
+    down[knot] -= h
+    up = p.values.copy()
+    up[knot] += h
+    assert loss(with_values(p, up), X, T) == q          # up: nothing changes
+    slope = (q - loss(with_values(p, down), X, T)) / h  # down: Q falls
+    assert slope > 0 and g[knot] == pytest.approx(slope, rel=1e-4)
+    result = adapt(c, X, T, epochs=20)
+    assert result.values[knot] < p.values[knot] and result.q_after < 0.5 * q

@@ -214,6 +214,22 @@ def test_outside_the_repository_packaged_rules_and_lessons_are_found_and_save_re
     assert "saved a.rules" in res.stdout                   # where the earlier `save` went
     res = teach("--lesson", "no-such-lesson")
     assert res.returncode == 1 and "cannot read lesson `no-such-lesson`" in res.stderr
+    assert "a packaged lesson: wider-turn" in res.stderr
+    res = teach("rulebases/mitos.rules", "--lesson", "wider-trun")     # a packaged name, mistyped
+    assert res.returncode == 1 and "did you mean `wider-turn`?" in res.stderr
+
+
+def test_a_session_from_python_finds_the_packaged_rule_base(tmp_path, monkeypatch):
+    """docs/teach.md's "From Python" example, run outside the repository."""
+    from mitos_cli.teach.session import Session
+
+    monkeypatch.chdir(tmp_path)
+    s = Session("rulebases/mitos.rules", out=[].append)
+    assert s.rules_path == default_rulebase_path()
+    s.run("correct road=78 size=45 position=4 -> steering=60")
+    s.run("adapt epochs 20")
+    s.run("save taught.rules")
+    assert (tmp_path / "taught.rules").is_file()
 
 
 def test_simulation_corrections_name_the_robot():

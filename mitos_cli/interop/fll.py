@@ -186,8 +186,8 @@ def parse_fll(text: str, path: str | None = None) -> RuleBase:
     notes: list[str] = []
     for v in variables:
         _tsukamoto(v, notes)
-    built = [_build_variable(v, [x.name for x in variables if x.role == "input"], notes)
-             for v in variables]
+    inputs = [x.name for x in variables if x.role == "input"]     # once: per variable, N^2
+    built = [_build_variable(v, inputs, notes) for v in variables]
     by_name = {v.name: v for v in built}
     outputs = {v.name: v for v in variables if v.role == "output"}
     for b in blocks:

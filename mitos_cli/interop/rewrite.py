@@ -16,6 +16,13 @@ from __future__ import annotations
 
 from ..errors import FormatError
 from ..lang.model import And, Expr, Not, Or, Prop, Rule
+from ..lang.parse import MAX_NESTING
+
+#: how many propositions the chained conditions of one rule block may hold, written out. Each
+#: tested output becomes the conditions of the rules that set it, which may test outputs in
+#: turn: a file of 30 rules each testing the previous output twice is 2^30 propositions (a
+#: few KB that took minutes, then hours, to read). A million is read and compiled in about 2 s.
+MAX_WRITTEN = 1_000_000
 
 
 def push_hedges(expr: Expr, hedges: tuple[str, ...], and_: str, or_: str, rule: Rule,
@@ -48,6 +55,24 @@ def unchain(rules: list[Rule], outputs: set[str], and_: str, or_: str,
     sources: dict[tuple[str, str], list[Expr]] = {}
     out: list[Rule] = []
     chained = 0
+    # the variables any rule tests, once (looked up for each weighted consequent, it made
+    # reading quadratic in the rules: 8,000 FCL rules WITH a weight took two minutes)
+    tested = {p.var for r in rules for p in _props(r.antecedent)}
+    sizes: dict[int, tuple[Expr, int, int]] = {}
+    written = 0
+
+    def charge(joined: Expr, rule: Rule, at: Prop) -> None:
+        """Count ``joined``'s propositions against :data:`MAX_WRITTEN` before it is used."""
+        nonlocal written
+        written += _size(joined, sizes)[1]
+        if written > MAX_WRITTEN:
+            raise FormatError(
+                f"rule `{rule.label}` tests `{at.var} is {at.term}`: written out, the chained "
+                f"conditions of this rule block would hold more than {MAX_WRITTEN:,} "
+                f"propositions", span=at.span or rule.span,
+                hint="MITOS restates each tested output as the conditions of the rules that "
+                     "set it; a chain that tests each output more than once doubles at each "
+                     "step: test each output once, or give the condition its own input")
 
     def expand(expr: Expr, rule: Rule) -> Expr:
         if isinstance(expr, Prop):
@@ -66,6 +91,7 @@ def unchain(rules: list[Rule], outputs: set[str], and_: str, or_: str,
                     f"can restate that only when the rule block's disjunction is the same "
                     f"(here `{or_}`)", span=expr.span or rule.span)
             joined = found[0] if len(found) == 1 else Or(tuple(found), expr.span)
+            charge(joined, rule, expr)
             hedged = push_hedges(joined, expr.hedges, and_, or_, rule,
                                  "a hedge on a chained output")
             return Not(hedged, expr.span) if expr.negated else hedged
@@ -77,12 +103,19 @@ def unchain(rules: list[Rule], outputs: set[str], and_: str, or_: str,
         antecedent = expand(rule.antecedent, rule)
         if antecedent != rule.antecedent:
             chained += 1
+            depth = _size(antecedent, sizes)[0]
+            if depth > MAX_NESTING:
+                raise FormatError(
+                    f"rule `{rule.label}` tests chained outputs: written out, its condition "
+                    f"nests {depth} deep, more than {MAX_NESTING}", span=rule.span,
+                    hint="MITOS restates each tested output as the conditions of the rules "
+                         "that set it, which adds their nesting at each step of the chain; "
+                         "shorten the chain")
             rule = Rule(rule.label, antecedent, rule.consequents, rule.weight, rule.span)
         for c in rule.consequents:
             if c.term is None or c.var not in outputs:
                 continue
-            if (rule.weight != 1.0 or c.hedges) and any(
-                    p.var == c.var for r in rules for p in _props(r.antecedent)):
+            if (rule.weight != 1.0 or c.hedges) and c.var in tested:
                 raise FormatError(f"rule `{rule.label}` sets the chained output `{c.var}` "
                                   f"with a weight or hedge, which the rules testing it would "
                                   f"see: not supported", span=c.span or rule.span)
@@ -94,6 +127,28 @@ def unchain(rules: list[Rule], outputs: set[str], and_: str, or_: str,
                      f"conditions of the earlier rules that set that term, which is what "
                      f"fuzzylite computes")
     return out
+
+
+def _size(expr: Expr, memo: dict[int, tuple[Expr, int, int]]) -> tuple[int, int]:
+    """The nesting depth and the number of propositions of ``expr`` read as a tree, in time
+    proportional to its distinct nodes: chained conditions share the conditions they repeat
+    (``memo`` keeps each node it measured alive, so its ``id`` stays its own)."""
+    stack: list[tuple[Expr, bool]] = [(expr, False)]
+    while stack:
+        node, ready = stack.pop()
+        if id(node) in memo:
+            continue
+        if isinstance(node, Prop):
+            memo[id(node)] = (node, 1, 1)
+            continue
+        items = (node.expr,) if isinstance(node, Not) else node.items
+        if not ready:
+            stack.append((node, True))
+            stack.extend((i, False) for i in items if id(i) not in memo)
+            continue
+        depth = 1 + max((memo[id(i)][1] for i in items), default=0)
+        memo[id(node)] = (node, depth, sum(memo[id(i)][2] for i in items))
+    return memo[id(expr)][1:]
 
 
 def _props(expr: Expr):

@@ -179,8 +179,11 @@ def write_termset(rb: RuleBase, inputs, outputs, source: str = "") -> str:
 
 def _term_spec(rb: RuleBase, v: Variable, t: Term, inputs: list[str]) -> str:
     p = t.params
+    frozen = (", frozen: true" if t.frozen else "") + \
+        (", held: false" if not t.held else "" if t.held_at is None else
+         f", held: {_scalar(t.held_at)}")
     if t.shape == "singleton":
-        return _scalar(p[0])
+        return f"{{shape: singleton, value: {_scalar(p[0])}{frozen}}}" if frozen else _scalar(p[0])
     if t.shape == "linear":
         coefficients = common.linear_coefficients(rb, v.name, t)
         if not any(coefficients.values()):          # y = constant: the same as a number
@@ -188,7 +191,6 @@ def _term_spec(rb: RuleBase, v: Variable, t: Term, inputs: list[str]) -> str:
         given = ", ".join(f"{_scalar(n)}: {_scalar(a)}" for n, a in coefficients.items()
                           if a != 0.0)
         return f"{{shape: linear, coefficients: {{{given}}}, constant: {_scalar(p[-1])}}}"
-    frozen = (", frozen: true" if t.frozen else "") + ("" if t.held else ", held: false")
     if t.formula is not None:                      # a JSON string is a YAML string
         return (f"{{shape: formula, formula: {json.dumps(t.formula.text)}"
                 f"{', frozen: true' if t.frozen else ''}}}")

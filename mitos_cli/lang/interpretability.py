@@ -22,7 +22,9 @@ centre             when the terms are written mirror-symmetric about a point (an
                    of terms; the first and last, second and second-last, ... are mirror
                    images, corner for corner), the middle term stays centred on that point
                    (``heading.AHEAD`` at 0, ``steering.ST`` at 90), unless it is written
-                   with ``held: false``
+                   with ``held: false``; a term written with ``held: POINT`` stays centred
+                   on that point (what ``mitos teach`` saves once its neighbours have moved
+                   out of symmetry, so that the hold outlives the symmetry it came from)
 =================  =========================================================================
 
 Piecewise-linear terms (triangles, trapezoids, shoulders) are measured exactly, on the points
@@ -267,7 +269,12 @@ def mirror_point(var: Variable) -> float | None:
 
 def held_term(var: Variable) -> tuple[Term, float] | None:
     """The middle term of a mirror-symmetric variable and its point, when it is written
-    symmetric about that point: what adaptation holds there unless released."""
+    symmetric about that point: what adaptation holds there unless released. A term written
+    with the point it is held at (``held: 90``, what ``mitos teach`` saves once adaptation has
+    moved its neighbours out of symmetry) is held there."""
+    written = next(((t, t.held_at) for t in var.terms if t.held_at is not None), None)
+    if written is not None:
+        return written
     point = mirror_point(var)
     if point is None:
         return None
@@ -349,7 +356,17 @@ def _order(var: Variable) -> list[Issue]:
 
 
 def _off_centre(var: Variable) -> list[Issue]:
-    """The middle term of terms that mirror each other about a point, but not on it."""
+    """The middle term of terms that mirror each other about a point, but not on it; a term
+    written with the point it is held at (``held: 90``), but not on it."""
+    tol = 1e-3 * (var.universe[1] - var.universe[0])
+    written = next(((t, t.held_at) for t in var.terms if t.held_at is not None), None)
+    if written is not None:
+        term, at = written
+        if not term.held or abs(centre(term) - at) <= tol:
+            return []
+        return [Issue("off-centre", var.name, (term.name,), (
+            f"`{var.name}.{term.name}` is centred on {_num(centre(term))}, off the point "
+            f"{_num(at)} it is held at"), f"move it back to {_num(at)}")]
     n = len(var.terms)
     if n < 3 or n % 2 == 0 or not all(learnable(t) for t in var.terms):
         return []
@@ -357,7 +374,6 @@ def _off_centre(var: Variable) -> list[Issue]:
                      var.terms[:n // 2] + (_placeholder(var),) + var.terms[n // 2 + 1:])
     point = mirror_point(outer)
     middle = var.terms[n // 2]
-    tol = 1e-3 * (var.universe[1] - var.universe[0])
     if point is None or abs(centre(middle) - point) <= tol or not middle.held:
         return []                                   # `held: false`: the instructor let it move
     return [Issue("off-centre", var.name, (middle.name,), (

@@ -8,6 +8,7 @@ the rule language (``parse(format_rule(r)) == r``).
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass, field
 
 from ..errors import Span
@@ -130,13 +131,22 @@ class RuleBase:
     def default_behavior(self) -> str:
         return self.behaviors[0].name
 
+    @functools.cached_property
+    def _by_name(self) -> dict[str, Behavior]:
+        """The behaviors by name, the first of a name (built once: a lookup per behavior by
+        walking them all made a file of N behaviors N^2 to read)."""
+        by_name: dict[str, Behavior] = {}
+        for b in self.behaviors:
+            by_name.setdefault(b.name, b)
+        return by_name
+
     def behavior(self, name: str | None = None) -> Behavior:
         from ..errors import unknown
 
         name = name or self.default_behavior
-        for b in self.behaviors:
-            if b.name == name:
-                return b
+        found = self._by_name.get(name)
+        if found is not None:
+            return found
         raise unknown("behavior", name, [b.name for b in self.behaviors])
 
 

@@ -7,6 +7,7 @@ actions; labels are unique within a behavior; ``use`` has no cycles; operator se
 
 from __future__ import annotations
 
+from collections import Counter
 from pathlib import Path
 
 from ..errors import RuleBaseError, Span, TermSetError, unknown
@@ -75,8 +76,9 @@ def build_rulebase(parsed: ParsedFile, termsets: tuple[TermSet, ...],
                             span=Span.in_text(parsed.text, parsed.path, 1, 1),
                             hint="write a rule: `if road is WIDE then speed is FAST`")
     names = [b.name for b in behaviors]
+    counts = Counter(names)                 # names.count per behavior was N^2
     for b in behaviors:
-        if names.count(b.name) > 1:
+        if counts[b.name] > 1:
             raise RuleBaseError(f"behavior `{b.name}` is defined twice", span=b.span)
     base_ops = ops_mod.resolve(parsed.operators)
     for b in behaviors:

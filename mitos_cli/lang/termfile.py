@@ -28,6 +28,7 @@ same as a bare number) or ``{shape: linear, coefficients: {road: 0.5, size: -1},
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 from typing import Any
 
@@ -177,8 +178,7 @@ def _term(name: str, spec: Any, key_span: Span, value_span: Span, variable: str,
                            hint=did_you_mean(str(shape), USER_SHAPES))
     frozen = _flag(spec, "frozen", False, what,
                    "`frozen: true` keeps adaptation from moving the term")
-    held = _flag(spec, "held", True, what,
-                 "`held: false` lets adaptation move a centre term off its point")
+    held, held_at = _held(spec, what)
     if shape == "linear":
         return _linear_term(what, name, spec, key_span, frozen, inputs)
     if shape == "formula":
@@ -210,7 +210,20 @@ def _term(name: str, spec: Any, key_span: Span, value_span: Span, variable: str,
             yamlpos.require(spec, p, TermSetError, what)
         params = tuple(yamlpos.expect_number(spec[p], spec.value_span(p), TermSetError,
                                              f"{what}: {p}") for p in kind.params)
-    return Term(name, internal, params, key_span, frozen, held)
+    return Term(name, internal, params, key_span, frozen, held, held_at)
+
+
+def _held(spec: YMap, what: str) -> tuple[bool, float | None]:
+    """``held``: true (the default: a centre term stays on its point of symmetry), false (it
+    may move), or the point it is held at (a number: ``held: 90``)."""
+    value = spec.get("held", True)
+    if isinstance(value, bool):
+        return value, None
+    if isinstance(value, (int, float)) and math.isfinite(value):
+        return True, float(value)
+    raise TermSetError(f"{what}: `held` must be true, false or the point the term is held at, "
+                       f"not `{value}`", span=spec.value_span("held"),
+                       hint="`held: false` lets adaptation move a centre term off its point")
 
 
 def _flag(spec: YMap, key: str, default: bool, what: str, hint: str) -> bool:

@@ -40,6 +40,10 @@ class Term:
     frozen: bool = False
     #: ``held: false`` in the YAML: a centre term adaptation may move off its point of symmetry
     held: bool = True
+    #: ``held: POINT`` in the YAML: the point a centre term is held at, written where its
+    #: neighbours no longer mirror each other about it (``mitos teach`` saves it after an
+    #: adaptation moved them); ``None``: the point of symmetry, if the terms have one
+    held_at: float | None = None
     #: the membership function of a ``formula`` term (its params are empty)
     formula: Formula | None = None
 

@@ -8,6 +8,7 @@ image that cannot be read.
 
 from __future__ import annotations
 
+from collections import Counter
 from pathlib import Path
 from typing import Any
 
@@ -339,8 +340,9 @@ def parse_world(text: str, path: str) -> World:
     for i, item in enumerate(_list(top, "obstacles")):
         obstacles.append(read_obstacle(r, item, top["obstacles"].item_span(i), i))
     names = [o.name for o in obstacles]
+    counts = Counter(names)                 # names.count per obstacle was N^2
     for i, o in enumerate(obstacles):
-        if names.count(o.name) > 1:
+        if counts[o.name] > 1:
             raise WorldError(f"two obstacles are named `{o.name}`",
                              span=top["obstacles"].item_span(i))
     randomise = (read_randomise(r, top["randomise"], top.value_span("randomise"), names)

@@ -14,7 +14,10 @@ network:
   their exact partial derivatives; other norms are refused;
 * hedges (:mod:`mitos_cli.fuzzy.hedges` derivatives) and ``not`` (``-1``);
 * memberships: the derivative of each piecewise-linear edge w.r.t. its corner points; a
-  saturated membership (0 or 1) has derivative 0.
+  saturated membership (0 or 1) has derivative 0. Where an example lies exactly on a corner
+  (a whole-numbered input on a knot), ``Q`` has a kink in that knot: each knot then gets the
+  one-sided slope of the side on which ``Q`` falls (:func:`_corner_grad`), not a 0 that
+  would hide that side from the descent.
 
 **Mamdani behaviors** also learn the corner points of their output sets (tied, ordered and
 bounded like input knots), and their gradient is central differences over the parameters, one
@@ -765,7 +768,9 @@ def difference_gradient(p: Parameters, values: np.ndarray, X: np.ndarray,
 def gradient(p: Parameters, values: np.ndarray, X: np.ndarray,
              targets: np.ndarray) -> tuple[float, np.ndarray]:
     """``Q`` and ``dQ/dvalues``: exact, by backpropagation through the network; for Mamdani
-    inference by central differences (:func:`difference_gradient`)."""
+    inference by central differences (:func:`difference_gradient`). A knot with examples
+    exactly on one of its corners, where ``Q`` has a kink, gets the one-sided slope of the side
+    on which ``Q`` falls (:func:`_falling_side`)."""
     if p.sets is not None:
         return difference_gradient(p, values, X, targets)
     c = with_values(p, values)
@@ -810,20 +815,66 @@ def gradient(p: Parameters, values: np.ndarray, X: np.ndarray,
             _backward_group(group, V, G, tnorm, snorm)
 
     grad = np.zeros(len(values))
+    up = down = None
     # membership layer
     rows = np.flatnonzero((p.corner_knot >= 0).any(axis=1))
     if rows.size:
         corners = np.array([[values[i] if i >= 0 else o for i, o in
                              zip(p.corner_knot[t], _orig_corners(p, t))] for t in rows.tolist()])
-        dmu = _membership_grad(corners, Xt[c.term_var[rows]])      # [4, t, n]
+        x = Xt[c.term_var[rows]]
+        dmu = _membership_grad(corners, x)                          # [4, t, n]
         gmu = G[2 + rows]                                           # [t, n]
-        gcorner = np.einsum("ctn,tn->tc", dmu, gmu)                 # [t, 4]
         idx = p.corner_knot[rows]
         ok = idx >= 0
-        np.add.at(grad, idx[ok], gcorner[ok])
+        np.add.at(grad, idx[ok], np.einsum("ctn,tn->tc", dmu, gmu)[ok])
+        sides = _corner_grad(corners, x)                            # examples on a corner
+        if sides is not None:
+            up, down = grad.copy(), grad.copy()
+            np.add.at(up, idx[ok], np.einsum("ctn,tn->tc", sides[0], gmu)[ok])
+            np.add.at(down, idx[ok], np.einsum("ctn,tn->tc", sides[1], gmu)[ok])
     ok = p.cons_knot >= 0
     np.add.at(grad, p.cons_knot[ok], gcons[ok])
+    if up is not None and down is not None:
+        np.add.at(up, p.cons_knot[ok], gcons[ok])
+        np.add.at(down, p.cons_knot[ok], gcons[ok])
+        grad = _falling_side(up, down)
     return Q, grad
+
+
+def _falling_side(up: np.ndarray, down: np.ndarray) -> np.ndarray:
+    """Per knot, from its one-sided slopes of ``Q`` (moving it up, moving it down): the slope
+    of a side on which ``Q`` falls (``up`` where negative, ``down`` where positive; the steeper
+    where both fall), 0 where ``Q`` rises on both sides (a kink at a minimum). Where the two
+    sides agree (no example on a corner) this is the slope itself."""
+    out = np.where(up < 0, up, np.where(down > 0, down, 0.0))
+    return np.where((up < 0) & (down > 0) & (down > -up), down, out)
+
+
+def _corner_grad(corners: np.ndarray, x: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+    """What examples lying exactly on a corner add to ``d mu / d (a, b, c, d)`` on each side:
+    ``(up, down)`` ``[4, t, n]``, for moving the corner up and down, or ``None`` when no example
+    lies on one. There ``mu`` has a kink in the corner's position (it is saturated on one side
+    and on an edge on the other), which :func:`_membership_grad` counts as 0: an example at
+    ``x = b`` of a rising edge leaves the edge's top when ``b`` moves up (``mu`` falls below 1),
+    one at ``x = a`` its foot when ``a`` moves down; on a falling edge, ``x = c`` when ``c``
+    moves down and ``x = d`` when ``d`` moves up. Whole-numbered inputs on a knot (``clutter``
+    = 1 on ``SPARSE`` / ``DENSE``'s knot at 1) are where this happens."""
+    A, B, C, D = (corners[:, i:i + 1] for i in range(4))
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+        has_rise = np.isfinite(A) & np.isfinite(B) & (B > A)
+        has_fall = np.isfinite(C) & np.isfinite(D) & (D > C)
+        at_a, at_b = has_rise & (x == A), has_rise & (x == B)
+        at_c, at_d = has_fall & (x == C), has_fall & (x == D)
+        if not (at_a.any() or at_b.any() or at_c.any() or at_d.any()):
+            return None
+        wr = np.where(has_rise, B - A, 1.0)
+        wf = np.where(has_fall, D - C, 1.0)
+        up, down = np.zeros((4,) + x.shape), np.zeros((4,) + x.shape)
+        down[0] = np.where(at_a, -1.0 / wr, 0.0)        # (x - b) / (b - a)^2 at x = a
+        up[1] = np.where(at_b, -1.0 / wr, 0.0)          # -(x - a) / (b - a)^2 at x = b
+        down[2] = np.where(at_c, 1.0 / wf, 0.0)         # (d - x) / (d - c)^2 at x = c
+        up[3] = np.where(at_d, 1.0 / wf, 0.0)           # (x - c) / (d - c)^2 at x = d
+    return up, down
 
 
 def _scatter_add(G: np.ndarray, idx: np.ndarray, vals: np.ndarray) -> None:
@@ -1031,14 +1082,14 @@ def adapt(compiled: CompiledRuleBase, X: np.ndarray, targets: np.ndarray, *, epo
             values = candidate
             Q, grad = gradient(p, values, X, targets)
             history.append(Q)
-            if history[-2] - Q <= 1e-9 * history[0]:
-                converged = True                     # no longer worth a step
-                break
-            step = min(1.0, step * 2.0)
             if on_epoch is not None:
                 on_epoch(epoch, Q)
             if on_values is not None:
                 on_values(values)
+            if history[-2] - Q <= 1e-9 * history[0]:
+                converged = True                     # no longer worth a step
+                break
+            step = min(1.0, step * 2.0)
     except KeyboardInterrupt:
         interrupted = True            # keep what the completed epochs learned
     q_learned = history[-1]
@@ -1060,7 +1111,8 @@ def _round(p: Parameters, values: np.ndarray, X: np.ndarray, targets: np.ndarray
         return p.values.copy(), q_start
     for extra in range(3):
         decimals = p.decimals + extra
-        out = np.where(changed, np.round(values * 10.0 ** decimals) / 10.0 ** decimals, values)
+        out = np.where(changed, np.round(values * 10.0 ** decimals) / 10.0 ** decimals,
+                       values) + 0.0             # + 0.0: a knot rounded to -0.0 is 0
         for dep, others, coef in p.dependents:        # symmetric triangles stay symmetric
             out[dep] = round(float(coef @ out[others]), int(decimals[dep]))
         if feasible(p, out):

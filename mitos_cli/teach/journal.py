@@ -199,6 +199,23 @@ FIELDS: dict[str, dict[str, type]] = {"start": {"rules": str, "behavior": str},
           "freeze": {"terms": list}, "release": {"terms": list}}
 
 
+#: JSON's names for the types ``json.loads`` gives (for messages about a journal line)
+_JSON_TYPE = {list: "array", dict: "object", int: "number", float: "number", bool: "boolean",
+              type(None): "null"}
+
+
+def _shown(entry: dict, key: str) -> str:
+    """``entry[key]`` for a message: its JSON text when short, else its JSON type (a mutated
+    journal's 200,000-element array is no help quoted whole)."""
+    if key not in entry:
+        return "missing"
+    value = entry[key]
+    text = json.dumps(value) if not isinstance(value, (list, dict)) else ""
+    if text and len(text) <= 40:
+        return text
+    return f"a JSON {_JSON_TYPE.get(type(value), 'string')}"
+
+
 def _problem(line: bytes, seq: int) -> str | None:
     """What is wrong with one journal line (``None``: nothing)."""
     try:
@@ -208,10 +225,12 @@ def _problem(line: bytes, seq: int) -> str | None:
     if not isinstance(entry, dict):
         return "the line is not a JSON object"
     if entry.get("seq") != seq or type(entry.get("seq")) is not int:
-        return f"expected change number {seq}, found {entry.get('seq')!r}"
+        return f"expected change number {seq}, found {_shown(entry, 'seq')}"
     op = entry.get("op")
+    if not isinstance(op, str):        # a list or an object cannot be looked up (TypeError)
+        return f"the change's name (`op`) is {_shown(entry, 'op')}, not a string"
     if op not in FIELDS:
-        return f"unknown change {op!r}"
+        return f"unknown change {_shown(entry, 'op')}"
     for key, kind in FIELDS[op].items():
         if not isinstance(entry.get(key), kind) or isinstance(entry.get(key), bool):
             return f"the `{op}` change has no valid `{key}`"

@@ -18,7 +18,7 @@ MEANING_SHIFT = 0.5
 
 
 def _num(x: float) -> str:
-    return f"{x:.4g}"
+    return f"{x + 0.0:.4g}"            # + 0.0: -0.0 reads as 0
 
 
 def in_words(before: RuleBase, after: RuleBase, parameters) -> str:

@@ -68,5 +68,13 @@ def read_lesson(source: str) -> tuple[str, str]:
     try:
         return path.read_text(encoding="utf-8"), source
     except (OSError, UnicodeDecodeError) as exc:
-        raise LessonError(f"cannot read lesson `{source}`: "
-                          f"{getattr(exc, 'strerror', None) or exc}") from None
+        error = LessonError(f"cannot read lesson `{source}`: "
+                            f"{getattr(exc, 'strerror', None) or exc}")
+        if isinstance(exc, FileNotFoundError):     # a mistyped name: the packaged lessons
+            from ..errors import did_you_mean
+            from ..resources import packaged_names
+
+            names = [n[:-len(".lesson")] for n in packaged_names("rulebases/lessons", ".lesson")]
+            error.expected = "a lesson file, or a packaged lesson: " + ", ".join(names)
+            error.hint = did_you_mean(path.stem, names)
+        raise error from None

@@ -109,15 +109,18 @@ def edit_termset(text: str, path: str, old, new) -> tuple[str, list[str]]:
         spec = variables[v_old.name]
         terms = spec["terms"]
         for t_old, t_new in zip(v_old.terms, v_new.terms):
-            if (t_old.frozen, t_old.held) != (t_new.frozen, t_new.held):
+            was, now = _flags(t_old), _flags(t_new)
+            if was != now:
                 edits += _flag_edits(text, starts, terms, t_old, t_new)
             if t_old.frozen != t_new.frozen:
                 changes.append(f"{v_old.name}.{t_old.name}: "
                                f"{'frozen' if t_new.frozen else 'no longer frozen'}")
-            if t_old.held != t_new.held:
+            if was["held"] != now["held"]:
                 changes.append(f"{v_old.name}.{t_old.name}: " + (
-                    "held at its point" if t_new.held else
-                    "free to move off its point (held: false)"))
+                    "free to move off its point (held: false)" if not t_new.held else
+                    "held at its point" if t_new.held_at is None else
+                    f"held at {now['held']} (held: {now['held']}: its neighbours no longer "
+                    "mirror each other about it)"))
             if t_old.params == t_new.params:
                 continue
             spans = _param_spans(terms, t_old)
@@ -134,14 +137,22 @@ def edit_termset(text: str, path: str, old, new) -> tuple[str, list[str]]:
     return _apply(text, edits), changes
 
 
+def _flags(term: Term) -> dict[str, str]:
+    """A term's ``frozen`` and ``held`` keys as its YAML writes them (``held``: true, false
+    or the point it is held at)."""
+    held = "false" if not term.held else \
+        "true" if term.held_at is None else format_number(term.held_at)
+    return {"frozen": "true" if term.frozen else "false", "held": held}
+
+
 def _flag_edits(text: str, starts: list[int], terms: yamlpos.YMap, old: Term,
                 new: Term) -> list[tuple[int, int, str]]:
-    """The edits that write ``new``'s ``frozen`` and ``held`` flags where they differ from
-    ``old``'s into its YAML: a flag's value replaced where it is written, else the keys added
+    """The edits that write ``new``'s ``frozen`` and ``held`` keys where they differ from
+    ``old``'s into its YAML: a key's value replaced where it is written, else the keys added
     (to a flow mapping before its ``}``, to a block mapping as its first lines; a bare crisp
     value becomes ``{shape: singleton, value: V, frozen: true}``)."""
-    flags = {key: "true" if getattr(new, key) else "false" for key in ("frozen", "held")
-             if getattr(old, key) != getattr(new, key)}
+    was = _flags(old)
+    flags = {key: value for key, value in _flags(new).items() if was[key] != value}
 
     def offset(span) -> int:
         return starts[span.line - 1] + span.column - 1

@@ -45,6 +45,10 @@ class State:
     examples: list[Example] = field(default_factory=list)
     frozen_terms: set = field(default_factory=set)      # (variable, term)
     released: set = field(default_factory=set)          # (variable, term)
+    # the rules tuple _put_rule made last and its labels' positions, so that the next rule put
+    # into that tuple finds its label without walking every rule (a lesson telling N rules was
+    # N^2): one entry, handed on to the new tuple; any other tuple builds its own
+    labels: tuple[tuple[Rule, ...], dict[str, int]] = ((), {})
 
 
 def _replace_behavior(rb: RuleBase, b: Behavior) -> RuleBase:
@@ -54,15 +58,22 @@ def _replace_behavior(rb: RuleBase, b: Behavior) -> RuleBase:
     return dataclasses.replace(rb, behaviors=behaviors)
 
 
-def _put_rule(b: Behavior, rule: Rule) -> Behavior:
-    rules = list(b.rules)
-    for i, r in enumerate(rules):
-        if rule.label and r.label == rule.label:
-            rules[i] = rule
-            break
+def _put_rule(state: State, b: Behavior, rule: Rule) -> Behavior:
+    """``b`` with ``rule`` in place of the first rule with its label, or added at the end
+    (``state.labels`` remembers the labels' positions in the tuple it makes)."""
+    rules, positions = state.labels
+    if rules is not b.rules:
+        positions = {}
+        for i, r in enumerate(b.rules):
+            positions.setdefault(r.label, i)
+    at = positions.get(rule.label) if rule.label else None
+    if at is None:
+        new = b.rules + (rule,)
+        positions.setdefault(rule.label, len(b.rules))
     else:
-        rules.append(rule)
-    return dataclasses.replace(b, rules=tuple(rules))
+        new = b.rules[:at] + (rule,) + b.rules[at + 1:]
+    state.labels = (new, positions)
+    return dataclasses.replace(b, rules=new)
 
 
 def _set_params(rb: RuleBase, terms: dict) -> RuleBase:
@@ -91,7 +102,8 @@ def apply(state: State, entry: dict) -> None:
     rb = state.rulebase
     if op == "rule":
         rule = parse_rule(entry["text"])
-        state.rulebase = _replace_behavior(rb, _put_rule(rb.behavior(entry["behavior"]), rule))
+        state.rulebase = _replace_behavior(rb, _put_rule(state, rb.behavior(entry["behavior"]),
+                                                         rule))
     elif op == "behavior":
         state.rulebase = _replace_behavior(rb, Behavior(entry["name"]))
         state.block = entry["name"]
@@ -130,12 +142,37 @@ def apply(state: State, entry: dict) -> None:
         state.rulebase = _set_flags(state.rulebase, entry["terms"], frozen=False)
         state.rulebase = _set_flags(state.rulebase, entry.get("holds", []), held=False)
     elif op == "adapt":
-        rb = _set_params(rb, entry["terms"])
-        state.rulebase = _set_crisp(rb, entry.get("crisp", []))
+        learned = _set_params(rb, entry["terms"])
+        state.rulebase = _keep_holds(rb, _set_crisp(learned, entry.get("crisp", [])))
     else:                                        # pragma: no cover - journal from the future
         raise LessonError(f"the journal holds an unknown change `{op}`")
 
 
+
+
+def _keep_holds(before: RuleBase, after: RuleBase) -> RuleBase:
+    """``after`` with each centre term held in ``before`` (by the symmetry of its neighbours)
+    written with its point (``held_at``) where ``after``'s terms are no longer symmetric
+    about it: the hold outlives the symmetry adaptation moved, in the next ``adapt`` and in
+    the saved files (``held: 90``), and ``mitos check`` can tell it moved."""
+    from ..lang.interpretability import TOLERANCE, held_term
+
+    pinned: dict[tuple[str, str], float] = {}
+    for old, new in zip(variables(before), variables(after)):
+        held = held_term(old)
+        if held is None or not held[0].held or held[0].held_at is not None:
+            continue
+        still = held_term(new)
+        tol = TOLERANCE * (old.universe[1] - old.universe[0])
+        if still is None or still[0].name != held[0].name or abs(still[1] - held[1]) > tol:
+            pinned[(old.name, held[0].name)] = float(held[1])
+    if not pinned:
+        return after
+    termsets = tuple(dataclasses.replace(ts, variables=tuple(
+        v.with_terms(tuple(dataclasses.replace(t, held_at=pinned[(v.name, t.name)])
+                           if (v.name, t.name) in pinned else t for t in v.terms))
+        for v in ts.variables)) for ts in after.termsets)
+    return dataclasses.replace(after, termsets=termsets)
 
 
 def _set_flags(rb: RuleBase, refs: list, frozen: bool | None = None,

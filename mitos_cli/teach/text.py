@@ -83,7 +83,8 @@ def terms_table(original: RuleBase, current: RuleBase, names: list[str]) -> str:
             o = old[v.name].term(t.name) if v.name in old else None
             was = f"   (was {params_text(o)})" if o is not None and o.params != t.params else ""
             frozen = ("  [frozen]" if t.frozen else "") + \
-                ("" if t.held else "  [held: false]")
+                ("  [held: false]" if not t.held else "" if t.held_at is None else
+                 f"  [held at {format_number(t.held_at)}]")
             lines.append(f"  {t.name:<10} {t.shape_name:<14} {params_text(t)}{frozen}{was}")
     return "\n".join(lines)
 
