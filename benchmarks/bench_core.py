@@ -43,6 +43,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+from revision import package_of
 
 from mitos_cli import load_rulebase
 from mitos_cli.engine.evaluation import evaluate
@@ -263,29 +264,6 @@ def startup(runs: int) -> None:
     print(f"| `python -c \"import numpy\"` (whole process) | {fmt_time(t_numpy)} | |")
 
 
-def _package_of(rev: str, into: Path):
-    """The ``mitos_cli`` package of git revision ``rev``, imported alongside this tree's: its
-    tree is exported into ``into`` (for a process of its own) and its package copied there as
-    ``mitos_cli_rev``, whose imports of itself are all relative (its data files, the grammar
-    and the rule bases, are read from the installed ``mitos_cli``)."""
-    import importlib
-    import shutil
-
-    root = Path(__file__).resolve().parents[1]
-    archive = subprocess.run(["git", "-C", str(root), "archive", rev, "mitos_cli", "rulebases",
-                              "grammar"], check=True, capture_output=True).stdout
-    subprocess.run(["tar", "-x", "-C", str(into)], input=archive, check=True)
-    alias = into / "alias"
-    shutil.copytree(into / "mitos_cli", alias / "mitos_cli_rev")
-    sys.path.insert(0, str(alias))
-    try:
-        theirs = importlib.import_module("mitos_cli_rev")
-    finally:
-        sys.path.remove(str(alias))
-    assert Path(theirs.__file__).is_relative_to(alias), theirs.__file__
-    return theirs
-
-
 def against(rev: str, quick: bool = False) -> None:
     """This tree's column batch (``load_rulebase().evaluate(**columns)``) against ``rev``'s and
     the kernel, interleaved in one process (best of the rounds, wall and CPU time); peak memory
@@ -297,7 +275,7 @@ def against(rev: str, quick: bool = False) -> None:
     host = machine()
     n, rounds, single_n, runs = (10**5, 5, 200, 5) if quick else (10**6, 20, 2000, 21)
     with tempfile.TemporaryDirectory() as tmp:
-        theirs = _package_of(rev, Path(tmp))
+        theirs = package_of(rev, Path(tmp), ("mitos_cli", "rulebases", "grammar"))
         saved = os.environ.get("MITOS_CACHE_DIR")
         os.environ["MITOS_CACHE_DIR"] = "off"    # the cache pickles this tree's classes
         try:

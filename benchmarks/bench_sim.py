@@ -43,15 +43,13 @@ import importlib
 import math
 import os
 import platform
-import shutil
 import statistics
-import subprocess
-import sys
 import tempfile
 import time
 from pathlib import Path
 
 import numpy as np
+from revision import package_of
 
 from mitos_cli.resources import packaged_path
 from mitos_cli.sim.lockstep import run_lockstep
@@ -163,25 +161,6 @@ def against_runs(rev: str, theirs, planner_name: str = "drive", rounds: int = 7)
         _stages(world, fuzzy, scene)
 
 
-def _package_of(rev: str, into: Path):
-    """The ``mitos_cli`` package of git revision ``rev`` as ``mitos_cli_rev``, imported beside
-    this tree's (its imports of itself are relative; the worlds and rule bases are read from
-    the installed ``mitos_cli``)."""
-    root = Path(__file__).resolve().parents[1]
-    archive = subprocess.run(["git", "-C", str(root), "archive", rev, "mitos_cli"], check=True,
-                             capture_output=True).stdout
-    subprocess.run(["tar", "-x", "-C", str(into)], input=archive, check=True)
-    alias = into / "alias"
-    shutil.copytree(into / "mitos_cli", alias / "mitos_cli_rev")
-    sys.path.insert(0, str(alias))
-    try:
-        theirs = importlib.import_module("mitos_cli_rev")
-    finally:
-        sys.path.remove(str(alias))
-    assert Path(theirs.__file__).is_relative_to(alias), theirs.__file__
-    return theirs
-
-
 def _cpu_of(world, planner, scene) -> tuple[float, int]:
     c = time.process_time()
     res = simulate(world, planner, scene=scene)
@@ -231,7 +210,7 @@ def main() -> None:
         theirs = None
         if args.against:
             os.environ["MITOS_CACHE_DIR"] = "off"    # the cache pickles one tree's classes
-            theirs = _package_of(args.against, Path(tmp))
+            theirs = package_of(args.against, Path(tmp))
         if 1 in sections:
             single_robot(fuzzy)
         if 2 in sections:

@@ -129,6 +129,14 @@ class Route:
         return np.sqrt((d * d).sum(axis=2).min(axis=1))
 
 
+def _path(came: dict[int, int], node: int) -> list[int]:
+    """The nodes from the start to ``node``, following ``came`` (the start's entry is -1)."""
+    path = [node]
+    while came[path[-1]] != -1:
+        path.append(came[path[-1]])
+    return path[::-1]
+
+
 def _astar(neighbours, start: int, goal: int, pos) -> list[int] | None:
     frontier = [(0.0, 0, start)]
     came = {start: -1}
@@ -137,10 +145,7 @@ def _astar(neighbours, start: int, goal: int, pos) -> list[int] | None:
     while frontier:
         _, _, node = heapq.heappop(frontier)
         if node == goal:
-            path = [node]
-            while came[path[-1]] != -1:
-                path.append(came[path[-1]])
-            return path[::-1]
+            return _path(came, node)
         for nxt, step in neighbours(node):
             c = cost[node] + step
             if c < cost.get(nxt, math.inf):
@@ -506,10 +511,7 @@ def _grid_astar(allowed: memoryview, costs: memoryview, offsets: list[int], C: i
     while frontier:
         _, _, node = heapq.heappop(frontier)
         if node == goal:
-            path = [node]
-            while came[path[-1]] != -1:
-                path.append(came[path[-1]])
-            return path[::-1]
+            return _path(came, node)
         here = cost[node]
         for base, off in moves:
             if allowed[base + node]:
