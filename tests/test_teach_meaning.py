@@ -232,6 +232,17 @@ def test_a_session_from_python_finds_the_packaged_rule_base(tmp_path, monkeypatc
     assert (tmp_path / "taught.rules").is_file()
 
 
+def test_a_session_on_a_path_too_long_to_look_up_says_so(tmp_path, monkeypatch):
+    """A journal's rule base named by a path the system cannot look up (a part over 255
+    characters) is a positioned refusal, not an OSError (found by the fuzzing campaign)."""
+    from mitos_cli.errors import MitosError
+    from mitos_cli.teach.session import Session
+
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(MitosError, match="too long"):
+        Session("/tmp/" + "x" * 300 + "mitos.rules", out=[].append)
+
+
 def test_simulation_corrections_name_the_robot():
     from mitos_cli.teach.session import Session
 

@@ -125,12 +125,11 @@ class Session:
                  journal: Journal | None = None, save_as: str | Path | None = None,
                  out: Callable[[str], None] | None = None,
                  progress: Callable | None = None) -> None:
-        self.rules_path = Path(rules_path)
-        if not self.rules_path.exists():
-            # as `mitos teach` and read_rulebase: a packaged rule base by its path or name
-            from ..resources import resolve
+        # as `mitos teach` and read_rulebase: the file, else a packaged rule base by its path
+        # or name (a name the system cannot look up, too long, is simply not found)
+        from ..resources import resolve
 
-            self.rules_path = resolve("rulebases", rules_path, ".rules") or self.rules_path
+        self.rules_path = resolve("rulebases", rules_path, ".rules") or Path(rules_path)
         self.original = load_rules_file(self.rules_path)
         self.journal = journal if journal is not None else MemoryJournal()
         self.save_as = Path(save_as) if save_as is not None else None
