@@ -48,19 +48,27 @@ def resolve(kind: str, name: str | Path, suffix: str, base: Path | None = None) 
     ``worlds/figure4.yaml``, ``rulebases/mitos.rules`` from anywhere), else ``None``."""
     p = Path(name)
     for candidate in ([base / p] if base is not None else []) + [p]:
-        if _is_file(candidate):
+        if is_file(candidate):
             return candidate
     for filename in (p.name, p.name + suffix):
-        if _is_file(data_dir(kind) / filename):
+        if is_file(data_dir(kind) / filename):
             return packaged_path(kind, filename)
     return None
 
 
-def _is_file(path: Path) -> bool:
+def is_file(path: Path) -> bool:
     """``path.is_file()``, False for a name the system cannot look up (longer than 255
     characters): such a name is simply not found, and the caller says so in words."""
     try:
         return path.is_file()
+    except OSError:
+        return False
+
+
+def exists(path: Path) -> bool:
+    """``path.exists()``, False for a name the system cannot look up (as :func:`is_file`)."""
+    try:
+        return path.exists()
     except OSError:
         return False
 

@@ -286,6 +286,30 @@ def test_long_paths_are_errors_not_tracebacks(args, tmp_path, monkeypatch):
     assert info.value.code in (1, 2)
 
 
+def test_long_paths_named_inside_files_are_positioned_errors(tmp_path, monkeypatch):
+    """A term set, a map image or a lesson named by a path the system cannot look up (a part
+    over 255 characters) is the reader's refusal, in process too: Path.exists and is_file
+    raise OSError for such a name."""
+    from mitos_cli.lang.resolve import load_rules_file
+    from mitos_cli.teach.lesson import read_lesson
+
+    monkeypatch.chdir(tmp_path)
+    long = "y" * 300
+    rules = tmp_path / "long.rules"
+    rules.write_text(f'terms "{long}.yaml"\nbehavior b:\n  r1: if a is X then b is Y\nend\n')
+    with pytest.raises(TermSetError) as info:
+        load_rules_file(rules)
+    _positioned(info.value, 1)
+    m = tmp_path / "m.yaml"
+    m.write_text(f"image: {long}.pgm\nresolution: 0.05\norigin: [0, 0, 0]\nnegate: 0\n"
+                 "occupied_thresh: 0.65\nfree_thresh: 0.196\n")
+    with pytest.raises(WorldError, match="too long") as info:
+        load_map_yaml(m)
+    _positioned(info.value, 1)
+    with pytest.raises(LessonError, match="too long"):
+        read_lesson(long + ".lesson")
+
+
 def test_check_threshold_nan_is_a_usage_error():
     from mitos_cli.cli.app import main
 

@@ -12,6 +12,7 @@ from pathlib import Path
 
 from ..errors import RuleBaseError, Span, TermSetError, unknown
 from ..fuzzy.hedges import HEDGES
+from ..resources import is_file
 from . import operators as ops_mod
 from .model import And, Behavior, Consequent, Expr, Not, Or, Prop, Rule, RuleBase
 from .parse import ParsedFile, parse_rules
@@ -38,7 +39,7 @@ def load_rules_file(path: str | Path) -> RuleBase:
     termsets = []
     for name, span in parsed.terms:
         target = path.parent / name
-        if not target.is_file():
+        if not is_file(target):
             raise TermSetError(f"term set `{name}` not found (looked for `{target}`)", span=span,
                                hint="term-set paths are relative to the rule file")
         termsets.append(load_termset(target))

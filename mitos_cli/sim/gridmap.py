@@ -26,6 +26,7 @@ import numpy as np
 
 from ..errors import Span, WorldError
 from ..lang import yamlpos
+from ..resources import exists
 from .pgm import read_pgm
 from .world import Grid
 
@@ -61,7 +62,7 @@ def _negate(spec: yamlpos.YMap) -> bool:
 
 def read_image(path: Path) -> tuple[np.ndarray, int]:
     """Pixels ``[rows, cols]`` (top row first) and the maximum value of a map image."""
-    if path.exists() and not path.is_file():     # /dev/zero, a FIFO: would read without end
+    if exists(path) and not path.is_file():     # /dev/zero, a FIFO: would read without end
         raise ValueError("it is not a regular file")
     if path.suffix.lower() in (".pgm", ".pnm"):
         return read_pgm(path)

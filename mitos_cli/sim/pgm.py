@@ -11,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..resources import exists
 from ..words import plural
 
 
@@ -82,7 +83,7 @@ def read_pgm(path: str | Path) -> tuple[np.ndarray, int]:
     Only regular files are read, and at most :data:`MAX_BYTES` of them (``image: /dev/zero``
     or a FIFO would otherwise be read without end)."""
     path = Path(path)
-    if path.exists() and not path.is_file():
+    if exists(path) and not path.is_file():
         raise ValueError("it is not a regular file")
     with open(path, "rb") as fh:
         data = fh.read(MAX_BYTES + 1)

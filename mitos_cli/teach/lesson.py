@@ -12,6 +12,7 @@ from collections.abc import Iterator
 from pathlib import Path
 
 from ..errors import MitosError, Span
+from ..resources import exists
 from .commands import incomplete
 from .session import Session
 
@@ -61,7 +62,7 @@ def read_lesson(source: str) -> tuple[str, str]:
     if source == "-":
         return sys.stdin.read(), "<stdin>"
     path = Path(source)
-    if not path.exists():                  # a packaged lesson by name: `--lesson wider-turn`
+    if not exists(path):                   # a packaged lesson by name: `--lesson wider-turn`
         found = resolve("rulebases/lessons", source, ".lesson")
         if found is not None:
             path, source = found, str(found)
