@@ -48,7 +48,8 @@ def free_travel(cells: np.ndarray, radius: float, pose: tuple[float, float, floa
     """How far (in, along the rear axle's path) the robot can drive from ``pose`` (x, y, heading
     in rad) with its wheel held ``delta`` degrees off straight (positive right), forward or
     ``backward``, before its footprint touches one of the occupied ``cells [P, 2]`` (discs of
-    ``radius``); ``reach`` when it can drive that far, 0 when it touches one already.
+    ``radius``); ``reach`` when it can drive that far. A cell the footprint touches already
+blocks only the motion that takes it deeper in (0 then).
 
     Only the cells in the box the footprint's circumscribed disc sweeps are tested: a cell
     outside it is inside no footprint along the arc (1e-6 in of slack for rounding), and each
@@ -76,8 +77,10 @@ def free_travel(cells: np.ndarray, radius: float, pose: tuple[float, float, floa
         return reach
     px, py = px[swept, None], py[swept, None]
     dx, dy = px - cx, py - cy
-    inside = (np.abs(dx * c + dy * s) <= hl) & (np.abs(dy * c - dx * s) <= hw)     # [P, K]
-    hit = inside.any(axis=0)
+    depth = np.minimum(hl - np.abs(dx * c + dy * s), hw - np.abs(dy * c - dx * s))  # [P, K]
+    # a cell the footprint already touches blocks only the way that takes it deeper in: a
+    # mark put by a noisy echo at the body's edge must not pin the robot where it stands
+    hit = np.where(depth[:, :1] >= 0, depth > depth[:, :1], depth >= 0).any(axis=0)
     if not hit.any():
         return reach
     return float(max(int(hit.argmax()) - 1, 0) * step)
@@ -151,8 +154,9 @@ def guard(command: tuple[float, float], body: Body, rec: Recovery, dt: float,
     rec.held = rec.held + dt if abs(want) > cfg.want and limit < cfg.want else 0.0
     if rec.held < cfg.patience or robot.max_reverse <= 0:
         return (steer, speed), False
-    lock = robot.steering_min if body.route_side > 0 else robot.steering_max
-    for wheel in (lock, robot.steering_straight):
+    lock, other = ((robot.steering_min, robot.steering_max) if body.route_side > 0 else
+                   (robot.steering_max, robot.steering_min))
+    for wheel in (lock, robot.steering_straight, other):    # the last rather than stay put
         if body.free(wheel, True, cfg) >= cfg.back_room:
             rec.left, rec.wheel, rec.held = cfg.back_time, wheel, 0.0
             return (wheel, -robot.max_reverse), True
