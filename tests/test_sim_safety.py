@@ -88,7 +88,7 @@ def test_no_backing_out_without_room_behind_or_without_a_reverse_gear():
     assert not any(safety.guard((90.0, 30.0), b, rec, 0.05, cfg)[1] for _ in range(60))
 
 
-def test_a_cell_the_body_touches_already_blocks_only_the_way_deeper_in():
+def test_backing_away_from_a_cell_the_body_touches_is_not_blocked_by_it():
     """A mark a noisy echo puts at the body's front edge stops the robot driving on, not
     backing away from it (it pinned robots in BARN's pole fields)."""
     edge = np.array([[12.5, 0.0]])                      # on the front edge, inside by 0.5 in

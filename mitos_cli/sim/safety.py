@@ -48,8 +48,8 @@ def free_travel(cells: np.ndarray, radius: float, pose: tuple[float, float, floa
     """How far (in, along the rear axle's path) the robot can drive from ``pose`` (x, y, heading
     in rad) with its wheel held ``delta`` degrees off straight (positive right), forward or
     ``backward``, before its footprint touches one of the occupied ``cells [P, 2]`` (discs of
-    ``radius``); ``reach`` when it can drive that far. A cell the footprint touches already
-blocks only the motion that takes it deeper in (0 then).
+    ``radius``); ``reach`` when it can drive that far, 0 when it touches one already, but for
+backing out: backward, a cell it touches blocks only the steps that take it deeper in.
 
     Only the cells in the box the footprint's circumscribed disc sweeps are tested: a cell
     outside it is inside no footprint along the arc (1e-6 in of slack for rounding), and each
@@ -78,9 +78,11 @@ blocks only the motion that takes it deeper in (0 then).
     px, py = px[swept, None], py[swept, None]
     dx, dy = px - cx, py - cy
     depth = np.minimum(hl - np.abs(dx * c + dy * s), hw - np.abs(dy * c - dx * s))  # [P, K]
-    # a cell the footprint already touches blocks only the way that takes it deeper in: a
-    # mark put by a noisy echo at the body's edge must not pin the robot where it stands
-    hit = np.where(depth[:, :1] >= 0, depth > depth[:, :1], depth >= 0).any(axis=0)
+    inside = depth >= 0
+    if backward:    # backing away from a cell the body touches already (a mark a noisy echo
+        # put at its edge) is not blocked by it until a step takes the body deeper in
+        inside = np.where(inside[:, :1], depth > depth[:, :1], inside)
+    hit = inside.any(axis=0)
     if not hit.any():
         return reach
     return float(max(int(hit.argmax()) - 1, 0) * step)
