@@ -88,6 +88,58 @@ def test_no_backing_out_without_room_behind_or_without_a_reverse_gear():
     assert not any(safety.guard((90.0, 30.0), b, rec, 0.05, cfg)[1] for _ in range(60))
 
 
+def test_backing_away_from_a_cell_the_body_touches_is_not_blocked_by_it():
+    """A mark a noisy echo puts at the body's front edge stops the robot driving on, not
+    backing away from it (it pinned robots in BARN's pole fields)."""
+    edge = np.array([[12.5, 0.0]])                      # on the front edge, inside by 0.5 in
+    assert safety.free_travel(edge, 1.0, AT, ROBOT, 0.0, False, 30.0) == 0.0
+    assert safety.free_travel(edge, 1.0, AT, ROBOT, 0.0, True, 30.0) == 30.0
+    for delta in (-60.0, 60.0):                         # backing on either lock swings away too
+        assert safety.free_travel(edge, 1.0, AT, ROBOT, delta, True, 30.0) > 5.0
+
+
+def test_the_guard_backs_out_on_the_other_lock_when_that_is_the_only_room():
+    """Route to the right: the left lock first, then straight; boxed in behind on both, it
+    backs out on the right lock rather than stay where it is."""
+    cfg = safety.Settings()
+    wall = [[14.5, y] for y in np.arange(-20.0, 21.0, 2.0)]
+    free = {w: [] for w in (ROBOT.steering_min, ROBOT.steering_straight, ROBOT.steering_max)}
+    # a pole behind the right rear corner: backing on the left lock or straight meets it
+    cells = wall + [[-17.0, -8.0]]
+    b = body(cells)
+    for wheel in free:
+        free[wheel] = b.free(wheel, True, cfg)
+    assert free[ROBOT.steering_min] < cfg.back_room and \
+        free[ROBOT.steering_straight] < cfg.back_room <= free[ROBOT.steering_max]
+    rec = safety.Recovery()
+    backs, steer = False, 90.0
+    for _ in range(40):
+        (steer, _), backs = safety.guard((90.0, 30.0), b, rec, 0.05, cfg)
+        if backs:
+            break
+    assert backs and steer == ROBOT.steering_max
+
+
+def test_a_robot_that_drives_out_and_back_is_not_stuck():
+    """Stuck is driven less than 3 in in 6 s, not displaced less: a robot that backs out of a
+    pocket and comes round near where it was had not stopped."""
+    from mitos_cli.resources import packaged_path
+    from mitos_cli.sim import Simulation, load_world
+
+    world = load_world(packaged_path("worlds", "corridor.yaml"))
+    sim = Simulation(world, seed=1)
+    x0, y0 = float(sim._x[0]), float(sim._y[0])
+    one = np.zeros(1)
+    window = int(round(6.0 / world.dt))
+    for k in range(window + 5):                         # 10 in out and back, every 2 s
+        u = 10.0 * abs(math.sin(math.pi * k * world.dt / 2.0))
+        sim.move_to(np.array([x0 + u]), np.array([y0]), one, one, one + 90.0)
+    assert not sim._check_stuck()
+    for _ in range(window + 1):                         # then it stands
+        sim.move_to(np.array([x0]), np.array([y0]), one, one, one + 90.0)
+    assert sim._check_stuck() and sim._outcomes[0] == "stuck"
+
+
 def test_a_robot_stops_short_of_a_wall_its_command_drives_it_at():
     from mitos_cli.resources import packaged_path
     from mitos_cli.sim import Simulation, load_world

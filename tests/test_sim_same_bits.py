@@ -143,7 +143,8 @@ def test_a_maps_marks_kept_as_a_list_clear_as_a_scan_of_its_window_did():
 
 
 def free_travel_over_every_cell(cells, radius, pose, robot, delta, backward, reach, step=1.0):
-    """safety.free_travel as it was written: every cell tested at every step."""
+    """safety.free_travel as it was written: every cell tested at every step (backing, a cell
+    touched at the start blocks only the steps that take it deeper in)."""
     x, y, h = pose
     if not len(cells):
         return reach
@@ -160,7 +161,10 @@ def free_travel_over_every_cell(cells, radius, pose, robot, delta, backward, rea
     c, s = np.cos(hk), np.sin(hk)
     dx = cells[:, 0, None] - (rx + wb / 2 * c)
     dy = cells[:, 1, None] - (ry + wb / 2 * s)
-    inside = (np.abs(dx * c + dy * s) <= hl) & (np.abs(dy * c - dx * s) <= hw)
+    depth = np.minimum(hl - np.abs(dx * c + dy * s), hw - np.abs(dy * c - dx * s))
+    inside = depth >= 0
+    if backward:
+        inside = np.where(inside[:, :1], depth > depth[:, :1], inside)
     hit = inside.any(axis=0)
     if not hit.any():
         return reach

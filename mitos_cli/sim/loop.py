@@ -7,7 +7,7 @@ poses: :func:`true_inputs`); a robot whose footprint touches anything has collid
 (the run ends); a robot within its goal's tolerance is done (it stops and stays as an obstacle);
 the planner evaluates all active robots in one batch; the kinematics apply the steering-rate and
 acceleration limits and integrate in ``substeps`` exact arcs. The run ends in ``success`` (every
-robot at its goal), ``collision``, ``stuck`` (a robot moved less than ``STUCK_DISTANCE`` in
+robot at its goal), ``collision``, ``stuck`` (a robot drove less than ``STUCK_DISTANCE`` in
 ``STUCK_TIME``) or ``timeout``; a robot still driving when another's collision or stuck ends
 the run reads ``stopped`` in its own outcome.
 
@@ -366,7 +366,7 @@ class Simulation:
         grid = self.scene.plan_grid or knowledge.plan_grid(self._given, self.scene.static,
                                                            self.world)
         self._maps = [knowledge.RobotMap.of(grid) for _ in range(n)]
-        self._history: list[tuple[np.ndarray, np.ndarray]] = []   # (x, y) after each move
+        self._odometer: list[np.ndarray] = []      # in each robot has driven, after each move
         self._recovery = [safety.Recovery() for _ in range(n)]
         self._backed: list[tuple[int, int]] = []
         self._outcomes = ["timeout"] * n
@@ -750,17 +750,18 @@ class Simulation:
                 steer: np.ndarray) -> None:
         """The robots' state after :func:`kinematics.step` (fresh arrays, never changed in
         place: the history keeps them)."""
+        driven = np.hypot(x - self._x, y - self._y)
+        self._odometer.append(self._odometer[-1] + driven if self._odometer else driven)
         self._x, self._y, self._h, self._v, self._steer = x, y, h, v, steer
-        self._history.append((x, y))
 
     def _check_stuck(self) -> bool:
-        """A driving robot that moved less than ``STUCK_DISTANCE`` in ``STUCK_TIME`` is stuck
-        (the run ends)."""
-        history, window = self._history, self._stuck_window
-        if len(history) <= window:
+        """A driving robot that drove less than ``STUCK_DISTANCE`` in ``STUCK_TIME`` is stuck
+        (the run ends). Driven, not displaced: a robot backing out of a pocket and turning
+        round may come back near where it was, and it was not stuck."""
+        odometer, window = self._odometer, self._stuck_window
+        if len(odometer) <= window:
             return False
-        (x1, y1), (x0, y0) = history[-1], history[-1 - window]
-        moved = np.hypot(x1 - x0, y1 - y0)
+        moved = odometer[-1] - odometer[-1 - window]
         stuck = self._active & (moved < STUCK_DISTANCE)
         for i in np.flatnonzero(stuck):
             self._outcomes[i] = "stuck"

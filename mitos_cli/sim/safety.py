@@ -48,7 +48,8 @@ def free_travel(cells: np.ndarray, radius: float, pose: tuple[float, float, floa
     """How far (in, along the rear axle's path) the robot can drive from ``pose`` (x, y, heading
     in rad) with its wheel held ``delta`` degrees off straight (positive right), forward or
     ``backward``, before its footprint touches one of the occupied ``cells [P, 2]`` (discs of
-    ``radius``); ``reach`` when it can drive that far, 0 when it touches one already.
+    ``radius``); ``reach`` when it can drive that far, 0 when it touches one already, but for
+backing out: backward, a cell it touches blocks only the steps that take it deeper in.
 
     Only the cells in the box the footprint's circumscribed disc sweeps are tested: a cell
     outside it is inside no footprint along the arc (1e-6 in of slack for rounding), and each
@@ -76,7 +77,11 @@ def free_travel(cells: np.ndarray, radius: float, pose: tuple[float, float, floa
         return reach
     px, py = px[swept, None], py[swept, None]
     dx, dy = px - cx, py - cy
-    inside = (np.abs(dx * c + dy * s) <= hl) & (np.abs(dy * c - dx * s) <= hw)     # [P, K]
+    depth = np.minimum(hl - np.abs(dx * c + dy * s), hw - np.abs(dy * c - dx * s))  # [P, K]
+    inside = depth >= 0
+    if backward:    # backing away from a cell the body touches already (a mark a noisy echo
+        # put at its edge) is not blocked by it until a step takes the body deeper in
+        inside = np.where(inside[:, :1], depth > depth[:, :1], inside)
     hit = inside.any(axis=0)
     if not hit.any():
         return reach
@@ -151,8 +156,9 @@ def guard(command: tuple[float, float], body: Body, rec: Recovery, dt: float,
     rec.held = rec.held + dt if abs(want) > cfg.want and limit < cfg.want else 0.0
     if rec.held < cfg.patience or robot.max_reverse <= 0:
         return (steer, speed), False
-    lock = robot.steering_min if body.route_side > 0 else robot.steering_max
-    for wheel in (lock, robot.steering_straight):
+    lock, other = ((robot.steering_min, robot.steering_max) if body.route_side > 0 else
+                   (robot.steering_max, robot.steering_min))
+    for wheel in (lock, robot.steering_straight, other):    # the last rather than stay put
         if body.free(wheel, True, cfg) >= cfg.back_room:
             rec.left, rec.wheel, rec.held = cfg.back_time, wheel, 0.0
             return (wheel, -robot.max_reverse), True
