@@ -220,9 +220,9 @@ class RobotMap:
         inside = (row >= 0) & (row < rows) & (col >= 0) & (col < cols)
         return row, col, inside
 
-    def near(self, p: np.ndarray, reach: float, given: bool = False) -> np.ndarray:
-        """The centres ``[P, 2]`` of the occupied cells in the square of half side ``reach``
-        around ``p`` (``given``: of the cells it was given, without its marks)."""
+    def _square(self, p: np.ndarray, reach: float) -> tuple[int, int, int, int]:
+        """Rows ``r0:r1`` and columns ``c0:c1`` of the cells in the square of half side
+        ``reach`` around ``p``, clipped to the grid."""
         g = self.grid
         res, (ox, oy) = g.resolution, g.origin
         rows, cols = self.occupied.shape
@@ -230,6 +230,12 @@ class RobotMap:
         r0 = min(max(int((p[1] - reach - oy) // res), 0), rows)
         c1 = min(max(int((p[0] + reach - ox) // res) + 1, 0), cols)
         r1 = min(max(int((p[1] + reach - oy) // res) + 1, 0), rows)
+        return r0, r1, c0, c1
+
+    def near(self, p: np.ndarray, reach: float, given: bool = False) -> np.ndarray:
+        """The centres ``[P, 2]`` of the occupied cells in the square of half side ``reach``
+        around ``p`` (``given``: of the cells it was given, without its marks)."""
+        r0, r1, c0, c1 = self._square(p, reach)
         cells = self.grid.occupied if given else self.occupied
         return _centres_of(self.grid, cells[r0:r1, c0:c1], r0, c0)
 
@@ -243,12 +249,8 @@ class RobotMap:
         if not len(self.marks):
             return
         g = self.grid
-        res, (ox, oy) = g.resolution, g.origin
-        rows, cols = self.occupied.shape
-        c0 = min(max(int((origin[0] - max_range - ox) // res), 0), cols)
-        r0 = min(max(int((origin[1] - max_range - oy) // res), 0), rows)
-        c1 = min(max(int((origin[0] + max_range - ox) // res) + 1, 0), cols)
-        r1 = min(max(int((origin[1] + max_range - oy) // res) + 1, 0), rows)
+        res, cols = g.resolution, self.occupied.shape[1]
+        r0, r1, c0, c1 = self._square(origin, max_range)
         # the marks in that window, in the row-major order np.nonzero would give them
         r, c = np.divmod(self.marks, cols)
         window = (r >= r0) & (r < r1) & (c >= c0) & (c < c1)
