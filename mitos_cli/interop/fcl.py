@@ -39,6 +39,7 @@ from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput
 from ..errors import FormatError, Span, did_you_mean
 from ..fuzzy import norms
 from ..fuzzy.shapes import TSUKAMOTO
+from ..lang.bulk import without_cyclic_gc
 from ..lang.cache import lark_parser
 from ..lang.model import And, Not, Prop, Rule, RuleBase
 from ..lang.resolve import MAIN
@@ -112,6 +113,7 @@ def _word(terminal: str) -> str:
     return "`" + terminal.replace("_", " ").lower() + "`" if terminal.isupper() else terminal
 
 
+@without_cyclic_gc
 def parse_fcl(text: str, path: str | None = None) -> RuleBase:
     """Read FCL ``text`` into a rule base (one behavior, ``main``)."""
     try:

@@ -29,6 +29,7 @@ import re
 from pathlib import Path
 
 from ..errors import FormatError, Span, did_you_mean
+from ..lang.bulk import without_cyclic_gc
 from ..lang.model import And, Consequent, Or, Prop, Rule, RuleBase
 from ..lang.terms import Role, Term, Variable
 from ..words import plural
@@ -115,6 +116,7 @@ def _vector(value: str, vspan: Span) -> list[float]:
     return [common.number(w, vspan) for w in value[1:-1].replace(",", " ").split()]
 
 
+@without_cyclic_gc
 def parse_fis(text: str, path: str | None = None) -> RuleBase:
     """Read ``.fis`` text into a rule base (one behavior, ``main``)."""
     sections, rule_lines = _sections(text, path)

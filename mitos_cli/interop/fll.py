@@ -31,6 +31,7 @@ from lark.exceptions import UnexpectedInput
 
 from ..errors import FormatError, Span, did_you_mean
 from ..fuzzy.formula import parse as parse_formula
+from ..lang.bulk import without_cyclic_gc
 from ..lang.cache import lark_parser
 from ..lang.model import Rule, RuleBase
 from ..lang.model import format_number as _fmt_weight
@@ -124,6 +125,7 @@ def _read_text(path: Path) -> str:
         raise FormatError(f"cannot read `{path}`: {exc.strerror or exc}") from None
 
 
+@without_cyclic_gc
 def parse_fll(text: str, path: str | None = None) -> RuleBase:
     """Read FLL ``text`` into a rule base: one behavior ``main``, or, when rule blocks need
     different operators (fuzzylite's hybrid engines), one behavior per block."""

@@ -17,6 +17,7 @@ from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput
 from ..errors import RuleSyntaxError, Span
 from ..fuzzy.hedges import HEDGES
 from ..resources import grammar_text
+from .bulk import without_cyclic_gc
 from .cache import lark_parser
 from .model import And, Behavior, Consequent, Not, Or, Prop, Rule, Setting, Use
 
@@ -307,6 +308,7 @@ def check_nesting(tree: Tree, text: str, path: str | None, limit: int = MAX_NEST
         stack.extend((child, depth + 1) for child in node.children if isinstance(child, Tree))
 
 
+@without_cyclic_gc
 def parse_rules(text: str, path: str | None = None) -> ParsedFile:
     """Parse a whole rule file into model objects (names unchecked)."""
     tree = parse_tree(text, path)

@@ -14,6 +14,7 @@ from ..errors import RuleBaseError, Span, TermSetError, unknown
 from ..fuzzy.hedges import HEDGES
 from ..resources import is_file
 from . import operators as ops_mod
+from .bulk import without_cyclic_gc
 from .model import And, Behavior, Consequent, Expr, Not, Or, Prop, Rule, RuleBase
 from .parse import ParsedFile, parse_rules
 from .termfile import load_termset
@@ -22,6 +23,7 @@ from .terms import TermSet, Variable
 MAIN = "main"
 
 
+@without_cyclic_gc
 def load_rules_file(path: str | Path) -> RuleBase:
     """Read, parse and check the rule file at ``path`` and the term sets it names."""
     from ..fileio import finish_saves
