@@ -117,6 +117,30 @@ def test_the_given_maps_unknown_cells_are_planned_through_and_the_truths_are_wal
     assert route.length == pytest.approx(1.2 * INCH_PER_M, abs=1.0)
 
 
+def test_an_mrpb_tests_time_limit_is_measured_along_its_route(tmp_path, monkeypatch):
+    """A wall between start and goal with its gap at the far end: the route is three times
+    the straight line, and so is the limit (``track``'s loop is five times)."""
+    monkeypatch.setattr(mrpb, "MIN_TIME_S", 0.0)
+    pixels = np.full((40, 40), 254)
+    pixels[0, :] = pixels[-1, :] = pixels[:, 0] = pixels[:, -1] = 0
+    pixels[:26, 20] = 0                                 # open only near the bottom: 0.65 m
+    _scenario(tmp_path, "room02", pixels, "test 1: start (-0.5, 0.7, 0) -> goal (0.5, 0.7, 0)\n")
+    [w] = mrpb.scenario_worlds(tmp_path, "room02")
+    length = prepare(w).routes[0].length
+    assert length > 2.5 * INCH_PER_M                   # the straight line: 1 m
+    assert w.time_limit == pytest.approx(mrpb.TIME_PER_M * length / INCH_PER_M)
+
+
+def test_a_refused_mrpb_test_keeps_the_straight_lines_limit(tmp_path, monkeypatch):
+    monkeypatch.setattr(mrpb, "MIN_TIME_S", 0.0)
+    pixels = np.full((40, 40), 254)
+    pixels[0, :] = pixels[-1, :] = pixels[:, 0] = pixels[:, -1] = 0
+    pixels[:, 20] = 0                                   # no way through
+    _scenario(tmp_path, "room02", pixels)
+    [w] = mrpb.scenario_worlds(tmp_path, "room02")
+    assert w.time_limit == pytest.approx(mrpb.TIME_PER_M * 1.2)
+
+
 def test_mrpb_drives_a_robot_of_mrpbs_size_through_its_22_in_gap(tmp_path):
     """track's only way is 0.56 m wide: MRPB's Pioneer passes it, the packaged tricycle not."""
     pixels = np.full((40, 40), 254)
