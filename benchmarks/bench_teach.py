@@ -4,6 +4,7 @@ Run from the repository root (one command; ``PYTHONPATH=.`` when the installed `
 is another checkout's)::
 
     python benchmarks/bench_teach.py            # add --quick for a fast smoke run
+    python benchmarks/bench_teach.py --only-fit --lesson my.lesson   # section e, another lesson
 
 It measures, in one run, on the packaged MITOS rule base (behavior ``avoid_obstacle``, the
 paper's 27 rules, 23 learnable numbers):
