@@ -2,13 +2,15 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
 import pytest
 
-from mitos_cli.sim.clutter import FREE_WAY_IN, KINDS, clutter
+from mitos_cli.sim.clutter import FREE_WAY_IN, KINDS, clutter, passable
 from mitos_cli.sim.loop import prepare
+from mitos_cli.sim.world import Motion, Obstacle
 from mitos_cli.sim.worldfile import parse_world
 
 HALL = """\
@@ -77,3 +79,26 @@ def test_the_clutter_is_unknown_to_the_route(hall):
     assert np.array_equal(again.routes[0].points, scene.routes[0].points)
     assert not any(getattr(o, "known", False) for o in cluttered.obstacles)
     assert math.isclose(again.routes[0].length, scene.routes[0].length)
+
+
+@pytest.mark.parametrize(("y", "width", "way"), [(20.0, 40.0, True), (10.0, 40.0, True),
+                                                 (5.0, 60.0, False), (0.0, 80.0, False)])
+def test_a_way_is_passable_when_the_body_fits_through_it(hall, y, width, way):
+    """The 18 in robot with its 2 in margin needs 22 in: 30 in pass, 15 in do not."""
+    world, _ = hall
+    box = Obstacle("box_1", "rectangle", 600.0, y, length=16.0, width=width)
+    assert passable(world, (box,)) is way
+
+
+def test_what_moves_does_not_shut_the_way(hall):
+    world, _ = hall
+    cart = Obstacle("cart", "rectangle", 600.0, 0.0, length=16.0, width=80.0,
+                    motion=Motion("velocity", velocity=(-10.0, 0.0)))
+    assert passable(world.with_changes(obstacles=(cart,)), ())
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_every_draw_leaves_the_robot_a_way_to_its_goal(hall, seed):
+    w = draw(hall, seed, count=12)
+    known = tuple(dataclasses.replace(o, known=True) for o in w.obstacles)
+    prepare(w.with_changes(obstacles=known))          # raises when there is no way

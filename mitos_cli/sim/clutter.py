@@ -10,17 +10,29 @@ the three counts. A place where the corridor is too narrow for the object and th
 skipped; the next draw tries another. Objects are at least ``spacing_in`` apart along the
 route, so two of them never close the way between them.
 
+The width across the route is a promise about a straight corridor; where the route bends
+through a door, an object beside the door can shut it for a body coming round the bend, with
+the ray across the route still finding 40 in. So every object is also checked the way BARN's
+generator checks its fields (:func:`passable`): drawn on the map with everything else that
+stands still, the route planner must still find a way from the start to the goal that the
+robot's body fits through (its half width and margin from everything); an object that shuts
+it is drawn again. The check takes nothing from the generator, so clutter that passes it is
+the clutter the same seed gave before.
+
 Everything comes from the generator passed in: the same seed gives the same clutter.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 
 import numpy as np
 
+from ..errors import MitosError
 from .geometry import ray_segments
+from .loop import prepare
 from .route import Route
 from .staticmap import StaticMap
 from .world import Obstacle, World
@@ -98,10 +110,26 @@ def clutter(world: World, static: StaticMap, route: Route, rng: np.random.Genera
                 continue
             name = f"{kind.name}_{k + 1}"
             if kind.radius:
-                placed.append(Obstacle(name, "circle", x, y, radius=kind.radius))
+                new = Obstacle(name, "circle", x, y, radius=kind.radius)
             else:
-                placed.append(Obstacle(name, "rectangle", x, y, length=kind.length,
-                                       width=kind.width, angle=math.degrees(heading)))
+                new = Obstacle(name, "rectangle", x, y, length=kind.length, width=kind.width,
+                               angle=math.degrees(heading))
+            if not passable(world, (*placed, new)):
+                continue
+            placed.append(new)
             taken.append(s)
             break
     return world.with_changes(obstacles=world.obstacles + tuple(placed))
+
+
+def passable(world: World, objects: tuple[Obstacle, ...]) -> bool:
+    """Whether the robot of ``world`` still has a way to its goal that its body fits through
+    with ``objects`` and the world's obstacles that stand still drawn on its map (moving ones
+    pass by)."""
+    still = tuple(dataclasses.replace(o, known=True) for o in (*world.obstacles, *objects)
+                  if o.motion.kind == "static")
+    try:
+        prepare(world.with_changes(obstacles=still))
+    except MitosError:
+        return False
+    return True
