@@ -102,3 +102,20 @@ def test_every_draw_leaves_the_robot_a_way_to_its_goal(hall, seed):
     w = draw(hall, seed, count=12)
     known = tuple(dataclasses.replace(o, known=True) for o in w.obstacles)
     prepare(w.with_changes(obstacles=known))          # raises when there is no way
+
+
+def test_nothing_is_put_where_a_moving_obstacle_passes(hall):
+    """A cart coming head-on in the lower half of the hall, 900 in in the run's 30 s (from
+    x = 1150 to 250): every object stays out of the band it sweeps (the discs holding it and
+    the object, and 2 in) or beyond where it gets to."""
+    world, scene = hall
+    cart = Obstacle("cart", "rectangle", 1150.0, -14.0, length=22.0, width=16.0,
+                    motion=Motion("velocity", velocity=(-30.0, 0.0)))
+    busy = world.with_changes(obstacles=(cart,))
+    for seed in range(8):
+        w = clutter(busy, scene.static, scene.routes[0], np.random.default_rng(seed), 6)
+        reach_cart = math.hypot(22.0, 16.0) / 2
+        for o in w.obstacles[1:]:
+            reach = o.radius or math.hypot(o.length, o.width) / 2
+            gap = reach_cart + reach + 2.0
+            assert abs(o.y - -14.0) >= gap - 1e-6 or o.x <= 250.0 - gap + 2.0

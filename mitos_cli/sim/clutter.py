@@ -10,14 +10,19 @@ the three counts. A place where the corridor is too narrow for the object and th
 skipped; the next draw tries another. Objects are at least ``spacing_in`` apart along the
 route, so two of them never close the way between them.
 
+Nothing is put where a moving obstacle of the world passes during the run (its path, from the
+start to the time limit, widened by both objects' sizes and ``MOVING_GAP_IN``): a cart would
+drive through a box as if it were not there, which no building shows.
+
 The width across the route is a promise about a straight corridor; where the route bends
 through a door, an object beside the door can shut it for a body coming round the bend, with
 the ray across the route still finding 40 in. So every object is also checked the way BARN's
 generator checks its fields (:func:`passable`): drawn on the map with everything else that
 stands still, the route planner must still find a way from the start to the goal that the
 robot's body fits through (its half width and margin from everything); an object that shuts
-it is drawn again. The check takes nothing from the generator, so clutter that passes it is
-the clutter the same seed gave before.
+it is drawn again. Neither check draws from the generator: a draw none of whose objects fails
+them is what the seed gave before they were made (an object drawn again changes the ones
+after it).
 
 Everything comes from the generator passed in: the same seed gives the same clutter.
 """
@@ -31,6 +36,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import MitosError
+from . import obstacles as obs_mod
 from .geometry import ray_segments
 from .loop import prepare
 from .route import Route
@@ -55,12 +61,18 @@ class Kind:
     def across(self) -> float:
         return 2 * self.radius if self.radius else self.width
 
+    @property
+    def reach(self) -> float:
+        """The radius of the disc round its centre that holds it."""
+        return self.radius or math.hypot(self.length, self.width) / 2
+
 
 #: what an office or a hospital corridor holds (inches)
 KINDS = (Kind("box", 16.0, 16.0), Kind("bin", radius=8.0), Kind("trolley", 30.0, 18.0))
 
 FREE_WAY_IN = 40.0         # in: the way left open past every object
 SPACING_IN = 90.0          # in: between objects, and from the start, the goal, other obstacles
+MOVING_GAP_IN = 2.0        # in: between an object and where a moving obstacle passes
 REACH_IN = 400.0           # in: how far across the route the walls are looked for
 MAX_TRIES = 40             # draws per object before giving up on it
 
@@ -86,6 +98,7 @@ def clutter(world: World, static: StaticMap, route: Route, rng: np.random.Genera
     placed: list[Obstacle] = []
     taken = [0.0, route.length]                                    # start and goal
     others = np.array([[o.x, o.y] for o in world.obstacles]).reshape(-1, 2)
+    paths = moving_paths(world)
     for k in range(count):
         for _ in range(MAX_TRIES):
             kind = kinds[int(rng.integers(len(kinds)))]
@@ -108,6 +121,9 @@ def clutter(world: World, static: StaticMap, route: Route, rng: np.random.Genera
             y = float(p[1] + math.cos(heading) * offset)
             if len(others) and np.hypot(*(others - (x, y)).T).min() < spacing_in:
                 continue
+            if any(np.hypot(*(centres - (x, y)).T).min() < reach + kind.reach + MOVING_GAP_IN
+                   for centres, reach in paths):
+                continue
             name = f"{kind.name}_{k + 1}"
             if kind.radius:
                 new = Obstacle(name, "circle", x, y, radius=kind.radius)
@@ -120,6 +136,19 @@ def clutter(world: World, static: StaticMap, route: Route, rng: np.random.Genera
             taken.append(s)
             break
     return world.with_changes(obstacles=world.obstacles + tuple(placed))
+
+
+def moving_paths(world: World) -> list[tuple[np.ndarray, float]]:
+    """Where each moving obstacle of ``world`` goes during a run: its centre at every tick up
+    to the time limit ``[T, 2]``, and the radius of the disc round its centre that holds it."""
+    times = np.arange(0.0, world.time_limit + world.dt, world.dt)
+    out = []
+    for o in world.obstacles:
+        if o.motion.kind == "static":
+            continue
+        reach = o.radius if o.shape == "circle" else math.hypot(o.length, o.width) / 2
+        out.append((np.array([obs_mod.position(o, float(t)) for t in times]), reach))
+    return out
 
 
 def passable(world: World, objects: tuple[Obstacle, ...]) -> bool:
