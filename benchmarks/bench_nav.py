@@ -15,7 +15,8 @@ Suites (docs/navigation.md says what each means and what was measured):
   its map;
 - ``clutter``: the shipped single-robot worlds (but ``figure4.yaml``, the paper's collision)
   and MRPB's office02 building with 3-6 seeded unknown boxes, bins and trolleys each
-  (:func:`mitos_cli.sim.clutter.clutter`, a 40 in way left past each), ``--draws`` per world;
+  (:func:`mitos_cli.sim.clutter.clutter`: a 40 in way left past each, a way to the goal the
+  robot fits through, none on a moving obstacle's path), ``--draws`` per world;
 - ``ticks``: one line, the speed aim: a BARN field of ``--ticks-obstacles`` unknown poles (one
   obstacle per pole), run by each planner on one core, in ticks per second of wall time.
 
