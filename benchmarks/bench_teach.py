@@ -51,6 +51,7 @@ import numpy as np
 
 from mitos_cli import load_rulebase
 from mitos_cli.engine.compile import compile_rulebase
+from mitos_cli.errors import MitosError
 from mitos_cli.lang.model import Setting
 from mitos_cli.teach.adapt import adapt, gradient, loss, parameterise, with_values
 
@@ -193,8 +194,15 @@ def main() -> None:
 
 def print_fit(epochs: int, lesson: Path) -> None:
     """Section e: the lesson's fit, constrained against unconstrained."""
-    fit = lesson_fit(epochs, lesson)
+    try:
+        fit = lesson_fit(epochs, lesson)
+    except MitosError as exc:
+        print(exc, file=sys.stderr)
+        raise SystemExit(1) from None
     if fit is None:
+        if lesson != LESSON:                # named by the user: a mistake, not a lean checkout
+            print(f"{lesson}: no such lesson", file=sys.stderr)
+            raise SystemExit(1)
         print(f"{lesson}: no such lesson (section e skipped)")
         return
     (qc, ec), (qu, eu), released = fit
@@ -290,10 +298,10 @@ def lesson_fit(epochs: int, lesson: Path = LESSON):
         return None
     session = Session(ROOT / "rulebases" / "mitos.rules", out=lambda s: None)
     session.base = ROOT
-    for _, line in commands(lesson.read_text(encoding="utf-8")):
+    for lineno, line in commands(lesson.read_text(encoding="utf-8")):
         if line.startswith("adapt"):
             break
-        session.run(line)
+        session.run(line, str(lesson), lineno)
     compiled = session.compiled()
     X, T = session.training_set(compiled)
     def run(**kw):
