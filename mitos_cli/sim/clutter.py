@@ -64,7 +64,7 @@ class Kind:
     @property
     def reach(self) -> float:
         """The radius of the disc round its centre that holds it."""
-        return self.radius or math.hypot(self.length, self.width) / 2
+        return holding_radius(self.radius, self.length, self.width)
 
 
 #: what an office or a hospital corridor holds (inches)
@@ -138,6 +138,12 @@ def clutter(world: World, static: StaticMap, route: Route, rng: np.random.Genera
     return world.with_changes(obstacles=world.obstacles + tuple(placed))
 
 
+def holding_radius(radius: float, length: float, width: float) -> float:
+    """The radius of the disc round a shape's centre that holds it: a circle's own, else half
+    a rectangle's diagonal."""
+    return radius or math.hypot(length, width) / 2
+
+
 def moving_paths(world: World) -> list[tuple[np.ndarray, float]]:
     """Where each moving obstacle of ``world`` goes during a run: its centre at every tick up
     to the time limit ``[T, 2]``, and the radius of the disc round its centre that holds it."""
@@ -146,7 +152,7 @@ def moving_paths(world: World) -> list[tuple[np.ndarray, float]]:
     for o in world.obstacles:
         if o.motion.kind == "static":
             continue
-        reach = o.radius if o.shape == "circle" else math.hypot(o.length, o.width) / 2
+        reach = holding_radius(o.radius if o.shape == "circle" else 0.0, o.length, o.width)
         out.append((np.array([obs_mod.position(o, float(t)) for t in times]), reach))
     return out
 
