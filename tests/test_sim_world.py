@@ -162,3 +162,70 @@ def test_packaged_world_names_resolve_and_unknown_ones_suggest():
     assert resolve_world_path("figure4").name == "figure4.yaml"
     with pytest.raises(WorldError, match="did you mean `figure4.yaml`"):
         resolve_world_path("figure5.yaml")
+
+
+def test_a_start_where_the_body_reaches_into_a_wall_is_refused_at_its_line():
+    # the centre is 2 in inside the 70 in corridor; half the 18 in body is in the wall
+    msg = error(BASE.replace("q_init: {x: 30, y: 0", "q_init: {x: 30, y: -33"))
+    assert "w.yaml:9:9" in msg and "the robot's body (24 x 18 in) reaches into a wall" in msg
+    assert parse_world(BASE.replace("q_init: {x: 30, y: 0", "q_init: {x: 30, y: -25"),
+                       "w.yaml")                        # 1 in to spare
+    msg = error(BASE.replace("q_init: {x: 30, y: 0, heading: 0",
+                             "q_init: {x: 30, y: -25, heading: 90"))    # turned across
+    assert "reaches into a wall" in msg
+
+
+def _pinched(width: float, extra: str = "") -> str:
+    """BASE with its middle 100 in narrowed to ``width``."""
+    return BASE.replace(
+        "    - points: [[0, 0], [400, 0]]\n      width: 70\n",
+        "    - points: [[0, 0], [150, 0]]\n      width: 70\n"
+        f"    - points: [[150, 0], [250, 0]]\n      width: {width}\n"
+        "    - points: [[250, 0], [400, 0]]\n      width: 70\n") + extra
+
+
+def test_a_corridor_narrower_than_the_robot_is_refused_naming_the_place():
+    from mitos_cli.sim.loop import prepare
+    from mitos_cli.sim.route import NarrowPassage
+
+    with pytest.raises(NarrowPassage) as info:
+        prepare(parse_world(_pinched(16), "w.yaml"))
+    msg = info.value.render()
+    assert "keeps 8.0 in from the walls (a corridor 16 in wide); it needs 11.0 in" in msg
+    x = float(msg.split("passes (")[1].split(",")[0])
+    assert 150 <= x <= 250
+    assert "the robot is 18 in wide: widen the corridor to at least 22 in" in msg
+
+
+def test_a_corridor_the_robot_fits_is_a_squeeze_the_world_may_allow():
+    from mitos_cli.sim.loop import prepare
+    from mitos_cli.sim.route import NarrowPassage
+
+    with pytest.raises(NarrowPassage, match=r"min_clearance: 9.9\}"):
+        prepare(parse_world(_pinched(20), "w.yaml"))
+    scene = prepare(parse_world(_pinched(20, "route: {min_clearance: 9.9}\n"), "w.yaml"))
+    assert scene.routes[0].length == pytest.approx(270.0)
+
+
+def test_a_corridor_route_goes_round_a_narrow_stretch_when_a_wide_way_leads_on():
+    from mitos_cli.sim.loop import prepare
+
+    loop = ("    - points: [[120, 0], [120, 150], [280, 150], [280, 0]]\n      width: 70\n")
+    text = _pinched(16).replace("      width: 16\n", "      width: 16\n" + loop)
+    route = prepare(parse_world(text, "w.yaml")).routes[0]
+    assert route.points[:, 1].max() == pytest.approx(150.0)     # north round the loop
+    assert route.length == pytest.approx(270.0 + 2 * 150.0)
+
+
+def test_a_behavior_the_rule_base_lacks_is_reported_at_the_world_files_line():
+    from mitos_cli.errors import NameError_
+    from mitos_cli.sim.planner import make_planner
+
+    w = parse_world(BASE + "behavior: drvie\n", "w.yaml")
+    with pytest.raises(NameError_) as info:
+        make_planner("fuzzy", w)
+    msg = info.value.render()
+    assert "w.yaml:15:11" in msg and "did you mean `drive`?" in msg
+    with pytest.raises(NameError_) as info:            # named on the command line: no line
+        make_planner("fuzzy", w, behavior="drvie")
+    assert info.value.span is None

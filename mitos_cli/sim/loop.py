@@ -69,7 +69,8 @@ def prepare(world: World) -> Scene:
     for a in world.agents:
         asked, least = clearances(world, a)
         if given.plain:
-            routes.append(plan_route(static, world.corridors, a.start, a.goal, asked, least))
+            routes.append(plan_route(static, world.corridors, a.start, a.goal, asked, least,
+                                     half_width=a.robot.width / 2))
         else:
             known = StaticMap(given.walls, np.zeros((0, 4, 2)), given.grid, static.bounds)
             routes.append(grid_route(known, a.start, a.goal, asked, minimum=least))

@@ -30,7 +30,7 @@ from typing import Protocol
 
 import numpy as np
 
-from ..errors import RuleBaseError, unknown
+from ..errors import NameError_, RuleBaseError, unknown
 
 
 @dataclass(frozen=True)
@@ -124,7 +124,13 @@ class PlannerKind:
 
 
 def _fuzzy(world, rulebase=None, behavior: str | None = None) -> Planner:
-    return FuzzyPlanner(rulebase, behavior or world.behavior)
+    try:
+        return FuzzyPlanner(rulebase, behavior or world.behavior)
+    except NameError_ as exc:       # the world file's `behavior:` names none of the rule base's
+        if behavior or exc.span is not None or not exc.message.startswith("unknown behavior"):
+            raise
+        exc.span = getattr(world, "behavior_span", None)
+        raise
 
 
 def _potential_field(world, rulebase=None, behavior: str | None = None) -> Planner:

@@ -17,7 +17,7 @@ import numpy as np
 
 from ..errors import WorldError
 from .distance import _capped, distance_transform
-from .geometry import clip_arrays
+from .geometry import clip_arrays, point_segment_distance
 from .staticmap import StaticMap
 from .world import Corridor, Goal, Grid, Pose, Robot
 
@@ -156,8 +156,13 @@ def _astar(neighbours, start: int, goal: int, pos) -> list[int] | None:
     return None
 
 
-def corridor_route(corridors: tuple[Corridor, ...], start: Pose, goal: Goal) -> Route:
-    """The shortest way along the corridors' centre lines, joined where they cross."""
+def corridor_route(corridors: tuple[Corridor, ...], start: Pose, goal: Goal,
+                   walls: np.ndarray | None = None, least: float = 0.0,
+                   half_width: float = 0.0) -> Route:
+    """The shortest way along the corridors' centre lines, joined where they cross, keeping
+    ``least`` inches from the ``walls [W, 4]`` (when given): a stretch narrower than that is
+    left out, and with no way round it the goal is refused, naming the narrowest place of the
+    widest way (:class:`NarrowPassage`; ``half_width``: the robot's, for what it suggests)."""
     segs = [(np.asarray(a, float), np.asarray(b, float), c.width)
             for c in corridors for a, b in zip(c.points[:-1], c.points[1:])]
     splits = [{0.0, 1.0} for _ in segs]
@@ -207,13 +212,72 @@ def corridor_route(corridors: tuple[Corridor, ...], start: Pose, goal: Goal) -> 
             adj.setdefault(u, []).append((v, step))
             adj.setdefault(v, []).append((u, step))
     s_id, g_id = (node(segs[i][0] + t * (segs[i][1] - segs[i][0])) for _, i, t in ends)
-    path = _astar(lambda n: adj.get(n, []), s_id, g_id, lambda n: coords[n])
+    room = _edge_room(adj, coords, walls)
+    path = _astar(lambda n: [(v, step) for v, step in adj.get(n, []) if room[n, v] >= least],
+                  s_id, g_id, lambda n: coords[n])
     if path is None:
-        raise WorldError("the corridors do not connect the start to the goal",
-                         hint="join the corridors: a route follows their centre lines")
+        if _astar(lambda n: adj.get(n, []), s_id, g_id, lambda n: coords[n]) is None:
+            raise WorldError("the corridors do not connect the start to the goal",
+                             hint="join the corridors: a route follows their centre lines")
+        assert walls is not None            # without walls every edge has room
+        raise _narrow_corridor(adj, coords, room, s_id, g_id, walls, least, half_width)
     # the route runs from the start's to the goal's projection onto the centre lines; the
     # goal itself is kept apart (perception steers for it over the last lookahead)
     return Route.of([coords[n] for n in path], goal=(goal.x, goal.y))
+
+
+def _edge_room(adj: dict[int, list[tuple[int, float]]], coords: list[np.ndarray],
+               walls: np.ndarray | None) -> dict[tuple[int, int], float]:
+    """The least distance from each edge ``(u, v)`` of the centre-line graph to the walls
+    (``inf`` without walls). An edge runs inside the corridors and crosses no wall, so the
+    distance between the two segments is that of the nearer end of one to the other."""
+    edges = sorted({(u, v) for u, out in adj.items() for v, _ in out})
+    if walls is None or not len(walls) or not edges:
+        return {e: math.inf for e in edges}
+    a = np.array([coords[u] for u, _ in edges])
+    b = np.array([coords[v] for _, v in edges])
+    ends = np.concatenate([a, b])                                            # [2E, 2]
+    to_walls = point_segment_distance(ends, walls).reshape(2, len(edges), -1).min(axis=0)
+    segs = np.concatenate([a, b], axis=1)                                    # [E, 4]
+    corners = np.concatenate([walls[:, :2], walls[:, 2:]])                  # [2W, 2]
+    to_edges = point_segment_distance(corners, segs).reshape(2, len(walls), -1).min(axis=0)
+    least = np.minimum(to_walls.min(axis=1), to_edges.min(axis=0))
+    return {e: float(d) for e, d in zip(edges, least)}
+
+
+def _narrow_corridor(adj, coords, room, s_id: int, g_id: int, walls: np.ndarray,
+                     least: float, half_width: float) -> NarrowPassage:
+    """The refusal of a corridor route: the widest way's narrowest edge (a bottleneck Dijkstra
+    over the centre-line graph) and the point of it nearest a wall."""
+    best = {s_id: math.inf}
+    came = {s_id: -1}
+    frontier = [(-math.inf, 0, s_id)]
+    tie = 0
+    while frontier:
+        width, _, u = heapq.heappop(frontier)
+        if u == g_id:
+            break
+        for v, _ in adj.get(u, []):
+            w = min(-width, room[u, v])
+            if w > best.get(v, -math.inf):
+                best[v], came[v] = w, u
+                tie += 1
+                heapq.heappush(frontier, (-w, tie, v))
+    path = _path(came, g_id)
+    u, v = min(zip(path[:-1], path[1:]), key=lambda e: room[e])
+    steps = np.linspace(0.0, 1.0, max(2, int(math.dist(coords[u], coords[v])) + 1))
+    points = coords[u] + steps[:, None] * (coords[v] - coords[u])
+    gap = point_segment_distance(points, walls).min(axis=1)
+    x, y = points[int(gap.argmin())]
+    g = float(gap.min())
+    squeeze = math.floor(g * 10) / 10
+    return NarrowPassage(
+        f"the only way to the goal passes ({x:.0f}, {y:.0f}), where the robot's centre keeps "
+        f"{g:.1f} in from the walls (a corridor {2 * g:.0f} in wide); it needs {least:.1f} in",
+        hint=(f"widen the corridor, or allow the squeeze with `route: {{min_clearance: "
+              f"{squeeze:g}}}`" if squeeze > half_width else
+              f"the robot is {2 * half_width:g} in wide: widen the corridor to at least "
+              f"{2 * least:g} in"))
 
 
 @dataclass(frozen=True)
@@ -666,9 +730,10 @@ def _refusal(node_c: np.ndarray, s, t, centre, floor: float,
 
 def plan_route(static: StaticMap, corridors: tuple[Corridor, ...], start: Pose, goal: Goal,
                clearance: float, minimum: float | None = None,
-               occupied: np.ndarray | None = None) -> Route:
+               occupied: np.ndarray | None = None, half_width: float = 0.0) -> Route:
     """The route over the corridors' centre lines or, with a grid, A* on the grid (on
     ``occupied`` when given: the cells the robot knows)."""
     if static.grid is None:
-        return corridor_route(corridors, start, goal)
+        return corridor_route(corridors, start, goal, static.walls,
+                              clearance if minimum is None else minimum, half_width)
     return grid_route(static, start, goal, clearance, minimum=minimum, occupied=occupied)

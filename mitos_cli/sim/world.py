@@ -10,6 +10,8 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from ..errors import Span
+
 
 @dataclass(frozen=True)
 class Pose:
@@ -162,6 +164,9 @@ class World:
     given: Grid | None = None      # grid ("given", this one), or nothing at all ("none")
     min_clearance: float | None = None   # in: the tightest squeeze its route may make
     replan: str = "clearance"      # when the route is planned again: one of REPLANS
+    behavior_span: Span | None = field(default=None, compare=False, repr=False)
+    # where the world file names ``behavior`` (the rule base, which knows the behaviors, is
+    # chosen later: an unknown name is reported there, pointing here)
 
     @property
     def robot(self) -> Robot:

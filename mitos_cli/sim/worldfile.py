@@ -349,7 +349,8 @@ def parse_world(text: str, path: str) -> World:
                  if "randomise" in top else Randomise())
     world = World(name, path, int(seed), dt, limit, int(substeps), tuple(agents), sensors,
                   tuple(corridors), grid, tuple(obstacles), randomise,
-                  str(top.get("behavior", "drive")), knows, given, min_clearance, replan)
+                  str(top.get("behavior", "drive")), knows, given, min_clearance, replan,
+                  top.value_span("behavior") if "behavior" in top else None)
     check_free(world, agent_spans)
     return world
 
@@ -384,10 +385,38 @@ def check_free(world: World, spans: list[tuple[Span, Span]]) -> None:
     for agent, (s_span, g_span) in zip(world.agents, spans):
         for what, p, span in (("start (q_init)", agent.start, s_span),
                               ("goal (q_goal)", agent.goal, g_span)):
+            who = "" if agent.name == "robot" else f" of `{agent.name}`"
             if not static.free(np.array([[p.x, p.y]]))[0]:
-                who = "" if agent.name == "robot" else f" of `{agent.name}`"
                 raise WorldError(f"the {what}{who} at ({p.x:g}, {p.y:g}) lies inside a wall",
                                  span=span, hint="move it into a corridor (free space)")
+        _check_body(agent, static, s_span)
+
+
+def _check_body(agent, static, span: Span) -> None:
+    """Refuse a start where the robot's footprint already touches a wall: the run would end
+    in a collision at its first tick."""
+    import math
+
+    import numpy as np
+
+    from .geometry import box_segment_distance
+
+    robot, (x, y, h) = agent.robot, (agent.start.x, agent.start.y,
+                                      math.radians(agent.start.heading))
+    hl, hw = robot.length / 2, robot.width / 2
+    walls = static.near(x, y, math.hypot(hl, hw))
+    if not len(walls):
+        return
+    c, s = math.cos(h), math.sin(h)
+    rel = walls.reshape(-1, 2) - (x, y)
+    local = np.stack([rel[:, 0] * c + rel[:, 1] * s, -rel[:, 0] * s + rel[:, 1] * c], axis=1)
+    if box_segment_distance(hl, hw, local.reshape(-1, 4)).min() <= 0.0:
+        who = "" if agent.name == "robot" else f" of `{agent.name}`"
+        raise WorldError(
+            f"at the start (q_init){who}, ({x:g}, {y:g}) heading {agent.start.heading:g} deg, "
+            f"the robot's body ({robot.length:g} x {robot.width:g} in) reaches into a wall",
+            span=span, hint="move the start further from the wall, or turn it along the "
+                            "corridor")
 
 
 def load_world(path: str | Path) -> World:
