@@ -80,6 +80,10 @@ def caret_under(exc: MitosError) -> str:
     ("r1: if road is WIDE then speed is", 34, None, "unexpected end of the input", "a name",
      None),
     ("r1: if (road is WIDE then speed is SLOW", 22, "then", "unexpected `then`", "`)`", None),
+    ("r1: iff road is WIDE then speed is SLOW", 9, "road", "unexpected `road`", "`is`",
+     "`iff` is read as a variable's name: did you mean `if`?"),
+    ("r1: if road is WIDE thn speed is SLOW", 21, "thn", "unexpected `thn`", "`then`",
+     "did you mean `then`?"),
     ("behavior b:\n  r1: if road is WIDE then speed is SLOW\n", 41, None,
      "unexpected end of the input", "`end`", "a behavior ends with `end`"),
 ])

@@ -67,6 +67,7 @@ def test_rule_lines_are_rules_of_the_rule_language():
     ("behavior", "the line ends too early", "a name", None),
     ("= 3", "unexpected `=`", "a name", "a line is a rule"),
     ("adapt epochs", "the line ends too early", "a number", None),
+    ("adapt epocs 5", "unexpected `epocs`", "`epochs`", "did you mean `epochs`?"),
 ])
 def test_mistyped_lines_say_what_was_expected(line, message, expected, hint):
     with pytest.raises(RuleSyntaxError) as info:

@@ -42,3 +42,13 @@ def test_a_term_is_shown_as_its_term_set_writes_it(name):
 def test_a_singleton_shows_its_value_alone():
     term = termset({"STOP": "{shape: singleton, value: 0.5}"}).variables[0].term("STOP")
     assert (term.shape_name, term.params_text()) == ("singleton", "0.5")
+
+
+def test_a_misspelt_key_of_a_triangle_is_pointed_at_with_a_suggestion():
+    from mitos_cli.errors import TermSetError
+
+    with pytest.raises(TermSetError) as info:
+        termset({"MEDIUM": "{shape: triangle, peek: 70, width: 30}"})
+    err = info.value
+    assert "unknown key `peek`" in err.message and err.hint == "did you mean `peak`?"
+    assert err.span.line == 6 and err.span.column == 33

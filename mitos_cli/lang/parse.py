@@ -69,6 +69,16 @@ def _expected(names) -> str:
     return words[0] if words else "something else"
 
 
+def keyword_hint(token: Token, expected) -> str | None:
+    """A misspelt keyword (``adapt epocs``, ``iff``): "did you mean" the closest keyword the
+    parser expected there, if one is close."""
+    from ..errors import did_you_mean
+
+    words = [n.lower() for n in expected if n.isupper() and n.isalpha() and n != "NAME"]
+    value = str(token.value)
+    return did_you_mean(value, words) if words and value.isidentifier() else None
+
+
 def _describe(token: Token) -> str:
     if token.type == "$END":
         return "the end of the input"
@@ -98,6 +108,8 @@ def syntax_error(exc: UnexpectedInput, text: str, path: str | None) -> RuleSynta
                                hint="the last rule or behavior is incomplete (a behavior ends "
                                     "with `end`)")
     assert isinstance(exc, UnexpectedToken)
+    from ..errors import did_you_mean
+
     token = exc.token
     span = Span.in_text(text, path, token.line, token.column,
                         token.column + max(1, len(str(token.value))))
@@ -105,15 +117,20 @@ def syntax_error(exc: UnexpectedInput, text: str, path: str | None) -> RuleSynta
     expected = set(exc.expected)
     if token.type == "NAME" and "IS" in expected:
         before = _word_before(text, token)
+        close = did_you_mean(before, RESERVED) if before else None
         if before in RESERVED:
             # `if road is WIDE and then ...`: the keyword was read as a variable's name
             hint = (f"`{before}` stands where a condition should be; a condition reads "
                     f"`variable is TERM`")
+        elif close:         # `r1: iff road is WIDE ...`: `iff` was read as a variable's name
+            hint = f"`{before}` is read as a variable's name: {close}"
         else:
             hint = "a condition reads `variable is TERM`"
     elif "THEN" in expected and token.type in ("NAME",):
-        hint = _hedge_hint(text, token) or \
+        hint = _hedge_hint(text, token) or keyword_hint(token, expected) or \
             "join conditions with `and` / `or`, and start the actions with `then`"
+    else:
+        hint = keyword_hint(token, expected)
     return RuleSyntaxError(f"unexpected {_describe(token)}", span=span,
                            expected=_expected(expected), hint=hint)
 

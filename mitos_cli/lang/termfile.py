@@ -185,6 +185,8 @@ def _term(name: str, spec: Any, key_span: Span, value_span: Span, variable: str,
         return _formula_term(what, name, spec, key_span, frozen)
     given = tuple(sorted(k for k in spec if k not in ("shape", "frozen", "held")))
     if shape == "triangle":
+        yamlpos.check_keys(spec, ("shape", "frozen", "held", "points", "peak", "width",
+                                  "left_width", "right_width"), TermSetError, what)
         internal = TRIANGLE_FORMS.get(given)
         if internal is None:
             raise TermSetError(f"{what}: a triangle takes `points: [a, b, c]`, or `peak` and "

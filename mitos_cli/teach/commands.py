@@ -19,7 +19,7 @@ from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput
 from ..errors import RuleSyntaxError, Span
 from ..lang.cache import lark_parser
 from ..lang.model import Rule, Setting, Use
-from ..lang.parse import TERMINAL_WORDS, _ToModel, check_nesting, shift
+from ..lang.parse import TERMINAL_WORDS, _ToModel, check_nesting, keyword_hint, shift
 from ..resources import grammar_text
 
 WORDS = dict(TERMINAL_WORDS, PATH="a file name", INT="a whole number", ARROW="`->`",
@@ -413,6 +413,8 @@ def _syntax_error(exc: UnexpectedInput, text: str, path: str) -> RuleSyntaxError
         hint = "a condition reads `variable is TERM`"
     elif "EQUAL" in expected:
         hint = "give values as NAME=VALUE, e.g. `road=78`"
+    else:
+        hint = keyword_hint(token, expected)
     return RuleSyntaxError(f"unexpected {_describe(token)}", span=span,
                            expected=_expected(expected), hint=hint)
 
