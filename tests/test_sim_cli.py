@@ -141,6 +141,8 @@ def test_require_success_exits_3_when_not_success(short):
 
 def test_require_takes_only_success(short):
     assert run(short, "--require", "collision").exit_code == 2
+    res = run(short, "--require", "sucess")
+    assert res.exit_code == 2 and "did you mean" in res.output and "`success`" in res.output
 
 
 def test_runs_print_a_table_of_rates(short):

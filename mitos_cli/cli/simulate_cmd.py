@@ -196,7 +196,11 @@ def simulate_command(
     from ..sim.worldfile import load_world, resolve_world_path
 
     if require is not None and require not in REQUIRE:
-        raise typer.BadParameter(f"--require takes `success`, not `{require}`")
+        from ..errors import did_you_mean
+
+        close = did_you_mean(require, REQUIRE)
+        raise typer.BadParameter(f"--require takes `success`, not `{require}`"
+                                 + (f"; {close}" if close else ""))
     planner_kind(planner_name)                  # an unknown name fails before any file is read
     if planner_name != "fuzzy" and (rulebase or behavior):
         raise typer.BadParameter(f"--rulebase and --behavior choose the fuzzy planner's rules; "
