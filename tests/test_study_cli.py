@@ -58,6 +58,8 @@ def test_compare_writes_table_csv_and_report(tiny, tmp_path, compare):
     r = compare(tiny, "--and", "min,product", "--runs", 2, "-o", out, "-j", 1)
     assert r.exit_code == 0, r.output
     assert "Outcomes per world and choice" in r.stdout and "Ranking" in r.stdout
+    header = next(line for line in r.stdout.splitlines() if "success" in line)
+    assert all(word in header for word in ("collision", "timeout", "stuck"))   # sum to 100%
     for label in ("fuzzy and=min", "fuzzy and=product", "potential_field"):
         assert label in r.output
     rows = read_rows(out)

@@ -86,7 +86,7 @@ def rich_tables(summaries: list[Summary], ranks: list[Rank]):
     table.add_column("world", no_wrap=True)
     table.add_column("choice", no_wrap=True)
     table.add_column("n", justify="right")
-    for _f, heading in RATE_COLUMNS[:3]:
+    for _f, heading in RATE_COLUMNS:
         table.add_column(heading, justify="right", no_wrap=True)
     for f in TABLE_METRICS:
         table.add_column(TERMINAL_HEADINGS[f], justify="right", no_wrap=True)
@@ -96,7 +96,7 @@ def rich_tables(summaries: list[Summary], ranks: list[Rank]):
         if last is not None and world != last:
             table.add_section()
         table.add_row(world if world != last else "", s.choice.label, str(s.n),
-                      *(_compact_rate(s.rates[f]) for f, _h in RATE_COLUMNS[:3]),
+                      *(_compact_rate(s.rates[f]) for f, _h in RATE_COLUMNS),
                       *(_compact_mean(s.metrics[f]) for f in TABLE_METRICS))
         last = world
     ranking = Table(title=RANK_TITLE, title_justify="left", box=box.SIMPLE_HEAD,
