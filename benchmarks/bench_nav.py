@@ -410,6 +410,14 @@ def main(argv: list[str] | None = None) -> int:
 
         if args.from_rows:
             return print_rows(args.from_rows, suites, planners)
+        needs = [s for s in ("mrpb", "clutter") if s in suites]
+        if needs and not args.mrpb.is_dir():
+            raise MitosError(
+                f"MRPB 1.0's maps are not in `{args.mrpb}` (the suites "
+                f"{' and '.join(needs)} drive them)",
+                hint="give their folder with `--mrpb DIR` (by default ../shared/maps/mrpb "
+                     "beside the repository), or leave those suites out: `--suites "
+                     "barn-unknown,barn-known,ticks`")
         root = str(args.mrpb)
         jobs = jobs_for(suites, planners, root, n_barn, args.seed, draws)
         keep = None
@@ -426,7 +434,7 @@ def main(argv: list[str] | None = None) -> int:
         ticks = ticks_line(planners, args.ticks_obstacles, args.seed) if "ticks" in suites \
             else None
     except MitosError as exc:
-        print(f"error: {exc}", file=sys.stderr)
+        print(exc.render(), file=sys.stderr)
         return 1
     print(table(results))
     if ticks:
