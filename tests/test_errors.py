@@ -425,3 +425,10 @@ def test_a_keyword_where_a_condition_should_be(tmp_path):
     with pytest.raises(RuleSyntaxError) as info:
         read_rulebase(tmp_path / "t.rules")
     assert info.value.hint.startswith("`then` stands where a condition should be")
+
+
+def test_a_rule_weight_out_of_range_points_at_its_with(tmp_path):
+    path = write(tmp_path, "r1: if road is WIDE\n    then speed is SLOW\n    with 1.5")
+    exc = error_of(lambda: load_rules_file(path))
+    assert exc.render().startswith(f"{path}:4:5: rule base error: a rule weight must lie in")
+    assert caret_under(exc) == "with 1.5"

@@ -67,6 +67,7 @@ class Rule:
     consequents: tuple[Consequent, ...]
     weight: float = 1.0
     span: Span | None = field(default=None, compare=False)
+    weight_span: Span | None = field(default=None, compare=False, repr=False)   # `with W`
 
 
 @dataclass(frozen=True)
@@ -77,6 +78,7 @@ class Use:
     condition: Expr | None = None
     weight: float = 1.0
     span: Span | None = field(default=None, compare=False)
+    weight_span: Span | None = field(default=None, compare=False, repr=False)   # `with W`
 
 
 @dataclass(frozen=True)

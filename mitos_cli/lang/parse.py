@@ -40,6 +40,14 @@ def parser() -> Lark:
 
 
 @dataclass(frozen=True)
+class _Weight:
+    """``with W`` as parsed: the number and where it stands."""
+
+    value: float
+    span: Span | None
+
+
+@dataclass(frozen=True)
 class ParsedFile:
     """A rule file as written: term-set paths, file-level items, behaviors."""
 
@@ -242,8 +250,9 @@ class _ToModel(Transformer):
     def label(self, items):
         return str(items[0])
 
-    def weight(self, items):
-        return items[0]
+    @v_args(meta=True)
+    def weight(self, meta, items):
+        return _Weight(items[0], self._s(meta))
 
     @v_args(meta=True)
     def rule(self, meta, items):
@@ -252,12 +261,14 @@ class _ToModel(Transformer):
             if isinstance(c, tuple):
                 return c
         return Rule(label or "", antecedent, tuple(consequents),
-                    1.0 if weight is None else weight, self._s(meta))
+                    1.0 if weight is None else weight.value, self._s(meta),
+                    None if weight is None else weight.span)
 
     @v_args(meta=True)
     def use_stmt(self, meta, items):
         name, condition, weight = items
-        return Use(str(name), condition, 1.0 if weight is None else weight, self._s(meta))
+        return Use(str(name), condition, 1.0 if weight is None else weight.value, self._s(meta),
+                   None if weight is None else weight.span)
 
     def frozen_stmt(self, items):
         return ("frozen", tuple(str(i) for i in items))

@@ -108,7 +108,7 @@ def _check_behavior(b: Behavior, variables: dict[str, Variable], behaviors: list
             raise unknown("behavior", use.behavior, behaviors, span=use.span)
         if use.condition is not None:
             check_expr(use.condition, variables)
-        _check_weight(use.weight, use.span)
+        _check_weight(use.weight, use.weight_span or use.span)
     for label in b.frozen:
         if label not in labels:
             raise unknown(f"rule label in behavior `{b.name}`", label, labels, span=b.span)
@@ -123,7 +123,7 @@ def check_rule(rule: Rule, variables: dict[str, Variable]) -> None:
         if c.var in seen:
             raise RuleBaseError(f"the rule sets `{c.var}` twice", span=c.span)
         seen.add(c.var)
-    _check_weight(rule.weight, rule.span)
+    _check_weight(rule.weight, rule.weight_span or rule.span)
 
 
 def _check_weight(weight: float, span: Span | None) -> None:
