@@ -229,3 +229,12 @@ def test_a_behavior_the_rule_base_lacks_is_reported_at_the_world_files_line():
     with pytest.raises(NameError_) as info:            # named on the command line: no line
         make_planner("fuzzy", w, behavior="drvie")
     assert info.value.span is None
+
+
+def test_a_goal_no_route_reaches_is_reported_at_its_line():
+    from mitos_cli.sim.loop import prepare
+    from mitos_cli.sim.route import NarrowPassage
+
+    with pytest.raises(NarrowPassage) as info:
+        prepare(parse_world(_pinched(16), "w.yaml"))
+    assert info.value.render().startswith("w.yaml:10:9: world error: the only way")

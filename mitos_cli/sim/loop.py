@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..errors import WorldError
 from . import geometry, kinematics, knowledge, perception, rows, safety, sensors
 from . import obstacles as obs_mod
 from .geometry import polygon_segments, rect_corners
@@ -68,12 +69,17 @@ def prepare(world: World) -> Scene:
     routes = []
     for a in world.agents:
         asked, least = clearances(world, a)
-        if given.plain:
-            routes.append(plan_route(static, world.corridors, a.start, a.goal, asked, least,
-                                     half_width=a.robot.width / 2))
-        else:
-            known = StaticMap(given.walls, np.zeros((0, 4, 2)), given.grid, static.bounds)
-            routes.append(grid_route(known, a.start, a.goal, asked, minimum=least))
+        try:
+            if given.plain:
+                routes.append(plan_route(static, world.corridors, a.start, a.goal, asked, least,
+                                         half_width=a.robot.width / 2))
+            else:
+                known = StaticMap(given.walls, np.zeros((0, 4, 2)), given.grid, static.bounds)
+                routes.append(grid_route(known, a.start, a.goal, asked, minimum=least))
+        except WorldError as exc:       # no route to the goal: said at the goal's line
+            if exc.span is None:
+                exc.span = a.goal_span
+            raise
     return Scene(static, tuple(routes), given, knowledge.plan_grid(given, static, world))
 
 

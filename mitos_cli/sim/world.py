@@ -139,6 +139,8 @@ class Agent:
     robot: Robot
     start: Pose
     goal: Goal
+    goal_span: Span | None = field(default=None, compare=False, repr=False)
+    # where the world file writes its q_goal (a goal its route cannot reach is reported there)
 
 
 #: ``route: {replan}``: when a robot plans its route again (:func:`.knowledge.replan`)

@@ -9,6 +9,7 @@ image that cannot be read.
 from __future__ import annotations
 
 from collections import Counter
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -309,6 +310,7 @@ def parse_world(text: str, path: str) -> World:
                             read_goal(r, yamlpos.require(a, "q_goal", WorldError, f"robot `{aname}`"),
                                       a.value_span("q_goal"), f"q_goal of `{aname}`")))
         agent_spans.append((a.value_span("q_init"), a.value_span("q_goal")))
+    agents = [replace(agent, goal_span=g) for agent, (_, g) in zip(agents, agent_spans)]
 
     mp = r.mapping(yamlpos.require(top, "map", WorldError, "the world file"),
                    top.value_span("map"), "map", MAP_KEYS)
