@@ -259,6 +259,16 @@ def test_bad_term_sets(tmp_path, old, new, marker, message):
     assert exc.render().startswith(f"{tmp_path / 't.terms.yaml'}:{line}:")
 
 
+@pytest.mark.parametrize("old, new, at", [
+    ("peak: 70, width: 30", "peak: 70, width: -3", "-"),
+    ("points: [40, 70]", "points: [70, 40]", "["),
+])
+def test_a_bad_term_value_is_pointed_at(tmp_path, old, new, at):
+    path = write(tmp_path, GOOD_RULE, TERMS.replace(old, new, 1))
+    exc = error_of(lambda: load_rules_file(path), TermSetError)
+    assert caret_under(exc).startswith(at)
+
+
 def test_unknown_key_suggests_the_right_one(tmp_path):
     path = write(tmp_path, GOOD_RULE, TERMS.replace("unit: in", "unti: in", 1))
     exc = error_of(lambda: load_rules_file(path), TermSetError)

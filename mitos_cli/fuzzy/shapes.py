@@ -98,11 +98,11 @@ def _ordered(names: tuple[str, ...]) -> Callable[[tuple[float, ...]], str | None
     return check
 
 
-def _positive(*indices: int) -> Callable[[tuple[float, ...]], str | None]:
+def _positive(names: tuple[str, ...], *indices: int) -> Callable[[tuple[float, ...]], str | None]:
     def check(p: tuple[float, ...]) -> str | None:
         for i in indices:
             if not p[i] > 0:
-                return f"width must be > 0, not {p[i]:g}"
+                return f"{names[i]} must be > 0, not {p[i]:g}"
         return None
     return check
 
@@ -136,11 +136,11 @@ def register(shape: Shape) -> Shape:
 register(Shape("triangle", ("a", "b", "c"), triangle, _ordered(("a", "b", "c")),
                lambda p: (p[0], p[1], p[1], p[2]), lambda p: p[1],
                "triangle by its corners: 0 at a, 1 at b, 0 at c"))
-register(Shape("triangle_pw", ("peak", "width"), triangle_pw, _positive(1),
+register(Shape("triangle_pw", ("peak", "width"), triangle_pw, _positive(("peak", "width"), 1),
                lambda p: (p[0] - p[1], p[0], p[0], p[0] + p[1]), lambda p: p[0],
                "the paper's eq. 15: 1 - |peak - x| / width"))
 register(Shape("triangle_plr", ("peak", "left_width", "right_width"), triangle_plr,
-               _positive(1, 2),
+               _positive(("peak", "left_width", "right_width"), 1, 2),
                lambda p: (p[0] - p[1], p[0], p[0], p[0] + p[2]), lambda p: p[0],
                "eq. 15 with separate left and right widths"))
 register(Shape("trapezoid", ("a", "b", "c", "d"), trapezoid, _ordered(("a", "b", "c", "d")),

@@ -212,6 +212,13 @@ def _term(name: str, spec: Any, key_span: Span, value_span: Span, variable: str,
             yamlpos.require(spec, p, TermSetError, what)
         params = tuple(yamlpos.expect_number(spec[p], spec.value_span(p), TermSetError,
                                              f"{what}: {p}") for p in kind.params)
+    problem = kind.check(params)
+    if problem:                 # at the value at fault, where the check names one
+        at = next((spec.value_span(p) for p in kind.params
+                   if p in spec and problem.startswith(f"{p} ")), None)
+        if at is None and "points" in spec:
+            at = spec.value_span("points")
+        raise TermSetError(f"{what}: {problem}", span=at or key_span)
     return Term(name, internal, params, key_span, frozen, held, held_at)
 
 
