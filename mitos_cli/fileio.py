@@ -24,7 +24,11 @@ def atomic_file(path: str | Path, binary: bool = False,
                 error: type[MitosError] = MitosError) -> Iterator[IO]:
     """Open a temporary file that replaces ``path`` when the block ends without an error; a
     failure (a missing directory included) raises ``error`` naming the file."""
-    path = Path(path)
+    path = _target(Path(path))
+    if path.exists() and not path.is_file():
+        with _in_place(path, binary, error) as fh:
+            yield fh
+        return
     directory = path.parent if str(path.parent) else Path(".")
     tmp = directory / f".{path.name}.{os.getpid()}.{secrets.token_hex(4)}.tmp"
     try:
@@ -44,6 +48,27 @@ def atomic_file(path: str | Path, binary: bool = False,
     finally:
         with contextlib.suppress(OSError):
             os.unlink(tmp)
+
+
+def _target(path: Path) -> Path:
+    """The file a write goes to: through a symbolic link to the file it names (the link
+    stays a link)."""
+    return path.resolve() if path.is_symlink() else path
+
+
+@contextlib.contextmanager
+def _in_place(path: Path, binary: bool, error: type[MitosError]) -> Iterator[IO]:
+    """Write to something that is not a regular file (a device such as /dev/null, a pipe) as
+    it is: renaming a file over it would replace it."""
+    if path.is_dir():
+        raise error(f"cannot write `{path}`: it is a directory",
+                    hint="give a file name inside it")
+    try:
+        with (open(path, "wb") if binary else
+              open(path, "w", encoding="utf-8", newline="")) as fh:
+            yield fh
+    except OSError as exc:
+        raise error(f"cannot write `{path}`: {exc.strerror or exc}") from None
 
 
 def atomic_write(path: str | Path, data: str | bytes,
@@ -75,7 +100,7 @@ def atomic_write_set(files: list[tuple[Path, str | bytes]], anchor: Path,
     pending: list[tuple[Path, Path]] = []
     try:
         for path, data in files:
-            path = Path(path)
+            path = _target(Path(path))
             tmp = path.parent / f".{path.name}.{os.getpid()}.{secrets.token_hex(4)}.tmp"
             try:
                 fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666)

@@ -291,3 +291,13 @@ def test_counts_are_singular_for_one(tmp_path, capsys):
     csv.write_text("road\n500\n78\n", encoding="utf-8")
     code, out, err = run_main(["eval", str(tmp_path / "t.rules"), "--batch", str(csv)], capsys)
     assert err == "warning: `road` outside its universe [0, 160] was clamped (1 sample)\n"
+
+
+@pytest.mark.skipif(not os.path.exists("/dev/full"), reason="needs /dev/full")
+def test_a_full_disk_under_stdout_is_an_error_not_a_traceback():
+    with open("/dev/full", "w") as full:
+        proc = subprocess.run([sys.executable, "-m", "mitos_cli", "eval", "road=78", "size=45",
+                               "position=4"], cwd=ROOT, stdout=full, stderr=subprocess.PIPE,
+                              text=True, timeout=60)
+    assert proc.returncode == 1 and "Traceback" not in proc.stderr
+    assert "cannot write the output: No space left on device" in proc.stderr

@@ -44,3 +44,25 @@ def test_replace_failing_is_an_error_and_leaves_nothing(tmp_path, monkeypatch):
     with pytest.raises(MitosError, match="disk full"):
         atomic_write(target, "new")
     assert target.read_text() == "old" and len(list(tmp_path.iterdir())) == 1
+
+
+def test_a_link_is_written_through_and_stays_a_link(tmp_path):
+    real = tmp_path / "real.txt"
+    real.write_text("old", encoding="utf-8")
+    link = tmp_path / "link.txt"
+    link.symlink_to(real)
+    atomic_write(link, "new")
+    assert link.is_symlink() and real.read_text(encoding="utf-8") == "new"
+
+
+@pytest.mark.skipif(not os.path.exists("/dev/null"), reason="needs /dev/null")
+def test_a_device_is_written_to_not_replaced():
+    import stat
+
+    atomic_write("/dev/null", "nothing to keep")
+    assert stat.S_ISCHR(os.stat("/dev/null").st_mode)
+
+
+def test_a_directory_is_refused_by_name(tmp_path):
+    with pytest.raises(MitosError, match="it is a directory"):
+        atomic_write(tmp_path, "x")

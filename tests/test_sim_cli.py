@@ -198,3 +198,9 @@ def test_one_run_shows_no_spread():
     out = CliRunner().invoke(app, ["simulate", "corridor.yaml", "--runs", "1"]).stdout
     row = out.splitlines()[1].split()
     assert "±" not in out and row[0] == "corridor" and float(row[-1]) > 0
+
+
+@pytest.mark.parametrize("option", [["--speed", "nan"], ["--fps", "nan", "--animate", "a.gif"]])
+def test_a_nan_option_is_a_usage_error(short, option):
+    res = run(short, *option)
+    assert res.exit_code == 2 and "must be a finite number" in res.output

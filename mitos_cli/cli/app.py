@@ -94,12 +94,17 @@ def main(argv: list[str] | None = None) -> None:
         sys.exit(1)
     except OSError as exc:
         # a path argument the system refuses to look up (a name over 255 characters): the
-        # user's input, not a bug, wherever in a command it was first used
-        if exc.errno not in (errno.ENAMETOOLONG, errno.ELOOP):
-            raise
+        # user's input, not a bug, wherever in a command it was first used; or a full disk
+        # under what the command writes (its output redirected to a file, /dev/full)
         from .output import report_error
 
-        report_error(path_error(exc))
+        if exc.errno in (errno.ENAMETOOLONG, errno.ELOOP):
+            report_error(path_error(exc))
+        elif exc.errno in (errno.ENOSPC, errno.EDQUOT, errno.EIO, errno.EFBIG):
+            report_error(MitosError(f"cannot write the output: {exc.strerror}",
+                                    hint="free some space, or write somewhere else"))
+        else:
+            raise
         sys.exit(1)
 
 

@@ -10,16 +10,8 @@ import typer
 
 from ..words import plural
 from .output import emit, warn_notes
+from .params import finite
 
-
-def _finite(value: float) -> float:
-    """``--threshold nan`` would pass ``min=0`` (every comparison with NaN is false) and turn
-    the coverage check off without a word."""
-    import math
-
-    if not math.isfinite(value):
-        raise typer.BadParameter(f"must be a finite number, not {value}")
-    return value
 
 def show_path(path: str | None) -> str:
     """A span's path as users should read it: relative when below the current directory."""
@@ -84,7 +76,7 @@ def check_command(
     behavior: Annotated[Optional[str], typer.Option(
         "--behavior", "-b", help="Check only this behavior (default: every behavior).")] = None,
     threshold: Annotated[float, typer.Option(
-        "--threshold", "-t", min=0.0, callback=_finite,
+        "--threshold", "-t", min=0.0, callback=finite,
         help="Report regions where the total DOF of an output's rules is below this.")] = 0.1,
     resolution: Annotated[int, typer.Option(
         "--resolution", "-n", min=2, max=10_000,

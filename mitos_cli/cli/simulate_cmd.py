@@ -11,6 +11,7 @@ import typer
 
 from . import complete
 from .output import emit, err
+from .params import finite
 from .progress import INTERRUPTED, progress_bar
 
 REQUIRE = ("success",)
@@ -171,7 +172,7 @@ def simulate_command(
     live: Annotated[bool, typer.Option(
         "--live", help="Show a terminal view on stderr while it runs, paced by --speed.")] = False,
     speed: Annotated[Optional[float], typer.Option(
-        "--speed", min=0.0, metavar="X",
+        "--speed", min=0.0, metavar="X", callback=finite,
         help="Real-time factor of --live (implies it): 1 real time (the default), 4 four "
              "times faster, 0 as fast as it can.")] = None,
     animate: Annotated[Optional[Path], typer.Option(
@@ -179,7 +180,7 @@ def simulate_command(
         help="Write the run as an animation: map, footprint, sonar cones, trail, obstacles, "
              "time and the fired rules' DOFs (.mp4 needs ffmpeg).")] = None,
     fps: Annotated[float, typer.Option(
-        "--fps", min=0.1, max=60.0,
+        "--fps", min=0.1, max=60.0, callback=finite,
         help="Animation frames per second of simulated time (plays in real time).")] = 10.0,
     require: Annotated[Optional[str], typer.Option(
         "--require", metavar="success", help="Exit 3 unless every run ends in this outcome.")] = None,
