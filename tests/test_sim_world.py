@@ -238,3 +238,15 @@ def test_a_goal_no_route_reaches_is_reported_at_its_line():
     with pytest.raises(NarrowPassage) as info:
         prepare(parse_world(_pinched(16), "w.yaml"))
     assert info.value.render().startswith("w.yaml:10:9: world error: the only way")
+
+
+def test_a_seed_keeps_every_digit():
+    big = 18446744073709551617
+    assert parse_world(BASE.replace("seed: 1", f"seed: {big}"), "w.yaml").seed == big
+    assert "seed must be at least 0" in error(BASE.replace("seed: 1", "seed: -3"))
+    assert "whole number" in error(BASE.replace("seed: 1", "seed: 1.5"))
+
+
+def test_a_run_of_too_many_ticks_is_refused_at_dt():
+    msg = error(BASE.replace("dt: 0.05", "dt: 0.00001"))
+    assert "w.yaml:3:5" in msg and "1,000,000 ticks; a run takes at most 100,000" in msg

@@ -272,17 +272,39 @@ def _list(mapping, key: str):
     return value
 
 
+#: the most ticks a run may take (a tiny ``dt`` would otherwise run for hours)
+MAX_TICKS = 100_000
+
+
+def _seed(r: _Reader, top: YMap) -> int:
+    """The world's seed, exactly: a whole number written in digits keeps every digit (read
+    as a float, two seeds past 2**53 would give the same run)."""
+    raw = top.get("seed", 0)
+    if isinstance(raw, int) and not isinstance(raw, bool):
+        if raw < 0:
+            raise WorldError(f"seed must be at least 0, not {raw}", span=top.value_span("seed"))
+        return raw
+    seed = r.number(top, "seed", "the world file", 0.0, minimum=0, sane=False)
+    if seed != int(seed) or seed > 2 ** 53:
+        raise WorldError("seed must be a whole number, written in digits",
+                         span=top.value_span("seed"))
+    return int(seed)
+
+
 def parse_world(text: str, path: str) -> World:
     """Parse world YAML ``text`` (read from ``path``, which anchors relative map paths)."""
     r = _Reader(path)
     doc = yamlpos.load(text, path, WorldError)
     top = r.mapping(doc, Span.in_text(text, path, 1, 1), "the world file", TOP_KEYS)
     name = str(yamlpos.require(top, "name", WorldError, "the world file"))
-    seed = r.number(top, "seed", "the world file", 0.0, minimum=0, sane=False)
-    if seed != int(seed):
-        raise WorldError("seed must be a whole number", span=top.value_span("seed"))
+    seed = _seed(r, top)
     dt = r.number(top, "dt", "the world file", None, positive=True, maximum=1.0)
     limit = r.number(top, "time_limit", "the world file", None, positive=True)
+    if limit / dt > MAX_TICKS:
+        raise WorldError(f"time_limit {limit:g} s at dt {dt:g} s is {limit / dt:,.0f} ticks; a "
+                         f"run takes at most {MAX_TICKS:,}", span=top.value_span("dt"),
+                         hint="a larger dt (0.05 s is the packaged worlds'), or a shorter "
+                              "time_limit")
     substeps = r.number(top, "substeps", "the world file", 1.0, minimum=1, maximum=100)
     robot = read_robot(r, yamlpos.require(top, "robot", WorldError, "the world file"),
                        top.value_span("robot"))
@@ -349,7 +371,7 @@ def parse_world(text: str, path: str) -> World:
                              span=top["obstacles"].item_span(i))
     randomise = (read_randomise(r, top["randomise"], top.value_span("randomise"), names)
                  if "randomise" in top else Randomise())
-    world = World(name, path, int(seed), dt, limit, int(substeps), tuple(agents), sensors,
+    world = World(name, path, seed, dt, limit, int(substeps), tuple(agents), sensors,
                   tuple(corridors), grid, tuple(obstacles), randomise,
                   str(top.get("behavior", "drive")), knows, given, min_clearance, replan,
                   top.value_span("behavior") if "behavior" in top else None)
