@@ -250,3 +250,15 @@ def test_a_seed_keeps_every_digit():
 def test_a_run_of_too_many_ticks_is_refused_at_dt():
     msg = error(BASE.replace("dt: 0.05", "dt: 0.00001"))
     assert "w.yaml:3:5" in msg and "1,000,000 ticks; a run takes at most 100,000" in msg
+
+
+@pytest.mark.parametrize("written, value", [("010", 10.0), ("1e1", 10.0), ("0x0A", 10.0),
+                                            ("10.0", 10.0)])
+def test_numbers_read_as_written(written, value):
+    w = parse_world(BASE.replace("time_limit: 10", f"time_limit: {written}"), "w.yaml")
+    assert w.time_limit == value
+
+
+def test_a_sexagesimal_looking_value_is_not_a_number():
+    assert "must be a number, not `1:00`" in error(BASE.replace("time_limit: 10",
+                                                                "time_limit: 1:00"))

@@ -1,7 +1,8 @@
 """YAML with source positions, so that every complaint about a term set or a world can name the
 file, the line and the key.
 
-Loading is ``yaml.SafeLoader`` underneath (nothing is ever evaluated as Python); mappings come
+Loading is ``yaml.SafeLoader`` underneath (nothing is ever evaluated as Python), with numbers
+read as YAML 1.2 reads them (:class:`_NumbersAsWritten`); mappings come
 back as :class:`YMap` and sequences as :class:`YList`, which remember where each key and value
 stood. Checking helpers (:func:`check_keys`, :func:`require`) raise the caller's error class with
 that position and a "did you mean" for unknown keys.
@@ -59,8 +60,46 @@ def _refuse(problem: str, mark: Any) -> yaml.constructor.ConstructorError:
     return yaml.constructor.ConstructorError(None, None, problem, mark)
 
 
+_INT, _FLOAT = "tag:yaml.org,2002:int", "tag:yaml.org,2002:float"
+
+
+class _NumbersAsWritten(yaml.SafeLoader):
+    """Numbers as YAML 1.2 (and every reader of it but PyYAML) reads them: ``010`` is ten, not
+    octal eight; ``1:00`` is text, not sexagesimal sixty; ``1e3`` and ``5e-2`` are numbers
+    without needing a dot; ``0o17`` and ``0x1F`` are octal and hexadecimal on purpose."""
+
+    yaml_implicit_resolvers = {
+        first: [(tag, regexp) for tag, regexp in resolvers if tag not in (_INT, _FLOAT)]
+        for first, resolvers in yaml.SafeLoader.yaml_implicit_resolvers.items()}
+
+
+_NumbersAsWritten.add_implicit_resolver(
+    _INT, re.compile(r"^(?:[-+]?[0-9]+|0o[0-7]+|0x[0-9a-fA-F]+)$"), list("-+0123456789"))
+_NumbersAsWritten.add_implicit_resolver(
+    _FLOAT, re.compile(r"^(?:[-+]?(?:\.[0-9]+|[0-9]+(?:\.[0-9]*)?)(?:[eE][-+]?[0-9]+)?"
+                       r"|[-+]?\.(?:inf|Inf|INF)|\.(?:nan|NaN|NAN))$"), list("-+.0123456789"))
+
+
+def _construct_int(loader: yaml.SafeLoader, node: yaml.ScalarNode) -> int:
+    value = str(node.value)
+    if value.startswith(("0o", "0x")):
+        return int(value[2:], 8 if value[1] == "o" else 16)
+    return int(value, 10)
+
+
+def _construct_float(loader: yaml.SafeLoader, node: yaml.ScalarNode) -> float:
+    value = str(node.value).lower()
+    if value.endswith(".inf"):
+        return float("-inf") if value.startswith("-") else float("inf")
+    return float("nan") if value == ".nan" else float(value)
+
+
+_NumbersAsWritten.add_constructor(_INT, _construct_int)
+_NumbersAsWritten.add_constructor(_FLOAT, _construct_float)
+
+
 def _build_loader(text: str, path: str | None) -> type:
-    class Loader(yaml.SafeLoader):
+    class Loader(_NumbersAsWritten):
         """Safe loading without aliases, anchors, merge keys or tags (no format here has
         them, and an alias bomb expands a few lines into billions of values), nested at most
         :data:`MAX_DEPTH` deep, and with the constructors' own errors kept at their node."""
