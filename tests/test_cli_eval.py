@@ -301,3 +301,16 @@ def test_a_full_disk_under_stdout_is_an_error_not_a_traceback():
                               text=True, timeout=60)
     assert proc.returncode == 1 and "Traceback" not in proc.stderr
     assert "cannot write the output: No space left on device" in proc.stderr
+
+
+@pytest.mark.parametrize("header, row", [("road,size,position", "7_8,45,4"),
+                                         ("road,size,position,id", "7_8,45,4,b"),
+                                         ("road,size,position", "\u0667\u0668,45,4")])
+def test_a_cell_python_alone_would_read_is_not_a_number(header, row):
+    """``float`` takes ``7_8`` (78) and other scripts' digits; with or without a pass-through
+    column, the cell is refused where it stands."""
+    with pytest.raises(InputError) as info:
+        read_batch(f"{header}\n78,45,4{',a' if 'id' in header else ''}\n{row}\n", "in.csv",
+                   ("road", "size", "position"))
+    assert info.value.span.line == 3 and "is not a number (input `road`, row 2)" in \
+        info.value.message

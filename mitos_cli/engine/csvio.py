@@ -11,6 +11,7 @@ from typing import NoReturn, TextIO
 import numpy as np
 
 from ..errors import InputError, Span, did_you_mean
+from ..numbers import parse_number
 from ..words import plural
 
 
@@ -96,7 +97,8 @@ def read_table(text: str, path: str, inputs: tuple[str, ...],
         if any(len(r) != len(header) for r in rows):
             _raise_bad_row(lines, path, header, order)
         try:
-            picked = np.array([[float(r[c]) for c in order] for r in rows], dtype=float)
+            picked = np.array([[parse_number(r[c]) for c in order] for r in rows],
+                              dtype=float)
         except ValueError:
             _raise_bad_row(lines, path, header, order)
     if np.isnan(picked).any():          # the engine refuses NaN: say where it stands
@@ -134,7 +136,7 @@ def _raise_bad_row(lines: list[str], path: str, header: list[str],
                                  span=Span(path, n, starts[c], line[:200]),
                                  hint="give every input a number")
             try:
-                float(cell)
+                parse_number(cell)
             except ValueError:
                 raise InputError(f"`{cell.strip()}` is not a number (input `{header[c]}`, "
                                  f"row {row})",

@@ -24,6 +24,7 @@ from ..lang import operators as ops_mod
 from ..lang.model import And, Behavior, Consequent, Expr, Not, Or, Prop, Rule, RuleBase, Setting
 from ..lang.resolve import MAIN, check_rule
 from ..lang.terms import Term, TermSet, Variable
+from ..numbers import parse_number
 from ..words import plural
 from . import rewrite
 
@@ -176,7 +177,7 @@ FORMULA_TERMS = {"Function": "a free formula"}
 def number(text: str, span: Span | None, what: str = "a number") -> float:
     """A number as the formats write them (``nan``, ``inf``, ``-inf`` included)."""
     try:
-        return float(text)
+        return parse_number(text)
     except ValueError:
         raise FormatError(f"expected {what}, not `{text}`", span=span) from None
 

@@ -1,0 +1,17 @@
+"""Numbers written as text (a CSV cell, a foreign file's value), read the one way every format
+here means them: ASCII decimal, an optional exponent, ``nan``, ``inf``. Python's ``float``
+alone also takes ``7_8`` (78) and other scripts' digits, which no file format writes."""
+
+from __future__ import annotations
+
+import re
+
+_NUMBER = re.compile(r"\s*[-+]?(?:(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)(?:[eE][-+]?[0-9]+)?"
+                     r"|nan|inf|infinity)\s*", re.IGNORECASE | re.ASCII)
+
+
+def parse_number(text: str) -> float:
+    """``text`` as a float; ``ValueError`` for anything else (``7_8``, ``٧٨``, ``0x10``)."""
+    if not _NUMBER.fullmatch(text):
+        raise ValueError(f"not a number: {text!r}")
+    return float(text)
