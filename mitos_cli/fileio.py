@@ -10,6 +10,7 @@ less the umask), not a temporary file's 0600.
 from __future__ import annotations
 
 import contextlib
+import errno
 import os
 import secrets
 from collections.abc import Iterator
@@ -17,6 +18,37 @@ from pathlib import Path
 from typing import IO
 
 from .errors import MitosError
+
+#: the largest text file read (bytes): far beyond any rule base, world, lesson or batch here
+MAX_TEXT_BYTES = 256 << 20
+
+
+def read_text(path: str | Path) -> str:
+    """A file the user named, as text: UTF-8, with or without a byte-order mark (which is not
+    content). Only a regular file is read, and at most :data:`MAX_TEXT_BYTES` of it: a
+    device (``/dev/zero``) or a pipe would be read without end. Raises ``OSError`` (with a
+    ``strerror`` to show) or ``UnicodeDecodeError``, as ``Path.read_text`` does."""
+    path = Path(path)
+    if path.exists() and not path.is_file():
+        raise OSError(errno.EINVAL, "it is a directory" if path.is_dir()
+                      else "it is not a regular file", str(path))
+    with open(path, "rb") as fh:
+        data = fh.read(MAX_TEXT_BYTES + 1)
+    if len(data) > MAX_TEXT_BYTES:
+        raise OSError(errno.EFBIG, f"it is larger than {MAX_TEXT_BYTES >> 20} MB", str(path))
+    return data.decode("utf-8-sig")
+
+
+def why_unreadable(exc: OSError | UnicodeDecodeError) -> str:
+    """What :func:`read_text`'s failure means, in words: the system's reason, or where the
+    bytes stop being UTF-8 text."""
+    if isinstance(exc, UnicodeDecodeError):
+        data = exc.object
+        line = data.count(b"\n", 0, exc.start) + 1
+        column = exc.start - (data.rfind(b"\n", 0, exc.start) + 1) + 1
+        return (f"it is not UTF-8 text (byte 0x{data[exc.start]:02x} at line {line}, "
+                f"column {column})")
+    return str(exc.strerror or exc)
 
 
 @contextlib.contextmanager

@@ -66,3 +66,38 @@ def test_a_device_is_written_to_not_replaced():
 def test_a_directory_is_refused_by_name(tmp_path):
     with pytest.raises(MitosError, match="it is a directory"):
         atomic_write(tmp_path, "x")
+
+
+def test_read_text_drops_a_byte_order_mark(tmp_path):
+    from mitos_cli.fileio import read_text
+
+    (tmp_path / "a.txt").write_bytes(b"\xef\xbb\xbfroad,size\n")
+    assert read_text(tmp_path / "a.txt") == "road,size\n"
+
+
+@pytest.mark.skipif(not os.path.exists("/dev/zero"), reason="needs /dev/zero")
+def test_read_text_refuses_a_device_instead_of_reading_it_without_end():
+    from mitos_cli.fileio import read_text
+
+    with pytest.raises(OSError, match="not a regular file"):
+        read_text("/dev/zero")
+
+
+def test_why_unreadable_says_where_the_bytes_stop_being_text(tmp_path):
+    from mitos_cli.fileio import read_text, why_unreadable
+
+    (tmp_path / "b.lesson").write_bytes(b"use drive\nat \xff\n")
+    with pytest.raises(UnicodeDecodeError) as info:
+        read_text(tmp_path / "b.lesson")
+    assert why_unreadable(info.value) == "it is not UTF-8 text (byte 0xff at line 2, column 4)"
+
+
+@pytest.mark.skipif(not os.path.exists("/dev/zero"), reason="needs /dev/zero")
+@pytest.mark.parametrize("argv", [["eval", "/dev/zero", "road=1"],
+                                  ["eval", "--batch", "/dev/zero"]])
+def test_a_device_named_as_a_file_is_refused_at_once(argv, capsys):
+    from mitos_cli.cli.app import main
+
+    with pytest.raises(SystemExit) as info:
+        main(argv)
+    assert info.value.code == 1 and "not a regular file" in capsys.readouterr().err

@@ -163,11 +163,13 @@ def run_batch(rb, source: str, on_no_rule: NoRule | None = None) -> None:
     if source == "-":
         text, name = sys.stdin.read(), "<stdin>"
     else:
+        from ..fileio import read_text, why_unreadable
+
         try:
-            text, name = Path(source).read_text(encoding="utf-8"), source
+            text, name = read_text(source), source
         except (OSError, UnicodeDecodeError) as exc:
-            raise InputError(f"cannot read batch file `{source}`: "
-                             f"{getattr(exc, 'strerror', None) or exc}") from None
+            raise InputError(f"cannot read batch file `{source}`: {why_unreadable(exc)}") \
+                from None
     batch = read_table(text, name, rb.compiled.inputs, unused_inputs(rb))
     X = batch.X
     result = rb.run(X, strict=False, detail=False)

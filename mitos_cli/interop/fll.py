@@ -30,6 +30,7 @@ from lark import Lark, Tree
 from lark.exceptions import UnexpectedInput
 
 from ..errors import FormatError, Span, did_you_mean
+from ..fileio import read_text
 from ..fuzzy.formula import parse as parse_formula
 from ..lang.bulk import without_cyclic_gc
 from ..lang.cache import lark_parser
@@ -118,7 +119,7 @@ def read_fll(path: str | Path) -> RuleBase:
 
 def _read_text(path: Path) -> str:
     try:
-        return path.read_text(encoding="utf-8-sig")     # a byte-order mark is not content
+        return read_text(path)          # UTF-8; a byte-order mark is not content
     except UnicodeDecodeError:
         raise FormatError(f"`{path}` is not a text file (it is not UTF-8)") from None
     except OSError as exc:

@@ -26,12 +26,12 @@ MAIN = "main"
 @without_cyclic_gc
 def load_rules_file(path: str | Path) -> RuleBase:
     """Read, parse and check the rule file at ``path`` and the term sets it names."""
-    from ..fileio import finish_saves
+    from ..fileio import finish_saves, read_text
 
     path = Path(path)
     finish_saves(path, error=RuleBaseError)   # a set save a crash left half done
     try:
-        text = path.read_text(encoding="utf-8")
+        text = read_text(path)
     except UnicodeDecodeError:
         raise RuleBaseError(f"`{path}` is not a text file (it is not UTF-8)",
                             span=Span(str(path), 1, 1)) from None

@@ -54,14 +54,15 @@ ALIASES = {"constant": "singleton"}     # Takagi-Sugeno's name for a crisp conse
 
 def load_termset(path: str | Path) -> TermSet:
     """Read and validate the term set at ``path``."""
+    from ..fileio import read_text
+
     path = Path(path)
     try:
-        data = path.read_bytes()
+        text = read_text(path)
     except OSError as exc:
         raise TermSetError(f"cannot read term set `{path}`: {exc.strerror or exc}") from None
-    try:
-        text = data.decode("utf-8")
     except UnicodeDecodeError as exc:
+        data = exc.object
         line = data.count(b"\n", 0, exc.start) + 1
         column = exc.start - (data.rfind(b"\n", 0, exc.start) + 1) + 1
         raise TermSetError(f"`{path}` is not a text file (byte 0x{data[exc.start]:02x} is not "

@@ -116,11 +116,13 @@ def rotate(blocked: np.ndarray, res: float, origin: tuple[float, float],
 def load_map_yaml(path: Path, *, unknown_occupied: bool = True,
                   where: Span | None = None) -> Grid:
     """Read a map_server ``map.yaml`` and its image into a :class:`Grid` in inches."""
+    from ..fileio import read_text, why_unreadable
+
     try:
-        text = path.read_text(encoding="utf-8")
+        text = read_text(path)
     except (OSError, UnicodeDecodeError) as exc:
-        raise WorldError(f"cannot read map file `{path}`: "
-                         f"{getattr(exc, 'strerror', None) or exc}", span=where) from None
+        raise WorldError(f"cannot read map file `{path}`: {why_unreadable(exc)}",
+                         span=where) from None
     # Until the file is known to be a map file, an error quotes nothing of it (docs/security.md).
     named = path.suffix.lower() in (".yaml", ".yml")
     try:

@@ -445,12 +445,13 @@ def _check_body(agent, static, span: Span) -> None:
 
 def load_world(path: str | Path) -> World:
     """Read and check the world file at ``path``."""
+    from ..fileio import read_text, why_unreadable
+
     path = Path(path)
     try:
-        text = path.read_text(encoding="utf-8")
+        text = read_text(path)
     except (OSError, UnicodeDecodeError) as exc:
-        raise WorldError(f"cannot read world file `{path}`: "
-                         f"{getattr(exc, 'strerror', None) or exc}") from None
+        raise WorldError(f"cannot read world file `{path}`: {why_unreadable(exc)}") from None
     if path.suffix.lower() not in (".yaml", ".yml"):
         # Until the file is known to be a world, an error quotes nothing of it (a lesson may
         # name any file; docs/security.md).

@@ -66,11 +66,12 @@ def read_lesson(source: str) -> tuple[str, str]:
         found = resolve("rulebases/lessons", source, ".lesson")
         if found is not None:
             path, source = found, str(found)
+    from ..fileio import read_text, why_unreadable
+
     try:
-        return path.read_text(encoding="utf-8"), source
+        return read_text(path), source
     except (OSError, UnicodeDecodeError) as exc:
-        error = LessonError(f"cannot read lesson `{source}`: "
-                            f"{getattr(exc, 'strerror', None) or exc}")
+        error = LessonError(f"cannot read lesson `{source}`: {why_unreadable(exc)}")
         if isinstance(exc, FileNotFoundError):     # a mistyped name: the packaged lessons
             from ..errors import did_you_mean
             from ..resources import packaged_names
