@@ -314,3 +314,12 @@ def test_a_cell_python_alone_would_read_is_not_a_number(header, row):
                    ("road", "size", "position"))
     assert info.value.span.line == 3 and "is not a number (input `road`, row 2)" in \
         info.value.message
+
+
+def test_json_is_strict_a_nan_output_is_null(capsys):
+    """A rule base that answers NaN where no rule fires (`default: nan`, as asked): --json
+    writes null, which every JSON parser reads, not the bare NaN that strict ones refuse."""
+    path = ROOT / "tests" / "data" / "interop" / "dimmer_fuzzylite.fcl"
+    code, out, _ = run_main(["eval", str(path), "Ambient=0", "--json"], capsys)
+    assert code == 0 and "NaN" not in out
+    json.loads(out, parse_constant=lambda c: pytest.fail(f"non-strict JSON: {c}"))

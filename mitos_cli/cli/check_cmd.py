@@ -2,14 +2,13 @@
 
 from __future__ import annotations
 
-import json
 import os
 from typing import Annotated, Optional
 
 import typer
 
 from ..words import plural
-from .output import emit, warn_notes
+from .output import emit, json_text, warn_notes
 from .params import finite
 
 
@@ -98,7 +97,7 @@ def check_command(
     report = check_rulebase(rb, behavior, threshold=threshold, resolution=resolution)
     name = display_path(rb.path)
     if as_json:
-        emit(json.dumps(to_json(report, name), indent=2))
+        emit(json_text(to_json(report, name)))
     else:
         emit(render(report, name))
     if not report.ok:

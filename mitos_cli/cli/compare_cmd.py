@@ -10,7 +10,7 @@ import typer
 
 from ..words import plural
 from . import complete
-from .output import emit, err, warn
+from .output import emit, err, json_text, warn
 from .progress import INTERRUPTED, progress_bar
 
 
@@ -100,9 +100,8 @@ def compare_command(
                                 quiet=as_json)
 
     if as_json:
-        import json
 
-        emit(json.dumps(outcome_json(outcome, out), indent=2))
+        emit(json_text(outcome_json(outcome, out)))
     else:
         _print_tables(outcome)
     try:

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import enum
-import json
 import sys
 from pathlib import Path
 from typing import Annotated, Optional
@@ -12,7 +11,7 @@ import typer
 
 from ..errors import InputError
 from ..words import plural
-from .output import emit, warn, warn_notes
+from .output import emit, json_text, warn, warn_notes
 
 
 class Engine(str, enum.Enum):
@@ -142,7 +141,7 @@ def eval_command(
     warn_clamped(result)
     trace = trace_of(result)
     if as_json:
-        emit(json.dumps(trace.to_json(), indent=2))
+        emit(json_text(trace.to_json()))
     else:
         emit(trace.render(digits))
 

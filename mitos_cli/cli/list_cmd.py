@@ -8,12 +8,11 @@ the commands accept (``mitos simulate corridor``, ``--rulebase mitos.rules``,
 
 from __future__ import annotations
 
-import json
 from typing import Annotated
 
 import typer
 
-from .output import emit
+from .output import emit, json_text
 
 #: Each section: its title in the listing, where the files are and the suffix they end in.
 SECTIONS = {
@@ -99,4 +98,4 @@ def list_command(
     Example: `mitos list`, then `mitos simulate slalom`.
     """
     cat = catalogue()
-    emit(json.dumps(cat, indent=2) if as_json else render(cat))
+    emit(json_text(cat) if as_json else render(cat))

@@ -2,12 +2,11 @@
 
 from __future__ import annotations
 
-import json
 from typing import Annotated
 
 import typer
 
-from .output import emit
+from .output import emit, json_text
 
 INFERENCE = {
     "weighted_average": "y = sum_r(dof_r * y_r) / sum_r(dof_r); y_r = the consequent's value "
@@ -100,4 +99,4 @@ def operators_command(
 ) -> None:
     """List every T-norm, S-norm, inference method, implication, defuzzifier and hedge."""
     cat = catalogue()
-    emit(json.dumps(cat, indent=2) if as_json else render(cat))
+    emit(json_text(cat) if as_json else render(cat))

@@ -26,6 +26,24 @@ def report_error(exc: MitosError) -> None:
     err(exc.render())
 
 
+def json_text(value) -> str:
+    """``value`` as strict JSON (indented): a NaN or an infinity, which ``json.dumps`` would
+    write as the bare ``NaN``/``Infinity`` that strict parsers refuse, is ``null``."""
+    import json
+    import math
+
+    def strict(v):
+        if isinstance(v, float) and not math.isfinite(v):
+            return None
+        if isinstance(v, dict):
+            return {k: strict(x) for k, x in v.items()}
+        if isinstance(v, (list, tuple)):
+            return [strict(x) for x in v]
+        return v
+
+    return json.dumps(strict(value), indent=2, allow_nan=False)
+
+
 def emit(text: str) -> None:
     """Data on stdout."""
     sys.stdout.write(text if text.endswith("\n") else text + "\n")

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 import sys
 from pathlib import Path
 from typing import Annotated, Optional
@@ -10,7 +9,7 @@ from typing import Annotated, Optional
 import typer
 
 from . import complete
-from .output import emit, err
+from .output import emit, err, json_text
 from .params import finite
 from .progress import INTERRUPTED, progress_bar
 
@@ -236,7 +235,7 @@ def simulate_command(
         if plot is not None:
             result = _draw_runs(result, loaded[0], plot)
         if as_json:
-            emit(json.dumps(result.to_json(), indent=2))
+            emit(json_text(result.to_json()))
         else:
             emit(_runs_table(result))
         if plot is not None:
@@ -291,7 +290,7 @@ def simulate_command(
 
         frames = animate_run(res, animate, fps=fps, detail=explain(res, planner))
     if as_json:
-        emit(json.dumps(_json_summary(res), indent=2))
+        emit(json_text(_json_summary(res)))
     else:
         emit(_verdict(res))
         emit(_summary(res))
