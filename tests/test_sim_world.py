@@ -262,3 +262,16 @@ def test_numbers_read_as_written(written, value):
 def test_a_sexagesimal_looking_value_is_not_a_number():
     assert "must be a number, not `1:00`" in error(BASE.replace("time_limit: 10",
                                                                 "time_limit: 1:00"))
+
+
+@pytest.mark.parametrize("obstacle, what", [
+    ("{name: bin, shape: circle, at: [300, 0], radius: 9}", "goal (q_goal)"),
+    ("{name: crate, shape: rectangle, at: [300, 2], length: 30, width: 20, angle: 30}",
+     "goal (q_goal)"),
+    ("{name: crate, shape: rectangle, at: [30, 0], length: 30, width: 20}", "start (q_init)"),
+])
+def test_a_start_or_goal_inside_an_obstacle_is_refused(obstacle, what):
+    msg = error(BASE + f"obstacles:\n  - {obstacle}\n")
+    name = obstacle.split("name: ")[1].split(",")[0]
+    assert f"the {what} at" in msg and f"lies inside obstacle `{name}`" in msg
+    assert ("w.yaml:10:9" if "goal" in what else "w.yaml:9:9") in msg

@@ -413,7 +413,35 @@ def check_free(world: World, spans: list[tuple[Span, Span]]) -> None:
             if not static.free(np.array([[p.x, p.y]]))[0]:
                 raise WorldError(f"the {what}{who} at ({p.x:g}, {p.y:g}) lies inside a wall",
                                  span=span, hint="move it into a corridor (free space)")
+            hit = _obstacle_at(world, p.x, p.y)
+            if hit is not None:
+                raise WorldError(f"the {what}{who} at ({p.x:g}, {p.y:g}) lies inside obstacle "
+                                 f"`{hit}` (where it stands at the start)", span=span,
+                                 hint="move it, or the obstacle")
         _check_body(agent, static, s_span)
+
+
+def _obstacle_at(world: World, x: float, y: float) -> str | None:
+    """The name of the first obstacle that covers (x, y) when the run starts, or None."""
+    import numpy as np
+
+    from .geometry import points_in_polygon
+    from .obstacles import positions, shapes_at
+
+    if not world.obstacles:
+        return None
+    centres, radii, circ, _, _, corners = shapes_at(world.obstacles,
+                                                    positions(world.obstacles, 0.0))
+    p = np.array([[x, y]])
+    inside = np.hypot(*(centres - p).T) < radii
+    if inside.any():
+        return world.obstacles[int(circ[int(np.argmax(inside))])].name
+    rect = [i for i, o in enumerate(world.obstacles) if o.shape == "rectangle"]
+    if rect:
+        within = np.asarray(points_in_polygon(p, corners))[0]
+        if within.any():
+            return world.obstacles[rect[int(np.argmax(within))]].name
+    return None
 
 
 def _check_body(agent, static, span: Span) -> None:
