@@ -275,3 +275,8 @@ def test_a_start_or_goal_inside_an_obstacle_is_refused(obstacle, what):
     name = obstacle.split("name: ")[1].split(",")[0]
     assert f"the {what} at" in msg and f"lies inside obstacle `{name}`" in msg
     assert ("w.yaml:10:9" if "goal" in what else "w.yaml:9:9") in msg
+
+
+def test_an_empty_number_says_so():
+    msg = error(BASE.replace("time_limit: 10", "time_limit: ~"))
+    assert "w.yaml:4:13" in msg and "must be a number, not nothing (an empty value or `~`)" in msg

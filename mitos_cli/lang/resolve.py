@@ -42,8 +42,10 @@ def load_rules_file(path: str | Path) -> RuleBase:
     for name, span in parsed.terms:
         target = path.parent / name
         if not is_file(target):
-            raise TermSetError(f"term set `{name}` not found (looked for `{target}`)", span=span,
-                               hint="term-set paths are relative to the rule file")
+            found = "is a directory" if target.is_dir() else "not found"
+            raise TermSetError(f"term set `{name}` {found} (looked for `{target}`)", span=span,
+                               hint="term-set paths are relative to the rule file, and name "
+                                    "a YAML file")
         termsets.append(load_termset(target))
     return build_rulebase(parsed, tuple(termsets), tuple(n for n, _ in parsed.terms))
 

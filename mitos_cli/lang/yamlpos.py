@@ -228,7 +228,8 @@ def expect_map(value: Any, span: Span, error: type[MitosError], what: str) -> YM
 def expect_number(value: Any, span: Span, error: type[MitosError], what: str) -> float:
     """``value`` as a finite float, or ``error`` saying a number was expected."""
     if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise error(f"{what} must be a number, not `{value}`", span=span)
+        shown = "nothing (an empty value or `~`)" if value is None else f"`{value}`"
+        raise error(f"{what} must be a number, not {shown}", span=span)
     try:
         number = float(value)
     except OverflowError:
