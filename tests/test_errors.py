@@ -442,3 +442,14 @@ def test_a_rule_weight_out_of_range_points_at_its_with(tmp_path):
     exc = error_of(lambda: load_rules_file(path))
     assert exc.render().startswith(f"{path}:4:5: rule base error: a rule weight must lie in")
     assert caret_under(exc) == "with 1.5"
+
+
+def test_an_operator_set_twice_on_one_line_is_refused(tmp_path):
+    from mitos_cli.teach.commands import parse_command
+
+    path = write(tmp_path, "operators: and = min, and = product\n" + GOOD_RULE)
+    exc = error_of(lambda: load_rules_file(path), RuleSyntaxError)
+    assert "`and` is set twice on one operators line (`min`, then `product`)" in exc.message
+    assert caret_under(exc) == "and = product"
+    with pytest.raises(RuleSyntaxError, match="set twice"):
+        parse_command("operators: or = max, or = sum", "l.lesson", 4)

@@ -353,6 +353,19 @@ def parse_rules(text: str, path: str | None = None) -> ParsedFile:
                       tuple(frozen), tuple(behaviors))
 
 
+def check_settings(settings: tuple[Setting, ...]) -> tuple[Setting, ...]:
+    """One ``operators:`` line sets each operator once: ``and = min, and = product`` would
+    keep the last without a word. (Later lines may change what earlier ones set.)"""
+    seen: dict[str, Setting] = {}
+    for s in settings:
+        if s.key in seen:
+            raise RuleSyntaxError(f"`{s.key}` is set twice on one operators line "
+                                  f"(`{seen[s.key].value}`, then `{s.value}`)", span=s.span,
+                                  hint="keep one of them")
+        seen[s.key] = s
+    return settings
+
+
 def _collect(item, terms: list[tuple[str, Span]], operators: list[Setting], rules: list[Rule],
              uses: list[Use], frozen: list[str], behaviors: list[Behavior]) -> None:
     if isinstance(item, Rule):
@@ -364,7 +377,7 @@ def _collect(item, terms: list[tuple[str, Span]], operators: list[Setting], rule
     elif item[0] == "terms":
         terms.extend(item[1])
     elif item[0] == "operators":
-        operators.extend(item[1])
+        operators.extend(check_settings(item[1]))
     elif item[0] == "frozen":
         frozen.extend(item[1])
     elif item[0] == "behavior":

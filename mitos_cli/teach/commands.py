@@ -19,7 +19,14 @@ from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput
 from ..errors import RuleSyntaxError, Span
 from ..lang.cache import lark_parser
 from ..lang.model import Rule, Setting, Use
-from ..lang.parse import TERMINAL_WORDS, _ToModel, check_nesting, keyword_hint, shift
+from ..lang.parse import (
+    TERMINAL_WORDS,
+    _ToModel,
+    check_nesting,
+    check_settings,
+    keyword_hint,
+    shift,
+)
 from ..resources import grammar_text
 
 WORDS = dict(TERMINAL_WORDS, PATH="a file name", INT="a whole number", ARROW="`->`",
@@ -324,6 +331,8 @@ def parse_command(line: str, path: str | None = None, lineno: int = 1) -> Comman
     result = _ToCommand(line, where, lineno - 1).transform(tree)
     if isinstance(result, Tree):            # pragma: no cover - every alternative is handled
         raise RuleSyntaxError(f"cannot read `{line.strip()}`")
+    if isinstance(result, TellOperators):
+        check_settings(result.settings)
     return result
 
 
