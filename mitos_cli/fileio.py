@@ -29,7 +29,7 @@ def read_text(path: str | Path) -> str:
     device (``/dev/zero``) or a pipe would be read without end. Raises ``OSError`` (with a
     ``strerror`` to show) or ``UnicodeDecodeError``, as ``Path.read_text`` does."""
     path = Path(path)
-    if path.exists() and not path.is_file():
+    if _special(path):
         raise OSError(errno.EINVAL, "it is a directory" if path.is_dir()
                       else "it is not a regular file", str(path))
     with open(path, "rb") as fh:
@@ -37,6 +37,15 @@ def read_text(path: str | Path) -> str:
     if len(data) > MAX_TEXT_BYTES:
         raise OSError(errno.EFBIG, f"it is larger than {MAX_TEXT_BYTES >> 20} MB", str(path))
     return data.decode("utf-8-sig")
+
+
+def _special(path: Path) -> bool:
+    """Whether ``path`` is there but not a regular file (a directory, a device, a pipe); a
+    name the system cannot look up (over 255 characters) is left to ``open`` to report."""
+    try:
+        return path.exists() and not path.is_file()
+    except OSError:
+        return False
 
 
 def why_unreadable(exc: OSError | UnicodeDecodeError) -> str:
@@ -57,7 +66,7 @@ def atomic_file(path: str | Path, binary: bool = False,
     """Open a temporary file that replaces ``path`` when the block ends without an error; a
     failure (a missing directory included) raises ``error`` naming the file."""
     path = _target(Path(path))
-    if path.exists() and not path.is_file():
+    if _special(path):
         with _in_place(path, binary, error) as fh:
             yield fh
         return
@@ -85,7 +94,10 @@ def atomic_file(path: str | Path, binary: bool = False,
 def _target(path: Path) -> Path:
     """The file a write goes to: through a symbolic link to the file it names (the link
     stays a link)."""
-    return path.resolve() if path.is_symlink() else path
+    try:
+        return path.resolve() if path.is_symlink() else path
+    except OSError:             # a name too long to look up: the write reports it
+        return path
 
 
 @contextlib.contextmanager

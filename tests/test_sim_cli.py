@@ -204,3 +204,8 @@ def test_one_run_shows_no_spread():
 def test_a_nan_option_is_a_usage_error(short, option):
     res = run(short, *option)
     assert res.exit_code == 2 and "must be a finite number" in res.output
+
+
+def test_an_empty_behavior_is_a_usage_error(short):
+    res = run(short, "-b", "")
+    assert res.exit_code == 2 and "must name something" in res.output

@@ -9,7 +9,7 @@ import typer
 
 from ..words import plural
 from .output import emit, json_text, warn_notes
-from .params import finite
+from .params import finite, named
 
 
 def show_path(path: str | None) -> str:
@@ -73,7 +73,8 @@ def check_command(
         metavar="[RULEBASE]",
         help="Rule file (default: the packaged MITOS rule base).")] = None,
     behavior: Annotated[Optional[str], typer.Option(
-        "--behavior", "-b", help="Check only this behavior (default: every behavior).")] = None,
+        "--behavior", "-b", callback=named,
+        help="Check only this behavior (default: every behavior).")] = None,
     threshold: Annotated[float, typer.Option(
         "--threshold", "-t", min=0.0, callback=finite,
         help="Report regions where the total DOF of an output's rules is below this.")] = 0.1,

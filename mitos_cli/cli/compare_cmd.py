@@ -11,6 +11,7 @@ import typer
 from ..words import plural
 from . import complete
 from .output import emit, err, json_text, warn
+from .params import named
 from .progress import INTERRUPTED, progress_bar
 
 
@@ -19,10 +20,10 @@ def compare_command(
         metavar="WORLDS...", autocompletion=complete.worlds,
         help="World files (or names of packaged worlds such as corridor.yaml).")],
     and_: Annotated[str, typer.Option(
-        "--and", metavar="TNORMS",
+        "--and", metavar="TNORMS", callback=named,
         help="T-norms of the fuzzy planner, comma-separated.")] = "min,product,lukasiewicz,einstein",
     or_: Annotated[Optional[str], typer.Option(
-        "--or", metavar="SNORMS",
+        "--or", metavar="SNORMS", callback=named,
         help="S-norms, comma-separated (crossed with --and); `dual` pairs each T-norm with "
              "its De Morgan dual. Default: the rule base's.")] = None,
     inference: Annotated[Optional[str], typer.Option(
@@ -59,7 +60,7 @@ def compare_command(
         "--rulebase", "-r", metavar="PATH",
         help="Rule base of the fuzzy planner (default: the packaged one).")] = None,
     behavior: Annotated[Optional[str], typer.Option(
-        "--behavior", "-b", help="Behavior to drive with (default: the world's).")] = None,
+        "--behavior", "-b", callback=named, help="Behavior to drive with (default: the world's).")] = None,
     plots: Annotated[bool, typer.Option(
         "--plots/--no-plots", help="Draw the plots of report.md (needs matplotlib).")] = True,
     as_json: Annotated[bool, typer.Option(

@@ -9,6 +9,7 @@ from typing import Annotated, Optional
 import typer
 
 from .output import emit, err, warn, warn_notes
+from .params import named
 
 
 class Target(str, Enum):
@@ -29,7 +30,7 @@ def convert_command(
         help="File to write (default: stdout; for --to rules: STEM.rules in the current "
              "directory).")] = None,
     behavior: Annotated[Optional[str], typer.Option(
-        "--behavior", "-b", help="Behavior to convert (default: the file's first).")] = None,
+        "--behavior", "-b", callback=named, help="Behavior to convert (default: the file's first).")] = None,
 ) -> None:
     """Convert a rule base between the MITOS rule language, FCL, MATLAB .fis and fuzzylite FLL.
 

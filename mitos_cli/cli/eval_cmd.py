@@ -12,6 +12,7 @@ import typer
 from ..errors import InputError
 from ..words import plural
 from .output import emit, json_text, warn, warn_notes
+from .params import named
 
 
 class Engine(str, enum.Enum):
@@ -76,7 +77,8 @@ def eval_command(
         help="Rule file (.rules, .fcl, .fis, .fll; default: the packaged MITOS rule base), "
              "then one NAME=VALUE per input.")] = None,
     behavior: Annotated[Optional[str], typer.Option(
-        "--behavior", "-b", help="Evaluate this behavior (default: the file's first).")] = None,
+        "--behavior", "-b", callback=named,
+        help="Evaluate this behavior (default: the file's first).")] = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
     batch: Annotated[Optional[str], typer.Option(
         "--batch", metavar="FILE.csv|-",

@@ -9,6 +9,7 @@ from typing import Annotated, Optional
 import typer
 
 from .output import emit, err, warn_notes
+from .params import named
 
 
 class Language(str, Enum):
@@ -25,7 +26,7 @@ def export_command(
     output: Annotated[Optional[Path], typer.Option(
         "--output", "-o", metavar="OUT", help="File to write (default: stdout).")] = None,
     behavior: Annotated[Optional[str], typer.Option(
-        "--behavior", "-b", help="Behavior to export (default: the file's first).")] = None,
+        "--behavior", "-b", callback=named, help="Behavior to export (default: the file's first).")] = None,
     prefix: Annotated[str, typer.Option(
         "--prefix", help="C names: PREFIX_eval, PREFIX_IN_<INPUT>, PREFIX_OUT_<OUTPUT>.")
     ] = "mitos",

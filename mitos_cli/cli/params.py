@@ -14,3 +14,11 @@ def finite(value: float | None) -> float | None:
     if value is not None and not math.isfinite(value):
         raise typer.BadParameter(f"must be a finite number, not {value}")
     return value
+
+
+def named(value: str | None) -> str | None:
+    """A name given as an option (``-b ''``, ``--and ''``) is not empty: an empty one would
+    quietly mean the default."""
+    if value is not None and not value.strip():
+        raise typer.BadParameter("must name something, not be empty")
+    return value

@@ -20,6 +20,7 @@ import typer
 from .eval_cmd import parse_values, split_args
 from .help import epilog
 from .output import emit, err, warn
+from .params import named
 
 FORMATS = ("png", "svg")
 RULE_SUFFIXES = (".rules", ".fcl", ".fis", ".fll")
@@ -57,7 +58,7 @@ OutputOpt = Annotated[Optional[str], typer.Option(
 ShowOpt = Annotated[bool, typer.Option(
     "--show", help="Open the picture in a window (where a display is available).")]
 BehaviorOpt = Annotated[Optional[str], typer.Option(
-    "--behavior", "-b", help="Use this behavior (default: the file's first).")]
+    "--behavior", "-b", callback=named, help="Use this behavior (default: the file's first).")]
 TitleOpt = Annotated[Optional[str], typer.Option(
     "--title", help="The picture's title (default: says what is drawn).")]
 
@@ -85,7 +86,7 @@ def terms_command(
     var: Annotated[Optional[list[str]], typer.Option(
         "--var", "-v", help="Draw only this variable (repeat for more).")] = None,
     behavior: Annotated[Optional[str], typer.Option(
-        "--behavior", "-b", help="Draw only the variables this behavior uses.")] = None,
+        "--behavior", "-b", callback=named, help="Draw only the variables this behavior uses.")] = None,
     output: OutputOpt = None,
     show: ShowOpt = False,
     title: TitleOpt = None,

@@ -10,7 +10,7 @@ import typer
 
 from . import complete
 from .output import emit, err, json_text
-from .params import finite
+from .params import finite, named
 from .progress import INTERRUPTED, progress_bar
 
 REQUIRE = ("success",)
@@ -148,7 +148,8 @@ def simulate_command(
     rulebase: Annotated[Optional[str], typer.Option(
         "--rulebase", "-r", metavar="PATH", help="Rule base (default: the packaged one).")] = None,
     behavior: Annotated[Optional[str], typer.Option(
-        "--behavior", "-b", help="Behavior that drives (default: the world's, else `drive`).")] = None,
+        "--behavior", "-b", callback=named,
+        help="Behavior that drives (default: the world's, else `drive`).")] = None,
     seed: Annotated[Optional[int], typer.Option(
         "--seed", min=0, help="Seed (default: the world's); with --runs, run j uses SEED+j.")] = None,
     runs: Annotated[int, typer.Option(

@@ -8,6 +8,7 @@ from typing import Annotated
 import typer
 
 from ..words import plural
+from .params import named
 
 
 class Transcript:
@@ -44,7 +45,7 @@ def teach_command(
         metavar="[RULES]",
         help="Rule file to teach (default: the packaged MITOS rule base).")] = None,
     behavior: Annotated[str | None, typer.Option(
-        "--behavior", "-b", help="The behavior to teach first (default: the file's first).")]
+        "--behavior", "-b", callback=named, help="The behavior to teach first (default: the file's first).")]
         = None,
     lesson: Annotated[str | None, typer.Option(
         "--lesson", "-l", metavar="FILE|-",

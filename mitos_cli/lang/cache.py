@@ -192,7 +192,9 @@ def rulebase_entry(path: Path, data: bytes) -> str:
 
 def cached_rulebase(path: Path, load: Callable[[Path], RuleBase]) -> RuleBase:
     """``load(path)``, or the cached result of an earlier call on the same files."""
-    if not path.is_file():                    # a device (/dev/zero) would be read without
+    from ..resources import is_file
+
+    if not is_file(path):                     # a device (/dev/zero) would be read without
         return load(path)                     # end: the loader reports what it is
     try:
         data = path.read_bytes()

@@ -12,7 +12,7 @@ from pathlib import Path
 
 from ..errors import RuleBaseError, Span, TermSetError, unknown
 from ..fuzzy.hedges import HEDGES
-from ..resources import is_file
+from ..resources import exists, is_file
 from . import operators as ops_mod
 from .bulk import without_cyclic_gc
 from .model import And, Behavior, Consequent, Expr, Not, Or, Prop, Rule, RuleBase
@@ -42,7 +42,7 @@ def load_rules_file(path: str | Path) -> RuleBase:
     for name, span in parsed.terms:
         target = path.parent / name
         if not is_file(target):
-            found = "is a directory" if target.is_dir() else "not found"
+            found = "is a directory" if exists(target) else "not found"
             raise TermSetError(f"term set `{name}` {found} (looked for `{target}`)", span=span,
                                hint="term-set paths are relative to the rule file, and name "
                                     "a YAML file")
