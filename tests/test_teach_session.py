@@ -317,3 +317,12 @@ def test_counts_of_one_are_singular(rules):
     say(s, out, "correct road=20 -> speed=15")
     text = say(s, out, "adapt epochs 1")
     assert "Q = sum (y - t)^2 over 1 example:" in text and "(1 epoch; RMS error" in text
+
+
+def test_a_correction_outside_the_universe_is_noted_and_an_infinite_one_refused(rules):
+    s, out = session(rules)
+    text = say(s, out, "correct road=500 size=45 position=4 -> steering=60")
+    assert "road = 500 lies outside its universe [0, 160]; the rules read it as 160" in text
+    with pytest.raises(LessonError, match="road = inf is not a finite number"):
+        s.run("correct road=1e400 size=45 position=4 -> steering=60")
+    assert len(s.state.examples) == 1

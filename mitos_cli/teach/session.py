@@ -394,6 +394,9 @@ class Session:
                 raise unknown(f"{role} variable", a.name, names, span=a.span, cls=LessonError)
             if a.name in out:
                 raise LessonError(f"`{a.name}` is given twice", span=a.span)
+            if not math.isfinite(a.value):      # 1e400 reads as inf: no example holds it
+                raise LessonError(f"{a.name} = {a.value:g} is not a finite number", span=a.span,
+                                  hint="give a value inside the variable's universe")
             if role == "output":
                 lo, hi = compiled.variables[a.name].universe
                 if not lo <= a.value <= hi:
@@ -419,6 +422,11 @@ class Session:
         compiled = self.compiled()
         inputs = self._values(c.inputs, compiled.inputs, "input", compiled, True)
         targets = self._values(c.targets, compiled.outputs, "output", compiled, False)
+        for name, value in inputs.items():
+            lo, hi = compiled.variables[name].universe
+            if not lo <= value <= hi:
+                self.out(f"note: {name} = {value:g} lies outside its universe [{lo:g}, {hi:g}]; "
+                         f"the rules read it as {min(max(value, lo), hi):g}")
         now = self._outputs(compiled, [inputs])[0]
         self.change("examples", line, behavior=compiled.behavior,
                     examples=[{"inputs": inputs, "targets": targets, "source": "correct"}])
