@@ -323,3 +323,10 @@ def test_json_is_strict_a_nan_output_is_null(capsys):
     code, out, _ = run_main(["eval", str(path), "Ambient=0", "--json"], capsys)
     assert code == 0 and "NaN" not in out
     json.loads(out, parse_constant=lambda c: pytest.fail(f"non-strict JSON: {c}"))
+
+
+def test_a_batch_whose_header_is_not_first_says_so():
+    with pytest.raises(InputError, match="first line is empty: the header comes first"):
+        read_batch("\nroad,size,position\n1,2,3\n", "in.csv", ("road", "size", "position"))
+    with pytest.raises(InputError, match="the batch CSV is empty"):
+        read_batch("\n\n", "in.csv", ("road", "size", "position"))

@@ -453,3 +453,9 @@ def test_an_operator_set_twice_on_one_line_is_refused(tmp_path):
     assert caret_under(exc) == "and = product"
     with pytest.raises(RuleSyntaxError, match="set twice"):
         parse_command("operators: or = max, or = sum", "l.lesson", 4)
+
+
+def test_a_behavior_named_as_a_hedge_is_refused(tmp_path):
+    path = write(tmp_path, "behavior very:\n  r1: if road is WIDE then speed is SLOW\nend\n")
+    exc = error_of(lambda: load_rules_file(path), RuleBaseError)
+    assert "`very` is a reserved word (a hedge), not a name" in exc.message

@@ -46,9 +46,14 @@ def read_table(text: str, path: str, inputs: tuple[str, ...],
         raise InputError("the batch CSV holds a NUL byte (it is not a text file)",
                          span=Span.at(text, path, nul, lineno, column))
     lines = text.splitlines()
-    if not lines or not lines[0].strip():
+    if not any(line.strip() for line in lines):
         raise InputError("the batch CSV is empty", span=Span(path, 1, 1),
                          expected="a header naming the inputs: " + ",".join(inputs))
+    if not lines[0].strip():
+        raise InputError("the batch CSV's first line is empty: the header comes first",
+                         span=Span(path, 1, 1),
+                         expected="a header naming the inputs: " + ",".join(inputs),
+                         hint="remove the empty lines above the header")
     header = [h.strip() for h in _cells(lines[0], path, 1)]
     starts = _starts(lines[0])
     seen: dict[str, int] = {}

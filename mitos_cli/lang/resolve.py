@@ -85,6 +85,9 @@ def build_rulebase(parsed: ParsedFile, termsets: tuple[TermSet, ...],
     for b in behaviors:
         if counts[b.name] > 1:
             raise RuleBaseError(f"behavior `{b.name}` is defined twice", span=b.span)
+        if b.name in HEDGES or b.name == "not":     # `use very when ...` could not name it
+            raise RuleBaseError(f"`{b.name}` is a reserved word (a hedge), not a name",
+                                span=b.span, hint="name the behavior something else")
     base_ops = ops_mod.resolve(parsed.operators)
     for b in behaviors:
         ops_mod.resolve(b.operators, base_ops)
