@@ -330,3 +330,17 @@ def test_a_batch_whose_header_is_not_first_says_so():
         read_batch("\nroad,size,position\n1,2,3\n", "in.csv", ("road", "size", "position"))
     with pytest.raises(InputError, match="the batch CSV is empty"):
         read_batch("\n\n", "in.csv", ("road", "size", "position"))
+
+
+def test_an_output_outside_its_universe_is_said(tmp_path, capsys):
+    for name in ("mitos.terms.yaml", "drive.terms.yaml"):
+        (tmp_path / name).write_text((ROOT / "rulebases" / name).read_text(encoding="utf-8"),
+                                     encoding="utf-8")
+    rules = tmp_path / "ws.rules"
+    rules.write_text('terms "mitos.terms.yaml", "drive.terms.yaml"\n'
+                     "operators: inference = weighted_sum\n"
+                     "r1: if road is MEDIUM then steering is RB\n"
+                     "r2: if road is MEDIUM then steering is RM\n", encoding="utf-8")
+    code, out, err = run_main(["eval", str(rules), "road=70"], capsys)
+    assert code == 0 and "steering = 280" in out
+    assert "output `steering` lies outside its universe [30, 150] (280)" in err

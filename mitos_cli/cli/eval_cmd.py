@@ -71,6 +71,24 @@ def warn_clamped(result) -> None:
             warn(f"`{c.inputs[k]}` outside its universe [{lo:g}, {hi:g}] was clamped{many}")
 
 
+def warn_outside(compiled, Y) -> None:
+    """An output outside its universe, which a weighted sum or a linear consequent can give
+    (the rules' values are what they are: said, not clamped)."""
+    import numpy as np
+
+    Y = np.atleast_2d(np.asarray(Y, dtype=float))
+    for j, name in enumerate(compiled.outputs):
+        lo, hi = compiled.variables[name].universe
+        col = Y[:, j]
+        out = np.isfinite(col) & ((col < lo - 1e-9 * max(1.0, abs(lo)))
+                                  | (col > hi + 1e-9 * max(1.0, abs(hi))))
+        if out.any():
+            many = (f" in {plural(int(out.sum()), 'sample')}" if len(col) > 1
+                    else f" ({col[out][0]:g})")
+            warn(f"output `{name}` lies outside its universe [{lo:g}, {hi:g}]{many}: the "
+                 f"behavior's inference or a linear consequent can leave it")
+
+
 def eval_command(
     args: Annotated[Optional[list[str]], typer.Argument(
         metavar="[RULEBASE] NAME=VALUE...",
@@ -141,6 +159,7 @@ def eval_command(
                                 if k not in unused}
     result = evaluate(rb.compiled, as_batch(rb.compiled, given))
     warn_clamped(result)
+    warn_outside(rb.compiled, result.outputs)
     trace = trace_of(result)
     if as_json:
         emit(json_text(trace.to_json()))
@@ -176,6 +195,7 @@ def run_batch(rb, source: str, on_no_rule: NoRule | None = None) -> None:
     result = rb.run(X, strict=False, detail=False)
     warn_clamped(result)
     Y, keep, flags = no_rule_policy(rb.compiled, result, on_no_rule or NoRule.default)
+    warn_outside(rb.compiled, Y[keep])
     taken = (*rb.compiled.inputs, *rb.compiled.outputs, *(() if on_no_rule is None
                                                          else ("no_rule",)))
     extra = passed_names(batch.extra, taken)
