@@ -280,3 +280,8 @@ def test_a_start_or_goal_inside_an_obstacle_is_refused(obstacle, what):
 def test_an_empty_number_says_so():
     msg = error(BASE.replace("time_limit: 10", "time_limit: ~"))
     assert "w.yaml:4:13" in msg and "must be a number, not nothing (an empty value or `~`)" in msg
+
+
+def test_a_name_with_a_control_character_is_refused():
+    msg = error(BASE.replace("name: t", 'name: "t\\e[31m"'))
+    assert "w.yaml:1:7" in msg and "control character" in msg

@@ -297,6 +297,9 @@ def parse_world(text: str, path: str) -> World:
     doc = yamlpos.load(text, path, WorldError)
     top = r.mapping(doc, Span.in_text(text, path, 1, 1), "the world file", TOP_KEYS)
     name = str(yamlpos.require(top, "name", WorldError, "the world file"))
+    if any(not c.isprintable() for c in name):      # it is printed in every table and title
+        raise WorldError("the world's name holds a control character",
+                         span=top.value_span("name"), hint="letters, digits, `-`, `_`, spaces")
     seed = _seed(r, top)
     dt = r.number(top, "dt", "the world file", None, positive=True, maximum=1.0)
     limit = r.number(top, "time_limit", "the world file", None, positive=True)
