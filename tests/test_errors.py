@@ -459,3 +459,11 @@ def test_a_behavior_named_as_a_hedge_is_refused(tmp_path):
     path = write(tmp_path, "behavior very:\n  r1: if road is WIDE then speed is SLOW\nend\n")
     exc = error_of(lambda: load_rules_file(path), RuleBaseError)
     assert "`very` is a reserved word (a hedge), not a name" in exc.message
+
+
+def test_a_frozen_label_naming_no_rule_is_pointed_at(tmp_path):
+    path = write(tmp_path, "behavior a:\n  r1: if road is WIDE then speed is SLOW\n"
+                           "  frozen r1, r7\nend\n")
+    exc = error_of(lambda: load_rules_file(path))
+    assert exc.span.line == 4 and caret_under(exc) == "r7"
+    assert exc.message == "unknown rule label `r7` in behavior `a`"

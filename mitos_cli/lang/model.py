@@ -100,6 +100,8 @@ class Behavior:
     operators: tuple[Setting, ...] = ()
     frozen: tuple[str, ...] = ()
     span: Span | None = field(default=None, compare=False)
+    frozen_spans: tuple[Span | None, ...] = field(default=(), compare=False, repr=False)
+    # where each of ``frozen`` is written (empty for a behavior not read from a file)
 
 
 @dataclass(frozen=True)

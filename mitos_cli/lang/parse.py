@@ -271,7 +271,9 @@ class _ToModel(Transformer):
                    None if weight is None else weight.span)
 
     def frozen_stmt(self, items):
-        return ("frozen", tuple(str(i) for i in items))
+        return ("frozen", tuple(str(i) for i in items),
+                tuple(shift(Span.at(self.text, self.path, i.start_pos, i.line, i.column,
+                                    i.end_column), self.line_offset) for i in items))
 
     @v_args(meta=True)
     def op_assign(self, meta, items):
@@ -367,7 +369,9 @@ def check_settings(settings: tuple[Setting, ...]) -> tuple[Setting, ...]:
 
 
 def _collect(item, terms: list[tuple[str, Span]], operators: list[Setting], rules: list[Rule],
-             uses: list[Use], frozen: list[str], behaviors: list[Behavior]) -> None:
+             uses: list[Use], frozen: list[str], behaviors: list[Behavior],
+             frozen_spans: list[Span | None] | None = None) -> None:
+    frozen_spans = [] if frozen_spans is None else frozen_spans
     if isinstance(item, Rule):
         rules.append(item)
     elif isinstance(item, Use):
@@ -380,16 +384,18 @@ def _collect(item, terms: list[tuple[str, Span]], operators: list[Setting], rule
         operators.extend(check_settings(item[1]))
     elif item[0] == "frozen":
         frozen.extend(item[1])
+        frozen_spans.extend(item[2])
     elif item[0] == "behavior":
         _, name, body, span = item
         b_rules: list[Rule] = []
         b_ops: list[Setting] = []
         b_uses: list[Use] = []
         b_frozen: list[str] = []
+        b_spans: list[Span | None] = []
         for sub in body:
-            _collect(sub, [], b_ops, b_rules, b_uses, b_frozen, [])
+            _collect(sub, [], b_ops, b_rules, b_uses, b_frozen, [], b_spans)
         behaviors.append(Behavior(name, tuple(b_rules), tuple(b_uses),
-                                  tuple(b_ops), tuple(b_frozen), span))
+                                  tuple(b_ops), tuple(b_frozen), span, tuple(b_spans)))
 
 
 def parse_rule(text: str, path: str | None = None) -> Rule:

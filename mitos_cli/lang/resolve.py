@@ -114,9 +114,12 @@ def _check_behavior(b: Behavior, variables: dict[str, Variable], behaviors: list
         if use.condition is not None:
             check_expr(use.condition, variables)
         _check_weight(use.weight, use.weight_span or use.span)
-    for label in b.frozen:
+    for i, label in enumerate(b.frozen):
         if label not in labels:
-            raise unknown(f"rule label in behavior `{b.name}`", label, labels, span=b.span)
+            at = b.frozen_spans[i] if i < len(b.frozen_spans) else None
+            exc = unknown("rule label", label, labels, span=at or b.span)
+            exc.message = f"unknown rule label `{label}` in behavior `{b.name}`"
+            raise exc
 
 
 def check_rule(rule: Rule, variables: dict[str, Variable]) -> None:
