@@ -25,13 +25,13 @@ MAX_TEXT_BYTES = 256 << 20
 
 def read_text(path: str | Path) -> str:
     """A file the user named, as text: UTF-8, with or without a byte-order mark (which is not
-    content). Only a regular file is read, and at most :data:`MAX_TEXT_BYTES` of it: a
-    device (``/dev/zero``) or a pipe would be read without end. Raises ``OSError`` (with a
-    ``strerror`` to show) or ``UnicodeDecodeError``, as ``Path.read_text`` does."""
+    content). At most :data:`MAX_TEXT_BYTES` are read: a device (``/dev/zero``) would be read
+    without end, while a pipe (``--batch <(...)``) is a file a user may well name. Raises
+    ``OSError`` (with a ``strerror`` to show) or ``UnicodeDecodeError``, as
+    ``Path.read_text`` does."""
     path = Path(path)
-    if _special(path):
-        raise OSError(errno.EINVAL, "it is a directory" if path.is_dir()
-                      else "it is not a regular file", str(path))
+    if _special(path) and path.is_dir():
+        raise OSError(errno.EISDIR, "it is a directory", str(path))
     with open(path, "rb") as fh:
         data = fh.read(MAX_TEXT_BYTES + 1)
     if len(data) > MAX_TEXT_BYTES:

@@ -76,11 +76,27 @@ def test_read_text_drops_a_byte_order_mark(tmp_path):
 
 
 @pytest.mark.skipif(not os.path.exists("/dev/zero"), reason="needs /dev/zero")
-def test_read_text_refuses_a_device_instead_of_reading_it_without_end():
+def test_read_text_stops_a_device_instead_of_reading_it_without_end():
     from mitos_cli.fileio import read_text
 
-    with pytest.raises(OSError, match="not a regular file"):
+    with pytest.raises(OSError, match="larger than 256 MB"):
         read_text("/dev/zero")
+
+
+def test_read_text_reads_a_pipe(tmp_path):
+    from mitos_cli.fileio import read_text
+
+    fifo = tmp_path / "rows"
+    os.mkfifo(fifo)
+    pid = os.fork()
+    if pid == 0:                                   # the writer: `<(printf ...)`
+        with open(fifo, "w") as fh:
+            fh.write("road\n1\n")
+        os._exit(0)
+    try:
+        assert read_text(fifo) == "road\n1\n"
+    finally:
+        os.waitpid(pid, 0)
 
 
 def test_why_unreadable_says_where_the_bytes_stop_being_text(tmp_path):
@@ -100,4 +116,4 @@ def test_a_device_named_as_a_file_is_refused_at_once(argv, capsys):
 
     with pytest.raises(SystemExit) as info:
         main(argv)
-    assert info.value.code == 1 and "not a regular file" in capsys.readouterr().err
+    assert info.value.code == 1 and "larger than 256 MB" in capsys.readouterr().err
