@@ -403,7 +403,9 @@ def read_given(mp: YMap, path: str, unknown_occupied: bool):
 
 
 def check_free(world: World, spans: list[tuple[Span, Span]]) -> None:
-    """Refuse a start or goal that lies inside a wall (outside every corridor)."""
+    """Refuse a start or goal that lies inside a wall (outside every corridor) or inside an
+    obstacle where it stands when the run starts, and a start where the robot's body already
+    reaches into a wall: each run would end at its first tick."""
     import numpy as np
 
     from .staticmap import build_static
