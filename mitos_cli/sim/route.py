@@ -270,14 +270,22 @@ def _narrow_corridor(adj, coords, room, s_id: int, g_id: int, walls: np.ndarray,
     gap = point_segment_distance(points, walls).min(axis=1)
     x, y = points[int(gap.argmin())]
     g = float(gap.min())
-    squeeze = math.floor(g * 10) / 10
+    return narrow_passage(float(x), float(y), g, least, "corridor", f"{2 * g:.0f}", half_width)
+
+
+def narrow_passage(x: float, y: float, gap: float, need: float, kind: str, wide: str,
+                   half_width: float = 0.0) -> NarrowPassage:
+    """The refusal naming the narrowest place (x, y) of the widest way, where the robot's
+    centre keeps ``gap`` of the ``need`` inches; the hint offers the squeeze only where the
+    body fits (wider than ``2 * half_width``)."""
+    squeeze = math.floor(gap * 10) / 10
     return NarrowPassage(
         f"the only way to the goal passes ({x:.0f}, {y:.0f}), where the robot's centre keeps "
-        f"{g:.1f} in from the walls (a corridor {2 * g:.0f} in wide); it needs {least:.1f} in",
-        hint=(f"widen the corridor, or allow the squeeze with `route: {{min_clearance: "
+        f"{gap:.1f} in from the walls (a {kind} {wide} in wide); it needs {need:.1f} in",
+        hint=(f"widen the {kind}, or allow the squeeze with `route: {{min_clearance: "
               f"{squeeze:g}}}`" if squeeze > half_width else
-              f"the robot is {2 * half_width:g} in wide: widen the corridor to at least "
-              f"{2 * least:g} in"))
+              f"the robot is {2 * half_width:g} in wide: widen the {kind} to at least "
+              f"{2 * need:g} in"))
 
 
 @dataclass(frozen=True)
@@ -720,12 +728,7 @@ def _refusal(node_c: np.ndarray, s, t, centre, floor: float,
                              hint="check the start and goal, or use `unknown: free`")
     (r, c), gap = widest
     x, y = centre((r, c))
-    return NarrowPassage(
-        f"the only way to the goal passes ({x:.0f}, {y:.0f}), where the robot's centre keeps "
-        f"{gap:.1f} in from the walls (a passage about {2 * gap:.0f} in wide); it needs "
-        f"{floor:.1f} in",
-        hint=f"widen the passage, or allow the squeeze with `route: {{min_clearance: "
-             f"{math.floor(gap * 10) / 10:g}}}`")
+    return narrow_passage(x, y, gap, floor, "passage", f"about {2 * gap:.0f}")
 
 
 def plan_route(static: StaticMap, corridors: tuple[Corridor, ...], start: Pose, goal: Goal,
