@@ -201,6 +201,28 @@ def test_the_prepared_search_patches_only_round_the_changed_cells():
         assert same(patched[2], whole[2])
 
 
+def test_a_robots_searches_patch_from_its_last_one_with_the_bits_of_the_whole():
+    world = load_world(packaged_path("worlds", "slalom.yaml"))
+    grid = prepare(world).plan_grid
+    rng = np.random.default_rng(11)
+    last = route.Prepared()
+    occ = grid.occupied.copy()
+    for k in range(10):              # marks added where the robot drives, some cleared again
+        r = rng.integers(0, occ.shape[0], int(rng.integers(1, 30)))
+        c = int(rng.integers(0, occ.shape[1] - 40)) + rng.integers(0, 40, len(r))
+        if k == 4:                                       # round node (0, 0) and (1, 1)
+            r, c = r % 5, c % 5
+        occ[r, c] = ~occ[r, c] if k % 3 == 2 else True
+        if k == 7:
+            occ[:] = False                              # nothing known: no shortcut at all
+        patched = route._prepared(grid, occ, 50.0, 3, last=last)
+        whole = route._prepared(grid, occ, 50.0, 3, keep=False)
+        assert same(patched[0].dist, whole[0].dist)
+        assert all(same(a, b) for a, b in zip(patched[1], whole[1]))
+        assert same(patched[2], whole[2])
+        assert same(last.occ, occ) and last.occ is not occ
+
+
 def test_a_star_over_flat_tables_takes_the_generic_searchs_path():
     rng = np.random.default_rng(8)
     for _ in range(30):

@@ -36,7 +36,7 @@ import numpy as np
 
 from . import obstacles as obs_mod
 from .geometry import points_in_polygon, ray_circles, ray_segments
-from .route import Clearance, NarrowPassage, Route, grid_route
+from .route import Clearance, NarrowPassage, Prepared, Route, grid_route
 from .staticmap import StaticMap, carve, corridor_rects, grid_walls
 from .world import Goal, Grid, Pose, World
 
@@ -188,6 +188,7 @@ class RobotMap:
     marks: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
     # the cells it marked (none given), as row * cols + col, ascending (row-major order)
     _around: tuple | None = field(default=None, repr=False)   # (planned, reach, its dilation)
+    prepared: Prepared = field(default_factory=Prepared, repr=False)   # for its next replan
 
     @classmethod
     def of(cls, grid: Grid) -> RobotMap:
@@ -384,7 +385,7 @@ def replan(rmap: RobotMap, route: Route, s: float, p: np.ndarray, goal: Goal, t:
     try:
         new = grid_route(_as_map(rmap.grid), Pose(float(p[0]), float(p[1]), heading), goal,
                          clearance, minimum=minimum, occupied=rmap.occupied, explain=False,
-                         leave=clearance + 6.0, behind=behind)
+                         leave=clearance + 6.0, behind=behind, last=rmap.prepared)
     except NarrowPassage:
         return None                # no way left on what it knows: drive on, the rules decide
     rmap.replans += 1

@@ -472,7 +472,8 @@ NARROW_COST = 20.0      # extra cost per step (in steps) of a node closer than t
 def grid_route(static: StaticMap, start: Pose, goal: Goal, clearance: float,
                cell: float = 6.0, minimum: float | None = None,
                occupied: np.ndarray | None = None, explain: bool = True,
-               leave: float = 0.0, behind: float = 0.0, keep: bool = True) -> Route:
+               leave: float = 0.0, behind: float = 0.0, keep: bool = True,
+               last: Prepared | None = None) -> Route:
     """A* on nodes about ``cell`` inches apart, each kept at least ``clearance`` inches (the
     exact Euclidean distance) from the occupied cells, preferring the middle of the corridors.
     Nodes closer than that but not closer than ``minimum`` (the robot's half width plus its
@@ -484,7 +485,8 @@ def grid_route(static: StaticMap, start: Pose, goal: Goal, clearance: float,
     within this many inches of the start, any node off the occupied cells is open (a robot
     that replans beside what it is passing must be able to move off). ``keep``: keep what
     the search works out from the grid's own cells for the next search on the same grid
-    (:func:`_prepared`; not for a grid made for one search)."""
+    (:func:`_prepared`; not for a grid made for one search); ``last``: where one robot's
+    searches on its own map keep what they work out, for its next."""
     g = static.grid
     assert g is not None        # callers plan on a grid (plan_route checks; the rest build one)
     occ = g.occupied if occupied is None else occupied
@@ -492,7 +494,8 @@ def grid_route(static: StaticMap, start: Pose, goal: Goal, clearance: float,
     k = max(1, int(round(cell / g.resolution)))
     rows, cols = occ.shape
     R, C = -(-rows // k), -(-cols // k)
-    field, (fr, fc, node_c), edge = _prepared(g, occ, reach + 2 * g.resolution, k, keep)
+    field, (fr, fc, node_c), edge = _prepared(g, occ, reach + 2 * g.resolution, k, keep,
+                                               last)
     node_c = node_c - g.resolution / 2                         # clearance at each node (in)
     size = k * g.resolution
 
@@ -655,13 +658,35 @@ def _node_xy(grid: Grid, nodes) -> np.ndarray:
                      grid.origin[1] + (fr + 0.5) * grid.resolution], axis=-1)
 
 
-def _prepared(grid: Grid, occ: np.ndarray, cap: float, k: int, keep: bool = True):
+@dataclass
+class Prepared:
+    """What :func:`_prepared` last worked out for one robot's map (its cells then, the field,
+    the nodes, every step's clearance and how many samples a step took), so that its next
+    search starts from there: between two replans a robot marks and clears a few cells round
+    where it drives, while the difference from the grid's own cells grows with every cell
+    it has marked since the start."""
+
+    key: tuple = ()                # (grid, cap, k) it was worked out for (the grid itself)
+    occ: np.ndarray | None = None  # a copy of the cells
+    field: Clearance | None = None
+    nodes: tuple = ()
+    edge: np.ndarray | None = None
+    samples: int = 0
+
+
+def _prepared(grid: Grid, occ: np.ndarray, cap: float, k: int, keep: bool = True,
+              last: Prepared | None = None):
     """The clearance field, the nodes and every step's clearance (:func:`_planned_on`) for
-    the cells ``occ`` (the grid's own, or a robot's map of it): from the grid's own, worked
+    the cells ``occ`` (the grid's own, or a robot's map of it): from the grid's own, or from
+    what was worked out for the same robot's map ``last`` time (kept there again), worked
     out again only where the cells that differ can reach. The capped field at a cell depends
     on the cells within ``n`` cells of it each way (:func:`.distance._capped`), a node on its
     block's field, a step's clearance on its two nodes and the cells between them (which lie
     in the two nodes' blocks): the rest keeps its bits."""
+    if last is not None and keep and occ is not grid.occupied:
+        out = _prepared_from(grid, occ, cap, k, last)
+        if out is not None:
+            return out
     res = grid.resolution
     n = int(math.ceil(cap / res))
     rows, cols = occ.shape
@@ -671,14 +696,47 @@ def _prepared(grid: Grid, occ: np.ndarray, cap: float, k: int, keep: bool = True
         nodes = _nodes(field.dist, k)
         xy = _node_xy(grid, nodes)
         edge = np.full((len(MOVES), *xy.shape[:2]), -np.inf)
-        _edges_from(edge, field, xy, _samples(field, xy), MOVES, (0, xy.shape[0]),
-                    (0, xy.shape[1]))
-        return field, nodes, edge
-    base_field, base_nodes, base_edge, samples = _planned_on(grid, cap, k)
-    diff = occ != grid.occupied
+        t = _samples(field, xy)
+        _edges_from(edge, field, xy, t, MOVES, (0, xy.shape[0]), (0, xy.shape[1]))
+        out = field, nodes, edge, len(t)
+    else:
+        out = _patched(grid, occ, grid.occupied, cap, k, *_planned_on(grid, cap, k))
+    if last is not None and keep:
+        _keep(last, grid, occ, cap, k, out)
+    return out[:3]
+
+
+def _prepared_from(grid: Grid, occ: np.ndarray, cap: float, k: int, last: Prepared):
+    """:func:`_prepared` from what ``last`` holds (``None`` when it holds nothing for this
+    grid, cap and block size, or when either's field is not the capped one: nothing
+    occupied, or a cap beyond the grid)."""
+    if last.occ is None or last.key[0] is not grid or last.key[1:] != (cap, k) \
+            or int(math.ceil(cap / grid.resolution)) >= max(occ.shape) \
+            or not occ.any() or not last.occ.any():
+        return None
+    assert last.field is not None and last.edge is not None
+    out = _patched(grid, occ, last.occ, cap, k, last.field, last.nodes, last.edge,
+                   last.samples)
+    _keep(last, grid, occ, cap, k, out)
+    return out[:3]
+
+
+def _keep(last: Prepared, grid: Grid, occ: np.ndarray, cap: float, k: int, out) -> None:
+    last.key, last.occ = (grid, cap, k), occ.copy()
+    last.field, last.nodes, last.edge, last.samples = out
+
+
+def _patched(grid: Grid, occ: np.ndarray, base_occ: np.ndarray, cap: float, k: int,
+             base_field: Clearance, base_nodes, base_edge: np.ndarray, samples: int):
+    """The field, nodes, steps' clearance and samples per step for ``occ``, from those worked
+    out for ``base_occ``: again only where the cells that differ can reach."""
+    res = grid.resolution
+    n = int(math.ceil(cap / res))
+    rows, cols = occ.shape
+    diff = occ != base_occ
     changed_rows = np.flatnonzero(diff.any(axis=1))
     if not len(changed_rows):
-        return base_field, base_nodes, base_edge
+        return base_field, base_nodes, base_edge, samples
     changed_cols = np.flatnonzero(diff.any(axis=0))
     # the field where it can differ (n cells round the changed ones), from n more round that
     d0, d1 = max(int(changed_rows[0]) - n, 0), min(int(changed_rows[-1]) + 1 + n, rows)
@@ -706,7 +764,7 @@ def _prepared(grid: Grid, occ: np.ndarray, cap: float, k: int, keep: bool = True
     else:                                # the steps from a node within a block of those
         _edges_from(edge, field, xy, t, MOVES, (max(b0 - 1, 0), min(b1 + 1, R)),
                     (max(c0 - 1, 0), min(c1 + 1, C)))
-    return field, nodes, edge
+    return field, nodes, edge, len(t)
 
 
 def _refusal(node_c: np.ndarray, s, t, centre, floor: float,
