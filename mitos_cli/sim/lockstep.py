@@ -1,9 +1,10 @@
 """Runs in lockstep: independent runs of one world stepped together, tick by tick.
 
 Each tick the robots of every run still going are sensed in one pass (:func:`.rows.sense`:
-beams, noise from each robot's own stream, clearance) and their rule inputs perceived in one
-pass (:func:`.perception.perceive_rows`); what a robot's own map and route need (marking and
-clearing its map, replanning, the lookahead) and its check are done run by run, with the code
+beams, noise from each robot's own stream, clearance), their pursuit points found in one pass
+(:func:`.perception.pursuit_points`) and their rule inputs perceived in one pass
+(:func:`.perception.perceive_rows`); what a robot's own map and route need (marking and
+clearing its map, replanning) and its check are done run by run, with the code
 of a run alone (:class:`~mitos_cli.sim.loop.Simulation`). Then the fuzzy planner's rule network
 is evaluated once for the active robots of every run (one engine batch: the engine gives each
 row the bits it gives alone), each run's brake checks its commands, and the robots of every run
@@ -109,10 +110,15 @@ def _observe_together(runs: list[Simulation]) -> list:
             parts += mine
         world = fresh[0].world
         got = rows.sense(parts, fresh[0].angles, world.sensors.range)
-        ticks, sights = [], []
+        sensed, aims = [], []
         for run, (start, stop) in zip(fresh, spans):
             s = run.sensed(got.part(start, stop))
-            mine_ = run.sights(s)
+            sensed.append(s)
+            aims += run.aims(s)
+        ahead, targets = perception.pursuit_points(aims, fresh[0].settings)
+        ticks, sights = [], []
+        for run, s, (start, stop) in zip(fresh, sensed, spans):
+            mine_ = run.aimed(s, aims[start:stop], ahead[start:stop], targets[start:stop])
             ticks.append((run, s, mine_, start, stop))
             sights += mine_
         inputs = perception.perceive_rows(sights, world.sensors.range, fresh[0].settings)

@@ -627,9 +627,15 @@ class Simulation:
                                                            self._cfg))
 
     def sights(self, s: _Sensed) -> list[perception.Sight]:
-        """Each robot's :class:`.perception.Sight` at tick ``s``: where it is on its route,
-        its map updated from its readings (and its route replanned if need be), how far
-        ahead it aims and what it keeps clear of."""
+        """Each robot's :class:`.perception.Sight` at tick ``s`` (:meth:`aims`, then every
+        robot's pursuit point at once)."""
+        aims = self.aims(s)
+        return self.aimed(s, aims, *perception.pursuit_points(aims, self._cfg))
+
+    def aims(self, s: _Sensed) -> list[perception.Aim]:
+        """Each robot's :class:`.perception.Aim` at tick ``s``: where it is on its route, its
+        map updated from its readings (and its route replanned if need be) and what its
+        pursuit point keeps clear of (runs in lockstep find their pursuit points together)."""
         routes, out = self._routes, []
         for i in range(self.n):
             f = perception.frame(routes[i], s.pose[i, :2], self._s_hint[i])
@@ -648,14 +654,24 @@ class Simulation:
             # what the route keeps clear of: the marks too, where it is replanned round them
             cells = rmap.near(s.pose[i, :2], self._cfg.lookahead + least,
                               given=self.world.replan != "clearance")
-            radius = rmap.grid.resolution / 2
-            ahead, target = perception.pursuit_point(routes[i], f, s.pose[i, :2], cells, radius,
-                                                     least + self._cfg.lookahead_room, self._cfg)
-            room = perception.route_room(f, s.pose[i, :2], cells, radius, least)
+            out.append(perception.Aim(routes[i], f, s.pose[i, :2], cells,
+                                      rmap.grid.resolution / 2,
+                                      least + self._cfg.lookahead_room))
+        return out
+
+    def aimed(self, s: _Sensed, aims: list[perception.Aim], ahead: np.ndarray,
+              targets: np.ndarray) -> list[perception.Sight]:
+        """The robots' sights from their :meth:`aims` and their pursuit points (lookaheads
+        ``ahead [n]``, points ``targets [n, 2]``): how far ahead each aims and what it keeps
+        clear of."""
+        out = []
+        for i, aim in enumerate(aims):
+            least = self._asked[i][1]
+            room = perception.route_room(aim.f, aim.p, aim.cells, aim.radius, least)
             out.append(perception.Sight(
-                routes[i], f, (float(self._x[i]), float(self._y[i]), float(self._h[i])),
+                aim.route, aim.f, (float(self._x[i]), float(self._y[i]), float(self._h[i])),
                 self.robots[i], self._dirs[i], s.ranges[i], self._expected[i], self._spacing,
-                self._threshold, ahead, room, self._kept(i, s, least), target))
+                self._threshold, float(ahead[i]), room, self._kept(i, s, least), targets[i]))
         return out
 
     def perceived(self, s: _Sensed, sights: list[perception.Sight],

@@ -378,24 +378,67 @@ def clear_lookahead(route: Route, f: Frame, p: np.ndarray, cells: np.ndarray, ra
     return pursuit_point(route, f, p, cells, radius, need, cfg)[0]
 
 
+@dataclass(frozen=True)
+class Aim:
+    """What a robot's pursuit point is found from (:func:`pursuit_points`): its route, where
+    it is on it, its place ``p``, and the occupied cells ``[P, 2]`` (discs of ``radius``) the
+    way to the point keeps ``need`` inches from."""
+
+    route: Route
+    f: Frame
+    p: np.ndarray
+    cells: np.ndarray
+    radius: float
+    need: float
+
+
 def pursuit_point(route: Route, f: Frame, p: np.ndarray, cells: np.ndarray, radius: float,
                   need: float, cfg: Settings) -> tuple[float, np.ndarray]:
     """:func:`clear_lookahead` and the route point that far ahead (:func:`target_point`)."""
+    ahead, target = pursuit_points([Aim(route, f, p, cells, radius, need)], cfg)
+    return float(ahead[0]), target[0]
+
+
+#: Where a row with fewer cells than the others has its padding: far from every route, so
+#: never the nearest (a row with no cells at all is not measured).
+_FAR = 1e12
+
+
+def pursuit_points(aims: list[Aim], cfg: Settings) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`pursuit_point` of every robot at once (runs in lockstep, each robot with its
+    own route and cells): the lookaheads ``[R]`` and the points ``[R, 2]``. The cells are
+    padded far away and every product is written out elementwise, so a robot gets the bits
+    it gets alone, in any batch."""
     ahead = _lookaheads(cfg)
-    if not len(cells):
-        return float(ahead[-1]), target_point(route, f, cfg, float(ahead[-1]))
-    q = target_points(route, f, ahead)                                        # [J, 2]
+    out_ahead = np.full(len(aims), float(ahead[-1]))
+    targets = np.empty((len(aims), 2))
+    have = []
+    for i, a in enumerate(aims):
+        if len(a.cells):
+            have.append(a)
+        else:
+            targets[i] = target_point(a.route, a.f, cfg, float(ahead[-1]))
+    if not have:
+        return out_ahead, targets
+    q = np.stack([target_points(a.route, a.f, ahead) for a in have])         # [H, J, 2]
+    p = np.stack([a.p for a in have])[:, None]                                # [H, 1, 2]
     e = q - p
-    ee = np.maximum((e * e).sum(axis=1), 1e-12)
-    rel = cells - p                                                           # [P, 2]
-    t = clip_arrays((rel @ e.T) / ee, 0.0, 1.0)                               # [P, J]
-    dx = rel[:, 0, None] - t * e[:, 0]
-    dy = rel[:, 1, None] - t * e[:, 1]
-    clear = np.hypot(dx, dy).min(axis=0) - radius >= need                    # [J]
-    if clear.all():
-        return float(ahead[-1]), q[-1]
-    k = max(int(clear.argmin()) - 1, 0)
-    return float(ahead[k]), q[k]
+    ee = np.maximum(e[..., 0] * e[..., 0] + e[..., 1] * e[..., 1], 1e-12)     # [H, J]
+    rel = np.full((len(have), max(len(a.cells) for a in have), 2), _FAR)
+    for j, a in enumerate(have):
+        rel[j, :len(a.cells)] = a.cells
+    rel -= p                                                                  # [H, P, 2]
+    rx, ry = rel[..., 0, None], rel[..., 1, None]                             # [H, P, 1]
+    ex, ey = e[:, None, :, 0], e[:, None, :, 1]                               # [H, 1, J]
+    t = clip_arrays((rx * ex + ry * ey) / ee[:, None], 0.0, 1.0)              # [H, P, J]
+    gap = np.hypot(rx - t * ex, ry - t * ey).min(axis=1)                      # [H, J]
+    clear = (gap - np.array([a.radius for a in have])[:, None]
+             >= np.array([a.need for a in have])[:, None])
+    have_i = np.array([i for i, a in enumerate(aims) if len(a.cells)])
+    k = np.where(clear.all(axis=1), len(ahead) - 1, np.maximum(clear.argmin(axis=1) - 1, 0))
+    out_ahead[have_i] = ahead[k]
+    targets[have_i] = q[np.arange(len(have)), k]
+    return out_ahead, targets
 
 
 def route_room(f: Frame, p: np.ndarray, cells: np.ndarray, radius: float,
