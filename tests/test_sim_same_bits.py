@@ -296,3 +296,21 @@ def test_robots_perceived_together_get_the_bits_they_get_alone(name):
         alone = perception.perceive_rows([sight], sims[0].world.sensors.range, cfg)
         for key in perception.INPUTS:
             assert same(alone[key][0], together[key][i]), key
+
+
+@pytest.mark.parametrize("name", ["slalom.yaml", "office.yaml", "detour.yaml"])
+def test_robots_aim_together_with_the_bits_they_get_alone(name):
+    sims = running(name)
+    aims = []
+    for sim in sims:
+        aims += sim.aims(sim.sense())
+    cfg = sims[0].settings
+    rng = np.random.default_rng(3)
+    # rows with no cells, with few and with many (padding of every width), in any order
+    aims += [dataclasses.replace(a, cells=a.cells[:k]) for a in aims[:3] for k in (0, 1, 5)]
+    aims = [aims[i] for i in rng.permutation(len(aims))]
+    assert any(len(a.cells) > 20 for a in aims)
+    ahead, targets = perception.pursuit_points(aims, cfg)
+    for i, a in enumerate(aims):
+        one, target = perception.pursuit_point(a.route, a.f, a.p, a.cells, a.radius, a.need, cfg)
+        assert same(one, ahead[i]) and same(target, targets[i])
