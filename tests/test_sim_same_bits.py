@@ -314,3 +314,21 @@ def test_robots_aim_together_with_the_bits_they_get_alone(name):
     for i, a in enumerate(aims):
         one, target = perception.pursuit_point(a.route, a.f, a.p, a.cells, a.radius, a.need, cfg)
         assert same(one, ahead[i]) and same(target, targets[i])
+
+
+def test_a_maps_near_cells_read_from_the_last_square_are_the_cells_of_a_fresh_look():
+    world = load_world(packaged_path("worlds", "slalom.yaml"))
+    grid = prepare(world).plan_grid
+    rng = np.random.default_rng(5)
+    kept, fresh = knowledge.RobotMap.of(grid), knowledge.RobotMap.of(grid)
+    for _ in range(40):
+        p = np.array([rng.uniform(0, 900), rng.uniform(-40, 40)])
+        if rng.random() < 0.3:                        # a mark between two looks
+            hits = p + rng.normal(0, 30, (3, 2))
+            dirs = np.tile([1.0, 0.0], (3, 1))
+            kept.mark(hits, dirs)
+            fresh.mark(hits, dirs)
+        given = bool(rng.random() < 0.2)
+        for reach in (60.0, float(rng.uniform(10, 60)), float(rng.uniform(10, 80))):
+            fresh._last_near = None                   # always looked up afresh
+            assert same(kept.near(p, reach, given), fresh.near(p, reach, given))

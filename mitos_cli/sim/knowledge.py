@@ -157,17 +157,6 @@ def _centre_lines(grid: Grid) -> tuple[np.ndarray, np.ndarray]:
     return xs, ys
 
 
-def _centres_of(grid: Grid, window: np.ndarray, r0: int, c0: int) -> np.ndarray:
-    """The centres ``[P, 2]`` of the set cells of ``window``, a part of ``grid``'s cells
-    from row ``r0`` and column ``c0`` (in row-major order, as ``np.nonzero`` gives them)."""
-    r, c = window.nonzero()
-    xs, ys = _centre_lines(grid)
-    out = np.empty((len(r), 2))
-    out[:, 0] = xs[c + c0]
-    out[:, 1] = ys[r + r0]
-    return out
-
-
 @functools.lru_cache(maxsize=4)
 def _given_dilated(grid: Grid, reach: int) -> np.ndarray:
     """:func:`_dilated` of a given grid's cells, shared by every robot and run that plans on
@@ -189,6 +178,8 @@ class RobotMap:
     # the cells it marked (none given), as row * cols + col, ascending (row-major order)
     _around: tuple | None = field(default=None, repr=False)   # (planned, reach, its dilation)
     prepared: Prepared = field(default_factory=Prepared, repr=False)   # for its next replan
+    _changes: int = field(default=0, repr=False)     # marks made and cleared so far
+    _last_near: tuple | None = field(default=None, repr=False)     # see near()
 
     @classmethod
     def of(cls, grid: Grid) -> RobotMap:
@@ -235,10 +226,26 @@ class RobotMap:
 
     def near(self, p: np.ndarray, reach: float, given: bool = False) -> np.ndarray:
         """The centres ``[P, 2]`` of the occupied cells in the square of half side ``reach``
-        around ``p`` (``given``: of the cells it was given, without its marks)."""
+        around ``p`` (``given``: of the cells it was given, without its marks). A square
+        inside the last one asked for, with no mark made or cleared since (the perception's
+        and then the brake's, each tick), is read from that one's cells: the same cells in
+        the same order."""
         r0, r1, c0, c1 = self._square(p, reach)
+        last = self._last_near
+        if last is not None and last[0] == (self._changes, given) and last[1] <= r0 \
+                and r1 <= last[2] and last[3] <= c0 and c1 <= last[4]:
+            r, c, centres = last[5:]
+            return centres[(r >= r0) & (r < r1) & (c >= c0) & (c < c1)]
         cells = self.grid.occupied if given else self.occupied
-        return _centres_of(self.grid, cells[r0:r1, c0:c1], r0, c0)
+        r, c = cells[r0:r1, c0:c1].nonzero()
+        r += r0
+        c += c0
+        xs, ys = _centre_lines(self.grid)
+        centres = np.empty((len(r), 2))
+        centres[:, 0], centres[:, 1] = xs[c], ys[r]
+        centres.flags.writeable = False                  # kept for the next question
+        self._last_near = ((self._changes, given), r0, r1, c0, c1, r, c, centres)
+        return centres
 
     def clear(self, origin: np.ndarray, dirs: np.ndarray, measured: np.ndarray,
               max_range: float) -> None:
@@ -267,6 +274,7 @@ class RobotMap:
         through = ((along > 0) & (along < np.minimum(measured, max_range) - res)
                    & (across < res / 2)).any(axis=1)
         if through.any():
+            self._changes += 1
             self.occupied[r[through], c[through]] = False
             self.marks = np.delete(self.marks, np.flatnonzero(window)[through])
 
@@ -278,6 +286,7 @@ class RobotMap:
         row, col = row[inside], col[inside]
         new = ~self.occupied[row, col]
         if new.any():
+            self._changes += 1
             self.occupied[row[new], col[new]] = True
             self.marks = np.union1d(self.marks, row[new] * self.occupied.shape[1] + col[new])
             g = self.grid
