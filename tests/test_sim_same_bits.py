@@ -332,3 +332,14 @@ def test_a_maps_near_cells_read_from_the_last_square_are_the_cells_of_a_fresh_lo
         for reach in (60.0, float(rng.uniform(10, 60)), float(rng.uniform(10, 80))):
             fresh._last_near = None                   # always looked up afresh
             assert same(kept.near(p, reach, given), fresh.near(p, reach, given))
+
+
+def test_distances_from_many_routes_at_once_are_each_routes_own():
+    rng = np.random.default_rng(9)
+    routes = [route.Route.of(np.cumsum(rng.normal(0, 40, (int(rng.integers(2, 12)), 2)),
+                                       axis=0)) for _ in range(7)]
+    s = [float(rng.uniform(-20, r.length + 20)) for r in routes]
+    points = rng.normal(0, 150, (7, 36, 2))
+    got = route.distances(routes, s, 120.0, points)
+    for i, r in enumerate(routes):
+        assert same(got[i], r.distance(points[i], s[i], 120.0))

@@ -89,7 +89,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .geometry import clip_arrays
-from .route import Route
+from .route import Route, distances
 from .world import Robot
 
 NO_OBSTACLE = 200.0     # in: the `obstacle` distance when nothing obstructs
@@ -540,11 +540,14 @@ def perceive_rows(rows: list[Sight], max_range: float,
     left, right = _road_rows(a, b, valid & ~obstacle_hit, cfg.window, max_range)
     road = left + right
     widen = measured * np.array([r.spacing for r in rows])[:, None] / 2
-    in_way = valid & ~obstacle_hit & (a > 0)
-    for i in np.flatnonzero(in_way.any(axis=1)):    # drawn on the map, but where the
-        r = rows[i]                                 # robot's route would hit it
-        in_way[i, in_way[i]] = r.route.near(hits[i][in_way[i]], r.f.s,
-                                            r.robot.width / 2 + r.robot.safety_margin, cfg.sight)
+    in_way = valid & ~obstacle_hit & (a > 0)    # drawn on the map, but where the robot's
+    some = np.flatnonzero(in_way.any(axis=1))   # route would hit it
+    if len(some):
+        gone = distances([rows[i].route for i in some], [rows[i].f.s for i in some],
+                         cfg.sight, hits[some])
+        reach = np.array([rows[i].robot.width / 2 + rows[i].robot.safety_margin
+                          for i in some])[:, None]
+        in_way[some] &= gone <= reach
     ah, bh, valid_ah, valid_bh = _own_frames(rows, rel, valid)
     size, position, distance = _obstruction_rows(
         [r.route for r in rows], [r.f for r in rows], a, b, hits, obstacle_hit | in_way,

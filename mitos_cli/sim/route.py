@@ -129,6 +129,34 @@ class Route:
         return np.sqrt((d * d).sum(axis=2).min(axis=1))
 
 
+def distances(routes: Sequence[Route], s: Sequence[float], ahead: float,
+              points: np.ndarray) -> np.ndarray:
+    """:meth:`Route.distance` of every row at once: row ``i``'s points ``[R, K, 2]`` from
+    ``routes[i]`` between arc lengths ``s[i]`` and ``s[i] + ahead``, ``[R, K]``. Each row's
+    segments are padded with copies of its last one (which the minimum cannot tell from
+    it), so a point gets the bits it gets from its route alone."""
+    spans = [route._window(si, si + ahead) for route, si in zip(routes, s)]
+    width = max((stop - first for first, stop in spans), default=0)
+    out = np.full(points.shape[:2], np.inf)
+    rows = [i for i, (first, stop) in enumerate(spans) if first < stop]
+    if not rows or not points.shape[1]:
+        return out
+    a = np.empty((len(rows), width, 2))
+    b = np.empty((len(rows), width, 2))
+    for j, i in enumerate(rows):
+        first, stop = spans[i]
+        pts = routes[i].points
+        a[j, :stop - first], b[j, :stop - first] = pts[first:stop], pts[first + 1:stop + 1]
+        a[j, stop - first:], b[j, stop - first:] = pts[stop - 1], pts[stop]
+    e = b - a                                                  # [H, M, 2]
+    ee = np.maximum((e * e).sum(axis=2), 1e-12)
+    rel = points[rows][:, :, None] - a[:, None]                # [H, K, M, 2]
+    t = clip_arrays((rel * e[:, None]).sum(axis=3) / ee[:, None], 0.0, 1.0)
+    d = rel - t[..., None] * e[:, None]
+    out[rows] = np.sqrt((d * d).sum(axis=3).min(axis=2))
+    return out
+
+
 def _path(came: dict[int, int], node: int) -> list[int]:
     """The nodes from the start to ``node``, following ``came`` (the start's entry is -1)."""
     path = [node]
