@@ -253,30 +253,32 @@ class RobotMap:
         (something that moved on, or a mark a noisy reading put in the way): a beam is a ray
         (:mod:`.sensors`), so a cell is seen through when the ray crosses it, within half a
         cell of its centre, a cell or more before the reading. Cells the robot was given stay
-        as given."""
+        as given. (:func:`clear_all` of one map.)"""
+        clear_all([self], origin[None], dirs[None], measured[None], max_range)
+
+    def _in_sight(self, origin: np.ndarray, max_range: float):
+        """The marks within ``max_range`` (a square) of ``origin``: their place in
+        :attr:`marks`, rows, columns and centres relative to ``origin``; ``None`` with none."""
         if not len(self.marks):
-            return
-        g = self.grid
-        res, cols = g.resolution, self.occupied.shape[1]
+            return None
         r0, r1, c0, c1 = self._square(origin, max_range)
         # the marks in that window, in the row-major order np.nonzero would give them
-        r, c = np.divmod(self.marks, cols)
+        r, c = np.divmod(self.marks, self.occupied.shape[1])
         window = (r >= r0) & (r < r1) & (c >= c0) & (c < c1)
         if not window.any():
-            return
+            return None
         r, c = r[window], c[window]
-        xs, ys = _centre_lines(g)
+        xs, ys = _centre_lines(self.grid)
         rel = np.empty((len(r), 2))
         rel[:, 0], rel[:, 1] = xs[c], ys[r]
         rel -= origin
-        along = rel @ dirs.T                                       # [P, B]
-        across = np.abs(rel[:, :1] * dirs[:, 1] - rel[:, 1:] * dirs[:, 0])
-        through = ((along > 0) & (along < np.minimum(measured, max_range) - res)
-                   & (across < res / 2)).any(axis=1)
-        if through.any():
-            self._changes += 1
-            self.occupied[r[through], c[through]] = False
-            self.marks = np.delete(self.marks, np.flatnonzero(window)[through])
+        return np.flatnonzero(window), r, c, rel
+
+    def _free(self, where: np.ndarray, r: np.ndarray, c: np.ndarray) -> None:
+        """Unmark the marks at places ``where`` of :attr:`marks` (cells ``r``, ``c``)."""
+        self._changes += 1
+        self.occupied[r, c] = False
+        self.marks = np.delete(self.marks, where)
 
     def mark(self, hits: np.ndarray, dirs: np.ndarray) -> None:
         """Mark the cells just beyond each hit point (the echo came from there)."""
@@ -306,6 +308,34 @@ class RobotMap:
         first = np.where(occ.any(axis=0), occ.argmax(axis=0), -1)
         return np.where(first >= 0, np.minimum(s[np.maximum(first, 0)] - step / 2, max_range),
                         max_range)
+
+
+def clear_all(maps: list[RobotMap], origins: np.ndarray, dirs: np.ndarray,
+              measured: np.ndarray, max_range: float) -> None:
+    """:meth:`RobotMap.clear` of every map at once (robots at ``origins [R, 2]``, their beams
+    ``dirs [R, B, 2]`` and readings ``measured [R, B]``; runs in lockstep clear together). The
+    marks in sight are padded far away, and the products are written out elementwise, so a
+    map is cleared as it would be alone."""
+    seen = [(m, i, got) for i, m in enumerate(maps)
+            if (got := m._in_sight(origins[i], max_range)) is not None]
+    if not seen:
+        return
+    rel = np.full((len(seen), max(len(got[3]) for _, _, got in seen), 2), 1e12)
+    for j, (_, _, got) in enumerate(seen):
+        rel[j, :len(got[3])] = got[3]
+    idx = [i for _, i, _ in seen]
+    d = dirs[idx]                                                  # [H, B, 2]
+    rx, ry = rel[..., 0, None], rel[..., 1, None]                  # [H, P, 1]
+    dx, dy = d[:, None, :, 0], d[:, None, :, 1]                    # [H, 1, B]
+    along = rx * dx + ry * dy                                      # [H, P, B]
+    across = np.abs(rx * dy - ry * dx)
+    res = np.array([m.grid.resolution for m, _, _ in seen])[:, None, None]
+    reach = np.minimum(measured[idx], max_range)[:, None] - res
+    through = ((along > 0) & (along < reach) & (across < res / 2)).any(axis=2)
+    for j, (m, _, (where, r, c, pts)) in enumerate(seen):
+        mine = through[j, :len(pts)]
+        if mine.any():
+            m._free(where[mine], r[mine], c[mine])
 
 
 def expected_ranges(g: Given, rmap: RobotMap | None, origin: np.ndarray, dirs: np.ndarray,

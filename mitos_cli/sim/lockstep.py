@@ -1,10 +1,11 @@
 """Runs in lockstep: independent runs of one world stepped together, tick by tick.
 
 Each tick the robots of every run still going are sensed in one pass (:func:`.rows.sense`:
-beams, noise from each robot's own stream, clearance), their pursuit points found in one pass
-(:func:`.perception.pursuit_points`) and their rule inputs perceived in one pass
-(:func:`.perception.perceive_rows`); what a robot's own map and route need (marking and
-clearing its map, replanning) and its check are done run by run, with the code
+beams, noise from each robot's own stream, clearance), the marks they see through cleared
+from their maps in one pass (:func:`.knowledge.clear_all`), their pursuit points found in one
+pass (:func:`.perception.pursuit_points`) and their rule inputs perceived in one pass
+(:func:`.perception.perceive_rows`); what else a robot's own map and route need (marking its
+map, replanning) and its check are done run by run, with the code
 of a run alone (:class:`~mitos_cli.sim.loop.Simulation`). Then the fuzzy planner's rule network
 is evaluated once for the active robots of every run (one engine batch: the engine gives each
 row the bits it gives alone), each run's brake checks its commands, and the robots of every run
@@ -20,7 +21,7 @@ from dataclasses import fields
 
 import numpy as np
 
-from . import kinematics, perception, rows
+from . import kinematics, knowledge, perception, rows
 from .loop import Scene, SimResult, Simulation
 from .planner import FuzzyPlanner, Planner
 from .world import World
@@ -97,9 +98,10 @@ class Lockstep:
 
 def _observe_together(runs: list[Simulation]) -> list:
     """:meth:`Simulation.observe` of every run: their robots' beams and clearance sensed in
-    one :func:`.rows.sense`, their inputs perceived in one :func:`.perception.perceive_rows`
-    (each row the bits of its robot alone); what each robot's map and route need, run by
-    run."""
+    one :func:`.rows.sense`, their maps cleared in one :func:`.knowledge.clear_all`, their
+    pursuit points found in one :func:`.perception.pursuit_points` and their inputs perceived
+    in one :func:`.perception.perceive_rows` (each row the bits of its robot alone); what
+    else each robot's map and route need, run by run."""
     fresh = [run for run in runs if not run.observed]
     if len(fresh) > 1:
         parts: list[rows.SenseRow] = []
@@ -110,11 +112,12 @@ def _observe_together(runs: list[Simulation]) -> list:
             parts += mine
         world = fresh[0].world
         got = rows.sense(parts, fresh[0].angles, world.sensors.range)
-        sensed, aims = [], []
-        for run, (start, stop) in zip(fresh, spans):
-            s = run.sensed(got.part(start, stop))
-            sensed.append(s)
-            aims += run.aims(s)
+        sensed = [run.sensed(got.part(start, stop)) for run, (start, stop) in zip(fresh, spans)]
+        clearing = [run.clearing(s) for run, s in zip(fresh, sensed)]
+        origins, dirs, measured = (np.concatenate([c[j] for c in clearing]) for j in (1, 2, 3))
+        knowledge.clear_all([m for c in clearing for m in c[0]], origins, dirs, measured,
+                            world.sensors.range)
+        aims = [aim for run, s in zip(fresh, sensed) for aim in run.aims(s)]
         ahead, targets = perception.pursuit_points(aims, fresh[0].settings)
         ticks, sights = [], []
         for run, s, (start, stop) in zip(fresh, sensed, spans):

@@ -627,15 +627,26 @@ class Simulation:
                                                            self._cfg))
 
     def sights(self, s: _Sensed) -> list[perception.Sight]:
-        """Each robot's :class:`.perception.Sight` at tick ``s`` (:meth:`aims`, then every
-        robot's pursuit point at once)."""
+        """Each robot's :class:`.perception.Sight` at tick ``s``: the marks its readings see
+        through cleared from its map (:meth:`clearing`), its :meth:`aims`, then every
+        robot's pursuit point at once."""
+        knowledge.clear_all(*self.clearing(s))
         aims = self.aims(s)
         return self.aimed(s, aims, *perception.pursuit_points(aims, self._cfg))
 
+    def clearing(self, s: _Sensed) -> tuple[list[knowledge.RobotMap], np.ndarray, np.ndarray,
+                                            np.ndarray, float]:
+        """What :func:`.knowledge.clear_all` clears the robots' maps with at tick ``s`` (runs
+        in lockstep clear theirs together): the maps, where the robots are, their beams and
+        readings, and the range."""
+        return (self._maps, s.pose[:, :2], np.stack(self._dirs), s.ranges,
+                self.world.sensors.range)
+
     def aims(self, s: _Sensed) -> list[perception.Aim]:
-        """Each robot's :class:`.perception.Aim` at tick ``s``: where it is on its route, its
-        map updated from its readings (and its route replanned if need be) and what its
-        pursuit point keeps clear of (runs in lockstep find their pursuit points together)."""
+        """Each robot's :class:`.perception.Aim` at tick ``s``, its map cleared
+        (:meth:`clearing`): where it is on its route, its map marked from its readings (and
+        its route replanned if need be) and what its pursuit point keeps clear of (runs in
+        lockstep find their pursuit points together)."""
         routes, out = self._routes, []
         for i in range(self.n):
             f = perception.frame(routes[i], s.pose[i, :2], self._s_hint[i])
@@ -694,13 +705,11 @@ class Simulation:
 
     def _learn(self, i: int, s: _Sensed) -> bool:
         """Mark on robot ``i``'s map what its readings show and its map does not (everything
-        it hits, with no map): whether anything new was marked. Its map is made on first
-        need."""
+        it hits, with no map): whether anything new was marked."""
         sen = self.world.sensors
         max_range = sen.range
         measured, dirs = s.ranges[i], self._dirs[i]
         rmap = self._maps[i]
-        rmap.clear(s.pose[i, :2], dirs, measured, max_range)
         valid = measured < max_range * 0.999
         seen = (valid if self._given.knows == "none"
                 else valid & (measured < self._expected[i] - self._threshold))
