@@ -365,3 +365,21 @@ def test_maps_cleared_together_are_each_cleared_as_alone():
             alone[i].clear(origins[i], dirs[i], measured[i], 40.0)
             assert np.array_equal(together[i].occupied, alone[i].occupied)
             assert np.array_equal(together[i].marks, alone[i].marks)
+
+
+def test_brake_sweeps_measured_together_are_each_measured_as_alone():
+    rng = np.random.default_rng(12)
+    robots = [Robot(), Robot(length=30.0, width=20.0, wheelbase=20.0)]
+    for _ in range(30):
+        sweeps = []
+        for _ in range(int(rng.integers(1, 12))):
+            robot = robots[int(rng.integers(0, 2))]
+            pose = (float(rng.uniform(-5, 5)), float(rng.uniform(-5, 5)),
+                    float(rng.uniform(-4, 4)))
+            cells = rng.uniform(-70, 70, (int(rng.choice([0, 3, 40, 300])), 2))
+            wheel = float(rng.choice([robot.steering_straight, rng.uniform(30, 150)]))
+            body = safety.Body(robot, pose, 90.0, cells, 1.0, 0.0)
+            sweeps.append((body, wheel, bool(rng.random() < 0.3)))
+        got = safety.free_travels(sweeps, 30.0)
+        for j, (body, wheel, backward) in enumerate(sweeps):
+            assert same(got[j], body.free(wheel, backward, safety.Settings()))

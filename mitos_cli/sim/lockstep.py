@@ -21,7 +21,7 @@ from dataclasses import fields
 
 import numpy as np
 
-from . import kinematics, knowledge, perception, rows
+from . import kinematics, knowledge, perception, rows, safety
 from .loop import Scene, SimResult, Simulation
 from .planner import FuzzyPlanner, Planner
 from .world import World
@@ -53,11 +53,9 @@ class Lockstep:
         """One tick of every run still going."""
         live = [run for run in self.runs if not run.done]
         commands = self._commands(live, _observe_together(live))
-        moving = []
-        for run, command in zip(live, commands):
-            _, moves = run.decide(command)
-            if moves:
-                moving.append(run)
+        ticks = [run.commanded(command) for run, command in zip(live, commands)]
+        _guard_together(live, ticks)
+        moving = [run for run, s in zip(live, ticks) if run.verdict(s)[1]]
         if moving:
             _move_together(moving, self._limits)
 
@@ -129,6 +127,21 @@ def _observe_together(runs: list[Simulation]) -> list:
             run.perceived(s, mine_, {k: v[start:stop] for k, v in inputs.items()})
             run.conclude(s)
     return [run.observe() for run in runs]
+
+
+def _guard_together(runs: list[Simulation], ticks: list) -> None:
+    """Every run's guard on its tick's commands, the first sweep of every robot of every
+    run measured in one :func:`.safety.free_travels`."""
+    sweeps = [run.braking(s) for run, s in zip(runs, ticks)]
+    every = [sweep for mine in sweeps for sweep in mine]
+    if not every:
+        return
+    cfg = runs[0].brake_settings
+    free = safety.free_travels(every, cfg.reach, cfg.step)
+    start = 0
+    for run, s, mine in zip(runs, ticks, sweeps):
+        run.braked(s, mine, free[start:start + len(mine)])
+        start += len(mine)
 
 
 def _limits(runs: list[Simulation], kept: list) -> kinematics.Limits:

@@ -475,6 +475,11 @@ class Simulation:
         self._observed = s
 
     @property
+    def brake_settings(self) -> safety.Settings:
+        """The settings of its robots' brake and backing out."""
+        return self._safety
+
+    @property
     def settings(self) -> perception.Settings:
         """The perception settings its robots perceive with."""
         return self._cfg
@@ -497,6 +502,13 @@ class Simulation:
         """The first half of :meth:`step`: observe, plan (or take ``command``), record the tick
         and the verdict; whether the robots move now (:meth:`act`, then :meth:`moved`; runs
         stepped in lockstep move all their robots in one batch between the two)."""
+        s = self.commanded(command)
+        self._guard(s)
+        return self.verdict(s)
+
+    def commanded(self, command: np.ndarray | None = None) -> _Sensed:
+        """The start of :meth:`decide`: the tick observed, and the planner's commands (or
+        ``command``) in it, before the guard."""
         s = self.observe()
         self._observed = None
         if command is None:
@@ -506,7 +518,11 @@ class Simulation:
             if not self._active.all():
                 s.command[~self._active] = np.stack([self.limits.straight, np.zeros(self.n)],
                                                     axis=1)[~self._active]
-        self._guard(s)
+        return s
+
+    def verdict(self, s: _Sensed) -> tuple[Tick, bool]:
+        """The end of :meth:`decide`, once the guard has had its say on ``s``'s commands:
+        the tick recorded and the verdict."""
         tick = self._record(s)
         if self._hit.any():
             self._collided = int(self._hit.sum())
@@ -748,8 +764,16 @@ class Simulation:
 
     def _guard(self, s: _Sensed) -> None:
         """The robot's own safety on every active robot's command (:mod:`.safety`): the brake,
-        and backing out of a pocket when it has held the robot too long."""
-        cfg = self._safety
+        and backing out of a pocket when it has held the robot too long. Their first sweeps
+        are measured together (:meth:`braking`, :func:`.safety.free_travels`)."""
+        sweeps = self.braking(s)
+        self.braked(s, sweeps, safety.free_travels(sweeps, self._safety.reach,
+                                                   self._safety.step))
+
+    def braking(self, s: _Sensed) -> list[tuple[safety.Body, float, bool]]:
+        """The first sweep (body, wheel, backward) the guard measures for each active robot
+        that brakes, in order (runs in lockstep measure theirs together)."""
+        cfg, out = self._safety, []
         for i in np.flatnonzero(self._active):
             robot, rmap = self.robots[i], self._maps[i]
             if not robot.brake:
@@ -758,8 +782,22 @@ class Simulation:
                                float(self._steer[i]),
                                rmap.near(s.pose[i, :2], cfg.reach + self._body[i]),
                                rmap.grid.resolution / 2, float(s.inputs["heading"][i]))
+            command = (float(s.command[i, 0]), float(s.command[i, 1]))
+            out.append((body, *safety.first_sweep(command, body, self._recovery[i], self.dt)))
+        return out
+
+    def braked(self, s: _Sensed, sweeps: list[tuple[safety.Body, float, bool]],
+               free: np.ndarray) -> None:
+        """:meth:`_guard` with the first sweeps of :meth:`braking` measured (``free [R]``)."""
+        cfg, j = self._safety, 0
+        for i in np.flatnonzero(self._active):
+            if not self.robots[i].brake:
+                continue
+            body, wheel, backward = sweeps[j]
             carried, backs = safety.guard((float(s.command[i, 0]), float(s.command[i, 1])),
-                                          body, self._recovery[i], self.dt, cfg)
+                                          body, self._recovery[i], self.dt, cfg,
+                                          (wheel, backward, float(free[j])))
+            j += 1
             s.command[i] = carried
             if backs:
                 self._backed.append((self._k, int(i)))

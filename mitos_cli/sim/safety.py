@@ -88,6 +88,67 @@ backing out: backward, a cell it touches blocks only the steps that take it deep
     return float(max(int(hit.argmax()) - 1, 0) * step)
 
 
+def free_travels(sweeps: list[tuple[Body, float, bool]], reach: float,
+                 step: float = 1.0) -> np.ndarray:
+    """:func:`free_travel` of many sweeps at once (``(body, wheel, backward)`` each; runs in
+    lockstep brake together), ``[R]``. What is one number per sweep is worked out as
+    :func:`free_travel` does, in Python floats; the rest elementwise over ``[R, K]`` steps and
+    ``[R, P, K]`` cells (padded far away), so a sweep gets the bits it gets alone."""
+    out = np.full(len(sweeps), float(reach))
+    rows = [j for j, (body, _, _) in enumerate(sweeps) if len(body.cells)]
+    if not rows:
+        return out
+    n = len(rows)
+    u = np.stack([_path(reach, step, sweeps[j][2]) for j in rows])            # [n, K]
+    h, k, a, b, sin_h, cos_h, half, hl, hw, disc = (np.empty((n, 1)) for _ in range(10))
+    for r, j in enumerate(rows):
+        body, wheel, _ = sweeps[j]
+        robot, (x, y, hh) = body.robot, body.pose
+        wb = robot.wheelbase
+        hl[r], hw[r] = robot.length / 2 + body.radius, robot.width / 2 + body.radius
+        delta = wheel - robot.steering_straight
+        h[r], k[r], half[r] = hh, -math.tan(math.radians(delta)) / wb, wb / 2
+        a[r], b[r] = x - wb / 2 * math.cos(hh), y - wb / 2 * math.sin(hh)
+        sin_h[r], cos_h[r] = math.sin(hh), math.cos(hh)
+        disc[r] = math.hypot(float(hl[r, 0]), float(hw[r, 0])) + 1e-6
+    hk = h + k * u
+    c, s = np.cos(hk), np.sin(hk)
+    turning = np.abs(k[:, 0]) > 1e-9
+    rx, ry = np.empty_like(u), np.empty_like(u)
+    t, st = turning, ~turning
+    rx[t] = a[t] + (s[t] - sin_h[t]) / k[t]
+    ry[t] = b[t] + (cos_h[t] - c[t]) / k[t]
+    rx[st] = a[st] + u[st] * cos_h[st]
+    ry[st] = b[st] + u[st] * sin_h[st]
+    cx, cy = rx + half * c, ry + half * s                      # the footprint's centres
+    lo_x, hi_x = cx.min(axis=1) - disc[:, 0], cx.max(axis=1) + disc[:, 0]
+    lo_y, hi_y = cy.min(axis=1) - disc[:, 0], cy.max(axis=1) + disc[:, 0]
+    cells = []
+    for r, j in enumerate(rows):
+        px, py = sweeps[j][0].cells[:, 0], sweeps[j][0].cells[:, 1]
+        cells.append(sweeps[j][0].cells[(px >= lo_x[r]) & (px <= hi_x[r])
+                                        & (py >= lo_y[r]) & (py <= hi_y[r])])
+    width = max(len(cs) for cs in cells)
+    if not width:
+        return out
+    p = np.full((n, width, 2), 1e12)
+    for r, cs in enumerate(cells):
+        p[r, :len(cs)] = cs
+    dx, dy = p[..., 0, None] - cx[:, None], p[..., 1, None] - cy[:, None]    # [n, P, K]
+    c, s = c[:, None], s[:, None]
+    depth = np.minimum(hl[..., None] - np.abs(dx * c + dy * s),
+                       hw[..., None] - np.abs(dy * c - dx * s))
+    inside = depth >= 0
+    back = np.array([sweeps[j][2] for j in rows])
+    if back.any():      # backing: a cell touched at the start blocks only deeper steps
+        inside[back] = np.where(inside[back][..., :1], depth[back] > depth[back][..., :1],
+                                inside[back])
+    hit = inside.any(axis=1)                                                # [n, K]
+    first = np.maximum(hit.argmax(axis=1) - 1, 0) * step
+    out[rows] = np.where(hit.any(axis=1), first, reach)
+    return out
+
+
 @functools.lru_cache(maxsize=16)
 def _path(reach: float, step: float, backward: bool) -> np.ndarray:
     """``[K]`` the rear axle's signed travel at each step of the sweep."""
@@ -132,26 +193,32 @@ class Body:
 
 
 def guard(command: tuple[float, float], body: Body, rec: Recovery, dt: float,
-          cfg: Settings = Settings()) -> tuple[tuple[float, float], bool]:
+          cfg: Settings = Settings(),
+          known: tuple[float, bool, float] | None = None) -> tuple[tuple[float, float], bool]:
     """The command the robot carries out (steering deg, speed in/s) and whether it begins to
     back out now, from its planner's ``command``: a backing-out under way goes on while the
     way behind is free; otherwise the brake holds the speed to what the arc the wheel will be
     on allows, and a robot held ``patience`` seconds against its planner's wish backs out
     (on the lock that swings its nose toward its route, else straight), if it has the room.
-    ``rec`` is updated."""
+    ``rec`` is updated. ``known``: a sweep already measured (wheel, backward, free travel:
+    :func:`first_sweep`'s, by :func:`free_travels` with other robots')."""
     robot = body.robot
+
+    def free(wheel: float, backward: bool) -> float:
+        if known is not None and known[:2] == (wheel, backward):
+            return known[2]
+        return body.free(wheel, backward, cfg)
+
     if rec.left > 0:
         rec.left -= dt
-        back = body.free(rec.wheel, True, cfg)
+        back = free(rec.wheel, True)
         if back > cfg.margin:
             return (rec.wheel, -min(robot.max_reverse,
                                     brake(back, robot.acceleration, cfg.margin))), False
         rec.left = 0.0
     steer, want = command
-    turn = robot.max_steering_rate * dt
-    target = min(max(steer, robot.steering_min), robot.steering_max)
-    wheel = body.wheel + min(max(target - body.wheel, -turn), turn)
-    limit = brake(body.free(wheel, want < 0, cfg), robot.acceleration, cfg.margin)
+    wheel = _wheel(steer, body, dt)
+    limit = brake(free(wheel, want < 0), robot.acceleration, cfg.margin)
     speed = math.copysign(limit, want) if abs(want) > limit else want
     rec.held = rec.held + dt if abs(want) > cfg.want and limit < cfg.want else 0.0
     if rec.held < cfg.patience or robot.max_reverse <= 0:
@@ -159,7 +226,24 @@ def guard(command: tuple[float, float], body: Body, rec: Recovery, dt: float,
     lock, other = ((robot.steering_min, robot.steering_max) if body.route_side > 0 else
                    (robot.steering_max, robot.steering_min))
     for wheel in (lock, robot.steering_straight, other):    # the last rather than stay put
-        if body.free(wheel, True, cfg) >= cfg.back_room:
+        if free(wheel, True) >= cfg.back_room:
             rec.left, rec.wheel, rec.held = cfg.back_time, wheel, 0.0
             return (wheel, -robot.max_reverse), True
     return (steer, speed), False
+
+
+def first_sweep(command: tuple[float, float], body: Body, rec: Recovery,
+                dt: float) -> tuple[float, bool]:
+    """The wheel (deg) and direction (backward?) of the first sweep :func:`guard` measures
+    for ``command``: the way behind a backing-out under way, else the arc the wheel turns to."""
+    if rec.left > 0:
+        return rec.wheel, True
+    return _wheel(command[0], body, dt), command[1] < 0
+
+
+def _wheel(steer: float, body: Body, dt: float) -> float:
+    """Where the wheel is after a tick turning toward ``steer`` at the robot's rate."""
+    robot = body.robot
+    turn = robot.max_steering_rate * dt
+    target = min(max(steer, robot.steering_min), robot.steering_max)
+    return body.wheel + min(max(target - body.wheel, -turn), turn)
