@@ -7,7 +7,7 @@ import dataclasses
 import numpy as np
 
 from mitos_cli.resources import packaged_path
-from mitos_cli.sim.loop import simulate
+from mitos_cli.sim.loop import shared_scene, simulate
 from mitos_cli.sim.planner import FuzzyPlanner
 from mitos_cli.sim.runs import run_many
 from mitos_cli.sim.worldfile import load_world
@@ -51,6 +51,17 @@ def test_run_many_does_not_depend_on_the_workers():
     two = run_many([world], runs=4, seed=5, workers=2)
     assert one.to_json() == two.to_json()
     assert [s["seed"] for s in one.worlds[0].summaries] == [5, 6, 7, 8]
+
+
+def test_a_run_of_many_is_the_run_alone_where_draws_move_what_the_robot_is_given():
+    # detour's cabinet is known (drawn on the robot's map) and randomised: each run's robot
+    # is given the map with the cabinet where its draw put it, in a chunk of runs as alone
+    world = short("detour.yaml", 21.0)     # where the cabinet's place tells (19.75-20.45 s)
+    assert shared_scene(world, True) is None and shared_scene(world, False) is not None
+    many = run_many([world], runs=1, seed=1, workers=1)
+    for j, summary in enumerate(many.worlds[0].summaries):
+        alone = simulate(world, seed=1 + j, randomise=True).summary()
+        assert {k: summary[k] for k in alone} == alone
 
 
 def test_the_planner_is_row_exact_so_recorded_dofs_are_the_ones_used():

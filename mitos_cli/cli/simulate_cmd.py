@@ -252,15 +252,16 @@ def simulate_command(
             raise typer.Exit(3)
         return
 
-    from ..sim.loop import prepare, simulate
+    from ..sim.loop import prepare, shared_scene, simulate
 
     world = loaded[0]
-    scene = prepare(world)
+    scene = shared_scene(world, randomise)      # None: the draw moves what the robot is given
     if live:
         from ..sim.live import LiveView
 
         try:
-            with LiveView(world, scene, speed=1.0 if speed is None else speed) as view:
+            with LiveView(world, scene or prepare(world),
+                          speed=1.0 if speed is None else speed) as view:
                 res = simulate(world, planner, seed, randomise=randomise, scene=scene,
                                on_tick=view.update)
         except KeyboardInterrupt:

@@ -22,7 +22,7 @@ from dataclasses import fields
 import numpy as np
 
 from . import kinematics, knowledge, perception, rows, safety
-from .loop import Scene, SimResult, Simulation
+from .loop import Scene, SimResult, Simulation, shared_scene
 from .planner import FuzzyPlanner, Planner
 from .world import World
 
@@ -41,6 +41,8 @@ class Lockstep:
         if planner is None:
             planner = FuzzyPlanner(None, world.behavior)
         self.planner = planner
+        if scene is None and seeds:      # the runs' map and routes, prepared once if they can
+            scene = shared_scene(world, randomise)
         self.runs = [Simulation(world, planner, seed, randomise=randomise, scene=scene)
                      for seed in seeds]
         self._limits: list = []                  # the runs that last moved and their limits

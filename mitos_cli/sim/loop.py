@@ -83,6 +83,19 @@ def prepare(world: World) -> Scene:
     return Scene(static, tuple(routes), given, knowledge.plan_grid(given, static, world))
 
 
+def shared_scene(world: World, randomise: bool) -> Scene | None:
+    """The scene every run of ``world`` can start from, prepared once; ``None`` when each
+    randomised run must prepare its own, because its draw moves an obstacle drawn on the
+    robots' map (``known: true``, as ``detour.yaml``'s cabinet): each run's robot is given
+    its own map and route, as the run alone is (``--seed SEED+j --randomise``)."""
+    if randomise:
+        known = {o.name for o in world.obstacles if o.known}
+        if any(j.obstacle in known and (j.dx != (0.0, 0.0) or j.dy != (0.0, 0.0))
+               for j in world.randomise.obstacles):
+            return None
+    return prepare(world)
+
+
 @dataclass
 class SimResult:
     """A finished run: verdict, metrics and every tick as arrays (``T`` ticks, ``n`` robots)."""

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .lockstep import run_lockstep
-from .loop import OUTCOMES, ROBOT_OUTCOMES, prepare
+from .loop import OUTCOMES, ROBOT_OUTCOMES, shared_scene
 from .world import World
 
 METRICS = ("time_s", "path_length_in", "min_clearance_in", "mean_speed_in_s",
@@ -26,7 +26,7 @@ def _chunk(task: tuple) -> tuple[int, list[dict]]:
     """One worker's runs of a world, stepped in lockstep (:mod:`.lockstep`: each run's bits
     are those it has alone)."""
     index, world, planner, seeds, randomise, measure, scene = task
-    scene = scene if scene is not None else prepare(world)
+    scene = scene if scene is not None else shared_scene(world, randomise)
     return index, [{**res.summary(), **(measure(res) if measure is not None else {})}
                    for res in run_lockstep(world, planner, seeds, randomise=randomise,
                                            scene=scene)]
@@ -142,9 +142,10 @@ def run_many(worlds: list[World], runs: int = 0, seed: int | None = None, planne
         seeds = [base] if runs <= 0 else [base + j for j in range(runs)]
         # about 8 chunks a worker, so that a progress bar moves; a world cut into several
         # chunks has its map and routes prepared once, here, and sent along (a grid map's
-        # route search costs about as much as a run)
+        # route search costs about as much as a run), unless its draws move what the robots
+        # are given (shared_scene)
         size = max(1, math.ceil(len(seeds) / (8 * workers)))
-        scene = prepare(w) if len(seeds) > size else None
+        scene = shared_scene(w, runs > 0) if len(seeds) > size else None
         for i in range(0, len(seeds), size):
             tasks.append((w, tuple(seeds[i:i + size]), scene))
     jobs = [(k, w, planner, chunk, runs > 0, measure, scene)

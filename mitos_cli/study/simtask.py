@@ -53,10 +53,11 @@ def check_choice(choice: Choice, context: StudyContext, world_path: str) -> None
 
 @functools.lru_cache(maxsize=32)
 def _scene(path: str):
-    """Walls and routes of a world: randomisation moves obstacles only, so they are shared."""
-    from ..sim.loop import prepare
+    """Walls and routes of a world, shared by its randomised runs (``None``: each run
+    prepares its own, where a draw moves what the robots are given; :func:`shared_scene`)."""
+    from ..sim.loop import shared_scene
 
-    return prepare(_world(path))
+    return shared_scene(_world(path), True)
 
 
 @functools.lru_cache(maxsize=64)
