@@ -303,7 +303,8 @@ def test_robots_aim_together_with_the_bits_they_get_alone(name):
     sims = running(name)
     aims = []
     for sim in sims:
-        aims += sim.aims(sim.sense())
+        s = sim.sense()
+        aims += sim.aims(s, perception.frames(*sim.framing(s)))
     cfg = sims[0].settings
     rng = np.random.default_rng(3)
     # rows with no cells, with few and with many (padding of every width), in any order
@@ -383,3 +384,16 @@ def test_brake_sweeps_measured_together_are_each_measured_as_alone():
         got = safety.free_travels(sweeps, 30.0)
         for j, (body, wheel, backward) in enumerate(sweeps):
             assert same(got[j], body.free(wheel, backward, safety.Settings()))
+
+
+def test_robots_placed_on_their_routes_together_get_the_bits_they_get_alone():
+    rng = np.random.default_rng(10)
+    routes = [route.Route.of(np.cumsum(rng.normal(0, 40, (int(rng.integers(2, 30)), 2)),
+                                       axis=0)) for _ in range(9)]
+    points = rng.normal(0, 120, (9, 2))
+    hints = [float(rng.uniform(-200, r.length + 200)) for r in routes]
+    together = perception.frames(routes, points, hints)
+    for r, p, hint, f in zip(routes, points, hints, together):
+        alone = perception.frame(r, p, hint)
+        assert same(alone.s, f.s) and same(alone.e, f.e)
+        assert same(alone.t, f.t) and same(alone.n, f.n)

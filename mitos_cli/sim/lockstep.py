@@ -117,7 +117,12 @@ def _observe_together(runs: list[Simulation]) -> list:
         origins, dirs, measured = (np.concatenate([c[j] for c in clearing]) for j in (1, 2, 3))
         knowledge.clear_all([m for c in clearing for m in c[0]], origins, dirs, measured,
                             world.sensors.range)
-        aims = [aim for run, s in zip(fresh, sensed) for aim in run.aims(s)]
+        framing = [run.framing(s) for run, s in zip(fresh, sensed)]
+        frames = perception.frames([r for f in framing for r in f[0]],
+                                   np.concatenate([f[1] for f in framing]),
+                                   np.concatenate([f[2] for f in framing]))
+        aims = [aim for run, s, (start, stop) in zip(fresh, sensed, spans)
+                for aim in run.aims(s, frames[start:stop])]
         ahead, targets = perception.pursuit_points(aims, fresh[0].settings)
         ticks, sights = [], []
         for run, s, (start, stop) in zip(fresh, sensed, spans):

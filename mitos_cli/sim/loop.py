@@ -660,8 +660,13 @@ class Simulation:
         through cleared from its map (:meth:`clearing`), its :meth:`aims`, then every
         robot's pursuit point at once."""
         knowledge.clear_all(*self.clearing(s))
-        aims = self.aims(s)
+        aims = self.aims(s, perception.frames(*self.framing(s)))
         return self.aimed(s, aims, *perception.pursuit_points(aims, self._cfg))
+
+    def framing(self, s: _Sensed) -> tuple[list[Route], np.ndarray, np.ndarray]:
+        """What :func:`.perception.frames` places the robots on their routes from at tick
+        ``s`` (runs in lockstep together): their routes, places and last arc lengths."""
+        return list(self._routes), s.pose[:, :2], self._s_hint
 
     def clearing(self, s: _Sensed) -> tuple[list[knowledge.RobotMap], np.ndarray, np.ndarray,
                                             np.ndarray, float]:
@@ -671,14 +676,15 @@ class Simulation:
         return (self._maps, s.pose[:, :2], np.stack(self._dirs), s.ranges,
                 self.world.sensors.range)
 
-    def aims(self, s: _Sensed) -> list[perception.Aim]:
+    def aims(self, s: _Sensed, frames: list[perception.Frame]) -> list[perception.Aim]:
         """Each robot's :class:`.perception.Aim` at tick ``s``, its map cleared
         (:meth:`clearing`): where it is on its route, its map marked from its readings (and
         its route replanned if need be) and what its pursuit point keeps clear of (runs in
-        lockstep find their pursuit points together)."""
+        lockstep find their pursuit points together); ``frames``: where they are on their
+        routes (:meth:`framing`)."""
         routes, out = self._routes, []
         for i in range(self.n):
-            f = perception.frame(routes[i], s.pose[i, :2], self._s_hint[i])
+            f = frames[i]
             rmap = self._maps[i]
             if self._learn(i, s) and self._active[i]:
                 route = knowledge.replan(rmap, routes[i], f.s, s.pose[i, :2],

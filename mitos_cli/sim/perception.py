@@ -89,7 +89,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .geometry import clip_arrays
-from .route import Route, distances
+from .route import Route, distances, projections
 from .world import Robot
 
 NO_OBSTACLE = 200.0     # in: the `obstacle` distance when nothing obstructs
@@ -137,6 +137,13 @@ class Frame:
 def frame(route: Route, p: np.ndarray, s_hint: float) -> Frame:
     s, e, t = route.project(p, s_hint)
     return Frame(s, e, t, np.array([t[1], -t[0]]))
+
+
+def frames(routes: list[Route], p: np.ndarray, hints) -> list[Frame]:
+    """:func:`frame` of every robot at once (``p [R, 2]``; runs in lockstep together), each
+    the bits of its own (:func:`.route.projections`)."""
+    return [Frame(s, e, t, np.array([t[1], -t[0]]))
+            for s, e, t in projections(routes, p, hints)]
 
 
 def _road(a, b, valid, window: float, far: float) -> tuple[float, float]:

@@ -129,6 +129,38 @@ class Route:
         return np.sqrt((d * d).sum(axis=2).min(axis=1))
 
 
+def projections(routes: Sequence[Route], points: np.ndarray, hints: Sequence[float],
+                back: float = 24.0, ahead: float = 120.0) -> list[tuple[float, float, np.ndarray]]:
+    """:meth:`Route.project` of every row at once (``points [R, 2]``, each on its route near
+    its hint): each row's segments in its window, padded with copies of its last one (the
+    nearest is the first of equals, so never a copy), so a row gets the bits it gets alone."""
+    spans = []
+    for route, hint in zip(routes, hints):
+        first, stop = route._window(hint - back, hint + ahead)
+        spans.append((0, 1) if first >= stop else (first, stop))
+    width = max(stop - first for first, stop in spans)
+    a, e = np.empty((len(routes), width, 2)), np.empty((len(routes), width, 2))
+    ee, root = np.empty((len(routes), width)), np.empty((len(routes), width))
+    for i, (route, (first, stop)) in enumerate(zip(routes, spans)):
+        sa, se, see, sroot = (x[first:stop] for x in route._segments)
+        m = stop - first
+        a[i, :m], e[i, :m], ee[i, :m], root[i, :m] = sa, se, see, sroot
+        a[i, m:], e[i, m:], ee[i, m:], root[i, m:] = sa[-1], se[-1], see[-1], sroot[-1]
+    p = points[:, None]                                                    # [R, 1, 2]
+    t = clip_arrays(((p - a) * e).sum(axis=2) / ee, 0.0, 1.0)              # [R, M]
+    closest = a + t[..., None] * e
+    gap = p - closest
+    d = np.hypot(gap[..., 0], gap[..., 1])
+    out = []
+    for r, (route, (first, _)) in enumerate(zip(routes, spans)):
+        i = int(d[r].argmin())
+        s = route.cum[first + i] + t[r, i] * root[r, i]
+        tangent = e[r, i] / math.sqrt(ee[r, i])
+        rel = points[r] - closest[r, i]
+        out.append((float(s), float(rel[0] * tangent[1] - rel[1] * tangent[0]), tangent))
+    return out
+
+
 def distances(routes: Sequence[Route], s: Sequence[float], ahead: float,
               points: np.ndarray) -> np.ndarray:
     """:meth:`Route.distance` of every row at once: row ``i``'s points ``[R, K, 2]`` from
