@@ -320,6 +320,17 @@ def clear_all(maps: list[RobotMap], origins: np.ndarray, dirs: np.ndarray,
             if (got := m._in_sight(origins[i], max_range)) is not None]
     if not seen:
         return
+    if len(seen) == 1:                  # one map: no batch to set up (the same arithmetic)
+        m, i, (where, r, c, rel) = seen[0]
+        res = m.grid.resolution
+        rx, ry = rel[:, 0, None], rel[:, 1, None]                  # [P, 1]
+        dx, dy = dirs[i, :, 0], dirs[i, :, 1]                      # [B]
+        along = rx * dx + ry * dy
+        through = ((along > 0) & (along < np.minimum(measured[i], max_range) - res)
+                   & (np.abs(rx * dy - ry * dx) < res / 2)).any(axis=1)
+        if through.any():
+            m._free(where[through], r[through], c[through])
+        return
     rel = np.full((len(seen), max(len(got[3]) for _, _, got in seen), 2), 1e12)
     for j, (_, _, got) in enumerate(seen):
         rel[j, :len(got[3])] = got[3]
@@ -329,9 +340,9 @@ def clear_all(maps: list[RobotMap], origins: np.ndarray, dirs: np.ndarray,
     dx, dy = d[:, None, :, 0], d[:, None, :, 1]                    # [H, 1, B]
     along = rx * dx + ry * dy                                      # [H, P, B]
     across = np.abs(rx * dy - ry * dx)
-    res = np.array([m.grid.resolution for m, _, _ in seen])[:, None, None]
-    reach = np.minimum(measured[idx], max_range)[:, None] - res
-    through = ((along > 0) & (along < reach) & (across < res / 2)).any(axis=2)
+    cell = np.array([m.grid.resolution for m, _, _ in seen])[:, None, None]
+    reach = np.minimum(measured[idx], max_range)[:, None] - cell
+    through = ((along > 0) & (along < reach) & (across < cell / 2)).any(axis=2)
     for j, (m, _, (where, r, c, pts)) in enumerate(seen):
         mine = through[j, :len(pts)]
         if mine.any():

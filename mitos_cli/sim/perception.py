@@ -142,6 +142,8 @@ def frame(route: Route, p: np.ndarray, s_hint: float) -> Frame:
 def frames(routes: list[Route], p: np.ndarray, hints) -> list[Frame]:
     """:func:`frame` of every robot at once (``p [R, 2]``; runs in lockstep together), each
     the bits of its own (:func:`.route.projections`)."""
+    if len(routes) == 1:
+        return [frame(routes[0], p[0], float(hints[0]))]
     return [Frame(s, e, t, np.array([t[1], -t[0]]))
             for s, e, t in projections(routes, p, hints)]
 
@@ -417,6 +419,9 @@ def pursuit_points(aims: list[Aim], cfg: Settings) -> tuple[np.ndarray, np.ndarr
     padded far away and every product is written out elementwise, so a robot gets the bits
     it gets alone, in any batch."""
     ahead = _lookaheads(cfg)
+    if len(aims) == 1:
+        one, target = _pursuit_one(aims[0], ahead, cfg)
+        return np.array([one]), target[None]
     out_ahead = np.full(len(aims), float(ahead[-1]))
     targets = np.empty((len(aims), 2))
     have = []
@@ -446,6 +451,23 @@ def pursuit_points(aims: list[Aim], cfg: Settings) -> tuple[np.ndarray, np.ndarr
     out_ahead[have_i] = ahead[k]
     targets[have_i] = q[np.arange(len(have)), k]
     return out_ahead, targets
+
+
+def _pursuit_one(a: Aim, ahead: np.ndarray, cfg: Settings) -> tuple[float, np.ndarray]:
+    """:func:`pursuit_points` of one robot, with no batch to set up (the same arithmetic)."""
+    if not len(a.cells):
+        return float(ahead[-1]), target_point(a.route, a.f, cfg, float(ahead[-1]))
+    q = target_points(a.route, a.f, ahead)                                    # [J, 2]
+    e = q - a.p
+    ee = np.maximum(e[:, 0] * e[:, 0] + e[:, 1] * e[:, 1], 1e-12)
+    rel = a.cells - a.p                                                       # [P, 2]
+    rx, ry = rel[:, 0, None], rel[:, 1, None]
+    t = clip_arrays((rx * e[:, 0] + ry * e[:, 1]) / ee, 0.0, 1.0)             # [P, J]
+    clear = np.hypot(rx - t * e[:, 0], ry - t * e[:, 1]).min(axis=0) - a.radius >= a.need
+    if clear.all():
+        return float(ahead[-1]), q[-1]
+    k = max(int(clear.argmin()) - 1, 0)
+    return float(ahead[k]), q[k]
 
 
 def route_room(f: Frame, p: np.ndarray, cells: np.ndarray, radius: float,

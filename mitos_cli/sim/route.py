@@ -167,6 +167,8 @@ def distances(routes: Sequence[Route], s: Sequence[float], ahead: float,
     ``routes[i]`` between arc lengths ``s[i]`` and ``s[i] + ahead``, ``[R, K]``. Each row's
     segments are padded with copies of its last one (which the minimum cannot tell from
     it), so a point gets the bits it gets from its route alone."""
+    if len(routes) == 1:
+        return routes[0].distance(points[0], s[0], ahead)[None]
     spans = [route._window(si, si + ahead) for route, si in zip(routes, s)]
     width = max((stop - first for first, stop in spans), default=0)
     out = np.full(points.shape[:2], np.inf)

@@ -94,6 +94,11 @@ def free_travels(sweeps: list[tuple[Body, float, bool]], reach: float,
     lockstep brake together), ``[R]``. What is one number per sweep is worked out as
     :func:`free_travel` does, in Python floats; the rest elementwise over ``[R, K]`` steps and
     ``[R, P, K]`` cells (padded far away), so a sweep gets the bits it gets alone."""
+    if len(sweeps) == 1:                 # a robot alone: no batch to set up
+        body, wheel, backward = sweeps[0]
+        return np.array([free_travel(body.cells, body.radius, body.pose, body.robot,
+                                     wheel - body.robot.steering_straight, backward, reach,
+                                     step)])
     out = np.full(len(sweeps), float(reach))
     rows = [j for j, (body, _, _) in enumerate(sweeps) if len(body.cells)]
     if not rows:
