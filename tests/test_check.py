@@ -317,3 +317,32 @@ def test_settings_only_mamdani_reads_are_flagged(tmp_path):
     assert finding.severity == "warning" and finding.span.line == 2
     assert finding.message == ("`defuzzify = lom` has no effect: behavior `main` uses "
                                "weighted_average inference")
+
+
+def test_the_coverage_check_reads_the_rules_dofs_only(tmp_path, monkeypatch):
+    """A Mamdani output sampled on 100,000 points makes each inferred sample cost 100,000
+    times a DOF; the check needs only the DOFs (it took minutes on the packaged rule base),
+    and they are the bits ``evaluate`` gives."""
+    from mitos_cli.engine import evaluation, mamdani
+    (tmp_path / "t.terms.yaml").write_text(
+        TERMS.replace("terms: {LS: 70, ST: 90, RS: 110}", "terms:\n"
+                      "      LS: {shape: triangle, peak: 70, width: 20}\n"
+                      "      ST: {shape: triangle, peak: 90, width: 20}\n"
+                      "      RS: {shape: triangle, peak: 110, width: 20}"), encoding="utf-8")
+    (tmp_path / "t.rules").write_text(
+        'terms "t.terms.yaml"\noperators: inference = mamdani, resolution = 100000\n'
+        "if road is NARROW then steering is LS\nif road is WIDE or size is LARGE "
+        "then steering is RS\n", encoding="utf-8")
+    rb = read_rulebase(tmp_path / "t.rules")
+    compiled = compile_rulebase(rb, "main")
+    X = np.stack([m.ravel() for m in np.meshgrid(*grid_axes(compiled, 9), indexing="ij")],
+                 axis=1)
+    dof = evaluation.evaluate(compiled, X, detail=True, strict=False).dof
+    assert np.array_equal(evaluation.rule_dofs(compiled, X), dof)
+
+    def inferred(*args, **kwargs):
+        raise AssertionError("the check inferred an output")
+    monkeypatch.setattr(mamdani, "mamdani_outputs", inferred)
+    monkeypatch.setattr(evaluation, "infer", inferred)
+    report = check_rulebase(rb)
+    assert report.grids[0].samples > 1000 and by_code(report, "no-rule-fires")

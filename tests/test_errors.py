@@ -239,6 +239,9 @@ def test_no_term_set(tmp_path):
      "    unit: in\n    universe: [0, 160]", "description: width of the road", "missing `role` in variable `road`"),
     ("universe: [0, 160]", "universe: [0, 160", "terms:", "invalid YAML: expected ',' or ']'"),
     ("universe: [0, 160]", "universe: [160, 0]", "[160, 0]", "universe [160, 0] is empty"),
+    # a subnormal width: every term a vertical edge, 1 on both sides of it
+    ("universe: [0, 160]", "universe: [0, 1e-320]", "[0, 1e-320]",
+     "is too narrow to compute with"),
     ("shape: left_shoulder", "shape: left_shouldr", "left_shouldr", "unknown shape `left_shouldr`"),
     ("role: input\n    universe: [0, 160]", "role: inptu\n    universe: [0, 160]", "inptu",
      "role must be `input` or `output`, not `inptu`"),

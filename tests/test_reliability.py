@@ -509,6 +509,12 @@ def test_edges_too_narrow_for_a_float_slope_give_numbers_not_warnings(recwarn):
     res = evaluate(compile_rulebase(rb), np.array([[0.0], [-10.0], [1.0]]), strict=False)
     dof = res.dof[:, 0]
     assert dof.tolist() == [1.0, 0.5, 0.0]
+    from mitos_cli.engine.check import check_rulebase
+    check_rulebase(parse_fll(       # its partition checks take the edge as a vertical one
+        "InputVariable: a\n  range: -45 45\n  term: ahead Triangle -20 0 1e-320\n"
+        "  term: left Triangle -45 -20 0\nOutputVariable: t\n  range: 0 1\n"
+        "  term: hi Triangle 0 1 1\nRuleBlock: main\n  rule: if a is ahead then t is hi\n"
+        "  rule: if a is left then t is hi\n", "narrow.fll"))
     assert not [w for w in recwarn if issubclass(w.category, RuntimeWarning)]
 
 

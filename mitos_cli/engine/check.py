@@ -60,7 +60,7 @@ from ..lang.model import (
 )
 from ..lang.terms import Variable
 from .compile import CompiledRuleBase, compile_rulebase
-from .evaluation import declares_nan, evaluate
+from .evaluation import declares_nan, rule_dofs
 
 SEVERITIES = ("error", "warning", "info")
 #: Most grid points one behavior is sampled on (the per-input resolution shrinks to fit).
@@ -363,9 +363,7 @@ def _sampled(compiled: CompiledRuleBase, threshold: float,
     shape = tuple(len(a) for a in axes)
     mesh = np.meshgrid(*axes, indexing="ij")
     X = np.stack([m.reshape(-1) for m in mesh], axis=1) if axes else np.zeros((1, 0))
-    result = evaluate(compiled, X, detail=True, strict=False)
-    dof = result.dof                                   # [n, R]
-    assert dof is not None                             # detail=True keeps the DOFs
+    dof = rule_dofs(compiled, X)                       # [n, R]
     info = GridInfo(compiled.behavior, tuple(zip(compiled.inputs, shape)), X.shape[0])
     out: list[Finding] = []
     name = compiled.behavior

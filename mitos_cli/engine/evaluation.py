@@ -465,6 +465,20 @@ def evaluate(compiled: CompiledRuleBase, X, *, detail: bool = True, keep_values:
                   outputs, counts, None if values is None else values.T, no_rule)
 
 
+def rule_dofs(compiled: CompiledRuleBase, X) -> np.ndarray:
+    """The rules' DOFs ``[n, R]`` on ``X[n, k]`` (clamped to the universes), the bits of
+    :func:`evaluate`'s ``dof``, without inferring the outputs: what a coverage check needs,
+    at a cost that does not grow with a Mamdani output's ``resolution``."""
+    X = _rows(compiled, X)
+    n = X.shape[0]
+    dof = np.empty((compiled.plan.n_rules, n))
+    for start in range(0, n, BLOCK):
+        block = slice(start, min(start + BLOCK, n))
+        Xt, _ = _clamp(compiled, X[block], start, n)
+        dof[:, block] = rule_dof(compiled, network_values(compiled, Xt))
+    return dof.T
+
+
 def evaluate_columns(compiled: CompiledRuleBase, Xt, *, strict: bool = True) -> np.ndarray:
     """The outputs ``[m, n]`` (one contiguous row per output) for inputs given as columns
     ``Xt[k, n]`` (an array, or a sequence of ``k`` 1-D arrays of one length):

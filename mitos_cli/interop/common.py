@@ -23,7 +23,7 @@ from ..fuzzy.shapes import SHAPES, TSUKAMOTO
 from ..lang import operators as ops_mod
 from ..lang.model import And, Behavior, Consequent, Expr, Not, Or, Prop, Rule, RuleBase, Setting
 from ..lang.resolve import MAIN, check_rule
-from ..lang.terms import Term, TermSet, Variable
+from ..lang.terms import Term, TermSet, Variable, universe_problem
 from ..numbers import parse_number
 from ..words import plural
 from . import rewrite
@@ -384,18 +384,42 @@ INFINITE_OK = {"trapezoid": {(0, -1), (1, -1), (2, 1), (3, 1)},
                "triangle": {(0, -1), (2, 1)}, "binary": {(1, -1), (1, 1)}}
 
 
-def check_numbers(variables: list[Variable]) -> None:
+def check_range(lo: float, hi: float, span: Span, what: str = "range",
+                point: bool = False) -> None:
+    """Refuse, at the range as written, one that is empty (a single point too, unless
+    ``point``: FLL's unused Takagi-Sugeno range) or too narrow to compute with (NaN and
+    infinities are refused by :func:`check_numbers`, which knows the terms)."""
+    if math.isnan(lo) or math.isnan(hi) or (point and lo == hi):
+        return
+    problem = universe_problem(lo, hi)
+    if problem:
+        raise FormatError(problem[0].replace("universe", what, 1), span=span,
+                          hint=problem[1] if lo < hi else "write the minimum first")
+
+
+def resolution(value: float, text: str, span: Span) -> int:
+    """A defuzzifier's resolution as written (``text``), within what MITOS evaluates."""
+    if not value.is_integer() or not ops_mod.RESOLUTION[0] <= value <= ops_mod.RESOLUTION[1]:
+        lo, hi = ops_mod.RESOLUTION
+        raise FormatError(f"resolution must be a whole number from {lo} to {hi}, not {text}",
+                          span=span)
+    return int(value)
+
+
+def check_numbers(variables: list[Variable], range_spans: dict[str, Span] | None = None) -> None:
     """Refuse, with the position, what floating point cannot evaluate: NaN or infinite
     parameters (but a shoulder's open end), ranges and defaults, numbers beyond
     :data:`LARGEST`, and a default outside its output's range. So no NaN or infinity leaves
-    the engine unless the file asked for one (``default: nan``)."""
+    the engine unless the file asked for one (``default: nan``). ``range_spans``: where each
+    variable's range is written (else the variable is named)."""
     for v in variables:
         lo, hi = v.universe
         open_range = (lo, hi) == (-math.inf, math.inf) and v.role == "output" and all(
             t.shape in ("singleton", "linear") for t in v.terms)   # an unused Sugeno range
         if not open_range:
             for end in (lo, hi):
-                _finite(end, f"variable `{v.name}`: the range", v.span)
+                _finite(end, f"variable `{v.name}`: the range",
+                        (range_spans or {}).get(v.name, v.span))
         for t in v.terms:
             allowed = INFINITE_OK.get(t.shape, set())
             for i, p in enumerate(t.params):
@@ -429,19 +453,22 @@ def check_implication(name: str, span: Span | None) -> str:
 
 def assemble(path: str | None, variables: list[Variable], rules: list[Rule], settings: Settings,
              default_resolution: int, span: Span | None = None,
-             notes: list[str] | None = None) -> RuleBase:
+             notes: list[str] | None = None,
+             range_spans: dict[str, Span] | None = None) -> RuleBase:
     """Check what a reader gathered and return the rule base (one behavior, ``main``)."""
     return assemble_blocks(path, variables, [(MAIN, rules, settings)], default_resolution, span,
-                           notes)
+                           notes, range_spans)
 
 
 def assemble_blocks(path: str | None, variables: list[Variable],
                     blocks: list[tuple[str, list[Rule], Settings]], default_resolution: int,
-                    span: Span | None = None, notes: list[str] | None = None) -> RuleBase:
+                    span: Span | None = None, notes: list[str] | None = None,
+                    range_spans: dict[str, Span] | None = None) -> RuleBase:
     """The rule base of one or more rule blocks: one block gives behavior ``main`` with the
     operators on the file; several (whose operators differ) give one behavior each, with its
     own operators, the first being the default. Chained outputs are restated first
-    (:func:`.rewrite.unchain`), with a line in ``notes``."""
+    (:func:`.rewrite.unchain`), with a line in ``notes``; ``range_spans``: where each
+    variable's range is written."""
     counts = Counter(v.name for v in variables)     # a count per variable was N^2
     for v in variables:
         if counts[v.name] > 1:
@@ -450,7 +477,7 @@ def assemble_blocks(path: str | None, variables: list[Variable],
         raise FormatError("the file defines no input variable", span=span)
     if not any(rules for _, rules, _ in blocks):
         raise FormatError("the file has no rules", span=span)
-    check_numbers(variables)
+    check_numbers(variables, range_spans)
     by_name = {v.name: v for v in variables}
     behaviors = []
     outputs = {v.name for v in variables if v.role == "output"}

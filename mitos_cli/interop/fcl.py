@@ -283,6 +283,7 @@ def _variable(node: Tree, role: Role, declared, settings: common.Record, locks: 
                 constants.append((name, terms[-1]))
         elif kind == "range_item":
             universe = (_num(item.children[0]), _num(item.children[1]))
+            common.check_range(*universe, span_of(item), "RANGE")
         elif kind == "option":
             key = str(item.children[0]).upper()
             if role == "input":
@@ -495,10 +496,8 @@ def _option(item: Tree, settings: common.Record, span_of, conj: dict) -> None:
         settings.set("defuzzify", method, span, "METHOD")
         if number is not None:
             res = _num(number)
-            if not res.is_integer() or res < 3:
-                raise FormatError(f"resolution must be a whole number >= 3, not "
-                                  f"{fmt_number(res)}", span=span_of(number))
-            settings.set("resolution", int(res), span_of(number), "resolution")
+            settings.set("resolution", common.resolution(res, fmt_number(res), span_of(number)),
+                         span_of(number), "resolution")
 
 
 def _norm(table: dict, value: str, what: str, span: Span) -> str:

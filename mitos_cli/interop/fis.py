@@ -166,9 +166,10 @@ def parse_fis(text: str, path: str | None = None) -> RuleBase:
         settings.set("sampling", "endpoints", None, "sampling")
 
     notes: list[str] = []
-    inputs = _variables(sections, "Input", "input", kind, notes)
+    ranges: dict[str, Span] = {}
+    inputs = _variables(sections, "Input", "input", kind, notes, 0, ranges)
     n_inputs = len(inputs)
-    outputs = _variables(sections, "Output", "output", kind, notes, n_inputs)
+    outputs = _variables(sections, "Output", "output", kind, notes, n_inputs, ranges)
     _check_count(system, "NumInputs", len(inputs), sys_span)
     _check_count(system, "NumOutputs", len(outputs), sys_span)
     variables = inputs + outputs
@@ -182,7 +183,8 @@ def parse_fis(text: str, path: str | None = None) -> RuleBase:
                               f"{'AND' if connective is And else 'OR'}", span=used.span,
                               hint=f"give {key} a method, e.g. "
                                    f"'{'min' if connective is And else 'max'}'")
-    rb = common.assemble(path, variables, rules, settings, DEFAULT_RESOLUTION, sys_span, notes)
+    rb = common.assemble(path, variables, rules, settings, DEFAULT_RESOLUTION, sys_span, notes,
+                         ranges)
     return dataclasses.replace(rb, notes=tuple(notes))
 
 
@@ -195,18 +197,21 @@ def _check_count(system: dict, key: str, found: int, span: Span) -> None:
 
 
 def _variables(sections, prefix: str, role: Role, kind: str, notes: list[str],
-               n_inputs: int = 0) -> list[Variable]:
+               n_inputs: int = 0, ranges: dict[str, Span] | None = None) -> list[Variable]:
+    """The ``[PrefixN]`` sections' variables, in order; ``ranges``: gets where each one's
+    range is written."""
     found = [(int(name[len(prefix):]), span, items) for name, span, items in sections
              if re.fullmatch(prefix + r"\d{1,9}", name)]
     found.sort(key=lambda f: f[0])
     for i, (number, span, _) in enumerate(found, 1):
         if number != i:
             raise FormatError(f"expected [{prefix}{i}], found [{prefix}{number}]", span=span)
-    return [_variable(span, items, role, kind, n_inputs, notes) for _, span, items in found]
+    return [_variable(span, items, role, kind, n_inputs, notes, ranges)
+            for _, span, items in found]
 
 
 def _variable(span: Span, items, role: Role, kind: str, n_inputs: int,
-              notes: list[str]) -> Variable:
+              notes: list[str], ranges: dict[str, Span] | None = None) -> Variable:
     values = {}
     terms: list[Term] = []
     for key, value, kspan, vspan in items:
@@ -239,6 +244,9 @@ def _variable(span: Span, items, role: Role, kind: str, n_inputs: int,
     rng = _vector(*values["Range"])
     if len(rng) != 2 or not rng[0] < rng[1]:
         raise FormatError("`Range` must be [min max] with min < max", span=values["Range"][1])
+    common.check_range(rng[0], rng[1], values["Range"][1], "Range")
+    if ranges is not None:
+        ranges[name] = values["Range"][1]
     if "NumMFs" in values and common.number(*values["NumMFs"]) != len(terms):
         raise FormatError(f"NumMFs={values['NumMFs'][0]} but the variable has {len(terms)} MFs",
                           span=values["NumMFs"][1])

@@ -72,6 +72,7 @@ class _Var:
     name: str
     span: Span
     range: tuple[float, float] | None = None
+    range_span: Span | None = None      # where the range is written
     terms: list = field(default_factory=list)          # (name, kind, values, span)
     default: float | None = None
     description: str = ""
@@ -217,7 +218,8 @@ def parse_fll(text: str, path: str | None = None) -> RuleBase:
         mine = [v for v in variables if v.role == "input" or v.name in concluded or
                 len(groups) == 1]
         _check_outputs(mine, rules, settings)
-    rb = common.assemble_blocks(path, built, groups, DEFAULT_RESOLUTION, engine_span, notes)
+    rb = common.assemble_blocks(path, built, groups, DEFAULT_RESOLUTION, engine_span, notes,
+                                {v.name: v.range_span for v in variables if v.range_span})
     return dataclasses.replace(rb, notes=tuple(notes))
 
 
@@ -253,9 +255,9 @@ def _variable_key(v: _Var, key: str, value: str, span: Span, vspan: Span,
         if len(words) != 2:
             raise FormatError("`range` takes two numbers: minimum and maximum", span=vspan)
         lo, hi = (common.number(w, vspan) for w in words)
-        if not lo <= hi:
-            raise FormatError(f"range [{lo:g}, {hi:g}] is empty", span=vspan)
+        common.check_range(lo, hi, vspan, point=True)
         v.range = (lo, hi)
+        v.range_span = vspan
     elif key == "term":
         if len(words) < 2:
             raise FormatError("`term` takes a name, a type and its parameters", span=vspan)
@@ -296,11 +298,9 @@ def _variable_key(v: _Var, key: str, value: str, span: Span, vspan: Span,
                     raise FormatError(f"unknown weighted defuzzifier type `{words[1]}`",
                                       span=vspan, expected="TakagiSugeno, Tsukamoto or Automatic")
             else:
-                res = common.number(words[1], vspan, "a resolution")
-                if not res.is_integer() or res < 3:
-                    raise FormatError(f"resolution must be a whole number >= 3, not {words[1]}",
-                                      span=vspan)
-                settings.set("resolution", int(res), vspan, "resolution")
+                res = common.resolution(common.number(words[1], vspan, "a resolution"),
+                                        words[1], vspan)
+                settings.set("resolution", res, vspan, "resolution")
 
 
 def _block_key(key: str, value: str, vspan: Span, settings: common.Record,

@@ -79,7 +79,8 @@ def memberships(corners: np.ndarray, x: np.ndarray) -> np.ndarray:
     """``mu[t, n]`` of piecewise-linear terms given by their corners ``[t, 4]`` (``a <= b <= c
     <= d``, infinite for a shoulder's open side) at the points ``x[n]``."""
     a, b, c, d = (corners[:, i:i + 1] for i in range(4))
-    with np.errstate(invalid="ignore", divide="ignore"):
+    # (an edge narrower than a normal float overflows to +-inf: clipped, a vertical edge)
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
         mu = np.fmin((x - a) / (b - a), (d - x) / (d - c))    # fmin: a NaN edge gives way
     mu = np.clip(mu, 0.0, 1.0)
     # NaN where both edges are NaN: an infinite corner (inf / inf) or x on a vertical edge
@@ -95,10 +96,11 @@ def breakpoints(corners: np.ndarray, universe: tuple[float, float]) -> np.ndarra
     a, b, c, d = corners.T
     rise = np.isfinite(a) & np.isfinite(b) & (b > a)
     fall = np.isfinite(c) & np.isfinite(d) & (d > c)
-    # each sloped edge as mu = slope * x + offset
-    slope = np.concatenate([1.0 / (b[rise] - a[rise]), -1.0 / (d[fall] - c[fall])])
-    offset = np.concatenate([-a[rise] / (b[rise] - a[rise]), d[fall] / (d[fall] - c[fall])])
-    with np.errstate(invalid="ignore", divide="ignore"):
+    # each sloped edge as mu = slope * x + offset (an edge narrower than a normal float is a
+    # vertical one: its slope overflows, and the crossings it gives are not finite)
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+        slope = np.concatenate([1.0 / (b[rise] - a[rise]), -1.0 / (d[fall] - c[fall])])
+        offset = np.concatenate([-a[rise] / (b[rise] - a[rise]), d[fall] / (d[fall] - c[fall])])
         cross = (offset[None, :] - offset[:, None]) / (slope[:, None] - slope[None, :])
     x = np.concatenate([[lo, hi], corners[np.isfinite(corners)], cross.ravel()])
     return np.unique(x[np.isfinite(x) & (x >= lo) & (x <= hi)])

@@ -22,6 +22,8 @@ DEFUZZIFIERS = ("centroid", "bisector", "mom", "som", "lom")
 #: ``resolution`` evenly spaced points including both ends (MATLAB's ``evalfis``), or the
 #: cells' left ends (jFuzzyLogic's ``min + i (max - min) / resolution``).
 SAMPLINGS = ("midpoints", "endpoints", "left")
+#: The least and the most points a Mamdani output is sampled on.
+RESOLUTION = (3, 100_000)
 
 
 @dataclass(frozen=True)
@@ -92,9 +94,9 @@ def _check(key: str, value: str, span: Span | None) -> str | int:
         number = float(value)
     except ValueError:
         number = -1.0
-    if not number.is_integer() or not 3 <= number <= 100_000:
-        raise RuleBaseError(f"resolution must be a whole number from 3 to 100000, not {value}",
-                            span=span)
+    if not number.is_integer() or not RESOLUTION[0] <= number <= RESOLUTION[1]:
+        raise RuleBaseError(f"resolution must be a whole number from {RESOLUTION[0]} to "
+                            f"{RESOLUTION[1]}, not {value}", span=span)
     return int(number)
 
 

@@ -37,7 +37,7 @@ from ..fuzzy.formula import parse as parse_formula
 from ..fuzzy.shapes import SHAPES
 from ..words import plural
 from . import yamlpos
-from .terms import Term, TermSet, Variable, check_term
+from .terms import Term, TermSet, Variable, check_term, universe_problem
 from .yamlpos import YList, YMap
 
 VARIABLE_KEYS = ("description", "unit", "role", "universe", "terms", "default")
@@ -123,9 +123,9 @@ def _variable(name: str, spec: Any, key_span: Span, value_span: Span,
         raise TermSetError(f"{what}: universe must be `[min, max]`", span=uspan)
     lo, hi = (yamlpos.expect_number(v, universe.item_span(i), TermSetError,
                                     f"{what}: universe bound") for i, v in enumerate(universe))
-    if not lo < hi:
-        raise TermSetError(f"{what}: universe [{lo:g}, {hi:g}] is empty", span=uspan,
-                           hint="write `universe: [min, max]` with min < max")
+    problem = universe_problem(lo, hi)
+    if problem:
+        raise TermSetError(f"{what}: {problem[0]}", span=uspan, hint=problem[1])
     terms_spec = yamlpos.expect_map(yamlpos.require(spec, "terms", TermSetError, what),
                                     spec.value_span("terms"), TermSetError, f"{what}: terms")
     terms = tuple(_term(tname, tspec, terms_spec.key_span(tname), terms_spec.value_span(tname),

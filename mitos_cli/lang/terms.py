@@ -106,9 +106,10 @@ class Variable:
 
     def __post_init__(self) -> None:
         lo, hi = self.universe
-        if not lo < hi:
-            raise TermSetError(f"variable `{self.name}`: universe [{lo:g}, {hi:g}] is empty",
-                               span=self.span, hint="write `universe: [min, max]` with min < max")
+        problem = universe_problem(lo, hi)
+        if problem:
+            raise TermSetError(f"variable `{self.name}`: {problem[0]}", span=self.span,
+                               hint=problem[1])
         seen: set[str] = set()
         for term in self.terms:
             if term.name in seen:
@@ -145,6 +146,24 @@ class TermSet:
             if v.name == name:
                 return v
         raise unknown("variable", name, [v.name for v in self.variables], span=span)
+
+
+#: The least width of a universe: across a narrower (subnormal) one every slope overflows and
+#: every term is a vertical edge, 1 on both sides of it. (A term's own edge may be that
+#: narrow: it is a vertical edge, evaluated as one.)
+TINY = float(np.finfo(float).tiny)
+
+
+def universe_problem(lo: float, hi: float) -> tuple[str, str] | None:
+    """What is wrong with a universe ``[lo, hi]`` and what to do, if anything: empty, or too
+    narrow to compute with (a subnormal width: every slope across it overflows)."""
+    if not lo < hi:
+        return (f"universe [{lo:g}, {hi:g}] is empty",
+                "write `universe: [min, max]` with min < max")
+    if hi - lo < TINY:
+        return (f"universe [{lo:g}, {hi:g}] is too narrow to compute with (at least {TINY:g} "
+                "wide)", "measure the variable in a smaller unit")
+    return None
 
 
 def check_term(term: Term, universe: tuple[float, float], variable: str,
