@@ -48,3 +48,42 @@ def test_version_is_the_package_version() -> None:
     from importlib.metadata import version
 
     assert version("mitos") == __version__              # what pip installed says the same
+
+
+def test_a_value_outside_an_options_names_is_a_mistake_in_a_value(capsys) -> None:
+    """As an unknown planner or T-norm: exit 1, the names and "did you mean" (Typer's own
+    choice check said exit 2 and listed the names without a suggestion). Any case is read."""
+    import pytest
+
+    from mitos_cli.cli.app import main
+
+    cases = [
+        (["convert", "rulebases/mitos.rules", "--to", "fsl"], "unknown format `fsl`", "fll"),
+        (["export", "rulebases/mitos.rules", "--to", "pyhton"], "unknown export language",
+         "python"),
+        (["eval", "road=78", "size=45", "position=4", "--fidelity", "matlb"],
+         "unknown engine `matlb`", "matlab"),
+        (["eval", "--batch", "-", "--on-no-rule", "skp"], "unknown --on-no-rule policy", "skip"),
+        (["plot", "surface", "steering", "--x", "road", "--style", "heat"], "unknown style",
+         "heatmap"),
+    ]
+    for args, message, meant in cases:
+        with pytest.raises(SystemExit) as info:
+            main(args)
+        err = capsys.readouterr().err
+        assert info.value.code == 1 and message in err, err
+        assert f"did you mean `{meant}`?" in err, err
+    with pytest.raises(SystemExit) as info:
+        main(["export", "rulebases/mitos.rules", "--to", "PYTHON"])
+    assert info.value.code == 0 and "def evaluate(X" in capsys.readouterr().out
+
+
+def test_an_options_names_are_shown_and_completed() -> None:
+    import os
+
+    assert "[c|python]" in run("export", "-h").stdout
+    env = {**os.environ, "_MITOS_COMPLETE": "complete_bash",
+           "COMP_WORDS": "mitos convert tipper.fis --to f", "COMP_CWORD": "4"}
+    out = subprocess.run([sys.executable, "-m", "mitos_cli"], env=env, capture_output=True,
+                         text=True)
+    assert out.stdout.split() == ["fcl", "fis", "fll"]

@@ -9,7 +9,7 @@ from typing import Annotated, Optional
 import typer
 
 from .output import emit, err, warn, warn_notes
-from .params import named
+from .params import choice, choices, completer, named
 
 
 class Target(str, Enum):
@@ -22,9 +22,9 @@ class Target(str, Enum):
 def convert_command(
     path: Annotated[Path, typer.Argument(
         metavar="FILE", help="Rule base to convert (.rules, .fcl, .fis or .fll).")],
-    to: Annotated[Target, typer.Option(
-        "--to", help="Format to write: rules (NAME.rules + NAME.terms.yaml), fcl, fis or fll.",
-        case_sensitive=False)],
+    to_name: Annotated[str, typer.Option(
+        "--to", metavar=choices(Target), autocompletion=completer(Target),
+        help="Format to write: rules (NAME.rules + NAME.terms.yaml), fcl, fis or fll.")],
     output: Annotated[Optional[Path], typer.Option(
         "--output", "-o", metavar="OUT",
         help="File to write (default: stdout; for --to rules: STEM.rules in the current "
@@ -41,6 +41,7 @@ def convert_command(
     from ..interop import conversion_notes, parse_foreign, round_trip_difference, write_foreign
     from ..interop.common import atomic_write
 
+    to = choice(Target, to_name, "format")
     rb = read_rulebase(path)
     warn_notes(rb)
     if behavior is not None:

@@ -12,7 +12,7 @@ import typer
 from ..errors import InputError
 from ..words import plural
 from .output import emit, json_text, warn, warn_notes
-from .params import named
+from .params import choice, choices, completer, named
 
 
 class Engine(str, enum.Enum):
@@ -106,13 +106,13 @@ def eval_command(
         "--digits", min=0, max=12, help="Decimals in the trace (the paper prints 1).")] = 1,
     network: Annotated[bool, typer.Option(
         "--network", help="Print the compiled network of fuzzy neurons instead.")] = False,
-    on_no_rule: Annotated[Optional[NoRule], typer.Option(
-        "--on-no-rule", case_sensitive=False,
+    on_no_rule_name: Annotated[Optional[str], typer.Option(
+        "--on-no-rule", metavar=choices(NoRule), autocompletion=completer(NoRule),
         help="With --batch, where no rule sets an output: error, default (the output's "
              "declared default, else an error; what happens without this option), nan, or "
              "skip the row. Given, it adds a `no_rule` column naming such outputs.")] = None,
-    fidelity: Annotated[Optional[Engine], typer.Option(
-        "--fidelity", case_sensitive=False,
+    fidelity_name: Annotated[Optional[str], typer.Option(
+        "--fidelity", metavar=choices(Engine), autocompletion=completer(Engine),
         help="Sample Mamdani outputs as this engine does, to reproduce its published tables: "
              "matlab (101 points with both ends), jfuzzylogic (1000 left cell ends), "
              "fuzzylite (cell midpoints, the file's resolution).")] = None,
@@ -120,6 +120,9 @@ def eval_command(
     """Evaluate a rule base: fuzzified inputs, fired rules with DOFs, crisp outputs."""
     from ..api import load_rulebase
 
+    on_no_rule = (None if on_no_rule_name is None
+                  else choice(NoRule, on_no_rule_name, "--on-no-rule policy"))
+    fidelity = None if fidelity_name is None else choice(Engine, fidelity_name, "engine")
     path, values = split_args(args or [])
     if path is not None and Path(path).suffix.lower() not in (".rules", ".fcl", ".fis", ".fll") \
             and not Path(path).exists():    # `mitos eval road78 size=45`: a lost `=`

@@ -9,7 +9,7 @@ from typing import Annotated, Optional
 import typer
 
 from .output import emit, err, warn_notes
-from .params import named
+from .params import choice, choices, completer, named
 
 
 class Language(str, Enum):
@@ -20,9 +20,9 @@ class Language(str, Enum):
 def export_command(
     path: Annotated[Path, typer.Argument(
         metavar="FILE", help="Rule base to export (.rules, .fcl, .fis or .fll).")],
-    to: Annotated[Language, typer.Option(
-        "--to", help="c: one C99 file (no allocation, only libm); python: a NumPy-only "
-                     "module.", case_sensitive=False)],
+    to_name: Annotated[str, typer.Option(
+        "--to", metavar=choices(Language), autocompletion=completer(Language),
+        help="c: one C99 file (no allocation, only libm); python: a NumPy-only module.")],
     output: Annotated[Optional[Path], typer.Option(
         "--output", "-o", metavar="OUT", help="File to write (default: stdout).")] = None,
     behavior: Annotated[Optional[str], typer.Option(
@@ -41,6 +41,7 @@ def export_command(
     from ..interop.common import atomic_write
     from ..interop.export import ident, to_c, to_python
 
+    to = choice(Language, to_name, "export language")
     if not ident(prefix) == prefix:
         raise typer.BadParameter(f"--prefix `{prefix}` is not a C identifier")
     rb = load_rulebase(path, behavior)

@@ -3,8 +3,15 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
+from enum import Enum
+from typing import TypeVar
 
 import typer
+
+from ..errors import unknown
+
+E = TypeVar("E", bound=Enum)
 
 
 def finite(value: float | None) -> float | None:
@@ -22,3 +29,22 @@ def named(value: str | None) -> str | None:
     if value is not None and not value.strip():
         raise typer.BadParameter("must name something, not be empty")
     return value
+
+
+def choice(kind: type[E], value: str, what: str) -> E:
+    """The member of ``kind`` named ``value`` (any case). An unknown name is a mistake in a
+    value, as an unknown planner or T-norm is: exit 1, the names, and "did you mean"."""
+    for member in kind:
+        if member.value == value.lower():
+            return member
+    raise unknown(what, value, [m.value for m in kind])
+
+
+def choices(kind: type[Enum]) -> str:
+    """The metavar of an option taking one of ``kind``'s names: ``[a|b|c]``."""
+    return "[" + "|".join(m.value for m in kind) + "]"
+
+
+def completer(kind: type[Enum]) -> Callable[[str], list[str]]:
+    """Shell completion of one of ``kind``'s names."""
+    return lambda incomplete: [m.value for m in kind if m.value.startswith(incomplete)]

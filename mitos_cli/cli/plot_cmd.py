@@ -20,7 +20,7 @@ import typer
 from .eval_cmd import parse_values, split_args
 from .help import epilog
 from .output import emit, err, warn
-from .params import named
+from .params import choice, choices, completer, named
 
 FORMATS = ("png", "svg")
 RULE_SUFFIXES = (".rules", ".fcl", ".fis", ".fll")
@@ -202,9 +202,9 @@ def surface_command(
              "midpoint of their universe, with a note).")] = None,
     resolution: Annotated[int, typer.Option(
         "--resolution", "-n", min=2, max=1000, help="Grid points per axis.")] = 61,
-    style: Annotated[Style, typer.Option(
-        "--style", help="3-D surface or heat map with contours (two inputs).")]
-    = Style.surface,
+    style_name: Annotated[str, typer.Option(
+        "--style", metavar=choices(Style), autocompletion=completer(Style),
+        help="3-D surface or heat map with contours (two inputs).")] = Style.surface.value,
     output: OutputOpt = None,
     show: ShowOpt = False,
     title: TitleOpt = None,
@@ -217,6 +217,7 @@ def surface_command(
     from ..api import load_rulebase
     from ..draw.data import surface
 
+    style = choice(Style, style_name, "style")
     path, out_name = _surface_args(args or [])
     rb = load_rulebase(path, behavior)
     if out_name is None:
