@@ -394,7 +394,8 @@ def check_range(lo: float, hi: float, span: Span, what: str = "range",
     problem = universe_problem(lo, hi)
     if problem:
         raise FormatError(problem[0].replace("universe", what, 1), span=span,
-                          hint=problem[1] if lo < hi else "write the minimum first")
+                          hint=problem[1] if lo < hi else "write the minimum, then a larger "
+                                                          "maximum")
 
 
 def resolution(value: float, text: str, span: Span) -> int:
