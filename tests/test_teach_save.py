@@ -117,6 +117,16 @@ def test_save_mistakes(rules, tmp_path):
         s.run("save")
 
 
+def test_save_makes_one_missing_directory_and_refuses_a_missing_path(rules, tmp_path):
+    """`save taught/new.rules` makes `taught/`; a path missing more than its last directory
+    is most likely a typo, refused as every other writer refuses it (nothing is created)."""
+    rb = load_rules_file(rules)
+    assert save_rulebase(rb, rb, tmp_path / "taught" / "new.rules").rules.is_file()
+    with pytest.raises(LessonError, match="the directory `.*nope` does not exist"):
+        save_rulebase(rb, rb, tmp_path / "nope" / "deeper" / "x.rules")
+    assert not (tmp_path / "nope").exists()
+
+
 def test_atomic_write_leaves_no_half_file(tmp_path, monkeypatch):
     target = tmp_path / "a.rules"
     target.write_text("old")

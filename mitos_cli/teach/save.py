@@ -79,13 +79,26 @@ def save_rulebase(original: RuleBase, current: RuleBase, target: Path) -> Saved:
     names = tuple(os.path.relpath(dest, target.parent).replace(os.sep, "/") for dest in targets)
     new_rules, changed = edit_rules(rules_text, str(src), original, current, names)
     changes += changed
-    try:
-        target.parent.mkdir(parents=True, exist_ok=True)   # `save taught/new.rules`
-    except OSError as exc:
-        raise LessonError(f"cannot create `{target.parent}`: {exc.strerror or exc}") from None
+    _directory_for(target)
     finish_saves(target, error=LessonError)        # one a crash left half done
     atomic_write_set(texts + [(target, new_rules)], target, error=LessonError)
     return Saved(target, tuple(d for d, _ in texts), tuple(changes))
+
+
+def _directory_for(target: Path) -> None:
+    """Make the directory ``target`` goes in when only that last one is missing (`save
+    taught/new.rules`); a path whose parents are missing too is most likely a typo, refused
+    as every other writer refuses a missing directory."""
+    parent = target.parent
+    if parent.is_dir():
+        return
+    if not parent.parent.is_dir():
+        raise LessonError(f"cannot save `{target}`: the directory `{parent.parent}` does not "
+                          f"exist", hint="check the path, or create the directory first")
+    try:
+        parent.mkdir()
+    except OSError as exc:
+        raise LessonError(f"cannot create `{parent}`: {exc.strerror or exc}") from None
 
 
 # ---- term sets ----------------------------------------------------------------------------------
