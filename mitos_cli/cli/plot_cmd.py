@@ -41,6 +41,11 @@ class Style(str, Enum):
 
 def check_output(path: Optional[str]) -> Optional[str]:
     """``-o`` must name a .png or .svg file (usage error otherwise)."""
+    return picture_path(path, "'-o' / '--output'")
+
+
+def picture_path(path: Optional[str], option: str) -> Optional[str]:
+    """The picture file an ``option`` names, a .png or .svg one (usage error otherwise)."""
     if path is None:
         return None
     suffix = Path(path).suffix.lower().lstrip(".")
@@ -48,7 +53,7 @@ def check_output(path: Optional[str]) -> Optional[str]:
         raise typer.BadParameter(
             f"`{path}` has {'extension .' + suffix if suffix else 'no extension'}; "
             f"the picture formats are " + " and ".join(f".{f}" for f in FORMATS),
-            param_hint="'-o' / '--output'")
+            param_hint=option)
     return path
 
 

@@ -196,13 +196,15 @@ def simulate_command(
     from ..sim.planner import make_planner, planner_kind
     from ..sim.worldfile import load_world, resolve_world_path
 
-    if require is not None and require not in REQUIRE:
-        from ..errors import did_you_mean
+    if require is not None and require not in REQUIRE:     # a wrong name: as a planner's
+        from ..errors import unknown
 
-        close = did_you_mean(require, REQUIRE)
-        raise typer.BadParameter(f"--require takes `success`, not `{require}`"
-                                 + (f"; {close}" if close else ""))
+        raise unknown("--require outcome", require, REQUIRE)
     planner_kind(planner_name)                  # an unknown name fails before any file is read
+    if plot is not None:                        # before the run, as `plot -o` does
+        from .plot_cmd import picture_path
+
+        picture_path(str(plot), "'--plot'")
     if planner_name != "fuzzy" and (rulebase or behavior):
         raise typer.BadParameter(f"--rulebase and --behavior choose the fuzzy planner's rules; "
                                  f"`{planner_name}` has none", param_hint="--planner")
