@@ -258,6 +258,15 @@ def test_an_input_without_its_equals_sign_is_a_usage_error(capsys):
     assert code == 1 and "cannot read rule file `missing.rules`" in err
 
 
+def test_a_misspelt_rule_file_or_its_term_set_named_instead_say_what_was_meant(capsys):
+    code, _, err = run_main(["eval", "rulebases/mitos.rule", "road=78"], capsys)
+    assert code == 2 and "did you mean `rulebases/mitos.rules`?" in " ".join(
+        err.replace("│", " ").split())
+    code, _, err = run_main(["eval", "rulebases/mitos.terms.yaml", "road=78"], capsys)
+    assert code == 1 and "is a YAML file (a term set, or a world), not a rule base" in err
+    assert "name the `.rules` file whose `terms` line lists it" in err
+
+
 def test_used_rules_take_the_operators_of_the_behavior_that_uses_them(tmp_path):
     """docs/language.md: `cruise` (and = product) evaluates avoid_obstacle's rules with
     product, so their DOFs there are not the ones avoid_obstacle alone gives."""
