@@ -272,3 +272,13 @@ def test_convert_warns_only_of_behaviors_it_leaves_out(tmp_path: Path) -> None:
     inputs = {name: float(lo + 0.37 * (hi - lo)) for name, (lo, hi) in zip(c.inputs, c.universe)}
     assert load_rulebase(tmp_path / "d.rules", "drive").evaluate(**inputs) == \
         original.evaluate(**inputs)
+
+
+def test_export_says_which_behavior_it_exported(tmp_path: Path, capsys) -> None:
+    """As `convert` does: the C file holds one behavior (and those it uses), not the file."""
+    code, output = run_main(["export", str(ROOT / "rulebases" / "mitos.rules"), "--to", "c",
+                             "-o", str(tmp_path / "p.c")], capsys)
+    assert code == 0 and "only behavior `avoid_obstacle` is exported" in output
+    code, output = run_main(["export", str(DATA / "tipper.fis"), "--to", "c",
+                             "-o", str(tmp_path / "t.c")], capsys)
+    assert code == 0 and "warning" not in output

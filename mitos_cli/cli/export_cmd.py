@@ -8,7 +8,7 @@ from typing import Annotated, Optional
 
 import typer
 
-from .output import emit, err, warn_notes
+from .output import emit, err, warn, warn_notes
 from .params import choice, choices, completer, named
 
 
@@ -38,6 +38,7 @@ def export_command(
     rounding.
     """
     from ..api import load_rulebase
+    from ..interop import left_out
     from ..interop.common import atomic_write
     from ..interop.export import ident, to_c, to_python
 
@@ -46,6 +47,9 @@ def export_command(
         raise typer.BadParameter(f"--prefix `{prefix}` is not a C identifier")
     rb = load_rulebase(path, behavior)
     warn_notes(rb.rulebase)
+    note = left_out(rb.rulebase, behavior, "exported")
+    if note:
+        warn(note)
     text = to_c(rb.compiled, prefix, path.name) if to is Language.c else \
         to_python(rb.compiled, path.name)
     if output is None:

@@ -74,6 +74,18 @@ def write_foreign(rb: RuleBase, fmt: str, behavior: str | None = None) -> str:
     raise FormatError(f"unknown format `{fmt}`", expected="one of " + ", ".join(FORMATS))
 
 
+def left_out(rb: RuleBase, behavior: str | None, done: str) -> str | None:
+    """The note that only one behavior (and those it uses) is ``done`` (written, exported):
+    ``None`` when that is all the rule base has."""
+    b = rb.behavior(behavior)
+    written = _used(rb, b.name)
+    others = [x.name for x in rb.behaviors if x.name not in written]
+    if not others:
+        return None
+    return (f"only behavior `{b.name}` is {done} (with the behaviors it uses); the others "
+            f"({', '.join(others)}) are not: choose one with --behavior")
+
+
 def conversion_notes(rb: RuleBase, fmt: str, behavior: str | None = None) -> list[str]:
     """What writing ``rb`` as ``fmt`` (``rules`` included) leaves out or changes; the file is
     written anyway and ``mitos convert`` prints these as warnings."""
@@ -81,12 +93,10 @@ def conversion_notes(rb: RuleBase, fmt: str, behavior: str | None = None) -> lis
     from .common import legal_names
 
     b = rb.behavior(behavior)
-    written = _used(rb, b.name)
-    left_out = [x.name for x in rb.behaviors if x.name not in written]
+    left = left_out(rb, behavior, "written")
     rb, out = legal_names(rb, fmt)
-    if left_out:
-        out.append(f"only behavior `{b.name}` is written (with the behaviors it uses); the "
-                   f"others ({', '.join(left_out)}) are not: choose one with --behavior")
+    if left:
+        out.append(left)
     if fmt == "fis":
         from .fis import notes
 
