@@ -123,18 +123,23 @@ def edit_termset(text: str, path: str, old, new) -> tuple[str, list[str]]:
         terms = spec["terms"]
         for t_old, t_new in zip(v_old.terms, v_new.terms):
             was, now = _flags(t_old), _flags(t_new)
+            said: list[str] = []             # one line per term, whatever changed in it
             if was != now:
                 edits += _flag_edits(text, starts, terms, t_old, t_new)
+            t_params_changed = t_old.params != t_new.params
+            if t_params_changed:
+                said.append(f"{_params(t_old)} -> {_params(t_new)}")
             if t_old.frozen != t_new.frozen:
-                changes.append(f"{v_old.name}.{t_old.name}: "
-                               f"{'frozen' if t_new.frozen else 'no longer frozen'}")
+                said.append("frozen" if t_new.frozen else "no longer frozen")
             if was["held"] != now["held"]:
-                changes.append(f"{v_old.name}.{t_old.name}: " + (
+                said.append(
                     "free to move off its point (held: false)" if not t_new.held else
                     "held at its point" if t_new.held_at is None else
-                    f"held at {now['held']} (held: {now['held']}: its neighbours no longer "
-                    "mirror each other about it)"))
-            if t_old.params == t_new.params:
+                    f"`held: {now['held']}` written (its neighbours no longer mirror each "
+                    f"other about it)")
+            if said:
+                changes.append(f"{v_old.name}.{t_old.name}: " + "; ".join(said))
+            if not t_params_changed:
                 continue
             spans = _param_spans(terms, t_old)
             for span, a, b in zip(spans, t_old.params, t_new.params):
@@ -146,7 +151,6 @@ def edit_termset(text: str, path: str, old, new) -> tuple[str, list[str]]:
                     raise LessonError(f"cannot find the number for `{v_old.name}."
                                       f"{t_old.name}` in {path}:{span.line}")
                 edits.append((match.start(), match.end(), format_number(b)))
-            changes.append(f"{v_old.name}.{t_old.name}: {_params(t_old)} -> {_params(t_new)}")
     return _apply(text, edits), changes
 
 
