@@ -154,7 +154,7 @@ class RuleSyntaxError(MitosError):
 class NameError_(MitosError):
     """A name (variable, term, hedge, behavior, operator) that is not defined."""
 
-    kind = "unknown name"
+    kind = "name error"
 
 
 class TermSetError(MitosError):
