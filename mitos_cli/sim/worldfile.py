@@ -115,8 +115,9 @@ class _Reader:
             return default
         value = str(m[key])
         if value not in options:
-            raise unknown(f"{key} in {what}", value, options, span=m.value_span(key),
-                          cls=WorldError)
+            err = unknown(key, value, options)          # "unknown shape `circel`" ...
+            raise WorldError(f"{err.message} in {what}", span=m.value_span(key),
+                             expected=err.expected, hint=err.hint)   # ... "in obstacle `box`"
         return value
 
     def flag(self, m: YMap, key: str, what: str, default: bool) -> bool:
