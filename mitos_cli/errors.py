@@ -12,7 +12,7 @@ import difflib
 import functools
 import re
 from collections.abc import Iterable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 
 @dataclass(frozen=True)
@@ -30,6 +30,17 @@ class Span:
     def __str__(self) -> str:
         where = self.path or "<input>"
         return f"{where}:{self.line}:{self.column}"
+
+    def ending(self, token: str) -> Span:
+        """This span narrowed to ``token`` where the text it covers ends with it (the unknown
+        term of ``speed is MEDUIM``); itself where it cannot tell."""
+        if self.source_line is None or self.end_column is None:
+            return self
+        start = self.end_column - len(token)
+        i = start - self.source_start
+        if start < self.column or i < 0 or self.source_line[i:i + len(token)] != token:
+            return self
+        return replace(self, column=start)
 
     @classmethod
     def in_text(cls, text: str, path: str | None, line: int, column: int,

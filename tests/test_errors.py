@@ -129,13 +129,13 @@ def test_missing_rule_file():
     ("r1: if raod is WIDE then speed is SLOW", "unknown input variable `raod`",
      "did you mean `road`?", "raod is WIDE"),
     ("r1: if road is WIDEE then speed is SLOW", "unknown term `WIDEE` of `road`",
-     "did you mean `WIDE`?", "road is WIDEE"),
+     "did you mean `WIDE`?", "WIDEE"),           # the caret under the term itself
     ("r1: if road is WIDE then sped is SLOW", "unknown output variable `sped`",
      "did you mean `speed`?", "sped is SLOW"),
     ("r1: if road is WIDE then speed is SLWO", "unknown term `SLWO` of `speed`",
-     "did you mean `SLOW`?", "speed is SLWO"),
+     "did you mean `SLOW`?", "SLWO"),
     ("r1: if road is wide then speed is SLOW", "unknown term `wide` of `road`",
-     "did you mean `WIDE`?", "road is wide"),
+     "did you mean `WIDE`?", "wide"),
 ])
 def test_unknown_names(tmp_path, rule, message, hint, at):
     path = write(tmp_path, rule)

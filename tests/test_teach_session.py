@@ -289,7 +289,7 @@ def test_errors_at_the_prompt_are_placed_at_prompt(rules):
     place."""
     s, out = session(rules)
     for line, column in [("correct road=78 size=45 position=4 -> steerin=60", 39),
-                         ("if road is NARROW then speed is SLOWW", 24),
+                         ("if road is NARROW then speed is SLOWW", 33),   # at the term
                          ("corect road=78", 1)]:
         with pytest.raises(MitosError) as info:
             s.run(line)

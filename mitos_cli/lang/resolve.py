@@ -160,7 +160,7 @@ def _check_hedges(hedges: tuple[str, ...], span: Span | None) -> None:
 def check_expr(expr: Expr, variables: dict[str, Variable]) -> None:
     if isinstance(expr, Prop):
         v = _variable(expr.var, "input", variables, expr.span)
-        v.term(expr.term, expr.span)
+        v.term(expr.term, expr.span and expr.span.ending(expr.term))
         _check_hedges(expr.hedges, expr.span)
     elif isinstance(expr, Not):
         check_expr(expr.expr, variables)
@@ -172,7 +172,7 @@ def check_expr(expr: Expr, variables: dict[str, Variable]) -> None:
 def _check_consequent(c: Consequent, variables: dict[str, Variable]) -> None:
     v = _variable(c.var, "output", variables, c.span)
     if c.term is not None:
-        v.term(c.term, c.span)
+        v.term(c.term, c.span and c.span.ending(c.term))
         _check_hedges(c.hedges, c.span)
     elif c.value is not None:
         lo, hi = v.universe

@@ -445,7 +445,7 @@ class Session:
                 out.append(cmd.Assign(t.name, t.value, t.span))
                 continue
             var = compiled.variables[t.name]
-            var.term(t.term, t.span)
+            var.term(t.term, t.span and t.span.ending(t.term))
             out.append(cmd.Assign(t.name, hedged(var, t.term, t.hedges), t.span))
         return tuple(out)
 
