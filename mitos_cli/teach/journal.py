@@ -65,8 +65,11 @@ def find_session(name: str | None, base: Path | None = None) -> Path:
             return root / name
         from ..errors import unknown
 
-        raise unknown("teaching session", name, [p.parent.name for p in found],
-                      cls=LessonError)
+        names = sorted(p.parent.name for p in found)         # oldest first (dated names)
+        err = unknown("teaching session", name, names)
+        if len(names) > 12:                                   # the newest are the likely ones
+            err.expected = "one of the newest: " + ", ".join(names[-12:])
+        raise err
     if not found:
         raise LessonError(f"no teaching session to resume in {ROOT}/",
                           hint="start one with `mitos teach RULES`")
