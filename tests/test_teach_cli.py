@@ -284,3 +284,20 @@ def test_prompt_errors_are_command_errors_at_the_prompts_line(work):
     at = err.index("<prompt>:8:1: command error: nothing to undo")
     assert err[at + 1:at + 3] == ["    undo", "    ^"]
     assert "lesson error" not in res.stderr
+
+
+def test_an_unknown_session_lists_the_newest(tmp_path):
+    """Twenty sessions: the list a misspelt --session gets is the newest twelve, not the
+    oldest (the ones a user is least likely to mean), and it is a name error."""
+    from mitos_cli.errors import NameError_
+    from mitos_cli.teach.journal import JOURNAL, ROOT, find_session
+
+    for i in range(20):
+        d = tmp_path / ROOT / f"mitos-20261203-0100{i:02d}"
+        d.mkdir(parents=True)
+        (d / JOURNAL).write_text('{"command": "use drive"}\n')
+    with pytest.raises(NameError_) as info:
+        find_session("mitos-20261203-01009", tmp_path)
+    assert info.value.expected.endswith("mitos-20261203-010019")
+    assert "mitos-20261203-010000" not in info.value.expected
+    assert "did you mean" in info.value.hint
