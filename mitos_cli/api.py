@@ -38,12 +38,12 @@ def read_rulebase(path: str | Path | None = None) -> RuleBase:
     else:
         path = resolve("rulebases", path, ".rules") or Path(path)
     suffix = path.suffix.lower()
-    if suffix in (".yaml", ".yml"):                    # a term set, named instead of its rules
-        from .errors import RuleBaseError, Span
+    if suffix in (".yaml", ".yml") and path.is_file():   # a term set or a world named
+        from .errors import RuleBaseError
 
         raise RuleBaseError(f"`{path}` is a YAML file (a term set, or a world), not a rule "
-                            f"base", span=Span(str(path), 1, 1),
-                            hint="name the `.rules` file whose `terms` line lists it")
+                            f"base", hint="a rule base is a .rules, .fcl, .fis or .fll file; "
+                            "a term set is read through the `terms` line of its .rules file")
     if suffix in (".fcl", ".fis", ".fll"):
         from .interop import read_foreign
 

@@ -210,8 +210,9 @@ class FormatError(MitosError):
     kind = "format error"
 
 
-def did_you_mean(name: str, candidates: Iterable[str]) -> str | None:
-    """The closest candidate to ``name`` as a hint, or ``None`` when nothing is close."""
+def closest(name: str, candidates: Iterable[str]) -> str | None:
+    """The candidate closest to ``name`` (as written, then in any case), or ``None`` when
+    nothing is close."""
     pool = list(candidates)
     close = difflib.get_close_matches(name, pool, n=1, cutoff=0.6)
     if not close:
@@ -220,7 +221,13 @@ def did_you_mean(name: str, candidates: Iterable[str]) -> str | None:
         close = [hit] if hit else difflib.get_close_matches(name.lower(), list(lowered), n=1,
                                                             cutoff=0.6)
         close = [lowered.get(c, c) for c in close]
-    return f"did you mean `{close[0]}`?" if close else None
+    return close[0] if close else None
+
+
+def did_you_mean(name: str, candidates: Iterable[str]) -> str | None:
+    """The closest candidate to ``name`` as a hint, or ``None`` when nothing is close."""
+    close = closest(name, candidates)
+    return f"did you mean `{close}`?" if close is not None else None
 
 
 def unknown(what: str, name: str, candidates: Iterable[str], *, span: Span | None = None,

@@ -17,10 +17,26 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import IO
 
-from .errors import MitosError
+from .errors import MitosError, closest
 
 #: the largest text file read (bytes): far beyond any rule base, world, lesson or batch here
 MAX_TEXT_BYTES = 256 << 20
+
+
+#: What a rule base is read from.
+RULE_SUFFIXES = (".rules", ".fcl", ".fis", ".fll")
+
+
+def nearby(path: str | Path, suffixes: tuple[str, ...] = RULE_SUFFIXES) -> str | None:
+    """"did you mean `DIR/NAME`?" for a file beside ``path`` whose name is close to its own
+    and ends in one of ``suffixes`` (`rulebases/mitoss.rules`, `rulebases/mitos.rule`)."""
+    where = Path(path).parent
+    try:
+        names = [p.name for p in where.iterdir() if p.suffix.lower() in suffixes]
+    except OSError:
+        return None
+    name = closest(Path(path).name, names)
+    return f"did you mean `{where / name}`?" if name is not None else None
 
 
 def read_text(path: str | Path) -> str:

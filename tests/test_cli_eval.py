@@ -264,7 +264,9 @@ def test_a_misspelt_rule_file_or_its_term_set_named_instead_say_what_was_meant(c
         err.replace("│", " ").split())
     code, _, err = run_main(["eval", "rulebases/mitos.terms.yaml", "road=78"], capsys)
     assert code == 1 and "is a YAML file (a term set, or a world), not a rule base" in err
-    assert "name the `.rules` file whose `terms` line lists it" in err
+    assert "a term set is read through the `terms` line of its .rules file" in err
+    code, _, err = run_main(["eval", "rulebases/mitoss.rules", "road=78"], capsys)
+    assert code == 1 and "did you mean `rulebases/mitos.rules`?" in err
 
 
 def test_used_rules_take_the_operators_of_the_behavior_that_uses_them(tmp_path):

@@ -318,7 +318,7 @@ def test_unknown_extension_and_missing_file(tmp_path: Path) -> None:
     (tmp_path / "tipper.fll").write_text(FLL)
     with pytest.raises(RuleBaseError) as exc:
         read_foreign(tmp_path / "tiper.fll")
-    assert exc.value.hint == "did you mean `tipper.fll`?"
+    assert exc.value.hint == f"did you mean `{tmp_path / 'tipper.fll'}`?"   # as it was named
     with pytest.raises(FormatError, match="unknown format `yaml`"):
         write_foreign(parse_fll(FLL), "yaml")
 

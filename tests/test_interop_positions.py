@@ -1,6 +1,6 @@
 """Numbers a reader cannot compute with are refused where they are written: a range that is
-infinite, subnormal or a defuzzifier resolution beyond what MITOS samples (each once told at
-the variable's name or at 1:1), in every format and in a term set."""
+infinite, NaN, empty or too narrow, or a defuzzifier resolution beyond what MITOS samples
+(each once told at the variable's name or at 1:1), in FLL, FIS and FCL."""
 
 from __future__ import annotations
 
@@ -25,6 +25,9 @@ def _refused(parse, text: str, at: str, words: str) -> None:
 
 @pytest.mark.parametrize("old, new, at, words", [
     ("range: 0 10", "range: -inf inf", "-inf inf", "the range is -inf"),
+    ("range: 0 10", "range: nan 10", "nan 10", "its ends must be numbers"),
+    ("range: 0 10", "range: 10 10", "10 10", "range [10, 10] is empty"),
+    ("range: 0 10", "range: 0 1e-302", "0 1e-302", "too narrow to compute with"),
     ("range: 0 10", "range: 0 1e-320", "0 1e-320", "too narrow to compute with"),
     ("defuzzifier: Centroid 200", "defuzzifier: Centroid 1e9", "Centroid 1e9",
      "resolution must be a whole number from 3 to 100000"),
@@ -42,7 +45,10 @@ def test_fis(new: str, words: str) -> None:
     _refused(parse_fis, FIS.replace("Range=[0 10]", new, 1), new[len("Range="):], words)
 
 
-def test_fcl() -> None:
+@pytest.mark.parametrize("new, words", [
+    ("RANGE := (0 .. 1e-320);", "too narrow to compute with"),
+    ("RANGE := (-inf .. inf);", "the range is -inf"),
+])
+def test_fcl(new: str, words: str) -> None:
     assert "RANGE := (0 .. 30);" in FCL
-    text = FCL.replace("RANGE := (0 .. 30);", "RANGE := (0 .. 1e-320);", 1)
-    _refused(parse_fcl, text, "RANGE := (0 .. 1e-320)", "too narrow to compute with")
+    _refused(parse_fcl, FCL.replace("RANGE := (0 .. 30);", new, 1), new[:-1], words)

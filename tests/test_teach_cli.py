@@ -287,17 +287,18 @@ def test_prompt_errors_are_command_errors_at_the_prompts_line(work):
 
 
 def test_an_unknown_session_lists_the_newest(tmp_path):
-    """Twenty sessions: the list a misspelt --session gets is the newest twelve, not the
-    oldest (the ones a user is least likely to mean), and it is a name error."""
+    """Twenty sessions: the list a misspelt --session gets is the newest twelve by time (not
+    by name: a session is named after its rule file), newest first, and it is a name error."""
     from mitos_cli.errors import NameError_
     from mitos_cli.teach.journal import JOURNAL, ROOT, find_session
 
-    for i in range(20):
-        d = tmp_path / ROOT / f"mitos-20261203-0100{i:02d}"
+    for i in range(20):                  # `z-` the oldest, `a-` the newest
+        d = tmp_path / ROOT / f"{'z' if i < 10 else 'a'}-20261203-0100{i:02d}"
         d.mkdir(parents=True)
         (d / JOURNAL).write_text('{"command": "use drive"}\n')
+        os.utime(d / JOURNAL, (1_000_000 + i, 1_000_000 + i))
     with pytest.raises(NameError_) as info:
-        find_session("mitos-20261203-01009", tmp_path)
-    assert info.value.expected.endswith("mitos-20261203-010019")
-    assert "mitos-20261203-010000" not in info.value.expected
+        find_session("a-20261203-01001", tmp_path)
+    assert info.value.expected.startswith("one of the newest: a-20261203-010019, ")
+    assert "z-20261203-010000" not in info.value.expected
     assert "did you mean" in info.value.hint

@@ -12,7 +12,7 @@ import typer
 from ..errors import InputError
 from ..words import plural
 from .output import emit, json_text, warn, warn_notes
-from .params import choice, choices, completer, named, similar_file
+from .params import choice, choices, completer, named
 
 
 class Engine(str, enum.Enum):
@@ -126,10 +126,12 @@ def eval_command(
     path, values = split_args(args or [])
     if path is not None and Path(path).suffix.lower() not in (".rules", ".fcl", ".fis", ".fll") \
             and not Path(path).exists():    # `mitos eval road78 size=45`: a lost `=`
-        close = similar_file(path, (".rules", ".fcl", ".fis", ".fll"))
+        from ..fileio import nearby
+
+        close = nearby(path)
         raise typer.BadParameter(f"`{path}` is neither a rule file nor NAME=VALUE (no file "
                                  f"of that name; write each input as NAME=VALUE)"
-                                 + (f"; did you mean `{close}`?" if close else ""))
+                                 + (f"; {close}" if close else ""))
     rb = load_rulebase(path, behavior)
     warn_notes(rb.rulebase)
     if fidelity is not None:

@@ -49,17 +49,3 @@ def completer(kind: type[Enum]) -> Callable[[str], list[str]]:
     """Shell completion of one of ``kind``'s names."""
     return lambda incomplete: [m.value for m in kind if m.value.startswith(incomplete)]
 
-
-def similar_file(path: str, suffixes: tuple[str, ...]) -> str | None:
-    """A file beside ``path`` whose name is close to it and ends in one of ``suffixes``
-    (`rulebases/mitos.rule` -> `rulebases/mitos.rules`), for a "did you mean"."""
-    import difflib
-    from pathlib import Path
-
-    where = Path(path).parent
-    try:
-        names = [p.name for p in where.iterdir() if p.suffix.lower() in suffixes]
-    except OSError:
-        return None
-    close = difflib.get_close_matches(Path(path).name, names, n=1, cutoff=0.75)
-    return str(where / close[0]) if close else None

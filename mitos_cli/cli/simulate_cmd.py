@@ -196,6 +196,7 @@ def simulate_command(
     from ..sim.planner import make_planner, planner_kind
     from ..sim.worldfile import load_world, resolve_world_path
 
+    require = None if require is None else require.lower()   # any case, as --to's names
     if require is not None and require not in REQUIRE:     # a wrong name: as a planner's
         from ..errors import unknown
 

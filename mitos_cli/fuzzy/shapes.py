@@ -160,6 +160,11 @@ register(Shape("linear", ("coefficients", "constant"), linear, lambda p: None, N
                "(params: LINEAR_LAYOUT)"))
 
 
+#: The slope of a vertical edge in the compiled kernel, and the cap of every slope: an edge
+#: narrower than ``1 / STEEP`` is a vertical one.
+STEEP = 1e300
+
+
 def kernel_params(corners: tuple[float, float, float, float]) -> tuple[float, float, float, float]:
     """Corner points as ``(b, s1, c, s2)`` for the compiled kernel
 
@@ -169,7 +174,7 @@ def kernel_params(corners: tuple[float, float, float, float]) -> tuple[float, fl
     a float, 1e-320 wide: an infinite slope times 0 at the corner would be NaN).
     """
     a, b, c, d = corners
-    steep = 1e300
+    steep = STEEP
     if b == -INF:           # left shoulder: no rising edge
         b, s1 = c, 0.0
     else:

@@ -11,7 +11,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..errors import FormatError, RuleBaseError, did_you_mean
+from ..errors import FormatError, RuleBaseError
+from ..fileio import nearby
 from ..lang.model import RuleBase
 
 READERS = {".fcl": "fcl", ".fis": "fis", ".fll": "fll"}
@@ -29,7 +30,7 @@ def read_foreign(path: str | Path) -> RuleBase:
         path.open("rb").close()
     except OSError as exc:
         raise RuleBaseError(f"cannot read rule file `{path}`: {exc.strerror or exc}",
-                            hint=_nearby(path)) from None
+                            hint=nearby(path)) from None
     if kind == "fll":
         from .fll import read_fll
 
@@ -41,16 +42,6 @@ def read_foreign(path: str | Path) -> RuleBase:
     from .fcl import read_fcl
 
     return read_fcl(path)
-
-
-def _nearby(path: Path) -> str | None:
-    """``did you mean`` among the rule files beside ``path``, if one is close."""
-    try:
-        names = [p.name for p in (path.parent if str(path.parent) else Path(".")).iterdir()
-                 if p.suffix.lower() in (*READERS, ".rules")]
-    except OSError:
-        return None
-    return did_you_mean(path.name, names)
 
 
 def write_foreign(rb: RuleBase, fmt: str, behavior: str | None = None) -> str:

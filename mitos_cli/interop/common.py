@@ -386,10 +386,13 @@ INFINITE_OK = {"trapezoid": {(0, -1), (1, -1), (2, 1), (3, 1)},
 
 def check_range(lo: float, hi: float, span: Span, what: str = "range",
                 point: bool = False) -> None:
-    """Refuse, at the range as written, one that is empty (a single point too, unless
-    ``point``: FLL's unused Takagi-Sugeno range) or too narrow to compute with (NaN and
-    infinities are refused by :func:`check_numbers`, which knows the terms)."""
-    if math.isnan(lo) or math.isnan(hi) or (point and lo == hi):
+    """Refuse, at the range as written, one with a NaN end, one that is empty (a single
+    point too, unless ``point``: FLL's unused Takagi-Sugeno range) or too narrow to compute
+    with (infinities are refused by :func:`check_numbers`, which knows the terms)."""
+    if math.isnan(lo) or math.isnan(hi):
+        raise FormatError(f"the {what} is [{lo:g}, {hi:g}]: its ends must be numbers",
+                          span=span, hint="write the minimum, then a larger maximum")
+    if point and lo == hi:
         return
     problem = universe_problem(lo, hi)
     if problem:

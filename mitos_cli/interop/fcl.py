@@ -172,10 +172,12 @@ def _function_block(fb: Tree, span_of) -> RuleBase:
     locks: dict[str, Span] = {}
     constants: list[tuple[str, Term]] = []
     variables = {}
+    ranges: dict[str, Span] = {}                     # where each RANGE is written
     for node in fuzzify + defuzzify:
         role = "input" if node.data == "fuzzify" else "output"
         record = records.setdefault(str(node.children[0]), common.Record())
-        v = _variable(node, role, declared, record, locks, constants, n_inputs, span_of, notes)
+        v = _variable(node, role, declared, record, locks, constants, n_inputs, span_of, notes,
+                      ranges)
         if v.name in variables:
             raise FormatError(f"variable `{v.name}` is defined twice", span=v.span)
         variables[v.name] = v
@@ -241,7 +243,7 @@ def _function_block(fb: Tree, span_of) -> RuleBase:
                         hint=f"for a singleton write `TERM {term.name} := value;`")
     ordered = [variables[n] for n in declared]
     rb = common.assemble_blocks(span_of(fb).path, ordered, groups, DEFAULT_RESOLUTION,
-                                span_of(fb), notes)
+                                span_of(fb), notes, ranges)
     return dataclasses.replace(rb, notes=tuple(notes))
 
 
@@ -260,7 +262,8 @@ def _tsukamoto(record: common.Record, v: Variable, notes: list[str]) -> None:
 
 
 def _variable(node: Tree, role: Role, declared, settings: common.Record, locks: dict,
-              constants: list, n_inputs: int, span_of, notes: list[str]) -> Variable:
+              constants: list, n_inputs: int, span_of, notes: list[str],
+              ranges: dict[str, Span] | None = None) -> Variable:
     name_token = node.children[0]
     name = str(name_token)
     if name not in declared:
@@ -284,6 +287,8 @@ def _variable(node: Tree, role: Role, declared, settings: common.Record, locks: 
         elif kind == "range_item":
             universe = (_num(item.children[0]), _num(item.children[1]))
             common.check_range(*universe, span_of(item), "RANGE")
+            if ranges is not None:
+                ranges[name] = span_of(item)
         elif kind == "option":
             key = str(item.children[0]).upper()
             if role == "input":

@@ -337,8 +337,12 @@ def _build_variable(v: _Var, inputs: list[str], notes: list[str]) -> Variable:
     if v.range is None:
         raise FormatError(f"variable `{v.name}` has no `range`", span=v.span)
     universe = v.range
-    if universe[0] == universe[1] and v.role == "output" and v.terms and all(
-            kind in ("Constant", "Linear") for _, kind, _, _ in v.terms):
+    if universe[0] == universe[1]:
+        if not (v.role == "output" and v.terms and all(
+                kind in ("Constant", "Linear") for _, kind, _, _ in v.terms)):
+            raise FormatError(f"range [{universe[0]:g}, {universe[1]:g}] is empty",
+                              span=v.range_span or v.span,
+                              hint="write the minimum, then a larger maximum")
         universe = (-float("inf"), float("inf"))     # a Takagi-Sugeno output's range is unused
     terms = []
     for name, kind, values, span in v.terms:

@@ -14,7 +14,7 @@ import numpy as np
 
 from ..errors import Span, TermSetError, unknown
 from ..fuzzy.formula import Formula
-from ..fuzzy.shapes import SHAPES, Shape
+from ..fuzzy.shapes import SHAPES, STEEP, Shape
 
 Role = Literal["input", "output"]
 
@@ -148,10 +148,10 @@ class TermSet:
         raise unknown("variable", name, [v.name for v in self.variables], span=span)
 
 
-#: The least width of a universe: across a narrower (subnormal) one every slope overflows and
-#: every term is a vertical edge, 1 on both sides of it. (A term's own edge may be that
-#: narrow: it is a vertical edge, evaluated as one.)
-TINY = float(np.finfo(float).tiny)
+#: The least width of a universe: across a narrower one every edge is steeper than the
+#: kernel's vertical edge (:data:`~mitos_cli.fuzzy.shapes.STEEP`), so every term is 1 on both
+#: sides of it. (A term's own edge may be that narrow: it is a vertical edge, evaluated as one.)
+TINY = 1.0 / STEEP
 
 
 def universe_problem(lo: float, hi: float) -> tuple[str, str] | None:

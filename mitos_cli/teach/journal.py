@@ -65,10 +65,10 @@ def find_session(name: str | None, base: Path | None = None) -> Path:
             return root / name
         from ..errors import unknown
 
-        names = sorted(p.parent.name for p in found)         # oldest first (dated names)
+        names = [p.parent.name for p in found]               # oldest first (by time)
         err = unknown("teaching session", name, names)
         if len(names) > 12:                                   # the newest are the likely ones
-            err.expected = "one of the newest: " + ", ".join(names[-12:])
+            err.expected = "one of the newest: " + ", ".join(reversed(names[-12:]))
         raise err
     if not found:
         raise LessonError(f"no teaching session to resume in {ROOT}/",

@@ -654,7 +654,8 @@ class Session:
     def _save(self, c: cmd.Save, line: str) -> None:
         from .save import save_rulebase
 
-        target = Path(c.path) if c.path is not None else self.save_as
+        # `save ~/taught.rules` at the prompt, where no shell expands the `~`
+        target = Path(c.path).expanduser() if c.path is not None else self.save_as
         if target is None:
             raise LessonError("say where to save: `save taught.rules`",
                               hint=f"the original {self.rules_path} is kept unless you name "
