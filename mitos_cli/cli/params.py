@@ -48,4 +48,3 @@ def choices(kind: type[Enum]) -> str:
 def completer(kind: type[Enum]) -> Callable[[str], list[str]]:
     """Shell completion of one of ``kind``'s names."""
     return lambda incomplete: [m.value for m in kind if m.value.startswith(incomplete)]
-
