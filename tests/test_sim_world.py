@@ -277,6 +277,51 @@ def test_a_start_or_goal_inside_an_obstacle_is_refused(obstacle, what):
     assert ("w.yaml:10:9" if "goal" in what else "w.yaml:9:9") in msg
 
 
+@pytest.mark.parametrize("obstacle, touches", [
+    ("{name: bin, shape: circle, at: [50, 0], radius: 9}", True),      # 1 in into the nose
+    ("{name: bin, shape: circle, at: [52, 0], radius: 9}", False),     # 1 in short of it
+    ("{name: crate, shape: rectangle, at: [30, 18], length: 30, width: 20, angle: 0}", True),
+    ("{name: crate, shape: rectangle, at: [30, 20], length: 30, width: 20, angle: 0}", False),
+    ("{name: crate, shape: rectangle, at: [30, 20], length: 30, width: 20, angle: 10}", True),
+])
+def test_a_start_where_the_body_reaches_into_an_obstacle_is_refused(obstacle, touches):
+    text = BASE + f"obstacles:\n  - {obstacle}\n"
+    if not touches:
+        assert parse_world(text, "w.yaml")
+        return
+    msg = error(text)
+    assert "w.yaml:9:9" in msg and "the robot's body (24 x 18 in) reaches into obstacle" in msg
+
+
+def test_robots_whose_bodies_overlap_at_the_start_are_refused():
+    robots = ("robots:\n  - name: b\n    q_init: {{x: {x}, y: 0, heading: 180}}\n"
+              "    q_goal: {{x: 300, y: 20}}\n")
+    msg = error(BASE + robots.format(x=50))        # noses 4 in into each other
+    assert "w.yaml:17:13" in msg and "overlaps robot `robot`'s at its start" in msg
+    assert parse_world(BASE + robots.format(x=55), "w.yaml")       # 1 in apart
+
+
+@pytest.mark.parametrize("jitter, what", [
+    ("{dx: [-125, -115], dy: [0, 0]}", "start (q_init) at (30, 0)"),
+    ("{dx: [100, 160], dy: [-1, 1]}", "goal (q_goal) at (300, 0)"),
+    ("{dx: [150, 150], dy: [5, 10]}", "goal (q_goal) at (300, 0)"),     # 1 in to spare
+])
+def test_a_randomise_range_that_reaches_a_start_or_goal_is_refused(jitter, what):
+    text = (BASE + "obstacles:\n  - {name: box, shape: circle, at: [150, 5], radius: 9}\n"
+            f"randomise:\n  obstacles:\n    box: {jitter}\n")
+    if "[5, 10]" in jitter:
+        assert parse_world(text, "w.yaml")
+        return
+    msg = error(text)
+    assert "w.yaml:19:10" in msg and f"randomise can move obstacle `box` over the {what}" in msg
+
+
+def test_a_moving_obstacle_may_start_over_the_goal_it_leaves():
+    text = (BASE + "obstacles:\n  - {name: cart, shape: circle, at: [330, 0], radius: 9, "
+            "velocity: [-10, 0]}\nrandomise:\n  obstacles:\n    cart: {dx: [-40, 0]}\n")
+    assert parse_world(text, "w.yaml")
+
+
 def test_an_empty_number_says_so():
     msg = error(BASE.replace("time_limit: 10", "time_limit: ~"))
     assert "w.yaml:4:13" in msg and "must be a number, not nothing (an empty value or `~`)" in msg

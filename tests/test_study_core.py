@@ -186,10 +186,13 @@ def test_resume_with_another_seed_is_refused(tmp_path):
 
 def test_resume_with_worlds_reordered_is_refused(tmp_path):
     run_study(small_study(runs=1), tmp_path, workers=1, task_fn=fake_sim)
+    before = {p.name: p.read_bytes() for p in tmp_path.iterdir()}
     swapped = Study(**{**small_study(runs=1).__dict__, "worlds": ["w2.yaml", "w1.yaml"]})
     with pytest.raises(StudyError) as exc:
         run_study(swapped, tmp_path, workers=1, resume=True, task_fn=fake_sim)
     assert "same order" in exc.value.hint
+    # refused before anything is written: study.json still describes the study on disk
+    assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before
 
 
 def test_hand_edited_results_are_reported(tmp_path):

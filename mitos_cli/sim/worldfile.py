@@ -11,7 +11,7 @@ from __future__ import annotations
 from collections import Counter
 from dataclasses import replace
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ..errors import NameError_, Span, WorldError, unknown
 from ..lang import yamlpos
@@ -30,6 +30,9 @@ from .world import (
     Sensors,
     World,
 )
+
+if TYPE_CHECKING:
+    import numpy as np
 
 TOP_KEYS = ("name", "seed", "dt", "time_limit", "substeps", "behavior", "robot", "sensors",
             "q_init", "q_goal", "map", "obstacles", "robots", "randomise", "route")
@@ -380,6 +383,9 @@ def parse_world(text: str, path: str) -> World:
                   str(top.get("behavior", "drive")), knows, given, min_clearance, replan,
                   top.value_span("behavior") if "behavior" in top else None)
     check_free(world, agent_spans)
+    check_starts(world, [s for s, _ in agent_spans])
+    if "randomise" in top:
+        check_jitters(world, top["randomise"].get("obstacles"))
     return world
 
 
@@ -415,7 +421,7 @@ def check_free(world: World, spans: list[tuple[Span, Span]]) -> None:
     for agent, (s_span, g_span) in zip(world.agents, spans):
         for what, p, span in (("start (q_init)", agent.start, s_span),
                               ("goal (q_goal)", agent.goal, g_span)):
-            who = "" if agent.name == "robot" else f" of `{agent.name}`"
+            who = _who(agent)
             if not static.free(np.array([[p.x, p.y]]))[0]:
                 raise WorldError(f"the {what}{who} at ({p.x:g}, {p.y:g}) lies inside a wall",
                                  span=span, hint="move it into a corridor (free space)")
@@ -450,6 +456,98 @@ def _obstacle_at(world: World, x: float, y: float) -> str | None:
     return None
 
 
+def _who(agent) -> str:
+    return "" if agent.name == "robot" else f" of `{agent.name}`"
+
+
+def _body_corners(agent) -> np.ndarray:
+    """The corners ``[4, 2]`` of ``agent``'s footprint at its start."""
+    import math
+
+    from .geometry import rect_corners
+
+    st, robot = agent.start, agent.robot
+    return rect_corners(st.x, st.y, math.radians(st.heading), robot.length, robot.width)
+
+
+def _box_meets(hl: float, hw: float, centre, heading: float, o, at) -> bool:
+    """Whether obstacle ``o`` standing at ``at`` reaches into the box ``[-hl, hl] x [-hw, hw]``
+    centred at ``centre`` and turned ``heading`` rad (touching is not reaching in)."""
+    import math
+
+    import numpy as np
+
+    from .geometry import box_polygon_depth, rect_corners
+
+    c, s = math.cos(heading), math.sin(heading)
+    turn = np.array([[c, -s], [s, c]])                      # world -> box frame: @ turn
+    if o.shape == "circle":
+        x, y = (np.asarray(at, float) - centre) @ turn
+        return math.hypot(max(abs(x) - hl, 0.0), max(abs(y) - hw, 0.0)) < o.radius
+    corners = rect_corners(at[0], at[1], math.radians(o.angle), o.length, o.width)
+    return bool(box_polygon_depth(hl, hw, ((corners - centre) @ turn)[None])[0] > 0.0)
+
+
+def check_starts(world: World, spans: list[Span]) -> None:
+    """Refuse a start where a robot's body reaches into an obstacle or into another robot's
+    body: the run would end in a collision at its first tick."""
+    import math
+
+    import numpy as np
+
+    from .geometry import box_polygon_depth
+
+    for i, (agent, span) in enumerate(zip(world.agents, spans)):
+        st, robot = agent.start, agent.robot
+        hl, hw, h = robot.length / 2, robot.width / 2, math.radians(st.heading)
+        centre = np.array([st.x, st.y])
+        where = (f"at the start (q_init){_who(agent)}, ({st.x:g}, {st.y:g}) heading "
+                 f"{st.heading:g} deg,")
+        for o in world.obstacles:
+            if _box_meets(hl, hw, centre, h, o, (o.x, o.y)):
+                raise WorldError(f"{where} the robot's body ({robot.length:g} x "
+                                 f"{robot.width:g} in) reaches into obstacle `{o.name}`",
+                                 span=span, hint="move the start or the obstacle")
+        c, s = math.cos(h), math.sin(h)
+        for other in world.agents[:i]:
+            local = (_body_corners(other) - centre) @ np.array([[c, -s], [s, c]])
+            if box_polygon_depth(hl, hw, local[None])[0] > 0.0:
+                raise WorldError(f"{where} the robot's body overlaps robot `{other.name}`'s "
+                                 "at its start", span=span,
+                                 hint="start the robots further apart")
+
+
+def check_jitters(world: World, written: YMap) -> None:
+    """Refuse a `randomise` range that can move an obstacle over a start or a goal: every run
+    drawn there would end at its first tick or never reach its goal (``written``: the
+    `randomise: obstacles:` mapping, for the positions)."""
+    import numpy as np
+
+    obstacles = {o.name: o for o in world.obstacles}
+    for j in world.randomise.obstacles:
+        o = obstacles[j.obstacle]
+        for agent in world.agents:
+            # a moving obstacle leaves the goal; over the start it is there at the first tick
+            ends = (("start (q_init)", agent.start),) + (
+                (("goal (q_goal)", agent.goal),) if o.motion.kind == "static" else ())
+            for what, p in ends:
+                # the obstacle reaches p for some offset (dx, dy) in the ranges exactly when
+                # it meets the box of the points p - (dx, dy)
+                lo = np.array([p.x - j.dx[1], p.y - j.dy[1]])
+                hi = np.array([p.x - j.dx[0], p.y - j.dy[0]])
+                hl, hw = (hi - lo) / 2
+                if _box_meets(float(hl), float(hw), (lo + hi) / 2, 0.0, o, (o.x, o.y)):
+                    raise WorldError(
+                        f"randomise can move obstacle `{o.name}` over the {what}"
+                        f"{_who(agent)} at ({p.x:g}, {p.y:g}) (dx {_range(j.dx)}, "
+                        f"dy {_range(j.dy)} in)", span=written.value_span(o.name),
+                        hint="narrow its dx and dy, or move the obstacle")
+
+
+def _range(r: tuple[float, float]) -> str:
+    return f"{r[0]:g}" if r[0] == r[1] else f"{r[0]:g} to {r[1]:g}"
+
+
 def _check_body(agent, static, span: Span) -> None:
     """Refuse a start where the robot's footprint already touches a wall: the run would end
     in a collision at its first tick."""
@@ -469,9 +567,8 @@ def _check_body(agent, static, span: Span) -> None:
     rel = walls.reshape(-1, 2) - (x, y)
     local = np.stack([rel[:, 0] * c + rel[:, 1] * s, -rel[:, 0] * s + rel[:, 1] * c], axis=1)
     if box_segment_distance(hl, hw, local.reshape(-1, 4)).min() <= 0.0:
-        who = "" if agent.name == "robot" else f" of `{agent.name}`"
         raise WorldError(
-            f"at the start (q_init){who}, ({x:g}, {y:g}) heading {agent.start.heading:g} deg, "
+            f"at the start (q_init){_who(agent)}, ({x:g}, {y:g}) heading {agent.start.heading:g} deg, "
             f"the robot's body ({robot.length:g} x {robot.width:g} in) reaches into a wall",
             span=span, hint="move the start further from the wall, or turn it along the "
                             "corridor")

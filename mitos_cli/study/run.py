@@ -15,7 +15,7 @@ from pathlib import Path
 
 from .executors import TaskFn, execute
 from .spec import Choice, Task, expand
-from .store import ResultStore, key_of, row_of, rows_for
+from .store import ResultStore, key_of, row_of
 from .summary import ALL_WORLDS, Rank, Summary, choice_of, rank, summaries
 
 
@@ -84,8 +84,7 @@ def run_study(study: Study, out_dir: str | Path, *, executor: str = "local",
     tasks = study.tasks()
     fn = task_fn or default_task_fn(study)
     with ResultStore(out_dir) as store:
-        previous = store.start(study.manifest(), resume=resume)
-        finished, todo = rows_for(tasks, previous)
+        finished, todo = store.start(study.manifest(), tasks, resume=resume)
         if on_start is not None:
             on_start(len(finished), len(tasks))
         by_index: dict[int, dict] = {}

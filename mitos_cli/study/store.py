@@ -117,11 +117,15 @@ class ResultStore:
 
     # -- writing -----------------------------------------------------------------------------
 
-    def start(self, manifest: dict, *, resume: bool) -> list[dict]:
-        """Open the directory for a study; return the rows already finished (with ``resume``).
+    def start(self, manifest: dict, tasks: list[Task], *,
+              resume: bool) -> tuple[list[dict], list[Task]]:
+        """Open the directory for a study of ``tasks``: the rows already finished (with
+        ``resume``, in task order) and the tasks still to run.
 
         Without ``resume`` an existing ``results.csv`` with rows is an error rather than being
-        overwritten; with it, the study must have the same seed as the one that wrote the rows.
+        overwritten; with it, the study must have the same seed as the one that wrote the rows
+        and give every finished run the seed it was made with (:func:`rows_for`). Everything
+        is checked before anything is written: a refused study leaves the directory as it was.
         """
         try:
             self.dir.mkdir(parents=True, exist_ok=True)
@@ -139,12 +143,13 @@ class ResultStore:
                              f"not {manifest.get('seed')}",
                              hint=f"resume with --seed {old.get('seed')}, or choose another "
                                   "directory with -o")
+        finished, todo = rows_for(tasks, rows)
         write_atomic(self.manifest_path, json.dumps(manifest, indent=2) + "\n")
         if not rows:
             write_atomic(self.path, ",".join(COLUMNS) + "\n")
         # kept open across append() calls (one fsync'd line per finished run); close() closes it
         self._file = open(self.path, "a", encoding="utf-8", newline="")  # noqa: SIM115
-        return rows
+        return finished, todo
 
     def append(self, row: dict) -> None:
         """Write one finished row and make it durable before returning."""
