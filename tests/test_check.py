@@ -346,3 +346,14 @@ def test_the_coverage_check_reads_the_rules_dofs_only(tmp_path, monkeypatch):
     monkeypatch.setattr(evaluation, "infer", inferred)
     report = check_rulebase(rb)
     assert report.grids[0].samples > 1000 and by_code(report, "no-rule-fires")
+
+
+@pytest.mark.parametrize("name", ["check_termless_input.fll", "check_formula_output.fll",
+                                  "check_formula_input.fll"])
+def test_files_eval_reads_are_checked_too(name, capsys):
+    # found in fuzzylite's examples: an input with no terms (a ValueError from the term
+    # gaps), a formula term on an output (StopIteration in the term order) or on an input
+    # (its NaN centre became a sample: "input `u` is not a number")
+    path = Path(__file__).parent / "data" / "interop" / name
+    code, out, err = run(["check", str(path)], capsys)
+    assert code == 0 and out.rstrip().endswith(" - OK") and not err

@@ -118,3 +118,42 @@ def test_a_command_from_outside_drives_the_same_run_as_the_planner():
     assert sim.routes == sim.result().routes
     with pytest.raises(RuntimeError, match="has ended"):
         sim.observe()
+
+
+class _Gives:
+    """A user's planner that commands what it is given, whatever the robots."""
+
+    name = "gives"
+
+    def __init__(self, steer, speed) -> None:
+        self.steer, self.speed = steer, speed
+
+    def plan(self, p):
+        return self.steer, self.speed
+
+
+@pytest.mark.parametrize("planner, says", [
+    (_Gives(np.full(3, 90.0), np.full(3, 10.0)),
+     "planner `gives` gave (3,) steering and (3,) speed values for 1 active robot"),
+    (_Gives(np.nan, 10.0), "the command of planner `gives` at 0 s must be finite numbers"),
+    (_Gives(90.0, np.inf), "must be finite numbers (steering deg, speed in/s), not [[90.0, inf]]"),
+])
+def test_a_planners_wrong_command_is_named_where_it_is_given(planner, says):
+    # a NaN became the robot's pose and failed a tick later, deep in the loop
+    with pytest.raises(ValueError) as exc:
+        Simulation(short("corridor.yaml", 1.0), planner).step()
+    assert says in str(exc.value)
+
+
+def test_a_wrong_command_from_outside_and_an_early_result_say_what_is_wrong():
+    sim = Simulation(short("corridor.yaml", 1.0))
+    with pytest.raises(RuntimeError, match="no tick recorded yet"):
+        sim.result()
+    with pytest.raises(ValueError, match=r"a command is \[1, 2\] .* not of shape \(3,\)"):
+        sim.step(np.zeros(3))
+    with pytest.raises(ValueError, match="the command must be finite numbers"):
+        sim.step(np.array([[np.nan, 20.0]]))
+    sim.step(np.array([[90.0, 20.0]]))                  # the run is as if none was given
+    again = Simulation(short("corridor.yaml", 1.0))
+    again.step(np.array([[90.0, 20.0]]))
+    same_run(sim.result(), again.result())

@@ -329,10 +329,9 @@ def grid_axes(compiled: CompiledRuleBase, resolution: int,
         axes = []
         for name, (lo, hi) in zip(compiled.inputs, compiled.universe):
             pts: list[np.ndarray | list[float]] = [np.linspace(lo, hi, n)]
-            for term in compiled.variables[name].terms:
-                corners = term.corners
-                pts.append([c for c in corners if lo <= c <= hi] if corners is not None
-                           else [term.center])
+            for term in compiled.variables[name].terms:      # a formula's centre is NaN
+                points = term.corners if term.corners is not None else (term.center,)
+                pts.append([c for c in points if lo <= c <= hi])
             axes.append(np.unique(np.concatenate([np.asarray(p, float) for p in pts])))
         return axes
 
@@ -483,7 +482,7 @@ def boxes_of(mask: np.ndarray, axes: list[np.ndarray], names: tuple[str, ...],
 def _term_gaps(rb: RuleBase) -> list[Finding]:
     out = []
     for var in rb.variables.values():
-        if var.role != "input":
+        if var.role != "input" or not var.terms:
             continue
         lo, hi = var.universe
         corners = [c for t in var.terms if t.corners for c in t.corners if lo <= c <= hi]

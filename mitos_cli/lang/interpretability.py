@@ -342,14 +342,15 @@ def variable_issues(var: Variable) -> list[Issue]:
 
 
 def _order(var: Variable) -> list[Issue]:
-    centres = [centre(t) for t in var.terms]
+    terms = [t for t in var.terms if np.isfinite(centre(t))]      # a formula has no centre
+    centres = [centre(t) for t in terms]
     steps = np.diff(centres)
     tol = TOLERANCE * (var.universe[1] - var.universe[0])
     if np.all(steps > tol) or np.all(steps < -tol):
         return []
     up = int(np.sum(steps > 0)) >= int(np.sum(steps < 0))
     k = next(i for i, s in enumerate(steps) if (s <= tol if up else s >= -tol))
-    t1, t2 = var.terms[k], var.terms[k + 1]
+    t1, t2 = terms[k], terms[k + 1]
     return [Issue("term-order", var.name, (t1.name, t2.name), (
         f"`{var.name}.{t2.name}` ({_num(centres[k + 1])}) is written after `{t1.name}` "
         f"({_num(centres[k])}) but does not lie {'above' if up else 'below'} it: the terms "

@@ -23,6 +23,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import WorldError
+from ..words import plural
 from . import geometry, kinematics, knowledge, perception, rows, safety, sensors
 from . import obstacles as obs_mod
 from .geometry import polygon_segments, rect_corners
@@ -522,12 +523,18 @@ class Simulation:
     def commanded(self, command: np.ndarray | None = None) -> _Sensed:
         """The start of :meth:`decide`: the tick observed, and the planner's commands (or
         ``command``) in it, before the guard."""
+        if command is not None:         # checked before the tick is observed: a refused
+            given = np.asarray(command, float)           # command leaves the run as it was
+            if given.size != 2 * self.n:
+                raise ValueError(f"a command is [{self.n}, 2] (steering deg, speed in/s for each "
+                                 f"robot), not of shape {given.shape}")
+            command = _finite(given.reshape(self.n, 2), "the command")
         s = self.observe()
         self._observed = None
         if command is None:
             self.plan(s)
         else:
-            s.command[:] = np.asarray(command, float).reshape(self.n, 2)
+            s.command[:] = command
             if not self._active.all():
                 s.command[~self._active] = np.stack([self.limits.straight, np.zeros(self.n)],
                                                     axis=1)[~self._active]
@@ -779,7 +786,18 @@ class Simulation:
                            self.angles, rows(s.pose), rows(self._v), rows(s.targets),
                            rows(self._goals), rows(self._steer), idx)
             c_steer, c_speed = self.planner.plan(sub)
-            cmd[idx, 0], cmd[idx, 1] = c_steer, c_speed
+            try:
+                cmd[idx, 0], cmd[idx, 1] = c_steer, c_speed
+            except ValueError:
+                raise ValueError(f"{self._planner_name} gave {np.shape(c_steer)} steering and "
+                                 f"{np.shape(c_speed)} speed values for "
+                                 f"{plural(len(idx), 'active robot')} (one each)") from None
+            if not np.isfinite(cmd[idx]).all():
+                _finite(cmd[idx], f"the command of {self._planner_name} at {s.t:g} s")
+
+    @property
+    def _planner_name(self) -> str:
+        return f"planner `{getattr(self.planner, 'name', type(self.planner).__name__)}`"
 
     def _guard(self, s: _Sensed) -> None:
         """The robot's own safety on every active robot's command (:mod:`.safety`): the brake,
@@ -867,31 +885,39 @@ class Simulation:
 
     def result(self) -> SimResult:
         """The recorded ticks as a :class:`SimResult` with the run's metrics."""
-        rec, dt, n = self.record, self.dt, self.n
+        rec, dt = self.record, self.dt
         T = len(rec)
+        if not T:
+            raise RuntimeError("no tick recorded yet: result() reports the ticks step() ran")
 
-        def stack(attr: str, shape: tuple[int, ...]) -> np.ndarray:
-            return (np.array([getattr(r, attr) for r in rec]) if rec
-                    else np.zeros((0, *shape)))
+        def stack(attr: str) -> np.ndarray:
+            return np.array([getattr(r, attr) for r in rec])
 
         res = SimResult(
             world=self.world, seed=self.seed,
             planner=getattr(self.planner, "name", type(self.planner).__name__),
             outcome=self.outcome, robot_outcomes=tuple(self._outcomes),
-            collisions=self._collided, t=np.arange(T) * dt, pose=stack("pose", (n, 3)),
-            speed=stack("speed", (n,)), steering=stack("steering", (n,)),
-            command=stack("command", (n, 2)), ranges=stack("ranges", (n, len(self.angles))),
-            perceived={key: (np.array([r.inputs[key] for r in rec]) if rec
-                             else np.zeros((0, n))) for key in perception.INPUTS},
-            clearance=stack("clearance", (n,)),
-            obstacles=(np.array([r.obstacles for r in rec]).reshape(T, -1, 2) if rec
-                       else np.zeros((0, len(self.world.obstacles), 2))),
-            routes=self.scene.routes, static=self.scene.static, active=stack("active", (n,)),
-            progress=stack("progress", (n,)), replanned=tuple(self._replanned),
+            collisions=self._collided, t=np.arange(T) * dt, pose=stack("pose"),
+            speed=stack("speed"), steering=stack("steering"),
+            command=stack("command"), ranges=stack("ranges"),
+            perceived={key: np.array([r.inputs[key] for r in rec]) for key in perception.INPUTS},
+            clearance=stack("clearance"),
+            obstacles=np.array([r.obstacles for r in rec]).reshape(T, -1, 2),
+            routes=self.scene.routes, static=self.scene.static, active=stack("active"),
+            progress=stack("progress"), replanned=tuple(self._replanned),
             backed_out=tuple(self._backed))
         res.robot_metrics = _robot_metrics(res, dt)
         res.metrics = _metrics(res, dt)
         return res
+
+
+def _finite(command: np.ndarray, what: str) -> np.ndarray:
+    """``command`` (steering, speed rows), refused unless every number is finite: a NaN
+    turned the robot's pose into NaN and failed a tick later, far from its cause."""
+    if not np.isfinite(command).all():
+        raise ValueError(f"{what} must be finite numbers (steering deg, speed in/s), not "
+                         f"{command.tolist()}")
+    return command
 
 
 def simulate(world: World, planner: Planner | None = None, seed: int | None = None, *,
