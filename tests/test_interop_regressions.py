@@ -486,3 +486,20 @@ def test_exported_python_computes_jfuzzylogics_dsigm(tmp_path: Path):
     rb = load_rulebase(path)
     X = np.linspace(0, 10, 41)[:, None]
     np.testing.assert_allclose(module.evaluate(X)[:, 0], rb.run(X).outputs[:, 0], atol=1e-12)
+
+
+@pytest.mark.parametrize("mf, term", [
+    ("'rampmf',[2 8]", "Ramp 2 8"), ("'cosinemf',[5 6]", "Cosine 5 6"),
+    ("'discretemf',[0 0 5 1 10 0]", "Discrete 0 0 5 1 10 0"), ("'spikemf',[5 4]", "Spike 5 4"),
+    ("'concavemf',[4 6]", "Concave 4 6"), ("'rectmf',[2 8]", "Rectangle 2 8"),
+    ("'binarymf',[5 1]", "Binary 5 1"),
+])
+def test_fis_reads_the_mf_types_fuzzylite_writes_as_its_terms(mf, term):
+    # fuzzylite's exporter writes its own terms as these types (its examples' AllTerms.fis,
+    # Laundry.fis), with the parameters in the order of its .fll; they were refused
+    fis = parse_fis(FIS.replace("MF1='low':'gbellmf',[3 2 0 0]", f"MF1='low':{mf}"), "s.fis")
+    fll = parse_fll(FLL_HEDGE_PREFIX.replace("term: veryhigh Triangle 0 10 10",
+                                             f"term: veryhigh {term}").replace(
+        "  rule: if x is notable then y is low\n", ""), "e.fll")
+    got, want = fis.variables["x"].terms[0], fll.variables["x"].terms[0]
+    assert (got.shape, got.params) == (want.shape, want.params)

@@ -9,7 +9,8 @@ Index 0 means "not in this rule"; a negative input index means NOT (``1 - mu``).
 not a language, so it is read line by line; every line keeps its number for errors.
 
 Mapping: ``trimf trapmf gaussmf gauss2mf gbellmf sigmf dsigmf psigmf pimf smf zmf linsmf linzmf
-constant linear``; ``and``: min, prod; ``or``: max, probor; ``imp``: min, prod; ``agg``: max,
+constant linear``, and the types fuzzylite's exporter adds (``rampmf cosinemf discretemf spikemf
+concavemf rectmf binarymf``, read as its terms); ``and``: min, prod; ``or``: max, probor; ``imp``: min, prod; ``agg``: max,
 probor (``sum`` is refused); defuzzifiers centroid, bisector, mom, som, lom (Mamdani) and
 wtaver, wtsum (Sugeno). When no rule fires MATLAB returns the middle of the output range (with
 a warning); the reader makes that the output's ``default``. Custom MF functions, negative output
@@ -55,6 +56,11 @@ MF_TYPES = {
     "linzmf": ("ramp", 2, (1, 0)),
     "constant": ("singleton", 1, (0,)),
 }
+#: fuzzylite's own MF types in the ``.fis`` files it writes (its ``FisExporter``): its terms,
+#: with the parameters in the order of its ``.fll`` (``FisImporter``)
+FUZZYLITE_MF_TYPES = {"binarymf": "Binary", "concavemf": "Concave", "cosinemf": "Cosine",
+                      "discretemf": "Discrete", "rampmf": "Ramp", "rectmf": "Rectangle",
+                      "spikemf": "Spike"}
 SYSTEM_KEYS = ("Name", "Type", "Version", "NumInputs", "NumOutputs", "NumRules", "AndMethod",
                "OrMethod", "ImpMethod", "AggMethod", "DefuzzMethod",
                "DisableStructuralChecks")     # MATLAB R2018b+; only affects MATLAB's editor
@@ -278,10 +284,13 @@ def _mf(value: str, vspan: Span, role: str, kind: str, n_inputs: int) -> Term:
             raise FormatError(f"MF `{name}`: linear takes {plural(n_inputs + 1, 'number')} (one "
                               f"per input and a constant), not {len(params)}", span=vspan)
         return common.make_term(name, "linear", tuple(params), vspan)
+    if mf in FUZZYLITE_MF_TYPES:
+        return common.fuzzylite_term(name, FUZZYLITE_MF_TYPES[mf], params, n_inputs, vspan)
     if mf not in MF_TYPES:
+        known = [*MF_TYPES, "linear", *FUZZYLITE_MF_TYPES]
         raise FormatError(f"MF `{name}`: membership function type `{mf}` is not supported",
-                          span=vspan, expected="one of " + ", ".join(list(MF_TYPES) + ["linear"]),
-                          hint=did_you_mean(mf, MF_TYPES))
+                          span=vspan, expected="one of " + ", ".join(known),
+                          hint=did_you_mean(mf, known))
     shape, count, order = MF_TYPES[mf]
     if len(params) > count and not any(params[count:]):
         params = params[:count]        # old MATLAB files pad every list with zeros to one length
