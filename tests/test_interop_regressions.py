@@ -503,3 +503,37 @@ def test_fis_reads_the_mf_types_fuzzylite_writes_as_its_terms(mf, term):
         "  rule: if x is notable then y is low\n", ""), "e.fll")
     got, want = fis.variables["x"].terms[0], fll.variables["x"].terms[0]
     assert (got.shape, got.params) == (want.shape, want.params)
+
+
+@pytest.mark.parametrize("index, hedges, negated, mu", [
+    ("2.2", ("very",), False, lambda t: t ** 2), ("-2.3", ("extremely",), True,
+                                                  lambda t: 1 - t ** 3),
+    ("2.05", ("somewhat",), False, math.sqrt), ("2.4", ("very", "very"), False,
+                                                 lambda t: t ** 4),
+])
+def test_fis_reads_octaves_hedges_in_an_antecedent(index, hedges, negated, mu):
+    # Octave's fuzzy-logic-toolkit: the fraction is the power round(100 f) / 10, then `not`
+    # (get_mf_index_and_hedge.m); its investment_portfolio.fis was refused
+    text = FIS.replace("NumRules=2", "NumRules=1").replace(
+        "MF1='low':'gbellmf',[3 2 0 0]", "MF1='lo':'trimf',[0 0 10]").replace(
+        "AndMethod='einstein_product'", "AndMethod='min'")
+    rules = text[text.index("[Rules]"):]
+    rb = parse_fis(text.replace(rules, f"[Rules]\n{index}, 1 (1) : 1\n"), "s.fis")
+    prop = rb.behaviors[0].rules[0].antecedent
+    assert (prop.term, prop.hedges, prop.negated) == ("low", hedges, negated)
+    from mitos_cli.engine.compile import compile_rulebase
+    from mitos_cli.engine.evaluation import as_batch, evaluate
+
+    c = compile_rulebase(rb)
+    dof = evaluate(c, as_batch(c, {"x": 7.5}), strict=False).dof[0, 0]
+    assert dof == pytest.approx(mu(0.75), abs=1e-15)
+
+
+def test_fis_refuses_a_hedge_octave_does_not_name_and_a_hedged_consequent():
+    text = FIS.replace("AndMethod='einstein_product'", "AndMethod='min'").replace(
+        "NumRules=2", "NumRules=1")
+    rules = text[text.index("[Rules]"):]
+    with pytest.raises(MitosError, match=r"Octave's hedge x\^1.5 \(the fraction .15\)"):
+        parse_fis(text.replace(rules, "[Rules]\n2.15, 1 (1) : 1\n"), "s.fis")
+    with pytest.raises(MitosError, match="fractional .hedged. consequents"):
+        parse_fis(text.replace(rules, "[Rules]\n2, 1.2 (1) : 1\n"), "s.fis")

@@ -10,11 +10,13 @@ not a language, so it is read line by line; every line keeps its number for erro
 
 Mapping: ``trimf trapmf gaussmf gauss2mf gbellmf sigmf dsigmf psigmf pimf smf zmf linsmf linzmf
 constant linear``, and the types fuzzylite's exporter adds (``rampmf cosinemf discretemf spikemf
-concavemf rectmf binarymf``, read as its terms); ``and``: min, prod; ``or``: max, probor; ``imp``: min, prod; ``agg``: max,
-probor (``sum`` is refused); defuzzifiers centroid, bisector, mom, som, lom (Mamdani) and
-wtaver, wtsum (Sugeno). When no rule fires MATLAB returns the middle of the output range (with
-a warning); the reader makes that the output's ``default``. Custom MF functions, negative output
-indices (complemented consequents) and fractional indices are refused.
+concavemf rectmf binarymf``, read as its terms); ``and``: min, prod; ``or``: max, probor;
+``imp``: min, prod; ``agg``: max, probor (``sum`` is refused); defuzzifiers centroid, bisector,
+mom, som, lom (Mamdani) and wtaver, wtsum (Sugeno). When no rule fires MATLAB returns the middle of the output range (with
+a warning); the reader makes that the output's ``default``. An antecedent's fractional MF index
+is Octave's hedge (``-2.3``: not extremely MF 2; ``.05 .2 .3 .4``: somewhat, very, extremely,
+very very). Custom MF functions, other fractions, and negative or fractional output indices
+(complemented or hedged consequents) are refused.
 
 Resolution: MATLAB's ``evalfis`` samples a Mamdani output at 101 evenly spaced points from the
 range's minimum to its maximum; the reader sets ``resolution = 101, sampling = endpoints``, which
@@ -300,6 +302,26 @@ def _mf(value: str, vspan: Span, role: str, kind: str, n_inputs: int) -> Term:
     return common.make_term(name, shape, tuple(params[i] for i in order), vspan)
 
 
+#: Octave's fuzzy-logic-toolkit: the fraction of an antecedent's MF index is a hedge, the
+#: power ``round(100 * fraction) / 10`` applied before ``not`` (get_mf_index_and_hedge.m,
+#: evalmf_private.m); the four it names, as MITOS's hedges
+OCTAVE_HEDGES = {0.5: ("somewhat",), 2.0: ("very",), 3.0: ("extremely",),
+                 4.0: ("very", "very")}
+
+
+def _hedges(idx: float, k: int, span: Span) -> tuple[str, ...]:
+    """The hedges Octave reads in the antecedent's MF index ``idx`` (``k`` its MF number)."""
+    power = round(100 * (abs(idx) - k)) / 10
+    if power == 0:
+        return ()
+    if power not in OCTAVE_HEDGES:
+        raise FormatError(f"MF index {fmt_number(idx)}: Octave's hedge x^{power:g} (the "
+                          f"fraction .{round(100 * (abs(idx) - k)):02d}) has no MITOS hedge",
+                          span=span, expected=".05 (somewhat), .2 (very), .3 (extremely) or .4 "
+                                              "(very very)")
+    return OCTAVE_HEDGES[power]
+
+
 def _rule(line: str, lineno: int, span: Span, inputs: list[Variable], outputs: list[Variable],
           text: str, path: str | None, index: int) -> Rule:
     m = re.fullmatch(r"([-\d.\s]+),([-\d.\s]+)\(\s*([-+\d.eE]+)\s*\)\s*:\s*(\d+)", line)
@@ -320,20 +342,21 @@ def _rule(line: str, lineno: int, span: Span, inputs: list[Variable], outputs: l
             raise FormatError(f"MF index {fmt_number(idx)} is not an MF number", span=span)
     props = []
     for v, idx in zip(inputs, ins):
-        if idx != int(idx):
-            raise FormatError(f"MF index {idx:g}: fractional indices (hedges) are not supported",
-                              span=span)
-        if idx == 0:
+        k = int(abs(idx))
+        if k == 0:                      # Octave ignores a fraction after 0 too
             continue
-        k = abs(int(idx))
         if k > len(v.terms):
             raise FormatError(f"`{v.name}` has {len(v.terms)} MFs, not {k}", span=span)
-        props.append(Prop(v.name, v.terms[k - 1].name, (), idx < 0, span))
+        props.append(Prop(v.name, v.terms[k - 1].name, _hedges(idx, k, span), idx < 0, span))
     cons = []
     for v, idx in zip(outputs, outs):
         if idx != int(idx) or idx < 0:
             raise FormatError(f"output MF index {idx:g}: negative (complemented) or fractional "
-                              f"consequents are not supported", span=span)
+                              f"(hedged) consequents are not supported", span=span,
+                              hint="Octave's toolkit reads a hedge there as a power of the "
+                                   "rule's strength (1 / power for a Sugeno output), which "
+                                   "MITOS's rules do not express: write the consequent's "
+                                   "whole MF number")
         if idx == 0:
             continue
         if idx > len(v.terms):
