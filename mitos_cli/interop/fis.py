@@ -12,11 +12,11 @@ Mapping: ``trimf trapmf gaussmf gauss2mf gbellmf sigmf dsigmf psigmf pimf smf zm
 constant linear``, and the types fuzzylite's exporter adds (``rampmf cosinemf discretemf spikemf
 concavemf rectmf binarymf``, read as its terms); ``and``: min, prod; ``or``: max, probor;
 ``imp``: min, prod; ``agg``: max, probor (``sum`` is refused); defuzzifiers centroid, bisector,
-mom, som, lom (Mamdani) and wtaver, wtsum (Sugeno). When no rule fires MATLAB returns the middle of the output range (with
-a warning); the reader makes that the output's ``default``. An antecedent's fractional MF index
-is Octave's hedge (``-2.3``: not extremely MF 2; ``.05 .2 .3 .4``: somewhat, very, extremely,
-very very). Custom MF functions, other fractions, and negative or fractional output indices
-(complemented or hedged consequents) are refused.
+mom, som, lom (Mamdani) and wtaver, wtsum (Sugeno). When no rule fires MATLAB returns the middle
+of the output range (with a warning); the reader makes that the output's ``default``. An
+antecedent's fractional MF index is Octave's hedge (``-2.3``: not extremely MF 2; ``.05 .2 .3
+.4``: somewhat, very, extremely, very very). Custom MF functions, other fractions, and negative
+or fractional output indices (complemented or hedged consequents) are refused.
 
 Resolution: MATLAB's ``evalfis`` samples a Mamdani output at 101 evenly spaced points from the
 range's minimum to its maximum; the reader sets ``resolution = 101, sampling = endpoints``, which
