@@ -65,6 +65,14 @@ def is_file(path: Path) -> bool:
         return False
 
 
+def is_dir(path: Path) -> bool:
+    """``path.is_dir()``, False for a name the system cannot look up (as :func:`is_file`)."""
+    try:
+        return path.is_dir()
+    except OSError:
+        return False
+
+
 def exists(path: Path) -> bool:
     """``path.exists()``, False for a name the system cannot look up (as :func:`is_file`)."""
     try:

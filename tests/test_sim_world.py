@@ -330,3 +330,18 @@ def test_an_empty_number_says_so():
 def test_a_name_with_a_control_character_is_refused():
     msg = error(BASE.replace("name: t", 'name: "t\\e[31m"'))
     assert "w.yaml:1:7" in msg and "control character" in msg
+
+
+def test_a_misspelt_world_path_points_at_the_file_beside_it(tmp_path, monkeypatch):
+    (tmp_path / "w").mkdir()
+    (tmp_path / "w" / "tiny.yaml").write_text(BASE)
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(WorldError) as exc:
+        resolve_world_path("w/tiyn.yaml")
+    assert exc.value.hint == "did you mean `w/tiny.yaml`?"      # was a packaged world's name
+    with pytest.raises(WorldError) as exc:
+        resolve_world_path("w")
+    assert exc.value.message == "`w` is a directory, not a world file"
+    with pytest.raises(WorldError) as exc:
+        resolve_world_path("slalm")                            # a name: the packaged worlds
+    assert exc.value.hint == "did you mean `slalom`?"

@@ -606,12 +606,20 @@ def resolve_world_path(name: str | Path, base: Path | None = None) -> Path:
     """The one way a world is found: a file as given (relative to ``base`` first, when a
     lesson names it), else the packaged world of that name (``figure4`` or ``figure4.yaml``);
     an unknown name gets the packaged names and a "did you mean"."""
-    from ..resources import packaged_names, resolve
+    from ..fileio import nearby
+    from ..resources import is_dir, packaged_names, resolve
 
     found = resolve("worlds", name, ".yaml", base)
     if found is not None:
         return found
+    where = Path(name) if base is None else base / name
+    if is_dir(where):
+        raise UnknownWorld(f"`{name}` is a directory, not a world file",
+                           hint="name one of the world files (.yaml) in it")
     names = list(packaged_names("worlds", ".yaml"))
     if not str(name).endswith(".yaml"):
         names = [n[:-len(".yaml")] for n in names]
-    raise unknown("world file", str(name), names, cls=UnknownWorld)
+    error = unknown("world file", str(name), names, cls=UnknownWorld)
+    if where.suffix or len(where.parts) > 1:      # a path: a file beside it first
+        error.hint = nearby(where, (".yaml", ".yml")) or error.hint
+    raise error
