@@ -240,11 +240,13 @@ class MitosEnv(gymnasium.Env):
 
     def _state(self) -> dict:
         sim = self.sim
-        last = sim.record[-1] if sim.record else None
+        if sim.done:                                        # the last tick it drove
+            inputs, obstacles = sim.record[-1].inputs, sim.record[-1].obstacles
+        else:                                               # the tick it stands in
+            s = sim.observe()
+            inputs, obstacles = s.inputs, s.where
         return {"t": sim.time, "pose": sim.pose, "speed": sim.speed, "steering": sim.steering,
-                "inputs": last.inputs if last else {k: np.zeros(1) for k in self.input_names},
-                "clearance": sim.clearance,
-                "obstacles": last.obstacles if last else np.zeros((0, 2))}
+                "inputs": inputs, "clearance": sim.clearance, "obstacles": obstacles}
 
     def _info(self) -> dict:
         sim = self.sim

@@ -145,3 +145,13 @@ def test_rgb_array_shows_the_robot(short_world):
     blue = np.array([0x1F, 0x5F, 0xBF])
     assert (np.abs(frame.astype(int) - blue).sum(axis=2) < 6).sum() > 20
     env.close()
+
+
+def test_reset_reports_where_the_robot_stands(short_world):
+    # reset's info said clearance inf (and its picture every input 0): no tick was recorded
+    env = gymnasium.make("mitos/World-v0", world=str(short_world))
+    _, info = env.reset(seed=4)
+    ref = simulate(load_world(short_world), seed=4)
+    assert info["clearance"] == ref.clearance[0, 0]
+    state = env.unwrapped._state()
+    assert all(state["inputs"][k][0] == ref.perceived[k][0, 0] for k in ref.perceived)

@@ -433,7 +433,10 @@ class Simulation:
 
     @property
     def clearance(self) -> np.ndarray:
-        """``[n]`` each robot's clearance at the last tick (in)."""
+        """``[n]`` each robot's clearance (in) where it stands: of the tick observed, else of
+        the last tick recorded (``inf`` before the first is observed)."""
+        if self._observed is not None:
+            return self._observed.clearance
         return self.record[-1].clearance if self.record else np.full(self.n, math.inf)
 
     @property
