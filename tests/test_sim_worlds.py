@@ -4,6 +4,7 @@ figure4 fails at obstacle B by the corner, as the paper's untaught robot does.""
 
 from __future__ import annotations
 
+import dataclasses
 from pathlib import Path
 
 import numpy as np
@@ -97,3 +98,11 @@ def test_contact_between_robots_reads_minus_the_penetration_depth():
     res = simulate(parse_world(text, "wall.yaml"), _Straight(steering=60.0))
     hit = res.robot_outcomes.index("collision")
     assert res.clearance[-1, hit] < 0 and res.clearance[:-1, hit].min() > 0
+
+
+def test_two_worlds_of_one_name_are_told_apart_by_their_files():
+    short = dataclasses.replace(world("corridor.yaml"), time_limit=0.5)
+    copy = dataclasses.replace(short, path="elsewhere/corridor.yaml")
+    runs = run_many([short, copy], runs=0, workers=1)
+    assert [w.world for w in runs.worlds] == [f"corridor ({short.path})",
+                                              "corridor (elsewhere/corridor.yaml)"]

@@ -123,7 +123,7 @@ def test_existing_results_need_resume(tiny, tmp_path, compare):
 
 
 @pytest.mark.parametrize("args, code, words", [
-    (["worlds/corridr.yaml"], 1, "did you mean `corridor.yaml`"),
+    (["worlds/corridr.yaml"], 1, "did you mean `worlds/corridor.yaml`"),
     (["TINY", "--and", "einstien"], 1, "unknown T-norm `einstien`"),
     (["TINY", "--planner", "potential"], 1, "did you mean `potential_field`"),
     (["TINY", "--scheduler", "tcp://x:1"], 2, "--scheduler needs --executor dask"),

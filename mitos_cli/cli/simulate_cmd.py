@@ -16,22 +16,6 @@ from .progress import INTERRUPTED, progress_bar
 REQUIRE = ("success",)
 
 
-def _near_misses(res) -> list[bool]:
-    """Per robot: it came closer than its ``safety_margin`` and did not collide."""
-    return [r["min_clearance_in"] < a.robot.safety_margin and o != "collision"
-            for a, r, o in zip(res.world.agents, res.robot_metrics, res.robot_outcomes)]
-
-
-def _json_summary(res) -> dict:
-    """``res.summary()`` with ``near_miss`` (overall: any robot's) beside the outcome."""
-    data = res.summary()
-    near = _near_misses(res)
-    data["near_miss"] = any(near) and res.outcome != "collision"
-    for robot, flag in zip(data.get("robots", ()), near):
-        robot["near_miss"] = flag
-    return data
-
-
 def _verdict(res) -> str:
     m = res.metrics
     agents = res.world.agents
@@ -295,7 +279,7 @@ def simulate_command(
 
         frames = animate_run(res, animate, fps=fps, detail=explain(res, planner))
     if as_json:
-        emit(json_text(_json_summary(res)))
+        emit(json_text(res.summary()))
     else:
         emit(_verdict(res))
         emit(_summary(res))

@@ -180,9 +180,16 @@ class SimResult:
         out = {"world": self.world.name, "seed": self.seed, "outcome": self.outcome,
                "reached_goal": all(o == "success" for o in self.robot_outcomes),
                **self.metrics}
+        near = self.near_misses()
         if len(self.robot_metrics) > 1:
-            out["robots"] = [dict(m) for m in self.robot_metrics]
+            out["robots"] = [{**m, "near_miss": flag} for m, flag in zip(self.robot_metrics, near)]
+        out["near_miss"] = any(near) and self.outcome != "collision"
         return out
+
+    def near_misses(self) -> list[bool]:
+        """Per robot: it came closer than its ``safety_margin`` and did not collide."""
+        return [m["min_clearance_in"] < a.robot.safety_margin and o != "collision"
+                for a, m, o in zip(self.world.agents, self.robot_metrics, self.robot_outcomes)]
 
 
 def _stop_ticks(res: SimResult) -> np.ndarray:

@@ -9,6 +9,7 @@ not depend on the number of workers or on which worker ran what.
 from __future__ import annotations
 
 import math
+from collections import Counter
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -197,5 +198,13 @@ def _group(worlds: list[World], tasks: list[tuple], results: list[list[dict] | N
     for (w, _, _), res in zip(tasks, results):
         if res is not None:
             grouped[id(w)].extend(res)
-    return Runs(tuple(WorldRuns(w.name, tuple(grouped[id(w)])) for w in worlds
-                      if grouped[id(w)]))
+    return Runs(tuple(WorldRuns(label, tuple(grouped[id(w)]))
+                      for w, label in zip(worlds, _labels(worlds)) if grouped[id(w)]))
+
+
+def _labels(worlds: list[World]) -> list[str]:
+    """Each world's name, with its file's where two worlds share a name (two copies of one
+    world gave two rows nobody could tell apart)."""
+    names = Counter(w.name for w in worlds)
+    return [w.name if names[w.name] == 1 or not w.path else f"{w.name} ({w.path})"
+            for w in worlds]
