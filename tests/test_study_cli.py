@@ -127,9 +127,10 @@ def test_existing_results_need_resume(tiny, tmp_path, compare):
     (["TINY", "--and", "einstien"], 1, "unknown T-norm `einstien`"),
     (["TINY", "--planner", "potential"], 1, "did you mean `potential_field`"),
     (["TINY", "--scheduler", "tcp://x:1"], 2, "--scheduler needs --executor dask"),
-    (["TINY", "--executor", "spark"], 2, "not an executor"),
+    (["TINY", "--executor", "dsk"], 1, "did you mean `dask`"),
     (["TINY", "--behavior", "drve"], 1, "drive"),
     (["TINY", "TINY"], 2, "given twice"),
+    (["TINY", "--planner", "dwa", "--and", "product"], 2, "--and chooses the fuzzy planner's"),
 ])
 def test_user_errors(tiny, tmp_path, compare, args, code, words):
     r = compare(*[tiny if a == "TINY" else a for a in args], "-o", tmp_path / "e")

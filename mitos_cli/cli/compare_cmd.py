@@ -8,11 +8,14 @@ from typing import Annotated, Optional
 
 import typer
 
+from ..errors import unknown
 from ..words import plural
 from . import complete
 from .output import emit, err, json_text, warn
 from .params import named
 from .progress import INTERRUPTED, progress_bar
+
+DEFAULT_AND = "min,product,lukasiewicz,einstein"
 
 
 def compare_command(
@@ -21,7 +24,7 @@ def compare_command(
         help="World files (or names of packaged worlds such as corridor.yaml).")],
     and_: Annotated[str, typer.Option(
         "--and", metavar="TNORMS", callback=named,
-        help="T-norms of the fuzzy planner, comma-separated.")] = "min,product,lukasiewicz,einstein",
+        help="T-norms of the fuzzy planner, comma-separated.")] = DEFAULT_AND,
     or_: Annotated[Optional[str], typer.Option(
         "--or", metavar="SNORMS", callback=named,
         help="S-norms, comma-separated (crossed with --and); `dual` pairs each T-norm with "
@@ -79,14 +82,21 @@ def compare_command(
     from ..study.executors import EXECUTORS
     from ..study.spec import split_list
 
-    if executor not in EXECUTORS:
-        raise typer.BadParameter(f"`{executor}` is not an executor; use local or dask",
-                                 param_hint="--executor")
+    if executor not in EXECUTORS:              # a name MITOS does not know: exit 1
+        raise unknown("executor", executor, EXECUTORS)
     if scheduler and executor != "dask":
         raise typer.BadParameter("--scheduler needs --executor dask", param_hint="--scheduler")
     planners = split_list(planner)
     if not planners:
         raise typer.BadParameter("name at least one planner", param_hint="--planner")
+    fuzzy_only = [flag for flag, given in (("--and", and_ != DEFAULT_AND), ("--or", or_),
+                                           ("--inference", inference), ("--rulebase", rulebase),
+                                           ("--behavior", behavior)) if given]
+    if "fuzzy" not in planners and fuzzy_only:     # they were dropped without a word
+        verb = "chooses" if len(fuzzy_only) == 1 else "choose"
+        raise typer.BadParameter(f"{', '.join(fuzzy_only)} {verb} the fuzzy planner's "
+                                 f"operators and rules; --planner {planner} has no fuzzy planner",
+                                 param_hint="--planner")
     choices = make_choices(planners, split_list(and_), split_list(or_), split_list(inference))
     paths = check_inputs(worlds, choices, rulebase, behavior)
     words = ["mitos", "compare", *worlds, "--and", and_, "--planner", planner]

@@ -208,8 +208,15 @@ def simulate_command(
 
         check_format(plot)
     if animate is not None:
+        from ..draw.animation import FORMATS as MOVIES
         from ..draw.animation import check_format as check_animation
 
+        suffix = animate.suffix.lower().lstrip(".")
+        if suffix not in MOVIES:             # as --plot's: a usage error, before the run
+            raise typer.BadParameter(
+                f"`{animate}` has {'extension .' + suffix if suffix else 'no extension'}; the "
+                f"animation formats are " + " and ".join(f".{f}" for f in MOVIES),
+                param_hint="--animate")
         check_animation(animate)
     planner = make_planner(planner_name, loaded[0], rulebase, behavior)
 
