@@ -215,3 +215,15 @@ def test_a_nan_option_is_a_usage_error(short, option):
 def test_an_empty_behavior_is_a_usage_error(short):
     res = run(short, "-b", "")
     assert res.exit_code == 2 and "must name something" in res.output
+
+
+def test_an_output_is_never_an_input_nor_another_output(short, capsys):
+    before = short.read_bytes()
+    code, err = run_main(capsys, short, "--out", short)       # replaced the world with a CSV
+    said = " ".join(err.replace("│", " ").split())
+    assert code == 2 and "is a file this command reads" in said
+    assert short.read_bytes() == before
+    same = short.parent / "same.png"
+    code, err = run_main(capsys, short, "--out", same, "--plot", same)
+    said = " ".join(err.replace("│", " ").split())
+    assert code == 2 and "is named by --out too" in said and not same.exists()

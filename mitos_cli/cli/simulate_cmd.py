@@ -16,6 +16,24 @@ from .progress import INTERRUPTED, progress_bar
 REQUIRE = ("success",)
 
 
+def _check_outputs(written, read: list[Path]) -> None:
+    """Refuse an output file that is a file the command reads or another output's: it was
+    overwritten without a word (``--out world.yaml`` replaced the world with the CSV)."""
+    inputs = {p.resolve() for p in read}
+    seen: dict[Path, str] = {}
+    for option, path in written:
+        if path is None:
+            continue
+        key = Path(path).resolve()
+        if key in inputs:
+            raise typer.BadParameter(f"`{path}` is a file this command reads; write to another "
+                                     "file", param_hint=option)
+        if key in seen:
+            raise typer.BadParameter(f"`{path}` is named by {seen[key]} too; give each output "
+                                     "its own file", param_hint=option)
+        seen[key] = option
+
+
 def _verdict(res) -> str:
     m = res.metrics
     agents = res.world.agents
@@ -196,6 +214,8 @@ def simulate_command(
     live = live or speed is not None
     names = worlds or [DEFAULT_WORLD]
     loaded = [load_world(resolve_world_path(n)) for n in names]
+    _check_outputs((("--out", out), ("--plot", plot), ("--animate", animate)),
+                   [Path(w.path) for w in loaded if w.path] + ([Path(rulebase)] if rulebase else []))
     many = len(loaded) > 1 or runs > 0
     if many and (out or trace or live or randomise or animate):
         raise typer.BadParameter("--out, --animate, --trace, --live, --speed and --randomise "
