@@ -537,3 +537,20 @@ def test_fis_refuses_a_hedge_octave_does_not_name_and_a_hedged_consequent():
         parse_fis(text.replace(rules, "[Rules]\n2.15, 1 (1) : 1\n"), "s.fis")
     with pytest.raises(MitosError, match="fractional .hedged. consequents"):
         parse_fis(text.replace(rules, "[Rules]\n2, 1.2 (1) : 1\n"), "s.fis")
+
+
+def test_fis_notes_where_a_sugeno_aggmethod_changes_other_engines_outputs():
+    # Octave's linear_tip_calculator.fis (AggMethod='max', two rules concluding one term):
+    # Octave and fuzzylite take the max first, MATLAB and MITOS average every rule; it was
+    # read without a word
+    sugeno = FIS.replace("Type='mamdani'", "Type='sugeno'").replace(
+        "DefuzzMethod='centroid'", "DefuzzMethod='wtaver'").replace(
+        "AndMethod='einstein_product'", "AndMethod='min'").replace(
+        "MF1='a':'trimf',[0 0 10]", "MF1='a':'constant',[2]").replace(
+        "MF2='b':'trimf',[0 10 10]", "MF2='b':'constant',[8]")
+    rules = sugeno[sugeno.index("[Rules]"):]
+    shared = sugeno.replace(rules, "[Rules]\n1, 1 (1) : 1\n2, 1 (1) : 1\n")
+    assert any("AggMethod='max' in a Sugeno system" in n and "(y.a)" in n
+               for n in parse_fis(shared, "s.fis").notes)
+    assert not any("AggMethod" in n for n in parse_fis(
+        sugeno.replace(rules, "[Rules]\n1, 1 (1) : 1\n2, 2 (1) : 1\n"), "s.fis").notes)

@@ -29,6 +29,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import re
+from collections import Counter
 from pathlib import Path
 
 from ..errors import FormatError, Span, did_you_mean
@@ -191,9 +192,29 @@ def parse_fis(text: str, path: str | None = None) -> RuleBase:
                               f"{'AND' if connective is And else 'OR'}", span=used.span,
                               hint=f"give {key} a method, e.g. "
                                    f"'{'min' if connective is And else 'max'}'")
+    if sugeno:
+        _sugeno_aggregation(system, rules, notes)
     rb = common.assemble(path, variables, rules, settings, DEFAULT_RESOLUTION, sys_span, notes,
                          ranges)
     return dataclasses.replace(rb, notes=tuple(notes))
+
+
+def _sugeno_aggregation(system: dict, rules: list[Rule], notes: list[str]) -> None:
+    """A note where a Sugeno file's ``AggMethod`` changes its outputs in other engines: MATLAB
+    (and MITOS) average every rule, Octave's toolkit and fuzzylite first take ``AggMethod``
+    over the rules concluding one output term (docs/conformance.md, part 3)."""
+    if "AggMethod" not in system:
+        return
+    value, vspan = system["AggMethod"]
+    agg = _string(value, vspan)
+    concluded = Counter((c.var, c.term) for r in rules for c in r.consequents)
+    shared = [f"{v}.{t}" for (v, t), n in concluded.items() if n > 1]
+    if agg in ("", "sum") or not shared:
+        return
+    notes.append(f"{vspan}: AggMethod='{agg}' in a Sugeno system: MITOS averages every rule's "
+                 f"output as MATLAB does; Octave's toolkit and fuzzylite take the {agg} over "
+                 f"the rules concluding one term first, so they differ where several do "
+                 f"({', '.join(shared[:3])}{', ...' if len(shared) > 3 else ''})")
 
 
 
