@@ -201,8 +201,9 @@ def test_a_corridor_the_robot_fits_is_a_squeeze_the_world_may_allow():
     from mitos_cli.sim.loop import prepare
     from mitos_cli.sim.route import NarrowPassage
 
-    with pytest.raises(NarrowPassage, match=r"min_clearance: 9.9\}"):
+    with pytest.raises(NarrowPassage, match=r"min_clearance: 9.9\}") as exc:
         prepare(parse_world(_pinched(20), "w.yaml"))
+    assert "its body then keeps as little as 1.0 in from the walls" in exc.value.hint
     scene = prepare(parse_world(_pinched(20, "route: {min_clearance: 9.9}\n"), "w.yaml"))
     assert scene.routes[0].length == pytest.approx(270.0)
 

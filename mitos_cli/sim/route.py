@@ -345,7 +345,9 @@ def narrow_passage(x: float, y: float, gap: float, need: float, kind: str, wide:
         f"the only way to the goal passes ({x:.0f}, {y:.0f}), where the robot's centre keeps "
         f"{gap:.1f} in from the walls (a {kind} {wide} in wide); it needs {need:.1f} in",
         hint=(f"widen the {kind}, or allow the squeeze with `route: {{min_clearance: "
-              f"{squeeze:g}}}`" if squeeze > half_width else
+              f"{squeeze:g}}}` (its body then keeps as little as {gap - half_width:.1f} in from the walls, "
+              f"closer than the brake can promise: worlds/README.md)"
+              if squeeze > half_width else
               f"the robot is {2 * half_width:g} in wide: widen the {kind} to at least "
               f"{2 * need:g} in"))
 
