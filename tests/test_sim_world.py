@@ -346,3 +346,17 @@ def test_a_misspelt_world_path_points_at_the_file_beside_it(tmp_path, monkeypatc
     with pytest.raises(WorldError) as exc:
         resolve_world_path("slalm")                            # a name: the packaged worlds
     assert exc.value.hint == "did you mean `slalom`?"
+
+
+@pytest.mark.parametrize("old, new, says", [
+    ("q_goal: {x: 300, y: 0}\n", "q_goal: {x: 300, y: 0}\nbehavior:\n",
+     "behavior must be the name of a behavior"),                       # was "`None`"
+    ("  footprint: {length: 24, width: 18}\n", "  footprint: {length: 24, width: 18}\n"
+     "  brake: maybe\n", "`brake` in robot must be true or false, not `maybe`"),
+    ("map:\n", "map:\n  given: whatever\n",
+     "`given` in map must be `none` or a map_server YAML file, not `whatever`"),
+    ("width: 70\n", "width: 70\nrandomise: {sensor_noise: 1}\n",
+     "sensor_noise must be a range [low, high]"),                      # was "a point [x, y]"
+])
+def test_wrong_values_are_said_in_words(old, new, says):
+    assert says in error(BASE.replace(old, new))

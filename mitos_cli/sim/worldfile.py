@@ -13,7 +13,7 @@ from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from ..errors import NameError_, Span, WorldError, unknown
+from ..errors import NameError_, Span, WorldError, did_you_mean, unknown
 from ..lang import yamlpos
 from ..lang.yamlpos import YList, YMap
 from .world import (
@@ -96,9 +96,10 @@ class _Reader:
                              span=span)
         return x
 
-    def point(self, value: Any, span: Span, what: str) -> tuple[float, float]:
+    def point(self, value: Any, span: Span, what: str,
+              shape: str = "a point [x, y] (inches)") -> tuple[float, float]:
         if not isinstance(value, list) or len(value) != 2:
-            raise WorldError(f"{what} must be a point [x, y] (inches)", span=span)
+            raise WorldError(f"{what} must be {shape}", span=span)
         x, y = (_sane(yamlpos.expect_number(v, span, WorldError, what), span, what)
                 for v in value)
         return x, y
@@ -118,6 +119,8 @@ class _Reader:
             return default
         value = str(m[key])
         if value not in options:
+            if value == "None" and m[key] is None:    # `given:` left empty: not `None`
+                value = ""
             err = unknown(key, value, options)          # "unknown shape `circel`" ...
             raise WorldError(f"{err.message} in {what}", span=m.value_span(key),
                              expected=err.expected, hint=err.hint)   # ... "in obstacle `box`"
@@ -128,12 +131,12 @@ class _Reader:
             return default
         value = m[key]
         if not isinstance(value, bool):
-            raise unknown(f"{key} in {what}", str(value), ("true", "false"),
-                          span=m.value_span(key), cls=WorldError)
+            raise WorldError(f"`{key}` in {what} must be true or false, not `{value}`",
+                             span=m.value_span(key), expected="true or false")
         return value
 
     def range_pair(self, value: Any, span: Span, what: str) -> tuple[float, float]:
-        lo, hi = self.point(value, span, what)
+        lo, hi = self.point(value, span, what, "a range [low, high]")
         if lo > hi:
             raise WorldError(f"{what} must be [low, high] with low <= high", span=span)
         return lo, hi
@@ -380,7 +383,7 @@ def parse_world(text: str, path: str) -> World:
                  if "randomise" in top else Randomise())
     world = World(name, path, seed, dt, limit, int(substeps), tuple(agents), sensors,
                   tuple(corridors), grid, tuple(obstacles), randomise,
-                  str(top.get("behavior", "drive")), knows, given, min_clearance, replan,
+                  _behavior(top), knows, given, min_clearance, replan,
                   top.value_span("behavior") if "behavior" in top else None)
     check_free(world, agent_spans)
     check_starts(world, [s for s, _ in agent_spans])
@@ -402,11 +405,23 @@ def read_given(mp: YMap, path: str, unknown_occupied: bool):
                          hint="`given: maps/office02_given.yaml`, or `given: none` for a robot "
                               "with no map")
     if not value.endswith((".yaml", ".yml")):
-        raise unknown("given in map", value, ("none", "PATH.yaml"), span=span, cls=WorldError)
+        raise WorldError(f"`given` in map must be `none` or a map_server YAML file, not "
+                         f"`{value}`", span=span, expected="none or PATH.yaml",
+                         hint=did_you_mean(value, ("none",)))
     from .gridmap import load_map_yaml
 
     return "given", load_map_yaml(Path(path).parent / value, unknown_occupied=unknown_occupied,
                                   where=span)
+
+
+def _behavior(top: YMap) -> str:
+    """The behavior the world names (``drive`` when none); an empty one is not `None`."""
+    value = top.get("behavior", "drive")
+    if not isinstance(value, str) or not value.strip():
+        raise WorldError("behavior must be the name of a behavior of the rule base",
+                         span=top.value_span("behavior"), hint="`behavior: drive`, or leave "
+                         "the line out for the packaged `drive`")
+    return value
 
 
 def check_free(world: World, spans: list[tuple[Span, Span]]) -> None:
