@@ -227,3 +227,9 @@ def test_an_output_is_never_an_input_nor_another_output(short, capsys):
     code, err = run_main(capsys, short, "--out", same, "--plot", same)
     said = " ".join(err.replace("│", " ").split())
     assert code == 2 and "is named by --out too" in said and not same.exists()
+
+
+def test_randomise_with_runs_says_why(short, capsys):
+    code, err = run_main(capsys, short, "--randomise", "--runs", 2)
+    said = " ".join(err.replace("│", " ").split())
+    assert code == 2 and "--runs randomises every run already" in said     # was "give one world"

@@ -165,7 +165,8 @@ def simulate_command(
     out: Annotated[Optional[Path], typer.Option(
         "--out", "-o", metavar="FILE.csv", help="Write one CSV row per tick.")] = None,
     trace: Annotated[bool, typer.Option(
-        "--trace", help="Print the paper-style DOF trace every --every ticks.")] = False,
+        "--trace", help="Print the paper-style DOF trace every --every ticks (of the first "
+                        "robot where there are several).")] = False,
     every: Annotated[int, typer.Option("--every", min=1, help="Ticks between traces.")] = 20,
     plot: Annotated[Optional[Path], typer.Option(
         "--plot", metavar="FILE.png|FILE.svg",
@@ -217,6 +218,9 @@ def simulate_command(
     _check_outputs((("--out", out), ("--plot", plot), ("--animate", animate)),
                    [Path(w.path) for w in loaded if w.path] + ([Path(rulebase)] if rulebase else []))
     many = len(loaded) > 1 or runs > 0
+    if randomise and runs > 0:                # not "give one world": it was one
+        raise typer.BadParameter("--runs randomises every run already; --randomise replays "
+                                 "one of them (with --seed)", param_hint="--randomise")
     if many and (out or trace or live or randomise or animate):
         raise typer.BadParameter("--out, --animate, --trace, --live, --speed and --randomise "
                                  "work on one world and one run; drop --runs or give one world")

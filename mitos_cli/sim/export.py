@@ -91,11 +91,12 @@ def traces(result: SimResult, planner, every: int, digits: int = 1) -> str:
     ticks = sorted(set(range(0, result.ticks, max(1, every))) | {result.ticks - 1}
                    | set(replans))
     blocks = []
+    who = result.world.agents[0].name            # the first robot's trace ("robot" alone)
     for k in ticks:
         if result.active is not None and not result.active[k, 0]:
             continue
         x, y, h = result.pose[k, 0]
-        head = (f"--- tick {k}, t = {result.t[k]:.2f} s: robot at ({x:.1f}, {y:.1f}) in, pose "
+        head = (f"--- tick {k}, t = {result.t[k]:.2f} s: {who} at ({x:.1f}, {y:.1f}) in, pose "
                 f"heading {h:.1f} deg, speed {result.speed[k, 0]:.1f} in/s, steering "
                 f"{result.steering[k, 0]:.1f} deg, clearance {result.clearance[k, 0]:.1f} in")
         pt = "  perceived: " + ", ".join(f"{key} {result.perceived[key][k, 0]:.1f}"
