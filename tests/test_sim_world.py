@@ -360,3 +360,10 @@ def test_a_misspelt_world_path_points_at_the_file_beside_it(tmp_path, monkeypatc
 ])
 def test_wrong_values_are_said_in_words(old, new, says):
     assert says in error(BASE.replace(old, new))
+
+
+def test_a_field_of_view_on_a_ring_is_refused():
+    ring = BASE + "sensors: {layout: ring, fov: 90}\n"          # it was silently ignored
+    assert "`fov` in sensors is for `layout: fan`" in error(ring)
+    assert parse_world(BASE + "sensors: {layout: ring, fov: 360}\n", "w.yaml")
+    assert parse_world(BASE + "sensors: {layout: fan, fov: 90}\n", "w.yaml")

@@ -187,6 +187,9 @@ def read_sensors(r: _Reader, value: Any, span: Span) -> Sensors:
     count = r.number(m, "count", "sensors", d.count, minimum=1, maximum=720)
     if count != int(count):
         raise WorldError("`count` in sensors must be a whole number", span=m.value_span("count"))
+    if layout == "ring" and "fov" in m and m["fov"] != 360:      # it was ignored
+        raise WorldError("`fov` in sensors is for `layout: fan`: a ring looks all round",
+                         span=m.value_span("fov"), hint="add `layout: fan`, or drop `fov`")
     return Sensors(layout, int(count),
                    r.number(m, "fov", "sensors", 180.0 if layout == "fan" else 360.0,
                             positive=True, maximum=360),
