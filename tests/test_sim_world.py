@@ -367,3 +367,10 @@ def test_a_field_of_view_on_a_ring_is_refused():
     assert "`fov` in sensors is for `layout: fan`" in error(ring)
     assert parse_world(BASE + "sensors: {layout: ring, fov: 360}\n", "w.yaml")
     assert parse_world(BASE + "sensors: {layout: fan, fov: 90}\n", "w.yaml")
+
+
+def test_a_huge_number_is_explained_in_its_own_unit():
+    msg = error(BASE.replace("time_limit: 10", "time_limit: 1e12"))
+    assert "1e7 s is 116 days" in msg and "inches" not in msg       # was "254 km"
+    msg = error(BASE + "sensors: {count: 1e8}\n")
+    assert "`count` in sensors must be at most 720, not 1e+08" in msg

@@ -57,10 +57,16 @@ MODES = ("loop", "ping-pong", "stop")
 LARGEST = 1e7
 
 
-def _sane(x: float, span: Span, what: str) -> float:
+#: what a number beyond LARGEST means, for the keys that are not lengths in inches
+BEYOND = {"time_limit": "times are in seconds: 1e7 s is 116 days",
+          "dt": "times are in seconds: 1e7 s is 116 days",
+          "substeps": "a count this large would never finish a tick"}
+
+
+def _sane(x: float, span: Span, what: str, key: str = "") -> float:
     if abs(x) > LARGEST:
         raise WorldError(f"{what} must be within ±{LARGEST:g}, not {x:g}", span=span,
-                         hint="world lengths are in inches: 1e7 in is 254 km")
+                         hint=BEYOND.get(key, "world lengths are in inches: 1e7 in is 254 km"))
     return x
 
 
@@ -84,8 +90,8 @@ class _Reader:
             return float(default)
         span = m.value_span(key)
         x = yamlpos.expect_number(m[key], span, WorldError, f"`{key}` in {what}")
-        if sane:
-            _sane(x, span, f"`{key}` in {what}")
+        if sane and (maximum is None or x <= maximum):     # else "at most", below
+            _sane(x, span, f"`{key}` in {what}", key)
         if positive and x <= 0:
             raise WorldError(f"`{key}` in {what} must be positive, not {x:g}", span=span)
         if minimum is not None and x < minimum:
