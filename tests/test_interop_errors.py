@@ -197,7 +197,7 @@ FIS_CASES = [
     ("1 1, 1 (1) : 2", "1 1 1 (1) : 2", "expected a rule"),
     ("1 1, 1 (1) : 2", "1 1 1, 1 (1) : 2", "the rule lists 3 inputs and 1 output"),
     ("1 1, 1 (1) : 2", "1 1, 1 (1) : 3", "connection 3: expected 1 (AND) or 2 (OR)"),
-    ("1 1, 1 (1) : 2", "1.2 1, 1 (1) : 2", "fractional indices (hedges) are not supported"),
+    ("1 1, 1 (1) : 2", "1.15 1, 1 (1) : 2", "Octave's hedge x^1.5 (the fraction .15)"),
     ("1 1, 1 (1) : 2", "4 1, 1 (1) : 2", "`service` has 3 MFs, not 4"),
     ("1 1, 1 (1) : 2", "1 1, -1 (1) : 2", "negative (complemented)"),
     ("1 1, 1 (1) : 2", "1 1, 4 (1) : 2", "`tip` has 3 MFs, not 4"),

@@ -72,7 +72,7 @@ def test_a_misspelt_known_key_suggests_it():
 def test_known_takes_true_or_false():
     text = error(world_text(CORRIDOR, "obstacles:\n"
                             "  - {name: a, shape: circle, at: [150, 0], radius: 5, known: ture}\n"))
-    assert "w.yaml:18:" in text and "unknown known in obstacle `a` `ture`" in text
+    assert "w.yaml:18:" in text and "`known` in obstacle `a` must be true or false" in text
     assert "did you mean `true`" in text
 
 

@@ -138,7 +138,8 @@ class _Reader:
         value = m[key]
         if not isinstance(value, bool):
             raise WorldError(f"`{key}` in {what} must be true or false, not `{value}`",
-                             span=m.value_span(key), expected="true or false")
+                             span=m.value_span(key), expected="true or false",
+                             hint=did_you_mean(str(value), ("true", "false")))
         return value
 
     def range_pair(self, value: Any, span: Span, what: str) -> tuple[float, float]:
