@@ -233,3 +233,9 @@ def test_randomise_with_runs_says_why(short, capsys):
     code, err = run_main(capsys, short, "--randomise", "--runs", 2)
     said = " ".join(err.replace("│", " ").split())
     assert code == 2 and "--runs randomises every run already" in said     # was "give one world"
+
+
+def test_one_runs_spread_is_null_as_in_compare(short):
+    data = json.loads(run(short, "--runs", 1, "--json").stdout)
+    row = data[0] if isinstance(data, list) else data["worlds"][0]
+    assert row["time_s"]["std"] is None            # was 0.0; compare --json says null

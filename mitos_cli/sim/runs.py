@@ -80,12 +80,13 @@ class WorldRuns:
                                ROBOT_OUTCOMES) for i, name in enumerate(names))
 
     def figures(self) -> dict:
-        """Each outcome's rate and each metric's mean and std over the runs."""
-        row: dict[str, float | dict[str, float]] = {f"{o}_rate": self.rate(o)
-                                                         for o in self.outcomes}
+        """Each outcome's rate and each metric's mean and std over the runs (the std of one
+        run is undefined: ``None``, null in JSON, as `compare --json` says it)."""
+        row: dict[str, float | dict[str, float | None]] = {f"{o}_rate": self.rate(o)
+                                                                for o in self.outcomes}
         for key in METRICS:
             mean, std = self.stat(key)
-            row[key] = {"mean": mean, "std": std}
+            row[key] = {"mean": mean, "std": std if len(self.summaries) > 1 else None}
         return row
 
 
