@@ -374,3 +374,8 @@ def test_a_huge_number_is_explained_in_its_own_unit():
     assert "1e7 s is 116 days" in msg and "inches" not in msg       # was "254 km"
     msg = error(BASE + "sensors: {count: 1e8}\n")
     assert "`count` in sensors must be at most 720, not 1e+08" in msg
+
+
+def test_randomising_obstacles_in_a_world_without_any_says_so():
+    msg = error(BASE + "randomise:\n  obstacles:\n    box: {dx: [-30, 30]}\n")
+    assert "randomise moves obstacles, and the world has none" in msg    # "expected one of "

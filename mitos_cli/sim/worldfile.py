@@ -262,6 +262,10 @@ def read_randomise(r: _Reader, value: Any, span: Span, names: list[str]) -> Rand
     m = r.mapping(value, span, "randomise", RANDOMISE_KEYS)
     jitters = []
     if "obstacles" in m:
+        if not names and m["obstacles"]:       # not "expected one of" nothing
+            raise WorldError("randomise moves obstacles, and the world has none",
+                             span=m.value_span("obstacles"),
+                             hint="add them under `obstacles:`, or drop `randomise: obstacles`")
         obs = r.mapping(m["obstacles"], m.value_span("obstacles"), "randomise obstacles",
                         tuple(names))
         for name, spec in obs.items():
