@@ -81,6 +81,9 @@ def teach_command(
     lesson_text = None
     if recover and not resume:
         raise typer.BadParameter("--recover applies to a resumed session: add --resume")
+    if save_as is not None and not save_as.endswith(".rules"):
+        raise typer.BadParameter(f"--save-as names the rule file to write, ending in `.rules`, "
+                                 f"not `{save_as}`")
     if as_json and lesson is None:
         raise typer.BadParameter("--json reports a lesson: add --lesson FILE")
     transcript = Transcript() if as_json else None

@@ -95,6 +95,7 @@ class Journal:
     @classmethod
     def create(cls, directory: Path) -> Journal:
         directory.mkdir(parents=True, exist_ok=True)
+        _lock(directory)
         journal = cls(directory)
         journal.path.touch()
         return journal
@@ -109,6 +110,7 @@ class Journal:
         path and line; with ``recover`` the session is kept up to that line instead (the
         damaged file kept aside the same way).
         """
+        _lock(directory)
         journal = cls(directory)
         raw = journal.path.read_bytes()
         lines = raw.split(b"\n")
@@ -189,6 +191,44 @@ class Journal:
         undone = {e["of"] for e in self.entries if e["op"] == "undo"}
         return [e for e in self.entries if e["seq"] not in undone and e["op"] not in
                 ("undo", "start", "save")]
+
+
+#: the sessions this process holds (their lock files stay open until it exits)
+_HELD: dict[Path, object] = {}
+
+
+def _lock(directory: Path) -> None:
+    """Hold ``directory``'s session for this process: two processes appending to one journal
+    would both number their next change alike and damage it (an advisory ``flock`` on
+    ``lock``, released by the system when the process ends, ``kill -9`` included; where the
+    system has no ``flock`` sessions are not locked)."""
+    try:
+        import fcntl
+    except ImportError:                          # pragma: no cover - not POSIX
+        return
+    key = directory.resolve()
+    if key in _HELD:
+        return
+    path = directory / "lock"
+    try:
+        fh = open(path, "a+", encoding="utf-8")
+    except OSError as exc:
+        raise LessonError(f"cannot open the session's lock {path}: {exc.strerror or exc}") \
+            from None
+    try:
+        fcntl.flock(fh.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except OSError:
+        fh.seek(0)
+        pid = fh.read().strip()
+        fh.close()
+        raise LessonError(f"session {directory.name} is open in another `mitos teach`"
+                          + (f" (process {pid})" if pid.isdigit() else ""),
+                          hint="finish or quit that one first; two at once would both write "
+                               "its journal") from None
+    fh.truncate(0)
+    fh.write(str(os.getpid()))
+    fh.flush()
+    _HELD[key] = fh
 
 
 #: what each kind of entry must carry, and of which type

@@ -35,12 +35,16 @@ def commands(text: str) -> Iterator[tuple[int, str]]:
 
 
 def run_lesson(session: Session, text: str, path: str) -> bool:
-    """Run every command of ``text``; False when the lesson said ``quit``."""
+    """Run every command of ``text``; False when the lesson said ``quit``. Ctrl-C stops the
+    lesson (``KeyboardInterrupt``), also when an ``adapt`` caught it to keep its epochs."""
     for lineno, line in commands(text):
         session.echo(f"{path}:{lineno}> {line.splitlines()[0]}")
+        session.interrupted = False
         try:
             if not session.run(line, path, lineno):
                 return False
+            if session.interrupted:         # Ctrl-C in an `adapt`: what it learned is kept
+                raise KeyboardInterrupt     # (journaled); the rest of the lesson is not run
         except MitosError as exc:
             if exc.span is None or exc.span.path != path:
                 where = Span.in_text("\n" * (lineno - 1) + line, path, lineno, 1)

@@ -23,7 +23,7 @@ from pathlib import Path
 
 from lark import Token, Tree
 
-from ..errors import LessonError, TermSetError
+from ..errors import LessonError, MitosError, TermSetError
 from ..fileio import atomic_write, atomic_write_set, finish_saves  # noqa: F401 (re-exported)
 from ..fuzzy.shapes import SHAPES
 from ..lang import yamlpos
@@ -67,6 +67,7 @@ def save_rulebase(original: RuleBase, current: RuleBase, target: Path) -> Saved:
         raise LessonError(f"`{src.name}` is not in the rule language; saving keeps the rule "
                           f"language only", hint="save to a `.rules` file after converting it")
     targets = termset_targets(target, src, original.termset_paths)
+    _check_targets(target, src, original, targets)
     changes: list[str] = []
     texts: list[tuple[Path, str | bytes]] = []
     for ts_old, ts_new, rel, dest in zip(original.termsets, current.termsets,
@@ -79,10 +80,60 @@ def save_rulebase(original: RuleBase, current: RuleBase, target: Path) -> Saved:
     names = tuple(os.path.relpath(dest, target.parent).replace(os.sep, "/") for dest in targets)
     new_rules, changed = edit_rules(rules_text, str(src), original, current, names)
     changes += changed
+    _check_reads_back(current, new_rules, texts, target, names)
     _directory_for(target)
     finish_saves(target, error=LessonError)        # one a crash left half done
     atomic_write_set(texts + [(target, new_rules)], target, error=LessonError)
     return Saved(target, tuple(d for d, _ in texts), tuple(changes))
+
+
+def _check_targets(target: Path, src: Path, original: RuleBase, targets: tuple[Path, ...]) -> None:
+    """Refuse a save that would write over a file the session reads: an original term set
+    saved under another rule file's name (`save b.rules` beside a rule file that reads
+    `b.terms.yaml`), or a term set onto the rule file itself."""
+    if target.suffix != ".rules":
+        raise LessonError(f"`{target}` does not end in `.rules`; save writes a rule file",
+                          hint=f"save {target.with_suffix('.rules').as_posix()}")
+    if target.resolve() == src.resolve():
+        return                            # over the original: its term sets in place
+    originals = {(src.parent / rel).resolve(): rel for rel in original.termset_paths}
+    for dest in targets:
+        rel = originals.get(dest.resolve())
+        if rel is not None:
+            raise LessonError(
+                f"saving as `{target}` would write its term set over `{dest}`, the term set "
+                f"`{src.name}` reads (`terms \"{rel}\"`), which would change what it means",
+                hint="save under another name, or over the original rule file itself "
+                     f"(`save {src}`)")
+
+
+def _check_reads_back(current: RuleBase, rules_text: str, texts, target: Path,
+                      names: tuple[str, ...]) -> None:
+    """The texts about to be written, read back, must be ``current``: a save never reports
+    success for a file that does not load or that means something else."""
+    from ..lang.operators import resolve
+    from ..lang.parse import parse_rules
+    from ..lang.resolve import build_rulebase
+    from ..lang.termfile import parse_termset
+
+    try:
+        back = build_rulebase(parse_rules(rules_text, str(target)),
+                              tuple(parse_termset(text, str(dest)) for dest, text in texts),
+                              names)
+        same = back.variables == current.variables and [
+            (b.name, b.rules, b.uses, b.frozen) for b in back.behaviors] == [
+            (b.name, b.rules, b.uses, b.frozen) for b in current.behaviors] and all(
+            resolve(x.operators, resolve(back.operators))
+            == resolve(y.operators, resolve(current.operators))
+            for x, y in zip(back.behaviors, current.behaviors))
+        why = "it reads back as another rule base"
+    except MitosError as exc:
+        same, why = False, f"it would not read back: {exc.message}"
+    if not same:
+        raise LessonError(f"`save` made a text that does not hold the session's rule base "
+                          f"({why}); nothing was written",
+                          hint="this is a bug in MITOS: the session and its journal are "
+                               "intact; please report the lesson that led here")
 
 
 def _directory_for(target: Path) -> None:
@@ -124,9 +175,9 @@ def edit_termset(text: str, path: str, old, new) -> tuple[str, list[str]]:
         for t_old, t_new in zip(v_old.terms, v_new.terms):
             was, now = _flags(t_old), _flags(t_new)
             said: list[str] = []             # one line per term, whatever changed in it
+            t_params_changed = t_old.params != t_new.params
             if was != now:
                 edits += _flag_edits(text, starts, terms, t_old, t_new)
-            t_params_changed = t_old.params != t_new.params
             if t_params_changed:
                 said.append(f"{_params(t_old)} -> {_params(t_new)}")
             if t_old.frozen != t_new.frozen:
@@ -139,7 +190,8 @@ def edit_termset(text: str, path: str, old, new) -> tuple[str, list[str]]:
                     f"other about it)")
             if said:
                 changes.append(f"{v_old.name}.{t_old.name}: " + "; ".join(said))
-            if not t_params_changed:
+            bare = not isinstance(terms[t_old.name], yamlpos.YMap)
+            if not t_params_changed or (bare and was != now):   # (the flags' edit wrote it)
                 continue
             spans = _param_spans(terms, t_old)
             for span, a, b in zip(spans, t_old.params, t_new.params):
@@ -167,7 +219,7 @@ def _flag_edits(text: str, starts: list[int], terms: yamlpos.YMap, old: Term,
     """The edits that write ``new``'s ``frozen`` and ``held`` keys where they differ from
     ``old``'s into its YAML: a key's value replaced where it is written, else the keys added
     (to a flow mapping before its ``}``, to a block mapping as its first lines; a bare crisp
-    value becomes ``{shape: singleton, value: V, frozen: true}``)."""
+    value becomes ``{shape: singleton, value: V, frozen: true}``, V its new value)."""
     was = _flags(old)
     flags = {key: value for key, value in _flags(new).items() if was[key] != value}
 
@@ -180,7 +232,8 @@ def _flag_edits(text: str, starts: list[int], terms: yamlpos.YMap, old: Term,
         match = NUMBER.match(text, at)
         end = match.end() if match else at
         pairs = "".join(f", {k}: {v}" for k, v in flags.items())
-        return [(at, end, f"{{shape: singleton, value: {text[at:end]}{pairs}}}")]
+        value = text[at:end] if old.params == new.params else format_number(new.params[0])
+        return [(at, end, f"{{shape: singleton, value: {value}{pairs}}}")]
     edits = []
     for key in [k for k in flags if k in spec]:
         at = offset(spec.value_span(key))
@@ -340,11 +393,10 @@ def edit_rules(text: str, path: str, original: RuleBase, current: RuleBase,
         for use in b.uses[len(old.uses):]:
             inserted.append(format_use(use))
             changes.append(f"{b.name}: {format_use(use)}")
-        new_ops = b.operators[len(old.operators):]
+        new_ops = _operators_text(b.operators[len(old.operators):])
         if new_ops:
-            inserted.append("operators: " + ", ".join(f"{o.key} = {o.value}" for o in new_ops))
-            changes.append(f"{b.name}: operators " + ", ".join(f"{o.key} = {o.value}"
-                                                               for o in new_ops))
+            inserted.append("operators: " + new_ops)
+            changes.append(f"{b.name}: operators {new_ops}")
         new_frozen = [label for label in b.frozen if label not in old.frozen]
         if new_frozen:
             inserted.append("frozen " + ", ".join(new_frozen))
@@ -365,6 +417,15 @@ def edit_rules(text: str, path: str, original: RuleBase, current: RuleBase,
     return out, changes
 
 
+def _operators_text(settings) -> str:
+    """``settings`` as one ``operators:`` line's text, each key once with the value told last
+    (one line may not set a key twice; two `operators:` lines at the prompt may)."""
+    last = {}
+    for setting in settings:
+        last[setting.key] = setting.value
+    return ", ".join(f"{key} = {value}" for key, value in last.items())
+
+
 def _only_crisp_changed(before, after) -> bool:
     if before.label != after.label or before.antecedent != after.antecedent \
             or before.weight != after.weight or len(before.consequents) != len(after.consequents):
@@ -378,7 +439,7 @@ def _only_crisp_changed(before, after) -> bool:
 def _behavior_text(b: Behavior) -> str:
     lines = [f"behavior {b.name}:"]
     if b.operators:
-        lines.append("    operators: " + ", ".join(f"{s.key} = {s.value}" for s in b.operators))
+        lines.append("    operators: " + _operators_text(b.operators))
     lines += ["    " + format_rule(r) for r in b.rules]
     lines += ["    " + format_use(u) for u in b.uses]
     if b.frozen:

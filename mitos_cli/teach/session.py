@@ -142,6 +142,7 @@ class Session:
         self.simulation: Recording | None = None
         self.base: Path | None = None       # where a lesson's relative world paths start
         self.saved_seq = 0
+        self.interrupted = False            # the last command's adaptation was cut short
         self.state = State(self.original, active)
         self._indexes: dict[str, _RuleIndex] = {}
         if not self.journal.entries:
@@ -377,9 +378,28 @@ class Session:
     def _telloperators(self, c: cmd.TellOperators, line: str) -> None:
         b = self.rulebase.behavior(self.focus)
         resolve(c.settings, resolve(b.operators, resolve(self.rulebase.operators)))
+        self._check_operators(b, c.settings)
         text = "operators: " + ", ".join(f"{s.key} = {s.value}" for s in c.settings)
         self.change("operators", line, behavior=b.name, text=text)
         self.out(f"{b.name}: {text}")
+
+    def _check_operators(self, b: Behavior, settings) -> None:
+        """Refuse operators the behavior's rules cannot be evaluated with (Tsukamoto
+        inference on terms that are not monotonic, ...) before they are journaled."""
+        from .state import _replace_behavior
+
+        if not b.rules and not b.uses:
+            return
+        trial = _replace_behavior(self.rulebase, dataclasses.replace(
+            b, operators=b.operators + tuple(settings)))
+        try:
+            compile_rulebase(trial, b.name)
+        except MitosError as exc:
+            where = f" ({exc.span.path}:{exc.span.line})" if exc.span is not None else ""
+            raise LessonError(f"behavior `{b.name}` cannot be evaluated with these operators: "
+                              f"{exc.message}{where}", hint=exc.hint or
+                              "keep its operators, or tell rules these operators can evaluate"
+                              ) from None
 
     def _values(self, given: tuple[cmd.Assign, ...], names: tuple[str, ...], role: str,
                 compiled: CompiledRuleBase, require_all: bool) -> dict:
@@ -559,6 +579,7 @@ class Session:
                               hint="adapt again to go on from where it stopped")
         rate = 0.5 if c.rate is None else c.rate
         result = self._learn(c, compiled, X, T, epochs, rate)
+        self.interrupted = result.interrupted
         before = self.rulebase
         terms, crisp = learned_changes(before, learned_rulebase(result.parameters,
                                                                 result.values))
