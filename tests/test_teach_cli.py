@@ -302,3 +302,24 @@ def test_an_unknown_session_lists_the_newest(tmp_path):
     assert info.value.expected.startswith("one of the newest: a-20261203-010019, ")
     assert "z-20261203-010000" not in info.value.expected
     assert "did you mean" in info.value.hint
+
+
+def test_a_session_open_in_one_process_is_refused_in_another(work):
+    """Two `mitos teach` appending to one journal would number their changes alike."""
+    p = Prompt(["rb/mitos.rules"], work)
+    p.say("correct road=78 size=45 position=4 -> steering=60", "example 1:")
+    res = mitos("teach", "--resume", "--lesson", "-", cwd=work,
+                stdin="correct road=70 size=45 position=4 -> steering=70\n")
+    assert res.returncode == 1 and "is open in another `mitos teach` (process" in res.stderr
+    p.say("correct road=60 size=45 position=4 -> steering=80", "example 2:")
+    p.proc.send_signal(signal.SIGKILL)            # the system releases the lock
+    p.proc.wait(timeout=30)
+    res = mitos("teach", "--resume", "--lesson", "-", cwd=work, stdin="show examples\n")
+    assert res.returncode == 0, res.stderr
+    assert "2 examples" in res.stderr
+
+
+def test_save_as_names_a_rules_file(work):
+    res = mitos("teach", "rb/mitos.rules", "--save-as", "x.png", "--lesson", "-", cwd=work,
+                stdin="")
+    assert res.returncode == 2 and "ending in `.rules`" in res.stderr

@@ -299,3 +299,68 @@ def test_frozen_must_be_true_or_false():
     with pytest.raises(TermSetError, match="`frozen` must be true or false") as err:
         parse_termset(text, "x.yaml")
     assert err.value.span.line == 6
+
+
+def test_a_frozen_crisp_value_that_also_moved_is_written_whole(rules, tmp_path):
+    """`LS: 70`, adapted to 67 and frozen in one session, becomes `{shape: singleton,
+    value: 67, frozen: true}` (the two edits of one number once overlapped: `67hape: ...`)."""
+    s = Session(rules, out=[].append)
+    s.run("correct road=78 size=45 position=4 -> steering=60")
+    s.run("adapt epochs 3")
+    s.run("frozen steering.LS")
+    s.run("unfrozen steering.ST")
+    s.run(f"save {tmp_path / 'w.rules'}")
+    saved = load_rules_file(tmp_path / "w.rules")
+    def stated(rb):
+        return [(v.name, t.name, t.params, t.frozen, t.held) for v in variables(rb) for t in v.terms]
+    assert stated(saved) == stated(s.rulebase)
+    text = (tmp_path / "w.mitos.terms.yaml").read_text()
+    learned = s.rulebase.variables["steering"].term("LS").params[0]
+    assert f"LS: {{shape: singleton, value: {learned:.4g}, frozen: true}}" in text
+
+
+def test_operators_told_twice_are_saved_as_one_setting(rules, tmp_path):
+    s = Session(rules, out=[].append)
+    s.run("operators: and = product")
+    s.run("operators: and = min, or = max")
+    s.run(f"save {tmp_path / 'o.rules'}")
+    text = (tmp_path / "o.rules").read_text()
+    assert "operators: and = min, or = max\n" in text and "and = product" not in text
+    assert load_rules_file(tmp_path / "o.rules").behaviors == s.rulebase.behaviors or \
+        load_rules_file(tmp_path / "o.rules").behavior("avoid_obstacle").operators[-2:] \
+        == s.rulebase.behavior("avoid_obstacle").operators[-2:]
+
+
+def test_save_refuses_to_write_over_a_term_set_the_rule_file_reads(tmp_path):
+    (tmp_path / "a.rules").write_text(
+        'terms "b.terms.yaml"\nbehavior b:\n    r0: if x is LO then y is A\n'
+        '    r1: if x is HI then y is B\nend\n')
+    terms = ("variables:\n  x: {role: input, universe: [0, 10], terms: {LO: {shape: "
+             "left_shoulder, points: [2, 8]}, HI: {shape: right_shoulder, points: [2, 8]}}}\n"
+             "  y: {role: output, universe: [0, 10], terms: {A: 2, B: 8}}\n")
+    (tmp_path / "b.terms.yaml").write_text(terms)
+    s = Session(tmp_path / "a.rules", out=[].append)
+    s.run("correct x=5 -> y=3")
+    s.run("adapt epochs 5")
+    with pytest.raises(LessonError, match="over `.*b.terms.yaml`, the term set `a.rules` reads"):
+        s.run(f"save {tmp_path / 'b.rules'}")
+    assert (tmp_path / "b.terms.yaml").read_text() == terms and not (tmp_path / "b.rules").exists()
+    with pytest.raises(LessonError, match=r"does not end in `\.rules`") as e:
+        s.run(f"save {tmp_path / 'out.txt'}")
+    assert e.value.hint == f"save {(tmp_path / 'out.rules').as_posix()}"
+    s.run(f"save {tmp_path / 'a.rules'}")          # over the original: its term set in place
+    assert (tmp_path / "b.terms.yaml").read_text() != terms
+
+
+def test_a_save_whose_text_would_not_read_back_writes_nothing(rules, tmp_path, monkeypatch):
+    """The read-back check: whatever the text surgery gets wrong, no broken file is written."""
+    from mitos_cli.teach import save
+
+    monkeypatch.setattr(save, "_apply", lambda text, edits: text + "\n}{ broken")
+    s = Session(rules, out=[].append)
+    s.run("correct road=78 size=45 position=4 -> steering=60")
+    s.run("adapt epochs 3")
+    with pytest.raises(LessonError, match="does not hold the session's rule base.*nothing was "
+                                          "written"):
+        s.run(f"save {tmp_path / 'x.rules'}")
+    assert list(tmp_path.iterdir()) == [rules.parent]

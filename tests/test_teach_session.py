@@ -1,5 +1,6 @@
 """Every teaching command through the session (and its mistakes), undo and journal replay."""
 
+import dataclasses
 import json
 import shutil
 
@@ -325,4 +326,40 @@ def test_a_correction_outside_the_universe_is_noted_and_an_infinite_one_refused(
     assert "road = 500 lies outside its universe [0, 160]; the rules read it as 160" in text
     with pytest.raises(LessonError, match="road = inf is not a finite number"):
         s.run("correct road=1e400 size=45 position=4 -> steering=60")
+    assert len(s.state.examples) == 1
+
+
+def test_operators_the_rules_cannot_be_evaluated_with_are_refused_unjournaled():
+    from mitos_cli.teach.journal import MemoryJournal
+
+    journal = MemoryJournal()
+    s = Session(default_rulebase_path(), journal=journal, out=[].append)
+    with pytest.raises(LessonError, match="cannot be evaluated with these operators: "
+                                          ".*Tsukamoto inference needs a monotonic"):
+        s.run("operators: inference = tsukamoto")
+    assert [e["op"] for e in journal.entries] == ["start"]
+    s.run("operators: and = product")             # what the rules can take is journaled
+    assert [e["op"] for e in journal.entries] == ["start", "operators"]
+
+
+def test_ctrl_c_in_a_lessons_adapt_stops_the_lesson(monkeypatch):
+    """At the prompt Ctrl-C ends an `adapt` early and the prompt goes on; in a lesson it
+    stops the lesson (what the completed epochs learned is journaled, nothing after runs)."""
+    from mitos_cli.teach import adapt as adapt_module
+    from mitos_cli.teach.lesson import run_lesson
+
+    real = adapt_module.adapt
+
+    def interrupted(*args, **kwargs):
+        kwargs["on_epoch"] = None
+        result = real(*args, **{**kwargs, "epochs": 2})
+        return dataclasses.replace(result, interrupted=True)
+
+    monkeypatch.setattr(adapt_module, "adapt", interrupted)
+    said: list[str] = []
+    s = Session(default_rulebase_path(), out=said.append)
+    with pytest.raises(KeyboardInterrupt):
+        run_lesson(s, "correct road=78 size=45 position=4 -> steering=60\nadapt epochs 50\n"
+                      "correct road=70 size=45 position=4 -> steering=80\n", "l.lesson")
+    assert [e["op"] for e in s.journal.entries] == ["start", "examples", "adapt"]
     assert len(s.state.examples) == 1

@@ -120,7 +120,7 @@ def _check_reads_back(current: RuleBase, rules_text: str, texts, target: Path,
         back = build_rulebase(parse_rules(rules_text, str(target)),
                               tuple(parse_termset(text, str(dest)) for dest, text in texts),
                               names)
-        same = back.variables == current.variables and [
+        same = _terms(back) == _terms(current) and [
             (b.name, b.rules, b.uses, b.frozen) for b in back.behaviors] == [
             (b.name, b.rules, b.uses, b.frozen) for b in current.behaviors] and all(
             resolve(x.operators, resolve(back.operators))
@@ -134,6 +134,16 @@ def _check_reads_back(current: RuleBase, rules_text: str, texts, target: Path,
                           f"({why}); nothing was written",
                           hint="this is a bug in MITOS: the session and its journal are "
                                "intact; please report the lesson that led here")
+
+
+def _terms(rb: RuleBase) -> dict:
+    """Every variable as a file states it (a released term's point is not written:
+    ``held: false`` says all)."""
+    import dataclasses
+
+    return {name: v.with_terms(tuple(dataclasses.replace(t, held_at=None) if not t.held else t
+                                     for t in v.terms))
+            for name, v in rb.variables.items()}
 
 
 def _directory_for(target: Path) -> None:
