@@ -19,7 +19,7 @@ from mitos_cli.teach.commands import incomplete, parse_command
      c.Correct((c.Assign("road", 78), c.Assign("size", 45), c.Assign("position", 4)),
                (c.Assign("steering", 60), c.Assign("speed", 20)))),
     ("simulate worlds/figure4.yaml", c.Simulate("worlds/figure4.yaml")),
-    ('simulate "my world.yaml" seed 3', c.Simulate("my world.yaml", 3)),
+    ('simulate "my world.yaml" seed 3', c.Simulate("my world.yaml", "3")),
     ("at 12.5s steering=55", c.At(12.5, None, (c.Assign("steering", 55),))),
     ("at 11 to 13s steering=55 speed=10",
      c.At(11, 13, (c.Assign("steering", 55), c.Assign("speed", 10)))),

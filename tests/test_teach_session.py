@@ -363,3 +363,23 @@ def test_ctrl_c_in_a_lessons_adapt_stops_the_lesson(monkeypatch):
                       "correct road=70 size=45 position=4 -> steering=80\n", "l.lesson")
     assert [e["op"] for e in s.journal.entries] == ["start", "examples", "adapt"]
     assert len(s.state.examples) == 1
+
+
+def test_a_resumed_session_can_correct_the_run_it_recorded(tmp_path, monkeypatch):
+    """`simulate` is journaled (a record, not a change): `--resume` drives the last run again
+    on the rule base as it was then, so `at` corrects the same run; a seed is exact."""
+    monkeypatch.chdir(tmp_path)
+    s = Session(default_rulebase_path(), journal=Journal.create(tmp_path / "j"), out=[].append)
+    s.run("use drive")
+    s.run("simulate figure4 seed 9007199254740993")
+    s.run("at 12.5s steering=55")
+    assert s.simulation.seed == 9007199254740993
+    with pytest.raises(LessonError, match="written in digits .* not `1e3`"):
+        s.run("simulate figure4 seed 1e3")
+    said: list[str] = []
+    again = Session.resume(Journal.open(tmp_path / "j"), out=said.append)
+    assert said[0].startswith("the last run is recorded again: figure4 (seed 9007199254740993)")
+    assert again.simulation.result.summary() == s.simulation.result.summary()
+    assert "simulate" not in [e["op"] for e in again.journal.active()]   # undo skips it
+    again.run("at 13s steering=60")
+    assert [e.source for e in again.state.examples] == ["figure4 t=12.5s", "figure4 t=13s"]

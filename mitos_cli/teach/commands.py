@@ -152,7 +152,7 @@ class Correct:
 @dataclass(frozen=True)
 class Simulate:
     world: str
-    seed: float | None = None        # checked to be whole by the session
+    seed: str | None = None          # as written: checked to be digits by the session
     robot: str | None = None         # which robot's run `at` corrects (default: the first)
 
 
@@ -271,7 +271,8 @@ class _ToCommand(_ToModel):
         return json.loads(str(token)) if token.type == "STRING" else str(token)
 
     def simulate_cmd(self, items):
-        return Simulate(items[0], items[1], None if items[2] is None else str(items[2]))
+        return Simulate(items[0], None if items[1] is None else str(items[1]),
+                        None if items[2] is None else str(items[2]))
 
     def time(self, items):
         return float(items[0])

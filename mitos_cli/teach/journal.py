@@ -190,7 +190,7 @@ class Journal:
         """The change entries that were not undone, in order."""
         undone = {e["of"] for e in self.entries if e["op"] == "undo"}
         return [e for e in self.entries if e["seq"] not in undone and e["op"] not in
-                ("undo", "start", "save")]
+                RECORDS]
 
 
 #: the sessions this process holds (their lock files stay open until it exits)
@@ -239,7 +239,11 @@ FIELDS: dict[str, dict[str, type]] = {"start": {"rules": str, "behavior": str},
                                                                     "behavior": str},
           "activate": {"behavior": str}, "examples": {"examples": list},
           "adapt": {"terms": dict}, "undo": {"of": int}, "save": {},
-          "freeze": {"terms": list}, "release": {"terms": list}}
+          "freeze": {"terms": list}, "release": {"terms": list},
+          "simulate": {"world": str, "behavior": str}}
+
+#: entries that record what happened without changing the rule base
+RECORDS = ("undo", "start", "save", "simulate")
 
 
 #: JSON's names for the types ``json.loads`` gives (for messages about a journal line)
@@ -288,6 +292,9 @@ def _problem(line: bytes, seq: int) -> str | None:
         return "the `start` change's `save_as` is not a path"
     if op == "save" and not isinstance(entry.get("path"), str):
         return "the `save` change has no valid `path`"
+    if op == "simulate" and (type(entry.get("seed")) not in (int, type(None))
+                             or not isinstance(entry.get("robot"), (str, type(None)))):
+        return "the `simulate` record has no valid `seed` or `robot`"
     return None
 
 

@@ -101,8 +101,9 @@ def _check_targets(target: Path, src: Path, original: RuleBase, targets: tuple[P
         rel = originals.get(dest.resolve())
         if rel is not None:
             raise LessonError(
-                f"saving as `{target}` would write its term set over `{dest}`, the term set "
-                f"`{src.name}` reads (`terms \"{rel}\"`), which would change what it means",
+                f"saving as `{target.name}` would write its term set over `{dest.name}`, the "
+                f"term set `{src.name}` reads (`terms \"{rel}\"`), which would change what it "
+                f"means",
                 hint="save under another name, or over the original rule file itself "
                      f"(`save {src}`)")
 

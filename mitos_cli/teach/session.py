@@ -39,7 +39,7 @@ from ..lang.resolve import check_expr, check_rule, load_rules_file
 from ..words import plural
 from . import commands as cmd
 from . import text
-from .journal import Journal, MemoryJournal
+from .journal import RECORDS, Journal, MemoryJournal
 from .state import State, apply, files_digest, learned_changes, variables
 
 if TYPE_CHECKING:
@@ -170,6 +170,7 @@ class Session:
             session.out(f"warning: {start['rules']} or its term set changed since the session "
                         f"started; the journal's changes are applied to the files as they are now")
         session.replay(recover)
+        session._simulate_again()
         saves = [e for e in journal.entries if e["op"] == "save"]
         session.saved_seq = saves[-1]["seq"] if saves else 0
         if saves:                                   # a bare `save` goes where the last went
@@ -199,6 +200,31 @@ class Session:
                 self._cut_journal(line)
                 return
 
+    def _simulate_again(self) -> None:
+        """The run the last ``simulate`` recorded, driven again on the rule base as it was
+        then (a run is a function of the rules, the world and the seed), so that ``at``
+        corrects it after a resume as before."""
+        from .simulation import run_world
+
+        runs = [e for e in self.journal.entries if e["op"] == "simulate"]
+        if not runs:
+            return
+        last = runs[-1]
+        before = [e for e in self.journal.entries if e["seq"] < last["seq"]]
+        undone = {e["of"] for e in before if e["op"] == "undo"}
+        state = State(self.original, self.start_behavior)
+        for entry in before:
+            if entry["seq"] not in undone and entry["op"] not in RECORDS:
+                apply(state, entry)
+        try:
+            self.simulation = run_world(last["world"], state.rulebase, last["behavior"],
+                                        last.get("seed"), None, last.get("robot"))
+        except MitosError as exc:           # the world file changed or went since
+            self.out(f"warning: the last run ({last.get('line', 'simulate')}) cannot be driven "
+                     f"again: {exc.message}; `simulate` it again to correct it")
+            return
+        self.out(f"the last run is recorded again: {self.simulation.describe()}")
+
     def _cut_journal(self, line: int) -> None:
         """Truncate the journal before ``line`` (kept whole aside) and forget later entries."""
         raw = self.journal.path.read_bytes()
@@ -221,7 +247,7 @@ class Session:
     @property
     def unsaved(self) -> bool:
         changes = [e["seq"] for e in self.journal.entries
-                   if e["op"] not in ("start", "save")]
+                   if e["op"] not in ("start", "save", "simulate")]
         return bool(changes) and changes[-1] > self.saved_seq
 
     def compiled(self, behavior: str | None = None) -> CompiledRuleBase:
@@ -521,10 +547,14 @@ class Session:
     def _simulate(self, c: cmd.Simulate, line: str) -> None:
         from .simulation import run_world
 
-        seed = _whole(c.seed, "seed", 0) if c.seed is not None else None
+        from .simulation import world_path
+
+        seed = _seed(c.seed) if c.seed is not None else None
         self.compiled()
         self.simulation = run_world(c.world, self.rulebase, self.state.active, seed, self.base,
                                     c.robot)
+        self.journal.append("simulate", line=line, world=str(world_path(c.world, self.base)),
+                            behavior=self.state.active, seed=seed, robot=c.robot)
         self.out(self.simulation.describe())
 
     def _at(self, c: cmd.At, line: str) -> None:
@@ -754,6 +784,15 @@ def _reaches(rb: RuleBase, start: str, target: str) -> bool:
 
 #: the most epochs one `adapt` runs (the paper's lesson needs 60; an epoch takes milliseconds)
 MAX_EPOCHS = 100_000
+
+
+def _seed(text: str) -> int:
+    """A seed exactly as written: digits (``9007199254740993`` is not a float's
+    ``9007199254740992``, and ``1e3`` is not a seed)."""
+    if not re.fullmatch(r"\+?\d+", text):
+        raise LessonError(f"a seed is a whole number written in digits (such as 42), not "
+                          f"`{text}`")
+    return int(text)
 
 
 def _whole(value: float, what: str, least: int) -> int:

@@ -39,6 +39,7 @@ class Recording:
     result: SimResult
     robot: int = 0                     # the column of the robot whose run is corrected
     robot_name: str = ""
+    seed: int | None = None            # as given to `simulate` (None: the world's own)
 
     @property
     def t(self) -> np.ndarray:
@@ -50,6 +51,7 @@ class Recording:
     def describe(self) -> str:
         s = self.result.summary()
         who = f" (robot {self.robot_name})" if self.robot_name else ""
+        who += f" (seed {self.seed})" if self.seed is not None else ""
         return (f"{self.name}{who} with behavior {self.behavior}: {s['outcome']} after "
                 f"{s['time_s']:g} s (min clearance {s['min_clearance_in']:.1f} in, "
                 f"{plural(s['collisions'], 'collision')}); "
@@ -105,4 +107,4 @@ def run_world(name: str, rulebase: RuleBase, behavior: str, seed: int | None = N
     index = names.index(robot) if robot is not None else 0
     result = simulate(world, FuzzyPlanner(rulebase, behavior), seed=seed)
     return Recording(Path(name).stem, behavior, result, index,
-                     names[index] if len(names) > 1 else "")
+                     names[index] if len(names) > 1 else "", seed)
