@@ -323,3 +323,12 @@ def test_save_as_names_a_rules_file(work):
     res = mitos("teach", "rb/mitos.rules", "--save-as", "x.png", "--lesson", "-", cwd=work,
                 stdin="")
     assert res.returncode == 2 and "ending in `.rules`" in res.stderr
+
+
+def test_a_bad_world_in_a_lesson_is_reported_in_the_world_file(work):
+    (work / "bad.yaml").write_text("corridor:\n  width: banana\n")
+    (work / "p.lesson").write_text("use drive\nsimulate bad.yaml\n")
+    res = mitos("teach", "rb/mitos.rules", "--lesson", "p.lesson", cwd=work)
+    assert res.returncode == 1
+    assert "bad.yaml:1:1: world error: unknown key `corridor` in the world file (simulated " \
+           "from p.lesson:2)" in res.stderr

@@ -157,6 +157,15 @@ def test_steering_instructions_in_term_steps(words, steering, expected):
                                expected)
 
 
+def test_a_wider_turn_is_one_turn():
+    """A window turning both ways (left to 50, right 130) is refused: one target for both turns
+    would steer the left turn hard right. A slight drift past straight (88) is one turn."""
+    with pytest.raises(LessonError, match="turned both ways in that window \\(1 of 4 ticks"):
+        targets(instruction(("make", "a", "wider", "turn")), window([50, 60, 70, 130]))
+    np.testing.assert_allclose(targets(instruction(("make", "a", "wider", "turn")),
+                                       window([70, 60, 92])), [40, 40, 40])
+
+
 def test_speed_and_wall_instructions():
     w = window([90, 90], speed=[25, 60], gap_left=[5, 40], gap_right=[40, 5])
     np.testing.assert_allclose(targets(instruction(("slow", "down")), w), [15, 50])

@@ -16,7 +16,8 @@ instruction                     targets at each tick of the window
                                 (ticks going straight give no example)
 ``turn less``                   steering one term back toward straight (never past it)
 ``make a wider turn``           every tick: the hardest steering of the window, one term
-                                further (a sustained turn, not the drift back of Figure 4)
+                                further (a sustained turn, not the drift back of Figure 4);
+                                refused when ticks turn half a term or more the other way
 ``slow down`` / ``speed up``    speed one term lower / higher
 ``keep further from the wall``  steering one term away from the nearer side
                                 (``gap_left`` / ``gap_right``)
@@ -137,6 +138,13 @@ def _wider(scale: Scale, w: Window) -> np.ndarray:
     if side == 0:
         raise LessonError("the robot did not turn in that window",
                           hint="name the window of the turn, or say `steering is LM`")
+    against = int(np.sum(u * side < -0.5))       # half a term or more the other way
+    if against:
+        raise LessonError(f"the robot turned both ways in that window ({against} of {len(u)} "
+                          f"ticks the other way, by half a term or more); `make a wider turn` "
+                          f"widens one turn",
+                          hint="name the window of one turn (`mitos simulate WORLD --trace` "
+                               "shows the steering at each tick), or say `steering is LM`")
     hardest = float(np.max(u * side))
     return np.full(len(u), float(scale.value(np.array(scale.centre + side * (hardest + 1.0)))))
 

@@ -11,7 +11,7 @@ from __future__ import annotations
 from collections.abc import Iterator
 from pathlib import Path
 
-from ..errors import MitosError, Span
+from ..errors import MitosError, Span, WorldError
 from ..resources import exists
 from .commands import incomplete
 from .session import Session
@@ -46,6 +46,10 @@ def run_lesson(session: Session, text: str, path: str) -> bool:
             if session.interrupted:         # Ctrl-C in an `adapt`: what it learned is kept
                 raise KeyboardInterrupt     # (journaled); the rest of the lesson is not run
         except MitosError as exc:
+            if isinstance(exc, WorldError) and exc.span is not None \
+                    and exc.span.path not in (None, "<prompt>", path):
+                exc.message += f" (simulated from {path}:{lineno})"   # where the world is wrong
+                raise
             if exc.span is None or exc.span.path != path:
                 where = Span.in_text("\n" * (lineno - 1) + line, path, lineno, 1)
                 if exc.span is not None and exc.span.path in (None, "<prompt>"):
