@@ -68,6 +68,15 @@ def test_rule_lines_are_rules_of_the_rule_language():
     ("= 3", "unexpected `=`", "a name", "a line is a rule"),
     ("adapt epochs", "the line ends too early", "a number", None),
     ("adapt epocs 5", "unexpected `epocs`", "`epochs`", "did you mean `epochs`?"),
+    ("quit now", "unexpected `now`", "the end of the line", None),
+    ("unfrozen r4", "the line ends too early", "`.`", "released with `undo`"),
+    ("save out dir.rules", "unexpected `dir`", "the end of the line", "is quoted"),
+    ("correct road=1 -> steering is vry LM", "unexpected `LM`", None, "did you mean `very`?"),
+    ("correct road=1 -> steering is not LM", "unexpected `LM`", None, "`not` says what it "),
+    ("use dr\u00efve", "unexpected `\u00efve`", None, "ASCII letters"),
+    ("at 5ms steering=70", "unexpected `=`", None, "a time is in seconds"),
+    ("adapt epochs 3 rate 0.9 rate 0.01", "`rate` is given twice in one `adapt`", None,
+     "give each option once"),
 ])
 def test_mistyped_lines_say_what_was_expected(line, message, expected, hint):
     with pytest.raises(RuleSyntaxError) as info:

@@ -383,3 +383,31 @@ def test_a_resumed_session_can_correct_the_run_it_recorded(tmp_path, monkeypatch
     assert "simulate" not in [e["op"] for e in again.journal.active()]   # undo skips it
     again.run("at 13s steering=60")
     assert [e.source for e in again.state.examples] == ["figure4 t=12.5s", "figure4 t=13s"]
+
+
+@pytest.mark.parametrize("line, message, column", [
+    ("frozen road.NARROWW", "unknown term `NARROWW` of `road`", 13),
+    ("frozen roadd.NARROW", "unknown variable `roadd`", 8),
+    ("frozen r400", "unknown rule label `r400` of `avoid_obstacle`", 8),
+    ("correct road=78 size=45 position=4 -> steering=150.00001",
+     "steering = 150.00001 lies outside its universe [30, 150]", 39),
+])
+def test_prompt_errors_point_at_what_is_wrong(line, message, column):
+    from mitos_cli.teach.prompt import at_prompt
+
+    s = Session(default_rulebase_path(), out=[].append)
+    with pytest.raises(MitosError) as info:
+        s.run(line)
+    err = at_prompt(info.value, line, 1)
+    assert err.message == message and err.span.column == column
+
+
+def test_undoing_every_change_leaves_nothing_unsaved():
+    s = Session(default_rulebase_path(), out=[].append)
+    s.run("use drive")
+    assert not s.unsaved                     # which behavior is active is not in the files
+    s.run("use avoid_obstacle")
+    s.run("correct road=78 size=45 position=4 -> steering=60")
+    assert s.unsaved
+    s.run("undo")
+    assert not s.unsaved

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import functools
 import json
+import re
 from dataclasses import dataclass, field
 
 from lark import Lark, Token, Tree, v_args
@@ -21,6 +22,7 @@ from ..lang.cache import lark_parser
 from ..lang.model import Rule, Setting, Use
 from ..lang.parse import (
     TERMINAL_WORDS,
+    _hedge_hint,
     _ToModel,
     check_nesting,
     check_settings,
@@ -31,7 +33,8 @@ from ..resources import grammar_text
 
 WORDS = dict(TERMINAL_WORDS, PATH="a file name", INT="a whole number", ARROW="`->`",
              SHOW_WHAT="rules, terms, examples, behaviors or history", EQUAL="`=`",
-             SIGNED_NUMBER="a number")
+             SIGNED_NUMBER="a number", SEED="a seed (a whole number)", DOT="`.`",
+             **{"$END": "the end of the line", "<END-OF-FILE>": "the end of the line"})
 
 #: Every command word, for completion and ``help``.
 COMMAND_WORDS = ("behavior", "end", "use", "frozen", "unfrozen", "operators", "eval", "correct",
@@ -169,6 +172,7 @@ class Adapt:
     rate: float | None = None
     plot: str | None = None
     constrained: bool = True         # `unconstrained`: order and bounds only
+    given: tuple[str, ...] = field(default=(), compare=False)   # the options, as written
 
 
 @dataclass(frozen=True)
@@ -294,7 +298,7 @@ class _ToCommand(_ToModel):
         return ("constrained", False)
 
     def adapt_cmd(self, items):
-        return Adapt(**dict(items))
+        return Adapt(**dict(items), given=tuple(key for key, _ in items))
 
     def show_cmd(self, items):
         return Show(str(items[0]), items[1])
@@ -334,7 +338,23 @@ def parse_command(line: str, path: str | None = None, lineno: int = 1) -> Comman
         raise RuleSyntaxError(f"cannot read `{line.strip()}`")
     if isinstance(result, TellOperators):
         check_settings(result.settings)
+    if isinstance(result, Adapt):
+        _check_once(result, line, where, lineno)
     return result
+
+
+def _check_once(c: Adapt, line: str, where: str, lineno: int) -> None:
+    """`adapt rate 0.9 rate 0.01`: an option given twice is refused at its second place
+    (which one was meant cannot be known)."""
+    for key in c.given:
+        if c.given.count(key) > 1:
+            word = "unconstrained" if key == "constrained" else key
+            places = [m.start() for m in re.finditer(rf"\b{word}\b", line)]
+            column = places[1] + 1 if len(places) > 1 else 1
+            raise RuleSyntaxError(f"`{word}` is given twice in one `adapt`",
+                                  span=Span.in_text("\n" * (lineno - 1) + line, where, lineno,
+                                                    column, column + len(word)),
+                                  hint="give each option once")
 
 
 def _unknown_command(line: str, text: str, path: str, lineno: int) -> RuleSyntaxError | None:
@@ -415,9 +435,13 @@ def _syntax_error(exc: UnexpectedInput, text: str, path: str) -> RuleSyntaxError
     assert token.line is not None and token.column is not None   # the lexer places its tokens
     span = Span.in_text(text, path, token.line, token.column,
                         token.column + max(1, len(str(token.value))))
-    hint = None
-    first = token.start_pos is not None and not text[:token.start_pos].strip()
-    if first:
+    before = text[:token.start_pos].split() if token.start_pos is not None else []
+    if before[:1] == ["save"]:              # `save out dir.rules`: one file name, then the end
+        expected = {"$END"}
+    hint = _teach_hint(text, token, before)
+    if hint is not None:
+        pass
+    elif not before:
         hint = FIRST_WORDS_HINT
     elif token.type == "NAME" and "IS" in expected:
         hint = "a condition reads `variable is TERM`"
@@ -427,6 +451,26 @@ def _syntax_error(exc: UnexpectedInput, text: str, path: str) -> RuleSyntaxError
         hint = keyword_hint(token, expected)
     return RuleSyntaxError(f"unexpected {_describe(token)}", span=span,
                            expected=_expected(expected), hint=hint)
+
+
+def _teach_hint(text: str, token: Token, before: list[str]) -> str | None:
+    """What a mistake of the teaching language most likely is, from the words before the
+    token the parser stopped at."""
+    at = token.start_pos or 0
+    if any(ord(c) > 127 for c in str(token.value)) or (at and ord(text[at - 1]) > 127):
+        return "names are written in ASCII letters, digits, `_` and `-`"
+    if before[:1] in (["save"], ["simulate"]) or before[-2:-1] == ["plot"]:
+        return 'a file name with a space in it is quoted: "my file.rules"'
+    if before[:1] == ["at"] and len(before) > 1 and any(
+            re.fullmatch(r"[\d.]+(ms|sec|secs|seconds?|min|m|h)", word)
+            for word in (before[1], "".join(before[1:3]))):
+        return "a time is in seconds: `at 5s` or `at 5` (`at 0.005s` for 5 ms)"
+    if before[-2:] == ["is", "not"] and ("->" in before or before[:1] == ["at"]):
+        return ("a target is a term, with hedges if need be (`steering is very LM`); `not` says "
+                "what it should not be, which is no target")
+    if "->" in before or before[:1] == ["at"]:
+        return _hedge_hint(text, token)
+    return None
 
 
 def _describe(token: Token) -> str:
@@ -446,4 +490,7 @@ def _eof_hint(text: str) -> str | None:
         return "give the inputs as NAME=VALUE, e.g. `eval road=78 size=45 position=4`"
     if first == "simulate":
         return "name a world file, e.g. `simulate worlds/figure4.yaml`"
+    if first == "unfrozen":
+        return ("`unfrozen` releases terms, as `unfrozen steering.LS`; a rule frozen in this "
+                "session is released with `undo`")
     return None

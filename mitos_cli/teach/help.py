@@ -44,7 +44,7 @@ Inside `behavior ... end`, `use B when C` blends B into the behavior being told.
     "frozen": """\
 frozen r4, r5     adaptation leaves the consequents of rules r4 and r5 of the open (or active)
                   behavior alone. A term is frozen in the YAML term set with `frozen: true`.
-frozen heading.AHEAD      adaptation leaves this term as it is (for the session)
+frozen heading.AHEAD      adaptation leaves this term as it is (`save` writes `frozen: true`)
 unfrozen heading.AHEAD    lift a freeze, or the hold of a centre term at its point""",
     "eval": """\
 eval road=78 size=45 position=4
@@ -105,5 +105,7 @@ def help_text(topic: str | None = None) -> str:
         return SUMMARY
     key = ALIASES.get(topic, topic)
     if key not in TOPICS:
-        raise unknown("help topic", topic, TOPICS, cls=LessonError)
+        error = unknown("help topic", topic, TOPICS, cls=LessonError)
+        error.expected = "one of " + ", ".join(sorted(TOPICS))   # all of them: a short list
+        raise error
     return TOPICS[key]

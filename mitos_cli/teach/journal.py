@@ -186,11 +186,12 @@ class Journal:
                 return line
         return 0
 
-    def active(self) -> list[dict]:
-        """The change entries that were not undone, in order."""
-        undone = {e["of"] for e in self.entries if e["op"] == "undo"}
-        return [e for e in self.entries if e["seq"] not in undone and e["op"] not in
-                RECORDS]
+    def active(self, upto: int | None = None) -> list[dict]:
+        """The change entries that were not undone, in order (as they stood after entry
+        ``upto``, when given)."""
+        entries = self.entries if upto is None else [e for e in self.entries if e["seq"] <= upto]
+        undone = {e["of"] for e in entries if e["op"] == "undo"}
+        return [e for e in entries if e["seq"] not in undone and e["op"] not in RECORDS]
 
 
 #: the sessions this process holds (their lock files stay open until it exits)

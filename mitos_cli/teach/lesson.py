@@ -15,6 +15,7 @@ from ..errors import MitosError, Span, WorldError
 from ..resources import exists
 from .commands import incomplete
 from .session import Session
+from .text import quoted_column
 
 
 def commands(text: str) -> Iterator[tuple[int, str]]:
@@ -51,7 +52,9 @@ def run_lesson(session: Session, text: str, path: str) -> bool:
                 exc.message += f" (simulated from {path}:{lineno})"   # where the world is wrong
                 raise
             if exc.span is None or exc.span.path != path:
-                where = Span.in_text("\n" * (lineno - 1) + line, path, lineno, 1)
+                start, end = quoted_column(exc.message, line)
+                where = Span.in_text("\n" * (lineno - 1) + line, path, lineno, start,
+                                     end or None)
                 if exc.span is not None and exc.span.path in (None, "<prompt>"):
                     where = Span.in_text("\n" * (lineno - 1) + line, path, lineno,
                                          exc.span.column, exc.span.end_column)

@@ -16,6 +16,7 @@ import sys
 from pathlib import Path
 
 from ..errors import LessonError, MitosError, Span
+from .text import quoted_column
 from ..fuzzy.hedges import HEDGES
 from .commands import COMMAND_WORDS, SHOW_WHAT, incomplete
 from .session import Session
@@ -109,7 +110,8 @@ def at_prompt(exc: MitosError, line: str, lineno: int) -> MitosError:
     if isinstance(exc, LessonError):
         exc.kind = "command error"
     if exc.span is None:
-        exc.span = Span.in_text("\n" * (lineno - 1) + line, PROMPT, lineno, 1)
+        start, end = quoted_column(exc.message, line)
+        exc.span = Span.in_text("\n" * (lineno - 1) + line, PROMPT, lineno, start, end or None)
     return exc
 
 

@@ -33,7 +33,8 @@ import numpy as np
 from ..engine.compile import CompiledRuleBase, compile_rulebase
 from ..errors import LessonError, MitosError, RuleBaseError, Span, unknown
 from ..lang.interpretability import held_term
-from ..lang.model import And, Behavior, Expr, Not, Prop, Rule, RuleBase, format_expr, format_rule, format_use
+from ..lang.model import (And, Behavior, Expr, Not, Prop, Rule, RuleBase, format_expr,
+                          format_number, format_rule, format_use)
 from ..lang.operators import resolve
 from ..lang.resolve import check_expr, check_rule, load_rules_file
 from ..words import plural
@@ -246,9 +247,10 @@ class Session:
 
     @property
     def unsaved(self) -> bool:
-        changes = [e["seq"] for e in self.journal.entries
-                   if e["op"] not in ("start", "save", "simulate")]
-        return bool(changes) and changes[-1] > self.saved_seq
+        def changes(upto: int | None = None) -> list[int]:   # what `save` would write
+            return [e["seq"] for e in self.journal.active(upto) if e["op"] != "activate"]
+
+        return changes() != changes(self.saved_seq)
 
     def compiled(self, behavior: str | None = None) -> CompiledRuleBase:
         name = behavior or self.state.active
@@ -372,7 +374,7 @@ class Session:
         labels = [r.label for r in b.rules]
         for label in c.labels:
             if label not in labels:
-                raise unknown(f"rule label in behavior `{b.name}`", label, labels)
+                raise unknown("rule label", label, labels, owner=b.name)
         self.change("frozen", line, behavior=b.name, labels=list(c.labels))
         self.out(f"{b.name}: adaptation leaves the consequents of {', '.join(c.labels)} alone")
 
@@ -446,7 +448,7 @@ class Session:
             if role == "output":
                 lo, hi = compiled.variables[a.name].universe
                 if not lo <= a.value <= hi:
-                    raise LessonError(f"{a.name} = {a.value:g} lies outside its universe "
+                    raise LessonError(f"{a.name} = {format_number(a.value)} lies outside its universe "
                                       f"[{lo:g}, {hi:g}]", span=a.span)
             out[a.name] = a.value
         missing = [n for n in names if n not in out]
@@ -605,7 +607,7 @@ class Session:
         X, T = self.training_set(compiled)
         epochs = _whole(c.epochs, "epochs", 1) if c.epochs is not None else 50
         if epochs > MAX_EPOCHS:         # 10^300 epochs is a hang, not a lesson
-            raise LessonError(f"at most {MAX_EPOCHS:,} epochs in one `adapt`, not {epochs:g}",
+            raise LessonError(f"at most {MAX_EPOCHS:,} epochs in one `adapt`, not {epochs:,}",
                               hint="adapt again to go on from where it stopped")
         rate = 0.5 if c.rate is None else c.rate
         result = self._learn(c, compiled, X, T, epochs, rate)

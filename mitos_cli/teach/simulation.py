@@ -7,6 +7,8 @@ perceived at a time (or in a time window) into examples.
 
 from __future__ import annotations
 
+import math
+
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -62,6 +64,9 @@ class Recording:
         t = self.t
         end = float(t[-1])
         for value in (start, stop):
+            if value is not None and not math.isfinite(value):
+                raise LessonError(f"a time is a finite number of seconds (the run lasted 0 to "
+                                  f"{end:g} s)")
             if value is not None and not -1e-9 <= value <= end + 1e-9:
                 raise LessonError(f"the run lasted 0 to {end:g} s; {value:g} s is outside it")
         active = self.result.active[:, self.robot] if self.result.active is not None else \

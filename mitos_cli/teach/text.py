@@ -143,3 +143,18 @@ def interpretability_text(rb: RuleBase) -> str:
         return "interpretability: terms in order, universes covered, terms distinct, " \
                "centre terms on their points"
     return "\n".join(["interpretability:"] + [f"  {i.message} ({i.hint})" for i in issues])
+
+
+def quoted_column(message: str, line: str) -> tuple[int, int]:
+    """Where in ``line`` the first name an error message quotes (`` `NARROWW` ``) is written,
+    as 1-based columns ``(start, end)``; ``(1, None)``-like ``(1, 0)`` when none is (the caret
+    then stands at the start of the line)."""
+    import re
+
+    for name in re.findall(r"`([^`\s]+)`", message):
+        found = re.search(r"(?<![\w.])" + re.escape(name) + r"(?![\w])", line)
+        if found is None and "." not in name:
+            found = re.search(r"(?<=\.)" + re.escape(name) + r"(?![\w])", line)  # `TERM`
+        if found is not None:
+            return found.start() + 1, found.end() + 1
+    return 1, 0
