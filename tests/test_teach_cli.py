@@ -332,3 +332,14 @@ def test_a_bad_world_in_a_lesson_is_reported_in_the_world_file(work):
     assert res.returncode == 1
     assert "bad.yaml:1:1: world error: unknown key `corridor` in the world file (simulated " \
            "from p.lesson:2)" in res.stderr
+
+
+def test_a_block_left_open_is_said_and_a_binary_lesson_is_placed(work):
+    res = mitos("teach", "rb/mitos.rules", "--lesson", "-", cwd=work,
+                stdin="behavior b1\nif road is NARROW then speed is SLOW\n")
+    assert res.returncode == 0 and "behavior `b1` still open" in res.stderr
+    res = mitos("teach", "--resume", "--lesson", "-", cwd=work, stdin="end\n")
+    assert "behavior `b1` is still open (`end` closes it)" in res.stderr
+    (work / "garbage.lesson").write_bytes(b"use drive\n\xaf\xfe junk\n")
+    res = mitos("teach", "rb/mitos.rules", "--lesson", "garbage.lesson", cwd=work)
+    assert res.returncode == 1 and res.stderr.startswith("garbage.lesson:2:1: lesson error: ")

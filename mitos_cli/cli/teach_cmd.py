@@ -104,7 +104,9 @@ def teach_command(
                f"and was dropped; the journal as it was is kept as {journal.aside}"
                if journal.skipped_tail else "")
             + (f"; recovered up to the damaged line {journal.recovered_at} of the journal "
-               f"(kept as {journal.aside})" if journal.recovered_at else ""))
+               f"(kept as {journal.aside})" if journal.recovered_at else "")
+            + (f"; behavior `{session.state.block}` is still open (`end` closes it)"
+               if session.state.block is not None else ""))
     else:
         from ..resources import resolve
 
@@ -138,6 +140,9 @@ def teach_command(
             err(f"interrupted: every change so far is in the journal; `mitos teach --resume "
                 f"--session {journal.directory.name}` continues")
             raise typer.Exit(130) from None
+        if session.state.block is not None:
+            err(f"warning: the lesson ended with behavior `{session.state.block}` still open; "
+                f"`end` closes it (`mitos teach --resume --session {journal.directory.name}`)")
         if session.save_as is not None and session.unsaved:
             if transcript is not None:
                 transcript.command("save (the lesson ended with unsaved changes)")

@@ -83,6 +83,11 @@ def read_lesson(source: str) -> tuple[str, str]:
         return read_text(path), source
     except (OSError, UnicodeDecodeError) as exc:
         error = LessonError(f"cannot read lesson `{source}`: {why_unreadable(exc)}")
+        if isinstance(exc, UnicodeDecodeError):        # the place of the first bad byte
+            data = exc.object
+            line = data.count(b"\n", 0, exc.start) + 1
+            column = exc.start - (data.rfind(b"\n", 0, exc.start) + 1) + 1
+            error.span = Span(source, line, column)
         if isinstance(exc, FileNotFoundError):     # a mistyped name: the packaged lessons
             from ..errors import did_you_mean
             from ..resources import packaged_names

@@ -160,6 +160,9 @@ def interact(session: Session, history: Path | None = None) -> None:
                 print("interrupted", file=err)
             sys.stdout.flush()
     finally:
+        if session.state.block is not None:
+            print(f"behavior `{session.state.block}` is still open; `mitos teach --resume` "
+                  f"keeps it open, `end` closes it", file=err)
         if session.unsaved:
             where = session.journal.directory.name
             print(f"unsaved changes are kept in the journal; `mitos teach --resume` "
