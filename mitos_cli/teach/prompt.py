@@ -16,10 +16,10 @@ import sys
 from pathlib import Path
 
 from ..errors import LessonError, MitosError, Span
-from .text import quoted_column
 from ..fuzzy.hedges import HEDGES
 from .commands import COMMAND_WORDS, SHOW_WHAT, incomplete
 from .session import Session
+from .text import quoted_column
 
 
 class Completer:

@@ -33,8 +33,19 @@ import numpy as np
 from ..engine.compile import CompiledRuleBase, compile_rulebase
 from ..errors import LessonError, MitosError, RuleBaseError, Span, unknown
 from ..lang.interpretability import held_term
-from ..lang.model import (And, Behavior, Expr, Not, Prop, Rule, RuleBase, format_expr,
-                          format_number, format_rule, format_use)
+from ..lang.model import (
+    And,
+    Behavior,
+    Expr,
+    Not,
+    Prop,
+    Rule,
+    RuleBase,
+    format_expr,
+    format_number,
+    format_rule,
+    format_use,
+)
 from ..lang.operators import resolve
 from ..lang.resolve import check_expr, check_rule, load_rules_file
 from ..words import plural
@@ -547,9 +558,7 @@ class Session:
         return [dict(zip(compiled.outputs, map(float, row))) for row in y]
 
     def _simulate(self, c: cmd.Simulate, line: str) -> None:
-        from .simulation import run_world
-
-        from .simulation import world_path
+        from .simulation import run_world, world_path
 
         seed = _seed(c.seed) if c.seed is not None else None
         self.compiled()

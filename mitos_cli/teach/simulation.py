@@ -8,7 +8,6 @@ perceived at a time (or in a time window) into examples.
 from __future__ import annotations
 
 import math
-
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
