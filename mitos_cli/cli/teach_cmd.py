@@ -71,6 +71,7 @@ def teach_command(
 ) -> None:
     """Teach a rule base: tell rules and behaviors, correct outputs, adapt, save."""
     from ..api import default_rulebase_path
+    from ..errors import LessonError
     from ..teach.journal import Journal, find_session, new_session_dir
     from ..teach.lesson import read_lesson, run_lesson
     from ..teach.progress import epoch_progress
@@ -94,8 +95,13 @@ def teach_command(
         if rules is not None or behavior is not None:
             raise typer.BadParameter("--resume continues a session with its own rule file and "
                                      "behavior; give neither RULES nor --behavior")
-        journal = Journal.open(find_session(session_name), recover=recover)
-        session = Session.resume(journal, out=out, progress=epoch_progress, recover=recover)
+        try:
+            journal = Journal.open(find_session(session_name), recover=recover)
+            session = Session.resume(journal, out=out, progress=epoch_progress,
+                                     recover=recover)
+        except LessonError as exc:          # the session, not a lesson, is what is wrong
+            exc.kind = "session error"
+            raise
         if save_as is not None:
             session.save_as = Path(save_as)
         err(f"resumed session {journal.directory.name}: {plural(len(journal.active()), 'change')}, "
