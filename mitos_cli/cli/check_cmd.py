@@ -29,7 +29,8 @@ def render(report, trace_path: str) -> str:
     for f in report.findings:
         where = (f"{show_path(f.span.path)}:{f.span.line}:{f.span.column}: "
                  if f.span else "")
-        lines.append(f"{where}{f.severity}: {f.message} [{f.code}]")
+        shown = "note" if f.severity == "info" else f.severity     # as the summary counts it
+        lines.append(f"{where}{shown}: {f.message} [{f.code}]")
         for box in f.regions:
             lines.append(f"    {box.describe()}")
         if f.more_regions:
