@@ -162,3 +162,27 @@ def test_a_yaw_of_3_14_as_in_the_stata_basement_map_is_turned_not_refused(tmp_pa
     centres = np.stack([g.origin[0] + (cols + 0.5), g.origin[1] + (rows + 0.5)], axis=1)
     assert len(centres) >= 1
     assert np.hypot(centres[:, 0] - x, centres[:, 1] - y).min() < 0.71
+
+
+def test_map_modes_raw_and_an_unknown_one(tmp_path: Path):
+    """`mode: raw` reads pixel values as occupancy percent (0 free, 100 occupied, above 100
+    unknown), as map_server does; an unknown mode was silently read as trinary."""
+    (tmp_path / "r.pgm").write_bytes(b"P5 3 1 255\n" + bytes([0, 100, 255]))
+    (tmp_path / "r.yaml").write_text("image: r.pgm\nresolution: 0.05\norigin: [0, 0, 0]\n"
+                                     "mode: raw\n")
+    g = load_map_yaml(tmp_path / "r.yaml", unknown_occupied=False)
+    assert g.occupied.tolist() == [[False, True, False]]
+    assert load_map_yaml(tmp_path / "r.yaml").occupied.tolist() == [[False, True, True]]
+    (tmp_path / "r.yaml").write_text("image: r.pgm\nresolution: 0.05\norigin: [0, 0, 0]\n"
+                                     "mode: rw\n")
+    with pytest.raises(WorldError, match="unknown map_server mode `rw`") as info:
+        load_map_yaml(tmp_path / "r.yaml")
+    assert info.value.span.line == 4 and info.value.hint == "did you mean `raw`?"
+
+
+def test_a_map_named_by_its_image_points_at_its_yaml(tmp_path: Path):
+    (tmp_path / "m.pgm").write_bytes(b"P5 2 3 255\n" + bytes(PIXELS))
+    (tmp_path / "m.yaml").write_text("image: m.pgm\nresolution: 0.05\norigin: [0, 0, 0]\n")
+    with pytest.raises(WorldError, match="`m.pgm` is a map image") as info:
+        load_map_yaml(tmp_path / "m.pgm")
+    assert info.value.hint == f"did you mean `{tmp_path / 'm.yaml'}`?"

@@ -379,3 +379,24 @@ def test_a_huge_number_is_explained_in_its_own_unit():
 def test_randomising_obstacles_in_a_world_without_any_says_so():
     msg = error(BASE + "randomise:\n  obstacles:\n    box: {dx: [-30, 30]}\n")
     assert "randomise moves obstacles, and the world has none" in msg    # "expected one of "
+
+
+def test_a_time_limit_shorter_than_a_tick_is_refused():
+    msg = error(BASE.replace("time_limit: 10", "time_limit: 0.01"))
+    assert "w.yaml:4:13" in msg and "shorter than one tick (dt 0.05 s)" in msg
+
+
+def test_a_name_that_is_not_text_is_refused():
+    assert "w.yaml:1:7" in error(BASE.replace("name: t", "name: [1, 2]"))
+    assert 'quote it: name: "42"' in error(BASE.replace("name: t", "name: 42"))
+
+
+def test_corridors_too_large_for_the_robots_map_are_refused():
+    """The robot's map of a corridor world is a raster of 2 in cells; a world of 1e6 in was
+    a NumPy allocation of 233 GiB (a traceback)."""
+    msg = error(BASE.replace("[[0, 0], [400, 0]]", "[[0, 0], [1000000, 0], [1000000, 1000000]]"))
+    assert "w.yaml:13:5" in msg and "at most 5,000,000 fit" in msg
+
+
+def test_an_angle_too_large_is_explained_in_degrees():
+    assert "angles are in degrees" in error(BASE.replace("heading: 0", "heading: 1e300"))

@@ -174,3 +174,30 @@ def test_compare_json_is_the_documented_object(tiny, tmp_path, monkeypatch, comp
     assert {k for s in data["summaries"] for k in s["rates"]} == {
         "success", "collision", "timeout", "stuck"}
     assert len(read_rows("st")) == data["tasks"] == data["executed"] == 6
+
+
+def test_resume_refuses_a_world_that_changed(tmp_path, compare):
+    """Resuming after the world file was edited would average runs of two different worlds
+    (it did: 50% success, where the edited world alone gives 0%)."""
+    world = tmp_path / "w.yaml"
+    world.write_text(TINY)
+    out = tmp_path / "s"
+    args = (world, "--planner", "dwa", "-o", out, "-j", 1, "--no-plots")
+    assert compare(*args, "--runs", 1).exit_code == 0
+    world.write_text(TINY + "\n# edited\n")
+    r = compare(*args, "--runs", 2, "--resume")
+    assert r.exit_code == 1 and "changed since the runs in" in r.stderr
+    assert len(read_rows(out)) == 1
+    world.write_text(TINY)                               # put back: it resumes
+    assert compare(*args, "--runs", 2, "--resume").exit_code == 0
+
+
+def test_worlds_of_one_stem_are_told_apart(tmp_path, compare):
+    (tmp_path / "sub").mkdir()
+    for w in (tmp_path / "w.yaml", tmp_path / "sub" / "w.yaml"):
+        w.write_text(TINY)
+    r = compare(tmp_path / "w.yaml", tmp_path / "sub" / "w.yaml", "--planner", "dwa",
+                "--runs", 1, "-o", tmp_path / "s", "-j", 1, "--no-plots")
+    assert r.exit_code == 0, r.output
+    report = (tmp_path / "s" / "report.md").read_text()
+    assert f"| {tmp_path / 'w.yaml'} |" in report and f"| {tmp_path / 'sub' / 'w.yaml'} |" in report

@@ -101,8 +101,13 @@ def _runs_table(runs) -> str:
                 row.append(f"{mean:.1f}" if len(r.summaries) == 1 else f"{mean:.1f} ± {std:.1f}")
             rows.append(row)
     widths = [max(len(r[i]) for r in rows) for i in range(len(head))]
-    return "\n".join("  ".join(c.ljust(wd) if i == 0 else c.rjust(wd)
-                               for i, (c, wd) in enumerate(zip(r, widths))) for r in rows)
+    table = "\n".join("  ".join(c.ljust(wd) if i == 0 else c.rjust(wd)
+                                for i, (c, wd) in enumerate(zip(r, widths))) for r in rows)
+    if any(r.rate("success") < 1 for w in runs.worlds for r in (w, *w.robots)
+           if "success" in r.outcomes):
+        table += ("\n(time, path and speed: means over every run, a collision's or a timeout's "
+                  "until it ended; `mitos compare` takes time and path over the successful runs)")
+    return table
 
 
 def _draw_runs(result, world, plot: Path):

@@ -11,8 +11,9 @@ row 0 at the bottom. Metres become inches.
 The image is a PGM (read here, no dependency) or anything Pillow reads (PNG, BMP, TIFF, ...;
 Pillow is the optional extra ``mitos[maps]``, which matplotlib already brings): colour images
 are read as luminance, an alpha channel is ignored, as map_server does in its default
-``trinary`` mode. An origin with a yaw rotates the map about its origin: the grid the simulator
-keeps is axis-aligned, so a rotated map is resampled (nearest cell, same resolution) onto the
+``trinary`` mode; ``mode: raw`` reads pixel values as occupancy percentages (:data:`MODES`).
+An origin with a yaw rotates the map about its origin: the grid the simulator keeps is
+axis-aligned, so a rotated map is resampled (nearest cell, same resolution) onto the
 axis-aligned cells covering it; a quarter, half or three-quarter turn is exact (no
 resampling), any other yaw moves walls by at most half a cell's diagonal.
 """
@@ -24,13 +25,14 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import Span, WorldError
+from ..errors import Span, WorldError, unknown
 from ..lang import yamlpos
 from ..resources import exists
 from .pgm import read_pgm
 from .world import Grid
 
 INCH_PER_M = 1.0 / 0.0254
+IMAGE_SUFFIXES = (".pgm", ".png", ".bmp", ".tif", ".tiff", ".jpg", ".jpeg", ".gif", ".ppm")
 MAP_KEYS = ("image", "resolution", "origin", "negate", "occupied_thresh", "free_thresh", "mode")
 
 
@@ -40,10 +42,21 @@ def occupancy(pixels: np.ndarray, maxval: int, negate: bool) -> np.ndarray:
     return p if negate else 1.0 - p
 
 
+#: map_server's modes: ``trinary`` and ``scale`` read a pixel as above (``scale`` grades the
+#: cells between the thresholds, which a grid of free and blocked cells cannot hold: they are
+#: unknown in both); ``raw`` takes the pixel value as the occupancy in percent (0 free, 100
+#: occupied, above 100 unknown; ``negate`` does not apply), as map_server writes it
+MODES = ("trinary", "scale", "raw")
+
+
 def classify(pixels: np.ndarray, maxval: int, *, negate: bool, occupied_thresh: float,
-             free_thresh: float, unknown_occupied: bool = True) -> np.ndarray:
+             free_thresh: float, unknown_occupied: bool = True,
+             mode: str = "trinary") -> np.ndarray:
     """Blocked cells ``[rows, cols]`` with row 0 at the BOTTOM of the map (rows flipped)."""
-    occ = occupancy(pixels, maxval, negate)
+    if mode == "raw":
+        occ = np.where(pixels > 100, np.nan, pixels / 100.0)      # NaN: unknown
+    else:
+        occ = occupancy(pixels, maxval, negate)
     occupied = occ > occupied_thresh
     free = occ < free_thresh
     blocked = occupied | (~free if unknown_occupied else np.zeros_like(occupied))
@@ -118,6 +131,14 @@ def load_map_yaml(path: Path, *, unknown_occupied: bool = True,
     """Read a map_server ``map.yaml`` and its image into a :class:`Grid` in inches."""
     from ..fileio import read_text, why_unreadable
 
+    if path.suffix.lower() in IMAGE_SUFFIXES:        # the image named where its YAML goes
+        beside = [p for p in (path.with_suffix(".yaml"), path.parent / "map.yaml") if exists(p)]
+        raise WorldError(f"`{path.name}` is a map image; a map is named by its map_server YAML "
+                         f"file (which names the image, its resolution and origin)", span=where,
+                         expected="PATH.yaml",
+                         hint=f"did you mean `{beside[0]}`?" if beside else
+                         "write a YAML beside it: `image: " + path.name + "`, `resolution: 0.05`, "
+                         "`origin: [0, 0, 0]`")
     try:
         text = read_text(path)
     except (OSError, UnicodeDecodeError) as exc:
@@ -150,6 +171,10 @@ def load_map_yaml(path: Path, *, unknown_occupied: bool = True,
     ox, oy, yaw = (yamlpos.expect_number(v, spec.value_span("origin"), WorldError, "origin")
                    for v in origin)
     negate = _negate(spec)
+    mode = spec.get("mode", "trinary")
+    if mode not in MODES:
+        raise unknown("map_server mode", str(mode), MODES, span=spec.value_span("mode"),
+                      cls=WorldError)
     occ_t, free_t = (yamlpos.expect_number(spec.get(key, default), spec.value_span(key),
                                            WorldError, key)
                      for key, default in (("occupied_thresh", 0.65), ("free_thresh", 0.196)))
@@ -171,7 +196,7 @@ def load_map_yaml(path: Path, *, unknown_occupied: bool = True,
                          span=spec.value_span("image"),
                          hint="give a PGM (P5 or P2) or an image Pillow reads (PNG)") from None
     blocked = classify(pixels, maxval, negate=negate, occupied_thresh=occ_t,
-                       free_thresh=free_t, unknown_occupied=unknown_occupied)
+                       free_thresh=free_t, unknown_occupied=unknown_occupied, mode=mode)
     res, origin = res_m * INCH_PER_M, (ox * INCH_PER_M, oy * INCH_PER_M)
     if abs(math.remainder(yaw, 2 * math.pi)) > 1e-12:
         blocked, origin = rotate(blocked, res, origin, yaw)

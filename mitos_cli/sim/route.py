@@ -12,6 +12,7 @@ import heapq
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
@@ -571,9 +572,14 @@ def grid_route(static: StaticMap, start: Pose, goal: Goal, clearance: float,
                 g.origin[1] + (fr[rc] + 0.5) * g.resolution)
 
     s, t = cell_of(start.x, start.y), cell_of(goal.x, goal.y)
-    for rc, what in ((s, "start"), (t, "goal")):
+    for rc, what, (x, y) in ((s, "start", (start.x, start.y)), (t, "goal", (goal.x, goal.y))):
         if not (0 <= rc[0] < R and 0 <= rc[1] < C):
-            raise WorldError(f"the {what} lies outside the map")
+            name = f" `{Path(g.source).name}`" if g.source else ""
+            raise WorldError(
+                f"the {what} ({x:g}, {y:g}) lies outside the map{name} the robot plans on "
+                f"(x {g.origin[0]:g} to {g.origin[0] + cols * g.resolution:g}, y "
+                f"{g.origin[1]:g} to {g.origin[1] + rows * g.resolution:g} in)",
+                hint="a `given` map must cover the start and the goal" if g.source else None)
     moves = MOVES
     floor = clearance if minimum is None else min(minimum, clearance)
     # prefer the middle; a node closer than `clearance` (but not than `floor`) costs

@@ -60,7 +60,9 @@ LARGEST = 1e7
 #: what a number beyond LARGEST means, for the keys that are not lengths in inches
 BEYOND = {"time_limit": "times are in seconds: 1e7 s is 116 days",
           "dt": "times are in seconds: 1e7 s is 116 days",
-          "substeps": "a count this large would never finish a tick"}
+          "substeps": "a count this large would never finish a tick",
+          **dict.fromkeys(("heading", "fov", "cone"),
+                          "angles are in degrees: 1e7 deg is 27,778 turns")}
 
 
 def _sane(x: float, span: Span, what: str, key: str = "") -> float:
@@ -312,18 +314,49 @@ def _seed(r: _Reader, top: YMap) -> int:
     return int(seed)
 
 
+#: cells of the robot's map of a corridor world (2 in each, knowledge.RASTER): 5e6 is a
+#: building of 4,470 x 4,470 in (114 m square); a run takes about 160 bytes a cell (a corridor
+#: of 18e6 cells took 2.9 GB)
+MAX_RASTER_CELLS = 5_000_000
+
+
+def _check_extent(corridors: list[Corridor], span: Span | None) -> None:
+    """Refuse corridors whose bounding box the robot's map (a raster of 2 in cells, made when
+    it must plan round something) cannot hold: it was a NumPy allocation of hundreds of GiB."""
+    from .knowledge import RASTER
+
+    xs = [x for c in corridors for x, _ in c.points]
+    ys = [y for c in corridors for _, y in c.points]
+    margin = max(c.width for c in corridors)
+    width, height = max(xs) - min(xs) + margin, max(ys) - min(ys) + margin
+    cells = (width / RASTER + 2) * (height / RASTER + 2)
+    if cells > MAX_RASTER_CELLS:
+        raise WorldError(f"the corridors span {width:,.0f} x {height:,.0f} in: the robot's map "
+                         f"of them would be {cells:,.0f} cells of {RASTER:g} in, and at most "
+                         f"{MAX_RASTER_CELLS:,} fit", span=span,
+                         hint="a smaller building, or a `grid` map at a coarser resolution")
+
+
 def parse_world(text: str, path: str) -> World:
     """Parse world YAML ``text`` (read from ``path``, which anchors relative map paths)."""
     r = _Reader(path)
     doc = yamlpos.load(text, path, WorldError)
     top = r.mapping(doc, Span.in_text(text, path, 1, 1), "the world file", TOP_KEYS)
-    name = str(yamlpos.require(top, "name", WorldError, "the world file"))
+    name = yamlpos.require(top, "name", WorldError, "the world file")
+    if not isinstance(name, str):                   # `name: [1, 2]` printed as a title
+        raise WorldError("the world's `name` must be text", span=top.value_span("name"),
+                         hint=f'quote it: name: "{name}"' if isinstance(name, (int, float))
+                         else "name: corridor")
     if any(not c.isprintable() for c in name):      # it is printed in every table and title
         raise WorldError("the world's name holds a control character",
                          span=top.value_span("name"), hint="letters, digits, `-`, `_`, spaces")
     seed = _seed(r, top)
     dt = r.number(top, "dt", "the world file", None, positive=True, maximum=1.0)
     limit = r.number(top, "time_limit", "the world file", None, positive=True)
+    if limit < dt:                                  # no tick would be run: no result
+        raise WorldError(f"time_limit {limit:g} s is shorter than one tick (dt {dt:g} s)",
+                         span=top.value_span("time_limit"),
+                         expected=f"a time_limit of at least dt ({dt:g} s)")
     if limit / dt > MAX_TICKS:
         raise WorldError(f"time_limit {limit:g} s at dt {dt:g} s is {limit / dt:,.0f} ticks; a "
                          f"run takes at most {MAX_TICKS:,}", span=top.value_span("dt"),
@@ -376,6 +409,8 @@ def parse_world(text: str, path: str) -> World:
     if not corridors and grid is None:
         raise WorldError("the map has neither `corridors` nor a `grid`", span=mp.span,
                          hint="add `corridors: [{points: [[0, 0], [600, 0]], width: 70}]`")
+    if grid is None:
+        _check_extent(corridors, mp.value_span("corridors"))
     knows, given = read_given(mp, path, unknown_occupied)
     min_clearance, replan = None, "clearance"
     if "route" in top:

@@ -50,8 +50,13 @@ def _metric_heading(field: str) -> str:
     raise KeyError(field)
 
 
-def _world_name(world: str) -> str:
-    return world if world == ALL_WORLDS else Path(world).stem
+def _world_names(summaries: list[Summary]) -> dict[str, str]:
+    """Each world as the tables show it: its file's stem, or its path as given where two
+    worlds of the study share a stem (`corr.yaml` and `sub/corr.yaml`)."""
+    worlds = list(dict.fromkeys(s.world for s in summaries))
+    stems = [Path(w).stem for w in worlds if w != ALL_WORLDS]
+    return {w: w if w == ALL_WORLDS or stems.count(Path(w).stem) > 1 else Path(w).stem
+            for w in worlds}
 
 
 # -- terminal -------------------------------------------------------------------------------
@@ -91,8 +96,9 @@ def rich_tables(summaries: list[Summary], ranks: list[Rank]):
     for f in TABLE_METRICS:
         table.add_column(TERMINAL_HEADINGS[f], justify="right", no_wrap=True)
     last = None
+    names = _world_names(summaries)
     for s in summaries:
-        world = _world_name(s.world)
+        world = names[s.world]
         if last is not None and world != last:
             table.add_section()
         table.add_row(world if world != last else "", s.choice.label, str(s.n),
@@ -133,7 +139,8 @@ def _md_table(header: list[str], rows: list[list[str]], align: list[str]) -> str
 def outcome_table_md(summaries: list[Summary]) -> str:
     header = ["world", "choice", "n", *(h for _f, h in RATE_COLUMNS),
               *(_metric_heading(f) for f in TABLE_METRICS)]
-    rows = [[_world_name(s.world), s.choice.label, str(s.n),
+    names = _world_names(summaries)
+    rows = [[names[s.world], s.choice.label, str(s.n),
              *(fmt_rate(s.rates[f]) for f, _h in RATE_COLUMNS),
              *(fmt_mean(s.metrics[f]) for f in TABLE_METRICS)] for s in summaries]
     return _md_table(header, rows, ["l", "l"] + ["r"] * (len(header) - 2))

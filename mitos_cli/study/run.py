@@ -37,7 +37,35 @@ class Study:
     def manifest(self) -> dict:
         return {"worlds": list(self.worlds), "choices": [c.label for c in self.choices],
                 "runs": self.runs, "seed": self.seed, "rulebase": self.rulebase,
-                "behavior": self.behavior, "command": self.command}
+                "behavior": self.behavior, "command": self.command,
+                "digests": self.digests()}
+
+    def digests(self) -> dict[str, str]:
+        """A digest of each input file (the worlds, the rule base and its term sets), so that
+        `--resume` can refuse to mix runs of a file that changed with runs of the new one."""
+        import hashlib
+
+        from ..api import read_rulebase
+        from ..errors import MitosError
+
+        def digest(paths: list[Path]) -> str | None:
+            h = hashlib.sha256()
+            try:
+                for p in paths:
+                    h.update(p.read_bytes())
+            except OSError:
+                return None                  # (reported where the file is read)
+            return h.hexdigest()[:16]
+
+        files = {path: [Path(path)] for path in self.worlds}
+        try:
+            rb = read_rulebase(self.rulebase)
+            if rb.path is not None:
+                files["rulebase"] = [Path(rb.path)] + [Path(rb.path).parent / p
+                                                       for p in rb.termset_paths]
+        except MitosError:
+            pass
+        return {name: d for name, paths in files.items() if (d := digest(paths)) is not None}
 
 
 @dataclass

@@ -143,6 +143,8 @@ class ResultStore:
                              f"not {manifest.get('seed')}",
                              hint=f"resume with --seed {old.get('seed')}, or choose another "
                                   "directory with -o")
+        if old is not None:
+            _check_unchanged(old.get("digests") or {}, manifest.get("digests") or {}, self.path)
         finished, todo = rows_for(tasks, rows)
         write_atomic(self.manifest_path, json.dumps(manifest, indent=2) + "\n")
         if not rows:
@@ -178,6 +180,17 @@ def write_atomic(path: Path, text: str) -> None:
     from ..fileio import atomic_write
 
     atomic_write(path, text, error=StudyError)
+
+
+def _check_unchanged(old: dict, new: dict, path: Path) -> None:
+    """A world or rule base edited since the study began: its finished runs are of the old
+    file, and resuming would average them with runs of the new one."""
+    changed = [name for name, digest in new.items() if name in old and old[name] != digest]
+    if changed:
+        what = ", ".join("the rule base" if n == "rulebase" else f"`{n}`" for n in changed)
+        raise StudyError(f"{what} changed since the runs in {path} were made; resuming would "
+                         f"mix runs of the old and the new file",
+                         hint="choose another directory with -o (or put the file back)")
 
 
 def rows_for(tasks: Iterable[Task], rows: list[dict]) -> tuple[list[dict], list[Task]]:
