@@ -215,11 +215,18 @@ def fuzzylite_term(name: str, kind: str, values: list[float], n_inputs: int,
                           hint="MITOS terms reach 1; scale the rule weights instead")
     if shape == "rectangle":            # fuzzylite takes the ends in either order
         values = sorted(values)
+    return make_term(name, *shoulder(shape, tuple(values)), span)
+
+
+def shoulder(shape: str, values: tuple[float, ...]) -> tuple[str, tuple[float, ...]]:
+    """A trapezoid with both feet at -inf (or +inf) is the shoulder it draws (``Trapezoid
+    -inf -inf c d``, ``trapmf [-inf -inf c d]``): a term set takes shoulders, not infinite
+    corners."""
     if shape == "trapezoid" and values[0] == values[1] == -math.inf:
-        shape, values = "left_shoulder", values[2:]         # `Trapezoid -inf -inf c d`
-    elif shape == "trapezoid" and values[2] == values[3] == math.inf:
-        shape, values = "right_shoulder", values[:2]        # `Trapezoid a b inf inf`
-    return make_term(name, shape, tuple(values), span)
+        return "left_shoulder", values[2:]
+    if shape == "trapezoid" and values[2] == values[3] == math.inf:
+        return "right_shoulder", values[:2]
+    return shape, values
 
 
 def distinct_names(terms: list[Term], variable: str, notes: list[str], why: str,

@@ -320,7 +320,8 @@ def _mf(value: str, vspan: Span, role: str, kind: str, n_inputs: int) -> Term:
     if len(params) != count:
         raise FormatError(f"MF `{name}`: {mf} takes {plural(count, 'number')}, not {len(params)}",
                           span=vspan)
-    return common.make_term(name, shape, tuple(params[i] for i in order), vspan)
+    return common.make_term(name, *common.shoulder(shape, tuple(params[i] for i in order)),
+                            vspan)
 
 
 #: Octave's fuzzy-logic-toolkit: the fraction of an antecedent's MF index is a hedge, the
@@ -477,11 +478,13 @@ def _mf_text(t: Term, v: Variable) -> str:
         assert corners is not None             # these five shapes are piecewise linear
         a, b, c, d = corners
         lo, hi = v.universe
-        # MATLAB trapmf has no infinite feet: put them just outside the universe
-        a = min(lo, b) - 1.0 if a == -float("inf") else a
-        b = a if b == -float("inf") else b
-        d = max(hi, c) + 1.0 if d == float("inf") else d
-        c = d if c == float("inf") else c
+        # a shoulder's open end: feet just outside the universe (inputs are clamped to it and
+        # outputs sampled inside it, so nothing computed changes); the feet were taken from
+        # the other infinite corner before, and written as `-inf`
+        if a == b == -math.inf:
+            a = b = min(lo, c) - 1.0
+        if c == d == math.inf:
+            c = d = max(hi, b) + 1.0
         if shape in ("triangle_pw", "triangle_plr"):
             return f"'{t.name}':'trimf',[{fmt_number(a)} {fmt_number(b)} {fmt_number(d)}]"
         return f"'{t.name}':'trapmf',[{' '.join(fmt_number(x) for x in (a, b, c, d))}]"
