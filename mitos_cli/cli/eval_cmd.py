@@ -102,8 +102,11 @@ def eval_command(
         "--batch", metavar="FILE.csv|-",
         help="Evaluate every row of a CSV whose header names the inputs; write a CSV of the "
              "inputs, the outputs and the CSV's other columns as they were.")] = None,
-    digits: Annotated[int, typer.Option(
-        "--digits", min=0, max=12, help="Decimals in the trace (the paper prints 1).")] = 1,
+    digits: Annotated[Optional[int], typer.Option(
+        "--digits", min=0, max=12,
+        help="Decimals in the trace (default 1, as the paper prints) and, with --batch, in the "
+             "outputs (default: every digit, the shortest text that reads back as the same "
+             "number).")] = None,
     network: Annotated[bool, typer.Option(
         "--network", help="Print the compiled network of fuzzy neurons instead.")] = False,
     on_no_rule_name: Annotated[Optional[str], typer.Option(
@@ -151,7 +154,7 @@ def eval_command(
         if as_json:
             raise typer.BadParameter("--batch writes a CSV; --json is for one evaluation "
                                      "(leave one of them out)")
-        run_batch(rb, batch, on_no_rule)
+        run_batch(rb, batch, on_no_rule, digits)
         return
     if on_no_rule is not None:
         raise typer.BadParameter("--on-no-rule applies to --batch")
@@ -171,7 +174,7 @@ def eval_command(
     if as_json:
         emit(json_text(trace.to_json()))
     else:
-        emit(trace.render(digits))
+        emit(trace.render(1 if digits is None else digits))
 
 
 def unused_inputs(rb) -> tuple[str, ...]:
@@ -181,14 +184,21 @@ def unused_inputs(rb) -> tuple[str, ...]:
                  if v.role == "input" and v.name not in rb.compiled.inputs)
 
 
-def run_batch(rb, source: str, on_no_rule: NoRule | None = None) -> None:
+def run_batch(rb, source: str, on_no_rule: NoRule | None = None,
+              digits: int | None = None) -> None:
     """Read the CSV, evaluate all rows as one batch, write inputs and outputs as CSV."""
-    import numpy as np
-
     from ..engine.csvio import passed_names, read_table, write_batch
 
-    if source == "-":
-        text, name = sys.stdin.read(), "<stdin>"
+    if source == "-":                  # bytes: a text stream would turn `\r\n` into `\n`
+        stream = getattr(sys.stdin, "buffer", None)
+        try:
+            text = stream.read().decode("utf-8-sig") if stream is not None else sys.stdin.read()
+        except UnicodeDecodeError as exc:
+            from ..fileio import why_unreadable
+
+            raise InputError(f"cannot read the batch from stdin: {why_unreadable(exc)}") \
+                from None
+        name = "<stdin>"
     else:
         from ..fileio import read_text, why_unreadable
 
@@ -210,9 +220,11 @@ def run_batch(rb, source: str, on_no_rule: NoRule | None = None) -> None:
     if renamed:
         warn("passed-through " + plural(len(renamed), "column") + " renamed, the output CSV "
              "has columns of those names: " + ", ".join(renamed))
-    write_batch(sys.stdout, rb.compiled.inputs, np.asarray(X)[keep],
+    everything = bool(keep.all())
+    write_batch(sys.stdout, rb.compiled.inputs,
+                [g if everything else g[keep] for g in batch.given],
                 rb.compiled.outputs, Y[keep], None if on_no_rule is None else flags[keep],
-                extra, [c for c, k in zip(batch.cells, keep) if k])
+                extra, [c if everything else c[keep] for c in batch.columns], digits)
 
 
 def no_rule_policy(compiled, result, policy: NoRule):
