@@ -211,7 +211,7 @@ def _lock(directory: Path) -> None:
         return
     path = directory / "lock"
     try:
-        fh = open(path, "a+", encoding="utf-8")
+        fh = open(path, "a+", encoding="utf-8")  # noqa: SIM115 - the lock is held while it is open
     except OSError as exc:
         raise LessonError(f"cannot open the session's lock {path}: {exc.strerror or exc}") \
             from None
