@@ -467,3 +467,13 @@ def test_a_bad_cell_early_in_a_large_batch_stops_the_reading(monkeypatch):
     with pytest.raises(InputError) as info:
         read_batch("road,size,position\n" + body, "b.csv", ("road", "size", "position"))
     assert str(info.value.span) == "b.csv:3:1" and len(calls) == 1
+
+
+@pytest.mark.parametrize("value", ["1_000", "\u0667\u0668", "0x10", " "])
+def test_a_single_value_is_read_as_a_batch_cell_is(value, capsys):
+    """`road=1_000` and `road=٧٨` were taken (by `float`) where the batch refuses them."""
+    code, out, err = run_main(["eval", f"road={value}", "size=45", "position=4"], capsys)
+    assert code == 1 and out == ""
+    assert f"input `road` must be a number, not `{value}`" in err
+    code, _, _ = run_main(["eval", "road=+7.8e1", "size=45", "position=4"], capsys)
+    assert code == 0

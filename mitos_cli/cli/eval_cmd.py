@@ -53,12 +53,17 @@ def split_args(args: list[str]) -> tuple[Optional[str], dict[str, str]]:
 
 
 def parse_values(values: dict[str, str]) -> dict[str, float]:
+    """``NAME=VALUE`` texts as numbers, read as a batch CSV's cells are (``parse_number``):
+    ``float`` alone would take ``1_000`` and other scripts' digits, which the batch refuses."""
+    from ..numbers import parse_number
+
     out = {}
     for name, text in values.items():
         try:
-            out[name] = float(text)
+            out[name] = parse_number(text)
         except ValueError:
-            raise InputError(f"input `{name}` must be a number, not `{text}`") from None
+            raise InputError(f"input `{name}` must be a number, not `{text}`",
+                             expected="a decimal number such as 78, -4.5 or 1e3") from None
     return out
 
 
