@@ -30,6 +30,7 @@ import dataclasses
 import math
 import re
 from collections import Counter
+from functools import partial
 from pathlib import Path
 
 from ..errors import FormatError, Span, did_you_mean
@@ -401,24 +402,29 @@ def write_fis(rb: RuleBase, behavior: str | None = None) -> str:
     negated, without hedges) joined all by AND or all by OR, as MATLAB's rule list is."""
     flat = common.flatten_for_export(rb, behavior)
     ops = flat.operators
+    at = partial(common.setting_span, rb, behavior)       # where an operator was chosen
     if ops.inference == "tsukamoto":
         raise FormatError("MATLAB's .fis has no Tsukamoto inference; write it to FLL or a "
-                          "rule file")
+                          "rule file", span=at("inference"))
     sugeno = ops.inference in ("weighted_average", "weighted_sum")
     inputs = common.all_inputs(rb, flat)
     name = flat.name
+    and_ = common.foreign_name(common.TNORMS, FIS, ops.and_, "AND method", span=at("and"))
+    or_ = common.foreign_name(common.SNORMS, FIS, ops.or_, "OR method", span=at("or"))
     lines = ["[System]", f"Name='{name}'", f"Type='{'sugeno' if sugeno else 'mamdani'}'",
              "Version=2.0", f"NumInputs={len(inputs)}", f"NumOutputs={len(flat.outputs)}",
              f"NumRules={len(flat.rules)}",
-             f"AndMethod='{common.foreign_name(common.TNORMS, FIS, ops.and_, 'AND method')}'",
-             f"OrMethod='{common.foreign_name(common.SNORMS, FIS, ops.or_, 'OR method')}'"]
+             f"AndMethod='{and_}'", f"OrMethod='{or_}'"]
     if sugeno:
         lines += ["ImpMethod='prod'", "AggMethod='sum'",
                   f"DefuzzMethod='{common.DEFUZZIFIERS[ops.inference][FIS]}'"]
     else:
-        imp = common.foreign_name(common.TNORMS, FIS, ops.implication, "implication")
-        agg = common.foreign_name(common.SNORMS, FIS, ops.aggregation, "aggregation")
-        defuzz = common.foreign_name(common.DEFUZZIFIERS, FIS, ops.defuzzify, "defuzzifier")
+        imp = common.foreign_name(common.TNORMS, FIS, ops.implication, "implication",
+                                  span=at("implication"))
+        agg = common.foreign_name(common.SNORMS, FIS, ops.aggregation, "aggregation",
+                                  span=at("aggregation"))
+        defuzz = common.foreign_name(common.DEFUZZIFIERS, FIS, ops.defuzzify, "defuzzifier",
+                                     span=at("defuzzify"))
         lines += [f"ImpMethod='{imp}'", f"AggMethod='{agg}'", f"DefuzzMethod='{defuzz}'"]
     for i, v in enumerate(inputs, 1):
         lines += ["", f"[Input{i}]"] + _var_lines(v, [_mf_text(t, v) for t in v.terms])
@@ -492,7 +498,7 @@ def _mf_text(t: Term, v: Variable) -> str:
         return f"'{t.name}':'linzmf',[{fmt_number(p[1])} {fmt_number(p[0])}]"
     if shape not in INVERSE:
         raise FormatError(f"term `{v.name}.{t.name}`: MATLAB has no `{shape}` membership "
-                          f"function")
+                          f"function", span=t.span)
     mf, order = INVERSE[shape]
     values = [0.0] * len(order)
     for mitos_i, matlab_i in enumerate(order):
