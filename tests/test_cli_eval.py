@@ -477,3 +477,14 @@ def test_a_single_value_is_read_as_a_batch_cell_is(value, capsys):
     assert f"input `road` must be a number, not `{value}`" in err
     code, _, _ = run_main(["eval", "road=+7.8e1", "size=45", "position=4"], capsys)
     assert code == 0
+
+
+def test_network_refuses_what_it_would_ignore(capsys, tmp_path):
+    """`--batch ok.csv --network` printed the network and ignored the batch."""
+    csv = tmp_path / "ok.csv"
+    csv.write_text("road,size,position\n78,45,4\n", encoding="utf-8")
+    for extra in (["--batch", str(csv)], ["road=78", "size=45", "position=4"], ["--json"]):
+        code, out, err = run_main(["eval", "--network", *extra], capsys)
+        assert code == 2 and out == "" and "--network prints the rule base's network" in err
+    code, out, _ = run_main(["eval", "--network"], capsys)
+    assert code == 0 and out

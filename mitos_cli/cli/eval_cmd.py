@@ -149,6 +149,9 @@ def eval_command(
         rb = LoadedRuleBase(rb.rulebase, behavior,
                             fidelity_settings(rb.rulebase, fidelity.value, behavior))
     if network:
+        if batch is not None or values or as_json:
+            raise typer.BadParameter("--network prints the rule base's network and evaluates "
+                                     "nothing: leave out --batch, --json and NAME=VALUE")
         from ..engine.describe import describe_network
 
         emit(describe_network(rb.compiled))
@@ -192,7 +195,7 @@ def unused_inputs(rb) -> tuple[str, ...]:
 def run_batch(rb, source: str, on_no_rule: NoRule | None = None,
               digits: int | None = None) -> None:
     """Read the CSV, evaluate all rows as one batch, write inputs and outputs as CSV."""
-    from ..engine.csvio import passed_names, read_table, write_batch
+    from ..engine.csvio import passed_names, read_table, row_span, write_batch
 
     if source == "-":                  # bytes: a text stream would turn `\r\n` into `\n`
         stream = getattr(sys.stdin, "buffer", None)
@@ -216,7 +219,8 @@ def run_batch(rb, source: str, on_no_rule: NoRule | None = None,
     X = batch.X
     result = rb.run(X, strict=False, detail=False)
     warn_clamped(result)
-    Y, keep, flags = no_rule_policy(rb.compiled, result, on_no_rule or NoRule.default)
+    Y, keep, flags = no_rule_policy(rb.compiled, result, on_no_rule or NoRule.default,
+                                    lambda row: row_span(text, name, row))
     warn_outside(rb.compiled, Y[keep])
     taken = (*rb.compiled.inputs, *rb.compiled.outputs, *(() if on_no_rule is None
                                                          else ("no_rule",)))
@@ -232,9 +236,10 @@ def run_batch(rb, source: str, on_no_rule: NoRule | None = None,
                 extra, [c if everything else c[keep] for c in batch.columns], digits)
 
 
-def no_rule_policy(compiled, result, policy: NoRule):
+def no_rule_policy(compiled, result, policy: NoRule, where=None):
     """``(outputs, rows to keep, no_rule column)`` after applying ``policy`` to the rows where
-    no rule set an output; a warning says how many rows each output's choice changed."""
+    no rule set an output; a warning says how many rows each output's choice changed. An
+    error stops at the first such row, at ``where(row)`` (its place in the batch file)."""
     import numpy as np
 
     from ..engine.evaluation import declares_nan
@@ -256,7 +261,8 @@ def no_rule_policy(compiled, result, policy: NoRule):
             values = ", ".join(f"{k}={result.inputs[row, i]:g}"
                                for i, k in enumerate(compiled.inputs))
             raise NoRuleFiredError(
-                f"no rule sets `{out}` for {values} ({count} of {n} rows)",
+                f"no rule sets `{out}` for {values} (row {row + 1}; {count} of {n} rows)",
+                span=None if where is None else where(row),
                 hint=("" if policy is NoRule.error else
                       f"`{out}` declares no default. ") +
                      "--on-no-rule default, nan or skip writes the other rows (docs/interop.md)")

@@ -309,6 +309,12 @@ def _line_offset(text: str, line: int) -> int:
     return next(islice(_BREAK.finditer(text), line - 2, None)).end()
 
 
+def row_span(text: str, path: str, row: int) -> Span:
+    """Where data row ``row`` (0-based, blank lines not counted) of a batch starts: for an
+    error about the row as a whole (no rule fired there)."""
+    return _span(text, path, _line_offset(text, _record_line(text, row)))
+
+
 def _span(text: str, path: str, index: int) -> Span:
     """The span at character ``index`` of ``text``, its line and column counted as the
     ``csv`` module counts lines."""
