@@ -273,3 +273,26 @@ def test_c_export_agrees_with_mitos_eval_command(tmp_path: Path) -> None:
         X = np.array([[inputs[name] for name in c.inputs]], dtype=float)
         got = run_c(c, X, tmp_path)[0]
         assert dict(zip(c.outputs, got)) == pytest.approx(want, abs=TOLERANCE)
+
+
+def test_python_export_evaluate_one_names_a_missing_or_unknown_input(tmp_path: Path) -> None:
+    """`evaluate_one(road=78, size=45)` raised a bare KeyError and unknown keywords were
+    ignored: a TypeError as Python's own calls give, with the closest input."""
+    c = load_rulebase(ROOT / "rulebases" / "mitos.rules").compiled
+    path = tmp_path / "planner.py"
+    path.write_text(to_python(c, "test"))
+    spec = importlib.util.spec_from_file_location("planner", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    with pytest.raises(TypeError, match=r"missing 1 required keyword argument: 'position'$"):
+        module.evaluate_one(road=78, size=45)
+    with pytest.raises(TypeError, match=r"missing 2 required keyword arguments: 'size', 'posi"):
+        module.evaluate_one(road=78)
+    with pytest.raises(TypeError, match=r"unexpected keyword argument 'positon'; did you mean "
+                                        r"'position'\?"):
+        module.evaluate_one(road=78, size=45, positon=4)
+    with pytest.raises(TypeError, match=r"argument 'zzz'; the inputs are 'road', 'size'"):
+        module.evaluate_one(road=78, size=45, position=4, zzz=1)
+    assert module.evaluate_one(road=78, size=45, position=4) == pytest.approx(
+        load_rulebase(ROOT / "rulebases" / "mitos.rules").evaluate(road=78, size=45,
+                                                                    position=4), abs=1e-12)

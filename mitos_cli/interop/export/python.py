@@ -29,6 +29,28 @@ def doc_text(text: str) -> str:
     return text if PLAIN.fullmatch(text) else ascii(text).replace('"', '\\"')
 
 
+#: evaluate_one's check of its keywords: a TypeError as a Python function's call gives, with
+#: the closest input for an unknown one (a bare KeyError, or a typo silently ignored, before)
+CHECK_NAMES = [
+    "def _check_names(inputs):",
+    '    """A missing or unknown input, as a TypeError naming it."""',
+    "    import difflib",
+    "",
+    "    for name in inputs:",
+    "        if name not in INPUTS:",
+    "            close = difflib.get_close_matches(name, INPUTS, n=1)",
+    "            hint = (f'; did you mean {close[0]!r}?' if close",
+    "                    else '; the inputs are ' + ', '.join(map(repr, INPUTS)))",
+    "            raise TypeError(f'evaluate_one() got an unexpected keyword argument '",
+    "                            f'{name!r}{hint}')",
+    "    missing = [name for name in INPUTS if name not in inputs]",
+    "    if missing:",
+    "        raise TypeError(f'evaluate_one() missing {len(missing)} required keyword '",
+    "                        f\"argument{'s' if len(missing) > 1 else ''}: \"",
+    "                        + ', '.join(map(repr, missing)))",
+    ""]
+
+
 def to_python(compiled: CompiledRuleBase, source: str = "") -> str:
     """A NumPy-only module with ``evaluate(X) -> Y`` for ``X[n, k]`` (and ``INPUTS``,
     ``OUTPUTS``, ``evaluate_one(**inputs)``)."""
@@ -44,8 +66,10 @@ def to_python(compiled: CompiledRuleBase, source: str = "") -> str:
     out += _py_evaluate(p)
     out += ["def evaluate_one(**inputs):",
             '    """Outputs by name for one value per input (by name)."""',
+            "    _check_names(inputs)",
             "    row = np.array([[float(inputs[name]) for name in INPUTS]])",
-            "    return dict(zip(OUTPUTS, (float(v) for v in evaluate(row)[0])))", ""]
+            "    return dict(zip(OUTPUTS, (float(v) for v in evaluate(row)[0])))", "", "",
+            *CHECK_NAMES]
     return "\n".join(out)
 
 
