@@ -30,24 +30,37 @@ def doc_text(text: str) -> str:
 
 
 #: evaluate_one's check of its keywords: a TypeError as a Python function's call gives, with
-#: the closest input for an unknown one (a bare KeyError, or a typo silently ignored, before)
+#: the closest input for an unknown one (a bare KeyError, or a typo silently ignored, before).
+#: Plain Python, no import: the module imports NumPy alone (tests/test_export_hostile.py).
 CHECK_NAMES = [
     "def _check_names(inputs):",
     '    """A missing or unknown input, as a TypeError naming it."""',
-    "    import difflib",
-    "",
     "    for name in inputs:",
     "        if name not in INPUTS:",
-    "            close = difflib.get_close_matches(name, INPUTS, n=1)",
-    "            hint = (f'; did you mean {close[0]!r}?' if close",
-    "                    else '; the inputs are ' + ', '.join(map(repr, INPUTS)))",
+    "            close = _closest(name)",
+    "            hint = (f'; did you mean {close!r}?' if close is not None",
+    "                    else '; the inputs are ' + ', '.join(f'{n!r}' for n in INPUTS))",
     "            raise TypeError(f'evaluate_one() got an unexpected keyword argument '",
     "                            f'{name!r}{hint}')",
     "    missing = [name for name in INPUTS if name not in inputs]",
     "    if missing:",
     "        raise TypeError(f'evaluate_one() missing {len(missing)} required keyword '",
     "                        f\"argument{'s' if len(missing) > 1 else ''}: \"",
-    "                        + ', '.join(map(repr, missing)))",
+    "                        + ', '.join(f'{n!r}' for n in missing))",
+    "",
+    "",
+    "def _closest(name):",
+    '    """The input fewest edits from ``name`` (at most a third of its length), or None."""',
+    "    best, found = max(1, len(name) // 3) + 1, None",
+    "    for other in INPUTS:",
+    "        row = list(range(len(other) + 1))",
+    "        for i, a in enumerate(name, 1):",
+    "            prev, row[0] = row[0], i",
+    "            for j, b in enumerate(other, 1):",
+    "                prev, row[j] = row[j], min(row[j] + 1, row[j - 1] + 1, prev + (a != b))",
+    "        if row[-1] < best:",
+    "            best, found = row[-1], other",
+    "    return found",
     ""]
 
 
