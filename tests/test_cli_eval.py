@@ -75,7 +75,8 @@ def test_json_matches_the_library(rb, capsys):
     assert [r["label"] for r in data["rules"]] == ["r4", "r5", "r7", "r8", "r22", "r23", "r25",
                                                    "r26"]
     assert all(set(r) == {"label", "text", "dof"} and r["dof"] > 0 for r in data["rules"])
-    assert data["inputs"]["road"] == {"value": 78.0, "memberships": {
+    assert data["inputs"]["road"] == {"value": 78.0, "given": 78.0, "clamped": False,
+                                      "memberships": {
         "NARROW": 0.0, "MEDIUM": pytest.approx(22 / 30), "WIDE": pytest.approx(8 / 30)}}
 
 
@@ -488,3 +489,16 @@ def test_network_refuses_what_it_would_ignore(capsys, tmp_path):
         assert code == 2 and out == "" and "--network prints the rule base's network" in err
     code, out, _ = run_main(["eval", "--network"], capsys)
     assert code == 0 and out
+
+
+def test_json_says_an_input_was_clamped_and_what_was_given(capsys):
+    """`--json` reported a clamped input's clamped value with no flag."""
+    code, out, err = run_main(["eval", "road=500", "size=45", "position=4", "--json"], capsys)
+    assert code == 0 and "`road` outside its universe [0, 160] was clamped" in err
+    road, size = (json.loads(out)["inputs"][k] for k in ("road", "size"))
+    assert (road["value"], road["given"], road["clamped"]) == (160.0, 500.0, True)
+    assert (size["value"], size["given"], size["clamped"]) == (45.0, 45.0, False)
+    code, out, _ = run_main(["eval", "road=160", "size=45", "position=4", "--json"], capsys)
+    assert json.loads(out)["inputs"]["road"]["clamped"] is False     # on the edge: as given
+    code, out, _ = run_main(["eval", "road=500", "size=45", "position=4"], capsys)
+    assert "road = 160 in (given 500, clamped to its universe)" in out

@@ -175,10 +175,11 @@ def eval_command(
     unused = unused_inputs(rb)
     given: dict[str, object] = {k: v for k, v in parse_values(values).items()
                                 if k not in unused}
-    result = evaluate(rb.compiled, as_batch(rb.compiled, given))
+    X = as_batch(rb.compiled, given)
+    result = evaluate(rb.compiled, X)
     warn_clamped(result)
     warn_outside(rb.compiled, result.outputs)
-    trace = trace_of(result)
+    trace = trace_of(result, given=X)
     if as_json:
         emit(json_text(trace.to_json()))
     else:
