@@ -128,7 +128,7 @@ class LoadedRuleBase:
             from .errors import InputError
 
             raise InputError("a trace takes one value per input")
-        return trace_of(evaluate(self.compiled, X))
+        return trace_of(evaluate(self.compiled, X), given=X)
 
 
 def load_rulebase(path: str | Path | None = None, behavior: str | None = None) -> LoadedRuleBase:

@@ -81,6 +81,10 @@ def atomic_file(path: str | Path, binary: bool = False,
                 error: type[MitosError] = MitosError) -> Iterator[IO]:
     """Open a temporary file that replaces ``path`` when the block ends without an error; a
     failure (a missing directory included) raises ``error`` naming the file."""
+    if _special(Path(path)):      # before following links: /dev/stdout names a pipe
+        with _in_place(Path(path), binary, error) as fh:
+            yield fh
+        return
     path = _target(Path(path))
     if _special(path):
         with _in_place(path, binary, error) as fh:

@@ -75,7 +75,8 @@ def test_json_matches_the_library(rb, capsys):
     assert [r["label"] for r in data["rules"]] == ["r4", "r5", "r7", "r8", "r22", "r23", "r25",
                                                    "r26"]
     assert all(set(r) == {"label", "text", "dof"} and r["dof"] > 0 for r in data["rules"])
-    assert data["inputs"]["road"] == {"value": 78.0, "memberships": {
+    assert data["inputs"]["road"] == {"value": 78.0, "given": 78.0, "clamped": False,
+                                      "memberships": {
         "NARROW": 0.0, "MEDIUM": pytest.approx(22 / 30), "WIDE": pytest.approx(8 / 30)}}
 
 
@@ -138,7 +139,7 @@ def test_batch_passes_other_columns_through(capsys, tmp_path):
     assert "`steering` as `given_steering`" in err
     lines = out.splitlines()
     assert lines[0] == "road,size,position,steering,speed,id,note,given_steering"
-    assert lines[1].startswith("78,45,4,65.4112554113,32.4242424242,")
+    assert lines[1].startswith("78,45,4,65.41125541125541,32.42424242424243,")
     assert lines[1].endswith(',a,"x, y",1') and lines[2].endswith(",b,,2")
 
 
@@ -355,3 +356,149 @@ def test_an_output_outside_its_universe_is_said(tmp_path, capsys):
     code, out, err = run_main(["eval", str(rules), "road=70"], capsys)
     assert code == 0 and "steering = 280" in out
     assert "output `steering` lies outside its universe [30, 150] (280)" in err
+
+
+# ---- batch CSV as the csv module reads it ---------------------------------------------------------
+
+def test_batch_passes_line_breaks_and_form_feeds_in_cells_through(capsys, tmp_path):
+    """`text.splitlines()` ran before the CSV parse: a quoted note's line break was lost and a
+    row was split at a form feed or NEL; pass-through cells come out exactly as read."""
+    import csv as csvmod
+    import io
+
+    notes = ["two\nlines", "crlf\r\nkept", "form\x0cfeed", "nel\x85here", 'say "hi", bye']
+    rows = [[78, 45, 4, n] for n in notes]
+    buf = io.StringIO(newline="")
+    w = csvmod.writer(buf, lineterminator="\r\n")
+    w.writerow(["road", "size", "position", "note"])
+    w.writerows(rows)
+    path = tmp_path / "in.csv"
+    path.write_bytes(buf.getvalue().encode("utf-8"))
+    code, out, err = run_main(["eval", "--batch", str(path)], capsys)
+    assert code == 0, err
+    got = list(csvmod.reader(io.StringIO(out, newline="")))
+    assert [r[-1] for r in got[1:]] == notes
+    assert all(r[:3] == ["78", "45", "4"] for r in got[1:])
+
+
+def test_batch_from_stdin_keeps_crlf_inside_cells(tmp_path):
+    text = 'road,size,position,note\r\n78,45,4,"a\r\nb"\r\n'
+    proc = subprocess.run([sys.executable, "-m", "mitos_cli", "eval", "--batch", "-"], cwd=ROOT,
+                          input=text.encode(), capture_output=True, timeout=120)
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.decode().endswith(',"a\r\nb"\n')
+
+
+@pytest.mark.parametrize("body", ['"78",45,4\n', '"78","45","4"\n', '"78",45,4,x\n'])
+def test_batch_reads_quoted_numbers(body):
+    header = "road,size,position" + (",id" if body.endswith("x\n") else "")
+    X = read_batch(f"{header}\n{body}", "q.csv", ("road", "size", "position"))
+    assert X.tolist() == [[78.0, 45.0, 4.0]]
+
+
+@pytest.mark.parametrize("text, message, where, expected", [
+    ('road,size,position\n1,2,3\n4,"5,6\n7,8,9\n', "this quote opens a cell that is never "
+     "closed", "q.csv:3:3", 'a closing `"` before the end of the file'),
+    ('road,size,position\n1,2,3\n"4"x,5,6\n', "`x` after a quoted cell's closing quote",
+     "q.csv:3:4", "`,` or the end of the line"),
+    ('road,"size\n', "this quote opens a cell that is never closed", "q.csv:1:6",
+     'a closing `"` before the end of the file'),
+])
+def test_malformed_csv_is_reported_where_it_breaks(text, message, where, expected):
+    """It was `q.csv:1:1: the batch CSV could not be read`, wherever the problem was."""
+    with pytest.raises(InputError) as info:
+        read_batch(text, "q.csv", ("road", "size", "position"))
+    assert message in info.value.message and str(info.value.span) == where
+    assert info.value.expected == expected
+
+
+def test_batch_cell_positions_count_lines_inside_quoted_cells():
+    text = 'id,road,size,position\n"a\nb",1,2,3\n"c",4,x,6\n'
+    with pytest.raises(InputError) as info:
+        read_batch(text, "q.csv", ("road", "size", "position"))
+    assert "`x` is not a number (input `size`, row 2)" in info.value.message
+    assert str(info.value.span) == "q.csv:4:7"
+
+
+def test_batch_writes_inputs_as_given_and_outputs_in_full(capsys, tmp_path):
+    """Every number was rewritten with 12 significant digits, the user's inputs included, and
+    --digits was ignored with --batch."""
+    path = tmp_path / "in.csv"
+    path.write_text("road,size,position\n78.000,4.5e1,+4\n", encoding="utf-8")
+    code, out, _ = run_main(["eval", "--batch", str(path)], capsys)
+    assert code == 0
+    row = out.splitlines()[1].split(",")
+    assert row[:3] == ["78.000", "4.5e1", "+4"]
+    single = load_rulebase().evaluate(road=78, size=45, position=4)
+    assert [float(v) for v in row[3:]] == [single["steering"], single["speed"]]   # bit for bit
+    assert row[3] == repr(single["steering"])
+    code, out, _ = run_main(["eval", "--batch", str(path), "--digits", "3"], capsys)
+    assert code == 0 and out.splitlines()[1] == "78.000,4.5e1,+4,65.411,32.424"
+
+
+@pytest.mark.parametrize("sep, name", [(";", "`;`"), ("\t", "a tab")])
+def test_a_semicolon_or_tab_separated_file_is_named_as_such(sep, name):
+    text = sep.join(["road", "size", "position"]) + "\n" + sep.join(["78", "45", "4"]) + "\n"
+    with pytest.raises(InputError) as info:
+        read_batch(text, "s.csv", ("road", "size", "position"))
+    assert info.value.message == (f"the header has one column; is the separator {name}? "
+                                  "MITOS reads comma-separated values")
+    assert str(info.value.span) == "s.csv:1:1"
+
+
+def test_every_misspelt_column_is_named():
+    with pytest.raises(InputError) as info:
+        read_batch("road,sise,positon\n78,45,4\n", "m.csv", ("road", "size", "position"))
+    assert info.value.message == "the batch CSV has no column for size, position"
+    assert str(info.value.span) == "m.csv:1:6"
+    assert info.value.hint == ("columns `sise`, `positon` are passed through as they are: did "
+                               "you mean `size`, `position`?")
+
+
+def test_a_bad_cell_early_in_a_large_batch_stops_the_reading(monkeypatch):
+    """The reading goes chunk by chunk and stops at the first bad one: the rows after it are
+    never converted."""
+    from mitos_cli.engine import csvio
+
+    calls = []
+    real = csvio._convert
+    monkeypatch.setattr(csvio, "_convert", lambda *a: calls.append(1) or real(*a))
+    monkeypatch.setattr(csvio, "CHUNK", 4)
+    body = "1,2,3\nx,2,3\n" + "1,2,3\n" * 1000
+    with pytest.raises(InputError) as info:
+        read_batch("road,size,position\n" + body, "b.csv", ("road", "size", "position"))
+    assert str(info.value.span) == "b.csv:3:1" and len(calls) == 1
+
+
+@pytest.mark.parametrize("value", ["1_000", "\u0667\u0668", "0x10", " "])
+def test_a_single_value_is_read_as_a_batch_cell_is(value, capsys):
+    """`road=1_000` and `road=٧٨` were taken (by `float`) where the batch refuses them."""
+    code, out, err = run_main(["eval", f"road={value}", "size=45", "position=4"], capsys)
+    assert code == 1 and out == ""
+    assert f"input `road` must be a number, not `{value}`" in err
+    code, _, _ = run_main(["eval", "road=+7.8e1", "size=45", "position=4"], capsys)
+    assert code == 0
+
+
+def test_network_refuses_what_it_would_ignore(capsys, tmp_path):
+    """`--batch ok.csv --network` printed the network and ignored the batch."""
+    csv = tmp_path / "ok.csv"
+    csv.write_text("road,size,position\n78,45,4\n", encoding="utf-8")
+    for extra in (["--batch", str(csv)], ["road=78", "size=45", "position=4"], ["--json"]):
+        code, out, err = run_main(["eval", "--network", *extra], capsys)
+        assert code == 2 and out == "" and "--network prints the rule base's network" in err
+    code, out, _ = run_main(["eval", "--network"], capsys)
+    assert code == 0 and out
+
+
+def test_json_says_an_input_was_clamped_and_what_was_given(capsys):
+    """`--json` reported a clamped input's clamped value with no flag."""
+    code, out, err = run_main(["eval", "road=500", "size=45", "position=4", "--json"], capsys)
+    assert code == 0 and "`road` outside its universe [0, 160] was clamped" in err
+    road, size = (json.loads(out)["inputs"][k] for k in ("road", "size"))
+    assert (road["value"], road["given"], road["clamped"]) == (160.0, 500.0, True)
+    assert (size["value"], size["given"], size["clamped"]) == (45.0, 45.0, False)
+    code, out, _ = run_main(["eval", "road=160", "size=45", "position=4", "--json"], capsys)
+    assert json.loads(out)["inputs"]["road"]["clamped"] is False     # on the edge: as given
+    code, out, _ = run_main(["eval", "road=500", "size=45", "position=4"], capsys)
+    assert "road = 160 in (given 500, clamped to its universe)" in out

@@ -175,6 +175,54 @@ def test_c_export_every_fuzzylite_shape(tmp_path: Path) -> None:
     agree(run_c(c, X, tmp_path), want)
 
 
+STATUS_DRIVER = r"""
+#include <stdio.h>
+int demo_eval(const double *in, double *out);
+int main(void) {
+    double in[16], out[16];
+    int k, m, i, j;
+    if (scanf("%d %d", &k, &m) != 2) return 1;
+    for (;;) {
+        int status;
+        for (i = 0; i < k; ++i) if (scanf("%lf", &in[i]) != 1) return 0;
+        status = demo_eval(in, out);
+        printf("%d", status);
+        for (j = 0; j < m; ++j) printf(" %.17g", out[j]);
+        printf("\n");
+    }
+}
+"""
+
+
+@needs_cc
+@pytest.mark.parametrize("name", ["mitos.rules", "tipper.fis"])
+def test_c_export_a_nan_input_gives_nan_and_a_status(name: str, tmp_path: Path) -> None:
+    """The clamp passes NaN and the min t-norm (`a < b ? a : b`) drops it: without a check
+    the C function returned a plausible number where the NumPy module returns NaN."""
+    path = ROOT / "rulebases" / name if name.endswith(".rules") else DATA / name
+    c = load_rulebase(path).compiled
+    text = to_c(c, "demo", "test")
+    assert "or DEMO_NAN_INPUT (-1) when an input is NaN" in text.split("*/")[0]  # documented
+    (tmp_path / "demo.c").write_text(text)
+    (tmp_path / "driver.c").write_text(STATUS_DRIVER)
+    built = subprocess.run([CC, "-std=c99", "-O0", "-Wall", "-Wextra", "-pedantic", "-Werror",
+                            "-o", str(tmp_path / "demo"), str(tmp_path / "demo.c"),
+                            str(tmp_path / "driver.c"), "-lm"], capture_output=True, text=True)
+    assert built.returncode == 0, built.stderr
+    middle = c.universe.mean(axis=1)
+    X = np.tile(middle, (len(c.inputs) + 1, 1))
+    for i in range(len(c.inputs)):
+        X[i + 1, i] = np.nan
+    rows = "\n".join(" ".join(repr(float(v)) for v in row) for row in X)
+    done = subprocess.run([str(tmp_path / "demo")], capture_output=True, text=True, check=True,
+                          input=f"{X.shape[1]} {len(c.outputs)}\n{rows}\n")
+    lines = [line.split() for line in done.stdout.splitlines()]
+    assert int(lines[0][0]) >= 0 and not np.isnan([float(v) for v in lines[0][1:]]).any()
+    for line in lines[1:]:
+        assert int(line[0]) == -1 and np.isnan([float(v) for v in line[1:]]).all(), line
+    assert np.isnan(run_python(c, X[1:], tmp_path)).all()      # as the NumPy module
+
+
 def test_python_export_agrees_with_eval(tmp_path: Path) -> None:
     for path in fixtures(tmp_path):
         c, X, want = reference(path)
@@ -225,3 +273,26 @@ def test_c_export_agrees_with_mitos_eval_command(tmp_path: Path) -> None:
         X = np.array([[inputs[name] for name in c.inputs]], dtype=float)
         got = run_c(c, X, tmp_path)[0]
         assert dict(zip(c.outputs, got)) == pytest.approx(want, abs=TOLERANCE)
+
+
+def test_python_export_evaluate_one_names_a_missing_or_unknown_input(tmp_path: Path) -> None:
+    """`evaluate_one(road=78, size=45)` raised a bare KeyError and unknown keywords were
+    ignored: a TypeError as Python's own calls give, with the closest input."""
+    c = load_rulebase(ROOT / "rulebases" / "mitos.rules").compiled
+    path = tmp_path / "planner.py"
+    path.write_text(to_python(c, "test"))
+    spec = importlib.util.spec_from_file_location("planner", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    with pytest.raises(TypeError, match=r"missing 1 required keyword argument: 'position'$"):
+        module.evaluate_one(road=78, size=45)
+    with pytest.raises(TypeError, match=r"missing 2 required keyword arguments: 'size', 'posi"):
+        module.evaluate_one(road=78)
+    with pytest.raises(TypeError, match=r"unexpected keyword argument 'positon'; did you mean "
+                                        r"'position'\?"):
+        module.evaluate_one(road=78, size=45, positon=4)
+    with pytest.raises(TypeError, match=r"argument 'zzz'; the inputs are 'road', 'size'"):
+        module.evaluate_one(road=78, size=45, position=4, zzz=1)
+    assert module.evaluate_one(road=78, size=45, position=4) == pytest.approx(
+        load_rulebase(ROOT / "rulebases" / "mitos.rules").evaluate(road=78, size=45,
+                                                                    position=4), abs=1e-12)

@@ -185,8 +185,9 @@ RuleBlock: {blocks[1]}
 
 # ---- what the generated code may contain -----------------------------------------------------
 
-SAFE_BUILTINS = {"float", "dict", "zip", "len", "ValueError", "range", "abs", "min", "max",
-                 "tuple", "list", "int", "bool", "any", "all", "enumerate", "isinstance", "np"}
+SAFE_BUILTINS = {"float", "dict", "zip", "len", "ValueError", "TypeError", "range", "abs", "min",
+                 "max", "tuple", "list", "int", "bool", "any", "all", "enumerate", "isinstance",
+                 "np"}
 
 
 def _constant(node: ast.expr) -> None:

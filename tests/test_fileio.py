@@ -117,3 +117,18 @@ def test_a_device_named_as_a_file_is_refused_at_once(argv, capsys):
     with pytest.raises(SystemExit) as info:
         main(argv)
     assert info.value.code == 1 and "larger than 256 MB" in capsys.readouterr().err
+
+
+@pytest.mark.skipif(not os.path.exists("/dev/stdout"), reason="needs /dev/stdout")
+def test_a_link_to_a_pipe_is_written_through(tmp_path):
+    """`convert ... -o /dev/stdout | less`: the link was followed to `/proc/N/fd/pipe:[...]`,
+    a name that is not there, and the write failed."""
+    import subprocess
+    import sys
+
+    code = ("from mitos_cli.fileio import atomic_write; "
+            "atomic_write('/dev/stdout', 'through the pipe\\n')")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          timeout=60)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout == "through the pipe\n"

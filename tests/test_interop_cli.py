@@ -75,6 +75,82 @@ def test_convert_refuses_to_overwrite_its_input(tmp_path: Path) -> None:
     assert result.exit_code == 2 and "would overwrite the input" in result.output
 
 
+def flat(output: str) -> str:
+    """A usage error's text without Rich's box and line breaks."""
+    import re
+
+    return " ".join(re.sub(r"[│╭╮╰╯─]", " ", output).split())
+
+
+def test_export_refuses_to_overwrite_its_input(tmp_path: Path) -> None:
+    """As convert does (exit 2), through a symbolic link named like the output too."""
+    src, terms = tmp_path / "x.rules", tmp_path / "mitos.terms.yaml"
+    for name in ("mitos.rules", "mitos.terms.yaml", "drive.terms.yaml"):
+        (tmp_path / name).write_text((ROOT / "rulebases" / name).read_text())
+    (tmp_path / "mitos.rules").rename(src)
+    link = tmp_path / "planner.c"
+    link.symlink_to(src)
+    before = src.read_text()
+    result = runner.invoke(app, ["export", str(src), "--to", "c", "-o", str(link)])
+    assert result.exit_code == 2 and "would overwrite the input" in flat(result.output)
+    (tmp_path / "terms.py").symlink_to(terms)
+    result = runner.invoke(app, ["export", str(src), "--to", "python", "-o",
+                                 str(tmp_path / "terms.py")])
+    assert result.exit_code == 2 and "would overwrite a term set `x.rules` reads" in \
+        flat(result.output)
+    assert src.read_text() == before and link.is_symlink()
+
+
+def test_convert_refuses_to_write_over_a_term_set_the_input_reads(tmp_path: Path) -> None:
+    """`-o drive.rules` beside mitos.rules writes drive.terms.yaml, which mitos.rules reads."""
+    for name in ("mitos.rules", "mitos.terms.yaml", "drive.terms.yaml"):
+        (tmp_path / name).write_text((ROOT / "rulebases" / name).read_text())
+    before = (tmp_path / "drive.terms.yaml").read_text()
+    result = runner.invoke(app, ["convert", str(tmp_path / "mitos.rules"), "--to", "rules",
+                                 "-b", "drive", "-o", str(tmp_path / "drive.rules")])
+    assert result.exit_code == 2, result.output
+    assert "drive.terms.yaml` would overwrite a term set `mitos.rules` reads" in \
+        flat(result.output)
+    assert (tmp_path / "drive.terms.yaml").read_text() == before
+    assert not (tmp_path / "drive.rules").exists()
+
+
+@pytest.mark.parametrize("args, expected", [
+    (["convert", "tipper.fis", "--to", "fcl", "-o", "out.fis"], "--to fcl is written to a .fcl"),
+    (["convert", "tipper.fis", "--to", "rules", "-o", "out.fll"], "--to rules is written to a "
+                                                                   ".rules"),
+    (["convert", "tipper.fis", "--to", "fll", "-o", "out"], "`out` has no extension"),
+    (["export", "tipper.fis", "--to", "c", "-o", "out.py"], "--to c is written to a .c"),
+    (["export", "tipper.fis", "--to", "python", "-o", "out.c"], "--to python is written to "
+                                                                "a .py"),
+])
+def test_output_extension_must_match_the_format(args, expected, tmp_path, monkeypatch) -> None:
+    """As `plot -o t.pdf`: a usage error, nothing written."""
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "tipper.fis").write_text((DATA / "tipper.fis").read_text())
+    result = runner.invoke(app, args)
+    assert result.exit_code == 2 and expected in flat(result.output), result.output
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["tipper.fis"]
+    good = runner.invoke(app, [*args[:-1], args[-1].rsplit(".", 1)[0] + "." + {
+        "fcl": "FCL", "rules": "rules", "fll": "fll", "c": "c", "python": "py"}[args[3]]])
+    assert good.exit_code == 0, good.output          # any case
+
+
+def test_convert_to_rules_without_o_never_overwrites(tmp_path: Path, monkeypatch) -> None:
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "tipper.terms.yaml").write_text("# mine\n")
+    result = runner.invoke(app, ["convert", str(DATA / "tipper.fis"), "--to", "rules"])
+    assert result.exit_code == 2
+    assert "tipper.terms.yaml` is already there" in flat(result.output)
+    assert "-o tipper.rules` replaces it on purpose" in flat(result.output)
+    assert (tmp_path / "tipper.terms.yaml").read_text() == "# mine\n"
+    assert not (tmp_path / "tipper.rules").exists()
+    result = runner.invoke(app, ["convert", str(DATA / "tipper.fis"), "--to", "rules", "-o",
+                                 "tipper.rules"])
+    assert result.exit_code == 0, result.output
+    assert "# mine" not in (tmp_path / "tipper.terms.yaml").read_text()
+
+
 def run_main(args: list[str], capsys) -> tuple[int, str]:
     """The console entry point (which turns MitosError into a message and exit 1)."""
     from mitos_cli.cli.app import main

@@ -52,3 +52,57 @@ def test_fis(new: str, words: str) -> None:
 def test_fcl(new: str, words: str) -> None:
     assert "RANGE := (0 .. 30);" in FCL
     _refused(parse_fcl, FCL.replace("RANGE := (0 .. 30);", new, 1), new[:-1], words)
+
+
+# ---- writers: a refusal points at what the source file says -----------------------------------
+
+def test_a_writer_refusing_a_term_gives_the_terms_position(tmp_path) -> None:
+    """`MATLAB has no `discrete` membership function` had no file:line:col."""
+    from pathlib import Path
+
+    from mitos_cli.api import read_rulebase
+    from mitos_cli.interop import write_foreign
+
+    source = Path(__file__).parent / "data" / "interop" / "robot_jfuzzylogic.fcl"
+    text = source.read_text().replace("TERM far := (1, 0) (2, 1) (3, 1);",
+                                      "TERM far := (1, 0) (2, 1) (3, 0.5);")
+    path = tmp_path / "disc.fcl"
+    path.write_text(text)
+    with pytest.raises(MitosError) as info:
+        write_foreign(read_rulebase(path), "fis")
+    assert "MATLAB has no `discrete` membership function" in info.value.message
+    line = next(i for i, s in enumerate(text.splitlines(), 1) if "TERM far" in s)
+    assert str(info.value.span) == f"{path}:{line}:2"
+
+
+def test_a_writer_refusing_an_operator_points_at_the_operators_line(tmp_path):
+    from pathlib import Path
+
+    from mitos_cli.api import read_rulebase
+    from mitos_cli.errors import FormatError
+    from mitos_cli.interop import write_foreign
+
+    terms = Path(__file__).parents[1] / "rulebases" / "mitos.terms.yaml"
+    (tmp_path / "mitos.terms.yaml").write_text(terms.read_text())
+    path = tmp_path / "lk.rules"
+    path.write_text('terms "mitos.terms.yaml"\noperators: and = lukasiewicz\n'
+                    "r1: if road is WIDE and size is SMALL_SZ then steering is RS\n")
+    with pytest.raises(FormatError) as info:
+        write_foreign(read_rulebase(path), "fis")
+    assert "FIS has no AND method `lukasiewicz`" in info.value.message
+    assert str(info.value.span) == f"{path}:2:12"
+
+
+def test_a_foreign_files_operator_is_refused_where_the_file_sets_it(tmp_path) -> None:
+    from mitos_cli.api import read_rulebase
+    from mitos_cli.errors import FormatError
+    from mitos_cli.interop import write_foreign
+
+    text = FLL.replace("conjunction: Minimum", "conjunction: NilpotentMinimum")
+    path = tmp_path / "n.fll"
+    path.write_text(text)
+    with pytest.raises(FormatError) as info:
+        write_foreign(read_rulebase(path), "fis")
+    assert "FIS has no AND method `nilpotent_minimum`" in info.value.message
+    assert info.value.span is not None and info.value.span.line == line_of(
+        text, "conjunction: NilpotentMinimum")

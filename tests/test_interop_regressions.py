@@ -267,8 +267,9 @@ def test_batch_honours_a_declared_nan_default_and_counts_the_rows(tmp_path: Path
 def test_batch_without_a_declared_default_stops_unless_asked(tmp_path: Path):
     fll = DIMMER.replace("  default: nan\n", "")
     result = batch(tmp_path, fll)
-    assert result.exit_code == 1 and "no rule sets `power` for light=0.1 (2 of 4 rows)" in \
-        str(result.exception) and "--on-no-rule" in result.exception.hint
+    assert result.exit_code == 1 and "no rule sets `power` for light=0.1 (row 1; 2 of 4 rows)" \
+        in str(result.exception) and "--on-no-rule" in result.exception.hint
+    assert str(result.exception.span) == f"{tmp_path / 'in.csv'}:2:1"
     result = batch(tmp_path, fll, "--on-no-rule", "nan")
     assert result.exit_code == 0, result.output
     assert result.stdout.splitlines() == ["light,power,no_rule", "0.1,nan,power", "0.4,0.9,",
@@ -280,7 +281,8 @@ def test_batch_without_a_declared_default_stops_unless_asked(tmp_path: Path):
                    "default")
     assert result.stdout.splitlines()[1] == "0.1,0.5,power"
     result = batch(tmp_path, DIMMER, "--on-no-rule", "error")
-    assert result.exit_code == 1
+    assert result.exit_code == 1      # the row's place in the file, as other batch errors
+    assert str(result.exception.span) == f"{tmp_path / 'in.csv'}:2:1"
 
 
 def test_api_gives_nan_only_where_the_rule_base_asked_for_it():

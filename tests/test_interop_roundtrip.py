@@ -91,6 +91,42 @@ def test_round_trip(path: Path, fmt: str, tmp_path: Path) -> None:
         assert (np.isnan(after) == np.isnan(before)).all()
 
 
+def test_mitos_rules_through_fis_back_to_rules(tmp_path: Path) -> None:
+    """.rules -> .fis -> .rules: the shoulders went out as `trapmf [-inf -inf c d]` and came
+    back as a term set MITOS refused (`point must be a finite number, not -inf`)."""
+    rb = read_rulebase(ROOT / "rulebases" / "mitos.rules")
+    fis = write_foreign(rb, "fis")
+    assert "inf" not in fis and "'NARROW':'trapmf',[-1 -1 40 70]" in fis   # feet outside
+    (tmp_path / "m.fis").write_text(fis)
+    via_fis = read_rulebase(tmp_path / "m.fis")
+    back = write_and_read(via_fis, "rules", tmp_path)
+    original = compile_rulebase(rb)
+    names = original.inputs
+    lo, hi = original.universe[:, 0], original.universe[:, 1]
+    rng = np.random.default_rng(np.random.SeedSequence(4).spawn(1)[0])
+    X = np.vstack([rng.uniform(lo, hi, size=(500, len(names))), lo, hi,
+                   rng.uniform(lo - (hi - lo), hi + (hi - lo), size=(100, len(names)))])
+    _, before = outputs(rb, X, names)
+    _, after = outputs(back, X, names)
+    fired = ~np.isnan(before)            # where no rule fires, .fis has MATLAB's mid-range
+    np.testing.assert_array_equal(after[fired], before[fired])
+
+
+def test_fis_reader_takes_infinite_feet_as_shoulders(tmp_path: Path) -> None:
+    """A .fis written with `trapmf [-inf -inf c d]` (MITOS before it wrote finite feet) reads
+    as the shoulder, as FLL's `Trapezoid -inf -inf c d` does, so it converts to a term set."""
+    text = write_foreign(read_rulebase(ROOT / "rulebases" / "mitos.rules"), "fis")
+    text = text.replace("[-1 -1 40 70]", "[-inf -inf 40 70]").replace(
+        "[70 100 161 161]", "[70 100 inf inf]")
+    (tmp_path / "old.fis").write_text(text)
+    road = read_rulebase(tmp_path / "old.fis").variables["road"]
+    assert road.term("NARROW").shape == "left_shoulder" and \
+        road.term("NARROW").params == (40.0, 70.0)
+    assert road.term("WIDE").shape == "right_shoulder"
+    back = write_and_read(read_rulebase(tmp_path / "old.fis"), "rules", tmp_path)
+    assert back.variables["road"].term("NARROW").shape == "left_shoulder"
+
+
 def test_rules_writer_keeps_operators_and_defaults(tmp_path: Path) -> None:
     rb = read_rulebase(DATA / "tipper_jfuzzylogic.fcl")
     rules, terms = write_rules(rb, "tipper.terms.yaml")

@@ -175,6 +175,9 @@ def test_usage_errors_exit_2(capsys, args, message):
      "`road` is on an axis and cannot also be fixed", None),
     (["surface", "steering", "--x", "road=0:500"],
      "range 0:500 of `road` is not inside its universe [0, 160]", None),
+    (["surface", "steering", "--x", "road", "--y", "position=20:-20"],   # inside, but reversed
+     "range 20:-20 of `position` is reversed: LOW comes first", "write position=-20:20"),
+    (["surface", "steering", "--x", "road=40:40"], "range 40:40 of `road` is empty", None),
     (["surface", "steering", "--x", "road", "--fix", "size=500"],
      "--fix size=500 is outside its universe [0, 100]", None),
     (["surface", "steering", "--x", "heading"],
@@ -189,6 +192,12 @@ def test_user_errors_exit_1(capsys, args, message, hint):
     assert message in err
     if hint:
         assert f"hint: {hint}" in err
+
+
+def test_a_range_is_read_as_numbers_are_everywhere(capsys):
+    """`road=1_0:40` was 10:40 through `float`, which the batch and NAME=VALUE refuse."""
+    code, _, err = run(["plot", "surface", "steering", "--x", "road=1_0:40"], capsys)
+    assert code == 2 and "write NAME or NAME=LOW:HIGH" in err
 
 
 def test_show_without_a_display_exits_1():

@@ -528,15 +528,26 @@ def test_a_quote_inside_a_header_cell_is_positioned(header):
 
 
 def test_cell_starts_agree_with_the_csv_module():
+    """The scanner that finds cells again for an error splits records as the ``csv`` module
+    (strict) does, line breaks in quotes included, and refuses what it refuses."""
     import csv
+    import io
     import random
 
-    from mitos_cli.engine.csvio import _starts
+    from mitos_cli.engine.csvio import _scan
 
     rng = random.Random(3)
-    for _ in range(2000):
-        line = "".join(rng.choice('ab",') for _ in range(rng.randrange(12)))
-        assert len(_starts(line)) == len(next(csv.reader([line]), [""])) or not line
+    for _ in range(3000):
+        text = "".join(rng.choice('ab",\n') for _ in range(rng.randrange(12))) + "\n"
+        starts, problem = _scan(text, 0)
+        try:
+            first = next(csv.reader(io.StringIO(text, newline=""), strict=True), [])
+        except csv.Error:
+            assert problem is not None, repr(text)
+            continue
+        assert problem is None, repr(text)
+        if first:
+            assert len(starts) == len(first), repr(text)
 
 
 def test_only_a_long_token_is_shortened_not_the_words_between_two_quotes():

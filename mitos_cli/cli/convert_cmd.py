@@ -10,6 +10,7 @@ import typer
 
 from .output import emit, err, warn, warn_notes
 from .params import choice, choices, completer, named
+from .targets import check_suffix, refuse_existing, refuse_inputs, source_files
 
 
 class Target(str, Enum):
@@ -27,8 +28,9 @@ def convert_command(
         help="Format to write: rules (NAME.rules + NAME.terms.yaml), fcl, fis or fll.")],
     output: Annotated[Optional[Path], typer.Option(
         "--output", "-o", metavar="OUT",
-        help="File to write (default: stdout; for --to rules: STEM.rules in the current "
-             "directory).")] = None,
+        help="File to write, ending in the format's extension (default: stdout; for --to "
+             "rules: STEM.rules and STEM.terms.yaml in the current directory, never over "
+             "existing files).")] = None,
     behavior: Annotated[Optional[str], typer.Option(
         "--behavior", "-b", callback=named, help="Behavior to convert (default: the file's first).")] = None,
 ) -> None:
@@ -42,20 +44,21 @@ def convert_command(
     from ..interop.common import atomic_write
 
     to = choice(Target, to_name, "format")
+    if output is not None:
+        check_suffix(output, f".{to.value}", f"--to {to.value}")
     rb = read_rulebase(path)
     warn_notes(rb)
     if behavior is not None:
         rb.behavior(behavior)                     # unknown behavior: did you mean
+    sources = source_files(rb, path)
     if to is Target.rules:
         from ..interop.rules_writer import write_rules
 
         rules_path = output if output is not None else Path.cwd() / f"{path.stem}.rules"
-        if rules_path.suffix != ".rules":
-            rules_path = rules_path.with_name(rules_path.name + ".rules")
         terms_path = rules_path.with_name(rules_path.stem + ".terms.yaml")
-        for target in (rules_path, terms_path):
-            if target.resolve() == path.resolve():
-                raise typer.BadParameter(f"`{target}` would overwrite the input; give -o OUT")
+        refuse_inputs([rules_path, terms_path], sources)
+        if output is None:
+            refuse_existing([rules_path, terms_path], rules_path.name)
         rules_text, terms_text = write_rules(rb, terms_path.name, behavior, path.name)
         for note in conversion_notes(rb, "rules", behavior):
             warn(note)
@@ -65,6 +68,8 @@ def convert_command(
             warn(note)
         err(f"wrote {rules_path} and {terms_path}")
         return
+    if output is not None:
+        refuse_inputs([output], sources)
     text = write_foreign(rb, to.value, behavior)
     for note in conversion_notes(rb, to.value, behavior):
         warn(note)
@@ -74,7 +79,5 @@ def convert_command(
     if output is None:
         emit(text)
     else:
-        if output.resolve() == path.resolve():
-            raise typer.BadParameter(f"`{output}` would overwrite the input")
         atomic_write(output, text)
         err(f"wrote {output}")

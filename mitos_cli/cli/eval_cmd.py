@@ -53,12 +53,17 @@ def split_args(args: list[str]) -> tuple[Optional[str], dict[str, str]]:
 
 
 def parse_values(values: dict[str, str]) -> dict[str, float]:
+    """``NAME=VALUE`` texts as numbers, read as a batch CSV's cells are (``parse_number``):
+    ``float`` alone would take ``1_000`` and other scripts' digits, which the batch refuses."""
+    from ..numbers import parse_number
+
     out = {}
     for name, text in values.items():
         try:
-            out[name] = float(text)
+            out[name] = parse_number(text)
         except ValueError:
-            raise InputError(f"input `{name}` must be a number, not `{text}`") from None
+            raise InputError(f"input `{name}` must be a number, not `{text}`",
+                             expected="a decimal number such as 78, -4.5 or 1e3") from None
     return out
 
 
@@ -102,8 +107,11 @@ def eval_command(
         "--batch", metavar="FILE.csv|-",
         help="Evaluate every row of a CSV whose header names the inputs; write a CSV of the "
              "inputs, the outputs and the CSV's other columns as they were.")] = None,
-    digits: Annotated[int, typer.Option(
-        "--digits", min=0, max=12, help="Decimals in the trace (the paper prints 1).")] = 1,
+    digits: Annotated[Optional[int], typer.Option(
+        "--digits", min=0, max=12,
+        help="Decimals in the trace (default 1, as the paper prints) and, with --batch, in the "
+             "outputs (default: every digit, the shortest text that reads back as the same "
+             "number).")] = None,
     network: Annotated[bool, typer.Option(
         "--network", help="Print the compiled network of fuzzy neurons instead.")] = False,
     on_no_rule_name: Annotated[Optional[str], typer.Option(
@@ -141,6 +149,9 @@ def eval_command(
         rb = LoadedRuleBase(rb.rulebase, behavior,
                             fidelity_settings(rb.rulebase, fidelity.value, behavior))
     if network:
+        if batch is not None or values or as_json:
+            raise typer.BadParameter("--network prints the rule base's network and evaluates "
+                                     "nothing: leave out --batch, --json and NAME=VALUE")
         from ..engine.describe import describe_network
 
         emit(describe_network(rb.compiled))
@@ -151,7 +162,7 @@ def eval_command(
         if as_json:
             raise typer.BadParameter("--batch writes a CSV; --json is for one evaluation "
                                      "(leave one of them out)")
-        run_batch(rb, batch, on_no_rule)
+        run_batch(rb, batch, on_no_rule, digits)
         return
     if on_no_rule is not None:
         raise typer.BadParameter("--on-no-rule applies to --batch")
@@ -164,14 +175,15 @@ def eval_command(
     unused = unused_inputs(rb)
     given: dict[str, object] = {k: v for k, v in parse_values(values).items()
                                 if k not in unused}
-    result = evaluate(rb.compiled, as_batch(rb.compiled, given))
+    X = as_batch(rb.compiled, given)
+    result = evaluate(rb.compiled, X)
     warn_clamped(result)
     warn_outside(rb.compiled, result.outputs)
-    trace = trace_of(result)
+    trace = trace_of(result, given=X)
     if as_json:
         emit(json_text(trace.to_json()))
     else:
-        emit(trace.render(digits))
+        emit(trace.render(1 if digits is None else digits))
 
 
 def unused_inputs(rb) -> tuple[str, ...]:
@@ -181,14 +193,21 @@ def unused_inputs(rb) -> tuple[str, ...]:
                  if v.role == "input" and v.name not in rb.compiled.inputs)
 
 
-def run_batch(rb, source: str, on_no_rule: NoRule | None = None) -> None:
+def run_batch(rb, source: str, on_no_rule: NoRule | None = None,
+              digits: int | None = None) -> None:
     """Read the CSV, evaluate all rows as one batch, write inputs and outputs as CSV."""
-    import numpy as np
+    from ..engine.csvio import passed_names, read_table, row_span, write_batch
 
-    from ..engine.csvio import passed_names, read_table, write_batch
+    if source == "-":                  # bytes: a text stream would turn `\r\n` into `\n`
+        stream = getattr(sys.stdin, "buffer", None)
+        try:
+            text = stream.read().decode("utf-8-sig") if stream is not None else sys.stdin.read()
+        except UnicodeDecodeError as exc:
+            from ..fileio import why_unreadable
 
-    if source == "-":
-        text, name = sys.stdin.read(), "<stdin>"
+            raise InputError(f"cannot read the batch from stdin: {why_unreadable(exc)}") \
+                from None
+        name = "<stdin>"
     else:
         from ..fileio import read_text, why_unreadable
 
@@ -201,7 +220,8 @@ def run_batch(rb, source: str, on_no_rule: NoRule | None = None) -> None:
     X = batch.X
     result = rb.run(X, strict=False, detail=False)
     warn_clamped(result)
-    Y, keep, flags = no_rule_policy(rb.compiled, result, on_no_rule or NoRule.default)
+    Y, keep, flags = no_rule_policy(rb.compiled, result, on_no_rule or NoRule.default,
+                                    lambda row: row_span(text, name, row))
     warn_outside(rb.compiled, Y[keep])
     taken = (*rb.compiled.inputs, *rb.compiled.outputs, *(() if on_no_rule is None
                                                          else ("no_rule",)))
@@ -210,14 +230,17 @@ def run_batch(rb, source: str, on_no_rule: NoRule | None = None) -> None:
     if renamed:
         warn("passed-through " + plural(len(renamed), "column") + " renamed, the output CSV "
              "has columns of those names: " + ", ".join(renamed))
-    write_batch(sys.stdout, rb.compiled.inputs, np.asarray(X)[keep],
+    everything = bool(keep.all())
+    write_batch(sys.stdout, rb.compiled.inputs,
+                [g if everything else g[keep] for g in batch.given],
                 rb.compiled.outputs, Y[keep], None if on_no_rule is None else flags[keep],
-                extra, [c for c, k in zip(batch.cells, keep) if k])
+                extra, [c if everything else c[keep] for c in batch.columns], digits)
 
 
-def no_rule_policy(compiled, result, policy: NoRule):
+def no_rule_policy(compiled, result, policy: NoRule, where=None):
     """``(outputs, rows to keep, no_rule column)`` after applying ``policy`` to the rows where
-    no rule set an output; a warning says how many rows each output's choice changed."""
+    no rule set an output; a warning says how many rows each output's choice changed. An
+    error stops at the first such row, at ``where(row)`` (its place in the batch file)."""
     import numpy as np
 
     from ..engine.evaluation import declares_nan
@@ -239,7 +262,8 @@ def no_rule_policy(compiled, result, policy: NoRule):
             values = ", ".join(f"{k}={result.inputs[row, i]:g}"
                                for i, k in enumerate(compiled.inputs))
             raise NoRuleFiredError(
-                f"no rule sets `{out}` for {values} ({count} of {n} rows)",
+                f"no rule sets `{out}` for {values} (row {row + 1}; {count} of {n} rows)",
+                span=None if where is None else where(row),
                 hint=("" if policy is NoRule.error else
                       f"`{out}` declares no default. ") +
                      "--on-no-rule default, nan or skip writes the other rows (docs/interop.md)")

@@ -10,11 +10,15 @@ import typer
 
 from .output import emit, err, warn, warn_notes
 from .params import choice, choices, completer, named
+from .targets import check_suffix, refuse_inputs, source_files
 
 
 class Language(str, Enum):
     c = "c"
     python = "python"
+
+
+SUFFIX = {Language.c: ".c", Language.python: ".py"}
 
 
 def export_command(
@@ -24,7 +28,9 @@ def export_command(
         "--to", metavar=choices(Language), autocompletion=completer(Language),
         help="c: one C99 file (no allocation, only libm); python: a NumPy-only module.")],
     output: Annotated[Optional[Path], typer.Option(
-        "--output", "-o", metavar="OUT", help="File to write (default: stdout).")] = None,
+        "--output", "-o", metavar="OUT",
+        help="File to write: a .c file for --to c, a .py file for --to python (default: "
+             "stdout).")] = None,
     behavior: Annotated[Optional[str], typer.Option(
         "--behavior", "-b", callback=named, help="Behavior to export (default: the file's first).")] = None,
     prefix: Annotated[str, typer.Option(
@@ -43,9 +49,13 @@ def export_command(
     from ..interop.export import ident, to_c, to_python
 
     to = choice(Language, to_name, "export language")
+    if output is not None:
+        check_suffix(output, SUFFIX[to], f"--to {to.value}")
     if not ident(prefix) == prefix:
         raise typer.BadParameter(f"--prefix `{prefix}` is not a C identifier")
     rb = load_rulebase(path, behavior)
+    if output is not None:
+        refuse_inputs([output], source_files(rb.rulebase, path))
     warn_notes(rb.rulebase)
     note = left_out(rb.rulebase, behavior, "exported")
     if note:

@@ -17,6 +17,7 @@ from typing import Annotated, Optional
 
 import typer
 
+from ..numbers import parse_number
 from .eval_cmd import parse_values, split_args
 from .help import epilog
 from .output import emit, err, warn
@@ -150,7 +151,7 @@ def _axis(text: str, option: str) -> tuple[str, Optional[tuple[float, float]]]:
     try:
         if not colon:
             raise ValueError
-        return name, (float(lo), float(hi))
+        return name, (parse_number(lo), parse_number(hi))
     except ValueError:
         raise typer.BadParameter(f"`{text}`: write NAME or NAME=LOW:HIGH, e.g. {name}=40:100",
                                  param_hint=option) from None

@@ -23,6 +23,9 @@ class InputTrace:
     unit: str
     memberships: tuple[tuple[str, float], ...]
     clamped: bool = False
+    #: the value as given, before clamping (``value`` is what the rules saw); ``None`` when
+    #: the trace was made without it
+    given: float | None = None
 
 
 @dataclass(frozen=True)
@@ -54,7 +57,9 @@ class Trace:
             "rulebase": self.rulebase,
             "behavior": self.behavior,
             "operators": self.operators,
-            "inputs": {i.name: {"value": i.value, "memberships": dict(i.memberships)}
+            "inputs": {i.name: {"value": i.value,
+                                "given": i.value if i.given is None else i.given,
+                                "clamped": i.clamped, "memberships": dict(i.memberships)}
                        for i in self.inputs},
             "rules": [{"label": r.label, "text": r.text, "dof": r.dof} for r in self.rules],
             "outputs": {name: value for name, value, _ in self.outputs},
@@ -76,7 +81,8 @@ class Trace:
             fuzzified.append(f"{i.name} = ({', '.join(shown)})")
         width = max(len(f) for f in fuzzified) if fuzzified else 0
         for text, i in zip(fuzzified, self.inputs):
-            note = " (clamped to its universe)" if i.clamped else ""
+            note = "" if not i.clamped else " (clamped to its universe)" if i.given is None \
+                else f" (given {i.given:g}, clamped to its universe)"
             lines.append(f"  {text.ljust(width)}   {i.name} = {i.value:g} {i.unit}".rstrip()
                          + note)
         lines += ["", f"rules fired ({len(self.rules)} of {self.n_rules}):"]
@@ -91,8 +97,9 @@ class Trace:
         return "\n".join(lines)
 
 
-def trace_of(result: Result, row: int = 0) -> Trace:
-    """The trace of sample ``row`` of an evaluation."""
+def trace_of(result: Result, row: int = 0, given: np.ndarray | None = None) -> Trace:
+    """The trace of sample ``row`` of an evaluation; ``given``, the ``X[n, k]`` it was given,
+    keeps the value of an input that was clamped."""
     if result.memberships is None or result.dof is None:
         raise ValueError("a trace needs the memberships and DOFs: evaluate(..., detail=True)")
     c = result.compiled
@@ -106,8 +113,10 @@ def trace_of(result: Result, row: int = 0) -> Trace:
             t += 1
         lo, hi = var.universe
         value = float(result.inputs[row, k])
-        inputs.append(InputTrace(name, value, var.unit, tuple(mus),
-                                 bool(result.clamped[k]) and value in (lo, hi)))
+        original = None if given is None else float(given[row, k])
+        clamped = bool(result.clamped[k]) and value in (lo, hi) and (
+            original is None or original != value)
+        inputs.append(InputTrace(name, value, var.unit, tuple(mus), clamped, original))
     rules = tuple(RuleTrace(c.labels[r], c.rule_text(r), float(result.dof[row, r]))
                   for r in range(c.n_rules) if result.dof[row, r] > 0)
     outputs = tuple((name, float(result.outputs[row, j]), c.variables[name].unit)

@@ -93,13 +93,25 @@ def table_lookup(table: dict, fmt: int, name: str, what: str, span: Span | None,
                       hint=did_you_mean(name, pool))
 
 
-def foreign_name(table: dict, fmt: int, mitos: str, what: str) -> str:
-    """The format's name for MITOS's operator ``mitos`` (writers), else a FormatError."""
+def foreign_name(table: dict, fmt: int, mitos: str, what: str,
+                 span: Span | None = None) -> str:
+    """The format's name for MITOS's operator ``mitos`` (writers), else a FormatError at
+    ``span``, where the rule base chose it (:func:`setting_span`)."""
     names = table.get(mitos)
     if names is None or names[fmt] is None:
-        raise FormatError(f"{FORMAT_NAMES[fmt]} has no {what} `{mitos}`",
-                          hint="choose another operator in the rule file's `operators:` line")
+        raise FormatError(f"{FORMAT_NAMES[fmt]} has no {what} `{mitos}`", span=span,
+                          hint="choose an operator the format has where this one is set")
     return names[fmt]
+
+
+def setting_span(rb: RuleBase, behavior: str | None, key: str) -> Span | None:
+    """Where the operator ``key`` (``and``, ``implication``, ...) that ``behavior`` uses was
+    set: the behavior's own ``operators:`` line, else the file's; ``None`` for a default."""
+    for settings in (rb.behavior(behavior).operators, rb.operators):
+        for s in reversed(settings):
+            if s.key == key:
+                return s.span
+    return None
 
 
 # ---------------------------------------------------------------------------------------------
@@ -215,11 +227,18 @@ def fuzzylite_term(name: str, kind: str, values: list[float], n_inputs: int,
                           hint="MITOS terms reach 1; scale the rule weights instead")
     if shape == "rectangle":            # fuzzylite takes the ends in either order
         values = sorted(values)
+    return make_term(name, *shoulder(shape, tuple(values)), span)
+
+
+def shoulder(shape: str, values: tuple[float, ...]) -> tuple[str, tuple[float, ...]]:
+    """A trapezoid with both feet at -inf (or +inf) is the shoulder it draws (``Trapezoid
+    -inf -inf c d``, ``trapmf [-inf -inf c d]``): a term set takes shoulders, not infinite
+    corners."""
     if shape == "trapezoid" and values[0] == values[1] == -math.inf:
-        shape, values = "left_shoulder", values[2:]         # `Trapezoid -inf -inf c d`
-    elif shape == "trapezoid" and values[2] == values[3] == math.inf:
-        shape, values = "right_shoulder", values[:2]        # `Trapezoid a b inf inf`
-    return make_term(name, shape, tuple(values), span)
+        return "left_shoulder", values[2:]
+    if shape == "trapezoid" and values[2] == values[3] == math.inf:
+        return "right_shoulder", values[:2]
+    return shape, values
 
 
 def distinct_names(terms: list[Term], variable: str, notes: list[str], why: str,
@@ -270,7 +289,8 @@ def fuzzylite_term_text(term: Term, variable: str) -> str:
             "left_shoulder", "right_shoulder") else "Triangle " + " ".join(
             fmt_number(v) for v in (a, b, d))
     if shape not in MITOS_TO_FUZZYLITE_SHAPES:
-        raise FormatError(f"term `{variable}.{term.name}`: fuzzylite has no `{shape}` term")
+        raise FormatError(f"term `{variable}.{term.name}`: fuzzylite has no `{shape}` term",
+                          span=term.span)
     return MITOS_TO_FUZZYLITE_SHAPES[shape] + " " + " ".join(fmt_number(v) for v in p)
 
 
@@ -318,18 +338,21 @@ class Settings:
 
     def operators(self, default_resolution: int) -> tuple[Setting, ...]:
         out = []
+        spans = self.spans or {}
         if self.and_:
-            out.append(Setting("and", self.and_))
+            out.append(Setting("and", self.and_, spans.get("and_")))
         if self.or_:
-            out.append(Setting("or", self.or_))
+            out.append(Setting("or", self.or_, spans.get("or_")))
         defuzz = self.defuzzify or "centroid"
         if defuzz in ("weighted_average", "weighted_sum", "tsukamoto"):
-            out.append(Setting("inference", defuzz))
+            out.append(Setting("inference", defuzz, spans.get("defuzzify")))
         else:
             out.append(Setting("inference", "mamdani"))
-            out.append(Setting("implication", self.implication or "min"))
-            out.append(Setting("aggregation", self.aggregation or "max"))
-            out.append(Setting("defuzzify", defuzz))
+            out.append(Setting("implication", self.implication or "min",
+                               spans.get("implication")))
+            out.append(Setting("aggregation", self.aggregation or "max",
+                               spans.get("aggregation")))
+            out.append(Setting("defuzzify", defuzz, spans.get("defuzzify")))
             out.append(Setting("resolution", str(self.resolution or default_resolution)))
             if self.sampling:
                 out.append(Setting("sampling", self.sampling))

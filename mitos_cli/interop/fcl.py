@@ -535,8 +535,10 @@ def write_fcl(rb: RuleBase, behavior: str | None = None) -> str:
     """FCL text (IEC 61131-7 as jFuzzyLogic reads it) for one behavior of ``rb``."""
     flat = common.flatten_for_export(rb, behavior)
     ops = flat.operators
+    at = functools.partial(common.setting_span, rb, behavior)       # where an operator was chosen
     if ops.inference == "tsukamoto":
-        raise FormatError("FCL has no Tsukamoto inference; write it to FLL or a rule file")
+        raise FormatError("FCL has no Tsukamoto inference; write it to FLL or a rule file",
+                          span=at("inference"))
     sugeno = ops.inference in ("weighted_average", "weighted_sum")
     inputs = common.all_inputs(rb, flat)
     out = [f"FUNCTION_BLOCK {flat.name}", "", "VAR_INPUT"]
@@ -563,7 +565,8 @@ def write_fcl(rb: RuleBase, behavior: str | None = None) -> str:
         if sugeno:
             out.append(f"    METHOD : {common.DEFUZZIFIERS[ops.inference][FCL]};")
         else:
-            method = common.foreign_name(common.DEFUZZIFIERS, FCL, ops.defuzzify, "defuzzifier")
+            method = common.foreign_name(common.DEFUZZIFIERS, FCL, ops.defuzzify, "defuzzifier",
+                                         span=at("defuzzify"))
             # IEC has no resolution: written (fuzzylite-style) only when not the default 1000
             res = "" if ops.resolution == DEFAULT_RESOLUTION else f" {ops.resolution}"
             out.append(f"    METHOD : {method}{res};")
@@ -571,11 +574,14 @@ def write_fcl(rb: RuleBase, behavior: str | None = None) -> str:
             out.append(f"    DEFAULT := {fmt_number(v.default)};")
         out += ["END_DEFUZZIFY", ""]
     out.append(f"RULEBLOCK {flat.name}")
-    out.append(f"    AND : {common.foreign_name(common.TNORMS, FCL, ops.and_, 'T-norm')};")
-    out.append(f"    OR : {common.foreign_name(common.SNORMS, FCL, ops.or_, 'S-norm')};")
+    and_ = common.foreign_name(common.TNORMS, FCL, ops.and_, "T-norm", span=at("and"))
+    or_ = common.foreign_name(common.SNORMS, FCL, ops.or_, "S-norm", span=at("or"))
+    out += [f"    AND : {and_};", f"    OR : {or_};"]
     if not sugeno:
-        act = common.foreign_name(common.TNORMS, FCL, ops.implication, "T-norm")
-        accu = common.foreign_name(common.SNORMS, FCL, ops.aggregation, "S-norm")
+        act = common.foreign_name(common.TNORMS, FCL, ops.implication, "T-norm",
+                                  span=at("implication"))
+        accu = common.foreign_name(common.SNORMS, FCL, ops.aggregation, "S-norm",
+                                   span=at("aggregation"))
         out += [f"    ACT : {act};", f"    ACCU : {accu};"]
     for i, r in enumerate(flat.rules, 1):
         out.append(f"    RULE {i} : {_rule_text(r)};")

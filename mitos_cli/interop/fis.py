@@ -30,6 +30,7 @@ import dataclasses
 import math
 import re
 from collections import Counter
+from functools import partial
 from pathlib import Path
 
 from ..errors import FormatError, Span, did_you_mean
@@ -320,7 +321,8 @@ def _mf(value: str, vspan: Span, role: str, kind: str, n_inputs: int) -> Term:
     if len(params) != count:
         raise FormatError(f"MF `{name}`: {mf} takes {plural(count, 'number')}, not {len(params)}",
                           span=vspan)
-    return common.make_term(name, shape, tuple(params[i] for i in order), vspan)
+    return common.make_term(name, *common.shoulder(shape, tuple(params[i] for i in order)),
+                            vspan)
 
 
 #: Octave's fuzzy-logic-toolkit: the fraction of an antecedent's MF index is a hedge, the
@@ -400,24 +402,29 @@ def write_fis(rb: RuleBase, behavior: str | None = None) -> str:
     negated, without hedges) joined all by AND or all by OR, as MATLAB's rule list is."""
     flat = common.flatten_for_export(rb, behavior)
     ops = flat.operators
+    at = partial(common.setting_span, rb, behavior)       # where an operator was chosen
     if ops.inference == "tsukamoto":
         raise FormatError("MATLAB's .fis has no Tsukamoto inference; write it to FLL or a "
-                          "rule file")
+                          "rule file", span=at("inference"))
     sugeno = ops.inference in ("weighted_average", "weighted_sum")
     inputs = common.all_inputs(rb, flat)
     name = flat.name
+    and_ = common.foreign_name(common.TNORMS, FIS, ops.and_, "AND method", span=at("and"))
+    or_ = common.foreign_name(common.SNORMS, FIS, ops.or_, "OR method", span=at("or"))
     lines = ["[System]", f"Name='{name}'", f"Type='{'sugeno' if sugeno else 'mamdani'}'",
              "Version=2.0", f"NumInputs={len(inputs)}", f"NumOutputs={len(flat.outputs)}",
              f"NumRules={len(flat.rules)}",
-             f"AndMethod='{common.foreign_name(common.TNORMS, FIS, ops.and_, 'AND method')}'",
-             f"OrMethod='{common.foreign_name(common.SNORMS, FIS, ops.or_, 'OR method')}'"]
+             f"AndMethod='{and_}'", f"OrMethod='{or_}'"]
     if sugeno:
         lines += ["ImpMethod='prod'", "AggMethod='sum'",
                   f"DefuzzMethod='{common.DEFUZZIFIERS[ops.inference][FIS]}'"]
     else:
-        imp = common.foreign_name(common.TNORMS, FIS, ops.implication, "implication")
-        agg = common.foreign_name(common.SNORMS, FIS, ops.aggregation, "aggregation")
-        defuzz = common.foreign_name(common.DEFUZZIFIERS, FIS, ops.defuzzify, "defuzzifier")
+        imp = common.foreign_name(common.TNORMS, FIS, ops.implication, "implication",
+                                  span=at("implication"))
+        agg = common.foreign_name(common.SNORMS, FIS, ops.aggregation, "aggregation",
+                                  span=at("aggregation"))
+        defuzz = common.foreign_name(common.DEFUZZIFIERS, FIS, ops.defuzzify, "defuzzifier",
+                                     span=at("defuzzify"))
         lines += [f"ImpMethod='{imp}'", f"AggMethod='{agg}'", f"DefuzzMethod='{defuzz}'"]
     for i, v in enumerate(inputs, 1):
         lines += ["", f"[Input{i}]"] + _var_lines(v, [_mf_text(t, v) for t in v.terms])
@@ -477,11 +484,13 @@ def _mf_text(t: Term, v: Variable) -> str:
         assert corners is not None             # these five shapes are piecewise linear
         a, b, c, d = corners
         lo, hi = v.universe
-        # MATLAB trapmf has no infinite feet: put them just outside the universe
-        a = min(lo, b) - 1.0 if a == -float("inf") else a
-        b = a if b == -float("inf") else b
-        d = max(hi, c) + 1.0 if d == float("inf") else d
-        c = d if c == float("inf") else c
+        # a shoulder's open end: feet just outside the universe (inputs are clamped to it and
+        # outputs sampled inside it, so nothing computed changes); the feet were taken from
+        # the other infinite corner before, and written as `-inf`
+        if a == b == -math.inf:
+            a = b = min(lo, c) - 1.0
+        if c == d == math.inf:
+            c = d = max(hi, b) + 1.0
         if shape in ("triangle_pw", "triangle_plr"):
             return f"'{t.name}':'trimf',[{fmt_number(a)} {fmt_number(b)} {fmt_number(d)}]"
         return f"'{t.name}':'trapmf',[{' '.join(fmt_number(x) for x in (a, b, c, d))}]"
@@ -489,7 +498,7 @@ def _mf_text(t: Term, v: Variable) -> str:
         return f"'{t.name}':'linzmf',[{fmt_number(p[1])} {fmt_number(p[0])}]"
     if shape not in INVERSE:
         raise FormatError(f"term `{v.name}.{t.name}`: MATLAB has no `{shape}` membership "
-                          f"function")
+                          f"function", span=t.span)
     mf, order = INVERSE[shape]
     values = [0.0] * len(order)
     for mitos_i, matlab_i in enumerate(order):

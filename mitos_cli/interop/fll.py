@@ -435,6 +435,7 @@ def write_fll(rb: RuleBase, behavior: str | None = None) -> str:
     """FLL text for one behavior of ``rb`` (reading it back gives the same outputs)."""
     flat = common.flatten_for_export(rb, behavior)
     ops = flat.operators
+    at = functools.partial(common.setting_span, rb, behavior)       # where an operator was chosen
     tsukamoto = ops.inference == "tsukamoto"
     sugeno = ops.inference in ("weighted_average", "weighted_sum") or tsukamoto
     inputs = common.all_inputs(rb, flat)
@@ -460,9 +461,11 @@ def write_fll(rb: RuleBase, behavior: str | None = None) -> str:
                 kind = common.DEFUZZIFIERS[ops.inference][FLL]
                 out.append(f"  defuzzifier: {kind} TakagiSugeno")
         else:
-            aggregation = common.foreign_name(common.SNORMS, FLL, ops.aggregation, "S-norm")
+            aggregation = common.foreign_name(common.SNORMS, FLL, ops.aggregation, "S-norm",
+                                              span=at("aggregation"))
             out.append(f"  aggregation: {aggregation}")
-            kind = common.foreign_name(common.DEFUZZIFIERS, FLL, ops.defuzzify, "defuzzifier")
+            kind = common.foreign_name(common.DEFUZZIFIERS, FLL, ops.defuzzify, "defuzzifier",
+                                       span=at("defuzzify"))
             res = "" if ops.resolution == DEFAULT_RESOLUTION else f" {ops.resolution}"
             out.append(f"  defuzzifier: {kind}{res}")
         out.append(f"  default: {'nan' if v.default is None else fmt_number(v.default)}")
@@ -471,14 +474,16 @@ def write_fll(rb: RuleBase, behavior: str | None = None) -> str:
             text = common.fuzzylite_term_text(t, v.name) if tsukamoto else \
                 _output_term(rb, t, v, sugeno, inputs)
             out.append(f"  term: {t.name} {text}")
-    out += [f"RuleBlock: {flat.name}", "  enabled: true",
-            f"  conjunction: {common.foreign_name(common.TNORMS, FLL, ops.and_, 'T-norm')}",
-            f"  disjunction: {common.foreign_name(common.SNORMS, FLL, ops.or_, 'S-norm')}"]
+    and_ = common.foreign_name(common.TNORMS, FLL, ops.and_, "T-norm", span=at("and"))
+    or_ = common.foreign_name(common.SNORMS, FLL, ops.or_, "S-norm", span=at("or"))
+    out += [f"RuleBlock: {flat.name}", "  enabled: true", f"  conjunction: {and_}",
+            f"  disjunction: {or_}"]
     if sugeno:
         out.append("  implication: none")
     else:
-        out.append(f"  implication: "
-                   f"{common.foreign_name(common.TNORMS, FLL, ops.implication, 'implication')}")
+        imp = common.foreign_name(common.TNORMS, FLL, ops.implication, "implication",
+                                  span=at("implication"))
+        out.append(f"  implication: {imp}")
     out.append("  activation: General")
     for r in flat.rules:
         out.append(f"  rule: {fuzzylite_rule_text(r, ops, 'fll')}")

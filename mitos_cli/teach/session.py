@@ -475,7 +475,8 @@ class Session:
 
         compiled = self.compiled()
         values = self._values(c.inputs, compiled.inputs, "input", compiled, True)
-        self.out(trace_of(evaluate(compiled, as_batch(compiled, values))).render())
+        X = as_batch(compiled, values)
+        self.out(trace_of(evaluate(compiled, X), given=X).render())
 
     def _correct(self, c: cmd.Correct, line: str) -> None:
         compiled = self.compiled()

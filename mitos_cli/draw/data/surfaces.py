@@ -112,6 +112,13 @@ def surface(compiled: CompiledRuleBase, output: str, x: str, y: str | None = Non
         lo, hi = compiled.universe[k]
         if limits is not None:
             a, b = limits
+            name = compiled.inputs[k]
+            if a > b:
+                raise InputError(f"range {a:g}:{b:g} of `{name}` is reversed: LOW comes first",
+                                 hint=f"write {name}={b:g}:{a:g}")
+            if a == b:
+                raise InputError(f"range {a:g}:{b:g} of `{name}` is empty: LOW and HIGH are "
+                                 f"the same", hint="give LOW:HIGH with LOW < HIGH")
             if not (lo <= a < b <= hi):
                 raise InputError(f"range {a:g}:{b:g} of `{compiled.inputs[k]}` is not inside "
                                  f"its universe [{lo:g}, {hi:g}]",

@@ -6,8 +6,10 @@ and ``static const`` tables) and exposes::
     int PREFIX_eval(const double in[PREFIX_N_INPUTS], double out[PREFIX_N_OUTPUTS]);
 
 with ``PREFIX_IN_<NAME>`` / ``PREFIX_OUT_<NAME>`` index macros. Inputs are clamped to their
-universes (NaN inputs give NaN outputs); an output no rule sets takes its default, or NaN when
-it has none, and the return value counts such outputs (0: every output was set by its rules).
+universes; an output no rule sets takes its default, or NaN when it has none, and the return
+value counts such outputs (0: every output was set by its rules). A NaN input gives NaN
+outputs and returns ``PREFIX_NAN_INPUT`` (-1), as the NumPy module and ``mitos eval`` do not
+let it pass as a number either.
 Names from the rule base appear only in comments, through :func:`comment`, and in
 identifiers made by :mod:`.program`.
 """
@@ -131,6 +133,7 @@ def to_c(compiled: CompiledRuleBase, prefix: str = "mitos", source: str = "") ->
         out += tables + [""]
     out += [signature, "{", f"    double x[{U}_N_INPUTS > 0 ? {U}_N_INPUTS : 1];",
             "    int fallback = 0;"]
+    out += _c_nan_inputs(U)
     out += _c_body(p)
     out += _c_outputs(compiled, P)
     out += ["    return fallback;", "}", ""]
@@ -146,9 +149,12 @@ def _c_header(p: Program, P: str, U: str, source: str) -> list[str]:
            " * C99, no allocation, only <math.h>: cc -std=c99 -c FILE.c, link with -lm.",
            f" * int {P}_eval(const double in[{U}_N_INPUTS], double out[{U}_N_OUTPUTS]):",
            " * inputs are clamped to their universes; an output no rule sets takes its default",
-           " * (NaN when it has none); returns how many outputs took that fallback. */",
+           " * (NaN when it has none). Returns how many outputs took that fallback (0: the rules",
+           f" * set every output), or {U}_NAN_INPUT (-1) when an input is NaN: then every",
+           " * output is NaN. */",
            "", "#include <math.h>", "",
-           f"#define {U}_N_INPUTS {len(c.inputs)}", f"#define {U}_N_OUTPUTS {len(c.outputs)}"]
+           f"#define {U}_N_INPUTS {len(c.inputs)}", f"#define {U}_N_OUTPUTS {len(c.outputs)}",
+           f"#define {U}_NAN_INPUT (-1)  /* returned when an input is NaN */"]
     for i, name in enumerate(unique_idents(c.inputs, str.upper)):
         lo, hi = c.universe[i]
         out.append(f"#define {U}_IN_{name.upper()} {i}  /* [{lo:g}, {hi:g}] */")
@@ -191,6 +197,18 @@ def _c_helpers(p: Program) -> list[str]:
     for h in p.hedges:
         out += [f"static double hedge_{h}(double x) {{", f"    {C_HEDGES[h]}", "}", ""]
     return out
+
+
+def _c_nan_inputs(U: str) -> list[str]:
+    """A NaN input makes every output NaN and the status negative: the clamp and the min
+    t-norm (``a < b ? a : b``) would otherwise turn it into a plausible number."""
+    return [f"    {{   /* a NaN input: every output NaN, return {U}_NAN_INPUT */",
+            "        int i;",
+            f"        for (i = 0; i < {U}_N_INPUTS; ++i) if (isnan(in[i])) {{",
+            f"            for (i = 0; i < {U}_N_OUTPUTS; ++i) out[i] = NAN;",
+            f"            return {U}_NAN_INPUT;",
+            "        }",
+            "    }"]
 
 
 def _c_body(p: Program) -> list[str]:

@@ -29,6 +29,41 @@ def doc_text(text: str) -> str:
     return text if PLAIN.fullmatch(text) else ascii(text).replace('"', '\\"')
 
 
+#: evaluate_one's check of its keywords: a TypeError as a Python function's call gives, with
+#: the closest input for an unknown one (a bare KeyError, or a typo silently ignored, before).
+#: Plain Python, no import: the module imports NumPy alone (tests/test_export_hostile.py).
+CHECK_NAMES = [
+    "def _check_names(inputs):",
+    '    """A missing or unknown input, as a TypeError naming it."""',
+    "    for name in inputs:",
+    "        if name not in INPUTS:",
+    "            close = _closest(name)",
+    "            hint = (f'; did you mean {close!r}?' if close is not None",
+    "                    else '; the inputs are ' + ', '.join(f'{n!r}' for n in INPUTS))",
+    "            raise TypeError(f'evaluate_one() got an unexpected keyword argument '",
+    "                            f'{name!r}{hint}')",
+    "    missing = [name for name in INPUTS if name not in inputs]",
+    "    if missing:",
+    "        raise TypeError(f'evaluate_one() missing {len(missing)} required keyword '",
+    "                        f\"argument{'s' if len(missing) > 1 else ''}: \"",
+    "                        + ', '.join(f'{n!r}' for n in missing))",
+    "",
+    "",
+    "def _closest(name):",
+    '    """The input fewest edits from ``name`` (at most a third of its length), or None."""',
+    "    best, found = max(1, len(name) // 3) + 1, None",
+    "    for other in INPUTS:",
+    "        row = list(range(len(other) + 1))",
+    "        for i, a in enumerate(name, 1):",
+    "            prev, row[0] = row[0], i",
+    "            for j, b in enumerate(other, 1):",
+    "                prev, row[j] = row[j], min(row[j] + 1, row[j - 1] + 1, prev + (a != b))",
+    "        if row[-1] < best:",
+    "            best, found = row[-1], other",
+    "    return found",
+    ""]
+
+
 def to_python(compiled: CompiledRuleBase, source: str = "") -> str:
     """A NumPy-only module with ``evaluate(X) -> Y`` for ``X[n, k]`` (and ``INPUTS``,
     ``OUTPUTS``, ``evaluate_one(**inputs)``)."""
@@ -44,8 +79,10 @@ def to_python(compiled: CompiledRuleBase, source: str = "") -> str:
     out += _py_evaluate(p)
     out += ["def evaluate_one(**inputs):",
             '    """Outputs by name for one value per input (by name)."""',
+            "    _check_names(inputs)",
             "    row = np.array([[float(inputs[name]) for name in INPUTS]])",
-            "    return dict(zip(OUTPUTS, (float(v) for v in evaluate(row)[0])))", ""]
+            "    return dict(zip(OUTPUTS, (float(v) for v in evaluate(row)[0])))", "", "",
+            *CHECK_NAMES]
     return "\n".join(out)
 
 

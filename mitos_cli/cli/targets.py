@@ -1,0 +1,71 @@
+"""Where ``convert`` and ``export`` may write: a file whose extension says what it holds, and
+never one of the files the rule base was read from (nothing the user wrote is ever lost)."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import typer
+
+OUTPUT_OPTION = "'-o' / '--output'"
+
+
+def check_suffix(path: Path, suffix: str, what: str) -> None:
+    """``-o`` must end in ``suffix`` (any case): a C file called ``out.py`` or an FCL file
+    called ``out.fis`` would be read later as what it is not. A device or a pipe
+    (``/dev/stdout``) has no extension to check."""
+    if _special(path) or path.suffix.lower() == suffix:
+        return
+    has = f"extension {path.suffix}" if path.suffix else "no extension"
+    raise typer.BadParameter(f"`{path}` has {has}; {what} is written to a {suffix} file",
+                             param_hint=OUTPUT_OPTION)
+
+
+def source_files(rulebase, path: Path) -> list[tuple[Path, str]]:
+    """The files ``rulebase`` was read from, each with a phrase saying what it is: the rule
+    file and the term sets its ``terms`` line names."""
+    files = [(path, "the input")]
+    for rel in getattr(rulebase, "termset_paths", ()):
+        files.append((path.parent / rel, f"a term set `{path.name}` reads (`terms \"{rel}\"`)"))
+    return files
+
+
+def refuse_inputs(targets: list[Path], sources: list[tuple[Path, str]]) -> None:
+    """A usage error (exit 2) when a file about to be written is one of ``sources`` (through
+    a symbolic or hard link too)."""
+    for target in targets:
+        for source, what in sources:
+            if same_file(target, source):
+                raise typer.BadParameter(f"`{target}` would overwrite {what}; give -o another "
+                                         f"name", param_hint=OUTPUT_OPTION)
+
+
+def refuse_existing(targets: list[Path], named: str) -> None:
+    """A usage error when a file written by default (no ``-o``) is already there: only a file
+    the user names on purpose is replaced."""
+    for target in targets:
+        if target.exists() or target.is_symlink():
+            raise typer.BadParameter(
+                f"`{target}` is already there and without -o nothing is overwritten; "
+                f"`-o {named}` replaces it on purpose, or write elsewhere with -o",
+                param_hint=OUTPUT_OPTION)
+
+
+def same_file(a: Path, b: Path) -> bool:
+    """Whether ``a`` and ``b`` are one file (a link to it included); a path that is not there
+    yet is compared by its resolved name."""
+    try:
+        return os.path.samefile(a, b)
+    except OSError:
+        try:
+            return a.resolve() == b.resolve()
+        except OSError:
+            return False
+
+
+def _special(path: Path) -> bool:
+    try:
+        return path.exists() and not path.is_file() and not path.is_dir()
+    except OSError:
+        return False
