@@ -420,6 +420,15 @@ def test_batch_cell_positions_count_lines_inside_quoted_cells():
     assert str(info.value.span) == "q.csv:4:7"
 
 
+def test_a_cell_past_the_csv_modules_field_limit_is_an_error_at_its_row():
+    """The fast reading takes a 131,073-character cell; finding its row for the message
+    went through the csv module, whose field limit then escaped as an internal exception."""
+    text = "road,size,position\n" + "a" * 140_000 + "\n"
+    with pytest.raises(InputError) as info:
+        read_batch(text, "q.csv", ("road", "size", "position"))
+    assert str(info.value.span).startswith("q.csv:2:")
+
+
 def test_batch_writes_inputs_as_given_and_outputs_in_full(capsys, tmp_path):
     """Every number was rewritten with 12 significant digits, the user's inputs included, and
     --digits was ignored with --batch."""

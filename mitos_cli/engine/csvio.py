@@ -308,7 +308,10 @@ def _records(text: str) -> Iterator[tuple[int, list[str]]]:
 def _record_line(text: str, row: int) -> int:
     """The line where data row ``row`` (0-based, blank lines not counted) starts."""
     records = (line for line, cells in islice(_records(text), 1, None) if not _blank(cells))
-    return next(islice(records, row, None))
+    try:
+        return next(islice(records, row, None))
+    except _Broken as broken:     # a cell past the csv module's field limit before the row:
+        return broken.line        # (the fast path read it) the place the module stops at
 
 
 def _line_offset(text: str, line: int) -> int:
