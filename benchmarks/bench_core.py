@@ -335,6 +335,7 @@ def against(rev: str, quick: bool = False) -> None:
 
     print(f"# MITOS core benchmark against {rev} ({time.strftime('%Y-%m-%d')})")
     print(f"machine: {host}")
+    print(_threads())
     print(f"command: python benchmarks/bench_core.py --against {rev}{' --quick' if quick else ''}")
     print(f"batch: {n:,} random inputs, best of {rounds} interleaved rounds (wall; CPU time of the "
           f"process in brackets); single: median of {rounds} alternating rounds of {single_n} calls; "
@@ -488,6 +489,7 @@ def main() -> None:
 
     print(f"# MITOS core benchmark ({time.strftime('%Y-%m-%d')})")
     print(f"machine: {host}")
+    print(_threads())
     print(f"command: python benchmarks/bench_core.py{' --quick' if args.quick else ''}")
     print(f"batch: {n:,} random inputs, best of {2 * repeats} interleaved rounds after a warm-up; "
           f"single: median of {repeats} repeats of the mean over {single_n} (MITOS) / "
@@ -521,6 +523,16 @@ def main() -> None:
           f"{t_eval / t_numpy:.2f}x `python -c \"import numpy\"` |")
     print(f"| `python -c \"import numpy\"` (whole process) | {fmt_time(t_numpy)} | |")
     print(f"\n{_load()} at the end")
+
+
+def _threads() -> str:
+    """Who may use how many threads: MITOS's batches (its blocks over threads) and the BLAS
+    product of the kernel."""
+    from mitos_cli.engine.threads import ENV, thread_count
+
+    blas = os.environ.get("OPENBLAS_NUM_THREADS") or os.environ.get("OMP_NUM_THREADS")
+    return (f"threads: MITOS batches {thread_count()} ({ENV}={os.environ.get(ENV, 'unset')}), "
+            f"the kernel's BLAS {blas or 'its default'}")
 
 
 def _load() -> str:

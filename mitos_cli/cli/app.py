@@ -86,6 +86,9 @@ def main(argv: list[str] | None = None) -> None:
     first = args[0] if args else None
     app = build_app(first if first in COMMANDS else None)
     try:
+        from ..engine.threads import given
+
+        given()                    # MITOS_NUM_THREADS, refused before any command runs
         app(args=args, prog_name="mitos", standalone_mode=True)
     except MitosError as exc:
         from .output import report_error

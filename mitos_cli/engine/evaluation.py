@@ -19,6 +19,7 @@ from ..fuzzy import hedges as hedge_mod
 from ..fuzzy import norms
 from ..fuzzy.shapes import SHAPES
 from .compile import CompiledRuleBase
+from .threads import Blocks, map_blocks
 
 
 @dataclass(frozen=True, eq=False)   # holds arrays: identity, not ==
@@ -425,8 +426,7 @@ def evaluate(compiled: CompiledRuleBase, X, *, detail: bool = True, keep_values:
     has none, ``strict`` (the default) raises :class:`NoRuleFiredError` and ``strict=False``
     leaves NaN there (for callers that report such samples themselves).
 
-    Blocks run one after the other: spreading them over threads was measured and gained
-    nothing on a 2-core machine (each layer streams its rows through the shared cache).
+    Blocks are spread over threads (:func:`~.threads.map_blocks`): the same bits.
     """
     X = _rows(compiled, X)
     n, k = X.shape
@@ -444,20 +444,23 @@ def evaluate(compiled: CompiledRuleBase, X, *, detail: bool = True, keep_values:
     values = np.empty((compiled.n_columns, n)) if keep_values else None
     out = np.empty((len(compiled.outputs), n))
 
-    counts = np.zeros(k, dtype=np.intp)
-    for start in range(0, n, BLOCK):          # blocks of samples, each one vectorized pass
-        block = slice(start, min(start + BLOCK, n))
-        Xt, clamped = _clamp(compiled, X[block], start, n)
-        counts += clamped
-        V = network_values(compiled, Xt)
-        d = rule_dof(compiled, V)
-        out[:, block] = infer(compiled, d, Xt)
-        clamped_in[:, block] = Xt
-        if mu is not None and dof is not None:      # detail
-            mu[:, block] = V[2:2 + T]
-            dof[:, block] = d
-        if values is not None:                      # keep_values
-            values[:, block] = V
+    def blocks(ranges: Blocks) -> np.ndarray:     # each block one vectorized pass
+        counts = np.zeros(k, dtype=np.intp)
+        for start, end in ranges:
+            block = slice(start, end)
+            Xt, clamped = _clamp(compiled, X[block], start, n)
+            counts += clamped
+            V = network_values(compiled, Xt)
+            d = rule_dof(compiled, V)
+            out[:, block] = infer(compiled, d, Xt)
+            clamped_in[:, block] = Xt
+            if mu is not None and dof is not None:      # detail
+                mu[:, block] = V[2:2 + T]
+                dof[:, block] = d
+            if values is not None:                      # keep_values
+                values[:, block] = V
+        return counts
+    counts = sum(map_blocks(blocks, n, BLOCK), np.zeros(k, dtype=np.intp))
     X = clamped_in.T
     no_rule = np.isnan(out.T)
     outputs = fill_defaults(compiled, out.T, X, strict)
@@ -486,7 +489,9 @@ def evaluate_columns(compiled: CompiledRuleBase, Xt, *, strict: bool = True) -> 
     rows or keeping its clamped inputs (``load_rulebase().evaluate(**arrays)``).
 
     A behavior whose rules are one grid (:class:`~mitos_cli.engine.compile.GridBatch`, the
-    paper's 27 rules) takes :func:`_grid_columns`, the same operations in fewer NumPy calls."""
+    paper's 27 rules) takes :func:`_grid_columns`, the same operations in fewer NumPy calls.
+    A large batch is cut into one part per thread (:mod:`~mitos_cli.engine.threads`): the
+    same bits, since no sample's operations depend on the others."""
     columns = [np.asarray(x, dtype=float) for x in Xt]   # the rows of Xt, not copied
     if len(columns) != len(compiled.inputs):
         raise InputError(f"expected {len(compiled.inputs)} input columns "
@@ -497,15 +502,18 @@ def evaluate_columns(compiled: CompiledRuleBase, Xt, *, strict: bool = True) -> 
     n = columns[0].shape[0] if columns else 0
     out = np.empty((len(compiled.outputs), n))
     grid = compiled.grid_batch
-    if grid is not None and n:
+    if grid is not None:
         unfired = _grid_columns(compiled, grid, columns, out)
     else:
         if not (isinstance(Xt, np.ndarray) and Xt.dtype == float and Xt.ndim == 2):
             Xt = np.array(columns).reshape(len(columns), n)
-        for start in range(0, n, BLOCK):
-            block = slice(start, min(start + BLOCK, n))
-            Xc, _ = _clamp_columns(compiled, Xt[:, block], start, n)
-            out[:, block] = infer(compiled, rule_dof(compiled, network_values(compiled, Xc)), Xc)
+
+        def blocks(ranges: Blocks) -> None:
+            for start, end in ranges:
+                Xc, _ = _clamp_columns(compiled, Xt[:, start:end], start, n)
+                out[:, start:end] = infer(compiled, rule_dof(compiled, network_values(compiled, Xc)),
+                                          Xc)
+        map_blocks(blocks, n, BLOCK)
         unfired = True
     if unfired and np.isnan(out).any():      # rare: the clamped rows, for the message
         rows = np.minimum(np.maximum(np.array(columns).T, compiled.plan.lo),
@@ -580,7 +588,8 @@ def _grid_columns(compiled: CompiledRuleBase, g, columns: list, out: np.ndarray)
 
     The operations of :func:`memberships`, :func:`_apply_grid`, :func:`rule_dof` and
     :func:`weighted_average` (so the same bits), over the grid's terms only, in about twenty
-    NumPy calls per block on buffers made once: no temporary arrays, no gathers, the sums'
+    NumPy calls per block on buffers each thread makes once (:func:`~.threads.map_blocks`):
+    no temporary arrays, no gathers, the sums'
     later steps on all sums at once. Inputs inside their universes (checked once over the
     batch) are not clamped block by block; that skips only the clamp's ``+ 0.0``, which
     turns an input of -0.0 into 0.0, and a membership is the same for both (either zero,
@@ -591,70 +600,83 @@ def _grid_columns(compiled: CompiledRuleBase, g, columns: list, out: np.ndarray)
     """
     plan = compiled.plan
     n = out.shape[1]
+    if not n:
+        return False
     lo, hi = plan.bounds
     inside = all(lo[v] <= x.min() and x.max() <= hi[v]      # NaN fails both
                  for v, x in enumerate(columns))
     count = -(-n // GRID_BLOCK)
-    block = -(-n // count)                     # blocks of one width, the last no wider
-    last = n - (count - 1) * block
-    full = _GridBlock(g, block)
+    width = -(-n // count)                     # blocks of one width, the last no wider
+    last = n - (count - 1) * width
+
+    def blocks(ranges: Blocks) -> bool:
+        full = _GridBlock(g, width)            # this thread's buffers
+        old = np.setbufsize(max(16, last - last % 16))
+        try:
+            unfired = False
+            for start, end in ranges:
+                b = full if end - start == width else _GridBlock(g, end - start, full)
+                unfired |= _grid_block(compiled, g, b, columns, inside, out, start, end)
+            return unfired
+        finally:
+            np.setbufsize(old)
+    return any(map_blocks(blocks, n, width))
+
+
+def _grid_block(compiled: CompiledRuleBase, g, b: _GridBlock, columns: list, inside: bool,
+                out: np.ndarray, start: int, end: int) -> bool:
+    """One block of :func:`_grid_columns`: ``out[:, start:end]``, True where a sample may have
+    no rule fired."""
+    # memberships: the linear kernel (memberships())
+    M = b.M
+    if inside:
+        for v, x in enumerate(columns):
+            xv = x[start:end]
+            np.subtract(xv, g.B[v], out=b.rise[v])
+            np.subtract(g.C[v], xv, out=b.fall[v])
+    else:
+        for v, x in enumerate(columns):
+            b.X[v] = x[start:end]
+        Xc, _ = _clamp_columns(compiled, b.X, start, out.shape[1])
+        b.X[...] = Xc
+        np.subtract(b.Xb, g.B, out=b.rise)
+        np.subtract(g.C, b.Xb, out=b.fall)
+    if g.overflow:
+        with np.errstate(over="ignore"):
+            b.RF *= g.S
+    else:
+        b.RF *= g.S
+    np.minimum(M, b.fall, out=M)
+    if g.plateaus:
+        np.minimum(M, b.zeros, out=M)
+    M += 1.0
+    np.maximum(M, b.zeros, out=M)
+    for acc, axis, target in b.grid:            # _apply_grid()
+        np.minimum(acc, axis, out=target)
+    if g.weight is not None:                    # rule_dof()
+        b.D *= g.weight
+    np.multiply(*b.products)                    # _constant_sums()
+    for x, y in b.tree:
+        np.add(x, y, out=x)
+    # weighted_average()
+    part = out[:, start:end]
+    if g.weighted_sum:
+        for j, num in enumerate(b.nums):
+            part[j] = num
+        return False
+    if b.shared:
+        den = b.dens[0]
+        if den.min() > 0:
+            np.divide(b.all_nums, den, out=part)
+            return False
     unfired = False
-    old = np.setbufsize(max(16, last - last % 16))
-    try:
-        for start in range(0, n, block):
-            end = min(start + block, n)
-            b = full if end - start == block else _GridBlock(g, end - start, full)
-            # memberships: the linear kernel (memberships())
-            M = b.M
-            if inside:
-                for v, x in enumerate(columns):
-                    xv = x[start:end]
-                    np.subtract(xv, g.B[v], out=b.rise[v])
-                    np.subtract(g.C[v], xv, out=b.fall[v])
-            else:
-                for v, x in enumerate(columns):
-                    b.X[v] = x[start:end]
-                Xc, _ = _clamp_columns(compiled, b.X, start, n)
-                b.X[...] = Xc
-                np.subtract(b.Xb, g.B, out=b.rise)
-                np.subtract(g.C, b.Xb, out=b.fall)
-            if g.overflow:
-                with np.errstate(over="ignore"):
-                    b.RF *= g.S
-            else:
-                b.RF *= g.S
-            np.minimum(M, b.fall, out=M)
-            if g.plateaus:
-                np.minimum(M, b.zeros, out=M)
-            M += 1.0
-            np.maximum(M, b.zeros, out=M)
-            for acc, axis, target in b.grid:            # _apply_grid()
-                np.minimum(acc, axis, out=target)
-            if g.weight is not None:                    # rule_dof()
-                b.D *= g.weight
-            np.multiply(*b.products)                    # _constant_sums()
-            for x, y in b.tree:
-                np.add(x, y, out=x)
-            # weighted_average()
-            part = out[:, start:end]
-            if g.weighted_sum:
-                for j, num in enumerate(b.nums):
-                    part[j] = num
-                continue
-            if b.shared:
-                den = b.dens[0]
-                if den.min() > 0:
-                    np.divide(b.all_nums, den, out=part)
-                    continue
-            for j, (num, den) in enumerate(zip(b.nums, b.dens)):
-                if den.min() > 0:
-                    np.divide(num, den, out=part[j])
-                else:
-                    part[j] = np.nan
-                    np.divide(num, den, out=part[j], where=den > 0)
-                    unfired = True
-    finally:
-        np.setbufsize(old)
+    for j, (num, den) in enumerate(zip(b.nums, b.dens)):
+        if den.min() > 0:
+            np.divide(num, den, out=part[j])
+        else:
+            part[j] = np.nan
+            np.divide(num, den, out=part[j], where=den > 0)
+            unfired = True
     return unfired
 
 

@@ -1,0 +1,128 @@
+"""A large batch is spread over threads: every sample keeps the bits it has in one thread and
+alone, an error names the sample one thread would name, and a forked child still evaluates."""
+
+from __future__ import annotations
+
+import multiprocessing
+
+import numpy as np
+import pytest
+
+from mitos_cli import load_rulebase
+from mitos_cli.engine import threads
+from mitos_cli.engine.evaluation import BLOCK, GRID_BLOCK, evaluate, evaluate_columns
+from mitos_cli.errors import InputError
+
+THREADS = ("1", "2", "3", "8")
+
+
+def _inputs(c, n: int, seed: int) -> np.ndarray:
+    """``X[n, k]``, a tenth of each input outside its universe (clamped)."""
+    rng = np.random.default_rng(seed)
+    lo, hi = c.universe[:, 0], c.universe[:, 1]
+    return rng.uniform(lo - (hi - lo) / 20, hi + (hi - lo) / 20, size=(n, len(c.inputs)))
+
+
+def _bits(a: np.ndarray) -> np.ndarray:
+    return np.ascontiguousarray(a).view(np.int64)
+
+
+@pytest.mark.parametrize("behavior", ["avoid_obstacle", "drive"])   # the grid path, the general
+def test_columns_keep_their_bits_in_any_number_of_threads(behavior, monkeypatch):
+    c = load_rulebase().behavior(behavior).compiled
+    X = _inputs(c, 4 * GRID_BLOCK + 321, seed=11)          # five blocks, the last short
+    outs = []
+    for t in THREADS:
+        monkeypatch.setenv(threads.ENV, t)
+        outs.append(_bits(evaluate_columns(c, X.T)))
+    assert all(np.array_equal(outs[0], o) for o in outs[1:])
+    monkeypatch.setenv(threads.ENV, "1")
+    for i in (0, GRID_BLOCK - 1, GRID_BLOCK, 3 * GRID_BLOCK + 5, len(X) - 1):
+        assert np.array_equal(_bits(evaluate_columns(c, X[i:i + 1].T))[:, 0], outs[0][:, i])
+
+
+def test_rows_keep_their_bits_and_details_in_any_number_of_threads(monkeypatch):
+    c = load_rulebase().compiled
+    X = _inputs(c, 3 * BLOCK + 17, seed=12)
+    results = []
+    for t in THREADS:
+        monkeypatch.setenv(threads.ENV, t)
+        results.append(evaluate(c, X, keep_values=True))
+    first = results[0]
+    for r in results[1:]:
+        for a, b in ((first.outputs, r.outputs), (first.dof, r.dof), (first.memberships, r.memberships),
+                     (first.values, r.values), (first.inputs, r.inputs)):
+            assert np.array_equal(_bits(a), _bits(b))
+        assert first.clamped.tolist() == r.clamped.tolist()
+
+
+def test_an_error_names_the_first_bad_sample_however_the_blocks_fall(monkeypatch):
+    c = load_rulebase().compiled
+    X = _inputs(c, 6 * GRID_BLOCK, seed=13)
+    X[4 * GRID_BLOCK + 9, 0] = np.nan                       # a later block, taken first maybe
+    X[GRID_BLOCK + 3, 2] = np.nan
+    for t in THREADS:
+        monkeypatch.setenv(threads.ENV, t)
+        for _ in range(5):
+            with pytest.raises(InputError, match=rf"`position` is not a number .*sample "
+                                                 rf"{GRID_BLOCK + 4}\)"):
+                evaluate_columns(c, X.T)
+            with pytest.raises(InputError, match=rf"sample {GRID_BLOCK + 4}\)"):
+                evaluate(c, X)
+
+
+@pytest.mark.parametrize("value", ["0", "-1", "two", "1.5", "4 threads", "257", "\u0664"])
+def test_a_thread_count_that_is_not_a_number_of_threads_is_refused(value, monkeypatch):
+    c = load_rulebase().compiled
+    monkeypatch.setenv(threads.ENV, value)
+    with pytest.raises(InputError, match=f"{threads.ENV} is `{value}`") as info:
+        evaluate_columns(c, _inputs(c, 3 * GRID_BLOCK, seed=14).T)
+    assert "a whole number from 1 to 256" in str(info.value)
+
+
+def test_the_cli_refuses_a_wrong_thread_count_before_any_command_runs():
+    import os
+    import subprocess
+    import sys
+
+    env = {**os.environ, threads.ENV: "two"}
+    done = subprocess.run([sys.executable, "-m", "mitos_cli", "eval", "road=78", "size=45",
+                           "position=4", "--json"], capture_output=True, text=True, env=env)
+    assert done.returncode == 1 and done.stdout == ""
+    assert done.stderr.startswith("input error: MITOS_NUM_THREADS is `two`, not a number of "
+                                  "threads\nexpected a whole number from 1 to 256\n")
+
+
+def _child(n: int) -> bytes:
+    c = load_rulebase().compiled
+    return evaluate_columns(c, _inputs(c, n, seed=15).T).tobytes()
+
+
+@pytest.mark.skipif("fork" not in multiprocessing.get_all_start_methods(),
+                    reason="no fork on this platform")
+def test_a_forked_child_makes_its_own_threads(monkeypatch):
+    monkeypatch.setenv(threads.ENV, "2")
+    n = 3 * GRID_BLOCK
+    expected = _child(n)                        # the parent's pool now has a thread
+    with multiprocessing.get_context("fork").Pool(1) as pool:
+        assert pool.apply_async(_child, (n,)).get(timeout=120) == expected
+
+
+def test_the_earliest_block_s_error_wins_even_when_a_later_one_fails_first(monkeypatch):
+    import time
+
+    monkeypatch.setenv(threads.ENV, "3")
+
+    def work(ranges):
+        for start, _ in ranges:
+            if start == 10:
+                time.sleep(0.3)                 # the others reach block 40 first
+                raise ValueError("block 10")
+            if start == 40:
+                raise ValueError("block 40")
+        return "done"
+
+    with pytest.raises(ValueError, match="block 10"):
+        threads.map_blocks(work, 60, 10)
+    sizes = threads.map_blocks(lambda ranges: sum(e - s for s, e in ranges), 65, 10)
+    assert len(sizes) == 3 and sum(sizes) == 65          # three threads, every sample once
