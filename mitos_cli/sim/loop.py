@@ -18,11 +18,13 @@ Randomness: ``SeedSequence(seed).spawn(1 + robots)``: the first stream randomise
 from __future__ import annotations
 
 import math
+import operator
+import os
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import WorldError
+from ..errors import InputError, WorldError
 from ..words import plural
 from . import geometry, kinematics, knowledge, perception, rows, safety, sensors
 from . import obstacles as obs_mod
@@ -315,11 +317,12 @@ class Simulation:
 
     def __init__(self, world: World, planner: Planner | None = None, seed: int | None = None,
                  *, randomise: bool = False, scene: Scene | None = None) -> None:
+        _check_world(world)
         if planner is None:
             from .planner import FuzzyPlanner
 
             planner = FuzzyPlanner(None, world.behavior)
-        self.planner = planner
+        self.planner = _check_planner(planner)
         self.randomise = randomise
         self._given_world, self._given_scene = world, scene
         self.reset(seed)
@@ -329,7 +332,7 @@ class Simulation:
     def reset(self, seed: int | None = None) -> Simulation:
         """Start the run again from ``seed`` (default: the world's)."""
         world = self._given_world
-        self.seed = world.seed if seed is None else int(seed)
+        self.seed = world.seed if seed is None else check_seed(seed)
         self._streams = [np.random.default_rng(s) for s in
                          np.random.SeedSequence(self.seed).spawn(1 + len(world.agents))]
         if self.randomise:
@@ -919,6 +922,46 @@ class Simulation:
         res.robot_metrics = _robot_metrics(res, dt)
         res.metrics = _metrics(res, dt)
         return res
+
+
+def check_seed(seed: object) -> int:
+    """``seed`` as an int of 0 or more, else an :class:`InputError` saying so (NumPy's
+    SeedSequence refused a negative seed with a bare ValueError from its internals, and
+    ``int()`` made 3.7 the seed 3 without a word)."""
+    try:
+        value = operator.index(seed)  # type: ignore[arg-type]  # int, NumPy ints; not floats, text
+    except TypeError:
+        value = -1
+    if value < 0:
+        raise InputError(f"a seed is a whole number, 0 or more, not `{seed!r:.40}`",
+                         hint="seed=1, as `mitos simulate --seed 1`")
+    return value
+
+
+def _check_world(world: object) -> None:
+    """A :class:`World`, else a :class:`WorldError` saying how to get one (a path got as far
+    as ``'str' object has no attribute 'behavior'``)."""
+    if isinstance(world, World):
+        return
+    hint = (f"load_world({str(world)!r}) reads it" if isinstance(world, (str, os.PathLike))
+            else "load_world('worlds/corridor.yaml') reads a world file")
+    raise WorldError(f"a simulation runs a loaded World, not {type(world).__name__} "
+                     f"`{world!r:.60}`", hint=hint)
+
+
+def _check_planner(planner: Planner) -> Planner:
+    """``planner`` if it has the :class:`Planner` protocol's ``plan``; else an
+    :class:`InputError` now, not an AttributeError at the first tick."""
+    if callable(getattr(planner, "plan", None)):
+        return planner
+    from .planner import PLANNERS
+
+    hint = (f"make_planner({planner!r}, world) from mitos_cli.sim.planner builds it"
+            if isinstance(planner, str) and planner in PLANNERS
+            else "FuzzyPlanner(rules_path, behavior), or any object with `name` and "
+                 "`plan(percepts)`")
+    raise InputError(f"a planner is an object with a `plan(percepts)` method, not "
+                     f"{type(planner).__name__} `{planner!r:.60}`", hint=hint)
 
 
 def _finite(command: np.ndarray, what: str) -> np.ndarray:
