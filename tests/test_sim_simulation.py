@@ -216,3 +216,22 @@ def test_run_many_says_what_is_wrong_with_its_arguments(kwargs, says):
         run_many(**args)
     with pytest.raises(InputError, match=r"run_many\(\[world\], \.\.\.\)"):
         run_many(world)          # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize("command, says", [
+    ("fast", "not `'fast'`"),
+    (5.0, "not `5.0`"),                 # (None is no command: the planner drives)
+    (np.zeros((2, 2)), "not of shape (2, 2)"),
+])
+def test_a_command_that_is_not_numbers_is_a_command_error(command, says):
+    """step("fast") met NumPy's "could not convert string to float"; the shape and NaN
+    messages were ValueErrors outside the project's errors (they are still ValueErrors)."""
+    from mitos_cli.errors import CommandError
+
+    sim = Simulation(short("corridor.yaml", 1.0))
+    with pytest.raises(CommandError, match=r"a command is \[1, 2\]") as exc:
+        sim.step(command)
+    assert says in exc.value.message and isinstance(exc.value, ValueError)
+    with pytest.raises(CommandError, match="must be finite numbers"):
+        sim.step(np.array([[90.0, np.inf]]))
+    assert sim.ticks == 0

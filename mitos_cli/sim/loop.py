@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import InputError, WorldError
+from ..errors import CommandError, InputError, WorldError
 from ..words import plural
 from . import geometry, kinematics, knowledge, perception, rows, safety, sensors
 from . import obstacles as obs_mod
@@ -537,11 +537,7 @@ class Simulation:
         """The start of :meth:`decide`: the tick observed, and the planner's commands (or
         ``command``) in it, before the guard."""
         if command is not None:         # checked before the tick is observed: a refused
-            given = np.asarray(command, float)           # command leaves the run as it was
-            if given.size != 2 * self.n:
-                raise ValueError(f"a command is [{self.n}, 2] (steering deg, speed in/s for each "
-                                 f"robot), not of shape {given.shape}")
-            command = _finite(given.reshape(self.n, 2), "the command")
+            command = self._command(command)             # command leaves the run as it was
         s = self.observe()
         self._observed = None
         if command is None:
@@ -552,6 +548,20 @@ class Simulation:
                 s.command[~self._active] = np.stack([self.limits.straight, np.zeros(self.n)],
                                                     axis=1)[~self._active]
         return s
+
+    def _command(self, command: object) -> np.ndarray:
+        """A command given from outside as ``[n, 2]`` finite floats, else a
+        :class:`CommandError` (text or ``None`` met NumPy's conversion errors)."""
+        try:
+            given = np.asarray(command, float)
+        except (TypeError, ValueError):
+            given = None
+        if given is None or given.size != 2 * self.n:
+            shape = (f"of shape {given.shape}" if given is not None and given.ndim
+                     else f"`{command!r:.40}`")
+            raise CommandError(f"a command is [{self.n}, 2] (steering deg, speed in/s for each "
+                               f"robot), not {shape}")
+        return _finite(given.reshape(self.n, 2), "the command")
 
     def verdict(self, s: _Sensed) -> tuple[Tick, bool]:
         """The end of :meth:`decide`, once the guard has had its say on ``s``'s commands:
@@ -801,8 +811,8 @@ class Simulation:
             c_steer, c_speed = self.planner.plan(sub)
             try:
                 cmd[idx, 0], cmd[idx, 1] = c_steer, c_speed
-            except ValueError:
-                raise ValueError(f"{self._planner_name} gave {np.shape(c_steer)} steering and "
+            except (TypeError, ValueError):
+                raise CommandError(f"{self._planner_name} gave {np.shape(c_steer)} steering and "
                                  f"{np.shape(c_speed)} speed values for "
                                  f"{plural(len(idx), 'active robot')} (one each)") from None
             if not np.isfinite(cmd[idx]).all():
@@ -968,7 +978,7 @@ def _finite(command: np.ndarray, what: str) -> np.ndarray:
     """``command`` (steering, speed rows), refused unless every number is finite: a NaN
     turned the robot's pose into NaN and failed a tick later, far from its cause."""
     if not np.isfinite(command).all():
-        raise ValueError(f"{what} must be finite numbers (steering deg, speed in/s), not "
+        raise CommandError(f"{what} must be finite numbers (steering deg, speed in/s), not "
                          f"{command.tolist()}")
     return command
 
