@@ -201,3 +201,18 @@ def test_a_loaded_world_makes_an_environment_and_a_non_world_says_what_is_taken(
     assert truncated and not terminated and info["t"] == 1.0
     with pytest.raises(WorldError, match="expected a path or a packaged world's name"):
         gymnasium.make("mitos/World-v0", world=None)
+
+
+def test_a_collision_run_differs_from_simulate_only_in_the_last_command():
+    """docs/gym.md: at the tick where a collision ends the run the environment asks for no
+    action and records the one before it; everything else is simulate()'s run."""
+    env = gymnasium.make("mitos/Figure4-v0")                 # collides at B
+    _, _, terminated, _, info = drive(env, seed=3)
+    ran = env.unwrapped.sim.result()
+    ref = simulate(load_world(packaged_path("worlds", "figure4.yaml")), seed=3)
+    assert terminated and info["outcome"] == ref.outcome == "collision"
+    for key in ("pose", "speed", "steering", "ranges", "clearance", "obstacles"):
+        assert np.array_equal(getattr(ran, key), getattr(ref, key)), key
+    assert np.array_equal(ran.command[:-1], ref.command[:-1])
+    assert np.array_equal(ran.command[-1], ran.command[-2])
+    assert ran.summary() == ref.summary()
