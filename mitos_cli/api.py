@@ -9,6 +9,7 @@
 from __future__ import annotations
 
 import functools
+import os
 from pathlib import Path
 
 import numpy as np
@@ -36,7 +37,7 @@ def read_rulebase(path: str | Path | None = None) -> RuleBase:
     if path is None:
         path = default_rulebase_path()
     else:
-        path = resolve("rulebases", path, ".rules") or Path(path)
+        path = resolve("rulebases", _path_given(path), ".rules") or Path(path)
     suffix = path.suffix.lower()
     if suffix in (".yaml", ".yml") and path.is_file():   # a term set or a world named
         from .errors import RuleBaseError
@@ -55,6 +56,31 @@ def read_rulebase(path: str | Path | None = None) -> RuleBase:
     return cached_rulebase(path, _load_rules_file)
 
 
+def _path_given(path: object) -> str | Path:
+    """``path`` if it can name a file; else a :class:`RuleBaseError` saying what is taken
+    (``load_rulebase(3)`` met pathlib's TypeError)."""
+    if isinstance(path, str):
+        return path
+    if isinstance(path, os.PathLike):
+        return Path(path)
+    from .errors import RuleBaseError
+
+    raise RuleBaseError(f"a rule base is read from a file: expected a path or a packaged rule "
+                        f"base's name, not {type(path).__name__} `{path!r:.60}`",
+                        hint="load_rulebase('rulebases/mitos.rules'), or load_rulebase() for "
+                             "the packaged one")
+
+
+def _behavior_given(rulebase: RuleBase, name: object) -> str | None:
+    """``name`` if it can name a behavior (``None``: the first); else the unknown-behavior
+    error with the behaviors' names (an int met "'int' object is not iterable" inside)."""
+    if name is None or isinstance(name, str):
+        return name
+    from .errors import unknown
+
+    raise unknown("behavior", f"{name!r:.40}", [b.name for b in rulebase.behaviors])
+
+
 def _load_rules_file(path: Path) -> RuleBase:
     from .lang.resolve import load_rules_file  # the parser (Lark) and YAML load only on a miss
 
@@ -68,7 +94,8 @@ class LoadedRuleBase:
                  overrides: tuple = ()) -> None:
         self.rulebase = rulebase
         self.overrides = tuple(overrides)
-        self.compiled: CompiledRuleBase = compile_rulebase(rulebase, behavior, self.overrides)
+        self.compiled: CompiledRuleBase = compile_rulebase(
+            rulebase, _behavior_given(rulebase, behavior), self.overrides)
 
     def __repr__(self) -> str:
         return (f"<LoadedRuleBase {self.rulebase.path or '(text)'}, behavior "
@@ -87,9 +114,12 @@ class LoadedRuleBase:
     def behaviors(self) -> tuple[str, ...]:
         return tuple(b.name for b in self.rulebase.behaviors)
 
-    @functools.cache  # noqa: B019 - a handful of behaviors, cached for the rule base's lifetime
     def behavior(self, name: str) -> LoadedRuleBase:
         """The same rule base with another behavior compiled (recalled by name alone)."""
+        return self._behavior(_behavior_given(self.rulebase, name))
+
+    @functools.cache  # noqa: B019 - a handful of behaviors, cached for the rule base's lifetime
+    def _behavior(self, name: str) -> LoadedRuleBase:
         return LoadedRuleBase(self.rulebase, name, self.overrides)
 
     def with_operators(self, **settings: str) -> LoadedRuleBase:

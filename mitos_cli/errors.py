@@ -186,6 +186,12 @@ class InputError(MitosError):
     kind = "input error"
 
 
+class CommandError(InputError, ValueError):
+    """A driving command (``Simulation.step(command)``, a planner's output, a Gymnasium action)
+    that is not finite ``[steering deg, speed in/s]`` numbers of the right shape. Also a
+    ``ValueError``, which these were before they were ``MitosError``s."""
+
+
 class NoRuleFiredError(MitosError):
     """No rule fired for some input and the output declares no default."""
 

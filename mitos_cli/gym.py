@@ -58,7 +58,8 @@ except ImportError as exc:  # pragma: no cover - the extra is missing
     raise MitosError("the Gymnasium environments need gymnasium, which is not installed",
                      hint="pip install 'mitos[gym]'") from exc
 
-from .errors import WorldError
+from .errors import CommandError, InputError, WorldError
+from .sim.world import World
 
 PROGRESS_REWARD = 0.01      # per inch of route
 COLLISION_PENALTY = -10.0
@@ -79,14 +80,16 @@ class MitosEnv(gymnasium.Env):
 
     metadata = {"render_modes": ["rgb_array", "human"], "render_fps": 20}
 
-    def __init__(self, world: str | Path = "corridor", *, rulebase: str | Path | None = None,
+    def __init__(self, world: str | Path | World = "corridor", *,
+                 rulebase: str | Path | None = None,
                  behavior: str | None = None, observe_ranges: bool = False,
                  render_mode: str | None = None) -> None:
         from .sim.loop import Simulation
         from .sim.planner import FuzzyPlanner
-        from .sim.worldfile import load_world, resolve_world_path
+        from .sim.worldfile import load_world
 
-        loaded = load_world(resolve_world_path(world))
+        # a World loaded (or changed) in Python, else a file or a packaged world's name
+        loaded = world if isinstance(world, World) else load_world(world)
         if len(loaded.agents) != 1:
             raise WorldError(f"world `{loaded.name}` has {len(loaded.agents)} robots; a "
                              f"Gymnasium environment drives one",
@@ -128,9 +131,23 @@ class MitosEnv(gymnasium.Env):
         x = observation["inputs"] if isinstance(observation, dict) else observation
         from .engine.evaluation import evaluate_one
 
-        out = evaluate_one(self.fuzzy.compiled, [float(v) for v in x])
+        out = evaluate_one(self.fuzzy.compiled, self._row(x))
         outputs = self.fuzzy.compiled.outputs
         return np.array([out[outputs.index("steering")], out[outputs.index("speed")]])
+
+    def _row(self, x) -> list[float]:
+        """One observation as the floats the rule base reads, else an :class:`InputError` (a
+        batch ``[1, k]`` met "only 0-dimensional arrays can be converted to Python scalars")."""
+        try:
+            row = np.asarray(x, dtype=np.float64)
+        except (TypeError, ValueError):
+            row = None
+        if row is None or row.ndim != 1:
+            what = f"of shape {row.shape}" if row is not None else f"`{x!r:.40}`"
+            raise InputError(f"an observation is one row of the {len(self.input_names)} inputs "
+                             f"({', '.join(self.input_names)}), not {what}",
+                             hint="for a batch of observations, call it on each row")
+        return row.tolist()
 
     # -- Gymnasium ----------------------------------------------------------------------------
 
@@ -151,9 +168,7 @@ class MitosEnv(gymnasium.Env):
         sim = self.sim
         if sim.done:
             raise RuntimeError("the episode has ended: call reset()")
-        command = np.asarray(action, dtype=np.float64).reshape(1, 2)
-        if not np.isfinite(command).all():
-            raise ValueError(f"the action must be finite numbers, not {action!r}")
+        command = _command(action)
         sim.step(command)
         if not sim.done:
             self._trail.append(sim.pose[0, :2].copy())
@@ -253,6 +268,24 @@ class MitosEnv(gymnasium.Env):
         return {"t": round(sim.ticks * sim.dt, 6), "pose": sim.pose[0],
                 "clearance": float(sim.clearance[0]),
                 "outcome": sim.robot_outcomes[0] if sim.done else "driving"}
+
+
+def _command(action) -> np.ndarray:
+    """``action`` as the ``[1, 2]`` command it is, else a :class:`CommandError` saying what an
+    action is (``step(5)`` met NumPy's "cannot reshape array of size 1 into shape (1,2)")."""
+    try:
+        command = np.asarray(action, dtype=np.float64)
+    except (TypeError, ValueError):
+        command = None
+    if command is None or command.size != 2:
+        shape = (f"of shape {command.shape}" if command is not None and command.ndim
+                 else f"`{action!r:.40}`")
+        raise CommandError(f"an action is [steering deg, speed in/s], not {shape}",
+                           hint="env.action_space.sample() is one; so is "
+                                "env.unwrapped.fuzzy_policy(observation)")
+    if not np.isfinite(command).all():
+        raise CommandError(f"the action must be finite numbers, not {action!r:.80}")
+    return command.reshape(1, 2)
 
 
 def env_name(world_file: str) -> str:

@@ -328,6 +328,25 @@ def test_unknown_input(rb):
     assert exc.message == "unknown input `raod`" and exc.hint == "did you mean `road`?"
 
 
+@pytest.mark.parametrize("path", [3, {"rules": "r1: ..."}])
+def test_load_rulebase_of_something_that_is_not_a_path_says_what_it_takes(path):
+    """load_rulebase(3) met pathlib's "expected str, bytes or os.PathLike object"."""
+    exc = error_of(lambda: load_rulebase(path), RuleBaseError)
+    assert exc.message.startswith("a rule base is read from a file: expected a path or a "
+                                  "packaged rule base's name, not ")
+
+
+@pytest.mark.parametrize("name, close", [(3, None), (["drive"], "drive")])
+def test_a_behavior_that_is_not_text_is_an_unknown_behavior(rb, name, close):
+    """rb.behavior(3) met "'int' object is not iterable" deep in the compiler, and
+    rb.behavior(["drive"]) the cache's "unhashable type: 'list'"."""
+    for call in (lambda: rb.behavior(name), lambda: load_rulebase(None, name)):
+        exc = error_of(call, NameError_)
+        assert exc.message == f"unknown behavior `{name!r}`" and "drive" in exc.expected
+        assert exc.hint == (f"did you mean `{close}`?" if close else None)
+    assert rb.behavior("drive") is rb.behavior("drive")      # still compiled once
+
+
 def test_no_rule_fired_without_default(tmp_path):
     terms = TERMS.replace("    default: 90\n", "")
     path = write(tmp_path, "r1: if road is WIDE then steering is RS and speed is SLOW", terms)

@@ -155,3 +155,64 @@ def test_reset_reports_where_the_robot_stands(short_world):
     assert info["clearance"] == ref.clearance[0, 0]
     state = env.unwrapped._state()
     assert all(state["inputs"][k][0] == ref.perceived[k][0, 0] for k in ref.perceived)
+
+
+@pytest.mark.parametrize("action, says", [
+    (5.0, "not `5.0`"),
+    (None, "not `None`"),
+    ([90.0, 10.0, 1.0], "not of shape (3,)"),
+    ("go", "not `'go'`"),
+])
+def test_an_action_that_is_not_steering_and_speed_says_what_an_action_is(action, says):
+    """step(5) met NumPy's "cannot reshape array of size 1 into shape (1,2)", step("go") its
+    "could not convert string to float"; a refused action leaves the episode as it was."""
+    from mitos_cli.errors import CommandError
+
+    env = gymnasium.make("mitos/Corridor-v0")
+    env.reset(seed=1)
+    with pytest.raises(CommandError, match=r"an action is \[steering deg, speed in/s\]") as exc:
+        env.step(action)
+    assert says in exc.value.message and isinstance(exc.value, ValueError)
+    assert env.unwrapped.sim.ticks == 0
+    env.step(np.array([[90.0, 10.0]], dtype=np.float32))     # [1, 2] and float32 are fine
+    assert env.unwrapped.sim.ticks == 1
+
+
+def test_fuzzy_policy_of_a_batch_says_it_takes_one_observation():
+    from mitos_cli.errors import InputError
+
+    env = gymnasium.make("mitos/Corridor-v0")
+    obs, _ = env.reset(seed=1)
+    with pytest.raises(InputError, match=r"one row of the 13 inputs .* not of shape \(1, 13\)"):
+        env.unwrapped.fuzzy_policy(obs[None])
+    assert np.array_equal(env.unwrapped.fuzzy_policy(list(obs)), env.unwrapped.fuzzy_policy(obs))
+
+
+def test_a_loaded_world_makes_an_environment_and_a_non_world_says_what_is_taken():
+    """A World loaded (or changed) in Python: `expected str, bytes or os.PathLike object,
+    not World`; now it is driven as it is."""
+    import dataclasses
+
+    world = dataclasses.replace(load_world(packaged_path("worlds", "corridor.yaml")),
+                                time_limit=1.0)
+    env = gymnasium.make("mitos/World-v0", world=world)
+    assert env.unwrapped.world is world
+    _, _, terminated, truncated, info = drive(env, seed=2)
+    assert truncated and not terminated and info["t"] == 1.0
+    with pytest.raises(WorldError, match="expected a path or a packaged world's name"):
+        gymnasium.make("mitos/World-v0", world=None)
+
+
+def test_a_collision_run_differs_from_simulate_only_in_the_last_command():
+    """docs/gym.md: at the tick where a collision ends the run the environment asks for no
+    action and records the one before it; everything else is simulate()'s run."""
+    env = gymnasium.make("mitos/Figure4-v0")                 # collides at B
+    _, _, terminated, _, info = drive(env, seed=3)
+    ran = env.unwrapped.sim.result()
+    ref = simulate(load_world(packaged_path("worlds", "figure4.yaml")), seed=3)
+    assert terminated and info["outcome"] == ref.outcome == "collision"
+    for key in ("pose", "speed", "steering", "ranges", "clearance", "obstacles"):
+        assert np.array_equal(getattr(ran, key), getattr(ref, key)), key
+    assert np.array_equal(ran.command[:-1], ref.command[:-1])
+    assert np.array_equal(ran.command[-1], ran.command[-2])
+    assert ran.summary() == ref.summary()

@@ -4,6 +4,7 @@ gives the same run bit for bit; reset(seed) starts it again; a user's planner dr
 from __future__ import annotations
 
 import dataclasses
+import re
 
 import numpy as np
 import pytest
@@ -157,3 +158,80 @@ def test_a_wrong_command_from_outside_and_an_early_result_say_what_is_wrong():
     again = Simulation(short("corridor.yaml", 1.0))
     again.step(np.array([[90.0, 20.0]]))
     same_run(sim.result(), again.result())
+
+
+@pytest.mark.parametrize("seed", [-1, 3.7, "3", np.array([3]), None])
+def test_a_seed_that_is_not_a_whole_number_of_0_or_more_is_refused(seed):
+    """-1 was a bare ValueError from NumPy's SeedSequence; 3.7 and "3" ran as seed 3."""
+    from mitos_cli.errors import InputError
+
+    world = short("corridor.yaml", 0.2)
+    if seed is None:                                    # the world's own: no complaint
+        assert Simulation(world, seed=seed).seed == world.seed
+        return
+    with pytest.raises(InputError, match="a seed is a whole number, 0 or more"):
+        Simulation(world, seed=seed)
+    with pytest.raises(InputError, match="a seed is a whole number"):
+        simulate(world, seed=seed)
+    with pytest.raises(InputError, match="a seed is a whole number"):
+        Simulation(world).reset(seed)
+
+
+def test_numpy_and_huge_seeds_are_the_runs_of_their_value():
+    world = short("moving.yaml", 0.5)
+    same_run(simulate(world, seed=np.int64(5), randomise=True),
+             simulate(world, seed=5, randomise=True))
+    assert Simulation(world, seed=np.uint64(2**63)).seed == 2**63
+
+
+def test_a_path_for_a_world_or_a_name_for_a_planner_says_what_is_taken():
+    """simulate("worlds/corridor.yaml") failed with `'str' object has no attribute
+    'behavior'`; simulate(world, "dwa") with an AttributeError at the first tick."""
+    from mitos_cli.errors import InputError, WorldError
+
+    with pytest.raises(WorldError, match="a simulation runs a loaded World, not str") as exc:
+        simulate("worlds/corridor.yaml")
+    assert exc.value.hint == "load_world('worlds/corridor.yaml') reads it"
+    with pytest.raises(InputError, match=r"a planner is an object with a `plan\(percepts\)`") as exc:
+        simulate(short("corridor.yaml", 0.2), "dwa")
+    assert "make_planner('dwa', world)" in exc.value.hint
+
+
+@pytest.mark.parametrize("kwargs, says", [
+    ({"worlds": "one"}, "takes a list of loaded worlds, not the path `one`"),
+    ({"worlds": ["corridor"]}, "runs loaded worlds, not str"),
+    ({"runs": 2.5}, "`runs` is a whole number, 0 or more, not `2.5`"),
+    ({"workers": 0}, "`workers` is a whole number, 1 or more, not `0`"),
+    ({"seed": -1}, "a seed is a whole number"),
+])
+def test_run_many_says_what_is_wrong_with_its_arguments(kwargs, says):
+    """A World not in a list, runs=2.5, workers=0 or seed=-1 met a TypeError, a
+    ZeroDivisionError or NumPy's ValueError inside."""
+    from mitos_cli.errors import InputError
+    from mitos_cli.sim import run_many
+
+    world = short("corridor.yaml", 0.2)
+    args = {"worlds": [world], "runs": 1, "workers": 1, **kwargs}
+    with pytest.raises(InputError, match=re.escape(says)):
+        run_many(**args)
+    with pytest.raises(InputError, match=r"run_many\(\[world\], \.\.\.\)"):
+        run_many(world)          # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize("command, says", [
+    ("fast", "not `'fast'`"),
+    (5.0, "not `5.0`"),                 # (None is no command: the planner drives)
+    (np.zeros((2, 2)), "not of shape (2, 2)"),
+])
+def test_a_command_that_is_not_numbers_is_a_command_error(command, says):
+    """step("fast") met NumPy's "could not convert string to float"; the shape and NaN
+    messages were ValueErrors outside the project's errors (they are still ValueErrors)."""
+    from mitos_cli.errors import CommandError
+
+    sim = Simulation(short("corridor.yaml", 1.0))
+    with pytest.raises(CommandError, match=r"a command is \[1, 2\]") as exc:
+        sim.step(command)
+    assert says in exc.value.message and isinstance(exc.value, ValueError)
+    with pytest.raises(CommandError, match="must be finite numbers"):
+        sim.step(np.array([[90.0, np.inf]]))
+    assert sim.ticks == 0

@@ -400,3 +400,39 @@ def test_corridors_too_large_for_the_robots_map_are_refused():
 
 def test_an_angle_too_large_is_explained_in_degrees():
     assert "angles are in degrees" in error(BASE.replace("heading: 0", "heading: 1e300"))
+
+
+def test_load_world_finds_a_packaged_world_from_any_directory(tmp_path, monkeypatch):
+    """docs/api.md's `load_world("worlds/figure4.yaml")` worked only from the repository root
+    (the command line, the Gymnasium environments and load_rulebase find packaged files from
+    anywhere); a file that is there is still read first."""
+    from mitos_cli.errors import NameError_
+    from mitos_cli.resources import packaged_path
+
+    monkeypatch.chdir(tmp_path)
+    packaged = packaged_path("worlds", "figure4.yaml")
+    assert load_world("worlds/figure4.yaml").path == str(packaged)
+    assert load_world("figure4").path == str(packaged)
+    (tmp_path / "figure4.yaml").write_text(BASE)
+    assert load_world("figure4.yaml").name == "t"
+    with pytest.raises(NameError_, match="unknown world file `figur4`") as exc:
+        load_world("figur4")
+    assert exc.value.hint == "did you mean `figure4`?"
+
+
+@pytest.mark.parametrize("given, says", [
+    (3, "not int `3`"),
+    (None, "not NoneType `None`"),
+    ({"map": {}}, "parse_world(text, 'name.yaml')"),
+])
+def test_load_world_of_something_that_is_not_a_path_says_what_it_takes(given, says):
+    with pytest.raises(WorldError, match="expected a path or a packaged world's name") as exc:
+        load_world(given)
+    assert says in exc.value.render()
+
+
+def test_load_world_of_a_loaded_world_says_it_is_loaded():
+    world = load_world("corridor")
+    with pytest.raises(WorldError) as exc:
+        load_world(world)
+    assert "loaded already" in str(exc.value) and len(exc.value.message) < 200

@@ -18,11 +18,13 @@ Randomness: ``SeedSequence(seed).spawn(1 + robots)``: the first stream randomise
 from __future__ import annotations
 
 import math
+import operator
+import os
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import WorldError
+from ..errors import CommandError, InputError, WorldError
 from ..words import plural
 from . import geometry, kinematics, knowledge, perception, rows, safety, sensors
 from . import obstacles as obs_mod
@@ -315,11 +317,12 @@ class Simulation:
 
     def __init__(self, world: World, planner: Planner | None = None, seed: int | None = None,
                  *, randomise: bool = False, scene: Scene | None = None) -> None:
+        _check_world(world)
         if planner is None:
             from .planner import FuzzyPlanner
 
             planner = FuzzyPlanner(None, world.behavior)
-        self.planner = planner
+        self.planner = _check_planner(planner)
         self.randomise = randomise
         self._given_world, self._given_scene = world, scene
         self.reset(seed)
@@ -329,7 +332,7 @@ class Simulation:
     def reset(self, seed: int | None = None) -> Simulation:
         """Start the run again from ``seed`` (default: the world's)."""
         world = self._given_world
-        self.seed = world.seed if seed is None else int(seed)
+        self.seed = world.seed if seed is None else check_seed(seed)
         self._streams = [np.random.default_rng(s) for s in
                          np.random.SeedSequence(self.seed).spawn(1 + len(world.agents))]
         if self.randomise:
@@ -534,11 +537,7 @@ class Simulation:
         """The start of :meth:`decide`: the tick observed, and the planner's commands (or
         ``command``) in it, before the guard."""
         if command is not None:         # checked before the tick is observed: a refused
-            given = np.asarray(command, float)           # command leaves the run as it was
-            if given.size != 2 * self.n:
-                raise ValueError(f"a command is [{self.n}, 2] (steering deg, speed in/s for each "
-                                 f"robot), not of shape {given.shape}")
-            command = _finite(given.reshape(self.n, 2), "the command")
+            command = self._command(command)             # command leaves the run as it was
         s = self.observe()
         self._observed = None
         if command is None:
@@ -549,6 +548,20 @@ class Simulation:
                 s.command[~self._active] = np.stack([self.limits.straight, np.zeros(self.n)],
                                                     axis=1)[~self._active]
         return s
+
+    def _command(self, command: object) -> np.ndarray:
+        """A command given from outside as ``[n, 2]`` finite floats, else a
+        :class:`CommandError` (text or ``None`` met NumPy's conversion errors)."""
+        try:
+            given = np.asarray(command, float)
+        except (TypeError, ValueError):
+            given = None
+        if given is None or given.size != 2 * self.n:
+            shape = (f"of shape {given.shape}" if given is not None and given.ndim
+                     else f"`{command!r:.40}`")
+            raise CommandError(f"a command is [{self.n}, 2] (steering deg, speed in/s for each "
+                               f"robot), not {shape}")
+        return _finite(given.reshape(self.n, 2), "the command")
 
     def verdict(self, s: _Sensed) -> tuple[Tick, bool]:
         """The end of :meth:`decide`, once the guard has had its say on ``s``'s commands:
@@ -798,8 +811,8 @@ class Simulation:
             c_steer, c_speed = self.planner.plan(sub)
             try:
                 cmd[idx, 0], cmd[idx, 1] = c_steer, c_speed
-            except ValueError:
-                raise ValueError(f"{self._planner_name} gave {np.shape(c_steer)} steering and "
+            except (TypeError, ValueError):
+                raise CommandError(f"{self._planner_name} gave {np.shape(c_steer)} steering and "
                                  f"{np.shape(c_speed)} speed values for "
                                  f"{plural(len(idx), 'active robot')} (one each)") from None
             if not np.isfinite(cmd[idx]).all():
@@ -921,11 +934,51 @@ class Simulation:
         return res
 
 
+def check_seed(seed: object) -> int:
+    """``seed`` as an int of 0 or more, else an :class:`InputError` saying so (NumPy's
+    SeedSequence refused a negative seed with a bare ValueError from its internals, and
+    ``int()`` made 3.7 the seed 3 without a word)."""
+    try:
+        value = operator.index(seed)  # type: ignore[arg-type]  # int, NumPy ints; not floats, text
+    except TypeError:
+        value = -1
+    if value < 0:
+        raise InputError(f"a seed is a whole number, 0 or more, not `{seed!r:.40}`",
+                         hint="seed=1, as `mitos simulate --seed 1`")
+    return value
+
+
+def _check_world(world: object) -> None:
+    """A :class:`World`, else a :class:`WorldError` saying how to get one (a path got as far
+    as ``'str' object has no attribute 'behavior'``)."""
+    if isinstance(world, World):
+        return
+    hint = (f"load_world({str(world)!r}) reads it" if isinstance(world, (str, os.PathLike))
+            else "load_world('worlds/corridor.yaml') reads a world file")
+    raise WorldError(f"a simulation runs a loaded World, not {type(world).__name__} "
+                     f"`{world!r:.60}`", hint=hint)
+
+
+def _check_planner(planner: Planner) -> Planner:
+    """``planner`` if it has the :class:`Planner` protocol's ``plan``; else an
+    :class:`InputError` now, not an AttributeError at the first tick."""
+    if callable(getattr(planner, "plan", None)):
+        return planner
+    from .planner import PLANNERS
+
+    hint = (f"make_planner({planner!r}, world) from mitos_cli.sim.planner builds it"
+            if isinstance(planner, str) and planner in PLANNERS
+            else "FuzzyPlanner(rules_path, behavior), or any object with `name` and "
+                 "`plan(percepts)`")
+    raise InputError(f"a planner is an object with a `plan(percepts)` method, not "
+                     f"{type(planner).__name__} `{planner!r:.60}`", hint=hint)
+
+
 def _finite(command: np.ndarray, what: str) -> np.ndarray:
     """``command`` (steering, speed rows), refused unless every number is finite: a NaN
     turned the robot's pose into NaN and failed a tick later, far from its cause."""
     if not np.isfinite(command).all():
-        raise ValueError(f"{what} must be finite numbers (steering deg, speed in/s), not "
+        raise CommandError(f"{what} must be finite numbers (steering deg, speed in/s), not "
                          f"{command.tolist()}")
     return command
 

@@ -9,14 +9,17 @@ not depend on the number of workers or on which worker ran what.
 from __future__ import annotations
 
 import math
+import operator
+import os
 from collections import Counter
 from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 
+from ..errors import InputError
 from .lockstep import run_lockstep
-from .loop import OUTCOMES, ROBOT_OUTCOMES, shared_scene
+from .loop import OUTCOMES, ROBOT_OUTCOMES, check_seed, shared_scene
 from .world import World
 
 METRICS = ("time_s", "path_length_in", "min_clearance_in", "mean_speed_in_s",
@@ -133,11 +136,15 @@ def run_many(worlds: list[World], runs: int = 0, seed: int | None = None, planne
     each run's summary in the worker (a benchmark's scores from the ticks).
     ``on_progress(done, total)`` is called as runs finish (a progress bar). Ctrl-C terminates
     the workers and raises :class:`RunsInterrupted` with the runs that had finished."""
+    worlds = _check_worlds(worlds)
+    runs = _whole("runs", runs, 0)
+    if seed is not None:
+        seed = check_seed(seed)
     if planner is None:
         from .planner import FuzzyPlanner
 
         planner = FuzzyPlanner(None, worlds[0].behavior if worlds else "drive")
-    workers = default_workers() if workers is None else workers
+    workers = default_workers() if workers is None else _whole("workers", workers, 1)
     tasks = []
     for w in worlds:
         base = w.seed if seed is None else seed
@@ -164,6 +171,40 @@ def run_many(worlds: list[World], runs: int = 0, seed: int | None = None, planne
     except KeyboardInterrupt:
         raise RunsInterrupted(_group(worlds, tasks, results), total) from None
     return _group(worlds, tasks, results)
+
+
+def _check_worlds(worlds: object) -> list[World]:
+    """``worlds`` as a list of loaded worlds, else an :class:`InputError` saying what is
+    taken (one World, or a path, failed deep inside with a bare TypeError or AttributeError)."""
+    if isinstance(worlds, World):
+        raise InputError("run_many takes a list of worlds, not one World",
+                         hint="run_many([world], ...)")
+    if isinstance(worlds, (str, os.PathLike)):
+        raise InputError(f"run_many takes a list of loaded worlds, not the path `{worlds}`",
+                         hint=f"run_many([load_world({str(worlds)!r})], ...)")
+    try:
+        out = list(worlds)  # type: ignore[call-overload]  # anything iterable is tried
+    except TypeError:
+        out = [worlds]
+    for w in out:
+        if not isinstance(w, World):
+            hint = (f"load_world({str(w)!r}) reads it" if isinstance(w, (str, os.PathLike))
+                    else "load_world('worlds/corridor.yaml') reads a world file")
+            raise InputError(f"run_many runs loaded worlds, not {type(w).__name__} "
+                             f"`{w!r:.60}`", hint=hint)
+    return out
+
+
+def _whole(what: str, value: object, least: int) -> int:
+    """``value`` as an int of at least ``least``, else an :class:`InputError` (``runs=2.5``
+    and ``workers=0`` met a TypeError, a ZeroDivisionError inside)."""
+    try:
+        n = operator.index(value)  # type: ignore[arg-type]  # anything is tried
+    except TypeError:
+        n = least - 1
+    if n < least:
+        raise InputError(f"`{what}` is a whole number, {least} or more, not `{value!r:.40}`")
+    return n
 
 
 def _execute(jobs: list[tuple], workers: int):

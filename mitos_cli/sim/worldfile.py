@@ -8,6 +8,7 @@ image that cannot be read.
 
 from __future__ import annotations
 
+import os
 from collections import Counter
 from dataclasses import replace
 from pathlib import Path
@@ -639,10 +640,16 @@ def _check_body(agent, static, span: Span) -> None:
 
 
 def load_world(path: str | Path) -> World:
-    """Read and check the world file at ``path``."""
+    """Read and check the world file at ``path``. A path that is not a file but names a
+    packaged world (``figure4``, ``worlds/figure4.yaml``) reads the packaged one, as the
+    command line and the Gymnasium environments do, so the documented calls work from any
+    directory; anything else is an :class:`UnknownWorld` with the packaged names."""
     from ..fileio import read_text, why_unreadable
+    from ..resources import is_file
 
-    path = Path(path)
+    path = Path(_world_path_given(path))
+    if not is_file(path):
+        path = resolve_world_path(path)
     try:
         text = read_text(path)
     except (OSError, UnicodeDecodeError) as exc:
@@ -658,6 +665,22 @@ def load_world(path: str | Path) -> World:
             raise WorldError(f"`{path}` is not a world file", span=Span(str(path), 1, 1),
                              expected="a YAML file with `map:` (see worlds/README.md)")
     return parse_world(text, str(path))
+
+
+def _world_path_given(path: object) -> str | os.PathLike:
+    """``path`` if it can name a file; else a :class:`WorldError` saying what a world is
+    given as (a dict or an int reached ``Path()``, whose TypeError said nothing of worlds)."""
+    if isinstance(path, (str, os.PathLike)):
+        return path
+    if isinstance(path, World):
+        hint = "it is loaded already: give it to simulate() or Simulation() as it is"
+    elif isinstance(path, dict):
+        hint = ("write it to a .yaml file, or give its YAML text to "
+                "mitos_cli.sim.worldfile.parse_world(text, 'name.yaml')")
+    else:
+        hint = "load_world('worlds/corridor.yaml'), or a packaged world's name: load_world('corridor')"
+    raise WorldError(f"a world is read from a file: expected a path or a packaged world's name, "
+                     f"not {type(path).__name__} `{path!r:.60}`", hint=hint)
 
 
 class UnknownWorld(WorldError, NameError_):
