@@ -140,8 +140,8 @@ class LoadedRuleBase:
         if len(inputs) == len(c.inputs) and all(type(v) in (float, int) for v in inputs.values()):
             try:                               # numbers by name: the one-sample path
                 values = [float(inputs[name]) for name in c.inputs]
-            except KeyError:
-                pass                           # a misspelt name: as_batch explains it
+            except (KeyError, OverflowError):
+                pass                           # a misspelt name, 10**400: as_columns explains
             else:
                 return dict(zip(c.outputs, evaluate_one(c, values)))
         columns = as_columns(c, inputs)

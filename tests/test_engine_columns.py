@@ -56,3 +56,31 @@ def test_no_rule_fired_names_the_sample_as_the_rows_path_does(tmp_path):
         evaluate(rb.compiled, np.array([[150.0], [20.0]]), detail=False)
     assert cols.value.message == rows.value.message == \
         "no rule sets `steering` for road=20 (1 of 2 samples)"
+
+
+@pytest.mark.parametrize(("value", "message"), [
+    (10**400, r"input `road` has a number too large for a float: `1000.*\(401 characters\)`"),
+    ([78, 10**400], "input `road` has a number too large for a float"),
+    (None, "input `road` is None, not a number"),
+    ([78.0, None], "input `road` has None among its values"),
+    (np.ma.masked_array([78.0, 60.0], mask=[False, True]), "input `road` has 1 masked values"),
+    (np.array([78 + 1j]), "input `road` is complex, not real numbers"),
+    ("wide", "input `road` must be a number, not `wide`"),
+])
+def test_what_numpy_would_misread_or_raise_about_is_refused_in_words(value, message):
+    rb = load_rulebase()
+    for call in (rb.evaluate, rb.trace):
+        with pytest.raises(InputError, match=message):
+            call(road=value, size=45, position=4)
+    assert rb.evaluate(road=np.ma.masked_array([78.0]), size=45, position=4)["steering"][0] \
+        == rb.evaluate(road=78.0, size=45, position=4)["steering"]
+
+
+@pytest.mark.parametrize(("X", "message"), [
+    ([["a", 45, 4]], r"the inputs must be numbers, not `\[\['a', 45, 4\]\]`"),
+    ([[10**400, 45, 4]], "the inputs have a number too large for a float"),
+    (None, "the inputs are None, not numbers"),
+])
+def test_a_batch_that_is_not_numbers_is_refused_in_words(X, message):
+    with pytest.raises(InputError, match=message):
+        load_rulebase().run(X)

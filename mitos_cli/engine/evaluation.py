@@ -57,7 +57,7 @@ def as_batch(compiled: CompiledRuleBase, columns: Mapping[str, object]) -> np.nd
         try:
             row = [float(columns[k]) for k in compiled.inputs]  # type: ignore[arg-type]  # anything is tried
             return np.array([row])
-        except (KeyError, TypeError, ValueError):
+        except (KeyError, TypeError, ValueError, OverflowError):
             pass                               # arrays, missing names or bad values: below
     _check_names(compiled, columns)
     return np.ascontiguousarray(_columns(compiled, columns).T)
@@ -97,14 +97,7 @@ def _columns(compiled: CompiledRuleBase, columns: Mapping[str, object]) -> np.nd
 
 
 def _column_list(compiled: CompiledRuleBase, columns: Mapping[str, object]) -> list[np.ndarray]:
-    arrays = []
-    for name in compiled.inputs:
-        value = columns[name]
-        try:
-            arr = np.asarray(value, dtype=float)
-        except (TypeError, ValueError):
-            raise InputError(f"input `{name}` must be a number, not `{value}`") from None
-        arrays.append(arr)
+    arrays = [floats(columns[name], f"input `{name}`") for name in compiled.inputs]
     try:
         shape = np.broadcast_shapes(*(a.shape for a in arrays))
     except ValueError:
@@ -116,6 +109,44 @@ def _column_list(compiled: CompiledRuleBase, columns: Mapping[str, object]) -> l
     return [arr if arr.shape == (n,) else np.broadcast_to(arr, (n,)) for arr in arrays]
 
 
+def floats(value: object, what: str, many: bool = False) -> np.ndarray:
+    """``value`` as a float array, or an :class:`InputError` about ``what`` (one input, or
+    ``many`` inputs) saying why it is not numbers. Besides what ``float()`` refuses, four things
+    NumPy would turn into numbers silently or into its own exceptions: ``None`` (read as NaN),
+    the masked entries of a masked array (read as what lies under the mask), complex numbers
+    (their imaginary part dropped) and integers past a float's range (an ``OverflowError``)."""
+    if type(value) is np.ndarray and value.dtype == float:        # the common case
+        return value
+    has, is_ = ("have", "are") if many else ("has", "is")
+    if value is None:
+        raise InputError(f"{what} {is_} None, not {'numbers' if many else 'a number'}",
+                         hint=f"give {'them numbers' if many else 'it a number'}")
+    if isinstance(value, np.ma.MaskedArray):
+        if np.ma.count_masked(value):
+            raise InputError(f"{what} {has} {np.ma.count_masked(value)} masked values",
+                             hint="fill them (`.filled(...)`) or leave those samples out")
+        value = value.data
+    try:
+        raw = np.asarray(value)
+        if raw.dtype.kind == "c":
+            raise InputError(f"{what} {is_} complex, not real numbers: `{_brief(value)}`")
+        if raw.dtype == object and any(v is None for v in raw.flat):
+            raise InputError(f"{what} {has} None among {'their' if many else 'its'} values",
+                             hint="give every sample a number")
+        return np.asarray(raw, dtype=float)
+    except OverflowError:
+        raise InputError(f"{what} {has} a number too large for a float: `{_brief(value)}`",
+                         expected="numbers of magnitude at most 1.8e308") from None
+    except (TypeError, ValueError):
+        raise InputError(f"{what} must be {'numbers' if many else 'a number'}, "
+                         f"not `{_brief(value)}`") from None
+
+
+def _brief(value: object) -> str:
+    text = str(value)
+    return text if len(text) <= 60 else f"{text[:40]}...{text[-15:]} ({len(text):,} characters)"
+
+
 def check_inputs(compiled: CompiledRuleBase, X) -> tuple[np.ndarray, np.ndarray]:
     """Refuse NaN, clamp to each universe: ``X[n, k]`` -> (clamped ``Xt[k, n]``, counts)."""
     return _clamp(compiled, _rows(compiled, X))
@@ -124,7 +155,7 @@ def check_inputs(compiled: CompiledRuleBase, X) -> tuple[np.ndarray, np.ndarray]
 def _rows(compiled: CompiledRuleBase, X) -> np.ndarray:
     """``X`` as a float array ``[n, k]`` (one sample may come as a flat ``[k]``)."""
     k = len(compiled.inputs)
-    X = np.asarray(X, dtype=float)
+    X = floats(X, "the inputs", many=True)
     if X.ndim == 1 and X.shape[0] == k:
         X = X[None]
     if X.ndim != 2 or X.shape[1] != k:
