@@ -418,6 +418,13 @@ def test_load_world_finds_a_packaged_world_from_any_directory(tmp_path, monkeypa
     with pytest.raises(NameError_, match="unknown world file `figur4`") as exc:
         load_world("figur4")
     assert exc.value.hint == "did you mean `figure4`?"
+    # a directory that is not the packaged one is a typo, not a way to the packaged world
+    for typo in ("nope/figure4.yaml", "/elsewhere/worlds/figure4.yaml", "world/figure4"):
+        with pytest.raises(NameError_, match=f"unknown world file `{typo}`") as exc:
+            load_world(typo)
+        assert exc.value.hint == (f"there is no `{typo}`; the packaged world of that name is "
+                                  "`figure4`")
+    assert load_world("./worlds/figure4.yaml").path == str(packaged)
 
 
 @pytest.mark.parametrize("given, says", [

@@ -709,4 +709,8 @@ def resolve_world_path(name: str | Path, base: Path | None = None) -> Path:
     error = unknown("world file", str(name), names, cls=UnknownWorld)
     if where.suffix or len(where.parts) > 1:      # a path: a file beside it first
         error.hint = nearby(where, (".yaml", ".yml")) or error.hint
+    packaged = where.name if where.name.endswith(".yaml") else where.name + ".yaml"
+    if len(where.parts) > 1 and packaged in packaged_names("worlds", ".yaml"):
+        error.hint = (f"there is no `{where}`; the packaged world of that name is "
+                      f"`{packaged[:-len('.yaml')]}`")
     raise error
