@@ -12,6 +12,7 @@ from . import complete
 from .output import emit, err, json_text
 from .params import finite, named
 from .progress import INTERRUPTED, progress_bar
+from .targets import check_directory
 
 REQUIRE = ("success",)
 
@@ -222,6 +223,9 @@ def simulate_command(
     loaded = [load_world(resolve_world_path(n)) for n in names]
     _check_outputs((("--out", out), ("--plot", plot), ("--animate", animate)),
                    [Path(w.path) for w in loaded if w.path] + ([Path(rulebase)] if rulebase else []))
+    for path in (out, plot, animate):         # before the run, not after it
+        if path is not None:
+            check_directory(path)
     many = len(loaded) > 1 or runs > 0
     if randomise and runs > 0:                # not "give one world": it was one
         raise typer.BadParameter("--runs randomises every run already; --randomise replays "
