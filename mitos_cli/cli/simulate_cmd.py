@@ -251,6 +251,10 @@ def simulate_command(
                 f"animation formats are " + " and ".join(f".{f}" for f in MOVIES),
                 param_hint="--animate")
         check_animation(animate)
+    if plot is not None or animate is not None:     # before the run, not after it
+        from ..draw.output import require_matplotlib
+
+        require_matplotlib()
     planner = make_planner(planner_name, loaded[0], rulebase, behavior)
 
     if many:
