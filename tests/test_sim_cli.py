@@ -183,6 +183,12 @@ def test_runs_print_a_table_of_rates(short):
     assert "success" in table.splitlines()[0] and "±" in table
 
 
+def test_too_many_runs_is_a_usage_error_not_a_full_memory(short):
+    """`--runs 100000000000000000000` listed that many seeds before the first run."""
+    res = run(short, "--runs", "1" + "0" * 20)
+    assert res.exit_code == 2 and "0<=x<=100000" in res.output
+
+
 def test_per_run_outputs_need_one_run(short, tmp_path):
     res = run(short, "--runs", 2, "--out", tmp_path / "x.csv")
     assert res.exit_code == 2

@@ -10,7 +10,7 @@ import typer
 
 from . import complete
 from .output import emit, err, json_text
-from .params import finite, named
+from .params import MAX_RUNS, finite, named
 from .progress import INTERRUPTED, progress_bar
 from .targets import check_directory
 
@@ -161,7 +161,7 @@ def simulate_command(
     seed: Annotated[Optional[int], typer.Option(
         "--seed", min=0, help="Seed (default: the world's); with --runs, run j uses SEED+j.")] = None,
     runs: Annotated[int, typer.Option(
-        "--runs", min=0,
+        "--runs", min=0, max=MAX_RUNS,
         help="Randomised runs per world (obstacle places, sensor noise); 0: the world once, "
              "as written (`compare` defaults to 20: it needs many).")] = 0,
     randomise: Annotated[bool, typer.Option(
