@@ -34,7 +34,7 @@ def compare_command(
         help="Inference methods: weighted_average, weighted_sum, mamdani. "
              "Default: the rule base's.")] = None,
     planner: Annotated[str, typer.Option(
-        "--planner", metavar="PLANNERS",
+        "--planner", metavar="PLANNERS", autocompletion=complete.planner_list,
         help="Planners to compare: fuzzy, potential_field, dwa.")] = "fuzzy,potential_field",
     runs: Annotated[int, typer.Option(
         "--runs", min=1, max=MAX_RUNS,
@@ -48,7 +48,7 @@ def compare_command(
         "--out", "-o", metavar="DIR",
         help="Directory for results.csv, report.md and the plots.")] = "study",
     executor: Annotated[str, typer.Option(
-        "--executor", metavar="local|dask",
+        "--executor", metavar="local|dask", autocompletion=complete.executors,
         help="local: a process pool on this machine; dask: dask.distributed.")] = "local",
     workers: Annotated[Optional[int], typer.Option(
         "--workers", "-j", min=1,
