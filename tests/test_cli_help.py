@@ -90,6 +90,13 @@ def test_completion_offers_packaged_worlds_and_planners():
     env.update(COMP_WORDS="mitos simulate --planner d", COMP_CWORD="3")
     assert subprocess.run(run, env=env, capture_output=True, text=True).stdout.split() == \
         ["dwa"]
+    # compare's --planner takes a list: the README promises planners there too
+    env.update(COMP_WORDS="mitos compare corridor --planner fuzzy,", COMP_CWORD="4")
+    assert subprocess.run(run, env=env, capture_output=True, text=True).stdout.split() == \
+        ["fuzzy,potential_field", "fuzzy,dwa"]
+    env.update(COMP_WORDS="mitos compare corridor --executor d", COMP_CWORD="4")
+    assert subprocess.run(run, env=env, capture_output=True, text=True).stdout.split() == \
+        ["dask"]
 
 
 def test_the_readme_lists_the_exit_codes_of_the_help():

@@ -173,11 +173,16 @@ def test_compare_ctrl_c_says_what_is_kept_and_how_to_resume(capsys, monkeypatch,
 
 
 @pytest.mark.skipif(not hasattr(os, "killpg"), reason="process groups")
-def test_ctrl_c_on_a_compare_pool_leaves_no_worker_tracebacks(tmp_path):
-    """A real Ctrl-C reaches the whole process group, workers included."""
+@pytest.mark.parametrize("executor", ["local", "dask"])
+def test_ctrl_c_on_a_compare_pool_leaves_no_worker_tracebacks(tmp_path, executor):
+    """A real Ctrl-C reaches the whole process group, workers included (a LocalCluster's
+    workers printed distributed's tracebacks and warnings under the "interrupted:" line)."""
+    if executor == "dask":
+        pytest.importorskip("distributed")
     out = tmp_path / "s"
     args = [sys.executable, "-m", "mitos_cli", "compare", str(TINY), "--and", "min,product",
-            "--planner", "fuzzy", "--runs", "6", "-o", str(out), "-j", "2", "--no-plots"]
+            "--planner", "fuzzy", "--runs", "6", "-o", str(out), "-j", "2", "--no-plots",
+            "--executor", executor]
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
     # a test worker (pytest -n) may ignore SIGINT, and an ignored signal stays ignored
     # across exec: the child gets Python's own Ctrl-C back
@@ -200,6 +205,7 @@ def test_ctrl_c_on_a_compare_pool_leaves_no_worker_tracebacks(tmp_path):
         pytest.skip("the study finished before Ctrl-C arrived")
     assert proc.returncode == 130, err
     assert "Traceback" not in err and "ForkPoolWorker" not in err and "Process " not in err
+    assert "WARNING" not in err and "ERROR" not in err
     assert "interrupted:" in err and "--resume" in err
 
 

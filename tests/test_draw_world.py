@@ -26,14 +26,23 @@ map:
 """
 
 
-def test_plot_without_matplotlib_says_how_to_install(tmp_path, monkeypatch, capsys):
+@pytest.mark.parametrize("args", [["--plot", "run.png"], ["--runs", "3", "--plot", "run.png"],
+                                  ["--animate", "run.gif"]])
+def test_plot_without_matplotlib_says_how_to_install(tmp_path, monkeypatch, capsys, args):
+    """... before the run: `--runs 1000 --plot` ran every run, then failed on the picture
+    and printed no table."""
+    from mitos_cli.sim import loop, runs
+
     world = tmp_path / "tiny.yaml"
     world.write_text(WORLD, encoding="utf-8")
     for name in [m for m in sys.modules if m == "matplotlib" or m.startswith("matplotlib.")]:
         monkeypatch.setitem(sys.modules, name, None)
     monkeypatch.setitem(sys.modules, "matplotlib", None)      # `import matplotlib` fails
+    monkeypatch.setattr(loop, "simulate", lambda *a, **k: pytest.fail("the run started"))
+    monkeypatch.setattr(runs, "run_many", lambda *a, **k: pytest.fail("the runs started"))
+    monkeypatch.chdir(tmp_path)
     with pytest.raises(SystemExit) as info:
-        main(["simulate", str(world), "--plot", str(tmp_path / "run.png")])
+        main(["simulate", str(world), *args])
     err = capsys.readouterr().err
     assert info.value.code == 1, err
     assert "drawing pictures needs matplotlib, which is not installed" in err

@@ -151,6 +151,28 @@ def test_a_plot_that_is_not_a_picture_is_refused_before_the_run(short, capsys, m
     assert code == 2 and "`run.jpg` has extension .jpg" in err and ".svg" in err
 
 
+@pytest.mark.parametrize("option, name", [("--plot", "missing/runs.png"),
+                                          ("--out", "missing/run.csv"),
+                                          ("--animate", "missing/run.gif"),
+                                          ("--out", ".")])
+def test_an_output_that_cannot_be_written_is_refused_before_the_run(short, tmp_path, capsys,
+                                                                     monkeypatch, option,
+                                                                     name):
+    """`--runs 1000 --plot typo/runs.png` ran every run, then failed on the picture and lost
+    them all: a missing directory (or a directory's name) is refused first."""
+    from mitos_cli.sim import loop, runs
+
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setattr(loop, "simulate", lambda *a, **k: pytest.fail("the run started"))
+    monkeypatch.setattr(runs, "run_many", lambda *a, **k: pytest.fail("the runs started"))
+    code, err = run_main(capsys, short, option, name)
+    assert code == 1 and f"cannot write `{name}`: " in err
+    assert ("No such file or directory" in err) != (name == ".")
+    if option == "--plot":
+        code, err = run_main(capsys, short, "--runs", 3, option, name)
+        assert code == 1 and f"cannot write `{name}`: No such file or directory" in err
+
+
 def test_runs_print_a_table_of_rates(short):
     res = run(short, short, "--json")
     assert res.exit_code == 0
@@ -159,6 +181,12 @@ def test_runs_print_a_table_of_rates(short):
     assert set(rows[0]["time_s"]) == {"mean", "std"}
     table = run(short, "--runs", 2, "--workers", 1).stdout
     assert "success" in table.splitlines()[0] and "±" in table
+
+
+def test_too_many_runs_is_a_usage_error_not_a_full_memory(short):
+    """`--runs 100000000000000000000` listed that many seeds before the first run."""
+    res = run(short, "--runs", "1" + "0" * 20)
+    assert res.exit_code == 2 and "0<=x<=100000" in res.output
 
 
 def test_per_run_outputs_need_one_run(short, tmp_path):

@@ -131,6 +131,8 @@ def test_existing_results_need_resume(tiny, tmp_path, compare):
     (["TINY", "--behavior", "drve"], 1, "drive"),
     (["TINY", "TINY"], 2, "given twice"),
     (["TINY", "--planner", "dwa", "--and", "product"], 2, "--and chooses the fuzzy planner's"),
+    (["TINY", "--runs", "1000000"], 2, "is not in the range 1<=x<=100000"),   # (no memory
+    (["TINY", "-n", "1000000"], 2, "is not in the range 1<=x<=100000"),       # for the tasks)
 ])
 def test_user_errors(tiny, tmp_path, compare, args, code, words):
     r = compare(*[tiny if a == "TINY" else a for a in args], "-o", tmp_path / "e")

@@ -12,7 +12,7 @@ from ..errors import unknown
 from ..words import plural
 from . import complete
 from .output import emit, err, json_text, warn
-from .params import named
+from .params import MAX_RUNS, named
 from .progress import INTERRUPTED, progress_bar
 
 DEFAULT_AND = "min,product,lukasiewicz,einstein"
@@ -34,21 +34,21 @@ def compare_command(
         help="Inference methods: weighted_average, weighted_sum, mamdani. "
              "Default: the rule base's.")] = None,
     planner: Annotated[str, typer.Option(
-        "--planner", metavar="PLANNERS",
+        "--planner", metavar="PLANNERS", autocompletion=complete.planner_list,
         help="Planners to compare: fuzzy, potential_field, dwa.")] = "fuzzy,potential_field",
     runs: Annotated[int, typer.Option(
-        "--runs", min=1,
+        "--runs", min=1, max=MAX_RUNS,
         help="Randomised runs per world and choice (a comparison needs many; `simulate` "
              "runs a world once as written unless given --runs).")] = 20,
     runs_n: Annotated[Optional[int], typer.Option(
-        "-n", min=1, hidden=True, help="The old spelling of --runs.")] = None,
+        "-n", min=1, max=MAX_RUNS, hidden=True, help="The old spelling of --runs.")] = None,
     seed: Annotated[int, typer.Option(
         "--seed", min=0, help="Seed of the whole study (runs are paired across choices).")] = 1,
     out: Annotated[str, typer.Option(
         "--out", "-o", metavar="DIR",
         help="Directory for results.csv, report.md and the plots.")] = "study",
     executor: Annotated[str, typer.Option(
-        "--executor", metavar="local|dask",
+        "--executor", metavar="local|dask", autocompletion=complete.executors,
         help="local: a process pool on this machine; dask: dask.distributed.")] = "local",
     workers: Annotated[Optional[int], typer.Option(
         "--workers", "-j", min=1,

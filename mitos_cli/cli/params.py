@@ -13,6 +13,12 @@ from ..errors import unknown
 
 E = TypeVar("E", bound=Enum)
 
+#: The most randomised runs ``simulate --runs`` and ``compare --runs`` take per world (and
+#: choice): about a day of one core's time. A few zeros too many (``--runs 1000000000``) made
+#: the list of seeds and tasks before the first run, eating the machine's memory for minutes
+#: with nothing on the screen; now it is a number outside the option's range (exit 2).
+MAX_RUNS = 100_000
+
 
 def finite(value: float | None) -> float | None:
     """``nan`` passes ``min=0`` (every comparison with NaN is false): refuse it, and the

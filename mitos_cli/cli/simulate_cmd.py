@@ -10,8 +10,9 @@ import typer
 
 from . import complete
 from .output import emit, err, json_text
-from .params import finite, named
+from .params import MAX_RUNS, finite, named
 from .progress import INTERRUPTED, progress_bar
+from .targets import check_directory
 
 REQUIRE = ("success",)
 
@@ -160,7 +161,7 @@ def simulate_command(
     seed: Annotated[Optional[int], typer.Option(
         "--seed", min=0, help="Seed (default: the world's); with --runs, run j uses SEED+j.")] = None,
     runs: Annotated[int, typer.Option(
-        "--runs", min=0,
+        "--runs", min=0, max=MAX_RUNS,
         help="Randomised runs per world (obstacle places, sensor noise); 0: the world once, "
              "as written (`compare` defaults to 20: it needs many).")] = 0,
     randomise: Annotated[bool, typer.Option(
@@ -222,6 +223,9 @@ def simulate_command(
     loaded = [load_world(resolve_world_path(n)) for n in names]
     _check_outputs((("--out", out), ("--plot", plot), ("--animate", animate)),
                    [Path(w.path) for w in loaded if w.path] + ([Path(rulebase)] if rulebase else []))
+    for path in (out, plot, animate):         # before the run, not after it
+        if path is not None:
+            check_directory(path)
     many = len(loaded) > 1 or runs > 0
     if randomise and runs > 0:                # not "give one world": it was one
         raise typer.BadParameter("--runs randomises every run already; --randomise replays "
@@ -247,6 +251,10 @@ def simulate_command(
                 f"animation formats are " + " and ".join(f".{f}" for f in MOVIES),
                 param_hint="--animate")
         check_animation(animate)
+    if plot is not None or animate is not None:     # before the run, not after it
+        from ..draw.output import require_matplotlib
+
+        require_matplotlib()
     planner = make_planner(planner_name, loaded[0], rulebase, behavior)
 
     if many:

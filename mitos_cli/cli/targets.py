@@ -1,5 +1,6 @@
-"""Where ``convert`` and ``export`` may write: a file whose extension says what it holds, and
-never one of the files the rule base was read from (nothing the user wrote is ever lost)."""
+"""Where ``convert``, ``export`` and ``simulate`` may write: a file whose extension says what it
+holds, in a directory that is there, and never one of the files the command reads (nothing the
+user wrote is ever lost)."""
 
 from __future__ import annotations
 
@@ -20,6 +21,26 @@ def check_suffix(path: Path, suffix: str, what: str) -> None:
     has = f"extension {path.suffix}" if path.suffix else "no extension"
     raise typer.BadParameter(f"`{path}` has {has}; {what} is written to a {suffix} file",
                              param_hint=OUTPUT_OPTION)
+
+
+def check_directory(path: Path) -> None:
+    """Refuse, before any work, a file that cannot be written where it is named: its directory
+    missing or not writable, or the name a directory's. ``simulate --runs 1000 --plot
+    typo/runs.png`` ran every run, then failed on the picture and lost them all. The words
+    are those of :func:`mitos_cli.fileio.atomic_file`, which says the same when it writes."""
+    from ..errors import MitosError
+
+    if _special(path):                     # a device or a pipe (/dev/stdout) is written as is
+        return
+    if path.is_dir():
+        raise MitosError(f"cannot write `{path}`: it is a directory",
+                         hint="give a file name inside it")
+    parent = path.parent if str(path.parent) else Path(".")
+    why = ("No such file or directory" if not parent.is_dir() else
+           "Permission denied" if not os.access(parent, os.W_OK | os.X_OK) else None)
+    if why is not None:
+        raise MitosError(f"cannot write `{path}`: {why}",
+                         hint="check that the directory exists and is writable")
 
 
 def source_files(rulebase, path: Path) -> list[tuple[Path, str]]:

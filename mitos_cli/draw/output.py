@@ -44,6 +44,12 @@ def _matplotlib():
     return matplotlib
 
 
+def require_matplotlib() -> None:
+    """:class:`DrawError` unless matplotlib can be imported: for a command that draws only
+    after long work (``simulate --runs 1000 --plot``), to refuse before the work, not after."""
+    _matplotlib()
+
+
 def new_figure(figsize: tuple[float, float], show: bool = False, **kwargs):
     """A new figure: managed by pyplot (and an interactive backend) when ``show``, else a
     bare Figure on an Agg canvas."""

@@ -9,6 +9,7 @@ arrive often.
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import os
 from collections.abc import Callable, Iterator, Sequence
@@ -106,14 +107,47 @@ def local_cluster(workers: int):
                          hint="pip install 'mitos[dask]', or use --executor local") from None
     scratch = tempfile.mkdtemp(prefix="mitos-dask-")
     try:
-        cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                               dashboard_address=None, host="127.0.0.1", security=security,
-                               local_directory=scratch)
+        with interrupts_ignored_by_children():
+            cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
+                                   dashboard_address=None, host="127.0.0.1",
+                                   security=security, local_directory=scratch)
     except BaseException:
         shutil.rmtree(scratch, ignore_errors=True)
         raise
     weakref.finalize(cluster, shutil.rmtree, scratch, True)
     return cluster
+
+
+@contextlib.contextmanager
+def interrupts_ignored_by_children() -> Iterator[None]:
+    """Start processes that ignore Ctrl-C, as the local pool's workers do (``ignore_interrupts``).
+
+    Ctrl-C reaches the whole process group: a LocalCluster's worker processes, interrupted in
+    the middle of a run, printed distributed's tracebacks of their broken connections under
+    the "interrupted:" line. An ignored signal stays ignored across ``exec``, so the processes
+    spawned while SIGINT is ignored here never see it and this process answers it alone (it
+    closes the cluster). The price: a Ctrl-C during the cluster's start (a second or two) is
+    lost, and the next one stops the study.
+    """
+    import signal
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        yield                          # (only the main thread may set a handler)
+        return
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
+def quiet_logs() -> None:
+    """Run in a local worker before a study stopped early closes the cluster: the runs it
+    cancels are expected, not the warnings distributed logs for each."""
+    import logging
+
+    logging.getLogger("distributed").setLevel(logging.ERROR)
 
 
 def run_dask(fn: TaskFn, tasks: Sequence[Task], workers: int, scheduler: str | None = None,
@@ -134,6 +168,10 @@ def run_dask(fn: TaskFn, tasks: Sequence[Task], workers: int, scheduler: str | N
         try:
             for _future, part in as_completed(futures, with_results=True):
                 yield from part
+        except BaseException:
+            if own and getattr(client, "cluster", None) is not None:
+                client.run(quiet_logs)      # its closing now cancels runs, which they log
+            raise
         finally:
             client.cancel(futures)
     finally:
