@@ -217,8 +217,8 @@ class FormatError(MitosError):
 
 
 def closest(name: str, candidates: Iterable[str]) -> str | None:
-    """The candidate closest to ``name`` (as written, then in any case), or ``None`` when
-    nothing is close."""
+    """The candidate closest to ``name`` (as written, then in any case, then the one name it
+    begins), or ``None`` when nothing is close."""
     pool = list(candidates)
     close = difflib.get_close_matches(name, pool, n=1, cutoff=0.6)
     if not close:
@@ -227,6 +227,9 @@ def closest(name: str, candidates: Iterable[str]) -> str | None:
         close = [hit] if hit else difflib.get_close_matches(name.lower(), list(lowered), n=1,
                                                             cutoff=0.6)
         close = [lowered.get(c, c) for c in close]
+    if not close and len(name) >= 3:         # `avoid` for `avoid_obstacle`: too short for difflib
+        close = [c for c in pool if c.lower().startswith(name.lower())]
+        close = close if len(close) == 1 else []
     return close[0] if close else None
 
 

@@ -489,3 +489,13 @@ def test_a_frozen_label_naming_no_rule_is_pointed_at(tmp_path):
     exc = error_of(lambda: load_rules_file(path))
     assert exc.span.line == 4 and caret_under(exc) == "r7"
     assert exc.message == "unknown rule label `r7` in behavior `a`"
+
+
+def test_a_name_cut_short_gets_the_one_name_it_begins():
+    from mitos_cli.errors import closest
+
+    behaviors = ["approach_goal", "avoid_obstacle", "cruise", "drive", "keep_clear", "keep_right"]
+    assert closest("avoid", behaviors) == "avoid_obstacle"      # difflib's ratio: 0.53
+    assert closest("AVOID", behaviors) == "avoid_obstacle"
+    assert closest("keep", behaviors) is None                   # two names begin with it
+    assert closest("av", behaviors) is None                     # too short to say
