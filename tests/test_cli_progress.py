@@ -233,3 +233,16 @@ def test_gym_human_render_without_a_display_falls_back_to_the_terminal_view(monk
         assert env.render() is None
     env.close()
     assert "t =   0.15 s (unpaced)" in capsys.readouterr().err
+
+
+def test_ctrl_c_in_a_single_run_says_so(capsys, monkeypatch, tmp_path):
+    from mitos_cli.sim import loop
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(loop, "simulate", interrupted)
+    code, out, err = run(capsys, "simulate", TINY, "--out", tmp_path / "t.csv")
+    assert code == 130 and out == ""
+    assert err.strip() == "interrupted before the run ended: nothing written"
+    assert not (tmp_path / "t.csv").exists()

@@ -122,6 +122,14 @@ def test_existing_results_need_resume(tiny, tmp_path, compare):
     assert r.exit_code == 1 and "already holds 1 result" in r.stderr and "--resume" in r.stderr
 
 
+def test_an_output_that_is_a_file_is_refused_as_such(tiny, tmp_path, compare):
+    afile = tmp_path / "afile"
+    afile.write_text("mine\n")
+    r = compare(tiny, "--and", "min", "--planner", "fuzzy", "--runs", 1, "-o", afile, "-j", 1)
+    assert r.exit_code == 1 and f"`{afile}` is a file, not a directory" in r.stderr
+    assert afile.read_text() == "mine\n"
+
+
 @pytest.mark.parametrize("args, code, words", [
     (["worlds/corridr.yaml"], 1, "did you mean `worlds/corridor.yaml`"),
     (["TINY", "--and", "einstien"], 1, "unknown T-norm `einstien`"),

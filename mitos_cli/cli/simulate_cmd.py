@@ -299,7 +299,11 @@ def simulate_command(
             err("interrupted: nothing written (the view shows the last tick drawn)")
             raise typer.Exit(INTERRUPTED) from None
     else:
-        res = simulate(world, planner, seed, randomise=randomise, scene=scene)
+        try:
+            res = simulate(world, planner, seed, randomise=randomise, scene=scene)
+        except KeyboardInterrupt:
+            err("interrupted before the run ended: nothing written")
+            raise typer.Exit(INTERRUPTED) from None
     if trace:
         from ..sim.export import traces
 

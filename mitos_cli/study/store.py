@@ -127,6 +127,9 @@ class ResultStore:
         and give every finished run the seed it was made with (:func:`rows_for`). Everything
         is checked before anything is written: a refused study leaves the directory as it was.
         """
+        if self.dir.exists() and not self.dir.is_dir():
+            raise StudyError(f"`{self.dir}` is a file, not a directory for the study's results",
+                             hint="choose a directory with -o (a new one is made)")
         try:
             self.dir.mkdir(parents=True, exist_ok=True)
         except OSError as exc:
