@@ -343,3 +343,17 @@ def test_imported_fll_file(tmp_path, capsys):
         code, _, err = run(["plot", *command, "-o", str(target)], capsys)
         assert code == 0, err
         assert target.read_bytes()[:8] == PNG
+
+
+@pytest.mark.parametrize("command", [["terms", "--var", "road"],
+                                     ["surface", "steering", "--x", "road"],
+                                     ["rules", "road=78", "size=45", "position=4"]])
+def test_show_with_a_file_and_no_display_writes_the_file_first(command, tmp_path):
+    env = {k: v for k, v in os.environ.items() if k not in ("DISPLAY", "WAYLAND_DISPLAY")}
+    env["MPLBACKEND"] = "Agg"
+    out = tmp_path / "x.png"
+    done = subprocess.run([sys.executable, "-m", "mitos_cli", "plot", *command, "--show",
+                           "-o", str(out)], capture_output=True, text=True, env=env, timeout=60)
+    assert done.returncode == 1 and out.read_bytes().startswith(b"\x89PNG")
+    assert f"wrote {out}\nerror: cannot open a window" in done.stderr
+    assert f"hint: the picture is in {out}" in done.stderr

@@ -73,9 +73,26 @@ def _wants_picture(output: Optional[str], show: bool) -> bool:
     return output is not None or show
 
 
-def _done(output: Optional[str]) -> None:
+def _done(output: Optional[str], no_window: Optional[str] = None) -> None:
     if output is not None:
         err(f"wrote {output}")
+    if no_window is not None:
+        from ..draw.output import DrawError
+
+        raise DrawError(f"cannot open a window: {no_window}",
+                        hint=f"the picture is in {output}" if output else None)
+
+
+def _window(output: Optional[str], show: bool) -> tuple[bool, Optional[str]]:
+    """``--show`` as it can be honoured, and why not: with ``-o`` where no window can open the
+    file is still written, then the window refused (it was refused before the file)."""
+    if show and output is not None:
+        from ..draw.output import no_window
+
+        why = no_window()
+        if why is not None:
+            return False, why
+    return show, None
 
 
 def _use_color(color: Optional[bool]) -> bool:
@@ -138,8 +155,9 @@ def terms_command(
             title = f"Term sets of behavior {behavior}: {where}"
         else:
             title = f"Term sets of {where}"
+    show, why = _window(output, show)
     draw_sheet(plots, output, title=title, show=show)
-    _done(output)
+    _done(output, why)
 
 
 def _axis(text: str, option: str) -> tuple[str, Optional[tuple[float, float]]]:
@@ -243,8 +261,9 @@ def surface_command(
         return
     from ..draw.surface import draw_surface
 
+    show, why = _window(output, show)
     draw_surface(s, output, style=style.value, show=show, title=title)
-    _done(output)
+    _done(output, why)
 
 
 def rules_command(
@@ -284,8 +303,9 @@ def rules_command(
         return
     from ..draw.rules import draw_rules
 
+    show, why = _window(output, show)
     draw_rules(view, output, show=show, max_rows=max_rules, title=title)
-    _done(output)
+    _done(output, why)
 
 
 def reflow(doc: str | None) -> str:

@@ -50,6 +50,20 @@ def require_matplotlib() -> None:
     _matplotlib()
 
 
+def no_window() -> str | None:
+    """Why no window can open here (no display, a backend that draws only files), or None."""
+    _matplotlib()
+    import matplotlib.pyplot as plt
+
+    backend = plt.get_backend().lower()
+    if backend not in NON_INTERACTIVE:
+        return None
+    if (os.name == "posix" and not os.environ.get("DISPLAY")
+            and not os.environ.get("WAYLAND_DISPLAY") and os.uname().sysname == "Linux"):
+        return "no display (DISPLAY is not set)"
+    return f"matplotlib's backend `{backend}` cannot open windows"
+
+
 def new_figure(figsize: tuple[float, float], show: bool = False, **kwargs):
     """A new figure: managed by pyplot (and an interactive backend) when ``show``, else a
     bare Figure on an Agg canvas."""
@@ -57,12 +71,8 @@ def new_figure(figsize: tuple[float, float], show: bool = False, **kwargs):
     if show:
         import matplotlib.pyplot as plt
 
-        backend = plt.get_backend().lower()
-        if backend in NON_INTERACTIVE:
-            why = ("no display (DISPLAY is not set)"
-                   if os.name == "posix" and not os.environ.get("DISPLAY")
-                   and not os.environ.get("WAYLAND_DISPLAY") and os.uname().sysname == "Linux"
-                   else f"matplotlib's backend `{backend}` cannot open windows")
+        why = no_window()
+        if why is not None:
             raise DrawError(f"cannot open a window: {why}",
                             hint="write a file instead with -o FILE.png or -o FILE.svg")
         return plt.figure(figsize=figsize, **kwargs)
