@@ -172,7 +172,8 @@ def simulate_command(
         "--out", "-o", metavar="FILE.csv", help="Write one CSV row per tick.")] = None,
     trace: Annotated[bool, typer.Option(
         "--trace", help="Print the paper-style DOF trace every --every ticks (of the first "
-                        "robot where there are several).")] = False,
+                        "robot where there are several; on stderr with --json, which keeps "
+                        "stdout for the JSON).")] = False,
     every: Annotated[int, typer.Option("--every", min=1, help="Ticks between traces.")] = 20,
     plot: Annotated[Optional[Path], typer.Option(
         "--plot", metavar="FILE.png|FILE.svg",
