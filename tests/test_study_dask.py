@@ -105,3 +105,19 @@ def test_a_stranger_cannot_reach_the_local_cluster(client):
         assert scratch.name.startswith("mitos-dask-") and scratch.stat().st_mode & 0o077 == 0
     # the owner's client still works, and its results are the serial run's (tests above)
     assert client.submit(sum, [1, 2]).result() == 3
+
+
+def test_a_local_cluster_has_no_more_workers_than_tasks(monkeypatch, tmp_path):
+    """`compare -j 500 --executor dask` started 500 worker processes for a handful of tasks."""
+    from mitos_cli.study import executors
+
+    asked = []
+
+    def no_cluster(scheduler, workers):
+        asked.append(workers)
+        raise RuntimeError("stop here")
+
+    monkeypatch.setattr(executors, "dask_client", no_cluster)
+    with pytest.raises(RuntimeError, match="stop here"):
+        list(executors.run_dask(fake_sim, [object()] * 3, 500))
+    assert asked == [3]

@@ -158,8 +158,8 @@ def run_dask(fn: TaskFn, tasks: Sequence[Task], workers: int, scheduler: str | N
     the paths given on the command line (a shared file system).
     """
     own = client is None
-    if own:
-        client = dask_client(scheduler, workers)
+    if own:                        # a LocalCluster of no more processes than tasks (-j 500)
+        client = dask_client(scheduler, min(workers, max(1, len(tasks))))
     try:
         from distributed import as_completed
 
