@@ -126,3 +126,23 @@ def test_the_earliest_block_s_error_wins_even_when_a_later_one_fails_first(monke
         threads.map_blocks(work, 60, 10)
     sizes = threads.map_blocks(lambda ranges: sum(e - s for s, e in ranges), 65, 10)
     assert len(sizes) == 3 and sum(sizes) == 65          # three threads, every sample once
+
+
+def test_batches_in_several_threads_at_once_with_pools_growing_under_them(monkeypatch):
+    """A batch that grows the pool (more threads asked for) must not stop another batch
+    submitting to the pool it took a moment before."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    c = load_rulebase().compiled
+    X = _inputs(c, 3 * GRID_BLOCK, seed=16)
+    monkeypatch.setenv(threads.ENV, "1")
+    expected = _bits(evaluate_columns(c, X.T))
+    monkeypatch.setenv(threads.ENV, "2")
+
+    def batch(k: int) -> bool:
+        if k % 3 == 0:
+            threads._executor(2 + k)              # another caller needing a larger pool
+        return np.array_equal(_bits(evaluate_columns(c, X.T)), expected)
+
+    with ThreadPoolExecutor(4) as callers:
+        assert all(callers.map(batch, range(24)))

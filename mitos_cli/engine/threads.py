@@ -137,15 +137,15 @@ def _attempt(work: Callable[[Blocks], T], queue: _Queue) -> T | _Failed:
 
 def _executor(threads: int) -> ThreadPoolExecutor:
     """The process's pool, made on first use with at least ``threads`` threads (and again in a
-    forked child, whose copy of the parent's pool has no threads behind it)."""
+    forked child, whose copy of the parent's pool has no threads behind it). A pool that grows
+    is replaced, not shut down: a batch in another thread may be submitting to it, and its
+    threads end when it is no longer referenced."""
     from concurrent.futures import ThreadPoolExecutor
 
     global _pool
     with _lock:
         pid = os.getpid()
         if _pool is None or _pool[0] != pid or _pool[1] < threads:
-            if _pool is not None and _pool[0] == pid:
-                _pool[2].shutdown(wait=False)
             _pool = (pid, threads, ThreadPoolExecutor(threads, thread_name_prefix="mitos-batch"))
         return _pool[2]
 
