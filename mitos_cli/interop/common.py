@@ -636,11 +636,14 @@ def flatten_for_export(rb: RuleBase, behavior: str | None = None, *,
 
 def all_inputs(rb: RuleBase, flat: Flat) -> tuple[Variable, ...]:
     """The inputs a written file needs, in term-set order: those the rules test, and those a
-    linear consequent of the rules weighs (its coefficients are rewritten over these)."""
+    linear consequent of the rules weighs (its coefficients are rewritten over these).
+    Terms are looked up in ``flat``'s outputs: they hold the ``crisp_80`` terms that stand for
+    crisp consequents, which ``rb`` does not."""
     needed = {v.name for v in flat.inputs}
+    outputs = {v.name: v for v in flat.outputs}
     for r in flat.rules:
         for c in r.consequents:
-            term = rb.variables[c.var].term(c.term) if c.term is not None else None
+            term = outputs[c.var].term(c.term) if c.term is not None else None
             if term is not None and term.shape == "linear":
                 needed.update(n for n, a in linear_coefficients(rb, c.var, term).items()
                               if a != 0.0)
