@@ -129,9 +129,11 @@ def fuzzylite_hedge(name: str, span: Span | None) -> str:
                       hint=did_you_mean(name, FUZZYLITE_HEDGES))
 
 
-def to_fuzzylite_hedge(name: str) -> str:
+def to_fuzzylite_hedge(name: str, span: Span | None = None) -> str:
+    """fuzzylite's name for hedge ``name``; refused at ``span`` (the proposition or consequent
+    using it) when fuzzylite has none."""
     if name not in MITOS_TO_FUZZYLITE_HEDGES:
-        raise FormatError(f"fuzzylite has no hedge like MITOS's `{name}` (x^3)",
+        raise FormatError(f"fuzzylite has no hedge like MITOS's `{name}` (x^3)", span=span,
                           hint="use `very` (x^2) or `intensely` (fuzzylite's `extremely`)")
     return MITOS_TO_FUZZYLITE_HEDGES[name]
 
