@@ -18,6 +18,8 @@ code                  severity    meaning
 ``conflict``          error       rules with the same antecedent and different consequents
 ``duplicate``         warning     rules with the same antecedent and the same consequents
 ``contradiction``     warning     an antecedent that asks for ``x is A`` and ``x is not A``
+``idle-setting``      warning     a Mamdani-only operator setting (``defuzzify``, ...) where
+                                  the inference is not Mamdani
 ``unreachable``       warning     a rule whose DOF is 0 at every sampled input
 ``term-gap``          warning     a stretch of an input's universe where all its terms are 0
 ``term-outside``      warning     an input term that never reaches 1 inside the universe
