@@ -221,6 +221,16 @@ def test_term_set_not_found(tmp_path):
     assert "term set `nope.yaml` not found" in exc.message and caret_under(exc) == '"nope.yaml"'
 
 
+def test_term_set_named_twice(tmp_path):
+    """`terms "t.terms.yaml", "./t.terms.yaml"` said "variable `road` is defined in two term
+    sets" at the one file that defines it."""
+    path = write(tmp_path, GOOD_RULE)
+    path.write_text('terms "t.terms.yaml", "./t.terms.yaml"\n' + GOOD_RULE, encoding="utf-8")
+    exc = error_of(lambda: load_rules_file(path), TermSetError)
+    assert exc.message == "term set `./t.terms.yaml` is named twice (also as `t.terms.yaml`)"
+    assert caret_under(exc) == '"./t.terms.yaml"' and exc.span.line == 1
+
+
 def test_no_term_set(tmp_path):
     path = tmp_path / "t.rules"
     path.write_text(GOOD_RULE, encoding="utf-8")
