@@ -176,6 +176,19 @@ def test_term_peaking_outside_the_universe(tmp_path):
     assert finding.span.line == 9 and finding.severity == "warning"
 
 
+@pytest.mark.parametrize("shape", ["sigmoid, inflection: 120, slope: 0.5",
+                                   "sigmoid_product, left: 110, rising: 1, falling: 1, "
+                                   "right: 150"])
+def test_a_sigmoid_shoulder_is_not_a_term_outside_the_universe(tmp_path, shape):
+    """A sigmoid comes within 1e-4 of 1 at the universe's end but never reaches it: check said
+    "never reaches 1 inside the universe (at most 1)" and told the user to move its peak in."""
+    terms = TERMS.replace("HUGE:   {shape: right_shoulder, points: [140, 150]}",
+                          f"HUGE:   {{shape: {shape}}}")
+    (tmp_path / "t.terms.yaml").write_text(terms, encoding="utf-8")
+    (tmp_path / "t.rules").write_text(RULES, encoding="utf-8")
+    assert by_code(check_rulebase(read_rulebase(tmp_path / "t.rules")), "term-outside") == []
+
+
 def test_one_behavior_only(tmp_path):
     (tmp_path / "t.terms.yaml").write_text(TERMS, encoding="utf-8")
     (tmp_path / "t.rules").write_text(

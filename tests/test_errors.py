@@ -86,6 +86,18 @@ def caret_under(exc: MitosError) -> str:
      "did you mean `then`?"),
     ("behavior b:\n  r1: if road is WIDE then speed is SLOW\n", 41, None,
      "unexpected end of the input", "`end`", "a behavior ends with `end`"),
+    # a misspelt statement keyword is read as a rule's label: say which keyword it was
+    ("behaviour b:\n", 11, "b",
+     "unexpected `b`", "`:`", "`behaviour` is not a keyword: did you mean `behavior`?"),
+    ("operator: and = product\n", 11, "and", "unexpected `and`", "`if`",
+     "`operator` is not a keyword: did you mean `operators`?"),
+    ("behavior b:\n  r1: if road is WIDE then speed is SLOW\n  frozn r1\n", 9, "r1",
+     "unexpected `r1`", "`:`", "`frozn` is not a keyword: did you mean `frozen`?"),
+    ("behavior b:\n  r1: if road is WIDE then speed is SLOW\nedn\n", 4, None,
+     "unexpected end of the input", "`:`", "`edn` is not a keyword: did you mean `end`?"),
+    # a variable's name before a missing `is` is no misspelt keyword (`temp` is not `terms`)
+    ("r1: if size is SMALL_SZ and temp SMALL_SZ then speed is SLOW", 34, "SMALL_SZ",
+     "unexpected `SMALL_SZ`", "`is`", "a condition reads `variable is TERM`"),
 ])
 def test_syntax_errors(tmp_path, line, col, at, message, expected, hint):
     path = write(tmp_path, line)
@@ -100,6 +112,7 @@ def test_syntax_errors(tmp_path, line, col, at, message, expected, hint):
         assert expected in text.splitlines()[3]
     if hint:
         assert "hint:" in text and hint in text
+    assert "did you mean `terms`" not in text
 
 
 def test_syntax_error_in_a_wrapped_rule_points_at_its_line(tmp_path):
@@ -206,6 +219,16 @@ def test_term_set_not_found(tmp_path):
     path.write_text('terms "nope.yaml"\n' + GOOD_RULE, encoding="utf-8")
     exc = error_of(lambda: load_rules_file(path), TermSetError)
     assert "term set `nope.yaml` not found" in exc.message and caret_under(exc) == '"nope.yaml"'
+
+
+def test_term_set_named_twice(tmp_path):
+    """`terms "t.terms.yaml", "./t.terms.yaml"` said "variable `road` is defined in two term
+    sets" at the one file that defines it."""
+    path = write(tmp_path, GOOD_RULE)
+    path.write_text('terms "t.terms.yaml", "./t.terms.yaml"\n' + GOOD_RULE, encoding="utf-8")
+    exc = error_of(lambda: load_rules_file(path), TermSetError)
+    assert exc.message == "term set `./t.terms.yaml` is named twice (also as `t.terms.yaml`)"
+    assert caret_under(exc) == '"./t.terms.yaml"' and exc.span.line == 1
 
 
 def test_no_term_set(tmp_path):

@@ -276,3 +276,24 @@ def test_python_export_evaluate_one_names_a_missing_or_unknown_input(tmp_path: P
     assert module.evaluate_one(road=78, size=45, position=4) == pytest.approx(
         load_rulebase(ROOT / "rulebases" / "mitos.rules").evaluate(road=78, size=45,
                                                                     position=4), abs=1e-12)
+
+
+def test_export_refuses_tsukamoto_at_the_operators_line(tmp_path: Path, capsys) -> None:
+    """`format error: `mitos export` has no code for Tsukamoto inference` said neither file
+    nor line; now it points at the `inference = tsukamoto` that chose it."""
+    from mitos_cli.cli.app import main
+
+    (tmp_path / "t.terms.yaml").write_text(
+        "variables:\n  x: {role: input, universe: [0, 10], terms: {A: {shape: left_shoulder, "
+        "points: [0, 10]}}}\n  y: {role: output, universe: [0, 100], terms: {UP: {shape: ramp, "
+        "points: [20, 80]}}}\n")
+    (tmp_path / "t.rules").write_text('terms "t.terms.yaml"\noperators: inference = tsukamoto\n'
+                                      "r1: if x is A then y is UP\n")
+    for to in ("c", "python"):
+        with pytest.raises(SystemExit) as info:
+            main(["export", str(tmp_path / "t.rules"), "--to", to])
+        err = capsys.readouterr().err
+        assert info.value.code == 1
+        assert "t.rules:2:12: format error: `mitos export` has no code for Tsukamoto " \
+               "inference" in err
+        assert "^^^^" in err

@@ -106,3 +106,26 @@ def test_a_foreign_files_operator_is_refused_where_the_file_sets_it(tmp_path) ->
     assert "FIS has no AND method `nilpotent_minimum`" in info.value.message
     assert info.value.span is not None and info.value.span.line == line_of(
         text, "conjunction: NilpotentMinimum")
+
+
+@pytest.mark.parametrize("fmt", ["fcl", "fll"])
+@pytest.mark.parametrize("rule, column", [("if a is extremely high then y is hi", 8),
+                                          ("if a is high then y is extremely hi", 23)])
+def test_a_hedge_fuzzylite_lacks_is_refused_where_the_rule_uses_it(tmp_path, fmt, rule,
+                                                                     column) -> None:
+    """`fuzzylite has no hedge like MITOS's `extremely`` had no file:line:col to find it by."""
+    from mitos_cli.api import read_rulebase
+    from mitos_cli.errors import FormatError
+    from mitos_cli.interop import write_foreign
+
+    (tmp_path / "t.terms.yaml").write_text(
+        "variables:\n  a: {role: input, universe: [0, 10], terms: {high: {shape: "
+        "right_shoulder, points: [2, 8]}}}\n"
+        "  y: {role: output, universe: [0, 1], terms: {hi: {shape: triangle, "
+        "points: [0.5, 1, 1]}}}\n")
+    path = tmp_path / "t.rules"
+    path.write_text(f'terms "t.terms.yaml"\noperators: inference = mamdani\nr1: {rule}\n')
+    with pytest.raises(FormatError, match="fuzzylite has no hedge like MITOS's `extremely`") \
+            as info:
+        write_foreign(read_rulebase(path), fmt)
+    assert str(info.value.span) == f"{path}:3:{column}"

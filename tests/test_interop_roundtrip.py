@@ -112,6 +112,29 @@ def test_mitos_rules_through_fis_back_to_rules(tmp_path: Path) -> None:
     np.testing.assert_array_equal(after[fired], before[fired])
 
 
+CRISP_TERMS = """variables:
+  temp: {role: input, universe: [0, 40], terms: {COLD: {shape: left_shoulder, points: [10, 20]},
+         HOT: {shape: right_shoulder, points: [10, 20]}}}
+  fan: {role: output, universe: [0, 3000], default: 0, terms: {HIGH: 3000}}
+"""
+
+
+@pytest.mark.parametrize("fmt", ["fcl", "fis", "fll", "rules"])
+def test_a_crisp_consequent_converts_with_the_same_outputs(fmt: str, tmp_path: Path) -> None:
+    """`then fan is 500` (language.md's `steering is 80`): every format refused it with
+    "unknown term `crisp_500` of `fan`" and no position, looking up the term the writer made
+    for it in the rule base rather than in the rules it writes."""
+    (tmp_path / "t.terms.yaml").write_text(CRISP_TERMS)
+    (tmp_path / "t.rules").write_text('terms "t.terms.yaml"\n'
+                                      "r1: if temp is COLD then fan is 500\n"
+                                      "r2: if temp is HOT then fan is HIGH\n")
+    rb = read_rulebase(tmp_path / "t.rules")
+    back = write_and_read(rb, fmt, tmp_path)
+    X = np.linspace(0.0, 40.0, 81)[:, None]
+    np.testing.assert_allclose(outputs(back, X, ("temp",))[1], outputs(rb, X, ("temp",))[1],
+                               rtol=0, atol=1e-9)
+
+
 def test_fis_reader_takes_infinite_feet_as_shoulders(tmp_path: Path) -> None:
     """A .fis written with `trapmf [-inf -inf c d]` (MITOS before it wrote finite feet) reads
     as the shoulder, as FLL's `Trapezoid -inf -inf c d` does, so it converts to a term set."""

@@ -119,6 +119,21 @@ def test_check_reports_each_interpretability_problem():
                 if f.code in ("term-order", "coverage", "indistinct", "off-centre")]
 
 
+@pytest.mark.parametrize("terms", [
+    "{STOP: 0, LOW: 1000, HIGH: 3000}",           # in order: 0 and 3000 mirror about anything
+    "{SHUT: 0, OPEN: 1000, HALF: 500}",           # out of order: term-order says so
+    "{N: {shape: triangle, points: [400, 600, 800]}, L: {shape: triangle, points: [0, 200, 400]}, "
+    "M: {shape: triangle, points: [200, 400, 600]}}"])
+def test_off_centre_needs_a_symmetry_the_writer_meant(terms):
+    """`vent: {SHUT: 0, OPEN: 1, HALF: 0.5}` was told "`OPEN` is centred on 1, off the point
+    0.25 its neighbours mirror each other about; move it back to 0.25"."""
+    text = ("variables:\n  x: {role: input, universe: [0, 3000], terms: {A: {shape: "
+            "left_shoulder, points: [0, 3000]}}}\n"
+            f"  y: {{role: output, universe: [0, 3000], terms: {terms}}}\n")
+    var = parse_termset(text).variables[1]
+    assert "off-centre" not in [i.code for i in meaning.variable_issues(var)]
+
+
 def test_coverage_is_exact_at_a_crossing():
     corners = np.array([[-np.inf, -np.inf, 0.0, 4.0], [2.0, 6.0, np.inf, np.inf]])
     low, where = meaning.coverage(corners, (0.0, 10.0))

@@ -18,6 +18,8 @@ code                  severity    meaning
 ``conflict``          error       rules with the same antecedent and different consequents
 ``duplicate``         warning     rules with the same antecedent and the same consequents
 ``contradiction``     warning     an antecedent that asks for ``x is A`` and ``x is not A``
+``idle-setting``      warning     a Mamdani-only operator setting (``defuzzify``, ...) where
+                                  the inference is not Mamdani
 ``unreachable``       warning     a rule whose DOF is 0 at every sampled input
 ``term-gap``          warning     a stretch of an input's universe where all its terms are 0
 ``term-outside``      warning     an input term that never reaches 1 inside the universe
@@ -69,6 +71,10 @@ MAX_SAMPLES = 300_000
 MAX_BOXES = 6
 #: Points per universe when looking for gaps between the terms of one input.
 GAP_RESOLUTION = 2001
+#: An input term whose largest membership inside the universe reaches this counts as reaching
+#: 1: a sigmoid used as a shoulder comes within 1e-4 of 1 but never gets there, and its peak
+#: is not "outside the universe" for that.
+NEARLY_ONE = 0.99
 
 
 @dataclass(frozen=True)
@@ -489,7 +495,7 @@ def _term_gaps(rb: RuleBase) -> list[Finding]:
         x = np.unique(np.concatenate([np.linspace(lo, hi, GAP_RESOLUTION), corners]))
         mus = np.array([t.membership(x) for t in var.terms])
         for term, mu in zip(var.terms, mus):
-            if mu.max() < 1.0:
+            if mu.max() < NEARLY_ONE:
                 out.append(Finding(
                     "warning", "term-outside",
                     f"input term `{var.name}.{term.name}` never reaches 1 inside the universe "

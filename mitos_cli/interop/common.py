@@ -129,9 +129,11 @@ def fuzzylite_hedge(name: str, span: Span | None) -> str:
                       hint=did_you_mean(name, FUZZYLITE_HEDGES))
 
 
-def to_fuzzylite_hedge(name: str) -> str:
+def to_fuzzylite_hedge(name: str, span: Span | None = None) -> str:
+    """fuzzylite's name for hedge ``name``; refused at ``span`` (the proposition or consequent
+    using it) when fuzzylite has none."""
     if name not in MITOS_TO_FUZZYLITE_HEDGES:
-        raise FormatError(f"fuzzylite has no hedge like MITOS's `{name}` (x^3)",
+        raise FormatError(f"fuzzylite has no hedge like MITOS's `{name}` (x^3)", span=span,
                           hint="use `very` (x^2) or `intensely` (fuzzylite's `extremely`)")
     return MITOS_TO_FUZZYLITE_HEDGES[name]
 
@@ -636,11 +638,14 @@ def flatten_for_export(rb: RuleBase, behavior: str | None = None, *,
 
 def all_inputs(rb: RuleBase, flat: Flat) -> tuple[Variable, ...]:
     """The inputs a written file needs, in term-set order: those the rules test, and those a
-    linear consequent of the rules weighs (its coefficients are rewritten over these)."""
+    linear consequent of the rules weighs (its coefficients are rewritten over these).
+    Terms are looked up in ``flat``'s outputs: they hold the ``crisp_80`` terms that stand for
+    crisp consequents, which ``rb`` does not."""
     needed = {v.name for v in flat.inputs}
+    outputs = {v.name: v for v in flat.outputs}
     for r in flat.rules:
         for c in r.consequents:
-            term = rb.variables[c.var].term(c.term) if c.term is not None else None
+            term = outputs[c.var].term(c.term) if c.term is not None else None
             if term is not None and term.shape == "linear":
                 needed.update(n for n, a in linear_coefficients(rb, c.var, term).items()
                               if a != 0.0)

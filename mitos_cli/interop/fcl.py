@@ -625,7 +625,7 @@ def _corner_points(corners) -> list[tuple[float, float]] | None:
 def _rule_text(r: Rule) -> str:
     def expr(e, parent: str) -> str:
         if isinstance(e, Prop):
-            words = (["NOT"] if e.negated else []) + [common.to_fuzzylite_hedge(h)
+            words = (["NOT"] if e.negated else []) + [common.to_fuzzylite_hedge(h, e.span)
                                                        for h in e.hedges] + [e.term]
             return f"{e.var} IS " + " ".join(words)
         if isinstance(e, Not):
@@ -635,7 +635,7 @@ def _rule_text(r: Rule) -> str:
         return f"({text})" if parent not in ("top", op, "not") else text
 
     cons = " AND ".join(f"{c.var} IS " + " ".join(
-        [common.to_fuzzylite_hedge(h) for h in hedges] + [common.concluded_term(c)])
+        [common.to_fuzzylite_hedge(h, c.span) for h in hedges] + [common.concluded_term(c)])
         for c, hedges in common.written_consequents(r))
     text = f"IF {expr(r.antecedent, 'top')} THEN {cons}"
     if r.weight != 1.0:

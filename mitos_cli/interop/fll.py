@@ -520,7 +520,7 @@ def fuzzylite_rule_text(rule: Rule, ops, dialect: str) -> str:
 
     def expr(e, parent: str) -> str:
         if isinstance(e, Prop):
-            words = (["not"] if e.negated else []) + [common.to_fuzzylite_hedge(h)
+            words = (["not"] if e.negated else []) + [common.to_fuzzylite_hedge(h, e.span)
                                                        for h in e.hedges] + [e.term]
             return f"{e.var} {kw('is')} " + " ".join(kw(w) if w == "not" else w for w in words)
         op = "and" if isinstance(e, And) else "or"
@@ -529,7 +529,7 @@ def fuzzylite_rule_text(rule: Rule, ops, dialect: str) -> str:
 
     assert not isinstance(antecedent, Not)
     cons = f" {kw('and')} ".join(
-        f"{c.var} {kw('is')} " + " ".join([common.to_fuzzylite_hedge(h) for h in hedges]
+        f"{c.var} {kw('is')} " + " ".join([common.to_fuzzylite_hedge(h, c.span) for h in hedges]
                                           + [common.concluded_term(c)])
         for c, hedges in common.written_consequents(rule))
     text = f"{kw('if')} {expr(antecedent, 'top')} {kw('then')} {cons}"

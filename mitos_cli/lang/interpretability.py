@@ -24,7 +24,10 @@ centre             when the terms are written mirror-symmetric about a point (an
                    (``heading.AHEAD`` at 0, ``steering.ST`` at 90), unless it is written
                    with ``held: false``; a term written with ``held: POINT`` stays centred
                    on that point (what ``mitos teach`` saves once its neighbours have moved
-                   out of symmetry, so that the hold outlives the symmetry it came from)
+                   out of symmetry, so that the hold outlives the symmetry it came from);
+                   not measured on terms out of order (their neighbours in writing are not
+                   their neighbours) nor on three terms whose outer two are crisp values
+                   (any two values mirror each other)
 =================  =========================================================================
 
 Piecewise-linear terms (triangles, trapezoids, shoulders) are measured exactly, on the points
@@ -371,7 +374,8 @@ def _off_centre(var: Variable) -> list[Issue]:
             f"`{var.name}.{term.name}` is centred on {_num(centre(term))}, off the point "
             f"{_num(at)} it is held at"), f"move it back to {_num(at)}")]
     n = len(var.terms)
-    if n < 3 or n % 2 == 0 or not all(learnable(t) for t in var.terms):
+    if n < 3 or n % 2 == 0 or not all(learnable(t) for t in var.terms) or _order(var) \
+            or _trivially_mirrored(var):
         return []
     outer = Variable(var.name, var.role, var.universe,
                      var.terms[:n // 2] + (_placeholder(var),) + var.terms[n // 2 + 1:])
@@ -383,6 +387,13 @@ def _off_centre(var: Variable) -> list[Issue]:
         f"`{var.name}.{middle.name}` is centred on {_num(centre(middle))}, off the point "
         f"{_num(point)} its neighbours mirror each other about"),
         f"move it back to {_num(point)}")]
+
+
+def _trivially_mirrored(var: Variable) -> bool:
+    """Three terms whose outer two are crisp values: any two values mirror each other about
+    their midpoint, so that says nothing of a point the middle term was meant to sit on
+    (``{OFF: 0, LOW: 1000, HIGH: 3000}`` is not LOW off 1500)."""
+    return len(var.terms) == 3 and var.terms[0].shape == var.terms[2].shape == "singleton"
 
 
 def _placeholder(var: Variable) -> Term:

@@ -113,8 +113,9 @@ def syntax_error(exc: UnexpectedInput, text: str, path: str | None) -> RuleSynta
         return RuleSyntaxError("unexpected end of the input",
                                span=Span.in_text(text, path, line, column),
                                expected=_expected(names) if names else None,
-                               hint="the last rule or behavior is incomplete (a behavior ends "
-                                    "with `end`)")
+                               hint=_statement_hint(text, len(text.rstrip())) or
+                               "the last rule or behavior is incomplete (a behavior ends "
+                               "with `end`)")
     assert isinstance(exc, UnexpectedToken)
     from ..errors import did_you_mean
 
@@ -130,7 +131,9 @@ def syntax_error(exc: UnexpectedInput, text: str, path: str | None) -> RuleSynta
             # `if road is WIDE and then ...`: the keyword was read as a variable's name
             hint = (f"`{before}` stands where a condition should be; a condition reads "
                     f"`variable is TERM`")
-        elif close:         # `r1: iff road is WIDE ...`: `iff` was read as a variable's name
+        elif close and not _after_connective(text, token):
+            # `r1: iff road is WIDE ...`: `iff` was read as a variable's name (but in
+            # `if temp COLD`, `temp` is one: not "did you mean `terms`")
             hint = f"`{before}` is read as a variable's name: {close}"
         else:
             hint = "a condition reads `variable is TERM`"
@@ -139,6 +142,7 @@ def syntax_error(exc: UnexpectedInput, text: str, path: str | None) -> RuleSynta
             "join conditions with `and` / `or`, and start the actions with `then`"
     else:
         hint = keyword_hint(token, expected)
+    hint = _statement_hint(text, token.start_pos) or hint
     return RuleSyntaxError(f"unexpected {_describe(token)}", span=span,
                            expected=_expected(expected), hint=hint)
 
@@ -162,6 +166,40 @@ def _hedge_hint(text: str, token: Token) -> str | None:
 #: words of the language that can also be read as names where a name is expected
 RESERVED = {"if", "then", "and", "or", "not", "is", "with", "use", "when", "end", "behavior",
             "terms", "operators", "frozen"}
+
+
+#: words that start a statement (`terms "a.yaml"`, `operators: ...`, `behavior b:`, ...)
+STATEMENTS = ("terms", "operators", "behavior", "end", "use", "frozen")
+
+
+def _statement_hint(text: str, pos: int | None) -> str | None:
+    """``behaviour b:``, ``operator: and = min``, ``edn``: a misspelt statement keyword, read as
+    a rule's label, when it is the first word of its line and the word just before ``pos``.
+    A word with a colon is only taken for a keyword that takes one (``user:`` is a label)."""
+    import re
+
+    from ..errors import did_you_mean
+
+    if pos is None:
+        return None
+    found = re.search(r"(?:^|\n)[ \t]*([A-Za-z_][\w\-]*)(:?)\s*\Z", text[:pos])
+    if found is None or found.group(1) in RESERVED:
+        return None
+    word = found.group(1)
+    pool = ("operators", "behavior") if found.group(2) else STATEMENTS
+    close = did_you_mean(word, pool)
+    return f"`{word}` is not a keyword: {close}" if close else None
+
+
+def _after_connective(text: str, token: Token) -> bool:
+    """Whether the word before ``token`` stands where a condition's variable does (after
+    `if`, `and`, `or`, `not`, `when` or `(`): then it is a variable's name, not a keyword."""
+    import re
+
+    if token.start_pos is None:
+        return False
+    return re.search(r"(?:\b(?:if|and|or|not|when)\b|\()\s*[A-Za-z_][\w\-]*\s*\Z",
+                     text[:token.start_pos]) is not None
 
 
 def _word_before(text: str, token: Token) -> str:

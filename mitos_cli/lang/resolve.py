@@ -40,8 +40,10 @@ def load_rules_file(path: str | Path) -> RuleBase:
                             hint=nearby(path)) from None
     parsed = parse_rules(text, str(path))
     termsets = []
+    seen: dict[Path, str] = {}
     for name, span in parsed.terms:
         target = path.parent / name
+        _named_once(target, name, span, seen)
         if not is_file(target):
             found = "is a directory" if exists(target) else "not found"
             raise TermSetError(f"term set `{name}` {found} (looked for `{target}`)", span=span,
@@ -49,6 +51,19 @@ def load_rules_file(path: str | Path) -> RuleBase:
                                     "a YAML file")
         termsets.append(load_termset(target))
     return build_rulebase(parsed, tuple(termsets), tuple(n for n, _ in parsed.terms))
+
+
+def _named_once(target: Path, name: str, span: Span | None, seen: dict[Path, str]) -> None:
+    """Refuse a term set the rule file names twice (its variables would be "defined in two term
+    sets", which sends the user looking for a second definition that is not there)."""
+    import os
+
+    key = Path(os.path.normpath(target))
+    if key in seen:
+        raise TermSetError(f"term set `{name}` is named twice"
+                           + (f" (also as `{seen[key]}`)" if seen[key] != name else ""),
+                           span=span, hint="name each term set once")
+    seen[key] = name
 
 
 def build_rulebase(parsed: ParsedFile, termsets: tuple[TermSet, ...],

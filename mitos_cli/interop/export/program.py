@@ -18,6 +18,7 @@ from ...engine.compile import CompiledRuleBase
 from ...errors import FormatError
 from ...fuzzy.shapes import kernel_params
 from ...lang.model import And, Expr, Not, Prop, flatten
+from ..common import setting_span
 
 #: Text that may stand as it is in a C comment or a Python docstring.
 PLAIN = re.compile(r"[A-Za-z0-9_ .,:;+=@%()\[\]<>~^!#&|{}-]*")
@@ -76,7 +77,10 @@ def term_columns(compiled: CompiledRuleBase) -> dict[tuple[str, str], str]:
 def program(compiled: CompiledRuleBase) -> Program:
     """Build the straight-line program of ``compiled``."""
     if compiled.operators.inference == "tsukamoto":
-        raise FormatError("`mitos export` has no code for Tsukamoto inference")
+        raise FormatError("`mitos export` has no code for Tsukamoto inference",
+                          span=setting_span(compiled.rulebase, compiled.behavior, "inference"),
+                          hint="export it with another inference, or convert it to FLL (`mitos "
+                               "convert --to fll`) to run it in fuzzylite")
     names = term_columns(compiled)
     hedges: set[str] = set()
     used: set[str] = set()
@@ -118,7 +122,7 @@ def program(compiled: CompiledRuleBase) -> Program:
         if names[key] in referenced:
             if term.formula is not None:
                 raise FormatError(f"term `{key[0]}.{key[1]}`: `mitos export` has no code for "
-                                  f"formula terms (`{term.formula.text}`)")
+                                  f"formula terms (`{term.formula.text}`)", span=term.span)
             kernel = kernel_params(term.corners) if term.corners is not None else None
             terms.append((int(compiled.term_var[i]), names[key], term.shape, term.params, kernel))
     shapes = {t[2] for t in terms if t[4] is None}
