@@ -624,6 +624,28 @@ def test_world_numbers_too_large_for_the_geometry_are_refused(tmp_path, old, new
     assert (err.value.span.line, err.value.span.column) == (21 if "[" in old else 22, col)
 
 
+@pytest.mark.parametrize("width", ["1e-320", "1e-20"])
+def test_a_corridor_too_thin_for_a_float_has_no_inside_and_no_warning(tmp_path, width):
+    """The fuzz pass of 2026-12-10: a corridor `width: 1e-320` (or any width lost against its
+    coordinates) gave a rectangle side of length 0, which the wall clipper divided by (NumPy's
+    'invalid value' / 'divide by zero' warnings). Such a rectangle has no inside: it clips
+    nothing, and the world reads as with any other width the robot cannot use."""
+    import warnings
+
+    from mitos_cli.sim.worldfile import load_world
+
+    thin = "    - points: [[100, -100], [100, -35]]\n      width: " + width + "\n"
+    path = tmp_path / "thin.yaml"
+    path.write_text(TINY_WORLD.read_text().replace("obstacles:", thin + "obstacles:", 1))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        world = load_world(path)                    # a side corridor no route needs
+        assert len(world.corridors) == 2
+        path.write_text(TINY_WORLD.read_text().replace("width: 70", "width: " + width))
+        with pytest.raises(WorldError, match=r"the start \(q_init\) at \(30, -10\) lies inside"):
+            load_world(path)
+
+
 def test_world_seed_may_be_large(tmp_path):
     from mitos_cli.sim.worldfile import load_world
 
