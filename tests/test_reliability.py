@@ -624,6 +624,29 @@ def test_world_numbers_too_large_for_the_geometry_are_refused(tmp_path, old, new
     assert (err.value.span.line, err.value.span.column) == (21 if "[" in old else 22, col)
 
 
+def test_a_term_set_named_twice_is_refused_at_its_line_before_it_is_read_again(tmp_path):
+    """The fuzz pass of 2026-12-10 (`mitos check` through the CLI, seed 20261211, rule files
+    input 257): `terms "mitos.terms.yaml"` repeated 20,000 times (500 KB) parsed the YAML once
+    per line (2,000 lines: 30 CPU s; the whole file about 13 minutes) to end in "variable
+    `road` is defined in two term sets" at the YAML. Now the second line is the error."""
+    from mitos_cli.lang.resolve import load_rules_file
+    from mitos_cli.resources import packaged_path
+
+    (tmp_path / "t.terms.yaml").write_text(
+        packaged_path("rulebases", "mitos.terms.yaml").read_text(encoding="utf-8"))
+    rules = tmp_path / "twice.rules"
+    rules.write_text('terms "t.terms.yaml"\n' * 2000 + "if road is WIDE then speed is 20\n")
+    start = time.process_time()
+    with pytest.raises(TermSetError, match=r"term set `t.terms.yaml` is named twice "
+                                           r"\(first at line 1\)") as info:
+        load_rules_file(rules)
+    assert time.process_time() - start < 5
+    assert (info.value.span.line, info.value.span.column) == (2, 7)
+    rules.write_text('terms "t.terms.yaml"\nterms "./t.terms.yaml"\n')
+    with pytest.raises(TermSetError, match="`./t.terms.yaml` is named twice"):
+        load_rules_file(rules)
+
+
 @pytest.mark.parametrize("width", ["1e-320", "1e-20"])
 def test_a_corridor_too_thin_for_a_float_has_no_inside_and_no_warning(tmp_path, width):
     """The fuzz pass of 2026-12-10: a corridor `width: 1e-320` (or any width lost against its
