@@ -3,6 +3,9 @@ the same bits as the rows of ``evaluate`` and as one sample alone, the same mess
 
 from __future__ import annotations
 
+import warnings
+from decimal import Decimal
+from fractions import Fraction
 from pathlib import Path
 
 import numpy as np
@@ -84,3 +87,65 @@ def test_what_numpy_would_misread_or_raise_about_is_refused_in_words(value, mess
 def test_a_batch_that_is_not_numbers_is_refused_in_words(X, message):
     with pytest.raises(InputError, match=message):
         load_rulebase().run(X)
+
+
+_WIDE = pytest.mark.skipif(not np.isfinite(np.longdouble("1e400")),
+                           reason="a long double here is a double")
+
+
+@pytest.mark.parametrize(("value", "message"), [
+    # the fuzz pass of 2026-12-10: each was evaluated at a number nobody gave
+    (True, "input `road` must be a number, not a bool: `True`"),                   # 1
+    (np.array([True, False]), "input `road` must be a number, not a bool"),
+    ([78, True], "input `road` must be a number, not a bool"),                       # [78, 1]
+    (np.datetime64("2020-01-01"), "input `road` must be a number, not a date"),     # 18,262 days
+    (np.array([5], dtype="timedelta64[s]"), "input `road` must be a number, not a duration"),
+    (bytearray(b"5"), r"input `road` must be a number, not bytes: `bytearray\(b'5'\)`"),  # 53
+    (b"78", "input `road` must be a number, not bytes"),
+    ("5_0", "input `road` must be a number, not `5_0`"),                              # 50
+    ("\uff15\uff10", "input `road` must be a number, not `\uff15\uff10`"),            # 50
+    (np.array(["78", "7_8"]), r"input `road` must be a number, not `\['78' '7_8'\]`"),
+    (Decimal("1e400"), r"input `road` has a number too large for a float: `1E\+400`"),  # inf
+    ([Decimal(78), Decimal("-1e999")], "input `road` has a number too large for a float"),
+    pytest.param(np.longdouble("1e400"), "input `road` has a number too large for a float",
+                 marks=_WIDE),                                                  # a warning
+    pytest.param(np.array([np.longdouble("1e400"), 78]), "input `road` has a number too large",
+                 marks=_WIDE),
+])
+def test_what_numpy_or_float_would_read_as_another_number_is_refused(value, message):
+    rb = load_rulebase()
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")                # no "overflow encountered in cast"
+        for call in (rb.evaluate, rb.trace):
+            with pytest.raises(InputError, match=message):
+                call(road=value, size=45, position=4)
+        with pytest.raises(InputError, match=_as_a_batch(message)):
+            rb.run([[value, 45, 4]] if np.ndim(value) == 0 and not isinstance(value, str)
+                   else value)
+
+
+def _as_a_batch(message: str) -> str:
+    """A message about input `road` as the batch's (``run``), up to the value quoted."""
+    head = message.split(":")[0].replace("input `road`", "the inputs").replace(" has ", " have ")
+    for one, many in (("a number,", "numbers,"), ("a bool", "bools"), ("a date", "dates"),
+                      ("a duration", "durations")):
+        head = head.replace(one, many)
+    return head
+
+
+@pytest.mark.parametrize("value", [
+    " 78 ", "78", "7.8e1", Decimal("78"), Fraction(156, 2), np.array(78), np.float16(78),
+    np.array([78], dtype=np.longdouble), np.array([78], dtype=np.int8), [np.array(78.0)],
+    np.array([Decimal("78")], dtype=object), "inf", Decimal("Infinity"),
+])
+def test_numbers_in_other_forms_are_the_numbers_they_say(value):
+    rb = load_rulebase()
+    expected = rb.evaluate(road=float(np.asarray(value, dtype=object).reshape(-1)[0]),
+                           size=45.0, position=4.0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        out = rb.evaluate(road=value, size=45, position=4)
+        assert {k: float(np.asarray(v).reshape(-1)[0]) for k, v in out.items()} == expected
+        assert rb.trace(road=value, size=45, position=4).outputs == \
+            rb.trace(**{"road": float(np.asarray(value, dtype=object).reshape(-1)[0]),
+                        "size": 45.0, "position": 4.0}).outputs

@@ -80,6 +80,25 @@ def test_a_thread_count_that_is_not_a_number_of_threads_is_refused(value, monkey
     assert "a whole number from 1 to 256" in str(info.value)
 
 
+@pytest.mark.parametrize("value", ["9" * 5000, "0" * 5000 + "2"])
+def test_a_thread_count_of_thousands_of_digits_is_read_without_int_s_limit(value, monkeypatch):
+    # the fuzz pass of 2026-12-10: int() raised ValueError ("Exceeds the limit (4300 digits)")
+    # from every command, before the message; leading zeros are still a number
+    c = load_rulebase().compiled
+    X = _inputs(c, 2 * GRID_BLOCK + 1, seed=16).T
+    monkeypatch.setenv(threads.ENV, value)
+    if value.endswith("2"):
+        assert threads.given() == 2
+        monkeypatch.setenv(threads.ENV, "1")
+        one = evaluate_columns(c, X)
+        monkeypatch.setenv(threads.ENV, value)
+        assert np.array_equal(_bits(evaluate_columns(c, X)), _bits(one))
+        return
+    with pytest.raises(InputError, match=r"MITOS_NUM_THREADS is `9{40}\.\.\.9{20}` \(5,000 "
+                                         r"characters\), not a number of threads"):
+        evaluate_columns(c, X)
+
+
 def test_the_cli_refuses_a_wrong_thread_count_before_any_command_runs():
     import os
     import subprocess

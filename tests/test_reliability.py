@@ -624,6 +624,50 @@ def test_world_numbers_too_large_for_the_geometry_are_refused(tmp_path, old, new
     assert (err.value.span.line, err.value.span.column) == (21 if "[" in old else 22, col)
 
 
+def test_a_term_set_named_twice_is_refused_at_its_line_before_it_is_read_again(tmp_path):
+    """The fuzz pass of 2026-12-10 (`mitos check` through the CLI, seed 20261211, rule files
+    input 257): `terms "mitos.terms.yaml"` repeated 20,000 times (500 KB) parsed the YAML once
+    per line (2,000 lines: 30 CPU s; the whole file about 13 minutes) to end in "variable
+    `road` is defined in two term sets" at the YAML. Now the second line is the error."""
+    from mitos_cli.lang.resolve import load_rules_file
+    from mitos_cli.resources import packaged_path
+
+    (tmp_path / "t.terms.yaml").write_text(
+        packaged_path("rulebases", "mitos.terms.yaml").read_text(encoding="utf-8"))
+    rules = tmp_path / "twice.rules"
+    rules.write_text('terms "t.terms.yaml"\n' * 2000 + "if road is WIDE then speed is 20\n")
+    start = time.process_time()
+    with pytest.raises(TermSetError, match=r"term set `t.terms.yaml` is named twice") as info:
+        load_rules_file(rules)
+    assert time.process_time() - start < 5
+    assert (info.value.span.line, info.value.span.column) == (2, 7)
+    rules.write_text('terms "t.terms.yaml"\nterms "./t.terms.yaml"\n')
+    with pytest.raises(TermSetError, match="`./t.terms.yaml` is named twice"):
+        load_rules_file(rules)
+
+
+@pytest.mark.parametrize("width", ["1e-320", "1e-20"])
+def test_a_corridor_too_thin_for_a_float_has_no_inside_and_no_warning(tmp_path, width):
+    """The fuzz pass of 2026-12-10: a corridor `width: 1e-320` (or any width lost against its
+    coordinates) gave a rectangle side of length 0, which the wall clipper divided by (NumPy's
+    'invalid value' / 'divide by zero' warnings). Such a rectangle has no inside: it clips
+    nothing, and the world reads as with any other width the robot cannot use."""
+    import warnings
+
+    from mitos_cli.sim.worldfile import load_world
+
+    thin = "    - points: [[100, -100], [100, -35]]\n      width: " + width + "\n"
+    path = tmp_path / "thin.yaml"
+    path.write_text(TINY_WORLD.read_text().replace("obstacles:", thin + "obstacles:", 1))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        world = load_world(path)                    # a side corridor no route needs
+        assert len(world.corridors) == 2
+        path.write_text(TINY_WORLD.read_text().replace("width: 70", "width: " + width))
+        with pytest.raises(WorldError, match=r"the start \(q_init\) at \(30, -10\) lies inside"):
+            load_world(path)
+
+
 def test_world_seed_may_be_large(tmp_path):
     from mitos_cli.sim.worldfile import load_world
 

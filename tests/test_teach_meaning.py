@@ -392,3 +392,51 @@ def test_tied_ruspini_partitions_hold_at_every_ordered_point(seed):
         assert cover >= 0.5 - 1e-9 and similar <= 1 / 3 + 1e-9, part.var
     gappy = np.array([[-np.inf, -np.inf, 0.0, 4.0], [2.0, 6.0, np.inf, np.inf]])
     assert not ruspini(np.array([[-1, -1, 0, 1], [2, 3, -1, -1]]), gappy, (0.0, 10.0))
+
+
+def _cube(mu: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """Similarity as it was formed before 2026-12-10: every pair's minima and maxima at once."""
+    both = np.minimum(mu[:, None, :], mu[None, :, :])
+    either = np.maximum(mu[:, None, :], mu[None, :, :])
+    dx = np.diff(x)
+
+    def area(m):
+        return ((m[..., 1:] + m[..., :-1]) * 0.5 * dx).sum(axis=-1)
+
+    inter, union = area(both), area(either)
+    return np.divide(inter, union, out=np.zeros_like(inter), where=union > 0)
+
+
+def test_similarity_keeps_its_bits_by_rows_by_overlap_and_for_repeated_terms():
+    rng = np.random.default_rng(20261210)
+    for _ in range(200):
+        t = int(rng.integers(1, 10))
+        x = np.unique(rng.uniform(0, 10, int(rng.integers(2, 200))))
+        mu = np.clip(rng.normal(0.2, 0.5, (t, len(x))), 0.0, 1.0)
+        mu[rng.integers(t)] = 0.0                          # a term 0 everywhere
+        mu[rng.integers(t)] = mu[rng.integers(t)]          # a repeated term
+        assert np.array_equal(meaning.similarity_on(mu, x).view(np.int64),
+                              _cube(mu, x).view(np.int64))
+
+
+def test_many_terms_are_measured_in_memory_proportional_to_them():
+    """The fuzz pass of 2026-12-10 (`mitos check` through the CLI, FLL): the dimmer's output
+    with `term: HIGH Sigmoid 0.75 20` repeated 740 times was a MemoryError (the similarity of
+    every pair formed a [740, 740, 1,000] cube of minima and another of maxima, 4.4 GB each);
+    200 triangles in one variable took 4.4 GB. Now: repeated terms are measured once, and a
+    row at a time, only against the terms it overlaps."""
+    import resource
+    import time
+
+    x = np.linspace(0.0, 1.0, 1001)
+    mu = np.vstack([1 / (1 + np.exp(-20 * (x - 0.75)))] * 740 + [np.exp(-(x / 0.2) ** 2 / 2)])
+    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    start = time.process_time()
+    s = meaning.similarity_on(mu, x)
+    assert s.shape == (741, 741) and s[0, 739] == 1.0 and s[0, 740] < 1.0
+    triangles = np.array([[c - 0.01, c, c + 0.01, c + 0.01] for c in np.linspace(0, 1, 400)])
+    xs = meaning.breakpoints(triangles, (0.0, 1.0))
+    meaning.similarity_on(meaning.memberships(triangles, xs), xs)
+    assert time.process_time() - start < 10               # was minutes, or a MemoryError
+    grown = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss - peak     # KB on Linux
+    assert grown < 500_000                                                   # was gigabytes

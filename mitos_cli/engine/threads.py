@@ -57,12 +57,14 @@ def given() -> int | None:
     text = os.environ.get(ENV, "").strip()
     if not text:
         return None
-    if not (text.isascii() and text.isdecimal() and 1 <= int(text) <= MAX):
+    digits = text.lstrip("0")       # int() raises past 4,300 digits: count them first
+    if not (text.isascii() and text.isdecimal() and len(digits) <= len(str(MAX))
+            and 1 <= int(digits or "0") <= MAX):
         raise InputError(f"{ENV} is `{text}`, not a number of threads",
                          expected=f"a whole number from 1 to {MAX}",
                          hint=f"unset {ENV} to use the CPUs this process may run on "
                               f"(at most {DEFAULT_MAX}), or set it to 1 for one thread")
-    return int(text)
+    return int(digits)
 
 
 def map_blocks(work: Callable[[Blocks], T], n: int, width: int) -> list[T]:

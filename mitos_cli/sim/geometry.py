@@ -170,8 +170,11 @@ def clip_segment_outside(seg: np.ndarray, rects: np.ndarray, shrink: float = 1e-
         centre = corners.mean(axis=0)
         u = corners[1] - corners[0]
         v = corners[3] - corners[0]
-        hl, hw = np.linalg.norm(u) / 2 - shrink, np.linalg.norm(v) / 2 - shrink
-        u, v = u / np.linalg.norm(u), v / np.linalg.norm(v)
+        nu, nv = np.linalg.norm(u), np.linalg.norm(v)
+        if not (nu > 0 and nv > 0):
+            continue            # a side of no length (a corridor 1e-20 in wide): no inside
+        hl, hw = nu / 2 - shrink, nv / 2 - shrink
+        u, v = u / nu, v / nv
         t0, t1 = 0.0, 1.0
         for axis, half in ((u, hl), (v, hw)):
             a0 = float(np.dot(p0 - centre, axis))
