@@ -94,7 +94,7 @@ _WIDE = pytest.mark.skipif(not np.isfinite(np.longdouble("1e400")),
 
 
 @pytest.mark.parametrize(("value", "message"), [
-    # the fuzz pass of 2026-12-10: each was evaluated at a number nobody gave
+    # the fuzz pass of 2026-12-03: each was evaluated at a number nobody gave
     (True, "input `road` must be a number, not a bool: `True`"),                   # 1
     (np.array([True, False]), "input `road` must be a number, not a bool"),
     ([78, True], "input `road` must be a number, not a bool"),                       # [78, 1]

@@ -82,7 +82,7 @@ def test_a_thread_count_that_is_not_a_number_of_threads_is_refused(value, monkey
 
 @pytest.mark.parametrize("value", ["9" * 5000, "0" * 5000 + "2"])
 def test_a_thread_count_of_thousands_of_digits_is_read_without_int_s_limit(value, monkeypatch):
-    # the fuzz pass of 2026-12-10: int() raised ValueError ("Exceeds the limit (4300 digits)")
+    # the fuzz pass of 2026-12-03: int() raised ValueError ("Exceeds the limit (4300 digits)")
     # from every command, before the message; leading zeros are still a number
     c = load_rulebase().compiled
     X = _inputs(c, 2 * GRID_BLOCK + 1, seed=16).T

@@ -625,7 +625,7 @@ def test_world_numbers_too_large_for_the_geometry_are_refused(tmp_path, old, new
 
 
 def test_a_term_set_named_twice_is_refused_at_its_line_before_it_is_read_again(tmp_path):
-    """The fuzz pass of 2026-12-10 (`mitos check` through the CLI, seed 20261211, rule files
+    """The fuzz pass of 2026-12-03 (`mitos check` through the CLI, seed 20261211, rule files
     input 257): `terms "mitos.terms.yaml"` repeated 20,000 times (500 KB) parsed the YAML once
     per line (2,000 lines: 30 CPU s; the whole file about 13 minutes) to end in "variable
     `road` is defined in two term sets" at the YAML. Now the second line is the error."""
@@ -648,7 +648,7 @@ def test_a_term_set_named_twice_is_refused_at_its_line_before_it_is_read_again(t
 
 @pytest.mark.parametrize("width", ["1e-320", "1e-20"])
 def test_a_corridor_too_thin_for_a_float_has_no_inside_and_no_warning(tmp_path, width):
-    """The fuzz pass of 2026-12-10: a corridor `width: 1e-320` (or any width lost against its
+    """The fuzz pass of 2026-12-03: a corridor `width: 1e-320` (or any width lost against its
     coordinates) gave a rectangle side of length 0, which the wall clipper divided by (NumPy's
     'invalid value' / 'divide by zero' warnings). Such a rectangle has no inside: it clips
     nothing, and the world reads as with any other width the robot cannot use."""

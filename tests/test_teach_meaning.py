@@ -395,7 +395,7 @@ def test_tied_ruspini_partitions_hold_at_every_ordered_point(seed):
 
 
 def _cube(mu: np.ndarray, x: np.ndarray) -> np.ndarray:
-    """Similarity as it was formed before 2026-12-10: every pair's minima and maxima at once."""
+    """Similarity as it was formed before 2026-12-03: every pair's minima and maxima at once."""
     both = np.minimum(mu[:, None, :], mu[None, :, :])
     either = np.maximum(mu[:, None, :], mu[None, :, :])
     dx = np.diff(x)
@@ -420,7 +420,7 @@ def test_similarity_keeps_its_bits_by_rows_by_overlap_and_for_repeated_terms():
 
 
 def test_many_terms_are_measured_in_memory_proportional_to_them():
-    """The fuzz pass of 2026-12-10 (`mitos check` through the CLI, FLL): the dimmer's output
+    """The fuzz pass of 2026-12-03 (`mitos check` through the CLI, FLL): the dimmer's output
     with `term: HIGH Sigmoid 0.75 20` repeated 740 times was a MemoryError (the similarity of
     every pair formed a [740, 740, 1,000] cube of minima and another of maxima, 4.4 GB each);
     200 triangles in one variable took 4.4 GB. Now: repeated terms are measured once, and a
