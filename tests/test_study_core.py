@@ -251,7 +251,8 @@ def test_output_directory_that_is_a_file(tmp_path):
     target.write_text("not a directory")
     with pytest.raises(StudyError) as exc:
         run_study(small_study(runs=1), target, workers=1, task_fn=fake_sim)
-    assert "cannot create the output directory" in exc.value.message
+    assert exc.value.message.endswith("taken` is a file, not a directory for the study's results")
+    assert target.read_text() == "not a directory"
 
 
 def test_unreadable_manifest_on_resume(tmp_path):
