@@ -19,6 +19,7 @@ from ..fuzzy import hedges as hedge_mod
 from ..fuzzy import norms
 from ..fuzzy.shapes import SHAPES
 from .compile import CompiledRuleBase
+from .inputs import floats
 from .threads import Blocks, map_blocks
 
 
@@ -108,126 +109,6 @@ def _column_list(compiled: CompiledRuleBase, columns: Mapping[str, object]) -> l
         raise InputError(f"inputs must be numbers or 1-D arrays, not of shape {shape}")
     n = shape[0] if shape else 1
     return [arr if arr.shape == (n,) else np.broadcast_to(arr, (n,)) for arr in arrays]
-
-
-def floats(value: object, what: str, many: bool = False) -> np.ndarray:
-    """``value`` as a float array, or an :class:`InputError` about ``what`` (one input, or
-    ``many`` inputs) saying why it is not numbers. Besides what ``float()`` refuses, what
-    NumPy would turn into numbers silently or into its own exceptions: ``None`` (read as NaN),
-    the masked entries of a masked array (read as what lies under the mask), complex numbers
-    (their imaginary part dropped), numbers past a float's range (an ``OverflowError``; a
-    ``Decimal`` or a long double read as infinite), bools (read as 1 and 0), dates and
-    durations (read as counts of their unit), bytes (a ``bytearray`` read as its byte values)
-    and text outside the one number grammar of every file here (``5_0`` read as 50)."""
-    if type(value) is np.ndarray and value.dtype == float:        # the common case
-        return value
-    has, is_ = ("have", "are") if many else ("has", "is")
-    if value is None:
-        raise InputError(f"{what} {is_} None, not {'numbers' if many else 'a number'}",
-                         hint=f"give {'them numbers' if many else 'it a number'}")
-    if isinstance(value, np.ma.MaskedArray):
-        if np.ma.count_masked(value):
-            raise InputError(f"{what} {has} {np.ma.count_masked(value)} masked values",
-                             hint="fill them (`.filled(...)`) or leave those samples out")
-        value = value.data
-    try:
-        if _is_bytes(value):
-            raise _NotNumbers("S")
-        raw = np.asarray(value)
-        if raw.dtype.kind == "c":
-            raise InputError(f"{what} {is_} complex, not real numbers: `{_brief(value)}`")
-        if raw.dtype == object and any(v is None for v in raw.flat):
-            raise InputError(f"{what} {has} None among {'their' if many else 'its'} values",
-                             hint="give every sample a number")
-        if raw.dtype.kind in _KINDS:
-            raise _NotNumbers(raw.dtype.kind)
-        if raw.dtype.kind in "iuf" and isinstance(value, (list, tuple)) and _holds_bool(value):
-            raise _NotNumbers("b")                 # [True, 2.5] is [1.0, 2.5] to NumPy
-        if raw.dtype.kind == "U" or raw.dtype == object:
-            return _one_by_one(raw)
-        with np.errstate(over="raise"):            # a long double past 1.8e308
-            return np.asarray(raw, dtype=float)
-    except _NotNumbers as exc:
-        one, several, hint = _KINDS[exc.kind]
-        raise InputError(f"{what} must be {'numbers' if many else 'a number'}, not "
-                         f"{several if many else one}: `{_brief(value)}`", hint=hint) from None
-    except (OverflowError, FloatingPointError):
-        raise InputError(f"{what} {has} a number too large for a float: `{_brief(value)}`",
-                         expected="numbers of magnitude at most 1.8e308") from None
-    except (TypeError, ValueError):
-        raise InputError(f"{what} must be {'numbers' if many else 'a number'}, "
-                         f"not `{_brief(value)}`",
-                         expected="a decimal number such as 78, -4.5 or 1e3") from None
-
-
-class _NotNumbers(Exception):
-    """Values NumPy reads as numbers though they are not the numbers meant: a key of
-    :data:`_KINDS`."""
-
-    def __init__(self, kind: str) -> None:
-        super().__init__(kind)
-        self.kind = kind
-
-
-#: What NumPy casts to float without complaint though it is no measurement, by array kind:
-#: (one, several, hint).
-_KINDS = {
-    "b": ("a bool", "bools", "give numbers: True and False would be read as 1 and 0"),
-    "M": ("a date", "dates", "give the number the input measures, not a date"),
-    "m": ("a duration", "durations",
-          "give the number in the input's unit (seconds: `d / np.timedelta64(1, 's')`)"),
-    "S": ("bytes", "bytes",
-          "decode text first (`.decode()`): NumPy reads a bytearray as its byte values"),
-}
-
-
-def _is_bytes(value: object) -> bool:
-    """``bytes``, a ``bytearray`` or a view of one: NumPy reads the last two as byte values
-    (``bytearray(b"5")`` is 53), where ``float()`` reads them as text (5)."""
-    if isinstance(value, memoryview):
-        value = value.obj
-    return isinstance(value, (bytes, bytearray))
-
-
-def _holds_bool(values: list | tuple) -> bool:
-    """Whether a list or tuple, or one nested in it, holds a bool (NumPy reads a bool among
-    numbers as 1 or 0, and says nothing). By the set of types: 20 ms for a million floats."""
-    types = set(map(type, values))
-    if bool in types or np.bool_ in types:
-        return True
-    return bool(types & {list, tuple}) and any(_holds_bool(v) for v in values
-                                                if type(v) in (list, tuple))
-
-
-def _one_by_one(raw: np.ndarray) -> np.ndarray:
-    """Text or Python objects ``raw`` as floats, each value alone: text by the number grammar
-    of the files (:func:`~mitos_cli.numbers.parse_number`), anything else by ``float()``,
-    with the kinds of :data:`_KINDS` refused, and a number ``float()`` makes
-    infinite though it is finite (``Decimal("1e400")``) an ``OverflowError``."""
-    from ..numbers import parse_number
-
-    out = np.empty(raw.shape)
-    flat = out.reshape(-1)
-    for i, v in enumerate(raw.flat):
-        if isinstance(v, str):
-            flat[i] = parse_number(v)
-            continue
-        if isinstance(v, (bool, np.bool_)):
-            raise _NotNumbers("b")
-        if isinstance(v, (np.datetime64, np.timedelta64)):
-            raise _NotNumbers("M" if isinstance(v, np.datetime64) else "m")
-        if _is_bytes(v):
-            raise _NotNumbers("S")
-        x = float(v)
-        if x in (np.inf, -np.inf) and not v == x:
-            raise OverflowError(v)
-        flat[i] = x
-    return out
-
-
-def _brief(value: object) -> str:
-    text = str(value)
-    return text if len(text) <= 60 else f"{text[:40]}...{text[-15:]} ({len(text):,} characters)"
 
 
 def check_inputs(compiled: CompiledRuleBase, X) -> tuple[np.ndarray, np.ndarray]:
@@ -604,7 +485,7 @@ def evaluate_columns(compiled: CompiledRuleBase, Xt, *, strict: bool = True) -> 
 
     A behavior whose rules are one grid (:class:`~mitos_cli.engine.compile.GridBatch`, the
     paper's 27 rules) takes :func:`_grid_columns`, the same operations in fewer NumPy calls.
-    A large batch is cut into one part per thread (:mod:`~mitos_cli.engine.threads`): the
+    A large batch's blocks are spread over threads (:mod:`~mitos_cli.engine.threads`): the
     same bits, since no sample's operations depend on the others."""
     columns = [np.asarray(x, dtype=float) for x in Xt]   # the rows of Xt, not copied
     if len(columns) != len(compiled.inputs):
