@@ -522,3 +522,14 @@ def test_a_name_cut_short_gets_the_one_name_it_begins():
     assert closest("AVOID", behaviors) == "avoid_obstacle"
     assert closest("keep", behaviors) is None                   # two names begin with it
     assert closest("av", behaviors) is None                     # too short to say
+
+
+def test_a_name_with_an_accent_is_told_names_are_ascii(tmp_path):
+    from mitos_cli.errors import RuleSyntaxError
+    from mitos_cli.lang.parse import parse_rules
+
+    with pytest.raises(RuleSyntaxError) as exc:
+        parse_rules("if température is COLD then fan is HIGH\n", "na.rules")
+    text = exc.value.render()
+    assert text.startswith("na.rules:1:8: syntax error: unexpected character `é`")
+    assert "hint: names are ASCII letters, digits, `_` and `-` (`temperature`)" in text

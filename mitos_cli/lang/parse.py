@@ -102,8 +102,12 @@ def syntax_error(exc: UnexpectedInput, text: str, path: str | None) -> RuleSynta
         message = f"unexpected character `{char}`" if char.isprintable() else \
             f"unexpected character {char!r}"
         allowed = _expected(exc.allowed) if exc.allowed else None
+        hint = None
+        if char.isalpha() and not char.isascii():     # `température`: names are ASCII
+            hint = ("names are ASCII letters, digits, `_` and `-` (`temperature`); other text "
+                    "belongs in a term set's `description`")
         return RuleSyntaxError(message, span=Span.in_text(text, path, line, column),
-                               expected=allowed)
+                               expected=allowed, hint=hint)
     if isinstance(exc, UnexpectedEOF) or (isinstance(exc, UnexpectedToken)
                                           and exc.token.type == "$END"):
         lines = text.rstrip().splitlines() or [""]
