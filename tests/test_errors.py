@@ -533,3 +533,14 @@ def test_a_name_with_an_accent_is_told_names_are_ascii(tmp_path):
     text = exc.value.render()
     assert text.startswith("na.rules:1:8: syntax error: unexpected character `é`")
     assert "hint: names are ASCII letters, digits, `_` and `-` (`temperature`)" in text
+
+
+@pytest.mark.parametrize("written, shown", [("2", "not 2"), ("2.5", "not 2.5"), ("1e9", "not 1e9")])
+def test_a_resolution_refused_is_shown_as_written(written, shown):
+    from mitos_cli.lang.operators import resolve
+    from mitos_cli.lang.parse import parse_rules
+
+    parsed = parse_rules(f"operators: resolution = {written}\nif a is B then c is D\n", "r.rules")
+    with pytest.raises(MitosError) as exc:
+        resolve(parsed.operators)
+    assert exc.value.message.endswith(f"from 3 to 100000, {shown}")

@@ -320,7 +320,10 @@ class _ToModel(Transformer):
     @v_args(meta=True)
     def op_assign(self, meta, items):
         value = items[1]
-        value = str(value) if isinstance(value, Token) else repr(value)
+        if isinstance(value, Token):
+            value = str(value)
+        else:                      # a number: as written (`1e9`, not the float's 1000000000.0)
+            value = self.text[meta.start_pos:meta.end_pos].split("=", 1)[1].strip()
         return Setting(str(items[0]), value, self._s(meta))
 
     def operators_stmt(self, items):
