@@ -143,8 +143,9 @@ def interrupts_ignored_by_children() -> Iterator[None]:
 
 
 def quiet_logs() -> None:
-    """Run in a local worker before a study stopped early closes the cluster: the runs it
-    cancels are expected, not the warnings distributed logs for each."""
+    """Run in each local worker, and in this process, before a study stopped early closes
+    the cluster: the runs it cancels are expected, not the warnings distributed logs for
+    each (a worker's, or this process's client's "Couldn't gather 1 keys")."""
     import logging
 
     logging.getLogger("distributed").setLevel(logging.ERROR)
@@ -170,8 +171,9 @@ def run_dask(fn: TaskFn, tasks: Sequence[Task], workers: int, scheduler: str | N
                 yield from part
         except BaseException:
             if own and getattr(client, "cluster", None) is not None:
-                client.run(quiet_logs)      # its closing now cancels runs, which they log
-            raise
+                client.run(quiet_logs)      # its closing now cancels runs, which they log,
+                quiet_logs()                # and so does this process's client ("Couldn't
+            raise                           # gather 1 keys, rescheduling")
         finally:
             client.cancel(futures)
     finally:
