@@ -149,6 +149,8 @@ def quiet_logs() -> None:
     import logging
 
     logging.getLogger("distributed").setLevel(logging.ERROR)
+    for name in ("asyncio", "tornado"):   # "Task exception was never retrieved" for the
+        logging.getLogger(name).setLevel(logging.CRITICAL)      # comms the closing cuts
 
 
 def run_dask(fn: TaskFn, tasks: Sequence[Task], workers: int, scheduler: str | None = None,
@@ -172,8 +174,9 @@ def run_dask(fn: TaskFn, tasks: Sequence[Task], workers: int, scheduler: str | N
         except BaseException:
             if own and getattr(client, "cluster", None) is not None:
                 client.run(quiet_logs)      # its closing now cancels runs, which they log,
-                quiet_logs()                # and so does this process's client ("Couldn't
-            raise                           # gather 1 keys, rescheduling")
+                client.run(quiet_logs, nanny=True)       # as do the workers' nannies
+                quiet_logs()                # and this process's client ("Couldn't gather")
+            raise
         finally:
             client.cancel(futures)
     finally:
