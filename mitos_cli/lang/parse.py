@@ -9,12 +9,13 @@ expected, in words.
 from __future__ import annotations
 
 import functools
+import re
 from dataclasses import dataclass
 
 from lark import Lark, Token, Transformer, Tree, v_args
 from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken
 
-from ..errors import RuleSyntaxError, Span
+from ..errors import RuleSyntaxError, Span, did_you_mean
 from ..fuzzy.hedges import HEDGES
 from ..resources import grammar_text
 from .bulk import without_cyclic_gc
@@ -80,8 +81,6 @@ def _expected(names) -> str:
 def keyword_hint(token: Token, expected) -> str | None:
     """A misspelt keyword (``adapt epocs``, ``iff``): "did you mean" the closest keyword the
     parser expected there, if one is close."""
-    from ..errors import did_you_mean
-
     words = [n.lower() for n in expected if n.isupper() and n.isalpha() and n != "NAME"]
     value = str(token.value)
     return did_you_mean(value, words) if words and value.isidentifier() else None
@@ -121,8 +120,6 @@ def syntax_error(exc: UnexpectedInput, text: str, path: str | None) -> RuleSynta
                                "the last rule or behavior is incomplete (a behavior ends "
                                "with `end`)")
     assert isinstance(exc, UnexpectedToken)
-    from ..errors import did_you_mean
-
     token = exc.token
     span = Span.in_text(text, path, token.line, token.column,
                         token.column + max(1, len(str(token.value))))
@@ -153,9 +150,6 @@ def syntax_error(exc: UnexpectedInput, text: str, path: str | None) -> RuleSynta
 
 def _hedge_hint(text: str, token: Token) -> str | None:
     """``road is vary WIDE``: the word before the term was meant as a hedge."""
-    import re
-
-    from ..errors import did_you_mean
     from ..fuzzy.hedges import HEDGES
 
     before = re.search(r"\bis\s+(?:not\s+)?([A-Za-z_][\w\-]*)\s*$",
@@ -180,10 +174,6 @@ def _statement_hint(text: str, pos: int | None) -> str | None:
     """``behaviour b:``, ``operator: and = min``, ``edn``: a misspelt statement keyword, read as
     a rule's label, when it is the first word of its line and the word just before ``pos``.
     A word with a colon is only taken for a keyword that takes one (``user:`` is a label)."""
-    import re
-
-    from ..errors import did_you_mean
-
     if pos is None:
         return None
     found = re.search(r"(?:^|\n)[ \t]*([A-Za-z_][\w\-]*)(:?)\s*\Z", text[:pos])
@@ -198,8 +188,6 @@ def _statement_hint(text: str, pos: int | None) -> str | None:
 def _after_connective(text: str, token: Token) -> bool:
     """Whether the word before ``token`` stands where a condition's variable does (after
     `if`, `and`, `or`, `not`, `when` or `(`): then it is a variable's name, not a keyword."""
-    import re
-
     if token.start_pos is None:
         return False
     return re.search(r"(?:\b(?:if|and|or|not|when)\b|\()\s*[A-Za-z_][\w\-]*\s*\Z",
