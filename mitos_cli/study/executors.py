@@ -90,8 +90,13 @@ def local_cluster(workers: int):
     to the workers as they start), so a connection without that certificate is refused
     during the handshake. The workers' scratch space (where Dask would spill pickled data) is
     a fresh 0700 directory of this user's, not the shared ``$TMPDIR/dask-scratch-space``,
-    and is removed with the cluster.
+    and is removed with the cluster. Its processes log only what is critical
+    (``silence_logs``): a run's error reaches this process as the task's exception, and what
+    they would log besides is the noise of a cluster closed under them (a study stopped with
+    Ctrl-C: "Failed to communicate with scheduler during heartbeat" and its traceback, from
+    a worker the closing cut off before it could be quieted).
     """
+    import logging
     import shutil
     import tempfile
     import weakref
@@ -110,7 +115,8 @@ def local_cluster(workers: int):
         with interrupts_ignored_by_children():
             cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
                                    dashboard_address=None, host="127.0.0.1",
-                                   security=security, local_directory=scratch)
+                                   security=security, local_directory=scratch,
+                                   silence_logs=logging.CRITICAL)
     except BaseException:
         shutil.rmtree(scratch, ignore_errors=True)
         raise
