@@ -11,13 +11,14 @@ from __future__ import annotations
 
 import functools
 import json
+import math
 import re
 from dataclasses import dataclass, field
 
 from lark import Lark, Token, Tree, v_args
 from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken
 
-from ..errors import RuleSyntaxError, Span
+from ..errors import LessonError, RuleSyntaxError, Span
 from ..lang.cache import lark_parser
 from ..lang.model import Rule, Setting, Use
 from ..lang.parse import (
@@ -340,6 +341,7 @@ def parse_command(line: str, path: str | None = None, lineno: int = 1) -> Comman
         check_settings(result.settings)
     if isinstance(result, Adapt):
         _check_once(result, line, where, lineno)
+        _check_values(result, line, where, lineno)
     return result
 
 
@@ -355,6 +357,39 @@ def _check_once(c: Adapt, line: str, where: str, lineno: int) -> None:
                                   span=Span.in_text("\n" * (lineno - 1) + line, where, lineno,
                                                     column, column + len(word)),
                                   hint="give each option once")
+
+
+#: the most epochs one `adapt` runs (the paper's lesson needs 60; an epoch takes milliseconds,
+#: and 10^300 epochs would be a hang, not a lesson)
+MAX_EPOCHS = 100_000
+
+
+def _check_values(c: Adapt, line: str, where: str, lineno: int) -> None:
+    """`adapt epochs 2.5`, `adapt rate 1e-400`: a value that cannot be used is refused at its
+    place in the line, before the session looks for examples, and named as written (1e-400 is
+    0 once read)."""
+    def refuse(word: str, message: str, hint: str) -> None:
+        match = re.search(rf"\b{word}\s+(\S+)", line)
+        assert match is not None                      # the grammar put the value there
+        raise LessonError(message.format(match.group(1)),
+                          span=Span.in_text("\n" * (lineno - 1) + line, where, lineno,
+                                            match.start(1) + 1, match.end(1) + 1),
+                          hint=hint)
+
+    e = c.epochs
+    if e is not None and not (math.isfinite(e) and e == int(e) and e >= 1):
+        refuse("epochs", "epochs must be a whole number of at least 1, not {}",
+               "for example `adapt epochs 50`")
+    if e is not None and e > MAX_EPOCHS:
+        refuse("epochs", f"at most {MAX_EPOCHS:,} epochs in one `adapt`, not {{}}",
+               "adapt again to go on from where it stopped")
+    if c.rate is not None and not 0.0 < c.rate < 1.0:
+        text = re.search(r"\brate\s+(\S+)", line)
+        digits = re.split("[eE]", text.group(1))[0] if text else ""
+        small = (" (too small for a float: it reads as 0)"
+                 if c.rate == 0.0 and re.search("[1-9]", digits) else "")
+        refuse("rate", "the learning factor must lie in (0, 1), not {}" + small,
+               "the paper's eta: try `rate 0.5`")
 
 
 def _unknown_command(line: str, text: str, path: str, lineno: int) -> RuleSyntaxError | None:

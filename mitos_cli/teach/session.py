@@ -616,8 +616,8 @@ class Session:
         compiled = self.compiled()
         X, T = self.training_set(compiled)
         epochs = _whole(c.epochs, "epochs", 1) if c.epochs is not None else 50
-        if epochs > MAX_EPOCHS:         # 10^300 epochs is a hang, not a lesson
-            raise LessonError(f"at most {MAX_EPOCHS:,} epochs in one `adapt`, not {epochs:,}",
+        if epochs > cmd.MAX_EPOCHS:     # 10^300 epochs is a hang, not a lesson
+            raise LessonError(f"at most {cmd.MAX_EPOCHS:,} epochs in one `adapt`, not {epochs:,}",
                               hint="adapt again to go on from where it stopped")
         rate = 0.5 if c.rate is None else c.rate
         result = self._learn(c, compiled, X, T, epochs, rate)
@@ -792,10 +792,6 @@ def _reaches(rb: RuleBase, start: str, target: str) -> bool:
         seen.add(name)
         stack.extend(u.behavior for u in rb.behavior(name).uses)
     return False
-
-
-#: the most epochs one `adapt` runs (the paper's lesson needs 60; an epoch takes milliseconds)
-MAX_EPOCHS = 100_000
 
 
 def _seed(text: str) -> int:
