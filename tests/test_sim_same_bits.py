@@ -52,6 +52,53 @@ def test_ray_circles_sums_as_einsum_did():
         assert same(geometry.ray_circles(origin, dirs, centres, radii, 150.0), want)
 
 
+def point_segment_distance_axis_by_axis(p, seg):
+    """:func:`.geometry.point_segment_distance` as it was written: x and y apart."""
+    ax, ay = seg[:, 0], seg[:, 1]
+    ex, ey = seg[:, 2] - ax, seg[:, 3] - ay
+    dx, dy = p[:, 0, None] - ax, p[:, 1, None] - ay
+    t = np.clip((dx * ex + dy * ey) / np.maximum(ex * ex + ey * ey, geometry.EPS), 0.0, 1.0)
+    return np.hypot(dx - t * ex, dy - t * ey)
+
+
+def box_segment_distance_axis_by_axis(hl, hw, seg):
+    """:func:`.geometry.box_segment_distance` as it was written: each end's distance on its
+    own, and the segments that may cross the box found by their own nearest point to its
+    centre."""
+    x0, y0, x1, y1 = seg[:, 0], seg[:, 1], seg[:, 2], seg[:, 3]
+    e0 = np.hypot(np.maximum(np.abs(x0) - hl, 0.0), np.maximum(np.abs(y0) - hw, 0.0))
+    e1 = np.hypot(np.maximum(np.abs(x1) - hl, 0.0), np.maximum(np.abs(y1) - hw, 0.0))
+    corners = np.array([[-hl, -hw], [hl, -hw], [hl, hw], [-hl, hw]])
+    d = np.minimum(np.minimum(e0, e1),
+                   point_segment_distance_axis_by_axis(corners, seg).min(axis=0))
+    dx, dy = x1 - x0, y1 - y0
+    t = np.clip(-(x0 * dx + y0 * dy) / np.maximum(dx * dx + dy * dy, geometry.EPS), 0.0, 1.0)
+    maybe = np.hypot(x0 + t * dx, y0 + t * dy) <= math.hypot(hl, hw)
+    out = d.copy()
+    out[maybe] = geometry._box_crossing(hl, hw, seg[maybe], d[maybe])
+    return out
+
+
+def test_distances_to_segments_worked_on_both_axes_at_once_are_those_axis_by_axis():
+    rng = np.random.default_rng(13)
+    for k in range(3000):
+        seg = rng.normal(0, 30, (int(rng.integers(1, 8)), 4))
+        if k % 3 == 0:
+            seg = np.round(seg)                          # ends on the box's sides and corners
+        if k % 5 == 0:
+            seg[0, 2:] = seg[0, :2]                      # a segment of no length
+        if k % 7 == 0:
+            seg[:, 1] = seg[:, 3] = 0.0                  # along the box's axis, through it
+        if k % 11 == 0:
+            seg[0] = (-0.0, 0.0, 0.0, -0.0)              # a point at the centre, signed zeros
+        hl, hw = (0.0, 0.0) if k % 17 == 0 else tuple(rng.uniform(0, 20, 2))
+        points = rng.normal(0, 30, (int(rng.integers(1, 6)), 2))
+        assert same(geometry.point_segment_distance(points, seg),
+                    point_segment_distance_axis_by_axis(points, seg))
+        assert same(geometry.box_segment_distance(hl, hw, seg),
+                    box_segment_distance_axis_by_axis(hl, hw, seg))
+
+
 def test_points_at_is_point_at_for_every_arc_length():
     rng = np.random.default_rng(2)
     for k in range(300):

@@ -61,15 +61,21 @@ def _following(k: int) -> np.ndarray:
 
 
 def point_segment_distance(p: np.ndarray, seg: np.ndarray) -> np.ndarray:
-    """Distances ``[P, S]`` from points ``[P, 2]`` to segments ``[S, 4]``."""
-    ax, ay = seg[:, 0], seg[:, 1]
-    ex, ey = seg[:, 2] - ax, seg[:, 3] - ay
-    dx = p[:, 0, None] - ax
-    dy = p[:, 1, None] - ay
-    ee = np.maximum(ex * ex + ey * ey, EPS)
-    t = (dx * ex + dy * ey) / ee
+    """Distances ``[P, S]`` from points ``[P, 2]`` to segments ``[S, 4]``.
+
+    The x and y arithmetic runs as one ``[..., 2]`` array (each entry is still
+    ``dx * ex + dy * ey`` and ``hypot(dx - t ex, dy - t ey)``): half the NumPy calls, which is
+    what a few points and segments cost."""
+    a = seg[:, :2]
+    e = seg[:, 2:] - a                                  # [S, 2] each side's run
+    d = p[:, None] - a                                  # [P, S, 2] from its start to the point
+    ee = e * e
+    ee = np.maximum(ee[:, 0] + ee[:, 1], EPS)
+    de = d * e
+    t = (de[..., 0] + de[..., 1]) / ee
     clip_arrays(t, 0.0, 1.0, out=t)
-    return np.hypot(dx - t * ex, dy - t * ey)
+    off = d - t[..., None] * e
+    return np.hypot(off[..., 0], off[..., 1])
 
 
 def cross(ax, ay, bx, by):
@@ -208,17 +214,17 @@ def box_segment_distance(hl: float, hw: float, seg: np.ndarray) -> np.ndarray:
     the box's frame (0 when a segment touches or crosses the box)."""
     if len(seg) == 0:
         return np.zeros(0)
-    x0, y0, x1, y1 = seg[:, 0], seg[:, 1], seg[:, 2], seg[:, 3]
-    # the endpoints' distances to the box
-    e0 = np.hypot(np.maximum(np.abs(x0) - hl, 0.0), np.maximum(np.abs(y0) - hw, 0.0))
-    e1 = np.hypot(np.maximum(np.abs(x1) - hl, 0.0), np.maximum(np.abs(y1) - hw, 0.0))
-    c = point_segment_distance(_box_corners(hl, hw), seg).min(axis=0)
-    d = np.minimum(np.minimum(e0, e1), c)
+    half, points, diagonal = _box(hl, hw)
+    # the endpoints' distances to the box: (|x| - hl, |y| - hw) of both ends, at least 0
+    q = np.abs(seg) - half
+    np.maximum(q, 0.0, out=q)
+    ends = np.hypot(q[:, 0::2], q[:, 1::2])                            # [S, 2]
+    # the box's corners' distances to the segments, and its centre's
+    near = point_segment_distance(points, seg)                          # [5, S]
+    d = np.minimum(np.minimum(ends[:, 0], ends[:, 1]), np.minimum.reduce(near[:4], axis=0))
     # a segment can cross the box only if it passes within the box's half diagonal of its
     # centre; clip just those (Liang-Barsky)
-    dx, dy = x1 - x0, y1 - y0
-    t = clip_arrays(-(x0 * dx + y0 * dy) / np.maximum(dx * dx + dy * dy, EPS), 0.0, 1.0)
-    maybe = np.hypot(x0 + t * dx, y0 + t * dy) <= math.hypot(hl, hw)
+    maybe = near[4] <= diagonal
     if not maybe.any():
         return d
     out = d.copy()
@@ -227,10 +233,14 @@ def box_segment_distance(hl: float, hw: float, seg: np.ndarray) -> np.ndarray:
 
 
 @functools.lru_cache(maxsize=64)
-def _box_corners(hl: float, hw: float) -> np.ndarray:
-    out = np.array([[-hl, -hw], [hl, -hw], [hl, hw], [-hl, hw]])
-    out.flags.writeable = False
-    return out
+def _box(hl: float, hw: float) -> tuple[np.ndarray, np.ndarray, float]:
+    """The box ``[-hl, hl] x [-hw, hw]``: its half sizes as a segment's ``[4]`` (hl, hw, hl,
+    hw), its corners (counter-clockwise from the rear right) then its centre ``[5, 2]``, and
+    its half diagonal."""
+    half = np.array([hl, hw, hl, hw])
+    points = np.array([[-hl, -hw], [hl, -hw], [hl, hw], [-hl, hw], [0.0, 0.0]])
+    half.flags.writeable = points.flags.writeable = False
+    return half, points, math.hypot(hl, hw)
 
 
 def box_polygon_depth(hl: float, hw: float, poly: np.ndarray) -> np.ndarray:

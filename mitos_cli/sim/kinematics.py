@@ -45,7 +45,8 @@ class Limits:
 class _Ramp:
     """What :func:`step` derives from the limits alone, ``[substeps, n]`` or ``[n]``: how far
     the wheel and the speed may have moved after each substep (up and down), the top speed
-    backward (negative) and half the wheelbase."""
+    backward (negative), half the wheelbase and the wheelbase negated (``-v sin(delta) / wb``
+    is ``v sin(delta) / -wb`` to the bit, one call fewer)."""
 
     steer_up: np.ndarray
     steer_down: np.ndarray
@@ -53,6 +54,7 @@ class _Ramp:
     speed_down: np.ndarray
     reverse: np.ndarray
     half: np.ndarray
+    back_wheelbase: np.ndarray
 
 
 _RAMPS: dict[int, tuple[Limits, float, int, _Ramp]] = {}
@@ -67,7 +69,8 @@ def _ramp(lim: Limits, dt: float, substeps: int) -> _Ramp:
     k = np.arange(1, substeps + 1, dtype=float)[:, None]
     d_steer = k * (lim.max_rate * sdt)
     d_speed = k * (lim.acceleration * sdt)
-    ramp = _Ramp(d_steer, -d_steer, d_speed, -d_speed, -lim.max_reverse, lim.wheelbase / 2.0)
+    ramp = _Ramp(d_steer, -d_steer, d_speed, -d_speed, -lim.max_reverse, lim.wheelbase / 2.0,
+                 -lim.wheelbase)
     if len(_RAMPS) >= 16:
         del _RAMPS[next(iter(_RAMPS))]
     _RAMPS[id(lim)] = (lim, dt, substeps, ramp)
@@ -132,15 +135,15 @@ def step(x, y, heading, speed, steering, cmd_steering, cmd_speed, lim: Limits, d
     steer_k = steering + _clip(target - steering, ramp.steer_down, ramp.steer_up)
     speed_k = speed + _clip(target_v - speed, ramp.speed_down, ramp.speed_up)
     delta = np.deg2rad(steer_k - lim.straight)
-    dh = -speed_k * np.sin(delta) / lim.wheelbase * sdt
+    dh = speed_k * np.sin(delta) / ramp.back_wheelbase * sdt        # -v sin(delta) / wb dt
     half_dh = dh / 2.0
     zero = half_dh == 0.0
     ratio = np.where(zero, 1.0, np.sin(half_dh) / np.where(zero, 1.0, half_dh))
     chord = speed_k * np.cos(delta) * sdt * ratio
-    h_after = heading + np.cumsum(dh, axis=0)
+    h_after = heading + np.add.accumulate(dh, axis=0)               # np.cumsum, called bare
     mid = h_after - half_dh
     half = ramp.half
-    rx = x - half * np.cos(heading) + (chord * np.cos(mid)).sum(axis=0)
-    ry = y - half * np.sin(heading) + (chord * np.sin(mid)).sum(axis=0)
+    rx = x - half * np.cos(heading) + np.add.reduce(chord * np.cos(mid), axis=0)
+    ry = y - half * np.sin(heading) + np.add.reduce(chord * np.sin(mid), axis=0)
     h = np.remainder(h_after[-1] + np.pi, 2.0 * np.pi) - np.pi
     return rx + half * np.cos(h), ry + half * np.sin(h), h, speed_k[-1], steer_k[-1]

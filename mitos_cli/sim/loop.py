@@ -646,8 +646,9 @@ class Simulation:
             self._expected = [knowledge.expected_ranges(
                 self._given, self._maps[i], pose[i, :2], self._dirs[i], self._near_known[i],
                 self.world.sensors.range) for i in range(n)]
+        inputs = np.zeros((len(perception.INPUTS), n))      # one block, a row per input
         return _Sensed(self.time, self._where, pose, got.ranges,
-                       {key: np.zeros(n) for key in perception.INPUTS}, np.zeros((n, 2)),
+                       dict(zip(perception.INPUTS, inputs)), np.zeros((n, 2)),
                        got.clearance, np.zeros((n, 2)))
 
     def _joined(self, i: int, walls: np.ndarray, sides: np.ndarray) -> np.ndarray:
@@ -834,7 +835,7 @@ class Simulation:
         """The first sweep (body, wheel, backward) the guard measures for each active robot
         that brakes, in order (runs in lockstep measure theirs together)."""
         cfg, out = self._safety, []
-        for i in np.flatnonzero(self._active):
+        for i in self._active.nonzero()[0]:
             robot, rmap = self.robots[i], self._maps[i]
             if not robot.brake:
                 continue
@@ -892,10 +893,10 @@ class Simulation:
         if len(odometer) <= window:
             return False
         moved = odometer[-1] - odometer[-1 - window]
-        stuck = self._active & (moved < STUCK_DISTANCE)
-        for i in np.flatnonzero(stuck):
+        stuck = (self._active & (moved < STUCK_DISTANCE)).nonzero()[0]
+        for i in stuck:
             self._outcomes[i] = "stuck"
-        return bool(stuck.any())
+        return len(stuck) > 0
 
     def _record(self, s: _Sensed) -> Tick:
         tick = Tick(self._k, s.t, _columns(self._x, self._y, np.rad2deg(self._h)),

@@ -12,6 +12,7 @@ of runs of one world). Calls that may round by their operands' shape (the penetr
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -75,13 +76,15 @@ def discs(polygons: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 def sense(rows: list[SenseRow], angles: np.ndarray, max_range: float) -> Sensed:
     """The beams of every row (:func:`.sensors.cast`, :func:`.sensors.add_noise`) and the
     clearance of its footprint, row by row the bits of one robot alone."""
-    if any(r.boxes.shape != rows[0].boxes.shape or len(r.centres) != len(rows[0].centres)
-           for r in rows):
+    if len(rows) > 1 and any(r.boxes.shape != rows[0].boxes.shape
+                             or len(r.centres) != len(rows[0].centres) for r in rows):
         raise ValueError("rows sensed together have as many obstacles each")
     heading = np.array([r.heading for r in rows])
     origin = np.array([(r.x, r.y) for r in rows])
     a = heading[:, None] + angles
-    dirs = np.stack([np.cos(a), np.sin(a)], axis=2)                     # [R, B, 2]
+    dirs = np.empty((*a.shape, 2))                                      # [R, B, 2]
+    dirs[..., 0] = np.cos(a)
+    dirs[..., 1] = np.sin(a)
     static, hit = _cast(rows, origin, dirs, max_range)
     ranges = _noisy(rows, hit, max_range)
     return Sensed(dirs, static, ranges, _clearance(rows, origin, heading))
@@ -106,17 +109,19 @@ def _cast(rows: list[SenseRow], origin: np.ndarray, dirs: np.ndarray,
     walls = [len(r.walls) for r in rows]
     total = [len(r.segments) for r in rows]
     seg = _stacked([r.segments for r in rows], max(total))              # [R, N, 4]
-    ex = seg[:, None, :, 2] - seg[:, None, :, 0]                        # [R, 1, N]
-    ey = seg[:, None, :, 3] - seg[:, None, :, 1]
-    px = seg[:, None, :, 0] - origin[:, None, None, 0]
-    py = seg[:, None, :, 1] - origin[:, None, None, 1]
+    run = seg[..., 2:] - seg[..., :2]                                   # [R, N, 2]
+    start = seg[..., :2] - origin[:, None]
+    ex, ey = run[:, None, :, 0], run[:, None, :, 1]                     # [R, 1, N]
+    px, py = start[:, None, :, 0], start[:, None, :, 1]
     dx, dy = dirs[..., 0, None], dirs[..., 1, None]                     # [R, B, 1]
     denom = cross(dx, dy, ex, ey)
     ok = np.abs(denom) > EPS
     safe = np.where(ok, denom, 1.0)
     t = cross(px, py, ex, ey) / safe
     s = cross(px, py, dx, dy) / safe
-    t = np.where(ok & (t >= 0.0) & (s >= 0.0) & (s <= 1.0), t, np.inf)  # [R, B, N]
+    ok &= t >= 0.0
+    ok &= s == clip_arrays(s, 0.0, 1.0)                 # 0 <= s <= 1 (false for NaN, too)
+    t = np.where(ok, t, np.inf)                                         # [R, B, N]
     hit = np.minimum(t.min(axis=2, initial=np.inf), max_range)
     if walls == total:                                  # no sides: the walls are all there is
         static = hit
@@ -134,10 +139,9 @@ def _cast(rows: list[SenseRow], origin: np.ndarray, dirs: np.ndarray,
 def _circles(rows: list[SenseRow], origin: np.ndarray, dirs: np.ndarray,
              max_range: float) -> np.ndarray:
     """:func:`.geometry.ray_circles` of every row, ``[R, B]``."""
-    centres = _stacked([r.centres for r in rows])                       # [R, C, 2]
+    off = origin[:, None] - _stacked([r.centres for r in rows])         # [R, C, 2]
     radii = _stacked([r.radii for r in rows])                           # [R, C]
-    mx = origin[:, 0, None] - centres[..., 0]                           # [R, C]
-    my = origin[:, 1, None] - centres[..., 1]
+    mx, my = off[..., 0], off[..., 1]
     b = mx[:, None] * dirs[..., 0, None] + my[:, None] * dirs[..., 1, None] + 0.0
     c = (mx * mx + my * my - radii ** 2)[:, None]                       # [R, 1, C]
     disc = b * b - c
@@ -181,17 +185,14 @@ class _Frames:
 
     def __init__(self, origin: np.ndarray, heading: np.ndarray) -> None:
         self.origin = origin
-        self.c = np.array([math.cos(h) for h in heading])[:, None]      # as one robot's
-        self.s = np.array([math.sin(h) for h in heading])[:, None]
+        turns = [(math.cos(h), math.sin(h)) for h in heading]          # as one robot's
+        # [R, 1, 2, 2]: row j of a point's turn is (x * c + y * s, x * -s + y * c)
+        self.turn = np.array([[[[c, s], [-s, c]]] for c, s in turns])
 
     def local(self, points: np.ndarray, idx=slice(None)) -> np.ndarray:
         """``[r, K, 2]`` world points of rows ``idx`` in their footprints' frames."""
-        rel = points - self.origin[idx, None]
-        c, s = self.c[idx], self.s[idx]
-        out = np.empty_like(rel)
-        out[..., 0] = rel[..., 0] * c + rel[..., 1] * s
-        out[..., 1] = -rel[..., 0] * s + rel[..., 1] * c
-        return out
+        rel = (points - self.origin[idx, None])[..., None, :] * self.turn[idx]    # [r, K, 2, 2]
+        return rel[..., 0] + rel[..., 1]
 
 
 def _group_clearance(rows: list[SenseRow], origin: np.ndarray, heading: np.ndarray,
@@ -205,26 +206,39 @@ def _group_clearance(rows: list[SenseRow], origin: np.ndarray, heading: np.ndarr
     best = _walls(rows, frames, hl, hw)
     reach = np.where(best > 0.0, best + math.hypot(hl, hw) + 1e-6, np.inf)[:, None]
     if len(rows[0].boxes):
-        middle, radius = _stacked([r.discs[0] for r in rows]), _stacked([r.discs[1] for r in rows])
-        away = middle - origin[:, None]
-        near = np.flatnonzero((np.hypot(away[..., 0], away[..., 1]) - radius <= reach).any(axis=1))
+        near = _near(origin, _stacked([r.discs[0] for r in rows]),
+                     _stacked([r.discs[1] for r in rows]), reach)
         if len(near):
             shape = rows[0].boxes.shape
             world = _stacked([rows[i].boxes for i in near]).reshape(len(near), -1, 2)
             boxes = frames.local(world, near).reshape(len(near), *shape)
             best[near] = np.minimum(best[near], _polygons(hl, hw, boxes).min(axis=1))
     if len(rows[0].centres):
-        rel = _stacked([r.centres for r in rows]) - origin[:, None]      # [R, C, 2]
-        radii = _stacked([r.radii for r in rows])
-        near = np.flatnonzero((np.hypot(rel[..., 0], rel[..., 1]) - radii <= reach).any(axis=1))
+        centres, radii = _stacked([r.centres for r in rows]), _stacked([r.radii for r in rows])
+        near = _near(origin, centres, radii, reach)
         if len(near):
-            rel, radii, c, s = rel[near], radii[near], frames.c[near], frames.s[near]
-            lx = np.abs(rel[..., 0] * c + rel[..., 1] * s) - hl
-            ly = np.abs(-rel[..., 0] * s + rel[..., 1] * c) - hw
+            # (|x| - hl, |y| - hw) of each centre in its row's footprint's frame
+            q = np.abs(frames.local(centres[near], near)) - _half_sizes(hl, hw)
+            lx, ly = q[..., 0], q[..., 1]
             outside = np.hypot(np.maximum(lx, 0), np.maximum(ly, 0))
             inside = np.minimum(np.maximum(lx, ly), 0)
-            best[near] = np.minimum(best[near], (outside + inside - radii).min(axis=1))
+            best[near] = np.minimum(best[near], (outside + inside - radii[near]).min(axis=1))
     return best
+
+
+def _near(origin: np.ndarray, middle: np.ndarray, radius: np.ndarray,
+          reach: np.ndarray) -> np.ndarray:
+    """The rows with a disc (``middle [R, D, 2]``, ``radius [R, D]``) within ``reach [R, 1]``
+    of their origin."""
+    away = middle - origin[:, None]
+    return (np.hypot(away[..., 0], away[..., 1]) - radius <= reach).any(axis=1).nonzero()[0]
+
+
+@functools.lru_cache(maxsize=16)
+def _half_sizes(hl: float, hw: float) -> np.ndarray:
+    out = np.array([hl, hw])
+    out.flags.writeable = False
+    return out
 
 
 def _walls(rows: list[SenseRow], frames: _Frames, hl: float, hw: float) -> np.ndarray:
@@ -239,9 +253,10 @@ def _walls(rows: list[SenseRow], frames: _Frames, hl: float, hw: float) -> np.nd
     w = box_segment_distance(hl, hw, ends.reshape(-1, 4)).reshape(len(rows), -1)
     real = None if min(counts) == width else np.arange(width) < np.array(counts)[:, None]
     crossing = w <= 0.0 if real is None else real & (w <= 0.0)
-    for i in np.flatnonzero(crossing.any(axis=1)):
-        mine = crossing[i, :counts[i]]
-        w[i, :counts[i]][mine] = -box_polygon_depth(hl, hw, ends[i, :counts[i]][mine])
+    if crossing.any():
+        for i in crossing.any(axis=1).nonzero()[0]:
+            mine = crossing[i, :counts[i]]
+            w[i, :counts[i]][mine] = -box_polygon_depth(hl, hw, ends[i, :counts[i]][mine])
     return (w if real is None else np.where(real, w, np.inf)).min(axis=1, initial=np.inf)
 
 
