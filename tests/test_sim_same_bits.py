@@ -397,3 +397,50 @@ def test_robots_placed_on_their_routes_together_get_the_bits_they_get_alone():
         alone = perception.frame(r, p, hint)
         assert same(alone.s, f.s) and same(alone.e, f.e)
         assert same(alone.t, f.t) and same(alone.n, f.n)
+
+
+def window_by_searchsorted(r: route.Route, lo: float, hi: float) -> tuple[int, int]:
+    return (int(np.searchsorted(r.cum[1:], lo, side="left")),
+            int(np.searchsorted(r.cum[:-1], hi, side="right")))
+
+
+def test_a_routes_window_found_by_bisection_is_the_one_searchsorted_finds():
+    rng = np.random.default_rng(11)
+    for _ in range(200):
+        r = route.Route.of(np.cumsum(rng.normal(0, 40, (int(rng.integers(2, 12)), 2)), axis=0))
+        ends = [*r.cum, -0.0, math.inf, -math.inf, math.nan, *rng.uniform(-50, r.length + 50, 6)]
+        for lo in ends:
+            for hi in ends[::3]:
+                assert r._window(lo, hi) == window_by_searchsorted(r, lo, hi)
+
+
+def project_on_arrays(r: route.Route, p, s_hint, back=24.0, ahead=120.0):
+    """:meth:`.route.Route.project` as it was written on arrays for every window."""
+    a, e = r.points[:-1], r.points[1:] - r.points[:-1]
+    ee = np.maximum((e * e).sum(axis=1), 1e-12)
+    root = np.sqrt(ee)
+    first, stop = window_by_searchsorted(r, s_hint - back, s_hint + ahead)
+    if first >= stop:
+        first, stop = 0, 1
+    a, e, ee, root = a[first:stop], e[first:stop], ee[first:stop], root[first:stop]
+    t = geometry.clip_arrays(((p - a) * e).sum(axis=1) / ee, 0.0, 1.0)
+    closest = a + t[:, None] * e
+    i = int(np.hypot(*(p - closest).T).argmin())
+    tangent = e[i] / math.sqrt(ee[i])
+    rel = p - closest[i]
+    return (float(r.cum[first + i] + t[i] * root[i]),
+            float(rel[0] * tangent[1] - rel[1] * tangent[0]), tangent)
+
+
+def test_a_projection_in_floats_onto_one_segment_is_the_one_on_arrays():
+    rng = np.random.default_rng(12)
+    for k in range(300):
+        r = route.Route.of(np.cumsum(rng.normal(0, 40, (int(rng.integers(2, 9)), 2)), axis=0))
+        ends = [float(rng.choice(r.points[:, 0])), float(rng.choice(r.points[:, 1]))]
+        p = np.array(ends if k % 5 == 0 else rng.normal(0, 100, 2))   # on a corner, or anywhere
+        for hint in (*r.cum, *rng.uniform(-200, r.length + 200, 4)):
+            for back, ahead in ((24.0, 120.0), (0.0, 1.0), (0.0, 0.0), (5.0, 30.0)):
+                got = r.project(p, hint, back, ahead)
+                want = project_on_arrays(r, p, hint, back, ahead)
+                assert all(same(x, y) for x, y in zip(got, want))
+                assert type(got[0]) is float and type(got[1]) is float

@@ -7,6 +7,7 @@ marriage of the fuzzy planner with roadmaps and cell decomposition).
 
 from __future__ import annotations
 
+import bisect
 import functools
 import heapq
 import math
@@ -61,22 +62,39 @@ class Route:
         s = np.where(s < 0.0, 0.0, s)                  # max(s, 0.0), then min(s, length),
         s = np.where(length < s, length, s)            # as Python's max and min pick
         i = np.minimum(np.searchsorted(self.cum, s, side="right") - 1, len(self.points) - 2)
-        start = self.points[i]
-        span = self.cum[i + 1] - self.cum[i]
-        ok = span > 0
-        frac = (s[ok] - self.cum[i[ok]]) / span[ok]
+        a, e, _, _, span = self._segments
+        if self._spans_positive:          # no segment of zero length to keep as it starts
+            return a[i] + ((s - self.cum[i]) / span[i])[:, None] * e[i]
+        start = a[i]
+        ok = span[i] > 0
+        frac = (s[ok] - self.cum[i[ok]]) / span[i[ok]]
         out = start.copy()
-        out[ok] = start[ok] + frac[:, None] * (self.points[i[ok] + 1] - start[ok])
+        out[ok] = start[ok] + frac[:, None] * e[i[ok]]
         return out
 
     @functools.cached_property
     def _segments(self) -> tuple[np.ndarray, ...]:
-        """Each segment's start ``a``, vector ``e``, squared length (at least 1e-12) and
-        length: the route does not change, so :meth:`project` does not recompute them."""
+        """Each segment's start ``a``, vector ``e``, squared length (at least 1e-12), length
+        and span of arc length: the route does not change, so :meth:`project` and
+        :meth:`points_at` do not recompute them."""
         a = self.points[:-1]
         e = self.points[1:] - a
         ee = np.maximum((e * e).sum(axis=1), 1e-12)
-        return a, e, ee, np.sqrt(ee)
+        return a, e, ee, np.sqrt(ee), self.cum[1:] - self.cum[:-1]
+
+    @functools.cached_property
+    def _spans_positive(self) -> bool:
+        """Every segment spans some arc length (:meth:`of` drops repeated points)."""
+        return bool((self._segments[4] > 0).all())
+
+    @functools.cached_property
+    def _lists(self) -> tuple[list[float], ...]:
+        """The arc lengths and each segment's start, vector, squared length and length as
+        Python floats (the same values), for the scalar arithmetic of a window of one
+        segment and the bisections of :meth:`_window`."""
+        a, e, ee, root, _ = self._segments
+        return (self.cum.tolist(), a[:, 0].tolist(), a[:, 1].tolist(), e[:, 0].tolist(),
+                e[:, 1].tolist(), ee.tolist(), root.tolist())
 
     def project(self, p: np.ndarray, s_hint: float, back: float = 24.0,
                 ahead: float = 120.0) -> tuple[float, float, np.ndarray]:
@@ -85,30 +103,44 @@ class Route:
 
         Only the segments in that window are measured (elementwise, so each gets the bits it
         would get among all); with none in it, the first segment answers."""
-        a, e, ee, root = self._segments
         first, stop = self._window(s_hint - back, s_hint + ahead)
         if first >= stop:
             first, stop = 0, 1
+        if stop - first == 1:
+            return self._project_one(first, float(p[0]), float(p[1]))
+        a, e, ee, root, _ = self._segments
         if stop - first < len(a):
             a, e, ee, root = a[first:stop], e[first:stop], ee[first:stop], root[first:stop]
-        t = clip_arrays(((p - a) * e).sum(axis=1) / ee, 0.0, 1.0)
+        t = clip_arrays(np.add.reduce((p - a) * e, axis=1) / ee, 0.0, 1.0)
         closest = a + t[:, None] * e
-        d = np.hypot(*(p - closest).T)
-        i = int(d.argmin())
+        gap = p - closest
+        i = int(np.hypot(gap[:, 0], gap[:, 1]).argmin())
         s = self.cum[first + i] + t[i] * root[i]
         tangent = e[i] / math.sqrt(ee[i])
-        rel = p - closest[i]
-        lateral = float(rel[0] * tangent[1] - rel[1] * tangent[0])   # right of the tangent
+        lateral = float(gap[i, 0] * tangent[1] - gap[i, 1] * tangent[0])   # right of it
         return float(s), lateral, tangent
 
+    def _project_one(self, j: int, px: float, py: float) -> tuple[float, float, np.ndarray]:
+        """:meth:`project` onto segment ``j`` alone, in Python floats: the same operations
+        in the same order as on arrays (the clip as :data:`.geometry.clip_arrays` does it:
+        ``-0.0`` and NaN kept), so the same bits without a dozen tiny arrays."""
+        cum, ax, ay, ex, ey, ee, root = self._lists
+        t = ((px - ax[j]) * ex[j] + (py - ay[j]) * ey[j]) / ee[j]
+        t = 0.0 if t < 0.0 else 1.0 if t > 1.0 else t
+        gx, gy = px - (ax[j] + t * ex[j]), py - (ay[j] + t * ey[j])
+        tx, ty = ex[j] / root[j], ey[j] / root[j]         # root: math.sqrt(ee), the same
+
+        return cum[j] + t * root[j], gx * ty - gy * tx, np.array([tx, ty])
 
     def _window(self, lo: float, hi: float) -> tuple[int, int]:
         """The segments ``first:stop`` that reach arc length ``lo`` and start by ``hi`` (those
         with ``cum[j + 1] >= lo`` and ``cum[j] <= hi``: arc length never decreases along the
-        route, so they are one run of segments)."""
-        cum = self.cum
-        return (int(np.searchsorted(cum[1:], lo, side="left")),
-                int(np.searchsorted(cum[:-1], hi, side="right")))
+        route, so they are one run of segments). Bisections of a list, as
+        ``np.searchsorted(cum[1:], lo, side="left")`` and ``np.searchsorted(cum[:-1], hi,
+        side="right")`` answer (which sort a NaN last)."""
+        cum = self._lists[0]
+        first = len(cum) - 1 if lo != lo else bisect.bisect_left(cum, lo, 1) - 1
+        return first, bisect.bisect_right(cum, hi, 0, len(cum) - 1)
 
     def near(self, points: np.ndarray, s: float, reach: float, ahead: float) -> np.ndarray:
         """Which ``points [P, 2]`` lie within ``reach`` of the route between arc lengths ``s``
@@ -143,7 +175,7 @@ def projections(routes: Sequence[Route], points: np.ndarray, hints: Sequence[flo
     a, e = np.empty((len(routes), width, 2)), np.empty((len(routes), width, 2))
     ee, root = np.empty((len(routes), width)), np.empty((len(routes), width))
     for i, (route, (first, stop)) in enumerate(zip(routes, spans)):
-        sa, se, see, sroot = (x[first:stop] for x in route._segments)
+        sa, se, see, sroot = (x[first:stop] for x in route._segments[:4])
         m = stop - first
         a[i, :m], e[i, :m], ee[i, :m], root[i, :m] = sa, se, see, sroot
         a[i, m:], e[i, m:], ee[i, m:], root[i, m:] = sa[-1], se[-1], see[-1], sroot[-1]
