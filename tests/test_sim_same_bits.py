@@ -62,6 +62,11 @@ def test_points_at_is_point_at_for_every_arc_length():
                             r.goal)
         s = np.concatenate([rng.uniform(-20, r.length + 20, 12), [0.0, -0.0, r.length, r.cum[1]]])
         assert same(r.points_at(s), [r.point_at(float(u)) for u in s])
+        j = int(rng.integers(0, len(r.cum) - 1))         # all on one segment, ends included
+        for s in (rng.uniform(r.cum[j], r.cum[j + 1], 9), r.cum[j:j + 2], [-0.0, r.cum[1]],
+                  [r.cum[-2], r.length], [r.length], [np.nan], np.zeros(0)):
+            s = np.asarray(s, float)
+            assert same(r.points_at(s), np.reshape([r.point_at(float(u)) for u in s], (-1, 2)))
 
 
 def test_a_routes_own_clearance_along_every_segment_at_once():
@@ -87,6 +92,28 @@ def accounted_cell_by_cell(rmap: knowledge.RobotMap, points: np.ndarray, reach: 
             inside = (r >= 0) & (r < rows_) & (c >= 0) & (c < cols_)
             out[inside] |= cells[r[inside], c[inside]]
     return out
+
+
+def cells_column_by_column(rmap: knowledge.RobotMap, points: np.ndarray):
+    """RobotMap.cells as it was written: each coordinate apart, four comparisons."""
+    g = rmap.grid
+    col = np.floor((points[:, 0] - g.origin[0]) / g.resolution).astype(np.int64)
+    row = np.floor((points[:, 1] - g.origin[1]) / g.resolution).astype(np.int64)
+    rows_, cols_ = rmap.occupied.shape
+    return row, col, (row >= 0) & (row < rows_) & (col >= 0) & (col < cols_)
+
+
+def test_cells_found_for_both_coordinates_at_once_are_those_of_each_apart():
+    rng = np.random.default_rng(13)
+    rmap = knowledge.RobotMap.of(Grid(rng.random((30, 40)) < 0.03, 2.0, (-7.0, 3.0)))
+    edges = np.array([[-7.0, 3.0], [73.0, 63.0], [72.999, 62.999], [-7.0 - 1e-12, 3.0],
+                      [-1e15, 1e15], [0.0, -0.0]])
+    for k in range(60):
+        pts = rng.uniform([-30, -30], [110, 90], (int(rng.integers(0, 40)), 2))
+        if k % 3 == 0:                                     # all inside, or a few edges
+            pts = rng.uniform([-7, 3], [73, 63], (20, 2)) if k % 2 else edges
+        got, want = rmap.cells(pts), cells_column_by_column(rmap, pts)
+        assert all(np.array_equal(a, b) for a, b in zip(got, want))
 
 
 def test_accounted_looks_up_a_dilation_with_the_same_answer():

@@ -703,8 +703,8 @@ class Simulation:
         """What :func:`.knowledge.clear_all` clears the robots' maps with at tick ``s`` (runs
         in lockstep clear theirs together): the maps, where the robots are, their beams and
         readings, and the range."""
-        return (self._maps, s.pose[:, :2], np.stack(self._dirs), s.ranges,
-                self.world.sensors.range)
+        dirs = self._dirs[0][None] if self.n == 1 else np.stack(self._dirs)
+        return self._maps, s.pose[:, :2], dirs, s.ranges, self.world.sensors.range
 
     def aims(self, s: _Sensed, frames: list[perception.Frame]) -> list[perception.Aim]:
         """Each robot's :class:`.perception.Aim` at tick ``s``, its map cleared
@@ -778,10 +778,11 @@ class Simulation:
         valid = measured < max_range * 0.999
         seen = (valid if self._given.knows == "none"
                 else valid & (measured < self._expected[i] - self._threshold))
-        if not seen.any():
+        if not np.count_nonzero(seen):               # (a count is cheaper than .any())
             return False
         before = len(rmap.fresh)
-        rmap.mark(s.pose[i, :2] + measured[seen, None] * dirs[seen], dirs[seen])
+        dirs = dirs[seen]
+        rmap.mark(s.pose[i, :2] + measured[seen, None] * dirs, dirs)
         return len(rmap.fresh) > before
 
     def check(self, s: _Sensed) -> None:

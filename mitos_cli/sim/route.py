@@ -58,11 +58,14 @@ class Route:
         """:meth:`point_at` of every arc length of ``s [K]`` at once, ``[K, 2]``: the same
         clamp, segment and arithmetic, element by element, so the same bits."""
         s = np.asarray(s, float)
+        a, e, _, _, span = self._segments
+        j = self._one_segment(s)
+        if j is not None:                 # no clamp, one segment: the same arithmetic
+            return a[j] + ((s - self.cum[j]) / span[j])[:, None] * e[j]
         length = self.length
         s = np.where(s < 0.0, 0.0, s)                  # max(s, 0.0), then min(s, length),
         s = np.where(length < s, length, s)            # as Python's max and min pick
         i = np.minimum(np.searchsorted(self.cum, s, side="right") - 1, len(self.points) - 2)
-        a, e, _, _, span = self._segments
         if self._spans_positive:          # no segment of zero length to keep as it starts
             return a[i] + ((s - self.cum[i]) / span[i])[:, None] * e[i]
         start = a[i]
@@ -71,6 +74,20 @@ class Route:
         out = start.copy()
         out[ok] = start[ok] + frac[:, None] * e[i[ok]]
         return out
+
+    def _one_segment(self, s: np.ndarray) -> int | None:
+        """The segment every arc length of ``s [K]`` lies on when they all lie on one
+        (within the route, none of zero span), as :meth:`points_at` would pick it for
+        each (the last segment takes the route's end); else ``None``."""
+        if s.ndim != 1 or not len(s) or not self._spans_positive:
+            return None
+        lo, hi = float(np.minimum.reduce(s)), float(np.maximum.reduce(s))
+        cum = self._lists[0]
+        if not (0.0 <= lo and hi <= cum[-1]):         # NaN, or a clamp to do
+            return None
+        last = len(cum) - 2
+        j = min(bisect.bisect_right(cum, lo) - 1, last)
+        return j if j == min(bisect.bisect_right(cum, hi) - 1, last) else None
 
     @functools.cached_property
     def _segments(self) -> tuple[np.ndarray, ...]:
