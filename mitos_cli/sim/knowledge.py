@@ -203,7 +203,10 @@ class RobotMap:
         planned round (its map when it last planned: the given cells, and what it had marked
         by then): an echo from the same object a little further along its side, as the robot
         sees it from another angle, is the object the route went round, not a new one."""
-        cells = self._cell_indices(points)
+        return self.accounted_cells(self.cell_indices(points), reach)
+
+    def accounted_cells(self, cells: np.ndarray, reach: int = 2) -> np.ndarray:
+        """:meth:`accounted` of the points in ``cells [P, 2]`` (:meth:`cell_indices`)."""
         if self.planned is None:
             near = _given_dilated(self.grid, reach)
         else:               # the cells it planned on do not change until it plans again
@@ -211,24 +214,25 @@ class RobotMap:
                     or self._around[1] != reach:
                 self._around = (self.planned, reach, _dilated(self.planned, reach))
             near = self._around[2]
-        cells += reach
+        cells = cells + reach
         inside = _inside(cells, near.shape)
         if inside is None:
             return near[cells[:, 1], cells[:, 0]]
-        out = np.zeros(len(points), dtype=bool)
+        out = np.zeros(len(cells), dtype=bool)
         out[inside] = near[cells[inside, 1], cells[inside, 0]]
         return out
 
     def cells(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The row, column and whether inside the grid of the cell of each of ``points
         [P, 2]``."""
-        cells = self._cell_indices(points)
+        cells = self.cell_indices(points)
         inside = _inside(cells, self.occupied.shape)
         return cells[:, 1], cells[:, 0], np.ones(len(cells), bool) if inside is None else inside
 
-    def _cell_indices(self, points: np.ndarray) -> np.ndarray:
-        """``[P, 2]``: the column and row of the cell of each of ``points [P, 2]`` (both
-        coordinates in one pass: the arithmetic per element is the same)."""
+    def cell_indices(self, points: np.ndarray) -> np.ndarray:
+        """``[P, 2]``: the column and row of the cell of each of ``points [P, 2]``, inside
+        the grid or not (both coordinates in one pass: the arithmetic per element is the
+        same)."""
         g = self.grid
         return np.floor((points - self._origin) / g.resolution).astype(np.int64)
 
@@ -310,9 +314,11 @@ class RobotMap:
 
     def mark(self, hits: np.ndarray, dirs: np.ndarray) -> None:
         """Mark the cells just beyond each hit point (the echo came from there)."""
-        if not len(hits):
-            return
-        cells = self._cell_indices(hits + dirs * (self.grid.resolution / 2))
+        if len(hits):
+            self.mark_cells(self.cell_indices(hits + dirs * (self.grid.resolution / 2)))
+
+    def mark_cells(self, cells: np.ndarray) -> None:
+        """Mark ``cells [P, 2]`` (:meth:`cell_indices`; those outside the grid are left)."""
         inside = _inside(cells, self.occupied.shape)
         if inside is not None:
             cells = cells[inside]
