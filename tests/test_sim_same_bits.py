@@ -459,7 +459,7 @@ def project_on_arrays(r: route.Route, p, s_hint, back=24.0, ahead=120.0):
             float(rel[0] * tangent[1] - rel[1] * tangent[0]), tangent)
 
 
-def test_a_projection_in_floats_onto_one_segment_is_the_one_on_arrays():
+def test_a_projection_in_floats_is_the_one_on_arrays():
     rng = np.random.default_rng(12)
     for k in range(300):
         r = route.Route.of(np.cumsum(rng.normal(0, 40, (int(rng.integers(2, 9)), 2)), axis=0))
@@ -471,3 +471,19 @@ def test_a_projection_in_floats_onto_one_segment_is_the_one_on_arrays():
                 want = project_on_arrays(r, p, hint, back, ahead)
                 assert all(same(x, y) for x, y in zip(got, want))
                 assert type(got[0]) is float and type(got[1]) is float
+
+
+def test_a_projection_in_floats_leaves_near_ties_to_the_arrays():
+    # a corner (a point on its bisector is as near to both sides), a route back on itself
+    # (every point as near to two segments), gaps of zero, of 1e-150 and of 1e200
+    corner = route.Route.of([[0.0, 0.0], [100.0, 0.0], [100.0, 100.0], [0.0, 100.0]])
+    back = route.Route.of([[0.0, 0.0], [50.0, 0.0], [0.0, 0.0]])
+    rng = np.random.default_rng(14)
+    points = [[150.0, -50.0], [60.0, 40.0], [50.0, 50.0], [100.0, 0.0], [30.0, 0.0],
+              [30.0, 1e-150], [1e200, -1e200], [25.0, 3.0], [-0.0, -0.0], *rng.normal(50, 60, (20, 2))]
+    for r in (corner, back):
+        for p in map(np.array, points):
+            for hint in (0.0, 60.0, 100.0, 150.0):
+                got = r.project(p, hint, 200.0, 200.0)
+                want = project_on_arrays(r, p, hint, 200.0, 200.0)
+                assert all(same(x, y) for x, y in zip(got, want))

@@ -123,8 +123,9 @@ class Route:
         first, stop = self._window(s_hint - back, s_hint + ahead)
         if first >= stop:
             first, stop = 0, 1
-        if stop - first == 1:
-            return self._project_one(first, float(p[0]), float(p[1]))
+        got = self._project_floats(first, stop, float(p[0]), float(p[1]))
+        if got is not None:
+            return got
         a, e, ee, root, _ = self._segments
         if stop - first < len(a):
             a, e, ee, root = a[first:stop], e[first:stop], ee[first:stop], root[first:stop]
@@ -137,16 +138,31 @@ class Route:
         lateral = float(gap[i, 0] * tangent[1] - gap[i, 1] * tangent[0])   # right of it
         return float(s), lateral, tangent
 
-    def _project_one(self, j: int, px: float, py: float) -> tuple[float, float, np.ndarray]:
-        """:meth:`project` onto segment ``j`` alone, in Python floats: the same operations
-        in the same order as on arrays (the clip as :data:`.geometry.clip_arrays` does it:
-        ``-0.0`` and NaN kept), so the same bits without a dozen tiny arrays."""
+    def _project_floats(self, first: int, stop: int, px: float,
+                        py: float) -> tuple[float, float, np.ndarray] | None:
+        """:meth:`project` onto segments ``first:stop`` in Python floats (a handful of
+        segments: cheaper than a dozen tiny arrays), or ``None`` where the nearest segment
+        is not plainly nearest. Each segment's ``t`` and gap are the arrays' operations in
+        the same order (the clip as :data:`.geometry.clip_arrays` does it: ``-0.0`` and NaN
+        kept), so the same bits. The arrays pick the segment by ``np.hypot`` of the gaps,
+        which Python does not have bit for bit; squared gaps pick the same one when the
+        nearest is nearer than the others by far more than either's rounding (relative
+        1e-9; no gap between 0 and 1e-140, where squares lose digits)."""
         cum, ax, ay, ex, ey, ee, root = self._lists
-        t = ((px - ax[j]) * ex[j] + (py - ay[j]) * ey[j]) / ee[j]
-        t = 0.0 if t < 0.0 else 1.0 if t > 1.0 else t
-        gx, gy = px - (ax[j] + t * ex[j]), py - (ay[j] + t * ey[j])
-        tx, ty = ex[j] / root[j], ey[j] / root[j]         # root: math.sqrt(ee), the same
-
+        gaps = []
+        for j in range(first, stop):
+            t = ((px - ax[j]) * ex[j] + (py - ay[j]) * ey[j]) / ee[j]
+            t = 0.0 if t < 0.0 else 1.0 if t > 1.0 else t
+            gx, gy = px - (ax[j] + t * ex[j]), py - (ay[j] + t * ey[j])
+            gaps.append((gx * gx + gy * gy, j, t, gx, gy))
+        q, j, t, gx, gy = min(gaps)
+        if not (q == 0.0 and gx == 0.0 and gy == 0.0 or 1e-280 <= q < math.inf):
+            return None                   # NaN, inf or a square in the subnormal range
+        bound = q * (1.0 + 1e-9)
+        for other in gaps:
+            if other[1] != j and not bound < other[0]:    # NaN too
+                return None
+        tx, ty = ex[j] / root[j], ey[j] / root[j]          # root: math.sqrt(ee), the same
         return cum[j] + t * root[j], gx * ty - gy * tx, np.array([tx, ty])
 
     def _window(self, lo: float, hi: float) -> tuple[int, int]:
