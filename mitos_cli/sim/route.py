@@ -186,13 +186,12 @@ class Route:
         first, stop = self._window(s, s + ahead)
         if first >= stop or not len(points):
             return np.full(len(points), np.inf)
-        a, b = self.points[first:stop], self.points[first + 1:stop + 1]
-        e = b - a
-        ee = np.maximum((e * e).sum(axis=1), 1e-12)
+        a, e, ee, _, _ = self._segments
+        a, e, ee = a[first:stop], e[first:stop], ee[first:stop]
         rel = points[:, None] - a                                  # [P, M, 2]
-        t = clip_arrays((rel * e).sum(axis=2) / ee, 0.0, 1.0)
+        t = clip_arrays(np.add.reduce(rel * e, axis=2) / ee, 0.0, 1.0)
         d = rel - t[..., None] * e
-        return np.sqrt((d * d).sum(axis=2).min(axis=1))
+        return np.sqrt(np.minimum.reduce(np.add.reduce(d * d, axis=2), axis=1))
 
 
 def projections(routes: Sequence[Route], points: np.ndarray, hints: Sequence[float],
