@@ -487,3 +487,15 @@ def test_a_projection_in_floats_leaves_near_ties_to_the_arrays():
                 got = r.project(p, hint, 200.0, 200.0)
                 want = project_on_arrays(r, p, hint, 200.0, 200.0)
                 assert all(same(x, y) for x, y in zip(got, want))
+
+
+def test_floor_division_of_floats_is_numpys():
+    # RobotMap._square divides Python floats where it divided NumPy scalars
+    rng = np.random.default_rng(15)
+    xs = [*rng.uniform(-500, 500, 300), *(rng.integers(-50, 50, 100) * 0.5), 0.0, -0.0,
+          1e-300, -1e-300, 5e-324, math.inf, -math.inf, math.nan]
+    with np.errstate(invalid="ignore"):                 # inf // res is NaN both ways
+        for x in xs:
+            for res in (2.0, 0.5, 0.1, 3.0, 1e-3, 7.25):
+                assert same(x // res, np.float64(x) // np.float64(res))
+                assert same(x // res, np.float64(x) // res)

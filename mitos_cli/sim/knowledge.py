@@ -28,6 +28,7 @@ Replanning (:func:`replan`), at most once every ``REPLAN_EVERY`` seconds, as the
 
 from __future__ import annotations
 
+import bisect
 import functools
 import math
 from dataclasses import dataclass, field
@@ -242,10 +243,11 @@ class RobotMap:
         g = self.grid
         res, (ox, oy) = g.resolution, g.origin
         rows, cols = self.occupied.shape
-        c0 = min(max(int((p[0] - reach - ox) // res), 0), cols)
-        r0 = min(max(int((p[1] - reach - oy) // res), 0), rows)
-        c1 = min(max(int((p[0] + reach - ox) // res) + 1, 0), cols)
-        r1 = min(max(int((p[1] + reach - oy) // res) + 1, 0), rows)
+        x, y = float(p[0]), float(p[1])   # NumPy's // on floats is Python's: the same bits
+        c0 = min(max(int((x - reach - ox) // res), 0), cols)
+        r0 = min(max(int((y - reach - oy) // res), 0), rows)
+        c1 = min(max(int((x + reach - ox) // res) + 1, 0), cols)
+        r1 = min(max(int((y + reach - oy) // res) + 1, 0), rows)
         return r0, r1, c0, c1
 
     def near(self, p: np.ndarray, reach: float, given: bool = False) -> np.ndarray:
@@ -288,22 +290,29 @@ class RobotMap:
         if not len(self.marks):
             return None
         r0, r1, c0, c1 = self._square(origin, max_range)
-        # the marks in that window, in the row-major order np.nonzero would give them
-        r, c, centres = self._marks_decoded()
-        where = ((r >= r0) & (r < r1) & (c >= c0) & (c < c1)).nonzero()[0]
+        # the marks in that window, in the row-major order np.nonzero would give them: those
+        # in its rows are one run of the ascending marks, then its columns are picked
+        r, c, centres, flat = self._marks_decoded()
+        cols = self.occupied.shape[1]
+        lo, hi = bisect.bisect_left(flat, r0 * cols), bisect.bisect_left(flat, r1 * cols)
+        if lo == hi:
+            return None
+        run = c[lo:hi]
+        where = ((run >= c0) & (run < c1)).nonzero()[0]
         if not len(where):
             return None
+        where += lo
         return where, r[where], c[where], centres[where] - origin
 
-    def _marks_decoded(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """The rows, columns and centres ``[M, 2]`` of :attr:`marks`, worked out again only
-        once the marks changed (a new array each time)."""
+    def _marks_decoded(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, list[int]]:
+        """The rows, columns and centres ``[M, 2]`` of :attr:`marks` and the marks as a
+        list, worked out again only once the marks changed (a new array each time)."""
         if self._decoded is None or self._decoded[0] is not self.marks:
             r, c = np.divmod(self.marks, self.occupied.shape[1])
             xs, ys = _centre_lines(self.grid)
             centres = np.empty((len(r), 2))
             centres[:, 0], centres[:, 1] = xs[c], ys[r]
-            self._decoded = (self.marks, r, c, centres)
+            self._decoded = (self.marks, r, c, centres, self.marks.tolist())
         return self._decoded[1:]
 
     def _free(self, where: np.ndarray, r: np.ndarray, c: np.ndarray) -> None:
