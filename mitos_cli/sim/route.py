@@ -711,14 +711,17 @@ def _grid_astar(allowed: memoryview, costs: memoryview, offsets: list[int], C: i
     """:func:`_astar` over the node grid with the steps of :func:`_steps` (the same pushes in
     the same order, so the same path), without a Python call per neighbour."""
     size = len(costs) // len(offsets)
-    gr, gc = divmod(goal, C)
+    target = divmod(goal, C)
     frontier = [(0.0, 0, start)]
     came = {start: -1}
     cost = {start: 0.0}
+    known = cost.get
     tie = 0
     moves = [(m * size, off) for m, off in enumerate(offsets)]
+    # the loop's names bound locally: the loop runs thousands of times a search
+    pop, push, dist, inf = heapq.heappop, heapq.heappush, math.dist, math.inf
     while frontier:
-        _, _, node = heapq.heappop(frontier)
+        node = pop(frontier)[2]
         if node == goal:
             return _path(came, node)
         here = cost[node]
@@ -726,12 +729,11 @@ def _grid_astar(allowed: memoryview, costs: memoryview, offsets: list[int], C: i
             if allowed[base + node]:
                 nxt = node + off
                 c = here + costs[base + node]
-                if c < cost.get(nxt, math.inf):
+                if c < known(nxt, inf):
                     cost[nxt] = c
                     came[nxt] = node
                     tie += 1
-                    heapq.heappush(frontier, (c + math.dist((nxt // C, nxt % C), (gr, gc)),
-                                              tie, nxt))
+                    push(frontier, (c + dist((nxt // C, nxt % C), target), tie, nxt))
     return None
 
 
