@@ -163,7 +163,7 @@ def _inside(cells: np.ndarray, shape: tuple[int, int]) -> np.ndarray | None:
     (rows, columns); ``None`` when all do. Seen unsigned, a negative index is a huge one,
     so one comparison tests both ends."""
     ok = cells.view(np.uint64) < np.array(shape[::-1], np.uint64)
-    return None if np.count_nonzero(ok) == ok.size else ok.all(axis=1)
+    return None if np.count_nonzero(ok) == ok.size else np.logical_and.reduce(ok, axis=1)
 
 
 @functools.lru_cache(maxsize=4)

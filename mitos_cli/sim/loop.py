@@ -785,7 +785,7 @@ class Simulation:
         it hits, with no map): whether anything new was marked."""
         sen = self.world.sensors
         max_range = sen.range
-        measured, dirs = s.ranges[i], self._dirs[i]
+        measured = s.ranges[i]
         rmap = self._maps[i]
         valid = measured < max_range * 0.999
         seen = (valid if self._given.knows == "none"

@@ -83,7 +83,7 @@ class Route:
             return None
         lo, hi = float(np.minimum.reduce(s)), float(np.maximum.reduce(s))
         cum = self._lists[0]
-        if not (0.0 <= lo and hi <= cum[-1]):         # NaN, or a clamp to do
+        if not (lo >= 0.0 and hi <= cum[-1]):         # NaN, or a clamp to do
             return None
         last = len(cum) - 2
         j = min(bisect.bisect_right(cum, lo) - 1, last)
