@@ -62,8 +62,9 @@ def test_points_at_is_point_at_for_every_arc_length():
                             r.goal)
         s = np.concatenate([rng.uniform(-20, r.length + 20, 12), [0.0, -0.0, r.length, r.cum[1]]])
         assert same(r.points_at(s), [r.point_at(float(u)) for u in s])
-        j = int(rng.integers(0, len(r.cum) - 1))         # all on one segment, ends included
+        j = int(rng.integers(0, len(r.cum) - 1))   # on one segment or more, ends included
         for s in (rng.uniform(r.cum[j], r.cum[j + 1], 9), r.cum[j:j + 2], [-0.0, r.cum[1]],
+                  rng.uniform(0.0, r.length, 9), r.cum, rng.uniform(0, 20) + np.arange(0, 97, 12.0),
                   [r.cum[-2], r.length], [r.length], [np.nan], np.zeros(0)):
             s = np.asarray(s, float)
             assert same(r.points_at(s), np.reshape([r.point_at(float(u)) for u in s], (-1, 2)))

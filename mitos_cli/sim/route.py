@@ -56,38 +56,37 @@ class Route:
 
     def points_at(self, s: np.ndarray) -> np.ndarray:
         """:meth:`point_at` of every arc length of ``s [K]`` at once, ``[K, 2]``: the same
-        clamp, segment and arithmetic, element by element, so the same bits."""
+        clamp, segment and arithmetic, element by element, so the same bits. Arc lengths
+        all within the route, none of zero span (the lookahead's, mostly) need no clamp and
+        no mask; those on one segment need no search either."""
         s = np.asarray(s, float)
+        if s.ndim != 1 or not len(s) or not self._spans_positive:
+            return self._points_at_masked(s)
+        cum = self._lists[0]
+        lo, hi = float(np.minimum.reduce(s)), float(np.maximum.reduce(s))
+        if not (lo >= 0.0 and hi <= cum[-1]):         # NaN, or a clamp to do
+            return self._points_at_masked(s)
         a, e, _, _, span = self._segments
-        j = self._one_segment(s)
-        if j is not None:                 # no clamp, one segment: the same arithmetic
-            return a[j] + ((s - self.cum[j]) / span[j])[:, None] * e[j]
+        last = len(cum) - 2
+        j = min(bisect.bisect_right(cum, lo) - 1, last)
+        if j != min(bisect.bisect_right(cum, hi) - 1, last):      # more than one segment
+            j = np.minimum(np.searchsorted(self.cum, s, side="right") - 1, last)
+        return a[j] + ((s - self.cum[j]) / span[j])[:, None] * e[j]
+
+    def _points_at_masked(self, s: np.ndarray) -> np.ndarray:
+        """:meth:`points_at` clamping ``s`` to the route and keeping a point of a segment of
+        zero span where it starts, as :meth:`point_at` does."""
         length = self.length
         s = np.where(s < 0.0, 0.0, s)                  # max(s, 0.0), then min(s, length),
         s = np.where(length < s, length, s)            # as Python's max and min pick
         i = np.minimum(np.searchsorted(self.cum, s, side="right") - 1, len(self.points) - 2)
-        if self._spans_positive:          # no segment of zero length to keep as it starts
-            return a[i] + ((s - self.cum[i]) / span[i])[:, None] * e[i]
+        a, e, _, _, span = self._segments
         start = a[i]
         ok = span[i] > 0
         frac = (s[ok] - self.cum[i[ok]]) / span[i[ok]]
         out = start.copy()
         out[ok] = start[ok] + frac[:, None] * e[i[ok]]
         return out
-
-    def _one_segment(self, s: np.ndarray) -> int | None:
-        """The segment every arc length of ``s [K]`` lies on when they all lie on one
-        (within the route, none of zero span), as :meth:`points_at` would pick it for
-        each (the last segment takes the route's end); else ``None``."""
-        if s.ndim != 1 or not len(s) or not self._spans_positive:
-            return None
-        lo, hi = float(np.minimum.reduce(s)), float(np.maximum.reduce(s))
-        cum = self._lists[0]
-        if not (lo >= 0.0 and hi <= cum[-1]):         # NaN, or a clamp to do
-            return None
-        last = len(cum) - 2
-        j = min(bisect.bisect_right(cum, lo) - 1, last)
-        return j if j == min(bisect.bisect_right(cum, hi) - 1, last) else None
 
     @functools.cached_property
     def _segments(self) -> tuple[np.ndarray, ...]:
