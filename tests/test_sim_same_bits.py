@@ -109,6 +109,12 @@ def test_points_at_is_point_at_for_every_arc_length():
                             r.goal)
         s = np.concatenate([rng.uniform(-20, r.length + 20, 12), [0.0, -0.0, r.length, r.cum[1]]])
         assert same(r.points_at(s), [r.point_at(float(u)) for u in s])
+        j = int(rng.integers(0, len(r.cum) - 1))   # on one segment or more, ends included
+        for s in (rng.uniform(r.cum[j], r.cum[j + 1], 9), r.cum[j:j + 2], [-0.0, r.cum[1]],
+                  rng.uniform(0.0, r.length, 9), r.cum, rng.uniform(0, 20) + np.arange(0, 97, 12.0),
+                  [r.cum[-2], r.length], [r.length], [np.nan], np.zeros(0)):
+            s = np.asarray(s, float)
+            assert same(r.points_at(s), np.reshape([r.point_at(float(u)) for u in s], (-1, 2)))
 
 
 def test_a_routes_own_clearance_along_every_segment_at_once():
@@ -134,6 +140,28 @@ def accounted_cell_by_cell(rmap: knowledge.RobotMap, points: np.ndarray, reach: 
             inside = (r >= 0) & (r < rows_) & (c >= 0) & (c < cols_)
             out[inside] |= cells[r[inside], c[inside]]
     return out
+
+
+def cells_column_by_column(rmap: knowledge.RobotMap, points: np.ndarray):
+    """RobotMap.cells as it was written: each coordinate apart, four comparisons."""
+    g = rmap.grid
+    col = np.floor((points[:, 0] - g.origin[0]) / g.resolution).astype(np.int64)
+    row = np.floor((points[:, 1] - g.origin[1]) / g.resolution).astype(np.int64)
+    rows_, cols_ = rmap.occupied.shape
+    return row, col, (row >= 0) & (row < rows_) & (col >= 0) & (col < cols_)
+
+
+def test_cells_found_for_both_coordinates_at_once_are_those_of_each_apart():
+    rng = np.random.default_rng(13)
+    rmap = knowledge.RobotMap.of(Grid(rng.random((30, 40)) < 0.03, 2.0, (-7.0, 3.0)))
+    edges = np.array([[-7.0, 3.0], [73.0, 63.0], [72.999, 62.999], [-7.0 - 1e-12, 3.0],
+                      [-1e15, 1e15], [0.0, -0.0]])
+    for k in range(60):
+        pts = rng.uniform([-30, -30], [110, 90], (int(rng.integers(0, 40)), 2))
+        if k % 3 == 0:                                     # all inside, or a few edges
+            pts = rng.uniform([-7, 3], [73, 63], (20, 2)) if k % 2 else edges
+        got, want = rmap.cells(pts), cells_column_by_column(rmap, pts)
+        assert all(np.array_equal(a, b) for a, b in zip(got, want))
 
 
 def test_accounted_looks_up_a_dilation_with_the_same_answer():
@@ -444,3 +472,78 @@ def test_robots_placed_on_their_routes_together_get_the_bits_they_get_alone():
         alone = perception.frame(r, p, hint)
         assert same(alone.s, f.s) and same(alone.e, f.e)
         assert same(alone.t, f.t) and same(alone.n, f.n)
+
+
+def window_by_searchsorted(r: route.Route, lo: float, hi: float) -> tuple[int, int]:
+    return (int(np.searchsorted(r.cum[1:], lo, side="left")),
+            int(np.searchsorted(r.cum[:-1], hi, side="right")))
+
+
+def test_a_routes_window_found_by_bisection_is_the_one_searchsorted_finds():
+    rng = np.random.default_rng(11)
+    for _ in range(200):
+        r = route.Route.of(np.cumsum(rng.normal(0, 40, (int(rng.integers(2, 12)), 2)), axis=0))
+        ends = [*r.cum, -0.0, math.inf, -math.inf, math.nan, *rng.uniform(-50, r.length + 50, 6)]
+        for lo in ends:
+            for hi in ends[::3]:
+                assert r._window(lo, hi) == window_by_searchsorted(r, lo, hi)
+
+
+def project_on_arrays(r: route.Route, p, s_hint, back=24.0, ahead=120.0):
+    """:meth:`.route.Route.project` as it was written on arrays for every window."""
+    a, e = r.points[:-1], r.points[1:] - r.points[:-1]
+    ee = np.maximum((e * e).sum(axis=1), 1e-12)
+    root = np.sqrt(ee)
+    first, stop = window_by_searchsorted(r, s_hint - back, s_hint + ahead)
+    if first >= stop:
+        first, stop = 0, 1
+    a, e, ee, root = a[first:stop], e[first:stop], ee[first:stop], root[first:stop]
+    t = geometry.clip_arrays(((p - a) * e).sum(axis=1) / ee, 0.0, 1.0)
+    closest = a + t[:, None] * e
+    i = int(np.hypot(*(p - closest).T).argmin())
+    tangent = e[i] / math.sqrt(ee[i])
+    rel = p - closest[i]
+    return (float(r.cum[first + i] + t[i] * root[i]),
+            float(rel[0] * tangent[1] - rel[1] * tangent[0]), tangent)
+
+
+def test_a_projection_in_floats_is_the_one_on_arrays():
+    rng = np.random.default_rng(12)
+    for k in range(300):
+        r = route.Route.of(np.cumsum(rng.normal(0, 40, (int(rng.integers(2, 9)), 2)), axis=0))
+        ends = [float(rng.choice(r.points[:, 0])), float(rng.choice(r.points[:, 1]))]
+        p = np.array(ends if k % 5 == 0 else rng.normal(0, 100, 2))   # on a corner, or anywhere
+        for hint in (*r.cum, *rng.uniform(-200, r.length + 200, 4)):
+            for back, ahead in ((24.0, 120.0), (0.0, 1.0), (0.0, 0.0), (5.0, 30.0)):
+                got = r.project(p, hint, back, ahead)
+                want = project_on_arrays(r, p, hint, back, ahead)
+                assert all(same(x, y) for x, y in zip(got, want))
+                assert type(got[0]) is float and type(got[1]) is float
+
+
+def test_a_projection_in_floats_leaves_near_ties_to_the_arrays():
+    # a corner (a point on its bisector is as near to both sides), a route back on itself
+    # (every point as near to two segments), gaps of zero, of 1e-150 and of 1e200
+    corner = route.Route.of([[0.0, 0.0], [100.0, 0.0], [100.0, 100.0], [0.0, 100.0]])
+    back = route.Route.of([[0.0, 0.0], [50.0, 0.0], [0.0, 0.0]])
+    rng = np.random.default_rng(14)
+    points = [[150.0, -50.0], [60.0, 40.0], [50.0, 50.0], [100.0, 0.0], [30.0, 0.0],
+              [30.0, 1e-150], [1e200, -1e200], [25.0, 3.0], [-0.0, -0.0], *rng.normal(50, 60, (20, 2))]
+    for r in (corner, back):
+        for p in map(np.array, points):
+            for hint in (0.0, 60.0, 100.0, 150.0):
+                got = r.project(p, hint, 200.0, 200.0)
+                want = project_on_arrays(r, p, hint, 200.0, 200.0)
+                assert all(same(x, y) for x, y in zip(got, want))
+
+
+def test_floor_division_of_floats_is_numpys():
+    # RobotMap._square divides Python floats where it divided NumPy scalars
+    rng = np.random.default_rng(15)
+    xs = [*rng.uniform(-500, 500, 300), *(rng.integers(-50, 50, 100) * 0.5), 0.0, -0.0,
+          1e-300, -1e-300, 5e-324, math.inf, -math.inf, math.nan]
+    with np.errstate(invalid="ignore"):                 # inf // res is NaN both ways
+        for x in xs:
+            for res in (2.0, 0.5, 0.1, 3.0, 1e-3, 7.25):
+                assert same(x // res, np.float64(x) // np.float64(res))
+                assert same(x // res, np.float64(x) // res)

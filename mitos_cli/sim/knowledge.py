@@ -28,6 +28,7 @@ Replanning (:func:`replan`), at most once every ``REPLAN_EVERY`` seconds, as the
 
 from __future__ import annotations
 
+import bisect
 import functools
 import math
 from dataclasses import dataclass, field
@@ -157,6 +158,14 @@ def _centre_lines(grid: Grid) -> tuple[np.ndarray, np.ndarray]:
     return xs, ys
 
 
+def _inside(cells: np.ndarray, shape: tuple[int, int]) -> np.ndarray | None:
+    """Which cells (columns and rows ``[P, 2]``, C-contiguous) lie inside a grid of ``shape``
+    (rows, columns); ``None`` when all do. Seen unsigned, a negative index is a huge one,
+    so one comparison tests both ends."""
+    ok = cells.view(np.uint64) < np.array(shape[::-1], np.uint64)
+    return None if np.count_nonzero(ok) == ok.size else np.logical_and.reduce(ok, axis=1)
+
+
 @functools.lru_cache(maxsize=4)
 def _given_dilated(grid: Grid, reach: int) -> np.ndarray:
     """:func:`_dilated` of a given grid's cells, shared by every robot and run that plans on
@@ -180,6 +189,11 @@ class RobotMap:
     prepared: Prepared = field(default_factory=Prepared, repr=False)   # for its next replan
     _changes: int = field(default=0, repr=False)     # marks made and cleared so far
     _last_near: tuple | None = field(default=None, repr=False)     # see near()
+    _decoded: tuple | None = field(default=None, repr=False)   # see _marks_decoded()
+    _origin: np.ndarray = field(init=False, repr=False)        # the grid's origin, [2]
+
+    def __post_init__(self) -> None:
+        self._origin = np.array(self.grid.origin, float)
 
     @classmethod
     def of(cls, grid: Grid) -> RobotMap:
@@ -190,7 +204,10 @@ class RobotMap:
         planned round (its map when it last planned: the given cells, and what it had marked
         by then): an echo from the same object a little further along its side, as the robot
         sees it from another angle, is the object the route went round, not a new one."""
-        row, col, _ = self.cells(points)
+        return self.accounted_cells(self.cell_indices(points), reach)
+
+    def accounted_cells(self, cells: np.ndarray, reach: int = 2) -> np.ndarray:
+        """:meth:`accounted` of the points in ``cells [P, 2]`` (:meth:`cell_indices`)."""
         if self.planned is None:
             near = _given_dilated(self.grid, reach)
         else:               # the cells it planned on do not change until it plans again
@@ -198,19 +215,27 @@ class RobotMap:
                     or self._around[1] != reach:
                 self._around = (self.planned, reach, _dilated(self.planned, reach))
             near = self._around[2]
-        r, c = row + reach, col + reach
-        inside = (r >= 0) & (r < near.shape[0]) & (c >= 0) & (c < near.shape[1])
-        out = np.zeros(len(points), dtype=bool)
-        out[inside] = near[r[inside], c[inside]]
+        cells = cells + reach
+        inside = _inside(cells, near.shape)
+        if inside is None:
+            return near[cells[:, 1], cells[:, 0]]
+        out = np.zeros(len(cells), dtype=bool)
+        out[inside] = near[cells[inside, 1], cells[inside, 0]]
         return out
 
     def cells(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The row, column and whether inside the grid of the cell of each of ``points
+        [P, 2]``."""
+        cells = self.cell_indices(points)
+        inside = _inside(cells, self.occupied.shape)
+        return cells[:, 1], cells[:, 0], np.ones(len(cells), bool) if inside is None else inside
+
+    def cell_indices(self, points: np.ndarray) -> np.ndarray:
+        """``[P, 2]``: the column and row of the cell of each of ``points [P, 2]``, inside
+        the grid or not (both coordinates in one pass: the arithmetic per element is the
+        same)."""
         g = self.grid
-        col = np.floor((points[:, 0] - g.origin[0]) / g.resolution).astype(np.int64)
-        row = np.floor((points[:, 1] - g.origin[1]) / g.resolution).astype(np.int64)
-        rows, cols = self.occupied.shape
-        inside = (row >= 0) & (row < rows) & (col >= 0) & (col < cols)
-        return row, col, inside
+        return np.floor((points - self._origin) / g.resolution).astype(np.int64)
 
     def _square(self, p: np.ndarray, reach: float) -> tuple[int, int, int, int]:
         """Rows ``r0:r1`` and columns ``c0:c1`` of the cells in the square of half side
@@ -218,10 +243,11 @@ class RobotMap:
         g = self.grid
         res, (ox, oy) = g.resolution, g.origin
         rows, cols = self.occupied.shape
-        c0 = min(max(int((p[0] - reach - ox) // res), 0), cols)
-        r0 = min(max(int((p[1] - reach - oy) // res), 0), rows)
-        c1 = min(max(int((p[0] + reach - ox) // res) + 1, 0), cols)
-        r1 = min(max(int((p[1] + reach - oy) // res) + 1, 0), rows)
+        x, y = float(p[0]), float(p[1])   # NumPy's // on floats is Python's: the same bits
+        c0 = min(max(int((x - reach - ox) // res), 0), cols)
+        r0 = min(max(int((y - reach - oy) // res), 0), rows)
+        c1 = min(max(int((x + reach - ox) // res) + 1, 0), cols)
+        r1 = min(max(int((y + reach - oy) // res) + 1, 0), rows)
         return r0, r1, c0, c1
 
     def near(self, p: np.ndarray, reach: float, given: bool = False) -> np.ndarray:
@@ -235,6 +261,8 @@ class RobotMap:
         if last is not None and last[0] == (self._changes, given) and last[1] <= r0 \
                 and r1 <= last[2] and last[3] <= c0 and c1 <= last[4]:
             r, c, centres = last[5:]
+            if (r0, r1, c0, c1) == last[1:5]:           # the same square: all of them
+                return centres
             return centres[(r >= r0) & (r < r1) & (c >= c0) & (c < c1)]
         cells = self.grid.occupied if given else self.occupied
         r, c = cells[r0:r1, c0:c1].nonzero()
@@ -262,17 +290,30 @@ class RobotMap:
         if not len(self.marks):
             return None
         r0, r1, c0, c1 = self._square(origin, max_range)
-        # the marks in that window, in the row-major order np.nonzero would give them
-        r, c = np.divmod(self.marks, self.occupied.shape[1])
-        window = (r >= r0) & (r < r1) & (c >= c0) & (c < c1)
-        if not window.any():
+        # the marks in that window, in the row-major order np.nonzero would give them: those
+        # in its rows are one run of the ascending marks, then its columns are picked
+        r, c, centres, flat = self._marks_decoded()
+        cols = self.occupied.shape[1]
+        lo, hi = bisect.bisect_left(flat, r0 * cols), bisect.bisect_left(flat, r1 * cols)
+        if lo == hi:
             return None
-        r, c = r[window], c[window]
-        xs, ys = _centre_lines(self.grid)
-        rel = np.empty((len(r), 2))
-        rel[:, 0], rel[:, 1] = xs[c], ys[r]
-        rel -= origin
-        return np.flatnonzero(window), r, c, rel
+        run = c[lo:hi]
+        where = ((run >= c0) & (run < c1)).nonzero()[0]
+        if not len(where):
+            return None
+        where += lo
+        return where, r[where], c[where], centres[where] - origin
+
+    def _marks_decoded(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, list[int]]:
+        """The rows, columns and centres ``[M, 2]`` of :attr:`marks` and the marks as a
+        list, worked out again only once the marks changed (a new array each time)."""
+        if self._decoded is None or self._decoded[0] is not self.marks:
+            r, c = np.divmod(self.marks, self.occupied.shape[1])
+            xs, ys = _centre_lines(self.grid)
+            centres = np.empty((len(r), 2))
+            centres[:, 0], centres[:, 1] = xs[c], ys[r]
+            self._decoded = (self.marks, r, c, centres, self.marks.tolist())
+        return self._decoded[1:]
 
     def _free(self, where: np.ndarray, r: np.ndarray, c: np.ndarray) -> None:
         """Unmark the marks at places ``where`` of :attr:`marks` (cells ``r``, ``c``)."""
@@ -282,12 +323,18 @@ class RobotMap:
 
     def mark(self, hits: np.ndarray, dirs: np.ndarray) -> None:
         """Mark the cells just beyond each hit point (the echo came from there)."""
-        if not len(hits):
-            return
-        row, col, inside = self.cells(hits + dirs * (self.grid.resolution / 2))
-        row, col = row[inside], col[inside]
-        new = ~self.occupied[row, col]
-        if new.any():
+        if len(hits):
+            self.mark_cells(self.cell_indices(hits + dirs * (self.grid.resolution / 2)))
+
+    def mark_cells(self, cells: np.ndarray) -> None:
+        """Mark ``cells [P, 2]`` (:meth:`cell_indices`; those outside the grid are left)."""
+        inside = _inside(cells, self.occupied.shape)
+        if inside is not None:
+            cells = cells[inside]
+        row, col = cells[:, 1], cells[:, 0]
+        known = self.occupied[row, col]
+        if np.count_nonzero(known) < len(known):      # (a count is cheaper than .all())
+            new = ~known
             self._changes += 1
             self.occupied[row[new], col[new]] = True
             self.marks = np.union1d(self.marks, row[new] * self.occupied.shape[1] + col[new])
@@ -328,7 +375,7 @@ def clear_all(maps: list[RobotMap], origins: np.ndarray, dirs: np.ndarray,
         along = rx * dx + ry * dy
         through = ((along > 0) & (along < np.minimum(measured[i], max_range) - res)
                    & (np.abs(rx * dy - ry * dx) < res / 2)).any(axis=1)
-        if through.any():
+        if np.count_nonzero(through):
             m._free(where[through], r[through], c[through])
         return
     rel = np.full((len(seen), max(len(got[3]) for _, _, got in seen), 2), 1e12)
@@ -345,7 +392,7 @@ def clear_all(maps: list[RobotMap], origins: np.ndarray, dirs: np.ndarray,
     through = ((along > 0) & (along < reach) & (across < cell / 2)).any(axis=2)
     for j, (m, _, (where, r, c, pts)) in enumerate(seen):
         mine = through[j, :len(pts)]
-        if mine.any():
+        if np.count_nonzero(mine):
             m._free(where[mine], r[mine], c[mine])
 
 
@@ -361,11 +408,11 @@ def expected_ranges(g: Given, rmap: RobotMap | None, origin: np.ndarray, dirs: n
         lo = np.minimum(g.sides[:, :2], g.sides[:, 2:])
         hi = np.maximum(g.sides[:, :2], g.sides[:, 2:])
         near = ((lo <= origin + max_range) & (hi >= origin - max_range)).all(axis=1)
-        if near.any():
+        if np.count_nonzero(near):
             out = np.minimum(out, ray_segments(origin, dirs, g.sides[near], max_range))
     if len(g.centres):
         near = np.hypot(*(g.centres - origin).T) <= max_range + g.radii
-        if near.any():
+        if np.count_nonzero(near):
             out = np.minimum(out, ray_circles(origin, dirs, g.centres[near], g.radii[near],
                                               max_range))
     return out

@@ -405,6 +405,7 @@ class Simulation:
         self._k = 0
         self._done = self.steps <= 0
         self._hit = np.zeros(n, dtype=bool)
+        self._beyond_at: tuple = (None, [])             # see _beyond()
         self._observed: _Sensed | None = None
         self._deciding: _Sensed | None = None
         self.record: list[Tick] = []
@@ -704,8 +705,8 @@ class Simulation:
         """What :func:`.knowledge.clear_all` clears the robots' maps with at tick ``s`` (runs
         in lockstep clear theirs together): the maps, where the robots are, their beams and
         readings, and the range."""
-        return (self._maps, s.pose[:, :2], np.stack(self._dirs), s.ranges,
-                self.world.sensors.range)
+        dirs = self._dirs[0][None] if self.n == 1 else np.stack(self._dirs)
+        return self._maps, s.pose[:, :2], dirs, s.ranges, self.world.sensors.range
 
     def aims(self, s: _Sensed, frames: list[perception.Frame]) -> list[perception.Aim]:
         """Each robot's :class:`.perception.Aim` at tick ``s``, its map cleared
@@ -765,24 +766,35 @@ class Simulation:
         it keeps, and which of its readings hit cells the route was planned round."""
         if self.world.replan != "clearance":
             return None
-        rmap, dirs = self._maps[i], self._dirs[i]
-        hits = s.pose[i, :2] + s.ranges[i, :, None] * dirs + dirs * (rmap.grid.resolution / 2)
-        return least, rmap.accounted(hits)
+        return least, self._maps[i].accounted_cells(self._beyond(i, s))
+
+    def _beyond(self, i: int, s: _Sensed) -> np.ndarray:
+        """The cells ``[B, 2]`` (:meth:`.knowledge.RobotMap.cell_indices`) just beyond robot
+        ``i``'s readings at tick ``s``, where their echoes came from: what :meth:`_learn`
+        marks and :meth:`_kept` looks up, worked out once a tick for both."""
+        if self._beyond_at[0] is not s:
+            self._beyond_at = (s, [None] * self.n)
+        cells = self._beyond_at[1]
+        if cells[i] is None:
+            rmap, dirs = self._maps[i], self._dirs[i]
+            cells[i] = rmap.cell_indices(s.pose[i, :2] + s.ranges[i, :, None] * dirs
+                                         + dirs * (rmap.grid.resolution / 2))
+        return cells[i]
 
     def _learn(self, i: int, s: _Sensed) -> bool:
         """Mark on robot ``i``'s map what its readings show and its map does not (everything
         it hits, with no map): whether anything new was marked."""
         sen = self.world.sensors
         max_range = sen.range
-        measured, dirs = s.ranges[i], self._dirs[i]
+        measured = s.ranges[i]
         rmap = self._maps[i]
         valid = measured < max_range * 0.999
         seen = (valid if self._given.knows == "none"
                 else valid & (measured < self._expected[i] - self._threshold))
-        if not seen.any():
+        if not np.count_nonzero(seen):               # (a count is cheaper than .any())
             return False
         before = len(rmap.fresh)
-        rmap.mark(s.pose[i, :2] + measured[seen, None] * dirs[seen], dirs[seen])
+        rmap.mark_cells(self._beyond(i, s)[seen])    # = rmap.mark(hits[seen], dirs[seen])
         return len(rmap.fresh) > before
 
     def check(self, s: _Sensed) -> None:

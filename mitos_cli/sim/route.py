@@ -7,6 +7,7 @@ marriage of the fuzzy planner with roadmaps and cell decomposition).
 
 from __future__ import annotations
 
+import bisect
 import functools
 import heapq
 import math
@@ -55,28 +56,61 @@ class Route:
 
     def points_at(self, s: np.ndarray) -> np.ndarray:
         """:meth:`point_at` of every arc length of ``s [K]`` at once, ``[K, 2]``: the same
-        clamp, segment and arithmetic, element by element, so the same bits."""
+        clamp, segment and arithmetic, element by element, so the same bits. Arc lengths
+        all within the route, none of zero span (the lookahead's, mostly) need no clamp and
+        no mask; those on one segment need no search either."""
         s = np.asarray(s, float)
+        if s.ndim != 1 or not len(s) or not self._spans_positive:
+            return self._points_at_masked(s)
+        cum = self._lists[0]
+        lo, hi = float(np.minimum.reduce(s)), float(np.maximum.reduce(s))
+        if not (lo >= 0.0 and hi <= cum[-1]):         # NaN, or a clamp to do
+            return self._points_at_masked(s)
+        a, e, _, _, span = self._segments
+        last = len(cum) - 2
+        j = min(bisect.bisect_right(cum, lo) - 1, last)
+        if j != min(bisect.bisect_right(cum, hi) - 1, last):      # more than one segment
+            j = np.minimum(np.searchsorted(self.cum, s, side="right") - 1, last)
+        return a[j] + ((s - self.cum[j]) / span[j])[:, None] * e[j]
+
+    def _points_at_masked(self, s: np.ndarray) -> np.ndarray:
+        """:meth:`points_at` clamping ``s`` to the route and keeping a point of a segment of
+        zero span where it starts, as :meth:`point_at` does."""
         length = self.length
         s = np.where(s < 0.0, 0.0, s)                  # max(s, 0.0), then min(s, length),
         s = np.where(length < s, length, s)            # as Python's max and min pick
         i = np.minimum(np.searchsorted(self.cum, s, side="right") - 1, len(self.points) - 2)
-        start = self.points[i]
-        span = self.cum[i + 1] - self.cum[i]
-        ok = span > 0
-        frac = (s[ok] - self.cum[i[ok]]) / span[ok]
+        a, e, _, _, span = self._segments
+        start = a[i]
+        ok = span[i] > 0
+        frac = (s[ok] - self.cum[i[ok]]) / span[i[ok]]
         out = start.copy()
-        out[ok] = start[ok] + frac[:, None] * (self.points[i[ok] + 1] - start[ok])
+        out[ok] = start[ok] + frac[:, None] * e[i[ok]]
         return out
 
     @functools.cached_property
     def _segments(self) -> tuple[np.ndarray, ...]:
-        """Each segment's start ``a``, vector ``e``, squared length (at least 1e-12) and
-        length: the route does not change, so :meth:`project` does not recompute them."""
+        """Each segment's start ``a``, vector ``e``, squared length (at least 1e-12), length
+        and span of arc length: the route does not change, so :meth:`project` and
+        :meth:`points_at` do not recompute them."""
         a = self.points[:-1]
         e = self.points[1:] - a
         ee = np.maximum((e * e).sum(axis=1), 1e-12)
-        return a, e, ee, np.sqrt(ee)
+        return a, e, ee, np.sqrt(ee), self.cum[1:] - self.cum[:-1]
+
+    @functools.cached_property
+    def _spans_positive(self) -> bool:
+        """Every segment spans some arc length (:meth:`of` drops repeated points)."""
+        return bool((self._segments[4] > 0).all())
+
+    @functools.cached_property
+    def _lists(self) -> tuple[list[float], ...]:
+        """The arc lengths and each segment's start, vector, squared length and length as
+        Python floats (the same values), for the scalar arithmetic of a window of one
+        segment and the bisections of :meth:`_window`."""
+        a, e, ee, root, _ = self._segments
+        return (self.cum.tolist(), a[:, 0].tolist(), a[:, 1].tolist(), e[:, 0].tolist(),
+                e[:, 1].tolist(), ee.tolist(), root.tolist())
 
     def project(self, p: np.ndarray, s_hint: float, back: float = 24.0,
                 ahead: float = 120.0) -> tuple[float, float, np.ndarray]:
@@ -85,30 +119,60 @@ class Route:
 
         Only the segments in that window are measured (elementwise, so each gets the bits it
         would get among all); with none in it, the first segment answers."""
-        a, e, ee, root = self._segments
         first, stop = self._window(s_hint - back, s_hint + ahead)
         if first >= stop:
             first, stop = 0, 1
+        got = self._project_floats(first, stop, float(p[0]), float(p[1]))
+        if got is not None:
+            return got
+        a, e, ee, root, _ = self._segments
         if stop - first < len(a):
             a, e, ee, root = a[first:stop], e[first:stop], ee[first:stop], root[first:stop]
-        t = clip_arrays(((p - a) * e).sum(axis=1) / ee, 0.0, 1.0)
+        t = clip_arrays(np.add.reduce((p - a) * e, axis=1) / ee, 0.0, 1.0)
         closest = a + t[:, None] * e
-        d = np.hypot(*(p - closest).T)
-        i = int(d.argmin())
+        gap = p - closest
+        i = int(np.hypot(gap[:, 0], gap[:, 1]).argmin())
         s = self.cum[first + i] + t[i] * root[i]
         tangent = e[i] / math.sqrt(ee[i])
-        rel = p - closest[i]
-        lateral = float(rel[0] * tangent[1] - rel[1] * tangent[0])   # right of the tangent
+        lateral = float(gap[i, 0] * tangent[1] - gap[i, 1] * tangent[0])   # right of it
         return float(s), lateral, tangent
 
+    def _project_floats(self, first: int, stop: int, px: float,
+                        py: float) -> tuple[float, float, np.ndarray] | None:
+        """:meth:`project` onto segments ``first:stop`` in Python floats (a handful of
+        segments: cheaper than a dozen tiny arrays), or ``None`` where the nearest segment
+        is not plainly nearest. Each segment's ``t`` and gap are the arrays' operations in
+        the same order (the clip as :data:`.geometry.clip_arrays` does it: ``-0.0`` and NaN
+        kept), so the same bits. The arrays pick the segment by ``np.hypot`` of the gaps,
+        which Python does not have bit for bit; squared gaps pick the same one when the
+        nearest is nearer than the others by far more than either's rounding (relative
+        1e-9; no gap between 0 and 1e-140, where squares lose digits)."""
+        cum, ax, ay, ex, ey, ee, root = self._lists
+        gaps = []
+        for j in range(first, stop):
+            t = ((px - ax[j]) * ex[j] + (py - ay[j]) * ey[j]) / ee[j]
+            t = 0.0 if t < 0.0 else 1.0 if t > 1.0 else t
+            gx, gy = px - (ax[j] + t * ex[j]), py - (ay[j] + t * ey[j])
+            gaps.append((gx * gx + gy * gy, j, t, gx, gy))
+        q, j, t, gx, gy = min(gaps)
+        if not (q == 0.0 and gx == 0.0 and gy == 0.0 or 1e-280 <= q < math.inf):
+            return None                   # NaN, inf or a square in the subnormal range
+        bound = q * (1.0 + 1e-9)
+        for other in gaps:
+            if other[1] != j and not bound < other[0]:    # NaN too
+                return None
+        tx, ty = ex[j] / root[j], ey[j] / root[j]          # root: math.sqrt(ee), the same
+        return cum[j] + t * root[j], gx * ty - gy * tx, np.array([tx, ty])
 
     def _window(self, lo: float, hi: float) -> tuple[int, int]:
         """The segments ``first:stop`` that reach arc length ``lo`` and start by ``hi`` (those
         with ``cum[j + 1] >= lo`` and ``cum[j] <= hi``: arc length never decreases along the
-        route, so they are one run of segments)."""
-        cum = self.cum
-        return (int(np.searchsorted(cum[1:], lo, side="left")),
-                int(np.searchsorted(cum[:-1], hi, side="right")))
+        route, so they are one run of segments). Bisections of a list, as
+        ``np.searchsorted(cum[1:], lo, side="left")`` and ``np.searchsorted(cum[:-1], hi,
+        side="right")`` answer (which sort a NaN last)."""
+        cum = self._lists[0]
+        first = len(cum) - 1 if lo != lo else bisect.bisect_left(cum, lo, 1) - 1
+        return first, bisect.bisect_right(cum, hi, 0, len(cum) - 1)
 
     def near(self, points: np.ndarray, s: float, reach: float, ahead: float) -> np.ndarray:
         """Which ``points [P, 2]`` lie within ``reach`` of the route between arc lengths ``s``
@@ -121,13 +185,12 @@ class Route:
         first, stop = self._window(s, s + ahead)
         if first >= stop or not len(points):
             return np.full(len(points), np.inf)
-        a, b = self.points[first:stop], self.points[first + 1:stop + 1]
-        e = b - a
-        ee = np.maximum((e * e).sum(axis=1), 1e-12)
+        a, e, ee, _, _ = self._segments
+        a, e, ee = a[first:stop], e[first:stop], ee[first:stop]
         rel = points[:, None] - a                                  # [P, M, 2]
-        t = clip_arrays((rel * e).sum(axis=2) / ee, 0.0, 1.0)
+        t = clip_arrays(np.add.reduce(rel * e, axis=2) / ee, 0.0, 1.0)
         d = rel - t[..., None] * e
-        return np.sqrt((d * d).sum(axis=2).min(axis=1))
+        return np.sqrt(np.minimum.reduce(np.add.reduce(d * d, axis=2), axis=1))
 
 
 def projections(routes: Sequence[Route], points: np.ndarray, hints: Sequence[float],
@@ -143,7 +206,7 @@ def projections(routes: Sequence[Route], points: np.ndarray, hints: Sequence[flo
     a, e = np.empty((len(routes), width, 2)), np.empty((len(routes), width, 2))
     ee, root = np.empty((len(routes), width)), np.empty((len(routes), width))
     for i, (route, (first, stop)) in enumerate(zip(routes, spans)):
-        sa, se, see, sroot = (x[first:stop] for x in route._segments)
+        sa, se, see, sroot = (x[first:stop] for x in route._segments[:4])
         m = stop - first
         a[i, :m], e[i, :m], ee[i, :m], root[i, :m] = sa, se, see, sroot
         a[i, m:], e[i, m:], ee[i, m:], root[i, m:] = sa[-1], se[-1], see[-1], sroot[-1]
@@ -647,14 +710,17 @@ def _grid_astar(allowed: memoryview, costs: memoryview, offsets: list[int], C: i
     """:func:`_astar` over the node grid with the steps of :func:`_steps` (the same pushes in
     the same order, so the same path), without a Python call per neighbour."""
     size = len(costs) // len(offsets)
-    gr, gc = divmod(goal, C)
+    target = divmod(goal, C)
     frontier = [(0.0, 0, start)]
     came = {start: -1}
     cost = {start: 0.0}
+    known = cost.get
     tie = 0
     moves = [(m * size, off) for m, off in enumerate(offsets)]
+    # the loop's names bound locally: the loop runs thousands of times a search
+    pop, push, dist, inf = heapq.heappop, heapq.heappush, math.dist, math.inf
     while frontier:
-        _, _, node = heapq.heappop(frontier)
+        node = pop(frontier)[2]
         if node == goal:
             return _path(came, node)
         here = cost[node]
@@ -662,12 +728,11 @@ def _grid_astar(allowed: memoryview, costs: memoryview, offsets: list[int], C: i
             if allowed[base + node]:
                 nxt = node + off
                 c = here + costs[base + node]
-                if c < cost.get(nxt, math.inf):
+                if c < known(nxt, inf):
                     cost[nxt] = c
                     came[nxt] = node
                     tie += 1
-                    heapq.heappush(frontier, (c + math.dist((nxt // C, nxt % C), (gr, gc)),
-                                              tie, nxt))
+                    push(frontier, (c + dist((nxt // C, nxt % C), target), tie, nxt))
     return None
 
 
