@@ -157,13 +157,16 @@ def _road_rows(a, b, valid, window: float, far: float) -> tuple[np.ndarray, np.n
     """Each row's nearest wall on the left and on the right among points ``[R, K]`` within
     ``window`` along the route (``far`` with none)."""
     side = valid & (np.abs(a) <= window)
-    return _least(side & (b < 0), -b, far), _least(side & (b > 0), b, far)
+    across = np.abs(b)                  # -b on the left, exactly
+    return _least(side & (b < 0), across, far), _least(side & (b > 0), across, far)
 
 
 def _least(mask: np.ndarray, values: np.ndarray, none: float) -> np.ndarray:
-    """``[R]``: each row's least of ``values [R, K]`` where ``mask`` (``none`` where none)."""
-    return np.where(mask.any(axis=1), np.where(mask, values, np.inf).min(axis=1, initial=np.inf),
-                    none)
+    """``[R]``: each row's least of ``values [R, K]`` where ``mask`` (``none`` where none;
+    ``values`` are finite where ``mask``, so a least of ``inf`` means none). One reduction
+    with ``where``: a minimum is exact, so these are the bits of the masked copy's."""
+    least = np.minimum.reduce(values, axis=1, initial=np.inf, where=mask)
+    return np.where(least < np.inf, least, none)
 
 
 def _obstruction(route: Route, a, b, points, valid, widen, robot: Robot, f: Frame,
@@ -173,22 +176,27 @@ def _obstruction(route: Route, a, b, points, valid, widen, robot: Robot, f: Fram
     ah, bh = rel_heading
     size, position, distance = _obstruction_rows(
         [route], [f], a[None], b[None], points[None], valid[None], widen[None], [robot], cfg,
-        ah[None], bh[None], [kept])
+        ah[None], bh[None], [kept], _bodies((robot,), cfg))
     return float(size[0]), float(position[0]), float(distance[0])
 
 
 def _obstruction_rows(routes: list[Route], frames: list[Frame], a, b, points, valid, widen,
                       robots: list[Robot], cfg: Settings, ah, bh,
-                      kept: list[tuple[float, np.ndarray] | None]):
+                      kept: list[tuple[float, np.ndarray] | None], body: dict[str, np.ndarray]):
     """Each row's ``(size, position, distance)`` of the nearest obstructing object among its
     ``points [R, K, 2]`` (``a``, ``b``: along and across its route; ``ah``, ``bh``: along and
-    across its heading). A point obstructs when it lies in the band swept along the route or
-    in the band swept along the robot's heading (so turning back toward an object it has not
-    yet passed brings it back)."""
-    half = _bodies(tuple(robots), cfg)["band"]
+    across its heading; ``body``: the robots' :func:`_bodies`). A point obstructs when it lies
+    in the band swept along the route or in the band swept along the robot's heading (so
+    turning back toward an object it has not yet passed brings it back)."""
+    size, position = np.zeros(len(routes)), np.zeros(len(routes))
+    distance = np.full(len(routes), NO_OBSTACLE)
     ahead = valid & (a > 0) & (a < cfg.sight)
-    blocking = ahead & (((b + widen > -half) & (b - widen < half)) |
-                        ((ah > 0) & (bh + widen > -half) & (bh - widen < half)))
+    if not ahead.any():
+        return size, position, distance
+    blocking = ahead & (_in_band(b, widen, body["band"])
+                        | ((ah > 0) & _in_band(bh, widen, body["band"])))
+    if not blocking.any():
+        return size, position, distance
     for i, word in enumerate(kept):     # what the route was planned round obstructs only
         if word is None:                # within its word
             continue
@@ -197,12 +205,18 @@ def _obstruction_rows(routes: list[Route], frames: list[Frame], a, b, points, va
         if round_.any():
             blocking[i, round_] = (routes[i].distance(points[i, round_], frames[i].s, cfg.sight)
                                    - widen[i, round_] < least)
-    size, position = np.zeros(len(routes)), np.zeros(len(routes))
-    distance = np.full(len(routes), NO_OBSTACLE)
     for j in np.flatnonzero(blocking.any(axis=1)):
         size[j], position[j], distance[j] = _object(
             routes[j], frames[j], a[j], points[j], ahead[j], blocking[j], widen[j], robots[j], cfg)
     return size, position, distance
+
+
+def _in_band(b: np.ndarray, widen: np.ndarray, half: np.ndarray) -> np.ndarray:
+    """Whether points ``b`` across a line, each widened by ``widen`` on both sides, reach into
+    the band ``half`` either side of it: ``b + widen > -half and b - widen < half``, which is
+    ``|b| - widen < half`` bit for bit (``-(b + widen)`` is ``-b - widen`` exactly, and of
+    ``b - widen`` and ``-b - widen`` the one from ``|b|`` is never the smaller)."""
+    return np.abs(b) - widen < half
 
 
 def _object(route: Route, f: Frame, a, points, ahead, blocking, widen, robot: Robot,
@@ -248,9 +262,15 @@ def free_ways_rows(ah: np.ndarray, bh: np.ndarray, widen: np.ndarray, unknown: n
     nearest point inside the body's band, less half the body's length. All at once:
     ``[rows, bands, ways, points]``. A point at the robot's centre (``ah = bh = 0``, the
     padding of a row with fewer points) is ahead on no way."""
-    body = _bodies(tuple(robots), cfg)
+    return _free_ways(ah, bh, widen, unknown, _bodies(tuple(robots), cfg), cfg, route_bearing)
+
+
+def _free_ways(ah: np.ndarray, bh: np.ndarray, widen: np.ndarray, unknown: np.ndarray,
+               body: dict[str, np.ndarray], cfg: Settings,
+               route_bearing: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`free_ways_rows` of robots whose :func:`_bodies` are ``body``."""
     length = body["length"][:, 0]
-    ways = np.repeat(_ways(cfg)[None], len(robots), axis=0)             # [R, W]
+    ways = np.repeat(_ways(cfg)[None], len(ah), axis=0)             # [R, W]
     ways[:, 1] = clip_arrays(route_bearing, -cfg.way_fov / 2, cfg.way_fov / 2)
     phi = np.deg2rad(ways)[..., None]
     cos, sin = np.cos(phi), np.sin(phi)
@@ -273,7 +293,7 @@ def free_ways_rows(ah: np.ndarray, bh: np.ndarray, widen: np.ndarray, unknown: n
     gain = 0.5 * free * weight[:, None]
     score += gain[:, 0]
     score += gain[:, 1]
-    return front, ways[np.arange(len(robots)), score.argmax(axis=1)]
+    return front, ways[np.arange(len(ah)), score.argmax(axis=1)]
 
 
 @functools.lru_cache(maxsize=8)
@@ -298,11 +318,17 @@ def nearest_rows(ah: np.ndarray, bh: np.ndarray, robots: list[Robot],
                  cfg: Settings) -> np.ndarray:
     """:func:`nearest` of every row of points ``[R, K]`` (a point at the robot's centre, the
     padding, is not ahead)."""
-    body = _bodies(tuple(robots), cfg)
+    return _nearest(ah, bh, _bodies(tuple(robots), cfg), cfg)
+
+
+def _nearest(ah: np.ndarray, bh: np.ndarray, body: dict[str, np.ndarray],
+             cfg: Settings) -> np.ndarray:
+    """:func:`nearest_rows` of robots whose :func:`_bodies` are ``body``."""
     half, band, length = body["half"], body["near"], body["length"]
-    ahead = (ah > 0) & (np.abs(bh) < band)
+    across = np.abs(bh)
+    ahead = (ah > 0) & (across < band)
     dx = np.maximum(ah - length, 0.0)
-    dy = np.maximum(np.abs(bh) - half, 0.0)
+    dy = np.maximum(across - half, 0.0)
     gap = _least(ahead, np.hypot(dx, dy), cfg.nearest_cap)
     return np.where(cfg.nearest_cap < gap, cfg.nearest_cap, gap)      # min(gap, cap)
 
@@ -344,24 +370,29 @@ def _walls(a, b, valid, robot: Robot, cfg: Settings, far: float,
            objects=None) -> tuple[float, float]:
     """Side gaps from points (a along, b across): walls count from ``wall_behind`` behind to
     ``wall_ahead`` ahead, objects (``objects`` mask) only while beside the robot's body."""
-    left, right = _walls_rows(a[None], b[None], valid[None], [robot], cfg, far,
+    left, right = _walls_rows(a[None], b[None], valid[None], _bodies((robot,), cfg), cfg, far,
                               None if objects is None else objects[None])
     return float(left[0]), float(right[0])
 
 
-def _walls_rows(a, b, valid, robots: list[Robot], cfg: Settings, far: float,
+def _walls_rows(a, b, valid, body: dict[str, np.ndarray], cfg: Settings, far: float,
                 objects=None) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`_walls` of every row of points ``[R, K]``."""
-    body = _bodies(tuple(robots), cfg)
+    """:func:`_walls` of every row of points ``[R, K]`` (``body``: the robots'
+    :func:`_bodies`)."""
     half = body["half"]
     ahead = cfg.wall_ahead if objects is None else np.where(objects, body["length"],
                                                             cfg.wall_ahead)
-    near = valid & (a >= -cfg.wall_behind) & (a <= ahead) & (np.abs(b) >= half)
-    left, right = near & (b < 0), near & (b > 0)
-    return (np.where(left.any(axis=1), np.where(left, -b, np.inf).min(axis=1, initial=np.inf)
-                     - half[:, 0], far),
-            np.where(right.any(axis=1), np.where(right, b, np.inf).min(axis=1, initial=np.inf)
-                     - half[:, 0], far))
+    across = np.abs(b)                  # -b on the left, exactly
+    near = valid & (a >= -cfg.wall_behind) & (a <= ahead) & (across >= half)
+    return (_gap(near & (b < 0), across, half[:, 0], far),
+            _gap(near & (b > 0), across, half[:, 0], far))
+
+
+def _gap(mask: np.ndarray, across: np.ndarray, half: np.ndarray, none: float) -> np.ndarray:
+    """``[R]``: each row's least of ``across [R, K]`` where ``mask``, less ``half [R]``
+    (``none`` where none; ``across`` is finite where ``mask``)."""
+    least = np.minimum.reduce(across, axis=1, initial=np.inf, where=mask)
+    return np.where(least < np.inf, least - half, none)
 
 
 def _common(route: Route, p, heading: float, f: Frame, road: float, robot: Robot,
@@ -556,6 +587,7 @@ def perceive_rows(rows: list[Sight], max_range: float,
     elementwise, with exact minima; what depends on a row's route, its map or a matrix
     product of its own beams row by row."""
     robots = [r.robot for r in rows]
+    body = _bodies(tuple(robots), cfg)
     p = np.array([r.pose[:2] for r in rows])                            # [R, 2]
     dirs = _stack([r.dirs for r in rows])
     measured = _stack([r.measured for r in rows])
@@ -564,28 +596,27 @@ def perceive_rows(rows: list[Sight], max_range: float,
     a = np.matmul(rel, _stack([r.f.t for r in rows])[..., None])[..., 0]   # rel @ f.t, rows
     b = np.matmul(rel, _stack([r.f.n for r in rows])[..., None])[..., 0]
     valid = measured < max_range * 0.999
-    threshold = np.array([r.threshold for r in rows])[:, None]
-    obstacle_hit = valid & (measured < _stack([r.expected for r in rows]) - threshold)
-    left, right = _road_rows(a, b, valid & ~obstacle_hit, cfg.window, max_range)
+    obstacle_hit = valid & (measured < _stack([r.expected for r in rows])
+                            - _column([r.threshold for r in rows]))
+    known = valid & ~obstacle_hit
+    left, right = _road_rows(a, b, known, cfg.window, max_range)
     road = left + right
-    widen = measured * np.array([r.spacing for r in rows])[:, None] / 2
-    in_way = valid & ~obstacle_hit & (a > 0)    # drawn on the map, but where the robot's
-    some = np.flatnonzero(in_way.any(axis=1))   # route would hit it
-    if len(some):
-        gone = distances([rows[i].route for i in some], [rows[i].f.s for i in some],
-                         cfg.sight, hits[some])
-        reach = np.array([rows[i].robot.width / 2 + rows[i].robot.safety_margin
-                          for i in some])[:, None]
-        in_way[some] &= gone <= reach
-    ah, bh, valid_ah, valid_bh = _own_frames(rows, rel, valid)
+    widen = measured * _column([r.spacing for r in rows]) / 2
+    obstructing = obstacle_hit | _in_way(rows, known & (a > 0), hits, cfg)
+    headings = [r.pose[2] for r in rows]
+    valid_ah, valid_bh = _own_frames(headings, rel, valid)
+    if obstructing.any():
+        ah, bh = _own_frames_all(headings, rel)
+    else:                       # what does not obstruct is not asked where it lies
+        ah, bh = valid_ah, valid_bh
     size, position, distance = _obstruction_rows(
-        [r.route for r in rows], [r.f for r in rows], a, b, hits, obstacle_hit | in_way,
-        widen, robots, cfg, ah, bh, [r.kept for r in rows])
+        [r.route for r in rows], [r.f for r in rows], a, b, hits, obstructing,
+        widen, robots, cfg, ah, bh, [r.kept for r in rows], body)
     common = np.array([_common(r.route, p[i], r.pose[2], r.f, float(road[i]), r.robot, cfg,
                                r.target, r.room) for i, r in enumerate(rows)])
     heading = common[:, 0]
-    wl, wr = _walls_rows(a, b, valid, robots, cfg, max_range, obstacle_hit)
-    front, opening = free_ways_rows(valid_ah, valid_bh, widen, obstacle_hit, robots, cfg, heading)
+    wl, wr = _walls_rows(a, b, valid, body, cfg, max_range, obstacle_hit)
+    front, opening = _free_ways(valid_ah, valid_bh, widen, obstacle_hit, body, cfg, heading)
     ring = np.array([len(r.dirs) > 2 and float(r.dirs[0] @ r.dirs[-1])
                      >= float(r.dirs[0] @ r.dirs[1]) - 1e-9 for r in rows])
     return {"road": road, "size": size, "position": position, "obstacle": distance,
@@ -593,8 +624,24 @@ def perceive_rows(rows: list[Sight], max_range: float,
                                          r.target) for i, r in enumerate(rows)]),
             "lane": common[:, 1], "goal": common[:, 2], "gap_left": wl, "gap_right": wr,
             "front": front, "opening": opening,
-            "clutter": clutter_rows(hits, valid & obstacle_hit, ah, cfg, ring),
-            "nearest": nearest_rows(valid_ah, valid_bh, robots, cfg)}
+            "clutter": clutter_rows(hits, obstacle_hit, ah, cfg, ring),
+            "nearest": _nearest(valid_ah, valid_bh, body, cfg)}
+
+
+def _in_way(rows: list[Sight], ahead: np.ndarray, hits: np.ndarray, cfg: Settings) -> np.ndarray:
+    """Which of the points ``hits [R, B, 2]`` ahead of their robots (``ahead``) and drawn on
+    its map stand where its route would hit them: within half its width plus its safety
+    margin of the route within ``sight``. Only the points some row asks about are measured
+    (a point's distance from a route is its own arithmetic, whatever else is measured)."""
+    cols = np.flatnonzero(ahead.any(axis=0))
+    if not len(cols):
+        return ahead
+    some = np.flatnonzero(ahead.any(axis=1))
+    gone = distances([rows[i].route for i in some], [rows[i].f.s for i in some], cfg.sight,
+                     hits[some[:, None], cols])
+    reach = _column([rows[i].robot.width / 2 + rows[i].robot.safety_margin for i in some])
+    ahead[some[:, None], cols] &= gone <= reach
+    return ahead
 
 
 @functools.lru_cache(maxsize=64)
@@ -624,19 +671,31 @@ def _stack(arrays: list[np.ndarray]) -> np.ndarray:
     return arrays[0][None] if len(arrays) == 1 else np.stack(arrays)
 
 
-def _own_frames(rows: list[Sight], rel: np.ndarray,
-                valid: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """The points ``rel [R, B, 2]`` in each robot's own frame (:func:`_own_frame`): all of
-    them, and the valid ones alone (as a robot alone computes them, from those points only;
-    the others read 0, the robot's centre)."""
-    cs = np.array([(math.cos(r.pose[2]), math.sin(r.pose[2])) for r in rows])   # [R, 2]
-    along = np.matmul(rel, cs[..., None])[..., 0]                       # rel @ [c, s]
-    across = np.matmul(rel, np.stack([cs[:, 1], -cs[:, 0]], axis=1)[..., None])[..., 0]
-    valid_along, valid_across = np.zeros(valid.shape), np.zeros(valid.shape)
-    for i, r in enumerate(rows):
-        valid_along[i, valid[i]], valid_across[i, valid[i]] = _own_frame(rel[i][valid[i]],
-                                                                         r.pose[2])
-    return along, across, valid_along, valid_across
+def _column(values: list[float]) -> float | np.ndarray:
+    """One value per row as a column ``[R, 1]`` to broadcast against ``[R, K]`` (the value
+    itself for one row: the same arithmetic, element by element)."""
+    return values[0] if len(values) == 1 else np.array(values)[:, None]
+
+
+def _own_frames(headings: list[float], rel: np.ndarray,
+                valid: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The valid points of ``rel [R, B, 2]`` in each robot's own frame, as a robot alone
+    computes them (:func:`_own_frame`, from those points only); the others read 0, the
+    robot's centre."""
+    along, across = np.zeros(valid.shape), np.zeros(valid.shape)
+    for i, heading in enumerate(headings):
+        mine = valid[i]
+        along[i, mine], across[i, mine] = _own_frame(rel[i][mine], heading)
+    return along, across
+
+
+def _own_frames_all(headings: list[float], rel: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """All the points ``rel [R, B, 2]`` in each robot's own frame (the products of
+    :func:`_own_frame`, row by row)."""
+    cs = np.array([(math.cos(h), math.sin(h), math.sin(h), -math.cos(h)) for h in headings])
+    along = np.matmul(rel, cs[:, :2, None])[..., 0]                     # rel @ [c, s]
+    across = np.matmul(rel, cs[:, 2:, None])[..., 0]                    # rel @ [s, -c]
+    return along, across
 
 
 def pursuit(route: Route, f: Frame, p: np.ndarray, bearing: float, cfg: Settings,
