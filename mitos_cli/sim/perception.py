@@ -260,7 +260,7 @@ def free_ways_rows(ah: np.ndarray, bh: np.ndarray, widen: np.ndarray, unknown: n
     """Each row's ``(front, opening)`` from its points ``[R, K]``. Every way tried is a
     direction from the robot's centre; its free length is the distance along it to the
     nearest point inside the body's band, less half the body's length. All at once:
-    ``[rows, bands, ways, points]``. A point at the robot's centre (``ah = bh = 0``, the
+    ``[rows, ways, points]``, one band after the other. A point at the robot's centre (``ah = bh = 0``, the
     padding of a row with fewer points) is ahead on no way."""
     return _free_ways(ah, bh, widen, unknown, _bodies(tuple(robots), cfg), cfg, route_bearing)
 
@@ -270,16 +270,25 @@ def _free_ways(ah: np.ndarray, bh: np.ndarray, widen: np.ndarray, unknown: np.nd
                route_bearing: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """:func:`free_ways_rows` of robots whose :func:`_bodies` are ``body``."""
     length = body["length"][:, 0]
-    ways = np.repeat(_ways(cfg)[None], len(ah), axis=0)             # [R, W]
+    base = _ways(cfg)
+    ways = np.empty((len(ah), len(base)))                                  # [R, W]
+    ways[:] = base
     ways[:, 1] = clip_arrays(route_bearing, -cfg.way_fov / 2, cfg.way_fov / 2)
     phi = np.deg2rad(ways)[..., None]
     cos, sin = np.cos(phi), np.sin(phi)
-    ah, bh = ah[:, None], bh[:, None]
-    along = ah * cos + bh * sin                                         # [R, W, K]
-    across = np.abs(-ah * sin + bh * cos) - widen[:, None]
-    bands = body["bands"]
-    inside = (along > 0)[:, None] & (across[:, None] < bands)          # [R, 2, W, K]
-    front = np.where(inside[:, 0, 0] & unknown, along[:, 0], np.inf).min(axis=1, initial=np.inf)
+    ah, bh, widen = ah[:, None], bh[:, None], widen[:, None]
+    along = ah * cos                                                       # [R, W, K]
+    along += bh * sin
+    across = bh * cos                   # -ah * sin + bh * cos, the same bits
+    across -= ah * sin
+    np.abs(across, out=across)
+    across -= widen
+    ahead = along > 0
+    narrow = across < body["way"][..., None]       # the band just clear of the body
+    narrow &= ahead
+    roomy = across < body["roomy"][..., None]      # and the roomier one
+    roomy &= ahead
+    front = np.minimum.reduce(along[:, 0], axis=1, initial=np.inf, where=narrow[:, 0] & unknown)
     front = clip_arrays(front - length, 0.0, cfg.sight)
     # the progress each way offers toward the route's bearing (behind the robot: toward the
     # side it lies on), in a band just clear of the body and in a roomy one, less a little
@@ -287,12 +296,11 @@ def _free_ways(ah: np.ndarray, bh: np.ndarray, widen: np.ndarray, unknown: np.nd
     toward = clip_arrays(route_bearing, -90.0, 90.0)
     score = -cfg.way_turn_cost * np.abs(ways)
     weight = np.cos(np.deg2rad(ways - toward[:, None])) + cfg.way_room_weight
-    free = np.where(inside, along[:, None], np.inf).min(axis=3, initial=np.inf)   # [R, 2, W]
-    free -= length[:, None, None]
-    free = clip_arrays(free, 0.0, cfg.way_reach)
-    gain = 0.5 * free * weight[:, None]
-    score += gain[:, 0]
-    score += gain[:, 1]
+    for inside in (narrow, roomy):
+        free = np.minimum.reduce(along, axis=2, initial=np.inf, where=inside)    # [R, W]
+        free -= length[:, None]
+        free = clip_arrays(free, 0.0, cfg.way_reach)
+        score += 0.5 * free * weight
     return front, ways[np.arange(len(ah)), score.argmax(axis=1)]
 
 
@@ -637,20 +645,36 @@ def _in_way(rows: list[Sight], ahead: np.ndarray, hits: np.ndarray, cfg: Setting
     if not len(cols):
         return ahead
     some = np.flatnonzero(ahead.any(axis=1))
-    gone = distances([rows[i].route for i in some], [rows[i].f.s for i in some], cfg.sight,
-                     hits[some[:, None], cols])
-    reach = _column([rows[i].robot.width / 2 + rows[i].robot.safety_margin for i in some])
-    ahead[some[:, None], cols] &= gone <= reach
+    asked = [rows[i] for i in some]
+    at = np.s_[:, cols] if len(asked) == len(rows) else np.ix_(some, cols)
+    gone = distances([r.route for r in asked], [r.f.s for r in asked], cfg.sight, hits[at])
+    ahead[at] &= gone <= _column([r.robot.width / 2 + r.robot.safety_margin for r in asked])
     return ahead
 
 
-@functools.lru_cache(maxsize=64)
 def _bodies(robots: tuple[Robot, ...], cfg: Settings) -> dict[str, np.ndarray]:
     """The robots' measures perception works with, ``[R, 1]`` each (read-only): half the
     width (``half``), half the length (``length``), the half width of the band an object
-    obstructs in (``band``), of a way (``way``) and of the band ``nearest`` looks in
-    (``near``), each the one robot's arithmetic; and both bands a way is scored in,
-    ``[R, 2, 1, 1]``."""
+    obstructs in (``band``), of a way (``way``), of the roomier band a way is also scored
+    in (``roomy``) and of the band ``nearest`` looks in (``near``), each the one robot's
+    arithmetic. Looked up by the robots' and settings' identities first (hashing a
+    :class:`Settings` costs more than the look-up saves, every tick), then by value."""
+    key = (*map(id, robots), id(cfg))
+    hit = _BODIES.get(key)
+    if hit is None:
+        if len(_BODIES) >= 64:
+            _BODIES.clear()
+        hit = _BODIES[key] = (robots, cfg, _measures(robots, cfg))   # holds them: ids stay
+    return hit[2]
+
+
+#: :func:`_bodies` by the identities of the robots and settings (which it keeps alive).
+_BODIES: dict[tuple[int, ...], tuple[tuple[Robot, ...], Settings, dict[str, np.ndarray]]] = {}
+
+
+@functools.lru_cache(maxsize=64)
+def _measures(robots: tuple[Robot, ...], cfg: Settings) -> dict[str, np.ndarray]:
+    """:func:`_bodies` by value."""
     def column(values) -> np.ndarray:
         return np.array(list(values), dtype=float)[:, None]
 
@@ -658,9 +682,8 @@ def _bodies(robots: tuple[Robot, ...], cfg: Settings) -> dict[str, np.ndarray]:
            "length": column(r.length / 2 for r in robots),
            "band": column(r.width / 2 + cfg.band_margin for r in robots),
            "way": column(r.width / 2 + cfg.way_margin for r in robots),
+           "roomy": column(r.width / 2 + cfg.way_margin + cfg.way_room for r in robots),
            "near": column(r.width / 2 + cfg.nearest_band for r in robots)}
-    way = out["way"][:, 0]
-    out["bands"] = np.stack([way, way + cfg.way_room], axis=1)[:, :, None, None]
     for a in out.values():
         a.flags.writeable = False
     return out
