@@ -156,9 +156,22 @@ def _road(a, b, valid, window: float, far: float) -> tuple[float, float]:
 def _road_rows(a, b, valid, window: float, far: float) -> tuple[np.ndarray, np.ndarray]:
     """Each row's nearest wall on the left and on the right among points ``[R, K]`` within
     ``window`` along the route (``far`` with none)."""
-    side = valid & (np.abs(a) <= window)
-    across = np.abs(b)                  # -b on the left, exactly
-    return _least(side & (b < 0), across, far), _least(side & (b > 0), across, far)
+    left, right = _beside(b, np.abs(b), [valid & (np.abs(a) <= window)])[0]
+    return _or(left, far), _or(right, far)
+
+
+def _beside(b: np.ndarray, across: np.ndarray, masks: list[np.ndarray]) -> np.ndarray:
+    """``[M, 2, R]``: for each of the ``masks [R, K]``, each row's least ``across`` (``|b|``)
+    among its points on the left (``b < 0``) and among those on the right (``b > 0``),
+    ``inf`` where none; all in one reduction (a minimum is exact: the bits of each alone)."""
+    inside = np.array(masks)[:, None] & np.array([b < 0, b > 0])      # [M, 2, R, K]
+    return np.minimum.reduce(np.where(inside, across, np.inf), axis=-1)
+
+
+def _or(least: np.ndarray, none: float, less: float | np.ndarray = 0.0) -> np.ndarray:
+    """``least - less``, ``none`` where ``least`` is ``inf`` (no point: the points' values
+    are finite)."""
+    return np.where(least < np.inf, least - less, none)
 
 
 def _least(mask: np.ndarray, values: np.ndarray, none: float) -> np.ndarray:
@@ -387,20 +400,18 @@ def _walls_rows(a, b, valid, body: dict[str, np.ndarray], cfg: Settings, far: fl
                 objects=None) -> tuple[np.ndarray, np.ndarray]:
     """:func:`_walls` of every row of points ``[R, K]`` (``body``: the robots'
     :func:`_bodies`)."""
-    half = body["half"]
+    across = np.abs(b)
+    left, right = _beside(b, across, [_walls_near(a, across, valid, body, cfg, objects)])[0]
+    return _or(left, far, body["half"][:, 0]), _or(right, far, body["half"][:, 0])
+
+
+def _walls_near(a, across, valid, body: dict[str, np.ndarray], cfg: Settings,
+                objects=None) -> np.ndarray:
+    """Which points ``[R, K]`` (``a`` along the route, ``across`` its distance from it)
+    :func:`_walls` measures the side gaps to."""
     ahead = cfg.wall_ahead if objects is None else np.where(objects, body["length"],
                                                             cfg.wall_ahead)
-    across = np.abs(b)                  # -b on the left, exactly
-    near = valid & (a >= -cfg.wall_behind) & (a <= ahead) & (across >= half)
-    return (_gap(near & (b < 0), across, half[:, 0], far),
-            _gap(near & (b > 0), across, half[:, 0], far))
-
-
-def _gap(mask: np.ndarray, across: np.ndarray, half: np.ndarray, none: float) -> np.ndarray:
-    """``[R]``: each row's least of ``across [R, K]`` where ``mask``, less ``half [R]``
-    (``none`` where none; ``across`` is finite where ``mask``)."""
-    least = np.minimum.reduce(across, axis=1, initial=np.inf, where=mask)
-    return np.where(least < np.inf, least - half, none)
+    return valid & (a >= -cfg.wall_behind) & (a <= ahead) & (across >= body["half"])
 
 
 def _common(route: Route, p, heading: float, f: Frame, road: float, robot: Robot,
@@ -607,8 +618,11 @@ def perceive_rows(rows: list[Sight], max_range: float,
     obstacle_hit = valid & (measured < _stack([r.expected for r in rows])
                             - _column([r.threshold for r in rows]))
     known = valid & ~obstacle_hit
-    left, right = _road_rows(a, b, known, cfg.window, max_range)
-    road = left + right
+    across = np.abs(b)                  # the walls beside the road, and beside the robot
+    (left, right), walls = _beside(b, across, [
+        known & (np.abs(a) <= cfg.window),
+        _walls_near(a, across, valid, body, cfg, obstacle_hit)])            # (_road_rows)
+    road = _or(left, max_range) + _or(right, max_range)
     widen = measured * _column([r.spacing for r in rows]) / 2
     obstructing = obstacle_hit | _in_way(rows, known & (a > 0), hits, cfg)
     headings = [r.pose[2] for r in rows]
@@ -623,10 +637,9 @@ def perceive_rows(rows: list[Sight], max_range: float,
     common = np.array([_common(r.route, p[i], r.pose[2], r.f, float(road[i]), r.robot, cfg,
                                r.target, r.room) for i, r in enumerate(rows)])
     heading = common[:, 0]
-    wl, wr = _walls_rows(a, b, valid, body, cfg, max_range, obstacle_hit)
+    wl, wr = _or(walls, max_range, body["half"][:, 0])                    # (_walls_rows)
     front, opening = _free_ways(valid_ah, valid_bh, widen, obstacle_hit, body, cfg, heading)
-    ring = np.array([len(r.dirs) > 2 and float(r.dirs[0] @ r.dirs[-1])
-                     >= float(r.dirs[0] @ r.dirs[1]) - 1e-9 for r in rows])
+    ring = np.array([_ring(r.dirs.tobytes()) for r in rows])
     return {"road": road, "size": size, "position": position, "obstacle": distance,
             "heading": np.array([pursuit(r.route, r.f, p[i], heading[i], cfg, r.lookahead,
                                          r.target) for i, r in enumerate(rows)]),
@@ -687,6 +700,14 @@ def _measures(robots: tuple[Robot, ...], cfg: Settings) -> dict[str, np.ndarray]
     for a in out.values():
         a.flags.writeable = False
     return out
+
+
+@functools.lru_cache(maxsize=16)
+def _ring(dirs: bytes) -> bool:
+    """Whether beams (``[B, 2]``, as bytes: a robot's beams are the same every tick) go
+    round, the last neighbouring the first."""
+    d = np.frombuffer(dirs).reshape(-1, 2)
+    return len(d) > 2 and float(d[0] @ d[-1]) >= float(d[0] @ d[1]) - 1e-9
 
 
 def _stack(arrays: list[np.ndarray]) -> np.ndarray:
