@@ -174,14 +174,6 @@ def _or(least: np.ndarray, none: float, less: float | np.ndarray = 0.0) -> np.nd
     return np.where(least < np.inf, least - less, none)
 
 
-def _least(mask: np.ndarray, values: np.ndarray, none: float) -> np.ndarray:
-    """``[R]``: each row's least of ``values [R, K]`` where ``mask`` (``none`` where none;
-    ``values`` are finite where ``mask``, so a least of ``inf`` means none). One reduction
-    with ``where``: a minimum is exact, so these are the bits of the masked copy's."""
-    least = np.minimum.reduce(values, axis=1, initial=np.inf, where=mask)
-    return np.where(least < np.inf, least, none)
-
-
 def _obstruction(route: Route, a, b, points, valid, widen, robot: Robot, f: Frame,
                  cfg: Settings, rel_heading, kept: tuple[float, np.ndarray] | None = None):
     """(size, position, distance) of the nearest obstructing object among ``points``
@@ -283,7 +275,7 @@ def _free_ways(ah: np.ndarray, bh: np.ndarray, widen: np.ndarray, unknown: np.nd
                route_bearing: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """:func:`free_ways_rows` of robots whose :func:`_bodies` are ``body``."""
     length = body["length"][:, 0]
-    base = _ways(cfg)
+    base = body["ways"]
     ways = np.empty((len(ah), len(base)))                                  # [R, W]
     ways[:] = base
     ways[:, 1] = clip_arrays(route_bearing, -cfg.way_fov / 2, cfg.way_fov / 2)
@@ -350,8 +342,9 @@ def _nearest(ah: np.ndarray, bh: np.ndarray, body: dict[str, np.ndarray],
     ahead = (ah > 0) & (across < band)
     dx = np.maximum(ah - length, 0.0)
     dy = np.maximum(across - half, 0.0)
-    gap = _least(ahead, np.hypot(dx, dy), cfg.nearest_cap)
-    return np.where(cfg.nearest_cap < gap, cfg.nearest_cap, gap)      # min(gap, cap)
+    gap = np.minimum.reduce(np.hypot(dx, dy), axis=1, initial=np.inf, where=ahead)
+    return np.where(cfg.nearest_cap < gap, cfg.nearest_cap, gap)      # min(gap, cap): the
+                                                                       # cap with none ahead
 
 
 def clutter(hits: np.ndarray, unknown: np.ndarray, ah: np.ndarray, cfg: Settings,
@@ -617,7 +610,7 @@ def perceive_rows(rows: list[Sight], max_range: float,
     valid = measured < max_range * 0.999
     obstacle_hit = valid & (measured < _stack([r.expected for r in rows])
                             - _column([r.threshold for r in rows]))
-    known = valid & ~obstacle_hit
+    known = valid ^ obstacle_hit        # valid & ~obstacle_hit (which lies within valid)
     across = np.abs(b)                  # the walls beside the road, and beside the robot
     (left, right), walls = _beside(b, across, [
         known & (np.abs(a) <= cfg.window),
@@ -654,10 +647,10 @@ def _in_way(rows: list[Sight], ahead: np.ndarray, hits: np.ndarray, cfg: Setting
     its map stand where its route would hit them: within half its width plus its safety
     margin of the route within ``sight``. Only the points some row asks about are measured
     (a point's distance from a route is its own arithmetic, whatever else is measured)."""
-    cols = np.flatnonzero(ahead.any(axis=0))
+    cols = ahead.any(axis=0).nonzero()[0]
     if not len(cols):
         return ahead
-    some = np.flatnonzero(ahead.any(axis=1))
+    some = ahead.any(axis=1).nonzero()[0] if len(rows) > 1 else [0]
     asked = [rows[i] for i in some]
     at = np.s_[:, cols] if len(asked) == len(rows) else np.ix_(some, cols)
     gone = distances([r.route for r in asked], [r.f.s for r in asked], cfg.sight, hits[at])
@@ -670,7 +663,7 @@ def _bodies(robots: tuple[Robot, ...], cfg: Settings) -> dict[str, np.ndarray]:
     width (``half``), half the length (``length``), the half width of the band an object
     obstructs in (``band``), of a way (``way``), of the roomier band a way is also scored
     in (``roomy``) and of the band ``nearest`` looks in (``near``), each the one robot's
-    arithmetic. Looked up by the robots' and settings' identities first (hashing a
+    arithmetic; and the ways :func:`free_ways` tries (``ways``, :func:`_ways`). Looked up by the robots' and settings' identities first (hashing a
     :class:`Settings` costs more than the look-up saves, every tick), then by value."""
     key = (*map(id, robots), id(cfg))
     hit = _BODIES.get(key)
@@ -696,7 +689,8 @@ def _measures(robots: tuple[Robot, ...], cfg: Settings) -> dict[str, np.ndarray]
            "band": column(r.width / 2 + cfg.band_margin for r in robots),
            "way": column(r.width / 2 + cfg.way_margin for r in robots),
            "roomy": column(r.width / 2 + cfg.way_margin + cfg.way_room for r in robots),
-           "near": column(r.width / 2 + cfg.nearest_band for r in robots)}
+           "near": column(r.width / 2 + cfg.nearest_band for r in robots),
+           "ways": _ways(cfg)}
     for a in out.values():
         a.flags.writeable = False
     return out
@@ -726,7 +720,7 @@ def _own_frames(headings: list[float], rel: np.ndarray,
     """The valid points of ``rel [R, B, 2]`` in each robot's own frame, as a robot alone
     computes them (:func:`_own_frame`, from those points only); the others read 0, the
     robot's centre."""
-    along, across = np.zeros(valid.shape), np.zeros(valid.shape)
+    along, across = np.zeros((2,) + valid.shape)
     for i, heading in enumerate(headings):
         mine = valid[i]
         along[i, mine], across[i, mine] = _own_frame(rel[i][mine], heading)
