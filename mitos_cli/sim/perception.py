@@ -632,7 +632,8 @@ def perceive_rows(rows: list[Sight], max_range: float,
     heading = common[:, 0]
     wl, wr = _or(walls, max_range, body["half"][:, 0])                    # (_walls_rows)
     front, opening = _free_ways(valid_ah, valid_bh, widen, obstacle_hit, body, cfg, heading)
-    ring = np.array([_ring(r.dirs.tobytes()) for r in rows])
+    ring = np.array([len(r.dirs) > 2 and float(r.dirs[0] @ r.dirs[-1])
+                     >= float(r.dirs[0] @ r.dirs[1]) - 1e-9 for r in rows])
     return {"road": road, "size": size, "position": position, "obstacle": distance,
             "heading": np.array([pursuit(r.route, r.f, p[i], heading[i], cfg, r.lookahead,
                                          r.target) for i, r in enumerate(rows)]),
@@ -694,14 +695,6 @@ def _measures(robots: tuple[Robot, ...], cfg: Settings) -> dict[str, np.ndarray]
     for a in out.values():
         a.flags.writeable = False
     return out
-
-
-@functools.lru_cache(maxsize=16)
-def _ring(dirs: bytes) -> bool:
-    """Whether beams (``[B, 2]``, as bytes: a robot's beams are the same every tick) go
-    round, the last neighbouring the first."""
-    d = np.frombuffer(dirs).reshape(-1, 2)
-    return len(d) > 2 and float(d[0] @ d[-1]) >= float(d[0] @ d[1]) - 1e-9
 
 
 def _stack(arrays: list[np.ndarray]) -> np.ndarray:
