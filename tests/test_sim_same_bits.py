@@ -547,3 +547,91 @@ def test_floor_division_of_floats_is_numpys():
             for res in (2.0, 0.5, 0.1, 3.0, 1e-3, 7.25):
                 assert same(x // res, np.float64(x) // np.float64(res))
                 assert same(x // res, np.float64(x) // res)
+
+
+def test_a_widened_point_in_a_band_is_the_two_sided_test():
+    values = [math.nan, -math.inf, math.inf, 0.0, -0.0, 1.0, -1.0, 9.5, -9.5, 5e-324, 1e300]
+    b, widen, half = (np.array(x).ravel() for x in np.meshgrid(values, values, values))
+    with np.errstate(invalid="ignore"):                  # inf - inf
+        want = (b + widen > -half) & (b - widen < half)
+        assert np.array_equal(perception._in_band(b, widen, half), want)
+    rng = np.random.default_rng(11)
+    b, widen, half = rng.normal(0, 20, (3, 100_000))
+    widen, half = np.abs(widen) * rng.choice([1.0, 0.0, -1.0], widen.shape), np.abs(half)
+    want = (b + widen > -half) & (b - widen < half)
+    assert np.array_equal(perception._in_band(b, widen, half), want)
+
+
+def _plain_free_ways(ah, bh, widen, unknown, robots, cfg, route_bearing):
+    """free_ways_rows as it was written before it went one band at a time."""
+    length = np.array([r.length / 2 for r in robots])
+    way = np.array([r.width / 2 + cfg.way_margin for r in robots])
+    bands = np.stack([way, way + cfg.way_room], axis=1)[:, :, None, None]
+    ways = np.repeat(perception._ways(cfg)[None], len(robots), axis=0)
+    ways[:, 1] = geometry.clip_arrays(route_bearing, -cfg.way_fov / 2, cfg.way_fov / 2)
+    phi = np.deg2rad(ways)[..., None]
+    cos, sin = np.cos(phi), np.sin(phi)
+    ah, bh = ah[:, None], bh[:, None]
+    along = ah * cos + bh * sin
+    across = np.abs(-ah * sin + bh * cos) - widen[:, None]
+    inside = (along > 0)[:, None] & (across[:, None] < bands)
+    front = np.where(inside[:, 0, 0] & unknown, along[:, 0], np.inf).min(axis=1, initial=np.inf)
+    front = geometry.clip_arrays(front - length, 0.0, cfg.sight)
+    toward = geometry.clip_arrays(route_bearing, -90.0, 90.0)
+    score = -cfg.way_turn_cost * np.abs(ways)
+    weight = np.cos(np.deg2rad(ways - toward[:, None])) + cfg.way_room_weight
+    free = np.where(inside, along[:, None], np.inf).min(axis=3, initial=np.inf)
+    free = geometry.clip_arrays(free - length[:, None, None], 0.0, cfg.way_reach)
+    gain = 0.5 * free * weight[:, None]
+    score += gain[:, 0]
+    score += gain[:, 1]
+    return front, ways[np.arange(len(robots)), score.argmax(axis=1)]
+
+
+def test_free_ways_one_band_at_a_time_are_the_plain_ways():
+    rng = np.random.default_rng(12)
+    cfg = perception.Settings()
+    for k in range(300):
+        n, rows = int(rng.integers(1, 40)), int(rng.choice([1, 1, 3]))
+        robots = [Robot(length=float(rng.uniform(10, 30)), width=float(rng.uniform(8, 24)))
+                  for _ in range(rows)]
+        ah, bh = rng.normal(0, rng.choice([15.0, 60.0]), (2, rows, n))
+        if k % 5 == 0:
+            ah[:, ::3] = bh[:, ::3] = 0.0          # padding at the robot's centre
+        widen = np.abs(rng.normal(0, 3, (rows, n)))
+        unknown = rng.random((rows, n)) < 0.4
+        bearing = rng.uniform(-200, 200, rows)
+        got = perception.free_ways_rows(ah, bh, widen, unknown, robots, cfg, bearing)
+        want = _plain_free_ways(ah, bh, widen, unknown, robots, cfg, bearing)
+        assert same(got[0], want[0]) and same(got[1], want[1])
+
+
+def test_road_and_side_gaps_from_one_reduction_are_the_plain_minima():
+    rng = np.random.default_rng(13)
+    cfg = perception.Settings()
+    for _ in range(200):
+        rows, n = int(rng.choice([1, 4])), int(rng.integers(1, 40))
+        robots = [Robot(length=float(rng.uniform(10, 30)), width=float(rng.uniform(8, 24)))
+                  for _ in range(rows)]
+        a, b = rng.normal(0, 40, (2, rows, n))
+        b[rng.random(b.shape) < 0.1] = 0.0
+        valid, objects = rng.random((2, rows, n)) < 0.7
+        half = np.array([r.width / 2 for r in robots])[:, None]
+        length = np.array([r.length / 2 for r in robots])[:, None]
+
+        def least(mask, values, none):
+            return np.where(mask.any(axis=1),
+                            np.where(mask, values, np.inf).min(axis=1, initial=np.inf), none)
+
+        side = valid & (np.abs(a) <= cfg.window)
+        got = perception._road_rows(a, b, valid, cfg.window, 200.0)
+        assert same(got[0], least(side & (b < 0), -b, 200.0))
+        assert same(got[1], least(side & (b > 0), b, 200.0))
+        ahead = np.where(objects, length, cfg.wall_ahead)
+        near = valid & (a >= -cfg.wall_behind) & (a <= ahead) & (np.abs(b) >= half)
+        body = perception._bodies(tuple(robots), cfg)
+        got = perception._walls_rows(a, b, valid, body, cfg, 200.0, objects)
+        assert same(got[0], np.where((near & (b < 0)).any(axis=1),
+                                     least(near & (b < 0), -b, 0.0) - half[:, 0], 200.0))
+        assert same(got[1], np.where((near & (b > 0)).any(axis=1),
+                                     least(near & (b > 0), b, 0.0) - half[:, 0], 200.0))

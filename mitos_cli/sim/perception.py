@@ -156,14 +156,22 @@ def _road(a, b, valid, window: float, far: float) -> tuple[float, float]:
 def _road_rows(a, b, valid, window: float, far: float) -> tuple[np.ndarray, np.ndarray]:
     """Each row's nearest wall on the left and on the right among points ``[R, K]`` within
     ``window`` along the route (``far`` with none)."""
-    side = valid & (np.abs(a) <= window)
-    return _least(side & (b < 0), -b, far), _least(side & (b > 0), b, far)
+    left, right = _beside(b, np.abs(b), [valid & (np.abs(a) <= window)])[0]
+    return _or(left, far), _or(right, far)
 
 
-def _least(mask: np.ndarray, values: np.ndarray, none: float) -> np.ndarray:
-    """``[R]``: each row's least of ``values [R, K]`` where ``mask`` (``none`` where none)."""
-    return np.where(mask.any(axis=1), np.where(mask, values, np.inf).min(axis=1, initial=np.inf),
-                    none)
+def _beside(b: np.ndarray, across: np.ndarray, masks: list[np.ndarray]) -> np.ndarray:
+    """``[M, 2, R]``: for each of the ``masks [R, K]``, each row's least ``across`` (``|b|``)
+    among its points on the left (``b < 0``) and among those on the right (``b > 0``),
+    ``inf`` where none; all in one reduction (a minimum is exact: the bits of each alone)."""
+    inside = np.array(masks)[:, None] & np.array([b < 0, b > 0])      # [M, 2, R, K]
+    return np.minimum.reduce(np.where(inside, across, np.inf), axis=-1)
+
+
+def _or(least: np.ndarray, none: float, less: float | np.ndarray = 0.0) -> np.ndarray:
+    """``least - less``, ``none`` where ``least`` is ``inf`` (no point: the points' values
+    are finite)."""
+    return np.where(least < np.inf, least - less, none)
 
 
 def _obstruction(route: Route, a, b, points, valid, widen, robot: Robot, f: Frame,
@@ -173,22 +181,27 @@ def _obstruction(route: Route, a, b, points, valid, widen, robot: Robot, f: Fram
     ah, bh = rel_heading
     size, position, distance = _obstruction_rows(
         [route], [f], a[None], b[None], points[None], valid[None], widen[None], [robot], cfg,
-        ah[None], bh[None], [kept])
+        ah[None], bh[None], [kept], _bodies((robot,), cfg))
     return float(size[0]), float(position[0]), float(distance[0])
 
 
 def _obstruction_rows(routes: list[Route], frames: list[Frame], a, b, points, valid, widen,
                       robots: list[Robot], cfg: Settings, ah, bh,
-                      kept: list[tuple[float, np.ndarray] | None]):
+                      kept: list[tuple[float, np.ndarray] | None], body: dict[str, np.ndarray]):
     """Each row's ``(size, position, distance)`` of the nearest obstructing object among its
     ``points [R, K, 2]`` (``a``, ``b``: along and across its route; ``ah``, ``bh``: along and
-    across its heading). A point obstructs when it lies in the band swept along the route or
-    in the band swept along the robot's heading (so turning back toward an object it has not
-    yet passed brings it back)."""
-    half = _bodies(tuple(robots), cfg)["band"]
+    across its heading; ``body``: the robots' :func:`_bodies`). A point obstructs when it lies
+    in the band swept along the route or in the band swept along the robot's heading (so
+    turning back toward an object it has not yet passed brings it back)."""
+    size, position = np.zeros(len(routes)), np.zeros(len(routes))
+    distance = np.full(len(routes), NO_OBSTACLE)
     ahead = valid & (a > 0) & (a < cfg.sight)
-    blocking = ahead & (((b + widen > -half) & (b - widen < half)) |
-                        ((ah > 0) & (bh + widen > -half) & (bh - widen < half)))
+    if not ahead.any():
+        return size, position, distance
+    blocking = ahead & (_in_band(b, widen, body["band"])
+                        | ((ah > 0) & _in_band(bh, widen, body["band"])))
+    if not blocking.any():
+        return size, position, distance
     for i, word in enumerate(kept):     # what the route was planned round obstructs only
         if word is None:                # within its word
             continue
@@ -197,12 +210,18 @@ def _obstruction_rows(routes: list[Route], frames: list[Frame], a, b, points, va
         if round_.any():
             blocking[i, round_] = (routes[i].distance(points[i, round_], frames[i].s, cfg.sight)
                                    - widen[i, round_] < least)
-    size, position = np.zeros(len(routes)), np.zeros(len(routes))
-    distance = np.full(len(routes), NO_OBSTACLE)
     for j in np.flatnonzero(blocking.any(axis=1)):
         size[j], position[j], distance[j] = _object(
             routes[j], frames[j], a[j], points[j], ahead[j], blocking[j], widen[j], robots[j], cfg)
     return size, position, distance
+
+
+def _in_band(b: np.ndarray, widen: np.ndarray, half: np.ndarray) -> np.ndarray:
+    """Whether points ``b`` across a line, each widened by ``widen`` on both sides, reach into
+    the band ``half`` either side of it: ``b + widen > -half and b - widen < half``, which is
+    ``|b| - widen < half`` bit for bit (``-(b + widen)`` is ``-b - widen`` exactly, and of
+    ``b - widen`` and ``-b - widen`` the one from ``|b|`` is never the smaller)."""
+    return np.abs(b) - widen < half
 
 
 def _object(route: Route, f: Frame, a, points, ahead, blocking, widen, robot: Robot,
@@ -246,20 +265,35 @@ def free_ways_rows(ah: np.ndarray, bh: np.ndarray, widen: np.ndarray, unknown: n
     """Each row's ``(front, opening)`` from its points ``[R, K]``. Every way tried is a
     direction from the robot's centre; its free length is the distance along it to the
     nearest point inside the body's band, less half the body's length. All at once:
-    ``[rows, bands, ways, points]``. A point at the robot's centre (``ah = bh = 0``, the
+    ``[rows, ways, points]``, one band after the other. A point at the robot's centre (``ah = bh = 0``, the
     padding of a row with fewer points) is ahead on no way."""
-    body = _bodies(tuple(robots), cfg)
+    return _free_ways(ah, bh, widen, unknown, _bodies(tuple(robots), cfg), cfg, route_bearing)
+
+
+def _free_ways(ah: np.ndarray, bh: np.ndarray, widen: np.ndarray, unknown: np.ndarray,
+               body: dict[str, np.ndarray], cfg: Settings,
+               route_bearing: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`free_ways_rows` of robots whose :func:`_bodies` are ``body``."""
     length = body["length"][:, 0]
-    ways = np.repeat(_ways(cfg)[None], len(robots), axis=0)             # [R, W]
+    base = body["ways"]
+    ways = np.empty((len(ah), len(base)))                                  # [R, W]
+    ways[:] = base
     ways[:, 1] = clip_arrays(route_bearing, -cfg.way_fov / 2, cfg.way_fov / 2)
     phi = np.deg2rad(ways)[..., None]
     cos, sin = np.cos(phi), np.sin(phi)
-    ah, bh = ah[:, None], bh[:, None]
-    along = ah * cos + bh * sin                                         # [R, W, K]
-    across = np.abs(-ah * sin + bh * cos) - widen[:, None]
-    bands = body["bands"]
-    inside = (along > 0)[:, None] & (across[:, None] < bands)          # [R, 2, W, K]
-    front = np.where(inside[:, 0, 0] & unknown, along[:, 0], np.inf).min(axis=1, initial=np.inf)
+    ah, bh, widen = ah[:, None], bh[:, None], widen[:, None]
+    along = ah * cos                                                       # [R, W, K]
+    along += bh * sin
+    across = bh * cos                   # -ah * sin + bh * cos, the same bits
+    across -= ah * sin
+    np.abs(across, out=across)
+    across -= widen
+    ahead = along > 0
+    narrow = across < body["way"][..., None]       # the band just clear of the body
+    narrow &= ahead
+    roomy = across < body["roomy"][..., None]      # and the roomier one
+    roomy &= ahead
+    front = np.minimum.reduce(along[:, 0], axis=1, initial=np.inf, where=narrow[:, 0] & unknown)
     front = clip_arrays(front - length, 0.0, cfg.sight)
     # the progress each way offers toward the route's bearing (behind the robot: toward the
     # side it lies on), in a band just clear of the body and in a roomy one, less a little
@@ -267,13 +301,12 @@ def free_ways_rows(ah: np.ndarray, bh: np.ndarray, widen: np.ndarray, unknown: n
     toward = clip_arrays(route_bearing, -90.0, 90.0)
     score = -cfg.way_turn_cost * np.abs(ways)
     weight = np.cos(np.deg2rad(ways - toward[:, None])) + cfg.way_room_weight
-    free = np.where(inside, along[:, None], np.inf).min(axis=3, initial=np.inf)   # [R, 2, W]
-    free -= length[:, None, None]
-    free = clip_arrays(free, 0.0, cfg.way_reach)
-    gain = 0.5 * free * weight[:, None]
-    score += gain[:, 0]
-    score += gain[:, 1]
-    return front, ways[np.arange(len(robots)), score.argmax(axis=1)]
+    for inside in (narrow, roomy):
+        free = np.minimum.reduce(along, axis=2, initial=np.inf, where=inside)    # [R, W]
+        free -= length[:, None]
+        free = clip_arrays(free, 0.0, cfg.way_reach)
+        score += 0.5 * free * weight
+    return front, ways[np.arange(len(ah)), score.argmax(axis=1)]
 
 
 @functools.lru_cache(maxsize=8)
@@ -298,13 +331,20 @@ def nearest_rows(ah: np.ndarray, bh: np.ndarray, robots: list[Robot],
                  cfg: Settings) -> np.ndarray:
     """:func:`nearest` of every row of points ``[R, K]`` (a point at the robot's centre, the
     padding, is not ahead)."""
-    body = _bodies(tuple(robots), cfg)
+    return _nearest(ah, bh, _bodies(tuple(robots), cfg), cfg)
+
+
+def _nearest(ah: np.ndarray, bh: np.ndarray, body: dict[str, np.ndarray],
+             cfg: Settings) -> np.ndarray:
+    """:func:`nearest_rows` of robots whose :func:`_bodies` are ``body``."""
     half, band, length = body["half"], body["near"], body["length"]
-    ahead = (ah > 0) & (np.abs(bh) < band)
+    across = np.abs(bh)
+    ahead = (ah > 0) & (across < band)
     dx = np.maximum(ah - length, 0.0)
-    dy = np.maximum(np.abs(bh) - half, 0.0)
-    gap = _least(ahead, np.hypot(dx, dy), cfg.nearest_cap)
-    return np.where(cfg.nearest_cap < gap, cfg.nearest_cap, gap)      # min(gap, cap)
+    dy = np.maximum(across - half, 0.0)
+    gap = np.minimum.reduce(np.hypot(dx, dy), axis=1, initial=np.inf, where=ahead)
+    return np.where(cfg.nearest_cap < gap, cfg.nearest_cap, gap)      # min(gap, cap): the
+                                                                       # cap with none ahead
 
 
 def clutter(hits: np.ndarray, unknown: np.ndarray, ah: np.ndarray, cfg: Settings,
@@ -344,24 +384,27 @@ def _walls(a, b, valid, robot: Robot, cfg: Settings, far: float,
            objects=None) -> tuple[float, float]:
     """Side gaps from points (a along, b across): walls count from ``wall_behind`` behind to
     ``wall_ahead`` ahead, objects (``objects`` mask) only while beside the robot's body."""
-    left, right = _walls_rows(a[None], b[None], valid[None], [robot], cfg, far,
+    left, right = _walls_rows(a[None], b[None], valid[None], _bodies((robot,), cfg), cfg, far,
                               None if objects is None else objects[None])
     return float(left[0]), float(right[0])
 
 
-def _walls_rows(a, b, valid, robots: list[Robot], cfg: Settings, far: float,
+def _walls_rows(a, b, valid, body: dict[str, np.ndarray], cfg: Settings, far: float,
                 objects=None) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`_walls` of every row of points ``[R, K]``."""
-    body = _bodies(tuple(robots), cfg)
-    half = body["half"]
+    """:func:`_walls` of every row of points ``[R, K]`` (``body``: the robots'
+    :func:`_bodies`)."""
+    across = np.abs(b)
+    left, right = _beside(b, across, [_walls_near(a, across, valid, body, cfg, objects)])[0]
+    return _or(left, far, body["half"][:, 0]), _or(right, far, body["half"][:, 0])
+
+
+def _walls_near(a, across, valid, body: dict[str, np.ndarray], cfg: Settings,
+                objects=None) -> np.ndarray:
+    """Which points ``[R, K]`` (``a`` along the route, ``across`` its distance from it)
+    :func:`_walls` measures the side gaps to."""
     ahead = cfg.wall_ahead if objects is None else np.where(objects, body["length"],
                                                             cfg.wall_ahead)
-    near = valid & (a >= -cfg.wall_behind) & (a <= ahead) & (np.abs(b) >= half)
-    left, right = near & (b < 0), near & (b > 0)
-    return (np.where(left.any(axis=1), np.where(left, -b, np.inf).min(axis=1, initial=np.inf)
-                     - half[:, 0], far),
-            np.where(right.any(axis=1), np.where(right, b, np.inf).min(axis=1, initial=np.inf)
-                     - half[:, 0], far))
+    return valid & (a >= -cfg.wall_behind) & (a <= ahead) & (across >= body["half"])
 
 
 def _common(route: Route, p, heading: float, f: Frame, road: float, robot: Robot,
@@ -556,6 +599,7 @@ def perceive_rows(rows: list[Sight], max_range: float,
     elementwise, with exact minima; what depends on a row's route, its map or a matrix
     product of its own beams row by row."""
     robots = [r.robot for r in rows]
+    body = _bodies(tuple(robots), cfg)
     p = np.array([r.pose[:2] for r in rows])                            # [R, 2]
     dirs = _stack([r.dirs for r in rows])
     measured = _stack([r.measured for r in rows])
@@ -564,28 +608,30 @@ def perceive_rows(rows: list[Sight], max_range: float,
     a = np.matmul(rel, _stack([r.f.t for r in rows])[..., None])[..., 0]   # rel @ f.t, rows
     b = np.matmul(rel, _stack([r.f.n for r in rows])[..., None])[..., 0]
     valid = measured < max_range * 0.999
-    threshold = np.array([r.threshold for r in rows])[:, None]
-    obstacle_hit = valid & (measured < _stack([r.expected for r in rows]) - threshold)
-    left, right = _road_rows(a, b, valid & ~obstacle_hit, cfg.window, max_range)
-    road = left + right
-    widen = measured * np.array([r.spacing for r in rows])[:, None] / 2
-    in_way = valid & ~obstacle_hit & (a > 0)    # drawn on the map, but where the robot's
-    some = np.flatnonzero(in_way.any(axis=1))   # route would hit it
-    if len(some):
-        gone = distances([rows[i].route for i in some], [rows[i].f.s for i in some],
-                         cfg.sight, hits[some])
-        reach = np.array([rows[i].robot.width / 2 + rows[i].robot.safety_margin
-                          for i in some])[:, None]
-        in_way[some] &= gone <= reach
-    ah, bh, valid_ah, valid_bh = _own_frames(rows, rel, valid)
+    obstacle_hit = valid & (measured < _stack([r.expected for r in rows])
+                            - _column([r.threshold for r in rows]))
+    known = valid ^ obstacle_hit        # valid & ~obstacle_hit (which lies within valid)
+    across = np.abs(b)                  # the walls beside the road, and beside the robot
+    (left, right), walls = _beside(b, across, [
+        known & (np.abs(a) <= cfg.window),
+        _walls_near(a, across, valid, body, cfg, obstacle_hit)])            # (_road_rows)
+    road = _or(left, max_range) + _or(right, max_range)
+    widen = measured * _column([r.spacing for r in rows]) / 2
+    obstructing = obstacle_hit | _in_way(rows, known & (a > 0), hits, cfg)
+    headings = [r.pose[2] for r in rows]
+    valid_ah, valid_bh = _own_frames(headings, rel, valid)
+    if obstructing.any():
+        ah, bh = _own_frames_all(headings, rel)
+    else:                       # what does not obstruct is not asked where it lies
+        ah, bh = valid_ah, valid_bh
     size, position, distance = _obstruction_rows(
-        [r.route for r in rows], [r.f for r in rows], a, b, hits, obstacle_hit | in_way,
-        widen, robots, cfg, ah, bh, [r.kept for r in rows])
+        [r.route for r in rows], [r.f for r in rows], a, b, hits, obstructing,
+        widen, robots, cfg, ah, bh, [r.kept for r in rows], body)
     common = np.array([_common(r.route, p[i], r.pose[2], r.f, float(road[i]), r.robot, cfg,
                                r.target, r.room) for i, r in enumerate(rows)])
     heading = common[:, 0]
-    wl, wr = _walls_rows(a, b, valid, robots, cfg, max_range, obstacle_hit)
-    front, opening = free_ways_rows(valid_ah, valid_bh, widen, obstacle_hit, robots, cfg, heading)
+    wl, wr = _or(walls, max_range, body["half"][:, 0])                    # (_walls_rows)
+    front, opening = _free_ways(valid_ah, valid_bh, widen, obstacle_hit, body, cfg, heading)
     ring = np.array([len(r.dirs) > 2 and float(r.dirs[0] @ r.dirs[-1])
                      >= float(r.dirs[0] @ r.dirs[1]) - 1e-9 for r in rows])
     return {"road": road, "size": size, "position": position, "obstacle": distance,
@@ -593,17 +639,50 @@ def perceive_rows(rows: list[Sight], max_range: float,
                                          r.target) for i, r in enumerate(rows)]),
             "lane": common[:, 1], "goal": common[:, 2], "gap_left": wl, "gap_right": wr,
             "front": front, "opening": opening,
-            "clutter": clutter_rows(hits, valid & obstacle_hit, ah, cfg, ring),
-            "nearest": nearest_rows(valid_ah, valid_bh, robots, cfg)}
+            "clutter": clutter_rows(hits, obstacle_hit, ah, cfg, ring),
+            "nearest": _nearest(valid_ah, valid_bh, body, cfg)}
 
 
-@functools.lru_cache(maxsize=64)
+def _in_way(rows: list[Sight], ahead: np.ndarray, hits: np.ndarray, cfg: Settings) -> np.ndarray:
+    """Which of the points ``hits [R, B, 2]`` ahead of their robots (``ahead``) and drawn on
+    its map stand where its route would hit them: within half its width plus its safety
+    margin of the route within ``sight``. Only the points some row asks about are measured
+    (a point's distance from a route is its own arithmetic, whatever else is measured)."""
+    cols = ahead.any(axis=0).nonzero()[0]
+    if not len(cols):
+        return ahead
+    some = ahead.any(axis=1).nonzero()[0] if len(rows) > 1 else np.zeros(1, dtype=np.intp)
+    asked = [rows[i] for i in some]
+    at = np.s_[:, cols] if len(asked) == len(rows) else np.ix_(some, cols)
+    gone = distances([r.route for r in asked], [r.f.s for r in asked], cfg.sight, hits[at])
+    ahead[at] &= gone <= _column([r.robot.width / 2 + r.robot.safety_margin for r in asked])
+    return ahead
+
+
 def _bodies(robots: tuple[Robot, ...], cfg: Settings) -> dict[str, np.ndarray]:
     """The robots' measures perception works with, ``[R, 1]`` each (read-only): half the
     width (``half``), half the length (``length``), the half width of the band an object
-    obstructs in (``band``), of a way (``way``) and of the band ``nearest`` looks in
-    (``near``), each the one robot's arithmetic; and both bands a way is scored in,
-    ``[R, 2, 1, 1]``."""
+    obstructs in (``band``), of a way (``way``), of the roomier band a way is also scored
+    in (``roomy``) and of the band ``nearest`` looks in (``near``), each the one robot's
+    arithmetic; and the ways :func:`free_ways` tries (``ways``, :func:`_ways`). Looked up by
+    the robots' and settings' identities first (hashing a :class:`Settings` costs more than
+    the look-up saves, every tick), then by value."""
+    key = (*map(id, robots), id(cfg))
+    hit = _BODIES.get(key)
+    if hit is None:
+        if len(_BODIES) >= 64:
+            _BODIES.clear()
+        hit = _BODIES[key] = (robots, cfg, _measures(robots, cfg))   # holds them: ids stay
+    return hit[2]
+
+
+#: :func:`_bodies` by the identities of the robots and settings (which it keeps alive).
+_BODIES: dict[tuple[int, ...], tuple[tuple[Robot, ...], Settings, dict[str, np.ndarray]]] = {}
+
+
+@functools.lru_cache(maxsize=64)
+def _measures(robots: tuple[Robot, ...], cfg: Settings) -> dict[str, np.ndarray]:
+    """:func:`_bodies` by value."""
     def column(values) -> np.ndarray:
         return np.array(list(values), dtype=float)[:, None]
 
@@ -611,9 +690,9 @@ def _bodies(robots: tuple[Robot, ...], cfg: Settings) -> dict[str, np.ndarray]:
            "length": column(r.length / 2 for r in robots),
            "band": column(r.width / 2 + cfg.band_margin for r in robots),
            "way": column(r.width / 2 + cfg.way_margin for r in robots),
-           "near": column(r.width / 2 + cfg.nearest_band for r in robots)}
-    way = out["way"][:, 0]
-    out["bands"] = np.stack([way, way + cfg.way_room], axis=1)[:, :, None, None]
+           "roomy": column(r.width / 2 + cfg.way_margin + cfg.way_room for r in robots),
+           "near": column(r.width / 2 + cfg.nearest_band for r in robots),
+           "ways": _ways(cfg)}
     for a in out.values():
         a.flags.writeable = False
     return out
@@ -624,19 +703,31 @@ def _stack(arrays: list[np.ndarray]) -> np.ndarray:
     return arrays[0][None] if len(arrays) == 1 else np.stack(arrays)
 
 
-def _own_frames(rows: list[Sight], rel: np.ndarray,
-                valid: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """The points ``rel [R, B, 2]`` in each robot's own frame (:func:`_own_frame`): all of
-    them, and the valid ones alone (as a robot alone computes them, from those points only;
-    the others read 0, the robot's centre)."""
-    cs = np.array([(math.cos(r.pose[2]), math.sin(r.pose[2])) for r in rows])   # [R, 2]
-    along = np.matmul(rel, cs[..., None])[..., 0]                       # rel @ [c, s]
-    across = np.matmul(rel, np.stack([cs[:, 1], -cs[:, 0]], axis=1)[..., None])[..., 0]
-    valid_along, valid_across = np.zeros(valid.shape), np.zeros(valid.shape)
-    for i, r in enumerate(rows):
-        valid_along[i, valid[i]], valid_across[i, valid[i]] = _own_frame(rel[i][valid[i]],
-                                                                         r.pose[2])
-    return along, across, valid_along, valid_across
+def _column(values: list[float]) -> float | np.ndarray:
+    """One value per row as a column ``[R, 1]`` to broadcast against ``[R, K]`` (the value
+    itself for one row: the same arithmetic, element by element)."""
+    return values[0] if len(values) == 1 else np.array(values)[:, None]
+
+
+def _own_frames(headings: list[float], rel: np.ndarray,
+                valid: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The valid points of ``rel [R, B, 2]`` in each robot's own frame, as a robot alone
+    computes them (:func:`_own_frame`, from those points only); the others read 0, the
+    robot's centre."""
+    along, across = np.zeros((2,) + valid.shape)
+    for i, heading in enumerate(headings):
+        mine = valid[i]
+        along[i, mine], across[i, mine] = _own_frame(rel[i][mine], heading)
+    return along, across
+
+
+def _own_frames_all(headings: list[float], rel: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """All the points ``rel [R, B, 2]`` in each robot's own frame (the products of
+    :func:`_own_frame`, row by row)."""
+    cs = np.array([(math.cos(h), math.sin(h), math.sin(h), -math.cos(h)) for h in headings])
+    along = np.matmul(rel, cs[:, :2, None])[..., 0]                     # rel @ [c, s]
+    across = np.matmul(rel, cs[:, 2:, None])[..., 0]                    # rel @ [s, -c]
+    return along, across
 
 
 def pursuit(route: Route, f: Frame, p: np.ndarray, bearing: float, cfg: Settings,

@@ -68,8 +68,9 @@ class Route:
             return self._points_at_masked(s)
         a, e, _, _, span = self._segments
         last = len(cum) - 2
-        j = min(bisect.bisect_right(cum, lo) - 1, last)
-        if j != min(bisect.bisect_right(cum, hi) - 1, last):      # more than one segment
+        first = min(bisect.bisect_right(cum, lo) - 1, last)
+        j: int | np.ndarray = first
+        if first != min(bisect.bisect_right(cum, hi) - 1, last):      # more than one segment
             j = np.minimum(np.searchsorted(self.cum, s, side="right") - 1, last)
         return a[j] + ((s - self.cum[j]) / span[j])[:, None] * e[j]
 
