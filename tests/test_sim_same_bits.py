@@ -624,7 +624,8 @@ def test_road_and_side_gaps_from_one_reduction_are_the_plain_minima():
                             np.where(mask, values, np.inf).min(axis=1, initial=np.inf), none)
 
         side = valid & (np.abs(a) <= cfg.window)
-        got = perception._road_rows(a, b, valid, cfg.window, 200.0)
+        (left, right), = perception._beside(b, np.abs(b), [side])      # as perceive_rows
+        got = perception._or(left, 200.0), perception._or(right, 200.0)
         assert same(got[0], least(side & (b < 0), -b, 200.0))
         assert same(got[1], least(side & (b > 0), b, 200.0))
         ahead = np.where(objects, length, cfg.wall_ahead)

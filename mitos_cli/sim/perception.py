@@ -148,18 +148,6 @@ def frames(routes: list[Route], p: np.ndarray, hints) -> list[Frame]:
             for s, e, t in projections(routes, p, hints)]
 
 
-def _road(a, b, valid, window: float, far: float) -> tuple[float, float]:
-    left, right = _road_rows(a[None], b[None], valid[None], window, far)
-    return float(left[0]), float(right[0])
-
-
-def _road_rows(a, b, valid, window: float, far: float) -> tuple[np.ndarray, np.ndarray]:
-    """Each row's nearest wall on the left and on the right among points ``[R, K]`` within
-    ``window`` along the route (``far`` with none)."""
-    left, right = _beside(b, np.abs(b), [valid & (np.abs(a) <= window)])[0]
-    return _or(left, far), _or(right, far)
-
-
 def _beside(b: np.ndarray, across: np.ndarray, masks: list[np.ndarray]) -> np.ndarray:
     """``[M, 2, R]``: for each of the ``masks [R, K]``, each row's least ``across`` (``|b|``)
     among its points on the left (``b < 0``) and among those on the right (``b > 0``),
@@ -613,8 +601,8 @@ def perceive_rows(rows: list[Sight], max_range: float,
     known = valid ^ obstacle_hit        # valid & ~obstacle_hit (which lies within valid)
     across = np.abs(b)                  # the walls beside the road, and beside the robot
     (left, right), walls = _beside(b, across, [
-        known & (np.abs(a) <= cfg.window),
-        _walls_near(a, across, valid, body, cfg, obstacle_hit)])            # (_road_rows)
+        known & (np.abs(a) <= cfg.window),                      # the road's walls
+        _walls_near(a, across, valid, body, cfg, obstacle_hit)])             # the side gaps'
     road = _or(left, max_range) + _or(right, max_range)
     widen = measured * _column([r.spacing for r in rows]) / 2
     obstructing = obstacle_hit | _in_way(rows, known & (a > 0), hits, cfg)
