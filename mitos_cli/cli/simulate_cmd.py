@@ -206,11 +206,7 @@ def simulate_command(
     from ..sim.planner import make_planner, planner_kind
     from ..sim.worldfile import load_world, resolve_world_path
 
-    require = None if require is None else require.lower()   # any case, as --to's names
-    if require is not None and require not in REQUIRE:     # a wrong name: as a planner's
-        from ..errors import unknown
-
-        raise unknown("--require outcome", require, REQUIRE)
+    require = _checked_require(require)
     planner_kind(planner_name)                  # an unknown name fails before any file is read
     if plot is not None:                        # before the run, as `plot -o` does
         from .plot_cmd import picture_path
@@ -220,21 +216,45 @@ def simulate_command(
         raise typer.BadParameter(f"--rulebase and --behavior choose the fuzzy planner's rules; "
                                  f"`{planner_name}` has none", param_hint="--planner")
     live = live or speed is not None
-    names = worlds or [DEFAULT_WORLD]
-    loaded = [load_world(resolve_world_path(n)) for n in names]
+    loaded = [load_world(resolve_world_path(n)) for n in worlds or [DEFAULT_WORLD]]
     _check_outputs((("--out", out), ("--plot", plot), ("--animate", animate)),
                    [Path(w.path) for w in loaded if w.path] + ([Path(rulebase)] if rulebase else []))
     for path in (out, plot, animate):         # before the run, not after it
         if path is not None:
             check_directory(path)
     many = len(loaded) > 1 or runs > 0
+    _check_run_options(many, len(loaded), runs, randomise, out, trace, live, animate, plot)
+    planner = make_planner(planner_name, loaded[0], rulebase, behavior)
+    if many:
+        _simulate_many(loaded, runs, seed, planner, workers, plot, as_json, require)
+    else:
+        _simulate_one(loaded[0], planner, seed, randomise, live, speed, trace, every, as_json,
+                      out, plot, animate, fps, require)
+
+
+def _checked_require(require: str | None) -> str | None:
+    """``--require``'s outcome in lower case (any case is taken, as ``--to``'s names are)."""
+    if require is None:
+        return None
+    require = require.lower()
+    if require not in REQUIRE:                # a wrong name: as a planner's
+        from ..errors import unknown
+
+        raise unknown("--require outcome", require, REQUIRE)
+    return require
+
+
+def _check_run_options(many: bool, worlds: int, runs: int, randomise: bool, out, trace: bool,
+                       live: bool, animate, plot) -> None:
+    """Usage errors among the options, and a picture format or a missing matplotlib, all
+    before any run: a mistake found after a long run costs the run."""
     if randomise and runs > 0:                # not "give one world": it was one
         raise typer.BadParameter("--runs randomises every run already; --randomise replays "
                                  "one of them (with --seed)", param_hint="--randomise")
     if many and (out or trace or live or randomise or animate):
         raise typer.BadParameter("--out, --animate, --trace, --live, --speed and --randomise "
                                  "work on one world and one run; drop --runs or give one world")
-    if plot is not None and len(loaded) > 1:
+    if plot is not None and worlds > 1:
         raise typer.BadParameter("--plot draws one world (with --runs, all its runs in one "
                                  "picture); give one world", param_hint="--plot")
     if plot is not None:
@@ -252,59 +272,44 @@ def simulate_command(
                 f"animation formats are " + " and ".join(f".{f}" for f in MOVIES),
                 param_hint="--animate")
         check_animation(animate)
-    if plot is not None or animate is not None:     # before the run, not after it
+    if plot is not None or animate is not None:
         from ..draw.output import require_matplotlib
 
         require_matplotlib()
-    planner = make_planner(planner_name, loaded[0], rulebase, behavior)
 
-    if many:
-        result, stopped = _run_many(loaded, runs, seed, planner, workers, plot, as_json)
-        if stopped is not None:
-            if not result.worlds:
-                err(f"interrupted before any run finished (0 of {stopped}); nothing written")
-                raise typer.Exit(INTERRUPTED)
-            plot = plot if len(result.worlds) == len(loaded) else None
-        if plot is not None:
-            result = _draw_runs(result, loaded[0], plot)
-        if as_json:
-            emit(json_text(result.to_json()))
-        else:
-            emit(_runs_table(result))
-        if plot is not None:
-            err(f"wrote picture of {len(result.worlds[0].summaries)} runs to {plot}")
-        if stopped is not None:
-            done = sum(len(w.summaries) for w in result.worlds)
-            what = "the JSON has" if as_json else "the table has"
-            err(f"interrupted: {what} the {done} of {stopped} runs that had finished "
-                f"(their seeds: runs_detail in --json)")
+
+def _simulate_many(loaded, runs: int, seed, planner, workers, plot, as_json: bool,
+                   require: str | None) -> None:
+    """Several worlds or ``--runs``: the outcome table (or JSON) and the runs' picture; after
+    Ctrl-C, what finished."""
+    result, stopped = _run_many(loaded, runs, seed, planner, workers, plot, as_json)
+    if stopped is not None:
+        if not result.worlds:
+            err(f"interrupted before any run finished (0 of {stopped}); nothing written")
             raise typer.Exit(INTERRUPTED)
-        failed = any(s["outcome"] != "success" for w in result.worlds for s in w.summaries)
-        if require and failed:
-            raise typer.Exit(3)
-        return
+        plot = plot if len(result.worlds) == len(loaded) else None
+    if plot is not None:
+        result = _draw_runs(result, loaded[0], plot)
+    emit(json_text(result.to_json()) if as_json else _runs_table(result))
+    if plot is not None:
+        err(f"wrote picture of {len(result.worlds[0].summaries)} runs to {plot}")
+    if stopped is not None:
+        done = sum(len(w.summaries) for w in result.worlds)
+        what = "the JSON has" if as_json else "the table has"
+        err(f"interrupted: {what} the {done} of {stopped} runs that had finished "
+            f"(their seeds: runs_detail in --json)")
+        raise typer.Exit(INTERRUPTED)
+    failed = any(s["outcome"] != "success" for w in result.worlds for s in w.summaries)
+    if require and failed:
+        raise typer.Exit(3)
 
-    from ..sim.loop import prepare, shared_scene, simulate
 
-    world = loaded[0]
-    scene = shared_scene(world, randomise)      # None: the draw moves what the robot is given
-    if live:
-        from ..sim.live import LiveView
-
-        try:
-            with LiveView(world, scene or prepare(world),
-                          speed=1.0 if speed is None else speed) as view:
-                res = simulate(world, planner, seed, randomise=randomise, scene=scene,
-                               on_tick=view.update)
-        except KeyboardInterrupt:
-            err("interrupted: nothing written (the view shows the last tick drawn)")
-            raise typer.Exit(INTERRUPTED) from None
-    else:
-        try:
-            res = simulate(world, planner, seed, randomise=randomise, scene=scene)
-        except KeyboardInterrupt:
-            err("interrupted before the run ended: nothing written")
-            raise typer.Exit(INTERRUPTED) from None
+def _simulate_one(world, planner, seed, randomise: bool, live: bool, speed, trace: bool,
+                  every: int, as_json: bool, out, plot, animate, fps: float,
+                  require: str | None) -> None:
+    """One run: its verdict and figures (or JSON), and the trace, CSV, picture and
+    animation asked for."""
+    res = _run_one(world, planner, seed, randomise, live, speed)
     if trace:
         from ..sim.export import traces
 
@@ -338,3 +343,24 @@ def simulate_command(
     if require and res.outcome != require:
         raise typer.Exit(3)
     sys.stdout.flush()
+
+
+def _run_one(world, planner, seed, randomise: bool, live: bool, speed):
+    """The run, shown live on the terminal if asked; Ctrl-C ends the command, writing
+    nothing."""
+    from ..sim.loop import prepare, shared_scene, simulate
+
+    scene = shared_scene(world, randomise)      # None: the draw moves what the robot is given
+    try:
+        if not live:
+            return simulate(world, planner, seed, randomise=randomise, scene=scene)
+        from ..sim.live import LiveView
+
+        with LiveView(world, scene or prepare(world),
+                      speed=1.0 if speed is None else speed) as view:
+            return simulate(world, planner, seed, randomise=randomise, scene=scene,
+                            on_tick=view.update)
+    except KeyboardInterrupt:
+        err("interrupted: nothing written (the view shows the last tick drawn)" if live
+            else "interrupted before the run ended: nothing written")
+        raise typer.Exit(INTERRUPTED) from None
