@@ -343,15 +343,45 @@ def parse_world(text: str, path: str) -> World:
     r = _Reader(path)
     doc = yamlpos.load(text, path, WorldError)
     top = r.mapping(doc, Span.in_text(text, path, 1, 1), "the world file", TOP_KEYS)
+    name = _name(top)
+    seed = _seed(r, top)
+    dt, limit, substeps = _timing(r, top)
+    robot = read_robot(r, yamlpos.require(top, "robot", WorldError, "the world file"),
+                       top.value_span("robot"))
+    sensors = _sensors(r, top)
+    agents, agent_spans = _agents(r, top, robot)
+    corridors, grid, knows, given = _map(r, top, path)
+    min_clearance, replan = _route(r, top)
+    obstacles = _obstacles(r, top)
+    randomise = (read_randomise(r, top["randomise"], top.value_span("randomise"),
+                                [o.name for o in obstacles])
+                 if "randomise" in top else Randomise())
+    world = World(name, path, seed, dt, limit, substeps, tuple(agents), sensors,
+                  tuple(corridors), grid, tuple(obstacles), randomise,
+                  _behavior(top), knows, given, min_clearance, replan,
+                  top.value_span("behavior") if "behavior" in top else None)
+    check_free(world, agent_spans)
+    check_starts(world, [s for s, _ in agent_spans])
+    if "randomise" in top:
+        check_jitters(world, top["randomise"].get("obstacles"))
+    return world
+
+
+def _name(top: YMap) -> str:
+    """The world's ``name``: text, printable (it is printed in every table and title)."""
     name = yamlpos.require(top, "name", WorldError, "the world file")
     if not isinstance(name, str):                   # `name: [1, 2]` printed as a title
         raise WorldError("the world's `name` must be text", span=top.value_span("name"),
                          hint=f'quote it: name: "{name}"' if isinstance(name, (int, float))
                          else "name: corridor")
-    if any(not c.isprintable() for c in name):      # it is printed in every table and title
+    if any(not c.isprintable() for c in name):
         raise WorldError("the world's name holds a control character",
                          span=top.value_span("name"), hint="letters, digits, `-`, `_`, spaces")
-    seed = _seed(r, top)
+    return name
+
+
+def _timing(r: _Reader, top: YMap) -> tuple[float, float, int]:
+    """``dt``, ``time_limit`` and ``substeps``: at least one tick, at most ``MAX_TICKS``."""
     dt = r.number(top, "dt", "the world file", None, positive=True, maximum=1.0)
     limit = r.number(top, "time_limit", "the world file", None, positive=True)
     if limit < dt:                                  # no tick would be run: no result
@@ -364,10 +394,20 @@ def parse_world(text: str, path: str) -> World:
                          hint="a larger dt (0.05 s is the packaged worlds'), or a shorter "
                               "time_limit")
     substeps = r.number(top, "substeps", "the world file", 1.0, minimum=1, maximum=100)
-    robot = read_robot(r, yamlpos.require(top, "robot", WorldError, "the world file"),
-                       top.value_span("robot"))
-    sensors = (read_sensors(r, top["sensors"], top.value_span("sensors"))
-               if "sensors" in top else Sensors())
+    return dt, limit, int(substeps)
+
+
+def _sensors(r: _Reader, top: YMap) -> Sensors:
+    """``sensors``, or the default ring."""
+    return (read_sensors(r, top["sensors"], top.value_span("sensors"))
+            if "sensors" in top else Sensors())
+
+
+def _agents(r: _Reader, top: YMap,
+            robot: Robot) -> tuple[list[Agent], list[tuple[Span, Span]]]:
+    """The first robot (``robot``, read already, ``q_init``, ``q_goal``) and the others under
+    ``robots`` (their own ``robot`` or the first's), each with the spans of its start and
+    goal (their checks point there)."""
     start = read_pose(r, yamlpos.require(top, "q_init", WorldError, "the world file"),
                       top.value_span("q_init"), "q_init")
     goal = read_goal(r, yamlpos.require(top, "q_goal", WorldError, "the world file"),
@@ -391,7 +431,11 @@ def parse_world(text: str, path: str) -> World:
                                       a.value_span("q_goal"), f"q_goal of `{aname}`")))
         agent_spans.append((a.value_span("q_init"), a.value_span("q_goal")))
     agents = [replace(agent, goal_span=g) for agent, (_, g) in zip(agents, agent_spans)]
+    return agents, agent_spans
 
+
+def _map(r: _Reader, top: YMap, path: str):
+    """``map``: its corridors, its grid (a map_server YAML), and what the robot is given."""
     mp = r.mapping(yamlpos.require(top, "map", WorldError, "the world file"),
                    top.value_span("map"), "map", MAP_KEYS)
     corridors = []
@@ -413,33 +457,30 @@ def parse_world(text: str, path: str) -> World:
     if grid is None:
         _check_extent(corridors, mp.value_span("corridors"))
     knows, given = read_given(mp, path, unknown_occupied)
-    min_clearance, replan = None, "clearance"
-    if "route" in top:
-        rt = r.mapping(top["route"], top.value_span("route"), "route", ROUTE_KEYS)
-        if "min_clearance" in rt:
-            min_clearance = r.number(rt, "min_clearance", "route", positive=True)
-        replan = r.choice(rt, "replan", REPLANS, "route", "clearance")
+    return corridors, grid, knows, given
 
-    obstacles = []
-    for i, item in enumerate(_list(top, "obstacles")):
-        obstacles.append(read_obstacle(r, item, top["obstacles"].item_span(i), i))
-    names = [o.name for o in obstacles]
-    counts = Counter(names)                 # names.count per obstacle was N^2
+
+def _route(r: _Reader, top: YMap) -> tuple[float | None, str]:
+    """``route``: the least clearance the route keeps (None: the robot's own) and how it is
+    replanned."""
+    if "route" not in top:
+        return None, "clearance"
+    rt = r.mapping(top["route"], top.value_span("route"), "route", ROUTE_KEYS)
+    min_clearance = (r.number(rt, "min_clearance", "route", positive=True)
+                     if "min_clearance" in rt else None)
+    return min_clearance, r.choice(rt, "replan", REPLANS, "route", "clearance")
+
+
+def _obstacles(r: _Reader, top: YMap) -> list[Obstacle]:
+    """``obstacles``, each named once."""
+    obstacles = [read_obstacle(r, item, top["obstacles"].item_span(i), i)
+                 for i, item in enumerate(_list(top, "obstacles"))]
+    counts = Counter(o.name for o in obstacles)     # names.count per obstacle was N^2
     for i, o in enumerate(obstacles):
         if counts[o.name] > 1:
             raise WorldError(f"two obstacles are named `{o.name}`",
                              span=top["obstacles"].item_span(i))
-    randomise = (read_randomise(r, top["randomise"], top.value_span("randomise"), names)
-                 if "randomise" in top else Randomise())
-    world = World(name, path, seed, dt, limit, int(substeps), tuple(agents), sensors,
-                  tuple(corridors), grid, tuple(obstacles), randomise,
-                  _behavior(top), knows, given, min_clearance, replan,
-                  top.value_span("behavior") if "behavior" in top else None)
-    check_free(world, agent_spans)
-    check_starts(world, [s for s, _ in agent_spans])
-    if "randomise" in top:
-        check_jitters(world, top["randomise"].get("obstacles"))
-    return world
+    return obstacles
 
 
 def read_given(mp: YMap, path: str, unknown_occupied: bool):
