@@ -70,16 +70,25 @@ def teach_command(
                        "printed; schema in docs/teach.md) instead of the transcript.")] = False,
 ) -> None:
     """Teach a rule base: tell rules and behaviors, correct outputs, adapt, save."""
-    from ..api import default_rulebase_path
-    from ..errors import LessonError
-    from ..teach.journal import Journal, find_session, new_session_dir
-    from ..teach.lesson import read_lesson, run_lesson
-    from ..teach.progress import epoch_progress
     from ..teach.prompt import interact
-    from ..teach.session import Session
-    from .output import emit, err
+    from .output import emit
 
-    lesson_text = None
+    _check_options(rules, behavior, lesson, save_as, resume, session_name, recover, as_json)
+    transcript = Transcript() if as_json else None
+    out = transcript.out if transcript is not None else emit      # what the session prints
+    if resume:
+        session, lesson_text = _resumed(session_name, recover, save_as, out), None
+    else:
+        session, lesson_text = _new_session(rules, behavior, lesson, save_as, out)
+    if lesson is not None:
+        _teach_lesson(session, lesson, lesson_text, transcript)
+        return
+    interact(session, session.journal.directory / "history")
+
+
+def _check_options(rules, behavior, lesson, save_as, resume: bool, session_name, recover: bool,
+                   as_json: bool) -> None:
+    """The options that do not go together, before a session is opened or created."""
     if recover and not resume:
         raise typer.BadParameter("--recover applies to a resumed session: add --resume")
     if save_as is not None and not save_as.endswith(".rules"):
@@ -87,73 +96,95 @@ def teach_command(
                                  f"not `{save_as}`")
     if as_json and lesson is None:
         raise typer.BadParameter("--json reports a lesson: add --lesson FILE")
-    transcript = Transcript() if as_json else None
-    out = transcript.out if transcript is not None else emit      # what the session prints
     if session_name is not None and not resume:
         raise typer.BadParameter("--session names a session to resume: add --resume")
-    if resume:
-        if rules is not None or behavior is not None:
-            raise typer.BadParameter("--resume continues a session with its own rule file and "
-                                     "behavior; give neither RULES nor --behavior")
-        try:
-            journal = Journal.open(find_session(session_name), recover=recover)
-            session = Session.resume(journal, out=out, progress=epoch_progress,
-                                     recover=recover)
-        except LessonError as exc:          # the session, not a lesson, is what is wrong
-            exc.kind = "session error"
-            raise
-        if save_as is not None:
-            session.save_as = Path(save_as)
-        err(f"resumed session {journal.directory.name}: {plural(len(journal.active()), 'change')}, "
-            f"{plural(len(session.state.examples), 'example')}, behavior {session.state.active}"
-            + (f"; the last change was incomplete (the journal was cut short during a write) "
-               f"and was dropped; the journal as it was is kept as {journal.aside}"
-               if journal.skipped_tail else "")
-            + (f"; recovered up to the damaged line {journal.recovered_at} of the journal "
-               f"(kept as {journal.aside})" if journal.recovered_at else "")
-            + (f"; behavior `{session.state.block}` is still open (`end` closes it)"
-               if session.state.block is not None else ""))
-    else:
-        from ..resources import resolve
+    if resume and (rules is not None or behavior is not None):
+        raise typer.BadParameter("--resume continues a session with its own rule file and "
+                                 "behavior; give neither RULES nor --behavior")
 
-        path = Path(rules) if rules is not None else default_rulebase_path()
-        if rules is not None and not path.exists():      # as eval and check: a packaged file
-            path = resolve("rulebases", rules, ".rules") or path
-        if not path.is_file():
-            from ..errors import RuleBaseError
 
-            raise RuleBaseError(f"`{path}` is a directory, not a rule file" if path.is_dir()
-                                else f"rule file `{path}` not found")
-        # A bad rule file, behavior or lesson is refused before a session exists: an empty
-        # session would be the newest, the one `mitos teach --resume` picks.
-        from ..api import load_rulebase
+def _resumed(session_name, recover: bool, save_as, out):
+    """The session ``--resume`` continues, replayed from its journal; what was found in the
+    journal is said on stderr."""
+    from ..errors import LessonError
+    from ..teach.journal import Journal, find_session
+    from ..teach.progress import epoch_progress
+    from ..teach.session import Session
+    from .output import err
 
-        load_rulebase(path, behavior)
-        if lesson is not None:
-            lesson_text = read_lesson(lesson)
-        journal = Journal.create(new_session_dir(path.stem))
-        session = Session(path, behavior, journal, save_as, out=out, progress=epoch_progress)
-        err(f"session {journal.directory.name} (journal in {journal.directory.as_posix()}; "
-            f"`mitos teach --resume` continues it)")
-    if lesson is not None:
-        text, name = lesson_text if lesson_text is not None else read_lesson(lesson)
-        session.echo = transcript.command if transcript is not None else emit
-        if lesson != "-":
-            session.base = Path(name).parent
-        try:
-            run_lesson(session, text, name)
-        except KeyboardInterrupt:
-            err(f"interrupted: every change so far is in the journal; `mitos teach --resume "
-                f"--session {journal.directory.name}` continues")
-            raise typer.Exit(130) from None
-        if session.state.block is not None:
-            err(f"warning: the lesson ended with behavior `{session.state.block}` still open; "
-                f"`end` closes it (`mitos teach --resume --session {journal.directory.name}`)")
-        if session.save_as is not None and session.unsaved:
-            if transcript is not None:
-                transcript.command("save (the lesson ended with unsaved changes)")
-            session.run("save")
+    try:
+        journal = Journal.open(find_session(session_name), recover=recover)
+        session = Session.resume(journal, out=out, progress=epoch_progress, recover=recover)
+    except LessonError as exc:          # the session, not a lesson, is what is wrong
+        exc.kind = "session error"
+        raise
+    if save_as is not None:
+        session.save_as = Path(save_as)
+    err(f"resumed session {journal.directory.name}: {plural(len(journal.active()), 'change')}, "
+        f"{plural(len(session.state.examples), 'example')}, behavior {session.state.active}"
+        + (f"; the last change was incomplete (the journal was cut short during a write) "
+           f"and was dropped; the journal as it was is kept as {journal.aside}"
+           if journal.skipped_tail else "")
+        + (f"; recovered up to the damaged line {journal.recovered_at} of the journal "
+           f"(kept as {journal.aside})" if journal.recovered_at else "")
+        + (f"; behavior `{session.state.block}` is still open (`end` closes it)"
+           if session.state.block is not None else ""))
+    return session
+
+
+def _new_session(rules, behavior, lesson, save_as, out):
+    """A new session on ``rules`` (a path, or a packaged rule base's name, as ``eval`` and
+    ``check`` take it) and the lesson's text, read first: a bad rule file, behavior or
+    lesson is refused before a session exists (an empty session would be the newest, the one
+    ``mitos teach --resume`` picks)."""
+    from ..api import default_rulebase_path, load_rulebase
+    from ..resources import resolve
+    from ..teach.journal import Journal, new_session_dir
+    from ..teach.lesson import read_lesson
+    from ..teach.progress import epoch_progress
+    from ..teach.session import Session
+    from .output import err
+
+    path = Path(rules) if rules is not None else default_rulebase_path()
+    if rules is not None and not path.exists():
+        path = resolve("rulebases", rules, ".rules") or path
+    if not path.is_file():
+        from ..errors import RuleBaseError
+
+        raise RuleBaseError(f"`{path}` is a directory, not a rule file" if path.is_dir()
+                            else f"rule file `{path}` not found")
+    load_rulebase(path, behavior)
+    lesson_text = read_lesson(lesson) if lesson is not None else None
+    journal = Journal.create(new_session_dir(path.stem))
+    session = Session(path, behavior, journal, save_as, out=out, progress=epoch_progress)
+    err(f"session {journal.directory.name} (journal in {journal.directory.as_posix()}; "
+        f"`mitos teach --resume` continues it)")
+    return session, lesson_text
+
+
+def _teach_lesson(session, lesson: str, lesson_text, transcript: Transcript | None) -> None:
+    """Run a lesson file (or stdin) in ``session``; save where ``--save-as`` says if it ends
+    with changes unsaved. Ctrl-C keeps every change (the journal has them)."""
+    from ..teach.lesson import read_lesson, run_lesson
+    from .output import emit, err
+
+    text, name = lesson_text if lesson_text is not None else read_lesson(lesson)
+    directory = session.journal.directory
+    session.echo = transcript.command if transcript is not None else emit
+    if lesson != "-":
+        session.base = Path(name).parent
+    try:
+        run_lesson(session, text, name)
+    except KeyboardInterrupt:
+        err(f"interrupted: every change so far is in the journal; `mitos teach --resume "
+            f"--session {directory.name}` continues")
+        raise typer.Exit(130) from None
+    if session.state.block is not None:
+        err(f"warning: the lesson ended with behavior `{session.state.block}` still open; "
+            f"`end` closes it (`mitos teach --resume --session {directory.name}`)")
+    if session.save_as is not None and session.unsaved:
         if transcript is not None:
-            emit(transcript.to_json(journal.directory, session))
-        return
-    interact(session, journal.directory / "history")
+            transcript.command("save (the lesson ended with unsaved changes)")
+        session.run("save")
+    if transcript is not None:
+        emit(transcript.to_json(directory, session))
