@@ -78,7 +78,7 @@ def compare_command(
     if runs_n is not None:
         warn("`-n` is --resolution in `check` and `plot surface`; write --runs here")
         runs = runs_n
-    from ..study import Study, make_choices, write_report
+    from ..study import Study, make_choices
     from ..study.executors import EXECUTORS
     from ..study.spec import split_list
 
@@ -86,43 +86,65 @@ def compare_command(
         raise unknown("executor", executor, EXECUTORS)
     if scheduler and executor != "dask":
         raise typer.BadParameter("--scheduler needs --executor dask", param_hint="--scheduler")
+    planners = _planners(planner, and_, or_, inference, rulebase, behavior)
+    choices = make_choices(planners, split_list(and_), split_list(or_), split_list(inference))
+    paths = check_inputs(worlds, choices, rulebase, behavior)
+    study = Study(paths, choices, runs, seed, rulebase, behavior,
+                  command=_command_line(worlds, and_, or_, inference, planner, rulebase,
+                                        behavior, runs, seed, out))
+    outcome = run_with_progress(study, out, executor, workers, scheduler, resume,
+                                quiet=as_json)
+
+    if as_json:
+        emit(json_text(outcome_json(outcome, out)))
+    else:
+        _print_tables(outcome)
+    report = _report(outcome, out, plots)
+    err(f"{plural(outcome.executed, 'run')} now, {outcome.skipped} from before; "
+        f"wrote {report.parent / 'results.csv'} and {report}")
+
+
+def _planners(planner: str, and_: str, or_, inference, rulebase, behavior) -> list[str]:
+    """``--planner``'s names; the fuzzy planner's options without it are refused (they were
+    dropped without a word)."""
+    from ..study.spec import split_list
+
     planners = split_list(planner)
     if not planners:
         raise typer.BadParameter("name at least one planner", param_hint="--planner")
     fuzzy_only = [flag for flag, given in (("--and", and_ != DEFAULT_AND), ("--or", or_),
                                            ("--inference", inference), ("--rulebase", rulebase),
                                            ("--behavior", behavior)) if given]
-    if "fuzzy" not in planners and fuzzy_only:     # they were dropped without a word
+    if "fuzzy" not in planners and fuzzy_only:
         verb = "chooses" if len(fuzzy_only) == 1 else "choose"
         raise typer.BadParameter(f"{', '.join(fuzzy_only)} {verb} the fuzzy planner's "
                                  f"operators and rules; --planner {planner} has no fuzzy planner",
                                  param_hint="--planner")
-    choices = make_choices(planners, split_list(and_), split_list(or_), split_list(inference))
-    paths = check_inputs(worlds, choices, rulebase, behavior)
+    return planners
+
+
+def _command_line(worlds, and_, or_, inference, planner, rulebase, behavior, runs: int,
+                  seed: int, out: str) -> str:
+    """The command that runs this study again, for report.md."""
     words = ["mitos", "compare", *worlds, "--and", and_, "--planner", planner]
     for flag, value in (("--or", or_), ("--inference", inference), ("--rulebase", rulebase),
                         ("--behavior", behavior)):
         if value:
             words += [flag, value]
     words += ["--runs", str(runs), "--seed", str(seed), "-o", out]
-    study = Study(paths, choices, runs, seed, rulebase, behavior,
-                  command=" ".join(shlex.quote(w) for w in words))
-    outcome = run_with_progress(study, out, executor, workers, scheduler, resume,
-                                quiet=as_json)
+    return " ".join(shlex.quote(w) for w in words)
 
-    if as_json:
 
-        emit(json_text(outcome_json(outcome, out)))
-    else:
-        _print_tables(outcome)
+def _report(outcome, out: str, plots: bool) -> Path:
+    """report.md (and its plots, unless matplotlib is missing: then without, and a warning)."""
+    from ..study import write_report
+
     try:
-        report = write_report(outcome, out, plots=plots)
+        return write_report(outcome, out, plots=plots)
     except ImportError:
         warn("matplotlib is not installed: report.md has no plots "
              "(pip install 'mitos[plot]')")
-        report = write_report(outcome, out, plots=False)
-    err(f"{plural(outcome.executed, 'run')} now, {outcome.skipped} from before; "
-        f"wrote {report.parent / 'results.csv'} and {report}")
+        return write_report(outcome, out, plots=False)
 
 
 def _print_tables(outcome) -> None:
