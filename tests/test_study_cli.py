@@ -211,3 +211,24 @@ def test_worlds_of_one_stem_are_told_apart(tmp_path, compare):
     assert r.exit_code == 0, r.output
     report = (tmp_path / "s" / "report.md").read_text()
     assert f"| {tmp_path / 'w.yaml'} |" in report and f"| {tmp_path / 'sub' / 'w.yaml'} |" in report
+
+
+def test_without_matplotlib_the_report_has_no_plots(tiny, tmp_path, compare, monkeypatch):
+    """A study is not lost for want of matplotlib: report.md is written without its plots,
+    and the user is told how to get them."""
+    import mitos_cli.study as study
+
+    real = study.write_report
+
+    def no_matplotlib(outcome, out, plots=True):
+        if plots:
+            raise ImportError("No module named 'matplotlib'")
+        return real(outcome, out, plots=False)
+
+    monkeypatch.setattr(study, "write_report", no_matplotlib)
+    out = tmp_path / "study"
+    r = compare(tiny, "--and", "min", "--planner", "fuzzy", "--runs", 1, "-o", out, "-j", 1)
+    assert r.exit_code == 0, r.output
+    assert "matplotlib is not installed: report.md has no plots" in r.stderr
+    assert "pip install 'mitos[plot]'" in r.stderr
+    assert (out / "report.md").is_file() and not (out / "success.png").exists()
