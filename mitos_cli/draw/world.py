@@ -4,6 +4,7 @@ at intervals. Draws a finished :class:`~mitos_cli.sim.loop.SimResult`; never ste
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -107,15 +108,43 @@ def draw_run(result, path: str | Path | None = None, *, footprint_every: float =
     """Draw ``result``; save to ``path`` (.png or .svg) and/or ``show``. Footprints every
     ``footprint_every`` seconds. Returns the figure."""
     _matplotlib()                      # a clear error, not a traceback, without matplotlib
-    from matplotlib.collections import LineCollection
-    from matplotlib.patches import Circle, Polygon
-
-    from ..sim.geometry import rect_corners
-
     world, static = result.world, result.static
     xmin, ymin, xmax, ymax = static.bounds
-    pad = PAD
     fig, ax = map_axes(static, show=show)
+    _draw_routes(ax, result)
+    t_end = float(result.t[-1]) if len(result.t) else 0.0
+    marks = Marks(time_step(t_end), 0.04 * max(xmax - xmin, ymax - ymin))
+    tracked = _draw_obstacles(ax, result, marks)
+    # one robot: its path coloured by speed; several: a colour and a legend entry each
+    vmax = max(1.0, float(np.nanmax(result.speed)) if result.speed.size else 1.0)
+    every = max(1, int(round(footprint_every / world.dt)))
+    line = None
+    for i, agent in enumerate(world.agents):
+        line = _draw_robot(ax, result, i, agent, every, vmax, marks, tracked) or line
+    if line is not None:
+        fig.colorbar(line, ax=ax, shrink=0.7, label="speed (in/s)")
+    place_legend(ax, static)
+    ax.set_xlim(xmin - PAD, xmax + PAD)
+    ax.set_ylim(ymin - PAD, ymax + PAD)
+    ax.set_xlabel("x (in)")
+    ax.set_ylabel("y (in)")
+    m = result.metrics
+    ax.set_title(f"{world.name}: {result.outcome} after {m['time_s']:.2f} s "
+                 f"(seed {result.seed}, min clearance {m['min_clearance_in']:.1f} in)",
+                 fontsize=9)
+    return finish(fig, path, show)
+
+
+@dataclass(frozen=True)
+class Marks:
+    """Time marks along the tracks: every ``step`` s, labels kept ``near`` apart."""
+
+    step: float
+    near: float
+
+
+def _draw_routes(ax, result) -> None:
+    """The routes planned at the start (dashed) and each replan (dash-dotted)."""
     for route in result.routes:
         ax.plot(route.points[:, 0], route.points[:, 1], ls="--", lw=0.8, color="#4a78b5",
                 label="route" if route is result.routes[0] else None)
@@ -123,21 +152,24 @@ def draw_run(result, path: str | Path | None = None, *, footprint_every: float =
         ax.plot(route.points[:, 0], route.points[:, 1], ls="-.", lw=0.8, color="#7a4ab5",
                 label="replanned route" if n == 0 else None)
 
-    # obstacles: where they started (faint, for moving ones), their tracks with time marks,
-    # where they ended
+
+def _draw_obstacles(ax, result, marks: Marks) -> list[int]:
+    """Each obstacle where it ended; a moving one also where it started (faint) and its
+    track with time marks. Returns the moving ones."""
+    from matplotlib.patches import Circle, Polygon
+
+    from ..sim.geometry import rect_corners
+
     track = result.obstacles                                  # [T, O, 2]
     named = _labelled(result)
-    t_end = float(result.t[-1]) if len(result.t) else 0.0
-    step = time_step(t_end)
-    near = 0.04 * max(xmax - xmin, ymax - ymin)
     tracked: list[int] = []
-    for j, o in enumerate(world.obstacles):
+    for j, o in enumerate(result.world.obstacles):
         xy = track[:, j] if len(track) else np.array([[o.x, o.y]])
         moving = np.ptp(xy, axis=0).max() > 1e-9 if len(xy) else False
         if moving:
             ax.plot(xy[:, 0], xy[:, 1], color="#b5524a", lw=0.8, ls=":",
                     label="obstacle track" if not tracked else None)
-            time_marks(ax, result.t, xy, step, "#8a2f27", near=near, above=True,
+            time_marks(ax, result.t, xy, marks.step, "#8a2f27", near=marks.near, above=True,
                        label="time marks (s)" if not tracked else None)
             tracked.append(j)
         for k, alpha in ((0, 0.25), (len(xy) - 1, 0.9)) if moving else ((len(xy) - 1, 0.9),):
@@ -152,65 +184,61 @@ def draw_run(result, path: str | Path | None = None, *, footprint_every: float =
         if j in named:
             ax.annotate(o.name, xy[-1], xytext=(6, 6), textcoords="offset points",
                         fontsize=8, color="#5c1f1a")
+    return tracked
 
-    # robots: footprints at intervals, path coloured by speed, start and goal
-    # one robot: its path coloured by speed; several: a colour and a legend entry each
-    several = len(world.agents) > 1
-    vmax = max(1.0, float(np.nanmax(result.speed)) if result.speed.size else 1.0)
-    every = max(1, int(round(footprint_every / world.dt)))
+
+def _draw_robot(ax, result, i: int, agent, every: int, vmax: float, marks: Marks,
+                tracked: list[int]):
+    """Robot ``i``: footprints every ``every`` ticks, its path (coloured by speed when it is
+    alone: the line returned, for the colour bar), time marks where obstacles moved, a
+    collision, its start and goal."""
+    from matplotlib.collections import LineCollection
+    from matplotlib.patches import Circle, Polygon
+
+    from ..sim.geometry import rect_corners
+
+    several = len(result.world.agents) > 1
+    drove = _drove(result, i)
+    pose = result.pose[drove, i]
+    speed = result.speed[drove, i]
+    if len(pose) == 0:
+        return None
     line = None
-    for i, agent in enumerate(world.agents):
-        drove = _drove(result, i)
-        pose = result.pose[drove, i]
-        speed = result.speed[drove, i]
-        if len(pose) == 0:
-            continue
-        colour = ROBOT_COLOURS[i % len(ROBOT_COLOURS)] if several else "#555555"
-        for k in list(range(0, len(pose), every)) + [len(pose) - 1]:
-            x, y, h = pose[k]
-            ax.add_patch(Polygon(rect_corners(x, y, np.deg2rad(h), agent.robot.length,
-                                              agent.robot.width),
-                                 closed=True, fill=False, edgecolor=colour, lw=0.5,
-                                 alpha=0.6 if several else 1.0))
-        if several:
-            ax.plot(pose[:, 0], pose[:, 1], color=colour, lw=2.0,
-                    label=f"{agent.name}: {result.robot_outcomes[i]}")
-        elif len(pose) > 1:
-            segs = np.stack([pose[:-1, :2], pose[1:, :2]], axis=1)
-            line = LineCollection(list(segs), cmap="viridis", linewidths=2.2)
-            line.set_array(speed[:-1])
-            line.set_clim(0, vmax)
-            ax.add_collection(line)
-        if tracked or several:           # where the robots were when the obstacles were there
-            time_marks(ax, result.t[drove], pose[:, :2], step,
-                       colour if several else "#333333", near=near, above=False,
-                       label=None if tracked else "time marks (s)" if i == 0 else None)
-        if result.robot_outcomes[i] == "collision":
-            x, y = pose[-1, :2]
-            ax.plot(x, y, marker="x", ms=9, mew=2.0, color="black", zorder=7, ls="none",
-                    label="collision" if "collision" not in result.robot_outcomes[:i] else None)
-            ax.annotate(f"collision at {result.robot_metrics[i]['time_s']:.2f} s", (x, y),
-                        fontsize=7.5, zorder=7, **inward(ax, x, y),
-                        bbox={"boxstyle": "round,pad=0.2", "fc": "white", "ec": "none",
-                              "alpha": 0.85})
-        ax.plot(agent.start.x, agent.start.y, marker="o", color="#2f6b2f", ms=5)
-        ax.add_patch(Circle((agent.goal.x, agent.goal.y), agent.goal.tolerance, fill=False,
-                            edgecolor="#2f6b2f", lw=1.0, ls="--"))
-        ax.annotate(agent.name if len(world.agents) > 1 else "goal",
-                    (agent.goal.x, agent.goal.y), xytext=(6, -10), textcoords="offset points",
-                    fontsize=8, color="#2f6b2f")
-    if line is not None:
-        fig.colorbar(line, ax=ax, shrink=0.7, label="speed (in/s)")
-    place_legend(ax, static)
-    ax.set_xlim(xmin - pad, xmax + pad)
-    ax.set_ylim(ymin - pad, ymax + pad)
-    ax.set_xlabel("x (in)")
-    ax.set_ylabel("y (in)")
-    m = result.metrics
-    ax.set_title(f"{world.name}: {result.outcome} after {m['time_s']:.2f} s "
-                 f"(seed {result.seed}, min clearance {m['min_clearance_in']:.1f} in)",
-                 fontsize=9)
-    return finish(fig, path, show)
+    colour = ROBOT_COLOURS[i % len(ROBOT_COLOURS)] if several else "#555555"
+    for k in list(range(0, len(pose), every)) + [len(pose) - 1]:
+        x, y, h = pose[k]
+        ax.add_patch(Polygon(rect_corners(x, y, np.deg2rad(h), agent.robot.length,
+                                          agent.robot.width),
+                             closed=True, fill=False, edgecolor=colour, lw=0.5,
+                             alpha=0.6 if several else 1.0))
+    if several:
+        ax.plot(pose[:, 0], pose[:, 1], color=colour, lw=2.0,
+                label=f"{agent.name}: {result.robot_outcomes[i]}")
+    elif len(pose) > 1:
+        segs = np.stack([pose[:-1, :2], pose[1:, :2]], axis=1)
+        line = LineCollection(list(segs), cmap="viridis", linewidths=2.2)
+        line.set_array(speed[:-1])
+        line.set_clim(0, vmax)
+        ax.add_collection(line)
+    if tracked or several:           # where the robots were when the obstacles were there
+        time_marks(ax, result.t[drove], pose[:, :2], marks.step,
+                   colour if several else "#333333", near=marks.near, above=False,
+                   label=None if tracked else "time marks (s)" if i == 0 else None)
+    if result.robot_outcomes[i] == "collision":
+        x, y = pose[-1, :2]
+        ax.plot(x, y, marker="x", ms=9, mew=2.0, color="black", zorder=7, ls="none",
+                label="collision" if "collision" not in result.robot_outcomes[:i] else None)
+        ax.annotate(f"collision at {result.robot_metrics[i]['time_s']:.2f} s", (x, y),
+                    fontsize=7.5, zorder=7, **inward(ax, x, y),
+                    bbox={"boxstyle": "round,pad=0.2", "fc": "white", "ec": "none",
+                          "alpha": 0.85})
+    ax.plot(agent.start.x, agent.start.y, marker="o", color="#2f6b2f", ms=5)
+    ax.add_patch(Circle((agent.goal.x, agent.goal.y), agent.goal.tolerance, fill=False,
+                        edgecolor="#2f6b2f", lw=1.0, ls="--"))
+    ax.annotate(agent.name if several else "goal",
+                (agent.goal.x, agent.goal.y), xytext=(6, -10), textcoords="offset points",
+                fontsize=8, color="#2f6b2f")
+    return line
 
 
 LABEL_LIMIT = 12        # obstacles named on a plot; beyond this only the one hit is
