@@ -137,15 +137,14 @@ class MitosEnv(gymnasium.Env):
 
     def _row(self, x) -> list[float]:
         """One observation as the floats the rule base reads, else an :class:`InputError` (a
-        batch ``[1, k]`` met "only 0-dimensional arrays can be converted to Python scalars")."""
-        try:
-            row = np.asarray(x, dtype=np.float64)
-        except (TypeError, ValueError):
-            row = None
-        if row is None or row.ndim != 1:
-            what = f"of shape {row.shape}" if row is not None else f"`{x!r:.40}`"
+        batch ``[1, k]`` met "only 0-dimensional arrays can be converted to Python scalars";
+        bools, dates and structured arrays are refused as the engine's inputs are)."""
+        from .engine.inputs import floats
+
+        row = floats(x, "the observation's values", many=True)
+        if row.ndim != 1:
             raise InputError(f"an observation is one row of the {len(self.input_names)} inputs "
-                             f"({', '.join(self.input_names)}), not {what}",
+                             f"({', '.join(self.input_names)}), not of shape {row.shape}",
                              hint="for a batch of observations, call it on each row")
         return row.tolist()
 

@@ -219,3 +219,16 @@ def test_a_collision_run_differs_from_simulate_only_in_the_last_command():
     assert np.array_equal(ran.command[:-1], ref.command[:-1])
     assert np.array_equal(ran.command[-1], ran.command[-2])
     assert ran.summary() == ref.summary()
+
+
+def test_fuzzy_policy_refuses_an_observation_that_is_not_numbers():
+    """`np.asarray(x, dtype=float)` read bools as 1 and 0 and a structure of one field as it."""
+    from mitos_cli.errors import InputError
+
+    env = gymnasium.make("mitos/Corridor-v0")
+    obs, _ = env.reset(seed=1)
+    with pytest.raises(InputError, match="the observation's values must be numbers, not bools"):
+        env.unwrapped.fuzzy_policy(obs > 0)
+    record = np.array([(x,) for x in obs], dtype=[("v", "f8")])
+    with pytest.raises(InputError, match=r"the observation's values are structured \(field `v`\)"):
+        env.unwrapped.fuzzy_policy(record)
