@@ -279,10 +279,10 @@ RULE_NEST = (lambda d: "if " + "not " * d + "road is WIDE then speed is FAST",
 POSITIONED = re.compile(r"\S[^\n]{0,4000}?:\d{1,9}:\d{1,9}: ")
 
 
-def cli_in_process(argv: list[str], work: Path) -> tuple[int, str]:
+def cli_in_process(argv: list[str], work: Path) -> tuple[int, str, str]:
     """``mitos ARGV`` through the CLI's own ``main`` in this process, run in ``work``: the exit
-    code and stderr (stdout is captured and dropped). An exception escaping ``main``
-    propagates: it is what a user would see as a traceback."""
+    code, stderr and stdout. An exception escaping ``main`` propagates: it is what a user would
+    see as a traceback."""
     from mitos_cli.cli.app import main
 
     out, err = io.StringIO(), io.StringIO()
@@ -299,10 +299,10 @@ def cli_in_process(argv: list[str], work: Path) -> tuple[int, str]:
     finally:
         os.chdir(cwd)
         sys.stdin = stdin
-    return code, err.getvalue()
+    return code, err.getvalue(), out.getvalue()
 
 
-def cli_subprocess(argv: list[str], work: Path, timeout: float) -> tuple[int, str]:
+def cli_subprocess(argv: list[str], work: Path, timeout: float) -> tuple[int, str, str]:
     """``python -m mitos_cli ARGV`` in ``work``: what a user runs, for spot checks."""
     env = dict(os.environ, PYTHONPATH=str(ROOT))
     try:
@@ -310,11 +310,18 @@ def cli_subprocess(argv: list[str], work: Path, timeout: float) -> tuple[int, st
                            capture_output=True, text=True, errors="replace", timeout=timeout)
     except subprocess.TimeoutExpired:
         raise Timeout() from None
-    return r.returncode, r.stderr
+    return r.returncode, r.stderr, r.stdout
 
 
-def cli_outcome(code: int, err: str) -> tuple[str, str]:
-    """The outcome of one ``mitos`` run from its exit code and stderr."""
+#: how much of stdout is read for a refusal printed there (``mitos check`` prints its errors
+#: first; a batch's outputs may be megabytes)
+STDOUT_READ = 64_000
+
+
+def cli_outcome(code: int, err: str, out: str = "") -> tuple[str, str]:
+    """The outcome of one ``mitos`` run from its exit code and stderr, and its stdout where an
+    exit 1 says nothing on stderr (``mitos check`` prints the errors it finds in a rule base,
+    positioned, with its report on stdout)."""
     if "Traceback (most recent call last)" in err:
         return "foreign", "traceback: " + err.strip().splitlines()[-1][:70]
     if "Warning: " in err:              # plain searches: a message may quote 200 KB of input
@@ -323,12 +330,35 @@ def cli_outcome(code: int, err: str) -> tuple[str, str]:
     if code in (0, 3):                 # 3: `simulate --require success` not met
         return "loaded", ""
     if code == 1:
-        first = err.strip().splitlines()[0][:60] if err.strip() else "(no message)"
+        if not err.strip():
+            return refusal_on_stdout(out[:STDOUT_READ])
+        first = err.strip().splitlines()[0][:60]
         positioned = any(POSITIONED.match(x) for x in err.splitlines()[:3])
         return ("refused+pos", "") if positioned else ("refused", first)
     if code == 2:
         return "refused", "usage error"
     return "foreign", f"exit {code}"
+
+
+def refusal_on_stdout(out: str) -> tuple[str, str]:
+    """An exit 1 whose answer is on stdout: the first error of ``mitos check``'s report (text,
+    or ``--json``), positioned or not; ``(no message)`` when stdout holds none either."""
+    if out.lstrip().startswith("{"):
+        try:
+            report = json.loads(out)
+        except ValueError:
+            report = {}
+        errors = [f for f in report.get("findings", ()) if isinstance(f, dict)
+                  and f.get("severity") == "error"] if isinstance(report, dict) else []
+        if errors:
+            positioned = isinstance(errors[0].get("span"), dict)
+            return ("refused+pos", "") if positioned else \
+                ("refused", "error: " + str(errors[0].get("message"))[:53])
+        return "refused", "(no message)"
+    line = next((x for x in out.splitlines() if "error: " in x and not x[:1].isspace()), None)
+    if line is None:
+        return "refused", "(no message)"
+    return ("refused+pos", "") if POSITIONED.match(line) else ("refused", line[:60])
 
 
 def via_cli(kind: Kind, how: str, limit: float) -> Callable:

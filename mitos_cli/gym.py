@@ -58,12 +58,33 @@ except ImportError as exc:  # pragma: no cover - the extra is missing
     raise MitosError("the Gymnasium environments need gymnasium, which is not installed",
                      hint="pip install 'mitos[gym]'") from exc
 
-from .errors import CommandError, InputError, WorldError
+from .errors import CommandError, InputError, WorldError, closest, unknown
 from .sim.world import World
 
 PROGRESS_REWARD = 0.01      # per inch of route
 COLLISION_PENALTY = -10.0
 GOAL_BONUS = 10.0
+
+
+class SeedError(InputError, gymnasium.error.Error):
+    """A seed ``reset`` does not take: Gymnasium's contract is ``None`` or an int of 0 or more.
+    Also Gymnasium's own ``error.Error``, which ``Env.reset`` raised for these (in its words:
+    "Seed must be a python integer, actual type: <class 'float'>"), so a caller's ``except``
+    still catches it."""
+
+
+class EnvOptionError(InputError, ValueError):
+    """A keyword the environment does not have (``gymnasium.make(id, **kwargs)`` passes its
+    unknown keywords on to it), or a value one does not take, said with the known options and
+    a "did you mean". Also a ``ValueError``, which a bad ``render_mode`` was; not a
+    ``TypeError``, which Python's own "unexpected keyword argument" was: ``gymnasium.make``
+    rebuilds a ``TypeError`` from its text alone, with the environment's kwargs appended."""
+
+
+#: The environment's own keywords, and those of ``gymnasium.make`` (a misspelt one of these
+#: reaches the environment too).
+OPTIONS = ("world", "rulebase", "behavior", "observe_ranges", "render_mode")
+MAKE_OPTIONS = ("max_episode_steps", "disable_env_checker", "autoreset")
 
 
 class _Commanded:
@@ -83,10 +104,12 @@ class MitosEnv(gymnasium.Env):
     def __init__(self, world: str | Path | World = "corridor", *,
                  rulebase: str | Path | None = None,
                  behavior: str | None = None, observe_ranges: bool = False,
-                 render_mode: str | None = None) -> None:
+                 render_mode: str | None = None, **others: Any) -> None:
         from .sim.loop import Simulation
         from .sim.planner import FuzzyPlanner
         from .sim.worldfile import load_world
+
+        _check_options(others, observe_ranges, render_mode, self.metadata["render_modes"])
 
         # a World loaded (or changed) in Python, else a file or a packaged world's name
         loaded = world if isinstance(world, World) else load_world(world)
@@ -94,9 +117,6 @@ class MitosEnv(gymnasium.Env):
             raise WorldError(f"world `{loaded.name}` has {len(loaded.agents)} robots; a "
                              f"Gymnasium environment drives one",
                              hint="give a world with one robot (no `robots:` list)")
-        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
-            raise ValueError(f"render_mode must be one of {self.metadata['render_modes']}, "
-                             f"not {render_mode!r}")
         self.world = loaded
         self.render_mode = render_mode
         self.observe_ranges = observe_ranges
@@ -137,21 +157,21 @@ class MitosEnv(gymnasium.Env):
 
     def _row(self, x) -> list[float]:
         """One observation as the floats the rule base reads, else an :class:`InputError` (a
-        batch ``[1, k]`` met "only 0-dimensional arrays can be converted to Python scalars")."""
-        try:
-            row = np.asarray(x, dtype=np.float64)
-        except (TypeError, ValueError):
-            row = None
-        if row is None or row.ndim != 1:
-            what = f"of shape {row.shape}" if row is not None else f"`{x!r:.40}`"
+        batch ``[1, k]`` met "only 0-dimensional arrays can be converted to Python scalars";
+        bools, dates and structured arrays are refused as the engine's inputs are)."""
+        from .engine.inputs import floats
+
+        row = floats(x, "the observation's values", many=True)
+        if row.ndim != 1:
             raise InputError(f"an observation is one row of the {len(self.input_names)} inputs "
-                             f"({', '.join(self.input_names)}), not {what}",
+                             f"({', '.join(self.input_names)}), not of shape {row.shape}",
                              hint="for a batch of observations, call it on each row")
         return row.tolist()
 
     # -- Gymnasium ----------------------------------------------------------------------------
 
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
+        seed = _check_seed(seed)
         super().reset(seed=seed)
         if seed is None:
             seed = (int(self.np_random.integers(2**31)) if self._seeded else self.world.seed)
@@ -268,6 +288,48 @@ class MitosEnv(gymnasium.Env):
         return {"t": round(sim.ticks * sim.dt, 6), "pose": sim.pose[0],
                 "clearance": float(sim.clearance[0]),
                 "outcome": sim.robot_outcomes[0] if sim.done else "driving"}
+
+
+def _check_options(others: dict[str, Any], observe_ranges: object, render_mode: object,
+                   modes: list[str]) -> None:
+    """Refuse a keyword the environment does not have (Python's "unexpected keyword
+    argument", re-raised by ``gymnasium.make`` with its kwargs), a ``render_mode`` it cannot
+    draw in and an ``observe_ranges`` that is not a bool (``"no"`` was true)."""
+    if others:
+        name = str(next(iter(others)))
+        near = closest(name, OPTIONS)
+        hint = (f"did you mean `{near}`?" if near else
+                f"did you mean `{made}` (a keyword of gymnasium.make)?"
+                if (made := closest(name, MAKE_OPTIONS)) else None)
+        raise EnvOptionError(f"unknown keyword `{name}` of the MITOS environment",
+                             expected="one of " + ", ".join(OPTIONS), hint=hint)
+    if render_mode is not None and render_mode not in modes:
+        error = unknown("render_mode", f"{render_mode}", modes, cls=EnvOptionError)
+        error.hint = error.hint or "render_mode=None (the default) draws nothing"
+        raise error
+    if not isinstance(observe_ranges, (bool, np.bool_)):
+        raise EnvOptionError(f"observe_ranges is True or False, not `{observe_ranges!r:.40}`",
+                             hint="observe_ranges=True adds the sonar ranges to the observation")
+
+
+def _check_seed(seed: object) -> int | None:
+    """``seed`` as Gymnasium's ``reset`` takes it (``None`` or an int of 0 or more), else a
+    :class:`SeedError` in words. A NumPy integer (``rng.integers(...)``) is taken as the int it
+    is, where Gymnasium refused it; a bool is refused, where Gymnasium took ``True`` as 1."""
+    if seed is None:
+        return None
+    expected = "an int of 0 or more, or None (Gymnasium's `reset(seed=...)`)"
+    hint = "env.reset(seed=1); env.reset() continues the environment's own generator"
+    if isinstance(seed, (int, np.integer)) and not isinstance(seed, bool):
+        value = int(seed)
+        if value >= 0:
+            return value
+        bits = value.bit_length()         # str() of over 4,300 digits is a ValueError
+        shown = f"{value}" if bits < 1000 else f"a number of {bits:,} bits"
+        raise SeedError(f"a seed must be 0 or more, not {shown}", expected=expected, hint=hint)
+    kind = type(seed).__name__
+    raise SeedError(f"a seed is a whole number, not {'a ' + kind if kind != 'str' else 'text'}"
+                    f": `{seed!r:.40}`", expected=expected, hint=hint)
 
 
 def _command(action) -> np.ndarray:

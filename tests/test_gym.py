@@ -219,3 +219,87 @@ def test_a_collision_run_differs_from_simulate_only_in_the_last_command():
     assert np.array_equal(ran.command[:-1], ref.command[:-1])
     assert np.array_equal(ran.command[-1], ran.command[-2])
     assert ran.summary() == ref.summary()
+
+
+def test_fuzzy_policy_refuses_an_observation_that_is_not_numbers():
+    """`np.asarray(x, dtype=float)` read bools as 1 and 0 and a structure of one field as it."""
+    from mitos_cli.errors import InputError
+
+    env = gymnasium.make("mitos/Corridor-v0")
+    obs, _ = env.reset(seed=1)
+    with pytest.raises(InputError, match="the observation's values must be numbers, not bools"):
+        env.unwrapped.fuzzy_policy(obs > 0)
+    record = np.array([(x,) for x in obs], dtype=[("v", "f8")])
+    with pytest.raises(InputError, match=r"the observation's values are structured \(field `v`\)"):
+        env.unwrapped.fuzzy_policy(record)
+
+
+@pytest.mark.parametrize(("seed", "says"), [
+    (-1, "a seed must be 0 or more, not -1"),
+    (np.int64(-2), "a seed must be 0 or more, not -2"),
+    pytest.param(-10**5000, "a seed must be 0 or more, not a number of 16,610 bits",
+                 id="-10**5000"),                                             # str() fails
+    (1.5, "a seed is a whole number, not a float: `1.5`"),
+    (3.0, "a seed is a whole number, not a float: `3.0`"),
+    ("3", "a seed is a whole number, not text: `'3'`"),
+    (True, "a seed is a whole number, not a bool: `True`"),        # Gymnasium took it as 1
+])
+def test_a_seed_reset_does_not_take_is_said_in_words(seed, says):
+    """Gymnasium's own "Seed must be greater or equal to zero, actual value: -1" (or "must be
+    a python integer, actual type: <class 'float'>"); still a `gymnasium.error.Error`."""
+    from mitos_cli.errors import InputError
+
+    env = gymnasium.make("mitos/Corridor-v0")
+    with pytest.raises(mgym.SeedError) as info:
+        env.reset(seed=seed)
+    assert info.value.message == says
+    assert isinstance(info.value, InputError) and isinstance(info.value, gymnasium.error.Error)
+    assert "an int of 0 or more, or None" in str(info.value)
+
+
+def test_the_seeds_gymnasium_takes_give_its_runs_and_a_numpy_int_its_int():
+    env = gymnasium.make("mitos/Corridor-v0")
+    first, _ = env.reset(seed=7)
+    assert env.unwrapped.np_random_seed == 7 and env.unwrapped.sim.seed == 7
+    again, _ = env.reset(seed=np.int64(7))        # Gymnasium refused a NumPy int
+    assert np.array_equal(first, again) and env.unwrapped.np_random_seed == 7
+    env.reset(seed=0)
+    env.reset(seed=2**70)                          # SeedSequence takes any size
+    assert env.unwrapped.sim.seed == 2**70
+    env.reset()
+    assert env.unwrapped.sim.seed is not None
+
+
+@pytest.mark.parametrize(("kwargs", "says", "hint"), [
+    ({"obsreve_ranges": True}, "unknown keyword `obsreve_ranges` of the MITOS environment",
+     "did you mean `observe_ranges`?"),
+    ({"rulebse": "x.rules"}, "unknown keyword `rulebse` of the MITOS environment",
+     "did you mean `rulebase`?"),
+    ({"max_episode_step": 5}, "unknown keyword `max_episode_step` of the MITOS environment",
+     "did you mean `max_episode_steps` (a keyword of gymnasium.make)?"),
+    ({"colour": "red"}, "unknown keyword `colour` of the MITOS environment", None),
+    ({"render_mode": "rgb"}, "unknown render_mode `rgb`", "did you mean `rgb_array`?"),
+    ({"observe_ranges": "no"}, "observe_ranges is True or False, not `'no'`",
+     "observe_ranges=True adds the sonar ranges to the observation"),
+])
+@pytest.mark.filterwarnings("ignore:.*not in the possible render_modes:UserWarning")
+def test_a_misspelt_keyword_is_said_with_the_options(kwargs, says, hint):
+    """`gymnasium.make(id, obsreve_ranges=True)` was Python's "MitosEnv.__init__() got an
+    unexpected keyword argument ... was raised from the environment creator for ... with
+    kwargs (...)"; `render_mode="rgb"` a bare ValueError."""
+    for make in (lambda: gymnasium.make("mitos/Corridor-v0", **kwargs),
+                 lambda: mgym.MitosEnv("corridor", **kwargs)):
+        with pytest.raises(mgym.EnvOptionError) as info:
+            make()
+        assert (info.value.message, info.value.hint) == (says, hint)
+        assert isinstance(info.value, ValueError) and not isinstance(info.value, TypeError)
+    if "keyword" in says:
+        assert info.value.expected == \
+            "one of world, rulebase, behavior, observe_ranges, render_mode"
+
+
+def test_every_keyword_the_options_list_is_one_the_environment_takes():
+    import inspect
+
+    params = inspect.signature(mgym.MitosEnv.__init__).parameters
+    assert set(mgym.OPTIONS) == {p for p in params if p not in ("self", "others")}

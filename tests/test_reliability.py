@@ -379,13 +379,53 @@ def test_cli_route_classifies_what_the_user_sees(kinds, tmp_path):
     fuzz, _, _ = kinds
     rules = tmp_path / "a.rules"
     rules.write_text('terms "nowhere.terms.yaml"\n')
-    code, err = fuzz.cli_in_process(["check", str(rules)], tmp_path)
+    code, err, _ = fuzz.cli_in_process(["check", str(rules)], tmp_path)
     assert code == 1 and fuzz.cli_outcome(code, err) == ("refused+pos", "")
-    code, err = fuzz.cli_in_process(["eval", "--digits", "x"], tmp_path)
-    assert (code, fuzz.cli_outcome(code, err)) == (2, ("refused", "usage error"))
+    code, err, out = fuzz.cli_in_process(["eval", "--digits", "x"], tmp_path)
+    assert (code, fuzz.cli_outcome(code, err, out)) == (2, ("refused", "usage error"))
     assert fuzz.cli_outcome(1, "Traceback (most recent call last):\n  ...\nKeyError: 'x'\n") \
         == ("foreign", "traceback: KeyError: 'x'")
     assert fuzz.cli_outcome(0, "f.py:3: RuntimeWarning: invalid value\n")[0] == "warning"
+
+
+GAP_TERMS = """variables:
+  road:
+    role: input
+    universe: [0, 100]
+    terms:
+      NARROW: {shape: left_shoulder, points: [10, 20]}
+  steering:
+    role: output
+    universe: [0, 180]
+    terms: {ST: 90}
+"""
+
+
+@pytest.mark.parametrize("as_json", [False, True])
+def test_cli_route_reads_a_checks_errors_on_stdout(kinds, tmp_path, as_json):
+    """``mitos check`` prints the errors it finds in a rule base, positioned, on stdout and
+    exits 1 with stderr empty: that was "refused without a position: (no message)" (FCL input
+    283 of the campaign of 2026-12-03). The route now reads stdout when stderr is empty."""
+    fuzz, _, _ = kinds
+    (tmp_path / "g.terms.yaml").write_text(GAP_TERMS)
+    rules = tmp_path / "g.rules"
+    rules.write_text('terms "g.terms.yaml"\nr1: if road is NARROW then steering is ST\n')
+    argv = ["check", str(rules), "-n", "5"] + (["--json"] if as_json else [])
+    code, err, out = fuzz.cli_in_process(argv, tmp_path)
+    assert (code, err) == (1, "") and "error" in out
+    assert fuzz.cli_outcome(code, err, out) == ("refused+pos", "")
+
+
+def test_cli_route_says_what_stdout_held_when_nothing_is_positioned(kinds):
+    """An exit 1 with stderr empty and an error without a position on stdout is a refusal
+    without one, named by that line; with nothing on either, "(no message)"."""
+    fuzz, _, _ = kinds
+    out = "warning: x [w]\nerror: no rule sets steering [gap]\n\nchecked a: ...\n"
+    assert fuzz.cli_outcome(1, "", out) == ("refused", "error: no rule sets steering [gap]")
+    assert fuzz.cli_outcome(1, "", "") == ("refused", "(no message)")
+    assert fuzz.cli_outcome(1, "", '{"findings": [{"severity": "error", "message": "m", '
+                                   '"span": null}]}') == ("refused", "error: m")
+    assert fuzz.cli_outcome(1, "", "{not json") == ("refused", "(no message)")
 
 
 def test_a_long_token_is_shortened_in_the_message(tmp_path):

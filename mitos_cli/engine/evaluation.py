@@ -487,10 +487,7 @@ def evaluate_columns(compiled: CompiledRuleBase, Xt, *, strict: bool = True) -> 
     paper's 27 rules) takes :func:`_grid_columns`, the same operations in fewer NumPy calls.
     A large batch's blocks are spread over threads (:mod:`~mitos_cli.engine.threads`): the
     same bits, since no sample's operations depend on the others."""
-    columns = [np.asarray(x, dtype=float) for x in Xt]   # the rows of Xt, not copied
-    if len(columns) != len(compiled.inputs):
-        raise InputError(f"expected {len(compiled.inputs)} input columns "
-                         f"({', '.join(compiled.inputs)}), not {len(columns)}")
+    Xt, columns = _input_columns(compiled, Xt)
     if any(x.ndim != 1 or x.shape != columns[0].shape for x in columns):
         raise InputError("input columns must be 1-D arrays of one length, not of shapes "
                          + ", ".join(str(x.shape) for x in columns))
@@ -515,6 +512,22 @@ def evaluate_columns(compiled: CompiledRuleBase, Xt, *, strict: bool = True) -> 
                           compiled.plan.hi) + 0.0
         fill_defaults(compiled, out.T, rows, strict)
     return out
+
+
+def _input_columns(compiled: CompiledRuleBase, Xt) -> tuple[object, list[np.ndarray]]:
+    """``Xt`` (an array ``[k, n]`` or ``k`` columns) and its columns as float arrays, each
+    through :func:`~.inputs.floats` as the rows' and the named inputs' values are (a bool,
+    date, bytes or structured column was read as numbers here, a complex one with NumPy's
+    warning); a float column is kept as it is, not copied."""
+    if isinstance(Xt, np.ndarray) or not hasattr(Xt, "__len__"):
+        Xt = floats(Xt, "the input columns", many=True)
+    if isinstance(Xt, np.ndarray) and Xt.ndim == 0:
+        raise InputError(f"expected {len(compiled.inputs)} input columns "
+                         f"({', '.join(compiled.inputs)}), not one number")
+    if len(Xt) != len(compiled.inputs):
+        raise InputError(f"expected {len(compiled.inputs)} input columns "
+                         f"({', '.join(compiled.inputs)}), not {len(Xt)}")
+    return Xt, [floats(x, f"input `{name}`") for x, name in zip(Xt, compiled.inputs)]
 
 
 #: Samples per block of :func:`_grid_columns`.
@@ -675,11 +688,18 @@ def _grid_block(compiled: CompiledRuleBase, g, b: _GridBlock, columns: list, ins
     return unfired
 
 
+_FLOAT = {float}
+
+
 def evaluate_one(compiled: CompiledRuleBase, values: list[float],
                  strict: bool = True) -> tuple[float, ...]:
     """The outputs for one sample (inputs in :attr:`CompiledRuleBase.inputs` order): the same
     bits as its row in :func:`evaluate`, through the network's scalar form where it has one
-    (:mod:`mitos_cli.engine.scalar`, a few microseconds instead of some forty NumPy calls)."""
+    (:mod:`mitos_cli.engine.scalar`, a few microseconds instead of some forty NumPy calls).
+    Values other than floats are read as :func:`~.inputs.floats` reads them (the scalar form
+    would take ``True`` as 1)."""
+    if not set(map(type, values)) <= _FLOAT:
+        values = floats(values, "the inputs", many=True).tolist()
     fn = compiled.scalar                # _evaluate_one's outputs, without the clamped inputs
     if fn is not None and len(values) == len(compiled.inputs):
         outputs = fn(*values)

@@ -17,8 +17,9 @@ def floats(value: object, what: str, many: bool = False) -> np.ndarray:
     the masked entries of a masked array (read as what lies under the mask), complex numbers
     (their imaginary part dropped), numbers past a float's range (an ``OverflowError``; a
     ``Decimal`` or a long double read as infinite), bools (read as 1 and 0), dates and
-    durations (read as counts of their unit), bytes (a ``bytearray`` read as its byte values)
-    and text outside the one number grammar of every file here (``5_0`` read as 50)."""
+    durations (read as counts of their unit), bytes (a ``bytearray`` read as its byte values),
+    structured and record arrays (a single number field read as that field) and text outside
+    the one number grammar of every file here (``5_0`` read as 50)."""
     if type(value) is np.ndarray and value.dtype == float:        # the common case
         return value
     has, is_ = ("have", "are") if many else ("has", "is")
@@ -39,6 +40,8 @@ def floats(value: object, what: str, many: bool = False) -> np.ndarray:
         if raw.dtype == object and any(v is None for v in raw.flat):
             raise InputError(f"{what} {has} None among {'their' if many else 'its'} values",
                              hint="give every sample a number")
+        if raw.dtype.kind == "V":
+            raise _NotNumbers("V", raw.dtype)
         if raw.dtype.kind in _KINDS:
             raise _NotNumbers(raw.dtype.kind)
         if raw.dtype.kind in "iuf" and isinstance(value, (list, tuple)) and _holds_bool(value):
@@ -48,6 +51,8 @@ def floats(value: object, what: str, many: bool = False) -> np.ndarray:
         with np.errstate(over="raise"):            # a long double past 1.8e308
             return np.asarray(raw, dtype=float)
     except _NotNumbers as exc:
+        if exc.kind == "V":
+            raise _structured(what, value, exc.dtype, many) from None
         one, several, hint = _KINDS[exc.kind]
         raise InputError(f"{what} must be {'numbers' if many else 'a number'}, not "
                          f"{several if many else one}: `{_brief(value)}`", hint=hint) from None
@@ -64,9 +69,30 @@ class _NotNumbers(Exception):
     """Values NumPy reads as numbers though they are not the numbers meant: a key of
     :data:`_KINDS`."""
 
-    def __init__(self, kind: str) -> None:
+    def __init__(self, kind: str, dtype: np.dtype | None = None) -> None:
         super().__init__(kind)
         self.kind = kind
+        self.dtype = dtype            # of a structured value ("V"), for its fields' names
+
+
+def _structured(what: str, value: object, dtype: np.dtype | None, many: bool) -> InputError:
+    """The error for a structured array or record (NumPy's kind ``V``): NumPy casts one of a
+    single number field to that number without a word, so which field was meant is asked
+    for, never guessed; a void without fields is raw bytes."""
+    is_, numbers = ("are", "numbers") if many else ("is", "a number")
+    names = dtype.names if dtype is not None else None
+    if not names:
+        return InputError(f"{what} {is_} raw bytes (a NumPy void), not {numbers}: "
+                          f"`{_brief(value)}`", hint="decode them into numbers first")
+    fields = ", ".join(f"`{n}`" for n in names[:12]) + (", ..." if len(names) > 12 else "")
+    hint = ("give one float column per input: "
+            "`numpy.lib.recfunctions.structured_to_unstructured(array)` has one column per "
+            "field, in the fields' order" if many else
+            f"give the field's values (`array[{names[0]!r}]`)")
+    return InputError(f"{what} {is_} structured (field{'s' if len(names) > 1 else ''} "
+                      f"{fields}), not {numbers}: `{_brief(value)}`",
+                      expected="a float array [n, k]" if many else
+                      "a number or a 1-D array of numbers", hint=hint)
 
 
 #: What NumPy casts to float without complaint though it is no measurement, by array kind:
@@ -118,6 +144,8 @@ def _one_by_one(raw: np.ndarray) -> np.ndarray:
             raise _NotNumbers("M" if isinstance(v, np.datetime64) else "m")
         if _is_bytes(v):
             raise _NotNumbers("S")
+        if isinstance(v, np.void):                 # a record among objects
+            raise _NotNumbers("V", v.dtype)
         x = float(v)
         if x in (np.inf, -np.inf) and not v == x:
             raise OverflowError(v)
