@@ -146,7 +146,7 @@ def animate_run(result, path: str | Path, *, fps: float = 10.0, detail=None,
                 text.show(None if r is None else (f"{dof[r]:.2f}",
                                                   f"{compiled.labels[r]}: {compiled.rule_text(r)}"))
 
-    writer = (animation.PillowWriter(fps=fps) if fmt == "gif"  # type: ignore[arg-type]
+    writer = (_gif_writer()(fps=fps) if fmt == "gif"
               else animation.FFMpegWriter(fps=fps))  # type: ignore[arg-type]
     _save(fig, draw, picked, writer, Path(path), fmt, dpi)
     return len(picked)
@@ -222,6 +222,24 @@ def _render_text(text: str, fontsize: float, dpi: int) -> np.ndarray:
     label.set_position((1 / width, 1 / height))
     canvas.draw()
     return np.asarray(canvas.buffer_rgba()).copy()
+
+
+@functools.cache
+def _gif_writer() -> type:
+    """matplotlib's Pillow writer, each frame reduced to its palette as it is taken, by
+    Pillow's fast octree: the flat colours of a map need no more, and the median cut Pillow
+    otherwise runs on every frame when the GIF is saved took a third of an animation's time."""
+    from matplotlib import animation
+    from PIL import Image
+
+    class GifWriter(animation.PillowWriter):
+        def grab_frame(self, **savefig_kwargs) -> None:
+            super().grab_frame(**savefig_kwargs)
+            frame = self._frames[-1]
+            if frame.mode == "RGB":              # not a frame with transparency
+                self._frames[-1] = frame.quantize(method=Image.Quantize.FASTOCTREE)
+
+    return GifWriter
 
 
 def _save(fig, draw, picked, writer, path: Path, fmt: str, dpi: int) -> None:
