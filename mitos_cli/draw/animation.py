@@ -233,6 +233,8 @@ def _gif_writer() -> type:
     from PIL import Image
 
     class GifWriter(animation.PillowWriter):
+        _frames: list                            # PillowWriter's, set up by its setup()
+
         def grab_frame(self, **savefig_kwargs) -> None:
             super().grab_frame(**savefig_kwargs)
             frame = self._frames[-1]
