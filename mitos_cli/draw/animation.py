@@ -57,8 +57,8 @@ def animate_run(result, path: str | Path, *, fps: float = 10.0, detail=None,
     fmt = check_format(path)
     _matplotlib()
     from matplotlib import animation
-    from matplotlib.collections import PatchCollection
-    from matplotlib.patches import Circle, Polygon, Rectangle, Wedge
+    from matplotlib.collections import PolyCollection
+    from matplotlib.patches import Circle, Polygon, Rectangle
 
     from ..sim.geometry import rect_corners
 
@@ -100,7 +100,7 @@ def animate_run(result, path: str | Path, *, fps: float = 10.0, detail=None,
         ax.add_patch(body)
         robots.append((agent.robot, body))
         trails.append(trail)
-    cones = PatchCollection([], facecolor="#f2c14e", edgecolor="none", alpha=0.35, zorder=2)
+    cones = PolyCollection([], facecolor="#f2c14e", edgecolor="none", alpha=0.35, zorder=2)
     ax.add_collection(cones)
     cones.set_clip_path(Rectangle((xmin, ymin), xmax - xmin, ymax - ymin,
                                   transform=ax.transData))     # no cone past the outer walls
@@ -129,14 +129,14 @@ def animate_run(result, path: str | Path, *, fps: float = 10.0, detail=None,
                 patch.set_center((cx, cy))
             else:
                 patch.set_xy(rect_corners(cx, cy, np.deg2rad(o.angle), o.length, o.width))
-        wedges = []
+        sectors = []
         for i, ((robot, body), trail) in enumerate(zip(robots, trails)):
             x, y, heading = result.pose[k, i]
             body.set_xy(rect_corners(x, y, np.deg2rad(heading), robot.length, robot.width))
             trail.set_data(result.pose[:k + 1, i, 0], result.pose[:k + 1, i, 1])
-            for a, r in zip(np.rad2deg(sen.angles) + heading, result.ranges[k, i]):
-                wedges.append(Wedge((x, y), float(r), a - half_cone, a + half_cone))
-        cones.set_paths(wedges)
+            sectors.append(_sectors(x, y, np.rad2deg(sen.angles) + heading, result.ranges[k, i],
+                                    half_cone))
+        cones.set_verts(list(np.concatenate(sectors)))
         if bars is not None and texts is not None:
             dof = detail.dof[k]
             order = [r for r in np.argsort(-dof, kind="stable")[:BARS] if dof[r] > 0]
@@ -150,6 +150,19 @@ def animate_run(result, path: str | Path, *, fps: float = 10.0, detail=None,
               else animation.FFMpegWriter(fps=fps))  # type: ignore[arg-type]
     _save(fig, draw, picked, writer, Path(path), fmt, dpi)
     return len(picked)
+
+
+def _sectors(x: float, y: float, bearings: np.ndarray, ranges: np.ndarray,
+             half: float, steps: int = 8) -> np.ndarray:
+    """``[B, steps + 2, 2]``: each beam's cone as a polygon, its apex at ``(x, y)`` and its
+    arc of ``ranges`` round ``bearings`` +- ``half`` (deg) in ``steps`` chords (one array for
+    every cone of a frame, where a matplotlib Wedge per beam built its Bezier arc anew)."""
+    theta = np.deg2rad(bearings[:, None] + np.linspace(-half, half, steps + 1))
+    out = np.empty((len(bearings), steps + 2, 2))
+    out[:, 0] = x, y
+    out[:, 1:, 0] = x + ranges[:, None] * np.cos(theta)
+    out[:, 1:, 1] = y + ranges[:, None] * np.sin(theta)
+    return out
 
 
 class _SlotText:
