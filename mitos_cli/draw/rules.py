@@ -152,12 +152,7 @@ def draw_rules(view: RuleView, path: str | Path | None = None, *, title: str | N
 
     With more than ``max_rows`` fired rules the strongest ``max_rows`` are drawn (in
     rule-base order) and the title says how many were left out."""
-    rows = list(view.rows)
-    hidden = 0
-    if len(rows) > max_rows:
-        keep = sorted(sorted(range(len(rows)), key=lambda i: -rows[i].dof)[:max_rows])
-        hidden = len(rows) - max_rows
-        rows = [rows[i] for i in keep]
+    rows, hidden = _strongest(list(view.rows), max_rows)
     used = {p.var for r in rows for p in r.props}
     inputs = [i for i in view.inputs if i.name in used] or list(view.inputs)
     outputs = list(view.outputs)
@@ -173,52 +168,14 @@ def draw_rules(view: RuleView, path: str | Path | None = None, *, title: str | N
                             hspace=2 * GAP_INCHES / (span - GAP_INCHES), wspace=0.12)
     bases = [n - 1 - k for k in range(len(rows))]          # first rule on top
     for k, inp in enumerate(inputs):
-        ax = fig.add_subplot(grid[0, k])
-        _bare(ax)
-        ax.set_xticks([])
-        ax.spines["bottom"].set_visible(False)
-        ax.set_xlim(*inp.universe)
-        ax.set_ylim(-0.05, n + 0.05)
-        for base, row in zip(bases, rows):
-            ax.axhline(base, color="black", linewidth=0.8)
-            draw_antecedent(ax, base, row, inp.name)
-            if k == 0:
-                ax.text(-0.08, base + BAND / 2, f"{row.label}\n" + row.dof_text.replace(
-                            " = ", "\n= "),
-                        transform=ax.get_yaxis_transform(), ha="right", va="center",
-                        fontsize=8)
-        ax.axvline(inp.value, color=VALUE_COLOR, linewidth=1.1)
-        unit = f" {inp.unit}" if inp.unit else ""
-        ax.set_title(f"{inp.name} = {inp.value:g}{unit}", fontsize=9, pad=3)
-        if not rows and k == 0:
-            ax.text(0.02, 0.5, "no rule fired", transform=ax.transAxes, fontsize=9)
+        _input_column(fig.add_subplot(grid[0, k]), inp, rows, bases, n, first=k == 0)
     for j, out in enumerate(outputs):
-        ax = fig.add_subplot(grid[0, len(inputs) + j])
-        _bare(ax)
-        ax.set_xticks([])
-        ax.spines["bottom"].set_visible(False)
-        lo, hi = out.universe
-        pad = 0.03 * (hi - lo)
-        ax.set_xlim(lo - pad, hi + pad)
-        ax.set_ylim(-0.05, n + 0.05)
-        for base, row in zip(bases, rows):
-            ax.axhline(base, color="black", linewidth=0.8)
-            draw_consequent(ax, base, row, out)
-        ax.set_title(out.name, fontsize=9, pad=3)
+        _output_column(fig.add_subplot(grid[0, len(inputs) + j]), out, rows, bases, n)
     # bottom row: the input axes' scales, then the outputs' aggregates and results
     for k, inp in enumerate(inputs):
-        ax = fig.add_subplot(grid[1, k])
-        _bare(ax)
-        ax.tick_params(axis="x", labelsize=7, length=2)
-        ax.set_xlim(*inp.universe)
-        ax.axvline(inp.value, color=VALUE_COLOR, linewidth=1.1)
-        unit = f" [{inp.unit}]" if inp.unit else ""
-        ax.set_xlabel(f"{inp.name}{unit}", fontsize=8)
-        if k == 0:
-            ax.text(-0.08, 0.5, "aggregate", transform=ax.transAxes, ha="right",
-                    va="center", fontsize=8, fontweight="bold")
-    for out in outputs:
-        ax = fig.add_subplot(grid[1, len(inputs) + outputs.index(out)])
+        _input_scale(fig.add_subplot(grid[1, k]), inp, first=k == 0)
+    for j, out in enumerate(outputs):
+        ax = fig.add_subplot(grid[1, len(inputs) + j])
         _bare(ax)
         ax.tick_params(axis="x", labelsize=7, length=2)
         draw_aggregate(ax, out)
@@ -228,3 +185,63 @@ def draw_rules(view: RuleView, path: str | Path | None = None, *, title: str | N
         heading += f"; the {hidden} weakest not shown"
     fig.suptitle(heading, fontsize=11, x=0.02, y=1 - 0.2 / height, ha="left")
     return finish(fig, path, show, tight=False)       # margins are set above
+
+
+def _strongest(rows: list, max_rows: int) -> tuple[list, int]:
+    """The ``max_rows`` rows of the largest DOFs, in rule-base order, and how many are left
+    out."""
+    if len(rows) <= max_rows:
+        return rows, 0
+    keep = sorted(sorted(range(len(rows)), key=lambda i: -rows[i].dof)[:max_rows])
+    return [rows[i] for i in keep], len(rows) - max_rows
+
+
+def _input_column(ax, inp, rows: list, bases: list[int], n: int, first: bool) -> None:
+    """An input's column: each rule's antecedent term on its row, the input's value across;
+    the first column also labels the rows with the rules and their DOFs."""
+    _bare(ax)
+    ax.set_xticks([])
+    ax.spines["bottom"].set_visible(False)
+    ax.set_xlim(*inp.universe)
+    ax.set_ylim(-0.05, n + 0.05)
+    for base, row in zip(bases, rows):
+        ax.axhline(base, color="black", linewidth=0.8)
+        draw_antecedent(ax, base, row, inp.name)
+        if first:
+            ax.text(-0.08, base + BAND / 2, f"{row.label}\n" + row.dof_text.replace(
+                        " = ", "\n= "),
+                    transform=ax.get_yaxis_transform(), ha="right", va="center",
+                    fontsize=8)
+    ax.axvline(inp.value, color=VALUE_COLOR, linewidth=1.1)
+    unit = f" {inp.unit}" if inp.unit else ""
+    ax.set_title(f"{inp.name} = {inp.value:g}{unit}", fontsize=9, pad=3)
+    if not rows and first:
+        ax.text(0.02, 0.5, "no rule fired", transform=ax.transAxes, fontsize=9)
+
+
+def _output_column(ax, out, rows: list, bases: list[int], n: int) -> None:
+    """An output's column: each rule's consequent, clipped by its DOF, on its row."""
+    _bare(ax)
+    ax.set_xticks([])
+    ax.spines["bottom"].set_visible(False)
+    lo, hi = out.universe
+    pad = 0.03 * (hi - lo)
+    ax.set_xlim(lo - pad, hi + pad)
+    ax.set_ylim(-0.05, n + 0.05)
+    for base, row in zip(bases, rows):
+        ax.axhline(base, color="black", linewidth=0.8)
+        draw_consequent(ax, base, row, out)
+    ax.set_title(out.name, fontsize=9, pad=3)
+
+
+def _input_scale(ax, inp, first: bool) -> None:
+    """Under an input's column, its scale and value (the first labels the row)."""
+    _bare(ax)
+    ax.tick_params(axis="x", labelsize=7, length=2)
+    ax.set_xlim(*inp.universe)
+    ax.axvline(inp.value, color=VALUE_COLOR, linewidth=1.1)
+    unit = f" [{inp.unit}]" if inp.unit else ""
+    ax.set_xlabel(f"{inp.name}{unit}", fontsize=8)
+    if first:
+        ax.text(-0.08, 0.5, "aggregate", transform=ax.transAxes, ha="right",
+                va="center", fontsize=8, fontweight="bold")
