@@ -86,15 +86,28 @@ def caret_under(exc: MitosError) -> str:
      "did you mean `then`?"),
     ("behavior b:\n  r1: if road is WIDE then speed is SLOW\n", 41, None,
      "unexpected end of the input", "`end`", "a behavior ends with `end`"),
-    # a misspelt statement keyword is read as a rule's label: say which keyword it was
-    ("behaviour b:\n", 11, "b",
-     "unexpected `b`", "`:`", "`behaviour` is not a keyword: did you mean `behavior`?"),
+    # a misspelt statement keyword is read as a rule's label: the word is reported, with
+    # which keyword it was
+    ("behaviour b:\n", 1, "behaviour", "unexpected `behaviour` after `\"t.terms.yaml\"`",
+     "`behavior`", "`behaviour` is not a keyword: did you mean `behavior`?"),
     ("operator: and = product\n", 11, "and", "unexpected `and`", "`if`",
      "`operator` is not a keyword: did you mean `operators`?"),
-    ("behavior b:\n  r1: if road is WIDE then speed is SLOW\n  frozn r1\n", 9, "r1",
-     "unexpected `r1`", "`:`", "`frozn` is not a keyword: did you mean `frozen`?"),
-    ("behavior b:\n  r1: if road is WIDE then speed is SLOW\nedn\n", 4, None,
-     "unexpected end of the input", "`:`", "`edn` is not a keyword: did you mean `end`?"),
+    ("behavior b:\n  r1: if road is WIDE then speed is SLOW\n  frozn r1\n", 3, "frozn",
+     "unexpected `frozn` after `SLOW`", "`frozen`",
+     "`frozn` is not a keyword: did you mean `frozen`?"),
+    ("behavior b:\n  r1: if road is WIDE then speed is SLOW\nedn\n", 1, "edn",
+     "unexpected `edn` after `SLOW`", "`end`", "`edn` is not a keyword: did you mean `end`?"),
+    # a stray word at a rule's end is read as the next rule's label: the word is reported
+    ("r1: if road is WIDE then speed is MEDIUM wiht 0.5\n", 42, "wiht",
+     "unexpected `wiht` after `MEDIUM`", "`with`", "did you mean `with`?"),
+    ("r1: if road is WIDE then speed is MEDIUM xyzzy\n", 42, "xyzzy",
+     "unexpected `xyzzy` after `MEDIUM`", "a rule's label",
+     "`xyzzy` is read as the label of a new rule, which needs `:` after it on the same line"),
+    # a label without its `:`
+    ("r1 if road is WIDE then speed is SLOW\n", 4, "if", "unexpected `if`", "`:`",
+     "a rule's label ends with `:` (`r1: if ...`)"),
+    ("foo bar\n", 5, "bar", "unexpected `bar`", "`:`",
+     "`foo` is read as a rule's label, which ends with `:`"),
     # a variable's name before a missing `is` is no misspelt keyword (`temp` is not `terms`)
     ("r1: if size is SMALL_SZ and temp SMALL_SZ then speed is SLOW", 34, "SMALL_SZ",
      "unexpected `SMALL_SZ`", "`is`", "a condition reads `variable is TERM`"),
@@ -113,6 +126,23 @@ def test_syntax_errors(tmp_path, line, col, at, message, expected, hint):
     if hint:
         assert "hint:" in text and hint in text
     assert "did you mean `terms`" not in text
+
+
+@pytest.mark.parametrize("typo, line, col, message, hint", [
+    ("  r1: if road is WIDE then speed is MEDIUM andd\n", 3, 44,
+     "unexpected `andd` after `MEDIUM`", "did you mean `and`?"),
+    ("  r1: if road is WIDE then speed is MEDIUM\nned\n# comment\n", 4, 1,
+     "unexpected `ned` after `MEDIUM`", "did you mean `end`?"),
+])
+def test_a_stray_word_is_reported_not_the_next_label(tmp_path, typo, line, col, message, hint):
+    """A word at a rule's end, or a misspelt `end`, is read as the next rule's label; the
+    error was at the next line's `r2` (or `behavior`), "expected `:`". It is at the word."""
+    path = write(tmp_path, "behavior a:\n" + typo + "  r2: if road is NARROW then speed is SLOW\n"
+                 "end\nbehavior b:\n  r3: if road is WIDE then speed is SLOW\nend\n")
+    exc = error_of(lambda: load_rules_file(path), RuleSyntaxError)
+    assert exc.message == message and str(exc.span) == f"{path}:{line}:{col}"
+    assert caret_under(exc) == message.split("`")[1]
+    assert hint in exc.hint and "`:`" not in (exc.expected or "")
 
 
 def test_syntax_error_in_a_wrapped_rule_points_at_its_line(tmp_path):
