@@ -42,6 +42,21 @@ class Span:
             return self
         return replace(self, column=start)
 
+    def naming(self, token: str) -> Span:
+        """This span narrowed to the first whole word ``token`` it covers on its line (the
+        unknown variable of ``raod is WIDE``, the name of ``behavior a:``); itself where it
+        cannot tell."""
+        if self.source_line is None:
+            return self
+        i = self.column - self.source_start
+        stop = None if self.end_column is None else self.end_column - self.source_start
+        found = re.compile(rf"(?<![\w\-]){re.escape(token)}(?![\w\-])").search(
+            self.source_line, max(i, 0), stop if stop is not None else len(self.source_line))
+        if i < 0 or found is None:
+            return self
+        column = found.start() + self.source_start
+        return replace(self, column=column, end_column=column + len(token))
+
     @classmethod
     def in_text(cls, text: str, path: str | None, line: int, column: int,
                 end_column: int | None = None) -> Span:

@@ -170,11 +170,11 @@ def test_missing_rule_file():
 
 @pytest.mark.parametrize("rule, message, hint, at", [
     ("r1: if raod is WIDE then speed is SLOW", "unknown input variable `raod`",
-     "did you mean `road`?", "raod is WIDE"),
+     "did you mean `road`?", "raod"),          # the name only, not `raod is WIDE`
     ("r1: if road is WIDEE then speed is SLOW", "unknown term `WIDEE` of `road`",
      "did you mean `WIDE`?", "WIDEE"),           # the caret under the term itself
     ("r1: if road is WIDE then sped is SLOW", "unknown output variable `sped`",
-     "did you mean `speed`?", "sped is SLOW"),
+     "did you mean `speed`?", "sped"),
     ("r1: if road is WIDE then speed is SLWO", "unknown term `SLWO` of `speed`",
      "did you mean `SLOW`?", "SLWO"),
     ("r1: if road is wide then speed is SLOW", "unknown term `wide` of `road`",
@@ -216,7 +216,7 @@ def test_output_in_a_condition(tmp_path):
     path = write(tmp_path, "r1: if speed is SLOW then steering is LS")
     exc = error_of(lambda: load_rules_file(path), RuleBaseError)
     assert exc.message == "`speed` is an output variable and cannot appear in a condition"
-    assert caret_under(exc) == "speed is SLOW"
+    assert caret_under(exc) == "speed"
 
 
 def test_unknown_operator(tmp_path):
@@ -224,6 +224,20 @@ def test_unknown_operator(tmp_path):
     exc = error_of(lambda: load_rules_file(path), NameError_)
     assert exc.message == "unknown T-norm `mni`" and exc.hint == "did you mean `min`?"
     assert str(exc.span).endswith(":2:12")
+
+
+def test_behavior_defined_twice_is_reported_at_the_second(tmp_path):
+    body = "  " + GOOD_RULE + "\nend\n"
+    path = write(tmp_path, "behavior a:\n" + body + "behavior b:\n" + body + "behavior a:\n" + body)
+    exc = error_of(lambda: load_rules_file(path), RuleBaseError)
+    assert exc.message == "behavior `a` is defined twice (first at line 2)"
+    assert str(exc.span) == f"{path}:8:10" and caret_under(exc) == "a"
+
+
+def test_behavior_main_and_top_level_rules(tmp_path):
+    path = write(tmp_path, GOOD_RULE + "\nbehavior main:\n  " + GOOD_RULE + "\nend\n")
+    exc = error_of(lambda: load_rules_file(path), RuleBaseError)
+    assert "behavior `main` is defined twice" in exc.message and exc.span.line == 3
 
 
 def test_duplicate_label(tmp_path):
