@@ -362,6 +362,17 @@ def test_wrong_values_are_said_in_words(old, new, says):
     assert says in error(BASE.replace(old, new))
 
 
+@pytest.mark.parametrize("old, new, says, hint", [
+    ("map:\n", "map:\n  unknown: ocupied\n", "`unknown: ocupied` in map: unknown value",
+     "did you mean `occupied`?"),                       # was "unknown unknown `ocupied`"
+    ("  model: tricycle\n", "  model: tricyle\n", "unknown model `tricyle` in robot",
+     "did you mean `tricycle`?"),                       # a key that names its value: as it was
+])
+def test_a_choice_reads_as_words(old, new, says, hint):
+    text = error(BASE.replace(old, new, 1))
+    assert f"error: {says}\n" in text and f"hint: {hint}" in text
+
+
 def test_a_field_of_view_on_a_ring_is_refused():
     ring = BASE + "sensors: {layout: ring, fov: 90}\n"          # it was silently ignored
     assert "`fov` in sensors is for `layout: fan`" in error(ring)

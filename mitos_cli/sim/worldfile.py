@@ -51,6 +51,9 @@ MODELS = ("tricycle",)
 LAYOUTS = ("ring", "fan")
 SHAPES = ("circle", "rectangle")
 MODES = ("loop", "ping-pong", "stop")
+#: keys whose value is a thing of that name ("unknown shape `circel`" reads); for the others
+#: ("unknown unknown `ocupied`" does not) an error quotes `key: value`
+NOUN_KEYS = ("model", "layout", "shape", "mode")
 
 
 #: The largest magnitude of any number in a world (inches, seconds, degrees): 1e7 in is
@@ -131,8 +134,10 @@ class _Reader:
             if value == "None" and m[key] is None:    # `given:` left empty: not `None`
                 value = ""
             err = unknown(key, value, options)          # "unknown shape `circel`" ...
-            raise WorldError(f"{err.message} in {what}", span=m.value_span(key),
-                             expected=err.expected, hint=err.hint)   # ... "in obstacle `box`"
+            message = (f"{err.message} in {what}" if key in NOUN_KEYS   # ... "in obstacle `box`"
+                       else f"`{key}: {value}` in {what}: unknown value")
+            raise WorldError(message, span=m.value_span(key), expected=err.expected,
+                             hint=err.hint)
         return value
 
     def flag(self, m: YMap, key: str, what: str, default: bool) -> bool:
