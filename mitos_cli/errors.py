@@ -248,6 +248,23 @@ def closest(name: str, candidates: Iterable[str]) -> str | None:
     return close[0] if close else None
 
 
+def closest_file(name: str, candidates: Iterable[str]) -> str | None:
+    """The file name among ``candidates`` closest to ``name``, comparing stems where the
+    extension is the same: a shared ``.yaml`` made ``nosuch.yaml`` close to ``office.yaml``
+    for difflib. A misspelt extension (``mitos.rule``) is still close to ``mitos.rules``."""
+    pool = list(candidates)
+    stem, dot, suffix = name.rpartition(".")
+    if dot and stem:
+        same = {c[:-len(suffix) - 1]: c for c in pool
+                if c.endswith("." + suffix) and len(c) > len(suffix) + 1}
+        if same:
+            hit = closest(stem, same)
+            if hit is not None:
+                return same[hit]
+            pool = [c for c in pool if c not in same.values()]
+    return closest(name, pool)
+
+
 def did_you_mean(name: str, candidates: Iterable[str]) -> str | None:
     """The closest candidate to ``name`` as a hint, or ``None`` when nothing is close."""
     close = closest(name, candidates)

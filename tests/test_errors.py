@@ -159,6 +159,21 @@ def test_binary_file_is_refused(tmp_path):
     assert "not a text file" in exc.message and exc.span.path == str(path)
 
 
+def test_a_missing_rule_file_guesses_only_a_close_name(tmp_path, capsys):
+    """`nosuch.rules` was "did you mean `dup.rules`?": the `.rules` both end in."""
+    (tmp_path / "dup.rules").write_text("")
+    (tmp_path / "mitos.rules").write_text("")
+    for args, hint in ((["simulate", "--rulebase", str(tmp_path / "nosuch.rules")], None),
+                       (["eval", str(tmp_path / "nosuch.rules"), "road=1"], None),
+                       (["simulate", "--rulebase", str(tmp_path / "mitoss.rules")],
+                        f"did you mean `{tmp_path / 'mitos.rules'}`?")):
+        with pytest.raises(SystemExit) as info:
+            main(args)
+        err = capsys.readouterr().err
+        assert info.value.code == 1 and "cannot read rule file" in err
+        assert (f"hint: {hint}" in err) if hint else "did you mean" not in err, err
+
+
 def test_missing_rule_file():
     exc = error_of(lambda: load_rules_file("no/such.rules"), RuleBaseError)
     assert "cannot read rule file `no/such.rules`" in exc.message
