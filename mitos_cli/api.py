@@ -17,6 +17,7 @@ import numpy as np
 from .engine.compile import CompiledRuleBase, compile_rulebase
 from .engine.evaluation import Result, as_batch, as_columns, evaluate, evaluate_columns, evaluate_one
 from .engine.trace import Trace, trace_of
+from .errors import MitosError
 from .lang.model import RuleBase
 from .resources import DEFAULT_RULEBASE, packaged_path
 
@@ -45,7 +46,18 @@ def read_rulebase(path: str | Path | None = None) -> RuleBase:
         raise RuleBaseError(f"`{path}` is a YAML file (a term set, or a world), not a rule "
                             f"base", hint="a rule base is a .rules, .fcl, .fis or .fll file; "
                             "a term set is read through the `terms` line of its .rules file")
-    if suffix in (".fcl", ".fis", ".fll"):
+    try:
+        return _read_by_extension(path)
+    except MitosError as exc:
+        from .interop import hint_wrong_reader
+
+        hint_wrong_reader(exc, path)
+        raise
+
+
+def _read_by_extension(path: Path) -> RuleBase:
+    """The rule base at ``path``, read by the reader its extension names."""
+    if path.suffix.lower() in (".fcl", ".fis", ".fll"):
         from .interop import read_foreign
 
         return read_foreign(path)

@@ -42,6 +42,21 @@ class Span:
             return self
         return replace(self, column=start)
 
+    def naming(self, token: str) -> Span:
+        """This span narrowed to the first whole word ``token`` it covers on its line (the
+        unknown variable of ``raod is WIDE``, the name of ``behavior a:``); itself where it
+        cannot tell."""
+        if self.source_line is None:
+            return self
+        i = self.column - self.source_start
+        stop = None if self.end_column is None else self.end_column - self.source_start
+        found = re.compile(rf"(?<![\w\-]){re.escape(token)}(?![\w\-])").search(
+            self.source_line, max(i, 0), stop if stop is not None else len(self.source_line))
+        if i < 0 or found is None:
+            return self
+        column = found.start() + self.source_start
+        return replace(self, column=column, end_column=column + len(token))
+
     @classmethod
     def in_text(cls, text: str, path: str | None, line: int, column: int,
                 end_column: int | None = None) -> Span:
@@ -231,6 +246,23 @@ def closest(name: str, candidates: Iterable[str]) -> str | None:
         close = [c for c in pool if c.lower().startswith(name.lower())]
         close = close if len(close) == 1 else []
     return close[0] if close else None
+
+
+def closest_file(name: str, candidates: Iterable[str]) -> str | None:
+    """The file name among ``candidates`` closest to ``name``, comparing stems where the
+    extension is the same: a shared ``.yaml`` made ``nosuch.yaml`` close to ``office.yaml``
+    for difflib. A misspelt extension (``mitos.rule``) is still close to ``mitos.rules``."""
+    pool = list(candidates)
+    stem, dot, suffix = name.rpartition(".")
+    if dot and stem:
+        same = {c[:-len(suffix) - 1]: c for c in pool
+                if c.endswith("." + suffix) and len(c) > len(suffix) + 1}
+        if same:
+            hit = closest(stem, same)
+            if hit is not None:
+                return same[hit]
+            pool = [c for c in pool if c not in same.values()]
+    return closest(name, pool)
 
 
 def did_you_mean(name: str, candidates: Iterable[str]) -> str | None:

@@ -17,7 +17,7 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import IO
 
-from .errors import MitosError, closest
+from .errors import MitosError, closest_file
 
 #: the largest text file read (bytes): far beyond any rule base, world, lesson or batch here
 MAX_TEXT_BYTES = 256 << 20
@@ -35,7 +35,7 @@ def nearby(path: str | Path, suffixes: tuple[str, ...] = RULE_SUFFIXES) -> str |
         names = [p.name for p in where.iterdir() if p.suffix.lower() in suffixes]
     except OSError:
         return None
-    name = closest(Path(path).name, names)
+    name = closest_file(Path(path).name, names)
     return f"did you mean `{where / name}`?" if name is not None else None
 
 

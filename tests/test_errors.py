@@ -86,15 +86,28 @@ def caret_under(exc: MitosError) -> str:
      "did you mean `then`?"),
     ("behavior b:\n  r1: if road is WIDE then speed is SLOW\n", 41, None,
      "unexpected end of the input", "`end`", "a behavior ends with `end`"),
-    # a misspelt statement keyword is read as a rule's label: say which keyword it was
-    ("behaviour b:\n", 11, "b",
-     "unexpected `b`", "`:`", "`behaviour` is not a keyword: did you mean `behavior`?"),
+    # a misspelt statement keyword is read as a rule's label: the word is reported, with
+    # which keyword it was
+    ("behaviour b:\n", 1, "behaviour", "unexpected `behaviour` after `\"t.terms.yaml\"`",
+     "`behavior`", "`behaviour` is not a keyword: did you mean `behavior`?"),
     ("operator: and = product\n", 11, "and", "unexpected `and`", "`if`",
      "`operator` is not a keyword: did you mean `operators`?"),
-    ("behavior b:\n  r1: if road is WIDE then speed is SLOW\n  frozn r1\n", 9, "r1",
-     "unexpected `r1`", "`:`", "`frozn` is not a keyword: did you mean `frozen`?"),
-    ("behavior b:\n  r1: if road is WIDE then speed is SLOW\nedn\n", 4, None,
-     "unexpected end of the input", "`:`", "`edn` is not a keyword: did you mean `end`?"),
+    ("behavior b:\n  r1: if road is WIDE then speed is SLOW\n  frozn r1\n", 3, "frozn",
+     "unexpected `frozn` after `SLOW`", "`frozen`",
+     "`frozn` is not a keyword: did you mean `frozen`?"),
+    ("behavior b:\n  r1: if road is WIDE then speed is SLOW\nedn\n", 1, "edn",
+     "unexpected `edn` after `SLOW`", "`end`", "`edn` is not a keyword: did you mean `end`?"),
+    # a stray word at a rule's end is read as the next rule's label: the word is reported
+    ("r1: if road is WIDE then speed is MEDIUM wiht 0.5\n", 42, "wiht",
+     "unexpected `wiht` after `MEDIUM`", "`with`", "did you mean `with`?"),
+    ("r1: if road is WIDE then speed is MEDIUM xyzzy\n", 42, "xyzzy",
+     "unexpected `xyzzy` after `MEDIUM`", "a rule's label",
+     "`xyzzy` is read as the label of a new rule, which needs `:` after it on the same line"),
+    # a label without its `:`
+    ("r1 if road is WIDE then speed is SLOW\n", 4, "if", "unexpected `if`", "`:`",
+     "a rule's label ends with `:` (`r1: if ...`)"),
+    ("foo bar\n", 5, "bar", "unexpected `bar`", "`:`",
+     "`foo` is read as a rule's label, which ends with `:`"),
     # a variable's name before a missing `is` is no misspelt keyword (`temp` is not `terms`)
     ("r1: if size is SMALL_SZ and temp SMALL_SZ then speed is SLOW", 34, "SMALL_SZ",
      "unexpected `SMALL_SZ`", "`is`", "a condition reads `variable is TERM`"),
@@ -115,6 +128,23 @@ def test_syntax_errors(tmp_path, line, col, at, message, expected, hint):
     assert "did you mean `terms`" not in text
 
 
+@pytest.mark.parametrize("typo, line, col, message, hint", [
+    ("  r1: if road is WIDE then speed is MEDIUM andd\n", 3, 44,
+     "unexpected `andd` after `MEDIUM`", "did you mean `and`?"),
+    ("  r1: if road is WIDE then speed is MEDIUM\nned\n# comment\n", 4, 1,
+     "unexpected `ned` after `MEDIUM`", "did you mean `end`?"),
+])
+def test_a_stray_word_is_reported_not_the_next_label(tmp_path, typo, line, col, message, hint):
+    """A word at a rule's end, or a misspelt `end`, is read as the next rule's label; the
+    error was at the next line's `r2` (or `behavior`), "expected `:`". It is at the word."""
+    path = write(tmp_path, "behavior a:\n" + typo + "  r2: if road is NARROW then speed is SLOW\n"
+                 "end\nbehavior b:\n  r3: if road is WIDE then speed is SLOW\nend\n")
+    exc = error_of(lambda: load_rules_file(path), RuleSyntaxError)
+    assert exc.message == message and str(exc.span) == f"{path}:{line}:{col}"
+    assert caret_under(exc) == message.split("`")[1]
+    assert hint in exc.hint and "`:`" not in (exc.expected or "")
+
+
 def test_syntax_error_in_a_wrapped_rule_points_at_its_line(tmp_path):
     path = write(tmp_path, "r1: if road is WIDE\n    and size SMALL_SZ\n    then speed is SLOW\n")
     exc = error_of(lambda: load_rules_file(path), RuleSyntaxError)
@@ -129,6 +159,21 @@ def test_binary_file_is_refused(tmp_path):
     assert "not a text file" in exc.message and exc.span.path == str(path)
 
 
+def test_a_missing_rule_file_guesses_only_a_close_name(tmp_path, capsys):
+    """`nosuch.rules` was "did you mean `dup.rules`?": the `.rules` both end in."""
+    (tmp_path / "dup.rules").write_text("")
+    (tmp_path / "mitos.rules").write_text("")
+    for args, hint in ((["simulate", "--rulebase", str(tmp_path / "nosuch.rules")], None),
+                       (["eval", str(tmp_path / "nosuch.rules"), "road=1"], None),
+                       (["simulate", "--rulebase", str(tmp_path / "mitoss.rules")],
+                        f"did you mean `{tmp_path / 'mitos.rules'}`?")):
+        with pytest.raises(SystemExit) as info:
+            main(args)
+        err = capsys.readouterr().err
+        assert info.value.code == 1 and "cannot read rule file" in err
+        assert (f"hint: {hint}" in err) if hint else "did you mean" not in err, err
+
+
 def test_missing_rule_file():
     exc = error_of(lambda: load_rules_file("no/such.rules"), RuleBaseError)
     assert "cannot read rule file `no/such.rules`" in exc.message
@@ -140,11 +185,11 @@ def test_missing_rule_file():
 
 @pytest.mark.parametrize("rule, message, hint, at", [
     ("r1: if raod is WIDE then speed is SLOW", "unknown input variable `raod`",
-     "did you mean `road`?", "raod is WIDE"),
+     "did you mean `road`?", "raod"),          # the name only, not `raod is WIDE`
     ("r1: if road is WIDEE then speed is SLOW", "unknown term `WIDEE` of `road`",
      "did you mean `WIDE`?", "WIDEE"),           # the caret under the term itself
     ("r1: if road is WIDE then sped is SLOW", "unknown output variable `sped`",
-     "did you mean `speed`?", "sped is SLOW"),
+     "did you mean `speed`?", "sped"),
     ("r1: if road is WIDE then speed is SLWO", "unknown term `SLWO` of `speed`",
      "did you mean `SLOW`?", "SLWO"),
     ("r1: if road is wide then speed is SLOW", "unknown term `wide` of `road`",
@@ -186,7 +231,7 @@ def test_output_in_a_condition(tmp_path):
     path = write(tmp_path, "r1: if speed is SLOW then steering is LS")
     exc = error_of(lambda: load_rules_file(path), RuleBaseError)
     assert exc.message == "`speed` is an output variable and cannot appear in a condition"
-    assert caret_under(exc) == "speed is SLOW"
+    assert caret_under(exc) == "speed"
 
 
 def test_unknown_operator(tmp_path):
@@ -194,6 +239,20 @@ def test_unknown_operator(tmp_path):
     exc = error_of(lambda: load_rules_file(path), NameError_)
     assert exc.message == "unknown T-norm `mni`" and exc.hint == "did you mean `min`?"
     assert str(exc.span).endswith(":2:12")
+
+
+def test_behavior_defined_twice_is_reported_at_the_second(tmp_path):
+    body = "  " + GOOD_RULE + "\nend\n"
+    path = write(tmp_path, "behavior a:\n" + body + "behavior b:\n" + body + "behavior a:\n" + body)
+    exc = error_of(lambda: load_rules_file(path), RuleBaseError)
+    assert exc.message == "behavior `a` is defined twice (first at line 2)"
+    assert str(exc.span) == f"{path}:8:10" and caret_under(exc) == "a"
+
+
+def test_behavior_main_and_top_level_rules(tmp_path):
+    path = write(tmp_path, GOOD_RULE + "\nbehavior main:\n  " + GOOD_RULE + "\nend\n")
+    exc = error_of(lambda: load_rules_file(path), RuleBaseError)
+    assert "behavior `main` is defined twice" in exc.message and exc.span.line == 3
 
 
 def test_duplicate_label(tmp_path):

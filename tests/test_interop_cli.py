@@ -358,3 +358,49 @@ def test_export_says_which_behavior_it_exported(tmp_path: Path, capsys) -> None:
     code, output = run_main(["export", str(DATA / "tipper.fis"), "--to", "c",
                              "-o", str(tmp_path / "t.c")], capsys)
     assert code == 0 and "warning" not in output
+
+
+def _run(capsys, *args: str) -> tuple[int, str]:
+    """``mitos ARGS`` in process: the exit code and what it wrote to stderr."""
+    from mitos_cli.cli.app import main
+
+    with pytest.raises(SystemExit) as info:
+        main(list(args))
+    return int(info.value.code or 0), capsys.readouterr().err
+
+
+@pytest.mark.parametrize("source, name, looks, statement, rename", [
+    ("tipper.fis", "tipper.txt", "a MATLAB .fis file", "[System]", "tipper.fis"),
+    ("tipper_jfuzzylogic.fcl", "tipper.rules", "an FCL file", "FUNCTION_BLOCK", "tipper.fcl"),
+    ("tipper.fis", "tipper.fll", "a MATLAB .fis file", "[System]", "tipper.fis"),
+    ("check_formula_input.fll", "check.fcl", "a fuzzylite FLL file", "Engine:", "check.fll"),
+])
+def test_a_file_read_by_the_wrong_reader_says_which_format_it_looks_like(
+        tmp_path: Path, capsys, source: str, name: str, looks: str, statement: str,
+        rename: str) -> None:
+    """`mitos eval tipper.txt` read a .fis as rules: "unexpected character `[`" and no more."""
+    path = tmp_path / name
+    path.write_bytes((DATA / source).read_bytes())
+    code, err = _run(capsys, "eval", str(path), "service=2", "food=1")
+    assert code == 1
+    assert f"hint: `{name}` looks like {looks} (`{statement}` on line " in err, err
+    assert "the reader is chosen by the file's extension" in err
+    assert f"rename it to `{rename}`" in err
+
+
+def test_teach_on_a_foreign_file_says_to_convert_it(tmp_path: Path, capsys) -> None:
+    path = tmp_path / "tipper.txt"
+    path.write_bytes((DATA / "tipper.fis").read_bytes())
+    code, err = _run(capsys, "teach", str(path), "--lesson", "-")
+    assert code == 1
+    assert ("but `mitos teach` reads the MITOS rule language only: rename it to `tipper.fis`, "
+            f"then convert it with `mitos convert {tmp_path / 'tipper.fis'} --to rules`") in err
+
+
+def test_a_rule_file_with_a_mistake_gets_no_format_hint(tmp_path: Path, capsys) -> None:
+    rules = (ROOT / "rulebases" / "mitos.rules").read_text().replace("then steering", "thn steering", 1)
+    (tmp_path / "m.rules").write_text(rules)
+    for f in ("mitos.terms.yaml", "drive.terms.yaml"):
+        (tmp_path / f).write_bytes((ROOT / "rulebases" / f).read_bytes())
+    code, err = _run(capsys, "check", str(tmp_path / "m.rules"))
+    assert code == 1 and "looks like" not in err and "syntax error" in err

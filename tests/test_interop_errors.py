@@ -290,6 +290,28 @@ def test_fcl_errors(old: str, new: str, words: str) -> None:
     assert span is not None and span.path == "bad.fcl" and span.line >= 1
 
 
+@pytest.mark.parametrize("old, new, at, hint", [
+    ("TERM poor :=", "TREM poor :=", "TREM", "did you mean `TERM`?"),
+    ("END_FUZZIFY", "END_FUZIFY", "END_FUZIFY", "did you mean `END_FUZZIFY`?"),
+    ("END_FUZZIFY", "", "FUZZIFY", None),           # a keyword out of place: no did-you-mean
+])
+def test_fcl_keywords_as_fcl_writes_them(old: str, new: str, at: str, hint: str | None) -> None:
+    """Expected keywords read `END_FUZZIFY`, not `end fuzzify`; a misspelt one is named."""
+    with pytest.raises(FormatError) as info:
+        parse_fcl(FCL.replace(old, new, 1), "bad.fcl")
+    exc = info.value
+    assert exc.message == f"unexpected `{at}`" and exc.hint == hint
+    assert exc.expected == "one of END_FUZZIFY, METHOD/ACCU/AND/OR/ACT, RANGE, TERM"
+    caret = exc.render().splitlines()[2]
+    assert caret.strip() == "^" * len(at)
+
+
+def test_fcl_punctuation_is_quoted() -> None:
+    with pytest.raises(FormatError) as info:
+        parse_fcl(FCL.replace("TERM poor :=", "TERM poor =", 1), "bad.fcl")
+    assert info.value.expected == "one of `:=`"
+
+
 def test_fcl_sugeno_lock_range() -> None:
     text = (Path(__file__).parent / "data" / "interop" / "dimmer_fuzzylite.fcl").read_text()
     text = text.replace("TERM LOW := Gaussian 0.000 0.200;", "TERM LOW := 0.1;").replace(

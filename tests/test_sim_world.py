@@ -362,6 +362,17 @@ def test_wrong_values_are_said_in_words(old, new, says):
     assert says in error(BASE.replace(old, new))
 
 
+@pytest.mark.parametrize("old, new, says, hint", [
+    ("map:\n", "map:\n  unknown: ocupied\n", "`unknown: ocupied` in map: unknown value",
+     "did you mean `occupied`?"),                       # was "unknown unknown `ocupied`"
+    ("  model: tricycle\n", "  model: tricyle\n", "unknown model `tricyle` in robot",
+     "did you mean `tricycle`?"),                       # a key that names its value: as it was
+])
+def test_a_choice_reads_as_words(old, new, says, hint):
+    text = error(BASE.replace(old, new, 1))
+    assert f"error: {says}\n" in text and f"hint: {hint}" in text
+
+
 def test_a_field_of_view_on_a_ring_is_refused():
     ring = BASE + "sensors: {layout: ring, fov: 90}\n"          # it was silently ignored
     assert "`fov` in sensors is for `layout: fan`" in error(ring)
@@ -415,16 +426,45 @@ def test_load_world_finds_a_packaged_world_from_any_directory(tmp_path, monkeypa
     assert load_world("figure4").path == str(packaged)
     (tmp_path / "figure4.yaml").write_text(BASE)
     assert load_world("figure4.yaml").name == "t"
-    with pytest.raises(NameError_, match="unknown world file `figur4`") as exc:
+    with pytest.raises(NameError_, match="world file `figur4` not found") as exc:
         load_world("figur4")
     assert exc.value.hint == "did you mean `figure4`?"
     # a directory that is not the packaged one is a typo, not a way to the packaged world
     for typo in ("nope/figure4.yaml", "/elsewhere/worlds/figure4.yaml", "world/figure4"):
-        with pytest.raises(NameError_, match=f"unknown world file `{typo}`") as exc:
+        with pytest.raises(NameError_, match=f"world file `{typo}` not found") as exc:
             load_world(typo)
         assert exc.value.hint == (f"there is no `{typo}`; the packaged world of that name is "
                                   "`figure4`")
     assert load_world("./worlds/figure4.yaml").path == str(packaged)
+
+
+@pytest.mark.parametrize("name, hint, listed", [
+    # a path: not found, and no packaged name unless one is close (`nosuch.yaml` was "did
+    # you mean `office.yaml`?": the `.yaml` both end in)
+    ("nosuch.yaml", "`mitos list` shows the packaged worlds", False),
+    ("foo/nosuch.yaml", "`mitos list` shows the packaged worlds", False),
+    ("slalm.yaml", "did you mean `slalom.yaml`?", True),
+    ("nosuch", None, True),                     # a name: the packaged worlds' names
+])
+def test_a_missing_world_file_is_not_found(tmp_path, monkeypatch, name, hint, listed):
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "other.yaml").write_text(BASE)   # a file beside it, not close either
+    with pytest.raises(WorldError) as exc:
+        resolve_world_path(name)
+    assert exc.value.message == f"world file `{name}` not found"
+    assert (exc.value.hint or "").startswith(hint) if hint else exc.value.hint is None
+    assert (exc.value.expected or "").startswith("one of the packaged worlds: ") == listed
+
+
+def test_simulate_a_missing_world_file(tmp_path, monkeypatch, capsys):
+    from mitos_cli.cli.app import main
+
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(SystemExit) as info:
+        main(["simulate", "nosuch.yaml"])
+    err = capsys.readouterr().err
+    assert info.value.code == 1 and "world error: world file `nosuch.yaml` not found" in err
+    assert "office" not in err
 
 
 @pytest.mark.parametrize("given, says", [

@@ -93,6 +93,10 @@ def test_usage_errors(work):
     assert res.returncode == 1 and "no teaching session to resume" in res.stderr
     res = mitos("teach", "nope.rules", cwd=work)
     assert res.returncode == 1 and "not found" in res.stderr
+    res = mitos("teach", "rb/mitoss.rules", cwd=work)      # as `simulate --rulebase`
+    assert res.returncode == 1 and "hint: did you mean `rb/mitos.rules`?" in res.stderr
+    res = mitos("teach", "rb/nosuch.rules", cwd=work)      # nothing close: no guess
+    assert res.returncode == 1 and "did you mean" not in res.stderr
     res = mitos("teach", "rb/mitos.rules", "--lesson", "missing.lesson", cwd=work)
     assert res.returncode == 1 and "cannot read lesson `missing.lesson`" in res.stderr
     res = mitos("teach", "rb", cwd=work)

@@ -138,6 +138,7 @@ def _new_session(rules, behavior, lesson, save_as, out):
     lesson is refused before a session exists (an empty session would be the newest, the one
     ``mitos teach --resume`` picks)."""
     from ..api import default_rulebase_path, load_rulebase
+    from ..errors import MitosError
     from ..resources import resolve
     from ..teach.journal import Journal, new_session_dir
     from ..teach.lesson import read_lesson
@@ -150,10 +151,18 @@ def _new_session(rules, behavior, lesson, save_as, out):
         path = resolve("rulebases", rules, ".rules") or path
     if not path.is_file():
         from ..errors import RuleBaseError
+        from ..fileio import nearby
 
         raise RuleBaseError(f"`{path}` is a directory, not a rule file" if path.is_dir()
-                            else f"rule file `{path}` not found")
-    load_rulebase(path, behavior)
+                            else f"rule file `{path}` not found",
+                            hint=None if path.is_dir() else nearby(path))  # as eval's
+    try:
+        load_rulebase(path, behavior)
+    except MitosError as exc:           # a .fis, .fcl or .fll (by its name or not): convert it
+        from ..interop import hint_wrong_reader
+
+        hint_wrong_reader(exc, path, "mitos teach")
+        raise
     lesson_text = read_lesson(lesson) if lesson is not None else None
     journal = Journal.create(new_session_dir(path.stem))
     session = Session(path, behavior, journal, save_as, out=out, progress=epoch_progress)

@@ -9,9 +9,10 @@ a :class:`~mitos_cli.errors.FormatError` at ``file:line`` naming the construct.
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
-from ..errors import FormatError, RuleBaseError
+from ..errors import FormatError, MitosError, RuleBaseError
 from ..fileio import nearby
 from ..lang.model import RuleBase
 
@@ -42,6 +43,75 @@ def read_foreign(path: str | Path) -> RuleBase:
     from .fcl import read_fcl
 
     return read_fcl(path)
+
+
+#: each format by how its files begin (its first statement), and what it is called
+SIGNATURES = {
+    "fis": ("a MATLAB .fis file", re.compile(r"(?im)^[ \t]*(\[System\])[ \t]*\r?$")),
+    "fcl": ("an FCL file", re.compile(r"(?im)^[ \t]*(FUNCTION_BLOCK)\b")),
+    "fll": ("a fuzzylite FLL file", re.compile(r"(?m)^[ \t]*(Engine[ \t]*:)")),
+    "rules": ("a MITOS rule file",
+              re.compile(r'(?m)^[ \t]*(terms[ \t]+"|behavior[ \t]+[A-Za-z_][\w\-]*[ \t]*:)')),
+}
+
+
+#: what each reader reads
+LANGUAGES = {"fis": "MATLAB .fis", "fcl": "FCL", "fll": "FLL",
+             "rules": "the MITOS rule language"}
+
+
+def reader_of(path: str | Path) -> str:
+    """The reader :func:`mitos_cli.api.read_rulebase` chooses for ``path``: by extension,
+    the rule language for any extension but .fcl, .fis and .fll."""
+    return READERS.get(Path(path).suffix.lower(), "rules")
+
+
+def looks_like(path: str | Path, head: int = 4096) -> tuple[str, str, int] | None:
+    """The format ``path``'s first statement belongs to (``[System]``: fis; ``FUNCTION_BLOCK``:
+    fcl; ``Engine:``: fll; ``terms "..."``: rules), with that statement and its line; ``None``
+    when none does or the file cannot be read."""
+    try:
+        with open(path, encoding="utf-8", errors="replace") as f:
+            text = f.read(head)
+    except OSError:
+        return None
+    found = [(m.start(), fmt, m) for fmt, (_, pattern) in SIGNATURES.items()
+             if (m := pattern.search(text))]
+    if not found:
+        return None
+    at, fmt, match = min(found, key=lambda f: f[0])
+    return fmt, match.group(1).strip(), text.count("\n", 0, at) + 1
+
+
+def wrong_reader_hint(path: str | Path, reader: str, command: str | None = None) -> str | None:
+    """What to do when ``path``, read as ``reader``, failed and looks like another format:
+    the reader goes by extension (there is no option to choose it). ``command``: a command
+    that reads the rule language whatever the extension (``mitos teach``)."""
+    path = Path(path)
+    looks = looks_like(path)
+    if looks is None or looks[0] == reader:
+        return None
+    fmt, statement, line = looks
+    what = SIGNATURES[fmt][0]
+    seen = f"`{path.name}` looks like {what} (`{statement}` on line {line})"
+    named = path if path.suffix.lower() == f".{fmt}" else path.with_suffix(f".{fmt}")
+    rename = "" if named == path else f"rename it to `{named.name}`, then "
+    if command is not None and fmt != "rules":
+        return (f"{seen}, but `{command}` reads the MITOS rule language only: {rename}convert "
+                f"it with `mitos convert {named} --to rules`")
+    return (f"{seen} but is read as {LANGUAGES[reader]}: the reader is chosen by the file's "
+            f"extension (.fcl, .fis, .fll, anything else the rule language; no option chooses "
+            f"another): rename it to `{named.name}`")
+
+
+def hint_wrong_reader(exc: MitosError, path: str | Path, command: str | None = None) -> None:
+    """Give ``exc``, an error in the file at ``path``, the hint of :func:`wrong_reader_hint`
+    when the file looks like another format (a ``.fis`` saved as ``.txt``)."""
+    if exc.span is None or exc.span.path != str(path):
+        return                      # not in the file itself (its term set, a missing file)
+    hint = wrong_reader_hint(path, reader_of(path) if command is None else "rules", command)
+    if hint is not None:
+        exc.hint = hint
 
 
 def write_foreign(rb: RuleBase, fmt: str, behavior: str | None = None) -> str:
@@ -177,5 +247,5 @@ def _used(rb: RuleBase, name: str) -> set[str]:
     return seen
 
 
-__all__ = ["FORMATS", "conversion_notes", "parse_foreign", "read_foreign",
-           "round_trip_difference", "write_foreign"]
+__all__ = ["FORMATS", "conversion_notes", "hint_wrong_reader", "looks_like", "parse_foreign", "read_foreign",
+           "reader_of", "round_trip_difference", "write_foreign", "wrong_reader_hint"]

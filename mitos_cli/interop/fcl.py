@@ -82,7 +82,12 @@ def read_fcl(path: str | Path) -> RuleBase:
 
 
 def _syntax_error(exc: UnexpectedInput, text: str, path: str | None) -> FormatError:
+    """Lark's exception in FCL's own words: keywords as FCL writes them (``END_FUZZIFY``),
+    and "did you mean" for a word that is a misspelt keyword (``TREM``, ``END_FUZIFY``)."""
     line, column = getattr(exc, "line", 1) or 1, getattr(exc, "column", 1) or 1
+    end_column = None
+    hint = None
+    expected = set(getattr(exc, "expected", None) or getattr(exc, "allowed", None) or ())
     if isinstance(exc, UnexpectedEOF) or (isinstance(exc, UnexpectedToken)
                                           and exc.token.type == "$END"):
         lines = text.splitlines() or [""]
@@ -90,27 +95,59 @@ def _syntax_error(exc: UnexpectedInput, text: str, path: str | None) -> FormatEr
         what = "unexpected end of file"
     elif isinstance(exc, UnexpectedToken):
         what = f"unexpected `{exc.token}`"
+        end_column = column + len(str(exc.token))
+        if exc.interactive_parser is not None:      # `expected` may hold LALR's merged states
+            expected = set(exc.interactive_parser.accepts()) or expected
+        if exc.token.type == "NAME":                # a word where a keyword stands
+            hint = did_you_mean(str(exc.token), _keywords(expected))
     elif isinstance(exc, UnexpectedCharacters):
         pos: int = exc.pos_in_stream  # type: ignore[assignment]  # lark declares None; the lexer sets an int
         char = text[pos] if pos < len(text) else ""
         what = f"unexpected character `{char}`"
     else:
         what = "cannot read this"
-    expected = getattr(exc, "expected", None) or getattr(exc, "allowed", None) or ()
-    words = sorted({_word(e) for e in expected if not e.startswith("__")})
-    return FormatError(what, span=Span.in_text(text, path, line, column),
-                       expected=("one of " + ", ".join(words)) if words else None)
+    words = sorted({_word(e) for e in expected})
+    return FormatError(what, span=Span.in_text(text, path, line, column, end_column),
+                       expected=("one of " + ", ".join(words)) if words else None, hint=hint)
+
+
+#: option keys (one terminal, OPTION_KEY) as FCL writes them
+OPTION_KEYS = ("METHOD", "ACCU", "AND", "OR", "ACT", "ACTIVATION", "IMPLICATION")
+
+
+def _keywords(terminals) -> list[str]:
+    """The keywords among ``terminals``, as FCL writes them (for "did you mean")."""
+    words: list[str] = []
+    for t in terminals:
+        if t == "OPTION_KEY":
+            words.extend(OPTION_KEYS)
+        elif (literal := _literal(t)) is not None and literal.replace("_", "").isalpha():
+            words.append(literal)
+    return words
+
+
+def _literal(terminal: str) -> str | None:
+    """The text of a keyword or punctuation terminal (``END_FUZZIFY``, ``:=``), or None for
+    a terminal that is a pattern (a name, a number)."""
+    from lark.lexer import PatternStr
+
+    for t in parser().terminals:
+        if t.name == terminal:
+            return t.pattern.value.upper() if isinstance(t.pattern, PatternStr) else None
+    return None
 
 
 def _word(terminal: str) -> str:
+    """A terminal as a reader of FCL knows it: ``END_FUZZIFY``, `` `:=` ``, a name."""
     names = {"NAME": "a name", "SIGNED_NUMBER": "a number", "NAN": "nan", "INF": "inf",
-             "INT": "a number", "SEMICOLON": "`;`", "COLON": "`:`", "LPAR": "`(`",
-             "RPAR": "`)`", "COMMA": "`,`", "WORD": "a hedge",
-             "OPTION_KEY": "METHOD/ACCU/AND/OR/ACT",
-             "$END": "the end of the file"}
+             "INT": "a number", "WORD": "a hedge", "OPTION_KEY": "/".join(OPTION_KEYS[:5]),
+             "SINGLETONS": "SINGLETONS", "FORMULA": "FUNCTION", "$END": "the end of the file"}
     if terminal in names:
         return names[terminal]
-    return "`" + terminal.replace("_", " ").lower() + "`" if terminal.isupper() else terminal
+    literal = _literal(terminal)
+    if literal is None:
+        return terminal
+    return literal if literal.replace("_", "").isalpha() else f"`{literal}`"
 
 
 @without_cyclic_gc

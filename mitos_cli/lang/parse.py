@@ -72,7 +72,12 @@ def _words(name: str, words: dict[str, str] = TERMINAL_WORDS) -> str:
 
 
 def _expected(names) -> str:
-    words = sorted({_words(n) for n in names if not n.startswith("__")})
+    return _expected_words(names, TERMINAL_WORDS)
+
+
+def _expected_words(names, words_of: dict[str, str]) -> str:
+    """The terminals ``names`` as a sentence (``a, b or c``), named as in ``words_of``."""
+    words = sorted({_words(n, words_of) for n in names if not n.startswith("__")})
     if len(words) > 1:
         return ", ".join(words[:-1]) + " or " + words[-1]
     return words[0] if words else "something else"
@@ -107,6 +112,10 @@ def syntax_error(exc: UnexpectedInput, text: str, path: str | None) -> RuleSynta
                     "belongs in a term set's `description`")
         return RuleSyntaxError(message, span=Span.in_text(text, path, line, column),
                                expected=allowed, hint=hint)
+    if isinstance(exc, UnexpectedToken) and exc.token.type == "$END":
+        stray = _stray_label(exc, text, path)
+        if isinstance(stray, RuleSyntaxError):
+            return stray
     if isinstance(exc, UnexpectedEOF) or (isinstance(exc, UnexpectedToken)
                                           and exc.token.type == "$END"):
         lines = text.rstrip().splitlines() or [""]
@@ -121,6 +130,9 @@ def syntax_error(exc: UnexpectedInput, text: str, path: str | None) -> RuleSynta
                                "with `end`)")
     assert isinstance(exc, UnexpectedToken)
     token = exc.token
+    stray = _stray_label(exc, text, path)
+    if isinstance(stray, RuleSyntaxError):
+        return stray
     span = Span.in_text(text, path, token.line, token.column,
                         token.column + max(1, len(str(token.value))))
     hint = None
@@ -143,9 +155,86 @@ def syntax_error(exc: UnexpectedInput, text: str, path: str | None) -> RuleSynta
             "join conditions with `and` / `or`, and start the actions with `then`"
     else:
         hint = keyword_hint(token, expected)
-    hint = _statement_hint(text, token.start_pos) or hint
+    hint = _statement_hint(text, token.start_pos) or stray or hint
     return RuleSyntaxError(f"unexpected {_describe(token)}", span=span,
                            expected=_expected(expected), hint=hint)
+
+
+def _label_word(exc: UnexpectedToken) -> Token | None:
+    """The word the parser took for a rule's label just before the failing token, if it did.
+
+    A rule may start with ``LABEL:``, so wherever a rule can start any word is read as a label
+    and only the token after it can fail: ``speed is MEDIUM andd`` fails at the next line's
+    ``r5``, ``ned`` for ``end`` at the next ``behavior``. The word was a label's start when the
+    state before it also accepts ``if`` (a rule's start).
+    """
+    state = exc.state
+    if state is None or len(state.state_stack) < 2 or not state.value_stack:
+        return None
+    word = state.value_stack[-1]
+    if not isinstance(word, Token) or word.type != "NAME":
+        return None
+    return word if "IF" in state.parse_conf.states[state.state_stack[-2]] else None
+
+
+def _before(text: str, word: Token, start: str) -> tuple[Token | None, set[str]]:
+    """The token before ``word`` and what the parser accepts there (``text`` parsed again up
+    to ``word``: only on an error, and linear)."""
+    last = None
+    interactive = parser().parse_interactive(text[:word.start_pos], start=start)
+    for last in interactive.iter_parse():  # noqa: B007 - keep the last token
+        pass
+    return last, set(interactive.accepts())
+
+
+#: how a word that may start a rule is named where it is expected
+LABEL_WORDS = {**TERMINAL_WORDS, "NAME": "a rule's label (`r5:`)"}
+
+
+def _stray_label(exc: UnexpectedToken, text: str, path: str | None) -> RuleSyntaxError | str | None:
+    """The error at a word read as a rule's label whose ``:`` is missing: the word itself
+    when it is no label (``andd`` at a line's end, ``ned`` for ``end``), else a hint for the
+    error at the token after it (``r5 if ...``: the label without its ``:``).
+
+    A label's ``:`` stands on the label's line: when the next token is on a later line (or is
+    the end of the input), or the word is close to a keyword the parser accepted before it,
+    the word is reported, with what could have stood there and "did you mean".
+    """
+    word = _label_word(exc)
+    if word is None or exc.state is None:
+        return None
+    token = exc.token
+    same_line = token.type != "$END" and token.line == word.line
+    if same_line and token.type == "IF":            # `r5 if road is ...`
+        return f"a rule's label ends with `:` (`{word}: if ...`)"
+    try:
+        last, accepts = _before(text, word, exc.state.parse_conf.start)
+    except UnexpectedInput:             # cannot happen: the text parsed up to the word
+        return None
+    close = _keyword_near(text, word, accepts)
+    if same_line and close is None:                 # `foo bar`
+        return f"`{word}` is read as a rule's label, which ends with `:` (`{word}: if ...`)"
+    after = f" after {_describe(last)}" if last is not None else ""
+    span = Span.in_text(text, path, word.line or 1, word.column or 1,
+                        (word.column or 1) + len(str(word)))
+    hint = (f"`{word}` is not a keyword: {close}" if close else
+            f"`{word}` is read as the label of a new rule, which needs `:` after it on the "
+            f"same line (`{word}: if ...`)")
+    return RuleSyntaxError(f"unexpected `{word}`{after}", span=span,
+                           expected=_expected_words(accepts, LABEL_WORDS), hint=hint)
+
+
+def _keyword_near(text: str, word: Token, accepts: set[str]) -> str | None:
+    """"did you mean" the keyword ``word`` is closest to, among those accepted before it; a
+    statement's keyword first when ``word`` starts its line (``ned``: `end`, not `and`)."""
+    keywords = [n.lower() for n in accepts if n.isupper() and n.isalpha() and n != "NAME"]
+    line_start = word.start_pos is not None and \
+        text[:word.start_pos].rpartition("\n")[2].strip() == ""
+    if line_start:
+        first = did_you_mean(str(word), [k for k in keywords if k in STATEMENTS])
+        if first:
+            return first
+    return did_you_mean(str(word), keywords) if keywords else None
 
 
 def _hedge_hint(text: str, token: Token) -> str | None:

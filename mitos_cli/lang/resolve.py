@@ -7,7 +7,6 @@ actions; labels are unique within a behavior; ``use`` has no cycles; operator se
 
 from __future__ import annotations
 
-from collections import Counter
 from pathlib import Path
 
 from ..errors import RuleBaseError, Span, TermSetError, unknown
@@ -97,10 +96,11 @@ def build_rulebase(parsed: ParsedFile, termsets: tuple[TermSet, ...],
                             span=Span.in_text(parsed.text, parsed.path, 1, 1),
                             hint="write a rule: `if road is WIDE then speed is FAST`")
     names = [b.name for b in behaviors]
-    counts = Counter(names)                 # names.count per behavior was N^2
+    first: dict[str, Behavior] = {}
     for b in behaviors:
-        if counts[b.name] > 1:
-            raise RuleBaseError(f"behavior `{b.name}` is defined twice", span=b.span)
+        if b.name in first:                 # reported at the second: the first was right
+            raise _defined_twice(b, first[b.name])
+        first[b.name] = b
         if b.name in HEDGES or b.name == "not":     # `use very when ...` could not name it
             raise RuleBaseError(f"`{b.name}` is a reserved word (a hedge), not a name",
                                 span=b.span, hint="name the behavior something else")
@@ -112,6 +112,16 @@ def build_rulebase(parsed: ParsedFile, termsets: tuple[TermSet, ...],
     for b in behaviors:
         _check_cycles(rb, b.name, ())
     return rb
+
+
+def _defined_twice(second: Behavior, first: Behavior) -> RuleBaseError:
+    """A behavior defined again, at the second definition, saying where the first is."""
+    where = f" (first at line {first.span.line})" if first.span else ""
+    if second.name == MAIN:             # the file's top-level rules, then `behavior main:`
+        where = " (also by the rules outside any behavior)"
+    span = second.span and second.span.naming(second.name)
+    return RuleBaseError(f"behavior `{second.name}` is defined twice{where}", span=span,
+                         hint="rename one of them, or move its rules into the other")
 
 
 def _check_behavior(b: Behavior, variables: dict[str, Variable], behaviors: list[str]) -> None:
@@ -156,6 +166,7 @@ def _check_weight(weight: float, span: Span | None) -> None:
 
 
 def _variable(name: str, role: str, variables: dict[str, Variable], span: Span | None) -> Variable:
+    span = span and span.naming(name)          # the name, not `name is TERM`
     v = variables.get(name)
     if v is None:
         pool = [n for n, var in variables.items() if var.role == role]
@@ -170,7 +181,7 @@ def _variable(name: str, role: str, variables: dict[str, Variable], span: Span |
 def _check_hedges(hedges: tuple[str, ...], span: Span | None) -> None:
     for h in hedges:
         if h not in HEDGES:
-            raise unknown("hedge", h, HEDGES, span=span)
+            raise unknown("hedge", h, HEDGES, span=span and span.naming(h))
 
 
 def check_expr(expr: Expr, variables: dict[str, Variable]) -> None:

@@ -51,6 +51,9 @@ MODELS = ("tricycle",)
 LAYOUTS = ("ring", "fan")
 SHAPES = ("circle", "rectangle")
 MODES = ("loop", "ping-pong", "stop")
+#: keys whose value is a thing of that name ("unknown shape `circel`" reads); for the others
+#: ("unknown unknown `ocupied`" does not) an error quotes `key: value`
+NOUN_KEYS = ("model", "layout", "shape", "mode")
 
 
 #: The largest magnitude of any number in a world (inches, seconds, degrees): 1e7 in is
@@ -131,8 +134,10 @@ class _Reader:
             if value == "None" and m[key] is None:    # `given:` left empty: not `None`
                 value = ""
             err = unknown(key, value, options)          # "unknown shape `circel`" ...
-            raise WorldError(f"{err.message} in {what}", span=m.value_span(key),
-                             expected=err.expected, hint=err.hint)   # ... "in obstacle `box`"
+            message = (f"{err.message} in {what}" if key in NOUN_KEYS   # ... "in obstacle `box`"
+                       else f"`{key}: {value}` in {what}: unknown value")
+            raise WorldError(message, span=m.value_span(key), expected=err.expected,
+                             hint=err.hint)
         return value
 
     def flag(self, m: YMap, key: str, what: str, default: bool) -> bool:
@@ -734,8 +739,7 @@ def resolve_world_path(name: str | Path, base: Path | None = None) -> Path:
     """The one way a world is found: a file as given (relative to ``base`` first, when a
     lesson names it), else the packaged world of that name (``figure4`` or ``figure4.yaml``);
     an unknown name gets the packaged names and a "did you mean"."""
-    from ..fileio import nearby
-    from ..resources import is_dir, packaged_names, resolve
+    from ..resources import is_dir, resolve
 
     found = resolve("worlds", name, ".yaml", base)
     if found is not None:
@@ -744,14 +748,31 @@ def resolve_world_path(name: str | Path, base: Path | None = None) -> Path:
     if is_dir(where):
         raise UnknownWorld(f"`{name}` is a directory, not a world file",
                            hint="name one of the world files (.yaml) in it")
-    names = list(packaged_names("worlds", ".yaml"))
-    if not str(name).endswith(".yaml"):
-        names = [n[:-len(".yaml")] for n in names]
-    error = unknown("world file", str(name), names, cls=UnknownWorld)
-    if where.suffix or len(where.parts) > 1:      # a path: a file beside it first
-        error.hint = nearby(where, (".yaml", ".yml")) or error.hint
-    packaged = where.name if where.name.endswith(".yaml") else where.name + ".yaml"
-    if len(where.parts) > 1 and packaged in packaged_names("worlds", ".yaml"):
-        error.hint = (f"there is no `{where}`; the packaged world of that name is "
-                      f"`{packaged[:-len('.yaml')]}`")
-    raise error
+    raise world_not_found(name, where)
+
+
+def world_not_found(name: str | Path, where: Path) -> UnknownWorld:
+    """"world file `X` not found" (``where``: the path looked for), with a file beside it
+    whose name is close, else the packaged world whose name is close. The packaged names are
+    listed when the name was one's (``slalm``) or is close to one, not for any path
+    (``nosuch.yaml``, ``foo/nosuch.yaml``: "did you mean office.yaml" was the shared ``.yaml``)."""
+    from ..errors import closest_file
+    from ..fileio import nearby
+    from ..resources import packaged_names
+
+    given = Path(name)
+    packaged = list(packaged_names("worlds", ".yaml"))
+    bare = not given.suffix and len(given.parts) == 1      # a packaged world's name
+    shown = packaged if given.suffix else [n[:-len(".yaml")] for n in packaged]
+    close = closest_file(given.name, shown) if len(given.parts) == 1 else None
+    hint = f"did you mean `{close}`?" if close else None
+    if given.suffix or len(where.parts) > 1:      # a path: a file beside it first
+        hint = nearby(where, (".yaml", ".yml")) or hint
+    same_name = given.name if given.name.endswith(".yaml") else given.name + ".yaml"
+    if len(given.parts) > 1 and same_name in packaged:
+        hint = (f"there is no `{given}`; the packaged world of that name is "
+                f"`{same_name[:-len('.yaml')]}`")
+    listing = ("one of the packaged worlds: " + ", ".join(shown)) if bare or close else None
+    if hint is None and listing is None:
+        hint = "`mitos list` shows the packaged worlds, which are found by name (`slalom`)"
+    return UnknownWorld(f"world file `{name}` not found", expected=listing, hint=hint)

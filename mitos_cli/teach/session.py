@@ -142,7 +142,13 @@ class Session:
         from ..resources import resolve
 
         self.rules_path = resolve("rulebases", rules_path, ".rules") or Path(rules_path)
-        self.original = load_rules_file(self.rules_path)
+        try:
+            self.original = load_rules_file(self.rules_path)
+        except MitosError as exc:       # a .fis, .fcl or .fll: convert it first
+            from ..interop import hint_wrong_reader
+
+            hint_wrong_reader(exc, self.rules_path, "mitos teach")
+            raise
         self.journal = journal if journal is not None else MemoryJournal()
         self.save_as = Path(save_as) if save_as is not None else None
         self.out = out or print

@@ -3,6 +3,7 @@ by the engine in one batch."""
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -80,6 +81,17 @@ def _input_axis(compiled: CompiledRuleBase, name: str, what: str) -> int:
     raise unknown(f"input ({what})", name, compiled.inputs, cls=InputError)
 
 
+def _finite(what: str, values: tuple[float, ...], universe: tuple[float, float]) -> None:
+    """Refuse NaN and infinity in a range or a held value as what they are (`-20:nan` was
+    "not inside its universe", as if it were a number too large)."""
+    for v in values:
+        if not math.isfinite(v):
+            kind = "not a number" if math.isnan(v) else "not a finite number"
+            raise InputError(f"{what}: `{v:g}` is {kind}",
+                             hint=f"give numbers inside the universe [{universe[0]:g}, "
+                                  f"{universe[1]:g}]")
+
+
 def surface(compiled: CompiledRuleBase, output: str, x: str, y: str | None = None,
             fixed: dict[str, float] | None = None, resolution: int = 61,
             x_range: tuple[float, float] | None = None,
@@ -113,6 +125,7 @@ def surface(compiled: CompiledRuleBase, output: str, x: str, y: str | None = Non
         if limits is not None:
             a, b = limits
             name = compiled.inputs[k]
+            _finite(f"range {a:g}:{b:g} of `{name}`", (a, b), (lo, hi))
             if a > b:
                 raise InputError(f"range {a:g}:{b:g} of `{name}` is reversed: LOW comes first",
                                  hint=f"write {name}={b:g}:{a:g}")
@@ -141,7 +154,8 @@ def surface(compiled: CompiledRuleBase, output: str, x: str, y: str | None = Non
             held.append(Fixed(name, float((lo + hi) / 2), var.unit, True))
     for f in held:
         lo, hi = compiled.universe[compiled.inputs.index(f.name)]
-        if np.isnan(f.value) or not lo <= f.value <= hi:
+        _finite(f"--fix {f.name}={f.value:g}", (f.value,), (lo, hi))
+        if not lo <= f.value <= hi:
             raise InputError(f"--fix {f.name}={f.value:g} is outside its universe "
                              f"[{lo:g}, {hi:g}]")
 
