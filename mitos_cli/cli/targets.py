@@ -26,21 +26,11 @@ def check_suffix(path: Path, suffix: str, what: str) -> None:
 def check_directory(path: Path) -> None:
     """Refuse, before any work, a file that cannot be written where it is named: its directory
     missing or not writable, or the name a directory's. ``simulate --runs 1000 --plot
-    typo/runs.png`` ran every run, then failed on the picture and lost them all. The words
-    are those of :func:`mitos_cli.fileio.atomic_file`, which says the same when it writes."""
-    from ..errors import MitosError
+    typo/runs.png`` ran every run, then failed on the picture and lost them all. (The check
+    itself is :func:`mitos_cli.fileio.check_writable`, which scripts below the CLI use too.)"""
+    from ..fileio import check_writable
 
-    if _special(path):                     # a device or a pipe (/dev/stdout) is written as is
-        return
-    if path.is_dir():
-        raise MitosError(f"cannot write `{path}`: it is a directory",
-                         hint="give a file name inside it")
-    parent = path.parent if str(path.parent) else Path(".")
-    why = ("No such file or directory" if not parent.is_dir() else
-           "Permission denied" if not os.access(parent, os.W_OK | os.X_OK) else None)
-    if why is not None:
-        raise MitosError(f"cannot write `{path}`: {why}",
-                         hint="check that the directory exists and is writable")
+    check_writable(path)
 
 
 def source_files(rulebase, path: Path) -> list[tuple[Path, str]]:
