@@ -25,6 +25,11 @@ code                  severity    meaning
 ``term-outside``      warning     an input term that never reaches 1 inside the universe
 ``unused-term``       warning     an input term (or a whole input) that no rule uses
 ``unconcluded-term``  info        an output term that no rule concludes
+``undersampled-term`` warning     a Mamdani output term (as a rule concludes it) whose largest
+                                  membership over the output's sample points is below
+                                  :data:`~mitos_cli.engine.mamdani.UNDERSAMPLED_BELOW` (0.5):
+                                  narrower than the sampling step, its rules hardly change
+                                  the output
 ``term-order``        warning     terms whose peaks (values) are not in the written order
 ``coverage``          warning     a point of an input's universe where no term reaches 0.5
 ``indistinct``        warning     two terms of a variable too alike to tell apart
@@ -161,12 +166,14 @@ def check_rulebase(rb: RuleBase, behavior: str | None = None, *, threshold: floa
     names = [behavior] if behavior else [b.name for b in rb.behaviors]
     findings: list[Finding] = []
     grids: list[GridInfo] = []
+    seen: set[tuple] = set()               # undersampled terms already reported
     for name in names:
         rb.behavior(name)                       # unknown behavior: did-you-mean error
         compiled = compile_rulebase(rb, name)
         findings += _rule_pairs(rb, name)
         findings += _contradictions(rb, name)
         findings += _idle_settings(rb, name, compiled)
+        findings += _undersampled(rb, name, compiled, seen)
         grid_findings, info = _sampled(compiled, threshold, resolution)
         findings += grid_findings
         grids.append(info)
@@ -196,6 +203,41 @@ def _idle_settings(rb: RuleBase, name: str, compiled) -> list[Finding]:
                 f"{compiled.operators.inference} inference", setting.span, name,
                 "add `inference = mamdani` to the operators line, or remove the setting"))
     return out
+
+
+def _undersampled(rb: RuleBase, name: str, compiled, seen: set[tuple]) -> list[Finding]:
+    """Output terms that the Mamdani sampling misses (:func:`.mamdani.undersampled`), once
+    per term and sampling however many behaviors conclude them."""
+    from .mamdani import undersampled
+
+    out = []
+    for u in undersampled(compiled):
+        key = (u.output, u.label, u.points, u.step)
+        if key in seen:
+            continue
+        seen.add(key)
+        term = rb.variables[u.output].term(u.term)
+        out.append(Finding("warning", "undersampled-term", u.describe(), term.span, name,
+                           resolution_hint(rb.path, u.points)))
+    return out
+
+
+def resolution_hint(path: str | None, points: int) -> str:
+    """How to sample an output more finely, in the words of the file's format."""
+    suffix = (path or "").rsplit(".", 1)[-1].lower()
+    finer = 1001 if points < 1001 else min(points * 10, 100_000)
+    if suffix == "fis":
+        return ("widen it; a .fis output is always sampled at MATLAB's 101 points: `mitos eval "
+                "--fidelity fuzzylite` samples 1000, or convert the file (`mitos convert --to "
+                "rules`) and set `resolution = 1001`")
+    if suffix == "fll":
+        return (f"widen it, or raise the defuzzifier's resolution (`defuzzifier: Centroid "
+                f"{finer}`)")
+    if suffix == "fcl":
+        return (f"widen it, or raise the defuzzifier's resolution (`METHOD : COG "
+                f"{finer};`)")
+    return (f"widen it, or raise the resolution (now {points}): `resolution = {finer}` in "
+            f"the behavior's (or the file's) `operators:` line")
 
 
 def _span_key(span: Span | None) -> tuple:
