@@ -52,6 +52,19 @@ def refuse_inputs(targets: list[Path], sources: list[tuple[Path, str]]) -> None:
                                          f"name", param_hint=OUTPUT_OPTION)
 
 
+def refuse_strays(named: Path, companions: list[Path]) -> None:
+    """A usage error when a file written beside ``named`` (the term set of ``-o OUT.rules``)
+    is already there and is not ``named``'s own (the existing ``named`` does not read it):
+    the user named only ``named``."""
+    from ..lang.resolve import strays
+
+    for path in strays(named, companions):
+        raise typer.BadParameter(
+            f"`{path}` is already there and no term set of `{named}`; writing `{named}` "
+            f"would write its term set over it: remove it, or choose another -o",
+            param_hint=OUTPUT_OPTION)
+
+
 def refuse_existing(targets: list[Path], named: str) -> None:
     """A usage error when a file written by default (no ``-o``) is already there: only a file
     the user names on purpose is replaced."""
