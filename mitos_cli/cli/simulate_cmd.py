@@ -12,7 +12,7 @@ from . import complete
 from .output import emit, err, json_text
 from .params import MAX_RUNS, finite, named
 from .progress import INTERRUPTED, progress_bar
-from .targets import check_directory
+from .targets import check_directory, check_suffix
 
 REQUIRE = ("success",)
 
@@ -169,7 +169,8 @@ def simulate_command(
                             "--seed SEED+j).")] = False,
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON instead of the table.")] = False,
     out: Annotated[Optional[Path], typer.Option(
-        "--out", "-o", metavar="FILE.csv", help="Write one CSV row per tick.")] = None,
+        "--out", "-o", metavar="FILE.csv",
+        help="Write one CSV row per tick to FILE.csv (a name ending in .csv).")] = None,
     trace: Annotated[bool, typer.Option(
         "--trace", help="Print the paper-style DOF trace every --every ticks (of the first "
                         "robot where there are several; on stderr with --json, which keeps "
@@ -222,6 +223,8 @@ def simulate_command(
     for path in (out, plot, animate):         # before the run, not after it
         if path is not None:
             check_directory(path)
+    if out is not None:                       # as --plot's and convert -o's: a usage error
+        check_suffix(out, ".csv", "the table of ticks (--out)", "'--out' / '-o'")
     many = len(loaded) > 1 or runs > 0
     _check_run_options(many, len(loaded), runs, randomise, out, trace, live, animate, plot)
     planner = make_planner(planner_name, loaded[0], rulebase, behavior)

@@ -12,7 +12,7 @@ import typer
 OUTPUT_OPTION = "'-o' / '--output'"
 
 
-def check_suffix(path: Path, suffix: str, what: str) -> None:
+def check_suffix(path: Path, suffix: str, what: str, option: str = OUTPUT_OPTION) -> None:
     """``-o`` must end in ``suffix`` (any case): a C file called ``out.py`` or an FCL file
     called ``out.fis`` would be read later as what it is not. A device or a pipe
     (``/dev/stdout``) has no extension to check."""
@@ -20,7 +20,7 @@ def check_suffix(path: Path, suffix: str, what: str) -> None:
         return
     has = f"extension {path.suffix}" if path.suffix else "no extension"
     raise typer.BadParameter(f"`{path}` has {has}; {what} is written to a {suffix} file",
-                             param_hint=OUTPUT_OPTION)
+                             param_hint=option)
 
 
 def check_directory(path: Path) -> None:
