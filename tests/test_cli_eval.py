@@ -249,6 +249,23 @@ def test_trace_says_when_an_output_is_its_default(tmp_path, capsys):
     assert "default" not in out
 
 
+def test_json_names_the_outputs_that_are_their_default(tmp_path, capsys):
+    """The text trace's "(its default: no rule sets it here)", for machines: `defaulted`."""
+    terms = (ROOT / "rulebases" / "mitos.terms.yaml").read_text(encoding="utf-8")
+    (tmp_path / "t.terms.yaml").write_text(terms, encoding="utf-8")
+    (tmp_path / "t.rules").write_text(
+        'terms "t.terms.yaml"\n'
+        "r1: if road is NARROW and size is MED_SZ then steering is LS and speed is SLOW\n"
+        "r2: if road is WIDE and size is SMALL_SZ then speed is FAST\n", encoding="utf-8")
+    code, out, _ = run_main(["eval", str(tmp_path / "t.rules"), "road=150", "size=5",
+                             "--json"], capsys)
+    data = json.loads(out)
+    assert code == 0 and data["defaulted"] == ["steering"]
+    assert data["outputs"]["steering"] == 90.0 and data["outputs"]["speed"] == 50.0
+    code, out, _ = run_main(["eval", "road=78", "size=45", "position=4", "--json"], capsys)
+    assert json.loads(out)["defaulted"] == []
+
+
 def test_an_input_without_its_equals_sign_is_a_usage_error(capsys):
     """`road78` was read as a rule file: "cannot read rule file `road78`"."""
     code, out, err = run_main(["eval", "road78", "size=45", "position=4"], capsys)

@@ -63,6 +63,9 @@ class Trace:
                        for i in self.inputs},
             "rules": [{"label": r.label, "text": r.text, "dof": r.dof} for r in self.rules],
             "outputs": {name: value for name, value, _ in self.outputs},
+            # the outputs that no rule sets here, each its `default` (the text trace says
+            # "its default: no rule sets it here"); added in 0.2, empty when rules set all
+            "defaulted": list(self.defaulted),
         }
 
     def render(self, digits: int = 1) -> str:
