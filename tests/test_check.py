@@ -410,3 +410,15 @@ def test_a_term_barely_sampled_is_reported_with_its_peak_and_a_wide_one_is_not(t
 
 def test_a_crisp_output_is_never_undersampled(flawed):
     assert not by_code(check_rulebase(read_rulebase(flawed)), "undersampled-term")
+
+
+def test_a_named_behavior_gets_only_the_findings_about_what_it_uses():
+    """`check -b avoid_obstacle` warned about `nearest.ROOMY`, an input it never reads."""
+    rb = read_rulebase(None)
+    everything = check_rulebase(rb, resolution=5)
+    assert any("nearest.ROOMY" in f.message for f in everything.findings)
+    one = check_rulebase(rb, "avoid_obstacle", resolution=5)
+    assert not any("nearest" in f.message for f in one.findings)
+    assert {f.code for f in one.findings} <= {"unconcluded-term"}    # about `speed`, it sets
+    take = check_rulebase(rb, "take_opening", resolution=5)           # it reads `nearest`
+    assert any("nearest.ROOMY" in f.message for f in take.findings)

@@ -75,7 +75,8 @@ def check_command(
         help="Rule file (default: the packaged MITOS rule base).")] = None,
     behavior: Annotated[Optional[str], typer.Option(
         "--behavior", "-b", callback=named,
-        help="Check only this behavior (default: every behavior).")] = None,
+        help="Check only this behavior, and the term sets' variables it reads or sets "
+             "(default: every behavior and variable).")] = None,
     threshold: Annotated[float, typer.Option(
         "--threshold", "-t", min=0.0, callback=finite,
         help="Report regions where the total DOF of an output's rules is below this.")] = 0.1,

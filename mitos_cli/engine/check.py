@@ -4,7 +4,8 @@
 severity, a message, the place in the rule file or term set it concerns (a :class:`Span`) and,
 for findings about the input space, the regions as boxes of input ranges. Nothing here prints.
 
-What is checked, per behavior (every behavior of the file unless one is named):
+What is checked, per behavior (every behavior of the file unless one is named; then the term
+sets' findings are only about the variables it reads or sets):
 
 ====================  ==========  ==========================================================
 code                  severity    meaning
@@ -177,9 +178,13 @@ def check_rulebase(rb: RuleBase, behavior: str | None = None, *, threshold: floa
         grid_findings, info = _sampled(compiled, threshold, resolution)
         findings += grid_findings
         grids.append(info)
-    findings += _term_gaps(rb)
-    findings += _unused_terms(rb)
-    findings += _interpretability(rb)
+    # the term sets' findings: with one behavior named, only about the variables it uses
+    # (its used behaviors' included); `nearest.ROOMY` is no concern of `avoid_obstacle`
+    scope = None if not behavior else set().union(*(
+        set(c.inputs) | set(c.outputs) for c in (compile_rulebase(rb, n) for n in names)))
+    findings += _term_gaps(rb, scope)
+    findings += _unused_terms(rb, scope)
+    findings += _interpretability(rb, scope)
     order = {s: i for i, s in enumerate(SEVERITIES)}
     findings.sort(key=lambda f: (order[f.severity], _span_key(f.span)))
     return Report(rb, tuple(findings), tuple(grids), threshold, tuple(names))
@@ -527,9 +532,14 @@ def boxes_of(mask: np.ndarray, axes: list[np.ndarray], names: tuple[str, ...],
 # ---------------------------------------------------------------------------------------------
 # term sets
 
-def _term_gaps(rb: RuleBase) -> list[Finding]:
+def _variables(rb: RuleBase, scope: set[str] | None) -> list[Variable]:
+    """The file's variables, or those in ``scope`` (the ones a named behavior uses)."""
+    return [v for v in rb.variables.values() if scope is None or v.name in scope]
+
+
+def _term_gaps(rb: RuleBase, scope: set[str] | None = None) -> list[Finding]:
     out = []
-    for var in rb.variables.values():
+    for var in _variables(rb, scope):
         if var.role != "input" or not var.terms:
             continue
         lo, hi = var.universe
@@ -558,11 +568,11 @@ def _term_gaps(rb: RuleBase) -> list[Finding]:
     return out
 
 
-def _interpretability(rb: RuleBase) -> list[Finding]:
+def _interpretability(rb: RuleBase, scope: set[str] | None = None) -> list[Finding]:
     from ..lang.interpretability import variable_issues
 
     out = []
-    for var in rb.variables.values():
+    for var in _variables(rb, scope):
         for issue in variable_issues(var):
             span = var.term(issue.terms[0]).span if issue.terms else var.span
             out.append(Finding("warning", issue.code, issue.message, span, None,
@@ -587,7 +597,7 @@ def _terms_used(expr: Expr, out: set[tuple[str, str]]) -> None:
             _terms_used(item, out)
 
 
-def _unused_terms(rb: RuleBase) -> list[Finding]:
+def _unused_terms(rb: RuleBase, scope: set[str] | None = None) -> list[Finding]:
     used: set[tuple[str, str]] = set()
     concluded: set[tuple[str, str]] = set()
     for b in rb.behaviors:                  # a term used anywhere in the file is used
@@ -601,7 +611,7 @@ def _unused_terms(rb: RuleBase) -> list[Finding]:
                 _terms_used(use.condition, used)
     set_by_rules = {c.var for b in rb.behaviors for r in b.rules for c in r.consequents}
     out = []
-    for var in rb.variables.values():
+    for var in _variables(rb, scope):
         if var.role == "input":
             names = [t for t in var.terms if (var.name, t.name) not in used]
             if len(names) == len(var.terms):
