@@ -422,3 +422,15 @@ def test_a_named_behavior_gets_only_the_findings_about_what_it_uses():
     assert {f.code for f in one.findings} <= {"unconcluded-term"}    # about `speed`, it sets
     take = check_rulebase(rb, "take_opening", resolution=5)           # it reads `nearest`
     assert any("nearest.ROOMY" in f.message for f in take.findings)
+
+
+def test_the_findings_name_a_packaged_file_as_the_summary_does(tmp_path, monkeypatch, capsys):
+    """From anywhere: `rulebases/drive.terms.yaml:103:7: warning: ...` above `checked
+    rulebases/mitos.rules (packaged)`, not the file's place in site-packages."""
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(SystemExit):
+        main(["check", "-n", "5"])
+    out = capsys.readouterr().out
+    located = [line for line in out.splitlines() if ": warning: " in line or ": note: " in line]
+    assert located and all(line.startswith("rulebases/") for line in located), located
+    assert "\nchecked rulebases/mitos.rules (packaged): " in out

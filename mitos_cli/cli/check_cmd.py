@@ -24,10 +24,14 @@ def show_path(path: str | None) -> str:
 
 
 def render(report, trace_path: str) -> str:
-    """The report for people: one ``path:line:col: severity: message`` block per finding."""
+    """The report for people: one ``path:line:col: severity: message`` block per finding,
+    each path in the form the summary's ``checked PATH`` has (a packaged file as
+    ``rulebases/...``, not its place in site-packages)."""
+    from ..resources import display_path
+
     lines = []
     for f in report.findings:
-        where = (f"{show_path(f.span.path)}:{f.span.line}:{f.span.column}: "
+        where = (f"{display_path(f.span.path, mark=False)}:{f.span.line}:{f.span.column}: "
                  if f.span else "")
         shown = "note" if f.severity == "info" else f.severity     # as the summary counts it
         lines.append(f"{where}{shown}: {f.message} [{f.code}]")
