@@ -181,6 +181,7 @@ def test_runs_print_a_table_of_rates(short):
     assert set(rows[0]["time_s"]) == {"mean", "std"}
     table = run(short, "--runs", 2, "--workers", 1).stdout
     assert "success" in table.splitlines()[0] and "±" in table
+    assert "(time, path, min clear and speed: mean ± standard deviation over the runs)" in table
 
 
 def test_too_many_runs_is_a_usage_error_not_a_full_memory(short):
@@ -291,3 +292,14 @@ def test_out_takes_any_case_of_csv_and_a_device(short, tmp_path, capsys):
     assert code == 0 and (tmp_path / "RUN.CSV").read_text().startswith("tick,t,")
     code, _ = run_main(capsys, short, "--out", "/dev/null")
     assert code == 0
+
+
+def test_the_trace_says_one_object_not_one_objects():
+    from mitos_cli import load_rulebase
+
+    trace = load_rulebase(None, "drive").trace(**{
+        k: v for k, v in dict(road=100, size=0, position=50, obstacle=0, heading=0, lane=0,
+                              goal=500, gap_left=60, gap_right=60, front=150, opening=0,
+                              clutter=1, nearest=60).items()})
+    text = trace.render()
+    assert "clutter = 1 object" in text and "1 objects" not in text

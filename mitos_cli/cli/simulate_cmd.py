@@ -104,6 +104,8 @@ def _runs_table(runs) -> str:
     widths = [max(len(r[i]) for r in rows) for i in range(len(head))]
     table = "\n".join("  ".join(c.ljust(wd) if i == 0 else c.rjust(wd)
                                 for i, (c, wd) in enumerate(zip(r, widths))) for r in rows)
+    if any(len(r.summaries) > 1 for w in runs.worlds for r in (w, *w.robots)):
+        table += "\n(time, path, min clear and speed: mean ± standard deviation over the runs)"
     if any(r.rate("success") < 1 for w in runs.worlds for r in (w, *w.robots)
            if "success" in r.outcomes):
         table += ("\n(time, path and speed: means over every run, a collision's or a timeout's "
