@@ -98,13 +98,13 @@ def warn_undersampled(rb, dof) -> None:
     """Once per term: a fired rule concludes a Mamdani output term that falls between its
     output's sample points (:func:`~mitos_cli.engine.mamdani.undersampled`), so the number
     printed hardly reflects it. The number is kept as it is (MATLAB samples the same way)."""
+    if dof is None or rb.compiled.operators.inference != "mamdani":
+        return                              # nothing imported for the common case
     import numpy as np
 
     from ..engine.check import resolution_hint
     from ..engine.mamdani import undersampled
 
-    if dof is None:
-        return
     for u in undersampled(rb.compiled):
         strongest = dof[:, u.rules].max(axis=0) if len(dof) else np.zeros(len(u.rules))
         fired = [rb.compiled.labels[r] for r, d in zip(u.rules, strongest) if d > 0]
