@@ -76,6 +76,29 @@ def why_unreadable(exc: OSError | UnicodeDecodeError) -> str:
     return str(exc.strerror or exc)
 
 
+def check_writable(path: str | Path) -> None:
+    """Refuse, before any work, a file that cannot be written where it is named: its directory
+    missing or not writable, or the name a directory's (a device or a pipe, /dev/stdout, is
+    written as it is). The words are those :func:`atomic_file` says when it writes."""
+    path = Path(path)
+    try:
+        if _special(path) and not path.is_dir():
+            return
+        if path.is_dir():
+            raise MitosError(f"cannot write `{path}`: it is a directory",
+                             hint="give a file name inside it")
+        parent = path.parent if str(path.parent) else Path(".")
+        why = ("No such file or directory" if not parent.is_dir() else
+               "Permission denied" if not os.access(parent, os.W_OK | os.X_OK) else None)
+    except OSError as exc:          # a name the system cannot look up (over 255 characters)
+        raise MitosError(f"cannot write `{path}`: {exc.strerror or exc}",
+                         hint="each part of a path may have at most 255 characters"
+                         if exc.errno == errno.ENAMETOOLONG else None) from None
+    if why is not None:
+        raise MitosError(f"cannot write `{path}`: {why}",
+                         hint="check that the directory exists and is writable")
+
+
 @contextlib.contextmanager
 def atomic_file(path: str | Path, binary: bool = False,
                 error: type[MitosError] = MitosError) -> Iterator[IO]:

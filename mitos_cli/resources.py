@@ -90,8 +90,10 @@ def exists(path: Path) -> bool:
         return False
 
 
-def display_path(path: str | None) -> str:
-    """A rule-base path as users should read it: relative to here, or marked as packaged."""
+def display_path(path: str | None, mark: bool = True) -> str:
+    """A rule-base path as users should read it: relative to here, or marked as packaged
+    (``rulebases/mitos.rules (packaged)``; without ``mark``, the place in a file of it,
+    ``rulebases/drive.terms.yaml:103:7``, as the summary line beside it names it)."""
     import os
     from pathlib import Path
 
@@ -101,7 +103,8 @@ def display_path(path: str | None) -> str:
     try:
         packaged = Path(str(data_dir("rulebases"))).resolve()
         if p.is_relative_to(packaged):
-            return f"rulebases/{p.relative_to(packaged).as_posix()} (packaged)"
+            return f"rulebases/{p.relative_to(packaged).as_posix()}" + (" (packaged)"
+                                                                        if mark else "")
     except (OSError, ValueError):
         pass
     try:

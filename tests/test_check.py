@@ -370,3 +370,67 @@ def test_files_eval_reads_are_checked_too(name, capsys):
     path = Path(__file__).parent / "data" / "interop" / name
     code, out, err = run(["check", str(path)], capsys)
     assert code == 0 and out.rstrip().endswith(" - OK") and not err
+
+
+TIPPER_FIS = Path(__file__).parent / "data" / "interop" / "tipper.fis"
+
+
+@pytest.mark.parametrize("cheap", ["[4.9 5 5.1]", "[5 5 5]"])
+def test_an_output_term_between_the_sample_points_is_reported(tmp_path, capsys, cheap):
+    """On MATLAB's 101 points of [0, 30] (every 0.3) a triangle 0.2 wide is 0 everywhere."""
+    fis = tmp_path / "f.fis"
+    fis.write_text(TIPPER_FIS.read_text().replace("[0 5 10]", cheap), encoding="utf-8")
+    (finding,) = by_code(check_rulebase(read_rulebase(fis)), "undersampled-term")
+    assert finding.message == ("term `cheap` of output `tip` falls between the 101 points its "
+                               "output is sampled at (every 0.3): its rules do not change `tip`")
+    assert finding.severity == "warning" and finding.span.line == 33
+    assert "--fidelity fuzzylite" in finding.hint
+    with pytest.raises(SystemExit) as exit_:
+        main(["check", str(fis)])
+    assert exit_.value.code == 0                # a warning
+    assert "[undersampled-term]" in capsys.readouterr().out
+
+
+def test_a_term_barely_sampled_is_reported_with_its_peak_and_a_wide_one_is_not(tmp_path):
+    terms = TERMS.replace("terms: {SLOW: 20, FAST: 50}",
+                          "terms:\n      SLOW: {shape: triangle, peak: 20.2, width: 0.4}\n"
+                          "      FAST: {shape: triangle, peak: 50, width: 1.2}")
+    (tmp_path / "t.terms.yaml").write_text(terms, encoding="utf-8")
+    (tmp_path / "t.rules").write_text("operators: inference = mamdani\n" + RULES,
+                                      encoding="utf-8")
+    (finding,) = by_code(check_rulebase(read_rulebase(tmp_path / "t.rules")),
+                         "undersampled-term")
+    # 101 midpoints of [0, 60], every 0.594: the nearest to SLOW's peak is 0.3 away, to
+    # FAST's 0.2 (inside half its width)
+    assert finding.message == ("term `SLOW` of output `speed` reaches only 0.26 at the 101 "
+                               "points its output is sampled at (every 0.594): its rules "
+                               "hardly change `speed`")
+    assert "resolution = 1001" in finding.hint and "`operators:` line" in finding.hint
+
+
+def test_a_crisp_output_is_never_undersampled(flawed):
+    assert not by_code(check_rulebase(read_rulebase(flawed)), "undersampled-term")
+
+
+def test_a_named_behavior_gets_only_the_findings_about_what_it_uses():
+    """`check -b avoid_obstacle` warned about `nearest.ROOMY`, an input it never reads."""
+    rb = read_rulebase(None)
+    everything = check_rulebase(rb, resolution=5)
+    assert any("nearest.ROOMY" in f.message for f in everything.findings)
+    one = check_rulebase(rb, "avoid_obstacle", resolution=5)
+    assert not any("nearest" in f.message for f in one.findings)
+    assert {f.code for f in one.findings} <= {"unconcluded-term"}    # about `speed`, it sets
+    take = check_rulebase(rb, "take_opening", resolution=5)           # it reads `nearest`
+    assert any("nearest.ROOMY" in f.message for f in take.findings)
+
+
+def test_the_findings_name_a_packaged_file_as_the_summary_does(tmp_path, monkeypatch, capsys):
+    """From anywhere: `rulebases/drive.terms.yaml:103:7: warning: ...` above `checked
+    rulebases/mitos.rules (packaged)`, not the file's place in site-packages."""
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(SystemExit):
+        main(["check", "-n", "5"])
+    out = capsys.readouterr().out
+    located = [line for line in out.splitlines() if ": warning: " in line or ": note: " in line]
+    assert located and all(line.startswith("rulebases/") for line in located), located
+    assert "\nchecked rulebases/mitos.rules (packaged): " in out

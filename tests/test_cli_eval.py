@@ -249,6 +249,23 @@ def test_trace_says_when_an_output_is_its_default(tmp_path, capsys):
     assert "default" not in out
 
 
+def test_json_names_the_outputs_that_are_their_default(tmp_path, capsys):
+    """The text trace's "(its default: no rule sets it here)", for machines: `defaulted`."""
+    terms = (ROOT / "rulebases" / "mitos.terms.yaml").read_text(encoding="utf-8")
+    (tmp_path / "t.terms.yaml").write_text(terms, encoding="utf-8")
+    (tmp_path / "t.rules").write_text(
+        'terms "t.terms.yaml"\n'
+        "r1: if road is NARROW and size is MED_SZ then steering is LS and speed is SLOW\n"
+        "r2: if road is WIDE and size is SMALL_SZ then speed is FAST\n", encoding="utf-8")
+    code, out, _ = run_main(["eval", str(tmp_path / "t.rules"), "road=150", "size=5",
+                             "--json"], capsys)
+    data = json.loads(out)
+    assert code == 0 and data["defaulted"] == ["steering"]
+    assert data["outputs"]["steering"] == 90.0 and data["outputs"]["speed"] == 50.0
+    code, out, _ = run_main(["eval", "road=78", "size=45", "position=4", "--json"], capsys)
+    assert json.loads(out)["defaulted"] == []
+
+
 def test_an_input_without_its_equals_sign_is_a_usage_error(capsys):
     """`road78` was read as a rule file: "cannot read rule file `road78`"."""
     code, out, err = run_main(["eval", "road78", "size=45", "position=4"], capsys)
@@ -511,3 +528,33 @@ def test_json_says_an_input_was_clamped_and_what_was_given(capsys):
     assert json.loads(out)["inputs"]["road"]["clamped"] is False     # on the edge: as given
     code, out, _ = run_main(["eval", "road=500", "size=45", "position=4"], capsys)
     assert "road = 160 in (given 500, clamped to its universe)" in out
+
+
+def _narrow_cheap(tmp_path) -> Path:
+    fis = tmp_path / "f.fis"
+    fis.write_text((ROOT / "tests/data/interop/tipper.fis").read_text()
+                   .replace("[0 5 10]", "[4.9 5 5.1]"), encoding="utf-8")
+    return fis
+
+
+def test_a_fired_rule_concluding_a_term_between_the_sample_points_is_told(capsys, tmp_path):
+    """MATLAB samples the same 101 points and prints the same 15: the number stays, and the
+    user is told (once) why `tip is cheap` at DOF 1 changes nothing."""
+    fis = _narrow_cheap(tmp_path)
+    code, out, err = run_main(["eval", str(fis), "service=2", "food=1"], capsys)
+    assert code == 0 and "tip = 15.0" in out
+    assert err.count("warning:") == 1
+    assert ("warning: term `cheap` of output `tip` falls between the 101 points its output is "
+            "sampled at (every 0.3): its rules do not change `tip`, though r1 fired (DOF up "
+            "to 1)\n  hint: widen it;") in err
+    code, out, err = run_main(["eval", str(fis), "service=2", "food=1", "--fidelity",
+                               "fuzzylite"], capsys)
+    assert "tip = 14.3" in out and "undersampled" not in err and "warning" not in err
+
+
+def test_the_batch_tells_it_once_too(capsys, tmp_path):
+    fis = _narrow_cheap(tmp_path)
+    csv = tmp_path / "in.csv"
+    csv.write_text("service,food\n2,1\n3,2\n", encoding="utf-8")
+    code, out, err = run_main(["eval", str(fis), "--batch", str(csv)], capsys)
+    assert code == 0 and err.count("term `cheap` of output `tip` falls between") == 1

@@ -138,17 +138,37 @@ def test_output_extension_must_match_the_format(args, expected, tmp_path, monkey
 
 def test_convert_to_rules_without_o_never_overwrites(tmp_path: Path, monkeypatch) -> None:
     monkeypatch.chdir(tmp_path)
-    (tmp_path / "tipper.terms.yaml").write_text("# mine\n")
+    assert runner.invoke(app, ["convert", str(DATA / "tipper.fis"), "--to", "rules"]) \
+        .exit_code == 0
     result = runner.invoke(app, ["convert", str(DATA / "tipper.fis"), "--to", "rules"])
     assert result.exit_code == 2
-    assert "tipper.terms.yaml` is already there" in flat(result.output)
+    assert "tipper.rules` is already there" in flat(result.output)
     assert "-o tipper.rules` replaces it on purpose" in flat(result.output)
-    assert (tmp_path / "tipper.terms.yaml").read_text() == "# mine\n"
-    assert not (tmp_path / "tipper.rules").exists()
     result = runner.invoke(app, ["convert", str(DATA / "tipper.fis"), "--to", "rules", "-o",
                                  "tipper.rules"])
-    assert result.exit_code == 0, result.output
-    assert "# mine" not in (tmp_path / "tipper.terms.yaml").read_text()
+    assert result.exit_code == 0, result.output     # tipper.rules and the term set it reads
+
+
+@pytest.mark.parametrize("named", [[], ["-o", "tipper.rules"]])
+def test_convert_to_rules_never_replaces_a_term_set_the_user_did_not_name(
+        tmp_path: Path, monkeypatch, named) -> None:
+    """The user names only tipper.rules; tipper.terms.yaml beside it, which no tipper.rules
+    reads, is theirs: refused before anything is written."""
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "tipper.terms.yaml").write_text("# mine\n")
+    (tmp_path / "tipper.rules").write_text('terms "other.terms.yaml"\n')
+    result = runner.invoke(app, ["convert", str(DATA / "tipper.fis"), "--to", "rules", *named])
+    assert result.exit_code == 2, result.output
+    said = flat(result.output)
+    assert "tipper.terms.yaml` is already there and no term set of `" in said
+    assert ("tipper.rules` would write its term set over it: remove it, or choose another -o"
+            in said)
+    assert (tmp_path / "tipper.terms.yaml").read_text() == "# mine\n"
+    assert (tmp_path / "tipper.rules").read_text() == 'terms "other.terms.yaml"\n'
+    (tmp_path / "tipper.terms.yaml").unlink()
+    result = runner.invoke(app, ["convert", str(DATA / "tipper.fis"), "--to", "rules",
+                                 "-o", "tipper.rules"])
+    assert result.exit_code == 0, result.output     # the named file is replaced, as asked
 
 
 def run_main(args: list[str], capsys) -> tuple[int, str]:

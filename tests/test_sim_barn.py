@@ -118,3 +118,69 @@ def test_every_generated_field_has_the_route_its_generator_promises(seed):
                           * (route.points[i + 1] - route.points[i])
                           for i in range(len(route.points) - 1)])
     assert field.at(pts).min() >= least - 1.0     # within the lower bound's half cell
+
+
+@pytest.mark.parametrize("args, says", [
+    (["--seed", "-7"], "argument --seed: the seed is a whole number of 0 or more, not -7"),
+    (["--seed", "x"], "argument --seed: a whole number is expected, not `x`"),
+    (["--fill", "25"], "not 25 (a percentage? --fill 0.25 is 25%)"),
+    (["--fill", "nan"], "in [0, 1), not nan"),
+    (["--smoothing", "-1"], "from 0 to 100, not -1"),
+    (["--smoothing", "1000000000"], "from 0 to 100, not 1000000000"),
+])
+def test_a_bad_option_value_is_a_usage_error(tmp_path, capsys, args, says):
+    out = tmp_path / "w.yaml"
+    with pytest.raises(SystemExit) as exc:
+        barn.main(args + ["--out", str(out)])
+    assert exc.value.code == 2
+    err = capsys.readouterr().err
+    assert "error: argument " in err and says in err
+    assert not out.exists()
+
+
+def test_the_out_file_must_be_yaml(tmp_path, capsys):
+    with pytest.raises(SystemExit) as exc:
+        barn.main(["--out", str(tmp_path / "w.txt")])
+    assert exc.value.code == 2
+    assert "has extension .txt; the world is written to a .yaml file" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("where, says", [
+    ("missing/w.yaml", "No such file or directory\nhint: check that the directory exists"),
+    (".", "it is a directory\nhint: give a file name inside it"),
+    ("a" * 300 + ".yaml", "File name too long\nhint: each part of a path may have at most 255"),
+])
+def test_a_path_that_cannot_be_written_is_refused_before_the_field_is_drawn(
+        tmp_path, capsys, monkeypatch, where, says):
+    monkeypatch.setattr(barn, "barn_world", lambda *a, **k: pytest.fail("drew a field"))
+    assert barn.main(["--out", str(tmp_path / where)]) == 1
+    err = capsys.readouterr().err
+    assert err.startswith("error: cannot write") and says in err and "Traceback" not in err
+
+
+def test_a_field_that_cannot_be_drawn_is_an_error_not_a_traceback(tmp_path, capsys):
+    assert barn.main(["--fill", "0.95", "--smoothing", "0", "--out",
+                      str(tmp_path / "w.yaml")]) == 1
+    assert "error: no field with a way through" in capsys.readouterr().err
+
+
+def test_the_help_says_what_each_option_takes(capsys):
+    with pytest.raises(SystemExit):
+        barn.main(["-h"])
+    text = " ".join(capsys.readouterr().out.split())
+    assert "fraction of cells filled before smoothing, in [0, 1), e.g. 0.25" in text
+    assert "fill percentage" not in text
+    assert "whole number >= 0 that draws the field" in text
+    assert "cellular-automaton smoothing iterations, 0-100" in text
+
+
+def test_a_known_world_replaces_its_own_map_but_no_other_file(tmp_path, capsys):
+    out = tmp_path / "k.yaml"
+    assert barn.main(["--seed", "3", "--known", "--out", str(out)]) == 0
+    assert barn.main(["--seed", "3", "--known", "--out", str(out)]) == 0    # its own map
+    out.unlink()                     # k.pgm is now no world file's map: the user's
+    before = (tmp_path / "k.pgm").read_bytes()
+    capsys.readouterr()
+    assert barn.main(["--seed", "4", "--known", "--out", str(out)]) == 1
+    assert "error: `" in capsys.readouterr().err
+    assert (tmp_path / "k.pgm").read_bytes() == before and not out.exists()

@@ -181,6 +181,7 @@ def test_runs_print_a_table_of_rates(short):
     assert set(rows[0]["time_s"]) == {"mean", "std"}
     table = run(short, "--runs", 2, "--workers", 1).stdout
     assert "success" in table.splitlines()[0] and "±" in table
+    assert "(time, path, min clear and speed: mean ± standard deviation over the runs)" in table
 
 
 def test_too_many_runs_is_a_usage_error_not_a_full_memory(short):
@@ -267,3 +268,38 @@ def test_one_runs_spread_is_null_as_in_compare(short):
     data = json.loads(run(short, "--runs", 1, "--json").stdout)
     row = data[0] if isinstance(data, list) else data["worlds"][0]
     assert row["time_s"]["std"] is None            # was 0.0; compare --json says null
+
+
+@pytest.mark.parametrize("name, has", [("run.txt", "extension .txt"),
+                                       ("run.json", "extension .json"),
+                                       ("run", "no extension")])
+def test_out_that_is_not_a_csv_is_refused_before_the_run(short, tmp_path, capsys, monkeypatch,
+                                                         name, has):
+    """As --plot, --animate and convert -o: a usage error (exit 2), before the run."""
+    from mitos_cli.sim import loop
+
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setattr(loop, "simulate", lambda *a, **k: pytest.fail("the run started"))
+    code, err = run_main(capsys, short, "--out", name)
+    said = " ".join(err.replace("│", " ").split())
+    assert code == 2 and f"`{name}` has {has}; the table of ticks (--out) is written to a .csv " \
+        "file" in said
+    assert not (tmp_path / name).exists()
+
+
+def test_out_takes_any_case_of_csv_and_a_device(short, tmp_path, capsys):
+    code, _ = run_main(capsys, short, "--out", tmp_path / "RUN.CSV")
+    assert code == 0 and (tmp_path / "RUN.CSV").read_text().startswith("tick,t,")
+    code, _ = run_main(capsys, short, "--out", "/dev/null")
+    assert code == 0
+
+
+def test_the_trace_says_one_object_not_one_objects():
+    from mitos_cli import load_rulebase
+
+    trace = load_rulebase(None, "drive").trace(**{
+        k: v for k, v in dict(road=100, size=0, position=50, obstacle=0, heading=0, lane=0,
+                              goal=500, gap_left=60, gap_right=60, front=150, opening=0,
+                              clutter=1, nearest=60).items()})
+    text = trace.render()
+    assert "clutter = 1 object" in text and "1 objects" not in text

@@ -232,3 +232,24 @@ def test_without_matplotlib_the_report_has_no_plots(tiny, tmp_path, compare, mon
     assert "matplotlib is not installed: report.md has no plots" in r.stderr
     assert "pip install 'mitos[plot]'" in r.stderr
     assert (out / "report.md").is_file() and not (out / "success.png").exists()
+
+
+@pytest.mark.parametrize("missing, words", [
+    ("distributed", "the Dask executor needs dask.distributed, which is not installed"),
+    ("cryptography", "the local Dask cluster needs `cryptography`"),
+])
+def test_dask_not_installed_is_said_before_anything_is_written(tiny, tmp_path, compare,
+                                                               monkeypatch, missing, words):
+    """It printed `runs (dask): 0 of 2 (0%)` first and left study.json and an empty
+    results.csv behind."""
+    import importlib.util
+
+    real = importlib.util.find_spec
+    monkeypatch.setattr(importlib.util, "find_spec",
+                        lambda name, *a: None if name == missing else real(name, *a))
+    out = tmp_path / "study"
+    r = compare(tiny, "--and", "min", "--planner", "fuzzy", "--runs", 2, "-o", out,
+                "--executor", "dask")
+    assert r.exit_code == 1 and words in r.stderr
+    assert "pip install 'mitos[dask]', or use --executor local" in r.stderr
+    assert "runs (dask)" not in r.stderr and not out.exists()

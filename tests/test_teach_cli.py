@@ -347,3 +347,22 @@ def test_a_block_left_open_is_said_and_a_binary_lesson_is_placed(work):
     (work / "garbage.lesson").write_bytes(b"use drive\n\xaf\xfe junk\n")
     res = mitos("teach", "rb/mitos.rules", "--lesson", "garbage.lesson", cwd=work)
     assert res.returncode == 1 and res.stderr.startswith("garbage.lesson:2:1: lesson error: ")
+
+
+def test_save_as_is_refused_before_the_session_when_a_term_set_there_is_not_its_own(work):
+    (work / "out.mitos.terms.yaml").write_text("# mine\n")
+    (work / "small.lesson").write_text(LESSON)
+    res = mitos("teach", "rb/mitos.rules", "--lesson", "small.lesson", "--save-as",
+                "out.rules", cwd=work)
+    assert res.returncode == 1
+    assert "`out.mitos.terms.yaml` is already there and no term set of `out.rules`" in res.stderr
+    assert "remove it, or save under another name" in res.stderr
+    assert "session" not in res.stderr.split("error")[0]       # no session was started
+    assert (work / "out.mitos.terms.yaml").read_text() == "# mine\n"
+    assert not (work / ".mitos").exists()
+
+
+def test_teach_help_names_the_term_sets_save_as_writes(work):
+    res = mitos("teach", "-h", cwd=work)
+    text = " ".join(res.stdout.replace("│", " ").split())
+    assert "OUT.mitos.terms.yaml and OUT.drive.terms.yaml" in text

@@ -364,3 +364,23 @@ def test_a_save_whose_text_would_not_read_back_writes_nothing(rules, tmp_path, m
                                           "written"):
         s.run(f"save {tmp_path / 'x.rules'}")
     assert list(tmp_path.iterdir()) == [rules.parent]
+
+
+def test_save_never_replaces_a_term_set_the_user_did_not_name(rules, tmp_path):
+    """`save out.rules` writes out.mitos.terms.yaml and out.drive.terms.yaml beside it: one
+    already there that no out.rules reads is the user's, and nothing is written."""
+    s = Session(rules, out=[].append)
+    out = tmp_path / "out.rules"
+    (tmp_path / "out.drive.terms.yaml").write_text("# mine\n")
+    with pytest.raises(LessonError, match=r"is already there and no term set of `.*out.rules`; "
+                                          r"saving as `out.rules` would write") as e:
+        s.run(f"save {out}")
+    assert e.value.hint == "remove it, or save under another name"
+    assert (tmp_path / "out.drive.terms.yaml").read_text() == "# mine\n"
+    assert not out.exists() and not (tmp_path / "out.mitos.terms.yaml").exists()
+    (tmp_path / "out.drive.terms.yaml").unlink()
+    s.run(f"save {out}")
+    s.run("correct road=78 size=45 position=4 -> steering=60")
+    s.run("adapt epochs 2")
+    s.run("save")              # again over out.rules: the term sets it reads are its own
+    assert "# mine" not in (tmp_path / "out.drive.terms.yaml").read_text()

@@ -24,10 +24,14 @@ def show_path(path: str | None) -> str:
 
 
 def render(report, trace_path: str) -> str:
-    """The report for people: one ``path:line:col: severity: message`` block per finding."""
+    """The report for people: one ``path:line:col: severity: message`` block per finding,
+    each path in the form the summary's ``checked PATH`` has (a packaged file as
+    ``rulebases/...``, not its place in site-packages)."""
+    from ..resources import display_path
+
     lines = []
     for f in report.findings:
-        where = (f"{show_path(f.span.path)}:{f.span.line}:{f.span.column}: "
+        where = (f"{display_path(f.span.path, mark=False)}:{f.span.line}:{f.span.column}: "
                  if f.span else "")
         shown = "note" if f.severity == "info" else f.severity     # as the summary counts it
         lines.append(f"{where}{shown}: {f.message} [{f.code}]")
@@ -75,7 +79,8 @@ def check_command(
         help="Rule file (default: the packaged MITOS rule base).")] = None,
     behavior: Annotated[Optional[str], typer.Option(
         "--behavior", "-b", callback=named,
-        help="Check only this behavior (default: every behavior).")] = None,
+        help="Check only this behavior, and the term sets' variables it reads or sets "
+             "(default: every behavior and variable).")] = None,
     threshold: Annotated[float, typer.Option(
         "--threshold", "-t", min=0.0, callback=finite,
         help="Report regions where the total DOF of an output's rules is below this.")] = 0.1,

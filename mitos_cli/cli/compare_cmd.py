@@ -86,6 +86,10 @@ def compare_command(
         raise unknown("executor", executor, EXECUTORS)
     if scheduler and executor != "dask":
         raise typer.BadParameter("--scheduler needs --executor dask", param_hint="--scheduler")
+    if executor == "dask":                      # before study.json or the progress bar
+        from ..study.executors import require_dask
+
+        require_dask(scheduler)
     planners = _planners(planner, and_, or_, inference, rulebase, behavior)
     choices = make_choices(planners, split_list(and_), split_list(or_), split_list(inference))
     paths = check_inputs(worlds, choices, rulebase, behavior)

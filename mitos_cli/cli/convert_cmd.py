@@ -10,7 +10,7 @@ import typer
 
 from .output import emit, err, warn, warn_notes
 from .params import choice, choices, completer, named
-from .targets import check_suffix, refuse_existing, refuse_inputs, source_files
+from .targets import check_suffix, refuse_existing, refuse_inputs, refuse_strays, source_files
 
 
 class Target(str, Enum):
@@ -30,7 +30,8 @@ def convert_command(
         "--output", "-o", metavar="OUT",
         help="File to write, ending in the format's extension (default: stdout; for --to "
              "rules: STEM.rules and STEM.terms.yaml in the current directory, never over "
-             "existing files).")] = None,
+             "existing files). -o OUT.rules also writes OUT.terms.yaml, never over a file "
+             "there that OUT.rules does not read.")] = None,
     behavior: Annotated[Optional[str], typer.Option(
         "--behavior", "-b", callback=named, help="Behavior to convert (default: the file's first).")] = None,
 ) -> None:
@@ -57,6 +58,7 @@ def convert_command(
         rules_path = output if output is not None else Path.cwd() / f"{path.stem}.rules"
         terms_path = rules_path.with_name(rules_path.stem + ".terms.yaml")
         refuse_inputs([rules_path, terms_path], sources)
+        refuse_strays(rules_path, [terms_path])       # a term set no rule file here reads
         if output is None:
             refuse_existing([rules_path, terms_path], rules_path.name)
         rules_text, terms_text = write_rules(rb, terms_path.name, behavior, path.name)

@@ -94,6 +94,27 @@ def warn_outside(compiled, Y) -> None:
                  f"behavior's inference or a linear consequent can leave it")
 
 
+def warn_undersampled(rb, dof) -> None:
+    """Once per term: a fired rule concludes a Mamdani output term that falls between its
+    output's sample points (:func:`~mitos_cli.engine.mamdani.undersampled`), so the number
+    printed hardly reflects it. The number is kept as it is (MATLAB samples the same way)."""
+    if dof is None or rb.compiled.operators.inference != "mamdani":
+        return                              # nothing imported for the common case
+    import numpy as np
+
+    from ..engine.check import resolution_hint
+    from ..engine.mamdani import undersampled
+
+    for u in undersampled(rb.compiled):
+        strongest = dof[:, u.rules].max(axis=0) if len(dof) else np.zeros(len(u.rules))
+        fired = [rb.compiled.labels[r] for r, d in zip(u.rules, strongest) if d > 0]
+        if fired:
+            warn(f"{u.describe()}, though {', '.join(fired[:3])}"
+                 f"{' ...' if len(fired) > 3 else ''} fired (DOF up to "
+                 f"{float(strongest.max()):.2g})\n  hint: "
+                 f"{resolution_hint(rb.rulebase.path, u.points)}")
+
+
 def eval_command(
     args: Annotated[Optional[list[str]], typer.Argument(
         metavar="[RULEBASE] NAME=VALUE...",
@@ -179,6 +200,7 @@ def eval_command(
     result = evaluate(rb.compiled, X)
     warn_clamped(result)
     warn_outside(rb.compiled, result.outputs)
+    warn_undersampled(rb, result.dof)
     trace = trace_of(result, given=X)
     if as_json:
         emit(json_text(trace.to_json()))
@@ -197,6 +219,8 @@ def run_batch(rb, source: str, on_no_rule: NoRule | None = None,
               digits: int | None = None) -> None:
     """Read the CSV, evaluate all rows as one batch, write inputs and outputs as CSV."""
     from ..engine.csvio import passed_names, read_table, row_span, write_batch
+    from ..engine.evaluation import rule_dofs
+    from ..engine.mamdani import undersampled
 
     if source == "-":                  # bytes: a text stream would turn `\r\n` into `\n`
         stream = getattr(sys.stdin, "buffer", None)
@@ -220,6 +244,8 @@ def run_batch(rb, source: str, on_no_rule: NoRule | None = None,
     X = batch.X
     result = rb.run(X, strict=False, detail=False)
     warn_clamped(result)
+    if undersampled(rb.compiled):       # the rules' DOFs, only when there is a term to tell
+        warn_undersampled(rb, rule_dofs(rb.compiled, X))
     Y, keep, flags = no_rule_policy(rb.compiled, result, on_no_rule or NoRule.default,
                                     lambda row: row_span(text, name, row))
     warn_outside(rb.compiled, Y[keep])

@@ -12,7 +12,7 @@ from . import complete
 from .output import emit, err, json_text
 from .params import MAX_RUNS, finite, named
 from .progress import INTERRUPTED, progress_bar
-from .targets import check_directory
+from .targets import check_directory, check_suffix
 
 REQUIRE = ("success",)
 
@@ -104,6 +104,8 @@ def _runs_table(runs) -> str:
     widths = [max(len(r[i]) for r in rows) for i in range(len(head))]
     table = "\n".join("  ".join(c.ljust(wd) if i == 0 else c.rjust(wd)
                                 for i, (c, wd) in enumerate(zip(r, widths))) for r in rows)
+    if any(len(r.summaries) > 1 for w in runs.worlds for r in (w, *w.robots)):
+        table += "\n(time, path, min clear and speed: mean ± standard deviation over the runs)"
     if any(r.rate("success") < 1 for w in runs.worlds for r in (w, *w.robots)
            if "success" in r.outcomes):
         table += ("\n(time, path and speed: means over every run, a collision's or a timeout's "
@@ -169,7 +171,8 @@ def simulate_command(
                             "--seed SEED+j).")] = False,
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON instead of the table.")] = False,
     out: Annotated[Optional[Path], typer.Option(
-        "--out", "-o", metavar="FILE.csv", help="Write one CSV row per tick.")] = None,
+        "--out", "-o", metavar="FILE.csv",
+        help="Write one CSV row per tick to FILE.csv (a name ending in .csv).")] = None,
     trace: Annotated[bool, typer.Option(
         "--trace", help="Print the paper-style DOF trace every --every ticks (of the first "
                         "robot where there are several; on stderr with --json, which keeps "
@@ -222,6 +225,8 @@ def simulate_command(
     for path in (out, plot, animate):         # before the run, not after it
         if path is not None:
             check_directory(path)
+    if out is not None:                       # as --plot's and convert -o's: a usage error
+        check_suffix(out, ".csv", "the table of ticks (--out)", "'--out' / '-o'")
     many = len(loaded) > 1 or runs > 0
     _check_run_options(many, len(loaded), runs, randomise, out, trace, live, animate, plot)
     planner = make_planner(planner_name, loaded[0], rulebase, behavior)

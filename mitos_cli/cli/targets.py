@@ -12,7 +12,7 @@ import typer
 OUTPUT_OPTION = "'-o' / '--output'"
 
 
-def check_suffix(path: Path, suffix: str, what: str) -> None:
+def check_suffix(path: Path, suffix: str, what: str, option: str = OUTPUT_OPTION) -> None:
     """``-o`` must end in ``suffix`` (any case): a C file called ``out.py`` or an FCL file
     called ``out.fis`` would be read later as what it is not. A device or a pipe
     (``/dev/stdout``) has no extension to check."""
@@ -20,27 +20,17 @@ def check_suffix(path: Path, suffix: str, what: str) -> None:
         return
     has = f"extension {path.suffix}" if path.suffix else "no extension"
     raise typer.BadParameter(f"`{path}` has {has}; {what} is written to a {suffix} file",
-                             param_hint=OUTPUT_OPTION)
+                             param_hint=option)
 
 
 def check_directory(path: Path) -> None:
     """Refuse, before any work, a file that cannot be written where it is named: its directory
     missing or not writable, or the name a directory's. ``simulate --runs 1000 --plot
-    typo/runs.png`` ran every run, then failed on the picture and lost them all. The words
-    are those of :func:`mitos_cli.fileio.atomic_file`, which says the same when it writes."""
-    from ..errors import MitosError
+    typo/runs.png`` ran every run, then failed on the picture and lost them all. (The check
+    itself is :func:`mitos_cli.fileio.check_writable`, which scripts below the CLI use too.)"""
+    from ..fileio import check_writable
 
-    if _special(path):                     # a device or a pipe (/dev/stdout) is written as is
-        return
-    if path.is_dir():
-        raise MitosError(f"cannot write `{path}`: it is a directory",
-                         hint="give a file name inside it")
-    parent = path.parent if str(path.parent) else Path(".")
-    why = ("No such file or directory" if not parent.is_dir() else
-           "Permission denied" if not os.access(parent, os.W_OK | os.X_OK) else None)
-    if why is not None:
-        raise MitosError(f"cannot write `{path}`: {why}",
-                         hint="check that the directory exists and is writable")
+    check_writable(path)
 
 
 def source_files(rulebase, path: Path) -> list[tuple[Path, str]]:
@@ -60,6 +50,19 @@ def refuse_inputs(targets: list[Path], sources: list[tuple[Path, str]]) -> None:
             if same_file(target, source):
                 raise typer.BadParameter(f"`{target}` would overwrite {what}; give -o another "
                                          f"name", param_hint=OUTPUT_OPTION)
+
+
+def refuse_strays(named: Path, companions: list[Path]) -> None:
+    """A usage error when a file written beside ``named`` (the term set of ``-o OUT.rules``)
+    is already there and is not ``named``'s own (the existing ``named`` does not read it):
+    the user named only ``named``."""
+    from ..lang.resolve import strays
+
+    for path in strays(named, companions):
+        raise typer.BadParameter(
+            f"`{path}` is already there and no term set of `{named}`; writing `{named}` "
+            f"would write its term set over it: remove it, or choose another -o",
+            param_hint=OUTPUT_OPTION)
 
 
 def refuse_existing(targets: list[Path], named: str) -> None:

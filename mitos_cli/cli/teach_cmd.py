@@ -53,8 +53,11 @@ def teach_command(
              "the first error (exit 1).")] = None,
     save_as: Annotated[str | None, typer.Option(
         "--save-as", "-o", metavar="OUT.rules",
-        help="Where `save` writes (OUT.rules and OUT.terms.yaml); a lesson saves there when it "
-             "ends. The original files are never overwritten unless you name them.")] = None,
+        help="Where `save` writes: OUT.rules and its term set beside it, OUT.terms.yaml (a "
+             "rule file with several term sets, as the packaged one: OUT.<each term set's "
+             "name>, e.g. OUT.mitos.terms.yaml and OUT.drive.terms.yaml); a lesson saves there "
+             "when it ends. The original files are never overwritten unless you name them, "
+             "nor a term set there that OUT.rules does not read.")] = None,
     resume: Annotated[bool, typer.Option(
         "--resume", help="Continue the last teaching session here (or --session NAME) from "
                          "its journal.")] = False,
@@ -119,6 +122,9 @@ def _resumed(session_name, recover: bool, save_as, out):
         exc.kind = "session error"
         raise
     if save_as is not None:
+        from ..teach.save import check_save_target
+
+        check_save_target(session.original, Path(save_as))
         session.save_as = Path(save_as)
     err(f"resumed session {journal.directory.name}: {plural(len(journal.active()), 'change')}, "
         f"{plural(len(session.state.examples), 'example')}, behavior {session.state.active}"
@@ -157,12 +163,16 @@ def _new_session(rules, behavior, lesson, save_as, out):
                             else f"rule file `{path}` not found",
                             hint=None if path.is_dir() else nearby(path))  # as eval's
     try:
-        load_rulebase(path, behavior)
+        loaded = load_rulebase(path, behavior)
     except MitosError as exc:           # a .fis, .fcl or .fll (by its name or not): convert it
         from ..interop import hint_wrong_reader
 
         hint_wrong_reader(exc, path, "mitos teach")
         raise
+    if save_as is not None:         # refused now, not when the lesson ends and saves
+        from ..teach.save import check_save_target
+
+        check_save_target(loaded.rulebase, Path(save_as))
     lesson_text = read_lesson(lesson) if lesson is not None else None
     journal = Journal.create(new_session_dir(path.stem))
     session = Session(path, behavior, journal, save_as, out=out, progress=epoch_progress)

@@ -4,7 +4,8 @@
 severity, a message, the place in the rule file or term set it concerns (a :class:`Span`) and,
 for findings about the input space, the regions as boxes of input ranges. Nothing here prints.
 
-What is checked, per behavior (every behavior of the file unless one is named):
+What is checked, per behavior (every behavior of the file unless one is named; then the term
+sets' findings are only about the variables it reads or sets):
 
 ====================  ==========  ==========================================================
 code                  severity    meaning
@@ -25,6 +26,11 @@ code                  severity    meaning
 ``term-outside``      warning     an input term that never reaches 1 inside the universe
 ``unused-term``       warning     an input term (or a whole input) that no rule uses
 ``unconcluded-term``  info        an output term that no rule concludes
+``undersampled-term`` warning     a Mamdani output term (as a rule concludes it) whose largest
+                                  membership over the output's sample points is below
+                                  :data:`~mitos_cli.engine.mamdani.UNDERSAMPLED_BELOW` (0.5):
+                                  narrower than the sampling step, its rules hardly change
+                                  the output
 ``term-order``        warning     terms whose peaks (values) are not in the written order
 ``coverage``          warning     a point of an input's universe where no term reaches 0.5
 ``indistinct``        warning     two terms of a variable too alike to tell apart
@@ -161,18 +167,24 @@ def check_rulebase(rb: RuleBase, behavior: str | None = None, *, threshold: floa
     names = [behavior] if behavior else [b.name for b in rb.behaviors]
     findings: list[Finding] = []
     grids: list[GridInfo] = []
+    seen: set[tuple] = set()               # undersampled terms already reported
     for name in names:
         rb.behavior(name)                       # unknown behavior: did-you-mean error
         compiled = compile_rulebase(rb, name)
         findings += _rule_pairs(rb, name)
         findings += _contradictions(rb, name)
         findings += _idle_settings(rb, name, compiled)
+        findings += _undersampled(rb, name, compiled, seen)
         grid_findings, info = _sampled(compiled, threshold, resolution)
         findings += grid_findings
         grids.append(info)
-    findings += _term_gaps(rb)
-    findings += _unused_terms(rb)
-    findings += _interpretability(rb)
+    # the term sets' findings: with one behavior named, only about the variables it uses
+    # (its used behaviors' included); `nearest.ROOMY` is no concern of `avoid_obstacle`
+    scope = None if not behavior else set().union(*(
+        set(c.inputs) | set(c.outputs) for c in (compile_rulebase(rb, n) for n in names)))
+    findings += _term_gaps(rb, scope)
+    findings += _unused_terms(rb, scope)
+    findings += _interpretability(rb, scope)
     order = {s: i for i, s in enumerate(SEVERITIES)}
     findings.sort(key=lambda f: (order[f.severity], _span_key(f.span)))
     return Report(rb, tuple(findings), tuple(grids), threshold, tuple(names))
@@ -196,6 +208,41 @@ def _idle_settings(rb: RuleBase, name: str, compiled) -> list[Finding]:
                 f"{compiled.operators.inference} inference", setting.span, name,
                 "add `inference = mamdani` to the operators line, or remove the setting"))
     return out
+
+
+def _undersampled(rb: RuleBase, name: str, compiled, seen: set[tuple]) -> list[Finding]:
+    """Output terms that the Mamdani sampling misses (:func:`.mamdani.undersampled`), once
+    per term and sampling however many behaviors conclude them."""
+    from .mamdani import undersampled
+
+    out = []
+    for u in undersampled(compiled):
+        key = (u.output, u.label, u.points, u.step)
+        if key in seen:
+            continue
+        seen.add(key)
+        term = rb.variables[u.output].term(u.term)
+        out.append(Finding("warning", "undersampled-term", u.describe(), term.span, name,
+                           resolution_hint(rb.path, u.points)))
+    return out
+
+
+def resolution_hint(path: str | None, points: int) -> str:
+    """How to sample an output more finely, in the words of the file's format."""
+    suffix = (path or "").rsplit(".", 1)[-1].lower()
+    finer = 1001 if points < 1001 else min(points * 10, 100_000)
+    if suffix == "fis":
+        return ("widen it; a .fis output is always sampled at MATLAB's 101 points: `mitos eval "
+                "--fidelity fuzzylite` samples 1000, or convert the file (`mitos convert --to "
+                "rules`) and set `resolution = 1001`")
+    if suffix == "fll":
+        return (f"widen it, or raise the defuzzifier's resolution (`defuzzifier: Centroid "
+                f"{finer}`)")
+    if suffix == "fcl":
+        return (f"widen it, or raise the defuzzifier's resolution (`METHOD : COG "
+                f"{finer};`)")
+    return (f"widen it, or raise the resolution (now {points}): `resolution = {finer}` in "
+            f"the behavior's (or the file's) `operators:` line")
 
 
 def _span_key(span: Span | None) -> tuple:
@@ -485,9 +532,14 @@ def boxes_of(mask: np.ndarray, axes: list[np.ndarray], names: tuple[str, ...],
 # ---------------------------------------------------------------------------------------------
 # term sets
 
-def _term_gaps(rb: RuleBase) -> list[Finding]:
+def _variables(rb: RuleBase, scope: set[str] | None) -> list[Variable]:
+    """The file's variables, or those in ``scope`` (the ones a named behavior uses)."""
+    return [v for v in rb.variables.values() if scope is None or v.name in scope]
+
+
+def _term_gaps(rb: RuleBase, scope: set[str] | None = None) -> list[Finding]:
     out = []
-    for var in rb.variables.values():
+    for var in _variables(rb, scope):
         if var.role != "input" or not var.terms:
             continue
         lo, hi = var.universe
@@ -516,11 +568,11 @@ def _term_gaps(rb: RuleBase) -> list[Finding]:
     return out
 
 
-def _interpretability(rb: RuleBase) -> list[Finding]:
+def _interpretability(rb: RuleBase, scope: set[str] | None = None) -> list[Finding]:
     from ..lang.interpretability import variable_issues
 
     out = []
-    for var in rb.variables.values():
+    for var in _variables(rb, scope):
         for issue in variable_issues(var):
             span = var.term(issue.terms[0]).span if issue.terms else var.span
             out.append(Finding("warning", issue.code, issue.message, span, None,
@@ -545,7 +597,7 @@ def _terms_used(expr: Expr, out: set[tuple[str, str]]) -> None:
             _terms_used(item, out)
 
 
-def _unused_terms(rb: RuleBase) -> list[Finding]:
+def _unused_terms(rb: RuleBase, scope: set[str] | None = None) -> list[Finding]:
     used: set[tuple[str, str]] = set()
     concluded: set[tuple[str, str]] = set()
     for b in rb.behaviors:                  # a term used anywhere in the file is used
@@ -559,7 +611,7 @@ def _unused_terms(rb: RuleBase) -> list[Finding]:
                 _terms_used(use.condition, used)
     set_by_rules = {c.var for b in rb.behaviors for r in b.rules for c in r.consequents}
     out = []
-    for var in rb.variables.values():
+    for var in _variables(rb, scope):
         if var.role == "input":
             names = [t for t in var.terms if (var.name, t.name) not in used]
             if len(names) == len(var.terms):

@@ -141,6 +141,56 @@ def build_tables(compiled) -> tuple[OutputTable, ...]:
     return tuple(tables)
 
 
+#: A consequent set whose largest membership over its output's sample points is below this
+#: is *undersampled*: a term narrower than the sampling step can fall between the points
+#: (``trimf [4.9 5 5.1]`` on MATLAB's 101 points of [0, 30], every 0.3, is 0 at every one),
+#: and its rules then hardly change the output, or not at all, however strongly they fire.
+#: Half the term's height: a triangle at least one step wide always reaches it.
+UNDERSAMPLED_BELOW = 0.5
+
+
+@dataclass(frozen=True)
+class Undersampled:
+    """A consequent set that its output's sampling misses (see :data:`UNDERSAMPLED_BELOW`)."""
+
+    output: str
+    label: str                # the set as rules conclude it: "cheap", "very cheap"
+    term: str                 # the output term under the hedges
+    peak: float               # its largest membership over the sample points
+    points: int               # the output's sample points (``resolution``)
+    step: float               # the distance between two of them
+    rules: np.ndarray         # [r] the rules concluding it (columns of ``dof``)
+
+    def describe(self) -> str:
+        """What is wrong, for ``check`` and ``eval``."""
+        where = (f"falls between the {self.points} points its output is sampled at "
+                 if self.peak <= 0.0 else
+                 f"reaches only {self.peak:.2g} at the {self.points} points its output is "
+                 f"sampled at ")
+        effect = "do not change" if self.peak <= 0.0 else "hardly change"
+        return (f"term `{self.label}` of output `{self.output}` {where}(every {self.step:.3g}): "
+                f"its rules {effect} `{self.output}`")
+
+
+def undersampled(compiled) -> tuple[Undersampled, ...]:
+    """The consequent sets of a Mamdani behavior that its outputs' sampling misses. A crisp
+    value or a singleton is a spike of height 1 at its nearest point: never missed."""
+    if compiled.operators.inference != "mamdani":
+        return ()
+    out = []
+    for table in compiled.mamdani:
+        if len(table.grid) < 2:
+            continue
+        step = float(table.grid[1] - table.grid[0])
+        for i, label in enumerate(table.labels):
+            peak = float(table.sets[i].max()) if table.sets.shape[1] else 0.0
+            if label.startswith("=") or not peak < UNDERSAMPLED_BELOW:
+                continue
+            out.append(Undersampled(table.name, label, label.split()[-1], peak,
+                                    len(table.grid), step, table.rules[table.set_of == i]))
+    return tuple(out)
+
+
 def aggregate(dof: np.ndarray, sets: np.ndarray, implication: str,
               aggregation: norms.Norm) -> np.ndarray:
     """The output fuzzy set ``[b, res]`` of DOFs ``[R, b]`` and consequent sets ``[R, res]``:

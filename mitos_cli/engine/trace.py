@@ -12,7 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..resources import display_path
-from ..words import plural
+from ..words import plural, with_unit
 from .evaluation import Result, declares_nan
 
 
@@ -63,6 +63,9 @@ class Trace:
                        for i in self.inputs},
             "rules": [{"label": r.label, "text": r.text, "dof": r.dof} for r in self.rules],
             "outputs": {name: value for name, value, _ in self.outputs},
+            # the outputs that no rule sets here, each its `default` (the text trace says
+            # "its default: no rule sets it here"); added in 0.2, empty when rules set all
+            "defaulted": list(self.defaulted),
         }
 
     def render(self, digits: int = 1) -> str:
@@ -83,8 +86,8 @@ class Trace:
         for text, i in zip(fuzzified, self.inputs):
             note = "" if not i.clamped else " (clamped to its universe)" if i.given is None \
                 else f" (given {i.given:g}, clamped to its universe)"
-            lines.append(f"  {text.ljust(width)}   {i.name} = {i.value:g} {i.unit}".rstrip()
-                         + note)
+            lines.append(f"  {text.ljust(width)}   {i.name} = "
+                         f"{with_unit(f'{i.value:g}', i.unit)}".rstrip() + note)
         lines += ["", f"rules fired ({len(self.rules)} of {self.n_rules}):"]
         for r in self.rules:
             lines.append(f"  {r.label}: {r.text}, DOF = {num(r.dof)}")
@@ -93,7 +96,7 @@ class Trace:
         lines += ["", "outputs:"]
         for name, value, unit in self.outputs:
             note = "   (its default: no rule sets it here)" if name in self.defaulted else ""
-            lines.append(f"  {name} = {num(value)} {unit}".rstrip() + note)
+            lines.append(f"  {name} = {with_unit(num(value), unit)}".rstrip() + note)
         return "\n".join(lines)
 
 

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..errors import RuleBaseError, Span, TermSetError, unknown
+from ..errors import MitosError, RuleBaseError, Span, TermSetError, unknown
 from ..fuzzy.hedges import HEDGES
 from ..resources import exists, is_file
 from . import operators as ops_mod
@@ -50,6 +50,31 @@ def load_rules_file(path: str | Path) -> RuleBase:
                                     "a YAML file")
         termsets.append(load_termset(target))
     return build_rulebase(parsed, tuple(termsets), tuple(n for n, _ in parsed.terms))
+
+
+def termsets_read(path: str | Path) -> set[Path]:
+    """The term sets (resolved paths) that the rule file at ``path`` names, when it is there
+    and parses; else none. A writer that puts a term set beside ``path`` may replace one of
+    these (it belongs to the rule file being replaced), never another file."""
+    from ..fileio import read_text
+
+    path = Path(path)
+    try:
+        parsed = parse_rules(read_text(path), str(path))
+        return {(path.parent / name).resolve() for name, _ in parsed.terms}
+    except (MitosError, OSError, UnicodeDecodeError, ValueError):
+        return set()
+
+
+def strays(rules_target: str | Path, companions) -> list[Path]:
+    """The files among ``companions`` (written beside ``rules_target``, which the user named)
+    that are already there and that the rule file at ``rules_target`` does not read: files
+    the user did not name, which writing would replace."""
+    there = [Path(p) for p in companions if Path(p).exists() or Path(p).is_symlink()]
+    if not there:
+        return []
+    own = termsets_read(rules_target)
+    return [p for p in there if p.resolve() not in own]
 
 
 def _named_once(target: Path, name: str, span: Span | None, seen: dict[Path, str]) -> None:

@@ -37,6 +37,7 @@ one as a world file (a known one also writes its map as PGM + map_server YAML be
 from __future__ import annotations
 
 import argparse
+import sys
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -297,44 +298,149 @@ def world_yaml(w: World, map_file: str | None = None) -> str:
     return "\n".join(lines) + "\n"
 
 
-def write_world(w: World, out: Path) -> list[Path]:
-    """Write ``w`` to ``out`` (and a known world's map beside it); the files written."""
+def companions(out: Path, known: bool) -> list[Path]:
+    """The files written beside the world file ``out``: a known world's map (PGM and its
+    map_server YAML)."""
     out = Path(out)
-    written = []
-    map_file = None
-    if w.grid is not None:
-        g = w.grid
-        pgm = out.with_suffix(".pgm")
-        img = np.where(g.occupied[::-1], 0, 254).astype(np.uint8)
-        pgm.write_bytes(f"P5\n{img.shape[1]} {img.shape[0]}\n255\n".encode() + img.tobytes())
-        map_yaml = out.with_name(out.stem + ".map.yaml")
-        map_yaml.write_text(f"image: {pgm.name}\nresolution: {g.resolution / M:.12g}\n"
-                            f"origin: [{g.origin[0] / M:.12g}, {g.origin[1] / M:.12g}, 0.0]\n"
-                            "negate: 0\n"
-                            "occupied_thresh: 0.65\nfree_thresh: 0.196\n", encoding="utf-8")
-        written += [pgm, map_yaml]
-        map_file = map_yaml.name
-    out.write_text(world_yaml(w, map_file), encoding="utf-8")
-    return [out] + written
+    return [out.with_suffix(".pgm"), out.with_name(out.stem + ".map.yaml")] if known else []
+
+
+def write_world(w: World, out: Path) -> list[Path]:
+    """Write ``w`` to ``out`` (and a known world's map beside it), each file whole or not at
+    all (:func:`~mitos_cli.fileio.atomic_write_set`); the files written."""
+    from ..fileio import atomic_write, atomic_write_set
+
+    out = Path(out)
+    if w.grid is None:
+        atomic_write(out, world_yaml(w))
+        return [out]
+    g = w.grid
+    pgm, map_yaml = companions(out, True)
+    img = np.where(g.occupied[::-1], 0, 254).astype(np.uint8)
+    map_text = (f"image: {pgm.name}\nresolution: {g.resolution / M:.12g}\n"
+                f"origin: [{g.origin[0] / M:.12g}, {g.origin[1] / M:.12g}, 0.0]\n"
+                "negate: 0\n"
+                "occupied_thresh: 0.65\nfree_thresh: 0.196\n")
+    atomic_write_set([(pgm, f"P5\n{img.shape[1]} {img.shape[0]}\n255\n".encode() + img.tobytes()),
+                      (map_yaml, map_text), (out, world_yaml(w, map_yaml.name))], out)
+    return [out, pgm, map_yaml]
+
+
+#: the most smoothing iterations the command takes (BARN uses 2-4; the automaton has long
+#: settled by then, and a huge number would only keep the command busy)
+MAX_SMOOTHING = 100
+
+
+def _seed(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"a whole number is expected, not `{text}`") from None
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"the seed is a whole number of 0 or more, not {value}")
+    return value
+
+
+def _fill(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"a number is expected, not `{text}`") from None
+    if not 0.0 <= value < 1.0:      # NaN too
+        hint = (f" (a percentage? --fill {value / 100:g} is {value:g}%)"
+                if 1.0 <= value < 100.0 else "")
+        raise argparse.ArgumentTypeError(
+            f"the fill is the fraction of cells filled, in [0, 1), not {text}{hint}")
+    return value
+
+
+def _smoothing(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"a whole number is expected, not `{text}`") from None
+    if not 0 <= value <= MAX_SMOOTHING:
+        raise argparse.ArgumentTypeError(
+            f"the smoothing iterations are a whole number from 0 to {MAX_SMOOTHING}, not {value}")
+    return value
+
+
+def _out(text: str) -> Path:
+    path = Path(text)
+    try:
+        if path.is_dir():           # said as every writer says it, with exit 1, when checked
+            return path
+    except OSError:                 # a name too long to look up: the same
+        return path
+    if path.suffix.lower() not in (".yaml", ".yml"):
+        has = f"extension {path.suffix}" if path.suffix else "no extension"
+        raise argparse.ArgumentTypeError(f"`{text}` has {has}; the world is written to a "
+                                         f".yaml file")
+    return path
+
+
+def _parser() -> argparse.ArgumentParser:
+    ap = argparse.ArgumentParser(prog="python -m mitos_cli.sim.barn",
+                                 description="Write a BARN-style world file.")
+    ap.add_argument("--seed", type=_seed, default=0,
+                    help="whole number >= 0 that draws the field, and the difficulty when "
+                         "--fill or --smoothing is not given (default: 0)")
+    ap.add_argument("--fill", type=_fill,
+                    help="fraction of cells filled before smoothing, in [0, 1), e.g. 0.25 "
+                         "(default: drawn from the seed, 0.15-0.30)")
+    ap.add_argument("--smoothing", type=_smoothing,
+                    help=f"cellular-automaton smoothing iterations, 0-{MAX_SMOOTHING} "
+                         "(default: drawn from the seed, 2-4)")
+    ap.add_argument("--known", action="store_true",
+                    help="draw the poles in the robot's map (also writes OUT.pgm and "
+                         "OUT.map.yaml beside the world file)")
+    ap.add_argument("--out", type=_out, required=True, metavar="OUT.yaml",
+                    help="world file to write")
+    return ap
+
+
+def _check_out(out: Path, known: bool) -> None:
+    """Refuse, before a field is drawn, a world file that cannot be written, and a known
+    world's map that would replace a file the user did not name (one the world file at
+    ``out`` does not read)."""
+    from ..errors import MitosError
+    from ..fileio import check_writable
+
+    check_writable(out)
+    try:
+        own = out.read_text(encoding="utf-8") if out.is_file() else ""
+    except (OSError, UnicodeDecodeError):
+        own = ""
+    pgm, map_yaml = companions(out, True)
+    for path in companions(out, known):
+        if (path.exists() or path.is_symlink()) and f"grid: {map_yaml.name}\n" not in own:
+            raise MitosError(f"`{path}` is already there, and a known world's map is written "
+                             f"there beside `{out}`",
+                             hint="remove it, or choose another --out")
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m mitos_cli.sim.barn",
-                                 description="Write a BARN-style world file.")
-    ap.add_argument("--seed", type=int, default=0)
-    ap.add_argument("--fill", type=float, help="fill percentage (default: drawn from the seed)")
-    ap.add_argument("--smoothing", type=int, help="smoothing iterations (default: drawn)")
-    ap.add_argument("--known", action="store_true", help="draw the poles in the robot's map")
-    ap.add_argument("--out", type=Path, required=True, help="world YAML to write")
+    """``python -m mitos_cli.sim.barn``: errors as ``mitos`` gives them (``error:`` and a hint;
+    exit 2 for a bad option, 1 for a file that cannot be written or a field that cannot be
+    drawn), never a traceback."""
+    from ..errors import MitosError
+
+    ap = _parser()
     args = ap.parse_args(argv)
     fill, smoothing = difficulty(args.seed)
     fill = fill if args.fill is None else args.fill
     smoothing = smoothing if args.smoothing is None else args.smoothing
     try:
-        w = barn_world(args.seed, fill, smoothing, known=args.known)
-    except ValueError as exc:
-        ap.exit(1, f"error: {exc}\n")
-    for p in write_world(w, args.out):
+        _check_out(args.out, args.known)
+        try:
+            w = barn_world(args.seed, fill, smoothing, known=args.known)
+        except ValueError as exc:
+            raise MitosError(str(exc)) from None
+        written = write_world(w, args.out)
+    except MitosError as exc:
+        print(exc.render(), file=sys.stderr)
+        return 1
+    for p in written:
         print(p)
     return 0
 

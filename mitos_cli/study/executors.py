@@ -60,6 +60,21 @@ def run_local(fn: TaskFn, tasks: Sequence[Task], workers: int) -> Iterator[tuple
         yield from part
 
 
+def require_dask(scheduler: str | None) -> None:
+    """Refuse ``--executor dask`` without dask.distributed (and, for the local cluster, the
+    `cryptography` its TLS needs) before a study writes anything or shows its progress: the
+    same words :func:`dask_client` and :func:`local_cluster` say, found without importing
+    them (a second and more)."""
+    from importlib.util import find_spec
+
+    if find_spec("distributed") is None:
+        raise StudyError("the Dask executor needs dask.distributed, which is not installed",
+                         hint="pip install 'mitos[dask]', or use --executor local")
+    if scheduler is None and find_spec("cryptography") is None:
+        raise StudyError("the local Dask cluster needs `cryptography` for its TLS certificates",
+                         hint="pip install 'mitos[dask]', or use --executor local")
+
+
 def dask_client(scheduler: str | None, workers: int, timeout: str = "10s"):
     """A ``distributed.Client`` to ``scheduler`` (giving up after ``timeout``), or to a new
     LocalCluster of ``workers`` processes."""

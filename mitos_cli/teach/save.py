@@ -66,8 +66,7 @@ def save_rulebase(original: RuleBase, current: RuleBase, target: Path) -> Saved:
     if src.suffix.lower() in (".fcl", ".fis", ".fll"):
         raise LessonError(f"`{src.name}` is not in the rule language; saving keeps the rule "
                           f"language only", hint="save to a `.rules` file after converting it")
-    targets = termset_targets(target, src, original.termset_paths)
-    _check_targets(target, src, original, targets)
+    targets = check_save_target(original, target)
     changes: list[str] = []
     texts: list[tuple[Path, str | bytes]] = []
     for ts_old, ts_new, rel, dest in zip(original.termsets, current.termsets,
@@ -87,10 +86,22 @@ def save_rulebase(original: RuleBase, current: RuleBase, target: Path) -> Saved:
     return Saved(target, tuple(d for d, _ in texts), tuple(changes))
 
 
+def check_save_target(original: RuleBase, target: Path) -> tuple[Path, ...]:
+    """The term-set files a save of ``original`` as ``target`` writes, after refusing a save
+    that would replace a file it must not (:func:`_check_targets`); ``mitos teach
+    --save-as`` asks before a session starts, ``save`` again when it writes."""
+    src = Path(original.path or target)
+    targets = termset_targets(target, src, original.termset_paths)
+    _check_targets(target, src, original, targets)
+    return targets
+
+
 def _check_targets(target: Path, src: Path, original: RuleBase, targets: tuple[Path, ...]) -> None:
     """Refuse a save that would write over a file the session reads: an original term set
     saved under another rule file's name (`save b.rules` beside a rule file that reads
-    `b.terms.yaml`), or a term set onto the rule file itself."""
+    `b.terms.yaml`), or a term set onto the rule file itself; or over a file the user did not
+    name: a term set there that the rule file saved over does not read (a term set of an
+    earlier save as ``target`` is its own, and is replaced)."""
     if target.suffix != ".rules":
         raise LessonError(f"`{target}` does not end in `.rules`; save writes a rule file",
                           hint=f"save {target.with_suffix('.rules').as_posix()}")
@@ -106,6 +117,13 @@ def _check_targets(target: Path, src: Path, original: RuleBase, targets: tuple[P
                 f"means",
                 hint="save under another name, or over the original rule file itself "
                      f"(`save {src}`)")
+    from ..lang.resolve import strays
+
+    for dest in strays(target, targets):
+        raise LessonError(
+            f"`{dest}` is already there and no term set of `{target}`; saving as "
+            f"`{target.name}` would write its term set over it",
+            hint="remove it, or save under another name")
 
 
 def _check_reads_back(current: RuleBase, rules_text: str, texts, target: Path,
