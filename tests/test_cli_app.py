@@ -91,18 +91,19 @@ def test_an_options_names_are_shown_and_completed() -> None:
 
 def test_a_reader_that_stops_early_is_what_the_readme_says(tmp_path) -> None:
     """README, "A reader that stops early": a trace larger than the pipe's buffer ends with
-    exit 1 and nothing on stderr; the default trace fits in it, and exits 0."""
+    exit 1 and nothing on stderr; the default trace fits in it, and its exit (0 or 1) is a
+    race between the verdict written after it and ``head`` exiting, quiet either way."""
     import os
     from pathlib import Path
 
     root = Path(__file__).resolve().parents[1]
     env = dict(os.environ, PYTHONPATH=str(root))
     mitos = f"{sys.executable} -m mitos_cli simulate --trace"
-    for extra, code in ((" --every 1", 1), ("", 0)):
+    for extra, codes in ((" --every 1", {1}), ("", {0, 1})):
         res = subprocess.run(["bash", "-c", f"{mitos}{extra} 2>{tmp_path / 'err'} | head -1; "
                               "exit ${PIPESTATUS[0]}"], capture_output=True, text=True,
                              env=env, cwd=tmp_path, timeout=120)
-        assert res.returncode == code, extra
+        assert res.returncode in codes, extra
         assert res.stdout.startswith("--- tick 0, t = 0.00 s")
         assert (tmp_path / "err").read_text() == ""
     readme = " ".join((root / "README.md").read_text(encoding="utf-8").split())
