@@ -163,6 +163,8 @@ def test_runs_count_a_run_a_success_only_if_every_robot_succeeded(rear_end):
     table = run(rear_end, "--runs", 2, "--workers", 1).splitlines()
     assert [line.split()[0] for line in table] == ["world", "rearend", "robot", "second",
                                                    "(time,"]           # the means' footnote
+    assert table[-1].startswith("(time, path, min clear and speed: mean ± standard deviation "
+                                "over every run, a collision's or a timeout's until it ended")
     assert table[1].split()[2:4] == ["0%", "100%"] and table[2].split()[2] == "100%"
 
 

@@ -104,13 +104,23 @@ def _runs_table(runs) -> str:
     widths = [max(len(r[i]) for r in rows) for i in range(len(head))]
     table = "\n".join("  ".join(c.ljust(wd) if i == 0 else c.rjust(wd)
                                 for i, (c, wd) in enumerate(zip(r, widths))) for r in rows)
-    if any(len(r.summaries) > 1 for w in runs.worlds for r in (w, *w.robots)):
-        table += "\n(time, path, min clear and speed: mean ± standard deviation over the runs)"
-    if any(r.rate("success") < 1 for w in runs.worlds for r in (w, *w.robots)
-           if "success" in r.outcomes):
-        table += ("\n(time, path and speed: means over every run, a collision's or a timeout's "
-                  "until it ended; `mitos compare` takes time and path over the successful runs)")
-    return table
+    return table + _runs_footnote(runs)
+
+
+def _runs_footnote(runs) -> str:
+    """What the figures of the runs table are: means (± standard deviations) over every run,
+    a failed run's until it ended."""
+    spread = any(len(r.summaries) > 1 for w in runs.worlds for r in (w, *w.robots))
+    failed = any(r.rate("success") < 1 for w in runs.worlds for r in (w, *w.robots)
+                 if "success" in r.outcomes)
+    if not (spread or failed):
+        return ""
+    what = "mean ± standard deviation" if spread else "means"
+    note = f"\n(time, path, min clear and speed: {what} over {'every run' if failed else 'the runs'}"
+    if failed:
+        note += (", a collision's or a timeout's until it ended; `mitos compare` takes time and "
+                 "path over the successful runs")
+    return note + ")"
 
 
 def _draw_runs(result, world, plot: Path):
