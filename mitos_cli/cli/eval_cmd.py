@@ -147,28 +147,11 @@ def eval_command(
              "fuzzylite (cell midpoints, the file's resolution).")] = None,
 ) -> None:
     """Evaluate a rule base: fuzzified inputs, fired rules with DOFs, crisp outputs."""
-    from ..api import load_rulebase
-
     on_no_rule = (None if on_no_rule_name is None
                   else choice(NoRule, on_no_rule_name, "--on-no-rule policy"))
     fidelity = None if fidelity_name is None else choice(Engine, fidelity_name, "engine")
     path, values = split_args(args or [])
-    if path is not None and Path(path).suffix.lower() not in (".rules", ".fcl", ".fis", ".fll") \
-            and not Path(path).exists():    # `mitos eval road78 size=45`: a lost `=`
-        from ..fileio import nearby
-
-        close = nearby(path)
-        raise typer.BadParameter(f"`{path}` is neither a rule file nor NAME=VALUE (no file "
-                                 f"of that name; write each input as NAME=VALUE)"
-                                 + (f"; {close}" if close else ""))
-    rb = load_rulebase(path, behavior)
-    warn_notes(rb.rulebase)
-    if fidelity is not None:
-        from ..api import LoadedRuleBase
-        from ..interop.common import fidelity_settings
-
-        rb = LoadedRuleBase(rb.rulebase, behavior,
-                            fidelity_settings(rb.rulebase, fidelity.value, behavior))
+    rb = _loaded(path, behavior, fidelity)
     if network:
         if batch is not None or values or as_json:
             raise typer.BadParameter("--network prints the rule base's network and evaluates "
@@ -190,6 +173,35 @@ def eval_command(
     if not values:
         raise typer.BadParameter(
             "give one NAME=VALUE per input: " + " ".join(f"{k}=..." for k in rb.inputs))
+    _evaluate_one(rb, values, as_json, digits)
+
+
+def _loaded(path: str | None, behavior: str | None, fidelity):
+    """The rule base (the packaged one without ``path``), its notes said, read as the engine
+    ``fidelity`` names where one is asked for; a lone word that is no file is a lost ``=``."""
+    from ..api import LoadedRuleBase, load_rulebase
+
+    if path is not None and Path(path).suffix.lower() not in (".rules", ".fcl", ".fis", ".fll") \
+            and not Path(path).exists():    # `mitos eval road78 size=45`: a lost `=`
+        from ..fileio import nearby
+
+        close = nearby(path)
+        raise typer.BadParameter(f"`{path}` is neither a rule file nor NAME=VALUE (no file "
+                                 f"of that name; write each input as NAME=VALUE)"
+                                 + (f"; {close}" if close else ""))
+    rb = load_rulebase(path, behavior)
+    warn_notes(rb.rulebase)
+    if fidelity is None:
+        return rb
+    from ..interop.common import fidelity_settings
+
+    return LoadedRuleBase(rb.rulebase, behavior,
+                          fidelity_settings(rb.rulebase, fidelity.value, behavior))
+
+
+def _evaluate_one(rb, values: dict[str, str], as_json: bool, digits: int | None) -> None:
+    """One sample from its ``NAME=VALUE`` texts: its trace (or JSON), and warnings on stderr for
+    clamped inputs, outputs outside their universes and undersampled terms that fired."""
     from ..engine.evaluation import as_batch, evaluate
     from ..engine.trace import trace_of
 
