@@ -636,3 +636,64 @@ def test_road_and_side_gaps_from_one_reduction_are_the_plain_minima():
                                      least(near & (b < 0), -b, 0.0) - half[:, 0], 200.0))
         assert same(got[1], np.where((near & (b > 0)).any(axis=1),
                                      least(near & (b > 0), b, 0.0) - half[:, 0], 200.0))
+
+
+def test_chords_cleared_from_the_squares_are_those_hypot_clears():
+    rng = np.random.default_rng(11)
+    dx, dy = rng.normal(0, 20, (2, 40, 30, 9))
+    radius, need = rng.uniform(0, 2, (40, 1)), rng.uniform(0, 30, (40, 1))
+    plain = np.hypot(dx, dy).min(axis=1)
+    # chords exactly on the line, a rounding either side of it, and a few odd values
+    need[:10] = plain[:10, :1] - radius[:10]
+    need[10:20] = np.nextafter(plain[10:20, :1] - radius[10:20], np.inf)
+    need[20:25] = np.nextafter(plain[20:25, :1] - radius[20:25], -np.inf)
+    dx[25, 0, 0], dy[26, 3, 2], dx[27, :, :] = np.nan, np.inf, 1e-170
+    dy[27, :, :] = 1e-170
+    dx[28, :, 1], dy[28, :, 1] = 1e200, 1e200
+    got = perception._clear_of(dx, dy, radius, need)
+    assert np.array_equal(got, np.hypot(dx, dy).min(axis=1) - radius >= need)
+
+
+def plain_pursuit_point(a: perception.Aim, cfg: perception.Settings):
+    """The pursuit point measured against every cell, with hypot (as it was written)."""
+    ahead = perception._lookaheads(cfg)
+    if not len(a.cells):
+        return float(ahead[-1]), perception.target_point(a.route, a.f, cfg, float(ahead[-1]))
+    q = perception.target_points(a.route, a.f, ahead)
+    e = q - a.p
+    ee = np.maximum(e[:, 0] * e[:, 0] + e[:, 1] * e[:, 1], 1e-12)
+    rel = a.cells - a.p
+    rx, ry = rel[:, 0, None], rel[:, 1, None]
+    t = np.clip((rx * e[:, 0] + ry * e[:, 1]) / ee, 0.0, 1.0)
+    clear = np.hypot(rx - t * e[:, 0], ry - t * e[:, 1]).min(axis=0) - a.radius >= a.need
+    k = len(ahead) - 1 if clear.all() else max(int(clear.argmin()) - 1, 0)
+    return float(ahead[k]), q[k]
+
+
+def test_pursuit_points_from_the_cells_near_their_chords_are_those_of_every_cell():
+    sims = running("slalom.yaml", ticks=60)
+    aims = []
+    for sim in sims:
+        s = sim.sense()
+        aims += sim.aims(s, perception.frames(*sim.framing(s)))
+    cfg = sims[0].settings
+    rng = np.random.default_rng(5)
+    made = []
+    for a in aims:
+        q = perception.target_points(a.route, a.f, perception._lookaheads(cfg))
+        for _ in range(30):      # cells about the chords, some at the box's edge, some far
+            k = int(rng.integers(1, 40))
+            on = q[rng.integers(0, len(q), k)] * rng.uniform(0, 1, (k, 1)) \
+                + a.p * rng.uniform(0, 1, (k, 1))
+            along = on + rng.normal(0, a.need + a.radius, (k, 2))
+            if rng.random() < 0.3:
+                along[0] = q[-1] + [a.need + a.radius, 0.0]
+            made.append(dataclasses.replace(a, cells=np.concatenate([a.cells, along])))
+    made += [dataclasses.replace(made[0], cells=np.full((3, 2), np.nan))]
+    ahead, targets = perception.pursuit_points(made, cfg)
+    for i, a in enumerate(made):
+        one, target = plain_pursuit_point(a, cfg)
+        assert same(one, ahead[i]) and same(target, targets[i])
+        alone = perception.pursuit_point(a.route, a.f, a.p, a.cells, a.radius, a.need, cfg)
+        assert same(alone[0], one) and same(alone[1], target)
+    assert len({float(x) for x in ahead}) > 3          # short lookaheads among them

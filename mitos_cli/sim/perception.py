@@ -446,41 +446,53 @@ _FAR = 1e12
 
 def pursuit_points(aims: list[Aim], cfg: Settings) -> tuple[np.ndarray, np.ndarray]:
     """:func:`pursuit_point` of every robot at once (runs in lockstep, each robot with its
-    own route and cells): the lookaheads ``[R]`` and the points ``[R, 2]``. The cells are
-    padded far away and every product is written out elementwise, so a robot gets the bits
-    it gets alone, in any batch."""
+    own route and cells): the lookaheads ``[R]`` and the points ``[R, 2]``. Only the cells
+    near a robot's chords are measured (:func:`_near_chords`: mostly none, and then every
+    chord is clear); they are padded far away and every product is written out
+    elementwise, so a robot gets the bits it gets alone, in any batch."""
     ahead = _lookaheads(cfg)
     if len(aims) == 1:
         one, target = _pursuit_one(aims[0], ahead, cfg)
         return np.array([one]), target[None]
     out_ahead = np.full(len(aims), float(ahead[-1]))
     targets = np.empty((len(aims), 2))
-    have = []
+    have, have_i = [], []
     for i, a in enumerate(aims):
         if len(a.cells):
             have.append(a)
+            have_i.append(i)
         else:
             targets[i] = target_point(a.route, a.f, cfg, float(ahead[-1]))
     if not have:
         return out_ahead, targets
     q = np.stack([target_points(a.route, a.f, ahead) for a in have])         # [H, J, 2]
-    p = np.stack([a.p for a in have])[:, None]                                # [H, 1, 2]
-    e = q - p
-    ee = np.maximum(e[..., 0] * e[..., 0] + e[..., 1] * e[..., 1], 1e-12)     # [H, J]
-    rel = np.full((len(have), max(len(a.cells) for a in have), 2), _FAR)
+    targets[have_i] = q[:, -1]                                  # where every chord is clear
+    cells = np.full((len(have), max(len(a.cells) for a in have), 2), _FAR)
     for j, a in enumerate(have):
-        rel[j, :len(a.cells)] = a.cells
-    rel -= p                                                                  # [H, P, 2]
-    rx, ry = rel[..., 0, None], rel[..., 1, None]                             # [H, P, 1]
-    ex, ey = e[:, None, :, 0], e[:, None, :, 1]                               # [H, 1, J]
-    t = clip_arrays((rx * ex + ry * ey) / ee[:, None], 0.0, 1.0)              # [H, P, J]
-    gap = np.hypot(rx - t * ex, ry - t * ey).min(axis=1)                      # [H, J]
-    clear = (gap - np.array([a.radius for a in have])[:, None]
-             >= np.array([a.need for a in have])[:, None])
-    have_i = np.array([i for i, a in enumerate(aims) if len(a.cells)])
+        cells[j, :len(a.cells)] = a.cells
+    p = np.stack([a.p for a in have])                                         # [H, 2]
+    near = _near_chords(cells, p, q, np.array([a.need + a.radius for a in have]))
+    some = near.any(axis=1).nonzero()[0]
+    if not len(some):
+        return out_ahead, targets
+    # the rows with cells near their chords, those cells first (the others padded far away)
+    near, q, p = near[some], q[some], p[some, None]                           # p [S, 1, 2]
+    order = np.argsort(~near, axis=1, kind="stable")[:, :int(near.sum(axis=1).max())]
+    rel = np.take_along_axis(cells[some], order[..., None], axis=1)
+    rel[~np.take_along_axis(near, order, axis=1)] = _FAR
+    rel -= p                                                                  # [S, P, 2]
+    e = q - p
+    ee = np.maximum(e[..., 0] * e[..., 0] + e[..., 1] * e[..., 1], 1e-12)     # [S, J]
+    rx, ry = rel[..., 0, None], rel[..., 1, None]                             # [S, P, 1]
+    ex, ey = e[:, None, :, 0], e[:, None, :, 1]                               # [S, 1, J]
+    t = clip_arrays((rx * ex + ry * ey) / ee[:, None], 0.0, 1.0)              # [S, P, J]
+    clear = _clear_of(rx - t * ex, ry - t * ey,
+                      np.array([have[j].radius for j in some])[:, None],
+                      np.array([have[j].need for j in some])[:, None])       # [S, J]
     k = np.where(clear.all(axis=1), len(ahead) - 1, np.maximum(clear.argmin(axis=1) - 1, 0))
-    out_ahead[have_i] = ahead[k]
-    targets[have_i] = q[np.arange(len(have)), k]
+    rows = np.array(have_i)[some]
+    out_ahead[rows] = ahead[k]
+    targets[rows] = q[np.arange(len(some)), k]
     return out_ahead, targets
 
 
@@ -489,16 +501,61 @@ def _pursuit_one(a: Aim, ahead: np.ndarray, cfg: Settings) -> tuple[float, np.nd
     if not len(a.cells):
         return float(ahead[-1]), target_point(a.route, a.f, cfg, float(ahead[-1]))
     q = target_points(a.route, a.f, ahead)                                    # [J, 2]
+    near = _near_chords(a.cells[None], a.p[None], q[None], np.array([a.need + a.radius]))[0]
+    if not np.count_nonzero(near):
+        return float(ahead[-1]), q[-1]
     e = q - a.p
     ee = np.maximum(e[:, 0] * e[:, 0] + e[:, 1] * e[:, 1], 1e-12)
-    rel = a.cells - a.p                                                       # [P, 2]
+    rel = a.cells[near] - a.p                                                 # [P, 2]
     rx, ry = rel[:, 0, None], rel[:, 1, None]
     t = clip_arrays((rx * e[:, 0] + ry * e[:, 1]) / ee, 0.0, 1.0)             # [P, J]
-    clear = np.hypot(rx - t * e[:, 0], ry - t * e[:, 1]).min(axis=0) - a.radius >= a.need
+    clear = _clear_of((rx - t * e[:, 0])[None], (ry - t * e[:, 1])[None],
+                      np.full((1, 1), a.radius), np.full((1, 1), a.need))[0]
     if clear.all():
         return float(ahead[-1]), q[-1]
     k = max(int(clear.argmin()) - 1, 0)
     return float(ahead[k]), q[k]
+
+
+def _near_chords(cells: np.ndarray, p: np.ndarray, q: np.ndarray,
+                 reach: np.ndarray) -> np.ndarray:
+    """``[H, P]``: which ``cells [H, P, 2]`` are not plainly clear of every chord from
+    ``p [H, 2]`` to the points ``q [H, J, 2]``: those in the box round the chords grown by
+    ``reach [H]`` (the need plus the discs' radius) and a margin far above rounding. A cell
+    outside it is farther than ``reach`` from every chord, so it never decides whether a
+    chord is clear, and leaving it out gives every chord the same answer (a NaN is kept)."""
+    lo = np.minimum(q.min(axis=1), p)                                         # [H, 2]
+    hi = np.maximum(q.max(axis=1), p)
+    grow = (reach + 1e-6 * (1.0 + np.abs(reach) + np.abs(lo).max(axis=1)
+                            + np.abs(hi).max(axis=1)))[:, None]
+    lo, hi = (lo - grow)[:, None], (hi + grow)[:, None]
+    return ~((cells < lo) | (cells > hi)).any(axis=2)
+
+
+#: How far (relative) a chord's clearance from the squares of the gaps may lie off the one
+#: from ``np.hypot`` (a few rounding errors, ~1e-15) before :func:`_clear_of` asks hypot.
+_ROUNDING = 1e-9
+
+
+def _clear_of(dx: np.ndarray, dy: np.ndarray, radius: np.ndarray,
+              need: np.ndarray) -> np.ndarray:
+    """``np.hypot(dx, dy).min(axis=1) - radius >= need`` (gaps ``[H, P, J]``, ``radius`` and
+    ``need`` ``[H, 1]``): whether each chord ``[H, J]`` keeps ``need`` from every disc. The
+    least gap is found from the squares (``np.hypot`` costs some 30 times a product); only a
+    chord whose answer lies within rounding of the line (or is NaN) is measured with hypot,
+    so each answer is the plain formula's."""
+    with np.errstate(over="ignore"):            # a square past 1e308 is asked of hypot
+        squares = dx * dx
+        squares += dy * dy
+    least = np.sqrt(np.minimum.reduce(squares, axis=1))                      # [H, J]
+    over = least - radius - need
+    band = _ROUNDING * (least + np.abs(radius) + np.abs(need)) + 1e-100     # tiny: underflow
+    clear = over > band
+    unsure = ~(clear | (over < -band))
+    if np.count_nonzero(unsure):
+        h, j = unsure.nonzero()
+        clear[h, j] = np.hypot(dx[h, :, j], dy[h, :, j]).min(axis=1) - radius[h, 0] >= need[h, 0]
+    return clear
 
 
 def route_room(f: Frame, p: np.ndarray, cells: np.ndarray, radius: float,
