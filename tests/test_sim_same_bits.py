@@ -697,3 +697,20 @@ def test_pursuit_points_from_the_cells_near_their_chords_are_those_of_every_cell
         alone = perception.pursuit_point(a.route, a.f, a.p, a.cells, a.radius, a.need, cfg)
         assert same(alone[0], one) and same(alone[1], target)
     assert len({float(x) for x in ahead}) > 3          # short lookaheads among them
+
+
+def test_free_ways_of_many_rows_worked_in_blocks_are_each_rows_own():
+    rng = np.random.default_rng(13)
+    cfg = perception.Settings()
+    rows, n = 3 * perception.CACHED // (39 * 36) + 7, 36        # three blocks and a part
+    robots = [Robot(length=float(rng.uniform(10, 30)), width=float(rng.uniform(8, 24)))
+              for _ in range(rows)]
+    ah, bh = rng.normal(0, 40.0, (2, rows, n))
+    widen = np.abs(rng.normal(0, 3, (rows, n)))
+    unknown = rng.random((rows, n)) < 0.4
+    bearing = rng.uniform(-200, 200, rows)
+    got = perception.free_ways_rows(ah, bh, widen, unknown, robots, cfg, bearing)
+    for i in range(rows):
+        one = perception.free_ways_rows(ah[i:i + 1], bh[i:i + 1], widen[i:i + 1],
+                                        unknown[i:i + 1], robots[i:i + 1], cfg, bearing[i:i + 1])
+        assert same(got[0][i], one[0][0]) and same(got[1][i], one[1][0])

@@ -261,7 +261,30 @@ def free_ways_rows(ah: np.ndarray, bh: np.ndarray, widen: np.ndarray, unknown: n
 def _free_ways(ah: np.ndarray, bh: np.ndarray, widen: np.ndarray, unknown: np.ndarray,
                body: dict[str, np.ndarray], cfg: Settings,
                route_bearing: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`free_ways_rows` of robots whose :func:`_bodies` are ``body``."""
+    """:func:`free_ways_rows` of robots whose :func:`_bodies` are ``body``, a block of rows
+    at a time (:data:`CACHED`: a lockstep batch of hundreds of robots spills its
+    ``[rows, ways, points]`` arrays out of a core's cache, which costs more than the calls
+    the blocks repeat; each row's arithmetic is its own)."""
+    rows = max(1, CACHED // (len(body["ways"]) * max(ah.shape[1], 1)))
+    if len(ah) <= rows:
+        return _free_ways_block(ah, bh, widen, unknown, body, cfg, route_bearing)
+    parts = [_free_ways_block(ah[i:i + rows], bh[i:i + rows], widen[i:i + rows],
+                              unknown[i:i + rows],
+                              {k: v if k == "ways" else v[i:i + rows] for k, v in body.items()},
+                              cfg, route_bearing[i:i + rows])
+             for i in range(0, len(ah), rows)]
+    return np.concatenate([f for f, _ in parts]), np.concatenate([o for _, o in parts])
+
+
+#: Elements (floats) in one of the largest arrays a batched stage works a block of rows on:
+#: 512 kB, so the block's arrays stay in a core's cache.
+CACHED = 1 << 16
+
+
+def _free_ways_block(ah: np.ndarray, bh: np.ndarray, widen: np.ndarray, unknown: np.ndarray,
+                     body: dict[str, np.ndarray], cfg: Settings,
+                     route_bearing: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`_free_ways` of one block of rows."""
     length = body["length"][:, 0]
     base = body["ways"]
     ways = np.empty((len(ah), len(base)))                                  # [R, W]
