@@ -74,26 +74,21 @@ class Lockstep:
         planner = self.planner
         if not isinstance(planner, FuzzyPlanner) or not live:
             return [None] * len(live)
-        active = [run.active for run in live]
+        active = np.concatenate([run.active for run in live])    # [all robots of all runs]
         compiled = planner.compiled
-        X = np.empty((sum(int(a.sum()) for a in active), len(compiled.inputs)))
-        for j, key in enumerate(compiled.inputs):
-            X[:, j] = np.concatenate([s.inputs[key][a] for s, a in zip(seen, active)])
+        X = np.empty((np.count_nonzero(active), len(compiled.inputs)))
         if len(X) == 0:
             return [None] * len(live)
+        for j, key in enumerate(compiled.inputs):
+            X[:, j] = np.concatenate([s.inputs[key] for s in seen])[active]
         from ..engine.evaluation import evaluate
 
         out = evaluate(compiled, X, detail=False).outputs
-        steer, speed = (out[:, compiled.outputs.index(k)] for k in ("steering", "speed"))
-        commands: list[np.ndarray | None] = []
-        row = 0
-        for run, a in zip(live, active):
-            cmd = np.zeros((run.n, 2))
-            count = int(a.sum())
-            cmd[a, 0], cmd[a, 1] = steer[row:row + count], speed[row:row + count]
-            row += count
-            commands.append(cmd)
-        return commands
+        commands = np.zeros((len(active), 2))
+        for j, key in enumerate(("steering", "speed")):
+            commands[active, j] = out[:, compiled.outputs.index(key)]
+        stops = np.cumsum([run.n for run in live]).tolist()
+        return [commands[stop - run.n:stop] for run, stop in zip(live, stops)]
 
 
 def _observe_together(runs: list[Simulation]) -> list:
