@@ -410,12 +410,13 @@ def test_a_maps_near_cells_read_from_the_last_square_are_the_cells_of_a_fresh_lo
             assert same(kept.near(p, reach, given), fresh.near(p, reach, given))
 
 
-def test_distances_from_many_routes_at_once_are_each_routes_own():
+@pytest.mark.parametrize("rows", [7, 400])             # 400: rows worked in blocks
+def test_distances_from_many_routes_at_once_are_each_routes_own(rows):
     rng = np.random.default_rng(9)
-    routes = [route.Route.of(np.cumsum(rng.normal(0, 40, (int(rng.integers(2, 12)), 2)),
-                                       axis=0)) for _ in range(7)]
+    routes = [route.Route.of(np.cumsum(rng.normal(0, 40, (int(rng.integers(2, 40)), 2)),
+                                       axis=0)) for _ in range(rows)]
     s = [float(rng.uniform(-20, r.length + 20)) for r in routes]
-    points = rng.normal(0, 150, (7, 36, 2))
+    points = rng.normal(0, 150, (rows, 36, 2))
     got = route.distances(routes, s, 120.0, points)
     for i, r in enumerate(routes):
         assert same(got[i], r.distance(points[i], s[i], 120.0))

@@ -88,7 +88,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .geometry import clip_arrays
+from .geometry import CACHED, clip_arrays
 from .route import Route, distances, projections
 from .world import Robot
 
@@ -274,11 +274,6 @@ def _free_ways(ah: np.ndarray, bh: np.ndarray, widen: np.ndarray, unknown: np.nd
                               cfg, route_bearing[i:i + rows])
              for i in range(0, len(ah), rows)]
     return np.concatenate([f for f, _ in parts]), np.concatenate([o for _, o in parts])
-
-
-#: Elements (floats) in one of the largest arrays a batched stage works a block of rows on:
-#: 512 kB, so the block's arrays stay in a core's cache.
-CACHED = 1 << 16
 
 
 def _free_ways_block(ah: np.ndarray, bh: np.ndarray, widen: np.ndarray, unknown: np.ndarray,

@@ -19,7 +19,7 @@ import numpy as np
 
 from ..errors import WorldError
 from .distance import _capped, distance_transform
-from .geometry import clip_arrays, point_segment_distance
+from .geometry import CACHED, clip_arrays, point_segment_distance
 from .staticmap import StaticMap
 from .world import Corridor, Goal, Grid, Pose, Robot
 
@@ -231,7 +231,9 @@ def distances(routes: Sequence[Route], s: Sequence[float], ahead: float,
     """:meth:`Route.distance` of every row at once: row ``i``'s points ``[R, K, 2]`` from
     ``routes[i]`` between arc lengths ``s[i]`` and ``s[i] + ahead``, ``[R, K]``. Each row's
     segments are padded with copies of its last one (which the minimum cannot tell from
-    it), so a point gets the bits it gets from its route alone."""
+    it), so a point gets the bits it gets from its route alone; the sums over x and y are
+    written out (a sum of two is one addition) and the rows are worked a block at a time
+    (:data:`.geometry.CACHED`)."""
     if len(routes) == 1:
         return routes[0].distance(points[0], s[0], ahead)[None]
     spans = [route._window(si, si + ahead) for route, si in zip(routes, s)]
@@ -248,11 +250,18 @@ def distances(routes: Sequence[Route], s: Sequence[float], ahead: float,
         a[j, :stop - first], b[j, :stop - first] = pts[first:stop], pts[first + 1:stop + 1]
         a[j, stop - first:], b[j, stop - first:] = pts[stop - 1], pts[stop]
     e = b - a                                                  # [H, M, 2]
-    ee = np.maximum((e * e).sum(axis=2), 1e-12)
-    rel = points[rows][:, :, None] - a[:, None]                # [H, K, M, 2]
-    t = clip_arrays((rel * e[:, None]).sum(axis=3) / ee[:, None], 0.0, 1.0)
-    d = rel - t[..., None] * e[:, None]
-    out[rows] = np.sqrt((d * d).sum(axis=3).min(axis=2))
+    ee = np.maximum(e[..., 0] * e[..., 0] + e[..., 1] * e[..., 1], 1e-12)
+    block = max(1, CACHED // (points.shape[1] * width))
+    for lo in range(0, len(rows), block):
+        hi = min(lo + block, len(rows))
+        at = rows[lo:hi]
+        px, py = points[at, :, 0, None], points[at, :, 1, None]             # [h, K, 1]
+        ax, ay = a[lo:hi, None, :, 0], a[lo:hi, None, :, 1]                # [h, 1, M]
+        ex, ey = e[lo:hi, None, :, 0], e[lo:hi, None, :, 1]
+        rx, ry = px - ax, py - ay                                          # [h, K, M]
+        t = clip_arrays((rx * ex + ry * ey) / ee[lo:hi, None], 0.0, 1.0)
+        dx, dy = rx - t * ex, ry - t * ey
+        out[at] = np.sqrt(np.minimum.reduce(dx * dx + dy * dy, axis=2))
     return out
 
 
