@@ -265,7 +265,7 @@ def distances(routes: Sequence[Route], s: Sequence[float], ahead: float,
     return out
 
 
-def _path(came: dict[int, int], node: int) -> list[int]:
+def _path(came: dict[int, int] | list[int], node: int) -> list[int]:
     """The nodes from the start to ``node``, following ``came`` (the start's entry is -1)."""
     path = [node]
     while came[path[-1]] != -1:
@@ -722,13 +722,13 @@ def _grid_astar(allowed: memoryview, costs: memoryview, offsets: list[int], C: i
     size = len(costs) // len(offsets)
     target = divmod(goal, C)
     frontier = [(0.0, 0, start)]
-    came = {start: -1}
-    cost = {start: 0.0}
-    known = cost.get
+    came = [-1] * size                   # lists by node: cheaper to read than dicts
+    cost = [math.inf] * size
+    cost[start] = 0.0
     tie = 0
     moves = [(m * size, off) for m, off in enumerate(offsets)]
     # the loop's names bound locally: the loop runs thousands of times a search
-    pop, push, dist, inf = heapq.heappop, heapq.heappush, math.dist, math.inf
+    pop, push, dist = heapq.heappop, heapq.heappush, math.dist
     while frontier:
         node = pop(frontier)[2]
         if node == goal:
@@ -738,7 +738,7 @@ def _grid_astar(allowed: memoryview, costs: memoryview, offsets: list[int], C: i
             if allowed[base + node]:
                 nxt = node + off
                 c = here + costs[base + node]
-                if c < known(nxt, inf):
+                if c < cost[nxt]:
                     cost[nxt] = c
                     came[nxt] = node
                     tie += 1
