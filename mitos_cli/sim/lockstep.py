@@ -26,6 +26,9 @@ from .loop import Scene, SimResult, Simulation, shared_scene
 from .planner import FuzzyPlanner, Planner
 from .world import World
 
+#: The row of each input in a tick's block of inputs (:data:`.perception.INPUTS` order).
+_ROW = {key: j for j, key in enumerate(perception.INPUTS)}
+
 #: Runs stepped together by default: enough to make the batched calls worth their set-up,
 #: few enough that the runs' recorded ticks stay small.
 BATCH = 64
@@ -79,8 +82,9 @@ class Lockstep:
         X = np.empty((np.count_nonzero(active), len(compiled.inputs)))
         if len(X) == 0:
             return [None] * len(live)
+        blocks = np.concatenate([s.block for s in seen], axis=1)        # [inputs, robots]
         for j, key in enumerate(compiled.inputs):
-            X[:, j] = np.concatenate([s.inputs[key] for s in seen])[active]
+            X[:, j] = blocks[_ROW[key], active]
         from ..engine.evaluation import evaluate
 
         out = evaluate(compiled, X, detail=False).outputs
@@ -125,8 +129,9 @@ def _observe_together(runs: list[Simulation]) -> list:
             ticks.append((run, s, mine_, start, stop))
             sights += mine_
         inputs = perception.perceive_rows(sights, world.sensors.range, fresh[0].settings)
+        block = np.stack([inputs[key] for key in perception.INPUTS])     # [inputs, robots]
         for run, s, mine_, start, stop in ticks:
-            run.perceived(s, mine_, {k: v[start:stop] for k, v in inputs.items()})
+            run.perceived(s, mine_, block[:, start:stop])
             run.conclude(s)
     return [run.observe() for run in runs]
 

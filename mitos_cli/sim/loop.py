@@ -285,6 +285,7 @@ class _Sensed:
     targets: np.ndarray
     clearance: np.ndarray
     command: np.ndarray             # [n, 2] filled by the plan stage
+    block: np.ndarray               # [inputs, n]: the rows ``inputs`` holds, one block
 
 
 class Simulation:
@@ -650,7 +651,7 @@ class Simulation:
         inputs = np.zeros((len(perception.INPUTS), n))      # one block, a row per input
         return _Sensed(self.time, self._where, pose, got.ranges,
                        dict(zip(perception.INPUTS, inputs)), np.zeros((n, 2)),
-                       got.clearance, np.zeros((n, 2)))
+                       got.clearance, np.zeros((n, 2)), inputs)
 
     def _joined(self, i: int, walls: np.ndarray, sides: np.ndarray) -> np.ndarray:
         """Robot ``i``'s nearby walls and then the obstacle sides as one array, kept while
@@ -753,11 +754,15 @@ class Simulation:
         return out
 
     def perceived(self, s: _Sensed, sights: list[perception.Sight],
-                  inputs: dict[str, np.ndarray]) -> None:
-        """Record the robots' inputs (their rows of :func:`.perception.perceive_rows`) and
-        target points in tick ``s``."""
-        for key in perception.INPUTS:
-            s.inputs[key][:] = inputs[key]
+                  inputs: dict[str, np.ndarray] | np.ndarray) -> None:
+        """Record the robots' inputs (their rows of :func:`.perception.perceive_rows`, or
+        those as one block ``[inputs, n]`` in :data:`.perception.INPUTS` order: runs in
+        lockstep copy theirs at once) and target points in tick ``s``."""
+        if isinstance(inputs, np.ndarray):
+            s.block[:] = inputs
+        else:
+            for key in perception.INPUTS:
+                s.inputs[key][:] = inputs[key]
         for i, sight in enumerate(sights):
             s.targets[i] = sight.target
 
