@@ -416,12 +416,21 @@ def _walls_near(a, across, valid, body: dict[str, np.ndarray], cfg: Settings,
 def _common(route: Route, p, heading: float, f: Frame, road: float, robot: Robot,
             cfg: Settings, target: np.ndarray, room: float) -> tuple[float, float, float]:
     d = target - p
-    bearing = math.degrees(math.atan2(d[1], d[0]) - heading)
+    return _common_of(float(d[0]), float(d[1]), heading, route.length - f.s, f.e,
+                      float(np.hypot(*(route.goal - p))), road, robot, cfg, room)
+
+
+def _common_of(dx: float, dy: float, heading: float, left: float, e: float, home: float,
+               road: float, robot: Robot, cfg: Settings,
+               room: float) -> tuple[float, float, float]:
+    """:func:`_common` from the target's offset ``(dx, dy)``, the route ``left`` ahead, the
+    offset ``e`` off it and the straight distance ``home`` to the goal (Python floats: the
+    rows' differences and distances are worked out together, then these row by row)."""
+    bearing = math.degrees(math.atan2(dy, dx) - heading)
     bearing = (bearing + 180.0) % 360.0 - 180.0
     road_l = min(road, cfg.road_cap)
     offset = max(0.0, min(road_l / 4, road_l / 2 - robot.width / 2 - cfg.lane_margin, room))
-    goal = max(route.length - f.s, float(np.hypot(*(route.goal - p))))
-    return -bearing, f.e - offset, goal
+    return -bearing, e - offset, max(left, home)
 
 
 def clear_lookahead(route: Route, f: Frame, p: np.ndarray, cells: np.ndarray, radius: float,
@@ -690,16 +699,22 @@ def perceive_rows(rows: list[Sight], max_range: float,
     size, position, distance = _obstruction_rows(
         [r.route for r in rows], [r.f for r in rows], a, b, hits, obstructing,
         widen, robots, cfg, ah, bh, [r.kept for r in rows], body)
-    common = np.array([_common(r.route, p[i], r.pose[2], r.f, float(road[i]), r.robot, cfg,
-                               r.target, r.room) for i, r in enumerate(rows)])
+    d = np.array([r.target for r in rows]) - p                          # to the targets
+    home = np.array([r.route.goal for r in rows]) - p                    # to the goals
+    far, dx, dy = np.hypot(d[:, 0], d[:, 1]).tolist(), d[:, 0].tolist(), d[:, 1].tolist()
+    common = np.array([_common_of(dx[i], dy[i], r.pose[2], r.route.length - r.f.s, r.f.e,
+                                  gone, road_i, r.robot, cfg, r.room)
+                       for i, (r, gone, road_i) in enumerate(
+                           zip(rows, np.hypot(home[:, 0], home[:, 1]).tolist(),
+                               road.tolist()))])
     heading = common[:, 0]
     wl, wr = _or(walls, max_range, body["half"][:, 0])                    # (_walls_rows)
     front, opening = _free_ways(valid_ah, valid_bh, widen, obstacle_hit, body, cfg, heading)
     ring = np.array([len(r.dirs) > 2 and float(r.dirs[0] @ r.dirs[-1])
                      >= float(r.dirs[0] @ r.dirs[1]) - 1e-9 for r in rows])
     return {"road": road, "size": size, "position": position, "obstacle": distance,
-            "heading": np.array([pursuit(r.route, r.f, p[i], heading[i], cfg, r.lookahead,
-                                         r.target) for i, r in enumerate(rows)]),
+            "heading": np.array([_pursuit_of(bearing, distance, cfg)
+                                 for bearing, distance in zip(heading.tolist(), far)]),
             "lane": common[:, 1], "goal": common[:, 2], "gap_left": wl, "gap_right": wr,
             "front": front, "opening": opening,
             "clutter": clutter_rows(hits, obstacle_hit, ah, cfg, ring),
@@ -806,8 +821,14 @@ def pursuit(route: Route, f: Frame, p: np.ndarray, bearing: float, cfg: Settings
         return bearing
     if target is None:
         target = target_point(route, f, cfg, cfg.lookahead if lookahead is None else lookahead)
-    distance = max(float(np.hypot(*(target - p))), 1e-9)
-    sine = min(1.0, cfg.lookahead / distance * math.sin(math.radians(abs(bearing))))
+    return _pursuit_of(bearing, float(np.hypot(*(target - p))), cfg)
+
+
+def _pursuit_of(bearing: float, distance: float, cfg: Settings) -> float:
+    """:func:`pursuit` of a target point ``distance`` away (Python floats)."""
+    if abs(bearing) >= 90.0:
+        return bearing
+    sine = min(1.0, cfg.lookahead / max(distance, 1e-9) * math.sin(math.radians(abs(bearing))))
     return math.copysign(math.degrees(math.asin(sine)), bearing)
 
 
