@@ -551,12 +551,12 @@ def _near_chords(cells: np.ndarray, p: np.ndarray, q: np.ndarray,
     ``reach [H]`` (the need plus the discs' radius) and a margin far above rounding. A cell
     outside it is farther than ``reach`` from every chord, so it never decides whether a
     chord is clear, and leaving it out gives every chord the same answer (a NaN is kept)."""
-    lo = np.minimum(q.min(axis=1), p)                                         # [H, 2]
-    hi = np.maximum(q.max(axis=1), p)
-    grow = (reach + 1e-6 * (1.0 + np.abs(reach) + np.abs(lo).max(axis=1)
-                            + np.abs(hi).max(axis=1)))[:, None]
-    lo, hi = (lo - grow)[:, None], (hi + grow)[:, None]
-    return ~((cells < lo) | (cells > hi)).any(axis=2)
+    ends = np.concatenate([q, p[:, None]], axis=1)                            # [H, J + 1, 2]
+    grow = (reach + 1e-6 * (1.0 + np.abs(reach)
+                            + np.maximum.reduce(np.abs(ends), axis=(1, 2))))[:, None, None]
+    lo = np.minimum.reduce(ends, axis=1, keepdims=True) - grow                # [H, 1, 2]
+    hi = np.maximum.reduce(ends, axis=1, keepdims=True) + grow
+    return ~np.logical_or.reduce((cells < lo) | (cells > hi), axis=2)
 
 
 #: How far (relative) a chord's clearance from the squares of the gaps may lie off the one
