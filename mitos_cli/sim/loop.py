@@ -365,6 +365,7 @@ class Simulation:
         self.dt = world.dt
         self.steps = int(math.floor(world.time_limit / self.dt + 1e-9))
         self._goals = np.array([[a.goal.x, a.goal.y] for a in world.agents], float)
+        self._goal_x, self._goal_y = self._goals[:, 0].copy(), self._goals[:, 1].copy()
         self._tol = np.array([a.goal.tolerance for a in world.agents], float)
         self._stuck_window = max(1, int(round(STUCK_TIME / self.dt)))
         self._given = self.scene.given or knowledge.given(world, self.scene.static)
@@ -806,11 +807,12 @@ class Simulation:
         """Contact (clearance <= 0) and arrival; an arrived robot stops driving."""
         active = self._active
         self._hit = active & (s.clearance <= 0.0)
-        arrived = active & (np.hypot(self._x - self._goals[:, 0],
-                                     self._y - self._goals[:, 1]) <= self._tol)
-        for i in np.flatnonzero(arrived):
-            self._outcomes[i] = "success"
-        active &= ~arrived
+        arrived = active & (np.hypot(self._x - self._goal_x, self._y - self._goal_y)
+                            <= self._tol)
+        if np.count_nonzero(arrived):
+            for i in arrived.nonzero()[0]:
+                self._outcomes[i] = "success"
+            active &= ~arrived
 
     def plan(self, s: _Sensed) -> None:
         """The planner's commands for the active robots, in one batch (the others: straight
@@ -868,7 +870,7 @@ class Simulation:
                free: np.ndarray) -> None:
         """:meth:`_guard` with the first sweeps of :meth:`braking` measured (``free [R]``)."""
         cfg, j = self._safety, 0
-        for i in np.flatnonzero(self._active):
+        for i in self._active.nonzero()[0]:
             if not self.robots[i].brake:
                 continue
             body, wheel, backward = sweeps[j]
