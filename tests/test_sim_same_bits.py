@@ -715,3 +715,19 @@ def test_free_ways_of_many_rows_worked_in_blocks_are_each_rows_own():
         one = perception.free_ways_rows(ah[i:i + 1], bh[i:i + 1], widen[i:i + 1],
                                         unknown[i:i + 1], robots[i:i + 1], cfg, bearing[i:i + 1])
         assert same(got[0][i], one[0][0]) and same(got[1][i], one[1][0])
+
+
+def test_cells_beyond_many_robots_readings_at_once_are_each_robots_own():
+    sims = running("slalom.yaml", runs=3, ticks=60)
+    maps, origins, dirs, measured, sensed = [], [], [], [], []
+    for sim in sims:
+        s = sim.sense()
+        m, o, d, r, _ = sim.clearing(s)
+        maps += m
+        origins.append(o), dirs.append(d), measured.append(r), sensed.append(s)
+    got = knowledge.beyond_cells(maps, *(np.concatenate(x) for x in (origins, dirs, measured)))
+    for j, (sim, s) in enumerate(zip(sims, sensed)):
+        assert same(got[j], sim._beyond(0, s))          # the one robot's own, worked alone
+    other = knowledge.RobotMap.of(Grid(np.zeros((4, 4), bool), 3.0, (0.0, 0.0), ""))
+    two = [np.concatenate([x[0], x[0]]) for x in (origins, dirs, measured)]
+    assert knowledge.beyond_cells([maps[0], other], *two) is None   # grids unlike: alone

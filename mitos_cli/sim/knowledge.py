@@ -396,6 +396,21 @@ def clear_all(maps: list[RobotMap], origins: np.ndarray, dirs: np.ndarray,
             m._free(where[mine], r[mine], c[mine])
 
 
+def beyond_cells(maps: list[RobotMap], origins: np.ndarray, dirs: np.ndarray,
+                 measured: np.ndarray) -> np.ndarray | None:
+    """The cells ``[R, B, 2]`` (:meth:`RobotMap.cell_indices`) just beyond every robot's
+    readings, where their echoes came from (robots at ``origins [R, 2]``, their beams ``dirs
+    [R, B, 2]`` and readings ``measured [R, B]``; runs in lockstep together), each the bits
+    of its own; ``None`` unless the maps share their cells' size and origin (the runs of a
+    world do)."""
+    grid = maps[0].grid
+    if any(m.grid is not grid and (m.grid.resolution != grid.resolution
+                                   or m.grid.origin != grid.origin) for m in maps):
+        return None
+    return maps[0].cell_indices(origins[:, None] + measured[..., None] * dirs
+                                + dirs * (grid.resolution / 2))
+
+
 def expected_ranges(g: Given, rmap: RobotMap | None, origin: np.ndarray, dirs: np.ndarray,
                     walls_near: np.ndarray, max_range: float) -> np.ndarray:
     """What the robot's map predicts along each beam: the given walls near it (the caller's

@@ -2,12 +2,13 @@
 
 Each tick the robots of every run still going are sensed in one pass (:func:`.rows.sense`:
 beams, noise from each robot's own stream, clearance), the marks they see through cleared
-from their maps in one pass (:func:`.knowledge.clear_all`), their pursuit points found in one
-pass (:func:`.perception.pursuit_points`) and their rule inputs perceived in one pass
+from their maps in one pass (:func:`.knowledge.clear_all`), the cells their echoes came from
+found in one pass (:func:`.knowledge.beyond_cells`), their pursuit points found in one pass
+(:func:`.perception.pursuit_points`) and their rule inputs perceived in one pass
 (:func:`.perception.perceive_rows`); what else a robot's own map and route need (marking its
-map, replanning) and its check are done run by run, with the code
-of a run alone (:class:`~mitos_cli.sim.loop.Simulation`). Then the fuzzy planner's rule network
-is evaluated once for the active robots of every run (one engine batch: the engine gives each
+map, replanning) and its check are done run by run, with the code of a run alone
+(:class:`~mitos_cli.sim.loop.Simulation`). Then the fuzzy planner's rule network is
+evaluated once for the active robots of every run (one engine batch: the engine gives each
 row the bits it gives alone), each run's brake checks its commands, and the robots of every run
 move in one batch of kinematics (elementwise per robot). Runs that end drop out. Every batched
 stage is elementwise per robot or an exact minimum, so each run's ticks, trajectory and summary
@@ -114,8 +115,12 @@ def _observe_together(runs: list[Simulation]) -> list:
         sensed = [run.sensed(got.part(start, stop)) for run, (start, stop) in zip(fresh, spans)]
         clearing = [run.clearing(s) for run, s in zip(fresh, sensed)]
         origins, dirs, measured = (np.concatenate([c[j] for c in clearing]) for j in (1, 2, 3))
-        knowledge.clear_all([m for c in clearing for m in c[0]], origins, dirs, measured,
-                            world.sensors.range)
+        maps = [m for c in clearing for m in c[0]]
+        knowledge.clear_all(maps, origins, dirs, measured, world.sensors.range)
+        beyond = knowledge.beyond_cells(maps, origins, dirs, measured)
+        if beyond is not None:
+            for run, s, (start, stop) in zip(fresh, sensed, spans):
+                run.beyond(s, beyond[start:stop])
         framing = [run.framing(s) for run, s in zip(fresh, sensed)]
         frames = perception.frames([r for f in framing for r in f[0]],
                                    np.concatenate([f[1] for f in framing]),

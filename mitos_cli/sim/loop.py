@@ -774,6 +774,12 @@ class Simulation:
             return None
         return least, self._maps[i].accounted_cells(self._beyond(i, s))
 
+    def beyond(self, s: _Sensed, cells: np.ndarray) -> None:
+        """Robot by robot, the cells just beyond its readings at tick ``s`` (``cells [n, B,
+        2]``, :func:`.knowledge.beyond_cells`: runs in lockstep work theirs out together),
+        for :meth:`_beyond` to answer with."""
+        self._beyond_at = (s, list(cells))
+
     def _beyond(self, i: int, s: _Sensed) -> np.ndarray:
         """The cells ``[B, 2]`` (:meth:`.knowledge.RobotMap.cell_indices`) just beyond robot
         ``i``'s readings at tick ``s``, where their echoes came from: what :meth:`_learn`
