@@ -731,3 +731,18 @@ def test_cells_beyond_many_robots_readings_at_once_are_each_robots_own():
     other = knowledge.RobotMap.of(Grid(np.zeros((4, 4), bool), 3.0, (0.0, 0.0), ""))
     two = [np.concatenate([x[0], x[0]]) for x in (origins, dirs, measured)]
     assert knowledge.beyond_cells([maps[0], other], *two) is None   # grids unlike: alone
+
+
+def test_route_gaps_measured_together_give_each_robots_own_room():
+    sims = running("slalom.yaml", ticks=60)
+    aims = []
+    for sim in sims:
+        s = sim.sense()
+        aims += sim.aims(s, perception.frames(*sim.framing(s)))
+    aims += [dataclasses.replace(a, cells=a.cells[:k]) for a in aims for k in (0, 1, 7)]
+    assert any(len(a.cells) > 20 for a in aims)
+    gaps = perception.route_gaps(aims)
+    for a, gap in zip(aims, gaps):
+        alone = perception.route_room(a.f, a.p, a.cells, a.radius, 9.5)
+        assert same(max(0.0, gap - a.radius - 9.5), alone)
+        assert same(perception.route_gaps([a])[0], gap)

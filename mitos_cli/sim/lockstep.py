@@ -128,9 +128,11 @@ def _observe_together(runs: list[Simulation]) -> list:
         aims = [aim for run, s, (start, stop) in zip(fresh, sensed, spans)
                 for aim in run.aims(s, frames[start:stop])]
         ahead, targets = perception.pursuit_points(aims, fresh[0].settings)
+        gaps = perception.route_gaps(aims)
         ticks, sights = [], []
         for run, s, (start, stop) in zip(fresh, sensed, spans):
-            mine_ = run.aimed(s, aims[start:stop], ahead[start:stop], targets[start:stop])
+            mine_ = run.aimed(s, aims[start:stop], ahead[start:stop], targets[start:stop],
+                              gaps[start:stop])
             ticks.append((run, s, mine_, start, stop))
             sights += mine_
         inputs = perception.perceive_rows(sights, world.sensors.range, fresh[0].settings)

@@ -740,14 +740,17 @@ class Simulation:
         return out
 
     def aimed(self, s: _Sensed, aims: list[perception.Aim], ahead: np.ndarray,
-              targets: np.ndarray) -> list[perception.Sight]:
+              targets: np.ndarray, gaps: list[float] | None = None) -> list[perception.Sight]:
         """The robots' sights from their :meth:`aims` and their pursuit points (lookaheads
         ``ahead [n]``, points ``targets [n, 2]``): how far ahead each aims and what it keeps
-        clear of."""
+        clear of (``gaps``: their :func:`.perception.route_gaps`, which runs in lockstep
+        measure together)."""
         out = []
+        if gaps is None:
+            gaps = perception.route_gaps(aims)
         for i, aim in enumerate(aims):
             least = self._asked[i][1]
-            room = perception.route_room(aim.f, aim.p, aim.cells, aim.radius, least)
+            room = max(0.0, gaps[i] - aim.radius - least)     # (perception.route_room)
             out.append(perception.Sight(
                 aim.route, aim.f, (float(self._x[i]), float(self._y[i]), float(self._h[i])),
                 self.robots[i], self._dirs[i], s.ranges[i], self._expected[i], self._spacing,

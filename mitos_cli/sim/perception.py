@@ -591,10 +591,38 @@ def route_room(f: Frame, p: np.ndarray, cells: np.ndarray, radius: float,
     within its least clearance of what it knows: the distance from the route point beside
     it to the nearest occupied cell (``cells [P, 2]``, discs of ``radius``) less ``least``
     (at least 0; ``inf`` with nothing known near)."""
+    return max(0.0, _route_gap(f, p, cells) - radius - least)
+
+
+def _route_gap(f: Frame, p: np.ndarray, cells: np.ndarray) -> float:
+    """The distance from the route point beside the robot to the nearest of ``cells``
+    (``inf`` with none): :func:`route_room` before its radius and least clearance."""
     if not len(cells):
         return math.inf
     c = p - f.e * f.n
-    return max(0.0, float(np.hypot(*(cells - c).T).min()) - radius - least)
+    return float(np.hypot(*(cells - c).T).min())
+
+
+def route_gaps(aims: list[Aim]) -> list[float]:
+    """:func:`_route_gap` of every robot's :class:`Aim` at once (runs in lockstep together):
+    the cells padded far away, the distances elementwise and their minima exact, so each
+    robot gets the bits it gets alone."""
+    if len(aims) == 1:
+        return [_route_gap(aims[0].f, aims[0].p, aims[0].cells)]
+    out = [math.inf] * len(aims)
+    have = [i for i, a in enumerate(aims) if len(a.cells)]
+    if not have:
+        return out
+    cells = np.full((len(have), max(len(aims[i].cells) for i in have), 2), _FAR)
+    for j, i in enumerate(have):
+        cells[j, :len(aims[i].cells)] = aims[i].cells
+    c = (np.array([aims[i].p for i in have])
+         - np.array([aims[i].f.e for i in have])[:, None] * np.array([aims[i].f.n for i in have]))
+    cells -= c[:, None]
+    gaps = np.minimum.reduce(np.hypot(cells[..., 0], cells[..., 1]), axis=1).tolist()
+    for i, gap in zip(have, gaps):
+        out[i] = gap
+    return out
 
 
 @functools.lru_cache(maxsize=8)
