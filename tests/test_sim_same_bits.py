@@ -746,3 +746,17 @@ def test_route_gaps_measured_together_give_each_robots_own_room():
         alone = perception.route_room(a.f, a.p, a.cells, a.radius, 9.5)
         assert same(max(0.0, gap - a.radius - 9.5), alone)
         assert same(perception.route_gaps([a])[0], gap)
+
+
+def test_robots_sharing_routes_placed_together_get_the_bits_they_get_alone():
+    rng = np.random.default_rng(14)
+    shared = [route.Route.of(np.cumsum(rng.normal(0, 30, (int(rng.integers(2, 40)), 2)),
+                                       axis=0)) for _ in range(5)]
+    routes = [shared[int(k)] for k in rng.integers(0, 5, 60)]       # each many rows' own
+    points = rng.normal(0, 150, (60, 2))
+    hints = [float(rng.uniform(-200, r.length + 200)) for r in routes]
+    together = perception.frames(routes, points, hints)
+    for r, p, hint, f in zip(routes, points, hints, together):
+        alone = perception.frame(r, p, hint)
+        assert same(alone.s, f.s) and same(alone.e, f.e)
+        assert same(alone.t, f.t) and same(alone.n, f.n)

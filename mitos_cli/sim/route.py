@@ -198,32 +198,49 @@ def projections(routes: Sequence[Route], points: np.ndarray, hints: Sequence[flo
                 back: float = 24.0, ahead: float = 120.0) -> list[tuple[float, float, np.ndarray]]:
     """:meth:`Route.project` of every row at once (``points [R, 2]``, each on its route near
     its hint): each row's segments in its window, padded with copies of its last one (the
-    nearest is the first of equals, so never a copy), so a row gets the bits it gets alone."""
-    spans = []
+    nearest is the first of equals, so never a copy), so a row gets the bits it gets alone.
+    The rows' segments are gathered from one table of their routes' (a route shared by
+    many rows is in it once), and the nearest points read out for all rows together."""
+    table: dict[int, int] = {}               # a route's first segment in the table
+    distinct: list[Route] = []
+    firsts, stops, starts = [], [], []
+    rows = 0
     for route, hint in zip(routes, hints):
         first, stop = route._window(hint - back, hint + ahead)
-        spans.append((0, 1) if first >= stop else (first, stop))
-    width = max(stop - first for first, stop in spans)
-    a, e = np.empty((len(routes), width, 2)), np.empty((len(routes), width, 2))
-    ee, root = np.empty((len(routes), width)), np.empty((len(routes), width))
-    for i, (route, (first, stop)) in enumerate(zip(routes, spans)):
-        sa, se, see, sroot = (x[first:stop] for x in route._segments[:4])
-        m = stop - first
-        a[i, :m], e[i, :m], ee[i, :m], root[i, :m] = sa, se, see, sroot
-        a[i, m:], e[i, m:], ee[i, m:], root[i, m:] = sa[-1], se[-1], see[-1], sroot[-1]
+        if first >= stop:
+            first, stop = 0, 1
+        at = table.get(id(route))
+        if at is None:
+            at = table[id(route)] = rows
+            rows += len(route.cum)
+            distinct.append(route)
+        firsts.append(first)
+        stops.append(stop)
+        starts.append(at)
+    first, stop, at = (np.array(v) for v in (firsts, stops, starts))
+    # route j's segments at rows at_j .. at_j + M_j - 2 of the table, its arc lengths at
+    # at_j .. at_j + M_j - 1 (one more row per route in every column: the last arc length)
+    seg = [r._segments for r in distinct]
+    a = np.concatenate([np.concatenate([g[0], g[0][-1:]]) for g in seg])
+    e = np.concatenate([np.concatenate([g[1], g[1][-1:]]) for g in seg])
+    ee = np.concatenate([np.concatenate([g[2], g[2][-1:]]) for g in seg])
+    root = np.concatenate([np.concatenate([g[3], g[3][-1:]]) for g in seg])
+    cum = np.concatenate([r.cum for r in distinct])
+    width = int((stop - first).max())
+    idx = at[:, None] + np.minimum(first[:, None] + np.arange(width), stop[:, None] - 1)
+    a, e, ee, root = a[idx], e[idx], ee[idx], root[idx]                   # [R, M, ...]
     p = points[:, None]                                                    # [R, 1, 2]
     t = clip_arrays(((p - a) * e).sum(axis=2) / ee, 0.0, 1.0)              # [R, M]
     closest = a + t[..., None] * e
     gap = p - closest
     d = np.hypot(gap[..., 0], gap[..., 1])
-    out = []
-    for r, (route, (first, _)) in enumerate(zip(routes, spans)):
-        i = int(d[r].argmin())
-        s = route.cum[first + i] + t[r, i] * root[r, i]
-        tangent = e[r, i] / math.sqrt(ee[r, i])
-        rel = points[r] - closest[r, i]
-        out.append((float(s), float(rel[0] * tangent[1] - rel[1] * tangent[0]), tangent))
-    return out
+    r = np.arange(len(routes))
+    i = d.argmin(axis=1)
+    s = (cum[at + first + i] + t[r, i] * root[r, i]).tolist()
+    tangent = e[r, i] / np.sqrt(ee[r, i])[:, None]
+    rel = points - closest[r, i]
+    lateral = (rel[:, 0] * tangent[:, 1] - rel[:, 1] * tangent[:, 0]).tolist()
+    return list(zip(s, lateral, tangent))
 
 
 def distances(routes: Sequence[Route], s: Sequence[float], ahead: float,
