@@ -422,23 +422,24 @@ def test_distances_from_many_routes_at_once_are_each_routes_own(rows):
         assert same(got[i], r.distance(points[i], s[i], 120.0))
 
 
-def test_maps_cleared_together_are_each_cleared_as_alone():
+@pytest.mark.parametrize("maps", [5, 120])            # 120: rows worked in blocks
+def test_maps_cleared_together_are_each_cleared_as_alone(maps):
     rng = np.random.default_rng(8)
     angles = np.deg2rad(np.arange(0, 360, 10))
-    grids = [Grid(rng.random((60, 80)) < 0.02, 2.0, (0.0, 0.0)) for _ in range(5)]
+    grids = [Grid(rng.random((60, 80)) < 0.02, 2.0, (0.0, 0.0)) for _ in range(maps)]
     together = [knowledge.RobotMap.of(g) for g in grids]
     alone = [knowledge.RobotMap.of(g) for g in grids]
     for _ in range(40):
-        origins = rng.uniform([10, 10], [150, 110], (5, 2))
-        dirs = np.tile(np.stack([np.cos(angles), np.sin(angles)], axis=1), (5, 1, 1))
-        measured = rng.uniform(0, 60, (5, len(angles)))
-        for i in range(5):
+        origins = rng.uniform([10, 10], [150, 110], (maps, 2))
+        dirs = np.tile(np.stack([np.cos(angles), np.sin(angles)], axis=1), (maps, 1, 1))
+        measured = rng.uniform(0, 60, (maps, len(angles)))
+        for i in range(maps):
             seen = rng.random(len(angles)) < (0.5 if i else 0.0)   # map 0 never marks
             hits = origins[i] + measured[i, seen, None] * dirs[i, seen]
             together[i].mark(hits, dirs[i, seen])
             alone[i].mark(hits, dirs[i, seen])
         knowledge.clear_all(together, origins, dirs, measured, 40.0)
-        for i in range(5):
+        for i in range(maps):
             alone[i].clear(origins[i], dirs[i], measured[i], 40.0)
             assert np.array_equal(together[i].occupied, alone[i].occupied)
             assert np.array_equal(together[i].marks, alone[i].marks)
