@@ -410,34 +410,36 @@ def test_a_maps_near_cells_read_from_the_last_square_are_the_cells_of_a_fresh_lo
             assert same(kept.near(p, reach, given), fresh.near(p, reach, given))
 
 
-def test_distances_from_many_routes_at_once_are_each_routes_own():
+@pytest.mark.parametrize("rows", [7, 400])             # 400: rows worked in blocks
+def test_distances_from_many_routes_at_once_are_each_routes_own(rows):
     rng = np.random.default_rng(9)
-    routes = [route.Route.of(np.cumsum(rng.normal(0, 40, (int(rng.integers(2, 12)), 2)),
-                                       axis=0)) for _ in range(7)]
+    routes = [route.Route.of(np.cumsum(rng.normal(0, 40, (int(rng.integers(2, 40)), 2)),
+                                       axis=0)) for _ in range(rows)]
     s = [float(rng.uniform(-20, r.length + 20)) for r in routes]
-    points = rng.normal(0, 150, (7, 36, 2))
+    points = rng.normal(0, 150, (rows, 36, 2))
     got = route.distances(routes, s, 120.0, points)
     for i, r in enumerate(routes):
         assert same(got[i], r.distance(points[i], s[i], 120.0))
 
 
-def test_maps_cleared_together_are_each_cleared_as_alone():
+@pytest.mark.parametrize("maps", [5, 120])            # 120: rows worked in blocks
+def test_maps_cleared_together_are_each_cleared_as_alone(maps):
     rng = np.random.default_rng(8)
     angles = np.deg2rad(np.arange(0, 360, 10))
-    grids = [Grid(rng.random((60, 80)) < 0.02, 2.0, (0.0, 0.0)) for _ in range(5)]
+    grids = [Grid(rng.random((60, 80)) < 0.02, 2.0, (0.0, 0.0)) for _ in range(maps)]
     together = [knowledge.RobotMap.of(g) for g in grids]
     alone = [knowledge.RobotMap.of(g) for g in grids]
     for _ in range(40):
-        origins = rng.uniform([10, 10], [150, 110], (5, 2))
-        dirs = np.tile(np.stack([np.cos(angles), np.sin(angles)], axis=1), (5, 1, 1))
-        measured = rng.uniform(0, 60, (5, len(angles)))
-        for i in range(5):
+        origins = rng.uniform([10, 10], [150, 110], (maps, 2))
+        dirs = np.tile(np.stack([np.cos(angles), np.sin(angles)], axis=1), (maps, 1, 1))
+        measured = rng.uniform(0, 60, (maps, len(angles)))
+        for i in range(maps):
             seen = rng.random(len(angles)) < (0.5 if i else 0.0)   # map 0 never marks
             hits = origins[i] + measured[i, seen, None] * dirs[i, seen]
             together[i].mark(hits, dirs[i, seen])
             alone[i].mark(hits, dirs[i, seen])
         knowledge.clear_all(together, origins, dirs, measured, 40.0)
-        for i in range(5):
+        for i in range(maps):
             alone[i].clear(origins[i], dirs[i], measured[i], 40.0)
             assert np.array_equal(together[i].occupied, alone[i].occupied)
             assert np.array_equal(together[i].marks, alone[i].marks)
@@ -636,3 +638,126 @@ def test_road_and_side_gaps_from_one_reduction_are_the_plain_minima():
                                      least(near & (b < 0), -b, 0.0) - half[:, 0], 200.0))
         assert same(got[1], np.where((near & (b > 0)).any(axis=1),
                                      least(near & (b > 0), b, 0.0) - half[:, 0], 200.0))
+
+
+def test_chords_cleared_from_the_squares_are_those_hypot_clears():
+    rng = np.random.default_rng(11)
+    dx, dy = rng.normal(0, 20, (2, 40, 30, 9))
+    radius, need = rng.uniform(0, 2, (40, 1)), rng.uniform(0, 30, (40, 1))
+    plain = np.hypot(dx, dy).min(axis=1)
+    # chords exactly on the line, a rounding either side of it, and a few odd values
+    need[:10] = plain[:10, :1] - radius[:10]
+    need[10:20] = np.nextafter(plain[10:20, :1] - radius[10:20], np.inf)
+    need[20:25] = np.nextafter(plain[20:25, :1] - radius[20:25], -np.inf)
+    dx[25, 0, 0], dy[26, 3, 2], dx[27, :, :] = np.nan, np.inf, 1e-170
+    dy[27, :, :] = 1e-170
+    dx[28, :, 1], dy[28, :, 1] = 1e200, 1e200
+    got = perception._clear_of(dx, dy, radius, need)
+    assert np.array_equal(got, np.hypot(dx, dy).min(axis=1) - radius >= need)
+
+
+def plain_pursuit_point(a: perception.Aim, cfg: perception.Settings):
+    """The pursuit point measured against every cell, with hypot (as it was written)."""
+    ahead = perception._lookaheads(cfg)
+    if not len(a.cells):
+        return float(ahead[-1]), perception.target_point(a.route, a.f, cfg, float(ahead[-1]))
+    q = perception.target_points(a.route, a.f, ahead)
+    e = q - a.p
+    ee = np.maximum(e[:, 0] * e[:, 0] + e[:, 1] * e[:, 1], 1e-12)
+    rel = a.cells - a.p
+    rx, ry = rel[:, 0, None], rel[:, 1, None]
+    t = np.clip((rx * e[:, 0] + ry * e[:, 1]) / ee, 0.0, 1.0)
+    clear = np.hypot(rx - t * e[:, 0], ry - t * e[:, 1]).min(axis=0) - a.radius >= a.need
+    k = len(ahead) - 1 if clear.all() else max(int(clear.argmin()) - 1, 0)
+    return float(ahead[k]), q[k]
+
+
+def test_pursuit_points_from_the_cells_near_their_chords_are_those_of_every_cell():
+    sims = running("slalom.yaml", ticks=60)
+    aims = []
+    for sim in sims:
+        s = sim.sense()
+        aims += sim.aims(s, perception.frames(*sim.framing(s)))
+    cfg = sims[0].settings
+    rng = np.random.default_rng(5)
+    made = []
+    for a in aims:
+        q = perception.target_points(a.route, a.f, perception._lookaheads(cfg))
+        for _ in range(30):      # cells about the chords, some at the box's edge, some far
+            k = int(rng.integers(1, 40))
+            on = q[rng.integers(0, len(q), k)] * rng.uniform(0, 1, (k, 1)) \
+                + a.p * rng.uniform(0, 1, (k, 1))
+            along = on + rng.normal(0, a.need + a.radius, (k, 2))
+            if rng.random() < 0.3:
+                along[0] = q[-1] + [a.need + a.radius, 0.0]
+            made.append(dataclasses.replace(a, cells=np.concatenate([a.cells, along])))
+    made += [dataclasses.replace(made[0], cells=np.full((3, 2), np.nan))]
+    ahead, targets = perception.pursuit_points(made, cfg)
+    for i, a in enumerate(made):
+        one, target = plain_pursuit_point(a, cfg)
+        assert same(one, ahead[i]) and same(target, targets[i])
+        alone = perception.pursuit_point(a.route, a.f, a.p, a.cells, a.radius, a.need, cfg)
+        assert same(alone[0], one) and same(alone[1], target)
+    assert len({float(x) for x in ahead}) > 3          # short lookaheads among them
+
+
+def test_free_ways_of_many_rows_worked_in_blocks_are_each_rows_own():
+    rng = np.random.default_rng(13)
+    cfg = perception.Settings()
+    rows, n = 3 * perception.CACHED // (39 * 36) + 7, 36        # three blocks and a part
+    robots = [Robot(length=float(rng.uniform(10, 30)), width=float(rng.uniform(8, 24)))
+              for _ in range(rows)]
+    ah, bh = rng.normal(0, 40.0, (2, rows, n))
+    widen = np.abs(rng.normal(0, 3, (rows, n)))
+    unknown = rng.random((rows, n)) < 0.4
+    bearing = rng.uniform(-200, 200, rows)
+    got = perception.free_ways_rows(ah, bh, widen, unknown, robots, cfg, bearing)
+    for i in range(rows):
+        one = perception.free_ways_rows(ah[i:i + 1], bh[i:i + 1], widen[i:i + 1],
+                                        unknown[i:i + 1], robots[i:i + 1], cfg, bearing[i:i + 1])
+        assert same(got[0][i], one[0][0]) and same(got[1][i], one[1][0])
+
+
+def test_cells_beyond_many_robots_readings_at_once_are_each_robots_own():
+    sims = running("slalom.yaml", runs=3, ticks=60)
+    maps, origins, dirs, measured, sensed = [], [], [], [], []
+    for sim in sims:
+        s = sim.sense()
+        m, o, d, r, _ = sim.clearing(s)
+        maps += m
+        origins.append(o), dirs.append(d), measured.append(r), sensed.append(s)
+    got = knowledge.beyond_cells(maps, *(np.concatenate(x) for x in (origins, dirs, measured)))
+    for j, (sim, s) in enumerate(zip(sims, sensed)):
+        assert same(got[j], sim._beyond(0, s))          # the one robot's own, worked alone
+    other = knowledge.RobotMap.of(Grid(np.zeros((4, 4), bool), 3.0, (0.0, 0.0), ""))
+    two = [np.concatenate([x[0], x[0]]) for x in (origins, dirs, measured)]
+    assert knowledge.beyond_cells([maps[0], other], *two) is None   # grids unlike: alone
+
+
+def test_route_gaps_measured_together_give_each_robots_own_room():
+    sims = running("slalom.yaml", ticks=60)
+    aims = []
+    for sim in sims:
+        s = sim.sense()
+        aims += sim.aims(s, perception.frames(*sim.framing(s)))
+    aims += [dataclasses.replace(a, cells=a.cells[:k]) for a in aims for k in (0, 1, 7)]
+    assert any(len(a.cells) > 20 for a in aims)
+    gaps = perception.route_gaps(aims)
+    for a, gap in zip(aims, gaps):
+        alone = perception.route_room(a.f, a.p, a.cells, a.radius, 9.5)
+        assert same(max(0.0, gap - a.radius - 9.5), alone)
+        assert same(perception.route_gaps([a])[0], gap)
+
+
+def test_robots_sharing_routes_placed_together_get_the_bits_they_get_alone():
+    rng = np.random.default_rng(14)
+    shared = [route.Route.of(np.cumsum(rng.normal(0, 30, (int(rng.integers(2, 40)), 2)),
+                                       axis=0)) for _ in range(5)]
+    routes = [shared[int(k)] for k in rng.integers(0, 5, 60)]       # each many rows' own
+    points = rng.normal(0, 150, (60, 2))
+    hints = [float(rng.uniform(-200, r.length + 200)) for r in routes]
+    together = perception.frames(routes, points, hints)
+    for r, p, hint, f in zip(routes, points, hints, together):
+        alone = perception.frame(r, p, hint)
+        assert same(alone.s, f.s) and same(alone.e, f.e)
+        assert same(alone.t, f.t) and same(alone.n, f.n)

@@ -14,6 +14,11 @@ import numpy as np
 
 EPS = 1e-9
 
+#: Elements (floats) in one of the largest arrays a batched stage works a block of rows on:
+#: 512 kB, so a block's arrays stay in a core's cache (a lockstep batch of hundreds of
+#: robots spills them out of it, which costs more than the calls the blocks repeat).
+CACHED = 1 << 16
+
 
 def _clip_ufunc() -> np.ufunc:
     """The ufunc ``np.clip`` calls, to call it without its Python wrapper (NumPy 2 keeps it in

@@ -36,7 +36,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import obstacles as obs_mod
-from .geometry import points_in_polygon, ray_circles, ray_segments
+from .geometry import CACHED, points_in_polygon, ray_circles, ray_segments
 from .route import Clearance, NarrowPassage, Prepared, Route, grid_route
 from .staticmap import StaticMap, carve, corridor_rects, grid_walls
 from .world import Goal, Grid, Pose, World
@@ -378,6 +378,15 @@ def clear_all(maps: list[RobotMap], origins: np.ndarray, dirs: np.ndarray,
         if np.count_nonzero(through):
             m._free(where[through], r[through], c[through])
         return
+    widest = max(len(got[3]) for _, _, got in seen)
+    block = max(1, CACHED // (widest * dirs.shape[1]))    # rows whose arrays stay in cache
+    for lo in range(0, len(seen), block):
+        _clear_block(seen[lo:lo + block], dirs, measured, max_range)
+
+
+def _clear_block(seen: list, dirs: np.ndarray, measured: np.ndarray, max_range: float) -> None:
+    """:func:`clear_all` of the maps ``seen`` (``(map, row, its marks in sight)`` each), their
+    marks padded far away: ``[H, P, B]`` products, elementwise."""
     rel = np.full((len(seen), max(len(got[3]) for _, _, got in seen), 2), 1e12)
     for j, (_, _, got) in enumerate(seen):
         rel[j, :len(got[3])] = got[3]
@@ -394,6 +403,21 @@ def clear_all(maps: list[RobotMap], origins: np.ndarray, dirs: np.ndarray,
         mine = through[j, :len(pts)]
         if np.count_nonzero(mine):
             m._free(where[mine], r[mine], c[mine])
+
+
+def beyond_cells(maps: list[RobotMap], origins: np.ndarray, dirs: np.ndarray,
+                 measured: np.ndarray) -> np.ndarray | None:
+    """The cells ``[R, B, 2]`` (:meth:`RobotMap.cell_indices`) just beyond every robot's
+    readings, where their echoes came from (robots at ``origins [R, 2]``, their beams ``dirs
+    [R, B, 2]`` and readings ``measured [R, B]``; runs in lockstep together), each the bits
+    of its own; ``None`` unless the maps share their cells' size and origin (the runs of a
+    world do)."""
+    grid = maps[0].grid
+    if any(m.grid is not grid and (m.grid.resolution != grid.resolution
+                                   or m.grid.origin != grid.origin) for m in maps):
+        return None
+    return maps[0].cell_indices(origins[:, None] + measured[..., None] * dirs
+                                + dirs * (grid.resolution / 2))
 
 
 def expected_ranges(g: Given, rmap: RobotMap | None, origin: np.ndarray, dirs: np.ndarray,

@@ -2,12 +2,13 @@
 
 Each tick the robots of every run still going are sensed in one pass (:func:`.rows.sense`:
 beams, noise from each robot's own stream, clearance), the marks they see through cleared
-from their maps in one pass (:func:`.knowledge.clear_all`), their pursuit points found in one
-pass (:func:`.perception.pursuit_points`) and their rule inputs perceived in one pass
+from their maps in one pass (:func:`.knowledge.clear_all`), the cells their echoes came from
+found in one pass (:func:`.knowledge.beyond_cells`), their pursuit points found in one pass
+(:func:`.perception.pursuit_points`) and their rule inputs perceived in one pass
 (:func:`.perception.perceive_rows`); what else a robot's own map and route need (marking its
-map, replanning) and its check are done run by run, with the code
-of a run alone (:class:`~mitos_cli.sim.loop.Simulation`). Then the fuzzy planner's rule network
-is evaluated once for the active robots of every run (one engine batch: the engine gives each
+map, replanning) and its check are done run by run, with the code of a run alone
+(:class:`~mitos_cli.sim.loop.Simulation`). Then the fuzzy planner's rule network is
+evaluated once for the active robots of every run (one engine batch: the engine gives each
 row the bits it gives alone), each run's brake checks its commands, and the robots of every run
 move in one batch of kinematics (elementwise per robot). Runs that end drop out. Every batched
 stage is elementwise per robot or an exact minimum, so each run's ticks, trajectory and summary
@@ -25,6 +26,9 @@ from . import kinematics, knowledge, perception, rows, safety
 from .loop import Scene, SimResult, Simulation, shared_scene
 from .planner import FuzzyPlanner, Planner
 from .world import World
+
+#: The row of each input in a tick's block of inputs (:data:`.perception.INPUTS` order).
+_ROW = {key: j for j, key in enumerate(perception.INPUTS)}
 
 #: Runs stepped together by default: enough to make the batched calls worth their set-up,
 #: few enough that the runs' recorded ticks stay small.
@@ -74,26 +78,22 @@ class Lockstep:
         planner = self.planner
         if not isinstance(planner, FuzzyPlanner) or not live:
             return [None] * len(live)
-        active = [run.active for run in live]
+        active = np.concatenate([run.active for run in live])    # [all robots of all runs]
         compiled = planner.compiled
-        X = np.empty((sum(int(a.sum()) for a in active), len(compiled.inputs)))
-        for j, key in enumerate(compiled.inputs):
-            X[:, j] = np.concatenate([s.inputs[key][a] for s, a in zip(seen, active)])
+        X = np.empty((np.count_nonzero(active), len(compiled.inputs)))
         if len(X) == 0:
             return [None] * len(live)
+        blocks = np.concatenate([s.block for s in seen], axis=1)        # [inputs, robots]
+        for j, key in enumerate(compiled.inputs):
+            X[:, j] = blocks[_ROW[key], active]
         from ..engine.evaluation import evaluate
 
         out = evaluate(compiled, X, detail=False).outputs
-        steer, speed = (out[:, compiled.outputs.index(k)] for k in ("steering", "speed"))
-        commands: list[np.ndarray | None] = []
-        row = 0
-        for run, a in zip(live, active):
-            cmd = np.zeros((run.n, 2))
-            count = int(a.sum())
-            cmd[a, 0], cmd[a, 1] = steer[row:row + count], speed[row:row + count]
-            row += count
-            commands.append(cmd)
-        return commands
+        commands = np.zeros((len(active), 2))
+        for j, key in enumerate(("steering", "speed")):
+            commands[active, j] = out[:, compiled.outputs.index(key)]
+        stops = np.cumsum([run.n for run in live]).tolist()
+        return [commands[stop - run.n:stop] for run, stop in zip(live, stops)]
 
 
 def _observe_together(runs: list[Simulation]) -> list:
@@ -115,8 +115,12 @@ def _observe_together(runs: list[Simulation]) -> list:
         sensed = [run.sensed(got.part(start, stop)) for run, (start, stop) in zip(fresh, spans)]
         clearing = [run.clearing(s) for run, s in zip(fresh, sensed)]
         origins, dirs, measured = (np.concatenate([c[j] for c in clearing]) for j in (1, 2, 3))
-        knowledge.clear_all([m for c in clearing for m in c[0]], origins, dirs, measured,
-                            world.sensors.range)
+        maps = [m for c in clearing for m in c[0]]
+        knowledge.clear_all(maps, origins, dirs, measured, world.sensors.range)
+        beyond = knowledge.beyond_cells(maps, origins, dirs, measured)
+        if beyond is not None:
+            for run, s, (start, stop) in zip(fresh, sensed, spans):
+                run.beyond(s, beyond[start:stop])
         framing = [run.framing(s) for run, s in zip(fresh, sensed)]
         frames = perception.frames([r for f in framing for r in f[0]],
                                    np.concatenate([f[1] for f in framing]),
@@ -124,14 +128,17 @@ def _observe_together(runs: list[Simulation]) -> list:
         aims = [aim for run, s, (start, stop) in zip(fresh, sensed, spans)
                 for aim in run.aims(s, frames[start:stop])]
         ahead, targets = perception.pursuit_points(aims, fresh[0].settings)
+        gaps = perception.route_gaps(aims)
         ticks, sights = [], []
         for run, s, (start, stop) in zip(fresh, sensed, spans):
-            mine_ = run.aimed(s, aims[start:stop], ahead[start:stop], targets[start:stop])
+            mine_ = run.aimed(s, aims[start:stop], ahead[start:stop], targets[start:stop],
+                              gaps[start:stop])
             ticks.append((run, s, mine_, start, stop))
             sights += mine_
         inputs = perception.perceive_rows(sights, world.sensors.range, fresh[0].settings)
+        block = np.stack([inputs[key] for key in perception.INPUTS])     # [inputs, robots]
         for run, s, mine_, start, stop in ticks:
-            run.perceived(s, mine_, {k: v[start:stop] for k, v in inputs.items()})
+            run.perceived(s, mine_, block[:, start:stop])
             run.conclude(s)
     return [run.observe() for run in runs]
 

@@ -285,6 +285,7 @@ class _Sensed:
     targets: np.ndarray
     clearance: np.ndarray
     command: np.ndarray             # [n, 2] filled by the plan stage
+    block: np.ndarray               # [inputs, n]: the rows ``inputs`` holds, one block
 
 
 class Simulation:
@@ -364,6 +365,7 @@ class Simulation:
         self.dt = world.dt
         self.steps = int(math.floor(world.time_limit / self.dt + 1e-9))
         self._goals = np.array([[a.goal.x, a.goal.y] for a in world.agents], float)
+        self._goal_x, self._goal_y = self._goals[:, 0].copy(), self._goals[:, 1].copy()
         self._tol = np.array([a.goal.tolerance for a in world.agents], float)
         self._stuck_window = max(1, int(round(STUCK_TIME / self.dt)))
         self._given = self.scene.given or knowledge.given(world, self.scene.static)
@@ -650,7 +652,7 @@ class Simulation:
         inputs = np.zeros((len(perception.INPUTS), n))      # one block, a row per input
         return _Sensed(self.time, self._where, pose, got.ranges,
                        dict(zip(perception.INPUTS, inputs)), np.zeros((n, 2)),
-                       got.clearance, np.zeros((n, 2)))
+                       got.clearance, np.zeros((n, 2)), inputs)
 
     def _joined(self, i: int, walls: np.ndarray, sides: np.ndarray) -> np.ndarray:
         """Robot ``i``'s nearby walls and then the obstacle sides as one array, kept while
@@ -738,14 +740,17 @@ class Simulation:
         return out
 
     def aimed(self, s: _Sensed, aims: list[perception.Aim], ahead: np.ndarray,
-              targets: np.ndarray) -> list[perception.Sight]:
+              targets: np.ndarray, gaps: list[float] | None = None) -> list[perception.Sight]:
         """The robots' sights from their :meth:`aims` and their pursuit points (lookaheads
         ``ahead [n]``, points ``targets [n, 2]``): how far ahead each aims and what it keeps
-        clear of."""
+        clear of (``gaps``: their :func:`.perception.route_gaps`, which runs in lockstep
+        measure together)."""
         out = []
+        if gaps is None:
+            gaps = perception.route_gaps(aims)
         for i, aim in enumerate(aims):
             least = self._asked[i][1]
-            room = perception.route_room(aim.f, aim.p, aim.cells, aim.radius, least)
+            room = max(0.0, gaps[i] - aim.radius - least)     # (perception.route_room)
             out.append(perception.Sight(
                 aim.route, aim.f, (float(self._x[i]), float(self._y[i]), float(self._h[i])),
                 self.robots[i], self._dirs[i], s.ranges[i], self._expected[i], self._spacing,
@@ -753,11 +758,15 @@ class Simulation:
         return out
 
     def perceived(self, s: _Sensed, sights: list[perception.Sight],
-                  inputs: dict[str, np.ndarray]) -> None:
-        """Record the robots' inputs (their rows of :func:`.perception.perceive_rows`) and
-        target points in tick ``s``."""
-        for key in perception.INPUTS:
-            s.inputs[key][:] = inputs[key]
+                  inputs: dict[str, np.ndarray] | np.ndarray) -> None:
+        """Record the robots' inputs (their rows of :func:`.perception.perceive_rows`, or
+        those as one block ``[inputs, n]`` in :data:`.perception.INPUTS` order: runs in
+        lockstep copy theirs at once) and target points in tick ``s``."""
+        if isinstance(inputs, np.ndarray):
+            s.block[:] = inputs
+        else:
+            for key in perception.INPUTS:
+                s.inputs[key][:] = inputs[key]
         for i, sight in enumerate(sights):
             s.targets[i] = sight.target
 
@@ -767,6 +776,12 @@ class Simulation:
         if self.world.replan != "clearance":
             return None
         return least, self._maps[i].accounted_cells(self._beyond(i, s))
+
+    def beyond(self, s: _Sensed, cells: np.ndarray) -> None:
+        """Robot by robot, the cells just beyond its readings at tick ``s`` (``cells [n, B,
+        2]``, :func:`.knowledge.beyond_cells`: runs in lockstep work theirs out together),
+        for :meth:`_beyond` to answer with."""
+        self._beyond_at = (s, list(cells))
 
     def _beyond(self, i: int, s: _Sensed) -> np.ndarray:
         """The cells ``[B, 2]`` (:meth:`.knowledge.RobotMap.cell_indices`) just beyond robot
@@ -801,11 +816,12 @@ class Simulation:
         """Contact (clearance <= 0) and arrival; an arrived robot stops driving."""
         active = self._active
         self._hit = active & (s.clearance <= 0.0)
-        arrived = active & (np.hypot(self._x - self._goals[:, 0],
-                                     self._y - self._goals[:, 1]) <= self._tol)
-        for i in np.flatnonzero(arrived):
-            self._outcomes[i] = "success"
-        active &= ~arrived
+        arrived = active & (np.hypot(self._x - self._goal_x, self._y - self._goal_y)
+                            <= self._tol)
+        if np.count_nonzero(arrived):
+            for i in arrived.nonzero()[0]:
+                self._outcomes[i] = "success"
+            active &= ~arrived
 
     def plan(self, s: _Sensed) -> None:
         """The planner's commands for the active robots, in one batch (the others: straight
@@ -863,7 +879,7 @@ class Simulation:
                free: np.ndarray) -> None:
         """:meth:`_guard` with the first sweeps of :meth:`braking` measured (``free [R]``)."""
         cfg, j = self._safety, 0
-        for i in np.flatnonzero(self._active):
+        for i in self._active.nonzero()[0]:
             if not self.robots[i].brake:
                 continue
             body, wheel, backward = sweeps[j]

@@ -88,7 +88,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .geometry import clip_arrays
+from .geometry import CACHED, clip_arrays
 from .route import Route, distances, projections
 from .world import Robot
 
@@ -261,7 +261,25 @@ def free_ways_rows(ah: np.ndarray, bh: np.ndarray, widen: np.ndarray, unknown: n
 def _free_ways(ah: np.ndarray, bh: np.ndarray, widen: np.ndarray, unknown: np.ndarray,
                body: dict[str, np.ndarray], cfg: Settings,
                route_bearing: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`free_ways_rows` of robots whose :func:`_bodies` are ``body``."""
+    """:func:`free_ways_rows` of robots whose :func:`_bodies` are ``body``, a block of rows
+    at a time (:data:`CACHED`: a lockstep batch of hundreds of robots spills its
+    ``[rows, ways, points]`` arrays out of a core's cache, which costs more than the calls
+    the blocks repeat; each row's arithmetic is its own)."""
+    rows = max(1, CACHED // (len(body["ways"]) * max(ah.shape[1], 1)))
+    if len(ah) <= rows:
+        return _free_ways_block(ah, bh, widen, unknown, body, cfg, route_bearing)
+    parts = [_free_ways_block(ah[i:i + rows], bh[i:i + rows], widen[i:i + rows],
+                              unknown[i:i + rows],
+                              {k: v if k == "ways" else v[i:i + rows] for k, v in body.items()},
+                              cfg, route_bearing[i:i + rows])
+             for i in range(0, len(ah), rows)]
+    return np.concatenate([f for f, _ in parts]), np.concatenate([o for _, o in parts])
+
+
+def _free_ways_block(ah: np.ndarray, bh: np.ndarray, widen: np.ndarray, unknown: np.ndarray,
+                     body: dict[str, np.ndarray], cfg: Settings,
+                     route_bearing: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`_free_ways` of one block of rows."""
     length = body["length"][:, 0]
     base = body["ways"]
     ways = np.empty((len(ah), len(base)))                                  # [R, W]
@@ -398,12 +416,21 @@ def _walls_near(a, across, valid, body: dict[str, np.ndarray], cfg: Settings,
 def _common(route: Route, p, heading: float, f: Frame, road: float, robot: Robot,
             cfg: Settings, target: np.ndarray, room: float) -> tuple[float, float, float]:
     d = target - p
-    bearing = math.degrees(math.atan2(d[1], d[0]) - heading)
+    return _common_of(float(d[0]), float(d[1]), heading, route.length - f.s, f.e,
+                      float(np.hypot(*(route.goal - p))), road, robot, cfg, room)
+
+
+def _common_of(dx: float, dy: float, heading: float, left: float, e: float, home: float,
+               road: float, robot: Robot, cfg: Settings,
+               room: float) -> tuple[float, float, float]:
+    """:func:`_common` from the target's offset ``(dx, dy)``, the route ``left`` ahead, the
+    offset ``e`` off it and the straight distance ``home`` to the goal (Python floats: the
+    rows' differences and distances are worked out together, then these row by row)."""
+    bearing = math.degrees(math.atan2(dy, dx) - heading)
     bearing = (bearing + 180.0) % 360.0 - 180.0
     road_l = min(road, cfg.road_cap)
     offset = max(0.0, min(road_l / 4, road_l / 2 - robot.width / 2 - cfg.lane_margin, room))
-    goal = max(route.length - f.s, float(np.hypot(*(route.goal - p))))
-    return -bearing, f.e - offset, goal
+    return -bearing, e - offset, max(left, home)
 
 
 def clear_lookahead(route: Route, f: Frame, p: np.ndarray, cells: np.ndarray, radius: float,
@@ -446,41 +473,53 @@ _FAR = 1e12
 
 def pursuit_points(aims: list[Aim], cfg: Settings) -> tuple[np.ndarray, np.ndarray]:
     """:func:`pursuit_point` of every robot at once (runs in lockstep, each robot with its
-    own route and cells): the lookaheads ``[R]`` and the points ``[R, 2]``. The cells are
-    padded far away and every product is written out elementwise, so a robot gets the bits
-    it gets alone, in any batch."""
+    own route and cells): the lookaheads ``[R]`` and the points ``[R, 2]``. Only the cells
+    near a robot's chords are measured (:func:`_near_chords`: mostly none, and then every
+    chord is clear); they are padded far away and every product is written out
+    elementwise, so a robot gets the bits it gets alone, in any batch."""
     ahead = _lookaheads(cfg)
     if len(aims) == 1:
         one, target = _pursuit_one(aims[0], ahead, cfg)
         return np.array([one]), target[None]
     out_ahead = np.full(len(aims), float(ahead[-1]))
     targets = np.empty((len(aims), 2))
-    have = []
+    have, have_i = [], []
     for i, a in enumerate(aims):
         if len(a.cells):
             have.append(a)
+            have_i.append(i)
         else:
             targets[i] = target_point(a.route, a.f, cfg, float(ahead[-1]))
     if not have:
         return out_ahead, targets
     q = np.stack([target_points(a.route, a.f, ahead) for a in have])         # [H, J, 2]
-    p = np.stack([a.p for a in have])[:, None]                                # [H, 1, 2]
-    e = q - p
-    ee = np.maximum(e[..., 0] * e[..., 0] + e[..., 1] * e[..., 1], 1e-12)     # [H, J]
-    rel = np.full((len(have), max(len(a.cells) for a in have), 2), _FAR)
+    targets[have_i] = q[:, -1]                                  # where every chord is clear
+    cells = np.full((len(have), max(len(a.cells) for a in have), 2), _FAR)
     for j, a in enumerate(have):
-        rel[j, :len(a.cells)] = a.cells
-    rel -= p                                                                  # [H, P, 2]
-    rx, ry = rel[..., 0, None], rel[..., 1, None]                             # [H, P, 1]
-    ex, ey = e[:, None, :, 0], e[:, None, :, 1]                               # [H, 1, J]
-    t = clip_arrays((rx * ex + ry * ey) / ee[:, None], 0.0, 1.0)              # [H, P, J]
-    gap = np.hypot(rx - t * ex, ry - t * ey).min(axis=1)                      # [H, J]
-    clear = (gap - np.array([a.radius for a in have])[:, None]
-             >= np.array([a.need for a in have])[:, None])
-    have_i = np.array([i for i, a in enumerate(aims) if len(a.cells)])
+        cells[j, :len(a.cells)] = a.cells
+    p = np.stack([a.p for a in have])                                         # [H, 2]
+    near = _near_chords(cells, p, q, np.array([a.need + a.radius for a in have]))
+    some = near.any(axis=1).nonzero()[0]
+    if not len(some):
+        return out_ahead, targets
+    # the rows with cells near their chords, those cells first (the others padded far away)
+    near, q, p = near[some], q[some], p[some, None]                           # p [S, 1, 2]
+    order = np.argsort(~near, axis=1, kind="stable")[:, :int(near.sum(axis=1).max())]
+    rel = np.take_along_axis(cells[some], order[..., None], axis=1)
+    rel[~np.take_along_axis(near, order, axis=1)] = _FAR
+    rel -= p                                                                  # [S, P, 2]
+    e = q - p
+    ee = np.maximum(e[..., 0] * e[..., 0] + e[..., 1] * e[..., 1], 1e-12)     # [S, J]
+    rx, ry = rel[..., 0, None], rel[..., 1, None]                             # [S, P, 1]
+    ex, ey = e[:, None, :, 0], e[:, None, :, 1]                               # [S, 1, J]
+    t = clip_arrays((rx * ex + ry * ey) / ee[:, None], 0.0, 1.0)              # [S, P, J]
+    clear = _clear_of(rx - t * ex, ry - t * ey,
+                      np.array([have[j].radius for j in some])[:, None],
+                      np.array([have[j].need for j in some])[:, None])       # [S, J]
     k = np.where(clear.all(axis=1), len(ahead) - 1, np.maximum(clear.argmin(axis=1) - 1, 0))
-    out_ahead[have_i] = ahead[k]
-    targets[have_i] = q[np.arange(len(have)), k]
+    rows = np.array(have_i)[some]
+    out_ahead[rows] = ahead[k]
+    targets[rows] = q[np.arange(len(some)), k]
     return out_ahead, targets
 
 
@@ -489,16 +528,61 @@ def _pursuit_one(a: Aim, ahead: np.ndarray, cfg: Settings) -> tuple[float, np.nd
     if not len(a.cells):
         return float(ahead[-1]), target_point(a.route, a.f, cfg, float(ahead[-1]))
     q = target_points(a.route, a.f, ahead)                                    # [J, 2]
+    near = _near_chords(a.cells[None], a.p[None], q[None], np.array([a.need + a.radius]))[0]
+    if not np.count_nonzero(near):
+        return float(ahead[-1]), q[-1]
     e = q - a.p
     ee = np.maximum(e[:, 0] * e[:, 0] + e[:, 1] * e[:, 1], 1e-12)
-    rel = a.cells - a.p                                                       # [P, 2]
+    rel = a.cells[near] - a.p                                                 # [P, 2]
     rx, ry = rel[:, 0, None], rel[:, 1, None]
     t = clip_arrays((rx * e[:, 0] + ry * e[:, 1]) / ee, 0.0, 1.0)             # [P, J]
-    clear = np.hypot(rx - t * e[:, 0], ry - t * e[:, 1]).min(axis=0) - a.radius >= a.need
+    clear = _clear_of((rx - t * e[:, 0])[None], (ry - t * e[:, 1])[None],
+                      np.full((1, 1), a.radius), np.full((1, 1), a.need))[0]
     if clear.all():
         return float(ahead[-1]), q[-1]
     k = max(int(clear.argmin()) - 1, 0)
     return float(ahead[k]), q[k]
+
+
+def _near_chords(cells: np.ndarray, p: np.ndarray, q: np.ndarray,
+                 reach: np.ndarray) -> np.ndarray:
+    """``[H, P]``: which ``cells [H, P, 2]`` are not plainly clear of every chord from
+    ``p [H, 2]`` to the points ``q [H, J, 2]``: those in the box round the chords grown by
+    ``reach [H]`` (the need plus the discs' radius) and a margin far above rounding. A cell
+    outside it is farther than ``reach`` from every chord, so it never decides whether a
+    chord is clear, and leaving it out gives every chord the same answer (a NaN is kept)."""
+    ends = np.concatenate([q, p[:, None]], axis=1)                            # [H, J + 1, 2]
+    grow = (reach + 1e-6 * (1.0 + np.abs(reach)
+                            + np.maximum.reduce(np.abs(ends), axis=(1, 2))))[:, None, None]
+    lo = np.minimum.reduce(ends, axis=1, keepdims=True) - grow                # [H, 1, 2]
+    hi = np.maximum.reduce(ends, axis=1, keepdims=True) + grow
+    return ~np.logical_or.reduce((cells < lo) | (cells > hi), axis=2)
+
+
+#: How far (relative) a chord's clearance from the squares of the gaps may lie off the one
+#: from ``np.hypot`` (a few rounding errors, ~1e-15) before :func:`_clear_of` asks hypot.
+_ROUNDING = 1e-9
+
+
+def _clear_of(dx: np.ndarray, dy: np.ndarray, radius: np.ndarray,
+              need: np.ndarray) -> np.ndarray:
+    """``np.hypot(dx, dy).min(axis=1) - radius >= need`` (gaps ``[H, P, J]``, ``radius`` and
+    ``need`` ``[H, 1]``): whether each chord ``[H, J]`` keeps ``need`` from every disc. The
+    least gap is found from the squares (``np.hypot`` costs some 30 times a product); only a
+    chord whose answer lies within rounding of the line (or is NaN) is measured with hypot,
+    so each answer is the plain formula's."""
+    with np.errstate(over="ignore"):            # a square past 1e308 is asked of hypot
+        squares = dx * dx
+        squares += dy * dy
+    least = np.sqrt(np.minimum.reduce(squares, axis=1))                      # [H, J]
+    over = least - radius - need
+    band = _ROUNDING * (least + np.abs(radius) + np.abs(need)) + 1e-100     # tiny: underflow
+    clear = over > band
+    unsure = ~(clear | (over < -band))
+    if np.count_nonzero(unsure):
+        h, j = unsure.nonzero()
+        clear[h, j] = np.hypot(dx[h, :, j], dy[h, :, j]).min(axis=1) - radius[h, 0] >= need[h, 0]
+    return clear
 
 
 def route_room(f: Frame, p: np.ndarray, cells: np.ndarray, radius: float,
@@ -507,10 +591,38 @@ def route_room(f: Frame, p: np.ndarray, cells: np.ndarray, radius: float,
     within its least clearance of what it knows: the distance from the route point beside
     it to the nearest occupied cell (``cells [P, 2]``, discs of ``radius``) less ``least``
     (at least 0; ``inf`` with nothing known near)."""
+    return max(0.0, _route_gap(f, p, cells) - radius - least)
+
+
+def _route_gap(f: Frame, p: np.ndarray, cells: np.ndarray) -> float:
+    """The distance from the route point beside the robot to the nearest of ``cells``
+    (``inf`` with none): :func:`route_room` before its radius and least clearance."""
     if not len(cells):
         return math.inf
     c = p - f.e * f.n
-    return max(0.0, float(np.hypot(*(cells - c).T).min()) - radius - least)
+    return float(np.hypot(*(cells - c).T).min())
+
+
+def route_gaps(aims: list[Aim]) -> list[float]:
+    """:func:`_route_gap` of every robot's :class:`Aim` at once (runs in lockstep together):
+    the cells padded far away, the distances elementwise and their minima exact, so each
+    robot gets the bits it gets alone."""
+    if len(aims) == 1:
+        return [_route_gap(aims[0].f, aims[0].p, aims[0].cells)]
+    out = [math.inf] * len(aims)
+    have = [i for i, a in enumerate(aims) if len(a.cells)]
+    if not have:
+        return out
+    cells = np.full((len(have), max(len(aims[i].cells) for i in have), 2), _FAR)
+    for j, i in enumerate(have):
+        cells[j, :len(aims[i].cells)] = aims[i].cells
+    c = (np.array([aims[i].p for i in have])
+         - np.array([aims[i].f.e for i in have])[:, None] * np.array([aims[i].f.n for i in have]))
+    cells -= c[:, None]
+    gaps = np.minimum.reduce(np.hypot(cells[..., 0], cells[..., 1]), axis=1).tolist()
+    for i, gap in zip(have, gaps):
+        out[i] = gap
+    return out
 
 
 @functools.lru_cache(maxsize=8)
@@ -615,16 +727,22 @@ def perceive_rows(rows: list[Sight], max_range: float,
     size, position, distance = _obstruction_rows(
         [r.route for r in rows], [r.f for r in rows], a, b, hits, obstructing,
         widen, robots, cfg, ah, bh, [r.kept for r in rows], body)
-    common = np.array([_common(r.route, p[i], r.pose[2], r.f, float(road[i]), r.robot, cfg,
-                               r.target, r.room) for i, r in enumerate(rows)])
+    d = np.array([r.target for r in rows]) - p                          # to the targets
+    home = np.array([r.route.goal for r in rows]) - p                    # to the goals
+    far, dx, dy = np.hypot(d[:, 0], d[:, 1]).tolist(), d[:, 0].tolist(), d[:, 1].tolist()
+    common = np.array([_common_of(dx[i], dy[i], r.pose[2], r.route.length - r.f.s, r.f.e,
+                                  gone, road_i, r.robot, cfg, r.room)
+                       for i, (r, gone, road_i) in enumerate(
+                           zip(rows, np.hypot(home[:, 0], home[:, 1]).tolist(),
+                               road.tolist()))])
     heading = common[:, 0]
     wl, wr = _or(walls, max_range, body["half"][:, 0])                    # (_walls_rows)
     front, opening = _free_ways(valid_ah, valid_bh, widen, obstacle_hit, body, cfg, heading)
     ring = np.array([len(r.dirs) > 2 and float(r.dirs[0] @ r.dirs[-1])
                      >= float(r.dirs[0] @ r.dirs[1]) - 1e-9 for r in rows])
     return {"road": road, "size": size, "position": position, "obstacle": distance,
-            "heading": np.array([pursuit(r.route, r.f, p[i], heading[i], cfg, r.lookahead,
-                                         r.target) for i, r in enumerate(rows)]),
+            "heading": np.array([_pursuit_of(bearing, distance, cfg)
+                                 for bearing, distance in zip(heading.tolist(), far)]),
             "lane": common[:, 1], "goal": common[:, 2], "gap_left": wl, "gap_right": wr,
             "front": front, "opening": opening,
             "clutter": clutter_rows(hits, obstacle_hit, ah, cfg, ring),
@@ -731,8 +849,14 @@ def pursuit(route: Route, f: Frame, p: np.ndarray, bearing: float, cfg: Settings
         return bearing
     if target is None:
         target = target_point(route, f, cfg, cfg.lookahead if lookahead is None else lookahead)
-    distance = max(float(np.hypot(*(target - p))), 1e-9)
-    sine = min(1.0, cfg.lookahead / distance * math.sin(math.radians(abs(bearing))))
+    return _pursuit_of(bearing, float(np.hypot(*(target - p))), cfg)
+
+
+def _pursuit_of(bearing: float, distance: float, cfg: Settings) -> float:
+    """:func:`pursuit` of a target point ``distance`` away (Python floats)."""
+    if abs(bearing) >= 90.0:
+        return bearing
+    sine = min(1.0, cfg.lookahead / max(distance, 1e-9) * math.sin(math.radians(abs(bearing))))
     return math.copysign(math.degrees(math.asin(sine)), bearing)
 
 

@@ -19,7 +19,7 @@ import numpy as np
 
 from ..errors import WorldError
 from .distance import _capped, distance_transform
-from .geometry import clip_arrays, point_segment_distance
+from .geometry import CACHED, clip_arrays, point_segment_distance
 from .staticmap import StaticMap
 from .world import Corridor, Goal, Grid, Pose, Robot
 
@@ -198,32 +198,49 @@ def projections(routes: Sequence[Route], points: np.ndarray, hints: Sequence[flo
                 back: float = 24.0, ahead: float = 120.0) -> list[tuple[float, float, np.ndarray]]:
     """:meth:`Route.project` of every row at once (``points [R, 2]``, each on its route near
     its hint): each row's segments in its window, padded with copies of its last one (the
-    nearest is the first of equals, so never a copy), so a row gets the bits it gets alone."""
-    spans = []
+    nearest is the first of equals, so never a copy), so a row gets the bits it gets alone.
+    The rows' segments are gathered from one table of their routes' (a route shared by
+    many rows is in it once), and the nearest points read out for all rows together."""
+    table: dict[int, int] = {}               # a route's first segment in the table
+    distinct: list[Route] = []
+    firsts, stops, starts = [], [], []
+    rows = 0
     for route, hint in zip(routes, hints):
         first, stop = route._window(hint - back, hint + ahead)
-        spans.append((0, 1) if first >= stop else (first, stop))
-    width = max(stop - first for first, stop in spans)
-    a, e = np.empty((len(routes), width, 2)), np.empty((len(routes), width, 2))
-    ee, root = np.empty((len(routes), width)), np.empty((len(routes), width))
-    for i, (route, (first, stop)) in enumerate(zip(routes, spans)):
-        sa, se, see, sroot = (x[first:stop] for x in route._segments[:4])
-        m = stop - first
-        a[i, :m], e[i, :m], ee[i, :m], root[i, :m] = sa, se, see, sroot
-        a[i, m:], e[i, m:], ee[i, m:], root[i, m:] = sa[-1], se[-1], see[-1], sroot[-1]
+        if first >= stop:
+            first, stop = 0, 1
+        at = table.get(id(route))
+        if at is None:
+            at = table[id(route)] = rows
+            rows += len(route.cum)
+            distinct.append(route)
+        firsts.append(first)
+        stops.append(stop)
+        starts.append(at)
+    first, stop, at = (np.array(v) for v in (firsts, stops, starts))
+    # route j's segments at rows at_j .. at_j + M_j - 2 of the table, its arc lengths at
+    # at_j .. at_j + M_j - 1 (one more row per route in every column: the last arc length)
+    seg = [r._segments for r in distinct]
+    a = np.concatenate([np.concatenate([g[0], g[0][-1:]]) for g in seg])
+    e = np.concatenate([np.concatenate([g[1], g[1][-1:]]) for g in seg])
+    ee = np.concatenate([np.concatenate([g[2], g[2][-1:]]) for g in seg])
+    root = np.concatenate([np.concatenate([g[3], g[3][-1:]]) for g in seg])
+    cum = np.concatenate([r.cum for r in distinct])
+    width = int((stop - first).max())
+    idx = at[:, None] + np.minimum(first[:, None] + np.arange(width), stop[:, None] - 1)
+    a, e, ee, root = a[idx], e[idx], ee[idx], root[idx]                   # [R, M, ...]
     p = points[:, None]                                                    # [R, 1, 2]
     t = clip_arrays(((p - a) * e).sum(axis=2) / ee, 0.0, 1.0)              # [R, M]
     closest = a + t[..., None] * e
     gap = p - closest
     d = np.hypot(gap[..., 0], gap[..., 1])
-    out = []
-    for r, (route, (first, _)) in enumerate(zip(routes, spans)):
-        i = int(d[r].argmin())
-        s = route.cum[first + i] + t[r, i] * root[r, i]
-        tangent = e[r, i] / math.sqrt(ee[r, i])
-        rel = points[r] - closest[r, i]
-        out.append((float(s), float(rel[0] * tangent[1] - rel[1] * tangent[0]), tangent))
-    return out
+    r = np.arange(len(routes))
+    i = d.argmin(axis=1)
+    s = (cum[at + first + i] + t[r, i] * root[r, i]).tolist()
+    tangent = e[r, i] / np.sqrt(ee[r, i])[:, None]
+    rel = points - closest[r, i]
+    lateral = (rel[:, 0] * tangent[:, 1] - rel[:, 1] * tangent[:, 0]).tolist()
+    return list(zip(s, lateral, tangent))
 
 
 def distances(routes: Sequence[Route], s: Sequence[float], ahead: float,
@@ -231,7 +248,9 @@ def distances(routes: Sequence[Route], s: Sequence[float], ahead: float,
     """:meth:`Route.distance` of every row at once: row ``i``'s points ``[R, K, 2]`` from
     ``routes[i]`` between arc lengths ``s[i]`` and ``s[i] + ahead``, ``[R, K]``. Each row's
     segments are padded with copies of its last one (which the minimum cannot tell from
-    it), so a point gets the bits it gets from its route alone."""
+    it), so a point gets the bits it gets from its route alone; the sums over x and y are
+    written out (a sum of two is one addition) and the rows are worked a block at a time
+    (:data:`.geometry.CACHED`)."""
     if len(routes) == 1:
         return routes[0].distance(points[0], s[0], ahead)[None]
     spans = [route._window(si, si + ahead) for route, si in zip(routes, s)]
@@ -248,15 +267,22 @@ def distances(routes: Sequence[Route], s: Sequence[float], ahead: float,
         a[j, :stop - first], b[j, :stop - first] = pts[first:stop], pts[first + 1:stop + 1]
         a[j, stop - first:], b[j, stop - first:] = pts[stop - 1], pts[stop]
     e = b - a                                                  # [H, M, 2]
-    ee = np.maximum((e * e).sum(axis=2), 1e-12)
-    rel = points[rows][:, :, None] - a[:, None]                # [H, K, M, 2]
-    t = clip_arrays((rel * e[:, None]).sum(axis=3) / ee[:, None], 0.0, 1.0)
-    d = rel - t[..., None] * e[:, None]
-    out[rows] = np.sqrt((d * d).sum(axis=3).min(axis=2))
+    ee = np.maximum(e[..., 0] * e[..., 0] + e[..., 1] * e[..., 1], 1e-12)
+    block = max(1, CACHED // (points.shape[1] * width))
+    for lo in range(0, len(rows), block):
+        hi = min(lo + block, len(rows))
+        at = rows[lo:hi]
+        px, py = points[at, :, 0, None], points[at, :, 1, None]             # [h, K, 1]
+        ax, ay = a[lo:hi, None, :, 0], a[lo:hi, None, :, 1]                # [h, 1, M]
+        ex, ey = e[lo:hi, None, :, 0], e[lo:hi, None, :, 1]
+        rx, ry = px - ax, py - ay                                          # [h, K, M]
+        t = clip_arrays((rx * ex + ry * ey) / ee[lo:hi, None], 0.0, 1.0)
+        dx, dy = rx - t * ex, ry - t * ey
+        out[at] = np.sqrt(np.minimum.reduce(dx * dx + dy * dy, axis=2))
     return out
 
 
-def _path(came: dict[int, int], node: int) -> list[int]:
+def _path(came: dict[int, int] | list[int], node: int) -> list[int]:
     """The nodes from the start to ``node``, following ``came`` (the start's entry is -1)."""
     path = [node]
     while came[path[-1]] != -1:
@@ -713,13 +739,13 @@ def _grid_astar(allowed: memoryview, costs: memoryview, offsets: list[int], C: i
     size = len(costs) // len(offsets)
     target = divmod(goal, C)
     frontier = [(0.0, 0, start)]
-    came = {start: -1}
-    cost = {start: 0.0}
-    known = cost.get
+    came = [-1] * size                   # lists by node: cheaper to read than dicts
+    cost = [math.inf] * size
+    cost[start] = 0.0
     tie = 0
     moves = [(m * size, off) for m, off in enumerate(offsets)]
     # the loop's names bound locally: the loop runs thousands of times a search
-    pop, push, dist, inf = heapq.heappop, heapq.heappush, math.dist, math.inf
+    pop, push, dist = heapq.heappop, heapq.heappush, math.dist
     while frontier:
         node = pop(frontier)[2]
         if node == goal:
@@ -729,7 +755,7 @@ def _grid_astar(allowed: memoryview, costs: memoryview, offsets: list[int], C: i
             if allowed[base + node]:
                 nxt = node + off
                 c = here + costs[base + node]
-                if c < known(nxt, inf):
+                if c < cost[nxt]:
                     cost[nxt] = c
                     came[nxt] = node
                     tie += 1

@@ -128,17 +128,19 @@ def free_travels(sweeps: list[tuple[Body, float, bool]], reach: float,
     cx, cy = rx + half * c, ry + half * s                      # the footprint's centres
     lo_x, hi_x = cx.min(axis=1) - disc[:, 0], cx.max(axis=1) + disc[:, 0]
     lo_y, hi_y = cy.min(axis=1) - disc[:, 0], cy.max(axis=1) + disc[:, 0]
-    cells = []
+    p = np.full((n, max(len(sweeps[j][0].cells) for j in rows), 2), 1e12)
     for r, j in enumerate(rows):
-        px, py = sweeps[j][0].cells[:, 0], sweeps[j][0].cells[:, 1]
-        cells.append(sweeps[j][0].cells[(px >= lo_x[r]) & (px <= hi_x[r])
-                                        & (py >= lo_y[r]) & (py <= hi_y[r])])
-    width = max(len(cs) for cs in cells)
+        p[r, :len(sweeps[j][0].cells)] = sweeps[j][0].cells
+    px, py = p[..., 0], p[..., 1]                                           # [n, P]
+    swept = ((px >= lo_x[:, None]) & (px <= hi_x[:, None])
+             & (py >= lo_y[:, None]) & (py <= hi_y[:, None]))
+    width = int(np.count_nonzero(swept, axis=1).max())
     if not width:
         return out
-    p = np.full((n, width, 2), 1e12)
-    for r, cs in enumerate(cells):
-        p[r, :len(cs)] = cs
+    # each row's swept cells first, in their order (the others padded far away)
+    order = np.argsort(~swept, axis=1, kind="stable")[:, :width]
+    p = np.take_along_axis(p, order[..., None], axis=1)
+    p[~np.take_along_axis(swept, order, axis=1)] = 1e12
     dx, dy = p[..., 0, None] - cx[:, None], p[..., 1, None] - cy[:, None]    # [n, P, K]
     c, s = c[:, None], s[:, None]
     depth = np.minimum(hl[..., None] - np.abs(dx * c + dy * s),
