@@ -217,7 +217,7 @@ def projections(routes: Sequence[Route], points: np.ndarray, hints: Sequence[flo
         firsts.append(first)
         stops.append(stop)
         starts.append(at)
-    first, stop, at = (np.array(v) for v in (firsts, stops, starts))
+    lo, hi, base = (np.array(v) for v in (firsts, stops, starts))     # [R] each
     # route j's segments at rows at_j .. at_j + M_j - 2 of the table, its arc lengths at
     # at_j .. at_j + M_j - 1 (one more row per route in every column: the last arc length)
     seg = [r._segments for r in distinct]
@@ -226,8 +226,8 @@ def projections(routes: Sequence[Route], points: np.ndarray, hints: Sequence[flo
     ee = np.concatenate([np.concatenate([g[2], g[2][-1:]]) for g in seg])
     root = np.concatenate([np.concatenate([g[3], g[3][-1:]]) for g in seg])
     cum = np.concatenate([r.cum for r in distinct])
-    width = int((stop - first).max())
-    idx = at[:, None] + np.minimum(first[:, None] + np.arange(width), stop[:, None] - 1)
+    width = int((hi - lo).max())
+    idx = base[:, None] + np.minimum(lo[:, None] + np.arange(width), hi[:, None] - 1)
     a, e, ee, root = a[idx], e[idx], ee[idx], root[idx]                   # [R, M, ...]
     p = points[:, None]                                                    # [R, 1, 2]
     t = clip_arrays(((p - a) * e).sum(axis=2) / ee, 0.0, 1.0)              # [R, M]
@@ -236,7 +236,7 @@ def projections(routes: Sequence[Route], points: np.ndarray, hints: Sequence[flo
     d = np.hypot(gap[..., 0], gap[..., 1])
     r = np.arange(len(routes))
     i = d.argmin(axis=1)
-    s = (cum[at + first + i] + t[r, i] * root[r, i]).tolist()
+    s = (cum[base + lo + i] + t[r, i] * root[r, i]).tolist()
     tangent = e[r, i] / np.sqrt(ee[r, i])[:, None]
     rel = points - closest[r, i]
     lateral = (rel[:, 0] * tangent[:, 1] - rel[:, 1] * tangent[:, 0]).tolist()
