@@ -463,17 +463,23 @@ def test_brake_sweeps_measured_together_are_each_measured_as_alone():
             assert same(got[j], body.free(wheel, backward, safety.Settings()))
 
 
+def assert_placed_as_alone(routes, points, hints) -> None:
+    """Robots placed on their routes together (:func:`perception.frames`) get the bits
+    each gets alone."""
+    together = perception.frames(routes, points, hints)
+    for r, p, hint, f in zip(routes, points, hints, together):
+        alone = perception.frame(r, p, hint)
+        assert same(alone.s, f.s) and same(alone.e, f.e)
+        assert same(alone.t, f.t) and same(alone.n, f.n)
+
+
 def test_robots_placed_on_their_routes_together_get_the_bits_they_get_alone():
     rng = np.random.default_rng(10)
     routes = [route.Route.of(np.cumsum(rng.normal(0, 40, (int(rng.integers(2, 30)), 2)),
                                        axis=0)) for _ in range(9)]
     points = rng.normal(0, 120, (9, 2))
     hints = [float(rng.uniform(-200, r.length + 200)) for r in routes]
-    together = perception.frames(routes, points, hints)
-    for r, p, hint, f in zip(routes, points, hints, together):
-        alone = perception.frame(r, p, hint)
-        assert same(alone.s, f.s) and same(alone.e, f.e)
-        assert same(alone.t, f.t) and same(alone.n, f.n)
+    assert_placed_as_alone(routes, points, hints)
 
 
 def window_by_searchsorted(r: route.Route, lo: float, hi: float) -> tuple[int, int]:
@@ -756,8 +762,4 @@ def test_robots_sharing_routes_placed_together_get_the_bits_they_get_alone():
     routes = [shared[int(k)] for k in rng.integers(0, 5, 60)]       # each many rows' own
     points = rng.normal(0, 150, (60, 2))
     hints = [float(rng.uniform(-200, r.length + 200)) for r in routes]
-    together = perception.frames(routes, points, hints)
-    for r, p, hint, f in zip(routes, points, hints, together):
-        alone = perception.frame(r, p, hint)
-        assert same(alone.s, f.s) and same(alone.e, f.e)
-        assert same(alone.t, f.t) and same(alone.n, f.n)
+    assert_placed_as_alone(routes, points, hints)

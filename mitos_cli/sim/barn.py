@@ -331,14 +331,20 @@ def write_world(w: World, out: Path) -> list[Path]:
 MAX_SMOOTHING = 100
 
 
-def _seed(text: str) -> int:
+def _whole(text: str, low: int, high: int | None, what: str) -> int:
+    """``text`` as a whole number in ``[low, high]``, or argparse's usage error saying
+    ``what`` it is."""
     try:
         value = int(text)
     except ValueError:
         raise argparse.ArgumentTypeError(f"a whole number is expected, not `{text}`") from None
-    if value < 0:
-        raise argparse.ArgumentTypeError(f"the seed is a whole number of 0 or more, not {value}")
+    if value < low or (high is not None and value > high):
+        raise argparse.ArgumentTypeError(f"{what}, not {value}")
     return value
+
+
+def _seed(text: str) -> int:
+    return _whole(text, 0, None, "the seed is a whole number of 0 or more")
 
 
 def _fill(text: str) -> float:
@@ -355,14 +361,8 @@ def _fill(text: str) -> float:
 
 
 def _smoothing(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"a whole number is expected, not `{text}`") from None
-    if not 0 <= value <= MAX_SMOOTHING:
-        raise argparse.ArgumentTypeError(
-            f"the smoothing iterations are a whole number from 0 to {MAX_SMOOTHING}, not {value}")
-    return value
+    return _whole(text, 0, MAX_SMOOTHING, "the smoothing iterations are a whole number from 0 "
+                                          f"to {MAX_SMOOTHING}")
 
 
 def _out(text: str) -> Path:
