@@ -90,24 +90,32 @@ def exists(path: Path) -> bool:
         return False
 
 
-def display_path(path: str | None, mark: bool = True) -> str:
-    """A rule-base path as users should read it: relative to here, or marked as packaged
-    (``rulebases/mitos.rules (packaged)``; without ``mark``, the place in a file of it,
-    ``rulebases/drive.terms.yaml:103:7``, as the summary line beside it names it)."""
+def display_path(path: str | None) -> str:
+    """A rule-base path as users should read it: relative to here, or marked as packaged."""
     import os
     from pathlib import Path
 
     if not path:
         return "<rules>"
-    p = Path(path).resolve()
+    packaged = packaged_name(path)
+    if packaged is not None:
+        return f"{packaged} (packaged)"
     try:
-        packaged = Path(str(data_dir("rulebases"))).resolve()
-        if p.is_relative_to(packaged):
-            return f"rulebases/{p.relative_to(packaged).as_posix()}" + (" (packaged)"
-                                                                        if mark else "")
-    except (OSError, ValueError):
-        pass
-    try:
-        return os.path.relpath(p)
+        return os.path.relpath(Path(path).resolve())
     except ValueError:
         return str(path)
+
+
+def packaged_name(path: str) -> str | None:
+    """``rulebases/NAME`` for a file of the packaged rule bases (wherever pip put them),
+    else None."""
+    from pathlib import Path
+
+    try:
+        packaged = Path(str(data_dir("rulebases"))).resolve()
+        p = Path(path).resolve()
+        if p.is_relative_to(packaged):
+            return f"rulebases/{p.relative_to(packaged).as_posix()}"
+    except (OSError, ValueError):
+        pass
+    return None

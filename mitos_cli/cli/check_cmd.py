@@ -25,14 +25,16 @@ def show_path(path: str | None) -> str:
 
 def render(report, trace_path: str) -> str:
     """The report for people: one ``path:line:col: severity: message`` block per finding,
-    each path in the form the summary's ``checked PATH`` has (a packaged file as
-    ``rulebases/...``, not its place in site-packages)."""
-    from ..resources import display_path
+    each path as the user gave it, a packaged file as the summary's ``checked PATH`` names
+    it (``rulebases/...``, not its place in site-packages)."""
+    from ..resources import packaged_name
 
     lines = []
     for f in report.findings:
-        where = (f"{display_path(f.span.path, mark=False)}:{f.span.line}:{f.span.column}: "
-                 if f.span else "")
+        where = ""
+        if f.span:
+            path = (f.span.path and packaged_name(f.span.path)) or show_path(f.span.path)
+            where = f"{path}:{f.span.line}:{f.span.column}: "
         shown = "note" if f.severity == "info" else f.severity     # as the summary counts it
         lines.append(f"{where}{shown}: {f.message} [{f.code}]")
         for box in f.regions:
