@@ -359,6 +359,55 @@ def test_robots_sensed_together_get_the_bits_they_get_alone(name):
             assert same(getattr(alone, key)[0], getattr(together, key)[i]), (i, key)
 
 
+def box_rows(seed: int, n_rows: int = 3, n_boxes: int = 40) -> list[rows.SenseRow]:
+    """Rows among ``n_boxes`` boxes, some rotated, some on a grid the beams run along (sides
+    and corners exactly on a beam), some over a row's origin; each row its own walls."""
+    rng = np.random.default_rng(seed)
+    grid = rng.random() < 0.5
+    if grid:                                        # axis-aligned, on whole inches
+        cx, cy = rng.integers(-80, 80, (2, n_boxes)).astype(float)
+        angle = np.zeros(n_boxes)
+        size = rng.integers(2, 12, (2, n_boxes)).astype(float)
+    else:
+        cx, cy = rng.uniform(-160, 160, (2, n_boxes))
+        angle = rng.uniform(-np.pi, np.pi, n_boxes)
+        size = rng.uniform(0.5, 30, (2, n_boxes))
+    boxes = geometry.rect_corners(cx, cy, angle, size[0], size[1])
+    sides = geometry.polygon_segments(boxes)
+    robot = Robot()
+    out = []
+    for i in range(n_rows):
+        walls = rng.uniform(-200, 200, (int(rng.integers(0, 6)), 4))
+        x, y = (0.0, 0.0) if grid else rng.uniform(-100, 100, 2)
+        out.append(rows.SenseRow(float(x), float(y), float(rng.choice([0.0, np.pi / 2])) if grid
+                                 else float(rng.uniform(-np.pi, np.pi)), robot, walls,
+                                 np.concatenate([walls, sides]), boxes, rows.discs(boxes),
+                                 np.zeros((0, 2)), np.zeros(0), 0.0, rng))
+    return out
+
+
+@pytest.mark.parametrize("seed", range(40))
+def test_beams_among_many_boxes_test_only_the_boxes_they_may_hit_with_the_same_bits(
+        seed, monkeypatch):
+    parts = box_rows(seed)
+    angles = np.deg2rad(np.arange(-180.0, 180.0, 2.5))
+    origin = np.array([(r.x, r.y) for r in parts])
+    a = np.array([r.heading for r in parts])[:, None] + angles
+    dirs = np.stack([np.cos(a), np.sin(a)], axis=-1)
+    seen = 0
+    for max_range in (150.0, 40.0):
+        for chosen in ([0], [1], [0, 1, 2]):
+            some = [parts[i] for i in chosen]
+            culled = rows._cast(some, origin[chosen], dirs[chosen], max_range)
+            monkeypatch.setattr(rows, "CULL_FROM", 10 ** 9)
+            every = rows._cast(some, origin[chosen], dirs[chosen], max_range)
+            monkeypatch.undo()
+            assert rows.CULL_FROM <= 40
+            assert same(culled[0], every[0]) and same(culled[1], every[1]), (max_range, chosen)
+            seen += int((culled[1] < culled[0]).sum())
+    assert seen > 0                                         # the boxes are in view
+
+
 @pytest.mark.parametrize("name", ["slalom.yaml", "office.yaml", "detour.yaml"])
 def test_robots_perceived_together_get_the_bits_they_get_alone(name):
     sims = running(name)

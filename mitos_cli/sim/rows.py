@@ -102,18 +102,57 @@ def _stacked(arrays: list[np.ndarray], width: int | None = None) -> np.ndarray:
     return out
 
 
+CULL_FROM = 16                 # boxes from which beams test only the boxes their discs allow
+
+
 def _cast(rows: list[SenseRow], origin: np.ndarray, dirs: np.ndarray,
           max_range: float) -> tuple[np.ndarray, np.ndarray]:
     """Noise-free ranges ``[R, B]``: to the walls alone, and to everything (walls, sides and
-    circles): :func:`.geometry.ray_hits` and :func:`.geometry.ray_circles`, per element."""
+    circles): :func:`.geometry.ray_hits` and :func:`.geometry.ray_circles`, per element.
+
+    Among many boxes each beam tests the sides only of the boxes whose discs it passes
+    through (:func:`_box_hits`): a side it cannot reach is never its nearest, and the sides
+    it tests get the same formula, element by element, so every range keeps its bits."""
     walls = [len(r.walls) for r in rows]
     total = [len(r.segments) for r in rows]
-    seg = _stacked([r.segments for r in rows], max(total))              # [R, N, 4]
+    boxes = len(rows[0].boxes)
+    if boxes >= CULL_FROM and all(t - w == 4 * boxes for w, t in zip(walls, total)):
+        static = _ray_hits(_stacked([r.walls for r in rows], max(walls)), origin, dirs)
+        hit = np.minimum(np.minimum(static, _box_hits(rows, origin, dirs, max_range)),
+                         max_range)
+        static = np.minimum(static, max_range)
+    else:
+        t = _ray_hits(_stacked([r.segments for r in rows], max(total)), origin, dirs, keep=True)
+        hit = np.minimum(t.min(axis=2, initial=np.inf), max_range)
+        if walls == total:                              # no sides: the walls are all there is
+            static = hit
+        elif min(walls) == max(walls):                  # the walls come first in every row
+            static = np.minimum(t[..., :walls[0]].min(axis=2, initial=np.inf), max_range)
+        else:
+            is_wall = np.arange(t.shape[2]) < np.array(walls)[:, None]
+            static = np.minimum(np.where(is_wall[:, None], t, np.inf)
+                                .min(axis=2, initial=np.inf), max_range)
+    if not len(rows[0].centres):
+        return static, hit
+    return static, np.minimum(hit, _circles(rows, origin, dirs, max_range))
+
+
+def _ray_hits(seg: np.ndarray, origin: np.ndarray, dirs: np.ndarray, keep: bool = False):
+    """How far along each beam ``dirs [R, B, 2]`` from ``origin [R, 2]`` it meets each
+    segment ``seg [R, N, 4]`` (``inf`` where it does not): ``[R, B, N]`` when ``keep``, else
+    the nearest ``[R, B]``."""
     run = seg[..., 2:] - seg[..., :2]                                   # [R, N, 2]
     start = seg[..., :2] - origin[:, None]
-    ex, ey = run[:, None, :, 0], run[:, None, :, 1]                     # [R, 1, N]
-    px, py = start[:, None, :, 0], start[:, None, :, 1]
-    dx, dy = dirs[..., 0, None], dirs[..., 1, None]                     # [R, B, 1]
+    t = _along(dirs[..., 0, None], dirs[..., 1, None],                  # [R, B, 1]
+               run[:, None, :, 0], run[:, None, :, 1],                  # [R, 1, N]
+               start[:, None, :, 0], start[:, None, :, 1])
+    return t if keep else t.min(axis=2, initial=np.inf)
+
+
+def _along(dx, dy, ex, ey, px, py) -> np.ndarray:
+    """:func:`.geometry.ray_hits`' formula, elementwise: how far along the beam ``(dx, dy)``
+    it meets the segment from ``(px, py)`` (relative to the beam's origin) running
+    ``(ex, ey)``, or ``inf``."""
     denom = cross(dx, dy, ex, ey)
     ok = np.abs(denom) > EPS
     safe = np.where(ok, denom, 1.0)
@@ -121,19 +160,35 @@ def _cast(rows: list[SenseRow], origin: np.ndarray, dirs: np.ndarray,
     s = cross(px, py, dx, dy) / safe
     ok &= t >= 0.0
     ok &= s == clip_arrays(s, 0.0, 1.0)                 # 0 <= s <= 1 (false for NaN, too)
-    t = np.where(ok, t, np.inf)                                         # [R, B, N]
-    hit = np.minimum(t.min(axis=2, initial=np.inf), max_range)
-    if walls == total:                                  # no sides: the walls are all there is
-        static = hit
-    elif min(walls) == max(walls):                      # the walls come first in every row
-        static = np.minimum(t[..., :walls[0]].min(axis=2, initial=np.inf), max_range)
-    else:
-        is_wall = np.arange(seg.shape[1]) < np.array(walls)[:, None]
-        static = np.minimum(np.where(is_wall[:, None], t, np.inf).min(axis=2, initial=np.inf),
-                            max_range)
-    if not len(rows[0].centres):
-        return static, hit
-    return static, np.minimum(hit, _circles(rows, origin, dirs, max_range))
+    return np.where(ok, t, np.inf)
+
+
+def _box_hits(rows: list[SenseRow], origin: np.ndarray, dirs: np.ndarray,
+              max_range: float) -> np.ndarray:
+    """The nearest box side along every beam ``[R, B]`` (``inf`` for none), testing a beam
+    only against the boxes whose enclosing discs (:func:`discs`) it passes through within
+    ``max_range``, with 1e-6 in of slack on top of theirs."""
+    middle = _stacked([r.discs[0] for r in rows]) - origin[:, None]    # [R, P, 2]
+    radius = _stacked([r.discs[1] for r in rows])[:, None] + 1e-6      # [R, 1, P]
+    dx, dy = dirs[..., 0, None], dirs[..., 1, None]                     # [R, B, 1]
+    mx, my = middle[:, None, :, 0], middle[:, None, :, 1]               # [R, 1, P]
+    along = dx * mx + dy * my                                           # [R, B, P]
+    maybe = np.abs(dx * my - dy * mx) <= radius
+    maybe &= along >= -radius
+    maybe &= along - radius <= max_range
+    r, b, p = np.nonzero(maybe)
+    out = np.full(dirs.shape[:2], np.inf)
+    if not len(r):
+        return out
+    sides = _stacked([r_.segments[len(r_.walls):] for r_ in rows])      # [R, 4P, 4]
+    seg = sides.reshape(len(rows), -1, 4, 4)[r, p]                      # [K, 4, 4]
+    run = seg[..., 2:] - seg[..., :2]                                   # [K, 4, 2]
+    start = seg[..., :2] - origin[r, None]
+    d = dirs[r, b]                                                      # [K, 2]
+    t = _along(d[:, 0, None], d[:, 1, None], run[..., 0], run[..., 1],
+               start[..., 0], start[..., 1]).min(axis=1)                # [K]
+    np.minimum.at(out, (r, b), t)
+    return out
 
 
 def _circles(rows: list[SenseRow], origin: np.ndarray, dirs: np.ndarray,
