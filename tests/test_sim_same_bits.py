@@ -376,7 +376,7 @@ def box_rows(seed: int, n_rows: int = 3, n_boxes: int = 40) -> list[rows.SenseRo
     sides = geometry.polygon_segments(boxes)
     robot = Robot()
     out = []
-    for i in range(n_rows):
+    for _ in range(n_rows):
         walls = rng.uniform(-200, 200, (int(rng.integers(0, 6)), 4))
         x, y = (0.0, 0.0) if grid else rng.uniform(-100, 100, 2)
         out.append(rows.SenseRow(float(x), float(y), float(rng.choice([0.0, np.pi / 2])) if grid
