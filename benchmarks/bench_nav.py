@@ -341,12 +341,14 @@ def aims(results: dict, ticks: dict | None) -> list[str]:
         out.append(f"| building maps with unknown clutter: >= 97% success | fuzzy "
                    f"{100 * fc['success_rate']:.1f}% ({fc['runs']} runs) | "
                    f"{'yes' if fc['success_rate'] >= 0.97 else 'no'} |")
-    if ticks:
-        worst = min(ticks[p]["ticks_per_s"] for p in ticks if isinstance(ticks[p], dict))
-        out.append(f"| {ticks['obstacles']} unknown obstacles: >= 100 ticks/s on one core | "
+    if ticks and isinstance(ticks.get("fuzzy"), dict):
+        # the aim is the product's planner, as every other line here; the baselines beside it
+        rate = ticks["fuzzy"]["ticks_per_s"]
+        out.append(f"| {ticks['obstacles']} unknown obstacles: the fuzzy planner >= 100 ticks/s "
+                   f"on one core | "
                    + ", ".join(f"{p} {v['ticks_per_s']:.0f} ({v['ticks_per_cpu_s']:.0f} per "
                                f"CPU s)" for p, v in ticks.items() if isinstance(v, dict))
-                   + f" | {'yes' if worst >= 100 else 'no'} |")
+                   + f" | {'yes' if rate >= 100 else 'no'} |")
     return out
 
 
