@@ -172,6 +172,7 @@ class MitosEnv(gymnasium.Env):
 
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
         seed = _check_seed(seed)
+        self.sim.randomise = _randomise(options)
         super().reset(seed=seed)
         if seed is None:
             seed = (int(self.np_random.integers(2**31)) if self._seeded else self.world.seed)
@@ -310,6 +311,32 @@ def _check_options(others: dict[str, Any], observe_ranges: object, render_mode: 
     if not isinstance(observe_ranges, (bool, np.bool_)):
         raise EnvOptionError(f"observe_ranges is True or False, not `{observe_ranges!r:.40}`",
                              hint="observe_ranges=True adds the sonar ranges to the observation")
+
+
+RESET_OPTIONS = ("randomise",)
+
+
+def _randomise(options: object) -> bool:
+    """Whether ``reset(options=...)`` asks for a randomised episode (``{"randomise": True}``:
+    obstacle places and sensor noise drawn from the world's ``randomise:`` ranges by the seed,
+    as ``mitos simulate --seed S --randomise`` does). Another key, or a value that is not a
+    bool, is an :class:`EnvOptionError`: an option ignored would be a silently different run."""
+    if options is None:
+        return False
+    if not isinstance(options, dict):
+        raise EnvOptionError(f"reset's options are a dict, not `{options!r:.40}`",
+                             hint='reset(options={"randomise": True})')
+    for name in options:
+        if name not in RESET_OPTIONS:
+            near = closest(str(name), RESET_OPTIONS)
+            raise EnvOptionError(f"unknown option `{name!s:.40}` of reset",
+                                 expected="one of " + ", ".join(RESET_OPTIONS),
+                                 hint=f"did you mean `{near}`?" if near else None)
+    value = options.get("randomise", False)
+    if not isinstance(value, (bool, np.bool_)):
+        raise EnvOptionError(f"randomise is True or False, not `{value!r:.40}`",
+                             hint="randomise=True draws the world's randomise: ranges")
+    return bool(value)
 
 
 def _check_seed(seed: object) -> int | None:

@@ -303,3 +303,35 @@ def test_every_keyword_the_options_list_is_one_the_environment_takes():
 
     params = inspect.signature(mgym.MitosEnv.__init__).parameters
     assert set(mgym.OPTIONS) == {p for p in params if p not in ("self", "others")}
+
+
+def test_a_randomised_reset_is_the_run_simulate_randomises_and_the_next_reset_is_not():
+    """`reset(options=...)` was ignored whatever it held: `{"randomise": True}` gave the
+    world as written, without a word."""
+    path = packaged_path("worlds", "moving.yaml")
+    env = gymnasium.make("mitos/Moving-v0")
+    obs, _ = env.reset(seed=7, options={"randomise": True})
+    for _ in range(40):
+        obs, *_ = env.step(env.unwrapped.fuzzy_policy(obs))
+    ran = env.unwrapped.sim.result()
+    ref = simulate(load_world(path), seed=7, randomise=True)
+    assert ran.ticks == 40
+    assert np.array_equal(ran.pose, ref.pose[:40])
+    assert env.unwrapped.sim.world.obstacles != load_world(path).obstacles
+    env.reset(seed=7)
+    assert env.unwrapped.sim.world.obstacles == load_world(path).obstacles
+
+
+@pytest.mark.parametrize(("options", "says", "hint"), [
+    ({"randomize": True}, "unknown option `randomize` of reset", "did you mean `randomise`?"),
+    ({"randomise": "yes"}, "randomise is True or False, not `'yes'`",
+     "randomise=True draws the world's randomise: ranges"),
+    (["randomise"], "reset's options are a dict, not `['randomise']`",
+     'reset(options={"randomise": True})'),
+])
+def test_a_reset_option_the_environment_does_not_take_is_said_with_the_options(
+        options, says, hint):
+    env = mgym.MitosEnv("corridor")
+    with pytest.raises(mgym.EnvOptionError) as info:
+        env.reset(seed=1, options=options)
+    assert (info.value.message, info.value.hint) == (says, hint)
