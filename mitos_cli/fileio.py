@@ -76,6 +76,17 @@ def why_unreadable(exc: OSError | UnicodeDecodeError) -> str:
     return str(exc.strerror or exc)
 
 
+def unreadable(kind: str, path: object, exc: OSError | UnicodeDecodeError) -> str:
+    """The words for a ``kind`` of file (``rule file``, ``term set``, ...) that could not be
+    read: "not found" when it is not there (as every command says it), "is a directory", or
+    "cannot read" with :func:`why_unreadable`'s reason."""
+    if isinstance(exc, FileNotFoundError):
+        return f"{kind} `{path}` not found"
+    if isinstance(exc, IsADirectoryError):
+        return f"`{path}` is a directory, not a {kind}"
+    return f"cannot read {kind} `{path}`: {why_unreadable(exc)}"
+
+
 def check_writable(path: str | Path) -> None:
     """Refuse, before any work, a file that cannot be written where it is named: its directory
     missing or not writable, or the name a directory's (a device or a pipe, /dev/stdout, is

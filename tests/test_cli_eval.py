@@ -273,7 +273,7 @@ def test_an_input_without_its_equals_sign_is_a_usage_error(capsys):
     assert "`road78` is neither a rule file nor NAME=VALUE" in " ".join(
         err.replace("│", " ").split())
     code, _, err = run_main(["eval", "missing.rules", "road=78"], capsys)
-    assert code == 1 and "cannot read rule file `missing.rules`" in err
+    assert code == 1 and "rule file `missing.rules` not found" in err
 
 
 def test_a_misspelt_rule_file_or_its_term_set_named_instead_say_what_was_meant(capsys):

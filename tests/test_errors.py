@@ -170,13 +170,13 @@ def test_a_missing_rule_file_guesses_only_a_close_name(tmp_path, capsys):
         with pytest.raises(SystemExit) as info:
             main(args)
         err = capsys.readouterr().err
-        assert info.value.code == 1 and "cannot read rule file" in err
+        assert info.value.code == 1 and "rule file `" in err and "` not found" in err
         assert (f"hint: {hint}" in err) if hint else "did you mean" not in err, err
 
 
 def test_missing_rule_file():
     exc = error_of(lambda: load_rules_file("no/such.rules"), RuleBaseError)
-    assert "cannot read rule file `no/such.rules`" in exc.message
+    assert "rule file `no/such.rules` not found" in exc.message
 
 
 # ---------------------------------------------------------------------------------------------
@@ -471,8 +471,8 @@ def run_main(args, capsys):
     (["eval", "road=nan", "size=45", "position=4"], "input `road` is not a number (NaN)"),
     (["eval", "-b", "avoid", "road=78", "size=45", "position=4"],
      "unknown behavior `avoid`"),
-    (["eval", "no/such.rules", "road=1"], "cannot read rule file `no/such.rules`"),
-    (["check", "no/such.rules"], "cannot read rule file `no/such.rules`"),
+    (["eval", "no/such.rules", "road=1"], "rule file `no/such.rules` not found"),
+    (["check", "no/such.rules"], "rule file `no/such.rules` not found"),
 ])
 def test_cli_user_errors_exit_1(capsys, args, message):
     code, out, err = run_main(args, capsys)

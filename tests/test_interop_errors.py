@@ -335,7 +335,7 @@ def test_unknown_extension_and_missing_file(tmp_path: Path) -> None:
     # a missing file is not a format error: it is reported as for a .rules file
     from mitos_cli.errors import RuleBaseError
 
-    with pytest.raises(RuleBaseError, match="cannot read rule file .*No such file"):
+    with pytest.raises(RuleBaseError, match="rule file `.*` not found"):
         read_foreign(tmp_path / "x.fll")
     (tmp_path / "tipper.fll").write_text(FLL)
     with pytest.raises(RuleBaseError) as exc:

@@ -92,7 +92,7 @@ def test_given_none_and_its_misspelling():
 
 def test_a_given_map_that_is_missing_is_named_where_it_is_written():
     text = error(world_text(CORRIDOR.replace("map:\n", "map:\n  given: nowhere.yaml\n")))
-    assert "w.yaml:14:10" in text and "cannot read map file `nowhere.yaml`" in text
+    assert "w.yaml:14:10" in text and "map file `nowhere.yaml` not found" in text
 
 
 def test_a_misspelt_map_or_route_key_suggests_it():

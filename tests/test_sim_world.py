@@ -112,7 +112,7 @@ def test_unreadable_map_image(tmp_path: Path):
     with pytest.raises(WorldError) as info:
         load_world(world)
     msg = info.value.render()
-    assert "map.yaml:1:8" in msg and "cannot read map image" in msg and "missing.pgm" in msg
+    assert "map.yaml:1:8" in msg and "map image `" in msg and "missing.pgm` not found" in msg
 
 
 def test_a_map_image_that_is_not_a_pgm(tmp_path: Path):

@@ -98,7 +98,7 @@ def test_usage_errors(work):
     res = mitos("teach", "rb/nosuch.rules", cwd=work)      # nothing close: no guess
     assert res.returncode == 1 and "did you mean" not in res.stderr
     res = mitos("teach", "rb/mitos.rules", "--lesson", "missing.lesson", cwd=work)
-    assert res.returncode == 1 and "cannot read lesson `missing.lesson`" in res.stderr
+    assert res.returncode == 1 and "lesson `missing.lesson` not found" in res.stderr
     res = mitos("teach", "rb", cwd=work)
     assert res.returncode == 1 and "`rb` is a directory, not a rule file" in res.stderr
     res = mitos("teach", "rb/mitos.rules", "-b", "drvie", cwd=work)

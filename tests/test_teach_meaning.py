@@ -237,7 +237,7 @@ def test_outside_the_repository_packaged_rules_and_lessons_are_found_and_save_re
     assert res.returncode == 0, res.stderr
     assert "saved a.rules" in res.stdout                   # where the earlier `save` went
     res = teach("--lesson", "no-such-lesson")
-    assert res.returncode == 1 and "cannot read lesson `no-such-lesson`" in res.stderr
+    assert res.returncode == 1 and "lesson `no-such-lesson` not found" in res.stderr
     assert "a packaged lesson: wider-turn" in res.stderr
     res = teach("rulebases/mitos.rules", "--lesson", "wider-trun")     # a packaged name, mistyped
     assert res.returncode == 1 and "did you mean `wider-turn`?" in res.stderr

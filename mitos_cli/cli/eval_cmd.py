@@ -245,13 +245,12 @@ def run_batch(rb, source: str, on_no_rule: NoRule | None = None,
                 from None
         name = "<stdin>"
     else:
-        from ..fileio import read_text, why_unreadable
+        from ..fileio import read_text, unreadable
 
         try:
             text, name = read_text(source), source
         except (OSError, UnicodeDecodeError) as exc:
-            raise InputError(f"cannot read batch file `{source}`: {why_unreadable(exc)}") \
-                from None
+            raise InputError(unreadable("batch file", source, exc)) from None
     batch = read_table(text, name, rb.compiled.inputs, unused_inputs(rb))
     X = batch.X
     result = rb.run(X, strict=False, detail=False)

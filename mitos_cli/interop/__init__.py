@@ -13,7 +13,7 @@ import re
 from pathlib import Path
 
 from ..errors import FormatError, MitosError, RuleBaseError
-from ..fileio import nearby
+from ..fileio import nearby, unreadable
 from ..lang.model import RuleBase
 
 READERS = {".fcl": "fcl", ".fis": "fis", ".fll": "fll"}
@@ -30,8 +30,7 @@ def read_foreign(path: str | Path) -> RuleBase:
     try:
         path.open("rb").close()
     except OSError as exc:
-        raise RuleBaseError(f"cannot read rule file `{path}`: {exc.strerror or exc}",
-                            hint=nearby(path)) from None
+        raise RuleBaseError(unreadable("rule file", path, exc), hint=nearby(path)) from None
     if kind == "fll":
         from .fll import read_fll
 

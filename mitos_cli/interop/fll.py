@@ -30,7 +30,7 @@ from lark import Lark, Tree
 from lark.exceptions import UnexpectedInput
 
 from ..errors import FormatError, Span, did_you_mean
-from ..fileio import read_text
+from ..fileio import read_text, unreadable
 from ..fuzzy.formula import parse as parse_formula
 from ..lang.bulk import without_cyclic_gc
 from ..lang.cache import lark_parser
@@ -124,7 +124,7 @@ def _read_text(path: Path) -> str:
     except UnicodeDecodeError:
         raise FormatError(f"`{path}` is not a text file (it is not UTF-8)") from None
     except OSError as exc:
-        raise FormatError(f"cannot read `{path}`: {exc.strerror or exc}") from None
+        raise FormatError(unreadable("rule file", path, exc)) from None
 
 
 @without_cyclic_gc

@@ -25,7 +25,7 @@ MAIN = "main"
 @without_cyclic_gc
 def load_rules_file(path: str | Path) -> RuleBase:
     """Read, parse and check the rule file at ``path`` and the term sets it names."""
-    from ..fileio import finish_saves, nearby, read_text
+    from ..fileio import finish_saves, nearby, read_text, unreadable
 
     path = Path(path)
     finish_saves(path, error=RuleBaseError)   # a set save a crash left half done
@@ -35,8 +35,7 @@ def load_rules_file(path: str | Path) -> RuleBase:
         raise RuleBaseError(f"`{path}` is not a text file (it is not UTF-8)",
                             span=Span(str(path), 1, 1)) from None
     except OSError as exc:
-        raise RuleBaseError(f"cannot read rule file `{path}`: {exc.strerror or exc}",
-                            hint=nearby(path)) from None
+        raise RuleBaseError(unreadable("rule file", path, exc), hint=nearby(path)) from None
     parsed = parse_rules(text, str(path))
     termsets = []
     seen: dict[Path, str] = {}

@@ -54,13 +54,13 @@ ALIASES = {"constant": "singleton"}     # Takagi-Sugeno's name for a crisp conse
 
 def load_termset(path: str | Path) -> TermSet:
     """Read and validate the term set at ``path``."""
-    from ..fileio import read_text
+    from ..fileio import read_text, unreadable
 
     path = Path(path)
     try:
         text = read_text(path)
     except OSError as exc:
-        raise TermSetError(f"cannot read term set `{path}`: {exc.strerror or exc}") from None
+        raise TermSetError(unreadable("term set", path, exc)) from None
     except UnicodeDecodeError as exc:
         data = exc.object
         line = data.count(b"\n", 0, exc.start) + 1

@@ -26,6 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import Span, WorldError, unknown
+from ..fileio import unreadable
 from ..lang import yamlpos
 from ..resources import exists
 from .pgm import read_pgm
@@ -129,7 +130,7 @@ def rotate(blocked: np.ndarray, res: float, origin: tuple[float, float],
 def load_map_yaml(path: Path, *, unknown_occupied: bool = True,
                   where: Span | None = None) -> Grid:
     """Read a map_server ``map.yaml`` and its image into a :class:`Grid` in inches."""
-    from ..fileio import read_text, why_unreadable
+    from ..fileio import read_text
 
     if path.suffix.lower() in IMAGE_SUFFIXES:        # the image named where its YAML goes
         beside = [p for p in (path.with_suffix(".yaml"), path.parent / "map.yaml") if exists(p)]
@@ -142,7 +143,7 @@ def load_map_yaml(path: Path, *, unknown_occupied: bool = True,
     try:
         text = read_text(path)
     except (OSError, UnicodeDecodeError) as exc:
-        raise WorldError(f"cannot read map file `{path}`: {why_unreadable(exc)}",
+        raise WorldError(unreadable("map file", path, exc),
                          span=where) from None
     # Until the file is known to be a map file, an error quotes nothing of it (docs/security.md).
     named = path.suffix.lower() in (".yaml", ".yml")
@@ -188,7 +189,7 @@ def load_map_yaml(path: Path, *, unknown_occupied: bool = True,
         raise WorldError(f"cannot read map image `{image_path}`: {exc}",
                          span=spec.value_span("image")) from None
     except OSError as exc:
-        raise WorldError(f"cannot read map image `{image_path}`: {exc.strerror or exc}",
+        raise WorldError(unreadable("map image", image_path, exc),
                          span=spec.value_span("image"),
                          hint="the image path is relative to the map's YAML file") from None
     except ValueError as exc:

@@ -40,6 +40,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import MitosError, Span, WorldError
+from ..fileio import unreadable
 from .gridmap import INCH_PER_M, load_map_yaml
 from .loop import prepare
 from .world import Agent, Goal, Pose, Randomise, Robot, Sensors, World
@@ -63,8 +64,7 @@ def read_tests(path: Path) -> list[tuple[int, Pose, Pose]]:
     try:
         text = path.read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError) as exc:
-        raise WorldError(f"cannot read MRPB tests `{path}`: "
-                         f"{getattr(exc, 'strerror', None) or exc}") from None
+        raise WorldError(unreadable("MRPB tests", path, exc)) from None
     out = []
     for i, line in enumerate(text.splitlines(), 1):
         if not line.strip() or line.lstrip().startswith("#"):

@@ -77,12 +77,12 @@ def read_lesson(source: str) -> tuple[str, str]:
         found = resolve("rulebases/lessons", source, ".lesson")
         if found is not None:
             path, source = found, str(found)
-    from ..fileio import read_text, why_unreadable
+    from ..fileio import read_text, unreadable
 
     try:
         return read_text(path), source
     except (OSError, UnicodeDecodeError) as exc:
-        error = LessonError(f"cannot read lesson `{source}`: {why_unreadable(exc)}")
+        error = LessonError(unreadable("lesson", source, exc))
         if isinstance(exc, UnicodeDecodeError):        # the place of the first bad byte
             data = exc.object
             line = data.count(b"\n", 0, exc.start) + 1
