@@ -15,11 +15,22 @@ from pathlib import Path
 import numpy as np
 
 from .engine.compile import CompiledRuleBase, compile_rulebase
-from .engine.evaluation import Result, as_batch, as_columns, evaluate, evaluate_columns, evaluate_one
+from .engine.evaluation import (
+    Result,
+    as_batch,
+    as_columns,
+    evaluate,
+    evaluate_columns,
+    evaluate_floats,
+)
 from .engine.trace import Trace, trace_of
 from .errors import MitosError
 from .lang.model import RuleBase
 from .resources import DEFAULT_RULEBASE, packaged_path
+
+#: The types the one-sample path of :meth:`LoadedRuleBase.evaluate` takes as they are (not
+#: ``bool``, whose type is its own: ``True`` is refused, not read as 1)
+_NUMBERS = {float, int}
 
 
 def default_rulebase_path() -> Path:
@@ -149,13 +160,13 @@ class LoadedRuleBase:
     def evaluate(self, **inputs) -> dict[str, float | np.ndarray]:
         """Outputs for inputs given by name (floats, or arrays evaluated as one batch)."""
         c = self.compiled
-        if len(inputs) == len(c.inputs) and all(type(v) in (float, int) for v in inputs.values()):
+        if len(inputs) == len(c.inputs) and _NUMBERS.issuperset(map(type, inputs.values())):
             try:                               # numbers by name: the one-sample path
                 values = [float(inputs[name]) for name in c.inputs]
             except (KeyError, OverflowError):
                 pass                           # a misspelt name, 10**400: as_columns explains
             else:
-                return dict(zip(c.outputs, evaluate_one(c, values)))
+                return dict(zip(c.outputs, evaluate_floats(c, values)))
         columns = as_columns(c, inputs)
         if all(np.ndim(v) == 0 for v in inputs.values()):
             result = evaluate(c, np.array([columns]).reshape(1, -1), detail=False)

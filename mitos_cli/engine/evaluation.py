@@ -698,12 +698,20 @@ def evaluate_one(compiled: CompiledRuleBase, values: list[float],
     (:mod:`mitos_cli.engine.scalar`, a few microseconds instead of some forty NumPy calls).
     Values other than floats are read as :func:`~.inputs.floats` reads them (the scalar form
     would take ``True`` as 1)."""
-    if not set(map(type, values)) <= _FLOAT:
+    if not _FLOAT.issuperset(map(type, values)):
         values = floats(values, "the inputs", many=True).tolist()
+    return evaluate_floats(compiled, values, strict)
+
+
+def evaluate_floats(compiled: CompiledRuleBase, values: list[float],
+                    strict: bool = True) -> tuple[float, ...]:
+    """:func:`evaluate_one` of values already Python floats (the caller has made them so)."""
     fn = compiled.scalar                # _evaluate_one's outputs, without the clamped inputs
     if fn is not None and len(values) == len(compiled.inputs):
         outputs = fn(*values)
-        if outputs is not None and not any(y != y for y in outputs):
+        # a NaN output (no rule fired: the default, or an error) makes the sum NaN; so do
+        # +inf and -inf together, which the NumPy path then answers as well
+        if outputs is not None and (total := sum(outputs)) == total:
             return outputs
     return tuple(evaluate(compiled, np.array([values], dtype=float), detail=False,
                           strict=strict).outputs[0].tolist())
@@ -717,7 +725,7 @@ def _evaluate_one(compiled: CompiledRuleBase,
     if fn is None or len(values) != len(compiled.inputs):
         return None
     outputs = fn(*values)
-    if outputs is None or any(y != y for y in outputs):
+    if outputs is None or (total := sum(outputs)) != total:      # NaN: as evaluate_floats
         return None
     lo, hi = compiled.plan.bounds
     clamped = [(a if x < a else b if x > b else x) + 0.0 for x, a, b in zip(values, lo, hi)]
