@@ -195,6 +195,22 @@ def test_resume_with_worlds_reordered_is_refused(tmp_path):
     assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before
 
 
+def test_resume_may_add_runs_but_not_leave_finished_ones_out(tmp_path):
+    """`compare W --resume --and product` on a study of two worlds and two norms rewrote its
+    report and study.json for the narrower selection, with results.csv still holding all."""
+    run_study(small_study(runs=1), tmp_path, workers=1, task_fn=fake_sim)
+    before = {p.name: p.read_bytes() for p in tmp_path.iterdir()}
+    narrower = Study(**{**small_study(runs=1).__dict__, "worlds": ["w1.yaml"]})
+    with pytest.raises(StudyError) as exc:
+        run_study(narrower, tmp_path, workers=1, resume=True, task_fn=fake_sim)
+    assert exc.value.message.endswith("holds 3 finished runs this study leaves out (the "
+                                      "first: run 0 of w2.yaml, fuzzy, and=min); resuming "
+                                      "would report on part of the file")
+    assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before
+    wider = run_study(small_study(runs=2), tmp_path, workers=1, resume=True, task_fn=fake_sim)
+    assert (wider.skipped, wider.executed) == (6, 6)
+
+
 def test_hand_edited_results_are_reported(tmp_path):
     run_study(small_study(runs=1), tmp_path, workers=1, task_fn=fake_sim)
     path = tmp_path / "results.csv"

@@ -149,6 +149,8 @@ class ResultStore:
         if old is not None:
             _check_unchanged(old.get("digests") or {}, manifest.get("digests") or {}, self.path)
         finished, todo = rows_for(tasks, rows)
+        if len(finished) < len(rows):
+            _refuse_narrower(rows, finished, old or {}, self.path)
         write_atomic(self.manifest_path, json.dumps(manifest, indent=2) + "\n")
         if not rows:
             write_atomic(self.path, ",".join(COLUMNS) + "\n")
@@ -194,6 +196,25 @@ def _check_unchanged(old: dict, new: dict, path: Path) -> None:
         raise StudyError(f"{what} changed since the runs in {path} were made; resuming would "
                          f"mix runs of the old and the new file",
                          hint="choose another directory with -o (or put the file back)")
+
+
+def _refuse_narrower(rows: list[dict], finished: list[dict], old: dict, path: Path) -> None:
+    """A resumed study that leaves out runs already in ``results.csv`` (fewer worlds, norms,
+    planners or runs): its report would cover part of the file, and the study's own report
+    would be replaced by it. Resuming may add runs, never drop them."""
+    kept = {key_of(r) for r in finished}
+    left = [r for r in rows if key_of(r) not in kept]
+    first = left[0]
+    choice = ", ".join([first["planner"]] + [f"{k}={first[k]}" for k in ("and", "or", "inference")
+                                             if first[k]])
+    command = old.get("command")
+    raise StudyError(
+        f"{path} holds {plural(len(left), 'finished run')} this study leaves out (the first: "
+        f"run {first['run']} of {Path(first['world']).name}, {choice}); resuming would report "
+        f"on part of the file",
+        hint=(f"resume the study as it was made: {command} --resume" if command else
+              "resume with the worlds, choices and runs the study was made with")
+        + ", or choose another directory with -o")
 
 
 def rows_for(tasks: Iterable[Task], rows: list[dict]) -> tuple[list[dict], list[Task]]:
