@@ -145,6 +145,16 @@ def test_a_stray_word_is_reported_not_the_next_label(tmp_path, typo, line, col, 
     assert hint in exc.hint and "`:`" not in (exc.expected or "")
 
 
+@pytest.mark.parametrize("header", ["behavior a", "behavior a   # the first one"])
+def test_a_header_without_its_colon_is_said_at_its_end(tmp_path, header):
+    """`behavior a` without `:` was "unexpected `r1`, expected `:`" at the next line."""
+    path = write(tmp_path, header + "\n  r1: if road is WIDE then speed is SLOW\nend\n")
+    exc = error_of(lambda: load_rules_file(path), RuleSyntaxError)
+    assert exc.message == "missing `:` after `behavior a`"
+    assert str(exc.span) == f"{path}:2:11" and exc.expected == "`:` at the end of the line"
+    assert exc.render().splitlines()[2] == "    " + " " * len("behavior a") + "^"
+
+
 def test_syntax_error_in_a_wrapped_rule_points_at_its_line(tmp_path):
     path = write(tmp_path, "r1: if road is WIDE\n    and size SMALL_SZ\n    then speed is SLOW\n")
     exc = error_of(lambda: load_rules_file(path), RuleSyntaxError)

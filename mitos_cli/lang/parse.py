@@ -133,6 +133,9 @@ def syntax_error(exc: UnexpectedInput, text: str, path: str | None) -> RuleSynta
     stray = _stray_label(exc, text, path)
     if isinstance(stray, RuleSyntaxError):
         return stray
+    missing = _missing_colon(exc, text, path)
+    if missing is not None:
+        return missing
     span = Span.in_text(text, path, token.line, token.column,
                         token.column + max(1, len(str(token.value))))
     hint = None
@@ -158,6 +161,20 @@ def syntax_error(exc: UnexpectedInput, text: str, path: str | None) -> RuleSynta
     hint = _statement_hint(text, token.start_pos) or stray or hint
     return RuleSyntaxError(f"unexpected {_describe(token)}", span=span,
                            expected=_expected(expected), hint=hint)
+
+
+def _missing_colon(exc: UnexpectedToken, text: str, path: str | None) -> RuleSyntaxError | None:
+    """A line that ends without the `:` it needs (`behavior drive` and the rules on the next
+    line): said at the end of that line, not at the next line's first word."""
+    last = (exc.token_history or [None])[-1]
+    if set(exc.expected) != {"COLON"} or last is None or last.end_line is None \
+            or last.end_line >= exc.token.line:
+        return None
+    line = text.splitlines()[last.end_line - 1]
+    return RuleSyntaxError(f"missing `:` after `{line[:last.end_column - 1].strip()}`",
+                           span=Span.in_text(text, path, last.end_line, last.end_column,
+                                             last.end_column + 1),
+                           expected="`:` at the end of the line")
 
 
 def _label_word(exc: UnexpectedToken) -> Token | None:
