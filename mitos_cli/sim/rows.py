@@ -180,7 +180,7 @@ def _box_hits(rows: list[SenseRow], origin: np.ndarray, dirs: np.ndarray,
     out = np.full(dirs.shape[:2], np.inf)
     if not len(r):
         return out
-    sides = _stacked([r_.segments[len(r_.walls):] for r_ in rows])      # [R, 4P, 4]
+    sides = _stacked([row.segments[len(row.walls):] for row in rows])    # [R, 4P, 4]
     seg = sides.reshape(len(rows), -1, 4, 4)[r, p]                      # [K, 4, 4]
     run = seg[..., 2:] - seg[..., :2]                                   # [K, 4, 2]
     start = seg[..., :2] - origin[r, None]
