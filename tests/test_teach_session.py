@@ -258,6 +258,48 @@ def test_simulate_and_at_and_their_mistakes(rules, tmp_path):
         s.run("adapt epochs 3 plot a.gif")
 
 
+def test_at_corrects_the_behavior_that_drove_the_run(rules):
+    """`use drive`, `simulate`, then `use avoid_obstacle` and `at ...`: the examples were made
+    from avoid_obstacle's output (steering 70, an output nobody used: its context had weight
+    0 on the straight) and taught its rules to steer hard left with no obstacle. A correction
+    of what the robot did goes to the rules that did it: drive's, with a note."""
+    s, out = session(rules)
+    s.run("use drive")
+    s.run("simulate figure4")
+    s.run("use avoid_obstacle")
+    text = say(s, out, "at 12s to 13s make a wider turn")
+    assert text.startswith("note: figure4 was driven by `drive`, so this corrects drive (the "
+                           "rules that produced the motion")
+    assert "`use drive` before `adapt`" in text
+    assert "(steering 89.83 -> 62.05 at 12 s)" in text         # drive's steering, not 70
+    assert {e.behavior for e in s.state.examples} == {"drive"}
+    assert "obstacle=200 heading=-14.86" in text                # drive's inputs
+    text = say(s, out, "at 12s steering is LM")                 # noted once per run
+    assert text.startswith("1 example from figure4 at 12 s (#22):")
+    with pytest.raises(LessonError) as info:
+        s.run("adapt epochs 1")
+    assert "the examples given so far correct drive: `use drive`" in info.value.render()
+    s.run("use drive")
+    assert not say(s, out, "at 12s steering=55").startswith("note")
+    with pytest.raises(LessonError, match=r"did not turn in that window \(steering within "
+                                          r"1.2 of 90 at every tick\)"):
+        s.run("at 10s to 11s make a wider turn")            # straight on: nothing to widen
+
+
+def test_at_after_the_driving_behavior_was_undone(rules):
+    s, out = session(rules)
+    s.run("behavior mine")
+    s.run("use drive")
+    s.run("end")
+    s.run("simulate figure4")
+    s.run("undo")                       # `end`: `mine` is open again, then gone
+    s.run("undo")
+    s.run("undo")
+    with pytest.raises(LessonError, match="driven by behavior `mine`, which is no longer in "
+                                          "the rule base"):
+        s.run("at 12s steering=55")
+
+
 def test_examples_belong_to_the_behavior_they_correct(rules):
     s, out = session(rules)
     s.run("correct road=78 size=45 position=4 -> steering=60")

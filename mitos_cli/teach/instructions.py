@@ -17,7 +17,8 @@ instruction                     targets at each tick of the window
 ``turn less``                   steering one term back toward straight (never past it)
 ``make a wider turn``           every tick: the hardest steering of the window, one term
                                 further (a sustained turn, not the drift back of Figure 4);
-                                refused when ticks turn half a term or more the other way
+                                refused when ticks turn half a term or more the other way,
+                                or when every tick goes straight (within 1 %)
 ``slow down`` / ``speed up``    speed one term lower / higher
 ``keep further from the wall``  steering one term away from the nearer side
                                 (``gap_left`` / ``gap_right``)
@@ -135,8 +136,12 @@ def _less(scale: Scale, w: Window) -> np.ndarray:
 def _wider(scale: Scale, w: Window) -> np.ndarray:
     u = scale.steps(w.outputs[scale.variable]) - scale.centre
     side = np.sign(np.sum(u))
-    if side == 0:
-        raise LessonError("the robot did not turn in that window",
+    if side == 0 or not np.any(_turning(scale, w)):     # straight (within 1 %) at every tick
+        var = w.variables[scale.variable]
+        tol = STRAIGHT * (var.universe[1] - var.universe[0])
+        straight = float(scale.value(np.array(scale.centre)))
+        raise LessonError(f"the robot did not turn in that window ({scale.variable} within "
+                          f"{tol:g} of {straight:g} at every tick), so there is no turn to widen",
                           hint="name the window of the turn, or say `steering is LM`")
     against = int(np.sum(u * side < -0.5))       # half a term or more the other way
     if against:

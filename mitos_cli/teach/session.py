@@ -158,6 +158,7 @@ class Session:
         self.original.behavior(active)              # unknown behavior: did you mean
         self.start_behavior = active
         self.simulation: Recording | None = None
+        self._noted: tuple[int, str] | None = None     # `at` said whom the run corrects
         self.base: Path | None = None       # where a lesson's relative world paths start
         self.saved_seq = 0
         self.interrupted = False            # the last command's adaptation was cut short
@@ -520,7 +521,8 @@ class Session:
         self._correct(cmd.Correct(c.inputs, self._said(c.targets, compiled)), line)
 
     def _atsaid(self, c: cmd.AtSaid, line: str) -> None:
-        compiled = self.compiled()
+        rec = self._recording()
+        compiled = self._driver(rec, note=False)
         self._at(cmd.At(c.start, c.stop, self._said(c.targets, compiled)), line)
 
     def _atinstruction(self, c: cmd.AtInstruction, line: str) -> None:
@@ -532,7 +534,7 @@ class Session:
             exc.span = c.span
             raise
         rec = self._recording()
-        compiled = self.compiled()
+        compiled = self._driver(rec)
         rows = rec.rows(c.start, c.stop)
         inputs = [rec.inputs_at(i, compiled.inputs) for i in rows]
         now = self._outputs(compiled, inputs)
@@ -557,6 +559,32 @@ class Session:
                               hint="run `simulate WORLD` first, then `at 12.5s steering=55`")
         return self.simulation
 
+    def _driver(self, rec: Recording, note: bool = True) -> CompiledRuleBase:
+        """The behavior that drove the recorded run, whichever behavior is active now.
+
+        ``at`` corrects what the robot did: the paper's instructor watches the motion and
+        says what it should have been, so the correction must reach the rules that produced
+        it. Those are the recording behavior's (with the behaviors it ``use``s, each weighted
+        by its context at that tick, which is how `adapt` spreads the correction over them).
+        The active behavior's output at the same inputs may be one nobody used (`use
+        avoid_obstacle` after a `drive` run: its rules had weight 0 on the straight), so its
+        rules are not taught from the run; a note says where the examples went."""
+        names = [b.name for b in self.rulebase.behaviors]
+        if rec.behavior not in names:
+            raise LessonError(f"the run was driven by behavior `{rec.behavior}`, which is no "
+                              "longer in the rule base (undone)",
+                              hint="`simulate` the world again to correct a run of the "
+                                   "active behavior")
+        if note and rec.behavior != self.state.active \
+                and self._noted != (id(rec), self.state.active):
+            self._noted = (id(rec), self.state.active)      # once per run and active behavior
+            self.out(f"note: {rec.name} was driven by `{rec.behavior}`, so this corrects "
+                     f"{rec.behavior} (the rules that produced the motion, with the behaviors "
+                     f"it uses), not the active `{self.state.active}`; `use {rec.behavior}` "
+                     f"before `adapt` (to teach `{self.state.active}` from a run, `simulate` "
+                     "with it active)")
+        return self.compiled(rec.behavior)
+
     def _outputs(self, compiled: CompiledRuleBase, inputs: list[dict]) -> list[dict]:
         from ..engine.evaluation import evaluate
 
@@ -577,7 +605,7 @@ class Session:
 
     def _at(self, c: cmd.At, line: str) -> None:
         rec = self._recording()
-        compiled = self.compiled()
+        compiled = self._driver(rec)
         rows = rec.rows(c.start, c.stop)
         targets = self._values(c.targets, compiled.outputs, "output", compiled, False)
         inputs = [rec.inputs_at(i, compiled.inputs) for i in rows]
