@@ -670,7 +670,7 @@ class Session:
         if result.parameters.frozen_reasons:
             self.out("not adapted: " + "; ".join(result.parameters.frozen_reasons))
         self.out(in_words(before, self.rulebase, result.parameters))
-        self.out(text.interpretability_text(self.rulebase))
+        self.out(self.interpretability())
         if c.plot is not None:
             self._plot_terms(before, self.rulebase, c.plot)
 
@@ -775,7 +775,8 @@ class Session:
         self.out(self.interpretability())
 
     def interpretability(self) -> str:
-        return text.interpretability_text(self.rulebase)
+        """The interpretability line of `adapt` and `save` (new term gaps marked)."""
+        return text.interpretability_text(self.rulebase, self.original)
 
     def _help(self, c: cmd.Help, line: str) -> None:
         from .help import help_text
