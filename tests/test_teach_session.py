@@ -453,3 +453,22 @@ def test_undoing_every_change_leaves_nothing_unsaved():
     assert s.unsaved
     s.run("undo")
     assert not s.unsaved
+
+
+def test_unfrozen_says_what_it_lifts(rules):
+    """`unfrozen steering.ST` said "(no freeze, no hold at a point of symmetry)", as if there
+    never was one, while it lifted ST's hold at 90 (save then writes `held: false`)."""
+    s, out = session(rules)
+    assert say(s, out, "unfrozen steering.ST") == (
+        "adaptation may move steering.ST: its hold at 90 is lifted (the point its neighbours "
+        "mirror each other about; `save` writes `held: false`)")
+    assert say(s, out, "unfrozen steering.ST") == (
+        "steering.ST is neither frozen nor held (its hold was lifted already): adaptation "
+        "could move it already")
+    s.run("frozen heading.AHEAD, road.NARROW")
+    assert say(s, out, "unfrozen heading.AHEAD, road.NARROW").splitlines() == [
+        "adaptation may move heading.AHEAD: its freeze and its hold at 0 are lifted (the point "
+        "its neighbours mirror each other about; `save` writes `held: false`)",
+        "adaptation may move road.NARROW: its freeze is lifted"]
+    assert say(s, out, "unfrozen road.WIDE") == \
+        "road.WIDE is neither frozen nor held: adaptation could move it already"

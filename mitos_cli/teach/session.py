@@ -417,9 +417,32 @@ class Session:
         written = self.original.variables
         holds = [[v, t] for v, t in terms if v in written
                  and (held := held_term(written[v])) is not None and held[0].name == t]
+        lifted = [self._lifted(v, t) for v, t in terms]          # before the change
         self.change("release", line, terms=terms, holds=holds)
-        self.out("adaptation may move " + ", ".join(f"{v}.{t}" for v, t in terms)
-                 + " (no freeze, no hold at a point of symmetry)")
+        for text_ in lifted:
+            self.out(text_)
+
+    def _lifted(self, var: str, term: str) -> str:
+        """What `unfrozen VAR.TERM` lifts, said before it does: a freeze, a hold at a point of
+        symmetry, both, or nothing (the term could move already)."""
+        now = self.rulebase.variables[var]
+        what, notes = [], []
+        if (var, term) in self.state.frozen_terms or now.term(term).frozen:
+            what.append("its freeze")
+        held = held_term(now)
+        if held is not None and held[0].name == term and held[0].held \
+                and (var, term) not in self.state.released:
+            what.append(f"its hold at {format_number(held[1])}")
+            notes.append("the point its neighbours mirror each other about; `save` writes "
+                         "`held: false`")
+        if not what:
+            already = " (its hold was lifted already)" if (var, term) in self.state.released \
+                and held is not None and held[0].name == term else ""
+            return (f"{var}.{term} is neither frozen nor held{already}: adaptation could move "
+                    "it already")
+        return (f"adaptation may move {var}.{term}: " + " and ".join(what)
+                + (" is" if len(what) == 1 else " are") + " lifted"
+                + (f" ({'; '.join(notes)})" if notes else ""))
 
     def _telloperators(self, c: cmd.TellOperators, line: str) -> None:
         b = self.rulebase.behavior(self.focus)
