@@ -791,6 +791,8 @@ class Session:
         self.saved_seq = entry["seq"]
         self.save_as = target                      # a later bare `save` goes here too
         files = ", ".join(str(p) for p in (saved.rules,) + saved.termsets)
+        if saved.created is not None:
+            self.out(f"created the directory {saved.created}")
         self.out(f"saved {files}" + (f" ({plural(len(saved.changes), 'change')})" if saved.changes
                                      else " (no changes)"))
         for change in saved.changes:
