@@ -17,7 +17,6 @@ updated; saving over the original rule file rewrites its term sets in place.
 from __future__ import annotations
 
 import contextlib
-
 import os
 import re
 from dataclasses import dataclass
