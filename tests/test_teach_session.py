@@ -472,3 +472,27 @@ def test_unfrozen_says_what_it_lifts(rules):
         "adaptation may move road.NARROW: its freeze is lifted"]
     assert say(s, out, "unfrozen road.WIDE") == \
         "road.WIDE is neither frozen nor held: adaptation could move it already"
+
+
+def test_a_comma_between_values_is_named_and_a_hedge_past_the_scale_is_noted(rules):
+    """`... -> steering=60, speed=20` expected "`->`, a name or the end of the line" though
+    the `->` was there; `steering is extremely LB` became 30 without a word."""
+    from mitos_cli.errors import RuleSyntaxError
+
+    s, out = session(rules)
+    with pytest.raises(RuleSyntaxError) as info:
+        s.run("correct road=78 size=45 position=4 -> steering=60, speed=20")
+    assert info.value.message == "unexpected `,`"
+    assert info.value.expected == "a name or the end of the line"
+    assert info.value.hint == "values are separated by spaces, not commas: `road=78 size=45`"
+    with pytest.raises(RuleSyntaxError) as info:
+        s.run("eval road=78, size=45 position=4")
+    assert "`->`" not in info.value.expected and "not commas" in info.value.hint
+    assert say(s, out, "correct road=78 size=45 position=4 -> steering is extremely LB") == (
+        "note: `steering is extremely LB` lies past LB, the end of the steering scale: the "
+        "target is LB's value, steering=30\n"
+        "example 1: road=78 size=45 position=4 -> steering=30   (now steering=65.41)")
+    assert say(s, out, "correct road=78 size=45 position=4 -> steering is very RB").startswith(
+        "note: `steering is very RB` lies past RB")
+    assert say(s, out, "correct road=78 size=45 position=4 -> steering is very LM").startswith(
+        "example 3:")                                       # 40: inside the scale, no note

@@ -78,10 +78,29 @@ def scale_of(var: Variable) -> Scale:
 
 
 def hedged(var: Variable, term: str, hedges: tuple[str, ...]) -> float:
-    """The target ``var is HEDGES TERM`` stands for."""
-    value = var.term(term).center
+    """The target ``var is HEDGES TERM`` stands for (at most the end of the scale: see
+    :func:`past_the_end`)."""
     if not hedges:
-        return value
+        return var.term(term).center
+    scale, u = _hedged_steps(var, term, hedges)
+    return float(scale.value(np.array(u)))
+
+
+def past_the_end(var: Variable, term: str, hedges: tuple[str, ...]) -> str | None:
+    """The term at the end of the scale when ``HEDGES TERM`` would lie past it (``very LB``,
+    ``extremely LB``: the target is LB's value, the furthest the scale goes), else None."""
+    if not hedges:
+        return None
+    scale, u = _hedged_steps(var, term, hedges)
+    last = len(scale.values) - 1
+    if u < -1e-9:
+        return scale.names[0]
+    return scale.names[last] if u > last + 1e-9 else None
+
+
+def _hedged_steps(var: Variable, term: str, hedges: tuple[str, ...]) -> tuple[Scale, float]:
+    """The scale of ``var`` and where ``HEDGES TERM`` lies on it, in steps (not clipped)."""
+    value = var.term(term).center
     scale = scale_of(var)
     u = float(scale.steps(np.array(value)))
     for h in reversed(hedges):                         # the innermost hedge first
@@ -93,7 +112,7 @@ def hedged(var: Variable, term: str, hedges: tuple[str, ...]) -> float:
             u += away * HEDGE_STEPS[h]
         else:
             u -= away * min(-HEDGE_STEPS[h], abs(u - scale.centre))
-    return float(scale.value(np.array(u)))
+    return scale, u
 
 
 @dataclass(frozen=True)
@@ -205,4 +224,4 @@ def targets(ins: Instruction, window: Window) -> np.ndarray:
 
 
 __all__ = ["HEDGE_STEPS", "INSTRUCTIONS", "Instruction", "Scale", "Window", "hedged",
-           "instruction", "scale_of", "targets"]
+           "instruction", "past_the_end", "scale_of", "targets"]

@@ -524,7 +524,7 @@ class Session:
 
     def _said(self, said, compiled: CompiledRuleBase) -> tuple[cmd.Assign, ...]:
         """``steering is very LM`` -> ``steering=40`` (the hedged term's value)."""
-        from .instructions import hedged
+        from .instructions import hedged, past_the_end
 
         out = []
         for t in said:
@@ -536,7 +536,14 @@ class Session:
                 continue
             var = compiled.variables[t.name]
             var.term(t.term, t.span and t.span.ending(t.term))
-            out.append(cmd.Assign(t.name, hedged(var, t.term, t.hedges), t.span))
+            value = hedged(var, t.term, t.hedges)
+            end = past_the_end(var, t.term, t.hedges)
+            if end is not None:
+                said = " ".join(t.hedges + (t.term,))
+                self.out(f"note: `{t.name} is {said}` lies past {end}, the end of the "
+                         f"{t.name} scale: the target is {end}'s value, "
+                         f"{t.name}={format_number(value)}")
+            out.append(cmd.Assign(t.name, value, t.span))
         return tuple(out)
 
     def _correctsaid(self, c: cmd.CorrectSaid, line: str) -> None:
