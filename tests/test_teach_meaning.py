@@ -440,3 +440,95 @@ def test_many_terms_are_measured_in_memory_proportional_to_them():
     assert time.process_time() - start < 10               # was minutes, or a MemoryError
     grown = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss - peak     # KB on Linux
     assert grown < 500_000                                                   # was gigabytes
+
+
+def test_coverage_is_kept_per_stretch_of_the_universe():
+    """Where the written terms cover to 0.5 they must keep doing so, and a stretch covered less
+    keeps its written least; one bound for the universe was 0 once any gap was written."""
+    corners = np.array([[0.0, 0.0, 1.0, 3.0], [7.0, 9.0, 10.0, 10.0]])   # tipper's food
+    ends, least = meaning.coverage_spans(corners, (0.0, 10.0))
+    np.testing.assert_allclose(ends, [0, 2, 8, 10])
+    np.testing.assert_allclose(least, [0.5, 0, 0.5])
+    inward = np.array([[0.53, 0.53, 0.58, 1.462], [7.0, 9.0, 10.0, 10.0]])
+    assert meaning.span_coverage(inward, (0.0, 10.0), ends)[0] == 0.0   # [0, 0.53] uncovered
+    vertical = np.array([[0.0, 0.0, 3.0, 3.0], [7.0, 7.0, 10.0, 10.0]])  # 1 at 3 and 7, 0 between
+    assert meaning.coverage_spans(vertical, (0.0, 10.0))[1].tolist() == [0.5, 0.0, 0.5]
+    dip = np.array([[-np.inf, -np.inf, 0.0, 4.0], [2.0, 6.0, np.inf, np.inf]])
+    ends, least = meaning.coverage_spans(dip, (0.0, 10.0))
+    np.testing.assert_allclose(ends, [0, 2, 4, 10])
+    np.testing.assert_allclose(least, [0.5, 0.25, 0.5])
+
+
+TIPPER_TERMS = """\
+variables:
+  service:
+    role: input
+    universe: [0, 10]
+    terms:
+      poor: {shape: gaussian, points: [0, 1.5]}
+      good: {shape: gaussian, points: [5, 1.5]}
+      excellent: {shape: gaussian, points: [10, 1.5]}
+  food:
+    role: input
+    universe: [0, 10]
+    terms:
+      rancid: {shape: trapezoid, points: [0, 0, 1, 3]}
+      delicious: {shape: trapezoid, points: [7, 9, 10, 10]}
+  tip:
+    role: output
+    universe: [0, 30]
+    default: 15
+    terms:
+      cheap: {shape: triangle, points: [0, 5, 10]}
+      average: {shape: triangle, points: [10, 15, 20]}
+      generous: {shape: triangle, points: [20, 25, 30]}
+"""
+
+TIPPER_RULES = """\
+terms "tipper.terms.yaml"
+operators: inference = mamdani, sampling = endpoints
+
+r1: if service is poor or food is rancid then tip is cheap
+r2: if service is good then tip is average
+r3: if service is excellent or food is delicious then tip is generous
+"""
+
+
+def test_a_converted_controller_keeps_the_end_of_its_universe_covered(tmp_path):
+    """`mitos convert tipper.fis` then teaching it: its `food` is written with a gap on [3, 7],
+    so the one coverage bound was 0, and examples that want `rancid` off at the most rancid
+    food moved its vertical edge on 0 inward (food in [0, 0.22] in no term), which neither
+    adapt nor save reported. The edge now stays (the descent goes on with the other knots),
+    and a gap adaptation does open (`unconstrained`) is in the interpretability line."""
+    from mitos_cli.teach.session import Session
+
+    (tmp_path / "tipper.terms.yaml").write_text(TIPPER_TERMS)
+    (tmp_path / "tipper.rules").write_text(TIPPER_RULES)
+    rng = np.random.default_rng(2)
+    lines = [f"correct service={s:.3f} food={f:.4f} -> tip=25"
+             for s, f in zip(rng.uniform(6, 10, 60), rng.uniform(0, 0.02, 60))]
+    lines += [f"correct service={s:.3f} food={f:.3f} -> tip={5 + 2 * s:.2f}"
+              for s, f in zip(rng.uniform(0, 10, 60), rng.uniform(0.6, 10, 60))]
+    for constrained in (True, False):
+        out: list[str] = []
+        s = Session(tmp_path / "tipper.rules", out=out.append)
+        for line in lines:
+            s.run(line)
+        out.clear()
+        s.run("adapt epochs 60" + ("" if constrained else " unconstrained"))
+        text = "\n".join(out)
+        food = s.rulebase.variables["food"]
+        gaps = meaning.term_gaps(food)
+        assert "changed (before -> after)" in text            # the descent went on
+        if constrained:
+            assert food.term("rancid").corners[:2] == (0.0, 0.0)
+            assert gaps == [(3.0, 7.0)] and "did not have" not in text
+            assert "input `food`: every term is 0 for food in [3, 7] (widen a neighbouring " \
+                   "term" in text
+        else:
+            assert gaps[0][0] == 0.0 and gaps[0][1] > 0.0
+            assert (f"input `food`: every term is 0 for food in [0, {gaps[0][1]:.6g}], a gap "
+                    "the terms as written did not have (widen") in text
+            out.clear()
+            s.run(f"save {tmp_path / 'u.rules'}")
+            assert "a gap the terms as written did not have" in "\n".join(out)

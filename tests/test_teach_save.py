@@ -385,3 +385,46 @@ def test_save_never_replaces_a_term_set_the_user_did_not_name(rules, tmp_path):
     s.run("adapt epochs 2")
     s.run("save")              # again over out.rules: the term sets it reads are its own
     assert "# mine" not in (tmp_path / "out.drive.terms.yaml").read_text()
+
+
+def test_save_names_the_rule_file_it_could_not_write_and_the_directory_it_made(
+        rules, tmp_path, monkeypatch):
+    """`save /proc/x.rules` said only `cannot write /proc/x.mitos.terms.yaml: No such file or
+    directory` (the term set, no hint); `save mitos.terms.yaml` hinted `save
+    mitos.terms.rules`; `save nodir/x.rules` made `nodir/` without a word."""
+    import os
+
+    out: list[str] = []
+    s = Session(rules, out=out.append)
+    s.run("correct road=78 size=45 position=4 -> steering=60")
+    s.run("adapt epochs 2")
+    locked = tmp_path / "locked"
+    locked.mkdir()
+    real_open = os.open
+
+    def refuse(path, *args, **kwargs):
+        if str(path).startswith(str(locked)):
+            raise FileNotFoundError(2, "No such file or directory")
+        return real_open(path, *args, **kwargs)
+
+    monkeypatch.setattr(os, "open", refuse)
+    with pytest.raises(LessonError) as info:
+        s.run(f"save {locked / 'x.rules'}")
+    assert info.value.message == (f"cannot save `{locked / 'x.rules'}`: cannot write "
+                                  f"`{locked / 'x.mitos.terms.yaml'}`: No such file or directory")
+    assert info.value.hint.startswith("save where you can write files (`save ~/x.rules`)")
+    with pytest.raises(LessonError) as info:                  # the directory it made goes
+        s.run(f"save {locked / 'sub' / 'x.rules'}")
+    assert not (locked / "sub").exists()
+    monkeypatch.undo()
+    with pytest.raises(LessonError) as info:
+        s.run(f"save {tmp_path / 'mitos.terms.yaml'}")
+    assert info.value.message.endswith("save writes a rule file (and its term sets beside it)")
+    assert info.value.hint == f"save {(tmp_path / 'mitos.rules').as_posix()}"
+    with pytest.raises(LessonError) as info:                  # never the original itself
+        s.run(f"save {rules.with_name('mitos.terms.yml')}")
+    assert info.value.hint == f"save {rules.with_name('taught.rules').as_posix()}"
+    out.clear()
+    s.run(f"save {tmp_path / 'nodir' / 'x.rules'}")
+    assert out[0] == f"created the directory {tmp_path / 'nodir'}"
+    assert out[1].startswith(f"saved {tmp_path / 'nodir' / 'x.rules'}")

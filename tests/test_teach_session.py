@@ -258,6 +258,48 @@ def test_simulate_and_at_and_their_mistakes(rules, tmp_path):
         s.run("adapt epochs 3 plot a.gif")
 
 
+def test_at_corrects_the_behavior_that_drove_the_run(rules):
+    """`use drive`, `simulate`, then `use avoid_obstacle` and `at ...`: the examples were made
+    from avoid_obstacle's output (steering 70, an output nobody used: its context had weight
+    0 on the straight) and taught its rules to steer hard left with no obstacle. A correction
+    of what the robot did goes to the rules that did it: drive's, with a note."""
+    s, out = session(rules)
+    s.run("use drive")
+    s.run("simulate figure4")
+    s.run("use avoid_obstacle")
+    text = say(s, out, "at 12s to 13s make a wider turn")
+    assert text.startswith("note: figure4 was driven by `drive`, so this corrects drive (the "
+                           "rules that produced the motion")
+    assert "`use drive` before `adapt`" in text
+    assert "(steering 89.83 -> 62.05 at 12 s)" in text         # drive's steering, not 70
+    assert {e.behavior for e in s.state.examples} == {"drive"}
+    assert "obstacle=200 heading=-14.86" in text                # drive's inputs
+    text = say(s, out, "at 12s steering is LM")                 # noted once per run
+    assert text.startswith("1 example from figure4 at 12 s (#22):")
+    with pytest.raises(LessonError) as info:
+        s.run("adapt epochs 1")
+    assert "the examples given so far correct drive: `use drive`" in info.value.render()
+    s.run("use drive")
+    assert not say(s, out, "at 12s steering=55").startswith("note")
+    with pytest.raises(LessonError, match=r"did not turn in that window \(steering within "
+                                          r"1.2 of 90 at every tick\)"):
+        s.run("at 10s to 11s make a wider turn")            # straight on: nothing to widen
+
+
+def test_at_after_the_driving_behavior_was_undone(rules):
+    s, out = session(rules)
+    s.run("behavior mine")
+    s.run("use drive")
+    s.run("end")
+    s.run("simulate figure4")
+    s.run("undo")                       # `end`: `mine` is open again, then gone
+    s.run("undo")
+    s.run("undo")
+    with pytest.raises(LessonError, match="driven by behavior `mine`, which is no longer in "
+                                          "the rule base"):
+        s.run("at 12s steering=55")
+
+
 def test_examples_belong_to_the_behavior_they_correct(rules):
     s, out = session(rules)
     s.run("correct road=78 size=45 position=4 -> steering=60")
@@ -411,3 +453,46 @@ def test_undoing_every_change_leaves_nothing_unsaved():
     assert s.unsaved
     s.run("undo")
     assert not s.unsaved
+
+
+def test_unfrozen_says_what_it_lifts(rules):
+    """`unfrozen steering.ST` said "(no freeze, no hold at a point of symmetry)", as if there
+    never was one, while it lifted ST's hold at 90 (save then writes `held: false`)."""
+    s, out = session(rules)
+    assert say(s, out, "unfrozen steering.ST") == (
+        "adaptation may move steering.ST: its hold at 90 is lifted (the point its neighbours "
+        "mirror each other about; `save` writes `held: false`)")
+    assert say(s, out, "unfrozen steering.ST") == (
+        "steering.ST is neither frozen nor held (its hold was lifted already): adaptation "
+        "could move it already")
+    s.run("frozen heading.AHEAD, road.NARROW")
+    assert say(s, out, "unfrozen heading.AHEAD, road.NARROW").splitlines() == [
+        "adaptation may move heading.AHEAD: its freeze and its hold at 0 are lifted (the point "
+        "its neighbours mirror each other about; `save` writes `held: false`)",
+        "adaptation may move road.NARROW: its freeze is lifted"]
+    assert say(s, out, "unfrozen road.WIDE") == \
+        "road.WIDE is neither frozen nor held: adaptation could move it already"
+
+
+def test_a_comma_between_values_is_named_and_a_hedge_past_the_scale_is_noted(rules):
+    """`... -> steering=60, speed=20` expected "`->`, a name or the end of the line" though
+    the `->` was there; `steering is extremely LB` became 30 without a word."""
+    from mitos_cli.errors import RuleSyntaxError
+
+    s, out = session(rules)
+    with pytest.raises(RuleSyntaxError) as info:
+        s.run("correct road=78 size=45 position=4 -> steering=60, speed=20")
+    assert info.value.message == "unexpected `,`"
+    assert info.value.expected == "a name or the end of the line"
+    assert info.value.hint == "values are separated by spaces, not commas: `road=78 size=45`"
+    with pytest.raises(RuleSyntaxError) as info:
+        s.run("eval road=78, size=45 position=4")
+    assert "`->`" not in info.value.expected and "not commas" in info.value.hint
+    assert say(s, out, "correct road=78 size=45 position=4 -> steering is extremely LB") == (
+        "note: `steering is extremely LB` lies past LB, the end of the steering scale: the "
+        "target is LB's value, steering=30\n"
+        "example 1: road=78 size=45 position=4 -> steering=30   (now steering=65.41)")
+    assert say(s, out, "correct road=78 size=45 position=4 -> steering is very RB").startswith(
+        "note: `steering is very RB` lies past RB")
+    assert say(s, out, "correct road=78 size=45 position=4 -> steering is very LM").startswith(
+        "example 3:")                                       # 40: inside the scale, no note

@@ -54,6 +54,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from ..errors import Span
+from ..lang import interpretability as meaning
 from ..lang.model import (
     And,
     Consequent,
@@ -76,7 +77,7 @@ MAX_SAMPLES = 300_000
 #: Regions listed per finding; the rest are counted.
 MAX_BOXES = 6
 #: Points per universe when looking for gaps between the terms of one input.
-GAP_RESOLUTION = 2001
+GAP_RESOLUTION = meaning.GAP_RESOLUTION
 #: An input term whose largest membership inside the universe reaches this counts as reaching
 #: 1: a sigmoid used as a shoulder comes within 1e-4 of 1 but never gets there, and its peak
 #: is not "outside the universe" for that.
@@ -543,8 +544,7 @@ def _term_gaps(rb: RuleBase, scope: set[str] | None = None) -> list[Finding]:
         if var.role != "input" or not var.terms:
             continue
         lo, hi = var.universe
-        corners = [c for t in var.terms if t.corners for c in t.corners if lo <= c <= hi]
-        x = np.unique(np.concatenate([np.linspace(lo, hi, GAP_RESOLUTION), corners]))
+        x = meaning.gap_points(var)
         mus = np.array([t.membership(x) for t in var.terms])
         for term, mu in zip(var.terms, mus):
             if mu.max() < NEARLY_ONE:
@@ -553,18 +553,10 @@ def _term_gaps(rb: RuleBase, scope: set[str] | None = None) -> list[Finding]:
                     f"input term `{var.name}.{term.name}` never reaches 1 inside the universe "
                     f"[{_num(lo)}, {_num(hi)}] (at most {mu.max():.3g})", term.span, None,
                     hint="move the term's peak into the universe, or widen the universe"))
-        top = mus.max(axis=0)
-        gap = top <= 0.0
-        for a, b in _runs(gap):
-            left, right = float(x[a]), float(x[b - 1])
+        for left, right in meaning.gaps_on(mus.max(axis=0), x):
             # a gap between two sample points around a single zero is a touching point
-            where = f"at {var.name} = {_num(left)}" if left == right else \
-                f"for {var.name} in [{_num(left)}, {_num(right)}]"
-            out.append(Finding(
-                "warning", "term-gap",
-                f"input `{var.name}`: every term is 0 {where}", var.span, None,
-                hint="widen a neighbouring term (or add one) so that the terms cover the "
-                     "universe"))
+            out.append(Finding("warning", "term-gap", meaning.gap_message(var, left, right),
+                               var.span, None, hint=meaning.GAP_HINT))
     return out
 
 
@@ -578,13 +570,6 @@ def _interpretability(rb: RuleBase, scope: set[str] | None = None) -> list[Findi
             out.append(Finding("warning", issue.code, issue.message, span, None,
                                hint=issue.hint))
     return out
-
-
-def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
-    """``[start, stop)`` of the runs of True in a 1-D mask."""
-    padded = np.concatenate([[False], mask, [False]])
-    edges = np.flatnonzero(padded[1:] != padded[:-1])
-    return list(zip(edges[::2], edges[1::2]))
 
 
 def _terms_used(expr: Expr, out: set[tuple[str, str]]) -> None:

@@ -63,6 +63,11 @@ TOLERANCE = 1e-6
 #: Evenly spaced points of the universe on which terms that are not piecewise linear are
 #: measured (plus the corners and centres of the variable's terms): 1,000 intervals.
 RESOLUTION = 1001
+#: Points per universe when looking for gaps between the terms of one input (plus the
+#: corners inside it).
+GAP_RESOLUTION = 2001
+#: What to do about a term gap (``mitos check``'s ``term-gap``, teach's interpretability line).
+GAP_HINT = "widen a neighbouring term (or add one) so that the terms cover the universe"
 
 
 @dataclass(frozen=True)
@@ -128,6 +133,54 @@ def coverage_on(mu: np.ndarray, x: np.ndarray, universe: tuple[float, float],
             return 1.0, float(universe[0])
     k = int(np.argmin(top))
     return float(top[k]), float(x[k])
+
+
+def coverage_spans(corners: np.ndarray, universe: tuple[float, float]
+                   ) -> tuple[np.ndarray, np.ndarray]:
+    """The universe cut into stretches the terms cover to :data:`COVERAGE` and stretches
+    they cover less, as ``(ends[s + 1], least[s])``: stretch ``s`` is ``[ends[s], ends[s +
+    1]]`` and ``least[s]`` the least largest-membership on it (exactly, as
+    :func:`span_coverage`), at most :data:`COVERAGE`.
+
+    What adaptation keeps per stretch: one least coverage for the whole universe is vacuous
+    as soon as the written terms leave a gap anywhere (a converted tipper's ``food`` is 0 on
+    [3, 7]), and then a term could leave the end of the universe uncovered. The envelope
+    crosses the level only where an edge does, or jumps at a vertical edge (a breakpoint), so
+    between those points each piece lies wholly on one side of it."""
+    lo, hi = universe
+    a, b, c, d = corners.T
+    with np.errstate(invalid="ignore", over="ignore"):
+        half = np.concatenate([a + COVERAGE * (b - a), d - COVERAGE * (d - c)])
+    x = np.union1d(breakpoints(corners, universe), half[np.isfinite(half) & (half > lo)
+                                                         & (half < hi)])
+    if len(x) < 2:
+        return np.array([lo, hi], dtype=float), np.array([span_coverage(
+            corners, universe, np.array([lo, hi], dtype=float))[0]])
+    mid = 0.5 * (x[:-1] + x[1:])
+    covered = memberships(corners, mid).max(axis=0) >= COVERAGE - 1e-12
+    cut = np.flatnonzero(covered[1:] != covered[:-1]) + 1
+    ends = np.concatenate([[x[0]], x[cut], [x[-1]]]).astype(float)
+    least = span_coverage(corners, universe, ends)
+    return ends, np.minimum(least, COVERAGE)
+
+
+def span_coverage(corners: np.ndarray, universe: tuple[float, float],
+                  ends: np.ndarray) -> np.ndarray:
+    """The least largest-membership on each stretch ``[ends[s], ends[s + 1]]``, exactly: at
+    the :func:`breakpoints` inside it and its ends, and at both ends of each piece between
+    them as the piece's line reaches them (a term is 1 on its vertical edge, and 0 just
+    beside it: ``[0, 0, 3, 3]`` and ``[7, 7, 10, 10]`` leave (3, 7) uncovered although both
+    are 1 at 3 and at 7)."""
+    x = np.union1d(breakpoints(corners, universe), ends)
+    top = memberships(corners, x).max(axis=0)
+    width = np.diff(x)
+    m1 = memberships(corners, x[:-1] + width / 3).max(axis=0)
+    m2 = memberships(corners, x[:-1] + 2 * width / 3).max(axis=0)
+    piece = np.clip(np.minimum(2 * m1 - m2, 2 * m2 - m1), 0.0, 1.0)   # the line's ends
+    first = np.searchsorted(x, ends[:-1])
+    last = np.searchsorted(x, ends[1:])
+    return np.array([min(top[i:j + 1].min(), piece[i:j].min(initial=1.0))
+                     for i, j in zip(first, last)])
 
 
 def similarity(corners: np.ndarray, universe: tuple[float, float]) -> np.ndarray:
@@ -416,12 +469,45 @@ def _placeholder(var: Variable) -> Term:
     return Term("_", "singleton", (0.0,))
 
 
+def gap_points(var: Variable) -> np.ndarray:
+    """Where gaps are looked for: :data:`GAP_RESOLUTION` points of the universe and the
+    terms' corners inside it (any shape: a term is asked its membership there)."""
+    lo, hi = var.universe
+    corners = [c for t in var.terms if t.corners for c in t.corners if lo <= c <= hi]
+    return np.unique(np.concatenate([np.linspace(lo, hi, GAP_RESOLUTION), corners]))
+
+
+def gaps_on(top: np.ndarray, x: np.ndarray) -> list[tuple[float, float]]:
+    """``(left, right)`` of each run of the points ``x`` where the largest membership ``top``
+    is 0 (``left == right``: the terms only touch 0 there)."""
+    padded = np.concatenate([[False], top <= 0.0, [False]])
+    edges = np.flatnonzero(padded[1:] != padded[:-1])
+    return [(float(x[a]), float(x[b - 1])) for a, b in zip(edges[::2], edges[1::2])]
+
+
+def term_gaps(var: Variable) -> list[tuple[float, float]]:
+    """The stretches of an input's universe where every term is 0 (``mitos check``'s
+    ``term-gap``); none for an output or a variable without terms."""
+    if var.role != "input" or not var.terms:
+        return []
+    x = gap_points(var)
+    return gaps_on(np.array([t.membership(x) for t in var.terms]).max(axis=0), x)
+
+
+def gap_message(var: Variable, left: float, right: float) -> str:
+    """How a gap is said: ``input `food`: every term is 0 for food in [0, 0.53]``."""
+    where = f"at {var.name} = {left:.6g}" if left == right else \
+        f"for {var.name} in [{left:.6g}, {right:.6g}]"
+    return f"input `{var.name}`: every term is 0 {where}"
+
+
 def rulebase_issues(variables) -> list[Issue]:
     """:func:`variable_issues` of each variable in turn."""
     return [i for v in variables for i in variable_issues(v)]
 
 
-__all__ = ["COVERAGE", "DISTINCT", "RESOLUTION", "SIMILARITY", "Issue", "centre", "core",
-           "coverage", "coverage_on", "held_term", "memberships", "mirror_point",
+__all__ = ["COVERAGE", "DISTINCT", "GAP_HINT", "GAP_RESOLUTION", "RESOLUTION", "SIMILARITY",
+           "Issue", "centre", "core", "coverage", "coverage_on", "coverage_spans",
+           "gap_message", "gap_points", "gaps_on", "held_term", "memberships", "mirror_point",
            "most_similar", "rulebase_issues", "sample_points", "sampled", "similarity",
-           "similarity_on", "variable_issues"]
+           "similarity_on", "span_coverage", "term_gaps", "variable_issues"]

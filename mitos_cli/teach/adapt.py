@@ -168,13 +168,23 @@ class Partition:
     """The fuzzy sets of one variable, whose coverage and distinguishability adaptation keeps:
     the knot of each corner (``-1``: the corner as written) and the least coverage and largest
     similarity allowed (the documented thresholds, or the written values where those are
-    already worse: adaptation never has to repair what the instructor wrote)."""
+    already worse: adaptation never has to repair what the instructor wrote).
+
+    Coverage is kept per stretch of the universe
+    (:func:`~mitos_cli.lang.interpretability.coverage_spans`): where the written terms cover
+    to 0.5 they keep doing so, and a stretch they cover less keeps at least its written least.
+    One bound for the whole universe was the worst written point, 0 as soon as the terms
+    left a gap anywhere, and then a term's edge on the end of the universe could move inward
+    and leave it uncovered (a converted tipper's ``food.rancid`` from [0, 0, 1, 3] to [0.53,
+    0.53, ...]). So a written gap may shrink but not widen or move."""
 
     var: str
     universe: tuple[float, float]
     knot: np.ndarray             # [t, 4]
     written: np.ndarray          # [t, 4] corners as written
-    least_coverage: float | None     # None: not measured (an output's sets)
+    #: ``(ends[s + 1], least[s])`` of the stretches whose coverage is kept (None: not
+    #: measured, an output's sets)
+    cover: tuple[np.ndarray, np.ndarray] | None
     most_similar: float
     #: a tied Ruspini partition: it holds at every ordered point, so it is never measured
     by_construction: bool = False
@@ -185,19 +195,21 @@ class Partition:
     def holds(self, values: np.ndarray) -> bool:
         if self.by_construction:
             return True
-        cover, similar = meaning.measures(self.corners(values), self.universe)
-        if self.least_coverage is not None and cover < self.least_coverage - 1e-12:
-            return False
-        return similar <= self.most_similar + 1e-12
+        corners = self.corners(values)
+        if self.cover is not None:
+            ends, least = self.cover
+            if np.any(meaning.span_coverage(corners, self.universe, ends) < least - 1e-12):
+                return False
+        return meaning.measures(corners, self.universe)[1] <= self.most_similar + 1e-12
 
 
 def partition(var: str, universe: tuple[float, float], knot: np.ndarray, written: np.ndarray,
               covered: bool) -> Partition:
     """A :class:`Partition` with its thresholds (see there)."""
-    least = min(meaning.COVERAGE, meaning.coverage(written, universe)[0]) if covered else None
+    cover = meaning.coverage_spans(written, universe) if covered else None
     most = max(meaning.SIMILARITY, meaning.most_similar(written, universe)[0]) \
         if len(written) > 1 else 1.0
-    return Partition(var, universe, knot, written, least, most,
+    return Partition(var, universe, knot, written, cover, most,
                      by_construction=ruspini(knot, written, universe))
 
 
@@ -986,13 +998,15 @@ def _need(p: Parameters, ids: np.ndarray, k: int) -> np.ndarray:
     return np.minimum(gap, np.diff(p.values[ids])) * (1 - 1e-9)     # never stricter than the start
 
 
-def descent_direction(p: Parameters, values: np.ndarray, grad: np.ndarray) -> np.ndarray:
+def descent_direction(p: Parameters, values: np.ndarray, grad: np.ndarray,
+                      held: tuple[int, ...] = ()) -> np.ndarray:
     """The projected steepest-descent direction (scaled coordinates) that does not push a knot
-    through a bound or a neighbour it already touches (active constraints held fixed)."""
+    through a bound or a neighbour it already touches (active constraints held fixed), nor
+    move the knots ``held`` (whose move breaks a partition's coverage or distinctness)."""
     g = grad * p.scale
     base = p.constraints if p.constraints is not None else np.zeros((0, len(values)))
-    extra: list[np.ndarray] = []
-    projector = p.projector
+    extra: list[np.ndarray] = [np.eye(len(values))[i] for i in held]
+    projector = _null_projector(np.vstack([base] + extra)) if held else p.projector
     for _ in range(len(values) + 1):
         d = -(projector @ g)
         tol = 1e-7 * p.scale
@@ -1032,6 +1046,34 @@ def feasible(p: Parameters, values: np.ndarray, partitions: bool = True) -> bool
     return not partitions or partitions_hold(p, values)
 
 
+def _scaled(direction: np.ndarray, rate: float) -> np.ndarray:
+    """``direction`` scaled so that the knot that moves most moves ``rate`` x :data:`STEP`."""
+    biggest = np.max(np.abs(direction)) if direction.size else 0.0
+    return direction * (rate * STEP / biggest) if biggest > 1e-15 else np.zeros_like(direction)
+
+
+def blocking(p: Parameters, values: np.ndarray, move: np.ndarray) -> tuple[int, ...]:
+    """The knots whose own ``move`` (the others still) breaks the coverage or the
+    distinctness of their partition; all the moving knots of a partition that only their
+    moves together break. Held while the others move, as a knot touching a bound is (an
+    active set): a step refused whole would stop the descent at the first knot that may not
+    go where Q falls (``food.rancid``'s edge on the end of the universe)."""
+    out: list[int] = []
+    for part in p.partitions:
+        mine = np.unique(part.knot[part.knot >= 0])
+        moving = mine[move[mine] != 0]
+        if not len(moving) or part.holds(values + move):
+            continue
+        alone = []
+        for i in moving:
+            trial = values.copy()
+            trial[i] += move[i]
+            if not part.holds(trial):
+                alone.append(int(i))
+        out += alone or [int(i) for i in moving]
+    return tuple(out)
+
+
 def partitions_hold(p: Parameters, values: np.ndarray) -> bool:
     """Coverage and distinguishability of every partition whose knots moved."""
     for part in p.partitions:
@@ -1068,6 +1110,7 @@ def adapt(compiled: CompiledRuleBase, X: np.ndarray, targets: np.ndarray, *, epo
                 break
             direction *= rate * STEP / biggest
             accepted = False
+            held: tuple[int, ...] = ()
             for _ in range(HALVINGS):
                 candidate = values + step * direction * p.scale
                 if feasible(p, candidate, partitions=False):       # the cheap checks first
@@ -1075,6 +1118,14 @@ def adapt(compiled: CompiledRuleBase, X: np.ndarray, targets: np.ndarray, *, epo
                     if q_new < Q and partitions_hold(p, candidate):
                         accepted = True
                         break
+                    if q_new < Q:               # a partition breaks: hold the knots that break it
+                        more = blocking(p, values, step * direction * p.scale)
+                        if more and not set(more) <= set(held):
+                            held = tuple(sorted(set(held) | set(more)))
+                            direction = _scaled(descent_direction(p, values, grad, held), rate)
+                            if not direction.any():
+                                break
+                            continue                # the others at the same step
                 step *= 0.5
             if not accepted:
                 converged = True

@@ -473,6 +473,8 @@ def _syntax_error(exc: UnexpectedInput, text: str, path: str) -> RuleSyntaxError
     before = text[:token.start_pos].split() if token.start_pos is not None else []
     if before[:1] == ["save"]:              # `save out dir.rules`: one file name, then the end
         expected = {"$END"}
+    if "->" in before or before[:1] in (["at"], ["eval"]):   # LALR's merged states: no arrow
+        expected.discard("ARROW")                           # is behind us or has a place
     hint = _teach_hint(text, token, before)
     if hint is not None:
         pass
@@ -494,6 +496,8 @@ def _teach_hint(text: str, token: Token, before: list[str]) -> str | None:
     at = token.start_pos or 0
     if any(ord(c) > 127 for c in str(token.value)) or (at and ord(text[at - 1]) > 127):
         return "names are written in ASCII letters, digits, `_` and `-`"
+    if token.value == "," and before[:1] in (["eval"], ["correct"], ["at"]):
+        return "values are separated by spaces, not commas: `road=78 size=45`"
     if before[:1] in (["save"], ["simulate"]) or before[-2:-1] == ["plot"]:
         return 'a file name with a space in it is quoted: "my file.rules"'
     if before[:1] == ["at"] and len(before) > 1 and any(

@@ -17,7 +17,8 @@ instruction                     targets at each tick of the window
 ``turn less``                   steering one term back toward straight (never past it)
 ``make a wider turn``           every tick: the hardest steering of the window, one term
                                 further (a sustained turn, not the drift back of Figure 4);
-                                refused when ticks turn half a term or more the other way
+                                refused when ticks turn half a term or more the other way,
+                                or when every tick goes straight (within 1 %)
 ``slow down`` / ``speed up``    speed one term lower / higher
 ``keep further from the wall``  steering one term away from the nearer side
                                 (``gap_left`` / ``gap_right``)
@@ -77,10 +78,29 @@ def scale_of(var: Variable) -> Scale:
 
 
 def hedged(var: Variable, term: str, hedges: tuple[str, ...]) -> float:
-    """The target ``var is HEDGES TERM`` stands for."""
-    value = var.term(term).center
+    """The target ``var is HEDGES TERM`` stands for (at most the end of the scale: see
+    :func:`past_the_end`)."""
     if not hedges:
-        return value
+        return var.term(term).center
+    scale, u = _hedged_steps(var, term, hedges)
+    return float(scale.value(np.array(u)))
+
+
+def past_the_end(var: Variable, term: str, hedges: tuple[str, ...]) -> str | None:
+    """The term at the end of the scale when ``HEDGES TERM`` would lie past it (``very LB``,
+    ``extremely LB``: the target is LB's value, the furthest the scale goes), else None."""
+    if not hedges:
+        return None
+    scale, u = _hedged_steps(var, term, hedges)
+    last = len(scale.values) - 1
+    if u < -1e-9:
+        return scale.names[0]
+    return scale.names[last] if u > last + 1e-9 else None
+
+
+def _hedged_steps(var: Variable, term: str, hedges: tuple[str, ...]) -> tuple[Scale, float]:
+    """The scale of ``var`` and where ``HEDGES TERM`` lies on it, in steps (not clipped)."""
+    value = var.term(term).center
     scale = scale_of(var)
     u = float(scale.steps(np.array(value)))
     for h in reversed(hedges):                         # the innermost hedge first
@@ -92,7 +112,7 @@ def hedged(var: Variable, term: str, hedges: tuple[str, ...]) -> float:
             u += away * HEDGE_STEPS[h]
         else:
             u -= away * min(-HEDGE_STEPS[h], abs(u - scale.centre))
-    return float(scale.value(np.array(u)))
+    return scale, u
 
 
 @dataclass(frozen=True)
@@ -135,8 +155,12 @@ def _less(scale: Scale, w: Window) -> np.ndarray:
 def _wider(scale: Scale, w: Window) -> np.ndarray:
     u = scale.steps(w.outputs[scale.variable]) - scale.centre
     side = np.sign(np.sum(u))
-    if side == 0:
-        raise LessonError("the robot did not turn in that window",
+    if side == 0 or not np.any(_turning(scale, w)):     # straight (within 1 %) at every tick
+        var = w.variables[scale.variable]
+        tol = STRAIGHT * (var.universe[1] - var.universe[0])
+        straight = float(scale.value(np.array(scale.centre)))
+        raise LessonError(f"the robot did not turn in that window ({scale.variable} within "
+                          f"{tol:g} of {straight:g} at every tick), so there is no turn to widen",
                           hint="name the window of the turn, or say `steering is LM`")
     against = int(np.sum(u * side < -0.5))       # half a term or more the other way
     if against:
@@ -200,4 +224,4 @@ def targets(ins: Instruction, window: Window) -> np.ndarray:
 
 
 __all__ = ["HEDGE_STEPS", "INSTRUCTIONS", "Instruction", "Scale", "Window", "hedged",
-           "instruction", "scale_of", "targets"]
+           "instruction", "past_the_end", "scale_of", "targets"]

@@ -16,6 +16,7 @@ updated; saving over the original rule file rewrites its term sets in place.
 
 from __future__ import annotations
 
+import contextlib
 import os
 import re
 from dataclasses import dataclass
@@ -44,6 +45,7 @@ class Saved:
     rules: Path
     termsets: tuple[Path, ...]
     changes: tuple[str, ...]          # one line per change, for people
+    created: Path | None = None       # the directory the save made (`save taught/new.rules`)
 
 
 def termset_targets(rules_target: Path, original_rules: Path,
@@ -80,10 +82,18 @@ def save_rulebase(original: RuleBase, current: RuleBase, target: Path) -> Saved:
     new_rules, changed = edit_rules(rules_text, str(src), original, current, names)
     changes += changed
     _check_reads_back(current, new_rules, texts, target, names)
-    _directory_for(target)
-    finish_saves(target, error=LessonError)        # one a crash left half done
-    atomic_write_set(texts + [(target, new_rules)], target, error=LessonError)
-    return Saved(target, tuple(d for d, _ in texts), tuple(changes))
+    created = _directory_for(target)
+    try:
+        finish_saves(target, error=LessonError)        # one a crash left half done
+        atomic_write_set(texts + [(target, new_rules)], target, error=LessonError)
+    except LessonError as exc:          # it names the file it failed on: often a term set
+        if created is not None:
+            with contextlib.suppress(OSError):
+                created.rmdir()                         # made for this save: nothing in it
+        raise LessonError(f"cannot save `{target}`: {exc.message}",
+                          hint=f"save where you can write files (`save ~/{target.name}`); "
+                               "the session keeps every change") from None
+    return Saved(target, tuple(d for d, _ in texts), tuple(changes), created)
 
 
 def check_save_target(original: RuleBase, target: Path) -> tuple[Path, ...]:
@@ -103,8 +113,9 @@ def _check_targets(target: Path, src: Path, original: RuleBase, targets: tuple[P
     name: a term set there that the rule file saved over does not read (a term set of an
     earlier save as ``target`` is its own, and is replaced)."""
     if target.suffix != ".rules":
-        raise LessonError(f"`{target}` does not end in `.rules`; save writes a rule file",
-                          hint=f"save {target.with_suffix('.rules').as_posix()}")
+        raise LessonError(f"`{target}` does not end in `.rules`; save writes a rule file"
+                          + (" (and its term sets beside it)" if target.suffix in YAML else ""),
+                          hint=f"save {_rules_name(target, src).as_posix()}")
     if target.resolve() == src.resolve():
         return                            # over the original: its term sets in place
     originals = {(src.parent / rel).resolve(): rel for rel in original.termset_paths}
@@ -124,6 +135,28 @@ def _check_targets(target: Path, src: Path, original: RuleBase, targets: tuple[P
             f"`{dest}` is already there and no term set of `{target}`; saving as "
             f"`{target.name}` would write its term set over it",
             hint="remove it, or save under another name")
+
+
+#: The endings of a term-set file's name (`mitos.terms.yaml`), stripped from a hint's name.
+YAML = (".yaml", ".yml")
+
+
+def _rules_name(target: Path, src: Path) -> Path:
+    """The rule file a save given ``target`` most likely meant: ``mitos.terms.yaml`` ->
+    ``mitos.rules`` (not ``mitos.terms.rules``), ``x.txt`` -> ``x.rules``; never the original
+    (a hint must not suggest writing over it): ``taught.rules`` then."""
+    name = target.name
+    for suffix in (".terms.yaml", ".terms.yml") + YAML:
+        if name.endswith(suffix) and len(name) > len(suffix):
+            name = name[:-len(suffix)]
+            break
+    else:
+        name = target.stem
+    out = target.with_name(f"{name}.rules")
+    with contextlib.suppress(OSError):
+        if out.resolve() == src.resolve():
+            out = target.with_name("taught.rules")
+    return out
 
 
 def _check_reads_back(current: RuleBase, rules_text: str, texts, target: Path,
@@ -165,13 +198,14 @@ def _terms(rb: RuleBase) -> dict:
             for name, v in rb.variables.items()}
 
 
-def _directory_for(target: Path) -> None:
+def _directory_for(target: Path) -> Path | None:
     """Make the directory ``target`` goes in when only that last one is missing (`save
-    taught/new.rules`); a path whose parents are missing too is most likely a typo, refused
-    as every other writer refuses a missing directory."""
+    taught/new.rules`), and return it (the session says so); a path whose parents are
+    missing too is most likely a typo, refused as every other writer refuses a missing
+    directory."""
     parent = target.parent
     if parent.is_dir():
-        return
+        return None
     if not parent.parent.is_dir():
         raise LessonError(f"cannot save `{target}`: the directory `{parent.parent}` does not "
                           f"exist", hint="check the path, or create the directory first")
@@ -179,6 +213,7 @@ def _directory_for(target: Path) -> None:
         parent.mkdir()
     except OSError as exc:
         raise LessonError(f"cannot create `{parent}`: {exc.strerror or exc}") from None
+    return parent
 
 
 # ---- term sets ----------------------------------------------------------------------------------

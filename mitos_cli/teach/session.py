@@ -158,6 +158,7 @@ class Session:
         self.original.behavior(active)              # unknown behavior: did you mean
         self.start_behavior = active
         self.simulation: Recording | None = None
+        self._noted: tuple[int, str] | None = None     # `at` said whom the run corrects
         self.base: Path | None = None       # where a lesson's relative world paths start
         self.saved_seq = 0
         self.interrupted = False            # the last command's adaptation was cut short
@@ -416,9 +417,32 @@ class Session:
         written = self.original.variables
         holds = [[v, t] for v, t in terms if v in written
                  and (held := held_term(written[v])) is not None and held[0].name == t]
+        lifted = [self._lifted(v, t) for v, t in terms]          # before the change
         self.change("release", line, terms=terms, holds=holds)
-        self.out("adaptation may move " + ", ".join(f"{v}.{t}" for v, t in terms)
-                 + " (no freeze, no hold at a point of symmetry)")
+        for text_ in lifted:
+            self.out(text_)
+
+    def _lifted(self, var: str, term: str) -> str:
+        """What `unfrozen VAR.TERM` lifts, said before it does: a freeze, a hold at a point of
+        symmetry, both, or nothing (the term could move already)."""
+        now = self.rulebase.variables[var]
+        what, notes = [], []
+        if (var, term) in self.state.frozen_terms or now.term(term).frozen:
+            what.append("its freeze")
+        held = held_term(now)
+        if held is not None and held[0].name == term and held[0].held \
+                and (var, term) not in self.state.released:
+            what.append(f"its hold at {format_number(held[1])}")
+            notes.append("the point its neighbours mirror each other about; `save` writes "
+                         "`held: false`")
+        if not what:
+            already = " (its hold was lifted already)" if (var, term) in self.state.released \
+                and held is not None and held[0].name == term else ""
+            return (f"{var}.{term} is neither frozen nor held{already}: adaptation could move "
+                    "it already")
+        return (f"adaptation may move {var}.{term}: " + " and ".join(what)
+                + (" is" if len(what) == 1 else " are") + " lifted"
+                + (f" ({'; '.join(notes)})" if notes else ""))
 
     def _telloperators(self, c: cmd.TellOperators, line: str) -> None:
         b = self.rulebase.behavior(self.focus)
@@ -500,7 +524,7 @@ class Session:
 
     def _said(self, said, compiled: CompiledRuleBase) -> tuple[cmd.Assign, ...]:
         """``steering is very LM`` -> ``steering=40`` (the hedged term's value)."""
-        from .instructions import hedged
+        from .instructions import hedged, past_the_end
 
         out = []
         for t in said:
@@ -512,7 +536,14 @@ class Session:
                 continue
             var = compiled.variables[t.name]
             var.term(t.term, t.span and t.span.ending(t.term))
-            out.append(cmd.Assign(t.name, hedged(var, t.term, t.hedges), t.span))
+            value = hedged(var, t.term, t.hedges)
+            end = past_the_end(var, t.term, t.hedges)
+            if end is not None:
+                said = " ".join(t.hedges + (t.term,))
+                self.out(f"note: `{t.name} is {said}` lies past {end}, the end of the "
+                         f"{t.name} scale: the target is {end}'s value, "
+                         f"{t.name}={format_number(value)}")
+            out.append(cmd.Assign(t.name, value, t.span))
         return tuple(out)
 
     def _correctsaid(self, c: cmd.CorrectSaid, line: str) -> None:
@@ -520,7 +551,8 @@ class Session:
         self._correct(cmd.Correct(c.inputs, self._said(c.targets, compiled)), line)
 
     def _atsaid(self, c: cmd.AtSaid, line: str) -> None:
-        compiled = self.compiled()
+        rec = self._recording()
+        compiled = self._driver(rec, note=False)
         self._at(cmd.At(c.start, c.stop, self._said(c.targets, compiled)), line)
 
     def _atinstruction(self, c: cmd.AtInstruction, line: str) -> None:
@@ -532,7 +564,7 @@ class Session:
             exc.span = c.span
             raise
         rec = self._recording()
-        compiled = self.compiled()
+        compiled = self._driver(rec)
         rows = rec.rows(c.start, c.stop)
         inputs = [rec.inputs_at(i, compiled.inputs) for i in rows]
         now = self._outputs(compiled, inputs)
@@ -557,6 +589,32 @@ class Session:
                               hint="run `simulate WORLD` first, then `at 12.5s steering=55`")
         return self.simulation
 
+    def _driver(self, rec: Recording, note: bool = True) -> CompiledRuleBase:
+        """The behavior that drove the recorded run, whichever behavior is active now.
+
+        ``at`` corrects what the robot did: the paper's instructor watches the motion and
+        says what it should have been, so the correction must reach the rules that produced
+        it. Those are the recording behavior's (with the behaviors it ``use``s, each weighted
+        by its context at that tick, which is how `adapt` spreads the correction over them).
+        The active behavior's output at the same inputs may be one nobody used (`use
+        avoid_obstacle` after a `drive` run: its rules had weight 0 on the straight), so its
+        rules are not taught from the run; a note says where the examples went."""
+        names = [b.name for b in self.rulebase.behaviors]
+        if rec.behavior not in names:
+            raise LessonError(f"the run was driven by behavior `{rec.behavior}`, which is no "
+                              "longer in the rule base (undone)",
+                              hint="`simulate` the world again to correct a run of the "
+                                   "active behavior")
+        if note and rec.behavior != self.state.active \
+                and self._noted != (id(rec), self.state.active):
+            self._noted = (id(rec), self.state.active)      # once per run and active behavior
+            self.out(f"note: {rec.name} was driven by `{rec.behavior}`, so this corrects "
+                     f"{rec.behavior} (the rules that produced the motion, with the behaviors "
+                     f"it uses), not the active `{self.state.active}`; `use {rec.behavior}` "
+                     f"before `adapt` (to teach `{self.state.active}` from a run, `simulate` "
+                     "with it active)")
+        return self.compiled(rec.behavior)
+
     def _outputs(self, compiled: CompiledRuleBase, inputs: list[dict]) -> list[dict]:
         from ..engine.evaluation import evaluate
 
@@ -577,7 +635,7 @@ class Session:
 
     def _at(self, c: cmd.At, line: str) -> None:
         rec = self._recording()
-        compiled = self.compiled()
+        compiled = self._driver(rec)
         rows = rec.rows(c.start, c.stop)
         targets = self._values(c.targets, compiled.outputs, "output", compiled, False)
         inputs = [rec.inputs_at(i, compiled.inputs) for i in rows]
@@ -642,7 +700,7 @@ class Session:
         if result.parameters.frozen_reasons:
             self.out("not adapted: " + "; ".join(result.parameters.frozen_reasons))
         self.out(in_words(before, self.rulebase, result.parameters))
-        self.out(text.interpretability_text(self.rulebase))
+        self.out(self.interpretability())
         if c.plot is not None:
             self._plot_terms(before, self.rulebase, c.plot)
 
@@ -740,6 +798,8 @@ class Session:
         self.saved_seq = entry["seq"]
         self.save_as = target                      # a later bare `save` goes here too
         files = ", ".join(str(p) for p in (saved.rules,) + saved.termsets)
+        if saved.created is not None:
+            self.out(f"created the directory {saved.created}")
         self.out(f"saved {files}" + (f" ({plural(len(saved.changes), 'change')})" if saved.changes
                                      else " (no changes)"))
         for change in saved.changes:
@@ -747,7 +807,8 @@ class Session:
         self.out(self.interpretability())
 
     def interpretability(self) -> str:
-        return text.interpretability_text(self.rulebase)
+        """The interpretability line of `adapt` and `save` (new term gaps marked)."""
+        return text.interpretability_text(self.rulebase, self.original)
 
     def _help(self, c: cmd.Help, line: str) -> None:
         from .help import help_text

@@ -134,15 +134,28 @@ def history_text(entries: list[dict]) -> str:
     return "\n".join(lines)
 
 
-def interpretability_text(rb: RuleBase) -> str:
-    """What ``mitos check`` says about the terms' meaning, for the prompt."""
-    from ..lang.interpretability import rulebase_issues
+def interpretability_text(rb: RuleBase, written: RuleBase | None = None) -> str:
+    """What ``mitos check`` says about the terms' meaning, for the prompt: its
+    interpretability findings and its term gaps, a gap that ``written`` (the rule base as the
+    files wrote it) did not have marked as opened since (adaptation may not open one, but
+    `adapt ... unconstrained` may, and `mitos check` would report it)."""
+    from ..lang import interpretability as meaning
 
-    issues = rulebase_issues(rb.variables.values())
-    if not issues:
+    lines = [f"  {i.message} ({i.hint})" for i in meaning.rulebase_issues(rb.variables.values())]
+    for var in rb.variables.values():
+        before = written.variables.get(var.name) if written is not None else None
+        old = meaning.term_gaps(before) if before is not None else []
+        slack = (var.universe[1] - var.universe[0]) / (meaning.GAP_RESOLUTION - 1)
+        for left, right in meaning.term_gaps(var):
+            new = before is not None and not any(a - slack <= left and right <= b + slack
+                                                 for a, b in old)
+            lines.append(f"  {meaning.gap_message(var, left, right)}"
+                         + (", a gap the terms as written did not have" if new
+                            else "") + f" ({meaning.GAP_HINT})")
+    if not lines:
         return "interpretability: terms in order, universes covered, terms distinct, " \
                "centre terms on their points"
-    return "\n".join(["interpretability:"] + [f"  {i.message} ({i.hint})" for i in issues])
+    return "\n".join(["interpretability:"] + lines)
 
 
 def quoted_column(message: str, line: str) -> tuple[int, int]:
