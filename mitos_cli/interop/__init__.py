@@ -13,8 +13,9 @@ import re
 from pathlib import Path
 
 from ..errors import FormatError, MitosError, RuleBaseError
-from ..fileio import nearby, unreadable
+from ..fileio import unreadable
 from ..lang.model import RuleBase
+from ..lang.resolve import rule_file_hint
 
 READERS = {".fcl": "fcl", ".fis": "fis", ".fll": "fll"}
 FORMATS = ("fcl", "fis", "fll")
@@ -30,7 +31,8 @@ def read_foreign(path: str | Path) -> RuleBase:
     try:
         path.open("rb").close()
     except OSError as exc:
-        raise RuleBaseError(unreadable("rule file", path, exc), hint=nearby(path)) from None
+        raise RuleBaseError(unreadable("rule file", path, exc),
+                            hint=rule_file_hint(path)) from None
     if kind == "fll":
         from .fll import read_fll
 
