@@ -45,7 +45,7 @@ from mitos_cli.engine.compile import compile_rulebase  # noqa: E402
 from mitos_cli.engine.evaluation import evaluate  # noqa: E402
 from mitos_cli.errors import MitosError  # noqa: E402
 from mitos_cli.interop import parse_foreign, round_trip_difference, write_foreign  # noqa: E402
-from mitos_cli.lang.model import Setting  # noqa: E402
+from mitos_cli.interop.common import fidelity_settings  # noqa: E402
 
 TOLERANCE = 1e-6
 DEBIAN = Path("/usr/share/doc/fuzzylite/examples")
@@ -147,17 +147,6 @@ def ensure_packages() -> list[str]:
     return [p for p, where in PACKAGES.items() if not where.exists()]
 
 
-def fuzzylite6_settings(path: Path, rb) -> tuple[Setting, ...]:
-    """fuzzylite 6 samples cell midpoints at the file's resolution, 100 when it gives none."""
-    text = path.read_text(errors="replace")
-    explicit = re.search(r"(Centroid|Bisector|COG|COA)\s+\d+", text)
-    ops = compile_rulebase(rb).operators
-    if ops.inference != "mamdani":
-        return ()
-    resolution = ops.resolution if explicit and path.suffix != ".fis" else 100
-    return (Setting("resolution", str(resolution)), Setting("sampling", "midpoints"))
-
-
 def fuzzylite6_table(path: Path, tmp: Path) -> tuple[list[str], np.ndarray] | None:
     out = tmp / (path.stem + "-" + path.suffix[1:] + ".fld")
     proc = subprocess.run(["fuzzylite", "-i", str(path), "-if", path.suffix[1:], "-o", str(out),
@@ -191,7 +180,7 @@ def part_debian(tmp: Path) -> dict:
         col = {plain(h): i for i, h in enumerate(header)}     # fuzzylite drops `-` from names
         error, defaulted = 0.0, 0
         for b in rb.behaviors:
-            c = LoadedRuleBase(rb, b.name, fuzzylite6_settings(path, rb)).compiled
+            c = LoadedRuleBase(rb, b.name, fidelity_settings(rb, "fuzzylite6", b.name)).compiled
             X = table[:, [col[plain(n)] for n in c.inputs]]
             Y = evaluate(c, X, strict=False, detail=False).outputs
             for j, out in enumerate(c.outputs):

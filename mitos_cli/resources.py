@@ -50,7 +50,7 @@ def resolve(kind: str, name: str | Path, suffix: str, base: Path | None = None) 
     for candidate in ([base / p] if base is not None else []) + [p]:
         if is_file(candidate):
             return candidate
-    if not _packaged_place(p.parent.as_posix(), kind):
+    if not packaged_place(p.parent.as_posix(), kind):
         return None             # `nope/corridor.yaml`: a mistyped directory, not the packaged
     for filename in (p.name, p.name + suffix):
         if is_file(data_dir(kind) / filename):
@@ -58,7 +58,7 @@ def resolve(kind: str, name: str | Path, suffix: str, base: Path | None = None) 
     return None
 
 
-def _packaged_place(directory: str, kind: str) -> bool:
+def packaged_place(directory: str, kind: str) -> bool:
     """Whether a file named in ``directory`` may be the packaged one: a bare name, or one
     under the directory it has in the repository (``worlds/``, ``rulebases/lessons/`` or
     ``lessons/``), as the docs and the README write them."""

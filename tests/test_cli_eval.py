@@ -287,6 +287,25 @@ def test_a_misspelt_rule_file_or_its_term_set_named_instead_say_what_was_meant(c
     assert code == 1 and "did you mean `rulebases/mitos.rules`?" in err
 
 
+@pytest.mark.parametrize("command", [["eval", "rulebases/mitoss.rules", "road=78"],
+                                     ["check", "rulebases/mitoss.rules"],
+                                     ["simulate", "corridor", "--rulebase",
+                                      "rulebases/mitoss.rules"],
+                                     ["teach", "rulebases/mitoss.rules", "--lesson", "-"],
+                                     ["eval", "mitoss.rules", "road=78"]])
+def test_a_misspelt_packaged_rule_file_from_elsewhere_gets_a_did_you_mean(
+        command, tmp_path, monkeypatch, capsys):
+    """Where there is no `rulebases/` (a user's own directory), `rulebases/mitos.rules` is the
+    packaged file, so a misspelling of it is suggested from the packaged ones, as worlds are."""
+    monkeypatch.chdir(tmp_path)
+    code, _, err = run_main(command, capsys)
+    name = command[1] if command[0] != "simulate" else command[3]
+    assert code == 1 and f"rule file `{name}` not found" in err
+    assert f"did you mean `{name.replace('mitoss', 'mitos')}`?" in err, err
+    code, _, err = run_main(["eval", "nope/mitoss.rules", "road=78"], capsys)
+    assert code == 1 and "did you mean" not in err      # another directory: not the packaged
+
+
 def test_used_rules_take_the_operators_of_the_behavior_that_uses_them(tmp_path):
     """docs/language.md: `cruise` (and = product) evaluates avoid_obstacle's rules with
     product, so their DOFs there are not the ones avoid_obstacle alone gives."""

@@ -424,3 +424,158 @@ def test_a_rule_file_with_a_mistake_gets_no_format_hint(tmp_path: Path, capsys) 
         (tmp_path / f).write_bytes((ROOT / "rulebases" / f).read_bytes())
     code, err = _run(capsys, "check", str(tmp_path / "m.rules"))
     assert code == 1 and "looks like" not in err and "syntax error" in err
+
+
+# ---------------------------------------------------------------------------------------------
+# FCL that fuzzylite 6 (Debian's `fuzzylite` binary), jFuzzyLogic and IEC 61131-7 read
+
+
+def _fuzzylite6(fcl: Path, inputs: list[str], rows: list[list[float]], tmp: Path) -> np.ndarray:
+    """The `fuzzylite` binary's outputs for ``rows`` of ``inputs`` on ``fcl`` (12 decimals)."""
+    import shutil
+    import subprocess
+
+    if shutil.which("fuzzylite") is None:
+        pytest.skip("the `fuzzylite` binary (Debian's fuzzylite 6) is not installed")
+    data = tmp / "in.fld"
+    data.write_text(" ".join(inputs) + "\n" + "\n".join(" ".join(map(repr, r)) for r in rows)
+                    + "\n")
+    out = tmp / "out.fld"
+    proc = subprocess.run(["fuzzylite", "-i", str(fcl), "-if", "fcl", "-o", str(out), "-of",
+                           "fld", "-d", str(data), "-dheader", "true", "-dinputs", "true",
+                           "-decimals", "12"], capture_output=True, text=True, timeout=60)
+    assert "error" not in (proc.stdout + proc.stderr).lower(), proc.stdout + proc.stderr
+    lines = out.read_text().split("\n")
+    header, body = lines[0].split(), [line.split() for line in lines[1:] if line.strip()]
+    assert header[:len(inputs)] == inputs and len(body) == len(rows), out.read_text()
+    return np.array([[float(x) for x in row[len(inputs):]] for row in body])
+
+
+def test_written_fcl_loads_in_fuzzylite_6_and_agrees(tmp_path: Path, capsys) -> None:
+    """The paper's 27 rules (Takagi-Sugeno, two outputs per rule) and the MATLAB tipper
+    (Mamdani) written as FCL give in the `fuzzylite` binary what MITOS gives: the Sugeno file to
+    its printed digits, the Mamdani one with `--fidelity fuzzylite6` (its 100 samples)."""
+    fcl = tmp_path / "m.fcl"
+    code, _ = _run(capsys, "convert", str(ROOT / "rulebases" / "mitos.rules"), "--to", "fcl",
+                   "-o", str(fcl))
+    assert code == 0
+    rows = [[78.0, 45.0, 4.0], [20.0, 90.0, -30.0], [130.0, 12.5, 6.9]]
+    got = _fuzzylite6(fcl, ["road", "size", "position"], rows, tmp_path)
+    rb = load_rulebase(fcl)
+    want = [[rb.evaluate(road=r[0], size=r[1], position=r[2])[o] for o in ("steering", "speed")]
+            for r in rows]
+    np.testing.assert_allclose(got, want, rtol=0, atol=1e-9)
+    assert got[0] == pytest.approx([65.411255411, 32.424242424], abs=1e-9)   # the paper's run
+
+    tip = tmp_path / "tipper.fcl"
+    code, _ = _run(capsys, "convert", str(DATA / "tipper.fis"), "--to", "fcl", "-o", str(tip))
+    assert code == 0
+    # rows where every rule fires above 1e-6 or not at all: fuzzylite 6 activates a rule only
+    # above its tolerance of 1e-6 (`Op::isGt`), so at service=2, food=1 its `generous` rule
+    # (6.7e-7) is left out and it gives 7.015211 where MITOS (and fuzzylite 8) give 7.015230
+    rows = [[3.0, 1.0], [4.0, 5.0], [7.0, 8.0], [5.0, 5.0]]
+    got = _fuzzylite6(tip, ["service", "food"], rows, tmp_path)
+    for row, value in zip(rows, got[:, 0]):
+        code = _eval_json(capsys, str(tip), f"service={row[0]!r}", f"food={row[1]!r}",
+                          "--fidelity", "fuzzylite6")
+        assert code["tip"] == pytest.approx(value, abs=1e-9)
+
+
+def _eval_json(capsys, *args: str) -> dict:
+    from mitos_cli.cli.app import main
+
+    with pytest.raises(SystemExit) as info:
+        main(["eval", *args, "--json"])
+    assert not info.value.code
+    return json.loads(capsys.readouterr().out)["outputs"]
+
+
+def test_fcl_dialects_differ_only_where_the_readers_do(tmp_path: Path, capsys) -> None:
+    """fuzzylite 6 reads ACCU only in DEFUZZIFY and `and` between conclusions; IEC 61131-7 and
+    jFuzzyLogic read ACCU only in the RULEBLOCK and `,`. Both have lower-case rule keywords
+    (fuzzylite reads no others) and no resolution after METHOD (no reader but MITOS reads
+    one); MITOS reads both back to the same outputs."""
+    from mitos_cli.interop.fcl import parse_fcl
+
+    rb = read_rulebase(DATA / "tipper.fis")
+    texts = {d: write_foreign(rb, "fcl", dialect=d) for d in ("fuzzylite", "iec")}
+    for dialect, text in texts.items():
+        block = text[text.index("RULEBLOCK"):]
+        assert ("ACCU : MAX;" in block) == (dialect == "iec")
+        assert ("ACCU : MAX;" in text[:text.index("RULEBLOCK")]) == (dialect == "fuzzylite")
+        assert "METHOD : COG;" in text and "COG 101" not in text
+        assert "RULE 1 : if service is poor or food is rancid then tip is cheap;" in text
+        assert text.startswith(f"// {'fuzzylite 6' if dialect == 'fuzzylite' else 'IEC'}")
+        from mitos_cli.api import LoadedRuleBase
+
+        back = LoadedRuleBase(parse_fcl(text, "x.fcl"))   # FCL `COG`: 1000 midpoints in MITOS
+        assert back.evaluate(service=2, food=1)["tip"] == pytest.approx(7.015028, abs=1e-6)
+    two = ROOT / "rulebases" / "mitos.rules"
+    iec = write_foreign(read_rulebase(two), "fcl", dialect="iec")
+    assert "then steering is RS, speed is MEDIUM;" in iec
+    assert "then steering is RS and speed is MEDIUM;" in write_foreign(read_rulebase(two), "fcl")
+    rules = tmp_path / "r.rules"                   # a resolution FCL cannot carry: said
+    rules.write_text((ROOT / "rulebases" / "mitos.rules").read_text())
+    for f in ("mitos.terms.yaml", "drive.terms.yaml"):
+        (tmp_path / f).write_bytes((ROOT / "rulebases" / f).read_bytes())
+    code, err = _run(capsys, "convert", str(DATA / "dimmer_fuzzylite.fcl"), "--to", "rules",
+                     "-o", str(rules))
+    rules.write_text(rules.read_text().replace("resolution = 1000", "resolution = 300"))
+    code, err = _run(capsys, "convert", str(rules), "--to", "fcl", "-o", str(tmp_path / "d.fcl"))
+    assert code == 0 and ("FCL has no resolution that fuzzylite 6, jFuzzyLogic and IEC 61131-7 "
+                          "read: `METHOD : COG;` is written without this rule base's 300 "
+                          "points") in " ".join(err.split()), err
+    code, _ = _run(capsys, "convert", str(DATA / "tipper.fis"), "--to", "fll", "--dialect",
+                   "iec")
+    assert code == 2                               # --dialect is FCL's
+
+
+def test_fuzzylite_dialect_moves_not_onto_propositions(tmp_path: Path) -> None:
+    """fuzzylite's `not` is a hedge: `not (a or b)` is written `a is not .. and b is not ..`
+    (exact with dual norms), and refused by name where the norms are not duals."""
+    from mitos_cli.errors import FormatError
+    from mitos_cli.interop.fcl import parse_fcl
+
+    fcl = (DATA / "tipper_jfuzzylogic.fcl").read_text()
+    fcl = fcl.replace("RULE 2 : IF service IS good", "RULE 2 : IF NOT (service IS poor OR "
+                      "food IS rancid) AND service IS good", 1)
+    rb = parse_fcl(fcl, "x.fcl")
+    text = write_foreign(rb, "fcl")
+    assert "if service is not poor and food is not rancid and service is good" in text, text
+    assert "not (service is poor or food is rancid)" in write_foreign(rb, "fcl", dialect="iec")
+    X = [dict(service=s, food=f) for s in (0.5, 3.0, 6.0, 9.5) for f in (0.5, 4.0, 8.0)]
+    from mitos_cli.api import LoadedRuleBase
+
+    for x in X:
+        assert LoadedRuleBase(parse_fcl(text)).evaluate(**x)["tip"] == pytest.approx(
+            LoadedRuleBase(rb).evaluate(**x)["tip"], abs=1e-12)
+    odd = fcl.replace("AND : MIN;", "AND : MIN; OR : BSUM;", 1)
+    with pytest.raises(FormatError, match="fuzzylite's FCL has no `not` over a group"):
+        write_foreign(parse_fcl(odd, "x.fcl"), "fcl")
+
+
+def test_fidelity_fuzzylite6_samples_100_points_where_the_file_gives_none(capsys) -> None:
+    """fuzzylite 6 reads an FCL `METHOD : COG;` (and a .fis centroid, an FLL `Centroid`) as
+    100 midpoints; fuzzylite 8 reads an FLL `Centroid` as 1000. `--fidelity fuzzylite6` and
+    `fuzzylite` sample so; a resolution the file writes is kept by both."""
+    import re
+
+    src = DATA / "dimmer_fuzzylite.fcl"
+    text = src.read_text()
+    assert re.search(r"METHOD\s*:\s*COG\s*;", text)
+    six = _eval_json(capsys, str(src), "Ambient=0.3", "--fidelity", "fuzzylite6")
+    eight = _eval_json(capsys, str(src), "Ambient=0.3", "--fidelity", "fuzzylite")
+    plain = _eval_json(capsys, str(src), "Ambient=0.3")
+    assert eight == plain and six != eight
+    from mitos_cli.api import LoadedRuleBase
+    from mitos_cli.interop.fcl import parse_fcl
+
+    at_100 = re.sub(r"METHOD\s*:\s*COG\s*;", "METHOD : COG 100;", text)
+    want = LoadedRuleBase(parse_fcl(at_100, "x.fcl")).evaluate(Ambient=0.3)
+    assert six == pytest.approx(dict(want), abs=1e-12)
+    at_300 = re.sub(r"METHOD\s*:\s*COG\s*;", "METHOD : COG 300;", text)
+    rb = parse_fcl(at_300, "x.fcl")
+    from mitos_cli.interop.common import fidelity_settings
+
+    assert LoadedRuleBase(rb, None, fidelity_settings(rb, "fuzzylite6")).evaluate(
+        Ambient=0.3) == pytest.approx(dict(LoadedRuleBase(rb).evaluate(Ambient=0.3)))

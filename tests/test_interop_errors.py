@@ -163,6 +163,12 @@ def test_fll_conflicting_outputs() -> None:
     with pytest.raises(FormatError) as info:
         parse_fll(text, "bad.fll")
     assert "differs from `centroid` set at bad.fll:15" in info.value.message
+    text = FLL + FLL[FLL.index("OutputVariable"):FLL.index("RuleBlock")].replace(
+        "OutputVariable: y", "OutputVariable: z").replace("Centroid 200", "Centroid 500")
+    with pytest.raises(FormatError) as info:            # fuzzylite's SimpleDimmerChained
+        parse_fll(text, "bad.fll")
+    assert "resolution `500` differs from `200`" in info.value.message
+    assert info.value.hint.startswith("give every output the same resolution")
 
 
 FIS = (Path(__file__).parent / "data" / "interop" / "tipper.fis").read_text()
@@ -222,6 +228,12 @@ def test_fis_sugeno_linear_count_and_missing_system() -> None:
         "MF1='cheap':'trimf',[0 5 10]", "MF1='cheap':'linear',[1 2]")
     with pytest.raises(FormatError, match=r"linear takes 3 numbers"):
         parse_fis(sugeno, "bad.fis")
+    ramp = sugeno.replace("MF1='cheap':'linear',[1 2]", "MF1='cheap':'rampmf',[0 0.25]")
+    with pytest.raises(FormatError) as info:            # fuzzylite's Tsukamoto .fis
+        parse_fis(ramp, "bad.fis")
+    assert info.value.message == ("MF `cheap`: the outputs of a Sugeno-type .fis take "
+                                  "`constant` or `linear` MFs, not `rampmf`")
+    assert "write the system as FLL" in info.value.hint
     with pytest.raises(FormatError, match=r"no \[System\] section"):
         parse_fis(FIS[FIS.index("[Input1]"):], "bad.fis")
     with pytest.raises(FormatError, match="output `tip` has no membership functions"):

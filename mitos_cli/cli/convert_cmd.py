@@ -20,6 +20,13 @@ class Target(str, Enum):
     fll = "fll"
 
 
+class Dialect(str, Enum):
+    """Which FCL readers the written FCL is for (``mitos_cli.interop.fcl.DIALECTS``)."""
+
+    fuzzylite = "fuzzylite"    # fuzzylite 6: ACCU in DEFUZZIFY, `and` between conclusions
+    iec = "iec"                # IEC 61131-7, jFuzzyLogic: ACCU in the RULEBLOCK, `,`
+
+
 def convert_command(
     path: Annotated[Path, typer.Argument(
         metavar="FILE", help="Rule base to convert (.rules, .fcl, .fis or .fll).")],
@@ -34,6 +41,11 @@ def convert_command(
              "there that OUT.rules does not read.")] = None,
     behavior: Annotated[Optional[str], typer.Option(
         "--behavior", "-b", callback=named, help="Behavior to convert (default: the file's first).")] = None,
+    dialect_name: Annotated[Optional[str], typer.Option(
+        "--dialect", metavar=choices(Dialect), autocompletion=completer(Dialect),
+        help="With --to fcl, the readers to write for: fuzzylite (fuzzylite 6, the default) "
+             "or iec (IEC 61131-7 and jFuzzyLogic). They differ in where ACCU stands and "
+             "what joins two conclusions (docs/interop.md).")] = None,
 ) -> None:
     """Convert a rule base between the MITOS rule language, FCL, MATLAB .fis and fuzzylite FLL.
 
@@ -45,6 +57,10 @@ def convert_command(
     from ..interop.common import atomic_write
 
     to = choice(Target, to_name, "format")
+    dialect = None if dialect_name is None else choice(Dialect, dialect_name, "FCL dialect")
+    if dialect is not None and to is not Target.fcl:
+        raise typer.BadParameter(f"--dialect chooses between FCL's dialects; --to {to.value} "
+                                 f"has none (leave --dialect out)")
     if output is not None:
         check_suffix(output, f".{to.value}", f"--to {to.value}")
     rb = read_rulebase(path)
@@ -72,7 +88,7 @@ def convert_command(
         return
     if output is not None:
         refuse_inputs([output], sources)
-    text = write_foreign(rb, to.value, behavior)
+    text = write_foreign(rb, to.value, behavior, None if dialect is None else dialect.value)
     for note in conversion_notes(rb, to.value, behavior):
         warn(note)
     for note in round_trip_difference(rb, parse_foreign(text, to.value, str(output or "-")),

@@ -20,7 +20,8 @@ class Engine(str, enum.Enum):
 
     matlab = "matlab"
     jfuzzylogic = "jfuzzylogic"
-    fuzzylite = "fuzzylite"
+    fuzzylite = "fuzzylite"       # fuzzylite 8 (pyfuzzylite): 1000 where the file says none
+    fuzzylite6 = "fuzzylite6"     # fuzzylite 6 (Debian's binary): 100 where the file says none
 
 
 class NoRule(str, enum.Enum):
@@ -144,7 +145,9 @@ def eval_command(
         "--fidelity", metavar=choices(Engine), autocompletion=completer(Engine),
         help="Sample Mamdani outputs as this engine does, to reproduce its published tables: "
              "matlab (101 points with both ends), jfuzzylogic (1000 left cell ends), "
-             "fuzzylite (cell midpoints, the file's resolution).")] = None,
+             "fuzzylite (fuzzylite 8: cell midpoints at the file's resolution, 1000 where it "
+             "gives none), fuzzylite6 (fuzzylite 6, Debian's `fuzzylite`: the same, 100 where "
+             "it gives none, as in every FCL `METHOD : COG;` and .fis).")] = None,
 ) -> None:
     """Evaluate a rule base: fuzzified inputs, fired rules with DOFs, crisp outputs."""
     on_no_rule = (None if on_no_rule_name is None

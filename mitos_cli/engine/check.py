@@ -241,7 +241,7 @@ def resolution_hint(path: str | None, points: int) -> str:
                 f"{finer}`)")
     if suffix == "fcl":
         return (f"widen it, or raise the defuzzifier's resolution (`METHOD : COG "
-                f"{finer};`)")
+                f"{finer};`, which MITOS reads; fuzzylite 6 and jFuzzyLogic read none)")
     return (f"widen it, or raise the resolution (now {points}): `resolution = {finer}` in "
             f"the behavior's (or the file's) `operators:` line")
 

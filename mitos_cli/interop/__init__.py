@@ -13,8 +13,9 @@ import re
 from pathlib import Path
 
 from ..errors import FormatError, MitosError, RuleBaseError
-from ..fileio import nearby, unreadable
+from ..fileio import unreadable
 from ..lang.model import RuleBase
+from ..lang.resolve import rule_file_hint
 
 READERS = {".fcl": "fcl", ".fis": "fis", ".fll": "fll"}
 FORMATS = ("fcl", "fis", "fll")
@@ -30,7 +31,8 @@ def read_foreign(path: str | Path) -> RuleBase:
     try:
         path.open("rb").close()
     except OSError as exc:
-        raise RuleBaseError(unreadable("rule file", path, exc), hint=nearby(path)) from None
+        raise RuleBaseError(unreadable("rule file", path, exc),
+                            hint=rule_file_hint(path)) from None
     if kind == "fll":
         from .fll import read_fll
 
@@ -113,9 +115,11 @@ def hint_wrong_reader(exc: MitosError, path: str | Path, command: str | None = N
         exc.hint = hint
 
 
-def write_foreign(rb: RuleBase, fmt: str, behavior: str | None = None) -> str:
+def write_foreign(rb: RuleBase, fmt: str, behavior: str | None = None,
+                  dialect: str | None = None) -> str:
     """One behavior of ``rb`` as ``fmt`` (``fcl``, ``fis`` or ``fll``) text; names the format
-    cannot hold are written as legal ones (:func:`conversion_notes` lists them)."""
+    cannot hold are written as legal ones (:func:`conversion_notes` lists them). ``dialect``:
+    FCL's (:data:`.fcl.DIALECTS`; the default is fuzzylite's)."""
     from .common import legal_names
 
     rb, _ = legal_names(rb, fmt)
@@ -128,9 +132,9 @@ def write_foreign(rb: RuleBase, fmt: str, behavior: str | None = None) -> str:
 
         return write_fis(rb, behavior)
     if fmt == "fcl":
-        from .fcl import write_fcl
+        from .fcl import DEFAULT_DIALECT, write_fcl
 
-        return write_fcl(rb, behavior)
+        return write_fcl(rb, behavior, dialect or DEFAULT_DIALECT)
     raise FormatError(f"unknown format `{fmt}`", expected="one of " + ", ".join(FORMATS))
 
 
@@ -166,6 +170,14 @@ def conversion_notes(rb: RuleBase, fmt: str, behavior: str | None = None) -> lis
         out.append(f"{fmt.upper()} Mamdani outputs are sampled at cell midpoints (fuzzylite's "
                    f"rule); this rule base samples at {ops.sampling} (MATLAB's), so results "
                    f"move by the discretisation")
+    elif fmt == "fcl" and ops.inference == "mamdani" and ops.resolution != 1000:
+        from .common import DEFUZZIFIERS
+
+        method = DEFUZZIFIERS.get(ops.defuzzify, ("", "", "COG"))[2]
+        out.append(f"FCL has no resolution that fuzzylite 6, jFuzzyLogic and IEC 61131-7 read: "
+                   f"`METHOD : {method};` is written without this rule base's "
+                   f"{ops.resolution} points, and read as 1000 (MITOS, jFuzzyLogic) or 100 "
+                   f"(fuzzylite 6)")
     return out
 
 

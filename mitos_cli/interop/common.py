@@ -333,8 +333,7 @@ class Settings:
         if old is not None and old != value:
             raise FormatError(f"{what} `{value}` differs from `{old}` set at "
                               f"{self.spans.get(key)}: MITOS uses one {what} per rule base",
-                              span=span, hint="use the same operator for every output and "
-                                              "rule block")
+                              span=span, hint=_same_hint(key))
         setattr(self, key, value)
         self.spans.setdefault(key, span)
 
@@ -355,7 +354,9 @@ class Settings:
             out.append(Setting("aggregation", self.aggregation or "max",
                                spans.get("aggregation")))
             out.append(Setting("defuzzify", defuzz, spans.get("defuzzify")))
-            out.append(Setting("resolution", str(self.resolution or default_resolution)))
+            # the span says the file wrote it (``--fidelity fuzzylite6`` keeps only those)
+            out.append(Setting("resolution", str(self.resolution or default_resolution),
+                               spans.get("resolution")))
             if self.sampling:
                 out.append(Setting("sampling", self.sampling))
         return tuple(out)
@@ -364,6 +365,16 @@ class Settings:
     def sugeno(self) -> bool:
         """Weighted inference (Takagi-Sugeno or Tsukamoto): no Mamdani settings."""
         return self.defuzzify in ("weighted_average", "weighted_sum", "tsukamoto")
+
+
+def _same_hint(key: str) -> str:
+    """What to do when two outputs or rule blocks set ``key`` differently."""
+    if key == "resolution":
+        return ("give every output the same resolution (MITOS samples one rule base's "
+                "outputs alike; the larger resolution samples finer)")
+    if key == "sampling":
+        return "give every output the same sampling"
+    return "use the same operator for every output and rule block"
 
 
 class Record(list):
@@ -849,10 +860,15 @@ def legal_names(rb: RuleBase, fmt: str) -> tuple[RuleBase, list[str]]:
 # Fidelity to a format's reference engine
 
 #: How each reference engine samples a Mamdani output: (resolution, sampling); ``None`` keeps
-#: the file's resolution. MATLAB's ``evalfis``: 101 points including both ends; jFuzzyLogic:
-#: 1000 left cell ends; fuzzylite: the file's resolution (1000 by default), cell midpoints.
+#: the file's resolution, a number replaces only a resolution the file does not write.
+#: MATLAB's ``evalfis``: 101 points including both ends; jFuzzyLogic: 1000 left cell ends;
+#: fuzzylite 8 (pyfuzzylite 8.0.6, which reads FLL only): the file's resolution, 1000 by
+#: default, at cell midpoints; fuzzylite 6 (Debian's ``fuzzylite`` binary, which reads FLL,
+#: FCL and .fis): the same with 100 by default (``IntegralDefuzzifier::_defaultResolution``),
+#: which is every FCL ``METHOD : COG;`` and every .fis ``centroid``.
 FIDELITY = {"matlab": (101, "endpoints"), "jfuzzylogic": (1000, "left"),
-            "fuzzylite": (None, "midpoints")}
+            "fuzzylite": (None, "midpoints"), "fuzzylite6": (None, "midpoints")}
+UNWRITTEN_RESOLUTION = {"fuzzylite": 1000, "fuzzylite6": 100}
 
 
 def fidelity_settings(rb: RuleBase, engine: str, behavior: str | None = None
@@ -868,5 +884,10 @@ def fidelity_settings(rb: RuleBase, engine: str, behavior: str | None = None
         return ()
     resolution, sampling = FIDELITY[engine]
     if resolution is None:
-        resolution = 1000 if ops.sampling == "endpoints" else ops.resolution
+        foreign = (rb.path or "").lower().endswith((".fll", ".fcl", ".fis"))
+        # the rule language's default (101) is its own and the FLL writer writes it; a
+        # foreign reader's default (FLL, FCL: 1000) is not in the file; .fis has none
+        written = not foreign or (setting_span(rb, behavior, "resolution") is not None
+                                  and ops.sampling != "endpoints")
+        resolution = ops.resolution if written else UNWRITTEN_RESOLUTION[engine]
     return (Setting("resolution", str(resolution)), Setting("sampling", sampling))

@@ -20,9 +20,10 @@ MITOS's model. Both dialects are read:
 - hedges (fuzzylite's dialect) as in FLL; ``NOT (...)`` over groups.
 
 Without a ``RANGE``, a variable's range is the extent of its piecewise-linear terms.
-The writer writes the IEC / jFuzzyLogic dialect (point lists for piecewise-linear terms, ACCU in
-the rule block); shapes IEC has no notation for use jFuzzyLogic's or fuzzylite's names, which
-this reader reads back.
+The writer writes one of two dialects (:data:`DIALECTS`): fuzzylite 6's (the default) or IEC
+61131-7 as jFuzzyLogic reads it; both have lower-case rule keywords, point lists for
+piecewise-linear terms and no resolution after METHOD. Shapes IEC has no notation for use
+jFuzzyLogic's or fuzzylite's names, which this reader reads back.
 """
 
 from __future__ import annotations
@@ -30,6 +31,7 @@ from __future__ import annotations
 import dataclasses
 import functools
 import math
+from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
@@ -41,7 +43,7 @@ from ..fuzzy import norms
 from ..fuzzy.shapes import TSUKAMOTO
 from ..lang.bulk import without_cyclic_gc
 from ..lang.cache import lark_parser
-from ..lang.model import And, Not, Prop, Rule, RuleBase
+from ..lang.model import And, Expr, Not, Or, Prop, Rule, RuleBase
 from ..lang.resolve import MAIN
 from ..lang.terms import Role, Term, Variable
 from ..words import plural
@@ -568,8 +570,30 @@ def _rule(item: Tree, variables: dict[str, Variable], span_of, index: int) -> Ru
 # Writer
 
 
-def write_fcl(rb: RuleBase, behavior: str | None = None) -> str:
-    """FCL text (IEC 61131-7 as jFuzzyLogic reads it) for one behavior of ``rb``."""
+#: The FCL dialects the writer writes, as ``mitos convert --dialect`` names them. The readers
+#: disagree on two things only (checked on fuzzylite 6's ``FclImporter`` and jFuzzyLogic's
+#: ``Fcl.g``): where ``ACCU`` stands (fuzzylite 6 refuses it in the RULEBLOCK and needs it in
+#: DEFUZZIFY; IEC 61131-7 and jFuzzyLogic read it only in the RULEBLOCK, and jFuzzyLogic takes
+#: SUM without it) and what joins two conclusions (fuzzylite 6: ``and``; IEC and jFuzzyLogic:
+#: ``,``). Everything else is written in the form all three read.
+DIALECTS = {
+    "fuzzylite": "fuzzylite 6's FclImporter (ACCU in DEFUZZIFY, `and` between conclusions)",
+    "iec": "IEC 61131-7 as jFuzzyLogic reads it (ACCU in the RULEBLOCK, `,` between "
+           "conclusions)",
+}
+DEFAULT_DIALECT = "fuzzylite"
+
+
+def write_fcl(rb: RuleBase, behavior: str | None = None, dialect: str = DEFAULT_DIALECT) -> str:
+    """FCL text for one behavior of ``rb`` in ``dialect`` (:data:`DIALECTS`).
+
+    Rule keywords are lower case (fuzzylite 6 reads only ``if is and or not then with``; IEC
+    and jFuzzyLogic read keywords in any case) and ``METHOD`` carries no resolution (none of
+    the three reads ``COG 200``; :func:`.conversion_notes` says what that changes)."""
+    if dialect not in DIALECTS:
+        raise FormatError(f"unknown FCL dialect `{dialect}`",
+                          expected="one of " + ", ".join(DIALECTS),
+                          hint=did_you_mean(dialect, DIALECTS))
     flat = common.flatten_for_export(rb, behavior)
     ops = flat.operators
     at = functools.partial(common.setting_span, rb, behavior)       # where an operator was chosen
@@ -578,7 +602,10 @@ def write_fcl(rb: RuleBase, behavior: str | None = None) -> str:
                           span=at("inference"))
     sugeno = ops.inference in ("weighted_average", "weighted_sum")
     inputs = common.all_inputs(rb, flat)
-    out = [f"FUNCTION_BLOCK {flat.name}", "", "VAR_INPUT"]
+    accu = None if sugeno else common.foreign_name(
+        common.SNORMS, FCL, ops.aggregation, "S-norm", span=at("aggregation"))
+    out = [f"// {DIALECTS[dialect]}; written by MITOS", "", f"FUNCTION_BLOCK {flat.name}", "",
+           "VAR_INPUT"]
     out += [f"    {v.name} : REAL;" for v in inputs] + ["END_VAR", "", "VAR_OUTPUT"]
     out += [f"    {v.name} : REAL;" for v in flat.outputs] + ["END_VAR", ""]
     for v in inputs:
@@ -587,28 +614,7 @@ def write_fcl(rb: RuleBase, behavior: str | None = None) -> str:
         out += [f"    TERM {t.name} := {_term_text(t, v)};" for t in v.terms]
         out += ["END_FUZZIFY", ""]
     for v in flat.outputs:
-        out.append(f"DEFUZZIFY {v.name}")
-        out.append(f"    RANGE := ({fmt_number(v.universe[0])} .. {fmt_number(v.universe[1])});")
-        for t in v.terms:
-            if sugeno and t.shape == "linear":
-                coefficients = common.linear_coefficients(rb, v.name, t)
-                values = [coefficients.get(x.name, 0.0) for x in inputs] + [t.params[-1]]
-                text = "Linear " + " ".join(fmt_number(c) for c in values)
-            elif sugeno:
-                text = fmt_number(t.center)
-            else:
-                text = _term_text(t, v)
-            out.append(f"    TERM {t.name} := {text};")
-        if sugeno:
-            out.append(f"    METHOD : {common.DEFUZZIFIERS[ops.inference][FCL]};")
-        else:
-            method = common.foreign_name(common.DEFUZZIFIERS, FCL, ops.defuzzify, "defuzzifier",
-                                         span=at("defuzzify"))
-            # IEC has no resolution: written (fuzzylite-style) only when not the default 1000
-            res = "" if ops.resolution == DEFAULT_RESOLUTION else f" {ops.resolution}"
-            out.append(f"    METHOD : {method}{res};")
-        if v.default is not None:           # none: no DEFAULT line (the output is NaN)
-            out.append(f"    DEFAULT := {fmt_number(v.default)};")
+        out += _defuzzify(rb, v, ops, inputs, at, accu if dialect == "fuzzylite" else None)
         out += ["END_DEFUZZIFY", ""]
     out.append(f"RULEBLOCK {flat.name}")
     and_ = common.foreign_name(common.TNORMS, FCL, ops.and_, "T-norm", span=at("and"))
@@ -617,13 +623,43 @@ def write_fcl(rb: RuleBase, behavior: str | None = None) -> str:
     if not sugeno:
         act = common.foreign_name(common.TNORMS, FCL, ops.implication, "T-norm",
                                   span=at("implication"))
-        accu = common.foreign_name(common.SNORMS, FCL, ops.aggregation, "S-norm",
-                                   span=at("aggregation"))
-        out += [f"    ACT : {act};", f"    ACCU : {accu};"]
+        out.append(f"    ACT : {act};")
+        if dialect == "iec":
+            out.append(f"    ACCU : {accu};")
     for i, r in enumerate(flat.rules, 1):
-        out.append(f"    RULE {i} : {_rule_text(r)};")
+        out.append(f"    RULE {i} : {_rule_text(r, dialect, ops)};")
     out += ["END_RULEBLOCK", "", "END_FUNCTION_BLOCK"]
     return "\n".join(out) + "\n"
+
+
+def _defuzzify(rb: RuleBase, v: Variable, ops, inputs: Sequence[Variable], at,
+               accu: str | None) -> list[str]:
+    """An output's DEFUZZIFY block up to its END; ``accu``: an ACCU line after METHOD, where
+    fuzzylite's own exporter writes it."""
+    sugeno = ops.inference in ("weighted_average", "weighted_sum")
+    out = [f"DEFUZZIFY {v.name}",
+           f"    RANGE := ({fmt_number(v.universe[0])} .. {fmt_number(v.universe[1])});"]
+    for t in v.terms:
+        if sugeno and t.shape == "linear":
+            coefficients = common.linear_coefficients(rb, v.name, t)
+            values = [coefficients.get(x.name, 0.0) for x in inputs] + [t.params[-1]]
+            text = "Linear " + " ".join(fmt_number(c) for c in values)
+        elif sugeno:
+            text = fmt_number(t.center)
+        else:
+            text = _term_text(t, v)
+        out.append(f"    TERM {t.name} := {text};")
+    if sugeno:
+        out.append(f"    METHOD : {common.DEFUZZIFIERS[ops.inference][FCL]};")
+    else:
+        method = common.foreign_name(common.DEFUZZIFIERS, FCL, ops.defuzzify, "defuzzifier",
+                                     span=at("defuzzify"))
+        out.append(f"    METHOD : {method};")
+    if accu is not None:
+        out.append(f"    ACCU : {accu};")
+    if v.default is not None:           # none: no DEFAULT line (the output is NaN)
+        out.append(f"    DEFAULT := {fmt_number(v.default)};")
+    return out
 
 
 def _term_text(t: Term, v: Variable) -> str:
@@ -659,22 +695,56 @@ def _corner_points(corners) -> list[tuple[float, float]] | None:
     return None
 
 
-def _rule_text(r: Rule) -> str:
+def _rule_text(r: Rule, dialect: str = DEFAULT_DIALECT, ops=None) -> str:
+    """A rule in lower-case keywords; conclusions joined as ``dialect`` reads them. fuzzylite's
+    ``not`` is a hedge on one proposition, so for it a ``not`` over a group is moved onto the
+    propositions (De Morgan), which is exact when the rule block's `and` and `or` are duals
+    (min and max, ...); otherwise it is refused by name."""
     def expr(e, parent: str) -> str:
         if isinstance(e, Prop):
-            words = (["NOT"] if e.negated else []) + [common.to_fuzzylite_hedge(h, e.span)
+            words = (["not"] if e.negated else []) + [common.to_fuzzylite_hedge(h, e.span)
                                                        for h in e.hedges] + [e.term]
-            return f"{e.var} IS " + " ".join(words)
+            return f"{e.var} is " + " ".join(words)
         if isinstance(e, Not):
-            return f"NOT ({expr(e.expr, 'not')})"
-        op = "AND" if isinstance(e, And) else "OR"
+            if dialect == "fuzzylite":
+                return expr(_de_morgan(e, r, ops), parent)
+            return f"not ({expr(e.expr, 'not')})"
+        op = "and" if isinstance(e, And) else "or"
         text = f" {op} ".join(expr(i, op) for i in e.items)
         return f"({text})" if parent not in ("top", op, "not") else text
 
-    cons = " AND ".join(f"{c.var} IS " + " ".join(
+    joint = " and " if dialect == "fuzzylite" else ", "
+    cons = joint.join(f"{c.var} is " + " ".join(
         [common.to_fuzzylite_hedge(h, c.span) for h in hedges] + [common.concluded_term(c)])
         for c, hedges in common.written_consequents(r))
-    text = f"IF {expr(r.antecedent, 'top')} THEN {cons}"
+    text = f"if {expr(r.antecedent, 'top')} then {cons}"
     if r.weight != 1.0:
-        text += f" WITH {fmt_number(r.weight)}"
+        text += f" with {fmt_number(r.weight)}"
     return text
+
+
+def _de_morgan(e: Not, r: Rule, ops) -> Expr:
+    """``not (a or b)`` as ``not a and not b`` (and the dual), down to the propositions."""
+    if ops is None or norms.lookup("tnorm", ops.and_).dual != ops.or_:
+        raise FormatError(f"rule `{r.label}`: fuzzylite's FCL has no `not` over a group (its "
+                          f"`not` is a hedge on one proposition), and with `and = {ops and ops.and_}`, "
+                          f"`or = {ops and ops.or_}` (not duals) it cannot be moved onto the "
+                          f"propositions", span=e.span or r.span,
+                          hint="write `--dialect iec` (IEC 61131-7, jFuzzyLogic)")
+
+    def negate(x: Expr) -> Expr:
+        if isinstance(x, Prop):
+            return dataclasses.replace(x, negated=not x.negated)
+        if isinstance(x, Not):
+            return push(x.expr)
+        items = tuple(negate(i) for i in x.items)
+        return Or(items, x.span) if isinstance(x, And) else And(items, x.span)
+
+    def push(x: Expr) -> Expr:
+        if isinstance(x, Prop):
+            return x
+        if isinstance(x, Not):
+            return negate(x.expr)
+        return type(x)(tuple(push(i) for i in x.items), x.span)
+
+    return negate(e.expr)

@@ -308,6 +308,11 @@ def _mf(value: str, vspan: Span, role: str, kind: str, n_inputs: int) -> Term:
             raise FormatError(f"MF `{name}`: linear takes {plural(n_inputs + 1, 'number')} (one "
                               f"per input and a constant), not {len(params)}", span=vspan)
         return common.make_term(name, "linear", tuple(params), vspan)
+    if role == "output" and kind == "sugeno" and mf != "constant":
+        raise FormatError(f"MF `{name}`: the outputs of a Sugeno-type .fis take `constant` or "
+                          f"`linear` MFs, not `{mf}`", span=vspan,
+                          hint="a .fis file has no Tsukamoto inference; for monotonic outputs "
+                               "(fuzzylite's Tsukamoto), write the system as FLL")
     if mf in FUZZYLITE_MF_TYPES:
         return common.fuzzylite_term(name, FUZZYLITE_MF_TYPES[mf], params, n_inputs, vspan)
     if mf not in MF_TYPES:

@@ -22,10 +22,30 @@ from .terms import TermSet, Variable
 MAIN = "main"
 
 
+def rule_file_hint(path: str | Path) -> str | None:
+    """"did you mean" for a rule file that is not there: a file beside it whose name is close
+    (:func:`..fileio.nearby`), else, where the packaged rule bases would be looked for
+    (``rulebases/mitoss.rules`` from a directory without ``rulebases/``), the packaged one
+    whose name is close, as a world file's name gets the packaged worlds."""
+    from ..errors import closest_file
+    from ..fileio import RULE_SUFFIXES, nearby
+    from ..resources import packaged_names, packaged_place
+
+    close = nearby(path)
+    if close is not None:
+        return close
+    given = Path(path)
+    if not packaged_place(given.parent.as_posix(), "rulebases"):
+        return None
+    names = [n for suffix in RULE_SUFFIXES for n in packaged_names("rulebases", suffix)]
+    name = closest_file(given.name, names)
+    return f"did you mean `{given.parent / name}`?" if name is not None else None
+
+
 @without_cyclic_gc
 def load_rules_file(path: str | Path) -> RuleBase:
     """Read, parse and check the rule file at ``path`` and the term sets it names."""
-    from ..fileio import finish_saves, nearby, read_text, unreadable
+    from ..fileio import finish_saves, read_text, unreadable
 
     path = Path(path)
     finish_saves(path, error=RuleBaseError)   # a set save a crash left half done
@@ -35,7 +55,8 @@ def load_rules_file(path: str | Path) -> RuleBase:
         raise RuleBaseError(f"`{path}` is not a text file (it is not UTF-8)",
                             span=Span(str(path), 1, 1)) from None
     except OSError as exc:
-        raise RuleBaseError(unreadable("rule file", path, exc), hint=nearby(path)) from None
+        raise RuleBaseError(unreadable("rule file", path, exc),
+                            hint=rule_file_hint(path)) from None
     parsed = parse_rules(text, str(path))
     termsets = []
     seen: dict[Path, str] = {}
