@@ -577,6 +577,31 @@ def test_a_behavior_named_as_a_hedge_is_refused(tmp_path):
     assert "`very` is a reserved word (a hedge), not a name" in exc.message
 
 
+@pytest.mark.parametrize("cond", ["road is very not WIDE", "road is not very not WIDE",
+                                  "road is somewhat very not not WIDE"])
+def test_not_after_a_hedge_is_refused_not_read_as_not_first(tmp_path, cond, capsys):
+    # `very not WIDE` is very(1 - WIDE); the model holds one `not`, applied last, so it was
+    # silently evaluated as `not very WIDE` (1 - WIDE^2): a different number
+    path = write(tmp_path, f"r1: if {cond} then speed is SLOW\n")
+    exc = error_of(lambda: load_rules_file(path), RuleSyntaxError)
+    assert "`not` after a hedge" in exc.message
+    line = f"r1: if {cond} then speed is SLOW"
+    assert exc.span.line == 2 and caret_under(exc) == "not"
+    assert exc.span.column == line.index(" not", line.index("very")) + 2
+    assert "a different number" in exc.hint and "define the complement" in exc.hint
+    with pytest.raises(SystemExit) as info:
+        main(["eval", str(path), "road=80", "size=10", "position=0"])
+    assert info.value.code == 1 and "`not` after a hedge" in capsys.readouterr().err
+
+
+def test_not_before_hedges_and_doubled_not_still_parse(tmp_path):
+    path = write(tmp_path, "r1: if road is not not very WIDE then speed is SLOW\n"
+                           "r2: if road is not very WIDE then speed is FAST\n")
+    rules = load_rules_file(path).behaviors[0].rules
+    assert rules[0].antecedent == Prop("road", "WIDE", ("very",), False)
+    assert rules[1].antecedent == Prop("road", "WIDE", ("very",), True)
+
+
 def test_a_frozen_label_naming_no_rule_is_pointed_at(tmp_path):
     path = write(tmp_path, "behavior a:\n  r1: if road is WIDE then speed is SLOW\n"
                            "  frozen r1, r7\nend\n")

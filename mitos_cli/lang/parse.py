@@ -458,7 +458,35 @@ def parse_tree(text: str, path: str | None = None, start: str = "start") -> Tree
     except UnexpectedInput as exc:
         raise syntax_error(exc, text, path) from None
     check_nesting(tree, text, path)
+    check_modifiers(tree, text, path)
     return tree
+
+
+def check_modifiers(tree: Tree, text: str, path: str | None) -> None:
+    """Refuse a ``not`` after a hedge (``x is very not LOW``).
+
+    A proposition holds its hedges and one ``negated`` flag, applied last: ``very not LOW``
+    would be evaluated as ``not very LOW`` (1 - 0.7^2 = 0.51 where very(1 - 0.7) = 0.09 was
+    written). Refused, at the ``not``, rather than read as a different number.
+    """
+    for node in tree.iter_subtrees():
+        if node.data != "proposition":
+            continue
+        var, *mods, term = node.children
+        tokens = [m for m in mods if isinstance(m, Token)]      # NOT and HEDGE, as written
+        types = [m.type for m in tokens]
+        if "HEDGE" not in types or "NOT" not in types[types.index("HEDGE"):]:
+            continue
+        hedge = tokens[types.index("HEDGE")]
+        late = tokens[types.index("NOT", types.index("HEDGE"))]
+        raise RuleSyntaxError(
+            f"`not` after a hedge (`{var} is {' '.join(map(str, mods))} {term}`) is not "
+            f"supported", span=Span.in_text(text, path, late.line or 1, late.column or 1,
+                                            (late.column or 1) + len(late)),
+            expected="`not` before the hedges: `VARIABLE is not HEDGE TERM`",
+            hint=f"`{var} is not {hedge} {term}` means 1 - {hedge}({term}), a different "
+                 f"number; for {hedge}(1 - {term}), define the complement of `{term}` as a "
+                 f"term of `{var}` in the term set and write `{var} is {hedge} THAT_TERM`")
 
 
 def check_nesting(tree: Tree, text: str, path: str | None, limit: int = MAX_NESTING) -> None:
