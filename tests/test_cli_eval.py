@@ -229,6 +229,26 @@ def test_behavior_option(tmp_path, capsys):
     assert outs == [50.0, 20.0]
 
 
+@pytest.mark.parametrize("text, default", [
+    ("behavior b1:\n  r1: if road is WIDE then speed is SLOW\nend\n"
+     "r9: if road is WIDE then speed is FAST\n", "b1"),
+    ("r9: if road is WIDE then speed is FAST\n"
+     "behavior b1:\n  r1: if road is WIDE then speed is SLOW\nend\n", "main"),
+    ("behavior b1:\n  r1: if road is WIDE then speed is SLOW\nend\n"
+     "use b1 when road is WIDE\nbehavior b2:\n  r2: if road is WIDE then speed is TOP\nend\n"
+     "r9: if road is WIDE then speed is FAST\n", "b1"),
+])
+def test_the_default_behavior_is_the_first_of_the_file(tmp_path, capsys, text, default):
+    """Top-level rules form `main` where the first of them stands: a behavior written before
+    them is the file's first, and the default (docs/language.md), not `main`."""
+    terms = (ROOT / "rulebases" / "mitos.terms.yaml").read_text(encoding="utf-8")
+    (tmp_path / "t.terms.yaml").write_text(terms, encoding="utf-8")
+    (tmp_path / "t.rules").write_text('terms "t.terms.yaml"\n' + text, encoding="utf-8")
+    code, out, _ = run_main(["eval", str(tmp_path / "t.rules"), "road=120", "--json"], capsys)
+    assert code == 0 and json.loads(out)["behavior"] == default
+    assert load_rulebase(tmp_path / "t.rules").rulebase.default_behavior == default
+
+
 def test_trace_says_when_an_output_is_its_default(tmp_path, capsys):
     """With `and = drastic` no rule fires at the sample run: both outputs are their defaults,
     and the trace says so instead of printing 90 / 0 as if the rules had computed them."""

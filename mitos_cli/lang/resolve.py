@@ -125,7 +125,8 @@ def build_rulebase(parsed: ParsedFile, termsets: tuple[TermSet, ...],
             variables[v.name] = v
     behaviors = list(parsed.behaviors)
     if parsed.rules or parsed.uses:
-        behaviors.insert(0, Behavior(MAIN, parsed.rules, parsed.uses, (), parsed.frozen))
+        behaviors.insert(_main_place(parsed), Behavior(MAIN, parsed.rules, parsed.uses, (),
+                                                       parsed.frozen))
     elif parsed.frozen:
         import re
 
@@ -157,6 +158,19 @@ def build_rulebase(parsed: ParsedFile, termsets: tuple[TermSet, ...],
     for b in behaviors:
         _check_cycles(rb, b.name, ())
     return rb
+
+
+def _main_place(parsed: ParsedFile) -> int:
+    """Where ``main`` (the rules outside any behavior) stands among the file's behaviors: at
+    its first rule or ``use``, so that the first behavior of the file is the default one, as
+    docs/language.md says, wherever the top-level rules are written."""
+    spans = [r.span for r in parsed.rules] + [u.span for u in parsed.uses]
+    starts = [(span.line, span.column) for span in spans if span is not None]
+    if not starts:
+        return 0
+    first = min(starts)
+    return sum(1 for b in parsed.behaviors
+               if b.span is not None and (b.span.line, b.span.column) < first)
 
 
 def _defined_twice(second: Behavior, first: Behavior) -> RuleBaseError:
