@@ -610,6 +610,33 @@ def test_a_frozen_label_naming_no_rule_is_pointed_at(tmp_path):
     assert exc.message == "unknown rule label `r7` in behavior `a`"
 
 
+def test_a_top_level_frozen_label_naming_no_rule_is_pointed_at(tmp_path, capsys):
+    path = write(tmp_path, "r1: if road is WIDE then speed is SLOW\n"
+                           "avoid_left: if road is NARROW then speed is SLOW\n"
+                           "frozen r1, avoid_lft\n")
+    exc = error_of(lambda: load_rules_file(path), NameError_)
+    assert (exc.span.line, exc.span.column) == (4, 12) and caret_under(exc) == "avoid_lft"
+    assert exc.message == ("unknown rule label `avoid_lft` in behavior `main` (the rules "
+                           "outside any behavior)")
+    assert exc.hint == "did you mean `avoid_left`?"
+    with pytest.raises(SystemExit) as info:
+        main(["eval", str(path), "road=80", "size=10", "position=0"])
+    assert info.value.code == 1 and ":4:12: name error" in capsys.readouterr().err
+
+
+def test_a_frozen_label_of_another_behavior_says_where_to_write_it(tmp_path):
+    path = write(tmp_path, "behavior b1:\n  r9: if road is WIDE then speed is SLOW\nend\n"
+                           "r1: if road is WIDE then speed is FAST\nfrozen r1, r9\n")
+    exc = error_of(lambda: load_rules_file(path), NameError_)
+    assert exc.span.line == 6 and caret_under(exc) == "r9"
+    assert exc.hint == ("`r9` is a rule in behavior `b1`: `frozen` names rules of the behavior "
+                        "it is written in, so write `frozen r9` there")
+    only = write(tmp_path, "behavior b1:\n  r9: if road is WIDE then speed is SLOW\nend\n"
+                           "frozen r9\n")
+    exc = error_of(lambda: load_rules_file(only), RuleBaseError)
+    assert exc.span.line == 5 and caret_under(exc) == "r9"
+
+
 def test_a_name_cut_short_gets_the_one_name_it_begins():
     from mitos_cli.errors import closest
 

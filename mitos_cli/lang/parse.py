@@ -60,6 +60,8 @@ class ParsedFile:
     uses: tuple[Use, ...] = ()
     frozen: tuple[str, ...] = ()
     behaviors: tuple[Behavior, ...] = ()
+    #: where each of ``frozen`` (the top-level `frozen` labels) is written
+    frozen_spans: tuple[Span | None, ...] = ()
 
 
 def _words(name: str, words: dict[str, str] = TERMINAL_WORDS) -> str:
@@ -516,10 +518,11 @@ def parse_rules(text: str, path: str | None = None) -> ParsedFile:
     uses: list[Use] = []
     frozen: list[str] = []
     behaviors: list[Behavior] = []
+    frozen_spans: list[Span | None] = []
     for item in items:
-        _collect(item, terms, operators, rules, uses, frozen, behaviors)
+        _collect(item, terms, operators, rules, uses, frozen, behaviors, frozen_spans)
     return ParsedFile(text, path, tuple(terms), tuple(operators), tuple(rules), tuple(uses),
-                      tuple(frozen), tuple(behaviors))
+                      tuple(frozen), tuple(behaviors), tuple(frozen_spans))
 
 
 def check_settings(settings: tuple[Setting, ...]) -> tuple[Setting, ...]:
