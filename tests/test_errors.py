@@ -637,6 +637,32 @@ def test_a_frozen_label_of_another_behavior_says_where_to_write_it(tmp_path):
     assert exc.span.line == 5 and caret_under(exc) == "r9"
 
 
+FORMULA_TERMS = """variables:
+  x: {role: input, universe: [0, 10], terms: {LOW: {shape: formula, formula: "1 - x / 10"}}}
+  y:
+    role: output
+    universe: [0, 1]
+    default: 0
+    terms: {A: {shape: formula, formula: "x"}, B: {shape: clipped_sigmoid_difference,
+            points: [0.2, 30, 30, 0.8]}}
+"""
+
+
+def test_a_formula_output_term_under_weighted_inference_is_refused(tmp_path, capsys):
+    # its centre was NaN and `mitos eval` printed the default, 0, as if the rules had set it
+    path = write(tmp_path, "r1: if x is LOW then y is A\n", FORMULA_TERMS)
+    with pytest.raises(SystemExit) as info:
+        main(["eval", str(path), "x=3"])
+    err = capsys.readouterr().err
+    assert info.value.code == 1 and ":2:22: rule base error: `y is A`: `A` is a formula " \
+        "term, which has no crisp value for `weighted_average` inference to average" in err
+    assert "inference = mamdani" in err
+    mamdani = write(tmp_path, "operators: inference = mamdani\n"
+                              "r1: if x is LOW then y is A\nr2: if x is very LOW then y is B\n",
+                    FORMULA_TERMS)
+    assert np.isfinite(load_rulebase(mamdani).evaluate(x=3)["y"])
+
+
 def test_a_name_cut_short_gets_the_one_name_it_begins():
     from mitos_cli.errors import closest
 
