@@ -610,6 +610,22 @@ def test_a_frozen_label_naming_no_rule_is_pointed_at(tmp_path):
     assert exc.message == "unknown rule label `r7` in behavior `a`"
 
 
+@pytest.mark.parametrize("action", [
+    "speed is not SLOW", "speed is very not SLOW", "speed is not very SLOW", "speed is not",
+    "speed is not with 0.5", "speed is SLOW and steering is not",
+])
+def test_not_in_an_action_says_so(tmp_path, action):
+    # `not` was read as a term and the term after it as a new rule's label without its `:`
+    path = write(tmp_path, f"r1: if road is WIDE then {action}\n"
+                           "r2: if road is NARROW then speed is FAST\n")
+    exc = error_of(lambda: load_rules_file(path), RuleSyntaxError)
+    assert exc.message.startswith("`not` is not allowed in an action")
+    line = f"r1: if road is WIDE then {action}"
+    assert (exc.span.line, exc.span.column) == (2, line.index(" not") + 2)
+    assert caret_under(exc) == "not"
+    assert "label" not in exc.render() and "not to its complement" in exc.hint
+
+
 def test_a_top_level_frozen_label_naming_no_rule_is_pointed_at(tmp_path, capsys):
     path = write(tmp_path, "r1: if road is WIDE then speed is SLOW\n"
                            "avoid_left: if road is NARROW then speed is SLOW\n"
