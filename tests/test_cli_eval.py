@@ -229,6 +229,45 @@ def test_behavior_option(tmp_path, capsys):
     assert outs == [50.0, 20.0]
 
 
+@pytest.mark.parametrize("text, default", [
+    ("behavior b1:\n  r1: if road is WIDE then speed is SLOW\nend\n"
+     "r9: if road is WIDE then speed is FAST\n", "b1"),
+    ("r9: if road is WIDE then speed is FAST\n"
+     "behavior b1:\n  r1: if road is WIDE then speed is SLOW\nend\n", "main"),
+    ("behavior b1:\n  r1: if road is WIDE then speed is SLOW\nend\n"
+     "use b1 when road is WIDE\nbehavior b2:\n  r2: if road is WIDE then speed is TOP\nend\n"
+     "r9: if road is WIDE then speed is FAST\n", "b1"),
+])
+def test_the_default_behavior_is_the_first_of_the_file(tmp_path, capsys, text, default):
+    """Top-level rules form `main` where the first of them stands: a behavior written before
+    them is the file's first, and the default (docs/language.md), not `main`."""
+    terms = (ROOT / "rulebases" / "mitos.terms.yaml").read_text(encoding="utf-8")
+    (tmp_path / "t.terms.yaml").write_text(terms, encoding="utf-8")
+    (tmp_path / "t.rules").write_text('terms "t.terms.yaml"\n' + text, encoding="utf-8")
+    code, out, _ = run_main(["eval", str(tmp_path / "t.rules"), "road=120", "--json"], capsys)
+    assert code == 0 and json.loads(out)["behavior"] == default
+    assert load_rulebase(tmp_path / "t.rules").rulebase.default_behavior == default
+
+
+def test_a_hedged_consequent_hedges_its_rules_dof_for_that_output(tmp_path, capsys):
+    """docs/language.md, Actions: under the weighted average `then speed is very FAST`
+    weighs the rule by DOF^2 for `speed` only; its other action keeps the DOF."""
+    terms = (ROOT / "rulebases" / "mitos.terms.yaml").read_text(encoding="utf-8")
+    (tmp_path / "t.terms.yaml").write_text(terms, encoding="utf-8")
+    (tmp_path / "t.rules").write_text(
+        'terms "t.terms.yaml"\n'
+        "r1: if road is WIDE then speed is very FAST and steering is RS\n"
+        "r2: if road is MEDIUM then speed is SLOW and steering is LS\n", encoding="utf-8")
+    code, out, _ = run_main(["eval", str(tmp_path / "t.rules"), "road=78", "--json"], capsys)
+    data = json.loads(out)
+    wide, medium = (data["inputs"]["road"]["memberships"][t] for t in ("WIDE", "MEDIUM"))
+    assert code == 0 and 0 < wide < 1 and 0 < medium < 1
+    assert data["outputs"]["speed"] == pytest.approx(
+        (wide ** 2 * 50 + medium * 20) / (wide ** 2 + medium))
+    assert data["outputs"]["steering"] == pytest.approx(
+        (wide * 110 + medium * 70) / (wide + medium))
+
+
 def test_trace_says_when_an_output_is_its_default(tmp_path, capsys):
     """With `and = drastic` no rule fires at the sample run: both outputs are their defaults,
     and the trace says so instead of printing 90 / 0 as if the rules had computed them."""

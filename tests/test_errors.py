@@ -577,12 +577,106 @@ def test_a_behavior_named_as_a_hedge_is_refused(tmp_path):
     assert "`very` is a reserved word (a hedge), not a name" in exc.message
 
 
+@pytest.mark.parametrize("cond", ["road is very not WIDE", "road is not very not WIDE",
+                                  "road is somewhat very not not WIDE"])
+def test_not_after_a_hedge_is_refused_not_read_as_not_first(tmp_path, cond, capsys):
+    # `very not WIDE` is very(1 - WIDE); the model holds one `not`, applied last, so it was
+    # silently evaluated as `not very WIDE` (1 - WIDE^2): a different number
+    path = write(tmp_path, f"r1: if {cond} then speed is SLOW\n")
+    exc = error_of(lambda: load_rules_file(path), RuleSyntaxError)
+    assert "`not` after a hedge" in exc.message
+    line = f"r1: if {cond} then speed is SLOW"
+    assert exc.span.line == 2 and caret_under(exc) == "not"
+    assert exc.span.column == line.index(" not", line.index("very")) + 2
+    assert "a different number" in exc.hint and "define the complement" in exc.hint
+    with pytest.raises(SystemExit) as info:
+        main(["eval", str(path), "road=80", "size=10", "position=0"])
+    assert info.value.code == 1 and "`not` after a hedge" in capsys.readouterr().err
+
+
+def test_not_before_hedges_and_doubled_not_still_parse(tmp_path):
+    path = write(tmp_path, "r1: if road is not not very WIDE then speed is SLOW\n"
+                           "r2: if road is not very WIDE then speed is FAST\n")
+    rules = load_rules_file(path).behaviors[0].rules
+    assert rules[0].antecedent == Prop("road", "WIDE", ("very",), False)
+    assert rules[1].antecedent == Prop("road", "WIDE", ("very",), True)
+
+
 def test_a_frozen_label_naming_no_rule_is_pointed_at(tmp_path):
     path = write(tmp_path, "behavior a:\n  r1: if road is WIDE then speed is SLOW\n"
                            "  frozen r1, r7\nend\n")
     exc = error_of(lambda: load_rules_file(path))
     assert exc.span.line == 4 and caret_under(exc) == "r7"
     assert exc.message == "unknown rule label `r7` in behavior `a`"
+
+
+@pytest.mark.parametrize("action", [
+    "speed is not SLOW", "speed is very not SLOW", "speed is not very SLOW", "speed is not",
+    "speed is not with 0.5", "speed is SLOW and steering is not",
+])
+def test_not_in_an_action_says_so(tmp_path, action):
+    # `not` was read as a term and the term after it as a new rule's label without its `:`
+    path = write(tmp_path, f"r1: if road is WIDE then {action}\n"
+                           "r2: if road is NARROW then speed is FAST\n")
+    exc = error_of(lambda: load_rules_file(path), RuleSyntaxError)
+    assert exc.message.startswith("`not` is not allowed in an action")
+    line = f"r1: if road is WIDE then {action}"
+    assert (exc.span.line, exc.span.column) == (2, line.index(" not") + 2)
+    assert caret_under(exc) == "not"
+    assert "label" not in exc.render() and "not to its complement" in exc.hint
+
+
+def test_a_top_level_frozen_label_naming_no_rule_is_pointed_at(tmp_path, capsys):
+    path = write(tmp_path, "r1: if road is WIDE then speed is SLOW\n"
+                           "avoid_left: if road is NARROW then speed is SLOW\n"
+                           "frozen r1, avoid_lft\n")
+    exc = error_of(lambda: load_rules_file(path), NameError_)
+    assert (exc.span.line, exc.span.column) == (4, 12) and caret_under(exc) == "avoid_lft"
+    assert exc.message == ("unknown rule label `avoid_lft` in behavior `main` (the rules "
+                           "outside any behavior)")
+    assert exc.hint == "did you mean `avoid_left`?"
+    with pytest.raises(SystemExit) as info:
+        main(["eval", str(path), "road=80", "size=10", "position=0"])
+    assert info.value.code == 1 and ":4:12: name error" in capsys.readouterr().err
+
+
+def test_a_frozen_label_of_another_behavior_says_where_to_write_it(tmp_path):
+    path = write(tmp_path, "behavior b1:\n  r9: if road is WIDE then speed is SLOW\nend\n"
+                           "r1: if road is WIDE then speed is FAST\nfrozen r1, r9\n")
+    exc = error_of(lambda: load_rules_file(path), NameError_)
+    assert exc.span.line == 6 and caret_under(exc) == "r9"
+    assert exc.hint == ("`r9` is a rule in behavior `b1`: `frozen` names rules of the behavior "
+                        "it is written in, so write `frozen r9` there")
+    only = write(tmp_path, "behavior b1:\n  r9: if road is WIDE then speed is SLOW\nend\n"
+                           "frozen r9\n")
+    exc = error_of(lambda: load_rules_file(only), RuleBaseError)
+    assert exc.span.line == 5 and caret_under(exc) == "r9"
+
+
+FORMULA_TERMS = """variables:
+  x: {role: input, universe: [0, 10], terms: {LOW: {shape: formula, formula: "1 - x / 10"}}}
+  y:
+    role: output
+    universe: [0, 1]
+    default: 0
+    terms: {A: {shape: formula, formula: "x"}, B: {shape: clipped_sigmoid_difference,
+            points: [0.2, 30, 30, 0.8]}}
+"""
+
+
+def test_a_formula_output_term_under_weighted_inference_is_refused(tmp_path, capsys):
+    # its centre was NaN and `mitos eval` printed the default, 0, as if the rules had set it
+    path = write(tmp_path, "r1: if x is LOW then y is A\n", FORMULA_TERMS)
+    with pytest.raises(SystemExit) as info:
+        main(["eval", str(path), "x=3"])
+    err = capsys.readouterr().err
+    assert info.value.code == 1 and ":2:22: rule base error: `y is A`: `A` is a formula " \
+        "term, which has no crisp value for `weighted_average` inference to average" in err
+    assert "inference = mamdani" in err
+    mamdani = write(tmp_path, "operators: inference = mamdani\n"
+                              "r1: if x is LOW then y is A\nr2: if x is very LOW then y is B\n",
+                    FORMULA_TERMS)
+    assert np.isfinite(load_rulebase(mamdani).evaluate(x=3)["y"])
 
 
 def test_a_name_cut_short_gets_the_one_name_it_begins():

@@ -136,6 +136,22 @@ def test_rules_as_text_match_eval(capsys):
     assert f"steering = {trace['outputs']['steering']:.2f} deg" in out
 
 
+def test_rules_as_text_take_a_width(capsys):
+    """`plot rules --width` sets the width of a Mamdani output's plot, as `plot terms
+    --width` does for the membership plots (default 72)."""
+    tipper = str(DATA / "tipper.fis")
+    widths = []
+    for extra in ([], ["--width", "40"], ["--width", "120"]):
+        code, out, _ = run(["plot", "rules", tipper, "service=5", "food=5", *extra], capsys)
+        assert code == 0
+        axis = [ln for ln in out.splitlines() if "└" in ln]
+        widths.append(len(axis[-1].rstrip()))
+    assert widths[1] <= 40 and widths[1] < widths[0] < widths[2] <= 120
+    code, _, err = run(["plot", "rules", tipper, "service=5", "food=5", "--width", "10"],
+                       capsys)
+    assert code == 2 and "--width" in err
+
+
 # ---------------------------------------------------------------- errors
 
 

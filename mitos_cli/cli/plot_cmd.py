@@ -101,6 +101,24 @@ def _use_color(color: Optional[bool]) -> bool:
     return sys.stdout.isatty() and not os.environ.get("NO_COLOR")
 
 
+#: the terminal drawing's options
+WidthOpt = Annotated[Optional[int], typer.Option(
+    "--width", min=30, max=400,
+    help="Terminal plot width in characters (default: the terminal's, at most 100).")]
+ColorOpt = Annotated[Optional[bool], typer.Option(
+    "--color/--no-color", help="Colour the terminal plot (default: when stdout is a "
+                               "terminal and NO_COLOR is unset).")]
+
+
+def _terminal_width(width: Optional[int]) -> int:
+    """``--width``, else the terminal's width, at most 100."""
+    if width is not None:
+        return width
+    import shutil
+
+    return min(shutil.get_terminal_size((80, 24)).columns, 100)
+
+
 def terms_command(
     args: Annotated[Optional[list[str]], typer.Argument(
         metavar="[RULEBASE] [NAME=VALUE]...",
@@ -113,13 +131,8 @@ def terms_command(
     output: OutputOpt = None,
     show: ShowOpt = False,
     title: TitleOpt = None,
-    width: Annotated[Optional[int], typer.Option(
-        "--width", min=30, max=400,
-        help="Terminal plot width in characters (default: the terminal's, at most 100).")]
-    = None,
-    color: Annotated[Optional[bool], typer.Option(
-        "--color/--no-color", help="Colour the terminal plot (default: when stdout is a "
-                                   "terminal and NO_COLOR is unset).")] = None,
+    width: WidthOpt = None,
+    color: ColorOpt = None,
 ) -> None:
     """Membership plots: every term of each variable, with given values marked.
 
@@ -139,11 +152,7 @@ def terms_command(
     if not _wants_picture(output, show):
         from ..draw.terminal import render_sheet
 
-        if width is None:
-            import shutil
-
-            width = min(shutil.get_terminal_size((80, 24)).columns, 100)
-        emit(render_sheet(plots, width=width, color=_use_color(color)))
+        emit(render_sheet(plots, width=_terminal_width(width), color=_use_color(color)))
         return
     from ..draw.terms import draw_sheet
 
@@ -278,6 +287,10 @@ def rules_command(
     max_rules: Annotated[int, typer.Option(
         "--max-rules", min=1, max=500,
         help="Draw at most this many fired rules (the strongest).")] = 30,
+    width: Annotated[int, typer.Option(
+        "--width", min=30, max=400,
+        help="Width in characters of a Mamdani output's plot in the text viewer.")] = 72,
+    color: ColorOpt = None,
 ) -> None:
     """Rule viewer: each fired rule with its memberships, DOF and consequent.
 
@@ -299,7 +312,7 @@ def rules_command(
     if not _wants_picture(output, show):
         from ..draw.terminal import render_rule_view
 
-        emit(render_rule_view(view))
+        emit(render_rule_view(view, width=width, color=_use_color(color)))
         return
     from ..draw.rules import draw_rules
 

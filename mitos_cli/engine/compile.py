@@ -460,6 +460,8 @@ def _used_variables(rb: RuleBase, flat, operators: Operators):
         for c in rule.consequents:
             if operators.inference == "tsukamoto":
                 _check_tsukamoto(c, rule, variables, concluded)
+            elif operators.inference != "mamdani":
+                _check_crisp_value(c, rule, variables, operators.inference)
             if c.term is not None and variables[c.var].term(c.term).shape == "linear":
                 names = linear_inputs.setdefault(c.var, _termset_inputs(rb, c.var))
                 coefficients = variables[c.var].term(c.term).params[:-1]
@@ -620,6 +622,20 @@ def _linear_consequents(flat, variables, inputs, outputs, linear_inputs,
                 out[r, j, -1] = term.params[-1]
                 value[r, j] = 0.0
     return out
+
+
+def _check_crisp_value(c, rule: Rule, variables, inference: str) -> None:
+    """Weighted inference needs each consequent term's crisp value (its centre); a ``formula``
+    term has none (its centre was NaN, and the output then silently its default)."""
+    if c.term is None or variables[c.var].term(c.term).shape != "formula":
+        return
+    from ..errors import RuleBaseError
+
+    raise RuleBaseError(
+        f"`{c.var} is {c.term}`: `{c.term}` is a formula term, which has no crisp value for "
+        f"`{inference}` inference to average", span=c.span or rule.span,
+        hint=f"give `{c.var}` a crisp term (`{c.term}: 42`) or a shape with a centre, or use "
+             f"`inference = mamdani`")
 
 
 def _check_tsukamoto(c, rule: Rule, variables, concluded: dict) -> None:

@@ -44,7 +44,7 @@ from .model import RuleBase
 if TYPE_CHECKING:
     from lark import Lark
 
-_FORMAT = 2
+_FORMAT = 3                  # raised when parsing changes (3: `very not` refused, `main` placed)
 _TAG = 32                    # bytes of HMAC-SHA256 before every entry
 _KEY = "key"
 

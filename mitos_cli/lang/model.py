@@ -109,7 +109,7 @@ class RuleBase:
     """A whole rule file: its term sets, file-level operators and behaviors.
 
     The default behavior is the first one in the file (top-level rules form a behavior named
-    ``main``, which then comes first).
+    ``main``, which stands where the first of them, or of their ``use`` lines, is written).
     """
 
     path: str | None

@@ -33,6 +33,10 @@ TERMINAL_WORDS = {
 }
 
 
+#: terminals never offered as "expected" (`not` in an action is read only to be refused)
+UNSAID = frozenset({"ACTION_NOT"})
+
+
 @functools.cache
 def parser() -> Lark:
     """The rule-language parser, built once per process (its analysis kept in :mod:`.cache`)."""
@@ -60,6 +64,8 @@ class ParsedFile:
     uses: tuple[Use, ...] = ()
     frozen: tuple[str, ...] = ()
     behaviors: tuple[Behavior, ...] = ()
+    #: where each of ``frozen`` (the top-level `frozen` labels) is written
+    frozen_spans: tuple[Span | None, ...] = ()
 
 
 def _words(name: str, words: dict[str, str] = TERMINAL_WORDS) -> str:
@@ -77,7 +83,8 @@ def _expected(names) -> str:
 
 def _expected_words(names, words_of: dict[str, str]) -> str:
     """The terminals ``names`` as a sentence (``a, b or c``), named as in ``words_of``."""
-    words = sorted({_words(n, words_of) for n in names if not n.startswith("__")})
+    words = sorted({_words(n, words_of) for n in names
+                    if not n.startswith("__") and n not in UNSAID})
     if len(words) > 1:
         return ", ".join(words[:-1]) + " or " + words[-1]
     return words[0] if words else "something else"
@@ -112,6 +119,10 @@ def syntax_error(exc: UnexpectedInput, text: str, path: str | None) -> RuleSynta
                     "belongs in a term set's `description`")
         return RuleSyntaxError(message, span=Span.in_text(text, path, line, column),
                                expected=allowed, hint=hint)
+    if isinstance(exc, UnexpectedInput):
+        negated = not_in_action_before(exc, text, path)
+        if negated is not None:
+            return negated
     if isinstance(exc, UnexpectedToken) and exc.token.type == "$END":
         stray = _stray_label(exc, text, path)
         if isinstance(stray, RuleSyntaxError):
@@ -458,7 +469,45 @@ def parse_tree(text: str, path: str | None = None, start: str = "start") -> Tree
     except UnexpectedInput as exc:
         raise syntax_error(exc, text, path) from None
     check_nesting(tree, text, path)
+    check_modifiers(tree, text, path)
     return tree
+
+
+#: what ``then y is not A`` is refused as: (the thing, the hint), or a hint made from its
+#: variable and term; a lesson's targets (``correct ... -> steering is not LM``) say their own
+TARGETS = ("a target", "a target is a term, with hedges if need be (`steering is very LM`); "
+                       "`not` says what it should not be, which is no target")
+
+
+def check_modifiers(tree: Tree, text: str, path: str | None,
+                    actions: tuple[str, str] | None = None) -> None:
+    """Refuse a ``not`` after a hedge (``x is very not LOW``), and any ``not`` in an action
+    (``then y is not A``; ``actions`` names what actions are in the text, see :data:`TARGETS`).
+
+    A proposition holds its hedges and one ``negated`` flag, applied last: ``very not LOW``
+    would be evaluated as ``not very LOW`` (1 - 0.7^2 = 0.51 where very(1 - 0.7) = 0.09 was
+    written). Refused, at the ``not``, rather than read as a different number.
+    """
+    for node in tree.iter_subtrees():
+        if node.data == "term_consequent":
+            _check_action(node, text, path, actions)
+        if node.data != "proposition":
+            continue
+        var, *mods, term = node.children
+        tokens = [m for m in mods if isinstance(m, Token)]      # NOT and HEDGE, as written
+        types = [m.type for m in tokens]
+        if "HEDGE" not in types or "NOT" not in types[types.index("HEDGE"):]:
+            continue
+        hedge = tokens[types.index("HEDGE")]
+        late = tokens[types.index("NOT", types.index("HEDGE"))]
+        raise RuleSyntaxError(
+            f"`not` after a hedge (`{var} is {' '.join(map(str, mods))} {term}`) is not "
+            f"supported", span=Span.in_text(text, path, late.line or 1, late.column or 1,
+                                            (late.column or 1) + len(late)),
+            expected="`not` before the hedges: `VARIABLE is not HEDGE TERM`",
+            hint=f"`{var} is not {hedge} {term}` means 1 - {hedge}({term}), a different "
+                 f"number; for {hedge}(1 - {term}), define the complement of `{term}` as a "
+                 f"term of `{var}` in the term set and write `{var} is {hedge} THAT_TERM`")
 
 
 def check_nesting(tree: Tree, text: str, path: str | None, limit: int = MAX_NESTING) -> None:
@@ -477,6 +526,67 @@ def check_nesting(tree: Tree, text: str, path: str | None, limit: int = MAX_NEST
         stack.extend((child, depth + 1) for child in node.children if isinstance(child, Tree))
 
 
+def _check_action(node: Tree, text: str, path: str | None,
+                  actions: tuple[str, str] | None = None) -> None:
+    """Refuse ``then y is not A``: an action sets an output to a term, never to a complement
+    (the grammar reads the ``not`` only to say so here)."""
+    var, *mods, term = node.children
+    late = next((m for m in mods if isinstance(m, Token) and m.type == "ACTION_NOT"), None)
+    if late is None:
+        return
+    exc = _not_in_action(text, path, late.line or 1, late.column or 1, str(var),
+                         [str(m) for m in mods if isinstance(m, Token) and m.type == "HEDGE"],
+                         str(term))
+    if actions is not None:
+        exc.message = exc.message.replace("an action", actions[0])
+        exc.hint = actions[1]
+    raise exc
+
+
+def _not_in_action(text: str, path: str | None, line: int, column: int, var: str,
+                   hedges: list[str], term: str | None) -> RuleSyntaxError:
+    """The error at the ``not`` of ``then VAR is [HEDGE ...] not ...``."""
+    written = " ".join([var, "is", *hedges, "not"] + ([term] if term else []))
+    return RuleSyntaxError(
+        f"`not` is not allowed in an action (`{written}`)",
+        span=Span.in_text(text, path, line, column, column + 3),
+        expected=f"`{var} is {' '.join(hedges + ['TERM'])}` or `{var} is NUMBER`",
+        hint=f"an action sets `{var}` to a term, not to its complement: name the term meant "
+             f"(or add one to the term set), or put the `not` in the condition "
+             f"(`if not ... then {var} is {term or 'TERM'}`)")
+
+
+#: ``VAR is [HEDGE ...] not`` after the start of the actions, in the same rule (no `if` after)
+_ACTION_NOT = re.compile(r"(?:(?!\bif\b).)*?\b([A-Za-z_][\w\-]*)\s+is\s+((?:(?:"
+                         + "|".join(HEDGE_NAMES) + r")\s+)*)not(?![\w\-])", re.S)
+
+
+def not_in_action_before(exc: UnexpectedInput, text: str, path: str | None,
+                         actions: str = r"\bthen\b") -> RuleSyntaxError | None:
+    """``then y is not`` with nothing a term could be after it (``y is not`` at the end of
+    the file, or before ``with``): the parse fails a word or two later, at what was read as
+    the term or a new rule's label; the `not` is the mistake, said there."""
+    pos = getattr(exc, "pos_in_stream", None)
+    if isinstance(exc, UnexpectedToken):
+        pos = exc.token.start_pos if exc.token.type != "$END" else len(text)
+    if pos is None:
+        pos = len(text)
+    before = text[:pos]
+    then = [m.end() for m in re.finditer(actions, before, re.M)]
+    if not then:
+        return None
+    found = None
+    for found in _ACTION_NOT.finditer(before, then[-1]):  # noqa: B007 - keep the last one
+        pass
+    if found is None or len(before[found.end():].split()) > 2:
+        return None
+    at = found.end() - 3
+    line = before.count("\n", 0, at) + 1
+    column = at - (before.rfind("\n", 0, at) + 1) + 1
+    return _not_in_action(text, path, line, column, found.group(1), found.group(2).split(),
+                          None)
+
+
 @without_cyclic_gc
 def parse_rules(text: str, path: str | None = None) -> ParsedFile:
     """Parse a whole rule file into model objects (names unchecked)."""
@@ -488,10 +598,11 @@ def parse_rules(text: str, path: str | None = None) -> ParsedFile:
     uses: list[Use] = []
     frozen: list[str] = []
     behaviors: list[Behavior] = []
+    frozen_spans: list[Span | None] = []
     for item in items:
-        _collect(item, terms, operators, rules, uses, frozen, behaviors)
+        _collect(item, terms, operators, rules, uses, frozen, behaviors, frozen_spans)
     return ParsedFile(text, path, tuple(terms), tuple(operators), tuple(rules), tuple(uses),
-                      tuple(frozen), tuple(behaviors))
+                      tuple(frozen), tuple(behaviors), tuple(frozen_spans))
 
 
 def check_settings(settings: tuple[Setting, ...]) -> tuple[Setting, ...]:

@@ -125,16 +125,19 @@ def build_rulebase(parsed: ParsedFile, termsets: tuple[TermSet, ...],
             variables[v.name] = v
     behaviors = list(parsed.behaviors)
     if parsed.rules or parsed.uses:
-        behaviors.insert(0, Behavior(MAIN, parsed.rules, parsed.uses, (), parsed.frozen))
+        behaviors.insert(_main_place(parsed), Behavior(MAIN, parsed.rules, parsed.uses, (),
+                                                       parsed.frozen,
+                                                       None, parsed.frozen_spans))
     elif parsed.frozen:
         import re
 
         found = re.search(r"(?m)^[ \t]*(frozen)\b", parsed.text)
         at = found.start(1) if found else 0
         line = parsed.text.count("\n", 0, at) + 1
+        span = parsed.frozen_spans[0] if parsed.frozen_spans else None
         raise RuleBaseError("`frozen` outside a behavior names rules that do not exist",
-                            span=Span.at(parsed.text, parsed.path, at, line,
-                                         at - (parsed.text.rfind("\n", 0, at) + 1) + 1),
+                            span=span or Span.at(parsed.text, parsed.path, at, line,
+                                                 at - (parsed.text.rfind("\n", 0, at) + 1) + 1),
                             hint="put `frozen LABEL, ...` inside the behavior of those rules")
     if not behaviors:
         raise RuleBaseError("the rule file has no rules",
@@ -150,13 +153,27 @@ def build_rulebase(parsed: ParsedFile, termsets: tuple[TermSet, ...],
             raise RuleBaseError(f"`{b.name}` is a reserved word (a hedge), not a name",
                                 span=b.span, hint="name the behavior something else")
     base_ops = ops_mod.resolve(parsed.operators)
+    labels = {b.name: {r.label for r in b.rules if r.label} for b in behaviors}
     for b in behaviors:
         ops_mod.resolve(b.operators, base_ops)
-        _check_behavior(b, variables, names)
+        _check_behavior(b, variables, names, labels)
     rb = RuleBase(parsed.path, termsets, tuple(behaviors), parsed.operators, termset_paths)
     for b in behaviors:
         _check_cycles(rb, b.name, ())
     return rb
+
+
+def _main_place(parsed: ParsedFile) -> int:
+    """Where ``main`` (the rules outside any behavior) stands among the file's behaviors: at
+    its first rule or ``use``, so that the first behavior of the file is the default one, as
+    docs/language.md says, wherever the top-level rules are written."""
+    spans = [r.span for r in parsed.rules] + [u.span for u in parsed.uses]
+    starts = [(span.line, span.column) for span in spans if span is not None]
+    if not starts:
+        return 0
+    first = min(starts)
+    return sum(1 for b in parsed.behaviors
+               if b.span is not None and (b.span.line, b.span.column) < first)
 
 
 def _defined_twice(second: Behavior, first: Behavior) -> RuleBaseError:
@@ -169,7 +186,8 @@ def _defined_twice(second: Behavior, first: Behavior) -> RuleBaseError:
                          hint="rename one of them, or move its rules into the other")
 
 
-def _check_behavior(b: Behavior, variables: dict[str, Variable], behaviors: list[str]) -> None:
+def _check_behavior(b: Behavior, variables: dict[str, Variable], behaviors: list[str],
+                    labels_of: dict[str, set[str]] | None = None) -> None:
     labels: set[str] = set()
     for rule in b.rules:
         if rule.label:
@@ -189,8 +207,21 @@ def _check_behavior(b: Behavior, variables: dict[str, Variable], behaviors: list
         if label not in labels:
             at = b.frozen_spans[i] if i < len(b.frozen_spans) else None
             exc = unknown("rule label", label, labels, span=at or b.span)
-            exc.message = f"unknown rule label `{label}` in behavior `{b.name}`"
+            exc.message = f"unknown rule label `{label}` in behavior `{b.name}`" + \
+                (" (the rules outside any behavior)" if b.name == MAIN else "")
+            exc.hint = exc.hint or _frozen_elsewhere(label, b.name, labels_of or {})
             raise exc
+
+
+def _frozen_elsewhere(label: str, behavior: str, labels_of: dict[str, set[str]]) -> str | None:
+    """A hint for ``frozen LABEL`` where LABEL is a rule of another behavior: `frozen` names
+    rules of the behavior it stands in (`main` for a line outside any behavior)."""
+    owners = [name for name, labels in labels_of.items() if label in labels and name != behavior]
+    if not owners:
+        return None
+    where = "outside any behavior" if owners[0] == MAIN else f"in behavior `{owners[0]}`"
+    return (f"`{label}` is a rule {where}: `frozen` names rules of the behavior it is written "
+            f"in, so write `frozen {label}` there")
 
 
 def check_rule(rule: Rule, variables: dict[str, Variable]) -> None:

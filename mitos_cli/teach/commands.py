@@ -22,12 +22,16 @@ from ..errors import LessonError, RuleSyntaxError, Span
 from ..lang.cache import lark_parser
 from ..lang.model import Rule, Setting, Use
 from ..lang.parse import (
+    TARGETS,
     TERMINAL_WORDS,
+    UNSAID,
     _hedge_hint,
     _ToModel,
+    check_modifiers,
     check_nesting,
     check_settings,
     keyword_hint,
+    not_in_action_before,
     shift,
 )
 from ..resources import grammar_text
@@ -317,6 +321,18 @@ class _ToCommand(_ToModel):
         return Quit()
 
 
+def _not_a_target(exc: UnexpectedInput, line: str, where: str) -> RuleSyntaxError | None:
+    """``correct road=1 -> steering is not`` (or a rule's ``then speed is not``): said at the
+    `not`, as for ``... is not LM``."""
+    if "->" not in line and line.split()[:1] != ["at"]:
+        return not_in_action_before(exc, line, where)
+    found = not_in_action_before(exc, line, where, r"->|^\s*at\b")
+    if found is not None:
+        found.message = found.message.replace("an action", TARGETS[0])
+        found.hint = TARGETS[1]
+    return found
+
+
 def parse_command(line: str, path: str | None = None, lineno: int = 1) -> Command:
     """Parse one command (``line`` may span several lines for a wrapped rule).
 
@@ -328,9 +344,11 @@ def parse_command(line: str, path: str | None = None, lineno: int = 1) -> Comman
         try:
             tree = parser().parse(line)
         except UnexpectedInput as exc:
-            raise _unknown_command(line, line, where, 1) \
+            raise _unknown_command(line, line, where, 1) or _not_a_target(exc, line, where) \
                 or _syntax_error(exc, line, where) from None
         check_nesting(tree, line, where)
+        check_modifiers(tree, line, where, TARGETS if "->" in line or
+                        line.split()[:1] == ["at"] else None)
     except RuleSyntaxError as exc:        # parsed alone: put it at its line of the lesson
         exc.span = shift(exc.span, lineno - 1)
         raise
@@ -436,7 +454,7 @@ def _words(name: str) -> str:
 
 
 def _expected(names) -> str | None:
-    words = sorted({_words(n) for n in names if not n.startswith("__")})
+    words = sorted({_words(n) for n in names if not n.startswith("__") and n not in UNSAID})
     if not words:
         return None
     return words[0] if len(words) == 1 else ", ".join(words[:-1]) + " or " + words[-1]
