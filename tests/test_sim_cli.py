@@ -135,11 +135,26 @@ def test_require_success_exits_3_when_not_success(short):
 
 
 def test_require_takes_only_success(short, capsys):
-    """Another name is a mistake in a value (exit 1, with the names), as a planner's is."""
+    """Another name is a usage error (exit 2, with the names), as a planner's is."""
     code, err = run_main(capsys, short, "--require", "collision")
-    assert code == 1 and "expected one of success" in err
+    assert code == 2 and "expected one of success" in err
     code, err = run_main(capsys, short, "--require", "sucess")
-    assert code == 1 and "did you mean `success`?" in err
+    assert code == 2 and "did you mean `success`?" in err
+
+
+def test_a_bad_option_value_is_a_usage_error_whatever_its_kind(short, capsys):
+    """A new user's third review: `--planner dwb` and `--require succes` exited 1 where
+    `--seed -1`, `--fps 0` and `--plot x.jpg` exit 2. All are mistakes in the command line:
+    exit 2, with "did you mean" where a name is misspelt. A behavior is looked up in the rule
+    file, which may be what is wrong: that stays a name error (exit 1)."""
+    for args in (["--planner", "dwb"], ["--require", "succes"], ["--seed", "-1"],
+                 ["--fps", "0"], ["--plot", "x.jpg"]):
+        code, err = run_main(capsys, short, *args)
+        assert code == 2, (args, err)
+    code, err = run_main(capsys, short, "--planner", "dwb")
+    assert "usage error: unknown planner `dwb`" in err and "did you mean `dwa`?" in err
+    code, err = run_main(capsys, short, "-b", "driv")
+    assert code == 1 and "did you mean `drive`?" in err
 
 
 def test_a_plot_that_is_not_a_picture_is_refused_before_the_run(short, capsys, monkeypatch):

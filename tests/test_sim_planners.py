@@ -40,9 +40,9 @@ def run(capsys, *args) -> tuple[int, str, str]:
     return code, out, err
 
 
-def test_simulate_planner_unknown_is_exit_1_with_did_you_mean(capsys):
+def test_simulate_planner_unknown_is_a_usage_error_with_did_you_mean(capsys):
     code, _, err = run(capsys, "corridor.yaml", "--planner", "potential")
-    assert code == 1 and "did you mean `potential_field`" in err
+    assert code == 2 and "did you mean `potential_field`" in err
 
 
 def test_simulate_planner_with_rules_for_another_planner_is_a_usage_error(capsys):
@@ -63,5 +63,5 @@ def test_compare_knows_dwa(capsys, tmp_path):
     try:
         main(["compare", "corridor.yaml", "--planner", "dwx", "-o", str(tmp_path / "s")])
     except SystemExit as exc:
-        assert exc.code == 1
+        assert exc.code == 2
     assert "did you mean `dwa`" in capsys.readouterr().err
