@@ -484,3 +484,15 @@ def test_load_world_of_a_loaded_world_says_it_is_loaded():
     with pytest.raises(WorldError) as exc:
         load_world(world)
     assert "loaded already" in str(exc.value) and len(exc.value.message) < 200
+
+
+@pytest.mark.parametrize("given", ["  given:\n", "  given:   # to do\n"])
+def test_an_empty_given_is_refused_as_an_empty_unknown_is(given):
+    """A new user's third review: an empty `given:` silently meant "no map at all" (as
+    `given: none`), where an empty `unknown:` is refused. Now it is refused, at the value."""
+    text = error(BASE.replace("map:\n", "map:\n" + given, 1))
+    assert "w.yaml:" in text and "`given:` in map is empty" in text
+    assert "expected a map_server YAML file or `none`" in text and "`given: none`" in text
+    written = BASE.replace("map:\n", "map:\n  given: none\n", 1)
+    assert parse_world(written, "w.yaml")                        # written out, it is taken
+    assert parse_world(BASE.replace("map:\n", "map:\n  given: null\n", 1), "w.yaml")

@@ -488,12 +488,27 @@ def _obstacles(r: _Reader, top: YMap) -> list[Obstacle]:
     return obstacles
 
 
+def _left_empty(span: Span) -> bool:
+    """Whether a null value at ``span`` was written as nothing (``given:``, ``{given: }``), not
+    as ``null`` or ``~``; where the line is not known, it was written."""
+    if span.source_line is None:
+        return False
+    rest = span.source_line[max(0, span.column - span.source_start):].strip()
+    return not rest or rest[0] in "#,}]"
+
+
 def read_given(mp: YMap, path: str, unknown_occupied: bool):
     """``map.given``: the robot's own map (a map_server YAML), ``none``, or (absent) the map."""
     if "given" not in mp:
         return "map", None
     value = mp["given"]
     span = mp.value_span("given")
+    if value is None and _left_empty(span):
+        # an empty `given:` quietly meant "no map at all", as an empty `unknown:` does not
+        raise WorldError("`given:` in map is empty", span=span,
+                         expected="a map_server YAML file or `none`",
+                         hint="`given: none` for a robot with no map, `given: maps/told.yaml` for "
+                              "the map it is told; leave `given` out: it plans on the map itself")
     if value is None or str(value).lower() in ("none", "null", "~"):
         return "none", None
     if not isinstance(value, str) or not value.strip():
