@@ -216,7 +216,8 @@ def check_inputs(worlds: list[str], choices, rulebase: str | None,
     paths = []
     for name in worlds:
         path = str(resolve_world_path(name))
-        load_world(path)
+        for note in load_world(path).notes:    # likely mistakes the file may hold
+            warn(note)
         if path in paths:
             raise typer.BadParameter(f"the world `{name}` is given twice")
         paths.append(path)

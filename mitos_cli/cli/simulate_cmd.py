@@ -9,7 +9,7 @@ from typing import Annotated, Optional
 import typer
 
 from . import complete
-from .output import emit, err, json_text
+from .output import emit, err, json_text, warn
 from .params import MAX_RUNS, finite, named, option_names
 from .progress import INTERRUPTED, progress_bar
 from .targets import check_directory, check_suffix
@@ -231,6 +231,8 @@ def simulate_command(
                                  f"`{planner_name}` has none", param_hint="--planner")
     live = live or speed is not None
     loaded = [load_world(resolve_world_path(n)) for n in worlds or [DEFAULT_WORLD]]
+    for note in (n for w in loaded for n in w.notes):   # likely mistakes: said, not refused
+        warn(note)
     _check_outputs((("--out", out), ("--plot", plot), ("--animate", animate)),
                    [Path(w.path) for w in loaded if w.path] + ([Path(rulebase)] if rulebase else []))
     for path in (out, plot, animate):         # before the run, not after it
