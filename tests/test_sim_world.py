@@ -563,3 +563,11 @@ def test_simulate_prints_the_warnings_and_runs(tmp_path, capsys):
     err = capsys.readouterr().err
     assert info.value.code == 0
     assert f"warning: {path}:16:5: obstacle `buried`" in err
+
+
+def test_a_velocity_of_three_numbers_is_said_in_in_per_s():
+    """It said "(in/s) must be a point [x, y] (inches)": two units for one value."""
+    text = error(BASE + "obstacles:\n  - {name: cart, shape: circle, at: [150, 20], radius: 5, "
+                        "velocity: [0, 0.5, 1]}\n")
+    assert "`velocity` of obstacle `cart` must be a velocity [vx, vy] (in/s)" in text
+    assert "inches" not in text

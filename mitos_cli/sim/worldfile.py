@@ -266,7 +266,8 @@ def read_obstacle(r: _Reader, value: Any, span: Span, index: int) -> Obstacle:
                          span=m.key_span("waypoints"))
     if "velocity" in m:
         motion = Motion("velocity", velocity=r.point(m["velocity"], m.value_span("velocity"),
-                                                     f"`velocity` of {what} (in/s)"))
+                                                     f"`velocity` of {what}",
+                                                     "a velocity [vx, vy] (in/s)"))
     elif "waypoints" in m:
         wps = r.points(m["waypoints"], m.value_span("waypoints"), f"`waypoints` of {what}", 1)
         motion = Motion("waypoints", waypoints=(at,) + wps,
