@@ -142,7 +142,7 @@ def test_no_robot_takes_a_colour_the_picture_uses_for_something_else(tmp_path):
     """A new user's third review: in a three-robot world the third robot's path was the
     purple of the "replanned route" line. No robot colour is one the plot gives the route, a
     replanned route, obstacles or the start and goal, nor near one (RGB distance > 50)."""
-    from mitos_cli.draw.world import RESERVED, REPLANNED_COLOUR
+    from mitos_cli.draw.world import REPLANNED_COLOUR, RESERVED
 
     def rgb(c: str) -> tuple[int, ...]:
         return tuple(int(c[k:k + 2], 16) for k in (1, 3, 5))
