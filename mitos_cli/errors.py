@@ -137,6 +137,8 @@ class MitosError(Exception):
     """
 
     kind = "error"
+    #: The CLI's exit code: 1 for a mistake in what the user wrote or asked for.
+    exit_code = 1
 
     def __init__(self, message: str, *, span: Span | None = None, expected: str | None = None,
                  hint: str | None = None) -> None:
@@ -181,6 +183,17 @@ class NameError_(MitosError):
     """A name (variable, term, hedge, behavior, operator) that is not defined."""
 
     kind = "name error"
+
+
+class UsageError(NameError_):
+    """An option given a name from a fixed list that is not on it (``--planner dwb``,
+    ``--require succes``, ``--to fxl``): a mistake in the command line, so exit 2 as Click's
+    own bad option values (``--seed -1``) are, with the names and "did you mean". A name looked
+    up in a file the user gave (a behavior, an input) stays a name error (exit 1): the file may
+    be what is wrong."""
+
+    kind = "usage error"
+    exit_code = 2
 
 
 class TermSetError(MitosError):

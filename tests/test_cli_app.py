@@ -51,8 +51,9 @@ def test_version_is_the_package_version() -> None:
 
 
 def test_a_value_outside_an_options_names_is_a_mistake_in_a_value(capsys) -> None:
-    """As an unknown planner or T-norm: exit 1, the names and "did you mean" (Typer's own
-    choice check said exit 2 and listed the names without a suggestion). Any case is read."""
+    """As an unknown planner or T-norm: a usage error (exit 2, as Typer's own choice check
+    said, and as `--seed -1` is), with the names and "did you mean" (which Typer's check did
+    not give). Any case is read."""
     import pytest
 
     from mitos_cli.cli.app import main
@@ -71,7 +72,8 @@ def test_a_value_outside_an_options_names_is_a_mistake_in_a_value(capsys) -> Non
         with pytest.raises(SystemExit) as info:
             main(args)
         err = capsys.readouterr().err
-        assert info.value.code == 1 and message in err, err
+        assert info.value.code == 2 and message in err, err
+        assert err.startswith("usage error: "), err
         assert f"did you mean `{meant}`?" in err, err
     with pytest.raises(SystemExit) as info:
         main(["export", "rulebases/mitos.rules", "--to", "PYTHON"])

@@ -136,3 +136,28 @@ def test_study_boxes_have_black_medians(tmp_path, monkeypatch):
     medians = [ln for ln in seen["fig"].axes[0].lines if len(ln.get_xdata()) == 2 and
                ln.get_ydata()[0] == ln.get_ydata()[1] == 2.5]
     assert len(medians) == 2 and all(ln.get_color() == "black" for ln in medians)
+
+
+def test_no_robot_takes_a_colour_the_picture_uses_for_something_else(tmp_path):
+    """A new user's third review: in a three-robot world the third robot's path was the
+    purple of the "replanned route" line. No robot colour is one the plot gives the route, a
+    replanned route, obstacles or the start and goal, nor near one (RGB distance > 50)."""
+    from mitos_cli.draw.world import REPLANNED_COLOUR, RESERVED
+
+    def rgb(c: str) -> tuple[int, ...]:
+        return tuple(int(c[k:k + 2], 16) for k in (1, 3, 5))
+
+    for robot in ROBOT_COLOURS:
+        assert min(sum((a - b) ** 2 for a, b in zip(rgb(robot), rgb(r))) ** 0.5
+                   for r in RESERVED) > 50, robot
+    assert len(set(ROBOT_COLOURS)) == len(ROBOT_COLOURS)
+    three = WORLD.replace("time_limit: 5", "time_limit: 1").replace(
+        "map:\n", "  - name: third\n    q_init: {x: 180, y: -30, heading: 0}\n"
+                  "    q_goal: {x: 330, y: -30, tolerance: 12}\nmap:\n")
+    path = tmp_path / "three.yaml"
+    path.write_text(three)
+    fig = draw_run(simulate(load_world(path)))
+    (ax,) = [a for a in fig.axes if a.get_legend() is not None]
+    paths = [ln.get_color() for ln in ax.lines
+             if ln.get_label().split(":")[0] in ("robot", "other", "third")]
+    assert paths == list(ROBOT_COLOURS[:3]) and REPLANNED_COLOUR not in paths

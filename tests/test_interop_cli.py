@@ -192,7 +192,7 @@ def test_convert_errors_exit_1_with_location(tmp_path: Path, capsys) -> None:
                             capsys)
     assert code == 1 and "hedges cannot be written to .fis" in output
     code, output = run_main(["convert", str(DATA / "tipper.fis"), "--to", "xml"], capsys)
-    assert code == 1 and "unknown format `xml`" in output   # a wrong name, as a planner's
+    assert code == 2 and "unknown format `xml`" in output   # a wrong name, as a planner's
     code, output = run_main(["convert", str(DATA / "tipper.fis"), "--to", "fll", "-o",
                              str(tmp_path / "missing" / "x.fll")], capsys)
     assert code == 1 and "cannot write" in output and "No such file or directory" in output

@@ -214,3 +214,58 @@ def test_show_without_display_is_a_clear_error(monkeypatch, mitos):
 def test_unwritable_path_is_a_clear_error(mitos, tmp_path):
     with pytest.raises(DrawError, match="cannot write"):
         draw_sheet(plotdata.sheet(mitos.rulebase, ["road"]), tmp_path / "no" / "dir.png")
+
+
+ONE_INPUT = """\
+variables:
+  x:
+    role: input
+    universe: [0, 10]
+    terms:
+      LOW: {shape: left_shoulder, points: [2, 8]}
+  speed:
+    role: output
+    universe: [0, 60]
+    terms:
+      SLOW: {shape: triangle, points: [0, 10, 20]}
+"""
+
+
+def test_rule_viewer_fills_each_term_up_to_its_membership(mitos):
+    """A new user's third review: the fill was the term *scaled* by the membership (the
+    curve is sampled at its breakpoints only, and min() of those samples joined a shoulder's
+    foot to its top); docs/plots.md says "filled up to its membership". The fill's edge now
+    follows the curve up to the membership, and meets it at the input value."""
+    from mitos_cli.draw.rules import clipped
+
+    x, y = clipped(np.array([0.0, 70.0, 100.0, 160.0]), np.array([0.0, 0.0, 1.0, 1.0]), 0.27)
+    np.testing.assert_allclose(x, [0, 70, 78.1, 100, 160])
+    np.testing.assert_allclose(y, [0, 0, 0.27, 0.27, 0.27])
+    view = plotdata.rule_view(mitos.compiled, SAMPLE)
+    fig = draw_rules(view)
+    row = view.rows[0]
+    for p in row.props:
+        _, fill = by_gid(fig, f"{row.label}:{p.var}")
+        edge = max((v for path in fill.get_paths() for v in path.vertices
+                    if abs(v[0] - SAMPLE[p.var]) < 1e-9), key=lambda v: v[1], default=None)
+        base = len(view.rows) - 1
+        if edge is not None:
+            assert edge[1] == pytest.approx(base + 0.8 * p.value)
+
+
+@pytest.mark.parametrize("weight", ["", " with 0.8"])
+def test_rule_viewer_row_labels_fit_a_narrow_figure(tmp_path, weight):
+    """"OOF 0.70" for "DOF 0.70" and "gregate" for "aggregate": with one input and one
+    output the labels ran off the figure's left edge."""
+    (tmp_path / "x.terms.yaml").write_text(ONE_INPUT)
+    (tmp_path / "one.rules").write_text(f'terms "x.terms.yaml"\nif x is LOW then speed is '
+                                        f'SLOW{weight}\n')
+    rb = load_rulebase(tmp_path / "one.rules")
+    fig = draw_rules(plotdata.rule_view(rb.compiled, {"x": 3.0}))
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    labels = [t for ax in fig.axes for t in ax.texts
+              if "DOF" in t.get_text() or t.get_text() == "aggregate"]
+    assert len(labels) == 2
+    for t in labels:
+        assert t.get_window_extent(renderer).x0 >= 0, t.get_text()

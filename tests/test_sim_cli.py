@@ -8,6 +8,7 @@ import json
 import re
 from pathlib import Path
 
+import numpy as np
 import pytest
 from typer.testing import CliRunner
 
@@ -135,11 +136,26 @@ def test_require_success_exits_3_when_not_success(short):
 
 
 def test_require_takes_only_success(short, capsys):
-    """Another name is a mistake in a value (exit 1, with the names), as a planner's is."""
+    """Another name is a usage error (exit 2, with the names), as a planner's is."""
     code, err = run_main(capsys, short, "--require", "collision")
-    assert code == 1 and "expected one of success" in err
+    assert code == 2 and "expected one of success" in err
     code, err = run_main(capsys, short, "--require", "sucess")
-    assert code == 1 and "did you mean `success`?" in err
+    assert code == 2 and "did you mean `success`?" in err
+
+
+def test_a_bad_option_value_is_a_usage_error_whatever_its_kind(short, capsys):
+    """A new user's third review: `--planner dwb` and `--require succes` exited 1 where
+    `--seed -1`, `--fps 0` and `--plot x.jpg` exit 2. All are mistakes in the command line:
+    exit 2, with "did you mean" where a name is misspelt. A behavior is looked up in the rule
+    file, which may be what is wrong: that stays a name error (exit 1)."""
+    for args in (["--planner", "dwb"], ["--require", "succes"], ["--seed", "-1"],
+                 ["--fps", "0"], ["--plot", "x.jpg"]):
+        code, err = run_main(capsys, short, *args)
+        assert code == 2, (args, err)
+    code, err = run_main(capsys, short, "--planner", "dwb")
+    assert "usage error: unknown planner `dwb`" in err and "did you mean `dwa`?" in err
+    code, err = run_main(capsys, short, "-b", "driv")
+    assert code == 1 and "did you mean `drive`?" in err
 
 
 def test_a_plot_that_is_not_a_picture_is_refused_before_the_run(short, capsys, monkeypatch):
@@ -305,3 +321,37 @@ def test_the_trace_says_one_object_not_one_objects():
                               clutter=1, nearest=60).items()})
     text = trace.render()
     assert "clutter = 1 object" in text and "1 objects" not in text
+
+
+
+def _raw_and_commanded(world: Path, tmp_path: Path) -> tuple[np.ndarray, np.ndarray]:
+    """The rules' own speed for every row of `simulate --out` (what `eval --batch` gives)
+    and the row's `cmd_speed`."""
+    from mitos_cli.engine.csvio import read_batch
+    from mitos_cli.engine.evaluation import evaluate
+    from mitos_cli.sim.planner import FuzzyPlanner
+
+    out = tmp_path / f"{world.stem}.csv"
+    assert run(world, "--out", out).exit_code == 0
+    compiled = FuzzyPlanner().compiled
+    text = out.read_text()
+    raw = evaluate(compiled, read_batch(text, str(out), compiled.inputs)).outputs
+    table = list(csv.DictReader(io.StringIO(text)))
+    return raw[:, compiled.outputs.index("speed")], np.array([float(r["cmd_speed"])
+                                                              for r in table])
+
+
+def test_cmd_speed_is_the_command_after_the_brake(tmp_path):
+    """A new user's third review: the docs called `cmd_speed` "the speed the planner asked
+    for", but the robot's own brake caps it (28.28 = sqrt(2 x 40 x 10) where the rules asked
+    33). As worlds/README.md now says: the brake only ever lowers it, and without the brake
+    it is the rules' own request (to the CSV's rounding)."""
+    from mitos_cli.sim.worldfile import resolve_world_path
+
+    corridor = resolve_world_path("corridor")
+    raw, cmd = _raw_and_commanded(corridor, tmp_path)
+    assert (cmd <= raw + 1e-3).all() and (cmd < raw - 5).any()       # capped at the box
+    free = tmp_path / "free.yaml"
+    free.write_text(corridor.read_text().replace("robot:\n", "robot:\n  brake: false\n", 1))
+    raw, cmd = _raw_and_commanded(free, tmp_path)
+    assert np.allclose(raw, cmd, atol=1e-3)

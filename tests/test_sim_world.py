@@ -484,3 +484,90 @@ def test_load_world_of_a_loaded_world_says_it_is_loaded():
     with pytest.raises(WorldError) as exc:
         load_world(world)
     assert "loaded already" in str(exc.value) and len(exc.value.message) < 200
+
+
+@pytest.mark.parametrize("given", ["  given:\n", "  given:   # to do\n"])
+def test_an_empty_given_is_refused_as_an_empty_unknown_is(given):
+    """A new user's third review: an empty `given:` silently meant "no map at all" (as
+    `given: none`), where an empty `unknown:` is refused. Now it is refused, at the value."""
+    text = error(BASE.replace("map:\n", "map:\n" + given, 1))
+    assert "w.yaml:" in text and "`given:` in map is empty" in text
+    assert "expected a map_server YAML file or `none`" in text and "`given: none`" in text
+    written = BASE.replace("map:\n", "map:\n  given: none\n", 1)
+    assert parse_world(written, "w.yaml")                        # written out, it is taken
+    assert parse_world(BASE.replace("map:\n", "map:\n  given: null\n", 1), "w.yaml")
+
+
+def test_a_wheelbase_longer_than_the_footprint_is_refused():
+    """A new user's third review: `wheelbase: 40` under a 24 in footprint was taken."""
+    text = error(BASE.replace("wheelbase: 16", "wheelbase: 40"))
+    assert "w.yaml:7:14: world error: the wheelbase (40 in) is longer than the robot's " \
+           "footprint (24 in long)" in text and "expected a wheelbase of at most 24 in" in text
+    other = BASE + ("robots:\n  - name: b\n    q_init: {x: 30, y: 20}\n    q_goal: {x: 300, y: 20}\n"
+                    "    robot: {footprint: {length: 12, width: 10}}\n")
+    assert "the wheelbase (16 in) is longer" in error(other)     # inherited, then too long
+    assert parse_world(BASE.replace("wheelbase: 16", "wheelbase: 24"), "w.yaml")
+
+
+def test_a_misspelt_offset_under_randomise_says_dx_or_dy():
+    text = error(BASE + "obstacles:\n  - {name: box, shape: circle, at: [150, 10], radius: 5}\n"
+                        "randomise:\n  obstacles:\n    box: {dz: [-5, 5]}\n")
+    assert "unknown key `dz` in randomise of `box`" in text
+    assert "did you mean `dx` or `dy`?" in text and "w.yaml:19:11" in text
+
+
+def test_a_corridor_in_metres_gets_a_hint_about_units():
+    """`width: 1.8` (metres by mistake) said only that the start lies in a wall."""
+    text = error(BASE.replace("width: 70", "width: 1.8"))
+    assert "hint: lengths in a world are inches: a corridor `width: 1.8` is narrower than " \
+           "the robot (18 in wide); if 1.8 is metres, write 71" in text
+    text = error(BASE.replace("width: 70", "width: 1.8").replace("y: 0, heading", "y: 30, heading"))
+    assert "lies inside a wall" in text and "lengths in a world are inches" in text
+
+
+OBSTACLES = ("obstacles:\n"
+             "  - {name: buried, shape: circle, at: [150, 80], radius: 5}\n"
+             "  - {name: slab, shape: rectangle, at: [250, -60], length: 20, width: 10}\n"
+             "  - {name: box, shape: rectangle, at: [120, 10], length: 10, width: 10}\n"
+             "  - {name: edge, shape: circle, at: [200, 38], radius: 5}\n")
+
+
+def test_an_obstacle_inside_a_wall_is_a_warning_not_an_error():
+    """Entirely in solid space, no beam or robot reaches it: harmless but pointless, so a
+    warning (at its item); one that reaches into the corridor is an ordinary obstacle."""
+    w = parse_world(BASE + OBSTACLES, "w.yaml")
+    assert len(w.notes) == 2, w.notes
+    assert w.notes[0].startswith("w.yaml:16:5: obstacle `buried` at (150, 80) lies entirely "
+                                 "inside a wall")
+    assert w.notes[1].startswith("w.yaml:17:5: obstacle `slab`")
+    assert parse_world(BASE, "w.yaml").notes == ()
+
+
+def test_a_randomise_range_that_buries_an_obstacle_is_a_warning():
+    w = parse_world(BASE + OBSTACLES + "randomise:\n  obstacles:\n    box: {dy: [-100, 100]}\n",
+                    "w.yaml")
+    assert any(n.startswith("w.yaml:22:10: randomise can move obstacle `box` entirely into a "
+                            "wall (dx 0, dy -100 in") for n in w.notes), w.notes
+    calm = parse_world(BASE + OBSTACLES + "randomise:\n  obstacles:\n    box: {dy: [-10, 10]}\n",
+                       "w.yaml")
+    assert len(calm.notes) == 2
+
+
+def test_simulate_prints_the_warnings_and_runs(tmp_path, capsys):
+    from mitos_cli.cli.app import main
+
+    path = tmp_path / "w.yaml"
+    path.write_text(BASE.replace("time_limit: 10", "time_limit: 0.5") + OBSTACLES)
+    with pytest.raises(SystemExit) as info:
+        main(["simulate", str(path)])
+    err = capsys.readouterr().err
+    assert info.value.code == 0
+    assert f"warning: {path}:16:5: obstacle `buried`" in err
+
+
+def test_a_velocity_of_three_numbers_is_said_in_in_per_s():
+    """It said "(in/s) must be a point [x, y] (inches)": two units for one value."""
+    text = error(BASE + "obstacles:\n  - {name: cart, shape: circle, at: [150, 20], radius: 5, "
+                        "velocity: [0, 0.5, 1]}\n")
+    assert "`velocity` of obstacle `cart` must be a velocity [vx, vy] (in/s)" in text
+    assert "inches" not in text

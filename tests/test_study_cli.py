@@ -132,10 +132,10 @@ def test_an_output_that_is_a_file_is_refused_as_such(tiny, tmp_path, compare):
 
 @pytest.mark.parametrize("args, code, words", [
     (["worlds/corridr.yaml"], 1, "did you mean `worlds/corridor.yaml`"),
-    (["TINY", "--and", "einstien"], 1, "unknown T-norm `einstien`"),
-    (["TINY", "--planner", "potential"], 1, "did you mean `potential_field`"),
+    (["TINY", "--and", "einstien"], 2, "unknown T-norm `einstien`"),
+    (["TINY", "--planner", "potential"], 2, "did you mean `potential_field`"),
     (["TINY", "--scheduler", "tcp://x:1"], 2, "--scheduler needs --executor dask"),
-    (["TINY", "--executor", "dsk"], 1, "did you mean `dask`"),
+    (["TINY", "--executor", "dsk"], 2, "did you mean `dask`"),
     (["TINY", "--behavior", "drve"], 1, "drive"),
     (["TINY", "TINY"], 2, "given twice"),
     (["TINY", "--planner", "dwa", "--and", "product"], 2, "--and chooses the fuzzy planner's"),

@@ -1,7 +1,8 @@
 """The ``mitos`` command: registers the commands and turns errors into messages.
 
 Our own errors (:class:`MitosError`) print ``path:line:col: message`` and exit 1; usage errors
-exit 2 (Click's convention); anything else is a bug and keeps its traceback.
+exit 2 (Click's convention, and our :class:`~mitos_cli.errors.UsageError`: an option's value
+that is not one of its names); anything else is a bug and keeps its traceback.
 
 Typer inspects the signature of every registered command (evaluating its annotations) before
 it runs any of them, and each command module imports what it needs. :func:`main` therefore
@@ -94,7 +95,7 @@ def main(argv: list[str] | None = None) -> None:
         from .output import report_error
 
         report_error(exc)
-        sys.exit(1)
+        sys.exit(exc.exit_code)
     except OSError as exc:
         # a path argument the system refuses to look up (a name over 255 characters): the
         # user's input, not a bug, wherever in a command it was first used; or a full disk

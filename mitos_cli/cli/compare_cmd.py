@@ -8,11 +8,11 @@ from typing import Annotated, Optional
 
 import typer
 
-from ..errors import unknown
+from ..errors import UsageError, unknown
 from ..words import plural
 from . import complete
 from .output import emit, err, json_text, warn
-from .params import MAX_RUNS, named
+from .params import MAX_RUNS, named, option_names
 from .progress import INTERRUPTED, progress_bar
 
 DEFAULT_AND = "min,product,lukasiewicz,einstein"
@@ -82,8 +82,8 @@ def compare_command(
     from ..study.executors import EXECUTORS
     from ..study.spec import split_list
 
-    if executor not in EXECUTORS:              # a name MITOS does not know: exit 1
-        raise unknown("executor", executor, EXECUTORS)
+    if executor not in EXECUTORS:              # a name MITOS does not know: exit 2
+        raise unknown("executor", executor, EXECUTORS, cls=UsageError)
     if scheduler and executor != "dask":
         raise typer.BadParameter("--scheduler needs --executor dask", param_hint="--scheduler")
     if executor == "dask":                      # before study.json or the progress bar
@@ -91,7 +91,9 @@ def compare_command(
 
         require_dask(scheduler)
     planners = _planners(planner, and_, or_, inference, rulebase, behavior)
-    choices = make_choices(planners, split_list(and_), split_list(or_), split_list(inference))
+    with option_names():                        # --planner, --and, --or, --inference: exit 2
+        choices = make_choices(planners, split_list(and_), split_list(or_),
+                               split_list(inference))
     paths = check_inputs(worlds, choices, rulebase, behavior)
     study = Study(paths, choices, runs, seed, rulebase, behavior,
                   command=_command_line(worlds, and_, or_, inference, planner, rulebase,
@@ -214,7 +216,8 @@ def check_inputs(worlds: list[str], choices, rulebase: str | None,
     paths = []
     for name in worlds:
         path = str(resolve_world_path(name))
-        load_world(path)
+        for note in load_world(path).notes:    # likely mistakes the file may hold
+            warn(note)
         if path in paths:
             raise typer.BadParameter(f"the world `{name}` is given twice")
         paths.append(path)

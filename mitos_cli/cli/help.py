@@ -78,7 +78,7 @@ EXAMPLES: dict[str, tuple[tuple[str, str], ...]] = {
 EXIT_CODES: tuple[tuple[int, str], ...] = (
     (0, "done"),
     (1, "a mistake in a file or a value (the message says where and what)"),
-    (2, "a usage error: an unknown option, a missing or malformed argument"),
+    (2, "a usage error: an unknown option or value, a missing or bad argument"),
 )
 OWN_EXIT_CODES: dict[str, tuple[tuple[int, str], ...]] = {
     "check": ((1, "a mistake in a file or value, or an error in the rule base"),),

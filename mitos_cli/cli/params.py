@@ -3,13 +3,14 @@
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from enum import Enum
 from typing import TypeVar
 
 import typer
 
-from ..errors import unknown
+from ..errors import NameError_, UsageError, unknown
 
 E = TypeVar("E", bound=Enum)
 
@@ -38,12 +39,26 @@ def named(value: str | None) -> str | None:
 
 
 def choice(kind: type[E], value: str, what: str) -> E:
-    """The member of ``kind`` named ``value`` (any case). An unknown name is a mistake in a
-    value, as an unknown planner or T-norm is: exit 1, the names, and "did you mean"."""
+    """The member of ``kind`` named ``value`` (any case). An unknown name is a mistake in the
+    command line, as an unknown planner or T-norm is: exit 2, the names, and "did you mean"."""
     for member in kind:
         if member.value == value.lower():
             return member
-    raise unknown(what, value, [m.value for m in kind])
+    raise unknown(what, value, [m.value for m in kind], cls=UsageError)
+
+
+@contextmanager
+def option_names() -> Iterator[None]:
+    """Checks of options' names against fixed lists (``--planner``, ``--and``) made by code
+    shared with Python callers, which raise a :class:`NameError_`: here the name came from the
+    command line, so it is a usage error (exit 2), with the same words and hint."""
+    try:
+        yield
+    except UsageError:
+        raise
+    except NameError_ as exc:
+        raise UsageError(exc.message, span=exc.span, expected=exc.expected,
+                         hint=exc.hint) from None
 
 
 def choices(kind: type[Enum]) -> str:

@@ -9,8 +9,8 @@ from typing import Annotated, Optional
 import typer
 
 from . import complete
-from .output import emit, err, json_text
-from .params import MAX_RUNS, finite, named
+from .output import emit, err, json_text, warn
+from .params import MAX_RUNS, finite, named, option_names
 from .progress import INTERRUPTED, progress_bar
 from .targets import check_directory, check_suffix
 
@@ -220,7 +220,8 @@ def simulate_command(
     from ..sim.worldfile import load_world, resolve_world_path
 
     require = _checked_require(require)
-    planner_kind(planner_name)                  # an unknown name fails before any file is read
+    with option_names():                        # an unknown name fails before any file is read
+        planner_kind(planner_name)
     if plot is not None:                        # before the run, as `plot -o` does
         from .plot_cmd import picture_path
 
@@ -230,6 +231,8 @@ def simulate_command(
                                  f"`{planner_name}` has none", param_hint="--planner")
     live = live or speed is not None
     loaded = [load_world(resolve_world_path(n)) for n in worlds or [DEFAULT_WORLD]]
+    for note in (n for w in loaded for n in w.notes):   # likely mistakes: said, not refused
+        warn(note)
     _check_outputs((("--out", out), ("--plot", plot), ("--animate", animate)),
                    [Path(w.path) for w in loaded if w.path] + ([Path(rulebase)] if rulebase else []))
     for path in (out, plot, animate):         # before the run, not after it
@@ -252,10 +255,10 @@ def _checked_require(require: str | None) -> str | None:
     if require is None:
         return None
     require = require.lower()
-    if require not in REQUIRE:                # a wrong name: as a planner's
-        from ..errors import unknown
+    if require not in REQUIRE:                # a wrong name: as a planner's (exit 2)
+        from ..errors import UsageError, unknown
 
-        raise unknown("--require outcome", require, REQUIRE)
+        raise unknown("--require outcome", require, REQUIRE, cls=UsageError)
     return require
 
 

@@ -32,6 +32,8 @@ MAX_ROWS = 30
 BAND = 0.8          # a row's curves span [base, base + BAND]; the rest is the gap to the next
 ROW_INCHES = 0.62
 GAP_INCHES = 0.34   # between the last rule and the aggregates
+LABEL_PAD = 6.0     # pt between a row's label and its first cell
+LABEL_SIZE = 8      # pt, the row labels and "aggregate"
 
 
 def _bare(ax) -> None:
@@ -55,12 +57,27 @@ def draw_antecedent(ax, base: float, row: RuleRow, var: str) -> None:
     for p in props:
         gid = f"{row.label}:{var}"
         ax.plot(p.x, base + BAND * p.y, color=TERM_COLOR, linewidth=1.2, gid=gid)
-        ax.fill_between(p.x, base, base + BAND * np.minimum(p.y, p.value), color=FILL_COLOR,
-                        alpha=0.75, linewidth=0, gid=gid)
+        x, y = clipped(p.x, p.y, p.value)
+        ax.fill_between(x, base, base + BAND * y, color=FILL_COLOR, alpha=0.75, linewidth=0,
+                        gid=gid)
     if props:
         _label(ax, 0.02, base + BAND + 0.12,
                " / ".join(f"{' '.join(('not',) * p.negated + p.hedges + (p.term,))} "
                           f"{p.value:.2f}" for p in props))
+
+
+def clipped(x: np.ndarray, y: np.ndarray, level: float) -> tuple[np.ndarray, np.ndarray]:
+    """The curve ``(x, y)`` cut at ``level``: what lies under both. The curve is sampled at
+    its breakpoints only, so ``min(y, level)`` on those samples joined the foot of a shoulder
+    to its top at ``level``: the term *scaled* by the membership, not filled up to it as the
+    docs say. The points where the curve crosses ``level`` are inserted first."""
+    x, y = np.asarray(x, float), np.asarray(y, float)
+    d = y - level
+    k = np.flatnonzero(d[:-1] * d[1:] < 0)           # a crossing inside segment k
+    t = d[k] / (d[k] - d[k + 1])
+    xs = np.insert(x, k + 1, x[k] + t * (x[k + 1] - x[k]))
+    ys = np.insert(y, k + 1, level)
+    return xs, np.minimum(ys, level)
 
 
 def spikes(grid: np.ndarray, y: np.ndarray, cells: int = 3) -> list[tuple[float, float]] | None:
@@ -159,11 +176,13 @@ def draw_rules(view: RuleView, path: str | Path | None = None, *, title: str | N
     ncols = len(inputs) + len(outputs)
     n = max(len(rows), 1)
     height = 1.6 + ROW_INCHES * (n + 1.3)
-    fig = new_figure((1.4 + 2.3 * ncols, height), show)
+    width = 1.4 + 2.3 * ncols
+    fig = new_figure((width, height), show)
     # a fixed gap between the rules and the aggregates (room for the results' titles),
     # whatever the number of rows: gridspec's hspace is a fraction of the mean axes height
     span = height - 0.75 - 0.55
-    grid = fig.add_gridspec(2, ncols, height_ratios=(n, 1.3), left=0.11, right=0.98,
+    left = _left_margin([_row_label(r) for r in rows], width)
+    grid = fig.add_gridspec(2, ncols, height_ratios=(n, 1.3), left=left, right=0.98,
                             top=1 - 0.75 / height, bottom=0.55 / height,
                             hspace=2 * GAP_INCHES / (span - GAP_INCHES), wspace=0.12)
     bases = [n - 1 - k for k in range(len(rows))]          # first rule on top
@@ -187,6 +206,29 @@ def draw_rules(view: RuleView, path: str | Path | None = None, *, title: str | N
     return finish(fig, path, show, tight=False)       # margins are set above
 
 
+def _row_label(row: RuleRow) -> str:
+    """A row's label: the rule and its DOF (split where weights and contexts scale it)."""
+    return f"{row.label}\n" + row.dof_text.replace(" = ", "\n= ")
+
+
+def _text_inches(text: str, weight: str = "normal") -> float:
+    """The width of ``text`` (its widest line) at the labels' size, in inches."""
+    from matplotlib.font_manager import FontProperties
+    from matplotlib.textpath import TextToPath
+
+    font = FontProperties(size=LABEL_SIZE, weight=weight)
+    return max(TextToPath().get_text_width_height_descent(line, font, ismath=False)[0]
+               for line in text.split("\n")) / 72
+
+
+def _left_margin(labels: list[str], width: float) -> float:
+    """The figure fraction left of the first column that holds the widest row label and
+    "aggregate" (a fraction of the figure's width cut `DOF` to `OOF` and `aggregate` to
+    `gregate` in a narrow figure), and never less than it was (0.11)."""
+    need = max([_text_inches("aggregate", "bold")] + [_text_inches(t) for t in labels])
+    return max(0.11, (need + LABEL_PAD / 72 + 0.12) / width)
+
+
 def _strongest(rows: list, max_rows: int) -> tuple[list, int]:
     """The ``max_rows`` rows of the largest DOFs, in rule-base order, and how many are left
     out."""
@@ -208,10 +250,10 @@ def _input_column(ax, inp, rows: list, bases: list[int], n: int, first: bool) ->
         ax.axhline(base, color="black", linewidth=0.8)
         draw_antecedent(ax, base, row, inp.name)
         if first:
-            ax.text(-0.08, base + BAND / 2, f"{row.label}\n" + row.dof_text.replace(
-                        " = ", "\n= "),
-                    transform=ax.get_yaxis_transform(), ha="right", va="center",
-                    fontsize=8)
+            ax.annotate(_row_label(row), (0, base + BAND / 2),
+                        xycoords=ax.get_yaxis_transform(), xytext=(-LABEL_PAD, 0),
+                        textcoords="offset points", ha="right", va="center",
+                        fontsize=LABEL_SIZE)
     ax.axvline(inp.value, color=VALUE_COLOR, linewidth=1.1)
     unit = f" {inp.unit}" if inp.unit else ""
     ax.set_title(f"{inp.name} = {inp.value:g}{unit}", fontsize=9, pad=3)
@@ -243,5 +285,6 @@ def _input_scale(ax, inp, first: bool) -> None:
     unit = f" [{inp.unit}]" if inp.unit else ""
     ax.set_xlabel(f"{inp.name}{unit}", fontsize=8)
     if first:
-        ax.text(-0.08, 0.5, "aggregate", transform=ax.transAxes, ha="right",
-                va="center", fontsize=8, fontweight="bold")
+        ax.annotate("aggregate", (0, 0.5), xycoords="axes fraction", xytext=(-LABEL_PAD, 0),
+                    textcoords="offset points", ha="right", va="center", fontsize=LABEL_SIZE,
+                    fontweight="bold")

@@ -12,8 +12,15 @@ import numpy as np
 from .output import _matplotlib, finish, new_figure
 
 PAD = 20.0      # in round the map
-#: a colour per robot where a world has several (the first is the footprint blue of the frames)
-ROBOT_COLOURS = ("#1f5fbf", "#d9731e", "#7a4ab5", "#1f9e89", "#c23b8a", "#8c6d31")
+#: the colours of what is drawn besides the robots: the route, a replanned route, obstacles
+#: (their fill, edge and time marks), the start and goal
+ROUTE_COLOUR, REPLANNED_COLOUR = "#4a78b5", "#7a4ab5"
+OBSTACLE_COLOURS = ("#b5524a", "#5c1f1a", "#8a2f27")
+GOAL_COLOUR = "#2f6b2f"
+RESERVED = (ROUTE_COLOUR, REPLANNED_COLOUR, *OBSTACLE_COLOURS, GOAL_COLOUR)
+#: a colour per robot where a world has several (the first is the footprint blue of the frames):
+#: none is one of ``RESERVED`` or near it (the third robot was the replanned route's purple)
+ROBOT_COLOURS = ("#1f5fbf", "#d9731e", "#1f9e89", "#c23b8a", "#8c6d31", "#c9a400")
 TIME_STEPS = (1, 2, 5, 10, 15, 20, 30, 60, 120, 300, 600)     # s between time marks
 
 
@@ -146,10 +153,10 @@ class Marks:
 def _draw_routes(ax, result) -> None:
     """The routes planned at the start (dashed) and each replan (dash-dotted)."""
     for route in result.routes:
-        ax.plot(route.points[:, 0], route.points[:, 1], ls="--", lw=0.8, color="#4a78b5",
+        ax.plot(route.points[:, 0], route.points[:, 1], ls="--", lw=0.8, color=ROUTE_COLOUR,
                 label="route" if route is result.routes[0] else None)
     for n, (_, _, route) in enumerate(getattr(result, "replanned", ())):
-        ax.plot(route.points[:, 0], route.points[:, 1], ls="-.", lw=0.8, color="#7a4ab5",
+        ax.plot(route.points[:, 0], route.points[:, 1], ls="-.", lw=0.8, color=REPLANNED_COLOUR,
                 label="replanned route" if n == 0 else None)
 
 
@@ -167,9 +174,10 @@ def _draw_obstacles(ax, result, marks: Marks) -> list[int]:
         xy = track[:, j] if len(track) else np.array([[o.x, o.y]])
         moving = np.ptp(xy, axis=0).max() > 1e-9 if len(xy) else False
         if moving:
-            ax.plot(xy[:, 0], xy[:, 1], color="#b5524a", lw=0.8, ls=":",
+            ax.plot(xy[:, 0], xy[:, 1], color=OBSTACLE_COLOURS[0], lw=0.8, ls=":",
                     label="obstacle track" if not tracked else None)
-            time_marks(ax, result.t, xy, marks.step, "#8a2f27", near=marks.near, above=True,
+            time_marks(ax, result.t, xy, marks.step, OBSTACLE_COLOURS[2], near=marks.near,
+                       above=True,
                        label="time marks (s)" if not tracked else None)
             tracked.append(j)
         for k, alpha in ((0, 0.25), (len(xy) - 1, 0.9)) if moving else ((len(xy) - 1, 0.9),):
@@ -179,11 +187,12 @@ def _draw_obstacles(ax, result, marks: Marks) -> list[int]:
                 patch = Circle((cx, cy), o.radius)
             else:
                 patch = Polygon(rect_corners(cx, cy, np.deg2rad(o.angle), o.length, o.width))
-            patch.set(facecolor="#b5524a", edgecolor="#5c1f1a", alpha=alpha, lw=0.8)
+            patch.set(facecolor=OBSTACLE_COLOURS[0], edgecolor=OBSTACLE_COLOURS[1], alpha=alpha,
+                      lw=0.8)
             ax.add_patch(patch)
         if j in named:
             ax.annotate(o.name, xy[-1], xytext=(6, 6), textcoords="offset points",
-                        fontsize=8, color="#5c1f1a")
+                        fontsize=8, color=OBSTACLE_COLOURS[1])
     return tracked
 
 
@@ -232,12 +241,12 @@ def _draw_robot(ax, result, i: int, agent, every: int, vmax: float, marks: Marks
                     fontsize=7.5, zorder=7, **inward(ax, x, y),
                     bbox={"boxstyle": "round,pad=0.2", "fc": "white", "ec": "none",
                           "alpha": 0.85})
-    ax.plot(agent.start.x, agent.start.y, marker="o", color="#2f6b2f", ms=5)
+    ax.plot(agent.start.x, agent.start.y, marker="o", color=GOAL_COLOUR, ms=5)
     ax.add_patch(Circle((agent.goal.x, agent.goal.y), agent.goal.tolerance, fill=False,
-                        edgecolor="#2f6b2f", lw=1.0, ls="--"))
+                        edgecolor=GOAL_COLOUR, lw=1.0, ls="--"))
     ax.annotate(agent.name if several else "goal",
                 (agent.goal.x, agent.goal.y), xytext=(6, -10), textcoords="offset points",
-                fontsize=8, color="#2f6b2f")
+                fontsize=8, color=GOAL_COLOUR)
     return line
 
 

@@ -36,7 +36,9 @@ POSE_COLUMNS = ("tick", "t", "robot", "x", "y", "pose_heading_deg", "speed", "st
 """The columns before the ranges: tick (count), t (s), robot (its name), x, y (in),
 pose_heading_deg (the robot's heading, deg CCW from +x), speed (in/s), steering (deg, 90
 straight), cmd_steering (deg), cmd_speed (in/s), clearance (in). ``pose_heading_deg`` is not
-the rule input ``heading`` (the route's bearing relative to the robot, positive right)."""
+the rule input ``heading`` (the route's bearing relative to the robot, positive right). The
+``cmd_`` columns are the command after the robot's own brake and backing out (``safety.py``),
+not the planner's raw request (``mitos eval --batch`` on the rows gives that)."""
 
 
 def columns(beams: int) -> list[str]:

@@ -30,7 +30,7 @@ from typing import Protocol
 
 import numpy as np
 
-from ..errors import NameError_, RuleBaseError, unknown
+from ..errors import NameError_, RuleBaseError, Span, unknown
 
 
 @dataclass(frozen=True)
@@ -58,6 +58,48 @@ class Planner(Protocol):
         ...
 
 
+def first_use(rulebase, behavior: str, name: str) -> Span | None:
+    """Where ``behavior`` (or a behavior it uses, depth first) first reads variable ``name``
+    in a rule's or a `use`'s condition; else where the term set declares it; else None."""
+    from ..lang.model import And, Not, Or, Prop
+
+    def in_expr(e) -> Span | None:
+        if isinstance(e, Prop):
+            return e.span.naming(name) if e.var == name and e.span else None
+        items = (e.expr,) if isinstance(e, Not) else e.items if isinstance(e, (And, Or)) else ()
+        return next((s for s in map(in_expr, items) if s is not None), None)
+
+    seen: set[str] = set()
+
+    def in_behavior(b: str) -> Span | None:
+        if b in seen:
+            return None
+        seen.add(b)
+        found = next((b_ for b_ in rulebase.behaviors if b_.name == b), None)
+        if found is None:
+            return None
+        for rule in found.rules:
+            if (s := in_expr(rule.antecedent)) is not None:
+                return s
+        for use in found.uses:
+            if use.condition is not None and (s := in_expr(use.condition)) is not None:
+                return s
+            if (s := in_behavior(use.behavior)) is not None:
+                return s
+        return None
+
+    span = in_behavior(behavior)
+    if span is None:
+        variable = rulebase.variables.get(name)
+        span = getattr(variable, "span", None)
+    return span
+
+
+def _behavior_span(rulebase, behavior: str) -> Span | None:
+    """Where ``behavior`` is declared in its rule file (None for top-level rules or text)."""
+    return next((b.span for b in rulebase.behaviors if b.name == behavior), None)
+
+
 class FuzzyPlanner:
     """A behavior of a rule base as the planner (default: the packaged ``drive``)."""
 
@@ -82,11 +124,15 @@ class FuzzyPlanner:
                 f"behavior `{self.compiled.behavior}` reads input "
                 + ", ".join(f"`{m}`" for m in missing)
                 + ", which the simulator does not perceive",
-                expected="inputs among " + ", ".join(INPUTS))
+                span=first_use(loaded.rulebase, self.compiled.behavior, missing[0]),
+                expected="inputs among " + ", ".join(INPUTS),
+                hint="the simulator measures only these (worlds/README.md, \"What the robot "
+                     "perceives\"); simulate a behavior that reads them (--behavior)")
         for out in ("steering", "speed"):
             if out not in self.compiled.outputs:
                 raise RuleBaseError(f"behavior `{self.compiled.behavior}` sets no `{out}`; "
                                     f"a driving behavior must set steering and speed",
+                                    span=_behavior_span(loaded.rulebase, self.compiled.behavior),
                                     hint="simulate a behavior such as `drive` (--behavior)")
         self._cols = [self.compiled.outputs.index("steering"),
                       self.compiled.outputs.index("speed")]

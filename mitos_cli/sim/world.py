@@ -169,6 +169,9 @@ class World:
     behavior_span: Span | None = field(default=None, compare=False, repr=False)
     # where the world file names ``behavior`` (the rule base, which knows the behaviors, is
     # chosen later: an unknown name is reported there, pointing here)
+    notes: tuple[str, ...] = field(default=(), compare=False, repr=False)
+    # what the file says that is legal but likely a mistake (``path:line:col: ...``), for the
+    # CLI to print as warnings; a run never reads them
 
     @property
     def robot(self) -> Robot:

@@ -35,6 +35,8 @@ from .world import (
 if TYPE_CHECKING:
     import numpy as np
 
+    from .staticmap import StaticMap
+
 TOP_KEYS = ("name", "seed", "dt", "time_limit", "substeps", "behavior", "robot", "sensors",
             "q_init", "q_goal", "map", "obstacles", "robots", "randomise", "route")
 ROBOT_KEYS = ("model", "wheelbase", "footprint", "safety_margin", "steering", "max_speed",
@@ -180,10 +182,12 @@ def read_robot(r: _Reader, value: Any, span: Span, base: Robot | None = None) ->
     if not smin < straight < smax:
         raise WorldError(f"steering needs min < straight < max, not {smin:g} < {straight:g} "
                          f"< {smax:g}", span=st.span)
+    wheelbase = r.number(m, "wheelbase", "robot", None if base is None else d.wheelbase,
+                         positive=True)
+    _check_wheelbase(m, wheelbase, fp[0])
     return Robot(
         model="tricycle",
-        wheelbase=r.number(m, "wheelbase", "robot", None if base is None else d.wheelbase,
-                           positive=True),
+        wheelbase=wheelbase,
         length=fp[0], width=fp[1],
         safety_margin=r.number(m, "safety_margin", "robot", d.safety_margin, minimum=0),
         steering_min=smin, steering_max=smax, steering_straight=straight,
@@ -193,6 +197,19 @@ def read_robot(r: _Reader, value: Any, span: Span, base: Robot | None = None) ->
         acceleration=r.number(m, "acceleration", "robot", d.acceleration, positive=True),
         max_reverse=r.number(m, "max_reverse", "robot", d.max_reverse, minimum=0),
         brake=r.flag(m, "brake", "robot", d.brake))
+
+
+def _check_wheelbase(m: YMap, wheelbase: float, length: float) -> None:
+    """Refuse a wheelbase longer than the footprint: the rear axle and the front wheel are on
+    the robot, and a body shorter than its wheelbase (`wheelbase: 40` under a 24 in footprint)
+    turns like a long robot while it collides like a short one."""
+    if wheelbase > length:
+        key = "wheelbase" if "wheelbase" in m else "footprint"
+        raise WorldError(f"the wheelbase ({wheelbase:g} in) is longer than the robot's footprint "
+                         f"({length:g} in long): its wheels must fit under its body",
+                         span=m.value_span(key) if key in m else m.span,
+                         expected=f"a wheelbase of at most {length:g} in",
+                         hint="shorten `wheelbase`, or lengthen `footprint: {length: ...}`")
 
 
 def read_sensors(r: _Reader, value: Any, span: Span) -> Sensors:
@@ -249,7 +266,8 @@ def read_obstacle(r: _Reader, value: Any, span: Span, index: int) -> Obstacle:
                          span=m.key_span("waypoints"))
     if "velocity" in m:
         motion = Motion("velocity", velocity=r.point(m["velocity"], m.value_span("velocity"),
-                                                     f"`velocity` of {what} (in/s)"))
+                                                     f"`velocity` of {what}",
+                                                     "a velocity [vx, vy] (in/s)"))
     elif "waypoints" in m:
         wps = r.points(m["waypoints"], m.value_span("waypoints"), f"`waypoints` of {what}", 1)
         motion = Motion("waypoints", waypoints=(at,) + wps,
@@ -277,6 +295,7 @@ def read_randomise(r: _Reader, value: Any, span: Span, names: list[str]) -> Rand
         obs = r.mapping(m["obstacles"], m.value_span("obstacles"), "randomise obstacles",
                         tuple(names))
         for name, spec in obs.items():
+            _check_offsets(spec, name)
             j = r.mapping(spec, obs.value_span(name), f"randomise of `{name}`", ("dx", "dy"))
             dx = r.range_pair(j["dx"], j.value_span("dx"), "dx") if "dx" in j else (0.0, 0.0)
             dy = r.range_pair(j["dy"], j.value_span("dy"), "dy") if "dy" in j else (0.0, 0.0)
@@ -287,6 +306,18 @@ def read_randomise(r: _Reader, value: Any, span: Span, names: list[str]) -> Rand
         if noise[0] < 0:
             raise WorldError("sensor_noise must not be negative", span=m.value_span("sensor_noise"))
     return Randomise(tuple(jitters), noise)
+
+
+def _check_offsets(spec: Any, name: str) -> None:
+    """An unknown key among an obstacle's offsets: `dz`, `x`, `dxy` are too far from `dx` and
+    `dy` for the usual "did you mean" (two letters, one different), so name both."""
+    if not isinstance(spec, YMap):
+        return                                  # r.mapping says what it must be
+    for key in spec:
+        if key not in ("dx", "dy"):
+            raise WorldError(f"unknown key `{key}` in randomise of `{name}`",
+                             span=spec.key_span(key), expected="dx or dy (in, added to `at`)",
+                             hint="did you mean `dx` or `dy`? (a world is flat: x and y only)")
 
 
 def _list(mapping, key: str):
@@ -365,11 +396,12 @@ def parse_world(text: str, path: str) -> World:
                   tuple(corridors), grid, tuple(obstacles), randomise,
                   _behavior(top), knows, given, min_clearance, replan,
                   top.value_span("behavior") if "behavior" in top else None)
-    check_free(world, agent_spans)
+    static = check_free(world, agent_spans)
     check_starts(world, [s for s, _ in agent_spans])
     if "randomise" in top:
         check_jitters(world, top["randomise"].get("obstacles"))
-    return world
+    notes = walled_in(world, static, top)
+    return replace(world, notes=tuple(notes)) if notes else world
 
 
 def _name(top: YMap) -> str:
@@ -488,12 +520,27 @@ def _obstacles(r: _Reader, top: YMap) -> list[Obstacle]:
     return obstacles
 
 
+def _left_empty(span: Span) -> bool:
+    """Whether a null value at ``span`` was written as nothing (``given:``, ``{given: }``), not
+    as ``null`` or ``~``; where the line is not known, it was written."""
+    if span.source_line is None:
+        return False
+    rest = span.source_line[max(0, span.column - span.source_start):].strip()
+    return not rest or rest[0] in "#,}]"
+
+
 def read_given(mp: YMap, path: str, unknown_occupied: bool):
     """``map.given``: the robot's own map (a map_server YAML), ``none``, or (absent) the map."""
     if "given" not in mp:
         return "map", None
     value = mp["given"]
     span = mp.value_span("given")
+    if value is None and _left_empty(span):
+        # an empty `given:` quietly meant "no map at all", as an empty `unknown:` does not
+        raise WorldError("`given:` in map is empty", span=span,
+                         expected="a map_server YAML file or `none`",
+                         hint="`given: none` for a robot with no map, `given: maps/told.yaml` for "
+                              "the map it is told; leave `given` out: it plans on the map itself")
     if value is None or str(value).lower() in ("none", "null", "~"):
         return "none", None
     if not isinstance(value, str) or not value.strip():
@@ -520,10 +567,10 @@ def _behavior(top: YMap) -> str:
     return value
 
 
-def check_free(world: World, spans: list[tuple[Span, Span]]) -> None:
+def check_free(world: World, spans: list[tuple[Span, Span]]) -> StaticMap:
     """Refuse a start or goal that lies inside a wall (outside every corridor) or inside an
     obstacle where it stands when the run starts, and a start where the robot's body already
-    reaches into a wall: each run would end at its first tick."""
+    reaches into a wall: each run would end at its first tick. Returns the static map."""
     import numpy as np
 
     from .staticmap import build_static
@@ -535,13 +582,95 @@ def check_free(world: World, spans: list[tuple[Span, Span]]) -> None:
             who = _who(agent)
             if not static.free(np.array([[p.x, p.y]]))[0]:
                 raise WorldError(f"the {what}{who} at ({p.x:g}, {p.y:g}) lies inside a wall",
-                                 span=span, hint="move it into a corridor (free space)")
+                                 span=span, hint=_units_hint(world, agent)
+                                 or "move it into a corridor (free space)")
             hit = _obstacle_at(world, p.x, p.y)
             if hit is not None:
                 raise WorldError(f"the {what}{who} at ({p.x:g}, {p.y:g}) lies inside obstacle "
                                  f"`{hit}` (where it stands at the start)", span=span,
                                  hint="move it, or the obstacle")
-        _check_body(agent, static, s_span)
+        _check_body(world, agent, static, s_span)
+    return static
+
+
+def _units_hint(world: World, agent) -> str | None:
+    """Where a corridor is narrower than the robot, a hint that world lengths are inches
+    (`width: 1.8`, metres by mistake, made the start "lie inside a wall" and said no more)."""
+    narrow = [c.width for c in world.corridors if c.width < agent.robot.width]
+    if not narrow:
+        return None
+    w = min(narrow)
+    return (f"lengths in a world are inches: a corridor `width: {w:g}` is narrower than the "
+            f"robot ({agent.robot.width:g} in wide){_as_metres(w)}")
+
+
+def _as_metres(x: float) -> str:
+    """``; if 1.8 is metres, write 71`` for a length that reads as metres, else nothing."""
+    return f"; if {x:g} is metres, write {x / 0.0254:.0f}" if x < 20 else ""
+
+
+def walled_in(world: World, static: StaticMap, top: YMap) -> list[str]:
+    """Warnings (``path:line:col: ...``) for obstacles that lie entirely inside a wall where
+    they start, or that `randomise` can move entirely into one. Not refused: such an
+    obstacle is harmless (no beam or robot reaches it), only pointless, and a generated or
+    randomised world may hold one; but it is likely a mistake the user should hear of."""
+    if not world.obstacles:
+        return []
+    notes = []
+    written: YList = top["obstacles"]
+    jitters = {j.obstacle: j for j in world.randomise.obstacles}
+    moves: YMap | None = top["randomise"].get("obstacles") if "randomise" in top else None
+    for i, o in enumerate(world.obstacles):
+        if o.motion.kind != "static":
+            continue                            # a mover may be meant to come out of one
+        if _inside_wall(static, o, (o.x, o.y)):
+            notes.append(f"{written.item_span(i)}: obstacle `{o.name}` at ({o.x:g}, {o.y:g}) "
+                         "lies entirely inside a wall: no beam or robot can reach it (move "
+                         "it into a corridor, or drop it)")
+        elif moves is not None and o.name in jitters:
+            off = _walled_offset(static, o, jitters[o.name])
+            if off is not None:
+                notes.append(f"{moves.value_span(o.name)}: randomise can move obstacle "
+                             f"`{o.name}` entirely into a wall (dx {off[0]:g}, dy {off[1]:g} in "
+                             f"puts it at ({o.x + off[0]:g}, {o.y + off[1]:g})): those runs "
+                             "have no such obstacle (narrow its dx and dy)")
+    return notes
+
+
+def _walled_offset(static: StaticMap, o, j) -> tuple[float, float] | None:
+    """An offset in `randomise`'s ranges (a 5 x 5 lattice over them, corners included) that
+    puts ``o`` entirely inside a wall, or None."""
+    import numpy as np
+
+    for dx in np.linspace(j.dx[0], j.dx[1], 5):
+        for dy in np.linspace(j.dy[0], j.dy[1], 5):
+            if _inside_wall(static, o, (o.x + dx, o.y + dy)):
+                return float(dx), float(dy)
+    return None
+
+
+def _inside_wall(static: StaticMap, o, at: tuple[float, float]) -> bool:
+    """Whether obstacle ``o`` standing at ``at`` lies entirely in solid space: its centre is
+    not free and no wall crosses or touches it."""
+    import math
+
+    import numpy as np
+
+    from .geometry import box_segment_distance, point_segment_distance
+
+    if static.free(np.array([at]))[0]:
+        return False
+    reach = o.radius if o.shape == "circle" else math.hypot(o.length, o.width) / 2
+    walls = static.near(at[0], at[1], reach)
+    if not len(walls):
+        return True
+    if o.shape == "circle":
+        return bool(point_segment_distance(np.array([at]), walls).min() > o.radius)
+    h = math.radians(o.angle)
+    c, s = math.cos(h), math.sin(h)
+    rel = walls.reshape(-1, 2) - at
+    local = np.stack([rel[:, 0] * c + rel[:, 1] * s, -rel[:, 0] * s + rel[:, 1] * c], axis=1)
+    return bool(box_segment_distance(o.length / 2, o.width / 2, local.reshape(-1, 4)).min() > 0)
 
 
 def _obstacle_at(world: World, x: float, y: float) -> str | None:
@@ -659,7 +788,7 @@ def _range(r: tuple[float, float]) -> str:
     return f"{r[0]:g}" if r[0] == r[1] else f"{r[0]:g} to {r[1]:g}"
 
 
-def _check_body(agent, static, span: Span) -> None:
+def _check_body(world: World, agent, static, span: Span) -> None:
     """Refuse a start where the robot's footprint already touches a wall: the run would end
     in a collision at its first tick."""
     import math
@@ -681,8 +810,8 @@ def _check_body(agent, static, span: Span) -> None:
         raise WorldError(
             f"at the start (q_init){_who(agent)}, ({x:g}, {y:g}) heading {agent.start.heading:g} deg, "
             f"the robot's body ({robot.length:g} x {robot.width:g} in) reaches into a wall",
-            span=span, hint="move the start further from the wall, or turn it along the "
-                            "corridor")
+            span=span, hint=_units_hint(world, agent) or "move the start further from the "
+                                                         "wall, or turn it along the corridor")
 
 
 def load_world(path: str | Path) -> World:
