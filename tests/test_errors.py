@@ -626,6 +626,17 @@ def test_not_in_an_action_says_so(tmp_path, action):
     assert "label" not in exc.render() and "not to its complement" in exc.hint
 
 
+def test_not_in_an_action_after_a_long_rule_is_found_at_its_place(tmp_path):
+    # the `not` is looked for back from the error only (a scan of every `X is Y` after the
+    # last `then` was quadratic: a 16 KB fuzzed rule took 2 s to be refused)
+    long = " and ".join(["road is WIDE"] * 2000)
+    line = f"r1: if {long} then speed is SLOW and steering is not"
+    path = write(tmp_path, line + "\nr2: if road is NARROW then speed is FAST\n")
+    exc = error_of(lambda: load_rules_file(path), RuleSyntaxError)
+    assert exc.message == "`not` is not allowed in an action (`steering is not`)"
+    assert caret_under(exc) == "not" and exc.span.column == line.rindex(" not") + 2
+
+
 def test_a_top_level_frozen_label_naming_no_rule_is_pointed_at(tmp_path, capsys):
     path = write(tmp_path, "r1: if road is WIDE then speed is SLOW\n"
                            "avoid_left: if road is NARROW then speed is SLOW\n"
