@@ -238,9 +238,9 @@ def test_a_rule_base_without_the_inputs_is_refused(short, tmp_path, capsys):
 def test_json_says_near_miss_as_the_text_does(tmp_path):
     text = (Path(__file__).parents[1] / "worlds" / "corridor.yaml").read_text()
     world = tmp_path / "close.yaml"
-    world.write_text(text.replace("safety_margin: 2 ", "safety_margin: 6 "))
+    world.write_text(text.replace("safety_margin: 2 ", "safety_margin: 9 "))
     shown = CliRunner().invoke(app, ["simulate", str(world)])
-    assert shown.exit_code == 0 and "closer than the safety margin (6 in)" in shown.stdout
+    assert shown.exit_code == 0 and "closer than the safety margin (9 in)" in shown.stdout
     data = json.loads(CliRunner().invoke(app, ["simulate", str(world), "--json"]).stdout)
     assert data["near_miss"] is True and data["outcome"] == "success"
     data = json.loads(CliRunner().invoke(app, ["simulate", "corridor.yaml", "--json"]).stdout)
@@ -348,10 +348,10 @@ def test_cmd_speed_is_the_command_after_the_brake(tmp_path):
     it is the rules' own request (to the CSV's rounding)."""
     from mitos_cli.sim.worldfile import resolve_world_path
 
-    corridor = resolve_world_path("corridor")
-    raw, cmd = _raw_and_commanded(corridor, tmp_path)
-    assert (cmd <= raw + 1e-3).all() and (cmd < raw - 5).any()       # capped at the box
+    slalom = resolve_world_path("slalom")
+    raw, cmd = _raw_and_commanded(slalom, tmp_path)
+    assert (cmd <= raw + 1e-3).all() and (cmd < raw - 5).any()       # capped by a pole
     free = tmp_path / "free.yaml"
-    free.write_text(corridor.read_text().replace("robot:\n", "robot:\n  brake: false\n", 1))
+    free.write_text(slalom.read_text().replace("robot:\n", "robot:\n  brake: false\n", 1))
     raw, cmd = _raw_and_commanded(free, tmp_path)
     assert np.allclose(raw, cmd, atol=1e-3)

@@ -16,8 +16,8 @@ ROBOT = Robot(length=24, width=18)
 
 def truth_at(x, y, outline):
     f = perception.frame(ROUTE, np.array([x, y]), x)
-    return perception.truth(ROUTE, f, (x, y, 0.0), ROBOT, (35.0 + y, 35.0 - y),
-                            np.asarray(outline, float).reshape(-1, 2), (20.0, 20.0))
+    return perception.truth(ROUTE, f, (x, y, 0.0), ROBOT, (70.0, 26.0 + y, 26.0 - y),
+                            np.asarray(outline, float).reshape(-1, 2))
 
 
 def circle(cx, cy, r, n=32):
@@ -67,6 +67,53 @@ def test_beams_see_the_obstacle_that_the_map_does_not_predict():
     assert got["road"] == pytest.approx(70, abs=0.5)
     assert got["obstacle"] == pytest.approx(180 - 9 - 100 - 12, abs=2)
     assert 0 < got["position"] < 20 and 10 < got["size"] < 30       # right of centre, ~18
+
+
+def corridor_reading(p, heading, route, count=36):
+    """What a noise-free ring of ``count`` beams reads at ``p`` in the 70 in corridor."""
+    from mitos_cli.sim import sensors
+    from mitos_cli.sim.staticmap import corridor_rects, corridor_walls
+    from mitos_cli.sim.world import Corridor, Sensors
+
+    walls = corridor_walls(corridor_rects((Corridor(((0, 0), (600, 0)), 70),)))
+    sen = Sensors(count=count)
+    dirs = sensors.beam_directions(heading, sen.angles)
+    expected, true = sensors.cast(p, dirs, walls, np.zeros((0, 4)), np.zeros((0, 2)),
+                                  np.zeros(0), sen.range)
+    f = perception.frame(route, p, 0.0)
+    return perception.perceive(route, f, (float(p[0]), float(p[1]), heading), ROBOT, dirs, true,
+                               expected, sen.range, 2 * np.pi / count, 4.0)
+
+
+@pytest.mark.parametrize("heading", [0.0, -0.3])
+def test_side_gaps_and_road_do_not_lean_with_a_leg_across_the_corridor(heading):
+    """The last leg to a goal off the corridor's middle runs 45 deg across it: the road and
+    the side gaps are the walls' distances still (across the leg, `gap_right` read 1.8 in
+    where the body was 14 in off the wall, and the road 54 in; the truth read 99)."""
+    p = np.array([556.0, -12.0])
+    across = Route.of([(0.0, 0.0), (560.0, 0.0), (570.0, -10.0)])
+    got = corridor_reading(p, heading, across)
+    straight = corridor_reading(p, heading, ROUTE)
+    for key in ("road", "gap_left", "gap_right"):
+        assert got[key] == straight[key]
+    assert got["road"] == pytest.approx(70.0, abs=0.5)
+    if heading == 0.0:                 # parallel to the walls: the gaps across the body
+        assert got["gap_right"] == pytest.approx(35 - 12 - 9, abs=0.3)
+        assert got["gap_left"] == pytest.approx(35 + 12 - 9, abs=0.3)
+    else:                              # turned toward the right wall: its front end is nearer
+        front = 35 - 12 - 12 * np.sin(0.3)
+        assert got["gap_right"] == pytest.approx(front - 9, abs=0.5)
+
+
+def test_a_pole_beside_the_body_is_its_gap_across_it_not_from_the_centre():
+    cfg = perception.Settings()
+    body = perception._bodies((ROBOT,), cfg)
+    ah, bh = np.array([[10.0, 20.0, -30.0]]), np.array([[-13.0, 15.0, 30.0]])
+    valid = np.ones((1, 3), dtype=bool)
+    road, left, right = perception._sides(ah, bh, ah, bh, valid, valid, body, cfg, 150.0)
+    assert left[0] == pytest.approx(13.0 - 9.0)                    # beside: across the body
+    assert right[0] == pytest.approx(np.hypot(20 - 12, 15) - 9)    # past the front: its end
+    assert road[0] == pytest.approx(np.hypot(10, 13) + np.hypot(20, 15))   # from the centre
 
 
 def test_nearest_is_the_gap_from_the_body_to_the_nearest_echo_near_its_band():

@@ -150,3 +150,37 @@ def test_a_robot_stops_short_of_a_wall_its_command_drives_it_at():
         sim.step(np.array([[40.0, 60.0]]))               # hard left at full speed
     res = sim.result()
     assert res.outcome != "collision" and res.clearance.min() > 0.0
+
+
+WALL_AHEAD = """
+name: wall-ahead
+dt: 0.05
+time_limit: 30
+substeps: 4
+robot: {{model: tricycle, wheelbase: 16, footprint: {{length: 24, width: 18}}, max_speed: 60, acceleration: 40}}
+sensors: {{layout: ring, count: 36, cone: 15, range: 150, noise: 0}}
+q_init: {{x: 30, y: 0, heading: 0}}
+q_goal: {{x: 120, y: 28, tolerance: 4}}
+map:
+  corridors:
+    - points: [[0, 0], [{end}, 0]]
+      width: 70
+"""
+
+
+@pytest.mark.parametrize("speed", [20.0, 30.0, 45.0, 60.0])
+def test_a_robot_driven_straight_at_a_wall_stops_short_of_it(tmp_path, speed):
+    """The brake counts the tick the robot drives on at what it was told before the next
+    command (it touched the wall at 3.7 in/s from a constant 30 in/s when it did not), and
+    looks as far as stopping from its top speed takes (the 30 in it looked let a robot at 60
+    in/s within 15 in of a wall before it braked)."""
+    from mitos_cli.sim import Simulation, load_world
+
+    path = tmp_path / "wall.yaml"
+    path.write_text(WALL_AHEAD.format(end=400))
+    sim = Simulation(load_world(path), seed=1)
+    while not sim.done and sim.time < 20.0:
+        sim.step(np.array([[90.0, speed]]))
+    res = sim.result()
+    assert res.outcome != "collision" and res.clearance.min() > 0.0
+    assert res.clearance.min() < 4.0, res.clearance.min()      # and it came near it

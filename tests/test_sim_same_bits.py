@@ -505,9 +505,10 @@ def test_brake_sweeps_measured_together_are_each_measured_as_alone():
                     float(rng.uniform(-4, 4)))
             cells = rng.uniform(-70, 70, (int(rng.choice([0, 3, 40, 300])), 2))
             wheel = float(rng.choice([robot.steering_straight, rng.uniform(30, 150)]))
-            body = safety.Body(robot, pose, 90.0, cells, 1.0, 0.0)
+            reach = float(rng.choice([30.0, 49.0]))      # robots' own reaches in one batch
+            body = safety.Body(robot, pose, 90.0, cells, 1.0, 0.0, reach)
             sweeps.append((body, wheel, bool(rng.random() < 0.3)))
-        got = safety.free_travels(sweeps, 30.0)
+        got = safety.free_travels(sweeps)
         for j, (body, wheel, backward) in enumerate(sweeps):
             assert same(got[j], body.free(wheel, backward, safety.Settings()))
 
@@ -663,7 +664,7 @@ def test_free_ways_one_band_at_a_time_are_the_plain_ways():
         assert same(got[0], want[0]) and same(got[1], want[1])
 
 
-def test_road_and_side_gaps_from_one_reduction_are_the_plain_minima():
+def test_road_and_side_gaps_of_rows_are_the_plain_minima():
     rng = np.random.default_rng(13)
     cfg = perception.Settings()
     for _ in range(200):
@@ -680,19 +681,25 @@ def test_road_and_side_gaps_from_one_reduction_are_the_plain_minima():
             return np.where(mask.any(axis=1),
                             np.where(mask, values, np.inf).min(axis=1, initial=np.inf), none)
 
-        side = valid & (np.abs(a) <= cfg.window)
-        (left, right), = perception._beside(b, np.abs(b), [side])      # as perceive_rows
-        got = perception._or(left, 200.0), perception._or(right, 200.0)
-        assert same(got[0], least(side & (b < 0), -b, 200.0))
-        assert same(got[1], least(side & (b > 0), b, 200.0))
+        walls = valid & (rng.random((rows, n)) < 0.8)
+        body = perception._bodies(tuple(robots), cfg)
+        ah, bh = rng.normal(0, 40, (2, rows, n))             # the robots' own frames
+        road, left, right = perception._sides(a, b, ah, bh, valid, walls, body, cfg, 200.0,
+                                              objects)
+        centre = np.hypot(ah, bh)
+        side = walls & (np.abs(a) <= cfg.window)
+        assert same(road, np.where((side & (b < 0)).any(axis=1),
+                                   least(side & (b < 0), centre, 0.0), 200.0)
+                    + np.where((side & (b > 0)).any(axis=1),
+                               least(side & (b > 0), centre, 0.0), 200.0))
         ahead = np.where(objects, length, cfg.wall_ahead)
         near = valid & (a >= -cfg.wall_behind) & (a <= ahead) & (np.abs(b) >= half)
-        body = perception._bodies(tuple(robots), cfg)
-        got = perception._walls_rows(a, b, valid, body, cfg, 200.0, objects)
-        assert same(got[0], np.where((near & (b < 0)).any(axis=1),
-                                     least(near & (b < 0), -b, 0.0) - half[:, 0], 200.0))
-        assert same(got[1], np.where((near & (b > 0)).any(axis=1),
-                                     least(near & (b > 0), b, 0.0) - half[:, 0], 200.0))
+        over = np.abs(ah) - length
+        axis = np.where(over > 0, np.hypot(over, np.abs(bh)), np.abs(bh))
+        assert same(left, np.where((near & (b < 0)).any(axis=1),
+                                   least(near & (b < 0), axis, 0.0) - half[:, 0], 200.0))
+        assert same(right, np.where((near & (b > 0)).any(axis=1),
+                                    least(near & (b > 0), axis, 0.0) - half[:, 0], 200.0))
 
 
 def test_chords_cleared_from_the_squares_are_those_hypot_clears():

@@ -271,9 +271,9 @@ def test_at_corrects_the_behavior_that_drove_the_run(rules):
     assert text.startswith("note: figure4 was driven by `drive`, so this corrects drive (the "
                            "rules that produced the motion")
     assert "`use drive` before `adapt`" in text
-    assert "(steering 89.83 -> 62.05 at 12 s)" in text         # drive's steering, not 70
+    assert "(steering 89.96 -> 53.28 at 12 s)" in text         # drive's steering, not 70
     assert {e.behavior for e in s.state.examples} == {"drive"}
-    assert "obstacle=200 heading=-14.86" in text                # drive's inputs
+    assert "obstacle=200 heading=-14.93" in text                # drive's inputs
     text = say(s, out, "at 12s steering is LM")                 # noted once per run
     assert text.startswith("1 example from figure4 at 12 s (#22):")
     with pytest.raises(LessonError) as info:

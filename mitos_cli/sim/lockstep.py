@@ -151,7 +151,7 @@ def _guard_together(runs: list[Simulation], ticks: list) -> None:
     if not every:
         return
     cfg = runs[0].brake_settings
-    free = safety.free_travels(every, cfg.reach, cfg.step)
+    free = safety.free_travels(every, cfg.step)
     start = 0
     for run, s, mine in zip(runs, ticks, sweeps):
         run.braked(s, mine, free[start:start + len(mine)])

@@ -375,6 +375,7 @@ class Simulation:
         self._asked = [clearances(world, a) for a in world.agents]
         self._body = [math.hypot(r.length, r.width) for r in self.robots]   # in: a diagonal
         self._safety = safety.Settings()
+        self._brake_reach = [safety.reach_of(r, self.dt, self._safety) for r in self.robots]
         self._still = None
         self._still_discs = None        # discs round the still rectangles (rows.SenseRow)
         if not any(o.motion.kind in ("velocity", "waypoints") for o in world.obstacles):
@@ -856,21 +857,21 @@ class Simulation:
         and backing out of a pocket when it has held the robot too long. Their first sweeps
         are measured together (:meth:`braking`, :func:`.safety.free_travels`)."""
         sweeps = self.braking(s)
-        self.braked(s, sweeps, safety.free_travels(sweeps, self._safety.reach,
-                                                   self._safety.step))
+        self.braked(s, sweeps, safety.free_travels(sweeps, self._safety.step))
 
     def braking(self, s: _Sensed) -> list[tuple[safety.Body, float, bool]]:
         """The first sweep (body, wheel, backward) the guard measures for each active robot
         that brakes, in order (runs in lockstep measure theirs together)."""
-        cfg, out = self._safety, []
+        out: list[tuple[safety.Body, float, bool]] = []
         for i in self._active.nonzero()[0]:
             robot, rmap = self.robots[i], self._maps[i]
             if not robot.brake:
                 continue
             body = safety.Body(robot, (float(self._x[i]), float(self._y[i]), float(self._h[i])),
                                float(self._steer[i]),
-                               rmap.near(s.pose[i, :2], cfg.reach + self._body[i]),
-                               rmap.grid.resolution / 2, float(s.inputs["heading"][i]))
+                               rmap.near(s.pose[i, :2], self._brake_reach[i] + self._body[i]),
+                               rmap.grid.resolution / 2, float(s.inputs["heading"][i]),
+                               self._brake_reach[i])
             command = (float(s.command[i, 0]), float(s.command[i, 1]))
             out.append((body, *safety.first_sweep(command, body, self._recovery[i], self.dt)))
         return out
@@ -1055,22 +1056,18 @@ def true_inputs(res: SimResult) -> dict[str, np.ndarray]:
             walls = static.near(pose[i, 0], pose[i, 1], reach)
             route = res.route_at(k, i)
             f = perception.frame(route, pose[i, :2], res.progress[k, i])
-            dirs = np.concatenate([sensors.beam_directions(pose[i, 2], angles), [-f.n, f.n]])
+            dirs = sensors.beam_directions(pose[i, 2], angles)
             expected = geometry.ray_segments(pose[i, :2], dirs, walls, sen.range)
-            # across the route, to the walls within reach (an opening reads as the sensor
-            # range, as the perceived width does, not as a sentinel a million inches wide)
-            across = geometry.ray_segments(pose[i, :2], dirs[-2:], walls, sen.range)
             things = np.concatenate([outline] + [corners[j] for j in range(n) if j != i])
-            gaps = perception.side_gaps(f, pose[i, :2], dirs[:-2], expected[:-2], things,
-                                        robots[i], sen.range, cfg)
-            seen = expected[:-2] < sen.range * 0.999
-            wall_points = pose[i, :2] + expected[:-2, None][seen] * dirs[:-2][seen]
+            sides = perception.true_sides(f, tuple(pose[i]), dirs, expected, things, robots[i],
+                                          sen.range, cfg)
+            seen = expected < sen.range * 0.999
+            wall_points = pose[i, :2] + expected[:, None][seen] * dirs[seen]
             known = np.concatenate([wall_points, things])
             ahead = perception.clear_lookahead(route, f, pose[i, :2], known, 0.0,
                                                least[i] + cfg.lookahead_room, cfg)
             room = perception.route_room(f, pose[i, :2], known, 0.0, least[i])
-            tr = perception.truth(route, f, tuple(pose[i]), robots[i],
-                                  (float(across[0]), float(across[1])), things, gaps, cfg,
+            tr = perception.truth(route, f, tuple(pose[i]), robots[i], sides, things, cfg,
                                   wall_points, ahead, room)
             for key in perception.INPUTS:
                 out[key][k, i] = tr[key]

@@ -15,9 +15,11 @@ like an obstacle.
 Inputs (all floats, units in the names of ``mitos.terms.yaml`` / ``drive.terms.yaml``):
 
 ``road`` (x1, in)
-    corridor width at the robot: nearest wall hit on the left plus nearest on the right among
-    beams that land within ``window`` of the robot along the route (``range`` for a side with
-    no wall in sight, e.g. at an intersection).
+    corridor width at the robot: the distance from its centre to the nearest wall hit on the
+    left of the route plus that to the nearest on the right, among beams that land within
+    ``window`` of the robot along the route (``range`` for a side with no wall in sight, e.g.
+    at an intersection). Distances, not offsets across the route: a route leg that runs
+    across a corridor (to a goal off its middle) does not widen it.
 ``size`` (x2, in)
     width across the route of the nearest *obstructing* object ahead: the obstacle hits within
     ``cluster`` of the nearest one, each widened by half the beam spacing at its range (an
@@ -70,11 +72,13 @@ Inputs (all floats, units in the names of ``mitos.terms.yaml`` / ``drive.terms.y
     show and only straight on; a jamb beside a door or a pole by the corner of the body is in
     ``nearest``, so the ``drive`` behavior slows for it.
 ``gap_left``, ``gap_right`` (in)
-    gap between the robot's side and the nearest thing hit on that side: walls among beams
-    landing from ``wall_behind`` behind to ``wall_ahead`` ahead of the robot's centre along
-    the route, objects only while beside its body; all at least half its width across
-    (``range`` when none): what keeps the robot off the walls while it avoids an obstacle, and off an
-    obstacle it is passing once that is no longer ahead.
+    gap between the robot's side and the nearest thing hit on that side of the route: its
+    distance from the body's long axis (across the body beside it, from its front or rear
+    end past it) less half the body's width; walls among beams landing from ``wall_behind``
+    behind to ``wall_ahead`` ahead of the robot's centre along the route, objects only while
+    beside its body; all at least half its width across the route (``range`` when none): what
+    keeps the robot off the walls while it avoids an obstacle, and off an obstacle it is
+    passing once that is no longer ahead.
 
 :func:`truth` computes the same quantities from the true geometry (noise-free walls, exact
 obstacle outlines) for the trace.
@@ -146,14 +150,6 @@ def frames(routes: list[Route], p: np.ndarray, hints) -> list[Frame]:
         return [frame(routes[0], p[0], float(hints[0]))]
     return [Frame(s, e, t, np.array([t[1], -t[0]]))
             for s, e, t in projections(routes, p, hints)]
-
-
-def _beside(b: np.ndarray, across: np.ndarray, masks: list[np.ndarray]) -> np.ndarray:
-    """``[M, 2, R]``: for each of the ``masks [R, K]``, each row's least ``across`` (``|b|``)
-    among its points on the left (``b < 0``) and among those on the right (``b > 0``),
-    ``inf`` where none; all in one reduction (a minimum is exact: the bits of each alone)."""
-    inside = np.array(masks)[:, None] & np.array([b < 0, b > 0])      # [M, 2, R, K]
-    return np.minimum.reduce(np.where(inside, across, np.inf), axis=-1)
 
 
 def _or(least: np.ndarray, none: float, less: float | np.ndarray = 0.0) -> np.ndarray:
@@ -386,31 +382,35 @@ def _previous(k: int) -> np.ndarray:
     return out
 
 
-def _walls(a, b, valid, robot: Robot, cfg: Settings, far: float,
-           objects=None) -> tuple[float, float]:
-    """Side gaps from points (a along, b across): walls count from ``wall_behind`` behind to
-    ``wall_ahead`` ahead, objects (``objects`` mask) only while beside the robot's body."""
-    left, right = _walls_rows(a[None], b[None], valid[None], _bodies((robot,), cfg), cfg, far,
-                              None if objects is None else objects[None])
-    return float(left[0]), float(right[0])
+def _sides(a, b, ah, bh, valid, walls, body: dict[str, np.ndarray], cfg: Settings, far: float,
+           objects=None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``road``, ``gap_left`` and ``gap_right`` of every row of points ``[R, K]``, given in the
+    route's frame (``a``, ``b``) and in the robot's own (``ah``, ``bh``; ``body``: the
+    robots' :func:`_bodies`); ``walls``: the points the road is measured to, ``objects``:
+    those that count for the side gaps only while beside the body.
 
-
-def _walls_rows(a, b, valid, body: dict[str, np.ndarray], cfg: Settings, far: float,
-                objects=None) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`_walls` of every row of points ``[R, K]`` (``body``: the robots'
-    :func:`_bodies`)."""
-    across = np.abs(b)
-    left, right = _beside(b, across, [_walls_near(a, across, valid, body, cfg, objects)])[0]
-    return _or(left, far, body["half"][:, 0]), _or(right, far, body["half"][:, 0])
-
-
-def _walls_near(a, across, valid, body: dict[str, np.ndarray], cfg: Settings,
-                objects=None) -> np.ndarray:
-    """Which points ``[R, K]`` (``a`` along the route, ``across`` its distance from it)
-    :func:`_walls` measures the side gaps to."""
+    The route's frame says which side a point is on and whether it is near enough (as
+    before); how far it is does not lean with the route, which on a short leg across a
+    corridor (to a goal off its middle, or a replanned one) lies 45 deg off the walls: the
+    road is the distance from the robot's centre to the nearest wall point on its left plus
+    that on its right (the nearest point of a straight wall is its foot, whatever the
+    direction), and a side gap the distance from the body's long axis (a segment half its
+    length each way from the centre) less half its width: across the body beside it, from
+    its front or rear end past it. A robot parallel to walls parallel to its route gets the
+    distances across the route, as before."""
+    over = np.abs(ah) - body["length"]
+    side = np.abs(bh)
+    axis = np.where(over > 0, np.hypot(over, side), side)      # from the body's long axis
+    centre = np.hypot(ah, bh)
     ahead = cfg.wall_ahead if objects is None else np.where(objects, body["length"],
                                                             cfg.wall_ahead)
-    return valid & (a >= -cfg.wall_behind) & (a <= ahead) & (across >= body["half"])
+    near = valid & (a >= -cfg.wall_behind) & (a <= ahead) & (np.abs(b) >= body["half"])
+    sides = np.array([b < 0, b > 0])
+    road = np.minimum.reduce(np.where(sides & (walls & (np.abs(a) <= cfg.window)), centre,
+                                      np.inf), axis=-1)
+    gaps = np.minimum.reduce(np.where(sides & near, axis, np.inf), axis=-1)
+    return (_or(road[0], far) + _or(road[1], far), _or(gaps[0], far, body["half"][:, 0]),
+            _or(gaps[1], far, body["half"][:, 0]))
 
 
 def _common(route: Route, p, heading: float, f: Frame, road: float, robot: Robot,
@@ -711,15 +711,12 @@ def perceive_rows(rows: list[Sight], max_range: float,
     obstacle_hit = valid & (measured < _stack([r.expected for r in rows])
                             - _column([r.threshold for r in rows]))
     known = valid ^ obstacle_hit        # valid & ~obstacle_hit (which lies within valid)
-    across = np.abs(b)                  # the walls beside the road, and beside the robot
-    (left, right), walls = _beside(b, across, [
-        known & (np.abs(a) <= cfg.window),                      # the road's walls
-        _walls_near(a, across, valid, body, cfg, obstacle_hit)])             # the side gaps'
-    road = _or(left, max_range) + _or(right, max_range)
-    widen = measured * _column([r.spacing for r in rows]) / 2
-    obstructing = obstacle_hit | _in_way(rows, known & (a > 0), hits, cfg)
     headings = [r.pose[2] for r in rows]
     valid_ah, valid_bh = _own_frames(headings, rel, valid)
+    road, wl, wr = _sides(a, b, valid_ah, valid_bh, valid, known, body, cfg, max_range,
+                          obstacle_hit)
+    widen = measured * _column([r.spacing for r in rows]) / 2
+    obstructing = obstacle_hit | _in_way(rows, known & (a > 0), hits, cfg)
     if obstructing.any():
         ah, bh = _own_frames_all(headings, rel)
     else:                       # what does not obstruct is not asked where it lies
@@ -736,7 +733,6 @@ def perceive_rows(rows: list[Sight], max_range: float,
                            zip(rows, np.hypot(home[:, 0], home[:, 1]).tolist(),
                                road.tolist()))])
     heading = common[:, 0]
-    wl, wr = _or(walls, max_range, body["half"][:, 0])                    # (_walls_rows)
     front, opening = _free_ways(valid_ah, valid_bh, widen, obstacle_hit, body, cfg, heading)
     ring = np.array([len(r.dirs) > 2 and float(r.dirs[0] @ r.dirs[-1])
                      >= float(r.dirs[0] @ r.dirs[1]) - 1e-9 for r in rows])
@@ -861,15 +857,15 @@ def _pursuit_of(bearing: float, distance: float, cfg: Settings) -> float:
 
 
 def truth(route: Route, f: Frame, pose: tuple[float, float, float], robot: Robot,
-          side_ranges: tuple[float, float], outline: np.ndarray, gaps: tuple[float, float],
+          sides: tuple[float, float, float], outline: np.ndarray,
           cfg: Settings = Settings(), wall_points: np.ndarray | None = None,
           lookahead: float | None = None, room: float = math.inf) -> dict[str, float]:
-    """The same inputs from the true geometry: ``side_ranges`` are exact distances to the walls
-    across the route (left, right), ``outline`` points on every obstacle and other robot,
-    ``gaps`` the noise-free side gaps (:func:`side_gaps`), ``wall_points`` where the beams
-    meet the walls (noise-free) for ``front`` and ``opening``."""
+    """The same inputs from the true geometry: ``sides`` the noise-free road and side gaps
+    (:func:`true_sides`), ``outline`` points on every obstacle and other robot,
+    ``wall_points`` where the beams meet the walls (noise-free) for ``front`` and
+    ``opening``."""
     p = np.array(pose[:2])
-    road = side_ranges[0] + side_ranges[1]
+    road, gaps = sides[0], sides[1:]
     rel = outline - p
     a = rel @ f.t if len(outline) else np.zeros(0)
     b = rel @ f.n if len(outline) else np.zeros(0)
@@ -890,14 +886,18 @@ def truth(route: Route, f: Frame, pose: tuple[float, float, float], robot: Robot
             "nearest": nearest(ah, bh, robot, cfg)}
 
 
-def side_gaps(route_frame: Frame, p: np.ndarray, dirs: np.ndarray, expected: np.ndarray,
-              outline: np.ndarray, robot: Robot, max_range: float,
-              cfg: Settings = Settings()) -> tuple[float, float]:
-    """Noise-free side gaps (for :func:`truth`): walls from the map-predicted ranges, objects
-    from their exact outlines."""
-    rel = np.concatenate([expected[:, None] * dirs, outline - p])
-    valid = np.concatenate([expected < max_range * 0.999, np.ones(len(outline), dtype=bool)])
+def true_sides(f: Frame, pose: tuple[float, float, float], dirs: np.ndarray, expected: np.ndarray,
+               outline: np.ndarray, robot: Robot, max_range: float,
+               cfg: Settings = Settings()) -> tuple[float, float, float]:
+    """Noise-free ``road``, ``gap_left`` and ``gap_right`` (for :func:`truth`), as
+    :func:`perceive` measures them: walls from the map-predicted ranges, objects from their
+    exact outlines."""
+    rel = np.concatenate([expected[:, None] * dirs, outline - np.array(pose[:2])])
+    walls = np.concatenate([expected < max_range * 0.999, np.zeros(len(outline), dtype=bool)])
     objects = np.concatenate([np.zeros(len(expected), dtype=bool),
                               np.ones(len(outline), dtype=bool)])
-    return _walls(rel @ route_frame.t, rel @ route_frame.n, valid, robot, cfg, max_range,
-                  objects)
+    ah, bh = _own_frame(rel, pose[2])
+    road, left, right = _sides((rel @ f.t)[None], (rel @ f.n)[None], ah[None], bh[None],
+                               (walls | objects)[None], walls[None],
+                               _bodies((robot,), cfg), cfg, max_range, objects[None])
+    return float(road[0]), float(left[0]), float(right[0])

@@ -10,7 +10,9 @@ them away, as the paper's robot had none):
 - **the brake** (:func:`brake`): the robot goes no faster than it can stop, at its
   acceleration, within the free travel of the arc its wheel is set to, keeping ``margin`` from
   everything it knows is there (its map: what it was given and what it has sensed, which its
-  readings keep up to date). Where the arc is shut the robot stops.
+  readings keep up to date), counting the tick it drives on before the next command; it
+  looks along the arc as far as stopping from its top speed takes (:func:`reach_of`). Where
+  the arc is shut the robot stops.
 - **backing out** (:class:`Recovery`): held by the brake for ``patience`` seconds while its
   planner wants to go on, the robot backs out for ``back_time`` seconds on the opposite lock
   (which swings its nose toward the side its route lies on), as far as the way behind is
@@ -34,7 +36,8 @@ from .world import Robot
 @dataclass(frozen=True)
 class Settings:
     margin: float = 1.0            # in: the body keeps this from what the robot knows
-    reach: float = 30.0            # in: how far along its arc the brake looks
+    reach: float = 30.0            # in: the least the brake looks along its arc (a robot
+                                   # looks as far as stopping from its top speed takes)
     step: float = 1.0              # in: the sweep's step along the rear axle's path
     patience: float = 1.0          # s: held to a stop this long, the robot backs out
     back_time: float = 1.5         # s: how long one backing-out lasts
@@ -88,22 +91,23 @@ backing out: backward, a cell it touches blocks only the steps that take it deep
     return float(max(int(hit.argmax()) - 1, 0) * step)
 
 
-def free_travels(sweeps: list[tuple[Body, float, bool]], reach: float,
-                 step: float = 1.0) -> np.ndarray:
-    """:func:`free_travel` of many sweeps at once (``(body, wheel, backward)`` each; runs in
-    lockstep brake together), ``[R]``. What is one number per sweep is worked out as
-    :func:`free_travel` does, in Python floats; the rest elementwise over ``[R, K]`` steps and
+def free_travels(sweeps: list[tuple[Body, float, bool]], step: float = 1.0) -> np.ndarray:
+    """:func:`free_travel` of many sweeps at once (``(body, wheel, backward)`` each, as far as
+    its body's ``reach``; runs in lockstep brake together), ``[R]``. What is one number per
+    sweep is worked out as :func:`free_travel` does, in Python floats; the rest elementwise
+    over ``[R, K]`` steps (to the farthest reach, a sweep's own steps only counted) and
     ``[R, P, K]`` cells (padded far away), so a sweep gets the bits it gets alone."""
     if len(sweeps) == 1:                 # a robot alone: no batch to set up
         body, wheel, backward = sweeps[0]
         return np.array([free_travel(body.cells, body.radius, body.pose, body.robot,
-                                     wheel - body.robot.steering_straight, backward, reach,
+                                     wheel - body.robot.steering_straight, backward, body.reach,
                                      step)])
-    out = np.full(len(sweeps), float(reach))
+    out = np.array([body.reach for body, _, _ in sweeps], dtype=float)
     rows = [j for j, (body, _, _) in enumerate(sweeps) if len(body.cells)]
     if not rows:
         return out
     n = len(rows)
+    reach = max(float(out[j]) for j in rows)
     u = np.stack([_path(reach, step, sweeps[j][2]) for j in rows])            # [n, K]
     h, k, a, b, sin_h, cos_h, half, hl, hw, disc = (np.empty((n, 1)) for _ in range(10))
     for r, j in enumerate(rows):
@@ -150,9 +154,9 @@ def free_travels(sweeps: list[tuple[Body, float, bool]], reach: float,
     if back.any():      # backing: a cell touched at the start blocks only deeper steps
         inside[back] = np.where(inside[back][..., :1], depth[back] > depth[back][..., :1],
                                 inside[back])
-    hit = inside.any(axis=1)                                                # [n, K]
+    hit = inside.any(axis=1) & (np.abs(u) <= out[rows, None] + step / 2)   # [n, K], its own
     first = np.maximum(hit.argmax(axis=1) - 1, 0) * step
-    out[rows] = np.where(hit.any(axis=1), first, reach)
+    out[rows] = np.where(hit.any(axis=1), first, out[rows])
     return out
 
 
@@ -164,10 +168,20 @@ def _path(reach: float, step: float, backward: bool) -> np.ndarray:
     return out
 
 
-def brake(free: float, acceleration: float, margin: float) -> float:
+def brake(free: float, acceleration: float, margin: float, dt: float = 0.0) -> float:
     """The fastest (in/s) a robot may drive that can stop at ``acceleration`` within ``free``
-    inches less ``margin``."""
-    return math.sqrt(2.0 * acceleration * max(free - margin, 0.0))
+    inches less ``margin`` when it drives on at that speed for ``dt`` before it brakes (the
+    command it is given now is carried out for a tick: ``v dt + v^2 / 2a`` is the room)."""
+    lag = acceleration * dt
+    return math.sqrt(lag * lag + 2.0 * acceleration * max(free - margin, 0.0)) - lag
+
+
+def reach_of(robot: Robot, dt: float, cfg: Settings) -> float:
+    """How far along its arc a robot's brake looks (in): what stopping from its top speed
+    takes, a tick's drive and the margin included, a step over (so that nothing in sight
+    leaves its top speed free), and at least ``cfg.reach``."""
+    v, a = robot.max_speed, robot.acceleration
+    return max(cfg.reach, math.ceil(v * dt + v * v / (2.0 * a) + cfg.margin) + cfg.step)
 
 
 @dataclass
@@ -184,7 +198,8 @@ class Recovery:
 class Body:
     """What the guard needs of one robot at one tick: its pose (x, y in, heading rad), its
     wheel's angle now (deg), the cells it knows are occupied near it (``[P, 2]``, discs of
-    ``radius``) and the side its route lies on (``heading`` input: positive right)."""
+    ``radius``), the side its route lies on (``heading`` input: positive right) and how far
+    along its arc its brake looks (:func:`reach_of`)."""
 
     robot: Robot
     pose: tuple[float, float, float]
@@ -192,11 +207,12 @@ class Body:
     cells: np.ndarray
     radius: float
     route_side: float
+    reach: float = Settings.reach
 
     def free(self, wheel: float, backward: bool, cfg: Settings) -> float:
         """Free travel with the wheel at ``wheel`` (deg, 90 straight), forward or backward."""
         return free_travel(self.cells, self.radius, self.pose, self.robot,
-                           wheel - self.robot.steering_straight, backward, cfg.reach, cfg.step)
+                           wheel - self.robot.steering_straight, backward, self.reach, cfg.step)
 
 
 def guard(command: tuple[float, float], body: Body, rec: Recovery, dt: float,
@@ -221,11 +237,11 @@ def guard(command: tuple[float, float], body: Body, rec: Recovery, dt: float,
         back = free(rec.wheel, True)
         if back > cfg.margin:
             return (rec.wheel, -min(robot.max_reverse,
-                                    brake(back, robot.acceleration, cfg.margin))), False
+                                    brake(back, robot.acceleration, cfg.margin, dt))), False
         rec.left = 0.0
     steer, want = command
     wheel = _wheel(steer, body, dt)
-    limit = brake(free(wheel, want < 0), robot.acceleration, cfg.margin)
+    limit = brake(free(wheel, want < 0), robot.acceleration, cfg.margin, dt)
     speed = math.copysign(limit, want) if abs(want) > limit else want
     rec.held = rec.held + dt if abs(want) > cfg.want and limit < cfg.want else 0.0
     if rec.held < cfg.patience or robot.max_reverse <= 0:
