@@ -205,6 +205,20 @@ def test_route_min_clearance_allows_the_squeeze(tmp_path):
     assert occupied_distance(pts, door_map(20)) >= 8.0 - 1e-9
 
 
+@pytest.mark.parametrize("noise", [0.0, 0.5])
+def test_the_walls_of_a_squeeze_the_world_allows_are_not_an_obstacle(noise):
+    """A 21 in corridor with `route: {min_clearance: 10.5}` (what the refusal suggests): both
+    walls stand within half the width and the margin of the route, and read as one obstacle
+    at CENTER; `avoid_obstacle` steered away from the one it saw first and collided after
+    3.8 in. The route chose the squeeze: its walls obstruct only nearer than it keeps."""
+    text = world_text("map:\n  corridors:\n    - points: [[0, 0], [400, 0]]\n      width: 21\n",
+                      "route: {min_clearance: 10.5}\n", limit=60)
+    world = parse_world(text.replace("noise: 0}", f"noise: {noise}}}"), "w.yaml")
+    res = simulate(world)
+    assert res.outcome == "success" and res.clearance.min() > 1.0
+    assert (res.perceived["obstacle"] == 200).all() and (res.perceived["size"] == 0).all()
+
+
 @settings(max_examples=25, deadline=None)
 @hgiven(st.integers(1, 12), st.integers(1, 12), st.integers(0, 2 ** 32 - 1),
         st.floats(0.0, 0.5))

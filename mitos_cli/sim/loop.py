@@ -752,10 +752,13 @@ class Simulation:
         for i, aim in enumerate(aims):
             least = self._asked[i][1]
             room = max(0.0, gaps[i] - aim.radius - least)     # (perception.route_room)
+            robot = self.robots[i]
+            squeeze = (least if least < robot.width / 2 + robot.safety_margin else math.inf)
             out.append(perception.Sight(
                 aim.route, aim.f, (float(self._x[i]), float(self._y[i]), float(self._h[i])),
-                self.robots[i], self._dirs[i], s.ranges[i], self._expected[i], self._spacing,
-                self._threshold, float(ahead[i]), room, self._kept(i, s, least), targets[i]))
+                robot, self._dirs[i], s.ranges[i], self._expected[i], self._spacing,
+                self._threshold, float(ahead[i]), room, self._kept(i, s, least), targets[i],
+                squeeze))
         return out
 
     def perceived(self, s: _Sensed, sights: list[perception.Sight],

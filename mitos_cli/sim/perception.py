@@ -8,9 +8,9 @@ an obstacle: an unknown box, an unknown wall, a corridor blocked by furniture. E
 has hit something drawn on its map (a wall, a door jamb, a pillar, a known obstacle), which the
 route already keeps its clearance from: it counts as a wall (``road``, ``gap_left``,
 ``gap_right``), unless it stands within half the robot's width plus its safety margin of the
-route ahead (where the route squeezes by under ``route: {min_clearance}``, or runs through
-what a robot with no map has only now mapped): there it is in the robot's way and obstructs
-like an obstacle.
+route ahead (where the route runs through what a robot with no map has only now mapped;
+where it squeezes by under ``route: {min_clearance}``, nearer than the squeeze keeps): there
+it is in the robot's way and obstructs like an obstacle.
 
 Inputs (all floats, units in the names of ``mitos.terms.yaml`` / ``drive.terms.yaml``):
 
@@ -656,19 +656,23 @@ def perceive(route: Route, f: Frame, pose: tuple[float, float, float], robot: Ro
              spacing: float, threshold: float, cfg: Settings = Settings(),
              lookahead: float | None = None, room: float = math.inf,
              kept: tuple[float, np.ndarray] | None = None,
-             target: np.ndarray | None = None) -> dict[str, float]:
+             target: np.ndarray | None = None, squeeze: float = math.inf) -> dict[str, float]:
     """The inputs from one robot's readings (see the module docstring); ``lookahead``: of
     ``heading`` (:func:`clear_lookahead`; default ``cfg.lookahead``); ``room``: how far the
     keep-right lane may lie off the route (:func:`route_room`); ``kept``: where the route is
     replanned round what the robot senses, the least clearance it keeps and which readings
     hit what it was planned round (``[B]``): those obstruct only within that clearance of
     the route, not anywhere in the band ahead; ``target``: the route point ``lookahead``
-    ahead (:func:`target_point`), when the caller has it. (:func:`perceive_rows` of one.)"""
+    ahead (:func:`target_point`), when the caller has it; ``squeeze``: where the world lets
+    the route pass closer to what is drawn than half the robot's width and its margin
+    (``route: {min_clearance}``), the least clearance the route keeps: what is drawn obstructs
+    only nearer the route than that, by the news ``threshold`` (the walls of the squeeze the
+    route chose are not an obstacle in its middle). (:func:`perceive_rows` of one.)"""
     ahead = cfg.lookahead if lookahead is None else lookahead
     if target is None:
         target = target_point(route, f, cfg, ahead)
     sight = Sight(route, f, (float(pose[0]), float(pose[1]), float(pose[2])), robot, dirs,
-                  measured, expected, spacing, threshold, ahead, room, kept, target)
+                  measured, expected, spacing, threshold, ahead, room, kept, target, squeeze)
     out = perceive_rows([sight], max_range, cfg)
     return {key: float(value[0]) for key, value in out.items()}
 
@@ -690,6 +694,7 @@ class Sight:
     room: float                    # how far the lane may lie off the route (:func:`route_room`)
     kept: tuple[float, np.ndarray] | None   # see :func:`perceive`
     target: np.ndarray             # [2] the route point ``lookahead`` ahead
+    squeeze: float = math.inf      # see :func:`perceive`
 
 
 def perceive_rows(rows: list[Sight], max_range: float,
@@ -748,8 +753,9 @@ def perceive_rows(rows: list[Sight], max_range: float,
 def _in_way(rows: list[Sight], ahead: np.ndarray, hits: np.ndarray, cfg: Settings) -> np.ndarray:
     """Which of the points ``hits [R, B, 2]`` ahead of their robots (``ahead``) and drawn on
     its map stand where its route would hit them: within half its width plus its safety
-    margin of the route within ``sight``. Only the points some row asks about are measured
-    (a point's distance from a route is its own arithmetic, whatever else is measured)."""
+    margin of the route within ``sight`` (in a squeeze, nearer than the route keeps: see
+    :func:`perceive`). Only the points some row asks about are measured (a point's distance
+    from a route is its own arithmetic, whatever else is measured)."""
     cols = ahead.any(axis=0).nonzero()[0]
     if not len(cols):
         return ahead
@@ -757,7 +763,8 @@ def _in_way(rows: list[Sight], ahead: np.ndarray, hits: np.ndarray, cfg: Setting
     asked = [rows[i] for i in some]
     at = np.s_[:, cols] if len(asked) == len(rows) else np.ix_(some, cols)
     gone = distances([r.route for r in asked], [r.f.s for r in asked], cfg.sight, hits[at])
-    ahead[at] &= gone <= _column([r.robot.width / 2 + r.robot.safety_margin for r in asked])
+    ahead[at] &= gone <= _column([min(r.robot.width / 2 + r.robot.safety_margin,
+                                      r.squeeze - r.threshold) for r in asked])
     return ahead
 
 
