@@ -343,7 +343,7 @@ def _raw_and_commanded(world: Path, tmp_path: Path) -> tuple[np.ndarray, np.ndar
 
 def test_cmd_speed_is_the_command_after_the_brake(tmp_path):
     """A new user's third review: the docs called `cmd_speed` "the speed the planner asked
-    for", but the robot's own brake caps it (28.28 = sqrt(2 x 40 x 10) where the rules asked
+    for", but the robot's own brake caps it (24.9 in/s with 10 in free, a tick counted, where the rules asked
     33). As worlds/README.md now says: the brake only ever lowers it, and without the brake
     it is the rules' own request (to the CSV's rounding)."""
     from mitos_cli.sim.worldfile import resolve_world_path
