@@ -184,3 +184,13 @@ def test_a_robot_driven_straight_at_a_wall_stops_short_of_it(tmp_path, speed):
     res = sim.result()
     assert res.outcome != "collision" and res.clearance.min() > 0.0
     assert res.clearance.min() < 4.0, res.clearance.min()      # and it came near it
+
+
+def test_the_brake_looks_as_far_as_stopping_takes_within_what_the_robot_sees():
+    cfg = safety.Settings()
+    assert safety.reach_of(Robot(), 0.05, cfg, 150.0) == 50.0      # 3 + 45 + 1 in, a step over
+    assert safety.reach_of(Robot(max_speed=10.0), 0.05, cfg, 150.0) == cfg.reach
+    slow = Robot(max_speed=200.0, acceleration=1.0)                # 20,000 in to stop
+    assert safety.reach_of(slow, 0.05, cfg, 150.0) == 150.0
+    # so it goes no faster than it can stop within its sensors' range
+    assert safety.brake(150.0, 1.0, cfg.margin, 0.05) < 18.0

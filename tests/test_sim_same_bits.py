@@ -505,7 +505,7 @@ def test_brake_sweeps_measured_together_are_each_measured_as_alone():
                     float(rng.uniform(-4, 4)))
             cells = rng.uniform(-70, 70, (int(rng.choice([0, 3, 40, 300])), 2))
             wheel = float(rng.choice([robot.steering_straight, rng.uniform(30, 150)]))
-            reach = float(rng.choice([30.0, 49.0]))      # robots' own reaches in one batch
+            reach = float(rng.choice([29.5, 30.0, 30.5, 50.0]))   # own reaches, one batch
             body = safety.Body(robot, pose, 90.0, cells, 1.0, 0.0, reach)
             sweeps.append((body, wheel, bool(rng.random() < 0.3)))
         got = safety.free_travels(sweeps)
@@ -696,10 +696,12 @@ def test_road_and_side_gaps_of_rows_are_the_plain_minima():
         near = valid & (a >= -cfg.wall_behind) & (a <= ahead) & (np.abs(b) >= half)
         over = np.abs(ah) - length
         axis = np.where(over > 0, np.hypot(over, np.abs(bh)), np.abs(bh))
-        assert same(left, np.where((near & (b < 0)).any(axis=1),
-                                   least(near & (b < 0), axis, 0.0) - half[:, 0], 200.0))
-        assert same(right, np.where((near & (b > 0)).any(axis=1),
-                                    least(near & (b > 0), axis, 0.0) - half[:, 0], 200.0))
+        assert same(left, np.maximum(np.where((near & (b < 0)).any(axis=1),
+                                              least(near & (b < 0), axis, 0.0) - half[:, 0],
+                                              200.0), 0.0))
+        assert same(right, np.maximum(np.where((near & (b > 0)).any(axis=1),
+                                               least(near & (b > 0), axis, 0.0) - half[:, 0],
+                                               200.0), 0.0))
 
 
 def test_chords_cleared_from_the_squares_are_those_hypot_clears():

@@ -375,7 +375,8 @@ class Simulation:
         self._asked = [clearances(world, a) for a in world.agents]
         self._body = [math.hypot(r.length, r.width) for r in self.robots]   # in: a diagonal
         self._safety = safety.Settings()
-        self._brake_reach = [safety.reach_of(r, self.dt, self._safety) for r in self.robots]
+        self._brake_reach = [safety.reach_of(r, self.dt, self._safety, sen.range)
+                             for r in self.robots]
         self._still = None
         self._still_discs = None        # discs round the still rectangles (rows.SenseRow)
         if not any(o.motion.kind in ("velocity", "waypoints") for o in world.obstacles):

@@ -76,7 +76,8 @@ Inputs (all floats, units in the names of ``mitos.terms.yaml`` / ``drive.terms.y
     distance from the body's long axis (across the body beside it, from its front or rear
     end past it) less half the body's width; walls among beams landing from ``wall_behind``
     behind to ``wall_ahead`` ahead of the robot's centre along the route, objects only while
-    beside its body; all at least half its width across the route (``range`` when none): what
+    beside its body; all at least half its width across the route (``range`` when none; at
+    least 0: a point by the nose of a robot turned across its route): what
     keeps the robot off the walls while it avoids an obstacle, and off an obstacle it is
     passing once that is no longer ahead.
 
@@ -395,9 +396,10 @@ def _sides(a, b, ah, bh, valid, walls, body: dict[str, np.ndarray], cfg: Setting
     road is the distance from the robot's centre to the nearest wall point on its left plus
     that on its right (the nearest point of a straight wall is its foot, whatever the
     direction), and a side gap the distance from the body's long axis (a segment half its
-    length each way from the centre) less half its width: across the body beside it, from
-    its front or rear end past it. A robot parallel to walls parallel to its route gets the
-    distances across the route, as before."""
+    length each way from the centre) less half its width, at least 0 (a point by the nose of
+    a robot turned across its route): across the body beside it, from its front or rear end
+    past it. A robot parallel to walls parallel to its route gets the distances across the
+    route, as before."""
     over = np.abs(ah) - body["length"]
     side = np.abs(bh)
     axis = np.where(over > 0, np.hypot(over, side), side)      # from the body's long axis
@@ -409,8 +411,9 @@ def _sides(a, b, ah, bh, valid, walls, body: dict[str, np.ndarray], cfg: Setting
     road = np.minimum.reduce(np.where(sides & (walls & (np.abs(a) <= cfg.window)), centre,
                                       np.inf), axis=-1)
     gaps = np.minimum.reduce(np.where(sides & near, axis, np.inf), axis=-1)
-    return (_or(road[0], far) + _or(road[1], far), _or(gaps[0], far, body["half"][:, 0]),
-            _or(gaps[1], far, body["half"][:, 0]))
+    half = body["half"][:, 0]
+    return (_or(road[0], far) + _or(road[1], far), np.maximum(_or(gaps[0], far, half), 0.0),
+            np.maximum(_or(gaps[1], far, half), 0.0))
 
 
 def _common(route: Route, p, heading: float, f: Frame, road: float, robot: Robot,
@@ -666,8 +669,9 @@ def perceive(route: Route, f: Frame, pose: tuple[float, float, float], robot: Ro
     ahead (:func:`target_point`), when the caller has it; ``squeeze``: where the world lets
     the route pass closer to what is drawn than half the robot's width and its margin
     (``route: {min_clearance}``), the least clearance the route keeps: what is drawn obstructs
-    only nearer the route than that, by the news ``threshold`` (the walls of the squeeze the
-    route chose are not an obstacle in its middle). (:func:`perceive_rows` of one.)"""
+    only nearer the route than that, by the news ``threshold`` (and at least half as near:
+    a squeeze of a few inches still has a middle), so the walls of the squeeze the route chose
+    are not an obstacle in its middle. (:func:`perceive_rows` of one.)"""
     ahead = cfg.lookahead if lookahead is None else lookahead
     if target is None:
         target = target_point(route, f, cfg, ahead)
@@ -764,7 +768,8 @@ def _in_way(rows: list[Sight], ahead: np.ndarray, hits: np.ndarray, cfg: Setting
     at = np.s_[:, cols] if len(asked) == len(rows) else np.ix_(some, cols)
     gone = distances([r.route for r in asked], [r.f.s for r in asked], cfg.sight, hits[at])
     ahead[at] &= gone <= _column([min(r.robot.width / 2 + r.robot.safety_margin,
-                                      r.squeeze - r.threshold) for r in asked])
+                                      max(r.squeeze - r.threshold, r.squeeze / 2))
+                                  for r in asked])
     return ahead
 
 

@@ -154,7 +154,7 @@ def free_travels(sweeps: list[tuple[Body, float, bool]], step: float = 1.0) -> n
     if back.any():      # backing: a cell touched at the start blocks only deeper steps
         inside[back] = np.where(inside[back][..., :1], depth[back] > depth[back][..., :1],
                                 inside[back])
-    hit = inside.any(axis=1) & (np.abs(u) <= out[rows, None] + step / 2)   # [n, K], its own
+    hit = inside.any(axis=1) & (np.abs(u) < out[rows, None] + step / 2)    # [n, K], its own
     first = np.maximum(hit.argmax(axis=1) - 1, 0) * step
     out[rows] = np.where(hit.any(axis=1), first, out[rows])
     return out
@@ -176,12 +176,15 @@ def brake(free: float, acceleration: float, margin: float, dt: float = 0.0) -> f
     return math.sqrt(lag * lag + 2.0 * acceleration * max(free - margin, 0.0)) - lag
 
 
-def reach_of(robot: Robot, dt: float, cfg: Settings) -> float:
+def reach_of(robot: Robot, dt: float, cfg: Settings, sight: float) -> float:
     """How far along its arc a robot's brake looks (in): what stopping from its top speed
     takes, a tick's drive and the margin included, a step over (so that nothing in sight
-    leaves its top speed free), and at least ``cfg.reach``."""
+    leaves its top speed free), at least ``cfg.reach`` and at most ``sight``, its sensors'
+    range: a robot that needs longer to stop goes no faster than it can stop within what it
+    can see (and a robot of 200 in/s braking at 1 in/s^2 does not sweep 20,000 in a tick)."""
     v, a = robot.max_speed, robot.acceleration
-    return max(cfg.reach, math.ceil(v * dt + v * v / (2.0 * a) + cfg.margin) + cfg.step)
+    need = math.ceil(v * dt + v * v / (2.0 * a) + cfg.margin) + cfg.step
+    return max(cfg.reach, min(need, math.ceil(sight)))
 
 
 @dataclass
