@@ -140,3 +140,41 @@ def test_a_fresh_planner_remembers_nothing_and_runs_replay(corridor_run):
     assert not planner._maps                                  # the run used a fresh copy
     again = simulate(world, planner)
     assert np.array_equal(first.pose, again.pose) and np.array_equal(first.pose, res.pose)
+
+
+def test_the_route_ahead_slows_it_before_a_sharp_bend():
+    """ROS's path_distance_bias: scored by how near each rollout ends to the route, a robot
+    30 in before a sharp left bend slows and turns in; scored only by progress toward the
+    route point pushed out to the horizon, it speeds up and overshoots (it circled a room
+    at 60 in/s in office02 #1 once the brake no longer capped it at 48)."""
+    robot, angles = Robot(), np.deg2rad(np.arange(36) * 10.0)
+    free = np.full((1, 36), 150.0)
+    path = np.concatenate([np.stack([np.arange(0, 31, 4.0), np.zeros(8)], 1),
+                           np.stack([np.full(20, 30.0), np.arange(4, 81, 4.0)], 1)])[None]
+    target = np.array([[30.0, 10.0]]) * (102 / math.hypot(30, 10))
+    args = (DWAParams(), target, np.array([30.0]), np.array([90.0]), free, angles, 150.0,
+            robot, 0.05)
+    (blind_s,), (blind_v,) = dwa_command(*args)
+    (steer,), (speed,) = dwa_command(*args, path=path)
+    assert speed < 30.0 < blind_v and steer < blind_s < 90.0        # left is below 90
+
+
+def test_only_a_planner_that_asks_is_given_the_route_ahead():
+    from mitos_cli.sim.loop import Simulation
+
+    world = parse_world(CORRIDOR, "dwa-corridor.yaml")
+    seen = {}
+
+    class Spy:
+        name = "spy"
+        path_reach = 40.0
+
+        def plan(self, p):
+            seen["path"] = p.path
+            return np.full(len(p.pose), 90.0), np.zeros(len(p.pose))
+
+    Simulation(world, Spy(), 3).step()
+    assert seen["path"].shape == (1, 11, 2)                   # 0, 4, ..., 40 in ahead
+    steps = np.hypot(*np.diff(seen["path"][0], axis=0).T)
+    assert np.allclose(seen["path"][0, 0], [30.0, -10.0]) and (steps <= 4.0 + 1e-9).all()
+    Simulation(world, None, 3).step()                          # the rules: no path made

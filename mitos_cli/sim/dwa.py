@@ -23,12 +23,16 @@ for every robot at once:
    when the robot is already closer, any closer than it is) is discarded, and so is one whose
    speed cannot be braked to a stop (at the acceleration limit) before the first pose that
    would be that close (Fox et al.'s admissible velocities).
-5. **Score.** ``heading_weight * heading + target_weight * progress + clearance_weight *
-   clearance + speed_weight * speed``: *heading* = how well the final heading points at the
-   route point ahead (1 aligned, 0 opposite), *progress* = how much closer the final pose is to
-   that point (pushed out along its bearing to the horizon's reach unless it is the goal),
-   *speed* = the sample's speed, these three scaled to [0, 1] over the admissible samples as
-   Fox et al. normalise; *clearance* = the smallest clearance along the trajectory over
+5. **Score.** ``heading_weight * heading + target_weight * progress + path_weight * path +
+   clearance_weight * clearance + speed_weight * speed``: *heading* = how well the final
+   heading points at the route point ahead (1 aligned, 0 opposite), *progress* = how much
+   closer the final pose is to that point (pushed out along its bearing to the horizon's
+   reach unless it is the goal), *path* = how near the final pose ends to the route (the
+   negated distance to the nearest of the route's points ahead: ROS's ``path_distance_bias``,
+   which keeps a fast robot from overshooting a sharp bend of the route, weighted against
+   progress as ROS's defaults weigh it against ``goal_distance_bias``, 32 to 24), *speed* =
+   the sample's speed, these four scaled to [0, 1] over the admissible samples as Fox et al.
+   normalise; *clearance* = the smallest clearance along the trajectory over
    ``clearance_cap_in`` (saturated at 1), absolute, so that a little more room where all is
    tight does not weigh as much as a wall ahead. The best sample is commanded.
 6. **No admissible trajectory:** brake as hard as allowed and turn the wheel toward the
@@ -68,6 +72,7 @@ class DWAParams:
     steering_samples: int = 15      # wheel angles across the window (vth_samples)
     heading_weight: float = 0.8     # aim of the final heading at the route point ahead
     target_weight: float = 1.0      # progress toward the route point ahead (goal_distance_bias)
+    path_weight: float = 32.0 / 24.0  # nearness of the final pose to the route (path_distance_bias)
     clearance_weight: float = 1.0   # smallest clearance along the trajectory (occdist_scale)
     speed_weight: float = 0.4       # prefer going fast
     clearance_cap_in: float = 24.0  # in: more clearance than this scores no better
@@ -175,17 +180,19 @@ def _scaled(x: np.ndarray, ok: np.ndarray) -> np.ndarray:
 def dwa_command(params: DWAParams, target: np.ndarray, speed: np.ndarray,
                 steering: np.ndarray, ranges: np.ndarray, angles: np.ndarray,
                 max_range: float, robot, dt: float,
-                memory: list[np.ndarray] | None = None) -> tuple[np.ndarray, np.ndarray]:
+                memory: list[np.ndarray] | None = None,
+                path: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Commanded (wheel angle [n] deg, speed [n] in/s) for ``n`` robots at once.
 
     ``target [n, 2]`` the route point ahead in the robot frame (in, x ahead, y left);
     ``speed``/``steering [n]`` the current ones; ``ranges [n, B]`` the readings at beam
     ``angles [B]`` (rad, CCW); ``robot`` the footprint and limits; ``dt`` the control period;
     ``memory``: each robot's remembered points in its frame (:class:`Costmap`), which then
-    stand for the echoes nearer than ``mark_range_in``.
+    stand for the echoes nearer than ``mark_range_in``; ``path [n, K, 2]``: the route's points
+    ahead in each robot's frame (scored by how near each rollout ends to them), or None.
     """
     out_s, out_v, _ = _command(params, target, speed, steering, ranges, angles, max_range,
-                               robot, dt, memory)
+                               robot, dt, memory, path)
     return out_s, out_v
 
 
@@ -208,8 +215,10 @@ def _obstacles(params: DWAParams, ranges: np.ndarray, angles: np.ndarray, max_ra
 
 def _command(params: DWAParams, target: np.ndarray, speed: np.ndarray, steering: np.ndarray,
              ranges: np.ndarray, angles: np.ndarray, max_range: float, robot, dt: float,
-             memory: list[np.ndarray] | None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """:func:`dwa_command`, and which robots had no admissible trajectory."""
+             memory: list[np.ndarray] | None,
+             path: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`dwa_command`, and which robots had no admissible trajectory (``path [n, K, 2]``:
+    the route's points ahead in each robot's frame, or None)."""
     p = params
     n = len(speed)
     full = np.ones(n)
@@ -251,6 +260,10 @@ def _command(params: DWAParams, target: np.ndarray, speed: np.ndarray, steering:
     room = np.minimum(clear.min(axis=2), p.clearance_cap_in) / p.clearance_cap_in
     score = (p.heading_weight * _scaled(heading, ok) + p.target_weight * _scaled(progress, ok)
              + p.clearance_weight * room + p.speed_weight * _scaled(v, ok))
+    if path is not None:                   # how near each final pose ends to the route
+        gap = poses[:, :, -1, None, :2] - path[:, None]                # [n, S, K, 2]
+        off = np.sqrt((gap * gap).sum(axis=-1)).min(axis=-1)           # [n, S]
+        score = score + p.path_weight * _scaled(-off, ok)
     score = np.where(ok, score, -np.inf)
     best = np.argmax(score, axis=1)
     rows = np.arange(n)
@@ -333,6 +346,12 @@ class DWAPlanner:
     def for_world(cls, world, params: DWAParams | None = None) -> DWAPlanner:
         return cls(world.agents[0].robot, world.sensors.range, world.dt, params)
 
+    @property
+    def path_reach(self) -> float:
+        """How far along its route ahead the planner is given points (``Percepts.path``):
+        as far as its fastest rollout drives."""
+        return self.robot.max_speed * self.params.horizon_s
+
     def fresh(self) -> DWAPlanner:
         """The same planner with nothing remembered (a run's start)."""
         return DWAPlanner(self.robot, self.sensor_range, self.dt, self.params)
@@ -380,9 +399,14 @@ class DWAPlanner:
         target = target * scale[:, None]
         steering = (np.full(n, self.robot.steering_straight) if p.steering is None
                     else np.asarray(p.steering, float))
+        path = getattr(p, "path", None)
+        if path is not None:                  # the route ahead, in each robot's frame
+            rel = np.asarray(path, float) - p.pose[:, None, :2]
+            path = np.stack([c[:, None] * rel[..., 0] + s[:, None] * rel[..., 1],
+                             -s[:, None] * rel[..., 0] + c[:, None] * rel[..., 1]], axis=-1)
         out_s, out_v, stuck = _command(
             self.params, target, np.asarray(p.speed, float), steering,
             np.asarray(p.ranges, float), np.asarray(p.beam_angles, float), self.sensor_range,
-            self.robot, self.dt, self._memory(p))
+            self.robot, self.dt, self._memory(p), path)
         self._recover(p, stuck)
         return out_s, out_v

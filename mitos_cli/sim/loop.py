@@ -39,6 +39,7 @@ STUCK_TIME = 6.0        # s
 STUCK_DISTANCE = 3.0    # in
 BEHIND = 30.0           # in: a replanned route that starts this near behind the robot costs more
 NEAR_SLACK = 24.0       # in: a robot's set of nearby walls is gathered again after this move
+PATH_STEP = 4.0         # in: the spacing of the route points a planner is given (Percepts.path)
 OUTCOMES = ("success", "collision", "timeout", "stuck")
 # a robot's own outcome may also be `stopped`: still driving when another robot's collision or
 # stuck ended the run (the run's outcome is then that collision or stuck)
@@ -841,7 +842,7 @@ class Simulation:
 
             sub = Percepts({key: rows(val) for key, val in s.inputs.items()}, rows(s.ranges),
                            self.angles, rows(s.pose), rows(self._v), rows(s.targets),
-                           rows(self._goals), rows(self._steer), idx)
+                           rows(self._goals), rows(self._steer), idx, self._path(idx))
             c_steer, c_speed = self.planner.plan(sub)
             try:
                 cmd[idx, 0], cmd[idx, 1] = c_steer, c_speed
@@ -851,6 +852,16 @@ class Simulation:
                                  f"{plural(len(idx), 'active robot')} (one each)") from None
             if not np.isfinite(cmd[idx]).all():
                 _finite(cmd[idx], f"the command of {self._planner_name} at {s.t:g} s")
+
+    def _path(self, idx: np.ndarray) -> np.ndarray | None:
+        """``Percepts.path`` of the robots ``idx``: their routes from where they are to the
+        planner's ``path_reach`` ahead, a point every ``PATH_STEP`` in (none when the planner
+        does not ask)."""
+        reach = getattr(self.planner, "path_reach", None)
+        if reach is None:
+            return None
+        ahead = np.arange(0.0, float(reach) + PATH_STEP / 2, PATH_STEP)
+        return np.stack([self._routes[i].points_at(self._s_hint[i] + ahead) for i in idx])
 
     @property
     def _planner_name(self) -> str:

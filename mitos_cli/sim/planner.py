@@ -48,6 +48,9 @@ class Percepts:
                                          # that search the commands reachable from it (DWA)
     robots: np.ndarray | None = None     # [n] which robot of the world each row is (rows
                                          # are the robots still driving)
+    path: np.ndarray | None = None       # [n, K, 2] points of each robot's route ahead, every
+                                         # few inches from where it is (in), for a planner
+                                         # whose ``path_reach`` asks for them (DWA)
 
 
 class Planner(Protocol):
