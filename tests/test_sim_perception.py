@@ -215,3 +215,23 @@ def test_keep_clear_steers_off_one_side_but_not_between_two_jambs():
     assert steering() == pytest.approx(90.0)
     assert steering(gap_left=2.0) > 100.0            # a wall close on the left: steer right
     assert steering(gap_left=2.0, gap_right=3.0) == pytest.approx(90.0)   # a door: straight on
+
+
+@pytest.mark.parametrize("squeeze, off, obstructs", [
+    (np.inf, 3.0, True),        # no squeeze: within half the width and the margin (11 in)
+    (10.5, 3.0, True),          # a squeeze of 10.5 in: nearer than 10.5 - 4
+    (10.5, 8.0, False),         # the squeeze's own walls
+    (3.5, 1.0, True),           # a squeeze of 3.5 in still has a middle: half of it
+    (3.5, 3.0, False),
+])
+def test_what_is_drawn_obstructs_in_a_squeeze_only_nearer_than_it_keeps(squeeze, off,
+                                                                          obstructs):
+    """One beam hits a point the map shows (a wall), 40 in ahead and ``off`` in left of the
+    route: an obstacle to the rules only where it stands in the robot's way."""
+    robot = Robot(length=24, width=18, safety_margin=2)
+    dirs = np.array([[40.0, off]]) / np.hypot(40.0, off)
+    reading = np.array([np.hypot(40.0, off)])
+    f = perception.frame(ROUTE, np.array([100.0, 0.0]), 100.0)
+    got = perception.perceive(ROUTE, f, (100.0, 0.0, 0.0), robot, dirs, reading, reading, 150.0,
+                              0.1, 4.0, squeeze=squeeze)
+    assert (got["obstacle"] < NO_OBSTACLE) == obstructs
