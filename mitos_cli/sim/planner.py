@@ -13,7 +13,8 @@ percepts and runs still replay bit for bit.
 
 :class:`FuzzyPlanner` evaluates a compiled behavior of a rule base on the fuzzy inputs, one batch
 for all robots. A baseline (a potential field, say) implements the same ``plan`` using
-``percepts.ranges`` / ``beam_angles`` / ``pose`` / ``target``:
+``percepts.ranges`` / ``beam_angles`` / ``pose`` / ``target``; a planner with a ``path_reach``
+(in) is also given ``percepts.path``, its route's points that far ahead (DWA scores by them):
 
 >>> class Straight:                                        # doctest: +SKIP
 ...     name = "straight"
@@ -48,9 +49,10 @@ class Percepts:
                                          # that search the commands reachable from it (DWA)
     robots: np.ndarray | None = None     # [n] which robot of the world each row is (rows
                                          # are the robots still driving)
-    path: np.ndarray | None = None       # [n, K, 2] points of each robot's route ahead, every
-                                         # few inches from where it is (in), for a planner
-                                         # whose ``path_reach`` asks for them (DWA)
+    path: np.ndarray | None = None       # [n, K, 2] points of each robot's route (world
+                                         # frame, in), every 4 in (loop.PATH_STEP) from where
+                                         # it is to the planner's ``path_reach`` ahead; None
+                                         # unless the planner has a ``path_reach`` (DWA)
 
 
 class Planner(Protocol):
