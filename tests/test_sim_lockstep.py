@@ -56,9 +56,10 @@ def test_runs_that_end_at_different_ticks_drop_out_and_the_rest_go_on():
         assert_same_run(a, b)
 
 
-def test_a_planner_other_than_the_fuzzy_one_plans_each_run_itself():
+@pytest.mark.parametrize("name", ["potential_field", "dwa"])   # dwa: with the route ahead
+def test_a_planner_other_than_the_fuzzy_one_plans_each_run_itself(name):
     world = dataclasses.replace(load_world(TINY), time_limit=1.0)
-    planner = make_planner("potential_field", world)
+    planner = make_planner(name, world)
     lock = Lockstep(world, planner, [1, 2], randomise=True)
     for seed, res in zip([1, 2], lock.results()):
         assert_same_run(simulate(world, planner, seed, randomise=True), res)
