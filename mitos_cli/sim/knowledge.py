@@ -35,6 +35,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from . import movers
 from . import obstacles as obs_mod
 from .geometry import CACHED, points_in_polygon, ray_circles, ray_segments
 from .route import Clearance, NarrowPassage, Prepared, Route, grid_route
@@ -182,6 +183,7 @@ class RobotMap:
     fresh: list = field(default_factory=list)      # marks since the last check, [k, 2] each
     checked_at: float = -math.inf  # s
     replans: int = 0
+    refuge: Goal | None = None     # where it waits for a mover to pass, while it waits
     planned: np.ndarray | None = None   # the cells the route was last planned on (None: given)
     marks: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
     # the cells it marked (none given), as row * cols + col, ascending (row-major order)
@@ -488,27 +490,124 @@ def way_past(rmap: RobotMap, route: Route, s: float, p: np.ndarray, ahead: float
 
 def replan(rmap: RobotMap, route: Route, s: float, p: np.ndarray, goal: Goal, t: float,
            clearance: float, minimum: float, sight: float, when: str = "clearance",
-           heading: float = 0.0, behind: float = 0.0) -> Route | None:
+           heading: float = 0.0, behind: float = 0.0,
+           moving: movers.Sweep | None = None) -> Route | None:
     """A new route from ``p`` when what the robot has newly sensed invalidates the route ahead
-    (``when``: see the module docstring), else ``None``."""
-    if when == "never" or not rmap.fresh or t - rmap.checked_at < REPLAN_EVERY:
+    (``when``: see the module docstring), else ``None``. ``moving``: where what moves toward it
+    will pass (:class:`.movers.Sweep`): the route keeps clear of that too (but for a way out
+    round the robot), and where that leaves no way to the goal it leads to a refuge out of
+    their way (:func:`refuge`) until one opens."""
+    if when == "never" or t - rmap.checked_at < REPLAN_EVERY:
         return None
-    fresh = np.concatenate(rmap.fresh)
+    sweep = None if moving is None else moving.cells
+    if not rmap.fresh and sweep is None and rmap.refuge is None:
+        return None
+    fresh = np.concatenate(rmap.fresh) if rmap.fresh else np.zeros((0, 2))
     rmap.fresh.clear()
     rmap.checked_at = t
     reach = minimum + rmap.grid.resolution / 2          # a mark is a cell, not its centre
-    if when == "clearance":
-        if not route.near(fresh, s, reach, sight).any():
+    crossing = sweep is not None and bool(route.near(_cell_centres(rmap.grid, sweep), s, reach,
+                                                     sight).any())
+    if rmap.refuge is None and not crossing:
+        if when == "clearance":
+            if not route.near(fresh, s, reach, sight).any():
+                return None
+        elif not route.near(fresh, s, clearance, sight).any() or \
+                way_past(rmap, route, s, p, sight, clearance, minimum):
             return None
-    elif not route.near(fresh, s, clearance, sight).any() or \
-            way_past(rmap, route, s, p, sight, clearance, minimum):
-        return None
-    try:
-        new = grid_route(_as_map(rmap.grid), Pose(float(p[0]), float(p[1]), heading), goal,
-                         clearance, minimum=minimum, occupied=rmap.occupied, explain=False,
-                         leave=clearance + 6.0, behind=behind, last=rmap.prepared)
-    except NarrowPassage:
-        return None                # no way left on what it knows: drive on, the rules decide
+    leave = clearance + 6.0
+    start = Pose(float(p[0]), float(p[1]), heading)
+
+    def toward(where: Goal, occupied: np.ndarray) -> Route | None:
+        try:
+            return grid_route(_as_map(rmap.grid), start, where, clearance, minimum=minimum,
+                              occupied=occupied, explain=False, leave=leave, behind=behind,
+                              last=rmap.prepared)
+        except NarrowPassage:
+            return None
+
+    if moving is None:
+        new = toward(goal, rmap.occupied)
+        if new is None:
+            return None            # no way left on what it knows: drive on, the rules decide
+        rmap.refuge = None
+    else:
+        occupied = rmap.occupied | _holed(rmap.grid, moving.cells, p,
+                                          max(leave, moving.wide + 6.0))
+        # a robot at a refuge waits there till nothing comes toward it; on its way it
+        # keeps right of what comes down its lane if it can
+        new = None
+        if rmap.refuge is None and moving.keep_right is not None:
+            new = toward(goal, occupied | _holed(rmap.grid, moving.keep_right, p,
+                                                 max(leave, moving.wide + 6.0)))
+        if rmap.refuge is None and new is None:
+            new = toward(goal, occupied)
+        if new is not None:
+            rmap.refuge = None
+        else:
+            new = refuge(rmap, rmap.occupied | moving.cells, occupied, start, clearance,
+                         minimum, sight, behind)
+            if new is None:
+                return None
+            rmap.refuge = Goal(float(new.goal[0]), float(new.goal[1]))
     rmap.replans += 1
     rmap.planned = rmap.occupied.copy()
     return new
+
+
+def _cell_centres(grid: Grid, cells: np.ndarray) -> np.ndarray:
+    """The centres ``[P, 2]`` of the set cells of ``cells`` (a boolean grid like ``grid``'s)."""
+    r, c = cells.nonzero()
+    return np.stack([grid.origin[0] + (c + 0.5) * grid.resolution,
+                     grid.origin[1] + (r + 0.5) * grid.resolution], axis=1)
+
+
+def _holed(grid: Grid, cells: np.ndarray, p: np.ndarray, radius: float) -> np.ndarray:
+    """``cells`` without those within ``radius`` of ``p``: a robot standing in a mover's way
+    must be able to plan its way out of it."""
+    near = movers.capsule_cells(cells.shape, grid.resolution, grid.origin, p, p, radius)
+    return cells & ~near
+
+
+REFUGE_TRIES = 8      # the nearest places out of the movers' way a refuge is sought at
+REFUGE_APART = 12.0   # in: the least distance between two places tried
+BEHIND_COST = 2.0     # an inch behind the robot counts as this many more on the way to a refuge
+
+
+def refuge(rmap: RobotMap, avoid: np.ndarray, occupied: np.ndarray, start: Pose,
+           clearance: float, minimum: float, sight: float, behind: float) -> Route | None:
+    """A route to the nearest place within ``sight`` that keeps ``clearance`` from the cells
+    ``avoid`` (what the robot knows and where movers will pass), planned on ``occupied``
+    (the same, less the movers' way round the robot); ``None`` when none is reached. The
+    place it held last (``rmap.refuge``) comes first while it is still out of their way: a
+    robot that changes its mind on the way to a refuge ends up in nobody's refuge."""
+    g = rmap.grid
+    p = np.array([start.x, start.y])
+    win = _window(g, avoid, p - sight, p + sight)
+    room = Clearance.of(win.occupied, win.resolution, win.origin,
+                        cap=clearance + 2 * win.resolution)
+    centres = _cell_centres(win, room.dist - win.resolution / 2 >= clearance)
+    # nearest first, a place behind the robot counted BEHIND_COST times farther: a robot
+    # that steers its front wheel reaches what lies ahead and beside it sooner
+    rel = centres - p
+    h = math.radians(start.heading)
+    back = np.maximum(-(rel[:, 0] * math.cos(h) + rel[:, 1] * math.sin(h)), 0.0)
+    places = list(centres[np.argsort(np.hypot(*rel.T) + BEHIND_COST * back, kind="stable")])
+    if rmap.refuge is not None:
+        held = np.array([rmap.refuge.x, rmap.refuge.y])
+        if room.at(held[None])[0] >= clearance:
+            places.insert(0, held)
+    tried: list[np.ndarray] = []
+    for c in places:
+        if len(tried) >= REFUGE_TRIES:
+            break
+        if any(math.dist(c, q) < REFUGE_APART for q in tried):
+            continue
+        tried.append(c)
+        try:
+            return grid_route(_as_map(g), start, Goal(float(c[0]), float(c[1])), clearance,
+                              minimum=minimum, occupied=occupied, explain=False,
+                              leave=clearance + 6.0, behind=behind, last=rmap.prepared)
+        except NarrowPassage:
+            continue
+    return None

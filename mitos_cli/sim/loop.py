@@ -26,7 +26,7 @@ import numpy as np
 
 from ..errors import CommandError, InputError, WorldError
 from ..words import plural
-from . import geometry, kinematics, knowledge, perception, rows, safety, sensors
+from . import geometry, kinematics, knowledge, movers, perception, rows, safety, sensors
 from . import obstacles as obs_mod
 from .geometry import polygon_segments, rect_corners
 from .planner import Percepts, Planner
@@ -402,6 +402,10 @@ class Simulation:
         grid = self.scene.plan_grid or knowledge.plan_grid(self._given, self.scene.static,
                                                            self.world)
         self._maps = [knowledge.RobotMap.of(grid) for _ in range(n)]
+        self._trackers = [movers.Tracker() for _ in range(n)]
+        self._free = [movers.FreeSpace.like(m.occupied, grid.resolution, grid.origin)
+                      for m in self._maps]
+        self._seen = [np.zeros(len(self.angles), dtype=bool) for _ in range(n)]
         self._odometer: list[np.ndarray] = []      # in each robot has driven, after each move
         self._recovery = [safety.Recovery() for _ in range(n)]
         self._backed: list[tuple[int, int]] = []
@@ -723,11 +727,13 @@ class Simulation:
         for i in range(self.n):
             f = frames[i]
             rmap = self._maps[i]
-            if self._learn(i, s) and self._active[i]:
+            learned = self._learn(i, s)
+            sweep = self._sweep(i, s)
+            if (learned or sweep is not None or rmap.refuge is not None) and self._active[i]:
                 route = knowledge.replan(rmap, routes[i], f.s, s.pose[i, :2],
                                          self.world.agents[i].goal, s.t, *self._asked[i],
                                          self._cfg.sight, self.world.replan,
-                                         math.degrees(self._h[i]), BEHIND)
+                                         math.degrees(self._h[i]), BEHIND, sweep)
                 if route is not None:
                     routes[i] = route
                     self._replanned.append((self._k, i, route))
@@ -812,11 +818,40 @@ class Simulation:
         valid = measured < max_range * 0.999
         seen = (valid if self._given.knows == "none"
                 else valid & (measured < self._expected[i] - self._threshold))
+        self._seen[i] = seen
         if not np.count_nonzero(seen):               # (a count is cheaper than .any())
             return False
         before = len(rmap.fresh)
         rmap.mark_cells(self._beyond(i, s)[seen])    # = rmap.mark(hits[seen], dirs[seen])
         return len(rmap.fresh) > before
+
+    def _sweep(self, i: int, s: _Sensed) -> movers.Sweep | None:
+        """Robot ``i``'s tracks of what its readings show and its map does not, brought up
+        to tick ``s`` (:mod:`.movers`), and where the movers among them will pass while it
+        gets out of their way (``None`` when nothing comes toward it)."""
+        if self.world.replan == "never":
+            return None
+        seen, p, dirs = self._seen[i], s.pose[i, :2], self._dirs[i]
+        rmap, free, tracker = self._maps[i], self._free[i], self._trackers[i]
+        hits = p + s.ranges[i, :, None] * dirs
+        runs = movers.objects(hits, seen, self.world.sensors.layout == "ring")
+        entered = free.entered(s.t, hits, dirs)
+        free.update(s.t, p, dirs, s.ranges[i])
+        tracker.update(s.t, [hits[r] for r in runs],
+                       [2 * np.count_nonzero(entered[r]) >= len(r) for r in runs])
+        h = float(self._h[i])
+        # (a robot on its way to a refuge draws away from what it yields to; it waits for
+        # it all the same)
+        own = (np.zeros(2) if rmap.refuge is not None
+               else self._v[i] * np.array([math.cos(h), math.sin(h)]))
+        found = tracker.movers(s.t, p, own)
+        if not found:
+            return None
+        robot, grid = self.robots[i], rmap.grid
+        asked, least = self._asked[i]
+        room = asked - least
+        return movers.sweep(found, p, h, robot.length, robot.width, rmap.occupied.shape,
+                            grid.resolution, grid.origin, room, self.world.sensors.range)
 
     def check(self, s: _Sensed) -> None:
         """Contact (clearance <= 0) and arrival; an arrived robot stops driving."""

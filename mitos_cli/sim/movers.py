@@ -1,0 +1,371 @@
+"""What moves, as the robot's own readings show it, and where it is going.
+
+The robot is told nothing of what moves. Each tick, the readings its map does not explain (the
+news perception marks) are cut into objects along the ring of beams: neighbouring beams whose
+echoes lie within ``LINK`` of each other are one object (:func:`objects`), as a laser scan is
+segmented. A :class:`Tracker` matches each object to the track it kept from the ticks before
+(the nearest predicted place within ``GATE``) and fits its velocity to the centres it was
+seen at over the last ``WINDOW`` seconds (a Theil-Sen slope: the echoes of a cart hop from
+one end of it to the other, and a median does not follow them).
+
+A track is a *mover* (:meth:`Tracker.movers`) when most of its recent echoes came from space
+a beam had passed through a moment before (:class:`FreeSpace`: something came where nothing
+was), its centre travelled ``MIN_TRAVEL`` or more, it moves at ``MIN_SPEED`` or more, it is
+no longer than ``MAX_EXTENT`` (a cart, a person, a robot: not a wall) and it comes toward the
+robot (within 60 deg of the robot's bearing from it, closing faster than the robot draws
+away). The echoes of a standing object slide along its faces as the robot drives by, but
+never into space a beam had just passed through, nor farther than the object is long.
+
+Where a mover goes (:func:`swept`) is a capsule from its centre along its velocity, as wide
+as the object and ``HALF_WIDTH`` at least (a sonar ring sees one or two echoes of a cart:
+its middle, not its edges): to ``PAST`` body lengths past the robot once its heading is
+known (``SETTLE`` s of track); and while it comes down the robot's lane, straight at the
+robot. Replanning (:func:`.knowledge.replan`) keeps the route clear of it, keeping right
+of what comes down the robot's lane where there is room; where no way to the goal is left,
+it sends the robot to the nearest place out of its way (a *refuge*), and the robot waits
+there until nothing comes toward it: planning in time, in the simplest form a route can
+say.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+LINK = 12.0          # in: echoes of neighbouring beams closer than this are one object
+GATE = 15.0          # in: the farthest an object is matched from its track's predicted place
+WINDOW = 1.5         # s: the track history the velocity is fitted over
+COVER = 0.6          # of WINDOW: how much of it a track must have been followed
+MIN_TRAVEL = 12.0    # in: the least a mover's place moves in WINDOW s
+MIN_SPEED = 6.0      # in/s: slower than this, an object is taken to stand still
+MAX_SPEED = 120.0    # in/s: faster than this, the match was two different objects
+MAX_EXTENT = 48.0    # in: longer than this, an object is a wall, not a mover
+MAX_MISS = 0.5       # s: a track not seen for this long is dropped
+HALF_WIDTH = 12.0    # in: the least half width given to a mover's path
+PAST = 2.0           # body lengths: how far past the robot a mover's path is kept
+HORIZON = 10.0       # s: the farthest ahead a mover's path is predicted
+APPROACH = 0.5       # cos 60 deg: a mover comes toward the robot within this cone
+SETTLE = 2.5         # s: a track followed this long has a heading to go by
+VOTE = 0.5           # s: the sightings a track's moving is voted over
+SHORT = 4.0          # in: a beam passes through the cells up to this short of its echo
+
+
+@dataclass(frozen=True)
+class Mover:
+    """A tracked object that moves: its centre (in), its velocity (in/s) and its half size."""
+
+    centre: np.ndarray        # [2]
+    velocity: np.ndarray      # [2]
+    radius: float             # in, half its extent as seen
+    settled: bool = True      # followed long enough that its heading is known
+
+
+@dataclass(frozen=True, eq=False)
+class Sweep:
+    """Where what moves toward a robot will pass while it gets out of the way: the cells of
+    its map (:func:`swept` of each mover) and how wide the widest way is. With movers down
+    its lane, ``keep_right``: the cells a robot that keeps right of them avoids, as people
+    in a corridor do, so that two robots that meet step aside to opposite sides (the ways
+    wider, by what the route asks beyond its least clearance: a route may squeeze past a
+    wall where nothing wider leads on, but it keeps right of a mover only with room)."""
+
+    cells: np.ndarray                       # bool [rows, cols]
+    wide: float                             # in
+    keep_right: np.ndarray | None = None    # bool [rows, cols]
+
+
+@dataclass
+class Track:
+    """One object followed from tick to tick: the times and centres it was seen at."""
+
+    times: list[float] = field(default_factory=list)
+    centres: list[np.ndarray] = field(default_factory=list)
+    radius: float = 0.0
+    moved: list[bool] = field(default_factory=list)    # an echo where a beam passed before
+    mover: bool = False          # found moving once: it stays a mover while it is followed
+    v: np.ndarray | None = None  # its velocity when it was last seen
+    born: float = 0.0            # when it was first seen
+
+    def moving(self, now: float) -> bool:
+        """Whether most of its sightings over the last ``VOTE`` s had an echo in space a
+        beam had passed through (:class:`FreeSpace`): something came where nothing was."""
+        recent = [m for t, m in zip(self.times, self.moved) if t >= now - VOTE]
+        return 2 * sum(recent) > len(recent)
+
+    def travelled(self, now: float) -> bool:
+        """Whether its place moved ``MIN_TRAVEL`` or more over the last ``WINDOW`` s: the
+        echoes of a standing object slide along its sides as the robot drives by, but not
+        farther than the object is long."""
+        first = next(k for k, t in enumerate(self.times) if t >= now - WINDOW)
+        return math.dist(self.centres[first], self.centres[-1]) >= MIN_TRAVEL
+
+    def velocity(self, now: float) -> np.ndarray | None:
+        """The Theil-Sen slope of the centre over the last ``WINDOW`` s (the median of the
+        slopes between every two sightings at least ``WINDOW / 2`` apart: echoes that hop
+        from one end of an object to the other move its centre by its width, and a median
+        does not follow them); ``None`` when the track covers too little of the window."""
+        t = np.array(self.times)
+        keep = t >= now - WINDOW
+        if np.count_nonzero(keep) < 3 or t[keep][-1] - t[keep][0] < COVER * WINDOW:
+            return None
+        t = t[keep]
+        c = np.array(self.centres)[keep]
+        i, j = np.triu_indices(len(t), 1)
+        far = t[j] - t[i] >= WINDOW / 2
+        if not far.any():
+            return None
+        i, j = i[far], j[far]
+        return np.median((c[j] - c[i]) / (t[j] - t[i])[:, None], axis=0)
+
+    def predicted(self, now: float) -> np.ndarray:
+        """Where the track should be at ``now``: its last centre moved on at its velocity."""
+        last = self.centres[-1]
+        v = self.velocity(self.times[-1])
+        return last if v is None else last + v * (now - self.times[-1])
+
+
+def objects(hits: np.ndarray, seen: np.ndarray, ring: bool) -> list[np.ndarray]:
+    """The beams ``seen`` cut into objects by their echoes ``hits [B, 2]``: runs of
+    neighbouring beams (around the ring when ``ring``) whose echoes lie within ``LINK`` of
+    each other. Each object is the array of its beams' indices."""
+    idx = np.flatnonzero(seen)
+    if not len(idx):
+        return []
+    pts = hits[idx]
+    gap = np.hypot(*(pts[1:] - pts[:-1]).T)
+    cut = ((np.diff(idx) > 1) | (gap > LINK)).nonzero()[0] + 1
+    runs = np.split(np.arange(len(idx)), cut)
+    if ring and len(runs) > 1 and idx[0] == 0 and idx[-1] == len(seen) - 1 \
+            and math.dist(pts[0], pts[-1]) <= LINK:
+        runs = [np.concatenate([runs[-1], runs[0]])] + runs[1:-1]
+    return [idx[r] for r in runs]
+
+
+@dataclass
+class Tracker:
+    """The tracks one robot keeps of the objects its readings show and its map does not."""
+
+    tracks: list[Track] = field(default_factory=list)
+
+    def update(self, now: float, found: list[np.ndarray], moved: list[bool]) -> None:
+        """Match the objects ``found`` at time ``now`` (``moved``: whether each has an echo
+        in space a beam had passed through) to the tracks (nearest first, each track and
+        object once), start a track for each object left, drop stale tracks."""
+        centres = [o.mean(axis=0) for o in found]
+        radii = [float(np.hypot(*(o - c).T).max()) if len(o) > 1 else 0.0
+                 for o, c in zip(found, centres)]
+        live = [tr for tr in self.tracks if now - tr.times[-1] <= MAX_MISS]
+        pairs = []
+        for j, tr in enumerate(live):
+            p = tr.predicted(now)
+            for i, c in enumerate(centres):
+                d = math.dist(p, c)
+                if d <= GATE:
+                    pairs.append((d, j, i))
+        pairs.sort()
+        used_t, used_o = set(), set()
+        for _, j, i in pairs:
+            if j in used_t or i in used_o:
+                continue
+            used_t.add(j)
+            used_o.add(i)
+            tr = live[j]
+            tr.times.append(now)
+            tr.centres.append(centres[i])
+            tr.radius = radii[i]
+            tr.moved.append(moved[i])
+            if len(tr.times) > 64:
+                del tr.times[:-32], tr.centres[:-32], tr.moved[:-32]
+        for i, c in enumerate(centres):      # (an object by a track is a piece of its object)
+            if i not in used_o and 2 * radii[i] <= MAX_EXTENT and not any(
+                    j in used_t and math.dist(live[j].centres[-1], c) <= GATE
+                    for j in range(len(live))):
+                live.append(Track([now], [c], radii[i], [moved[i]], born=now))
+        self.tracks = live
+
+    def movers(self, now: float, robot: np.ndarray, own: np.ndarray) -> list[Mover]:
+        """The tracks that move toward the robot at ``robot [2]`` driving at velocity ``own
+        [2]`` (see the module docstring): those seen at ``now``, and the movers among those
+        missed for at most ``MAX_MISS`` s, where they should be by now (a sonar ring loses a
+        cart between two beams for a tick or two)."""
+        out = []
+        for tr in self.tracks:
+            if 2 * tr.radius > MAX_EXTENT:
+                continue
+            if tr.times[-1] == now:
+                v = tr.velocity(now)
+                speed = 0.0 if v is None else float(np.hypot(*v))
+                tr.mover = (v is not None and (tr.mover or tr.moving(now) and tr.travelled(now))
+                            and MIN_SPEED <= speed <= MAX_SPEED)
+                tr.v = v
+                centre = tr.centres[-1]
+            elif tr.mover and tr.v is not None:
+                v, speed = tr.v, float(np.hypot(*tr.v))
+                centre = tr.centres[-1] + v * (now - tr.times[-1])
+            else:
+                continue
+            if not tr.mover or v is None:
+                continue
+            to_robot = robot - centre
+            dist = float(np.hypot(*to_robot))
+            # it heads for the robot, and the robot does not draw away from it faster
+            if float(v @ to_robot) < APPROACH * speed * dist or float((v - own) @ to_robot) <= 0:
+                continue
+            out.append(Mover(centre, v, tr.radius, now - tr.born >= SETTLE))
+        return out
+
+
+@dataclass
+class FreeSpace:
+    """When a beam last passed through each cell of a robot's map (``-inf``: never): an
+    echo from a cell a beam passed through a moment ago came from something that moved
+    there. A beam counts as passing through a cell up to ``SHORT`` short of its echo, so
+    that noise on the echo of a standing object never reads as one."""
+
+    seen: np.ndarray            # [rows, cols] s
+    resolution: float           # in per cell
+    origin: np.ndarray          # [2] in, the grid's lower left corner
+
+    @classmethod
+    def like(cls, occupied: np.ndarray, resolution: float,
+             origin: tuple[float, float]) -> FreeSpace:
+        return cls(np.full(occupied.shape, -np.inf), resolution, np.array(origin, float))
+
+    def _cells(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The cells ``[P, 2]`` (col, row) of ``points [P, 2]`` and which lie in the grid."""
+        cells = np.floor((points - self.origin) / self.resolution).astype(np.int64)
+        rows, cols = self.seen.shape
+        inside = (cells[:, 0] >= 0) & (cells[:, 0] < cols) & (cells[:, 1] >= 0) \
+            & (cells[:, 1] < rows)
+        return cells, inside
+
+    def update(self, now: float, p: np.ndarray, dirs: np.ndarray, ranges: np.ndarray) -> None:
+        """Stamp ``now`` on the cells the beams ``dirs [B, 2]`` from ``p`` pass through short
+        of their readings ``ranges [B]``."""
+        s = np.arange(self.resolution, float(ranges.max()) - SHORT + self.resolution / 2,
+                      self.resolution)
+        if not len(s):
+            return
+        keep = s[:, None] < ranges[None] - SHORT                      # [S, B]
+        pts = p + s[:, None, None] * dirs[None]                       # [S, B, 2]
+        cells, inside = self._cells(pts[keep])
+        self.seen[cells[inside, 1], cells[inside, 0]] = now
+
+    def entered(self, now: float, points: np.ndarray, dirs: np.ndarray) -> np.ndarray:
+        """Which echoes ``points [P, 2]`` (of beams ``dirs [P, 2]``) lie, a cell beyond the
+        echo, in a cell a beam passed through within the last ``WINDOW`` s (before ``now``)."""
+        cells, inside = self._cells(points + dirs * self.resolution)
+        out = np.zeros(len(points), dtype=bool)
+        t = self.seen[cells[inside, 1], cells[inside, 0]]
+        out[inside] = (t >= now - WINDOW) & (t < now)
+        return out
+
+
+Capsule = tuple[np.ndarray, np.ndarray, float]     # a segment's two ends and a radius
+
+
+def lane(m: Mover, robot: np.ndarray, heading: float, width: float) -> bool:
+    """Whether ``m`` comes down the lane of a robot at ``robot [2]`` heading ``heading``
+    (rad), ``width`` inches wide: its centre within a body width of the robot's line."""
+    to_robot = robot - m.centre
+    return abs(math.cos(heading) * to_robot[1] - math.sin(heading) * to_robot[0]) < width
+
+
+def swept(m: Mover, robot: np.ndarray, heading: float, length: float, width: float
+          ) -> list[Capsule]:
+    """The ways a mover may sweep while a robot at ``robot [2]`` heading ``heading`` (rad),
+    ``length`` by ``width`` inches, gets out of its way: along its velocity once its heading
+    is known (:attr:`Mover.settled`), and straight at the robot while it comes down the
+    robot's :func:`lane`. A ring of sonars measures the heading of an object it has seen for
+    a second or two to some tens of degrees, its range, and so how fast it closes, much
+    better; once the robot stands aside, only the heading says where the mover goes on."""
+    out = []
+    radius = max(m.radius, HALF_WIDTH)
+    if m.settled:
+        speed = float(np.hypot(*m.velocity))
+        along = m.velocity / speed
+        reach = float((robot - m.centre) @ along) + PAST * length
+        span = min(max(reach, 0.0), speed * HORIZON)
+        out.append((m.centre, m.centre + along * span, radius))
+    if lane(m, robot, heading, width):
+        out.append((m.centre, np.array(robot, float), radius))
+    return out
+
+
+def sweep(found: list[Mover], robot: np.ndarray, heading: float, length: float, width: float,
+          shape: tuple[int, int], resolution: float, origin: tuple[float, float],
+          room: float = 0.0, far: float = 150.0) -> Sweep | None:
+    """The cells of a map (``shape``, ``resolution``, ``origin``) that the movers ``found``
+    will sweep while the robot (see :func:`swept`) gets out of their way; ``None`` when
+    none. With movers in its lane, :attr:`Sweep.keep_right` too: the same ways ``room``
+    wider, and the robot's left of those movers up to ``far``."""
+    cells = np.zeros(shape, dtype=bool)
+    roomy = np.zeros(shape, dtype=bool)
+    left = np.zeros(shape, dtype=bool)
+    wide = 0.0
+    for m in found:
+        for a, b, radius in swept(m, robot, heading, length, width):
+            cells |= capsule_cells(shape, resolution, origin, a, b, radius)
+            roomy |= capsule_cells(shape, resolution, origin, a, b, radius + room)
+            wide = max(wide, radius)
+        if lane(m, robot, heading, width):
+            left |= left_cells(shape, resolution, origin, robot, m.centre, HALF_WIDTH, far)
+    if not wide:
+        return None
+    return Sweep(cells, wide, (left | roomy) if left.any() else None)
+
+
+def capsule_cells(shape: tuple[int, int], resolution: float, origin: tuple[float, float],
+                  a: np.ndarray, b: np.ndarray, radius: float) -> np.ndarray:
+    """A boolean grid ``shape`` with the cells whose centres lie within ``radius`` of the
+    segment ``a``-``b`` set (only the segment's bounding box is visited)."""
+    out = np.zeros(shape, dtype=bool)
+    ox, oy = origin
+    lo, hi = np.minimum(a, b) - radius, np.maximum(a, b) + radius
+    rows, cols = shape
+    c0, c1 = max(int((lo[0] - ox) // resolution), 0), min(int((hi[0] - ox) // resolution) + 1, cols)
+    r0, r1 = max(int((lo[1] - oy) // resolution), 0), min(int((hi[1] - oy) // resolution) + 1, rows)
+    if c0 >= c1 or r0 >= r1:
+        return out
+    xs = ox + (np.arange(c0, c1) + 0.5) * resolution
+    ys = oy + (np.arange(r0, r1) + 0.5) * resolution
+    px, py = np.meshgrid(xs, ys)
+    e = b - a
+    ee = float(e @ e)
+    t = np.zeros_like(px) if ee == 0 else np.clip(((px - a[0]) * e[0] + (py - a[1]) * e[1]) / ee,
+                                                   0.0, 1.0)
+    d = np.hypot(px - a[0] - t * e[0], py - a[1] - t * e[1])
+    out[r0:r1, c0:c1] = d <= radius
+    return out
+
+
+def left_cells(shape: tuple[int, int], resolution: float, origin: tuple[float, float],
+               robot: np.ndarray, mover: np.ndarray, near: float, far: float) -> np.ndarray:
+    """A boolean grid ``shape`` with the cells set that lie on the robot's left facing the
+    mover, between the two (along the line from ``robot`` to ``mover``), from ``near`` to
+    ``far`` inches off that line: where a robot keeping right does not go to let the mover
+    by."""
+    out = np.zeros(shape, dtype=bool)
+    e = mover - robot
+    length = float(np.hypot(*e))
+    if length == 0:
+        return out
+    u = e / length
+    n = np.array([-u[1], u[0]])                          # the robot's left, facing the mover
+    corners = np.array([robot + n * near, robot + n * far, mover + n * near, mover + n * far])
+    ox, oy = origin
+    rows, cols = shape
+    lo, hi = corners.min(axis=0), corners.max(axis=0)
+    c0, c1 = max(int((lo[0] - ox) // resolution), 0), min(int((hi[0] - ox) // resolution) + 1, cols)
+    r0, r1 = max(int((lo[1] - oy) // resolution), 0), min(int((hi[1] - oy) // resolution) + 1, rows)
+    if c0 >= c1 or r0 >= r1:
+        return out
+    px, py = np.meshgrid(ox + (np.arange(c0, c1) + 0.5) * resolution,
+                         oy + (np.arange(r0, r1) + 0.5) * resolution)
+    rx, ry = px - robot[0], py - robot[1]
+    along = rx * u[0] + ry * u[1]
+    side = rx * n[0] + ry * n[1]
+    out[r0:r1, c0:c1] = (along >= 0) & (along <= length) & (side >= near) & (side <= far)
+    return out

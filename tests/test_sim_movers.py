@@ -1,0 +1,250 @@
+"""What moves, as the robot's readings show it: segmentation, free space, tracks, where a
+mover will pass, and a robot that waits for a cart where there is no way past it."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from mitos_cli.sim import knowledge, movers
+from mitos_cli.sim.loop import clearances, prepare, simulate
+from mitos_cli.sim.route import Clearance
+from mitos_cli.sim.worldfile import parse_world
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def ring_hits(points: dict[int, tuple[float, float]], count: int = 36):
+    hits = np.zeros((count, 2))
+    seen = np.zeros(count, dtype=bool)
+    for k, xy in points.items():
+        hits[k], seen[k] = xy, True
+    return hits, seen
+
+
+# --- objects along the ring ----------------------------------------------------------------
+
+def test_neighbouring_echoes_close_together_are_one_object_and_a_gap_cuts_them():
+    hits, seen = ring_hits({3: (100, 0), 4: (100, 8), 5: (100, 16),     # one face
+                            6: (100, 60),                                # too far from it
+                            9: (0, 100)})                                # beams apart
+    runs = movers.objects(hits, seen, ring=True)
+    assert [r.tolist() for r in runs] == [[3, 4, 5], [6], [9]]
+
+
+def test_an_object_across_the_first_beam_of_a_ring_is_one_object():
+    hits, seen = ring_hits({0: (100, 0), 1: (100, 8), 35: (100, -8), 20: (-100, 0)})
+    runs = movers.objects(hits, seen, ring=True)
+    assert sorted(r.tolist() for r in runs) == [[20], [35, 0, 1]]
+    assert len(movers.objects(hits, seen, ring=False)) == 3       # a fan does not wrap
+
+
+# --- free space ----------------------------------------------------------------------------
+
+def grid_free(size: int = 100):
+    return movers.FreeSpace.like(np.zeros((size, size), dtype=bool), 2.0, (-100.0, -100.0))
+
+
+def test_an_echo_where_a_beam_passed_a_moment_ago_came_from_something_that_moved_there():
+    free = grid_free()
+    east = np.array([[1.0, 0.0]])
+    free.update(1.0, np.zeros(2), east, np.array([80.0]))        # the beam passed to 80 in
+    echo_inside = np.array([[40.0, 0.0]])                         # later, an echo at 40 in
+    echo_at_wall = np.array([[80.0, 0.0]])                        # or at the wall it hit
+    assert free.entered(1.2, echo_inside, east).tolist() == [True]
+    assert free.entered(1.2, echo_at_wall, east).tolist() == [False]
+    # noise on the echo of the wall (SHORT) is not something that came
+    assert free.entered(1.2, echo_at_wall - [movers.SHORT / 2, 0], east).tolist() == [False]
+    # long ago is not a moment ago, and the same tick is not before it
+    assert free.entered(1.0 + movers.WINDOW + 0.1, echo_inside, east).tolist() == [False]
+    assert free.entered(1.0, echo_inside, east).tolist() == [False]
+
+
+# --- tracks --------------------------------------------------------------------------------
+
+def follow(tracker: movers.Tracker, centre, velocity, seconds: float, moved: bool,
+           wobble: float = 3.0, dt: float = 0.05, t0: float = 0.0):
+    """Feed ``tracker`` an object of two echoes 8 in apart whose centre moves at ``velocity``,
+    one echo hopping ``wobble`` in from tick to tick (a sonar ring sees parts of a cart)."""
+    c0, v = np.asarray(centre, float), np.asarray(velocity, float)
+    t = t0
+    for k in range(int(round(seconds / dt))):
+        t = t0 + k * dt
+        c = c0 + v * (t - t0)
+        hop = wobble * (1 if k % 2 else -1)
+        echoes = np.array([c + [0, -4 + hop], c + [0, 4]])
+        tracker.update(t, [echoes], [moved])
+    return t
+
+
+def test_a_cart_coming_head_on_is_a_mover_with_its_velocity():
+    tracker = movers.Tracker()
+    t = follow(tracker, (300, 0), (-15, 0), 2.0, moved=True)
+    found = tracker.movers(t, np.array([0.0, 0.0]), own=np.array([30.0, 0.0]))
+    assert len(found) == 1
+    assert np.allclose(found[0].velocity, (-15, 0), atol=1.5)
+    assert not found[0].settled                               # 2 s < SETTLE
+    t = follow(tracker, (300 - 15 * 2.05, 0), (-15, 0), 1.0, moved=True, t0=t + 0.05)
+    assert tracker.movers(t, np.array([0.0, 0.0]), own=np.zeros(2))[0].settled
+
+
+def test_what_moves_away_or_stands_is_no_mover():
+    away = movers.Tracker()
+    t = follow(away, (300, 0), (15, 0), 2.0, moved=True)
+    assert away.movers(t, np.zeros(2), own=np.zeros(2)) == []
+    across = movers.Tracker()                                  # passes across, 90 deg off
+    t = follow(across, (300, -100), (0, 15), 2.0, moved=True)
+    assert across.movers(t, np.zeros(2), own=np.zeros(2)) == []
+    # a standing pole whose echoes slide along it as the robot passes: they never come
+    # into space a beam had just passed through
+    pole = movers.Tracker()
+    t = follow(pole, (300, 0), (-15, 0), 2.0, moved=False)
+    assert pole.movers(t, np.zeros(2), own=np.zeros(2)) == []
+    # a robot that draws away from a cart faster than it comes is not in its way
+    chase = movers.Tracker()
+    t = follow(chase, (300, 0), (-15, 0), 2.0, moved=True)
+    assert chase.movers(t, np.zeros(2), own=np.array([-40.0, 0.0])) == []
+
+
+def test_a_mover_missed_for_a_tick_or_two_is_kept_where_it_should_be():
+    tracker = movers.Tracker()
+    t = follow(tracker, (300, 0), (-15, 0), 2.0, moved=True)
+    assert tracker.movers(t, np.zeros(2), own=np.zeros(2))         # (called every tick)
+    tracker.update(t + 0.2, [], [])
+    found = tracker.movers(t + 0.2, np.zeros(2), own=np.zeros(2))
+    assert len(found) == 1 and math.isclose(found[0].centre[0], 300 - 15 * (t + 0.2), abs_tol=2)
+    tracker.update(t + movers.MAX_MISS + 0.1, [], [])
+    assert tracker.movers(t + movers.MAX_MISS + 0.1, np.zeros(2), own=np.zeros(2)) == []
+
+
+# --- where a mover will pass ---------------------------------------------------------------
+
+def test_a_settled_mover_sweeps_past_the_robot_and_down_its_lane():
+    m = movers.Mover(np.array([100.0, 0.0]), np.array([-15.0, 0.0]), 5.0, settled=True)
+    ways = movers.swept(m, np.array([0.0, 0.0]), 0.0, length=24, width=18)
+    along, lane = ways
+    assert np.allclose(along[0], (100, 0)) and np.allclose(along[1], (-48, 0))   # 2 lengths
+    far = movers.Mover(np.array([400.0, 0.0]), np.array([-15.0, 0.0]), 5.0, settled=True)
+    assert np.allclose(movers.swept(far, np.zeros(2), 0.0, 24, 18)[0][1],
+                       (400 - 15 * movers.HORIZON, 0))          # no farther than it goes
+    assert along[2] == movers.HALF_WIDTH                  # a sonar ring sees a cart's middle
+    assert np.allclose(lane[1], (0, 0))                   # straight at the robot
+    beside = movers.swept(m, np.array([0.0, 40.0]), 0.0, length=24, width=18)
+    assert len(beside) == 1                               # not in the robot's lane
+
+
+def test_a_mover_whose_heading_is_not_known_yet_sweeps_only_down_the_robots_lane():
+    m = movers.Mover(np.array([200.0, 0.0]), np.array([-15.0, 0.0]), 5.0, settled=False)
+    assert movers.swept(m, np.array([0.0, 40.0]), 0.0, length=24, width=18) == []
+    (a, b, _), = movers.swept(m, np.array([0.0, 0.0]), 0.0, length=24, width=18)
+    assert np.allclose(a, (200, 0)) and np.allclose(b, (0, 0))
+
+
+def test_a_robot_keeps_right_of_what_comes_down_its_lane_with_room():
+    shape, res, origin = (40, 120), 2.0, (-20.0, -40.0)
+    m = movers.Mover(np.array([150.0, 0.0]), np.array([-15.0, 0.0]), 5.0, settled=True)
+    sw = movers.sweep([m], np.array([0.0, 0.0]), 0.0, 24, 18, shape, res, origin, room=3.5,
+                      far=40)
+    assert sw is not None and sw.keep_right is not None and sw.wide == movers.HALF_WIDTH
+    rows, cols = np.mgrid[0:shape[0], 0:shape[1]]
+    y = origin[1] + (rows + 0.5) * res
+    x = origin[0] + (cols + 0.5) * res
+    between = (x > 20) & (x < 130)
+    # the robot's left (y > 0 facing the cart at +x) is kept clear of, its right is not
+    assert sw.keep_right[between & (y > movers.HALF_WIDTH + 4) & (y < 38)].all()
+    assert not sw.keep_right[between & (y < -(movers.HALF_WIDTH + 3.5) - 2)].any()
+    # and on its right, the ways are 3.5 in wider than in ``cells``
+    edge = between & (y < -movers.HALF_WIDTH) & (y > -(movers.HALF_WIDTH + 3.5))
+    assert edge.any() and (sw.keep_right & ~sw.cells)[edge].all()
+    beside = movers.sweep([m], np.array([0.0, 60.0]), 0.0, 24, 18, shape, res, origin)
+    assert beside is not None and beside.keep_right is None     # not in its lane
+
+
+@settings(max_examples=60, deadline=None)
+@given(ax=st.floats(-50, 150), ay=st.floats(-50, 150), bx=st.floats(-50, 150),
+       by=st.floats(-50, 150), radius=st.floats(0.5, 40))
+def test_capsule_cells_are_the_cells_whose_centres_lie_within_the_radius(ax, ay, bx, by, radius):
+    shape, res, origin = (40, 50), 2.5, (-20.0, -10.0)
+    a, b = np.array([ax, ay]), np.array([bx, by])
+    got = movers.capsule_cells(shape, res, origin, a, b, radius)
+    rows, cols = np.mgrid[0:shape[0], 0:shape[1]]
+    p = np.stack([origin[0] + (cols + 0.5) * res, origin[1] + (rows + 0.5) * res], axis=-1)
+    e = b - a
+    t = np.clip(((p - a) @ e) / max(float(e @ e), 1e-300), 0, 1) if e @ e else np.zeros(shape)
+    d = np.hypot(*(p - a - t[..., None] * e).transpose(2, 0, 1))
+    near_edge = np.abs(d - radius) < 1e-9
+    assert np.array_equal(got[~near_edge], (d <= radius)[~near_edge])
+
+
+# --- a robot that waits --------------------------------------------------------------------
+
+YIELD = (ROOT / "worlds" / "moving.yaml").read_text(encoding="utf-8")
+YIELD = YIELD[:YIELD.index("\nobstacles:")].replace("seed: 3", "seed: 12") + """
+obstacles:
+  - {name: oncoming, shape: rectangle, at: [1000, -14], length: 22, width: 16,
+     velocity: [-15, 0]}
+  - {name: trolley, shape: rectangle, at: [742, 23], length: 30, width: 18}
+"""
+
+
+def test_where_a_cart_and_a_trolley_leave_no_way_past_the_robot_waits_for_the_cart():
+    # the cart comes head-on in the robot's lane; beside the trolley the way left between
+    # them is 20 in, for a robot 18 in wide and its 2 in margin on each side
+    world = parse_world(YIELD, "yield.yaml")
+    res = simulate(world)
+    assert res.outcome == "success" and res.clearance[:, 0].min() > 0
+    cart = [o.name for o in world.obstacles].index("oncoming")
+    ahead = res.obstacles[:, cart, 0] > res.pose[:, 0, 0]          # before it went by
+    # it stood (slower than 5 in/s) a second or more before the cart went by...
+    stood = np.convolve((res.speed[:, 0] < 5) & ahead, np.ones(int(1.0 / world.dt)), "valid")
+    assert stood.max() == int(1.0 / world.dt)
+    # ...and stood aside: while the cart went by, the robot was left of the cart's lane
+    by = np.abs(res.obstacles[:, cart, 0] - res.pose[:, 0, 0]) < 20
+    assert by.any() and (res.pose[by, 0, 1] > 0).all()
+
+
+# --- replanning round what moves -----------------------------------------------------------
+
+CORRIDOR = YIELD[:YIELD.index("\nobstacles:")]
+
+
+def corridor_map():
+    world = parse_world(CORRIDOR, "c.yaml")
+    scene = prepare(world)
+    grid = knowledge.plan_grid(knowledge.given(world, scene.static), scene.static, world)
+    return (world, knowledge.RobotMap.of(grid), scene.routes[0],
+            clearances(world, world.agents[0]))
+
+
+def across(rmap, x: float, y0: float, y1: float, radius: float = 12.0) -> movers.Sweep:
+    g = rmap.grid
+    cells = movers.capsule_cells(rmap.occupied.shape, g.resolution, g.origin,
+                                 np.array([x, y0]), np.array([x, y1]), radius)
+    return movers.Sweep(cells, radius)
+
+
+def test_with_no_way_past_what_comes_it_goes_to_a_refuge_and_waits_there_till_it_passed():
+    world, rmap, route, (asked, least) = corridor_map()
+    goal, p = world.agents[0].goal, np.array([300.0, -10.0])
+    shut = across(rmap, 400, -60, 60)                       # the whole corridor, ahead
+    to_refuge = knowledge.replan(rmap, route, 270, p, goal, 1.0, asked, least, 150,
+                                 moving=shut)
+    assert to_refuge is not None and rmap.refuge is not None
+    place = np.array([rmap.refuge.x, rmap.refuge.y])
+    g = rmap.grid
+    free = ~(rmap.occupied | shut.cells)
+    room = Clearance.of(~free, g.resolution, g.origin, cap=asked + 10)
+    assert room.at(place[None])[0] >= asked                 # out of everyone's way
+    assert math.dist(to_refuge.goal, place) < 1e-9
+    # while something still comes toward it, it stays, even where a way past opens
+    half = across(rmap, 400, -60, -30)
+    again = knowledge.replan(rmap, to_refuge, 0, p, goal, 2.0, asked, least, 150, moving=half)
+    assert again is not None and math.dist(again.goal, place) < 1e-9
+    # once nothing does, it goes on to its goal
+    on = knowledge.replan(rmap, again, 0, p, goal, 3.0, asked, least, 150)
+    assert on is not None and rmap.refuge is None
+    assert math.dist(on.goal, (goal.x, goal.y)) < 1e-9
