@@ -45,23 +45,43 @@ def test_an_object_across_the_first_beam_of_a_ring_is_one_object():
 
 # --- free space ----------------------------------------------------------------------------
 
-def grid_free(size: int = 100):
-    return movers.FreeSpace.like(np.zeros((size, size), dtype=bool), 2.0, (-100.0, -100.0))
+def ring_free(count: int = 36):
+    angles = np.deg2rad(np.arange(count) * (360.0 / count))
+    return movers.FreeSpace.of(angles, ring=True, dt=0.05), angles
 
 
 def test_an_echo_where_a_beam_passed_a_moment_ago_came_from_something_that_moved_there():
-    free = grid_free()
+    free, angles = ring_free()
+    dirs = np.stack([np.cos(angles), np.sin(angles)], axis=1)
+    ranges = np.full(36, 150.0)
+    ranges[0] = 80.0                                          # east: a wall at 80 in
+    free.update(1.0, np.zeros(2), dirs, ranges)
     east = np.array([[1.0, 0.0]])
-    free.update(1.0, np.zeros(2), east, np.array([80.0]))        # the beam passed to 80 in
-    echo_inside = np.array([[40.0, 0.0]])                         # later, an echo at 40 in
-    echo_at_wall = np.array([[80.0, 0.0]])                        # or at the wall it hit
+    echo_inside = np.array([[40.0, 0.0]])                     # later, an echo at 40 in
+    echo_at_wall = np.array([[80.0, 0.0]])                    # or at the wall it hit
     assert free.entered(1.2, echo_inside, east).tolist() == [True]
     assert free.entered(1.2, echo_at_wall, east).tolist() == [False]
     # noise on the echo of the wall (SHORT) is not something that came
     assert free.entered(1.2, echo_at_wall - [movers.SHORT / 2, 0], east).tolist() == [False]
+    # between two beams, 5 deg off each line at 60 in, no beam passed
+    off = 60 * np.array([[math.cos(math.radians(5)), math.sin(math.radians(5))]])
+    assert free.entered(1.2, off, off / 60).tolist() == [False]
     # long ago is not a moment ago, and the same tick is not before it
     assert free.entered(1.0 + movers.WINDOW + 0.1, echo_inside, east).tolist() == [False]
     assert free.entered(1.0, echo_inside, east).tolist() == [False]
+
+
+def test_free_space_follows_the_robots_pose_and_a_fan_of_beams():
+    angles = np.deg2rad(np.linspace(45, -45, 10))             # a fan, left to right
+    free = movers.FreeSpace.of(angles, ring=False, dt=0.05)
+    heading = math.radians(90)                                # the robot faces north
+    dirs = np.stack([np.cos(angles + heading), np.sin(angles + heading)], axis=1)
+    free.update(0.0, np.array([10.0, 10.0]), dirs, np.full(10, 100.0))
+    north = np.array([[0.0, 1.0]])
+    ahead = np.array([10.0, 10.0]) + 50 * dirs[4:5]           # on the fifth beam's line
+    assert free.entered(0.5, ahead, north).tolist() == [True]
+    behind = np.array([[10.0, -40.0]])                        # outside the fan
+    assert free.entered(0.5, behind, -north).tolist() == [False]
 
 
 # --- tracks --------------------------------------------------------------------------------

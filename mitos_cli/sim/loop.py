@@ -403,8 +403,8 @@ class Simulation:
                                                            self.world)
         self._maps = [knowledge.RobotMap.of(grid) for _ in range(n)]
         self._trackers = [movers.Tracker() for _ in range(n)]
-        self._free = [movers.FreeSpace.like(m.occupied, grid.resolution, grid.origin)
-                      for m in self._maps]
+        ring = self.world.sensors.layout == "ring"
+        self._free = [movers.FreeSpace.of(self.angles, ring, self.dt) for _ in range(n)]
         self._seen = [np.zeros(len(self.angles), dtype=bool) for _ in range(n)]
         self._odometer: list[np.ndarray] = []      # in each robot has driven, after each move
         self._recovery = [safety.Recovery() for _ in range(n)]
@@ -833,12 +833,16 @@ class Simulation:
             return None
         seen, p, dirs = self._seen[i], s.pose[i, :2], self._dirs[i]
         rmap, free, tracker = self._maps[i], self._free[i], self._trackers[i]
+        if not tracker.tracks and not np.count_nonzero(seen):    # nothing to follow
+            free.update(s.t, p, dirs, s.ranges[i])
+            return None
         hits = p + s.ranges[i, :, None] * dirs
         runs = movers.objects(hits, seen, self.world.sensors.layout == "ring")
-        entered = free.entered(s.t, hits, dirs)
+        entered = free.entered(s.t, hits[seen], dirs[seen])
         free.update(s.t, p, dirs, s.ranges[i])
+        at = np.cumsum(seen) - 1                     # a seen beam's place among the seen
         tracker.update(s.t, [hits[r] for r in runs],
-                       [2 * np.count_nonzero(entered[r]) >= len(r) for r in runs])
+                       [2 * np.count_nonzero(entered[at[r]]) >= len(r) for r in runs])
         h = float(self._h[i])
         # (a robot on its way to a refuge draws away from what it yields to; it waits for
         # it all the same)

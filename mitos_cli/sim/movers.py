@@ -49,7 +49,8 @@ HORIZON = 10.0       # s: the farthest ahead a mover's path is predicted
 APPROACH = 0.5       # cos 60 deg: a mover comes toward the robot within this cone
 SETTLE = 2.5         # s: a track followed this long has a heading to go by
 VOTE = 0.5           # s: the sightings a track's moving is voted over
-SHORT = 4.0          # in: a beam passes through the cells up to this short of its echo
+SHORT = 4.0          # in: a beam passes through what lies up to this short of its echo
+STEP = 2.0           # in: ... and this near its line; an echo is tested this far beyond it
 
 
 @dataclass(frozen=True)
@@ -85,7 +86,8 @@ class Track:
     radius: float = 0.0
     moved: list[bool] = field(default_factory=list)    # an echo where a beam passed before
     mover: bool = False          # found moving once: it stays a mover while it is followed
-    v: np.ndarray | None = None  # its velocity when it was last seen
+    v: np.ndarray | None = None  # its velocity when it was last seen, if a mover
+    fit: np.ndarray | None = None   # its :meth:`velocity` when it was last seen
     born: float = 0.0            # when it was first seen
 
     def moving(self, now: float) -> bool:
@@ -122,8 +124,7 @@ class Track:
     def predicted(self, now: float) -> np.ndarray:
         """Where the track should be at ``now``: its last centre moved on at its velocity."""
         last = self.centres[-1]
-        v = self.velocity(self.times[-1])
-        return last if v is None else last + v * (now - self.times[-1])
+        return last if self.fit is None else last + self.fit * (now - self.times[-1])
 
 
 def objects(hits: np.ndarray, seen: np.ndarray, ring: bool) -> list[np.ndarray]:
@@ -178,6 +179,8 @@ class Tracker:
             tr.moved.append(moved[i])
             if len(tr.times) > 64:
                 del tr.times[:-32], tr.centres[:-32], tr.moved[:-32]
+            # (what stands is matched where it was: only what may move is worth a fit)
+            tr.fit = tr.velocity(now) if tr.mover or tr.moving(now) else None
         for i, c in enumerate(centres):      # (an object by a track is a piece of its object)
             if i not in used_o and 2 * radii[i] <= MAX_EXTENT and not any(
                     j in used_t and math.dist(live[j].centres[-1], c) <= GATE
@@ -195,7 +198,7 @@ class Tracker:
             if 2 * tr.radius > MAX_EXTENT:
                 continue
             if tr.times[-1] == now:
-                v = tr.velocity(now)
+                v = tr.fit
                 speed = 0.0 if v is None else float(np.hypot(*v))
                 tr.mover = (v is not None and (tr.mover or tr.moving(now) and tr.travelled(now))
                             and MIN_SPEED <= speed <= MAX_SPEED)
@@ -219,48 +222,57 @@ class Tracker:
 
 @dataclass
 class FreeSpace:
-    """When a beam last passed through each cell of a robot's map (``-inf``: never): an
-    echo from a cell a beam passed through a moment ago came from something that moved
-    there. A beam counts as passing through a cell up to ``SHORT`` short of its echo, so
-    that noise on the echo of a standing object never reads as one."""
+    """The beams of the last ``WINDOW`` s, as they were cast (the robot's pose and its
+    readings): an echo from where a beam passed a moment ago came from something that moved
+    there. A beam passes through what lies within ``STEP`` of its line and ``SHORT`` short
+    of its echo, so that noise on the echo of a standing object never reads as one. The
+    beams are those of one layout (``angles``: evenly spaced, as every layout's are)."""
 
-    seen: np.ndarray            # [rows, cols] s
-    resolution: float           # in per cell
-    origin: np.ndarray          # [2] in, the grid's lower left corner
+    a0: float                   # rad: the first beam's direction from the heading
+    step: float                 # rad between neighbouring beams
+    ring: bool                  # the beams go all round
+    times: np.ndarray           # [J] s (-inf: an empty slot)
+    poses: np.ndarray           # [J, 3] x, y (in), heading (rad)
+    ranges: np.ndarray          # [J, B] in
+    slot: int = 0
 
     @classmethod
-    def like(cls, occupied: np.ndarray, resolution: float,
-             origin: tuple[float, float]) -> FreeSpace:
-        return cls(np.full(occupied.shape, -np.inf), resolution, np.array(origin, float))
-
-    def _cells(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """The cells ``[P, 2]`` (col, row) of ``points [P, 2]`` and which lie in the grid."""
-        cells = np.floor((points - self.origin) / self.resolution).astype(np.int64)
-        rows, cols = self.seen.shape
-        inside = (cells[:, 0] >= 0) & (cells[:, 0] < cols) & (cells[:, 1] >= 0) \
-            & (cells[:, 1] < rows)
-        return cells, inside
+    def of(cls, angles: np.ndarray, ring: bool, dt: float) -> FreeSpace:
+        keep = int(math.ceil(WINDOW / dt)) + 1
+        step = float(angles[1] - angles[0]) if len(angles) > 1 else 0.0
+        return cls(float(angles[0]), step, ring, np.full(keep, -np.inf), np.zeros((keep, 3)),
+                   np.zeros((keep, len(angles))))
 
     def update(self, now: float, p: np.ndarray, dirs: np.ndarray, ranges: np.ndarray) -> None:
-        """Stamp ``now`` on the cells the beams ``dirs [B, 2]`` from ``p`` pass through short
-        of their readings ``ranges [B]``."""
-        s = np.arange(self.resolution, float(ranges.max()) - SHORT + self.resolution / 2,
-                      self.resolution)
-        if not len(s):
-            return
-        keep = s[:, None] < ranges[None] - SHORT                      # [S, B]
-        pts = p + s[:, None, None] * dirs[None]                       # [S, B, 2]
-        cells, inside = self._cells(pts[keep])
-        self.seen[cells[inside, 1], cells[inside, 0]] = now
+        """Keep the beams ``dirs [B, 2]`` cast from ``p`` at ``now`` and their ``ranges [B]``
+        (in place of the oldest kept)."""
+        k = self.slot
+        self.times[k] = now
+        self.poses[k] = p[0], p[1], math.atan2(dirs[0, 1], dirs[0, 0]) - self.a0
+        self.ranges[k] = ranges
+        self.slot = (k + 1) % len(self.times)
 
     def entered(self, now: float, points: np.ndarray, dirs: np.ndarray) -> np.ndarray:
-        """Which echoes ``points [P, 2]`` (of beams ``dirs [P, 2]``) lie, a cell beyond the
-        echo, in a cell a beam passed through within the last ``WINDOW`` s (before ``now``)."""
-        cells, inside = self._cells(points + dirs * self.resolution)
-        out = np.zeros(len(points), dtype=bool)
-        t = self.seen[cells[inside, 1], cells[inside, 0]]
-        out[inside] = (t >= now - WINDOW) & (t < now)
-        return out
+        """Which echoes ``points [P, 2]`` (of beams ``dirs [P, 2]``) lie, ``STEP`` beyond the
+        echo, where a beam kept from the last ``WINDOW`` s (before ``now``) passed."""
+        live = (self.times >= now - WINDOW) & (self.times < now)
+        if not len(points) or not live.any():
+            return np.zeros(len(points), dtype=bool)
+        pose, ranges = self.poses[live], self.ranges[live]                  # [J, 3], [J, B]
+        q = points + dirs * STEP
+        rel = q[:, None, :] - pose[None, :, :2]                             # [P, J, 2]
+        dist = np.hypot(rel[..., 0], rel[..., 1])
+        bearing = np.arctan2(rel[..., 1], rel[..., 0]) - pose[None, :, 2] - self.a0
+        beams = ranges.shape[1]
+        k = np.rint(bearing / self.step) if self.step else np.zeros_like(bearing)
+        k = np.mod(k, beams) if self.ring else k
+        inside = (k >= 0) & (k < beams)
+        k = np.clip(k, 0, beams - 1).astype(np.int64)
+        off = np.mod(bearing - k * self.step + np.pi, 2 * np.pi) - np.pi    # from that beam
+        reach = ranges[np.arange(len(pose))[None, :], k]                    # [P, J]
+        passed = inside & (np.abs(off) < np.pi / 2) & (dist * np.abs(np.sin(off)) <= STEP) \
+            & (dist * np.cos(off) < reach - SHORT)
+        return passed.any(axis=1)
 
 
 Capsule = tuple[np.ndarray, np.ndarray, float]     # a segment's two ends and a radius
