@@ -47,7 +47,13 @@ def test_an_object_across_the_first_beam_of_a_ring_is_one_object():
 
 def ring_free(count: int = 36):
     angles = np.deg2rad(np.arange(count) * (360.0 / count))
-    return movers.FreeSpace.of(angles, ring=True, dt=0.05), angles
+    return movers.FreeSpace.of(angles, ring=True, dt=0.05, resolution=2.0), angles
+
+
+def entered(free, now, points, dirs) -> list[bool | None]:
+    """Per echo: None where no kept beam's line crossed it, else whether one passed it."""
+    on, passed = free.entered(now, points, dirs)
+    return [bool(p) if o else None for o, p in zip(on, passed)]
 
 
 def test_an_echo_where_a_beam_passed_a_moment_ago_came_from_something_that_moved_there():
@@ -57,36 +63,34 @@ def test_an_echo_where_a_beam_passed_a_moment_ago_came_from_something_that_moved
     ranges[0] = 80.0                                          # east: a wall at 80 in
     free.update(1.0, np.zeros(2), dirs, ranges)
     east = np.array([[1.0, 0.0]])
-    echo_inside = np.array([[40.0, 0.0]])                     # later, an echo at 40 in
-    echo_at_wall = np.array([[80.0, 0.0]])                    # or at the wall it hit
-    assert free.entered(1.2, echo_inside, east).tolist() == [True]
-    assert free.entered(1.2, echo_at_wall, east).tolist() == [False]
+    assert entered(free, 1.2, np.array([[40.0, 0.0]]), east) == [True]    # came since
+    assert entered(free, 1.2, np.array([[80.0, 0.0]]), east) == [False]   # the wall
     # noise on the echo of the wall (SHORT) is not something that came
-    assert free.entered(1.2, echo_at_wall - [movers.SHORT / 2, 0], east).tolist() == [False]
-    # between two beams, 5 deg off each line at 60 in, no beam passed
+    assert entered(free, 1.2, np.array([[80.0 - movers.SHORT / 2, 0]]), east) == [False]
+    # half a cell off the line is still on it; between two beams no line crossed
+    assert entered(free, 1.2, np.array([[40.0, 0.9]]), east) == [True]
     off = 60 * np.array([[math.cos(math.radians(5)), math.sin(math.radians(5))]])
-    assert free.entered(1.2, off, off / 60).tolist() == [False]
+    assert entered(free, 1.2, off, off / 60) == [None]
     # long ago is not a moment ago, and the same tick is not before it
-    assert free.entered(1.0 + movers.WINDOW + 0.1, echo_inside, east).tolist() == [False]
-    assert free.entered(1.0, echo_inside, east).tolist() == [False]
+    assert entered(free, 1.0 + movers.WINDOW + 0.1, np.array([[40.0, 0.0]]), east) == [None]
+    assert entered(free, 1.0, np.array([[40.0, 0.0]]), east) == [None]
 
 
 def test_free_space_follows_the_robots_pose_and_a_fan_of_beams():
     angles = np.deg2rad(np.linspace(45, -45, 10))             # a fan, left to right
-    free = movers.FreeSpace.of(angles, ring=False, dt=0.05)
+    free = movers.FreeSpace.of(angles, ring=False, dt=0.05, resolution=2.0)
     heading = math.radians(90)                                # the robot faces north
     dirs = np.stack([np.cos(angles + heading), np.sin(angles + heading)], axis=1)
     free.update(0.0, np.array([10.0, 10.0]), dirs, np.full(10, 100.0))
-    north = np.array([[0.0, 1.0]])
     ahead = np.array([10.0, 10.0]) + 50 * dirs[4:5]           # on the fifth beam's line
-    assert free.entered(0.5, ahead, north).tolist() == [True]
+    assert entered(free, 0.5, ahead, dirs[4:5]) == [True]
     behind = np.array([[10.0, -40.0]])                        # outside the fan
-    assert free.entered(0.5, behind, -north).tolist() == [False]
+    assert entered(free, 0.5, behind, np.array([[0.0, -1.0]])) == [None]
 
 
 # --- tracks --------------------------------------------------------------------------------
 
-def follow(tracker: movers.Tracker, centre, velocity, seconds: float, moved: bool,
+def follow(tracker: movers.Tracker, centre, velocity, seconds: float, moved: bool | None,
            wobble: float = 3.0, dt: float = 0.05, t0: float = 0.0):
     """Feed ``tracker`` an object of two echoes 8 in apart whose centre moves at ``velocity``,
     one echo hopping ``wobble`` in from tick to tick (a sonar ring sees parts of a cart)."""
@@ -124,6 +128,10 @@ def test_what_moves_away_or_stands_is_no_mover():
     pole = movers.Tracker()
     t = follow(pole, (300, 0), (-15, 0), 2.0, moved=False)
     assert pole.movers(t, np.zeros(2), own=np.zeros(2)) == []
+    # nor one whose echoes no beam's line had crossed before: nothing says it came
+    unseen = movers.Tracker()
+    t = follow(unseen, (300, 0), (-15, 0), 2.0, moved=None)
+    assert unseen.movers(t, np.zeros(2), own=np.zeros(2)) == []
     # a robot that draws away from a cart faster than it comes is not in its way
     chase = movers.Tracker()
     t = follow(chase, (300, 0), (-15, 0), 2.0, moved=True)

@@ -404,7 +404,8 @@ class Simulation:
         self._maps = [knowledge.RobotMap.of(grid) for _ in range(n)]
         self._trackers = [movers.Tracker() for _ in range(n)]
         ring = self.world.sensors.layout == "ring"
-        self._free = [movers.FreeSpace.of(self.angles, ring, self.dt) for _ in range(n)]
+        self._free = [movers.FreeSpace.of(self.angles, ring, self.dt, grid.resolution)
+                      for _ in range(n)]
         self._seen = [np.zeros(len(self.angles), dtype=bool) for _ in range(n)]
         self._odometer: list[np.ndarray] = []      # in each robot has driven, after each move
         self._recovery = [safety.Recovery() for _ in range(n)]
@@ -838,11 +839,14 @@ class Simulation:
             return None
         hits = p + s.ranges[i, :, None] * dirs
         runs = movers.objects(hits, seen, self.world.sensors.layout == "ring")
-        entered = free.entered(s.t, hits[seen], dirs[seen])
+        tested, entered = free.entered(s.t, hits[seen], dirs[seen])
         free.update(s.t, p, dirs, s.ranges[i])
         at = np.cumsum(seen) - 1                     # a seen beam's place among the seen
-        tracker.update(s.t, [hits[r] for r in runs],
-                       [2 * np.count_nonzero(entered[at[r]]) >= len(r) for r in runs])
+        # an object moved when most of its echoes that a beam's line had crossed came where
+        # that beam had passed (None: no line crossed any)
+        moved = [None if not (n := np.count_nonzero(tested[at[r]]))
+                 else 2 * np.count_nonzero(entered[at[r]]) >= n for r in runs]
+        tracker.update(s.t, [hits[r] for r in runs], moved)
         h = float(self._h[i])
         # (a robot on its way to a refuge draws away from what it yields to; it waits for
         # it all the same)

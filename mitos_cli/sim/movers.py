@@ -50,7 +50,7 @@ APPROACH = 0.5       # cos 60 deg: a mover comes toward the robot within this co
 SETTLE = 2.5         # s: a track followed this long has a heading to go by
 VOTE = 0.5           # s: the sightings a track's moving is voted over
 SHORT = 4.0          # in: a beam passes through what lies up to this short of its echo
-STEP = 2.0           # in: ... and this near its line; an echo is tested this far beyond it
+STEP = 2.0           # in: an echo is tested this far beyond it
 
 
 @dataclass(frozen=True)
@@ -84,7 +84,9 @@ class Track:
     times: list[float] = field(default_factory=list)
     centres: list[np.ndarray] = field(default_factory=list)
     radius: float = 0.0
-    moved: list[bool] = field(default_factory=list)    # an echo where a beam passed before
+    moved: list[bool | None] = field(default_factory=list)
+    # per sighting: whether its echoes came where a beam passed before (None: no beam's
+    # line crossed them)
     mover: bool = False          # found moving once: it stays a mover while it is followed
     v: np.ndarray | None = None  # its velocity when it was last seen, if a mover
     fit: np.ndarray | None = None   # its :meth:`velocity` when it was last seen
@@ -93,7 +95,7 @@ class Track:
     def moving(self, now: float) -> bool:
         """Whether most of its sightings over the last ``VOTE`` s had an echo in space a
         beam had passed through (:class:`FreeSpace`): something came where nothing was."""
-        recent = [m for t, m in zip(self.times, self.moved) if t >= now - VOTE]
+        recent = [m for t, m in zip(self.times, self.moved) if t >= now - VOTE and m is not None]
         return 2 * sum(recent) > len(recent)
 
     def travelled(self, now: float) -> bool:
@@ -150,43 +152,54 @@ class Tracker:
 
     tracks: list[Track] = field(default_factory=list)
 
-    def update(self, now: float, found: list[np.ndarray], moved: list[bool]) -> None:
+    def update(self, now: float, found: list[np.ndarray], moved: list[bool | None]) -> None:
         """Match the objects ``found`` at time ``now`` (``moved``: whether each has an echo
         in space a beam had passed through) to the tracks (nearest first, each track and
         object once), start a track for each object left, drop stale tracks."""
-        centres = [o.mean(axis=0) for o in found]
-        radii = [float(np.hypot(*(o - c).T).max()) if len(o) > 1 else 0.0
-                 for o, c in zip(found, centres)]
         live = [tr for tr in self.tracks if now - tr.times[-1] <= MAX_MISS]
-        pairs = []
-        for j, tr in enumerate(live):
-            p = tr.predicted(now)
-            for i, c in enumerate(centres):
-                d = math.dist(p, c)
-                if d <= GATE:
-                    pairs.append((d, j, i))
-        pairs.sort()
-        used_t, used_o = set(), set()
-        for _, j, i in pairs:
-            if j in used_t or i in used_o:
+        if not found:
+            self.tracks = live
+            return
+        sizes = np.array([len(o) for o in found])
+        pts = np.concatenate(found)
+        starts = np.concatenate([[0], np.cumsum(sizes)[:-1]])
+        centres = np.add.reduceat(pts, starts, axis=0) / sizes[:, None]            # [O, 2]
+        spread = np.hypot(*(pts - np.repeat(centres, sizes, axis=0)).T)
+        radii = np.maximum.reduceat(spread, starts)                                  # [O]
+        used_t: set[int] = set()
+        used_o: set[int] = set()
+        if live:
+            pred = np.array([tr.predicted(now) for tr in live])                     # [T, 2]
+            d = np.hypot(*(pred[:, None] - centres[None]).transpose(2, 0, 1))     # [T, O]
+            tj, oi = np.nonzero(d <= GATE)
+            for k in np.argsort(d[tj, oi], kind="stable"):       # nearest first, each once
+                j, i = int(tj[k]), int(oi[k])
+                if j in used_t or i in used_o:
+                    continue
+                used_t.add(j)
+                used_o.add(i)
+                self._sighted(live[j], now, centres[i], float(radii[i]), moved[i])
+        taken = np.array([live[j].centres[-1] for j in sorted(used_t)]).reshape(-1, 2)
+        for i in range(len(centres)):        # (an object by a track is a piece of its object)
+            if i in used_o or 2 * radii[i] > MAX_EXTENT:
                 continue
-            used_t.add(j)
-            used_o.add(i)
-            tr = live[j]
-            tr.times.append(now)
-            tr.centres.append(centres[i])
-            tr.radius = radii[i]
-            tr.moved.append(moved[i])
-            if len(tr.times) > 64:
-                del tr.times[:-32], tr.centres[:-32], tr.moved[:-32]
-            # (what stands is matched where it was: only what may move is worth a fit)
-            tr.fit = tr.velocity(now) if tr.mover or tr.moving(now) else None
-        for i, c in enumerate(centres):      # (an object by a track is a piece of its object)
-            if i not in used_o and 2 * radii[i] <= MAX_EXTENT and not any(
-                    j in used_t and math.dist(live[j].centres[-1], c) <= GATE
-                    for j in range(len(live))):
-                live.append(Track([now], [c], radii[i], [moved[i]], born=now))
+            if len(taken) and np.hypot(*(taken - centres[i]).T).min() <= GATE:
+                continue
+            live.append(Track([now], [centres[i]], float(radii[i]), [moved[i]], born=now))
         self.tracks = live
+
+    @staticmethod
+    def _sighted(tr: Track, now: float, centre: np.ndarray, radius: float,
+                 moved: bool | None) -> None:
+        """``tr`` seen again at ``now``, at ``centre``."""
+        tr.times.append(now)
+        tr.centres.append(centre)
+        tr.radius = radius
+        tr.moved.append(moved)
+        if len(tr.times) > 64:
+            del tr.times[:-32], tr.centres[:-32], tr.moved[:-32]
+        # (what stands is matched where it was: only what may move is worth a fit)
+        tr.fit = tr.velocity(now) if tr.mover or tr.moving(now) else None
 
     def movers(self, now: float, robot: np.ndarray, own: np.ndarray) -> list[Mover]:
         """The tracks that move toward the robot at ``robot [2]`` driving at velocity ``own
@@ -224,9 +237,9 @@ class Tracker:
 class FreeSpace:
     """The beams of the last ``WINDOW`` s, as they were cast (the robot's pose and its
     readings): an echo from where a beam passed a moment ago came from something that moved
-    there. A beam passes through what lies within ``STEP`` of its line and ``SHORT`` short
-    of its echo, so that noise on the echo of a standing object never reads as one. The
-    beams are those of one layout (``angles``: evenly spaced, as every layout's are)."""
+    there. A beam passes through what lies within half a map cell of its line and ``SHORT``
+    short of its echo, so that noise on the echo of a standing object never reads as one.
+    The beams are those of one layout (``angles``: evenly spaced, as every layout's are)."""
 
     a0: float                   # rad: the first beam's direction from the heading
     step: float                 # rad between neighbouring beams
@@ -234,14 +247,17 @@ class FreeSpace:
     times: np.ndarray           # [J] s (-inf: an empty slot)
     poses: np.ndarray           # [J, 3] x, y (in), heading (rad)
     ranges: np.ndarray          # [J, B] in
+    near: float                 # in: how near a beam's line a point it passed lies
     slot: int = 0
 
     @classmethod
-    def of(cls, angles: np.ndarray, ring: bool, dt: float) -> FreeSpace:
+    def of(cls, angles: np.ndarray, ring: bool, dt: float, resolution: float) -> FreeSpace:
+        """For beams at ``angles`` (rad from the heading), ticks of ``dt`` s and a map of
+        ``resolution`` (a beam passes through what lies within half a cell of its line)."""
         keep = int(math.ceil(WINDOW / dt)) + 1
         step = float(angles[1] - angles[0]) if len(angles) > 1 else 0.0
         return cls(float(angles[0]), step, ring, np.full(keep, -np.inf), np.zeros((keep, 3)),
-                   np.zeros((keep, len(angles))))
+                   np.zeros((keep, len(angles))), resolution / 2)
 
     def update(self, now: float, p: np.ndarray, dirs: np.ndarray, ranges: np.ndarray) -> None:
         """Keep the beams ``dirs [B, 2]`` cast from ``p`` at ``now`` and their ``ranges [B]``
@@ -252,12 +268,16 @@ class FreeSpace:
         self.ranges[k] = ranges
         self.slot = (k + 1) % len(self.times)
 
-    def entered(self, now: float, points: np.ndarray, dirs: np.ndarray) -> np.ndarray:
-        """Which echoes ``points [P, 2]`` (of beams ``dirs [P, 2]``) lie, ``STEP`` beyond the
-        echo, where a beam kept from the last ``WINDOW`` s (before ``now``) passed."""
+    def entered(self, now: float, points: np.ndarray, dirs: np.ndarray
+                ) -> tuple[np.ndarray, np.ndarray]:
+        """For echoes ``points [P, 2]`` (of beams ``dirs [P, 2]``), tested ``STEP`` beyond the
+        echo against the beams kept from the last ``WINDOW`` s (before ``now``): which lie on
+        the line of one (within ``near``: the robot's map clears a mark the same way), and
+        which of those lay short of its echo then (something came where nothing was)."""
+        none = np.zeros(len(points), dtype=bool)
         live = (self.times >= now - WINDOW) & (self.times < now)
         if not len(points) or not live.any():
-            return np.zeros(len(points), dtype=bool)
+            return none, none
         pose, ranges = self.poses[live], self.ranges[live]                  # [J, 3], [J, B]
         q = points + dirs * STEP
         rel = q[:, None, :] - pose[None, :, :2]                             # [P, J, 2]
@@ -270,9 +290,9 @@ class FreeSpace:
         k = np.clip(k, 0, beams - 1).astype(np.int64)
         off = np.mod(bearing - k * self.step + np.pi, 2 * np.pi) - np.pi    # from that beam
         reach = ranges[np.arange(len(pose))[None, :], k]                    # [P, J]
-        passed = inside & (np.abs(off) < np.pi / 2) & (dist * np.abs(np.sin(off)) <= STEP) \
-            & (dist * np.cos(off) < reach - SHORT)
-        return passed.any(axis=1)
+        on = inside & (np.abs(off) < np.pi / 2) & (dist * np.abs(np.sin(off)) < self.near)
+        passed = on & (dist * np.cos(off) < reach - SHORT)
+        return on.any(axis=1), passed.any(axis=1)
 
 
 Capsule = tuple[np.ndarray, np.ndarray, float]     # a segment's two ends and a radius
