@@ -4,7 +4,8 @@ Laws that hold exactly in floating point are tested exactly: commutativity, the 
 (``T(a, 1) == a``, ``S(a, 0) == a``: the compiled network pads neurons with the identity
 column), the boundary, the range [0, 1], and associativity of min, max, drastic and nilpotent
 norms. The rational norms (Lukasiewicz, product, Einstein, Hamacher) are associative and
-monotone only up to rounding: within 1e-12.
+monotone only up to rounding: within 1e-12, and for the Hamacher sum's associativity near
+``a = b = 1`` within what its division by ``1 - a b`` makes of an ulp.
 
 De Morgan duality ``S(a, b) = 1 - T(1 - a, 1 - b)`` is tested on a dyadic grid, where
 ``1 - a`` is exact: with general floats ``1 - (1 - a) != a`` and the discontinuous norms
@@ -16,7 +17,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from mitos_cli.fuzzy import norms
@@ -79,13 +80,25 @@ def test_identity_and_boundary_exact(norm, a):
 @pytest.mark.parametrize("norm", ALL, ids=IDS)
 @FAST
 @given(a=values, b=values, c=values)
+@example(a=0.9453125, b=0.99999, c=0.99999)      # the Hamacher sum's ill-conditioned corner
 def test_associative(norm, a, b, c):
     left = call(norm, call(norm, a, b), c)
     right = call(norm, a, call(norm, b, c))
     if norm.name in EXACTLY_ASSOCIATIVE:
         assert left == right
     else:
-        assert left == pytest.approx(right, abs=TOL)
+        assert left == pytest.approx(right, abs=TOL + _amplified(norm, a, b, c))
+
+
+def _amplified(norm, a, b, c) -> float:
+    """How far rounding alone may set the two sides apart beyond ``TOL``: the Hamacher sum
+    divides by ``1 - x y``, whose rounding (an ulp of 1) is amplified by ``1 / (1 - x y)``
+    near ``x = y = 1`` (``a = 0.9453125, b = c = 0.99999`` differ by 1.8e-12)."""
+    if norm.name != "hamacher_sum":
+        return 0.0
+    pairs = [(a, b), (b, c), (call(norm, a, b), c), (a, call(norm, b, c))]
+    dens = [1.0 - x * y for x, y in pairs if 1.0 - x * y > 0.0]
+    return 8 * np.finfo(float).eps / min(dens, default=1.0)
 
 
 @pytest.mark.parametrize("norm", ALL, ids=IDS)
