@@ -7,6 +7,7 @@ import math
 from pathlib import Path
 
 import numpy as np
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -76,16 +77,20 @@ def test_an_echo_where_a_beam_passed_a_moment_ago_came_from_something_that_moved
     assert entered(free, 1.0, np.array([[40.0, 0.0]]), east) == [None]
 
 
-def test_free_space_follows_the_robots_pose_and_a_fan_of_beams():
-    angles = np.deg2rad(np.linspace(45, -45, 10))             # a fan, left to right
+@pytest.mark.parametrize("heading_deg", [90, 0, 170, 180, -170, -90])
+@pytest.mark.parametrize("fan_deg", [90, 270])                 # BARN's lidar spans 270 deg
+def test_free_space_follows_the_robots_pose_and_a_fan_of_beams(heading_deg, fan_deg):
+    n = 10
+    angles = np.deg2rad(np.linspace(fan_deg / 2, -fan_deg / 2, n))   # a fan, left to right
     free = movers.FreeSpace.of(angles, ring=False, dt=0.05, resolution=2.0)
-    heading = math.radians(90)                                # the robot faces north
+    heading = math.radians(heading_deg)
     dirs = np.stack([np.cos(angles + heading), np.sin(angles + heading)], axis=1)
-    free.update(0.0, np.array([10.0, 10.0]), dirs, np.full(10, 100.0))
-    ahead = np.array([10.0, 10.0]) + 50 * dirs[4:5]           # on the fifth beam's line
-    assert entered(free, 0.5, ahead, dirs[4:5]) == [True]
-    behind = np.array([[10.0, -40.0]])                        # outside the fan
-    assert entered(free, 0.5, behind, np.array([[0.0, -1.0]])) == [None]
+    p = np.array([10.0, 10.0])
+    free.update(0.0, p, dirs, np.full(n, 100.0))
+    along = p + 50 * dirs                                       # on every beam's line
+    assert entered(free, 0.5, along, dirs) == [True] * n
+    back = -np.array([math.cos(heading), math.sin(heading)])  # straight behind: outside the fan
+    assert entered(free, 0.5, p + 50 * back[None], back[None]) == [None]
 
 
 # --- tracks --------------------------------------------------------------------------------
@@ -211,7 +216,8 @@ def test_capsule_cells_are_the_cells_whose_centres_lie_within_the_radius(ax, ay,
 # --- a robot that waits --------------------------------------------------------------------
 
 YIELD = (ROOT / "worlds" / "moving.yaml").read_text(encoding="utf-8")
-YIELD = YIELD[:YIELD.index("\nobstacles:")].replace("seed: 3", "seed: 12") + """
+assert "\nseed: 3\n" in YIELD, "moving.yaml's seed moved: the yield world is built from it"
+YIELD = YIELD[:YIELD.index("\nobstacles:")].replace("\nseed: 3\n", "\nseed: 12\n") + """
 obstacles:
   - {name: oncoming, shape: rectangle, at: [1000, -14], length: 22, width: 16,
      velocity: [-15, 0]}
@@ -276,3 +282,23 @@ def test_with_no_way_past_what_comes_it_goes_to_a_refuge_and_waits_there_till_it
     on = knowledge.replan(rmap, again, 0, p, goal, 3.0, asked, least, 150)
     assert on is not None and rmap.refuge is None
     assert math.dist(on.goal, (goal.x, goal.y)) < 1e-9
+
+
+def test_a_robot_standing_in_a_movers_way_is_sent_out_of_it():
+    world, rmap, route, (asked, least) = corridor_map()
+    goal, p = world.agents[0].goal, np.array([300.0, -10.0])
+    g = rmap.grid
+    lane = movers.capsule_cells(rmap.occupied.shape, g.resolution, g.origin,
+                                np.array([420.0, -10.0]), p, 12.0)    # straight at it
+    shut = across(rmap, 420, -60, 60)
+    coming = movers.Sweep(lane | shut.cells, 12.0)
+    col, row = rmap.cell_indices(p[None])[0]
+    assert coming.cells[row, col]                           # it stands in the cart's way
+    to_refuge = knowledge.replan(rmap, route, 270, p, goal, 1.0, asked, least, 150,
+                                 moving=coming)
+    assert to_refuge is not None and rmap.refuge is not None
+    place = np.array([rmap.refuge.x, rmap.refuge.y])
+    room = Clearance.of(rmap.occupied | coming.cells, g.resolution, g.origin, cap=asked + 10)
+    assert room.at(place[None])[0] >= asked                 # out of the cart's way
+    assert math.dist(place, p) > 12.0                       # which it was not, where it stood
+

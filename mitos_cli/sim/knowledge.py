@@ -489,7 +489,7 @@ def way_past(rmap: RobotMap, route: Route, s: float, p: np.ndarray, ahead: float
 
 
 def replan(rmap: RobotMap, route: Route, s: float, p: np.ndarray, goal: Goal, t: float,
-           clearance: float, minimum: float, sight: float, when: str = "clearance",
+           clearance: float, minimum: float, sight: float, when: str = "clearance", *,
            heading: float = 0.0, behind: float = 0.0,
            moving: movers.Sweep | None = None) -> Route | None:
     """A new route from ``p`` when what the robot has newly sensed invalidates the route ahead
@@ -528,8 +528,8 @@ def replan(rmap: RobotMap, route: Route, s: float, p: np.ndarray, goal: Goal, t:
 
     if moving is None:
         new = toward(goal, rmap.occupied)
-        if new is None:
-            return None            # no way left on what it knows: drive on, the rules decide
+        if new is None:            # no way left on what it knows: drive on, the rules decide
+            return None            # (at a refuge: wait there, and try again at the next check)
         rmap.refuge = None
     else:
         occupied = rmap.occupied | _holed(rmap.grid, moving.cells, p,

@@ -734,7 +734,8 @@ class Simulation:
                 route = knowledge.replan(rmap, routes[i], f.s, s.pose[i, :2],
                                          self.world.agents[i].goal, s.t, *self._asked[i],
                                          self._cfg.sight, self.world.replan,
-                                         math.degrees(self._h[i]), BEHIND, sweep)
+                                         heading=math.degrees(self._h[i]), behind=BEHIND,
+                                         moving=sweep)
                 if route is not None:
                     routes[i] = route
                     self._replanned.append((self._k, i, route))

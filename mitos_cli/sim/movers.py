@@ -53,7 +53,7 @@ SHORT = 4.0          # in: a beam passes through what lies up to this short of i
 STEP = 2.0           # in: an echo is tested this far beyond it
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Mover:
     """A tracked object that moves: its centre (in), its velocity (in/s) and its half size."""
 
@@ -81,13 +81,14 @@ class Sweep:
 class Track:
     """One object followed from tick to tick: the times and centres it was seen at."""
 
-    times: list[float] = field(default_factory=list)
-    centres: list[np.ndarray] = field(default_factory=list)
+    times: list[float] = field(default_factory=list, repr=False)
+    centres: list[np.ndarray] = field(default_factory=list, repr=False)
     radius: float = 0.0
-    moved: list[bool | None] = field(default_factory=list)
+    moved: list[bool | None] = field(default_factory=list, repr=False)
     # per sighting: whether its echoes came where a beam passed before (None: no beam's
     # line crossed them)
     mover: bool = False          # found moving once: it stays a mover while it is followed
+    # and fitted a velocity of 6-120 in/s
     v: np.ndarray | None = None  # its velocity when it was last seen, if a mover
     fit: np.ndarray | None = None   # its :meth:`velocity` when it was last seen
     born: float = 0.0            # when it was first seen
@@ -102,7 +103,8 @@ class Track:
         """Whether its place moved ``MIN_TRAVEL`` or more over the last ``WINDOW`` s: the
         echoes of a standing object slide along its sides as the robot drives by, but not
         farther than the object is long."""
-        first = next(k for k, t in enumerate(self.times) if t >= now - WINDOW)
+        first = next((k for k, t in enumerate(self.times) if t >= now - WINDOW),
+                     len(self.times) - 1)
         return math.dist(self.centres[first], self.centres[-1]) >= MIN_TRAVEL
 
     def velocity(self, now: float) -> np.ndarray | None:
@@ -196,8 +198,9 @@ class Tracker:
         tr.centres.append(centre)
         tr.radius = radius
         tr.moved.append(moved)
-        if len(tr.times) > 64:
-            del tr.times[:-32], tr.centres[:-32], tr.moved[:-32]
+        if now - tr.times[0] > 2 * WINDOW:         # keep what the window and the vote read
+            first = next(k for k, t in enumerate(tr.times) if t >= now - WINDOW)
+            del tr.times[:first], tr.centres[:first], tr.moved[:first]
         # (what stands is matched where it was: only what may move is worth a fit)
         tr.fit = tr.velocity(now) if tr.mover or tr.moving(now) else None
 
@@ -244,9 +247,9 @@ class FreeSpace:
     a0: float                   # rad: the first beam's direction from the heading
     step: float                 # rad between neighbouring beams
     ring: bool                  # the beams go all round
-    times: np.ndarray           # [J] s (-inf: an empty slot)
-    poses: np.ndarray           # [J, 3] x, y (in), heading (rad)
-    ranges: np.ndarray          # [J, B] in
+    times: np.ndarray = field(repr=False)     # [J] s (-inf: an empty slot)
+    poses: np.ndarray = field(repr=False)     # [J, 3] x, y (in), heading (rad)
+    ranges: np.ndarray = field(repr=False)    # [J, B] in
     near: float                 # in: how near a beam's line a point it passed lies
     slot: int = 0
 
@@ -282,7 +285,10 @@ class FreeSpace:
         q = points + dirs * STEP
         rel = q[:, None, :] - pose[None, :, :2]                             # [P, J, 2]
         dist = np.hypot(rel[..., 0], rel[..., 1])
-        bearing = np.arctan2(rel[..., 1], rel[..., 0]) - pose[None, :, 2] - self.a0
+        ahead = np.arctan2(rel[..., 1], rel[..., 0]) - pose[None, :, 2]     # from the heading
+        if not self.ring:        # a fan's beams do not wrap round: (-pi, pi] before its first
+            ahead = np.mod(ahead + np.pi, 2 * np.pi) - np.pi
+        bearing = ahead - self.a0
         beams = ranges.shape[1]
         k = np.rint(bearing / self.step) if self.step else np.zeros_like(bearing)
         k = np.mod(k, beams) if self.ring else k
