@@ -31,6 +31,7 @@ from __future__ import annotations
 import bisect
 import functools
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -497,61 +498,82 @@ def replan(rmap: RobotMap, route: Route, s: float, p: np.ndarray, goal: Goal, t:
     will pass (:class:`.movers.Sweep`): the route keeps clear of that too (but for a way out
     round the robot), and where that leaves no way to the goal it leads to a refuge out of
     their way (:func:`refuge`) until one opens."""
-    if when == "never" or t - rmap.checked_at < REPLAN_EVERY:
+    if not _due(rmap, route, s, p, t, clearance, minimum, sight, when, moving):
         return None
-    sweep = None if moving is None else moving.cells
-    if not rmap.fresh and sweep is None and rmap.refuge is None:
-        return None
-    fresh = np.concatenate(rmap.fresh) if rmap.fresh else np.zeros((0, 2))
-    rmap.fresh.clear()
-    rmap.checked_at = t
-    reach = minimum + rmap.grid.resolution / 2          # a mark is a cell, not its centre
-    crossing = sweep is not None and bool(route.near(_cell_centres(rmap.grid, sweep), s, reach,
-                                                     sight).any())
-    if rmap.refuge is None and not crossing:
-        if when == "clearance":
-            if not route.near(fresh, s, reach, sight).any():
-                return None
-        elif not route.near(fresh, s, clearance, sight).any() or \
-                way_past(rmap, route, s, p, sight, clearance, minimum):
-            return None
-    leave = clearance + 6.0
     start = Pose(float(p[0]), float(p[1]), heading)
-
-    def toward(where: Goal, occupied: np.ndarray) -> Route | None:
-        try:
-            return grid_route(_as_map(rmap.grid), start, where, clearance, minimum=minimum,
-                              occupied=occupied, explain=False, leave=leave, behind=behind,
-                              last=rmap.prepared)
-        except NarrowPassage:
-            return None
-
+    plan = functools.partial(_plan, rmap, start, clearance, minimum, behind)
     if moving is None:
-        new = toward(goal, rmap.occupied)
+        new = plan(goal, rmap.occupied)
         if new is None:            # no way left on what it knows: drive on, the rules decide
             return None            # (at a refuge: wait there, and try again at the next check)
         rmap.refuge = None
     else:
-        occupied = rmap.occupied | _holed(rmap.grid, moving.cells, p,
-                                          max(leave, moving.wide + 6.0))
-        # a robot at a refuge waits there till nothing comes toward it; on its way it
-        # keeps right of what comes down its lane if it can
-        new = None
-        if rmap.refuge is None and moving.keep_right is not None:
-            new = toward(goal, occupied | _holed(rmap.grid, moving.keep_right, p,
-                                                 max(leave, moving.wide + 6.0)))
-        if rmap.refuge is None and new is None:
-            new = toward(goal, occupied)
-        if new is not None:
-            rmap.refuge = None
-        else:
-            new = refuge(rmap, rmap.occupied | moving.cells, occupied, start, clearance,
-                         minimum, sight, behind)
-            if new is None:
-                return None
-            rmap.refuge = Goal(float(new.goal[0]), float(new.goal[1]))
+        new = _past_movers(rmap, moving, plan, p, goal, start, clearance, minimum, sight, behind)
+        if new is None:
+            return None
     rmap.replans += 1
     rmap.planned = rmap.occupied.copy()
+    return new
+
+
+def _due(rmap: RobotMap, route: Route, s: float, p: np.ndarray, t: float, clearance: float,
+         minimum: float, sight: float, when: str, moving: movers.Sweep | None) -> bool:
+    """Whether the route is planned again at ``t``: a check is due (every ``REPLAN_EVERY``
+    s), and what was marked since the last one comes near the route ahead (``when``), or
+    a mover will pass across it, or the robot waits at a refuge. A check takes the marks."""
+    if when == "never" or t - rmap.checked_at < REPLAN_EVERY:
+        return False
+    if not rmap.fresh and moving is None and rmap.refuge is None:
+        return False
+    fresh = np.concatenate(rmap.fresh) if rmap.fresh else np.zeros((0, 2))
+    rmap.fresh.clear()
+    rmap.checked_at = t
+    reach = minimum + rmap.grid.resolution / 2          # a mark is a cell, not its centre
+    if rmap.refuge is not None or moving is not None and bool(
+            route.near(_cell_centres(rmap.grid, moving.cells), s, reach, sight).any()):
+        return True
+    if when == "clearance":
+        return bool(route.near(fresh, s, reach, sight).any())
+    return (bool(route.near(fresh, s, clearance, sight).any())
+            and not way_past(rmap, route, s, p, sight, clearance, minimum))
+
+
+def _plan(rmap: RobotMap, start: Pose, clearance: float, minimum: float, behind: float,
+          where: Goal, occupied: np.ndarray) -> Route | None:
+    """A route on ``occupied`` (cells like ``rmap``'s) from ``start`` to ``where``, or
+    ``None`` where none keeps ``minimum``."""
+    try:
+        return grid_route(_as_map(rmap.grid), start, where, clearance, minimum=minimum,
+                          occupied=occupied, explain=False, leave=clearance + 6.0,
+                          behind=behind, last=rmap.prepared)
+    except NarrowPassage:
+        return None
+
+
+Planner = Callable[[Goal, np.ndarray], Route | None]   # _plan from the robot, to a place
+
+
+def _past_movers(rmap: RobotMap, moving: movers.Sweep, plan: Planner, p: np.ndarray,
+                 goal: Goal, start: Pose, clearance: float, minimum: float, sight: float,
+                 behind: float) -> Route | None:
+    """A route to the goal clear of where the movers will pass (but round the robot), right
+    of those down its lane where there is room; where there is none, a route to a refuge,
+    and the robot at a refuge waits there till nothing comes toward it; ``None`` when
+    neither is left. ``plan(where, occupied)``: :func:`_plan` from the robot."""
+    hole = max(clearance + 6.0, moving.wide + 6.0)
+    occupied = rmap.occupied | _holed(rmap.grid, moving.cells, p, hole)
+    new = None
+    if rmap.refuge is None and moving.keep_right is not None:
+        new = plan(goal, occupied | _holed(rmap.grid, moving.keep_right, p, hole))
+    if rmap.refuge is None and new is None:
+        new = plan(goal, occupied)
+    if new is not None:
+        rmap.refuge = None
+        return new
+    new = refuge(rmap, rmap.occupied | moving.cells, occupied, start, clearance, minimum,
+                 sight, behind)
+    if new is not None:
+        rmap.refuge = Goal(float(new.goal[0]), float(new.goal[1]))
     return new
 
 
