@@ -146,7 +146,7 @@ def test_what_moves_away_or_stands_is_no_mover():
 def test_a_mover_missed_for_a_tick_or_two_is_kept_where_it_should_be():
     tracker = movers.Tracker()
     t = follow(tracker, (300, 0), (-15, 0), 2.0, moved=True)
-    assert tracker.movers(t, np.zeros(2), own=np.zeros(2))         # (called every tick)
+    assert tracker.movers(t, np.zeros(2), own=np.zeros(2))
     tracker.update(t + 0.2, [], [])
     found = tracker.movers(t + 0.2, np.zeros(2), own=np.zeros(2))
     assert len(found) == 1 and math.isclose(found[0].centre[0], 300 - 15 * (t + 0.2), abs_tol=2)

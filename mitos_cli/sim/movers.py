@@ -87,8 +87,8 @@ class Track:
     moved: list[bool | None] = field(default_factory=list, repr=False)
     # per sighting: whether its echoes came where a beam passed before (None: no beam's
     # line crossed them)
-    mover: bool = False          # found moving once: it stays a mover while it is followed
-    # and fitted a velocity of 6-120 in/s
+    mover: bool = False          # found moving once, it stays a mover while it is followed
+    # and fitted a velocity of 6-120 in/s (told at each sighting)
     v: np.ndarray | None = None  # its velocity when it was last seen, if a mover
     fit: np.ndarray | None = None   # its :meth:`velocity` when it was last seen
     born: float = 0.0            # when it was first seen
@@ -202,7 +202,13 @@ class Tracker:
             first = next(k for k, t in enumerate(tr.times) if t >= now - WINDOW)
             del tr.times[:first], tr.centres[:first], tr.moved[:first]
         # (what stands is matched where it was: only what may move is worth a fit)
-        tr.fit = tr.velocity(now) if tr.mover or tr.moving(now) else None
+        tr.fit = v = tr.velocity(now) if tr.mover or tr.moving(now) else None
+        if 2 * radius > MAX_EXTENT:          # a wall, for now: neither found nor lost moving
+            return
+        speed = 0.0 if v is None else float(np.hypot(*v))
+        tr.mover = (v is not None and (tr.mover or tr.moving(now) and tr.travelled(now))
+                    and MIN_SPEED <= speed <= MAX_SPEED)
+        tr.v = v
 
     def movers(self, now: float, robot: np.ndarray, own: np.ndarray) -> list[Mover]:
         """The tracks that move toward the robot at ``robot [2]`` driving at velocity ``own
@@ -211,22 +217,12 @@ class Tracker:
         cart between two beams for a tick or two)."""
         out = []
         for tr in self.tracks:
-            if 2 * tr.radius > MAX_EXTENT:
+            v = tr.v
+            if 2 * tr.radius > MAX_EXTENT or not tr.mover or v is None:
                 continue
-            if tr.times[-1] == now:
-                v = tr.fit
-                speed = 0.0 if v is None else float(np.hypot(*v))
-                tr.mover = (v is not None and (tr.mover or tr.moving(now) and tr.travelled(now))
-                            and MIN_SPEED <= speed <= MAX_SPEED)
-                tr.v = v
-                centre = tr.centres[-1]
-            elif tr.mover and tr.v is not None:
-                v, speed = tr.v, float(np.hypot(*tr.v))
-                centre = tr.centres[-1] + v * (now - tr.times[-1])
-            else:
-                continue
-            if not tr.mover or v is None:
-                continue
+            speed = float(np.hypot(*v))
+            centre = (tr.centres[-1] if tr.times[-1] == now
+                      else tr.centres[-1] + v * (now - tr.times[-1]))
             to_robot = robot - centre
             dist = float(np.hypot(*to_robot))
             # it heads for the robot, and the robot does not draw away from it faster
