@@ -8,13 +8,14 @@ segmented. A :class:`Tracker` matches each object to the track it kept from the 
 seen at over the last ``WINDOW`` seconds (a Theil-Sen slope: the echoes of a cart hop from
 one end of it to the other, and a median does not follow them).
 
-A track is a *mover* (:meth:`Tracker.movers`) when most of its recent echoes came from space
-a beam had passed through a moment before (:class:`FreeSpace`: something came where nothing
-was), its centre travelled ``MIN_TRAVEL`` or more, it moves at ``MIN_SPEED`` or more, it is
-no longer than ``MAX_EXTENT`` (a cart, a person, a robot: not a wall) and it comes toward the
-robot (within 60 deg of the robot's bearing from it, closing faster than the robot draws
-away). The echoes of a standing object slide along its faces as the robot drives by, but
-never into space a beam had just passed through, nor farther than the object is long.
+A track is a *mover* when most of its recent echoes came from space a beam had passed
+through a moment before (:class:`FreeSpace`: something came where nothing was), its centre
+travelled ``MIN_TRAVEL`` or more, it moves at ``MIN_SPEED`` to ``MAX_SPEED`` and it is no
+longer than ``MAX_EXTENT`` (a cart, a person, a robot: not a wall); :meth:`Tracker.movers`
+lists those that come toward the robot (within 60 deg of the robot's bearing from it,
+closing faster than the robot draws away). The echoes of a standing object slide along its
+faces as the robot drives by, but seldom into space a beam had just passed through, nor
+farther than the object is long.
 
 Where a mover goes (:func:`swept`) is a capsule from its centre along its velocity, as wide
 as the object and ``HALF_WIDTH`` at least (a sonar ring sees one or two echoes of a cart:
