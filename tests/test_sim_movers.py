@@ -284,6 +284,29 @@ def test_with_no_way_past_what_comes_it_goes_to_a_refuge_and_waits_there_till_it
     assert math.dist(on.goal, (goal.x, goal.y)) < 1e-9
 
 
+def test_a_robot_at_its_refuge_waits_while_a_mover_comes_whose_way_is_not_drawn():
+    # a cart whose heading is not known yet sweeps only down the robot's lane; the robot
+    # turned out of that lane for its refuge, and the cart still comes toward it
+    world, rmap, route, (asked, least) = corridor_map()
+    goal, p = world.agents[0].goal, np.array([300.0, -10.0])
+    cart = movers.Mover(np.array([380.0, -14.0]), np.array([-15.0, 0.0]), 8.0, settled=False)
+    turned = math.radians(60.0)
+    assert movers.swept(cart, p, turned, 24, 18) == []
+    args = (p, turned, 24, 18, rmap.occupied.shape, rmap.grid.resolution, rmap.grid.origin)
+    assert movers.sweep([cart], *args) is None                # nothing it must keep clear of
+    waiting = movers.sweep([cart], *args, waiting=True)
+    assert waiting is not None and not waiting.cells.any()
+    assert movers.sweep([], *args, waiting=True) is None      # nothing comes: it goes on
+    to_refuge = knowledge.replan(rmap, route, 270, p, goal, 1.0, asked, least, 150,
+                                 moving=across(rmap, 400, -60, 60))
+    assert to_refuge is not None and rmap.refuge is not None
+    place = (rmap.refuge.x, rmap.refuge.y)
+    again = knowledge.replan(rmap, to_refuge, 0, p, goal, 2.0, asked, least, 150,
+                             moving=waiting)
+    assert again is not None and math.dist(again.goal, place) < 1e-9
+    assert rmap.refuge is not None
+
+
 def test_a_robot_standing_in_a_movers_way_is_sent_out_of_it():
     world, rmap, route, (asked, least) = corridor_map()
     goal, p = world.agents[0].goal, np.array([300.0, -10.0])

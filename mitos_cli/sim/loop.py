@@ -860,7 +860,8 @@ class Simulation:
         asked, least = self._asked[i]
         room = asked - least
         return movers.sweep(found, p, h, robot.length, robot.width, rmap.occupied.shape,
-                            grid.resolution, grid.origin, room, self.world.sensors.range)
+                            grid.resolution, grid.origin, room, self.world.sensors.range,
+                            waiting=rmap.refuge is not None)
 
     def check(self, s: _Sensed) -> None:
         """Contact (clearance <= 0) and arrival; an arrived robot stops driving."""

@@ -331,11 +331,14 @@ def swept(m: Mover, robot: np.ndarray, heading: float, length: float, width: flo
 
 def sweep(found: list[Mover], robot: np.ndarray, heading: float, length: float, width: float,
           shape: tuple[int, int], resolution: float, origin: tuple[float, float],
-          room: float = 0.0, far: float = 150.0) -> Sweep | None:
+          room: float = 0.0, far: float = 150.0, waiting: bool = False) -> Sweep | None:
     """The cells of a map (``shape``, ``resolution``, ``origin``) that the movers ``found``
     will sweep while the robot (see :func:`swept`) gets out of their way; ``None`` when
     none. With movers in its lane, :attr:`Sweep.keep_right` too: the same ways ``room``
-    wider, and the robot's left of those movers up to ``far``."""
+    wider, and the robot's left of those movers up to ``far``. A robot ``waiting`` at a
+    refuge waits while anything is ``found`` (an empty sweep): a mover whose heading is not
+    known yet sweeps nothing once the robot has turned out of its lane for the refuge, and
+    it comes on all the same."""
     cells = np.zeros(shape, dtype=bool)
     roomy = np.zeros(shape, dtype=bool)
     left = np.zeros(shape, dtype=bool)
@@ -347,7 +350,7 @@ def sweep(found: list[Mover], robot: np.ndarray, heading: float, length: float, 
             wide = max(wide, radius)
         if lane(m, robot, heading, width):
             left |= left_cells(shape, resolution, origin, robot, m.centre, HALF_WIDTH, far)
-    if not wide:
+    if not wide and not (waiting and found):
         return None
     return Sweep(cells, wide, (left | roomy) if left.any() else None)
 
