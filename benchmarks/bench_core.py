@@ -181,18 +181,33 @@ def simpful_system(rb):
 # ---------------------------------------------------------------------------------------------
 # timing helpers
 
+#: Calls of one function in a row within a round; the first is not timed. The call after
+#: another function's pays for it: OpenBLAS's threads spin for a while after the kernel's
+#: product, so the batch timed next had one core (86-119 ms against 64-70 ms on 2 cores).
+CALLS = 3
+
+
+def in_a_row(fn, calls: int = CALLS) -> tuple[float, float]:
+    """The best wall and CPU seconds of the calls of ``fn`` after the first of ``calls`` in a
+    row."""
+    fn()
+    wall = cpu = float("inf")
+    for _ in range(calls - 1):
+        t0, c0 = time.perf_counter(), time.process_time()
+        fn()
+        cpu = min(cpu, time.process_time() - c0)
+        wall = min(wall, time.perf_counter() - t0)
+    return wall, cpu
+
+
 def interleaved_best(fns: dict, repeats: int) -> dict:
-    """Best time of each function over ``repeats`` rounds that call every one in turn, so a
-    machine whose load changes during the run slows each of them alike (the ratios are what
-    the benchmark reports)."""
-    for fn in fns.values():
-        fn()                                       # warm-up
+    """Best time of each function over ``repeats`` rounds that call every one in turn (each
+    :data:`CALLS` times in a row, :func:`in_a_row`), so a machine whose load changes during
+    the run slows each of them alike (the ratios are what the benchmark reports)."""
     best = {name: float("inf") for name in fns}
     for _ in range(repeats):
         for name, fn in fns.items():
-            t0 = time.perf_counter()
-            fn()
-            best[name] = min(best[name], time.perf_counter() - t0)
+            best[name] = min(best[name], in_a_row(fn)[0])
     return best
 
 
@@ -296,14 +311,10 @@ def against(rev: str, quick: bool = False) -> None:
                "this tree": lambda: rb.evaluate(**columns)}
         wall = {k: float("inf") for k in fns}
         cpu = dict(wall)
-        for fn in fns.values():
-            fn()
         for _ in range(rounds):
             for name, fn in fns.items():
-                t0, c0 = time.perf_counter(), time.process_time()
-                fn()
-                cpu[name] = min(cpu[name], time.process_time() - c0)
-                wall[name] = min(wall[name], time.perf_counter() - t0)
+                w, cp = in_a_row(fn)
+                cpu[name], wall[name] = min(cpu[name], cp), min(wall[name], w)
         memory = {name: peak_memory(fn) for name, fn in fns.items()}
 
         pts = [tuple(map(float, x)) for x in X[:single_n]]
@@ -337,8 +348,9 @@ def against(rev: str, quick: bool = False) -> None:
     print(f"machine: {host}")
     print(_threads())
     print(f"command: python benchmarks/bench_core.py --against {rev}{' --quick' if quick else ''}")
-    print(f"batch: {n:,} random inputs, best of {rounds} interleaved rounds (wall; CPU time of the "
-          f"process in brackets); single: median of {rounds} alternating rounds of {single_n} calls; "
+    print(f"batch: {n:,} random inputs, best of {rounds} interleaved rounds of {CALLS} calls in a "
+          f"row, the first untimed (wall; CPU time of the process in brackets); single: median "
+          f"of {rounds} alternating rounds of {single_n} calls; "
           f"process: median of {runs} alternating runs\n")
     print(f"| measurement | {rev} | this tree |")
     print("| --- | ---: | ---: |")
@@ -491,7 +503,8 @@ def main() -> None:
     print(f"machine: {host}")
     print(_threads())
     print(f"command: python benchmarks/bench_core.py{' --quick' if args.quick else ''}")
-    print(f"batch: {n:,} random inputs, best of {2 * repeats} interleaved rounds after a warm-up; "
+    print(f"batch: {n:,} random inputs, best of {2 * repeats} interleaved rounds of {CALLS} calls "
+          f"in a row, the first untimed; "
           f"single: median of {repeats} repeats of the mean over {single_n} (MITOS) / "
           f"{len(pts[:max(50, single_n // 4)])} (peers) calls; process: median of {runs} runs\n")
     print("| measurement | figure | ratio |")

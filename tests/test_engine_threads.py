@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from mitos_cli import load_rulebase
-from mitos_cli.engine import threads
+from mitos_cli.engine import evaluation, threads
 from mitos_cli.engine.evaluation import BLOCK, GRID_BLOCK, evaluate, evaluate_columns
 from mitos_cli.errors import InputError
 
@@ -39,6 +39,16 @@ def test_columns_keep_their_bits_in_any_number_of_threads(behavior, monkeypatch)
     monkeypatch.setenv(threads.ENV, "1")
     for i in (0, GRID_BLOCK - 1, GRID_BLOCK, 3 * GRID_BLOCK + 5, len(X) - 1):
         assert np.array_equal(_bits(evaluate_columns(c, X[i:i + 1].T))[:, 0], outs[0][:, i])
+
+
+def test_one_thread_takes_blocks_its_cache_holds_and_threads_take_wide_ones(monkeypatch):
+    g = load_rulebase().compiled.grid_batch
+    monkeypatch.setenv(threads.ENV, "1")
+    narrow = evaluation._grid_width(g, 10**6)
+    assert narrow == 1536 and narrow % 256 == 0          # 27 rules: 912 bytes a sample
+    monkeypatch.setenv(threads.ENV, "2")
+    assert evaluation._grid_width(g, 10**6) == GRID_BLOCK
+    assert evaluation._grid_width(g, GRID_BLOCK) == narrow    # one block: the caller's thread
 
 
 def test_rows_keep_their_bits_and_details_in_any_number_of_threads(monkeypatch):

@@ -9,6 +9,7 @@ in any batch.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 
@@ -20,7 +21,7 @@ from ..fuzzy import norms
 from ..fuzzy.shapes import SHAPES
 from .compile import CompiledRuleBase
 from .inputs import floats
-from .threads import Blocks, map_blocks
+from .threads import Blocks, map_blocks, thread_count
 
 
 @dataclass(frozen=True, eq=False)   # holds arrays: identity, not ==
@@ -530,8 +531,17 @@ def _input_columns(compiled: CompiledRuleBase, Xt) -> tuple[object, list[np.ndar
     return Xt, [floats(x, f"input `{name}`") for x, name in zip(Xt, compiled.inputs)]
 
 
-#: Samples per block of :func:`_grid_columns`.
+#: Samples per block of :func:`_grid_columns` when the batch is spread over threads. Every
+#: NumPy call releases the GIL and takes it back, so threads that make many short calls wait
+#: on each other: wide blocks make fewer (on 2 cores, 1,536-sample blocks in two threads ran
+#: slower than in one).
 GRID_BLOCK = 8192
+
+#: Bytes of a block's buffers when one thread evaluates the batch: three quarters of a core's
+#: L2 cache (2 MiB on the Xeon measured), so that a block stays there. For the paper's 27
+#: rules that is 1,536 samples, which ran 1.3x the 8,192 of :data:`GRID_BLOCK` in one thread
+#: (1,024 and 2,048: 1.2x; ``benchmarks/bench_core.py``).
+CACHE_BYTES = 1_572_864
 
 
 class _GridBlock:
@@ -613,7 +623,7 @@ def _grid_columns(compiled: CompiledRuleBase, g, columns: list, out: np.ndarray)
     lo, hi = plan.bounds
     inside = all(lo[v] <= x.min() and x.max() <= hi[v]      # NaN fails both
                  for v, x in enumerate(columns))
-    count = -(-n // GRID_BLOCK)
+    count = -(-n // _grid_width(g, n))
     width = -(-n // count)                     # blocks of one width, the last no wider
     last = n - (count - 1) * width
 
@@ -629,6 +639,20 @@ def _grid_columns(compiled: CompiledRuleBase, g, columns: list, out: np.ndarray)
         finally:
             np.setbufsize(old)
     return any(map_blocks(blocks, n, width))
+
+
+def _grid_width(g, n: int) -> int:
+    """The widest block of :func:`_grid_columns` for ``n`` samples: :data:`GRID_BLOCK` when
+    they are spread over threads, else as many samples as :data:`CACHE_BYTES` holds of the
+    buffers of :class:`_GridBlock` (a multiple of 256, at least 512 and at most
+    :data:`GRID_BLOCK`)."""
+    if n > GRID_BLOCK and thread_count() > 1:
+        return GRID_BLOCK
+    k, t = g.B.shape[:2]
+    R, nw = g.Kw.shape[:2]
+    inner = sum(math.prod(g.shape[:d + 1]) for d in range(1, len(g.axes) - 1))
+    per_sample = 8 * (k + 2 * (k * t + 1) + 1 + inner + R * (nw + 1))
+    return min(GRID_BLOCK, max(512, CACHE_BYTES // per_sample // 256 * 256))
 
 
 def _grid_block(compiled: CompiledRuleBase, g, b: _GridBlock, columns: list, inside: bool,
