@@ -43,6 +43,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+from peers import require
 from revision import package_of
 
 from mitos_cli import load_rulebase
@@ -418,6 +419,7 @@ def main() -> None:
     if args.against:
         against(args.against, quick=args.quick)
         return
+    require("bench_core.py", "fuzzylite", "simpful")
     n = 10**5 if args.quick else 10**6
     repeats = 3 if args.quick else 5
     single_n = 200 if args.quick else 2000

@@ -28,6 +28,7 @@ from pathlib import Path
 
 import numpy as np
 import yaml
+from peers import require
 
 FL_TNORM = {"min": "Minimum", "product": "AlgebraicProduct", "lukasiewicz": "BoundedDifference",
             "drastic": "DrasticProduct", "einstein": "EinsteinProduct",
@@ -180,6 +181,7 @@ def main() -> None:
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--seed", type=int, default=0)
     args = ap.parse_args()
+    require("bench_norms.py", "fuzzylite", "skfuzzy")
 
     import fuzzylite as fl
 

@@ -31,6 +31,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from bench_core import _version, best_of, fmt_time, fuzzylite_engine, machine  # noqa: E402
+from peers import require  # noqa: E402
 
 from mitos_cli import load_rulebase
 from mitos_cli.draw import data as plotdata  # noqa: E402
@@ -59,6 +60,7 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--quick", action="store_true", help="small sizes, for a smoke run")
     args = ap.parse_args()
+    require("bench_plot.py", "fuzzylite", "matplotlib")
     n = 51 if args.quick else 201
     loop_n = 21 if args.quick else 61          # per-point loops run on a coarser grid
     repeats = 3 if args.quick else 5
