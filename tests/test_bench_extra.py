@@ -75,3 +75,15 @@ def test_the_bench_extra_installs_every_import_of_the_benchmarks():
     assert not missing, f"add to the bench extra in pyproject.toml: {missing}"
     for dist, needs in UNDECLARED.items():
         assert dist in provided and needs <= provided, (dist, needs - provided)
+
+
+def test_a_benchmark_names_a_missing_peer_and_how_to_install_it(monkeypatch, capsys):
+    monkeypatch.syspath_prepend(str(ROOT / "benchmarks"))
+    import peers
+
+    peers.require("bench_x.py", "json")                      # present: nothing happens
+    with pytest.raises(SystemExit) as exit_:
+        peers.require("bench_x.py", "json", "skfuzzy_not_here", "fuzzylite_not_here")
+    message = str(exit_.value.code)
+    assert message.startswith("bench_x.py: the peers it is measured against are not installed")
+    assert "skfuzzy_not_here, fuzzylite_not_here" in message and 'pip install -e ".[bench]"' in message
