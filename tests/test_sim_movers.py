@@ -285,16 +285,13 @@ def test_with_no_way_past_what_comes_it_goes_to_a_refuge_and_waits_there_till_it
 
 
 def test_a_robot_at_its_refuge_waits_while_a_mover_comes_whose_way_is_not_drawn():
-    # a cart whose heading is not known yet sweeps only down the robot's lane (and, for a
-    # robot bound for a refuge, straight at it while it stands in the cart's way); the robot
-    # turned out of that lane for its refuge, and the cart, passing beside it, still comes
+    # a cart whose heading is not known yet sweeps only down the robot's lane; the robot
+    # turned out of that lane for its refuge, and the cart still comes toward it
     world, rmap, route, (asked, least) = corridor_map()
     goal, p = world.agents[0].goal, np.array([300.0, -10.0])
-    cart = movers.Mover(np.array([380.0, -36.0]), np.array([-15.0, 0.0]), 8.0, settled=False)
+    cart = movers.Mover(np.array([380.0, -14.0]), np.array([-15.0, 0.0]), 8.0, settled=False)
     turned = math.radians(60.0)
-    assert not movers.in_way(cart, p, 18)
     assert movers.swept(cart, p, turned, 24, 18) == []
-    assert movers.swept(cart, p, turned, 24, 18, waiting=True) == []
     args = (p, turned, 24, 18, rmap.occupied.shape, rmap.grid.resolution, rmap.grid.origin)
     assert movers.sweep([cart], *args) is None                # nothing it must keep clear of
     waiting = movers.sweep([cart], *args, waiting=True)
@@ -308,35 +305,6 @@ def test_a_robot_at_its_refuge_waits_while_a_mover_comes_whose_way_is_not_drawn(
                              moving=waiting)
     assert again is not None and math.dist(again.goal, place) < 1e-9
     assert rmap.refuge is not None
-
-
-def test_a_robot_turned_for_its_refuge_keeps_out_of_the_way_of_what_comes_at_it():
-    # turned 60 deg for its refuge, the robot has left its own lane, but it stands in the way
-    # of the cart (its line of travel passes 4 in from the robot): waiting, the robot keeps
-    # the way straight at it clear, and is sent out of it, not left where the cart will pass
-    world, rmap, route, (asked, least) = corridor_map()
-    goal, p = world.agents[0].goal, np.array([300.0, -10.0])
-    cart = movers.Mover(np.array([380.0, -14.0]), np.array([-15.0, 0.0]), 8.0, settled=False)
-    turned = math.radians(60.0)
-    assert movers.in_way(cart, p, 18) and not movers.lane(cart, p, turned, 18)
-    assert movers.swept(cart, p, turned, 24, 18) == []         # driving on: its lane only
-    ((a, b, radius),) = movers.swept(cart, p, turned, 24, 18, waiting=True)
-    assert np.array_equal(a, cart.centre) and np.array_equal(b, p) and radius == 12.0
-    behind = movers.Mover(cart.centre, -cart.velocity, 8.0, settled=False)
-    assert not movers.in_way(behind, p, 18)                     # going away: not in its way
-    to_refuge = knowledge.replan(rmap, route, 270, p, goal, 1.0, asked, least, 150,
-                                 moving=across(rmap, 400, -60, 60))
-    assert to_refuge is not None and rmap.refuge is not None
-    args = (p, turned, 24, 18, rmap.occupied.shape, rmap.grid.resolution, rmap.grid.origin)
-    coming = movers.sweep([cart], *args, waiting=True)
-    assert coming is not None and coming.cells.any()
-    again = knowledge.replan(rmap, to_refuge, 0, p, goal, 2.0, asked, least, 150,
-                             moving=coming)
-    assert again is not None and rmap.refuge is not None
-    place = np.array([rmap.refuge.x, rmap.refuge.y])
-    g = rmap.grid
-    room = Clearance.of(rmap.occupied | coming.cells, g.resolution, g.origin, cap=asked + 10)
-    assert room.at(place[None])[0] >= asked                 # out of the cart's way
 
 
 def test_a_robot_standing_in_a_movers_way_is_sent_out_of_it():

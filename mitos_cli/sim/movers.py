@@ -21,11 +21,11 @@ Where a mover goes (:func:`swept`) is a capsule from its centre along its veloci
 as the object and ``HALF_WIDTH`` at least (a sonar ring sees one or two echoes of a cart:
 its middle, not its edges): to ``PAST`` body lengths past the robot once its heading is
 known (``SETTLE`` s of track); and while it comes down the robot's lane, straight at the
-robot (for a robot bound for a refuge, also while the robot stands in its way). Replanning
-(:func:`.knowledge.replan`) keeps the route clear of it, keeping right of what comes down the
-robot's lane where there is room; where no way to the goal is left, it sends the robot to
-the nearest place out of its way (a *refuge*), and the robot waits there until nothing
-comes toward it: planning in time, in the simplest form a route can say.
+robot. Replanning (:func:`.knowledge.replan`) keeps the route clear of it, keeping right
+of what comes down the robot's lane where there is room; where no way to the goal is left,
+it sends the robot to the nearest place out of its way (a *refuge*), and the robot waits
+there until nothing comes toward it: planning in time, in the simplest form a route can
+say.
 """
 
 from __future__ import annotations
@@ -308,18 +308,14 @@ def lane(m: Mover, robot: np.ndarray, heading: float, width: float) -> bool:
     return abs(math.cos(heading) * to_robot[1] - math.sin(heading) * to_robot[0]) < width
 
 
-def swept(m: Mover, robot: np.ndarray, heading: float, length: float, width: float,
-          waiting: bool = False) -> list[Capsule]:
+def swept(m: Mover, robot: np.ndarray, heading: float, length: float, width: float
+          ) -> list[Capsule]:
     """The ways a mover may sweep while a robot at ``robot [2]`` heading ``heading`` (rad),
     ``length`` by ``width`` inches, gets out of its way: along its velocity once its heading
     is known (:attr:`Mover.settled`), and straight at the robot while it comes down the
-    robot's :func:`lane` or, for a robot ``waiting`` (bound for a refuge or at it), while the
-    robot stands :func:`in_way` of it. A ring of sonars measures the heading of an object it
-    has seen for a second or two to some tens of degrees, its range, and so how fast it
-    closes, much better; once the robot stands aside, only the heading says where the mover
-    goes on. (A robot turning for its refuge leaves its own lane at once: measured along its
-    heading alone, the mover it yields to swept nothing, and the way to the refuge could be
-    planned across the mover's path.)"""
+    robot's :func:`lane`. A ring of sonars measures the heading of an object it has seen for
+    a second or two to some tens of degrees, its range, and so how fast it closes, much
+    better; once the robot stands aside, only the heading says where the mover goes on."""
     out = []
     radius = max(m.radius, HALF_WIDTH)
     if m.settled:
@@ -328,19 +324,9 @@ def swept(m: Mover, robot: np.ndarray, heading: float, length: float, width: flo
         reach = float((robot - m.centre) @ along) + PAST * length
         span = min(max(reach, 0.0), speed * HORIZON)
         out.append((m.centre, m.centre + along * span, radius))
-    if lane(m, robot, heading, width) or waiting and in_way(m, robot, width):
+    if lane(m, robot, heading, width):
         out.append((m.centre, np.array(robot, float), radius))
     return out
-
-
-def in_way(m: Mover, robot: np.ndarray, width: float) -> bool:
-    """Whether a robot at ``robot [2]`` stands in the way of ``m``: ahead of it, within
-    ``width`` inches of the line it moves along (its velocity as fitted so far)."""
-    to_robot = robot - m.centre
-    speed = float(np.hypot(*m.velocity))
-    if speed == 0 or float(m.velocity @ to_robot) <= 0:
-        return False
-    return abs(float(m.velocity[0] * to_robot[1] - m.velocity[1] * to_robot[0])) < width * speed
 
 
 def sweep(found: list[Mover], robot: np.ndarray, heading: float, length: float, width: float,
@@ -351,15 +337,14 @@ def sweep(found: list[Mover], robot: np.ndarray, heading: float, length: float, 
     none. With movers in its lane, :attr:`Sweep.keep_right` too: the same ways ``room``
     wider, and the robot's left of those movers up to ``far``. A robot ``waiting`` at a
     refuge waits while anything is ``found`` (an empty sweep): a mover whose heading is not
-    known yet may sweep nothing once the robot has turned out of its lane for the refuge, and
-    it comes on all the same; and its way is swept straight at the robot while the robot
-    stands in it (:func:`swept`)."""
+    known yet sweeps nothing once the robot has turned out of its lane for the refuge, and
+    it comes on all the same."""
     cells = np.zeros(shape, dtype=bool)
     roomy = np.zeros(shape, dtype=bool)
     left = np.zeros(shape, dtype=bool)
     wide = 0.0
     for m in found:
-        for a, b, radius in swept(m, robot, heading, length, width, waiting):
+        for a, b, radius in swept(m, robot, heading, length, width):
             cells |= capsule_cells(shape, resolution, origin, a, b, radius)
             roomy |= capsule_cells(shape, resolution, origin, a, b, radius + room)
             wide = max(wide, radius)
