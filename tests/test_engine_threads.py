@@ -81,6 +81,20 @@ def test_an_error_names_the_first_bad_sample_however_the_blocks_fall(monkeypatch
                 evaluate(c, X)
 
 
+def test_an_error_names_the_first_bad_sample_not_the_first_input_with_one(monkeypatch):
+    # in one block of 8,192 samples but two of 1,536: the sample, not the input, comes first
+    c = load_rulebase().compiled
+    X = _inputs(c, 3 * GRID_BLOCK, seed=15)
+    X[2000, 0] = np.nan
+    X[5, 2] = np.nan
+    for t in THREADS:
+        monkeypatch.setenv(threads.ENV, t)
+        with pytest.raises(InputError, match=r"`position` is not a number .*sample 6\)"):
+            evaluate_columns(c, X.T)
+        with pytest.raises(InputError, match=r"`position` is not a number .*sample 6\)"):
+            evaluate(c, X)
+
+
 @pytest.mark.parametrize("value", ["0", "-1", "two", "1.5", "4 threads", "257", "\u0664"])
 def test_a_thread_count_that_is_not_a_number_of_threads_is_refused(value, monkeypatch):
     c = load_rulebase().compiled

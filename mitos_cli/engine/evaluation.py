@@ -147,8 +147,9 @@ def _clamp_columns(compiled: CompiledRuleBase, Xt: np.ndarray, first: int = 0,
     if not (Xc != Xt).any():                   # the common case: nothing to clamp, no NaN
         return Xc, np.zeros(len(plan.lo), dtype=np.intp)
     bad = np.isnan(Xt)
-    if bad.any():
-        col, row = map(int, np.argwhere(bad)[0])
+    if bad.any():          # the first sample with a NaN, whatever the width of the blocks
+        row = int(np.argmax(bad.any(axis=0)))
+        col = int(np.argmax(bad[:, row]))
         where = f" (sample {first + row + 1})" if (total or Xt.shape[1]) > 1 else ""
         raise InputError(f"input `{compiled.inputs[col]}` is not a number (NaN){where}",
                          hint="give every input a finite number")
