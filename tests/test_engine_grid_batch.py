@@ -87,14 +87,21 @@ def test_the_grid_path_gives_the_bits_of_the_general_path(rb, data):
     c = compile_rulebase(rb, "main")
     assert c.grid_batch is not None, "one grid of linear terms takes the grid path"
     X = data.draw(batches(len(c.inputs)))
-    rows = evaluate(c, X, detail=False, strict=False).outputs          # the general path
+    rows = evaluate(c, X, strict=False).outputs              # the general path (with detail)
     inside = np.clip(X, c.universe[:, 0], c.universe[:, 1])
     for block in (16, 32, 8192):                                        # several blocks, one
         for Xin in (X, inside):                                         # clamped per block or not
-            expected = rows if Xin is X else evaluate(c, Xin, detail=False, strict=False).outputs
+            expected = rows if Xin is X else evaluate(c, Xin, strict=False).outputs
             with grid_block(block):
                 got = evaluate_columns(c, list(Xin.T), strict=False)
             assert np.array_equal(bits(got), bits(expected.T))
+    fast = evaluate(c, X, detail=False, strict=False)                   # rows, the grid path
+    assert np.array_equal(bits(fast.outputs), bits(rows))
+    general = evaluate(c, X, strict=False)
+    assert np.array_equal(bits(fast.inputs), bits(general.inputs))
+    assert fast.clamped.tolist() == general.clamped.tolist()
+    if len(X) > 1:                                       # (one sample: the scalar form's)
+        assert np.array_equal(fast.no_rule, general.no_rule)
     for i in range(len(X)):                                             # each sample alone
         alone = evaluate_columns(c, X[i:i + 1].T, strict=False)
         assert np.array_equal(bits(alone[:, 0]), bits(rows[i]))
@@ -119,13 +126,13 @@ def test_the_packaged_rule_base_takes_the_grid_path_in_any_batch():
     rng = np.random.default_rng(11)
     X = rng.uniform(c.universe[:, 0] - 5, c.universe[:, 1] + 5, size=(3 * 8192 + 5, 3))
     X[:4] = [[-0.0, 0.0, -0.0], [100.0, 100.0, 7.0], [0.0, 0.0, -7.0], [50.5, -0.0, 0.0]]
-    rows = evaluate(c, X, detail=False).outputs
+    rows = evaluate(c, X).outputs
     for n in (1, 2, 3, 8191, 8192, 8193, len(X)):
         out = rb.evaluate(**{name: X[:n, j] for j, name in enumerate(c.inputs)})
         for j, name in enumerate(c.outputs):
             assert np.array_equal(bits(out[name]), bits(rows[:n, j])), (n, name)
     inside = np.clip(X, c.universe[:, 0], c.universe[:, 1])   # not clamped block by block
-    rows = evaluate(c, inside, detail=False).outputs
+    rows = evaluate(c, inside).outputs
     assert np.array_equal(bits(evaluate_columns(c, inside.T)), bits(rows.T))
 
 
@@ -167,6 +174,6 @@ def test_plateaus_vertical_edges_and_weights_on_a_lattice(inference):
     assert c.grid_batch is not None and c.grid_batch.plateaus
     grid = np.array(np.meshgrid(np.arange(-1.0, 11.0, 0.125), np.arange(-6.0, 6.0, 0.125)))
     X = np.vstack([grid.reshape(2, -1).T, [[-0.0, -0.0], [4.0, -0.0], [0.0, 0.0]]])
-    rows = evaluate(c, X, detail=False).outputs
+    rows = evaluate(c, X).outputs
     with grid_block(64):
         assert np.array_equal(bits(evaluate_columns(c, X.T)), bits(rows.T))
