@@ -276,7 +276,42 @@ def test_unreadable_manifest_on_resume(tmp_path):
     (tmp_path / "study.json").write_text("{not json")
     with pytest.raises(StudyError) as exc:
         run_study(small_study(runs=1), tmp_path, workers=1, resume=True, task_fn=fake_sim)
-    assert "cannot read" in exc.value.message and "study.json" in exc.value.message
+    assert "study.json is not JSON" in exc.value.message
+    assert exc.value.span is not None and (exc.value.span.line, exc.value.span.column) == (1, 2)
+
+
+@pytest.mark.parametrize("manifest, says", [
+    ("[1]", "is not a study manifest"),                    # JSON, but not an object
+    ("[" * 100_000, "nests too deep to read"),             # past the JSON reader's recursion
+    (b"{\"seed\": \xff}", "it is not UTF-8 text"),
+])
+def test_a_broken_manifest_is_refused_with_what_it_is(tmp_path, manifest, says):
+    run_study(small_study(runs=1), tmp_path, workers=1, task_fn=fake_sim)
+    path = tmp_path / "study.json"
+    path.write_bytes(manifest if isinstance(manifest, bytes) else manifest.encode())
+    with pytest.raises(StudyError, match=says) as exc:
+        run_study(small_study(runs=1), tmp_path, workers=1, resume=True, task_fn=fake_sim)
+    assert "remove" in (exc.value.hint or "")
+
+
+@pytest.mark.parametrize("results, says, line", [
+    (b"\xff\n", "it is not UTF-8 text", 2),
+    ("x" * 140_000 + "\n", "line 2 is not a row of results", 2),     # past csv's field limit
+])
+def test_a_broken_results_file_is_refused_at_its_line(tmp_path, results, says, line):
+    run_study(small_study(runs=1), tmp_path, workers=1, task_fn=fake_sim)
+    path = tmp_path / "results.csv"
+    header = path.read_bytes().splitlines(keepends=True)[0]
+    path.write_bytes(header + (results if isinstance(results, bytes) else results.encode()))
+    with pytest.raises(StudyError, match=says) as exc:
+        run_study(small_study(runs=1), tmp_path, workers=1, resume=True, task_fn=fake_sim)
+    assert exc.value.span is not None and exc.value.span.line == line
+
+
+def test_a_results_file_that_is_a_directory_is_refused(tmp_path):
+    (tmp_path / "results.csv").mkdir()
+    with pytest.raises(StudyError, match="is a directory, not a results file"):
+        run_study(small_study(runs=1), tmp_path, workers=1, resume=True, task_fn=fake_sim)
 
 
 def test_dask_missing_says_how_to_install(monkeypatch):

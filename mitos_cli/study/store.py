@@ -17,7 +17,8 @@ from collections.abc import Iterable
 from pathlib import Path
 from typing import TextIO
 
-from ..errors import MitosError
+from ..errors import MitosError, Span
+from ..fileio import read_text, unreadable
 from ..words import plural
 from .spec import KEY_FIELDS, Task
 
@@ -35,6 +36,15 @@ class StudyError(MitosError):
     """A study directory that cannot be written or resumed."""
 
     kind = "study error"
+
+
+def _bad_byte(path: Path, exc: OSError | UnicodeDecodeError) -> Span | None:
+    """Where a file stops being UTF-8 text (``None`` for any other failure to read it)."""
+    if not isinstance(exc, UnicodeDecodeError):
+        return None
+    data = exc.object
+    line = data.count(b"\n", 0, exc.start) + 1
+    return Span(str(path), line, exc.start - (data.rfind(b"\n", 0, exc.start) + 1) + 1)
 
 
 def row_of(task: Task, result: dict) -> dict:
@@ -80,40 +90,69 @@ class ResultStore:
         """The finished rows (an unfinished last line is cut off the file and not returned)."""
         if not self.path.exists():
             return []
-        data = self.path.read_bytes()
-        if data and not data.endswith(b"\n"):       # killed in the middle of a row
-            data = data[: data.rfind(b"\n") + 1]
-            with open(self.path, "r+b") as fh:
-                fh.truncate(len(data))
-        text = data.decode("utf-8")
+        try:
+            data = self.path.read_bytes()
+            if data and not data.endswith(b"\n"):       # killed in the middle of a row
+                data = data[: data.rfind(b"\n") + 1]
+                with open(self.path, "r+b") as fh:
+                    fh.truncate(len(data))
+            text = data.decode("utf-8")
+        except (OSError, UnicodeDecodeError) as exc:
+            raise StudyError(unreadable("results file", self.path, exc), span=_bad_byte(
+                self.path, exc), hint=f"choose another output directory with -o, or remove "
+                                      f"{self.path} to run the study again") from None
         if not text:
             return []
         reader = csv.reader(io.StringIO(text, newline=""))
-        header = next(reader)
-        if tuple(header) != COLUMNS:
-            raise StudyError(f"{self.path} is not a results file of this version of mitos",
-                             expected="the columns " + ",".join(COLUMNS),
-                             hint="choose another output directory with -o")
-        rows = []
-        for line_no, values in enumerate(reader, start=2):
-            if len(values) != len(COLUMNS):
-                raise StudyError(f"{self.path}:{line_no}: expected {len(COLUMNS)} values, "
-                                 f"found {len(values)}",
-                                 hint="the file was edited by hand; remove that line")
-            try:
-                rows.append({f: _parse(f, v) for f, v in zip(COLUMNS, values)})
-            except ValueError:
-                raise StudyError(f"{self.path}:{line_no}: a value is not a number",
-                                 hint="the file was edited by hand; remove that line") from None
-        return rows
+        try:
+            header = next(reader)
+            if tuple(header) != COLUMNS:
+                raise StudyError(f"{self.path} is not a results file of this version of mitos",
+                                 expected="the columns " + ",".join(COLUMNS),
+                                 hint="choose another output directory with -o")
+            return [self._row(values, line_no) for line_no, values in enumerate(reader, start=2)]
+        except csv.Error as exc:               # a field past csv's limit, a NUL byte
+            line_no = reader.line_num
+            line = text.splitlines()[line_no - 1] if line_no else ""
+            raise StudyError(f"line {line_no} is not a row of results ({exc})",
+                             span=Span(str(self.path), line_no, 1, line[:200]),
+                             hint="the file was edited by hand; remove that line") from None
+
+    def _row(self, values: list[str], line_no: int) -> dict:
+        """Line ``line_no``'s ``values`` as a row, checked."""
+        if len(values) != len(COLUMNS):
+            raise StudyError(f"{self.path}:{line_no}: expected {len(COLUMNS)} values, "
+                             f"found {len(values)}",
+                             hint="the file was edited by hand; remove that line")
+        try:
+            return {f: _parse(f, v) for f, v in zip(COLUMNS, values)}
+        except ValueError:
+            raise StudyError(f"{self.path}:{line_no}: a value is not a number",
+                             hint="the file was edited by hand; remove that line") from None
 
     def manifest(self) -> dict | None:
+        """What ``study.json`` says the study was; ``None`` when there is none."""
         if not self.manifest_path.exists():
             return None
+        hint = (f"choose another output directory with -o, or remove {self.manifest_path} "
+                f"and {self.path} to run the study again")
         try:
-            return json.loads(self.manifest_path.read_text(encoding="utf-8"))
-        except (OSError, ValueError) as exc:
-            raise StudyError(f"cannot read {self.manifest_path}: {exc}") from None
+            got = json.loads(read_text(self.manifest_path))
+        except (OSError, UnicodeDecodeError) as exc:
+            raise StudyError(unreadable("study manifest", self.manifest_path, exc),
+                             span=_bad_byte(self.manifest_path, exc), hint=hint) from None
+        except json.JSONDecodeError as exc:
+            raise StudyError(f"{self.manifest_path} is not JSON: {exc.msg}",
+                             span=Span(str(self.manifest_path), exc.lineno, exc.colno),
+                             hint=hint) from None
+        except (ValueError, RecursionError):     # nested past what the reader follows
+            raise StudyError(f"{self.manifest_path} is not a study manifest: it nests too "
+                             f"deep to read", hint=hint) from None
+        if not isinstance(got, dict):
+            raise StudyError(f"{self.manifest_path} is not a study manifest",
+                             expected="a JSON object (the study's seed, worlds and choices)",
+                             hint=hint)
+        return got
 
     # -- writing -----------------------------------------------------------------------------
 
