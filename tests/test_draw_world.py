@@ -89,3 +89,15 @@ def test_in_a_crowd_only_the_obstacle_hit_is_named():
                           robot_outcomes=("collision",))
     assert _labelled(run) == {hit}
     assert _labelled(SimpleNamespace(**{**vars(run), "outcome": "success"})) == set()
+
+
+@pytest.mark.parametrize("args", [["--plot", "run.png"], ["--runs", "2", "--plot", "run.png"],
+                                  ["--animate", "run.gif"]])
+def test_a_dollar_in_a_worlds_name_is_drawn_as_written(tmp_path, monkeypatch, capsys, args):
+    pytest.importorskip("matplotlib")
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "w.yaml").write_text(WORLD.replace("name: tiny", 'name: "co $x^$ rridor"'))
+    with pytest.raises(SystemExit) as exc:        # mathtext would stop on `$x^$`
+        main(["simulate", "w.yaml", *args])
+    assert exc.value.code == 0, capsys.readouterr().err
+    assert (tmp_path / args[-1]).stat().st_size > 0

@@ -382,3 +382,11 @@ def test_show_with_a_file_and_no_display_writes_the_file_first(command, tmp_path
     assert done.returncode == 1 and out.read_bytes().startswith(b"\x89PNG")
     assert f"wrote {out}\nerror: cannot open a window" in done.stderr
     assert f"hint: the picture is in {out}" in done.stderr
+
+
+def test_a_title_with_dollars_is_drawn_as_written(tmp_path, capsys):
+    pytest.importorskip("matplotlib")
+    out = tmp_path / "s.png"
+    code, _, err = run(["plot", *SURFACE, "-o", str(out), "--title", "é $x^$ %s {}"], capsys)
+    assert code == 0, err
+    assert out.read_bytes().startswith(PNG)

@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from .frame import OBSTACLE_COLOUR, ROBOT_COLOUR, TRAIL_COLOUR, draw_background
-from .output import DrawError, _matplotlib, new_figure
+from .output import DrawError, _matplotlib, literal_text, new_figure
 
 FORMATS = ("gif", "mp4")
 BARS = 8                    # fired rules shown, by DOF
@@ -228,7 +228,7 @@ def _render_text(text: str, fontsize: float, dpi: int) -> np.ndarray:
     fig = Figure(dpi=dpi)
     canvas = FigureCanvasAgg(fig)
     fig.patch.set_alpha(0.0)
-    label = fig.text(0, 0, text, fontsize=fontsize, va="bottom", ha="left")
+    label = fig.text(0, 0, text, fontsize=fontsize, va="bottom", ha="left", parse_math=False)
     box = label.get_window_extent(canvas.get_renderer())
     width, height = int(np.ceil(box.width)) + 2, int(np.ceil(box.height)) + 2
     fig.set_size_inches(width / dpi, height / dpi)
@@ -264,6 +264,7 @@ def _save(fig, draw, picked, writer, path: Path, fmt: str, dpi: int) -> None:
     import os
 
     part = path.with_name(f".{path.name}.part.{fmt}")
+    literal_text(fig)
     try:
         with writer.saving(fig, str(part), dpi):
             for k in picked:

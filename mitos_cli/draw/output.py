@@ -84,10 +84,21 @@ def new_figure(figsize: tuple[float, float], show: bool = False, **kwargs):
     return fig
 
 
+def literal_text(fig) -> None:
+    """Every text of ``fig`` drawn as it is written: a ``$`` in a title, a world's name or a
+    unit is a dollar sign, not the start of matplotlib's mathtext (which stops on ``$x^$``
+    with a traceback when the figure is drawn)."""
+    from matplotlib.text import Text
+
+    for text in fig.findobj(Text):
+        text.set_parse_math(False)
+
+
 def finish(fig, path: str | Path | None = None, show: bool = False, dpi: int = 150,
            tight: bool = True):
     """Save ``fig`` to ``path`` (atomically: a temporary file renamed into place), then show
     it when asked; ``tight`` trims the margins (one more layout pass). Returns the figure."""
+    literal_text(fig)
     if path is not None:
         path = Path(path)
         fmt = check_format(path)

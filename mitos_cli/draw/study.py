@@ -7,6 +7,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from .output import literal_text
+
 
 def _pyplot():
     import matplotlib
@@ -111,6 +113,7 @@ def clearance_boxes(rows: list[dict], worlds: list[str], labels: list[str],
 def _save(fig, plt, path) -> Path:
     path = Path(path)
     tmp = path.with_name(path.stem + ".tmp" + path.suffix)
+    literal_text(fig)
     fig.savefig(tmp, dpi=110)
     plt.close(fig)
     tmp.replace(path)
