@@ -216,6 +216,29 @@ def test_a_torn_last_journal_line_is_dropped(rules, tmp_path):
     assert Session.resume(j, out=[].append).rulebase == s.rulebase
 
 
+@pytest.mark.parametrize("edit, says", [
+    (lambda e: e["examples"][0].update(inputs=5), "not inputs and targets given as numbers"),
+    (lambda e: e["examples"][0]["inputs"].update(size=[1, 2]), "given as numbers by name"),
+    (lambda e: e["examples"][0]["targets"].update(steering=True), "given as numbers by name"),
+    (lambda e: e["examples"][0]["inputs"].update(size=float("nan")), "given as numbers"),
+    (lambda e: e.update(behavior=1.5), "`behavior` is 1.5, not a name"),
+    (lambda e: e["examples"][0]["inputs"].pop("size"), "no value for `size`"),
+    (lambda e: e["examples"][0]["targets"].update(spead=1.0), "`spead` is not one of its outputs"),
+])
+def test_a_journal_whose_examples_were_edited_is_refused_at_their_line(rules, tmp_path, edit,
+                                                                         says):
+    journal = Journal.create(tmp_path / "j")
+    s, _ = session(rules, journal=journal)
+    s.run("correct road=78 size=45 position=4 -> steering=60")
+    lines = journal.path.read_text().splitlines()
+    entry = json.loads(lines[1])
+    edit(entry)
+    journal.path.write_text("\n".join([lines[0], json.dumps(entry)]) + "\n")
+    with pytest.raises(LessonError, match=says) as info:
+        Session.resume(Journal.open(tmp_path / "j"), out=[].append)
+    assert info.value.span is not None and info.value.span.line == 2
+
+
 def test_help(rules):
     s, out = session(rules)
     assert "adapt [epochs N] [rate ETA]" in say(s, out, "help")

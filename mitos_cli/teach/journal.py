@@ -14,6 +14,7 @@ state is the replay of the changes not undone.
 from __future__ import annotations
 
 import json
+import math
 import os
 import time
 from dataclasses import dataclass, field
@@ -264,6 +265,27 @@ def _shown(entry: dict, key: str) -> str:
     return f"a JSON {_JSON_TYPE.get(type(value), 'string')}"
 
 
+def _numbers(values: object) -> bool:
+    """Whether ``values`` is a JSON object of finite numbers by name."""
+    return isinstance(values, dict) and all(
+        isinstance(k, str) and type(v) in (int, float) and math.isfinite(v)
+        for k, v in values.items())
+
+
+def _examples_problem(entry: dict) -> str | None:
+    """What is wrong with an ``examples`` entry's examples (``None``: nothing); that their
+    names are the behavior's is checked when the entry is replayed."""
+    if not isinstance(entry.get("behavior", ""), str):
+        return f"the `examples` change's `behavior` is {_shown(entry, 'behavior')}, not a name"
+    for i, example in enumerate(entry["examples"], 1):
+        if not isinstance(example, dict) or not _numbers(example.get("inputs")) \
+                or not _numbers(example.get("targets")) \
+                or not isinstance(example.get("source", ""), str):
+            return (f"example {i} of the `examples` change is not inputs and targets given as "
+                    f"numbers by name")
+    return None
+
+
 def _problem(line: bytes, seq: int) -> str | None:
     """What is wrong with one journal line (``None``: nothing)."""
     try:
@@ -293,6 +315,8 @@ def _problem(line: bytes, seq: int) -> str | None:
         return "the `start` change's `save_as` is not a path"
     if op == "save" and not isinstance(entry.get("path"), str):
         return "the `save` change has no valid `path`"
+    if op == "examples":
+        return _examples_problem(entry)
     if op == "simulate" and (type(entry.get("seed")) not in (int, type(None))
                              or not isinstance(entry.get("robot"), (str, type(None)))):
         return "the `simulate` record has no valid `seed` or `robot`"

@@ -204,6 +204,8 @@ class Session:
         for entry in self.journal.active():
             try:
                 apply(self.state, entry)
+                if entry["op"] == "examples":
+                    self._check_examples(entry)
             except (MitosError, KeyError, TypeError, ValueError, AttributeError,
                     IndexError) as exc:
                 line = self.journal.line_of(entry)
@@ -218,6 +220,19 @@ class Session:
                 self.journal.recovered_at = line
                 self._cut_journal(line)
                 return
+
+    def _check_examples(self, entry: dict) -> None:
+        """That a replayed ``examples`` entry gives every input of its behavior and corrects
+        only its outputs (a journal edited by hand may not)."""
+        compiled = self.compiled(entry.get("behavior") or None)
+        for i, example in enumerate(entry["examples"], 1):
+            missing = [k for k in compiled.inputs if k not in example["inputs"]]
+            wrong = [k for k in example["targets"] if k not in compiled.outputs]
+            if missing or wrong or not example["targets"]:
+                raise LessonError(
+                    f"example {i} does not correct behavior `{compiled.behavior}`: " + (
+                        f"no value for {', '.join(f'`{k}`' for k in missing)}" if missing else
+                        f"`{wrong[0]}` is not one of its outputs" if wrong else "no target"))
 
     def _simulate_again(self) -> None:
         """The run the last ``simulate`` recorded, driven again on the rule base as it was
