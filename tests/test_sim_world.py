@@ -571,3 +571,12 @@ def test_a_velocity_of_three_numbers_is_said_in_in_per_s():
                         "velocity: [0, 0.5, 1]}\n")
     assert "`velocity` of obstacle `cart` must be a velocity [vx, vy] (in/s)" in text
     assert "inches" not in text
+
+
+def test_a_range_that_ends_at_minus_zero_draws_as_zero_to_zero():
+    from mitos_cli.sim.loop import simulate
+
+    w = parse_world(BASE.replace("width: 70\n", "width: 70\nrandomise: {sensor_noise: [0, -0.0]}\n"),
+                    "w.yaml")
+    assert [str(x) for x in w.randomise.sensor_noise] == ["0.0", "0.0"]
+    simulate(w, seed=3, randomise=True)          # numpy refused uniform(0.0, -0.0)

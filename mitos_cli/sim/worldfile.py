@@ -156,7 +156,7 @@ class _Reader:
         lo, hi = self.point(value, span, what, "a range [low, high]")
         if lo > hi:
             raise WorldError(f"{what} must be [low, high] with low <= high", span=span)
-        return lo, hi
+        return lo + 0.0, hi + 0.0       # [0, -0.0]: a draw from it refused -0.0 below 0.0
 
 
 def read_robot(r: _Reader, value: Any, span: Span, base: Robot | None = None) -> Robot:

@@ -148,9 +148,14 @@ class ResultStore:
         except (ValueError, RecursionError):     # nested past what the reader follows
             raise StudyError(f"{self.manifest_path} is not a study manifest: it nests too "
                              f"deep to read", hint=hint) from None
-        if not isinstance(got, dict):
+        digests = got.get("digests", {}) if isinstance(got, dict) else None
+        if not isinstance(digests, dict) or not all(
+                isinstance(v, str) for v in digests.values()) \
+                or not isinstance(got.get("command", ""), str):
             raise StudyError(f"{self.manifest_path} is not a study manifest",
-                             expected="a JSON object (the study's seed, worlds and choices)",
+                             expected="a JSON object (the study's seed, worlds and choices; "
+                                      "its `digests` an object of file digests, its "
+                                      "`command` a string)",
                              hint=hint)
         return got
 
