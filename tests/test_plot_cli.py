@@ -390,3 +390,16 @@ def test_a_title_with_dollars_is_drawn_as_written(tmp_path, capsys):
     code, _, err = run(["plot", *SURFACE, "-o", str(out), "--title", "é $x^$ %s {}"], capsys)
     assert code == 0, err
     assert out.read_bytes().startswith(PNG)
+
+
+def test_a_surface_of_many_fixed_inputs_wraps_its_title_and_warns_of_nothing(tmp_path, capsys):
+    pytest.importorskip("matplotlib")
+    out = tmp_path / "s.png"
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")            # matplotlib's "constrained_layout not applied"
+        code, _, err = run(["plot", "surface", "steering", "--x", "size", "-b", "drive", "-n", "5",
+                            "--style", "heatmap", "-o", str(out)], capsys)
+    assert code == 0, err
+    assert "Warning" not in err and out.read_bytes().startswith(PNG)

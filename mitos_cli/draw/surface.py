@@ -7,6 +7,7 @@ blank region with a legend entry saying so, never as a made-up number.
 
 from __future__ import annotations
 
+import textwrap
 from pathlib import Path
 
 import numpy as np
@@ -140,7 +141,10 @@ def draw_surface(s: Surface, path: str | Path | None = None, *, style: str = "su
         fig = new_figure((8.4, 6.4), show)
         ax = fig.add_subplot(projection="3d")
         draw_surface3d(fig, ax, s)
-    heading = title or title_of(s)
+    # (a behavior of thirteen inputs holds twelve fixed: on one line its title was wider than
+    # the picture, and the layout squeezed the axes to nothing)
+    heading = "\n".join(line for part in (title or title_of(s)).split("\n")
+                        for line in textwrap.wrap(part, 90) or [part])
     if s.y is not None and style == "surface":
         fig.suptitle(heading, fontsize=12, y=0.9)
     else:
