@@ -2,6 +2,7 @@
 
 import dataclasses
 import json
+import re
 import shutil
 
 import pytest
@@ -237,6 +238,36 @@ def test_a_journal_whose_examples_were_edited_is_refused_at_their_line(rules, tm
     with pytest.raises(LessonError, match=says) as info:
         Session.resume(Journal.open(tmp_path / "j"), out=[].append)
     assert info.value.span is not None and info.value.span.line == 2
+
+
+@pytest.mark.parametrize("op, edit, says", [
+    ("frozen", lambda e: e.update(labels=[1]), "`labels` are not rule labels"),
+    ("frozen", lambda e: e.update(labels=[[1]]), "`labels` are not rule labels"),
+    ("adapt", lambda e: e.update(q=[]), "`q` is not its Q before and after"),
+    ("adapt", lambda e: e.update(terms={"steering": {"LM": "x"}}), "`terms` are not parameters"),
+    ("adapt", lambda e: e.update(crisp=[["x"]]), "`crisp` are not [behavior, rule, output"),
+    ("start", lambda e: e.update(rules="a\0b"), "`rules` holds a NUL byte"),
+    ("rule", lambda e: e.update(text="r27: if road is NOPE then steering is LB"),
+     "unknown term `NOPE` of `road`"),
+    ("rule", lambda e: e.update(text="r27: if road is NARROW then nope is LB"), "`nope`"),
+    ("use", lambda e: e.update(text="use b"), "`b` uses `b`: a cycle"),
+])
+def test_a_journal_whose_changes_were_edited_is_refused_at_their_line(rules, tmp_path, op,
+                                                                        edit, says):
+    journal = Journal.create(tmp_path / "j")
+    s, _ = session(rules, journal=journal)
+    for line in ["r27: if road is NARROW then steering is LB", "behavior b", "use avoid_obstacle",
+                 "end", "use avoid_obstacle", "frozen r4",
+                 "correct road=78 size=45 position=4 -> steering=60", "adapt epochs 2"]:
+        s.run(line)
+    lines = journal.path.read_text().splitlines()
+    entries = [json.loads(x) for x in lines]
+    at = next(i for i, e in enumerate(entries) if e["op"] == op)
+    edit(entries[at])
+    journal.path.write_text("".join(json.dumps(e) + "\n" for e in entries))
+    with pytest.raises(MitosError, match=re.escape(says)) as info:
+        Session.resume(Journal.open(tmp_path / "j"), out=[].append)
+    assert info.value.span is not None and info.value.span.line == at + 1
 
 
 def test_help(rules):

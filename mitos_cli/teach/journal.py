@@ -286,6 +286,27 @@ def _examples_problem(entry: dict) -> str | None:
     return None
 
 
+def _adapt_problem(entry: dict) -> str | None:
+    """What is wrong with an ``adapt`` entry's learned numbers (``None``: nothing)."""
+    terms = entry["terms"]
+    if not all(isinstance(v, str) and isinstance(ts, dict) and all(
+            isinstance(t, str) and isinstance(ps, list) and ps and all(
+                type(x) in (int, float) and math.isfinite(x) for x in ps)
+            for t, ps in ts.items()) for v, ts in terms.items()):
+        return "the `adapt` change's `terms` are not parameters by variable and term"
+    crisp = entry.get("crisp", [])
+    if not isinstance(crisp, list) or not all(
+            isinstance(c, list) and len(c) == 4 and isinstance(c[0], str)
+            and type(c[1]) is int and c[1] >= 0 and isinstance(c[2], str)
+            and type(c[3]) in (int, float) and math.isfinite(c[3]) for c in crisp):
+        return "the `adapt` change's `crisp` are not [behavior, rule, output, value] rows"
+    q = entry.get("q", [0.0, 0.0])
+    if not isinstance(q, list) or len(q) != 2 or not all(
+            type(x) in (int, float) for x in q):
+        return "the `adapt` change's `q` is not its Q before and after"
+    return None
+
+
 def _problem(line: bytes, seq: int) -> str | None:
     """What is wrong with one journal line (``None``: nothing)."""
     try:
@@ -317,6 +338,13 @@ def _problem(line: bytes, seq: int) -> str | None:
         return "the `save` change has no valid `path`"
     if op == "examples":
         return _examples_problem(entry)
+    if op == "adapt":
+        return _adapt_problem(entry)
+    if op == "frozen" and not all(isinstance(x, str) for x in entry["labels"]):
+        return "the `frozen` change's `labels` are not rule labels"
+    for key in ("rules", "path", "save_as", "world"):      # a path the system cannot open
+        if "\0" in str(entry.get(key) or ""):
+            return f"the `{op}` change's `{key}` holds a NUL byte"
     if op == "simulate" and (type(entry.get("seed")) not in (int, type(None))
                              or not isinstance(entry.get("robot"), (str, type(None)))):
         return "the `simulate` record has no valid `seed` or `robot`"

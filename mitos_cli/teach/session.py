@@ -47,12 +47,13 @@ from ..lang.model import (
     format_use,
 )
 from ..lang.operators import resolve
+from ..lang.parse import parse_rule
 from ..lang.resolve import check_expr, check_rule, load_rules_file
 from ..words import plural
 from . import commands as cmd
 from . import text
 from .journal import RECORDS, Journal, MemoryJournal
-from .state import State, apply, files_digest, learned_changes, variables
+from .state import State, apply, files_digest, journaled, learned_changes, variables
 
 if TYPE_CHECKING:
     from .simulation import Recording
@@ -203,6 +204,7 @@ class Session:
         self.state = State(self.original, self.start_behavior)
         for entry in self.journal.active():
             try:
+                self._check_entry(entry)
                 apply(self.state, entry)
                 if entry["op"] == "examples":
                     self._check_examples(entry)
@@ -220,6 +222,18 @@ class Session:
                 self.journal.recovered_at = line
                 self._cut_journal(line)
                 return
+
+    def _check_entry(self, entry: dict) -> None:
+        """What the prompt checks of a rule or a `use` when it is told, checked again of a
+        replayed entry (a journal edited by hand): the rule's names, the `use`'s cycle."""
+        op = entry["op"]
+        if op == "rule":
+            check_rule(parse_rule(entry["text"]), self.rulebase.variables)
+        elif op == "use":
+            use = journaled(entry, cmd.TellUse).use
+            if use.behavior == entry["behavior"] \
+                    or _reaches(self.rulebase, use.behavior, entry["behavior"]):
+                raise RuleBaseError(f"`{use.behavior}` uses `{entry['behavior']}`: a cycle")
 
     def _check_examples(self, entry: dict) -> None:
         """That a replayed ``examples`` entry gives every input of its behavior and corrects

@@ -113,7 +113,7 @@ def apply(state: State, entry: dict) -> None:
             state.active = entry["activate"]
     elif op == "use":
         b = rb.behavior(entry["behavior"])
-        use = _journaled(entry, cmd.TellUse).use
+        use = journaled(entry, cmd.TellUse).use
         state.rulebase = _replace_behavior(rb, dataclasses.replace(b, uses=b.uses + (use,)))
     elif op == "frozen":
         b = rb.behavior(entry["behavior"])
@@ -121,7 +121,7 @@ def apply(state: State, entry: dict) -> None:
         state.rulebase = _replace_behavior(rb, dataclasses.replace(b, frozen=labels))
     elif op == "operators":
         b = rb.behavior(entry["behavior"])
-        settings = _journaled(entry, cmd.TellOperators).settings
+        settings = journaled(entry, cmd.TellOperators).settings
         state.rulebase = _replace_behavior(rb, dataclasses.replace(
             b, operators=b.operators + settings))
     elif op == "activate":
@@ -210,7 +210,7 @@ def learned_changes(before: RuleBase, after: RuleBase) -> tuple[dict, list]:
     return terms, crisp
 
 
-def _journaled(entry: dict, kind: type[_C]) -> _C:
+def journaled(entry: dict, kind: type[_C]) -> _C:
     """The command a journal entry recorded, which must be of the entry's kind."""
     parsed = cmd.parse_command(entry["text"])
     if not isinstance(parsed, kind):
