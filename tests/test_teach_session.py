@@ -251,6 +251,9 @@ def test_a_journal_whose_examples_were_edited_is_refused_at_their_line(rules, tm
      "unknown term `NOPE` of `road`"),
     ("rule", lambda e: e.update(text="r27: if road is NARROW then nope is LB"), "`nope`"),
     ("use", lambda e: e.update(text="use b"), "`b` uses `b`: a cycle"),
+    ("adapt", lambda e: e.update(terms={"road": {"NARROW": [-1e9, 1e9]}}),
+     "term `road.NARROW`: its core"),                      # learned where no term can be
+    ("adapt", lambda e: e.update(terms={"rood": {"NARROW": [0, 10]}}), "unknown variable `rood`"),
 ])
 def test_a_journal_whose_changes_were_edited_is_refused_at_their_line(rules, tmp_path, op,
                                                                         edit, says):

@@ -49,6 +49,7 @@ from ..lang.model import (
 from ..lang.operators import resolve
 from ..lang.parse import parse_rule
 from ..lang.resolve import check_expr, check_rule, load_rules_file
+from ..lang.terms import check_term
 from ..words import plural
 from . import commands as cmd
 from . import text
@@ -234,6 +235,15 @@ class Session:
             if use.behavior == entry["behavior"] \
                     or _reaches(self.rulebase, use.behavior, entry["behavior"]):
                 raise RuleBaseError(f"`{use.behavior}` uses `{entry['behavior']}`: a cycle")
+        elif op == "adapt":                      # what adaptation can learn: well-formed terms
+            variables = self.rulebase.variables
+            for name, terms in entry["terms"].items():
+                if name not in variables:
+                    raise unknown("variable", name, list(variables), cls=LessonError)
+                v = variables[name]
+                for term, params in terms.items():
+                    check_term(v.term(term).with_params(tuple(map(float, params))), v.universe,
+                               name, peak_inside=v.role == "output")
 
     def _check_examples(self, entry: dict) -> None:
         """That a replayed ``examples`` entry gives every input of its behavior and corrects
