@@ -17,7 +17,7 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import IO
 
-from .errors import MitosError, closest_file
+from .errors import MitosError, Span, closest_file
 
 #: the largest text file read (bytes): far beyond any rule base, world, lesson or batch here
 MAX_TEXT_BYTES = 256 << 20
@@ -74,6 +74,16 @@ def why_unreadable(exc: OSError | UnicodeDecodeError) -> str:
         return (f"it is not UTF-8 text (byte 0x{data[exc.start]:02x} at line {line}, "
                 f"column {column})")
     return str(exc.strerror or exc)
+
+
+def bad_byte(path: object, exc: OSError | UnicodeDecodeError) -> Span | None:
+    """Where a file stops being UTF-8 text, for :func:`read_text`'s failure ``exc`` (``None``
+    for any other failure to read it)."""
+    if not isinstance(exc, UnicodeDecodeError):
+        return None
+    data = exc.object
+    line = data.count(b"\n", 0, exc.start) + 1
+    return Span(str(path), line, exc.start - (data.rfind(b"\n", 0, exc.start) + 1) + 1)
 
 
 def unreadable(kind: str, path: object, exc: OSError | UnicodeDecodeError) -> str:

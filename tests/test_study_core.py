@@ -283,6 +283,7 @@ def test_unreadable_manifest_on_resume(tmp_path):
 @pytest.mark.parametrize("manifest, says", [
     ("[1]", "is not a study manifest"),                    # JSON, but not an object
     ('{"seed": 1, "digests": 5}', "is not a study manifest"),
+    ('{"seed": ' + "9" * 5000 + "}", "is not a study manifest"),   # past int()'s digits
     ('{"seed": 1, "command": []}', "is not a study manifest"),
     ("[" * 100_000, "nests too deep to read"),             # past the JSON reader's recursion
     (b"{\"seed\": \xff}", "it is not UTF-8 text"),

@@ -18,7 +18,7 @@ from pathlib import Path
 from typing import TextIO
 
 from ..errors import MitosError, Span
-from ..fileio import read_text, unreadable
+from ..fileio import bad_byte, read_text, unreadable
 from ..words import plural
 from .spec import KEY_FIELDS, Task
 
@@ -36,15 +36,6 @@ class StudyError(MitosError):
     """A study directory that cannot be written or resumed."""
 
     kind = "study error"
-
-
-def _bad_byte(path: Path, exc: OSError | UnicodeDecodeError) -> Span | None:
-    """Where a file stops being UTF-8 text (``None`` for any other failure to read it)."""
-    if not isinstance(exc, UnicodeDecodeError):
-        return None
-    data = exc.object
-    line = data.count(b"\n", 0, exc.start) + 1
-    return Span(str(path), line, exc.start - (data.rfind(b"\n", 0, exc.start) + 1) + 1)
 
 
 def row_of(task: Task, result: dict) -> dict:
@@ -98,7 +89,7 @@ class ResultStore:
                     fh.truncate(len(data))
             text = data.decode("utf-8")
         except (OSError, UnicodeDecodeError) as exc:
-            raise StudyError(unreadable("results file", self.path, exc), span=_bad_byte(
+            raise StudyError(unreadable("results file", self.path, exc), span=bad_byte(
                 self.path, exc), hint=f"choose another output directory with -o, or remove "
                                       f"{self.path} to run the study again") from None
         if not text:
@@ -111,7 +102,7 @@ class ResultStore:
                                  expected="the columns " + ",".join(COLUMNS),
                                  hint="choose another output directory with -o")
             return [self._row(values, line_no) for line_no, values in enumerate(reader, start=2)]
-        except csv.Error as exc:               # a field past csv's limit, a NUL byte
+        except csv.Error as exc:               # a field past csv's limit
             line_no = reader.line_num
             line = text.splitlines()[line_no - 1] if line_no else ""
             raise StudyError(f"line {line_no} is not a row of results ({exc})",
@@ -140,14 +131,17 @@ class ResultStore:
             got = json.loads(read_text(self.manifest_path))
         except (OSError, UnicodeDecodeError) as exc:
             raise StudyError(unreadable("study manifest", self.manifest_path, exc),
-                             span=_bad_byte(self.manifest_path, exc), hint=hint) from None
+                             span=bad_byte(self.manifest_path, exc), hint=hint) from None
         except json.JSONDecodeError as exc:
             raise StudyError(f"{self.manifest_path} is not JSON: {exc.msg}",
                              span=Span(str(self.manifest_path), exc.lineno, exc.colno),
                              hint=hint) from None
-        except (ValueError, RecursionError):     # nested past what the reader follows
+        except RecursionError:                   # nested past what the reader follows
             raise StudyError(f"{self.manifest_path} is not a study manifest: it nests too "
                              f"deep to read", hint=hint) from None
+        except ValueError as exc:                # a number of more digits than int() reads
+            raise StudyError(f"{self.manifest_path} is not a study manifest: {exc}",
+                             hint=hint) from None
         digests = got.get("digests", {}) if isinstance(got, dict) else None
         if not isinstance(digests, dict) or not all(
                 isinstance(v, str) for v in digests.values()) \

@@ -77,17 +77,12 @@ def read_lesson(source: str) -> tuple[str, str]:
         found = resolve("rulebases/lessons", source, ".lesson")
         if found is not None:
             path, source = found, str(found)
-    from ..fileio import read_text, unreadable
+    from ..fileio import bad_byte, read_text, unreadable
 
     try:
         return read_text(path), source
     except (OSError, UnicodeDecodeError) as exc:
-        error = LessonError(unreadable("lesson", source, exc))
-        if isinstance(exc, UnicodeDecodeError):        # the place of the first bad byte
-            data = exc.object
-            line = data.count(b"\n", 0, exc.start) + 1
-            column = exc.start - (data.rfind(b"\n", 0, exc.start) + 1) + 1
-            error.span = Span(source, line, column)
+        error = LessonError(unreadable("lesson", source, exc), span=bad_byte(source, exc))
         if isinstance(exc, FileNotFoundError):     # a mistyped name: the packaged lessons
             from ..errors import did_you_mean
             from ..resources import packaged_names
