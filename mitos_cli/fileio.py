@@ -68,11 +68,10 @@ def why_unreadable(exc: OSError | UnicodeDecodeError) -> str:
     """What :func:`read_text`'s failure means, in words: the system's reason, or where the
     bytes stop being UTF-8 text."""
     if isinstance(exc, UnicodeDecodeError):
-        data = exc.object
-        line = data.count(b"\n", 0, exc.start) + 1
-        column = exc.start - (data.rfind(b"\n", 0, exc.start) + 1) + 1
-        return (f"it is not UTF-8 text (byte 0x{data[exc.start]:02x} at line {line}, "
-                f"column {column})")
+        where = bad_byte(None, exc)
+        assert where is not None
+        return (f"it is not UTF-8 text (byte 0x{exc.object[exc.start]:02x} at line "
+                f"{where.line}, column {where.column})")
     return str(exc.strerror or exc)
 
 
@@ -83,7 +82,8 @@ def bad_byte(path: object, exc: OSError | UnicodeDecodeError) -> Span | None:
         return None
     data = exc.object
     line = data.count(b"\n", 0, exc.start) + 1
-    return Span(str(path), line, exc.start - (data.rfind(b"\n", 0, exc.start) + 1) + 1)
+    return Span(None if path is None else str(path), line,
+                exc.start - (data.rfind(b"\n", 0, exc.start) + 1) + 1)
 
 
 def unreadable(kind: str, path: object, exc: OSError | UnicodeDecodeError) -> str:

@@ -244,6 +244,7 @@ def test_a_journal_whose_examples_were_edited_is_refused_at_their_line(rules, tm
     ("frozen", lambda e: e.update(labels=[1]), "`labels` are not rule labels"),
     ("frozen", lambda e: e.update(labels=[[1]]), "`labels` are not rule labels"),
     ("adapt", lambda e: e.update(q=[]), "`q` is not its Q before and after"),
+    ("adapt", lambda e: e.update(q=[1.0, float("nan")]), "`q` is not its Q before and after"),
     ("adapt", lambda e: e.update(terms={"steering": {"LM": "x"}}), "`terms` are not parameters"),
     ("adapt", lambda e: e.update(crisp=[["x"]]), "`crisp` are not [behavior, rule, output"),
     ("start", lambda e: e.update(rules="a\0b"), "`rules` holds a NUL byte"),

@@ -302,7 +302,7 @@ def _adapt_problem(entry: dict) -> str | None:
         return "the `adapt` change's `crisp` are not [behavior, rule, output, value] rows"
     q = entry.get("q", [0.0, 0.0])
     if not isinstance(q, list) or len(q) != 2 or not all(
-            type(x) in (int, float) for x in q):
+            type(x) in (int, float) and math.isfinite(x) for x in q):
         return "the `adapt` change's `q` is not its Q before and after"
     return None
 
