@@ -111,6 +111,34 @@ def test_crisp_consequents_are_edited_in_place(tmp_path):
     assert abs(r1.consequents[0].value - 30) < 1 and abs(r2.consequents[0].value - 70) < 1
 
 
+def test_unlabelled_rules_are_saved_in_their_places(tmp_path):
+    """Labels are optional: an unlabelled rule is edited where it stands, and a rule told
+    without a label is added once, not every unlabelled rule of the file again."""
+    (tmp_path / "t.terms.yaml").write_text(
+        "variables:\n  x: {role: input, universe: [0, 10], terms: {"
+        "LO: {shape: left_shoulder, points: [2, 8]}, HI: {shape: right_shoulder, "
+        "points: [2, 8]}}}\n  y: {role: output, universe: [0, 100], terms: {A: 0}}\n")
+    (tmp_path / "t.rules").write_text(
+        'terms "t.terms.yaml"\nbehavior b:\n    if x is LO then y is 20   # low\n'
+        "    if x is HI then y is 80\nend\n")
+    s = Session(tmp_path / "t.rules", out=[].append)
+    s.run(f"save {tmp_path / 'same.rules'}")
+    assert (tmp_path / "same.rules").read_text() == (
+        (tmp_path / "t.rules").read_text().replace("t.terms", "same.terms"))
+    s.run("use b")
+    s.run("correct x=0 -> y=30")
+    s.run("correct x=10 -> y=70")
+    s.run("adapt epochs 30")
+    s.run("if x is HI then y is 90")
+    s.run(f"save {tmp_path / 'u.rules'}")
+    text = (tmp_path / "u.rules").read_text()
+    assert text.count("if x is LO") == 1 and text.count("if x is HI") == 2
+    assert "   # low\n" in text
+    r1, r2, r3 = load_rules_file(tmp_path / "u.rules").behaviors[0].rules
+    assert abs(r1.consequents[0].value - 30) < 1 and abs(r2.consequents[0].value - 70) < 1
+    assert r3.consequents[0].value == 90
+
+
 def test_save_mistakes(rules, tmp_path):
     s = Session(rules, out=[].append)
     with pytest.raises(LessonError, match="say where to save"):

@@ -345,7 +345,8 @@ def _apply(text: str, edits: list[tuple[int, int, str]]) -> str:
 class _Place:
     """Where a behavior's parts stand in the rule file."""
 
-    rules: dict                 # label -> (start, end, crisp number tokens by variable)
+    rules: list                 # in order: (label or "", (start, end, crisp number tokens
+                                # by variable)); a session keeps its rules' places
     end_line_start: int | None  # offset of the line holding `end` (None: top level)
     indent: str
 
@@ -376,24 +377,22 @@ def _rule_place(tree: Tree) -> tuple[str, tuple[int, int, dict]]:
 def _places(text: str) -> tuple[dict[str, _Place], list[Token]]:
     tree = rule_parser().parse(text, start="start")
     places: dict[str, _Place] = {}
-    top = _Place({}, None, "")
+    top = _Place([], None, "")
     terms_tokens: list[Token] = []
     for item in tree.children:
         if not isinstance(item, Tree):
             continue
         if item.data == "rule":
-            label, where = _rule_place(item)
-            top.rules[label] = where
+            top.rules.append(_rule_place(item))
         elif item.data == "terms_stmt":
             terms_tokens += [t for t in item.children if isinstance(t, Token)]
         elif item.data == "behavior":
             name = str(item.children[0])
-            rules = {}
+            rules = []
             indent = "    "
             for sub in item.children[1:]:
                 if isinstance(sub, Tree) and sub.data == "rule":
-                    label, where = _rule_place(sub)
-                    rules[label] = where
+                    rules.append(_rule_place(sub))
                     line_start = text.rfind("\n", 0, sub.meta.start_pos) + 1
                     indent = text[line_start:sub.meta.start_pos]
                     if indent.strip():
@@ -429,21 +428,24 @@ def edit_rules(text: str, path: str, original: RuleBase, current: RuleBase,
             changes.append(f"new behavior {b.name} ({plural(len(b.rules), 'rule')})")
             continue
         place = places.get(b.name)
-        old_rules = {r.label: r for r in old.rules}
         inserted: list[str] = []
-        for rule in b.rules:
-            before = old_rules.get(rule.label) if rule.label else None
+        for i, rule in enumerate(b.rules):
+            # a rule told again under its label stays in its place, a new one is added at
+            # the end (`state._put_rule`): the first rules are the file's, in its order,
+            # labelled or not
+            before = old.rules[i] if i < len(old.rules) else None
             if before is None:
                 inserted.append(format_rule(rule))
                 changes.append(f"{b.name}: new rule {format_rule(rule)}")
                 continue
             if before == rule:
                 continue
-            if place is None or rule.label not in place.rules:    # the file changed since
-                raise LessonError(f"{path} changed since the lesson began: rule "
-                                  f"`{rule.label}` of behavior {b.name} is no longer there",
+            if place is None or i >= len(place.rules) or place.rules[i][0] != before.label:
+                raise LessonError(f"{path} changed since the lesson began: rule "    # since
+                                  f"`{before.label or f'#{i + 1}'}` of behavior {b.name} is no "
+                                  f"longer there",
                                   hint="start the lesson again on the file as it is now")
-            start, end, crisp = place.rules[rule.label]
+            start, end, crisp = place.rules[i][1]
             if _only_crisp_changed(before, rule) and all(c.var in crisp for c in rule.consequents
                                                          if c.term is None):
                 for c_old, c_new in zip(before.consequents, rule.consequents):
