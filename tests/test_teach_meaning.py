@@ -284,6 +284,25 @@ def test_simulation_corrections_name_the_robot():
         s.run("simulate multirobot robot oncomin")
 
 
+def test_a_robot_that_stopped_is_corrected_only_up_to_its_stop():
+    """In a world of several robots, one that reached its goal stands still while the others
+    drive on: its window (and its verdict) are its own, not the world's."""
+    from mitos_cli.teach.session import Session
+
+    said = []
+    s = Session(default_rulebase_path(), out=said.append)
+    s.run("use drive")
+    s.run("simulate multirobot robot oncoming")
+    rec = s.simulation
+    own = rec.result.robot_metrics[1]
+    assert rec.end < float(rec.t[-1])                   # the other robot drives on
+    assert f"success after {own['time_s']:g} s" in said[-1]
+    assert f"(0 to {rec.end:g} s)" in said[-1]
+    with pytest.raises(LessonError, match="robot oncoming's run lasted 0 to"):
+        s.run(f"at {float(rec.t[-1]):g}s steering=80")
+    s.run(f"at {rec.end:g}s steering=80")               # its last tick is still its own
+
+
 def test_the_measures_memberships_are_the_terms_own():
     for var in PAPER.variables.values():
         terms = [t for t in var.terms if t.corners is not None]

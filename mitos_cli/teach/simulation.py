@@ -49,29 +49,50 @@ class Recording:
     def time(self, row: int) -> float:
         return float(self.t[row])
 
+    @property
+    def _active(self) -> np.ndarray:
+        """The ticks at which the corrected robot still drove (it stops at its goal while
+        the others go on)."""
+        if self.result.active is None:
+            return np.ones(len(self.t), dtype=bool)
+        return self.result.active[:, self.robot]
+
+    @property
+    def _last(self) -> int:
+        """The row of the corrected robot's last tick: the one at which it arrived or hit
+        something (its run is recorded up to there; the others may drive on)."""
+        rows = np.flatnonzero(self._active)
+        return min(int(rows[-1]) + 1, len(self.t) - 1) if rows.size else len(self.t) - 1
+
+    @property
+    def end(self) -> float:
+        """When the corrected robot's run ends (s): see :attr:`_last`."""
+        return float(self.t[self._last])
+
     def describe(self) -> str:
         s = self.result.summary()
+        if self.robot_name:              # the corrected robot's own run, not the world's
+            own = self.result.robot_metrics[self.robot]
+            s = {**s, **own, "collisions": int(own["outcome"] == "collision")}
         who = f" (robot {self.robot_name})" if self.robot_name else ""
         who += f" (seed {self.seed})" if self.seed is not None else ""
         return (f"{self.name}{who} with behavior {self.behavior}: {s['outcome']} after "
                 f"{s['time_s']:g} s (min clearance {s['min_clearance_in']:.1f} in, "
                 f"{plural(s['collisions'], 'collision')}); "
-                f"correct it with `at TIME OUTPUT=VALUE` (0 to {self.time(-1):g} s)")
+                f"correct it with `at TIME OUTPUT=VALUE` (0 to {self.end:g} s)")
 
     def rows(self, start: float, stop: float | None) -> np.ndarray:
         """Tick rows at ``start`` (the nearest) or from ``start`` to ``stop``."""
-        t = self.t
-        end = float(t[-1])
+        t, end, active = self.t, self.end, self._active
+        whose = f"robot {self.robot_name}'s run" if self.robot_name else "the run"
         for value in (start, stop):
             if value is not None and not math.isfinite(value):
-                raise LessonError(f"a time is a finite number of seconds (the run lasted 0 to "
-                                  f"{end:g} s)")
+                raise LessonError(f"a time is a finite number of seconds ({whose} lasted 0 "
+                                  f"to {end:g} s)")
             if value is not None and not -1e-9 <= value <= end + 1e-9:
-                raise LessonError(f"the run lasted 0 to {end:g} s; {value:g} s is outside it")
-        active = self.result.active[:, self.robot] if self.result.active is not None else \
-            np.ones(len(t), dtype=bool)
+                raise LessonError(f"{whose} lasted 0 to {end:g} s; {value:g} s is outside it")
         if stop is None:
-            return np.array([int(np.argmin(np.abs(t - start)))])
+            return np.array([int(np.argmin(np.abs(t[:self._last + 1] - start)))])
         if stop < start:
             raise LessonError(f"`at {start:g}s to {stop:g}s`: the window ends before it starts")
         rows = np.flatnonzero((t >= start - 1e-9) & (t <= stop + 1e-9) & active)
