@@ -87,6 +87,11 @@ def test_rule_lines_are_rules_of_the_rule_language():
     ("at 5ms steering=70", "unexpected `=`", None, "a time is in seconds"),
     ("adapt epochs 3 rate 0.9 rate 0.01", "`rate` is given twice in one `adapt`", None,
      "give each option once"),
+    ("simulate figure4 seed 2x", "unexpected `x`", None, "a seed is a whole number"),
+    ("simulate figure4 seed x", "unexpected `x`", "a seed", "a seed is a whole number"),
+    ("simulate my world.yaml", "unexpected `world`", "`robot` or `seed`", "is quoted"),
+    ("simulate figure4 seed 3 robo x", "unexpected `robo`", "`robot`",
+     "did you mean `robot`?"),
 ])
 def test_mistyped_lines_say_what_was_expected(line, message, expected, hint):
     with pytest.raises(RuleSyntaxError) as info:
@@ -128,3 +133,14 @@ def test_adapt_values_that_cannot_be_used_are_refused_where_written(line, messag
     err = info.value
     assert message in err.message
     assert (err.span.line, err.span.column) == (4, column)
+
+
+def test_an_adapt_whose_gain_rounds_away_says_so():
+    """Q lowered by the descent but lost to the grid learned values are kept to is not "Q
+    cannot go lower"."""
+    from mitos_cli.teach.session import _nothing_changed
+
+    said = _nothing_changed([1.1e-3, 5e-5, 1.6e-6, 1.1e-3], rounded=True)
+    assert "lowered Q to 1.6e-06" in said and "rounds back" in said and "stays 0.0011" in said
+    assert "cannot go lower" in _nothing_changed([2.0, 2.0, 2.0], rounded=True)
+    assert "cannot go lower" in _nothing_changed([2.0, 2.0], rounded=False)

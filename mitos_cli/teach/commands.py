@@ -39,6 +39,7 @@ from ..resources import grammar_text
 WORDS = dict(TERMINAL_WORDS, PATH="a file name", INT="a whole number", ARROW="`->`",
              SHOW_WHAT="rules, terms, examples, behaviors or history", EQUAL="`=`",
              SIGNED_NUMBER="a number", SEED="a seed (a whole number)", DOT="`.`",
+             SEED_WORD="`seed`",
              **{"$END": "the end of the line", "<END-OF-FILE>": "the end of the line"})
 
 #: Every command word, for completion and ``help``.
@@ -491,6 +492,10 @@ def _syntax_error(exc: UnexpectedInput, text: str, path: str) -> RuleSyntaxError
     before = text[:token.start_pos].split() if token.start_pos is not None else []
     if before[:1] == ["save"]:              # `save out dir.rules`: one file name, then the end
         expected = {"$END"}
+    if before[:1] == ["simulate"]:          # LALR's merged states: no `adapt` option here
+        expected -= {"EPOCHS", "RATE", "PLOT", "UNCONSTRAINED"}
+        if "ROBOT" in expected and "seed" not in before:    # (`seed` is an anonymous token)
+            expected.add("SEED_WORD")
     if "->" in before or before[:1] in (["at"], ["eval"]):   # LALR's merged states: no arrow
         expected.discard("ARROW")                           # is behind us or has a place
     hint = _teach_hint(text, token, before)
@@ -516,7 +521,12 @@ def _teach_hint(text: str, token: Token, before: list[str]) -> str | None:
         return "names are written in ASCII letters, digits, `_` and `-`"
     if token.value == "," and before[:1] in (["eval"], ["correct"], ["at"]):
         return "values are separated by spaces, not commas: `road=78 size=45`"
-    if before[:1] in (["save"], ["simulate"]) or before[-2:-1] == ["plot"]:
+    glued = at > 0 and not text[at - 1].isspace()
+    if before[:1] == ["simulate"] and (before[-1:] == ["seed"]                  # `seed x`
+                                       or before[-2:-1] == ["seed"] and glued):  # `seed 2x`
+        return "a seed is a whole number written in digits (such as 42)"
+    if (before[:1] == ["save"] or before[:1] == ["simulate"] and len(before) == 2
+            or before[-2:-1] == ["plot"]):                      # just after the file name
         return 'a file name with a space in it is quoted: "my file.rules"'
     if before[:1] == ["at"] and len(before) > 1 and any(
             re.fullmatch(r"[\d.]+(ms|sec|secs|seconds?|min|m|h)", word)

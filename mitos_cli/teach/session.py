@@ -731,7 +731,7 @@ class Session:
         history = [float(q) for q in result.history]
         self.out(text.q_lines(history, len(X), result))
         if not terms and not crisp:
-            self.out("nothing changed: Q cannot go lower from here with these examples")
+            self.out(_nothing_changed(history, result.rounded))
             return
         self.change("adapt", line, behavior=compiled.behavior, terms=terms, crisp=crisp,
                     q=[history[0], history[-1]], epochs=epochs, rate=rate)
@@ -898,6 +898,18 @@ def _reaches(rb: RuleBase, start: str, target: str) -> bool:
         seen.add(name)
         stack.extend(u.behavior for u in rb.behavior(name).uses)
     return False
+
+
+def _nothing_changed(history: list[float], rounded: bool) -> str:
+    """Why an ``adapt`` changed nothing: the descent found nothing lower, or what it found
+    was lost to the grid learned values are kept to (``history``: Q per epoch, the rounded
+    one last when ``rounded``)."""
+    descent = history[:-1] if rounded else history
+    if rounded and min(descent) < history[0]:
+        return (f"nothing changed: the descent lowered Q to {min(descent):.6g}, but every value "
+                f"it moved rounds back to what it was (learned values are kept to a readable "
+                f"grid), so Q stays {history[0]:.6g}")
+    return "nothing changed: Q cannot go lower from here with these examples"
 
 
 def _seed(text: str) -> int:
