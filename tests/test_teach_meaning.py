@@ -140,6 +140,55 @@ def test_coverage_is_exact_at_a_crossing():
     assert low == pytest.approx(0.25) and where == pytest.approx(3.0)   # (4 - x) / 4 = (x - 2) / 4
 
 
+
+def _input(terms: str, universe: str = "[0, 100]"):
+    return parse_termset(f"variables:\n  x: {{role: input, universe: {universe}, terms: "
+                         f"{terms}}}\n").variables[0]
+
+
+@pytest.mark.parametrize("terms, universe, stretches", [
+    # the audit's: LOW falls to 0.5 at 35, HIGH rises to it at 65; least 0.2 at 50
+    ("{LOW: {shape: left_shoulder, points: [10, 60]}, HIGH: {shape: right_shoulder, "
+     "points: [40, 90]}}", "[0, 100]", "x in [35, 65]"),
+    # two dips, the ends rounded to the universe's thousandth (100/3 -> 33.3)
+    ("{A: {shape: left_shoulder, points: [0, 50]}, B: {shape: triangle, points: "
+     "[100/3, 50, 200/3]}, C: {shape: right_shoulder, points: [60, 100]}}".replace(
+         "100/3", repr(100 / 3)).replace("200/3", repr(200 / 3)),
+     "[0, 100]", "x in [25, 41.7] and [58.3, 80]"),
+    # a gap on [30, 40] and a dip at 78: the stretches around the gap are named too
+    ("{A: {shape: left_shoulder, points: [10, 30]}, B: {shape: triangle, points: "
+     "[40, 60, 90]}, C: {shape: right_shoulder, points: [70, 90]}}", "[0, 100]",
+     "x in [20, 50] and [75, 80]"),
+    # gaussians: on samples, the ends where the largest membership crosses 0.5
+    ("{LO: {shape: gaussian, mean: 0, sigma: 1}, HI: {shape: gaussian, mean: 10, sigma: 1}}",
+     "[0, 10]", "x in [1.18, 8.82]"),
+])
+def test_coverage_names_the_stretches_below_the_threshold(terms, universe, stretches):
+    """`mitos check` said "covered only to 0.2 at x = 50", one point, where the issue asks
+    for the input range: the stretches below 0.5 are named, the least kept."""
+    (issue,) = [i for i in meaning.variable_issues(_input(terms, universe))
+                if i.code == "coverage"]
+    assert f"less than 0.5 for {stretches} (every point" in issue.message
+
+
+def test_coverage_stretches_end_where_the_largest_membership_is_the_threshold():
+    var = _input("{LOW: {shape: left_shoulder, points: [10, 60]}, HIGH: {shape: "
+                 "right_shoulder, points: [40, 90]}}")
+    corners = np.array([t.corners for t in var.terms], dtype=float)
+    ((a, b),) = meaning.uncovered(corners, var.universe)
+    assert (a, b) == pytest.approx((35.0, 65.0))
+    x = np.linspace(0, 100, 1001)
+    top = meaning.memberships(corners, x).max(axis=0)
+    ((sa, sb),) = meaning.uncovered_on(top, x)          # on samples: the same stretch
+    assert (sa, sb) == pytest.approx((35.0, 65.0))
+    (issue,) = meaning.variable_issues(var)
+    assert issue.message.startswith("`x` is covered only to 0.2 at x = 50, less than 0.5 "
+                                    "for x in [35, 65]")
+    gapped = _input("{A: {shape: left_shoulder, points: [10, 30]}, B: {shape: triangle, "
+                    "points: [40, 60, 90]}, C: {shape: right_shoulder, points: [70, 90]}}")
+    (issue,) = [i for i in meaning.variable_issues(gapped) if i.code == "coverage"]
+    assert "covered only to 0.4 at x = 78 outside its term gaps, less" in issue.message
+
 def test_hedged_terms_move_along_the_scale():
     steering = PAPER.variables["steering"]
     assert hedged(steering, "LM", ()) == 50

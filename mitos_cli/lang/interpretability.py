@@ -164,6 +164,35 @@ def coverage_spans(corners: np.ndarray, universe: tuple[float, float]
     return ends, np.minimum(least, COVERAGE)
 
 
+def uncovered(corners: np.ndarray, universe: tuple[float, float]) -> list[tuple[float, float]]:
+    """The stretches ``(left, right)`` of the universe where the largest membership of these
+    piecewise-linear terms is below :data:`COVERAGE`, exactly (:func:`coverage_spans`)."""
+    ends, least = coverage_spans(corners, universe)
+    return [(float(a), float(b)) for a, b, m in zip(ends[:-1], ends[1:], least)
+            if m < COVERAGE - 1e-9 and b > a]
+
+
+def uncovered_on(top: np.ndarray, x: np.ndarray) -> list[tuple[float, float]]:
+    """:func:`uncovered` on samples: each run of the points ``x`` where the largest
+    membership ``top`` is below :data:`COVERAGE`, its ends where ``top`` crosses the level
+    between a sample and its neighbour (linearly; an end of the universe is an end)."""
+    below = top < COVERAGE - 1e-9
+    padded = np.concatenate([[False], below, [False]])
+    edges = np.flatnonzero(padded[1:] != padded[:-1])
+    out = []
+    for a, b in zip(edges[::2], edges[1::2]):          # samples a .. b - 1 are below
+        left = x[a] if a == 0 else _crossing(x[a - 1], x[a], top[a - 1], top[a])
+        right = x[b - 1] if b == len(x) else _crossing(x[b], x[b - 1], top[b], top[b - 1])
+        out.append((float(left), float(right)))
+    return out
+
+
+def _crossing(x_in: float, x_out: float, m_in: float, m_out: float) -> float:
+    """Where the line from ``(x_in, m_in)`` (covered) to ``(x_out, m_out)`` (below) reaches
+    :data:`COVERAGE`."""
+    return x_in + (m_in - COVERAGE) / (m_in - m_out) * (x_out - x_in)
+
+
 def span_coverage(corners: np.ndarray, universe: tuple[float, float],
                   ends: np.ndarray) -> np.ndarray:
     """The least largest-membership on each stretch ``[ends[s], ends[s + 1]]``, exactly: at
@@ -384,15 +413,16 @@ def variable_issues(var: Variable) -> list[Issue]:
             x = breakpoints(corners, var.universe)
             mu = memberships(corners, x)
         else:                                                   # any shape: on samples
+            corners = None
             x = sample_points(sets, var.universe)
             mu = sampled(sets, x)
         if var.role == "input":
             low, where = coverage_on(mu, x, var.universe, besides_gaps=True)   # see term-gap
             if low < COVERAGE - 1e-9:
-                out.append(Issue("coverage", var.name, (), (
-                    f"`{var.name}` is covered only to {_num(low)} at {var.name} = "
-                    f"{_num(where)} (every point of the universe should belong to some term "
-                    f"at least {COVERAGE:g})"),
+                spans = (uncovered_on(mu.max(axis=0), x) if corners is None
+                         else uncovered(corners, var.universe))
+                out.append(Issue("coverage", var.name, (), _coverage_message(
+                    var, low, where, spans, gaps=bool(np.any(mu.max(axis=0) <= 0.0))),
                     "widen the neighbouring terms so that they overlap there"))
         if len(sets) >= 2:
             s, i, j = _most(similarity_on(mu, x))
@@ -411,6 +441,41 @@ def variable_issues(var: Variable) -> list[Issue]:
                 "move them apart, or merge them into one term"))
     out += _off_centre(var)
     return out
+
+
+#: Stretches named in one coverage finding; more are counted.
+SHOWN_STRETCHES = 4
+
+
+def _coverage_message(var: Variable, low: float, where: float,
+                      spans: list[tuple[float, float]], gaps: bool) -> str:
+    """```x` is covered only to 0.2 at x = 50, less than 0.5 for x in [35, 65] (...)``: the
+    least and where, then the stretches below :data:`COVERAGE` (those around a gap too, the
+    gap itself being the ``term-gap`` finding), their ends rounded to the decimal place of a
+    thousandth of the universe, the resolution the sampled measures have."""
+    step = (var.universe[1] - var.universe[0]) / (RESOLUTION - 1)
+    text = f"`{var.name}` is covered only to {_num(low)} at {var.name} = {_num(where)}"
+    if gaps:
+        text += " outside its term gaps"
+    if spans:
+        shown = [f"[{_rounded(a, step)}, {_rounded(b, step)}]"
+                 for a, b in spans[:SHOWN_STRETCHES]]
+        listed = shown[0] if len(shown) == 1 else ", ".join(shown[:-1]) + " and " + shown[-1]
+        more = len(spans) - len(shown)
+        text += (f", less than {COVERAGE:g} for {var.name} in {listed}"
+                 + (f" and {more} more stretch{'es' if more > 1 else ''}" if more else ""))
+    return text + (f" (every point of the universe should belong to some term at least "
+                   f"{COVERAGE:g})")
+
+
+def _rounded(x: float, step: float) -> str:
+    """``x`` to the power of ten at most ``step`` (35.00000001 -> 35, 33.3333 -> 33.3)."""
+    if not step > 0 or not np.isfinite(x):
+        return _num(x)
+    decimals = -int(np.floor(np.log10(step)))
+    value = round(float(x), decimals) + 0.0                 # + 0.0: -0.0 reads as 0
+    return f"{value:.{max(decimals, 0)}f}".rstrip("0").rstrip(".") if decimals > 0 else \
+        f"{value:.0f}"
 
 
 def _order(var: Variable) -> list[Issue]:
@@ -510,4 +575,5 @@ __all__ = ["COVERAGE", "DISTINCT", "GAP_HINT", "GAP_RESOLUTION", "RESOLUTION", "
            "Issue", "centre", "core", "coverage", "coverage_on", "coverage_spans",
            "gap_message", "gap_points", "gaps_on", "held_term", "memberships", "mirror_point",
            "most_similar", "rulebase_issues", "sample_points", "sampled", "similarity",
-           "similarity_on", "span_coverage", "term_gaps", "variable_issues"]
+           "similarity_on", "span_coverage", "term_gaps", "uncovered", "uncovered_on",
+           "variable_issues"]
