@@ -600,3 +600,43 @@ def test_a_converted_controller_keeps_the_end_of_its_universe_covered(tmp_path):
             out.clear()
             s.run(f"save {tmp_path / 'u.rules'}")
             assert "a gap the terms as written did not have" in "\n".join(out)
+
+
+def _said(before: dict[str, float], after: dict[str, float]) -> list[str]:
+    """What `in_words` says when the crisp output `o` (deg) moves from ``before`` to
+    ``after``."""
+    from types import SimpleNamespace
+
+    from mitos_cli.teach.learned import in_words
+
+    def rulebase(values):
+        terms = ", ".join(f"{k}: {v!r}" for k, v in values.items())
+        text = f"variables:\n  x: {{role: input, universe: [0, 1], terms: {{A: {{shape: " \
+               f"left_shoulder, points: [0, 1]}}}}}}\n  o: {{role: output, unit: deg, " \
+               f"universe: [0, 200], terms: {{{terms}}}}}\n"
+        rules = "behavior b:\n" + "".join(f" if x is A then o is {k}\n" for k in values) + "end\n"
+        return build_rulebase(parse_rules(rules), (parse_termset(text),), ("t.yaml",))
+
+    parameters = SimpleNamespace(held=(), knots=(SimpleNamespace(var="o"),))
+    return in_words(rulebase(before), rulebase(after), parameters).splitlines()[1:]
+
+
+def test_learned_words_show_a_small_move_and_the_table_s_digits():
+    """`steering.RS: 110 -> 110 deg, toward ST` for 109.97; `130 -> 130.9` beside a table of
+    changes that said 130.87."""
+    said = _said({"ST": 90.0, "RS": 110.0, "RM": 130.0, "RB": 150.0},
+                 {"ST": 90.0, "RS": 109.97, "RM": 130.87, "RB": 150.0 + 1e-12})
+    assert said == ["  o.RS: 110 -> 109.97 deg, toward ST",
+                    "  o.RM: 130 -> 130.87 deg, toward RB",
+                    f"  o.RB: 150.0 -> {150.0 + 1e-12!r} deg"]      # never "150 -> 150"
+
+
+def test_learned_words_say_past_a_neighbour_not_a_share_over_the_whole_way():
+    """`out.MID: 30 -> 42.5, toward HI (125% of the way: it now means nearly what HI
+    meant)`: it went past HI."""
+    said = _said({"LO": 0.0, "MID": 30.0, "HI": 40.0}, {"LO": 0.0, "MID": 42.5, "HI": 60.0})
+    assert said[0] == ("  o.MID: 30 -> 42.5 deg, past HI (written at 40 deg: it now lies "
+                       "beyond what HI meant)")
+    said = _said({"LO": 0.0, "MID": 30.0, "HI": 40.0}, {"LO": 0.0, "MID": 37.0, "HI": 60.0})
+    assert said[0] == ("  o.MID: 30 -> 37 deg, toward HI (70% of the way: it now means "
+                       "nearly what HI meant)")

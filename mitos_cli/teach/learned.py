@@ -5,20 +5,34 @@ middle): ``steering.LS: 70 -> 62 deg, toward LM``; a term held at its point of s
 so (``steering.ST: unchanged (held at 90)``; ``heading.AHEAD: held at 0, its slopes moved
 with its neighbours`` when its feet, shared with its neighbours' peaks, moved). A term whose
 centre moved more than :data:`MEANING_SHIFT` of the way to its written neighbour on that side
-is flagged: it now means something close to that neighbour.
+is flagged: it now means something close to that neighbour; one that went past where the
+neighbour was written says so (``out.MID: 30 -> 42.5, past HI (written at 40) ...``).
+
+The numbers are the terms' own as ``changed (before -> after)`` prints them (adaptation rounds
+them to a readable grid): ``130 -> 130.87``, never ``130.9`` beside a table that says 130.87,
+and never ``110 -> 110`` for a move to 109.97.
 """
 
 from __future__ import annotations
 
 from ..lang.interpretability import centre
-from ..lang.model import RuleBase
+from ..lang.model import RuleBase, format_number
 
 #: Share of the distance to the next term beyond which a move "changes the meaning".
 MEANING_SHIFT = 0.5
 
 
 def _num(x: float) -> str:
-    return f"{x + 0.0:.4g}"            # + 0.0: -0.0 reads as 0
+    """As the table of changes writes a number (``format_number``), without the noise of the
+    core's middle (``0.5 * (b + c)``) in its last bits."""
+    return format_number(round(x, 9) + 0.0)          # + 0.0: -0.0 reads as 0
+
+
+def _moved(a: float, b: float) -> tuple[str, str]:
+    """``a`` and ``b`` said so that they differ when they do (a move smaller than the noise
+    :func:`_num` drops is written out in full)."""
+    before, after = _num(a), _num(b)
+    return (before, after) if before != after or a == b else (repr(a), repr(b))
 
 
 def in_words(before: RuleBase, after: RuleBase, parameters) -> str:
@@ -54,13 +68,10 @@ def in_words(before: RuleBase, after: RuleBase, parameters) -> str:
                 continue
             i = order.index(t_old)
             j = i + (1 if b > a else -1)
-            text = f"  {name}.{t_new.name}: {_num(a)} -> {_num(b)}{unit}"
+            before_, after_ = _moved(a, b)
+            text = f"  {name}.{t_new.name}: {before_} -> {after_}{unit}"
             if 0 <= j < len(order):
-                share = abs(b - a) / max(abs(centre(order[j]) - a), 1e-12)
-                text += f", toward {order[j].name}"
-                if share > MEANING_SHIFT:
-                    text += (f" ({share:.0%} of the way: it now means nearly what "
-                             f"{order[j].name} meant)")
+                text += _toward(a, b, order[j].name, centre(order[j]), unit)
             lines.append(text)
     if len(lines) == 1:
         lines.append("  no term moved")
@@ -68,3 +79,18 @@ def in_words(before: RuleBase, after: RuleBase, parameters) -> str:
         lines.append("  (a held term is the centre of mirror-symmetric terms; `unfrozen "
                      "VARIABLE.TERM` lets it move)")
     return "\n".join(lines)
+
+
+def _toward(a: float, b: float, neighbour: str, there: float, unit: str) -> str:
+    """Which way a centre moved from ``a`` to ``b``: toward the ``neighbour`` written at
+    ``there`` (flagged past :data:`MEANING_SHIFT` of the way), or past it."""
+    share = abs(b - a) / max(abs(there - a), 1e-12)
+    if share > 1.0:
+        return (f", past {neighbour} (written at {_num(there)}{unit}: it now lies beyond what "
+                f"{neighbour} meant)")
+    if share == 1.0:
+        return f", onto {neighbour} (it now means what {neighbour} meant)"
+    text = f", toward {neighbour}"
+    if share > MEANING_SHIFT:
+        text += f" ({share:.0%} of the way: it now means nearly what {neighbour} meant)"
+    return text
