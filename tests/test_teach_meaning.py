@@ -134,6 +134,29 @@ def test_off_centre_needs_a_symmetry_the_writer_meant(terms):
     assert "off-centre" not in [i.code for i in meaning.variable_issues(var)]
 
 
+@pytest.mark.parametrize("terms, universe, flagged", [
+    # 3 values from 40 to 60: half of 10 is 5 (the universe's 100 / 2 / 2 would be 25)
+    ("{LO: 40, MID: 44, HI: 60}", "[0, 100]", [("LO", "MID", "closer than 5,")]),
+    # written in a corner of a wide universe: as far apart as their number allows
+    ("{STOP: 0, CRAWL: 5, SLOW: 10}", "[0, 60]", []),
+    ("{LB: 30, LM: 50, LS: 70, ST: 90, RS: 110, RM: 130, RB: 150}", "[30, 150]", []),
+])
+def test_crisp_values_are_kept_apart_by_their_own_spread(terms, universe, flagged):
+    """docs/teach.md said "spread evenly over the universe"; the measure (one for check and
+    adapt) spreads them from the smallest to the largest, and the docs now say so."""
+    text = ("variables:\n  x: {role: input, universe: [0, 1], terms: {A: {shape: "
+            "left_shoulder, points: [0, 1]}}}\n"
+            f"  o: {{role: output, universe: {universe}, terms: {terms}}}\n")
+    var = parse_termset(text).variables[1]
+    found = [i for i in meaning.variable_issues(var) if i.code == "indistinct"]
+    assert [(i.terms[0], i.terms[1]) for i in found] == [f[:2] for f in flagged]
+    for issue, (_, _, says) in zip(found, flagged):
+        assert says in issue.message
+    values = np.array([t.params[0] for t in var.terms])
+    assert meaning.least_distance(values) == pytest.approx(
+        0.5 * (values.max() - values.min()) / (len(values) - 1))
+
+
 def test_coverage_is_exact_at_a_crossing():
     corners = np.array([[-np.inf, -np.inf, 0.0, 4.0], [2.0, 6.0, np.inf, np.inf]])
     low, where = meaning.coverage(corners, (0.0, 10.0))
