@@ -92,6 +92,25 @@ def test_rule_lines_are_rules_of_the_rule_language():
     ("simulate my world.yaml", "unexpected `world`", "`robot` or `seed`", "is quoted"),
     ("simulate figure4 seed 3 robo x", "unexpected `robo`", "`robot`",
      "did you mean `robot`?"),
+    # a relative instruction where a target goes: it needs a window of the recorded run
+    ("correct heading=-5 -> turn harder", "unexpected `harder`", "`is`",
+     "`turn harder` is an instruction: it takes a window of the recorded run, "
+     "`at 13s to 14.5s turn harder`"),
+    ("correct heading=-5 -> go faster", "unexpected `faster`", "`is`",
+     "a target reads `OUTPUT=VALUE` or `OUTPUT is TERM`; a relative instruction"),
+    # a bare instruction: it is no command; the window, and the list
+    ("turn harder", "unknown command `turn`: an instruction takes a window of the recorded "
+     "run, `at 13s to 14.5s turn harder`", "`turn harder`, `turn less`, `make a wider turn`, "
+     "`slow down`, `speed up`, `keep further from the wall`, `keep right`", "simulate WORLD"),
+    ("make a wider turn", "unknown command `make`: an instruction takes a window of the "
+     "recorded run, `at 13s to 14.5s make a wider turn`", "`at START [to END]`", None),
+    ("speed=20", "unknown command `speed`", "one of behavior", None),
+    # a target takes only the hedges that move a value along its scale
+    ("at 1s to 2s steering is vry LM", "unexpected `LM`", None,
+     "`vry` is not a hedge (hedges of a target: very, extremely, somewhat, more_or_less); "
+     "did you mean `very`?"),
+    ("r1: if road is vry WIDE then speed is SLOW", "unexpected `WIDE`", None,
+     "(hedges: very, extremely, somewhat, more_or_less, seldom, intensely, any)"),
 ])
 def test_mistyped_lines_say_what_was_expected(line, message, expected, hint):
     with pytest.raises(RuleSyntaxError) as info:

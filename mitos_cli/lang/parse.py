@@ -265,8 +265,10 @@ def _keyword_near(text: str, word: Token, accepts: set[str]) -> str | None:
     return did_you_mean(str(word), keywords) if keywords else None
 
 
-def _hedge_hint(text: str, token: Token) -> str | None:
-    """``road is vary WIDE``: the word before the term was meant as a hedge."""
+def _hedge_hint(text: str, token: Token, allowed: tuple[str, ...] | None = None) -> str | None:
+    """``road is vary WIDE``: the word before the term was meant as a hedge. ``allowed``: the
+    hedges that may stand there (a teaching target takes only those that move a value along
+    its scale), listed and offered instead of every hedge."""
     from ..fuzzy.hedges import HEDGES
 
     before = re.search(r"\bis\s+(?:not\s+)?([A-Za-z_][\w\-]*)\s*$",
@@ -274,8 +276,10 @@ def _hedge_hint(text: str, token: Token) -> str | None:
     if before is None or before.group(1) in HEDGES:
         return None
     word = before.group(1)
-    close = did_you_mean(word, HEDGES)          # only a near miss is taken for a hedge
-    return f"`{word}` is not a hedge (hedges: {', '.join(HEDGES)}); {close}" if close else None
+    pool = list(HEDGES) if allowed is None else list(allowed)
+    close = did_you_mean(word, pool)            # only a near miss is taken for a hedge
+    where = "hedges" if allowed is None else "hedges of a target"
+    return f"`{word}` is not a hedge ({where}: {', '.join(pool)}); {close}" if close else None
 
 
 #: words of the language that can also be read as names where a name is expected

@@ -35,6 +35,7 @@ from ..lang.parse import (
     shift,
 )
 from ..resources import grammar_text
+from .instructions import HEDGE_STEPS, INSTRUCTIONS
 
 WORDS = dict(TERMINAL_WORDS, PATH="a file name", INT="a whole number", ARROW="`->`",
              SHOW_WHAT="rules, terms, examples, behaviors or history", EQUAL="`=`",
@@ -423,6 +424,14 @@ def _unknown_command(line: str, text: str, path: str, lineno: int) -> RuleSyntax
         return None
     word = match.group(1)
     column = match.start(1) + 1
+    said = starts_instruction(line.split())
+    if said is not None:
+        return RuleSyntaxError(
+            f"unknown command `{word}`: an instruction takes a window of the recorded run, "
+            f"`at 13s to 14.5s {said}`",
+            span=Span.in_text(text, path, lineno, column, column + len(word)),
+            expected="`at START [to END]` before one of the instructions " + INSTRUCTION_LIST,
+            hint="`simulate WORLD` records a run; `help at` says more")
     return RuleSyntaxError(f"unknown command `{word}`",
                            span=Span.in_text(text, path, lineno, column, column + len(word)),
                            expected="a rule (`if ... then ...`, or `LABEL: if ...`) or one of "
@@ -430,6 +439,21 @@ def _unknown_command(line: str, text: str, path: str, lineno: int) -> RuleSyntax
                            hint=(f"a rule label ends with a colon: `{word}: if ...`"
                                  if line[match.end():].split()[:1] == ["if"] else
                                  did_you_mean(word, COMMAND_WORDS + ("if",)) or "type `help`"))
+
+
+#: The instructions, as messages list them.
+INSTRUCTION_LIST = ", ".join(f"`{k}`" for k in INSTRUCTIONS)
+
+
+def starts_instruction(words: list[str]) -> str | None:
+    """The instruction whose first words ``words`` begin with (or that begins with all of
+    ``words``), as written in full: ``turn harder``, ``turn`` -> ``turn harder``."""
+    for phrase in INSTRUCTIONS:
+        said = phrase.split()
+        n = min(len(said), len(words))
+        if n and words[:n] == said[:n]:
+            return phrase
+    return None
 
 
 def incomplete(line: str) -> bool:
@@ -503,6 +527,8 @@ def _syntax_error(exc: UnexpectedInput, text: str, path: str) -> RuleSyntaxError
         pass
     elif not before:
         hint = FIRST_WORDS_HINT
+    elif token.type == "NAME" and "IS" in expected and "->" in before:
+        hint = _target_hint(before)
     elif token.type == "NAME" and "IS" in expected:
         hint = "a condition reads `variable is TERM`"
     elif "EQUAL" in expected:
@@ -511,6 +537,18 @@ def _syntax_error(exc: UnexpectedInput, text: str, path: str) -> RuleSyntaxError
         hint = keyword_hint(token, expected)
     return RuleSyntaxError(f"unexpected {_describe(token)}", span=span,
                            expected=_expected(expected), hint=hint)
+
+
+def _target_hint(before: list[str]) -> str:
+    """After ``correct ... ->``: what a target reads, and where an instruction goes
+    (``correct heading=-5 -> turn harder``)."""
+    after = before[len(before) - before[::-1].index("->"):]
+    said = starts_instruction(after)
+    window = (f"`{said}` is an instruction: it takes a window of the recorded run, "
+              f"`at 13s to 14.5s {said}`, not inputs" if said is not None else
+              "a relative instruction (`turn harder`, ...) takes a window of the recorded run: "
+              "`at 13s to 14.5s turn harder`")
+    return f"a target reads `OUTPUT=VALUE` or `OUTPUT is TERM`; {window}"
 
 
 def _teach_hint(text: str, token: Token, before: list[str]) -> str | None:
@@ -535,9 +573,9 @@ def _teach_hint(text: str, token: Token, before: list[str]) -> str | None:
     if before[-2:] == ["is", "not"] and ("->" in before or before[:1] == ["at"]):
         return ("a target is a term, with hedges if need be (`steering is very LM`); `not` says "
                 "what it should not be, which is no target")
-    if "->" in before or before[:1] == ["at"]:
-        return _hedge_hint(text, token)
-    return None
+    if "->" in before or before[:1] == ["at"]:            # targets: the hedges they take
+        return _hedge_hint(text, token, tuple(HEDGE_STEPS))
+    return _hedge_hint(text, token)                      # a rule's condition: any hedge
 
 
 def _describe(token: Token) -> str:
