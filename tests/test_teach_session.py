@@ -316,6 +316,35 @@ def test_simulate_and_at_and_their_mistakes(rules, tmp_path):
         s.run("adapt epochs 3 plot a.gif")
 
 
+def test_simulating_a_behavior_that_cannot_drive_says_use_at_the_prompt(rules):
+    """"simulate a behavior such as `drive` (--behavior)": at the prompt there is no
+    --behavior; a behavior is chosen with `use`."""
+    s, _ = session(rules)
+    s.run("use follow_route")                                  # sets steering, not speed
+    with pytest.raises(RuleBaseError) as info:
+        s.run("simulate figure4")
+    assert "--behavior" not in info.value.hint
+    assert info.value.hint == ("simulate a behavior such as `drive` (`use drive`, then "
+                               "`simulate` again)")
+
+
+def test_simulating_a_behavior_of_inputs_not_perceived_says_use_at_the_prompt(tmp_path):
+    (tmp_path / "g.yaml").write_text(
+        "variables:\n  gizmo: {role: input, universe: [0, 1], terms: {LOW: {shape: "
+        "left_shoulder, points: [0, 1]}}}\n  steering: {role: output, universe: [30, 150], "
+        "terms: {LM: 50}}\n  speed: {role: output, universe: [0, 60], terms: {SLOW: 10}}\n",
+        encoding="utf-8")
+    rules = tmp_path / "g.rules"
+    rules.write_text('terms "g.yaml"\nbehavior b:\n  if gizmo is LOW then steering is LM and '
+                     'speed is SLOW\nend\n', encoding="utf-8")
+    s, _ = session(rules)
+    with pytest.raises(RuleBaseError) as info:
+        s.run("simulate figure4")
+    assert "which the simulator does not perceive" in info.value.message
+    assert info.value.hint.endswith("simulate a behavior that reads them (`use NAME`, then "
+                                    "`simulate` again)")            # this file has no drive
+
+
 def test_at_corrects_the_behavior_that_drove_the_run(rules):
     """`use drive`, `simulate`, then `use avoid_obstacle` and `at ...`: the examples were made
     from avoid_obstacle's output (steering 70, an output nobody used: its context had weight

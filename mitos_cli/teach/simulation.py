@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..errors import LessonError
+from ..errors import LessonError, MitosError
 from ..lang.model import RuleBase
 from ..words import plural
 
@@ -130,6 +130,13 @@ def run_world(name: str, rulebase: RuleBase, behavior: str, seed: int | None = N
 
         raise unknown(f"robot of {Path(name).name}", robot, names, cls=LessonError)
     index = names.index(robot) if robot is not None else 0
-    result = simulate(world, FuzzyPlanner(rulebase, behavior), seed=seed)
+    try:
+        planner = FuzzyPlanner(rulebase, behavior)
+    except MitosError as exc:           # its hints name `mitos simulate --behavior`
+        if exc.hint:
+            name = "drive" if "drive" in {b.name for b in rulebase.behaviors} else "NAME"
+            exc.hint = exc.hint.replace("(--behavior)", f"(`use {name}`, then `simulate` again)")
+        raise
+    result = simulate(world, planner, seed=seed)
     return Recording(Path(name).stem, behavior, result, index,
                      names[index] if len(names) > 1 else "", seed)
