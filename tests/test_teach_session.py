@@ -551,14 +551,38 @@ def test_unfrozen_says_what_it_lifts(rules):
         "mirror each other about; `save` writes `held: false`)")
     assert say(s, out, "unfrozen steering.ST") == (
         "steering.ST is neither frozen nor held (its hold was lifted already): adaptation "
-        "could move it already")
+        "could move it already; nothing changes")
     s.run("frozen heading.AHEAD, road.NARROW")
     assert say(s, out, "unfrozen heading.AHEAD, road.NARROW").splitlines() == [
         "adaptation may move heading.AHEAD: its freeze and its hold at 0 are lifted (the point "
         "its neighbours mirror each other about; `save` writes `held: false`)",
         "adaptation may move road.NARROW: its freeze is lifted"]
     assert say(s, out, "unfrozen road.WIDE") == \
-        "road.WIDE is neither frozen nor held: adaptation could move it already"
+        "road.WIDE is neither frozen nor held: adaptation could move it already; nothing changes"
+
+
+def test_frozen_or_unfrozen_that_changes_nothing_is_no_unsaved_change(rules):
+    """`unfrozen heading.LEFT` of a term neither frozen nor held was journaled: "unsaved
+    changes" at the end, and `save` then said "(no changes)". Like `frozen` of a frozen term,
+    it now says that nothing changes, and journals nothing."""
+    s, out = session(rules)
+    seq = len(s.journal.active())
+    assert say(s, out, "unfrozen heading.LEFT") == (
+        "heading.LEFT is neither frozen nor held: adaptation could move it already; nothing "
+        "changes")
+    assert not s.unsaved and len(s.journal.active()) == seq
+    s.run("frozen heading.LEFT")
+    assert s.unsaved
+    assert say(s, out, "frozen heading.LEFT") == (
+        "heading.LEFT is frozen already: adaptation keeps it as it is; nothing changes")
+    assert say(s, out, "frozen heading.LEFT, heading.AHEAD").splitlines() == [
+        "adaptation keeps heading.AHEAD as it is (`unfrozen` lets it move; `save` writes "
+        "`frozen: true`)",
+        "heading.LEFT is frozen already: adaptation keeps it as it is"]
+    assert s.journal.active()[-1]["terms"] == [["heading", "AHEAD"]]
+    say(s, out, "undo")                                 # takes back the AHEAD freeze only
+    assert say(s, out, "undo") == "undone: frozen heading.LEFT"
+    assert not s.unsaved
 
 
 def test_a_comma_between_values_is_named_and_a_hedge_past_the_scale_is_noted(rules):

@@ -444,26 +444,43 @@ class Session:
         return [list(r) for r in refs]
 
     def _freezeterms(self, c: cmd.FreezeTerms, line: str) -> None:
+        """Freeze terms; a term frozen already is said so and not journaled (a command that
+        changes nothing is no unsaved change: `save` would write nothing for it)."""
         terms = self._term_refs(c.terms)
-        self.change("freeze", line, terms=terms)
-        self.out("adaptation keeps " + ", ".join(f"{v}.{t}" for v, t in terms)
-                 + (" as it is" if len(terms) == 1 else " as they are")
-                 + " (`unfrozen` lets it move; `save` writes `frozen: true`)")
+        variables = self.rulebase.variables
+        new = [[v, t] for v, t in terms if not variables[v].term(t).frozen]
+        already = [f"{v}.{t}" for v, t in terms if [v, t] not in new]
+        if new:
+            self.change("freeze", line, terms=new)
+            self.out("adaptation keeps " + ", ".join(f"{v}.{t}" for v, t in new)
+                     + (" as it is" if len(new) == 1 else " as they are")
+                     + " (`unfrozen` lets it move; `save` writes `frozen: true`)")
+        if already:
+            self.out(", ".join(already) + (" is" if len(already) == 1 else " are")
+                     + " frozen already: adaptation keeps "
+                     + ("it" if len(already) == 1 else "them") + " as "
+                     + ("it is" if len(already) == 1 else "they are")
+                     + ("; nothing changes" if not new else ""))
 
     def _releaseterms(self, c: cmd.ReleaseTerms, line: str) -> None:
+        """Lift freezes and holds; a term with neither is said so and not journaled, as
+        `frozen` of a frozen term."""
         terms = self._term_refs(c.terms)
+        lifted = [(v, t, *self._lifted(v, t)) for v, t in terms]          # before the change
+        changed = [[v, t] for v, t, _, lifts in lifted if lifts]
         # the centre terms among them, as the files wrote them: `save` writes `held: false`
         written = self.original.variables
-        holds = [[v, t] for v, t in terms if v in written
+        holds = [[v, t] for v, t in changed if v in written
                  and (held := held_term(written[v])) is not None and held[0].name == t]
-        lifted = [self._lifted(v, t) for v, t in terms]          # before the change
-        self.change("release", line, terms=terms, holds=holds)
-        for text_ in lifted:
-            self.out(text_)
+        if changed:
+            self.change("release", line, terms=changed, holds=holds)
+        for _, _, text_, _ in lifted:
+            self.out(text_ + ("" if changed else "; nothing changes"))
 
-    def _lifted(self, var: str, term: str) -> str:
+    def _lifted(self, var: str, term: str) -> tuple[str, bool]:
         """What `unfrozen VAR.TERM` lifts, said before it does: a freeze, a hold at a point of
-        symmetry, both, or nothing (the term could move already)."""
+        symmetry, both, or nothing (the term could move already); and whether it lifts
+        anything."""
         now = self.rulebase.variables[var]
         what, notes = [], []
         if (var, term) in self.state.frozen_terms or now.term(term).frozen:
@@ -478,10 +495,10 @@ class Session:
             already = " (its hold was lifted already)" if (var, term) in self.state.released \
                 and held is not None and held[0].name == term else ""
             return (f"{var}.{term} is neither frozen nor held{already}: adaptation could move "
-                    "it already")
+                    "it already"), False
         return (f"adaptation may move {var}.{term}: " + " and ".join(what)
                 + (" is" if len(what) == 1 else " are") + " lifted"
-                + (f" ({'; '.join(notes)})" if notes else ""))
+                + (f" ({'; '.join(notes)})" if notes else "")), True
 
     def _telloperators(self, c: cmd.TellOperators, line: str) -> None:
         b = self.rulebase.behavior(self.focus)
