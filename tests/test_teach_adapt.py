@@ -181,6 +181,18 @@ def test_frozen_terms_and_frozen_rules_keep_their_values():
     assert any("B.peak" in x for x in labels)
 
 
+def test_not_adapted_names_frozen_input_terms_frozen_rules_terms_and_frozen_outputs():
+    """`not adapted:` named `steering.LB is frozen` but not the frozen `heading.LEFT`: the
+    docs say frozen terms, output terms concluded by a frozen rule and shapes not learned
+    keep their values, and the line now names all of them."""
+    compiled = small()                          # z.C frozen: true; r1 (frozen) concludes S
+    assert parameterise(compiled).frozen_reasons == ("z.C is frozen",
+                                                     "y.S is concluded by a frozen rule")
+    p = parameterise(compiled, frozen_terms={("x", "MID"), ("y", "L")})
+    assert p.frozen_reasons == ("x.MID is frozen", "z.C is frozen", "y.L is frozen",
+                                "y.S is concluded by a frozen rule")
+
+
 def test_refusals_are_clear():
     # (Mamdani behaviors are adapted too: tests/test_teach_mamdani.py)
     with pytest.raises(LessonError, match="not `and = lukasiewicz`"):

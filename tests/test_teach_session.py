@@ -607,3 +607,16 @@ def test_a_comma_between_values_is_named_and_a_hedge_past_the_scale_is_noted(rul
         "note: `steering is very RB` lies past RB")
     assert say(s, out, "correct road=78 size=45 position=4 -> steering is very LM").startswith(
         "example 3:")                                       # 40: inside the scale, no note
+
+
+def test_not_adapted_names_the_frozen_input_terms_too(rules):
+    """After `frozen heading.LEFT, heading.FAR_LEFT` and `frozen steering.LB`, `adapt` said
+    only `not adapted: steering.LB is frozen`."""
+    s, out = session(rules)
+    for line in ("use follow_route", "frozen heading.LEFT, heading.FAR_LEFT",
+                 "frozen steering.LB", "correct heading=-5 -> steering=40",
+                 "correct heading=5 -> steering=90", "correct heading=-30 -> steering=60"):
+        s.run(line)
+    text = say(s, out, "adapt epochs 30")
+    assert ("not adapted: heading.FAR_LEFT is frozen; heading.LEFT is frozen; steering.LB is "
+            "frozen") in text.splitlines()

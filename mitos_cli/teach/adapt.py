@@ -424,6 +424,8 @@ def _input_knots(b: _Builder) -> np.ndarray:
             term = var.term(compiled.term_names[t][1])
             if term.shape in FROM_CORNERS:
                 items.append((t, term))
+                if b.term_frozen(vname, term):          # said as a frozen output term is
+                    b.reasons.append(f"{vname}.{term.name} is frozen")
             else:
                 b.reasons.append(f"{vname}.{term.name}: shape `{term.shape}` is not learned")
         for t, ids in b.tie_corners(vname, "input", items).items():
@@ -455,6 +457,8 @@ def _output_knots(b: _Builder) -> tuple[np.ndarray, dict]:
         for tname, i in term_knot.items():
             b.frozen[i] = (i not in used or i in locked or b.term_frozen(oname, var.term(tname))
                            or tname in held)
+            if i in locked and not b.term_frozen(oname, var.term(tname)):
+                b.reasons.append(f"{oname}.{tname} is concluded by a frozen rule")
             out_terms[(oname, tname)] = np.array([i, -1, -1, -1], dtype=np.intp)
         _thaw_sets(b, oname, shaped, used_sets, locked_sets)
     return cons_knot, out_terms
@@ -544,6 +548,8 @@ def _thaw_sets(b: _Builder, oname: str, shaped: dict, used_sets: set, locked_set
                 b.frozen[i] = True
         if b.term_frozen(oname, var.term(tname)) and tname in used_sets:
             b.reasons.append(f"{oname}.{tname} is frozen")
+        elif tname in locked_sets and not b.term_frozen(oname, var.term(tname)):
+            b.reasons.append(f"{oname}.{tname} is concluded by a frozen rule")
 
 
 def _set_specs(compiled: CompiledRuleBase, cons_knot: np.ndarray) -> tuple[SetSpec, ...]:

@@ -747,14 +747,17 @@ class Session:
                                                                 result.values))
         history = [float(q) for q in result.history]
         self.out(text.q_lines(history, len(X), result))
+        kept = result.parameters.frozen_reasons     # frozen terms, rules, shapes not learned
         if not terms and not crisp:
+            if kept:
+                self.out("not adapted: " + "; ".join(kept))
             self.out(_nothing_changed(history, result.rounded))
             return
         self.change("adapt", line, behavior=compiled.behavior, terms=terms, crisp=crisp,
                     q=[history[0], history[-1]], epochs=epochs, rate=rate)
         self.out(text.changed_table(before, self.rulebase, crisp))
-        if result.parameters.frozen_reasons:
-            self.out("not adapted: " + "; ".join(result.parameters.frozen_reasons))
+        if kept:
+            self.out("not adapted: " + "; ".join(kept))
         self.out(in_words(before, self.rulebase, result.parameters))
         self.out(self.interpretability())
         if c.plot is not None:
