@@ -33,6 +33,15 @@ def constraints_hold(compiled, p, values) -> None:
         assert meaning.variable_issues(var) == [], name
     for var, term, point in p.held:
         assert meaning.centre(rb.variables[var].term(term)) == pytest.approx(point, abs=1e-9)
+    for name in compiled.inputs + compiled.outputs:        # each nearer its own written place
+        written = sorted(compiled.variables[name].terms, key=meaning.centre)
+        now = {t.name: meaning.centre(t) for t in rb.variables[name].terms}
+        places = [meaning.centre(t) for t in written]
+        for j, t in enumerate(written):
+            if j:
+                assert now[t.name] >= (places[j - 1] + places[j]) / 2 - 1e-9, (name, t.name)
+            if j + 1 < len(written):
+                assert now[t.name] <= (places[j] + places[j + 1]) / 2 + 1e-9, (name, t.name)
 
 
 @settings(max_examples=8, deadline=None, suppress_health_check=[HealthCheck.too_slow])
@@ -55,6 +64,20 @@ def test_random_corrections_keep_order_coverage_distinctness_and_points(seed, n,
     epochs = result.history[:-1] if result.rounded else result.history
     assert all(b < a for a, b in zip(epochs, epochs[1:]))  # Q never increases
     assert result.q_after <= result.q_before
+
+
+def test_one_correction_does_not_move_a_term_onto_its_neighbour():
+    """The issue's own example: `correct heading=-5 -> steering=60` pulled `LEFT`'s peak (and
+    `FAR_LEFT`'s edge) to -1.87 deg, next to `AHEAD`'s 0. A term now moves at most half the
+    way to its neighbour as written; unconstrained, it still goes all the way."""
+    X = np.array([[-5.0]])
+    T = np.array([[60.0]])
+    held = adapt(FOLLOW, X, T, epochs=5)
+    rb = learned_rulebase(held.parameters, held.values)
+    assert -42.5 <= meaning.centre(rb.variables["heading"].term("LEFT")) <= -12.5 + 1e-9
+    free = adapt(FOLLOW, X, T, epochs=5, constrained=False)
+    rb = learned_rulebase(free.parameters, free.values)
+    assert meaning.centre(rb.variables["heading"].term("LEFT")) > -12.5
 
 
 def test_unconstrained_moves_what_constrained_holds():

@@ -360,12 +360,31 @@ class _Builder:
             if term.shape == "triangle_pw":
                 self.sym_rows.append((out[key][0], out[key][1], out[key][3]))
         self._hold_set(vname, items, out)
+        if self.constrained:
+            self._keep_places(var.universe, [(term.corners[1:3], out[key][1:3])
+                                             for key, term in items])
         if self.constrained and len(items) == len(var.terms) and items:
             written = np.array([term.corners for _, term in items], dtype=float)
             self.partitions.append(partition(vname, var.universe,
                                              np.array([out[k] for k, _ in items]), written,
                                              covered=kind == "input"))
         return out
+
+    def _keep_places(self, universe: tuple[float, float], cores: list) -> None:
+        """Each term's core (``(b, c)`` as written and their knots) kept nearer its own centre
+        as written than either neighbour's: a term moves at most half the way to the next one,
+        so that it never comes to mean what its neighbour meant (`LEFT` peaking at 2 deg left
+        of ahead). The bounds are the midpoints between the written centres."""
+        centres = [_core_centre(tuple(core), universe) for core, _ in cores]
+        order = sorted(range(len(cores)), key=lambda n: centres[n])
+        for j, n in enumerate(order):
+            lo = universe[0] if j == 0 else 0.5 * (centres[order[j - 1]] + centres[n])
+            hi = universe[1] if j == len(order) - 1 else 0.5 * (centres[n] + centres[order[j + 1]])
+            for i in cores[n][1]:
+                if i >= 0:
+                    v = self.values[i]
+                    self.lo[i] = max(self.lo[i], min(lo, v))
+                    self.hi[i] = min(self.hi[i], max(hi, v))
 
     def _hold_set(self, vname: str, items: list, out: dict) -> None:
         """A held triangle keeps its peak (its slopes may move: they are its neighbours'
@@ -380,6 +399,14 @@ class _Builder:
         for i in ids[1:3]:
             if i >= 0:
                 self.frozen[i] = True
+
+
+def _core_centre(core: tuple[float, float], universe: tuple[float, float]) -> float:
+    """The centre of a core ``(b, c)`` (a shoulder's: its finite end)."""
+    b, c = core
+    if not math.isfinite(b):
+        return c if math.isfinite(c) else 0.5 * (universe[0] + universe[1])
+    return b if not math.isfinite(c) else 0.5 * (b + c)
 
 
 def parameterise(compiled: CompiledRuleBase, *, constrained: bool = True,
@@ -476,6 +503,8 @@ def _crisp_terms(b: _Builder, oname: str) -> dict[str, int]:
         ids.append(term_knot[tname])
         if b.term_frozen(oname, var.term(tname)):
             b.reasons.append(f"{oname}.{tname} is frozen")
+    if len(ids) > 1 and b.constrained:
+        b._keep_places((ulo, uhi), [((b.values[i], b.values[i]), (i, i)) for i in ids])
     if len(ids) > 1:
         b.order.append(np.array(ids, dtype=np.intp))
         least = meaning.least_distance(np.array([b.values[i] for i in ids])) / (uhi - ulo)
