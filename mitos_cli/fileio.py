@@ -13,7 +13,7 @@ import contextlib
 import errno
 import os
 import secrets
-from collections.abc import Iterator
+from collections.abc import Iterable, Iterator
 from pathlib import Path
 from typing import IO
 
@@ -27,16 +27,25 @@ MAX_TEXT_BYTES = 256 << 20
 RULE_SUFFIXES = (".rules", ".fcl", ".fis", ".fll")
 
 
-def nearby(path: str | Path, suffixes: tuple[str, ...] = RULE_SUFFIXES) -> str | None:
+def nearby(path: str | Path, suffixes: tuple[str, ...] = RULE_SUFFIXES,
+           also: Iterable[str] = ()) -> str | None:
     """"did you mean `DIR/NAME`?" for a file beside ``path`` whose name is close to its own
-    and ends in one of ``suffixes`` (`rulebases/mitoss.rules`, `rulebases/mitos.rule`)."""
+    and ends in one of ``suffixes`` (`rulebases/mitoss.rules`, `rulebases/mitos.rule`), or
+    for one of the names ``also`` (the packaged files, where ``path`` may name one of them:
+    `worlds/slalon.yaml` from a directory without `worlds/`), whichever is closest."""
+    name = nearby_name(path, suffixes, also)
+    return f"did you mean `{Path(path).parent / name}`?" if name is not None else None
+
+
+def nearby_name(path: str | Path, suffixes: tuple[str, ...] = RULE_SUFFIXES,
+                also: Iterable[str] = ()) -> str | None:
+    """The name :func:`nearby` suggests, without its directory."""
     where = Path(path).parent
     try:
         names = [p.name for p in where.iterdir() if p.suffix.lower() in suffixes]
-    except OSError:
-        return None
-    name = closest_file(Path(path).name, names)
-    return f"did you mean `{where / name}`?" if name is not None else None
+    except OSError:                 # no such directory: only ``also`` may be meant
+        names = []
+    return closest_file(Path(path).name, [*names, *also])
 
 
 def read_text(path: str | Path) -> str:

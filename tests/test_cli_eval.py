@@ -317,8 +317,7 @@ def test_an_input_without_its_equals_sign_is_a_usage_error(capsys):
 
 def test_a_misspelt_rule_file_or_its_term_set_named_instead_say_what_was_meant(capsys):
     code, _, err = run_main(["eval", "rulebases/mitos.rule", "road=78"], capsys)
-    assert code == 2 and "did you mean `rulebases/mitos.rules`?" in " ".join(
-        err.replace("│", " ").split())
+    assert code == 1 and "did you mean `rulebases/mitos.rules`?" in err
     code, _, err = run_main(["eval", "rulebases/mitos.terms.yaml", "road=78"], capsys)
     assert code == 1 and "is a YAML file (a term set, or a world), not a rule base" in err
     assert "a term set is read through the `terms` line of its .rules file" in err
@@ -343,6 +342,29 @@ def test_a_misspelt_packaged_rule_file_from_elsewhere_gets_a_did_you_mean(
     assert f"did you mean `{name.replace('mitoss', 'mitos')}`?" in err, err
     code, _, err = run_main(["eval", "nope/mitoss.rules", "road=78"], capsys)
     assert code == 1 and "did you mean" not in err      # another directory: not the packaged
+
+
+@pytest.mark.parametrize("files", [(), ("mitos.fll",)])
+def test_eval_finds_rule_files_as_the_other_commands_do(files, tmp_path, monkeypatch, capsys):
+    """eval had a lookup of its own: `mitos` (the packaged rule base to `check`, `plot`,
+    `convert`, `simulate --rulebase`) and `mitos.rule` were "neither a rule file nor
+    NAME=VALUE" (exit 2), and beside a `mitos.fll` the typo's hint was that file."""
+    monkeypatch.chdir(tmp_path)
+    for name in files:
+        (tmp_path / name).write_text("")
+    sample = ["road=78", "size=45", "position=4"]
+    code, out, _ = run_main(["eval", "mitos", *sample], capsys)
+    assert code == 0 and "steering" in out
+    for command in (["eval", "mitos.rule", *sample], ["check", "mitos.rule"]):
+        code, out, err = run_main(command, capsys)
+        assert code == 1 and out == "", command
+        assert "rule file `mitos.rule` not found" in err
+        assert "hint: did you mean `mitos.rules`?" in err, err
+    code, _, err = run_main(["eval", "nosuch", *sample], capsys)   # no file's name: a lost `=`
+    assert code == 2 and "neither a rule file nor NAME=VALUE" in " ".join(
+        err.replace("│", " ").split())
+    code, _, err = run_main(["eval", "nosuch.txt", *sample], capsys)
+    assert code == 1 and "rule file `nosuch.txt` not found" in err
 
 
 def test_used_rules_take_the_operators_of_the_behavior_that_uses_them(tmp_path):

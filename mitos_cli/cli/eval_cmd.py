@@ -184,14 +184,9 @@ def _loaded(path: str | None, behavior: str | None, fidelity):
     ``fidelity`` names where one is asked for; a lone word that is no file is a lost ``=``."""
     from ..api import LoadedRuleBase, load_rulebase
 
-    if path is not None and Path(path).suffix.lower() not in (".rules", ".fcl", ".fis", ".fll") \
-            and not Path(path).exists():    # `mitos eval road78 size=45`: a lost `=`
-        from ..fileio import nearby
-
-        close = nearby(path)
+    if path is not None and not _names_file(path):  # `mitos eval road78 size=45`: a lost `=`
         raise typer.BadParameter(f"`{path}` is neither a rule file nor NAME=VALUE (no file "
-                                 f"of that name; write each input as NAME=VALUE)"
-                                 + (f"; {close}" if close else ""))
+                                 f"of that name; write each input as NAME=VALUE)")
     rb = load_rulebase(path, behavior)
     warn_notes(rb.rulebase)
     if fidelity is None:
@@ -200,6 +195,21 @@ def _loaded(path: str | None, behavior: str | None, fidelity):
 
     return LoadedRuleBase(rb.rulebase, behavior,
                           fidelity_settings(rb.rulebase, fidelity.value, behavior))
+
+
+def _names_file(word: str) -> bool:
+    """Whether ``word``, the first of eval's arguments and no NAME=VALUE, names a rule file,
+    found or not, as ``check``, ``plot`` and ``simulate --rulebase`` read one: a file, a packaged
+    rule base (``mitos``), or what looks like a file's name (an extension, a directory, a name
+    close to a rule file's: ``mitos.rule``), which is then "not found" with a "did you mean"
+    (exit 1). Anything else (``road78``) is an input that lost its ``=`` (exit 2)."""
+    from ..lang.resolve import rule_file_hint
+    from ..resources import exists, resolve
+
+    given = Path(word)
+    return (exists(given) or resolve("rulebases", word, ".rules") is not None
+            or given.suffix[1:].isalpha() or len(given.parts) > 1
+            or rule_file_hint(word) is not None)
 
 
 def _evaluate_one(rb, values: dict[str, str], as_json: bool, digits: int | None) -> None:

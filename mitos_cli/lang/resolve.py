@@ -23,23 +23,17 @@ MAIN = "main"
 
 
 def rule_file_hint(path: str | Path) -> str | None:
-    """"did you mean" for a rule file that is not there: a file beside it whose name is close
-    (:func:`..fileio.nearby`), else, where the packaged rule bases would be looked for
-    (``rulebases/mitoss.rules`` from a directory without ``rulebases/``), the packaged one
-    whose name is close, as a world file's name gets the packaged worlds."""
-    from ..errors import closest_file
+    """"did you mean" for a rule file that is not there: the closest of the files beside it
+    (:func:`..fileio.nearby`) and, where the packaged rule bases would be looked for
+    (``mitos.rule``, ``rulebases/mitoss.rules`` from anywhere), the packaged ones, as a world
+    file's name gets the packaged worlds: a `mitos.fll` here was suggested for `mitos.rule`,
+    which every command reads as the packaged `mitos.rules` once spelt right."""
     from ..fileio import RULE_SUFFIXES, nearby
     from ..resources import packaged_names, packaged_place
 
-    close = nearby(path)
-    if close is not None:
-        return close
-    given = Path(path)
-    if not packaged_place(given.parent.as_posix(), "rulebases"):
-        return None
-    names = [n for suffix in RULE_SUFFIXES for n in packaged_names("rulebases", suffix)]
-    name = closest_file(given.name, names)
-    return f"did you mean `{given.parent / name}`?" if name is not None else None
+    packaged = ([n for suffix in RULE_SUFFIXES for n in packaged_names("rulebases", suffix)]
+                if packaged_place(Path(path).parent.as_posix(), "rulebases") else [])
+    return nearby(path, RULE_SUFFIXES, packaged)
 
 
 @without_cyclic_gc
