@@ -315,6 +315,24 @@ def test_an_input_without_its_equals_sign_is_a_usage_error(capsys):
     assert code == 1 and "rule file `missing.rules` not found" in err
 
 
+@pytest.mark.parametrize("args, said, meant", [
+    (["road", "78"], "`road 78`", "road=78"),
+    (["road", "78", "size=45", "position=4"], "`road 78`", "road=78"),
+    (["road=", "78", "size=45"], "`road= 78`", "road=78"),
+    (["road", "=78"], "`road =78`", "road=78"),
+    (["mitos", "size", "45"], "`size 45`", "size=45"),
+    (["road=78", "size", "45", "position=4"], "`size 45`", "size=45"),
+    (["road78", "size=45", "position=4"], "`road78` is neither", "road=78"),
+    (["position-4.5", "road=78"], "`position-4.5` is neither", "position=-4.5")])
+def test_an_input_name_apart_from_its_number_is_told_as_meant(args, said, meant, capsys):
+    """`mitos eval road 78` said "`78` is neither the rule base (which comes first) nor
+    NAME=VALUE", pointing nowhere near the lost `=`."""
+    code, out, err = run_main(["eval", *args], capsys)
+    text = " ".join(err.replace("│", " ").split())
+    assert code == 2 and out == ""
+    assert said in text and f"did you mean `{meant}`?" in text, text
+
+
 def test_a_misspelt_rule_file_or_its_term_set_named_instead_say_what_was_meant(capsys):
     code, _, err = run_main(["eval", "rulebases/mitos.rule", "road=78"], capsys)
     assert code == 1 and "did you mean `rulebases/mitos.rules`?" in err

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import enum
+import re
 import sys
 from pathlib import Path
 from typing import Annotated, Optional
@@ -37,7 +38,11 @@ def split_args(args: list[str]) -> tuple[Optional[str], dict[str, str]]:
     """``[RULEBASE] NAME=VALUE ...`` -> (rule-base path or None, {name: text})."""
     path: Optional[str] = None
     values: dict[str, str] = {}
-    for arg in args:
+    for i, arg in enumerate(args):
+        meant = _apart(args[i:i + 2])
+        if meant is not None:
+            raise typer.BadParameter(f"`{arg} {args[i + 1]}`: write each input as NAME=VALUE, "
+                                     f"in one word; did you mean `{meant}`?")
         if "=" in arg:
             name, _, value = arg.partition("=")
             if not name:
@@ -51,6 +56,23 @@ def split_args(args: list[str]) -> tuple[Optional[str], dict[str, str]]:
             raise typer.BadParameter(
                 f"`{arg}` is neither the rule base (which comes first) nor NAME=VALUE")
     return path, values
+
+
+def _apart(pair: list[str]) -> str | None:
+    """``road=78`` for an input name and its number given as two words (``road 78``, ``road=
+    78``, ``road =78``), which the shell split; else None."""
+    from ..numbers import parse_number
+
+    if len(pair) != 2:
+        return None
+    name, value = pair[0].removesuffix("="), pair[1].removeprefix("=")
+    if "=" in name or "=" in value or not name.isidentifier():
+        return None
+    try:
+        parse_number(value)
+    except ValueError:
+        return None
+    return f"{name}={value}"
 
 
 def parse_values(values: dict[str, str]) -> dict[str, float]:
@@ -185,8 +207,10 @@ def _loaded(path: str | None, behavior: str | None, fidelity):
     from ..api import LoadedRuleBase, load_rulebase
 
     if path is not None and not _names_file(path):  # `mitos eval road78 size=45`: a lost `=`
+        lost = re.fullmatch(r"([^\W\d]\w*?)([-+]?(?:\d+\.?\d*|\.\d+))", path)
         raise typer.BadParameter(f"`{path}` is neither a rule file nor NAME=VALUE (no file "
-                                 f"of that name; write each input as NAME=VALUE)")
+                                 f"of that name; write each input as NAME=VALUE)"
+                                 + (f"; did you mean `{lost[1]}={lost[2]}`?" if lost else ""))
     rb = load_rulebase(path, behavior)
     warn_notes(rb.rulebase)
     if fidelity is None:
