@@ -292,6 +292,23 @@ def test_term_set_not_found(tmp_path):
     assert "term set `nope.yaml` not found" in exc.message and caret_under(exc) == '"nope.yaml"'
 
 
+def test_a_misspelt_term_set_gets_the_close_one_beside_it(tmp_path):
+    """`terms "t.term.yaml"` said only "not found" beside a `t.terms.yaml`."""
+    path = write(tmp_path, GOOD_RULE)
+    path.write_text('terms "t.term.yaml"\n' + GOOD_RULE, encoding="utf-8")
+    exc = error_of(lambda: load_rules_file(path), TermSetError)
+    assert "term set `t.term.yaml` not found" in exc.message
+    assert caret_under(exc) == '"t.term.yaml"' and exc.span.line == 1
+    assert exc.hint == "did you mean `t.terms.yaml`?"
+    (tmp_path / "sub").mkdir()
+    path.write_text('terms "sub/../t.term.yaml"\n' + GOOD_RULE, encoding="utf-8")
+    exc = error_of(lambda: load_rules_file(path), TermSetError)
+    assert exc.hint == "did you mean `sub/../t.terms.yaml`?"     # as the line names it
+    path.write_text('terms "nothing.yaml"\n' + GOOD_RULE, encoding="utf-8")
+    exc = error_of(lambda: load_rules_file(path), TermSetError)
+    assert exc.hint == "term-set paths are relative to the rule file, and name a YAML file"
+
+
 def test_term_set_named_twice(tmp_path):
     """`terms "t.terms.yaml", "./t.terms.yaml"` said "variable `road` is defined in two term
     sets" at the one file that defines it."""

@@ -446,6 +446,11 @@ def test_load_world_finds_a_packaged_world_from_any_directory(tmp_path, monkeypa
     ("foo/nosuch.yaml", "`mitos list` shows the packaged worlds", False),
     ("slalm.yaml", "did you mean `slalom.yaml`?", True),
     ("nosuch", None, True),                     # a name: the packaged worlds' names
+    # `worlds/NAME.yaml` is found from anywhere, so its misspelling gets the packaged names
+    # too (it got only "`mitos list` shows ..." where there is no `worlds/`)
+    ("worlds/slalon.yaml", "did you mean `worlds/slalom.yaml`?", False),
+    ("worlds/nosuch.yaml", "`mitos list` shows the packaged worlds", False),
+    ("foo/slalon.yaml", "`mitos list` shows the packaged worlds", False),
 ])
 def test_a_missing_world_file_is_not_found(tmp_path, monkeypatch, name, hint, listed):
     monkeypatch.chdir(tmp_path)

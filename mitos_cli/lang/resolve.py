@@ -36,6 +36,18 @@ def rule_file_hint(path: str | Path) -> str | None:
     return nearby(path, RULE_SUFFIXES, packaged)
 
 
+def termset_hint(target: Path, name: str) -> str:
+    """What to write in the ``terms`` line for a term set that is not there: the YAML file
+    beside it whose name is close (`mitos.terms.yaml` for `mitos.term.yaml`), as the line
+    names it, else how the line's paths are read."""
+    from ..fileio import nearby_name
+
+    close = nearby_name(target, (".yaml", ".yml")) if not exists(target) else None
+    if close is not None:
+        return f"did you mean `{(Path(name).parent / close).as_posix()}`?"
+    return "term-set paths are relative to the rule file, and name a YAML file"
+
+
 @without_cyclic_gc
 def load_rules_file(path: str | Path) -> RuleBase:
     """Read, parse and check the rule file at ``path`` and the term sets it names."""
@@ -60,8 +72,7 @@ def load_rules_file(path: str | Path) -> RuleBase:
         if not is_file(target):
             found = "is a directory" if exists(target) else "not found"
             raise TermSetError(f"term set `{name}` {found} (looked for `{target}`)", span=span,
-                               hint="term-set paths are relative to the rule file, and name "
-                                    "a YAML file")
+                               hint=termset_hint(target, name))
         termsets.append(load_termset(target))
     return build_rulebase(parsed, tuple(termsets), tuple(n for n, _ in parsed.terms))
 

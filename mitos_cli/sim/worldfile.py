@@ -881,22 +881,24 @@ def resolve_world_path(name: str | Path, base: Path | None = None) -> Path:
 
 
 def world_not_found(name: str | Path, where: Path) -> UnknownWorld:
-    """"world file `X` not found" (``where``: the path looked for), with a file beside it
-    whose name is close, else the packaged world whose name is close. The packaged names are
+    """"world file `X` not found" (``where``: the path looked for), with the closest of the
+    files beside it and, where the name may be a packaged world's, the packaged worlds. The packaged names are
     listed when the name was one's (``slalm``) or is close to one, not for any path
     (``nosuch.yaml``, ``foo/nosuch.yaml``: "did you mean office.yaml" was the shared ``.yaml``)."""
     from ..errors import closest_file
     from ..fileio import nearby
-    from ..resources import packaged_names
+    from ..resources import packaged_names, packaged_place
 
     given = Path(name)
     packaged = list(packaged_names("worlds", ".yaml"))
+    # `worlds/slalon.yaml` from anywhere: `worlds/NAME.yaml` is a packaged world's name too
+    maybe_packaged = packaged if packaged_place(given.parent.as_posix(), "worlds") else []
     bare = not given.suffix and len(given.parts) == 1      # a packaged world's name
     shown = packaged if given.suffix else [n[:-len(".yaml")] for n in packaged]
     close = closest_file(given.name, shown) if len(given.parts) == 1 else None
     hint = f"did you mean `{close}`?" if close else None
     if given.suffix or len(where.parts) > 1:      # a path: a file beside it first
-        hint = nearby(where, (".yaml", ".yml")) or hint
+        hint = nearby(where, (".yaml", ".yml"), maybe_packaged) or hint
     same_name = given.name if given.name.endswith(".yaml") else given.name + ".yaml"
     if len(given.parts) > 1 and same_name in packaged:
         hint = (f"there is no `{given}`; the packaged world of that name is "
