@@ -16,7 +16,8 @@ both the rule file and its term set); kills it with ``SIGKILL`` at a random mome
   the reference run's.
 
 and, with ``--sweep``, kills ``mitos compare -o DIR`` (2 T-norms x 4 runs on a small world) at a
-random moment, runs ``--resume``, and checks that ``results.csv`` then holds every run once,
+random moment, runs ``--resume`` (the command again when the kill came before the study
+began), and checks that ``results.csv`` then holds every run once,
 that the rows written before the kill are untouched and that the rows are, bit for bit, those of
 an uninterrupted sweep.
 
@@ -202,7 +203,10 @@ def sweep_trial(work: Path, whole: list[str], delay: float) -> dict:
     proc.send_signal(signal.SIGKILL)
     proc.wait()
     before = _rows(work)
-    r = subprocess.run(_sweep(work, resume=True), cwd=work, capture_output=True, text=True,
+    # killed before the study began (no study.json yet): there is nothing to resume, and
+    # --resume refuses a directory that holds no study; the sweep is started again
+    began = any((work / "out" / name).exists() for name in ("study.json", "results.csv"))
+    r = subprocess.run(_sweep(work, resume=began), cwd=work, capture_output=True, text=True,
                        env=ENV)
     assert r.returncode == 0, r.stderr[-500:]
     after = _rows(work)

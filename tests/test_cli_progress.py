@@ -172,6 +172,22 @@ def test_compare_ctrl_c_says_what_is_kept_and_how_to_resume(capsys, monkeypatch,
     assert "(2 now, 1 from before)" in err and err.rstrip().endswith("--resume")
 
 
+def test_compare_ctrl_c_before_the_study_began_says_start_it_again(capsys, monkeypatch,
+                                                                    tmp_path):
+    """Stopped before a study was there, `... --resume` would be refused (no study in DIR)."""
+    import mitos_cli.study as study_mod
+
+    def interrupted(study, out, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(study_mod, "run_study", interrupted)
+    code, _, err = run(capsys, "compare", TINY, "--and", "min", "--runs", 2,
+                       "-o", tmp_path / "s")
+    assert code == 130 and "Traceback" not in err
+    assert f"interrupted before the study began in {tmp_path / 's'}; start it with:" in err
+    assert "--resume" not in err and err.rstrip().endswith(str(tmp_path / "s"))
+
+
 @pytest.mark.skipif(not hasattr(os, "killpg"), reason="process groups")
 @pytest.mark.parametrize("executor", ["local", "dask"])
 def test_ctrl_c_on_a_compare_pool_leaves_no_worker_tracebacks(tmp_path, executor):

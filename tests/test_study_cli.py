@@ -122,6 +122,15 @@ def test_existing_results_need_resume(tiny, tmp_path, compare):
     assert r.exit_code == 1 and "already holds 1 result" in r.stderr and "--resume" in r.stderr
 
 
+def test_resume_of_a_directory_without_a_study_is_a_user_error(tiny, tmp_path, compare):
+    """`compare corridor --resume -o nosuchdir` exited 0: "5 runs now, 0 from before"."""
+    out = tmp_path / "nosuchdir"
+    r = compare(tiny, "--and", "min", "--planner", "fuzzy", "--runs", 1, "-o", out, "--resume")
+    assert r.exit_code == 1 and r.stdout == "" and not out.exists()
+    assert f"study error: `{out}` holds no study to resume" in r.stderr
+    assert "leave out --resume to start a study there" in r.stderr
+
+
 def test_an_output_that_is_a_file_is_refused_as_such(tiny, tmp_path, compare):
     afile = tmp_path / "afile"
     afile.write_text("mine\n")

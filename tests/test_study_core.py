@@ -176,6 +176,25 @@ def test_existing_results_need_resume(tmp_path):
     assert "already holds 6 results" in exc.value.message and "--resume" in exc.value.hint
 
 
+def test_resume_of_a_directory_without_a_study_is_refused(tmp_path):
+    """`compare --resume -o typo` began a new study there ("5 runs now, 0 from before")."""
+    for where in (tmp_path / "nosuch", tmp_path):
+        with pytest.raises(StudyError) as exc:
+            run_study(small_study(runs=1), where, workers=1, resume=True, task_fn=fake_sim)
+        assert exc.value.message == f"`{where}` holds no study to resume (no study.json or " \
+                                    f"results.csv)"
+        assert "leave out --resume to start a study there" in exc.value.hint
+    assert not (tmp_path / "nosuch").exists() and not any(tmp_path.iterdir())
+    # a study stopped before its first run finished holds no row, but is one: it resumes
+    study = small_study(runs=1)
+    with pytest.raises(Crash):
+        run_study(study, tmp_path, workers=1, task_fn=functools.partial(crashing_sim, after=0,
+                                                                        log=[]))
+    assert ResultStore(tmp_path).load() == []
+    outcome = run_study(study, tmp_path, workers=1, resume=True, task_fn=fake_sim)
+    assert outcome.skipped == 0 and outcome.executed == 6
+
+
 def test_resume_with_another_seed_is_refused(tmp_path):
     run_study(small_study(runs=1), tmp_path, workers=1, task_fn=fake_sim)
     other = Study(**{**small_study(runs=1).__dict__, "seed": 4})

@@ -57,8 +57,8 @@ def compare_command(
         "--scheduler", metavar="ADDR",
         help="Dask scheduler address (tcp://host:8786); without it a LocalCluster.")] = None,
     resume: Annotated[bool, typer.Option(
-        "--resume", help="Continue the study in DIR: skip every run already in results.csv."
-    )] = False,
+        "--resume", help="Continue the study in DIR: skip every run already in results.csv "
+                         "(DIR must hold one; without --resume a study starts there).")] = False,
     rulebase: Annotated[Optional[str], typer.Option(
         "--rulebase", "-r", metavar="PATH",
         help="Rule base of the fuzzy planner (default: the packaged one).")] = None,
@@ -253,6 +253,9 @@ def run_with_progress(study, out, executor, workers, scheduler, resume, quiet=Fa
         except KeyboardInterrupt:
             pass
     done = kept["before"] + kept["now"]
+    if not kept["total"] and not resume:      # before on_start: no run of it is kept
+        err(f"interrupted before the study began in {out}; start it with:\n  {study.command}")
+        raise typer.Exit(INTERRUPTED)
     err(f"interrupted: {done} of {plural(kept['total'], 'run')} kept in "
         f"{Path(out) / 'results.csv'} ({kept['now']} now, {kept['before']} from before); "
         f"go on with:\n  {study.command} --resume")

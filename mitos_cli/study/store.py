@@ -161,13 +161,21 @@ class ResultStore:
         ``resume``, in task order) and the tasks still to run.
 
         Without ``resume`` an existing ``results.csv`` with rows is an error rather than being
-        overwritten; with it, the study must have the same seed as the one that wrote the rows
-        and give every finished run the seed it was made with (:func:`rows_for`). Everything
-        is checked before anything is written: a refused study leaves the directory as it was.
+        overwritten; with it, the directory must hold a study (its ``study.json`` or
+        ``results.csv``, with rows or not), which must have the same seed as the one that
+        wrote the rows and give every finished run the seed it was made with
+        (:func:`rows_for`). Everything is checked before anything is written: a refused study
+        leaves the directory as it was.
         """
         if self.dir.exists() and not self.dir.is_dir():
             raise StudyError(f"`{self.dir}` is a file, not a directory for the study's results",
                              hint="choose a directory with -o (a new one is made)")
+        if resume and not (self.manifest_path.exists() or self.path.exists()):
+            # a mistyped -o began a new study under the name, and "0 from before" was all
+            # that said the study meant was not resumed
+            raise StudyError(f"`{self.dir}` holds no study to resume (no study.json or "
+                             f"results.csv)", hint="check the directory given with -o, or "
+                             "leave out --resume to start a study there")
         try:
             self.dir.mkdir(parents=True, exist_ok=True)
         except OSError as exc:
