@@ -76,6 +76,24 @@ def test_known_takes_true_or_false():
     assert "did you mean `true`" in text
 
 
+@pytest.mark.parametrize("value, meant", [("yes", "true"), ("Off", "false"), ("ON", "true"),
+                                          ("no", "false"), ('"yes"', "true")])
+def test_known_refuses_yaml_1_1_booleans_as_it_refuses_1(value, meant):
+    """worlds/README.md: a `known` neither true nor false is refused; `known: yes` was taken
+    as true (YAML 1.1) while `known: 1` was refused."""
+    text = error(world_text(CORRIDOR, "obstacles:\n"
+                            f"  - {{name: a, shape: circle, at: [150, 0], radius: 5, "
+                            f"known: {value}}}\n"))
+    shown = value.strip('"')
+    assert f"w.yaml:18:62: world error: `known` in obstacle `a` must be true or false, not " \
+           f"`{shown}`" in text, text
+    assert f"hint: write `known: {meant}`" in text
+    text = error(world_text(CORRIDOR, "obstacles:\n"
+                            "  - {name: a, shape: circle, at: [150, 0], radius: 5, known: 1}\n"))
+    assert "must be true or false, not `1`" in text
+    assert "hint: write `known: true` or `known: false`" in text
+
+
 def test_a_moving_obstacle_cannot_be_known():
     text = error(world_text(CORRIDOR, "obstacles:\n"
                             "  - {name: cart, shape: circle, at: [150, 0], radius: 5,\n"

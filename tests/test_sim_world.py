@@ -354,6 +354,10 @@ def test_a_misspelt_world_path_points_at_the_file_beside_it(tmp_path, monkeypatc
      "behavior must be the name of a behavior"),                       # was "`None`"
     ("  footprint: {length: 24, width: 18}\n", "  footprint: {length: 24, width: 18}\n"
      "  brake: maybe\n", "`brake` in robot must be true or false, not `maybe`"),
+    ("  footprint: {length: 24, width: 18}\n", "  footprint: {length: 24, width: 18}\n"
+     "  brake: off\n", "w.yaml:9:10: world error: `brake` in robot must be true or false, "
+     "not `off`\n      brake: off\n             ^\nexpected true or false\nhint: "
+     "write `brake: false`"),                           # was false (YAML 1.1), silently
     ("map:\n", "map:\n  given: whatever\n",
      "`given` in map must be `none` or a map_server YAML file, not `whatever`"),
     ("width: 70\n", "width: 70\nrandomise: {sensor_noise: 1}\n",

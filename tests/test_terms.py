@@ -52,3 +52,15 @@ def test_a_misspelt_key_of_a_triangle_is_pointed_at_with_a_suggestion():
     err = info.value
     assert "unknown key `peek`" in err.message and err.hint == "did you mean `peak`?"
     assert err.span.line == 6 and err.span.column == 33
+
+
+@pytest.mark.parametrize("value", ["yes", "off", "1"])
+def test_frozen_refuses_what_is_not_true_or_false(value):
+    """`frozen: yes` froze the term (YAML 1.1 reads it as true) while `frozen: 1` was refused;
+    booleans are now read as YAML 1.2 reads them, in term sets as in worlds."""
+    from mitos_cli.errors import TermSetError
+
+    with pytest.raises(TermSetError) as info:
+        termset({"MID": f"{{shape: triangle, points: [2, 5, 8], frozen: {value}}}"})
+    assert f"`frozen` must be true or false, not `{value}`" in info.value.message
+    assert info.value.span.line == 6

@@ -27,3 +27,17 @@ def test_quoted_keys_and_positions():
 def test_duplicate_keys_are_refused():
     with pytest.raises(TermSetError, match="duplicate key `a`"):
         yamlpos.load("a: 1\na: 2\n", "f.yaml", TermSetError)
+
+
+def test_booleans_are_read_as_yaml_1_2_reads_them():
+    """Only true and false (in three cases) are booleans; YAML 1.1's yes/no/on/off are the
+    text they are, so that a flag given one is refused instead of silently read."""
+    data = yamlpos.load("a: [true, True, TRUE, false, False, FALSE]\n"
+                        "b: [yes, Yes, YES, no, No, NO, on, On, ON, off, Off, OFF, y, n]\n",
+                        "f.yaml", TermSetError)
+    assert data["a"] == [True, True, True, False, False, False]
+    assert data["b"] == ["yes", "Yes", "YES", "no", "No", "NO", "on", "On", "ON", "off", "Off",
+                         "OFF", "y", "n"]
+    assert [yamlpos.yaml11_bool(v) for v in data["b"]] == [True] * 3 + [False] * 3 + \
+        [True] * 3 + [False] * 3 + [None, None]
+    assert yamlpos.yaml11_bool("oN") is None and yamlpos.yaml11_bool(True) is None

@@ -2,7 +2,7 @@
 file, the line and the key.
 
 Loading is ``yaml.SafeLoader`` underneath (nothing is ever evaluated as Python), with numbers
-read as YAML 1.2 reads them (:class:`_NumbersAsWritten`); mappings come
+and booleans read as YAML 1.2 reads them (:class:`_Yaml12Scalars`); mappings come
 back as :class:`YMap` and sequences as :class:`YList`, which remember where each key and value
 stood. Checking helpers (:func:`check_keys`, :func:`require`) raise the caller's error class with
 that position and a "did you mean" for unknown keys.
@@ -61,21 +61,42 @@ def _refuse(problem: str, mark: Any) -> yaml.constructor.ConstructorError:
 
 
 _INT, _FLOAT = "tag:yaml.org,2002:int", "tag:yaml.org,2002:float"
+_BOOL = "tag:yaml.org,2002:bool"
+#: ``yes``, ``no``, ``on``, ``off`` (any of their three cases): booleans in YAML 1.1 only
+YAML11_BOOL = "tag:mitos:yaml11-bool"
+_YAML11_MEANS = {spelt: means for word, means in (("yes", True), ("on", True), ("no", False),
+                                                  ("off", False))
+                 for spelt in (word, word.title(), word.upper())}
 
 
-class _NumbersAsWritten(yaml.SafeLoader):
-    """Numbers as YAML 1.2 (and every reader of it but PyYAML) reads them: ``010`` is ten, not
-    octal eight; ``1:00`` is text, not sexagesimal sixty; ``1e3`` and ``5e-2`` are numbers
-    without needing a dot; ``0o17`` and ``0x1F`` are octal and hexadecimal on purpose."""
+class _Yaml12Scalars(yaml.SafeLoader):
+    """Numbers and booleans as YAML 1.2 (and every reader of it but PyYAML) reads them:
+    ``010`` is ten, not octal eight; ``1:00`` is text, not sexagesimal sixty; ``1e3`` and
+    ``5e-2`` are numbers without needing a dot; ``0o17`` and ``0x1F`` are octal and hexadecimal
+    on purpose; only ``true`` and ``false`` are booleans. YAML 1.1's ``yes``, ``no``, ``on``
+    and ``off`` come back as the text they are (:data:`YAML11_BOOL` while resolving, so that a
+    key spelt so is refused): a flag given one is refused, as ``known: 1`` is, where it was
+    silently true (``known: yes``)."""
 
     yaml_implicit_resolvers = {
-        first: [(tag, regexp) for tag, regexp in resolvers if tag not in (_INT, _FLOAT)]
+        first: [(tag, regexp) for tag, regexp in resolvers if tag not in (_INT, _FLOAT, _BOOL)]
         for first, resolvers in yaml.SafeLoader.yaml_implicit_resolvers.items()}
 
 
-_NumbersAsWritten.add_implicit_resolver(
+def yaml11_bool(value: Any) -> bool | None:
+    """What YAML 1.1 would read ``value`` (a scalar as loaded here) as, when it is one of the
+    booleans of YAML 1.1 alone (``yes`` -> True); else None. For hints: "write `true`"."""
+    return _YAML11_MEANS.get(value) if isinstance(value, str) else None
+
+
+_Yaml12Scalars.add_implicit_resolver(
+    _BOOL, re.compile(r"^(?:true|True|TRUE|false|False|FALSE)$"), list("tTfF"))
+_Yaml12Scalars.add_implicit_resolver(
+    YAML11_BOOL, re.compile(r"^(?:yes|Yes|YES|no|No|NO|on|On|ON|off|Off|OFF)$"),
+    list("yYnNoO"))
+_Yaml12Scalars.add_implicit_resolver(
     _INT, re.compile(r"^(?:[-+]?[0-9]+|0o[0-7]+|0x[0-9a-fA-F]+)$"), list("-+0123456789"))
-_NumbersAsWritten.add_implicit_resolver(
+_Yaml12Scalars.add_implicit_resolver(
     _FLOAT, re.compile(r"^(?:[-+]?(?:\.[0-9]+|[0-9]+(?:\.[0-9]*)?)(?:[eE][-+]?[0-9]+)?"
                        r"|[-+]?\.(?:inf|Inf|INF)|\.(?:nan|NaN|NAN))$"), list("-+.0123456789"))
 
@@ -94,12 +115,17 @@ def _construct_float(loader: yaml.SafeLoader, node: yaml.ScalarNode) -> float:
     return float("nan") if value == ".nan" else float(value)
 
 
-_NumbersAsWritten.add_constructor(_INT, _construct_int)
-_NumbersAsWritten.add_constructor(_FLOAT, _construct_float)
+def _construct_text(loader: yaml.SafeLoader, node: yaml.ScalarNode) -> str:
+    return str(node.value)
+
+
+_Yaml12Scalars.add_constructor(_INT, _construct_int)
+_Yaml12Scalars.add_constructor(_FLOAT, _construct_float)
+_Yaml12Scalars.add_constructor(YAML11_BOOL, _construct_text)
 
 
 def _build_loader(text: str, path: str | None) -> type:
-    class Loader(_NumbersAsWritten):
+    class Loader(_Yaml12Scalars):
         """Safe loading without aliases, anchors, merge keys or tags (no format here has
         them, and an alias bomb expands a few lines into billions of values), nested at most
         :data:`MAX_DEPTH` deep, and with the constructors' own errors kept at their node."""
@@ -156,7 +182,8 @@ def _build_loader(text: str, path: str | None) -> type:
             if key_node.tag != "tag:yaml.org,2002:str":
                 # YAML 1.1 reads ON, off, yes, No, 1e3, ~ ... as booleans, numbers, null
                 kind = key_node.tag.rsplit(":", 1)[-1]
-                kind = {"bool": "true/false", "null": "null"}.get(kind, "a number")
+                kind = {"bool": "true/false", "yaml11-bool": "true/false",
+                        "null": "null"}.get(kind, "a number")
                 raise yaml.constructor.ConstructorError(
                     None, None, f"the key `{key_node.value}` reads as {kind} in YAML; "
                     f"write it in quotes: \"{key_node.value}\"", key_node.start_mark)

@@ -143,13 +143,19 @@ class _Reader:
         return value
 
     def flag(self, m: YMap, key: str, what: str, default: bool) -> bool:
+        """``true`` or ``false`` (every yes/no key of a world: ``known``, ``brake``); ``1``
+        and YAML 1.1's ``yes``/``no``/``on``/``off`` are refused where they stand."""
         if key not in m:
             return default
         value = m[key]
         if not isinstance(value, bool):
+            meant = yamlpos.yaml11_bool(value)
+            hint = (f"write `{key}: {str(meant).lower()}`: only true and false are yes/no "
+                    f"values here (YAML 1.2), `{value}` is text" if meant is not None else
+                    did_you_mean(str(value), ("true", "false"))
+                    or f"write `{key}: true` or `{key}: false`")
             raise WorldError(f"`{key}` in {what} must be true or false, not `{value}`",
-                             span=m.value_span(key), expected="true or false",
-                             hint=did_you_mean(str(value), ("true", "false")))
+                             span=m.value_span(key), expected="true or false", hint=hint)
         return value
 
     def range_pair(self, value: Any, span: Span, what: str) -> tuple[float, float]:
