@@ -355,3 +355,17 @@ def test_cmd_speed_is_the_command_after_the_brake(tmp_path):
     free.write_text(slalom.read_text().replace("robot:\n", "robot:\n  brake: false\n", 1))
     raw, cmd = _raw_and_commanded(free, tmp_path)
     assert np.allclose(raw, cmd, atol=1e-3)
+
+
+def test_the_readme_says_the_default_trace_size(capsys):
+    """README.md said the default `simulate --trace` is "about 45 KB": it is 39,477 bytes.
+    The figure, and that it fits in a pipe's 64 KiB (why `| head -1` races), are checked."""
+    readme = (Path(__file__).parents[1] / "README.md").read_text(encoding="utf-8")
+    said = re.search(r"a trace every 20 ticks, about (\d+) KB, less than the\s+pipe's 64 KiB",
+                     readme)
+    assert said is not None
+    with pytest.raises(SystemExit) as info:
+        main(["simulate", "--trace"])
+    size = len(capsys.readouterr().out.encode("utf-8"))
+    assert info.value.code in (0, None)
+    assert abs(size / 1000 - int(said.group(1))) < 1 and size < 64 * 1024, size
