@@ -126,6 +126,20 @@ def test_surface_table_marks_no_rule(tmp_path, capsys):
         ["10.0"] * 4 + ["-"] * 3 + ["90.0"] * 4
 
 
+def test_a_curve_table_right_aligns_both_columns(capsys):
+    """The output column was left-aligned under a right-aligned input column:
+    "      0  5.1" over "    2.5  10.0"."""
+    code, out, _ = run(["plot", "surface", str(DATA / "tipper.fis"), "--x", "service",
+                        "-n", "5"], capsys)
+    assert code == 0
+    assert out.splitlines()[1:] == ["service   tip",
+                                    "      0   5.1",
+                                    "    2.5  10.0",
+                                    "      5  15.0",
+                                    "    7.5  20.0",
+                                    "     10  24.9"]
+
+
 def test_rules_as_text_match_eval(capsys):
     code, out, _ = run(["plot", "rules", *SAMPLE], capsys)
     assert code == 0

@@ -287,8 +287,9 @@ def render_surface(s: Surface, max_cols: int = 11, max_rows: int = 11) -> str:
     if s.y is None:
         rows = [(f"{s.x.values[i]:g}", fmt(s.z[i])) for i in xi]
         w0 = max(len(s.x.label), *(len(a) for a, _ in rows))
-        lines.append(f"{s.x.label:>{w0}}  {s.output}")
-        lines += [f"{a:>{w0}}  {b}" for a, b in rows]
+        w1 = max(len(s.output), *(len(b) for _, b in rows))   # right-aligned, as the x column
+        lines.append(f"{s.x.label:>{w0}}  {s.output:>{w1}}")
+        lines += [f"{a:>{w0}}  {b:>{w1}}" for a, b in rows]
         return "\n".join(lines)
     yi = pick(len(s.y.values), max_rows)
     head = [f"{s.x.values[i]:g}" for i in xi]
