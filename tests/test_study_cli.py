@@ -122,12 +122,14 @@ def test_existing_results_need_resume(tiny, tmp_path, compare):
     assert r.exit_code == 1 and "already holds 1 result" in r.stderr and "--resume" in r.stderr
 
 
-def test_resume_of_a_directory_without_a_study_is_a_user_error(tiny, tmp_path, compare):
+def test_resume_of_a_directory_without_a_study_is_a_user_error(tiny, tmp_path, compare,
+                                                                 monkeypatch):
     """`compare corridor --resume -o nosuchdir` exited 0: "5 runs now, 0 from before"."""
-    out = tmp_path / "nosuchdir"
-    r = compare(tiny, "--and", "min", "--planner", "fuzzy", "--runs", 1, "-o", out, "--resume")
-    assert r.exit_code == 1 and r.stdout == "" and not out.exists()
-    assert f"study error: `{out}` holds no study to resume" in r.stderr
+    monkeypatch.chdir(tmp_path)
+    r = compare(tiny, "--and", "min", "--planner", "fuzzy", "--runs", 1, "-o", "nosuchdir",
+                "--resume")
+    assert r.exit_code == 1 and r.stdout == "" and not (tmp_path / "nosuchdir").exists()
+    assert "study error: `nosuchdir` holds no study to resume" in r.stderr
     assert "leave out --resume to start a study there" in r.stderr
 
 
