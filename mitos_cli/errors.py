@@ -238,6 +238,12 @@ class LessonError(MitosError):
     kind = "lesson error"
 
 
+class WriteError(MitosError):
+    """A file that cannot be written: its directory missing or read-only, a full disk. One
+    kind and one wording ("error: cannot write `X`: why") from every command, whatever the file
+    holds: `export` called it a format error and `simulate` an error."""
+
+
 class FormatError(MitosError):
     """A foreign file (FCL, FIS, FLL) that cannot be read or written."""
 

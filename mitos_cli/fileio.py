@@ -17,7 +17,7 @@ from collections.abc import Iterable, Iterator
 from pathlib import Path
 from typing import IO
 
-from .errors import MitosError, Span, closest_file
+from .errors import MitosError, Span, WriteError, closest_file
 
 #: the largest text file read (bytes): far beyond any rule base, world, lesson or batch here
 MAX_TEXT_BYTES = 256 << 20
@@ -115,25 +115,27 @@ def check_writable(path: str | Path) -> None:
         if _special(path) and not path.is_dir():
             return
         if path.is_dir():
-            raise MitosError(f"cannot write `{path}`: it is a directory",
+            raise WriteError(f"cannot write `{path}`: it is a directory",
                              hint="give a file name inside it")
         parent = path.parent if str(path.parent) else Path(".")
         why = ("No such file or directory" if not parent.is_dir() else
                "Permission denied" if not os.access(parent, os.W_OK | os.X_OK) else None)
     except OSError as exc:          # a name the system cannot look up (over 255 characters)
-        raise MitosError(f"cannot write `{path}`: {exc.strerror or exc}",
+        raise WriteError(f"cannot write `{path}`: {exc.strerror or exc}",
                          hint="each part of a path may have at most 255 characters"
                          if exc.errno == errno.ENAMETOOLONG else None) from None
     if why is not None:
-        raise MitosError(f"cannot write `{path}`: {why}",
+        raise WriteError(f"cannot write `{path}`: {why}",
                          hint="check that the directory exists and is writable")
 
 
 @contextlib.contextmanager
 def atomic_file(path: str | Path, binary: bool = False,
-                error: type[MitosError] = MitosError) -> Iterator[IO]:
+                error: type[MitosError] = WriteError) -> Iterator[IO]:
     """Open a temporary file that replaces ``path`` when the block ends without an error; a
-    failure (a missing directory included) raises ``error`` naming the file."""
+    failure (a missing directory included) raises ``error`` naming the file: a
+    :class:`WriteError`, the same from every command, unless a caller that catches its own
+    kind (a teaching session's ``save``) asks for another."""
     if _special(Path(path)):      # before following links: /dev/stdout names a pipe
         with _in_place(Path(path), binary, error) as fh:
             yield fh
@@ -189,7 +191,7 @@ def _in_place(path: Path, binary: bool, error: type[MitosError]) -> Iterator[IO]
 
 
 def atomic_write(path: str | Path, data: str | bytes,
-                 error: type[MitosError] = MitosError) -> None:
+                 error: type[MitosError] = WriteError) -> None:
     """Replace ``path`` with ``data`` (text as UTF-8) in one step."""
     with atomic_file(path, binary=isinstance(data, bytes), error=error) as fh:
         fh.write(data)
@@ -202,7 +204,7 @@ def _manifest(anchor: Path) -> Path:
 
 
 def atomic_write_set(files: list[tuple[Path, str | bytes]], anchor: Path,
-                     error: type[MitosError] = MitosError) -> None:
+                     error: type[MitosError] = WriteError) -> None:
     """Replace several files so that readers see the old set or the new set, whole.
 
     Every new file is written beside its target and fsynced; then a manifest naming them
@@ -240,7 +242,7 @@ def atomic_write_set(files: list[tuple[Path, str | bytes]], anchor: Path,
     finish_saves(Path(anchor), error=error)
 
 
-def finish_saves(anchor: Path, error: type[MitosError] = MitosError) -> bool:
+def finish_saves(anchor: Path, error: type[MitosError] = WriteError) -> bool:
     """Complete a set save that a crash interrupted after its manifest was written, and remove
     temporary files of saves that died before it. True when something was completed."""
     import json

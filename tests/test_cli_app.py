@@ -4,7 +4,9 @@ from __future__ import annotations
 
 import subprocess
 import sys
+from pathlib import Path
 
+import pytest
 import typer.main
 
 from mitos_cli.cli.app import COMMANDS, build_app
@@ -111,3 +113,21 @@ def test_a_reader_that_stops_early_is_what_the_readme_says(tmp_path) -> None:
     readme = " ".join((root / "README.md").read_text(encoding="utf-8").split())
     assert "(`mitos simulate --trace --every 1 | head -1`) ends the command quietly, with " \
            "exit 1" in readme
+
+
+@pytest.mark.skipif(not Path("/proc/self").is_dir(), reason="a directory no file can be made in")
+@pytest.mark.parametrize("args, target", [
+    (["export", "rulebases/mitos.rules", "--to", "c", "-o"], "/proc/mitos-x.c"),
+    (["convert", "mitos", "--to", "fll", "-o"], "/proc/mitos-x.fll"),
+    (["simulate", "corridor", "--out"], "/proc/mitos-x.csv"),
+    (["plot", "terms", "--var", "road", "-o"], "/proc/mitos-x.png"),
+])
+def test_a_file_that_cannot_be_written_is_said_alike_by_every_command(args, target) -> None:
+    """`export -o /proc/x.c` said "format error: cannot write ...", `simulate` "error: cannot
+    write ...": one kind of error (WriteError), one wording."""
+    proc = run(*args, target)
+    assert proc.returncode == 1, proc.stderr
+    said = [line for line in proc.stderr.splitlines() if "cannot write" in line]
+    assert len(said) == 1 and said[0].startswith(f"error: cannot write `{target}`: "), \
+        proc.stderr
+    assert "Traceback" not in proc.stderr

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+from pathlib import Path
 
 import pytest
 
@@ -35,6 +36,23 @@ def test_an_error_inside_keeps_the_old_file(tmp_path):
 def test_a_missing_directory_is_the_callers_error(tmp_path):
     with pytest.raises(TermSetError, match="cannot write .*nowhere.*No such file"):
         atomic_write(tmp_path / "nowhere" / "a.txt", "x", error=TermSetError)
+
+
+@pytest.mark.skipif(not Path("/proc/self").is_dir(), reason="a directory no file can be made in")
+def test_a_write_that_fails_is_a_write_error(tmp_path):
+    """One kind for every command's write failure (export's was a format error), whether
+    the check before the work or the write itself finds it."""
+    from mitos_cli.errors import WriteError
+    from mitos_cli.fileio import check_writable
+
+    with pytest.raises(WriteError) as info:
+        atomic_write("/proc/mitos-x.txt", "x")
+    assert info.value.kind == "error"
+    assert info.value.message.startswith("cannot write `/proc/mitos-x.txt`: ")
+    with pytest.raises(WriteError) as info:
+        check_writable(tmp_path / "nowhere" / "a.txt")
+    assert info.value.message == (f"cannot write `{tmp_path / 'nowhere' / 'a.txt'}`: No such "
+                                  f"file or directory")
 
 
 def test_replace_failing_is_an_error_and_leaves_nothing(tmp_path, monkeypatch):

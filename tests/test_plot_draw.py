@@ -15,6 +15,7 @@ from mitos_cli.draw.output import DrawError, check_format  # noqa: E402
 from mitos_cli.draw.rules import draw_rules  # noqa: E402
 from mitos_cli.draw.surface import draw_surface  # noqa: E402
 from mitos_cli.draw.terms import draw_sheet, draw_terms_before_after  # noqa: E402
+from mitos_cli.errors import WriteError  # noqa: E402
 
 SAMPLE = {"road": 78.0, "size": 45.0, "position": 4.0}
 
@@ -212,7 +213,7 @@ def test_show_without_display_is_a_clear_error(monkeypatch, mitos):
 
 
 def test_unwritable_path_is_a_clear_error(mitos, tmp_path):
-    with pytest.raises(DrawError, match="cannot write"):
+    with pytest.raises(WriteError, match="cannot write"):
         draw_sheet(plotdata.sheet(mitos.rulebase, ["road"]), tmp_path / "no" / "dir.png")
 
 

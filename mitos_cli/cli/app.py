@@ -19,7 +19,7 @@ from typing import Annotated
 
 import typer
 
-from ..errors import MitosError
+from ..errors import MitosError, WriteError
 from .help import epilog, paragraphs
 
 #: One line per command: its name -> (module in this package, command function or Typer app).
@@ -105,7 +105,7 @@ def main(argv: list[str] | None = None) -> None:
         if exc.errno in (errno.ENAMETOOLONG, errno.ELOOP):
             report_error(path_error(exc))
         elif exc.errno in (errno.ENOSPC, errno.EDQUOT, errno.EIO, errno.EFBIG):
-            report_error(MitosError(f"cannot write the output: {exc.strerror}",
+            report_error(WriteError(f"cannot write the output: {exc.strerror}",
                                     hint="free some space, or write somewhere else"))
         else:
             raise

@@ -15,6 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..errors import WriteError
 from .frame import OBSTACLE_COLOUR, ROBOT_COLOUR, TRAIL_COLOUR, draw_background
 from .output import DrawError, _matplotlib, literal_text, new_figure
 
@@ -272,7 +273,7 @@ def _save(fig, draw, picked, writer, path: Path, fmt: str, dpi: int) -> None:
                 writer.grab_frame()
         os.replace(part, path)
     except OSError as exc:
-        raise DrawError(f"cannot write `{path}`: {exc.strerror or exc}") from None
+        raise WriteError(f"cannot write `{path}`: {exc.strerror or exc}") from None
     finally:
         if part.exists():
             part.unlink()

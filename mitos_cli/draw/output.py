@@ -20,7 +20,8 @@ NON_INTERACTIVE = {"agg", "cairo", "pdf", "pgf", "ps", "svg", "template"}
 
 
 class DrawError(MitosError):
-    """A picture that cannot be drawn here (no matplotlib, no display, unwritable file)."""
+    """A picture that cannot be drawn here (no matplotlib, no display); a file that cannot be
+    written is a :class:`~mitos_cli.errors.WriteError`, as for every command."""
 
     kind = "error"
 
@@ -106,7 +107,7 @@ def finish(fig, path: str | Path | None = None, show: bool = False, dpi: int = 1
 
         from ..fileio import atomic_file
 
-        with atomic_file(path, binary=True, error=DrawError) as fh, \
+        with atomic_file(path, binary=True) as fh, \
                 matplotlib.rc_context({"svg.hashsalt": "mitos"}):
             fig.savefig(fh, format=fmt, dpi=dpi, bbox_inches="tight" if tight else None,
                         metadata=_metadata(fmt))

@@ -749,10 +749,11 @@ def simple_nots(expr: Expr, rule: Rule, ops: ops_mod.Operators) -> Expr:
 
 
 def atomic_write(path: str | Path, text: str) -> None:
-    """Write ``text`` to ``path`` atomically (:func:`mitos_cli.fileio.atomic_write`)."""
+    """Write ``text`` to ``path`` atomically (:func:`mitos_cli.fileio.atomic_write`; a
+    failure is a :class:`~mitos_cli.errors.WriteError`, as every command's is)."""
     from ..fileio import atomic_write as write
 
-    write(path, text, error=FormatError)
+    write(path, text)
 
 
 

@@ -54,7 +54,7 @@ def load_rules_file(path: str | Path) -> RuleBase:
     from ..fileio import finish_saves, read_text, unreadable
 
     path = Path(path)
-    finish_saves(path, error=RuleBaseError)   # a set save a crash left half done
+    finish_saves(path)              # a set save a crash left half done
     try:
         text = read_text(path)
     except UnicodeDecodeError:

@@ -230,7 +230,7 @@ def write_atomic(path: Path, text: str) -> None:
     """Write ``text`` to ``path`` through a temporary file and a rename."""
     from ..fileio import atomic_write
 
-    atomic_write(path, text, error=StudyError)
+    atomic_write(path, text)
 
 
 def _check_unchanged(old: dict, new: dict, path: Path) -> None:
