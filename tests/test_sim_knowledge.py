@@ -216,6 +216,37 @@ def test_a_passage_narrower_than_the_robot_needs_is_refused_with_its_place(tmp_p
     assert "it needs 11.0 in" in text and "route: {min_clearance:" in text
 
 
+def test_a_grid_squeeze_hint_says_what_the_body_keeps(tmp_path):
+    """The hint said the route's centre clearance where it means the body's: "keeps as
+    little as 9.5 in" for a 20 in door and an 18 in robot, whose body keeps 0.5 in."""
+    with pytest.raises(NarrowPassage) as info:
+        prepare(load_world(grid_world(tmp_path, door_map(20))))
+    assert "centre keeps 9.5 in" in info.value.message
+    assert info.value.hint == ("widen the passage, or allow the squeeze with `route: "
+                               "{min_clearance: 9.5}` (its body then keeps as little as 0.5 in "
+                               "from the walls, closer than the brake can promise: "
+                               "worlds/README.md)")
+
+
+def test_a_grid_door_the_body_cannot_pass_is_offered_no_squeeze(tmp_path):
+    """A 17 in door keeps the centre 8.5 in from the walls: `min_clearance: 8.5` (what the
+    hint offered) led the 18 in robot into the jamb."""
+    with pytest.raises(NarrowPassage) as info:
+        prepare(load_world(grid_world(tmp_path, door_map(17))))
+    assert "centre keeps 8.5 in" in info.value.message
+    assert info.value.hint == "the robot is 18 in wide: widen the passage to at least 22 in"
+
+
+def test_a_squeeze_that_keeps_the_body_clear_is_not_called_closer_than_the_brake(tmp_path):
+    with pytest.raises(NarrowPassage) as info:
+        prepare(load_world(grid_world(tmp_path, door_map(40),
+                                      extra="route: {min_clearance: 25}\n")))
+    assert "centre keeps 19.5 in" in info.value.message and "it needs 25.0 in" in info.value.message
+    assert info.value.hint == ("widen the passage, or allow the squeeze with `route: "
+                               "{min_clearance: 19.5}` (its body then keeps as little as 10.5 in "
+                               "from the walls)")
+
+
 def test_route_min_clearance_allows_the_squeeze(tmp_path):
     world = load_world(grid_world(tmp_path, door_map(20), extra="route: {min_clearance: 8}\n"))
     assert world.min_clearance == 8

@@ -79,7 +79,8 @@ def prepare(world: World) -> Scene:
                                          half_width=a.robot.width / 2))
             else:
                 known = StaticMap(given.walls, np.zeros((0, 4, 2)), given.grid, static.bounds)
-                routes.append(grid_route(known, a.start, a.goal, asked, minimum=least))
+                routes.append(grid_route(known, a.start, a.goal, asked, minimum=least,
+                                         half_width=a.robot.width / 2))
         except WorldError as exc:       # no route to the goal: said at the goal's line
             if exc.span is None:
                 exc.span = a.goal_span

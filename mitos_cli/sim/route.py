@@ -430,17 +430,26 @@ def narrow_passage(x: float, y: float, gap: float, need: float, kind: str, wide:
                    half_width: float = 0.0) -> NarrowPassage:
     """The refusal naming the narrowest place (x, y) of the widest way, where the robot's
     centre keeps ``gap`` of the ``need`` inches; the hint offers the squeeze only where the
-    body fits (wider than ``2 * half_width``)."""
+    body fits (wider than ``2 * half_width``), and says what its body would keep: the centre's
+    clearance less ``half_width``, not the centre's own."""
     squeeze = math.floor(gap * 10) / 10
+    body = gap - half_width
+    brake = (", closer than the brake can promise: worlds/README.md" if body < BRAKE_PROMISE
+             else "")
     return NarrowPassage(
         f"the only way to the goal passes ({x:.0f}, {y:.0f}), where the robot's centre keeps "
         f"{gap:.1f} in from the walls (a {kind} {wide} in wide); it needs {need:.1f} in",
         hint=(f"widen the {kind}, or allow the squeeze with `route: {{min_clearance: "
-              f"{squeeze:g}}}` (its body then keeps as little as {gap - half_width:.1f} in from the walls, "
-              f"closer than the brake can promise: worlds/README.md)"
+              f"{squeeze:g}}}` (its body then keeps as little as {body:.1f} in from the walls"
+              f"{brake})"
               if squeeze > half_width else
               f"the robot is {2 * half_width:g} in wide: widen the {kind} to at least "
               f"{2 * need:g} in"))
+
+
+#: in: a body nearer a wall than this, the brake cannot promise to keep off it (worlds/README.md,
+#: "a body passing within about 2 in of a wall ... can touch it")
+BRAKE_PROMISE = 2.0
 
 
 @dataclass(frozen=True)
@@ -628,7 +637,7 @@ def grid_route(static: StaticMap, start: Pose, goal: Goal, clearance: float,
                cell: float = 6.0, minimum: float | None = None,
                occupied: np.ndarray | None = None, explain: bool = True,
                leave: float = 0.0, behind: float = 0.0, keep: bool = True,
-               last: Prepared | None = None) -> Route:
+               last: Prepared | None = None, half_width: float = 0.0) -> Route:
     """A* on nodes about ``cell`` inches apart, each kept at least ``clearance`` inches (the
     exact Euclidean distance) from the occupied cells, preferring the middle of the corridors.
     Nodes closer than that but not closer than ``minimum`` (the robot's half width plus its
@@ -641,7 +650,8 @@ def grid_route(static: StaticMap, start: Pose, goal: Goal, clearance: float,
     that replans beside what it is passing must be able to move off). ``keep``: keep what
     the search works out from the grid's own cells for the next search on the same grid
     (:func:`_prepared`; not for a grid made for one search); ``last``: where one robot's
-    searches on its own map keep what they work out, for its next."""
+    searches on its own map keep what they work out, for its next. ``half_width``: the
+    robot's, for what a refusal suggests (a squeeze only where its body fits)."""
     g = static.grid
     assert g is not None        # callers plan on a grid (plan_route checks; the rest build one)
     occ = g.occupied if occupied is None else occupied
@@ -706,7 +716,7 @@ def grid_route(static: StaticMap, start: Pose, goal: Goal, clearance: float,
     if path is None:
         if not explain:
             raise NarrowPassage("no way to the goal on what the robot knows")
-        raise _refusal(node_c, s, t, centre, floor, edge)
+        raise _refusal(node_c, s, t, centre, floor, edge, half_width)
     pts = np.array([centre(divmod(n, C)) for n in path])
     pts = np.vstack([[start.x, start.y], pts[1:-1], [goal.x, goal.y]])
     pts = _simplify(pts, size * 0.75, field, clearance)
@@ -930,7 +940,7 @@ def _patched(grid: Grid, occ: np.ndarray, base_occ: np.ndarray, cap: float, k: i
 
 
 def _refusal(node_c: np.ndarray, s, t, centre, floor: float,
-             edge: np.ndarray | None = None) -> WorldError:
+             edge: np.ndarray | None = None, half_width: float = 0.0) -> WorldError:
     free_c = np.maximum(node_c, 0.0)
     free_c[s] = free_c[t] = np.inf
     if edge is not None:        # the steps out of the start and into the goal are exempt
@@ -948,7 +958,7 @@ def _refusal(node_c: np.ndarray, s, t, centre, floor: float,
                              hint="check the start and goal, or use `unknown: free`")
     (r, c), gap = widest
     x, y = centre((r, c))
-    return narrow_passage(x, y, gap, floor, "passage", f"about {2 * gap:.0f}")
+    return narrow_passage(x, y, gap, floor, "passage", f"about {2 * gap:.0f}", half_width)
 
 
 def plan_route(static: StaticMap, corridors: tuple[Corridor, ...], start: Pose, goal: Goal,
@@ -959,4 +969,5 @@ def plan_route(static: StaticMap, corridors: tuple[Corridor, ...], start: Pose, 
     if static.grid is None:
         return corridor_route(corridors, start, goal, static.walls,
                               clearance if minimum is None else minimum, half_width)
-    return grid_route(static, start, goal, clearance, minimum=minimum, occupied=occupied)
+    return grid_route(static, start, goal, clearance, minimum=minimum, occupied=occupied,
+                      half_width=half_width)
