@@ -248,10 +248,28 @@ def test_a_squeeze_that_keeps_the_body_clear_is_not_called_closer_than_the_brake
 
 
 def test_route_min_clearance_allows_the_squeeze(tmp_path):
-    world = load_world(grid_world(tmp_path, door_map(20), extra="route: {min_clearance: 8}\n"))
-    assert world.min_clearance == 8
+    world = load_world(grid_world(tmp_path, door_map(20), extra="route: {min_clearance: 9.5}\n"))
+    assert world.min_clearance == 9.5
     pts = dense(prepare(world).routes[0].points)
-    assert occupied_distance(pts, door_map(20)) >= 8.0 - 1e-9
+    # through the door, clear of every wall pixel by half the robot's width (its nodes keep
+    # 9.5 in; the straight piece simplification lays through the door runs 0.8 in off its
+    # middle, 9.2 in from the jamb)
+    assert occupied_distance(pts, door_map(20)) >= 9.0
+
+
+def test_a_min_clearance_below_half_the_robots_width_is_refused_where_it_is_written():
+    """`min_clearance: 5` for an 18 in robot was taken without a word: the route it allows
+    leads the centre through gaps the body cannot pass."""
+    text = error(world_text(CORRIDOR, "route: {min_clearance: 5}\n"))
+    assert text.startswith("w.yaml:17:24: world error: `min_clearance` in route must be at "
+                           "least 9 in, half the robot's width (18 in), not 5")
+    assert "expected a min_clearance of at least 9 in" in text
+    assert "leave it out for the robot's own (11 in" in text
+    assert parse_world(world_text(CORRIDOR, "route: {min_clearance: 9}\n"), "w.yaml")
+    wide = world_text(CORRIDOR, "route: {min_clearance: 9.5}\nrobots:\n  - name: wide\n"
+                      "    q_init: {x: 30, y: 20}\n    q_goal: {x: 300, y: 20}\n"
+                      "    robot: {footprint: {length: 24, width: 20}}\n")
+    assert "half robot `wide`'s width (20 in), not 9.5" in error(wide)
 
 
 @pytest.mark.parametrize("noise", [0.0, 0.5])

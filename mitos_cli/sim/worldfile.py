@@ -393,7 +393,7 @@ def parse_world(text: str, path: str) -> World:
     sensors = _sensors(r, top)
     agents, agent_spans = _agents(r, top, robot)
     corridors, grid, knows, given = _map(r, top, path)
-    min_clearance, replan = _route(r, top)
+    min_clearance, replan = _route(r, top, agents)
     obstacles = _obstacles(r, top)
     randomise = (read_randomise(r, top["randomise"], top.value_span("randomise"),
                                 [o.name for o in obstacles])
@@ -503,7 +503,7 @@ def _map(r: _Reader, top: YMap, path: str):
     return corridors, grid, knows, given
 
 
-def _route(r: _Reader, top: YMap) -> tuple[float | None, str]:
+def _route(r: _Reader, top: YMap, agents: list[Agent]) -> tuple[float | None, str]:
     """``route``: the least clearance the route keeps (None: the robot's own) and how it is
     replanned."""
     if "route" not in top:
@@ -511,7 +511,28 @@ def _route(r: _Reader, top: YMap) -> tuple[float | None, str]:
     rt = r.mapping(top["route"], top.value_span("route"), "route", ROUTE_KEYS)
     min_clearance = (r.number(rt, "min_clearance", "route", positive=True)
                      if "min_clearance" in rt else None)
+    if min_clearance is not None:
+        _check_squeeze(min_clearance, rt.value_span("min_clearance"), agents)
     return min_clearance, r.choice(rt, "replan", REPLANS, "route", "clearance")
+
+
+def _check_squeeze(least: float, span: Span, agents: list[Agent]) -> None:
+    """Refuse a ``min_clearance`` below half a robot's width: it lets the route lead the
+    centre through a gap the body cannot pass (`min_clearance: 8.8` through a 17.7 in door
+    took the 18 in robot into the jamb), as no squeeze the refusals offer does."""
+    widest = max(agents, key=lambda a: a.robot.width)
+    half = widest.robot.width / 2
+    if least >= half:
+        return
+    who = "the robot's" if len(agents) == 1 else f"robot `{widest.name}`'s"
+    own = half + widest.robot.safety_margin
+    raise WorldError(f"`min_clearance` in route must be at least {half:g} in, half {who} "
+                     f"width ({widest.robot.width:g} in), not {least:g}: the route could lead "
+                     "its centre through a gap its body does not pass", span=span,
+                     expected=f"a min_clearance of at least {half:g} in",
+                     hint=f"leave it out for the robot's own ({own:g} in: half its width and "
+                          "its safety margin), or squeeze no closer than "
+                          f"`min_clearance: {half:g}`")
 
 
 def _obstacles(r: _Reader, top: YMap) -> list[Obstacle]:
