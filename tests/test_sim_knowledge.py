@@ -247,6 +247,37 @@ def test_a_squeeze_that_keeps_the_body_clear_is_not_called_closer_than_the_brake
                                "from the walls)")
 
 
+def _refusal(tmp_path: Path, given: np.ndarray, **kw) -> str:
+    with pytest.raises(NarrowPassage) as info:
+        prepare(load_world(grid_world(tmp_path, hall(120), given, **kw)))
+    return info.value.render().replace(f"{tmp_path}/", "")
+
+
+def test_a_start_in_a_wall_of_the_given_map_is_said_at_the_start(tmp_path):
+    """A start free on the map but inside a wall of the map the robot is given was refused
+    as "the only way to the goal passes (206, 32) ... a passage about 10 in wide"."""
+    told = hall(120)
+    told[60:80, 35:45] = False                              # a pillar round the start
+    text = _refusal(tmp_path, told)
+    assert text.startswith("w.yaml:11:9: world error: the start (q_init) at (40, 70) lies "
+                           "inside a wall of the map `given.yaml` the robot is given\n")
+    assert "hint: move the start, or give the robot a map that shows it clear: it plans on " \
+        "the map it is given" in text
+    told = hall(120)
+    told[60:80, 375:385] = False                            # and round the goal
+    assert _refusal(tmp_path, told).startswith(
+        "w.yaml:12:9: world error: the goal (q_goal) at (380, 70) lies inside a wall of the "
+        "map `given.yaml` the robot is given\n")
+
+
+def test_a_start_too_near_a_wall_of_the_given_map_to_leave_is_said_at_the_start(tmp_path):
+    told = hall(120)
+    told[60:64, 25:40] = told[76:80, 25:40] = told[60:80, 25:30] = False   # a pocket
+    assert _refusal(tmp_path, told, start=(36, 70)).startswith(
+        "w.yaml:11:9: world error: the start (q_init) at (36, 70) lies 5.5 in from a wall "
+        "of the map `given.yaml` the robot is given, and its route needs 11.0 in to leave it")
+
+
 def test_route_min_clearance_allows_the_squeeze(tmp_path):
     world = load_world(grid_world(tmp_path, door_map(20), extra="route: {min_clearance: 9.5}\n"))
     assert world.min_clearance == 9.5

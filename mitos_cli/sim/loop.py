@@ -30,7 +30,7 @@ from . import geometry, kinematics, knowledge, movers, perception, rows, safety,
 from . import obstacles as obs_mod
 from .geometry import polygon_segments, rect_corners
 from .planner import Percepts, Planner
-from .route import Route, grid_route, plan_route
+from .route import NarrowPassage, Route, grid_route, plan_route
 from .route import clearances as route_clearances
 from .staticmap import StaticMap, build_static
 from .world import Agent, Grid, World
@@ -80,10 +80,12 @@ def prepare(world: World) -> Scene:
             else:
                 known = StaticMap(given.walls, np.zeros((0, 4, 2)), given.grid, static.bounds)
                 routes.append(grid_route(known, a.start, a.goal, asked, minimum=least,
-                                         half_width=a.robot.width / 2))
+                                         half_width=a.robot.width / 2,
+                                         given=given.knows == "given"))
         except WorldError as exc:       # no route to the goal: said at the goal's line
-            if exc.span is None:
-                exc.span = a.goal_span
+            if exc.span is None:        # (a start it cannot leave, at the start's)
+                at_start = isinstance(exc, NarrowPassage) and exc.end == "start"
+                exc.span = a.start_span if at_start else a.goal_span
             raise
     return Scene(static, tuple(routes), given, knowledge.plan_grid(given, static, world))
 

@@ -562,7 +562,12 @@ def _simplify(points: np.ndarray, tol: float, clearance: Clearance | None = None
 
 
 class NarrowPassage(WorldError):
-    """The only way to the goal is narrower than the robot needs (names the narrowest place)."""
+    """The only way to the goal is narrower than the robot needs (names the narrowest place).
+    ``end``: the line of the world file it belongs at, the start's or (mostly) the goal's."""
+
+    def __init__(self, message: str, *, end: str = "goal", **kw) -> None:
+        super().__init__(message, **kw)
+        self.end = end
 
 
 def _widest_way(free_c: np.ndarray, s: tuple[int, int], t: tuple[int, int],
@@ -637,7 +642,8 @@ def grid_route(static: StaticMap, start: Pose, goal: Goal, clearance: float,
                cell: float = 6.0, minimum: float | None = None,
                occupied: np.ndarray | None = None, explain: bool = True,
                leave: float = 0.0, behind: float = 0.0, keep: bool = True,
-               last: Prepared | None = None, half_width: float = 0.0) -> Route:
+               last: Prepared | None = None, half_width: float = 0.0,
+               given: bool = False) -> Route:
     """A* on nodes about ``cell`` inches apart, each kept at least ``clearance`` inches (the
     exact Euclidean distance) from the occupied cells, preferring the middle of the corridors.
     Nodes closer than that but not closer than ``minimum`` (the robot's half width plus its
@@ -651,7 +657,9 @@ def grid_route(static: StaticMap, start: Pose, goal: Goal, clearance: float,
     the search works out from the grid's own cells for the next search on the same grid
     (:func:`_prepared`; not for a grid made for one search); ``last``: where one robot's
     searches on its own map keep what they work out, for its next. ``half_width``: the
-    robot's, for what a refusal suggests (a squeeze only where its body fits)."""
+    robot's, for what a refusal suggests (a squeeze only where its body fits); ``given``: the
+    grid is the map the robot is given (``map: {given}``), not the map itself, which a
+    refusal says (a start in a wall of it passed the checks of the map itself)."""
     g = static.grid
     assert g is not None        # callers plan on a grid (plan_route checks; the rest build one)
     occ = g.occupied if occupied is None else occupied
@@ -675,11 +683,12 @@ def grid_route(static: StaticMap, start: Pose, goal: Goal, clearance: float,
     for rc, what, (x, y) in ((s, "start", (start.x, start.y)), (t, "goal", (goal.x, goal.y))):
         if not (0 <= rc[0] < R and 0 <= rc[1] < C):
             name = f" `{Path(g.source).name}`" if g.source else ""
-            raise WorldError(
+            raise NarrowPassage(
                 f"the {what} ({x:g}, {y:g}) lies outside the map{name} the robot plans on "
                 f"(x {g.origin[0]:g} to {g.origin[0] + cols * g.resolution:g}, y "
                 f"{g.origin[1]:g} to {g.origin[1] + rows * g.resolution:g} in)",
-                hint="a `given` map must cover the start and the goal" if g.source else None)
+                hint="a `given` map must cover the start and the goal" if g.source else None,
+                end=what)
     moves = MOVES
     floor = clearance if minimum is None else min(minimum, clearance)
     # prefer the middle; a node closer than `clearance` (but not than `floor`) costs
@@ -716,7 +725,10 @@ def grid_route(static: StaticMap, start: Pose, goal: Goal, clearance: float,
     if path is None:
         if not explain:
             raise NarrowPassage("no way to the goal on what the robot knows")
-        raise _refusal(node_c, s, t, centre, floor, edge, half_width)
+        ends = ((what, p, _end_room(field, occ, p)) for what, p in
+                (("start", (start.x, start.y)), ("goal", (goal.x, goal.y))))
+        raise _refusal(node_c, s, t, centre, floor, edge, half_width, tuple(ends),
+                       _map_words(g, given), size)
     pts = np.array([centre(divmod(n, C)) for n in path])
     pts = np.vstack([[start.x, start.y], pts[1:-1], [goal.x, goal.y]])
     pts = _simplify(pts, size * 0.75, field, clearance)
@@ -940,7 +952,16 @@ def _patched(grid: Grid, occ: np.ndarray, base_occ: np.ndarray, cap: float, k: i
 
 
 def _refusal(node_c: np.ndarray, s, t, centre, floor: float,
-             edge: np.ndarray | None = None, half_width: float = 0.0) -> WorldError:
+             edge: np.ndarray | None = None, half_width: float = 0.0,
+             ends: tuple[tuple[str, tuple[float, float], float], ...] = (),
+             mapped: str = "the map", step: float = 0.0) -> WorldError:
+    """Why no way keeps ``floor``: a start or goal (``ends``: each with its clearance, -1
+    inside a wall) in a wall of the map the robot plans on (``mapped``, in words) or too near
+    one to leave it (the widest way's narrowest place lies within ``floor`` and a node
+    ``step`` of it), no way at all, or the narrowest place of the widest way."""
+    for what, (x, y), room in ends:
+        if room < 0:
+            return _end_refused(what, x, y, f"lies inside a wall of {mapped}", mapped)
     free_c = np.maximum(node_c, 0.0)
     free_c[s] = free_c[t] = np.inf
     if edge is not None:        # the steps out of the start and into the goal are exempt
@@ -958,7 +979,37 @@ def _refusal(node_c: np.ndarray, s, t, centre, floor: float,
                              hint="check the start and goal, or use `unknown: free`")
     (r, c), gap = widest
     x, y = centre((r, c))
+    for what, end, room in ends:
+        if room < floor and math.dist((x, y), end) <= floor + step:
+            return _end_refused(what, *end, f"lies {room:.1f} in from a wall of {mapped}, "
+                                f"and its route needs {floor:.1f} in to leave it", mapped)
     return narrow_passage(x, y, gap, floor, "passage", f"about {2 * gap:.0f}", half_width)
+
+
+def _end_room(field: Clearance, occ: np.ndarray, p: tuple[float, float]) -> float:
+    """The clearance (in) of the cell holding point ``p`` (what a node there keeps), -1
+    where that cell is occupied."""
+    _, row, col, inside = field._cell_of(np.array([p]))
+    if inside[0] and occ[row[0], col[0]]:
+        return -1.0
+    return float(field.cells(np.array([p]))[0])
+
+
+def _map_words(g: Grid, given: bool) -> str:
+    """The map a route is planned on, in words: the one the robot is given, by name."""
+    if not given:
+        return "the map"
+    return f"the map `{Path(g.source).name}` the robot is given" if g.source else \
+        "the map the robot is given"
+
+
+def _end_refused(what: str, x: float, y: float, why: str, mapped: str) -> NarrowPassage:
+    """The refusal of a start or goal its route cannot leave or reach, at its own line."""
+    name = {"start": "start (q_init)", "goal": "goal (q_goal)"}[what]
+    hint = (f"move the {what}, or give the robot a map that shows it clear: it plans on the "
+            "map it is given, not on the map itself" if mapped != "the map" else
+            f"move the {what} further from the walls")
+    return NarrowPassage(f"the {name} at ({x:g}, {y:g}) {why}", hint=hint, end=what)
 
 
 def plan_route(static: StaticMap, corridors: tuple[Corridor, ...], start: Pose, goal: Goal,

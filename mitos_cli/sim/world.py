@@ -141,6 +141,8 @@ class Agent:
     goal: Goal
     goal_span: Span | None = field(default=None, compare=False, repr=False)
     # where the world file writes its q_goal (a goal its route cannot reach is reported there)
+    start_span: Span | None = field(default=None, compare=False, repr=False)
+    # and its q_init (a start its route cannot leave)
 
 
 #: ``route: {replan}``: when a robot plans its route again (:func:`.knowledge.replan`)

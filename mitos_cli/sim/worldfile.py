@@ -473,7 +473,8 @@ def _agents(r: _Reader, top: YMap,
                             read_goal(r, yamlpos.require(a, "q_goal", WorldError, f"robot `{aname}`"),
                                       a.value_span("q_goal"), f"q_goal of `{aname}`")))
         agent_spans.append((a.value_span("q_init"), a.value_span("q_goal")))
-    agents = [replace(agent, goal_span=g) for agent, (_, g) in zip(agents, agent_spans)]
+    agents = [replace(agent, start_span=s, goal_span=g)
+              for agent, (s, g) in zip(agents, agent_spans)]
     return agents, agent_spans
 
 
