@@ -278,6 +278,15 @@ def test_a_start_too_near_a_wall_of_the_given_map_to_leave_is_said_at_the_start(
         "of the map `given.yaml` the robot is given, and its route needs 11.0 in to leave it")
 
 
+def test_no_way_on_the_given_map_says_it_is_the_given_map(tmp_path):
+    told = hall(120)
+    told[:, 200:210] = False
+    text = _refusal(tmp_path, told)
+    assert "world error: no way from the start to the goal through the map `given.yaml` the " \
+        "robot is given: it plans its route on that map, not on the map itself" in text
+    assert "unknown: free" not in text and "`given: none`" in text
+
+
 def test_route_min_clearance_allows_the_squeeze(tmp_path):
     world = load_world(grid_world(tmp_path, door_map(20), extra="route: {min_clearance: 9.5}\n"))
     assert world.min_clearance == 9.5

@@ -975,8 +975,14 @@ def _refusal(node_c: np.ndarray, s, t, centre, floor: float,
                 edge[m, r, c] = np.inf
     widest = _widest_way(free_c, s, t, edge)
     if widest is None or widest[1] <= 0:
-        return NarrowPassage("no way through the map from the start to the goal",
-                             hint="check the start and goal, or use `unknown: free`")
+        if mapped == "the map":
+            return NarrowPassage("no way through the map from the start to the goal",
+                                 hint="check the start and goal, or use `unknown: free`")
+        return NarrowPassage(f"no way from the start to the goal through {mapped}: it "
+                             "plans its route on that map, not on the map itself",
+                             hint="open a way on the map it is given, give it another "
+                                  "(`given: PATH.yaml`), or none (`given: none`: it finds "
+                                  "its way as it goes)")
     (r, c), gap = widest
     x, y = centre((r, c))
     for what, end, room in ends:
