@@ -430,6 +430,16 @@ def test_a_route_key_replan_takes_three_words(tmp_path):
     assert "clearance" in str(err.value) and ":" in str(err.value)
 
 
+def test_replan_false_is_quoted_as_written_and_means_never():
+    """`replan: false` was quoted as "`replan: False`", Python's spelling of the value."""
+    text = error(world_text(CORRIDOR, "route: {replan: false}\n"))
+    assert "world error: `replan: false` in route: unknown value" in text
+    assert "hint: did you mean `never`? (`replan: never` keeps the route planned at the " \
+        "start)" in text
+    assert "`unknown: true` in map" in error(world_text(CORRIDOR.replace(
+        "map:\n", "map:\n  unknown: true\n")))
+
+
 def test_a_robot_with_no_map_maps_and_replans_round_a_corner(tmp_path):
     w = tmp_path / "w.yaml"
     w.write_text(world_text("map:\n  given: none\n  corridors:\n"

@@ -71,6 +71,18 @@ BEYOND = {"time_limit": "times are in seconds: 1e7 s is 116 days",
                           "angles are in degrees: 1e7 deg is 27,778 turns")}
 
 
+#: a value of a key of words that means one of them (``replan: false``: never replan)
+MEANT = {("replan", "false"): ("never", "`replan: never` keeps the route planned at the start")}
+
+
+def _as_written(value: Any) -> str:
+    """A scalar as YAML writes it, for a message to quote (``false``, not Python's ``False``;
+    an empty value as nothing, not ``None``)."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    return "" if value is None else str(value)
+
+
 def _sane(x: float, span: Span, what: str, key: str = "") -> float:
     if abs(x) > LARGEST:
         raise WorldError(f"{what} must be within ±{LARGEST:g}, not {x:g}", span=span,
@@ -131,15 +143,15 @@ class _Reader:
             if default is None:
                 return yamlpos.require(m, key, WorldError, what)   # raises: `key` is missing
             return default
-        value = str(m[key])
+        value = _as_written(m[key])
         if value not in options:
-            if value == "None" and m[key] is None:    # `given:` left empty: not `None`
-                value = ""
             err = unknown(key, value, options)          # "unknown shape `circel`" ...
             message = (f"{err.message} in {what}" if key in NOUN_KEYS   # ... "in obstacle `box`"
                        else f"`{key}: {value}` in {what}: unknown value")
+            meant = MEANT.get((key, value))
             raise WorldError(message, span=m.value_span(key), expected=err.expected,
-                             hint=err.hint)
+                             hint=f"did you mean `{meant[0]}`? ({meant[1]})" if meant
+                             else err.hint)
         return value
 
     def flag(self, m: YMap, key: str, what: str, default: bool) -> bool:
