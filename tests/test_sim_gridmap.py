@@ -186,3 +186,33 @@ def test_a_map_named_by_its_image_points_at_its_yaml(tmp_path: Path):
     with pytest.raises(WorldError, match="`m.pgm` is a map image") as info:
         load_map_yaml(tmp_path / "m.pgm")
     assert info.value.hint == f"did you mean `{tmp_path / 'm.yaml'}`?"
+
+
+def test_a_misspelt_map_or_image_gets_a_did_you_mean_as_it_is_written(tmp_path: Path):
+    """A misspelt `grid:` / `given:` path (or `image:`) was "not found" and no more, where a
+    misspelt world file name gets the file beside it."""
+    from mitos_cli.sim.worldfile import load_world
+
+    maps = tmp_path / "maps"
+    maps.mkdir()
+    (maps / "hall.pgm").write_bytes(b"P5 2 3 255\n" + bytes(PIXELS))
+    (maps / "hall.yaml").write_text("image: hall.pgm\nresolution: 0.05\norigin: [0, 0, 0]\n")
+    world = (Path(__file__).parent.parent / "worlds" / "corridor.yaml").read_text()
+    for key in ("grid", "given"):
+        w = tmp_path / f"w_{key}.yaml"
+        w.write_text(world.replace("map:\n", "map:\n  grid: maps/hall.yaml\n  given: none\n")
+                     .replace(f"{key}: " + ("maps/hall.yaml" if key == "grid" else "none"),
+                              f"{key}: maps/hal.yaml"))
+        with pytest.raises(WorldError) as info:
+            load_world(w)
+        assert info.value.message == f"map file `{maps / 'hal.yaml'}` not found"
+        assert info.value.hint == "did you mean `maps/hall.yaml`?"
+    (maps / "hall.yaml").write_text("image: hal.pgm\nresolution: 0.05\norigin: [0, 0, 0]\n")
+    with pytest.raises(WorldError) as info:
+        load_map_yaml(maps / "hall.yaml")
+    assert info.value.hint == ("did you mean `hall.pgm`? (the image path is relative to the "
+                               "map's YAML file)")
+    (maps / "hall.yaml").write_text("image: nothing.pgm\nresolution: 0.05\norigin: [0, 0, 0]\n")
+    with pytest.raises(WorldError) as info:
+        load_map_yaml(maps / "hall.yaml")
+    assert info.value.hint == "the image path is relative to the map's YAML file"

@@ -127,9 +127,26 @@ def rotate(blocked: np.ndarray, res: float, origin: tuple[float, float],
     return out, (origin[0] + lo[0], origin[1] + lo[1])
 
 
+def _beside(path: Path, written: str | None, exc: OSError | UnicodeDecodeError,
+            suffixes: tuple[str, ...]) -> str | None:
+    """"did you mean `X`?" for a file that is not there, where one beside it has a name
+    close to its own (as a world file's name gets: :func:`.fileio.nearby`), written as the
+    file that names it writes the path."""
+    from ..fileio import nearby_name
+
+    if not isinstance(exc, FileNotFoundError):
+        return None
+    name = nearby_name(path, suffixes)
+    if name is None:
+        return None
+    return f"did you mean `{(Path(written).parent if written else path.parent) / name}`?"
+
+
 def load_map_yaml(path: Path, *, unknown_occupied: bool = True,
-                  where: Span | None = None) -> Grid:
-    """Read a map_server ``map.yaml`` and its image into a :class:`Grid` in inches."""
+                  where: Span | None = None, written: str | None = None) -> Grid:
+    """Read a map_server ``map.yaml`` and its image into a :class:`Grid` in inches
+    (``written``: the path as the world file writes it, for a "did you mean" as it would be
+    written there)."""
     from ..fileio import read_text
 
     if path.suffix.lower() in IMAGE_SUFFIXES:        # the image named where its YAML goes
@@ -143,8 +160,8 @@ def load_map_yaml(path: Path, *, unknown_occupied: bool = True,
     try:
         text = read_text(path)
     except (OSError, UnicodeDecodeError) as exc:
-        raise WorldError(unreadable("map file", path, exc),
-                         span=where) from None
+        raise WorldError(unreadable("map file", path, exc), span=where,
+                         hint=_beside(path, written, exc, (".yaml", ".yml"))) from None
     # Until the file is known to be a map file, an error quotes nothing of it (docs/security.md).
     named = path.suffix.lower() in (".yaml", ".yml")
     try:
@@ -189,9 +206,12 @@ def load_map_yaml(path: Path, *, unknown_occupied: bool = True,
         raise WorldError(f"cannot read map image `{image_path}`: {exc}",
                          span=spec.value_span("image")) from None
     except OSError as exc:
+        close = _beside(image_path, str(image), exc, IMAGE_SUFFIXES)
         raise WorldError(unreadable("map image", image_path, exc),
                          span=spec.value_span("image"),
-                         hint="the image path is relative to the map's YAML file") from None
+                         hint=f"{close} (the image path is relative to the map's YAML file)"
+                         if close else "the image path is relative to the map's YAML file") \
+            from None
     except ValueError as exc:
         raise WorldError(f"cannot read map image `{image_path}`: {exc}",
                          span=spec.value_span("image"),

@@ -506,7 +506,8 @@ def _map(r: _Reader, top: YMap, path: str):
         from .gridmap import load_map_yaml
 
         grid = load_map_yaml(Path(path).parent / str(mp["grid"]),
-                             unknown_occupied=unknown_occupied, where=mp.value_span("grid"))
+                             unknown_occupied=unknown_occupied, where=mp.value_span("grid"),
+                             written=str(mp["grid"]))
     if not corridors and grid is None:
         raise WorldError("the map has neither `corridors` nor a `grid`", span=mp.span,
                          hint="add `corridors: [{points: [[0, 0], [600, 0]], width: 70}]`")
@@ -594,7 +595,7 @@ def read_given(mp: YMap, path: str, unknown_occupied: bool):
     from .gridmap import load_map_yaml
 
     return "given", load_map_yaml(Path(path).parent / value, unknown_occupied=unknown_occupied,
-                                  where=span)
+                                  where=span, written=value)
 
 
 def _behavior(top: YMap) -> str:
