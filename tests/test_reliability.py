@@ -644,7 +644,7 @@ TINY_WORLD = Path(__file__).parent / "data" / "tiny.yaml"
 
 
 @pytest.mark.parametrize("old, new, col", [
-    ("[[0, 0], [280, 0]]", "[[0, 0], [280, 1.0e+37]]", 24),
+    ("[[0, 0], [280, 0]]", "[[0, 0], [280, 1.0e+37]]", 30),       # at the number
     ("width: 70", "width: 8.0e+178", 14),
 ])
 def test_world_numbers_too_large_for_the_geometry_are_refused(tmp_path, old, new, col):

@@ -216,3 +216,14 @@ def test_a_misspelt_map_or_image_gets_a_did_you_mean_as_it_is_written(tmp_path: 
     with pytest.raises(WorldError) as info:
         load_map_yaml(maps / "hall.yaml")
     assert info.value.hint == "the image path is relative to the map's YAML file"
+
+
+def test_a_bad_origin_number_is_pointed_at_itself(tmp_path: Path):
+    """`origin: [0, 0, half]` put the caret on the `[`."""
+    (tmp_path / "m.yaml").write_text("image: m.pgm\nresolution: 0.05\norigin: [0, 0, half]\n")
+    with pytest.raises(WorldError) as info:
+        load_map_yaml(tmp_path / "m.yaml")
+    text = info.value.render()
+    assert text.startswith(f"{tmp_path / 'm.yaml'}:3:16: world error: origin must be a number, "
+                           "not `half`")
+    assert text.splitlines()[2] == " " * 19 + "^"

@@ -52,6 +52,13 @@ def test_unknown_robot_key_points_at_its_line():
     assert "w.yaml:7:3" in msg and "did you mean `wheelbase`?" in msg
 
 
+def test_a_bad_coordinate_is_pointed_at_itself_not_its_list():
+    msg = error(BASE.replace("[[0, 0], [400, 0]]", "[[0, 0], [400, far]]"))
+    assert msg.startswith("w.yaml:13:30: world error: a point of `points` of corridor 1 must be "
+                          "a number, not `far`")
+    assert msg.splitlines()[2] == " " * 33 + "^"
+
+
 def test_missing_field_names_what_to_add():
     msg = error(BASE.replace("q_goal: {x: 300, y: 0}\n", ""))
     assert "missing `q_goal`" in msg and "w.yaml:1:1" in msg

@@ -127,6 +127,12 @@ def rotate(blocked: np.ndarray, res: float, origin: tuple[float, float],
     return out, (origin[0] + lo[0], origin[1] + lo[1])
 
 
+def _item_span(value: list, index: int, span: Span) -> Span:
+    """Where item ``index`` of a YAML list is written (``half`` of ``[0, 0, half]``, not its
+    ``[``); ``span`` where that is not known."""
+    return value.item_span(index) if isinstance(value, yamlpos.YList) else span
+
+
 def _beside(path: Path, written: str | None, exc: OSError | UnicodeDecodeError,
             suffixes: tuple[str, ...]) -> str | None:
     """"did you mean `X`?" for a file that is not there, where one beside it has a name
@@ -186,8 +192,9 @@ def load_map_yaml(path: Path, *, unknown_occupied: bool = True,
     if not isinstance(origin, list) or len(origin) != 3:
         raise WorldError("origin must be [x, y, yaw] (metres, metres, radians)",
                          span=spec.value_span("origin"))
-    ox, oy, yaw = (yamlpos.expect_number(v, spec.value_span("origin"), WorldError, "origin")
-                   for v in origin)
+    ox, oy, yaw = (yamlpos.expect_number(v, _item_span(origin, i, spec.value_span("origin")),
+                                         WorldError, "origin")
+                   for i, v in enumerate(origin))
     negate = _negate(spec)
     mode = spec.get("mode", "trinary")
     if mode not in MODES:

@@ -126,8 +126,9 @@ class _Reader:
               shape: str = "a point [x, y] (inches)") -> tuple[float, float]:
         if not isinstance(value, list) or len(value) != 2:
             raise WorldError(f"{what} must be {shape}", span=span)
-        x, y = (_sane(yamlpos.expect_number(v, span, WorldError, what), span, what)
-                for v in value)
+        spans = value.item_spans if isinstance(value, YList) else [span] * 2
+        x, y = (_sane(yamlpos.expect_number(v, at, WorldError, what), at, what)
+                for v, at in zip(value, spans))
         return x, y
 
     def points(self, value: Any, span: Span, what: str, least: int) -> tuple:
