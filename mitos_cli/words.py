@@ -1,5 +1,6 @@
 """Counted nouns for messages: ``plural(1, "rule")`` is ``1 rule``, ``plural(27, "rule")``
-``27 rules``, so no user reads "(1 rules)"."""
+``27 rules``, so no user reads "(1 rules)"; and a clearance as it is printed beside the
+margin it is compared with (:func:`clearance`)."""
 
 from __future__ import annotations
 
@@ -22,3 +23,15 @@ def with_unit(number: str, unit: str) -> str:
             and unit.endswith("s") and not unit.endswith("ss"):
         unit = unit[:-2] if unit.endswith(("ches", "shes", "xes", "sses")) else unit[:-1]
     return f"{number} {unit}"
+
+
+def clearance(x: float, margin: float | None = None) -> str:
+    """A clearance (in) to a tenth, as every verdict prints it, but never ``-0.0`` (a
+    clearance of -0.04 in is 0.0 to a tenth), and with as many more digits as it takes to
+    show which side of ``margin`` it lies on (1.99 beside a margin of 2 is ``1.99``: "2.0
+    in; closer than the safety margin (2 in)" read as a contradiction)."""
+    for digits in range(1, 18):
+        text = f"{x:.{digits}f}"
+        if margin is None or (float(text) < margin) == (x < margin):
+            break
+    return text[1:] if text.startswith("-") and float(text) == 0 else text

@@ -247,6 +247,31 @@ def test_json_says_near_miss_as_the_text_does(tmp_path):
     assert data["near_miss"] is False
 
 
+def test_the_verdict_prints_a_clearance_on_the_side_of_the_margin_it_lies():
+    from types import SimpleNamespace
+
+    from mitos_cli.cli.simulate_cmd import _summary, _verdict
+    from mitos_cli.sim.world import Robot
+
+    def run(clear: float, outcome: str = "success") -> SimpleNamespace:
+        agent = SimpleNamespace(name="robot", robot=Robot())
+        m = {"outcome": outcome, "reached_goal": True, "collisions": 0, "time_s": 1.0,
+             "ticks": 20, "path_length_in": 1.0, "mean_speed_in_s": 1.0,
+             "min_clearance_in": clear, "steering_total_variation_deg": 0.0, "replans": 0,
+             "backouts": 0}
+        return SimpleNamespace(metrics=m, world=SimpleNamespace(agents=[agent], name="w"),
+                               robot_metrics=[m], outcome=outcome, robot_outcomes=[outcome],
+                               seed=1, planner="fuzzy:drive", summary=lambda: m)
+
+    assert _verdict(run(1.99)).endswith(
+        "min clearance 1.99 in; closer than the safety margin (2 in)")
+    assert "  min clearance             1.99 in\n" in _summary(run(1.99))
+    assert _verdict(run(2.01)).endswith("min clearance 2.0 in")
+    assert _verdict(run(-0.03, "collision")).endswith("min clearance 0.0 in")
+    assert "  min clearance             0.0 in\n" in _summary(run(-0.03, "collision"))
+    assert _verdict(run(-0.1, "collision")).endswith("min clearance -0.1 in")
+
+
 def test_one_run_shows_no_spread():
     out = CliRunner().invoke(app, ["simulate", "corridor.yaml", "--runs", "1"]).stdout
     row = out.splitlines()[1].split()

@@ -1,8 +1,8 @@
-"""Counted nouns in messages (`mitos_cli.words.plural`)."""
+"""Counted nouns in messages (`mitos_cli.words.plural`), clearances beside their margin."""
 
 import pytest
 
-from mitos_cli.words import plural, with_unit
+from mitos_cli.words import clearance, plural, with_unit
 
 
 @pytest.mark.parametrize("n, word, many, text", [
@@ -26,3 +26,14 @@ def test_plural(n, word, many, text):
 ])
 def test_a_counted_unit_is_singular_after_exactly_one(number, unit, text):
     assert with_unit(number, unit) == text
+
+
+@pytest.mark.parametrize("x, margin, text", [
+    (8.2162571612858, None, "8.2"), (-0.1, None, "-0.1"), (2.0, 2.0, "2.0"),
+    (-0.04, None, "0.0"), (-0.0, None, "0.0"), (-0.04, 2.0, "0.0"),    # no -0.0
+    (1.99, 2.0, "1.99"), (1.9999, 2.0, "1.9999"), (1.94, 2.0, "1.9"),
+    (2.04, 2.0, "2.0"), (1.4, 2.0, "1.4"), (8.96, 9.0, "8.96"),
+])
+def test_a_clearance_shows_which_side_of_its_margin_it_lies(x, margin, text):
+    """"min clearance -0.0 in" and "2.0 in; closer than the safety margin (2 in)" (1.99)."""
+    assert clearance(x, margin) == text

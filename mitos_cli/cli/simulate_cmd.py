@@ -8,6 +8,7 @@ from typing import Annotated, Optional
 
 import typer
 
+from ..words import clearance
 from . import complete
 from .output import emit, err, json_text, warn
 from .params import MAX_RUNS, finite, named, option_names
@@ -47,9 +48,9 @@ def _verdict(res) -> str:
                 f"({close[0].robot.safety_margin:g} in)")
     others = ("" if len(agents) == 1 else " (" + ", ".join(
         f"{a.name} {o}" for a, o in zip(agents, res.robot_outcomes)) + ")")
+    shown = clearance(m["min_clearance_in"], close[0].robot.safety_margin if near else None)
     return (f"{res.world.name}: {res.outcome.upper()}{others} after {m['time_s']:.2f} s "
-            f"(seed {res.seed}, {res.planner}); min clearance {m['min_clearance_in']:.1f} in"
-            f"{near}")
+            f"(seed {res.seed}, {res.planner}); min clearance {shown} in{near}")
 
 
 def _table(rows: list[tuple[str, ...]]) -> str:
@@ -63,7 +64,7 @@ _ROWS = (   # label, key, format (the overall figures, then each robot's)
     ("collisions", "collisions", str), ("time", "time_s", lambda v: f"{v:.2f} s"),
     ("ticks", "ticks", str), ("path length", "path_length_in", lambda v: f"{v:.1f} in"),
     ("mean speed", "mean_speed_in_s", lambda v: f"{v:.1f} in/s"),
-    ("min clearance", "min_clearance_in", lambda v: f"{v:.1f} in"),
+    ("min clearance", "min_clearance_in", lambda v: f"{clearance(v)} in"),
     ("steering total variation", "steering_total_variation_deg", lambda v: f"{v:.0f} deg"),
     ("replans", "replans", str), ("backed out", "backouts", str))
 
@@ -74,7 +75,13 @@ def _summary(res) -> str:
     overall = res.summary()
     each = res.robot_metrics if len(res.robot_metrics) > 1 else ()
     rows = [("", "all robots", *(r["name"] for r in each))] if each else []
+    margins = [a.robot.safety_margin for a in res.world.agents]
     for label, key, fmt in _ROWS:
+        if key == "min_clearance_in":       # beside the margin, as the verdict says it
+            cells = [f"{clearance(overall[key], min(margins))} in"]
+            cells += [f"{clearance(r[key], m)} in" for r, m in zip(each, margins)]
+            rows.append((label, *cells))
+            continue
         cells = [fmt(overall[key])]
         for r in each:
             if key == "collisions":

@@ -9,6 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..words import clearance
 from .output import _matplotlib, finish, new_figure
 
 PAD = 20.0      # in round the map
@@ -137,7 +138,7 @@ def draw_run(result, path: str | Path | None = None, *, footprint_every: float =
     ax.set_ylabel("y (in)")
     m = result.metrics
     ax.set_title(f"{world.name}: {result.outcome} after {m['time_s']:.2f} s "
-                 f"(seed {result.seed}, min clearance {m['min_clearance_in']:.1f} in)",
+                 f"(seed {result.seed}, min clearance {clearance(m['min_clearance_in'])} in)",
                  fontsize=9)
     return finish(fig, path, show)
 

@@ -25,6 +25,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import CommandError, InputError, WorldError
+from ..words import clearance as shown_clearance
 from ..words import plural
 from . import geometry, kinematics, knowledge, movers, perception, rows, safety, sensors
 from . import obstacles as obs_mod
@@ -159,7 +160,7 @@ class SimResult:
                 f"after {m.get('time_s', self.ticks * self.world.dt):g} s ({self.ticks} ticks"
                 f"{f', {robots} robots' if robots > 1 else ''}), path "
                 f"{m.get('path_length_in', 0.0):.1f} in, min clearance "
-                f"{m.get('min_clearance_in', 0.0):.1f} in>")
+                f"{shown_clearance(m.get('min_clearance_in', 0.0))} in>")
 
     def _repr_png_(self) -> bytes | None:
         """A notebook shows the run as ``--plot`` draws it (nothing without matplotlib)."""

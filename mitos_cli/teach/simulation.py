@@ -16,7 +16,7 @@ import numpy as np
 
 from ..errors import LessonError, MitosError
 from ..lang.model import RuleBase
-from ..words import plural
+from ..words import clearance, plural
 
 if TYPE_CHECKING:
     from ..sim.loop import SimResult
@@ -77,7 +77,7 @@ class Recording:
         who = f" (robot {self.robot_name})" if self.robot_name else ""
         who += f" (seed {self.seed})" if self.seed is not None else ""
         return (f"{self.name}{who} with behavior {self.behavior}: {s['outcome']} after "
-                f"{s['time_s']:g} s (min clearance {s['min_clearance_in']:.1f} in, "
+                f"{s['time_s']:g} s (min clearance {clearance(s['min_clearance_in'])} in, "
                 f"{plural(s['collisions'], 'collision')}); "
                 f"correct it with `at TIME OUTPUT=VALUE` (0 to {self.end:g} s)")
 
