@@ -35,3 +35,10 @@ def clearance(x: float, margin: float | None = None) -> str:
         if margin is None or (float(text) < margin) == (x < margin):
             break
     return text[1:] if text.startswith("-") and float(text) == 0 else text
+
+
+def tenths(x: float) -> str:
+    """A length to a tenth of an inch, a whole one without ``.0`` (``18.5``, ``16``): a
+    corridor 18.5 in wide was "18 in wide" beside a centre that keeps "9.2 in" of it."""
+    text = f"{x:.1f}"
+    return text[:-2] if text.endswith(".0") else text

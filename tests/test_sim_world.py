@@ -205,6 +205,16 @@ def test_a_corridor_narrower_than_the_robot_is_refused_naming_the_place():
     assert "the robot is 18 in wide: widen the corridor to at least 22 in" in msg
 
 
+def test_a_corridor_width_is_said_to_a_tenth():
+    """An 18.5 in corridor was "18 in wide"."""
+    from mitos_cli.sim.loop import prepare
+    from mitos_cli.sim.route import NarrowPassage
+
+    with pytest.raises(NarrowPassage) as info:
+        prepare(parse_world(_pinched(18.5), "w.yaml"))
+    assert "(a corridor 18.5 in wide); it needs 11.0 in" in info.value.message
+
+
 def test_a_corridor_the_robot_fits_is_a_squeeze_the_world_may_allow():
     from mitos_cli.sim.loop import prepare
     from mitos_cli.sim.route import NarrowPassage

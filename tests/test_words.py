@@ -2,7 +2,7 @@
 
 import pytest
 
-from mitos_cli.words import clearance, plural, with_unit
+from mitos_cli.words import clearance, plural, tenths, with_unit
 
 
 @pytest.mark.parametrize("n, word, many, text", [
@@ -37,3 +37,9 @@ def test_a_counted_unit_is_singular_after_exactly_one(number, unit, text):
 def test_a_clearance_shows_which_side_of_its_margin_it_lies(x, margin, text):
     """"min clearance -0.0 in" and "2.0 in; closer than the safety margin (2 in)" (1.99)."""
     assert clearance(x, margin) == text
+
+
+@pytest.mark.parametrize("x, text", [(18.5, "18.5"), (16.0, "16"), (17.72, "17.7"),
+                                     (21.96, "22"), (0.04, "0")])
+def test_a_width_is_said_to_a_tenth_a_whole_one_without_its_point(x, text):
+    assert tenths(x) == text

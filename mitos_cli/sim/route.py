@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import WorldError
+from ..words import tenths
 from .distance import _capped, distance_transform
 from .geometry import CACHED, clip_arrays, point_segment_distance
 from .staticmap import StaticMap
@@ -423,7 +424,7 @@ def _narrow_corridor(adj, coords, room, s_id: int, g_id: int, walls: np.ndarray,
     gap = point_segment_distance(points, walls).min(axis=1)
     x, y = points[int(gap.argmin())]
     g = float(gap.min())
-    return narrow_passage(float(x), float(y), g, least, "corridor", f"{2 * g:.0f}", half_width)
+    return narrow_passage(float(x), float(y), g, least, "corridor", tenths(2 * g), half_width)
 
 
 def narrow_passage(x: float, y: float, gap: float, need: float, kind: str, wide: str,
@@ -989,7 +990,7 @@ def _refusal(node_c: np.ndarray, s, t, centre, floor: float,
         if room < floor and math.dist((x, y), end) <= floor + step:
             return _end_refused(what, *end, f"lies {room:.1f} in from a wall of {mapped}, "
                                 f"and its route needs {floor:.1f} in to leave it", mapped)
-    return narrow_passage(x, y, gap, floor, "passage", f"about {2 * gap:.0f}", half_width)
+    return narrow_passage(x, y, gap, floor, "passage", f"about {tenths(2 * gap)}", half_width)
 
 
 def _end_room(field: Clearance, occ: np.ndarray, p: tuple[float, float]) -> float:
