@@ -287,6 +287,63 @@ def test_no_way_on_the_given_map_says_it_is_the_given_map(tmp_path):
     assert "unknown: free" not in text and "`given: none`" in text
 
 
+def metric_door_world(tmp_path: Path, door_px: int) -> Path:
+    """Two rooms (0.05 m pixels, 1.97 in) joined by a door ``door_px`` pixels wide, in a wall
+    4 pixels thick: the reviewer's door maps."""
+    px = np.full((70, 220), 254, dtype=np.uint8)
+    px[:2], px[-2:], px[:, :2], px[:, -2:] = 0, 0, 0, 0
+    px[:, 108:112] = 0
+    px[35 - door_px // 2:35 - door_px // 2 + door_px, 108:112] = 254
+    (tmp_path / "door.pgm").write_bytes(b"P5 220 70 255\n" + px.tobytes())
+    (tmp_path / "door.yaml").write_text("image: door.pgm\nresolution: 0.05\n"
+                                        "origin: [0, 0, 0]\n", encoding="utf-8")
+    w = tmp_path / "w.yaml"
+    w.write_text(world_text("map:\n  grid: door.yaml\n", start=(40, 30), goal=(390, 110)),
+                 encoding="utf-8")
+    return w
+
+
+def exact_clearance(points: np.ndarray, grid) -> float:
+    """The least distance from ``points`` to an occupied cell of ``grid`` taken as the disc of
+    half a cell round its centre (the route's measure), brute force."""
+    r, c = np.nonzero(grid.occupied)
+    centres = np.stack([grid.origin[0] + (c + 0.5) * grid.resolution,
+                        grid.origin[1] + (r + 0.5) * grid.resolution], axis=1)
+    return min(float(np.hypot(*(part[:, None] - centres[None]).T).min())
+               for part in np.array_split(points, max(1, len(points) // 200))) \
+        - grid.resolution / 2
+
+
+def test_an_even_door_the_robot_fits_is_routed_between_the_cells(tmp_path):
+    """A 12-pixel door (23.6 in) was refused, "keeps 10.8 in ... it needs 11.0": the nodes
+    sit on the cells' centres, half a cell off its middle, which keeps 11.8 in. The route
+    found between the cells keeps what it claims, measured exactly."""
+    from mitos_cli.sim.clutter import passable
+
+    world = load_world(metric_door_world(tmp_path, 12))
+    route = prepare(world).routes[0]
+    pts = dense(route.points, 0.05)
+    assert exact_clearance(pts, world.grid) >= 11.0
+    door = pts[np.abs(pts[:, 0] - 216.5) < 4]                   # in the door, in its middle
+    assert np.allclose(door[:, 1], 35 * 0.05 / 0.0254)
+    assert exact_clearance(door, world.grid) == pytest.approx(6 * 0.05 / 0.0254)
+    with pytest.raises(NarrowPassage, match="keeps 10.8 in"):      # the nodes' own verdict
+        prepare(world, between=False)
+    assert not passable(world, ())       # the clutter suite's placements keep theirs
+
+
+def test_a_door_too_narrow_between_the_cells_too_is_still_refused(tmp_path):
+    with pytest.raises(NarrowPassage, match=r"keeps 10.8 in .* it needs 11.0 in"):
+        prepare(load_world(metric_door_world(tmp_path, 11)))      # 21.7 in
+
+
+@pytest.mark.parametrize("door_px", [13, 14, 20])
+def test_a_route_found_at_the_cells_centres_is_kept_as_it_was(tmp_path, door_px):
+    world = load_world(metric_door_world(tmp_path, door_px))
+    assert np.array_equal(prepare(world).routes[0].points,
+                          prepare(world, between=False).routes[0].points)
+
+
 def test_route_min_clearance_allows_the_squeeze(tmp_path):
     world = load_world(grid_world(tmp_path, door_map(20), extra="route: {min_clearance: 9.5}\n"))
     assert world.min_clearance == 9.5

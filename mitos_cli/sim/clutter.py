@@ -163,8 +163,8 @@ def passable(world: World, objects: tuple[Obstacle, ...]) -> bool:
     pass by)."""
     still = tuple(dataclasses.replace(o, known=True) for o in (*world.obstacles, *objects)
                   if o.motion.kind == "static")
-    try:
-        prepare(world.with_changes(obstacles=still))
+    try:        # nodes at the cells' centres alone: the placements the suite's figures drew
+        prepare(world.with_changes(obstacles=still), between=False)
     except MitosError:
         return False
     return True

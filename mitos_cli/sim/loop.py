@@ -66,9 +66,12 @@ def clearances(world: World, agent: Agent) -> tuple[float, float]:
     return route_clearances(agent.robot, world.min_clearance)
 
 
-def prepare(world: World) -> Scene:
+def prepare(world: World, between: bool = True) -> Scene:
     """Walls, what the robots know and their routes (A* over the corridors or the grid they
-    are given; the truth's own with the default ``given``)."""
+    are given; the truth's own with the default ``given``). ``between``: a grid route refused
+    by less than a node can stand off a passage's middle is looked for again between the
+    cells (:func:`.route.grid_route`); ``False`` keeps the refusal of nodes at the cells'
+    centres alone (the clutter suite's placements were decided by it)."""
     static = build_static(world)
     given = knowledge.given(world, static)
     routes = []
@@ -77,12 +80,12 @@ def prepare(world: World) -> Scene:
         try:
             if given.plain:
                 routes.append(plan_route(static, world.corridors, a.start, a.goal, asked, least,
-                                         half_width=a.robot.width / 2))
+                                         half_width=a.robot.width / 2, between=between))
             else:
                 known = StaticMap(given.walls, np.zeros((0, 4, 2)), given.grid, static.bounds)
                 routes.append(grid_route(known, a.start, a.goal, asked, minimum=least,
                                          half_width=a.robot.width / 2,
-                                         given=given.knows == "given"))
+                                         given=given.knows == "given", between=between))
         except WorldError as exc:       # no route to the goal: said at the goal's line
             if exc.span is None:        # (a start it cannot leave, at the start's)
                 at_start = isinstance(exc, NarrowPassage) and exc.end == "start"

@@ -569,6 +569,7 @@ class NarrowPassage(WorldError):
     def __init__(self, message: str, *, end: str = "goal", **kw) -> None:
         super().__init__(message, **kw)
         self.end = end
+        self.gap: float | None = None      # the centre's clearance at the narrowest place
 
 
 def _widest_way(free_c: np.ndarray, s: tuple[int, int], t: tuple[int, int],
@@ -644,7 +645,7 @@ def grid_route(static: StaticMap, start: Pose, goal: Goal, clearance: float,
                occupied: np.ndarray | None = None, explain: bool = True,
                leave: float = 0.0, behind: float = 0.0, keep: bool = True,
                last: Prepared | None = None, half_width: float = 0.0,
-               given: bool = False) -> Route:
+               given: bool = False, between: bool = False) -> Route:
     """A* on nodes about ``cell`` inches apart, each kept at least ``clearance`` inches (the
     exact Euclidean distance) from the occupied cells, preferring the middle of the corridors.
     Nodes closer than that but not closer than ``minimum`` (the robot's half width plus its
@@ -660,7 +661,10 @@ def grid_route(static: StaticMap, start: Pose, goal: Goal, clearance: float,
     searches on its own map keep what they work out, for its next. ``half_width``: the
     robot's, for what a refusal suggests (a squeeze only where its body fits); ``given``: the
     grid is the map the robot is given (``map: {given}``), not the map itself, which a
-    refusal says (a start in a wall of it passed the checks of the map itself)."""
+    refusal says (a start in a wall of it passed the checks of the map itself); ``between``:
+    before it refuses a way that falls short of ``minimum`` by less than a node can stand off
+    a passage's middle, look again with nodes between the cells too (:func:`_between_cells`):
+    a route found without it is never changed."""
     g = static.grid
     assert g is not None        # callers plan on a grid (plan_route checks; the rest build one)
     occ = g.occupied if occupied is None else occupied
@@ -728,8 +732,14 @@ def grid_route(static: StaticMap, start: Pose, goal: Goal, clearance: float,
             raise NarrowPassage("no way to the goal on what the robot knows")
         ends = ((what, p, _end_room(field, occ, p)) for what, p in
                 (("start", (start.x, start.y)), ("goal", (goal.x, goal.y))))
-        raise _refusal(node_c, s, t, centre, floor, edge, half_width, tuple(ends),
-                       _map_words(g, given), size)
+        refusal = _refusal(node_c, s, t, centre, floor, edge, half_width, tuple(ends),
+                           _map_words(g, given), size)
+        gap = getattr(refusal, "gap", None)
+        if between and gap is not None and floor - gap < g.resolution * math.sqrt(0.5):
+            found = _between_cells(g, occ, start, goal, clearance, floor, cell)
+            if found is not None:
+                return found
+        raise refusal
     pts = np.array([centre(divmod(n, C)) for n in path])
     pts = np.vstack([[start.x, start.y], pts[1:-1], [goal.x, goal.y]])
     pts = _simplify(pts, size * 0.75, field, clearance)
@@ -990,7 +1000,66 @@ def _refusal(node_c: np.ndarray, s, t, centre, floor: float,
         if room < floor and math.dist((x, y), end) <= floor + step:
             return _end_refused(what, *end, f"lies {room:.1f} in from a wall of {mapped}, "
                                 f"and its route needs {floor:.1f} in to leave it", mapped)
-    return narrow_passage(x, y, gap, floor, "passage", f"about {tenths(2 * gap)}", half_width)
+    out = narrow_passage(x, y, gap, floor, "passage", f"about {tenths(2 * gap)}", half_width)
+    out.gap = gap
+    return out
+
+
+def _between_cells(g: Grid, occ: np.ndarray, start: Pose, goal: Goal, clearance: float,
+                   floor: float, cell: float) -> Route | None:
+    """The route :func:`grid_route` finds with nodes at the cells' corners too, or ``None``.
+
+    A node stands at a cell's centre, half a cell off the middle of a passage an even number
+    of cells wide: a 12-cell door of 23.6 in, whose middle keeps 11.8 in, was refused as
+    keeping 10.8 of the 11 asked. The centres and corners are the cells of a grid of half
+    the size, occupied where an occupied cell's centre is: its exact distance transform is the
+    distance to the nearest occupied centre at every centre and corner, and each of its
+    clearances reads a quarter of a cell more than the grid's own (it takes off half its own
+    cell, not half the grid's), so ``clearance`` and ``floor`` are asked for a quarter of a
+    cell more. The route is kept only if it keeps ``floor`` exactly: every occupied centre's
+    distance from each of its segments, less half a cell, the first and last segments
+    (leaving the start, reaching the goal) as much as the start and goal themselves keep."""
+    rows, cols = occ.shape
+    fine = np.zeros((2 * rows + 1, 2 * cols + 1), dtype=bool)
+    fine[1::2, 1::2] = occ
+    half = g.resolution / 2
+    grid = Grid(fine, half, (g.origin[0] - half / 2, g.origin[1] - half / 2), g.source)
+    static = StaticMap(np.zeros((0, 4)), np.zeros((0, 4, 2)), grid,
+                       (grid.origin[0], grid.origin[1], grid.origin[0] + fine.shape[1] * half,
+                        grid.origin[1] + fine.shape[0] * half))
+    quarter = g.resolution / 4
+    try:
+        route = grid_route(static, start, goal, clearance + quarter, cell, floor + quarter,
+                           explain=False, keep=False)
+    except NarrowPassage:
+        return None
+    return route if _keeps(route, g, occ, floor) else None
+
+
+def _keeps(route: Route, g: Grid, occ: np.ndarray, floor: float) -> bool:
+    """Whether ``route`` keeps ``floor`` from the occupied cells of ``g`` (``occ``), each a
+    disc of half a cell round its centre, measured exactly: each segment's distance from the
+    centres, its first and last as much as the start and the goal keep if that is less."""
+    r, c = np.nonzero(occ)
+    if not len(r):
+        return True
+    centres = np.stack([g.origin[0] + (c + 0.5) * g.resolution,
+                        g.origin[1] + (r + 0.5) * g.resolution], axis=1)
+    pts = route.points
+    lo, hi = pts.min(axis=0) - floor - g.resolution, pts.max(axis=0) + floor + g.resolution
+    near = centres[((centres >= lo) & (centres <= hi)).all(axis=1)]
+    if not len(near):
+        return True
+    half = g.resolution / 2
+    segs = np.concatenate([pts[:-1], pts[1:]], axis=1)
+    block = max(1, CACHED // len(segs))           # a block of centres at a time
+    kept = np.minimum.reduce([point_segment_distance(near[i:i + block], segs).min(axis=0)
+                              for i in range(0, len(near), block)]) - half
+    ends = np.hypot(*(near[:, None] - pts[[0, -1]][None]).T).min(axis=1) - half
+    need = np.full(len(kept), floor)
+    need[0] = min(need[0], ends[0])
+    need[-1] = min(need[-1], ends[1])
+    return bool((kept >= need - 1e-9).all())
 
 
 def _end_room(field: Clearance, occ: np.ndarray, p: tuple[float, float]) -> float:
@@ -1021,11 +1090,13 @@ def _end_refused(what: str, x: float, y: float, why: str, mapped: str) -> Narrow
 
 def plan_route(static: StaticMap, corridors: tuple[Corridor, ...], start: Pose, goal: Goal,
                clearance: float, minimum: float | None = None,
-               occupied: np.ndarray | None = None, half_width: float = 0.0) -> Route:
+               occupied: np.ndarray | None = None, half_width: float = 0.0,
+               between: bool = False) -> Route:
     """The route over the corridors' centre lines or, with a grid, A* on the grid (on
-    ``occupied`` when given: the cells the robot knows)."""
+    ``occupied`` when given: the cells the robot knows; ``between``: see
+    :func:`grid_route`)."""
     if static.grid is None:
         return corridor_route(corridors, start, goal, static.walls,
                               clearance if minimum is None else minimum, half_width)
     return grid_route(static, start, goal, clearance, minimum=minimum, occupied=occupied,
-                      half_width=half_width)
+                      half_width=half_width, between=between)
