@@ -194,3 +194,45 @@ def test_the_brake_looks_as_far_as_stopping_takes_within_what_the_robot_sees():
     assert safety.reach_of(slow, 0.05, cfg, 150.0) == 150.0
     # so it goes no faster than it can stop within its sensors' range
     assert safety.brake(150.0, 1.0, cfg.margin, 0.05) < 18.0
+
+
+def _beside(heading: float, across: float) -> np.ndarray:
+    """A cell's centre beside the middle of a robot at the origin heading ``heading`` (rad),
+    ``across`` inches to its right."""
+    c, s = math.cos(heading), math.sin(heading)
+    return np.array([[across * s, -across * c]])
+
+
+def test_a_cell_is_the_square_it_is_its_corner_meets_a_slanting_flank():
+    """A cell 1.2 half sides off the flank: clear of a flank along the grid, but at 45 deg its
+    corner (0.41 half sides out of the disc it was once taken for) reaches into the body."""
+    across = ROBOT.width / 2 + 1.2
+    square = (0.0, 0.0, 0.0)
+    slant = (0.0, 0.0, math.pi / 4)
+    assert safety.free_travel(_beside(0.0, across), 1.0, square, ROBOT, 0.0, False, 30.0) == 30.0
+    assert safety.free_travel(_beside(math.pi / 4, across), 1.0, slant, ROBOT, 0.0, False,
+                              30.0) == 0.0
+    bodies = [(safety.Body(ROBOT, pose, 90.0, _beside(pose[2], across), 1.0, 0.0, 30.0), 90.0,
+               False) for pose in (square, slant)]
+    assert safety.free_travels(bodies).tolist() == [30.0, 0.0]      # alone or together
+
+
+def test_a_wheel_is_not_turned_toward_what_the_robot_can_no_longer_stop_short_of():
+    """Driving at 40 in/s with its wheel at 120, told to turn hard right (150) toward a wall
+    5 in off its right flank: the hard turn leaves less room than it needs to stop, the arc
+    it is on leaves more, so the wheel stays; standing, it may turn."""
+    cfg = safety.Settings()
+    wall = [[x, -14.0] for x in np.arange(-20.0, 80.0, 2.0)]
+    cells = np.asarray(wall, float)
+
+    def at(speed: float) -> safety.Body:
+        return safety.Body(ROBOT, AT, 120.0, cells, 1.0, 0.0, 40.0, speed)
+
+    moving = at(40.0)
+    turned = safety.brake(moving.free(129.0, False, cfg), ROBOT.acceleration, cfg.margin, 0.05)
+    kept = safety.brake(moving.free(120.0, False, cfg), ROBOT.acceleration, cfg.margin, 0.05)
+    assert turned < 40.0 - ROBOT.acceleration * 0.05 and kept > turned
+    (steer, speed), _ = safety.guard((150.0, 40.0), moving, safety.Recovery(), 0.05, cfg)
+    assert steer == 120.0 and speed == pytest.approx(min(40.0, kept))
+    (steer, _), _ = safety.guard((150.0, 40.0), at(0.0), safety.Recovery(), 0.05, cfg)
+    assert steer == 150.0

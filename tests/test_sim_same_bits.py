@@ -223,7 +223,7 @@ def free_travel_over_every_cell(cells, radius, pose, robot, delta, backward, rea
     x, y, h = pose
     if not len(cells):
         return reach
-    wb, hl, hw = robot.wheelbase, robot.length / 2 + radius, robot.width / 2 + radius
+    wb, hl, hw = robot.wheelbase, robot.length / 2, robot.width / 2
     u = np.arange(0.0, reach + step / 2, step) * (-1.0 if backward else 1.0)
     k = -math.tan(math.radians(delta)) / wb
     hk = h + k * u
@@ -236,7 +236,12 @@ def free_travel_over_every_cell(cells, radius, pose, robot, delta, backward, rea
     c, s = np.cos(hk), np.sin(hk)
     dx = cells[:, 0, None] - (rx + wb / 2 * c)
     dy = cells[:, 1, None] - (ry + wb / 2 * s)
-    depth = np.minimum(hl - np.abs(dx * c + dy * s), hw - np.abs(dy * c - dx * s))
+    ac, as_ = np.abs(c), np.abs(s)        # each cell the square it is: four axes
+    e = radius * (ac + as_)
+    depth = np.minimum(np.minimum(hl + e - np.abs(dx * c + dy * s),
+                                  hw + e - np.abs(dy * c - dx * s)),
+                       np.minimum(radius + hl * ac + hw * as_ - np.abs(dx),
+                                  radius + hl * as_ + hw * ac - np.abs(dy)))
     inside = depth >= 0
     if backward:
         inside = np.where(inside[:, :1], depth > depth[:, :1], inside)

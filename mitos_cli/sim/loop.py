@@ -938,7 +938,7 @@ class Simulation:
                                float(self._steer[i]),
                                rmap.near(s.pose[i, :2], self._brake_reach[i] + self._body[i]),
                                rmap.grid.resolution / 2, float(s.inputs["heading"][i]),
-                               self._brake_reach[i])
+                               self._brake_reach[i], float(self._v[i]))
             command = (float(s.command[i, 0]), float(s.command[i, 1]))
             out.append((body, *safety.first_sweep(command, body, self._recovery[i], self.dt)))
         return out

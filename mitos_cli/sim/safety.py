@@ -12,7 +12,11 @@ them away, as the paper's robot had none):
   everything it knows is there (its map: what it was given and what it has sensed, which its
   readings keep up to date), counting the tick it drives on before the next command; it
   looks along the arc as far as stopping from its top speed takes (:func:`reach_of`). Where
-  the arc is shut the robot stops.
+  the arc is shut the robot stops. A wheel that would turn toward what the robot could no
+  longer stop short of, at the speed it has, is held where it is when its own arc leaves
+  more room: the brake bounds the speed on one arc, and a hard turn at speed (a planner
+  swerving just after it passed another robot) swung a robot into a wall it could then not
+  stop before.
 - **backing out** (:class:`Recovery`): held by the brake for ``patience`` seconds while its
   planner wants to go on, the robot backs out for ``back_time`` seconds on the opposite lock
   (which swings its nose toward the side its route lies on), as far as the way behind is
@@ -50,9 +54,10 @@ def free_travel(cells: np.ndarray, radius: float, pose: tuple[float, float, floa
                 step: float = 1.0) -> float:
     """How far (in, along the rear axle's path) the robot can drive from ``pose`` (x, y, heading
     in rad) with its wheel held ``delta`` degrees off straight (positive right), forward or
-    ``backward``, before its footprint touches one of the occupied ``cells [P, 2]`` (discs of
-    ``radius``); ``reach`` when it can drive that far, 0 when it touches one already, but for
-backing out: backward, a cell it touches blocks only the steps that take it deeper in.
+    ``backward``, before its footprint touches one of the occupied ``cells [P, 2]`` (squares
+    of half side ``radius``, :func:`_depth`); ``reach`` when it can drive that far, 0 when it
+    touches one already, but for backing out: backward, a cell it touches blocks only the steps
+    that take it deeper in.
 
     Only the cells in the box the footprint's circumscribed disc sweeps are tested: a cell
     outside it is inside no footprint along the arc (1e-6 in of slack for rounding), and each
@@ -60,7 +65,7 @@ backing out: backward, a cell it touches blocks only the steps that take it deep
     x, y, h = pose
     if not len(cells):
         return reach
-    wb, hl, hw = robot.wheelbase, robot.length / 2 + radius, robot.width / 2 + radius
+    wb, hl, hw = robot.wheelbase, robot.length / 2, robot.width / 2
     u = _path(reach, step, backward)                 # [K]
     k = -math.tan(math.radians(delta)) / wb          # rad per inch of the rear axle's path
     hk = h + k * u
@@ -72,7 +77,7 @@ backing out: backward, a cell it touches blocks only the steps that take it deep
         rx = x - wb / 2 * math.cos(h) + u * math.cos(h)
         ry = y - wb / 2 * math.sin(h) + u * math.sin(h)
     cx, cy = rx + wb / 2 * c, ry + wb / 2 * s        # the footprint's centre at each step
-    disc = math.hypot(hl, hw) + 1e-6
+    disc = math.hypot(hl, hw) + radius * math.sqrt(2) + 1e-6     # a cell's corner too
     px, py = cells[:, 0], cells[:, 1]
     swept = ((px >= cx.min() - disc) & (px <= cx.max() + disc)
              & (py >= cy.min() - disc) & (py <= cy.max() + disc))
@@ -80,7 +85,7 @@ backing out: backward, a cell it touches blocks only the steps that take it deep
         return reach
     px, py = px[swept, None], py[swept, None]
     dx, dy = px - cx, py - cy
-    depth = np.minimum(hl - np.abs(dx * c + dy * s), hw - np.abs(dy * c - dx * s))  # [P, K]
+    depth = _depth(dx, dy, c, s, hl, hw, radius)                   # [P, K]
     inside = depth >= 0
     if backward:    # backing away from a cell the body touches already (a mark a noisy echo
         # put at its edge) is not blocked by it until a step takes the body deeper in
@@ -89,6 +94,22 @@ backing out: backward, a cell it touches blocks only the steps that take it deep
     if not hit.any():
         return reach
     return float(max(int(hit.argmax()) - 1, 0) * step)
+
+
+def _depth(dx, dy, c, s, hl, hw, r):
+    """How deep a cell, the square of half side ``r`` centred ``(dx, dy)`` from the
+    footprint's centre, reaches into the footprint (half length ``hl``, half width ``hw``,
+    heading cosine ``c`` and sine ``s``): the least overlap along the four axes that can
+    separate two rectangles, the footprint's two and the grid's. Taken as a disc of radius
+    ``r``, a cell's corner stood 0.41 r out of it, and a flank sliding past a wall block at a
+    slant met that corner with the brake's way free."""
+    ac, as_ = np.abs(c), np.abs(s)
+    e = r * (ac + as_)                   # the cell's half extent along the footprint's axes
+    along = hl + e - np.abs(dx * c + dy * s)
+    across = hw + e - np.abs(dy * c - dx * s)
+    x = r + hl * ac + hw * as_ - np.abs(dx)      # the footprint's half extents on the grid's
+    y = r + hl * as_ + hw * ac - np.abs(dy)
+    return np.minimum(np.minimum(along, across), np.minimum(x, y))
 
 
 def free_travels(sweeps: list[tuple[Body, float, bool]], step: float = 1.0) -> np.ndarray:
@@ -114,12 +135,12 @@ def free_travels(sweeps: list[tuple[Body, float, bool]], step: float = 1.0) -> n
         body, wheel, _ = sweeps[j]
         robot, (x, y, hh) = body.robot, body.pose
         wb = robot.wheelbase
-        hl[r], hw[r] = robot.length / 2 + body.radius, robot.width / 2 + body.radius
+        hl[r], hw[r] = robot.length / 2, robot.width / 2
         delta = wheel - robot.steering_straight
         h[r], k[r], half[r] = hh, -math.tan(math.radians(delta)) / wb, wb / 2
         a[r], b[r] = x - wb / 2 * math.cos(hh), y - wb / 2 * math.sin(hh)
         sin_h[r], cos_h[r] = math.sin(hh), math.cos(hh)
-        disc[r] = math.hypot(float(hl[r, 0]), float(hw[r, 0])) + 1e-6
+        disc[r] = math.hypot(float(hl[r, 0]), float(hw[r, 0])) + body.radius * math.sqrt(2) + 1e-6
     hk = h + k * u
     c, s = np.cos(hk), np.sin(hk)
     turning = np.abs(k[:, 0]) > 1e-9
@@ -147,8 +168,8 @@ def free_travels(sweeps: list[tuple[Body, float, bool]], step: float = 1.0) -> n
     p[~np.take_along_axis(swept, order, axis=1)] = 1e12
     dx, dy = p[..., 0, None] - cx[:, None], p[..., 1, None] - cy[:, None]    # [n, P, K]
     c, s = c[:, None], s[:, None]
-    depth = np.minimum(hl[..., None] - np.abs(dx * c + dy * s),
-                       hw[..., None] - np.abs(dy * c - dx * s))
+    rad = np.array([sweeps[j][0].radius for j in rows])[:, None, None]
+    depth = _depth(dx, dy, c, s, hl[..., None], hw[..., None], rad)
     inside = depth >= 0
     back = np.array([sweeps[j][2] for j in rows])
     if back.any():      # backing: a cell touched at the start blocks only deeper steps
@@ -200,8 +221,8 @@ class Recovery:
 @dataclass(frozen=True)
 class Body:
     """What the guard needs of one robot at one tick: its pose (x, y in, heading rad), its
-    wheel's angle now (deg), the cells it knows are occupied near it (``[P, 2]``, discs of
-    ``radius``), the side its route lies on (``heading`` input: positive right) and how far
+    wheel's angle now (deg), the cells it knows are occupied near it (``[P, 2]``, squares of
+    half side ``radius``), the side its route lies on (``heading`` input: positive right) and how far
     along its arc its brake looks (:func:`reach_of`)."""
 
     robot: Robot
@@ -211,6 +232,7 @@ class Body:
     radius: float
     route_side: float
     reach: float = Settings.reach
+    speed: float = 0.0                 # in/s: how fast it drives now
 
     def free(self, wheel: float, backward: bool, cfg: Settings) -> float:
         """Free travel with the wheel at ``wheel`` (deg, 90 straight), forward or backward."""
@@ -245,6 +267,13 @@ def guard(command: tuple[float, float], body: Body, rec: Recovery, dt: float,
     steer, want = command
     wheel = _wheel(steer, body, dt)
     limit = brake(free(wheel, want < 0), robot.acceleration, cfg.margin, dt)
+    slowest = max(abs(body.speed) - robot.acceleration * dt, 0.0)
+    if limit < slowest and wheel != body.wheel:
+        # turning the wheel puts what it would hit nearer than it can stop: hold the wheel
+        # where it is when that arc leaves more room
+        hold = brake(free(body.wheel, want < 0), robot.acceleration, cfg.margin, dt)
+        if hold > limit:
+            steer, limit = body.wheel, hold
     speed = math.copysign(limit, want) if abs(want) > limit else want
     rec.held = rec.held + dt if abs(want) > cfg.want and limit < cfg.want else 0.0
     if rec.held < cfg.patience or robot.max_reverse <= 0:
