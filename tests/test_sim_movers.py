@@ -197,6 +197,30 @@ def test_a_robot_keeps_right_of_what_comes_down_its_lane_with_room():
     assert beside is not None and beside.keep_right is None     # not in its lane
 
 
+@pytest.mark.parametrize("y, squeeze", [(12.0, True), (2.0, False), (-12.0, False)])
+def test_a_robot_squeezes_right_of_what_comes_down_its_lane_on_its_left(y, squeeze):
+    """Where keeping right with room is not possible, a robot whose oncoming mover comes on
+    its left squeezes past on its right (``Sweep.left``) rather than cross in front of it; one
+    dead ahead or on its right may be passed on either side."""
+    shape, res, origin = (40, 120), 2.0, (-20.0, -40.0)
+    m = movers.Mover(np.array([100.0, y]), np.array([-30.0, 0.0]), 5.0, settled=False)
+    sw = movers.sweep([m], np.array([0.0, 0.0]), 0.0, 24, 18, shape, res, origin, room=3.5)
+    assert sw is not None and sw.keep_right is not None
+    assert (sw.left is not None) == squeeze
+    if squeeze:
+        assert not (sw.left & ~sw.keep_right).any()         # keep_right without the room
+
+
+def test_two_robots_that_meet_do_not_swerve_across_each_others_way():
+    """`multirobot` run 1006 of `--runs 100 --seed 1000`: the oncoming robot, unable to keep
+    right of the other with room, planned its way across in front of it, and the two met
+    (both collided at 10.95 s); it now squeezes past on its right and both arrive."""
+    from mitos_cli.sim.worldfile import load_world
+
+    world = load_world(Path(__file__).resolve().parents[1] / "worlds" / "multirobot.yaml")
+    assert simulate(world, None, 1006, randomise=True).robot_outcomes == ("success", "success")
+
+
 @settings(max_examples=60, deadline=None)
 @given(ax=st.floats(-50, 150), ay=st.floats(-50, 150), bx=st.floats(-50, 150),
        by=st.floats(-50, 150), radius=st.floats(0.5, 40))

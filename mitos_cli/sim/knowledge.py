@@ -557,7 +557,8 @@ def _past_movers(rmap: RobotMap, moving: movers.Sweep, plan: Planner, p: np.ndar
                  goal: Goal, start: Pose, clearance: float, minimum: float, sight: float,
                  behind: float) -> Route | None:
     """A route to the goal clear of where the movers will pass (but round the robot), right
-    of those down its lane where there is room; where there is none, a route to a refuge,
+    of those down its lane where there is room (without it, where one comes on the robot's
+    left: :attr:`.movers.Sweep.left`); where there is none, a route to a refuge,
     and the robot at a refuge waits there till nothing comes toward it; ``None`` when
     neither is left. ``plan(where, occupied)``: :func:`_plan` from the robot."""
     hole = max(clearance + 6.0, moving.wide + 6.0)
@@ -565,6 +566,8 @@ def _past_movers(rmap: RobotMap, moving: movers.Sweep, plan: Planner, p: np.ndar
     new = None
     if rmap.refuge is None and moving.keep_right is not None:
         new = plan(goal, occupied | _holed(rmap.grid, moving.keep_right, p, hole))
+        if new is None and moving.left is not None:     # right of it, squeezing past
+            new = plan(goal, occupied | _holed(rmap.grid, moving.left, p, hole))
     if rmap.refuge is None and new is None:
         new = plan(goal, occupied)
     if new is not None:

@@ -22,7 +22,10 @@ as the object and ``HALF_WIDTH`` at least (a sonar ring sees one or two echoes o
 its middle, not its edges): to ``PAST`` body lengths past the robot once its heading is
 known (``SETTLE`` s of track); and while it comes down the robot's lane, straight at the
 robot. Replanning (:func:`.knowledge.replan`) keeps the route clear of it, keeping right
-of what comes down the robot's lane where there is room; where no way to the goal is left,
+of what comes down the robot's lane where there is room (and, where that mover comes on the
+robot's left, squeezing past on the right without the room rather than crossing in front of
+it: two robots that met swerved across each other's way);
+where no way to the goal is left,
 it sends the robot to the nearest place out of its way (a *refuge*), and the robot waits
 there until nothing comes toward it: planning in time, in the simplest form a route can
 say.
@@ -76,6 +79,9 @@ class Sweep:
     cells: np.ndarray                       # bool [rows, cols]
     wide: float                             # in
     keep_right: np.ndarray | None = None    # bool [rows, cols]
+    # keep_right without the room, where a mover comes down the lane on the robot's left:
+    # the robot squeezes past on its right rather than cross the mover's way
+    left: np.ndarray | None = None          # bool [rows, cols]
 
 
 @dataclass
@@ -335,7 +341,9 @@ def sweep(found: list[Mover], robot: np.ndarray, heading: float, length: float, 
     """The cells of a map (``shape``, ``resolution``, ``origin``) that the movers ``found``
     will sweep while the robot (see :func:`swept`) gets out of their way; ``None`` when
     none. With movers in its lane, :attr:`Sweep.keep_right` too: the same ways ``room``
-    wider, and the robot's left of those movers up to ``far``. A robot ``waiting`` at a
+    wider, and the robot's left of those movers up to ``far``; and :attr:`Sweep.left`, the
+    robot's left alone, when one of them comes on its left (:func:`_on_left`). A robot
+    ``waiting`` at a
     refuge waits while anything is ``found`` (an empty sweep): a mover whose heading is not
     known yet sweeps nothing once the robot has turned out of its lane for the refuge, and
     it comes on all the same."""
@@ -352,7 +360,17 @@ def sweep(found: list[Mover], robot: np.ndarray, heading: float, length: float, 
             left |= left_cells(shape, resolution, origin, robot, m.centre, HALF_WIDTH, far)
     if not wide and not (waiting and found):
         return None
-    return Sweep(cells, wide, (left | roomy) if left.any() else None)
+    return Sweep(cells, wide, (left | roomy) if left.any() else None,
+                 left if left.any() and any(_on_left(m, robot, heading, width) for m in found)
+                 else None)
+
+
+def _on_left(m: Mover, robot: np.ndarray, heading: float, width: float) -> bool:
+    """Whether ``m`` comes down the robot's lane on its left, half a body width or more off
+    its line: going left of it would cross its way."""
+    rel = m.centre - robot
+    return (lane(m, robot, heading, width)
+            and math.cos(heading) * rel[1] - math.sin(heading) * rel[0] >= width / 2)
 
 
 def capsule_cells(shape: tuple[int, int], resolution: float, origin: tuple[float, float],
