@@ -387,13 +387,15 @@ def test_a_robot_that_stopped_is_corrected_only_up_to_its_stop():
     said = []
     s = Session(default_rulebase_path(), out=said.append)
     s.run("use drive")
-    s.run("simulate multirobot robot oncoming")
+    s.run("simulate multirobot")
+    first = min(s.simulation.result.robot_metrics, key=lambda m: m["time_s"])["name"]
+    s.run(f"simulate multirobot robot {first}")
     rec = s.simulation
-    own = rec.result.robot_metrics[1]
+    own = rec.result.robot_metrics[rec.robot]
     assert rec.end < float(rec.t[-1])                   # the other robot drives on
     assert f"success after {own['time_s']:g} s" in said[-1]
     assert f"(0 to {rec.end:g} s)" in said[-1]
-    with pytest.raises(LessonError, match="robot oncoming's run lasted 0 to"):
+    with pytest.raises(LessonError, match=f"robot {first}'s run lasted 0 to"):
         s.run(f"at {float(rec.t[-1]):g}s steering=80")
     s.run(f"at {rec.end:g}s steering=80")               # its last tick is still its own
 
