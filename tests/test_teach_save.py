@@ -91,11 +91,14 @@ def test_changed_numbers_only(rules, tmp_path):
     assert variables(again) == variables(s.rulebase)
 
 
+#: a term set of one input (LO, HI) and one crisp output, for the crisp and unlabelled rules
+LO_HI = ("variables:\n  x: {role: input, universe: [0, 10], terms: {"
+         "LO: {shape: left_shoulder, points: [2, 8]}, HI: {shape: right_shoulder, "
+         "points: [2, 8]}}}\n  y: {role: output, universe: [0, 100], terms: {A: 0}}\n")
+
+
 def test_crisp_consequents_are_edited_in_place(tmp_path):
-    (tmp_path / "t.terms.yaml").write_text(
-        "variables:\n  x: {role: input, universe: [0, 10], terms: {"
-        "LO: {shape: left_shoulder, points: [2, 8]}, HI: {shape: right_shoulder, "
-        "points: [2, 8]}}}\n  y: {role: output, universe: [0, 100], terms: {A: 0}}\n")
+    (tmp_path / "t.terms.yaml").write_text(LO_HI)
     (tmp_path / "t.rules").write_text(
         'terms "t.terms.yaml"\n# comment\nr1: if x is LO\n   then y is 20   # low\n'
         "r2: if x is HI then y is 80\n")
@@ -114,10 +117,7 @@ def test_crisp_consequents_are_edited_in_place(tmp_path):
 def test_unlabelled_rules_are_saved_in_their_places(tmp_path):
     """Labels are optional: an unlabelled rule is edited where it stands, and a rule told
     without a label is added once, not every unlabelled rule of the file again."""
-    (tmp_path / "t.terms.yaml").write_text(
-        "variables:\n  x: {role: input, universe: [0, 10], terms: {"
-        "LO: {shape: left_shoulder, points: [2, 8]}, HI: {shape: right_shoulder, "
-        "points: [2, 8]}}}\n  y: {role: output, universe: [0, 100], terms: {A: 0}}\n")
+    (tmp_path / "t.terms.yaml").write_text(LO_HI)
     (tmp_path / "t.rules").write_text(
         'terms "t.terms.yaml"\nbehavior b:\n    if x is LO then y is 20   # low\n'
         "    if x is HI then y is 80\nend\n")
