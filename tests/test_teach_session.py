@@ -316,6 +316,20 @@ def test_simulate_and_at_and_their_mistakes(rules, tmp_path):
         s.run("adapt epochs 3 plot a.gif")
 
 
+def test_a_world_driven_with_another_behavior_than_its_own_says_so(rules):
+    """A new session's behavior is the file's first (`avoid_obstacle`): Figure 4 then ends
+    after 2 s, not at B; the verdict says which behavior `mitos simulate` drives it with."""
+    s, out = session(rules)
+    text = say(s, out, "simulate figure4")
+    assert text.startswith("figure4 with behavior avoid_obstacle: collision after 2.2 s")
+    assert text.endswith("(`mitos simulate` drives figure4 with behavior drive: `use drive` "
+                         "to drive it so here)")
+    s.run("use drive")
+    text = say(s, out, "simulate figure4")
+    assert text.startswith("figure4 with behavior drive: collision after 14.7 s")
+    assert "mitos simulate" not in text
+
+
 def test_simulating_a_behavior_that_cannot_drive_says_use_at_the_prompt(rules):
     """"simulate a behavior such as `drive` (--behavior)": at the prompt there is no
     --behavior; a behavior is chosen with `use`."""

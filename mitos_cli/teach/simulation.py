@@ -79,7 +79,17 @@ class Recording:
         return (f"{self.name}{who} with behavior {self.behavior}: {s['outcome']} after "
                 f"{s['time_s']:g} s (min clearance {clearance(s['min_clearance_in'])} in, "
                 f"{plural(s['collisions'], 'collision')}); "
-                f"correct it with `at TIME OUTPUT=VALUE` (0 to {self.end:g} s)")
+                f"correct it with `at TIME OUTPUT=VALUE` (0 to {self.end:g} s)" + self._whose())
+
+    def _whose(self) -> str:
+        """A note when the session drove the world with another behavior than the one
+        ``mitos simulate`` drives it with (the file's first behavior is rarely a driver: a new
+        session's `avoid_obstacle` hits Figure 4's first obstacle after 2 s)."""
+        own = self.result.world.behavior
+        if own == self.behavior:
+            return ""
+        return (f"\n  (`mitos simulate` drives {self.name} with behavior {own}: "
+                f"`use {own}` to drive it so here)")
 
     def rows(self, start: float, stop: float | None) -> np.ndarray:
         """Tick rows at ``start`` (the nearest) or from ``start`` to ``stop``."""
