@@ -198,8 +198,42 @@ def test_runs_print_a_table_of_rates(short):
     table = run(short, "--runs", 2, "--workers", 1).stdout
     assert "success" in table.splitlines()[0] and "±" in table
     # the short world times out: the figures are over every run, each until it ended
-    assert ("(time, path, min clear and speed: mean ± standard deviation over every run, a "
-            "collision's or a timeout's until it ended;") in " ".join(table.split())
+    assert ("(time, path, min clear, speed, replans and backed out: mean ± standard deviation "
+            "over every run, a collision's or a timeout's until it ended;") in " ".join(
+                table.split())
+
+
+def test_runs_report_replans_and_backouts_beside_the_other_figures(short):
+    """A run's summary says `replans` and `backed out`; `--runs` said neither, in its table
+    or in its JSON (only each run's own summary, under runs_detail, had them)."""
+    rows = json.loads(run(short, "--runs", 3, "--workers", 1, "--json").stdout)
+    detail = rows[0]["runs_detail"]
+    for key in ("replans", "backouts"):
+        counts = [s[key] for s in detail]
+        assert rows[0][key] == {"mean": pytest.approx(np.mean(counts)),
+                                "std": pytest.approx(np.std(counts, ddof=1))}
+    table = run(short, "--runs", 3, "--workers", 1).stdout.splitlines()
+    assert table[0].split()[-3:] == ["replans", "backed", "out"]
+    assert len({len(line) for line in table[:2]}) == 1          # the columns line up
+
+
+def test_the_runs_table_shows_replans_and_backouts_as_mean_and_spread():
+    from mitos_cli.cli.simulate_cmd import _runs_table
+    from mitos_cli.sim.runs import Runs, WorldRuns
+
+    def summary(outcome: str, replans: int, backouts: int) -> dict:
+        return {"outcome": outcome, "time_s": 10.0, "path_length_in": 300.0,
+                "min_clearance_in": 3.0, "mean_speed_in_s": 30.0,
+                "steering_total_variation_deg": 10.0, "replans": replans, "backouts": backouts}
+
+    runs = Runs((WorldRuns("w", (summary("success", 2, 0), summary("timeout", 6, 4),
+                                 summary("success", 1, 0))),))
+    head, row, *note = _runs_table(runs).splitlines()
+    assert row.endswith("  3.0 ± 2.6   1.3 ± 2.3")
+    assert head.endswith("  replans  backed out") and len(head) == len(row)
+    assert "replans and backed out: mean ± standard deviation over every run" in " ".join(note)
+    one = Runs((WorldRuns("w", (summary("success", 2, 1),)),))
+    assert _runs_table(one).splitlines()[1].endswith("      2.0         1.0")
 
 
 def test_too_many_runs_is_a_usage_error_not_a_full_memory(short):
@@ -275,7 +309,10 @@ def test_the_verdict_prints_a_clearance_on_the_side_of_the_margin_it_lies():
 def test_one_run_shows_no_spread():
     out = CliRunner().invoke(app, ["simulate", "corridor.yaml", "--runs", "1"]).stdout
     row = out.splitlines()[1].split()
-    assert "±" not in out and row[0] == "corridor" and float(row[-1]) > 0
+    assert "±" not in out and row[0] == "corridor" and float(row[-3]) > 0     # the speed
+    (run,) = json.loads(CliRunner().invoke(app, ["simulate", "corridor.yaml", "--runs", "1",
+                                                 "--json"]).stdout)[0]["runs_detail"]
+    assert row[-2:] == [f"{run['replans']:.1f}", f"{run['backouts']:.1f}"]
 
 
 @pytest.mark.parametrize("option", [["--speed", "nan"], ["--fps", "nan", "--animate", "a.gif"]])

@@ -163,8 +163,13 @@ def test_runs_count_a_run_a_success_only_if_every_robot_succeeded(rear_end):
     table = run(rear_end, "--runs", 2, "--workers", 1).splitlines()
     assert [line.split()[0] for line in table] == ["world", "rearend", "robot", "second",
                                                    "(time,"]           # the means' footnote
-    assert table[-1].startswith("(time, path, min clear and speed: mean ± standard deviation "
-                                "over every run, a collision's or a timeout's until it ended")
+    assert table[-1].startswith("(time, path, min clear, speed, replans and backed out: mean ± "
+                                "standard deviation over every run, a collision's or a "
+                                "timeout's until it ended")
+    for r in [row, *row["robots"]]:                   # each robot's counts, and the world's sum
+        assert set(r["replans"]) == set(r["backouts"]) == {"mean", "std"}
+    assert row["replans"]["mean"] == pytest.approx(
+        sum(r["replans"]["mean"] for r in row["robots"]))
     assert table[1].split()[2:4] == ["0%", "100%"] and table[2].split()[2] == "100%"
 
 

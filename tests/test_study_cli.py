@@ -60,6 +60,7 @@ def test_compare_writes_table_csv_and_report(tiny, tmp_path, compare):
     assert "Outcomes per world and choice" in r.stdout and "Ranking" in r.stdout
     header = next(line for line in r.stdout.splitlines() if "success" in line)
     assert all(word in header for word in ("collision", "timeout", "stuck"))   # sum to 100%
+    assert header.split()[-3:] == ["replans", "backed", "out"]
     for label in ("fuzzy and=min", "fuzzy and=product", "potential_field"):
         assert label in r.output
     rows = read_rows(out)
@@ -67,6 +68,7 @@ def test_compare_writes_table_csv_and_report(tiny, tmp_path, compare):
         "success", "collision", "timeout", "stuck"}
     report = (out / "report.md").read_text()
     assert "Paired comparison" in report and "| fuzzy and=min |" in report
+    assert "| steering TV (deg) * | replans | backed out |" in report
     assert (out / "success.png").stat().st_size > 1000
     assert (out / "clearance.png").stat().st_size > 1000
     # paired: every choice drove run r with the same seed
@@ -74,6 +76,23 @@ def test_compare_writes_table_csv_and_report(tiny, tmp_path, compare):
     for row in rows:
         seeds.setdefault(row["run"], set()).add(row["seed"])
     assert all(len(s) == 1 for s in seeds.values())
+
+
+def test_each_row_has_the_replans_and_backouts_of_its_run(tiny, tmp_path, compare):
+    """results.csv had no replans or backouts: a row carries its run's, the very figures
+    `mitos simulate WORLD --seed SEED --randomise` prints for it."""
+    from mitos_cli.sim import load_world, simulate
+    from mitos_cli.sim.planner import make_planner
+
+    out = tmp_path / "study"
+    r = compare(tiny, "--planner", "dwa", "--runs", 2, "-o", out, "-j", 1, "--no-plots")
+    assert r.exit_code == 0, r.output
+    world = load_world(tiny)
+    for row in read_rows(out):
+        alone = simulate(world, make_planner("dwa", world), int(row["seed"]), randomise=True)
+        assert (row["outcome"], float(row["time_s"]), int(row["replans"]),
+                int(row["backouts"])) == (alone.outcome, alone.metrics["time_s"],
+                                          alone.metrics["replans"], alone.metrics["backouts"])
 
 
 def test_real_simulator_pool_equals_serial(tiny, tmp_path):

@@ -30,7 +30,8 @@ def fake_sim(task, log=None) -> dict:
             "time_s": float(10 + rng.random() * 5), "path_length_in": float(300 + rng.random()),
             "min_clearance_in": float(rng.normal(8, 2)) / 3.0,
             "mean_speed_in_s": float(30 + rng.random()),
-            "steering_total_variation_deg": float(rng.random() * 100), "ticks": 200}
+            "steering_total_variation_deg": float(rng.random() * 100), "ticks": 200,
+            "replans": int(u * 4), "backouts": int(outcome == "timeout")}
 
 
 class Crash(Exception):
@@ -237,7 +238,7 @@ def test_hand_edited_results_are_reported(tmp_path):
     path.write_text("".join(lines[:2]) + "w1.yaml,fuzzy,min\n")
     with pytest.raises(StudyError) as exc:
         ResultStore(tmp_path).load()
-    assert "results.csv:3: expected 15 values, found 3" in exc.value.message
+    assert "results.csv:3: expected 17 values, found 3" in exc.value.message
     path.write_text("world,oops\n")
     with pytest.raises(StudyError) as exc:
         ResultStore(tmp_path).load()
@@ -266,6 +267,37 @@ def test_summaries_and_ranking():
     t = s[0]
     assert t.metrics["time_s"].n == t.rates["success"].k
     assert t.metrics["min_clearance_in"].n == t.n
+    # replans and backouts count over every run, as the collisions are counted
+    mine = [r for r in rows if r["world"] == t.world and r["planner"] == t.choice.planner
+            and r["and"] == t.choice.and_]
+    for key in ("replans", "backouts"):
+        assert t.metrics[key].n == t.n
+        assert t.metrics[key].mean == pytest.approx(np.mean([r[key] for r in mine]))
+
+
+def test_results_carry_replans_and_backouts_as_whole_numbers(tmp_path):
+    outcome = run_study(small_study(runs=2), tmp_path, workers=1, task_fn=fake_sim)
+    header = (tmp_path / "results.csv").read_text().splitlines()[0].split(",")
+    assert header[-2:] == ["replans", "backouts"]
+    back = ResultStore(tmp_path).load()
+    assert back == outcome.rows and {type(r[k]) for r in back for k in header[-2:]} == {int}
+
+
+def test_results_of_the_version_before_replans_are_refused_as_such(tmp_path):
+    """A results.csv written before the rows had replans and backouts: resuming it would
+    report them over part of the runs; it is refused, saying why (not "not a results file")."""
+    run_study(small_study(runs=1), tmp_path, workers=1, task_fn=fake_sim)
+    path = tmp_path / "results.csv"
+    old = ["".join(line.rsplit(",", 2)[:1]) for line in path.read_text().splitlines()]
+    path.write_text("\n".join(old) + "\n")
+    before = {p.name: p.read_bytes() for p in tmp_path.iterdir()}
+    with pytest.raises(StudyError) as exc:
+        run_study(small_study(runs=1), tmp_path, workers=1, resume=True, task_fn=fake_sim)
+    assert exc.value.message == (f"{path} was written by an earlier version of mitos: its "
+                                 f"rows have no replans and backouts, which this version "
+                                 f"reports for every run")
+    assert exc.value.hint == "run the study again in another directory with -o"
+    assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before
 
 
 def test_non_numeric_value_in_results(tmp_path):

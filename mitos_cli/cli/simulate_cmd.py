@@ -92,19 +92,24 @@ def _summary(res) -> str:
     return _table(rows)
 
 
+_RUNS_FIGURES = (   # heading, key: the runs table's figures, each a mean (± std) over the runs
+    ("time s", "time_s"), ("path in", "path_length_in"), ("min clear in", "min_clearance_in"),
+    ("speed in/s", "mean_speed_in_s"), ("replans", "replans"), ("backed out", "backouts"))
+
+
 def _runs_table(runs) -> str:
     """One row per world; under a world of several robots, one row per robot (its outcome
     rates and figures: the world's row counts a run a success only if every robot's was)."""
     outcomes = ["success", "collision", "timeout", "stuck"]
     if any(w.robots for w in runs.worlds):         # a robot's own outcome may be `stopped`
         outcomes.append("stopped")
-    head = ["world", "runs", *outcomes, "time s", "path in", "min clear in", "speed in/s"]
+    head = ["world", "runs", *outcomes, *(h for h, _ in _RUNS_FIGURES)]
     rows = [head]
     for w in runs.worlds:
         for label, r in [(w.world, w)] + [(f"  {x.world}", x) for x in w.robots]:
             row = [label, str(len(r.summaries))]
             row += [f"{100 * r.rate(o):.0f}%" if o in r.outcomes else "-" for o in outcomes]
-            for key in ("time_s", "path_length_in", "min_clearance_in", "mean_speed_in_s"):
+            for _, key in _RUNS_FIGURES:
                 mean, std = r.stat(key)
                 row.append(f"{mean:.1f}" if len(r.summaries) == 1 else f"{mean:.1f} ± {std:.1f}")
             rows.append(row)
@@ -123,7 +128,8 @@ def _runs_footnote(runs) -> str:
     if not (spread or failed):
         return ""
     what = "mean ± standard deviation" if spread else "means"
-    note = f"\n(time, path, min clear and speed: {what} over {'every run' if failed else 'the runs'}"
+    note = (f"\n(time, path, min clear, speed, replans and backed out: {what} over "
+            f"{'every run' if failed else 'the runs'}")
     if failed:
         note += (", a collision's or a timeout's until it ended; `mitos compare` takes time and "
                  "path over the successful runs")

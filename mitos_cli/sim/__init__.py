@@ -10,9 +10,10 @@ API (everything in inches, seconds, degrees)::
     result.outcome          # "success" | "collision" | "timeout" | "stuck"
                             # (a robot's own, in result.robot_outcomes: also "stopped")
     result.summary()        # the --json dict: world, seed, outcome, reached_goal, collisions,
-                            # time_s, path_length_in, min_clearance_in, mean_speed_in_s,
-                            # steering_total_variation_deg, ticks (over all robots), and with
-                            # several robots `robots`: each one's (result.robot_metrics)
+                            # time_s, path_length_in, min_clearance_in, replans, backouts,
+                            # mean_speed_in_s, steering_total_variation_deg, ticks (over all
+                            # robots), near_miss, and with several robots `robots`: each
+                            # one's (result.robot_metrics)
     result.t, result.pose[T, n, 3], result.speed[T, n], result.steering[T, n],
     result.command[T, n, 2], result.ranges[T, n, B], result.clearance[T, n],
     result.perceived["road"][T, n], result.true["road"][T, n], result.obstacles[T, O, 2]
@@ -28,7 +29,8 @@ API (everything in inches, seconds, degrees)::
                             # together: one rule evaluation per tick for all, each run's bits
                             # those it has alone (Lockstep: the same, a tick at a time)
     runs = run_many([world], runs=20, seed=1, planner=None, workers=2)   # randomised runs
-    runs.to_json()          # per world: outcome rates, each metric's mean and std
+    runs.to_json()          # per world: outcome rates, each metric's mean and std (replans
+                            # and backouts too), every run's summary under runs_detail
     runs.worlds[0].rate("success"), runs.worlds[0].robots   # (several robots: each one's)
 
 Modules: ``world`` (model), ``worldfile`` (YAML loader), ``pgm`` + ``gridmap`` (ROS map_server

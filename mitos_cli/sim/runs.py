@@ -22,8 +22,10 @@ from .lockstep import run_lockstep
 from .loop import OUTCOMES, ROBOT_OUTCOMES, check_seed, shared_scene
 from .world import World
 
+#: each run's figures whose mean and std ``--runs`` reports (``replans`` and ``backouts``
+#: are counts: routes planned again, and times a robot backed out)
 METRICS = ("time_s", "path_length_in", "min_clearance_in", "mean_speed_in_s",
-           "steering_total_variation_deg")
+           "steering_total_variation_deg", "replans", "backouts")
 
 
 def _chunk(task: tuple) -> tuple[int, list[dict]]:

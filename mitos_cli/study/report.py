@@ -12,7 +12,8 @@ from .summary import ALL_WORLDS, METRICS, Rank, Summary
 
 RATE_COLUMNS = (("success", "success"), ("collision", "collision"), ("timeout", "timeout"),
                 ("stuck", "stuck"))
-TABLE_METRICS = ("time_s", "path_length_in", "min_clearance_in", "steering_total_variation_deg")
+TABLE_METRICS = ("time_s", "path_length_in", "min_clearance_in", "steering_total_variation_deg",
+                 "replans", "backouts")
 
 
 def fmt_rate(r: Rate, ci: bool = True) -> str:
@@ -46,7 +47,7 @@ def fmt_p(p: float | None) -> str:
 def _metric_heading(field: str) -> str:
     for f, label, unit, which in METRICS:
         if f == field:
-            return f"{label} ({unit})" + (" *" if which == "success" else "")
+            return label + (f" ({unit})" if unit else "") + (" *" if which == "success" else "")
     raise KeyError(field)
 
 
@@ -75,7 +76,8 @@ def _compact_mean(m: Mean) -> str:
 
 
 TERMINAL_HEADINGS = {"time_s": "time s*", "path_length_in": "path in*",
-                     "min_clearance_in": "clear in", "steering_total_variation_deg": "steer TV*"}
+                     "min_clearance_in": "clear in", "steering_total_variation_deg": "steer TV*",
+                     "replans": "replans", "backouts": "backed out"}
 
 
 def rich_tables(summaries: list[Summary], ranks: list[Rank]):
@@ -192,7 +194,8 @@ def render_markdown(manifest: dict, summaries: list[Summary], ranks: list[Rank],
         "## Outcomes per world and choice",
         "",
         "Rates with the Wilson 95% interval; metrics as mean ± std [95% t interval]. "
-        "Columns marked * use successful runs only; minimum clearance uses all runs.",
+        "Columns marked * use successful runs only; minimum clearance, replans and backed "
+        "out (times a robot backed out) use all runs.",
         "",
         outcome_table_md(summaries),
         "",

@@ -22,13 +22,18 @@ from ..fileio import bad_byte, read_text, unreadable
 from ..words import plural
 from .spec import KEY_FIELDS, Task
 
-#: what a run reports, in this order, after the key and the seed
+#: what a run reports, in this order, after the key and the seed (``replans``: routes planned
+#: again; ``backouts``: times a robot backed out; both summed over the robots)
 RESULT_FIELDS = ("outcome", "collisions", "time_s", "path_length_in", "min_clearance_in",
-                 "mean_speed_in_s", "steering_total_variation_deg", "ticks")
+                 "mean_speed_in_s", "steering_total_variation_deg", "ticks", "replans",
+                 "backouts")
 FLOAT_FIELDS = frozenset({"time_s", "path_length_in", "min_clearance_in", "mean_speed_in_s",
                           "steering_total_variation_deg"})
-INT_FIELDS = frozenset({"collisions", "ticks", "run", "seed"})
+INT_FIELDS = frozenset({"collisions", "ticks", "run", "seed", "replans", "backouts"})
 COLUMNS = (*KEY_FIELDS, "seed", *RESULT_FIELDS)
+#: the columns of results.csv before it had ``replans`` and ``backouts`` (its rows cannot be
+#: resumed: they lack figures every row of the study's report must have)
+COLUMNS_BEFORE_REPLANS = COLUMNS[:-2]
 OUTCOMES = ("success", "collision", "timeout", "stuck")
 
 
@@ -97,6 +102,11 @@ class ResultStore:
         reader = csv.reader(io.StringIO(text, newline=""))
         try:
             header = next(reader)
+            if tuple(header) == COLUMNS_BEFORE_REPLANS:
+                raise StudyError(f"{self.path} was written by an earlier version of mitos: its "
+                                 f"rows have no replans and backouts, which this version "
+                                 f"reports for every run",
+                                 hint="run the study again in another directory with -o")
             if tuple(header) != COLUMNS:
                 raise StudyError(f"{self.path} is not a results file of this version of mitos",
                                  expected="the columns " + ",".join(COLUMNS),

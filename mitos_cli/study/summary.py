@@ -7,7 +7,10 @@ Which runs each figure uses:
   well a choice drives when it gets there; a run cut short by a collision has a short path and
   little steering, which would read as "better");
 - minimum clearance: all runs (a collision is clearance 0 or less, which is what a safety margin
-  should count).
+  should count);
+- replans and backouts (routes planned again, times a robot backed out): all runs, as the
+  collisions are counted (a run that timed out backing out again and again is what they should
+  show).
 
 Ranking (pooled over all worlds): success rate, higher first; ties by mean time to goal, lower
 first; then by mean minimum clearance, higher first. Because every choice drives the same
@@ -26,13 +29,15 @@ from .store import OUTCOMES
 
 ALL_WORLDS = "all worlds"
 
-#: (field, label, unit, which runs: "success" or "all")
+#: (field, label, unit ("" for a count), which runs: "success" or "all")
 METRICS = (
     ("time_s", "time to goal", "s", "success"),
     ("path_length_in", "path length", "in", "success"),
     ("min_clearance_in", "min clearance", "in", "all"),
     ("steering_total_variation_deg", "steering TV", "deg", "success"),
     ("mean_speed_in_s", "mean speed", "in/s", "success"),
+    ("replans", "replans", "", "all"),
+    ("backouts", "backed out", "", "all"),
 )
 
 
