@@ -130,6 +130,60 @@ def test_trace_every_n_ticks(short):
     assert "rules fired" in res.stdout and "perceived:" in res.stdout and "true:" in res.stdout
 
 
+NOT_RULES = "is not a rule base: no DOF trace, only each tick's pose and inputs)"
+
+
+@pytest.mark.parametrize("planner", ["dwa", "potential_field"])
+def test_trace_of_a_planner_that_is_not_a_rule_base(short, planner):
+    """`--planner dwa --trace` printed one line, "(planner dwa is not a rule base: no DOF
+    trace)": each traced tick has its pose and inputs, as the fuzzy planner's, without the
+    rules, under a line that says so."""
+    res = run(short, "--planner", planner, "--trace", "--every", 20)
+    assert res.exit_code == 0, res.output
+    assert res.stdout.startswith(f"(planner {planner} {NOT_RULES}\n\n--- tick 0, t = 0.00 s: "
+                                 f"robot at (30.0, -10.0) in, pose heading 0.0 deg, speed ")
+    trace = res.stdout[:res.stdout.index("short: ")]
+    ticks = [int(k) for k in re.findall(r"^--- tick (\d+), t = ", trace, re.M)]
+    last = json.loads(run(short, "--planner", planner, "--json").stdout)["ticks"] - 1
+    assert set(ticks) >= {0, 20, 40, last} and ticks == sorted(set(ticks))
+    assert trace.count("\n  perceived: road ") == trace.count("\n  true:      road ") == len(ticks)
+    assert "rules fired" not in trace and "fuzzified" not in trace
+    fewer = run(short, "--planner", planner, "--trace", "--every", 30).stdout     # --every
+    assert set(re.findall(r"^--- tick (\d+), ", fewer, re.M)) >= {"0", "30", str(last)}
+    assert "--- tick 20, " not in fewer
+
+
+@pytest.mark.parametrize("planner", ["fuzzy", "dwa"])
+def test_trace_with_json_goes_to_stderr(short, capsys, planner):
+    with pytest.raises(SystemExit) as info:
+        main(["simulate", str(short), "--planner", planner, "--trace", "--json"])
+    out, err = capsys.readouterr()
+    assert info.value.code in (0, None)
+    assert json.loads(out)["ticks"] > 0                           # stdout: the JSON alone
+    assert err.count("--- tick ") >= 3 and "  perceived: " in err and "  true:      " in err
+    assert ("rules fired" in err) == (planner == "fuzzy") and (NOT_RULES in err) == (
+        planner != "fuzzy")
+
+
+def test_a_trace_without_rules_is_the_fuzzy_trace_without_its_dof_part(short):
+    """The same run traced by a planner that explains (the rules) and by one that does not:
+    each tick's head and inputs are the same lines."""
+    from mitos_cli.sim import load_world, simulate
+    from mitos_cli.sim.export import traces
+    from mitos_cli.sim.planner import FuzzyPlanner
+
+    world = load_world(short)
+    planner = FuzzyPlanner(None, world.behavior)
+    res = simulate(world, planner, world.seed)
+    note, *bare = traces(res, object(), 20).split("\n\n")
+    assert note == f"(planner fuzzy:drive {NOT_RULES}"
+    full = traces(res, planner, 20).split("\n\n--- tick ")
+    assert len(bare) == len(full)
+    for without, block in zip(bare, full):
+        head = block.split("\n\nrule base ")[0]
+        assert without == (head if head.startswith("--- tick ") else "--- tick " + head)
+
+
 def test_require_success_exits_3_when_not_success(short):
     assert run(short, "--require", "success").exit_code == 3
     assert run(short).exit_code == 0

@@ -197,9 +197,10 @@ def simulate_command(
         "--out", "-o", metavar="FILE.csv",
         help="Write one CSV row per tick to FILE.csv (a name ending in .csv).")] = None,
     trace: Annotated[bool, typer.Option(
-        "--trace", help="Print the paper-style DOF trace every --every ticks (of the first "
-                        "robot where there are several; on stderr with --json, which keeps "
-                        "stdout for the JSON).")] = False,
+        "--trace", help="Every --every ticks, print the pose, speed, steering, clearance and "
+                        "perceived vs true inputs, then the paper-style DOF trace (none for a "
+                        "planner that is not a rule base); of the first robot where there are "
+                        "several; on stderr with --json, which keeps stdout for the JSON.")] = False,
     every: Annotated[int, typer.Option("--every", min=1, help="Ticks between traces.")] = 20,
     plot: Annotated[Optional[Path], typer.Option(
         "--plot", metavar="FILE.png|FILE.svg",

@@ -81,32 +81,43 @@ def csv_text(result: SimResult, planner) -> str:
 
 
 def traces(result: SimResult, planner, every: int, digits: int = 1) -> str:
-    """The DOF trace every ``every`` ticks (and at the last tick, and at each tick it
-    replanned) of the first robot, each headed by the time, the pose and the perceived vs true
-    inputs."""
+    """The first robot every ``every`` ticks (and at the last tick, and at each tick it
+    replanned): the time, the pose and the perceived vs true inputs, then the DOF trace. A
+    planner that is not a rule base has no DOF trace: its ticks come without, under a line
+    that says so."""
     from ..engine.trace import trace_of
 
     detail = explain(result, planner, 0)
-    if detail is None:
-        return f"(planner {result.planner} is not a rule base: no DOF trace)"
     replans = {k: route for k, i, route in getattr(result, "replanned", ()) if i == 0}
     ticks = sorted(set(range(0, result.ticks, max(1, every))) | {result.ticks - 1}
                    | set(replans))
-    blocks = []
+    blocks = [] if detail is not None else [
+        f"(planner {result.planner} is not a rule base: no DOF trace, only each tick's pose "
+        f"and inputs)"]
     who = result.world.agents[0].name            # the first robot's trace ("robot" alone)
     for k in ticks:
-        if result.active is not None and not result.active[k, 0]:
+        if k < 0 or result.active is not None and not result.active[k, 0]:
             continue
-        x, y, h = result.pose[k, 0]
-        head = (f"--- tick {k}, t = {result.t[k]:.2f} s: {who} at ({x:.1f}, {y:.1f}) in, pose "
-                f"heading {h:.1f} deg, speed {result.speed[k, 0]:.1f} in/s, steering "
-                f"{result.steering[k, 0]:.1f} deg, clearance {result.clearance[k, 0]:.1f} in")
-        pt = "  perceived: " + ", ".join(f"{key} {result.perceived[key][k, 0]:.1f}"
-                                         for key in INPUTS)
-        tr = "  true:      " + ", ".join(f"{key} {result.true[key][k, 0]:.1f}" for key in INPUTS)
-        lines = [head, pt, tr]
+        lines = [_tick_head(result, k, who), *_inputs_lines(result, k)]
         if k in replans:
             lines.append(f"  replanned: what it sensed lies in the way ahead; the new route "
                          f"runs {replans[k].length:.0f} in to the goal")
-        blocks.append("\n".join([*lines, "", trace_of(detail, k).render(digits)]))
+        if detail is not None:
+            lines += ["", trace_of(detail, k).render(digits)]
+        blocks.append("\n".join(lines))
     return "\n\n".join(blocks)
+
+
+def _tick_head(result: SimResult, k: int, who: str) -> str:
+    """A traced tick's first line: the first robot's time, place, speed, wheel and room."""
+    x, y, h = result.pose[k, 0]
+    return (f"--- tick {k}, t = {result.t[k]:.2f} s: {who} at ({x:.1f}, {y:.1f}) in, pose "
+            f"heading {h:.1f} deg, speed {result.speed[k, 0]:.1f} in/s, steering "
+            f"{result.steering[k, 0]:.1f} deg, clearance {result.clearance[k, 0]:.1f} in")
+
+
+def _inputs_lines(result: SimResult, k: int) -> list[str]:
+    """The inputs the first robot perceived at tick ``k`` and those of the true geometry."""
+    return ["  perceived: " + ", ".join(f"{key} {result.perceived[key][k, 0]:.1f}"
+                                        for key in INPUTS),
+            "  true:      " + ", ".join(f"{key} {result.true[key][k, 0]:.1f}" for key in INPUTS)]
