@@ -117,7 +117,9 @@ def free_travels(sweeps: list[tuple[Body, float, bool]], step: float = 1.0) -> n
     its body's ``reach``; runs in lockstep brake together), ``[R]``. What is one number per
     sweep is worked out as :func:`free_travel` does, in Python floats; the rest elementwise
     over ``[R, K]`` steps (to the farthest reach, a sweep's own steps only counted) and
-    ``[R, P, K]`` cells (padded far away), so a sweep gets the bits it gets alone."""
+    ``[M, K]`` for the ``M`` cells in the sweeps' boxes, each with its sweep's steps (not padded
+    to the sweep with the most: a quarter of the cells would be real), so a sweep gets the bits
+    it gets alone."""
     if len(sweeps) == 1:                 # a robot alone: no batch to set up
         body, wheel, backward = sweeps[0]
         return np.array([free_travel(body.cells, body.radius, body.pose, body.robot,
@@ -153,29 +155,26 @@ def free_travels(sweeps: list[tuple[Body, float, bool]], step: float = 1.0) -> n
     cx, cy = rx + half * c, ry + half * s                      # the footprint's centres
     lo_x, hi_x = cx.min(axis=1) - disc[:, 0], cx.max(axis=1) + disc[:, 0]
     lo_y, hi_y = cy.min(axis=1) - disc[:, 0], cy.max(axis=1) + disc[:, 0]
-    p = np.full((n, max(len(sweeps[j][0].cells) for j in rows), 2), 1e12)
-    for r, j in enumerate(rows):
-        p[r, :len(sweeps[j][0].cells)] = sweeps[j][0].cells
-    px, py = p[..., 0], p[..., 1]                                           # [n, P]
-    swept = ((px >= lo_x[:, None]) & (px <= hi_x[:, None])
-             & (py >= lo_y[:, None]) & (py <= hi_y[:, None]))
-    width = int(np.count_nonzero(swept, axis=1).max())
-    if not width:
+    cells = np.concatenate([sweeps[j][0].cells for j in rows])                # [P, 2]
+    owner = np.repeat(np.arange(n), [len(sweeps[j][0].cells) for j in rows])
+    px, py = cells[:, 0], cells[:, 1]
+    swept = ((px >= lo_x[owner]) & (px <= hi_x[owner])
+             & (py >= lo_y[owner]) & (py <= hi_y[owner]))
+    if not swept.any():
         return out
-    # each row's swept cells first, in their order (the others padded far away)
-    order = np.argsort(~swept, axis=1, kind="stable")[:, :width]
-    p = np.take_along_axis(p, order[..., None], axis=1)
-    p[~np.take_along_axis(swept, order, axis=1)] = 1e12
-    dx, dy = p[..., 0, None] - cx[:, None], p[..., 1, None] - cy[:, None]    # [n, P, K]
-    c, s = c[:, None], s[:, None]
-    rad = np.array([sweeps[j][0].radius for j in rows])[:, None, None]
-    depth = _depth(dx, dy, c, s, hl[..., None], hw[..., None], rad)
+    px, py, owner = px[swept, None], py[swept, None], owner[swept]     # [M, 1], by sweep
+    rad = np.array([sweeps[j][0].radius for j in rows])[owner, None]
+    depth = _depth(px - cx[owner], py - cy[owner], c[owner], s[owner], hl[owner], hw[owner],
+                   rad)                                                           # [M, K]
     inside = depth >= 0
-    back = np.array([sweeps[j][2] for j in rows])
+    back = np.array([sweeps[j][2] for j in rows])[owner]
     if back.any():      # backing: a cell touched at the start blocks only deeper steps
-        inside[back] = np.where(inside[back][..., :1], depth[back] > depth[back][..., :1],
+        inside[back] = np.where(inside[back][:, :1], depth[back] > depth[back][:, :1],
                                 inside[back])
-    hit = inside.any(axis=1) & (np.abs(u) < out[rows, None] + step / 2)    # [n, K], its own
+    hit = np.zeros((n, len(u[0])), dtype=bool)
+    first_of = np.flatnonzero(np.r_[True, owner[1:] != owner[:-1]])     # each sweep's run
+    hit[owner[first_of]] = np.logical_or.reduceat(inside, first_of, axis=0)
+    hit &= np.abs(u) < out[rows, None] + step / 2                        # [n, K], its own
     first = np.maximum(hit.argmax(axis=1) - 1, 0) * step
     out[rows] = np.where(hit.any(axis=1), first, out[rows])
     return out
