@@ -230,7 +230,7 @@ def box_segment_distance(hl: float, hw: float, seg: np.ndarray) -> np.ndarray:
     # a segment can cross the box only if it passes within the box's half diagonal of its
     # centre; clip just those (Liang-Barsky)
     maybe = near[4] <= diagonal
-    if not maybe.any():
+    if not np.count_nonzero(maybe):
         return d
     out = d.copy()
     out[maybe] = _box_crossing(hl, hw, seg[maybe], d[maybe])
@@ -285,7 +285,7 @@ def box_polygon_distance(hl: float, hw: float, poly: np.ndarray,
         side_gaps = box_segment_distance(hl, hw, polygon_segments(poly))
     gap = side_gaps.reshape(len(poly), -1).min(axis=1)
     over = polygon_overlaps(hl, hw, poly, gap)
-    if not over.any():
+    if not np.count_nonzero(over):
         return gap
     out = gap.copy()
     depth = box_polygon_depth(hl, hw, poly[over])

@@ -376,8 +376,9 @@ def clear_all(maps: list[RobotMap], origins: np.ndarray, dirs: np.ndarray,
         rx, ry = rel[:, 0, None], rel[:, 1, None]                  # [P, 1]
         dx, dy = dirs[i, :, 0], dirs[i, :, 1]                      # [B]
         along = rx * dx + ry * dy
-        through = ((along > 0) & (along < np.minimum(measured[i], max_range) - res)
-                   & (np.abs(rx * dy - ry * dx) < res / 2)).any(axis=1)
+        through = np.logical_or.reduce((along > 0) & (along < np.minimum(measured[i], max_range)
+                                                      - res)
+                                       & (np.abs(rx * dy - ry * dx) < res / 2), axis=1)
         if np.count_nonzero(through):
             m._free(where[through], r[through], c[through])
         return
@@ -401,7 +402,7 @@ def _clear_block(seen: list, dirs: np.ndarray, measured: np.ndarray, max_range: 
     across = np.abs(rx * dy - ry * dx)
     cell = np.array([m.grid.resolution for m, _, _ in seen])[:, None, None]
     reach = np.minimum(measured[idx], max_range)[:, None] - cell
-    through = ((along > 0) & (along < reach) & (across < cell / 2)).any(axis=2)
+    through = np.logical_or.reduce((along > 0) & (along < reach) & (across < cell / 2), axis=2)
     for j, (m, _, (where, r, c, pts)) in enumerate(seen):
         mine = through[j, :len(pts)]
         if np.count_nonzero(mine):
@@ -477,7 +478,7 @@ def way_past(rmap: RobotMap, route: Route, s: float, p: np.ndarray, ahead: float
     g = _window(rmap.grid, rmap.occupied, lo, hi)
     room = Clearance.of(g.occupied, g.resolution, g.origin, cap=minimum + 2 * g.resolution)
     beyond = (along >= end) & (room.at(sample) >= minimum)
-    if not beyond.any():
+    if not np.count_nonzero(beyond):
         return False
     target = sample[int(np.argmax(beyond))]
     try:

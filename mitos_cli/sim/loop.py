@@ -497,7 +497,8 @@ class Simulation:
     def ending(self) -> bool:
         """The observed tick ends the run whatever is commanded: a robot touches something or
         every robot is at its goal (False before :meth:`observe`)."""
-        return self._observed is not None and bool(self._hit.any() or not self._active.any())
+        return self._observed is not None and bool(np.count_nonzero(self._hit)
+                                                   or not np.count_nonzero(self._active))
 
     def observe(self, sensed: rows.Sensed | None = None) -> _Sensed:
         """Sense, perceive and check the current tick, once; the next :meth:`step` goes on from
@@ -585,13 +586,13 @@ class Simulation:
         """The end of :meth:`decide`, once the guard has had its say on ``s``'s commands:
         the tick recorded and the verdict."""
         tick = self._record(s)
-        if self._hit.any():
+        if np.count_nonzero(self._hit):
             self._collided = int(self._hit.sum())
             for i in np.flatnonzero(self._hit):
                 self._outcomes[i] = "collision"
             self._stop_the_others()
             self._done = True
-        elif not self._active.any():
+        elif not np.count_nonzero(self._active):
             self._done = True
         else:
             self._deciding = s
@@ -849,7 +850,7 @@ class Simulation:
         runs = movers.objects(hits, seen, self.world.sensors.layout == "ring")
         tested, entered = free.entered(s.t, hits[seen], dirs[seen])
         free.update(s.t, p, dirs, s.ranges[i])
-        at = np.cumsum(seen) - 1                     # a seen beam's place among the seen
+        at = np.add.accumulate(seen, dtype=np.intp) - 1      # a seen beam's place among the seen
         # an object moved when most of its echoes that a beam's line had crossed came where
         # that beam had passed (None: no line crossed any)
         moved = [None if not (n := np.count_nonzero(tested[at[r]]))
@@ -886,7 +887,7 @@ class Simulation:
         wheel, no speed)."""
         cmd = s.command
         cmd[:, 0] = self.limits.straight
-        if self._active.any():
+        if np.count_nonzero(self._active):
             idx = np.flatnonzero(self._active)
 
             def rows(a: np.ndarray) -> np.ndarray:      # a copy of the active robots' rows

@@ -38,6 +38,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .geometry import clip_arrays
+
 LINK = 12.0          # in: echoes of neighbouring beams closer than this are one object
 GATE = 15.0          # in: the farthest an object is matched from its track's predicted place
 WINDOW = 1.5         # s: the track history the velocity is fitted over
@@ -127,7 +129,7 @@ class Track:
         c = np.array(self.centres)[keep]
         i, j = np.triu_indices(len(t), 1)
         far = t[j] - t[i] >= WINDOW / 2
-        if not far.any():
+        if not np.count_nonzero(far):
             return None
         i, j = i[far], j[far]
         return np.median((c[j] - c[i]) / (t[j] - t[i])[:, None], axis=0)
@@ -171,7 +173,7 @@ class Tracker:
             return
         sizes = np.array([len(o) for o in found])
         pts = np.concatenate(found)
-        starts = np.concatenate([[0], np.cumsum(sizes)[:-1]])
+        starts = np.concatenate([[0], np.add.accumulate(sizes)[:-1]])
         centres = np.add.reduceat(pts, starts, axis=0) / sizes[:, None]            # [O, 2]
         spread = np.hypot(*(pts - np.repeat(centres, sizes, axis=0)).T)
         radii = np.maximum.reduceat(spread, starts)                                  # [O]
@@ -282,7 +284,7 @@ class FreeSpace:
         which of those lay short of its echo then (something came where nothing was)."""
         none = np.zeros(len(points), dtype=bool)
         live = (self.times >= now - WINDOW) & (self.times < now)
-        if not len(points) or not live.any():
+        if not len(points) or not np.count_nonzero(live):
             return none, none
         pose, ranges = self.poses[live], self.ranges[live]                  # [J, 3], [J, B]
         q = points + dirs * STEP
@@ -296,12 +298,12 @@ class FreeSpace:
         k = np.rint(bearing / self.step) if self.step else np.zeros_like(bearing)
         k = np.mod(k, beams) if self.ring else k
         inside = (k >= 0) & (k < beams)
-        k = np.clip(k, 0, beams - 1).astype(np.int64)
+        k = clip_arrays(k, 0, beams - 1).astype(np.int64)
         off = np.mod(bearing - k * self.step + np.pi, 2 * np.pi) - np.pi    # from that beam
         reach = ranges[np.arange(len(pose))[None, :], k]                    # [P, J]
         on = inside & (np.abs(off) < np.pi / 2) & (dist * np.abs(np.sin(off)) < self.near)
         passed = on & (dist * np.cos(off) < reach - SHORT)
-        return on.any(axis=1), passed.any(axis=1)
+        return np.logical_or.reduce(on, axis=1), np.logical_or.reduce(passed, axis=1)
 
 
 Capsule = tuple[np.ndarray, np.ndarray, float]     # a segment's two ends and a radius

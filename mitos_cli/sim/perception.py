@@ -181,21 +181,21 @@ def _obstruction_rows(routes: list[Route], frames: list[Frame], a, b, points, va
     size, position = np.zeros(len(routes)), np.zeros(len(routes))
     distance = np.full(len(routes), NO_OBSTACLE)
     ahead = valid & (a > 0) & (a < cfg.sight)
-    if not ahead.any():
+    if not np.count_nonzero(ahead):
         return size, position, distance
     blocking = ahead & (_in_band(b, widen, body["band"])
                         | ((ah > 0) & _in_band(bh, widen, body["band"])))
-    if not blocking.any():
+    if not np.count_nonzero(blocking):
         return size, position, distance
     for i, word in enumerate(kept):     # what the route was planned round obstructs only
         if word is None:                # within its word
             continue
         least, planned = word
         round_ = blocking[i] & planned
-        if round_.any():
+        if np.count_nonzero(round_):
             blocking[i, round_] = (routes[i].distance(points[i, round_], frames[i].s, cfg.sight)
                                    - widen[i, round_] < least)
-    for j in np.flatnonzero(blocking.any(axis=1)):
+    for j in np.flatnonzero(np.logical_or.reduce(blocking, axis=1)):
         size[j], position[j], distance[j] = _object(
             routes[j], frames[j], a[j], points[j], ahead[j], blocking[j], widen[j], robots[j], cfg)
     return size, position, distance
@@ -364,7 +364,7 @@ def clutter_rows(hits: np.ndarray, unknown: np.ndarray, ah: np.ndarray, cfg: Set
                  circular: np.ndarray) -> np.ndarray:
     """:func:`clutter` of every row of points ``[R, K, 2]`` (``circular [R]``)."""
     seen = unknown & (ah > 0) & (ah <= cfg.sight)
-    if not seen.any():
+    if not np.count_nonzero(seen):
         return np.zeros(len(seen))
     before = _previous(hits.shape[1])              # np.roll(..., 1), cheaper
     gap = hits - hits[:, before]
@@ -372,7 +372,7 @@ def clutter_rows(hits: np.ndarray, unknown: np.ndarray, ah: np.ndarray, cfg: Set
     joined = seen & seen[:, before] & close        # point i continues the run of point i - 1
     joined[:, 0] &= circular
     count = np.count_nonzero(seen & ~joined, axis=1)
-    return np.where(seen.any(axis=1), np.maximum(count, 1), 0).astype(float)
+    return np.where(np.logical_or.reduce(seen, axis=1), np.maximum(count, 1), 0).astype(float)
 
 
 @functools.lru_cache(maxsize=8)
@@ -502,7 +502,7 @@ def pursuit_points(aims: list[Aim], cfg: Settings) -> tuple[np.ndarray, np.ndarr
         cells[j, :len(a.cells)] = a.cells
     p = np.stack([a.p for a in have])                                         # [H, 2]
     near = _near_chords(cells, p, q, np.array([a.need + a.radius for a in have]))
-    some = near.any(axis=1).nonzero()[0]
+    some = np.logical_or.reduce(near, axis=1).nonzero()[0]
     if not len(some):
         return out_ahead, targets
     # the rows with cells near their chords, those cells first (the others padded far away)
@@ -541,7 +541,7 @@ def _pursuit_one(a: Aim, ahead: np.ndarray, cfg: Settings) -> tuple[float, np.nd
     t = clip_arrays((rx * e[:, 0] + ry * e[:, 1]) / ee, 0.0, 1.0)             # [P, J]
     clear = _clear_of((rx - t * e[:, 0])[None], (ry - t * e[:, 1])[None],
                       np.full((1, 1), a.radius), np.full((1, 1), a.need))[0]
-    if clear.all():
+    if np.count_nonzero(clear) == clear.size:
         return float(ahead[-1]), q[-1]
     k = max(int(clear.argmin()) - 1, 0)
     return float(ahead[k]), q[k]
@@ -726,7 +726,7 @@ def perceive_rows(rows: list[Sight], max_range: float,
                           obstacle_hit)
     widen = measured * _column([r.spacing for r in rows]) / 2
     obstructing = obstacle_hit | _in_way(rows, known & (a > 0), hits, cfg)
-    if obstructing.any():
+    if np.count_nonzero(obstructing):
         ah, bh = _own_frames_all(headings, rel)
     else:                       # what does not obstruct is not asked where it lies
         ah, bh = valid_ah, valid_bh
@@ -760,10 +760,11 @@ def _in_way(rows: list[Sight], ahead: np.ndarray, hits: np.ndarray, cfg: Setting
     margin of the route within ``sight`` (in a squeeze, nearer than the route keeps: see
     :func:`perceive`). Only the points some row asks about are measured (a point's distance
     from a route is its own arithmetic, whatever else is measured)."""
-    cols = ahead.any(axis=0).nonzero()[0]
+    cols = np.logical_or.reduce(ahead, axis=0).nonzero()[0]
     if not len(cols):
         return ahead
-    some = ahead.any(axis=1).nonzero()[0] if len(rows) > 1 else np.zeros(1, dtype=np.intp)
+    some = (np.logical_or.reduce(ahead, axis=1).nonzero()[0] if len(rows) > 1
+            else np.zeros(1, dtype=np.intp))
     asked = [rows[i] for i in some]
     at = np.s_[:, cols] if len(asked) == len(rows) else np.ix_(some, cols)
     gone = distances([r.route for r in asked], [r.f.s for r in asked], cfg.sight, hits[at])

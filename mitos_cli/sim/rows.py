@@ -286,7 +286,8 @@ def _near(origin: np.ndarray, middle: np.ndarray, radius: np.ndarray,
     """The rows with a disc (``middle [R, D, 2]``, ``radius [R, D]``) within ``reach [R, 1]``
     of their origin."""
     away = middle - origin[:, None]
-    return (np.hypot(away[..., 0], away[..., 1]) - radius <= reach).any(axis=1).nonzero()[0]
+    return np.logical_or.reduce(np.hypot(away[..., 0], away[..., 1]) - radius <= reach,
+                                axis=1).nonzero()[0]
 
 
 @functools.lru_cache(maxsize=16)
@@ -308,8 +309,8 @@ def _walls(rows: list[SenseRow], frames: _Frames, hl: float, hw: float) -> np.nd
     w = box_segment_distance(hl, hw, ends.reshape(-1, 4)).reshape(len(rows), -1)
     real = None if min(counts) == width else np.arange(width) < np.array(counts)[:, None]
     crossing = w <= 0.0 if real is None else real & (w <= 0.0)
-    if crossing.any():
-        for i in crossing.any(axis=1).nonzero()[0]:
+    if np.count_nonzero(crossing):
+        for i in np.logical_or.reduce(crossing, axis=1).nonzero()[0]:
             mine = crossing[i, :counts[i]]
             w[i, :counts[i]][mine] = -box_polygon_depth(hl, hw, ends[i, :counts[i]][mine])
     return (w if real is None else np.where(real, w, np.inf)).min(axis=1, initial=np.inf)
@@ -323,7 +324,7 @@ def _polygons(hl: float, hw: float, boxes: np.ndarray) -> np.ndarray:
     gap = box_segment_distance(hl, hw, polygon_segments(flat)).reshape(R * P, -1).min(axis=1)
     over = polygon_overlaps(hl, hw, flat, gap).reshape(R, P)
     gap = gap.reshape(R, P)
-    for i in np.flatnonzero(over.any(axis=1)):
+    for i in np.flatnonzero(np.logical_or.reduce(over, axis=1)):
         depth = box_polygon_depth(hl, hw, boxes[i][over[i]])
         gap[i, over[i]] = np.where(depth > 0.0, -depth, gap[i, over[i]])
     return gap

@@ -81,7 +81,7 @@ def free_travel(cells: np.ndarray, radius: float, pose: tuple[float, float, floa
     px, py = cells[:, 0], cells[:, 1]
     swept = ((px >= cx.min() - disc) & (px <= cx.max() + disc)
              & (py >= cy.min() - disc) & (py <= cy.max() + disc))
-    if not swept.any():
+    if not np.count_nonzero(swept):
         return reach
     px, py = px[swept, None], py[swept, None]
     dx, dy = px - cx, py - cy
@@ -90,8 +90,8 @@ def free_travel(cells: np.ndarray, radius: float, pose: tuple[float, float, floa
     if backward:    # backing away from a cell the body touches already (a mark a noisy echo
         # put at its edge) is not blocked by it until a step takes the body deeper in
         inside = np.where(inside[:, :1], depth > depth[:, :1], inside)
-    hit = inside.any(axis=0)
-    if not hit.any():
+    hit = np.logical_or.reduce(inside, axis=0)
+    if not np.count_nonzero(hit):
         return reach
     return float(max(int(hit.argmax()) - 1, 0) * step)
 
@@ -168,7 +168,7 @@ def free_travels(sweeps: list[tuple[Body, float, bool]], step: float = 1.0) -> n
                    rad)                                                           # [M, K]
     inside = depth >= 0
     back = np.array([sweeps[j][2] for j in rows])[owner]
-    if back.any():      # backing: a cell touched at the start blocks only deeper steps
+    if np.count_nonzero(back):      # backing: a cell touched at the start blocks only deeper steps
         inside[back] = np.where(inside[back][:, :1], depth[back] > depth[back][:, :1],
                                 inside[back])
     hit = np.zeros((n, len(u[0])), dtype=bool)
@@ -176,7 +176,7 @@ def free_travels(sweeps: list[tuple[Body, float, bool]], step: float = 1.0) -> n
     hit[owner[first_of]] = np.logical_or.reduceat(inside, first_of, axis=0)
     hit &= np.abs(u) < out[rows, None] + step / 2                        # [n, K], its own
     first = np.maximum(hit.argmax(axis=1) - 1, 0) * step
-    out[rows] = np.where(hit.any(axis=1), first, out[rows])
+    out[rows] = np.where(np.logical_or.reduce(hit, axis=1), first, out[rows])
     return out
 
 
