@@ -144,17 +144,18 @@ def objects(hits: np.ndarray, seen: np.ndarray, ring: bool) -> list[np.ndarray]:
     """The beams ``seen`` cut into objects by their echoes ``hits [B, 2]``: runs of
     neighbouring beams (around the ring when ``ring``) whose echoes lie within ``LINK`` of
     each other. Each object is the array of its beams' indices."""
-    idx = np.flatnonzero(seen)
+    idx = seen.nonzero()[0]
     if not len(idx):
         return []
     pts = hits[idx]
     gap = np.hypot(*(pts[1:] - pts[:-1]).T)
-    cut = ((np.diff(idx) > 1) | (gap > LINK)).nonzero()[0] + 1
-    runs = np.split(np.arange(len(idx)), cut)
+    # (slices at the cuts: np.split and np.diff cost more in their Python than the work)
+    ends = [0, *(((idx[1:] - idx[:-1] > 1) | (gap > LINK)).nonzero()[0] + 1).tolist(), len(idx)]
+    runs = [idx[a:b] for a, b in zip(ends[:-1], ends[1:])]
     if ring and len(runs) > 1 and idx[0] == 0 and idx[-1] == len(seen) - 1 \
             and math.dist(pts[0], pts[-1]) <= LINK:
         runs = [np.concatenate([runs[-1], runs[0]])] + runs[1:-1]
-    return [idx[r] for r in runs]
+    return runs
 
 
 @dataclass
@@ -175,15 +176,15 @@ class Tracker:
         pts = np.concatenate(found)
         starts = np.concatenate([[0], np.add.accumulate(sizes)[:-1]])
         centres = np.add.reduceat(pts, starts, axis=0) / sizes[:, None]            # [O, 2]
-        spread = np.hypot(*(pts - np.repeat(centres, sizes, axis=0)).T)
+        spread = np.hypot(*(pts - centres.repeat(sizes, axis=0)).T)
         radii = np.maximum.reduceat(spread, starts)                                  # [O]
         used_t: set[int] = set()
         used_o: set[int] = set()
         if live:
             pred = np.array([tr.predicted(now) for tr in live])                     # [T, 2]
             d = np.hypot(*(pred[:, None] - centres[None]).transpose(2, 0, 1))     # [T, O]
-            tj, oi = np.nonzero(d <= GATE)
-            for k in np.argsort(d[tj, oi], kind="stable"):       # nearest first, each once
+            tj, oi = (d <= GATE).nonzero()
+            for k in d[tj, oi].argsort(kind="stable"):           # nearest first, each once
                 j, i = int(tj[k]), int(oi[k])
                 if j in used_t or i in used_o:
                     continue
@@ -282,9 +283,9 @@ class FreeSpace:
         echo against the beams kept from the last ``WINDOW`` s (before ``now``): which lie on
         the line of one (within ``near``: the robot's map clears a mark the same way), and
         which of those lay short of its echo then (something came where nothing was)."""
-        none = np.zeros(len(points), dtype=bool)
         live = (self.times >= now - WINDOW) & (self.times < now)
         if not len(points) or not np.count_nonzero(live):
+            none = np.zeros(len(points), dtype=bool)
             return none, none
         pose, ranges = self.poses[live], self.ranges[live]                  # [J, 3], [J, B]
         q = points + dirs * STEP
@@ -296,12 +297,17 @@ class FreeSpace:
         bearing = ahead - self.a0
         beams = ranges.shape[1]
         k = np.rint(bearing / self.step) if self.step else np.zeros_like(bearing)
-        k = np.mod(k, beams) if self.ring else k
-        inside = (k >= 0) & (k < beams)
-        k = clip_arrays(k, 0, beams - 1).astype(np.int64)
+        if self.ring:           # every direction has its beam (a NaN would fail the look-up)
+            inside = None
+            k = np.mod(k, beams).astype(np.int64)
+        else:
+            inside = (k >= 0) & (k < beams)
+            k = clip_arrays(k, 0, beams - 1).astype(np.int64)
         off = np.mod(bearing - k * self.step + np.pi, 2 * np.pi) - np.pi    # from that beam
         reach = ranges[np.arange(len(pose))[None, :], k]                    # [P, J]
-        on = inside & (np.abs(off) < np.pi / 2) & (dist * np.abs(np.sin(off)) < self.near)
+        on = (np.abs(off) < np.pi / 2) & (dist * np.abs(np.sin(off)) < self.near)
+        if inside is not None:
+            on &= inside
         passed = on & (dist * np.cos(off) < reach - SHORT)
         return np.logical_or.reduce(on, axis=1), np.logical_or.reduce(passed, axis=1)
 
