@@ -893,7 +893,9 @@ class Simulation:
             def rows(a: np.ndarray) -> np.ndarray:      # a copy of the active robots' rows
                 return a.copy() if len(idx) == self.n else a[idx]
 
-            sub = Percepts({key: rows(val) for key, val in s.inputs.items()}, rows(s.ranges),
+            # the inputs copied as one block (``s.inputs`` holds its rows), one row each
+            block = s.block.copy() if len(idx) == self.n else s.block[:, idx]
+            sub = Percepts(dict(zip(perception.INPUTS, block)), rows(s.ranges),
                            self.angles, rows(s.pose), rows(self._v), rows(s.targets),
                            rows(self._goals), rows(self._steer), idx, self._path(idx))
             c_steer, c_speed = self.planner.plan(sub)
