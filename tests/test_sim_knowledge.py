@@ -14,9 +14,10 @@ from hypothesis import settings
 from hypothesis import strategies as st
 
 from mitos_cli.errors import WorldError
+from mitos_cli.sim import barn
 from mitos_cli.sim.distance import distance_transform
 from mitos_cli.sim.loop import prepare, simulate
-from mitos_cli.sim.route import NarrowPassage
+from mitos_cli.sim.route import Clearance, NarrowPassage, Squares, _simplify
 from mitos_cli.sim.worldfile import load_world, parse_world
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -178,6 +179,35 @@ def dense(route_points: np.ndarray, step: float = 1.0) -> np.ndarray:
         n = max(2, int(math.dist(a, b) / step) + 1)
         out.append(a + np.linspace(0, 1, n)[:, None] * (b - a))
     return np.concatenate(out)
+
+
+def piece_rooms(points: np.ndarray, occupied: np.ndarray, resolution: float,
+                origin: tuple[float, float] = (0.0, 0.0), reach: float = 40.0) -> np.ndarray:
+    """Each piece's distance ``[M - 1]`` from the occupied cells, each the square it is (those
+    within ``reach`` of it; ``inf`` with none), brute force and apart from the planner's
+    geometry: along a piece, the distance to a square (a convex set) is a convex function of
+    where on the piece one stands, so a ternary search finds its least."""
+    r, c = np.nonzero(occupied)
+    centres = np.stack([origin[0] + (c + 0.5) * resolution,
+                        origin[1] + (r + 0.5) * resolution], axis=1)
+    out = np.full(len(points) - 1, np.inf)
+    for k, (a, b) in enumerate(zip(points[:-1], points[1:])):
+        near = centres[((centres >= np.minimum(a, b) - reach)
+                        & (centres <= np.maximum(a, b) + reach)).all(axis=1)]
+        if not len(near):
+            continue
+
+        def gap(t, a=a, b=b, near=near):
+            q = np.maximum(np.abs(a + t[:, None] * (b - a) - near) - resolution / 2, 0.0)
+            return np.hypot(q[:, 0], q[:, 1])
+
+        lo, hi = np.zeros(len(near)), np.ones(len(near))
+        for _ in range(100):
+            m1, m2 = lo + (hi - lo) / 3, hi - (hi - lo) / 3
+            left = gap(m1) <= gap(m2)
+            lo, hi = np.where(left, lo, m1), np.where(left, m2, hi)
+        out[k] = min(gap(lo).min(), gap(np.zeros(len(near))).min(), gap(np.ones(len(near))).min())
+    return out
 
 
 # --- routes that keep their word -----------------------------------------------------------
@@ -348,10 +378,72 @@ def test_route_min_clearance_allows_the_squeeze(tmp_path):
     world = load_world(grid_world(tmp_path, door_map(20), extra="route: {min_clearance: 9.5}\n"))
     assert world.min_clearance == 9.5
     pts = dense(prepare(world).routes[0].points)
-    # through the door, clear of every wall pixel by half the robot's width (its nodes keep
-    # 9.5 in; the straight piece simplification lays through the door runs 0.8 in off its
-    # middle, 9.2 in from the jamb)
-    assert occupied_distance(pts, door_map(20)) >= 9.0
+    assert occupied_distance(pts, door_map(20)) >= 9.0     # clear of every wall pixel
+
+
+def test_a_squeeze_is_not_straightened_inside_its_min_clearance(tmp_path):
+    """The straight piece simplification laid from the start to the goal ran through the door
+    0.8 in off its middle, 9.21 in from the jamb where `min_clearance: 9.5` was asked: the
+    estimate it was checked by (every half cell, a lower bound) underestimated the nodes'
+    own way through the door as much. Now the door is passed on the nodes' line, 9.5 in from
+    the jamb, measured exactly."""
+    world = load_world(grid_world(tmp_path, door_map(20), extra="route: {min_clearance: 9.5}\n"))
+    route = prepare(world).routes[0]
+    rooms = piece_rooms(route.points, world.grid.occupied, world.grid.resolution,
+                        world.grid.origin)
+    assert rooms.min() >= 9.5 - 1e-9
+    assert rooms.min() == pytest.approx(9.5)                # the door's, on the nodes' line
+
+
+def test_a_barn_route_is_not_straightened_inside_its_least_clearance():
+    """BARN field 1000 (the first of `bench_nav.py --seed 1000`): a straight piece of its known
+    route kept 9.56 in of the 10.5 the Jackal needs (its path before straightening kept
+    10.63 there)."""
+    w = barn.world_of(barn.field(1000, *barn.difficulty(1000)), known=True)
+    route = prepare(w).routes[0]
+    rooms = piece_rooms(route.points, w.grid.occupied, w.grid.resolution, w.grid.origin)
+    assert rooms.min() >= 10.5 - 1e-9
+
+
+def walk(occupied: np.ndarray, rng: np.random.Generator, steps: int) -> list[tuple[int, int]]:
+    """Free cells one step apart (of the 8 round each), none twice, from a random one: a path
+    like the one A* goes through on the route's nodes."""
+    free = np.argwhere(~occupied)
+    r, c = (int(v) for v in free[rng.integers(len(free))])
+    cells = [(r, c)]
+    for _ in range(steps):
+        nxt = [(r + dr, c + dc) for dr in (-1, 0, 1) for dc in (-1, 0, 1)
+               if (dr or dc) and 0 <= r + dr < occupied.shape[0] and 0 <= c + dc < occupied.shape[1]
+               and not occupied[r + dr, c + dc] and (r + dr, c + dc) not in cells]
+        if not nxt:
+            break
+        r, c = nxt[rng.integers(len(nxt))]
+        cells.append((r, c))
+    return cells
+
+
+@settings(max_examples=60, deadline=None)
+@hgiven(st.integers(4, 14), st.integers(4, 14), st.integers(0, 2 ** 32 - 1),
+        st.floats(0.0, 0.35), st.floats(0.0, 8.0), st.floats(0.0, 6.0), st.floats(0.5, 12.0))
+def test_a_straight_piece_keeps_the_floor_or_what_its_stretch_kept(rows, cols, seed, density,
+                                                                  floor, more, tol):
+    """Every piece simplification keeps is at least ``floor`` from every occupied cell, or as
+    far as the stretch of path it replaces, whichever is less, measured exactly."""
+    rng = np.random.default_rng(seed)
+    occupied = rng.random((rows, cols)) < density
+    if occupied.all():
+        return
+    res, origin = 2.0, (-3.0, 5.0)
+    cells = walk(occupied, rng, 40)
+    pts = np.array([[origin[0] + (c + 0.5) * res, origin[1] + (r + 0.5) * res] for r, c in cells])
+    out = _simplify(pts, tol, Clearance.of(occupied, res, origin), floor + more,
+                    Squares(occupied, res, origin), floor)
+    kept = [int(np.flatnonzero((pts == p).all(axis=1))[0]) for p in out]
+    assert kept == sorted(set(kept)) and kept[0] == 0 and kept[-1] == len(pts) - 1
+    steps = piece_rooms(pts, occupied, res, origin)
+    rooms = piece_rooms(out, occupied, res, origin)
+    for (i, j), room in zip(zip(kept[:-1], kept[1:]), rooms):
+        assert room >= min(floor, steps[i:j].min()) - 1e-9
 
 
 def test_a_min_clearance_below_half_the_robots_width_is_refused_where_it_is_written():

@@ -20,7 +20,7 @@ import numpy as np
 from ..errors import WorldError
 from ..words import tenths
 from .distance import _capped, distance_transform
-from .geometry import CACHED, clip_arrays, point_segment_distance
+from .geometry import CACHED, box_segment_distance, clip_arrays, point_segment_distance
 from .staticmap import StaticMap
 from .world import Corridor, Goal, Grid, Pose, Robot
 
@@ -531,13 +531,67 @@ def _samples_of(n: int) -> np.ndarray:
     return out
 
 
+@dataclass(frozen=True)
+class Squares:
+    """The occupied cells of a grid, each the square it is: how near a straight piece comes
+    to them, measured exactly (:func:`.geometry.box_segment_distance`). What a route
+    promises about its clearance is kept by this measure, not by :class:`Clearance`'s
+    estimate."""
+
+    occupied: np.ndarray           # [rows, cols]
+    resolution: float
+    origin: tuple[float, float]
+
+    def __hash__(self) -> int:
+        return id(self)
+
+    def room(self, a: np.ndarray, b: np.ndarray, reach: float) -> float:
+        """The distance (in) from the segment ``a``-``b`` to the nearest occupied cell, or
+        ``reach`` where none lies nearer (cells outside the grid are free). A long segment is
+        measured in pieces of about ``4 * reach``, each against the cells round it alone."""
+        res, (ox, oy) = self.resolution, self.origin
+        rows, cols = self.occupied.shape
+        n = max(1, int(math.ceil(math.dist(a, b) / max(4 * reach, 4 * res))))
+        ends = a + np.linspace(0.0, 1.0, n + 1)[:, None] * (b - a)
+        rel = []
+        for p, q in zip(ends[:-1], ends[1:]):
+            lo, hi = np.minimum(p, q) - reach, np.maximum(p, q) + reach
+            c0, c1 = max(int((lo[0] - ox) // res), 0), min(int((hi[0] - ox) // res) + 1, cols)
+            r0, r1 = max(int((lo[1] - oy) // res), 0), min(int((hi[1] - oy) // res) + 1, rows)
+            if c0 >= c1 or r0 >= r1:
+                continue
+            r, c = np.nonzero(self.occupied[r0:r1, c0:c1])
+            cx, cy = ox + (c + c0 + 0.5) * res, oy + (r + r0 + 0.5) * res
+            rel.append(np.stack([p[0] - cx, p[1] - cy, q[0] - cx, q[1] - cy], axis=1))
+        seg = np.concatenate(rel) if rel else np.zeros((0, 4))
+        if not len(seg):
+            return reach
+        return min(float(box_segment_distance(res / 2, res / 2, seg).min()), reach)
+
+
 def _simplify(points: np.ndarray, tol: float, clearance: Clearance | None = None,
-              asked: float = 0.0) -> np.ndarray:
+              asked: float = 0.0, squares: Squares | None = None,
+              floor: float = 0.0) -> np.ndarray:
     """Douglas-Peucker that keeps its word: a shortcut replaces a stretch of the path only if
-    it stays as far from the walls as the stretch did, or at least ``asked`` inches."""
+    it stays as far from the walls as the stretch did, or at least ``asked`` inches, as the
+    ``clearance`` field estimates them every half cell; and, with ``squares``, only if it
+    keeps at least ``floor`` or what the stretch keeps, whichever is less, measured exactly
+    from the occupied cells (:meth:`Squares.room`). The estimate alone let a shortcut cut
+    inside the floor where it underestimated the stretch too. A shortcut the estimate
+    accepts and that keeps the floor exactly is taken as before."""
     keep = np.zeros(len(points), dtype=bool)
     keep[[0, -1]] = True
     own = clearance.along_path(points) if clearance is not None else None
+    steps: dict[int, float] = {}            # the path's own steps, measured as they are needed
+
+    def stretch(i: int, j: int) -> float:
+        """The least exact room of the path's steps from point ``i`` to point ``j``."""
+        assert squares is not None
+        for m in range(i, j):
+            if m not in steps:
+                steps[m] = squares.room(points[m], points[m + 1], floor)
+        return min(steps[m] for m in range(i, j))
+
     stack = [(0, len(points) - 1)]
     while stack:
         i, j = stack.pop()
@@ -554,8 +608,11 @@ def _simplify(points: np.ndarray, tol: float, clearance: Clearance | None = None
             assert clearance is not None        # `own` is measured only with a clearance
             need = min(asked, float(own[i:j].min()))
             split = clearance.along(a, b) < need
-            if split and d[k] <= 1e-9:
-                k = (j - i) // 2 - 1
+        if not split and squares is not None:
+            room = squares.room(a, b, floor)
+            split = room < floor - 1e-9 and room < stretch(i, j) - 1e-9
+        if split and d[k] <= 1e-9:              # on the line: split the stretch in two
+            k = (j - i) // 2 - 1
         if split:
             keep[i + 1 + k] = True
             stack += [(i, i + 1 + k), (i + 1 + k, j)]
@@ -742,7 +799,8 @@ def grid_route(static: StaticMap, start: Pose, goal: Goal, clearance: float,
         raise refusal
     pts = np.array([centre(divmod(n, C)) for n in path])
     pts = np.vstack([[start.x, start.y], pts[1:-1], [goal.x, goal.y]])
-    pts = _simplify(pts, size * 0.75, field, clearance)
+    pts = _simplify(pts, size * 0.75, field, clearance,
+                    Squares(occ, g.resolution, g.origin), floor)
     return Route.of(pts, goal=(goal.x, goal.y))
 
 
