@@ -362,6 +362,23 @@ def test_an_even_door_the_robot_fits_is_routed_between_the_cells(tmp_path):
     assert not passable(world, ())       # the clutter suite's placements keep theirs
 
 
+def test_a_route_between_the_cells_is_measured_from_the_squares_not_discs():
+    """A route found between the cells is kept only if it keeps the floor from each cell, the
+    square it is: a piece passing a cell's corner 2.9 in off keeps 3.11 in from the disc of
+    half a cell round its centre, which was taken for 3 in kept."""
+    from mitos_cli.sim.route import Route, _keeps
+    from mitos_cli.sim.world import Grid
+
+    occupied = np.zeros((1, 1), dtype=bool)
+    occupied[0, 0] = True                              # the cell [0, 1] x [0, 1]
+    grid = Grid(occupied, 1.0, (0.0, 0.0), "")
+    c = 2 + 2.9 * math.sqrt(2)                         # the line x + y = c, 2.9 in off (1, 1)
+    route = Route.of([[c / 2 + 20, c / 2 - 20], [c / 2 - 20, c / 2 + 20]])
+    assert piece_rooms(route.points, occupied, 1.0)[0] == pytest.approx(2.9)
+    assert not _keeps(route, grid, occupied, 3.0)
+    assert _keeps(route, grid, occupied, 2.9 - 1e-6)
+
+
 def test_a_door_too_narrow_between_the_cells_too_is_still_refused(tmp_path):
     with pytest.raises(NarrowPassage, match=r"keeps 10.8 in .* it needs 11.0 in"):
         prepare(load_world(metric_door_world(tmp_path, 11)))      # 21.7 in

@@ -1074,9 +1074,9 @@ def _between_cells(g: Grid, occ: np.ndarray, start: Pose, goal: Goal, clearance:
     distance to the nearest occupied centre at every centre and corner, and each of its
     clearances reads a quarter of a cell more than the grid's own (it takes off half its own
     cell, not half the grid's), so ``clearance`` and ``floor`` are asked for a quarter of a
-    cell more. The route is kept only if it keeps ``floor`` exactly: every occupied centre's
-    distance from each of its segments, less half a cell, the first and last segments
-    (leaving the start, reaching the goal) as much as the start and goal themselves keep."""
+    cell more. The route is kept only if it keeps ``floor`` exactly (:func:`_keeps`): each of
+    its segments' distance from every occupied cell, the square it is, the first and last
+    segments (leaving the start, reaching the goal) as much as the start and goal keep."""
     rows, cols = occ.shape
     fine = np.zeros((2 * rows + 1, 2 * cols + 1), dtype=bool)
     fine[1::2, 1::2] = occ
@@ -1095,29 +1095,15 @@ def _between_cells(g: Grid, occ: np.ndarray, start: Pose, goal: Goal, clearance:
 
 
 def _keeps(route: Route, g: Grid, occ: np.ndarray, floor: float) -> bool:
-    """Whether ``route`` keeps ``floor`` from the occupied cells of ``g`` (``occ``), each a
-    disc of half a cell round its centre, measured exactly: each segment's distance from the
-    centres, its first and last as much as the start and the goal keep if that is less."""
-    r, c = np.nonzero(occ)
-    if not len(r):
-        return True
-    centres = np.stack([g.origin[0] + (c + 0.5) * g.resolution,
-                        g.origin[1] + (r + 0.5) * g.resolution], axis=1)
+    """Whether ``route`` keeps ``floor`` from the occupied cells of ``g`` (``occ``), each the
+    square it is, measured exactly (:meth:`Squares.room`): its first and last pieces as much
+    as the start and the goal keep if that is less."""
+    squares = Squares(occ, g.resolution, g.origin)
     pts = route.points
-    lo, hi = pts.min(axis=0) - floor - g.resolution, pts.max(axis=0) + floor + g.resolution
-    near = centres[((centres >= lo) & (centres <= hi)).all(axis=1)]
-    if not len(near):
-        return True
-    half = g.resolution / 2
-    segs = np.concatenate([pts[:-1], pts[1:]], axis=1)
-    block = max(1, CACHED // len(segs))           # a block of centres at a time
-    kept = np.minimum.reduce([point_segment_distance(near[i:i + block], segs).min(axis=0)
-                              for i in range(0, len(near), block)]) - half
-    ends = np.hypot(*(near[:, None] - pts[[0, -1]][None]).T).min(axis=1) - half
-    need = np.full(len(kept), floor)
-    need[0] = min(need[0], ends[0])
-    need[-1] = min(need[-1], ends[1])
-    return bool((kept >= need - 1e-9).all())
+    need = np.full(len(pts) - 1, floor)
+    need[0] = min(need[0], squares.room(pts[0], pts[0], floor))
+    need[-1] = min(need[-1], squares.room(pts[-1], pts[-1], floor))
+    return all(squares.room(a, b, floor) >= n - 1e-9 for a, b, n in zip(pts[:-1], pts[1:], need))
 
 
 def _end_room(field: Clearance, occ: np.ndarray, p: tuple[float, float]) -> float:
