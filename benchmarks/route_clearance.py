@@ -96,15 +96,16 @@ def measure(raw: np.ndarray, kept: np.ndarray, grid, occ: np.ndarray, floor: flo
     pts = raw[idx]
     rooms = segment_rooms(pts, grid, occ, reach)
     own = segment_rooms(raw, grid, occ, reach)
-    need = np.full(len(rooms), floor)
-    need[0] = min(need[0], point_room(pts[0], grid, occ, reach))
-    need[-1] = min(need[-1], point_room(pts[-1], grid, occ, reach))
+    start, goal = (point_room(p, grid, occ, reach) for p in (pts[0], pts[-1]))
+    need, own_need = np.full(len(rooms), floor), np.full(len(own), floor)
+    need[0] = own_need[0] = min(floor, start)
+    need[-1], own_need[-1] = min(need[-1], goal), min(own_need[-1], goal)
     stretch = np.array([min(floor, own[i:j].min()) for i, j in zip(idx[:-1], idx[1:])])
     short, cut = need - rooms, stretch - rooms
     k = int(cut.argmax())
     return {"floor": floor, "least": float(rooms.min()), "shortfall": max(float(short.max()), 0.0),
             "path_least": float(own.min()),
-            "path_shortfall": max(float((np.minimum(floor, own) - own).max()), 0.0),
+            "path_shortfall": max(float((own_need - own).max()), 0.0),
             "cut": max(float(cut[k]), 0.0), "piece": [pts[k].tolist(), pts[k + 1].tolist()],
             "pieces": len(rooms), "nodes": len(raw)}
 
