@@ -218,37 +218,51 @@ def test_a_maps_marks_kept_as_a_list_clear_as_a_scan_of_its_window_did():
 
 
 def free_travel_over_every_cell(cells, radius, pose, robot, delta, backward, reach, step=1.0):
-    """safety.free_travel as it was written: every cell tested at every step (backing, a cell
-    touched at the start blocks only the steps that take it deeper in)."""
+    """safety.free_travel as it is written, but every cell tested at every place, and
+    between every two places where it might be touched (backing, a cell touched at the start
+    blocks only the places that take it deeper in)."""
     x, y, h = pose
     if not len(cells):
         return reach
     wb, hl, hw = robot.wheelbase, robot.length / 2, robot.width / 2
-    u = np.arange(0.0, reach + step / 2, step) * (-1.0 if backward else 1.0)
     k = -math.tan(math.radians(delta)) / wb
-    hk = h + k * u
-    if abs(k) > 1e-9:
-        rx = x - wb / 2 * math.cos(h) + (np.sin(hk) - math.sin(h)) / k
-        ry = y - wb / 2 * math.sin(h) + (math.cos(h) - np.cos(hk)) / k
-    else:
-        rx = x - wb / 2 * math.cos(h) + u * math.cos(h)
-        ry = y - wb / 2 * math.sin(h) + u * math.sin(h)
-    c, s = np.cos(hk), np.sin(hk)
-    dx = cells[:, 0, None] - (rx + wb / 2 * c)
-    dy = cells[:, 1, None] - (ry + wb / 2 * s)
-    ac, as_ = np.abs(c), np.abs(s)        # each cell the square it is: four axes
-    e = radius * (ac + as_)
-    depth = np.minimum(np.minimum(hl + e - np.abs(dx * c + dy * s),
-                                  hw + e - np.abs(dy * c - dx * s)),
-                       np.minimum(radius + hl * ac + hw * as_ - np.abs(dx),
-                                  radius + hl * as_ + hw * ac - np.abs(dy)))
+    far = wb / 2 + math.hypot(hl, hw) + 2 * math.sqrt(2) * radius + step
+    du = step / (1.0 + abs(k) * far)
+    u = np.arange(0.0, reach + du / 2, du) * (-1.0 if backward else 1.0)
+
+    def depth_at(u):                      # [P, ...] each cell the square it is: four axes
+        hk = h + k * u
+        c, s = np.cos(hk), np.sin(hk)
+        if abs(k) > 1e-9:
+            rx = x - wb / 2 * math.cos(h) + (s - math.sin(h)) / k
+            ry = y - wb / 2 * math.sin(h) + (math.cos(h) - c) / k
+        else:
+            rx = x - wb / 2 * math.cos(h) + u * math.cos(h)
+            ry = y - wb / 2 * math.sin(h) + u * math.sin(h)
+        dx = cells[:, 0].reshape((-1,) + (1,) * u.ndim) - (rx + wb / 2 * c)
+        dy = cells[:, 1].reshape((-1,) + (1,) * u.ndim) - (ry + wb / 2 * s)
+        ac, as_ = np.abs(c), np.abs(s)
+        e = radius * (ac + as_)
+        return np.minimum(np.minimum(hl + e - np.abs(dx * c + dy * s),
+                                     hw + e - np.abs(dy * c - dx * s)),
+                          np.minimum(radius + hl * ac + hw * as_ - np.abs(dx),
+                                     radius + hl * as_ + hw * ac - np.abs(dy)))
+
+    depth = depth_at(u)                                               # [P, K]
     inside = depth >= 0
     if backward:
         inside = np.where(inside[:, :1], depth > depth[:, :1], inside)
+    t = np.arange(1, safety.BETWEEN) / safety.BETWEEN
+    between = depth_at(u[:-1, None] + (u[1:, None] - u[:-1, None]) * t)     # [P, K-1, B-1]
+    ends = np.concatenate([depth[:, :-1, None], between, depth[:, 1:, None]], axis=2)
+    touch = (between >= 0).any(axis=2) | (ends[..., :-1] + ends[..., 1:]
+                                          >= -step / safety.BETWEEN).any(axis=2)
+    maybe = (depth[:, :-1] + depth[:, 1:] >= -step) & ~inside[:, :-1] & ~inside[:, 1:]
+    inside[:, 1:] |= maybe & (depth[:, :1] < 0) & touch
     hit = inside.any(axis=0)
     if not hit.any():
         return reach
-    return float(max(int(np.argmax(hit)) - 1, 0) * step)
+    return float(max(int(np.argmax(hit)) - 1, 0) * du)
 
 
 def test_the_brakes_sweep_tests_only_the_cells_its_disc_sweeps_with_the_same_answer():

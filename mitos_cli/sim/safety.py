@@ -59,41 +59,126 @@ def free_travel(cells: np.ndarray, radius: float, pose: tuple[float, float, floa
     touches one already, but for backing out: backward, a cell it touches blocks only the steps
     that take it deeper in.
 
-    Only the cells in the box the footprint's circumscribed disc sweeps are tested: a cell
-    outside it is inside no footprint along the arc (1e-6 in of slack for rounding), and each
-    cell's test is its own."""
+    The footprint is placed every :func:`_spacing` along the arc, close enough that no cell's
+    depth changes by more than ``step`` from one place to the next; where a cell might be
+    touched between two places, :func:`_between` looks closer. So the body touches nothing
+    between two places unseen: at full lock a front corner moves three to four times as far
+    as the rear axle, and places a whole inch of the axle's path apart let it clip a wall's
+    corner. Only the cells in the box the footprint's circumscribed disc sweeps (grown by a
+    step) are tested: a cell outside it is touched nowhere along the arc, and each cell's test
+    is its own."""
     x, y, h = pose
     if not len(cells):
         return reach
     wb, hl, hw = robot.wheelbase, robot.length / 2, robot.width / 2
-    u = _path(reach, step, backward)                 # [K]
     k = -math.tan(math.radians(delta)) / wb          # rad per inch of the rear axle's path
-    hk = h + k * u
-    c, s = np.cos(hk), np.sin(hk)
-    if abs(k) > 1e-9:
-        rx = x - wb / 2 * math.cos(h) + (s - math.sin(h)) / k
-        ry = y - wb / 2 * math.sin(h) + (math.cos(h) - c) / k
-    else:
-        rx = x - wb / 2 * math.cos(h) + u * math.cos(h)
-        ry = y - wb / 2 * math.sin(h) + u * math.sin(h)
-    cx, cy = rx + wb / 2 * c, ry + wb / 2 * s        # the footprint's centre at each step
-    disc = math.hypot(hl, hw) + radius * math.sqrt(2) + 1e-6     # a cell's corner too
+    du = _spacing(robot, k, radius, step)
+    u = _path(reach, du, backward)                   # [K]
+    arc = Arc(*(np.full((1, 1), v) for v in (
+        h, k, x - wb / 2 * math.cos(h), y - wb / 2 * math.sin(h), math.sin(h), math.cos(h),
+        wb / 2, abs(k) > 1e-9)))
+    c, s, cx, cy = arc.centres(u[None])              # [1, K]: the footprint's centres
+    disc = math.hypot(hl, hw) + radius * math.sqrt(2) + step + 1e-6     # a cell's corner too
     px, py = cells[:, 0], cells[:, 1]
     swept = ((px >= cx.min() - disc) & (px <= cx.max() + disc)
              & (py >= cy.min() - disc) & (py <= cy.max() + disc))
     if not np.count_nonzero(swept):
         return reach
     px, py = px[swept, None], py[swept, None]
-    dx, dy = px - cx, py - cy
-    depth = _depth(dx, dy, c, s, hl, hw, radius)                   # [P, K]
-    inside = depth >= 0
-    if backward:    # backing away from a cell the body touches already (a mark a noisy echo
-        # put at its edge) is not blocked by it until a step takes the body deeper in
-        inside = np.where(inside[:, :1], depth > depth[:, :1], inside)
+    depth = _depth(px - cx, py - cy, c, s, hl, hw, radius)                   # [P, K]
+    inside = _touched(depth, backward)
+    every = np.zeros(len(px), dtype=np.intp)
+    _between(inside, depth, u[None], every, arc, px, py, hl, hw, radius, step)
     hit = np.logical_or.reduce(inside, axis=0)
     if not np.count_nonzero(hit):
         return reach
-    return float(max(int(hit.argmax()) - 1, 0) * step)
+    return float(max(int(hit.argmax()) - 1, 0) * du)
+
+
+@dataclass(frozen=True)
+class Arc:
+    """The arcs of ``R`` sweeps (each field ``[R, 1]``): heading
+    (rad), curvature (rad per inch of the rear axle's path), the rear axle's start, the
+    heading's sine and cosine, half the wheelbase and whether it turns at all."""
+
+    h: np.ndarray
+    k: np.ndarray
+    a: np.ndarray
+    b: np.ndarray
+    sin_h: np.ndarray
+    cos_h: np.ndarray
+    half: np.ndarray
+    turning: np.ndarray
+
+    def centres(self, u: np.ndarray, rows: np.ndarray | None = None):
+        """``(cos, sin, x, y)`` of the heading and the footprint's centre after ``u [R, K]``
+        inches of the rear axle's path (``rows``: of those sweeps, one per row of ``u``)."""
+        pick = (lambda v: v) if rows is None else (lambda v: v[rows])
+        h, k, a, b = pick(self.h), pick(self.k), pick(self.a), pick(self.b)
+        sin_h, cos_h, turning = pick(self.sin_h), pick(self.cos_h), pick(self.turning)
+        hk = h + k * u
+        c, s = np.cos(hk), np.sin(hk)
+        bend = np.where(turning, k, 1.0)              # a straight sweep divides by nothing
+        rx = np.where(turning, a + (s - sin_h) / bend, a + u * cos_h)
+        ry = np.where(turning, b + (cos_h - c) / bend, b + u * sin_h)
+        half = pick(self.half)
+        return c, s, rx + half * c, ry + half * s
+
+
+#: Places looked at between two of a sweep's where a cell may be touched between them.
+BETWEEN = 8
+
+
+def _touched(depth: np.ndarray, backward) -> np.ndarray:
+    """``[P, K]`` whether the footprint touches each cell at each place; backing away from a
+    cell it touches already (a mark a noisy echo put at its edge), only the places deeper in
+    (``backward``: a bool, or one per cell)."""
+    inside = depth >= 0
+    back = np.broadcast_to(np.asarray(backward), (len(depth),))
+    if np.count_nonzero(back):
+        inside[back] = np.where(inside[back][:, :1], depth[back] > depth[back][:, :1],
+                                inside[back])
+    return inside
+
+
+def _between(inside: np.ndarray, depth: np.ndarray, u: np.ndarray, owner: np.ndarray,
+             arc: Arc, px, py, hl, hw, radius, step: float) -> None:
+    """Mark in ``inside [P, K]`` the cells touched between two places ``j`` and ``j + 1`` (at
+    ``j + 1``). The depth changes by at most ``step`` from one place to the next, so a cell
+    can be touched between only where the two depths add up to ``-step`` or more; there
+    :data:`BETWEEN` - 1 places between are looked at, and the cell counts as touched if one
+    of them touches it or two neighbours add up to ``-step / BETWEEN`` or more (what is left
+    unseen: a graze of ``step / (2 BETWEEN)``, which counts). ``u [R, K]`` the places of each
+    sweep, ``owner [P]`` each cell's sweep; a cell touched at the start is left out (backing
+    away, only deeper places count)."""
+    maybe = (depth[:, :-1] + depth[:, 1:] >= -step) & ~inside[:, :-1] & ~inside[:, 1:]
+    maybe &= depth[:, :1] < 0
+    cell, j = np.nonzero(maybe)
+    if not len(cell):
+        return
+    rows = owner[cell]
+    lo, hi = u[rows, j][:, None], u[rows, j + 1][:, None]
+    t = np.arange(1, BETWEEN) / BETWEEN
+    uu = lo + (hi - lo) * t                                               # [C, BETWEEN - 1]
+    c, s, cx, cy = arc.centres(uu, rows)
+    pick = (lambda v: v[cell]) if np.ndim(hl) else (lambda v: v)
+    dd = _depth(px[cell] - cx, py[cell] - cy, c, s, pick(hl), pick(hw), pick(radius))
+    ends = np.concatenate([depth[cell, j, None], dd, depth[cell, j + 1, None]], axis=1)
+    touch = (np.logical_or.reduce(dd >= 0, axis=1)
+             | np.logical_or.reduce(ends[:, :-1] + ends[:, 1:] >= -step / BETWEEN, axis=1))
+    inside[cell[touch], j[touch] + 1] = True
+
+
+def _spacing(robot: Robot, k: float, radius: float, step: float) -> float:
+    """The rear axle's travel between two places of the footprint along an arc of curvature
+    ``k`` (rad per inch) such that no cell's depth (:func:`_depth`) changes by more than
+    ``step``: per inch of the axle's travel the footprint's centre moves at most
+    ``1 + |k| wb / 2`` inches and turns ``|k|`` rad, and a turn moves the depth of a cell
+    that can touch by at most ``|k|`` times its distance from the centre (half the
+    footprint's diagonal, a cell's diagonal and the step). Straight on, ``step`` itself."""
+    far = (robot.wheelbase / 2 + math.hypot(robot.length / 2, robot.width / 2)
+           + 2 * math.sqrt(2) * radius + step)
+    return step / (1.0 + abs(k) * far)
 
 
 def _depth(dx, dy, c, s, hl, hw, r):
@@ -116,10 +201,10 @@ def free_travels(sweeps: list[tuple[Body, float, bool]], step: float = 1.0) -> n
     """:func:`free_travel` of many sweeps at once (``(body, wheel, backward)`` each, as far as
     its body's ``reach``; runs in lockstep brake together), ``[R]``. What is one number per
     sweep is worked out as :func:`free_travel` does, in Python floats; the rest elementwise
-    over ``[R, K]`` steps (to the farthest reach, a sweep's own steps only counted) and
-    ``[M, K]`` for the ``M`` cells in the sweeps' boxes, each with its sweep's steps (not padded
-    to the sweep with the most: a quarter of the cells would be real), so a sweep gets the bits
-    it gets alone."""
+    over ``[R, K]`` places (each sweep's own, its last repeated to the longest) and ``[M, K]``
+    for the ``M`` cells in the sweeps' boxes, each with its sweep's places (not padded to the
+    sweep with the most: a quarter of the cells would be real), so a sweep gets the bits it
+    gets alone."""
     if len(sweeps) == 1:                 # a robot alone: no batch to set up
         body, wheel, backward = sweeps[0]
         return np.array([free_travel(body.cells, body.radius, body.pose, body.robot,
@@ -130,29 +215,28 @@ def free_travels(sweeps: list[tuple[Body, float, bool]], step: float = 1.0) -> n
     if not rows:
         return out
     n = len(rows)
-    reach = max(float(out[j]) for j in rows)
-    u = np.stack([_path(reach, step, sweeps[j][2]) for j in rows])            # [n, K]
-    h, k, a, b, sin_h, cos_h, half, hl, hw, disc = (np.empty((n, 1)) for _ in range(10))
+    h, k, a, b, sin_h, cos_h, half, hl, hw, disc, du = (np.empty((n, 1)) for _ in range(11))
+    paths = []
     for r, j in enumerate(rows):
-        body, wheel, _ = sweeps[j]
+        body, wheel, backward = sweeps[j]
         robot, (x, y, hh) = body.robot, body.pose
         wb = robot.wheelbase
         hl[r], hw[r] = robot.length / 2, robot.width / 2
         delta = wheel - robot.steering_straight
-        h[r], k[r], half[r] = hh, -math.tan(math.radians(delta)) / wb, wb / 2
+        kr = -math.tan(math.radians(delta)) / wb
+        h[r], k[r], half[r] = hh, kr, wb / 2
         a[r], b[r] = x - wb / 2 * math.cos(hh), y - wb / 2 * math.sin(hh)
         sin_h[r], cos_h[r] = math.sin(hh), math.cos(hh)
-        disc[r] = math.hypot(float(hl[r, 0]), float(hw[r, 0])) + body.radius * math.sqrt(2) + 1e-6
-    hk = h + k * u
-    c, s = np.cos(hk), np.sin(hk)
-    turning = np.abs(k[:, 0]) > 1e-9
-    rx, ry = np.empty_like(u), np.empty_like(u)
-    t, st = turning, ~turning
-    rx[t] = a[t] + (s[t] - sin_h[t]) / k[t]
-    ry[t] = b[t] + (cos_h[t] - c[t]) / k[t]
-    rx[st] = a[st] + u[st] * cos_h[st]
-    ry[st] = b[st] + u[st] * sin_h[st]
-    cx, cy = rx + half * c, ry + half * s                      # the footprint's centres
+        disc[r] = (math.hypot(float(hl[r, 0]), float(hw[r, 0])) + body.radius * math.sqrt(2)
+                   + step + 1e-6)
+        du[r] = _spacing(robot, kr, body.radius, step)
+        paths.append(_path(body.reach, float(du[r, 0]), backward))
+    own = np.array([len(path) for path in paths])
+    u = np.empty((n, int(own.max())))                      # [n, K]: each sweep's own places,
+    for r, path in enumerate(paths):                       # its last repeated after them
+        u[r, :len(path)], u[r, len(path):] = path, path[-1]
+    arc = Arc(h, k, a, b, sin_h, cos_h, half, np.abs(k) > 1e-9)
+    c, s, cx, cy = arc.centres(u)                              # the footprint's centres
     lo_x, hi_x = cx.min(axis=1) - disc[:, 0], cx.max(axis=1) + disc[:, 0]
     lo_y, hi_y = cy.min(axis=1) - disc[:, 0], cy.max(axis=1) + disc[:, 0]
     cells = np.concatenate([sweeps[j][0].cells for j in rows])                # [P, 2]
@@ -160,29 +244,26 @@ def free_travels(sweeps: list[tuple[Body, float, bool]], step: float = 1.0) -> n
     px, py = cells[:, 0], cells[:, 1]
     swept = ((px >= lo_x[owner]) & (px <= hi_x[owner])
              & (py >= lo_y[owner]) & (py <= hi_y[owner]))
-    if not swept.any():
+    if not np.count_nonzero(swept):
         return out
     px, py, owner = px[swept, None], py[swept, None], owner[swept]     # [M, 1], by sweep
     rad = np.array([sweeps[j][0].radius for j in rows])[owner, None]
     depth = _depth(px - cx[owner], py - cy[owner], c[owner], s[owner], hl[owner], hw[owner],
                    rad)                                                           # [M, K]
-    inside = depth >= 0
-    back = np.array([sweeps[j][2] for j in rows])[owner]
-    if np.count_nonzero(back):      # backing: a cell touched at the start blocks only deeper steps
-        inside[back] = np.where(inside[back][:, :1], depth[back] > depth[back][:, :1],
-                                inside[back])
+    inside = _touched(depth, np.array([sweeps[j][2] for j in rows])[owner])
+    _between(inside, depth, u, owner, arc, px, py, hl[owner], hw[owner], rad, step)
     hit = np.zeros((n, len(u[0])), dtype=bool)
     first_of = np.flatnonzero(np.r_[True, owner[1:] != owner[:-1]])     # each sweep's run
     hit[owner[first_of]] = np.logical_or.reduceat(inside, first_of, axis=0)
-    hit &= np.abs(u) < out[rows, None] + step / 2                        # [n, K], its own
-    first = np.maximum(hit.argmax(axis=1) - 1, 0) * step
+    hit &= np.arange(u.shape[1]) < own[:, None]                          # [n, K], its own
+    first = np.maximum(hit.argmax(axis=1) - 1, 0) * du[:, 0]
     out[rows] = np.where(np.logical_or.reduce(hit, axis=1), first, out[rows])
     return out
 
 
 @functools.lru_cache(maxsize=16)
 def _path(reach: float, step: float, backward: bool) -> np.ndarray:
-    """``[K]`` the rear axle's signed travel at each step of the sweep."""
+    """``[K]`` the rear axle's signed travel at each place of the sweep, ``step`` apart."""
     out = np.arange(0.0, reach + step / 2, step) * (-1.0 if backward else 1.0)
     out.flags.writeable = False
     return out
