@@ -236,3 +236,52 @@ def test_a_wheel_is_not_turned_toward_what_the_robot_can_no_longer_stop_short_of
     assert steer == 120.0 and speed == pytest.approx(min(40.0, kept))
     (steer, _), _ = safety.guard((150.0, 40.0), at(0.0), safety.Recovery(), 0.05, cfg)
     assert steer == 150.0
+
+
+def _first_touch(cells, radius, pose, robot, delta, backward, reach, fine=0.002):
+    """Where along the rear axle's path the footprint first touches a cell, found by placing it
+    every ``fine`` inch (``math.inf``: nowhere within ``reach``): the brake's answer checked by
+    brute force."""
+    u = np.arange(0.0, reach, fine) * (-1.0 if backward else 1.0)
+    wb = robot.wheelbase
+    arc = safety.Arc(*(np.full((1, 1), v) for v in (
+        pose[2], -math.tan(math.radians(delta)) / wb, pose[0] - wb / 2 * math.cos(pose[2]),
+        pose[1] - wb / 2 * math.sin(pose[2]), math.sin(pose[2]), math.cos(pose[2]), wb / 2,
+        abs(delta) > 1e-7)))
+    c, s, cx, cy = arc.centres(u[None])
+    depth = safety._depth(cells[:, :1] - cx, cells[:, 1:] - cy, c, s, robot.length / 2,
+                          robot.width / 2, radius)
+    touched = (depth >= 0).any(axis=0)
+    return abs(float(u[touched.argmax()])) if touched.any() else math.inf
+
+
+def test_at_full_lock_the_sweep_misses_no_corner_between_two_places():
+    """office02#1 among seed 1000's clutter: a Pioneer turning at full lock with 0.44 in to a
+    wall's corner was told 12 in were free (the sweep placed its body a whole inch of the rear
+    axle's path apart, and its front corner swung 3 in past the corner between two places)."""
+    pioneer = Robot(wheelbase=12.0, length=17.5, width=15.0)
+    pose = (416.92, 116.01, math.radians(-79.0))
+    corner = np.array([[426.18110236, 107.28346457]])
+    r = 1.968503937007874 / 2
+    first = _first_touch(corner, r, pose, pioneer, 60.0, False, 30.0)
+    assert first < 1.0
+    assert safety.free_travel(corner, r, pose, pioneer, 60.0, False, 30.0) <= first
+
+
+def test_the_sweep_never_reaches_past_where_the_body_first_touches():
+    rng = np.random.default_rng(20261204)
+    robot = Robot(wheelbase=12.0, length=17.5, width=15.0)
+    tight = 0
+    for _ in range(300):
+        pose = (0.0, 0.0, float(rng.uniform(-math.pi, math.pi)))
+        cells = rng.uniform(-25, 25, (int(rng.integers(1, 12)), 2))
+        cells = cells[np.hypot(*cells.T) > 13.0]         # none the body touches at the start
+        if not len(cells):
+            continue
+        delta = float(rng.choice([60.0, -60.0, rng.uniform(-60, 60)]))
+        backward = bool(rng.random() < 0.2)
+        free = safety.free_travel(cells, 1.0, pose, robot, delta, backward, 30.0)
+        first = _first_touch(cells, 1.0, pose, robot, delta, backward, 30.0)
+        assert free <= first, (pose, delta, backward)
+        tight += first < math.inf and free >= first - 2.0
+    assert tight > 20                # and not far short of it: within two places' travel

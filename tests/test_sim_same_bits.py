@@ -228,7 +228,7 @@ def free_travel_over_every_cell(cells, radius, pose, robot, delta, backward, rea
     k = -math.tan(math.radians(delta)) / wb
     far = wb / 2 + math.hypot(hl, hw) + 2 * math.sqrt(2) * radius + step
     du = step / (1.0 + abs(k) * far)
-    u = np.arange(0.0, reach + du / 2, du) * (-1.0 if backward else 1.0)
+    u = np.arange(math.ceil(reach / du - 1e-9) + 1) * (-du if backward else du)
 
     def depth_at(u):                      # [P, ...] each cell the square it is: four axes
         hk = h + k * u

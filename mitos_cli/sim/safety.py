@@ -263,8 +263,9 @@ def free_travels(sweeps: list[tuple[Body, float, bool]], step: float = 1.0) -> n
 
 @functools.lru_cache(maxsize=16)
 def _path(reach: float, step: float, backward: bool) -> np.ndarray:
-    """``[K]`` the rear axle's signed travel at each place of the sweep, ``step`` apart."""
-    out = np.arange(0.0, reach + step / 2, step) * (-1.0 if backward else 1.0)
+    """``[K]`` the rear axle's signed travel at each place of the sweep, ``step`` apart, the
+    last at ``reach`` or just past it (a touch short of ``reach`` is never beyond the last)."""
+    out = np.arange(math.ceil(reach / step - 1e-9) + 1) * (-step if backward else step)
     out.flags.writeable = False
     return out
 
