@@ -31,6 +31,7 @@ from __future__ import annotations
 import functools
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -74,10 +75,9 @@ def free_travel(cells: np.ndarray, radius: float, pose: tuple[float, float, floa
     k = -math.tan(math.radians(delta)) / wb          # rad per inch of the rear axle's path
     du = _spacing(robot, k, radius, step)
     u = _path(reach, du, backward)                   # [K]
-    arc = Arc(*(np.full((1, 1), v) for v in (
-        h, k, x - wb / 2 * math.cos(h), y - wb / 2 * math.sin(h), math.sin(h), math.cos(h),
-        wb / 2, abs(k) > 1e-9)))
-    c, s, cx, cy = arc.centres(u[None])              # [1, K]: the footprint's centres
+    arc = Arc(h, k, x - wb / 2 * math.cos(h), y - wb / 2 * math.sin(h), math.sin(h),
+              math.cos(h), wb / 2, abs(k) > 1e-9)
+    c, s, cx, cy = arc.centres(u)                    # [K]: the footprint's centres
     disc = math.hypot(hl, hw) + radius * math.sqrt(2) + step + 1e-6     # a cell's corner too
     px, py = cells[:, 0], cells[:, 1]
     swept = ((px >= cx.min() - disc) & (px <= cx.max() + disc)
@@ -97,30 +97,37 @@ def free_travel(cells: np.ndarray, radius: float, pose: tuple[float, float, floa
 
 @dataclass(frozen=True)
 class Arc:
-    """The arcs of ``R`` sweeps (each field ``[R, 1]``): heading
+    """The arc of one sweep (each field a float), or of ``R`` (each ``[R, 1]``): heading
     (rad), curvature (rad per inch of the rear axle's path), the rear axle's start, the
-    heading's sine and cosine, half the wheelbase and whether it turns at all."""
+    heading's sine and cosine, half the wheelbase and whether it turns at all. One sweep's
+    places come out bit for bit as the same sweep's among many."""
 
-    h: np.ndarray
-    k: np.ndarray
-    a: np.ndarray
-    b: np.ndarray
-    sin_h: np.ndarray
-    cos_h: np.ndarray
-    half: np.ndarray
-    turning: np.ndarray
+    h: Any
+    k: Any
+    a: Any
+    b: Any
+    sin_h: Any
+    cos_h: Any
+    half: Any
+    turning: Any
 
     def centres(self, u: np.ndarray, rows: np.ndarray | None = None):
-        """``(cos, sin, x, y)`` of the heading and the footprint's centre after ``u [R, K]``
-        inches of the rear axle's path (``rows``: of those sweeps, one per row of ``u``)."""
-        pick = (lambda v: v) if rows is None else (lambda v: v[rows])
+        """``(cos, sin, x, y)`` of the heading and the footprint's centre after ``u`` inches
+        of the rear axle's path (``[R, K]``, or ``rows``: of those sweeps, one per row)."""
+        def pick(v):
+            return v if rows is None or np.ndim(v) == 0 else v[rows]
+
         h, k, a, b = pick(self.h), pick(self.k), pick(self.a), pick(self.b)
         sin_h, cos_h, turning = pick(self.sin_h), pick(self.cos_h), pick(self.turning)
         hk = h + k * u
         c, s = np.cos(hk), np.sin(hk)
-        bend = np.where(turning, k, 1.0)              # a straight sweep divides by nothing
-        rx = np.where(turning, a + (s - sin_h) / bend, a + u * cos_h)
-        ry = np.where(turning, b + (cos_h - c) / bend, b + u * sin_h)
+        if np.ndim(turning) == 0:                     # one sweep: one formula
+            rx = a + (s - sin_h) / k if turning else a + u * cos_h
+            ry = b + (cos_h - c) / k if turning else b + u * sin_h
+        else:
+            bend = np.where(turning, k, 1.0)          # a straight sweep divides by nothing
+            rx = np.where(turning, a + (s - sin_h) / bend, a + u * cos_h)
+            ry = np.where(turning, b + (cos_h - c) / bend, b + u * sin_h)
         half = pick(self.half)
         return c, s, rx + half * c, ry + half * s
 
@@ -134,6 +141,8 @@ def _touched(depth: np.ndarray, backward) -> np.ndarray:
     cell it touches already (a mark a noisy echo put at its edge), only the places deeper in
     (``backward``: a bool, or one per cell)."""
     inside = depth >= 0
+    if backward is False:
+        return inside
     back = np.broadcast_to(np.asarray(backward), (len(depth),))
     if np.count_nonzero(back):
         inside[back] = np.where(inside[back][:, :1], depth[back] > depth[back][:, :1],
