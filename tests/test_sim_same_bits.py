@@ -254,9 +254,7 @@ def free_travel_over_every_cell(cells, radius, pose, robot, delta, backward, rea
         inside = np.where(inside[:, :1], depth > depth[:, :1], inside)
     t = np.arange(1, safety.BETWEEN) / safety.BETWEEN
     between = depth_at(u[:-1, None] + (u[1:, None] - u[:-1, None]) * t)     # [P, K-1, B-1]
-    ends = np.concatenate([depth[:, :-1, None], between, depth[:, 1:, None]], axis=2)
-    touch = (between >= 0).any(axis=2) | (ends[..., :-1] + ends[..., 1:]
-                                          >= -step / safety.BETWEEN).any(axis=2)
+    touch = (between >= 0).any(axis=2)
     maybe = (depth[:, :-1] + depth[:, 1:] >= -step) & ~inside[:, :-1] & ~inside[:, 1:]
     inside[:, 1:] |= maybe & (depth[:, :1] < 0) & touch
     hit = inside.any(axis=0)

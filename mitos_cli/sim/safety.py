@@ -62,8 +62,8 @@ def free_travel(cells: np.ndarray, radius: float, pose: tuple[float, float, floa
 
     The footprint is placed every :func:`_spacing` along the arc, close enough that no cell's
     depth changes by more than ``step`` from one place to the next; where a cell might be
-    touched between two places, :func:`_between` looks closer. So the body touches nothing
-    between two places unseen: at full lock a front corner moves three to four times as far
+    touched between two places, :func:`_between` looks closer. So no touch deeper than 1/16
+    in (``step / 16``) passes between two places unseen: at full lock a front corner moves three to four times as far
     as the rear axle, and places a whole inch of the axle's path apart let it clip a wall's
     corner. Only the cells in the box the footprint's circumscribed disc sweeps (grown by a
     step) are tested: a cell outside it is touched nowhere along the arc, and each cell's test
@@ -155,11 +155,13 @@ def _between(inside: np.ndarray, depth: np.ndarray, u: np.ndarray, owner: np.nda
     """Mark in ``inside [P, K]`` the cells touched between two places ``j`` and ``j + 1`` (at
     ``j + 1``). The depth changes by at most ``step`` from one place to the next, so a cell
     can be touched between only where the two depths add up to ``-step`` or more; there
-    :data:`BETWEEN` - 1 places between are looked at, and the cell counts as touched if one
-    of them touches it or two neighbours add up to ``-step / BETWEEN`` or more (what is left
-    unseen: a graze of ``step / (2 BETWEEN)``, which counts). ``u [R, K]`` the places of each
-    sweep, ``owner [P]`` each cell's sweep; a cell touched at the start is left out (backing
-    away, only deeper places count)."""
+    :data:`BETWEEN` - 1 places between are looked at, and a cell one of them touches counts.
+    Between two of those the depth changes by at most ``step / BETWEEN``: what is left unseen
+    is a graze of less than ``step / (2 BETWEEN)`` (1/16 in), not a corner swinging through a
+    cell. (Counting every pair that might graze would stop a robot sliding past a cell of its
+    map a few thousandths of an inch off, which the map's cells, larger than what they mark,
+    make common among poles.) ``u [R, K]`` the places of each sweep, ``owner [P]`` each cell's
+    sweep; a cell touched at the start is left out (backing away, only deeper places count)."""
     maybe = (depth[:, :-1] + depth[:, 1:] >= -step) & ~inside[:, :-1] & ~inside[:, 1:]
     maybe &= depth[:, :1] < 0
     cell, j = np.nonzero(maybe)
@@ -172,9 +174,7 @@ def _between(inside: np.ndarray, depth: np.ndarray, u: np.ndarray, owner: np.nda
     c, s, cx, cy = arc.centres(uu, rows)
     pick = (lambda v: v[cell]) if np.ndim(hl) else (lambda v: v)
     dd = _depth(px[cell] - cx, py[cell] - cy, c, s, pick(hl), pick(hw), pick(radius))
-    ends = np.concatenate([depth[cell, j, None], dd, depth[cell, j + 1, None]], axis=1)
-    touch = (np.logical_or.reduce(dd >= 0, axis=1)
-             | np.logical_or.reduce(ends[:, :-1] + ends[:, 1:] >= -step / BETWEEN, axis=1))
+    touch = np.logical_or.reduce(dd >= 0, axis=1)
     inside[cell[touch], j[touch] + 1] = True
 
 
@@ -349,7 +349,7 @@ def guard(command: tuple[float, float], body: Body, rec: Recovery, dt: float,
 
     if rec.left > 0:
         rec.left -= dt
-        back = free(rec.wheel, True)
+        back = free(_wheel(rec.wheel, body, dt), True)   # the arc of the wheel still turning
         if back > cfg.margin:
             return (rec.wheel, -min(robot.max_reverse,
                                     brake(back, robot.acceleration, cfg.margin, dt))), False
@@ -382,7 +382,7 @@ def first_sweep(command: tuple[float, float], body: Body, rec: Recovery,
     """The wheel (deg) and direction (backward?) of the first sweep :func:`guard` measures
     for ``command``: the way behind a backing-out under way, else the arc the wheel turns to."""
     if rec.left > 0:
-        return rec.wheel, True
+        return _wheel(rec.wheel, body, dt), True
     return _wheel(command[0], body, dt), command[1] < 0
 
 
