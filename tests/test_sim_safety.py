@@ -287,3 +287,18 @@ def test_the_sweep_never_reaches_past_where_the_body_first_touches_deeper_than_a
         assert free <= first, (pose, delta, backward)
         tight += first < math.inf and free >= first - 2.0
     assert tight > 20                # and not far short of it: within two places' travel
+
+
+def test_backing_out_measures_the_arc_of_the_wheel_as_it_will_be_not_the_lock():
+    """A backing-out on the right lock with the wheel still straight: the next tick drives the
+    arc of the wheel 9 deg off straight, which meets a cell behind and to the right after 1.6
+    in; the lock's arc would leave 4.9 in. Measured on the lock, field 1076 of BARN's seed
+    1000 backed into a pole at 12 in/s."""
+    cell = np.array([[-15.0, -8.0]])
+    body = safety.Body(ROBOT, AT, 90.0, cell, 1.0, 0.0, 30.0)
+    rec = safety.Recovery(left=1.0, wheel=150.0)
+    (steer, speed), _ = safety.guard((90.0, 20.0), body, rec, 0.05)
+    after = safety.free_travel(cell, 1.0, AT, ROBOT, 9.0, True, 30.0)
+    assert steer == 150.0 and speed == -safety.brake(after, ROBOT.acceleration, 1.0, 0.05)
+    assert safety.first_sweep((90.0, 20.0), body, safety.Recovery(left=1.0, wheel=150.0),
+                              0.05) == (99.0, True)
