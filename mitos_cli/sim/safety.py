@@ -65,9 +65,9 @@ def free_travel(cells: np.ndarray, radius: float, pose: tuple[float, float, floa
     touched between two places, :func:`_between` looks closer. So no touch deeper than 1/16
     in (``step / 16``) passes between two places unseen: at full lock a front corner moves
     three to four times as far as the rear axle, and places a whole inch of the axle's path
-    apart let it clip a wall's corner. Only the cells in the box the footprint's circumscribed disc sweeps (grown by a
-    step) are tested: a cell outside it is touched nowhere along the arc, and each cell's test
-    is its own."""
+    apart let it clip a wall's corner. Only the cells in the box the footprint's circumscribed
+    disc sweeps (grown by a step) are tested: a cell outside it is touched nowhere along the
+    arc, and each cell's test is its own."""
     x, y, h = pose
     if not len(cells):
         return reach
