@@ -302,3 +302,16 @@ def test_backing_out_measures_the_arc_of_the_wheel_as_it_will_be_not_the_lock():
     assert steer == 150.0 and speed == -safety.brake(after, ROBOT.acceleration, 1.0, 0.05)
     assert safety.first_sweep((90.0, 20.0), body, safety.Recovery(left=1.0, wheel=150.0),
                               0.05) == (99.0, True)
+
+
+def test_a_backing_out_waits_for_its_wheel_where_the_arcs_on_the_way_are_shut():
+    """Nose in at full left lock, backing out on the right lock: the arcs the wheel passes on
+    its way over are shut behind, the lock's is not; the robot waits for the wheel instead of
+    giving the backing-out up (three of 1,000 `slalom` runs were stuck so)."""
+    cell = np.array([[-15.0, -8.0]])
+    body = safety.Body(ROBOT, AT, 30.0, cell, 1.0, 0.0, 30.0)
+    rec = safety.Recovery(left=1.0, wheel=150.0)
+    on_the_way = safety.free_travel(cell, 1.0, AT, ROBOT, -51.0, True, 30.0)
+    assert on_the_way <= 1.0 < safety.free_travel(cell, 1.0, AT, ROBOT, 60.0, True, 30.0)
+    (steer, speed), _ = safety.guard((90.0, 20.0), body, rec, 0.05)
+    assert (steer, speed) == (150.0, 0.0) and rec.left > 0

@@ -349,10 +349,13 @@ def guard(command: tuple[float, float], body: Body, rec: Recovery, dt: float,
 
     if rec.left > 0:
         rec.left -= dt
-        back = free(_wheel(rec.wheel, body, dt), True)   # the arc of the wheel still turning
+        wheel = _wheel(rec.wheel, body, dt)
+        back = free(wheel, True)                 # the arc of the wheel as it will be
         if back > cfg.margin:
             return (rec.wheel, -min(robot.max_reverse,
                                     brake(back, robot.acceleration, cfg.margin, dt))), False
+        if wheel != rec.wheel:                   # still turning to the lock: wait for it
+            return (rec.wheel, 0.0), False
         rec.left = 0.0
     steer, want = command
     wheel = _wheel(steer, body, dt)
