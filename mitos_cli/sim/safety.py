@@ -43,7 +43,8 @@ class Settings:
     margin: float = 1.0            # in: the body keeps this from what the robot knows
     reach: float = 30.0            # in: the least the brake looks along its arc (a robot
                                    # looks as far as stopping from its top speed takes)
-    step: float = 1.0              # in: the sweep's step along the rear axle's path
+    step: float = 1.0              # in: the most a cell's depth changes between two places of
+                                   # the sweep (the rear axle's travel between them, straight on)
     patience: float = 1.0          # s: held to a stop this long, the robot backs out
     back_time: float = 1.5         # s: how long one backing-out lasts
     back_room: float = 4.0         # in: it backs out only with this much free behind
