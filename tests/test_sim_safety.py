@@ -315,3 +315,35 @@ def test_a_backing_out_waits_for_its_wheel_where_the_arcs_on_the_way_are_shut():
     assert on_the_way <= 1.0 < safety.free_travel(cell, 1.0, AT, ROBOT, 60.0, True, 30.0)
     (steer, speed), _ = safety.guard((90.0, 20.0), body, rec, 0.05)
     assert (steer, speed) == (150.0, 0.0) and rec.left > 0
+
+
+def test_the_coarse_pass_leaves_out_no_cell_that_comes_within_a_step_of_the_body():
+    """:func:`safety._near` looks at every ``COARSE``-th place only; a cell it leaves out must
+    be below ``-step`` at every place (never touched, nor a pair of places :func:`_between`
+    looks between), on sweeps of every size and curvature (a small robot at full lock with a
+    long step has no bound), with cells strewn about the footprint at every place."""
+    rng = np.random.default_rng(20261205)
+    left_out, gaps = 0, []
+    for _ in range(300):
+        wb = float(rng.choice([4.0, rng.uniform(8, 40)]))
+        robot = Robot(wheelbase=wb, length=wb * rng.uniform(1.0, 2.0), width=wb * rng.uniform(0.5, 1.5))
+        radius, step = float(rng.uniform(0.2, 2.0)), float(rng.choice([0.25, 1.0, 2.0]))
+        delta = float(rng.choice([60.0, -60.0, 0.0, rng.uniform(-60, 60)]))
+        h, k, a, b, sin_h, cos_h, half, hl, hw, _, du = safety._sweep_of(
+            (0.0, 0.0, float(rng.uniform(-math.pi, math.pi))), robot, delta, radius, step)
+        u = safety._path(30.0, du, bool(rng.random() < 0.3))[None]
+        arc = safety.Arc(*(np.full((1, 1), v) for v in (h, k, a, b, sin_h, cos_h, half,
+                                                         abs(k) > 1e-9)))
+        c, s, cx, cy = arc.centres(u)
+        at = rng.integers(0, u.shape[1], 300)
+        spread = hl + hw + 2 * radius + 6 * step
+        px = cx[0, at, None] + rng.uniform(-spread, spread, (300, 1))
+        py = cy[0, at, None] + rng.uniform(-spread, spread, (300, 1))
+        reach = safety._depth(px - cx, py - cy, c, s, hl, hw, radius).max(axis=1)   # every place
+        places = (c, s, cx, cy, *safety._room(c, s, hl, hw, radius))
+        bound = safety._bound(*(np.full((1, 1), v) for v in (k, du, hl, hw, half, radius)), step)
+        near = safety._near(px, py, np.zeros(300, dtype=np.intp), places, bound[0])
+        assert not np.count_nonzero(~near & (reach >= -step))
+        left_out += np.count_nonzero(~near)
+        gaps += list(-step - reach[~near])
+    assert left_out > 20_000 and min(gaps) < 1.0      # it leaves out many, some near the edge

@@ -69,24 +69,19 @@ def free_travel(cells: np.ndarray, radius: float, pose: tuple[float, float, floa
     apart let it clip a wall's corner. Only the cells in the box the footprint's circumscribed
     disc sweeps (grown by a step) are tested: a cell outside it is touched nowhere along the
     arc, and each cell's test is its own."""
-    x, y, h = pose
     if not len(cells):
         return reach
-    wb, hl, hw = robot.wheelbase, robot.length / 2, robot.width / 2
-    k = -math.tan(math.radians(delta)) / wb          # rad per inch of the rear axle's path
-    du = _spacing(robot, k, radius, step)
+    h, k, a, b, sin_h, cos_h, half, hl, hw, disc, du = _sweep_of(pose, robot, delta, radius, step)
     u = _path(reach, du, backward)                   # [K]
-    arc = Arc(h, k, x - wb / 2 * math.cos(h), y - wb / 2 * math.sin(h), math.sin(h),
-              math.cos(h), wb / 2, abs(k) > 1e-9)
+    arc = Arc(h, k, a, b, sin_h, cos_h, half, abs(k) > 1e-9)
     c, s, cx, cy = arc.centres(u)                    # [K]: the footprint's centres
-    disc = math.hypot(hl, hw) + radius * math.sqrt(2) + step + 1e-6     # a cell's corner too
     px, py = cells[:, 0], cells[:, 1]
     swept = ((px >= cx.min() - disc) & (px <= cx.max() + disc)
              & (py >= cy.min() - disc) & (py <= cy.max() + disc))
     if not np.count_nonzero(swept):
         return reach
     px, py = px[swept, None], py[swept, None]
-    depth = _depth(px - cx, py - cy, c, s, hl, hw, radius)                   # [P, K]
+    depth = _depth_in(px - cx, py - cy, c, s, _room(c, s, hl, hw, radius))      # [P, K]
     inside = _touched(depth, backward)
     every = np.zeros(len(px), dtype=np.intp)
     _between(inside, depth, u[None], every, arc, px, py, hl, hw, radius, step)
@@ -94,6 +89,20 @@ def free_travel(cells: np.ndarray, radius: float, pose: tuple[float, float, floa
     if not np.count_nonzero(hit):
         return reach
     return float(max(int(hit.argmax()) - 1, 0) * du)
+
+
+def _sweep_of(pose: tuple[float, float, float], robot: Robot, delta: float, radius: float,
+              step: float) -> tuple[float, ...]:
+    """One sweep's numbers in Python floats, the same alone and among many: :class:`Arc`'s
+    heading, curvature, the rear axle's start, the heading's sine and cosine and half the
+    wheelbase; the footprint's half length and width, how far the box of the cells it may
+    touch reaches past its centres, and the places' spacing (:func:`_spacing`)."""
+    x, y, h = pose
+    wb, hl, hw = robot.wheelbase, robot.length / 2, robot.width / 2
+    k = -math.tan(math.radians(delta)) / wb          # rad per inch of the rear axle's path
+    disc = math.hypot(hl, hw) + radius * math.sqrt(2) + step + 1e-6     # a cell's corner too
+    return (h, k, x - wb / 2 * math.cos(h), y - wb / 2 * math.sin(h), math.sin(h), math.cos(h),
+            wb / 2, hl, hw, disc, _spacing(robot, k, radius, step))
 
 
 @dataclass(frozen=True)
@@ -198,13 +207,24 @@ def _depth(dx, dy, c, s, hl, hw, r):
     separate two rectangles, the footprint's two and the grid's. Taken as a disc of radius
     ``r``, a cell's corner stood 0.41 r out of it, and a flank sliding past a wall block at a
     slant met that corner with the brake's way free."""
+    return _depth_in(dx, dy, c, s, _room(c, s, hl, hw, r))
+
+
+def _room(c, s, hl, hw, r) -> tuple[Any, Any, Any, Any]:
+    """What of :func:`_depth` depends on the footprint's place alone, not on the cell: the
+    footprint's half extents grown by the cell's, along its own axes and along the grid's
+    (worked out once a place, not once a cell and place, in the order :func:`_depth` sums)."""
     ac, as_ = np.abs(c), np.abs(s)
     e = r * (ac + as_)                   # the cell's half extent along the footprint's axes
-    along = hl + e - np.abs(dx * c + dy * s)
-    across = hw + e - np.abs(dy * c - dx * s)
-    x = r + hl * ac + hw * as_ - np.abs(dx)      # the footprint's half extents on the grid's
-    y = r + hl * as_ + hw * ac - np.abs(dy)
-    return np.minimum(np.minimum(along, across), np.minimum(x, y))
+    return hl + e, hw + e, r + hl * ac + hw * as_, r + hl * as_ + hw * ac
+
+
+def _depth_in(dx, dy, c, s, room) -> np.ndarray:
+    """:func:`_depth` with the footprint's :func:`_room` at each place."""
+    along, across, x, y = room
+    along = along - np.abs(dx * c + dy * s)
+    across = across - np.abs(dy * c - dx * s)
+    return np.minimum(np.minimum(along, across), np.minimum(x - np.abs(dx), y - np.abs(dy)))
 
 
 def free_travels(sweeps: list[tuple[Body, float, bool]], step: float = 1.0) -> np.ndarray:
@@ -212,9 +232,9 @@ def free_travels(sweeps: list[tuple[Body, float, bool]], step: float = 1.0) -> n
     its body's ``reach``; runs in lockstep brake together), ``[R]``. What is one number per
     sweep is worked out as :func:`free_travel` does, in Python floats; the rest elementwise
     over ``[R, K]`` places (each sweep's own, its last repeated to the longest) and ``[M, K]``
-    for the ``M`` cells in the sweeps' boxes, each with its sweep's places (not padded to the
-    sweep with the most: a quarter of the cells would be real), so a sweep gets the bits it
-    gets alone."""
+    for the ``M`` cells in the sweeps' boxes that :func:`_near` keeps, each with its sweep's
+    places (not padded to the sweep with the most: a quarter of the cells would be real), so
+    a sweep gets the bits it gets alone."""
     if len(sweeps) == 1:                 # a robot alone: no batch to set up
         body, wheel, backward = sweeps[0]
         return np.array([free_travel(body.cells, body.radius, body.pose, body.robot,
@@ -225,50 +245,86 @@ def free_travels(sweeps: list[tuple[Body, float, bool]], step: float = 1.0) -> n
     if not rows:
         return out
     n = len(rows)
-    h, k, a, b, sin_h, cos_h, half, hl, hw, disc, du = (np.empty((n, 1)) for _ in range(11))
-    paths = []
-    for r, j in enumerate(rows):
-        body, wheel, backward = sweeps[j]
-        robot, (x, y, hh) = body.robot, body.pose
-        wb = robot.wheelbase
-        hl[r], hw[r] = robot.length / 2, robot.width / 2
-        delta = wheel - robot.steering_straight
-        kr = -math.tan(math.radians(delta)) / wb
-        h[r], k[r], half[r] = hh, kr, wb / 2
-        a[r], b[r] = x - wb / 2 * math.cos(hh), y - wb / 2 * math.sin(hh)
-        sin_h[r], cos_h[r] = math.sin(hh), math.cos(hh)
-        disc[r] = (math.hypot(float(hl[r, 0]), float(hw[r, 0])) + body.radius * math.sqrt(2)
-                   + step + 1e-6)
-        du[r] = _spacing(robot, kr, body.radius, step)
-        paths.append(_path(body.reach, float(du[r, 0]), backward))
-    own = np.array([len(path) for path in paths])
-    u = np.empty((n, int(own.max())))                      # [n, K]: each sweep's own places,
-    for r, path in enumerate(paths):                       # its last repeated after them
-        u[r, :len(path)], u[r, len(path):] = path, path[-1]
+    bodies = [sweeps[j][0] for j in rows]
+    back = np.array([sweeps[j][2] for j in rows])
+    h, k, a, b, sin_h, cos_h, half, hl, hw, disc, du = np.array([
+        _sweep_of(body.pose, body.robot, wheel - body.robot.steering_straight, body.radius, step)
+        for body, wheel, _ in (sweeps[j] for j in rows)]).T[:, :, None]       # [n, 1] each
+    rad = np.array([body.radius for body in bodies])[:, None]
+    reach = np.array([body.reach for body in bodies])[:, None]
+    own = (np.ceil(reach / du - 1e-9) + 1).astype(np.intp)       # as many places as _path's
+    u = np.minimum(np.arange(int(own.max())), own - 1) * np.where(back[:, None], -du, du)
     arc = Arc(h, k, a, b, sin_h, cos_h, half, np.abs(k) > 1e-9)
-    c, s, cx, cy = arc.centres(u)                              # the footprint's centres
+    c, s, cx, cy = arc.centres(u)              # [n, K]: the footprint at each sweep's places
     lo_x, hi_x = cx.min(axis=1) - disc[:, 0], cx.max(axis=1) + disc[:, 0]
     lo_y, hi_y = cy.min(axis=1) - disc[:, 0], cy.max(axis=1) + disc[:, 0]
-    cells = np.concatenate([sweeps[j][0].cells for j in rows])                # [P, 2]
-    owner = np.repeat(np.arange(n), [len(sweeps[j][0].cells) for j in rows])
+    cells = np.concatenate([body.cells for body in bodies])                     # [P, 2]
+    owner = np.repeat(np.arange(n), [len(body.cells) for body in bodies])
     px, py = cells[:, 0], cells[:, 1]
     swept = ((px >= lo_x[owner]) & (px <= hi_x[owner])
              & (py >= lo_y[owner]) & (py <= hi_y[owner]))
     if not np.count_nonzero(swept):
         return out
     px, py, owner = px[swept, None], py[swept, None], owner[swept]     # [M, 1], by sweep
-    rad = np.array([sweeps[j][0].radius for j in rows])[owner, None]
-    depth = _depth(px - cx[owner], py - cy[owner], c[owner], s[owner], hl[owner], hw[owner],
-                   rad)                                                           # [M, K]
-    inside = _touched(depth, np.array([sweeps[j][2] for j in rows])[owner])
-    _between(inside, depth, u, owner, arc, px, py, hl[owner], hw[owner], rad, step)
-    hit = np.zeros((n, len(u[0])), dtype=bool)
+    places = (c, s, cx, cy, *_room(c, s, hl, hw, rad))
+    near = _near(px, py, owner, places, _bound(k, du, hl, hw, half, rad, step)[owner, 0])
+    px, py, owner = px[near], py[near], owner[near]
+    if not len(owner):
+        return out
+    c, s, cx, cy, *room = (np.take(v, owner, axis=0) for v in places)
+    depth = _depth_in(px - cx, py - cy, c, s, room)                                # [M, K]
+    inside = _touched(depth, back[owner])
+    _between(inside, depth, u, owner, arc, px, py, hl[owner], hw[owner], rad[owner], step)
+    hit = np.zeros(u.shape, dtype=bool)
     first_of = np.flatnonzero(np.r_[True, owner[1:] != owner[:-1]])     # each sweep's run
     hit[owner[first_of]] = np.logical_or.reduceat(inside, first_of, axis=0)
-    hit &= np.arange(u.shape[1]) < own[:, None]                          # [n, K], its own
+    hit &= np.arange(u.shape[1]) < own                                   # [n, K], its own
     first = np.maximum(hit.argmax(axis=1) - 1, 0) * du[:, 0]
     out[rows] = np.where(np.logical_or.reduce(hit, axis=1), first, out[rows])
     return out
+
+
+#: The coarse pass (:func:`_near`) looks at every ``COARSE``-th place of a sweep, and its last.
+COARSE = 8
+#: in: far more than a depth's rounding (of the places, the footprint's centres and the depth
+#: itself: below 1e-5 in for coordinates of thousands of inches and curvatures above 1e-9)
+ROUNDING = 1e-3
+
+
+def _near(px: np.ndarray, py: np.ndarray, owner: np.ndarray, places: tuple[np.ndarray, ...],
+          bound: np.ndarray) -> np.ndarray:
+    """``[M]`` which cells (``px, py [M, 1]`` of sweeps ``owner [M]``) may reach a depth of
+    ``-step`` at one of their sweep's places (``places``: ``c, s, cx, cy`` and :func:`_room`,
+    each ``[R, K]``), from their depths at every ``COARSE``-th place and the last alone: a
+    cell deeper than ``-bound`` (:func:`_bound`) at none of those is below ``-step`` at every
+    place, so it is never touched, not even at the start (backing away, :func:`_touched`),
+    nor between two places (two depths below ``-step`` add up to less than ``-step``,
+    :func:`_between`). Leaving it out changes no bit of the answer, and most of the cells in
+    a sweep's box are out of its reach."""
+    last = places[0].shape[1] - 1
+    cols = np.r_[np.arange(0, last, COARSE), last]
+    c, s, cx, cy, *room = (np.take(v[:, cols], owner, axis=0) for v in places)
+    return _depth_in(px - cx, py - cy, c, s, room).max(axis=1) >= -bound
+
+
+def _bound(k: np.ndarray, du: np.ndarray, hl: np.ndarray, hw: np.ndarray, half: np.ndarray,
+           r: np.ndarray, step: float) -> np.ndarray:
+    """The depth a cell must reach at one of the places :func:`_near` looks at to reach
+    ``-step`` at a place between (of sweeps of curvature ``k``, places ``du`` apart, half the
+    wheelbase ``half``; cells of half side ``r``). Every place is at most ``h = COARSE du /
+    2`` of the axle's path from one looked at. Per inch of that path the footprint's centre
+    moves 1 along its heading and ``|k| half`` across it, and turns ``|k|`` rad; a cell at
+    depth ``-D`` or more lies within ``hl + 1.42 r + D`` of the centre along the heading and
+    ``hw + 1.42 r + D`` across it, so there no overlap of :func:`_depth` changes faster than
+    ``L = 1 + |k| (F + D)``, ``F = half + hl + hw + 2.83 r``. A cell at ``-T`` or more at a
+    place (``T = step + ROUNDING``) is thus at ``-T - L h`` or more within ``h`` of it, which
+    is ``-D`` for the ``D`` below. ``ROUNDING`` more covers the rounding of the depth looked
+    at as ``T`` does that of the other. Where ``|k| h`` nears 1, no bound (inf)."""
+    a = np.abs(k)
+    h = COARSE / 2 * du
+    f = half + hl + hw + 2 * math.sqrt(2) * r
+    d = (step + ROUNDING + h * (1 + a * f)) / np.maximum(1 - a * h, 0.5)
+    return np.where(a * h < 0.5, d + ROUNDING, np.inf)
 
 
 @functools.lru_cache(maxsize=16)
