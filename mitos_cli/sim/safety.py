@@ -83,9 +83,10 @@ def free_travel(cells: np.ndarray, radius: float, pose: tuple[float, float, floa
     px, py = px[swept, None], py[swept, None]
     depth = _depth_in(px - cx, py - cy, c, s, _room(c, s, hl, hw, radius))      # [P, K]
     inside = _touched(depth, backward)
-    every = np.zeros(len(px), dtype=np.intp)
-    _between(inside, depth, u[None], every, arc, px, py, hl, hw, radius, step)
     hit = np.logical_or.reduce(inside, axis=0)
+    cell, j = _pairs(inside, depth, step)
+    _between(hit[None], len(u), cell, j, np.zeros(len(px), dtype=np.intp), u[None], arc, px, py,
+             hl, hw, radius)
     if not np.count_nonzero(hit):
         return reach
     return float(max(int(hit.argmax()) - 1, 0) * du)
@@ -160,24 +161,34 @@ def _touched(depth: np.ndarray, backward) -> np.ndarray:
     return inside
 
 
-def _between(inside: np.ndarray, depth: np.ndarray, u: np.ndarray, owner: np.ndarray,
-             arc: Arc, px, py, hl, hw, radius, step: float) -> None:
-    """Mark in ``inside [P, K]`` the cells touched between two places ``j`` and ``j + 1`` (at
-    ``j + 1``). The depth changes by at most ``step`` from one place to the next, so a cell
-    can be touched between only where the two depths add up to ``-step`` or more; there
-    :data:`BETWEEN` - 1 places between are looked at, and a cell one of them touches counts.
-    Between two of those the depth changes by at most ``step / BETWEEN``: what is left unseen
-    is a graze of less than ``step / (2 BETWEEN)`` (1/16 in), not a corner swinging through a
-    cell. (Counting every pair that might graze would stop a robot sliding past a cell of its
-    map a few thousandths of an inch off, which the map's cells, larger than what they mark,
-    make common among poles.) ``u [R, K]`` the places of each sweep, ``owner [P]`` each cell's
-    sweep; a cell touched at the start is left out (backing away, only deeper places count)."""
+def _pairs(inside: np.ndarray, depth: np.ndarray, step: float) -> tuple[np.ndarray, np.ndarray]:
+    """``(cell, j)``: where a cell may be touched between two places ``j`` and ``j + 1`` of
+    ``depth [P, K]`` that touch it at neither (``inside``). The depth changes by at most
+    ``step`` from one place to the next, so only where the two depths add up to ``-step`` or
+    more; a cell touched at the start is left out (backing away, only deeper places count)."""
     maybe = (depth[:, :-1] + depth[:, 1:] >= -step) & ~inside[:, :-1] & ~inside[:, 1:]
     maybe &= depth[:, :1] < 0
-    cell, j = np.nonzero(maybe)
-    if not len(cell):
-        return
+    return np.divmod(np.flatnonzero(maybe), depth.shape[1] - 1)
+
+
+def _between(hit: np.ndarray, own, cell: np.ndarray, j: np.ndarray, owner: np.ndarray,
+             u: np.ndarray, arc: Arc, px, py, hl, hw, radius) -> None:
+    """Mark in ``hit [R, K]`` (where each sweep touches a cell, within its ``own`` places) the
+    places ``j + 1`` of the :func:`_pairs` ``(cell, j)`` where one of :data:`BETWEEN` - 1
+    places between ``j`` and ``j + 1`` touches the cell. Between two of those the depth
+    changes by at most ``step / BETWEEN``: what is left unseen is a graze of less than
+    ``step / (2 BETWEEN)`` (1/16 in), not a corner swinging through a cell. (Counting every
+    pair that might graze would stop a robot sliding past a cell of its map a few thousandths
+    of an inch off, which the map's cells, larger than what they mark, make common among
+    poles.) Only the pairs before a sweep's first touch are looked at: the first is all that
+    counts, and most pairs come after it. ``u [R, K]`` the places of each sweep, ``owner
+    [P]`` each cell's sweep."""
     rows = owner[cell]
+    first = np.where(np.logical_or.reduce(hit, axis=1), hit.argmax(axis=1), own)
+    keep = j + 1 < first[rows]
+    if not np.count_nonzero(keep):
+        return
+    cell, j, rows = cell[keep], j[keep], rows[keep]
     lo, hi = u[rows, j][:, None], u[rows, j + 1][:, None]
     t = np.arange(1, BETWEEN) / BETWEEN
     uu = lo + (hi - lo) * t                                               # [C, BETWEEN - 1]
@@ -185,7 +196,7 @@ def _between(inside: np.ndarray, depth: np.ndarray, u: np.ndarray, owner: np.nda
     pick = (lambda v: v[cell]) if np.ndim(hl) else (lambda v: v)
     dd = _depth(px[cell] - cx, py[cell] - cy, c, s, pick(hl), pick(hw), pick(radius))
     touch = np.logical_or.reduce(dd >= 0, axis=1)
-    inside[cell[touch], j[touch] + 1] = True
+    hit[rows[touch], j[touch] + 1] = True
 
 
 def _spacing(robot: Robot, k: float, radius: float, step: float) -> float:
@@ -274,11 +285,12 @@ def free_travels(sweeps: list[tuple[Body, float, bool]], step: float = 1.0) -> n
     c, s, cx, cy, *room = (np.take(v, owner, axis=0) for v in places)
     depth = _depth_in(px - cx, py - cy, c, s, room)                                # [M, K]
     inside = _touched(depth, back[owner])
-    _between(inside, depth, u, owner, arc, px, py, hl[owner], hw[owner], rad[owner], step)
     hit = np.zeros(u.shape, dtype=bool)
     first_of = np.flatnonzero(np.r_[True, owner[1:] != owner[:-1]])     # each sweep's run
     hit[owner[first_of]] = np.logical_or.reduceat(inside, first_of, axis=0)
     hit &= np.arange(u.shape[1]) < own                                   # [n, K], its own
+    cell, j = _pairs(inside, depth, step)
+    _between(hit, own[:, 0], cell, j, owner, u, arc, px, py, hl[owner], hw[owner], rad[owner])
     first = np.maximum(hit.argmax(axis=1) - 1, 0) * du[:, 0]
     out[rows] = np.where(np.logical_or.reduce(hit, axis=1), first, out[rows])
     return out
