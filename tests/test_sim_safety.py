@@ -347,3 +347,22 @@ def test_the_coarse_pass_leaves_out_no_cell_that_comes_within_a_step_of_the_body
         left_out += np.count_nonzero(~near)
         gaps += list(-step - reach[~near])
     assert left_out > 20_000 and min(gaps) < 1.0      # it leaves out many, some near the edge
+
+
+def test_sweeps_measured_a_few_cells_at_a_time_get_the_bits_they_get_at_once(monkeypatch):
+    """:func:`safety.free_travels` works out ``CHUNK`` elements at a time; a chunk of a cell
+    or two (a sweep's cells split among chunks) gives each sweep what it gets alone."""
+    rng = np.random.default_rng(7)
+    sweeps = []
+    for _ in range(12):
+        pose = (float(rng.uniform(-5, 5)), float(rng.uniform(-5, 5)), float(rng.uniform(-4, 4)))
+        cells = rng.uniform(-50, 50, (int(rng.choice([0, 5, 60])), 2))
+        cells = cells[np.hypot(cells[:, 0] - pose[0], cells[:, 1] - pose[1]) > 16.0]
+        body = safety.Body(ROBOT, pose, 90.0, cells, 1.0, 0.0, 30.0)
+        sweeps.append((body, float(rng.choice([90.0, 30.0, 150.0, rng.uniform(30, 150)])),
+                       bool(rng.random() < 0.3)))
+    alone = [body.free(wheel, backward, safety.Settings()) for body, wheel, backward in sweeps]
+    assert safety.free_travels(sweeps).tolist() == alone
+    monkeypatch.setattr(safety, "CHUNK", 50)
+    assert safety.free_travels(sweeps).tolist() == alone
+    assert 30.0 in alone and len(set(alone)) > 3

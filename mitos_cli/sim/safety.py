@@ -199,6 +199,18 @@ def _between(hit: np.ndarray, own, cell: np.ndarray, j: np.ndarray, owner: np.nd
     hit[rows[touch], j[touch] + 1] = True
 
 
+#: Elements (float64, 128 KB) in one of the ``[M, K]`` arrays worked out at a time: the
+#: arrays of a whole batch at once were too large for the allocator to keep, and came fresh
+#: from the system at every call, a page fault every 4 KB (30% of a lockstep sweep's time).
+CHUNK = 16384
+
+
+def _chunks(rows: int, width: int) -> list[slice]:
+    """Slices of ``rows`` rows of ``width`` elements each, :data:`CHUNK` elements at most."""
+    per = max(CHUNK // max(width, 1), 1)
+    return [slice(lo, lo + per) for lo in range(0, rows, per)]
+
+
 def _spacing(robot: Robot, k: float, radius: float, step: float) -> float:
     """The rear axle's travel between two places of the footprint along an arc of curvature
     ``k`` (rad per inch) such that no cell's depth (:func:`_depth`) changes by more than
@@ -278,18 +290,23 @@ def free_travels(sweeps: list[tuple[Body, float, bool]], step: float = 1.0) -> n
         return out
     px, py, owner = px[swept, None], py[swept, None], owner[swept]     # [M, 1], by sweep
     places = (c, s, cx, cy, *_room(c, s, hl, hw, rad))
-    near = _near(px, py, owner, places, _bound(k, du, hl, hw, half, rad, step)[owner, 0])
+    bound = _bound(k, du, hl, hw, half, rad, step)[owner, 0]
+    near = np.concatenate([_near(px[part], py[part], owner[part], places, bound[part])
+                           for part in _chunks(len(owner), u.shape[1] // COARSE + 2)])
     px, py, owner = px[near], py[near], owner[near]
     if not len(owner):
         return out
-    c, s, cx, cy, *room = (np.take(v, owner, axis=0) for v in places)
-    depth = _depth_in(px - cx, py - cy, c, s, room)                                # [M, K]
-    inside = _touched(depth, back[owner])
-    hit = np.zeros(u.shape, dtype=bool)
-    first_of = np.flatnonzero(np.r_[True, owner[1:] != owner[:-1]])     # each sweep's run
-    hit[owner[first_of]] = np.logical_or.reduceat(inside, first_of, axis=0)
+    hit, pairs = np.zeros(u.shape, dtype=bool), []
+    for part in _chunks(len(owner), u.shape[1]):
+        c, s, cx, cy, *room = (np.take(v, owner[part], axis=0) for v in places)
+        depth = _depth_in(px[part] - cx, py[part] - cy, c, s, room)                 # [M, K]
+        inside = _touched(depth, back[owner[part]])
+        first_of = np.flatnonzero(np.r_[True, np.diff(owner[part]) != 0])   # each sweep's run
+        hit[owner[part][first_of]] |= np.logical_or.reduceat(inside, first_of, axis=0)
+        cell, j = _pairs(inside, depth, step)
+        pairs.append((cell + part.start, j))
     hit &= np.arange(u.shape[1]) < own                                   # [n, K], its own
-    cell, j = _pairs(inside, depth, step)
+    cell, j = (np.concatenate(v) for v in zip(*pairs))
     _between(hit, own[:, 0], cell, j, owner, u, arc, px, py, hl[owner], hw[owner], rad[owner])
     first = np.maximum(hit.argmax(axis=1) - 1, 0) * du[:, 0]
     out[rows] = np.where(np.logical_or.reduce(hit, axis=1), first, out[rows])
