@@ -152,12 +152,10 @@ def _touched(depth: np.ndarray, backward) -> np.ndarray:
     cell it touches already (a mark a noisy echo put at its edge), only the places deeper in
     (``backward``: a bool, or one per cell)."""
     inside = depth >= 0
-    if backward is False:
+    if backward is False or not np.count_nonzero(backward):
         return inside
     back = np.broadcast_to(np.asarray(backward), (len(depth),))
-    if np.count_nonzero(back):
-        inside[back] = np.where(inside[back][:, :1], depth[back] > depth[back][:, :1],
-                                inside[back])
+    inside[back] = np.where(inside[back][:, :1], depth[back] > depth[back][:, :1], inside[back])
     return inside
 
 
@@ -291,8 +289,9 @@ def free_travels(sweeps: list[tuple[Body, float, bool]], step: float = 1.0) -> n
     px, py, owner = px[swept, None], py[swept, None], owner[swept]     # [M, 1], by sweep
     places = (c, s, cx, cy, *_room(c, s, hl, hw, rad))
     bound = _bound(k, du, hl, hw, half, rad, step)[owner, 0]
-    near = np.concatenate([_near(px[part], py[part], owner[part], places, bound[part])
-                           for part in _chunks(len(owner), u.shape[1] // COARSE + 2)])
+    coarse = tuple(v[:, _coarse(u.shape[1])] for v in places)
+    near = np.concatenate([_near(px[part], py[part], owner[part], coarse, bound[part])
+                           for part in _chunks(len(owner), coarse[0].shape[1])])
     px, py, owner = px[near], py[near], owner[near]
     if not len(owner):
         return out
@@ -301,7 +300,7 @@ def free_travels(sweeps: list[tuple[Body, float, bool]], step: float = 1.0) -> n
         c, s, cx, cy, *room = (np.take(v, owner[part], axis=0) for v in places)
         depth = _depth_in(px[part] - cx, py[part] - cy, c, s, room)                 # [M, K]
         inside = _touched(depth, back[owner[part]])
-        first_of = np.flatnonzero(np.r_[True, np.diff(owner[part]) != 0])   # each sweep's run
+        first_of = _runs(owner[part])
         hit[owner[part][first_of]] |= np.logical_or.reduceat(inside, first_of, axis=0)
         cell, j = _pairs(inside, depth, step)
         pairs.append((cell + part.start, j))
@@ -320,20 +319,28 @@ COARSE = 8
 ROUNDING = 1e-3
 
 
-def _near(px: np.ndarray, py: np.ndarray, owner: np.ndarray, places: tuple[np.ndarray, ...],
+def _near(px: np.ndarray, py: np.ndarray, owner: np.ndarray, coarse: tuple[np.ndarray, ...],
           bound: np.ndarray) -> np.ndarray:
     """``[M]`` which cells (``px, py [M, 1]`` of sweeps ``owner [M]``) may reach a depth of
-    ``-step`` at one of their sweep's places (``places``: ``c, s, cx, cy`` and :func:`_room`,
-    each ``[R, K]``), from their depths at every ``COARSE``-th place and the last alone: a
+    ``-step`` at one of their sweep's places, from their depths at the :func:`_coarse`
+    places alone (``coarse``: ``c, s, cx, cy`` and :func:`_room` there, each ``[R, C]``): a
     cell deeper than ``-bound`` (:func:`_bound`) at none of those is below ``-step`` at every
     place, so it is never touched, not even at the start (backing away, :func:`_touched`),
     nor between two places (two depths below ``-step`` add up to less than ``-step``,
-    :func:`_between`). Leaving it out changes no bit of the answer, and most of the cells in
-    a sweep's box are out of its reach."""
-    last = places[0].shape[1] - 1
-    cols = np.r_[np.arange(0, last, COARSE), last]
-    c, s, cx, cy, *room = (np.take(v[:, cols], owner, axis=0) for v in places)
+    :func:`_pairs`). Leaving it out changes no bit of the answer, and most of the cells in a
+    sweep's box are out of its reach."""
+    c, s, cx, cy, *room = (np.take(v, owner, axis=0) for v in coarse)
     return _depth_in(px - cx, py - cy, c, s, room).max(axis=1) >= -bound
+
+
+def _coarse(places: int) -> np.ndarray:
+    """The places :func:`_near` looks at of ``places``: every ``COARSE``-th and the last."""
+    return np.append(np.arange(0, places - 1, COARSE), places - 1)
+
+
+def _runs(owner: np.ndarray) -> np.ndarray:
+    """Where each run of equal owners begins in ``owner`` (sorted)."""
+    return np.append(0, np.flatnonzero(owner[1:] != owner[:-1]) + 1)
 
 
 def _bound(k: np.ndarray, du: np.ndarray, hl: np.ndarray, hw: np.ndarray, half: np.ndarray,
