@@ -340,10 +340,9 @@ def test_the_coarse_pass_leaves_out_no_cell_that_comes_within_a_step_of_the_body
         px = cx[0, at, None] + rng.uniform(-spread, spread, (300, 1))
         py = cy[0, at, None] + rng.uniform(-spread, spread, (300, 1))
         reach = safety._depth(px - cx, py - cy, c, s, hl, hw, radius).max(axis=1)   # every place
-        coarse = tuple(v[:, safety._coarse(u.shape[1])]
-                       for v in (c, s, cx, cy, *safety._room(c, s, hl, hw, radius)))
+        places = (c, s, cx, cy, *safety._room(c, s, hl, hw, radius))
         bound = safety._bound(*(np.full((1, 1), v) for v in (k, du, hl, hw, half, radius)), step)
-        near = safety._near(px, py, np.zeros(300, dtype=np.intp), coarse, bound[0])
+        near = safety._near(px, py, np.zeros(300, dtype=np.intp), places, bound[:, 0])
         assert not np.count_nonzero(~near & (reach >= -step))
         left_out += np.count_nonzero(~near)
         gaps += list(-step - reach[~near])

@@ -63,12 +63,12 @@ def free_travel(cells: np.ndarray, radius: float, pose: tuple[float, float, floa
 
     The footprint is placed every :func:`_spacing` along the arc, close enough that no cell's
     depth changes by more than ``step`` from one place to the next; where a cell might be
-    touched between two places, :func:`_between` looks closer. So no touch deeper than 1/16
-    in (``step / 16``) passes between two places unseen: at full lock a front corner moves
-    three to four times as far as the rear axle, and places a whole inch of the axle's path
-    apart let it clip a wall's corner. Only the cells in the box the footprint's circumscribed
-    disc sweeps (grown by a step) are tested: a cell outside it is touched nowhere along the
-    arc, and each cell's test is its own."""
+    touched between two places (:func:`_pairs`), :func:`_between` looks closer. So no touch
+    deeper than 1/16 in (``step / 16``) passes between two places unseen: at full lock a front
+    corner moves three to four times as far as the rear axle, and places a whole inch of the
+    axle's path apart let it clip a wall's corner. Only the cells in the box the footprint's
+    circumscribed disc sweeps (grown by a step) are tested: a cell outside it is touched
+    nowhere along the arc, and each cell's test is its own."""
     if not len(cells):
         return reach
     h, k, a, b, sin_h, cos_h, half, hl, hw, disc, du = _sweep_of(pose, robot, delta, radius, step)
@@ -265,47 +265,27 @@ def free_travels(sweeps: list[tuple[Body, float, bool]], step: float = 1.0) -> n
     rows = [j for j, (body, _, _) in enumerate(sweeps) if len(body.cells)]
     if not rows:
         return out
-    n = len(rows)
     bodies = [sweeps[j][0] for j in rows]
     back = np.array([sweeps[j][2] for j in rows])
     h, k, a, b, sin_h, cos_h, half, hl, hw, disc, du = np.array([
         _sweep_of(body.pose, body.robot, wheel - body.robot.steering_straight, body.radius, step)
-        for body, wheel, _ in (sweeps[j] for j in rows)]).T[:, :, None]       # [n, 1] each
+        for body, wheel, _ in (sweeps[j] for j in rows)]).T[:, :, None]       # [R, 1] each
     rad = np.array([body.radius for body in bodies])[:, None]
     reach = np.array([body.reach for body in bodies])[:, None]
     own = (np.ceil(reach / du - 1e-9) + 1).astype(np.intp)       # as many places as _path's
     u = np.minimum(np.arange(int(own.max())), own - 1) * np.where(back[:, None], -du, du)
     arc = Arc(h, k, a, b, sin_h, cos_h, half, np.abs(k) > 1e-9)
-    c, s, cx, cy = arc.centres(u)              # [n, K]: the footprint at each sweep's places
-    lo_x, hi_x = cx.min(axis=1) - disc[:, 0], cx.max(axis=1) + disc[:, 0]
-    lo_y, hi_y = cy.min(axis=1) - disc[:, 0], cy.max(axis=1) + disc[:, 0]
-    cells = np.concatenate([body.cells for body in bodies])                     # [P, 2]
-    owner = np.repeat(np.arange(n), [len(body.cells) for body in bodies])
-    px, py = cells[:, 0], cells[:, 1]
-    swept = ((px >= lo_x[owner]) & (px <= hi_x[owner])
-             & (py >= lo_y[owner]) & (py <= hi_y[owner]))
-    if not np.count_nonzero(swept):
+    c, s, cx, cy = arc.centres(u)              # [R, K]: the footprint at each sweep's places
+    px, py, owner = _in_boxes(bodies, cx, cy, disc[:, 0])                # [M, 1], by sweep
+    if not len(owner):
         return out
-    px, py, owner = px[swept, None], py[swept, None], owner[swept]     # [M, 1], by sweep
     places = (c, s, cx, cy, *_room(c, s, hl, hw, rad))
-    bound = _bound(k, du, hl, hw, half, rad, step)[owner, 0]
-    coarse = tuple(v[:, _coarse(u.shape[1])] for v in places)
-    near = np.concatenate([_near(px[part], py[part], owner[part], coarse, bound[part])
-                           for part in _chunks(len(owner), coarse[0].shape[1])])
+    near = _near(px, py, owner, places, _bound(k, du, hl, hw, half, rad, step)[:, 0])
     px, py, owner = px[near], py[near], owner[near]
     if not len(owner):
         return out
-    hit, pairs = np.zeros(u.shape, dtype=bool), []
-    for part in _chunks(len(owner), u.shape[1]):
-        c, s, cx, cy, *room = (np.take(v, owner[part], axis=0) for v in places)
-        depth = _depth_in(px[part] - cx, py[part] - cy, c, s, room)                 # [M, K]
-        inside = _touched(depth, back[owner[part]])
-        first_of = _runs(owner[part])
-        hit[owner[part][first_of]] |= np.logical_or.reduceat(inside, first_of, axis=0)
-        cell, j = _pairs(inside, depth, step)
-        pairs.append((cell + part.start, j))
-    hit &= np.arange(u.shape[1]) < own                                   # [n, K], its own
-    cell, j = (np.concatenate(v) for v in zip(*pairs))
+    hit, cell, j = _touches(px, py, owner, places, back, step)
+    hit &= np.arange(u.shape[1]) < own                                   # [R, K], its own
     _between(hit, own[:, 0], cell, j, owner, u, arc, px, py, hl[owner], hw[owner], rad[owner])
     first = np.maximum(hit.argmax(axis=1) - 1, 0) * du[:, 0]
     out[rows] = np.where(np.logical_or.reduce(hit, axis=1), first, out[rows])
@@ -319,18 +299,58 @@ COARSE = 8
 ROUNDING = 1e-3
 
 
-def _near(px: np.ndarray, py: np.ndarray, owner: np.ndarray, coarse: tuple[np.ndarray, ...],
+def _in_boxes(bodies: list[Body], cx: np.ndarray, cy: np.ndarray,
+              disc: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The cells (``px, py [M, 1]``) in the box each body's sweep may touch (its centres
+    ``cx, cy [R, K]``, grown by ``disc [R]``), and their sweep (``owner [M]``, sorted)."""
+    lo_x, hi_x = cx.min(axis=1) - disc, cx.max(axis=1) + disc
+    lo_y, hi_y = cy.min(axis=1) - disc, cy.max(axis=1) + disc
+    cells = np.concatenate([body.cells for body in bodies])                     # [P, 2]
+    owner = np.repeat(np.arange(len(bodies)), [len(body.cells) for body in bodies])
+    px, py = cells[:, 0], cells[:, 1]
+    swept = ((px >= lo_x[owner]) & (px <= hi_x[owner])
+             & (py >= lo_y[owner]) & (py <= hi_y[owner]))
+    return px[swept, None], py[swept, None], owner[swept]
+
+
+def _near(px: np.ndarray, py: np.ndarray, owner: np.ndarray, places: tuple[np.ndarray, ...],
           bound: np.ndarray) -> np.ndarray:
     """``[M]`` which cells (``px, py [M, 1]`` of sweeps ``owner [M]``) may reach a depth of
-    ``-step`` at one of their sweep's places, from their depths at the :func:`_coarse`
-    places alone (``coarse``: ``c, s, cx, cy`` and :func:`_room` there, each ``[R, C]``): a
-    cell deeper than ``-bound`` (:func:`_bound`) at none of those is below ``-step`` at every
-    place, so it is never touched, not even at the start (backing away, :func:`_touched`),
-    nor between two places (two depths below ``-step`` add up to less than ``-step``,
-    :func:`_pairs`). Leaving it out changes no bit of the answer, and most of the cells in a
-    sweep's box are out of its reach."""
-    c, s, cx, cy, *room = (np.take(v, owner, axis=0) for v in coarse)
-    return _depth_in(px - cx, py - cy, c, s, room).max(axis=1) >= -bound
+    ``-step`` at one of their sweep's ``places`` (``c, s, cx, cy`` and :func:`_room`, each
+    ``[R, K]``), from their depths at the :func:`_coarse` places alone: a cell deeper than
+    ``-bound [R]`` (:func:`_bound`) at none of those is below ``-step`` at every place, so it
+    is never touched, not even at the start (backing away, :func:`_touched`), nor between two
+    places (two depths below ``-step`` add up to less than ``-step``, :func:`_pairs`).
+    Leaving it out changes no bit of the answer, and most of the cells in a sweep's box are
+    out of its reach."""
+    coarse = tuple(v[:, _coarse(v.shape[1])] for v in places)
+
+    def deep(part: slice) -> np.ndarray:
+        c, s, cx, cy, *room = (np.take(v, owner[part], axis=0) for v in coarse)
+        return _depth_in(px[part] - cx, py[part] - cy, c, s, room).max(axis=1)
+
+    return np.concatenate([deep(part) >= -bound[owner[part]]
+                           for part in _chunks(len(owner), coarse[0].shape[1])])
+
+
+def _touches(px: np.ndarray, py: np.ndarray, owner: np.ndarray, places: tuple[np.ndarray, ...],
+             back: np.ndarray, step: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Where each sweep touches a cell (``[R, K]``, :func:`_touched`; backing out, ``back
+    [R]``) and the pairs of places a cell may be touched between (:func:`_pairs`), worked
+    out :data:`CHUNK` elements at a time: the cells ``px, py [M, 1]`` of sweeps ``owner
+    [M]`` (sorted) at their sweep's ``places`` (as :func:`_near` takes them)."""
+    hit = np.zeros(places[0].shape, dtype=bool)
+    pairs = []
+    for part in _chunks(len(owner), places[0].shape[1]):
+        c, s, cx, cy, *room = (np.take(v, owner[part], axis=0) for v in places)
+        depth = _depth_in(px[part] - cx, py[part] - cy, c, s, room)                 # [M, K]
+        inside = _touched(depth, back[owner[part]])
+        first_of = _runs(owner[part])
+        hit[owner[part][first_of]] |= np.logical_or.reduceat(inside, first_of, axis=0)
+        cell, j = _pairs(inside, depth, step)
+        pairs.append((cell + part.start, j))
+    cell, j = (np.concatenate(v) for v in zip(*pairs))
+    return hit, cell, j
 
 
 def _coarse(places: int) -> np.ndarray:
