@@ -17,6 +17,7 @@ Randomness: ``SeedSequence(seed).spawn(1 + robots)``: the first stream randomise
 
 from __future__ import annotations
 
+import itertools
 import math
 import operator
 import os
@@ -254,6 +255,13 @@ def _footprints(pose: np.ndarray, robots) -> np.ndarray:
                         np.array([r.length for r in robots]), np.array([r.width for r in robots]))
 
 
+def _rows_of(parts: list[np.ndarray]) -> np.ndarray:
+    """``[P, 2]``: the rows of ``parts`` one after the other (one part: itself)."""
+    if len(parts) == 1:
+        return parts[0]
+    return np.concatenate(parts) if parts else np.zeros((0, 2))
+
+
 def _columns(*columns: np.ndarray) -> np.ndarray:
     """``np.stack(columns, axis=1)``, without its Python set-up (a tick makes a few)."""
     out = np.empty((len(columns[0]), len(columns)))
@@ -423,6 +431,7 @@ class Simulation:
         self._done = self.steps <= 0
         self._hit = np.zeros(n, dtype=bool)
         self._beyond_at: tuple = (None, [])             # see _beyond()
+        self._watched: tuple = (None, [], {}, [])       # see watching()
         self._observed: _Sensed | None = None
         self._deciding: _Sensed | None = None
         self.record: list[Tick] = []
@@ -726,19 +735,24 @@ class Simulation:
         dirs = self._dirs[0][None] if self.n == 1 else np.stack(self._dirs)
         return self._maps, s.pose[:, :2], dirs, s.ranges, self.world.sensors.range
 
-    def aims(self, s: _Sensed, frames: list[perception.Frame]) -> list[perception.Aim]:
+    def aims(self, s: _Sensed, frames: list[perception.Frame],
+             entered: tuple[np.ndarray, np.ndarray] | None = None) -> list[perception.Aim]:
         """Each robot's :class:`.perception.Aim` at tick ``s``, its map cleared
         (:meth:`clearing`): where it is on its route, its map marked from its readings (and
         its route replanned if need be) and what its pursuit point keeps clear of (runs in
         lockstep find their pursuit points together); ``frames``: where they are on their
-        routes (:meth:`framing`)."""
+        routes (:meth:`framing`); ``entered``: :func:`.movers.entered` of what it is
+        :meth:`watching` (runs in lockstep test theirs together; ``None``: tested here)."""
+        if entered is None:
+            spaces, points, dirs, counts = self.watching(s)
+            entered = movers.entered(spaces, s.t, points, dirs, counts)
+        _, learned, _, ends = self._watched
         routes, out = self._routes, []
         for i in range(self.n):
             f = frames[i]
             rmap = self._maps[i]
-            learned = self._learn(i, s)
-            sweep = self._sweep(i, s)
-            if (learned or sweep is not None or rmap.refuge is not None) and self._active[i]:
+            sweep = self._sweep(i, s, *(e[ends[i]:ends[i + 1]] for e in entered))
+            if (learned[i] or sweep is not None or rmap.refuge is not None) and self._active[i]:
                 route = knowledge.replan(rmap, routes[i], f.s, s.pose[i, :2],
                                          self.world.agents[i].goal, s.t, *self._asked[i],
                                          self._cfg.sight, self.world.replan,
@@ -835,10 +849,33 @@ class Simulation:
         rmap.mark_cells(self._beyond(i, s)[seen])    # = rmap.mark(hits[seen], dirs[seen])
         return len(rmap.fresh) > before
 
-    def _sweep(self, i: int, s: _Sensed) -> movers.Sweep | None:
+    def watching(self, s: _Sensed) -> tuple[list[movers.FreeSpace], np.ndarray, np.ndarray,
+                                            list[int]]:
+        """Each robot's map marked from its readings at tick ``s`` (:meth:`_learn`), and what
+        :func:`.movers.entered` tests for its tracks (runs in lockstep test theirs
+        together): the beams each robot following something kept, the echoes and beams of
+        the readings it sees that its map does not show, and how many are each robot's."""
+        learned = [self._learn(i, s) for i in range(self.n)]
+        follows = ([] if self.world.replan == "never" else         # (what _sweep follows)
+                   [i for i in range(self.n)
+                    if self._trackers[i].tracks or np.count_nonzero(self._seen[i])])
+        hits = {i: s.pose[i, :2] + s.ranges[i, :, None] * self._dirs[i] for i in follows}
+        counts = [int(np.count_nonzero(self._seen[i])) for i in follows]
+        ends = [0] * (self.n + 1)
+        for i, count in zip(follows, counts):
+            ends[i + 1] = count
+        self._watched = (s, learned, hits, list(itertools.accumulate(ends)))
+        seen = [self._seen[i] for i in follows]
+        return ([self._free[i] for i in follows],
+                _rows_of([hits[i][k] for i, k in zip(follows, seen)]),
+                _rows_of([self._dirs[i][k] for i, k in zip(follows, seen)]), counts)
+
+    def _sweep(self, i: int, s: _Sensed, tested: np.ndarray, entered: np.ndarray
+               ) -> movers.Sweep | None:
         """Robot ``i``'s tracks of what its readings show and its map does not, brought up
-        to tick ``s`` (:mod:`.movers`), and where the movers among them will pass while it
-        gets out of their way (``None`` when nothing comes toward it)."""
+        to tick ``s`` (:mod:`.movers`; ``tested`` and ``entered``: what :meth:`watching`
+        found of its echoes), and where the movers among them will pass while it gets out of
+        their way (``None`` when nothing comes toward it)."""
         if self.world.replan == "never":
             return None
         seen, p, dirs = self._seen[i], s.pose[i, :2], self._dirs[i]
@@ -846,9 +883,8 @@ class Simulation:
         if not tracker.tracks and not np.count_nonzero(seen):    # nothing to follow
             free.update(s.t, p, dirs, s.ranges[i])
             return None
-        hits = p + s.ranges[i, :, None] * dirs
+        hits = self._watched[2][i]
         runs = movers.objects(hits, seen, self.world.sensors.layout == "ring")
-        tested, entered = free.entered(s.t, hits[seen], dirs[seen])
         free.update(s.t, p, dirs, s.ranges[i])
         at = np.add.accumulate(seen, dtype=np.intp) - 1      # a seen beam's place among the seen
         # an object moved when most of its echoes that a beam's line had crossed came where

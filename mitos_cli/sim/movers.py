@@ -34,6 +34,7 @@ say.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -283,33 +284,50 @@ class FreeSpace:
         echo against the beams kept from the last ``WINDOW`` s (before ``now``): which lie on
         the line of one (within ``near``: the robot's map clears a mark the same way), and
         which of those lay short of its echo then (something came where nothing was)."""
-        live = (self.times >= now - WINDOW) & (self.times < now)
-        if not len(points) or not np.count_nonzero(live):
-            none = np.zeros(len(points), dtype=bool)
-            return none, none
-        pose, ranges = self.poses[live], self.ranges[live]                  # [J, 3], [J, B]
-        q = points + dirs * STEP
-        rel = q[:, None, :] - pose[None, :, :2]                             # [P, J, 2]
-        dist = np.hypot(rel[..., 0], rel[..., 1])
-        ahead = np.arctan2(rel[..., 1], rel[..., 0]) - pose[None, :, 2]     # from the heading
-        if not self.ring:        # a fan's beams do not wrap round: (-pi, pi] before its first
-            ahead = np.mod(ahead + np.pi, 2 * np.pi) - np.pi
-        bearing = ahead - self.a0
-        beams = ranges.shape[1]
-        k = np.rint(bearing / self.step) if self.step else np.zeros_like(bearing)
-        if self.ring:           # every direction has its beam (a NaN would fail the look-up)
-            inside = None
-            k = np.mod(k, beams).astype(np.int64)
-        else:
-            inside = (k >= 0) & (k < beams)
-            k = clip_arrays(k, 0, beams - 1).astype(np.int64)
-        off = np.mod(bearing - k * self.step + np.pi, 2 * np.pi) - np.pi    # from that beam
-        reach = ranges[np.arange(len(pose))[None, :], k]                    # [P, J]
-        on = (np.abs(off) < np.pi / 2) & (dist * np.abs(np.sin(off)) < self.near)
-        if inside is not None:
-            on &= inside
-        passed = on & (dist * np.cos(off) < reach - SHORT)
-        return np.logical_or.reduce(on, axis=1), np.logical_or.reduce(passed, axis=1)
+        return entered([self], now, points, dirs, [len(points)])
+
+
+def entered(spaces: Sequence[FreeSpace], now: float, points: np.ndarray, dirs: np.ndarray,
+            counts: Sequence[int]) -> tuple[np.ndarray, np.ndarray]:
+    """:meth:`FreeSpace.entered` of the echoes of many robots at once: the first ``counts[0]``
+    of ``points [P, 2]`` and ``dirs [P, 2]`` against ``spaces[0]``, the next ``counts[1]``
+    against ``spaces[1]``... (beams of one layout; robots in lockstep test theirs together).
+    A robot's echoes are a handful, so one ``[P, J]`` pass for all is cheaper than one per
+    robot; each element is worked as it would be alone, and the beams not kept from the
+    last ``WINDOW`` s are masked out instead of left out."""
+    if not len(points):
+        none = np.zeros(0, dtype=bool)
+        return none, none
+    first = spaces[0]
+    slots, beams = first.ranges.shape
+    if len(spaces) == 1:     # one robot: its own arrays, broadcast ([1, J])
+        times, pose, ranges = first.times[None], first.poses[None], first.ranges
+        row = np.arange(slots) * beams
+    else:
+        owner = np.repeat(np.arange(len(spaces)), counts)                     # [P]
+        times = np.array([sp.times for sp in spaces])[owner]                  # [P, J]
+        pose = np.array([sp.poses for sp in spaces])[owner]                   # [P, J, 3]
+        ranges = np.array([sp.ranges for sp in spaces])                       # [R, J, B]
+        row = (owner[:, None] * slots + np.arange(slots)) * beams             # [P, J]
+    live = (times >= now - WINDOW) & (times < now)
+    q = points + dirs * STEP
+    rel = q[:, None, :] - pose[..., :2]                                       # [P, J, 2]
+    dist = np.hypot(rel[..., 0], rel[..., 1])
+    ahead = np.arctan2(rel[..., 1], rel[..., 0]) - pose[..., 2]           # from the heading
+    if not first.ring:       # a fan's beams do not wrap round: (-pi, pi] before its first
+        ahead = np.mod(ahead + np.pi, 2 * np.pi) - np.pi
+    bearing = ahead - first.a0
+    k = np.rint(bearing / first.step) if first.step else np.zeros_like(bearing)
+    if first.ring:          # every direction has its beam (a NaN would fail the look-up)
+        k = np.mod(k, beams).astype(np.int64)
+    else:
+        live = live & (k >= 0) & (k < beams)
+        k = clip_arrays(k, 0, beams - 1).astype(np.int64)
+    off = np.mod(bearing - k * first.step + np.pi, 2 * np.pi) - np.pi        # from that beam
+    reach = ranges.reshape(-1)[row + k]                                       # [P, J]
+    on = (np.abs(off) < np.pi / 2) & (dist * np.abs(np.sin(off)) < first.near) & live
+    passed = on & (dist * np.cos(off) < reach - SHORT)
+    return np.logical_or.reduce(on, axis=1), np.logical_or.reduce(passed, axis=1)
 
 
 Capsule = tuple[np.ndarray, np.ndarray, float]     # a segment's two ends and a radius
