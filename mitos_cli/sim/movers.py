@@ -33,6 +33,8 @@ say.
 
 from __future__ import annotations
 
+import bisect
+import functools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -106,15 +108,14 @@ class Track:
     def moving(self, now: float) -> bool:
         """Whether most of its sightings over the last ``VOTE`` s had an echo in space a
         beam had passed through (:class:`FreeSpace`): something came where nothing was."""
-        recent = [m for t, m in zip(self.times, self.moved) if t >= now - VOTE and m is not None]
-        return 2 * sum(recent) > len(recent)
+        recent = self.moved[bisect.bisect_left(self.times, now - VOTE):]    # (times ascend)
+        return recent.count(True) > recent.count(False)
 
     def travelled(self, now: float) -> bool:
         """Whether its place moved ``MIN_TRAVEL`` or more over the last ``WINDOW`` s: the
         echoes of a standing object slide along its sides as the robot drives by, but not
         farther than the object is long."""
-        first = next((k for k, t in enumerate(self.times) if t >= now - WINDOW),
-                     len(self.times) - 1)
+        first = min(bisect.bisect_left(self.times, now - WINDOW), len(self.times) - 1)
         return math.dist(self.centres[first], self.centres[-1]) >= MIN_TRAVEL
 
     def velocity(self, now: float) -> np.ndarray | None:
@@ -122,23 +123,39 @@ class Track:
         slopes between every two sightings at least ``WINDOW / 2`` apart: echoes that hop
         from one end of an object to the other move its centre by its width, and a median
         does not follow them); ``None`` when the track covers too little of the window."""
-        t = np.array(self.times)
-        keep = t >= now - WINDOW
-        if np.count_nonzero(keep) < 3 or t[keep][-1] - t[keep][0] < COVER * WINDOW:
+        first = bisect.bisect_left(self.times, now - WINDOW)
+        if len(self.times) - first < 3 or self.times[-1] - self.times[first] < COVER * WINDOW:
             return None
-        t = t[keep]
-        c = np.array(self.centres)[keep]
-        i, j = np.triu_indices(len(t), 1)
+        t = np.array(self.times[first:])
+        c = np.array(self.centres[first:])
+        i, j = _pairs(len(t))
         far = t[j] - t[i] >= WINDOW / 2
         if not np.count_nonzero(far):
             return None
         i, j = i[far], j[far]
-        return np.median((c[j] - c[i]) / (t[j] - t[i])[:, None], axis=0)
+        return _median((c[j] - c[i]) / (t[j] - t[i])[:, None])
 
     def predicted(self, now: float) -> np.ndarray:
         """Where the track should be at ``now``: its last centre moved on at its velocity."""
         last = self.centres[-1]
         return last if self.fit is None else last + self.fit * (now - self.times[-1])
+
+
+@functools.lru_cache(maxsize=64)
+def _pairs(n: int) -> tuple[np.ndarray, np.ndarray]:
+    """``np.triu_indices(n, 1)``, worked out once for each ``n`` (a track's sightings in
+    ``WINDOW`` s are a few tens at most)."""
+    i, j = np.triu_indices(n, 1)
+    i.flags.writeable = j.flags.writeable = False
+    return i, j
+
+
+def _median(x: np.ndarray) -> np.ndarray:
+    """``np.median(x, axis=0)`` of finite ``x [K, 2]`` (K > 0) without its Python: the mean
+    of the middle one or two of each column sorted, summed from 0 as np.mean sums (no -0)."""
+    s = np.sort(x, axis=0)
+    k = len(s) // 2
+    return 0.0 + s[k] if len(s) % 2 else (0.0 + s[k - 1] + s[k]) / 2
 
 
 def objects(hits: np.ndarray, seen: np.ndarray, ring: bool) -> list[np.ndarray]:
@@ -192,10 +209,12 @@ class Tracker:
                 used_t.add(j)
                 used_o.add(i)
                 self._sighted(live[j], now, centres[i], float(radii[i]), moved[i])
-        taken = np.array([live[j].centres[-1] for j in sorted(used_t)]).reshape(-1, 2)
+        taken = None
         for i in range(len(centres)):        # (an object by a track is a piece of its object)
             if i in used_o or 2 * radii[i] > MAX_EXTENT:
                 continue
+            if taken is None:
+                taken = np.array([live[j].centres[-1] for j in sorted(used_t)]).reshape(-1, 2)
             if len(taken) and np.hypot(*(taken - centres[i]).T).min() <= GATE:
                 continue
             live.append(Track([now], [centres[i]], float(radii[i]), [moved[i]], born=now))
@@ -210,14 +229,15 @@ class Tracker:
         tr.radius = radius
         tr.moved.append(moved)
         if now - tr.times[0] > 2 * WINDOW:         # keep what the window and the vote read
-            first = next(k for k, t in enumerate(tr.times) if t >= now - WINDOW)
+            first = bisect.bisect_left(tr.times, now - WINDOW)
             del tr.times[:first], tr.centres[:first], tr.moved[:first]
         # (what stands is matched where it was: only what may move is worth a fit)
         tr.fit = v = tr.velocity(now) if tr.mover or tr.moving(now) else None
         if 2 * radius > MAX_EXTENT:          # a wall, for now: neither found nor lost moving
             return
         speed = 0.0 if v is None else float(np.hypot(*v))
-        tr.mover = (v is not None and (tr.mover or tr.moving(now) and tr.travelled(now))
+        # (a fit means it was a mover or moving)
+        tr.mover = (v is not None and (tr.mover or tr.travelled(now))
                     and MIN_SPEED <= speed <= MAX_SPEED)
         tr.v = v
 
