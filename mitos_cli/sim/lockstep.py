@@ -126,9 +126,9 @@ def _observe_together(runs: list[Simulation]) -> list:
         frames = perception.frames([r for f in framing for r in f[0]],
                                    np.concatenate([f[1] for f in framing]),
                                    np.concatenate([f[2] for f in framing]))
-        entered = _entered_together(fresh, sensed)
-        aims = [aim for run, s, (start, stop), e in zip(fresh, sensed, spans, entered)
-                for aim in run.aims(s, frames[start:stop], e)]
+        sighted = _sightings_together(fresh, sensed)
+        aims = [aim for run, s, (start, stop), seen in zip(fresh, sensed, spans, sighted)
+                for aim in run.aims(s, frames[start:stop], seen)]
         ahead, targets = perception.pursuit_points(aims, fresh[0].settings)
         gaps = perception.route_gaps(aims)
         ticks, sights = [], []
@@ -145,16 +145,14 @@ def _observe_together(runs: list[Simulation]) -> list:
     return [run.observe() for run in runs]
 
 
-def _entered_together(runs: list[Simulation], sensed: list) -> list[tuple[np.ndarray, np.ndarray]]:
-    """What each run is :meth:`~.loop.Simulation.watching` (its maps marked), tested in one
-    :func:`.movers.entered` for the robots of all runs (they tick together: one time)."""
+def _sightings_together(runs: list[Simulation], sensed: list) -> list[list[movers.Seen]]:
+    """What each run is :meth:`~.loop.Simulation.watching` (its maps marked), seen in one
+    :func:`.movers.sightings` for the robots of all runs (they tick together: one time)."""
     watched = [run.watching(s) for run, s in zip(runs, sensed)]
-    tested, entered = movers.entered([sp for w in watched for sp in w[0]], sensed[0].t,
-                                     np.concatenate([w[1] for w in watched]),
-                                     np.concatenate([w[2] for w in watched]),
-                                     [c for w in watched for c in w[3]])
-    ends = [0, *itertools.accumulate(len(w[1]) for w in watched)]
-    return [(tested[a:b], entered[a:b]) for a, b in zip(ends[:-1], ends[1:])]
+    got = movers.sightings([sp for w in watched for sp in w[0]], sensed[0].t,
+                           *(np.concatenate([w[j] for w in watched]) for j in (1, 2, 3)))
+    ends = [0, *itertools.accumulate(len(w[0]) for w in watched)]
+    return [got[a:b] for a, b in zip(ends[:-1], ends[1:])]
 
 
 def _guard_together(runs: list[Simulation], ticks: list) -> None:

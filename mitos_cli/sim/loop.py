@@ -17,7 +17,6 @@ Randomness: ``SeedSequence(seed).spawn(1 + robots)``: the first stream randomise
 
 from __future__ import annotations
 
-import itertools
 import math
 import operator
 import os
@@ -255,13 +254,6 @@ def _footprints(pose: np.ndarray, robots) -> np.ndarray:
                         np.array([r.length for r in robots]), np.array([r.width for r in robots]))
 
 
-def _rows_of(parts: list[np.ndarray]) -> np.ndarray:
-    """``[P, 2]``: the rows of ``parts`` one after the other (one part: itself)."""
-    if len(parts) == 1:
-        return parts[0]
-    return np.concatenate(parts) if parts else np.zeros((0, 2))
-
-
 def _columns(*columns: np.ndarray) -> np.ndarray:
     """``np.stack(columns, axis=1)``, without its Python set-up (a tick makes a few)."""
     out = np.empty((len(columns[0]), len(columns)))
@@ -431,7 +423,7 @@ class Simulation:
         self._done = self.steps <= 0
         self._hit = np.zeros(n, dtype=bool)
         self._beyond_at: tuple = (None, [])             # see _beyond()
-        self._watched: tuple = (None, [], {}, [])       # see watching()
+        self._watched: tuple = (None, [], [])           # see watching()
         self._observed: _Sensed | None = None
         self._deciding: _Sensed | None = None
         self.record: list[Tick] = []
@@ -736,22 +728,25 @@ class Simulation:
         return self._maps, s.pose[:, :2], dirs, s.ranges, self.world.sensors.range
 
     def aims(self, s: _Sensed, frames: list[perception.Frame],
-             entered: tuple[np.ndarray, np.ndarray] | None = None) -> list[perception.Aim]:
+             sighted: list[movers.Seen] | None = None) -> list[perception.Aim]:
         """Each robot's :class:`.perception.Aim` at tick ``s``, its map cleared
         (:meth:`clearing`): where it is on its route, its map marked from its readings (and
         its route replanned if need be) and what its pursuit point keeps clear of (runs in
         lockstep find their pursuit points together); ``frames``: where they are on their
-        routes (:meth:`framing`); ``entered``: :func:`.movers.entered` of what it is
-        :meth:`watching` (runs in lockstep test theirs together; ``None``: tested here)."""
-        if entered is None:
-            spaces, points, dirs, counts = self.watching(s)
-            entered = movers.entered(spaces, s.t, points, dirs, counts)
-        _, learned, _, ends = self._watched
+        routes (:meth:`framing`); ``sighted``: :func:`.movers.sightings` of what it is
+        :meth:`watching` (runs in lockstep see theirs together; ``None``: seen here)."""
+        if sighted is None:
+            spaces, hits, dirs, seen = self.watching(s)
+            sighted = movers.sightings(spaces, s.t, hits, dirs, seen)
+        _, learned, follows = self._watched
+        sights: list[movers.Seen | None] = [None] * self.n
+        for i, got in zip(follows, sighted):
+            sights[i] = got
         routes, out = self._routes, []
         for i in range(self.n):
             f = frames[i]
             rmap = self._maps[i]
-            sweep = self._sweep(i, s, *(e[ends[i]:ends[i + 1]] for e in entered))
+            sweep = self._sweep(i, s, sights[i])
             if (learned[i] or sweep is not None or rmap.refuge is not None) and self._active[i]:
                 route = knowledge.replan(rmap, routes[i], f.s, s.pose[i, :2],
                                          self.world.agents[i].goal, s.t, *self._asked[i],
@@ -850,48 +845,37 @@ class Simulation:
         return len(rmap.fresh) > before
 
     def watching(self, s: _Sensed) -> tuple[list[movers.FreeSpace], np.ndarray, np.ndarray,
-                                            list[int]]:
+                                            np.ndarray]:
         """Each robot's map marked from its readings at tick ``s`` (:meth:`_learn`), and what
-        :func:`.movers.entered` tests for its tracks (runs in lockstep test theirs
-        together): the beams each robot following something kept, the echoes and beams of
-        the readings it sees that its map does not show, and how many are each robot's."""
+        :func:`.movers.sightings` looks at for the robots that follow something (runs in
+        lockstep see theirs together): the beams each kept, its echoes ``[F, B, 2]``, beams
+        ``[F, B, 2]`` and which it sees that its map does not show ``[F, B]``."""
         learned = [self._learn(i, s) for i in range(self.n)]
         follows = ([] if self.world.replan == "never" else         # (what _sweep follows)
                    [i for i in range(self.n)
                     if self._trackers[i].tracks or np.count_nonzero(self._seen[i])])
-        hits = {i: s.pose[i, :2] + s.ranges[i, :, None] * self._dirs[i] for i in follows}
-        counts = [int(np.count_nonzero(self._seen[i])) for i in follows]
-        ends = [0] * (self.n + 1)
-        for i, count in zip(follows, counts):
-            ends[i + 1] = count
-        self._watched = (s, learned, hits, list(itertools.accumulate(ends)))
-        seen = [self._seen[i] for i in follows]
-        return ([self._free[i] for i in follows],
-                _rows_of([hits[i][k] for i, k in zip(follows, seen)]),
-                _rows_of([self._dirs[i][k] for i, k in zip(follows, seen)]), counts)
+        self._watched = (s, learned, follows)
+        if self.n == 1:
+            dirs, seen = self._dirs[0][None], self._seen[0][None]
+        else:
+            dirs, seen = np.stack(self._dirs), np.stack(self._seen)
+        dirs, seen = dirs[follows], seen[follows]
+        hits = s.pose[follows, None, :2] + s.ranges[follows, :, None] * dirs
+        return [self._free[i] for i in follows], hits, dirs, seen
 
-    def _sweep(self, i: int, s: _Sensed, tested: np.ndarray, entered: np.ndarray
-               ) -> movers.Sweep | None:
+    def _sweep(self, i: int, s: _Sensed, sighted: movers.Seen | None) -> movers.Sweep | None:
         """Robot ``i``'s tracks of what its readings show and its map does not, brought up
-        to tick ``s`` (:mod:`.movers`; ``tested`` and ``entered``: what :meth:`watching`
-        found of its echoes), and where the movers among them will pass while it gets out of
+        to tick ``s`` (:mod:`.movers`; ``sighted``: what :meth:`watching` saw, ``None`` when
+        it follows nothing), and where the movers among them will pass while it gets out of
         their way (``None`` when nothing comes toward it)."""
         if self.world.replan == "never":
             return None
-        seen, p, dirs = self._seen[i], s.pose[i, :2], self._dirs[i]
-        rmap, free, tracker = self._maps[i], self._free[i], self._trackers[i]
-        if not tracker.tracks and not np.count_nonzero(seen):    # nothing to follow
-            free.update(s.t, p, dirs, s.ranges[i])
+        p, dirs = s.pose[i, :2], self._dirs[i]
+        rmap, tracker = self._maps[i], self._trackers[i]
+        self._free[i].update(s.t, p, dirs, s.ranges[i])
+        if sighted is None:                                  # nothing to follow
             return None
-        hits = self._watched[2][i]
-        runs = movers.objects(hits, seen, self.world.sensors.layout == "ring")
-        free.update(s.t, p, dirs, s.ranges[i])
-        at = np.add.accumulate(seen, dtype=np.intp) - 1      # a seen beam's place among the seen
-        # an object moved when most of its echoes that a beam's line had crossed came where
-        # that beam had passed (None: no line crossed any)
-        moved = [None if not (n := np.count_nonzero(tested[at[r]]))
-                 else 2 * np.count_nonzero(entered[at[r]]) >= n for r in runs]
-        tracker.update(s.t, [hits[r] for r in runs], moved)
+        tracker.follow(s.t, *sighted)
         h = float(self._h[i])
         # (a robot on its way to a refuge draws away from what it yields to; it waits for
         # it all the same)

@@ -35,6 +35,7 @@ from __future__ import annotations
 
 import bisect
 import functools
+import itertools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -163,17 +164,73 @@ def objects(hits: np.ndarray, seen: np.ndarray, ring: bool) -> list[np.ndarray]:
     neighbouring beams (around the ring when ``ring``) whose echoes lie within ``LINK`` of
     each other. Each object is the array of its beams' indices."""
     idx = seen.nonzero()[0]
-    if not len(idx):
-        return []
-    pts = hits[idx]
+    order, starts = _cut(np.zeros_like(idx), idx, hits[idx], len(seen), ring)
+    beams = idx[order]
+    return [beams[a:b] for a, b in zip(starts, [*starts[1:], len(beams)])]
+
+
+def _cut(robot: np.ndarray, beam: np.ndarray, pts: np.ndarray, beams: int, ring: bool
+         ) -> tuple[np.ndarray, list[int]]:
+    """The echoes ``pts [N, 2]`` of the beams seen (``robot [N]`` by robot, ``beam [N]``
+    ascending) cut into :func:`objects`: the order to take them in and where each object
+    starts in it. An object across the first beam of a ring is one, its last run first."""
+    order = np.arange(len(pts))
+    if not len(pts):
+        return order, []
     gap = np.hypot(*(pts[1:] - pts[:-1]).T)
-    # (slices at the cuts: np.split and np.diff cost more in their Python than the work)
-    ends = [0, *(((idx[1:] - idx[:-1] > 1) | (gap > LINK)).nonzero()[0] + 1).tolist(), len(idx)]
-    runs = [idx[a:b] for a, b in zip(ends[:-1], ends[1:])]
-    if ring and len(runs) > 1 and idx[0] == 0 and idx[-1] == len(seen) - 1 \
-            and math.dist(pts[0], pts[-1]) <= LINK:
-        runs = [np.concatenate([runs[-1], runs[0]])] + runs[1:-1]
-    return runs
+    cut = (robot[1:] != robot[:-1]) | (beam[1:] - beam[:-1] > 1) | (gap > LINK)
+    starts = [0, *(cut.nonzero()[0] + 1).tolist()]
+    if not ring:
+        return order, starts
+    first = np.flatnonzero(np.r_[True, robot[1:] != robot[:-1]])      # each robot's first
+    last = np.r_[first[1:], len(pts)] - 1
+    across = (beam[first] == 0) & (beam[last] == beams - 1)
+    for a, z in zip(first[across].tolist(), last[across].tolist()):
+        k = bisect.bisect_right(starts, z) - 1                 # its last run starts there
+        s = starts[k]
+        if s == a or math.dist(pts[a], pts[z]) > LINK:
+            continue
+        order[a:z + 1] = np.r_[s:z + 1, a:s]
+        m = bisect.bisect_left(starts, a)
+        starts[m + 1:k + 1] = [t + z + 1 - s for t in starts[m + 1:k]]
+    return order, starts
+
+
+def shapes(pts: np.ndarray, starts: Sequence[int]) -> tuple[np.ndarray, np.ndarray]:
+    """The centres ``[O, 2]`` and half sizes ``[O]`` of objects whose echoes ``pts [N, 2]``
+    start at ``starts`` (those of many robots together are each the bits of its own)."""
+    if not len(pts):
+        return np.zeros((0, 2)), np.zeros(0)
+    sizes = np.diff(np.r_[starts, len(pts)])
+    centres = np.add.reduceat(pts, starts, axis=0) / sizes[:, None]
+    spread = np.hypot(*(pts - centres.repeat(sizes, axis=0)).T)
+    return centres, np.maximum.reduceat(spread, starts)
+
+
+Seen = tuple[np.ndarray, np.ndarray, list[bool | None]]     # what :meth:`Tracker.follow` takes
+
+
+def sightings(spaces: Sequence[FreeSpace], now: float, hits: np.ndarray, dirs: np.ndarray,
+              seen: np.ndarray) -> list[Seen]:
+    """What each robot sees that its map does not show, as :meth:`Tracker.follow` takes it:
+    the :func:`objects` of its beams ``seen [R, B]`` (echoes ``hits [R, B, 2]``, beams ``dirs
+    [R, B, 2]``), their centres and half sizes (:func:`shapes`), and whether most of the
+    echoes of each that a beam kept in ``spaces[r]`` crossed came where it had passed
+    (:func:`entered`; ``None``: none crossed). All robots at once (runs in lockstep see
+    theirs together): they see a few echoes each, and one pass is cheaper than one each."""
+    robot, beam = seen.nonzero()
+    if not len(robot):
+        return [(np.zeros((0, 2)), np.zeros(0), []) for _ in range(len(seen))]
+    pts = hits[robot, beam]
+    crossed, came = entered(spaces, now, pts, dirs[robot, beam], robot)
+    order, starts = _cut(robot, beam, pts, seen.shape[1], spaces[0].ring)
+    centres, radii = shapes(pts[order], starts)
+    crossed = np.add.reduceat(crossed[order], starts, dtype=np.intp).tolist()
+    came = np.add.reduceat(came[order], starts, dtype=np.intp).tolist()
+    moved = [None if not n else 2 * e >= n for n, e in zip(crossed, came)]
+    ends = [0, *itertools.accumulate(np.bincount(robot[order[starts]], minlength=len(seen))
+                                     .tolist())]
+    return [(centres[a:b], radii[a:b], moved[a:b]) for a, b in zip(ends[:-1], ends[1:])]
 
 
 @dataclass
@@ -183,19 +240,21 @@ class Tracker:
     tracks: list[Track] = field(default_factory=list)
 
     def update(self, now: float, found: list[np.ndarray], moved: list[bool | None]) -> None:
-        """Match the objects ``found`` at time ``now`` (``moved``: whether each has an echo
-        in space a beam had passed through) to the tracks (nearest first, each track and
-        object once), start a track for each object left, drop stale tracks."""
+        """:meth:`follow` the objects whose echoes are ``found`` (``[k, 2]`` each)."""
+        starts = [0, *itertools.accumulate(len(o) for o in found[:-1])]
+        pts = np.concatenate(found) if found else np.zeros((0, 2))
+        self.follow(now, *shapes(pts, starts), moved)
+
+    def follow(self, now: float, centres: np.ndarray, radii: np.ndarray,
+               moved: list[bool | None]) -> None:
+        """Match the objects seen at time ``now`` (centres ``[O, 2]``, half sizes ``[O]``;
+        ``moved``: whether each has an echo in space a beam had passed through) to the
+        tracks (nearest first, each track and object once), start a track for each object
+        left, drop stale tracks."""
         live = [tr for tr in self.tracks if now - tr.times[-1] <= MAX_MISS]
-        if not found:
+        if not len(centres):
             self.tracks = live
             return
-        sizes = np.array([len(o) for o in found])
-        pts = np.concatenate(found)
-        starts = np.concatenate([[0], np.add.accumulate(sizes)[:-1]])
-        centres = np.add.reduceat(pts, starts, axis=0) / sizes[:, None]            # [O, 2]
-        spread = np.hypot(*(pts - centres.repeat(sizes, axis=0)).T)
-        radii = np.maximum.reduceat(spread, starts)                                  # [O]
         used_t: set[int] = set()
         used_o: set[int] = set()
         if live:
@@ -304,27 +363,25 @@ class FreeSpace:
         echo against the beams kept from the last ``WINDOW`` s (before ``now``): which lie on
         the line of one (within ``near``: the robot's map clears a mark the same way), and
         which of those lay short of its echo then (something came where nothing was)."""
-        return entered([self], now, points, dirs, [len(points)])
+        return entered([self], now, points, dirs)
 
 
 def entered(spaces: Sequence[FreeSpace], now: float, points: np.ndarray, dirs: np.ndarray,
-            counts: Sequence[int]) -> tuple[np.ndarray, np.ndarray]:
-    """:meth:`FreeSpace.entered` of the echoes of many robots at once: the first ``counts[0]``
-    of ``points [P, 2]`` and ``dirs [P, 2]`` against ``spaces[0]``, the next ``counts[1]``
-    against ``spaces[1]``... (beams of one layout; robots in lockstep test theirs together).
-    A robot's echoes are a handful, so one ``[P, J]`` pass for all is cheaper than one per
-    robot; each element is worked as it would be alone, and the beams not kept from the
-    last ``WINDOW`` s are masked out instead of left out."""
+            owner: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """:meth:`FreeSpace.entered` of the echoes of many robots at once: ``points [P, 2]`` and
+    ``dirs [P, 2]`` against ``spaces[owner[p]]`` (``None``: all against ``spaces[0]``;
+    beams of one layout). A robot's echoes are a handful, so one ``[P, J]`` pass for all is
+    cheaper than one per robot; each element is worked as it would be alone, and the beams
+    not kept from the last ``WINDOW`` s are masked out instead of left out."""
     if not len(points):
         none = np.zeros(0, dtype=bool)
         return none, none
     first = spaces[0]
     slots, beams = first.ranges.shape
-    if len(spaces) == 1:     # one robot: its own arrays, broadcast ([1, J])
+    if owner is None or len(spaces) == 1:     # one robot: its own arrays, broadcast ([1, J])
         times, pose, ranges = first.times[None], first.poses[None], first.ranges
         row = np.arange(slots) * beams
     else:
-        owner = np.repeat(np.arange(len(spaces)), counts)                     # [P]
         times = np.array([sp.times for sp in spaces])[owner]                  # [P, J]
         pose = np.array([sp.poses for sp in spaces])[owner]                   # [P, J, 3]
         ranges = np.array([sp.ranges for sp in spaces])                       # [R, J, B]
