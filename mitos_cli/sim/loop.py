@@ -859,8 +859,9 @@ class Simulation:
             dirs, seen = self._dirs[0][None], self._seen[0][None]
         else:
             dirs, seen = np.stack(self._dirs), np.stack(self._seen)
-        dirs, seen = dirs[follows], seen[follows]
-        hits = s.pose[follows, None, :2] + s.ranges[follows, :, None] * dirs
+        pick = slice(None) if len(follows) == self.n else follows    # (a slice is a view)
+        dirs, seen = dirs[pick], seen[pick]
+        hits = s.pose[pick, None, :2] + s.ranges[pick, :, None] * dirs
         return [self._free[i] for i in follows], hits, dirs, seen
 
     def _sweep(self, i: int, s: _Sensed, sighted: movers.Seen | None) -> movers.Sweep | None:

@@ -164,33 +164,32 @@ def objects(hits: np.ndarray, seen: np.ndarray, ring: bool) -> list[np.ndarray]:
     neighbouring beams (around the ring when ``ring``) whose echoes lie within ``LINK`` of
     each other. Each object is the array of its beams' indices."""
     idx = seen.nonzero()[0]
-    order, starts = _cut(np.zeros_like(idx), idx, hits[idx], len(seen), ring)
-    beams = idx[order]
+    order, starts = _cut(seen[None], np.zeros_like(idx), idx, hits[idx], ring)
+    beams = idx if order is None else idx[order]
     return [beams[a:b] for a, b in zip(starts, [*starts[1:], len(beams)])]
 
 
-def _cut(robot: np.ndarray, beam: np.ndarray, pts: np.ndarray, beams: int, ring: bool
-         ) -> tuple[np.ndarray, list[int]]:
-    """The echoes ``pts [N, 2]`` of the beams seen (``robot [N]`` by robot, ``beam [N]``
-    ascending) cut into :func:`objects`: the order to take them in and where each object
-    starts in it. An object across the first beam of a ring is one, its last run first."""
-    order = np.arange(len(pts))
+def _cut(seen: np.ndarray, robot: np.ndarray, beam: np.ndarray, pts: np.ndarray, ring: bool
+         ) -> tuple[np.ndarray | None, list[int]]:
+    """The echoes ``pts [N, 2]`` of the beams ``seen [R, B]`` (robot ``robot [N]`` and beam
+    ``beam [N]`` of each, as ``seen.nonzero()`` gives them) cut into :func:`objects`: where
+    each object starts, and the order to take the echoes in (``None``: as they come). An
+    object across the first beam of a ring is one, its last run first."""
     if not len(pts):
-        return order, []
+        return None, []
     gap = np.hypot(*(pts[1:] - pts[:-1]).T)
     cut = (robot[1:] != robot[:-1]) | (beam[1:] - beam[:-1] > 1) | (gap > LINK)
     starts = [0, *(cut.nonzero()[0] + 1).tolist()]
-    if not ring:
-        return order, starts
-    first = np.flatnonzero(np.r_[True, robot[1:] != robot[:-1]])      # each robot's first
-    last = np.r_[first[1:], len(pts)] - 1
-    across = (beam[first] == 0) & (beam[last] == beams - 1)
-    for a, z in zip(first[across].tolist(), last[across].tolist()):
+    order = None
+    for r in (seen[:, 0] & seen[:, -1]).nonzero()[0].tolist() if ring else ():
+        a, z = int(robot.searchsorted(r)), int(robot.searchsorted(r, "right")) - 1
         k = bisect.bisect_right(starts, z) - 1                 # its last run starts there
         s = starts[k]
         if s == a or math.dist(pts[a], pts[z]) > LINK:
             continue
-        order[a:z + 1] = np.r_[s:z + 1, a:s]
+        if order is None:
+            order = np.arange(len(pts))
+        order[a:z + 1] = np.concatenate((order[s:z + 1], order[a:s]))
         m = bisect.bisect_left(starts, a)
         starts[m + 1:k + 1] = [t + z + 1 - s for t in starts[m + 1:k]]
     return order, starts
@@ -201,7 +200,8 @@ def shapes(pts: np.ndarray, starts: Sequence[int]) -> tuple[np.ndarray, np.ndarr
     start at ``starts`` (those of many robots together are each the bits of its own)."""
     if not len(pts):
         return np.zeros((0, 2)), np.zeros(0)
-    sizes = np.diff(np.r_[starts, len(pts)])
+    bounds = np.array([*starts, len(pts)])
+    sizes = bounds[1:] - bounds[:-1]
     centres = np.add.reduceat(pts, starts, axis=0) / sizes[:, None]
     spread = np.hypot(*(pts - centres.repeat(sizes, axis=0)).T)
     return centres, np.maximum.reduceat(spread, starts)
@@ -223,13 +223,16 @@ def sightings(spaces: Sequence[FreeSpace], now: float, hits: np.ndarray, dirs: n
         return [(np.zeros((0, 2)), np.zeros(0), []) for _ in range(len(seen))]
     pts = hits[robot, beam]
     crossed, came = entered(spaces, now, pts, dirs[robot, beam], robot)
-    order, starts = _cut(robot, beam, pts, seen.shape[1], spaces[0].ring)
-    centres, radii = shapes(pts[order], starts)
-    crossed = np.add.reduceat(crossed[order], starts, dtype=np.intp).tolist()
-    came = np.add.reduceat(came[order], starts, dtype=np.intp).tolist()
+    order, starts = _cut(seen, robot, beam, pts, spaces[0].ring)
+    if order is not None:
+        pts, robot, crossed, came = pts[order], robot[order], crossed[order], came[order]
+    centres, radii = shapes(pts, starts)
+    crossed = np.add.reduceat(crossed, starts, dtype=np.intp).tolist()
+    came = np.add.reduceat(came, starts, dtype=np.intp).tolist()
     moved = [None if not n else 2 * e >= n for n, e in zip(crossed, came)]
-    ends = [0, *itertools.accumulate(np.bincount(robot[order[starts]], minlength=len(seen))
-                                     .tolist())]
+    if len(seen) == 1:
+        return [(centres, radii, moved)]
+    ends = [0, *itertools.accumulate(np.bincount(robot[starts], minlength=len(seen)).tolist())]
     return [(centres[a:b], radii[a:b], moved[a:b]) for a, b in zip(ends[:-1], ends[1:])]
 
 
@@ -338,6 +341,11 @@ class FreeSpace:
     ranges: np.ndarray = field(repr=False)    # [J, B] in
     near: float                 # in: how near a beam's line a point it passed lies
     slot: int = 0
+    rows: np.ndarray = field(init=False, repr=False)   # [J] where each slot's ranges start
+    # in ranges.reshape(-1)
+
+    def __post_init__(self) -> None:
+        self.rows = np.arange(len(self.times)) * self.ranges.shape[1]
 
     @classmethod
     def of(cls, angles: np.ndarray, ring: bool, dt: float, resolution: float) -> FreeSpace:
@@ -379,13 +387,12 @@ def entered(spaces: Sequence[FreeSpace], now: float, points: np.ndarray, dirs: n
     first = spaces[0]
     slots, beams = first.ranges.shape
     if owner is None or len(spaces) == 1:     # one robot: its own arrays, broadcast ([1, J])
-        times, pose, ranges = first.times[None], first.poses[None], first.ranges
-        row = np.arange(slots) * beams
+        times, pose, ranges, row = first.times[None], first.poses[None], first.ranges, first.rows
     else:
         times = np.array([sp.times for sp in spaces])[owner]                  # [P, J]
         pose = np.array([sp.poses for sp in spaces])[owner]                   # [P, J, 3]
         ranges = np.array([sp.ranges for sp in spaces])                       # [R, J, B]
-        row = (owner[:, None] * slots + np.arange(slots)) * beams             # [P, J]
+        row = owner[:, None] * (slots * beams) + first.rows                   # [P, J]
     live = (times >= now - WINDOW) & (times < now)
     q = points + dirs * STEP
     rel = q[:, None, :] - pose[..., :2]                                       # [P, J, 2]
