@@ -164,8 +164,17 @@ def _inside(cells: np.ndarray, shape: tuple[int, int]) -> np.ndarray | None:
     """Which cells (columns and rows ``[P, 2]``, C-contiguous) lie inside a grid of ``shape``
     (rows, columns); ``None`` when all do. Seen unsigned, a negative index is a huge one,
     so one comparison tests both ends."""
-    ok = cells.view(np.uint64) < np.array(shape[::-1], np.uint64)
+    ok = cells.view(np.uint64) < _limits(shape)
     return None if np.count_nonzero(ok) == ok.size else np.logical_and.reduce(ok, axis=1)
+
+
+@functools.lru_cache(maxsize=16)
+def _limits(shape: tuple[int, int]) -> np.ndarray:
+    """The columns and rows of a grid of ``shape`` as unsigned integers (:func:`_inside`
+    asks a few times a tick)."""
+    out = np.array(shape[::-1], np.uint64)
+    out.flags.writeable = False
+    return out
 
 
 @functools.lru_cache(maxsize=4)
@@ -338,12 +347,18 @@ class RobotMap:
         known = self.occupied[row, col]
         if np.count_nonzero(known) < len(known):      # (a count is cheaper than .all())
             new = ~known
+            row, col = row[new], col[new]
             self._changes += 1
-            self.occupied[row[new], col[new]] = True
-            self.marks = np.union1d(self.marks, row[new] * self.occupied.shape[1] + col[new])
-            g = self.grid
-            self.fresh.append(np.stack([g.origin[0] + (col[new] + 0.5) * g.resolution,
-                                        g.origin[1] + (row[new] + 0.5) * g.resolution], axis=1))
+            self.occupied[row, col] = True
+            # (np.union1d's Python costs more than the work: the new cells were unmarked)
+            marks = np.concatenate([self.marks,
+                                    sorted(set((row * self.occupied.shape[1] + col).tolist()))])
+            marks.sort()
+            self.marks = marks
+            xs, ys = _centre_lines(self.grid)
+            centres = np.empty((len(row), 2))
+            centres[:, 0], centres[:, 1] = xs[col], ys[row]
+            self.fresh.append(centres)
 
     def ranges(self, origin: np.ndarray, dirs: np.ndarray, max_range: float) -> np.ndarray:
         """Ranges ``[B]`` this map predicts: each beam marched in half cells to the first
