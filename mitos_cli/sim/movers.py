@@ -258,28 +258,31 @@ class Tracker:
         if not len(centres):
             self.tracks = live
             return
+        half = radii.tolist()
         used_t: set[int] = set()
         used_o: set[int] = set()
         if live:
             pred = np.array([tr.predicted(now) for tr in live])                     # [T, 2]
-            d = np.hypot(*(pred[:, None] - centres[None]).transpose(2, 0, 1))     # [T, O]
-            tj, oi = (d <= GATE).nonzero()
-            for k in d[tj, oi].argsort(kind="stable"):           # nearest first, each once
-                j, i = int(tj[k]), int(oi[k])
+            d = np.hypot(*(pred[:, None] - centres[None]).transpose(2, 0, 1)).ravel()
+            apart = d.tolist()                                           # [T * O], row-major
+            for k in d.argsort(kind="stable").tolist():          # nearest first, each once
+                if not apart[k] <= GATE:         # the rest lie farther (NaN sorts last)
+                    break
+                j, i = divmod(k, len(half))
                 if j in used_t or i in used_o:
                     continue
                 used_t.add(j)
                 used_o.add(i)
-                self._sighted(live[j], now, centres[i], float(radii[i]), moved[i])
+                self._sighted(live[j], now, centres[i], half[i], moved[i])
         taken = None
-        for i in range(len(centres)):        # (an object by a track is a piece of its object)
-            if i in used_o or 2 * radii[i] > MAX_EXTENT:
+        for i in range(len(half)):           # (an object by a track is a piece of its object)
+            if i in used_o or 2 * half[i] > MAX_EXTENT:
                 continue
             if taken is None:
                 taken = np.array([live[j].centres[-1] for j in sorted(used_t)]).reshape(-1, 2)
             if len(taken) and np.hypot(*(taken - centres[i]).T).min() <= GATE:
                 continue
-            live.append(Track([now], [centres[i]], float(radii[i]), [moved[i]], born=now))
+            live.append(Track([now], [centres[i]], half[i], [moved[i]], born=now))
         self.tracks = live
 
     @staticmethod
