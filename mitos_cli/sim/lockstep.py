@@ -150,7 +150,7 @@ def _sightings_together(runs: list[Simulation], sensed: list) -> list[list[mover
     :func:`.movers.sightings` for the robots of all runs (they tick together: one time)."""
     watched = [run.watching(s) for run, s in zip(runs, sensed)]
     got = movers.sightings([sp for w in watched for sp in w[0]], sensed[0].t,
-                           *(np.concatenate([w[j] for w in watched]) for j in (1, 2, 3)))
+                           *(np.concatenate([w[j] for w in watched]) for j in (1, 2, 3, 4)))
     ends = [0, *itertools.accumulate(len(w[0]) for w in watched)]
     return [got[a:b] for a, b in zip(ends[:-1], ends[1:])]
 

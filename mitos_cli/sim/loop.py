@@ -736,8 +736,8 @@ class Simulation:
         routes (:meth:`framing`); ``sighted``: :func:`.movers.sightings` of what it is
         :meth:`watching` (runs in lockstep see theirs together; ``None``: seen here)."""
         if sighted is None:
-            spaces, hits, dirs, seen = self.watching(s)
-            sighted = movers.sightings(spaces, s.t, hits, dirs, seen)
+            spaces, *looks = self.watching(s)
+            sighted = movers.sightings(spaces, s.t, *looks)
         _, learned, follows = self._watched
         sights: list[movers.Seen | None] = [None] * self.n
         for i, got in zip(follows, sighted):
@@ -845,11 +845,12 @@ class Simulation:
         return len(rmap.fresh) > before
 
     def watching(self, s: _Sensed) -> tuple[list[movers.FreeSpace], np.ndarray, np.ndarray,
-                                            np.ndarray]:
+                                            np.ndarray, np.ndarray]:
         """Each robot's map marked from its readings at tick ``s`` (:meth:`_learn`), and what
         :func:`.movers.sightings` looks at for the robots that follow something (runs in
-        lockstep see theirs together): the beams each kept, its echoes ``[F, B, 2]``, beams
-        ``[F, B, 2]`` and which it sees that its map does not show ``[F, B]``."""
+        lockstep see theirs together): the beams each kept, where it stands ``[F, 2]``, its
+        readings ``[F, B]``, beams ``[F, B, 2]`` and which it sees that its map does not
+        show ``[F, B]``."""
         learned = [self._learn(i, s) for i in range(self.n)]
         follows = ([] if self.world.replan == "never" else         # (what _sweep follows)
                    [i for i in range(self.n)
@@ -860,9 +861,8 @@ class Simulation:
         else:
             dirs, seen = np.stack(self._dirs), np.stack(self._seen)
         pick = slice(None) if len(follows) == self.n else follows    # (a slice is a view)
-        dirs, seen = dirs[pick], seen[pick]
-        hits = s.pose[pick, None, :2] + s.ranges[pick, :, None] * dirs
-        return [self._free[i] for i in follows], hits, dirs, seen
+        return ([self._free[i] for i in follows], s.pose[pick, :2], s.ranges[pick], dirs[pick],
+                seen[pick])
 
     def _sweep(self, i: int, s: _Sensed, sighted: movers.Seen | None) -> movers.Sweep | None:
         """Robot ``i``'s tracks of what its readings show and its map does not, brought up

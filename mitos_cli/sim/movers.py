@@ -210,19 +210,21 @@ def shapes(pts: np.ndarray, starts: Sequence[int]) -> tuple[np.ndarray, np.ndarr
 Seen = tuple[np.ndarray, np.ndarray, list[bool | None]]     # what :meth:`Tracker.follow` takes
 
 
-def sightings(spaces: Sequence[FreeSpace], now: float, hits: np.ndarray, dirs: np.ndarray,
-              seen: np.ndarray) -> list[Seen]:
+def sightings(spaces: Sequence[FreeSpace], now: float, origins: np.ndarray, ranges: np.ndarray,
+              dirs: np.ndarray, seen: np.ndarray) -> list[Seen]:
     """What each robot sees that its map does not show, as :meth:`Tracker.follow` takes it:
-    the :func:`objects` of its beams ``seen [R, B]`` (echoes ``hits [R, B, 2]``, beams ``dirs
-    [R, B, 2]``), their centres and half sizes (:func:`shapes`), and whether most of the
-    echoes of each that a beam kept in ``spaces[r]`` crossed came where it had passed
-    (:func:`entered`; ``None``: none crossed). All robots at once (runs in lockstep see
-    theirs together): they see a few echoes each, and one pass is cheaper than one each."""
+    the :func:`objects` of its beams ``seen [R, B]`` (cast from ``origins [R, 2]`` along
+    ``dirs [R, B, 2]``, echoes at ``ranges [R, B]``), their centres and half sizes
+    (:func:`shapes`), and whether most of the echoes of each that a beam kept in
+    ``spaces[r]`` crossed came where it had passed (:func:`entered`; ``None``: none
+    crossed). All robots at once (runs in lockstep see theirs together): they see a few
+    echoes each, and one pass is cheaper than one each."""
     robot, beam = seen.nonzero()
     if not len(robot):
         return [(np.zeros((0, 2)), np.zeros(0), []) for _ in range(len(seen))]
-    pts = hits[robot, beam]
-    crossed, came = entered(spaces, now, pts, dirs[robot, beam], robot)
+    along = dirs[robot, beam]
+    pts = origins[robot] + ranges[robot, beam, None] * along                # the echoes
+    crossed, came = entered(spaces, now, pts, along, robot)
     order, starts = _cut(seen, robot, beam, pts, spaces[0].ring)
     if order is not None:
         pts, robot, crossed, came = pts[order], robot[order], crossed[order], came[order]
