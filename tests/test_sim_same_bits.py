@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from mitos_cli.resources import packaged_path
-from mitos_cli.sim import geometry, knowledge, perception, route, rows, safety
+from mitos_cli.sim import geometry, knowledge, movers, perception, route, rows, safety
 from mitos_cli.sim.loop import Simulation, prepare
 from mitos_cli.sim.planner import FuzzyPlanner
 from mitos_cli.sim.world import Grid, Robot
@@ -797,6 +797,87 @@ def test_free_ways_of_many_rows_worked_in_blocks_are_each_rows_own():
         one = perception.free_ways_rows(ah[i:i + 1], bh[i:i + 1], widen[i:i + 1],
                                         unknown[i:i + 1], robots[i:i + 1], cfg, bearing[i:i + 1])
         assert same(got[0][i], one[0][0]) and same(got[1][i], one[1][0])
+
+
+def plain_sighting(free: movers.FreeSpace, now: float, origin, ranges, dirs, seen, ring: bool):
+    """What one robot sees that its map does not show, as the tracker worked it out robot by
+    robot: the seen beams cut into objects, each echo tested against the beams kept in the
+    window (gathered), each object's vote, centre and half size."""
+    hits = origin + ranges[:, None] * dirs
+    idx = seen.nonzero()[0]
+    runs = []
+    if len(idx):
+        pts = hits[idx]
+        gap = np.hypot(*(pts[1:] - pts[:-1]).T)
+        ends = [0, *(((idx[1:] - idx[:-1] > 1) | (gap > movers.LINK)).nonzero()[0] + 1), len(idx)]
+        runs = [idx[a:b] for a, b in zip(ends[:-1], ends[1:])]
+        if ring and len(runs) > 1 and idx[0] == 0 and idx[-1] == len(seen) - 1 \
+                and math.dist(pts[0], pts[-1]) <= movers.LINK:
+            runs = [np.concatenate([runs[-1], runs[0]])] + runs[1:-1]
+    tested = entered = np.zeros(len(idx), dtype=bool)
+    live = (free.times >= now - movers.WINDOW) & (free.times < now)
+    if len(idx) and live.any():
+        pose, kept = free.poses[live], free.ranges[live]
+        rel = (hits[idx] + dirs[idx] * movers.STEP)[:, None, :] - pose[None, :, :2]
+        dist = np.hypot(rel[..., 0], rel[..., 1])
+        ahead = np.arctan2(rel[..., 1], rel[..., 0]) - pose[None, :, 2]
+        if not ring:
+            ahead = np.mod(ahead + np.pi, 2 * np.pi) - np.pi
+        bearing = ahead - free.a0
+        k = np.rint(bearing / free.step)
+        inside = (k >= 0) & (k < kept.shape[1])
+        k = np.mod(k, kept.shape[1]).astype(np.int64) if ring \
+            else np.clip(k, 0, kept.shape[1] - 1).astype(np.int64)
+        off = np.mod(bearing - k * free.step + np.pi, 2 * np.pi) - np.pi
+        on = (np.abs(off) < np.pi / 2) & (dist * np.abs(np.sin(off)) < free.near)
+        on &= True if ring else inside
+        passed = on & (dist * np.cos(off) < kept[np.arange(len(pose))[None, :], k] - movers.SHORT)
+        tested, entered = on.any(axis=1), passed.any(axis=1)
+    at = np.add.accumulate(seen, dtype=np.intp) - 1
+    moved = [None if not (n := np.count_nonzero(tested[at[r]]))
+             else 2 * np.count_nonzero(entered[at[r]]) >= n for r in runs]
+    if not runs:
+        return np.zeros((0, 2)), np.zeros(0), moved
+    found = [hits[r] for r in runs]
+    sizes = np.array([len(o) for o in found])
+    starts = np.concatenate([[0], np.cumsum(sizes)[:-1]])
+    pts = np.concatenate(found)
+    centres = np.add.reduceat(pts, starts, axis=0) / sizes[:, None]
+    spread = np.hypot(*(pts - centres.repeat(sizes, axis=0)).T)
+    return centres, np.maximum.reduceat(spread, starts), moved
+
+
+@pytest.mark.parametrize("ring", [True, False])
+def test_what_robots_see_together_is_what_each_sees_alone(ring):
+    rng = np.random.default_rng(21 + ring)
+    beams, dt = 36, 0.05
+    angles = (np.deg2rad(np.arange(beams) * 10.0) if ring
+              else np.deg2rad(np.linspace(135, -135, beams)))              # a ring, a fan
+    spaces, now = [], 3.0
+    for _ in range(40):                          # robots driving about with a wall in view
+        free = movers.FreeSpace.of(angles, ring, dt, 2.0)
+        x, y, h = rng.uniform(-50, 50), rng.uniform(-50, 50), rng.uniform(-4, 4)
+        for k in range(int(rng.integers(0, 2 * movers.WINDOW / dt))):
+            x, y, h = x + rng.normal(0, 2), y + rng.normal(0, 2), h + rng.normal(0, 0.05)
+            d = np.stack([np.cos(angles + h), np.sin(angles + h)], axis=1)
+            free.update(now - (k + 1) * dt, np.array([x, y]), d, rng.uniform(5, 150, beams))
+        spaces.append(free)
+    origins = rng.uniform(-50, 50, (40, 2))
+    heading = rng.uniform(-4, 4, 40)
+    dirs = np.stack([np.cos(angles + heading[:, None]), np.sin(angles + heading[:, None])], axis=2)
+    ranges = rng.uniform(5, 150, (40, beams))
+    ranges[::3] = 60 + rng.normal(0, 2, (14, beams))         # one object round the robot
+    seen = rng.random((40, beams)) < rng.uniform(0, 1, (40, 1))
+    seen[::4, [0, -1]] = True                               # across a ring's first beam
+    seen[5] = False
+    together = movers.sightings(spaces, now, origins, ranges, dirs, seen)
+    for r, (centres, radii, moved) in enumerate(together):
+        plain = plain_sighting(spaces[r], now, origins[r], ranges[r], dirs[r], seen[r], ring)
+        alone = movers.sightings(spaces[r:r + 1], now, origins[r:r + 1], ranges[r:r + 1],
+                                 dirs[r:r + 1], seen[r:r + 1])[0]
+        for got in (alone, (centres, radii, moved)):
+            assert same(got[0], plain[0]) and same(got[1], plain[1]) and got[2] == plain[2]
+    assert any(None in m and True in m and False in m for _, _, m in together)
 
 
 def test_cells_beyond_many_robots_readings_at_once_are_each_robots_own():
