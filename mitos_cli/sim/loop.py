@@ -877,6 +877,8 @@ class Simulation:
         if sighted is None:                                  # nothing to follow
             return None
         tracker.follow(s.t, *sighted)
+        if not any(tr.mover for tr in tracker.tracks):          # nothing it follows moves
+            return None
         h = float(self._h[i])
         # (a robot on its way to a refuge draws away from what it yields to; it waits for
         # it all the same)
