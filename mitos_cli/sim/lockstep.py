@@ -152,8 +152,10 @@ def _sightings_together(runs: list[Simulation], sensed: list) -> list[list[mover
     """What each run is :meth:`~.loop.Simulation.watching` (its maps marked), seen in one
     :func:`.movers.sightings` for the robots of all runs (they tick together: one time)."""
     watched = [run.watching(s) for run, s in zip(runs, sensed)]
-    got = movers.sightings([sp for w in watched for sp in w[0]], sensed[0].t,
-                           *(np.concatenate([w[j] for w in watched]) for j in (1, 2, 3, 4)))
+    looking = [w for w in watched if w[0]]                  # runs whose robots follow something
+    got = movers.sightings([sp for w in looking for sp in w[0]], sensed[0].t,
+                           *(np.concatenate([w[j] for w in looking]) for j in (1, 2, 3, 4))
+                           ) if looking else []
     ends = [0, *itertools.accumulate(len(w[0]) for w in watched)]
     return [got[a:b] for a, b in zip(ends[:-1], ends[1:])]
 

@@ -424,6 +424,9 @@ class Simulation:
         self._hit = np.zeros(n, dtype=bool)
         self._beyond_at: tuple = (None, [])             # see _beyond()
         self._watched: tuple = (None, [], [])           # see watching()
+        beams = len(self.angles)                        # what watching() gives for no robot
+        self._unseen = (np.zeros((0, 2)), np.zeros((0, beams)), np.zeros((0, beams, 2)),
+                        np.zeros((0, beams), dtype=bool))
         self._observed: _Sensed | None = None
         self._deciding: _Sensed | None = None
         self.record: list[Tick] = []
@@ -856,6 +859,8 @@ class Simulation:
                    [i for i in range(self.n)
                     if self._trackers[i].tracks or np.count_nonzero(self._seen[i])])
         self._watched = (s, learned, follows)
+        if not follows:
+            return [], *self._unseen
         if self.n == 1:
             dirs, seen = self._dirs[0][None], self._seen[0][None]
         else:
