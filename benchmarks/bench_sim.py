@@ -5,6 +5,7 @@ time of ``--runs 100`` on one and two worker processes.
     python benchmarks/bench_sim.py --only 2,4 --against main   # this tree and main's, one process
     python benchmarks/bench_sim.py --only 5       # 1,000 randomised slalom runs, two ways
     python benchmarks/bench_sim.py --only 4,5 --runs 200
+    python benchmarks/bench_sim.py --only 4 --seconds 0 --sizes 16,64 --against main  # full runs
 
 1. **one robot, 60 simulated seconds at dt = 0.05** (1200 ticks): the packaged corridor world
    stretched to 2500 in so that the run never ends early; sensing (36 beams), perception, the
@@ -25,9 +26,11 @@ time of ``--runs 100`` on one and two worker processes.
 3. **--runs 100** of ``slalom.yaml`` (randomised obstacles and noise) through ``run_many`` with
    1 and 2 workers; the two must give identical results.
 4. **time per robot-tick in lockstep** (:mod:`mitos_cli.sim.lockstep`) at batch sizes 1, 16,
-   256 and 1,024: that many randomised runs of ``slalom.yaml`` cut to 2 simulated seconds (40
-   ticks each), stepped together, CPU time per robot-tick; the peer in the same run is the same
-   16 runs each simulated alone (``simulate``), and every batch's results must equal theirs.
+   256 and 1,024 (``--sizes``): that many randomised runs of ``slalom.yaml`` cut to 2 simulated
+   seconds (40 ticks each; ``--seconds 0``: every run to its end, where its map holds more and
+   its brake sweeps more cells: a robot-tick costs about 1.5x), stepped together, CPU time
+   per robot-tick; the peer in the same run is the same 16 runs each simulated alone
+   (``simulate``), and every batch's results must equal theirs.
    With ``--against REV``: REV's tree at the same batch sizes, rounds interleaved.
 5. **1,000 randomised runs of ``slalom.yaml`` on 2 workers** (``--runs`` to change the number):
    ``run_many`` (each worker steps its runs in lockstep) against the runs simulated one by one
@@ -199,6 +202,9 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--only", default="1,2,3,4", help="sections to run (default 1,2,3,4)")
     ap.add_argument("--runs", type=int, default=1000, help="runs of section 5 (1000)")
+    ap.add_argument("--seconds", type=float, default=2.0, help="section 4: simulated seconds a "
+                    "run (2; 0: the world's own limit, every run to its end)")
+    ap.add_argument("--sizes", default="1,16,256,1024", help="section 4: batch sizes")
     ap.add_argument("--against", metavar="REV", help="sections 2 and 4: this tree and git "
                     "revision REV's, interleaved in one process")
     args = ap.parse_args()
@@ -223,7 +229,8 @@ def main() -> None:
         if 3 in sections:
             hundred_runs(fuzzy)
         if 4 in sections:
-            batch_sizes(fuzzy, args.against, theirs)
+            batch_sizes(fuzzy, args.against, theirs, args.seconds,
+                        [int(x) for x in args.sizes.split(",")])
         if 5 in sections:
             thousand_runs(fuzzy, args.runs)
     print(f"load average {_load():.2f} at the end")
@@ -292,13 +299,18 @@ def hundred_runs(fuzzy) -> None:
     print(f"   identical results with 1 and 2 workers; wall-time speed-up {walls[1] / walls[2]:.2f}x")
 
 
-def batch_sizes(fuzzy, rev: str | None = None, theirs=None) -> None:
+def batch_sizes(fuzzy, rev: str | None = None, theirs=None, seconds: float = 2.0,
+                sizes: list[int] | None = None) -> None:
     """Section 4: CPU time per robot-tick of runs stepped together, by batch size (with
-    ``rev``: also its tree's, the two interleaved batch by batch)."""
-    world = dataclasses.replace(load_world(packaged_path("worlds", "slalom.yaml")),
-                                time_limit=2.0)
+    ``rev``: also its tree's, the two interleaved batch by batch). Runs of ``seconds``
+    simulated seconds (0: to their end; the first seconds, in the open, cost the least)."""
+    def cut(world):
+        return dataclasses.replace(world, time_limit=seconds) if seconds else world
+
+    world = cut(load_world(packaged_path("worlds", "slalom.yaml")))
     scene = prepare(world)
-    print("\n4. lockstep: slalom.yaml randomised, 2 simulated s a run, CPU time per robot-tick")
+    length = f"{seconds:g} simulated s a run" if seconds else "every run to its end"
+    print(f"\n4. lockstep: slalom.yaml randomised, {length}, CPU time per robot-tick")
     seeds = list(range(16))
     c = time.process_time()
     alone = [simulate(world, fuzzy, s, randomise=True, scene=scene) for s in seeds]
@@ -307,14 +319,12 @@ def batch_sizes(fuzzy, rev: str | None = None, theirs=None) -> None:
     old = None
     if theirs is not None:
         loop = importlib.import_module(theirs.__name__ + ".sim.loop")
-        old_world = dataclasses.replace(importlib.import_module(
-            theirs.__name__ + ".sim.worldfile").load_world(packaged_path("worlds",
-                                                                         "slalom.yaml")),
-            time_limit=2.0)
+        old_world = cut(importlib.import_module(theirs.__name__ + ".sim.worldfile")
+                        .load_world(packaged_path("worlds", "slalom.yaml")))
         old = (importlib.import_module(theirs.__name__ + ".sim.lockstep").run_lockstep,
                old_world, importlib.import_module(theirs.__name__ + ".sim.planner")
                .FuzzyPlanner(None, "drive"), loop.prepare(old_world))
-    for size in (1, 16, 256, 1024):
+    for size in sizes or (1, 16, 256, 1024):
         runs = list(range(max(size, 16)))
         c = time.process_time()
         res = run_lockstep(world, fuzzy, runs, randomise=True, scene=scene, batch=size)
