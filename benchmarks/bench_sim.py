@@ -202,9 +202,10 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--only", default="1,2,3,4", help="sections to run (default 1,2,3,4)")
     ap.add_argument("--runs", type=int, default=1000, help="runs of section 5 (1000)")
-    ap.add_argument("--seconds", type=float, default=2.0, help="section 4: simulated seconds a "
+    ap.add_argument("--seconds", type=_seconds, default=2.0, help="section 4: simulated seconds a "
                     "run (2; 0: the world's own limit, every run to its end)")
-    ap.add_argument("--sizes", default="1,16,256,1024", help="section 4: batch sizes")
+    ap.add_argument("--sizes", type=_sizes, default="1,16,256,1024",
+                    help="section 4: batch sizes, comma-separated")
     ap.add_argument("--against", metavar="REV", help="sections 2 and 4: this tree and git "
                     "revision REV's, interleaved in one process")
     args = ap.parse_args()
@@ -230,10 +231,26 @@ def main() -> None:
             hundred_runs(fuzzy)
         if 4 in sections:
             batch_sizes(fuzzy, args.against, theirs, args.seconds,
-                        [int(x) for x in args.sizes.split(",")])
+                        args.sizes)
         if 5 in sections:
             thousand_runs(fuzzy, args.runs)
     print(f"load average {_load():.2f} at the end")
+
+
+def _seconds(text: str) -> float:
+    """``--seconds``: a finite number of simulated seconds, 0 or more."""
+    value = float(text)
+    if not math.isfinite(value) or value < 0:
+        raise ValueError(text)
+    return value
+
+
+def _sizes(text: str) -> list[int]:
+    """``--sizes``: batch sizes of 1 or more, comma-separated."""
+    sizes = [int(x) for x in text.split(",")]
+    if not sizes or min(sizes) < 1:
+        raise ValueError(text)
+    return sizes
 
 
 def _cpus() -> str:
