@@ -317,14 +317,17 @@ def test_a_robots_searches_patch_from_its_last_one_with_the_bits_of_the_whole():
 
 def test_a_star_over_flat_tables_takes_the_generic_searchs_path():
     rng = np.random.default_rng(8)
-    for _ in range(30):
-        R, C = int(rng.integers(3, 15)), int(rng.integers(3, 15))
+    for _ in range(200):
+        R, C = int(rng.integers(3, 25)), int(rng.integers(3, 25))
         blocked = rng.random((R, C)) < 0.25
         ok = rng.random((8, R, C)) < 0.8
         loose = rng.random((R, C)) < 0.1
         narrow = rng.random((8, R, C)) < 0.2
         penalty = rng.uniform(0, 5, (R, C))
-        s, t = (0, 0), (R - 1, C - 1)
+        if rng.random() < 0.5:     # cheap nodes: a step onto one costs less than the heuristic
+            penalty[rng.random((R, C)) < 0.5] = -0.9        # falls, so nodes are reopened
+        s = (int(rng.integers(0, R)), int(rng.integers(0, C)))
+        t = (int(rng.integers(0, R)), int(rng.integers(0, C)))
         blocked[s] = blocked[t] = False
 
         def neighbours(n: int):
@@ -336,10 +339,11 @@ def test_a_star_over_flat_tables_takes_the_generic_searchs_path():
                     yield rr * C + cc, step * (1.0 + penalty[rr, cc]
                                                + (route.NARROW_COST if narrow[m, r, c] else 0.0))
 
-        want = route._astar(neighbours, 0, t[0] * C + t[1], lambda n: (n // C, n % C))
-        allowed, costs = route._steps(list(route.MOVES), blocked, ok, loose, penalty, narrow)
-        got = route._grid_astar(allowed, costs, [dr * C + dc for dr, dc, _ in route.MOVES], C,
-                                0, t[0] * C + t[1])
+        want = route._astar(neighbours, s[0] * C + s[1], t[0] * C + t[1],
+                            lambda n: (n // C, n % C))
+        costs = route._steps(list(route.MOVES), blocked, ok, loose, penalty, narrow)
+        got = route._grid_astar(costs, [dr * C + dc for dr, dc, _ in route.MOVES], R, C,
+                                s[0] * C + s[1], t[0] * C + t[1])
         assert got == want
 
 

@@ -781,9 +781,9 @@ def grid_route(static: StaticMap, start: Pose, goal: Goal, clearance: float,
     ok = (edge >= floor) & ~blocked[None]
     narrow = (edge < clearance) & (node_c >= clearance)[None]
 
-    allowed, costs = _steps(moves, blocked, ok, loose, penalty, narrow)
-    path = _grid_astar(allowed, costs, [dr * C + dc for dr, dc, _ in moves], C,
-                       s[0] * C + s[1], t[0] * C + t[1])
+    costs = _steps(moves, blocked, ok, loose, penalty, narrow)
+    path = _grid_astar(costs, [dr * C + dc for dr, dc, _ in moves], R, C, s[0] * C + s[1],
+                       t[0] * C + t[1])
     if path is None:
         if not explain:
             raise NarrowPassage("no way to the goal on what the robot knows")
@@ -805,52 +805,71 @@ def grid_route(static: StaticMap, start: Pose, goal: Goal, clearance: float,
 
 
 def _steps(moves: Sequence[tuple[int, int, float]], blocked: np.ndarray, ok: np.ndarray,
-           loose: np.ndarray, penalty: np.ndarray,
-           narrow: np.ndarray) -> tuple[memoryview, memoryview]:
-    """Every step of the node grid ``[R, C]`` at once, flat (move ``m`` from node ``n`` at
-    ``m * R * C + n``): whether it may be taken (onto the grid, onto a node not blocked, along
-    an edge that keeps the floor or from or to a loose node) and its cost, ``step * (1 +
-    penalty + NARROW_COST where the edge is narrow)`` in that order, as A* added it up; as
-    flat memoryviews, whose items read as Python ints and floats."""
+           loose: np.ndarray, penalty: np.ndarray, narrow: np.ndarray) -> memoryview:
+    """Every step of the node grid ``[R, C]`` at once, flat and node by node (move ``m``
+    from node ``n`` at ``n * len(moves) + m``): its cost, ``step * (1 + penalty +
+    NARROW_COST where the edge is narrow)`` in that order, as A* added it up, or ``inf``
+    where it may not be taken (off the grid, onto a blocked node, or along an edge short
+    of the floor between two nodes neither of them loose): A* adds that up and finds it no
+    cheaper than any node's cost, as if it had skipped the step."""
     R, C = blocked.shape
-    allowed = np.zeros((len(moves), R, C), dtype=bool)
-    costs = np.zeros((len(moves), R, C))
+    costs = np.full((R, C, len(moves)), np.inf)
     for m, (dr, dc, step) in enumerate(moves):
         src = (slice(max(0, -dr), R - max(0, dr)), slice(max(0, -dc), C - max(0, dc)))
         dst = (slice(max(0, dr), R + min(0, dr)), slice(max(0, dc), C + min(0, dc)))
-        allowed[m][src] = ~blocked[dst] & (ok[m][src] | loose[src] | loose[dst])
-        costs[m][src] = step * (1.0 + penalty[dst] + np.where(narrow[m][src], NARROW_COST, 0.0))
-    return allowed.view(np.uint8).reshape(-1).data, costs.reshape(-1).data
+        allowed = ~blocked[dst] & (ok[m][src] | loose[src] | loose[dst])
+        cost = step * (1.0 + penalty[dst] + np.where(narrow[m][src], NARROW_COST, 0.0))
+        costs[src + (m,)] = np.where(allowed, cost, np.inf)
+    return costs.reshape(-1).data
 
 
-def _grid_astar(allowed: memoryview, costs: memoryview, offsets: list[int], C: int, start: int,
+@functools.lru_cache(maxsize=4)
+def _distances(R: int, C: int) -> np.ndarray:
+    """``[2R - 1, 2C - 1]``: ``math.dist`` from node ``(R - 1, C - 1)`` to every node of a
+    grid twice the size less one, each worked out by ``math.dist`` itself (it depends on
+    the differences alone), so that A*'s heuristic is read, not worked out, with its bits.
+    Kept (read-only)."""
+    out = np.array([[math.dist((r, c), (R - 1, C - 1)) for c in range(2 * C - 1)]
+                    for r in range(2 * R - 1)])
+    out.flags.writeable = False
+    return out
+
+
+def _grid_astar(costs: memoryview, offsets: list[int], R: int, C: int, start: int,
                 goal: int) -> list[int] | None:
-    """:func:`_astar` over the node grid with the steps of :func:`_steps` (the same pushes in
-    the same order, so the same path), without a Python call per neighbour."""
-    size = len(costs) // len(offsets)
-    target = divmod(goal, C)
+    """:func:`_astar` over the node grid ``[R, C]`` with the steps of :func:`_steps` (the
+    same pushes in the same order, so the same path), without a Python call per neighbour:
+    the heuristic to the goal is read from :func:`_distances`, and a node popped again at
+    the cost it was expanded at is not expanded again (it would push nothing: no step from
+    it is cheaper than it was)."""
+    size, k = R * C, len(offsets)
+    gr, gc = divmod(goal, C)
+    h = _distances(R, C)[R - 1 - gr:2 * R - 1 - gr, C - 1 - gc:2 * C - 1 - gc].ravel().tolist()
     frontier = [(0.0, 0, start)]
     came = [-1] * size                   # lists by node: cheaper to read than dicts
-    cost = [math.inf] * size
+    cost = [math.inf] * (size + C + 1)   # a step off the grid (costing inf) reads the padding
+                                         # at the end, a negative index too
+    done = [math.nan] * size             # the cost a node was expanded at
     cost[start] = 0.0
     tie = 0
-    moves = [(m * size, off) for m, off in enumerate(offsets)]
     # the loop's names bound locally: the loop runs thousands of times a search
-    pop, push, dist = heapq.heappop, heapq.heappush, math.dist
+    pop, push = heapq.heappop, heapq.heappush
     while frontier:
         node = pop(frontier)[2]
         if node == goal:
             return _path(came, node)
         here = cost[node]
-        for base, off in moves:
-            if allowed[base + node]:
+        if done[node] == here:
+            continue
+        done[node] = here
+        for off, step in zip(offsets, costs[node * k:node * k + k]):
+            c = here + step
+            if c < cost[node + off]:
                 nxt = node + off
-                c = here + costs[base + node]
-                if c < cost[nxt]:
-                    cost[nxt] = c
-                    came[nxt] = node
-                    tie += 1
-                    push(frontier, (c + dist((nxt // C, nxt % C), target), tie, nxt))
+                cost[nxt] = c
+                came[nxt] = node
+                tie += 1
+                push(frontier, (c + h[nxt], tie, nxt))
     return None
 
 
@@ -982,7 +1001,9 @@ def _keep(last: Prepared, grid: Grid, occ: np.ndarray, cap: float, k: int, out) 
 def _patched(grid: Grid, occ: np.ndarray, base_occ: np.ndarray, cap: float, k: int,
              base_field: Clearance, base_nodes, base_edge: np.ndarray, samples: int):
     """The field, nodes, steps' clearance and samples per step for ``occ``, from those worked
-    out for ``base_occ``: again only where the cells that differ can reach."""
+    out for ``base_occ``: the field again where the cells that differ can reach, and the
+    nodes and steps only round the cells whose distance changed (a node depends on its
+    block's distances alone, a step on its two nodes and the cells between them)."""
     res = grid.resolution
     n = int(math.ceil(cap / res))
     rows, cols = occ.shape
