@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from mitos_cli.resources import packaged_path
-from mitos_cli.sim import geometry, knowledge, movers, perception, route, rows, safety
+from mitos_cli.sim import distance, geometry, knowledge, movers, perception, route, rows, safety
 from mitos_cli.sim.loop import Simulation, prepare
 from mitos_cli.sim.planner import FuzzyPlanner
 from mitos_cli.sim.world import Grid, Robot
@@ -273,6 +273,49 @@ def test_the_brakes_sweep_tests_only_the_cells_its_disc_sweeps_with_the_same_ans
         backward = bool(rng.random() < 0.3)
         assert same(safety.free_travel(cells, 1.0, pose, robot, delta, backward, 30.0),
                     free_travel_over_every_cell(cells, 1.0, pose, robot, delta, backward, 30.0))
+
+
+def steps_clearance_sample_by_sample(field, xy, t) -> np.ndarray:
+    """Every step's clearance as :func:`.route._edges_from` measured it, each sample's
+    clearance (:meth:`.route.Clearance.cells`) and then their minimum."""
+    R, C = xy.shape[:2]
+    out = np.full((len(route.MOVES), R, C), -np.inf)
+    for m, (dr, dc, _) in enumerate(route.MOVES):
+        r0, r1, c0, c1 = max(-dr, 0), min(R - dr, R), max(-dc, 0), min(C - dc, C)
+        a, b = xy[r0:r1, c0:c1], xy[r0 + dr:r1 + dr, c0 + dc:c1 + dc]
+        pts = a[..., None, :] + t[:, None] * (b - a)[..., None, :]
+        out[m, r0:r1, c0:c1] = field.cells(pts.reshape(-1, 2)).reshape(pts.shape[:-1]).min(
+            axis=-1)
+    return out
+
+
+def test_steps_clearance_from_their_least_distance_is_the_least_of_their_samples():
+    rng = np.random.default_rng(17)
+    for k in range(40):
+        grid = Grid(rng.random((int(rng.integers(5, 60)), int(rng.integers(5, 60)))) < 0.05,
+                    float(rng.choice([1.0, 2.0, 0.7])), tuple(rng.uniform(-50, 50, 2)))
+        field = route.Clearance.of(grid.occupied, grid.resolution, grid.origin,
+                                   cap=float(rng.choice([6.0, 20.0, 1e3])))
+        nodes = route._nodes(field.dist, int(rng.integers(1, 4)))
+        xy = route._node_xy(grid, nodes)
+        if k % 4 == 0:          # samples off the field (a field smaller than the nodes' grid)
+            field = route.Clearance(field.dist[:-2, :-3], field.resolution, field.origin)
+        t = route._samples(field, xy)
+        got = np.full((len(route.MOVES), *xy.shape[:2]), -np.inf)
+        route._edges_from(got, field, xy, t, route.MOVES, (0, xy.shape[0]), (0, xy.shape[1]))
+        assert same(got, steps_clearance_sample_by_sample(field, xy, t))
+
+
+def test_a_part_of_the_capped_distances_is_that_part_of_the_whole():
+    rng = np.random.default_rng(18)
+    for _ in range(100):
+        cells = rng.random((int(rng.integers(1, 40)), int(rng.integers(1, 40)))) < 0.1
+        cap = int(rng.integers(1, 12))
+        r0, c0 = int(rng.integers(0, cells.shape[0])), int(rng.integers(0, cells.shape[1]))
+        r1 = int(rng.integers(r0 + 1, cells.shape[0] + 1))
+        c1 = int(rng.integers(c0 + 1, cells.shape[1] + 1))
+        assert same(distance._capped(cells, cap, (r0, r1, c0, c1)),
+                    distance._capped(cells, cap)[r0:r1, c0:c1])
 
 
 def test_the_prepared_search_patches_only_round_the_changed_cells():

@@ -65,17 +65,21 @@ def _column_distance(blocked: np.ndarray) -> np.ndarray:
     return np.minimum(idx - above, below - idx)
 
 
-def _capped(blocked: np.ndarray, cap: int) -> np.ndarray:
+def _capped(blocked: np.ndarray, cap: int,
+            part: tuple[int, int, int, int] | None = None) -> np.ndarray:
     """Exact squared distances up to ``cap`` cells (larger ones read ``cap**2`` or more): the
-    column distances, then the minimum over row offsets within the cap, all as array shifts."""
+    column distances, then the minimum over row offsets within the cap, all as array shifts.
+    ``part``: only rows ``r0:r1`` and columns ``c0:c1`` of the answer (each cell's minimum is
+    its own, so the bits of the whole)."""
     g = np.minimum(_column_distance(blocked), cap + 1.0) ** 2
     rows, cols = g.shape
-    padded = np.full((rows, cols + 2 * cap), (cap + 1.0) ** 2)
-    padded[:, cap:cap + cols] = g
-    d = g.copy()
+    r0, r1, c0, c1 = (0, rows, 0, cols) if part is None else part
+    padded = np.full((r1 - r0, cols + 2 * cap), (cap + 1.0) ** 2)
+    padded[:, cap:cap + cols] = g[r0:r1]
+    d = g[r0:r1, c0:c1].copy()
     for dc in range(1, cap + 1):
-        np.minimum(d, padded[:, cap + dc:cap + dc + cols] + dc * dc, out=d)
-        np.minimum(d, padded[:, cap - dc:cap - dc + cols] + dc * dc, out=d)
+        np.minimum(d, padded[:, cap + dc + c0:cap + dc + c1] + dc * dc, out=d)
+        np.minimum(d, padded[:, cap - dc + c0:cap - dc + c1] + dc * dc, out=d)
     return d
 
 

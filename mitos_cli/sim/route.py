@@ -888,17 +888,35 @@ def _edges_from(out: np.ndarray, field: Clearance, xy: np.ndarray, t: np.ndarray
     nodes in ``rows`` x ``cols`` (half-open ranges of node rows and columns) to its neighbour
     in each move, sampled at ``t`` along it and measured as the nodes are
     (:meth:`Clearance.cells`); each step's clearance is its own samples' alone, so any part
-    gives the bits of the whole. Steps off the grid are left as they are (``-inf``)."""
+    gives the bits of the whole. Steps off the grid are left as they are (``-inf``).
+
+    A sample's clearance, ``max(dist - res / 2, 0)``, never falls as ``dist`` grows (nor
+    does a rounded subtraction), so the smallest is that of the smallest ``dist``: one
+    subtraction a step, not one a sample. Samples lie between two nodes, inside the grid
+    (one that does not sends the step to :meth:`Clearance.cells`)."""
     R, C = xy.shape[:2]
+    res, (ox, oy) = field.resolution, field.origin
+    rows_n, cols_n = field.dist.shape
+    flat = field.dist.reshape(-1)
     for m, (dr, dc, _) in enumerate(moves):
         r0, r1 = max(rows[0], -dr, 0), min(rows[1], R - dr, R)
         c0, c1 = max(cols[0], -dc, 0), min(cols[1], C - dc, C)
         if r0 >= r1 or c0 >= c1:
             continue
         a, b = xy[r0:r1, c0:c1], xy[r0 + dr:r1 + dr, c0 + dc:c1 + dc]
-        pts = a[..., None, :] + t[:, None] * (b - a)[..., None, :]
-        out[m, r0:r1, c0:c1] = field.cells(pts.reshape(-1, 2)).reshape(pts.shape[:-1]).min(
-            axis=-1)
+        ax, ay = a[..., 0, None], a[..., 1, None]
+        x = ax + t * (b[..., 0, None] - ax)                              # [r, c, T]
+        y = ay + t * (b[..., 1, None] - ay)
+        col = np.floor((x - ox) / res).astype(np.int64)
+        row = np.floor((y - oy) / res).astype(np.int64)
+        if not (col.min() >= 0 and col.max() < cols_n and row.min() >= 0
+                and row.max() < rows_n):
+            pts = np.stack([x, y], axis=-1)
+            out[m, r0:r1, c0:c1] = field.cells(pts.reshape(-1, 2)).reshape(x.shape).min(
+                axis=-1)
+            continue
+        least = np.minimum.reduce(flat[row * cols_n + col], axis=-1)
+        out[m, r0:r1, c0:c1] = np.maximum(least - res / 2, 0.0)
 
 
 MOVES = tuple((dr, dc, math.hypot(dr, dc)) for dr in (-1, 0, 1) for dc in (-1, 0, 1)
@@ -1017,12 +1035,18 @@ def _patched(grid: Grid, occ: np.ndarray, base_occ: np.ndarray, cap: float, k: i
     e0, e1 = max(int(changed_cols[0]) - n, 0), min(int(changed_cols[-1]) + 1 + n, cols)
     f0, f1 = max(d0 - n, 0), min(d1 + n, rows)
     g0, g1 = max(e0 - n, 0), min(e1 + n, cols)
+    part = np.sqrt(_capped(occ[f0:f1, g0:g1], n, (d0 - f0, d1 - f0, e0 - g0, e1 - g0))) * res
+    moved = part != base_field.dist[d0:d1, e0:e1]
+    moved_rows = np.flatnonzero(np.logical_or.reduce(moved, axis=1))
+    if not len(moved_rows):                     # no cell's distance changed: nor anything else
+        return base_field, base_nodes, base_edge, samples
+    moved_cols = np.flatnonzero(np.logical_or.reduce(moved, axis=0))
     dist = base_field.dist.copy()
-    part = np.sqrt(_capped(occ[f0:f1, g0:g1], n)) * res
-    dist[d0:d1, e0:e1] = part[d0 - f0:d1 - f0, e0 - g0:e1 - g0]
+    dist[d0:d1, e0:e1] = part
     field = Clearance(dist, res, grid.origin)
-    # the nodes of the blocks that overlap it
-    b0, b1, c0, c1 = d0 // k, -(-d1 // k), e0 // k, -(-e1 // k)
+    # the nodes of the blocks that hold a cell whose distance changed
+    b0, b1 = (d0 + int(moved_rows[0])) // k, -(-(d0 + int(moved_rows[-1]) + 1) // k)
+    c0, c1 = (e0 + int(moved_cols[0])) // k, -(-(e0 + int(moved_cols[-1]) + 1) // k)
     fr, fc, node_d = (a.copy() for a in base_nodes)
     sub = _nodes(dist[b0 * k:b1 * k, c0 * k:c1 * k], k)
     fr[b0:b1, c0:c1] = sub[0] + b0 * k
