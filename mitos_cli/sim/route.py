@@ -506,7 +506,7 @@ class Clearance:
     def along(self, a: np.ndarray, b: np.ndarray) -> float:
         """The smallest clearance on the segment a-b, sampled every half cell."""
         n = max(2, int(math.ceil(math.dist(a, b) / (self.resolution / 2))) + 1)
-        t = np.linspace(0.0, 1.0, n)[:, None]
+        t = _samples_of(n)[:, None]
         return float(self.at(a + t * (b - a)).min())
 
     def along_path(self, points: np.ndarray) -> np.ndarray:
@@ -515,8 +515,9 @@ class Clearance:
         if len(points) < 2:
             return np.zeros(0)
         a, step = points[:-1], points[1:] - points[:-1]
+        xy = points.tolist()                # math.dist reads Python floats the faster
         counts = [max(2, int(math.ceil(math.dist(p, q) / (self.resolution / 2))) + 1)
-                  for p, q in zip(points[:-1], points[1:])]
+                  for p, q in zip(xy[:-1], xy[1:])]
         t = np.concatenate([_samples_of(n) for n in counts])[:, None]
         which = np.repeat(np.arange(len(a)), counts)
         room = self.at(a[which] + t * step[which])
@@ -797,8 +798,11 @@ def grid_route(static: StaticMap, start: Pose, goal: Goal, clearance: float,
             if found is not None:
                 return found
         raise refusal
-    pts = np.array([centre(divmod(n, C)) for n in path])
-    pts = np.vstack([[start.x, start.y], pts[1:-1], [goal.x, goal.y]])
+    r, c = np.divmod(np.array(path[1:-1], dtype=np.int64), C)
+    pts = np.empty((len(r) + 2, 2))       # the start, centre() of every node between, the goal
+    pts[1:-1, 0] = g.origin[0] + (fc[r, c] + 0.5) * g.resolution
+    pts[1:-1, 1] = g.origin[1] + (fr[r, c] + 0.5) * g.resolution
+    pts[0], pts[-1] = (start.x, start.y), (goal.x, goal.y)
     pts = _simplify(pts, size * 0.75, field, clearance,
                     Squares(occ, g.resolution, g.origin), floor)
     return Route.of(pts, goal=(goal.x, goal.y))
