@@ -117,6 +117,28 @@ def test_points_at_is_point_at_for_every_arc_length():
             assert same(r.points_at(s), np.reshape([r.point_at(float(u)) for u in s], (-1, 2)))
 
 
+def test_points_along_many_routes_at_once_are_each_routes_own():
+    rng = np.random.default_rng(15)
+    for k in range(60):
+        shared = []
+        for j in range(int(rng.integers(1, 6))):
+            r = route.Route.of(np.cumsum(rng.normal(0, 30, (int(rng.integers(2, 30)), 2)), axis=0))
+            if (k + j) % 5 == 0:                          # a zero-length segment kept as given
+                r = route.Route(np.vstack([r.points[:1], r.points]),
+                                np.concatenate([[0.0], r.cum]), r.goal)
+            shared.append(r)
+        routes = [shared[int(i)] for i in rng.integers(0, len(shared), int(rng.integers(1, 12)))]
+        s = np.array([rng.uniform(-20, r.length + 20) + np.arange(0.0, 36.0, 4.0) for r in routes])
+        s[rng.random(s.shape) < 0.1] = 0.0
+        for i, r in enumerate(routes):                    # ends, knots, -0.0, inf and NaN
+            s[i, int(rng.integers(0, s.shape[1]))] = rng.choice(
+                [-0.0, r.length, r.cum[int(rng.integers(0, len(r.cum)))], -np.inf, np.inf,
+                 np.nan if rng.random() < 0.2 else 1.0])
+        got = route.points_along(routes, s)
+        for i, r in enumerate(routes):
+            assert same(got[i], r.points_at(s[i]))
+
+
 def test_a_routes_own_clearance_along_every_segment_at_once():
     rng = np.random.default_rng(3)
     occupied = rng.random((40, 50)) < 0.05

@@ -94,7 +94,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .geometry import CACHED, clip_arrays
-from .route import Route, distances, projections
+from .route import Route, distances, points_along, projections
 from .world import Robot
 
 NO_OBSTACLE = 200.0     # in: the `obstacle` distance when nothing obstructs
@@ -495,7 +495,7 @@ def pursuit_points(aims: list[Aim], cfg: Settings) -> tuple[np.ndarray, np.ndarr
             targets[i] = target_point(a.route, a.f, cfg, float(ahead[-1]))
     if not have:
         return out_ahead, targets
-    q = np.stack([target_points(a.route, a.f, ahead) for a in have])         # [H, J, 2]
+    q = _targets(have, ahead)                                                 # [H, J, 2]
     targets[have_i] = q[:, -1]                                  # where every chord is clear
     cells = np.full((len(have), max(len(a.cells) for a in have), 2), _FAR)
     for j, a in enumerate(have):
@@ -641,6 +641,18 @@ def target_points(route: Route, f: Frame, ahead: np.ndarray) -> np.ndarray:
     s = f.s + ahead
     out = route.points_at(s)
     out[s >= route.length] = route.goal
+    return out
+
+
+def _targets(aims: list[Aim], ahead: np.ndarray) -> np.ndarray:
+    """:func:`target_points` of every robot at once, ``[H, J, 2]`` (:func:`.route.points_along`:
+    each the bits of its own)."""
+    s = np.array([a.f.s for a in aims])[:, None] + ahead
+    out = points_along([a.route for a in aims], s)
+    past = s >= np.array([a.route.length for a in aims])[:, None]
+    rows = np.flatnonzero(np.logical_or.reduce(past, axis=1))
+    for i in rows:
+        out[i, past[i]] = aims[i].route.goal
     return out
 
 

@@ -44,7 +44,7 @@ class Route:
         cum = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(pts, axis=0).T))])
         return cls(pts, cum, pts[-1].copy() if goal is None else np.asarray(goal, float))
 
-    @property
+    @functools.cached_property
     def length(self) -> float:
         return float(self.cum[-1])
 
@@ -99,6 +99,19 @@ class Route:
         e = self.points[1:] - a
         ee = np.maximum((e * e).sum(axis=1), 1e-12)
         return a, e, ee, np.sqrt(ee), self.cum[1:] - self.cum[:-1]
+
+    @functools.cached_property
+    def _rows(self) -> np.ndarray:
+        """``[M, 6]``: at each point its arc length and the segment from it (start x and y,
+        vector x and y, span of arc length; at the last point the last segment again), the
+        rows :func:`points_along` gathers from (the same values)."""
+        a, e, _, _, span = self._segments
+        out = np.empty((len(self.cum), 6))
+        out[:, 0] = self.cum
+        out[:-1, 1:3], out[:-1, 3:5], out[:-1, 5] = a, e, span
+        out[-1, 1:] = out[-2, 1:]
+        out.flags.writeable = False
+        return out
 
     @functools.cached_property
     def _spans_positive(self) -> bool:
@@ -193,6 +206,35 @@ class Route:
         t = clip_arrays(np.add.reduce(rel * e, axis=2) / ee, 0.0, 1.0)
         d = rel - t[..., None] * e
         return np.sqrt(np.minimum.reduce(np.add.reduce(d * d, axis=2), axis=1))
+
+
+def points_along(routes: Sequence[Route], s: np.ndarray) -> np.ndarray:
+    """:meth:`Route.points_at` of every row at once: row ``i``'s arc lengths ``s[i]`` on
+    ``routes[i]``, ``[R, J, 2]``. Each is clamped to its route, its segment found by counting
+    the arc lengths up to it (what ``np.searchsorted`` answers) and its point worked out as
+    :meth:`Route.points_at` does, elementwise from the rows' routes' :attr:`Route._rows`
+    laid end to end, so the same bits. A row with a NaN (which no count places) is left to
+    its route."""
+    asked = np.asarray(s, float)
+    rows = [r._rows for r in routes]
+    size = np.fromiter(map(len, rows), np.int64, len(rows))
+    base = np.cumsum(size) - size
+    table = np.concatenate(rows)
+    cum = table[:, 0]
+    last = (size - 1)[:, None]                                               # [R, 1]
+    length = cum[base[:, None] + last]
+    s = np.where(asked < 0.0, 0.0, asked)          # max(s, 0.0), then min(s, length),
+    s = np.where(length < s, length, s)            # as Python's max and min pick
+    upto = cum[base[:, None] + np.minimum(np.arange(int(size.max())), last)]     # [R, M]
+    count = np.add.reduce(upto[:, None, :] <= s[..., None], axis=2)               # [R, J]
+    got = table[base[:, None] + np.minimum(count - 1, last - 1)]                  # [R, J, 6]
+    ok = got[..., 5] > 0
+    out = got[..., 1:3].copy()
+    at = got[ok]
+    out[ok] = at[:, 1:3] + ((s[ok] - at[:, 0]) / at[:, 5])[:, None] * at[:, 3:5]
+    for row in np.flatnonzero(np.logical_or.reduce(s != s, axis=1)).tolist():
+        out[row] = routes[row].points_at(asked[row])
+    return out
 
 
 def projections(routes: Sequence[Route], points: np.ndarray, hints: Sequence[float],
