@@ -633,6 +633,20 @@ def test_a_routes_window_found_by_bisection_is_the_one_searchsorted_finds():
                 assert r._window(lo, hi) == window_by_searchsorted(r, lo, hi)
 
 
+def test_windows_of_many_routes_at_once_are_each_routes_own():
+    rng = np.random.default_rng(16)
+    for _ in range(100):
+        routes = [route.Route.of(np.cumsum(rng.normal(0, 40, (int(rng.integers(2, 12)), 2)),
+                                           axis=0)) for _ in range(int(rng.integers(1, 9)))]
+        ends = [[*r.cum, -0.0, math.inf, -math.inf, math.nan, *rng.uniform(-50, r.length + 50, 6)]
+                for r in routes]
+        lo = np.array([rng.choice(e) for e in ends])
+        hi = np.array([rng.choice(e) for e in ends])
+        table, base, size = route._laid(routes)
+        first, stop = route._windows(route._arc_lengths(table, base, size), size, lo, hi)
+        assert [r._window(a, b) for r, a, b in zip(routes, lo, hi)] == list(zip(first, stop))
+
+
 def project_on_arrays(r: route.Route, p, s_hint, back=24.0, ahead=120.0):
     """:meth:`.route.Route.project` as it was written on arrays for every window."""
     a, e = r.points[:-1], r.points[1:] - r.points[:-1]

@@ -187,14 +187,17 @@ def _obstruction_rows(routes: list[Route], frames: list[Frame], a, b, points, va
                         | ((ah > 0) & _in_band(bh, widen, body["band"])))
     if not np.count_nonzero(blocking):
         return size, position, distance
-    for i, word in enumerate(kept):     # what the route was planned round obstructs only
-        if word is None:                # within its word
-            continue
-        least, planned = word
-        round_ = blocking[i] & planned
-        if np.count_nonzero(round_):
-            blocking[i, round_] = (routes[i].distance(points[i, round_], frames[i].s, cfg.sight)
-                                   - widen[i, round_] < least)
+    # what the route was planned round obstructs only within its word: the distances of
+    # every point of the rows with such points, at once (each point's its own)
+    rounds = [(i, word[0], blocking[i] & word[1]) for i, word in enumerate(kept)
+              if word is not None]
+    rounds = [row for row in rounds if np.count_nonzero(row[2])]
+    if rounds:
+        some = [i for i, _, _ in rounds]
+        gone = distances([routes[i] for i in some], [frames[i].s for i in some], cfg.sight,
+                         points[some])
+        for (i, least, round_), far in zip(rounds, gone):
+            blocking[i, round_] = far[round_] - widen[i, round_] < least
     for j in np.flatnonzero(np.logical_or.reduce(blocking, axis=1)):
         size[j], position[j], distance[j] = _object(
             routes[j], frames[j], a[j], points[j], ahead[j], blocking[j], widen[j], robots[j], cfg)

@@ -102,14 +102,15 @@ class Route:
 
     @functools.cached_property
     def _rows(self) -> np.ndarray:
-        """``[M, 6]``: at each point its arc length and the segment from it (start x and y,
-        vector x and y, span of arc length; at the last point the last segment again), the
-        rows :func:`points_along` gathers from (the same values)."""
-        a, e, _, _, span = self._segments
-        out = np.empty((len(self.cum), 6))
-        out[:, 0] = self.cum
-        out[:-1, 1:3], out[:-1, 3:5], out[:-1, 5] = a, e, span
-        out[-1, 1:] = out[-2, 1:]
+        """``[M, 8]``: each point's arc length and place (x, y), and the segment from it (its
+        vector x and y, span of arc length, squared length and length; at the last point the
+        last segment's again): the rows :func:`projections`, :func:`distances` and
+        :func:`points_along` gather from, the values of :attr:`_segments`."""
+        a, e, ee, root, span = self._segments
+        out = np.empty((len(self.cum), 8))
+        out[:, 0], out[:, 1:3] = self.cum, self.points
+        out[:-1, 3:5], out[:-1, 5], out[:-1, 6], out[:-1, 7] = e, span, ee, root
+        out[-1, 3:] = out[-2, 3:]
         out.flags.writeable = False
         return out
 
@@ -208,26 +209,46 @@ class Route:
         return np.sqrt(np.minimum.reduce(np.add.reduce(d * d, axis=2), axis=1))
 
 
+def _laid(routes: Sequence[Route]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The rows' routes' :attr:`Route._rows` laid end to end, ``[N, 8]`` (a route shared by
+    rows laid once a row: a few hundred rows), and where each row's starts and how many
+    points it has, ``[R]`` each."""
+    rows = [r._rows for r in routes]
+    size = np.fromiter(map(len, rows), np.int64, len(rows))
+    return np.concatenate(rows), np.cumsum(size) - size, size
+
+
+def _arc_lengths(table: np.ndarray, base: np.ndarray, size: np.ndarray) -> np.ndarray:
+    """``[R, M]``: each row's arc lengths, padded with copies of its last."""
+    return table[base[:, None] + np.minimum(np.arange(int(size.max())), size[:, None] - 1), 0]
+
+
+def _windows(cum: np.ndarray, size: np.ndarray, lo: np.ndarray,
+             hi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """:meth:`Route._window` of every row at once (arc lengths ``cum [R, M]`` from
+    :func:`_arc_lengths`, ``lo`` and ``hi [R]``): what its bisections find, counted (arc
+    length never decreases; the padding counts no more than the last it copies), a NaN
+    sorted last as they sort it."""
+    last = size - 1
+    first = np.minimum(np.add.reduce(cum[:, 1:] < lo[:, None], axis=1), last)
+    stop = np.minimum(np.add.reduce(cum[:, :-1] <= hi[:, None], axis=1), last)
+    return np.where(lo != lo, last, first), np.where(hi != hi, last, stop)
+
+
 def points_along(routes: Sequence[Route], s: np.ndarray) -> np.ndarray:
     """:meth:`Route.points_at` of every row at once: row ``i``'s arc lengths ``s[i]`` on
     ``routes[i]``, ``[R, J, 2]``. Each is clamped to its route, its segment found by counting
     the arc lengths up to it (what ``np.searchsorted`` answers) and its point worked out as
-    :meth:`Route.points_at` does, elementwise from the rows' routes' :attr:`Route._rows`
-    laid end to end, so the same bits. A row with a NaN (which no count places) is left to
-    its route."""
+    :meth:`Route.points_at` does, elementwise from the routes' :func:`_laid` rows, so the
+    same bits. A row with a NaN (which no count places) is left to its route."""
     asked = np.asarray(s, float)
-    rows = [r._rows for r in routes]
-    size = np.fromiter(map(len, rows), np.int64, len(rows))
-    base = np.cumsum(size) - size
-    table = np.concatenate(rows)
-    cum = table[:, 0]
+    table, base, size = _laid(routes)
     last = (size - 1)[:, None]                                               # [R, 1]
-    length = cum[base[:, None] + last]
+    length = table[base[:, None] + last, 0]
     s = np.where(asked < 0.0, 0.0, asked)          # max(s, 0.0), then min(s, length),
     s = np.where(length < s, length, s)            # as Python's max and min pick
-    upto = cum[base[:, None] + np.minimum(np.arange(int(size.max())), last)]     # [R, M]
-    count = np.add.reduce(upto[:, None, :] <= s[..., None], axis=2)               # [R, J]
-    got = table[base[:, None] + np.minimum(count - 1, last - 1)]                  # [R, J, 6]
+    count = np.add.reduce(_arc_lengths(table, base, size)[:, None, :] <= s[..., None], axis=2)
+    got = table[base[:, None] + np.minimum(count - 1, last - 1)]                  # [R, J, 8]
     ok = got[..., 5] > 0
     out = got[..., 1:3].copy()
     at = got[ok]
@@ -240,38 +261,18 @@ def points_along(routes: Sequence[Route], s: np.ndarray) -> np.ndarray:
 def projections(routes: Sequence[Route], points: np.ndarray, hints: Sequence[float],
                 back: float = 24.0, ahead: float = 120.0) -> list[tuple[float, float, np.ndarray]]:
     """:meth:`Route.project` of every row at once (``points [R, 2]``, each on its route near
-    its hint): each row's segments in its window, padded with copies of its last one (the
-    nearest is the first of equals, so never a copy), so a row gets the bits it gets alone.
-    The rows' segments are gathered from one table of their routes' (a route shared by
-    many rows is in it once), and the nearest points read out for all rows together."""
-    table: dict[int, int] = {}               # a route's first segment in the table
-    distinct: list[Route] = []
-    firsts, stops, starts = [], [], []
-    rows = 0
-    for route, hint in zip(routes, hints):
-        first, stop = route._window(hint - back, hint + ahead)
-        if first >= stop:
-            first, stop = 0, 1
-        at = table.get(id(route))
-        if at is None:
-            at = table[id(route)] = rows
-            rows += len(route.cum)
-            distinct.append(route)
-        firsts.append(first)
-        stops.append(stop)
-        starts.append(at)
-    lo, hi, base = (np.array(v) for v in (firsts, stops, starts))     # [R] each
-    # route j's segments at rows at_j .. at_j + M_j - 2 of the table, its arc lengths at
-    # at_j .. at_j + M_j - 1 (one more row per route in every column: the last arc length)
-    seg = [r._segments for r in distinct]
-    a = np.concatenate([np.concatenate([g[0], g[0][-1:]]) for g in seg])
-    e = np.concatenate([np.concatenate([g[1], g[1][-1:]]) for g in seg])
-    ee = np.concatenate([np.concatenate([g[2], g[2][-1:]]) for g in seg])
-    root = np.concatenate([np.concatenate([g[3], g[3][-1:]]) for g in seg])
-    cum = np.concatenate([r.cum for r in distinct])
+    its hint): each row's segments in its window (:func:`_windows`), padded with copies of
+    its last one (the nearest is the first of equals, so never a copy), gathered from the
+    routes' :func:`_laid` rows, so a row gets the bits it gets alone; the nearest points are
+    read out for all rows together."""
+    table, base, size = _laid(routes)
+    hint = np.array(hints, float)
+    lo, hi = _windows(_arc_lengths(table, base, size), size, hint - back, hint + ahead)
+    empty = lo >= hi                                            # none in it: the first one
+    lo, hi = np.where(empty, 0, lo), np.where(empty, 1, hi)
     width = int((hi - lo).max())
-    idx = base[:, None] + np.minimum(lo[:, None] + np.arange(width), hi[:, None] - 1)
-    a, e, ee, root = a[idx], e[idx], ee[idx], root[idx]                   # [R, M, ...]
+    rows = table[base[:, None] + np.minimum(lo[:, None] + np.arange(width), hi[:, None] - 1)]
+    a, e, ee, root = rows[..., 1:3], rows[..., 3:5], rows[..., 6], rows[..., 7]   # [R, M, ...]
     p = points[:, None]                                                    # [R, 1, 2]
     t = clip_arrays(((p - a) * e).sum(axis=2) / ee, 0.0, 1.0)              # [R, M]
     closest = a + t[..., None] * e
@@ -279,7 +280,7 @@ def projections(routes: Sequence[Route], points: np.ndarray, hints: Sequence[flo
     d = np.hypot(gap[..., 0], gap[..., 1])
     r = np.arange(len(routes))
     i = d.argmin(axis=1)
-    s = (cum[base + lo + i] + t[r, i] * root[r, i]).tolist()
+    s = (table[base + lo + i, 0] + t[r, i] * root[r, i]).tolist()
     tangent = e[r, i] / np.sqrt(ee[r, i])[:, None]
     rel = points - closest[r, i]
     lateral = (rel[:, 0] * tangent[:, 1] - rel[:, 1] * tangent[:, 0]).tolist()
@@ -290,26 +291,23 @@ def distances(routes: Sequence[Route], s: Sequence[float], ahead: float,
               points: np.ndarray) -> np.ndarray:
     """:meth:`Route.distance` of every row at once: row ``i``'s points ``[R, K, 2]`` from
     ``routes[i]`` between arc lengths ``s[i]`` and ``s[i] + ahead``, ``[R, K]``. Each row's
-    segments are padded with copies of its last one (which the minimum cannot tell from
-    it), so a point gets the bits it gets from its route alone; the sums over x and y are
-    written out (a sum of two is one addition) and the rows are worked a block at a time
-    (:data:`.geometry.CACHED`)."""
+    segments (:func:`_windows`) are padded with copies of its last one (which the minimum
+    cannot tell from it), so a point gets the bits it gets from its route alone; the sums
+    over x and y are written out (a sum of two is one addition) and the rows are worked a
+    block at a time (:data:`.geometry.CACHED`)."""
     if len(routes) == 1:
         return routes[0].distance(points[0], s[0], ahead)[None]
-    spans = [route._window(si, si + ahead) for route, si in zip(routes, s)]
-    width = max((stop - first for first, stop in spans), default=0)
+    table, base, size = _laid(routes)
+    start = np.array(s, float)
+    first, stop = _windows(_arc_lengths(table, base, size), size, start, start + ahead)
+    width = max(int((stop - first).max()), 0)
     out = np.full(points.shape[:2], np.inf)
-    rows = [i for i, (first, stop) in enumerate(spans) if first < stop]
-    if not rows or not points.shape[1]:
+    rows = np.flatnonzero(first < stop)
+    if not len(rows) or not points.shape[1]:
         return out
-    a = np.empty((len(rows), width, 2))
-    b = np.empty((len(rows), width, 2))
-    for j, i in enumerate(rows):
-        first, stop = spans[i]
-        pts = routes[i].points
-        a[j, :stop - first], b[j, :stop - first] = pts[first:stop], pts[first + 1:stop + 1]
-        a[j, stop - first:], b[j, stop - first:] = pts[stop - 1], pts[stop]
-    e = b - a                                                  # [H, M, 2]
+    at = base[rows, None] + np.minimum(first[rows, None] + np.arange(width), stop[rows, None] - 1)
+    a = table[at, 1:3]                                          # [H, M, 2]: each segment's
+    e = table[at + 1, 1:3] - a                                  # ends, as the route has them
     ee = np.maximum(e[..., 0] * e[..., 0] + e[..., 1] * e[..., 1], 1e-12)
     block = max(1, CACHED // (points.shape[1] * width))
     for lo in range(0, len(rows), block):
