@@ -593,17 +593,19 @@ class Squares:
         res, (ox, oy) = self.resolution, self.origin
         rows, cols = self.occupied.shape
         n = max(1, int(math.ceil(math.dist(a, b) / max(4 * reach, 4 * res))))
-        ends = a + np.linspace(0.0, 1.0, n + 1)[:, None] * (b - a)
+        ends = (a + _samples_of(n + 1)[:, None] * (b - a)).tolist()     # floats: the same
         rel = []
-        for p, q in zip(ends[:-1], ends[1:]):
-            lo, hi = np.minimum(p, q) - reach, np.maximum(p, q) + reach
-            c0, c1 = max(int((lo[0] - ox) // res), 0), min(int((hi[0] - ox) // res) + 1, cols)
-            r0, r1 = max(int((lo[1] - oy) // res), 0), min(int((hi[1] - oy) // res) + 1, rows)
+        for (px, py), (qx, qy) in zip(ends[:-1], ends[1:]):
+            c0 = max(int((min(px, qx) - reach - ox) // res), 0)
+            c1 = min(int((max(px, qx) + reach - ox) // res) + 1, cols)
+            r0 = max(int((min(py, qy) - reach - oy) // res), 0)
+            r1 = min(int((max(py, qy) + reach - oy) // res) + 1, rows)
             if c0 >= c1 or r0 >= r1:
                 continue
             r, c = np.nonzero(self.occupied[r0:r1, c0:c1])
-            cx, cy = ox + (c + c0 + 0.5) * res, oy + (r + r0 + 0.5) * res
-            rel.append(np.stack([p[0] - cx, p[1] - cy, q[0] - cx, q[1] - cy], axis=1))
+            if len(r):
+                cx, cy = ox + (c + c0 + 0.5) * res, oy + (r + r0 + 0.5) * res
+                rel.append(np.stack([px - cx, py - cy, qx - cx, qy - cy], axis=1))
         seg = np.concatenate(rel) if rel else np.zeros((0, 4))
         if not len(seg):
             return reach
