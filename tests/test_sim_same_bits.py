@@ -545,6 +545,29 @@ def test_a_maps_near_cells_read_from_the_last_square_are_the_cells_of_a_fresh_lo
             assert same(kept.near(p, reach, given), fresh.near(p, reach, given))
 
 
+def test_many_maps_near_cells_asked_at_once_are_each_maps_own():
+    rng = np.random.default_rng(16)
+    for _ in range(60):
+        rows, cols = (int(n) for n in rng.integers(1, 40, 2))
+        res = float(rng.choice([0.5, 2.0, 3.0]))
+        grid = Grid(rng.random((rows, cols)) < 0.2, res, tuple(rng.normal(0, 5, 2).tolist()))
+        maps = [knowledge.RobotMap.of(grid) for _ in range(int(rng.integers(2, 8)))]
+        for m in maps:
+            m.mark(rng.uniform(-10, cols * res + 10, (5, 2)), np.tile([1.0, 0.0], (5, 1)))
+        # squares inside, across the edges and wholly outside the grid, of one cell or more
+        points = rng.uniform(-30, max(rows, cols) * res + 30, (len(maps), 2))
+        reaches = rng.choice([0.0, res / 3, float(rng.uniform(0, 40))], len(maps))
+        for given in (False, True):
+            got = knowledge.near_all(maps, points, reaches, given)
+            for m, p, reach, cells in zip(maps, points, reaches, got):
+                m._last_near = None                   # looked up afresh
+                assert same(cells, m.near(p, float(reach), given))
+    other = knowledge.RobotMap.of(Grid(np.ones((4, 4), bool), 3.0, (0.0, 0.0)))
+    two = [maps[0], other]                                 # grids unlike: one by one
+    got = knowledge.near_all(two, np.array([[1.0, 1.0]] * 2), np.array([5.0, 5.0]))
+    assert all(same(cells, m.near(np.array([1.0, 1.0]), 5.0)) for m, cells in zip(two, got))
+
+
 @pytest.mark.parametrize("rows", [7, 400])             # 400: rows worked in blocks
 def test_distances_from_many_routes_at_once_are_each_routes_own(rows):
     rng = np.random.default_rng(9)

@@ -375,6 +375,71 @@ class RobotMap:
                         max_range)
 
 
+def near_all(maps: list[RobotMap], points: np.ndarray, reaches: np.ndarray,
+             given: bool = False) -> list[np.ndarray]:
+    """``[m.near(p, reach, given) for m, p, reach in zip(maps, points [R, 2], reaches [R])]``
+    in one pass (runs in lockstep ask together): every square's cells copied into one block
+    of windows of the largest square's size, the rest left unoccupied, and one ``nonzero``:
+    the same cells, in the same order, with the same centres. Maps that do not share their
+    cells' shape, size and origin answer one by one."""
+    grid = _alike(maps) if len(maps) > 1 else None
+    if grid is None:
+        return [m.near(p, reach, given) for m, p, reach in zip(maps, points, reaches)]
+    r0, r1, c0, c1 = _squares(grid, points, reaches)
+    high, wide = int((r1 - r0).max()), int((c1 - c0).max())
+    if high <= 0 or wide <= 0:
+        return [np.zeros((0, 2)) for _ in maps]
+    block = np.zeros((len(maps), high, wide), dtype=bool)
+    for j, (m, a, b, e, f) in enumerate(zip(maps, r0.tolist(), r1.tolist(), c0.tolist(),
+                                             c1.tolist())):
+        block[j, :b - a, :f - e] = (m.grid.occupied if given else m.occupied)[a:b, e:f]
+    k, at = np.divmod(np.flatnonzero(block), high * wide)
+    r, c = np.divmod(at, wide)
+    r += r0[k]
+    c += c0[k]
+    xs, ys = _centre_lines(grid)
+    centres = np.empty((len(r), 2))
+    centres[:, 0], centres[:, 1] = xs[c], ys[r]
+    centres.flags.writeable = False                  # (as near's)
+    ends = np.cumsum(np.bincount(k, minlength=len(maps))).tolist()
+    return [centres[a:b] for a, b in zip([0, *ends[:-1]], ends)]
+
+
+def _alike(maps: list[RobotMap]) -> Grid | None:
+    """The first map's grid when every map's cells have its shape, size and origin (the runs
+    of a world do), else ``None``."""
+    grid = maps[0].grid
+    shape = grid.occupied.shape
+    if any(m.grid is not grid and (m.grid.occupied.shape != shape
+                                   or m.grid.resolution != grid.resolution
+                                   or m.grid.origin != grid.origin) for m in maps):
+        return None
+    return grid
+
+
+def _squares(grid: Grid, points: np.ndarray, reaches: np.ndarray) -> tuple[np.ndarray, ...]:
+    """:meth:`RobotMap._square` of every point ``[R, 2]`` with its reach ``[R]`` at once:
+    rows ``r0:r1`` and columns ``c0:c1``, ``[R]`` each (NumPy's ``//`` on floats is Python's:
+    the same cells)."""
+    res, (ox, oy) = grid.resolution, grid.origin
+    rows, cols = grid.occupied.shape
+    reach = reaches[:, None]
+    corners = np.concatenate([points - reach, points + reach], axis=1)   # x0 y0 x1 y1 [R, 4]
+    cells = ((corners - _four(ox, oy)) // res).astype(np.int64)
+    cells[:, 2:] += 1
+    np.minimum(np.maximum(cells, 0, out=cells), _four(cols, rows), out=cells)
+    c0, r0, c1, r1 = cells.T
+    return r0, r1, c0, c1
+
+
+@functools.lru_cache(maxsize=16, typed=True)       # (2 and 2.0 are two arrays)
+def _four(x: float, y: float) -> np.ndarray:
+    """``[x, y, x, y]``, read-only (:func:`_squares` asks twice a tick)."""
+    out = np.array([x, y, x, y])
+    out.flags.writeable = False
+    return out
+
+
 def clear_all(maps: list[RobotMap], origins: np.ndarray, dirs: np.ndarray,
               measured: np.ndarray, max_range: float) -> None:
     """:meth:`RobotMap.clear` of every map at once (robots at ``origins [R, 2]``, their beams

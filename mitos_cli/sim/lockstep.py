@@ -5,7 +5,8 @@ beams, noise from each robot's own stream, clearance), the marks they see throug
 from their maps in one pass (:func:`.knowledge.clear_all`), the cells their echoes came from
 found in one pass (:func:`.knowledge.beyond_cells`), what they see that their maps do not
 show cut into objects and tested against the beams they kept in one pass
-(:func:`.movers.sightings`), their pursuit points found in one pass
+(:func:`.movers.sightings`), the cells near them on their maps found in one pass
+(:func:`.knowledge.near_all`), their pursuit points found in one pass
 (:func:`.perception.pursuit_points`) and their rule inputs perceived in one pass
 (:func:`.perception.perceive_rows`); what else a robot's own map and route need (marking its
 map, following its tracks, replanning) and its check are done run by run, with the code of a
@@ -102,7 +103,8 @@ class Lockstep:
 def _observe_together(runs: list[Simulation]) -> list:
     """:meth:`Simulation.observe` of every run: their robots' beams and clearance sensed in
     one :func:`.rows.sense`, their maps cleared in one :func:`.knowledge.clear_all`, what
-    they see seen in one :func:`.movers.sightings`, their pursuit points found in one
+    they see seen in one :func:`.movers.sightings`, what their maps hold near them found in
+    one :func:`.knowledge.near_all`, their pursuit points found in one
     :func:`.perception.pursuit_points` and their inputs perceived in one
     :func:`.perception.perceive_rows` (each row the bits of its robot alone); what else each
     robot's map and route need, run by run."""
@@ -130,8 +132,10 @@ def _observe_together(runs: list[Simulation]) -> list:
                                    np.concatenate([f[1] for f in framing]),
                                    np.concatenate([f[2] for f in framing]))
         sighted = _sightings_together(fresh, sensed)
-        aims = [aim for run, s, (start, stop), seen in zip(fresh, sensed, spans, sighted)
-                for aim in run.aims(s, frames[start:stop], seen)]
+        near = _near_together([run.aim_squares(s) for run, s in zip(fresh, sensed)])
+        aims = [aim for run, s, (start, stop), seen, cells in zip(fresh, sensed, spans, sighted,
+                                                                  near)
+                for aim in run.aims(s, frames[start:stop], seen, cells)]
         ahead, targets = perception.pursuit_points(aims, fresh[0].settings)
         gaps = perception.route_gaps(aims)
         ticks, sights = [], []
@@ -160,10 +164,24 @@ def _sightings_together(runs: list[Simulation], sensed: list) -> list[list[mover
     return [got[a:b] for a, b in zip(ends[:-1], ends[1:])]
 
 
+def _near_together(asks: list[tuple]) -> list[list[np.ndarray]]:
+    """What the maps answer each run's squares ``(maps, points, reaches, given)`` (the runs of
+    a world ask alike), asked in one :func:`.knowledge.near_all`, run by run."""
+    maps = [m for ask in asks for m in ask[0]]
+    if not maps:
+        return [[] for _ in asks]
+    got = knowledge.near_all(maps, np.concatenate([ask[1] for ask in asks]),
+                             np.concatenate([ask[2] for ask in asks]), asks[0][3])
+    ends = [0, *itertools.accumulate(len(ask[0]) for ask in asks)]
+    return [got[a:b] for a, b in zip(ends[:-1], ends[1:])]
+
+
 def _guard_together(runs: list[Simulation], ticks: list) -> None:
-    """Every run's guard on its tick's commands, the first sweep of every robot of every
-    run measured in one :func:`.safety.free_travels`."""
-    sweeps = [run.braking(s) for run, s in zip(runs, ticks)]
+    """Every run's guard on its tick's commands, what every robot's map holds near it found
+    in one :func:`.knowledge.near_all` and the first sweep of every robot of every run
+    measured in one :func:`.safety.free_travels`."""
+    near = _near_together([(*run.brake_squares(s), False) for run, s in zip(runs, ticks)])
+    sweeps = [run.braking(s, cells) for run, s, cells in zip(runs, ticks, near)]
     every = [sweep for mine in sweeps for sweep in mine]
     if not every:
         return

@@ -731,13 +731,16 @@ class Simulation:
         return self._maps, s.pose[:, :2], dirs, s.ranges, self.world.sensors.range
 
     def aims(self, s: _Sensed, frames: list[perception.Frame],
-             sighted: list[movers.Seen] | None = None) -> list[perception.Aim]:
+             sighted: list[movers.Seen] | None = None,
+             near: list[np.ndarray] | None = None) -> list[perception.Aim]:
         """Each robot's :class:`.perception.Aim` at tick ``s``, its map cleared
         (:meth:`clearing`): where it is on its route, its map marked from its readings (and
         its route replanned if need be) and what its pursuit point keeps clear of (runs in
         lockstep find their pursuit points together); ``frames``: where they are on their
         routes (:meth:`framing`); ``sighted``: :func:`.movers.sightings` of what it is
-        :meth:`watching` (runs in lockstep see theirs together; ``None``: seen here)."""
+        :meth:`watching` (runs in lockstep see theirs together; ``None``: seen here);
+        ``near``: what each robot's map answers :meth:`aim_squares` (runs in lockstep ask
+        together; ``None``: asked here)."""
         if sighted is None:
             spaces, *looks = self.watching(s)
             sighted = movers.sightings(spaces, s.t, *looks)
@@ -763,12 +766,21 @@ class Simulation:
             self._s_hint[i] = f.s
             least = self._asked[i][1]
             # what the route keeps clear of: the marks too, where it is replanned round them
-            cells = rmap.near(s.pose[i, :2], self._cfg.lookahead + least,
-                              given=self.world.replan != "clearance")
+            cells = (rmap.near(s.pose[i, :2], self._cfg.lookahead + least,
+                               given=self.world.replan != "clearance")
+                     if near is None else near[i])
             out.append(perception.Aim(routes[i], f, s.pose[i, :2], cells,
                                       rmap.grid.resolution / 2,
                                       least + self._cfg.lookahead_room))
         return out
+
+    def aim_squares(self, s: _Sensed) -> tuple[list[knowledge.RobotMap], np.ndarray,
+                                               np.ndarray, bool]:
+        """What :meth:`aims` asks the robots' maps at tick ``s`` (:func:`.knowledge.near_all`:
+        runs in lockstep ask together): the maps, where the robots are, the half sides of
+        their squares and whether of the given cells alone."""
+        reaches = np.array([self._cfg.lookahead + least for _, least in self._asked])
+        return self._maps, s.pose[:, :2], reaches, self.world.replan != "clearance"
 
     def aimed(self, s: _Sensed, aims: list[perception.Aim], ahead: np.ndarray,
               targets: np.ndarray, gaps: list[float] | None = None) -> list[perception.Sight]:
@@ -957,18 +969,30 @@ class Simulation:
         sweeps = self.braking(s)
         self.braked(s, sweeps, safety.free_travels(sweeps, self._safety.step))
 
-    def braking(self, s: _Sensed) -> list[tuple[safety.Body, float, bool]]:
+    def brake_squares(self, s: _Sensed) -> tuple[list[knowledge.RobotMap], np.ndarray,
+                                                 np.ndarray]:
+        """What :meth:`braking` asks the maps of the active robots that brake at tick ``s``
+        (:func:`.knowledge.near_all`: runs in lockstep ask together): the maps, where the
+        robots are and the half sides of their squares."""
+        idx = [i for i in self._active.nonzero()[0].tolist() if self.robots[i].brake]
+        return ([self._maps[i] for i in idx], s.pose[idx, :2],
+                np.array([self._brake_reach[i] + self._body[i] for i in idx]))
+
+    def braking(self, s: _Sensed, near: list[np.ndarray] | None = None
+                ) -> list[tuple[safety.Body, float, bool]]:
         """The first sweep (body, wheel, backward) the guard measures for each active robot
-        that brakes, in order (runs in lockstep measure theirs together)."""
+        that brakes, in order (runs in lockstep measure theirs together; ``near``: what their
+        maps answer :meth:`brake_squares`, which runs in lockstep ask together)."""
         out: list[tuple[safety.Body, float, bool]] = []
         for i in self._active.nonzero()[0]:
             robot, rmap = self.robots[i], self._maps[i]
             if not robot.brake:
                 continue
+            cells = (rmap.near(s.pose[i, :2], self._brake_reach[i] + self._body[i])
+                     if near is None else near[len(out)])
             body = safety.Body(robot, (float(self._x[i]), float(self._y[i]), float(self._h[i])),
-                               float(self._steer[i]),
-                               rmap.near(s.pose[i, :2], self._brake_reach[i] + self._body[i]),
-                               rmap.grid.resolution / 2, float(s.inputs["heading"][i]),
+                               float(self._steer[i]), cells, rmap.grid.resolution / 2,
+                               float(s.inputs["heading"][i]),
                                self._brake_reach[i], float(self._v[i]))
             command = (float(s.command[i, 0]), float(s.command[i, 1]))
             out.append((body, *safety.first_sweep(command, body, self._recovery[i], self.dt)))
