@@ -603,6 +603,24 @@ def test_maps_cleared_together_are_each_cleared_as_alone(maps):
             assert np.array_equal(together[i].marks, alone[i].marks)
 
 
+def test_marks_in_sight_of_many_maps_at_once_are_each_maps_own():
+    rng = np.random.default_rng(17)
+    grid = Grid(rng.random((50, 70)) < 0.02, 2.0, (-3.0, 5.0))
+    maps = [knowledge.RobotMap.of(grid) for _ in range(9)]
+    for _ in range(30):
+        for m in maps[1:]:                                  # map 0 never marks
+            hits = rng.uniform(-10, 150, (int(rng.integers(0, 6)), 2))
+            m.mark(hits, np.tile([0.0, 1.0], (len(hits), 1)))
+        origins = rng.uniform(-60, 200, (len(maps), 2))
+        max_range = float(rng.uniform(0, 60))
+        got = knowledge._in_sight_all(maps, origins, max_range)
+        for m, o, mine in zip(maps, origins, got):
+            alone = m._in_sight(o, max_range)
+            assert (mine is None) == (alone is None)
+            assert mine is None or all(same(a, b) for a, b in zip(mine, alone))
+    assert any(g is None for g in got) and any(g is not None for g in got)
+
+
 def test_brake_sweeps_measured_together_are_each_measured_as_alone():
     rng = np.random.default_rng(12)
     robots = [Robot(), Robot(length=30.0, width=20.0, wheelbase=20.0)]
