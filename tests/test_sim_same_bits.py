@@ -197,6 +197,29 @@ def test_accounted_looks_up_a_dilation_with_the_same_answer():
         assert same(rmap.accounted(pts), accounted_cell_by_cell(rmap, pts))
 
 
+def test_many_maps_marked_and_looked_up_at_once_are_each_maps_own():
+    rng = np.random.default_rng(18)
+    grid = Grid(rng.random((30, 40)) < 0.03, 2.0, (-7.0, 3.0))
+    together = [knowledge.RobotMap.of(grid) for _ in range(7)]
+    alone = [knowledge.RobotMap.of(grid) for _ in range(7)]
+    flags: list[bool] = []
+    for k in range(40):
+        if k == 20:                     # some plan again: a dilation of their own
+            for m, a in zip(together[::2], alone[::2]):
+                m.planned, a.planned = m.occupied.copy(), a.occupied.copy()
+        # cells inside the grid, beyond its edges and outside its dilation too
+        cells = rng.integers([-6, -6], [46, 36], (len(together), 25, 2))
+        seen = rng.random((len(together), 25)) < 0.3
+        marked = knowledge.mark_all(together, cells, seen)
+        assert marked == [a.mark_cells(c[w]) for a, c, w in zip(alone, cells, seen)]
+        flags += marked
+        got = knowledge.accounted_all(together, cells)
+        for m, a, c, row in zip(together, alone, cells, got):
+            assert np.array_equal(m.occupied, a.occupied) and np.array_equal(m.marks, a.marks)
+            assert np.array_equal(row, a.accounted_cells(c))
+    assert any(flags) and not all(flags)
+
+
 def clear_by_scanning(occupied: np.ndarray, given: np.ndarray, grid: Grid, origin, dirs,
                       measured, max_range: float) -> None:
     """RobotMap.clear as it was written: its window scanned for marked cells."""

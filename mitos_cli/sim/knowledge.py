@@ -221,13 +221,7 @@ class RobotMap:
 
     def accounted_cells(self, cells: np.ndarray, reach: int = 2) -> np.ndarray:
         """:meth:`accounted` of the points in ``cells [P, 2]`` (:meth:`cell_indices`)."""
-        if self.planned is None:
-            near = _given_dilated(self.grid, reach)
-        else:               # the cells it planned on do not change until it plans again
-            if self._around is None or self._around[0] is not self.planned \
-                    or self._around[1] != reach:
-                self._around = (self.planned, reach, _dilated(self.planned, reach))
-            near = self._around[2]
+        near = self._dilation(reach)
         cells = cells + reach
         inside = _inside(cells, near.shape)
         if inside is None:
@@ -235,6 +229,16 @@ class RobotMap:
         out = np.zeros(len(cells), dtype=bool)
         out[inside] = near[cells[inside, 1], cells[inside, 0]]
         return out
+
+    def _dilation(self, reach: int) -> np.ndarray:
+        """:func:`_dilated` of the cells its route was planned round (:meth:`accounted`)."""
+        if self.planned is None:
+            return _given_dilated(self.grid, reach)
+        # the cells it planned on do not change until it plans again
+        if self._around is None or self._around[0] is not self.planned \
+                or self._around[1] != reach:
+            self._around = (self.planned, reach, _dilated(self.planned, reach))
+        return self._around[2]
 
     def cells(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The row, column and whether inside the grid of the cell of each of ``points
@@ -339,11 +343,14 @@ class RobotMap:
         if len(hits):
             self.mark_cells(self.cell_indices(hits + dirs * (self.grid.resolution / 2)))
 
-    def mark_cells(self, cells: np.ndarray) -> None:
-        """Mark ``cells [P, 2]`` (:meth:`cell_indices`; those outside the grid are left)."""
+    def mark_cells(self, cells: np.ndarray) -> bool:
+        """Mark ``cells [P, 2]`` (:meth:`cell_indices`; those outside the grid are left):
+        whether any was not marked yet."""
         inside = _inside(cells, self.occupied.shape)
-        if inside is not None:
-            cells = cells[inside]
+        return self._mark(cells if inside is None else cells[inside])
+
+    def _mark(self, cells: np.ndarray) -> bool:
+        """:meth:`mark_cells` of ``cells [P, 2]`` inside the grid."""
         row, col = cells[:, 1], cells[:, 0]
         known = self.occupied[row, col]
         if np.count_nonzero(known) < len(known):      # (a count is cheaper than .all())
@@ -360,6 +367,8 @@ class RobotMap:
             centres = np.empty((len(row), 2))
             centres[:, 0], centres[:, 1] = xs[col], ys[row]
             self.fresh.append(centres)
+            return True
+        return False
 
     def ranges(self, origin: np.ndarray, dirs: np.ndarray, max_range: float) -> np.ndarray:
         """Ranges ``[B]`` this map predicts: each beam marched in half cells to the first
@@ -533,6 +542,40 @@ def beyond_cells(maps: list[RobotMap], origins: np.ndarray, dirs: np.ndarray,
         return None
     return maps[0].cell_indices(origins[:, None] + measured[..., None] * dirs
                                 + dirs * (grid.resolution / 2))
+
+
+def mark_all(maps: list[RobotMap], cells: np.ndarray, seen: np.ndarray) -> list[bool]:
+    """``[m.mark_cells(c[w]) for m, c, w in zip(maps, cells [R, B, 2], seen [R, B])]``, the
+    cells inside the grid found in one pass (maps alike: the runs of a world)."""
+    grid = _alike(maps) if len(maps) > 1 else None
+    if grid is None:
+        return [m.mark_cells(c[w]) for m, c, w in zip(maps, cells, seen)]
+    take = seen & np.logical_and.reduce(cells.view(np.uint64) < _limits(grid.occupied.shape),
+                                        axis=2)
+    return [bool(n) and m._mark(c[w]) for m, c, w, n in
+            zip(maps, cells, take, np.count_nonzero(take, axis=1).tolist())]
+
+
+def accounted_all(maps: list[RobotMap], cells: np.ndarray, reach: int = 2) -> np.ndarray:
+    """``[m.accounted_cells(c, reach) for m, c in zip(maps, cells [R, B, 2])]`` as ``[R, B]``:
+    the cells inside tested and their places in a dilation worked out in one pass, then one
+    ``take`` a map (maps alike: the runs of a world)."""
+    grid = _alike(maps) if len(maps) > 1 else None
+    if grid is None:
+        return np.array([m.accounted_cells(c, reach) for m, c in zip(maps, cells)], dtype=bool
+                        ).reshape(cells.shape[:2])
+    rows, cols = grid.occupied.shape
+    cells = cells + reach
+    inside = np.logical_and.reduce(
+        cells.view(np.uint64) < _limits((rows + 2 * reach, cols + 2 * reach)), axis=2)
+    flat = cells[..., 1] * (cols + 2 * reach) + cells[..., 0]      # [R, B], row-major
+    everywhere = np.count_nonzero(inside) == inside.size
+    if not everywhere:
+        flat[~inside] = 0                   # looked up at a cell of the dilation, then left
+    out = np.empty(inside.shape, dtype=bool)
+    for j, m in enumerate(maps):
+        np.take(m._dilation(reach), flat[j], out=out[j])
+    return out if everywhere else out & inside
 
 
 def expected_ranges(g: Given, rmap: RobotMap | None, origin: np.ndarray, dirs: np.ndarray,

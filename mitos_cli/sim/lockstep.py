@@ -124,24 +124,32 @@ def _observe_together(runs: list[Simulation]) -> list:
         maps = [m for c in clearing for m in c[0]]
         knowledge.clear_all(maps, origins, dirs, measured, world.sensors.range)
         beyond = knowledge.beyond_cells(maps, origins, dirs, measured)
+        learned = None
         if beyond is not None:
             for run, s, (start, stop) in zip(fresh, sensed, spans):
                 run.beyond(s, beyond[start:stop])
+            marked = knowledge.mark_all(maps, beyond, np.concatenate(
+                [run.seeing(s) for run, s in zip(fresh, sensed)]))
+            learned = [marked[start:stop] for start, stop in spans]
         framing = [run.framing(s) for run, s in zip(fresh, sensed)]
         frames = perception.frames([r for f in framing for r in f[0]],
                                    np.concatenate([f[1] for f in framing]),
                                    np.concatenate([f[2] for f in framing]))
-        sighted = _sightings_together(fresh, sensed)
+        sighted = _sightings_together(fresh, sensed, learned)
         near = _near_together([run.aim_squares(s) for run, s in zip(fresh, sensed)])
         aims = [aim for run, s, (start, stop), seen, cells in zip(fresh, sensed, spans, sighted,
                                                                   near)
                 for aim in run.aims(s, frames[start:stop], seen, cells)]
         ahead, targets = perception.pursuit_points(aims, fresh[0].settings)
         gaps = perception.route_gaps(aims)
+        # (after the aims: a route planned again is planned round the cells marked by then)
+        accounted = (knowledge.accounted_all(maps, beyond)
+                     if beyond is not None and world.replan == "clearance" else None)
         ticks, sights = [], []
         for run, s, (start, stop) in zip(fresh, sensed, spans):
             mine_ = run.aimed(s, aims[start:stop], ahead[start:stop], targets[start:stop],
-                              gaps[start:stop])
+                              gaps[start:stop], None if accounted is None
+                              else accounted[start:stop])
             ticks.append((run, s, mine_, start, stop))
             sights += mine_
         inputs = perception.perceive_rows(sights, world.sensors.range, fresh[0].settings)
@@ -152,10 +160,13 @@ def _observe_together(runs: list[Simulation]) -> list:
     return [run.observe() for run in runs]
 
 
-def _sightings_together(runs: list[Simulation], sensed: list) -> list[list[movers.Seen]]:
-    """What each run is :meth:`~.loop.Simulation.watching` (its maps marked), seen in one
-    :func:`.movers.sightings` for the robots of all runs (they tick together: one time)."""
-    watched = [run.watching(s) for run, s in zip(runs, sensed)]
+def _sightings_together(runs: list[Simulation], sensed: list,
+                        learned: list | None = None) -> list[list[movers.Seen]]:
+    """What each run is :meth:`~.loop.Simulation.watching` (its maps marked, or ``learned``
+    whether they were, run by run), seen in one :func:`.movers.sightings` for the robots of
+    all runs (they tick together: one time)."""
+    watched = [run.watching(s, None if learned is None else learned[j])
+               for j, (run, s) in enumerate(zip(runs, sensed))]
     looking = [w for w in watched if w[0]]                  # runs whose robots follow something
     got = movers.sightings([sp for w in looking for sp in w[0]], sensed[0].t,
                            *(np.concatenate([w[j] for w in looking]) for j in (1, 2, 3, 4))

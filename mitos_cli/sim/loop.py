@@ -783,11 +783,13 @@ class Simulation:
         return self._maps, s.pose[:, :2], reaches, self.world.replan != "clearance"
 
     def aimed(self, s: _Sensed, aims: list[perception.Aim], ahead: np.ndarray,
-              targets: np.ndarray, gaps: list[float] | None = None) -> list[perception.Sight]:
+              targets: np.ndarray, gaps: list[float] | None = None,
+              accounted: np.ndarray | None = None) -> list[perception.Sight]:
         """The robots' sights from their :meth:`aims` and their pursuit points (lookaheads
         ``ahead [n]``, points ``targets [n, 2]``): how far ahead each aims and what it keeps
-        clear of (``gaps``: their :func:`.perception.route_gaps`, which runs in lockstep
-        measure together)."""
+        clear of (``gaps``: their :func:`.perception.route_gaps`; ``accounted [n, B]``: which
+        readings hit cells their routes were planned round, :func:`.knowledge.accounted_all`;
+        runs in lockstep work both out together)."""
         out = []
         if gaps is None:
             gaps = perception.route_gaps(aims)
@@ -799,7 +801,7 @@ class Simulation:
             out.append(perception.Sight(
                 aim.route, aim.f, (float(self._x[i]), float(self._y[i]), float(self._h[i])),
                 robot, self._dirs[i], s.ranges[i], self._expected[i], self._spacing,
-                self._threshold, float(ahead[i]), room, self._kept(i, s, least), targets[i],
+                self._threshold, float(ahead[i]), room, self._kept(i, s, least, accounted), targets[i],
                 squeeze))
         return out
 
@@ -816,11 +818,15 @@ class Simulation:
         for i, sight in enumerate(sights):
             s.targets[i] = sight.target
 
-    def _kept(self, i: int, s: _Sensed, least: float) -> tuple[float, np.ndarray] | None:
+    def _kept(self, i: int, s: _Sensed, least: float,
+              accounted: np.ndarray | None = None) -> tuple[float, np.ndarray] | None:
         """Where robot ``i``'s route is replanned round what it senses: the least clearance
-        it keeps, and which of its readings hit cells the route was planned round."""
+        it keeps, and which of its readings hit cells the route was planned round (row ``i``
+        of ``accounted``, or looked up here)."""
         if self.world.replan != "clearance":
             return None
+        if accounted is not None:
+            return least, accounted[i]
         return least, self._maps[i].accounted_cells(self._beyond(i, s))
 
     def beyond(self, s: _Sensed, cells: np.ndarray) -> None:
@@ -855,18 +861,30 @@ class Simulation:
         self._seen[i] = seen
         if not np.count_nonzero(seen):               # (a count is cheaper than .any())
             return False
-        before = len(rmap.fresh)
-        rmap.mark_cells(self._beyond(i, s)[seen])    # = rmap.mark(hits[seen], dirs[seen])
-        return len(rmap.fresh) > before
+        return rmap.mark_cells(self._beyond(i, s)[seen])    # = rmap.mark(hits[seen], dirs[seen])
 
-    def watching(self, s: _Sensed) -> tuple[list[movers.FreeSpace], np.ndarray, np.ndarray,
-                                            np.ndarray, np.ndarray]:
+    def seeing(self, s: _Sensed) -> np.ndarray:
+        """``[n, B]``: which readings at tick ``s`` show what each robot's map does not (every
+        echo, with no map), as :meth:`_learn` finds them robot by robot; runs in lockstep
+        mark their maps with them together (:func:`.knowledge.mark_all`)."""
+        seen = s.ranges < self.world.sensors.range * 0.999
+        if self._given.knows != "none":
+            expected = self._expected[0][None] if self.n == 1 else np.stack(self._expected)
+            seen &= s.ranges < expected - self._threshold
+        self._seen = list(seen)
+        return seen
+
+    def watching(self, s: _Sensed, learned: list[bool] | None = None
+                 ) -> tuple[list[movers.FreeSpace], np.ndarray, np.ndarray, np.ndarray,
+                            np.ndarray]:
         """Each robot's map marked from its readings at tick ``s`` (:meth:`_learn`), and what
         :func:`.movers.sightings` looks at for the robots that follow something (runs in
         lockstep see theirs together): the beams each kept, where it stands ``[F, 2]``, its
         readings ``[F, B]``, beams ``[F, B, 2]`` and which it sees that its map does not
-        show ``[F, B]``."""
-        learned = [self._learn(i, s) for i in range(self.n)]
+        show ``[F, B]``. ``learned``: whether each robot's map was marked (runs in lockstep
+        mark theirs together, :meth:`seeing`; ``None``: marked here)."""
+        if learned is None:
+            learned = [self._learn(i, s) for i in range(self.n)]
         follows = ([] if self.world.replan == "never" else         # (what _sweep follows)
                    [i for i in range(self.n)
                     if self._trackers[i].tracks or np.count_nonzero(self._seen[i])])
