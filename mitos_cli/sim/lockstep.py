@@ -3,13 +3,14 @@
 Each tick the robots of every run still going are sensed in one pass (:func:`.rows.sense`:
 beams, noise from each robot's own stream, clearance), the marks they see through cleared
 from their maps in one pass (:func:`.knowledge.clear_all`), the cells their echoes came from
-found in one pass (:func:`.knowledge.beyond_cells`), what they see that their maps do not
-show cut into objects and tested against the beams they kept in one pass
-(:func:`.movers.sightings`), the cells near them on their maps found in one pass
-(:func:`.knowledge.near_all`), their pursuit points found in one pass
-(:func:`.perception.pursuit_points`) and their rule inputs perceived in one pass
-(:func:`.perception.perceive_rows`); what else a robot's own map and route need (marking its
-map, following its tracks, replanning) and its check are done run by run, with the code of a
+found in one pass (:func:`.knowledge.beyond_cells`), their maps marked from them in one pass
+(:func:`.knowledge.mark_all`), what they see that their maps do not show cut into objects and
+tested against the beams they kept in one pass (:func:`.movers.sightings`), the cells near
+them on their maps found in one pass (:func:`.knowledge.near_all`), their readings looked up
+where their routes were planned in one pass (:func:`.knowledge.accounted_all`), their pursuit
+points found in one pass (:func:`.perception.pursuit_points`) and their rule inputs perceived
+in one pass (:func:`.perception.perceive_rows`); what else a robot's own map and route need
+(following its tracks, replanning) and its check are done run by run, with the code of a
 run alone (:class:`~mitos_cli.sim.loop.Simulation`). Then the fuzzy planner's rule network is
 evaluated once for the active robots of every run (one engine batch: the engine gives each
 row the bits it gives alone), each run's brake checks its commands, and the robots of every run
@@ -102,9 +103,11 @@ class Lockstep:
 
 def _observe_together(runs: list[Simulation]) -> list:
     """:meth:`Simulation.observe` of every run: their robots' beams and clearance sensed in
-    one :func:`.rows.sense`, their maps cleared in one :func:`.knowledge.clear_all`, what
-    they see seen in one :func:`.movers.sightings`, what their maps hold near them found in
-    one :func:`.knowledge.near_all`, their pursuit points found in one
+    one :func:`.rows.sense`, their maps cleared in one :func:`.knowledge.clear_all` and
+    marked in one :func:`.knowledge.mark_all`, what they see seen in one
+    :func:`.movers.sightings`, what their maps hold near them found in one
+    :func:`.knowledge.near_all` and their readings looked up in one
+    :func:`.knowledge.accounted_all`, their pursuit points found in one
     :func:`.perception.pursuit_points` and their inputs perceived in one
     :func:`.perception.perceive_rows` (each row the bits of its robot alone); what else each
     robot's map and route need, run by run."""
