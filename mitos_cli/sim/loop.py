@@ -848,25 +848,17 @@ class Simulation:
                                          + dirs * (rmap.grid.resolution / 2))
         return cells[i]
 
-    def _learn(self, i: int, s: _Sensed) -> bool:
-        """Mark on robot ``i``'s map what its readings show and its map does not (everything
-        it hits, with no map): whether anything new was marked."""
-        sen = self.world.sensors
-        max_range = sen.range
-        measured = s.ranges[i]
-        rmap = self._maps[i]
-        valid = measured < max_range * 0.999
-        seen = (valid if self._given.knows == "none"
-                else valid & (measured < self._expected[i] - self._threshold))
-        self._seen[i] = seen
+    def _learn(self, i: int, s: _Sensed, seen: np.ndarray) -> bool:
+        """Mark on robot ``i``'s map the cells beyond its readings ``seen`` (:meth:`seeing`'s
+        row): whether anything new was marked."""
         if not np.count_nonzero(seen):               # (a count is cheaper than .any())
             return False
-        return rmap.mark_cells(self._beyond(i, s)[seen])    # = rmap.mark(hits[seen], dirs[seen])
+        return self._maps[i].mark_cells(self._beyond(i, s)[seen])   # = rmap.mark(hits, dirs)
 
     def seeing(self, s: _Sensed) -> np.ndarray:
         """``[n, B]``: which readings at tick ``s`` show what each robot's map does not (every
-        echo, with no map), as :meth:`_learn` finds them robot by robot; runs in lockstep
-        mark their maps with them together (:func:`.knowledge.mark_all`)."""
+        echo, with no map): what :meth:`_learn` marks robot by robot, and runs in lockstep
+        mark together (:func:`.knowledge.mark_all`)."""
         seen = s.ranges < self.world.sensors.range * 0.999
         if self._given.knows != "none":
             expected = self._expected[0][None] if self.n == 1 else np.stack(self._expected)
@@ -884,7 +876,8 @@ class Simulation:
         show ``[F, B]``. ``learned``: whether each robot's map was marked (runs in lockstep
         mark theirs together, :meth:`seeing`; ``None``: marked here)."""
         if learned is None:
-            learned = [self._learn(i, s) for i in range(self.n)]
+            seen = self.seeing(s)
+            learned = [self._learn(i, s, seen[i]) for i in range(self.n)]
         follows = ([] if self.world.replan == "never" else         # (what _sweep follows)
                    [i for i in range(self.n)
                     if self._trackers[i].tracks or np.count_nonzero(self._seen[i])])
