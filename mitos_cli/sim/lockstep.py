@@ -9,12 +9,15 @@ tested against the beams they kept in one pass (:func:`.movers.sightings`), the 
 them on their maps found in one pass (:func:`.knowledge.near_all`), their readings looked up
 where their routes were planned in one pass (:func:`.knowledge.accounted_all`), their pursuit
 points found in one pass (:func:`.perception.pursuit_points`) and their rule inputs perceived
-in one pass (:func:`.perception.perceive_rows`); what else a robot's own map and route need
-(following its tracks, replanning) and its check are done run by run, with the code of a
-run alone (:class:`~mitos_cli.sim.loop.Simulation`). Then the fuzzy planner's rule network is
-evaluated once for the active robots of every run (one engine batch: the engine gives each
-row the bits it gives alone), each run's brake checks its commands, and the robots of every run
-move in one batch of kinematics (elementwise per robot). Runs that end drop out. Every batched
+in one pass (:func:`.perception.perceive_rows`) and checked (contact, arrival) in one pass;
+what else a robot's own map and route need (following its tracks, replanning) is done run by
+run, with the code of a run alone (:class:`~mitos_cli.sim.loop.Simulation`). Then the fuzzy
+planner's rule network is evaluated once for the active robots of every run (one engine
+batch: the engine gives each row the bits it gives alone), each run's brake checks its
+commands, every run's tick is recorded and judged in one pass, and the robots of every run
+move in one batch of kinematics (elementwise per robot). The bookkeeping done once for all
+runs is :class:`~mitos_cli.sim.loop.Batch`'s; each run's arrays are views of the batch's.
+Runs that end drop out. Every batched
 stage is elementwise per robot or an exact minimum, so each run's ticks, trajectory and summary
 are bit for bit those of the same run alone, whatever the batch
 (``tests/test_sim_lockstep.py``, ``tests/test_sim_same_bits.py``)."""
@@ -23,12 +26,11 @@ from __future__ import annotations
 
 import itertools
 from collections.abc import Sequence
-from dataclasses import fields
 
 import numpy as np
 
-from . import kinematics, knowledge, movers, perception, rows, safety
-from .loop import Scene, SimResult, Simulation, shared_scene
+from . import knowledge, movers, perception, rows, safety
+from .loop import Batch, Scene, SimResult, Simulation, shared_scene
 from .planner import FuzzyPlanner, Planner
 from .world import World
 
@@ -54,21 +56,44 @@ class Lockstep:
             scene = shared_scene(world, randomise)
         self.runs = [Simulation(world, planner, seed, randomise=randomise, scene=scene)
                      for seed in seeds]
-        self._limits: list = []                  # the runs that last moved and their limits
+        self._batch: Batch | None = None         # the runs last stepped together
 
     @property
     def done(self) -> bool:
         return all(run.done for run in self.runs)
 
     def step(self) -> None:
-        """One tick of every run still going."""
+        """One tick of every run still going (run by run when one is left, or when some
+        were observed already)."""
         live = [run for run in self.runs if not run.done]
-        commands = self._commands(live, _observe_together(live))
-        ticks = [run.commanded(command) for run, command in zip(live, commands)]
-        _guard_together(live, ticks)
-        moving = [run for run, s in zip(live, ticks) if run.verdict(s)[1]]
-        if moving:
-            _move_together(moving, self._limits)
+        if len(live) > 1 and not any(run.observed for run in live):
+            batch = self._batch_of(live)
+            _observe_together(batch)
+            ticks = batch.commanded(self._commands(live, batch.block, batch.active))
+            _guard_together(live, ticks)
+            moving = batch.verdict()
+        else:
+            seen = [run.observe() for run in live]
+            commands = self._commands(live, np.concatenate([s.block for s in seen], axis=1)
+                                      if seen else None,
+                                      np.concatenate([run.active for run in live]))
+            ticks = [run.commanded(None if commands is None else commands[a:b])
+                     for run, (a, b) in zip(live, _spans(live))]
+            _guard_together(live, ticks)
+            moving = [run for run, s in zip(live, ticks) if run.verdict(s)[1]]
+        if len(moving) == 1:
+            moving[0].act(moving[0].decided)
+            moving[0].moved()
+        elif moving:
+            self._batch_of(moving).move()
+
+    def _batch_of(self, runs: list[Simulation]) -> Batch:
+        """The :class:`Batch` of ``runs``: the last one while they are the same runs."""
+        kept = self._batch
+        if kept is None or len(kept.runs) != len(runs) or any(
+                a is not b for a, b in zip(kept.runs, runs)):
+            kept = self._batch = Batch(runs)
+        return kept
 
     def results(self) -> list[SimResult]:
         """Step until every run has ended; each run's :class:`SimResult`, in seed order."""
@@ -76,19 +101,19 @@ class Lockstep:
             self.step()
         return [run.result() for run in self.runs]
 
-    def _commands(self, live: list[Simulation], seen: list) -> list[np.ndarray | None]:
-        """Each run's commands ``[n, 2]`` from one evaluation of the rule network for the
-        active robots of all of them (``None``: the run plans itself, as planners other than
-        the fuzzy one do, whose rows need not be independent of the batch)."""
+    def _commands(self, live: list[Simulation], blocks: np.ndarray | None,
+                  active: np.ndarray) -> np.ndarray | None:
+        """The commands ``[robots, 2]`` of the robots of all ``live`` runs, from one
+        evaluation of the rule network for the active ones (``blocks [inputs, robots]``:
+        their inputs; ``None``: each run plans itself, as planners other than the fuzzy one
+        do, whose rows need not be independent of the batch)."""
         planner = self.planner
-        if not isinstance(planner, FuzzyPlanner) or not live:
-            return [None] * len(live)
-        active = np.concatenate([run.active for run in live])    # [all robots of all runs]
+        if not isinstance(planner, FuzzyPlanner) or blocks is None:
+            return None
         compiled = planner.compiled
         X = np.empty((np.count_nonzero(active), len(compiled.inputs)))
         if len(X) == 0:
-            return [None] * len(live)
-        blocks = np.concatenate([s.block for s in seen], axis=1)        # [inputs, robots]
+            return None
         for j, key in enumerate(compiled.inputs):
             X[:, j] = blocks[_ROW[key], active]
         from ..engine.evaluation import evaluate
@@ -97,70 +122,54 @@ class Lockstep:
         commands = np.zeros((len(active), 2))
         for j, key in enumerate(("steering", "speed")):
             commands[active, j] = out[:, compiled.outputs.index(key)]
-        stops = np.cumsum([run.n for run in live]).tolist()
-        return [commands[stop - run.n:stop] for run, stop in zip(live, stops)]
+        return commands
 
 
-def _observe_together(runs: list[Simulation]) -> list:
-    """:meth:`Simulation.observe` of every run: their robots' beams and clearance sensed in
-    one :func:`.rows.sense`, their maps cleared in one :func:`.knowledge.clear_all` and
-    marked in one :func:`.knowledge.mark_all`, what they see seen in one
-    :func:`.movers.sightings`, what their maps hold near them found in one
+def _spans(runs: list[Simulation]) -> list[tuple[int, int]]:
+    """Where each run's robots lie in the rows of all of them."""
+    stops = list(itertools.accumulate(run.n for run in runs))
+    return list(zip([0, *stops[:-1]], stops))
+
+
+def _observe_together(batch: Batch) -> None:
+    """:meth:`Simulation.observe` of every run of ``batch``: their robots' beams and
+    clearance sensed in one :func:`.rows.sense`, their maps cleared in one
+    :func:`.knowledge.clear_all` and marked in one :func:`.knowledge.mark_all`, what they
+    see seen in one :func:`.movers.sightings`, what their maps hold near them found in one
     :func:`.knowledge.near_all` and their readings looked up in one
     :func:`.knowledge.accounted_all`, their pursuit points found in one
-    :func:`.perception.pursuit_points` and their inputs perceived in one
-    :func:`.perception.perceive_rows` (each row the bits of its robot alone); what else each
-    robot's map and route need, run by run."""
-    fresh = [run for run in runs if not run.observed]
-    if len(fresh) > 1:
-        parts: list[rows.SenseRow] = []
-        spans = []
-        for run in fresh:
-            mine = run.sense_rows()
-            spans.append((len(parts), len(parts) + len(mine)))
-            parts += mine
-        world = fresh[0].world
-        got = rows.sense(parts, fresh[0].angles, world.sensors.range)
-        sensed = [run.sensed(got.part(start, stop)) for run, (start, stop) in zip(fresh, spans)]
-        clearing = [run.clearing(s) for run, s in zip(fresh, sensed)]
-        origins, dirs, measured = (np.concatenate([c[j] for c in clearing]) for j in (1, 2, 3))
-        maps = [m for c in clearing for m in c[0]]
-        knowledge.clear_all(maps, origins, dirs, measured, world.sensors.range)
-        beyond = knowledge.beyond_cells(maps, origins, dirs, measured)
-        learned = None
-        if beyond is not None:
-            for run, s, (start, stop) in zip(fresh, sensed, spans):
-                run.beyond(s, beyond[start:stop])
-            marked = knowledge.mark_all(maps, beyond, np.concatenate(
-                [run.seeing(s) for run, s in zip(fresh, sensed)]))
-            learned = [marked[start:stop] for start, stop in spans]
-        framing = [run.framing(s) for run, s in zip(fresh, sensed)]
-        frames = perception.frames([r for f in framing for r in f[0]],
-                                   np.concatenate([f[1] for f in framing]),
-                                   np.concatenate([f[2] for f in framing]))
-        sighted = _sightings_together(fresh, sensed, learned)
-        near = _near_together([run.aim_squares(s) for run, s in zip(fresh, sensed)])
-        aims = [aim for run, s, (start, stop), seen, cells in zip(fresh, sensed, spans, sighted,
-                                                                  near)
-                for aim in run.aims(s, frames[start:stop], seen, cells)]
-        ahead, targets = perception.pursuit_points(aims, fresh[0].settings)
-        gaps = perception.route_gaps(aims)
-        # (after the aims: a route planned again is planned round the cells marked by then)
-        accounted = (knowledge.accounted_all(maps, beyond)
-                     if beyond is not None and world.replan == "clearance" else None)
-        ticks, sights = [], []
-        for run, s, (start, stop) in zip(fresh, sensed, spans):
-            mine_ = run.aimed(s, aims[start:stop], ahead[start:stop], targets[start:stop],
-                              gaps[start:stop], None if accounted is None
-                              else accounted[start:stop])
-            ticks.append((run, s, mine_, start, stop))
-            sights += mine_
-        inputs = perception.perceive_rows(sights, world.sensors.range, fresh[0].settings)
-        block = np.stack([inputs[key] for key in perception.INPUTS])     # [inputs, robots]
-        for run, s, mine_, start, stop in ticks:
-            run.perceived(s, mine_, block[:, start:stop])
-            run.conclude(s)
-    return [run.observe() for run in runs]
+    :func:`.perception.pursuit_points`, their inputs perceived in one
+    :func:`.perception.perceive_rows` (each row the bits of its robot alone) and checked in
+    one :meth:`.Batch.conclude`; what else each robot's map and route need, run by run."""
+    fresh, spans, maps = batch.runs, batch.spans, batch.maps
+    world = fresh[0].world
+    got = rows.sense([part for run in fresh for part in run.sense_rows()], fresh[0].angles,
+                     world.sensors.range)
+    sensed = batch.sensed(got)
+    knowledge.clear_all(maps, batch.at, got.dirs, got.ranges, world.sensors.range)
+    beyond = knowledge.beyond_cells(maps, batch.at, got.dirs, got.ranges)
+    learned = None
+    if beyond is not None:
+        batch.beyond(beyond)
+        marked = knowledge.mark_all(maps, beyond, batch.seeing())
+        learned = [marked[start:stop] for start, stop in spans]
+    frames = perception.frames(*batch.framing())
+    sighted = _sightings_together(fresh, sensed, learned)
+    near = knowledge.near_all(maps, batch.at, batch.reaches, world.replan != "clearance")
+    aims = [aim for run, s, (start, stop), seen in zip(fresh, sensed, spans, sighted)
+            for aim in run.aims(s, frames[start:stop], seen, near[start:stop])]
+    ahead, targets = perception.pursuit_points(aims, fresh[0].settings)
+    gaps = perception.route_gaps(aims)
+    # (after the aims: a route planned again is planned round the cells marked by then)
+    accounted = (knowledge.accounted_all(maps, beyond)
+                 if beyond is not None and world.replan == "clearance" else None)
+    sights = []
+    for run, s, (start, stop) in zip(fresh, sensed, spans):
+        sights += run.aimed(s, aims[start:stop], ahead[start:stop], targets[start:stop],
+                            gaps[start:stop], None if accounted is None
+                            else accounted[start:stop])
+    batch.conclude(perception.perceive_rows(sights, world.sensors.range, fresh[0].settings),
+                   targets)
 
 
 def _sightings_together(runs: list[Simulation], sensed: list,
@@ -205,35 +214,6 @@ def _guard_together(runs: list[Simulation], ticks: list) -> None:
     for run, s, mine in zip(runs, ticks, sweeps):
         run.braked(s, mine, free[start:start + len(mine)])
         start += len(mine)
-
-
-def _limits(runs: list[Simulation], kept: list) -> kinematics.Limits:
-    """The limits of the robots of ``runs``, one after the other; ``kept`` holds the last
-    (the same runs moving together keep the same limits, whose ramps the kinematics then
-    derives once)."""
-    if not kept or len(kept[0]) != len(runs) or any(a is not b for a, b in zip(kept[0], runs)):
-        kept[:] = [list(runs), kinematics.Limits(*(
-            np.concatenate([getattr(run.limits, f.name) for run in runs])
-            for f in fields(kinematics.Limits)))]
-    return kept[1]
-
-
-def _move_together(runs: list[Simulation], kept: list) -> None:
-    """:meth:`Simulation.act` for every robot of ``runs`` in one call of the kinematics
-    (``kept``: the last limits, :func:`_limits`)."""
-    parts = [run.motion() for run in runs]
-    x, y, h, v, steer, c_steer, c_speed = (np.concatenate([p[j] for p in parts])
-                                           for j in range(7))
-    limits = _limits(runs, kept)
-    world = runs[0].world
-    after = kinematics.step(x, y, h, v, steer, c_steer, c_speed, limits, world.dt,
-                            world.substeps)
-    start = 0
-    for run in runs:
-        stop = start + run.n
-        run.move_to(*(a[start:stop] for a in after))
-        run.moved()
-        start = stop
 
 
 def run_lockstep(world: World, planner: Planner | None, seeds: Sequence[int], *,

@@ -17,10 +17,11 @@ Randomness: ``SeedSequence(seed).spawn(1 + robots)``: the first stream randomise
 
 from __future__ import annotations
 
+import itertools
 import math
 import operator
 import os
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 
 import numpy as np
 
@@ -590,18 +591,22 @@ class Simulation:
         """The end of :meth:`decide`, once the guard has had its say on ``s``'s commands:
         the tick recorded and the verdict."""
         tick = self._record(s)
-        if np.count_nonzero(self._hit):
+        return tick, self._judge(s, bool(np.count_nonzero(self._hit)),
+                                 bool(np.count_nonzero(self._active)))
+
+    def _judge(self, s: _Sensed, hit: bool, driving: bool) -> bool:
+        """The verdict on tick ``s`` (``hit``: a robot touches something; ``driving``: a
+        robot still drives): whether the robots move now."""
+        if hit:
             self._collided = int(self._hit.sum())
             for i in np.flatnonzero(self._hit):
                 self._outcomes[i] = "collision"
             self._stop_the_others()
-            self._done = True
-        elif not np.count_nonzero(self._active):
-            self._done = True
-        else:
+        elif driving:
             self._deciding = s
-            return tick, True
-        return tick, False
+            return True
+        self._done = True
+        return False
 
     @property
     def decided(self) -> _Sensed:
@@ -613,7 +618,11 @@ class Simulation:
         """The second half of :meth:`step`, after :meth:`act`: the next tick, or the end of
         the run (stuck, or out of time)."""
         self._k += 1
-        if self._check_stuck():
+        self._go_on(self._check_stuck())
+
+    def _go_on(self, stuck: bool) -> None:
+        """The next tick begins: the run ends if a robot is ``stuck`` or time is out."""
+        if stuck:
             self._stop_the_others()
             self._done = True
         else:
@@ -662,17 +671,22 @@ class Simulation:
         each robot's own map predicts along its beams."""
         n = self.n
         pose = _columns(self._x, self._y, self._h)
-        self._dirs = list(got.dirs)
-        if self._plain:
-            self._expected = list(got.static)
-        else:                                            # what the robot's own map predicts
-            self._expected = [knowledge.expected_ranges(
-                self._given, self._maps[i], pose[i, :2], self._dirs[i], self._near_known[i],
-                self.world.sensors.range) for i in range(n)]
+        self._beams(pose, list(got.dirs), list(got.static))
         inputs = np.zeros((len(perception.INPUTS), n))      # one block, a row per input
         return _Sensed(self.time, self._where, pose, got.ranges,
                        dict(zip(perception.INPUTS, inputs)), np.zeros((n, 2)),
                        got.clearance, np.zeros((n, 2)), inputs)
+
+    def _beams(self, pose: np.ndarray, dirs: list[np.ndarray], static: list[np.ndarray]) -> None:
+        """Keep each robot's beams ``dirs`` at ``pose`` and what its own map predicts along
+        them (the walls alone, ``static``, when it is given the map)."""
+        self._dirs = dirs
+        if self._plain:
+            self._expected = static
+        else:
+            self._expected = [knowledge.expected_ranges(
+                self._given, self._maps[i], pose[i, :2], dirs[i], self._near_known[i],
+                self.world.sensors.range) for i in range(self.n)]
 
     def _joined(self, i: int, walls: np.ndarray, sides: np.ndarray) -> np.ndarray:
         """Robot ``i``'s nearby walls and then the obstacle sides as one array, kept while
@@ -1055,10 +1069,13 @@ class Simulation:
         if len(odometer) <= window:
             return False
         moved = odometer[-1] - odometer[-1 - window]
-        stuck = (self._active & (moved < STUCK_DISTANCE)).nonzero()[0]
-        for i in stuck:
+        return self._stuck(self._active & (moved < STUCK_DISTANCE))
+
+    def _stuck(self, stuck: np.ndarray) -> bool:
+        """Whether any robot is ``stuck [n]``; those read ``stuck``."""
+        for i in stuck.nonzero()[0]:
             self._outcomes[i] = "stuck"
-        return len(stuck) > 0
+        return bool(np.count_nonzero(stuck))
 
     def _record(self, s: _Sensed) -> Tick:
         tick = Tick(self._k, s.t, _columns(self._x, self._y, np.rad2deg(self._h)),
@@ -1095,6 +1112,174 @@ class Simulation:
         res.robot_metrics = _robot_metrics(res, dt)
         res.metrics = _metrics(res, dt)
         return res
+
+
+class Batch:
+    """Runs of one world stepped together (:mod:`.lockstep`), their robots one after the
+    other in the batch's rows: the bookkeeping each run does alone each tick (its arrays, the
+    check, the record, the verdict, the move) done once for the robots of all, elementwise,
+    so each run keeps the bits it has alone. A run's arrays are views of the batch's, which
+    are fresh each tick (nothing changes them in place but through the run's own view)."""
+
+    def __init__(self, runs: list[Simulation]) -> None:
+        self.runs = runs
+        stops = list(itertools.accumulate(run.n for run in runs))
+        self.spans = list(zip([0, *stops[:-1]], stops))
+        self._starts = np.array([0, *stops[:-1]])
+        self._owner = [(run, i) for run in runs for i in range(run.n)]   # each row's robot
+        self._goal_x, self._goal_y, self._tol = (self._gather(name)
+                                                 for name in ("_goal_x", "_goal_y", "_tol"))
+        self._straight = np.concatenate([run.limits.straight for run in runs])
+        self.maps = [m for run in runs for m in run._maps]
+        self._plain = all(run._plain for run in runs)
+        # each row's farthest echo, news threshold and whether its map shows anything
+        # (:meth:`Simulation.seeing`; a randomised run draws its own sensor noise)
+        far, threshold, knows = np.array([(run.world.sensors.range * 0.999, run._threshold,
+                                           run._given.knows != "none")
+                                          for run in runs for _ in range(run.n)]).T[:, :, None]
+        self._seeing = (far, threshold, None if knows.all() else knows > 0)
+        self.reaches = np.array([run._cfg.lookahead + least      # (Simulation.aim_squares)
+                                 for run in runs for _, least in run._asked])
+        self._limits: kinematics.Limits | None = None
+        self._now: tuple[np.ndarray, ...] | None = None     # this tick's x, y, heading
+        self.ticks: list[_Sensed] = []
+
+    def _gather(self, name: str) -> np.ndarray:
+        """The runs' arrays ``name`` one after the other (a fresh array)."""
+        return np.concatenate([getattr(run, name) for run in self.runs])
+
+    def sensed(self, got: rows.Sensed) -> list[_Sensed]:
+        """:meth:`Simulation.sensed` of every run from the rows of all (``got``): the tick's
+        arrays made once, each run's :class:`_Sensed` views of them."""
+        x, y, h = self._now = (self._gather("_x"), self._gather("_y"), self._gather("_h"))
+        pose = _columns(x, y, h)
+        n = len(x)
+        self.block = np.zeros((len(perception.INPUTS), n))    # a row per input, as alone
+        self.targets, self.command = np.zeros((n, 2)), np.zeros((n, 2))
+        dirs, static = list(got.dirs), list(got.static)
+        self.ticks = []
+        for run, (a, b) in zip(self.runs, self.spans):
+            run._beams(pose[a:b], dirs[a:b], static[a:b])
+            block = self.block[:, a:b]
+            self.ticks.append(_Sensed(run.time, run._where, pose[a:b], got.ranges[a:b],
+                                      dict(zip(perception.INPUTS, block)), self.targets[a:b],
+                                      got.clearance[a:b], self.command[a:b], block))
+        self.got, self.at = got, pose[:, :2].copy()
+        return self.ticks
+
+    def seeing(self) -> np.ndarray:
+        """:meth:`Simulation.seeing` of every run at once: ``[rows, B]``."""
+        ranges, (far, threshold, knows) = self.got.ranges, self._seeing
+        seen = ranges < far
+        expected = (self.got.static if self._plain else
+                    np.array([e for run in self.runs for e in run._expected]))
+        news = ranges < expected - threshold
+        seen &= news if knows is None else news | ~knows      # (knows: the rows that know)
+        rows_ = list(seen)
+        for run, (a, b) in zip(self.runs, self.spans):
+            run._seen = rows_[a:b]
+        return seen
+
+    def framing(self) -> tuple[list[Route], np.ndarray, np.ndarray]:
+        """:meth:`Simulation.framing` of every run at once."""
+        return ([r for run in self.runs for r in run._routes], self.at,
+                self._gather("_s_hint"))
+
+    def beyond(self, cells: np.ndarray) -> None:
+        """:meth:`Simulation.beyond` of every run: ``cells [rows, B, 2]``."""
+        each = list(cells)
+        for run, s, (a, b) in zip(self.runs, self.ticks, self.spans):
+            run._beyond_at = (s, each[a:b])
+
+    def conclude(self, inputs: dict[str, np.ndarray], targets: np.ndarray) -> None:
+        """:meth:`Simulation.perceived` and :meth:`Simulation.conclude` of every run: the
+        rows' ``inputs`` and ``targets`` kept, the check made once for every robot."""
+        for j, key in enumerate(perception.INPUTS):
+            self.block[j] = inputs[key]
+        self.targets[:] = targets
+        x, y, _ = self._ticked()
+        active = self._gather("_active")
+        self.hit = active & (self.got.clearance <= 0.0)
+        arrived = active & (np.hypot(x - self._goal_x, y - self._goal_y) <= self._tol)
+        for run, s, (a, b) in zip(self.runs, self.ticks, self.spans):
+            run._hit = self.hit[a:b]
+            run._observed = s
+        for row in arrived.nonzero()[0].tolist():
+            run, i = self._owner[row]
+            run._outcomes[i] = "success"
+            run._active[i] = False
+        self.active = active & ~arrived
+
+    def _ticked(self) -> tuple[np.ndarray, ...]:
+        assert self._now is not None, "sensed() first"
+        return self._now
+
+    def commanded(self, commands: np.ndarray | None) -> list[_Sensed]:
+        """:meth:`Simulation.commanded` of every run: ``commands [rows, 2]`` for all (the
+        stopped robots' rows are set here), else each run's planner plans its own."""
+        if commands is None or not np.isfinite(commands).all():     # (refused run by run)
+            return [run.commanded(None if commands is None else commands[a:b])
+                    for run, (a, b) in zip(self.runs, self.spans)]
+        stopped = ~self.active
+        commands[stopped, 0] = self._straight[stopped]
+        commands[stopped, 1] = 0.0
+        self.command[:] = commands
+        for run in self.runs:
+            run._observed = None
+        return self.ticks
+
+    def verdict(self) -> list[Simulation]:
+        """:meth:`Simulation.verdict` of every run, once the guard has had its say: each
+        run's tick recorded; the runs whose robots move now."""
+        x, y, h = self._ticked()
+        pose = _columns(x, y, np.rad2deg(h))
+        speed, steering, hint = (self._gather(name) for name in ("_v", "_steer", "_s_hint"))
+        hit = np.logical_or.reduceat(self.hit, self._starts).tolist()
+        driving = np.logical_or.reduceat(self.active, self._starts).tolist()
+        moving = []
+        for j, (run, s, (a, b)) in enumerate(zip(self.runs, self.ticks, self.spans)):
+            run.record.append(Tick(run._k, s.t, pose[a:b], speed[a:b], steering[a:b], s.command,
+                                   s.ranges, s.inputs, s.clearance, s.where, self.active[a:b],
+                                   hint[a:b]))
+            if run._judge(s, hit[j], driving[j]):
+                moving.append(run)
+        return moving
+
+    def move(self) -> None:
+        """:meth:`Simulation.act` and :meth:`Simulation.moved` of every run (each one's
+        robots moving, as after :meth:`verdict`) in one call of the kinematics; the runs of a
+        batch have run as many ticks."""
+        runs = self.runs
+        if self._now is None:           # (some runs of the tick's batch ended: theirs alone)
+            self._now = (self._gather("_x"), self._gather("_y"), self._gather("_h"))
+            self.active = self._gather("_active")
+            self.command = np.concatenate([run.decided.command for run in runs])
+        x, y, h = self._now
+        if self._limits is None:
+            self._limits = kinematics.Limits(*(np.concatenate(
+                [getattr(run.limits, f.name) for run in runs]) for f in fields(kinematics.Limits)))
+        world = runs[0].world
+        command = self.command.T.copy()
+        after = kinematics.step(x, y, h, np.where(self.active, self._gather("_v"), 0.0),
+                                self._gather("_steer"), command[0], command[1], self._limits,
+                                world.dt, world.substeps)
+        driven = np.hypot(after[0] - x, after[1] - y)
+        odometer = runs[0]._odometer
+        assert all(len(run._odometer) == len(odometer) for run in runs), "ticked together"
+        if odometer:
+            driven = np.concatenate([run._odometer[-1] for run in runs]) + driven
+        window = runs[0]._stuck_window
+        stuck = None
+        if len(odometer) + 1 > window:
+            moved = driven - np.concatenate([run._odometer[-window] for run in runs])
+            stuck = self.active & (moved < STUCK_DISTANCE)
+            stuck_any = np.logical_or.reduceat(stuck, self._starts).tolist()
+        for j, (run, (a, b)) in enumerate(zip(runs, self.spans)):
+            run._x, run._y, run._h, run._v, run._steer = (part[a:b] for part in after)
+            run._odometer.append(driven[a:b])
+            run._k += 1
+            run._go_on(stuck is not None and stuck_any[j] and run._stuck(stuck[a:b]))
+        self._now = None
 
 
 def check_seed(seed: object) -> int:

@@ -58,12 +58,6 @@ class Sensed:
     ranges: np.ndarray
     clearance: np.ndarray
 
-    def part(self, start: int, stop: int) -> Sensed:
-        """Rows ``start:stop`` (one run's robots; the readings and clearance copied, as the
-        run records them)."""
-        return Sensed(self.dirs[start:stop], self.static[start:stop],
-                      self.ranges[start:stop].copy(), self.clearance[start:stop].copy())
-
 
 def discs(polygons: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Discs holding convex polygons ``[P, k, 2]``: their corners' mean and the farthest
