@@ -382,6 +382,10 @@ class Simulation:
         self._known_walls = StaticMap(self._given.walls, np.zeros((0, 4, 2)), None,
                                       self.scene.static.bounds)
         self._asked = [clearances(world, a) for a in world.agents]
+        # each robot's Sight.squeeze: its least clearance, where that is less than half its
+        # width and its margin (else none)
+        self._squeeze = [least if least < r.width / 2 + r.safety_margin else math.inf
+                         for r, (_, least) in zip(self.robots, self._asked)]
         self._body = [math.hypot(r.length, r.width) for r in self.robots]   # in: a diagonal
         self._safety = safety.Settings()
         self._brake_reach = [safety.reach_of(r, self.dt, self._safety, sen.range)
@@ -651,6 +655,7 @@ class Simulation:
             footprints = _footprints(np.stack([x, y, h], axis=1), self.robots)
             robot_sides = polygon_segments(footprints).reshape(n, 4, 4)
         out = []
+        xs, ys, hs = x.tolist(), y.tolist(), h.tolist()
         for i in range(n):
             if n > 1:
                 others = np.concatenate([rect_sides] + [robot_sides[j] for j in range(n)
@@ -660,8 +665,8 @@ class Simulation:
                 others, boxes = rect_sides, rect_box
             discs = (self._still_discs if n == 1 and self._still_discs is not None
                      else rows.discs(boxes))
-            walls = self._walls_near(i)
-            out.append(rows.SenseRow(float(x[i]), float(y[i]), float(h[i]), self.robots[i],
+            walls = self._walls_near(i, xs[i], ys[i])
+            out.append(rows.SenseRow(xs[i], ys[i], hs[i], self.robots[i],
                                      walls, self._joined(i, walls, others), boxes, discs,
                                      centres, radii, sen.noise, self._streams[1 + i]))
         return out
@@ -704,9 +709,9 @@ class Simulation:
         where = obs_mod.positions(self.world.obstacles, t)
         return where, obs_mod.shapes_at(self.world.obstacles, where)
 
-    def _walls_near(self, i: int) -> np.ndarray:
-        """Robot ``i``'s nearby walls, gathered again once it moved ``NEAR_SLACK`` away."""
-        x, y = self._x[i], self._y[i]
+    def _walls_near(self, i: int, x: float, y: float) -> np.ndarray:
+        """Robot ``i``'s nearby walls (it is at ``x, y``), gathered again once it moved
+        ``NEAR_SLACK`` away."""
         if math.hypot(x - self._near_at[i][0], y - self._near_at[i][1]) > NEAR_SLACK:
             self._near_at[i] = (x, y)
             self._near_walls[i] = self.scene.static.near(x, y, self._reach + NEAR_SLACK)
@@ -807,16 +812,14 @@ class Simulation:
         out = []
         if gaps is None:
             gaps = perception.route_gaps(aims)
+        poses, lookaheads = s.pose.tolist(), ahead.tolist()    # (x, y, heading: as sensed)
         for i, aim in enumerate(aims):
             least = self._asked[i][1]
             room = max(0.0, gaps[i] - aim.radius - least)     # (perception.route_room)
-            robot = self.robots[i]
-            squeeze = (least if least < robot.width / 2 + robot.safety_margin else math.inf)
             out.append(perception.Sight(
-                aim.route, aim.f, (float(self._x[i]), float(self._y[i]), float(self._h[i])),
-                robot, self._dirs[i], s.ranges[i], self._expected[i], self._spacing,
-                self._threshold, float(ahead[i]), room, self._kept(i, s, least, accounted), targets[i],
-                squeeze))
+                aim.route, aim.f, tuple(poses[i]), self.robots[i], self._dirs[i], s.ranges[i],
+                self._expected[i], self._spacing, self._threshold, lookaheads[i], room,
+                self._kept(i, s, least, accounted), targets[i], self._squeeze[i]))
         return out
 
     def perceived(self, s: _Sensed, sights: list[perception.Sight],
