@@ -1202,11 +1202,8 @@ class Batch:
         self.targets[:] = targets
         x, y, _ = self._ticked()
         active = self._gather("_active")
-        self.hit = active & (self.got.clearance <= 0.0)
+        self.hit = active & (self.got.clearance <= 0.0)      # (each run's, at its verdict)
         arrived = active & (np.hypot(x - self._goal_x, y - self._goal_y) <= self._tol)
-        for run, s, (a, b) in zip(self.runs, self.ticks, self.spans):
-            run._hit = self.hit[a:b]
-            run._observed = s
         for row in arrived.nonzero()[0].tolist():
             run, i = self._owner[row]
             run._outcomes[i] = "success"
@@ -1221,14 +1218,15 @@ class Batch:
         """:meth:`Simulation.commanded` of every run: ``commands [rows, 2]`` for all (the
         stopped robots' rows are set here), else each run's planner plans its own."""
         if commands is None or not np.isfinite(commands).all():     # (refused run by run)
-            return [run.commanded(None if commands is None else commands[a:b])
-                    for run, (a, b) in zip(self.runs, self.spans)]
+            out = []
+            for run, s, (a, b) in zip(self.runs, self.ticks, self.spans):
+                run._observed = s
+                out.append(run.commanded(None if commands is None else commands[a:b]))
+            return out
         stopped = ~self.active
         commands[stopped, 0] = self._straight[stopped]
         commands[stopped, 1] = 0.0
         self.command[:] = commands
-        for run in self.runs:
-            run._observed = None
         return self.ticks
 
     def verdict(self) -> list[Simulation]:
@@ -1241,6 +1239,7 @@ class Batch:
         driving = np.logical_or.reduceat(self.active, self._starts).tolist()
         moving = []
         for j, (run, s, (a, b)) in enumerate(zip(self.runs, self.ticks, self.spans)):
+            run._hit = self.hit[a:b]
             run.record.append(Tick(run._k, s.t, pose[a:b], speed[a:b], steering[a:b], s.command,
                                    s.ranges, s.inputs, s.clearance, s.where, self.active[a:b],
                                    hint[a:b]))
