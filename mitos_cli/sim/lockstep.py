@@ -17,10 +17,9 @@ batch: the engine gives each row the bits it gives alone), each run's brake chec
 commands, every run's tick is recorded and judged in one pass, and the robots of every run
 move in one batch of kinematics (elementwise per robot). The bookkeeping done once for all
 runs is :class:`~mitos_cli.sim.loop.Batch`'s; each run's arrays are views of the batch's.
-Runs that end drop out. Every batched
-stage is elementwise per robot or an exact minimum, so each run's ticks, trajectory and summary
-are bit for bit those of the same run alone, whatever the batch
-(``tests/test_sim_lockstep.py``, ``tests/test_sim_same_bits.py``)."""
+Runs that end drop out. Every batched stage is elementwise per robot or an exact minimum, so
+each run's ticks, trajectory and summary are bit for bit those of the same run alone, whatever
+the batch (``tests/test_sim_lockstep.py``, ``tests/test_sim_same_bits.py``)."""
 
 from __future__ import annotations
 
@@ -30,7 +29,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from . import knowledge, movers, perception, rows, safety
-from .loop import Batch, Scene, SimResult, Simulation, shared_scene
+from .loop import Batch, Scene, SimResult, Simulation, row_spans, shared_scene
 from .planner import FuzzyPlanner, Planner
 from .world import World
 
@@ -66,6 +65,8 @@ class Lockstep:
         """One tick of every run still going (run by run when one is left, or when some
         were observed already)."""
         live = [run for run in self.runs if not run.done]
+        if not live:
+            return
         if len(live) > 1 and not any(run.observed for run in live):
             batch = self._batch_of(live)
             _observe_together(batch)
@@ -74,11 +75,10 @@ class Lockstep:
             moving = batch.verdict()
         else:
             seen = [run.observe() for run in live]
-            commands = self._commands(live, np.concatenate([s.block for s in seen], axis=1)
-                                      if seen else None,
+            commands = self._commands(live, np.concatenate([s.block for s in seen], axis=1),
                                       np.concatenate([run.active for run in live]))
             ticks = [run.commanded(None if commands is None else commands[a:b])
-                     for run, (a, b) in zip(live, _spans(live))]
+                     for run, (a, b) in zip(live, row_spans(live))]
             _guard_together(live, ticks)
             moving = [run for run, s in zip(live, ticks) if run.verdict(s)[1]]
         if len(moving) == 1:
@@ -101,14 +101,14 @@ class Lockstep:
             self.step()
         return [run.result() for run in self.runs]
 
-    def _commands(self, live: list[Simulation], blocks: np.ndarray | None,
+    def _commands(self, live: list[Simulation], blocks: np.ndarray,
                   active: np.ndarray) -> np.ndarray | None:
         """The commands ``[robots, 2]`` of the robots of all ``live`` runs, from one
         evaluation of the rule network for the active ones (``blocks [inputs, robots]``:
         their inputs; ``None``: each run plans itself, as planners other than the fuzzy one
         do, whose rows need not be independent of the batch)."""
         planner = self.planner
-        if not isinstance(planner, FuzzyPlanner) or blocks is None:
+        if not isinstance(planner, FuzzyPlanner):
             return None
         compiled = planner.compiled
         X = np.empty((np.count_nonzero(active), len(compiled.inputs)))
@@ -123,12 +123,6 @@ class Lockstep:
         for j, key in enumerate(("steering", "speed")):
             commands[active, j] = out[:, compiled.outputs.index(key)]
         return commands
-
-
-def _spans(runs: list[Simulation]) -> list[tuple[int, int]]:
-    """Where each run's robots lie in the rows of all of them."""
-    stops = list(itertools.accumulate(run.n for run in runs))
-    return list(zip([0, *stops[:-1]], stops))
 
 
 def _observe_together(batch: Batch) -> None:

@@ -1117,6 +1117,12 @@ class Simulation:
         return res
 
 
+def row_spans(runs: list[Simulation]) -> list[tuple[int, int]]:
+    """Where each run's robots lie in the rows of all of them, one run after the other."""
+    stops = list(itertools.accumulate(run.n for run in runs))
+    return list(zip([0, *stops[:-1]], stops))
+
+
 class Batch:
     """Runs of one world stepped together (:mod:`.lockstep`), their robots one after the
     other in the batch's rows: the bookkeeping each run does alone each tick (its arrays, the
@@ -1126,9 +1132,8 @@ class Batch:
 
     def __init__(self, runs: list[Simulation]) -> None:
         self.runs = runs
-        stops = list(itertools.accumulate(run.n for run in runs))
-        self.spans = list(zip([0, *stops[:-1]], stops))
-        self._starts = np.array([0, *stops[:-1]])
+        self.spans = row_spans(runs)
+        self._starts = np.array([a for a, _ in self.spans])
         self._owner = [(run, i) for run in runs for i in range(run.n)]   # each row's robot
         self._goal_x, self._goal_y, self._tol = (self._gather(name)
                                                  for name in ("_goal_x", "_goal_y", "_tol"))
@@ -1245,6 +1250,8 @@ class Batch:
                                    hint[a:b]))
             if run._judge(s, hit[j], driving[j]):
                 moving.append(run)
+        if len(moving) < len(self.runs):    # (the tick's arrays move every run or none)
+            self._now = None
         return moving
 
     def move(self) -> None:
@@ -1265,14 +1272,14 @@ class Batch:
         after = kinematics.step(x, y, h, np.where(self.active, self._gather("_v"), 0.0),
                                 self._gather("_steer"), command[0], command[1], self._limits,
                                 world.dt, world.substeps)
-        driven = np.hypot(after[0] - x, after[1] - y)
-        odometer = runs[0]._odometer
-        assert all(len(run._odometer) == len(odometer) for run in runs), "ticked together"
-        if odometer:
+        driven = np.hypot(after[0] - x, after[1] - y)         # (Simulation.move_to)
+        ticks = len(runs[0]._odometer)
+        assert all(len(run._odometer) == ticks for run in runs), "runs ticked together"
+        if ticks:
             driven = np.concatenate([run._odometer[-1] for run in runs]) + driven
-        window = runs[0]._stuck_window
+        window = runs[0]._stuck_window                          # (Simulation._check_stuck)
         stuck = None
-        if len(odometer) + 1 > window:
+        if ticks + 1 > window:
             moved = driven - np.concatenate([run._odometer[-window] for run in runs])
             stuck = self.active & (moved < STUCK_DISTANCE)
             stuck_any = np.logical_or.reduceat(stuck, self._starts).tolist()
