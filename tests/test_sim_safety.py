@@ -366,3 +366,32 @@ def test_sweeps_measured_a_few_cells_at_a_time_get_the_bits_they_get_at_once(mon
     monkeypatch.setattr(safety, "CHUNK", 50)
     assert safety.free_travels(sweeps).tolist() == alone
     assert 30.0 in alone and len(set(alone)) > 3
+
+
+def test_the_guard_given_its_first_sweep_measured_carries_out_what_it_does_alone():
+    """:func:`safety.guard` with :func:`safety.first_sweep`'s sweep measured (``known``, as
+    runs in lockstep measure theirs together) gives the command, the backing-out and the
+    recovery state it gives measuring every sweep itself: driving, held, backing out, and a
+    backing-out at its lock with the way behind shut, which hands back to the planner."""
+    rng = np.random.default_rng(11)
+    cases = 0
+    for _ in range(400):
+        cells = rng.uniform(-40, 40, (int(rng.integers(0, 80)), 2))
+        cells = cells[np.hypot(cells[:, 0], cells[:, 1]) > 15.0]
+        if rng.random() < 0.5:                                     # close behind it
+            cells = np.vstack([cells, [rng.uniform(-17, -13), rng.uniform(-10, 10)]])
+        lock = float(rng.choice([30.0, 150.0]))
+        wheel = float(rng.choice([lock, rng.uniform(30, 150)]))
+        body = safety.Body(ROBOT, AT, wheel, cells, 1.0, float(rng.uniform(-1, 1)), 30.0,
+                           float(rng.uniform(-10, 40)))
+        state = dict(held=float(rng.choice([0.0, 0.98])),
+                     left=float(rng.choice([0.0, 0.0, 1.0])), wheel=lock)
+        command = (float(rng.uniform(20, 160)), float(rng.uniform(-20, 60)))
+        alone, together = safety.Recovery(**state), safety.Recovery(**state)
+        first = safety.first_sweep(command, body, together, 0.05)
+        known = (*first, body.free(*first, safety.Settings()))
+        assert (safety.guard(command, body, alone, 0.05)
+                == safety.guard(command, body, together, 0.05, known=known))
+        assert alone == together
+        cases += state["left"] > 0 and wheel == lock and alone.left == 0
+    assert cases >= 10                # backing-outs handed back at their lock, the way shut

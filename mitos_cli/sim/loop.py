@@ -422,6 +422,7 @@ class Simulation:
         self._odometer: list[np.ndarray] = []      # in each robot has driven, after each move
         self._recovery = [safety.Recovery() for _ in range(n)]
         self._backed: list[tuple[int, int]] = []
+        self._braking: list[int] = []                   # see braking()
         self._outcomes = ["timeout"] * n
         self._collided = 0
         self._k = 0
@@ -1002,9 +1003,13 @@ class Simulation:
         """What :meth:`braking` asks the maps of the active robots that brake at tick ``s``
         (:func:`.knowledge.near_all`: runs in lockstep ask together): the maps, where the
         robots are and the half sides of their squares."""
-        idx = [i for i in self._active.nonzero()[0].tolist() if self.robots[i].brake]
+        idx = self._brakers()
         return ([self._maps[i] for i in idx], s.pose[idx, :2],
                 np.array([self._brake_reach[i] + self._body[i] for i in idx]))
+
+    def _brakers(self) -> list[int]:
+        """The active robots that brake, in order."""
+        return [i for i in self._active.nonzero()[0].tolist() if self.robots[i].brake]
 
     def braking(self, s: _Sensed, near: list[np.ndarray] | None = None
                 ) -> list[tuple[safety.Body, float, bool]]:
@@ -1012,35 +1017,30 @@ class Simulation:
         that brakes, in order (runs in lockstep measure theirs together; ``near``: what their
         maps answer :meth:`brake_squares`, which runs in lockstep ask together)."""
         out: list[tuple[safety.Body, float, bool]] = []
-        for i in self._active.nonzero()[0]:
-            robot, rmap = self.robots[i], self._maps[i]
-            if not robot.brake:
-                continue
+        self._braking = idx = self._brakers()          # the robots :meth:`braked` guards
+        x, y, h, steer, v = self._x, self._y, self._h, self._steer, self._v
+        side, cmd = s.inputs["heading"], s.command
+        for j, i in enumerate(idx):
+            rmap = self._maps[i]
             cells = (rmap.near(s.pose[i, :2], self._brake_reach[i] + self._body[i])
-                     if near is None else near[len(out)])
-            body = safety.Body(robot, (float(self._x[i]), float(self._y[i]), float(self._h[i])),
-                               float(self._steer[i]), cells, rmap.grid.resolution / 2,
-                               float(s.inputs["heading"][i]),
-                               self._brake_reach[i], float(self._v[i]))
-            command = (float(s.command[i, 0]), float(s.command[i, 1]))
+                     if near is None else near[j])
+            body = safety.Body(self.robots[i], (x.item(i), y.item(i), h.item(i)), steer.item(i),
+                               cells, rmap.grid.resolution / 2, side.item(i),
+                               self._brake_reach[i], v.item(i))
+            command = (cmd.item(i, 0), cmd.item(i, 1))
             out.append((body, *safety.first_sweep(command, body, self._recovery[i], self.dt)))
         return out
 
     def braked(self, s: _Sensed, sweeps: list[tuple[safety.Body, float, bool]],
                free: np.ndarray) -> None:
         """:meth:`_guard` with the first sweeps of :meth:`braking` measured (``free [R]``)."""
-        cfg, j = self._safety, 0
-        for i in self._active.nonzero()[0]:
-            if not self.robots[i].brake:
-                continue
-            body, wheel, backward = sweeps[j]
-            carried, backs = safety.guard((float(s.command[i, 0]), float(s.command[i, 1])),
-                                          body, self._recovery[i], self.dt, cfg,
-                                          (wheel, backward, float(free[j])))
-            j += 1
-            s.command[i] = carried
+        cfg, cmd = self._safety, s.command
+        for i, (body, wheel, backward), f in zip(self._braking, sweeps, free.tolist()):
+            carried, backs = safety.guard((cmd.item(i, 0), cmd.item(i, 1)), body,
+                                          self._recovery[i], self.dt, cfg, (wheel, backward, f))
+            cmd[i] = carried
             if backs:
-                self._backed.append((self._k, int(i)))
+                self._backed.append((self._k, i))
 
     def act(self, s: _Sensed) -> None:
         """Steering-rate and acceleration limits and exact arcs, substep by substep; stopped

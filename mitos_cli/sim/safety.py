@@ -451,8 +451,9 @@ def guard(command: tuple[float, float], body: Body, rec: Recovery, dt: float,
     way behind is free; otherwise the brake holds the speed to what the arc the wheel will be
     on allows, and a robot held ``patience`` seconds against its planner's wish backs out
     (on the lock that swings its nose toward its route, else straight), if it has the room.
-    ``rec`` is updated. ``known``: a sweep already measured (wheel, backward, free travel:
-    :func:`first_sweep`'s, by :func:`free_travels` with other robots')."""
+    ``rec`` is updated. ``known``: the first sweep already measured (wheel, backward, free
+    travel: :func:`first_sweep`'s for ``command``, ``body`` and ``rec``, by
+    :func:`free_travels` with other robots'), whose wheel is not worked out again."""
     robot = body.robot
 
     def free(wheel: float, backward: bool) -> float:
@@ -460,9 +461,10 @@ def guard(command: tuple[float, float], body: Body, rec: Recovery, dt: float,
             return known[2]
         return body.free(wheel, backward, cfg)
 
+    first = known
     if rec.left > 0:
         rec.left -= dt
-        wheel = _wheel(rec.wheel, body, dt)
+        wheel = _wheel(rec.wheel, body, dt) if known is None else known[0]
         back = free(wheel, True)                 # the arc of the wheel as it will be
         if back > cfg.margin:
             return (rec.wheel, -min(robot.max_reverse,
@@ -470,8 +472,9 @@ def guard(command: tuple[float, float], body: Body, rec: Recovery, dt: float,
         if wheel != rec.wheel:                   # still turning to the lock: wait for it
             return (rec.wheel, 0.0), False
         rec.left = 0.0
+        first = None                             # (the first sweep was the way behind)
     steer, want = command
-    wheel = _wheel(steer, body, dt)
+    wheel = _wheel(steer, body, dt) if first is None else first[0]
     limit = brake(free(wheel, want < 0), robot.acceleration, cfg.margin, dt)
     slowest = max(abs(body.speed) - robot.acceleration * dt, 0.0)
     if limit < slowest and wheel != body.wheel:
