@@ -135,6 +135,8 @@ class Arc:
         if np.ndim(turning) == 0:                     # one sweep: one formula
             rx = a + (s - sin_h) / k if turning else a + u * cos_h
             ry = b + (cos_h - c) / k if turning else b + u * sin_h
+        elif turning.all():                           # (a wheel is seldom exactly straight)
+            rx, ry = a + (s - sin_h) / k, b + (cos_h - c) / k
         else:
             bend = np.where(turning, k, 1.0)          # a straight sweep divides by nothing
             rx = np.where(turning, a + (s - sin_h) / bend, a + u * cos_h)
@@ -322,15 +324,18 @@ def _near(px: np.ndarray, py: np.ndarray, owner: np.ndarray, places: tuple[np.nd
     is never touched, not even at the start (backing away, :func:`_touched`), nor between two
     places (two depths below ``-step`` add up to less than ``-step``, :func:`_pairs`).
     Leaving it out changes no bit of the answer, and most of the cells in a sweep's box are
-    out of its reach."""
-    coarse = tuple(v[:, _coarse(v.shape[1])] for v in places)
+    out of its reach. (The places a cell is looked at run down a column: NumPy takes the
+    greatest of each column at once, and of each short row one row at a time.)"""
+    width = places[0].shape[1]
+    at = _coarse(width)[:, None]                                # [C, 1]
 
     def deep(part: slice) -> np.ndarray:
-        c, s, cx, cy, *room = (np.take(v, owner[part], axis=0) for v in coarse)
-        return _depth_in(px[part] - cx, py[part] - cy, c, s, room).max(axis=1)
+        where = at + owner[part] * width                        # [C, M]: in places, flat
+        c, s, cx, cy, *room = (np.take(v, where) for v in places)
+        return _depth_in(px[part, 0] - cx, py[part, 0] - cy, c, s, room).max(axis=0)
 
     return np.concatenate([deep(part) >= -bound[owner[part]]
-                           for part in _chunks(len(owner), coarse[0].shape[1])])
+                           for part in _chunks(len(owner), len(at))])
 
 
 def _touches(px: np.ndarray, py: np.ndarray, owner: np.ndarray, places: tuple[np.ndarray, ...],
