@@ -308,11 +308,14 @@ def _in_boxes(bodies: list[Body], cx: np.ndarray, cy: np.ndarray,
     lo_x, hi_x = cx.min(axis=1) - disc, cx.max(axis=1) + disc
     lo_y, hi_y = cy.min(axis=1) - disc, cy.max(axis=1) + disc
     cells = np.concatenate([body.cells for body in bodies])                     # [P, 2]
-    owner = np.repeat(np.arange(len(bodies)), [len(body.cells) for body in bodies])
+    counts = [len(body.cells) for body in bodies]
     px, py = cells[:, 0], cells[:, 1]
-    swept = ((px >= lo_x[owner]) & (px <= hi_x[owner])
-             & (py >= lo_y[owner]) & (py <= hi_y[owner]))
-    return px[swept, None], py[swept, None], owner[swept]
+    swept = px >= np.repeat(lo_x, counts)            # (each sweep's bound, cell by cell)
+    swept &= px <= np.repeat(hi_x, counts)
+    swept &= py >= np.repeat(lo_y, counts)
+    swept &= py <= np.repeat(hi_y, counts)
+    keep = np.flatnonzero(swept)
+    return px[keep, None], py[keep, None], np.repeat(np.arange(len(bodies)), counts)[keep]
 
 
 def _near(px: np.ndarray, py: np.ndarray, owner: np.ndarray, places: tuple[np.ndarray, ...],
