@@ -265,7 +265,8 @@ class Tracker:
         used_o: set[int] = set()
         if live:
             pred = np.array([tr.predicted(now) for tr in live])                     # [T, 2]
-            d = np.hypot(*(pred[:, None] - centres[None]).transpose(2, 0, 1)).ravel()
+            apart_xy = pred[:, None] - centres[None]                                # [T, O, 2]
+            d = np.hypot(apart_xy[..., 0], apart_xy[..., 1]).ravel()
             apart = d.tolist()                                           # [T * O], row-major
             for k in d.argsort(kind="stable").tolist():          # nearest first, each once
                 if not apart[k] <= GATE:         # the rest lie farther (NaN sorts last)
