@@ -2,14 +2,16 @@
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 from pathlib import Path
 
 import numpy as np
 import pytest
 
+from mitos_cli.errors import CommandError
 from mitos_cli.resources import packaged_path
-from mitos_cli.sim import rows
+from mitos_cli.sim import kinematics, loop, rows
 from mitos_cli.sim.lockstep import Lockstep, run_lockstep
 from mitos_cli.sim.loop import STUCK_TIME, Batch, Simulation, prepare, simulate
 from mitos_cli.sim.planner import FuzzyPlanner, make_planner
@@ -103,3 +105,74 @@ def test_runs_stuck_in_a_batch_are_stuck_at_the_tick_they_are_alone():
     for seed, res in zip([1, 2, 3], lock.results()):
         assert res.robot_outcomes[0] == "stuck"
         assert_same_run(simulate(world, Stands(), seed, randomise=True), res)
+
+
+def _short(name: str, seconds: float):
+    return dataclasses.replace(load_world(packaged_path("worlds", f"{name}.yaml")),
+                               time_limit=seconds)
+
+
+def test_runs_started_again_inside_a_lockstep_run_as_started_alone():
+    """A batch is of the runs as they were started: reset() gives a run new maps."""
+    world = _short("office", 4.0)
+    lock = Lockstep(world, None, [1, 2], randomise=True)
+    for _ in range(5):
+        lock.step()
+    for run, seed in zip(lock.runs, [3, 4]):
+        run.reset(seed)
+    for seed, res in zip([3, 4], lock.results()):
+        assert_same_run(simulate(world, None, seed, randomise=True), res)
+
+
+@pytest.mark.parametrize("name", ["multirobot", "office"])
+def test_a_run_stepped_alone_inside_a_lockstep_keeps_its_bits(name):
+    """A user may step one run ahead of the others: the runs are then at different ticks."""
+    world = _short(name, 3.0)
+    lock = Lockstep(world, None, [1, 2, 3], randomise=True)
+    lock.step()
+    lock.runs[1].step()
+    for seed, res in zip([1, 2, 3], lock.results()):
+        assert_same_run(simulate(world, None, seed, randomise=True), res)
+
+
+def test_a_refused_command_is_told_as_alone_and_moves_no_robot(monkeypatch):
+    world = _short("corridor", 2.0)
+    lock = Lockstep(world, None, [1, 2, 3])
+    lock.step()
+    real = Lockstep._commands
+
+    def broken(self, live, blocks, active):
+        out = real(self, live, blocks, active)
+        out[-1] = np.nan
+        return out
+
+    monkeypatch.setattr(Lockstep, "_commands", broken)
+    with pytest.raises(CommandError, match=r"the command of planner `.+` at 0\.05 s"):
+        lock.step()
+    monkeypatch.setattr(Lockstep, "_commands", real)
+    moved, real_step = [], kinematics.step
+
+    def step(x, y, h, v, steer, c_steer, c_speed, *rest):
+        moved.append(np.stack([c_steer, c_speed], axis=1))
+        return real_step(x, y, h, v, steer, c_steer, c_speed, *rest)
+
+    monkeypatch.setattr(loop.kinematics, "step", step)
+    lock.step()                 # the robots move by the commands this tick recorded
+    recorded = np.concatenate([run.record[-1].command for run in lock.runs])
+    assert len(moved) == 1 and moved[0].tobytes() == recorded.tobytes()
+
+
+def test_what_a_run_recorded_in_a_batch_no_later_tick_changes():
+    """A run's tick holds views of the batch's arrays of that tick."""
+    lock = Lockstep(_short("slalom", 1.0), None, [1, 2], randomise=True)
+    lock.step()
+    first = [copy.deepcopy(run.record[0]) for run in lock.runs]
+    lock.results()
+    for kept, run in zip(first, lock.runs):
+        now = run.record[0]
+        for f in dataclasses.fields(now):
+            a, b = getattr(kept, f.name), getattr(now, f.name)
+            if isinstance(a, dict):
+                assert all(a[k].tobytes() == b[k].tobytes() for k in a)
+            else:
+                assert np.asarray(a).tobytes() == np.asarray(b).tobytes()

@@ -62,12 +62,14 @@ class Lockstep:
         return all(run.done for run in self.runs)
 
     def step(self) -> None:
-        """One tick of every run still going (run by run when one is left, or when some
-        were observed already)."""
+        """One tick of every run still going: observed, checked, recorded and moved as one
+        :class:`Batch` when they are at the same tick and none was observed from outside;
+        else each observed and moved as alone (the rule network and the guard still for all
+        at once)."""
         live = [run for run in self.runs if not run.done]
         if not live:
             return
-        if len(live) > 1 and not any(run.observed for run in live):
+        if len(live) > 1 and _in_step(live) and not any(run.observed for run in live):
             batch = self._batch_of(live)
             _observe_together(batch)
             ticks = batch.commanded(self._commands(live, batch.block, batch.active))
@@ -81,17 +83,17 @@ class Lockstep:
                      for run, (a, b) in zip(live, row_spans(live))]
             _guard_together(live, ticks)
             moving = [run for run, s in zip(live, ticks) if run.verdict(s)[1]]
-        if len(moving) == 1:
-            moving[0].act(moving[0].decided)
-            moving[0].moved()
-        elif moving:
+        if len(moving) > 1 and _in_step(moving):
             self._batch_of(moving).move()
+        else:
+            for run in moving:
+                run.act(run.decided)
+                run.moved()
 
     def _batch_of(self, runs: list[Simulation]) -> Batch:
-        """The :class:`Batch` of ``runs``: the last one while they are the same runs."""
+        """The :class:`Batch` of ``runs``: the last one while it serves them."""
         kept = self._batch
-        if kept is None or len(kept.runs) != len(runs) or any(
-                a is not b for a, b in zip(kept.runs, runs)):
+        if kept is None or not kept.serves(runs):
             kept = self._batch = Batch(runs)
         return kept
 
@@ -123,6 +125,11 @@ class Lockstep:
         for j, key in enumerate(("steering", "speed")):
             commands[active, j] = out[:, compiled.outputs.index(key)]
         return commands
+
+
+def _in_step(runs: list[Simulation]) -> bool:
+    """Whether ``runs`` are at the same tick (a user may step one of them alone)."""
+    return len({run.ticks for run in runs}) == 1
 
 
 def _observe_together(batch: Batch) -> None:
@@ -182,13 +189,13 @@ def _sightings_together(runs: list[Simulation], sensed: list,
 
 
 def _near_together(asks: list[tuple]) -> list[list[np.ndarray]]:
-    """What the maps answer each run's squares ``(maps, points, reaches, given)`` (the runs of
-    a world ask alike), asked in one :func:`.knowledge.near_all`, run by run."""
+    """What the maps hold round each run's braking robots (:meth:`.Simulation.brake_squares`:
+    ``(maps, points, reaches)``), asked in one :func:`.knowledge.near_all`, run by run."""
     maps = [m for ask in asks for m in ask[0]]
     if not maps:
         return [[] for _ in asks]
     got = knowledge.near_all(maps, np.concatenate([ask[1] for ask in asks]),
-                             np.concatenate([ask[2] for ask in asks]), asks[0][3])
+                             np.concatenate([ask[2] for ask in asks]))
     ends = [0, *itertools.accumulate(len(ask[0]) for ask in asks)]
     return [got[a:b] for a, b in zip(ends[:-1], ends[1:])]
 
@@ -197,7 +204,7 @@ def _guard_together(runs: list[Simulation], ticks: list) -> None:
     """Every run's guard on its tick's commands, what every robot's map holds near it found
     in one :func:`.knowledge.near_all` and the first sweep of every robot of every run
     measured in one :func:`.safety.free_travels`."""
-    near = _near_together([(*run.brake_squares(s), False) for run, s in zip(runs, ticks)])
+    near = _near_together([run.brake_squares(s) for run, s in zip(runs, ticks)])
     sweeps = [run.braking(s, cells) for run, s, cells in zip(runs, ticks, near)]
     every = [sweep for mine in sweeps for sweep in mine]
     if not every:

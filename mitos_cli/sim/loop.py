@@ -429,6 +429,7 @@ class Simulation:
         self._done = self.steps <= 0
         self._hit = np.zeros(n, dtype=bool)
         self._beyond_at: tuple = (None, [])             # see _beyond()
+        self._epoch = next(_EPOCHS)                     # this start's (a Batch is of one)
         self._watched: tuple = (None, [], [])           # see watching()
         beams = len(self.angles)                        # what watching() gives for no robot
         self._unseen = (np.zeros((0, 2)), np.zeros((0, beams)), np.zeros((0, beams, 2)),
@@ -510,15 +511,14 @@ class Simulation:
         return self._observed is not None and bool(np.count_nonzero(self._hit)
                                                    or not np.count_nonzero(self._active))
 
-    def observe(self, sensed: rows.Sensed | None = None) -> _Sensed:
+    def observe(self) -> _Sensed:
         """Sense, perceive and check the current tick, once; the next :meth:`step` goes on from
         there. What a policy outside the simulator decides on: ``.inputs`` (name -> ``[n]``),
-        ``.ranges [n, B]``, ``.pose``, ``.clearance``. ``sensed``: this tick's rows of
-        :func:`.rows.sense` for :meth:`sense_rows` (runs in lockstep sense together)."""
+        ``.ranges [n, B]``, ``.pose``, ``.clearance``."""
         if self._done:
             raise RuntimeError("the run has ended (reset() starts it again)")
         if self._observed is None:
-            s = self.sense() if sensed is None else self.sensed(sensed)
+            s = self.sense()
             self.perceive(s)
             self.conclude(s)
         assert self._observed is not None
@@ -739,14 +739,14 @@ class Simulation:
 
     def framing(self, s: _Sensed) -> tuple[list[Route], np.ndarray, np.ndarray]:
         """What :func:`.perception.frames` places the robots on their routes from at tick
-        ``s`` (runs in lockstep together): their routes, places and last arc lengths."""
+        ``s``: their routes, places and last arc lengths (:meth:`Batch.framing`: of runs in
+        lockstep)."""
         return list(self._routes), s.pose[:, :2], self._s_hint
 
     def clearing(self, s: _Sensed) -> tuple[list[knowledge.RobotMap], np.ndarray, np.ndarray,
                                             np.ndarray, float]:
-        """What :func:`.knowledge.clear_all` clears the robots' maps with at tick ``s`` (runs
-        in lockstep clear theirs together): the maps, where the robots are, their beams and
-        readings, and the range."""
+        """What :func:`.knowledge.clear_all` clears the robots' maps with at tick ``s``: the
+        maps, where the robots are, their beams and readings, and the range."""
         dirs = self._dirs[0][None] if self.n == 1 else np.stack(self._dirs)
         return self._maps, s.pose[:, :2], dirs, s.ranges, self.world.sensors.range
 
@@ -759,8 +759,9 @@ class Simulation:
         lockstep find their pursuit points together); ``frames``: where they are on their
         routes (:meth:`framing`); ``sighted``: :func:`.movers.sightings` of what it is
         :meth:`watching` (runs in lockstep see theirs together; ``None``: seen here);
-        ``near``: what each robot's map answers :meth:`aim_squares` (runs in lockstep ask
-        together; ``None``: asked here)."""
+        ``near``: what each robot's map holds within its lookahead and least clearance
+        (:meth:`.knowledge.RobotMap.near`; runs in lockstep ask together, ``None``: asked
+        here)."""
         if sighted is None:
             spaces, *looks = self.watching(s)
             sighted = movers.sightings(spaces, s.t, *looks)
@@ -794,14 +795,6 @@ class Simulation:
                                       least + self._cfg.lookahead_room))
         return out
 
-    def aim_squares(self, s: _Sensed) -> tuple[list[knowledge.RobotMap], np.ndarray,
-                                               np.ndarray, bool]:
-        """What :meth:`aims` asks the robots' maps at tick ``s`` (:func:`.knowledge.near_all`:
-        runs in lockstep ask together): the maps, where the robots are, the half sides of
-        their squares and whether of the given cells alone."""
-        reaches = np.array([self._cfg.lookahead + least for _, least in self._asked])
-        return self._maps, s.pose[:, :2], reaches, self.world.replan != "clearance"
-
     def aimed(self, s: _Sensed, aims: list[perception.Aim], ahead: np.ndarray,
               targets: np.ndarray, gaps: list[float] | None = None,
               accounted: np.ndarray | None = None) -> list[perception.Sight]:
@@ -824,15 +817,11 @@ class Simulation:
         return out
 
     def perceived(self, s: _Sensed, sights: list[perception.Sight],
-                  inputs: dict[str, np.ndarray] | np.ndarray) -> None:
-        """Record the robots' inputs (their rows of :func:`.perception.perceive_rows`, or
-        those as one block ``[inputs, n]`` in :data:`.perception.INPUTS` order: runs in
-        lockstep copy theirs at once) and target points in tick ``s``."""
-        if isinstance(inputs, np.ndarray):
-            s.block[:] = inputs
-        else:
-            for key in perception.INPUTS:
-                s.inputs[key][:] = inputs[key]
+                  inputs: dict[str, np.ndarray]) -> None:
+        """Record the robots' inputs (their rows of :func:`.perception.perceive_rows`) and
+        target points in tick ``s``."""
+        for key in perception.INPUTS:
+            s.inputs[key][:] = inputs[key]
         for i, sight in enumerate(sights):
             s.targets[i] = sight.target
 
@@ -846,12 +835,6 @@ class Simulation:
         if accounted is not None:
             return least, accounted[i]
         return least, self._maps[i].accounted_cells(self._beyond(i, s))
-
-    def beyond(self, s: _Sensed, cells: np.ndarray) -> None:
-        """Robot by robot, the cells just beyond its readings at tick ``s`` (``cells [n, B,
-        2]``, :func:`.knowledge.beyond_cells`: runs in lockstep work theirs out together),
-        for :meth:`_beyond` to answer with."""
-        self._beyond_at = (s, list(cells))
 
     def _beyond(self, i: int, s: _Sensed) -> np.ndarray:
         """The cells ``[B, 2]`` (:meth:`.knowledge.RobotMap.cell_indices`) just beyond robot
@@ -875,12 +858,12 @@ class Simulation:
 
     def seeing(self, s: _Sensed) -> np.ndarray:
         """``[n, B]``: which readings at tick ``s`` show what each robot's map does not (every
-        echo, with no map): what :meth:`_learn` marks robot by robot, and runs in lockstep
-        mark together (:func:`.knowledge.mark_all`)."""
-        seen = s.ranges < self.world.sensors.range * 0.999
+        echo, with no map): what :meth:`_learn` marks robot by robot (:meth:`Batch.seeing`:
+        runs in lockstep, by the same :func:`_news`)."""
+        expected = None
         if self._given.knows != "none":
             expected = self._expected[0][None] if self.n == 1 else np.stack(self._expected)
-            seen &= s.ranges < expected - self._threshold
+        seen = _news(s.ranges, expected, self.world.sensors.range * 0.999, self._threshold)
         self._seen = list(seen)
         return seen
 
@@ -943,9 +926,8 @@ class Simulation:
     def check(self, s: _Sensed) -> None:
         """Contact (clearance <= 0) and arrival; an arrived robot stops driving."""
         active = self._active
-        self._hit = active & (s.clearance <= 0.0)
-        arrived = active & (np.hypot(self._x - self._goal_x, self._y - self._goal_y)
-                            <= self._tol)
+        self._hit, arrived = _arrivals(active, s.clearance, self._x, self._y, self._goal_x,
+                                       self._goal_y, self._tol)
         if np.count_nonzero(arrived):
             for i in arrived.nonzero()[0]:
                 self._outcomes[i] = "success"
@@ -1081,9 +1063,15 @@ class Simulation:
         return bool(np.count_nonzero(stuck))
 
     def _record(self, s: _Sensed) -> Tick:
-        tick = Tick(self._k, s.t, _columns(self._x, self._y, np.rad2deg(self._h)),
-                    self._v.copy(), self._steer.copy(), s.command, s.ranges, s.inputs,
-                    s.clearance, s.where, self._active.copy(), self._s_hint.copy())
+        return self._keep(s, _columns(self._x, self._y, np.rad2deg(self._h)), self._v.copy(),
+                          self._steer.copy(), self._active.copy(), self._s_hint.copy())
+
+    def _keep(self, s: _Sensed, pose: np.ndarray, speed: np.ndarray, steering: np.ndarray,
+              active: np.ndarray, progress: np.ndarray) -> Tick:
+        """Record tick ``s`` with the robots' state as it was observed (arrays no later
+        tick changes in place: the record keeps them)."""
+        tick = Tick(self._k, s.t, pose, speed, steering, s.command, s.ranges, s.inputs,
+                    s.clearance, s.where, active, progress)
         self.record.append(tick)
         return tick
 
@@ -1117,6 +1105,30 @@ class Simulation:
         return res
 
 
+def _news(ranges: np.ndarray, expected: np.ndarray | None, far: float,
+          threshold: float | np.ndarray) -> np.ndarray:
+    """Which readings show what a robot's map does not: an echo (shorter than ``far``), and,
+    where the map predicts ranges (``expected``), ``threshold`` shorter than predicted. One
+    rule for a run alone and for runs in lockstep (``threshold`` a column: each run's)."""
+    seen = ranges < far
+    if expected is not None:
+        seen &= ranges < expected - threshold
+    return seen
+
+
+def _arrivals(active: np.ndarray, clearance: np.ndarray, x: np.ndarray, y: np.ndarray,
+              goal_x: np.ndarray, goal_y: np.ndarray, tol: np.ndarray
+              ) -> tuple[np.ndarray, np.ndarray]:
+    """Which driving robots touch something (clearance 0 or less) and which are at their
+    goals: one rule for a run alone and for runs in lockstep."""
+    return (active & (clearance <= 0.0),
+            active & (np.hypot(x - goal_x, y - goal_y) <= tol))
+
+
+#: Each start of a run (:meth:`Simulation.reset`) is told apart by a number from here.
+_EPOCHS = itertools.count()
+
+
 def row_spans(runs: list[Simulation]) -> list[tuple[int, int]]:
     """Where each run's robots lie in the rows of all of them, one run after the other."""
     stops = list(itertools.accumulate(run.n for run in runs))
@@ -1127,11 +1139,14 @@ class Batch:
     """Runs of one world stepped together (:mod:`.lockstep`), their robots one after the
     other in the batch's rows: the bookkeeping each run does alone each tick (its arrays, the
     check, the record, the verdict, the move) done once for the robots of all, elementwise,
-    so each run keeps the bits it has alone. A run's arrays are views of the batch's, which
-    are fresh each tick (nothing changes them in place but through the run's own view)."""
+    so each run keeps the bits it has alone. A run's pose, readings, inputs and commands of a
+    tick are views of the batch's arrays, which are fresh each tick: a run's record keeps
+    them, so no later tick may write into them. A batch is of the runs as they were started
+    (:meth:`serves`); they are at the same tick when it steps them."""
 
     def __init__(self, runs: list[Simulation]) -> None:
         self.runs = runs
+        self._epochs = [run._epoch for run in runs]
         self.spans = row_spans(runs)
         self._starts = np.array([a for a, _ in self.spans])
         self._owner = [(run, i) for run in runs for i in range(run.n)]   # each row's robot
@@ -1140,17 +1155,29 @@ class Batch:
         self._straight = np.concatenate([run.limits.straight for run in runs])
         self.maps = [m for run in runs for m in run._maps]
         self._plain = all(run._plain for run in runs)
-        # each row's farthest echo, news threshold and whether its map shows anything
-        # (:meth:`Simulation.seeing`; a randomised run draws its own sensor noise)
-        far, threshold, knows = np.array([(run.world.sensors.range * 0.999, run._threshold,
-                                           run._given.knows != "none")
-                                          for run in runs for _ in range(run.n)]).T[:, :, None]
-        self._seeing = (far, threshold, None if knows.all() else knows > 0)
-        self.reaches = np.array([run._cfg.lookahead + least      # (Simulation.aim_squares)
+        # (Simulation.seeing: the runs of one world are given the same map and sensors; a
+        # randomised run draws its own sensor noise, so its own news threshold)
+        self._knows = runs[0]._given.knows != "none"
+        self._far = runs[0].world.sensors.range * 0.999
+        self._threshold = np.array([run._threshold for run in runs
+                                    for _ in range(run.n)])[:, None]
+        self.reaches = np.array([run._cfg.lookahead + least      # (Simulation.aims)
                                  for run in runs for _, least in run._asked])
         self._limits: kinematics.Limits | None = None
-        self._now: tuple[np.ndarray, ...] | None = None     # this tick's x, y, heading
+        # the tick observed last (:meth:`sensed`): its runs' ticks, x, y and heading, readings,
+        # robots' places, inputs (a row each), targets, commands, contacts and who drives
         self.ticks: list[_Sensed] = []
+        self._now: tuple[np.ndarray, ...] | None = None
+        self.got = rows.Sensed(np.zeros((0, 0, 2)), np.zeros((0, 0)), np.zeros((0, 0)), np.zeros(0))
+        self.at, self.block = np.zeros((0, 2)), np.zeros((len(perception.INPUTS), 0))
+        self.targets, self.command = np.zeros((0, 2)), np.zeros((0, 2))
+        self.hit, self.active = np.zeros(0, dtype=bool), np.zeros(0, dtype=bool)
+
+    def serves(self, runs: list[Simulation]) -> bool:
+        """Whether this is the batch of ``runs``: the same runs, none started again since."""
+        return (len(runs) == len(self.runs)
+                and all(a is b and a._epoch == e for a, b, e in zip(runs, self.runs,
+                                                                    self._epochs)))
 
     def _gather(self, name: str) -> np.ndarray:
         """The runs' arrays ``name`` one after the other (a fresh array)."""
@@ -1177,12 +1204,11 @@ class Batch:
 
     def seeing(self) -> np.ndarray:
         """:meth:`Simulation.seeing` of every run at once: ``[rows, B]``."""
-        ranges, (far, threshold, knows) = self.got.ranges, self._seeing
-        seen = ranges < far
-        expected = (self.got.static if self._plain else
-                    np.array([e for run in self.runs for e in run._expected]))
-        news = ranges < expected - threshold
-        seen &= news if knows is None else news | ~knows      # (knows: the rows that know)
+        expected = None
+        if self._knows:
+            expected = (self.got.static if self._plain else
+                        np.array([e for run in self.runs for e in run._expected]))
+        seen = _news(self.got.ranges, expected, self._far, self._threshold)
         rows_ = list(seen)
         for run, (a, b) in zip(self.runs, self.spans):
             run._seen = rows_[a:b]
@@ -1201,14 +1227,15 @@ class Batch:
 
     def conclude(self, inputs: dict[str, np.ndarray], targets: np.ndarray) -> None:
         """:meth:`Simulation.perceived` and :meth:`Simulation.conclude` of every run: the
-        rows' ``inputs`` and ``targets`` kept, the check made once for every robot."""
+        rows' ``inputs`` and ``targets`` kept, the check made once for every robot. The runs
+        are not left observed (:attr:`Simulation.observed`): the batch decides for them."""
         for j, key in enumerate(perception.INPUTS):
             self.block[j] = inputs[key]
         self.targets[:] = targets
         x, y, _ = self._ticked()
         active = self._gather("_active")
-        self.hit = active & (self.got.clearance <= 0.0)      # (each run's, at its verdict)
-        arrived = active & (np.hypot(x - self._goal_x, y - self._goal_y) <= self._tol)
+        self.hit, arrived = _arrivals(active, self.got.clearance, x, y, self._goal_x,
+                                      self._goal_y, self._tol)    # (hit: each run's at verdict)
         for row in arrived.nonzero()[0].tolist():
             run, i = self._owner[row]
             run._outcomes[i] = "success"
@@ -1222,12 +1249,15 @@ class Batch:
     def commanded(self, commands: np.ndarray | None) -> list[_Sensed]:
         """:meth:`Simulation.commanded` of every run: ``commands [rows, 2]`` for all (the
         stopped robots' rows are set here), else each run's planner plans its own."""
-        if commands is None or not np.isfinite(commands).all():     # (refused run by run)
+        if commands is None:
             out = []
-            for run, s, (a, b) in zip(self.runs, self.ticks, self.spans):
+            for run, s in zip(self.runs, self.ticks):
                 run._observed = s
-                out.append(run.commanded(None if commands is None else commands[a:b]))
+                out.append(run.commanded())
             return out
+        if not np.isfinite(commands).all():                 # refused as a run alone does
+            for run, s, (a, b) in zip(self.runs, self.ticks, self.spans):
+                _finite(commands[a:b], f"the command of {run._planner_name} at {s.t:g} s")
         stopped = ~self.active
         commands[stopped, 0] = self._straight[stopped]
         commands[stopped, 1] = 0.0
@@ -1245,13 +1275,9 @@ class Batch:
         moving = []
         for j, (run, s, (a, b)) in enumerate(zip(self.runs, self.ticks, self.spans)):
             run._hit = self.hit[a:b]
-            run.record.append(Tick(run._k, s.t, pose[a:b], speed[a:b], steering[a:b], s.command,
-                                   s.ranges, s.inputs, s.clearance, s.where, self.active[a:b],
-                                   hint[a:b]))
+            run._keep(s, pose[a:b], speed[a:b], steering[a:b], self.active[a:b], hint[a:b])
             if run._judge(s, hit[j], driving[j]):
                 moving.append(run)
-        if len(moving) < len(self.runs):    # (the tick's arrays move every run or none)
-            self._now = None
         return moving
 
     def move(self) -> None:
@@ -1259,7 +1285,8 @@ class Batch:
         robots moving, as after :meth:`verdict`) in one call of the kinematics; the runs of a
         batch have run as many ticks."""
         runs = self.runs
-        if self._now is None:           # (some runs of the tick's batch ended: theirs alone)
+        if self._now is None or any(run._deciding is not s for run, s in zip(runs, self.ticks)):
+            # (not every run of the tick the batch observed moves by it: each run's own)
             self._now = (self._gather("_x"), self._gather("_y"), self._gather("_h"))
             self.active = self._gather("_active")
             self.command = np.concatenate([run.decided.command for run in runs])
