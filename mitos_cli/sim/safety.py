@@ -202,7 +202,7 @@ def _between(hit: np.ndarray, own, cell: np.ndarray, j: np.ndarray, owner: np.nd
 #: Elements (float64, 64 KB) in one of the ``[M, K]`` arrays worked out at a time: the
 #: arrays of a whole batch at once were too large for the allocator to keep, and came fresh
 #: from the system at every call, a page fault every 4 KB (30% of a lockstep sweep's time).
-#: At 128 KB they still did often: 64 slalom runs in lockstep took 205,000 page faults, at
+#: At 128 KB they still did often: 64 slalom runs in lockstep took 208,000 page faults, at
 #: 64 KB 57,000, and their sweeps 30 -> 26 us a robot-tick (more chunks cost 2 us a sweep
 #: measured apart, where nothing faults).
 CHUNK = 8192
