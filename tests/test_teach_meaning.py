@@ -359,7 +359,7 @@ def test_a_session_on_a_path_too_long_to_look_up_says_so(tmp_path, monkeypatch):
 
     monkeypatch.chdir(tmp_path)
     with pytest.raises(MitosError, match="too long"):
-        Session("/tmp/" + "x" * 300 + "mitos.rules", out=[].append)
+        Session(str(tmp_path / ("x" * 300 + "mitos.rules")), out=[].append)
 
 
 def test_simulation_corrections_name_the_robot():

@@ -413,8 +413,8 @@ def test_examples_belong_to_the_behavior_they_correct(rules):
 
 
 def test_save_to_a_directory_is_refused_before_writing(rules, tmp_path):
-    """`save /tmp` raised IsADirectoryError (a traceback that ended the session) after
-    writing the term sets beside the directory as `/tmp.mitos.terms.yaml`."""
+    """`save DIR` raised IsADirectoryError (a traceback that ended the session) after
+    writing the term sets beside the directory as `DIR.mitos.terms.yaml`."""
     s, out = session(rules)
     s.run("correct road=78 size=45 position=4 -> steering=60")
     folder = tmp_path / "out"
