@@ -395,3 +395,84 @@ def test_the_guard_given_its_first_sweep_measured_carries_out_what_it_does_alone
         assert alone == together
         cases += state["left"] > 0 and wheel == lock and alone.left == 0
     assert cases >= 10                # backing-outs handed back at their lock, the way shut
+
+
+def _fleet_case(rng: np.random.Generator, n: int):
+    """``n`` robots of their own shapes and limits (one with no reverse gear, now and then),
+    scattered among cells, some close behind or ahead, with their commands, wheels, speeds and
+    recovery states (held near its patience, backing out at a lock, at rest)."""
+    robots = [Robot(wheelbase=float(rng.uniform(10, 20)), length=float(rng.uniform(18, 30)),
+                    width=float(rng.uniform(12, 20)), steering_min=float(rng.choice([30, 45])),
+                    steering_max=float(rng.choice([135, 150])),
+                    max_steering_rate=float(rng.choice([90, 180])),
+                    acceleration=float(rng.uniform(20, 60)),
+                    max_reverse=float(rng.choice([15.0, 15.0, 0.0]))) for _ in range(n)]
+    fleet = safety.Fleet(robots, rng.choice([0.5, 1.0], n).tolist(),
+                         rng.choice([30.0, 40.0], n).tolist(), 0.05)
+    x, y, h = rng.uniform(-200, 200, n), rng.uniform(-200, 200, n), rng.uniform(-4, 4, n)
+    cells = []
+    for j in range(n):
+        own = rng.uniform(-45, 45, (int(rng.choice([0, 20, 90])), 2))
+        own = own[np.hypot(own[:, 0], own[:, 1]) > 15.0]
+        if rng.random() < 0.4:                                     # close behind it
+            own = np.vstack([own, [rng.uniform(-19, -13), rng.uniform(-10, 10)]])
+        if rng.random() < 0.5:                                     # just ahead of its front
+            front = robots[j].length / 2
+            own = np.vstack([own, [rng.uniform(front + 1, front + 3), rng.uniform(-5, 5)]])
+        c, s = math.cos(h[j]), math.sin(h[j])
+        cells.append(np.column_stack([x[j] + own[:, 0] * c - own[:, 1] * s,
+                                      y[j] + own[:, 0] * s + own[:, 1] * c]))
+    lock = np.where(rng.random(n) < 0.5, fleet.lo, fleet.hi)
+    wheel = np.where(rng.random(n) < 0.3, lock, rng.uniform(30, 150, n))
+    now = (x, y, h, wheel, rng.uniform(-10, 50, n), rng.uniform(-1, 1, n))
+    state = np.column_stack([rng.choice([0.0, 0.5, 0.98], n), rng.choice([0.0, 0.0, 1.0], n),
+                             lock])
+    command = np.column_stack([rng.uniform(20, 160, n), rng.uniform(-20, 60, n)])
+    return fleet, now, cells, state, command
+
+
+def test_a_fleet_guarded_at_once_carries_out_what_each_robot_does_alone():
+    """:meth:`safety.Fleet.guard` (most robots decided with arrays, the rest by
+    :func:`safety.guard` with their first sweep known) gives every robot the command, the
+    backing-out and the recovery state :func:`safety.guard` gives it alone, to the bit; the
+    robots that do not brake, or are not among the rows, are left as they were."""
+    rng = np.random.default_rng(5)
+    kinds = {"eased": 0, "kept": 0, "held": 0, "backs": 0, "backing": 0}
+    for _ in range(100):
+        n = int(rng.integers(1, 12))
+        fleet, now, cells, state, command = _fleet_case(rng, n)
+        rows = np.flatnonzero(rng.random(n) < 0.8)
+        want_command, want_state, want_backs = command.copy(), state.copy(), []
+        for i in rows.tolist():
+            x, y, h, wheel, speed, side = (float(v[i]) for v in now)
+            body = safety.Body(fleet.robots[i], (x, y, h), wheel, cells[i], float(fleet.radius[i]),
+                               side, float(fleet.reach[i]), speed)
+            rec = safety.Recovery(*state[i].tolist())
+            carried, backs = safety.guard(tuple(command[i].tolist()), body, rec, 0.05)
+            want_command[i], want_state[i] = carried, (rec.held, rec.left, rec.wheel)
+            want_backs += [i] if backs else []
+            kinds["eased"] += carried[1] != command[i, 1]
+            kinds["kept"] += carried[0] == wheel != command[i, 0] and not state[i, 1] > 0
+            kinds["held"] += rec.held > state[i, 0]
+            kinds["backs"] += int(backs)
+            kinds["backing"] += state[i, 1] > 0
+        got = fleet.guard(rows, command, state, now, [cells[i] for i in rows.tolist()])
+        assert got == want_backs
+        assert command.tobytes() == want_command.tobytes()
+        assert state.tobytes() == want_state.tobytes()
+    assert min(kinds.values()) >= 10, kinds
+
+
+def test_a_fleets_sweeps_measured_together_are_each_robots_alone():
+    """:meth:`safety.Fleet.free` (each sweep's numbers worked out for all at once) gives
+    every sweep the bits :meth:`safety.Body.free` gives it alone, forward and backward."""
+    rng = np.random.default_rng(6)
+    for _ in range(30):
+        n = int(rng.integers(2, 12))
+        fleet, (x, y, h, wheel, speed, side), cells, _, _ = _fleet_case(rng, n)
+        back = rng.random(n) < 0.3
+        rows = np.arange(n)
+        alone = [safety.Body(fleet.robots[i], (x[i], y[i], h[i]), 90.0, cells[i],
+                             float(fleet.radius[i]), 0.0, float(fleet.reach[i]))
+                 .free(float(wheel[i]), bool(back[i]), fleet.cfg) for i in rows]
+        assert fleet.free(rows, x, y, h, wheel, back, cells).tolist() == alone

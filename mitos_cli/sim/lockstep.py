@@ -13,13 +13,15 @@ in one pass (:func:`.perception.perceive_rows`) and checked (contact, arrival) i
 what else a robot's own map and route need (following its tracks, replanning) is done run by
 run, with the code of a run alone (:class:`~mitos_cli.sim.loop.Simulation`). Then the fuzzy
 planner's rule network is evaluated once for the active robots of every run (one engine
-batch: the engine gives each row the bits it gives alone), each run's brake checks its
-commands, every run's tick is recorded and judged in one pass, and the robots of every run
-move in one batch of kinematics (elementwise per robot). The bookkeeping done once for all
-runs is :class:`~mitos_cli.sim.loop.Batch`'s; each run's arrays are views of the batch's.
-Runs that end drop out. Every batched stage is elementwise per robot or an exact minimum, so
-each run's ticks, trajectory and summary are bit for bit those of the same run alone, whatever
-the batch (``tests/test_sim_lockstep.py``, ``tests/test_sim_same_bits.py``)."""
+batch: the engine gives each row the bits it gives alone), the brake of every robot of every
+run checks its command in one pass (:meth:`.safety.Fleet.guard`: the first sweeps measured
+together, most commands decided with arrays), every run's tick is recorded and judged in one
+pass, and the robots of every run move in one batch of kinematics (elementwise per robot).
+The bookkeeping done once for all runs is :class:`~mitos_cli.sim.loop.Batch`'s; each run's
+arrays are views of the batch's. Runs that end drop out. Every batched stage is elementwise
+per robot or an exact minimum, so each run's ticks, trajectory and summary are bit for bit
+those of the same run alone, whatever the batch (``tests/test_sim_lockstep.py``,
+``tests/test_sim_same_bits.py``)."""
 
 from __future__ import annotations
 
@@ -28,7 +30,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from . import knowledge, movers, perception, rows, safety
+from . import knowledge, movers, perception, rows
 from .loop import Batch, Scene, SimResult, Simulation, row_spans, shared_scene
 from .planner import FuzzyPlanner, Planner
 from .world import World
@@ -64,16 +66,16 @@ class Lockstep:
     def step(self) -> None:
         """One tick of every run still going: observed, checked, recorded and moved as one
         :class:`Batch` when they are at the same tick and none was observed from outside;
-        else each observed and moved as alone (the rule network and the guard still for all
-        at once)."""
+        else each observed, guarded and moved as alone (the rule network still for all at
+        once)."""
         live = [run for run in self.runs if not run.done]
         if not live:
             return
         if len(live) > 1 and _in_step(live) and not any(run.observed for run in live):
             batch = self._batch_of(live)
             _observe_together(batch)
-            ticks = batch.commanded(self._commands(live, batch.block, batch.active))
-            _guard_together(live, ticks)
+            batch.commanded(self._commands(live, batch.block, batch.active))
+            batch.guard()
             moving = batch.verdict()
         else:
             seen = [run.observe() for run in live]
@@ -188,33 +190,11 @@ def _sightings_together(runs: list[Simulation], sensed: list,
     return [got[a:b] for a, b in zip(ends[:-1], ends[1:])]
 
 
-def _near_together(asks: list[tuple]) -> list[list[np.ndarray]]:
-    """What the maps hold round each run's braking robots (:meth:`.Simulation.brake_squares`:
-    ``(maps, points, reaches)``), asked in one :func:`.knowledge.near_all`, run by run."""
-    maps = [m for ask in asks for m in ask[0]]
-    if not maps:
-        return [[] for _ in asks]
-    got = knowledge.near_all(maps, np.concatenate([ask[1] for ask in asks]),
-                             np.concatenate([ask[2] for ask in asks]))
-    ends = [0, *itertools.accumulate(len(ask[0]) for ask in asks)]
-    return [got[a:b] for a, b in zip(ends[:-1], ends[1:])]
-
-
 def _guard_together(runs: list[Simulation], ticks: list) -> None:
-    """Every run's guard on its tick's commands, what every robot's map holds near it found
-    in one :func:`.knowledge.near_all` and the first sweep of every robot of every run
-    measured in one :func:`.safety.free_travels`."""
-    near = _near_together([run.brake_squares(s) for run, s in zip(runs, ticks)])
-    sweeps = [run.braking(s, cells) for run, s, cells in zip(runs, ticks, near)]
-    every = [sweep for mine in sweeps for sweep in mine]
-    if not every:
-        return
-    cfg = runs[0].brake_settings
-    free = safety.free_travels(every, cfg.step)
-    start = 0
-    for run, s, mine in zip(runs, ticks, sweeps):
-        run.braked(s, mine, free[start:start + len(mine)])
-        start += len(mine)
+    """Every run's guard on its tick's commands, run by run: runs not at one tick, or one of
+    them observed from outside (a user stepping a run alone), are not a :class:`Batch`."""
+    for run, s in zip(runs, ticks):
+        run._guard(s)
 
 
 def run_lockstep(world: World, planner: Planner | None, seeds: Sequence[int], *,

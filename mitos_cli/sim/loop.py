@@ -386,7 +386,6 @@ class Simulation:
         # width and its margin (else none)
         self._squeeze = [least if least < r.width / 2 + r.safety_margin else math.inf
                          for r, (_, least) in zip(self.robots, self._asked)]
-        self._body = [math.hypot(r.length, r.width) for r in self.robots]   # in: a diagonal
         self._safety = safety.Settings()
         self._brake_reach = [safety.reach_of(r, self.dt, self._safety, sen.range)
                              for r in self.robots]
@@ -420,9 +419,10 @@ class Simulation:
                       for _ in range(n)]
         self._seen = [np.zeros(len(self.angles), dtype=bool) for _ in range(n)]
         self._odometer: list[np.ndarray] = []      # in each robot has driven, after each move
-        self._recovery = [safety.Recovery() for _ in range(n)]
+        self._fleet = safety.Fleet(self.robots, [m.grid.resolution / 2 for m in self._maps],
+                                   self._brake_reach, self.dt, self._safety)
+        self._recovery = safety.rest(n)                 # each robot's safety.Recovery, a row
         self._backed: list[tuple[int, int]] = []
-        self._braking: list[int] = []                   # see braking()
         self._outcomes = ["timeout"] * n
         self._collided = 0
         self._k = 0
@@ -975,54 +975,14 @@ class Simulation:
 
     def _guard(self, s: _Sensed) -> None:
         """The robot's own safety on every active robot's command (:mod:`.safety`): the brake,
-        and backing out of a pocket when it has held the robot too long. Their first sweeps
-        are measured together (:meth:`braking`, :func:`.safety.free_travels`)."""
-        sweeps = self.braking(s)
-        self.braked(s, sweeps, safety.free_travels(sweeps, self._safety.step))
-
-    def brake_squares(self, s: _Sensed) -> tuple[list[knowledge.RobotMap], np.ndarray,
-                                                 np.ndarray]:
-        """What :meth:`braking` asks the maps of the active robots that brake at tick ``s``
-        (:func:`.knowledge.near_all`: runs in lockstep ask together): the maps, where the
-        robots are and the half sides of their squares."""
-        idx = self._brakers()
-        return ([self._maps[i] for i in idx], s.pose[idx, :2],
-                np.array([self._brake_reach[i] + self._body[i] for i in idx]))
-
-    def _brakers(self) -> list[int]:
-        """The active robots that brake, in order."""
-        return [i for i in self._active.nonzero()[0].tolist() if self.robots[i].brake]
-
-    def braking(self, s: _Sensed, near: list[np.ndarray] | None = None
-                ) -> list[tuple[safety.Body, float, bool]]:
-        """The first sweep (body, wheel, backward) the guard measures for each active robot
-        that brakes, in order (runs in lockstep measure theirs together; ``near``: what their
-        maps answer :meth:`brake_squares`, which runs in lockstep ask together)."""
-        out: list[tuple[safety.Body, float, bool]] = []
-        self._braking = idx = self._brakers()          # the robots :meth:`braked` guards
-        x, y, h, steer, v = self._x, self._y, self._h, self._steer, self._v
-        side, cmd = s.inputs["heading"], s.command
-        for j, i in enumerate(idx):
-            rmap = self._maps[i]
-            cells = (rmap.near(s.pose[i, :2], self._brake_reach[i] + self._body[i])
-                     if near is None else near[j])
-            body = safety.Body(self.robots[i], (x.item(i), y.item(i), h.item(i)), steer.item(i),
-                               cells, rmap.grid.resolution / 2, side.item(i),
-                               self._brake_reach[i], v.item(i))
-            command = (cmd.item(i, 0), cmd.item(i, 1))
-            out.append((body, *safety.first_sweep(command, body, self._recovery[i], self.dt)))
-        return out
-
-    def braked(self, s: _Sensed, sweeps: list[tuple[safety.Body, float, bool]],
-               free: np.ndarray) -> None:
-        """:meth:`_guard` with the first sweeps of :meth:`braking` measured (``free [R]``)."""
-        cfg, cmd = self._safety, s.command
-        for i, (body, wheel, backward), f in zip(self._braking, sweeps, free.tolist()):
-            carried, backs = safety.guard((cmd.item(i, 0), cmd.item(i, 1)), body,
-                                          self._recovery[i], self.dt, cfg, (wheel, backward, f))
-            cmd[i] = carried
-            if backs:
-                self._backed.append((self._k, i))
+        and backing out of a pocket when it has held the robot too long; their first sweeps
+        measured together (:meth:`.safety.Fleet.guard`)."""
+        fleet = self._fleet
+        rows = np.flatnonzero(self._active & fleet.brakes)
+        cells = [self._maps[i].near(s.pose[i, :2], fleet.squares.item(i)) for i in rows.tolist()]
+        now = (self._x, self._y, self._h, self._steer, self._v, s.inputs["heading"])
+        for i in fleet.guard(rows, s.command, self._recovery, now, cells):
+            self._backed.append((self._k, i))
 
     def act(self, s: _Sensed) -> None:
         """Steering-rate and acceleration limits and exact arcs, substep by substep; stopped
@@ -1125,6 +1085,9 @@ def _arrivals(active: np.ndarray, clearance: np.ndarray, x: np.ndarray, y: np.nd
             active & (np.hypot(x - goal_x, y - goal_y) <= tol))
 
 
+#: The row of the route's side (``heading``) in a tick's block of inputs.
+_SIDE = perception.INPUTS.index("heading")
+
 #: Each start of a run (:meth:`Simulation.reset`) is told apart by a number from here.
 _EPOCHS = itertools.count()
 
@@ -1164,6 +1127,7 @@ class Batch:
         self.reaches = np.array([run._cfg.lookahead + least      # (Simulation.aims)
                                  for run in runs for _, least in run._asked])
         self._limits: kinematics.Limits | None = None
+        self._fleet = safety.Fleet.joined([run._fleet for run in runs])
         # the tick observed last (:meth:`sensed`): its runs' ticks, x, y and heading, readings,
         # robots' places, inputs (a row each), targets, commands, contacts and who drives
         self.ticks: list[_Sensed] = []
@@ -1263,6 +1227,31 @@ class Batch:
         commands[stopped, 1] = 0.0
         self.command[:] = commands
         return self.ticks
+
+    def guard(self) -> None:
+        """:meth:`Simulation._guard` of every run at once, on the commands :meth:`commanded`
+        set: what the maps hold round the robots that brake found in one
+        :func:`.knowledge.near_all`, one :meth:`.safety.Fleet.guard` for all, and what it
+        changed of each robot's recovery (seldom anything) and its backing-outs given back
+        to its run."""
+        fleet = self._fleet
+        rows = np.flatnonzero(self.active & fleet.brakes)
+        if not len(rows):
+            return
+        maps = self.maps if len(rows) == len(self.maps) else [self.maps[i] for i in rows.tolist()]
+        cells = knowledge.near_all(maps, self.at[rows], fleet.squares[rows])
+        x, y, h = self._ticked()
+        state = self._gather("_recovery")
+        was = state.copy()
+        backs = fleet.guard(rows, self.command, state, (x, y, h, self._gather("_steer"),
+                                                        self._gather("_v"), self.block[_SIDE]),
+                            cells)
+        for row in np.flatnonzero((state != was).any(axis=1)).tolist():
+            run, i = self._owner[row]
+            run._recovery[i] = state[row]
+        for row in backs:
+            run, i = self._owner[row]
+            run._backed.append((run._k, i))
 
     def verdict(self) -> list[Simulation]:
         """:meth:`Simulation.verdict` of every run, once the guard has had its say: each

@@ -101,9 +101,14 @@ def _sweep_of(pose: tuple[float, float, float], robot: Robot, delta: float, radi
     x, y, h = pose
     wb, hl, hw = robot.wheelbase, robot.length / 2, robot.width / 2
     k = -math.tan(math.radians(delta)) / wb          # rad per inch of the rear axle's path
-    disc = math.hypot(hl, hw) + radius * math.sqrt(2) + step + 1e-6     # a cell's corner too
     return (h, k, x - wb / 2 * math.cos(h), y - wb / 2 * math.sin(h), math.sin(h), math.cos(h),
-            wb / 2, hl, hw, disc, _spacing(robot, k, radius, step))
+            wb / 2, hl, hw, _disc(robot, radius, step), _spacing(robot, k, radius, step))
+
+
+def _disc(robot: Robot, radius: float, step: float) -> float:
+    """How far past the footprint's centres the box of the cells a sweep may touch reaches:
+    its circumscribed disc, a cell's corner (of half side ``radius``) and a step."""
+    return math.hypot(robot.length / 2, robot.width / 2) + radius * math.sqrt(2) + step + 1e-6
 
 
 @dataclass(frozen=True)
@@ -221,9 +226,14 @@ def _spacing(robot: Robot, k: float, radius: float, step: float) -> float:
     ``1 + |k| wb / 2`` inches and turns ``|k|`` rad, and a turn moves the depth of a cell
     that can touch by at most ``|k|`` times its distance from the centre (half the
     footprint's diagonal, a cell's diagonal and the step). Straight on, ``step`` itself."""
-    far = (robot.wheelbase / 2 + math.hypot(robot.length / 2, robot.width / 2)
-           + 2 * math.sqrt(2) * radius + step)
-    return step / (1.0 + abs(k) * far)
+    return step / (1.0 + abs(k) * _far(robot, radius, step))
+
+
+def _far(robot: Robot, radius: float, step: float) -> float:
+    """:func:`_spacing`'s reach of a turn: half the wheelbase, half the footprint's diagonal,
+    a cell's diagonal and the step."""
+    return (robot.wheelbase / 2 + math.hypot(robot.length / 2, robot.width / 2)
+            + 2 * math.sqrt(2) * radius + step)
 
 
 def _depth(dx, dy, c, s, hl, hw, r):
@@ -255,12 +265,9 @@ def _depth_in(dx, dy, c, s, room) -> np.ndarray:
 
 def free_travels(sweeps: list[tuple[Body, float, bool]], step: float = 1.0) -> np.ndarray:
     """:func:`free_travel` of many sweeps at once (``(body, wheel, backward)`` each, as far as
-    its body's ``reach``; runs in lockstep brake together), ``[R]``. What is one number per
-    sweep is worked out as :func:`free_travel` does, in Python floats; the rest elementwise
-    over ``[R, K]`` places (each sweep's own, its last repeated to the longest) and ``[M, K]``
-    for the ``M`` cells in the sweeps' boxes that :func:`_near` keeps, each with its sweep's
-    places (not padded to the sweep with the most: a quarter of the cells would be real), so
-    a sweep gets the bits it gets alone."""
+    its body's ``reach``), ``[R]``: what is one number per sweep is worked out as
+    :func:`free_travel` does, in Python floats; the rest by :func:`_travels`, so a sweep gets
+    the bits it gets alone."""
     if len(sweeps) == 1:                 # a robot alone: no batch to set up
         body, wheel, backward = sweeps[0]
         return np.array([free_travel(body.cells, body.radius, body.pose, body.robot,
@@ -271,17 +278,31 @@ def free_travels(sweeps: list[tuple[Body, float, bool]], step: float = 1.0) -> n
     if not rows:
         return out
     bodies = [sweeps[j][0] for j in rows]
-    back = np.array([sweeps[j][2] for j in rows])
-    h, k, a, b, sin_h, cos_h, half, hl, hw, disc, du = np.array([
+    numbers = np.array([
         _sweep_of(body.pose, body.robot, wheel - body.robot.steering_straight, body.radius, step)
-        for body, wheel, _ in (sweeps[j] for j in rows)]).T[:, :, None]       # [R, 1] each
-    rad = np.array([body.radius for body in bodies])[:, None]
-    reach = np.array([body.reach for body in bodies])[:, None]
-    own = (np.ceil(reach / du - 1e-9) + 1).astype(np.intp)       # as many places as _path's
+        for body, wheel, _ in (sweeps[j] for j in rows)]).T                   # [11, R]
+    out[rows] = _travels([body.cells for body in bodies], numbers,
+                         np.array([body.radius for body in bodies]), out[rows],
+                         np.array([sweeps[j][2] for j in rows]), step)
+    return out
+
+
+def _travels(cells: list[np.ndarray], numbers, radius: np.ndarray, reach: np.ndarray,
+             back: np.ndarray, step: float) -> np.ndarray:
+    """The free travel ``[R]`` of ``R`` sweeps (runs in lockstep brake together), each with
+    cells (``[P, 2]`` each, of half side ``radius [R]``), backward or not (``back [R]``), as
+    far as ``reach [R]``; ``numbers``: each sweep's :func:`_sweep_of`, ``[R]`` each. Worked
+    out elementwise over ``[R, K]`` places (each sweep's own, its last repeated to the
+    longest) and ``[M, K]`` for the ``M`` cells in the sweeps' boxes that :func:`_near`
+    keeps, each with its sweep's places (not padded to the sweep with the most: a quarter of
+    the cells would be real), so a sweep gets the bits it gets alone."""
+    h, k, a, b, sin_h, cos_h, half, hl, hw, disc, du = (v[:, None] for v in numbers)  # [R, 1]
+    rad, out = radius[:, None], reach.copy()
+    own = (np.ceil(reach[:, None] / du - 1e-9) + 1).astype(np.intp)    # as many places as _path's
     u = np.minimum(np.arange(int(own.max())), own - 1) * np.where(back[:, None], -du, du)
     arc = Arc(h, k, a, b, sin_h, cos_h, half, np.abs(k) > 1e-9)
     c, s, cx, cy = arc.centres(u)              # [R, K]: the footprint at each sweep's places
-    px, py, owner = _in_boxes(bodies, cx, cy, disc[:, 0])                # [M, 1], by sweep
+    px, py, owner = _in_boxes(cells, cx, cy, disc[:, 0])                # [M, 1], by sweep
     if not len(owner):
         return out
     places = (c, s, cx, cy, *_room(c, s, hl, hw, rad))
@@ -293,8 +314,7 @@ def free_travels(sweeps: list[tuple[Body, float, bool]], step: float = 1.0) -> n
     hit &= np.arange(u.shape[1]) < own                                   # [R, K], its own
     _between(hit, own[:, 0], cell, j, owner, u, arc, px, py, hl[owner], hw[owner], rad[owner])
     first = np.maximum(hit.argmax(axis=1) - 1, 0) * du[:, 0]
-    out[rows] = np.where(np.logical_or.reduce(hit, axis=1), first, out[rows])
-    return out
+    return np.where(np.logical_or.reduce(hit, axis=1), first, out)
 
 
 #: The coarse pass (:func:`_near`) looks at every ``COARSE``-th place of a sweep, and its last.
@@ -304,21 +324,22 @@ COARSE = 8
 ROUNDING = 1e-3
 
 
-def _in_boxes(bodies: list[Body], cx: np.ndarray, cy: np.ndarray,
+def _in_boxes(known: list[np.ndarray], cx: np.ndarray, cy: np.ndarray,
               disc: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The cells (``px, py [M, 1]``) in the box each body's sweep may touch (its centres
-    ``cx, cy [R, K]``, grown by ``disc [R]``), and their sweep (``owner [M]``, sorted)."""
+    """The cells (``px, py [M, 1]``) of ``known`` (each sweep's) in the box each sweep may
+    touch (its centres ``cx, cy [R, K]``, grown by ``disc [R]``), and their sweep (``owner
+    [M]``, sorted)."""
     lo_x, hi_x = cx.min(axis=1) - disc, cx.max(axis=1) + disc
     lo_y, hi_y = cy.min(axis=1) - disc, cy.max(axis=1) + disc
-    cells = np.concatenate([body.cells for body in bodies])                     # [P, 2]
-    counts = [len(body.cells) for body in bodies]
+    cells = np.concatenate(known)                                               # [P, 2]
+    counts = [len(c) for c in known]
     px, py = cells[:, 0], cells[:, 1]
     swept = px >= np.repeat(lo_x, counts)            # (each sweep's bound, cell by cell)
     swept &= px <= np.repeat(hi_x, counts)
     swept &= py >= np.repeat(lo_y, counts)
     swept &= py <= np.repeat(hi_y, counts)
     keep = np.flatnonzero(swept)
-    return px[keep, None], py[keep, None], np.repeat(np.arange(len(bodies)), counts)[keep]
+    return px[keep, None], py[keep, None], np.repeat(np.arange(len(known)), counts)[keep]
 
 
 def _near(px: np.ndarray, py: np.ndarray, owner: np.ndarray, places: tuple[np.ndarray, ...],
@@ -403,12 +424,13 @@ def _path(reach: float, step: float, backward: bool) -> np.ndarray:
     return out
 
 
-def brake(free: float, acceleration: float, margin: float, dt: float = 0.0) -> float:
+def brake(free, acceleration, margin: float, dt: float = 0.0):
     """The fastest (in/s) a robot may drive that can stop at ``acceleration`` within ``free``
     inches less ``margin`` when it drives on at that speed for ``dt`` before it brakes (the
-    command it is given now is carried out for a tick: ``v dt + v^2 / 2a`` is the room)."""
+    command it is given now is carried out for a tick: ``v dt + v^2 / 2a`` is the room).
+    Floats, or arrays of robots (:meth:`Fleet.guard`): the same bits."""
     lag = acceleration * dt
-    return math.sqrt(lag * lag + 2.0 * acceleration * max(free - margin, 0.0)) - lag
+    return np.sqrt(lag * lag + 2.0 * acceleration * np.maximum(free - margin, 0.0)) - lag
 
 
 def reach_of(robot: Robot, dt: float, cfg: Settings, sight: float) -> float:
@@ -522,3 +544,147 @@ def _wheel(steer: float, body: Body, dt: float) -> float:
     turn = robot.max_steering_rate * dt
     target = min(max(steer, robot.steering_min), robot.steering_max)
     return body.wheel + min(max(target - body.wheel, -turn), turn)
+
+
+def rest(n: int) -> np.ndarray:
+    """``[n, 3]`` the :class:`Recovery` of ``n`` robots at rest, a row each: held, left, wheel
+    (the state :meth:`Fleet.guard` keeps)."""
+    calm = Recovery()
+    return np.tile([calm.held, calm.left, calm.wheel], (n, 1))
+
+
+class Fleet:
+    """Robots a guard keeps, a row each, and what of them stays from tick to tick: each one's
+    :class:`~.world.Robot`, the half side of its map's cells (``radius``) and how far its
+    brake looks (``reach``, :func:`reach_of`), with what :func:`guard` and :func:`_sweep_of`
+    work out of them, as arrays ``[N]``. One robot's runs alone, many runs' in lockstep."""
+
+    def __init__(self, robots: list[Robot], radius: list[float], reach: list[float], dt: float,
+                 cfg: Settings = Settings()) -> None:
+        self.robots, self.dt, self.cfg = tuple(robots), dt, cfg
+        self.radius, self.reach = np.array(radius, float), np.array(reach, float)
+
+        def each(value) -> np.ndarray:
+            return np.array([value(r) for r in robots], float)
+
+        step = cfg.step
+        self.brakes = np.array([r.brake for r in robots], dtype=bool)
+        self.wheelbase, self.half = each(lambda r: r.wheelbase), each(lambda r: r.wheelbase / 2)
+        self.hl, self.hw = each(lambda r: r.length / 2), each(lambda r: r.width / 2)
+        self.straight, self.lo, self.hi = (each(lambda r: r.steering_straight),
+                                           each(lambda r: r.steering_min),
+                                           each(lambda r: r.steering_max))
+        self.turn = each(lambda r: r.max_steering_rate * dt)        # deg a tick
+        self.acceleration, self.reverse = each(lambda r: r.acceleration), each(
+            lambda r: r.max_reverse)
+        # in: the half side of the square round it whose cells it brakes for
+        self.squares = self.reach + each(lambda r: math.hypot(r.length, r.width))
+        self.disc = np.array([_disc(r, rad, step) for r, rad in zip(robots, radius)])
+        self.far = np.array([_far(r, rad, step) for r, rad in zip(robots, radius)])
+
+    def __repr__(self) -> str:
+        return f"<Fleet of {len(self.robots)} robots, dt {self.dt:g} s>"
+
+    @classmethod
+    def joined(cls, fleets: list[Fleet]) -> Fleet:
+        """The robots of ``fleets``, one fleet after the other (of one ``dt`` and settings)."""
+        return cls([r for f in fleets for r in f.robots],
+                   np.concatenate([f.radius for f in fleets]).tolist(),
+                   np.concatenate([f.reach for f in fleets]).tolist(), fleets[0].dt,
+                   fleets[0].cfg)
+
+    def guard(self, rows: np.ndarray, command: np.ndarray, state: np.ndarray,
+              now: tuple[np.ndarray, ...], cells: list[np.ndarray]) -> list[int]:
+        """:func:`guard` of the robots ``rows`` (ascending) at once, on their ``command [N,
+        2]`` and their :class:`Recovery` ``state [N, 3]`` (:func:`rest`), both updated in
+        place; the rows that begin to back out, in order. ``now``: every row's x, y (in),
+        heading (rad), wheel (deg), speed (in/s) and route side, ``[N]`` each; ``cells``:
+        what each of ``rows`` knows is occupied near it. Their first sweeps
+        (:func:`first_sweep`) are measured together; a robot whose command the brake alone
+        decides (no backing out under way or to begin, no wheel to hold: most, most ticks)
+        is decided here, the rest by :func:`guard` itself, with its first sweep known. One
+        robot is guarded as alone: the arrays would cost more than they save."""
+        if len(rows) <= 1:
+            return [i for i in rows.tolist() if self._one(i, command, state, now, cells[0])]
+        cfg, dt = self.cfg, self.dt
+        x, y, h, wheel, speed, _ = (v[rows] for v in now)
+        held, left, lock = state[rows].T
+        steer, want = command[rows].T
+        backing = left > 0
+        turned = self._wheels(rows, np.where(backing, lock, steer), wheel)
+        back = backing | (want < 0)
+        free = self.free(rows, x, y, h, turned, back, cells)
+        acceleration = self.acceleration[rows]
+        limit = brake(free, acceleration, cfg.margin, dt)
+        slowest = np.maximum(np.abs(speed) - acceleration * dt, 0.0)
+        held = np.where((np.abs(want) > cfg.want) & (limit < cfg.want), held + dt, 0.0)
+        hard = (backing | ((limit < slowest) & (turned != wheel))
+                | ((held >= cfg.patience) & (self.reverse[rows] > 0)))
+        easy = rows[~hard]
+        command[easy, 1] = np.where(np.abs(want) > limit, np.copysign(limit, want), want)[~hard]
+        state[easy, 0] = held[~hard]
+        return [int(rows[j]) for j in np.flatnonzero(hard).tolist()
+                if self._one(int(rows[j]), command, state, now, cells[j],
+                             (turned.item(j), bool(back[j]), free.item(j)))]
+
+    def _one(self, i: int, command: np.ndarray, state: np.ndarray, now: tuple[np.ndarray, ...],
+             cells: np.ndarray, known: tuple[float, bool, float] | None = None) -> bool:
+        """:func:`guard` of the robot of row ``i`` (:meth:`guard`'s arguments, ``cells`` its
+        own, ``known`` its first sweep if measured): whether it begins to back out."""
+        x, y, h, wheel, speed, side = (v.item(i) for v in now)
+        body = Body(self.robots[i], (x, y, h), wheel, cells, self.radius.item(i), side,
+                    self.reach.item(i), speed)
+        rec = Recovery(*state[i].tolist())
+        command[i], backs = guard((command.item(i, 0), command.item(i, 1)), body, rec, self.dt,
+                                  self.cfg, known)
+        state[i] = rec.held, rec.left, rec.wheel
+        return backs
+
+    def _wheels(self, rows: np.ndarray, steer: np.ndarray, wheel: np.ndarray) -> np.ndarray:
+        """:func:`_wheel` of the robots ``rows`` (wheels at ``wheel``, turning toward
+        ``steer``), with Python's ``min`` and ``max`` to the bit (ties and zeros' signs)."""
+        turn = self.turn[rows]
+        target = _least(_most(steer, self.lo[rows]), self.hi[rows])
+        return wheel + _least(_most(target - wheel, -turn), turn)
+
+    def free(self, rows: np.ndarray, x: np.ndarray, y: np.ndarray, h: np.ndarray,
+             wheel: np.ndarray, back: np.ndarray, cells: list[np.ndarray]) -> np.ndarray:
+        """:func:`free_travels` of the robots ``rows`` at ``x, y, h``, their wheels at
+        ``wheel`` (deg), backward or not (``back``), what each knows being ``cells``, ``[R]``
+        each; each sweep's numbers (:func:`_sweep_of`) worked out for all at once in the
+        same Python floats."""
+        step, reach = self.cfg.step, self.reach[rows]
+        some = np.flatnonzero(np.fromiter(map(len, cells), np.intp, len(cells)))
+        if not len(some):
+            return reach
+        which = rows[some]
+        reach[some] = _travels([cells[j] for j in some.tolist()],
+                               self._sweeps(which, x[some], y[some], h[some],
+                                            wheel[some] - self.straight[which]),
+                               self.radius[which], reach[some], back[some], step)
+        return reach
+
+    def _sweeps(self, rows: np.ndarray, x: np.ndarray, y: np.ndarray, h: np.ndarray,
+                delta: np.ndarray) -> tuple[np.ndarray, ...]:
+        """:func:`_sweep_of` of the robots ``rows`` at ``x, y, h`` with their wheels
+        ``delta`` off straight, ``[R]`` each: the sines, cosines and tangents by :mod:`math`,
+        one robot at a time as alone, the rest elementwise in the same order."""
+        n, heading = len(rows), h.tolist()
+        sin_h = np.fromiter(map(math.sin, heading), float, n)
+        cos_h = np.fromiter(map(math.cos, heading), float, n)
+        k = -np.fromiter(map(math.tan, map(math.radians, delta.tolist())), float, n) \
+            / self.wheelbase[rows]
+        half = self.half[rows]
+        du = self.cfg.step / (1.0 + np.abs(k) * self.far[rows])
+        return (h, k, x - half * cos_h, y - half * sin_h, sin_h, cos_h, half, self.hl[rows],
+                self.hw[rows], self.disc[rows], du)
+
+
+def _most(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Python's ``max(a, b)`` elementwise: ``b`` only where it is greater."""
+    return np.where(b > a, b, a)
+
+
+def _least(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Python's ``min(a, b)`` elementwise: ``b`` only where it is less."""
+    return np.where(b < a, b, a)
