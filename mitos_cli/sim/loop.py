@@ -978,7 +978,7 @@ class Simulation:
         and backing out of a pocket when it has held the robot too long; their first sweeps
         measured together (:meth:`.safety.Fleet.guard`)."""
         fleet = self._fleet
-        rows = np.flatnonzero(self._active & fleet.brakes)
+        rows = (self._active & fleet.brakes).nonzero()[0]
         cells = [self._maps[i].near(s.pose[i, :2], fleet.squares.item(i)) for i in rows.tolist()]
         now = (self._x, self._y, self._h, self._steer, self._v, s.inputs["heading"])
         for i in fleet.guard(rows, s.command, self._recovery, now, cells):
@@ -1235,7 +1235,7 @@ class Batch:
         changed of each robot's recovery (seldom anything) and its backing-outs given back
         to its run."""
         fleet = self._fleet
-        rows = np.flatnonzero(self.active & fleet.brakes)
+        rows = (self.active & fleet.brakes).nonzero()[0]
         if not len(rows):
             return
         maps = self.maps if len(rows) == len(self.maps) else [self.maps[i] for i in rows.tolist()]
@@ -1246,7 +1246,7 @@ class Batch:
         backs = fleet.guard(rows, self.command, state, (x, y, h, self._gather("_steer"),
                                                         self._gather("_v"), self.block[_SIDE]),
                             cells)
-        for row in np.flatnonzero((state != was).any(axis=1)).tolist():
+        for row in (state != was).any(axis=1).nonzero()[0].tolist():
             run, i = self._owner[row]
             run._recovery[i] = state[row]
         for row in backs:

@@ -623,7 +623,7 @@ class Fleet:
         easy = rows[~hard]
         command[easy, 1] = np.where(np.abs(want) > limit, np.copysign(limit, want), want)[~hard]
         state[easy, 0] = held[~hard]
-        return [int(rows[j]) for j in np.flatnonzero(hard).tolist()
+        return [int(rows[j]) for j in hard.nonzero()[0].tolist()
                 if self._one(int(rows[j]), command, state, now, cells[j],
                              (turned.item(j), bool(back[j]), free.item(j)))]
 
@@ -654,7 +654,7 @@ class Fleet:
         each; each sweep's numbers (:func:`_sweep_of`) worked out for all at once in the
         same Python floats."""
         step, reach = self.cfg.step, self.reach[rows]
-        some = np.flatnonzero(np.fromiter(map(len, cells), np.intp, len(cells)))
+        some = np.fromiter(map(len, cells), np.intp, len(cells)).nonzero()[0]
         if not len(some):
             return reach
         which = rows[some]
