@@ -557,7 +557,8 @@ class Fleet:
     """Robots a guard keeps, a row each, and what of them stays from tick to tick: each one's
     :class:`~.world.Robot`, the half side of its map's cells (``radius``) and how far its
     brake looks (``reach``, :func:`reach_of`), with what :func:`guard` and :func:`_sweep_of`
-    work out of them, as arrays ``[N]``. One robot's runs alone, many runs' in lockstep."""
+    work out of them, as arrays ``[N]``. A run holds one of its robots; runs in lockstep, one
+    of the robots of all of them."""
 
     def __init__(self, robots: list[Robot], radius: list[float], reach: list[float], dt: float,
                  cfg: Settings = Settings()) -> None:
@@ -575,8 +576,8 @@ class Fleet:
                                            each(lambda r: r.steering_min),
                                            each(lambda r: r.steering_max))
         self.turn = each(lambda r: r.max_steering_rate * dt)        # deg a tick
-        self.acceleration, self.reverse = each(lambda r: r.acceleration), each(
-            lambda r: r.max_reverse)
+        self.acceleration = each(lambda r: r.acceleration)
+        self.reverse = each(lambda r: r.max_reverse)
         # in: the half side of the square round it whose cells it brakes for
         self.squares = self.reach + each(lambda r: math.hypot(r.length, r.width))
         self.disc = np.array([_disc(r, rad, step) for r, rad in zip(robots, radius)])
