@@ -235,3 +235,26 @@ def test_what_is_drawn_obstructs_in_a_squeeze_only_nearer_than_it_keeps(squeeze,
     got = perception.perceive(ROUTE, f, (100.0, 0.0, 0.0), robot, dirs, reading, reading, 150.0,
                               0.1, 4.0, squeeze=squeeze)
     assert (got["obstacle"] < NO_OBSTACLE) == obstructs
+
+
+def test_own_frames_of_all_rows_at_once_are_each_robots_own_bits():
+    """Every row's points in its robot's frame, all rows in one product, are the bits of
+    :func:`perception._own_frame` of that row alone: of all its points, and of its valid
+    points alone (rows of none, one and several valid points, as a batch meets them)."""
+    rng = np.random.default_rng(7)
+    for beams in (1, 2, 5, 36):
+        rel = rng.normal(size=(40, beams, 2)) * rng.choice([1e-3, 1.0, 150.0], size=(40, beams, 2))
+        valid = rng.random((40, beams)) < rng.random((40, 1))
+        valid[:3] = False
+        valid[3:6] = np.eye(beams, dtype=bool)[rng.integers(0, beams, 3)]   # one point each
+        headings = rng.uniform(-7.0, 7.0, 40).tolist()
+        along, across, valid_along, valid_across = perception._own_frames(headings, rel, valid)
+        for i, heading in enumerate(headings):
+            want = perception._own_frame(rel[i], heading)
+            assert along[i].tobytes() == want[0].tobytes()
+            assert across[i].tobytes() == want[1].tobytes()
+            mine = valid[i]
+            alone = perception._own_frame(rel[i][mine], heading)
+            assert valid_along[i, mine].tobytes() == alone[0].tobytes()
+            assert valid_across[i, mine].tobytes() == alone[1].tobytes()
+            assert not valid_along[i, ~mine].any() and not valid_across[i, ~mine].any()

@@ -736,13 +736,13 @@ def perceive_rows(rows: list[Sight], max_range: float,
                             - _column([r.threshold for r in rows]))
     known = valid ^ obstacle_hit        # valid & ~obstacle_hit (which lies within valid)
     headings = [r.pose[2] for r in rows]
-    valid_ah, valid_bh = _own_frames(headings, rel, valid)
+    all_ah, all_bh, valid_ah, valid_bh = _own_frames(headings, rel, valid)
     road, wl, wr = _sides(a, b, valid_ah, valid_bh, valid, known, body, cfg, max_range,
                           obstacle_hit)
     widen = measured * _column([r.spacing for r in rows]) / 2
     obstructing = obstacle_hit | _in_way(rows, known & (a > 0), hits, cfg)
     if np.count_nonzero(obstructing):
-        ah, bh = _own_frames_all(headings, rel)
+        ah, bh = all_ah, all_bh
     else:                       # what does not obstruct is not asked where it lies
         ah, bh = valid_ah, valid_bh
     size, position, distance = _obstruction_rows(
@@ -840,24 +840,24 @@ def _column(values: list[float]) -> float | np.ndarray:
 
 
 def _own_frames(headings: list[float], rel: np.ndarray,
-                valid: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The valid points of ``rel [R, B, 2]`` in each robot's own frame, as a robot alone
-    computes them (:func:`_own_frame`, from those points only); the others read 0, the
-    robot's centre."""
-    along, across = np.zeros((2,) + valid.shape)
-    for i, heading in enumerate(headings):
-        mine = valid[i]
-        along[i, mine], across[i, mine] = _own_frame(rel[i][mine], heading)
-    return along, across
-
-
-def _own_frames_all(headings: list[float], rel: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """All the points ``rel [R, B, 2]`` in each robot's own frame (the products of
-    :func:`_own_frame`, row by row)."""
+                valid: np.ndarray) -> tuple[np.ndarray, ...]:
+    """The points ``rel [R, B, 2]`` in each robot's own frame, along and across its heading:
+    all of them (the products of :func:`_own_frame`, row by row), then the valid ones as a
+    robot alone computes them from those points only, the others 0 (the robot's centre).
+    A row's product is NumPy's matrix-vector product, whose every element is its own
+    whatever the other rows, but a row of one point is a dot product, whose bits may differ:
+    those few are worked out again as one (``tests/test_sim_perception.py``)."""
     cs = np.array([(math.cos(h), math.sin(h), math.sin(h), -math.cos(h)) for h in headings])
     along = np.matmul(rel, cs[:, :2, None])[..., 0]                     # rel @ [c, s]
     across = np.matmul(rel, cs[:, 2:, None])[..., 0]                    # rel @ [s, -c]
-    return along, across
+    valid_along, valid_across = np.where(valid, along, 0.0), np.where(valid, across, 0.0)
+    lone = (np.count_nonzero(valid, axis=1) == 1).nonzero()[0]
+    if len(lone):
+        j = valid[lone].argmax(axis=1)
+        point = rel[lone, j][:, None]                                   # [L, 1, 2]
+        valid_along[lone, j] = np.matmul(point, cs[lone, :2, None])[:, 0, 0]
+        valid_across[lone, j] = np.matmul(point, cs[lone, 2:, None])[:, 0, 0]
+    return along, across, valid_along, valid_across
 
 
 def pursuit(route: Route, f: Frame, p: np.ndarray, bearing: float, cfg: Settings,
