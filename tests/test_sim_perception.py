@@ -258,3 +258,18 @@ def test_own_frames_of_all_rows_at_once_are_each_robots_own_bits():
             assert valid_along[i, mine].tobytes() == alone[0].tobytes()
             assert valid_across[i, mine].tobytes() == alone[1].tobytes()
             assert not valid_along[i, ~mine].any() and not valid_across[i, ~mine].any()
+
+
+def test_rings_of_all_rows_at_once_are_each_rows_own_test():
+    """Whether each row's beams go all round, for all rows at once, is the row's own dot
+    product test (rings, fans, beams off by a rounding error, noise)."""
+    rng = np.random.default_rng(3)
+    for beams in (1, 2, 3, 36):
+        angles = np.concatenate([np.linspace(0, 2 * np.pi, beams, endpoint=False)[None]
+                                 + rng.uniform(-4, 4, (30, 1)),
+                                 np.linspace(-1.0, 1.0, beams)[None] + rng.uniform(-4, 4, (30, 1))])
+        dirs = np.stack([np.cos(angles), np.sin(angles)], axis=-1)
+        dirs[::7] += rng.normal(scale=1e-9, size=dirs[::7].shape)
+        want = [len(d) > 2 and float(d[0] @ d[-1]) >= float(d[0] @ d[1]) - 1e-9 for d in dirs]
+        assert perception._rings(dirs).tolist() == want
+        assert perception._rings(dirs[:1]).tolist() == want[:1]

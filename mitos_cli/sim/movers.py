@@ -264,7 +264,8 @@ class Tracker:
         used_t: set[int] = set()
         used_o: set[int] = set()
         if live:
-            pred = np.array([tr.predicted(now) for tr in live])                     # [T, 2]
+            pred = (live[0].predicted(now)[None] if len(live) == 1 else          # [T, 2]
+                    np.concatenate([tr.predicted(now) for tr in live]).reshape(-1, 2))
             apart_xy = pred[:, None] - centres[None]                                # [T, O, 2]
             d = np.hypot(apart_xy[..., 0], apart_xy[..., 1]).ravel()
             apart = d.tolist()                                           # [T * O], row-major

@@ -758,8 +758,7 @@ def perceive_rows(rows: list[Sight], max_range: float,
                                road.tolist()))])
     heading = common[:, 0]
     front, opening = _free_ways(valid_ah, valid_bh, widen, obstacle_hit, body, cfg, heading)
-    ring = np.array([len(r.dirs) > 2 and float(r.dirs[0] @ r.dirs[-1])
-                     >= float(r.dirs[0] @ r.dirs[1]) - 1e-9 for r in rows])
+    ring = _rings(dirs)
     return {"road": road, "size": size, "position": position, "obstacle": distance,
             "heading": np.array([_pursuit_of(bearing, distance, cfg)
                                  for bearing, distance in zip(heading.tolist(), far)]),
@@ -767,6 +766,19 @@ def perceive_rows(rows: list[Sight], max_range: float,
             "front": front, "opening": opening,
             "clutter": clutter_rows(hits, obstacle_hit, ah, cfg, ring),
             "nearest": _nearest(valid_ah, valid_bh, body, cfg)}
+
+
+def _rings(dirs: np.ndarray) -> np.ndarray:
+    """``[R]``: whether each row's beams ``dirs [R, B, 2]`` go all round (its last beam
+    neighbours its first as its second does): ``dirs[0] @ dirs[-1] >= dirs[0] @ dirs[1]``,
+    within rounding, row by row (a stacked product of one row by one column is each row's
+    dot product)."""
+    if dirs.shape[1] <= 2:
+        return np.zeros(len(dirs), dtype=bool)
+    first = dirs[:, :1]                                                 # [R, 1, 2]
+    last = np.matmul(first, dirs[:, -1, :, None])[:, 0, 0]
+    second = np.matmul(first, dirs[:, 1, :, None])[:, 0, 0]
+    return last >= second - 1e-9
 
 
 def _in_way(rows: list[Sight], ahead: np.ndarray, hits: np.ndarray, cfg: Settings) -> np.ndarray:
