@@ -520,15 +520,24 @@ def test_beams_among_many_boxes_test_only_the_boxes_they_may_hit_with_the_same_b
 @pytest.mark.parametrize("name", ["slalom.yaml", "office.yaml", "detour.yaml"])
 def test_robots_perceived_together_get_the_bits_they_get_alone(name):
     sims = running(name)
-    sights = []
-    for sim in sims:
-        sights += sim.sights(sim.sense())
-    cfg = sims[0].settings
-    together = perception.perceive_rows(sights, sims[0].world.sensors.range, cfg)
-    for i, sight in enumerate(sights):
-        alone = perception.perceive_rows([sight], sims[0].world.sensors.range, cfg)
+    parts = [sim.sights(sim.sense()) for sim in sims]
+    cfg, max_range = sims[0].settings, sims[0].world.sensors.range
+    together = perception.perceive_all(_joined(parts), max_range, cfg)
+    rows = [(part, i) for part in parts for i in range(len(part.routes))]
+    for j, (part, i) in enumerate(rows):
+        alone = perception.perceive_all(_joined([part], slice(i, i + 1)), max_range, cfg)
         for key in perception.INPUTS:
-            assert same(alone[key][0], together[key][i]), key
+            assert same(alone[key][0], together[key][j]), key
+
+
+def _joined(parts: list[perception.Sights], rows: slice = slice(None)) -> perception.Sights:
+    """The ``rows`` of ``parts``' rows one after the other."""
+    def join(name: str):
+        values = [getattr(part, name)[rows] for part in parts]
+        return (sum(values, []) if isinstance(values[0], list)
+                else np.concatenate(values))
+
+    return perception.Sights(**{f.name: join(f.name) for f in dataclasses.fields(perception.Sights)})
 
 
 @pytest.mark.parametrize("name", ["slalom.yaml", "office.yaml", "detour.yaml"])

@@ -9,7 +9,7 @@ tested against the beams they kept in one pass (:func:`.movers.sightings`), the 
 them on their maps found in one pass (:func:`.knowledge.near_all`), their readings looked up
 where their routes were planned in one pass (:func:`.knowledge.accounted_all`), their pursuit
 points found in one pass (:func:`.perception.pursuit_points`) and their rule inputs perceived
-in one pass (:func:`.perception.perceive_rows`) and checked (contact, arrival) in one pass;
+in one pass (:func:`.perception.perceive_all`) and checked (contact, arrival) in one pass;
 what else a robot's own map and route need (following its tracks, replanning) is done run by
 run, with the code of a run alone (:class:`~mitos_cli.sim.loop.Simulation`). Then the fuzzy
 planner's rule network is evaluated once for the active robots of every run (one engine
@@ -142,7 +142,7 @@ def _observe_together(batch: Batch) -> None:
     :func:`.knowledge.near_all` and their readings looked up in one
     :func:`.knowledge.accounted_all`, their pursuit points found in one
     :func:`.perception.pursuit_points`, their inputs perceived in one
-    :func:`.perception.perceive_rows` (each row the bits of its robot alone) and checked in
+    :func:`.perception.perceive_all` (each row the bits of its robot alone) and checked in
     one :meth:`.Batch.conclude`; what else each robot's map and route need, run by run."""
     fresh, spans, maps = batch.runs, batch.spans, batch.maps
     world = fresh[0].world
@@ -161,17 +161,15 @@ def _observe_together(batch: Batch) -> None:
     near = knowledge.near_all(maps, batch.at, batch.reaches, world.replan != "clearance")
     aims = [aim for run, s, (start, stop), seen in zip(fresh, sensed, spans, sighted)
             for aim in run.aims(s, frames[start:stop], seen, near[start:stop])]
-    ahead, targets = perception.pursuit_points(aims, fresh[0].settings)
+    targets = perception.pursuit_points(aims, fresh[0].settings)[1]
     gaps = perception.route_gaps(aims)
     # (after the aims: a route planned again is planned round the cells marked by then)
-    accounted = (knowledge.accounted_all(maps, beyond)
-                 if beyond is not None and world.replan == "clearance" else None)
-    sights = []
-    for run, s, (start, stop) in zip(fresh, sensed, spans):
-        sights += run.aimed(s, aims[start:stop], ahead[start:stop], targets[start:stop],
-                            gaps[start:stop], None if accounted is None
-                            else accounted[start:stop])
-    batch.conclude(perception.perceive_rows(sights, world.sensors.range, fresh[0].settings),
+    if world.replan == "clearance" and beyond is not None:
+        accounted = knowledge.accounted_all(maps, beyond)
+    else:
+        accounted = np.concatenate([run.accounted(s) for run, s in zip(fresh, sensed)])
+    sights = batch.aimed(aims, targets, gaps, accounted)
+    batch.conclude(perception.perceive_all(sights, world.sensors.range, fresh[0].settings),
                    targets)
 
 

@@ -382,7 +382,7 @@ class Simulation:
         self._known_walls = StaticMap(self._given.walls, np.zeros((0, 4, 2)), None,
                                       self.scene.static.bounds)
         self._asked = [clearances(world, a) for a in world.agents]
-        # each robot's Sight.squeeze: its least clearance, where that is less than half its
+        # each robot's Sights.squeeze: its least clearance, where that is less than half its
         # width and its margin (else none)
         self._squeeze = [least if least < r.width / 2 + r.safety_margin else math.inf
                          for r, (_, least) in zip(self.robots, self._asked)]
@@ -724,18 +724,18 @@ class Simulation:
         """The rule inputs and the route's target point of every robot from its readings;
         first, what they show that its map does not is marked on the map it plans on, and
         its route planned again if that shuts its way (:mod:`.knowledge`). All robots'
-        inputs at once (:func:`.perception.perceive_rows`)."""
+        inputs at once (:func:`.perception.perceive_all`)."""
         sights = self.sights(s)
-        self.perceived(s, sights, perception.perceive_rows(sights, self.world.sensors.range,
-                                                           self._cfg))
+        self.perceived(s, sights, perception.perceive_all(sights, self.world.sensors.range,
+                                                          self._cfg))
 
-    def sights(self, s: _Sensed) -> list[perception.Sight]:
-        """Each robot's :class:`.perception.Sight` at tick ``s``: the marks its readings see
-        through cleared from its map (:meth:`clearing`), its :meth:`aims`, then every
+    def sights(self, s: _Sensed) -> perception.Sights:
+        """The robots' :class:`.perception.Sights` at tick ``s``: the marks their readings see
+        through cleared from their maps (:meth:`clearing`), their :meth:`aims`, then every
         robot's pursuit point at once."""
         knowledge.clear_all(*self.clearing(s))
         aims = self.aims(s, perception.frames(*self.framing(s)))
-        return self.aimed(s, aims, *perception.pursuit_points(aims, self._cfg))
+        return self.aimed(s, aims, perception.pursuit_points(aims, self._cfg)[1])
 
     def framing(self, s: _Sensed) -> tuple[list[Route], np.ndarray, np.ndarray]:
         """What :func:`.perception.frames` places the robots on their routes from at tick
@@ -795,51 +795,45 @@ class Simulation:
                                       least + self._cfg.lookahead_room))
         return out
 
-    def aimed(self, s: _Sensed, aims: list[perception.Aim], ahead: np.ndarray,
-              targets: np.ndarray, gaps: list[float] | None = None,
-              accounted: np.ndarray | None = None) -> list[perception.Sight]:
-        """The robots' sights from their :meth:`aims` and their pursuit points (lookaheads
-        ``ahead [n]``, points ``targets [n, 2]``): how far ahead each aims and what it keeps
-        clear of (``gaps``: their :func:`.perception.route_gaps`; ``accounted [n, B]``: which
-        readings hit cells their routes were planned round, :func:`.knowledge.accounted_all`;
-        runs in lockstep work both out together)."""
-        out = []
+    def aimed(self, s: _Sensed, aims: list[perception.Aim], targets: np.ndarray,
+              gaps: list[float] | None = None) -> perception.Sights:
+        """The robots' sights from their :meth:`aims` and their pursuit points ``targets
+        [n, 2]``: what each keeps clear of (``gaps``: their :func:`.perception.route_gaps`,
+        worked out here when ``None``) and which of their readings hit cells their routes
+        were planned round (:meth:`.knowledge.RobotMap.accounted_cells`; runs in lockstep
+        work both out together, :meth:`Batch.aimed`)."""
         if gaps is None:
             gaps = perception.route_gaps(aims)
-        poses, lookaheads = s.pose.tolist(), ahead.tolist()    # (x, y, heading: as sensed)
-        for i, aim in enumerate(aims):
-            least = self._asked[i][1]
-            room = max(0.0, gaps[i] - aim.radius - least)     # (perception.route_room)
-            out.append(perception.Sight(
-                aim.route, aim.f, tuple(poses[i]), self.robots[i], self._dirs[i], s.ranges[i],
-                self._expected[i], self._spacing, self._threshold, lookaheads[i], room,
-                self._kept(i, s, least, accounted), targets[i], self._squeeze[i]))
-        return out
+        n = self.n
+        dirs, expected = ((self._dirs[0][None], self._expected[0][None]) if n == 1
+                          else (np.stack(self._dirs), np.stack(self._expected)))
+        return _sights(aims, self.robots, s.pose, dirs, s.ranges, expected,
+                       np.full(n, self._spacing),
+                       np.full(n, self._threshold), np.array([a[1] for a in self._asked]),
+                       self.accounted(s), targets, gaps, np.array(self._squeeze))
 
-    def perceived(self, s: _Sensed, sights: list[perception.Sight],
+    def accounted(self, s: _Sensed) -> np.ndarray:
+        """``[n, B]``: which readings at tick ``s`` hit cells the robots' routes were planned
+        round (:meth:`.knowledge.RobotMap.accounted_cells`), where the routes are replanned
+        round what they sense (else none; runs in lockstep look theirs up together,
+        :func:`.knowledge.accounted_all`)."""
+        kept = np.zeros(s.ranges.shape, dtype=bool)
+        if self.world.replan == "clearance":
+            kept[:] = [self._maps[i].accounted_cells(self._beyond(i, s)) for i in range(self.n)]
+        return kept
+
+    def perceived(self, s: _Sensed, sights: perception.Sights,
                   inputs: dict[str, np.ndarray]) -> None:
-        """Record the robots' inputs (their rows of :func:`.perception.perceive_rows`) and
+        """Record the robots' inputs (their rows of :func:`.perception.perceive_all`) and
         target points in tick ``s``."""
         for key in perception.INPUTS:
             s.inputs[key][:] = inputs[key]
-        for i, sight in enumerate(sights):
-            s.targets[i] = sight.target
-
-    def _kept(self, i: int, s: _Sensed, least: float,
-              accounted: np.ndarray | None = None) -> tuple[float, np.ndarray] | None:
-        """Where robot ``i``'s route is replanned round what it senses: the least clearance
-        it keeps, and which of its readings hit cells the route was planned round (row ``i``
-        of ``accounted``, or looked up here)."""
-        if self.world.replan != "clearance":
-            return None
-        if accounted is not None:
-            return least, accounted[i]
-        return least, self._maps[i].accounted_cells(self._beyond(i, s))
+        s.targets[:] = sights.target
 
     def _beyond(self, i: int, s: _Sensed) -> np.ndarray:
         """The cells ``[B, 2]`` (:meth:`.knowledge.RobotMap.cell_indices`) just beyond robot
         ``i``'s readings at tick ``s``, where their echoes came from: what :meth:`_learn`
-        marks and :meth:`_kept` looks up, worked out once a tick for both."""
+        marks and :meth:`accounted` looks up, worked out once a tick for both."""
         if self._beyond_at[0] is not s:
             self._beyond_at = (s, [None] * self.n)
         cells = self._beyond_at[1]
@@ -1065,6 +1059,20 @@ class Simulation:
         return res
 
 
+def _sights(aims: list[perception.Aim], robots: list, pose: np.ndarray, dirs: np.ndarray,
+            measured: np.ndarray, expected: np.ndarray, spacing: np.ndarray,
+            threshold: np.ndarray, least: np.ndarray, kept: np.ndarray, targets: np.ndarray,
+            gaps: list[float], squeeze: np.ndarray) -> perception.Sights:
+    """The robots' :class:`.perception.Sights` from their aims (``gaps``: their
+    :func:`.perception.route_gaps`) and the rest of their rows: one rule for a run alone and
+    for runs in lockstep. How far a lane may lie off its route is
+    :func:`.perception.route_room`'s ``max(0.0, gap - radius - least)``, elementwise."""
+    room = np.array(gaps) - np.array([a.radius for a in aims]) - least
+    return perception.Sights([a.route for a in aims], [a.f for a in aims], robots, pose, dirs,
+                             measured, expected, spacing, threshold,
+                             np.where(room > 0.0, room, 0.0), least, kept, targets, squeeze)
+
+
 def _news(ranges: np.ndarray, expected: np.ndarray | None, far: float,
           threshold: float | np.ndarray) -> np.ndarray:
     """Which readings show what a robot's map does not: an echo (shorter than ``far``), and,
@@ -1126,6 +1134,11 @@ class Batch:
                                     for _ in range(run.n)])[:, None]
         self.reaches = np.array([run._cfg.lookahead + least      # (Simulation.aims)
                                  for run in runs for _, least in run._asked])
+        # (Simulation.aimed)
+        self._robots = [r for run in runs for r in run.robots]
+        self._least = np.array([least for run in runs for _, least in run._asked])
+        self._spacing = np.array([run._spacing for run in runs for _ in range(run.n)])
+        self._squeeze = np.array([q for run in runs for q in run._squeeze])
         self._limits: kinematics.Limits | None = None
         self._fleet = safety.Fleet.joined([run._fleet for run in runs])
         # the tick observed last (:meth:`sensed`): its runs' ticks, x, y and heading, readings,
@@ -1133,7 +1146,8 @@ class Batch:
         self.ticks: list[_Sensed] = []
         self._now: tuple[np.ndarray, ...] | None = None
         self.got = rows.Sensed(np.zeros((0, 0, 2)), np.zeros((0, 0)), np.zeros((0, 0)), np.zeros(0))
-        self.at, self.block = np.zeros((0, 2)), np.zeros((len(perception.INPUTS), 0))
+        self.pose, self.at = np.zeros((0, 3)), np.zeros((0, 2))
+        self.block = np.zeros((len(perception.INPUTS), 0))
         self.targets, self.command = np.zeros((0, 2)), np.zeros((0, 2))
         self.hit, self.active = np.zeros(0, dtype=bool), np.zeros(0, dtype=bool)
 
@@ -1163,7 +1177,7 @@ class Batch:
             self.ticks.append(_Sensed(run.time, run._where, pose[a:b], got.ranges[a:b],
                                       dict(zip(perception.INPUTS, block)), self.targets[a:b],
                                       got.clearance[a:b], self.command[a:b], block))
-        self.got, self.at = got, pose[:, :2].copy()
+        self.got, self.pose, self.at = got, pose, pose[:, :2].copy()
         return self.ticks
 
     def seeing(self) -> np.ndarray:
@@ -1182,6 +1196,17 @@ class Batch:
         """:meth:`Simulation.framing` of every run at once."""
         return ([r for run in self.runs for r in run._routes], self.at,
                 self._gather("_s_hint"))
+
+    def aimed(self, aims: list[perception.Aim], targets: np.ndarray, gaps: list[float],
+              accounted: np.ndarray) -> perception.Sights:
+        """:meth:`Simulation.aimed` of every run at once, from the batch's rows
+        (``accounted [rows, B]``: their :meth:`Simulation.accounted`)."""
+        got = self.got
+        expected = (got.static if self._plain else
+                    np.array([e for run in self.runs for e in run._expected]))
+        return _sights(aims, self._robots, self.pose, got.dirs, got.ranges, expected,
+                       self._spacing, self._threshold[:, 0], self._least, accounted, targets,
+                       gaps, self._squeeze)
 
     def beyond(self, cells: np.ndarray) -> None:
         """:meth:`Simulation.beyond` of every run: ``cells [rows, B, 2]``."""

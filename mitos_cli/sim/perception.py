@@ -160,22 +160,24 @@ def _or(least: np.ndarray, none: float, less: float | np.ndarray = 0.0) -> np.nd
 
 
 def _obstruction(route: Route, a, b, points, valid, widen, robot: Robot, f: Frame,
-                 cfg: Settings, rel_heading, kept: tuple[float, np.ndarray] | None = None):
+                 cfg: Settings, rel_heading):
     """(size, position, distance) of the nearest obstructing object among ``points``
-    (:func:`_obstruction_rows` of one row)."""
+    (:func:`_obstruction_rows` of one row, kept clear of nothing)."""
     ah, bh = rel_heading
     size, position, distance = _obstruction_rows(
         [route], [f], a[None], b[None], points[None], valid[None], widen[None], [robot], cfg,
-        ah[None], bh[None], [kept], _bodies((robot,), cfg))
+        ah[None], bh[None], np.zeros(1), np.zeros((1, len(a)), dtype=bool),
+        _bodies((robot,), cfg))
     return float(size[0]), float(position[0]), float(distance[0])
 
 
 def _obstruction_rows(routes: list[Route], frames: list[Frame], a, b, points, valid, widen,
-                      robots: list[Robot], cfg: Settings, ah, bh,
-                      kept: list[tuple[float, np.ndarray] | None], body: dict[str, np.ndarray]):
+                      robots: list[Robot], cfg: Settings, ah, bh, least: np.ndarray,
+                      kept: np.ndarray, body: dict[str, np.ndarray]):
     """Each row's ``(size, position, distance)`` of the nearest obstructing object among its
     ``points [R, K, 2]`` (``a``, ``b``: along and across its route; ``ah``, ``bh``: along and
-    across its heading; ``body``: the robots' :func:`_bodies`). A point obstructs when it lies
+    across its heading; ``least [R]``, ``kept [R, K]``: :attr:`Sights.least` and
+    :attr:`Sights.kept`; ``body``: the robots' :func:`_bodies`). A point obstructs when it lies
     in the band swept along the route or in the band swept along the robot's heading (so
     turning back toward an object it has not yet passed brings it back)."""
     size, position = np.zeros(len(routes)), np.zeros(len(routes))
@@ -189,15 +191,13 @@ def _obstruction_rows(routes: list[Route], frames: list[Frame], a, b, points, va
         return size, position, distance
     # what the route was planned round obstructs only within its word: the distances of
     # every point of the rows with such points, at once (each point's its own)
-    rounds = [(i, word[0], blocking[i] & word[1]) for i, word in enumerate(kept)
-              if word is not None]
-    rounds = [row for row in rounds if np.count_nonzero(row[2])]
-    if rounds:
-        some = [i for i, _, _ in rounds]
-        gone = distances([routes[i] for i in some], [frames[i].s for i in some], cfg.sight,
-                         points[some])
-        for (i, least, round_), far in zip(rounds, gone):
-            blocking[i, round_] = far[round_] - widen[i, round_] < least
+    rounds = blocking & kept
+    some = np.logical_or.reduce(rounds, axis=1).nonzero()[0]
+    if len(some):
+        gone = distances([routes[i] for i in some.tolist()],
+                         [frames[i].s for i in some.tolist()], cfg.sight, points[some])
+        blocking[some] = np.where(rounds[some], gone - widen[some] < least[some, None],
+                                  blocking[some])
     for j in np.flatnonzero(np.logical_or.reduce(blocking, axis=1)):
         size[j], position[j], distance[j] = _object(
             routes[j], frames[j], a[j], points[j], ahead[j], blocking[j], widen[j], robots[j], cfg)
@@ -716,46 +716,89 @@ class Sight:
     squeeze: float = math.inf      # see :func:`perceive`
 
 
+@dataclass
+class Sights:
+    """What robots perceive from at one tick, a row each (:func:`perceive_all`): the arrays
+    of their :class:`Sight` one above the other (:meth:`of`), or made so at once (runs in
+    lockstep make theirs from the arrays that hold all their robots' rows)."""
+
+    routes: list[Route]
+    frames: list[Frame]
+    robots: list[Robot]
+    pose: np.ndarray               # [R, 3] x, y (in), heading (rad)
+    dirs: np.ndarray               # [R, B, 2] their beams
+    measured: np.ndarray           # [R, B] their readings
+    expected: np.ndarray           # [R, B] what their maps predict
+    spacing: np.ndarray            # [R] their beams' spacing
+    threshold: np.ndarray          # [R] in: news thresholds
+    room: np.ndarray               # [R] how far each lane may lie off its route
+    least: np.ndarray              # [R] the least clearance each route is replanned with
+    kept: np.ndarray               # [R, B] readings that hit what its route was planned round
+    # (a Sight's ``kept``; all False where its route is not replanned round what it senses)
+    target: np.ndarray             # [R, 2] the route points ``lookahead`` ahead
+    squeeze: np.ndarray            # [R] see :func:`perceive`
+
+    @classmethod
+    def of(cls, rows: list[Sight]) -> Sights:
+        """The rows of ``rows``, one above the other."""
+        kept = [r.kept for r in rows]
+        beams = len(rows[0].measured)
+        return cls([r.route for r in rows], [r.f for r in rows], [r.robot for r in rows],
+                   np.array([r.pose for r in rows]), _stack([r.dirs for r in rows]),
+                   _stack([r.measured for r in rows]), _stack([r.expected for r in rows]),
+                   np.array([r.spacing for r in rows]), np.array([r.threshold for r in rows]),
+                   np.array([r.room for r in rows]),
+                   np.array([0.0 if k is None else k[0] for k in kept]),
+                   np.array([np.zeros(beams, dtype=bool) if k is None else k[1] for k in kept]
+                            ).reshape(len(rows), beams),
+                   np.array([r.target for r in rows]), np.array([r.squeeze for r in rows]))
+
+
 def perceive_rows(rows: list[Sight], max_range: float,
                   cfg: Settings = Settings()) -> dict[str, np.ndarray]:
     """The inputs of every row (``[R]`` each, :data:`INPUTS`), each row's the bits of
-    :func:`perceive` for that robot alone: the beams' arithmetic over ``[R, B]`` arrays,
-    elementwise, with exact minima; what depends on a row's route, its map or a matrix
-    product of its own beams row by row."""
-    robots = [r.robot for r in rows]
+    :func:`perceive` for that robot alone (:func:`perceive_all` of their :class:`Sights`)."""
+    return perceive_all(Sights.of(rows), max_range, cfg)
+
+
+def perceive_all(rows: Sights, max_range: float,
+                 cfg: Settings = Settings()) -> dict[str, np.ndarray]:
+    """The inputs of every row of ``rows`` (``[R]`` each, :data:`INPUTS`), each row's the
+    bits of :func:`perceive` for that robot alone: the beams' arithmetic over ``[R, B]``
+    arrays, elementwise, with exact minima; what depends on a row's route or its map row
+    by row."""
+    robots = rows.robots
     body = _bodies(tuple(robots), cfg)
-    p = np.array([r.pose[:2] for r in rows])                            # [R, 2]
-    dirs = _stack([r.dirs for r in rows])
-    measured = _stack([r.measured for r in rows])
+    p = rows.pose[:, :2]                                                # [R, 2]
+    dirs, measured = rows.dirs, rows.measured
     hits = p[:, None] + measured[..., None] * dirs                      # [R, B, 2]
     rel = hits - p[:, None]
-    a = np.matmul(rel, _stack([r.f.t for r in rows])[..., None])[..., 0]   # rel @ f.t, rows
-    b = np.matmul(rel, _stack([r.f.n for r in rows])[..., None])[..., 0]
+    a = np.matmul(rel, _stack([f.t for f in rows.frames])[..., None])[..., 0]   # rel @ f.t
+    b = np.matmul(rel, _stack([f.n for f in rows.frames])[..., None])[..., 0]
     valid = measured < max_range * 0.999
-    obstacle_hit = valid & (measured < _stack([r.expected for r in rows])
-                            - _column([r.threshold for r in rows]))
+    obstacle_hit = valid & (measured < rows.expected - rows.threshold[:, None])
     known = valid ^ obstacle_hit        # valid & ~obstacle_hit (which lies within valid)
-    headings = [r.pose[2] for r in rows]
+    headings = rows.pose[:, 2].tolist()
     all_ah, all_bh, valid_ah, valid_bh = _own_frames(headings, rel, valid)
     road, wl, wr = _sides(a, b, valid_ah, valid_bh, valid, known, body, cfg, max_range,
                           obstacle_hit)
-    widen = measured * _column([r.spacing for r in rows]) / 2
-    obstructing = obstacle_hit | _in_way(rows, known & (a > 0), hits, cfg)
+    widen = measured * rows.spacing[:, None] / 2
+    obstructing = obstacle_hit | _in_way(rows, known & (a > 0), hits, body, cfg)
     if np.count_nonzero(obstructing):
         ah, bh = all_ah, all_bh
     else:                       # what does not obstruct is not asked where it lies
         ah, bh = valid_ah, valid_bh
     size, position, distance = _obstruction_rows(
-        [r.route for r in rows], [r.f for r in rows], a, b, hits, obstructing,
-        widen, robots, cfg, ah, bh, [r.kept for r in rows], body)
-    d = np.array([r.target for r in rows]) - p                          # to the targets
-    home = np.array([r.route.goal for r in rows]) - p                    # to the goals
+        rows.routes, rows.frames, a, b, hits, obstructing, widen, robots, cfg, ah, bh,
+        rows.least, rows.kept, body)
+    d = rows.target - p                                                 # to the targets
+    home = np.array([r.goal for r in rows.routes]) - p                  # to the goals
     far, dx, dy = np.hypot(d[:, 0], d[:, 1]).tolist(), d[:, 0].tolist(), d[:, 1].tolist()
-    common = np.array([_common_of(dx[i], dy[i], r.pose[2], r.route.length - r.f.s, r.f.e,
-                                  gone, road_i, r.robot, cfg, r.room)
-                       for i, (r, gone, road_i) in enumerate(
-                           zip(rows, np.hypot(home[:, 0], home[:, 1]).tolist(),
-                               road.tolist()))])
+    common = np.array([_common_of(dx[i], dy[i], headings[i], r.length - f.s, f.e, gone,
+                                  road_i, robot, cfg, room)
+                       for i, (r, f, robot, room, gone, road_i) in enumerate(
+                           zip(rows.routes, rows.frames, robots, rows.room.tolist(),
+                               np.hypot(home[:, 0], home[:, 1]).tolist(), road.tolist()))])
     heading = common[:, 0]
     front, opening = _free_ways(valid_ah, valid_bh, widen, obstacle_hit, body, cfg, heading)
     ring = _rings(dirs)
@@ -781,7 +824,8 @@ def _rings(dirs: np.ndarray) -> np.ndarray:
     return last >= second - 1e-9
 
 
-def _in_way(rows: list[Sight], ahead: np.ndarray, hits: np.ndarray, cfg: Settings) -> np.ndarray:
+def _in_way(rows: Sights, ahead: np.ndarray, hits: np.ndarray, body: dict[str, np.ndarray],
+            cfg: Settings) -> np.ndarray:
     """Which of the points ``hits [R, B, 2]`` ahead of their robots (``ahead``) and drawn on
     its map stand where its route would hit them: within half its width plus its safety
     margin of the route within ``sight`` (in a squeeze, nearer than the route keeps: see
@@ -790,14 +834,18 @@ def _in_way(rows: list[Sight], ahead: np.ndarray, hits: np.ndarray, cfg: Setting
     cols = np.logical_or.reduce(ahead, axis=0).nonzero()[0]
     if not len(cols):
         return ahead
-    some = (np.logical_or.reduce(ahead, axis=1).nonzero()[0] if len(rows) > 1
+    n = len(rows.routes)
+    some = (np.logical_or.reduce(ahead, axis=1).nonzero()[0] if n > 1
             else np.zeros(1, dtype=np.intp))
-    asked = [rows[i] for i in some]
-    at = np.s_[:, cols] if len(asked) == len(rows) else np.ix_(some, cols)
-    gone = distances([r.route for r in asked], [r.f.s for r in asked], cfg.sight, hits[at])
-    ahead[at] &= gone <= _column([min(r.robot.width / 2 + r.robot.safety_margin,
-                                      max(r.squeeze - r.threshold, r.squeeze / 2))
-                                  for r in asked])
+    asked = some.tolist()
+    at = np.s_[:, cols] if len(asked) == n else np.ix_(some, cols)
+    gone = distances([rows.routes[i] for i in asked], [rows.frames[i].s for i in asked],
+                     cfg.sight, hits[at])
+    # (only compared with: the sign of a zero, where a min or max of Python and of NumPy
+    # may differ, does not matter)
+    squeeze, threshold = rows.squeeze[some], rows.threshold[some]
+    ahead[at] &= gone <= np.minimum(body["in_way"][some, 0],
+                                    np.maximum(squeeze - threshold, squeeze / 2))[:, None]
     return ahead
 
 
@@ -805,7 +853,8 @@ def _bodies(robots: tuple[Robot, ...], cfg: Settings) -> dict[str, np.ndarray]:
     """The robots' measures perception works with, ``[R, 1]`` each (read-only): half the
     width (``half``), half the length (``length``), the half width of the band an object
     obstructs in (``band``), of a way (``way``), of the roomier band a way is also scored
-    in (``roomy``) and of the band ``nearest`` looks in (``near``), each the one robot's
+    in (``roomy``), of the band ``nearest`` looks in (``near``) and within which what is
+    drawn stands in its way (``in_way``, :func:`perceive`), each the one robot's
     arithmetic; and the ways :func:`free_ways` tries (``ways``, :func:`_ways`). Looked up by
     the robots' and settings' identities first (hashing a :class:`Settings` costs more than
     the look-up saves, every tick), then by value."""
@@ -834,6 +883,7 @@ def _measures(robots: tuple[Robot, ...], cfg: Settings) -> dict[str, np.ndarray]
            "way": column(r.width / 2 + cfg.way_margin for r in robots),
            "roomy": column(r.width / 2 + cfg.way_margin + cfg.way_room for r in robots),
            "near": column(r.width / 2 + cfg.nearest_band for r in robots),
+           "in_way": column(r.width / 2 + r.safety_margin for r in robots),
            "ways": _ways(cfg)}
     for a in out.values():
         a.flags.writeable = False
@@ -843,12 +893,6 @@ def _measures(robots: tuple[Robot, ...], cfg: Settings) -> dict[str, np.ndarray]
 def _stack(arrays: list[np.ndarray]) -> np.ndarray:
     """The arrays one above the other (a view of the one, when there is one)."""
     return arrays[0][None] if len(arrays) == 1 else np.stack(arrays)
-
-
-def _column(values: list[float]) -> float | np.ndarray:
-    """One value per row as a column ``[R, 1]`` to broadcast against ``[R, K]`` (the value
-    itself for one row: the same arithmetic, element by element)."""
-    return values[0] if len(values) == 1 else np.array(values)[:, None]
 
 
 def _own_frames(headings: list[float], rel: np.ndarray,
