@@ -11,7 +11,7 @@ import pytest
 
 from mitos_cli.errors import CommandError
 from mitos_cli.resources import packaged_path
-from mitos_cli.sim import kinematics, loop, rows
+from mitos_cli.sim import kinematics, loop, movers, rows
 from mitos_cli.sim.lockstep import Lockstep, run_lockstep
 from mitos_cli.sim.loop import STUCK_TIME, Batch, Simulation, prepare, simulate
 from mitos_cli.sim.planner import FuzzyPlanner, make_planner
@@ -87,6 +87,35 @@ def test_a_batch_sees_the_news_each_run_sees_alone_with_its_own_noise():
     alone = np.concatenate([run.seeing(s) for run, s in zip(runs, sensed)])
     assert 0 < np.count_nonzero(alone) < alone.size
     assert together.tobytes() == alone.tobytes()
+
+
+def test_a_batch_watches_what_each_run_watches_alone():
+    """The robots that follow something (tracks kept, or news seen) and what the tracker
+    looks at for them, of every run at once, are each run's own, in run order."""
+    world = load_world(packaged_path("worlds", "multirobot.yaml"))
+    runs = [Simulation(world, None, seed, randomise=True) for seed in range(7000, 7004)]
+    batch = Batch(runs)
+    got = rows.sense([part for run in runs for part in run.sense_rows()], runs[0].angles,
+                     world.sensors.range)
+    rng = np.random.default_rng(2)          # news for some robots, none for the others
+    short = got.static - rng.uniform(8.0, 16.0, got.ranges.shape)
+    ranges = np.where(rng.random((len(short), 1)) < 0.5, world.sensors.range, short)
+    got = rows.Sensed(got.dirs, got.static, ranges, got.clearance)
+    sensed = batch.sensed(got)
+    batch.seeing()
+    quiet = [(run, i) for run in runs for i in range(run.n) if not run._seen[i].any()]
+    assert quiet and len(quiet) < len(batch.maps)
+    quiet[0][0]._trackers[quiet[0][1]].tracks.append(movers.Track([0.0], [np.zeros(2)]))
+    learned = [[False] * run.n for run in runs]
+    spaces, follows, *looks = batch.watching(learned)
+    together = [run._watched for run in runs]
+    alone = [run.watching(s, mine) for run, s, mine in zip(runs, sensed, learned)]
+    assert [w[1:] for w in together] == [run._watched[1:] for run in runs]
+    assert len(follows) == len(spaces) == sum(len(w[0]) for w in alone)
+    assert len(follows) == len(batch.maps) - len(quiet) + 1
+    assert all(a is b for a, b in zip(spaces, [f for w in alone for f in w[0]]))
+    for j, look in enumerate(looks):
+        assert look.tobytes() == np.concatenate([w[1 + j] for w in alone]).tobytes()
 
 
 def test_runs_stuck_in_a_batch_are_stuck_at_the_tick_they_are_alone():

@@ -157,7 +157,8 @@ def _observe_together(batch: Batch) -> None:
         marked = knowledge.mark_all(maps, beyond, batch.seeing())
         learned = [marked[start:stop] for start, stop in spans]
     frames = perception.frames(*batch.framing())
-    sighted = _sightings_together(fresh, sensed, learned)
+    sighted = (_sightings_together(fresh, sensed) if learned is None
+               else _watched_together(batch, learned))
     near = knowledge.near_all(maps, batch.at, batch.reaches, world.replan != "clearance")
     aims = [aim for run, s, (start, stop), seen in zip(fresh, sensed, spans, sighted)
             for aim in run.aims(s, frames[start:stop], seen, near[start:stop])]
@@ -173,13 +174,21 @@ def _observe_together(batch: Batch) -> None:
                    targets)
 
 
-def _sightings_together(runs: list[Simulation], sensed: list,
-                        learned: list | None = None) -> list[list[movers.Seen]]:
-    """What each run is :meth:`~.loop.Simulation.watching` (its maps marked, or ``learned``
-    whether they were, run by run), seen in one :func:`.movers.sightings` for the robots of
-    all runs (they tick together: one time)."""
-    watched = [run.watching(s, None if learned is None else learned[j])
-               for j, (run, s) in enumerate(zip(runs, sensed))]
+def _watched_together(batch: Batch, learned: list[list[bool]]) -> list[list[movers.Seen]]:
+    """What the robots of every run of ``batch`` follow (:meth:`.Batch.watching`: their maps
+    marked, ``learned`` whether they were), seen in one :func:`.movers.sightings`, run by
+    run."""
+    spaces, rows, *looks = batch.watching(learned)
+    got = movers.sightings(spaces, batch.ticks[0].t, *looks) if len(rows) else []
+    ends = rows.searchsorted([start for start, _ in batch.spans] + [batch.spans[-1][1]]).tolist()
+    return [got[a:b] for a, b in zip(ends[:-1], ends[1:])]
+
+
+def _sightings_together(runs: list[Simulation], sensed: list) -> list[list[movers.Seen]]:
+    """What each run is :meth:`~.loop.Simulation.watching` (its maps marked run by run),
+    seen in one :func:`.movers.sightings` for the robots of all runs (they tick together:
+    one time)."""
+    watched = [run.watching(s) for run, s in zip(runs, sensed)]
     looking = [w for w in watched if w[0]]                  # runs whose robots follow something
     got = movers.sightings([sp for w in looking for sp in w[0]], sensed[0].t,
                            *(np.concatenate([w[j] for w in looking]) for j in (1, 2, 3, 4))

@@ -1139,6 +1139,11 @@ class Batch:
         self._least = np.array([least for run in runs for _, least in run._asked])
         self._spacing = np.array([run._spacing for run in runs for _ in range(run.n)])
         self._squeeze = np.array([q for run in runs for q in run._squeeze])
+        # (Simulation.watching)
+        self._follows = runs[0].world.replan != "never"
+        self._trackers = [t for run in runs for t in run._trackers]
+        self._spaces = [f for run in runs for f in run._free]
+        self._seen = np.zeros((0, 0), dtype=bool)
         self._limits: kinematics.Limits | None = None
         self._fleet = safety.Fleet.joined([run._fleet for run in runs])
         # the tick observed last (:meth:`sensed`): its runs' ticks, x, y and heading, readings,
@@ -1186,11 +1191,29 @@ class Batch:
         if self._knows:
             expected = (self.got.static if self._plain else
                         np.array([e for run in self.runs for e in run._expected]))
-        seen = _news(self.got.ranges, expected, self._far, self._threshold)
+        self._seen = seen = _news(self.got.ranges, expected, self._far, self._threshold)
         rows_ = list(seen)
         for run, (a, b) in zip(self.runs, self.spans):
             run._seen = rows_[a:b]
         return seen
+
+    def watching(self, learned: list[list[bool]]) -> tuple[list[movers.FreeSpace], np.ndarray,
+                                                            np.ndarray, np.ndarray, np.ndarray,
+                                                            np.ndarray]:
+        """:meth:`Simulation.watching` of every run at once, their maps marked by
+        :meth:`seeing` (``learned``: whether each run's were): each run's watch kept, and the
+        rows of the robots that follow something (those with tracks or news) with what
+        :func:`.movers.sightings` looks at for them."""
+        flags = [False] * len(self._trackers)
+        if self._follows:
+            flags = (np.array([bool(t.tracks) for t in self._trackers])
+                     | np.logical_or.reduce(self._seen, axis=1)).tolist()
+        for run, s, (a, b), mine in zip(self.runs, self.ticks, self.spans, learned):
+            run._watched = (s, mine, [i for i in range(b - a) if flags[a + i]])
+        rows = np.flatnonzero(flags)
+        got = self.got
+        return ([self._spaces[i] for i in rows.tolist()], rows, self.at[rows], got.ranges[rows],
+                got.dirs[rows], self._seen[rows])
 
     def framing(self) -> tuple[list[Route], np.ndarray, np.ndarray]:
         """:meth:`Simulation.framing` of every run at once."""
