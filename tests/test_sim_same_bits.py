@@ -1077,3 +1077,42 @@ def test_robots_sharing_routes_placed_together_get_the_bits_they_get_alone():
     points = rng.normal(0, 150, (60, 2))
     hints = [float(rng.uniform(-200, r.length + 200)) for r in routes]
     assert_placed_as_alone(routes, points, hints)
+
+
+def _object_alone(r: route.Route, f: perception.Frame, a, points, ahead, blocking, widen,
+                  length: float, cfg: perception.Settings) -> tuple[float, float, float]:
+    """The object of one row, written out (distance, size, position)."""
+    i = int(np.where(blocking, a, np.inf).argmin())
+    near = ahead & (np.hypot(*(points - points[i]).T) <= cfg.cluster)
+    distance = max(0.0, float(a[near].min()) - length)
+    pts = points[near]
+    centre = pts.mean(axis=0)
+    _, e_o, t_o = r.project(centre, f.s, back=0.0, ahead=cfg.sight + cfg.cluster)
+    across = (pts - centre) @ np.array([t_o[1], -t_o[0]]) + e_o
+    lo, hi = float((across - widen[near]).min()), float((across + widen[near]).max())
+    return distance, hi - lo, (lo + hi) / 2
+
+
+def test_objects_of_many_rows_at_once_are_each_rows_own():
+    rng = np.random.default_rng(16)
+    cfg = perception.Settings()
+    for k in range(40):
+        rows_ = int(rng.integers(1, 9))
+        beams = int(rng.choice([1, 2, 5, 36]))
+        routes = [route.Route.of(np.cumsum(rng.normal(0, 40, (int(rng.integers(2, 9)), 2)), axis=0))
+                  for _ in range(rows_)]
+        frames = [perception.frame(r, rng.normal(0, 30, 2), rng.uniform(0, r.length))
+                  for r in routes]
+        points = rng.normal(0, 25, (rows_, beams, 2))
+        a = rng.uniform(-20, 160, (rows_, beams))
+        ahead = rng.random((rows_, beams)) < 0.8
+        blocking = ahead & (rng.random((rows_, beams)) < 0.5)
+        blocking[np.arange(rows_), rng.integers(0, beams, rows_)] = True
+        ahead |= blocking
+        widen = rng.uniform(0, 3, (rows_, beams))
+        length = rng.uniform(-5, 20, rows_)
+        got = perception._objects(routes, frames, a, points, ahead, blocking, widen, length, cfg)
+        for j in range(rows_):
+            want = _object_alone(routes[j], frames[j], a[j], points[j], ahead[j], blocking[j],
+                                 widen[j], float(length[j]), cfg)
+            assert same([got[0][j], got[1][j], got[2][j]], list(want)), (k, j)

@@ -165,14 +165,14 @@ def _obstruction(route: Route, a, b, points, valid, widen, robot: Robot, f: Fram
     (:func:`_obstruction_rows` of one row, kept clear of nothing)."""
     ah, bh = rel_heading
     size, position, distance = _obstruction_rows(
-        [route], [f], a[None], b[None], points[None], valid[None], widen[None], [robot], cfg,
+        [route], [f], a[None], b[None], points[None], valid[None], widen[None], cfg,
         ah[None], bh[None], np.zeros(1), np.zeros((1, len(a)), dtype=bool),
         _bodies((robot,), cfg))
     return float(size[0]), float(position[0]), float(distance[0])
 
 
 def _obstruction_rows(routes: list[Route], frames: list[Frame], a, b, points, valid, widen,
-                      robots: list[Robot], cfg: Settings, ah, bh, least: np.ndarray,
+                      cfg: Settings, ah, bh, least: np.ndarray,
                       kept: np.ndarray, body: dict[str, np.ndarray]):
     """Each row's ``(size, position, distance)`` of the nearest obstructing object among its
     ``points [R, K, 2]`` (``a``, ``b``: along and across its route; ``ah``, ``bh``: along and
@@ -198,9 +198,12 @@ def _obstruction_rows(routes: list[Route], frames: list[Frame], a, b, points, va
                          [frames[i].s for i in some.tolist()], cfg.sight, points[some])
         blocking[some] = np.where(rounds[some], gone - widen[some] < least[some, None],
                                   blocking[some])
-    for j in np.flatnonzero(np.logical_or.reduce(blocking, axis=1)):
-        size[j], position[j], distance[j] = _object(
-            routes[j], frames[j], a[j], points[j], ahead[j], blocking[j], widen[j], robots[j], cfg)
+    rows = np.flatnonzero(np.logical_or.reduce(blocking, axis=1))
+    if len(rows):
+        distance[rows], size[rows], position[rows] = _objects(
+            [routes[j] for j in rows.tolist()], [frames[j] for j in rows.tolist()], a[rows],
+            points[rows], ahead[rows], blocking[rows], widen[rows], body["length"][rows, 0],
+            cfg)
     return size, position, distance
 
 
@@ -212,22 +215,34 @@ def _in_band(b: np.ndarray, widen: np.ndarray, half: np.ndarray) -> np.ndarray:
     return np.abs(b) - widen < half
 
 
-def _object(route: Route, f: Frame, a, points, ahead, blocking, widen, robot: Robot,
-            cfg: Settings) -> tuple[float, float, float]:
-    """(size, position, distance) of the object the nearest blocking point belongs to: the
-    points ahead within ``cluster`` of it."""
-    i = int(np.where(blocking, a, np.inf).argmin())
-    near = ahead & (np.hypot(*(points - points[i]).T) <= cfg.cluster)
-    distance = max(0.0, float(a[near].min()) - robot.length / 2)
+def _objects(routes: list[Route], frames: list[Frame], a, points, ahead, blocking, widen,
+             length: np.ndarray, cfg: Settings) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Each row's distance, size and position of the object its nearest blocking point
+    belongs to (the points ahead within ``cluster`` of it; ``length``: half the robots'
+    lengths): the nearest points, the objects and their distances for all rows at once
+    (elementwise, exact minima), where each object stands on its route in one
+    :func:`.route.projections`; how wide it is there, row by row (a row's own product)."""
+    i = np.where(blocking, a, np.inf).argmin(axis=1)
+    gap = points - points[np.arange(len(points)), i][:, None]
+    near = ahead & (np.hypot(gap[..., 0], gap[..., 1]) <= cfg.cluster)
+    distance = np.minimum.reduce(a, axis=1, initial=np.inf, where=near) - length
+    distance = np.where(distance > 0.0, distance, 0.0)              # max(0.0, distance)
+    pts = [row[mine] for row, mine in zip(points, near)]
+    # (np.mean's arithmetic: the sum of the points, divided by their count)
+    centres = np.array([np.add.reduce(p, axis=0) / len(p) for p in pts]).reshape(-1, 2)
+    hints = [f.s for f in frames]
+    reach = cfg.sight + cfg.cluster
     # size and position across the road where the object stands (around a corner that is
     # the next leg of the route, not the robot's)
-    pts = points[near]
-    centre = pts.mean(axis=0)
-    s_o, e_o, t_o = route.project(centre, f.s, back=0.0, ahead=cfg.sight + cfg.cluster)
-    across = (pts - centre) @ np.array([t_o[1], -t_o[0]]) + e_o
-    lo = float((across - widen[near]).min())
-    hi = float((across + widen[near]).max())
-    return hi - lo, (lo + hi) / 2, distance
+    where = ([routes[0].project(centres[0], hints[0], back=0.0, ahead=reach)]
+             if len(routes) == 1 else projections(routes, centres, hints, 0.0, reach))
+    size, position = np.zeros(len(pts)), np.zeros(len(pts))
+    for j, (p, centre, (_, e_o, t_o)) in enumerate(zip(pts, centres, where)):
+        across = (p - centre) @ np.array([t_o[1], -t_o[0]]) + e_o
+        lo = float((across - widen[j, near[j]]).min())
+        hi = float((across + widen[j, near[j]]).max())
+        size[j], position[j] = hi - lo, (lo + hi) / 2
+    return distance, size, position
 
 
 def _own_frame(rel: np.ndarray, heading: float) -> tuple[np.ndarray, np.ndarray]:
@@ -789,7 +804,7 @@ def perceive_all(rows: Sights, max_range: float,
     else:                       # what does not obstruct is not asked where it lies
         ah, bh = valid_ah, valid_bh
     size, position, distance = _obstruction_rows(
-        rows.routes, rows.frames, a, b, hits, obstructing, widen, robots, cfg, ah, bh,
+        rows.routes, rows.frames, a, b, hits, obstructing, widen, cfg, ah, bh,
         rows.least, rows.kept, body)
     d = rows.target - p                                                 # to the targets
     home = np.array([r.goal for r in rows.routes]) - p                  # to the goals
