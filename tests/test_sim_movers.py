@@ -349,3 +349,37 @@ def test_a_robot_standing_in_a_movers_way_is_sent_out_of_it():
     assert room.at(place[None])[0] >= asked                 # out of the cart's way
     assert math.dist(place, p) > 12.0                       # which it was not, where it stood
 
+
+
+def _state(tracker: movers.Tracker) -> list:
+    """A tracker's tracks as bytes and values, to compare bit for bit."""
+    return [(tr.times, np.array(tr.centres).tobytes(), tr.radius, tr.moved, tr.mover,
+             None if tr.v is None else tr.v.tobytes(), None if tr.fit is None else tr.fit.tobytes(),
+             tr.born) for tr in tracker.tracks]
+
+
+def test_trackers_followed_together_follow_as_each_alone():
+    """Trackers matched in one pass (distances and their order for all) keep the tracks
+    each keeps alone, tick after tick: objects that move on, stand, come and go, lie
+    equally far from two tracks, and none at all."""
+    rng = np.random.default_rng(5)
+    together = [movers.Tracker() for _ in range(12)]
+    alone = [movers.Tracker() for _ in range(12)]
+    places = rng.uniform(-60, 60, (12, 4, 2))
+    speeds = rng.choice([0.0, 20.0, 40.0], (12, 4, 1)) * rng.normal(size=(12, 4, 2))
+    for k in range(60):
+        now = k * 0.05
+        seen = []
+        for j in range(12):
+            some = rng.random(4) < 0.7 if j % 5 else np.zeros(4, dtype=bool)
+            centres = places[j, some] + speeds[j, some] * now + rng.normal(0, 0.5, (int(some.sum()), 2))
+            if k % 9 == 0 and len(centres) > 1:
+                centres[1] = centres[0] + 3.0          # two objects as far from one track
+            radii = rng.uniform(1, 30, len(centres))
+            seen.append((centres, radii, [bool(m) if m < 2 else None
+                                          for m in rng.integers(0, 3, len(centres))]))
+        movers.follow_all(together, now, seen)
+        for tracker, got in zip(alone, seen):
+            tracker.follow(now, *got)
+        assert [_state(t) for t in together] == [_state(t) for t in alone], k
+    assert any(tr.mover for t in alone for tr in t.tracks)

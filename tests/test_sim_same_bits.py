@@ -546,6 +546,7 @@ def test_robots_aim_together_with_the_bits_they_get_alone(name):
     aims = []
     for sim in sims:
         s = sim.sense()
+        sim.tracked(s)
         aims += sim.aims(s, perception.frames(*sim.framing(s)))
     cfg = sims[0].settings
     rng = np.random.default_rng(3)
@@ -916,6 +917,7 @@ def test_pursuit_points_from_the_cells_near_their_chords_are_those_of_every_cell
     aims = []
     for sim in sims:
         s = sim.sense()
+        sim.tracked(s)
         aims += sim.aims(s, perception.frames(*sim.framing(s)))
     cfg = sims[0].settings
     rng = np.random.default_rng(5)
@@ -1059,6 +1061,7 @@ def test_route_gaps_measured_together_give_each_robots_own_room():
     aims = []
     for sim in sims:
         s = sim.sense()
+        sim.tracked(s)
         aims += sim.aims(s, perception.frames(*sim.framing(s)))
     aims += [dataclasses.replace(a, cells=a.cells[:k]) for a in aims for k in (0, 1, 7)]
     assert any(len(a.cells) > 20 for a in aims)

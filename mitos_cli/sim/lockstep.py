@@ -157,11 +157,14 @@ def _observe_together(batch: Batch) -> None:
         marked = knowledge.mark_all(maps, beyond, batch.seeing())
         learned = [marked[start:stop] for start, stop in spans]
     frames = perception.frames(*batch.framing())
-    sighted = (_sightings_together(fresh, sensed) if learned is None
-               else _watched_together(batch, learned))
+    if learned is None:
+        for run, s, seen in zip(fresh, sensed, _sightings_together(fresh, sensed)):
+            run.tracked(s, seen)
+    else:
+        batch.tracked(_watched_together(batch, learned))
     near = knowledge.near_all(maps, batch.at, batch.reaches, world.replan != "clearance")
-    aims = [aim for run, s, (start, stop), seen in zip(fresh, sensed, spans, sighted)
-            for aim in run.aims(s, frames[start:stop], seen, near[start:stop])]
+    aims = [aim for run, s, (start, stop) in zip(fresh, sensed, spans)
+            for aim in run.aims(s, frames[start:stop], near[start:stop])]
     targets = perception.pursuit_points(aims, fresh[0].settings)[1]
     gaps = perception.route_gaps(aims)
     # (after the aims: a route planned again is planned round the cells marked by then)
@@ -174,14 +177,12 @@ def _observe_together(batch: Batch) -> None:
                    targets)
 
 
-def _watched_together(batch: Batch, learned: list[list[bool]]) -> list[list[movers.Seen]]:
-    """What the robots of every run of ``batch`` follow (:meth:`.Batch.watching`: their maps
-    marked, ``learned`` whether they were), seen in one :func:`.movers.sightings`, run by
-    run."""
+def _watched_together(batch: Batch, learned: list[list[bool]]) -> list[movers.Seen]:
+    """What the robots of every run of ``batch`` that follow something see
+    (:meth:`.Batch.watching`: their maps marked, ``learned`` whether they were), seen in one
+    :func:`.movers.sightings`, in row order."""
     spaces, rows, *looks = batch.watching(learned)
-    got = movers.sightings(spaces, batch.ticks[0].t, *looks) if len(rows) else []
-    ends = rows.searchsorted([start for start, _ in batch.spans] + [batch.spans[-1][1]]).tolist()
-    return [got[a:b] for a, b in zip(ends[:-1], ends[1:])]
+    return movers.sightings(spaces, batch.ticks[0].t, *looks) if len(rows) else []
 
 
 def _sightings_together(runs: list[Simulation], sensed: list) -> list[list[movers.Seen]]:

@@ -734,6 +734,7 @@ class Simulation:
         through cleared from their maps (:meth:`clearing`), their :meth:`aims`, then every
         robot's pursuit point at once."""
         knowledge.clear_all(*self.clearing(s))
+        self.tracked(s)
         aims = self.aims(s, perception.frames(*self.framing(s)))
         return self.aimed(s, aims, perception.pursuit_points(aims, self._cfg)[1])
 
@@ -750,30 +751,37 @@ class Simulation:
         dirs = self._dirs[0][None] if self.n == 1 else np.stack(self._dirs)
         return self._maps, s.pose[:, :2], dirs, s.ranges, self.world.sensors.range
 
-    def aims(self, s: _Sensed, frames: list[perception.Frame],
-             sighted: list[movers.Seen] | None = None,
-             near: list[np.ndarray] | None = None) -> list[perception.Aim]:
-        """Each robot's :class:`.perception.Aim` at tick ``s``, its map cleared
-        (:meth:`clearing`): where it is on its route, its map marked from its readings (and
-        its route replanned if need be) and what its pursuit point keeps clear of (runs in
-        lockstep find their pursuit points together); ``frames``: where they are on their
-        routes (:meth:`framing`); ``sighted``: :func:`.movers.sightings` of what it is
-        :meth:`watching` (runs in lockstep see theirs together; ``None``: seen here);
-        ``near``: what each robot's map holds within its lookahead and least clearance
-        (:meth:`.knowledge.RobotMap.near`; runs in lockstep ask together, ``None``: asked
-        here)."""
+    def tracked(self, s: _Sensed, sighted: list[movers.Seen] | None = None) -> None:
+        """Each robot's map marked from its readings at tick ``s`` and what it sees that the
+        map does not show followed (:meth:`watching`): the beams it kept
+        (:class:`.movers.FreeSpace`) and its tracks brought up to ``s``
+        (:func:`.movers.follow_all`); ``sighted``: :func:`.movers.sightings` of what the
+        robots that follow something see (runs in lockstep see and follow theirs together,
+        :meth:`Batch.tracked`; ``None``: seen here)."""
         if sighted is None:
             spaces, *looks = self.watching(s)
             sighted = movers.sightings(spaces, s.t, *looks)
+        if self.world.replan == "never":
+            return
+        for i in range(self.n):
+            self._free[i].update(s.t, s.pose[i, :2], self._dirs[i], s.ranges[i])
+        movers.follow_all([self._trackers[i] for i in self._watched[2]], s.t, sighted)
+
+    def aims(self, s: _Sensed, frames: list[perception.Frame],
+             near: list[np.ndarray] | None = None) -> list[perception.Aim]:
+        """Each robot's :class:`.perception.Aim` at tick ``s``, its map cleared
+        (:meth:`clearing`) and marked and its tracks followed (:meth:`tracked`): where it is
+        on its route (its route replanned if need be) and what its pursuit point keeps clear
+        of (runs in lockstep find their pursuit points together); ``frames``: where they are
+        on their routes (:meth:`framing`); ``near``: what each robot's map holds within its
+        lookahead and least clearance (:meth:`.knowledge.RobotMap.near`; runs in lockstep
+        ask together, ``None``: asked here)."""
         _, learned, follows = self._watched
-        sights: list[movers.Seen | None] = [None] * self.n
-        for i, got in zip(follows, sighted):
-            sights[i] = got
         routes, out = self._routes, []
         for i in range(self.n):
             f = frames[i]
             rmap = self._maps[i]
-            sweep = self._sweep(i, s, sights[i])
+            sweep = self._sweep(i, s) if i in follows else None
             if (learned[i] or sweep is not None or rmap.refuge is not None) and self._active[i]:
                 route = knowledge.replan(rmap, routes[i], f.s, s.pose[i, :2],
                                          self.world.agents[i].goal, s.t, *self._asked[i],
@@ -887,19 +895,12 @@ class Simulation:
         return ([self._free[i] for i in follows], s.pose[pick, :2], s.ranges[pick], dirs[pick],
                 seen[pick])
 
-    def _sweep(self, i: int, s: _Sensed, sighted: movers.Seen | None) -> movers.Sweep | None:
-        """Robot ``i``'s tracks of what its readings show and its map does not, brought up
-        to tick ``s`` (:mod:`.movers`; ``sighted``: what :meth:`watching` saw, ``None`` when
-        it follows nothing), and where the movers among them will pass while it gets out of
-        their way (``None`` when nothing comes toward it)."""
-        if self.world.replan == "never":
-            return None
-        p, dirs = s.pose[i, :2], self._dirs[i]
+    def _sweep(self, i: int, s: _Sensed) -> movers.Sweep | None:
+        """Where the movers among the tracks robot ``i`` follows (brought up to tick ``s``,
+        :meth:`tracked`) will pass while it gets out of their way (``None`` when nothing
+        comes toward it)."""
+        p = s.pose[i, :2]
         rmap, tracker = self._maps[i], self._trackers[i]
-        self._free[i].update(s.t, p, dirs, s.ranges[i])
-        if sighted is None:                                  # nothing to follow
-            return None
-        tracker.follow(s.t, *sighted)
         if not any(tr.mover for tr in tracker.tracks):          # nothing it follows moves
             return None
         h = float(self._h[i])
@@ -1144,6 +1145,7 @@ class Batch:
         self._trackers = [t for run in runs for t in run._trackers]
         self._spaces = [f for run in runs for f in run._free]
         self._seen = np.zeros((0, 0), dtype=bool)
+        self._watching = np.zeros(0, dtype=np.intp)         # the rows that follow something
         self._limits: kinematics.Limits | None = None
         self._fleet = safety.Fleet.joined([run._fleet for run in runs])
         # the tick observed last (:meth:`sensed`): its runs' ticks, x, y and heading, readings,
@@ -1197,6 +1199,17 @@ class Batch:
             run._seen = rows_[a:b]
         return seen
 
+    def tracked(self, sighted: list[movers.Seen]) -> None:
+        """:meth:`Simulation.tracked` of every run once they are :meth:`watching`
+        (``sighted``: what the robots that follow something see, in row order): every
+        robot's beams kept, the tracks of all followed in one :func:`.movers.follow_all`."""
+        if not self._follows:
+            return
+        got, t = self.got, self.ticks[0].t
+        for space, p, dirs, ranges in zip(self._spaces, self.at, got.dirs, got.ranges):
+            space.update(t, p, dirs, ranges)
+        movers.follow_all([self._trackers[i] for i in self._watching.tolist()], t, sighted)
+
     def watching(self, learned: list[list[bool]]) -> tuple[list[movers.FreeSpace], np.ndarray,
                                                             np.ndarray, np.ndarray, np.ndarray,
                                                             np.ndarray]:
@@ -1210,7 +1223,7 @@ class Batch:
                      | np.logical_or.reduce(self._seen, axis=1)).tolist()
         for run, s, (a, b), mine in zip(self.runs, self.ticks, self.spans, learned):
             run._watched = (s, mine, [i for i in range(b - a) if flags[a + i]])
-        rows = np.flatnonzero(flags)
+        self._watching = rows = np.flatnonzero(flags)
         got = self.got
         return ([self._spaces[i] for i in rows.tolist()], rows, self.at[rows], got.ranges[rows],
                 got.dirs[rows], self._seen[rows])

@@ -255,29 +255,25 @@ class Tracker:
         """Match the objects seen at time ``now`` (centres ``[O, 2]``, half sizes ``[O]``;
         ``moved``: whether each has an echo in space a beam had passed through) to the
         tracks (nearest first, each track and object once), start a track for each object
-        left, drop stale tracks."""
-        live = [tr for tr in self.tracks if now - tr.times[-1] <= MAX_MISS]
-        if not len(centres):
-            self.tracks = live
-            return
+        left, drop stale tracks (:func:`follow_all` of one)."""
+        follow_all([self], now, [(centres, radii, moved)])
+
+    def _match(self, now: float, live: list[Track], centres: np.ndarray, radii: np.ndarray,
+               moved: list[bool | None], apart: list[float], order: list[int]) -> None:
+        """:meth:`follow` with the live tracks' distances to the objects ``apart`` (row-major
+        ``[T * O]``) and their order, nearest first."""
         half = radii.tolist()
         used_t: set[int] = set()
         used_o: set[int] = set()
-        if live:
-            pred = (live[0].predicted(now)[None] if len(live) == 1 else          # [T, 2]
-                    np.concatenate([tr.predicted(now) for tr in live]).reshape(-1, 2))
-            apart_xy = pred[:, None] - centres[None]                                # [T, O, 2]
-            d = np.hypot(apart_xy[..., 0], apart_xy[..., 1]).ravel()
-            apart = d.tolist()                                           # [T * O], row-major
-            for k in d.argsort(kind="stable").tolist():          # nearest first, each once
-                if not apart[k] <= GATE:         # the rest lie farther (NaN sorts last)
-                    break
-                j, i = divmod(k, len(half))
-                if j in used_t or i in used_o:
-                    continue
-                used_t.add(j)
-                used_o.add(i)
-                self._sighted(live[j], now, centres[i], half[i], moved[i])
+        for k in order:                                          # nearest first, each once
+            if not apart[k] <= GATE:             # the rest lie farther (NaN sorts last)
+                break
+            j, i = divmod(k, len(half))
+            if j in used_t or i in used_o:
+                continue
+            used_t.add(j)
+            used_o.add(i)
+            self._sighted(live[j], now, centres[i], half[i], moved[i])
         taken = None
         for i in range(len(half)):           # (an object by a track is a piece of its object)
             if i in used_o or 2 * half[i] > MAX_EXTENT:
@@ -330,6 +326,50 @@ class Tracker:
                 continue
             out.append(Mover(centre, v, tr.radius, now - tr.born >= SETTLE))
         return out
+
+
+def follow_all(trackers: Sequence[Tracker], now: float, seen: Sequence[Seen]) -> None:
+    """:meth:`Tracker.follow` of every tracker with what it saw (``seen``, as
+    :func:`sightings` gives it): the distances from the live tracks to the objects of all
+    at once (:func:`_apart`), the matching tracker by tracker."""
+    lives = [[tr for tr in t.tracks if now - tr.times[-1] <= MAX_MISS] for t in trackers]
+    apart, order, pairs = _apart(lives, seen, now)
+    start = 0
+    for tracker, live, (centres, radii, moved), n in zip(trackers, lives, seen, pairs):
+        if not len(centres):
+            tracker.tracks = live
+            continue
+        tracker._match(now, live, centres, radii, moved, apart[start:start + n],
+                       [k - start for k in order[start:start + n]])
+        start += n
+
+
+def _apart(lives: list[list[Track]], seen: Sequence[Seen], now: float
+           ) -> tuple[list[float], list[int], list[int]]:
+    """The distances from each tracker's live tracks (``lives``), where they should be by
+    ``now``, to its objects (``seen``), row-major ``[T * O]`` a tracker, one tracker after
+    the other, each the bits of its own; their order, nearest first, tracker by tracker (one
+    stable sort by tracker and distance: NaN last, as the tracker's own stable argsort);
+    and how many each tracker has."""
+    sizes = np.array([len(live) if len(got[0]) else 0 for live, got in zip(lives, seen)])
+    objects = np.array([len(got[0]) for got in seen])
+    pairs = sizes * objects
+    if not pairs.any():
+        return [], [], pairs.tolist()
+    pred = np.concatenate([tr.predicted(now) for live, t in zip(lives, sizes.tolist()) if t
+                           for tr in live]).reshape(-1, 2)                   # [T, 2]
+    if len(seen) == 1:                                          # (one: no pairs to lay out)
+        gap = pred[:, None] - seen[0][0][None]
+        d = np.hypot(gap[..., 0], gap[..., 1]).ravel()
+        return d.tolist(), d.argsort(kind="stable").tolist(), pairs.tolist()
+    owner = np.repeat(np.arange(len(seen)), pairs)
+    k = np.arange(len(owner)) - (np.cumsum(pairs) - pairs)[owner]       # row-major, each
+    per = objects[owner]
+    track = (np.cumsum(sizes) - sizes)[owner] + k // per
+    thing = (np.cumsum(objects) - objects)[owner] + k % per
+    gap = pred[track] - np.concatenate([got[0] for got in seen])[thing]
+    d = np.hypot(gap[:, 0], gap[:, 1])
+    return d.tolist(), np.lexsort((d, owner)).tolist(), pairs.tolist()
 
 
 @dataclass
