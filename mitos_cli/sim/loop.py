@@ -386,6 +386,11 @@ class Simulation:
         # width and its margin (else none)
         self._squeeze = [least if least < r.width / 2 + r.safety_margin else math.inf
                          for r, (_, least) in zip(self.robots, self._asked)]
+        # each robot's row of Sights: its beams' spacing, news threshold, least clearance
+        # and squeeze (Simulation.aimed)
+        self._sighting = (np.full(self.n, self._spacing), np.full(self.n, self._threshold),
+                          np.array([least for _, least in self._asked]),
+                          np.array(self._squeeze))
         self._safety = safety.Settings()
         self._brake_reach = [safety.reach_of(r, self.dt, self._safety, sen.range)
                              for r in self.robots]
@@ -812,13 +817,11 @@ class Simulation:
         work both out together, :meth:`Batch.aimed`)."""
         if gaps is None:
             gaps = perception.route_gaps(aims)
-        n = self.n
-        dirs, expected = ((self._dirs[0][None], self._expected[0][None]) if n == 1
+        dirs, expected = ((self._dirs[0][None], self._expected[0][None]) if self.n == 1
                           else (np.stack(self._dirs), np.stack(self._expected)))
-        return _sights(aims, self.robots, s.pose, dirs, s.ranges, expected,
-                       np.full(n, self._spacing),
-                       np.full(n, self._threshold), np.array([a[1] for a in self._asked]),
-                       self.accounted(s), targets, gaps, np.array(self._squeeze))
+        spacing, threshold, least, squeeze = self._sighting
+        return _sights(aims, self.robots, s.pose, dirs, s.ranges, expected, spacing, threshold,
+                       least, self.accounted(s), targets, gaps, squeeze)
 
     def accounted(self, s: _Sensed) -> np.ndarray:
         """``[n, B]``: which readings at tick ``s`` hit cells the robots' routes were planned
@@ -1137,9 +1140,8 @@ class Batch:
                                  for run in runs for _, least in run._asked])
         # (Simulation.aimed)
         self._robots = [r for run in runs for r in run.robots]
-        self._least = np.array([least for run in runs for _, least in run._asked])
-        self._spacing = np.array([run._spacing for run in runs for _ in range(run.n)])
-        self._squeeze = np.array([q for run in runs for q in run._squeeze])
+        self._spacing, _, self._least, self._squeeze = (
+            np.concatenate([run._sighting[j] for run in runs]) for j in range(4))
         # (Simulation.watching)
         self._follows = runs[0].world.replan != "never"
         self._trackers = [t for run in runs for t in run._trackers]

@@ -351,25 +351,26 @@ def _apart(lives: list[list[Track]], seen: Sequence[Seen], now: float
     the other, each the bits of its own; their order, nearest first, tracker by tracker (one
     stable sort by tracker and distance: NaN last, as the tracker's own stable argsort);
     and how many each tracker has."""
-    sizes = np.array([len(live) if len(got[0]) else 0 for live, got in zip(lives, seen)])
-    objects = np.array([len(got[0]) for got in seen])
-    pairs = sizes * objects
-    if not pairs.any():
-        return [], [], pairs.tolist()
-    pred = np.concatenate([tr.predicted(now) for live, t in zip(lives, sizes.tolist()) if t
+    objects = [len(got[0]) for got in seen]
+    sizes = [len(live) if o else 0 for live, o in zip(lives, objects)]
+    pairs = [t * o for t, o in zip(sizes, objects)]
+    if not any(pairs):
+        return [], [], pairs
+    pred = np.concatenate([tr.predicted(now) for live, t in zip(lives, sizes) if t
                            for tr in live]).reshape(-1, 2)                   # [T, 2]
     if len(seen) == 1:                                          # (one: no pairs to lay out)
         gap = pred[:, None] - seen[0][0][None]
         d = np.hypot(gap[..., 0], gap[..., 1]).ravel()
-        return d.tolist(), d.argsort(kind="stable").tolist(), pairs.tolist()
-    owner = np.repeat(np.arange(len(seen)), pairs)
-    k = np.arange(len(owner)) - (np.cumsum(pairs) - pairs)[owner]       # row-major, each
-    per = objects[owner]
-    track = (np.cumsum(sizes) - sizes)[owner] + k // per
-    thing = (np.cumsum(objects) - objects)[owner] + k % per
+        return d.tolist(), d.argsort(kind="stable").tolist(), pairs
+    counts, size, many = np.array(pairs), np.array(sizes), np.array(objects)
+    owner = np.repeat(np.arange(len(seen)), counts)
+    k = np.arange(len(owner)) - (np.cumsum(counts) - counts)[owner]     # row-major, each
+    per = many[owner]
+    track = (np.cumsum(size) - size)[owner] + k // per
+    thing = (np.cumsum(many) - many)[owner] + k % per
     gap = pred[track] - np.concatenate([got[0] for got in seen])[thing]
     d = np.hypot(gap[:, 0], gap[:, 1])
-    return d.tolist(), np.lexsort((d, owner)).tolist(), pairs.tolist()
+    return d.tolist(), np.lexsort((d, owner)).tolist(), pairs
 
 
 @dataclass
