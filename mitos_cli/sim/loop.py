@@ -830,7 +830,8 @@ class Simulation:
         :func:`.knowledge.accounted_all`)."""
         kept = np.zeros(s.ranges.shape, dtype=bool)
         if self.world.replan == "clearance":
-            kept[:] = [self._maps[i].accounted_cells(self._beyond(i, s)) for i in range(self.n)]
+            for i in range(self.n):
+                kept[i] = self._maps[i].accounted_cells(self._beyond(i, s))
         return kept
 
     def perceived(self, s: _Sensed, sights: perception.Sights,
