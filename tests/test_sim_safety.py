@@ -476,3 +476,26 @@ def test_a_fleets_sweeps_measured_together_are_each_robots_alone():
                              float(fleet.radius[i]), 0.0, float(fleet.reach[i]))
                  .free(float(wheel[i]), bool(back[i]), fleet.cfg) for i in rows]
         assert fleet.free(rows, x, y, h, wheel, back, cells).tolist() == alone
+
+
+def test_fleets_joined_are_the_fleet_of_all_their_robots():
+    """:meth:`safety.Fleet.joined` (the rows joined, as a batch joins its runs') holds every
+    array the fleet of all the robots works out, to the bit."""
+    rng = np.random.default_rng(7)
+    parts = [_fleet_case(rng, int(n))[0] for n in (1, 3, 2)]
+    joined = safety.Fleet.joined(parts)
+    whole = safety.Fleet([r for f in parts for r in f.robots],
+                         np.concatenate([f.radius for f in parts]).tolist(),
+                         np.concatenate([f.reach for f in parts]).tolist(), 0.05)
+    assert joined.robots == whole.robots and (joined.dt, joined.cfg) == (whole.dt, whole.cfg)
+    names = [k for k, v in vars(whole).items() if isinstance(v, np.ndarray)]
+    assert sorted(names) == sorted(safety._FLEET_ROWS)
+    for name in names:
+        assert getattr(joined, name).tobytes() == getattr(whole, name).tobytes(), name
+
+
+def test_the_brake_of_one_robot_is_a_python_float():
+    """:func:`safety.brake` of floats is a float (the fleet's arrays have their own)."""
+    limit = safety.brake(30.0, 40.0, 2.0, 0.05)
+    assert type(limit) is float and limit == safety._brakes(np.array([30.0]), np.array([40.0]),
+                                                             2.0, 0.05)[0]

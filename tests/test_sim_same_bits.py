@@ -546,8 +546,7 @@ def test_robots_aim_together_with_the_bits_they_get_alone(name):
     aims = []
     for sim in sims:
         s = sim.sense()
-        sim.tracked(s)
-        aims += sim.aims(s, perception.frames(*sim.framing(s)))
+        aims += sim.aims(s, perception.frames(*sim.framing(s)))   # (tracked first by itself)
     cfg = sims[0].settings
     rng = np.random.default_rng(3)
     # rows with no cells, with few and with many (padding of every width), in any order
@@ -1119,3 +1118,15 @@ def test_objects_of_many_rows_at_once_are_each_rows_own():
             want = _object_alone(routes[j], frames[j], a[j], points[j], ahead[j], blocking[j],
                                  widen[j], float(length[j]), cfg)
             assert same([got[0][j], got[1][j], got[2][j]], list(want)), (k, j)
+
+
+def test_a_call_of_aimed_with_the_lookaheads_it_no_longer_takes_is_refused():
+    """``Simulation.aimed`` once took the lookaheads before the targets; a call written so
+    is refused at once (``gaps`` is by name), not read as targets and gaps."""
+    sim = running("slalom.yaml")[0]
+    s = sim.sense()
+    aims = sim.aims(s, perception.frames(*sim.framing(s)))
+    ahead, targets = perception.pursuit_points(aims, sim.settings)
+    with pytest.raises(TypeError):
+        sim.aimed(s, aims, ahead, targets)
+    assert sim.aimed(s, aims, targets).target.tobytes() == targets.tobytes()

@@ -5,22 +5,23 @@ beams, noise from each robot's own stream, clearance), the marks they see throug
 from their maps in one pass (:func:`.knowledge.clear_all`), the cells their echoes came from
 found in one pass (:func:`.knowledge.beyond_cells`), their maps marked from them in one pass
 (:func:`.knowledge.mark_all`), what they see that their maps do not show cut into objects and
-tested against the beams they kept in one pass (:func:`.movers.sightings`), the cells near
-them on their maps found in one pass (:func:`.knowledge.near_all`), their readings looked up
-where their routes were planned in one pass (:func:`.knowledge.accounted_all`), their pursuit
-points found in one pass (:func:`.perception.pursuit_points`) and their rule inputs perceived
-in one pass (:func:`.perception.perceive_all`) and checked (contact, arrival) in one pass;
-what else a robot's own map and route need (following its tracks, replanning) is done run by
-run, with the code of a run alone (:class:`~mitos_cli.sim.loop.Simulation`). Then the fuzzy
-planner's rule network is evaluated once for the active robots of every run (one engine
-batch: the engine gives each row the bits it gives alone), the brake of every robot of every
-run checks its command in one pass (:meth:`.safety.Fleet.guard`: the first sweeps measured
-together, most commands decided with arrays), every run's tick is recorded and judged in one
-pass, and the robots of every run move in one batch of kinematics (elementwise per robot).
-The bookkeeping done once for all runs is :class:`~mitos_cli.sim.loop.Batch`'s; each run's
-arrays are views of the batch's. Runs that end drop out. Every batched stage is elementwise
-per robot or an exact minimum, so each run's ticks, trajectory and summary are bit for bit
-those of the same run alone, whatever the batch (``tests/test_sim_lockstep.py``,
+tested against the beams they kept in one pass (:func:`.movers.sightings`) and their tracks
+followed in one pass (:func:`.movers.follow_all`), the cells near them on their maps found in
+one pass (:func:`.knowledge.near_all`), their readings looked up where their routes were
+planned in one pass (:func:`.knowledge.accounted_all`), their pursuit points found in one
+pass (:func:`.perception.pursuit_points`) and their rule inputs perceived in one pass
+(:func:`.perception.perceive_all`) and checked (contact, arrival) in one pass; what else a
+robot's own route needs (replanning) is done run by run, with the code of a run alone
+(:class:`~mitos_cli.sim.loop.Simulation`). Then the fuzzy planner's rule network is
+evaluated once for the active robots of every run (one engine batch: the engine gives each
+row the bits it gives alone), the brake of every robot of every run checks its command in
+one pass (:meth:`.safety.Fleet.guard`: the first sweeps measured together, most commands
+decided with arrays), every run's tick is recorded and judged in one pass, and the robots of
+every run move in one batch of kinematics (elementwise per robot). The bookkeeping done once
+for all runs is :class:`~mitos_cli.sim.loop.Batch`'s; each run's arrays are views of the
+batch's. Runs that end drop out. Every batched stage is elementwise per robot or an exact
+minimum, so each run's ticks, trajectory and summary are bit for bit those of the same run
+alone, whatever the batch (``tests/test_sim_lockstep.py``,
 ``tests/test_sim_same_bits.py``)."""
 
 from __future__ import annotations

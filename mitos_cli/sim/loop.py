@@ -536,11 +536,6 @@ class Simulation:
         self._observed = s
 
     @property
-    def brake_settings(self) -> safety.Settings:
-        """The settings of its robots' brake and backing out."""
-        return self._safety
-
-    @property
     def settings(self) -> perception.Settings:
         """The perception settings its robots perceive with."""
         return self._cfg
@@ -757,12 +752,12 @@ class Simulation:
         return self._maps, s.pose[:, :2], dirs, s.ranges, self.world.sensors.range
 
     def tracked(self, s: _Sensed, sighted: list[movers.Seen] | None = None) -> None:
-        """Each robot's map marked from its readings at tick ``s`` and what it sees that the
-        map does not show followed (:meth:`watching`): the beams it kept
-        (:class:`.movers.FreeSpace`) and its tracks brought up to ``s``
-        (:func:`.movers.follow_all`); ``sighted``: :func:`.movers.sightings` of what the
-        robots that follow something see (runs in lockstep see and follow theirs together,
-        :meth:`Batch.tracked`; ``None``: seen here)."""
+        """What each robot sees at tick ``s`` that its map does not show, followed: the beams
+        it kept (:class:`.movers.FreeSpace`) and its tracks brought up to ``s``
+        (:func:`.movers.follow_all`). ``sighted``: :func:`.movers.sightings` of what the
+        robots that follow something see, their maps marked (:meth:`watching`; runs in
+        lockstep mark, see and follow theirs together, :meth:`Batch.tracked`); ``None``:
+        the maps are marked and the sightings seen here."""
         if sighted is None:
             spaces, *looks = self.watching(s)
             sighted = movers.sightings(spaces, s.t, *looks)
@@ -781,6 +776,8 @@ class Simulation:
         on their routes (:meth:`framing`); ``near``: what each robot's map holds within its
         lookahead and least clearance (:meth:`.knowledge.RobotMap.near`; runs in lockstep
         ask together, ``None``: asked here)."""
+        if self._watched[0] is not s:               # not yet tracked at this tick
+            self.tracked(s)
         _, learned, follows = self._watched
         routes, out = self._routes, []
         for i in range(self.n):
@@ -808,7 +805,7 @@ class Simulation:
                                       least + self._cfg.lookahead_room))
         return out
 
-    def aimed(self, s: _Sensed, aims: list[perception.Aim], targets: np.ndarray,
+    def aimed(self, s: _Sensed, aims: list[perception.Aim], targets: np.ndarray, *,
               gaps: list[float] | None = None) -> perception.Sights:
         """The robots' sights from their :meth:`aims` and their pursuit points ``targets
         [n, 2]``: what each keeps clear of (``gaps``: their :func:`.perception.route_gaps`,

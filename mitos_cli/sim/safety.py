@@ -424,11 +424,19 @@ def _path(reach: float, step: float, backward: bool) -> np.ndarray:
     return out
 
 
-def brake(free, acceleration, margin: float, dt: float = 0.0):
+def brake(free: float, acceleration: float, margin: float, dt: float = 0.0) -> float:
     """The fastest (in/s) a robot may drive that can stop at ``acceleration`` within ``free``
     inches less ``margin`` when it drives on at that speed for ``dt`` before it brakes (the
-    command it is given now is carried out for a tick: ``v dt + v^2 / 2a`` is the room).
-    Floats, or arrays of robots (:meth:`Fleet.guard`): the same bits."""
+    command it is given now is carried out for a tick: ``v dt + v^2 / 2a`` is the room)."""
+    lag = acceleration * dt
+    return math.sqrt(lag * lag + 2.0 * acceleration * max(free - margin, 0.0)) - lag
+
+
+def _brakes(free: np.ndarray, acceleration: np.ndarray, margin: float,
+            dt: float) -> np.ndarray:
+    """:func:`brake` of many robots at once, elementwise: the same bits (a square root is
+    correctly rounded in NumPy as in :mod:`math`, and ``np.maximum(a, b)`` is ``max(a, b)``,
+    ties and NaN alike)."""
     lag = acceleration * dt
     return np.sqrt(lag * lag + 2.0 * acceleration * np.maximum(free - margin, 0.0)) - lag
 
@@ -485,8 +493,8 @@ def guard(command: tuple[float, float], body: Body, rec: Recovery, dt: float,
     on allows, and a robot held ``patience`` seconds against its planner's wish backs out
     (on the lock that swings its nose toward its route, else straight), if it has the room.
     ``rec`` is updated. ``known``: the first sweep already measured (wheel, backward, free
-    travel: :func:`first_sweep`'s for ``command``, ``body`` and ``rec``, by
-    :func:`free_travels` with other robots'), whose wheel is not worked out again."""
+    travel: :func:`first_sweep`'s for ``command``, ``body`` and ``rec``, measured with other
+    robots' by :meth:`Fleet.guard`), whose wheel is not worked out again."""
     robot = body.robot
 
     def free(wheel: float, backward: bool) -> float:
@@ -553,12 +561,17 @@ def rest(n: int) -> np.ndarray:
     return np.tile([calm.held, calm.left, calm.wheel], (n, 1))
 
 
+#: The arrays of a :class:`Fleet`, a row per robot.
+_FLEET_ROWS = ("radius", "reach", "brakes", "wheelbase", "half", "hl", "hw", "straight", "lo",
+               "hi", "turn", "acceleration", "reverse", "squares", "disc", "far")
+
+
 class Fleet:
     """Robots a guard keeps, a row each, and what of them stays from tick to tick: each one's
     :class:`~.world.Robot`, the half side of its map's cells (``radius``) and how far its
     brake looks (``reach``, :func:`reach_of`), with what :func:`guard` and :func:`_sweep_of`
-    work out of them, as arrays ``[N]``. A run holds one of its robots; runs in lockstep, one
-    of the robots of all of them."""
+    work out of them, as arrays ``[N]``. A run holds one fleet of its robots; runs in
+    lockstep join theirs into one (:meth:`joined`)."""
 
     def __init__(self, robots: list[Robot], radius: list[float], reach: list[float], dt: float,
                  cfg: Settings = Settings()) -> None:
@@ -588,11 +601,15 @@ class Fleet:
 
     @classmethod
     def joined(cls, fleets: list[Fleet]) -> Fleet:
-        """The robots of ``fleets``, one fleet after the other (of one ``dt`` and settings)."""
-        return cls([r for f in fleets for r in f.robots],
-                   np.concatenate([f.radius for f in fleets]).tolist(),
-                   np.concatenate([f.reach for f in fleets]).tolist(), fleets[0].dt,
-                   fleets[0].cfg)
+        """The robots of ``fleets``, one fleet after the other (of one ``dt`` and settings):
+        their rows joined, not worked out again (a batch joins its runs' fleets whenever a
+        run drops out)."""
+        out = cls.__new__(cls)
+        out.robots = tuple(r for f in fleets for r in f.robots)
+        out.dt, out.cfg = fleets[0].dt, fleets[0].cfg
+        for name in _FLEET_ROWS:
+            setattr(out, name, np.concatenate([getattr(f, name) for f in fleets]))
+        return out
 
     def guard(self, rows: np.ndarray, command: np.ndarray, state: np.ndarray,
               now: tuple[np.ndarray, ...], cells: list[np.ndarray]) -> list[int]:
@@ -616,7 +633,7 @@ class Fleet:
         back = backing | (want < 0)
         free = self.free(rows, x, y, h, turned, back, cells)
         acceleration = self.acceleration[rows]
-        limit = brake(free, acceleration, cfg.margin, dt)
+        limit = _brakes(free, acceleration, cfg.margin, dt)
         slowest = np.maximum(np.abs(speed) - acceleration * dt, 0.0)
         held = np.where((np.abs(want) > cfg.want) & (limit < cfg.want), held + dt, 0.0)
         hard = (backing | ((limit < slowest) & (turned != wheel))
