@@ -60,6 +60,17 @@ def test_runs_that_end_at_different_ticks_drop_out_and_the_rest_go_on():
         assert_same_run(a, b)
 
 
+def test_finished_gives_each_run_as_it_ends_with_its_bits_alone():
+    world = load_world(TINY)
+    planner, scene = FuzzyPlanner(None, world.behavior), prepare(world)
+    seeds = [3, 5, 8]
+    got = list(Lockstep(world, planner, seeds, randomise=True, scene=scene).finished())
+    assert sorted(i for i, _ in got) == [0, 1, 2]
+    assert [res.ticks for _, res in got] == sorted(res.ticks for _, res in got)  # as they end
+    for i, res in got:
+        assert_same_run(simulate(world, planner, seeds[i], randomise=True, scene=scene), res)
+
+
 @pytest.mark.parametrize("name", ["potential_field", "dwa"])   # dwa: with the route ahead
 def test_a_planner_other_than_the_fuzzy_one_plans_each_run_itself(name):
     world = dataclasses.replace(load_world(TINY), time_limit=1.0)

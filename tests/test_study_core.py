@@ -5,13 +5,14 @@ from __future__ import annotations
 import functools
 import math
 import zlib
+from pathlib import Path
 
 import numpy as np
 import pytest
 
 from mitos_cli.errors import MitosError
 from mitos_cli.study import Study, make_choices, run_study
-from mitos_cli.study.executors import chunks, execute
+from mitos_cli.study.executors import chunks, execute, lockstep_chunks
 from mitos_cli.study.spec import Choice, expand, split_list, task_seeds
 from mitos_cli.study.stats import mean_interval, t_cdf, t_quantile, wilson
 from mitos_cli.study.store import ResultStore, StudyError
@@ -118,6 +119,47 @@ def test_chunks_cover_every_task_once():
     tasks = expand(["w"], [Choice("potential_field")], 100, 0)
     parts = chunks(tasks, 2)
     assert [t for p in parts for t in p] == tasks and max(map(len, parts)) <= 8
+
+
+def test_lockstep_chunks_keep_one_world_and_choice_each_and_cover_every_task_once():
+    tasks = expand(["a", "b"], make_choices(["fuzzy", "potential_field"], ["min"], [], []),
+                   100, 0)
+    for workers, most in ((1, 64), (2, 64), (3, 16)):
+        parts = lockstep_chunks(tasks, workers, most)
+        assert sorted(t.index for p in parts for t in p) == list(range(len(tasks)))
+        assert all(len({(t.world, t.choice) for t in p}) == 1 for p in parts)
+        assert max(map(len, parts)) == min(most, math.ceil(100 / workers))
+        assert [p[0].index for p in parts] == sorted(p[0].index for p in parts)
+
+
+def test_the_simulator_steps_a_chunk_together_with_each_task_s_bits_alone(tmp_path):
+    from mitos_cli.study.simtask import StudyContext, run_task, run_tasks
+
+    world = tmp_path / "tiny.yaml"
+    world.write_text((Path(__file__).parent / "data" / "tiny.yaml").read_text())
+    tasks = expand([str(world)], make_choices(["fuzzy", "potential_field"], ["min", "product"],
+                                               [], []), 3, 5)
+    context = StudyContext()
+    together = dict(run_tasks(context, tasks))
+    assert sorted(t.index for t in together) == [t.index for t in tasks]
+    for task in tasks:
+        assert together[task] == run_task(context, task)
+
+
+def _parts(n: int):
+    for i in range(n):
+        if n == 3 and i == 1:
+            raise Crash("killed")
+        yield n, i
+
+
+def test_a_streaming_pool_gives_every_part_as_made_and_raises_a_worker_s_error():
+    from mitos_cli.sim.runs import pool_streaming
+
+    got = sorted(pool_streaming(_parts, [1, 2, 4], 2, 7))
+    assert got == [(1, 0), (2, 0), (2, 1), (4, 0), (4, 1), (4, 2), (4, 3)]
+    with pytest.raises(Crash, match="killed"):
+        list(pool_streaming(_parts, [1, 3, 2], 2, 6))
 
 
 # -- executors, store, resume --------------------------------------------------------------

@@ -27,7 +27,7 @@ alone, whatever the batch (``tests/test_sim_lockstep.py``,
 from __future__ import annotations
 
 import itertools
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 
 import numpy as np
 
@@ -105,6 +105,19 @@ class Lockstep:
         while not self.done:
             self.step()
         return [run.result() for run in self.runs]
+
+    def finished(self) -> Iterator[tuple[int, SimResult]]:
+        """Step until every run has ended, giving each run's place among the seeds and its
+        :class:`SimResult` the tick it ends (a progress bar moves, a study writes it down)."""
+        given = [False] * len(self.runs)
+        while True:
+            for i, run in enumerate(self.runs):
+                if run.done and not given[i]:
+                    given[i] = True
+                    yield i, run.result()
+            if all(given):
+                return
+            self.step()
 
     def _commands(self, live: list[Simulation], blocks: np.ndarray,
                   active: np.ndarray) -> np.ndarray | None:

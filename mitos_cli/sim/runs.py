@@ -8,17 +8,19 @@ not depend on the number of workers or on which worker ran what.
 
 from __future__ import annotations
 
+import contextlib
 import math
 import operator
 import os
 from collections import Counter
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
 from ..errors import InputError
-from .lockstep import run_lockstep
+from .lockstep import BATCH, Lockstep
 from .loop import OUTCOMES, ROBOT_OUTCOMES, check_seed, shared_scene
 from .world import World
 
@@ -28,14 +30,13 @@ METRICS = ("time_s", "path_length_in", "min_clearance_in", "mean_speed_in_s",
            "steering_total_variation_deg", "replans", "backouts")
 
 
-def _chunk(task: tuple) -> tuple[int, list[dict]]:
-    """One worker's runs of a world, stepped in lockstep (:mod:`.lockstep`: each run's bits
-    are those it has alone)."""
+def _chunk_runs(task: tuple) -> Iterator[tuple[int, int, dict]]:
+    """One chunk's runs of a world, stepped in lockstep (:mod:`.lockstep`: each run's bits
+    are those it has alone): ``(chunk, place in the chunk, summary)`` as each run ends."""
     index, world, planner, seeds, randomise, measure, scene = task
     scene = scene if scene is not None else shared_scene(world, randomise)
-    return index, [{**res.summary(), **(measure(res) if measure is not None else {})}
-                   for res in run_lockstep(world, planner, seeds, randomise=randomise,
-                                           scene=scene)]
+    for j, res in Lockstep(world, planner, seeds, randomise=randomise, scene=scene).finished():
+        yield index, j, {**res.summary(), **(measure(res) if measure is not None else {})}
 
 
 def ignore_interrupts() -> None:
@@ -151,23 +152,24 @@ def run_many(worlds: list[World], runs: int = 0, seed: int | None = None, planne
     for w in worlds:
         base = w.seed if seed is None else seed
         seeds = [base] if runs <= 0 else [base + j for j in range(runs)]
-        # about 8 chunks a worker, so that a progress bar moves; a world cut into several
+        # each worker's share in lockstep batches of up to BATCH runs (a batch of 5 runs costs
+        # about twice what a batch of 40 does a robot-tick); a world cut into several
         # chunks has its map and routes prepared once, here, and sent along (a grid map's
         # route search costs about as much as a run), unless its draws move what the robots
         # are given (shared_scene)
-        size = max(1, math.ceil(len(seeds) / (8 * workers)))
+        size = max(1, min(BATCH, math.ceil(len(seeds) / workers)))
         scene = shared_scene(w, runs > 0) if len(seeds) > size else None
         for i in range(0, len(seeds), size):
             tasks.append((w, tuple(seeds[i:i + size]), scene))
     jobs = [(k, w, planner, chunk, runs > 0, measure, scene)
             for k, (w, chunk, scene) in enumerate(tasks)]
     total = sum(len(chunk) for _, chunk, _ in tasks)
-    results: list[list[dict] | None] = [None] * len(jobs)
+    results: list[list[dict | None]] = [[None] * len(chunk) for _, chunk, _ in tasks]
     done = 0
     try:
-        for k, res in _execute(jobs, workers):
-            results[k] = res
-            done += len(res)
+        for k, j, summary in _execute(jobs, workers):
+            results[k][j] = summary
+            done += 1
             if on_progress is not None:
                 on_progress(done, total)
     except KeyboardInterrupt:
@@ -209,13 +211,15 @@ def _whole(what: str, value: object, least: int) -> int:
     return n
 
 
-def _execute(jobs: list[tuple], workers: int):
-    """``(index, summaries)`` of each chunk as it finishes: in this process, or on a pool
+def _execute(jobs: list[tuple], workers: int) -> Iterator[tuple[int, int, dict]]:
+    """``(chunk, place, summary)`` of each run as it ends: in this process, or on a pool
     that is terminated at once on Ctrl-C or an error."""
     if workers <= 1 or len(jobs) <= 1:
-        yield from map(_chunk, jobs)
+        for job in jobs:
+            yield from _chunk_runs(job)
         return
-    yield from pool_unordered(_chunk, jobs, min(workers, len(jobs)))
+    yield from pool_streaming(_chunk_runs, jobs, min(workers, len(jobs)),
+                              sum(len(job[3]) for job in jobs))
 
 
 def pool_unordered(fn, items: list, workers: int):
@@ -224,10 +228,59 @@ def pool_unordered(fn, items: list, workers: int):
     import multiprocessing
 
     pool = multiprocessing.get_context().Pool(workers, initializer=ignore_interrupts)
-    finished = False
-    try:
+    with _terminated_unless_finished(pool) as finishing:
         yield from pool.imap_unordered(fn, items)
-        finished = True
+        finishing()
+
+
+#: where a pool worker of :func:`pool_streaming` puts what its generator yields
+_outbox: Any = None
+
+
+def _streaming_worker(outbox) -> None:
+    global _outbox
+    ignore_interrupts()
+    _outbox = outbox
+
+
+def _stream(fn, item) -> None:
+    for part in fn(item):
+        _outbox.put(part)
+
+
+def pool_streaming(fn: Callable[[Any], Iterator[Any]], items: list, workers: int, expected: int):
+    """What the generator ``fn(item)`` yields, for each item, on a pool of ``workers``
+    processes, as each part is made (``expected``: how many parts there are in all); a
+    worker's error is raised here, and on Ctrl-C or an error the workers are terminated."""
+    import functools
+    import multiprocessing
+    import queue
+
+    context = multiprocessing.get_context()
+    outbox = context.Queue()
+    pool = context.Pool(workers, initializer=_streaming_worker, initargs=(outbox,))
+    with _terminated_unless_finished(pool) as finishing:
+        pending = pool.map_async(functools.partial(_stream, fn), items, chunksize=1)
+        for _ in range(expected):
+            while True:
+                try:
+                    part = outbox.get(timeout=0.1)
+                    break
+                except queue.Empty:
+                    if pending.ready() and not pending.successful():
+                        pending.get()                   # raises the worker's error
+            yield part
+        pending.get()
+        finishing()
+
+
+@contextlib.contextmanager
+def _terminated_unless_finished(pool) -> Iterator[Callable[[], None]]:
+    """``pool`` closed and joined once the caller says it finished, else terminated at once
+    (Ctrl-C or an error: its workers are not left to finish)."""
+    finished = []
+    try:
+        yield lambda: finished.append(True)
     finally:
         if finished:
             pool.close()
@@ -236,12 +289,11 @@ def pool_unordered(fn, items: list, workers: int):
         pool.join()
 
 
-def _group(worlds: list[World], tasks: list[tuple], results: list[list[dict] | None]) -> Runs:
+def _group(worlds: list[World], tasks: list[tuple], results: list[list[dict | None]]) -> Runs:
     """Each world's finished runs in seed order (worlds with none left out when interrupted)."""
     grouped: dict[int, list[dict]] = {id(w): [] for w in worlds}
     for (w, _, _), res in zip(tasks, results):
-        if res is not None:
-            grouped[id(w)].extend(res)
+        grouped[id(w)].extend(summary for summary in res if summary is not None)
     return Runs(tuple(WorldRuns(label, tuple(grouped[id(w)]))
                       for w, label in zip(worlds, _labels(worlds)) if grouped[id(w)]))
 

@@ -8,7 +8,6 @@
 
 from __future__ import annotations
 
-import functools
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -94,9 +93,9 @@ class Outcome:
 
 def default_task_fn(study: Study) -> TaskFn:
     """The simulator as a picklable task function."""
-    from .simtask import StudyContext, run_task
+    from .simtask import Simulator, StudyContext
 
-    return functools.partial(run_task, StudyContext(study.rulebase, study.behavior))
+    return Simulator(StudyContext(study.rulebase, study.behavior))
 
 
 def run_study(study: Study, out_dir: str | Path, *, executor: str = "local",

@@ -8,6 +8,7 @@ a chunk of tasks pays for parsing and compiling once.
 from __future__ import annotations
 
 import functools
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 
 from .spec import Choice, Task
@@ -80,4 +81,38 @@ def run_task(context: StudyContext, task: Task) -> dict:
     world = _world(task.world)
     result = simulate(world, _planner(context, task.choice, task.world), task.seed,
                       randomise=True, scene=_scene(task.world))
+    return _fields(result)
+
+
+def run_tasks(context: StudyContext, tasks: Sequence[Task]) -> Iterator[tuple[Task, dict]]:
+    """Simulate ``tasks``, those of each world and choice stepped together
+    (:class:`~mitos_cli.sim.lockstep.Lockstep`: each run's bits are those :func:`run_task`
+    gives it alone), giving each task and its fields as its run ends."""
+    from ..sim.lockstep import Lockstep
+
+    groups: dict[tuple[str, Choice], list[Task]] = {}
+    for task in tasks:
+        groups.setdefault((task.world, task.choice), []).append(task)
+    for (path, choice), group in groups.items():
+        runs = Lockstep(_world(path), _planner(context, choice, path),
+                        [task.seed for task in group], randomise=True, scene=_scene(path))
+        for j, result in runs.finished():
+            yield group[j], _fields(result)
+
+
+def _fields(result) -> dict:
     return {"outcome": result.outcome, **{f: result.metrics[f] for f in RESULT_FIELDS[1:]}}
+
+
+@dataclass(frozen=True)
+class Simulator:
+    """The simulator as a study's task function (picklable): one task alone, or a chunk of
+    tasks in lockstep (:attr:`each`, which the executors use where a task function has it)."""
+
+    context: StudyContext
+
+    def __call__(self, task: Task) -> dict:
+        return run_task(self.context, task)
+
+    def each(self, tasks: Sequence[Task]) -> Iterator[tuple[Task, dict]]:
+        return run_tasks(self.context, tasks)
