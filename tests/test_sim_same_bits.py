@@ -351,6 +351,29 @@ def test_steps_clearance_from_their_least_distance_is_the_least_of_their_samples
         assert same(got, steps_clearance_sample_by_sample(field, xy, t))
 
 
+def test_the_steps_clearance_of_a_block_of_nodes_is_that_block_of_the_whole():
+    rng = np.random.default_rng(19)
+    for k in range(40):
+        grid = Grid(rng.random((int(rng.integers(5, 60)), int(rng.integers(5, 60)))) < 0.05,
+                    float(rng.choice([1.0, 2.0, 0.7])), tuple(rng.uniform(-50, 50, 2)))
+        field = route.Clearance.of(grid.occupied, grid.resolution, grid.origin, cap=20.0)
+        xy = route._node_xy(grid, route._nodes(field.dist, int(rng.integers(1, 4))))
+        if k % 4 == 0:          # samples off the field (a field smaller than the nodes' grid)
+            field = route.Clearance(field.dist[:-2, :-3], field.resolution, field.origin)
+        t = route._samples(field, xy)
+        R, C = xy.shape[:2]
+        r0, c0 = int(rng.integers(-1, R)), int(rng.integers(-1, C))
+        r1, c1 = int(rng.integers(r0 + 1, R + 2)), int(rng.integers(c0 + 1, C + 2))
+        got = np.full((len(route.MOVES), R, C), 7.0)        # what is not measured stays
+        route._edges_from(got, field, xy, t, route.MOVES, (r0, r1), (c0, c1))
+        want = steps_clearance_sample_by_sample(field, xy, t)
+        inside = np.zeros((R, C), dtype=bool)
+        inside[max(r0, 0):r1, max(c0, 0):c1] = True
+        want[:, ~inside] = 7.0
+        want[np.isneginf(want)] = 7.0                       # steps off the grid
+        assert same(got, want)
+
+
 def test_a_part_of_the_capped_distances_is_that_part_of_the_whole():
     rng = np.random.default_rng(18)
     for _ in range(100):

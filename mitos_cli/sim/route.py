@@ -938,31 +938,38 @@ def _edges_from(out: np.ndarray, field: Clearance, xy: np.ndarray, t: np.ndarray
 
     A sample's clearance, ``max(dist - res / 2, 0)``, never falls as ``dist`` grows (nor
     does a rounded subtraction), so the smallest is that of the smallest ``dist``: one
-    subtraction a step, not one a sample. Samples lie between two nodes, inside the grid
-    (one that does not sends the step to :meth:`Clearance.cells`)."""
+    subtraction a step, not one a sample. Every move's samples are worked out at once, the
+    samples outermost (long inner loops), a step off the grid as a step to the node itself
+    (and left out). Samples lie between two nodes, inside the grid (one that does not sends
+    the steps to :meth:`Clearance.cells`)."""
     R, C = xy.shape[:2]
+    r0, r1 = max(rows[0], 0), min(rows[1], R)
+    c0, c1 = max(cols[0], 0), min(cols[1], C)
+    if r0 >= r1 or c0 >= c1:
+        return
     res, (ox, oy) = field.resolution, field.origin
     rows_n, cols_n = field.dist.shape
-    flat = field.dist.reshape(-1)
-    for m, (dr, dc, _) in enumerate(moves):
-        r0, r1 = max(rows[0], -dr, 0), min(rows[1], R - dr, R)
-        c0, c1 = max(cols[0], -dc, 0), min(cols[1], C - dc, C)
-        if r0 >= r1 or c0 >= c1:
-            continue
-        a, b = xy[r0:r1, c0:c1], xy[r0 + dr:r1 + dr, c0 + dc:c1 + dc]
-        ax, ay = a[..., 0, None], a[..., 1, None]
-        x = ax + t * (b[..., 0, None] - ax)                              # [r, c, T]
-        y = ay + t * (b[..., 1, None] - ay)
-        col = np.floor((x - ox) / res).astype(np.int64)
-        row = np.floor((y - oy) / res).astype(np.int64)
-        if not (col.min() >= 0 and col.max() < cols_n and row.min() >= 0
-                and row.max() < rows_n):
-            pts = np.stack([x, y], axis=-1)
-            out[m, r0:r1, c0:c1] = field.cells(pts.reshape(-1, 2)).reshape(x.shape).min(
-                axis=-1)
-            continue
-        least = np.minimum.reduce(flat[row * cols_n + col], axis=-1)
-        out[m, r0:r1, c0:c1] = np.maximum(least - res / 2, 0.0)
+    r, c = np.arange(r0, r1)[:, None], np.arange(c0, c1)[None, :]
+    dr, dc = (np.array([move[j] for move in moves], dtype=np.intp)[:, None, None]
+              for j in (0, 1))
+    on = (r + dr >= 0) & (r + dr < R) & (c + dc >= 0) & (c + dc < C)     # [M, r, c]
+    src = (r * C + c).reshape(-1)                            # the nodes the steps leave, flat
+    dst = np.where(on.reshape(len(moves), -1), src + (dr * C + dc).reshape(-1, 1), src)
+    xs, ys = xy[..., 0].reshape(-1), xy[..., 1].reshape(-1)
+    ax, ay, tt = xs[src], ys[src], t[:, None, None]
+    x = ax + tt * (xs[dst] - ax)                                         # [T, M, P]
+    y = ay + tt * (ys[dst] - ay)
+    col = np.floor((x - ox) / res).astype(np.int64)
+    row = np.floor((y - oy) / res).astype(np.int64)
+    part = out[:, r0:r1, c0:c1]
+    if col.min() >= 0 and col.max() < cols_n and row.min() >= 0 and row.max() < rows_n:
+        row *= cols_n
+        row += col
+        least = np.minimum.reduce(field.dist.reshape(-1)[row], axis=0) - res / 2
+        part[on] = np.maximum(least, 0.0).reshape(on.shape)[on]
+        return
+    cells = field.cells(np.stack([x.reshape(-1), y.reshape(-1)], axis=1)).reshape(x.shape)
+    part[on] = np.minimum.reduce(cells, axis=0).reshape(on.shape)[on]
 
 
 MOVES = tuple((dr, dc, math.hypot(dr, dc)) for dr in (-1, 0, 1) for dc in (-1, 0, 1)
