@@ -216,3 +216,33 @@ def test_what_a_run_recorded_in_a_batch_no_later_tick_changes():
                 assert all(a[k].tobytes() == b[k].tobytes() for k in a)
             else:
                 assert np.asarray(a).tobytes() == np.asarray(b).tobytes()
+
+
+def test_a_batch_aims_and_replans_each_robot_as_its_run_alone(monkeypatch):
+    """At every tick where a robot is due a replanning check, the batch's aims, routes
+    (planned again or not) and places on them are those each run finds alone."""
+    world = load_world(packaged_path("worlds", "multirobot.yaml"))
+    world = dataclasses.replace(world, time_limit=80 * world.dt)
+    replans = []
+    aims = Batch.aims
+
+    def checked(self, frames, near):
+        if not loop.knowledge.checks_due(self.maps, self.ticks[0].t, self._when):
+            return aims(self, frames, near)
+        runs, ticks, frames_, near_ = copy.deepcopy((self.runs, self.ticks, frames, near))
+        got = aims(self, frames, near)
+        want = [aim for run, s, (a, b) in zip(runs, ticks, self.spans)
+                for aim in run.aims(s, frames_[a:b], near_[a:b])]
+        for x, y in zip(got, want, strict=True):
+            assert x.route.points.tobytes() == y.route.points.tobytes()
+            assert (x.f.s, x.f.e, x.radius, x.need) == (y.f.s, y.f.e, y.radius, y.need)
+            assert x.p.tobytes() == y.p.tobytes() and x.cells.tobytes() == y.cells.tobytes()
+        for a, b in zip(self.runs, runs):
+            assert a._s_hint.tobytes() == b._s_hint.tobytes()
+            assert [(k, i) for k, i, _ in a._replanned] == [(k, i) for k, i, _ in b._replanned]
+        replans.append(sum(len(run._replanned) for run in runs))
+        return got
+
+    monkeypatch.setattr(Batch, "aims", checked)
+    run_lockstep(world, None, [7000, 7001, 7002], randomise=True)
+    assert len(replans) > 10 and replans[-1] >= 2         # checks made, routes planned again

@@ -10,9 +10,10 @@ followed in one pass (:func:`.movers.follow_all`), the cells near them on their 
 one pass (:func:`.knowledge.near_all`), their readings looked up where their routes were
 planned in one pass (:func:`.knowledge.accounted_all`), their pursuit points found in one
 pass (:func:`.perception.pursuit_points`) and their rule inputs perceived in one pass
-(:func:`.perception.perceive_all`) and checked (contact, arrival) in one pass; what else a
-robot's own route needs (replanning) is done run by run, with the code of a run alone
-(:class:`~mitos_cli.sim.loop.Simulation`). Then the fuzzy planner's rule network is
+(:func:`.perception.perceive_all`) and checked (contact, arrival) in one pass; the robots
+due a replanning check are found in one pass (:func:`.knowledge.checks_due`) and only their
+routes planned again, robot by robot, with the code of a run alone
+(:meth:`~mitos_cli.sim.loop.Simulation.replanned`). Then the fuzzy planner's rule network is
 evaluated once for the active robots of every run (one engine batch: the engine gives each
 row the bits it gives alone), the brake of every robot of every run checks its command in
 one pass (:meth:`.safety.Fleet.guard`: the first sweeps measured together, most commands
@@ -154,7 +155,8 @@ def _observe_together(batch: Batch) -> None:
     :func:`.knowledge.clear_all` and marked in one :func:`.knowledge.mark_all`, what they
     see seen in one :func:`.movers.sightings`, what their maps hold near them found in one
     :func:`.knowledge.near_all` and their readings looked up in one
-    :func:`.knowledge.accounted_all`, their pursuit points found in one
+    :func:`.knowledge.accounted_all`, the robots due a replanning check found in one
+    :meth:`.Batch.aims`, their pursuit points found in one
     :func:`.perception.pursuit_points`, their inputs perceived in one
     :func:`.perception.perceive_all` (each row the bits of its robot alone) and checked in
     one :meth:`.Batch.conclude`; what else each robot's map and route need, run by run."""
@@ -177,8 +179,7 @@ def _observe_together(batch: Batch) -> None:
     else:
         batch.tracked(_watched_together(batch, learned))
     near = knowledge.near_all(maps, batch.at, batch.reaches, world.replan != "clearance")
-    aims = [aim for run, s, (start, stop) in zip(fresh, sensed, spans)
-            for aim in run.aims(s, frames[start:stop], near[start:stop])]
+    aims = batch.aims(frames, near)
     targets = perception.pursuit_points(aims, fresh[0].settings)[1]
     gaps = perception.route_gaps(aims)
     # (after the aims: a route planned again is planned round the cells marked by then)

@@ -771,39 +771,49 @@ class Simulation:
              near: list[np.ndarray] | None = None) -> list[perception.Aim]:
         """Each robot's :class:`.perception.Aim` at tick ``s``, its map cleared
         (:meth:`clearing`) and marked and its tracks followed (:meth:`tracked`): where it is
-        on its route (its route replanned if need be) and what its pursuit point keeps clear
-        of (runs in lockstep find their pursuit points together); ``frames``: where they are
-        on their routes (:meth:`framing`); ``near``: what each robot's map holds within its
-        lookahead and least clearance (:meth:`.knowledge.RobotMap.near`; runs in lockstep
-        ask together, ``None``: asked here)."""
+        on its route (its route replanned if need be, :meth:`replanned`) and what its pursuit
+        point keeps clear of (runs in lockstep find their pursuit points together);
+        ``frames``: where they are on their routes (:meth:`framing`); ``near``: what each
+        robot's map holds within its lookahead and least clearance
+        (:meth:`.knowledge.RobotMap.near`; runs in lockstep ask together, ``None``: asked
+        here)."""
         if self._watched[0] is not s:               # not yet tracked at this tick
             self.tracked(s)
+        frames = list(frames)
+        for i in knowledge.checks_due(self._maps, s.t, self.world.replan):
+            frames[i] = self.replanned(s, i, frames[i])
+        self._s_hint = np.array([f.s for f in frames])
+        if near is None:    # what the route keeps clear of: the marks too, where it is
+            given = self.world.replan != "clearance"        # replanned round them
+            near = [m.near(p, self._cfg.lookahead + least, given=given)
+                    for m, p, (_, least) in zip(self._maps, s.pose[:, :2], self._asked)]
+        return [perception.Aim(route, f, p, cells, m.grid.resolution / 2,
+                               least + self._cfg.lookahead_room)
+                for route, f, p, cells, m, (_, least) in zip(self._routes, frames, s.pose[:, :2],
+                                                             near, self._maps, self._asked)]
+
+    def replanned(self, s: _Sensed, i: int, f: perception.Frame) -> perception.Frame:
+        """Where robot ``i`` is on its route at tick ``s`` (``f``: where it was on the route it
+        had), its route planned again first (:func:`.knowledge.replan`) where it drives and
+        what it learned, a mover coming toward it (:meth:`_sweep`) or the refuge it waits at
+        asks for it. Asked of the robots due a replanning check alone
+        (:func:`.knowledge.checks_due`): no other's route is planned again."""
         _, learned, follows = self._watched
-        routes, out = self._routes, []
-        for i in range(self.n):
-            f = frames[i]
-            rmap = self._maps[i]
-            sweep = self._sweep(i, s) if i in follows else None
-            if (learned[i] or sweep is not None or rmap.refuge is not None) and self._active[i]:
-                route = knowledge.replan(rmap, routes[i], f.s, s.pose[i, :2],
-                                         self.world.agents[i].goal, s.t, *self._asked[i],
-                                         self._cfg.sight, self.world.replan,
-                                         heading=math.degrees(self._h[i]), behind=BEHIND,
-                                         moving=sweep)
-                if route is not None:
-                    routes[i] = route
-                    self._replanned.append((self._k, i, route))
-                    f = perception.frame(route, s.pose[i, :2], 0.0)
-            self._s_hint[i] = f.s
-            least = self._asked[i][1]
-            # what the route keeps clear of: the marks too, where it is replanned round them
-            cells = (rmap.near(s.pose[i, :2], self._cfg.lookahead + least,
-                               given=self.world.replan != "clearance")
-                     if near is None else near[i])
-            out.append(perception.Aim(routes[i], f, s.pose[i, :2], cells,
-                                      rmap.grid.resolution / 2,
-                                      least + self._cfg.lookahead_room))
-        return out
+        rmap = self._maps[i]
+        if not self._active[i]:
+            return f
+        sweep = self._sweep(i, s) if i in follows else None
+        if not (learned[i] or sweep is not None or rmap.refuge is not None):
+            return f
+        route = knowledge.replan(rmap, self._routes[i], f.s, s.pose[i, :2],
+                                 self.world.agents[i].goal, s.t, *self._asked[i],
+                                 self._cfg.sight, self.world.replan,
+                                 heading=math.degrees(self._h[i]), behind=BEHIND, moving=sweep)
+        if route is None:
+            return f
+        self._routes[i] = route
+        self._replanned.append((self._k, i, route))
+        return perception.frame(route, s.pose[i, :2], 0.0)
 
     def aimed(self, s: _Sensed, aims: list[perception.Aim], targets: np.ndarray, *,
               gaps: list[float] | None = None) -> perception.Sights:
@@ -1134,8 +1144,13 @@ class Batch:
         self._far = runs[0].world.sensors.range * 0.999
         self._threshold = np.array([run._threshold for run in runs
                                     for _ in range(run.n)])[:, None]
-        self.reaches = np.array([run._cfg.lookahead + least      # (Simulation.aims)
+        # (Simulation.aims)
+        self.reaches = np.array([run._cfg.lookahead + least
                                  for run in runs for _, least in run._asked])
+        self._when = runs[0].world.replan
+        self._rows = [(j, i) for j, run in enumerate(runs) for i in range(run.n)]
+        self._radius = [m.grid.resolution / 2 for m in self.maps]
+        self._need = [least + run._cfg.lookahead_room for run in runs for _, least in run._asked]
         # (Simulation.aimed)
         self._robots = [r for run in runs for r in run.robots]
         self._spacing, _, self._least, self._squeeze = (
@@ -1232,6 +1247,23 @@ class Batch:
         """:meth:`Simulation.framing` of every run at once."""
         return ([r for run in self.runs for r in run._routes], self.at,
                 self._gather("_s_hint"))
+
+    def aims(self, frames: list[perception.Frame],
+             near: list[np.ndarray]) -> list[perception.Aim]:
+        """:meth:`Simulation.aims` of every run at once, once they are tracked: the robots due
+        a replanning check found in one pass (:func:`.knowledge.checks_due`), only their
+        routes planned again (:meth:`Simulation.replanned`, robot by robot), and each robot's
+        aim from the batch's rows (``frames``, ``near``: of the batch's rows)."""
+        frames = list(frames)
+        for row in knowledge.checks_due(self.maps, self.ticks[0].t, self._when):
+            j, i = self._rows[row]
+            frames[row] = self.runs[j].replanned(self.ticks[j], i, frames[row])
+        hint = np.array([f.s for f in frames])
+        for run, (a, b) in zip(self.runs, self.spans):
+            run._s_hint = hint[a:b]
+        routes = [route for run in self.runs for route in run._routes]
+        return [perception.Aim(*aim) for aim in zip(routes, frames, self.at, near, self._radius,
+                                                    self._need)]
 
     def aimed(self, aims: list[perception.Aim], targets: np.ndarray, gaps: list[float],
               accounted: np.ndarray) -> perception.Sights:
