@@ -740,9 +740,14 @@ def test_windows_of_many_routes_at_once_are_each_routes_own():
                 for r in routes]
         lo = np.array([rng.choice(e) for e in ends])
         hi = np.array([rng.choice(e) for e in ends])
-        table, base, size = route._laid(routes)
-        first, stop = route._windows(route._arc_lengths(table, base, size), size, lo, hi)
+        table, base, size, cum = route._laid(routes)
+        first, stop = route._windows(cum, size, lo, hi)
         assert [r._window(a, b) for r, a, b in zip(routes, lo, hi)] == list(zip(first, stop))
+        again = route._laid(list(routes))                 # the same routes: what was laid
+        assert all(a is b and not a.flags.writeable for a, b in zip(again, (table, base, size,
+                                                                            cum)))
+        other = route._laid(routes[::-1])
+        assert other[0].tobytes() == np.concatenate([r._rows for r in routes[::-1]]).tobytes()
 
 
 def project_on_arrays(r: route.Route, p, s_hint, back=24.0, ahead=120.0):

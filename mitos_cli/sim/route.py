@@ -209,13 +209,27 @@ class Route:
         return np.sqrt(np.minimum.reduce(np.add.reduce(d * d, axis=2), axis=1))
 
 
-def _laid(routes: Sequence[Route]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _laid(routes: Sequence[Route]) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """The rows' routes' :attr:`Route._rows` laid end to end, ``[N, 8]`` (a route shared by
-    rows laid once a row: a few hundred rows), and where each row's starts and how many
-    points it has, ``[R]`` each."""
+    rows laid once a row: a few hundred rows), where each row's starts and how many points
+    it has, ``[R]`` each, and each row's arc lengths (:func:`_arc_lengths`). Kept
+    (read-only) for the next rows of the same routes: runs in lockstep ask with their
+    robots' routes several times a tick, and a route changes only when it is planned
+    again."""
+    return _laid_once(tuple(routes))
+
+
+@functools.lru_cache(maxsize=8)
+def _laid_once(routes: tuple[Route, ...]) -> tuple[np.ndarray, np.ndarray, np.ndarray,
+                                                   np.ndarray]:
+    """:func:`_laid` of ``routes`` (a route hashes by itself: the same routes, in order)."""
     rows = [r._rows for r in routes]
     size = np.fromiter(map(len, rows), np.int64, len(rows))
-    return np.concatenate(rows), np.cumsum(size) - size, size
+    table, base = np.concatenate(rows), np.cumsum(size) - size
+    out = table, base, size, _arc_lengths(table, base, size)
+    for a in out:
+        a.flags.writeable = False
+    return out
 
 
 def _arc_lengths(table: np.ndarray, base: np.ndarray, size: np.ndarray) -> np.ndarray:
@@ -242,12 +256,12 @@ def points_along(routes: Sequence[Route], s: np.ndarray) -> np.ndarray:
     :meth:`Route.points_at` does, elementwise from the routes' :func:`_laid` rows, so the
     same bits. A row with a NaN (which no count places) is left to its route."""
     asked = np.asarray(s, float)
-    table, base, size = _laid(routes)
+    table, base, size, cum = _laid(routes)
     last = (size - 1)[:, None]                                               # [R, 1]
     length = table[base[:, None] + last, 0]
     s = np.where(asked < 0.0, 0.0, asked)          # max(s, 0.0), then min(s, length),
     s = np.where(length < s, length, s)            # as Python's max and min pick
-    count = np.add.reduce(_arc_lengths(table, base, size)[:, None, :] <= s[..., None], axis=2)
+    count = np.add.reduce(cum[:, None, :] <= s[..., None], axis=2)
     got = table[base[:, None] + np.minimum(count - 1, last - 1)]                  # [R, J, 8]
     ok = got[..., 5] > 0
     out = got[..., 1:3].copy()
@@ -265,9 +279,9 @@ def projections(routes: Sequence[Route], points: np.ndarray, hints: Sequence[flo
     its last one (the nearest is the first of equals, so never a copy), gathered from the
     routes' :func:`_laid` rows, so a row gets the bits it gets alone; the nearest points are
     read out for all rows together."""
-    table, base, size = _laid(routes)
+    table, base, size, cum = _laid(routes)
     hint = np.array(hints, float)
-    lo, hi = _windows(_arc_lengths(table, base, size), size, hint - back, hint + ahead)
+    lo, hi = _windows(cum, size, hint - back, hint + ahead)
     empty = lo >= hi                                            # none in it: the first one
     lo, hi = np.where(empty, 0, lo), np.where(empty, 1, hi)
     width = int((hi - lo).max())
@@ -297,9 +311,9 @@ def distances(routes: Sequence[Route], s: Sequence[float], ahead: float,
     block at a time (:data:`.geometry.CACHED`)."""
     if len(routes) == 1:
         return routes[0].distance(points[0], s[0], ahead)[None]
-    table, base, size = _laid(routes)
+    table, base, size, cum = _laid(routes)
     start = np.array(s, float)
-    first, stop = _windows(_arc_lengths(table, base, size), size, start, start + ahead)
+    first, stop = _windows(cum, size, start, start + ahead)
     width = max(int((stop - first).max()), 0)
     out = np.full(points.shape[:2], np.inf)
     rows = np.flatnonzero(first < stop)
