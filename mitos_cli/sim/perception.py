@@ -574,10 +574,15 @@ def _near_chords(cells: np.ndarray, p: np.ndarray, q: np.ndarray,
     chord is clear, and leaving it out gives every chord the same answer (a NaN is kept)."""
     ends = np.concatenate([q, p[:, None]], axis=1)                            # [H, J + 1, 2]
     grow = (reach + 1e-6 * (1.0 + np.abs(reach)
-                            + np.maximum.reduce(np.abs(ends), axis=(1, 2))))[:, None, None]
-    lo = np.minimum.reduce(ends, axis=1, keepdims=True) - grow                # [H, 1, 2]
-    hi = np.maximum.reduce(ends, axis=1, keepdims=True) + grow
-    return ~np.logical_or.reduce((cells < lo) | (cells > hi), axis=2)
+                            + np.maximum.reduce(np.abs(ends), axis=(1, 2))))[:, None]
+    lo = np.minimum.reduce(ends, axis=1) - grow                               # [H, 2]
+    hi = np.maximum.reduce(ends, axis=1) + grow
+    x, y = cells[..., 0], cells[..., 1]           # (a coordinate at a time: long inner loops)
+    out = x < lo[:, :1]
+    out |= x > hi[:, :1]
+    out |= y < lo[:, 1:]
+    out |= y > hi[:, 1:]
+    return ~out
 
 
 #: How far (relative) a chord's clearance from the squares of the gaps may lie off the one
