@@ -94,7 +94,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .geometry import CACHED, clip_arrays
-from .route import Route, distances, points_along, projections
+from .route import Route, distances, points_along, projected, projections
 from .world import Robot
 
 NO_OBSTACLE = 200.0     # in: the `obstacle` distance when nothing obstructs
@@ -146,11 +146,13 @@ def frame(route: Route, p: np.ndarray, s_hint: float) -> Frame:
 
 def frames(routes: list[Route], p: np.ndarray, hints) -> list[Frame]:
     """:func:`frame` of every robot at once (``p [R, 2]``; runs in lockstep together), each
-    the bits of its own (:func:`.route.projections`)."""
+    the bits of its own (:func:`.route.projected`; the normals turned all at once)."""
     if len(routes) == 1:
         return [frame(routes[0], p[0], float(hints[0]))]
-    return [Frame(s, e, t, np.array([t[1], -t[0]]))
-            for s, e, t in projections(routes, p, hints)]
+    s, e, t = projected(routes, p, hints)
+    n = np.empty_like(t)
+    n[:, 0], n[:, 1] = t[:, 1], -t[:, 0]
+    return [Frame(*row) for row in zip(s, e, t, n)]
 
 
 def _or(least: np.ndarray, none: float, less: float | np.ndarray = 0.0) -> np.ndarray:

@@ -275,10 +275,19 @@ def points_along(routes: Sequence[Route], s: np.ndarray) -> np.ndarray:
 def projections(routes: Sequence[Route], points: np.ndarray, hints: Sequence[float],
                 back: float = 24.0, ahead: float = 120.0) -> list[tuple[float, float, np.ndarray]]:
     """:meth:`Route.project` of every row at once (``points [R, 2]``, each on its route near
-    its hint): each row's segments in its window (:func:`_windows`), padded with copies of
+    its hint): :func:`projected`'s arc lengths, offsets and tangents, a row each."""
+    return list(zip(*projected(routes, points, hints, back, ahead)))
+
+
+def projected(routes: Sequence[Route], points: np.ndarray, hints: Sequence[float],
+              back: float = 24.0, ahead: float = 120.0
+              ) -> tuple[list[float], list[float], np.ndarray]:
+    """:func:`projections` as the rows' arc lengths, lateral offsets and unit tangents
+    ``[R, 2]``: each row's segments in its window (:func:`_windows`), padded with copies of
     its last one (the nearest is the first of equals, so never a copy), gathered from the
     routes' :func:`_laid` rows, so a row gets the bits it gets alone; the nearest points are
-    read out for all rows together."""
+    read out for all rows together. A coordinate at a time (a sum over x and y is one
+    addition), as :meth:`Route.project`'s arrays add them up."""
     table, base, size, cum = _laid(routes)
     hint = np.array(hints, float)
     lo, hi = _windows(cum, size, hint - back, hint + ahead)
@@ -286,19 +295,18 @@ def projections(routes: Sequence[Route], points: np.ndarray, hints: Sequence[flo
     lo, hi = np.where(empty, 0, lo), np.where(empty, 1, hi)
     width = int((hi - lo).max())
     rows = table[base[:, None] + np.minimum(lo[:, None] + np.arange(width), hi[:, None] - 1)]
-    a, e, ee, root = rows[..., 1:3], rows[..., 3:5], rows[..., 6], rows[..., 7]   # [R, M, ...]
-    p = points[:, None]                                                    # [R, 1, 2]
-    t = clip_arrays(((p - a) * e).sum(axis=2) / ee, 0.0, 1.0)              # [R, M]
-    closest = a + t[..., None] * e
-    gap = p - closest
-    d = np.hypot(gap[..., 0], gap[..., 1])
+    ax, ay, ex, ey = rows[..., 1], rows[..., 2], rows[..., 3], rows[..., 4]    # [R, M] each
+    ee, root = rows[..., 6], rows[..., 7]
+    px, py = points[:, 0, None], points[:, 1, None]                           # [R, 1]
+    t = clip_arrays(((px - ax) * ex + (py - ay) * ey) / ee, 0.0, 1.0)         # [R, M]
+    cx, cy = ax + t * ex, ay + t * ey
     r = np.arange(len(routes))
-    i = d.argmin(axis=1)
+    i = np.hypot(px - cx, py - cy).argmin(axis=1)
     s = (table[base + lo + i, 0] + t[r, i] * root[r, i]).tolist()
-    tangent = e[r, i] / np.sqrt(ee[r, i])[:, None]
-    rel = points - closest[r, i]
-    lateral = (rel[:, 0] * tangent[:, 1] - rel[:, 1] * tangent[:, 0]).tolist()
-    return list(zip(s, lateral, tangent))
+    tangent = rows[r, i, 3:5] / np.sqrt(ee[r, i])[:, None]
+    gx, gy = points[:, 0] - cx[r, i], points[:, 1] - cy[r, i]
+    lateral = (gx * tangent[:, 1] - gy * tangent[:, 0]).tolist()
+    return s, lateral, tangent
 
 
 def distances(routes: Sequence[Route], s: Sequence[float], ahead: float,
@@ -307,8 +315,9 @@ def distances(routes: Sequence[Route], s: Sequence[float], ahead: float,
     ``routes[i]`` between arc lengths ``s[i]`` and ``s[i] + ahead``, ``[R, K]``. Each row's
     segments (:func:`_windows`) are padded with copies of its last one (which the minimum
     cannot tell from it), so a point gets the bits it gets from its route alone; the sums
-    over x and y are written out (a sum of two is one addition) and the rows are worked a
-    block at a time (:data:`.geometry.CACHED`)."""
+    over x and y are written out (a sum of two is one addition), the points innermost (a
+    row has a few segments in its window, and some twenty points) and the rows are worked
+    a block at a time (:data:`.geometry.CACHED`)."""
     if len(routes) == 1:
         return routes[0].distance(points[0], s[0], ahead)[None]
     table, base, size, cum = _laid(routes)
@@ -327,13 +336,13 @@ def distances(routes: Sequence[Route], s: Sequence[float], ahead: float,
     for lo in range(0, len(rows), block):
         hi = min(lo + block, len(rows))
         at = rows[lo:hi]
-        px, py = points[at, :, 0, None], points[at, :, 1, None]             # [h, K, 1]
-        ax, ay = a[lo:hi, None, :, 0], a[lo:hi, None, :, 1]                # [h, 1, M]
-        ex, ey = e[lo:hi, None, :, 0], e[lo:hi, None, :, 1]
-        rx, ry = px - ax, py - ay                                          # [h, K, M]
-        t = clip_arrays((rx * ex + ry * ey) / ee[lo:hi, None], 0.0, 1.0)
+        px, py = points[at, None, :, 0], points[at, None, :, 1]             # [h, 1, K]
+        ax, ay = a[lo:hi, :, 0, None], a[lo:hi, :, 1, None]                # [h, M, 1]
+        ex, ey = e[lo:hi, :, 0, None], e[lo:hi, :, 1, None]
+        rx, ry = px - ax, py - ay                          # [h, M, K]: the points innermost
+        t = clip_arrays((rx * ex + ry * ey) / ee[lo:hi, :, None], 0.0, 1.0)
         dx, dy = rx - t * ex, ry - t * ey
-        out[at] = np.sqrt(np.minimum.reduce(dx * dx + dy * dy, axis=2))
+        out[at] = np.sqrt(np.minimum.reduce(dx * dx + dy * dy, axis=1))
     return out
 
 
