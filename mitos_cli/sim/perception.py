@@ -520,7 +520,7 @@ def pursuit_points(aims: list[Aim], cfg: Settings) -> tuple[np.ndarray, np.ndarr
     cells = np.full((len(have), max(len(a.cells) for a in have), 2), _FAR)
     for j, a in enumerate(have):
         cells[j, :len(a.cells)] = a.cells
-    p = np.stack([a.p for a in have])                                         # [H, 2]
+    p = np.array([a.p for a in have])                                         # [H, 2]
     near = _near_chords(cells, p, q, np.array([a.need + a.radius for a in have]))
     some = np.logical_or.reduce(near, axis=1).nonzero()[0]
     if not len(some):
@@ -646,8 +646,8 @@ def route_gaps(aims: list[Aim]) -> list[float]:
         cells[j, :len(aims[i].cells)] = aims[i].cells
     c = (np.array([aims[i].p for i in have])
          - np.array([aims[i].f.e for i in have])[:, None] * np.array([aims[i].f.n for i in have]))
-    cells -= c[:, None]
-    gaps = np.minimum.reduce(np.hypot(cells[..., 0], cells[..., 1]), axis=1).tolist()
+    gaps = np.minimum.reduce(np.hypot(cells[..., 0] - c[:, :1], cells[..., 1] - c[:, 1:]),
+                             axis=1).tolist()                  # (a coordinate at a time)
     for i, gap in zip(have, gaps):
         out[i] = gap
     return out
