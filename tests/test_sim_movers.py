@@ -383,3 +383,19 @@ def test_trackers_followed_together_follow_as_each_alone():
             tracker.follow(now, *got)
         assert [_state(t) for t in together] == [_state(t) for t in alone], k
     assert any(tr.mover for t in alone for tr in t.tracks)
+
+
+def test_only_the_robots_due_a_replanning_check_plan_again():
+    """:func:`.knowledge.checks_due` names the robots whose :func:`.knowledge.replan` may plan
+    again: with a mover across the way, exactly those do."""
+    world, rmap, route, (asked, least) = corridor_map()
+    goal, p, t = world.agents[0].goal, np.array([300.0, -10.0]), 5.0
+    maps = [knowledge.RobotMap.of(rmap.grid) for _ in range(6)]
+    for m, last in zip(maps, (-math.inf, t - 3.0, t - 0.5, t - 0.49, t - 0.1, t)):
+        m.checked_at = last
+    due = knowledge.checks_due(maps, t)
+    assert due == [0, 1, 2] and knowledge.checks_due(maps, t, "never") == []
+    for i, m in enumerate(maps):
+        new = knowledge.replan(m, route, 270, p, goal, t, asked, least, 150,
+                               moving=across(m, 400, -60, 60))
+        assert (new is not None) == (i in due)

@@ -674,12 +674,11 @@ def replan(rmap: RobotMap, route: Route, s: float, p: np.ndarray, goal: Goal, t:
 def checks_due(maps: list[RobotMap], t: float, when: str = "clearance") -> list[int]:
     """Which of ``maps`` (one robot's each) are due a replanning check at ``t``: none when
     the routes are never replanned, else those last checked ``REPLAN_EVERY`` s ago or more
-    (``t`` less their times, as :func:`replan` takes it, in one pass). Only these robots'
-    :func:`replan` can plan again."""
+    (as :func:`replan` takes it; Python floats: cheaper than an array of a few hundred).
+    Only these robots' :func:`replan` can plan again."""
     if when == "never":
         return []
-    checked = np.array([m.checked_at for m in maps])
-    return (~(t - checked < REPLAN_EVERY)).nonzero()[0].tolist()
+    return [i for i, m in enumerate(maps) if not t - m.checked_at < REPLAN_EVERY]
 
 
 def _due(rmap: RobotMap, route: Route, s: float, p: np.ndarray, t: float, clearance: float,
