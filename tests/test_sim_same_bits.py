@@ -7,8 +7,10 @@ from __future__ import annotations
 import dataclasses
 import math
 
+import hypothesis
 import numpy as np
 import pytest
+from hypothesis import strategies as st
 
 from mitos_cli.resources import packaged_path
 from mitos_cli.sim import distance, geometry, knowledge, movers, perception, route, rows, safety
@@ -518,6 +520,21 @@ def box_rows(seed: int, n_rows: int = 3, n_boxes: int = 40) -> list[rows.SenseRo
     return out
 
 
+@hypothesis.settings(max_examples=200, deadline=None)
+@hypothesis.given(st.lists(st.integers(0, 6), min_size=1, max_size=9), st.integers(0, 3),
+       st.sampled_from([(), (2,), (4,), (4, 2)]), st.integers(0, 2 ** 32 - 1))
+def test_rows_stacked_are_each_row_padded_with_zeros(lengths, extra, tail, seed):
+    rng = np.random.default_rng(seed)
+    arrays = [rng.normal(size=(n, *tail)) for n in lengths]
+    width = max(lengths) + extra
+    got = rows._stacked(arrays, width)
+    assert got.shape == (len(arrays), width, *tail)
+    for row, a in zip(got, arrays):
+        assert same(row[:len(a)], a) and not row[len(a):].any()
+    alike = [rng.normal(size=(lengths[0], *tail)) for _ in lengths]     # width left out
+    assert same(rows._stacked(alike), np.stack(alike))
+
+
 @pytest.mark.parametrize("seed", range(40))
 def test_beams_among_many_boxes_test_only_the_boxes_they_may_hit_with_the_same_bits(
         seed, monkeypatch):
@@ -530,9 +547,9 @@ def test_beams_among_many_boxes_test_only_the_boxes_they_may_hit_with_the_same_b
     for max_range in (150.0, 40.0):
         for chosen in ([0], [1], [0, 1, 2]):
             some = [parts[i] for i in chosen]
-            culled = rows._cast(some, origin[chosen], dirs[chosen], max_range)
+            culled = rows._cast(rows._Stacks(some), origin[chosen], dirs[chosen], max_range)
             monkeypatch.setattr(rows, "CULL_FROM", 10 ** 9)
-            every = rows._cast(some, origin[chosen], dirs[chosen], max_range)
+            every = rows._cast(rows._Stacks(some), origin[chosen], dirs[chosen], max_range)
             monkeypatch.undo()
             assert rows.CULL_FROM <= 40
             assert same(culled[0], every[0]) and same(culled[1], every[1]), (max_range, chosen)

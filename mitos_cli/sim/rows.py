@@ -79,27 +79,63 @@ def sense(rows: list[SenseRow], angles: np.ndarray, max_range: float) -> Sensed:
     dirs = np.empty((*a.shape, 2))                                      # [R, B, 2]
     dirs[..., 0] = np.cos(a)
     dirs[..., 1] = np.sin(a)
-    static, hit = _cast(rows, origin, dirs, max_range)
+    stacks = _Stacks(rows)
+    static, hit = _cast(stacks, origin, dirs, max_range)
     ranges = _noisy(rows, hit, max_range)
-    return Sensed(dirs, static, ranges, _clearance(rows, origin, heading))
+    return Sensed(dirs, static, ranges, _clearance(stacks, origin, heading))
 
 
 def _stacked(arrays: list[np.ndarray], width: int | None = None) -> np.ndarray:
     """``[R, width, ...]``: the arrays one above the other, each padded with zeros to
-    ``width`` rows (a view of the one array, when there is one that needs no padding)."""
+    ``width`` rows (a view of the one array, when there is one that needs no padding): one
+    concatenation, then the rows laid out in a block where they are not all ``width`` long."""
     width = len(arrays[0]) if width is None else width
     if len(arrays) == 1 and len(arrays[0]) == width:
         return arrays[0][None]
-    out = np.zeros((len(arrays), width, *arrays[0].shape[1:]))
-    for i, a in enumerate(arrays):
-        out[i, :len(a)] = a
+    flat = np.concatenate(arrays, dtype=float)
+    if len(flat) == len(arrays) * width:                # (none is longer than width)
+        return flat.reshape(len(arrays), width, *flat.shape[1:])
+    out = np.zeros((len(arrays), width, *flat.shape[1:]))
+    out[np.arange(width) < np.fromiter(map(len, arrays), np.intp, len(arrays))[:, None]] = flat
     return out
+
+
+class _Stacks:
+    """The rows' arrays one above the other (:func:`_stacked`), each stacked once a
+    :func:`sense`, when a stage first asks for it."""
+
+    def __init__(self, rows: list[SenseRow]) -> None:
+        self.rows = rows
+
+    @functools.cached_property
+    def wall_counts(self) -> list[int]:
+        return [len(r.walls) for r in self.rows]
+
+    @functools.cached_property
+    def walls(self) -> np.ndarray:                      # [R, W, 4], W the most of a row
+        return _stacked([r.walls for r in self.rows], max(self.wall_counts))
+
+    @functools.cached_property
+    def centres(self) -> np.ndarray:                    # [R, C, 2]
+        return _stacked([r.centres for r in self.rows])
+
+    @functools.cached_property
+    def radii(self) -> np.ndarray:                      # [R, C]
+        return _stacked([r.radii for r in self.rows])
+
+    @functools.cached_property
+    def middles(self) -> np.ndarray:                    # [R, P, 2], the discs' (:func:`discs`)
+        return _stacked([r.discs[0] for r in self.rows])
+
+    @functools.cached_property
+    def reaches(self) -> np.ndarray:                    # [R, P], their radii
+        return _stacked([r.discs[1] for r in self.rows])
 
 
 CULL_FROM = 16                 # boxes from which beams test only the boxes their discs allow
 
 
-def _cast(rows: list[SenseRow], origin: np.ndarray, dirs: np.ndarray,
+def _cast(stacks: _Stacks, origin: np.ndarray, dirs: np.ndarray,
           max_range: float) -> tuple[np.ndarray, np.ndarray]:
     """Noise-free ranges ``[R, B]``: to the walls alone, and to everything (walls, sides and
     circles): :func:`.geometry.ray_hits` and :func:`.geometry.ray_circles`, per element.
@@ -107,12 +143,13 @@ def _cast(rows: list[SenseRow], origin: np.ndarray, dirs: np.ndarray,
     Among many boxes each beam tests the sides only of the boxes whose discs it passes
     through (:func:`_box_hits`): a side it cannot reach is never its nearest, and the sides
     it tests get the same formula, element by element, so every range keeps its bits."""
-    walls = [len(r.walls) for r in rows]
+    rows = stacks.rows
+    walls = stacks.wall_counts
     total = [len(r.segments) for r in rows]
     boxes = len(rows[0].boxes)
     if boxes >= CULL_FROM and all(t - w == 4 * boxes for w, t in zip(walls, total)):
-        static = _ray_hits(_stacked([r.walls for r in rows], max(walls)), origin, dirs)
-        hit = np.minimum(np.minimum(static, _box_hits(rows, origin, dirs, max_range)),
+        static = _ray_hits(stacks.walls, origin, dirs)
+        hit = np.minimum(np.minimum(static, _box_hits(stacks, origin, dirs, max_range)),
                          max_range)
         static = np.minimum(static, max_range)
     else:
@@ -128,7 +165,7 @@ def _cast(rows: list[SenseRow], origin: np.ndarray, dirs: np.ndarray,
                                 .min(axis=2, initial=np.inf), max_range)
     if not len(rows[0].centres):
         return static, hit
-    return static, np.minimum(hit, _circles(rows, origin, dirs, max_range))
+    return static, np.minimum(hit, _circles(stacks, origin, dirs, max_range))
 
 
 def _ray_hits(seg: np.ndarray, origin: np.ndarray, dirs: np.ndarray, keep: bool = False):
@@ -157,13 +194,14 @@ def _along(dx, dy, ex, ey, px, py) -> np.ndarray:
     return np.where(ok, t, np.inf)
 
 
-def _box_hits(rows: list[SenseRow], origin: np.ndarray, dirs: np.ndarray,
+def _box_hits(stacks: _Stacks, origin: np.ndarray, dirs: np.ndarray,
               max_range: float) -> np.ndarray:
     """The nearest box side along every beam ``[R, B]`` (``inf`` for none), testing a beam
     only against the boxes whose enclosing discs (:func:`discs`) it passes through within
     ``max_range``, with 1e-6 in of slack on top of theirs."""
-    middle = _stacked([r.discs[0] for r in rows]) - origin[:, None]    # [R, P, 2]
-    radius = _stacked([r.discs[1] for r in rows])[:, None] + 1e-6      # [R, 1, P]
+    rows = stacks.rows
+    middle = stacks.middles - origin[:, None]                           # [R, P, 2]
+    radius = stacks.reaches[:, None] + 1e-6                             # [R, 1, P]
     dx, dy = dirs[..., 0, None], dirs[..., 1, None]                     # [R, B, 1]
     mx, my = middle[:, None, :, 0], middle[:, None, :, 1]               # [R, 1, P]
     along = dx * mx + dy * my                                           # [R, B, P]
@@ -185,11 +223,11 @@ def _box_hits(rows: list[SenseRow], origin: np.ndarray, dirs: np.ndarray,
     return out
 
 
-def _circles(rows: list[SenseRow], origin: np.ndarray, dirs: np.ndarray,
+def _circles(stacks: _Stacks, origin: np.ndarray, dirs: np.ndarray,
              max_range: float) -> np.ndarray:
     """:func:`.geometry.ray_circles` of every row, ``[R, B]``."""
-    off = origin[:, None] - _stacked([r.centres for r in rows])         # [R, C, 2]
-    radii = _stacked([r.radii for r in rows])                           # [R, C]
+    off = origin[:, None] - stacks.centres                              # [R, C, 2]
+    radii = stacks.radii                                                # [R, C]
     mx, my = off[..., 0], off[..., 1]
     b = mx[:, None] * dirs[..., 0, None] + my[:, None] * dirs[..., 1, None] + 0.0
     c = (mx * mx + my * my - radii ** 2)[:, None]                       # [R, 1, C]
@@ -212,20 +250,22 @@ def _noisy(rows: list[SenseRow], ranges: np.ndarray, max_range: float) -> np.nda
     return out if all(noisy) else np.where(np.array(noisy)[:, None], out, ranges)
 
 
-def _clearance(rows: list[SenseRow], origin: np.ndarray, heading: np.ndarray) -> np.ndarray:
+def _clearance(stacks: _Stacks, origin: np.ndarray, heading: np.ndarray) -> np.ndarray:
     """The clearance of every row ``[R]`` (rows of one footprint together): the signed
     distance from its footprint to walls, polygons and circles, computed in the footprint's
     own frame (the gap when apart, 0 touching, minus the penetration depth when
     overlapping)."""
+    rows = stacks.rows
     groups: dict[tuple[float, float], list[int]] = {}
     for i, r in enumerate(rows):
         groups.setdefault((r.robot.length / 2, r.robot.width / 2), []).append(i)
     if len(groups) == 1:
         (hl, hw), _ = groups.popitem()
-        return _group_clearance(rows, origin, heading, hl, hw)
+        return _group_clearance(stacks, origin, heading, hl, hw)
     out = np.empty(len(rows))
     for (hl, hw), idx in groups.items():
-        out[idx] = _group_clearance([rows[i] for i in idx], origin[idx], heading[idx], hl, hw)
+        out[idx] = _group_clearance(_Stacks([rows[i] for i in idx]), origin[idx], heading[idx],
+                                    hl, hw)
     return out
 
 
@@ -234,9 +274,10 @@ class _Frames:
 
     def __init__(self, origin: np.ndarray, heading: np.ndarray) -> None:
         self.origin = origin
-        turns = [(math.cos(h), math.sin(h)) for h in heading]          # as one robot's
+        h = heading.tolist()
+        c, s = list(map(math.cos, h)), list(map(math.sin, h))          # as one robot's
         # [R, 1, 2, 2]: row j of a point's turn is (x * c + y * s, x * -s + y * c)
-        self.turn = np.array([[[[c, s], [-s, c]]] for c, s in turns])
+        self.turn = np.array([c, s, [-x for x in s], c]).T.reshape(len(h), 1, 2, 2)
 
     def local(self, points: np.ndarray, idx=slice(None)) -> np.ndarray:
         """``[r, K, 2]`` world points of rows ``idx`` in their footprints' frames."""
@@ -244,26 +285,26 @@ class _Frames:
         return rel[..., 0] + rel[..., 1]
 
 
-def _group_clearance(rows: list[SenseRow], origin: np.ndarray, heading: np.ndarray,
+def _group_clearance(stacks: _Stacks, origin: np.ndarray, heading: np.ndarray,
                      hl: float, hw: float) -> np.ndarray:
     """The clearance of rows with the same footprint ``[-hl, hl] x [-hw, hw]``. A thing whose
     enclosing disc lies farther from the footprint's than the walls cannot be the nearest
     (1e-6 in of slack for rounding); rows with none nearer skip that kind of thing, but only
     while no wall touches the footprint (whatever may overlap it is measured together, as
     one robot alone does)."""
+    rows = stacks.rows
     frames = _Frames(origin, heading)
-    best = _walls(rows, frames, hl, hw)
+    best = _walls(stacks, frames, hl, hw)
     reach = np.where(best > 0.0, best + math.hypot(hl, hw) + 1e-6, np.inf)[:, None]
     if len(rows[0].boxes):
-        near = _near(origin, _stacked([r.discs[0] for r in rows]),
-                     _stacked([r.discs[1] for r in rows]), reach)
+        near = _near(origin, stacks.middles, stacks.reaches, reach)
         if len(near):
             shape = rows[0].boxes.shape
             world = _stacked([rows[i].boxes for i in near]).reshape(len(near), -1, 2)
             boxes = frames.local(world, near).reshape(len(near), *shape)
             best[near] = np.minimum(best[near], _polygons(hl, hw, boxes).min(axis=1))
     if len(rows[0].centres):
-        centres, radii = _stacked([r.centres for r in rows]), _stacked([r.radii for r in rows])
+        centres, radii = stacks.centres, stacks.radii
         near = _near(origin, centres, radii, reach)
         if len(near):
             # (|x| - hl, |y| - hw) of each centre in its row's footprint's frame
@@ -291,14 +332,14 @@ def _half_sizes(hl: float, hw: float) -> np.ndarray:
     return out
 
 
-def _walls(rows: list[SenseRow], frames: _Frames, hl: float, hw: float) -> np.ndarray:
+def _walls(stacks: _Stacks, frames: _Frames, hl: float, hw: float) -> np.ndarray:
     """``[R]``: the signed distance from each row's footprint to its nearest wall (``inf``
     with none); the depth of walls that cross it row by row."""
-    counts = [len(r.walls) for r in rows]
+    rows, counts = stacks.rows, stacks.wall_counts
     width = max(counts)
     if not width:
         return np.full(len(rows), np.inf)
-    walls = _stacked([r.walls for r in rows], width)
+    walls = stacks.walls
     ends = frames.local(walls.reshape(len(rows), -1, 2)).reshape(len(rows), -1, 2, 2)
     w = box_segment_distance(hl, hw, ends.reshape(-1, 4)).reshape(len(rows), -1)
     real = None if min(counts) == width else np.arange(width) < np.array(counts)[:, None]
