@@ -218,6 +218,9 @@ def test_many_maps_marked_and_looked_up_at_once_are_each_maps_own():
         got = knowledge.accounted_all(together, cells)
         for m, a, c, row in zip(together, alone, cells, got):
             assert np.array_equal(m.occupied, a.occupied) and np.array_equal(m.marks, a.marks)
+            assert m.marks.dtype == a.marks.dtype and m._changes == a._changes
+            assert len(m.fresh) == len(a.fresh)
+            assert all(same(x, y) for x, y in zip(m.fresh, a.fresh))   # centres, in order
             assert np.array_equal(row, a.accounted_cells(c))
     assert any(flags) and not all(flags)
 

@@ -546,14 +546,52 @@ def beyond_cells(maps: list[RobotMap], origins: np.ndarray, dirs: np.ndarray,
 
 def mark_all(maps: list[RobotMap], cells: np.ndarray, seen: np.ndarray) -> list[bool]:
     """``[m.mark_cells(c[w]) for m, c, w in zip(maps, cells [R, B, 2], seen [R, B])]``, the
-    cells inside the grid found in one pass (maps alike: the runs of a world)."""
+    cells inside the grid found in one pass and the new ones marked in another
+    (:func:`_add_marks`; maps alike: the runs of a world)."""
     grid = _alike(maps) if len(maps) > 1 else None
     if grid is None:
         return [m.mark_cells(c[w]) for m, c, w in zip(maps, cells, seen)]
     take = seen & np.logical_and.reduce(cells.view(np.uint64) < _limits(grid.occupied.shape),
                                         axis=2)
-    return [bool(n) and m._mark(c[w]) for m, c, w, n in
-            zip(maps, cells, take, np.count_nonzero(take, axis=1).tolist())]
+    k, b = take.nonzero()                       # map by map, each in its beams' order
+    row, col = cells[k, b, 1], cells[k, b, 0]
+    ends = np.cumsum(np.bincount(k, minlength=len(maps))).tolist()
+    known = np.empty(len(k), dtype=bool)
+    for m, a, e in zip(maps, [0, *ends[:-1]], ends):
+        if e > a:
+            known[a:e] = m.occupied[row[a:e], col[a:e]]
+    new = np.flatnonzero(~known)
+    if not len(new):
+        return [False] * len(maps)
+    _add_marks(maps, grid, k[new], row[new], col[new])
+    return np.bincount(k[new], minlength=len(maps)).astype(bool).tolist()
+
+
+def _add_marks(maps: list[RobotMap], grid: Grid, k: np.ndarray, row: np.ndarray,
+               col: np.ndarray) -> None:
+    """:meth:`RobotMap._mark` of the cells not yet marked (rows ``row``, columns ``col`` of
+    maps ``k``, ascending; maps alike): their marks merged as one sorted array of cells keyed
+    by map (a map's new cells are not among its marks), the centres as one array, then each
+    map's part of both. The same marks, and the same centres in the same order."""
+    rows, cols = grid.occupied.shape
+    size = rows * cols
+    which = np.unique(k)
+    js = which.tolist()
+    old = [maps[j].marks for j in js]
+    keys = np.concatenate([np.concatenate(old) + np.repeat(which * size, [len(o) for o in old]),
+                           np.unique(k * size + row * cols + col)])
+    keys.sort()
+    bounds = np.searchsorted(keys, np.concatenate([which, which + 1]) * size).tolist()
+    xs, ys = _centre_lines(grid)
+    centres = np.empty((len(k), 2))
+    centres[:, 0], centres[:, 1] = xs[col], ys[row]
+    ends = np.searchsorted(k, which, side="right").tolist()
+    for j, a, e, lo, hi in zip(js, [0, *ends[:-1]], ends, bounds[:len(js)], bounds[len(js):]):
+        m = maps[j]
+        m._changes += 1
+        m.occupied[row[a:e], col[a:e]] = True
+        m.marks = keys[lo:hi] - j * size
+        m.fresh.append(centres[a:e])
 
 
 def accounted_all(maps: list[RobotMap], cells: np.ndarray, reach: int = 2) -> np.ndarray:
