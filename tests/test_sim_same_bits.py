@@ -655,13 +655,17 @@ def test_distances_from_many_routes_at_once_are_each_routes_own(rows):
         assert same(got[i], r.distance(points[i], s[i], 120.0))
 
 
-@pytest.mark.parametrize("maps", [5, 120])            # 120: rows worked in blocks
-def test_maps_cleared_together_are_each_cleared_as_alone(maps):
+@pytest.mark.parametrize("maps, unlike", [(5, False), (120, False), (7, True)])
+def test_maps_cleared_together_are_each_cleared_as_alone(maps, unlike):
+    """120 maps: marks worked in blocks; ``unlike``: grids of two shapes, each map's marks in
+    sight found alone."""
     rng = np.random.default_rng(8)
     angles = np.deg2rad(np.arange(0, 360, 10))
-    grids = [Grid(rng.random((60, 80)) < 0.02, 2.0, (0.0, 0.0)) for _ in range(maps)]
+    grids = [Grid(rng.random((60 - 10 * (unlike and i % 2), 80)) < 0.02, 2.0, (0.0, 0.0))
+             for i in range(maps)]
     together = [knowledge.RobotMap.of(g) for g in grids]
     alone = [knowledge.RobotMap.of(g) for g in grids]
+    cleared = False
     for _ in range(40):
         origins = rng.uniform([10, 10], [150, 110], (maps, 2))
         dirs = np.tile(np.stack([np.cos(angles), np.sin(angles)], axis=1), (maps, 1, 1))
@@ -676,24 +680,31 @@ def test_maps_cleared_together_are_each_cleared_as_alone(maps):
             alone[i].clear(origins[i], dirs[i], measured[i], 40.0)
             assert np.array_equal(together[i].occupied, alone[i].occupied)
             assert np.array_equal(together[i].marks, alone[i].marks)
+            assert together[i]._changes == alone[i]._changes
+        cleared |= any(m._changes > 40 for m in together[1:])   # some marks were seen through
+    assert cleared
 
 
 def test_marks_in_sight_of_many_maps_at_once_are_each_maps_own():
     rng = np.random.default_rng(17)
     grid = Grid(rng.random((50, 70)) < 0.02, 2.0, (-3.0, 5.0))
     maps = [knowledge.RobotMap.of(grid) for _ in range(9)]
+    none = some = False
     for _ in range(30):
         for m in maps[1:]:                                  # map 0 never marks
             hits = rng.uniform(-10, 150, (int(rng.integers(0, 6)), 2))
             m.mark(hits, np.tile([0.0, 1.0], (len(hits), 1)))
         origins = rng.uniform(-60, 200, (len(maps), 2))
         max_range = float(rng.uniform(0, 60))
-        got = knowledge._in_sight_all(maps, origins, max_range)
-        for m, o, mine in zip(maps, origins, got):
+        k, *got = knowledge._in_sight_all(maps, origins, max_range)
+        assert np.array_equal(k, np.sort(k, kind="stable"))
+        for j, (m, o) in enumerate(zip(maps, origins)):
             alone = m._in_sight(o, max_range)
-            assert (mine is None) == (alone is None)
-            assert mine is None or all(same(a, b) for a, b in zip(mine, alone))
-    assert any(g is None for g in got) and any(g is not None for g in got)
+            assert (alone is None) == (j not in k)
+            assert alone is None or all(same(a[k == j], b) for a, b in zip(got, alone))
+            none |= alone is None
+            some |= alone is not None
+    assert none and some
 
 
 def test_brake_sweeps_measured_together_are_each_measured_as_alone():

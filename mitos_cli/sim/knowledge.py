@@ -336,7 +336,9 @@ class RobotMap:
         """Unmark the marks at places ``where`` of :attr:`marks` (cells ``r``, ``c``)."""
         self._changes += 1
         self.occupied[r, c] = False
-        self.marks = np.delete(self.marks, where)
+        keep = np.ones(len(self.marks), dtype=bool)      # (np.delete's Python costs more)
+        keep[where] = False
+        self.marks = self.marks[keep]
 
     def mark(self, hits: np.ndarray, dirs: np.ndarray) -> None:
         """Mark the cells just beyond each hit point (the echo came from there)."""
@@ -453,43 +455,60 @@ def _four(x: float, y: float) -> np.ndarray:
 def clear_all(maps: list[RobotMap], origins: np.ndarray, dirs: np.ndarray,
               measured: np.ndarray, max_range: float) -> None:
     """:meth:`RobotMap.clear` of every map at once (robots at ``origins [R, 2]``, their beams
-    ``dirs [R, B, 2]`` and readings ``measured [R, B]``; runs in lockstep clear together). The
-    marks in sight are padded far away, and the products are written out elementwise, so a
-    map is cleared as it would be alone."""
-    seen = [(m, i, got) for i, (m, got) in enumerate(zip(maps, _in_sight_all(maps, origins,
-                                                                          max_range)))
-            if got is not None]
-    if not seen:
-        return
-    if len(seen) == 1:                  # one map: no batch to set up (the same arithmetic)
-        m, i, (where, r, c, rel) = seen[0]
+    ``dirs [R, B, 2]`` and readings ``measured [R, B]``; runs in lockstep clear together):
+    the marks in sight of every map one after the other, each with its robot's beams, and
+    the products written out elementwise, so a map is cleared as it would be alone."""
+    if len(maps) == 1:                  # one map: no beams to gather (the same arithmetic)
+        m, got = maps[0], maps[0]._in_sight(origins[0], max_range)
+        if got is None:
+            return
+        where, r, c, rel = got
         res = m.grid.resolution
         rx, ry = rel[:, 0, None], rel[:, 1, None]                  # [P, 1]
-        dx, dy = dirs[i, :, 0], dirs[i, :, 1]                      # [B]
+        dx, dy = dirs[0, :, 0], dirs[0, :, 1]                      # [B]
         along = rx * dx + ry * dy
-        through = np.logical_or.reduce((along > 0) & (along < np.minimum(measured[i], max_range)
+        through = np.logical_or.reduce((along > 0) & (along < np.minimum(measured[0], max_range)
                                                       - res)
                                        & (np.abs(rx * dy - ry * dx) < res / 2), axis=1)
         if np.count_nonzero(through):
             m._free(where[through], r[through], c[through])
         return
-    widest = max(len(got[3]) for _, _, got in seen)
-    block = max(1, CACHED // (widest * dirs.shape[1]))    # rows whose arrays stay in cache
-    for lo in range(0, len(seen), block):
-        _clear_block(seen[lo:lo + block], dirs, measured, max_range)
+    k, where, r, c, rel = _in_sight_all(maps, origins, max_range)
+    if not len(k):
+        return
+    cell = np.array([m.grid.resolution for m in maps])
+    beams = (np.ascontiguousarray(dirs[..., 0]), np.ascontiguousarray(dirs[..., 1]),
+             np.minimum(measured, max_range) - cell[:, None], cell / 2)
+    block = max(1, CACHED // dirs.shape[1])             # marks whose arrays stay in cache
+    through = np.concatenate([_seen_through(rel[lo:lo + block], k[lo:lo + block], *beams)
+                              for lo in range(0, len(k), block)])
+    hit = np.flatnonzero(through)
+    if not len(hit):
+        return
+    which, first = np.unique(k[hit], return_index=True)     # each map's marks seen through
+    for j, a, e in zip(which.tolist(), first.tolist(), [*first[1:].tolist(), len(hit)]):
+        mine = hit[a:e]
+        maps[j]._free(where[mine], r[mine], c[mine])
 
 
-def _in_sight_all(maps: list[RobotMap], origins: np.ndarray, max_range: float) -> list:
-    """``[m._in_sight(o, max_range) for m, o in zip(maps, origins [R, 2])]`` at once: every
-    map's marks decoded and tested against its square in one pass (maps alike: the runs of a
-    world), then split map by map; the same marks in the same order, the same centres."""
+def _in_sight_all(maps: list[RobotMap], origins: np.ndarray, max_range: float) -> tuple:
+    """:meth:`RobotMap._in_sight` of every map (robots at ``origins [R, 2]``), one map's
+    after the other: the maps ``k``, and the marks' places, rows, columns and centres
+    relative to their robots; every map's marks decoded and tested against its square in one
+    pass (maps alike: the runs of a world). The same marks in the same order, the same
+    centres."""
     grid = _alike(maps) if len(maps) > 1 else None
     if grid is None:
-        return [m._in_sight(o, max_range) for m, o in zip(maps, origins)]
+        got = [(j, g) for j, (m, o) in enumerate(zip(maps, origins))
+               if (g := m._in_sight(o, max_range)) is not None]
+        if not got:
+            return _none_in_sight()
+        k = np.repeat([j for j, _ in got], [len(g[0]) for _, g in got])
+        return (k, *(np.concatenate(part) for part in zip(*(g for _, g in got))))
     counts = [len(m.marks) for m in maps]
     ends = list(itertools.accumulate(counts))
     if not ends[-1]:
-        return [None] * len(maps)
+        return _none_in_sight()
     k = np.repeat(np.arange(len(maps)), counts)
     r, c = np.divmod(np.concatenate([m.marks for m in maps]), grid.occupied.shape[1])
     r0, r1, c0, c1 = _squares(grid, origins, np.full(len(maps), max_range))
@@ -500,33 +519,32 @@ def _in_sight_all(maps: list[RobotMap], origins: np.ndarray, max_range: float) -
     rel = np.empty((len(sel), 2))
     rel[:, 0], rel[:, 1] = xs[c], ys[r]
     rel -= origins[k]
-    out: list = []
-    a = 0
-    for b in np.cumsum(np.bincount(k, minlength=len(maps))).tolist():
-        out.append((where[a:b], r[a:b], c[a:b], rel[a:b]) if b > a else None)
-        a = b
-    return out
+    return k, where, r, c, rel
 
 
-def _clear_block(seen: list, dirs: np.ndarray, measured: np.ndarray, max_range: float) -> None:
-    """:func:`clear_all` of the maps ``seen`` (``(map, row, its marks in sight)`` each), their
-    marks padded far away: ``[H, P, B]`` products, elementwise."""
-    rel = np.full((len(seen), max(len(got[3]) for _, _, got in seen), 2), 1e12)
-    for j, (_, _, got) in enumerate(seen):
-        rel[j, :len(got[3])] = got[3]
-    idx = [i for _, i, _ in seen]
-    d = dirs[idx]                                                  # [H, B, 2]
-    rx, ry = rel[..., 0, None], rel[..., 1, None]                  # [H, P, 1]
-    dx, dy = d[:, None, :, 0], d[:, None, :, 1]                    # [H, 1, B]
-    along = rx * dx + ry * dy                                      # [H, P, B]
-    across = np.abs(rx * dy - ry * dx)
-    cell = np.array([m.grid.resolution for m, _, _ in seen])[:, None, None]
-    reach = np.minimum(measured[idx], max_range)[:, None] - cell
-    through = np.logical_or.reduce((along > 0) & (along < reach) & (across < cell / 2), axis=2)
-    for j, (m, _, (where, r, c, pts)) in enumerate(seen):
-        mine = through[j, :len(pts)]
-        if np.count_nonzero(mine):
-            m._free(where[mine], r[mine], c[mine])
+def _none_in_sight() -> tuple:
+    """:func:`_in_sight_all` with no mark in sight."""
+    return (np.zeros(0, dtype=np.intp), np.zeros(0, dtype=np.intp), np.zeros(0, dtype=np.int64),
+            np.zeros(0, dtype=np.int64), np.zeros((0, 2)))
+
+
+def _seen_through(rel: np.ndarray, k: np.ndarray, dx: np.ndarray, dy: np.ndarray,
+                  reach: np.ndarray, half: np.ndarray) -> np.ndarray:
+    """Which marks (centres ``rel [K, 2]`` relative to robots ``k``) a beam of their robot
+    (``dx``, ``dy [R, B]``) passes through, short of its echo (``reach [R, B]``: the reading
+    less a cell) and within half a cell (``half [R]``) of the mark's centre: ``[K, B]``
+    products, elementwise (``rx * dx + ry * dy`` and ``|rx * dy - ry * dx|``)."""
+    dx, dy = dx[k], dy[k]                                          # [K, B]
+    rx, ry = rel[:, 0, None], rel[:, 1, None]                      # [K, 1]
+    along = rx * dx
+    along += ry * dy
+    across = rx * dy
+    across -= ry * dx
+    np.abs(across, out=across)
+    through = along > 0
+    through &= along < reach[k]
+    through &= across < half[k, None]
+    return np.logical_or.reduce(through, axis=1)
 
 
 def beyond_cells(maps: list[RobotMap], origins: np.ndarray, dirs: np.ndarray,
