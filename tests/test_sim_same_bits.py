@@ -536,6 +536,12 @@ def test_rows_stacked_are_each_row_padded_with_zeros(lengths, extra, tail, seed)
         assert same(row[:len(a)], a) and not row[len(a):].any()
     alike = [rng.normal(size=(lengths[0], *tail)) for _ in lengths]     # width left out
     assert same(rows._stacked(alike), np.stack(alike))
+    padded = rows._stacked(arrays)                                      # to the longest
+    assert padded.shape == (len(arrays), max(lengths), *tail)
+    assert same(padded, got[:, :max(lengths)])
+    if extra and max(lengths):
+        with pytest.raises(ValueError, match="does not fit"):
+            rows._stacked(arrays + [np.zeros((width, *tail))], width - 1)
 
 
 @pytest.mark.parametrize("seed", range(40))

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import functools
 import math
+import os
+import signal
 import zlib
 from pathlib import Path
 
@@ -124,12 +126,13 @@ def test_chunks_cover_every_task_once():
 def test_lockstep_chunks_keep_one_world_and_choice_each_and_cover_every_task_once():
     tasks = expand(["a", "b"], make_choices(["fuzzy", "potential_field"], ["min"], [], []),
                    100, 0)
-    for workers, most in ((1, 64), (2, 64), (3, 16)):
+    for workers, most, size in ((1, 64, 50), (2, 64, 50), (3, 16, 12), (2, 200, 50)):
         parts = lockstep_chunks(tasks, workers, most)
         assert sorted(t.index for p in parts for t in p) == list(range(len(tasks)))
         assert all(len({(t.world, t.choice) for t in p}) == 1 for p in parts)
-        assert max(map(len, parts)) == min(most, math.ceil(100 / workers))
+        assert max(map(len, parts)) == size and len(parts) % workers == 0
         assert [p[0].index for p in parts] == sorted(p[0].index for p in parts)
+    assert len(lockstep_chunks(tasks[:3], 2)) == 3                 # one world and choice each
 
 
 def test_the_simulator_steps_a_chunk_together_with_each_task_s_bits_alone(tmp_path):
@@ -147,19 +150,26 @@ def test_the_simulator_steps_a_chunk_together_with_each_task_s_bits_alone(tmp_pa
 
 
 def _parts(n: int):
+    if n == 5:
+        os.kill(os.getpid(), signal.SIGKILL)          # the out-of-memory killer, say
     for i in range(n):
         if n == 3 and i == 1:
             raise Crash("killed")
-        yield n, i
+        yield (lambda: i) if n == 6 else (n, i)       # n == 6: a part pickle refuses
 
 
 def test_a_streaming_pool_gives_every_part_as_made_and_raises_a_worker_s_error():
-    from mitos_cli.sim.runs import pool_streaming
+    from mitos_cli.sim.runs import WorkerLost, pool_streaming
 
-    got = sorted(pool_streaming(_parts, [1, 2, 4], 2, 7))
+    got = sorted(pool_streaming(_parts, [1, 2, 4, 0], 2))
     assert got == [(1, 0), (2, 0), (2, 1), (4, 0), (4, 1), (4, 2), (4, 3)]
     with pytest.raises(Crash, match="killed"):
-        list(pool_streaming(_parts, [1, 3, 2], 2, 6))
+        list(pool_streaming(_parts, [1, 3, 2], 2))
+    with pytest.raises(AttributeError, match="pickle"):               # not a hang
+        list(pool_streaming(_parts, [1, 6], 2))
+    with pytest.raises(WorkerLost, match="unfinished") as lost:      # not a hang either
+        list(pool_streaming(_parts, [1, 5, 2], 2))
+    assert "fewer workers" in lost.value.hint
 
 
 # -- executors, store, resume --------------------------------------------------------------

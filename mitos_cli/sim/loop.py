@@ -772,11 +772,10 @@ class Simulation:
         """Each robot's :class:`.perception.Aim` at tick ``s``, its map cleared
         (:meth:`clearing`) and marked and its tracks followed (:meth:`tracked`): where it is
         on its route (its route replanned if need be, :meth:`replanned`) and what its pursuit
-        point keeps clear of (runs in lockstep find their pursuit points together);
-        ``frames``: where they are on their routes (:meth:`framing`); ``near``: what each
-        robot's map holds within its lookahead and least clearance
-        (:meth:`.knowledge.RobotMap.near`; runs in lockstep ask together, ``None``: asked
-        here)."""
+        point keeps clear of; ``frames``: where they are on their routes (:meth:`framing`);
+        ``near``: what each robot's map holds within its lookahead and least clearance
+        (:meth:`.knowledge.RobotMap.near`; ``None``: asked here). Runs in lockstep ask
+        :meth:`Batch.aims` instead, for all their robots at once."""
         if self._watched[0] is not s:               # not yet tracked at this tick
             self.tracked(s)
         frames = list(frames)

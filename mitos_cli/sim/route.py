@@ -970,6 +970,11 @@ def _edges_from(out: np.ndarray, field: Clearance, xy: np.ndarray, t: np.ndarray
     c0, c1 = max(cols[0], 0), min(cols[1], C)
     if r0 >= r1 or c0 >= c1:
         return
+    band = max(1, _EDGE_SAMPLES // (len(moves) * len(t) * (c1 - c0)))
+    if r1 - r0 > band:            # a whole grid in bands of rows: its arrays stay tens of MB
+        for a in range(r0, r1, band):
+            _edges_from(out, field, xy, t, moves, (a, min(a + band, r1)), (c0, c1))
+        return
     res, (ox, oy) = field.resolution, field.origin
     rows_n, cols_n = field.dist.shape
     r, c = np.arange(r0, r1)[:, None], np.arange(c0, c1)[None, :]
@@ -994,6 +999,9 @@ def _edges_from(out: np.ndarray, field: Clearance, xy: np.ndarray, t: np.ndarray
     cells = field.cells(np.stack([x.reshape(-1), y.reshape(-1)], axis=1)).reshape(x.shape)
     part[on] = np.minimum.reduce(cells, axis=0).reshape(on.shape)[on]
 
+
+#: samples :func:`_edges_from` works out in one pass (about 40 bytes each at its peak)
+_EDGE_SAMPLES = 8 * CACHED
 
 MOVES = tuple((dr, dc, math.hypot(dr, dc)) for dr in (-1, 0, 1) for dc in (-1, 0, 1)
               if dr or dc)

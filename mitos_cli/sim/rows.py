@@ -87,16 +87,21 @@ def sense(rows: list[SenseRow], angles: np.ndarray, max_range: float) -> Sensed:
 
 def _stacked(arrays: list[np.ndarray], width: int | None = None) -> np.ndarray:
     """``[R, width, ...]``: the arrays one above the other, each padded with zeros to
-    ``width`` rows (a view of the one array, when there is one that needs no padding): one
-    concatenation, then the rows laid out in a block where they are not all ``width`` long."""
-    width = len(arrays[0]) if width is None else width
+    ``width`` rows (default: the longest's; a view of the one array, when there is one that
+    needs no padding): one concatenation, then the rows laid out in a block where they are
+    not all ``width`` long."""
+    lengths = np.fromiter(map(len, arrays), np.intp, len(arrays))
+    longest = int(lengths.max())
+    width = longest if width is None else width
+    if longest > width:
+        raise ValueError(f"an array of {longest} rows does not fit in {width}")
     if len(arrays) == 1 and len(arrays[0]) == width:
         return arrays[0][None]
     flat = np.concatenate(arrays, dtype=float)
-    if len(flat) == len(arrays) * width:                # (none is longer than width)
+    if len(flat) == len(arrays) * width:                # (all are width long)
         return flat.reshape(len(arrays), width, *flat.shape[1:])
     out = np.zeros((len(arrays), width, *flat.shape[1:]))
-    out[np.arange(width) < np.fromiter(map(len, arrays), np.intp, len(arrays))[:, None]] = flat
+    out[np.arange(width) < lengths[:, None]] = flat
     return out
 
 

@@ -8,8 +8,6 @@ not depend on the number of workers or on which worker ran what.
 
 from __future__ import annotations
 
-import contextlib
-import math
 import operator
 import os
 from collections import Counter
@@ -19,7 +17,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import InputError
+from ..errors import InputError, MitosError
 from .lockstep import BATCH, Lockstep
 from .loop import OUTCOMES, ROBOT_OUTCOMES, check_seed, shared_scene
 from .world import World
@@ -157,7 +155,7 @@ def run_many(worlds: list[World], runs: int = 0, seed: int | None = None, planne
         # chunks has its map and routes prepared once, here, and sent along (a grid map's
         # route search costs about as much as a run), unless its draws move what the robots
         # are given (shared_scene)
-        size = max(1, min(BATCH, math.ceil(len(seeds) / workers)))
+        size = even_chunks(len(seeds), workers, BATCH)
         scene = shared_scene(w, runs > 0) if len(seeds) > size else None
         for i in range(0, len(seeds), size):
             tasks.append((w, tuple(seeds[i:i + size]), scene))
@@ -218,22 +216,19 @@ def _execute(jobs: list[tuple], workers: int) -> Iterator[tuple[int, int, dict]]
         for job in jobs:
             yield from _chunk_runs(job)
         return
-    yield from pool_streaming(_chunk_runs, jobs, min(workers, len(jobs)),
-                              sum(len(job[3]) for job in jobs))
+    yield from pool_streaming(_chunk_runs, jobs, min(workers, len(jobs)))
 
 
-def pool_unordered(fn, items: list, workers: int):
-    """``fn(item)`` for each item on a pool of ``workers`` processes, in the order they
-    finish; on Ctrl-C or an error the workers are terminated at once, not left to finish."""
-    import multiprocessing
-
-    pool = multiprocessing.get_context().Pool(workers, initializer=ignore_interrupts)
-    with _terminated_unless_finished(pool) as finishing:
-        yield from pool.imap_unordered(fn, items)
-        finishing()
+def even_chunks(n: int, workers: int, most: int) -> int:
+    """How many of ``n`` items a chunk takes: at most ``most``, and as many chunks as a
+    multiple of ``workers`` so that each worker gets about as much (200 runs on 2 workers in
+    batches of at most 64: four chunks of 50, not 64, 64, 64 and 8)."""
+    count = -(-n // max(1, most))
+    count = -(-count // workers) * workers
+    return max(1, -(-n // count))
 
 
-#: where a pool worker of :func:`pool_streaming` puts what its generator yields
+#: where a pool worker of :func:`pool_streaming` puts what its generators yield
 _outbox: Any = None
 
 
@@ -243,50 +238,74 @@ def _streaming_worker(outbox) -> None:
     _outbox = outbox
 
 
-def _stream(fn, item) -> None:
+def _stream(fn, job: tuple[int, Any]) -> None:
+    """Put what ``fn(item)`` yields, each part pickled here (an error raised in this thread
+    reaches :func:`pool_streaming`, not the queue's feeder thread), and then an end."""
+    import pickle
+
+    k, item = job
     for part in fn(item):
-        _outbox.put(part)
+        _outbox.put(("part", k, pickle.dumps(part)))
+    _outbox.put(("end", k, None))
 
 
-def pool_streaming(fn: Callable[[Any], Iterator[Any]], items: list, workers: int, expected: int):
+class WorkerLost(MitosError):
+    """A pool worker ended before the pool did: killed (out of memory, a signal). Said as an
+    error, not a traceback; without it the pool would wait for its items for ever."""
+
+
+def pool_streaming(fn: Callable[[Any], Iterator[Any]], items: list,
+                   workers: int) -> Iterator[Any]:
     """What the generator ``fn(item)`` yields, for each item, on a pool of ``workers``
-    processes, as each part is made (``expected``: how many parts there are in all); a
-    worker's error is raised here, and on Ctrl-C or an error the workers are terminated."""
+    processes, as each part is made. A worker's error is raised here, and so is
+    :class:`WorkerLost` when a worker dies; on Ctrl-C or an error the workers are terminated
+    at once, not left to finish."""
     import functools
     import multiprocessing
+    import pickle
     import queue
 
     context = multiprocessing.get_context()
     outbox = context.Queue()
+    others = {p.pid for p in multiprocessing.active_children()}
     pool = context.Pool(workers, initializer=_streaming_worker, initargs=(outbox,))
-    with _terminated_unless_finished(pool) as finishing:
-        pending = pool.map_async(functools.partial(_stream, fn), items, chunksize=1)
-        for _ in range(expected):
-            while True:
-                try:
-                    part = outbox.get(timeout=0.1)
-                    break
-                except queue.Empty:
-                    if pending.ready() and not pending.successful():
-                        pending.get()                   # raises the worker's error
-            yield part
-        pending.get()
-        finishing()
-
-
-@contextlib.contextmanager
-def _terminated_unless_finished(pool) -> Iterator[Callable[[], None]]:
-    """``pool`` closed and joined once the caller says it finished, else terminated at once
-    (Ctrl-C or an error: its workers are not left to finish)."""
-    finished = []
+    started = {p.pid for p in multiprocessing.active_children()} - others
+    finished = False
     try:
-        yield lambda: finished.append(True)
+        pending = pool.map_async(functools.partial(_stream, fn), list(enumerate(items)),
+                                 chunksize=1)
+        ended = 0
+        while ended < len(items):
+            try:
+                what, _, part = outbox.get(timeout=0.1)
+            except queue.Empty:
+                _check(pending, started)
+                continue
+            if what == "part":
+                yield pickle.loads(part)
+            else:
+                ended += 1
+        pending.get()
+        finished = True
     finally:
         if finished:
             pool.close()
         else:
             pool.terminate()
         pool.join()
+
+
+def _check(pending, workers: set[int | None]) -> None:
+    """Raise a worker's error, or :class:`WorkerLost` when one of the pool's ``workers`` is
+    gone (a pool's workers end only when the pool does)."""
+    import multiprocessing
+
+    if pending.ready() and not pending.successful():
+        pending.get()
+    if not workers <= {p.pid for p in multiprocessing.active_children()}:
+        raise WorkerLost("a worker process ended with runs unfinished: killed (out of "
+                         "memory, or a signal?)",
+                         hint="run again with fewer workers (-j), or fewer runs at once")
 
 
 def _group(worlds: list[World], tasks: list[tuple], results: list[list[dict | None]]) -> Runs:

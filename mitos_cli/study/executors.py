@@ -4,7 +4,8 @@ Every executor is a generator of ``(task, result)`` pairs in the order they fini
 writes each one down at once. A task's result depends on the task alone (its seed is in it), so
 every executor gives the same results as a serial run, bit for bit; only the arrival order
 differs. Tasks travel in chunks to keep the per-task overhead low, and the simulator steps a
-chunk's runs of one world and choice together; results still arrive as each task finishes.
+chunk's runs of one world and choice together. From the local pool each result arrives as its
+task finishes; from Dask, a chunk's results arrive together when the chunk ends.
 """
 
 from __future__ import annotations
@@ -51,18 +52,23 @@ def chunks(tasks: Sequence[Task], workers: int, most: int = 8) -> list[list[Task
     return [list(tasks[i:i + size]) for i in range(0, len(tasks), size)]
 
 
-def lockstep_chunks(tasks: Sequence[Task], workers: int, most: int = 64) -> list[list[Task]]:
+def lockstep_chunks(tasks: Sequence[Task], workers: int,
+                    most: int | None = None) -> list[list[Task]]:
     """Cut ``tasks`` into chunks of one world and choice each, for a task function that runs
-    a chunk together: each worker's share of a world and choice in chunks of at most ``most``
-    (a lockstep batch of 5 runs costs about twice what one of 40 does a robot-tick), the
-    chunks in the order of their first tasks (a sweep stopped half-way holds about as many
-    runs of every world and choice)."""
+    a chunk together: each world and choice in as many chunks as a multiple of ``workers``,
+    of at most ``most`` (default: a lockstep batch, :data:`.lockstep.BATCH`; a batch of 5
+    runs costs about twice what one of 40 does a robot-tick), the chunks in the order of
+    their first tasks (a sweep stopped half-way holds about as many runs of every world and
+    choice)."""
+    from ..sim.lockstep import BATCH
+    from ..sim.runs import even_chunks
+
     groups: dict[tuple, list[Task]] = {}
     for task in tasks:
         groups.setdefault((task.world, task.choice), []).append(task)
     out = []
     for group in groups.values():
-        size = max(1, min(most, -(-len(group) // workers)))
+        size = even_chunks(len(group), workers, BATCH if most is None else most)
         out += [group[i:i + size] for i in range(0, len(group), size)]
     return sorted(out, key=lambda chunk: chunk[0].index)
 
@@ -90,8 +96,7 @@ def run_local(fn: TaskFn, tasks: Sequence[Task], workers: int) -> Iterator[tuple
     from ..sim.runs import pool_streaming
 
     parts = _chunks_for(fn, tasks, workers)
-    yield from pool_streaming(functools.partial(run_chunk, fn), parts,
-                              min(workers, len(parts)), len(tasks))
+    yield from pool_streaming(functools.partial(run_chunk, fn), parts, min(workers, len(parts)))
 
 
 def require_dask(scheduler: str | None) -> None:
@@ -222,8 +227,10 @@ def run_dask(fn: TaskFn, tasks: Sequence[Task], workers: int, scheduler: str | N
         from distributed import as_completed
 
         n = len(client.scheduler_info().get("workers", {})) or workers
-        futures = client.map(functools.partial(chunk_list, fn), _chunks_for(fn, tasks, n),
-                             pure=False)
+        # (a chunk's rows arrive together when it ends: four chunks a worker, so that they
+        # arrive through the sweep and Ctrl-C drops less that was not yet written down)
+        futures = client.map(functools.partial(chunk_list, fn),
+                             _chunks_for(fn, tasks, 4 * n), pure=False)
         try:
             for _future, part in as_completed(futures, with_results=True):
                 yield from part
