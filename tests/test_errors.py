@@ -167,6 +167,10 @@ def test_binary_file_is_refused(tmp_path):
     path.write_bytes(b"\x89PNG\r\n\x1a\n\x00\xff\xfe")
     exc = error_of(lambda: load_rules_file(path), RuleBaseError)
     assert "not a text file" in exc.message and exc.span.path == str(path)
+    path.write_bytes(b'terms "t.yaml"\nbehavior a:\n  r1: if x is \xe9 then y is z\n')
+    exc = error_of(lambda: load_rules_file(path), RuleBaseError)
+    assert exc.message.endswith("is not a text file (byte 0xe9 is not UTF-8)")
+    assert (exc.span.line, exc.span.column) == (3, 15)
 
 
 def test_a_missing_rule_file_guesses_only_a_close_name(tmp_path, capsys):

@@ -431,3 +431,43 @@ def test_rules_writer_refusals() -> None:
                      .replace("a is high or b is big", "a is high"))
     with pytest.raises(FormatError, match="input `b` has no terms"):
         write_rules(bare, "x.terms.yaml")
+
+
+# ---------------------------------------------------------------------------------------------
+# Encodings: MATLAB and Java on Windows write Windows-1252
+
+
+def test_a_windows_1252_fis_is_read_with_a_note(tmp_path: Path) -> None:
+    text = Path("tests/data/interop/tipper.fis").read_text().replace(
+        "Name='service'", "Name='service'\n% Temperatur (°C), naïve")
+    (tmp_path / "t.fis").write_bytes(text.encode("cp1252"))
+    rb = read_foreign(tmp_path / "t.fis")
+    same = read_foreign(Path("tests/data/interop/tipper.fis"))
+    assert write_foreign(rb, "fll") == write_foreign(same, "fll")
+    assert rb.notes[0].startswith("`t.fis` is not UTF-8 (byte 0xb0 at line ")
+    assert "read as Windows-1252" in rb.notes[0]
+
+
+def test_a_windows_1252_name_reaches_the_rules(tmp_path: Path) -> None:
+    text = Path("tests/data/interop/tipper.fis").read_text().replace("service", "qualité")
+    (tmp_path / "t.fis").write_bytes(text.encode("cp1252"))
+    rb = read_foreign(tmp_path / "t.fis")
+    assert "read as Windows-1252" in rb.notes[0]
+    from mitos_cli.interop import conversion_notes
+
+    assert any("`qualité` is written as `qualit_`" in note
+               for note in conversion_notes(rb, "rules"))
+
+
+@pytest.mark.parametrize("data, message, at", [
+    (b"[System]\nName='a\x00\xb0'\n", "byte 0x00 at line 2, column 8 is neither UTF-8 nor", (2, 8)),
+    (b"[System]\n\xe9\x81\n", "byte 0xe9 at line 2, column 1 is neither UTF-8 nor", (2, 1)),
+    ("[System]\n".encode("utf-16"), "is UTF-16 text", (1, 1)),
+])
+def test_bytes_that_are_no_text_are_refused_where_they_are(tmp_path: Path, data: bytes,
+                                                           message: str, at: tuple) -> None:
+    (tmp_path / "x.fis").write_bytes(data)
+    with pytest.raises(FormatError, match=message) as exc:
+        read_foreign(tmp_path / "x.fis")
+    assert exc.value.span is not None
+    assert (exc.value.span.line, exc.value.span.column) == at

@@ -50,6 +50,7 @@ from ..words import plural
 from . import common
 from .common import FCL, FLL, fmt_number
 from .ruletree import conclusions, expression
+from .text import read_foreign_file
 
 DEFAULT_RESOLUTION = 1000
 
@@ -77,10 +78,7 @@ def parser() -> Lark:
 
 
 def read_fcl(path: str | Path) -> RuleBase:
-    from .fll import _read_text
-
-    path = Path(path)
-    return parse_fcl(_read_text(path), str(path))
+    return read_foreign_file(Path(path), parse_fcl)
 
 
 def _syntax_error(exc: UnexpectedInput, text: str, path: str | None) -> FormatError:

@@ -40,6 +40,7 @@ from ..lang.terms import Role, Term, Variable
 from ..words import plural
 from . import common
 from .common import FIS, Settings, fmt_number
+from .text import read_foreign_file
 
 DEFAULT_RESOLUTION = 101
 
@@ -73,10 +74,7 @@ VAR_KEYS = ("Name", "Range", "NumMFs", "Enabled", "Default", "LockPrevious", "Lo
 
 
 def read_fis(path: str | Path) -> RuleBase:
-    from .fll import _read_text
-
-    path = Path(path)
-    return parse_fis(_read_text(path), str(path))
+    return read_foreign_file(Path(path), parse_fis)
 
 
 def _sections(text: str, path: str | None):

@@ -30,7 +30,6 @@ from lark import Lark, Tree
 from lark.exceptions import UnexpectedInput
 
 from ..errors import FormatError, Span, did_you_mean
-from ..fileio import read_text, unreadable
 from ..fuzzy.formula import parse as parse_formula
 from ..lang.bulk import without_cyclic_gc
 from ..lang.cache import lark_parser
@@ -42,6 +41,7 @@ from . import common
 from .common import FLL, Settings, fmt_number
 from .ruletree import conclusions as conclusions_of
 from .ruletree import expression
+from .text import read_foreign_file
 
 #: fuzzylite's monotonic terms, which its weighted defuzzifiers invert (Tsukamoto inference)
 TSUKAMOTO_KINDS = ("Ramp", "Sigmoid", "SShape", "ZShape", "Concave", "Arc")
@@ -114,17 +114,7 @@ class _Block:
 
 
 def read_fll(path: str | Path) -> RuleBase:
-    path = Path(path)
-    return parse_fll(_read_text(path), str(path))
-
-
-def _read_text(path: Path) -> str:
-    try:
-        return read_text(path)          # UTF-8; a byte-order mark is not content
-    except UnicodeDecodeError:
-        raise FormatError(f"`{path}` is not a text file (it is not UTF-8)") from None
-    except OSError as exc:
-        raise FormatError(unreadable("rule file", path, exc)) from None
+    return read_foreign_file(Path(path), parse_fll)
 
 
 @without_cyclic_gc

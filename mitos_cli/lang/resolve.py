@@ -51,15 +51,15 @@ def termset_hint(target: Path, name: str) -> str:
 @without_cyclic_gc
 def load_rules_file(path: str | Path) -> RuleBase:
     """Read, parse and check the rule file at ``path`` and the term sets it names."""
-    from ..fileio import finish_saves, read_text, unreadable
+    from ..fileio import bad_byte, finish_saves, read_text, unreadable
 
     path = Path(path)
     finish_saves(path)              # a set save a crash left half done
     try:
         text = read_text(path)
-    except UnicodeDecodeError:
-        raise RuleBaseError(f"`{path}` is not a text file (it is not UTF-8)",
-                            span=Span(str(path), 1, 1)) from None
+    except UnicodeDecodeError as exc:
+        raise RuleBaseError(f"`{path}` is not a text file (byte 0x{exc.object[exc.start]:02x} "
+                            "is not UTF-8)", span=bad_byte(path, exc)) from None
     except OSError as exc:
         raise RuleBaseError(unreadable("rule file", path, exc),
                             hint=rule_file_hint(path)) from None

@@ -54,7 +54,7 @@ ALIASES = {"constant": "singleton"}     # Takagi-Sugeno's name for a crisp conse
 
 def load_termset(path: str | Path) -> TermSet:
     """Read and validate the term set at ``path``."""
-    from ..fileio import read_text, unreadable
+    from ..fileio import bad_byte, read_text, unreadable
 
     path = Path(path)
     try:
@@ -62,11 +62,8 @@ def load_termset(path: str | Path) -> TermSet:
     except OSError as exc:
         raise TermSetError(unreadable("term set", path, exc)) from None
     except UnicodeDecodeError as exc:
-        data = exc.object
-        line = data.count(b"\n", 0, exc.start) + 1
-        column = exc.start - (data.rfind(b"\n", 0, exc.start) + 1) + 1
-        raise TermSetError(f"`{path}` is not a text file (byte 0x{data[exc.start]:02x} is not "
-                           f"UTF-8)", span=Span(str(path), line, column)) from None
+        raise TermSetError(f"`{path}` is not a text file (byte 0x{exc.object[exc.start]:02x} "
+                           "is not UTF-8)", span=bad_byte(path, exc)) from None
     return parse_termset(text, str(path))
 
 
