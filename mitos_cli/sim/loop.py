@@ -280,6 +280,7 @@ class Tick:
     obstacles: np.ndarray           # [O, 2] obstacle positions
     active: np.ndarray              # [n] robot still driving after this tick's verdict
     progress: np.ndarray            # [n] arc length along each robot's route (in)
+    block: np.ndarray = field(repr=False)   # [inputs, n]: the rows ``inputs`` holds, one block
 
 
 @dataclass
@@ -1036,7 +1037,7 @@ class Simulation:
         """Record tick ``s`` with the robots' state as it was observed (arrays no later
         tick changes in place: the record keeps them)."""
         tick = Tick(self._k, s.t, pose, speed, steering, s.command, s.ranges, s.inputs,
-                    s.clearance, s.where, active, progress)
+                    s.clearance, s.where, active, progress, s.block)
         self.record.append(tick)
         return tick
 
@@ -1050,8 +1051,9 @@ class Simulation:
             raise RuntimeError("no tick recorded yet: result() reports the ticks step() ran")
 
         def stack(attr: str) -> np.ndarray:
-            return np.array([getattr(r, attr) for r in rec])
+            return _stacked([getattr(r, attr) for r in rec])
 
+        inputs = stack("block")                         # [T, inputs, n]
         res = SimResult(
             world=self.world, seed=self.seed,
             planner=getattr(self.planner, "name", type(self.planner).__name__),
@@ -1059,15 +1061,20 @@ class Simulation:
             collisions=self._collided, t=np.arange(T) * dt, pose=stack("pose"),
             speed=stack("speed"), steering=stack("steering"),
             command=stack("command"), ranges=stack("ranges"),
-            perceived={key: np.array([r.inputs[key] for r in rec]) for key in perception.INPUTS},
-            clearance=stack("clearance"),
-            obstacles=np.array([r.obstacles for r in rec]).reshape(T, -1, 2),
+            perceived=dict(zip(perception.INPUTS, inputs.transpose(1, 0, 2).copy())),
+            clearance=stack("clearance"), obstacles=stack("obstacles").reshape(T, -1, 2),
             routes=self.scene.routes, static=self.scene.static, active=stack("active"),
             progress=stack("progress"), replanned=tuple(self._replanned),
             backed_out=tuple(self._backed))
         res.robot_metrics = _robot_metrics(res, dt)
         res.metrics = _metrics(res, dt)
         return res
+
+
+def _stacked(parts: list[np.ndarray]) -> np.ndarray:
+    """``np.array(parts)`` of arrays of one shape, ``[len(parts), *shape]``: one concatenation
+    (``np.array`` looks at each part on its own: 5 ms of a run's 500 ticks)."""
+    return np.concatenate(parts).reshape(len(parts), *np.shape(parts[0]))
 
 
 def _sights(aims: list[perception.Aim], robots: list, pose: np.ndarray, dirs: np.ndarray,
