@@ -1173,6 +1173,10 @@ class Batch:
         # robots' places, inputs (a row each), targets, commands, contacts and who drives
         self.ticks: list[_Sensed] = []
         self._now: tuple[np.ndarray, ...] | None = None
+        # its robots' speeds and wheels (the batch's tick leaves them as they were until it
+        # moves them) and their arc lengths along their routes (:meth:`aims`)
+        self._drive: tuple[np.ndarray, np.ndarray] = (np.zeros(0), np.zeros(0))
+        self._hint = np.zeros(0)
         self.got = rows.Sensed(np.zeros((0, 0, 2)), np.zeros((0, 0)), np.zeros((0, 0)), np.zeros(0))
         self.pose, self.at = np.zeros((0, 3)), np.zeros((0, 2))
         self.block = np.zeros((len(perception.INPUTS), 0))
@@ -1193,6 +1197,7 @@ class Batch:
         """:meth:`Simulation.sensed` of every run from the rows of all (``got``): the tick's
         arrays made once, each run's :class:`_Sensed` views of them."""
         x, y, h = self._now = (self._gather("_x"), self._gather("_y"), self._gather("_h"))
+        self._drive = (self._gather("_v"), self._gather("_steer"))
         pose = _columns(x, y, h)
         n = len(x)
         self.block = np.zeros((len(perception.INPUTS), n))    # a row per input, as alone
@@ -1264,7 +1269,7 @@ class Batch:
         for row in knowledge.checks_due(self.maps, self.ticks[0].t, self._when):
             j, i = self._rows[row]
             frames[row] = self.runs[j].replanned(self.ticks[j], i, frames[row])
-        hint = np.array([f.s for f in frames])
+        self._hint = hint = np.array([f.s for f in frames])
         for run, (a, b) in zip(self.runs, self.spans):
             run._s_hint = hint[a:b]
         routes = [route for run in self.runs for route in run._routes]
@@ -1342,8 +1347,8 @@ class Batch:
         x, y, h = self._ticked()
         state = self._gather("_recovery")
         was = state.copy()
-        backs = fleet.guard(rows, self.command, state, (x, y, h, self._gather("_steer"),
-                                                        self._gather("_v"), self.block[_SIDE]),
+        v, steer = self._drive
+        backs = fleet.guard(rows, self.command, state, (x, y, h, steer, v, self.block[_SIDE]),
                             cells)
         for row in (state != was).any(axis=1).nonzero()[0].tolist():
             run, i = self._owner[row]
@@ -1357,7 +1362,8 @@ class Batch:
         run's tick recorded; the runs whose robots move now."""
         x, y, h = self._ticked()
         pose = _columns(x, y, np.rad2deg(h))
-        speed, steering, hint = (self._gather(name) for name in ("_v", "_steer", "_s_hint"))
+        speed, steering = self._drive
+        hint = self._hint
         hit = np.logical_or.reduceat(self.hit, self._starts).tolist()
         driving = np.logical_or.reduceat(self.active, self._starts).tolist()
         moving = []
@@ -1376,17 +1382,18 @@ class Batch:
         if self._now is None or any(run._deciding is not s for run, s in zip(runs, self.ticks)):
             # (not every run of the tick the batch observed moves by it: each run's own)
             self._now = (self._gather("_x"), self._gather("_y"), self._gather("_h"))
+            self._drive = (self._gather("_v"), self._gather("_steer"))
             self.active = self._gather("_active")
             self.command = np.concatenate([run.decided.command for run in runs])
         x, y, h = self._now
+        v, steer = self._drive
         if self._limits is None:
             self._limits = kinematics.Limits(*(np.concatenate(
                 [getattr(run.limits, f.name) for run in runs]) for f in fields(kinematics.Limits)))
         world = runs[0].world
         command = self.command.T.copy()
-        after = kinematics.step(x, y, h, np.where(self.active, self._gather("_v"), 0.0),
-                                self._gather("_steer"), command[0], command[1], self._limits,
-                                world.dt, world.substeps)
+        after = kinematics.step(x, y, h, np.where(self.active, v, 0.0), steer, command[0],
+                                command[1], self._limits, world.dt, world.substeps)
         driven = np.hypot(after[0] - x, after[1] - y)         # (Simulation.move_to)
         ticks = len(runs[0]._odometer)
         assert all(len(run._odometer) == ticks for run in runs), "runs ticked together"
