@@ -41,6 +41,30 @@ def test_stepping_by_hand_is_simulate():
     same_run(sim.result(), simulate(world, planner, 7, randomise=True))
 
 
+def test_the_result_holds_every_recorded_tick_as_it_was_recorded():
+    """result() stacks the record (one concatenation a field): each tick's arrays, bit for bit,
+    and each tick's inputs the rows of its block, in order, as contiguous [T, n] arrays."""
+    from mitos_cli.sim.perception import INPUTS
+
+    sim = Simulation(short("moving.yaml", 2.0), seed=3, randomise=True)
+    while not sim.done:
+        sim.step()
+    res = sim.result()
+    for k, tick in enumerate(sim.record):
+        for key in ("pose", "speed", "steering", "command", "ranges", "clearance", "active",
+                    "progress"):
+            assert np.array_equal(getattr(res, key)[k], getattr(tick, key)), key
+        assert np.array_equal(res.obstacles[k], tick.obstacles.reshape(-1, 2))
+        assert list(tick.inputs) == list(INPUTS)
+        for j, key in enumerate(INPUTS):
+            assert np.shares_memory(tick.inputs[key], tick.block)
+            assert np.array_equal(tick.inputs[key], tick.block[j])
+            assert np.array_equal(res.perceived[key][k], tick.inputs[key]), key
+    assert all(v.shape == (res.ticks, 1) and v.flags.c_contiguous
+               for v in res.perceived.values())
+    assert res.active.dtype == bool and res.pose.shape == (res.ticks, 1, 3)
+
+
 def test_reset_starts_the_same_run_again():
     world = short("moving.yaml", 1.0)
     sim = Simulation(world, seed=3, randomise=True)

@@ -22,6 +22,7 @@ import math
 import operator
 import os
 from dataclasses import dataclass, field, fields
+from functools import cached_property
 
 import numpy as np
 
@@ -275,12 +276,17 @@ class Tick:
     steering: np.ndarray            # [n] deg (the wheel's actual angle)
     command: np.ndarray             # [n, 2] planner's steering and speed
     ranges: np.ndarray              # [n, B] in (noisy readings)
-    inputs: dict[str, np.ndarray]   # name -> [n] perceived rule inputs
+    block: np.ndarray = field(repr=False)   # [inputs, n]: the perceived rule inputs, a row each
     clearance: np.ndarray           # [n] in
     obstacles: np.ndarray           # [O, 2] obstacle positions
     active: np.ndarray              # [n] robot still driving after this tick's verdict
     progress: np.ndarray            # [n] arc length along each robot's route (in)
-    block: np.ndarray = field(repr=False)   # [inputs, n]: the rows ``inputs`` holds, one block
+
+    @cached_property
+    def inputs(self) -> dict[str, np.ndarray]:
+        """name -> ``[n]`` perceived rule inputs: the rows of :attr:`block` (made when asked:
+        runs in lockstep record 64 ticks at once, and few are looked at)."""
+        return dict(zip(perception.INPUTS, self.block))
 
 
 @dataclass
@@ -291,11 +297,15 @@ class _Sensed:
     where: np.ndarray
     pose: np.ndarray
     ranges: np.ndarray
-    inputs: dict[str, np.ndarray]
     targets: np.ndarray
     clearance: np.ndarray
     command: np.ndarray             # [n, 2] filled by the plan stage
-    block: np.ndarray               # [inputs, n]: the rows ``inputs`` holds, one block
+    block: np.ndarray               # [inputs, n]: the rule inputs, a row each
+
+    @cached_property
+    def inputs(self) -> dict[str, np.ndarray]:
+        """name -> ``[n]``: the rows of :attr:`block` (made when asked)."""
+        return dict(zip(perception.INPUTS, self.block))
 
 
 class Simulation:
@@ -679,10 +689,9 @@ class Simulation:
         n = self.n
         pose = _columns(self._x, self._y, self._h)
         self._beams(pose, list(got.dirs), list(got.static))
-        inputs = np.zeros((len(perception.INPUTS), n))      # one block, a row per input
-        return _Sensed(self.time, self._where, pose, got.ranges,
-                       dict(zip(perception.INPUTS, inputs)), np.zeros((n, 2)),
-                       got.clearance, np.zeros((n, 2)), inputs)
+        return _Sensed(self.time, self._where, pose, got.ranges, np.zeros((n, 2)),
+                       got.clearance, np.zeros((n, 2)),
+                       np.zeros((len(perception.INPUTS), n)))     # one block, a row per input
 
     def _beams(self, pose: np.ndarray, dirs: list[np.ndarray], static: list[np.ndarray]) -> None:
         """Keep each robot's beams ``dirs`` at ``pose`` and what its own map predicts along
@@ -845,8 +854,8 @@ class Simulation:
                   inputs: dict[str, np.ndarray]) -> None:
         """Record the robots' inputs (their rows of :func:`.perception.perceive_all`) and
         target points in tick ``s``."""
-        for key in perception.INPUTS:
-            s.inputs[key][:] = inputs[key]
+        for j, key in enumerate(perception.INPUTS):
+            s.block[j] = inputs[key]
         s.targets[:] = sights.target
 
     def _beyond(self, i: int, s: _Sensed) -> np.ndarray:
@@ -1036,8 +1045,8 @@ class Simulation:
               active: np.ndarray, progress: np.ndarray) -> Tick:
         """Record tick ``s`` with the robots' state as it was observed (arrays no later
         tick changes in place: the record keeps them)."""
-        tick = Tick(self._k, s.t, pose, speed, steering, s.command, s.ranges, s.inputs,
-                    s.clearance, s.where, active, progress, s.block)
+        tick = Tick(self._k, s.t, pose, speed, steering, s.command, s.ranges, s.block,
+                    s.clearance, s.where, active, progress)
         self.record.append(tick)
         return tick
 
@@ -1206,10 +1215,9 @@ class Batch:
         self.ticks = []
         for run, (a, b) in zip(self.runs, self.spans):
             run._beams(pose[a:b], dirs[a:b], static[a:b])
-            block = self.block[:, a:b]
             self.ticks.append(_Sensed(run.time, run._where, pose[a:b], got.ranges[a:b],
-                                      dict(zip(perception.INPUTS, block)), self.targets[a:b],
-                                      got.clearance[a:b], self.command[a:b], block))
+                                      self.targets[a:b], got.clearance[a:b], self.command[a:b],
+                                      self.block[:, a:b]))
         self.got, self.pose, self.at = got, pose, pose[:, :2].copy()
         return self.ticks
 
