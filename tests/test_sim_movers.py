@@ -93,6 +93,43 @@ def test_free_space_follows_the_robots_pose_and_a_fan_of_beams(heading_deg, fan_
     assert entered(free, 0.5, p + 50 * back[None], back[None]) == [None]
 
 
+@settings(max_examples=25, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.booleans(), st.integers(1, 40))
+def test_spaces_stacked_keep_and_look_up_the_beams_as_each_space_alone(seed, ring, ticks):
+    """Spaces.stacked: one write keeps every robot's beams as its own update would, and
+    entered() looks a subset's echoes up in the stack with the bits of the spaces one by one."""
+    rng = np.random.default_rng(seed)
+    robots, beams = 5, 8
+    angles = np.deg2rad(np.arange(beams) * (45.0 if ring else 20.0) - (0.0 if ring else 70.0))
+    alone = [movers.FreeSpace.of(angles, ring, 0.05, 2.0) for _ in range(robots)]
+    spaces = [movers.FreeSpace.of(angles, ring, 0.05, 2.0) for _ in range(robots)]
+    stack = movers.Spaces.stacked(spaces)
+    assert stack is not None
+    for k in range(ticks):
+        now = 0.05 * k
+        at = rng.uniform(-20, 20, (robots, 2))
+        heading = rng.uniform(-math.pi, math.pi, robots)
+        dirs = np.stack([np.cos(heading[:, None] + angles), np.sin(heading[:, None] + angles)],
+                        axis=2)
+        ranges = rng.uniform(5, 60, (robots, beams))
+        for sp, p, d, r in zip(alone, at, dirs, ranges):
+            sp.update(now, p, d, r)
+        stack.update(now, at, dirs, ranges)
+    for a, b in zip(alone, spaces):
+        assert a.slot == b.slot
+        for name in ("times", "poses", "ranges"):
+            assert np.array_equal(getattr(a, name), getattr(b, name)), name
+    rows = np.array([0, 2, 3])
+    owner = rng.integers(0, len(rows), 12)
+    points = rng.uniform(-40, 40, (12, 2))
+    along = rng.normal(size=(12, 2))
+    along /= np.hypot(*along.T)[:, None]
+    now = 0.05 * ticks
+    got = movers.entered(stack.picked(rows), now, points, along, owner)
+    want = movers.entered([alone[i] for i in rows], now, points, along, owner)
+    assert all(np.array_equal(g, w) for g, w in zip(got, want))
+
+
 # --- tracks --------------------------------------------------------------------------------
 
 def follow(tracker: movers.Tracker, centre, velocity, seconds: float, moved: bool | None,

@@ -21,6 +21,7 @@ import itertools
 import math
 import operator
 import os
+from collections.abc import Sequence
 from dataclasses import dataclass, field, fields
 from functools import cached_property
 
@@ -1174,6 +1175,7 @@ class Batch:
         self._follows = runs[0].world.replan != "never"
         self._trackers = [t for run in runs for t in run._trackers]
         self._spaces = [f for run in runs for f in run._free]
+        self._kept = movers.Spaces.stacked(self._spaces) if self._follows else None
         self._seen = np.zeros((0, 0), dtype=bool)
         self._watching = np.zeros(0, dtype=np.intp)         # the rows that follow something
         self._limits: kinematics.Limits | None = None
@@ -1240,13 +1242,16 @@ class Batch:
         if not self._follows:
             return
         got, t = self.got, self.ticks[0].t
-        for space, p, dirs, ranges in zip(self._spaces, self.at, got.dirs, got.ranges):
-            space.update(t, p, dirs, ranges)
+        if self._kept is None:
+            for space, p, dirs, ranges in zip(self._spaces, self.at, got.dirs, got.ranges):
+                space.update(t, p, dirs, ranges)
+        else:
+            self._kept.update(t, self.at, got.dirs, got.ranges)
         movers.follow_all([self._trackers[i] for i in self._watching.tolist()], t, sighted)
 
-    def watching(self, learned: list[list[bool]]) -> tuple[list[movers.FreeSpace], np.ndarray,
-                                                            np.ndarray, np.ndarray, np.ndarray,
-                                                            np.ndarray]:
+    def watching(self, learned: list[list[bool]]
+                 ) -> tuple[Sequence[movers.FreeSpace], np.ndarray, np.ndarray, np.ndarray,
+                            np.ndarray, np.ndarray]:
         """:meth:`Simulation.watching` of every run at once, their maps marked by
         :meth:`seeing` (``learned``: whether each run's were): each run's watch kept, and the
         rows of the robots that follow something (those with tracks or news) with what
@@ -1259,8 +1264,9 @@ class Batch:
             run._watched = (s, mine, [i for i in range(b - a) if flags[a + i]])
         self._watching = rows = np.flatnonzero(flags)
         got = self.got
-        return ([self._spaces[i] for i in rows.tolist()], rows, self.at[rows], got.ranges[rows],
-                got.dirs[rows], self._seen[rows])
+        spaces = (self._kept.picked(rows) if self._kept is not None
+                  else [self._spaces[i] for i in rows.tolist()])
+        return spaces, rows, self.at[rows], got.ranges[rows], got.dirs[rows], self._seen[rows]
 
     def framing(self) -> tuple[list[Route], np.ndarray, np.ndarray]:
         """:meth:`Simulation.framing` of every run at once."""

@@ -422,6 +422,63 @@ class FreeSpace:
         return entered([self], now, points, dirs)
 
 
+class Spaces(Sequence[FreeSpace]):
+    """The :class:`FreeSpace` of robots stepped together whose arrays are rows of one stack
+    each (:meth:`stacked`; ``rows``: those of them it holds, in order): the beams of all kept
+    in one write (:meth:`update`) and looked up by :func:`entered` where they lie."""
+
+    def __init__(self, every: list[FreeSpace], times: np.ndarray, poses: np.ndarray,
+                 ranges: np.ndarray, rows: np.ndarray) -> None:
+        self.every, self.rows = every, rows
+        self.times, self.poses, self.ranges = times, poses, ranges   # [R, J], [R, J, 3], [R, J, B]
+
+    @classmethod
+    def stacked(cls, spaces: list[FreeSpace]) -> Spaces | None:
+        """``spaces`` (of one layout: ``None`` otherwise), their arrays copied into one stack
+        each and each made a view of its row."""
+        first = spaces[0]
+        if any((sp.a0, sp.step, sp.ring, sp.near, sp.ranges.shape)
+               != (first.a0, first.step, first.ring, first.near, first.ranges.shape)
+               for sp in spaces):
+            return None
+        out = cls(spaces, np.array([sp.times for sp in spaces]),
+                  np.array([sp.poses for sp in spaces]), np.array([sp.ranges for sp in spaces]),
+                  np.arange(len(spaces)))
+        for j, sp in enumerate(spaces):
+            sp.times, sp.poses, sp.ranges = out.times[j], out.poses[j], out.ranges[j]
+        return out
+
+    def __len__(self) -> int:
+        return len(self.rows)
+
+    def __getitem__(self, i: int) -> FreeSpace:  # type: ignore[override]  # (no slices)
+        return self.every[self.rows[i]]
+
+    def picked(self, rows: np.ndarray) -> Spaces:
+        """The spaces ``rows`` (ascending) of :attr:`every`."""
+        return Spaces(self.every, self.times, self.poses, self.ranges, rows)
+
+    def update(self, now: float, points: np.ndarray, dirs: np.ndarray,
+               ranges: np.ndarray) -> None:
+        """:meth:`FreeSpace.update` of every space (``points [R, 2]``, ``dirs [R, B, 2]``,
+        ``ranges [R, B]``) in one write when they keep their beams in the same slot (robots
+        stepped together from their start), else one by one."""
+        every = self.every
+        k = every[0].slot
+        if any(sp.slot != k for sp in every):
+            for sp, p, d, r in zip(every, points, dirs, ranges):
+                sp.update(now, p, d, r)
+            return
+        a0 = every[0].a0
+        self.times[:, k] = now
+        self.poses[:, k, :2] = points
+        self.poses[:, k, 2] = [math.atan2(y, x) - a0 for x, y in dirs[:, 0].tolist()]
+        self.ranges[:, k] = ranges
+        slot = (k + 1) % self.times.shape[1]
+        for sp in every:
+            sp.slot = slot
+
+
 def entered(spaces: Sequence[FreeSpace], now: float, points: np.ndarray, dirs: np.ndarray,
             owner: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """:meth:`FreeSpace.entered` of the echoes of many robots at once: ``points [P, 2]`` and
@@ -436,6 +493,10 @@ def entered(spaces: Sequence[FreeSpace], now: float, points: np.ndarray, dirs: n
     slots, beams = first.ranges.shape
     if owner is None or len(spaces) == 1:     # one robot: its own arrays, broadcast ([1, J])
         times, pose, ranges, row = first.times[None], first.poses[None], first.ranges, first.rows
+    elif isinstance(spaces, Spaces):          # rows of one stack: looked up where they lie
+        at = spaces.rows[owner]
+        times, pose, ranges = spaces.times[at], spaces.poses[at], spaces.ranges
+        row = at[:, None] * (slots * beams) + first.rows
     else:
         times = np.array([sp.times for sp in spaces])[owner]                  # [P, J]
         pose = np.array([sp.poses for sp in spaces])[owner]                   # [P, J, 3]
