@@ -573,16 +573,40 @@ def mark_all(maps: list[RobotMap], cells: np.ndarray, seen: np.ndarray) -> list[
                                         axis=2)
     k, b = take.nonzero()                       # map by map, each in its beams' order
     row, col = cells[k, b, 1], cells[k, b, 0]
-    ends = np.cumsum(np.bincount(k, minlength=len(maps))).tolist()
-    known = np.empty(len(k), dtype=bool)
-    for m, a, e in zip(maps, [0, *ends[:-1]], ends):
-        if e > a:
-            known[a:e] = m.occupied[row[a:e], col[a:e]]
+    if all(m.grid is grid for m in maps):
+        known = _known(maps, grid, k, row, col)
+    else:
+        ends = np.cumsum(np.bincount(k, minlength=len(maps))).tolist()
+        known = np.empty(len(k), dtype=bool)
+        for m, a, e in zip(maps, [0, *ends[:-1]], ends):
+            if e > a:
+                known[a:e] = m.occupied[row[a:e], col[a:e]]
     new = np.flatnonzero(~known)
     if not len(new):
         return [False] * len(maps)
     _add_marks(maps, grid, k[new], row[new], col[new])
     return np.bincount(k[new], minlength=len(maps)).astype(bool).tolist()
+
+
+def _known(maps: list[RobotMap], grid: Grid, k: np.ndarray, row: np.ndarray,
+           col: np.ndarray) -> np.ndarray:
+    """Which cells (rows ``row``, columns ``col`` of maps ``k``, ascending) the maps hold
+    occupied, every map on ``grid``: a map's cells are the grid's plus its marks (none of
+    them a grid's cell), so the grid's looked up for all at once and the marks of all as one
+    ascending array of cells keyed by map, with one ``searchsorted``."""
+    known = grid.occupied[row, col]
+    marks = [m.marks for m in maps]
+    counts = [len(m) for m in marks]
+    if not any(counts) or not len(k):
+        return known
+    rows, cols = grid.occupied.shape
+    size = rows * cols
+    keys = np.concatenate(marks) + np.repeat(np.arange(len(maps)) * size, counts)
+    asked = k * size + row * cols + col
+    at = np.searchsorted(keys, asked)
+    at[at == len(keys)] = 0
+    known |= keys[at] == asked
+    return known
 
 
 def _add_marks(maps: list[RobotMap], grid: Grid, k: np.ndarray, row: np.ndarray,
