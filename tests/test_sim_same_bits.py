@@ -209,6 +209,14 @@ def test_many_maps_marked_and_looked_up_at_once_are_each_maps_own():
         if k == 20:                     # some plan again: a dilation of their own
             for m, a in zip(together[::2], alone[::2]):
                 m.planned, a.planned = m.occupied.copy(), a.occupied.copy()
+        if k % 5 == 4:                  # marks seen through are freed, then marked again
+            origins = rng.uniform([-5.0, 5.0], [70.0, 60.0], (len(together), 2))
+            turn = rng.uniform(0, 2 * np.pi, (len(together), 1)) + np.linspace(0, 6, 24)
+            dirs = np.stack([np.cos(turn), np.sin(turn)], axis=2)
+            measured = rng.uniform(5.0, 60.0, (len(together), 24))
+            knowledge.clear_all(together, origins, dirs, measured, 60.0)
+            for a, o, d, r in zip(alone, origins, dirs, measured):
+                a.clear(o, d, r, 60.0)
         # cells inside the grid, beyond its edges and outside its dilation too
         cells = rng.integers([-6, -6], [46, 36], (len(together), 25, 2))
         seen = rng.random((len(together), 25)) < 0.3
