@@ -912,6 +912,56 @@ def test_free_ways_one_band_at_a_time_are_the_plain_ways():
         assert same(got[0], want[0]) and same(got[1], want[1])
 
 
+def _edge_points(rng, body, cfg, rows, n):
+    """Points ``(ah, bh, widen)`` on ways of the grid at a band's edge (across it by the band
+    and the widening, to a rounding or two), some behind the robot on it, some at its
+    centre, some anywhere."""
+    phi = np.deg2rad(rng.choice(perception._ways(cfg)[2:], (rows, n)))
+    widen = np.abs(rng.normal(0, 3, (rows, n)))
+    band = np.where(rng.random((rows, n)) < 0.5, body["way"], body["roomy"])
+    across = (band + widen) * rng.choice([-1.0, 1.0], (rows, n))
+    across = across * (1.0 + rng.choice([-4e-16, -2e-16, 0.0, 2e-16, 4e-16], (rows, n)))
+    along = rng.choice([rng.uniform(-40, 150), 1e-9, -1e-9, 0.0], (rows, n))
+    ah = along * np.cos(phi) - across * np.sin(phi)
+    bh = along * np.sin(phi) + across * np.cos(phi)
+    anywhere = rng.random((rows, n)) < 0.3
+    ah[anywhere], bh[anywhere] = rng.normal(0, 60, (2, int(anywhere.sum())))
+    centre = rng.random((rows, n)) < 0.1
+    ah[centre] = bh[centre] = 0.0
+    return ah, bh, widen
+
+
+def test_free_ways_tried_near_each_point_are_those_of_every_point_on_every_way():
+    rng = np.random.default_rng(21)
+    cfg = perception.Settings()
+    for _ in range(300):
+        rows, n = int(rng.integers(1, 6)), int(rng.integers(1, 40))
+        robots = [Robot(length=float(rng.uniform(10, 30)), width=float(rng.uniform(8, 24)))
+                  for _ in range(rows)]
+        body = perception._bodies(tuple(robots), cfg)
+        ah, bh, widen = _edge_points(rng, body, cfg, rows, n)
+        unknown = rng.random((rows, n)) < 0.4
+        bearing = rng.uniform(-200, 200, rows)
+        ways = perception._ways_of(body, cfg, bearing)
+        every = perception._free_along(ah, bh, widen, unknown, ways, body)[1]
+        assert same(perception._grid_free(ah, bh, widen, body, cfg), every[..., 2:])
+        got = perception._free_ways_near(ah, bh, widen, unknown, body, cfg, bearing)
+        want = perception._free_ways_block(ah, bh, widen, unknown, body, cfg, bearing)
+        assert same(got[0], want[0]) and same(got[1], want[1])
+
+
+def test_free_ways_of_points_not_finite_or_ways_all_round_try_every_point():
+    cfg, wide = perception.Settings(), perception.Settings(way_fov=360.0)
+    assert perception._near_ways(cfg) and not perception._near_ways(wide)
+    ah, bh = np.array([[30.0, np.nan, 5.0]]), np.array([[2.0, 1.0, np.inf]])
+    with np.errstate(invalid="ignore"):                  # inf * 0
+        got = perception.free_ways_rows(ah, bh, np.zeros((1, 3)), np.ones((1, 3), dtype=bool),
+                                        [Robot()], cfg, np.array([10.0]))
+        want = _plain_free_ways(ah, bh, np.zeros((1, 3)), np.ones((1, 3), dtype=bool),
+                                [Robot()], cfg, np.array([10.0]))
+    assert same(got[0], want[0]) and same(got[1], want[1])
+
+
 def test_road_and_side_gaps_of_rows_are_the_plain_minima():
     rng = np.random.default_rng(13)
     cfg = perception.Settings()

@@ -281,14 +281,18 @@ def _free_ways(ah: np.ndarray, bh: np.ndarray, widen: np.ndarray, unknown: np.nd
     """:func:`free_ways_rows` of robots whose :func:`_bodies` are ``body``, a block of rows
     at a time (:data:`CACHED`: a lockstep batch of hundreds of robots spills its
     ``[rows, ways, points]`` arrays out of a core's cache, which costs more than the calls
-    the blocks repeat; each row's arithmetic is its own)."""
-    rows = max(1, CACHED // (len(body["ways"]) * max(ah.shape[1], 1)))
+    the blocks repeat; each row's arithmetic is its own). Finite points go
+    :func:`_free_ways_near`'s way when every way tried lies within 90 deg of the heading (as
+    it does by default), whose arrays are some four times smaller (blocks of four times the
+    rows measured fastest)."""
+    near = ah.size > 0 and _near_ways(cfg) and bool(np.isfinite(ah + bh + widen).all())
+    block = _free_ways_near if near else _free_ways_block
+    rows = max(1, (4 if near else 1) * CACHED // (len(body["ways"]) * max(ah.shape[1], 1)))
     if len(ah) <= rows:
-        return _free_ways_block(ah, bh, widen, unknown, body, cfg, route_bearing)
-    parts = [_free_ways_block(ah[i:i + rows], bh[i:i + rows], widen[i:i + rows],
-                              unknown[i:i + rows],
-                              {k: v if k == "ways" else v[i:i + rows] for k, v in body.items()},
-                              cfg, route_bearing[i:i + rows])
+        return block(ah, bh, widen, unknown, body, cfg, route_bearing)
+    parts = [block(ah[i:i + rows], bh[i:i + rows], widen[i:i + rows], unknown[i:i + rows],
+                   {k: v if k == "ways" else v[i:i + rows] for k, v in body.items()},
+                   cfg, route_bearing[i:i + rows])
              for i in range(0, len(ah), rows)]
     return np.concatenate([f for f, _ in parts]), np.concatenate([o for _, o in parts])
 
@@ -296,12 +300,26 @@ def _free_ways(ah: np.ndarray, bh: np.ndarray, widen: np.ndarray, unknown: np.nd
 def _free_ways_block(ah: np.ndarray, bh: np.ndarray, widen: np.ndarray, unknown: np.ndarray,
                      body: dict[str, np.ndarray], cfg: Settings,
                      route_bearing: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`_free_ways` of one block of rows."""
-    length = body["length"][:, 0]
-    base = body["ways"]
-    ways = np.empty((len(ah), len(base)))                                  # [R, W]
-    ways[:] = base
+    """:func:`_free_ways` of one block of rows, every point on every way."""
+    ways = _ways_of(body, cfg, route_bearing)
+    front, free = _free_along(ah, bh, widen, unknown, ways, body)
+    return _opened(front, free, ways, body, cfg, route_bearing)
+
+
+def _ways_of(body: dict[str, np.ndarray], cfg: Settings,
+             route_bearing: np.ndarray) -> np.ndarray:
+    """``[R, W]``: the ways each row tries (deg, :func:`_ways`), its route's bearing second."""
+    ways = np.empty((len(route_bearing), len(body["ways"])))
+    ways[:] = body["ways"]
     ways[:, 1] = clip_arrays(route_bearing, -cfg.way_fov / 2, cfg.way_fov / 2)
+    return ways
+
+
+def _free_along(ah: np.ndarray, bh: np.ndarray, widen: np.ndarray, unknown: np.ndarray,
+                ways: np.ndarray, body: dict[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+    """Along each of ``ways [R, W]`` (the first straight on), the nearest of every point
+    ``[R, K]`` ahead in the body's band and in the roomier one, ``[2, R, W]`` (``inf``:
+    none); and along the first, the nearest of the ``unknown`` ones in the body's band."""
     phi = np.deg2rad(ways)[..., None]
     cos, sin = np.cos(phi), np.sin(phi)
     ah, bh, widen = ah[:, None], bh[:, None], widen[:, None]
@@ -317,19 +335,109 @@ def _free_ways_block(ah: np.ndarray, bh: np.ndarray, widen: np.ndarray, unknown:
     roomy = across < body["roomy"][..., None]      # and the roomier one
     roomy &= ahead
     front = np.minimum.reduce(along[:, 0], axis=1, initial=np.inf, where=narrow[:, 0] & unknown)
-    front = clip_arrays(front - length, 0.0, cfg.sight)
-    # the progress each way offers toward the route's bearing (behind the robot: toward the
-    # side it lies on), in a band just clear of the body and in a roomy one, less a little
-    # for every degree turned
+    free = np.empty((2, *ways.shape))
+    for out, inside in zip(free, (narrow, roomy)):
+        np.minimum.reduce(along, axis=2, initial=np.inf, where=inside, out=out)
+    return front, free
+
+
+def _opened(front: np.ndarray, free: np.ndarray, ways: np.ndarray, body: dict[str, np.ndarray],
+            cfg: Settings, route_bearing: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(front, opening)`` from the nearest points ahead on each way (:func:`_free_along`):
+    the progress each way offers toward the route's bearing (behind the robot: toward the
+    side it lies on), in a band just clear of the body and in a roomy one, less a little
+    for every degree turned; the way that offers the most."""
+    length = body["length"]
+    front = clip_arrays(front - length[:, 0], 0.0, cfg.sight)
     toward = clip_arrays(route_bearing, -90.0, 90.0)
     score = -cfg.way_turn_cost * np.abs(ways)
     weight = np.cos(np.deg2rad(ways - toward[:, None])) + cfg.way_room_weight
-    for inside in (narrow, roomy):
-        free = np.minimum.reduce(along, axis=2, initial=np.inf, where=inside)    # [R, W]
-        free -= length[:, None]
-        free = clip_arrays(free, 0.0, cfg.way_reach)
-        score += 0.5 * free * weight
-    return front, ways[np.arange(len(ah)), score.argmax(axis=1)]
+    free -= length
+    for band in clip_arrays(free, 0.0, cfg.way_reach):
+        score += 0.5 * band * weight
+    return front, ways[np.arange(len(ways)), score.argmax(axis=1)]
+
+
+#: How far (deg) past the ways a point's band can reach (:func:`_free_ways_near`) a way is
+#: still tried: far above the rounding of the angles, so a way left out is plainly clear.
+_WAY_SLACK = 1e-2
+
+
+def _free_ways_near(ah: np.ndarray, bh: np.ndarray, widen: np.ndarray, unknown: np.ndarray,
+                    body: dict[str, np.ndarray], cfg: Settings,
+                    route_bearing: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`_free_ways_block` trying each point (finite) only on the ways its bands may
+    reach: straight on and the route's bearing every point, each of the ``way_step`` grid
+    only the points within ``asin(reach / distance)`` (``reach``: the roomier band and the
+    point's widening) of its bearing and :data:`_WAY_SLACK`: some one in nine. A point left
+    out is farther than ``reach`` from that way, or behind the robot on it, by far more than
+    rounding, so every band holds the points it held and each minimum is the same (the
+    products each a pair's own, elementwise)."""
+    ways = _ways_of(body, cfg, route_bearing)
+    front, two = _free_along(ah, bh, widen, unknown, ways[:, :2], body)
+    free = np.empty((2, *ways.shape))
+    free[..., :2] = two
+    free[..., 2:] = _grid_free(ah, bh, widen, body, cfg)
+    return _opened(front, free, ways, body, cfg, route_bearing)
+
+
+def _grid_free(ah: np.ndarray, bh: np.ndarray, widen: np.ndarray, body: dict[str, np.ndarray],
+               cfg: Settings) -> np.ndarray:
+    """``[2, R, G]``: :func:`_free_along` of the ``way_step`` grid of ways (``G`` of them), each
+    point on the ways its bands may reach (:func:`_free_ways_near`): the pairs listed point by
+    point, their distances along and across worked out as :func:`_free_along` does, and
+    those in a band set in a table of each row's points by way, whose least is taken."""
+    grid = body["ways"][2:]
+    cos, sin = _grid_trig(cfg)
+    rows, g = len(ah), len(grid)
+    far = np.hypot(ah, bh)
+    reach = np.maximum(body["way"], body["roomy"]) + widen
+    bearing = np.degrees(np.arctan2(bh, ah)) - grid[0]
+    with np.errstate(divide="ignore", invalid="ignore"):        # (at the centre: not tried)
+        half = np.degrees(np.arcsin(clip_arrays(reach / far, 0.0, 1.0)))
+        lo = np.floor((bearing - half - _WAY_SLACK) / cfg.way_step)
+        hi = np.floor((bearing + half + _WAY_SLACK) / cfg.way_step) + 1.0
+        first = clip_arrays(lo, 0, g).astype(np.intp)
+        count = clip_arrays(hi, 0, g).astype(np.intp) - first
+    count[far == 0.0] = 0                          # at the robot's centre: ahead on no way
+    place = np.cumsum(count > 0, axis=1) - 1       # each point's place among its row's tried
+    table = np.full((2, max(int(place[:, -1].max()) + 1, 0), rows, g), np.inf)
+    count = count.ravel()
+    pairs = int(count.sum())
+    if pairs:
+        j = np.arange(pairs) - np.repeat(np.cumsum(count) - count - first.ravel(), count)
+        at = j + np.repeat(((place * rows + np.arange(rows)[:, None]) * g).ravel(), count)
+        a, b = np.repeat(ah.ravel(), count), np.repeat(bh.ravel(), count)
+        c, s = cos[j], sin[j]
+        along = a * c
+        along += b * s
+        across = b * c
+        across -= a * s
+        np.abs(across, out=across)
+        across -= np.repeat(widen.ravel(), count)
+        ahead = along > 0
+        for out, band in zip(table, (body["way"], body["roomy"])):
+            inside = across < np.repeat(np.broadcast_to(band, ah.shape).ravel(), count)
+            inside &= ahead
+            out.ravel()[at[inside]] = along[inside]
+    return np.minimum.reduce(table, axis=1, initial=np.inf)
+
+
+@functools.lru_cache(maxsize=8)
+def _near_ways(cfg: Settings) -> bool:
+    """Whether :func:`_free_ways_near` serves: an even grid of ways within 90 deg of the
+    heading (the ways near a point's bearing are then found without going round behind)."""
+    grid = _ways(cfg)[2:]
+    return bool(cfg.way_step > 0 and len(grid) and np.abs(grid).max() <= 90.0)
+
+
+@functools.lru_cache(maxsize=8)
+def _grid_trig(cfg: Settings) -> tuple[np.ndarray, np.ndarray]:
+    """The cosines and sines of the ``way_step`` grid of ways (:func:`_ways`)."""
+    phi = np.deg2rad(_ways(cfg)[2:])
+    cos, sin = np.cos(phi), np.sin(phi)
+    cos.flags.writeable = sin.flags.writeable = False
+    return cos, sin
 
 
 @functools.lru_cache(maxsize=8)
