@@ -962,6 +962,34 @@ def test_free_ways_of_points_not_finite_or_ways_all_round_try_every_point():
     assert same(got[0], want[0]) and same(got[1], want[1])
 
 
+def test_bearings_lanes_and_pursuits_of_rows_are_each_rows_python_floats():
+    rng = np.random.default_rng(22)
+    cfg = perception.Settings()
+    odd = [math.nan, math.inf, -math.inf, 0.0, -0.0, 1e-300, 90.0, -90.0, 180.0, 1e-9]
+    for k in range(60):
+        n = int(rng.integers(1, 50))
+        dx, dy, e = rng.normal(0, 60, (3, n))
+        heading = rng.uniform(-2 * math.pi, 2 * math.pi, n)
+        left, home, road = rng.uniform(0, 400, (3, n))
+        half, room = rng.uniform(4, 14, n), rng.choice([math.inf, 0.0, 5.0, 30.0], n)
+        bearing = rng.choice([rng.uniform(-120, 120), 89.99, -90.0, 0.0], n)
+        far = rng.choice([rng.uniform(0, 60), 0.0, 1e-12, 5.0], n)
+        if k % 4 == 0:              # odd values and ties, as Python's min and max meet them
+            for x in (dx, dy, e, left, home, road, room, bearing, far):
+                x[rng.random(n) < 0.2] = rng.choice(odd)
+            road[rng.random(n) < 0.3] = cfg.road_cap
+            home[rng.random(n) < 0.3] = left[0]
+        got = perception._common_rows(dx, dy, heading, left, e, home, road, half, cfg, room)
+        got = (*got, perception._pursuit_rows(bearing, far, cfg))
+        for i in range(n):
+            robot = Robot(width=float(2 * half[i]))
+            want = perception._common_of(float(dx[i]), float(dy[i]), float(heading[i]),
+                                         float(left[i]), float(e[i]), float(home[i]),
+                                         float(road[i]), robot, cfg, float(room[i]))
+            want = (*want, perception._pursuit_of(float(bearing[i]), float(far[i]), cfg))
+            assert all(same(g[i], w) for g, w in zip(got, want)), (i, got, want)
+
+
 def test_road_and_side_gaps_of_rows_are_the_plain_minima():
     rng = np.random.default_rng(13)
     cfg = perception.Settings()

@@ -614,20 +614,15 @@ def pursuit_points(aims: list[Aim], cfg: Settings) -> tuple[np.ndarray, np.ndarr
         return np.array([one]), target[None]
     out_ahead = np.full(len(aims), float(ahead[-1]))
     targets = np.empty((len(aims), 2))
-    have, have_i = [], []
-    for i, a in enumerate(aims):
-        if len(a.cells):
-            have.append(a)
-            have_i.append(i)
-        else:
-            targets[i] = target_point(a.route, a.f, cfg, float(ahead[-1]))
-    if not have:
+    sizes, cells = _with_cells(aims)
+    for i in np.flatnonzero(sizes == 0).tolist():
+        targets[i] = target_point(aims[i].route, aims[i].f, cfg, float(ahead[-1]))
+    have_i = np.flatnonzero(sizes)
+    if not len(have_i):
         return out_ahead, targets
+    have = aims if len(have_i) == len(aims) else [aims[i] for i in have_i.tolist()]
     q = _targets(have, ahead)                                                 # [H, J, 2]
     targets[have_i] = q[:, -1]                                  # where every chord is clear
-    cells = np.full((len(have), max(len(a.cells) for a in have), 2), _FAR)
-    for j, a in enumerate(have):
-        cells[j, :len(a.cells)] = a.cells
     p = np.array([a.p for a in have])                                         # [H, 2]
     near = _near_chords(cells, p, q, np.array([a.need + a.radius for a in have]))
     some = np.logical_or.reduce(near, axis=1).nonzero()[0]
@@ -648,7 +643,7 @@ def pursuit_points(aims: list[Aim], cfg: Settings) -> tuple[np.ndarray, np.ndarr
                       np.array([have[j].radius for j in some])[:, None],
                       np.array([have[j].need for j in some])[:, None])       # [S, J]
     k = np.where(clear.all(axis=1), len(ahead) - 1, np.maximum(clear.argmin(axis=1) - 1, 0))
-    rows = np.array(have_i)[some]
+    rows = have_i[some]
     out_ahead[rows] = ahead[k]
     targets[rows] = q[np.arange(len(some)), k]
     return out_ahead, targets
@@ -745,20 +740,30 @@ def route_gaps(aims: list[Aim]) -> list[float]:
     robot gets the bits it gets alone."""
     if len(aims) == 1:
         return [_route_gap(aims[0].f, aims[0].p, aims[0].cells)]
-    out = [math.inf] * len(aims)
-    have = [i for i, a in enumerate(aims) if len(a.cells)]
-    if not have:
-        return out
-    cells = np.full((len(have), max(len(aims[i].cells) for i in have), 2), _FAR)
-    for j, i in enumerate(have):
-        cells[j, :len(aims[i].cells)] = aims[i].cells
-    c = (np.array([aims[i].p for i in have])
-         - np.array([aims[i].f.e for i in have])[:, None] * np.array([aims[i].f.n for i in have]))
-    gaps = np.minimum.reduce(np.hypot(cells[..., 0] - c[:, :1], cells[..., 1] - c[:, 1:]),
-                             axis=1).tolist()                  # (a coordinate at a time)
-    for i, gap in zip(have, gaps):
-        out[i] = gap
-    return out
+    out = np.full(len(aims), math.inf)
+    sizes, cells = _with_cells(aims)
+    have_i = np.flatnonzero(sizes)
+    if not len(have_i):
+        return out.tolist()
+    have = aims if len(have_i) == len(aims) else [aims[i] for i in have_i.tolist()]
+    c = (np.array([a.p for a in have])
+         - np.array([a.f.e for a in have])[:, None] * np.array([a.f.n for a in have]))
+    out[have_i] = np.minimum.reduce(np.hypot(cells[..., 0] - c[:, :1], cells[..., 1] - c[:, 1:]),
+                                    axis=1)                    # (a coordinate at a time)
+    return out.tolist()
+
+
+def _with_cells(aims: list[Aim]) -> tuple[np.ndarray, np.ndarray]:
+    """How many cells each of ``aims`` has ``[R]``, and the cells of those with some
+    ``[H, P, 2]``: each row's own, then padding :data:`_FAR` away (row by row: a slice
+    costs less than a mask of them all)."""
+    cells = [a.cells for a in aims]
+    sizes = list(map(len, cells))
+    have = [i for i, n in enumerate(sizes) if n]
+    out = np.full((len(have), max(sizes, default=0), 2), _FAR)
+    for row, i in zip(out, have):
+        row[:sizes[i]] = cells[i]
+    return np.array(sizes, dtype=np.intp), out
 
 
 @functools.lru_cache(maxsize=8)
@@ -903,8 +908,8 @@ def perceive_all(rows: Sights, max_range: float,
     dirs, measured = rows.dirs, rows.measured
     hits = p[:, None] + measured[..., None] * dirs                      # [R, B, 2]
     rel = hits - p[:, None]
-    a = np.matmul(rel, _stack([f.t for f in rows.frames])[..., None])[..., 0]   # rel @ f.t
-    b = np.matmul(rel, _stack([f.n for f in rows.frames])[..., None])[..., 0]
+    a = np.matmul(rel, np.array([f.t for f in rows.frames])[..., None])[..., 0]  # rel @ f.t
+    b = np.matmul(rel, np.array([f.n for f in rows.frames])[..., None])[..., 0]
     valid = measured < max_range * 0.999
     obstacle_hit = valid & (measured < rows.expected - rows.threshold[:, None])
     known = valid ^ obstacle_hit        # valid & ~obstacle_hit (which lies within valid)
@@ -921,24 +926,73 @@ def perceive_all(rows: Sights, max_range: float,
     size, position, distance = _obstruction_rows(
         rows.routes, rows.frames, a, b, hits, obstructing, widen, cfg, ah, bh,
         rows.least, rows.kept, body)
-    d = rows.target - p                                                 # to the targets
-    home = np.array([r.goal for r in rows.routes]) - p                  # to the goals
-    far, dx, dy = np.hypot(d[:, 0], d[:, 1]).tolist(), d[:, 0].tolist(), d[:, 1].tolist()
-    common = np.array([_common_of(dx[i], dy[i], headings[i], r.length - f.s, f.e, gone,
-                                  road_i, robot, cfg, room)
-                       for i, (r, f, robot, room, gone, road_i) in enumerate(
-                           zip(rows.routes, rows.frames, robots, rows.room.tolist(),
-                               np.hypot(home[:, 0], home[:, 1]).tolist(), road.tolist()))])
-    heading = common[:, 0]
+    heading, lane, goal, pursued = _steering(rows, p, road, body, cfg)
     front, opening = _free_ways(valid_ah, valid_bh, widen, obstacle_hit, body, cfg, heading)
     ring = _rings(dirs)
     return {"road": road, "size": size, "position": position, "obstacle": distance,
-            "heading": np.array([_pursuit_of(bearing, distance, cfg)
-                                 for bearing, distance in zip(heading.tolist(), far)]),
-            "lane": common[:, 1], "goal": common[:, 2], "gap_left": wl, "gap_right": wr,
+            "heading": pursued, "lane": lane, "goal": goal, "gap_left": wl, "gap_right": wr,
             "front": front, "opening": opening,
             "clutter": clutter_rows(hits, obstacle_hit, ah, cfg, ring),
             "nearest": _nearest(valid_ah, valid_bh, body, cfg)}
+
+
+def _steering(rows: Sights, p: np.ndarray, road: np.ndarray, body: dict[str, np.ndarray],
+              cfg: Settings) -> tuple[np.ndarray, ...]:
+    """Each row's route bearing, ``lane``, ``goal`` and ``heading`` (its :func:`_common`
+    and :func:`pursuit`): the differences and distances of all rows at once, then those of
+    a robot alone in Python floats (:func:`_common_of`, :func:`_pursuit_of`: arrays of one
+    cost more), of a batch as arrays (:func:`_common_rows`, :func:`_pursuit_rows`)."""
+    d = rows.target - p                                                 # to the targets
+    home = np.array([r.goal for r in rows.routes]) - p                  # to the goals
+    home = np.hypot(home[:, 0], home[:, 1])
+    far = np.hypot(d[:, 0], d[:, 1])
+    if len(p) == 1:
+        r, f = rows.routes[0], rows.frames[0]
+        one = _common_of(float(d[0, 0]), float(d[0, 1]), float(rows.pose[0, 2]), r.length - f.s,
+                         f.e, float(home[0]), float(road[0]), rows.robots[0], cfg,
+                         float(rows.room[0]))
+        return (*(np.array([x]) for x in one),
+                np.array([_pursuit_of(one[0], float(far[0]), cfg)]))
+    left = np.array([r.length for r in rows.routes]) - np.array([f.s for f in rows.frames])
+    bearing, lane, goal = _common_rows(d[:, 0], d[:, 1], rows.pose[:, 2], left,
+                                       np.array([f.e for f in rows.frames]), home, road,
+                                       body["half"][:, 0], cfg, rows.room)
+    return bearing, lane, goal, _pursuit_rows(bearing, far, cfg)
+
+
+def _common_rows(dx: np.ndarray, dy: np.ndarray, heading: np.ndarray, left: np.ndarray,
+                 e: np.ndarray, home: np.ndarray, road: np.ndarray, half: np.ndarray,
+                 cfg: Settings, room: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`_common_of` of every row (``[R]`` each; ``half``: half the robots' widths), each
+    row's bits: the angle from :func:`math.atan2` row by row, the rest elementwise (NumPy's
+    degrees and remainder are Python's; each ``min`` and ``max`` as Python picks)."""
+    angle = np.fromiter(map(math.atan2, dy.tolist(), dx.tolist()), float, len(dx))
+    with np.errstate(invalid="ignore"):                         # (NaN stays NaN, as in Python)
+        bearing = np.remainder(np.degrees(angle - heading) + 180.0, 360.0) - 180.0
+    road_l = _least(road, cfg.road_cap)
+    offset = _least(_least(road_l / 4, road_l / 2 - half - cfg.lane_margin), room)
+    offset = np.where(offset > 0.0, offset, 0.0)                        # max(0.0, offset)
+    return -bearing, e - offset, np.where(home > left, home, left)      # max(left, home)
+
+
+def _least(a: np.ndarray, b: float | np.ndarray) -> np.ndarray:
+    """Python's ``min(a, b)`` elementwise: ``b`` only where it is less than ``a``."""
+    return np.where(b < a, b, a)
+
+
+def _pursuit_rows(bearing: np.ndarray, distance: np.ndarray, cfg: Settings) -> np.ndarray:
+    """:func:`_pursuit_of` of every row (``[R]`` each), each row's bits: the sines from
+    :mod:`math` row by row, the rest elementwise (NumPy's radians and degrees are Python's)."""
+    out = bearing.copy()
+    turn = np.flatnonzero(~(np.abs(bearing) >= 90.0))
+    if len(turn):
+        b, far = bearing[turn], distance[turn]
+        sine = np.fromiter(map(math.sin, np.radians(np.abs(b)).tolist()), float, len(turn))
+        sine = cfg.lookahead / np.where(far < 1e-9, 1e-9, far) * sine  # max(distance, 1e-9)
+        sine = np.where(sine < 1.0, sine, 1.0)                          # min(1.0, sine)
+        out[turn] = np.copysign(np.degrees(np.fromiter(map(math.asin, sine.tolist()), float,
+                                                       len(turn))), b)
+    return out
 
 
 def _rings(dirs: np.ndarray) -> np.ndarray:
