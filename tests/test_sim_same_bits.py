@@ -943,7 +943,7 @@ def test_free_ways_tried_near_each_point_are_those_of_every_point_on_every_way()
         unknown = rng.random((rows, n)) < 0.4
         bearing = rng.uniform(-200, 200, rows)
         ways = perception._ways_of(body, cfg, bearing)
-        every = perception._free_along(ah, bh, widen, unknown, ways, body)[1]
+        every = np.stack(perception._free_along(ah, bh, widen, unknown, ways, body)[1])
         assert same(perception._grid_free(ah, bh, widen, body, cfg), every[..., 2:])
         got = perception._free_ways_near(ah, bh, widen, unknown, body, cfg, bearing)
         want = perception._free_ways_block(ah, bh, widen, unknown, body, cfg, bearing)

@@ -89,6 +89,7 @@ from __future__ import annotations
 
 import functools
 import math
+from collections.abc import Iterable
 from dataclasses import dataclass
 
 import numpy as np
@@ -281,13 +282,16 @@ def _free_ways(ah: np.ndarray, bh: np.ndarray, widen: np.ndarray, unknown: np.nd
     """:func:`free_ways_rows` of robots whose :func:`_bodies` are ``body``, a block of rows
     at a time (:data:`CACHED`: a lockstep batch of hundreds of robots spills its
     ``[rows, ways, points]`` arrays out of a core's cache, which costs more than the calls
-    the blocks repeat; each row's arithmetic is its own). Finite points go
-    :func:`_free_ways_near`'s way when every way tried lies within 90 deg of the heading (as
-    it does by default), whose arrays are some four times smaller (blocks of four times the
-    rows measured fastest)."""
-    near = ah.size > 0 and _near_ways(cfg) and bool(np.isfinite(ah + bh + widen).all())
+    the blocks repeat; each row's arithmetic is its own). More than a few rows of finite
+    points go :func:`_free_ways_near`'s way when every way tried lies within 90 deg of the
+    heading (as by default): its arrays are some four times smaller (blocks of four times
+    the rows measured fastest), but it makes three times the calls (a robot alone or a few
+    measured faster every point on every way)."""
+    pairs = len(body["ways"]) * max(ah.shape[1], 1)
+    near = (len(ah) * pairs > CACHED // 8 and _near_ways(cfg)
+            and bool(np.isfinite(ah + bh + widen).all()))
     block = _free_ways_near if near else _free_ways_block
-    rows = max(1, (4 if near else 1) * CACHED // (len(body["ways"]) * max(ah.shape[1], 1)))
+    rows = max(1, (4 if near else 1) * CACHED // pairs)
     if len(ah) <= rows:
         return block(ah, bh, widen, unknown, body, cfg, route_bearing)
     parts = [block(ah[i:i + rows], bh[i:i + rows], widen[i:i + rows], unknown[i:i + rows],
@@ -316,10 +320,11 @@ def _ways_of(body: dict[str, np.ndarray], cfg: Settings,
 
 
 def _free_along(ah: np.ndarray, bh: np.ndarray, widen: np.ndarray, unknown: np.ndarray,
-                ways: np.ndarray, body: dict[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
-    """Along each of ``ways [R, W]`` (the first straight on), the nearest of every point
-    ``[R, K]`` ahead in the body's band and in the roomier one, ``[2, R, W]`` (``inf``:
-    none); and along the first, the nearest of the ``unknown`` ones in the body's band."""
+                ways: np.ndarray, body: dict[str, np.ndarray]
+                ) -> tuple[np.ndarray, tuple[np.ndarray, np.ndarray]]:
+    """Along the first of ``ways [R, W]`` (straight on), the nearest of the ``unknown``
+    points ``[R, K]`` ahead in the body's band; along each, the nearest of every point ahead
+    in the body's band and in the roomier one, ``[R, W]`` each (``inf``: none)."""
     phi = np.deg2rad(ways)[..., None]
     cos, sin = np.cos(phi), np.sin(phi)
     ah, bh, widen = ah[:, None], bh[:, None], widen[:, None]
@@ -335,26 +340,25 @@ def _free_along(ah: np.ndarray, bh: np.ndarray, widen: np.ndarray, unknown: np.n
     roomy = across < body["roomy"][..., None]      # and the roomier one
     roomy &= ahead
     front = np.minimum.reduce(along[:, 0], axis=1, initial=np.inf, where=narrow[:, 0] & unknown)
-    free = np.empty((2, *ways.shape))
-    for out, inside in zip(free, (narrow, roomy)):
-        np.minimum.reduce(along, axis=2, initial=np.inf, where=inside, out=out)
-    return front, free
+    return front, (np.minimum.reduce(along, axis=2, initial=np.inf, where=narrow),
+                   np.minimum.reduce(along, axis=2, initial=np.inf, where=roomy))
 
 
-def _opened(front: np.ndarray, free: np.ndarray, ways: np.ndarray, body: dict[str, np.ndarray],
-            cfg: Settings, route_bearing: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """``(front, opening)`` from the nearest points ahead on each way (:func:`_free_along`):
-    the progress each way offers toward the route's bearing (behind the robot: toward the
-    side it lies on), in a band just clear of the body and in a roomy one, less a little
-    for every degree turned; the way that offers the most."""
+def _opened(front: np.ndarray, free: Iterable[np.ndarray], ways: np.ndarray,
+            body: dict[str, np.ndarray], cfg: Settings,
+            route_bearing: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(front, opening)`` from the nearest points ahead on each way in each band
+    (:func:`_free_along`; written over): the progress each way offers toward the route's
+    bearing (behind the robot: toward the side it lies on), in a band just clear of the body
+    and in a roomy one, less a little for every degree turned; the way that offers the most."""
     length = body["length"]
     front = clip_arrays(front - length[:, 0], 0.0, cfg.sight)
     toward = clip_arrays(route_bearing, -90.0, 90.0)
     score = -cfg.way_turn_cost * np.abs(ways)
     weight = np.cos(np.deg2rad(ways - toward[:, None])) + cfg.way_room_weight
-    free -= length
-    for band in clip_arrays(free, 0.0, cfg.way_reach):
-        score += 0.5 * band * weight
+    for band in free:
+        band -= length
+        score += 0.5 * clip_arrays(band, 0.0, cfg.way_reach) * weight
     return front, ways[np.arange(len(ways)), score.argmax(axis=1)]
 
 
@@ -908,8 +912,8 @@ def perceive_all(rows: Sights, max_range: float,
     dirs, measured = rows.dirs, rows.measured
     hits = p[:, None] + measured[..., None] * dirs                      # [R, B, 2]
     rel = hits - p[:, None]
-    a = np.matmul(rel, np.array([f.t for f in rows.frames])[..., None])[..., 0]  # rel @ f.t
-    b = np.matmul(rel, np.array([f.n for f in rows.frames])[..., None])[..., 0]
+    a = np.matmul(rel, _stack([f.t for f in rows.frames])[..., None])[..., 0]   # rel @ f.t
+    b = np.matmul(rel, _stack([f.n for f in rows.frames])[..., None])[..., 0]
     valid = measured < max_range * 0.999
     obstacle_hit = valid & (measured < rows.expected - rows.threshold[:, None])
     known = valid ^ obstacle_hit        # valid & ~obstacle_hit (which lies within valid)
@@ -951,8 +955,8 @@ def _steering(rows: Sights, p: np.ndarray, road: np.ndarray, body: dict[str, np.
         one = _common_of(float(d[0, 0]), float(d[0, 1]), float(rows.pose[0, 2]), r.length - f.s,
                          f.e, float(home[0]), float(road[0]), rows.robots[0], cfg,
                          float(rows.room[0]))
-        return (*(np.array([x]) for x in one),
-                np.array([_pursuit_of(one[0], float(far[0]), cfg)]))
+        out = np.array([*one, _pursuit_of(one[0], float(far[0]), cfg)])[:, None]
+        return out[0], out[1], out[2], out[3]
     left = np.array([r.length for r in rows.routes]) - np.array([f.s for f in rows.frames])
     bearing, lane, goal = _common_rows(d[:, 0], d[:, 1], rows.pose[:, 2], left,
                                        np.array([f.e for f in rows.frames]), home, road,
@@ -1075,8 +1079,9 @@ def _measures(robots: tuple[Robot, ...], cfg: Settings) -> dict[str, np.ndarray]
 
 
 def _stack(arrays: list[np.ndarray]) -> np.ndarray:
-    """The arrays one above the other (a view of the one, when there is one)."""
-    return arrays[0][None] if len(arrays) == 1 else np.stack(arrays)
+    """The arrays (of one shape) one above the other (a view of the one, when there is one;
+    ``np.array`` copies many for less than ``np.stack``)."""
+    return arrays[0][None] if len(arrays) == 1 else np.array(arrays)
 
 
 def _own_frames(headings: list[float], rel: np.ndarray,
