@@ -230,22 +230,27 @@ def _objects(routes: list[Route], frames: list[Frame], a, points, ahead, blockin
     near = ahead & (np.hypot(gap[..., 0], gap[..., 1]) <= cfg.cluster)
     distance = np.minimum.reduce(a, axis=1, initial=np.inf, where=near) - length
     distance = np.where(distance > 0.0, distance, 0.0)              # max(0.0, distance)
-    pts = [row[mine] for row, mine in zip(points, near)]
+    pts, wide = points[near], widen[near]                       # the rows' one after another
+    ends = np.cumsum(np.count_nonzero(near, axis=1)).tolist()
+    spans = list(zip([0, *ends[:-1]], ends))
     # (np.mean's arithmetic: the sum of the points, divided by their count)
-    centres = np.array([np.add.reduce(p, axis=0) / len(p) for p in pts]).reshape(-1, 2)
+    centres = np.array([np.add.reduce(pts[start:stop], axis=0) / (stop - start)
+                        for start, stop in spans]).reshape(-1, 2)
     hints = [f.s for f in frames]
     reach = cfg.sight + cfg.cluster
     # size and position across the road where the object stands (around a corner that is
     # the next leg of the route, not the robot's)
     where = ([routes[0].project(centres[0], hints[0], back=0.0, ahead=reach)]
              if len(routes) == 1 else projections(routes, centres, hints, 0.0, reach))
-    size, position = np.zeros(len(pts)), np.zeros(len(pts))
-    for j, (p, centre, (_, e_o, t_o)) in enumerate(zip(pts, centres, where)):
-        across = (p - centre) @ np.array([t_o[1], -t_o[0]]) + e_o
-        lo = float((across - widen[j, near[j]]).min())
-        hi = float((across + widen[j, near[j]]).max())
-        size[j], position[j] = hi - lo, (lo + hi) / 2
-    return distance, size, position
+    t = np.array([t_o for _, _, t_o in where]).reshape(-1, 2)
+    normal = np.empty_like(t)
+    normal[:, 0], normal[:, 1] = t[:, 1], -t[:, 0]
+    lo, hi = np.empty(len(spans)), np.empty(len(spans))
+    for j, ((start, stop), centre, (_, e_o, _)) in enumerate(zip(spans, centres, where)):
+        across = (pts[start:stop] - centre) @ normal[j] + e_o
+        lo[j] = np.minimum.reduce(across - wide[start:stop])
+        hi[j] = np.maximum.reduce(across + wide[start:stop])
+    return distance, hi - lo, (lo + hi) / 2
 
 
 def _own_frame(rel: np.ndarray, heading: float) -> tuple[np.ndarray, np.ndarray]:
@@ -406,8 +411,9 @@ def _grid_free(ah: np.ndarray, bh: np.ndarray, widen: np.ndarray, body: dict[str
     count[far == 0.0] = 0                          # at the robot's centre: ahead on no way
     place = np.cumsum(count > 0, axis=1) - 1       # each point's place among its row's tried
     table = np.full((2, max(int(place[:, -1].max()) + 1, 0), rows, g), np.inf)
+    each = np.add.reduce(count, axis=1)            # the pairs of each row, one row after another
     count = count.ravel()
-    pairs = int(count.sum())
+    pairs = int(each.sum())
     if pairs:
         j = np.arange(pairs) - np.repeat(np.cumsum(count) - count - first.ravel(), count)
         at = j + np.repeat(((place * rows + np.arange(rows)[:, None]) * g).ravel(), count)
@@ -421,7 +427,7 @@ def _grid_free(ah: np.ndarray, bh: np.ndarray, widen: np.ndarray, body: dict[str
         across -= np.repeat(widen.ravel(), count)
         ahead = along > 0
         for out, band in zip(table, (body["way"], body["roomy"])):
-            inside = across < np.repeat(np.broadcast_to(band, ah.shape).ravel(), count)
+            inside = across < np.repeat(band[:, 0], each)
             inside &= ahead
             out.ravel()[at[inside]] = along[inside]
     return np.minimum.reduce(table, axis=1, initial=np.inf)
