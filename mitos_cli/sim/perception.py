@@ -153,7 +153,7 @@ def frames(routes: list[Route], p: np.ndarray, hints) -> list[Frame]:
     s, e, t = projected(routes, p, hints)
     n = np.empty_like(t)
     n[:, 0], n[:, 1] = t[:, 1], -t[:, 0]
-    return [Frame(*row) for row in zip(s, e, t, n)]
+    return list(map(Frame, s, e, t, n))
 
 
 def _or(least: np.ndarray, none: float, less: float | np.ndarray = 0.0) -> np.ndarray:
