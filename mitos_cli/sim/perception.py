@@ -170,19 +170,20 @@ def _obstruction(route: Route, a, b, points, valid, widen, robot: Robot, f: Fram
     size, position, distance = _obstruction_rows(
         [route], [f], a[None], b[None], points[None], valid[None], widen[None], cfg,
         ah[None], bh[None], np.zeros(1), np.zeros((1, len(a)), dtype=bool),
-        _bodies((robot,), cfg))
+        np.full((1, len(a)), np.inf), _bodies((robot,), cfg))
     return float(size[0]), float(position[0]), float(distance[0])
 
 
 def _obstruction_rows(routes: list[Route], frames: list[Frame], a, b, points, valid, widen,
-                      cfg: Settings, ah, bh, least: np.ndarray,
-                      kept: np.ndarray, body: dict[str, np.ndarray]):
+                      cfg: Settings, ah, bh, least: np.ndarray, kept: np.ndarray,
+                      gone: np.ndarray, body: dict[str, np.ndarray]):
     """Each row's ``(size, position, distance)`` of the nearest obstructing object among its
     ``points [R, K, 2]`` (``a``, ``b``: along and across its route; ``ah``, ``bh``: along and
     across its heading; ``least [R]``, ``kept [R, K]``: :attr:`Sights.least` and
-    :attr:`Sights.kept`; ``body``: the robots' :func:`_bodies`). A point obstructs when it lies
-    in the band swept along the route or in the band swept along the robot's heading (so
-    turning back toward an object it has not yet passed brings it back)."""
+    :attr:`Sights.kept`; ``gone [R, K]``: how far the points kept ahead lie from the route
+    (:func:`_route_distances`); ``body``: the robots' :func:`_bodies`). A point obstructs when
+    it lies in the band swept along the route or in the band swept along the robot's heading
+    (so turning back toward an object it has not yet passed brings it back)."""
     size, position = np.zeros(len(routes)), np.zeros(len(routes))
     distance = np.full(len(routes), NO_OBSTACLE)
     ahead = valid & (a > 0) & (a < cfg.sight)
@@ -192,14 +193,11 @@ def _obstruction_rows(routes: list[Route], frames: list[Frame], a, b, points, va
                         | ((ah > 0) & _in_band(bh, widen, body["band"])))
     if not np.count_nonzero(blocking):
         return size, position, distance
-    # what the route was planned round obstructs only within its word: the distances of
-    # every point of the rows with such points, at once (each point's its own)
+    # what the route was planned round obstructs only within its word
     rounds = blocking & kept
     some = np.logical_or.reduce(rounds, axis=1).nonzero()[0]
     if len(some):
-        gone = distances([routes[i] for i in some.tolist()],
-                         [frames[i].s for i in some.tolist()], cfg.sight, points[some])
-        blocking[some] = np.where(rounds[some], gone - widen[some] < least[some, None],
+        blocking[some] = np.where(rounds[some], gone[some] - widen[some] < least[some, None],
                                   blocking[some])
     rows = np.flatnonzero(np.logical_or.reduce(blocking, axis=1))
     if len(rows):
@@ -928,14 +926,17 @@ def perceive_all(rows: Sights, max_range: float,
     road, wl, wr = _sides(a, b, valid_ah, valid_bh, valid, known, body, cfg, max_range,
                           obstacle_hit)
     widen = measured * rows.spacing[:, None] / 2
-    obstructing = obstacle_hit | _in_way(rows, known & (a > 0), hits, body, cfg)
+    ahead = a > 0
+    drawn = known & ahead
+    gone = _route_distances(rows, drawn | (obstacle_hit & rows.kept & ahead), hits, cfg)
+    obstructing = obstacle_hit | _in_way(rows, drawn, gone, body)
     if np.count_nonzero(obstructing):
         ah, bh = all_ah, all_bh
     else:                       # what does not obstruct is not asked where it lies
         ah, bh = valid_ah, valid_bh
     size, position, distance = _obstruction_rows(
         rows.routes, rows.frames, a, b, hits, obstructing, widen, cfg, ah, bh,
-        rows.least, rows.kept, body)
+        rows.least, rows.kept, gone, body)
     heading, lane, goal, pursued = _steering(rows, p, road, body, cfg)
     front, opening = _free_ways(valid_ah, valid_bh, widen, obstacle_hit, body, cfg, heading)
     ring = _rings(dirs)
@@ -1018,29 +1019,38 @@ def _rings(dirs: np.ndarray) -> np.ndarray:
     return last >= second - 1e-9
 
 
-def _in_way(rows: Sights, ahead: np.ndarray, hits: np.ndarray, body: dict[str, np.ndarray],
-            cfg: Settings) -> np.ndarray:
-    """Which of the points ``hits [R, B, 2]`` ahead of their robots (``ahead``) and drawn on
-    its map stand where its route would hit them: within half its width plus its safety
-    margin of the route within ``sight`` (in a squeeze, nearer than the route keeps: see
-    :func:`perceive`). Only the points some row asks about are measured (a point's distance
-    from a route is its own arithmetic, whatever else is measured)."""
-    cols = np.logical_or.reduce(ahead, axis=0).nonzero()[0]
+def _route_distances(rows: Sights, asked: np.ndarray, hits: np.ndarray,
+                     cfg: Settings) -> np.ndarray:
+    """``[R, K]``: how far the points ``hits [R, K, 2]`` each row asks about (``asked``) lie
+    from its route within ``sight`` (``inf`` elsewhere): what :func:`_in_way` and
+    :func:`_obstruction_rows` measure, in one :func:`.route.distances` of the columns some
+    row asks about, of the rows that ask (a point's distance from a route is its own
+    arithmetic, whatever else is measured)."""
+    out = np.full(asked.shape, np.inf)
+    cols = np.logical_or.reduce(asked, axis=0).nonzero()[0]
     if not len(cols):
-        return ahead
+        return out
     n = len(rows.routes)
-    some = (np.logical_or.reduce(ahead, axis=1).nonzero()[0] if n > 1
+    some = (np.logical_or.reduce(asked, axis=1).nonzero()[0] if n > 1
             else np.zeros(1, dtype=np.intp))
-    asked = some.tolist()
-    at = np.s_[:, cols] if len(asked) == n else np.ix_(some, cols)
-    gone = distances([rows.routes[i] for i in asked], [rows.frames[i].s for i in asked],
-                     cfg.sight, hits[at])
+    asking = some.tolist()
+    at = np.s_[:, cols] if len(asking) == n else np.ix_(some, cols)
+    out[at] = distances([rows.routes[i] for i in asking], [rows.frames[i].s for i in asking],
+                        cfg.sight, hits[at])
+    return out
+
+
+def _in_way(rows: Sights, ahead: np.ndarray, gone: np.ndarray,
+            body: dict[str, np.ndarray]) -> np.ndarray:
+    """Which of the points ahead of their robots (``ahead``) and drawn on its map stand
+    where its route would hit them: within half its width plus its safety margin of the
+    route within ``sight`` (``gone``: :func:`_route_distances`; in a squeeze, nearer than
+    the route keeps: see :func:`perceive`)."""
     # (only compared with: the sign of a zero, where a min or max of Python and of NumPy
     # may differ, does not matter)
-    squeeze, threshold = rows.squeeze[some], rows.threshold[some]
-    ahead[at] &= gone <= np.minimum(body["in_way"][some, 0],
-                                    np.maximum(squeeze - threshold, squeeze / 2))[:, None]
-    return ahead
+    squeeze, threshold = rows.squeeze, rows.threshold
+    return ahead & (gone <= np.minimum(body["in_way"][:, 0],
+                                       np.maximum(squeeze - threshold, squeeze / 2))[:, None])
 
 
 def _bodies(robots: tuple[Robot, ...], cfg: Settings) -> dict[str, np.ndarray]:
