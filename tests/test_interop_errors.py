@@ -460,9 +460,18 @@ def test_a_windows_1252_name_reaches_the_rules(tmp_path: Path) -> None:
 
 
 @pytest.mark.parametrize("data, message, at", [
-    (b"[System]\nName='a\x00\xb0'\n", "byte 0x00 at line 2, column 8 is neither UTF-8 nor", (2, 8)),
-    (b"[System]\n\xe9\x81\n", "byte 0xe9 at line 2, column 1 is neither UTF-8 nor", (2, 1)),
+    (b"[System]\nName='a\x00\xb0'\n", r"\(byte 0x00 at line 2, column 8\)$", (2, 8)),
+    (b"[System]\nName='a\x00b'\n", r"\(byte 0x00 at line 2, column 8\)$", (2, 8)),   # UTF-8
+    ("[System]\nName='a'\n".encode("utf-16-le"), "looks like UTF-16 text", (1, 2)),
     ("[System]\n".encode("utf-16"), "is UTF-16 text", (1, 1)),
+    ("[System]\n".encode("utf-32"), "is UTF-32 text", (1, 1)),
+    # 0xe9 is é in Windows-1252: the byte it leaves undefined is the one refused
+    (b"[System]\n\xe9\x81\n", "byte 0x81 at line 2, column 2 is neither UTF-8 nor", (2, 2)),
+    # UTF-8 on one line, a Windows-1252 degree sign on another: as one, the other is garbled
+    ("[System]\nName='qualité'\n% 20 °C\n".encode().replace("°".encode(), b"\xb0"),
+     "is UTF-8 at line 2, but byte 0xb0 at line 3, column 6 is not UTF-8", (3, 6)),
+    (b"\xef\xbb\xbf[System]\n% 20 \xb0C\n",
+     "begins with UTF-8's byte-order mark, but byte 0xb0 at line 2, column 6", (2, 6)),
 ])
 def test_bytes_that_are_no_text_are_refused_where_they_are(tmp_path: Path, data: bytes,
                                                            message: str, at: tuple) -> None:

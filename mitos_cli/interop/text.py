@@ -3,14 +3,17 @@
 fuzzylite reads a file's bytes as they are and jFuzzyLogic in the platform's charset, and
 MATLAB writes ``.fis`` files in the platform's encoding: on Windows that is Windows-1252, so a
 file saved there with ``Temperatur (°C)`` in a name or a comment is not UTF-8. Such a file is
-read as Windows-1252, with a note that says so; bytes that are no text in either (a NUL, an
-undefined code point, a UTF-16 file) are refused at their line and column.
+read as Windows-1252, with a note that says so. Bytes that are no text in either (a NUL, a
+code point Windows-1252 leaves undefined, a UTF-16 or UTF-32 file), and a file that is UTF-8
+in one place and not in another (read as Windows-1252, its UTF-8 would be garbled), are
+refused at their line and column.
 """
 
 from __future__ import annotations
 
 import codecs
 import dataclasses
+import re
 from collections.abc import Callable
 from pathlib import Path
 
@@ -32,26 +35,60 @@ def read_foreign_file(path: Path, parse: Callable[[str, str], RuleBase]) -> Rule
 def foreign_text(path: Path) -> tuple[str, str | None]:
     """``path``'s text, and a note when it was read as Windows-1252 (``None`` for UTF-8)."""
     try:
-        return read_text(path), None
+        text = read_text(path)
     except UnicodeDecodeError as exc:
-        data: bytes = exc.object
-        if data.startswith((codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE)):
-            raise FormatError(f"`{path}` is UTF-16 text; MITOS reads UTF-8 or Windows-1252",
-                              span=_at(path, data, 0), hint="save it as UTF-8") from None
-        nul = data.find(b"\0")
-        if nul < 0 and not data.startswith(codecs.BOM_UTF8):
-            try:
-                text = data.decode(LEGACY)
-            except UnicodeDecodeError:
-                pass
-            else:
-                return text, (f"`{path.name}` is not UTF-8 ({_byte(path, data, exc.start)}): "
-                              "read as Windows-1252, the encoding MATLAB and Java write on Windows")
-        bad = nul if nul >= 0 else exc.start
-        raise FormatError(f"`{path}` is not a text file ({_byte(path, data, bad)} is neither "
-                          "UTF-8 nor Windows-1252 text)", span=_at(path, data, bad)) from None
+        not_utf8 = exc
     except OSError as exc:
         raise FormatError(unreadable("rule file", path, exc)) from None
+    else:
+        if "\0" in text:          # valid UTF-8, yet no text a fuzzy-logic tool writes
+            raise _nul(path, text.encode("utf-8"))
+        return text, None
+    return _legacy(path, not_utf8), (
+        f"`{path.name}` is not UTF-8 ({_byte(path, not_utf8.object, not_utf8.start)}): read "
+        "as Windows-1252, the encoding MATLAB and Java write on Windows")
+
+
+#: A character of two to four bytes, written as UTF-8 writes it.
+_MULTIBYTE = re.compile(rb"[\xc2-\xdf][\x80-\xbf]|[\xe0-\xef][\x80-\xbf]{2}|"
+                        rb"[\xf0-\xf4][\x80-\xbf]{3}")
+
+
+def _legacy(path: Path, exc: UnicodeDecodeError) -> str:
+    """The text of ``path``, not UTF-8 (``exc``), as Windows-1252, or why it is not that
+    either: another Unicode encoding, a NUL, a file that is UTF-8 elsewhere (read as
+    Windows-1252, its UTF-8 would be garbled), a byte Windows-1252 leaves undefined."""
+    data: bytes = exc.object            # (without a UTF-8 byte-order mark: read_text drops it)
+    with open(path, "rb") as fh:
+        head = fh.read(4)
+    for bom, name in ((codecs.BOM_UTF32_LE, "UTF-32"), (codecs.BOM_UTF32_BE, "UTF-32"),
+                      (codecs.BOM_UTF16_LE, "UTF-16"), (codecs.BOM_UTF16_BE, "UTF-16")):
+        if head.startswith(bom):
+            raise FormatError(f"`{path}` is {name} text; MITOS reads UTF-8 or Windows-1252",
+                              span=_at(path, data, 0), hint="save it as UTF-8")
+    if b"\0" in data:
+        raise _nul(path, data)
+    utf8 = _MULTIBYTE.search(data)
+    if head.startswith(codecs.BOM_UTF8) or utf8 is not None:
+        said = ("begins with UTF-8's byte-order mark" if utf8 is None else
+                f"is UTF-8 at line {_at(path, data, utf8.start()).line}")
+        raise FormatError(f"`{path}` {said}, but {_byte(path, data, exc.start)} is not "
+                          "UTF-8", span=_at(path, data, exc.start), hint="save it as UTF-8")
+    try:
+        return data.decode(LEGACY)
+    except UnicodeDecodeError as undefined:
+        raise FormatError(f"`{path}` is not a text file ({_byte(path, data, undefined.start)} "
+                          "is neither UTF-8 nor Windows-1252 text)",
+                          span=_at(path, data, undefined.start)) from None
+
+
+def _nul(path: Path, data: bytes) -> FormatError:
+    """The refusal of a file with a NUL byte in it (most often UTF-16 without its mark)."""
+    at = data.find(b"\0")
+    wide = len(data) >= 8 and data[:64].count(b"\0") >= min(len(data), 64) // 3
+    return FormatError(f"`{path}` is not a text file ({_byte(path, data, at)})"
+                       + (": it looks like UTF-16 text" if wide else ""),
+                       span=_at(path, data, at), hint="save it as UTF-8" if wide else None)
 
 
 def _at(path: Path, data: bytes, start: int) -> Span:
