@@ -950,16 +950,29 @@ def test_free_ways_tried_near_each_point_are_those_of_every_point_on_every_way()
         assert same(got[0], want[0]) and same(got[1], want[1])
 
 
-def test_free_ways_of_points_not_finite_or_ways_all_round_try_every_point():
-    cfg, wide = perception.Settings(), perception.Settings(way_fov=360.0)
-    assert perception._near_ways(cfg) and not perception._near_ways(wide)
-    ah, bh = np.array([[30.0, np.nan, 5.0]]), np.array([[2.0, 1.0, np.inf]])
+@pytest.mark.parametrize("case", ["finite", "not finite", "no points", "ways all round"])
+def test_free_ways_go_near_each_point_only_where_they_may(case, monkeypatch):
+    """Rows enough for :func:`perception._free_ways_near` (300 robots, 36 points): finite
+    points take it, and points not finite, rows of no points and ways all round do not;
+    each gives the bits of every point on every way."""
+    rng = np.random.default_rng(5)
+    rows, n = 300, 0 if case == "no points" else 36
+    cfg = perception.Settings(way_fov=360.0) if case == "ways all round" else perception.Settings()
+    assert perception._near_ways(cfg) == (case != "ways all round")
+    ah, bh = rng.normal(0, 60, (2, rows, n))
+    if case == "not finite":
+        ah[7, 3], bh[9, 5] = np.nan, np.inf
+    widen, unknown = np.abs(rng.normal(0, 3, (rows, n))), rng.random((rows, n)) < 0.4
+    bearing, robots = rng.uniform(-200, 200, rows), [Robot()] * rows
+    near = []
+    plain = perception._free_ways_near
+    monkeypatch.setattr(perception, "_free_ways_near",
+                        lambda *args: near.append(1) or plain(*args))
     with np.errstate(invalid="ignore"):                  # inf * 0
-        got = perception.free_ways_rows(ah, bh, np.zeros((1, 3)), np.ones((1, 3), dtype=bool),
-                                        [Robot()], cfg, np.array([10.0]))
-        want = _plain_free_ways(ah, bh, np.zeros((1, 3)), np.ones((1, 3), dtype=bool),
-                                [Robot()], cfg, np.array([10.0]))
+        got = perception.free_ways_rows(ah, bh, widen, unknown, robots, cfg, bearing)
+        want = _plain_free_ways(ah, bh, widen, unknown, robots, cfg, bearing)
     assert same(got[0], want[0]) and same(got[1], want[1])
+    assert bool(near) == (case == "finite")
 
 
 def test_bearings_lanes_and_pursuits_of_rows_are_each_rows_python_floats():

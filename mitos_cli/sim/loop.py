@@ -23,7 +23,6 @@ import operator
 import os
 from collections.abc import Sequence
 from dataclasses import dataclass, field, fields
-from functools import cached_property
 
 import numpy as np
 
@@ -283,10 +282,10 @@ class Tick:
     active: np.ndarray              # [n] robot still driving after this tick's verdict
     progress: np.ndarray            # [n] arc length along each robot's route (in)
 
-    @cached_property
+    @rows.once
     def inputs(self) -> dict[str, np.ndarray]:
         """name -> ``[n]`` perceived rule inputs: the rows of :attr:`block` (made when asked:
-        runs in lockstep record 64 ticks at once, and few are looked at)."""
+        a lockstep batch records a tick of each of its runs at once, and few are looked at)."""
         return dict(zip(perception.INPUTS, self.block))
 
 
@@ -303,7 +302,7 @@ class _Sensed:
     command: np.ndarray             # [n, 2] filled by the plan stage
     block: np.ndarray               # [inputs, n]: the rule inputs, a row each
 
-    @cached_property
+    @rows.once
     def inputs(self) -> dict[str, np.ndarray]:
         """name -> ``[n]``: the rows of :attr:`block` (made when asked)."""
         return dict(zip(perception.INPUTS, self.block))
@@ -1283,7 +1282,8 @@ class Batch:
         for row in knowledge.checks_due(self.maps, self.ticks[0].t, self._when):
             j, i = self._rows[row]
             frames[row] = self.runs[j].replanned(self.ticks[j], i, frames[row])
-        self._hint = hint = np.array([f.s for f in frames])
+        hint = np.array([f.s for f in frames])
+        self._hint = hint.copy()             # (for the record: no view of a run's own)
         for run, (a, b) in zip(self.runs, self.spans):
             run._s_hint = hint[a:b]
         routes = [route for run in self.runs for route in run._routes]

@@ -285,13 +285,14 @@ def _free_ways(ah: np.ndarray, bh: np.ndarray, widen: np.ndarray, unknown: np.nd
     """:func:`free_ways_rows` of robots whose :func:`_bodies` are ``body``, a block of rows
     at a time (:data:`CACHED`: a lockstep batch of hundreds of robots spills its
     ``[rows, ways, points]`` arrays out of a core's cache, which costs more than the calls
-    the blocks repeat; each row's arithmetic is its own). More than a few rows of finite
-    points go :func:`_free_ways_near`'s way when every way tried lies within 90 deg of the
-    heading (as by default): its arrays are some four times smaller (blocks of four times
-    the rows measured fastest), but it makes three times the calls (a robot alone or a few
-    measured faster every point on every way)."""
+    the blocks repeat; each row's arithmetic is its own). Rows of finite points with more
+    than ``CACHED / 8`` pairs of a way and a point go :func:`_free_ways_near`'s way when
+    every way tried lies within 90 deg of the heading (as by default): its arrays are some
+    four times smaller (blocks of four times the rows measured fastest), but it makes three
+    times the calls, so fewer pairs (a robot alone with up to 210 beams at the default ways)
+    go every point on every way, measured faster."""
     pairs = len(body["ways"]) * max(ah.shape[1], 1)
-    near = (len(ah) * pairs > CACHED // 8 and _near_ways(cfg)
+    near = (len(ah) * pairs > CACHED // 8 and ah.shape[1] > 0 and _near_ways(cfg)
             and bool(np.isfinite(ah + bh + widen).all()))
     block = _free_ways_near if near else _free_ways_block
     rows = max(1, (4 if near else 1) * CACHED // pairs)
@@ -408,7 +409,7 @@ def _grid_free(ah: np.ndarray, bh: np.ndarray, widen: np.ndarray, body: dict[str
         count = clip_arrays(hi, 0, g).astype(np.intp) - first
     count[far == 0.0] = 0                          # at the robot's centre: ahead on no way
     place = np.cumsum(count > 0, axis=1) - 1       # each point's place among its row's tried
-    table = np.full((2, max(int(place[:, -1].max()) + 1, 0), rows, g), np.inf)
+    table = np.full((2, int(place[:, -1].max()) + 1, rows, g), np.inf)
     each = np.add.reduce(count, axis=1)            # the pairs of each row, one row after another
     count = count.ravel()
     pairs = int(each.sum())
