@@ -59,8 +59,11 @@ def _legacy(path: Path, exc: UnicodeDecodeError) -> str:
     either: another Unicode encoding, a NUL, a file that is UTF-8 elsewhere (read as
     Windows-1252, its UTF-8 would be garbled), a byte Windows-1252 leaves undefined."""
     data: bytes = exc.object            # (without a UTF-8 byte-order mark: read_text drops it)
-    with open(path, "rb") as fh:
-        head = fh.read(4)
+    try:
+        with open(path, "rb") as fh:
+            head = fh.read(4)
+    except OSError:                     # (a pipe, read already)
+        head = data[:4]
     for bom, name in ((codecs.BOM_UTF32_LE, "UTF-32"), (codecs.BOM_UTF32_BE, "UTF-32"),
                       (codecs.BOM_UTF16_LE, "UTF-16"), (codecs.BOM_UTF16_BE, "UTF-16")):
         if head.startswith(bom):
