@@ -89,10 +89,14 @@ def bad_byte(path: object, exc: OSError | UnicodeDecodeError) -> Span | None:
     for any other failure to read it)."""
     if not isinstance(exc, UnicodeDecodeError):
         return None
-    data = exc.object
-    line = data.count(b"\n", 0, exc.start) + 1
+    return byte_span(path, exc.object, exc.start)
+
+
+def byte_span(path: object, data: bytes, start: int) -> Span:
+    """Where byte ``start`` of a file's ``data`` is: its line and column (counted in bytes)."""
+    line = data.count(b"\n", 0, start) + 1
     return Span(None if path is None else str(path), line,
-                exc.start - (data.rfind(b"\n", 0, exc.start) + 1) + 1)
+                start - (data.rfind(b"\n", 0, start) + 1) + 1)
 
 
 def unreadable(kind: str, path: object, exc: OSError | UnicodeDecodeError) -> str:

@@ -17,8 +17,9 @@ import re
 from collections.abc import Callable
 from pathlib import Path
 
-from ..errors import FormatError, Span
-from ..fileio import bad_byte, read_text, unreadable
+from ..errors import FormatError
+from ..fileio import byte_span as _at
+from ..fileio import read_text, unreadable
 from ..lang.model import RuleBase
 
 #: The encoding a file that is not UTF-8 is read in: what MATLAB and Java write on Windows.
@@ -92,13 +93,6 @@ def _nul(path: Path, data: bytes) -> FormatError:
     return FormatError(f"`{path}` is not a text file ({_byte(path, data, at)})"
                        + (": it looks like UTF-16 text" if wide else ""),
                        span=_at(path, data, at), hint="save it as UTF-8" if wide else None)
-
-
-def _at(path: Path, data: bytes, start: int) -> Span:
-    """Where byte ``start`` of ``data`` is: its line and column (counted in bytes)."""
-    span = bad_byte(path, UnicodeDecodeError("utf-8", data, start, start + 1, "not text"))
-    assert span is not None
-    return span
 
 
 def _byte(path: Path, data: bytes, start: int) -> str:
