@@ -699,6 +699,34 @@ def test_maps_cleared_together_are_each_cleared_as_alone(maps, unlike):
     assert cleared
 
 
+def seen_through_every_product(rel, k, dx, dy, reach, half):
+    """knowledge._seen_through as it was written: both products of every mark and beam."""
+    dx, dy = dx[k], dy[k]
+    rx, ry = rel[:, 0, None], rel[:, 1, None]
+    along = rx * dx + ry * dy
+    across = np.abs(rx * dy - ry * dx)
+    return ((along > 0) & (along < reach[k]) & (across < half[k, None])).any(axis=1)
+
+
+@hypothesis.given(st.integers(0, 2**32 - 1), st.integers(0, 40), st.integers(1, 5))
+def test_marks_seen_through_from_the_beams_near_them_are_those_of_every_beam(seed, marks, robots):
+    rng = np.random.default_rng(seed)
+    angles = rng.uniform(0, 2 * np.pi, (robots, 12))
+    dx, dy = np.cos(angles), np.sin(angles)
+    # marks on the cells of a grid, some of them exactly on a beam or half a cell off it
+    rel = rng.integers(-20, 21, (marks, 2)) * 2.0
+    k = np.sort(rng.integers(0, robots, marks))
+    on = rng.random(marks) < 0.3
+    pick = rng.integers(0, 12, marks)
+    dist = rng.integers(0, 20, marks) * 2.0
+    rel[on, 0] = dist[on] * dx[k[on], pick[on]] + (rng.random(np.count_nonzero(on)) < 0.5)
+    rel[on, 1] = dist[on] * dy[k[on], pick[on]]
+    reach = rng.choice([0.0, 10.0, 38.0, 60.0], (robots, 12))
+    half = rng.choice([1.0, 2.0], robots)
+    assert np.array_equal(knowledge._seen_through(rel, k, dx, dy, reach, half),
+                          seen_through_every_product(rel, k, dx, dy, reach, half))
+
+
 def test_marks_in_sight_of_many_maps_at_once_are_each_maps_own():
     rng = np.random.default_rng(17)
     grid = Grid(rng.random((50, 70)) < 0.02, 2.0, (-3.0, 5.0))
