@@ -439,6 +439,27 @@ def test_a_robots_searches_patch_from_its_last_one_with_the_bits_of_the_whole():
         assert same(last.occ, occ) and last.occ is not occ
 
 
+@hypothesis.settings(deadline=None, max_examples=60)
+@hypothesis.given(st.integers(0, 2**32 - 1), st.integers(1, 4), st.integers(2, 9))
+def test_steps_worked_out_again_only_near_the_changed_distances_are_those_of_the_whole(
+        seed, k, reach):
+    """Blocks of 1 to 4 cells, distances capped at 2 to 9 cells: a step that crosses the
+    corner of a block beside its two nodes' blocks (a diagonal one) is worked out again too."""
+    rng = np.random.default_rng(seed)
+    rows, cols = (int(n) for n in rng.integers(12, 40, 2))
+    grid = Grid(rng.random((rows, cols)) < 0.06, 2.0, (-3.0, 1.5))
+    occ = grid.occupied.copy()
+    r = rng.integers(0, rows, int(rng.integers(1, 6)))
+    c = rng.integers(0, cols, len(r))
+    occ[r, c] = ~occ[r, c]
+    cap = 2.0 * reach - 0.5
+    patched = route._prepared(grid, occ, cap, k)
+    whole = route._prepared(grid, occ, cap, k, keep=False)
+    assert same(patched[0].dist, whole[0].dist)
+    assert all(same(a, b) for a, b in zip(patched[1], whole[1]))
+    assert same(patched[2], whole[2])
+
+
 def test_a_star_over_flat_tables_takes_the_generic_searchs_path():
     rng = np.random.default_rng(8)
     for _ in range(200):

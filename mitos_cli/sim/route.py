@@ -975,29 +975,62 @@ def _edges_from(out: np.ndarray, field: Clearance, xy: np.ndarray, t: np.ndarray
         for a in range(r0, r1, band):
             _edges_from(out, field, xy, t, moves, (a, min(a + band, r1)), (c0, c1))
         return
-    res, (ox, oy) = field.resolution, field.origin
-    rows_n, cols_n = field.dist.shape
     r, c = np.arange(r0, r1)[:, None], np.arange(c0, c1)[None, :]
     dr, dc = (np.array([move[j] for move in moves], dtype=np.intp)[:, None, None]
               for j in (0, 1))
     on = (r + dr >= 0) & (r + dr < R) & (c + dc >= 0) & (c + dc < C)     # [M, r, c]
     src = (r * C + c).reshape(-1)                            # the nodes the steps leave, flat
     dst = np.where(on.reshape(len(moves), -1), src + (dr * C + dc).reshape(-1, 1), src)
+    least = _least(field, xy, t, src, dst)                                 # [M, P]
+    out[:, r0:r1, c0:c1][on] = least.reshape(on.shape)[on]
+
+
+def _least(field: Clearance, xy: np.ndarray, t: np.ndarray, src: np.ndarray,
+           dst: np.ndarray) -> np.ndarray:
+    """The smallest clearance on each step from node ``src`` to node ``dst`` (flat indices
+    of the nodes ``xy [R, C, 2]``; ``src`` broadcast against ``dst``), sampled at ``t`` (see
+    :func:`_edges_from`), ``dst``'s shape."""
+    res, (ox, oy) = field.resolution, field.origin
+    rows_n, cols_n = field.dist.shape
     xs, ys = xy[..., 0].reshape(-1), xy[..., 1].reshape(-1)
-    ax, ay, tt = xs[src], ys[src], t[:, None, None]
-    x = ax + tt * (xs[dst] - ax)                                         # [T, M, P]
+    ax, ay, tt = xs[src], ys[src], t.reshape((-1,) + (1,) * dst.ndim)
+    x = ax + tt * (xs[dst] - ax)                                         # [T, *dst.shape]
     y = ay + tt * (ys[dst] - ay)
     col = np.floor((x - ox) / res).astype(np.int64)
     row = np.floor((y - oy) / res).astype(np.int64)
-    part = out[:, r0:r1, c0:c1]
     if col.min() >= 0 and col.max() < cols_n and row.min() >= 0 and row.max() < rows_n:
         row *= cols_n
         row += col
         least = np.minimum.reduce(field.dist.reshape(-1)[row], axis=0) - res / 2
-        part[on] = np.maximum(least, 0.0).reshape(on.shape)[on]
-        return
+        return np.maximum(least, 0.0)
     cells = field.cells(np.stack([x.reshape(-1), y.reshape(-1)], axis=1)).reshape(x.shape)
-    part[on] = np.minimum.reduce(cells, axis=0).reshape(on.shape)[on]
+    return np.minimum.reduce(cells, axis=0)
+
+
+def _edges_near(out: np.ndarray, field: Clearance, xy: np.ndarray, t: np.ndarray,
+                moves: tuple[tuple[int, int, float], ...], dirty: np.ndarray) -> None:
+    """:func:`_edges_from` of the steps that may sample a cell of a ``dirty`` block (``[R,
+    C]``, a node's): a step's samples lie between its two nodes' cell centres, so in its own
+    block, the block it steps into or (a diagonal step) the two beside both. The rest keep
+    their bits; the steps are worked out a slice at a time (arrays of tens of MB at most)."""
+    R, C = dirty.shape
+    pad = np.zeros((R + 2, C + 2), dtype=bool)
+    pad[1:-1, 1:-1] = dirty
+    picked = []
+    for m, (dr, dc, _) in enumerate(moves):
+        near = dirty | pad[1 + dr:1 + dr + R, 1:-1] | pad[1:-1, 1 + dc:1 + dc + C] \
+            | pad[1 + dr:1 + dr + R, 1 + dc:1 + dc + C]
+        if dr:                                              # no step off the grid
+            near[R - 1 if dr > 0 else 0] = False
+        if dc:
+            near[:, C - 1 if dc > 0 else 0] = False
+        r, c = near.nonzero()
+        picked.append((np.full(len(r), m), r, c, r * C + c, (r + dr) * C + c + dc))
+    move, r, c, src, dst = (np.concatenate(part) for part in zip(*picked))
+    step = max(1, _EDGE_SAMPLES // len(t))
+    for a in range(0, len(src), step):
+        s = slice(a, a + step)
+        out[move[s], r[s], c[s]] = _least(field, xy, t, src[s], dst[s])
 
 
 #: samples :func:`_edges_from` works out in one pass (about 40 bytes each at its peak)
@@ -1056,7 +1089,8 @@ def _prepared(grid: Grid, occ: np.ndarray, cap: float, k: int, keep: bool = True
     out again only where the cells that differ can reach. The capped field at a cell depends
     on the cells within ``n`` cells of it each way (:func:`.distance._capped`), a node on its
     block's field, a step's clearance on its two nodes and the cells between them (which lie
-    in the two nodes' blocks): the rest keeps its bits."""
+    in the two nodes' blocks and, a diagonal step's, the two beside both): the rest keeps its
+    bits."""
     if last is not None and keep and occ is not grid.occupied:
         out = _prepared_from(grid, occ, cap, k, last)
         if out is not None:
@@ -1143,9 +1177,11 @@ def _patched(grid: Grid, occ: np.ndarray, base_occ: np.ndarray, cap: float, k: i
     edge = base_edge.copy()
     if len(t) != samples:                # node (0, 0) or (1, 1) moved: every step again
         _edges_from(edge, field, xy, t, MOVES, (0, R), (0, C))
-    else:                                # the steps from a node within a block of those
-        _edges_from(edge, field, xy, t, MOVES, (max(b0 - 1, 0), min(b1 + 1, R)),
-                    (max(c0 - 1, 0), min(c1 + 1, C)))
+    else:                                # the steps that may sample a changed distance
+        dirty = np.zeros((R, C), dtype=bool)
+        mr, mc = moved.nonzero()
+        dirty[(d0 + mr) // k, (e0 + mc) // k] = True
+        _edges_near(edge, field, xy, t, MOVES, dirty)
     return field, nodes, edge, len(t)
 
 
