@@ -532,19 +532,33 @@ def _seen_through(rel: np.ndarray, k: np.ndarray, dx: np.ndarray, dy: np.ndarray
                   reach: np.ndarray, half: np.ndarray) -> np.ndarray:
     """Which marks (centres ``rel [K, 2]`` relative to robots ``k``) a beam of their robot
     (``dx``, ``dy [R, B]``) passes through, short of its echo (``reach [R, B]``: the reading
-    less a cell) and within half a cell (``half [R]``) of the mark's centre: ``[K, B]``
-    products, elementwise (``rx * dy - ry * dx``, then ``rx * dx + ry * dy`` only for the
-    few beams that pass within half a cell: the same products, fewer of them)."""
-    rx, ry = rel[:, 0, None], rel[:, 1, None]                      # [K, 1]
-    across = rx * dy[k]
-    across -= ry * dx[k]
+    less a cell) and within half a cell (``half [R]``) of the mark's centre: ``|rx * dy - ry
+    * dx| < half`` and ``0 < rx * dx + ry * dy < reach``, elementwise. Every mark and beam is
+    tried in single precision first, with a margin that covers its rounding (a few units
+    in the 24th bit of the coordinates: :data:`SLACK`); the few that pass are tested again
+    in double, as before, so the same marks and beams pass."""
+    scale = float(np.fmax.reduce(np.abs(rel), axis=None, initial=0.0))   # (NaN left out)
+    rx, ry = (rel[:, j, None].astype(np.float32) for j in (0, 1))          # [K, 1]
+    across = rx * dy.astype(np.float32)[k]
+    across -= ry * dx.astype(np.float32)[k]
     np.abs(across, out=across)
-    i, b = (across < half[k, None]).nonzero()
+    bound = np.nextafter((half + SLACK * scale).astype(np.float32), np.float32(np.inf))
+    i, b = np.divmod(np.flatnonzero(across < bound[k, None]), dx.shape[1])  # (rounded up)
     j = k[i]
-    along = rel[i, 0] * dx[j, b] + rel[i, 1] * dy[j, b]
+    x, y = rel[i, 0], rel[i, 1]
+    near = np.abs(x * dy[j, b] - y * dx[j, b]) < half[j]
+    i, b, j, x, y = i[near], b[near], j[near], x[near], y[near]
+    along = x * dx[j, b] + y * dy[j, b]
     out = np.zeros(len(rel), dtype=bool)
     out[i[(along > 0) & (along < reach[j, b])]] = True
     return out
+
+
+#: how far (times the largest coordinate) :func:`_seen_through` lets single precision put
+#: ``|rx * dy - ry * dx|`` below its double: the coordinates and unit directions rounded,
+#: their products and their difference, at most ``5 * 2**-24 * (|rx| + |ry|)``, under
+#: ``6e-7`` times the largest coordinate; six times that
+SLACK = 4e-6
 
 
 def beyond_cells(maps: list[RobotMap], origins: np.ndarray, dirs: np.ndarray,
