@@ -751,6 +751,10 @@ def test_marks_seen_through_from_the_beams_near_them_are_those_of_every_beam(see
     reach = rng.choice([0.0, 10.0, 38.0, 60.0], (robots, 12))
     assert np.array_equal(knowledge._seen_through(rel, k, dx, dy, reach, half),
                           seen_through_every_product(rel, k, dx, dy, reach, half))
+    # directions longer than a unit, and coordinates beyond single precision
+    for grow, far in ((3.0, 1.0), (1.0, 1e35)):
+        args = rel * far, k, dx * grow, dy * grow, reach * far * grow, half * far * grow
+        assert np.array_equal(knowledge._seen_through(*args), seen_through_every_product(*args))
 
 
 def test_marks_in_sight_of_many_maps_at_once_are_each_maps_own():

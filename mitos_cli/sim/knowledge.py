@@ -544,14 +544,21 @@ def _seen_through(rel: np.ndarray, k: np.ndarray, dx: np.ndarray, dy: np.ndarray
     * dx| < half`` and ``0 < rx * dx + ry * dy < reach``, elementwise. Every mark and beam is
     tried in single precision first, with a margin that covers its rounding (a few units
     in the 24th bit of the coordinates: :data:`SLACK`); the few that pass are tested again
-    in double, as before, so the same marks and beams pass."""
-    scale = float(np.fmax.reduce(np.abs(rel), axis=None, initial=0.0))   # (NaN left out)
-    rx, ry = (rel[:, j, None].astype(np.float32) for j in (0, 1))          # [K, 1]
-    across = rx * dy.astype(np.float32)[k]
-    across -= ry * dx.astype(np.float32)[k]
+    in double, as before, so the same marks and beams pass (all of it in double where the
+    coordinates are too large for single precision)."""
+    coords, ex, ey = (float(np.fmax.reduce(np.abs(a), axis=None, initial=0.0))  # (NaN left
+                      for a in (rel, dx, dy))                                   # out)
+    scale = coords * max(ex, ey, 1.0)
+    if scale < 1e30:
+        kind = np.float32
+        bound = np.nextafter((half + SLACK * scale).astype(kind), kind(np.inf))  # rounded up
+    else:
+        kind, bound = np.float64, np.full(len(half), np.inf)
+    rx, ry = (rel[:, j, None].astype(kind) for j in (0, 1))                # [K, 1]
+    across = rx * dy.astype(kind)[k]
+    across -= ry * dx.astype(kind)[k]
     np.abs(across, out=across)
-    bound = np.nextafter((half + SLACK * scale).astype(np.float32), np.float32(np.inf))
-    i, b = np.divmod(np.flatnonzero(across < bound[k, None]), dx.shape[1])  # (rounded up)
+    i, b = np.divmod(np.flatnonzero(across < bound[k, None]), dx.shape[1])
     j = k[i]
     x, y = rel[i, 0], rel[i, 1]
     near = np.abs(x * dy[j, b] - y * dx[j, b]) < half[j]
@@ -562,10 +569,10 @@ def _seen_through(rel: np.ndarray, k: np.ndarray, dx: np.ndarray, dy: np.ndarray
     return out
 
 
-#: how far (times the largest coordinate) :func:`_seen_through` lets single precision put
-#: ``|rx * dy - ry * dx|`` below its double: the coordinates and unit directions rounded,
-#: their products and their difference, at most ``5 * 2**-24 * (|rx| + |ry|)``, under
-#: ``6e-7`` times the largest coordinate; six times that
+#: how far (times the largest coordinate and direction) :func:`_seen_through` lets single
+#: precision put ``|rx * dy - ry * dx|`` below its double: the coordinates and directions
+#: rounded, their products and their difference, at most ``4 * 2**-24 * (|rx| + |ry|) *
+#: max(|dx|, |dy|)``, under ``5e-7`` times the largest of each; eight times that
 SLACK = 4e-6
 
 
