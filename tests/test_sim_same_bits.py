@@ -573,6 +573,35 @@ def test_rows_stacked_are_each_row_padded_with_zeros(lengths, extra, tail, seed)
             rows._stacked(arrays + [np.zeros((width, *tail))], width - 1)
 
 
+@pytest.mark.parametrize("seed", range(10))
+@pytest.mark.parametrize("boxes", [6, 40])           # beams test every side, or culled
+def test_rows_sensed_with_the_stacks_kept_get_the_bits_of_rows_stacked_afresh(seed, boxes):
+    angles = np.deg2rad(np.arange(-180.0, 180.0, 10.0))
+    parts = box_rows(seed, n_rows=4, n_boxes=boxes)
+    kept: rows.Kept = {}
+    rng = np.random.default_rng(seed)
+    for tick in range(6):
+        before = {name: stack for name, (_, stack) in kept.items()}
+        if tick % 2:                         # some rows gather other walls, or move boxes
+            i = int(rng.integers(len(parts)))
+            walls = rng.uniform(-200, 200, (int(rng.integers(0, 8)), 4))
+            sides = parts[i].segments[len(parts[i].walls):]
+            parts[i] = dataclasses.replace(parts[i], walls=walls,
+                                           segments=np.concatenate([walls, sides]))
+        if tick == 4:
+            j = int(rng.integers(len(parts)))
+            boxes = parts[j].boxes + 1.5
+            parts[j] = dataclasses.replace(parts[j], boxes=boxes, discs=rows.discs(boxes),
+                                           segments=np.concatenate(
+                                               [parts[j].walls, geometry.polygon_segments(boxes)]))
+        fresh = rows.sense(parts, angles, 150.0)
+        again = rows.sense(parts, angles, 150.0, kept)
+        for key in ("dirs", "static", "ranges", "clearance"):
+            assert same(getattr(fresh, key), getattr(again, key)), (tick, key)
+        if tick == 2:                                   # nothing changed: nothing stacked again
+            assert before and all(kept[name][1] is stack for name, stack in before.items())
+
+
 @pytest.mark.parametrize("seed", range(40))
 def test_beams_among_many_boxes_test_only_the_boxes_they_may_hit_with_the_same_bits(
         seed, monkeypatch):

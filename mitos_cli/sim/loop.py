@@ -1151,6 +1151,7 @@ class Batch:
         self._goal_x, self._goal_y, self._tol = (self._gather(name)
                                                  for name in ("_goal_x", "_goal_y", "_tol"))
         self._straight = np.concatenate([run.limits.straight for run in runs])
+        self.stacked: rows.Kept = {}        # what its last rows.sense stacked of the runs' rows
         self.maps = [m for run in runs for m in run._maps]
         self._plain = all(run._plain for run in runs)
         # (Simulation.seeing: the runs of one world are given the same map and sensors; a

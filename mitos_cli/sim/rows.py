@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import functools
 import math
+import operator
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any, Generic, TypeVar, overload
@@ -71,9 +72,16 @@ def discs(polygons: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return middle, np.hypot(off[..., 0], off[..., 1]).max(axis=1, initial=0.0) + 1e-6
 
 
-def sense(rows: list[SenseRow], angles: np.ndarray, max_range: float) -> Sensed:
+#: Rows' arrays stacked at a :func:`sense`, by name: the arrays of each row and their stack.
+Kept = dict[str, tuple[list[np.ndarray], np.ndarray]]
+
+
+def sense(rows: list[SenseRow], angles: np.ndarray, max_range: float,
+          kept: Kept | None = None) -> Sensed:
     """The beams of every row (:func:`.sensors.cast`, :func:`.sensors.add_noise`) and the
-    clearance of its footprint, row by row the bits of one robot alone."""
+    clearance of its footprint, row by row the bits of one robot alone. ``kept``: what the
+    last :func:`sense` of these rows stacked (runs in lockstep keep it from tick to tick),
+    taken again where every row's array is the very one it was, and updated."""
     if len(rows) > 1 and any(r.boxes.shape != rows[0].boxes.shape
                              or len(r.centres) != len(rows[0].centres) for r in rows):
         raise ValueError("rows sensed together have as many obstacles each")
@@ -83,7 +91,7 @@ def sense(rows: list[SenseRow], angles: np.ndarray, max_range: float) -> Sensed:
     dirs = np.empty((*a.shape, 2))                                      # [R, B, 2]
     dirs[..., 0] = np.cos(a)
     dirs[..., 1] = np.sin(a)
-    stacks = _Stacks(rows)
+    stacks = _Stacks(rows, kept)
     static, hit = _cast(stacks, origin, dirs, max_range)
     ranges = _noisy(rows, hit, max_range)
     return Sensed(dirs, static, ranges, _clearance(stacks, origin, heading))
@@ -132,10 +140,24 @@ class once(Generic[T]):
 
 class _Stacks:
     """The rows' arrays one above the other (:func:`_stacked`), each stacked once a
-    :func:`sense`, when a stage first asks for it."""
+    :func:`sense`, when a stage first asks for it; from ``kept`` (:data:`Kept`, updated)
+    where the rows' arrays are the very ones stacked last (a run's obstacles stand still,
+    and its walls are gathered again only once it moved on: most ticks, all of them)."""
 
-    def __init__(self, rows: list[SenseRow]) -> None:
+    def __init__(self, rows: list[SenseRow], kept: Kept | None = None) -> None:
         self.rows = rows
+        self.kept: Kept = {} if kept is None else kept
+
+    def _stack(self, name: str, arrays: list[np.ndarray], width: int | None = None) -> np.ndarray:
+        """``_stacked(arrays, width)``, or the stack kept of the same arrays (their widths
+        are the same too)."""
+        old = self.kept.get(name)
+        if old is not None and len(old[0]) == len(arrays) and all(map(operator.is_, old[0],
+                                                                        arrays)):
+            return old[1]
+        out = _stacked(arrays, width)
+        self.kept[name] = (arrays, out)
+        return out
 
     @once
     def wall_counts(self) -> list[int]:
@@ -143,23 +165,28 @@ class _Stacks:
 
     @once
     def walls(self) -> np.ndarray:                      # [R, W, 4], W the most of a row
-        return _stacked([r.walls for r in self.rows], max(self.wall_counts))
+        return self._stack("walls", [r.walls for r in self.rows], max(self.wall_counts))
+
+    @once
+    def segments(self) -> np.ndarray:                   # [R, N, 4], N the most of a row
+        arrays = [r.segments for r in self.rows]
+        return self._stack("segments", arrays, max(map(len, arrays)))
 
     @once
     def centres(self) -> np.ndarray:                    # [R, C, 2]
-        return _stacked([r.centres for r in self.rows])
+        return self._stack("centres", [r.centres for r in self.rows])
 
     @once
     def radii(self) -> np.ndarray:                      # [R, C]
-        return _stacked([r.radii for r in self.rows])
+        return self._stack("radii", [r.radii for r in self.rows])
 
     @once
     def middles(self) -> np.ndarray:                    # [R, P, 2], the discs' (:func:`discs`)
-        return _stacked([r.discs[0] for r in self.rows])
+        return self._stack("middles", [r.discs[0] for r in self.rows])
 
     @once
     def reaches(self) -> np.ndarray:                    # [R, P], their radii
-        return _stacked([r.discs[1] for r in self.rows])
+        return self._stack("reaches", [r.discs[1] for r in self.rows])
 
 
 CULL_FROM = 16                 # boxes from which beams test only the boxes their discs allow
@@ -183,7 +210,7 @@ def _cast(stacks: _Stacks, origin: np.ndarray, dirs: np.ndarray,
                          max_range)
         static = np.minimum(static, max_range)
     else:
-        t = _ray_hits(_stacked([r.segments for r in rows], max(total)), origin, dirs, keep=True)
+        t = _ray_hits(stacks.segments, origin, dirs, keep=True)
         hit = np.minimum(t.min(axis=2, initial=np.inf), max_range)
         if walls == total:                              # no sides: the walls are all there is
             static = hit
