@@ -342,7 +342,8 @@ def test_the_coarse_pass_leaves_out_no_cell_that_comes_within_a_step_of_the_body
         reach = safety._depth(px - cx, py - cy, c, s, hl, hw, radius).max(axis=1)   # every place
         places = (c, s, cx, cy, *safety._room(c, s, hl, hw, radius))
         bound = safety._bound(*(np.full((1, 1), v) for v in (k, du, hl, hw, half, radius)), step)
-        near = safety._near(px, py, np.zeros(300, dtype=np.intp), places, bound[:, 0])
+        near, _ = safety._near(px, py, np.zeros(300, dtype=np.intp), places, bound[:, 0],
+                               np.array([u[0, -1] < 0]))
         assert not np.count_nonzero(~near & (reach >= -step))
         left_out += np.count_nonzero(~near)
         gaps += list(-step - reach[~near])
@@ -499,3 +500,37 @@ def test_the_brake_of_one_robot_is_a_python_float():
     limit = safety.brake(30.0, 40.0, 2.0, 0.05)
     assert type(limit) is float and limit == safety._brakes(np.array([30.0]), np.array([40.0]),
                                                              2.0, 0.05)[0]
+
+
+@pytest.mark.parametrize("chunk", [8192, 60])
+def test_sweeps_measured_only_up_to_their_first_sure_touch_get_the_bits_they_get_alone(
+        chunk, monkeypatch):
+    """:func:`safety._travels` looks at each sweep's places only up to the first where the
+    coarse pass finds a cell touched for sure (:func:`safety._near`); every sweep still gets
+    what it gets alone, among walls close ahead, cells the body touches at the start (backing
+    away from them) and no cell in reach, its places split among chunks or not."""
+    monkeypatch.setattr(safety, "CHUNK", chunk)
+    rng = np.random.default_rng(14)
+    trimmed = []
+    touches = safety._touches
+
+    def spy(px, py, owner, places, back, step, upto):
+        trimmed.append(int(np.count_nonzero(upto < places[0].shape[1])))
+        return touches(px, py, owner, places, back, step, upto)
+
+    monkeypatch.setattr(safety, "_touches", spy)
+    for _ in range(40):
+        sweeps = []
+        for _ in range(int(rng.integers(2, 10))):
+            pose = (float(rng.uniform(-5, 5)), float(rng.uniform(-5, 5)),
+                    float(rng.uniform(-4, 4)))
+            cells = rng.uniform(-45, 45, (int(rng.choice([0, 3, 40, 120])), 2))
+            if rng.random() < 0.3:                   # one under its body at the start
+                cells = np.vstack([cells, np.array(pose[:2]) + rng.uniform(-10, 10, 2)])
+            body = safety.Body(ROBOT, pose, 90.0, cells, float(rng.choice([0.5, 1.0])), 0.0,
+                               float(rng.choice([30.0, 50.0])))
+            sweeps.append((body, float(rng.choice([90.0, 30.0, 150.0, rng.uniform(30, 150)])),
+                           bool(rng.random() < 0.4)))
+        alone = [body.free(wheel, backward, safety.Settings()) for body, wheel, backward in sweeps]
+        assert safety.free_travels(sweeps).tolist() == alone
+    assert sum(trimmed) > 100                          # many sweeps were cut short

@@ -306,12 +306,15 @@ def _travels(cells: list[np.ndarray], numbers, radius: np.ndarray, reach: np.nda
     if not len(owner):
         return out
     places = (c, s, cx, cy, *_room(c, s, hl, hw, rad))
-    near = _near(px, py, owner, places, _bound(k, du, hl, hw, half, rad, step)[:, 0])
+    near, sure = _near(px, py, owner, places, _bound(k, du, hl, hw, half, rad, step)[:, 0], back)
     px, py, owner = px[near], py[near], owner[near]
     if not len(owner):
         return out
-    hit, cell, j = _touches(px, py, owner, places, back, step)
-    hit &= np.arange(u.shape[1]) < own                                   # [R, K], its own
+    # each sweep's places up to the first where a cell is touched for sure (its own at most):
+    # no later place changes where it first touches, nor a pair _between looks at
+    upto = own[:, 0].copy()
+    np.minimum.at(upto, owner, sure[near] + 1)
+    hit, cell, j = _touches(px, py, owner, places, back, step, upto)
     _between(hit, own[:, 0], cell, j, owner, u, arc, px, py, hl[owner], hw[owner], rad[owner])
     first = np.maximum(hit.argmax(axis=1) - 1, 0) * du[:, 0]
     return np.where(np.logical_or.reduce(hit, axis=1), first, out)
@@ -343,7 +346,7 @@ def _in_boxes(known: list[np.ndarray], cx: np.ndarray, cy: np.ndarray,
 
 
 def _near(px: np.ndarray, py: np.ndarray, owner: np.ndarray, places: tuple[np.ndarray, ...],
-          bound: np.ndarray) -> np.ndarray:
+          bound: np.ndarray, back: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """``[M]`` which cells (``px, py [M, 1]`` of sweeps ``owner [M]``) may reach a depth of
     ``-step`` at one of their sweep's ``places`` (``c, s, cx, cy`` and :func:`_room`, each
     ``[R, K]``), from their depths at the :func:`_coarse` places alone: a cell deeper than
@@ -351,48 +354,77 @@ def _near(px: np.ndarray, py: np.ndarray, owner: np.ndarray, places: tuple[np.nd
     is never touched, not even at the start (backing away, :func:`_touched`), nor between two
     places (two depths below ``-step`` add up to less than ``-step``, :func:`_pairs`).
     Leaving it out changes no bit of the answer, and most of the cells in a sweep's box are
-    out of its reach. (The places a cell is looked at run down a column: NumPy takes the
-    greatest of each column at once, and of each short row one row at a time.)"""
+    out of its reach. Also ``[M]``: the first of those places where each cell is touched for
+    sure (:func:`_touched`, backing out of sweeps ``back [R]``: its depth 0 or more, and not
+    a cell touched at the start backed away from), past the last place where none is. (The
+    places a cell is looked at run down a column: NumPy takes the greatest of each column at
+    once, and of each short row one row at a time.)"""
     width = places[0].shape[1]
     at = _coarse(width)[:, None]                                # [C, 1]
 
-    def deep(part: slice) -> np.ndarray:
+    def deep(part: slice) -> tuple[np.ndarray, np.ndarray]:
         where = at + owner[part] * width                        # [C, M]: in places, flat
         c, s, cx, cy, *room = (np.take(v, where) for v in places)
-        return _depth_in(px[part, 0] - cx, py[part, 0] - cy, c, s, room).max(axis=0)
+        depth = _depth_in(px[part, 0] - cx, py[part, 0] - cy, c, s, room)
+        sure = depth >= 0
+        sure &= (depth[:1] < 0) | ~back[owner[part]]
+        return (depth.max(axis=0) >= -bound[owner[part]],
+                np.where(np.logical_or.reduce(sure, axis=0), at[sure.argmax(axis=0), 0], width))
 
-    return np.concatenate([deep(part) >= -bound[owner[part]]
-                           for part in _chunks(len(owner), len(at))])
+    near, sure = zip(*(deep(part) for part in _chunks(len(owner), len(at))))
+    return np.concatenate(near), np.concatenate(sure)
 
 
 def _touches(px: np.ndarray, py: np.ndarray, owner: np.ndarray, places: tuple[np.ndarray, ...],
-             back: np.ndarray, step: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+             back: np.ndarray, step: float, upto: np.ndarray
+             ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Where each sweep touches a cell (``[R, K]``, :func:`_touched`; backing out, ``back
-    [R]``) and the pairs of places a cell may be touched between (:func:`_pairs`), worked
-    out :data:`CHUNK` elements at a time: the cells ``px, py [M, 1]`` of sweeps ``owner
-    [M]`` (sorted) at their sweep's ``places`` (as :func:`_near` takes them)."""
+    [R]``) within its first ``upto [R]`` places, and the pairs of those places a cell may be
+    touched between (:func:`_pairs`), worked out :data:`CHUNK` elements at a time: the cells
+    ``px, py [M, 1]`` of sweeps ``owner [M]`` (sorted) at their sweep's ``places`` (as
+    :func:`_near` takes them), each cell's places one after the other (a sweep's count up to
+    its first sure touch, :func:`_near`: about half the places of the longest sweep)."""
+    width = places[0].shape[1]
     hit = np.zeros(places[0].shape, dtype=bool)
+    flat_hit = hit.reshape(-1)
     pairs = []
-    for part in _chunks(len(owner), places[0].shape[1]):
-        c, s, cx, cy, *room = (np.take(v, owner[part], axis=0) for v in places)
-        depth = _depth_in(px[part] - cx, py[part] - cy, c, s, room)                 # [M, K]
-        inside = _touched(depth, back[owner[part]])
-        first_of = _runs(owner[part])
-        hit[owner[part][first_of]] |= np.logical_or.reduceat(inside, first_of, axis=0)
-        cell, j = _pairs(inside, depth, step)
-        pairs.append((cell + part.start, j))
+    for part in _spans(upto[owner]):
+        count = upto[owner[part]]
+        cell = np.repeat(np.arange(part.start, part.stop), count)             # [N]
+        first = np.cumsum(count) - count               # where each cell's places begin
+        j = np.arange(len(cell)) - np.repeat(first, count)
+        at = owner[cell] * width + j                                            # in places
+        c, s, cx, cy, *room = (np.take(v, at) for v in places)
+        depth = _depth_in(px[cell, 0] - cx, py[cell, 0] - cy, c, s, room)      # [N]
+        inside = depth >= 0
+        start = depth[first][cell - part.start]        # each cell's depth at the start
+        if np.count_nonzero(back[owner[part]]):        # (_touched, a cell at a time)
+            away = back[owner[cell]] & (start >= 0)
+            inside[away] = depth[away] > start[away]
+        flat_hit[at[inside]] = True
+        maybe = (depth[:-1] + depth[1:] >= -step) & ~inside[:-1] & ~inside[1:]    # (_pairs)
+        maybe &= (j[1:] != 0) & (start[:-1] < 0)       # one cell's places, not touched at first
+        k = np.flatnonzero(maybe)
+        pairs.append((cell[k], j[k]))
     cell, j = (np.concatenate(v) for v in zip(*pairs))
     return hit, cell, j
+
+
+def _spans(count: np.ndarray) -> list[slice]:
+    """Slices of the cells with ``count [M]`` places each of about :data:`CHUNK` places each:
+    a slice ends before the cell that would take it past a multiple of :data:`CHUNK` (a cell
+    with more places alone)."""
+    ends = np.cumsum(count)
+    if ends[-1] <= CHUNK:
+        return [slice(0, len(count))]
+    cuts = np.searchsorted(ends, np.arange(CHUNK, int(ends[-1]), CHUNK), side="right").tolist()
+    bounds = sorted({0, *cuts, len(count)})
+    return [slice(a, b) for a, b in zip(bounds[:-1], bounds[1:])]
 
 
 def _coarse(places: int) -> np.ndarray:
     """The places :func:`_near` looks at of ``places``: every ``COARSE``-th and the last."""
     return np.append(np.arange(0, places - 1, COARSE), places - 1)
-
-
-def _runs(owner: np.ndarray) -> np.ndarray:
-    """Where each run of equal owners begins in ``owner`` (sorted)."""
-    return np.append(0, np.flatnonzero(owner[1:] != owner[:-1]) + 1)
 
 
 def _bound(k: np.ndarray, du: np.ndarray, hl: np.ndarray, hw: np.ndarray, half: np.ndarray,
