@@ -175,6 +175,22 @@ def test_a_run_stepped_alone_inside_a_lockstep_keeps_its_bits(name):
         assert_same_run(simulate(world, None, seed, randomise=True), res)
 
 
+def test_runs_each_stepped_alone_between_two_batch_ticks_keep_their_bits():
+    """Every run stepped alone a tick is at one tick with the others again, and their batch
+    still serves them: it reads the places the runs moved to alone, not those it left."""
+    world = _short("slalom", 3.0)
+    lock = Lockstep(world, None, [1, 2, 3], randomise=True)
+    for _ in range(3):
+        lock.step()
+    batch = lock._batch
+    for run in lock.runs:
+        run.step()
+    lock.step()
+    assert lock._batch is batch                          # the same batch went on
+    for seed, res in zip([1, 2, 3], lock.results()):
+        assert_same_run(simulate(world, None, seed, randomise=True), res)
+
+
 def test_a_refused_command_is_told_as_alone_and_moves_no_robot(monkeypatch):
     world = _short("corridor", 2.0)
     lock = Lockstep(world, None, [1, 2, 3])

@@ -1127,6 +1127,10 @@ _SIDE = perception.INPUTS.index("heading")
 _EPOCHS = itertools.count()
 
 
+#: A run's x (:meth:`Batch._state` asks whether each run's is still the batch's).
+_X = operator.attrgetter("_x")
+
+
 def row_spans(runs: list[Simulation]) -> list[tuple[int, int]]:
     """Where each run's robots lie in the rows of all of them, one run after the other."""
     stops = list(itertools.accumulate(run.n for run in runs))
@@ -1148,6 +1152,10 @@ class Batch:
         self.spans = row_spans(runs)
         self._starts = np.array([a for a, _ in self.spans])
         self._owner = [(run, i) for run in runs for i in range(run.n)]   # each row's robot
+        self._single = len(self._owner) == len(runs)            # a robot a run (most worlds)
+        # the runs' x, y, heading, speed and wheel as :meth:`move` left them (each run's
+        # views of them), and each run's x
+        self._moved: tuple[tuple[np.ndarray, ...], list[np.ndarray]] | None = None
         self._goal_x, self._goal_y, self._tol = (self._gather(name)
                                                  for name in ("_goal_x", "_goal_y", "_tol"))
         self._straight = np.concatenate([run.limits.straight for run in runs])
@@ -1204,22 +1212,42 @@ class Batch:
         """The runs' arrays ``name`` one after the other (a fresh array)."""
         return np.concatenate([getattr(run, name) for run in self.runs])
 
+    def _each(self, rows: np.ndarray) -> list[np.ndarray]:
+        """Each run's rows of ``rows [robots, ...]``, views, one run after the other (a robot
+        a run: split in one pass, not sliced run by run)."""
+        if self._single:
+            return list(rows[:, None])
+        return [rows[a:b] for a, b in self.spans]
+
+    def _state(self) -> tuple[np.ndarray, ...]:
+        """The runs' x, y, heading, speed and wheel, ``[rows]`` each: those :meth:`move` left
+        while every run still holds its views of them (a run moved alone or started again
+        holds arrays of its own, :meth:`Simulation.move_to`), else gathered afresh. Neither
+        is ever written into (the record keeps them)."""
+        if self._moved is not None and all(map(operator.is_, map(_X, self.runs),
+                                                self._moved[1])):
+            return self._moved[0]
+        return tuple(self._gather(name) for name in ("_x", "_y", "_h", "_v", "_steer"))
+
     def sensed(self, got: rows.Sensed) -> list[_Sensed]:
         """:meth:`Simulation.sensed` of every run from the rows of all (``got``): the tick's
         arrays made once, each run's :class:`_Sensed` views of them."""
-        x, y, h = self._now = (self._gather("_x"), self._gather("_y"), self._gather("_h"))
-        self._drive = (self._gather("_v"), self._gather("_steer"))
+        x, y, h, *drive = self._state()
+        self._now, self._drive = (x, y, h), (drive[0], drive[1])
         pose = _columns(x, y, h)
         n = len(x)
         self.block = np.zeros((len(perception.INPUTS), n))    # a row per input, as alone
         self.targets, self.command = np.zeros((n, 2)), np.zeros((n, 2))
         dirs, static = list(got.dirs), list(got.static)
+        blocks = (list(self.block.T[:, :, None]) if self._single       # [inputs, 1] each
+                  else [self.block[:, a:b] for a, b in self.spans])
         self.ticks = []
-        for run, (a, b) in zip(self.runs, self.spans):
-            run._beams(pose[a:b], dirs[a:b], static[a:b])
-            self.ticks.append(_Sensed(run.time, run._where, pose[a:b], got.ranges[a:b],
-                                      self.targets[a:b], got.clearance[a:b], self.command[a:b],
-                                      self.block[:, a:b]))
+        for run, (a, b), *each in zip(self.runs, self.spans, self._each(pose),
+                                      self._each(got.ranges), self._each(self.targets),
+                                      self._each(got.clearance), self._each(self.command),
+                                      blocks):
+            run._beams(each[0], dirs[a:b], static[a:b])
+            self.ticks.append(_Sensed(run.time, run._where, *each))
         self.got, self.pose, self.at = got, pose, pose[:, :2].copy()
         return self.ticks
 
@@ -1382,10 +1410,13 @@ class Batch:
         hit = np.logical_or.reduceat(self.hit, self._starts).tolist()
         driving = np.logical_or.reduceat(self.active, self._starts).tolist()
         moving = []
-        for j, (run, s, (a, b)) in enumerate(zip(self.runs, self.ticks, self.spans)):
-            run._hit = self.hit[a:b]
-            run._keep(s, pose[a:b], speed[a:b], steering[a:b], self.active[a:b], hint[a:b])
-            if run._judge(s, hit[j], driving[j]):
+        for run, s, touch, drives, mine, *kept in zip(
+                self.runs, self.ticks, hit, driving, self._each(self.hit), self._each(pose),
+                self._each(speed), self._each(steering), self._each(self.active),
+                self._each(hint)):
+            run._hit = mine
+            run._keep(s, *kept)
+            if run._judge(s, touch, drives):
                 moving.append(run)
         return moving
 
@@ -1396,8 +1427,8 @@ class Batch:
         runs = self.runs
         if self._now is None or any(run._deciding is not s for run, s in zip(runs, self.ticks)):
             # (not every run of the tick the batch observed moves by it: each run's own)
-            self._now = (self._gather("_x"), self._gather("_y"), self._gather("_h"))
-            self._drive = (self._gather("_v"), self._gather("_steer"))
+            x, y, h, *drive = self._state()
+            self._now, self._drive = (x, y, h), (drive[0], drive[1])
             self.active = self._gather("_active")
             self.command = np.concatenate([run.decided.command for run in runs])
         x, y, h = self._now
@@ -1420,11 +1451,15 @@ class Batch:
             moved = driven - np.concatenate([run._odometer[-window] for run in runs])
             stuck = self.active & (moved < STUCK_DISTANCE)
             stuck_any = np.logical_or.reduceat(stuck, self._starts).tolist()
-        for j, (run, (a, b)) in enumerate(zip(runs, self.spans)):
-            run._x, run._y, run._h, run._v, run._steer = (part[a:b] for part in after)
-            run._odometer.append(driven[a:b])
+        xs = self._each(after[0])
+        for j, (run, (a, b), *state) in enumerate(zip(runs, self.spans, xs,
+                                                     *map(self._each, after[1:]),
+                                                     self._each(driven))):
+            run._x, run._y, run._h, run._v, run._steer, driven_j = state
+            run._odometer.append(driven_j)
             run._k += 1
             run._go_on(stuck is not None and stuck_any[j] and run._stuck(stuck[a:b]))
+        self._moved = (after, xs)
         self._now = None
 
 
