@@ -162,8 +162,7 @@ def _observe_together(batch: Batch) -> None:
     one :meth:`.Batch.conclude`; what else each robot's map and route need, run by run."""
     fresh, spans, maps = batch.runs, batch.spans, batch.maps
     world = fresh[0].world
-    got = rows.sense([part for run in fresh for part in run.sense_rows()], fresh[0].angles,
-                     world.sensors.range, batch.stacked)
+    got = rows.sense(batch.sense_rows(), fresh[0].angles, world.sensors.range, batch.stacked)
     sensed = batch.sensed(got)
     knowledge.clear_all(maps, batch.at, got.dirs, got.ranges, world.sensors.range)
     beyond = knowledge.beyond_cells(maps, batch.at, got.dirs, got.ranges)

@@ -1156,6 +1156,11 @@ class Batch:
         # the runs' x, y, heading, speed and wheel as :meth:`move` left them (each run's
         # views of them), and each run's x
         self._moved: tuple[tuple[np.ndarray, ...], list[np.ndarray]] | None = None
+        # the runs' rows of rows.sense, kept from tick to tick where each run is of one robot
+        # among obstacles that stand still (sense_rows), and the sides of those obstacles
+        self._keeps_rows = self._single and all(run._still is not None for run in runs)
+        self._sensing: list[rows.SenseRow] = []
+        self._sides = [run._still[1][3] for run in runs if run._still is not None]
         self._goal_x, self._goal_y, self._tol = (self._gather(name)
                                                  for name in ("_goal_x", "_goal_y", "_tol"))
         self._straight = np.concatenate([run.limits.straight for run in runs])
@@ -1228,6 +1233,22 @@ class Batch:
                                                 self._moved[1])):
             return self._moved[0]
         return tuple(self._gather(name) for name in ("_x", "_y", "_h", "_v", "_steer"))
+
+    def sense_rows(self) -> list[rows.SenseRow]:
+        """:meth:`Simulation.sense_rows` of every run. A run of one robot among obstacles that
+        stand still keeps its row from tick to tick: only the robot's place and heading
+        change, and its walls once it moved on (:meth:`Simulation._walls_near`)."""
+        if not self._keeps_rows:
+            return [part for run in self.runs for part in run.sense_rows()]
+        if not self._sensing:
+            self._sensing = [run.sense_rows()[0] for run in self.runs]
+            return self._sensing
+        x, y, h = (v.tolist() for v in self._state()[:3])
+        for run, row, sides, *at in zip(self.runs, self._sensing, self._sides, x, y, h):
+            walls = run._walls_near(0, at[0], at[1])
+            row.x, row.y, row.heading = at
+            row.walls, row.segments = walls, run._joined(0, walls, sides)
+        return self._sensing
 
     def sensed(self, got: rows.Sensed) -> list[_Sensed]:
         """:meth:`Simulation.sensed` of every run from the rows of all (``got``): the tick's
