@@ -13,7 +13,17 @@ import pytest
 from hypothesis import strategies as st
 
 from mitos_cli.resources import packaged_path
-from mitos_cli.sim import distance, geometry, knowledge, movers, perception, route, rows, safety
+from mitos_cli.sim import (
+    distance,
+    geometry,
+    knowledge,
+    loop,
+    movers,
+    perception,
+    route,
+    rows,
+    safety,
+)
 from mitos_cli.sim.loop import Simulation, prepare
 from mitos_cli.sim.planner import FuzzyPlanner
 from mitos_cli.sim.world import Grid, Robot
@@ -571,6 +581,25 @@ def test_rows_stacked_are_each_row_padded_with_zeros(lengths, extra, tail, seed)
     if extra and max(lengths):
         with pytest.raises(ValueError, match="does not fit"):
             rows._stacked(arrays + [np.zeros((width, *tail))], width - 1)
+
+
+@hypothesis.settings(max_examples=200, deadline=None)
+@hypothesis.given(st.integers(1, 40), st.sampled_from([(), (1,), (3,), (0, 2), (13, 1), (2, 3)]),
+                  st.sampled_from(["float", "bool", "view", "column"]), st.integers(0, 2 ** 32 - 1))
+def test_a_records_ticks_stacked_are_np_array_of_them(ticks, shape, kind, seed):
+    """:func:`loop._stacked` joins the parts' bytes where they lie together, else concatenates
+    them (views with their bytes apart, as columns of a batch's block): either way
+    ``np.array(parts)``, shape, type and bits."""
+    rng = np.random.default_rng(seed)
+    if kind == "float":
+        parts = [rng.normal(size=shape) for _ in range(ticks)]
+    elif kind == "bool":
+        parts = [rng.random(shape) < 0.5 for _ in range(ticks)]
+    else:                                       # rows or columns of larger arrays
+        big = rng.normal(size=(ticks, *shape, 3))
+        parts = list(big[..., 0] if kind == "column" else big[..., :1].reshape(ticks, *shape))
+    got, want = loop._stacked(parts), np.array(parts)
+    assert got.shape == want.shape and got.dtype == want.dtype and same(got, want)
 
 
 @pytest.mark.parametrize("seed", range(10))

@@ -1081,9 +1081,18 @@ class Simulation:
 
 
 def _stacked(parts: list[np.ndarray]) -> np.ndarray:
-    """``np.array(parts)`` of arrays of one shape, ``[len(parts), *shape]``: one concatenation
-    (``np.array`` looks at each part on its own: 5 ms of a run's 500 ticks)."""
-    return np.concatenate(parts).reshape(len(parts), *np.shape(parts[0]))
+    """``np.array(parts)`` of arrays of one shape and type, ``[len(parts), *shape]``: their
+    bytes joined where each part's lie together (a quarter of the time of ``np.concatenate``,
+    which looks at each part's shape and type; ``np.array`` at each element: 5 ms of a run's
+    500 ticks), else one concatenation."""
+    first = parts[0]
+    try:
+        joined = bytearray().join(parts)  # type: ignore[arg-type]  # (arrays are buffers)
+    except TypeError:                                   # a part whose bytes are apart
+        joined = None
+    if joined is None or len(joined) != len(parts) * first.nbytes:     # (or of other sizes)
+        return np.concatenate(parts).reshape(len(parts), *first.shape)
+    return np.frombuffer(joined, dtype=first.dtype).reshape(len(parts), *first.shape)
 
 
 def _sights(aims: list[perception.Aim], robots: list, pose: np.ndarray, dirs: np.ndarray,
@@ -1257,10 +1266,13 @@ class Batch:
         self._now, self._drive = (x, y, h), (drive[0], drive[1])
         pose = _columns(x, y, h)
         n = len(x)
-        self.block = np.zeros((len(perception.INPUTS), n))    # a row per input, as alone
+        # a row per input, as alone, laid out a robot's inputs after another's: a run of one
+        # robot holds a block [inputs, 1] whose bytes lie together (result() joins them)
+        inputs = np.zeros((n, len(perception.INPUTS)))
+        self.block = inputs.T
         self.targets, self.command = np.zeros((n, 2)), np.zeros((n, 2))
         dirs, static = list(got.dirs), list(got.static)
-        blocks = (list(self.block.T[:, :, None]) if self._single       # [inputs, 1] each
+        blocks = (list(inputs[:, :, None]) if self._single
                   else [self.block[:, a:b] for a, b in self.spans])
         self.ticks = []
         for run, (a, b), *each in zip(self.runs, self.spans, self._each(pose),
