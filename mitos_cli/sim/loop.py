@@ -1172,6 +1172,12 @@ class Batch:
         self._sides = [run._still[1][3] for run in runs if run._still is not None]
         self._goal_x, self._goal_y, self._tol = (self._gather(name)
                                                  for name in ("_goal_x", "_goal_y", "_tol"))
+        # whether each robot drives, and its safety.Recovery: the batch's arrays, each run's
+        # its views of them (both are written in place, by the run alone or by the batch)
+        self._active, self._recovery = self._gather("_active"), self._gather("_recovery")
+        for run, active, recovery in zip(runs, self._each(self._active),
+                                         self._each(self._recovery)):
+            run._active, run._recovery = active, recovery
         self._straight = np.concatenate([run.limits.straight for run in runs])
         self.stacked: rows.Kept = {}        # what its last rows.sense stacked of the runs' rows
         self.maps = [m for run in runs for m in run._maps]
@@ -1377,14 +1383,13 @@ class Batch:
             self.block[j] = inputs[key]
         self.targets[:] = targets
         x, y, _ = self._ticked()
-        active = self._gather("_active")
-        self.hit, arrived = _arrivals(active, self.got.clearance, x, y, self._goal_x,
+        self.hit, arrived = _arrivals(self._active, self.got.clearance, x, y, self._goal_x,
                                       self._goal_y, self._tol)    # (hit: each run's at verdict)
         for row in arrived.nonzero()[0].tolist():
             run, i = self._owner[row]
             run._outcomes[i] = "success"
-            run._active[i] = False
-        self.active = active & ~arrived
+        self._active &= ~arrived                                  # (the runs' too)
+        self.active = self._active.copy()
 
     def _ticked(self) -> tuple[np.ndarray, ...]:
         assert self._now is not None, "sensed() first"
@@ -1411,9 +1416,9 @@ class Batch:
     def guard(self) -> None:
         """:meth:`Simulation._guard` of every run at once, on the commands :meth:`commanded`
         set: what the maps hold round the robots that brake found in one
-        :func:`.knowledge.near_all`, one :meth:`.safety.Fleet.guard` for all, and what it
-        changed of each robot's recovery (seldom anything) and its backing-outs given back
-        to its run."""
+        :func:`.knowledge.near_all`, one :meth:`.safety.Fleet.guard` for all on the robots'
+        recovery (the batch's array, each run's its view), and the backing-outs given back
+        to each robot's run."""
         fleet = self._fleet
         rows = (self.active & fleet.brakes).nonzero()[0]
         if not len(rows):
@@ -1421,14 +1426,9 @@ class Batch:
         maps = self.maps if len(rows) == len(self.maps) else [self.maps[i] for i in rows.tolist()]
         cells = knowledge.near_all(maps, self.at[rows], fleet.squares[rows])
         x, y, h = self._ticked()
-        state = self._gather("_recovery")
-        was = state.copy()
         v, steer = self._drive
-        backs = fleet.guard(rows, self.command, state, (x, y, h, steer, v, self.block[_SIDE]),
-                            cells)
-        for row in (state != was).any(axis=1).nonzero()[0].tolist():
-            run, i = self._owner[row]
-            run._recovery[i] = state[row]
+        backs = fleet.guard(rows, self.command, self._recovery,     # (the runs' too)
+                            (x, y, h, steer, v, self.block[_SIDE]), cells)
         for row in backs:
             run, i = self._owner[row]
             run._backed.append((run._k, i))
@@ -1462,7 +1462,7 @@ class Batch:
             # (not every run of the tick the batch observed moves by it: each run's own)
             x, y, h, *drive = self._state()
             self._now, self._drive = (x, y, h), (drive[0], drive[1])
-            self.active = self._gather("_active")
+            self.active = self._active.copy()
             self.command = np.concatenate([run.decided.command for run in runs])
         x, y, h = self._now
         v, steer = self._drive
