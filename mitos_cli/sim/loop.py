@@ -1136,8 +1136,9 @@ _SIDE = perception.INPUTS.index("heading")
 _EPOCHS = itertools.count()
 
 
-#: A run's x (:meth:`Batch._state` asks whether each run's is still the batch's).
-_X = operator.attrgetter("_x")
+#: A run's x and arc lengths (:meth:`Batch._state` and :meth:`Batch.framing` ask whether
+#: each run's are still the batch's).
+_X, _HINT = operator.attrgetter("_x"), operator.attrgetter("_s_hint")
 
 
 def row_spans(runs: list[Simulation]) -> list[tuple[int, int]]:
@@ -1216,6 +1217,8 @@ class Batch:
         # moves them) and their arc lengths along their routes (:meth:`aims`)
         self._drive: tuple[np.ndarray, np.ndarray] = (np.zeros(0), np.zeros(0))
         self._hint = np.zeros(0)
+        # the arc lengths :meth:`aims` gave the runs, and each run's view of them
+        self._hints: tuple[np.ndarray, list[np.ndarray]] = (np.zeros(0), [])
         self.got = rows.Sensed(np.zeros((0, 0, 2)), np.zeros((0, 0)), np.zeros((0, 0)), np.zeros(0))
         self.pose, self.at = np.zeros((0, 3)), np.zeros((0, 2))
         self.block = np.zeros((len(perception.INPUTS), 0))
@@ -1327,8 +1330,12 @@ class Batch:
         if self._follows:
             flags = (np.array([bool(t.tracks) for t in self._trackers])
                      | np.logical_or.reduce(self._seen, axis=1)).tolist()
-        for run, s, (a, b), mine in zip(self.runs, self.ticks, self.spans, learned):
-            run._watched = (s, mine, [i for i in range(b - a) if flags[a + i]])
+        if self._single:
+            for run, s, mine, flag in zip(self.runs, self.ticks, learned, flags):
+                run._watched = (s, mine, [0] if flag else [])
+        else:
+            for run, s, (a, b), mine in zip(self.runs, self.ticks, self.spans, learned):
+                run._watched = (s, mine, [i for i in range(b - a) if flags[a + i]])
         self._watching = rows = np.flatnonzero(flags)
         got = self.got
         spaces = (self._kept.picked(rows) if self._kept is not None
@@ -1337,8 +1344,10 @@ class Batch:
 
     def framing(self) -> tuple[list[Route], np.ndarray, np.ndarray]:
         """:meth:`Simulation.framing` of every run at once."""
-        return ([r for run in self.runs for r in run._routes], self.at,
-                self._gather("_s_hint"))
+        hint, views = self._hints
+        if not (views and all(map(operator.is_, map(_HINT, self.runs), views))):
+            hint = self._gather("_s_hint")        # (the runs' own, not those aims left)
+        return [r for run in self.runs for r in run._routes], self.at, hint
 
     def aims(self, frames: list[perception.Frame],
              near: list[np.ndarray]) -> list[perception.Aim]:
@@ -1352,8 +1361,9 @@ class Batch:
             frames[row] = self.runs[j].replanned(self.ticks[j], i, frames[row])
         hint = np.array([f.s for f in frames])
         self._hint = hint.copy()             # (for the record: no view of a run's own)
-        for run, (a, b) in zip(self.runs, self.spans):
-            run._s_hint = hint[a:b]
+        self._hints = hint, self._each(hint)
+        for run, mine in zip(self.runs, self._hints[1]):
+            run._s_hint = mine
         routes = [route for run in self.runs for route in run._routes]
         return [perception.Aim(*aim) for aim in zip(routes, frames, self.at, near, self._radius,
                                                     self._need)]
