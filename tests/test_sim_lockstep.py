@@ -191,6 +191,53 @@ def test_runs_each_stepped_alone_between_two_batch_ticks_keep_their_bits():
         assert_same_run(simulate(world, None, seed, randomise=True), res)
 
 
+def _turned_by_hand(run) -> None:
+    """A tick of ``run`` driven by a user's own kinematics: turned on the spot, its x and y
+    (the very arrays :meth:`Simulation.motion` gave) kept."""
+    _, moves = run.decide()
+    if moves:
+        x, y, h, v, steer, _, _ = run.motion()
+        run.move_to(x, y, h + 0.05, v, steer)
+        run.moved()
+
+
+def test_runs_moved_by_hand_between_two_batch_ticks_are_sensed_where_they_were_moved():
+    """A run moved by hand (:meth:`Simulation.move_to`) with its own x holds a state the
+    batch did not leave: the batch senses and moves it from there, as the run alone would."""
+    world = _short("slalom", 3.0)
+    lock = Lockstep(world, None, [1, 2], randomise=True)
+    alone = [Simulation(world, None, seed, randomise=True) for seed in (1, 2)]
+    for _ in range(3):
+        lock.step()
+        for run in alone:
+            run.step()
+    for run in lock.runs + alone:
+        _turned_by_hand(run)
+    for res, run in zip(lock.results(), alone):
+        while not run.done:
+            run.step()
+        assert_same_run(run.result(), res)
+
+
+def test_a_lockstep_copied_mid_run_gives_the_runs_of_the_original():
+    """A copy (``copy.deepcopy``) holds runs of their own arrays, not views of the batch's:
+    it makes its batch afresh, and the copy and the original end as the runs alone do (each
+    run's robots arrive one after the other: one drives on where the other stopped)."""
+    world = _short("multirobot", 30.0)
+    lock = Lockstep(world, None, [1, 2], randomise=True)
+    for _ in range(3):
+        lock.step()
+    copied = copy.deepcopy(lock)
+    while not copied.done:                   # each run's robots drive as its record says
+        copied.step()
+        for run in copied.runs:
+            assert run.done or np.array_equal(run.active, run.record[-1].active)
+    for seed, res, again in zip([1, 2], lock.results(), copied.results()):
+        want = simulate(world, None, seed, randomise=True)
+        assert_same_run(want, res)
+        assert_same_run(want, again)
+
+
 def test_a_refused_command_is_told_as_alone_and_moves_no_robot(monkeypatch):
     world = _short("corridor", 2.0)
     lock = Lockstep(world, None, [1, 2, 3])

@@ -534,3 +534,17 @@ def test_sweeps_measured_only_up_to_their_first_sure_touch_get_the_bits_they_get
         alone = [body.free(wheel, backward, safety.Settings()) for body, wheel, backward in sweeps]
         assert safety.free_travels(sweeps).tolist() == alone
     assert sum(trimmed) > 100                          # many sweeps were cut short
+
+
+def test_a_sweep_of_no_place_among_others_keeps_its_reach():
+    """A reach below 0 among sweeps measured together (no place to sweep, or one) gives what
+    it gave before the sweeps were cut at their first sure touch (the first version of the cut raised); the
+    others' are measured as ever."""
+    cells = np.array([[10.0, 0.0], [3.0, 1.0]])
+    for reach, before in ((-0.999, 0.0), (-1.0, -1.0), (-2.5, -2.5)):
+        sweeps = [(safety.Body(ROBOT, AT, 90.0, cells, 1.0, 0.0, reach), 90.0, False),
+                  (safety.Body(ROBOT, AT, 90.0, cells, 1.0, 0.0, 30.0), 90.0, False)]
+        with np.errstate(all="ignore"):
+            got = safety.free_travels(sweeps)
+        assert got[1] == safety.free_travels(sweeps[1:])[0]
+        assert got[0] == before

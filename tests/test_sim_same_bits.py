@@ -584,17 +584,21 @@ def test_rows_stacked_are_each_row_padded_with_zeros(lengths, extra, tail, seed)
 
 
 @hypothesis.settings(max_examples=200, deadline=None)
-@hypothesis.given(st.integers(1, 40), st.sampled_from([(), (1,), (3,), (0, 2), (13, 1), (2, 3)]),
-                  st.sampled_from(["float", "bool", "view", "column"]), st.integers(0, 2 ** 32 - 1))
+@hypothesis.given(st.integers(1, 40), st.sampled_from([(1,), (3,), (0, 2), (13, 1), (2, 3)]),
+                  st.sampled_from(["float", "bool", "view", "column", "mixed"]),
+                  st.integers(0, 2 ** 32 - 1))
 def test_a_records_ticks_stacked_are_np_array_of_them(ticks, shape, kind, seed):
-    """:func:`loop._stacked` joins the parts' bytes where they lie together, else concatenates
-    them (views with their bytes apart, as columns of a batch's block): either way
-    ``np.array(parts)``, shape, type and bits."""
+    """:func:`loop._stacked` of parts whose bytes lie together or apart (views, as columns of
+    a batch's block), or of other types (a state a user moved a run to with whole numbers)
+    is ``np.array(parts)``: shape, type and bits."""
     rng = np.random.default_rng(seed)
     if kind == "float":
         parts = [rng.normal(size=shape) for _ in range(ticks)]
     elif kind == "bool":
         parts = [rng.random(shape) < 0.5 for _ in range(ticks)]
+    elif kind == "mixed":
+        parts = [rng.integers(-9, 9, size=shape) if j % 2 else rng.normal(size=shape)
+                 for j in range(ticks)]
     else:                                       # rows or columns of larger arrays
         big = rng.normal(size=(ticks, *shape, 3))
         parts = list(big[..., 0] if kind == "column" else big[..., :1].reshape(ticks, *shape))
@@ -809,10 +813,13 @@ def test_marks_seen_through_from_the_beams_near_them_are_those_of_every_beam(see
     reach = rng.choice([0.0, 10.0, 38.0, 60.0], (robots, 12))
     assert np.array_equal(knowledge._seen_through(rel, k, dx, dy, reach, half),
                           seen_through_every_product(rel, k, dx, dy, reach, half))
-    # directions longer than a unit, and coordinates beyond single precision
-    for grow, far in ((3.0, 1.0), (1.0, 1e35)):
+    # directions longer than a unit; coordinates beyond single precision, or so small that
+    # its rounding is no longer relative (subnormal); directions beyond it
+    for grow, far in ((3.0, 1.0), (1.0, 1e35), (1.0, 1e-44), (1e39, 1e-10)):
         args = rel * far, k, dx * grow, dy * grow, reach * far * grow, half * far * grow
-        assert np.array_equal(knowledge._seen_through(*args), seen_through_every_product(*args))
+        with np.errstate(over="ignore", under="ignore", invalid="ignore"):
+            assert np.array_equal(knowledge._seen_through(*args),
+                                  seen_through_every_product(*args))
 
 
 def test_marks_in_sight_of_many_maps_at_once_are_each_maps_own():

@@ -536,6 +536,13 @@ def _none_in_sight() -> tuple:
             np.zeros(0, dtype=np.int64), np.zeros((0, 2)))
 
 
+#: how far (times the largest coordinate and direction) :func:`_seen_through` lets single
+#: precision put ``|rx * dy - ry * dx|`` below its double: the coordinates and directions
+#: rounded, their products and their difference, at most ``4 * 2**-24 * (|rx| + |ry|) *
+#: max(|dx|, |dy|)``, under ``5e-7`` times the largest of each; eight times that
+SLACK = 4e-6
+
+
 def _seen_through(rel: np.ndarray, k: np.ndarray, dx: np.ndarray, dy: np.ndarray,
                   reach: np.ndarray, half: np.ndarray) -> np.ndarray:
     """Which marks (centres ``rel [K, 2]`` relative to robots ``k``) a beam of their robot
@@ -545,11 +552,12 @@ def _seen_through(rel: np.ndarray, k: np.ndarray, dx: np.ndarray, dy: np.ndarray
     tried in single precision first, with a margin that covers its rounding (a few units
     in the 24th bit of the coordinates: :data:`SLACK`); the few that pass are tested again
     in double, as before, so the same marks and beams pass (all of it in double where the
-    coordinates are too large for single precision)."""
+    coordinates or directions are too large for single precision, or the coordinates so
+    small that its rounding is no longer relative: never, on a map in inches)."""
     coords, ex, ey = (float(np.fmax.reduce(np.abs(a), axis=None, initial=0.0))  # (NaN left
                       for a in (rel, dx, dy))                                   # out)
     scale = coords * max(ex, ey, 1.0)
-    if scale < 1e30:
+    if 1e-30 < scale < 1e30 and max(ex, ey) < 1e30:
         kind = np.float32
         bound = np.nextafter((half + SLACK * scale).astype(kind), kind(np.inf))  # rounded up
     else:
@@ -568,12 +576,6 @@ def _seen_through(rel: np.ndarray, k: np.ndarray, dx: np.ndarray, dy: np.ndarray
     out[i[(along > 0) & (along < reach[j, b])]] = True
     return out
 
-
-#: how far (times the largest coordinate and direction) :func:`_seen_through` lets single
-#: precision put ``|rx * dy - ry * dx|`` below its double: the coordinates and directions
-#: rounded, their products and their difference, at most ``4 * 2**-24 * (|rx| + |ry|) *
-#: max(|dx|, |dy|)``, under ``5e-7`` times the largest of each; eight times that
-SLACK = 4e-6
 
 
 def beyond_cells(maps: list[RobotMap], origins: np.ndarray, dirs: np.ndarray,

@@ -61,6 +61,12 @@ class Lockstep:
                      for seed in seeds]
         self._batch: Batch | None = None         # the runs last stepped together
 
+    def __getstate__(self) -> dict:
+        """A copy (``copy.deepcopy``, pickle) without its batch: the runs' copies hold arrays
+        of their own where the batch's runs hold views of its arrays, so the copy makes a
+        batch of them afresh."""
+        return {**self.__dict__, "_batch": None}
+
     @property
     def done(self) -> bool:
         return all(run.done for run in self.runs)

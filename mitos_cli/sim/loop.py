@@ -446,6 +446,7 @@ class Simulation:
         self._hit = np.zeros(n, dtype=bool)
         self._beyond_at: tuple = (None, [])             # see _beyond()
         self._epoch = next(_EPOCHS)                     # this start's (a Batch is of one)
+        self._moved_by: object = None                   # the Batch.move that moved it last
         self._watched: tuple = (None, [], [])           # see watching()
         beams = len(self.angles)                        # what watching() gives for no robot
         self._unseen = (np.zeros((0, 2)), np.zeros((0, beams)), np.zeros((0, beams, 2)),
@@ -1020,6 +1021,7 @@ class Simulation:
         driven = np.hypot(x - self._x, y - self._y)
         self._odometer.append(self._odometer[-1] + driven if self._odometer else driven)
         self._x, self._y, self._h, self._v, self._steer = x, y, h, v, steer
+        self._moved_by = None                           # (its own arrays, not a batch's)
 
     def _check_stuck(self) -> bool:
         """A driving robot that drove less than ``STUCK_DISTANCE`` in ``STUCK_TIME`` is stuck
@@ -1081,18 +1083,9 @@ class Simulation:
 
 
 def _stacked(parts: list[np.ndarray]) -> np.ndarray:
-    """``np.array(parts)`` of arrays of one shape and type, ``[len(parts), *shape]``: their
-    bytes joined where each part's lie together (a quarter of the time of ``np.concatenate``,
-    which looks at each part's shape and type; ``np.array`` at each element: 5 ms of a run's
-    500 ticks), else one concatenation."""
-    first = parts[0]
-    try:
-        joined = bytearray().join(parts)  # type: ignore[arg-type]  # (arrays are buffers)
-    except TypeError:                                   # a part whose bytes are apart
-        joined = None
-    if joined is None or len(joined) != len(parts) * first.nbytes:     # (or of other sizes)
-        return np.concatenate(parts).reshape(len(parts), *first.shape)
-    return np.frombuffer(joined, dtype=first.dtype).reshape(len(parts), *first.shape)
+    """``np.array(parts)`` of arrays of one shape, ``[len(parts), *shape]``: one concatenation
+    (``np.array`` looks at each part on its own: 5 ms of a run's 500 ticks)."""
+    return np.concatenate(parts).reshape(len(parts), *np.shape(parts[0]))
 
 
 def _sights(aims: list[perception.Aim], robots: list, pose: np.ndarray, dirs: np.ndarray,
@@ -1136,9 +1129,8 @@ _SIDE = perception.INPUTS.index("heading")
 _EPOCHS = itertools.count()
 
 
-#: A run's x and arc lengths (:meth:`Batch._state` and :meth:`Batch.framing` ask whether
-#: each run's are still the batch's).
-_X, _HINT = operator.attrgetter("_x"), operator.attrgetter("_s_hint")
+#: A run's arc lengths (:meth:`Batch.framing` asks whether each run's are still the batch's).
+_HINT = operator.attrgetter("_s_hint")
 
 
 def row_spans(runs: list[Simulation]) -> list[tuple[int, int]]:
@@ -1153,8 +1145,11 @@ class Batch:
     check, the record, the verdict, the move) done once for the robots of all, elementwise,
     so each run keeps the bits it has alone. A run's pose, readings, inputs and commands of a
     tick are views of the batch's arrays, which are fresh each tick: a run's record keeps
-    them, so no later tick may write into them. A batch is of the runs as they were started
-    (:meth:`serves`); they are at the same tick when it steps them."""
+    them, so no later tick may write into them. Whether each robot drives and its recovery
+    are the batch's arrays from tick to tick, each run holding views of them, written in
+    place only; so is the state :meth:`move` left, until a run is moved otherwise. A batch
+    is of the runs as they were started (:meth:`serves`); they are at the same tick when it
+    steps them."""
 
     def __init__(self, runs: list[Simulation]) -> None:
         self.runs = runs
@@ -1164,13 +1159,14 @@ class Batch:
         self._owner = [(run, i) for run in runs for i in range(run.n)]   # each row's robot
         self._single = len(self._owner) == len(runs)            # a robot a run (most worlds)
         # the runs' x, y, heading, speed and wheel as :meth:`move` left them (each run's
-        # views of them), and each run's x
-        self._moved: tuple[tuple[np.ndarray, ...], list[np.ndarray]] | None = None
+        # views of them), and the token it left on each run it moved
+        self._moved: tuple[tuple[np.ndarray, ...], object] | None = None
         # the runs' rows of rows.sense, kept from tick to tick where each run is of one robot
         # among obstacles that stand still (sense_rows), and the sides of those obstacles
         self._keeps_rows = self._single and all(run._still is not None for run in runs)
         self._sensing: list[rows.SenseRow] = []
-        self._sides = [run._still[1][3] for run in runs if run._still is not None]
+        self._sides = ([run._still[1][3] for run in runs if run._still is not None]
+                       if self._keeps_rows else [])
         self._goal_x, self._goal_y, self._tol = (self._gather(name)
                                                  for name in ("_goal_x", "_goal_y", "_tol"))
         # whether each robot drives, and its safety.Recovery: the batch's arrays, each run's
@@ -1246,9 +1242,8 @@ class Batch:
         """The runs' x, y, heading, speed and wheel, ``[rows]`` each: those :meth:`move` left
         while every run still holds its views of them (a run moved alone or started again
         holds arrays of its own, :meth:`Simulation.move_to`), else gathered afresh. Neither
-        is ever written into (the record keeps them)."""
-        if self._moved is not None and all(map(operator.is_, map(_X, self.runs),
-                                                self._moved[1])):
+        is written into here."""
+        if self._moved is not None and all(run._moved_by is self._moved[1] for run in self.runs):
             return self._moved[0]
         return tuple(self._gather(name) for name in ("_x", "_y", "_h", "_v", "_steer"))
 
@@ -1448,17 +1443,17 @@ class Batch:
         run's tick recorded; the runs whose robots move now."""
         x, y, h = self._ticked()
         pose = _columns(x, y, np.rad2deg(h))
-        speed, steering = self._drive
+        speed, steering = (part.copy() for part in self._drive)  # (the runs' own: kept apart)
         hint = self._hint
         hit = np.logical_or.reduceat(self.hit, self._starts).tolist()
         driving = np.logical_or.reduceat(self.active, self._starts).tolist()
         moving = []
-        for run, s, touch, drives, mine, *kept in zip(
+        for run, s, touch, drives, mine, *state in zip(
                 self.runs, self.ticks, hit, driving, self._each(self.hit), self._each(pose),
                 self._each(speed), self._each(steering), self._each(self.active),
                 self._each(hint)):
             run._hit = mine
-            run._keep(s, *kept)
+            run._keep(s, *state)
             if run._judge(s, touch, drives):
                 moving.append(run)
         return moving
@@ -1494,15 +1489,16 @@ class Batch:
             moved = driven - np.concatenate([run._odometer[-window] for run in runs])
             stuck = self.active & (moved < STUCK_DISTANCE)
             stuck_any = np.logical_or.reduceat(stuck, self._starts).tolist()
-        xs = self._each(after[0])
-        for j, (run, (a, b), *state) in enumerate(zip(runs, self.spans, xs,
-                                                     *map(self._each, after[1:]),
-                                                     self._each(driven))):
-            run._x, run._y, run._h, run._v, run._steer, driven_j = state
-            run._odometer.append(driven_j)
+        token = object()
+        for j, (run, (a, b), *state, gone) in enumerate(zip(runs, self.spans,
+                                                           *map(self._each, after),
+                                                           self._each(driven))):
+            run._x, run._y, run._h, run._v, run._steer = state
+            run._moved_by = token
+            run._odometer.append(gone)
             run._k += 1
             run._go_on(stuck is not None and stuck_any[j] and run._stuck(stuck[a:b]))
-        self._moved = (after, xs)
+        self._moved = (after, token)
         self._now = None
 
 

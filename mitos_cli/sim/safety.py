@@ -312,7 +312,7 @@ def _travels(cells: list[np.ndarray], numbers, radius: np.ndarray, reach: np.nda
         return out
     # each sweep's places up to the first where a cell is touched for sure (its own at most):
     # no later place changes where it first touches, nor a pair _between looks at
-    upto = own[:, 0].copy()
+    upto = np.maximum(own[:, 0], 0)            # (a sweep of no place: a reach below 0)
     np.minimum.at(upto, owner, sure[near] + 1)
     hit, cell, j = _touches(px, py, owner, places, back, step, upto)
     _between(hit, own[:, 0], cell, j, owner, u, arc, px, py, hl[owner], hw[owner], rad[owner])
@@ -382,8 +382,8 @@ def _touches(px: np.ndarray, py: np.ndarray, owner: np.ndarray, places: tuple[np
     [R]``) within its first ``upto [R]`` places, and the pairs of those places a cell may be
     touched between (:func:`_pairs`), worked out :data:`CHUNK` elements at a time: the cells
     ``px, py [M, 1]`` of sweeps ``owner [M]`` (sorted) at their sweep's ``places`` (as
-    :func:`_near` takes them), each cell's places one after the other (a sweep's count up to
-    its first sure touch, :func:`_near`: about half the places of the longest sweep)."""
+    :func:`_near` takes them), each cell's places one after the other (up to its sweep's
+    first sure touch, :func:`_near`)."""
     width = places[0].shape[1]
     hit = np.zeros(places[0].shape, dtype=bool)
     flat_hit = hit.reshape(-1)
@@ -411,9 +411,9 @@ def _touches(px: np.ndarray, py: np.ndarray, owner: np.ndarray, places: tuple[np
 
 
 def _spans(count: np.ndarray) -> list[slice]:
-    """Slices of the cells with ``count [M]`` places each of about :data:`CHUNK` places each:
-    a slice ends before the cell that would take it past a multiple of :data:`CHUNK` (a cell
-    with more places alone)."""
+    """The cells (``count [M]`` places each) cut into slices at each multiple of
+    :data:`CHUNK` places: a slice ends with the cell whose places reach past the next
+    multiple, so it holds up to about twice :data:`CHUNK` (a cell of more, alone)."""
     ends = np.cumsum(count)
     if ends[-1] <= CHUNK:
         return [slice(0, len(count))]
