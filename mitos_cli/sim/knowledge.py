@@ -162,28 +162,18 @@ def _centre_lines(grid: Grid) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _inside(cells: np.ndarray, shape: tuple[int, int]) -> np.ndarray | None:
-    """Which cells (columns and rows ``[P, 2]``, C-contiguous) lie inside a grid of ``shape``
-    (rows, columns); ``None`` when all do. Seen unsigned, a negative index is a huge one,
-    so one comparison tests both ends."""
-    ok = cells.view(np.uint64) < _limits(shape)
-    return None if np.count_nonzero(ok) == ok.size else ok[:, 0] & ok[:, 1]
+    """:func:`_within`, or ``None`` when every cell lies inside."""
+    ok = _within(cells, shape)
+    return None if np.count_nonzero(ok) == ok.size else ok
 
 
 def _within(cells: np.ndarray, shape: tuple[int, int]) -> np.ndarray:
-    """Which cells (columns and rows ``[..., 2]``) lie inside a grid of ``shape`` (rows,
-    columns), as :func:`_inside` tests them, a coordinate at a time (many cells: cheaper
-    than reducing pairs)."""
+    """Which cells (columns and rows ``[..., 2]``, int64, C-contiguous) lie inside a grid of
+    ``shape`` (rows, columns). Seen unsigned, a negative index is a huge one, so one
+    comparison a coordinate tests both ends (a coordinate at a time: cheaper than reducing
+    pairs)."""
     seen = cells.view(np.uint64)
     return (seen[..., 0] < shape[1]) & (seen[..., 1] < shape[0])
-
-
-@functools.lru_cache(maxsize=16)
-def _limits(shape: tuple[int, int]) -> np.ndarray:
-    """The columns and rows of a grid of ``shape`` as unsigned integers (:func:`_inside`
-    asks a few times a tick)."""
-    out = np.array(shape[::-1], np.uint64)
-    out.flags.writeable = False
-    return out
 
 
 @functools.lru_cache(maxsize=4)
@@ -575,7 +565,6 @@ def _seen_through(rel: np.ndarray, k: np.ndarray, dx: np.ndarray, dy: np.ndarray
     out = np.zeros(len(rel), dtype=bool)
     out[i[(along > 0) & (along < reach[j, b])]] = True
     return out
-
 
 
 def beyond_cells(maps: list[RobotMap], origins: np.ndarray, dirs: np.ndarray,
