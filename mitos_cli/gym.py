@@ -269,10 +269,11 @@ class MitosEnv(gymnasium.Env):
         return obs
 
     def _left(self) -> float:
-        """Route left to the goal (in), along the robot's route now."""
+        """Route left to the goal (in) where the robot was last perceived, along its route
+        then: the route and the progress of one observation (a tick recorded before a replan
+        measured its progress along the old route)."""
         sim = self.sim
-        progress = sim.record[-1].progress[0] if sim.record else 0.0
-        return max(0.0, sim.routes[0].length - float(progress))
+        return max(0.0, sim.routes[0].length - float(sim.progress[0]))
 
     def _state(self) -> dict:
         sim = self.sim

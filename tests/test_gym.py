@@ -72,6 +72,42 @@ def test_fuzzy_policy_drives_the_trajectory_of_simulate_bit_for_bit(short_world)
     assert sum(rewards) == pytest.approx(0.01 * (ref.routes[0].length - left))
 
 
+def test_a_steps_reward_is_that_steps_progress():
+    """Straight down the corridor's straight route, each step's reward is 0.01 per inch the
+    step moved the robot, the first step's too (the reward once came a step late: the
+    progress of the tick recorded before the motion)."""
+    env = gymnasium.make("mitos/Corridor-v0")
+    _, info = env.reset(seed=1)
+    x = info["pose"][0]
+    for _ in range(5):
+        _, reward, *_, info = env.step(np.array([90.0, 60.0]))
+        assert reward == pytest.approx(mgym.PROGRESS_REWARD * (info["pose"][0] - x), abs=1e-12)
+        assert reward > 0
+        x = info["pose"][0]
+
+
+def test_a_replan_rewards_only_the_change_in_the_route_left():
+    """`moving` replans round a cart after 15.6 s onto a route 14 in longer than what was
+    left: that step's reward is about -0.14, not +3.5 then -3.6 (the new route's length was
+    once taken less the progress made along the old one)."""
+    env = gymnasium.make("mitos/Moving-v0")
+    obs, _ = env.reset(seed=1)
+    sim, replans, steps = env.unwrapped.sim, [], []
+    while True:
+        before = sim.routes[0]
+        left = before.length - sim.progress[0]
+        obs, reward, terminated, truncated, info = env.step(env.unwrapped.fuzzy_policy(obs))
+        if terminated or truncated:
+            break
+        steps.append(reward)
+        now = sim.routes[0].length - sim.progress[0]
+        assert reward == pytest.approx(mgym.PROGRESS_REWARD * (left - now), abs=1e-12)
+        if sim.routes[0] is not before:
+            replans.append(reward)
+    assert info["outcome"] == "success" and replans
+    assert max(abs(r) for r in steps) < 0.5        # a tick moves the robot 3 in at most
+
+
 def test_the_documented_example_reaches_the_goal_as_simulate_does(capsys):
     """docs/gym.md's example, run as written: the goal, the bonus, simulate's trajectory."""
     import re

@@ -522,6 +522,14 @@ class Simulation:
         return tuple(self._routes)
 
     @property
+    def progress(self) -> np.ndarray:
+        """``[n]`` how far (in) each robot is along its route (:attr:`routes`) where it was
+        last perceived: the route left to its goal is the route's length minus this. (A
+        recorded tick's ``progress`` is along the route as it was then; a replan since starts
+        the new route where the robot stood.)"""
+        return self._s_hint.copy()
+
+    @property
     def ending(self) -> bool:
         """The observed tick ends the run whatever is commanded: a robot touches something or
         every robot is at its goal (False before :meth:`observe`)."""
