@@ -290,7 +290,9 @@ def test_hand_edited_results_are_reported(tmp_path):
     path.write_text("".join(lines[:2]) + "w1.yaml,fuzzy,min\n")
     with pytest.raises(StudyError) as exc:
         ResultStore(tmp_path).load()
-    assert "results.csv:3: expected 17 values, found 3" in exc.value.message
+    assert exc.value.message == "expected 17 values in a row, found 3"
+    assert (exc.value.span.line, exc.value.span.column) == (3, 1)
+    assert exc.value.span.path.endswith("results.csv")
     path.write_text("world,oops\n")
     with pytest.raises(StudyError) as exc:
         ResultStore(tmp_path).load()
@@ -362,7 +364,37 @@ def test_non_numeric_value_in_results(tmp_path):
     path.write_text("".join(lines))
     with pytest.raises(StudyError) as exc:
         ResultStore(tmp_path).load()
-    assert "results.csv:2: a value is not a number" in exc.value.message
+    assert exc.value.message == "`time_s` is `fast`, not a number"
+    span = exc.value.span
+    assert (span.line, span.column) == (2, len(",".join(cells[:9])) + 2)
+    assert span.source_line[span.column - 1:span.end_column - 1] == "fast"
+
+
+@pytest.mark.parametrize("field, value, said", [
+    ("outcome", "succes", "not an outcome of a run"),         # in no column of the table
+    ("time_s", "nan", "which no run reports"),                # left out of the mean
+    ("min_clearance_in", "inf", "which no run reports"),      # a mean of inf, a std of nan
+    ("min_clearance_in", "-inf", "which no run reports"),
+    ("ticks", "1.5", "not a number"),
+])
+def test_a_row_no_run_reports_is_refused(tmp_path, field, value, said):
+    """A hand-edited row that parses but is no run's (``--resume`` once took a misspelt
+    outcome, counted in no column, and a ``nan``, left out of the means) names the field."""
+    from mitos_cli.study.store import COLUMNS
+
+    run_study(small_study(runs=1), tmp_path, workers=1, task_fn=fake_sim)
+    path = tmp_path / "results.csv"
+    lines = path.read_text().splitlines(keepends=True)
+    cells = lines[1].rstrip("\n").split(",")
+    cells[COLUMNS.index(field)] = value
+    lines[1] = ",".join(cells) + "\n"
+    path.write_text("".join(lines))
+    with pytest.raises(StudyError) as exc:
+        ResultStore(tmp_path).load()
+    assert exc.value.message == f"`{field}` is `{value}`, {said}"
+    assert exc.value.span.line == 2
+    if field == "outcome":
+        assert exc.value.hint == "did you mean `success`?"
 
 
 def test_output_directory_that_is_a_file(tmp_path):

@@ -12,12 +12,13 @@ from __future__ import annotations
 import csv
 import io
 import json
+import math
 import os
 from collections.abc import Iterable
 from pathlib import Path
 from typing import TextIO
 
-from ..errors import MitosError, Span
+from ..errors import MitosError, Span, did_you_mean
 from ..fileio import bad_byte, read_text, unreadable
 from ..words import plural
 from .spec import KEY_FIELDS, Task
@@ -61,6 +62,22 @@ def _format(value) -> str:
     if isinstance(value, float):
         return repr(value)          # shortest string that reads back to the same double
     return str(value)
+
+
+#: what a field of a row must be, where it is not a number
+_EXPECTED = {"outcome": "one of " + ", ".join(OUTCOMES), **{f: "a whole number" for f in INT_FIELDS}}
+
+
+def _wrong(field: str, value) -> str | None:
+    """What is wrong with a row's parsed ``value`` of ``field`` (``None``: did not parse),
+    or ``None`` when nothing is."""
+    if value is None:
+        return "not a number"
+    if field == "outcome" and value not in OUTCOMES:
+        return "not an outcome of a run"
+    if field in FLOAT_FIELDS and not math.isfinite(value):
+        return "which no run reports"
+    return None
 
 
 def _parse(field: str, text: str):
@@ -111,7 +128,11 @@ class ResultStore:
                 raise StudyError(f"{self.path} is not a results file of this version of mitos",
                                  expected="the columns " + ",".join(COLUMNS),
                                  hint="choose another output directory with -o")
-            return [self._row(values, line_no) for line_no, values in enumerate(reader, start=2)]
+            lines, rows = text.splitlines(), []
+            for values in reader:
+                line_no = reader.line_num                  # (a row's last line)
+                rows.append(self._row(values, line_no, lines[line_no - 1]))
+            return rows
         except csv.Error as exc:               # a field past csv's limit
             line_no = reader.line_num
             line = text.splitlines()[line_no - 1] if line_no else ""
@@ -119,17 +140,31 @@ class ResultStore:
                              span=Span(str(self.path), line_no, 1, line[:200]),
                              hint="the file was edited by hand; remove that line") from None
 
-    def _row(self, values: list[str], line_no: int) -> dict:
-        """Line ``line_no``'s ``values`` as a row, checked."""
+    def _row(self, values: list[str], line_no: int, line: str) -> dict:
+        """Line ``line_no``'s ``values`` as a row, checked: what a run can report (a known
+        outcome, whole numbers, finite figures), so that a row edited by hand cannot count
+        as a run it is not (a misspelt outcome in no column, a ``nan`` left out of a mean)."""
         if len(values) != len(COLUMNS):
-            raise StudyError(f"{self.path}:{line_no}: expected {len(COLUMNS)} values, "
-                             f"found {len(values)}",
+            raise StudyError(f"expected {len(COLUMNS)} values in a row, found {len(values)}",
+                             span=Span(str(self.path), line_no, 1, line[:200]),
                              hint="the file was edited by hand; remove that line")
-        try:
-            return {f: _parse(f, v) for f, v in zip(COLUMNS, values)}
-        except ValueError:
-            raise StudyError(f"{self.path}:{line_no}: a value is not a number",
-                             hint="the file was edited by hand; remove that line") from None
+        row = {}
+        for j, (f, v) in enumerate(zip(COLUMNS, values)):
+            try:
+                row[f] = value = _parse(f, v)
+            except ValueError:
+                value = None
+            bad = _wrong(f, value)
+            if bad:
+                plain = line.split(",") == values           # (no field quoted)
+                column = sum(len(w) + 1 for w in values[:j]) + 1 if plain else 1
+                hint = did_you_mean(v, OUTCOMES) if f == "outcome" else None
+                raise StudyError(f"`{f}` is `{v}`, {bad}",
+                                 span=Span(str(self.path), line_no, column, line[:200],
+                                           end_column=column + len(v) if plain else None),
+                                 expected=_EXPECTED.get(f, "a finite number"),
+                                 hint=hint or "the file was edited by hand; remove that line")
+        return row
 
     def manifest(self) -> dict | None:
         """What ``study.json`` says the study was; ``None`` when there is none."""
