@@ -36,6 +36,9 @@ def test_sixteen_bit_pgm():
     (b"P5 2 2 255\n\x00", "holds 1 of its 4 pixels"),
     (b"P5 2", "cut short"),
     (b"P2 1 1 255 300", "outside 0..255"),
+    # a binary pixel above the header's maximum was read as it stood: an occupancy below 0
+    (b"P5 2 1 100\n\x00\xfe", "column 1, row 0 .* is 254, outside 0..100"),
+    (b"P5\n" + b"9" * 5000 + b" 1\n255\n\x00", "a number of 5,000 digits"),
 ])
 def test_broken_pgms_are_refused_in_words(data, words):
     with pytest.raises(ValueError, match=words):

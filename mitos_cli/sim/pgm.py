@@ -35,6 +35,8 @@ def _header(data: bytes, count: int) -> tuple[list[int], int]:
                 i += 1
             if start == i:
                 raise ValueError(f"unexpected byte {c!r} in the PGM header")
+            if i - start > 18:              # (far past any image read; int() has a limit)
+                raise ValueError(f"a number of {i - start:,} digits in the PGM header")
             values.append(int(data[start:i]))
     return values, i + 1
 
@@ -59,6 +61,7 @@ def parse_pgm(data: bytes) -> tuple[np.ndarray, int]:
         if body.size < n:
             raise ValueError(f"the PGM image holds {body.size} of its {plural(n, 'pixel')}")
         pixels = body[:n].astype(np.uint16)
+        _within(pixels, maxval, width)
     else:
         try:
             pixels = np.array(data[offset - 1:].split(), dtype=np.int64)
@@ -67,10 +70,20 @@ def parse_pgm(data: bytes) -> tuple[np.ndarray, int]:
         if pixels.size < n:
             raise ValueError(f"the PGM image holds {pixels.size} of its {plural(n, 'pixel')}")
         pixels = pixels[:n]
-        if pixels.min(initial=0) < 0 or pixels.max(initial=0) > maxval:
-            raise ValueError(f"a PGM pixel lies outside 0..{maxval}")
+        _within(pixels, maxval, width)
         pixels = pixels.astype(np.uint16)
     return pixels.reshape(height, width), maxval
+
+
+def _within(pixels: np.ndarray, maxval: int, width: int) -> None:
+    """Refuse a pixel outside ``0..maxval`` (binary or ASCII alike: read as it stands, a
+    pixel above the maximum is an occupancy below 0, free, or with ``negate`` a wall)."""
+    bad = np.flatnonzero((pixels < 0) | (pixels > maxval))
+    if len(bad):
+        row, col = divmod(int(bad[0]), width)
+        raise ValueError(f"the pixel at column {col}, row {row} (from the top left) is "
+                         f"{int(pixels[bad[0]])}, outside 0..{maxval}, the range its header "
+                         f"gives ({plural(len(bad), 'such pixel')})")
 
 
 #: the largest image read (bytes): a 16-bit 8,000 x 8,000 map, far beyond any building
