@@ -145,6 +145,34 @@ def test_a_rotated_map_is_turned_about_its_origin(tmp_path: Path):
     assert grid.origin[0] < -3.9 and grid.origin[1] < -3.9     # it lies left of and below
 
 
+def _free_map(tmp_path: Path, corridors: str = "") -> Path:
+    """A world on a free 10 x 10 ft map (120 in a side at 1 in a cell, lower left at 0, 0)."""
+    (tmp_path / "map.pgm").write_bytes(b"P5 120 120 255\n" + bytes([254]) * 120 * 120)
+    (tmp_path / "map.yaml").write_text("image: map.pgm\nresolution: 0.0254\n"
+                                       "origin: [0, 0, 0]\n", encoding="utf-8")
+    world = tmp_path / "w.yaml"
+    world.write_text(BASE.replace("q_init: {x: 30, y: 0", "q_init: {x: 30, y: 60")
+                     .replace("  corridors:\n    - points: [[0, 0], [400, 0]]\n"
+                              "      width: 70\n", "  grid: map.yaml\n" + corridors),
+                     encoding="utf-8")
+    return world
+
+
+def test_a_goal_off_the_map_is_outside_the_map_not_inside_a_wall(tmp_path: Path):
+    """Off a grid all is solid, but "inside a wall ... move it into a corridor" told the user
+    of a wrong `origin` or a corridor carved past the map's edge what they had done."""
+    with pytest.raises(WorldError) as info:
+        load_world(_free_map(tmp_path))                   # the goal at (300, 0)
+    msg = info.value.render()
+    assert ("w.yaml:10:9: world error: the goal (q_goal) at (300, 0) lies outside the map "
+            "`map.yaml` (x 0 to 120, y 0 to 120 in)") in msg
+    assert "check the map's `origin` and `resolution`" in msg
+    corridor = "  corridors:\n    - points: [[0, 60], [400, 60]]\n      width: 40\n"
+    with pytest.raises(WorldError) as info:
+        load_world(_free_map(tmp_path, corridor))
+    assert "hint: a corridor carved into a map ends at the map's edge" in info.value.render()
+
+
 def test_unknown_map_key_in_map_yaml(tmp_path: Path):
     (tmp_path / "map.yaml").write_text("image: m.pgm\nresolutoin: 0.05\n", encoding="utf-8")
     world = tmp_path / "w.yaml"

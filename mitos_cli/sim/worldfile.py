@@ -623,6 +623,12 @@ def check_free(world: World, spans: list[tuple[Span, Span]]) -> StaticMap:
                               ("goal (q_goal)", agent.goal, g_span)):
             who = _who(agent)
             if not static.free(np.array([[p.x, p.y]]))[0]:
+                off = _off_the_grid(static, p.x, p.y)
+                if off is not None:
+                    raise WorldError(f"the {what}{who} at ({p.x:g}, {p.y:g}) {off}", span=span,
+                                     hint="a corridor carved into a map ends at the map's edge"
+                                     if world.corridors else "check the map's `origin` and "
+                                     "`resolution` (metres, in its YAML) and the point (inches)")
                 raise WorldError(f"the {what}{who} at ({p.x:g}, {p.y:g}) lies inside a wall",
                                  span=span, hint=_units_hint(world, agent)
                                  or "move it into a corridor (free space)")
@@ -633,6 +639,19 @@ def check_free(world: World, spans: list[tuple[Span, Span]]) -> StaticMap:
                                  hint="move it, or the obstacle")
         _check_body(world, agent, static, s_span)
     return static
+
+
+def _off_the_grid(static: StaticMap, x: float, y: float) -> str | None:
+    """``lies outside the map `m.yaml` (x .. to .., y .. to .. in)`` for a point off the
+    world's grid (all of which is wall: a wrong ``origin`` put every point there), else
+    ``None``."""
+    if static.grid is None:
+        return None
+    x0, y0, x1, y1 = static.bounds
+    if x0 <= x < x1 and y0 <= y < y1:
+        return None
+    name = f" `{Path(static.grid.source).name}`" if static.grid.source else ""
+    return (f"lies outside the map{name} (x {x0:.6g} to {x1:.6g}, y {y0:.6g} to {y1:.6g} in)")
 
 
 def _units_hint(world: World, agent) -> str | None:
