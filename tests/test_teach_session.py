@@ -4,6 +4,7 @@ import dataclasses
 import json
 import re
 import shutil
+from pathlib import Path
 
 import pytest
 
@@ -526,6 +527,27 @@ def test_a_resumed_session_can_correct_the_run_it_recorded(tmp_path, monkeypatch
     assert "simulate" not in [e["op"] for e in again.journal.active()]   # undo skips it
     again.run("at 13s steering=60")
     assert [e.source for e in again.state.examples] == ["figure4 t=12.5s", "figure4 t=13s"]
+
+
+def test_a_resumed_session_says_when_the_run_driven_again_is_another(tmp_path, monkeypatch):
+    """The world file edited between the run and `--resume`: the run driven again is another
+    (8.75 s, not 7.7 s), and `at` would correct it without a word; the journal keeps what
+    tells the runs apart, and the resumed session says they differ."""
+    monkeypatch.chdir(tmp_path)
+    world = tmp_path / "tiny.yaml"
+    shutil.copy(Path(__file__).parent / "data" / "tiny.yaml", world)
+    s = Session(default_rulebase_path(), journal=Journal.create(tmp_path / "j"), out=[].append)
+    s.run("use drive")
+    s.run("simulate tiny.yaml")
+    said: list[str] = []
+    Session.resume(Journal.open(tmp_path / "j"), out=said.append)
+    assert len(said) == 1 and said[0].startswith("the last run is recorded again")
+    world.write_text(world.read_text().replace("at: [150, -12]", "at: [150, 20]"))
+    said.clear()
+    Session.resume(Journal.open(tmp_path / "j"), out=said.append)
+    assert said[1] == ("warning: this is not the run recorded before (success after 8.75 s, "
+                       "now success after 7.7 s): `tiny.yaml` or a file it reads changed "
+                       "since; `at` corrects the run driven now")
 
 
 @pytest.mark.parametrize("line, message, column", [

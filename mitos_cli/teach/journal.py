@@ -346,8 +346,9 @@ def _problem(line: bytes, seq: int) -> str | None:
         if "\0" in str(entry.get(key) or ""):
             return f"the `{op}` change's `{key}` holds a NUL byte"
     if op == "simulate" and (type(entry.get("seed")) not in (int, type(None))
-                             or not isinstance(entry.get("robot"), (str, type(None)))):
-        return "the `simulate` record has no valid `seed` or `robot`"
+                             or not all(isinstance(entry.get(k), (str, type(None)))
+                                        for k in ("robot", "run", "verdict"))):
+        return "the `simulate` record has no valid `seed`, `robot`, `run` or `verdict`"
     return None
 
 

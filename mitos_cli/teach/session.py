@@ -282,6 +282,10 @@ class Session:
                      f"again: {exc.message}; `simulate` it again to correct it")
             return
         self.out(f"the last run is recorded again: {self.simulation.describe()}")
+        if last.get("run") not in (None, self.simulation.fingerprint):   # (older journals: none)
+            self.out(f"warning: this is not the run recorded before ({last.get('verdict')}, "
+                     f"now {self.simulation.verdict}): `{Path(last['world']).name}` or a file "
+                     f"it reads changed since; `at` corrects the run driven now")
 
     def _cut_journal(self, line: int) -> None:
         """Truncate the journal before ``line`` (kept whole aside) and forget later entries."""
@@ -686,7 +690,8 @@ class Session:
         self.simulation = run_world(c.world, self.rulebase, self.state.active, seed, self.base,
                                     c.robot)
         self.journal.append("simulate", line=line, world=str(world_path(c.world, self.base)),
-                            behavior=self.state.active, seed=seed, robot=c.robot)
+                            behavior=self.state.active, seed=seed, robot=c.robot,
+                            run=self.simulation.fingerprint, verdict=self.simulation.verdict)
         self.out(self.simulation.describe())
 
     def _at(self, c: cmd.At, line: str) -> None:

@@ -69,6 +69,24 @@ class Recording:
         """When the corrected robot's run ends (s): see :attr:`_last`."""
         return float(self.t[self._last])
 
+    @property
+    def fingerprint(self) -> str:
+        """What tells this run from another (every robot's pose at every tick, hashed): the
+        journal keeps it, so that a resumed session knows whether the run it drove again is
+        the one the instructor saw."""
+        import hashlib
+
+        pose = np.ascontiguousarray(self.result.pose, dtype=np.float64)
+        return hashlib.sha256(pose.tobytes()).hexdigest()[:16]
+
+    @property
+    def verdict(self) -> str:
+        """``success after 8.75 s``: the outcome and the time of the corrected robot."""
+        s = self.result.summary()
+        if self.robot_name:
+            s = {**s, **self.result.robot_metrics[self.robot]}
+        return f"{s['outcome']} after {s['time_s']:g} s"
+
     def describe(self) -> str:
         s = self.result.summary()
         if self.robot_name:              # the corrected robot's own run, not the world's
