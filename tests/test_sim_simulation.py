@@ -184,9 +184,12 @@ def test_a_wrong_command_from_outside_and_an_early_result_say_what_is_wrong():
     same_run(sim.result(), again.result())
 
 
-@pytest.mark.parametrize("seed", [-1, 3.7, "3", np.array([3]), None])
+@pytest.mark.parametrize("seed", [-1, 3.7, "3", np.array([3]), True, np.True_, -10**5000, None],
+                         ids=["-1", "3.7", "text", "array", "True", "np.True_", "huge", "None"])
 def test_a_seed_that_is_not_a_whole_number_of_0_or_more_is_refused(seed):
-    """-1 was a bare ValueError from NumPy's SeedSequence; 3.7 and "3" ran as seed 3."""
+    """-1 was a bare ValueError from NumPy's SeedSequence; 3.7 and "3" ran as seed 3, and
+    True as seed 1 (Gymnasium's reset and the engine's inputs refuse a bool); a negative
+    seed of over 4,300 digits met Python's limit on printing it."""
     from mitos_cli.errors import InputError
 
     world = short("corridor.yaml", 0.2)
@@ -227,6 +230,7 @@ def test_a_path_for_a_world_or_a_name_for_a_planner_says_what_is_taken():
     ({"runs": 2.5}, "`runs` is a whole number, 0 or more, not `2.5`"),
     ({"workers": 0}, "`workers` is a whole number, 1 or more, not `0`"),
     ({"seed": -1}, "a seed is a whole number"),
+    ({"seed": True}, "a seed is a whole number, 0 or more, not `True`"),
 ])
 def test_run_many_says_what_is_wrong_with_its_arguments(kwargs, says):
     """A World not in a list, runs=2.5, workers=0 or seed=-1 met a TypeError, a

@@ -1513,13 +1513,16 @@ class Batch:
 def check_seed(seed: object) -> int:
     """``seed`` as an int of 0 or more, else an :class:`InputError` saying so (NumPy's
     SeedSequence refused a negative seed with a bare ValueError from its internals, and
-    ``int()`` made 3.7 the seed 3 without a word)."""
+    ``int()`` made 3.7 the seed 3 without a word; ``True`` is not 1 here, as it is not in
+    the engine's inputs or Gymnasium's ``reset``)."""
     try:
         value = operator.index(seed)  # type: ignore[arg-type]  # int, NumPy ints; not floats, text
     except TypeError:
         value = -1
-    if value < 0:
-        raise InputError(f"a seed is a whole number, 0 or more, not `{seed!r:.40}`",
+    if value < 0 or isinstance(seed, (bool, np.bool_)):
+        shown = (f"a number of {value.bit_length():,} bits" if value.bit_length() > 1000
+                 else f"`{seed!r:.40}`")          # (repr of over 4,300 digits raises)
+        raise InputError(f"a seed is a whole number, 0 or more, not {shown}",
                          hint="seed=1, as `mitos simulate --seed 1`")
     return value
 
