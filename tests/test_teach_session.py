@@ -315,6 +315,12 @@ def test_simulate_and_at_and_their_mistakes(rules, tmp_path):
     assert "plotted" in text and list(tmp_path.glob("a*.svg"))
     with pytest.raises(Exception, match="unknown picture format"):
         s.run("adapt epochs 3 plot a.gif")
+    # a plot that cannot be written is refused before the descent: once, the adaptation was
+    # kept and journaled with only "error: cannot write" said, and adapting again adapted twice
+    changes = len(s.journal.entries)
+    with pytest.raises(Exception, match="cannot write .*: No such file or directory"):
+        s.run(f"adapt epochs 3 plot {tmp_path / 'missing' / 'a.svg'}")
+    assert len(s.journal.entries) == changes
 
 
 def test_a_world_driven_with_another_behavior_than_its_own_says_so(rules):

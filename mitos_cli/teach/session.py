@@ -779,10 +779,12 @@ class Session:
         if params.n_free == 0:
             raise LessonError(f"nothing in behavior `{compiled.behavior}` may be adapted",
                               hint="every term and consequent it uses is frozen")
-        if c.plot is not None:
+        if c.plot is not None:   # checked before the descent, whose change is kept anyway
             from ..draw.output import check_format
+            from ..fileio import check_writable
 
             check_format(c.plot)
+            check_writable(c.plot)
         progress = self.progress(epochs) if self.progress else None
         try:
             return adapt(compiled, X, T, epochs=epochs, rate=rate, parameters=params,
