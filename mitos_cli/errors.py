@@ -127,6 +127,14 @@ def _shorten(match: re.Match[str]) -> str:
 
 
 _NEWLINE = re.compile(r"\n")
+#: control characters (C0 but tab and newline, DEL, C1): what a mutated file or a pasted
+#: escape sequence holds, shown rather than sent to the terminal (an ESC would act there)
+_CONTROL = re.compile(r"[\x00-\x08\x0b-\x1f\x7f-\x9f]")
+
+
+def visible(text: str) -> str:
+    """``text`` with each control character as its escape (``\\x1b``)."""
+    return _CONTROL.sub(lambda m: f"\\x{ord(m.group()):02x}", text)
 
 
 class MitosError(Exception):
@@ -151,22 +159,23 @@ class MitosError(Exception):
     def render(self) -> str:
         """The message as the CLI prints it: ``path:line:col: error: ...``, line, caret, hint."""
         head = f"{self.span}: " if self.span else ""
-        out = [f"{head}{self.kind}: {_QUOTED.sub(_shorten, self.message)}"]
+        out = [f"{head}{self.kind}: {visible(_QUOTED.sub(_shorten, self.message))}"]
         if self.span and self.span.source_line is not None:
             raw = self.span.source_line.rstrip("\r\n")
             col = self.span.column - self.span.source_start      # 0-based in ``raw``
             if len(raw) > SHOWN:          # a very long line: only the part around the column
                 first = min(max(0, col - SHOWN // 2), len(raw) - SHOWN)
                 raw, col = raw[first:first + SHOWN], col - first
+            raw = _CONTROL.sub("\ufffd", raw)        # (one character each: the caret stays)
             src = raw.expandtabs(4)
             col = len(raw[:max(0, col)].expandtabs(4))
             width = max(1, (self.span.end_column or self.span.column + 1) - self.span.column)
             out.append(f"    {src}")
             out.append("    " + " " * col + "^" * min(width, max(1, len(src) - col)))
         if self.expected:
-            out.append(f"expected {self.expected}")
+            out.append(f"expected {visible(self.expected)}")
         if self.hint:
-            out.append(f"hint: {self.hint}")
+            out.append(f"hint: {visible(self.hint)}")
         return "\n".join(out)
 
     def __str__(self) -> str:

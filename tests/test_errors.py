@@ -173,6 +173,26 @@ def test_binary_file_is_refused(tmp_path):
     assert (exc.span.line, exc.span.column) == (3, 15)
 
 
+def test_control_characters_are_shown_not_sent_to_the_terminal():
+    """A file's ESC (a colour or a cursor move) was echoed raw in the message's quoted line,
+    and acted on the terminal: it is now shown as an escape, and in the quoted line as one
+    character, so the caret stays under what it points at."""
+    from mitos_cli.errors import Span
+
+    line = "eval road=78 \x01size=45\x1b[31m"
+    err = RuleSyntaxError("unexpected `\x01size`", span=Span("y.lesson", 1, 14, line,
+                                                             end_column=19),
+                          expected="`,` \x9b", hint="\x7f")
+    text = err.render()
+    assert not re.search(r"[\x00-\x08\x0b-\x1f\x7f-\x9f]", text)
+    assert text.splitlines() == [
+        "y.lesson:1:14: syntax error: unexpected `\\x01size`",
+        "    eval road=78 \ufffdsize=45\ufffd[31m",
+        "                 ^^^^^",
+        "expected `,` \\x9b",
+        "hint: \\x7f"]
+
+
 def test_a_missing_rule_file_guesses_only_a_close_name(tmp_path, capsys):
     """`nosuch.rules` was "did you mean `dup.rules`?": the `.rules` both end in."""
     (tmp_path / "dup.rules").write_text("")

@@ -11,7 +11,7 @@ from __future__ import annotations
 from collections.abc import Iterator
 from pathlib import Path
 
-from ..errors import MitosError, Span, WorldError
+from ..errors import MitosError, Span, WorldError, visible
 from ..resources import exists
 from .commands import incomplete
 from .session import Session
@@ -39,7 +39,7 @@ def run_lesson(session: Session, text: str, path: str) -> bool:
     """Run every command of ``text``; False when the lesson said ``quit``. Ctrl-C stops the
     lesson (``KeyboardInterrupt``), also when an ``adapt`` caught it to keep its epochs."""
     for lineno, line in commands(text):
-        session.echo(f"{path}:{lineno}> {line.splitlines()[0]}")
+        session.echo(f"{path}:{lineno}> {visible(line.splitlines()[0])}")
         session.interrupted = False
         try:
             if not session.run(line, path, lineno):
