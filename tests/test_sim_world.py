@@ -435,6 +435,23 @@ def test_a_huge_number_is_explained_in_its_own_unit():
     assert "1e7 s is 116 days" in msg and "inches" not in msg       # was "254 km"
     msg = error(BASE + "sensors: {count: 1e8}\n")
     assert "`count` in sensors must be at most 720, not 1e+08" in msg
+    # an obstacle's angle and the wheel's limits are degrees, its rate degrees a second
+    msg = error(BASE + "obstacles: [{shape: rectangle, at: [100, 0], length: 10, width: 10, "
+                       "angle: 1e300}]\n")
+    assert "hint: angles are in degrees: 1e7 deg is 27,778 turns" in msg
+    msg = error(BASE.replace("  wheelbase: 16\n", "  wheelbase: 16\n  steering: {max_rate: 1e300}\n"))
+    assert "hint: a steering rate is in degrees a second" in msg
+
+
+def test_small_wording_of_the_world_reader():
+    """`waypoints: []` said "at least 1 points"; `seed: true` quoted Python's `True`; an
+    empty name was taken, and every verdict began `: TIMEOUT`."""
+    msg = error(BASE + "obstacles: [{shape: circle, at: [100, 0], radius: 5, waypoints: []}]\n")
+    assert "must be a list of at least one point [x, y]" in msg
+    assert "must be a number, not `true`" in error(BASE.replace("seed: 1", "seed: true"))
+    for empty in ('""', "'  '"):
+        msg = error(BASE.replace("name: t", f"name: {empty}"))
+        assert "w.yaml:1:7: world error: the world's `name` is empty" in msg
 
 
 def test_randomising_obstacles_in_a_world_without_any_says_so():

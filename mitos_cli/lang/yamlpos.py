@@ -255,8 +255,9 @@ def expect_map(value: Any, span: Span, error: type[MitosError], what: str) -> YM
 def expect_number(value: Any, span: Span, error: type[MitosError], what: str) -> float:
     """``value`` as a finite float, or ``error`` saying a number was expected."""
     if isinstance(value, bool) or not isinstance(value, (int, float)):
-        shown = "nothing (an empty value or `~`)" if value is None else f"`{value}`"
-        raise error(f"{what} must be a number, not {shown}", span=span)
+        shown = ("nothing (an empty value or `~`)" if value is None else
+                 f"`{str(value).lower()}`" if isinstance(value, bool) else f"`{value}`")
+        raise error(f"{what} must be a number, not {shown}", span=span)   # (YAML's `true`)
     try:
         number = float(value)
     except OverflowError:

@@ -67,8 +67,10 @@ LARGEST = 1e7
 BEYOND = {"time_limit": "times are in seconds: 1e7 s is 116 days",
           "dt": "times are in seconds: 1e7 s is 116 days",
           "substeps": "a count this large would never finish a tick",
-          **dict.fromkeys(("heading", "fov", "cone"),
-                          "angles are in degrees: 1e7 deg is 27,778 turns")}
+          **dict.fromkeys(("heading", "fov", "cone", "angle", "min", "max", "straight"),
+                          "angles are in degrees: 1e7 deg is 27,778 turns"),
+          "max_rate": "a steering rate is in degrees a second: 1e7 deg/s is 27,778 turns a "
+                      "second"}
 
 
 #: a value of a key of words that means one of them (``replan: false``: never replan)
@@ -133,7 +135,8 @@ class _Reader:
 
     def points(self, value: Any, span: Span, what: str, least: int) -> tuple:
         if not isinstance(value, list) or len(value) < least:
-            raise WorldError(f"{what} must be a list of at least {least} points [x, y]",
+            raise WorldError(f"{what} must be a list of at least "
+                             f"{'one point' if least == 1 else f'{least} points'} [x, y]",
                              span=span)
         spans = value.item_spans if isinstance(value, YList) else [span] * len(value)
         return tuple(self.point(p, s, f"a point of {what}") for p, s in zip(value, spans))
@@ -433,6 +436,9 @@ def _name(top: YMap) -> str:
     if any(not c.isprintable() for c in name):
         raise WorldError("the world's name holds a control character",
                          span=top.value_span("name"), hint="letters, digits, `-`, `_`, spaces")
+    if not name.strip():                            # a verdict of `: TIMEOUT after 1 s`
+        raise WorldError("the world's `name` is empty", span=top.value_span("name"),
+                         hint="name: corridor (it heads every verdict and table)")
     return name
 
 
