@@ -133,6 +133,20 @@ def test_killed_sweep_resumes_without_recomputing(tiny, tmp_path):
     assert after[:len(before)] == before                       # finished rows untouched
 
 
+def test_a_reader_that_stops_early_still_gets_the_report_written(tiny, tmp_path):
+    """`mitos compare ... | head -1`: the tables went to stdout before report.md was written,
+    so a reader that had gone ended the command before the study's report."""
+    out = tmp_path / "piped"
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    proc = subprocess.Popen([sys.executable, "-m", "mitos_cli", "compare", tiny, "--and", "min",
+                             "--planner", "fuzzy", "--runs", "1", "-o", str(out), "--no-plots"],
+                            env=env, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL)
+    assert proc.stdout is not None
+    proc.stdout.close()                                      # the reader is gone at once
+    proc.wait(timeout=120)
+    assert (out / "report.md").exists() and len(read_rows(out)) == 1
+
+
 def test_existing_results_need_resume(tiny, tmp_path, compare):
     out = tmp_path / "s"
     assert compare(tiny, "--and", "min", "--planner", "fuzzy", "--runs", 1, "-o", out, "-j", 1,

@@ -101,11 +101,11 @@ def compare_command(
     outcome = run_with_progress(study, out, executor, workers, scheduler, resume,
                                 quiet=as_json)
 
+    report = _report(outcome, out, plots)       # (before stdout, which a reader may close)
     if as_json:
         emit(json_text(outcome_json(outcome, out)))
     else:
         _print_tables(outcome)
-    report = _report(outcome, out, plots)
     err(f"{plural(outcome.executed, 'run')} now, {outcome.skipped} from before; "
         f"wrote {report.parent / 'results.csv'} and {report}")
 
