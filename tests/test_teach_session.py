@@ -321,6 +321,9 @@ def test_simulate_and_at_and_their_mistakes(rules, tmp_path):
     with pytest.raises(Exception, match="cannot write .*: No such file or directory"):
         s.run(f"adapt epochs 3 plot {tmp_path / 'missing' / 'a.svg'}")
     assert len(s.journal.entries) == changes
+    # `show terms plot` names the file given, not the first one made from it (`a-road`)
+    with pytest.raises(Exception, match="cannot write `a`: unknown picture format"):
+        s.run("show terms plot a")
 
 
 def test_a_world_driven_with_another_behavior_than_its_own_says_so(rules):

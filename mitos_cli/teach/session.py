@@ -818,6 +818,10 @@ class Session:
         if c.what == "rules":
             self.out(self.describe_rules())
         elif c.what == "terms":
+            if c.plot is not None:      # the name given, not the first one made from it
+                from ..draw.output import check_format
+
+                check_format(c.plot)
             self.out(text.terms_table(self.original, self.rulebase, self._shownvariables()))
             if c.plot is not None:
                 self._plot_terms(self.original, self.rulebase, c.plot)
