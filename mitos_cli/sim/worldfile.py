@@ -657,7 +657,7 @@ def _off_the_grid(static: StaticMap, x: float, y: float) -> str | None:
     if x0 <= x < x1 and y0 <= y < y1:
         return None
     name = f" `{Path(static.grid.source).name}`" if static.grid.source else ""
-    return (f"lies outside the map{name} (x {x0:.6g} to {x1:.6g}, y {y0:.6g} to {y1:.6g} in)")
+    return f"lies outside the map{name} (x {x0:.6g} to {x1:.6g}, y {y0:.6g} to {y1:.6g} in)"
 
 
 def _units_hint(world: World, agent) -> str | None:
