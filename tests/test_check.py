@@ -268,6 +268,60 @@ def test_grid_includes_corners_and_stays_capped():
     assert all(a[0] == u[0] and a[-1] == u[1] for a, u in zip(tiny, compiled.universe))
 
 
+
+def _ruspini(tmp_path, rules: str, inputs: int = 6, default: str = "    default: 50\n"):
+    """``inputs`` inputs of 9 triangles each on [0, 80], peaks every 10 (a Ruspini
+    partition): their corner points alone (9 ** 6) are more than the grid holds."""
+    v = "".join(f"  x{i}:\n    role: input\n    universe: [0, 80]\n    terms:\n" + "".join(
+        f"      T{k}: {{shape: triangle, peak: {10 * k}, width: 10}}\n" for k in range(9))
+        for i in range(inputs))
+    (tmp_path / "ru.terms.yaml").write_text(
+        "variables:\n" + v + "  y:\n    role: output\n    universe: [0, 100]\n" + default
+        + "    terms: {A: 0, B: 100}\n", encoding="utf-8")
+    (tmp_path / "ru.rules").write_text('terms "ru.terms.yaml"\n' + rules, encoding="utf-8")
+    return read_rulebase(tmp_path / "ru.rules")
+
+
+def test_a_rule_firing_only_where_the_thinned_grid_skipped_is_not_unreachable(tmp_path):
+    """Six inputs of 9 terms: the grid kept 8 points per input, not 40, and `check` said the
+    rules on T4 "never fire ... conditions cannot hold together" (they fire at DOF 1). A rule
+    is now judged on a grid of its own inputs, every corner point and between them; only a
+    rule whose own inputs are too many for that is a note, saying what was skipped."""
+    rules = "".join(f"r{i}_{k}: if x{i} is T{k} then y is {'AB'[k % 2]}\n"
+                    for i in range(6) for k in range(9))
+    rules += "all4: if " + " and ".join(f"x{i} is T4" for i in range(6)) + " then y is A\n"
+    rules += "never: if x0 is T1 and x0 is T3 then y is B\n"
+    report = check_rulebase(_ruspini(tmp_path, rules))
+    (grid,) = report.grids
+    assert grid.skipped == tuple(f"x{i}" for i in range(6))
+    found = {f.message.split("`")[1]: f for f in by_code(report, "unreachable")}
+    assert set(found) == {"all4", "never"}
+    assert found["never"].severity == "warning" and found["never"].message.startswith(
+        "`never` never fires: its DOF is 0 at all ")
+    assert "every corner point of their terms and between them" in found["never"].message
+    assert found["all4"].severity == "info"
+    assert "a grid that skipped corner points of `x0`, `x1`, `x2`, `x3` and 2 more: it may " \
+        "fire between them" in found["all4"].message
+
+
+def test_a_thinned_grid_says_so(tmp_path, capsys):
+    """`no-rule-fires` on a grid that skipped corner points may miss places, and says so;
+    the summary and the JSON name the inputs."""
+    rules = "".join(f"r{k}: if x0 is T{k} then y is {'AB'[k % 2]}\n" for k in range(9)
+                    if k not in (4, 5))             # x0 in (30, 60) in no rule of x0 ...
+    rules += "".join(f"s{i}: if x{i} is T0 then y is A\n" for i in range(1, 6))     # ... nor above 10 here
+    report = check_rulebase(_ruspini(tmp_path, rules, default=""))
+    (gap,) = by_code(report, "no-rule-fires")
+    assert gap.message.endswith("(on a grid that skipped corner points of `x0`, `x1`, `x2`, "
+                                "`x3` and 2 more: there may be more)")
+    code, out, _ = run(["check", str(tmp_path / "ru.rules")], capsys)
+    assert code == 1 and "\nnote: `main`'s grid skipped corner points of `x0`, `x1`, `x2`, " \
+        "`x3` and 2 more (all of them would take 5.31e+05 samples" in out
+    code, out, _ = run(["check", str(tmp_path / "ru.rules"), "--json"], capsys)
+    assert json.loads(out)["behaviors"][0]["skipped_corners"] == [f"x{i}" for i in range(6)]
+    assert not check_rulebase(read_rulebase()).grids[0].skipped      # avoid_obstacle
+
+
 # ---------------------------------------------------------------------------------------------
 # the command
 

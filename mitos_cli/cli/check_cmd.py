@@ -53,8 +53,22 @@ def render(report, trace_path: str) -> str:
     if lines:
         lines.append("")
     lines.append(f"checked {trace_path}: {grids}")
+    for g in report.grids:
+        if g.skipped:
+            lines.append(skipped_note(g))
     lines.append(", ".join(counts) + (" - OK" if report.ok else ""))
     return "\n".join(lines)
+
+
+def skipped_note(grid) -> str:
+    """Says that a behavior's grid is coarser than its terms (too many inputs), so that its
+    `no-rule-fires` and `low-dof` findings, or their absence, claim no more than was seen."""
+    from ..engine.check import MAX_SAMPLES, listed_names
+
+    return (f"note: `{grid.behavior}`'s grid skipped corner points of {listed_names(grid.skipped)} "
+            f"(all of them would take {grid.corner_samples:.3g} samples, the grid at most "
+            f"{MAX_SAMPLES:,}): places where no rule fires, or the DOF is low, may be missed "
+            f"between them")
 
 
 def to_json(report, trace_path: str) -> dict:
@@ -63,7 +77,8 @@ def to_json(report, trace_path: str) -> dict:
         "ok": report.ok,
         "threshold": report.threshold,
         "behaviors": [{"name": g.behavior, "samples": g.samples,
-                       "grid": {name: n for name, n in g.points}} for g in report.grids],
+                       "grid": {name: n for name, n in g.points},
+                       "skipped_corners": list(g.skipped)} for g in report.grids],
         "summary": {s: report.count(s) for s in ("error", "warning", "info")},
         "findings": [_shown(f.to_json()) for f in report.findings],
     }

@@ -21,7 +21,10 @@ code                  severity    meaning
 ``contradiction``     warning     an antecedent that asks for ``x is A`` and ``x is not A``
 ``idle-setting``      warning     a Mamdani-only operator setting (``defuzzify``, ...) where
                                   the inference is not Mamdani
-``unreachable``       warning     a rule whose DOF is 0 at every sampled input
+``unreachable``       warning     a rule that fires nowhere: its DOF is 0 on a grid of the
+                                  inputs its conditions name, every corner point of their
+                                  terms and the midpoints between them (info, hedged, when
+                                  even that grid is too large to hold them)
 ``term-gap``          warning     a stretch of an input's universe where all its terms are 0
 ``term-outside``      warning     an input term that never reaches 1 inside the universe
 ``unused-term``       warning     an input term (or a whole input) that no rule uses
@@ -43,7 +46,10 @@ thresholds are documented there); ``mitos teach`` runs them after ``adapt`` and 
 The input space is sampled on a grid: ``resolution`` evenly spaced points per input plus every
 corner point of its terms (where memberships start or stop being 0), capped at
 :data:`MAX_SAMPLES` points in all. The whole grid is one vectorized batch through
-:func:`mitos_cli.engine.evaluation.evaluate`. Regions are reported as boxes of sampled values, e.g.
+:func:`mitos_cli.engine.evaluation.evaluate`. With many inputs even the corner points are too
+many; the grid then skips some, and :attr:`GridInfo.skipped` names those inputs (the
+``no-rule-fires`` and ``low-dof`` findings say so too: they may miss places between samples).
+Regions are reported as boxes of sampled values, e.g.
 ``road in [0, 40] and size in [70, 100]``; an input left out of a box may take any value.
 """
 
@@ -136,6 +142,10 @@ class GridInfo:
     behavior: str
     points: tuple[tuple[str, int], ...]    # samples per input
     samples: int
+    #: inputs whose terms' corner points the grid could not all hold (too many inputs):
+    #: `no-rule-fires` and `low-dof` may miss places between its samples
+    skipped: tuple[str, ...] = ()
+    corner_samples: float = 0.0            # the samples every corner point would take
 
 
 @dataclass(frozen=True)
@@ -375,34 +385,58 @@ def _contradictions(rb: RuleBase, behavior: str) -> list[Finding]:
 # ---------------------------------------------------------------------------------------------
 # the sampled input space
 
-def grid_axes(compiled: CompiledRuleBase, resolution: int,
-              max_samples: int = MAX_SAMPLES) -> list[np.ndarray]:
-    """Sample points per input: ``resolution`` even steps plus the terms' corner points,
-    with ``resolution`` lowered until the grid has at most ``max_samples`` points."""
-    def axes_for(n: int) -> list[np.ndarray]:
-        axes = []
-        for name, (lo, hi) in zip(compiled.inputs, compiled.universe):
-            pts: list[np.ndarray | list[float]] = [np.linspace(lo, hi, n)]
-            for term in compiled.variables[name].terms:      # a formula's centre is NaN
-                points = term.corners if term.corners is not None else (term.center,)
-                pts.append([c for c in points if lo <= c <= hi])
-            axes.append(np.unique(np.concatenate([np.asarray(p, float) for p in pts])))
-        return axes
+def corner_points(compiled: CompiledRuleBase, i: int) -> np.ndarray:
+    """Input ``i``'s universe ends and its terms' corner points inside the universe (a
+    smooth term's centre; a formula has neither), sorted."""
+    lo, hi = compiled.universe[i]
+    pts = [lo, hi]
+    for term in compiled.variables[compiled.inputs[i]].terms:    # a formula's centre is NaN
+        points = term.corners if term.corners is not None else (term.center,)
+        pts += [c for c in points if lo <= c <= hi]
+    return np.unique(np.asarray(pts, float))
 
-    def size(axes: list[np.ndarray]) -> int:
-        return int(np.prod([len(a) for a in axes], dtype=float))
+
+def _axis(compiled: CompiledRuleBase, i: int, n: int, between: bool) -> np.ndarray:
+    """``n`` even steps of input ``i``'s universe and its corner points (``between``: and
+    the midpoints of neighbouring corner points)."""
+    lo, hi = compiled.universe[i]
+    pts = [np.linspace(lo, hi, n), corner_points(compiled, i)]
+    if between:
+        pts.append(_midpoints(compiled, i))
+    return np.unique(np.concatenate(pts))
+
+
+def _midpoints(compiled: CompiledRuleBase, i: int) -> np.ndarray:
+    corners = corner_points(compiled, i)
+    return 0.5 * (corners[:-1] + corners[1:])
+
+
+def _size(axes: list[np.ndarray]) -> float:
+    return float(np.prod([len(a) for a in axes], dtype=float))
+
+
+def fitted_axes(compiled: CompiledRuleBase, inputs: list[int], resolution: int,
+                max_samples: int = MAX_SAMPLES, between: bool = False) -> list[np.ndarray]:
+    """Sample points of ``inputs``: ``resolution`` even steps plus the corner points (and,
+    ``between``, the midpoints between them), with ``resolution`` lowered until the grid has
+    at most ``max_samples`` points, then the midpoints dropped, then (many inputs: even the
+    corners are too many) the corners thinned evenly: :func:`skipped_corners` tells."""
+    def axes_for(n: int, mid: bool) -> list[np.ndarray]:
+        return [_axis(compiled, i, n, mid) for i in inputs]
 
     lo, hi = 2, max(2, resolution)
-    if size(axes_for(hi)) <= max_samples:
-        return axes_for(hi)
+    if _size(axes_for(hi, between)) <= max_samples:
+        return axes_for(hi, between)
+    if between and _size(axes_for(2, True)) > max_samples:
+        between = False                      # the midpoints go before the corners do
     while hi - lo > 1:                       # the largest resolution that fits
         mid = (lo + hi) // 2
-        if size(axes_for(mid)) <= max_samples:
+        if _size(axes_for(mid, between)) <= max_samples:
             lo = mid
         else:
             hi = mid
-    axes = axes_for(lo)
-    if size(axes) > max_samples:             # many inputs: even the corners are too many;
+    axes = axes_for(lo, between)
+    if _size(axes) > max_samples:            # many inputs: even the corners are too many;
         per_axis = max(2, int(max_samples ** (1.0 / len(axes))))   # thin them evenly
         axes = [a if len(a) <= per_axis else
                 a[np.unique(np.round(np.linspace(0, len(a) - 1, per_axis)).astype(int))]
@@ -410,14 +444,44 @@ def grid_axes(compiled: CompiledRuleBase, resolution: int,
     return axes
 
 
+def grid_axes(compiled: CompiledRuleBase, resolution: int,
+              max_samples: int = MAX_SAMPLES) -> list[np.ndarray]:
+    """Sample points per input: ``resolution`` even steps plus the terms' corner points,
+    with ``resolution`` lowered until the grid has at most ``max_samples`` points
+    (:func:`fitted_axes` over every input)."""
+    return fitted_axes(compiled, list(range(len(compiled.inputs))), resolution, max_samples)
+
+
+def skipped_corners(compiled: CompiledRuleBase, inputs: list[int],
+                    axes: list[np.ndarray]) -> tuple[str, ...]:
+    """The inputs whose axis lost some of its corner points to :func:`fitted_axes`'s
+    thinning: between the samples of those, a rule may fire or stop firing unseen."""
+    return tuple(compiled.inputs[i] for i, a in zip(inputs, axes)
+                 if not np.isin(corner_points(compiled, i), a).all())
+
+
+def listed_names(names: tuple[str, ...] | list[str], most: int = 4) -> str:
+    """``a, b, c and 10 more`` (backquoted)."""
+    shown = [f"`{n}`" for n in names[:most]]
+    more = len(names) - len(shown)
+    if more:
+        return ", ".join(shown) + f" and {more} more"
+    return shown[0] if len(shown) == 1 else ", ".join(shown[:-1]) + " and " + shown[-1]
+
+
 def _sampled(compiled: CompiledRuleBase, threshold: float,
              resolution: int) -> tuple[list[Finding], GridInfo]:
+    every = list(range(len(compiled.inputs)))
     axes = grid_axes(compiled, resolution)
     shape = tuple(len(a) for a in axes)
     mesh = np.meshgrid(*axes, indexing="ij")
     X = np.stack([m.reshape(-1) for m in mesh], axis=1) if axes else np.zeros((1, 0))
     dof = rule_dofs(compiled, X)                       # [n, R]
-    info = GridInfo(compiled.behavior, tuple(zip(compiled.inputs, shape)), X.shape[0])
+    skipped = skipped_corners(compiled, every, axes)
+    info = GridInfo(compiled.behavior, tuple(zip(compiled.inputs, shape)), X.shape[0],
+                    skipped, _size([corner_points(compiled, i) for i in every]))
+    thinned = (f" (on a grid that skipped corner points of {listed_names(skipped)}: there may "
+               f"be more)" if skipped else "")
     out: list[Finding] = []
     name = compiled.behavior
     span = _behavior_span(compiled.rulebase, name)
@@ -448,6 +512,7 @@ def _sampled(compiled: CompiledRuleBase, threshold: float,
                 severity = "warning" if has_default or summed else "error"
                 message = (f"behavior `{name}`: no rule sets {what} in "
                            f"{_pct(share)} of the input space")
+                message += thinned
                 if summed:                    # a weighted sum of nothing is 0, not an error
                     message += " (the weighted sum is 0 there)"
                     hint = "add rules that cover these inputs"
@@ -462,7 +527,7 @@ def _sampled(compiled: CompiledRuleBase, threshold: float,
             else:
                 severity = "warning"
                 message = (f"behavior `{name}`: the rules setting {what} fire with a total DOF "
-                           f"below {threshold:g} in {_pct(share)} of the input space")
+                           f"below {threshold:g} in {_pct(share)} of the input space{thinned}")
                 hint = "widen the terms or add rules, so that more than a trace of a rule fires"
             out.append(Finding(severity, kind, message, span, name, hint,
                                tuple(boxes[:MAX_BOXES]), max(0, len(boxes) - MAX_BOXES), share,
@@ -473,15 +538,81 @@ def _sampled(compiled: CompiledRuleBase, threshold: float,
     fires = (dof > 0.0).any(axis=0) if dof.shape[0] else np.zeros(compiled.n_rules, bool)
     own = np.array([not contexts for _, _, contexts in flatten(compiled.rulebase, name)],
                    dtype=bool)
-    for r in np.flatnonzero(~fires & own):
-        rule = compiled.rules[r]
-        why = " (its weight is 0)" if rule.weight == 0 else ""
-        out.append(Finding(
-            "warning", "unreachable",
-            f"`{compiled.labels[r]}` never fires: its DOF is 0 at all {X.shape[0]:,} sampled "
-            f"inputs{why}", rule.span, name,
-            hint="its conditions cannot hold together; check the terms it names"))
+    out += _unreachable(compiled, np.flatnonzero(~fires & own), resolution)
     return out, info
+
+
+#: Samples evaluated at once when a rule is looked at on a grid of its own inputs.
+CHUNK = 20_000
+
+
+def _unreachable(compiled: CompiledRuleBase, rules: np.ndarray,
+                 resolution: int) -> list[Finding]:
+    """Of ``rules`` (none fired on the behavior's grid, which may have had to skip corner
+    points), those that fire nowhere. A rule's DOF reads only the inputs its conditions
+    (and its `use` contexts' conditions) name, so it is looked at again on a grid of those
+    alone, holding every corner point of their terms and the midpoint between each two:
+    between neighbouring corner points a piecewise-linear term is linear, so wherever the
+    rule fires it fires at one of those points (for T-norms without zero divisors: `min`,
+    `product`, ...). Only when that grid too is too large is the finding hedged."""
+    flat = flatten(compiled.rulebase, compiled.behavior)
+    groups: dict[tuple[int, ...], list[int]] = {}
+    for r in rules:
+        _, rule, contexts = flat[r]
+        used: set[tuple[str, str]] = set()
+        for expr in (rule.antecedent,) + tuple(u.condition for u in contexts
+                                               if u.condition is not None):
+            _terms_used(expr, used)
+        key = tuple(sorted({compiled.inputs.index(v) for v, _ in used}))
+        groups.setdefault(key, []).append(int(r))
+    out = []
+    for inputs, members in groups.items():
+        axes = fitted_axes(compiled, list(inputs), resolution, between=True)
+        fires = _fires_on(compiled, np.array(members), list(inputs), axes)
+        names = tuple(compiled.inputs[i] for i in inputs)
+        skipped = skipped_corners(compiled, list(inputs), axes)
+        exact = not skipped and all(np.isin(_midpoints(compiled, i), a).all()
+                                    for i, a in zip(inputs, axes))
+        samples = int(_size(axes))
+        for r in np.array(members)[~fires]:
+            rule = compiled.rules[r]
+            why = " (its weight is 0)" if rule.weight == 0 else ""
+            label = compiled.labels[r]
+            if exact or rule.weight == 0:
+                out.append(Finding(
+                    "warning", "unreachable",
+                    f"`{label}` never fires: its DOF is 0 at all {samples:,} sampled values of "
+                    f"{listed_names(names)}, every corner point of their terms and between them"
+                    f"{why}", rule.span, compiled.behavior,
+                    hint="its conditions cannot hold together; check the terms it names"))
+                continue
+            gap = (f"corner points of {listed_names(skipped)}" if skipped else
+                   "the points between corner points")
+            out.append(Finding(
+                "info", "unreachable",
+                f"`{label}` fired at none of {samples:,} sampled inputs of {listed_names(names)}, "
+                f"a grid that skipped {gap}: it may fire between them", rule.span,
+                compiled.behavior, hint="check that its conditions can hold together"))
+    return out
+
+
+def _fires_on(compiled: CompiledRuleBase, rules: np.ndarray, inputs: list[int],
+              axes: list[np.ndarray]) -> np.ndarray:
+    """Which of ``rules`` have a DOF above 0 somewhere on the grid ``axes`` of ``inputs``
+    (every other input at its universe's low end: those rules do not read it), a
+    :data:`CHUNK` of samples at a time."""
+    shape = tuple(len(a) for a in axes)
+    total = int(np.prod(shape))
+    fires = np.zeros(len(rules), bool)
+    for start in range(0, total, CHUNK):
+        at = np.unravel_index(np.arange(start, min(start + CHUNK, total)), shape)
+        X = np.repeat(compiled.universe[None, :, 0], len(at[0]), axis=0)
+        for d, i in enumerate(inputs):
+            X[:, i] = axes[d][at[d]]
+        fires |= (rule_dofs(compiled, X)[:, rules] > 0.0).any(axis=0)
+        if fires.all():
+            break
+    return fires
 
 
 def _pct(share: float) -> str:
