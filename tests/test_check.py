@@ -97,7 +97,7 @@ def test_coverage_gap_without_default_is_an_error(flawed):
     assert regions == ["road in [0, 50] and size in [40, 100]",
                        "road in [100, 160] and size in [0, 40]"]
     assert gap.span.line == 2 and gap.span.path == str(flawed)     # the first rule
-    assert 0.3 < gap.share < 0.4
+    assert gap.share == pytest.approx(50 / 160 * 0.6 + 60 / 160 * 0.4)
 
 
 def test_coverage_gap_with_default_is_a_warning(flawed):
@@ -106,6 +106,26 @@ def test_coverage_gap_with_default_is_a_warning(flawed):
     assert "no rule sets `speed`" in gap.message and "speed = 0" in gap.message
     assert [b.describe() for b in gap.regions] == ["road in [90, 160]",
                                                   "road in [0, 50] and size in [40, 100]"]
+
+
+
+@pytest.mark.parametrize("points, where, share", [
+    ("[2, 4]", "in 20% of the input space", 0.2),        # x in [4, 6]: 9 of the 41 samples
+    ("[2, 5]", "on lines or points of the input space (none of its volume)", 0.0)])   # x = 5
+def test_no_rule_fires_gives_the_share_of_the_input_space(tmp_path, points, where, share):
+    """It gave the share of the samples (22%, 9 of 41, for a gap of 20%), which the terms'
+    corner points crowd; it is the share of the volume now, exact where the grid holds them."""
+    high = "[6, 8]" if points == "[2, 4]" else "[5, 8]"
+    (tmp_path / "e.terms.yaml").write_text(
+        "variables:\n  x: {role: input, universe: [0, 10], terms: {LO: {shape: left_shoulder, "
+        f"points: {points}}}, HI: {{shape: right_shoulder, points: {high}}}}}}}\n"
+        "  y: {role: output, universe: [0, 100], default: 50, terms: {A: 0, B: 100}}\n",
+        encoding="utf-8")
+    (tmp_path / "e.rules").write_text('terms "e.terms.yaml"\nr1: if x is LO then y is A\n'
+                                      "r2: if x is HI then y is B\n", encoding="utf-8")
+    (gap,) = by_code(check_rulebase(read_rulebase(tmp_path / "e.rules")), "no-rule-fires")
+    assert gap.message.startswith(f"behavior `main`: no rule sets `y` {where} (the default")
+    assert gap.share == pytest.approx(share, abs=1e-12)
 
 
 def test_coverage_gap_with_weighted_sum_is_a_warning(tmp_path):
@@ -298,7 +318,7 @@ def test_a_rule_firing_only_where_the_thinned_grid_skipped_is_not_unreachable(tm
     assert set(found) == {"all4", "never"}
     assert found["never"].severity == "warning" and found["never"].message.startswith(
         "`never` never fires: its DOF is 0 at all ")
-    assert "every corner point of their terms and between them" in found["never"].message
+    assert "every corner point of its terms and between them" in found["never"].message
     assert found["all4"].severity == "info"
     assert "a grid that skipped corner points of `x0`, `x1`, `x2`, `x3` and 2 more: it may " \
         "fire between them" in found["all4"].message

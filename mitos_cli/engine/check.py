@@ -119,7 +119,7 @@ class Finding:
     hint: str | None = None
     regions: tuple[Box, ...] = ()
     more_regions: int = 0    # boxes not listed in ``regions``
-    share: float | None = None   # fraction of the grid the regions cover
+    share: float | None = None   # fraction of the input space's volume (volume_share)
     uncovered: int = 0       # grid cells of a very ragged region left out of every box
 
     def to_json(self) -> dict:
@@ -505,13 +505,15 @@ def _sampled(compiled: CompiledRuleBase, threshold: float,
         for key, outs in reported.items():
             mask, has_default = masks[key], key[1]
             boxes, uncovered = boxes_of(mask.reshape(shape), axes, compiled.inputs)
-            share = float(mask.mean())
+            share = volume_share(mask.reshape(shape), axes,
+                                 inner=kind == "no-rule-fires" and not skipped)
             what = " and ".join(f"`{o}`" for o in outs)
             summed = compiled.operators.inference == "weighted_sum"
             if kind == "no-rule-fires":
                 severity = "warning" if has_default or summed else "error"
-                message = (f"behavior `{name}`: no rule sets {what} in "
-                           f"{_pct(share)} of the input space")
+                where = (f"in {_pct(share)} of the input space" if share > 0 else
+                         "on lines or points of the input space (none of its volume)")
+                message = f"behavior `{name}`: no rule sets {what} {where}"
                 message += thinned
                 if summed:                    # a weighted sum of nothing is 0, not an error
                     message += " (the weighted sum is 0 there)"
@@ -582,7 +584,8 @@ def _unreachable(compiled: CompiledRuleBase, rules: np.ndarray,
                 out.append(Finding(
                     "warning", "unreachable",
                     f"`{label}` never fires: its DOF is 0 at all {samples:,} sampled values of "
-                    f"{listed_names(names)}, every corner point of their terms and between them"
+                    f"{listed_names(names)}, every corner point of {'their' if len(names) > 1 else 'its'} "
+                    f"terms and between them"
                     f"{why}", rule.span, compiled.behavior,
                     hint="its conditions cannot hold together; check the terms it names"))
                 continue
@@ -613,6 +616,24 @@ def _fires_on(compiled: CompiledRuleBase, rules: np.ndarray, inputs: list[int],
         if fires.all():
             break
     return fires
+
+
+def volume_share(mask: np.ndarray, axes: list[np.ndarray], inner: bool) -> float:
+    """The share of the input space's volume that the grid ``mask`` stands for (not of its
+    samples: the corner points crowd some stretches). Each cell between neighbouring samples
+    counts its volume times the share of its vertices in the mask, or (``inner``) only when
+    all are: where no rule fires is bounded by corner points (a piecewise-linear term is 0
+    on a whole cell or only at its ends), so on a grid that holds them that is exact."""
+    if any(len(a) < 2 for a in axes):
+        return float(mask.mean())
+    m = mask.astype(float)
+    for d in range(mask.ndim):
+        lo = np.take(m, np.arange(len(axes[d]) - 1), axis=d)
+        hi = np.take(m, np.arange(1, len(axes[d])), axis=d)
+        m = np.minimum(lo, hi) if inner else 0.5 * (lo + hi)
+    for a in axes:                           # contract each axis with its cells' widths
+        m = np.tensordot(np.diff(a) / (a[-1] - a[0]), m, axes=(0, 0))
+    return float(m)
 
 
 def _pct(share: float) -> str:
