@@ -83,7 +83,8 @@ def test_flawed_rule_base_findings(flawed):
         ("error", "no-rule-fires"), ("warning", "no-rule-fires"), ("warning", "low-dof"),
         ("error", "conflict"), ("warning", "duplicate"), ("warning", "unreachable"),
         ("warning", "contradiction"), ("warning", "unused-term"), ("warning", "term-gap"),
-        ("warning", "coverage")])     # road: NARROW and MEDIUM cross at 0.25 (road = 55)
+        ("warning", "coverage"),      # road: NARROW and MEDIUM cross at 0.25 (road = 55)
+        ("warning", "coverage")])     # size: below 0.5 on [25, 55], around its gap at 40
     assert report.findings[0].severity == "error"            # errors come first
 
 
@@ -357,7 +358,7 @@ def test_cli_exit_codes(flawed, capsys):
     code, out, _ = run(["check", str(flawed)], capsys)
     assert code == 1
     assert f"{flawed}:3:1: error: `r2` has the same antecedent as `r1`" in out
-    assert out.rstrip().endswith("2 errors, 8 warnings, 0 notes")   # 8: road coverage 0.25
+    assert out.rstrip().endswith("2 errors, 9 warnings, 0 notes")   # 9: road, size coverage
     code, out, _ = run(["check"], capsys)
     assert code == 0 and out.rstrip().endswith(" - OK") and "0 errors" in out
 
@@ -368,7 +369,7 @@ def test_cli_json_matches_the_library(flawed, capsys):
     report = check_rulebase(read_rulebase(flawed), threshold=0.05)
     assert code == 1 and data["ok"] is False and data["threshold"] == 0.05
     assert data["findings"] == [f.to_json() for f in report.findings]
-    assert data["summary"] == {"error": 2, "warning": 7, "info": 0}   # 7: with road coverage
+    assert data["summary"] == {"error": 2, "warning": 8, "info": 0}   # 8: with coverage
     gap = data["findings"][0]
     assert gap["code"] == "no-rule-fires" and gap["regions"][0] == {"road": [0.0, 50.0],
                                                                     "size": [40.0, 100.0]}

@@ -205,6 +205,10 @@ def _input(terms: str, universe: str = "[0, 100]"):
     ("{A: {shape: left_shoulder, points: [10, 30]}, B: {shape: triangle, points: "
      "[40, 60, 90]}, C: {shape: right_shoulder, points: [70, 90]}}", "[0, 100]",
      "x in [20, 50] and [75, 80]"),
+    # only around a gap on [4, 6]: each shoulder falls from 1 to 0 between two breakpoints,
+    # which were all the measure saw (no finding)
+    ("{LO: {shape: left_shoulder, points: [2, 4]}, HI: {shape: right_shoulder, points: "
+     "[6, 8]}}", "[0, 10]", "x in [3, 7]"),
     # gaussians: on samples, the ends where the largest membership crosses 0.5
     ("{LO: {shape: gaussian, mean: 0, sigma: 1}, HI: {shape: gaussian, mean: 10, sigma: 1}}",
      "[0, 10]", "x in [1.18, 8.82]"),
@@ -234,6 +238,14 @@ def test_coverage_stretches_end_where_the_largest_membership_is_the_threshold():
                     "points: [40, 60, 90]}, C: {shape: right_shoulder, points: [70, 90]}}")
     (issue,) = [i for i in meaning.variable_issues(gapped) if i.code == "coverage"]
     assert "covered only to 0.4 at x = 78 outside its term gaps, less" in issue.message
+    around = _input("{LO: {shape: left_shoulder, points: [2, 4]}, HI: {shape: right_shoulder, "
+                    "points: [6, 8]}}", "[0, 10]")
+    (issue,) = meaning.variable_issues(around)
+    assert issue.message.startswith("`x` is covered to 0.5 except next to its term gaps, "
+                                    "less than 0.5 for x in [3, 7] (every point")
+    vertical = _input("{LO: {shape: trapezoid, points: [0, 0, 3, 3]}, HI: {shape: trapezoid, "
+                      "points: [7, 7, 10, 10]}}", "[0, 10]")
+    assert meaning.variable_issues(vertical) == []       # the gap (3, 7) is all there is
 
 def test_hedged_terms_move_along_the_scale():
     steering = PAPER.variables["steering"]

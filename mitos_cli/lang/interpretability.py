@@ -418,7 +418,7 @@ def variable_issues(var: Variable) -> list[Issue]:
             mu = sampled(sets, x)
         if var.role == "input":
             low, where = coverage_on(mu, x, var.universe, besides_gaps=True)   # see term-gap
-            if low < COVERAGE - 1e-9:
+            if low < COVERAGE - 1e-9 or _dips_beside_gaps(sets, corners, x):
                 spans = (uncovered_on(mu.max(axis=0), x) if corners is None
                          else uncovered(corners, var.universe))
                 out.append(Issue("coverage", var.name, (), _coverage_message(
@@ -443,6 +443,18 @@ def variable_issues(var: Variable) -> list[Issue]:
     return out
 
 
+def _dips_beside_gaps(sets: list[Term], corners: np.ndarray | None, x: np.ndarray) -> bool:
+    """Whether the largest membership lies strictly between 0 and :data:`COVERAGE`
+    anywhere: at a point of ``x`` or a third or two thirds of the way to the next. Next to a
+    term gap it falls to 0 between two breakpoints where it is 1 (a shoulder's edge ending
+    at the gap), which the breakpoints alone never show; the envelope is linear between
+    them, so a dip shows at one of those thirds."""
+    width = np.diff(x)
+    at = np.concatenate([x, x[:-1] + width / 3, x[:-1] + 2 * width / 3])
+    top = (memberships(corners, at) if corners is not None else sampled(sets, at)).max(axis=0)
+    return bool(np.any((top > 0.0) & (top < COVERAGE - 1e-9)))
+
+
 #: Stretches named in one coverage finding; more are counted.
 SHOWN_STRETCHES = 4
 
@@ -454,9 +466,12 @@ def _coverage_message(var: Variable, low: float, where: float,
     gap itself being the ``term-gap`` finding), their ends rounded to the decimal place of a
     thousandth of the universe, the resolution the sampled measures have."""
     step = (var.universe[1] - var.universe[0]) / (RESOLUTION - 1)
-    text = f"`{var.name}` is covered only to {_num(low)} at {var.name} = {_num(where)}"
-    if gaps:
-        text += " outside its term gaps"
+    if low < COVERAGE - 1e-9:
+        text = f"`{var.name}` is covered only to {_num(low)} at {var.name} = {_num(where)}"
+        if gaps:
+            text += " outside its term gaps"
+    else:                       # below only where a term falls to a gap
+        text = f"`{var.name}` is covered to {COVERAGE:g} except next to its term gaps"
     if spans:
         shown = [f"[{_rounded(a, step)}, {_rounded(b, step)}]"
                  for a, b in spans[:SHOWN_STRETCHES]]
