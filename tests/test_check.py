@@ -466,6 +466,34 @@ def test_an_output_term_between_the_sample_points_is_reported(tmp_path, capsys, 
     assert "[undersampled-term]" in capsys.readouterr().out
 
 
+
+def test_an_output_term_outside_its_range_is_not_called_undersampled(tmp_path, capsys):
+    """`trimf [40 45 50]` on [0, 30] was "undersampled", with the advice to raise the
+    resolution, which no resolution answers; so was a formula that is 0 all over the range."""
+    fis = tmp_path / "f.fis"
+    fis.write_text(TIPPER_FIS.read_text().replace("[0 5 10]", "[40 45 50]"), encoding="utf-8")
+    report = check_rulebase(read_rulebase(fis))
+    assert not by_code(report, "undersampled-term")
+    (finding,) = by_code(report, "term-outside")
+    assert finding.message == ("term `cheap` of output `tip` lies outside its range [0, 30]: "
+                               "its rules do not change `tip`")
+    assert finding.span.line == 33 and "widen the output's range" in finding.hint
+    with pytest.raises(SystemExit):
+        main(["eval", str(fis), "service=3", "food=8"])
+    err = capsys.readouterr().err
+    assert "`cheap` of output `tip` lies outside its range [0, 30]" in err and \
+        "resolution" not in err
+    terms = TERMS.replace("terms: {SLOW: 20, FAST: 50}", "terms:\n      SLOW: {shape: formula, "
+                          "formula: \"-x\"}\n      FAST: {shape: triangle, peak: 50, width: 10}")
+    (tmp_path / "t.terms.yaml").write_text(terms, encoding="utf-8")
+    (tmp_path / "t.rules").write_text("operators: inference = mamdani\n" + RULES,
+                                      encoding="utf-8")
+    (zero,) = by_code(check_rulebase(read_rulebase(tmp_path / "t.rules")), "term-outside")
+    assert zero.message == ("term `SLOW` of output `speed` is 0 all over its range [0, 60]: "
+                            "its rules do not change `speed`")
+    assert "above 0 somewhere" in zero.hint
+
+
 def test_a_term_barely_sampled_is_reported_with_its_peak_and_a_wide_one_is_not(tmp_path):
     terms = TERMS.replace("terms: {SLOW: 20, FAST: 50}",
                           "terms:\n      SLOW: {shape: triangle, peak: 20.2, width: 0.4}\n"

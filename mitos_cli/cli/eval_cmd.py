@@ -125,7 +125,7 @@ def warn_undersampled(rb, dof) -> None:
         return                              # nothing imported for the common case
     import numpy as np
 
-    from ..engine.check import resolution_hint
+    from ..engine.check import undersampled_hint
     from ..engine.mamdani import undersampled
 
     for u in undersampled(rb.compiled):
@@ -135,7 +135,7 @@ def warn_undersampled(rb, dof) -> None:
             warn(f"{u.describe()}, though {', '.join(fired[:3])}"
                  f"{' ...' if len(fired) > 3 else ''} fired (DOF up to "
                  f"{float(strongest.max()):.2g})\n  hint: "
-                 f"{resolution_hint(rb.rulebase.path, u.points)}")
+                 f"{undersampled_hint(rb.rulebase.path, u)}")
 
 
 def eval_command(

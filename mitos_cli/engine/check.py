@@ -26,14 +26,17 @@ code                  severity    meaning
                                   terms and the midpoints between them (info, hedged, when
                                   even that grid is too large to hold them)
 ``term-gap``          warning     a stretch of an input's universe where all its terms are 0
-``term-outside``      warning     an input term that never reaches 1 inside the universe
+``term-outside``      warning     an input term that never reaches 1 inside the universe;
+                                  a Mamdani output term (as a rule concludes it) that lies
+                                  outside its output's range, or is 0 all over it
 ``unused-term``       warning     an input term (or a whole input) that no rule uses
 ``unconcluded-term``  info        an output term that no rule concludes
 ``undersampled-term`` warning     a Mamdani output term (as a rule concludes it) whose largest
                                   membership over the output's sample points is below
                                   :data:`~mitos_cli.engine.mamdani.UNDERSAMPLED_BELOW` (0.5):
                                   narrower than the sampling step, its rules hardly change
-                                  the output
+                                  the output (above 0 somewhere in the range, else
+                                  ``term-outside``)
 ``term-order``        warning     terms whose peaks (values) are not in the written order
 ``coverage``          warning     a point of an input's universe where no term reaches 0.5
 ``indistinct``        warning     two terms of a variable too alike to tell apart
@@ -233,9 +236,20 @@ def _undersampled(rb: RuleBase, name: str, compiled, seen: set[tuple]) -> list[F
             continue
         seen.add(key)
         term = rb.variables[u.output].term(u.term)
-        out.append(Finding("warning", "undersampled-term", u.describe(), term.span, name,
-                           resolution_hint(rb.path, u.points)))
+        code = "term-outside" if u.outside else "undersampled-term"
+        out.append(Finding("warning", code, u.describe(), term.span, name,
+                           undersampled_hint(rb.path, u)))
     return out
+
+
+def undersampled_hint(path: str | None, u) -> str:
+    """What to do about a term its output's sampling misses: a finer sampling, or (a term
+    outside the range, or 0 all over it) moving it in."""
+    if u.outside == "outside":
+        return "move the term into the range, or widen the output's range"
+    if u.outside:
+        return "change the term so that it is above 0 somewhere in the output's range"
+    return resolution_hint(path, u.points)
 
 
 def resolution_hint(path: str | None, points: int) -> str:

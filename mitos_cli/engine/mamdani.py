@@ -160,9 +160,19 @@ class Undersampled:
     points: int               # the output's sample points (``resolution``)
     step: float               # the distance between two of them
     rules: np.ndarray         # [r] the rules concluding it (columns of ``dof``)
+    #: "" when it is above 0 somewhere in the output's range, only narrower than a step;
+    #: "outside" when it lies outside the range, "zero" when it is 0 all over it (a
+    #: formula): no resolution makes its rules count
+    outside: str = ""
+    universe: tuple[float, float] = (0.0, 0.0)
 
     def describe(self) -> str:
         """What is wrong, for ``check`` and ``eval``."""
+        if self.outside:
+            lo, hi = self.universe
+            where = "lies outside" if self.outside == "outside" else "is 0 all over"
+            return (f"term `{self.label}` of output `{self.output}` {where} its range "
+                    f"[{lo:g}, {hi:g}]: its rules do not change `{self.output}`")
         where = (f"falls between the {self.points} points its output is sampled at "
                  if self.peak <= 0.0 else
                  f"reaches only {self.peak:.2g} at the {self.points} points its output is "
@@ -186,9 +196,30 @@ def undersampled(compiled) -> tuple[Undersampled, ...]:
             peak = float(table.sets[i].max()) if table.sets.shape[1] else 0.0
             if label.startswith("=") or not peak < UNDERSAMPLED_BELOW:
                 continue
-            out.append(Undersampled(table.name, label, label.split()[-1], peak,
-                                    len(table.grid), step, table.rules[table.set_of == i]))
+            var = compiled.variables[table.name]
+            term = var.term(label.split()[-1])
+            outside = "" if _above_zero(term, label.split()[:-1], var.universe) else \
+                "outside" if term.corners is not None else "zero"
+            out.append(Undersampled(table.name, label, term.name, peak, len(table.grid), step,
+                                    table.rules[table.set_of == i], outside,
+                                    (float(var.universe[0]), float(var.universe[1]))))
     return tuple(out)
+
+
+#: Points of an output's range on which a term missed by its sampling is looked at again.
+DENSE = 100_001
+
+
+def _above_zero(term, hedges: list[str], universe: tuple[float, float]) -> bool:
+    """Whether the (hedged) term is above 0 anywhere in the range: at :data:`DENSE` points
+    and its corner points and centre inside it (a term as narrow as a float is still seen at
+    its peak)."""
+    lo, hi = universe
+    extra = [c for c in (term.corners or ()) + (term.center,) if lo <= c <= hi]
+    x = np.concatenate([np.linspace(lo, hi, DENSE), np.asarray(extra, dtype=float)])
+    with np.errstate(all="ignore"):
+        mu = hedge_mod.apply(tuple(hedges), np.asarray(term.membership(x), dtype=float))
+    return bool(np.any(mu > 0.0))
 
 
 def aggregate(dof: np.ndarray, sets: np.ndarray, implication: str,
