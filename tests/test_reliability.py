@@ -531,6 +531,44 @@ def test_a_use_cycle_is_reported_at_the_use_that_closes_it(tmp_path):
     assert (info.value.span.line, info.value.span.column) == (4, 3)
 
 
+def _uses(tmp_path, text: str) -> Path:
+    (tmp_path / "mitos.terms.yaml").write_text((ROOT / "rulebases" / "mitos.terms.yaml")
+                                               .read_text())
+    rules = tmp_path / "u.rules"
+    rules.write_text('terms "mitos.terms.yaml"\n' + text)
+    return rules
+
+
+def test_behaviors_that_use_the_same_two_again_are_refused_before_they_double_out(tmp_path):
+    """Two behaviors a level, each using both of the next level's: written out they double
+    at each level, and a 2 KB file took `check` minutes and gigabytes (the cycle check alone
+    walked every path). They are refused at the `use` that passes the limit, at once."""
+    from mitos_cli.lang.resolve import MAX_WRITTEN_RULES, load_rules_file
+
+    levels = 16
+    text = "".join(f"behavior {n}{i}:\n  r: if road is WIDE then steering is RS\n"
+                   + (f"  use b{i + 1}\n  use c{i + 1}\n" if i < levels - 1 else "") + "end\n"
+                   for i in range(levels) for n in "bc")
+    with pytest.raises(RuleBaseError, match=f"would hold more than {MAX_WRITTEN_RULES:,} rules "
+                                            "once the behaviors it uses are written out") as info:
+        load_rules_file(_uses(tmp_path, text))
+    assert info.value.span.source_line.strip().startswith("use ")
+
+
+def test_a_chain_of_uses_deeper_than_the_limit_is_refused_not_a_recursion_error(tmp_path):
+    """1,000 behaviors each using the next met Python's recursion limit (a traceback)."""
+    from mitos_cli.lang.resolve import MAX_USE_DEPTH, load_rules_file
+
+    text = "".join(f"behavior b{i}:\n  r{i}: if road is WIDE then steering is RS\n"
+                   + (f"  use b{i + 1}\n" if i < 999 else "") + "end\n" for i in range(1000))
+    with pytest.raises(RuleBaseError, match=f"use each other more than {MAX_USE_DEPTH} deep"):
+        load_rules_file(_uses(tmp_path, text))
+    fine = "".join(f"behavior b{i}:\n  r{i}: if road is WIDE then steering is RS\n"
+                   + (f"  use b{i + 1}\n" if i < MAX_USE_DEPTH else "") + "end\n"
+                   for i in range(MAX_USE_DEPTH + 1))
+    assert len(load_rules_file(_uses(tmp_path, fine)).behaviors) == MAX_USE_DEPTH + 1
+
+
 def test_edges_too_narrow_for_a_float_slope_give_numbers_not_warnings(recwarn):
     """FLL terms 1e-320 wide: an infinite slope (or 2 / width) times 0 at the corner was NaN,
     with NumPy's "invalid value" / "overflow" warnings printed to the user."""

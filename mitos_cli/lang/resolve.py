@@ -163,8 +163,7 @@ def build_rulebase(parsed: ParsedFile, termsets: tuple[TermSet, ...],
         ops_mod.resolve(b.operators, base_ops)
         _check_behavior(b, variables, names, labels)
     rb = RuleBase(parsed.path, termsets, tuple(behaviors), parsed.operators, termset_paths)
-    for b in behaviors:
-        _check_cycles(rb, b.name, ())
+    _check_uses(rb)
     return rb
 
 
@@ -289,13 +288,61 @@ def _check_consequent(c: Consequent, variables: dict[str, Variable]) -> None:
                                 f"[{lo:g}, {hi:g}]", span=c.span)
 
 
-def _check_cycles(rb: RuleBase, name: str, stack: tuple[str, ...],
-                  span: Span | None = None) -> None:
-    """``span``: the ``use`` that led to ``name``; the one closing a cycle is reported (the
-    file's top level, ``main``, has no position of its own)."""
-    if name in stack:
-        cycle = " -> ".join(stack + (name,))
-        raise RuleBaseError(f"behaviors use each other in a cycle: {cycle}",
-                            span=span or rb.behavior(stack[0]).span)
-    for use in rb.behavior(name).uses:
-        _check_cycles(rb, use.behavior, stack + (name,), use.span)
+#: The longest chain of behaviors each using the next (a rule's conditions may nest 100 deep
+#: too): evaluation writes used behaviors out level by level.
+MAX_USE_DEPTH = 100
+#: The most rules a behavior may hold once the behaviors it uses are written out: each `use`
+#: writes the used behavior out again, so behaviors that use two others, which use the same
+#: two again, double at each level (18 levels: 262,143 rules, minutes and gigabytes).
+MAX_WRITTEN_RULES = 20_000
+
+
+def _check_uses(rb: RuleBase) -> None:
+    """Refuse, at the ``use`` that does it, behaviors that use each other in a cycle, a chain
+    of uses deeper than :data:`MAX_USE_DEPTH`, and a behavior of more than
+    :data:`MAX_WRITTEN_RULES` rules written out. One walk over the file's uses, each once
+    (the file's top level, ``main``, has no position of its own: a cycle is reported at the
+    ``use`` closing it)."""
+    done: dict[str, tuple[int, int]] = {}       # name -> (chain of uses below, rules written out)
+    for root in rb.behaviors:
+        if root.name in done:
+            continue
+        path, todo = [root.name], [iter(root.uses)]
+        while todo:
+            use = next(todo[-1], None)
+            if use is None:                      # every behavior it uses is done
+                done[path[-1]] = _written(rb.behavior(path[-1]), done)
+                path.pop()
+                todo.pop()
+            elif use.behavior in path:
+                cycle = " -> ".join(path[path.index(use.behavior):] + [use.behavior])
+                raise RuleBaseError(f"behaviors use each other in a cycle: {cycle}",
+                                    span=use.span)
+            elif use.behavior not in done:
+                path.append(use.behavior)
+                todo.append(iter(rb.behavior(use.behavior).uses))
+
+
+def _written(b: Behavior, done: dict[str, tuple[int, int]]) -> tuple[int, int]:
+    """``b``'s chain of uses and its rules written out, from those of the behaviors it uses
+    (``done``); refused, at its use that makes them, beyond the limits."""
+    depth, rules = 0, len(b.rules)
+    for use in b.uses:
+        below, written = done[use.behavior]
+        if below + 1 > MAX_USE_DEPTH:
+            raise RuleBaseError(f"behaviors use each other more than {MAX_USE_DEPTH} deep: "
+                                f"`{b.name}` uses `{use.behavior}`, which starts a chain of "
+                                f"{below} uses", span=use.span or b.span,
+                                hint="use the behaviors from fewer levels: a behavior may "
+                                     "use several others directly")
+        depth, rules = max(depth, below + 1), rules + written
+        if rules > MAX_WRITTEN_RULES:
+            raise RuleBaseError(f"behavior `{b.name}` would hold more than "
+                                f"{MAX_WRITTEN_RULES:,} rules once the behaviors it uses are "
+                                f"written out ({rules:,} with `{use.behavior}`)",
+                                span=use.span or b.span,
+                                hint="each `use` writes the used behavior's rules out again: "
+                                     "a behavior used from several places counts once for each")
+    return depth, rules
+
+
