@@ -220,6 +220,26 @@ def test_a_bad_formula_is_refused_at_its_column(formula, column, words):
     assert info.value.span.line == 4 and info.value.span.column == start + column - 1
 
 
+def test_a_long_formula_is_evaluated_and_a_deep_one_refused_at_its_column():
+    """A sum of 1,000 terms or a 100-deep nesting is read and evaluated (both ended in
+    RecursionError); one level more is refused at the first `(` past the limit."""
+    from mitos_cli.fuzzy.formula import MAX_NESTING, parse
+
+    x = np.linspace(0, 1, 5)
+    long = parse("x/10" + " + 0*x" * 1000 + " - x^2^1" * 1000)
+    assert np.array_equal(long(x), x / 10 - 1000 * x ** 2 ** 1)
+    assert parse("2^-x^3")(x) == pytest.approx(2.0 ** -(x ** 3))
+    deep = "(" * MAX_NESTING + "x" + ")" * MAX_NESTING
+    assert np.array_equal(parse(deep)(x), x)
+    for formula in ("(" + deep + ")", "-" * 1000 + "x", "abs(" * 400 + "x" + ")" * 400):
+        text = FUNCTION.replace("1 - 4 * (x - 0.5)^2", formula)
+        with pytest.raises(FormatError, match="nested more than 100 deep") as info:
+            parse_fll(text, "t.fll")
+        start = text.splitlines()[3].index(formula) + 1
+        step = 4 if formula.startswith("abs") else 1
+        assert info.value.span.line == 4 and info.value.span.column == start + 100 * step
+
+
 def test_a_formula_membership_outside_0_1_is_refused_at_evaluation():
     from mitos_cli.errors import InputError
 

@@ -6,6 +6,10 @@ on arrays of any shape. The language is fuzzylite's: ``+ - * / % ^ **``, unary `
 ``and`` / ``or``, the comparison functions ``gt ge eq neq le lt`` (1 or 0), ``min max pow
 atan2 fmod`` and the one-argument functions of :data:`FUNCTIONS`, ``pi``. A precedence-climbing
 parser (linear in the text) reports the column of what it could not read and what it expected.
+A run of operators of one precedence (``x/10 + 0*x + ...``, a long polynomial) is one n-ary
+node, parsed and evaluated in a loop, and the tree is evaluated without recursion; nesting
+(parentheses, function calls, unary operators) deeper than :data:`MAX_NESTING` is refused at
+its column, as the rule language refuses conditions nested too deep.
 Only ``x`` is a variable: a formula over other variables of an engine would make a term depend
 on values the membership layer does not see, so it is refused by name.
 """
@@ -56,7 +60,12 @@ UNARY_PRECEDENCE = 5          # -x^2 is -(x^2), as in fuzzylite and mathematics
 _TOKEN = re.compile(r"\s*(?:(?P<num>(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)|"
                     r"(?P<name>[A-Za-z_][A-Za-z_0-9]*)|(?P<op>\*\*|[-+*/%^(),~!]))")
 
-Node = tuple  # ("num", value) | ("x",) | ("un", op, node) | ("bin", op, a, b) | ("call", f, args)
+#: how deep parentheses, function calls and unary operators may nest: far beyond any readable
+#: formula, and shallow enough for the parser, which recurses once per level
+MAX_NESTING = 100
+
+Node = tuple  # ("num", value) | ("x",) | ("un", op, node) | ("call", f, args)
+#             | ("chain", first, ((op, node), ...)): operators of one precedence, in order
 
 
 @dataclass(frozen=True)
@@ -72,18 +81,57 @@ class Formula:
             return np.broadcast_to(_eval(self.tree, x), x.shape).astype(float)
 
 
-def _eval(node: Node, x: np.ndarray):
+def _children(node: Node) -> tuple[Node, ...]:
+    kind = node[0]
+    if kind == "un":
+        return (node[2],)
+    if kind == "chain":
+        return (node[1], *(operand for _, operand in node[2]))
+    if kind == "call":
+        return node[2]
+    return ()
+
+
+def _apply(node: Node, values: list, x: np.ndarray):
+    """``node``'s value from its children's ``values``: a chain folds from the left, or from
+    the right for a right-associative operator (``x^2^3`` is ``x^(2^3)``)."""
     kind = node[0]
     if kind == "num":
         return node[1]
     if kind == "x":
         return x
     if kind == "un":
-        return UNARY[node[1]](_eval(node[2], x))
-    if kind == "bin":
-        return BINARY[node[1]][2](_eval(node[2], x), _eval(node[3], x))
-    args = [_eval(a, x) for a in node[2]]
-    return (FUNCTIONS.get(node[1]) or FUNCTIONS2[node[1]])(*args)
+        return UNARY[node[1]](values[0])
+    if kind == "call":
+        return (FUNCTIONS.get(node[1]) or FUNCTIONS2[node[1]])(*values)
+    ops = [op for op, _ in node[2]]
+    if BINARY[ops[0]][1]:
+        acc = values[-1]
+        for op, left in zip(reversed(ops), reversed(values[:-1])):
+            acc = BINARY[op][2](left, acc)
+        return acc
+    acc = values[0]
+    for op, right in zip(ops, values[1:]):
+        acc = BINARY[op][2](acc, right)
+    return acc
+
+
+def _eval(tree: Node, x: np.ndarray):
+    """The tree's value, walked with a stack of its own (no recursion, whatever its depth)."""
+    stack: list[tuple[Node, bool]] = [(tree, False)]
+    values: list = []
+    while stack:
+        node, done = stack.pop()
+        children = _children(node)
+        if done or not children:
+            n = len(children)
+            args = values[len(values) - n:] if n else []
+            del values[len(values) - n:]
+            values.append(_apply(node, args, x))
+            continue
+        stack.append((node, True))
+        stack.extend((child, False) for child in reversed(children))
+    return values[0]
 
 
 class _Parser:
@@ -103,7 +151,7 @@ class _Parser:
             kind = m.lastgroup or "op"
             self.tokens.append((kind, m.group(kind), m.start(kind)))
             pos = m.end()
-        self.i = 0
+        self.i = self.depth = 0
 
     def fail(self, column: int, message: str, expected: str | None = None):
         span = self.span
@@ -129,21 +177,37 @@ class _Parser:
         return None
 
     def expression(self, min_prec: int = 0) -> Node:
+        """Operators binding at least ``min_prec``: each run of one precedence is one chain,
+        read in a loop, so a sum of a thousand terms costs no deeper recursion than one."""
         left = self.unary()
         while (op := self.binary_op()) is not None:
             prec, right_assoc, _ = BINARY[op]
             if prec < min_prec:
                 break
-            self.i += 1
-            right = self.expression(prec if right_assoc else prec + 1)
-            left = ("bin", op, left, right)
+            rest = []
+            while op is not None and BINARY[op][0] == prec:
+                self.i += 1
+                rest.append((op, self.expression(prec + 1)))
+                op = self.binary_op()
+            left = ("chain", left, tuple(rest))
         return left
+
+    def nest(self, col: int) -> None:
+        """One level deeper (a parenthesis, a function call, a unary operator) at ``col``."""
+        self.depth += 1
+        if self.depth > MAX_NESTING:
+            self.fail(col, f"the formula is nested more than {MAX_NESTING} deep "
+                           f"(parentheses, function calls and unary operators)",
+                      "a formula with fewer levels: drop doubled signs and parentheses")
 
     def unary(self) -> Node:
         tok = self.peek()
         if tok is not None and tok[0] == "op" and tok[1] in UNARY:
+            self.nest(tok[2])
             self.i += 1
-            return ("un", tok[1], self.expression(UNARY_PRECEDENCE))
+            node = ("un", tok[1], self.expression(UNARY_PRECEDENCE))
+            self.depth -= 1
+            return node
         return self.atom()
 
     def atom(self) -> Node:
@@ -157,8 +221,10 @@ class _Parser:
         if kind == "num":
             return ("num", float(value))
         if value == "(":
+            self.nest(col)
             inner = self.expression()
             self.take(")", "`)` closing the `(`")
+            self.depth -= 1
             return inner
         if kind != "name":
             self.i -= 1
@@ -176,11 +242,13 @@ class _Parser:
                            f"variable `x` may use only `x`, numbers, `pi` and functions)"
                       + (f"; {hint}" if hint else ""), None)
         self.take("(", f"`(` after the function `{value}`")
+        self.nest(col)
         args = [self.expression()]
         for _ in range(arity - 1):
             self.take(",", f"`,`: `{value}` takes {arity} arguments")
             args.append(self.expression())
         self.take(")", f"`)`: `{value}` takes {arity} argument{'s' if arity > 1 else ''}")
+        self.depth -= 1
         return ("call", value, tuple(args))
 
 
