@@ -44,7 +44,8 @@ from .model import RuleBase
 if TYPE_CHECKING:
     from lark import Lark
 
-_FORMAT = 3                  # raised when parsing changes (3: `very not` refused, `main` placed)
+_FORMAT = 4                  # raised when parsing changes (3: `very not` refused, `main` placed;
+                             # 4: a formula's operators of one precedence are one node)
 _TAG = 32                    # bytes of HMAC-SHA256 before every entry
 _KEY = "key"
 
