@@ -50,10 +50,16 @@ def nearby_name(path: str | Path, suffixes: tuple[str, ...] = RULE_SUFFIXES,
 
 def read_text(path: str | Path) -> str:
     """A file the user named, as text: UTF-8, with or without a byte-order mark (which is not
-    content). At most :data:`MAX_TEXT_BYTES` are read: a device (``/dev/zero``) would be read
-    without end, while a pipe (``--batch <(...)``) is a file a user may well name. Raises
-    ``OSError`` (with a ``strerror`` to show) or ``UnicodeDecodeError``, as
-    ``Path.read_text`` does."""
+    content), read as :func:`read_bytes` reads it. Raises ``OSError`` (with a ``strerror`` to
+    show) or ``UnicodeDecodeError``, as ``Path.read_text`` does."""
+    return read_bytes(path).decode("utf-8-sig")
+
+
+def read_bytes(path: str | Path) -> bytes:
+    """A file the user named, opened once: a pipe (``--batch <(...)``, a named pipe) is a file
+    a user may well name, and it can be read only once. At most :data:`MAX_TEXT_BYTES` are
+    read: a device (``/dev/zero``) would be read without end. Raises ``OSError`` (with a
+    ``strerror`` to show)."""
     path = Path(path)
     if _special(path) and path.is_dir():
         raise OSError(errno.EISDIR, "it is a directory", str(path))
@@ -61,7 +67,7 @@ def read_text(path: str | Path) -> str:
         data = fh.read(MAX_TEXT_BYTES + 1)
     if len(data) > MAX_TEXT_BYTES:
         raise OSError(errno.EFBIG, f"it is larger than {MAX_TEXT_BYTES >> 20} MB", str(path))
-    return data.decode("utf-8-sig")
+    return data
 
 
 def _special(path: Path) -> bool:

@@ -32,6 +32,52 @@ def test_eval_accepts_each_format() -> None:
     assert "tip = 7.0169" in result.stdout
 
 
+def _through_a_pipe(tmp_path: Path, name: str, data: bytes, args: list[str]):
+    """``mitos eval`` on a named pipe a child process writes ``data`` into; stopped by an
+    alarm if the command waits for it."""
+    import os
+    import signal
+
+    fifo = tmp_path / name
+    os.mkfifo(fifo)
+    pid = os.fork()
+    if pid == 0:                                   # the writer: `cat tipper.fis > pipe.fis &`
+        try:
+            with open(fifo, "wb") as fh:
+                fh.write(data)
+        finally:
+            os._exit(0)
+
+    def hung(*_):
+        raise TimeoutError("the command waits for the pipe")
+
+    old = signal.signal(signal.SIGALRM, hung)
+    signal.alarm(20)
+    try:
+        return runner.invoke(app, ["eval", str(fifo), *args])
+    finally:
+        signal.alarm(0)
+        signal.signal(signal.SIGALRM, old)
+        os.kill(pid, signal.SIGKILL)
+        os.waitpid(pid, 0)
+
+
+def test_a_foreign_file_that_is_a_named_pipe_is_read_once(tmp_path: Path) -> None:
+    """Each reader opened the file twice (a probe, then the read): the probe took the
+    writer's data, and the second open waited for a writer that was gone."""
+    result = _through_a_pipe(tmp_path, "tipper.fis", (DATA / "tipper.fis").read_bytes(),
+                             ["service=2", "food=1"])
+    assert result.exit_code == 0 and "tip = 7.0" in result.stdout, result.output
+    fll = write_foreign(read_rulebase(DATA / "tipper.fis"), "fll").encode()
+    result = _through_a_pipe(tmp_path, "tipper.fll", fll, ["service=2", "food=1"])
+    assert result.exit_code == 0 and "tip = 7.0" in result.stdout, result.output
+    legacy = b"// Temp\xe9rature\n" + (DATA / "tipper_jfuzzylogic.fcl").read_bytes()
+    result = _through_a_pipe(tmp_path, "legacy.fcl", legacy, ["service=3", "food=8"])
+    assert result.exit_code == 0 and "Windows-1252" in result.output, result.output
+    result = _through_a_pipe(tmp_path, "bom.fcl", b"\xef\xbb\xbf\xe9" + legacy, ["food=8"])
+    assert result.exit_code == 1 and "byte-order mark" in str(result.exception), result.output
+
+
 def test_convert_to_each_format_and_back(tmp_path: Path) -> None:
     source = ROOT / "rulebases" / "mitos.rules"
     for fmt in ("fcl", "fll", "fis"):

@@ -12,10 +12,8 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
-from ..errors import FormatError, MitosError, RuleBaseError
-from ..fileio import unreadable
+from ..errors import FormatError, MitosError
 from ..lang.model import RuleBase
-from ..lang.resolve import rule_file_hint
 
 READERS = {".fcl": "fcl", ".fis": "fis", ".fll": "fll"}
 FORMATS = ("fcl", "fis", "fll")
@@ -28,12 +26,7 @@ def read_foreign(path: str | Path) -> RuleBase:
     if kind is None:
         raise FormatError(f"`{path}`: unknown format `{path.suffix}`",
                           expected="a .fcl, .fis or .fll file")
-    try:
-        path.open("rb").close()
-    except OSError as exc:
-        raise RuleBaseError(unreadable("rule file", path, exc),
-                            hint=rule_file_hint(path)) from None
-    if kind == "fll":
+    if kind == "fll":             # (each reader opens the file once: it may be a pipe)
         from .fll import read_fll
 
         return read_fll(path)
@@ -70,8 +63,11 @@ def reader_of(path: str | Path) -> str:
 def looks_like(path: str | Path, head: int = 4096) -> tuple[str, str, int] | None:
     """The format ``path``'s first statement belongs to (``[System]``: fis; ``FUNCTION_BLOCK``:
     fcl; ``Engine:``: fll; ``terms "..."``: rules), with that statement and its line; ``None``
-    when none does or the file cannot be read."""
+    when none does or the file cannot be read. Only a regular file is opened again: a named
+    pipe, read already, would wait for a writer that is gone."""
     try:
+        if not Path(path).is_file():
+            return None
         with open(path, encoding="utf-8", errors="replace") as f:
             text = f.read(head)
     except OSError:

@@ -17,10 +17,11 @@ import re
 from collections.abc import Callable
 from pathlib import Path
 
-from ..errors import FormatError
+from ..errors import FormatError, RuleBaseError
 from ..fileio import byte_span as _at
-from ..fileio import read_text, unreadable
+from ..fileio import read_bytes, unreadable
 from ..lang.model import RuleBase
+from ..lang.resolve import rule_file_hint
 
 #: The encoding a file that is not UTF-8 is read in: what MATLAB and Java write on Windows.
 LEGACY = "cp1252"
@@ -34,20 +35,22 @@ def read_foreign_file(path: Path, parse: Callable[[str, str], RuleBase]) -> Rule
 
 
 def foreign_text(path: Path) -> tuple[str, str | None]:
-    """``path``'s text, and a note when it was read as Windows-1252 (``None`` for UTF-8)."""
+    """``path``'s text, and a note when it was read as Windows-1252 (``None`` for UTF-8). The
+    file is opened once: a second open of a named pipe waits for a writer that is gone."""
     try:
-        text = read_text(path)
-    except UnicodeDecodeError as exc:
-        not_utf8 = exc
+        raw = read_bytes(path)
     except OSError as exc:
-        raise FormatError(unreadable("rule file", path, exc)) from None
-    else:
-        if "\0" in text:          # valid UTF-8, yet no text a fuzzy-logic tool writes
-            raise _nul(path, text.encode("utf-8"))
-        return text, None
-    return _legacy(path, not_utf8), (
-        f"`{path.name}` is not UTF-8 ({_byte(path, not_utf8.object, not_utf8.start)}): read "
-        "as Windows-1252, the encoding MATLAB and Java write on Windows")
+        raise RuleBaseError(unreadable("rule file", path, exc),
+                            hint=rule_file_hint(path)) from None
+    try:
+        text = raw.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        return _legacy(path, raw[:4], exc), (
+            f"`{path.name}` is not UTF-8 ({_byte(path, exc.object, exc.start)}): read "
+            "as Windows-1252, the encoding MATLAB and Java write on Windows")
+    if "\0" in text:          # valid UTF-8, yet no text a fuzzy-logic tool writes
+        raise _nul(path, text.encode("utf-8"))
+    return text, None
 
 
 #: A character of two to four bytes, written as UTF-8 writes it.
@@ -55,16 +58,12 @@ _MULTIBYTE = re.compile(rb"[\xc2-\xdf][\x80-\xbf]|[\xe0-\xef][\x80-\xbf]{2}|"
                         rb"[\xf0-\xf4][\x80-\xbf]{3}")
 
 
-def _legacy(path: Path, exc: UnicodeDecodeError) -> str:
-    """The text of ``path``, not UTF-8 (``exc``), as Windows-1252, or why it is not that
-    either: another Unicode encoding, a NUL, a file that is UTF-8 elsewhere (read as
-    Windows-1252, its UTF-8 would be garbled), a byte Windows-1252 leaves undefined."""
-    data: bytes = exc.object            # (without a UTF-8 byte-order mark: read_text drops it)
-    try:
-        with open(path, "rb") as fh:
-            head = fh.read(4)
-    except OSError:                     # (a pipe, read already)
-        head = data[:4]
+def _legacy(path: Path, head: bytes, exc: UnicodeDecodeError) -> str:
+    """The text of ``path``, not UTF-8 (``exc``; ``head`` is its first bytes), as
+    Windows-1252, or why it is not that either: another Unicode encoding, a NUL, a file that
+    is UTF-8 elsewhere (read as Windows-1252, its UTF-8 would be garbled), a byte Windows-1252
+    leaves undefined."""
+    data: bytes = exc.object            # (without a UTF-8 byte-order mark: the decoder drops it)
     for bom, name in ((codecs.BOM_UTF32_LE, "UTF-32"), (codecs.BOM_UTF32_BE, "UTF-32"),
                       (codecs.BOM_UTF16_LE, "UTF-16"), (codecs.BOM_UTF16_BE, "UTF-16")):
         if head.startswith(bom):
