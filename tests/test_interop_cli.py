@@ -114,6 +114,36 @@ def test_convert_to_rules_writes_both_files(tmp_path: Path, monkeypatch) -> None
     assert not list(tmp_path.glob("**/.*.tmp")), "temporary files left behind"
 
 
+@pytest.mark.parametrize("old, new, line", [
+    ("MF1='rancid':'trapmf',[0 0 1 3]", "MF1='rancid':'trapmf',[-5 -4 -3 -2]", 26),
+    ("MF1='cheap':'trimf',[0 5 10]", "MF1='cheap':'trimf',[40 45 50]", 33),
+])
+def test_convert_to_rules_refuses_a_term_outside_its_range_before_writing(
+        old, new, line, tmp_path: Path, monkeypatch) -> None:
+    """MATLAB accepts a term whose core lies outside its range, a term set does not: the
+    conversion wrote both files, then refused them at the term set it had written."""
+    monkeypatch.chdir(tmp_path)
+    text = (DATA / "tipper.fis").read_text()
+    assert old in text
+    (tmp_path / "out.fis").write_text(text.replace(old, new))
+    result = runner.invoke(app, ["convert", "out.fis", "--to", "rules", "-o", "out.rules"])
+    assert result.exit_code == 1
+    span = result.exception.span
+    assert (span.path, span.line) == ("out.fis", line), result.exception
+    assert "needs a term's core (an output term's peak) inside" in result.exception.message
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out.fis"]
+
+
+def test_convert_to_rules_writes_nothing_it_cannot_read_back(tmp_path: Path, monkeypatch) -> None:
+    import mitos_cli.interop.rules_writer as writer
+
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setattr(writer, "write_rules", lambda *a: ('terms "t.terms.yaml"\nr1 if\n', "{}"))
+    result = runner.invoke(app, ["convert", str(DATA / "tipper.fis"), "--to", "rules"])
+    assert result.exit_code == 1 and "nothing was written" in result.exception.hint
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_convert_refuses_to_overwrite_its_input(tmp_path: Path) -> None:
     src = tmp_path / "x.fll"
     src.write_text(write_foreign(read_rulebase(DATA / "tipper.fis"), "fll"))

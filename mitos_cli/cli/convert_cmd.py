@@ -80,9 +80,10 @@ def convert_command(
         rules_text, terms_text = write_rules(rb, terms_path.name, behavior, path.name)
         for note in conversion_notes(rb, "rules", behavior):
             warn(note)
+        back = _read_back(rules_text, terms_text, rules_path, terms_path)
         atomic_write(terms_path, terms_text)
         atomic_write(rules_path, rules_text)
-        for note in round_trip_difference(rb, read_rulebase(rules_path), "rules", behavior):
+        for note in round_trip_difference(rb, back, "rules", behavior):
             warn(note)
         err(f"wrote {rules_path} and {terms_path}")
         return
@@ -99,3 +100,23 @@ def convert_command(
     else:
         atomic_write(output, text)
         err(f"wrote {output}")
+
+
+def _read_back(rules_text: str, terms_text: str, rules_path: Path, terms_path: Path):
+    """The rule base the two files will hold, read before they are written: a conversion
+    no command could read is refused with nothing written (it used to be written, then
+    refused inside MITOS's own output)."""
+    from ..errors import MitosError
+    from ..lang.parse import parse_rules
+    from ..lang.resolve import build_rulebase
+    from ..lang.termfile import parse_termset
+
+    try:
+        parsed = parse_rules(rules_text, str(rules_path))
+        return build_rulebase(parsed, (parse_termset(terms_text, str(terms_path)),),
+                              (terms_path.name,))
+    except MitosError as exc:
+        exc.hint = ("nothing was written: this is what the conversion would have written, "
+                    "which MITOS cannot read back (a defect of `mitos convert`; please report "
+                    "it with the source file)")
+        raise

@@ -32,6 +32,22 @@ def check_name(name: str, what: str) -> None:
                           hint="rename it in the source file (letters, digits, `_` and `-`)")
 
 
+def check_readable(v: Variable, t: Term) -> None:
+    """Refuse, at the source file's term, a term its format accepts but a term set refuses: a
+    core (or an output's peak) outside the variable's range, which MATLAB and fuzzylite allow.
+    Written as it is, the converted files could not be read back by any command."""
+    from ..errors import TermSetError
+    from ..lang.terms import check_term
+
+    try:
+        check_term(t, v.universe, v.name, peak_inside=v.role == "output")
+    except TermSetError as exc:
+        raise FormatError(f"{exc.message}: the rule language needs a term's core (an output "
+                          f"term's peak) inside its variable's range", span=t.span,
+                          hint="move the term inside the range, or widen the range, in the "
+                               "source file") from None
+
+
 def write_rules(rb: RuleBase, termset_name: str, behavior: str | None = None,
                 source: str = "") -> tuple[str, str]:
     """``(rules text, term-set YAML text)``; the rules file names ``termset_name``.
@@ -71,6 +87,7 @@ def write_rules(rb: RuleBase, termset_name: str, behavior: str | None = None,
         check_name(v.name, "variable")
         for t in v.terms:
             check_name(t.name, f"term of `{v.name}`")
+            check_readable(v, t)
     head = [f"# {name}: written by `mitos convert`" + (f" from {source}" if source else ""),
             "", f"terms {_quote(termset_name)}"]
     file_settings = resolve(rb.operators).settings()
