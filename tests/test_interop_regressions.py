@@ -374,6 +374,22 @@ def test_fis_non_finite_and_extreme_numbers_are_refused(old, new, words):
     assert words in info.value.message and info.value.span is not None
 
 
+def test_a_bad_default_is_refused_at_its_own_line():
+    """The default's line, not the variable's header (`OutputVariable: y`, `DEFUZZIFY tip`)."""
+    fll = FLL_HEDGE_PREFIX.replace("default: nan", "default: 1000")
+    fis = TIPPER_FIS.replace("Range=[0 30]", "Range=[0 30]\nDefault=40")
+    fcl = (Path(__file__).parent / "data" / "interop" / "tipper_jfuzzylogic.fcl").read_text()
+    assert "DEFAULT := 0;" in fcl
+    for parse, text, line in (
+            (parse_fll, fll, fll.splitlines().index("  default: 1000") + 1),
+            (parse_fis, fis, fis.splitlines().index("Default=40") + 1),
+            (parse_fcl, fcl.replace("DEFAULT := 0;", "DEFAULT := 1e200;"),
+             next(i + 1 for i, t in enumerate(fcl.splitlines()) if "DEFAULT := 0;" in t))):
+        with pytest.raises(MitosError, match="default") as info:
+            parse(text, "f")
+        assert info.value.span.line == line, info.value
+
+
 def test_fis_section_numbers_too_long_for_int_are_refused():
     with pytest.raises(MitosError, match="unknown section"):
         parse_fis(TIPPER_FIS.replace("[Input1]", "[Input" + "9" * 5000 + "]"), "tipper.fis")

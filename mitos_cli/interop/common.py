@@ -446,12 +446,17 @@ def resolution(value: float, text: str, span: Span) -> int:
     return int(value)
 
 
-def check_numbers(variables: list[Variable], range_spans: dict[str, Span] | None = None) -> None:
+#: where a reader found each variable's range and default: ``(variable, "range" | "default")``
+Places = dict[tuple[str, str], Span]
+
+
+def check_numbers(variables: list[Variable], places: Places | None = None) -> None:
     """Refuse, with the position, what floating point cannot evaluate: NaN or infinite
     parameters (but a shoulder's open end), ranges and defaults, numbers beyond
     :data:`LARGEST`, and a default outside its output's range. So no NaN or infinity leaves
-    the engine unless the file asked for one (``default: nan``). ``range_spans``: where each
-    variable's range is written (else the variable is named)."""
+    the engine unless the file asked for one (``default: nan``). ``places``: where each
+    variable's range and default are written (else the variable is named)."""
+    places = places or {}
     for v in variables:
         lo, hi = v.universe
         open_range = (lo, hi) == (-math.inf, math.inf) and v.role == "output" and all(
@@ -459,7 +464,7 @@ def check_numbers(variables: list[Variable], range_spans: dict[str, Span] | None
         if not open_range:
             for end in (lo, hi):
                 _finite(end, f"variable `{v.name}`: the range",
-                        (range_spans or {}).get(v.name, v.span))
+                        places.get((v.name, "range"), v.span))
         for t in v.terms:
             allowed = INFINITE_OK.get(t.shape, set())
             for i, p in enumerate(t.params):
@@ -468,10 +473,11 @@ def check_numbers(variables: list[Variable], range_spans: dict[str, Span] | None
                 _finite(p, f"term `{v.name}.{t.name}`: parameter {i + 1}", t.span or v.span)
         d = v.default
         if d is not None and d == d:
-            _finite(d, f"output `{v.name}`: the default", v.span)
+            at = places.get((v.name, "default"), v.span)
+            _finite(d, f"output `{v.name}`: the default", at)
             if not open_range and not lo <= d <= hi:
                 raise FormatError(f"output `{v.name}`: the default {d:g} lies outside its "
-                                  f"range [{lo:g}, {hi:g}]", span=v.span,
+                                  f"range [{lo:g}, {hi:g}]", span=at,
                                   hint="give a default inside the range, or nan for none")
 
 
@@ -494,21 +500,21 @@ def check_implication(name: str, span: Span | None) -> str:
 def assemble(path: str | None, variables: list[Variable], rules: list[Rule], settings: Settings,
              default_resolution: int, span: Span | None = None,
              notes: list[str] | None = None,
-             range_spans: dict[str, Span] | None = None) -> RuleBase:
+             places: Places | None = None) -> RuleBase:
     """Check what a reader gathered and return the rule base (one behavior, ``main``)."""
     return assemble_blocks(path, variables, [(MAIN, rules, settings)], default_resolution, span,
-                           notes, range_spans)
+                           notes, places)
 
 
 def assemble_blocks(path: str | None, variables: list[Variable],
                     blocks: list[tuple[str, list[Rule], Settings]], default_resolution: int,
                     span: Span | None = None, notes: list[str] | None = None,
-                    range_spans: dict[str, Span] | None = None) -> RuleBase:
+                    places: Places | None = None) -> RuleBase:
     """The rule base of one or more rule blocks: one block gives behavior ``main`` with the
     operators on the file; several (whose operators differ) give one behavior each, with its
     own operators, the first being the default. Chained outputs are restated first
-    (:func:`.rewrite.unchain`), with a line in ``notes``; ``range_spans``: where each
-    variable's range is written."""
+    (:func:`.rewrite.unchain`), with a line in ``notes``; ``places``: where each
+    variable's range and default are written."""
     counts = Counter(v.name for v in variables)     # a count per variable was N^2
     for v in variables:
         if counts[v.name] > 1:
@@ -517,7 +523,7 @@ def assemble_blocks(path: str | None, variables: list[Variable],
         raise FormatError("the file defines no input variable", span=span)
     if not any(rules for _, rules, _ in blocks):
         raise FormatError("the file has no rules", span=span)
-    check_numbers(variables, range_spans)
+    check_numbers(variables, places)
     by_name = {v.name: v for v in variables}
     behaviors = []
     outputs = {v.name for v in variables if v.role == "output"}

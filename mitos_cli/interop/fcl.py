@@ -209,7 +209,7 @@ def _function_block(fb: Tree, span_of) -> RuleBase:
     locks: dict[str, Span] = {}
     constants: list[tuple[str, Term]] = []
     variables = {}
-    ranges: dict[str, Span] = {}                     # where each RANGE is written
+    ranges: common.Places = {}                        # where each RANGE and DEFAULT is written
     for node in fuzzify + defuzzify:
         role = "input" if node.data == "fuzzify" else "output"
         record = records.setdefault(str(node.children[0]), common.Record())
@@ -300,7 +300,7 @@ def _tsukamoto(record: common.Record, v: Variable, notes: list[str]) -> None:
 
 def _variable(node: Tree, role: Role, declared, settings: common.Record, locks: dict,
               constants: list, n_inputs: int, span_of, notes: list[str],
-              ranges: dict[str, Span] | None = None) -> Variable:
+              ranges: common.Places | None = None) -> Variable:
     name_token = node.children[0]
     name = str(name_token)
     if name not in declared:
@@ -325,7 +325,7 @@ def _variable(node: Tree, role: Role, declared, settings: common.Record, locks: 
             universe = (_num(item.children[0]), _num(item.children[1]))
             common.check_range(*universe, span_of(item), "RANGE")
             if ranges is not None:
-                ranges[name] = span_of(item)
+                ranges[name, "range"] = span_of(item)
         elif kind == "option":
             key = str(item.children[0]).upper()
             if role == "input":
@@ -349,6 +349,8 @@ def _variable(node: Tree, role: Role, declared, settings: common.Record, locks: 
                                       hint="give a number: `DEFAULT := value;`")
                 raise FormatError(f"DEFAULT must be a number, not `{value}`", span=span_of(value))
             default = _num(value)              # nan: NaN when no rule fires, as asked
+            if ranges is not None:
+                ranges[name, "default"] = span_of(item)
         elif kind == "lock_item":
             for word in item.children:
                 w = str(word).upper()

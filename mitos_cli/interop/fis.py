@@ -174,7 +174,7 @@ def parse_fis(text: str, path: str | None = None) -> RuleBase:
         settings.set("sampling", "endpoints", None, "sampling")
 
     notes: list[str] = []
-    ranges: dict[str, Span] = {}
+    ranges: common.Places = {}
     inputs = _variables(sections, "Input", "input", kind, notes, 0, ranges)
     n_inputs = len(inputs)
     outputs = _variables(sections, "Output", "output", kind, notes, n_inputs, ranges)
@@ -225,9 +225,9 @@ def _check_count(system: dict, key: str, found: int, span: Span) -> None:
 
 
 def _variables(sections, prefix: str, role: Role, kind: str, notes: list[str],
-               n_inputs: int = 0, ranges: dict[str, Span] | None = None) -> list[Variable]:
+               n_inputs: int = 0, ranges: common.Places | None = None) -> list[Variable]:
     """The ``[PrefixN]`` sections' variables, in order; ``ranges``: gets where each one's
-    range is written."""
+    range (and fuzzylite's ``Default``) is written."""
     found = [(int(name[len(prefix):]), span, items) for name, span, items in sections
              if re.fullmatch(prefix + r"\d{1,9}", name)]
     found.sort(key=lambda f: f[0])
@@ -239,7 +239,7 @@ def _variables(sections, prefix: str, role: Role, kind: str, notes: list[str],
 
 
 def _variable(span: Span, items, role: Role, kind: str, n_inputs: int,
-              notes: list[str], ranges: dict[str, Span] | None = None) -> Variable:
+              notes: list[str], ranges: common.Places | None = None) -> Variable:
     values = {}
     terms: list[Term] = []
     for key, value, kspan, vspan in items:
@@ -274,7 +274,7 @@ def _variable(span: Span, items, role: Role, kind: str, n_inputs: int,
         raise FormatError("`Range` must be [min max] with min < max", span=values["Range"][1])
     common.check_range(rng[0], rng[1], values["Range"][1], "Range")
     if ranges is not None:
-        ranges[name] = values["Range"][1]
+        ranges[name, "range"] = values["Range"][1]
     if "NumMFs" in values and common.number(*values["NumMFs"]) != len(terms):
         raise FormatError(f"NumMFs={values['NumMFs'][0]} but the variable has {len(terms)} MFs",
                           span=values["NumMFs"][1])
@@ -283,6 +283,8 @@ def _variable(span: Span, items, role: Role, kind: str, n_inputs: int,
     default = (rng[0] + rng[1]) / 2 if role == "output" else None     # MATLAB's choice
     if "Default" in values:                      # fuzzylite's: nan when the file says so
         default = common.number(*values["Default"])
+        if ranges is not None:
+            ranges[name, "default"] = values["Default"][1]
     try:
         return Variable(name, role, (rng[0], rng[1]), tuple(terms), "", "", default,
                         values["Name"][1])

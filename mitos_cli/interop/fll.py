@@ -73,6 +73,7 @@ class _Var:
     span: Span
     range: tuple[float, float] | None = None
     range_span: Span | None = None      # where the range is written
+    default_span: Span | None = None    # where the default is written
     terms: list = field(default_factory=list)          # (name, kind, values, span)
     default: float | None = None
     description: str = ""
@@ -208,8 +209,11 @@ def parse_fll(text: str, path: str | None = None) -> RuleBase:
         mine = [v for v in variables if v.role == "input" or v.name in concluded or
                 len(groups) == 1]
         _check_outputs(mine, rules, settings)
+    places: common.Places = {(v.name, what): at for v in variables
+                             for what, at in (("range", v.range_span), ("default", v.default_span))
+                             if at is not None}
     rb = common.assemble_blocks(path, built, groups, DEFAULT_RESOLUTION, engine_span, notes,
-                                {v.name: v.range_span for v in variables if v.range_span})
+                                places)
     return dataclasses.replace(rb, notes=tuple(notes))
 
 
@@ -270,6 +274,7 @@ def _variable_key(v: _Var, key: str, value: str, span: Span, vspan: Span,
                               span=vspan, hint="set `default:` to the value to use instead")
     elif key == "default":
         v.default = common.number(value, vspan)     # nan: NaN when no rule fires, as asked
+        v.default_span = vspan
     elif key in ("aggregation", "accumulation"):
         if value != "none":
             settings.set("aggregation", common.table_lookup(common.SNORMS, FLL, value,
