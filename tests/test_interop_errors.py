@@ -243,6 +243,28 @@ def test_fis_sugeno_linear_count_and_missing_system() -> None:
 
 FCL = (Path(__file__).parent / "data" / "interop" / "tipper_jfuzzylogic.fcl").read_text()
 
+
+def test_a_name_defined_twice_is_reported_at_the_second_definition() -> None:
+    """As the rule language does (`behavior `a` is defined twice (first at line 2)`): the
+    first definition is the correct one; the second is what to look at."""
+    cases = [
+        (parse_fis, FIS.replace("Name='food'", "Name='service'"), "Name='service'", 2,
+         "variable `service` is defined twice (first at line 15)"),
+        (parse_fll, FLL + "InputVariable: b\n  range: 0 1\n  term: x Ramp 0 1\n",
+         "InputVariable: b", 2, "variable `b` is defined twice (first at line "),
+        (parse_fcl, FCL.replace("TERM good := (1, 0)", "TERM poor := (1, 0)"), "TERM poor", 2,
+         "variable `service`: duplicate term `poor` (first at line "),
+        (parse_fcl, FCL.replace("\tfood : REAL;", "\tfood : REAL;\n\tfood : REAL;"),
+         "\tfood : REAL;", 2, "variable `food` is declared twice (first at line "),
+    ]
+    for parse, text, needle, nth, words in cases:
+        with pytest.raises(FormatError) as info:
+            parse(text, "twice")
+        lines = [i for i, line in enumerate(text.splitlines(), 1) if needle in line]
+        first = lines[0]
+        assert info.value.message.startswith(words) and f"line {first})" in info.value.message
+        assert info.value.span.line == lines[nth - 1], (info.value.render(), lines)
+
 FCL_CASES = [
     ("END_FUNCTION_BLOCK", "END_FUNCTION_BLOCK\nFUNCTION_BLOCK two\nEND_FUNCTION_BLOCK",
      "the file has 2 function blocks"),

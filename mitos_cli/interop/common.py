@@ -11,7 +11,6 @@ other direction. Anything a format names that MITOS cannot compute exactly is re
 from __future__ import annotations
 
 import math
-from collections import Counter
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -23,7 +22,7 @@ from ..fuzzy.shapes import SHAPES, TSUKAMOTO
 from ..lang import operators as ops_mod
 from ..lang.model import And, Behavior, Consequent, Expr, Not, Or, Prop, Rule, RuleBase, Setting
 from ..lang.resolve import MAIN, check_rule
-from ..lang.terms import Term, TermSet, Variable, universe_problem
+from ..lang.terms import Term, TermSet, Variable, first_at, universe_problem
 from ..numbers import parse_number
 from ..words import plural
 from . import rewrite
@@ -515,10 +514,11 @@ def assemble_blocks(path: str | None, variables: list[Variable],
     own operators, the first being the default. Chained outputs are restated first
     (:func:`.rewrite.unchain`), with a line in ``notes``; ``places``: where each
     variable's range and default are written."""
-    counts = Counter(v.name for v in variables)     # a count per variable was N^2
-    for v in variables:
-        if counts[v.name] > 1:
-            raise FormatError(f"variable `{v.name}` is defined twice", span=v.span)
+    first: dict[str, Variable] = {}
+    for v in variables:                             # at the second definition, as rules do
+        if first.setdefault(v.name, v) is not v:
+            raise FormatError(f"variable `{v.name}` is defined twice"
+                              + first_at(first[v.name].span), span=v.span)
     if not any(v.role == "input" for v in variables):
         raise FormatError("the file defines no input variable", span=span)
     if not any(rules for _, rules, _ in blocks):

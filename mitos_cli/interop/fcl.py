@@ -45,7 +45,7 @@ from ..lang.bulk import without_cyclic_gc
 from ..lang.cache import lark_parser
 from ..lang.model import And, Expr, Not, Or, Prop, Rule, RuleBase
 from ..lang.resolve import MAIN
-from ..lang.terms import Role, Term, Variable
+from ..lang.terms import Role, Term, Variable, first_at
 from ..words import plural
 from . import common
 from .common import FCL, FLL, fmt_number
@@ -191,7 +191,8 @@ def _function_block(fb: Tree, span_of) -> RuleBase:
                 name, typ, rng, after = decl.children
                 rng = rng if rng is not None else after
                 if str(name) in declared:
-                    raise FormatError(f"variable `{name}` is declared twice", span=span_of(name))
+                    raise FormatError(f"variable `{name}` is declared twice"
+                                      + first_at(declared[str(name)][1]), span=span_of(name))
                 if str(typ).upper() != "REAL":
                     raise FormatError(f"variable `{name}`: type `{typ}` is not supported",
                                       span=span_of(typ), expected="REAL")
@@ -208,7 +209,7 @@ def _function_block(fb: Tree, span_of) -> RuleBase:
     notes: list[str] = []
     locks: dict[str, Span] = {}
     constants: list[tuple[str, Term]] = []
-    variables = {}
+    variables: dict[str, Variable] = {}
     ranges: common.Places = {}                        # where each RANGE and DEFAULT is written
     for node in fuzzify + defuzzify:
         role = "input" if node.data == "fuzzify" else "output"
@@ -216,7 +217,8 @@ def _function_block(fb: Tree, span_of) -> RuleBase:
         v = _variable(node, role, declared, record, locks, constants, n_inputs, span_of, notes,
                       ranges)
         if v.name in variables:
-            raise FormatError(f"variable `{v.name}` is defined twice", span=v.span)
+            raise FormatError(f"variable `{v.name}` is defined twice"
+                              + first_at(variables[v.name].span), span=v.span)
         variables[v.name] = v
     for name, (role, span, _) in declared.items():
         if name not in variables:
@@ -374,8 +376,9 @@ def _variable(node: Tree, role: Role, declared, settings: common.Record, locks: 
                           span=span_of(node))
     try:
         return Variable(name, role, (lo, hi), tuple(terms), "", "", default, span_of(name_token))
-    except Exception as exc:
-        raise FormatError(getattr(exc, "message", str(exc)), span=span_of(node)) from None
+    except Exception as exc:                     # duplicate terms: TermSetError with a span
+        raise FormatError(getattr(exc, "message", str(exc)),
+                          span=getattr(exc, "span", None) or span_of(node)) from None
 
 
 #: Where jFuzzyLogic's ``estimateUniverse`` puts the ends of a term with unbounded support,

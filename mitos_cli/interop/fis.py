@@ -288,8 +288,9 @@ def _variable(span: Span, items, role: Role, kind: str, n_inputs: int,
     try:
         return Variable(name, role, (rng[0], rng[1]), tuple(terms), "", "", default,
                         values["Name"][1])
-    except Exception as exc:
-        raise FormatError(getattr(exc, "message", str(exc)), span=span) from None
+    except Exception as exc:                     # duplicate terms: TermSetError with a span
+        raise FormatError(getattr(exc, "message", str(exc)),
+                          span=getattr(exc, "span", None) or span) from None
 
 
 def _mf(value: str, vspan: Span, role: str, kind: str, n_inputs: int) -> Term:

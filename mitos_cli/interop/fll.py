@@ -359,7 +359,8 @@ def _build_variable(v: _Var, inputs: list[str], notes: list[str]) -> Variable:
         return Variable(v.name, v.role, universe, tuple(terms), v.description, "", v.default,
                         v.span)
     except Exception as exc:                     # duplicate terms: TermSetError with a span
-        raise FormatError(getattr(exc, "message", str(exc)), span=v.span) from None
+        raise FormatError(getattr(exc, "message", str(exc)),
+                          span=getattr(exc, "span", None) or v.span) from None
 
 
 def _rule(value: str, text: str, path: str | None, lineno: int, vcol: int,

@@ -91,6 +91,12 @@ class Term:
         return replace(self, params=tuple(float(p) for p in params))
 
 
+def first_at(span: Span | None) -> str:
+    """`` (first at line N)``, said of a name given twice, at the second; empty without a
+    position."""
+    return f" (first at line {span.line})" if span is not None else ""
+
+
 @dataclass(frozen=True)
 class Variable:
     """A linguistic variable: x1 road width, y1 steering, ..."""
@@ -110,12 +116,12 @@ class Variable:
         if problem:
             raise TermSetError(f"variable `{self.name}`: {problem[0]}", span=self.span,
                                hint=problem[1])
-        seen: set[str] = set()
+        seen: dict[str, Term] = {}
         for term in self.terms:
-            if term.name in seen:
-                raise TermSetError(f"variable `{self.name}`: duplicate term `{term.name}`",
-                                   span=term.span)
-            seen.add(term.name)
+            first = seen.setdefault(term.name, term)
+            if first is not term:
+                raise TermSetError(f"variable `{self.name}`: duplicate term `{term.name}`"
+                                   + first_at(first.span), span=term.span)
 
     @property
     def term_names(self) -> tuple[str, ...]:
