@@ -542,10 +542,32 @@ def test_cli_user_errors_exit_1(capsys, args, message):
     (["check", "--threshold", "-1"], "--threshold"),
     (["check", "--resolution", "1"], "--resolution"),
     (["frobnicate"], "No such command"),
+    # a single-value option given twice: Click kept the last without a word
+    (["eval", "-b", "drive", "-b", "avoid_obstacle", "road=78"], "'-b' is given twice"),
+    (["eval", "--behavior=drive", "-bavoid_obstacle", "road=78"], "'-b' is given twice"),
+    (["convert", "rulebases/mitos.rules", "--to", "fll", "--to", "fis"], "'--to' is given twice"),
+    (["plot", "surface", "steering", "--x", "road", "--x", "size"], "'--x' is given twice"),
+    (["check", "--threshold", "0.1", "--threshold", "0.2"], "'--threshold' / '-t' is given twice"),
 ])
 def test_cli_usage_errors_exit_2(capsys, args, message):
     code, out, err = run_main(args, capsys)
-    assert code == 2 and message in err
+    assert code == 2 and message in " ".join(err.replace("│", " ").split()), err
+
+
+def test_every_command_refuses_a_single_value_option_given_twice():
+    """The check is made once, by the class every command is registered with; flags and
+    options that take several values (`--fix`) may repeat."""
+    import typer
+
+    from mitos_cli.cli.app import build_app
+    from mitos_cli.cli.params import OnceCommand
+
+    def leaves(cmd):
+        subs = getattr(cmd, "commands", None)
+        return [c for s in subs.values() for c in leaves(s)] if subs else [cmd]
+
+    commands = leaves(typer.main.get_command(build_app()))
+    assert len(commands) >= 12 and all(isinstance(c, OnceCommand) for c in commands)
 
 
 def test_cli_syntax_error_through_a_real_process(tmp_path):

@@ -21,6 +21,7 @@ import typer
 
 from ..errors import MitosError, WriteError
 from .help import epilog, paragraphs
+from .params import OnceCommand
 
 #: One line per command: its name -> (module in this package, command function or Typer app).
 COMMANDS: dict[str, tuple[str, str]] = {
@@ -71,7 +72,8 @@ def build_app(only: str | None = None) -> typer.Typer:
         if isinstance(target, typer.Typer):
             app.add_typer(target, name=name)
         else:
-            app.command(name, help=paragraphs(target.__doc__), epilog=epilog(name))(target)
+            app.command(name, cls=OnceCommand, help=paragraphs(target.__doc__),
+                        epilog=epilog(name))(target)
     return app
 
 

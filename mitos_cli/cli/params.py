@@ -6,9 +6,10 @@ import math
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from enum import Enum
-from typing import TypeVar
+from typing import Any, TypeVar
 
 import typer
+from typer.core import TyperCommand, TyperOption
 
 from ..errors import NameError_, UsageError, unknown
 
@@ -69,3 +70,39 @@ def choices(kind: type[Enum]) -> str:
 def completer(kind: type[Enum]) -> Callable[[str], list[str]]:
     """Shell completion of one of ``kind``'s names."""
     return lambda incomplete: [m.value for m in kind if m.value.startswith(incomplete)]
+
+
+class GivenTwice(typer.BadParameter):
+    """A usage error (exit 2) that says itself, without Click's "Invalid value for"."""
+
+    def format_message(self) -> str:
+        return self.message
+
+
+class OnceCommand(TyperCommand):
+    """A command whose single-value options may each be given once. Click keeps the last of
+    ``--x road --x size`` without a word, so what was asked for first was silently dropped;
+    repeats are refused as ``--fix size=45 --fix size=50`` and ``road=78 road=80`` are.
+    Every command is registered with this class (``cls=``), so each of its options is checked
+    here rather than option by option."""
+
+    def parse_args(self, ctx: Any, args: list[str]) -> list[str]:   # (Click's Context)
+        if not ctx.resilient_parsing:           # (not while completing a command line)
+            _, _, order = self.make_parser(ctx).parse_args(args=list(args))
+            refuse_repeats(ctx, order)
+        return super().parse_args(ctx, args)
+
+
+def refuse_repeats(ctx: typer.Context, order: list) -> None:
+    """A usage error (exit 2) for the first single-value option given twice in ``order``
+    (the parameters as the parser met them, once per occurrence). Flags and options that
+    take several values (``--fix``, ``--world``) may repeat."""
+    seen: set[str] = set()
+    for param in order:
+        if not isinstance(param, TyperOption) or param.multiple or param.count \
+                or param.is_flag or param.name is None:
+            continue
+        if param.name in seen:
+            raise GivenTwice(f"{param.get_error_hint(ctx)} is given twice: give it once (the "
+                             f"last would be kept without a word)", ctx=ctx, param=param)
+        seen.add(param.name)

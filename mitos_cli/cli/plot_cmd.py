@@ -21,7 +21,7 @@ from ..numbers import parse_number
 from .eval_cmd import parse_values, split_args
 from .help import epilog
 from .output import emit, err, warn
-from .params import choice, choices, completer, named
+from .params import OnceCommand, choice, choices, completer, named
 
 FORMATS = ("png", "svg")
 RULE_SUFFIXES = (".rules", ".fcl", ".fis", ".fll")
@@ -330,11 +330,11 @@ def reflow(doc: str | None) -> str:
     return "\n\n".join(" ".join(p.split()) for p in paragraphs)
 
 
-plot_app.command("terms", help=reflow(terms_command.__doc__),
+plot_app.command("terms", cls=OnceCommand, help=reflow(terms_command.__doc__),
                  epilog=epilog("plot terms"))(terms_command)
-plot_app.command("surface", help=reflow(surface_command.__doc__),
+plot_app.command("surface", cls=OnceCommand, help=reflow(surface_command.__doc__),
                  epilog=epilog("plot surface"))(surface_command)
-plot_app.command("rules", help=reflow(rules_command.__doc__),
+plot_app.command("rules", cls=OnceCommand, help=reflow(rules_command.__doc__),
                  epilog=epilog("plot rules"))(rules_command)
 
 __all__ = ["plot_app"]
