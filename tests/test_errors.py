@@ -316,6 +316,19 @@ def test_term_set_not_found(tmp_path):
     assert "term set `nope.yaml` not found" in exc.message and caret_under(exc) == '"nope.yaml"'
 
 
+def test_a_term_set_that_is_a_device_or_a_directory_is_called_what_it_is(tmp_path):
+    """`terms "/dev/zero"` was "is a directory"."""
+    import os
+
+    (tmp_path / "d.yaml").mkdir()
+    os.mkfifo(tmp_path / "p.yaml")
+    for name, found in (("d.yaml", "is a directory"), ("p.yaml", "is not a regular file")):
+        path = tmp_path / "t.rules"
+        path.write_text(f'terms "{name}"\n' + GOOD_RULE, encoding="utf-8")
+        exc = error_of(lambda: load_rules_file(path), TermSetError)
+        assert f"term set `{name}` {found} (looked for" in exc.message
+
+
 def test_a_misspelt_term_set_gets_the_close_one_beside_it(tmp_path):
     """`terms "t.term.yaml"` said only "not found" beside a `t.terms.yaml`."""
     path = write(tmp_path, GOOD_RULE)

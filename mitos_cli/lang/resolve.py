@@ -11,7 +11,7 @@ from pathlib import Path
 
 from ..errors import MitosError, RuleBaseError, Span, TermSetError, unknown
 from ..fuzzy.hedges import HEDGES
-from ..resources import exists, is_file
+from ..resources import exists, is_dir, is_file
 from . import operators as ops_mod
 from .bulk import without_cyclic_gc
 from .model import And, Behavior, Consequent, Expr, Not, Or, Prop, Rule, RuleBase
@@ -70,7 +70,8 @@ def load_rules_file(path: str | Path) -> RuleBase:
         target = path.parent / name
         _named_once(target, name, span, seen)
         if not is_file(target):
-            found = "is a directory" if exists(target) else "not found"
+            found = ("not found" if not exists(target) else "is a directory" if is_dir(target)
+                     else "is not a regular file")          # a device, a pipe
             raise TermSetError(f"term set `{name}` {found} (looked for `{target}`)", span=span,
                                hint=termset_hint(target, name))
         termsets.append(load_termset(target))
