@@ -54,6 +54,19 @@ def test_a_misspelt_key_of_a_triangle_is_pointed_at_with_a_suggestion():
     assert err.span.line == 6 and err.span.column == 33
 
 
+@pytest.mark.parametrize("spec, words", [
+    ("{shape: concave, inflection: 3, end: 3}", "inflection and end must differ, not both 3"),
+    ("{shape: binary, start: 3, direction: 3}", "start and direction must differ"),
+    ("{shape: arc, start: 3, end: 3}", "start and end must differ"),
+])
+def test_parameters_that_must_differ_are_named_as_the_shape_names_them(spec, words):
+    """`concave` was refused with "start and end must differ": it has no `start`."""
+    from mitos_cli.errors import TermSetError
+
+    with pytest.raises(TermSetError, match=words):
+        termset({"T": spec})
+
+
 @pytest.mark.parametrize("value", ["yes", "off", "1"])
 def test_frozen_refuses_what_is_not_true_or_false(value):
     """`frozen: yes` froze the term (YAML 1.1 reads it as true) while `frozen: 1` was refused;

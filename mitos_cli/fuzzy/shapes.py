@@ -378,8 +378,12 @@ def _check_discrete(p: tuple[float, ...]) -> str | None:
     return None
 
 
-def _distinct(p: tuple[float, ...]) -> str | None:
-    return None if p[0] != p[1] else f"start and end must differ, not both {p[0]:g}"
+def _distinct(first: str, second: str) -> Callable[[tuple[float, ...]], str | None]:
+    """The two parameters must differ; named as the shape names them (`concave` has
+    `inflection` and `end`, no `start`)."""
+    def check(p: tuple[float, ...]) -> str | None:
+        return None if p[0] != p[1] else f"{first} and {second} must differ, not both {p[0]:g}"
+    return check
 
 
 def _nonzero(i: int, what: str) -> Callable[[tuple[float, ...]], str | None]:
@@ -401,7 +405,7 @@ for _shape in (
     Shape("rectangle", ("start", "end"), rectangle, _ordered(("start", "end")),
           lambda p: (p[0], p[0], p[1], p[1]), lambda p: (p[0] + p[1]) / 2,
           "1 from start to end, 0 elsewhere"),
-    Shape("ramp", ("start", "end"), ramp, _distinct,
+    Shape("ramp", ("start", "end"), ramp, _distinct("start", "end"),
           lambda p: (p[0], p[1], INF, INF) if p[0] < p[1] else (-INF, -INF, p[1], p[0]),
           lambda p: p[1], "0 at start, linear to 1 at end and beyond (falls when end < start)"),
     Shape("gaussian", ("mean", "sigma"), gaussian, _nonzero(1, "sigma"), None, lambda p: p[0],
@@ -433,13 +437,13 @@ for _shape in (
           "raised cosine of the given width around center"),
     Shape("spike", ("center", "width"), spike, _nonzero(1, "width"), None, lambda p: p[0],
           "exp(-|10 (x - center) / width|)"),
-    Shape("concave", ("inflection", "end"), concave, _distinct, None, lambda p: p[1],
+    Shape("concave", ("inflection", "end"), concave, _distinct("inflection", "end"), None, lambda p: p[1],
           "concave curve: 0.5 at inflection, 1 at end and beyond"),
-    Shape("semi_ellipse", ("start", "end"), semi_ellipse, _distinct, None,
+    Shape("semi_ellipse", ("start", "end"), semi_ellipse, _distinct("start", "end"), None,
           lambda p: (p[0] + p[1]) / 2, "upper half ellipse over [start, end]"),
-    Shape("arc", ("start", "end"), arc, _distinct, None, lambda p: p[1],
+    Shape("arc", ("start", "end"), arc, _distinct("start", "end"), None, lambda p: p[1],
           "quarter circle from 0 at start to 1 at end, 1 beyond"),
-    Shape("binary", ("start", "direction"), binary, _distinct, None, lambda p: p[0],
+    Shape("binary", ("start", "direction"), binary, _distinct("start", "direction"), None, lambda p: p[0],
           "1 from start towards direction (+inf or -inf), 0 elsewhere"),
     Shape("discrete", ("x1", "y1", "xn", "yn"), discrete, _check_discrete, None,
           _discrete_center, "piecewise linear through the points (x1, y1) ... (xn, yn)",
