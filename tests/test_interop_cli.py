@@ -493,6 +493,18 @@ def test_teach_on_a_foreign_file_says_to_convert_it(tmp_path: Path, capsys) -> N
             f"then convert it with `mitos convert {tmp_path / 'tipper.fis'} --to rules`") in err
 
 
+@pytest.mark.parametrize("name", ["t.rules", "t.fll", "t.txt"])
+def test_a_term_set_given_as_the_rule_base_says_so(tmp_path: Path, capsys, name: str) -> None:
+    """A term set under another name got "unexpected `road` ... expected `if`" and no more."""
+    (tmp_path / name).write_bytes((ROOT / "rulebases" / "mitos.terms.yaml").read_bytes())
+    for command in (["check"], ["eval"], ["teach"]):
+        code, err = _run(capsys, *command, str(tmp_path / name), *(["--lesson", "-"] if
+                                                                   command == ["teach"] else []))
+        assert code == 1
+        assert (f"hint: `{name}` looks like a YAML term set (`variables:` on line 3), not a rule "
+                f"base: a term set is read through the `terms` line of its .rules file") in err
+
+
 def test_a_rule_file_with_a_mistake_gets_no_format_hint(tmp_path: Path, capsys) -> None:
     rules = (ROOT / "rulebases" / "mitos.rules").read_text().replace("then steering", "thn steering", 1)
     (tmp_path / "m.rules").write_text(rules)

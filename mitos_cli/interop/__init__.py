@@ -46,6 +46,8 @@ SIGNATURES = {
     "fll": ("a fuzzylite FLL file", re.compile(r"(?m)^[ \t]*(Engine[ \t]*:)")),
     "rules": ("a MITOS rule file",
               re.compile(r'(?m)^[ \t]*(terms[ \t]+"|behavior[ \t]+[A-Za-z_][\w\-]*[ \t]*:)')),
+    # not a rule base at all, but what a rule file's `terms` line names
+    "termset": ("a YAML term set", re.compile(r"(?m)^(variables[ \t]*:)[ \t]*(?:#.*)?\r?$")),
 }
 
 
@@ -91,6 +93,9 @@ def wrong_reader_hint(path: str | Path, reader: str, command: str | None = None)
     fmt, statement, line = looks
     what = SIGNATURES[fmt][0]
     seen = f"`{path.name}` looks like {what} (`{statement}` on line {line})"
+    if fmt == "termset":
+        return (f"{seen}, not a rule base: a term set is read through the `terms` line of "
+                f"its .rules file: give that file")
     named = path if path.suffix.lower() == f".{fmt}" else path.with_suffix(f".{fmt}")
     rename = "" if named == path else f"rename it to `{named.name}`, then "
     if command is not None and fmt != "rules":
