@@ -647,6 +647,19 @@ def test_an_operator_set_twice_on_one_line_is_refused(tmp_path):
         parse_command("operators: or = max, or = sum", "l.lesson", 4)
 
 
+def test_an_operator_set_again_on_a_later_file_level_line_is_warned_of(tmp_path, capsys):
+    """`operators: and = min` then `operators: and = product` merged without a word."""
+    path = write(tmp_path, "operators: and = min\noperators: or = max\n"
+                           "operators: and = product\n" + GOOD_RULE)
+    rb = load_rules_file(path)
+    assert rb.notes == (f"{path}:4:12: `and` is set again (`product`; line 2 set `min`): the "
+                        f"later line wins for the whole file; keep one `and` (a behavior's own "
+                        f"`operators:` line sets it for that behavior)",)
+    code, _, err = run_main(["eval", str(path), "road=90", "size=20", "position=-5"], capsys)
+    assert code == 0 and f"warning: {path}:4:12: `and` is set again" in err
+    assert load_rules_file(write(tmp_path, "operators: and = min\n" + GOOD_RULE)).notes == ()
+
+
 def test_a_behavior_named_as_a_hedge_is_refused(tmp_path):
     path = write(tmp_path, "behavior very:\n  r1: if road is WIDE then speed is SLOW\nend\n")
     exc = error_of(lambda: load_rules_file(path), RuleBaseError)

@@ -359,6 +359,28 @@ def test_operators_told_twice_are_saved_as_one_setting(rules, tmp_path):
         == s.rulebase.behavior("avoid_obstacle").operators[-2:]
 
 
+def test_operators_told_at_top_level_are_set_where_the_file_sets_them(tmp_path):
+    """A second file-level `operators:` line setting a key again is read with a warning;
+    a save changes the key where the file sets it, and adds a line only for the others."""
+    (tmp_path / "t.terms.yaml").write_text(LO_HI)
+    (tmp_path / "t.rules").write_text(
+        'terms "t.terms.yaml"\noperators: and = min, or = max   # ours\n'
+        "r1: if x is LO then y is 20\nr2: if x is HI and x is LO then y is 80\n")
+    s = Session(tmp_path / "t.rules", out=[].append)
+    s.run("operators: and = product")
+    s.run("operators: inference = weighted_sum")
+    s.run(f"save {tmp_path / 'o.rules'}")
+    text = (tmp_path / "o.rules").read_text()
+    assert "operators: and = product, or = max   # ours\n" in text
+    assert text.count("operators:") == 2 and "operators: inference = weighted_sum\n" in text
+    saved = load_rules_file(tmp_path / "o.rules")
+    assert saved.notes == ()
+    from mitos_cli.lang.operators import resolve
+
+    assert resolve(saved.operators) == resolve(s.rulebase.behavior("main").operators,
+                                               resolve(s.rulebase.operators))
+
+
 def test_save_refuses_to_write_over_a_term_set_the_rule_file_reads(tmp_path):
     (tmp_path / "a.rules").write_text(
         'terms "b.terms.yaml"\nbehavior b:\n    r0: if x is LO then y is A\n'

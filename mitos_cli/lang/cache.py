@@ -45,7 +45,8 @@ if TYPE_CHECKING:
     from lark import Lark
 
 _FORMAT = 4                  # raised when parsing changes (3: `very not` refused, `main` placed;
-                             # 4: a formula's operators of one precedence are one node)
+                             # 4: a formula's operators of one precedence are one node, a
+                             # file-level operator set again is noted)
 _TAG = 32                    # bytes of HMAC-SHA256 before every entry
 _KEY = "key"
 

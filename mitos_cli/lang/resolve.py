@@ -14,7 +14,7 @@ from ..fuzzy.hedges import HEDGES
 from ..resources import exists, is_dir, is_file
 from . import operators as ops_mod
 from .bulk import without_cyclic_gc
-from .model import And, Behavior, Consequent, Expr, Not, Or, Prop, Rule, RuleBase
+from .model import And, Behavior, Consequent, Expr, Not, Or, Prop, Rule, RuleBase, Setting
 from .parse import ParsedFile, parse_rules
 from .termfile import load_termset
 from .terms import TermSet, Variable
@@ -163,9 +163,26 @@ def build_rulebase(parsed: ParsedFile, termsets: tuple[TermSet, ...],
     for b in behaviors:
         ops_mod.resolve(b.operators, base_ops)
         _check_behavior(b, variables, names, labels)
-    rb = RuleBase(parsed.path, termsets, tuple(behaviors), parsed.operators, termset_paths)
+    rb = RuleBase(parsed.path, termsets, tuple(behaviors), parsed.operators, termset_paths,
+                  notes=set_again(parsed.operators))
     _check_uses(rb)
     return rb
+
+
+def set_again(settings: tuple[Setting, ...]) -> tuple[str, ...]:
+    """A note for each operator a later file-level ``operators:`` line sets again: the lines
+    merge, key by key, the last one winning for the whole file, which was done without a
+    word (one line setting a key twice is an error)."""
+    first: dict[str, Setting] = {}
+    notes = []
+    for s in settings:
+        before = first.setdefault(s.key, s)
+        if before is s or before.span is None or s.span is None:
+            continue
+        notes.append(f"{s.span}: `{s.key}` is set again (`{s.value}`; line {before.span.line} "
+                     f"set `{before.value}`): the later line wins for the whole file; keep one "
+                     f"`{s.key}` (a behavior's own `operators:` line sets it for that behavior)")
+    return tuple(notes)
 
 
 def _main_place(parsed: ParsedFile) -> int:

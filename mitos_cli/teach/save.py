@@ -19,7 +19,7 @@ from __future__ import annotations
 import contextlib
 import os
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from lark import Token, Tree
@@ -349,6 +349,8 @@ class _Place:
                                 # by variable)); a session keeps its rules' places
     end_line_start: int | None  # offset of the line holding `end` (None: top level)
     indent: str
+    #: top level: where each operator is last set on an `operators:` line (start, end)
+    settings: dict[str, tuple[int, int]] = field(default_factory=dict)
 
 
 def _tokens(tree: Tree):
@@ -386,6 +388,10 @@ def _places(text: str) -> tuple[dict[str, _Place], list[Token]]:
             top.rules.append(_rule_place(item))
         elif item.data == "terms_stmt":
             terms_tokens += [t for t in item.children if isinstance(t, Token)]
+        elif item.data == "operators_stmt":
+            top.settings.update((str(a.children[0]), (a.meta.start_pos, a.meta.end_pos))
+                                for a in item.children
+                                if isinstance(a, Tree) and a.data == "op_assign")
         elif item.data == "behavior":
             name = str(item.children[0])
             rules = []
@@ -459,10 +465,19 @@ def edit_rules(text: str, path: str, original: RuleBase, current: RuleBase,
         for use in b.uses[len(old.uses):]:
             inserted.append(format_use(use))
             changes.append(f"{b.name}: {format_use(use)}")
-        new_ops = _operators_text(b.operators[len(old.operators):])
-        if new_ops:
-            inserted.append("operators: " + new_ops)
-            changes.append(f"{b.name}: operators {new_ops}")
+        told = b.operators[len(old.operators):]
+        if told:
+            changes.append(f"{b.name}: operators {_operators_text(told)}")
+            kept = [s for s in told if place is None or place.end_line_start is not None
+                    or s.key not in place.settings]
+            if place is not None and place.end_line_start is None:
+                # set where the file already sets it: a second file-level line setting the
+                # same key is read with a warning
+                for key, value in _last_values(told).items():
+                    if key in place.settings:
+                        edits.append((*place.settings[key], f"{key} = {value}"))
+            if kept:
+                inserted.append("operators: " + _operators_text(kept))
         new_frozen = [label for label in b.frozen if label not in old.frozen]
         if new_frozen:
             inserted.append("frozen " + ", ".join(new_frozen))
@@ -486,10 +501,12 @@ def edit_rules(text: str, path: str, original: RuleBase, current: RuleBase,
 def _operators_text(settings) -> str:
     """``settings`` as one ``operators:`` line's text, each key once with the value told last
     (one line may not set a key twice; two `operators:` lines at the prompt may)."""
-    last = {}
-    for setting in settings:
-        last[setting.key] = setting.value
-    return ", ".join(f"{key} = {value}" for key, value in last.items())
+    return ", ".join(f"{key} = {value}" for key, value in _last_values(settings).items())
+
+
+def _last_values(settings) -> dict[str, str]:
+    """Each key of ``settings`` with the value told last."""
+    return {setting.key: setting.value for setting in settings}
 
 
 def _only_crisp_changed(before, after) -> bool:
