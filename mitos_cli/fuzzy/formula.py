@@ -124,9 +124,9 @@ def _eval(tree: Node, x: np.ndarray):
         node, done = stack.pop()
         children = _children(node)
         if done or not children:
-            n = len(children)
-            args = values[len(values) - n:] if n else []
-            del values[len(values) - n:]
+            start = len(values) - len(children)      # its children's values, last on top
+            args = values[start:]
+            del values[start:]
             values.append(_apply(node, args, x))
             continue
         stack.append((node, True))
@@ -181,7 +181,7 @@ class _Parser:
         read in a loop, so a sum of a thousand terms costs no deeper recursion than one."""
         left = self.unary()
         while (op := self.binary_op()) is not None:
-            prec, right_assoc, _ = BINARY[op]
+            prec = BINARY[op][0]
             if prec < min_prec:
                 break
             rest = []
