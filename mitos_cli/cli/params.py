@@ -87,7 +87,8 @@ class OnceCommand(TyperCommand):
     here rather than option by option."""
 
     def parse_args(self, ctx: Any, args: list[str]) -> list[str]:   # (Click's Context)
-        if not ctx.resilient_parsing:           # (not while completing a command line)
+        # not while completing a command line, nor when help is asked for
+        if not ctx.resilient_parsing and not set(args) & set(ctx.help_option_names):
             _, _, order = self.make_parser(ctx).parse_args(args=list(args))
             refuse_repeats(ctx, order)
         return super().parse_args(ctx, args)
