@@ -5,6 +5,8 @@ Tsukamoto inference and ``lock-range`` / ``lock-previous``."""
 
 from __future__ import annotations
 
+import sys
+
 import numpy as np
 import pytest
 
@@ -238,6 +240,21 @@ def test_a_long_formula_is_evaluated_and_a_deep_one_refused_at_its_column():
         start = text.splitlines()[3].index(formula) + 1
         step = 4 if formula.startswith("abs") else 1
         assert info.value.span.line == 4 and info.value.span.column == start + 100 * step
+
+
+def test_a_formula_read_from_a_deep_stack_is_refused_not_a_recursion_error():
+    """Within the nesting limit the parser still recurses a few frames a level: called from
+    deep inside a program, a worst-case formula is an error in words, never a traceback."""
+    from mitos_cli.errors import TermSetError
+    from mitos_cli.fuzzy.formula import MAX_NESTING, parse
+
+    text = "".join(f"x {'+*^'[i % 3]} (" for i in range(MAX_NESTING)) + "x" + ")" * MAX_NESTING
+
+    def deep(n):
+        return parse(text) if n == 0 else deep(n - 1)
+
+    with pytest.raises(TermSetError, match="nested too deep to read here"):
+        deep(sys.getrecursionlimit() - 300)
 
 
 def test_a_formula_membership_outside_0_1_is_refused_at_evaluation():

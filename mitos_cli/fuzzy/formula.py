@@ -260,7 +260,12 @@ def parse(text: str, span: Span | None = None,
         raise error("a formula term needs a formula", span=span,
                     expected="a formula of x, e.g. `1 / (1 + x^2)`")
     p = _Parser(text, span, error)
-    tree = p.expression()
+    try:
+        tree = p.expression()
+    except RecursionError:       # within MAX_NESTING, but called from a deep stack already
+        raise error(f"the formula is nested too deep to read here (at most {MAX_NESTING} "
+                    f"levels, and fewer from deep inside a program)", span=span,
+                    expected="a formula with fewer levels") from None
     tok = p.peek()
     if tok is not None:
         p.fail(tok[2], f"unexpected `{tok[1]}` after a complete formula",
