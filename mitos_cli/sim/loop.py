@@ -1515,11 +1515,11 @@ def check_seed(seed: object) -> int:
     SeedSequence refused a negative seed with a bare ValueError from its internals, and
     ``int()`` made 3.7 the seed 3 without a word; ``True`` is not 1 here, as it is not in
     the engine's inputs or Gymnasium's ``reset``)."""
-    try:
-        value = operator.index(seed)  # type: ignore[arg-type]  # int, NumPy ints; not floats, text
+    try:           # (a bool first: NumPy 1.x takes its own as an index, with a warning)
+        value = -1 if isinstance(seed, (bool, np.bool_)) else operator.index(seed)  # type: ignore[arg-type]
     except TypeError:
         value = -1
-    if value < 0 or isinstance(seed, (bool, np.bool_)):
+    if value < 0:
         shown = (f"a number of {value.bit_length():,} bits" if value.bit_length() > 1000
                  else f"`{seed!r:.40}`")          # (repr of over 4,300 digits raises)
         raise InputError(f"a seed is a whole number, 0 or more, not {shown}",
