@@ -43,6 +43,7 @@ from concurrent.futures import ProcessPoolExecutor, as_completed
 from pathlib import Path
 
 import numpy as np
+from options import guarded, positive_int, writable
 
 from mitos_cli.errors import MitosError, unknown
 from mitos_cli.sim import barn, mrpb
@@ -273,6 +274,10 @@ def ticks_world(n_obstacles: int, seed: int):
     rng = np.random.default_rng(np.random.SeedSequence([seed, 2]))
     filled = rng.random((barn.CELLS, barn.CELLS)) < 0.35
     rows, cols = np.nonzero(filled)
+    if n_obstacles > len(rows):
+        raise MitosError(f"the ticks line's field holds {len(rows)} poles, not {n_obstacles}",
+                         hint=f"give `--ticks-obstacles {len(rows)}` or fewer (or another "
+                              f"`--seed`)")
     order = np.argsort(np.hypot(cols - barn.CELLS / 2, rows - barn.CELLS / 2), kind="stable")
     base = barn.world_of(barn.Field(filled, 0.35, 0, seed, 1))
     pole = base.obstacles[0]
@@ -352,14 +357,39 @@ def aims(results: dict, ticks: dict | None) -> list[str]:
     return out
 
 
+ROW_KEYS = {"suite": str, "world": str, "runs": dict}
+
+
+def read_rows(path: Path) -> list[dict]:
+    """The rows of a ``--rows`` file, each line checked; a torn last line (a run killed while
+    it appended) is dropped with a note, a damaged line elsewhere is refused by its number."""
+    try:
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise MitosError(f"cannot read rows from `{path}`: {exc}") from None
+    numbered = [(n, line) for n, line in enumerate(text.splitlines(), 1) if line.strip()]
+    rows = []
+    for n, line in numbered:
+        try:
+            row = json.loads(line)
+        except ValueError as exc:
+            if n == numbered[-1][0] and not text.endswith("\n"):      # written in part
+                print(f"note: {path.name}:{n}: a torn last line (a stopped run) is left out",
+                      file=sys.stderr)
+                break
+            raise MitosError(f"cannot read rows from `{path}`: line {n}: {exc.msg}") from None
+        if not isinstance(row, dict) or any(not isinstance(row.get(k), t)
+                                            for k, t in ROW_KEYS.items()):
+            raise MitosError(f"cannot read rows from `{path}`: line {n} is not a row",
+                             expected="a JSON object with `suite`, `world` and `runs`, as "
+                                      "`--rows` writes")
+        rows.append(row)
+    return rows
+
+
 def print_rows(path: Path, suites, planners) -> int:
     """The table and notes of the rows a run kept (``--rows``), however far it got."""
-    try:
-        rows = [json.loads(line) for line in path.read_text(encoding="utf-8").splitlines()
-                if line.strip()]
-    except (OSError, ValueError) as exc:
-        print(f"error: cannot read rows from `{path}`: {exc}", file=sys.stderr)
-        return 1
+    rows = read_rows(path)
     kept = [p for p in planners if all(p in r["runs"] for r in rows if r.get("runs"))]
     results, notes = suite_results(rows, suites, kept)
     print(table(results))
@@ -370,21 +400,23 @@ def print_rows(path: Path, suites, planners) -> int:
     return 0
 
 
+@guarded
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--quick", action="store_true", help="10 BARN worlds and 2 clutter draws")
-    ap.add_argument("--worlds", type=int, default=None, help="BARN worlds (default 100)")
-    ap.add_argument("--draws", type=int, default=None, help="clutter draws per world (10)")
+    ap.add_argument("--worlds", type=positive_int, default=None, help="BARN worlds (default 100)")
+    ap.add_argument("--draws", type=positive_int, default=None,
+                    help="clutter draws per world (10)")
     ap.add_argument("--seed", type=int, default=0, help="seed of the BARN fields and clutter")
     ap.add_argument("--planners", default=",".join(PLANNERS), help="comma-separated")
     ap.add_argument("--suites", default=",".join(SUITES), help="comma-separated")
     ap.add_argument("--mrpb", type=Path, default=MRPB_DIR, help="MRPB 1.0's maps and tests")
-    ap.add_argument("--jobs", type=int, default=os.cpu_count() or 1,
+    ap.add_argument("--jobs", type=positive_int, default=os.cpu_count() or 1,
                     help="worker processes (default: the core count)")
-    ap.add_argument("--ticks-obstacles", type=int, default=300,
+    ap.add_argument("--ticks-obstacles", type=positive_int, default=300,
                     help="unknown obstacles of the ticks line (300)")
-    ap.add_argument("--json", type=Path, default=None, help="write the figures here too")
-    ap.add_argument("--rows", type=Path, default=None,
+    ap.add_argument("--json", type=writable, default=None, help="write the figures here too")
+    ap.add_argument("--rows", type=writable, default=None,
                     help="append each finished task's rows here as JSON lines (a stopped run "
                          "keeps what it measured)")
     ap.add_argument("--from-rows", type=Path, default=None,
@@ -395,8 +427,8 @@ def main(argv: list[str] | None = None) -> int:
     draws = args.draws if args.draws is not None else (2 if args.quick else 10)
     planners = tuple(p.strip() for p in args.planners.split(",") if p.strip())
     suites = tuple(s.strip() for s in args.suites.split(",") if s.strip())
-    if args.jobs < 1 or n_barn < 0 or draws < 0:
-        ap.error("--jobs must be at least 1, --worlds and --draws at least 0")
+    if not planners or not suites:
+        ap.error(f"no {'planner' if not planners else 'suite'} given (comma-separated names)")
     try:
         for p in planners:
             if p not in PLANNERS:
@@ -421,6 +453,8 @@ def main(argv: list[str] | None = None) -> int:
                      "beside the repository), or leave those suites out: `--suites "
                      "barn-unknown,barn-known,ticks`")
         root = str(args.mrpb)
+        if "ticks" in suites:
+            ticks_world(args.ticks_obstacles, args.seed)       # as many poles as the field holds
         jobs = jobs_for(suites, planners, root, n_barn, args.seed, draws)
         keep = None
         if args.rows:

@@ -36,6 +36,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+from options import count, writable
 
 from mitos_cli.errors import MitosError
 from mitos_cli.sim import barn, knowledge, loop, mrpb
@@ -192,10 +193,11 @@ def report(suite: str, name: str, m: dict) -> None:
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--mrpb", type=Path, default=MRPB_DIR, help="MRPB 1.0's maps and tests")
-    ap.add_argument("--barn", type=int, default=20, help="BARN fields (20)")
+    ap.add_argument("--barn", type=count, default=20, help="BARN fields (20)")
     ap.add_argument("--seed", type=int, default=1000, help="the first BARN field's seed (1000)")
     ap.add_argument("--drive", default=None, help="run MRPB's tests with this planner too")
-    ap.add_argument("--json", type=Path, default=None, help="write every route's figures here")
+    ap.add_argument("--json", type=writable, default=None,
+                    help="write every route's figures here")
     args = ap.parse_args(argv)
     rec = Recorder()
     old = rec.install()

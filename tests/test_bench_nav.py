@@ -58,3 +58,39 @@ def test_refused_and_failed_tasks_are_counted_in_generated_notes(tmp_path, capsy
                            "--planners", "fuzzy,dwa"]) == 0
     out = capsys.readouterr().out
     assert "| MRPB: every test reached by the fuzzy planner | 1 of 2 | no |" in out
+
+
+def kept_rows(tmp_path: Path, text: str) -> Path:
+    kept = tmp_path / "rows.jsonl"
+    kept.write_text(text)
+    return kept
+
+
+def test_from_rows_names_a_damaged_line_by_its_number_and_drops_a_torn_last_one(tmp_path,
+                                                                             capsys):
+    good = json.dumps({"suite": "mrpb", "world": "a", "refused": None, "length": 787.4,
+                       "runs": {"fuzzy": run("success")}}) + "\n"
+    kept = kept_rows(tmp_path, good * 3 + '{"bad": \n' + good)
+    assert bench_nav.main(["--from-rows", str(kept), "--suites", "mrpb",
+                           "--planners", "fuzzy"]) == 1
+    assert f"cannot read rows from `{kept}`: line 4: Expecting value" in capsys.readouterr().err
+    kept = kept_rows(tmp_path, good * 3 + good[:40])            # a run killed while appending
+    assert bench_nav.main(["--from-rows", str(kept), "--suites", "mrpb",
+                           "--planners", "fuzzy"]) == 0
+    out, err = capsys.readouterr()
+    assert "rows.jsonl:4: a torn last line (a stopped run) is left out" in err
+    assert "from 3 rows of `rows.jsonl`" in out
+
+
+@pytest.mark.parametrize("text", ["[1, 2]\n", '{"runs": 5}\n', '{"suite": "mrpb"}\n'])
+def test_from_rows_refuses_json_that_is_not_a_row(text, tmp_path, capsys):
+    kept = kept_rows(tmp_path, text)
+    assert bench_nav.main(["--from-rows", str(kept)]) == 1
+    err = capsys.readouterr().err
+    assert f"cannot read rows from `{kept}`: line 1 is not a row" in err and "Traceback" not in err
+
+
+def test_the_ticks_line_refuses_more_obstacles_than_its_field_holds():
+    assert len(bench_nav.ticks_world(348, 0).obstacles) == 348
+    with pytest.raises(bench_nav.MitosError, match="holds 348 poles, not 349"):
+        bench_nav.ticks_world(349, 0)
