@@ -26,6 +26,8 @@ import tempfile
 import time
 from pathlib import Path
 
+from options import guarded, positive_int
+
 ROOT = Path(__file__).resolve().parent.parent
 
 
@@ -38,15 +40,19 @@ def cpu_seconds() -> float:
     return total
 
 
-def main() -> None:
+@guarded
+def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--world", default=str(ROOT / "worlds" / "corridor.yaml"))
-    ap.add_argument("--runs", type=int, default=200, help="runs per choice (5 choices)")
+    ap.add_argument("--runs", type=positive_int, default=200, help="runs per choice (5 choices)")
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--skip-dask", action="store_true")
-    args = ap.parse_args()
+    args = ap.parse_args(argv)
 
+    from mitos_cli.sim.worldfile import load_world
     from mitos_cli.study import Study, make_choices, run_study
+
+    load_world(args.world)          # a world it cannot read is said now, in one line
 
     choices = make_choices(["fuzzy", "potential_field"],
                            ["min", "product", "lukasiewicz", "einstein"], [], [])
@@ -95,9 +101,8 @@ def main() -> None:
     print(f"rows identical across modes: {same}")
     print(f"speed-up vs 1 process: 2 processes {base / two:.2f}x"
           + (f", dask {base / dask:.2f}x" if not args.skip_dask else ""))
-    if not same:
-        sys.exit(1)
+    return 0 if same else 1
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())

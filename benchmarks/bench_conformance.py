@@ -40,6 +40,9 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
+from options import directory  # noqa: E402
+from peers import require  # noqa: E402
+
 from mitos_cli.api import LoadedRuleBase, read_rulebase  # noqa: E402
 from mitos_cli.engine.compile import compile_rulebase  # noqa: E402
 from mitos_cli.engine.evaluation import evaluate  # noqa: E402
@@ -342,14 +345,18 @@ def report_rows(title: str, part: dict) -> None:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="pyfuzzylite's examples only")
-    parser.add_argument("--fcl-dir", type=Path, metavar="DIR",
+    parser.add_argument("--fcl-dir", type=directory, metavar="DIR",
                         help="also read every .fcl under DIR (e.g. a jFuzzyLogic checkout)")
     args = parser.parse_args()
-    tmp = Path(tempfile.mkdtemp(prefix="mitos-conformance-"))
     all_files: list[Path] = []
     examples = pyfuzzylite_examples()
+    if examples is None and args.quick and not args.fcl_dir:    # --quick: part 1 alone
+        require("bench_conformance.py", "fuzzylite")
+        sys.exit("bench_conformance.py: pyfuzzylite's examples are not in its package: "
+                 "--quick has nothing to measure")
+    tmp = Path(tempfile.mkdtemp(prefix="mitos-conformance-"))
     if examples is None:
-        print("pyfuzzylite is not installed (pip install -e '.[agreement]'): part 1 skipped")
+        print("pyfuzzylite is not installed (pip install -e \".[bench]\"): part 1 skipped")
     else:
         part = part_pyfuzzylite(examples, tmp)
         report_rows("1. pyfuzzylite examples through `mitos eval --batch`", part)

@@ -43,6 +43,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+from options import revision
 from peers import require
 from revision import package_of
 
@@ -409,7 +410,7 @@ def main() -> None:
     ap.add_argument("--quick", action="store_true", help="small sizes, for a smoke run")
     ap.add_argument("--startup", action="store_true",
                     help="only the whole-process start-up of `mitos eval` against NumPy's import")
-    ap.add_argument("--against", metavar="REV",
+    ap.add_argument("--against", metavar="REV", type=revision,
                     help="only the column batch, one evaluation and start-up of this tree against "
                          "git revision REV's (e.g. main), in one process, rounds interleaved")
     args = ap.parse_args()

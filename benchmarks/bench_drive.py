@@ -21,6 +21,8 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))   # this source tree first
 
+from options import count, guarded, positive_int  # noqa: E402
+
 from mitos_cli.resources import packaged_path  # noqa: E402
 from mitos_cli.sim import barn  # noqa: E402
 from mitos_cli.sim.planner import FuzzyPlanner  # noqa: E402
@@ -39,17 +41,20 @@ def rates(summaries: list[dict]) -> str:
             + f"  mean time to goal {mean_t:5.1f} s")
 
 
-def main() -> None:
+@guarded
+def main(argv: list[str] | None = None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--barn", type=int, default=0, help="BARN-style worlds to run")
+    ap.add_argument("--barn", type=count, default=0, help="BARN-style worlds to run")
     ap.add_argument("--seed", type=int, default=1000, help="first BARN seed")
     ap.add_argument("--known", action="store_true", help="poles drawn in the robot's map")
     ap.add_argument("--shipped", action="store_true", help="the shipped worlds")
-    ap.add_argument("--runs", type=int, default=20, help="randomised runs per shipped world")
+    ap.add_argument("--runs", type=positive_int, default=20, help="randomised runs per shipped world")
     ap.add_argument("--rules", help="rule file (default: the packaged rule base)")
-    ap.add_argument("--workers", type=int)
+    ap.add_argument("--workers", type=positive_int)
     ap.add_argument("--show", action="store_true", help="print each failed run")
-    args = ap.parse_args()
+    args = ap.parse_args(argv)
+    if not args.barn and not args.shipped:
+        ap.error("nothing to run: give --barn N (BARN-style worlds) or --shipped")
     planner = FuzzyPlanner(args.rules, "drive")
     print(f"# {platform.processor() or platform.machine()}, Python {platform.python_version()}")
     if args.barn:
@@ -81,4 +86,4 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())

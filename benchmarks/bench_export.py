@@ -20,6 +20,7 @@ FCL, FIS and FLL readers, parse to checked model) against pyfuzzylite's FLL impo
 
 from __future__ import annotations
 
+import argparse
 import importlib.util
 import os
 import shutil
@@ -33,6 +34,8 @@ import numpy as np
 
 ROOT = Path(__file__).parents[1]
 sys.path.insert(0, str(ROOT))
+
+from peers import require  # noqa: E402
 
 from mitos_cli.api import load_rulebase, read_rulebase  # noqa: E402
 from mitos_cli.engine.evaluation import evaluate  # noqa: E402
@@ -97,7 +100,7 @@ def bench(label: str, path: Path, tmp: Path) -> None:
     t_python = best_of(lambda: module.evaluate(X))
 
     cc = shutil.which("cc") or shutil.which("gcc")
-    t_c = float("nan")
+    t_c = None
     if cc:
         (tmp / "m.c").write_text(to_c(c, "bench", path.name))
         (tmp / "d.c").write_text(DRIVER)
@@ -111,62 +114,60 @@ def bench(label: str, path: Path, tmp: Path) -> None:
         got = np.fromfile(tmp / "y.bin").reshape(N, len(c.outputs))
         assert np.allclose(got, want, rtol=0, atol=1e-9, equal_nan=True)
 
-    t_fl = float("nan")
-    try:
-        import fuzzylite as fl
+    import fuzzylite as fl
 
-        engine = fl.FllImporter().from_string(write_foreign(rb.rulebase, "fll"))
+    engine = fl.FllImporter().from_string(write_foreign(rb.rulebase, "fll"))
 
-        def run_fl():
-            for i, name in enumerate(c.inputs):
-                engine.input_variable(name).value = X[:, i]
-            engine.process()
-            return np.column_stack([np.asarray(engine.output_variable(o).value, dtype=float)
-                                    for o in c.outputs])
+    def run_fl():
+        for i, name in enumerate(c.inputs):
+            engine.input_variable(name).value = X[:, i]
+        engine.process()
+        return np.column_stack([np.asarray(engine.output_variable(o).value, dtype=float)
+                                for o in c.outputs])
 
-        theirs = run_fl()
-        # the same system: pyfuzzylite samples Mamdani outputs at midpoints, a .fis at
-        # MATLAB's end points, so only the weighted-average rule base is compared exactly
-        if c.operators.inference != "mamdani":
-            assert np.allclose(theirs, want, rtol=0, atol=1e-9, equal_nan=True)
-        t_fl = best_of(run_fl, 3)
-    except ImportError:
-        pass
+    theirs = run_fl()
+    # the same system: pyfuzzylite samples Mamdani outputs at midpoints, a .fis at
+    # MATLAB's end points, so only the weighted-average rule base is compared exactly
+    if c.operators.inference != "mamdani":
+        assert np.allclose(theirs, want, rtol=0, atol=1e-9, equal_nan=True)
+    t_fl = best_of(run_fl, 3)
 
     print(f"\n{label} ({path.relative_to(ROOT)}; {c.n_rules} rules, {c.operators.describe()})")
     print(f"  {'implementation':34s} {'total s':>9s} {'us/sample':>10s} {'vs engine':>10s}")
     for name, t in (("MITOS engine (batch)", t_engine), ("exported NumPy module (batch)", t_python),
                     ("exported C (one call per sample)", t_c),
                     ("pyfuzzylite 8 (vectorized)", t_fl)):
-        print(f"  {name:34s} {t:9.4f} {1e6 * t / N:10.3f} {t_engine / t:9.2f}x")
+        if t is None:
+            print(f"  {name:34s} not timed: no C compiler (cc or gcc) on PATH")
+        else:
+            print(f"  {name:34s} {t:9.4f} {1e6 * t / N:10.3f} {t_engine / t:9.2f}x")
 
 
-def bench_readers() -> None:
+def bench_readers(tmp: Path) -> None:
+    import fuzzylite as fl
+
     data = ROOT / "tests" / "data" / "interop"
-    tmp = Path(tempfile.mkdtemp())
     fll = tmp / "mitos.fll"
     fll.write_text(write_foreign(read_rulebase(ROOT / "rulebases" / "mitos.rules"), "fll"))
     print("\nreading a file into a checked model (best of 20, ms)")
     for path in (data / "tipper.fis", data / "tipper_jfuzzylogic.fcl", fll):
         t = best_of(lambda: read_rulebase(path), 20)
         print(f"  MITOS {path.suffix:5s} {path.name:28s} {1e3 * t:8.2f}")
-    try:
-        import fuzzylite as fl
-
-        text = fll.read_text()
-        t = best_of(lambda: fl.FllImporter().from_string(text), 20)
-        print(f"  pyfuzzylite .fll {fll.name:22s} {1e3 * t:8.2f}")
-    except ImportError:
-        pass
+    text = fll.read_text()
+    t = best_of(lambda: fl.FllImporter().from_string(text), 20)
+    print(f"  pyfuzzylite .fll {fll.name:22s} {1e3 * t:8.2f}")
 
 
-def main() -> None:
+def main(argv: list[str] | None = None) -> None:
+    argparse.ArgumentParser(description=__doc__,
+                            formatter_class=argparse.RawDescriptionHelpFormatter).parse_args(argv)
+    require("bench_export.py", "fuzzylite")
     print(f"{os.cpu_count()} CPUs, load average {os.getloadavg()[0]:.2f}, NumPy "
           f"{np.__version__}, n = {N}")
     with tempfile.TemporaryDirectory() as tmp:
         bench("mitos", ROOT / "rulebases" / "mitos.rules", Path(tmp))
         bench("tipper", ROOT / "tests" / "data" / "interop" / "tipper.fis", Path(tmp))
-    bench_readers()
+        bench_readers(Path(tmp))
 
 
 if __name__ == "__main__":

@@ -11,6 +11,7 @@ per second of wall time on one core.
 
 from __future__ import annotations
 
+import argparse
 import platform
 import sys
 import time
@@ -53,7 +54,9 @@ def best_rate(world, repeats: int = 3) -> tuple[float, object]:
     return best, res
 
 
-def main() -> None:
+def main(argv: list[str] | None = None) -> None:
+    argparse.ArgumentParser(description=__doc__,
+                            formatter_class=argparse.RawDescriptionHelpFormatter).parse_args(argv)
     print(f"machine: {platform.processor() or platform.machine()}, Python "
           f"{platform.python_version()}, one process")
     print(f"{'run':44} {'ticks':>6} {'ticks/s':>8}  outcome  replans")

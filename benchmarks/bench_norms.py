@@ -28,6 +28,7 @@ from pathlib import Path
 
 import numpy as np
 import yaml
+from options import positive_int
 from peers import require
 
 FL_TNORM = {"min": "Minimum", "product": "AlgebraicProduct", "lukasiewicz": "BoundedDifference",
@@ -178,7 +179,7 @@ def best_of(fn, repeat: int) -> float:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--quick", action="store_true", help="smaller batches")
-    ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--repeat", type=positive_int, default=3)
     ap.add_argument("--seed", type=int, default=0)
     args = ap.parse_args()
     require("bench_norms.py", "fuzzylite", "skfuzzy")

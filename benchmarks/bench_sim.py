@@ -47,13 +47,16 @@ import math
 import os
 import platform
 import statistics
+import sys
 import tempfile
 import time
 from pathlib import Path
 
 import numpy as np
+from options import guarded, positive_int, revision
 from revision import package_of
 
+from mitos_cli.errors import MitosError
 from mitos_cli.resources import packaged_path
 from mitos_cli.sim.lockstep import run_lockstep
 from mitos_cli.sim.loop import Simulation, prepare, simulate
@@ -152,8 +155,8 @@ def against_runs(rev: str, theirs, planner_name: str = "drive", rounds: int = 7)
             best[key] = min(best.get(key, math.inf), time.process_time() - c)
     for name in ("slalom.yaml", "office.yaml"):
         mine, old = setups[name, "this tree"][4], setups[name, rev][4]
-        assert mine.summary() == old.summary() and mine.pose.tobytes() == old.pose.tobytes(), \
-            f"{name}: this tree's run differs from {rev}'s"
+        if mine.summary() != old.summary() or mine.pose.tobytes() != old.pose.tobytes():
+            raise differs(f"{name}'s run", rev)
         rates = {tree: mine.ticks / best[name, tree] for tree in ("this tree", rev)}
         print(f"   {name[:-5]}: {mine.ticks} ticks, this tree {rates['this tree']:,.0f} ticks/s "
               f"({1e6 / rates['this tree']:.0f} us/tick), {rev} {rates[rev]:,.0f} ticks/s "
@@ -162,6 +165,13 @@ def against_runs(rev: str, theirs, planner_name: str = "drive", rounds: int = 7)
               f"interleaved rounds; the same run from both trees)")
         loop, world, fuzzy, scene, _ = setups[name, "this tree"]
         _stages(world, fuzzy, scene)
+
+
+def differs(what: str, rev: str) -> MitosError:
+    """Why ``--against REV`` stops: the two trees are timed on the same run, or not at all."""
+    return MitosError(f"{what} differs between this tree and `{rev}`",
+                      hint="the speed of two trees is compared on the same runs; give a "
+                           "revision whose simulator gives the same ones")
 
 
 def _cpu_of(world, planner, scene) -> tuple[float, int]:
@@ -198,18 +208,21 @@ def time_runs(world, planner, repeats: int = 5) -> tuple[list[float], object]:
     return times, res
 
 
-def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--only", default="1,2,3,4", help="sections to run (default 1,2,3,4)")
-    ap.add_argument("--runs", type=int, default=1000, help="runs of section 5 (1000)")
+@guarded
+def main(argv: list[str] | None = None) -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--only", type=_sections, default="1,2,3,4",
+                    help="sections to run, comma-separated, of 1-5 (default 1,2,3,4; 5 is the "
+                         "1,000 runs)")
+    ap.add_argument("--runs", type=positive_int, default=1000, help="runs of section 5 (1000)")
     ap.add_argument("--seconds", type=_seconds, default=2.0, help="section 4: simulated seconds a "
                     "run (2; 0: the world's own limit, every run to its end)")
     ap.add_argument("--sizes", type=_sizes, default="1,16,256,1024",
                     help="section 4: batch sizes, comma-separated")
-    ap.add_argument("--against", metavar="REV", help="sections 2 and 4: this tree and git "
+    ap.add_argument("--against", metavar="REV", type=revision, help="sections 2 and 4: this tree and git "
                     "revision REV's, interleaved in one process")
-    args = ap.parse_args()
-    sections = {int(x) for x in args.only.split(",")}
+    args = ap.parse_args(argv)
+    sections = args.only
     print(f"{platform.python_version()}, numpy {np.__version__}, {_cpus()}, "
           f"load average {_load():.2f} at start")
     fuzzy = FuzzyPlanner(None, "drive")
@@ -235,6 +248,17 @@ def main() -> None:
         if 5 in sections:
             thousand_runs(fuzzy, args.runs)
     print(f"load average {_load():.2f} at the end")
+
+
+def _sections(text: str) -> set[int]:
+    """``--only``: section numbers of 1-5, comma-separated."""
+    try:
+        sections = {int(x) for x in text.split(",")}
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"`{text}`: give section numbers, e.g. 1,2") from None
+    if not sections <= {1, 2, 3, 4, 5}:
+        raise argparse.ArgumentTypeError(f"`{text}`: the sections are 1 to 5")
+    return sections
 
 
 def _seconds(text: str) -> float:
@@ -357,7 +381,8 @@ def batch_sizes(fuzzy, rev: str | None = None, theirs=None, seconds: float = 2.0
                                   batch=size)
             old_per = (time.process_time() - c) / sum(r.ticks * len(r.robot_outcomes)
                                                        for r in theirs_res)
-            assert [r.summary() for r in theirs_res] == [r.summary() for r in res]
+            if [r.summary() for r in theirs_res] != [r.summary() for r in res]:
+                raise differs(f"the batch of {size}'s runs", rev)
             line += f"; {rev}: {1e6 * old_per:.0f} us ({old_per / per:.2f}x slower, same runs)"
         print(line)
 
@@ -404,4 +429,4 @@ def _outcomes(summaries: list[dict]) -> str:
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())

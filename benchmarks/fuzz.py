@@ -64,6 +64,8 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))          # this tree's mitos_cli, not an installed one
+from options import positive_int  # noqa: E402
+
 SEED = 20261201
 
 OUTCOMES = ("loaded", "refused+pos", "refused", "foreign", "slow", "nonfinite", "warning")
@@ -1118,7 +1120,7 @@ def _write(out: Path, kind: Kind, data, want, scratch: Path, limit: float, slow:
 def table(kinds: list[Kind]) -> str:
     rows = ["| input | tried | loaded | refused with a position | refused without one | "
             "foreign exception | slow | non-finite | warning | CPU s | large inputs: n, "
-            "largest, ms per KB (max) |", "|---|" + "---:|" * 11]
+            "largest, ms per KB (max) |", "|---|" + "---:|" * 10]
     total = dict.fromkeys(OUTCOMES, 0)
     tried, cpu = 0, 0.0
     for k in kinds:
@@ -1225,7 +1227,7 @@ def run_jobs(args) -> list[Kind]:
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--per-format", type=int, default=2000, help="inputs per input kind")
+    ap.add_argument("--per-format", type=positive_int, default=2000, help="inputs per input kind")
     ap.add_argument("--quick", action="store_true", help="a short campaign (150 per kind)")
     ap.add_argument("--out", type=Path, default=None,
                     help="directory for minimal reproducers of new signatures")
@@ -1237,7 +1239,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--shard", type=shard_of, default=(0, 1), metavar="K/N",
                     help="run only inputs K, K + N, K + 2N, ... of each kind, 0 <= K < N (N "
                          "campaigns in parallel cover them all)")
-    ap.add_argument("--jobs", type=int, default=1, metavar="N",
+    ap.add_argument("--jobs", type=positive_int, default=1, metavar="N",
                     help="run the N shards 0/N .. N-1/N at once in N processes and print their "
                          "summed table (one worker each: N cores)")
     ap.add_argument("--via", choices=("reader", "cli", "subprocess"), default="reader",
@@ -1245,8 +1247,6 @@ def main(argv: list[str] | None = None) -> int:
                          "(stdout and stderr captured); subprocess: `python -m mitos_cli`, for "
                          "spot checks")
     args = ap.parse_args(argv)
-    if args.jobs < 1:
-        ap.error("--jobs must be at least 1")
     if args.jobs > 1 and args.shard != (0, 1):
         ap.error("--jobs runs every shard itself: give --jobs or --shard, not both")
     args.n = 150 if args.quick else args.per_format
@@ -1260,6 +1260,10 @@ def main(argv: list[str] | None = None) -> int:
                          via=args.via, shard=args.shard)
         shard = "shard {}/{}".format(*args.shard)
     LOADS.append(os.getloadavg()[0])
+    if not any(k.tried for k in kinds) and not LOST:
+        ap.error("nothing was run: no input kind"
+                 + (f" matches `--only {args.only}`" if args.only else "")
+                 + (f" that `--via {args.via}` reads" if args.via != "reader" else ""))
     wall = time.perf_counter() - t0
     own = resource.getrusage(resource.RUSAGE_SELF)
     children = resource.getrusage(resource.RUSAGE_CHILDREN)

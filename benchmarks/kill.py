@@ -40,6 +40,8 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))          # this tree's mitos_cli, here and in the killed runs
+from options import positive_int  # noqa: E402
+
 ENV = dict(os.environ, PYTHONPATH=str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", ""))
 ROUNDS = 6
 
@@ -244,7 +246,7 @@ def sweep_campaign(trials: int, seed: int, log=print) -> list[dict]:
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--trials", type=int, default=50)
+    ap.add_argument("--trials", type=positive_int, default=50)
     ap.add_argument("--sweep", action="store_true", help="kill sweeps instead of teaching")
     ap.add_argument("--seed", type=int, default=20261201)
     args = ap.parse_args(argv)

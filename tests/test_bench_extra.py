@@ -87,3 +87,94 @@ def test_a_benchmark_names_a_missing_peer_and_how_to_install_it(monkeypatch, cap
     message = str(exit_.value.code)
     assert message.startswith("bench_x.py: the peers it is measured against are not installed")
     assert "skfuzzy_not_here, fuzzylite_not_here" in message and 'pip install -e ".[bench]"' in message
+
+
+def script(name: str, monkeypatch):
+    """A benchmark script imported as a module (its ``main`` is not run)."""
+    monkeypatch.syspath_prepend(str(ROOT / "benchmarks"))
+    import importlib
+
+    return importlib.import_module(name)
+
+
+@pytest.mark.parametrize("name, argv, said", [
+    ("bench_drive", ["--barn", "-1"], "argument --barn: `-1`: must be at least 0"),
+    ("bench_drive", ["--barn", "1", "--workers", "0"], "argument --workers: `0`: must be at least 1"),
+    ("bench_drive", [], "nothing to run: give --barn N"),
+    ("bench_sim", ["--only", "x"], "argument --only: `x`: give section numbers"),
+    ("bench_sim", ["--only", "9"], "argument --only: `9`: the sections are 1 to 5"),
+    ("bench_sim", ["--only", "5", "--runs", "0"], "argument --runs: `0`: must be at least 1"),
+    ("bench_sim", ["--only", "2", "--against", "nosuchrev"], "unknown revision `nosuchrev`"),
+    ("bench_core", ["--against", "nosuchrev"], "unknown revision `nosuchrev`"),
+    ("bench_norms", ["--quick", "--repeat", "0"], "argument --repeat: `0`: must be at least 1"),
+    ("bench_compare", ["--runs", "0"], "argument --runs: `0`: must be at least 1"),
+    ("bench_nav", ["--ticks-obstacles", "-5"], "`-5`: must be at least 1"),
+    ("bench_nav", ["--worlds", "0"], "argument --worlds: `0`: must be at least 1"),
+    ("bench_nav", ["--planners", ","], "no planner given"),
+    ("bench_nav", ["--json", "{tmp}"], "cannot write to `{tmp}`: it is a directory"),
+    ("bench_nav", ["--rows", "{tmp}"], "cannot write to `{tmp}`: it is a directory"),
+    ("bench_nav", ["--json", "{tmp}/no/x.json"], "cannot write to `{tmp}/no/x.json`: no directory"),
+    ("route_clearance", ["--json", "{tmp}"], "cannot write to `{tmp}`: it is a directory"),
+    ("bench_conformance", ["--quick", "--fcl-dir", "{tmp}/no"], "`{tmp}/no` is not a directory"),
+    ("bench_teach", ["--only-fit", "--epochs", "-3"], "argument --epochs: `-3`: must be at least 1"),
+    ("bench_teach", ["--only-fit", "--lesson", "{tmp}"], "`{tmp}` is a directory, not a lesson"),
+    ("fuzz", ["--per-format", "-1"], "argument --per-format: `-1`: must be at least 1"),
+    ("kill", ["--trials", "-1"], "argument --trials: `-1`: must be at least 1"),
+    ("bench_export", ["--bogus"], "unrecognized arguments: --bogus"),
+    ("bench_knowledge", ["--bogus"], "unrecognized arguments: --bogus"),
+])
+def test_a_wrong_option_value_is_a_usage_error_before_anything_runs(name, argv, said, tmp_path,
+                                                                    monkeypatch, capsys):
+    module = script(name, monkeypatch)
+    monkeypatch.setattr(sys, "argv", [f"{name}.py", *(a.format(tmp=tmp_path) for a in argv)])
+    with pytest.raises(SystemExit) as exit_:
+        module.main()
+    assert exit_.value.code == 2
+    err = capsys.readouterr().err
+    assert said.format(tmp=tmp_path) in err and "Traceback" not in err
+
+
+def test_export_and_knowledge_have_a_usage_text(monkeypatch, capsys):
+    for name in ("bench_export", "bench_knowledge"):
+        module = script(name, monkeypatch)
+        monkeypatch.setattr(sys, "argv", [f"{name}.py", "--help"])
+        with pytest.raises(SystemExit) as exit_:
+            module.main()
+        assert exit_.value.code == 0
+        assert capsys.readouterr().out.startswith(f"usage: {name}.py [-h]")
+
+
+@pytest.mark.parametrize("name, argv, said", [
+    ("bench_drive", ["--barn", "1", "--rules", "{tmp}/old.rules"], "rule file `{tmp}/old.rules` not found"),
+    ("bench_compare", ["--runs", "1", "--skip-dask", "--world", "{tmp}/nosuch.yaml"],
+     "world file `{tmp}/nosuch.yaml` not found"),
+])
+def test_a_missing_file_is_said_in_one_line_not_a_traceback(name, argv, said, tmp_path,
+                                                            monkeypatch, capsys):
+    module = script(name, monkeypatch)
+    monkeypatch.setattr(sys, "argv", [f"{name}.py", *(a.format(tmp=tmp_path) for a in argv)])
+    assert module.main() == 1
+    err = capsys.readouterr().err
+    assert said.format(tmp=tmp_path) in err.splitlines()[0] and "Traceback" not in err
+
+
+def test_a_missing_peer_is_named_not_printed_as_nan(monkeypatch, capsys):
+    import importlib.util
+
+    for name, argv in (("bench_export", []), ("bench_conformance", ["--quick"])):
+        module = script(name, monkeypatch)
+        found = importlib.util.find_spec
+        monkeypatch.setattr(importlib.util, "find_spec",
+                            lambda m, *a, _found=found: None if m == "fuzzylite" else _found(m, *a))
+        monkeypatch.setattr(sys, "argv", [f"{name}.py", *argv])
+        with pytest.raises(SystemExit) as exit_:
+            module.main()
+        message = str(exit_.value.code)
+        assert message.startswith(f"{name}.py: the peers it is measured against are not "
+                                  f"installed (pyfuzzylite)")
+        monkeypatch.undo()
+
+
+def test_the_fuzz_table_has_as_many_cells_in_its_delimiter_row_as_in_its_header(monkeypatch):
+    lines = script("fuzz", monkeypatch).table([]).splitlines()
+    assert lines[0].count("|") == lines[1].count("|") == lines[2].count("|")
