@@ -61,13 +61,14 @@ def test_refused_and_failed_tasks_are_counted_in_generated_notes(tmp_path, capsy
 
 
 def kept_rows(tmp_path: Path, text: str) -> Path:
-    kept = tmp_path / "rows.jsonl"
-    kept.write_text(text)
-    return kept
+    """``rows.jsonl`` in the current directory (a short name: messages shorten long ones)."""
+    (tmp_path / "rows.jsonl").write_text(text)
+    return Path("rows.jsonl")
 
 
 def test_from_rows_names_a_damaged_line_by_its_number_and_drops_a_torn_last_one(tmp_path,
-                                                                             capsys):
+                                                                             monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
     good = json.dumps({"suite": "mrpb", "world": "a", "refused": None, "length": 787.4,
                        "runs": {"fuzzy": run("success")}}) + "\n"
     kept = kept_rows(tmp_path, good * 3 + '{"bad": \n' + good)
@@ -83,7 +84,8 @@ def test_from_rows_names_a_damaged_line_by_its_number_and_drops_a_torn_last_one(
 
 
 @pytest.mark.parametrize("text", ["[1, 2]\n", '{"runs": 5}\n', '{"suite": "mrpb"}\n'])
-def test_from_rows_refuses_json_that_is_not_a_row(text, tmp_path, capsys):
+def test_from_rows_refuses_json_that_is_not_a_row(text, tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
     kept = kept_rows(tmp_path, text)
     assert bench_nav.main(["--from-rows", str(kept)]) == 1
     err = capsys.readouterr().err
