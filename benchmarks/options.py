@@ -6,7 +6,6 @@ from __future__ import annotations
 
 import argparse
 import functools
-import os
 import subprocess
 import sys
 from collections.abc import Callable
@@ -57,17 +56,16 @@ def existing_file(text: str) -> Path:
 
 
 def writable(text: str) -> Path:
-    """A file the run will write, checked now: a path it cannot write is said before the run,
-    not after it with the figures lost."""
-    path = Path(text)
-    parent = path.parent if str(path.parent) else Path(".")
-    if path.is_dir():
-        raise argparse.ArgumentTypeError(f"cannot write to `{text}`: it is a directory")
-    if not parent.is_dir():
-        raise argparse.ArgumentTypeError(f"cannot write to `{text}`: no directory `{parent}`")
-    if not os.access(path if path.exists() else parent, os.W_OK):
-        raise argparse.ArgumentTypeError(f"cannot write to `{text}`: permission denied")
-    return path
+    """A file the run will write, checked now (:func:`mitos_cli.fileio.check_writable`, as
+    the commands check theirs): a path it cannot write is said before the run, not after it
+    with the figures lost."""
+    from mitos_cli.fileio import check_writable
+
+    try:
+        check_writable(text)
+    except MitosError as exc:
+        raise argparse.ArgumentTypeError(exc.message) from None
+    return Path(text)
 
 
 def revision(text: str) -> str:
