@@ -67,6 +67,24 @@ def test_parameters_that_must_differ_are_named_as_the_shape_names_them(spec, wor
         termset({"T": spec})
 
 
+@pytest.mark.parametrize("name, words", [
+    ("very", "term `road.very` is a hedge word"),
+    ("not", "term `road.not` is a keyword"),
+    ('"a.b"', "term `road.a.b` holds what a name in a rule cannot"),
+    ('"1x"', "term `road.1x` holds what a name in a rule cannot"),
+])
+def test_a_term_name_no_rule_could_write_is_refused_at_its_key(name, words):
+    """A term named `very` or `a.b` was read, and every rule naming it was a syntax error in
+    the rule file; keywords a rule reads as names where one stands (`end`, `is`) still are."""
+    from mitos_cli.errors import TermSetError
+
+    with pytest.raises(TermSetError, match=re.escape(words)) as info:
+        termset({name: "{shape: triangle, peak: 70, width: 30}", "W": "80"})
+    assert (info.value.span.line, info.value.span.column) == (6, 7)
+    for fine in ("end", "is", "x-y", "_a"):
+        assert termset({fine: "80"}).variables[0].term(fine)
+
+
 @pytest.mark.parametrize("value", ["yes", "off", "1"])
 def test_frozen_refuses_what_is_not_true_or_false(value):
     """`frozen: yes` froze the term (YAML 1.1 reads it as true) while `frozen: 1` was refused;

@@ -29,11 +29,13 @@ same as a bare number) or ``{shape: linear, coefficients: {road: 0.5, size: -1},
 from __future__ import annotations
 
 import math
+import re
 from pathlib import Path
 from typing import Any
 
 from ..errors import Span, TermSetError, did_you_mean
 from ..fuzzy.formula import parse as parse_formula
+from ..fuzzy.hedges import HEDGES
 from ..fuzzy.shapes import SHAPES
 from ..words import plural
 from . import yamlpos
@@ -104,9 +106,28 @@ def parse_termset(text: str, path: str | None = None) -> TermSet:
     return TermSet(out, path)
 
 
+#: a name a rule can write (the rule language's NAME)
+_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_\-]*[A-Za-z0-9_]|[A-Za-z_]")
+
+
+def _writable(name: Any, span: Span, what: str) -> None:
+    """Refuse a name no rule could write (docs/language.md, "Words and names"): characters
+    the rule language's names do not take (`a.b`, `1x`), a hedge or `not` (`x is very` reads
+    a hedge before a term). Such a name was read, and every rule naming it was a syntax error
+    in the rule file."""
+    text = str(name)
+    if _NAME.fullmatch(text) and text not in HEDGES and text != "not":
+        return
+    why = ("is a hedge word" if text in HEDGES else "is a keyword" if text == "not" else
+           "holds what a name in a rule cannot (letters, digits, `_` and `-`, starting with a "
+           "letter or `_`)")
+    raise TermSetError(f"{what} {why}, so no rule could name it", span=span, hint="rename it")
+
+
 def _variable(name: str, spec: Any, key_span: Span, value_span: Span,
               inputs: tuple[str, ...] = ()) -> Variable:
     what = f"variable `{name}`"
+    _writable(name, key_span, what)
     spec = yamlpos.expect_map(spec, value_span, TermSetError, what)
     yamlpos.check_keys(spec, VARIABLE_KEYS, TermSetError, what)
     role = yamlpos.require(spec, "role", TermSetError, what)
@@ -165,6 +186,7 @@ def _variable(name: str, spec: Any, key_span: Span, value_span: Span,
 def _term(name: str, spec: Any, key_span: Span, value_span: Span, variable: str,
           inputs: tuple[str, ...] = ()) -> Term:
     what = f"term `{variable}.{name}`"
+    _writable(name, key_span, what)
     if isinstance(spec, (int, float)) and not isinstance(spec, bool):
         value = yamlpos.expect_number(spec, value_span, TermSetError, what)
         return Term(name, "singleton", (value,), key_span)
