@@ -608,11 +608,19 @@ def test_network_refuses_what_it_would_ignore(capsys, tmp_path):
     """`--batch ok.csv --network` printed the network and ignored the batch."""
     csv = tmp_path / "ok.csv"
     csv.write_text("road,size,position\n78,45,4\n", encoding="utf-8")
-    for extra in (["--batch", str(csv)], ["road=78", "size=45", "position=4"], ["--json"]):
+    for extra in (["--batch", str(csv)], ["road=78", "size=45", "position=4"], ["--json"],
+                  ["--digits", "3"]):
         code, out, err = run_main(["eval", "--network", *extra], capsys)
         assert code == 2 and out == "" and "--network prints the rule base's network" in err
     code, out, _ = run_main(["eval", "--network"], capsys)
     assert code == 0 and out
+
+
+def test_json_refuses_digits_it_would_ignore(capsys):
+    """`--json --digits 3` was taken and printed every digit: --json keeps them all."""
+    code, out, err = run_main(["eval", "road=78", "size=45", "position=4", "--json",
+                               "--digits", "3"], capsys)
+    assert code == 2 and out == "" and "--json gives every digit" in err
 
 
 def test_json_says_an_input_was_clamped_and_what_was_given(capsys):

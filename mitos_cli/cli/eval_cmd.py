@@ -178,9 +178,10 @@ def eval_command(
     path, values = split_args(args or [])
     rb = _loaded(path, behavior, fidelity)
     if network:
-        if batch is not None or values or as_json:
+        if batch is not None or values or as_json or digits is not None:
             raise typer.BadParameter("--network prints the rule base's network and evaluates "
-                                     "nothing: leave out --batch, --json and NAME=VALUE")
+                                     "nothing: leave out --batch, --json, --digits and "
+                                     "NAME=VALUE")
         from ..engine.describe import describe_network
 
         emit(describe_network(rb.compiled))
@@ -198,6 +199,10 @@ def eval_command(
     if not values:
         raise typer.BadParameter(
             "give one NAME=VALUE per input: " + " ".join(f"{k}=..." for k in rb.inputs))
+    if as_json and digits is not None:      # (it was taken and did nothing)
+        raise typer.BadParameter("--json gives every digit (the shortest text that reads back "
+                                 "as the same number); --digits rounds the trace and a "
+                                 "--batch's outputs: leave one of them out")
     _evaluate_one(rb, values, as_json, digits)
 
 
