@@ -381,7 +381,7 @@ def main() -> None:
                                                          "*.fis"))))
     if args.fcl_dir:
         part = part_fcl_dir(args.fcl_dir)
-        report_rows(f"5. FCL files under {args.fcl_dir}", part)
+        report_rows(f"FCL files under {args.fcl_dir} (--fcl-dir; round trips in 4)", part)
         unexpected = [n for n, s, why, _ in part["rows"] if "unexpected" in why]
         print(f"  refused without naming a construct: {len(unexpected)}"
               + (f" ({', '.join(unexpected)})" if unexpected else ""))
