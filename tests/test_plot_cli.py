@@ -417,3 +417,20 @@ def test_a_surface_of_many_fixed_inputs_wraps_its_title_and_warns_of_nothing(tmp
                             "--style", "heatmap", "-o", str(out)], capsys)
     assert code == 0, err
     assert "Warning" not in err and out.read_bytes().startswith(PNG)
+
+
+def test_a_formula_term_outside_0_1_is_drawn_with_a_warning(capsys, tmp_path):
+    """`eval` and `check` refuse a formula term that leaves [0, 1]; `plot terms` drew it
+    without a word, as if it worked."""
+    (tmp_path / "f.terms.yaml").write_text(
+        "variables:\n"
+        "  x: {role: input, universe: [0, 10], terms: {LO: {shape: left_shoulder, points: [2, 8]},"
+        " HI: {shape: formula, formula: \"x/5\"}}}\n"
+        "  y: {role: output, universe: [0, 100], default: 50, terms: {A: 0, B: 100}}\n")
+    rules = tmp_path / "f.rules"
+    rules.write_text('terms "f.terms.yaml"\nr1: if x is LO then y is A\nr2: if x is HI then y is B\n')
+    code, out, err = run(["plot", "terms", str(rules)], capsys)
+    assert code == 0 and out
+    assert "warning: term `x.HI` gives 1." in err and "a membership degree lies in [0, 1]" in err
+    code, _, err = run(["plot", "terms"], capsys)
+    assert code == 0 and "membership degree" not in err

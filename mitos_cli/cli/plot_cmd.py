@@ -149,6 +149,7 @@ def terms_command(
         if p.clamped:
             lo, hi = p.universe
             warn(f"`{p.name}` outside its universe [{lo:g}, {hi:g}] was clamped")
+        _warn_no_degree(p)
     if not _wants_picture(output, show):
         from ..draw.terminal import render_sheet
 
@@ -167,6 +168,20 @@ def terms_command(
     show, why = _window(output, show)
     draw_sheet(plots, output, title=title, show=show)
     _done(output, why)
+
+
+def _warn_no_degree(plot) -> None:
+    """Say where a drawn term (a formula) leaves [0, 1], which `eval` and `check` refuse: the
+    picture shows it, and without a word it looked like a term that works."""
+    import numpy as np
+
+    for c in plot.curves:
+        bad = np.flatnonzero(~((c.y >= 0.0) & (c.y <= 1.0))) if c.kind == "curve" else []
+        if len(bad):
+            at = int(bad[0])
+            warn(f"term `{plot.name}.{c.name}` gives {float(c.y[at]):g} at {plot.name} = "
+                 f"{float(c.x[at]):g}: a membership degree lies in [0, 1] (`eval` and `check` "
+                 f"refuse it)")
 
 
 def _axis(text: str, option: str) -> tuple[str, Optional[tuple[float, float]]]:
