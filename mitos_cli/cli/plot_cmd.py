@@ -176,7 +176,9 @@ def _warn_no_degree(plot) -> None:
     import numpy as np
 
     for c in plot.curves:
-        bad = np.flatnonzero(~((c.y >= 0.0) & (c.y <= 1.0))) if c.kind == "curve" else []
+        if c.kind != "curve":
+            continue
+        bad = np.flatnonzero(~((c.y >= 0.0) & (c.y <= 1.0)))
         if len(bad):
             at = int(bad[0])
             warn(f"term `{plot.name}.{c.name}` gives {float(c.y[at]):g} at {plot.name} = "
