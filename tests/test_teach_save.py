@@ -381,6 +381,25 @@ def test_operators_told_at_top_level_are_set_where_the_file_sets_them(tmp_path):
                                                resolve(s.rulebase.operators))
 
 
+def test_operators_told_in_a_behavior_are_set_where_the_behavior_sets_them(tmp_path):
+    """Two `operators:` lines of one behavior setting a key again are read with a warning
+    too, so a save changes the key on the behavior's own line rather than adding another."""
+    (tmp_path / "t.terms.yaml").write_text(LO_HI)
+    (tmp_path / "t.rules").write_text(
+        'terms "t.terms.yaml"\nbehavior b:\n    operators: and = min\n'
+        "    r1: if x is LO and x is HI then y is 20\nend\n")
+    s = Session(tmp_path / "t.rules", out=[].append)
+    s.run("operators: and = product")
+    s.run(f"save {tmp_path / 'o.rules'}")
+    text = (tmp_path / "o.rules").read_text()
+    assert "    operators: and = product\n" in text and text.count("operators:") == 1
+    saved = load_rules_file(tmp_path / "o.rules")
+    assert saved.notes == () and saved.behavior("b").operators == s.rulebase.behavior("b").operators[-1:]
+    (tmp_path / "twice.rules").write_text(text.replace("end\n", "    operators: and = min\nend\n"))
+    notes = load_rules_file(tmp_path / "twice.rules").notes
+    assert len(notes) == 1 and "the later line wins for behavior `b`" in notes[0]
+
+
 def test_save_refuses_to_write_over_a_term_set_the_rule_file_reads(tmp_path):
     (tmp_path / "a.rules").write_text(
         'terms "b.terms.yaml"\nbehavior b:\n    r0: if x is LO then y is A\n'

@@ -164,24 +164,27 @@ def build_rulebase(parsed: ParsedFile, termsets: tuple[TermSet, ...],
         ops_mod.resolve(b.operators, base_ops)
         _check_behavior(b, variables, names, labels)
     rb = RuleBase(parsed.path, termsets, tuple(behaviors), parsed.operators, termset_paths,
-                  notes=set_again(parsed.operators))
+                  notes=set_again(parsed.operators)
+                  + tuple(n for b in behaviors for n in set_again(b.operators, b.name)))
     _check_uses(rb)
     return rb
 
 
-def set_again(settings: tuple[Setting, ...]) -> tuple[str, ...]:
-    """A note for each operator a later file-level ``operators:`` line sets again: the lines
-    merge, key by key, the last one winning for the whole file, which was done without a
-    word (one line setting a key twice is an error)."""
+def set_again(settings: tuple[Setting, ...], behavior: str | None = None) -> tuple[str, ...]:
+    """A note for each operator a later ``operators:`` line of the file's top level (or of
+    ``behavior``) sets again: the lines merge, key by key, the last one winning, which was
+    done without a word (one line setting a key twice is an error)."""
     first: dict[str, Setting] = {}
     notes = []
+    scope = f"behavior `{behavior}`" if behavior else "the whole file"
+    aside = "" if behavior else " (a behavior's own `operators:` line sets it for that behavior)"
     for s in settings:
         before = first.setdefault(s.key, s)
         if before is s or before.span is None or s.span is None:
             continue
         notes.append(f"{s.span}: `{s.key}` is set again (`{s.value}`; line {before.span.line} "
-                     f"set `{before.value}`): the later line wins for the whole file; keep one "
-                     f"`{s.key}` (a behavior's own `operators:` line sets it for that behavior)")
+                     f"set `{before.value}`): the later line wins for {scope}; keep one "
+                     f"`{s.key}`{aside}")
     return tuple(notes)
 
 

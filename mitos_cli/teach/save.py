@@ -349,7 +349,8 @@ class _Place:
                                 # by variable)); a session keeps its rules' places
     end_line_start: int | None  # offset of the line holding `end` (None: top level)
     indent: str
-    #: top level: where each operator is last set on an `operators:` line (start, end)
+    #: where each operator is last set on an `operators:` line (start, end): the file's
+    #: top level, or the behavior's own lines
     settings: dict[str, tuple[int, int]] = field(default_factory=dict)
 
 
@@ -389,14 +390,15 @@ def _places(text: str) -> tuple[dict[str, _Place], list[Token]]:
         elif item.data == "terms_stmt":
             terms_tokens += [t for t in item.children if isinstance(t, Token)]
         elif item.data == "operators_stmt":
-            top.settings.update((str(a.children[0]), (a.meta.start_pos, a.meta.end_pos))
-                                for a in item.children
-                                if isinstance(a, Tree) and a.data == "op_assign")
+            top.settings.update(_settings_at(item))
         elif item.data == "behavior":
             name = str(item.children[0])
             rules = []
             indent = "    "
+            settings: dict[str, tuple[int, int]] = {}
             for sub in item.children[1:]:
+                if isinstance(sub, Tree) and sub.data == "operators_stmt":
+                    settings.update(_settings_at(sub))
                 if isinstance(sub, Tree) and sub.data == "rule":
                     rules.append(_rule_place(sub))
                     line_start = text.rfind("\n", 0, sub.meta.start_pos) + 1
@@ -407,10 +409,16 @@ def _places(text: str) -> tuple[dict[str, _Place], list[Token]]:
             line_start = text.rfind("\n", 0, end_kw) + 1
             if text[line_start:end_kw].strip():          # `end` shares its line: insert before it
                 line_start = end_kw
-            places[name] = _Place(rules, line_start, indent)
+            places[name] = _Place(rules, line_start, indent, settings)
     if top.rules:
         places["main"] = top
     return places, terms_tokens
+
+
+def _settings_at(stmt: Tree) -> dict[str, tuple[int, int]]:
+    """Where an ``operators:`` line sets each operator (start, end of ``key = value``)."""
+    return {str(a.children[0]): (a.meta.start_pos, a.meta.end_pos) for a in stmt.children
+            if isinstance(a, Tree) and a.data == "op_assign"}
 
 
 def edit_rules(text: str, path: str, original: RuleBase, current: RuleBase,
@@ -468,11 +476,10 @@ def edit_rules(text: str, path: str, original: RuleBase, current: RuleBase,
         told = b.operators[len(old.operators):]
         if told:
             changes.append(f"{b.name}: operators {_operators_text(told)}")
-            kept = [s for s in told if place is None or place.end_line_start is not None
-                    or s.key not in place.settings]
-            if place is not None and place.end_line_start is None:
-                # set where the file already sets it: a second file-level line setting the
-                # same key is read with a warning
+            kept = [s for s in told if place is None or s.key not in place.settings]
+            if place is not None:
+                # set where the file (or the behavior) already sets it: a second line
+                # setting the same key is read with a warning
                 for key, value in _last_values(told).items():
                     if key in place.settings:
                         edits.append((*place.settings[key], f"{key} = {value}"))
