@@ -476,6 +476,8 @@ def skipped_corners(compiled: CompiledRuleBase, inputs: list[int],
 
 def listed_names(names: tuple[str, ...] | list[str], most: int = 4) -> str:
     """``a, b, c and 10 more`` (backquoted)."""
+    if not names:
+        return "no input"
     shown = [f"`{n}`" for n in names[:most]]
     more = len(names) - len(shown)
     if more:
