@@ -97,12 +97,16 @@ LO_HI = ("variables:\n  x: {role: input, universe: [0, 10], terms: {"
          "points: [2, 8]}}}\n  y: {role: output, universe: [0, 100], terms: {A: 0}}\n")
 
 
-def test_crisp_consequents_are_edited_in_place(tmp_path):
+def lo_hi_session(tmp_path, rules: str) -> Session:
+    """A session on ``t.rules`` (its text ``rules``) and ``t.terms.yaml`` (:data:`LO_HI`)."""
     (tmp_path / "t.terms.yaml").write_text(LO_HI)
-    (tmp_path / "t.rules").write_text(
-        'terms "t.terms.yaml"\n# comment\nr1: if x is LO\n   then y is 20   # low\n'
-        "r2: if x is HI then y is 80\n")
-    s = Session(tmp_path / "t.rules", out=[].append)
+    (tmp_path / "t.rules").write_text(rules)
+    return Session(tmp_path / "t.rules", out=[].append)
+
+
+def test_crisp_consequents_are_edited_in_place(tmp_path):
+    s = lo_hi_session(tmp_path, 'terms "t.terms.yaml"\n# comment\nr1: if x is LO\n'
+                                '   then y is 20   # low\nr2: if x is HI then y is 80\n')
     s.run("correct x=0 -> y=30")
     s.run("correct x=10 -> y=70")
     s.run("adapt epochs 30")
@@ -117,11 +121,9 @@ def test_crisp_consequents_are_edited_in_place(tmp_path):
 def test_unlabelled_rules_are_saved_in_their_places(tmp_path):
     """Labels are optional: an unlabelled rule is edited where it stands, and a rule told
     without a label is added once, not every unlabelled rule of the file again."""
-    (tmp_path / "t.terms.yaml").write_text(LO_HI)
-    (tmp_path / "t.rules").write_text(
-        'terms "t.terms.yaml"\nbehavior b:\n    if x is LO then y is 20   # low\n'
-        "    if x is HI then y is 80\nend\n")
-    s = Session(tmp_path / "t.rules", out=[].append)
+    s = lo_hi_session(tmp_path, 'terms "t.terms.yaml"\nbehavior b:\n'
+                                '    if x is LO then y is 20   # low\n'
+                                "    if x is HI then y is 80\nend\n")
     s.run(f"save {tmp_path / 'same.rules'}")
     assert (tmp_path / "same.rules").read_text() == (
         (tmp_path / "t.rules").read_text().replace("t.terms", "same.terms"))
@@ -362,11 +364,8 @@ def test_operators_told_twice_are_saved_as_one_setting(rules, tmp_path):
 def test_operators_told_at_top_level_are_set_where_the_file_sets_them(tmp_path):
     """A second file-level `operators:` line setting a key again is read with a warning;
     a save changes the key where the file sets it, and adds a line only for the others."""
-    (tmp_path / "t.terms.yaml").write_text(LO_HI)
-    (tmp_path / "t.rules").write_text(
-        'terms "t.terms.yaml"\noperators: and = min, or = max   # ours\n'
-        "r1: if x is LO then y is 20\nr2: if x is HI and x is LO then y is 80\n")
-    s = Session(tmp_path / "t.rules", out=[].append)
+    s = lo_hi_session(tmp_path, 'terms "t.terms.yaml"\noperators: and = min, or = max   # ours\n'
+                                "r1: if x is LO then y is 20\nr2: if x is HI and x is LO then y is 80\n")
     s.run("operators: and = product")
     s.run("operators: inference = weighted_sum")
     s.run(f"save {tmp_path / 'o.rules'}")
@@ -384,11 +383,8 @@ def test_operators_told_at_top_level_are_set_where_the_file_sets_them(tmp_path):
 def test_operators_told_in_a_behavior_are_set_where_the_behavior_sets_them(tmp_path):
     """Two `operators:` lines of one behavior setting a key again are read with a warning
     too, so a save changes the key on the behavior's own line rather than adding another."""
-    (tmp_path / "t.terms.yaml").write_text(LO_HI)
-    (tmp_path / "t.rules").write_text(
-        'terms "t.terms.yaml"\nbehavior b:\n    operators: and = min\n'
-        "    r1: if x is LO and x is HI then y is 20\nend\n")
-    s = Session(tmp_path / "t.rules", out=[].append)
+    s = lo_hi_session(tmp_path, 'terms "t.terms.yaml"\nbehavior b:\n    operators: and = min\n'
+                                "    r1: if x is LO and x is HI then y is 20\nend\n")
     s.run("operators: and = product")
     s.run(f"save {tmp_path / 'o.rules'}")
     text = (tmp_path / "o.rules").read_text()
