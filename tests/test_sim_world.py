@@ -167,10 +167,29 @@ def test_a_goal_off_the_map_is_outside_the_map_not_inside_a_wall(tmp_path: Path)
     assert ("w.yaml:10:9: world error: the goal (q_goal) at (300, 0) lies outside the map "
             "`map.yaml` (x 0 to 120, y 0 to 120 in)") in msg
     assert "check the map's `origin` and `resolution`" in msg
-    corridor = "  corridors:\n    - points: [[0, 60], [400, 60]]\n      width: 40\n"
-    with pytest.raises(WorldError) as info:
-        load_world(_free_map(tmp_path, corridor))
-    assert "hint: a corridor carved into a map ends at the map's edge" in info.value.render()
+
+
+def test_a_corridor_carved_past_the_maps_edge_grows_the_map(tmp_path: Path):
+    """A corridor carved into a map ended at the map's edge without a word (all beyond it
+    solid), and a goal in it was "inside a wall": the map now grows, by whole cells of wall,
+    to hold its corridors, its own cells where they were."""
+    from mitos_cli.sim.loop import simulate
+    from mitos_cli.sim.staticmap import build_static
+
+    corridor = "  corridors:\n    - points: [[30, 60], [400, 60]]\n      width: 40\n"
+    path = _free_map(tmp_path, corridor)
+    path.write_text(path.read_text().replace("q_goal: {x: 300, y: 0}", "q_goal: {x: 380, y: 60}")
+                    .replace("time_limit: 10", "time_limit: 30"))
+    world = load_world(path)
+    static = build_static(world)
+    assert static.bounds[0] == 0 and static.bounds[2] >= 420      # 120 in of map, grown
+    assert static.grid is not None and static.grid.origin == (0.0, 0.0)
+    assert static.free([[380, 60], [300, 60]]).all() and not static.free([[300, 100]])[0]
+    assert simulate(world, seed=1).outcome == "success"
+    far = "  corridors:\n    - points: [[30, 60], [9000000, 60]]\n      width: 40\n"
+    with pytest.raises(WorldError, match="the corridors reach so far past the map `map.yaml` "
+                                         "that it would grow to 1.08e"):
+        load_world(_free_map(tmp_path, far))
 
 
 def test_unknown_map_key_in_map_yaml(tmp_path: Path):

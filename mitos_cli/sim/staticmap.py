@@ -5,15 +5,18 @@ sensors see and the robot can hit) and a ``free(points)`` test. Corridors are re
 per polyline piece, stretched by half the width beyond each end so that corners and
 intersections fall out of their overlaps; a wall is every rectangle side minus what lies inside
 another rectangle. A grid's walls are the cell edges between blocked and free cells, merged
-into runs. With both, the corridors are carved into the grid first.
+into runs. With both, the corridors are carved into the grid first, grown to hold them.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
+from ..errors import WorldError
 from .geometry import clip_segment_outside, points_in_polygon, rect_corners
 from .world import Corridor, Grid, World
 
@@ -68,14 +71,46 @@ def grid_walls(grid: Grid) -> np.ndarray:
     return np.concatenate([horiz, vert]).astype(float)
 
 
+#: The most cells a grid grown to hold its corridors may have (a 16-bit 8,000 x 8,000 image,
+#: the largest map read, has 6.4e7): a corridor miles off the map is a mistake, not a plan.
+MAX_GROWN = 64_000_000
+
+
 def carve(grid: Grid, rects: np.ndarray) -> Grid:
-    """The grid with every cell whose centre lies in a corridor made free."""
+    """The grid with every cell whose centre lies in a corridor made free, grown first by
+    whole cells of wall to hold every corridor (:func:`covering`)."""
+    grid = covering(grid, rects)
     rows, cols = grid.occupied.shape
     ys, xs = np.mgrid[0:rows, 0:cols]
     centres = np.stack([grid.origin[0] + (xs.ravel() + 0.5) * grid.resolution,
                         grid.origin[1] + (ys.ravel() + 0.5) * grid.resolution], axis=1)
     inside = points_in_polygon(centres, rects).any(axis=1).reshape(rows, cols)
     return Grid(grid.occupied & ~inside, grid.resolution, grid.origin, grid.source)
+
+
+def covering(grid: Grid, rects: np.ndarray) -> Grid:
+    """``grid`` grown by whole cells of wall (its cells where they were) until it holds every
+    corridor rectangle ``rects [Q, 4, 2]``: a corridor carved into a map used to end at the
+    map's edge without a word, all beyond it solid."""
+    if not len(rects):
+        return grid
+    res, (ox, oy) = grid.resolution, grid.origin
+    rows, cols = grid.occupied.shape
+    lo, hi = rects.reshape(-1, 2).min(axis=0), rects.reshape(-1, 2).max(axis=0)
+    left, bottom = (max(0, math.ceil((o - m) / res)) for o, m in zip((ox, oy), lo))
+    right = max(0, math.ceil((hi[0] - (ox + cols * res)) / res))
+    top = max(0, math.ceil((hi[1] - (oy + rows * res)) / res))
+    if not (left or bottom or right or top):
+        return grid
+    size = (rows + bottom + top) * (cols + left + right)
+    if size > MAX_GROWN:
+        name = f" `{Path(grid.source).name}`" if grid.source else ""
+        raise WorldError(f"the corridors reach so far past the map{name} that it would grow to "
+                         f"{size:.3g} cells, more than {MAX_GROWN:.3g}",
+                         hint="check the corridors' points (inches) and the map's `origin` and "
+                              "`resolution` (metres)")
+    occupied = np.pad(grid.occupied, ((bottom, top), (left, right)), constant_values=True)
+    return Grid(occupied, res, (ox - left * res, oy - bottom * res), grid.source)
 
 
 @dataclass(frozen=True)

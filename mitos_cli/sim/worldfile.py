@@ -632,9 +632,8 @@ def check_free(world: World, spans: list[tuple[Span, Span]]) -> StaticMap:
                 off = _off_the_grid(static, p.x, p.y)
                 if off is not None:
                     raise WorldError(f"the {what}{who} at ({p.x:g}, {p.y:g}) {off}", span=span,
-                                     hint="a corridor carved into a map ends at the map's edge"
-                                     if world.corridors else "check the map's `origin` and "
-                                     "`resolution` (metres, in its YAML) and the point (inches)")
+                                     hint="check the map's `origin` and `resolution` (metres, "
+                                          "in its YAML) and the point (inches)")
                 raise WorldError(f"the {what}{who} at ({p.x:g}, {p.y:g}) lies inside a wall",
                                  span=span, hint=_units_hint(world, agent)
                                  or "move it into a corridor (free space)")
