@@ -45,16 +45,6 @@ def directory(text: str) -> Path:
     return path
 
 
-def existing_file(text: str) -> Path:
-    """An existing file, not a directory."""
-    path = Path(text)
-    if path.is_dir():
-        raise argparse.ArgumentTypeError(f"`{text}` is a directory, not a file")
-    if not path.is_file():
-        raise argparse.ArgumentTypeError(f"`{text}` not found")
-    return path
-
-
 def writable(text: str) -> Path:
     """A file the run will write, checked now (:func:`mitos_cli.fileio.check_writable`, as
     the commands check theirs): a path it cannot write is said before the run, not after it
