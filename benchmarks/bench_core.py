@@ -43,9 +43,9 @@ import time
 from pathlib import Path
 
 import numpy as np
-from options import revision
+from options import guarded, revision
 from peers import require
-from revision import package_of
+from revision import differs, foreign, package_of
 
 from mitos_cli import load_rulebase
 from mitos_cli.engine.evaluation import evaluate
@@ -291,7 +291,7 @@ def against(rev: str, quick: bool = False) -> None:
 
     host = machine()
     n, rounds, single_n, runs = (10**5, 5, 200, 5) if quick else (10**6, 20, 2000, 21)
-    with tempfile.TemporaryDirectory() as tmp:
+    with tempfile.TemporaryDirectory() as tmp, foreign(rev):
         theirs = package_of(rev, Path(tmp), ("mitos_cli", "rulebases", "grammar"))
         saved = os.environ.get("MITOS_CACHE_DIR")
         os.environ["MITOS_CACHE_DIR"] = "off"    # the cache pickles this tree's classes
@@ -308,7 +308,9 @@ def against(rev: str, quick: bool = False) -> None:
         columns = {name: np.ascontiguousarray(X[:, j]) for j, name in enumerate(c.inputs)}
         kernel = PaperKernel(rb)
         a, b = old.evaluate(**columns), rb.evaluate(**columns)
-        assert all(np.array_equal(a[o].view(np.uint64), b[o].view(np.uint64)) for o in c.outputs)
+        if not all(np.array_equal(a[o].view(np.uint64), b[o].view(np.uint64))
+                   for o in c.outputs):
+            raise differs("the packaged rule base's column batch", rev)
         fns = {"kernel": lambda: kernel(X), rev: lambda: old.evaluate(**columns),
                "this tree": lambda: rb.evaluate(**columns)}
         wall = {k: float("inf") for k in fns}
@@ -405,7 +407,8 @@ def fmt_time(s: float) -> str:
 
 # ---------------------------------------------------------------------------------------------
 
-def main() -> None:
+@guarded
+def main(argv: list[str] | None = None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--quick", action="store_true", help="small sizes, for a smoke run")
     ap.add_argument("--startup", action="store_true",
@@ -413,7 +416,7 @@ def main() -> None:
     ap.add_argument("--against", metavar="REV", type=revision,
                     help="only the column batch, one evaluation and start-up of this tree against "
                          "git revision REV's (e.g. main), in one process, rounds interleaved")
-    args = ap.parse_args()
+    args = ap.parse_args(argv)
     if args.startup:
         startup(runs=21)
         return
@@ -568,4 +571,4 @@ def _version(dist: str) -> str:
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())

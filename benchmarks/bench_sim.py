@@ -54,9 +54,8 @@ from pathlib import Path
 
 import numpy as np
 from options import guarded, positive_int, revision
-from revision import package_of
+from revision import differs, foreign, package_of
 
-from mitos_cli.errors import MitosError
 from mitos_cli.resources import packaged_path
 from mitos_cli.sim.lockstep import run_lockstep
 from mitos_cli.sim.loop import Simulation, prepare, simulate
@@ -147,6 +146,9 @@ def against_runs(rev: str, theirs, planner_name: str = "drive", rounds: int = 7)
             scene = loop.prepare(world)
             setups[name, tree] = (loop, world, fuzzy, scene, loop.simulate(world, fuzzy,
                                                                            scene=scene))
+        mine, old = setups[name, "this tree"][4], setups[name, rev][4]
+        if mine.summary() != old.summary() or mine.pose.tobytes() != old.pose.tobytes():
+            raise differs(f"{name}'s run", rev)         # before any round is timed
     best: dict[tuple[str, str], float] = {}
     for _ in range(rounds):
         for key, (loop, world, fuzzy, scene, _) in setups.items():
@@ -154,9 +156,7 @@ def against_runs(rev: str, theirs, planner_name: str = "drive", rounds: int = 7)
             loop.simulate(world, fuzzy, scene=scene)
             best[key] = min(best.get(key, math.inf), time.process_time() - c)
     for name in ("slalom.yaml", "office.yaml"):
-        mine, old = setups[name, "this tree"][4], setups[name, rev][4]
-        if mine.summary() != old.summary() or mine.pose.tobytes() != old.pose.tobytes():
-            raise differs(f"{name}'s run", rev)
+        mine = setups[name, "this tree"][4]
         rates = {tree: mine.ticks / best[name, tree] for tree in ("this tree", rev)}
         print(f"   {name[:-5]}: {mine.ticks} ticks, this tree {rates['this tree']:,.0f} ticks/s "
               f"({1e6 / rates['this tree']:.0f} us/tick), {rev} {rates[rev]:,.0f} ticks/s "
@@ -165,13 +165,6 @@ def against_runs(rev: str, theirs, planner_name: str = "drive", rounds: int = 7)
               f"interleaved rounds; the same run from both trees)")
         loop, world, fuzzy, scene, _ = setups[name, "this tree"]
         _stages(world, fuzzy, scene)
-
-
-def differs(what: str, rev: str) -> MitosError:
-    """Why ``--against REV`` stops: the two trees are timed on the same run, or not at all."""
-    return MitosError(f"{what} differs between this tree and `{rev}`",
-                      hint="the speed of two trees is compared on the same runs; give a "
-                           "revision whose simulator gives the same ones")
 
 
 def _cpu_of(world, planner, scene) -> tuple[float, int]:
@@ -226,7 +219,7 @@ def main(argv: list[str] | None = None) -> None:
     print(f"{platform.python_version()}, numpy {np.__version__}, {_cpus()}, "
           f"load average {_load():.2f} at start")
     fuzzy = FuzzyPlanner(None, "drive")
-    with tempfile.TemporaryDirectory() as tmp:
+    with tempfile.TemporaryDirectory() as tmp, foreign(args.against):
         theirs = None
         if args.against:
             os.environ["MITOS_CACHE_DIR"] = "off"    # the cache pickles one tree's classes

@@ -179,3 +179,53 @@ def test_a_missing_peer_is_named_not_printed_as_nan(monkeypatch, capsys):
 def test_the_fuzz_table_has_as_many_cells_in_its_delimiter_row_as_in_its_header(monkeypatch):
     lines = script("fuzz", monkeypatch).table([]).splitlines()
     assert lines[0].count("|") == lines[1].count("|") == lines[2].count("|")
+
+
+def test_an_error_from_the_other_tree_is_one_line_naming_the_revision(monkeypatch):
+    revision = script("revision", monkeypatch)
+    from mitos_cli.errors import MitosError
+
+    theirs = type("RuleBaseError", (Exception,), {"__module__": "mitos_cli_rev.errors"})
+    for raised, said in (
+            (theirs("behavior `drive` reads input `nearest`\nexpected ..."),
+             "RuleBaseError: behavior `drive` reads input `nearest`"),
+            (AttributeError("module 'mitos_cli_rev.sim' has no attribute 'lockstep'"),
+             "AttributeError: module 'mitos_cli_rev.sim' has no attribute 'lockstep'")):
+        with pytest.raises(MitosError) as caught, revision.foreign("abc1234"):
+            raise raised
+        assert caught.value.message == ("revision `abc1234` cannot be measured by this "
+                                        f"benchmark: {said}")
+    for own in (ValueError("this tree's own"), MitosError("this tree's own")):
+        with pytest.raises(type(own)) as caught, revision.foreign("abc1234"):
+            raise own
+        assert caught.value is own
+    with pytest.raises(AttributeError), revision.foreign(None):     # no --against: unchanged
+        raise AttributeError("module 'mitos_cli_rev.sim' has no attribute 'lockstep'")
+
+
+def test_a_revision_whose_runs_differ_is_refused_before_any_figure(tmp_path, monkeypatch,
+                                                                   capsys):
+    """``--against`` times two trees on the same run: a tree whose run differs (here a
+    stand-in whose last pose is an inch off) stops the section with one line, no figures."""
+    sim = tmp_path / "otherrev" / "sim"
+    sim.mkdir(parents=True)
+    (sim.parent / "__init__.py").write_text("")
+    (sim / "__init__.py").write_text("")
+    (sim / "worldfile.py").write_text("from mitos_cli.sim.worldfile import load_world\n")
+    (sim / "planner.py").write_text("from mitos_cli.sim.planner import FuzzyPlanner\n")
+    (sim / "loop.py").write_text(
+        "from mitos_cli.sim.loop import prepare, simulate as _simulate\n\n\n"
+        "def simulate(*args, **kwargs):\n"
+        "    res = _simulate(*args, **kwargs)\n"
+        "    res.pose[-1, 0, 0] += 1.0\n"
+        "    return res\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    import importlib
+
+    bench_sim = script("bench_sim", monkeypatch)
+    from mitos_cli.errors import MitosError
+
+    with pytest.raises(MitosError) as caught:
+        bench_sim.against_runs("otherrev", importlib.import_module("otherrev"), rounds=1)
+    assert caught.value.message == "slalom.yaml's run differs between this tree and `otherrev`"
+    assert "ticks/s" not in capsys.readouterr().out
