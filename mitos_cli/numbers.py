@@ -6,6 +6,12 @@ from __future__ import annotations
 
 import re
 
+#: The largest magnitude a number of a term set or a foreign file may have. The engine
+#: multiplies at most two of them (a coefficient by an input, a sample point by a membership)
+#: and sums at most a million products, so every intermediate stays below 1e306, inside a
+#: double's range.
+LARGEST = 1e150
+
 _NUMBER = re.compile(r"\s*[-+]?(?:(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)(?:[eE][-+]?[0-9]+)?"
                      r"|nan|inf|infinity)\s*", re.IGNORECASE | re.ASCII)
 

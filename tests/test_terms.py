@@ -95,3 +95,25 @@ def test_frozen_refuses_what_is_not_true_or_false(value):
         termset({"MID": f"{{shape: triangle, points: [2, 5, 8], frozen: {value}}}"})
     assert f"`frozen` must be true or false, not `{value}`" in info.value.message
     assert info.value.span.line == 6
+
+
+@pytest.mark.parametrize("text, words", [
+    ("x: {role: input, universe: [-1e308, 1e308], terms: {A: {shape: triangle, "
+     "points: [-1, 0, 1]}}}", "universe bound is -1e+308"),
+    ("x: {role: input, universe: [0, 10], terms: {A: {shape: triangle, "
+     "points: [0, 5, 1e151]}}}", "point is 1e+151"),
+    ("y: {role: output, universe: [0, 1.7e308], terms: {B: 1e300}}", "universe bound is 1.7e+308"),
+    ("y: {role: output, universe: [0, 1], terms: {B: {shape: linear, "
+     "coefficients: {}, constant: -1e200}}}", "constant is -1e+200"),
+])
+def test_a_number_past_what_the_engine_computes_without_overflow_is_refused_at_it(text, words):
+    """As the foreign readers refuse it (interop.md, "Numbers"): a universe of ±1e308 made a
+    Mamdani grid's step `inf` (a traceback) or its output a silent 0.0, and two rules
+    concluding 1.7e308 averaged to `inf`."""
+    from mitos_cli.errors import TermSetError
+
+    with pytest.raises(TermSetError) as info:
+        parse_termset("variables:\n  " + text + "\n")
+    assert words in info.value.message
+    assert "numbers beyond ±1e+150 cannot be evaluated" in info.value.message
+    assert info.value.span is not None and info.value.span.line == 2

@@ -23,7 +23,7 @@ from ..lang import operators as ops_mod
 from ..lang.model import And, Behavior, Consequent, Expr, Not, Or, Prop, Rule, RuleBase, Setting
 from ..lang.resolve import MAIN, check_rule
 from ..lang.terms import Term, TermSet, Variable, first_at, universe_problem
-from ..numbers import parse_number
+from ..numbers import LARGEST, parse_number
 from ..words import plural
 from . import rewrite
 
@@ -407,10 +407,6 @@ def disjoint_outputs(blocks: list[list[Rule]]) -> bool:
     return True
 
 
-#: The largest magnitude a foreign file's number may have. The engine multiplies at most two
-#: of them (a coefficient by an input, a sample point by a membership) and sums at most a
-#: million products, so every intermediate stays below 1e306, inside a double's range.
-LARGEST = 1e150
 
 #: Where an infinite parameter is meaningful, as (index, sign): the open end of a shoulder
 #: (fuzzylite writes ``Trapezoid -inf -inf c d``, ``Triangle -inf b c``) and the direction of

@@ -37,6 +37,7 @@ from ..errors import Span, TermSetError, did_you_mean
 from ..fuzzy.formula import parse as parse_formula
 from ..fuzzy.hedges import HEDGES
 from ..fuzzy.shapes import SHAPES
+from ..numbers import LARGEST
 from ..words import plural
 from . import yamlpos
 from .terms import Term, TermSet, Variable, check_term, universe_problem
@@ -139,8 +140,8 @@ def _variable(name: str, spec: Any, key_span: Span, value_span: Span,
     uspan = spec.value_span("universe")
     if not isinstance(universe, YList) or len(universe) != 2:
         raise TermSetError(f"{what}: universe must be `[min, max]`", span=uspan)
-    lo, hi = (yamlpos.expect_number(v, universe.item_span(i), TermSetError,
-                                    f"{what}: universe bound") for i, v in enumerate(universe))
+    lo, hi = (_number(v, universe.item_span(i), f"{what}: universe bound")
+              for i, v in enumerate(universe))
     problem = universe_problem(lo, hi)
     if problem:
         raise TermSetError(f"{what}: {problem[0]}", span=uspan, hint=problem[1])
@@ -170,8 +171,7 @@ def _variable(name: str, spec: Any, key_span: Span, value_span: Span,
         if isinstance(value, float) and value != value:
             default = value            # `default: .nan`: no rule fired means NaN, as asked
         else:
-            default = yamlpos.expect_number(value, spec.value_span("default"),
-                                            TermSetError, f"{what}: default")
+            default = _number(value, spec.value_span("default"), f"{what}: default")
         if default == default and not lo <= default <= hi:
             raise TermSetError(f"{what}: default {default:g} lies outside the universe "
                                f"[{lo:g}, {hi:g}]", span=spec.value_span("default"))
@@ -188,7 +188,7 @@ def _term(name: str, spec: Any, key_span: Span, value_span: Span, variable: str,
     what = f"term `{variable}.{name}`"
     _writable(name, key_span, what)
     if isinstance(spec, (int, float)) and not isinstance(spec, bool):
-        value = yamlpos.expect_number(spec, value_span, TermSetError, what)
+        value = _number(spec, value_span, what)
         return Term(name, "singleton", (value,), key_span)
     spec = yamlpos.expect_map(spec, value_span, TermSetError, what)
     shape = yamlpos.require(spec, "shape", TermSetError, what)
@@ -223,15 +223,15 @@ def _term(name: str, spec: Any, key_span: Span, value_span: Span, variable: str,
         elif not isinstance(points, YList) or len(points) != len(kind.params):
             raise TermSetError(f"{what}: `points` must list {plural(len(kind.params), 'number')} "
                                f"({', '.join(kind.params)})", span=pspan)
-        params = tuple(yamlpos.expect_number(v, points.item_span(i), TermSetError,
-                                             f"{what}: point") for i, v in enumerate(points))
+        params = tuple(_number(v, points.item_span(i), f"{what}: point")
+                       for i, v in enumerate(points))
     else:
         allowed = ("shape", "frozen", "held", "points") + kind.params
         yamlpos.check_keys(spec, allowed, TermSetError, what)
         for p in kind.params:
             yamlpos.require(spec, p, TermSetError, what)
-        params = tuple(yamlpos.expect_number(spec[p], spec.value_span(p), TermSetError,
-                                             f"{what}: {p}") for p in kind.params)
+        params = tuple(_number(spec[p], spec.value_span(p), f"{what}: {p}")
+                       for p in kind.params)
     problem = kind.check(params)
     if problem:                 # at the value at fault, where the check names one
         at = next((spec.value_span(p) for p in kind.params
@@ -240,6 +240,18 @@ def _term(name: str, spec: Any, key_span: Span, value_span: Span, variable: str,
             at = spec.value_span("points")
         raise TermSetError(f"{what}: {problem}", span=at or key_span)
     return Term(name, internal, params, key_span, frozen, held, held_at)
+
+
+def _number(value: Any, span: Span, what: str) -> float:
+    """``value`` as a finite float within ±:data:`~mitos_cli.numbers.LARGEST`, as the foreign
+    readers take numbers: beyond it a universe's width, a Mamdani grid's step or a weighted
+    average's sum overflows to ``inf`` or ``nan`` with nothing said."""
+    number = yamlpos.expect_number(value, span, TermSetError, what)
+    if abs(number) > LARGEST:
+        raise TermSetError(f"{what} is {number:g}: numbers beyond ±{LARGEST:g} cannot be "
+                           "evaluated in floating point without overflow", span=span,
+                           hint="measure the variable in a larger unit")
+    return number
 
 
 def _held(spec: YMap, what: str) -> tuple[bool, float | None]:
@@ -269,9 +281,8 @@ def _linear_term(what: str, name: str, spec: YMap, key_span: Span, frozen: bool,
     """``{shape: linear, coefficients: {road: 0.5}, constant: 90}`` -> params
     ``(c_1, ..., c_k, constant)`` over ``inputs`` (the term set's input variables)."""
     yamlpos.check_keys(spec, ("shape", "frozen", "coefficients", "constant"), TermSetError, what)
-    constant = yamlpos.expect_number(yamlpos.require(spec, "constant", TermSetError, what),
-                                     spec.value_span("constant"), TermSetError,
-                                     f"{what}: constant")
+    constant = _number(yamlpos.require(spec, "constant", TermSetError, what),
+                       spec.value_span("constant"), f"{what}: constant")
     coefficients = dict.fromkeys(inputs, 0.0)
     if "coefficients" in spec:
         given = yamlpos.expect_map(spec["coefficients"], spec.value_span("coefficients"),
@@ -282,8 +293,7 @@ def _linear_term(what: str, name: str, spec: YMap, key_span: Span, frozen: bool,
                                    span=given.key_span(var),
                                    expected="one of " + ", ".join(inputs) if inputs else None,
                                    hint=did_you_mean(var, inputs))
-            coefficients[var] = yamlpos.expect_number(value, given.value_span(var),
-                                                      TermSetError, f"{what}: coefficient")
+            coefficients[var] = _number(value, given.value_span(var), f"{what}: coefficient")
     return Term(name, "linear", tuple(coefficients.values()) + (constant,), key_span, frozen)
 
 
