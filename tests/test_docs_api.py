@@ -30,3 +30,26 @@ def test_worlds_readme_python_example_says_what_it_prints(monkeypatch, capsys):
     exec(compile(block, "worlds/README.md", "exec"), {})
     printed = capsys.readouterr().out.split()
     assert printed[-1] == said.group(1)
+
+
+
+def test_every_python_block_of_the_readme_runs_as_written(monkeypatch):
+    """README.md's Python blocks, each pasted as it stands (one used arrays it never made),
+    from the repository root; a line whose comment shows a result (``# {'steering': ...}``)
+    gives that result."""
+    import re
+
+    monkeypatch.chdir(ROOT)
+    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    checker, shown = doctest.OutputChecker(), 0
+    for block in re.findall(r"```python\n(.*?)```", text, re.S):
+        namespace: dict = {}
+        exec(compile(block, "README.md", "exec"), namespace)
+        for line in block.splitlines():
+            code, _, comment = line.partition("#")
+            if comment.strip().startswith("{"):
+                got = repr(eval(code.strip(), namespace))
+                assert checker.check_output(comment.strip() + "\n", got + "\n",
+                                            doctest.ELLIPSIS), (line, got)
+                shown += 1
+    assert shown

@@ -10,7 +10,7 @@ from mitos_cli.api import load_rulebase, read_rulebase
 from mitos_cli.engine import mamdani
 from mitos_cli.engine.compile import compile_rulebase
 from mitos_cli.engine.evaluation import evaluate
-from mitos_cli.errors import NoRuleFiredError
+from mitos_cli.errors import MitosError, NoRuleFiredError
 from mitos_cli.fuzzy import norms
 from mitos_cli.fuzzy.hedges import HEDGES
 from mitos_cli.lang.model import Setting
@@ -101,6 +101,23 @@ def test_matches_the_book_with_max(tmp_path, implication, defuzzify):
     got = evaluate(rb.compiled, X).outputs[:, 0]
     want = [reference(r, s, implication, "max", defuzzify) for r, s in SAMPLES]
     np.testing.assert_allclose(got, want, rtol=0, atol=1e-9)
+
+
+@pytest.mark.parametrize("alias, name", [("prod", "product"), ("algebraic_product", "product"),
+                                         ("minimum", "min"), ("bounded_product", "lukasiewicz"),
+                                         ("einstein_product", "einstein")])
+def test_an_implication_takes_every_name_of_its_t_norm_as_and_does(tmp_path, alias, name):
+    """language.md: `implication` is "any T-norm above", aliases included (`and = prod` was
+    taken and `implication = prod` refused)."""
+    rb = load_rulebase(write(tmp_path, f"implication = {alias}"))
+    assert rb.compiled.operators.implication == name
+
+
+def test_an_unknown_implication_is_refused_with_a_suggestion(tmp_path):
+    with pytest.raises(MitosError) as info:
+        load_rulebase(write(tmp_path, "implication = prodd"))
+    assert "unknown implication `prodd`" in info.value.message
+    assert "did you mean `prod`" in (info.value.hint or "")
 
 
 @pytest.mark.parametrize("aggregation", sorted(norms.SNORMS))

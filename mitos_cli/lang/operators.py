@@ -73,18 +73,19 @@ KEYS = {"and": "and_", "or": "or_", "inference": "inference", "implication": "im
 
 
 def _check(key: str, value: str, span: Span | None) -> str | int:
-    if key == "and":
+    if key in ("and", "implication"):       # an implication is any T-norm, by any of its names
         try:
             return norms.lookup("tnorm", value).name
         except KeyError:
-            raise unknown("T-norm", value, norms.names("tnorm"), span=span) from None
+            what = "T-norm" if key == "and" else "implication"
+            raise unknown(what, value, norms.names("tnorm"), span=span) from None
     if key in ("or", "aggregation"):
         try:
             return norms.lookup("snorm", value).name
         except KeyError:
             raise unknown("S-norm", value, norms.names("snorm"), span=span) from None
-    choices = {"inference": INFERENCES, "implication": IMPLICATIONS,
-               "defuzzify": DEFUZZIFIERS, "sampling": SAMPLINGS}.get(key)
+    choices = {"inference": INFERENCES, "defuzzify": DEFUZZIFIERS,
+               "sampling": SAMPLINGS}.get(key)
     if choices is not None:
         if value not in choices:
             raise unknown(key, value, choices, span=span)
