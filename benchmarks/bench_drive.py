@@ -36,9 +36,9 @@ def rates(summaries: list[dict]) -> str:
     n = len(summaries)
     count = collections.Counter(s["outcome"] for s in summaries)
     ok = [s["time_s"] for s in summaries if s["outcome"] == "success"]
-    mean_t = sum(ok) / len(ok) if ok else float("nan")
+    mean_t = f"{sum(ok) / len(ok):5.1f} s" if ok else "  -   (no run reached it)"
     return (f"{n:4d} runs  " + "  ".join(f"{o} {count[o] / n:5.3f}" for o in OUTCOMES)
-            + f"  mean time to goal {mean_t:5.1f} s")
+            + f"  mean time to goal {mean_t}")
 
 
 @guarded

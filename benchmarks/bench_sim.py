@@ -9,7 +9,7 @@ time of ``--runs 100`` on one and two worker processes.
 
 1. **one robot, 60 simulated seconds at dt = 0.05** (1200 ticks): the packaged corridor world
    stretched to 2500 in so that the run never ends early; sensing (36 beams), perception, the
-   fuzzy planner (behavior ``drive``, 44 rules), kinematics (4 substeps). Best and median of 5.
+   fuzzy planner (behavior ``drive``, 55 rules), kinematics (4 substeps). Best and median of 5.
    Peers in the same run: the same loop with a constant planner (no rule evaluation) in the
    same corridor without its obstacle (the constant planner would hit it), and the planner's
    share of the tick measured by timing ``plan`` inside the loop. Times are wall times; the

@@ -322,8 +322,9 @@ STDOUT_READ = 64_000
 
 def cli_outcome(code: int, err: str, out: str = "") -> tuple[str, str]:
     """The outcome of one ``mitos`` run from its exit code and stderr, and its stdout where an
-    exit 1 says nothing on stderr (``mitos check`` prints the errors it finds in a rule base,
-    positioned, with its report on stdout)."""
+    exit 1 says no error on stderr, only warnings or nothing (``mitos check`` prints the errors
+    it finds in a rule base, positioned, with its report on stdout, and what the reader warned
+    of on stderr)."""
     if "Traceback (most recent call last)" in err:
         return "foreign", "traceback: " + err.strip().splitlines()[-1][:70]
     if "Warning: " in err:              # plain searches: a message may quote 200 KB of input
@@ -332,8 +333,10 @@ def cli_outcome(code: int, err: str, out: str = "") -> tuple[str, str]:
     if code in (0, 3):                 # 3: `simulate --require success` not met
         return "loaded", ""
     if code == 1:
-        if not err.strip():
-            return refusal_on_stdout(out[:STDOUT_READ])
+        if "error: " not in err:
+            found = refusal_on_stdout(out[:STDOUT_READ])
+            if found[0] == "refused+pos" or not err.strip():
+                return found
         first = err.strip().splitlines()[0][:60]
         positioned = any(POSITIONED.match(x) for x in err.splitlines()[:3])
         return ("refused+pos", "") if positioned else ("refused", first)

@@ -229,3 +229,10 @@ def test_a_revision_whose_runs_differ_is_refused_before_any_figure(tmp_path, mon
         bench_sim.against_runs("otherrev", importlib.import_module("otherrev"), rounds=1)
     assert caught.value.message == "slalom.yaml's run differs between this tree and `otherrev`"
     assert "ticks/s" not in capsys.readouterr().out
+
+
+def test_a_mean_time_to_goal_of_no_success_is_said_not_printed_as_nan(monkeypatch):
+    rates = script("bench_drive", monkeypatch).rates
+    line = rates([{"outcome": "collision", "time_s": 3.0}, {"outcome": "timeout", "time_s": 60.0}])
+    assert "nan" not in line and line.endswith("mean time to goal   -   (no run reached it)")
+    assert rates([{"outcome": "success", "time_s": 20.0}]).endswith("mean time to goal  20.0 s")

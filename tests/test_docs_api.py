@@ -53,3 +53,24 @@ def test_every_python_block_of_the_readme_runs_as_written(monkeypatch):
                                             doctest.ELLIPSIS), (line, got)
                 shown += 1
     assert shown
+
+
+def test_the_counts_of_the_drive_behavior_the_benchmark_pages_give_are_its_own():
+    """docs/benchmarks.md and bench_sim.py described `drive` as 44 rules on 9 inputs when it
+    had grown to 55 on 13: each count they state is the packaged behavior's."""
+    import re
+
+    from mitos_cli import load_rulebase
+    from mitos_cli.teach.adapt import parameterise
+
+    compiled = load_rulebase(behavior="drive").compiled
+    page = (ROOT / "docs" / "benchmarks.md").read_text(encoding="utf-8")
+    script = (ROOT / "benchmarks" / "bench_sim.py").read_text(encoding="utf-8")
+    p = parameterise(compiled)
+    said = re.search(r"perception of the (\d+) rule inputs, the `drive` behavior of\s+the "
+                     r"packaged rule base \((\d+) rules", page)
+    assert said and (int(said[1]), int(said[2])) == (len(compiled.inputs), len(compiled.rules))
+    said = re.search(r"on the `drive` behavior, (\d+) learnable numbers, (\d+) of them free", page)
+    assert said and (int(said[1]), int(said[2])) == (len(p.values), p.n_free)
+    said = re.search(r"behavior ``drive``, (\d+) rules", script)
+    assert said and int(said[1]) == len(compiled.rules)

@@ -428,6 +428,18 @@ def test_cli_route_says_what_stdout_held_when_nothing_is_positioned(kinds):
     assert fuzz.cli_outcome(1, "", "{not json") == ("refused", "(no message)")
 
 
+def test_cli_route_reads_stdout_when_stderr_holds_only_warnings(kinds):
+    """`mitos check` of an FLL file that its reader warns about (a chained engine) and that
+    holds a conflict: the warning on stderr, the positioned error on stdout. The campaign took
+    the warning for an unpositioned refusal (FLL input 113 of seed 20261208)."""
+    fuzz, _, _ = kinds
+    err = "warning: f.fll: 7 rules chain outputs into inputs\n"
+    out = "f.fll:40:9: error: `r9` has the same antecedent as `r6` [conflict]\n\nchecked ...\n"
+    assert fuzz.cli_outcome(1, err, out) == ("refused+pos", "")
+    assert fuzz.cli_outcome(1, err, "") == ("refused", "warning: f.fll: 7 rules chain outputs into inputs")
+    assert fuzz.cli_outcome(1, "world error: bad\n", out) == ("refused", "world error: bad")
+
+
 def test_a_long_token_is_shortened_in_the_message(tmp_path):
     """A 200,000-digit number in a rule file was quoted whole in the message and under a
     200,000-caret line (and the campaign's classification of it was quadratic)."""
