@@ -376,6 +376,12 @@ def test_non_numeric_value_in_results(tmp_path):
     ("min_clearance_in", "inf", "which no run reports"),      # a mean of inf, a std of nan
     ("min_clearance_in", "-inf", "which no run reports"),
     ("ticks", "1.5", "not a number"),
+    ("time_s", "-5", "which no run reports"),                # averaged into the time to goal
+    ("path_length_in", "-0.5", "which no run reports"),
+    ("ticks", "-1", "which no run reports"),
+    ("replans", "-1", "which no run reports"),
+    ("backouts", "-2", "which no run reports"),
+    ("collisions", "-1", "which no run reports"),
 ])
 def test_a_row_no_run_reports_is_refused(tmp_path, field, value, said):
     """A hand-edited row that parses but is no run's (``--resume`` once took a misspelt
@@ -395,6 +401,32 @@ def test_a_row_no_run_reports_is_refused(tmp_path, field, value, said):
     assert exc.value.span.line == 2
     if field == "outcome":
         assert exc.value.hint == "did you mean `success`?"
+    if value.startswith("-") and value != "-inf":
+        assert exc.value.expected.endswith(", 0 or more")
+
+
+@pytest.mark.parametrize("outcome, collisions", [("success", "3"), ("timeout", "1"),
+                                                  ("stuck", "2"), ("collision", "0")])
+def test_a_row_whose_outcome_contradicts_its_collisions_is_refused(tmp_path, outcome,
+                                                                   collisions):
+    """The simulator's outcome is `collision` exactly when a robot collided; `--resume` took
+    a hand-edited `success` with 3 collisions and averaged it in."""
+    from mitos_cli.study.store import COLUMNS
+
+    run_study(small_study(runs=1), tmp_path, workers=1, task_fn=fake_sim)
+    path = tmp_path / "results.csv"
+    lines = path.read_text().splitlines(keepends=True)
+    cells = lines[1].rstrip("\n").split(",")
+    cells[COLUMNS.index("outcome")], cells[COLUMNS.index("collisions")] = outcome, collisions
+    lines[1] = ",".join(cells) + "\n"
+    path.write_text("".join(lines))
+    with pytest.raises(StudyError) as exc:
+        run_study(small_study(runs=1), tmp_path, workers=1, resume=True, task_fn=fake_sim)
+    assert exc.value.message == f"`collisions` is `{collisions}` in a row whose outcome is " \
+                                f"`{outcome}`"
+    span = exc.value.span
+    assert span.line == 2 and span.source_line[span.column - 1:span.end_column - 1] == collisions
+    assert exc.value.hint == "the file was edited by hand; remove that line"
 
 
 def test_output_directory_that_is_a_file(tmp_path):

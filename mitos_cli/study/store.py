@@ -36,6 +36,11 @@ COLUMNS = (*KEY_FIELDS, "seed", *RESULT_FIELDS)
 #: resumed: they lack figures every row of the study's report must have)
 COLUMNS_BEFORE_REPLANS = COLUMNS[:-2]
 OUTCOMES = ("success", "collision", "timeout", "stuck")
+#: the fields no run reports below 0 (counts, a time, a length, a speed, a variation, the run's
+#: index and seed; a clearance is below 0 where a robot overlaps what it hit)
+NON_NEGATIVE = frozenset({"collisions", "time_s", "path_length_in", "mean_speed_in_s",
+                          "steering_total_variation_deg", "ticks", "replans", "backouts", "run",
+                          "seed"})
 
 
 class StudyError(MitosError):
@@ -64,8 +69,12 @@ def _format(value) -> str:
     return str(value)
 
 
-#: what a field of a row must be, where it is not a number
-_EXPECTED = {"outcome": "one of " + ", ".join(OUTCOMES), **{f: "a whole number" for f in INT_FIELDS}}
+def _expected(field: str) -> str:
+    """What a field of a row must be."""
+    if field == "outcome":
+        return "one of " + ", ".join(OUTCOMES)
+    kind = "a whole number" if field in INT_FIELDS else "a finite number"
+    return kind + (", 0 or more" if field in NON_NEGATIVE else "")
 
 
 def _wrong(field: str, value) -> str | None:
@@ -76,6 +85,8 @@ def _wrong(field: str, value) -> str | None:
     if field == "outcome" and value not in OUTCOMES:
         return "not an outcome of a run"
     if field in FLOAT_FIELDS and not math.isfinite(value):
+        return "which no run reports"
+    if field in NON_NEGATIVE and value < 0:
         return "which no run reports"
     return None
 
@@ -142,8 +153,10 @@ class ResultStore:
 
     def _row(self, values: list[str], line_no: int, line: str) -> dict:
         """Line ``line_no``'s ``values`` as a row, checked: what a run can report (a known
-        outcome, whole numbers, finite figures), so that a row edited by hand cannot count
-        as a run it is not (a misspelt outcome in no column, a ``nan`` left out of a mean)."""
+        outcome, whole numbers, finite figures, no count, time or length below 0, a collision
+        counted where the outcome is one), so that a row edited by hand cannot count as a run
+        it is not (a misspelt outcome in no column, a ``nan`` left out of a mean, a time of
+        -5 s in one)."""
         if len(values) != len(COLUMNS):
             raise StudyError(f"expected {len(COLUMNS)} values in a row, found {len(values)}",
                              span=Span(str(self.path), line_no, 1, line[:200]),
@@ -156,15 +169,29 @@ class ResultStore:
                 value = None
             bad = _wrong(f, value)
             if bad:
-                plain = line.split(",") == values           # (no field quoted)
-                column = sum(len(w) + 1 for w in values[:j]) + 1 if plain else 1
                 hint = did_you_mean(v, OUTCOMES) if f == "outcome" else None
                 raise StudyError(f"`{f}` is `{v}`, {bad}",
-                                 span=Span(str(self.path), line_no, column, line[:200],
-                                           end_column=column + len(v) if plain else None),
-                                 expected=_EXPECTED.get(f, "a finite number"),
+                                 span=self._span(line_no, line, values, j), expected=_expected(f),
                                  hint=hint or "the file was edited by hand; remove that line")
+        if (row["outcome"] == "collision") != (row["collisions"] > 0):
+            j = COLUMNS.index("collisions")
+            raise StudyError(f"`collisions` is `{values[j]}` in a row whose outcome is "
+                             f"`{row['outcome']}`", span=self._span(line_no, line, values, j),
+                             expected="1 or more where the outcome is `collision`, else 0 (a "
+                                      "run's outcome is `collision` when a robot collided)",
+                             hint="the file was edited by hand; remove that line")
         return row
+
+    def _span(self, line_no: int, line: str, values: list[str], first: int,
+              last: int | None = None) -> Span:
+        """Where fields ``first`` to ``last`` (default: ``first``) of a row are on its line
+        (its start where a field is quoted)."""
+        last = first if last is None else last
+        if line.split(",") != values:                   # a field quoted: no column to tell
+            return Span(str(self.path), line_no, 1, line[:200])
+        column = sum(len(w) + 1 for w in values[:first]) + 1
+        width = sum(len(w) + 1 for w in values[first:last + 1]) - 1
+        return Span(str(self.path), line_no, column, line[:200], end_column=column + width)
 
     def manifest(self) -> dict | None:
         """What ``study.json`` says the study was; ``None`` when there is none."""
