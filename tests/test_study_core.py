@@ -299,6 +299,21 @@ def test_hand_edited_results_are_reported(tmp_path):
     assert "not a results file" in exc.value.message
 
 
+def test_a_results_file_with_a_byte_order_mark_resumes(tmp_path):
+    """A results.csv saved "UTF-8 with BOM" (Excel, an editor) was "not a results file of
+    this version of mitos", with the columns it has as the ones expected."""
+    study = small_study(runs=2)
+    with pytest.raises(Crash):
+        run_study(study, tmp_path, workers=1, task_fn=functools.partial(crashing_sim, after=5,
+                                                                         log=[]))
+    path = tmp_path / "results.csv"
+    path.write_bytes(b"\xef\xbb\xbf" + path.read_bytes())
+    outcome = run_study(study, tmp_path, workers=1, resume=True, task_fn=fake_sim)
+    assert (outcome.skipped, outcome.executed) == (5, 7)
+    assert outcome.rows == run_study(study, tmp_path / "fresh", workers=1, task_fn=fake_sim).rows
+    assert ResultStore(tmp_path).load() == ResultStore(tmp_path / "fresh").load() != []
+
+
 def test_unknown_executor():
     with pytest.raises(MitosError) as exc:
         list(execute(fake_sim, small_study(1).tasks(), "dusk"))

@@ -120,7 +120,7 @@ class ResultStore:
                 data = data[: data.rfind(b"\n") + 1]
                 with open(self.path, "r+b") as fh:
                     fh.truncate(len(data))
-            text = data.decode("utf-8")
+            text = data.decode("utf-8-sig")          # (a byte-order mark is not content)
         except (OSError, UnicodeDecodeError) as exc:
             raise StudyError(unreadable("results file", self.path, exc), span=bad_byte(
                 self.path, exc), hint=f"choose another output directory with -o, or remove "
