@@ -221,6 +221,43 @@ def test_cut_off_last_line_is_recomputed(tmp_path):
     assert path.read_bytes() == data or len(ResultStore(tmp_path).load()) == len(out.rows)
 
 
+def test_a_whole_last_row_without_its_newline_is_a_row(tmp_path):
+    """A file saved by an editor ends without a newline: its last row, whole, was cut off the
+    file as if a kill had torn it, and run again."""
+    study = small_study(runs=1)
+    run_study(study, tmp_path, workers=1, task_fn=fake_sim)
+    path = tmp_path / "results.csv"
+    data = path.read_bytes()
+    path.write_bytes(data.rstrip(b"\n"))
+    assert len(ResultStore(tmp_path).load()) == 6
+    log: list[int] = []
+    out = run_study(study, tmp_path, workers=1, resume=True,
+                    task_fn=functools.partial(fake_sim, log=log))
+    assert (out.skipped, out.executed, log) == (6, 0, [])
+    assert path.read_bytes() == data                          # its newline given back
+    wider = run_study(small_study(runs=2), tmp_path, workers=1, resume=True, task_fn=fake_sim)
+    assert (wider.skipped, wider.executed) == (6, 6) and len(ResultStore(tmp_path).load()) == 12
+
+
+@pytest.mark.parametrize("cut", [1, 20])     # the newline only; a row torn in two
+@pytest.mark.parametrize("how", ["no --resume", "another seed", "narrower"])
+def test_a_refused_study_writes_nothing(tmp_path, cut, how):
+    """A refused `compare` cut the last row off a file without a final newline (and counted
+    one result fewer in its refusal), though it said it changed nothing."""
+    run_study(small_study(runs=1), tmp_path, workers=1, task_fn=fake_sim)
+    path = tmp_path / "results.csv"
+    path.write_bytes(path.read_bytes()[:-cut])
+    before = {p.name: p.read_bytes() for p in tmp_path.iterdir()}
+    study = {"no --resume": small_study(runs=1),
+             "another seed": Study(**{**small_study(runs=1).__dict__, "seed": 4}),
+             "narrower": Study(**{**small_study(runs=1).__dict__, "worlds": ["w1.yaml"]})}[how]
+    with pytest.raises(StudyError) as exc:
+        run_study(study, tmp_path, workers=1, resume=how != "no --resume", task_fn=fake_sim)
+    assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before
+    if how == "no --resume":
+        assert f"already holds {6 if cut == 1 else 5} results" in exc.value.message
+
+
 def test_existing_results_need_resume(tmp_path):
     study = small_study(runs=1)
     run_study(study, tmp_path, workers=1, task_fn=fake_sim)

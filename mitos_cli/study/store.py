@@ -2,9 +2,10 @@
 
 Each row is appended, flushed and fsync'ed, so a study that is killed (or whose worker dies)
 loses no finished result; ``--resume`` reads the rows back and skips their tasks. A row cut off
-by the kill (no final newline) is dropped and recomputed. Floats are written with ``repr``, so
-they read back bit for bit. ``study.json`` beside it records what the study was (seed, worlds,
-choices, runs, rule base).
+by the kill (no final newline, fewer values than a row) is dropped and recomputed; a whole last
+row without its newline (as an editor saves a file) is a row. Nothing is written before a study
+is known to go on. Floats are written with ``repr``, so they read back bit for bit.
+``study.json`` beside it records what the study was (seed, worlds, choices, runs, rule base).
 """
 
 from __future__ import annotations
@@ -107,24 +108,32 @@ class ResultStore:
         self.path = self.dir / "results.csv"
         self.manifest_path = self.dir / "study.json"
         self._file: TextIO | None = None
+        self._keep: int | None = None      # the bytes before a torn last line (see load)
+        self._unended = False              # a whole last row without its newline
 
     # -- reading -----------------------------------------------------------------------------
 
     def load(self) -> list[dict]:
-        """The finished rows (an unfinished last line is cut off the file and not returned)."""
+        """The finished rows. Reading never writes: a last line without its newline is a row
+        when it is a whole one (an editor saves a file so), and is left out when it was cut
+        short (a kill in the middle of a row); :meth:`start` mends the file only once the
+        study goes on."""
+        self._keep, self._unended = None, False
         if not self.path.exists():
             return []
         try:
             data = self.path.read_bytes()
-            if data and not data.endswith(b"\n"):       # killed in the middle of a row
-                data = data[: data.rfind(b"\n") + 1]
-                with open(self.path, "r+b") as fh:
-                    fh.truncate(len(data))
-            text = data.decode("utf-8-sig")          # (a byte-order mark is not content)
+            cut = data.rfind(b"\n") + 1
+            text = data[:cut].decode("utf-8-sig")          # (a byte-order mark is not content)
         except (OSError, UnicodeDecodeError) as exc:
             raise StudyError(unreadable("results file", self.path, exc), span=bad_byte(
                 self.path, exc), hint=f"choose another output directory with -o, or remove "
                                       f"{self.path} to run the study again") from None
+        last = _whole_line(data[cut:], header=cut == 0)
+        if last is not None:
+            text, self._unended = text + last + "\n", True
+        elif cut < len(data):                              # killed in the middle of a row
+            self._keep = cut
         if not text:
             return []
         reader = csv.reader(io.StringIO(text, newline=""))
@@ -272,9 +281,21 @@ class ResultStore:
         write_atomic(self.manifest_path, json.dumps(manifest, indent=2) + "\n")
         if not rows:
             write_atomic(self.path, ",".join(COLUMNS) + "\n")
+        else:
+            self._mend()
         # kept open across append() calls (one fsync'd line per finished run); close() closes it
         self._file = open(self.path, "a", encoding="utf-8", newline="")  # noqa: SIM115
         return finished, todo
+
+    def _mend(self) -> None:
+        """End the file where its last whole row ends, before rows are appended to it: a row
+        cut short by a kill is cut off, a whole last row without its newline gets one."""
+        if self._keep is not None:
+            with open(self.path, "r+b") as fh:
+                fh.truncate(self._keep)
+        elif self._unended:
+            with open(self.path, "ab") as fh:
+                fh.write(b"\n")
 
     def append(self, row: dict) -> None:
         """Write one finished row and make it durable before returning."""
@@ -296,6 +317,28 @@ class ResultStore:
 
     def __exit__(self, *exc) -> None:
         self.close()
+
+
+def _whole_line(data: bytes, header: bool) -> str | None:
+    """The last line of a results file, without its newline, as text if it is whole: the
+    ``header``, or a row with at least the values of a row, the last not empty (a kill cuts a
+    row short, never makes it longer); ``None`` when it was cut short or there is none."""
+    try:
+        line = data.decode("utf-8-sig" if header else "utf-8")
+    except UnicodeDecodeError:
+        return None                                   # cut inside a character
+    if not line:
+        return None
+    if header:
+        full = ",".join(COLUMNS)
+        return None if full.startswith(line) and line != full else line
+    try:
+        values = next(csv.reader([line]))
+    except (csv.Error, StopIteration):
+        return None
+    if len(values) > len(COLUMNS) or (len(values) == len(COLUMNS) and values[-1]):
+        return line
+    return None
 
 
 def write_atomic(path: Path, text: str) -> None:
