@@ -351,6 +351,27 @@ def test_a_results_file_with_a_byte_order_mark_resumes(tmp_path):
     assert ResultStore(tmp_path).load() == ResultStore(tmp_path / "fresh").load() != []
 
 
+@pytest.mark.parametrize("copy", ["same", "other figures"])
+def test_a_run_held_twice_is_refused_at_its_second_row(tmp_path, copy):
+    """A row copied (or two results files joined) ended `--resume` in an IndexError."""
+    run_study(small_study(runs=1), tmp_path, workers=1, task_fn=fake_sim)
+    path = tmp_path / "results.csv"
+    lines = path.read_text().splitlines(keepends=True)
+    again = lines[2] if copy == "same" else lines[2].replace(",200,", ",201,")
+    path.write_text("".join(lines) + again)
+    before = path.read_bytes()
+    with pytest.raises(StudyError) as exc:
+        run_study(small_study(runs=1), tmp_path, workers=1, resume=True, task_fn=fake_sim)
+    row = lines[2].split(",")
+    assert exc.value.message == (f"run 0 of {row[0]} ({row[1]}, and={row[2]}) is here a "
+                                 f"second time: its first row is line 3")
+    span = exc.value.span
+    assert (span.line, span.column) == (8, 1) and span.path == str(path)
+    assert span.source_line[:span.end_column - 1] == ",".join(row[:6])
+    assert "remove one of the two lines" in exc.value.hint
+    assert path.read_bytes() == before
+
+
 def test_unknown_executor():
     with pytest.raises(MitosError) as exc:
         list(execute(fake_sim, small_study(1).tasks(), "dusk"))

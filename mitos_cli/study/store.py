@@ -92,6 +92,12 @@ def _wrong(field: str, value) -> str | None:
     return None
 
 
+def _label(row: dict) -> str:
+    """A row's choice as messages name it: ``fuzzy, and=min``."""
+    return ", ".join([row["planner"]] + [f"{k}={row[k]}" for k in ("and", "or", "inference")
+                                         if row[k]])
+
+
 def _parse(field: str, text: str):
     if field in FLOAT_FIELDS:
         return float(text)
@@ -110,6 +116,7 @@ class ResultStore:
         self._file: TextIO | None = None
         self._keep: int | None = None      # the bytes before a torn last line (see load)
         self._unended = False              # a whole last row without its newline
+        self._at: list[tuple[int, str, list[str]]] = []   # each row's line: number, text, values
 
     # -- reading -----------------------------------------------------------------------------
 
@@ -148,10 +155,12 @@ class ResultStore:
                 raise StudyError(f"{self.path} is not a results file of this version of mitos",
                                  expected="the columns " + ",".join(COLUMNS),
                                  hint="choose another output directory with -o")
-            lines, rows = text.splitlines(), []
+            lines, rows, self._at = text.splitlines(), [], []
             for values in reader:
                 line_no = reader.line_num                  # (a row's last line)
                 rows.append(self._row(values, line_no, lines[line_no - 1]))
+                self._at.append((line_no, lines[line_no - 1], values))
+            self._refuse_twice(rows)
             return rows
         except csv.Error as exc:               # a field past csv's limit
             line_no = reader.line_num
@@ -190,6 +199,22 @@ class ResultStore:
                                       "run's outcome is `collision` when a robot collided)",
                              hint="the file was edited by hand; remove that line")
         return row
+
+    def _refuse_twice(self, rows: list[dict]) -> None:
+        """A run held twice (a row copied, two results files joined): the study would count
+        it twice, or take itself for one that leaves out runs. ``rows`` are those of
+        :meth:`load`, in its order."""
+        first: dict[tuple[str, ...], int] = {}
+        for row, (line_no, line, values) in zip(rows, self._at):
+            key = key_of(row)
+            if key in first:
+                raise StudyError(
+                    f"run {row['run']} of {Path(row['world']).name} ({_label(row)}) is here a "
+                    f"second time: its first row is line {first[key]}",
+                    span=self._span(line_no, line, values, 0, len(KEY_FIELDS) - 1),
+                    hint="the file was edited by hand, or two results files were joined; "
+                         "remove one of the two lines")
+            first[key] = line_no
 
     def _span(self, line_no: int, line: str, values: list[str], first: int,
               last: int | None = None) -> Span:
@@ -276,8 +301,10 @@ class ResultStore:
         if old is not None:
             _check_unchanged(old.get("digests") or {}, manifest.get("digests") or {}, self.path)
         finished, todo = rows_for(tasks, rows)
-        if len(finished) < len(rows):
-            _refuse_narrower(rows, finished, old or {}, self.path)
+        kept = {key_of(r) for r in finished}
+        left = [r for r in rows if key_of(r) not in kept]
+        if left:
+            _refuse_narrower(left, old or {}, self.path)
         write_atomic(self.manifest_path, json.dumps(manifest, indent=2) + "\n")
         if not rows:
             write_atomic(self.path, ",".join(COLUMNS) + "\n")
@@ -359,20 +386,16 @@ def _check_unchanged(old: dict, new: dict, path: Path) -> None:
                          hint="choose another directory with -o (or put the file back)")
 
 
-def _refuse_narrower(rows: list[dict], finished: list[dict], old: dict, path: Path) -> None:
+def _refuse_narrower(left: list[dict], old: dict, path: Path) -> None:
     """A resumed study that leaves out runs already in ``results.csv`` (fewer worlds, norms,
-    planners or runs): its report would cover part of the file, and the study's own report
-    would be replaced by it. Resuming may add runs, never drop them."""
-    kept = {key_of(r) for r in finished}
-    left = [r for r in rows if key_of(r) not in kept]
+    planners or runs; ``left``: their rows): its report would cover part of the file, and the
+    study's own report would be replaced by it. Resuming may add runs, never drop them."""
     first = left[0]
-    choice = ", ".join([first["planner"]] + [f"{k}={first[k]}" for k in ("and", "or", "inference")
-                                             if first[k]])
     command = old.get("command")
     raise StudyError(
         f"{path} holds {plural(len(left), 'finished run')} this study leaves out (the first: "
-        f"run {first['run']} of {Path(first['world']).name}, {choice}); resuming would report "
-        f"on part of the file",
+        f"run {first['run']} of {Path(first['world']).name}, {_label(first)}); resuming would "
+        f"report on part of the file",
         hint=(f"resume the study as it was made: {command} --resume" if command else
               "resume with the worlds, choices and runs the study was made with")
         + ", or choose another directory with -o")
