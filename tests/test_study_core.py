@@ -320,6 +320,23 @@ def test_resume_may_add_runs_but_not_leave_finished_ones_out(tmp_path):
     assert (wider.skipped, wider.executed) == (6, 6)
 
 
+def test_the_command_that_resumes_names_the_directory_being_resumed(tmp_path):
+    """A study copied to another directory was told to resume "as it was made", with the
+    -o of the directory it was made in."""
+    import shutil
+
+    study = Study(**{**small_study(runs=1).__dict__,
+                     "command": "mitos compare w1.yaml w2.yaml --runs 1 --seed 3 -o 'old dir'"})
+    run_study(study, tmp_path / "old dir", workers=1, task_fn=fake_sim)
+    shutil.copytree(tmp_path / "old dir", tmp_path / "new")
+    narrower = Study(**{**small_study(runs=1).__dict__, "worlds": ["w1.yaml"]})
+    with pytest.raises(StudyError) as exc:
+        run_study(narrower, tmp_path / "new", workers=1, resume=True, task_fn=fake_sim)
+    assert exc.value.hint == (f"resume the study as it was made: mitos compare w1.yaml w2.yaml "
+                              f"--runs 1 --seed 3 -o {tmp_path / 'new'} --resume, or choose "
+                              f"another directory with -o")
+
+
 def test_hand_edited_results_are_reported(tmp_path):
     run_study(small_study(runs=1), tmp_path, workers=1, task_fn=fake_sim)
     path = tmp_path / "results.csv"

@@ -15,6 +15,7 @@ import io
 import json
 import math
 import os
+import shlex
 from collections.abc import Iterable
 from pathlib import Path
 from typing import TextIO
@@ -304,7 +305,7 @@ class ResultStore:
         kept = {key_of(r) for r in finished}
         left = [r for r in rows if key_of(r) not in kept]
         if left:
-            _refuse_narrower(left, old or {}, self.path)
+            _refuse_narrower(left, old or {}, self.path, self.dir)
         write_atomic(self.manifest_path, json.dumps(manifest, indent=2) + "\n")
         if not rows:
             write_atomic(self.path, ",".join(COLUMNS) + "\n")
@@ -386,12 +387,14 @@ def _check_unchanged(old: dict, new: dict, path: Path) -> None:
                          hint="choose another directory with -o (or put the file back)")
 
 
-def _refuse_narrower(left: list[dict], old: dict, path: Path) -> None:
+def _refuse_narrower(left: list[dict], old: dict, path: Path, out: Path) -> None:
     """A resumed study that leaves out runs already in ``results.csv`` (fewer worlds, norms,
     planners or runs; ``left``: their rows): its report would cover part of the file, and the
     study's own report would be replaced by it. Resuming may add runs, never drop them."""
     first = left[0]
     command = old.get("command")
+    if command:
+        command = _writing_to(command, out)
     raise StudyError(
         f"{path} holds {plural(len(left), 'finished run')} this study leaves out (the first: "
         f"run {first['run']} of {Path(first['world']).name}, {_label(first)}); resuming would "
@@ -399,6 +402,19 @@ def _refuse_narrower(left: list[dict], old: dict, path: Path) -> None:
         hint=(f"resume the study as it was made: {command} --resume" if command else
               "resume with the worlds, choices and runs the study was made with")
         + ", or choose another directory with -o")
+
+
+def _writing_to(command: str, out: Path) -> str:
+    """The study's ``command`` with ``-o`` naming ``out``, the directory being resumed (a
+    study copied or moved since it was made: its command names the old place)."""
+    try:
+        words = shlex.split(command)
+    except ValueError:                       # (a study.json edited by hand)
+        return command
+    at = max((i for i, w in enumerate(words[:-1]) if w in ("-o", "--out")), default=None)
+    if at is None:
+        return command
+    return shlex.join([*words[:at + 1], str(out), *words[at + 2:]])
 
 
 def rows_for(tasks: Iterable[Task], rows: list[dict]) -> tuple[list[dict], list[Task]]:
