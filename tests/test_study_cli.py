@@ -246,6 +246,37 @@ def test_resume_refuses_a_world_that_changed(tmp_path, compare):
     assert compare(*args, "--runs", 2, "--resume").exit_code == 0
 
 
+def test_a_study_resumes_from_another_directory(tmp_path, compare, monkeypatch):
+    """A world is the file, not the path typed: a study made with `tiny.yaml` from its own
+    directory "left out" its runs when resumed from anywhere else, even with the command its
+    hint gave. The rows go on naming the world as they did."""
+    home, elsewhere, out = tmp_path / "home", tmp_path / "elsewhere", tmp_path / "s"
+    home.mkdir()
+    elsewhere.mkdir()
+    world = home / "tiny.yaml"
+    world.write_text(TINY)
+    args = ("--planner", "dwa", "-o", out, "-j", 1, "--no-plots")
+    monkeypatch.chdir(home)
+    assert compare("tiny.yaml", *args, "--runs", 1).exit_code == 0
+    monkeypatch.chdir(elsewhere)
+    r = compare("../home/tiny.yaml", *args, "--runs", 2, "--resume")      # by its digest
+    assert r.exit_code == 0, r.output
+    assert "1 run now, 1 from before" in r.stderr
+    assert [row["world"] for row in read_rows(out)] == ["tiny.yaml"] * 2
+    world.write_text(TINY + "\n# edited\n")
+    r = compare(world, *args, "--runs", 3, "--resume")
+    assert r.exit_code == 1 and f"; `{world}` given now is not the file the runs of " \
+                                f"`tiny.yaml` were made with, or it was changed since" in r.stderr
+    monkeypatch.chdir(home)
+    r = compare(world, *args, "--runs", 3, "--resume")                   # the same file
+    assert r.exit_code == 1 and "`tiny.yaml` changed since the runs in" in r.stderr
+    world.write_text(TINY)
+    r = compare(world, *args, "--runs", 3, "--resume")
+    assert r.exit_code == 0 and "1 run now, 2 from before" in r.stderr
+    assert [row["world"] for row in read_rows(out)] == ["tiny.yaml"] * 3
+    assert compare("tiny.yaml", *args, "--runs", 3, "--resume").exit_code == 0
+
+
 def test_worlds_of_one_stem_are_told_apart(tmp_path, compare):
     (tmp_path / "sub").mkdir()
     for w in (tmp_path / "w.yaml", tmp_path / "sub" / "w.yaml"):

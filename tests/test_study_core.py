@@ -389,6 +389,41 @@ def test_a_run_held_twice_is_refused_at_its_second_row(tmp_path, copy):
     assert path.read_bytes() == before
 
 
+def test_alike_worlds_resumed_by_other_paths_keep_their_order(tmp_path, monkeypatch):
+    """Two worlds of the same text, made from their directory and resumed from another by
+    their full paths: each is found by its digest, the first world not yet taken first."""
+    home = tmp_path / "home"
+    home.mkdir()
+    for name in ("w1.yaml", "w2.yaml"):
+        (home / name).write_text("the same world\n")
+    monkeypatch.chdir(home)
+    run_study(small_study(runs=1), tmp_path / "s", workers=1, task_fn=fake_sim)
+    monkeypatch.chdir(tmp_path)
+    given = Study(**{**small_study(runs=2).__dict__,
+                     "worlds": [str(home / "w1.yaml"), str(home / "w2.yaml")]})
+    out = run_study(given, tmp_path / "s", workers=1, resume=True, task_fn=fake_sim)
+    assert (out.skipped, out.executed) == (6, 6)
+    assert [r["world"] for r in ResultStore(tmp_path / "s").load()] == \
+        [r["world"] for r in ResultStore(tmp_path / "s").load()[:6]] * 2
+    assert {r["world"] for r in ResultStore(tmp_path / "s").load()} == {"w1.yaml", "w2.yaml"}
+    assert {r["world"] for r in out.rows} == set(given.worlds)
+
+
+def test_a_run_held_under_two_names_of_its_world_is_refused(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    for name in ("w1.yaml", "w2.yaml"):
+        Path(name).write_text(name + "\n")
+    run_study(small_study(runs=1), "s", workers=1, task_fn=fake_sim)
+    path = tmp_path / "s" / "results.csv"
+    lines = path.read_text().splitlines(keepends=True)
+    world, rest = lines[1].split(",", 1)
+    path.write_text("".join(lines) + f"{tmp_path / world},{rest}")
+    with pytest.raises(StudyError) as exc:
+        run_study(small_study(runs=1), "s", workers=1, resume=True, task_fn=fake_sim)
+    assert "is here a second time: its first row is line 2" in exc.value.message
+    assert exc.value.span.line == 8
+
+
 def test_unknown_executor():
     with pytest.raises(MitosError) as exc:
         list(execute(fake_sim, small_study(1).tasks(), "dusk"))

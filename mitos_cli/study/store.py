@@ -6,6 +6,8 @@ by the kill (no final newline, fewer values than a row) is dropped and recompute
 row without its newline (as an editor saves a file) is a row. Nothing is written before a study
 is known to go on. Floats are written with ``repr``, so they read back bit for bit.
 ``study.json`` beside it records what the study was (seed, worlds, choices, runs, rule base).
+A world is the file, not the path as typed: a study resumes from any directory, and its rows
+keep the names of the worlds they were written with.
 """
 
 from __future__ import annotations
@@ -22,6 +24,7 @@ from typing import TextIO
 
 from ..errors import MitosError, Span, did_you_mean
 from ..fileio import bad_byte, read_text, unreadable
+from ..resources import is_file
 from ..words import plural
 from .spec import KEY_FIELDS, Task
 
@@ -118,6 +121,7 @@ class ResultStore:
         self._keep: int | None = None      # the bytes before a torn last line (see load)
         self._unended = False              # a whole last row without its newline
         self._at: list[tuple[int, str, list[str]]] = []   # each row's line: number, text, values
+        self._names: dict[str, str] = {}   # a world as given now -> as the rows name it
 
     # -- reading -----------------------------------------------------------------------------
 
@@ -271,8 +275,11 @@ class ResultStore:
         overwritten; with it, the directory must hold a study (its ``study.json`` or
         ``results.csv``, with rows or not), which must have the same seed as the one that
         wrote the rows and give every finished run the seed it was made with
-        (:func:`rows_for`). Everything is checked before anything is written: a refused study
-        leaves the directory as it was.
+        (:func:`rows_for`). A world of the rows given now by another path (from another
+        directory) is the same world when it is the same file or has the digest ``study.json``
+        records for it (:func:`_recorded_names`); the rows go on naming it as they did.
+        Everything is checked before anything is written: a refused study leaves the directory
+        as it was.
         """
         if self.dir.exists() and not self.dir.is_dir():
             raise StudyError(f"`{self.dir}` is a file, not a directory for the study's results",
@@ -299,13 +306,22 @@ class ResultStore:
                              f"not {manifest.get('seed')}",
                              hint=f"resume with --seed {old.get('seed')}, or choose another "
                                   "directory with -o")
+        given = list(manifest.get("worlds") or [])
+        worlds = _worlds_of(rows, old or {}, manifest)
         if old is not None:
-            _check_unchanged(old.get("digests") or {}, manifest.get("digests") or {}, self.path)
+            now = manifest.get("digests") or {}
+            _check_unchanged(old.get("digests") or {}, {
+                **now, **{name: now[w] for name, w in worlds.items() if w in now}}, self.path)
+        if any(name != w for name, w in worlds.items()):   # the rows, their worlds named as now
+            rows = [{**r, "world": worlds.get(r["world"], r["world"])} for r in rows]
+            self._refuse_twice(rows)         # (one world under two of its names)
+        self._names = _written_names(worlds)
+        manifest = _renamed(manifest, self._names)
         finished, todo = rows_for(tasks, rows)
         kept = {key_of(r) for r in finished}
         left = [r for r in rows if key_of(r) not in kept]
         if left:
-            _refuse_narrower(left, old or {}, self.path, self.dir)
+            _refuse_narrower(left, old or {}, self.path, self.dir, given)
         write_atomic(self.manifest_path, json.dumps(manifest, indent=2) + "\n")
         if not rows:
             write_atomic(self.path, ",".join(COLUMNS) + "\n")
@@ -326,7 +342,10 @@ class ResultStore:
                 fh.write(b"\n")
 
     def append(self, row: dict) -> None:
-        """Write one finished row and make it durable before returning."""
+        """Write one finished row and make it durable before returning (its world named as
+        the rows before it name it)."""
+        if row["world"] in self._names:
+            row = {**row, "world": self._names[row["world"]]}
         line = io.StringIO()
         csv.writer(line, lineterminator="\n").writerow(_format(row[f]) for f in COLUMNS)
         if self._file is None:
@@ -387,21 +406,78 @@ def _check_unchanged(old: dict, new: dict, path: Path) -> None:
                          hint="choose another directory with -o (or put the file back)")
 
 
-def _refuse_narrower(left: list[dict], old: dict, path: Path, out: Path) -> None:
+def _refuse_narrower(left: list[dict], old: dict, path: Path, out: Path,
+                     worlds: list[str]) -> None:
     """A resumed study that leaves out runs already in ``results.csv`` (fewer worlds, norms,
     planners or runs; ``left``: their rows): its report would cover part of the file, and the
-    study's own report would be replaced by it. Resuming may add runs, never drop them."""
+    study's own report would be replaced by it. Resuming may add runs, never drop them.
+    ``worlds``: the study's, as given now (a world of the rows by the same file name is
+    another file, or was changed since: it is said)."""
     first = left[0]
     command = old.get("command")
     if command:
         command = _writing_to(command, out)
+    named = first["world"]
+    alike = [] if named in worlds else [w for w in worlds if Path(w).name == Path(named).name]
+    other = (f"; `{alike[0]}` given now is not the file the runs of `{named}` were made "
+             f"with, or it was changed since") if alike else ""
     raise StudyError(
         f"{path} holds {plural(len(left), 'finished run')} this study leaves out (the first: "
-        f"run {first['run']} of {Path(first['world']).name}, {_label(first)}); resuming would "
+        f"run {first['run']} of {Path(named).name}, {_label(first)}){other}; resuming would "
         f"report on part of the file",
         hint=(f"resume the study as it was made: {command} --resume" if command else
               "resume with the worlds, choices and runs the study was made with")
         + ", or choose another directory with -o")
+
+
+def _worlds_of(rows: list[dict], old: dict, new: dict) -> dict[str, str]:
+    """Each name the ``rows`` (or ``old``, the manifest they were made with) give a world of
+    the study ``new`` (its manifest), and that world as ``new`` names it. A world is the
+    file, not the path as typed (relative to another directory, a packaged world by its name
+    or its path): the same name, else the same file from here, else the digest ``old``
+    records for it (a world not yet taken first: two worlds may be alike)."""
+    listed = old.get("worlds")
+    recorded = list(dict.fromkeys(
+        [w for w in (listed if isinstance(listed, list) else []) if isinstance(w, str)]
+        + [r["world"] for r in rows]))
+    worlds = list(new.get("worlds") or [])
+    was, now = old.get("digests") or {}, new.get("digests") or {}
+    found = {name: name for name in recorded if name in worlds}
+    for name in recorded:
+        here = _file(name) if name not in found else None
+        same = [w for w in worlds if here is not None and _file(w) == here]
+        if same:
+            found[name] = same[0]
+    for name in recorded:
+        if name not in found and was.get(name) is not None:
+            alike = [w for w in worlds if now.get(w) == was[name]]
+            untaken = [w for w in alike if w not in found.values()]
+            if alike:
+                found[name] = (untaken or alike)[0]
+    return found
+
+
+def _written_names(worlds: dict[str, str]) -> dict[str, str]:
+    """Each world (as given now) whose rows are written under another name, and that name:
+    the first the rows give it (``worlds``: :func:`_worlds_of`), unless they name it as
+    given."""
+    names: dict[str, str] = {}
+    for name, world in worlds.items():          # (the names as given come first)
+        names.setdefault(world, name)
+    return {world: name for world, name in names.items() if world != name}
+
+
+def _file(path: str) -> str | None:
+    """The file ``path`` names from here, links followed; ``None`` when it names none."""
+    return os.path.realpath(path) if is_file(Path(path)) else None
+
+
+def _renamed(manifest: dict, names: dict[str, str]) -> dict:
+    """``manifest`` with its worlds named as the rows name them (``names``)."""
+    if not names:
+        return manifest
+    return {**manifest, "worlds": [names.get(w, w) for w in manifest.get("worlds") or []],
+            "digests": {names.get(k, k): v for k, v in (manifest.get("digests") or {}).items()}}
 
 
 def _writing_to(command: str, out: Path) -> str:
