@@ -277,7 +277,7 @@ class ResultStore:
         wrote the rows and give every finished run the seed it was made with
         (:func:`rows_for`). A world of the rows given now by another path (from another
         directory) is the same world when it is the same file or has the digest ``study.json``
-        records for it (:func:`_recorded_names`); the rows go on naming it as they did.
+        records for it (:func:`_worlds_of`); the rows go on naming it as they did.
         Everything is checked before anything is written: a refused study leaves the directory
         as it was.
         """
