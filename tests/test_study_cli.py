@@ -265,8 +265,9 @@ def test_a_study_resumes_from_another_directory(tmp_path, compare, monkeypatch):
     assert [row["world"] for row in read_rows(out)] == ["tiny.yaml"] * 2
     world.write_text(TINY + "\n# edited\n")
     r = compare(world, *args, "--runs", 3, "--resume")
-    assert r.exit_code == 1 and f"; `{world}` given now is not the file the runs of " \
-                                f"`tiny.yaml` were made with, or it was changed since" in r.stderr
+    assert r.exit_code == 1 and "home/tiny.yaml` " in r.stderr       # (a long path is cut)
+    assert "given now is not the file the runs of `tiny.yaml` were made with, or it was " \
+           "changed since" in r.stderr
     monkeypatch.chdir(home)
     r = compare(world, *args, "--runs", 3, "--resume")                   # the same file
     assert r.exit_code == 1 and "`tiny.yaml` changed since the runs in" in r.stderr
