@@ -11,6 +11,7 @@ import pytest
 from mitos_cli.api import default_rulebase_path
 from mitos_cli.errors import LessonError, MitosError, NameError_, RuleBaseError
 from mitos_cli.teach.journal import Journal
+from mitos_cli.teach.prompt import at_prompt
 from mitos_cli.teach.session import Session
 
 RULEBASES = default_rulebase_path().parent
@@ -313,17 +314,23 @@ def test_simulate_and_at_and_their_mistakes(rules, tmp_path):
     s.run("undo")
     text = say(s, out, f"adapt epochs 3 plot {tmp_path / 'a.svg'}")
     assert "plotted" in text and list(tmp_path.glob("a*.svg"))
-    with pytest.raises(Exception, match="unknown picture format"):
+    # a picture that cannot be drawn is the command's failure, as every other command's
+    with pytest.raises(LessonError, match="unknown picture format"):
         s.run("adapt epochs 3 plot a.gif")
     # a plot that cannot be written is refused before the descent: once, the adaptation was
     # kept and journaled with only "error: cannot write" said, and adapting again adapted twice
     changes = len(s.journal.entries)
-    with pytest.raises(Exception, match="cannot write .*: No such file or directory"):
+    with pytest.raises(LessonError, match="cannot write .*: No such file or directory"):
         s.run(f"adapt epochs 3 plot {tmp_path / 'missing' / 'a.svg'}")
     assert len(s.journal.entries) == changes
     # `show terms plot` names the file given, not the first one made from it (`a-road`)
-    with pytest.raises(Exception, match="cannot write `a`: unknown picture format"):
+    with pytest.raises(LessonError, match="cannot write `a`: unknown picture format"):
         s.run("show terms plot a")
+    with pytest.raises(LessonError) as info:
+        s.run("show terms plot t.txt", "<prompt>", 3)
+    assert at_prompt(info.value, "show terms plot t.txt", 3).render().splitlines()[:3] == [
+        "<prompt>:3:17: command error: cannot write `t.txt`: unknown picture format `txt`",
+        "    show terms plot t.txt", "                    ^^^^^"]
 
 
 def test_a_world_driven_with_another_behavior_than_its_own_says_so(rules):

@@ -21,10 +21,11 @@ transition), so replaying the journal's entries rebuilds the state exactly: that
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import math
 import re
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -783,8 +784,9 @@ class Session:
             from ..draw.output import check_format
             from ..fileio import check_writable
 
-            check_format(c.plot)
-            check_writable(c.plot)
+            with _drawing():
+                check_format(c.plot)
+                check_writable(c.plot)
         progress = self.progress(epochs) if self.progress else None
         try:
             return adapt(compiled, X, T, epochs=epochs, rate=rate, parameters=params,
@@ -808,7 +810,8 @@ class Session:
         for old, new in changed:
             dest = target if len(changed) == 1 else \
                 target.with_name(f"{target.stem}-{new.name}{target.suffix}")
-            draw_terms_before_after(old, new, dest)
+            with _drawing():
+                draw_terms_before_after(old, new, dest)
             written.append(str(dest))
         self.out("plotted " + ", ".join(written))
 
@@ -821,7 +824,8 @@ class Session:
             if c.plot is not None:      # the name given, not the first one made from it
                 from ..draw.output import check_format
 
-                check_format(c.plot)
+                with _drawing():
+                    check_format(c.plot)
             self.out(text.terms_table(self.original, self.rulebase, self._shownvariables()))
             if c.plot is not None:
                 self._plot_terms(self.original, self.rulebase, c.plot)
@@ -917,6 +921,21 @@ class Session:
 
 
 # ---- small helpers ---------------------------------------------------------------------------
+
+@contextlib.contextmanager
+def _drawing() -> Iterator[None]:
+    """A picture a command cannot draw or write (`plot t.txt`, a missing directory) is that
+    command's failure, a `command error` (a lesson's `lesson error`) as every other command's:
+    it was a bare `error`, the drawing module's word."""
+    from ..draw.output import DrawError
+    from ..errors import WriteError
+
+    try:
+        yield
+    except (DrawError, WriteError) as exc:
+        raise LessonError(exc.message, span=exc.span, expected=exc.expected,
+                          hint=exc.hint) from None
+
 
 def _reaches(rb: RuleBase, start: str, target: str) -> bool:
     seen, stack = set(), [start]
