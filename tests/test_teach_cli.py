@@ -327,6 +327,13 @@ def test_save_as_names_a_rules_file(work):
     res = mitos("teach", "rb/mitos.rules", "--save-as", "x.png", "--lesson", "-", cwd=work,
                 stdin="")
     assert res.returncode == 2 and "ending in `.rules`" in res.stderr
+    # `.rules` ends in `.rules` but names no file (the lesson refused it, exit 1, as a name
+    # that "does not end in `.rules`"): the same usage error
+    for given in (".rules", "out/.rules"):
+        res = mitos("teach", "rb/mitos.rules", "--save-as", given, "--lesson", "-", cwd=work,
+                    stdin="")
+        assert res.returncode == 2 and "is only the ending, give it a name" in res.stderr
+        assert "does not end in" not in res.stderr
 
 
 def test_a_bad_world_in_a_lesson_is_reported_in_the_world_file(work):

@@ -413,6 +413,10 @@ def test_save_refuses_to_write_over_a_term_set_the_rule_file_reads(tmp_path):
     with pytest.raises(LessonError, match=r"does not end in `\.rules`") as e:
         s.run(f"save {tmp_path / 'out.txt'}")
     assert e.value.hint == f"save {(tmp_path / 'out.rules').as_posix()}"
+    # a dot-file's suffix is empty: `.rules` "did not end in `.rules`" (hint `.rules.rules`)
+    with pytest.raises(LessonError, match=r"names no rule file: `\.rules` is the ending") as e:
+        s.run(f"save {tmp_path / '.rules'}")
+    assert e.value.hint == f"give it a name: `save {(tmp_path / 'taught.rules').as_posix()}`"
     s.run(f"save {tmp_path / 'a.rules'}")          # over the original: its term set in place
     assert (tmp_path / "b.terms.yaml").read_text() != terms
 

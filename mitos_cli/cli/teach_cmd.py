@@ -92,11 +92,17 @@ def teach_command(
 def _check_options(rules, behavior, lesson, save_as, resume: bool, session_name, recover: bool,
                    as_json: bool) -> None:
     """The options that do not go together, before a session is opened or created."""
+    from ..teach.save import nameless
+
     if recover and not resume:
         raise typer.BadParameter("--recover applies to a resumed session: add --resume")
     if save_as is not None and not save_as.endswith(".rules"):
         raise typer.BadParameter(f"--save-as names the rule file to write, ending in `.rules`, "
                                  f"not `{save_as}`")
+    if save_as is not None and nameless(save_as):
+        raise typer.BadParameter(f"--save-as names the rule file to write: `{save_as}` is only "
+                                 f"the ending, give it a name (`--save-as "
+                                 f"{Path(save_as).with_name('taught.rules').as_posix()}`)")
     if as_json and lesson is None:
         raise typer.BadParameter("--json reports a lesson: add --lesson FILE")
     if session_name is not None and not resume:

@@ -112,6 +112,10 @@ def _check_targets(target: Path, src: Path, original: RuleBase, targets: tuple[P
     `b.terms.yaml`), or a term set onto the rule file itself; or over a file the user did not
     name: a term set there that the rule file saved over does not read (a term set of an
     earlier save as ``target`` is its own, and is replaced)."""
+    if nameless(target):
+        raise LessonError(f"`{target}` names no rule file: `.rules` is the ending, and the name "
+                          "before it is missing",
+                          hint=f"give it a name: `save {(target.parent / 'taught.rules').as_posix()}`")
     if target.suffix != ".rules":
         raise LessonError(f"`{target}` does not end in `.rules`; save writes a rule file"
                           + (" (and its term sets beside it)" if target.suffix in YAML else ""),
@@ -135,6 +139,12 @@ def _check_targets(target: Path, src: Path, original: RuleBase, targets: tuple[P
             f"`{dest}` is already there and no term set of `{target}`; saving as "
             f"`{target.name}` would write its term set over it",
             hint="remove it, or save under another name")
+
+
+def nameless(target: str | Path) -> bool:
+    """Whether ``target`` is only the ending, `.rules` (`dir/.rules`): ``Path.suffix`` of a
+    dot-file is empty, so "`.rules` does not end in `.rules`" was said of it."""
+    return Path(target).name.lower() == ".rules"
 
 
 #: The endings of a term-set file's name (`mitos.terms.yaml`), stripped from a hint's name.
