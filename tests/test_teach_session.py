@@ -333,6 +333,28 @@ def test_simulate_and_at_and_their_mistakes(rules, tmp_path):
         "    show terms plot t.txt", "                    ^^^^^"]
 
 
+def test_a_hedge_or_time_that_cannot_be_used_is_refused_at_its_own_word(rules):
+    """`seldom LB` in a target and `at` times outside the run (or a window ending before it
+    starts) were all pointed at column 1, under the command word."""
+    s, _ = session(rules)
+
+    def place(line):
+        with pytest.raises(LessonError) as info:
+            s.run(line, "<prompt>", 4)
+        span = info.value.span
+        return span.line, span.column, span.end_column
+
+    assert place("correct road=78 size=45 position=4 -> steering is seldom LB") == (4, 51, 57)
+    s.run("use drive")
+    s.run("simulate corridor")
+    assert place("at 1e400s steering=50") == (4, 4, 10)
+    assert place("at -1s steering=50") == (4, 4, 7)
+    assert place("at 1s to 100s turn harder") == (4, 10, 14)
+    assert place("at 5s to 2s steering is LB") == (4, 4, 12)
+    assert place("at 5s to 2s steering=50") == (4, 4, 12)
+    assert place("at 5s to 5.01s steering is very seldom LB") == (4, 33, 39)
+
+
 def test_a_world_driven_with_another_behavior_than_its_own_says_so(rules):
     """A new session's behavior is the file's first (`avoid_obstacle`): Figure 4 then ends
     after 2 s, not at B; the verdict says which behavior `mitos simulate` drives it with."""

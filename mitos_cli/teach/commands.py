@@ -107,11 +107,16 @@ class CorrectSaid:
     targets: tuple[Said, ...]
 
 
+#: where an `at`'s two times are written (for an error about one of them)
+Places = tuple[Span | None, Span | None]
+
+
 @dataclass(frozen=True)
 class AtSaid:
     start: float
     stop: float | None
     targets: tuple[Said, ...]
+    places: Places = field(default=(None, None), compare=False)
 
 
 @dataclass(frozen=True)
@@ -122,6 +127,7 @@ class AtInstruction:
     stop: float | None
     words: tuple[str, ...]
     span: Span | None = field(default=None, compare=False)
+    places: Places = field(default=(None, None), compare=False)
 
 
 @dataclass(frozen=True)
@@ -171,6 +177,7 @@ class At:
     start: float
     stop: float | None
     targets: tuple[Assign, ...]
+    places: Places = field(default=(None, None), compare=False)
 
 
 @dataclass(frozen=True)
@@ -263,13 +270,13 @@ class _ToCommand(_ToModel):
         return CorrectSaid(items[0], items[2])
 
     def at_said(self, items):
-        start, stop, said = items
-        return AtSaid(start, stop, said)
+        (start, stop), places, (said,) = _window(items)
+        return AtSaid(start, stop, said, places)
 
     @v_args(meta=True)
     def at_instruction(self, meta, items):
-        start, stop, *words = items
-        return AtInstruction(start, stop, tuple(str(w) for w in words), self._s(meta))
+        (start, stop), places, words = _window(items)
+        return AtInstruction(start, stop, tuple(str(w) for w in words), self._s(meta), places)
 
     def eval_cmd(self, items):
         return Eval(tuple(items))
@@ -285,12 +292,13 @@ class _ToCommand(_ToModel):
         return Simulate(items[0], None if items[1] is None else str(items[1]),
                         None if items[2] is None else str(items[2]))
 
-    def time(self, items):
-        return float(items[0])
+    @v_args(meta=True)
+    def time(self, meta, items):
+        return float(items[0]), self._s(meta)
 
     def at_cmd(self, items):
-        start, stop, *targets = items
-        return At(start, stop, tuple(targets))
+        (start, stop), places, targets = _window(items)
+        return At(start, stop, tuple(targets), places)
 
     def epochs(self, items):
         return ("epochs", float(items[0]))
@@ -321,6 +329,13 @@ class _ToCommand(_ToModel):
 
     def quit_cmd(self, items):
         return Quit()
+
+
+def _window(items: list) -> tuple[tuple[float, float | None], Places, list]:
+    """An `at`'s times (the end ``None`` without `to`), where each is written, and the rest."""
+    start, stop, *rest = items
+    return ((start[0], None if stop is None else stop[0]),
+            (start[1], None if stop is None else stop[1]), rest)
 
 
 def _not_a_target(exc: UnexpectedInput, line: str, where: str) -> RuleSyntaxError | None:

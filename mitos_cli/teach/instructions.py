@@ -37,7 +37,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import LessonError, did_you_mean
+from ..errors import LessonError, Span, did_you_mean
 from ..lang.interpretability import mirror_point
 from ..lang.terms import Variable
 
@@ -98,6 +98,12 @@ def past_the_end(var: Variable, term: str, hedges: tuple[str, ...]) -> str | Non
     return scale.names[last] if u > last + 1e-9 else None
 
 
+def not_a_target_hedge(hedge: str, term: str, span: Span | None = None) -> LessonError:
+    """The error for a hedge of a rule's condition in a target (`seldom LB`), at ``span``."""
+    return LessonError(f"`{hedge} {term}` has no meaning for a target value", span=span,
+                       expected="very, extremely, somewhat or more_or_less")
+
+
 def _hedged_steps(var: Variable, term: str, hedges: tuple[str, ...]) -> tuple[Scale, float]:
     """The scale of ``var`` and where ``HEDGES TERM`` lies on it, in steps (not clipped)."""
     value = var.term(term).center
@@ -105,8 +111,7 @@ def _hedged_steps(var: Variable, term: str, hedges: tuple[str, ...]) -> tuple[Sc
     u = float(scale.steps(np.array(value)))
     for h in reversed(hedges):                         # the innermost hedge first
         if h not in HEDGE_STEPS:
-            raise LessonError(f"`{h} {term}` has no meaning for a target value",
-                              expected="very, extremely, somewhat or more_or_less")
+            raise not_a_target_hedge(h, term)
         away = np.sign(u - scale.centre)
         if HEDGE_STEPS[h] > 0:
             u += away * HEDGE_STEPS[h]

@@ -585,7 +585,7 @@ class Session:
 
     def _said(self, said, compiled: CompiledRuleBase) -> tuple[cmd.Assign, ...]:
         """``steering is very LM`` -> ``steering=40`` (the hedged term's value)."""
-        from .instructions import hedged, past_the_end
+        from .instructions import HEDGE_STEPS, hedged, not_a_target_hedge, past_the_end
 
         out = []
         for t in said:
@@ -597,6 +597,9 @@ class Session:
                 continue
             var = compiled.variables[t.name]
             var.term(t.term, t.span and t.span.ending(t.term))
+            for h in t.hedges:          # said at the hedge, not at the line's start
+                if h not in HEDGE_STEPS:
+                    raise not_a_target_hedge(h, t.term, t.span and t.span.naming(h))
             value = hedged(var, t.term, t.hedges)
             end = past_the_end(var, t.term, t.hedges)
             if end is not None:
@@ -614,7 +617,7 @@ class Session:
     def _atsaid(self, c: cmd.AtSaid, line: str) -> None:
         rec = self._recording()
         compiled = self._driver(rec, note=False)
-        self._at(cmd.At(c.start, c.stop, self._said(c.targets, compiled)), line)
+        self._at(cmd.At(c.start, c.stop, self._said(c.targets, compiled), c.places), line)
 
     def _atinstruction(self, c: cmd.AtInstruction, line: str) -> None:
         from .instructions import Window, instruction, targets
@@ -626,7 +629,7 @@ class Session:
             raise
         rec = self._recording()
         compiled = self._driver(rec)
-        rows = rec.rows(c.start, c.stop)
+        rows = rec.rows(c.start, c.stop, c.places)
         inputs = [rec.inputs_at(i, compiled.inputs) for i in rows]
         now = self._outputs(compiled, inputs)
         window = Window({o: np.array([y[o] for y in now]) for o in compiled.outputs},
@@ -698,7 +701,7 @@ class Session:
     def _at(self, c: cmd.At, line: str) -> None:
         rec = self._recording()
         compiled = self._driver(rec)
-        rows = rec.rows(c.start, c.stop)
+        rows = rec.rows(c.start, c.stop, c.places)
         targets = self._values(c.targets, compiled.outputs, "output", compiled, False)
         inputs = [rec.inputs_at(i, compiled.inputs) for i in rows]
         self._add_window(compiled, rec, rows, inputs, [targets] * len(rows), line)

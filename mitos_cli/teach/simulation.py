@@ -7,6 +7,7 @@ perceived at a time (or in a time window) into examples.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -14,7 +15,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..errors import LessonError, MitosError
+from ..errors import LessonError, MitosError, Span
 from ..lang.model import RuleBase
 from ..words import clearance, plural
 
@@ -109,23 +110,29 @@ class Recording:
         return (f"\n  (`mitos simulate` drives {self.name} with behavior {own}: "
                 f"`use {own}` to drive it so here)")
 
-    def rows(self, start: float, stop: float | None) -> np.ndarray:
-        """Tick rows at ``start`` (the nearest) or from ``start`` to ``stop``."""
+    def rows(self, start: float, stop: float | None,
+             places: tuple[Span | None, Span | None] = (None, None)) -> np.ndarray:
+        """Tick rows at ``start`` (the nearest) or from ``start`` to ``stop``. A time that
+        cannot be used is refused at its place (``places``: where the two are written), not
+        at the line's first column."""
         t, end, active = self.t, self.end, self._active
         whose = f"robot {self.robot_name}'s run" if self.robot_name else "the run"
-        for value in (start, stop):
+        for value, place in zip((start, stop), places):
             if value is not None and not math.isfinite(value):
                 raise LessonError(f"a time is a finite number of seconds ({whose} lasted 0 "
-                                  f"to {end:g} s)")
+                                  f"to {end:g} s)", span=place)
             if value is not None and not -1e-9 <= value <= end + 1e-9:
-                raise LessonError(f"{whose} lasted 0 to {end:g} s; {value:g} s is outside it")
+                raise LessonError(f"{whose} lasted 0 to {end:g} s; {value:g} s is outside it",
+                                  span=place)
         if stop is None:
             return np.array([int(np.argmin(np.abs(t[:self._last + 1] - start)))])
         if stop < start:
-            raise LessonError(f"`at {start:g}s to {stop:g}s`: the window ends before it starts")
+            raise LessonError(f"`at {start:g}s to {stop:g}s`: the window ends before it starts",
+                              span=_between(*places))
         rows = np.flatnonzero((t >= start - 1e-9) & (t <= stop + 1e-9) & active)
         if rows.size == 0:
-            raise LessonError(f"no recorded tick between {start:g} s and {stop:g} s")
+            raise LessonError(f"no recorded tick between {start:g} s and {stop:g} s",
+                              span=_between(*places))
         return rows
 
     def when(self, rows: np.ndarray) -> str:
@@ -168,3 +175,10 @@ def run_world(name: str, rulebase: RuleBase, behavior: str, seed: int | None = N
     result = simulate(world, planner, seed=seed)
     return Recording(Path(name).stem, behavior, result, index,
                      names[index] if len(names) > 1 else "", seed)
+
+
+def _between(first: Span | None, last: Span | None) -> Span | None:
+    """The window from the place of its first time to the end of its last (`5s to 2s`)."""
+    if first is None or last is None or last.line != first.line:
+        return first
+    return dataclasses.replace(first, end_column=last.end_column)
