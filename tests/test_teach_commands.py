@@ -127,6 +127,20 @@ def test_mistyped_lines_say_what_was_expected(line, message, expected, hint):
     assert "$END" not in text and "Token(" not in text and "__ANON" not in text
 
 
+@pytest.mark.parametrize("line", [
+    "correct road=78 -> steering is LB LM",
+    "correct road=78 -> steering is vary LB",
+    "correct road=78 -> steering is LM with 0.5",
+    "at 1s to 2s steering is LB speed",
+])
+def test_a_target_is_not_offered_a_with_it_refuses(line):
+    """A target reuses the rule language's consequent, which `with W` may follow in a rule: the
+    error offered `with`, and following it gave the same error without it."""
+    with pytest.raises(RuleSyntaxError) as info:
+        parse_command(line)
+    assert info.value.expected == "`and` or the end of the line"
+
+
 def test_a_rule_may_continue_on_the_next_line():
     assert incomplete("r1: if road is WIDE")
     assert incomplete("if road is WIDE and size is SMALL_SZ")

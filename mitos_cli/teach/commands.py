@@ -537,6 +537,10 @@ def _syntax_error(exc: UnexpectedInput, text: str, path: str) -> RuleSyntaxError
             expected.add("SEED_WORD")
     if "->" in before or before[:1] in (["at"], ["eval"]):   # LALR's merged states: no arrow
         expected.discard("ARROW")                           # is behind us or has a place
+    if ("->" in before or before[:1] == ["at"]) and "WITH" in expected:
+        # a target reuses the rule language's consequent, which a rule's `with` may follow;
+        # a target takes no weight, and the line may end after it
+        expected = expected - {"WITH"} | {"$END"}
     hint = _teach_hint(text, token, before)
     if hint is not None:
         pass
