@@ -84,7 +84,8 @@ def test_rule_lines_are_rules_of_the_rule_language():
     ("r1: if road is WIDE then speed is not SLOW",
      "`not` is not allowed in an action (`speed is not SLOW`)", None, "not to its complement"),
     ("use dr\u00efve", "unexpected `\u00efve`", None, "ASCII letters"),
-    ("at 5ms steering=70", "unexpected `=`", None, "a time is in seconds"),
+    ("at 5ms steering=70", "a time must be a number of seconds, not `5ms`", "a decimal number",
+     "a time is in seconds"),
     ("adapt epochs 3 rate 0.9 rate 0.01", "`rate` is given twice in one `adapt`", None,
      "give each option once"),
     ("simulate figure4 seed 2x", "unexpected `x`", None, "a seed is a whole number"),
@@ -139,6 +140,38 @@ def test_a_target_is_not_offered_a_with_it_refuses(line):
     with pytest.raises(RuleSyntaxError) as info:
         parse_command(line)
     assert info.value.expected == "`and` or the end of the line"
+
+
+@pytest.mark.parametrize("line, message, column, hint", [
+    ("correct road=0x1F size=45 position=4 -> steering=60", "`road` must be a number, not "
+     "`0x1F`", 14, None),
+    ("eval road=7_8 size=45 position=4", "`road` must be a number, not `7_8`", 11, None),
+    ("eval road=78 size=4_", "`size` must be a number, not `4_`", 19, None),
+    ("eval road=1.2.3", "`road` must be a number, not `1.2.3`", 11, None),
+    ("correct road=78 -> steering is 6_0", "`steering` must be a number, not `6_0`", 32, None),
+    ("adapt epochs 0x10", "`epochs` must be a number, not `0x10`", 14, None),
+    ("at 0x10s steering=50", "a time must be a number of seconds, not `0x10s`", 4,
+     "a time is in seconds"),
+    ("at 3s to 1_2s turn harder", "a time must be a number of seconds, not `1_2s`", 10,
+     "a time is in seconds"),
+])
+def test_a_malformed_number_is_named_at_its_own_place(line, message, column, hint):
+    """The lexer read `0x1F` as `0` and a name `x1F`, so the error fell on the next word
+    ("unexpected `size`, expected `=`"); `mitos eval` names the value for the same text."""
+    with pytest.raises(RuleSyntaxError) as info:
+        parse_command(line, "lesson.lesson", 3)
+    err = info.value
+    assert err.message == message
+    assert (err.span.line, err.span.column) == (3, column)
+    assert err.expected.startswith("a decimal number such as 78, -4.5 or 1e3")
+    assert err.hint == hint or hint in err.hint
+
+
+@pytest.mark.parametrize("line", ["eval road=+5 size=.5 position=5.", "eval road=1E+2 size=-.5e1",
+                                  "at 1.5 to 2s speed=+1e1", "at 3 to 3.1 steering is 60",
+                                  "adapt epochs 5 rate .5"])
+def test_every_number_the_grammar_reads_is_still_read(line):
+    parse_command(line)
 
 
 def test_a_rule_may_continue_on_the_next_line():

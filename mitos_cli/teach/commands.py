@@ -358,6 +358,9 @@ def parse_command(line: str, path: str | None = None, lineno: int = 1) -> Comman
     """
     where = path or "<prompt>"
     try:
+        bad = _bad_number(line, where)
+        if bad is not None:
+            raise bad
         try:
             tree = parser().parse(line)
         except UnexpectedInput as exc:
@@ -378,6 +381,46 @@ def parse_command(line: str, path: str | None = None, lineno: int = 1) -> Comman
         _check_once(result, line, where, lineno)
         _check_values(result, line, where, lineno)
     return result
+
+
+#: a number as the grammar reads it (Lark's SIGNED_NUMBER)
+_NUMBER = r"[-+]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][-+]?\d+)?"
+#: a word that begins as a number does, up to a blank, `=`, `,` or `#`
+_NUMBERISH = r"[-+]?\.?\d[^\s=,#]*"
+#: what a number is, in the words `mitos eval` says it
+DECIMAL = "a decimal number such as 78, -4.5 or 1e3"
+TIME_HINT = "a time is in seconds: `at 5s` or `at 5` (`at 0.005s` for 5 ms)"
+
+
+def _bad_number(line: str, where: str) -> RuleSyntaxError | None:
+    """`road=0x1F`, `7_8`, `at 0x10s`, `at 12ms`: a number glued to letters, which the lexer
+    reads as a number and a name, so the error fell on the next word (or `at 0x10s turn
+    harder` read `x10s` as an instruction's word). Said at the number, as `mitos eval` says
+    it; only where a teaching command takes a number (a rule's are the rule language's)."""
+    first = line.split()[:1]
+    found: list[tuple[int, str, str, bool]] = []     # (start, word, whose, is a time)
+    if first in (["eval"], ["correct"], ["at"]):
+        found += [(m.start(2), m.group(2), f"`{m.group(1)}`", False) for m in
+                  re.finditer(rf"([A-Za-z_][\w\-]*)\s*=\s*({_NUMBERISH})", line)]
+        found += [(m.start(2), m.group(2), f"`{m.group(1)}`", False) for m in
+                  re.finditer(rf"([A-Za-z_][\w\-]*)\s+is\s+({_NUMBERISH})", line)]
+    if first == ["at"]:
+        found += [(m.start(1), m.group(1), "a time", True) for m in
+                  re.finditer(rf"(?:^\s*at|\sto)\s+({_NUMBERISH})", line)]
+    if first == ["adapt"]:
+        found += [(m.start(2), m.group(2), f"`{m.group(1)}`", False) for m in
+                  re.finditer(rf"\b(epochs|rate)\s+({_NUMBERISH})", line)]
+    for start, word, whose, time in sorted(found):
+        if re.fullmatch(_NUMBER + ("s?" if time else ""), word):
+            continue
+        lineno = line.count("\n", 0, start) + 1
+        column = start - (line.rfind("\n", 0, start) + 1) + 1
+        return RuleSyntaxError(
+            f"{whose} must be a number{' of seconds' if time else ''}, not `{word}`",
+            span=Span.in_text(line, where, lineno, column, column + len(word)),
+            expected=DECIMAL + (", with or without `s`" if time else ""),
+            hint=TIME_HINT if time else None)
+    return None
 
 
 def _check_once(c: Adapt, line: str, where: str, lineno: int) -> None:
@@ -588,7 +631,7 @@ def _teach_hint(text: str, token: Token, before: list[str]) -> str | None:
     if before[:1] == ["at"] and len(before) > 1 and any(
             re.fullmatch(r"[\d.]+(ms|sec|secs|seconds?|min|m|h)", word)
             for word in (before[1], "".join(before[1:3]))):
-        return "a time is in seconds: `at 5s` or `at 5` (`at 0.005s` for 5 ms)"
+        return TIME_HINT
     if before[-2:] == ["is", "not"] and ("->" in before or before[:1] == ["at"]):
         return ("a target is a term, with hedges if need be (`steering is very LM`); `not` says "
                 "what it should not be, which is no target")
