@@ -380,6 +380,20 @@ def test_an_empty_behavior_is_a_usage_error(short):
     assert res.exit_code == 2 and "must name something" in res.output
 
 
+@pytest.mark.parametrize("args", [
+    ["simulate", ""], ["simulate", "corridor", ""], ["simulate", "corridor", "--rulebase", ""],
+    ["compare", "", "--runs", "1"], ["teach", ""], ["teach", "--lesson", ""],
+    ["eval", "", "x=1"], ["check", ""],
+])
+def test_an_empty_path_is_a_usage_error(args):
+    """`Path('')` is the current directory: an empty world, rule file or lesson was "``
+    is a directory, not a world file", exit 1, where the same empty `-b` is a usage error."""
+    res = CliRunner().invoke(app, args)
+    said = re.sub(r"[\s\u2502]+", " ", res.output)          # (the box Click draws wraps it)
+    assert res.exit_code == 2 and "must name something, not be empty" in said
+    assert "directory" not in said
+
+
 def test_an_output_is_never_an_input_nor_another_output(short, capsys):
     before = short.read_bytes()
     code, err = run_main(capsys, short, "--out", short)       # replaced the world with a CSV

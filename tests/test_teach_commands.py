@@ -174,6 +174,24 @@ def test_every_number_the_grammar_reads_is_still_read(line):
     parse_command(line)
 
 
+@pytest.mark.parametrize("line, column, example", [
+    ('simulate ""', 10, "simulate worlds/figure4.yaml"),
+    ('simulate " " seed 3', 10, "simulate worlds/figure4.yaml"),
+    ('save ""', 6, "save taught.rules"),
+    ('show terms plot ""', 17, "plot terms.png"),
+    ('adapt epochs 3 plot ""', 21, "plot terms.png"),
+])
+def test_an_empty_file_name_is_refused_at_its_place(line, column, example):
+    """`Path('')` is the current directory: `simulate ""` was "`` is a directory, not a world
+    file" at column 1."""
+    with pytest.raises(LessonError) as info:
+        parse_command(line, "lesson.lesson", 2)
+    err = info.value
+    assert err.message == "the file name is empty: it names no file"
+    assert (err.span.line, err.span.column) == (2, column)
+    assert err.hint == f"give a file name, e.g. `{example}`"
+
+
 def test_a_rule_may_continue_on_the_next_line():
     assert incomplete("r1: if road is WIDE")
     assert incomplete("if road is WIDE and size is SMALL_SZ")

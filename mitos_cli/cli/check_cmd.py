@@ -92,7 +92,7 @@ def _shown(finding: dict) -> dict:
 
 def check_command(
     rulebase: Annotated[Optional[str], typer.Argument(
-        metavar="[RULEBASE]",
+        metavar="[RULEBASE]", callback=named,
         help="Rule file (default: the packaged MITOS rule base).")] = None,
     behavior: Annotated[Optional[str], typer.Option(
         "--behavior", "-b", callback=named,

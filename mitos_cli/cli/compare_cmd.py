@@ -20,7 +20,7 @@ DEFAULT_AND = "min,product,lukasiewicz,einstein"
 
 def compare_command(
     worlds: Annotated[list[str], typer.Argument(
-        metavar="WORLDS...", autocompletion=complete.worlds,
+        metavar="WORLDS...", autocompletion=complete.worlds, callback=named,
         help="World files (or names of packaged worlds such as corridor.yaml).")],
     and_: Annotated[str, typer.Option(
         "--and", metavar="TNORMS", callback=named,
@@ -60,7 +60,7 @@ def compare_command(
         "--resume", help="Continue the study in DIR: skip every run already in results.csv "
                          "(DIR must hold one; without --resume a study starts there).")] = False,
     rulebase: Annotated[Optional[str], typer.Option(
-        "--rulebase", "-r", metavar="PATH",
+        "--rulebase", "-r", metavar="PATH", callback=named,
         help="Rule base of the fuzzy planner (default: the packaged one).")] = None,
     behavior: Annotated[Optional[str], typer.Option(
         "--behavior", "-b", callback=named, help="Behavior to drive with (default: the world's).")] = None,

@@ -140,7 +140,7 @@ def warn_undersampled(rb, dof) -> None:
 
 def eval_command(
     args: Annotated[Optional[list[str]], typer.Argument(
-        metavar="[RULEBASE] NAME=VALUE...",
+        metavar="[RULEBASE] NAME=VALUE...", callback=named,
         help="Rule file (.rules, .fcl, .fis, .fll; default: the packaged MITOS rule base), "
              "then one NAME=VALUE per input.")] = None,
     behavior: Annotated[Optional[str], typer.Option(

@@ -14,6 +14,7 @@ from typer.core import TyperCommand, TyperOption
 from ..errors import NameError_, UsageError, unknown
 
 E = TypeVar("E", bound=Enum)
+V = TypeVar("V", bound="str | list[str] | None")
 
 #: The most randomised runs ``simulate --runs`` and ``compare --runs`` take per world (and
 #: choice): about a day of one core's time. A few zeros too many (``--runs 1000000000``) made
@@ -31,10 +32,13 @@ def finite(value: float | None) -> float | None:
     return value
 
 
-def named(value: str | None) -> str | None:
+def named(value: V) -> V:
     """A name given as an option (``-b ''``, ``--and ''``) is not empty: an empty one would
-    quietly mean the default."""
-    if value is not None and not value.strip():
+    quietly mean the default. Nor is a file named as an argument or option (``mitos simulate
+    ''``, ``--lesson ''``, each of a list): ``Path('')`` is the current directory, so it was
+    "`` is a directory", exit 1, where the same empty value of ``-b`` is a usage error."""
+    values = value if isinstance(value, list) else [value]
+    if any(v is not None and not v.strip() for v in values):
         raise typer.BadParameter("must name something, not be empty")
     return value
 

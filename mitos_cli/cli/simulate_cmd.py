@@ -175,11 +175,12 @@ def _write_text(path: Path, text: str) -> None:
 
 def simulate_command(
     worlds: Annotated[Optional[list[str]], typer.Argument(
-        metavar="[WORLD.yaml]...", autocompletion=complete.worlds,
+        metavar="[WORLD.yaml]...", autocompletion=complete.worlds, callback=named,
         help="World files (default: the packaged corridor.yaml); names of packaged worlds "
              "such as figure4.yaml work from anywhere.")] = None,
     rulebase: Annotated[Optional[str], typer.Option(
-        "--rulebase", "-r", metavar="PATH", help="Rule base (default: the packaged one).")] = None,
+        "--rulebase", "-r", metavar="PATH", callback=named,
+        help="Rule base (default: the packaged one).")] = None,
     behavior: Annotated[Optional[str], typer.Option(
         "--behavior", "-b", callback=named,
         help="Behavior that drives (default: the world's, else `drive`).")] = None,

@@ -42,13 +42,13 @@ class Transcript:
 
 def teach_command(
     rules: Annotated[str | None, typer.Argument(
-        metavar="[RULES]",
+        metavar="[RULES]", callback=named,
         help="Rule file to teach (default: the packaged MITOS rule base).")] = None,
     behavior: Annotated[str | None, typer.Option(
         "--behavior", "-b", callback=named, help="The behavior to teach first (default: the file's first).")]
         = None,
     lesson: Annotated[str | None, typer.Option(
-        "--lesson", "-l", metavar="FILE|-",
+        "--lesson", "-l", metavar="FILE|-", callback=named,
         help="Run the commands of a lesson file (- for stdin) instead of the prompt; stop at "
              "the first error (exit 1).")] = None,
     save_as: Annotated[str | None, typer.Option(

@@ -377,6 +377,7 @@ def parse_command(line: str, path: str | None = None, lineno: int = 1) -> Comman
         raise RuleSyntaxError(f"cannot read `{line.strip()}`")
     if isinstance(result, TellOperators):
         check_settings(result.settings)
+    _check_file_name(result, line, where, lineno)
     if isinstance(result, Adapt):
         _check_once(result, line, where, lineno)
         _check_values(result, line, where, lineno)
@@ -421,6 +422,23 @@ def _bad_number(line: str, where: str) -> RuleSyntaxError | None:
             expected=DECIMAL + (", with or without `s`" if time else ""),
             hint=TIME_HINT if time else None)
     return None
+
+
+def _check_file_name(c: Command, line: str, where: str, lineno: int) -> None:
+    """`simulate ""`, `save ""`, `plot ""`: a quoted file name that is empty names no file
+    (``Path('')`` is the current directory: `simulate ""` said "`` is a directory"), as an
+    empty path on the command line is a usage error."""
+    name, example = ((c.world, "simulate worlds/figure4.yaml") if isinstance(c, Simulate) else
+                     (c.path, "save taught.rules") if isinstance(c, Save) else
+                     (c.plot, "plot terms.png") if isinstance(c, (Show, Adapt)) else
+                     (None, ""))
+    if name is None or name.strip():
+        return
+    quoted = re.search(r'"\s*"', line)
+    column, end = (quoted.start() + 1, quoted.end() + 1) if quoted else (1, None)
+    raise LessonError("the file name is empty: it names no file",
+                      span=Span.in_text("\n" * (lineno - 1) + line, where, lineno, column, end),
+                      hint=f"give a file name, e.g. `{example}`")
 
 
 def _check_once(c: Adapt, line: str, where: str, lineno: int) -> None:
