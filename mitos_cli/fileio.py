@@ -39,13 +39,50 @@ def nearby(path: str | Path, suffixes: tuple[str, ...] = RULE_SUFFIXES,
 
 def nearby_name(path: str | Path, suffixes: tuple[str, ...] = RULE_SUFFIXES,
                 also: Iterable[str] = ()) -> str | None:
-    """The name :func:`nearby` suggests, without its directory."""
-    where = Path(path).parent
+    """The name :func:`nearby` suggests, without its directory: never the name given, nor a
+    link that leads nowhere (a dangling link or a loop is listed in its directory, and
+    "`loop1.yaml` not found, did you mean `loop1.yaml`?" was said of it)."""
+    where, given = Path(path).parent, Path(path).name
     try:
-        names = [p.name for p in where.iterdir() if p.suffix.lower() in suffixes]
+        names = [p.name for p in where.iterdir() if p.suffix.lower() in suffixes
+                 and p.name != given and _there(p)]
     except OSError:                 # no such directory: only ``also`` may be meant
         names = []
-    return closest_file(Path(path).name, [*names, *also])
+    return closest_file(given, [*names, *(n for n in also if n != given)])
+
+
+def _there(path: Path) -> bool:
+    """Whether ``path`` leads to something (a link to nothing, or in a loop, does not)."""
+    try:
+        return path.exists()
+    except OSError:
+        return False
+
+
+def broken_link(kind: str, path: str | Path) -> str | None:
+    """What is wrong with ``path`` when it is a symbolic link that leads to no file, in words:
+    "`dangling.yaml` is a link to `nonexist.yaml`, which does not exist", or for a loop what
+    reading it says ("cannot read KIND `X`: Too many levels of symbolic links"); ``None``
+    for anything else. A name that is such a link is there, so it is not "not found"."""
+    path = Path(path)
+    try:
+        if not path.is_symlink():
+            return None
+        os.stat(path)
+    except FileNotFoundError:
+        last = path                 # the last link of a chain, whose target is missing
+        with contextlib.suppress(OSError):
+            for _ in range(40):
+                target = last.parent / os.readlink(last)
+                if not target.is_symlink():
+                    break
+                last = target
+        through = f" (through `{last}`)" if last != path else ""
+        return (f"`{path}` is a link to `{os.readlink(last)}`{through}, which does not "
+                f"exist")
+    except OSError as exc:
+        return f"cannot read {kind} `{path}`: {exc.strerror or exc}"
+    return None
 
 
 def read_text(path: str | Path) -> str:
@@ -110,7 +147,7 @@ def unreadable(kind: str, path: object, exc: OSError | UnicodeDecodeError) -> st
     read: "not found" when it is not there (as every command says it), "is a directory", or
     "cannot read" with :func:`why_unreadable`'s reason."""
     if isinstance(exc, FileNotFoundError):
-        return f"{kind} `{path}` not found"
+        return broken_link(kind, str(path)) or f"{kind} `{path}` not found"
     if isinstance(exc, IsADirectoryError):
         return f"`{path}` is a directory, not a {kind}"
     return f"cannot read {kind} `{path}`: {why_unreadable(exc)}"

@@ -150,3 +150,41 @@ def test_a_link_to_a_pipe_is_written_through(tmp_path):
                           timeout=60)
     assert done.returncode == 0, done.stderr
     assert done.stdout == "through the pipe\n"
+
+
+@pytest.fixture
+def links(tmp_path):
+    """A loop of two links, a dangling link and a chain of two ending nowhere."""
+    (tmp_path / "loop1.yaml").symlink_to("loop2.yaml")
+    (tmp_path / "loop2.yaml").symlink_to("loop1.yaml")
+    (tmp_path / "dangling.yaml").symlink_to("nonexist.yaml")
+    (tmp_path / "a.yaml").symlink_to("b.yaml")
+    (tmp_path / "b.yaml").symlink_to("gone.yaml")
+    return tmp_path
+
+
+def test_a_link_that_leads_nowhere_is_said_so(links):
+    """A dangling link or a loop is in its directory: it was "not found, did you mean" itself."""
+    from mitos_cli.fileio import broken_link
+
+    assert broken_link("world file", links / "dangling.yaml") == (
+        f"`{links / 'dangling.yaml'}` is a link to `nonexist.yaml`, which does not exist")
+    assert broken_link("world file", links / "a.yaml") == (
+        f"`{links / 'a.yaml'}` is a link to `gone.yaml` (through `{links / 'b.yaml'}`), which "
+        "does not exist")
+    assert broken_link("world file", links / "loop1.yaml") == (
+        f"cannot read world file `{links / 'loop1.yaml'}`: Too many levels of symbolic links")
+    assert broken_link("world file", links / "nothing.yaml") is None
+    (links / "real.yaml").write_text("x")
+    (links / "good.yaml").symlink_to("real.yaml")
+    assert broken_link("world file", links / "good.yaml") is None
+
+
+def test_did_you_mean_never_names_the_file_given_nor_a_broken_link(links):
+    from mitos_cli.fileio import nearby_name
+
+    assert nearby_name(links / "loop1.yaml", (".yaml",)) is None
+    assert nearby_name(links / "dangling.yaml", (".yaml",)) is None
+    assert nearby_name(links / "danglin.yaml", (".yaml",)) is None
+    (links / "office.yaml").write_text("x")
+    assert nearby_name(links / "ofice.yaml", (".yaml",)) == "office.yaml"

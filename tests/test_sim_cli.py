@@ -394,6 +394,21 @@ def test_an_empty_path_is_a_usage_error(args):
     assert "directory" not in said
 
 
+def test_a_world_that_is_a_link_to_nothing_is_said_so(tmp_path, capsys, monkeypatch):
+    """A loop or a dangling link was "world file `loop1.yaml` not found", with "did you mean
+    `loop1.yaml`?"."""
+    monkeypatch.chdir(tmp_path)
+    Path("loop1.yaml").symlink_to("loop2.yaml")
+    Path("loop2.yaml").symlink_to("loop1.yaml")
+    Path("dangling.yaml").symlink_to("nonexist.yaml")
+    assert run_main(capsys, "loop1.yaml") == (1, (
+        "world error: cannot read world file `loop1.yaml`: Too many levels of symbolic links\n"))
+    with pytest.raises(SystemExit) as info:
+        main(["compare", "dangling.yaml", "--runs", "1", "-o", "s"])
+    assert (info.value.code, capsys.readouterr().err) == (1, (
+        "world error: `dangling.yaml` is a link to `nonexist.yaml`, which does not exist\n"))
+
+
 def test_an_output_is_never_an_input_nor_another_output(short, capsys):
     before = short.read_bytes()
     code, err = run_main(capsys, short, "--out", short)       # replaced the world with a CSV

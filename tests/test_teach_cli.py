@@ -336,6 +336,29 @@ def test_save_as_names_a_rules_file(work):
         assert "does not end in" not in res.stderr
 
 
+def test_a_rule_file_lesson_or_world_that_is_a_link_to_nothing_is_said_so(work):
+    """A loop or a dangling link was "not found", with a "did you mean" naming itself."""
+    (work / "l1.rules").symlink_to("l2.rules")
+    (work / "l2.rules").symlink_to("l1.rules")
+    (work / "dl.rules").symlink_to("nope.rules")
+    (work / "dl.lesson").symlink_to("nope.lesson")
+    (work / "loop1.yaml").symlink_to("loop2.yaml")
+    (work / "loop2.yaml").symlink_to("loop1.yaml")
+    res = mitos("teach", "l1.rules", "--lesson", "-", cwd=work, stdin="")
+    assert (res.returncode, res.stderr) == (1, "rule base error: cannot read rule file "
+                                               "`l1.rules`: Too many levels of symbolic links\n")
+    res = mitos("teach", "dl.rules", "--lesson", "-", cwd=work, stdin="")
+    assert res.stderr == "rule base error: `dl.rules` is a link to `nope.rules`, which does not exist\n"
+    res = mitos("teach", "rb/mitos.rules", "--lesson", "dl.lesson", cwd=work)
+    assert res.stderr == ("lesson error: `dl.lesson` is a link to `nope.lesson`, which does not "
+                          "exist\n")
+    res = mitos("teach", "rb/mitos.rules", "--lesson", "-", cwd=work,
+                stdin="simulate loop1.yaml\n")
+    assert "<stdin>:1:10: world error: cannot read world file `loop1.yaml`: Too many levels " \
+           "of symbolic links" in res.stderr
+    assert "did you mean" not in res.stderr
+
+
 def test_a_bad_world_in_a_lesson_is_reported_in_the_world_file(work):
     (work / "bad.yaml").write_text("corridor:\n  width: banana\n")
     (work / "p.lesson").write_text("use drive\nsimulate bad.yaml\n")

@@ -163,11 +163,13 @@ def _new_session(rules, behavior, lesson, save_as, out):
         path = resolve("rulebases", rules, ".rules") or path
     if not path.is_file():
         from ..errors import RuleBaseError
+        from ..fileio import broken_link
         from ..lang.resolve import rule_file_hint
 
-        raise RuleBaseError(f"`{path}` is a directory, not a rule file" if path.is_dir()
-                            else f"rule file `{path}` not found",
-                            hint=None if path.is_dir() else rule_file_hint(path))  # as eval's
+        link = broken_link("rule file", path)       # a dangling link, a loop: as eval says it
+        raise RuleBaseError(link or (f"`{path}` is a directory, not a rule file" if path.is_dir()
+                                     else f"rule file `{path}` not found"),
+                            hint=None if path.is_dir() or link else rule_file_hint(path))
     try:
         loaded = load_rulebase(path, behavior)
     except MitosError as exc:           # a .fis, .fcl or .fll (by its name or not): convert it

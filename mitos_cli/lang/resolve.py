@@ -51,7 +51,7 @@ def termset_hint(target: Path, name: str) -> str:
 @without_cyclic_gc
 def load_rules_file(path: str | Path) -> RuleBase:
     """Read, parse and check the rule file at ``path`` and the term sets it names."""
-    from ..fileio import bad_byte, finish_saves, read_text, unreadable
+    from ..fileio import bad_byte, broken_link, finish_saves, read_text, unreadable
 
     path = Path(path)
     finish_saves(path)              # a set save a crash left half done
@@ -70,6 +70,9 @@ def load_rules_file(path: str | Path) -> RuleBase:
         target = path.parent / name
         _named_once(target, name, span, seen)
         if not is_file(target):
+            link = broken_link("term set", target)
+            if link is not None:
+                raise TermSetError(link, span=span)
             found = ("not found" if not exists(target) else "is a directory" if is_dir(target)
                      else "is not a regular file")          # a device, a pipe
             raise TermSetError(f"term set `{name}` {found} (looked for `{target}`)", span=span,

@@ -943,6 +943,12 @@ def resolve_world_path(name: str | Path, base: Path | None = None) -> Path:
     if is_dir(where):
         raise UnknownWorld(f"`{name}` is a directory, not a world file",
                            hint="name one of the world files (.yaml) in it")
+    from ..fileio import broken_link
+
+    for given in dict.fromkeys([where, Path(name)]):    # a dangling link, a loop: it is there
+        why = broken_link("world file", given)
+        if why is not None:
+            raise WorldError(why)
     raise world_not_found(name, where)
 
 

@@ -77,13 +77,14 @@ def read_lesson(source: str) -> tuple[str, str]:
         found = resolve("rulebases/lessons", source, ".lesson")
         if found is not None:
             path, source = found, str(found)
-    from ..fileio import bad_byte, read_text, unreadable
+    from ..fileio import bad_byte, broken_link, read_text, unreadable
 
     try:
         return read_text(path), source
     except (OSError, UnicodeDecodeError) as exc:
         error = LessonError(unreadable("lesson", source, exc), span=bad_byte(source, exc))
-        if isinstance(exc, FileNotFoundError):     # a mistyped name: the packaged lessons
+        if isinstance(exc, FileNotFoundError) and broken_link("lesson", path) is None:
+            # a mistyped name: the packaged lessons
             from ..errors import did_you_mean
             from ..resources import packaged_names
 
