@@ -161,3 +161,20 @@ def test_no_robot_takes_a_colour_the_picture_uses_for_something_else(tmp_path):
     paths = [ln.get_color() for ln in ax.lines
              if ln.get_label().split(":")[0] in ("robot", "other", "third")]
     assert paths == list(ROBOT_COLOURS[:3]) and REPLANNED_COLOUR not in paths
+
+
+def test_study_plots_draw_dollars_as_written(tmp_path):
+    """A world's or choice's name with `$x^$` stopped the study's plots in matplotlib's
+    mathtext (the layout measured the texts before they were made literal, and wrap=True
+    measures them as mathtext whatever parse_math says)."""
+    from types import SimpleNamespace
+
+    from mitos_cli.draw import study
+
+    rows = [{"world": "w $x^$", "min_clearance_in": 1.0, "c": "a $x^$"}]
+    study.clearance_boxes(rows, ["w $x^$"], ["a $x^$"], lambda r: r["c"], tmp_path / "c.png")
+    rate = SimpleNamespace(k=3, n=4, lo=0.3, hi=0.9)
+    summary = SimpleNamespace(world="w $x^$", choice=SimpleNamespace(label="a $x^$"),
+                              rates={"success": rate})
+    study.success_bars([summary], ["w $x^$"], ["a $x^$"], tmp_path / "s.png")
+    assert (tmp_path / "c.png").stat().st_size > 0 and (tmp_path / "s.png").stat().st_size > 0

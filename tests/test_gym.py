@@ -3,6 +3,8 @@
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 
@@ -183,6 +185,17 @@ def test_rgb_array_shows_the_robot(short_world):
     assert frame.dtype == np.uint8 and frame.ndim == 3 and frame.shape[2] == 3
     blue = np.array([0x1F, 0x5F, 0xBF])
     assert (np.abs(frame.astype(int) - blue).sum(axis=2) < 6).sum() > 20
+    env.close()
+
+
+def test_rgb_array_draws_a_dollar_in_the_worlds_name_as_written(short_world):
+    # the frame's texts went to matplotlib's mathtext, which stopped on `$x^$`
+    text = short_world.read_text(encoding="utf-8")
+    short_world.write_text(re.sub(r"(?m)^name: .*$", 'name: "sla $x^$ lom"', text),
+                           encoding="utf-8")
+    env = gymnasium.make("mitos/World-v0", world=str(short_world), render_mode="rgb_array")
+    env.reset(seed=1)
+    assert env.render().ndim == 3
     env.close()
 
 

@@ -406,6 +406,36 @@ def test_a_title_with_dollars_is_drawn_as_written(tmp_path, capsys):
     assert out.read_bytes().startswith(PNG)
 
 
+DOLLARS = """\
+variables:
+  price:
+    role: input
+    description: "price in $$ per hour, $x^$"
+    unit: "$$"
+    universe: [0, 10]
+    terms: {LOW: {shape: triangle, points: [0, 0, 10]}, HIGH: {shape: triangle, points: [0, 10, 10]}}
+  buy:
+    role: output
+    universe: [0, 1]
+    terms: {NOPE: 0, BUY: 1}
+"""
+
+
+@pytest.mark.parametrize("value", [[], ["price=3"]])
+def test_a_description_or_unit_with_dollars_is_drawn_as_written(tmp_path, capsys, value):
+    """`plot terms -o` laid the sheet out before the texts were made literal: a `$$` in a
+    description stopped matplotlib's mathtext with a traceback."""
+    pytest.importorskip("matplotlib")
+    (tmp_path / "p.terms.yaml").write_text(DOLLARS)
+    rules = tmp_path / "p.rules"
+    rules.write_text('terms "p.terms.yaml"\nr1: if price is LOW then buy is BUY\n'
+                     "r2: if price is HIGH then buy is NOPE\n")
+    out = tmp_path / "p.svg"
+    code, _, err = run(["plot", "terms", str(rules), *value, "-o", str(out)], capsys)
+    assert code == 0, err
+    assert "price in $$ per hour, $x^$" in out.read_text() and "price [$$]" in out.read_text()
+
+
 def test_a_surface_of_many_fixed_inputs_wraps_its_title_and_warns_of_nothing(tmp_path, capsys):
     pytest.importorskip("matplotlib")
     out = tmp_path / "s.png"

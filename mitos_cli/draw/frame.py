@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .output import _matplotlib, new_figure
+from .output import _matplotlib, literal_text, new_figure
 
 ROBOT_COLOUR = "#1f5fbf"     # the footprint (a test looks for this colour in the frames)
 TRAIL_COLOUR = "#2ca02c"
@@ -54,6 +54,7 @@ class RunFrame:
         self._title = self.fig.text(0.01, 1.0 - 0.15 / fh, "", fontsize=9, va="center")
         ax.set_xlim(xmin - pad, xmax + pad)
         ax.set_ylim(ymin - pad, ymax + pad)
+        literal_text(self.fig)          # a world's name or label is drawn as written
 
     def update(self, pose, obstacles, trail, t: float | None = None) -> None:
         """Move the artists to this moment."""

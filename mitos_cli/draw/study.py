@@ -5,6 +5,7 @@ matplotlib is imported inside the functions (Agg backend), so importing this mod
 
 from __future__ import annotations
 
+import textwrap
 from pathlib import Path
 
 from .output import literal_text
@@ -66,6 +67,7 @@ def success_bars(summaries, worlds: list[str], labels: list[str], path: str | Pa
     ax.grid(axis="y", alpha=0.3)
     ax.legend(fontsize=8, ncol=min(3, n_c), loc="upper center", bbox_to_anchor=(0.5, -0.12),
               frameon=False)
+    literal_text(fig)                   # before the layout measures a world's or choice's name
     fig.tight_layout()
     return _save(fig, plt, path)
 
@@ -105,7 +107,11 @@ def clearance_boxes(rows: list[dict], worlds: list[str], labels: list[str],
     fig.suptitle("Minimum clearance over all runs (boxes: quartiles; whiskers: 1.5 IQR)",
                  fontsize=11)
     legend = "   ".join(f"{j + 1}: {label}" for j, label in enumerate(labels))
-    fig.text(0.5, 0.01, legend, ha="center", fontsize=8, wrap=True)
+    # wrapped here: matplotlib's wrap=True measures the text as mathtext whatever parse_math
+    # says, and stops on a `$` in a choice's label
+    legend = textwrap.fill(legend, int(fig.get_size_inches()[0] * 14), break_long_words=False)
+    fig.text(0.5, 0.01, legend, ha="center", fontsize=8)
+    literal_text(fig)
     fig.tight_layout(rect=(0, 0.06, 1, 0.95))
     return _save(fig, plt, path)
 

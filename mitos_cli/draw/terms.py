@@ -16,7 +16,7 @@ import numpy as np
 
 from ..lang.terms import Variable
 from .data import VariablePlot, variable_plot, visible
-from .output import finish, new_figure
+from .output import finish, literal_text, new_figure
 
 #: term colours (matplotlib's tab10, colour-blind friendlier than the default cycle's order)
 COLORS = ("#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#17becf", "#8c564b",
@@ -81,7 +81,10 @@ def draw_curves(ax, plot: VariablePlot, *, colors: Sequence[str] | None = None,
 
 def stagger_labels(fig) -> None:
     """Lift a term label one step where it would overlap the one to its left, measured on the
-    laid-out figure (so long names such as MODERATE next to MEDIUM stay readable)."""
+    laid-out figure (so long names such as MODERATE next to MEDIUM stay readable). The texts
+    are made literal first: laying out parses them, and a `$$` in a description is no
+    mathtext."""
+    literal_text(fig)
     engine = fig.get_layout_engine()
     if engine is not None:
         engine.execute(fig)                     # place the axes as the saved figure has them
