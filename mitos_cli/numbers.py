@@ -4,6 +4,7 @@ alone also takes ``7_8`` (78) and other scripts' digits, which no file format wr
 
 from __future__ import annotations
 
+import math
 import re
 
 #: The largest magnitude a number of a term set or a foreign file may have. The engine
@@ -21,3 +22,13 @@ def parse_number(text: str) -> float:
     if not _NUMBER.fullmatch(text):
         raise ValueError(f"not a number: {text!r}")
     return float(text)
+
+
+def parse_value(text: str) -> float:
+    """An input's value written as text: :func:`parse_number`, but a finite number past a
+    float's range (``1e400``) is an ``OverflowError``, as ``10**400`` is, not ``inf``; ``inf``
+    written as such stays ``inf``."""
+    x = parse_number(text)
+    if math.isinf(x) and "inf" not in text.lower():
+        raise OverflowError(f"too large for a float: {text!r}")
+    return x

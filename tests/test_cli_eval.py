@@ -443,6 +443,20 @@ def test_a_cell_python_alone_would_read_is_not_a_number(header, row):
         info.value.message
 
 
+@pytest.mark.parametrize("cell", ["1e400", "-1e999", "00.5e999"])
+def test_a_cell_past_a_floats_range_is_refused_where_it_stands(cell):
+    """`1e400` was read as inf and clamped, where the API refuses `10**400`; `-inf` as written
+    stays infinite."""
+    with pytest.raises(InputError) as info:
+        read_batch(f"road,size,position\n78,45,4\n{cell},45,4\n", "in.csv",
+                   ("road", "size", "position"))
+    assert info.value.span.line == 3 and info.value.span.column == 1
+    assert f"input `road` has a number too large for a float: `{cell}` (row 2)" in \
+        info.value.message
+    X = read_batch("road,size,position\n-inf,45,Infinity\n", "in.csv", ("road", "size", "position"))
+    assert X[0, 0] == -np.inf and X[0, 2] == np.inf
+
+
 def test_json_is_strict_a_nan_output_is_null(capsys):
     """A rule base that answers NaN where no rule fires (`default: nan`, as asked): --json
     writes null, which every JSON parser reads, not the bare NaN that strict ones refuse."""
@@ -602,6 +616,17 @@ def test_a_single_value_is_read_as_a_batch_cell_is(value, capsys):
     assert f"input `road` must be a number, not `{value}`" in err
     code, _, _ = run_main(["eval", "road=+7.8e1", "size=45", "position=4"], capsys)
     assert code == 0
+
+
+@pytest.mark.parametrize("value", ["1e400", "-1e999"])
+def test_a_single_value_past_a_floats_range_is_refused(value, capsys):
+    """`road=1e400` was read as inf and only warned of as clamped; `road=inf` is still
+    taken as written."""
+    code, out, err = run_main(["eval", f"road={value}", "size=45", "position=4"], capsys)
+    assert code == 1 and out == ""
+    assert f"input `road` has a number too large for a float: `{value}`" in err
+    code, _, err = run_main(["eval", "road=inf", "size=45", "position=4"], capsys)
+    assert code == 0 and "clamped" in err
 
 
 def test_network_refuses_what_it_would_ignore(capsys, tmp_path):

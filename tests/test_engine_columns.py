@@ -105,6 +105,8 @@ _WIDE = pytest.mark.skipif(not np.isfinite(np.longdouble("1e400")),
     ("5_0", "input `road` must be a number, not `5_0`"),                              # 50
     ("\uff15\uff10", "input `road` must be a number, not `\uff15\uff10`"),            # 50
     (np.array(["78", "7_8"]), r"input `road` must be a number, not `\['78' '7_8'\]`"),
+    ("1e400", "input `road` has a number too large for a float: `1e400`"),         # inf
+    (np.array(["78", "-1e999"]), "input `road` has a number too large for a float"),
     (Decimal("1e400"), r"input `road` has a number too large for a float: `1E\+400`"),  # inf
     ([Decimal(78), Decimal("-1e999")], "input `road` has a number too large for a float"),
     pytest.param(np.longdouble("1e400"), "input `road` has a number too large for a float",

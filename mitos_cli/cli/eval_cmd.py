@@ -76,14 +76,18 @@ def _apart(pair: list[str]) -> str | None:
 
 
 def parse_values(values: dict[str, str]) -> dict[str, float]:
-    """``NAME=VALUE`` texts as numbers, read as a batch CSV's cells are (``parse_number``):
-    ``float`` alone would take ``1_000`` and other scripts' digits, which the batch refuses."""
-    from ..numbers import parse_number
+    """``NAME=VALUE`` texts as numbers, read as a batch CSV's cells are (``parse_value``):
+    ``float`` alone would take ``1_000`` and other scripts' digits, which the batch refuses,
+    and read ``1e400`` as ``inf``."""
+    from ..numbers import parse_value
 
     out = {}
     for name, text in values.items():
         try:
-            out[name] = parse_number(text)
+            out[name] = parse_value(text)
+        except OverflowError:
+            raise InputError(f"input `{name}` has a number too large for a float: `{text}`",
+                             expected="numbers of magnitude at most 1.8e308") from None
         except ValueError:
             raise InputError(f"input `{name}` must be a number, not `{text}`",
                              expected="a decimal number such as 78, -4.5 or 1e3") from None

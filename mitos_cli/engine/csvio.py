@@ -245,6 +245,7 @@ def _convert(rows: Callable[[], list[list[str]]], columns: list[Sequence[str]], 
             numbers.append(np.array([parse_number(v) for v in column], dtype=float))
         cells.append(raw)
     X = np.column_stack(numbers) if numbers else np.empty((len(columns[0]), 0))
+    _refuse_overflow(X, columns, done, header, order, text, path)
     if np.isnan(X).any():               # the engine refuses NaN: say where it stands
         r, j = (int(i) for i in np.argwhere(np.isnan(X))[0])
         c = order[j]
@@ -253,6 +254,19 @@ def _convert(rows: Callable[[], list[list[str]]], columns: list[Sequence[str]], 
                          hint=f"`{columns[c][r].strip()}` reads as NaN; give every input a finite "
                               "value (out-of-range values are clamped to the universe)")
     return cells, X
+
+
+def _refuse_overflow(X: np.ndarray, columns: list[Sequence[str]], done: int, header: list[str],
+                     order: list[int], text: str, path: str) -> None:
+    """The first cell whose number is past a float's range (``1e400``, read as ``inf``), as
+    the error ``10**400`` gets from the API; a cell written ``inf`` stays infinite."""
+    for r, j in np.argwhere(np.isinf(X)):
+        c = order[j]
+        cell = columns[c][r].strip()
+        if "inf" not in cell.lower():
+            raise InputError(f"input `{header[c]}` has a number too large for a float: `{cell}` "
+                             f"(row {done + r + 1})", span=_cell_span(text, path, done + r, c),
+                             expected="numbers of magnitude at most 1.8e308")
 
 
 def _bad_row(rows: list[list[str]], done: int, header: list[str], order: list[int],

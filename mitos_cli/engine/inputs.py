@@ -127,16 +127,16 @@ def _holds_bool(values: list | tuple) -> bool:
 
 def _one_by_one(raw: np.ndarray) -> np.ndarray:
     """Text or Python objects ``raw`` as floats, each value alone: text by the number grammar
-    of the files (:func:`~mitos_cli.numbers.parse_number`), anything else by ``float()``,
+    of the files (:func:`~mitos_cli.numbers.parse_value`), anything else by ``float()``,
     with the kinds of :data:`_KINDS` refused, and a number ``float()`` makes
-    infinite though it is finite (``Decimal("1e400")``) an ``OverflowError``."""
-    from ..numbers import parse_number
+    infinite though it is finite (``Decimal("1e400")``, ``"1e400"``) an ``OverflowError``."""
+    from ..numbers import parse_value
 
     out = np.empty(raw.shape)
     flat = out.reshape(-1)
     for i, v in enumerate(raw.flat):
         if isinstance(v, str):
-            flat[i] = parse_number(v)
+            flat[i] = parse_value(v)
             continue
         if isinstance(v, (bool, np.bool_)):
             raise _NotNumbers("b")
