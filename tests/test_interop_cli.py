@@ -618,6 +618,26 @@ def test_fcl_dialects_differ_only_where_the_readers_do(tmp_path: Path, capsys) -
     assert code == 2                               # --dialect is FCL's
 
 
+@pytest.mark.parametrize("sampling, owner", [
+    ("left", "the cells' left ends (jFuzzyLogic's)"),
+    ("endpoints", "evenly spaced points including both ends (MATLAB's)")])
+def test_fcl_notes_both_the_sampling_and_the_dropped_resolution(tmp_path, capsys, sampling,
+                                                                owner):
+    """The resolution's note was an `elif` after the sampling's, so a rule base sampled at
+    `left` or `endpoints` lost its resolution without a word; `left` was called MATLAB's."""
+    terms = "mitos.terms.yaml"
+    (tmp_path / terms).write_bytes((ROOT / "rulebases" / terms).read_bytes())
+    rules = tmp_path / "s.rules"
+    rules.write_text('terms "mitos.terms.yaml"\n'
+                     f"operators: inference = mamdani, sampling = {sampling}, resolution = 201\n"
+                     "r1: if road is WIDE then speed is FAST\n"
+                     "r2: if road is NARROW then speed is SLOW\n")
+    code, err = _run(capsys, "convert", str(rules), "--to", "fcl", "-o", str(tmp_path / "s.fcl"))
+    err = " ".join(err.split())
+    assert code == 0 and f"this rule base samples at {owner}" in err, err
+    assert "is written without this rule base's 201 points" in err, err
+
+
 def test_fuzzylite_dialect_moves_not_onto_propositions(tmp_path: Path) -> None:
     """fuzzylite's `not` is a hedge: `not (a or b)` is written `a is not .. and b is not ..`
     (exact with dual norms), and refused by name where the norms are not duals."""

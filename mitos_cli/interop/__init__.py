@@ -151,6 +151,11 @@ def left_out(rb: RuleBase, behavior: str | None, done: str) -> str | None:
             f"({', '.join(others)}) are not: choose one with --behavior")
 
 
+#: Where a sampling other than fuzzylite's midpoints takes its points, and whose rule it is.
+SAMPLED_AT = {"endpoints": "evenly spaced points including both ends (MATLAB's)",
+              "left": "the cells' left ends (jFuzzyLogic's)"}
+
+
 def conversion_notes(rb: RuleBase, fmt: str, behavior: str | None = None) -> list[str]:
     """What writing ``rb`` as ``fmt`` (``rules`` included) leaves out or changes; the file is
     written anyway and ``mitos convert`` prints these as warnings."""
@@ -169,9 +174,9 @@ def conversion_notes(rb: RuleBase, fmt: str, behavior: str | None = None) -> lis
     ops = of_behavior(rb, b)
     if fmt in ("fcl", "fll") and ops.inference == "mamdani" and ops.sampling != "midpoints":
         out.append(f"{fmt.upper()} Mamdani outputs are sampled at cell midpoints (fuzzylite's "
-                   f"rule); this rule base samples at {ops.sampling} (MATLAB's), so results "
+                   f"rule); this rule base samples at {SAMPLED_AT[ops.sampling]}, so results "
                    f"move by the discretisation")
-    elif fmt == "fcl" and ops.inference == "mamdani" and ops.resolution != 1000:
+    if fmt == "fcl" and ops.inference == "mamdani" and ops.resolution != 1000:
         from .common import DEFUZZIFIERS
 
         method = DEFUZZIFIERS.get(ops.defuzzify, ("", "", "COG"))[2]
