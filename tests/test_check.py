@@ -407,6 +407,35 @@ def test_settings_only_mamdani_reads_are_flagged(tmp_path):
                                "weighted_average inference")
 
 
+SIGMOID = """\
+variables:
+  x: {role: input, universe: [0, 10], terms: {A: {shape: triangle, points: [0, 0, 10]}, B: {shape: triangle, points: [0, 10, 10]}}}
+  y: {role: output, universe: [0, 1], default: 0, terms: {S: {shape: sigmoid, points: [0.5, 10]}, DN: {shape: ramp, points: [1, 0]}}}
+"""
+
+
+def test_a_tsukamoto_sigmoid_is_warned_of_when_read_and_checked(tmp_path, capsys):
+    """A sigmoid reaches 1 only at infinity: `y = inf` at x=0, which the FLL reader warned of
+    and the rule language, `eval` and `check` did not."""
+    (tmp_path / "ts.terms.yaml").write_text(SIGMOID, encoding="utf-8")
+    path = tmp_path / "ts.rules"
+    path.write_text('terms "ts.terms.yaml"\noperators: inference = tsukamoto\n'
+                    "r1: if x is A then y is S\nr2: if x is B then y is DN\n", encoding="utf-8")
+    rb = read_rulebase(path)
+    (note,) = rb.notes
+    assert note.startswith(f"{path}:3:20: `y is S` inverts a sigmoid (Tsukamoto inference)")
+    (finding,) = by_code(check_rulebase(rb), "infinite-output")
+    assert finding.severity == "warning" and (finding.span.line, finding.span.column) == (3, 59)
+    assert "where rule `r1` fires fully `y` is +-inf" in finding.message
+    code, out, err = run(["check", str(path)], capsys)
+    assert code == 0 and "[infinite-output]" in out and "1 warning" in out
+    assert "inverts a sigmoid" in err
+    code, out, err = run(["eval", str(path), "x=0"], capsys)
+    assert code == 0 and "y = inf" in out and "a sigmoid reaches 1 only at infinity" in err
+    path.write_text(path.read_text().replace("tsukamoto", "mamdani"))
+    assert read_rulebase(path).notes == ()
+
+
 def test_the_coverage_check_reads_the_rules_dofs_only(tmp_path, monkeypatch):
     """A Mamdani output sampled on 100,000 points makes each inferred sample cost 100,000
     times a DOF; the check needs only the DOFs (it took minutes on the packaged rule base),

@@ -21,6 +21,8 @@ code                  severity    meaning
 ``contradiction``     warning     an antecedent that asks for ``x is A`` and ``x is not A``
 ``idle-setting``      warning     a Mamdani-only operator setting (``defuzzify``, ...) where
                                   the inference is not Mamdani
+``infinite-output``   warning     a sigmoid a Tsukamoto rule concludes: it reaches 1 only at
+                                  infinity, so where the rule fires fully the output is +-inf
 ``unreachable``       warning     a rule that fires nowhere: its DOF is 0 on a grid of the
                                   inputs its conditions name, every corner point of their
                                   terms and the midpoints between them (info, hedged, when
@@ -189,6 +191,7 @@ def check_rulebase(rb: RuleBase, behavior: str | None = None, *, threshold: floa
         findings += _contradictions(rb, name)
         findings += _idle_settings(rb, name, compiled)
         findings += _undersampled(rb, name, compiled, seen)
+        findings += _infinite_inverses(rb, name, compiled, seen)
         grid_findings, info = _sampled(compiled, threshold, resolution)
         findings += grid_findings
         grids.append(info)
@@ -239,6 +242,29 @@ def _undersampled(rb: RuleBase, name: str, compiled, seen: set[tuple]) -> list[F
         code = "term-outside" if u.outside else "undersampled-term"
         out.append(Finding("warning", code, u.describe(), term.span, name,
                            undersampled_hint(rb.path, u)))
+    return out
+
+
+def _infinite_inverses(rb: RuleBase, name: str, compiled, seen: set[tuple]) -> list[Finding]:
+    """Sigmoids a Tsukamoto behavior concludes, once per term: a sigmoid reaches 1 only at
+    infinity, so where its rules fire fully the output is +-inf."""
+    if compiled.operators.inference != "tsukamoto":
+        return []
+    out = []
+    for j, output in enumerate(compiled.outputs):
+        for r in range(compiled.n_rules):
+            term = compiled.cons_term[r][j]
+            if term is None or ("infinite", output, term) in seen \
+                    or rb.variables[output].term(term).shape != "sigmoid":
+                continue
+            seen.add(("infinite", output, term))
+            out.append(Finding(
+                "warning", "infinite-output",
+                f"`{output}.{term}` is a sigmoid, which Tsukamoto inference inverts: it reaches "
+                f"1 only at infinity, so where rule `{compiled.labels[r]}` fires fully "
+                f"`{output}` is +-inf (as in fuzzylite)", rb.variables[output].term(term).span,
+                name, "conclude a term that reaches 1 (ramp, s_shape, z_shape, concave, arc), "
+                      "or keep the rule's degree below 1"))
     return out
 
 

@@ -168,7 +168,8 @@ def build_rulebase(parsed: ParsedFile, termsets: tuple[TermSet, ...],
         _check_behavior(b, variables, names, labels)
     rb = RuleBase(parsed.path, termsets, tuple(behaviors), parsed.operators, termset_paths,
                   notes=set_again(parsed.operators)
-                  + tuple(n for b in behaviors for n in set_again(b.operators, b.name)))
+                  + tuple(n for b in behaviors for n in set_again(b.operators, b.name))
+                  + infinite_inverses(behaviors, variables, base_ops))
     _check_uses(rb)
     return rb
 
@@ -188,6 +189,26 @@ def set_again(settings: tuple[Setting, ...], behavior: str | None = None) -> tup
         notes.append(f"{s.span}: `{s.key}` is set again (`{s.value}`; line {before.span.line} "
                      f"set `{before.value}`): the later line wins for {scope}; keep one "
                      f"`{s.key}`{aside}")
+    return tuple(notes)
+
+
+def infinite_inverses(behaviors, variables: dict[str, Variable], base_ops) -> tuple[str, ...]:
+    """A note for each sigmoid a Tsukamoto behavior's rule concludes: a sigmoid reaches 1 only
+    at infinity, so where the rule fires fully its inverse, and the output, is +-inf (as in
+    fuzzylite, whose reader's note this is); nothing else said so."""
+    notes, seen = [], set()
+    for b in behaviors:
+        if ops_mod.resolve(b.operators, base_ops).inference != "tsukamoto":
+            continue
+        for rule in b.rules:
+            for c in rule.consequents:
+                if c.term is None or variables[c.var].term(c.term).shape != "sigmoid" \
+                        or (c.var, c.term) in seen:
+                    continue
+                seen.add((c.var, c.term))
+                notes.append(f"{c.span or rule.span}: `{c.var} is {c.term}` inverts a sigmoid "
+                             f"(Tsukamoto inference); a sigmoid reaches 1 only at infinity, so "
+                             f"where the rule fires fully `{c.var}` is +-inf, as in fuzzylite")
     return tuple(notes)
 
 
