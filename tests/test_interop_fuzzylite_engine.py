@@ -342,6 +342,36 @@ def test_tsukamoto_refuses_a_term_it_cannot_invert_and_formats_without_it():
             write_foreign(rb, fmt)
 
 
+def test_fll_writer_refuses_a_tsukamoto_term_without_inverse_at_the_term(tmp_path, capsys):
+    """A triangle no rule concludes is fine to the rule language, not to FLL's `WeightedAverage
+    Tsukamoto`: `convert --to fll` failed on reading its own text back, at a line of a file it
+    never wrote; it is refused at the term in the term set, and nothing is written."""
+    from mitos_cli.api import read_rulebase
+    from mitos_cli.cli.app import main
+    from mitos_cli.interop import write_foreign
+
+    (tmp_path / "t.terms.yaml").write_text(
+        "variables:\n"
+        "  x: {role: input, universe: [0, 10], terms: {A: {shape: triangle, points: [0, 0, 10]},"
+        " B: {shape: triangle, points: [0, 10, 10]}}}\n"
+        "  y:\n    role: output\n    universe: [0, 1]\n    default: 0\n    terms:\n"
+        "      DN: {shape: ramp, points: [1, 0]}\n      UP: {shape: ramp, points: [0, 1]}\n"
+        "      T: {shape: triangle, points: [0, 0.5, 1]}\n", encoding="utf-8")
+    rules = tmp_path / "t.rules"
+    rules.write_text('terms "t.terms.yaml"\noperators: inference = tsukamoto\n'
+                     "r1: if x is A then y is DN\nr2: if x is B then y is UP\n", encoding="utf-8")
+    with pytest.raises(FormatError) as info:
+        write_foreign(read_rulebase(rules), "fll")
+    assert "output term `y.T`" in info.value.message and "not a `triangle` term" in \
+        info.value.message
+    assert info.value.span.path.endswith("t.terms.yaml") and info.value.span.line == 10
+    with pytest.raises(SystemExit) as done:
+        main(["convert", str(rules), "--to", "fll", "-o", str(tmp_path / "t.fll")])
+    err = capsys.readouterr().err
+    assert done.value.code == 1 and "t.terms.yaml:10:" in err and "t.fll:" not in err
+    assert not (tmp_path / "t.fll").exists()
+
+
 def test_tsukamoto_refuses_a_term_concluded_twice():
     from mitos_cli.errors import RuleBaseError
 

@@ -31,6 +31,7 @@ from lark.exceptions import UnexpectedInput
 
 from ..errors import FormatError, Span, did_you_mean
 from ..fuzzy.formula import parse as parse_formula
+from ..fuzzy.shapes import TSUKAMOTO
 from ..lang.bulk import without_cyclic_gc
 from ..lang.cache import lark_parser
 from ..lang.model import Rule, RuleBase
@@ -467,6 +468,8 @@ def write_fll(rb: RuleBase, behavior: str | None = None) -> str:
         out.append(f"  default: {'nan' if v.default is None else fmt_number(v.default)}")
         out.append("  lock-previous: false")
         for t in v.terms:
+            if tsukamoto:
+                _invertible(t, v)
             text = common.fuzzylite_term_text(t, v.name) if tsukamoto else \
                 _output_term(rb, t, v, sugeno, inputs)
             out.append(f"  term: {t.name} {text}")
@@ -488,6 +491,18 @@ def write_fll(rb: RuleBase, behavior: str | None = None) -> str:
 
 def _one_line(text: str) -> str:
     return " ".join(text.replace("#", "").split())
+
+
+def _invertible(t: Term, v: Variable) -> None:
+    """Refuse, at the term, a Tsukamoto output's term that has no inverse: FLL's
+    ``WeightedAverage Tsukamoto`` holds monotonic terms only (the reader refuses the others),
+    and a concluded one was refused already, so this one no rule concludes."""
+    if t.shape not in TSUKAMOTO:
+        raise FormatError(f"output term `{v.name}.{t.name}`: an FLL Tsukamoto output holds "
+                          f"monotonic terms only ({', '.join(TSUKAMOTO)}), not a "
+                          f"`{t.shape}` term", span=t.span,
+                          hint=f"no rule concludes `{t.name}`: remove it from `{v.name}`'s "
+                               f"terms (no output changes), or use another inference")
 
 
 def _output_term(rb: RuleBase, t: Term, v: Variable, sugeno: bool,
