@@ -661,6 +661,16 @@ def test_json_says_an_input_was_clamped_and_what_was_given(capsys):
     assert "road = 160 in (given 500, clamped to its universe)" in out
 
 
+def test_json_keeps_an_infinite_input_as_given(capsys):
+    """`road=inf` gave `"given": null`, which reads as "nothing given": JSON has no infinity,
+    so --json writes it as the text "inf" ("-inf"); a NaN output stays null."""
+    code, out, _ = run_main(["eval", "road=inf", "size=45", "position=-inf", "--json"], capsys)
+    inputs = json.loads(out)["inputs"]
+    assert code == 0 and (inputs["road"]["value"], inputs["road"]["given"]) == (160.0, "inf")
+    assert (inputs["position"]["value"], inputs["position"]["given"]) == (-60.0, "-inf")
+    assert float(inputs["road"]["given"]) == np.inf       # the files' number grammar reads it
+
+
 def _narrow_cheap(tmp_path) -> Path:
     fis = tmp_path / "f.fis"
     fis.write_text((ROOT / "tests/data/interop/tipper.fis").read_text()

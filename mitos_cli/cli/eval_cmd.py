@@ -261,7 +261,7 @@ def _evaluate_one(rb, values: dict[str, str], as_json: bool, digits: int | None)
     warn_undersampled(rb, result.dof)
     trace = trace_of(result, given=X)
     if as_json:
-        emit(json_text(trace.to_json()))
+        emit(json_text(trace.to_json(), infinity_as_text=True))
     else:
         emit(trace.render(1 if digits is None else digits))
 

@@ -26,14 +26,18 @@ def report_error(exc: MitosError) -> None:
     err(exc.render())
 
 
-def json_text(value) -> str:
+def json_text(value, infinity_as_text: bool = False) -> str:
     """``value`` as strict JSON (indented): a NaN or an infinity, which ``json.dumps`` would
-    write as the bare ``NaN``/``Infinity`` that strict parsers refuse, is ``null``."""
+    write as the bare ``NaN``/``Infinity`` that strict parsers refuse, is ``null``; with
+    ``infinity_as_text`` an infinity is the text ``"inf"`` or ``"-inf"`` (an input given as
+    ``inf`` is a value, which ``null`` would deny)."""
     import json
     import math
 
     def strict(v):
         if isinstance(v, float) and not math.isfinite(v):
+            if infinity_as_text and math.isinf(v):
+                return "inf" if v > 0 else "-inf"
             return None
         if isinstance(v, dict):
             return {k: strict(x) for k, x in v.items()}
