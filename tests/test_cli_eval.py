@@ -629,6 +629,17 @@ def test_a_single_value_past_a_floats_range_is_refused(value, capsys):
     assert code == 0 and "clamped" in err
 
 
+def test_nan_is_refused_for_an_input_no_rule_tests(capsys):
+    """`unused=nan` was taken (the value is dropped before the engine, which refuses NaN)
+    where `unused=abc` was refused; NaN inputs are an error (language.md)."""
+    fll = str(ROOT / "tests" / "data" / "interop" / "check_termless_input.fll")
+    for name, given in (("unused", ["a=0.5", "unused=nan"]), ("a", ["a=NaN", "unused=3"])):
+        code, out, err = run_main(["eval", fll, *given], capsys)
+        assert code == 1 and out == "" and f"input `{name}` is not a number (NaN)" in err, err
+    code, out, _ = run_main(["eval", fll, "a=0.5", "unused=3"], capsys)
+    assert code == 0
+
+
 def test_network_refuses_what_it_would_ignore(capsys, tmp_path):
     """`--batch ok.csv --network` printed the network and ignored the batch."""
     csv = tmp_path / "ok.csv"

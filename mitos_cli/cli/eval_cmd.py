@@ -252,8 +252,9 @@ def _evaluate_one(rb, values: dict[str, str], as_json: bool, digits: int | None)
     from ..engine.trace import trace_of
 
     unused = unused_inputs(rb)
-    given: dict[str, object] = {k: v for k, v in parse_values(values).items()
-                                if k not in unused}
+    numbers = parse_values(values)
+    refuse_nan(numbers)
+    given: dict[str, object] = {k: v for k, v in numbers.items() if k not in unused}
     X = as_batch(rb.compiled, given)
     result = evaluate(rb.compiled, X)
     warn_clamped(result)
@@ -264,6 +265,16 @@ def _evaluate_one(rb, values: dict[str, str], as_json: bool, digits: int | None)
         emit(json_text(trace.to_json(), infinity_as_text=True))
     else:
         emit(trace.render(1 if digits is None else digits))
+
+
+def refuse_nan(numbers: dict[str, float]) -> None:
+    """NaN inputs are an error, as the engine says for the inputs the rules test; an input
+    they do not test is dropped before the engine, and took `unused=nan` where it refused
+    `unused=abc`."""
+    for name, x in numbers.items():
+        if x != x:
+            raise InputError(f"input `{name}` is not a number (NaN)",
+                             hint="give every input a finite number")
 
 
 def unused_inputs(rb) -> tuple[str, ...]:
