@@ -288,6 +288,21 @@ def test_trace_says_when_an_output_is_its_default(tmp_path, capsys):
     assert "default" not in out
 
 
+def test_trace_shows_a_huge_or_tiny_output_readably(tmp_path, capsys):
+    """An output of 1.7e148 was printed as 149 digits to one decimal; one of -1e-30 as -0.0."""
+    (tmp_path / "h.terms.yaml").write_text(
+        "variables:\n"
+        "  x: {role: input, universe: [0, 10], terms: {A: {shape: triangle, points: [0, 5, 10]}}}\n"
+        "  y: {role: output, universe: [0, 1e149], terms: {B: 1.7e148}}\n"
+        "  z: {role: output, universe: [-1, 1], terms: {N: -1e-30}}\n", encoding="utf-8")
+    (tmp_path / "h.rules").write_text('terms "h.terms.yaml"\nr1: if x is A then y is B and z is N\n',
+                                      encoding="utf-8")
+    code, out, _ = run_main(["eval", str(tmp_path / "h.rules"), "x=5"], capsys)
+    assert code == 0 and "  y = 1.7e+148\n" in out and "  z = -1e-30" in out, out
+    code, out, _ = run_main(["eval", str(tmp_path / "h.rules"), "x=5", "--digits", "8"], capsys)
+    assert "  y = 1.7e+148\n" in out, out
+
+
 def test_json_names_the_outputs_that_are_their_default(tmp_path, capsys):
     """The text trace's "(its default: no rule sets it here)", for machines: `defaulted`."""
     terms = (ROOT / "rulebases" / "mitos.terms.yaml").read_text(encoding="utf-8")

@@ -15,6 +15,10 @@ from ..resources import display_path
 from ..words import plural, with_unit
 from .evaluation import Result, declares_nan
 
+#: From this magnitude the trace shows a number as ``1.69158e+148``: a float's 17 digits end
+#: there, and the fixed form's further digits say nothing.
+LONG = 1e15
+
 
 @dataclass(frozen=True)
 class InputTrace:
@@ -71,8 +75,10 @@ class Trace:
     def render(self, digits: int = 1) -> str:
         """The paper's layout: fuzzified inputs, fired rules with DOFs, crisp outputs."""
         def num(x: float) -> str:
+            if abs(x) >= LONG:                  # not 150 digits, most of them noise
+                return f"{x:.{max(digits, 6)}g}"
             text = f"{x:.{digits}f}"
-            if x > 0 and float(text) == 0:       # a rule that fired, if only a little
+            if x != 0 and float(text) == 0:     # a rule that fired, if only a little
                 text = f"{x:.{max(digits, 1)}g}"
             return text
 
