@@ -362,7 +362,13 @@ def _check_seed(seed: object) -> int | None:
 
 def _command(action) -> np.ndarray:
     """``action`` as the ``[1, 2]`` command it is, else a :class:`CommandError` saying what an
-    action is (``step(5)`` met NumPy's "cannot reshape array of size 1 into shape (1,2)")."""
+    action is (``step(5)`` met NumPy's "cannot reshape array of size 1 into shape (1,2)"; a
+    bool was read as 1 or 0, where every other entry point refuses it)."""
+    from .engine.inputs import holds_bool
+
+    if holds_bool(action):
+        raise CommandError(f"the action must be numbers, not bools: `{action!r:.80}`",
+                           hint="give numbers: True and False would be read as 1 and 0")
     try:
         command = np.asarray(action, dtype=np.float64)
     except (TypeError, ValueError):

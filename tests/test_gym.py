@@ -230,6 +230,20 @@ def test_an_action_that_is_not_steering_and_speed_says_what_an_action_is(action,
     assert env.unwrapped.sim.ticks == 1
 
 
+@pytest.mark.parametrize("action", [[True, 30], np.array([True, False]), (np.bool_(True), 3.0),
+                                    np.array([True, 3.0], dtype=object)])
+def test_an_action_holding_a_bool_is_refused(action):
+    """[True, 30] was a steering command of 1 deg, where fuzzy_policy, reset(seed=True) and
+    simulate(seed=True) refuse bools."""
+    from mitos_cli.errors import CommandError
+
+    env = gymnasium.make("mitos/Corridor-v0")
+    env.reset(seed=1)
+    with pytest.raises(CommandError, match="the action must be numbers, not bools"):
+        env.step(action)
+    assert env.unwrapped.sim.ticks == 0
+
+
 def test_fuzzy_policy_of_a_batch_says_it_takes_one_observation():
     from mitos_cli.errors import InputError
 

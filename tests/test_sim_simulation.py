@@ -262,4 +262,6 @@ def test_a_command_that_is_not_numbers_is_a_command_error(command, says):
     assert says in exc.value.message and isinstance(exc.value, ValueError)
     with pytest.raises(CommandError, match="must be finite numbers"):
         sim.step(np.array([[90.0, np.inf]]))
+    with pytest.raises(CommandError, match="must be numbers, not bools"):    # read as 1.0
+        sim.step([[True, 30.0]])
     assert sim.ticks == 0

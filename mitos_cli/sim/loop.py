@@ -600,7 +600,13 @@ class Simulation:
 
     def _command(self, command: object) -> np.ndarray:
         """A command given from outside as ``[n, 2]`` finite floats, else a
-        :class:`CommandError` (text or ``None`` met NumPy's conversion errors)."""
+        :class:`CommandError` (text or ``None`` met NumPy's conversion errors; a bool was
+        read as 1 or 0)."""
+        from ..engine.inputs import holds_bool
+
+        if holds_bool(command):
+            raise CommandError(f"the command must be numbers, not bools: `{command!r:.80}`",
+                               hint="give numbers: True and False would be read as 1 and 0")
         try:
             given = np.asarray(command, float)
         except (TypeError, ValueError):
