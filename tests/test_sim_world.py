@@ -398,6 +398,16 @@ def test_a_name_with_a_control_character_is_refused():
     assert "w.yaml:1:7" in msg and "control character" in msg
 
 
+def test_an_empty_world_name_says_so():
+    """Path("") is ".": load_world("") said "`.` is a directory", a path never given."""
+    from mitos_cli.sim import load_world
+
+    for load in (load_world, resolve_world_path):
+        with pytest.raises(WorldError) as exc:
+            load("")
+        assert exc.value.message == "the world's name is empty"
+
+
 def test_a_misspelt_world_path_points_at_the_file_beside_it(tmp_path, monkeypatch):
     (tmp_path / "w").mkdir()
     (tmp_path / "w" / "tiny.yaml").write_text(BASE)

@@ -912,6 +912,7 @@ def _world_path_given(path: object) -> str | os.PathLike:
     """``path`` if it can name a file; else a :class:`WorldError` saying what a world is
     given as (a dict or an int reached ``Path()``, whose TypeError said nothing of worlds)."""
     if isinstance(path, (str, os.PathLike)):
+        _named(path)
         return path
     if isinstance(path, World):
         hint = "it is loaded already: give it to simulate() or Simulation() as it is"
@@ -922,6 +923,15 @@ def _world_path_given(path: object) -> str | os.PathLike:
         hint = "load_world('worlds/corridor.yaml'), or a packaged world's name: load_world('corridor')"
     raise WorldError(f"a world is read from a file: expected a path or a packaged world's name, "
                      f"not {type(path).__name__} `{path!r:.60}`", hint=hint)
+
+
+def _named(path: str | os.PathLike) -> None:
+    """A :class:`WorldError` if ``path`` is empty: ``Path("")`` is ``.``, and "`.` is a
+    directory" named a path the user never gave."""
+    if isinstance(path, str) and not path:
+        raise WorldError("the world's name is empty",
+                         hint="give a world file's path, or a packaged world's name such as "
+                              "`corridor`")
 
 
 class UnknownWorld(WorldError, NameError_):
@@ -936,6 +946,7 @@ def resolve_world_path(name: str | Path, base: Path | None = None) -> Path:
     an unknown name gets the packaged names and a "did you mean"."""
     from ..resources import is_dir, resolve
 
+    _named(name)
     found = resolve("worlds", name, ".yaml", base)
     if found is not None:
         return found
