@@ -107,12 +107,14 @@ class MitosEnv(gymnasium.Env):
                  render_mode: str | None = None, **others: Any) -> None:
         from .sim.loop import Simulation
         from .sim.planner import FuzzyPlanner
+        from .sim.worldcheck import check_built
         from .sim.worldfile import load_world
 
         _check_options(others, observe_ranges, render_mode, self.metadata["render_modes"])
 
         # a World loaded (or changed) in Python, else a file or a packaged world's name
         loaded = world if isinstance(world, World) else load_world(world)
+        check_built(loaded)          # before its numbers make the spaces (a NaN Box bound)
         if len(loaded.agents) != 1:
             raise WorldError(f"world `{loaded.name}` has {len(loaded.agents)} robots; a "
                              f"Gymnasium environment drives one",

@@ -224,6 +224,50 @@ def test_a_path_for_a_world_or_a_name_for_a_planner_says_what_is_taken():
     assert "make_planner('dwa', world)" in exc.value.hint
 
 
+def _robot(world, **changes):
+    agent = world.agents[0]
+    return (dataclasses.replace(agent, robot=dataclasses.replace(agent.robot, **changes)),)
+
+
+@pytest.mark.parametrize("change, says", [
+    (lambda w: {"time_limit": float("nan")}, "`time_limit` must be a finite number, not nan"),
+    (lambda w: {"time_limit": float("inf")}, "`time_limit` must be a finite number, not inf"),
+    (lambda w: {"time_limit": 0.0}, "`time_limit` must be positive, not 0.0"),
+    (lambda w: {"time_limit": 0.01}, "`time_limit` must be at least dt (0.05 s)"),
+    (lambda w: {"dt": -0.05}, "`dt` must be positive, not -0.05"),
+    (lambda w: {"dt": 1e-9}, "`time_limit` must be at most 100,000 ticks"),
+    (lambda w: {"substeps": 0}, "`substeps` must be at least 1, not 0"),
+    (lambda w: {"substeps": 2.0}, "`substeps` must be a whole number (an int), not 2.0"),
+    (lambda w: {"seed": True}, "`seed` must be a whole number of 0 or more, not True"),
+    (lambda w: {"agents": _robot(w, max_speed=float("nan"))},
+     "`agents[0].robot.max_speed` must be a finite number"),
+    (lambda w: {"agents": _robot(w, wheelbase=30.0)}, "`agents[0].robot.wheelbase` must be at most"),
+    (lambda w: {"sensors": dataclasses.replace(w.sensors, range=0.0)},
+     "`sensors.range` must be positive"),
+    (lambda w: {"sensors": dataclasses.replace(w.sensors, count=0)},
+     "`sensors.count` must be at least 1"),
+    (lambda w: {"obstacles": (dataclasses.replace(w.obstacles[0], radius=-8.0),) + w.obstacles[1:]},
+     "`obstacles[0].radius` must be positive"),
+    (lambda w: {"corridors": (dataclasses.replace(w.corridors[0], width=float("inf")),)},
+     "`corridors[0].width` must be a finite number"),
+])
+def test_a_world_changed_in_python_is_checked_as_its_file_would_be(change, says):
+    """time_limit=0 said "no tick recorded yet" (the Gymnasium environment "the run has
+    ended"), NaN was a bare ValueError in the loop, inf an OverflowError; a world file with
+    these values is refused at its line."""
+    import gymnasium
+
+    import mitos_cli.gym  # noqa: F401
+    from mitos_cli.errors import WorldError
+
+    world = load_world(packaged_path("worlds", "moving.yaml"))
+    bad = dataclasses.replace(world, **change(world))
+    with pytest.raises(WorldError, match=re.escape(says)):
+        simulate(bad, seed=1)
+    with pytest.raises(WorldError, match=re.escape(says)):
+        gymnasium.make("mitos/World-v0", world=bad)
+
+
 @pytest.mark.parametrize("kwargs, says", [
     ({"worlds": "one"}, "takes a list of loaded worlds, not the path `one`"),
     ({"worlds": ["corridor"]}, "runs loaded worlds, not str"),

@@ -1534,9 +1534,13 @@ def check_seed(seed: object) -> int:
 
 
 def _check_world(world: object) -> None:
-    """A :class:`World`, else a :class:`WorldError` saying how to get one (a path got as far
-    as ``'str' object has no attribute 'behavior'``)."""
+    """A :class:`World` whose numbers a world file could hold, else a :class:`WorldError`
+    saying how to get one (a path got as far as ``'str' object has no attribute 'behavior'``)
+    or naming the field (a World changed in Python: :mod:`.worldcheck`)."""
     if isinstance(world, World):
+        from .worldcheck import check_built
+
+        check_built(world)
         return
     hint = (f"load_world({str(world)!r}) reads it" if isinstance(world, (str, os.PathLike))
             else "load_world('worlds/corridor.yaml') reads a world file")
