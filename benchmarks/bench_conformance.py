@@ -13,7 +13,9 @@
    fuzzylite 6 samples (its default resolution is 100 cells, midpoints).
 3. ``.fis`` files (Debian's ``octave-fuzzy-logic-toolkit`` and the fuzzylite ones): compared
    with Octave's ``evalfis`` where Octave reads them (MATLAB's semantics: 101 points
-   including both ends), and MATLAB's documented tipper values.
+   including both ends) on 200 inputs drawn from each file's own stream (keyed on its path
+   under its folder, so no file's figure moves when another one loads), and MATLAB's
+   documented tipper values.
 4. Every file that loads is converted to every other format and read back: outputs unchanged
    (1e-9 of the output's range), or the converter's warning gives the measured difference.
 
@@ -227,13 +229,21 @@ def octave_outputs(fis: Path, X: np.ndarray, tmp: Path) -> np.ndarray | None:
     return np.loadtxt(outputs, delimiter=",", ndmin=2)
 
 
+def file_rng(path: Path, root: Path) -> np.random.Generator:
+    """A stream of its own for each file, keyed on its path under its root, so one file's
+    inputs do not move when the reader learns to load another file before it."""
+    return np.random.default_rng(np.random.SeedSequence([7, *path.relative_to(root).as_posix()
+                                                          .encode()]))
+
+
 def part_fis(tmp: Path) -> dict:
-    files = sorted(glob.glob(str(OCTAVE / "fuzzy-logic-toolkit*" / "*.fis")))
-    files += sorted(str(p) for p in DEBIAN.rglob("*.fis"))
+    files = [(Path(f), Path(f).parent)        # the toolkit's folder: its version is not the key
+             for f in sorted(glob.glob(str(OCTAVE / "fuzzy-logic-toolkit*" / "*.fis")))]
+    files += [(p, DEBIAN) for p in sorted(DEBIAN.rglob("*.fis"))]
     rows = []
-    rng = np.random.default_rng(np.random.SeedSequence(7))
-    for f in map(Path, files):
-        name = f"{f.parent.name}/{f.name}"
+    for f, root in files:
+        name = f"{f.parent.name}/{f.name}" if root != DEBIAN else str(f.relative_to(DEBIAN))
+        rng = file_rng(f, root)
         try:
             rb = read_rulebase(f)
         except MitosError as exc:

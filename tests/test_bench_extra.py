@@ -176,6 +176,30 @@ def test_a_missing_peer_is_named_not_printed_as_nan(monkeypatch, capsys):
         monkeypatch.undo()
 
 
+def test_conformance_part_3_draws_each_file_s_inputs_from_a_stream_of_its_own(tmp_path,
+                                                                             monkeypatch):
+    """Part 3 drew every file's inputs from one stream: a file's sample, and so its figure,
+    moved when the reader learned to load a file before it (docs/conformance.md)."""
+    import shutil
+
+    module = script("bench_conformance", monkeypatch)
+    tipper = ROOT / "tests" / "data" / "interop" / "tipper.fis"
+    debian = tmp_path / "debian"
+    (debian / "b").mkdir(parents=True)
+    shutil.copy(tipper, debian / "b" / "z.fis")
+    monkeypatch.setattr(module, "DEBIAN", debian)
+    monkeypatch.setattr(module, "OCTAVE", tmp_path / "no-octave")
+    seen: dict[str, list] = {}
+    monkeypatch.setattr(module, "octave_outputs",
+                        lambda f, X, tmp: seen.setdefault(f.name, []).append(X.copy()))
+    module.part_fis(tmp_path)
+    (debian / "a").mkdir()
+    shutil.copy(tipper, debian / "a" / "y.fis")           # a file before it, that loads
+    module.part_fis(tmp_path)
+    assert len(seen["z.fis"]) == 2 and (seen["z.fis"][0] == seen["z.fis"][1]).all()
+    assert not (seen["y.fis"][0] == seen["z.fis"][0]).all()     # each file a stream of its own
+
+
 def test_the_fuzz_table_has_as_many_cells_in_its_delimiter_row_as_in_its_header(monkeypatch):
     lines = script("fuzz", monkeypatch).table([]).splitlines()
     assert lines[0].count("|") == lines[1].count("|") == lines[2].count("|")
