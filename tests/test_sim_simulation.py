@@ -266,6 +266,7 @@ def test_a_world_changed_in_python_is_checked_as_its_file_would_be(change, says)
         simulate(bad, seed=1)
     with pytest.raises(WorldError, match=re.escape(says)):
         gymnasium.make("mitos/World-v0", world=bad)
+    assert Simulation(dataclasses.replace(world, seed=np.int64(3))).seed == 3   # an integer
 
 
 @pytest.mark.parametrize("kwargs, says", [

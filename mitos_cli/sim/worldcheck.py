@@ -25,7 +25,7 @@ def check_built(world: World) -> None:
     """Refuse ``world`` unless its numbers and names are what a world file may hold."""
     c = _Fields(world.name)
     seed = world.seed
-    if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0:
+    if not isinstance(seed, Integral) or isinstance(seed, bool) or seed < 0:
         c.refuse("seed", seed, "a whole number of 0 or more")
     dt = c.number("dt", world.dt, positive=True, maximum=1.0)
     limit = c.number("time_limit", world.time_limit, positive=True)
@@ -158,8 +158,8 @@ class _Fields:
         if not math.isfinite(x):
             self.refuse(field, value, "a finite number")
         if abs(x) > LARGEST and (maximum is None or x <= maximum):
-            key = field.rsplit(".", 1)[-1].removeprefix("steering_").replace("max_steering_rate",
-                                                                              "max_rate")
+            name = field.rsplit(".", 1)[-1]               # the world file's key, for BEYOND
+            key = {"max_steering_rate": "max_rate"}.get(name, name.removeprefix("steering_"))
             self.refuse(field, value, f"within ±{LARGEST:g} ("
                         f"{BEYOND.get(key, 'world lengths are in inches: 1e7 in is 254 km')})")
         if positive and x <= 0:
@@ -187,4 +187,5 @@ class _Fields:
 
     def choice(self, field: str, value: object, options: tuple[str, ...]) -> None:
         if value not in options:
-            self.refuse(field, value, "one of " + ", ".join(options))
+            self.refuse(field, value, "one of " + ", ".join(options) if options
+                        else "a name the world has, and it has none")
