@@ -273,6 +273,7 @@ def test_a_world_changed_in_python_is_checked_as_its_file_would_be(change, says)
     ({"worlds": "one"}, "takes a list of loaded worlds, not the path `one`"),
     ({"worlds": ["corridor"]}, "runs loaded worlds, not str"),
     ({"runs": 2.5}, "`runs` is a whole number, 0 or more, not `2.5`"),
+    ({"runs": True}, "`runs` is a whole number, 0 or more, not `True`"),    # was 1 run
     ({"workers": 0}, "`workers` is a whole number, 1 or more, not `0`"),
     ({"seed": -1}, "a seed is a whole number"),
     ({"seed": True}, "a seed is a whole number, 0 or more, not `True`"),

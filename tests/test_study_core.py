@@ -618,3 +618,20 @@ def test_dask_missing_says_how_to_install(monkeypatch):
     with pytest.raises(StudyError) as exc:
         dask_client(None, 2)
     assert "needs dask.distributed" in exc.value.message and "mitos[dask]" in exc.value.hint
+
+
+@pytest.mark.parametrize("changes, says", [
+    ({"runs": -1}, "`runs` is a whole number, 1 or more, not `-1`"),    # NumPy's OverflowError
+    ({"runs": 0}, "`runs` is a whole number, 1 or more, not `0`"),      # compared nothing
+    ({"runs": True}, "`runs` is a whole number, 1 or more, not `True`"),
+    ({"seed": -1}, "a seed is a whole number, 0 or more, not `-1`"),    # NumPy's ValueError
+    ({"seed": True}, "a seed is a whole number, 0 or more, not `True`"),  # ran as seed 1
+])
+def test_a_study_checks_runs_and_seed_as_compare_does(changes, says):
+    from mitos_cli.errors import InputError
+
+    with pytest.raises(InputError) as exc:
+        Study(["a.yaml"], [Choice("potential_field")], **{"runs": 1, "seed": 1, **changes})
+    assert exc.value.message == says
+    study = Study(["a.yaml"], [Choice("dwa")], runs=np.int64(2), seed=np.uint8(3))
+    assert (type(study.runs), type(study.seed)) == (int, int) and len(study.tasks()) == 2

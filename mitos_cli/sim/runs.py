@@ -138,14 +138,14 @@ def run_many(worlds: list[World], runs: int = 0, seed: int | None = None, planne
     ``on_progress(done, total)`` is called as runs finish (a progress bar). Ctrl-C terminates
     the workers and raises :class:`RunsInterrupted` with the runs that had finished."""
     worlds = _check_worlds(worlds)
-    runs = _whole("runs", runs, 0)
+    runs = whole("runs", runs, 0)
     if seed is not None:
         seed = check_seed(seed)
     if planner is None:
         from .planner import FuzzyPlanner
 
         planner = FuzzyPlanner(None, worlds[0].behavior if worlds else "drive")
-    workers = default_workers() if workers is None else _whole("workers", workers, 1)
+    workers = default_workers() if workers is None else whole("workers", workers, 1)
     tasks = []
     for w in worlds:
         base = w.seed if seed is None else seed
@@ -197,11 +197,11 @@ def _check_worlds(worlds: object) -> list[World]:
     return out
 
 
-def _whole(what: str, value: object, least: int) -> int:
+def whole(what: str, value: object, least: int) -> int:
     """``value`` as an int of at least ``least``, else an :class:`InputError` (``runs=2.5``
-    and ``workers=0`` met a TypeError, a ZeroDivisionError inside)."""
+    and ``workers=0`` met a TypeError, a ZeroDivisionError inside; ``True`` is not 1)."""
     try:
-        n = operator.index(value)  # type: ignore[arg-type]  # anything is tried
+        n = -1 if isinstance(value, (bool, np.bool_)) else operator.index(value)  # type: ignore[arg-type]
     except TypeError:
         n = least - 1
     if n < least:

@@ -30,6 +30,18 @@ class Study:
     behavior: str | None = None
     command: str = "mitos compare"
 
+    def __post_init__(self) -> None:
+        """``runs`` (1 or more, as ``mitos compare --runs``) and ``seed`` checked as
+        :func:`~mitos_cli.sim.runs.run_many` checks them, else an :class:`InputError`
+        (``runs=-1`` was NumPy's OverflowError, ``seed=-1`` its ValueError, ``seed=True`` ran
+        as the seed 1, ``runs=0`` compared nothing); NumPy integers become ints (the study's
+        ``study.json`` is JSON)."""
+        from ..sim.loop import check_seed
+        from ..sim.runs import whole
+
+        object.__setattr__(self, "runs", whole("runs", self.runs, 1))
+        object.__setattr__(self, "seed", check_seed(self.seed))
+
     def tasks(self) -> list[Task]:
         return expand(self.worlds, self.choices, self.runs, self.seed)
 
