@@ -192,6 +192,8 @@ def test_the_brake_looks_as_far_as_stopping_takes_within_what_the_robot_sees():
     assert safety.reach_of(Robot(max_speed=10.0), 0.05, cfg, 150.0) == cfg.reach
     slow = Robot(max_speed=200.0, acceleration=1.0)                # 20,000 in to stop
     assert safety.reach_of(slow, 0.05, cfg, 150.0) == 150.0
+    stuck = Robot(acceleration=1e-320)                             # inf to stop: not a traceback
+    assert safety.reach_of(stuck, 0.05, cfg, 150.0) == 150.0
     # so it goes no faster than it can stop within its sensors' range
     assert safety.brake(150.0, 1.0, cfg.margin, 0.05) < 18.0
 

@@ -609,6 +609,26 @@ def test_a_wheelbase_longer_than_the_footprint_is_refused():
     assert parse_world(BASE.replace("wheelbase: 16", "wheelbase: 24"), "w.yaml")
 
 
+def test_a_turn_tighter_than_half_an_inch_is_refused_at_the_value_that_makes_it():
+    """The fuzz audit: `wheelbase: 1e-320` died in the brake's sweep (division by zero),
+    `wheelbase: 1e-10` asked for 8 TiB, `wheelbase: 0.01` on a map ran for minutes; a lock of
+    90 deg did the same at any wheelbase (its places are closer the tighter the turn)."""
+    text = error(BASE.replace("wheelbase: 16", "wheelbase: 1e-320"))
+    assert text.startswith("w.yaml:7:14: world error: the robot's tightest turn has a radius "
+                           "of 5.78e-321 in (wheelbase 1e-320 in at a lock of 60 deg)")
+    assert "expected a wheelbase of at least 0.866 in at this lock" in text
+    assert "wheelbase 0.01 in" in error(BASE.replace("wheelbase: 16", "wheelbase: 0.01"))
+    assert parse_world(BASE.replace("wheelbase: 16", "wheelbase: 1"), "w.yaml")
+    steer = "  wheelbase: 16\n  steering: {min: 0, max: 180}\n"
+    text = error(BASE.replace("  wheelbase: 16\n", steer))
+    assert text.startswith("w.yaml:8:19: world error: the steering's lock is 90 deg off straight")
+    text = error(BASE.replace("  wheelbase: 16\n", steer.replace("min: 0, max: 180", "min: 1, max: 150")))
+    assert "w.yaml:8:19:" in text and "expected a lock of at most 88.2 deg" in text
+    other = BASE + ("robots:\n  - name: b\n    q_init: {x: 30, y: 20}\n    q_goal: {x: 300, y: 20}\n"
+                    "    robot: {wheelbase: 0.1}\n")
+    assert "w.yaml:19:24: world error: the robot's tightest turn" in error(other)
+
+
 def test_a_misspelt_offset_under_randomise_says_dx_or_dy():
     text = error(BASE + "obstacles:\n  - {name: box, shape: circle, at: [150, 10], radius: 5}\n"
                         "randomise:\n  obstacles:\n    box: {dz: [-5, 5]}\n")

@@ -229,6 +229,23 @@ def _spacing(robot: Robot, k: float, radius: float, step: float) -> float:
     return step / (1.0 + abs(k) * _far(robot, radius, step))
 
 
+#: in: the least radius of a robot's tightest turn (the rear axle's path at full lock). The
+#: sweep's places are ``step / (1 + |k| far)`` apart (:func:`_spacing`), so their number grows
+#: as one over that radius: at 0.06 in a 3 s run on a small map took 18 s, at 0.006 in it was
+#: killed after a minute at 434 MB, at 1e-15 in (a lock of 90 deg) it asked for more memory
+#: than a machine has. The packaged robots turn at 7.5 to 9.2 in; a robot that turns within
+#: half an inch of its rear axle turns on the spot, which no tricycle does.
+TIGHTEST_TURN = 0.5
+
+
+def tightest_turn(robot: Robot) -> float:
+    """The radius (in) of the rear axle's path at the robot's full lock: ``wheelbase /
+    tan(lock)``; 0 where the wheel can stand across the robot (a lock of 90 deg or more)."""
+    lock = max(robot.steering_straight - robot.steering_min,
+               robot.steering_max - robot.steering_straight)
+    return robot.wheelbase / math.tan(math.radians(lock)) if lock < 90 else 0.0
+
+
 def _far(robot: Robot, radius: float, step: float) -> float:
     """:func:`_spacing`'s reach of a turn: half the wheelbase, half the footprint's diagonal,
     a cell's diagonal and the step."""
@@ -480,8 +497,10 @@ def reach_of(robot: Robot, dt: float, cfg: Settings, sight: float) -> float:
     range: a robot that needs longer to stop goes no faster than it can stop within what it
     can see (and a robot of 200 in/s braking at 1 in/s^2 does not sweep 20,000 in a tick)."""
     v, a = robot.max_speed, robot.acceleration
-    need = math.ceil(v * dt + v * v / (2.0 * a) + cfg.margin) + cfg.step
-    return max(cfg.reach, min(need, math.ceil(sight)))
+    stop = v * dt + v * v / (2.0 * a) + cfg.margin
+    if not stop < sight:           # its sight bounds it (inf at `acceleration: 1e-320`)
+        return max(cfg.reach, math.ceil(sight))
+    return max(cfg.reach, min(math.ceil(stop) + cfg.step, math.ceil(sight)))
 
 
 @dataclass

@@ -8,6 +8,7 @@ image that cannot be read.
 
 from __future__ import annotations
 
+import math
 import os
 from collections import Counter
 from dataclasses import replace
@@ -17,6 +18,7 @@ from typing import TYPE_CHECKING, Any
 from ..errors import NameError_, Span, WorldError, did_you_mean, unknown
 from ..lang import yamlpos
 from ..lang.yamlpos import YList, YMap
+from .safety import TIGHTEST_TURN, tightest_turn
 from .world import (
     REPLANS,
     Agent,
@@ -207,7 +209,7 @@ def read_robot(r: _Reader, value: Any, span: Span, base: Robot | None = None) ->
     wheelbase = r.number(m, "wheelbase", "robot", None if base is None else d.wheelbase,
                          positive=True)
     _check_wheelbase(m, wheelbase, fp[0])
-    return Robot(
+    robot = Robot(
         model="tricycle",
         wheelbase=wheelbase,
         length=fp[0], width=fp[1],
@@ -219,6 +221,44 @@ def read_robot(r: _Reader, value: Any, span: Span, base: Robot | None = None) ->
         acceleration=r.number(m, "acceleration", "robot", d.acceleration, positive=True),
         max_reverse=r.number(m, "max_reverse", "robot", d.max_reverse, minimum=0),
         brake=r.flag(m, "brake", "robot", d.brake))
+    _check_turn(m, st, robot)
+    return robot
+
+
+def _check_turn(m: YMap, st: YMap, robot: Robot) -> None:
+    """Refuse a robot whose tightest turn is narrower than :data:`~.safety.TIGHTEST_TURN`
+    (`wheelbase: 0.01`, or `steering: {min: 0, max: 180}`, whose wheel stands across the
+    body): its brake's sweep places the body along the arc closer together the tighter the
+    turn, and a run took minutes and gigabytes, or died asking for terabytes."""
+    radius = tightest_turn(robot)
+    if radius >= TIGHTEST_TURN:
+        return
+    lock = max(robot.steering_straight - robot.steering_min,
+               robot.steering_max - robot.steering_straight)
+    side = "min" if robot.steering_straight - robot.steering_min == lock else "max"
+    blame_lock = side in st and (lock > 60 or "wheelbase" not in m)   # the packaged: 60 deg
+    span = (st.value_span(side) if blame_lock
+            else m.value_span("wheelbase") if "wheelbase" in m else m.span)
+    if lock >= 90:
+        raise WorldError(f"the steering's lock is {lock:g} deg off straight: the wheel can "
+                         f"stand across the robot, which then turns on the spot about its "
+                         f"rear axle", span=span,
+                         expected="a lock under 90 deg (`min` and `max` within 90 of "
+                                  "`straight`)",
+                         hint="the packaged robots steer 60 deg either way: "
+                              "`steering: {min: 30, max: 150, straight: 90}`")
+    expected = (f"a lock of at most "
+                f"{math.degrees(math.atan(robot.wheelbase / TIGHTEST_TURN)):.3g} deg at this "
+                f"wheelbase" if blame_lock else
+                f"a wheelbase of at least {TIGHTEST_TURN * math.tan(math.radians(lock)):.3g} "
+                f"in at this lock")
+    raise WorldError(f"the robot's tightest turn has a radius of {radius:.3g} in (wheelbase "
+                     f"{robot.wheelbase:.3g} in at a lock of {lock:g} deg): a tricycle turns "
+                     f"about a point at least {TIGHTEST_TURN:g} in from its rear axle",
+                     span=span, expected=expected,
+                     hint="wheelbases are in inches (the packaged robots': 12 to 16 in); a "
+                          "smaller lock (`steering: min` and `max` nearer `straight`) turns "
+                          "wider")
 
 
 def _check_wheelbase(m: YMap, wheelbase: float, length: float) -> None:
