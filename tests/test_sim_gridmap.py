@@ -10,6 +10,7 @@ import pytest
 from mitos_cli.errors import WorldError
 from mitos_cli.sim.gridmap import INCH_PER_M, classify, load_map_yaml
 from mitos_cli.sim.pgm import parse_pgm
+from mitos_cli.sim.worldfile import load_world
 
 # a 3 x 2 image, top row first: white (free), grey (unknown), black (occupied)
 PIXELS = [254, 254, 205, 205, 0, 0]
@@ -72,6 +73,28 @@ def test_map_yaml_resolution_and_origin_in_inches(tmp_path: Path):
     assert g.resolution == pytest.approx(0.05 * INCH_PER_M)
     assert g.origin == pytest.approx((-INCH_PER_M, 2 * INCH_PER_M))
     assert g.occupied[0].all() and not g.occupied[2].any()
+
+
+@pytest.mark.filterwarnings("error")
+@pytest.mark.parametrize("res", ["1e-320", "1e-300", "1e-30"])
+def test_a_resolution_finer_than_a_micrometre_is_refused_at_its_line(tmp_path: Path, res):
+    """The fuzz audit: at 1e-320 m the cell lookup printed NumPy's overflow warnings, and at
+    1e-30 a 600-pixel map was one point, the start reported outside a map of width 0."""
+    (tmp_path / "m.pgm").write_bytes(b"P5 2 3 255\n" + bytes(PIXELS))
+    (tmp_path / "m.yaml").write_text(f"image: m.pgm\nresolution: {res}\norigin: [-15, -15, 0]\n")
+    world = "\n".join(("name: m", "dt: 0.05", "time_limit: 1",
+                       "robot: {model: tricycle, wheelbase: 16, footprint: {length: 24, width: 18}}",
+                       "q_init: {x: 0, y: 0, heading: 0}", "q_goal: {x: 100, y: 0}",
+                       "map: {grid: m.yaml}", ""))
+    (tmp_path / "w.yaml").write_text(world)
+    with pytest.raises(WorldError) as info:
+        load_world(tmp_path / "w.yaml")
+    text = info.value.render()
+    assert text.startswith(f"{tmp_path / 'm.yaml'}:2:13: world error: resolution {res} m per "
+                           "pixel is finer than a micrometre")
+    assert "hint: the resolution is in metres per pixel: 0.05 is 5 cm" in text
+    (tmp_path / "m.yaml").write_text("image: m.pgm\nresolution: 1e-6\norigin: [0, 0, 0]\n")
+    assert load_map_yaml(tmp_path / "m.yaml").resolution == pytest.approx(1e-6 * INCH_PER_M)
 
 
 def test_bad_thresholds(tmp_path: Path):

@@ -35,6 +35,10 @@ from .world import Grid
 INCH_PER_M = 1.0 / 0.0254
 IMAGE_SUFFIXES = (".pgm", ".png", ".bmp", ".tif", ".tiff", ".jpg", ".jpeg", ".gif", ".ppm")
 MAP_KEYS = ("image", "resolution", "origin", "negate", "occupied_thresh", "free_thresh", "mode")
+#: m per pixel: the finest resolution taken, a micrometre (ROS maps are centimetres: 0.05).
+#: At 1e-30 m a 600-pixel map was narrower than floats tell apart at its origin (its cells
+#: all one point, the start "outside the map"), and at 1e-320 the cell lookup overflowed.
+FINEST = 1e-6
 
 
 def occupancy(pixels: np.ndarray, maxval: int, negate: bool) -> np.ndarray:
@@ -188,6 +192,12 @@ def load_map_yaml(path: Path, *, unknown_occupied: bool = True,
     if res_m <= 0:
         raise WorldError("resolution must be positive (metres per pixel)",
                          span=spec.value_span("resolution"))
+    if res_m < FINEST:
+        raise WorldError(f"resolution {res_m:.3g} m per pixel is finer than a micrometre",
+                         span=spec.value_span("resolution"),
+                         expected=f"at least {FINEST:g} (metres per pixel)",
+                         hint="the resolution is in metres per pixel: 0.05 is 5 cm, as ROS "
+                              "maps usually are")
     origin = yamlpos.require(spec, "origin", WorldError, what)
     if not isinstance(origin, list) or len(origin) != 3:
         raise WorldError("origin must be [x, y, yaw] (metres, metres, radians)",
