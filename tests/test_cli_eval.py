@@ -127,6 +127,20 @@ def test_batch_errors(capsys, tmp_path, text, message):
     assert code == 1 and message in err and out == ""
 
 
+def test_a_batch_that_is_not_utf8_is_placed_at_its_byte(capsys, tmp_path):
+    """The fuzz audit: the place was in prose only, where every other reader puts it first."""
+    csv = tmp_path / "bad.csv"
+    csv.write_bytes(b"road,size,position\n78,45,4\n78,\xff,4\n")
+    code, out, err = run_main(["eval", "--batch", str(csv)], capsys)
+    assert code == 1 and err.startswith(f"{csv}:3:4: input error: cannot read batch file `{csv}`: "
+                                        "it is not UTF-8 text (byte 0xff at line 3, column 4)")
+    proc = subprocess.run([sys.executable, "-m", "mitos_cli", "eval", "--batch", "-"], cwd=ROOT,
+                          input=csv.read_bytes(), capture_output=True, timeout=120)
+    assert proc.returncode == 1
+    assert proc.stderr.decode().startswith("<stdin>:3:4: input error: cannot read the batch from "
+                                           "stdin: it is not UTF-8 text")
+
+
 def test_batch_passes_other_columns_through(capsys, tmp_path):
     """Columns that are not inputs come out after the outputs as they went in (text, quotes,
     empty cells); one named like an output is written as `given_NAME`."""

@@ -97,6 +97,14 @@ def test_a_resolution_finer_than_a_micrometre_is_refused_at_its_line(tmp_path: P
     assert load_map_yaml(tmp_path / "m.yaml").resolution == pytest.approx(1e-6 * INCH_PER_M)
 
 
+def test_a_map_file_that_is_not_utf8_is_placed_at_its_byte(tmp_path: Path):
+    (tmp_path / "m.yaml").write_bytes(b"image: m.pgm\nresolution: 0.05 # \xff\norigin: [0, 0, 0]\n")
+    with pytest.raises(WorldError) as info:
+        load_map_yaml(tmp_path / "m.yaml")
+    assert info.value.render().startswith(f"{tmp_path / 'm.yaml'}:2:20: world error: cannot read "
+                                          "map file")
+
+
 def test_bad_thresholds(tmp_path: Path):
     (tmp_path / "m.yaml").write_text("image: m.pgm\nresolution: 0.05\norigin: [0, 0, 0]\n"
                                      "occupied_thresh: 0.1\nfree_thresh: 0.5\n")

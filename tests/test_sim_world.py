@@ -629,6 +629,17 @@ def test_a_turn_tighter_than_half_an_inch_is_refused_at_the_value_that_makes_it(
     assert "w.yaml:19:24: world error: the robot's tightest turn" in error(other)
 
 
+def test_a_world_file_that_is_not_utf8_is_placed_at_its_byte(tmp_path: Path):
+    """The fuzz audit: "(byte 0xff at line 15, column 3)" in prose only, where the term-set,
+    rule-file and lesson readers put the place first."""
+    path = tmp_path / "w.yaml"
+    path.write_bytes(BASE.encode() + b"# \xff\n")
+    with pytest.raises(WorldError) as info:
+        load_world(path)
+    assert info.value.render().startswith(f"{path}:15:3: world error: cannot read world file "
+                                          f"`{path}`: it is not UTF-8 text (byte 0xff at line 15")
+
+
 def test_a_misspelt_offset_under_randomise_says_dx_or_dy():
     text = error(BASE + "obstacles:\n  - {name: box, shape: circle, at: [150, 10], radius: 5}\n"
                         "randomise:\n  obstacles:\n    box: {dz: [-5, 5]}\n")

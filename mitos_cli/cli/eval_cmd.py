@@ -296,18 +296,19 @@ def run_batch(rb, source: str, on_no_rule: NoRule | None = None,
         try:
             text = stream.read().decode("utf-8-sig") if stream is not None else sys.stdin.read()
         except UnicodeDecodeError as exc:
-            from ..fileio import why_unreadable
+            from ..fileio import bad_byte, why_unreadable
 
-            raise InputError(f"cannot read the batch from stdin: {why_unreadable(exc)}") \
-                from None
+            raise InputError(f"cannot read the batch from stdin: {why_unreadable(exc)}",
+                             span=bad_byte("<stdin>", exc)) from None
         name = "<stdin>"
     else:
-        from ..fileio import read_text, unreadable
+        from ..fileio import bad_byte, read_text, unreadable
 
         try:
             text, name = read_text(source), source
         except (OSError, UnicodeDecodeError) as exc:
-            raise InputError(unreadable("batch file", source, exc)) from None
+            raise InputError(unreadable("batch file", source, exc),
+                             span=bad_byte(source, exc)) from None
     batch = read_table(text, name, rb.compiled.inputs, unused_inputs(rb))
     X = batch.X
     result = rb.run(X, strict=False, detail=False)

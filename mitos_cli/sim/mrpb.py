@@ -40,7 +40,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import MitosError, Span, WorldError
-from ..fileio import unreadable
+from ..fileio import bad_byte, unreadable
 from .gridmap import INCH_PER_M, load_map_yaml
 from .loop import prepare
 from .world import Agent, Goal, Pose, Randomise, Robot, Sensors, World
@@ -64,7 +64,7 @@ def read_tests(path: Path) -> list[tuple[int, Pose, Pose]]:
     try:
         text = path.read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError) as exc:
-        raise WorldError(unreadable("MRPB tests", path, exc)) from None
+        raise WorldError(unreadable("MRPB tests", path, exc), span=bad_byte(path, exc)) from None
     out = []
     for i, line in enumerate(text.splitlines(), 1):
         if not line.strip() or line.lstrip().startswith("#"):
