@@ -267,8 +267,13 @@ def test_a_world_changed_in_python_is_checked_as_its_file_would_be(change, says)
     with pytest.raises(WorldError, match=re.escape(says)):
         gymnasium.make("mitos/World-v0", world=bad)
     assert Simulation(dataclasses.replace(world, seed=np.int64(3))).seed == 3   # an integer
+
+
 def test_a_world_built_in_python_with_a_turn_too_tight_is_refused_before_the_run():
     """`Robot(wheelbase=1e-10)` made the brake's sweep ask for 8 TiB at the first tick."""
+    import gymnasium
+
+    import mitos_cli.gym  # noqa: F401
     from mitos_cli.errors import WorldError
 
     world = short("corridor.yaml", 0.2)
@@ -277,6 +282,8 @@ def test_a_world_built_in_python_with_a_turn_too_tight_is_refused_before_the_run
     tiny = dataclasses.replace(world, agents=(agent, *world.agents[1:]))
     with pytest.raises(WorldError, match=r"its tightest turn has a radius of 5\.77e-11 in"):
         Simulation(tiny)
+    with pytest.raises(WorldError, match=r"its tightest turn has a radius of 5\.77e-11 in"):
+        gymnasium.make("mitos/World-v0", world=tiny)
 
 
 @pytest.mark.parametrize("kwargs, says", [

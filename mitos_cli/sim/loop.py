@@ -339,7 +339,6 @@ class Simulation:
     def __init__(self, world: World, planner: Planner | None = None, seed: int | None = None,
                  *, randomise: bool = False, scene: Scene | None = None) -> None:
         _check_world(world)
-        _check_turns(world)
         if planner is None:
             from .planner import FuzzyPlanner
 
@@ -1547,23 +1546,6 @@ def _check_world(world: object) -> None:
             else "load_world('worlds/corridor.yaml') reads a world file")
     raise WorldError(f"a simulation runs a loaded World, not {type(world).__name__} "
                      f"`{world!r:.60}`", hint=hint)
-
-
-def _check_turns(world: World) -> None:
-    """Each robot's tightest turn at least :data:`~.safety.TIGHTEST_TURN` wide, as the world
-    reader asks (a World built in Python with ``Robot(wheelbase=1e-10)`` made the brake's
-    sweep ask for terabytes)."""
-    for agent in world.agents:
-        radius = safety.tightest_turn(agent.robot)
-        if not radius >= safety.TIGHTEST_TURN:
-            r = agent.robot
-            raise WorldError(f"robot `{agent.name}`: its tightest turn has a radius of "
-                             f"{radius:.3g} in (wheelbase {r.wheelbase:.3g} in, steering "
-                             f"{r.steering_min:g} to {r.steering_max:g} deg, straight "
-                             f"{r.steering_straight:g}): a tricycle turns about a point at least "
-                             f"{safety.TIGHTEST_TURN:g} in from its rear axle",
-                             hint="a longer wheelbase (in inches), or a lock under 90 deg nearer "
-                                  "straight")
 
 
 def _check_planner(planner: Planner) -> Planner:

@@ -12,6 +12,7 @@ from numbers import Integral, Real
 from typing import NoReturn
 
 from ..errors import WorldError
+from .safety import TIGHTEST_TURN, tightest_turn
 from .world import REPLANS, Agent, Obstacle, World
 from .worldfile import BEYOND, LARGEST, LAYOUTS, MAX_TICKS, MODES, SHAPES
 
@@ -81,6 +82,14 @@ def _agent(c: _Fields, at: str, agent: Agent) -> None:
     if not low < straight < high:
         c.refuse(f"{at}.robot.steering_straight", straight,
                  f"between steering_min ({low:g}) and steering_max ({high:g})")
+    radius = tightest_turn(r)
+    if not radius >= TIGHTEST_TURN:   # (the brake's sweep asked for terabytes at 1e-10 in)
+        raise WorldError(f"world `{c.world}`: robot `{agent.name}`: its tightest turn has a "
+                         f"radius of {radius:.3g} in (wheelbase {r.wheelbase:.3g} in, steering "
+                         f"{low:g} to {high:g} deg, straight {straight:g}): a tricycle turns "
+                         f"about a point at least {TIGHTEST_TURN:g} in from its rear axle",
+                         hint="a longer wheelbase (in inches), or a lock under 90 deg nearer "
+                              "straight")
     c.number(f"{at}.robot.max_steering_rate", r.max_steering_rate, positive=True)
     c.number(f"{at}.robot.max_speed", r.max_speed, positive=True)
     c.number(f"{at}.robot.acceleration", r.acceleration, positive=True)
