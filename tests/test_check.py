@@ -178,6 +178,22 @@ def test_unused_terms_and_gaps(flawed):
     assert by_code(report, "unconcluded-term") == []
 
 
+def test_the_unconcluded_terms_named_are_capped(tmp_path):
+    """A fuzzed FLL output of 20,000 terms, one concluded: the note named the other 19,999 on
+    one line (220 KB). It names the first ten and counts the others."""
+    values = ", ".join(f"V{i}: {i}" for i in range(25))
+    (tmp_path / "t.terms.yaml").write_text(
+        "variables:\n  x: {role: input, universe: [0, 1], terms: {LO: {shape: left_shoulder, "
+        "points: [0, 1]}, HI: {shape: right_shoulder, points: [0, 1]}}}\n"
+        f"  y: {{role: output, universe: [0, 24], terms: {{{values}}}}}\n", encoding="utf-8")
+    (tmp_path / "t.rules").write_text('terms "t.terms.yaml"\nbehavior b:\n'
+                                      "  if x is LO then y is V0\n  if x is HI then y is V24\n"
+                                      "end\n", encoding="utf-8")
+    (note,) = by_code(check_rulebase(read_rulebase(tmp_path / "t.rules")), "unconcluded-term")
+    assert note.message == ("output `y`: no rule concludes V1, V2, V3, V4, V5, V6, V7, V8, V9, "
+                            "V10 and 13 more")
+
+
 def test_term_gap_over_a_range(tmp_path):
     terms = TERMS.replace("[10, 40]", "[10, 20]").replace("[40, 70]", "[50, 70]")
     (tmp_path / "t.terms.yaml").write_text(terms, encoding="utf-8")

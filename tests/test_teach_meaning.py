@@ -570,6 +570,64 @@ def test_many_terms_are_measured_in_memory_proportional_to_them():
     assert grown < 500_000                                                   # was gigabytes
 
 
+def _old_most(mu: np.ndarray, x: np.ndarray) -> tuple[float, int, int]:
+    """The most similar pair as `mitos check` found it before 2026-12-05: the whole [t, t]
+    matrix, its diagonal set to -1, the first largest in reading order."""
+    s = _cube(mu, x)
+    np.fill_diagonal(s, -1.0)
+    i, j = np.unravel_index(int(np.argmax(s)), s.shape)
+    return float(s[i, j]), int(i), int(j)
+
+
+@settings(max_examples=300, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), t=st.integers(1, 14), n=st.integers(2, 80),
+       narrow=st.booleans(), repeats=st.integers(0, 4), zeros=st.integers(0, 2))
+def test_the_most_similar_pair_is_the_one_the_whole_matrix_gave(seed, t, n, narrow, repeats,
+                                                                  zeros):
+    """Measuring only pairs whose supports overlap, and repeated terms once, finds the same
+    pair with the same bits as the whole matrix did: ties, terms 0 everywhere, -0.0, terms
+    that all overlap or none."""
+    rng = np.random.default_rng(seed)
+    x = np.unique(rng.uniform(0, 10, n))
+    mu = np.clip(rng.normal(0.2, 0.5, (t, len(x))), 0.0, 1.0)
+    if narrow:                                             # supports of a few points
+        for row in mu:
+            a = int(rng.integers(0, len(x)))
+            row[:a] = 0.0
+            row[a + int(rng.integers(0, 4)):] = 0.0
+    for _ in range(zeros):
+        mu[rng.integers(t)] = -0.0 if rng.random() < 0.5 else 0.0
+    for _ in range(repeats):
+        mu[rng.integers(t)] = mu[rng.integers(t)]
+    old, new = _old_most(mu, x), meaning.most_similar_on(mu, x)
+    assert new[1:] == old[1:] and np.float64(new[0]).view(np.int64) == \
+        np.float64(old[0]).view(np.int64)
+
+
+def test_a_variable_of_20000_terms_is_checked_in_memory_proportional_to_them():
+    """The fuzz pass of 2026-12-05: an FLL output with 20,000 terms took 6.6 GB and 85 s in
+    `mitos check` (the [t, t] matrix of similarities, twice), or a MemoryError. Its terms
+    as memberships on the samples are 160 MB; the check now needs little more."""
+    import time
+    import tracemalloc
+
+    from mitos_cli.lang.terms import Term, Variable
+
+    terms = tuple(Term(f"L{i}", "gaussian", ((i % 200) / 200, 0.001 if i % 2 else 0.2))
+                  for i in range(20_000))
+    var = Variable("y", "output", (0.0, 1.0), terms)
+    tracemalloc.start()
+    start = time.process_time()
+    try:
+        found = meaning.variable_issues(var)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert time.process_time() - start < 30
+    assert peak < 400e6                                    # was over 6 GB
+    assert {(f.code, f.terms) for f in found} >= {("indistinct", ("L0", "L200"))}
+
+
 def test_coverage_is_kept_per_stretch_of_the_universe():
     """Where the written terms cover to 0.5 they must keep doing so, and a stretch covered less
     keeps its written least; one bound for the universe was 0 once any gap was written."""

@@ -511,6 +511,17 @@ def listed_names(names: tuple[str, ...] | list[str], most: int = 4) -> str:
     return shown[0] if len(shown) == 1 else ", ".join(shown[:-1]) + " and " + shown[-1]
 
 
+#: Terms one ``unconcluded-term`` note names; more are counted.
+SHOWN_TERMS = 10
+
+
+def _first_names(names: list[str]) -> str:
+    """``A, B, C`` or ``A, B, ... J and 19,990 more`` (the note named all 20,000 terms of a
+    fuzzed FLL file on one line)."""
+    more = len(names) - SHOWN_TERMS
+    return ", ".join(names[:SHOWN_TERMS]) + (f" and {more:,} more" if more > 0 else "")
+
+
 def _sampled(compiled: CompiledRuleBase, threshold: float,
              resolution: int) -> tuple[list[Finding], GridInfo]:
     every = list(range(len(compiled.inputs)))
@@ -808,7 +819,7 @@ def _unused_terms(rb: RuleBase, scope: set[str] | None = None) -> list[Finding]:
             if unconcluded and var.name in set_by_rules:
                 out.append(Finding("info", "unconcluded-term",
                                    f"output `{var.name}`: no rule concludes "
-                                   + ", ".join(unconcluded), var.span, None))
+                                   + _first_names(unconcluded), var.span, None))
             elif var.name not in set_by_rules:
                 out.append(Finding("warning", "unused-term",
                                    f"output `{var.name}` is set by no rule", var.span, None,
