@@ -75,6 +75,24 @@ def test_a_writer_refusing_a_term_gives_the_terms_position(tmp_path) -> None:
     assert str(info.value.span) == f"{path}:{line}:2"
 
 
+@pytest.mark.parametrize("to, words", [("fis", "MATLAB has no `formula` membership function"),
+                                       ("fcl", "FCL has no formula terms")])
+def test_a_formula_term_is_refused_at_its_place_by_both_writers(to: str, words: str) -> None:
+    """`--to fis` gave the formula term's `check_formula_input.fll:6:21` and source line;
+    `--to fcl` refused the same term with neither."""
+    from pathlib import Path
+
+    from mitos_cli.api import read_rulebase
+    from mitos_cli.interop import write_foreign
+
+    path = Path(__file__).parent / "data" / "interop" / "check_formula_input.fll"
+    with pytest.raises(MitosError) as info:
+        write_foreign(read_rulebase(path), to)
+    assert words in info.value.message
+    assert str(info.value.span) == f"{path}:6:21"
+    assert "term: lo Function 1 - x" in info.value.render()
+
+
 def test_a_writer_refusing_an_operator_points_at_the_operators_line(tmp_path):
     from pathlib import Path
 

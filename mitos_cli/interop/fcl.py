@@ -668,7 +668,7 @@ def _defuzzify(rb: RuleBase, v: Variable, ops, inputs: Sequence[Variable], at,
 def _term_text(t: Term, v: Variable) -> str:
     if t.formula is not None:
         raise FormatError(f"term `{v.name}.{t.name}`: FCL has no formula terms (fuzzylite's "
-                          f"`Function`); write it to FLL or a term set")
+                          f"`Function`); write it to FLL or a term set", span=t.span)
     if t.shape == "singleton":
         return fmt_number(t.params[0])
     if t.shape == "clipped_sigmoid_difference":          # jFuzzyLogic's DSIGM g1 c1 g2 c2
