@@ -371,12 +371,34 @@ def test_a_bad_world_in_a_lesson_is_reported_in_the_world_file(work):
 def test_a_block_left_open_is_said_and_a_binary_lesson_is_placed(work):
     res = mitos("teach", "rb/mitos.rules", "--lesson", "-", cwd=work,
                 stdin="behavior b1\nif road is NARROW then speed is SLOW\n")
-    assert res.returncode == 0 and "behavior `b1` still open" in res.stderr
+    assert res.returncode == 0 and "<stdin>:1:1: warning: the lesson ended with behavior `b1` " \
+        "still open" in res.stderr
     res = mitos("teach", "--resume", "--lesson", "-", cwd=work, stdin="end\n")
     assert "behavior `b1` is still open (`end` closes it)" in res.stderr
     (work / "garbage.lesson").write_bytes(b"use drive\n\xaf\xfe junk\n")
     res = mitos("teach", "rb/mitos.rules", "--lesson", "garbage.lesson", cwd=work)
     assert res.returncode == 1 and res.stderr.startswith("garbage.lesson:2:1: lesson error: ")
+
+
+def test_a_block_left_open_with_save_as_is_an_error_where_it_was_opened(work):
+    """With `--save-as` the lesson's save cannot be made: exit 1, as without it the lesson
+    ends with a warning (the session keeps the behavior open). The error had no position;
+    it is at the line that opened the behavior, or at the lesson's end when a resumed
+    session had it open already."""
+    (work / "open.lesson").write_text("# careful driving\nbehavior careful:\n"
+                                      "    if road is NARROW then speed is SLOW\n")
+    res = mitos("teach", "rb/mitos.rules", "--lesson", "open.lesson", "-o", "out/t.rules",
+                cwd=work)
+    assert res.returncode == 1 and not (work / "out").exists()
+    assert "open.lesson:2:1: lesson error: the lesson ended with behavior `careful` still " \
+           "open, so it cannot be saved to out/t.rules\n    behavior careful:\n" in res.stderr
+    assert "warning" not in res.stderr
+    res = mitos("teach", "--resume", "--lesson", "-", "-o", "out/t.rules", cwd=work,
+                stdin="show behaviors\n")
+    assert res.returncode == 1 and "<stdin>:1:15: lesson error: the lesson ended" in res.stderr
+    res = mitos("teach", "--resume", "--lesson", "-", "-o", "out/t.rules", cwd=work,
+                stdin="end\n")
+    assert res.returncode == 0 and (work / "out" / "t.rules").exists()
 
 
 def test_save_as_is_refused_before_the_session_when_a_term_set_there_is_not_its_own(work):

@@ -189,6 +189,26 @@ def _new_session(rules, behavior, lesson, save_as, out):
     return session, lesson_text
 
 
+def _ended_open(session, text: str, name: str) -> None:
+    """A lesson that ends with a behavior still open, told at the line that opened it (or at
+    the lesson's end, when it was open before): a warning, since the session keeps it open
+    for ``--resume`` to close; with ``--save-as`` an error, since the save asked for cannot be
+    made (a behavior half told is not saved)."""
+    from ..errors import LessonError
+    from ..teach.lesson import lesson_end
+    from .output import err
+
+    where = session.opened_at or lesson_end(text, name)
+    resume = f"mitos teach --resume --session {session.journal.directory.name}"
+    if session.save_as is not None:
+        raise LessonError(f"the lesson ended with behavior `{session.state.block}` still open, "
+                          f"so it cannot be saved to {session.save_as}", span=where,
+                          hint=f"close it with `end` in the lesson, or continue the session "
+                               f"(`{resume}`): every change is in its journal")
+    err(f"{where}: warning: the lesson ended with behavior `{session.state.block}` still open; "
+        f"`end` closes it (`{resume}`)")
+
+
 def _teach_lesson(session, lesson: str, lesson_text, transcript: Transcript | None) -> None:
     """Run a lesson file (or stdin) in ``session``; save where ``--save-as`` says if it ends
     with changes unsaved. Ctrl-C keeps every change (the journal has them)."""
@@ -207,8 +227,7 @@ def _teach_lesson(session, lesson: str, lesson_text, transcript: Transcript | No
             f"--session {directory.name}` continues")
         raise typer.Exit(130) from None
     if session.state.block is not None:
-        err(f"warning: the lesson ended with behavior `{session.state.block}` still open; "
-            f"`end` closes it (`mitos teach --resume --session {directory.name}`)")
+        _ended_open(session, text, name)
     if session.save_as is not None and session.unsaved:
         if transcript is not None:
             transcript.command("save (the lesson ended with unsaved changes)")

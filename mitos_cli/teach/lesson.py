@@ -41,11 +41,15 @@ def run_lesson(session: Session, text: str, path: str) -> bool:
     for lineno, line in commands(text):
         session.echo(f"{path}:{lineno}> {visible(line.splitlines()[0])}")
         session.interrupted = False
+        was_open = session.state.block
         try:
             if not session.run(line, path, lineno):
                 return False
             if session.interrupted:         # Ctrl-C in an `adapt`: what it learned is kept
                 raise KeyboardInterrupt     # (journaled); the rest of the lesson is not run
+            if session.state.block != was_open:     # where it opened, for the lesson's end
+                session.opened_at = None if session.state.block is None else Span.in_text(
+                    "\n" * (lineno - 1) + line, path, lineno, len(line) - len(line.lstrip()) + 1)
         except MitosError as exc:
             if isinstance(exc, WorldError) and exc.span is not None \
                     and exc.span.path not in (None, "<prompt>", path):
@@ -61,6 +65,12 @@ def run_lesson(session: Session, text: str, path: str) -> bool:
                 exc.span = where
             raise
     return True
+
+
+def lesson_end(text: str, path: str) -> Span:
+    """Just after the last character of the lesson (where a missing ``end`` would go)."""
+    lines = text.splitlines() or [""]
+    return Span.in_text(text, path, len(lines), len(lines[-1]) + 1)
 
 
 def read_lesson(source: str) -> tuple[str, str]:

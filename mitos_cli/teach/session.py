@@ -165,6 +165,7 @@ class Session:
         self.base: Path | None = None       # where a lesson's relative world paths start
         self.saved_seq = 0
         self.interrupted = False            # the last command's adaptation was cut short
+        self.opened_at: Span | None = None  # where a lesson opened the behavior still open
         self.state = State(self.original, active)
         self._indexes: dict[str, _RuleIndex] = {}
         if not self.journal.entries:
