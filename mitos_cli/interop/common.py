@@ -796,8 +796,10 @@ def legal_names(rb: RuleBase, fmt: str) -> tuple[RuleBase, list[str]]:
     reserved = RESERVED_NAMES.get(fmt, set())
 
     def legal(name: str, taken: set[str]) -> str:
+        """``name``, or a legal one none of ``taken`` (but ``name``) has."""
         if pattern.fullmatch(name) and name.lower() not in reserved:
             return name
+        taken = taken - {name}      # only here: a copy per name was quadratic in the terms
         new = re.sub(r"[^A-Za-z0-9_]", "_", name) if fmt != "fis" else name.replace("'", "_")
         if not new or not (new[0].isalpha() or new[0] == "_") and fmt != "fis":
             new = "_" + new
@@ -811,7 +813,7 @@ def legal_names(rb: RuleBase, fmt: str) -> tuple[RuleBase, list[str]]:
     all_vars = [v for ts in rb.termsets for v in ts.variables]
     taken_vars = {v.name for v in all_vars}
     for v in all_vars:
-        new = legal(v.name, taken_vars - {v.name})
+        new = legal(v.name, taken_vars)
         if new != v.name:
             var_map[v.name] = new
             taken_vars.add(new)
@@ -819,7 +821,7 @@ def legal_names(rb: RuleBase, fmt: str) -> tuple[RuleBase, list[str]]:
                          f"cannot name it `{v.name}`)")
         taken_terms = set(v.term_names)
         for t in v.terms:
-            new_t = legal(t.name, taken_terms - {t.name})
+            new_t = legal(t.name, taken_terms)
             if new_t != t.name:
                 term_map[(v.name, t.name)] = new_t
                 taken_terms.add(new_t)
