@@ -628,6 +628,58 @@ def test_a_variable_of_20000_terms_is_checked_in_memory_proportional_to_them():
     assert {(f.code, f.terms) for f in found} >= {("indistinct", ("L0", "L200"))}
 
 
+def _every_crossing(corners: np.ndarray, universe: tuple[float, float]) -> np.ndarray:
+    """The breakpoints as they were before 2026-12-05: the lines of every two sloped edges
+    crossed, whether the edges overlap or not."""
+    lo, hi = universe
+    a, b, c, d = corners.T
+    rise = np.isfinite(a) & np.isfinite(b) & (b > a)
+    fall = np.isfinite(c) & np.isfinite(d) & (d > c)
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+        slope = np.concatenate([1.0 / (b[rise] - a[rise]), -1.0 / (d[fall] - c[fall])])
+        offset = np.concatenate([-a[rise] / (b[rise] - a[rise]), d[fall] / (d[fall] - c[fall])])
+        cross = (offset[None, :] - offset[:, None]) / (slope[:, None] - slope[None, :])
+    x = np.concatenate([[lo, hi], corners[np.isfinite(corners)], cross.ravel()])
+    return np.unique(x[np.isfinite(x) & (x >= lo) & (x <= hi)])
+
+
+@settings(max_examples=300, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), t=st.integers(1, 10), whole=st.booleans())
+def test_only_overlapping_edges_are_crossed(seed, t, whole):
+    """Two edges cross only where both are: the breakpoints of overlapping edges alone are
+    some of the old ones, and measure every pair and the coverage as all of them did (to
+    rounding: the trapezoids are cut at fewer points)."""
+    rng = np.random.default_rng(seed)
+    universe = (0.0, 10.0)
+    corners = np.sort(rng.uniform(0, 10, (t, 4)), axis=1)
+    corners[rng.integers(t), :2] = -np.inf
+    corners[rng.integers(t), 2:] = np.inf
+    if whole:                                              # ties: edges meeting at corners
+        corners = np.round(corners)
+        # no edge standing upright inside the universe: it is measured there on the points
+        # beside it, which both sets of breakpoints leave to chance
+        upright = np.isfinite(corners[:, 0]) & (corners[:, 0] == corners[:, 1])
+        corners[upright & (corners[:, 0] > 0), 0] -= 0.5
+        upright = np.isfinite(corners[:, 3]) & (corners[:, 2] == corners[:, 3])
+        corners[upright & (corners[:, 3] < 10), 3] += 0.5
+    x, every = meaning.breakpoints(corners, universe), _every_crossing(corners, universe)
+    assert np.isin(x, every).all()
+    mu, old = meaning.memberships(corners, x), meaning.memberships(corners, every)
+    np.testing.assert_allclose(meaning.similarity_on(mu, x), meaning.similarity_on(old, every),
+                               atol=1e-12)
+    assert mu.max(axis=0).min() == pytest.approx(old.max(axis=0).min(), abs=1e-12)
+
+
+def test_many_triangles_have_breakpoints_in_proportion():
+    """2,000 triangles in one FLL variable took 23 GB in `mitos check`: the lines of every two
+    edges crossed gave millions of points, each a column of the memberships."""
+    rng = np.random.default_rng(20261205)
+    peaks = np.sort(rng.uniform(0, 1, 1000))
+    width = rng.uniform(0.001, 0.003, 1000)
+    triangles = np.stack([peaks - width, peaks, peaks, peaks + width], axis=1)
+    assert len(meaning.breakpoints(triangles, (-1.0, 2.0))) < 10 * len(triangles)
+
+
 def test_coverage_is_kept_per_stretch_of_the_universe():
     """Where the written terms cover to 0.5 they must keep doing so, and a stretch covered less
     keeps its written least; one bound for the universe was 0 once any gap was written."""

@@ -99,7 +99,10 @@ def memberships(corners: np.ndarray, x: np.ndarray) -> np.ndarray:
 
 def breakpoints(corners: np.ndarray, universe: tuple[float, float]) -> np.ndarray:
     """Every point of the universe where the min or max of two of these piecewise-linear
-    terms can bend: its ends, the corners and where two sloped edges cross (sorted)."""
+    terms can bend: its ends, the corners and where two sloped edges cross (sorted). Two
+    edges cross only where both are, so only edges whose stretches overlap are crossed
+    (found in order of where they begin): the lines of every two edges, crossed, gave up to
+    (2 t)^2 points, each a column of the memberships (2,000 triangles took 23 GB)."""
     lo, hi = universe
     a, b, c, d = corners.T
     rise = np.isfinite(a) & np.isfinite(b) & (b > a)
@@ -109,9 +112,23 @@ def breakpoints(corners: np.ndarray, universe: tuple[float, float]) -> np.ndarra
     with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
         slope = np.concatenate([1.0 / (b[rise] - a[rise]), -1.0 / (d[fall] - c[fall])])
         offset = np.concatenate([-a[rise] / (b[rise] - a[rise]), d[fall] / (d[fall] - c[fall])])
-        cross = (offset[None, :] - offset[:, None]) / (slope[:, None] - slope[None, :])
-    x = np.concatenate([[lo, hi], corners[np.isfinite(corners)], cross.ravel()])
+        i, j = _overlapping(np.concatenate([a[rise], c[fall]]),
+                            np.concatenate([b[rise], d[fall]]))
+        cross = (offset[j] - offset[i]) / (slope[i] - slope[j])
+    x = np.concatenate([[lo, hi], corners[np.isfinite(corners)], cross])
     return np.unique(x[np.isfinite(x) & (x >= lo) & (x <= hi)])
+
+
+def _overlapping(left: np.ndarray, right: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Every pair ``(i, j)``, ``i != j``, of the stretches ``[left, right]`` that overlap
+    (touching counts), each once."""
+    order = np.argsort(left, kind="stable")
+    # the stretches beginning after i's and by its right end: i + 1 ... last[i] - 1 in order
+    last = np.searchsorted(left[order], right[order], side="right")
+    count = np.maximum(last - np.arange(len(order)) - 1, 0)
+    i = np.repeat(np.arange(len(order)), count)
+    j = i + 1 + np.arange(len(i)) - np.repeat(np.cumsum(count) - count, count)
+    return order[i], order[j]
 
 
 def coverage(corners: np.ndarray, universe: tuple[float, float],
