@@ -137,13 +137,29 @@ def coverage(corners: np.ndarray, universe: tuple[float, float],
     envelope of piecewise-linear functions is smallest at one of its :func:`breakpoints`.
     ``besides_gaps``: the least above 0 (where no term is above 0 is a gap, reported apart)."""
     x = breakpoints(corners, universe)
-    return coverage_on(memberships(corners, x), x, universe, besides_gaps)
+    return least_top(envelope(corners, x), x, universe, besides_gaps)
 
 
 def coverage_on(mu: np.ndarray, x: np.ndarray, universe: tuple[float, float],
                 besides_gaps: bool = False) -> tuple[float, float]:
     """:func:`coverage` from the memberships ``mu[t, n]`` at the points ``x[n]``."""
-    top = mu.max(axis=0)
+    return least_top(mu.max(axis=0), x, universe, besides_gaps)
+
+
+def envelope(corners: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """The largest membership of these piecewise-linear terms at each point of ``x``, a
+    block of terms at a time (all at once is terms times points: quadratic in the terms,
+    which have about four breakpoints each)."""
+    step = max(1, PAIR_BLOCK // max(1, len(x)))
+    top = memberships(corners[:step], x).max(axis=0)
+    for i in range(step, len(corners), step):
+        np.maximum(top, memberships(corners[i:i + step], x).max(axis=0), out=top)
+    return top
+
+
+def least_top(top: np.ndarray, x: np.ndarray, universe: tuple[float, float],
+              besides_gaps: bool = False) -> tuple[float, float]:
+    """:func:`coverage` from the largest membership ``top[n]`` at the points ``x[n]``."""
     if besides_gaps:
         x, top = x[top > 0], top[top > 0]
         if not len(top):
@@ -174,7 +190,7 @@ def coverage_spans(corners: np.ndarray, universe: tuple[float, float]
         return np.array([lo, hi], dtype=float), np.array([span_coverage(
             corners, universe, np.array([lo, hi], dtype=float))[0]])
     mid = 0.5 * (x[:-1] + x[1:])
-    covered = memberships(corners, mid).max(axis=0) >= COVERAGE - 1e-12
+    covered = envelope(corners, mid) >= COVERAGE - 1e-12
     cut = np.flatnonzero(covered[1:] != covered[:-1]) + 1
     ends = np.concatenate([[x[0]], x[cut], [x[-1]]]).astype(float)
     least = span_coverage(corners, universe, ends)
@@ -218,10 +234,10 @@ def span_coverage(corners: np.ndarray, universe: tuple[float, float],
     beside it: ``[0, 0, 3, 3]`` and ``[7, 7, 10, 10]`` leave (3, 7) uncovered although both
     are 1 at 3 and at 7)."""
     x = np.union1d(breakpoints(corners, universe), ends)
-    top = memberships(corners, x).max(axis=0)
+    top = envelope(corners, x)
     width = np.diff(x)
-    m1 = memberships(corners, x[:-1] + width / 3).max(axis=0)
-    m2 = memberships(corners, x[:-1] + 2 * width / 3).max(axis=0)
+    m1 = envelope(corners, x[:-1] + width / 3)
+    m2 = envelope(corners, x[:-1] + 2 * width / 3)
     piece = np.clip(np.minimum(2 * m1 - m2, 2 * m2 - m1), 0.0, 1.0)   # the line's ends
     first = np.searchsorted(x, ends[:-1])
     last = np.searchsorted(x, ends[1:])
@@ -266,9 +282,9 @@ def similarity_on(mu: np.ndarray, x: np.ndarray) -> np.ndarray:
     return out
 
 
-#: Most memberships of term pairs :func:`most_similar_on` forms at once (pairs times points):
-#: 16 MB of minima and as much of maxima, whatever the number of terms.
-PAIR_BLOCK = 1 << 21
+#: Most memberships :func:`most_similar_on` and :func:`envelope` form in one array (terms or
+#: pairs times points): 8 MB, a few such arrays at once, whatever the number of terms.
+PAIR_BLOCK = 1 << 20
 
 
 def most_similar_on(mu: np.ndarray, x: np.ndarray) -> tuple[float, int, int]:
@@ -283,9 +299,35 @@ def most_similar_on(mu: np.ndarray, x: np.ndarray) -> tuple[float, int, int]:
     distinct, which, counts = _distinct_rows(mu)
     above = distinct > 0
     some = above.any(axis=1)
-    start = np.where(some, above.argmax(axis=1), -1)
+    start = np.where(some, above.argmax(axis=1), 0)
     end = np.where(some, distinct.shape[1] - 1 - above[:, ::-1].argmax(axis=1), -1)
-    best = np.zeros(len(distinct))          # each row's largest: 0 for a term beside any other
+    return _most_similar(lambda k: distinct[k], x, which, counts, start, end)
+
+
+def most_similar(corners: np.ndarray, universe: tuple[float, float]) -> tuple[float, int, int]:
+    """The largest similarity of two different piecewise-linear terms and which two, as
+    :func:`most_similar_on` on their memberships at the :func:`breakpoints`, without forming
+    those memberships: a term's row only when measured (t terms have about 4 t breakpoints,
+    so all the rows at once are quadratic in the terms: 20,000 triangles, 10 GB)."""
+    return _linear_most(corners, breakpoints(corners, universe))
+
+
+def _linear_most(corners: np.ndarray, x: np.ndarray) -> tuple[float, int, int]:
+    """:func:`most_similar` at the points ``x``."""
+    distinct, which, counts = _distinct_rows(corners)
+    # the points from the term's left corner to its right one: all where it is above 0
+    start = np.searchsorted(x, distinct[:, 0], side="left")
+    end = np.searchsorted(x, distinct[:, 3], side="right") - 1
+    return _most_similar(lambda k: memberships(distinct[k], x), x, which, counts, start, end)
+
+
+def _most_similar(rows, x: np.ndarray, which: np.ndarray, counts: np.ndarray, start: np.ndarray,
+                  end: np.ndarray) -> tuple[float, int, int]:
+    """:func:`most_similar_on` of the terms ``which`` (indices of distinct terms, each
+    occurring ``counts`` times), whose memberships ``rows(k)`` gives for distinct terms ``k``
+    and are 0 outside the points ``start`` ... ``end`` (an empty stretch: ``end < start``)."""
+    some = start <= end
+    best = np.zeros(len(counts))            # each row's largest: 0 for a term beside any other
     order = np.flatnonzero(some)[np.argsort(start[some], kind="stable")]
     starts = start[order]
     ks: list[np.ndarray] = []
@@ -294,17 +336,17 @@ def most_similar_on(mu: np.ndarray, x: np.ndarray) -> tuple[float, int, int]:
         v = order[p + int(counts[k] < 2):int(np.searchsorted(starts, end[k], side="right"))]
         ks.append(np.full(len(v), k))
         vs.append(v)
-        if sum(map(len, vs)) * distinct.shape[1] >= PAIR_BLOCK or p == len(order) - 1:
+        if sum(map(len, vs)) * len(x) >= PAIR_BLOCK or p == len(order) - 1:
             k_, v_ = np.concatenate(ks), np.concatenate(vs)
-            s = _pair_similarity(distinct, x, k_, v_)
+            s = _pair_similarity(rows, x, k_, v_)
             np.maximum.at(best, k_, s)
             np.maximum.at(best, v_, s)
             ks, vs = [], []
     r = int(np.argmax(best[which]))         # the first row holding the largest
     k = which[r]
     near = np.flatnonzero(some & (start <= end[k]) & (end >= start[k]))
-    row = np.zeros(len(distinct))
-    row[near] = _pair_similarity(distinct, x, np.full(len(near), k), near)
+    row = np.zeros(len(counts))
+    row[near] = _pair_similarity(rows, x, np.full(len(near), k), near)
     full = row[which]
     full[r] = -1.0
     j = int(np.argmax(full))
@@ -323,8 +365,8 @@ def _distinct_rows(mu: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return mu[first], which, np.bincount(which, minlength=len(seen))
 
 
-def _pair_similarity(mu: np.ndarray, x: np.ndarray, k: np.ndarray, v: np.ndarray) -> np.ndarray:
-    """The similarity of the terms ``mu[k[p]]`` and ``mu[v[p]]`` for each pair ``p`` as
+def _pair_similarity(rows, x: np.ndarray, k: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """The similarity of the terms ``rows(k[p])`` and ``rows(v[p])`` for each pair ``p`` as
     :func:`similarity_on` forms it (0 for two terms never both above 0), in blocks of
     :data:`PAIR_BLOCK` memberships."""
     dx = np.diff(x)
@@ -333,9 +375,9 @@ def _pair_similarity(mu: np.ndarray, x: np.ndarray, k: np.ndarray, v: np.ndarray
         return ((m[..., 1:] + m[..., :-1]) * 0.5 * dx).sum(axis=-1)
 
     out = np.zeros(len(k))
-    step = max(1, PAIR_BLOCK // mu.shape[1])
+    step = max(1, PAIR_BLOCK // max(1, len(x)))
     for i in range(0, len(k), step):
-        a, b = mu[k[i:i + step]], mu[v[i:i + step]]
+        a, b = rows(k[i:i + step]), rows(v[i:i + step])
         inter, union = area(np.minimum(a, b)), area(np.maximum(a, b))
         meets = ((a > 0) & (b > 0)).any(axis=1)
         out[i:i + step] = np.divide(inter, union, out=np.zeros_like(inter),
@@ -367,18 +409,6 @@ def measures(corners: np.ndarray, universe: tuple[float, float]) -> tuple[float,
     sim = np.divide(inter, union, out=np.zeros_like(inter), where=union > 0)
     np.fill_diagonal(sim, -1.0)
     return cover, float(sim.max())
-
-
-def most_similar(corners: np.ndarray, universe: tuple[float, float]) -> tuple[float, int, int]:
-    """The largest similarity of two different terms and which two."""
-    return _most(similarity(corners, universe))
-
-
-def _most(s: np.ndarray) -> tuple[float, int, int]:
-    s = s.copy()
-    np.fill_diagonal(s, -1.0)
-    i, j = np.unravel_index(int(np.argmax(s)), s.shape)
-    return float(s[i, j]), int(i), int(j)
 
 
 # ---- terms of any shape, on samples -------------------------------------------------------------
@@ -507,21 +537,22 @@ def variable_issues(var: Variable) -> list[Issue]:
         if all(learnable(t) for t in sets):                     # exact
             corners = np.array([t.corners for t in sets], dtype=float)
             x = breakpoints(corners, var.universe)
-            mu = memberships(corners, x)
+            top = envelope(corners, x)          # never every term's memberships at once
         else:                                                   # any shape: on samples
             corners = None
             x = sample_points(sets, var.universe)
             mu = sampled(sets, x)
+            top = mu.max(axis=0)
         if var.role == "input":
-            low, where = coverage_on(mu, x, var.universe, besides_gaps=True)   # see term-gap
+            low, where = least_top(top, x, var.universe, besides_gaps=True)   # see term-gap
             if low < COVERAGE - 1e-9 or _dips_beside_gaps(sets, corners, x):
-                spans = (uncovered_on(mu.max(axis=0), x) if corners is None
+                spans = (uncovered_on(top, x) if corners is None
                          else uncovered(corners, var.universe))
                 out.append(Issue("coverage", var.name, (), _coverage_message(
-                    var, low, where, spans, gaps=bool(np.any(mu.max(axis=0) <= 0.0))),
+                    var, low, where, spans, gaps=bool(np.any(top <= 0.0))),
                     "widen the neighbouring terms so that they overlap there"))
         if len(sets) >= 2:
-            s, i, j = most_similar_on(mu, x)
+            s, i, j = most_similar_on(mu, x) if corners is None else _linear_most(corners, x)
             if s > SIMILARITY + 1e-9:
                 out.append(Issue("indistinct", var.name, (sets[i].name, sets[j].name), (
                     f"`{var.name}.{sets[i].name}` and `{sets[j].name}` are hard to tell apart "
@@ -547,7 +578,7 @@ def _dips_beside_gaps(sets: list[Term], corners: np.ndarray | None, x: np.ndarra
     them, so a dip shows at one of those thirds."""
     width = np.diff(x)
     at = np.concatenate([x, x[:-1] + width / 3, x[:-1] + 2 * width / 3])
-    top = (memberships(corners, at) if corners is not None else sampled(sets, at)).max(axis=0)
+    top = envelope(corners, at) if corners is not None else sampled(sets, at).max(axis=0)
     return bool(np.any((top > 0.0) & (top < COVERAGE - 1e-9)))
 
 
@@ -683,7 +714,7 @@ def rulebase_issues(variables) -> list[Issue]:
 
 
 __all__ = ["COVERAGE", "DISTINCT", "GAP_HINT", "GAP_RESOLUTION", "RESOLUTION", "SIMILARITY",
-           "Issue", "centre", "core", "coverage", "coverage_on", "coverage_spans",
+           "Issue", "centre", "core", "coverage", "coverage_on", "envelope", "least_top", "coverage_spans",
            "gap_message", "gap_points", "gaps_on", "held_term", "memberships", "mirror_point",
            "most_similar", "most_similar_on", "rulebase_issues", "sample_points", "sampled", "similarity",
            "similarity_on", "span_coverage", "term_gaps", "uncovered", "uncovered_on",
