@@ -713,9 +713,9 @@ def rulebase_issues(variables) -> list[Issue]:
     return [i for v in variables for i in variable_issues(v)]
 
 
-__all__ = ["COVERAGE", "DISTINCT", "GAP_HINT", "GAP_RESOLUTION", "RESOLUTION", "SIMILARITY",
-           "Issue", "centre", "core", "coverage", "coverage_on", "envelope", "least_top", "coverage_spans",
-           "gap_message", "gap_points", "gaps_on", "held_term", "memberships", "mirror_point",
-           "most_similar", "most_similar_on", "rulebase_issues", "sample_points", "sampled", "similarity",
-           "similarity_on", "span_coverage", "term_gaps", "uncovered", "uncovered_on",
-           "variable_issues"]
+__all__ = ["COVERAGE", "DISTINCT", "GAP_HINT", "GAP_RESOLUTION", "PAIR_BLOCK", "RESOLUTION",
+           "SIMILARITY", "Issue", "centre", "core", "coverage", "coverage_on", "coverage_spans",
+           "envelope", "gap_message", "gap_points", "gaps_on", "held_term", "least_top",
+           "memberships", "mirror_point", "most_similar", "most_similar_on", "rulebase_issues",
+           "sample_points", "sampled", "similarity", "similarity_on", "span_coverage",
+           "term_gaps", "uncovered", "uncovered_on", "variable_issues"]
