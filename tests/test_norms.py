@@ -124,8 +124,11 @@ def test_de_morgan_on_exact_grid(tnorm, snorm, a, b):
                               if t.name not in DISCONTINUOUS])
 @FAST
 @given(a=unit, b=unit)
+@example(a=0.9999920678048861, b=0.9999920678048861)    # 3.1e-12 apart: the division by 1 - ab
 def test_de_morgan_on_floats(tnorm, snorm, a, b):
-    assert call(snorm, a, b) == pytest.approx(1.0 - call(tnorm, 1.0 - a, 1.0 - b), abs=TOL)
+    slack = _amplified(snorm, a, b, 0.0)   # (c = 0: S(., 0) is exact, adds no pair of its own)
+    assert call(snorm, a, b) == pytest.approx(1.0 - call(tnorm, 1.0 - a, 1.0 - b),
+                                              abs=TOL + slack)
 
 
 @pytest.mark.parametrize("norm", ALL, ids=IDS)
