@@ -270,3 +270,16 @@ def test_rule_viewer_row_labels_fit_a_narrow_figure(tmp_path, weight):
     assert len(labels) == 2
     for t in labels:
         assert t.get_window_extent(renderer).x0 >= 0, t.get_text()
+
+
+def test_every_panel_title_of_the_packaged_sheet_stays_inside_the_figure(mitos):
+    """The right column's descriptions were wrapped to the panel's whole width, but a title
+    starts over the axes, after the y label: `clutter`'s ran past the figure's right edge
+    ("... are in" cut at the edge)."""
+    fig = draw_sheet(plotdata.sheet(mitos.rulebase))
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    titles = [ax._left_title for ax in visible_axes(fig)]     # (set_title(loc="left"))
+    assert len(titles) == 16 and all(t.get_text() for t in titles)
+    for title in titles:
+        assert title.get_window_extent(renderer).x1 <= fig.bbox.x1, title.get_text()

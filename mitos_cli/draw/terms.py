@@ -169,8 +169,11 @@ def draw_sheet(plots: Sequence[VariablePlot], path: str | Path | None = None, *,
         step = span // len(row)
         inches = fig.get_size_inches()[0] / len(row)
         for k, plot in enumerate(row):
+            # ~ characters of 10 pt across the axes the title starts over (the panel less
+            # its y label and ticks): the panel's whole width ran the third column's past
+            # the figure's edge
             draw_panel(fig.add_subplot(grid[i, k * step:(k + 1) * step]), plot,
-                       title_width=int(inches * 12.5))     # ~ characters of 10 pt a panel
+                       title_width=int((inches - 0.8) * 12.5))
     if title:
         fig.suptitle(title, fontsize=13, fontweight="bold")
     stagger_labels(fig)
