@@ -280,6 +280,6 @@ def test_every_panel_title_of_the_packaged_sheet_stays_inside_the_figure(mitos):
     fig.canvas.draw()
     renderer = fig.canvas.get_renderer()
     titles = [ax._left_title for ax in visible_axes(fig)]     # (set_title(loc="left"))
-    assert len(titles) == 16 and all(t.get_text() for t in titles)
+    assert len(titles) == 15 and all(t.get_text() for t in titles)     # 13 inputs, 2 outputs
     for title in titles:
         assert title.get_window_extent(renderer).x1 <= fig.bbox.x1, title.get_text()
