@@ -384,6 +384,8 @@ def test_an_empty_behavior_is_a_usage_error(short):
     ["simulate", ""], ["simulate", "corridor", ""], ["simulate", "corridor", "--rulebase", ""],
     ["compare", "", "--runs", "1"], ["teach", ""], ["teach", "--lesson", ""],
     ["eval", "", "x=1"], ["check", ""],
+    ["compare", "corridor", "--runs", "1", "-o", ""],     # wrote its study into the cwd
+    ["eval", "--batch", ""],
 ])
 def test_an_empty_path_is_a_usage_error(args):
     """`Path('')` is the current directory: an empty world, rule file or lesson was "``

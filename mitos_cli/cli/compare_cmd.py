@@ -45,7 +45,7 @@ def compare_command(
     seed: Annotated[int, typer.Option(
         "--seed", min=0, help="Seed of the whole study (runs are paired across choices).")] = 1,
     out: Annotated[str, typer.Option(
-        "--out", "-o", metavar="DIR",
+        "--out", "-o", metavar="DIR", callback=named,
         help="Directory for results.csv, report.md and the plots.")] = "study",
     executor: Annotated[str, typer.Option(
         "--executor", metavar="local|dask", autocompletion=complete.executors,

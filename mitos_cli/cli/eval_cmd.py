@@ -152,7 +152,7 @@ def eval_command(
         help="Evaluate this behavior (default: the file's first).")] = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
     batch: Annotated[Optional[str], typer.Option(
-        "--batch", metavar="FILE.csv|-",
+        "--batch", metavar="FILE.csv|-", callback=named,
         help="Evaluate every row of a CSV whose header names the inputs; write a CSV of the "
              "inputs, the outputs and the CSV's other columns as they were.")] = None,
     digits: Annotated[Optional[int], typer.Option(
