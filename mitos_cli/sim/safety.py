@@ -238,11 +238,16 @@ def _spacing(robot: Robot, k: float, radius: float, step: float) -> float:
 TIGHTEST_TURN = 0.5
 
 
-def tightest_turn(robot: Robot) -> float:
-    """The radius (in) of the rear axle's path at the robot's full lock: ``wheelbase /
-    tan(lock)``; 0 where the wheel can stand across the robot (a lock of 90 deg or more)."""
-    lock = max(robot.steering_straight - robot.steering_min,
+def full_lock(robot: Robot) -> float:
+    """How far (deg) the robot's wheel turns from straight at most, to either side."""
+    return max(robot.steering_straight - robot.steering_min,
                robot.steering_max - robot.steering_straight)
+
+
+def tightest_turn(robot: Robot) -> float:
+    """The radius (in) of the rear axle's path at the robot's :func:`full_lock`:
+    ``wheelbase / tan(lock)``; 0 where the wheel can stand across the robot (90 deg or more)."""
+    lock = full_lock(robot)
     return robot.wheelbase / math.tan(math.radians(lock)) if lock < 90 else 0.0
 
 

@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING, Any
 from ..errors import NameError_, Span, WorldError, did_you_mean, unknown
 from ..lang import yamlpos
 from ..lang.yamlpos import YList, YMap
-from .safety import TIGHTEST_TURN, tightest_turn
+from .safety import TIGHTEST_TURN, full_lock, tightest_turn
 from .world import (
     REPLANS,
     Agent,
@@ -233,8 +233,7 @@ def _check_turn(m: YMap, st: YMap, robot: Robot) -> None:
     radius = tightest_turn(robot)
     if radius >= TIGHTEST_TURN:
         return
-    lock = max(robot.steering_straight - robot.steering_min,
-               robot.steering_max - robot.steering_straight)
+    lock = full_lock(robot)
     side = "min" if robot.steering_straight - robot.steering_min == lock else "max"
     blame_lock = side in st and (lock > 60 or "wheelbase" not in m)   # the packaged: 60 deg
     span = (st.value_span(side) if blame_lock
