@@ -386,6 +386,11 @@ def test_an_empty_behavior_is_a_usage_error(short):
     ["eval", "", "x=1"], ["check", ""],
     ["compare", "corridor", "--runs", "1", "-o", ""],     # wrote its study into the cwd
     ["eval", "--batch", ""],
+    # Path-typed: Click made `''` the current directory before any check saw it
+    ["simulate", "corridor", "-o", ""], ["simulate", "corridor", "--plot", ""],
+    ["simulate", "corridor", "--animate", ""],
+    ["convert", "rulebases/mitos.rules", "--to", "fcl", "-o", ""], ["convert", "", "--to", "fcl"],
+    ["export", "rulebases/mitos.rules", "--to", "c", "-o", ""], ["export", "", "--to", "c"],
 ])
 def test_an_empty_path_is_a_usage_error(args):
     """`Path('')` is the current directory: an empty world, rule file or lesson was "``

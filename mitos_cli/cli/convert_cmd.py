@@ -9,7 +9,7 @@ from typing import Annotated, Optional
 import typer
 
 from .output import emit, err, warn, warn_notes
-from .params import choice, choices, completer, named
+from .params import choice, choices, completer, file_arg, named
 from .targets import check_suffix, refuse_existing, refuse_inputs, refuse_strays, source_files
 
 
@@ -29,12 +29,12 @@ class Dialect(str, Enum):
 
 def convert_command(
     path: Annotated[Path, typer.Argument(
-        metavar="FILE", help="Rule base to convert (.rules, .fcl, .fis or .fll).")],
+        parser=file_arg, metavar="FILE", help="Rule base to convert (.rules, .fcl, .fis or .fll).")],
     to_name: Annotated[str, typer.Option(
         "--to", metavar=choices(Target), autocompletion=completer(Target),
         help="Format to write: rules (NAME.rules + NAME.terms.yaml), fcl, fis or fll.")],
     output: Annotated[Optional[Path], typer.Option(
-        "--output", "-o", metavar="OUT",
+        "--output", "-o", parser=file_arg, metavar="OUT",
         help="File to write, ending in the format's extension (default: stdout; for --to "
              "rules: STEM.rules and STEM.terms.yaml in the current directory, never over "
              "existing files). -o OUT.rules also writes OUT.terms.yaml, never over a file "

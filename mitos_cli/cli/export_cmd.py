@@ -9,7 +9,7 @@ from typing import Annotated, Optional
 import typer
 
 from .output import emit, err, warn, warn_notes
-from .params import choice, choices, completer, named
+from .params import choice, choices, completer, file_arg, named
 from .targets import check_suffix, refuse_inputs, source_files
 
 
@@ -23,12 +23,12 @@ SUFFIX = {Language.c: ".c", Language.python: ".py"}
 
 def export_command(
     path: Annotated[Path, typer.Argument(
-        metavar="FILE", help="Rule base to export (.rules, .fcl, .fis or .fll).")],
+        parser=file_arg, metavar="FILE", help="Rule base to export (.rules, .fcl, .fis or .fll).")],
     to_name: Annotated[str, typer.Option(
         "--to", metavar=choices(Language), autocompletion=completer(Language),
         help="c: one C99 file (no allocation, only libm); python: a NumPy-only module.")],
     output: Annotated[Optional[Path], typer.Option(
-        "--output", "-o", metavar="OUT",
+        "--output", "-o", parser=file_arg, metavar="OUT",
         help="File to write: a .c file for --to c, a .py file for --to python (default: "
              "stdout).")] = None,
     behavior: Annotated[Optional[str], typer.Option(

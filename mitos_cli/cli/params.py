@@ -6,6 +6,7 @@ import math
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from enum import Enum
+from pathlib import Path
 from typing import Any, TypeVar
 
 import typer
@@ -41,6 +42,15 @@ def named(value: V) -> V:
     if any(v is not None and not v.strip() for v in values):
         raise typer.BadParameter("must name something, not be empty")
     return value
+
+
+def file_arg(text: str) -> Path:
+    """A file named on the command line, as a path: :func:`named`'s check for a
+    ``Path``-typed option, which Click would otherwise turn from ``''`` into ``.`` (the
+    current directory) before any callback sees it, so that ``-o ''`` said "`.` has no
+    extension" or "cannot write `.`: it is a directory", exit 1."""
+    named(text)
+    return Path(text)
 
 
 def choice(kind: type[E], value: str, what: str) -> E:

@@ -11,7 +11,7 @@ import typer
 from ..words import clearance
 from . import complete
 from .output import emit, err, json_text, warn
-from .params import MAX_RUNS, finite, named, option_names
+from .params import MAX_RUNS, file_arg, finite, named, option_names
 from .progress import INTERRUPTED, progress_bar
 from .targets import check_directory, check_suffix
 
@@ -195,7 +195,7 @@ def simulate_command(
                             "--seed SEED+j).")] = False,
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON instead of the table.")] = False,
     out: Annotated[Optional[Path], typer.Option(
-        "--out", "-o", metavar="FILE.csv",
+        "--out", "-o", parser=file_arg, metavar="FILE.csv",
         help="Write one CSV row per tick to FILE.csv (a name ending in .csv).")] = None,
     trace: Annotated[bool, typer.Option(
         "--trace", help="Every --every ticks, print the pose, speed, steering, clearance and "
@@ -204,7 +204,7 @@ def simulate_command(
                         "several; on stderr with --json, which keeps stdout for the JSON.")] = False,
     every: Annotated[int, typer.Option("--every", min=1, help="Ticks between traces.")] = 20,
     plot: Annotated[Optional[Path], typer.Option(
-        "--plot", metavar="FILE.png|FILE.svg",
+        "--plot", parser=file_arg, metavar="FILE.png|FILE.svg",
         help="Draw the run (world, obstacles, path); with --runs, every run's path in one "
              "picture, coloured by outcome.")] = None,
     live: Annotated[bool, typer.Option(
@@ -214,7 +214,7 @@ def simulate_command(
         help="Real-time factor of --live (implies it): 1 real time (the default), 4 four "
              "times faster, 0 as fast as it can.")] = None,
     animate: Annotated[Optional[Path], typer.Option(
-        "--animate", metavar="FILE.gif|FILE.mp4",
+        "--animate", parser=file_arg, metavar="FILE.gif|FILE.mp4",
         help="Write the run as an animation: map, footprint, sonar cones, trail, obstacles, "
              "time and the fired rules' DOFs (.mp4 needs ffmpeg).")] = None,
     fps: Annotated[float, typer.Option(
