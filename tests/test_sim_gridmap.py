@@ -97,6 +97,25 @@ def test_a_resolution_finer_than_a_micrometre_is_refused_at_its_line(tmp_path: P
     assert load_map_yaml(tmp_path / "m.yaml").resolution == pytest.approx(1e-6 * INCH_PER_M)
 
 
+@pytest.mark.filterwarnings("error")
+@pytest.mark.parametrize("res, origin, where, said", [
+    ("1e308", "[-15, -15, 0]", "2:13", "resolution 1e+308 m per pixel puts the map's far edge beyond"),
+    ("1e5", "[-15, -15, 0]", "2:13", "resolution 100000 m per pixel puts the map's far edge beyond"),
+    ("0.05", "[-1e300, -15, 0]", "3:9", "the map's origin lies 3.94e+301 in away, beyond"),
+])
+def test_a_map_beyond_a_worlds_reach_is_refused_at_its_line(tmp_path: Path, res, origin, where, said):
+    """The fuzz audit: a resolution of 1e308 m made every cell infinitely wide, and the start
+    was "inside a wall"; a world's numbers lie within ±1e7 in, and so does its map now."""
+    (tmp_path / "m.pgm").write_bytes(b"P5 2 3 255\n" + bytes(PIXELS))
+    (tmp_path / "m.yaml").write_text(f"image: m.pgm\nresolution: {res}\norigin: {origin}\n")
+    with pytest.raises(WorldError) as info:
+        load_map_yaml(tmp_path / "m.yaml")
+    text = info.value.render()
+    assert text.startswith(f"{tmp_path / 'm.yaml'}:{where}: world error: {said}")
+    (tmp_path / "m.yaml").write_text("image: m.pgm\nresolution: 1e3\norigin: [-1e3, 0, 0]\n")
+    assert load_map_yaml(tmp_path / "m.yaml").resolution == pytest.approx(1e3 * INCH_PER_M)
+
+
 def test_a_map_file_that_is_not_utf8_is_placed_at_its_byte(tmp_path: Path):
     (tmp_path / "m.yaml").write_bytes(b"image: m.pgm\nresolution: 0.05 # \xff\norigin: [0, 0, 0]\n")
     with pytest.raises(WorldError) as info:

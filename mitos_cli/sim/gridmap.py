@@ -31,6 +31,7 @@ from ..lang import yamlpos
 from ..resources import exists
 from .pgm import read_pgm
 from .world import Grid
+from .worldfile import LARGEST
 
 INCH_PER_M = 1.0 / 0.0254
 IMAGE_SUFFIXES = (".pgm", ".png", ".bmp", ".tif", ".tiff", ".jpg", ".jpeg", ".gif", ".ppm")
@@ -39,6 +40,26 @@ MAP_KEYS = ("image", "resolution", "origin", "negate", "occupied_thresh", "free_
 #: At 1e-30 m a 600-pixel map was narrower than floats tell apart at its origin (its cells
 #: all one point, the start "outside the map"), and at 1e-320 the cell lookup overflowed.
 FINEST = 1e-6
+
+
+def _check_extent(spec: yamlpos.YMap, origin: tuple[float, float], res_m: float,
+                  shape: tuple[int, ...]) -> None:
+    """A map lies where a world's numbers may (within ±``LARGEST`` in): a resolution of
+    1e308 m made its cells infinitely wide and the start "inside a wall", and an origin
+    beyond it put every point of the world off the map by a number with 300 digits."""
+    far = max(abs(v) for v in origin) * INCH_PER_M
+    if far > LARGEST:
+        raise WorldError(f"the map's origin lies {far:.3g} in away, beyond ±{LARGEST:g} in, "
+                         "where a world lies", span=spec.value_span("origin"),
+                         hint="the origin is in metres: [-15, -15, 0] puts the map's corner "
+                              "15 m left of and below the world's (0, 0)")
+    if far + res_m * INCH_PER_M * max(shape) > LARGEST:
+        raise WorldError(f"resolution {res_m:g} m per pixel puts the map's far edge beyond "
+                         f"±{LARGEST:g} in, where a world lies", span=spec.value_span("resolution"),
+                         expected=f"at most {(LARGEST - far) / INCH_PER_M / max(shape):.3g} "
+                                  f"(metres per pixel) for this {max(shape)}-pixel image",
+                         hint="the resolution is in metres per pixel: 0.05 is 5 cm, as ROS "
+                              "maps usually are")
 
 
 def occupancy(pixels: np.ndarray, maxval: int, negate: bool) -> np.ndarray:
@@ -235,6 +256,7 @@ def load_map_yaml(path: Path, *, unknown_occupied: bool = True,
                          hint="give a PGM (P5 or P2) or an image Pillow reads (PNG)") from None
     blocked = classify(pixels, maxval, negate=negate, occupied_thresh=occ_t,
                        free_thresh=free_t, unknown_occupied=unknown_occupied, mode=mode)
+    _check_extent(spec, (ox, oy), res_m, blocked.shape)
     res, origin = res_m * INCH_PER_M, (ox * INCH_PER_M, oy * INCH_PER_M)
     if abs(math.remainder(yaw, 2 * math.pi)) > 1e-12:
         blocked, origin = rotate(blocked, res, origin, yaw)
