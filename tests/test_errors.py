@@ -111,6 +111,9 @@ def caret_under(exc: MitosError) -> str:
     # a variable's name before a missing `is` is no misspelt keyword (`temp` is not `terms`)
     ("r1: if size is SMALL_SZ and temp SMALL_SZ then speed is SLOW", 34, "SMALL_SZ",
      "unexpected `SMALL_SZ`", "`is`", "a condition reads `variable is TERM`"),
+    # a number past a float's range read as inf: "steering = inf lies outside its universe"
+    ("r1: if road is WIDE then steering is 2e400", 38, "2e400", "`2e400` is past a float's range",
+     "a number within", None),
 ])
 def test_syntax_errors(tmp_path, line, col, at, message, expected, hint):
     path = write(tmp_path, line)

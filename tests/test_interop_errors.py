@@ -114,7 +114,8 @@ FLL_CASES = [
     ("defuzzifier: Centroid 200", "defuzzifier: WeightedAverage Magic",
      "unknown weighted defuzzifier type `Magic`"),
     ("term: off Triangle 0 0.25 0.5", "term: off Constant 0.25",
-     "fuzzylite's `Constant` is a flat membership"),
+     "fuzzylite's `Constant` is a flat membership"),    ("term: off Triangle 0 0.25 0.5", "term: off Triangle 0 0.25 5e999",    # was "... is inf"
+     "`5e999` is past a float's range"),
 ]
 
 
@@ -208,7 +209,8 @@ FIS_CASES = [
     ("1 1, 1 (1) : 2", "1 1, -1 (1) : 2", "negative (complemented)"),
     ("1 1, 1 (1) : 2", "1 1, 4 (1) : 2", "`tip` has 3 MFs, not 4"),
     ("1 1, 1 (1) : 2", "0 0, 1 (1) : 2", "the rule has no condition"),
-    ("1 1, 1 (1) : 2", "1 1, 0 (1) : 2", "the rule has no consequent"),
+    ("1 1, 1 (1) : 2", "1 1, 0 (1) : 2", "the rule has no consequent"),    ("MF1='rancid':'trapmf',[0 0 1 3]", "MF1='rancid':'trapmf',[0 0 1 3e400]",
+     "`3e400` is past a float's range"),                     # was "the ... parameter 4 is inf"
 ]
 
 
@@ -309,7 +311,7 @@ FCL_CASES = [
     ("METHOD : COG;", "METHOD : cogf;", "jFuzzyLogic's fast centre of gravity"),
     ("RULE 2 : IF service IS good", "RULE 2 : IF service IS goood", "of `service`"),
     ("TERM cheap := trian 0 5 10;", "TERM cheap := Constant 5;",
-     "fuzzylite's `Constant` is a flat membership"),
+     "fuzzylite's `Constant` is a flat membership"),    ("RANGE := (0 .. 30);", "RANGE := (0 .. 3e400);", "`3e400` is past a float's range"),
 ]
 
 

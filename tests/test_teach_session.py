@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 
 from mitos_cli.api import default_rulebase_path
-from mitos_cli.errors import LessonError, MitosError, NameError_, RuleBaseError
+from mitos_cli.errors import LessonError, MitosError, NameError_, RuleBaseError, RuleSyntaxError
 from mitos_cli.teach.journal import Journal
 from mitos_cli.teach.prompt import at_prompt
 from mitos_cli.teach.session import Session
@@ -347,7 +347,9 @@ def test_a_hedge_or_time_that_cannot_be_used_is_refused_at_its_own_word(rules):
     assert place("correct road=78 size=45 position=4 -> steering is seldom LB") == (4, 51, 57)
     s.run("use drive")
     s.run("simulate corridor")
-    assert place("at 1e400s steering=50") == (4, 4, 10)
+    with pytest.raises(RuleSyntaxError, match="`1e400` is past a float's range") as past:
+        s.run("at 1e400s steering=50", "<prompt>", 4)
+    assert (past.value.span.line, past.value.span.column, past.value.span.end_column) == (4, 4, 9)
     assert place("at -1s steering=50") == (4, 4, 7)
     assert place("at 1s to 100s turn harder") == (4, 10, 14)
     assert place("at 5s to 2s steering is LB") == (4, 4, 12)
@@ -506,8 +508,10 @@ def test_a_correction_outside_the_universe_is_noted_and_an_infinite_one_refused(
     s, out = session(rules)
     text = say(s, out, "correct road=500 size=45 position=4 -> steering=60")
     assert "road = 500 lies outside its universe [0, 160]; the rules read it as 160" in text
-    with pytest.raises(LessonError, match="road = inf is not a finite number"):
+    with pytest.raises(RuleSyntaxError) as info:         # was "road = inf is not finite"
         s.run("correct road=1e400 size=45 position=4 -> steering=60")
+    assert info.value.message == "`1e400` is past a float's range"
+    assert (info.value.span.line, info.value.span.column) == (1, 14)
     assert len(s.state.examples) == 1
 
 
@@ -662,8 +666,6 @@ def test_frozen_or_unfrozen_that_changes_nothing_is_no_unsaved_change(rules):
 def test_a_comma_between_values_is_named_and_a_hedge_past_the_scale_is_noted(rules):
     """`... -> steering=60, speed=20` expected "`->`, a name or the end of the line" though
     the `->` was there; `steering is extremely LB` became 30 without a word."""
-    from mitos_cli.errors import RuleSyntaxError
-
     s, out = session(rules)
     with pytest.raises(RuleSyntaxError) as info:
         s.run("correct road=78 size=45 position=4 -> steering=60, speed=20")

@@ -23,7 +23,7 @@ from ..lang import operators as ops_mod
 from ..lang.model import And, Behavior, Consequent, Expr, Not, Or, Prop, Rule, RuleBase, Setting
 from ..lang.resolve import MAIN, check_rule
 from ..lang.terms import Term, TermSet, Variable, first_at, universe_problem
-from ..numbers import LARGEST, parse_number
+from ..numbers import LARGEST, parse_value
 from ..words import plural
 from . import rewrite
 
@@ -188,11 +188,20 @@ FORMULA_TERMS = {"Function": "a free formula"}
 
 
 def number(text: str, span: Span | None, what: str = "a number") -> float:
-    """A number as the formats write them (``nan``, ``inf``, ``-inf`` included)."""
+    """A number as the formats write them (``nan``, ``inf``, ``-inf`` included); one past a
+    float's range (``1e400``) is refused as written, not read as the ``inf`` it was not."""
     try:
-        return parse_number(text)
+        return parse_value(text)
+    except OverflowError:
+        raise past_range(text, span) from None
     except ValueError:
         raise FormatError(f"expected {what}, not `{text}`", span=span) from None
+
+
+def past_range(text: str, span: Span | None) -> FormatError:
+    """The error of a number written past a float's range, such as ``1e400``."""
+    return FormatError(f"`{text}` is past a float's range: numbers beyond ±{LARGEST:g} cannot "
+                       "be evaluated in floating point without overflow", span=span)
 
 
 def fuzzylite_term(name: str, kind: str, values: list[float], n_inputs: int,

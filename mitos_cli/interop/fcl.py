@@ -167,6 +167,9 @@ def parse_fcl(text: str, path: str | None = None) -> RuleBase:
         end = meta.end_column if meta.end_line == meta.line else None
         return Span.in_text(text, path, meta.line, meta.column, end)
 
+    for token in tree.scan_values(lambda v: isinstance(v, Token) and v.type == "SIGNED_NUMBER"):
+        if math.isinf(float(token)):
+            raise common.past_range(str(token), span_of(token))
     blocks = tree.children
     if len(blocks) > 1:
         raise FormatError(f"the file has {len(blocks)} function blocks; MITOS reads one",

@@ -9,13 +9,20 @@ expected, in words.
 from __future__ import annotations
 
 import functools
+import math
 import re
 from dataclasses import dataclass
 
 from lark import Lark, Token, Transformer, Tree, v_args
-from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken
+from lark.exceptions import (
+    UnexpectedCharacters,
+    UnexpectedEOF,
+    UnexpectedInput,
+    UnexpectedToken,
+    VisitError,
+)
 
-from ..errors import RuleSyntaxError, Span, did_you_mean
+from ..errors import MitosError, RuleSyntaxError, Span, did_you_mean
 from ..fuzzy.hedges import HEDGES
 from ..resources import grammar_text
 from .bulk import without_cyclic_gc
@@ -341,7 +348,7 @@ def _span(meta, text: str, path: str | None) -> Span | None:
 
 
 class _ToModel(Transformer):
-    """Tree -> model objects. Only builds: names are checked later (Lark wraps errors here)."""
+    """Tree -> model objects. Only builds: names are checked later."""
 
     def __init__(self, text: str, path: str | None, line_offset: int = 0) -> None:
         super().__init__()
@@ -353,8 +360,23 @@ class _ToModel(Transformer):
         span = _span(meta, self.text, self.path)
         return shift(span, self.line_offset)
 
-    def number(self, items):
-        return float(items[0])
+    def transform(self, tree):
+        """Lark wraps what a callback raises in ``VisitError``; a MITOS error raised while
+        building (a number past a float's range) is the user's, so it comes out as itself."""
+        try:
+            return super().transform(tree)
+        except VisitError as exc:
+            if isinstance(exc.orig_exc, MitosError):
+                raise exc.orig_exc from None
+            raise
+
+    @v_args(meta=True)
+    def number(self, meta, items):
+        value = float(items[0])
+        if math.isinf(value):             # the grammar's numbers have no `inf`: 1e400 overflowed
+            raise RuleSyntaxError(f"`{items[0]}` is past a float's range", span=self._s(meta),
+                                  expected="a number within ±1.8e308")
+        return value
 
     def NAME(self, token):
         return token

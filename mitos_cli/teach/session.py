@@ -545,7 +545,7 @@ class Session:
                 raise unknown(f"{role} variable", a.name, names, span=a.span, cls=LessonError)
             if a.name in out:
                 raise LessonError(f"`{a.name}` is given twice", span=a.span)
-            if not math.isfinite(a.value):      # 1e400 reads as inf: no example holds it
+            if not math.isfinite(a.value):      # (a guard: the grammar reads 1e400 as an error)
                 raise LessonError(f"{a.name} = {a.value:g} is not a finite number", span=a.span,
                                   hint="give a value inside the variable's universe")
             if role == "output":
