@@ -97,6 +97,21 @@ def test_frozen_refuses_what_is_not_true_or_false(value):
     assert info.value.span.line == 6
 
 
+@pytest.mark.parametrize("written", ["7.0e400", "-1.5E+999"])
+def test_a_number_past_a_floats_range_is_named_as_written(written):
+    """YAML reads `7.0e400` as inf, and the error said "not `inf`" of a number the user
+    never wrote as such; `-.inf` written as such is still "not `-inf`"."""
+    from mitos_cli.errors import TermSetError
+
+    text = f"x: {{role: input, universe: [0, 10], terms: {{A: {{shape: triangle, peak: {written}, width: 1}}}}}}"
+    with pytest.raises(TermSetError) as info:
+        parse_termset("variables:\n  " + text + "\n")
+    assert info.value.message.endswith(f"peak must be a finite number: `{written}` is past a float's range")
+    with pytest.raises(TermSetError) as info:
+        parse_termset("variables:\n  " + text.replace(written, "-.inf") + "\n")
+    assert info.value.message.endswith("peak must be a finite number, not `-inf`")
+
+
 @pytest.mark.parametrize("text, words", [
     ("x: {role: input, universe: [-1e308, 1e308], terms: {A: {shape: triangle, "
      "points: [-1, 0, 1]}}}", "universe bound is -1e+308"),

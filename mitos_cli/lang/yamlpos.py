@@ -264,5 +264,17 @@ def expect_number(value: Any, span: Span, error: type[MitosError], what: str) ->
         raise error(f"{what} must be a finite number, not an integer of "
                     f"{len(str(abs(value)))} digits", span=span) from None
     if number != number or number in (float("inf"), float("-inf")):
+        text = _written(span)
+        if text is not None and "inf" not in text.lower():    # 1.0e400: YAML read inf
+            raise error(f"{what} must be a finite number: `{text}` is past a float's range",
+                        span=span)
         raise error(f"{what} must be a finite number, not `{value}`", span=span)
     return number
+
+
+def _written(span: Span) -> str | None:
+    """The scalar as written at ``span``, where the span holds its line."""
+    if span.source_line is None:
+        return None
+    found = re.compile(r"[^\s,\]}#]+").match(span.source_line, span.column - span.source_start)
+    return found.group() if found else None
