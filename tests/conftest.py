@@ -14,3 +14,12 @@ os.environ.setdefault("MITOS_CACHE_DIR", tempfile.mkdtemp(prefix="mitos-test-cac
 # where the environment says not to, or each one recompiles all of MITOS first.
 os.environ.pop("PYTHONDONTWRITEBYTECODE", None)
 sys.dont_write_bytecode = False
+
+# Property tests draw the same examples on every run (each test's from its own name), so a
+# red CI is a defect anyone can reproduce, never a draw that passes on the next try. Explore
+# new examples on purpose: `python -m pytest --hypothesis-profile=explore` (docs/reliability.md).
+from hypothesis import settings  # noqa: E402
+
+settings.register_profile("repeatable", derandomize=True, database=None)
+settings.register_profile("explore", max_examples=500)
+settings.load_profile("repeatable")

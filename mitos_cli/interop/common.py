@@ -199,8 +199,10 @@ def number(text: str, span: Span | None, what: str = "a number") -> float:
 
 
 def past_range(text: str, span: Span | None) -> FormatError:
-    """The error of a number written past a float's range, such as ``1e400``."""
-    return FormatError(f"`{text}` is past a float's range: numbers beyond ±{LARGEST:g} cannot "
+    """The error of a number written past a float's range, such as ``1e400`` (a long one
+    shown by its ends and length)."""
+    shown = f"`{text}`" if len(text) <= 24 else f"`{text[:10]}...{text[-6:]}` ({len(text)} characters)"
+    return FormatError(f"{shown} is past a float's range: numbers beyond ±{LARGEST:g} cannot "
                        "be evaluated in floating point without overflow", span=span)
 
 
