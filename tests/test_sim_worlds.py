@@ -106,3 +106,14 @@ def test_two_worlds_of_one_name_are_told_apart_by_their_files():
     runs = run_many([short, copy], runs=0, workers=1)
     assert [w.world for w in runs.worlds] == [f"corridor ({short.path})",
                                               "corridor (elsewhere/corridor.yaml)"]
+
+
+def test_one_world_given_twice_is_two_rows_of_their_own_runs():
+    """`[w, w]` (as `[w] * 2` makes) keyed both rows on the one object: each row held the
+    runs of both, 4 runs for 2 and a smaller standard deviation."""
+    short = dataclasses.replace(world("corridor.yaml"), time_limit=0.5)
+    alone = run_many([short], runs=2, seed=1, workers=1).to_json()[0]
+    twice = run_many([short, short], runs=2, seed=1, workers=1)
+    assert [[s["seed"] for s in w.summaries] for w in twice.worlds] == [[1, 2], [1, 2]]
+    for row in twice.to_json():
+        assert row["runs"] == 2 and row["time_s"] == alone["time_s"]

@@ -147,7 +147,7 @@ def run_many(worlds: list[World], runs: int = 0, seed: int | None = None, planne
         planner = FuzzyPlanner(None, worlds[0].behavior if worlds else "drive")
     workers = default_workers() if workers is None else whole("workers", workers, 1)
     tasks = []
-    for w in worlds:
+    for place, w in enumerate(worlds):
         base = w.seed if seed is None else seed
         seeds = [base] if runs <= 0 else [base + j for j in range(runs)]
         # each worker's share in lockstep batches of up to BATCH runs (a batch of 5 runs costs
@@ -158,9 +158,9 @@ def run_many(worlds: list[World], runs: int = 0, seed: int | None = None, planne
         size = even_chunks(len(seeds), workers, BATCH)
         scene = shared_scene(w, runs > 0) if len(seeds) > size else None
         for i in range(0, len(seeds), size):
-            tasks.append((w, tuple(seeds[i:i + size]), scene))
-    jobs = [(k, w, planner, chunk, runs > 0, measure, scene)
-            for k, (w, chunk, scene) in enumerate(tasks)]
+            tasks.append((place, tuple(seeds[i:i + size]), scene))
+    jobs = [(k, worlds[place], planner, chunk, runs > 0, measure, scene)
+            for k, (place, chunk, scene) in enumerate(tasks)]
     total = sum(len(chunk) for _, chunk, _ in tasks)
     results: list[list[dict | None]] = [[None] * len(chunk) for _, chunk, _ in tasks]
     done = 0
@@ -309,12 +309,14 @@ def _check(pending, workers: set[int | None]) -> None:
 
 
 def _group(worlds: list[World], tasks: list[tuple], results: list[list[dict | None]]) -> Runs:
-    """Each world's finished runs in seed order (worlds with none left out when interrupted)."""
-    grouped: dict[int, list[dict]] = {id(w): [] for w in worlds}
-    for (w, _, _), res in zip(tasks, results):
-        grouped[id(w)].extend(summary for summary in res if summary is not None)
-    return Runs(tuple(WorldRuns(label, tuple(grouped[id(w)]))
-                      for w, label in zip(worlds, _labels(worlds)) if grouped[id(w)]))
+    """Each world's finished runs in seed order (worlds with none left out when interrupted),
+    one row per place in ``worlds``: the same World given twice is two rows of their own
+    runs, as two copies of it are (keyed on the object, each row held the runs of both)."""
+    grouped: list[list[dict]] = [[] for _ in worlds]
+    for (place, _, _), res in zip(tasks, results):
+        grouped[place].extend(summary for summary in res if summary is not None)
+    return Runs(tuple(WorldRuns(label, tuple(runs))
+                      for runs, label in zip(grouped, _labels(worlds)) if runs))
 
 
 def _labels(worlds: list[World]) -> list[str]:
