@@ -635,3 +635,39 @@ def test_a_study_checks_runs_and_seed_as_compare_does(changes, says):
     assert exc.value.message == says
     study = Study(["a.yaml"], [Choice("dwa")], runs=np.int64(2), seed=np.uint8(3))
     assert (type(study.runs), type(study.seed)) == (int, int) and len(study.tasks()) == 2
+
+
+@pytest.mark.parametrize("worlds, says, hint", [
+    # read a character at a time: "world file `t` not found"
+    ("tests/data/tiny.yaml", "takes a list of world files, not the path `tests/data/tiny.yaml`",
+     "Study(['tests/data/tiny.yaml'], ...)"),
+    (Path("a.yaml"), "not the path `a.yaml`", "Study(['a.yaml'], ...)"),
+    (["a.yaml", 3], "runs world files, not int `3`", "Study(['worlds/corridor.yaml'], ...)"),
+    ([], "a Study needs at least one world file", None),
+    # each row summarized the runs of both (n 4 for 2 runs); `mitos compare` refuses it
+    (["a.yaml", "b.yaml", "a.yaml"], "the world `a.yaml` is given twice", "runs=N"),
+    (["a.yaml", "./a.yaml"], "the world `./a.yaml` is given twice (as `a.yaml`)", "runs=N"),
+])
+def test_a_study_says_what_its_worlds_are(worlds, says, hint):
+    from mitos_cli.errors import InputError
+
+    with pytest.raises(InputError) as exc:
+        Study(worlds, [Choice("dwa")], runs=1, seed=1)
+    assert says in exc.value.message
+    assert exc.value.hint is None if hint is None else hint in exc.value.hint
+
+
+def test_a_study_runs_world_paths_and_refuses_loaded_worlds(tmp_path):
+    """A Path failed in study.json's JSON, a World in `Path()`: both bare TypeErrors."""
+    from mitos_cli.errors import InputError
+    from mitos_cli.sim import load_world
+
+    study = Study([tmp_path / "w1.yaml", "w2.yaml"], [Choice("dwa")], runs=1, seed=1)
+    assert study.worlds == [str(tmp_path / "w1.yaml"), "w2.yaml"]
+    out = run_study(study, tmp_path / "out", workers=1, task_fn=fake_sim)
+    assert [r["world"] for r in out.rows] == study.worlds
+    tiny = load_world(Path(__file__).parent / "data" / "tiny.yaml")
+    for worlds in ([tiny], tiny):
+        with pytest.raises(InputError, match="world files, not (loaded worlds|one World)") as exc:
+            Study(worlds, [Choice("dwa")], runs=1, seed=1)
+        assert exc.value.hint == f"give its file: Study([{tiny.path!r}], ...)"

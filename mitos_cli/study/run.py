@@ -8,6 +8,7 @@
 
 from __future__ import annotations
 
+import os
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -20,7 +21,8 @@ from .summary import ALL_WORLDS, Rank, Summary, choice_of, rank, summaries
 
 @dataclass(frozen=True)
 class Study:
-    """What to compare: worlds x choices x runs, from one seed, with one rule base."""
+    """What to compare: worlds x choices x runs, from one seed, with one rule base.
+    ``worlds`` are world files (``str`` or ``Path``), each given once."""
 
     worlds: list[str]
     choices: list[Choice]
@@ -39,6 +41,7 @@ class Study:
         from ..sim.loop import check_seed
         from ..sim.runs import whole
 
+        object.__setattr__(self, "worlds", world_files(self.worlds))
         object.__setattr__(self, "runs", whole("runs", self.runs, 1))
         object.__setattr__(self, "seed", check_seed(self.seed))
 
@@ -77,6 +80,64 @@ class Study:
         except MitosError:
             pass
         return {name: d for name, paths in files.items() if (d := digest(paths)) is not None}
+
+
+def world_files(worlds: object) -> list[str]:
+    """``worlds`` as a list of world files (a ``Path`` as its text), else an
+    :class:`InputError` saying what a study takes: one path was read a character at a time, a
+    ``Path`` or a ``World`` failed later with a bare TypeError, and a world given twice had
+    each of its rows summarize the runs of both (``mitos compare`` refuses it)."""
+    from ..errors import InputError
+    from ..sim.world import World
+
+    if isinstance(worlds, (str, os.PathLike)):
+        raise InputError(f"a Study takes a list of world files, not the path `{worlds}`",
+                         hint=f"Study([{str(worlds)!r}], ...)")
+    if isinstance(worlds, World):
+        raise InputError("a Study takes a list of world files, not one World",
+                         hint=_world_hint(worlds))
+    try:
+        given = list(worlds)  # type: ignore[call-overload]  # anything iterable is tried
+    except TypeError:
+        raise InputError(f"a Study takes a list of world files, not {type(worlds).__name__} "
+                         f"`{worlds!r:.60}`") from None
+    if not given:
+        raise InputError("a Study needs at least one world file")
+    out: list[str] = []
+    seen: dict[Path, str] = {}
+    for w in given:
+        name = _world_file(w)
+        key = Path(name).resolve()
+        if key in seen:
+            also = "" if seen[key] == name else f" (as `{seen[key]}`)"
+            raise InputError(f"the world `{name}` is given twice{also}",
+                             hint="give each world once; more runs of it: runs=N")
+        seen[key] = name
+        out.append(name)
+    return out
+
+
+def _world_file(world: object) -> str:
+    """One world of a study as the file's text, else an :class:`InputError` saying why: each
+    run reads the file, and ``study.json`` records its digest."""
+    from ..errors import InputError
+    from ..sim.world import World
+
+    if isinstance(world, World):
+        raise InputError("a Study runs world files, not loaded worlds (each run reads the "
+                         "file, and study.json records its digest)", hint=_world_hint(world))
+    name = os.fspath(world) if isinstance(world, (str, os.PathLike)) else None
+    if not isinstance(name, str):
+        raise InputError(f"a Study runs world files, not {type(world).__name__} "
+                         f"`{world!r:.60}`", hint="Study(['worlds/corridor.yaml'], ...)")
+    return name
+
+
+def _world_hint(world) -> str:
+    """Where a loaded World can go instead: its file, or :func:`run_many`."""
+    if world.path:
+        return f"give its file: Study([{str(world.path)!r}], ...)"
+    return "save it as a .yaml file, or run it as it is with run_many([world], ...)"
 
 
 @dataclass
