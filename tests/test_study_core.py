@@ -103,6 +103,25 @@ def test_choice_errors_say_did_you_mean(args, message, hint):
     assert message in exc.value.message and hint in (exc.value.hint or "")
 
 
+@pytest.mark.parametrize("args, message, hint", [
+    # read a letter at a time: "unknown planner `f`", "unknown T-norm `m`"
+    (("fuzzy", [], [], []), "planners are a list of names, not the string `fuzzy`", "['fuzzy']"),
+    ((["fuzzy"], "min, product", [], []), "T-norms are a list of names, not the string "
+     "`min, product`", "['min', 'product']"),
+    ((["fuzzy"], [], None, []), "S-norms are a list of names, not NoneType `None`",
+     "make_choices("),
+    ((["fuzzy"], [], [], [1]), "inference methods are a list of names, not of int `1`",
+     "make_choices("),
+])
+def test_choices_are_lists_of_names(args, message, hint):
+    from mitos_cli.errors import InputError
+
+    with pytest.raises(InputError) as exc:
+        make_choices(*args)
+    assert exc.value.message == message and hint in exc.value.hint
+    assert make_choices(("fuzzy",), ("min",), (), ()) == [Choice("fuzzy", "min")]
+
+
 def test_seeds_are_paired_and_extend():
     choices = make_choices(["fuzzy", "potential_field"], ["min", "product"], [], [])
     tasks = expand(["a.yaml", "b.yaml"], choices, 4, seed=7)

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import unknown
+from ..errors import InputError, unknown
 from ..fuzzy import norms
 from ..lang.operators import INFERENCES
 from ..sim.planner import PLANNERS as _REGISTRY
@@ -102,6 +102,8 @@ def make_choices(planners: list[str], ands: list[str], ors: list[str],
     An empty list keeps the rule base's setting. ``--or dual`` pairs each T-norm with its
     De Morgan dual instead of crossing them.
     """
+    planners, ands = _names("planners", planners), _names("T-norms", ands)
+    ors, inferences = _names("S-norms", ors), _names("inference methods", inferences)
     for p in planners:
         if p not in PLANNERS:
             raise unknown("planner", p, PLANNERS)
@@ -120,6 +122,25 @@ def make_choices(planners: list[str], ands: list[str], ors: list[str],
             if c not in choices:
                 choices.append(c)
     return choices
+
+
+def _names(what: str, names: object) -> list[str]:
+    """``names`` as a list of strings, else an :class:`InputError` (a string was read a
+    letter at a time: ``make_choices("fuzzy", ...)`` said "unknown planner `f`")."""
+    example = 'make_choices(["fuzzy"], ["min", "product"], [], [])'
+    if isinstance(names, str):
+        raise InputError(f"{what} are a list of names, not the string `{names}`",
+                         hint=f"{split_list(names) or [names]!r}")
+    try:
+        out = list(names)  # type: ignore[call-overload]  # anything iterable is tried
+    except TypeError:
+        raise InputError(f"{what} are a list of names, not {type(names).__name__} "
+                         f"`{names!r:.40}`", hint=example) from None
+    for name in out:
+        if not isinstance(name, str):
+            raise InputError(f"{what} are a list of names, not of {type(name).__name__} "
+                             f"`{name!r:.40}`", hint=example)
+    return out
 
 
 def task_seeds(seed: int, n_worlds: int, runs: int) -> list[list[int]]:
