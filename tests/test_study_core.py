@@ -676,6 +676,17 @@ def test_a_study_says_what_its_worlds_are(worlds, says, hint):
     assert exc.value.hint is None if hint is None else hint in exc.value.hint
 
 
+@pytest.mark.parametrize("workers", [0, -5, 2.5, True])
+def test_run_study_checks_workers_as_run_many_does(tmp_path, workers):
+    """All four ran (serially) without a word; run_many refuses them."""
+    from mitos_cli.errors import InputError
+
+    with pytest.raises(InputError) as exc:
+        run_study(small_study(runs=1), tmp_path / "out", workers=workers, task_fn=fake_sim)
+    assert exc.value.message == f"`workers` is a whole number, 1 or more, not `{workers!r}`"
+    assert not (tmp_path / "out").exists()
+
+
 def test_a_study_runs_world_paths_and_refuses_loaded_worlds(tmp_path):
     """A Path failed in study.json's JSON, a World in `Path()`: both bare TypeErrors."""
     from mitos_cli.errors import InputError

@@ -180,7 +180,13 @@ def run_study(study: Study, out_dir: str | Path, *, executor: str = "local",
     as it arrives, and summarize all finished rows (in task order, whatever the executor).
 
     ``on_start(skipped, total)`` is called once, ``on_result(task, row)`` per finished task.
+    ``workers`` is checked as :func:`~mitos_cli.sim.runs.run_many` checks it (0, -5, 2.5 and
+    True all ran without a word).
     """
+    from ..sim.runs import whole
+
+    if workers is not None:
+        workers = whole("workers", workers, 1)
     tasks = study.tasks()
     fn = task_fn or default_task_fn(study)
     with ResultStore(out_dir) as store:
