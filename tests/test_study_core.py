@@ -168,6 +168,51 @@ def test_the_simulator_steps_a_chunk_together_with_each_task_s_bits_alone(tmp_pa
         assert together[task] == run_task(context, task)
 
 
+def test_an_edited_world_or_rule_base_is_run_as_it_is_now(tmp_path):
+    """The worker's caches were keyed on the path: a second study of the session ran the
+    world and rule base as first read (a 10.55 s success in a world of time_limit 2), while
+    study.json recorded the digest of the edited file."""
+    import hashlib
+    import json
+    import shutil
+
+    data = Path(__file__).parent.parent
+    world = tmp_path / "w.yaml"
+    world.write_text((data / "tests" / "data" / "tiny.yaml").read_text())
+    shutil.copytree(data / "rulebases", tmp_path / "rb", ignore=shutil.ignore_patterns("lessons"))
+    rules = tmp_path / "rb" / "mitos.rules"
+
+    def run(name: str) -> tuple[str, str]:
+        study = Study([world], make_choices(["fuzzy"], ["min"], [], []), runs=1, seed=1,
+                      rulebase=str(rules))
+        row = run_study(study, tmp_path / name, workers=1).rows[0]
+        digests = json.loads((tmp_path / name / "study.json").read_text())["digests"]
+        assert digests[str(world)] == hashlib.sha256(world.read_bytes()).hexdigest()[:16]
+        return row["outcome"], row["path_length_in"]
+
+    first = run("a")
+    text = world.read_text()
+    world.write_text(text.replace("time_limit: 15", "time_limit: 2"))
+    assert run("b")[0] == "timeout"
+    world.write_text(text)
+    assert run("c") == first
+    rules.write_text(rules.read_text().replace("road is WIDE then speed is FAST",
+                                               "road is WIDE then speed is SLOW"))
+    slow = run("d")
+    assert slow[0] == "success" and slow[1] != first[1]
+
+
+def test_a_file_changed_while_the_study_runs_is_refused():
+    """Runs of a world as it is now under the digest study.json recorded of it before."""
+    from mitos_cli.study.simtask import StudyContext, run_task
+
+    world = str(Path(__file__).parent / "data" / "tiny.yaml")
+    task = expand([world], [Choice("potential_field")], 1, 1)[0]
+    with pytest.raises(StudyError, match="changed while the study ran") as exc:
+        run_task(StudyContext(digests=((world, "0123456789abcdef"),)), task)
+    assert f"`{world}`" in exc.value.message and "--resume" in exc.value.hint
+
+
 def _parts(n: int):
     if n == 5:
         os.kill(os.getpid(), signal.SIGKILL)          # the out-of-memory killer, say

@@ -8,6 +8,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import os
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -56,30 +57,16 @@ class Study:
 
     def digests(self) -> dict[str, str]:
         """A digest of each input file (the worlds, the rule base and its term sets), so that
-        `--resume` can refuse to mix runs of a file that changed with runs of the new one."""
-        import hashlib
-
+        `--resume` can refuse to mix runs of a file that changed with runs of the new one.
+        The simulator's caches are keyed on them (:mod:`.simtask`)."""
         from ..api import read_rulebase
         from ..errors import MitosError
+        from .simtask import RULEBASE, file_digest, rulebase_digest
 
-        def digest(paths: list[Path]) -> str | None:
-            h = hashlib.sha256()
-            try:
-                for p in paths:
-                    h.update(p.read_bytes())
-            except OSError:
-                return None                  # (reported where the file is read)
-            return h.hexdigest()[:16]
-
-        files = {path: [Path(path)] for path in self.worlds}
-        try:
-            rb = read_rulebase(self.rulebase)
-            if rb.path is not None:
-                files["rulebase"] = [Path(rb.path)] + [Path(rb.path).parent / p
-                                                       for p in rb.termset_paths]
-        except MitosError:
-            pass
-        return {name: d for name, paths in files.items() if (d := digest(paths)) is not None}
+        found = {path: file_digest([Path(path)]) for path in self.worlds}
+        with contextlib.suppress(MitosError):    # (reported where the rule base is read)
+            found[RULEBASE] = rulebase_digest(read_rulebase(self.rulebase))
+        return {name: d for name, d in found.items() if d is not None}
 
 
 def world_files(worlds: object) -> list[str]:
@@ -164,11 +151,14 @@ class Outcome:
         return pooled or self.per_world()
 
 
-def default_task_fn(study: Study) -> TaskFn:
-    """The simulator as a picklable task function."""
+def default_task_fn(study: Study, digests: dict[str, str] | None = None) -> TaskFn:
+    """The simulator as a picklable task function, running the files as ``digests`` (the
+    ones ``study.json`` records; default: as they are now) say they are."""
     from .simtask import Simulator, StudyContext
 
-    return Simulator(StudyContext(study.rulebase, study.behavior))
+    digests = study.digests() if digests is None else digests
+    return Simulator(StudyContext(study.rulebase, study.behavior,
+                                  tuple(sorted(digests.items()))))
 
 
 def run_study(study: Study, out_dir: str | Path, *, executor: str = "local",
@@ -188,9 +178,10 @@ def run_study(study: Study, out_dir: str | Path, *, executor: str = "local",
     if workers is not None:
         workers = whole("workers", workers, 1)
     tasks = study.tasks()
-    fn = task_fn or default_task_fn(study)
+    manifest = study.manifest()
+    fn = task_fn or default_task_fn(study, manifest["digests"])
     with ResultStore(out_dir) as store:
-        finished, todo = store.start(study.manifest(), tasks, resume=resume)
+        finished, todo = store.start(manifest, tasks, resume=resume)
         if on_start is not None:
             on_start(len(finished), len(tasks))
         by_index: dict[int, dict] = {}

@@ -2,48 +2,109 @@
 
 This is the only module of the study that knows the simulator. A worker process keeps the
 worlds it has read and the rule bases it has compiled (per operator choice) in small caches, so
-a chunk of tasks pays for parsing and compiling once.
+a chunk of tasks pays for parsing and compiling once. The caches are keyed on what the files
+hold (their digests, as ``study.json`` records them), not on their paths: a file edited between
+two studies of one session (a notebook, a Dask cluster) is read again.
 """
 
 from __future__ import annotations
 
 import functools
+import hashlib
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
+from pathlib import Path
 
 from .spec import Choice, Task
-from .store import RESULT_FIELDS
+from .store import RESULT_FIELDS, StudyError
+
+#: the key of the rule base's digest among a study's (the others are its world files)
+RULEBASE = "rulebase"
 
 
 @dataclass(frozen=True)
 class StudyContext:
-    """What every task of a study shares: the fuzzy planner's rule base and behavior."""
+    """What every task of a study shares: the fuzzy planner's rule base and behavior, and
+    the digests of its files that ``study.json`` records (``(name, digest)`` pairs; without
+    them, each file's digest is taken as it is now)."""
 
     rulebase: str | None = None
     behavior: str | None = None
+    digests: tuple[tuple[str, str], ...] = ()
+
+    def digest(self, name: str) -> str | None:
+        """The recorded digest of a world file (or of :data:`RULEBASE`), if any."""
+        return dict(self.digests).get(name)
+
+
+def file_digest(paths: Sequence[Path]) -> str | None:
+    """A digest of the files' bytes (16 hex digits); None when one cannot be read (reported
+    where the file is read)."""
+    h = hashlib.sha256()
+    try:
+        for p in paths:
+            h.update(p.read_bytes())
+    except OSError:
+        return None
+    return h.hexdigest()[:16]
+
+
+def rulebase_digest(rb) -> str | None:
+    """A digest of the files a rule base was read from: its own and its term sets."""
+    if rb.path is None:
+        return None
+    path = Path(rb.path)
+    return file_digest([path] + [path.parent / p for p in rb.termset_paths])
+
+
+def _world_key(context: StudyContext, path: str) -> str | None:
+    return context.digest(path) or file_digest([Path(path)])
+
+
+def _rulebase_key(context: StudyContext) -> str | None:
+    if context.digest(RULEBASE) is not None:
+        return context.digest(RULEBASE)
+    from ..api import read_rulebase
+
+    return rulebase_digest(read_rulebase(context.rulebase))
+
+
+def _unchanged(what: str, key: str | None, now: str | None) -> None:
+    """A file that no longer holds what the study recorded: its runs would be of another
+    file than ``study.json`` says (keyed on the path, a later study of the session ran the
+    file as it was when first read)."""
+    if key is not None and now != key:
+        raise StudyError(f"{what} changed while the study ran; its runs so far are of the "
+                         f"file as it was", hint="put the file back and resume (--resume), or "
+                         "run the study again in another directory (-o)")
 
 
 @functools.lru_cache(maxsize=32)
-def _world(path: str):
+def _world(path: str, key: str | None):
     from ..sim.worldfile import load_world
 
-    return load_world(path)
+    world = load_world(path)
+    _unchanged(f"the world file `{path}`", key, file_digest([Path(path)]))
+    return world
 
 
 @functools.lru_cache(maxsize=8)
-def _rulebase(path: str | None):
+def _rulebase(path: str | None, key: str | None):
     from ..api import read_rulebase
 
-    return read_rulebase(path)
+    rb = read_rulebase(path)
+    _unchanged("the rule base", key, rulebase_digest(rb))
+    return rb
 
 
 @functools.lru_cache(maxsize=64)
-def loaded_rulebase(path: str | None, behavior: str | None, overrides: tuple):
-    """The rule base compiled with the choice's operators (``overrides``: (key, value) pairs)."""
+def loaded_rulebase(path: str | None, key: str | None, behavior: str | None, overrides: tuple):
+    """The rule base compiled with the choice's operators (``overrides``: (key, value) pairs;
+    ``key``: the digest of its files)."""
     from ..api import LoadedRuleBase
     from ..lang.model import Setting
 
-    return LoadedRuleBase(_rulebase(path), behavior,
+    return LoadedRuleBase(_rulebase(path, key), behavior,
                           tuple(Setting(k, v) for k, v in overrides))
 
 
@@ -53,24 +114,30 @@ def check_choice(choice: Choice, context: StudyContext, world_path: str) -> None
 
 
 @functools.lru_cache(maxsize=32)
-def _scene(path: str):
+def _scene(path: str, key: str | None):
     """Walls and routes of a world, shared by its randomised runs (``None``: each run
     prepares its own, where a draw moves what the robots are given; :func:`shared_scene`)."""
     from ..sim.loop import shared_scene
 
-    return shared_scene(_world(path), True)
+    return shared_scene(_world(path, key), True)
+
+
+def _planner(context: StudyContext, choice: Choice, path: str):
+    rulebase = _rulebase_key(context) if choice.planner == "fuzzy" else None
+    return _make_planner(context, choice, path, _world_key(context, path), rulebase)
 
 
 @functools.lru_cache(maxsize=64)
-def _planner(context: StudyContext, choice: Choice, path: str):
+def _make_planner(context: StudyContext, choice: Choice, path: str, key: str | None,
+                  rulebase: str | None):
     from ..sim.planner import make_planner
 
-    world = _world(path)
+    world = _world(path, key)
     if choice.planner != "fuzzy":
         return make_planner(choice.planner, world)
     behavior = context.behavior or world.behavior
-    return make_planner("fuzzy", world,
-                        loaded_rulebase(context.rulebase, behavior, choice.overrides()), behavior)
+    return make_planner("fuzzy", world, loaded_rulebase(context.rulebase, rulebase, behavior,
+                                                        choice.overrides()), behavior)
 
 
 def run_task(context: StudyContext, task: Task) -> dict:
@@ -78,9 +145,9 @@ def run_task(context: StudyContext, task: Task) -> dict:
     :data:`RESULT_FIELDS`."""
     from ..sim.loop import simulate
 
-    world = _world(task.world)
-    result = simulate(world, _planner(context, task.choice, task.world), task.seed,
-                      randomise=True, scene=_scene(task.world))
+    key = _world_key(context, task.world)
+    result = simulate(_world(task.world, key), _planner(context, task.choice, task.world),
+                      task.seed, randomise=True, scene=_scene(task.world, key))
     return _fields(result)
 
 
@@ -94,8 +161,9 @@ def run_tasks(context: StudyContext, tasks: Sequence[Task]) -> Iterator[tuple[Ta
     for task in tasks:
         groups.setdefault((task.world, task.choice), []).append(task)
     for (path, choice), group in groups.items():
-        runs = Lockstep(_world(path), _planner(context, choice, path),
-                        [task.seed for task in group], randomise=True, scene=_scene(path))
+        key = _world_key(context, path)
+        runs = Lockstep(_world(path, key), _planner(context, choice, path),
+                        [task.seed for task in group], randomise=True, scene=_scene(path, key))
         for j, result in runs.finished():
             yield group[j], _fields(result)
 
