@@ -182,12 +182,15 @@ def test_an_output_that_is_a_file_is_refused_as_such(tiny, tmp_path, compare):
     (["TINY", "--executor", "dsk"], 2, "did you mean `dask`"),
     (["TINY", "--behavior", "drve"], 1, "drive"),
     (["TINY", "TINY"], 2, "given twice"),
+    (["TINY", "TINY_AGAIN"], 2, "given twice"),    # (another spelling: Study's exit 1)
     (["TINY", "--planner", "dwa", "--and", "product"], 2, "--and chooses the fuzzy planner's"),
     (["TINY", "--runs", "1000000"], 2, "is not in the range 1<=x<=100000"),   # (no memory
     (["TINY", "-n", "1000000"], 2, "is not in the range 1<=x<=100000"),       # for the tasks)
 ])
 def test_user_errors(tiny, tmp_path, compare, args, code, words):
-    r = compare(*[tiny if a == "TINY" else a for a in args], "-o", tmp_path / "e")
+    again = str(Path(tiny).parent / ".." / Path(tiny).parent.name / "tiny.yaml")
+    r = compare(*[{"TINY": tiny, "TINY_AGAIN": again}.get(a, a) for a in args], "-o",
+                tmp_path / "e")
     assert r.exit_code == code, r.output
     assert words in r.output
     assert not (tmp_path / "e" / "results.csv").exists()

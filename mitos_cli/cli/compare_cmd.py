@@ -214,12 +214,14 @@ def check_inputs(worlds: list[str], choices, rulebase: str | None,
     from ..study.simtask import StudyContext, check_choice
 
     paths = []
+    files: set[Path] = set()
     for name in worlds:
         path = str(resolve_world_path(name))
         for note in load_world(path).notes:    # likely mistakes the file may hold
             warn(note)
-        if path in paths:
+        if Path(path).resolve() in files:     # (`a.yaml` and `./a.yaml` too, as Study says)
             raise typer.BadParameter(f"the world `{name}` is given twice")
+        files.add(Path(path).resolve())
         paths.append(path)
     context = StudyContext(rulebase, behavior)
     for path in paths:
