@@ -317,6 +317,17 @@ def test_trace_shows_a_huge_or_tiny_output_readably(tmp_path, capsys):
     assert "  y = 1.7e+148\n" in out, out
 
 
+def test_trace_render_takes_the_digits_eval_takes(rb):
+    """`render(-1)` and `render(True)` raised "Format specifier missing precision", `render(1.5)`
+    a TypeError, and `render(99)` was taken where `eval --digits` allows 0 to 12."""
+    trace = rb.trace(road=78, size=45, position=4)
+    for digits in (-1, 13, 99, 1.5, True, np.True_, "2", None):
+        with pytest.raises(InputError, match=r"digits is a whole number from 0 to 12 "):
+            trace.render(digits)
+    assert "  speed = 32 in/s" in trace.render(0)
+    assert "  speed = 32.424242424242 in/s" in trace.render(np.int64(12))
+
+
 def test_json_names_the_outputs_that_are_their_default(tmp_path, capsys):
     """The text trace's "(its default: no rule sets it here)", for machines: `defaulted`."""
     terms = (ROOT / "rulebases" / "mitos.terms.yaml").read_text(encoding="utf-8")

@@ -7,13 +7,18 @@ for machines (the ``mitos eval --json`` contract).
 
 from __future__ import annotations
 
+import operator
 from dataclasses import dataclass
 
 import numpy as np
 
+from ..errors import InputError
 from ..resources import display_path
 from ..words import plural, with_unit
 from .evaluation import Result, declares_nan
+
+#: the decimals :meth:`Trace.render` gives, as ``mitos eval --digits`` allows them
+DIGITS = (0, 12)
 
 #: From this magnitude the trace shows a number as ``1.69158e+148``: a float's 17 digits end
 #: there, and the fixed form's further digits say nothing.
@@ -74,6 +79,8 @@ class Trace:
 
     def render(self, digits: int = 1) -> str:
         """The paper's layout: fuzzified inputs, fired rules with DOFs, crisp outputs."""
+        digits = _digits(digits)
+
         def num(x: float) -> str:
             if abs(x) >= LONG:                  # not 150 digits, most of them noise
                 return f"{x:.{max(digits, 6)}g}"
@@ -104,6 +111,19 @@ class Trace:
             note = "   (its default: no rule sets it here)" if name in self.defaulted else ""
             lines.append(f"  {name} = {with_unit(num(value), unit)}".rstrip() + note)
         return "\n".join(lines)
+
+
+def _digits(value: object) -> int:
+    """``value`` as a number of decimals, else an :class:`InputError` (-1 and ``True`` met
+    "Format specifier missing precision", 1.5 a TypeError, and 99 was taken)."""
+    try:
+        n = -1 if isinstance(value, (bool, np.bool_)) else operator.index(value)  # type: ignore[arg-type]
+    except TypeError:
+        n = -1
+    if not DIGITS[0] <= n <= DIGITS[1]:
+        raise InputError(f"digits is a whole number from {DIGITS[0]} to {DIGITS[1]} "
+                         f"(as `mitos eval --digits`), not `{value!r:.40}`")
+    return n
 
 
 def trace_of(result: Result, row: int = 0, given: np.ndarray | None = None) -> Trace:
