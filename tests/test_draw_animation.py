@@ -8,8 +8,9 @@ import pytest
 from typer.testing import CliRunner
 
 from mitos_cli.cli.app import app, main
-from mitos_cli.draw.animation import frame_ticks
+from mitos_cli.draw.animation import animate_run, frame_ticks
 from mitos_cli.draw.frame import ROBOT_COLOUR
+from mitos_cli.errors import InputError
 from mitos_cli.resources import packaged_path
 
 PIL = pytest.importorskip("PIL.Image")
@@ -74,3 +75,22 @@ def test_mp4_without_ffmpeg_says_so(short_world, tmp_path, monkeypatch, capsys):
     assert code == 1
     assert "MP4 needs ffmpeg, which is not on the PATH" in err
     assert "write a .gif" in err
+
+
+def test_animate_run_takes_the_fps_and_width_the_cli_takes(short_world, tmp_path):
+    """From Python, fps 0 met a ZeroDivisionError, -1 and 1e-6 an OverflowError and NaN a
+    ValueError deep inside, width_px 0 an IndexError, and `fps=True` was 1 frame a second."""
+    from mitos_cli.sim import load_world, simulate
+
+    result = simulate(load_world(short_world))
+    gif = tmp_path / "a.gif"
+    for fps in (0, -1, float("nan"), float("inf"), 1e-6, 60.5, True, "10", None):
+        with pytest.raises(InputError, match=r"fps is a number of frames per second from 0.1 "
+                                             r"to 60 \(as `mitos simulate --fps`\), not `"):
+            animate_run(result, gif, fps=fps)
+    for width in (0, -5, 99, 4001, 720.0, True, "720"):
+        with pytest.raises(InputError, match=r"width_px is a whole number of pixels from 100 "
+                                             r"to 4000, not `"):
+            animate_run(result, gif, width_px=width)
+    assert not gif.exists()
+    assert animate_run(result, gif, fps=np.float64(2.5), width_px=np.int64(100)) == 6

@@ -11,17 +11,24 @@ file plays at ``fps`` (real time).
 from __future__ import annotations
 
 import functools
+import math
+import numbers
+import operator
 from pathlib import Path
 
 import numpy as np
 
-from ..errors import WriteError
+from ..errors import InputError, WriteError
 from .frame import OBSTACLE_COLOUR, ROBOT_COLOUR, TRAIL_COLOUR, draw_background
 from .output import DrawError, _matplotlib, literal_text, new_figure
 
 FORMATS = ("gif", "mp4")
 BARS = 8                    # fired rules shown, by DOF
 OTHER_ROBOTS = ("#d17a00", "#7b3fa0", "#008b8b", "#a0522d")
+#: frames per second, as ``mitos simulate --fps`` takes them
+FPS = (0.1, 60.0)
+#: the picture's width in pixels (the CLI's is 720)
+WIDTH_PX = (100, 4000)
 
 
 def check_format(path: str | Path) -> str:
@@ -50,11 +57,42 @@ def frame_ticks(ticks: int, dt: float, fps: float) -> np.ndarray:
     return picked if picked[-1] == ticks - 1 else np.append(picked, ticks - 1)
 
 
+def check_fps(fps: object) -> float:
+    """``fps`` as a number of frames per second in :data:`FPS`, else an :class:`InputError`
+    (0 met a ZeroDivisionError, -1 and 1e-6 an OverflowError, NaN a ValueError inside, and
+    ``True`` was 1 frame per second)."""
+    try:
+        real = isinstance(fps, numbers.Real) and not isinstance(fps, (bool, np.bool_))
+        value = float(fps) if real else math.nan  # type: ignore[arg-type]
+    except OverflowError:                                   # 10**400
+        value = math.nan
+    if not FPS[0] <= value <= FPS[1]:
+        raise InputError(f"fps is a number of frames per second from {FPS[0]:g} to {FPS[1]:g} "
+                         f"(as `mitos simulate --fps`), not `{fps!r:.40}`")
+    return value
+
+
+def check_width(width_px: object) -> int:
+    """``width_px`` as a whole number of pixels in :data:`WIDTH_PX`, else an
+    :class:`InputError` (0 met an IndexError inside, -5 matplotlib's "figure size must be
+    positive", and a width of millions of pixels would fill the memory)."""
+    try:
+        n = (-1 if isinstance(width_px, (bool, np.bool_))
+             else operator.index(width_px))  # type: ignore[arg-type]
+    except TypeError:
+        n = -1
+    if not WIDTH_PX[0] <= n <= WIDTH_PX[1]:
+        raise InputError(f"width_px is a whole number of pixels from {WIDTH_PX[0]} to "
+                         f"{WIDTH_PX[1]}, not `{width_px!r:.40}`")
+    return n
+
+
 def animate_run(result, path: str | Path, *, fps: float = 10.0, detail=None,
                 width_px: int = 720) -> int:
     """Write ``result`` as an animation to ``path``; ``detail`` is the planner's engine result
     for robot 0 (rows = ticks, :func:`mitos_cli.sim.export.explain`) for the DOF panel.
     Returns the number of frames written."""
+    fps, width_px = check_fps(fps), check_width(width_px)
     fmt = check_format(path)
     _matplotlib()
     from matplotlib import animation
