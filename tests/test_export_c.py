@@ -278,6 +278,39 @@ def test_python_export_evaluate_one_names_a_missing_or_unknown_input(tmp_path: P
                                                                     position=4), abs=1e-12)
 
 
+def test_python_export_checks_its_values_and_hints_a_swap(tmp_path: Path) -> None:
+    """`evaluate_one(raod=...)` got no hint (a swap counted as two edits), a 3-D `X` met NumPy's
+    "could not broadcast", bools were read as 1 and 0, and an array for one input met NumPy's
+    "only 0-dimensional arrays can be converted"."""
+    c = load_rulebase(ROOT / "rulebases" / "mitos.rules").compiled
+    path = tmp_path / "planner.py"
+    path.write_text(to_python(c, "test"))
+    spec = importlib.util.spec_from_file_location("planner", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    for typo in ("raod", "Road", "szie", "postiion"):
+        with pytest.raises(TypeError, match=rf"argument '{typo}'; did you mean '(road|size|posi)"):
+            module.evaluate_one(**{typo: 1})
+    with pytest.raises(ValueError, match=r"X must be 2-D, one row of 3 inputs per sample "
+                                         r"\(X\[n, 3\]\), not of shape \(2, 3, 3\)$"):
+        module.evaluate(np.zeros((2, 3, 3)))
+    for X in ([[True, 45, 4]], np.ones((2, 3), dtype=bool), np.array([[78, False, 4]], dtype=object),
+              (78.0, 45.0, np.True_)):
+        with pytest.raises(TypeError, match=r"X must hold numbers, not bools"):
+            module.evaluate(X)
+    for value in (True, np.array(True), [False]):
+        with pytest.raises(TypeError, match=r"takes numbers, not bools: road="):
+            module.evaluate_one(road=value, size=45, position=4)
+    for value in (np.array([1.0, 2.0]), [78], np.zeros((1, 1))):
+        with pytest.raises(TypeError, match=r"takes one number per input, not .* for 'road'; "
+                                            r"evaluate\(X\) takes many samples"):
+            module.evaluate_one(road=value, size=45, position=4)
+    one = module.evaluate(np.array([[78.0, 45.0, 4.0]]))
+    assert module.evaluate([78, 45, 4]).tobytes() == one.tobytes()            # a row as before
+    assert module.evaluate_one(road=np.array(78.0), size=np.int64(45), position="4") == \
+        dict(zip(module.OUTPUTS, one[0].tolist()))
+
+
 def test_export_refuses_tsukamoto_at_the_operators_line(tmp_path: Path, capsys) -> None:
     """`format error: `mitos export` has no code for Tsukamoto inference` said neither file
     nor line; now it points at the `inference = tsukamoto` that chose it."""

@@ -30,8 +30,9 @@ def doc_text(text: str) -> str:
 
 
 #: evaluate_one's check of its keywords: a TypeError as a Python function's call gives, with
-#: the closest input for an unknown one (a bare KeyError, or a typo silently ignored, before).
-#: Plain Python, no import: the module imports NumPy alone (tests/test_export_hostile.py).
+#: the closest input for an unknown one (a bare KeyError, or a typo silently ignored, before;
+#: ``raod`` got no hint, a swap of two letters counting as two edits). Plain Python, no
+#: import: the module imports NumPy alone (tests/test_export_hostile.py).
 CHECK_NAMES = [
     "def _check_names(inputs):",
     '    """A missing or unknown input, as a TypeError naming it."""',
@@ -50,17 +51,75 @@ CHECK_NAMES = [
     "",
     "",
     "def _closest(name):",
-    '    """The input fewest edits from ``name`` (at most a third of its length), or None."""',
+    '    """The input fewest edits from ``name`` in any case (at most a third of its length; two',
+    '    letters swapped are one edit), else the one input it begins, or None."""',
+    "    low = name.lower()",
     "    best, found = max(1, len(name) // 3) + 1, None",
     "    for other in INPUTS:",
-    "        row = list(range(len(other) + 1))",
-    "        for i, a in enumerate(name, 1):",
-    "            prev, row[0] = row[0], i",
-    "            for j, b in enumerate(other, 1):",
-    "                prev, row[j] = row[j], min(row[j] + 1, row[j - 1] + 1, prev + (a != b))",
-    "        if row[-1] < best:",
-    "            best, found = row[-1], other",
+    "        edits = _edits(low, other.lower())",
+    "        if edits < best:",
+    "            best, found = edits, other",
+    "    if found is None and len(name) >= 3:",
+    "        starts = [other for other in INPUTS if other.lower().startswith(low)]",
+    "        found = starts[0] if len(starts) == 1 else None",
     "    return found",
+    "",
+    "",
+    "def _edits(a, b):",
+    '    """Insertions, deletions, substitutions and swaps of two neighbours from ``a`` to ``b``."""',
+    "    before, row = None, list(range(len(b) + 1))",
+    "    for i in range(1, len(a) + 1):",
+    "        above, row = row, [i] + [0] * len(b)",
+    "        for j in range(1, len(b) + 1):",
+    "            row[j] = min(above[j] + 1, row[j - 1] + 1, above[j - 1] + (a[i - 1] != b[j - 1]))",
+    "            if i > 1 and j > 1 and a[i - 1] == b[j - 2] and a[i - 2] == b[j - 1]:",
+    "                row[j] = min(row[j], before[j - 2] + 1)",
+    "        before = above",
+    "    return row[-1]",
+    ""]
+
+
+#: evaluate's and evaluate_one's check of their values: what NumPy would take silently (a bool
+#: as 1 or 0) or reject with its own words from deep inside (a 3-D ``X``: "could not broadcast";
+#: an array for one input: "only 0-dimensional arrays can be converted").
+CHECK_VALUES = [
+    "def _rows(X):",
+    '    """``X`` as floats ``[n, k]`` (one sample ``[k]`` as one row), or an error saying why not."""',
+    "    if _holds_bool(X):",
+    "        raise TypeError('X must hold numbers, not bools: True and False would be read as 1 '",
+    "                        'and 0')",
+    "    X = np.atleast_2d(np.asarray(X, dtype=float))",
+    "    if X.ndim != 2:",
+    "        raise ValueError(f'X must be 2-D, one row of {len(INPUTS)} inputs per sample '",
+    "                         f'(X[n, {len(INPUTS)}]), not of shape {X.shape}')",
+    "    if X.shape[1] != len(INPUTS):",
+    "        raise ValueError(f'expected {len(INPUTS)} input columns: ' + ', '.join(INPUTS))",
+    "    return X",
+    "",
+    "",
+    "def _holds_bool(value):",
+    '    """Whether ``value`` is a bool or holds one (NumPy reads a bool among numbers as 1 or 0)."""',
+    "    if isinstance(value, (bool, np.bool_)):",
+    "        return True",
+    "    if isinstance(value, np.ndarray):",
+    "        return value.dtype == bool or (value.dtype.kind == 'O'",
+    "                                         and any(_holds_bool(v) for v in value.flat))",
+    "    if isinstance(value, (list, tuple)):",
+    "        for v in value:",
+    "            if isinstance(v, (bool, np.bool_, list, tuple, np.ndarray)) and _holds_bool(v):",
+    "                return True",
+    "    return False",
+    "",
+    "",
+    "def _value(name, value):",
+    '    """One input\'s value as a float: not a bool (read as 1 or 0), not several values."""',
+    "    if _holds_bool(value):",
+    "        raise TypeError(f'evaluate_one() takes numbers, not bools: {name}={value!r} would be '",
+    "                        'read as 1 or 0')",
+    "    if isinstance(value, (list, tuple)) or np.ndim(value) != 0:",
+    "        raise TypeError(f'evaluate_one() takes one number per input, not {value!r:.60} for '",
+    "                        f'{name!r}; evaluate(X) takes many samples, one row each')",
+    "    return float(value)",
     ""]
 
 
@@ -80,9 +139,9 @@ def to_python(compiled: CompiledRuleBase, source: str = "") -> str:
     out += ["def evaluate_one(**inputs):",
             '    """Outputs by name for one value per input (by name)."""',
             "    _check_names(inputs)",
-            "    row = np.array([[float(inputs[name]) for name in INPUTS]])",
+            "    row = np.array([[_value(name, inputs[name]) for name in INPUTS]])",
             "    return dict(zip(OUTPUTS, (float(v) for v in evaluate(row)[0])))", "", "",
-            *CHECK_NAMES]
+            *CHECK_NAMES, "", *CHECK_VALUES]
     return "\n".join(out)
 
 
@@ -110,11 +169,8 @@ def _py_header(p: Program, source: str) -> list[str]:
 def _py_evaluate(p: Program) -> list[str]:
     """``evaluate(X)``: clamped inputs, one array per membership and per rule, the outputs."""
     c = p.compiled
-    k = len(c.inputs)
     out = ["def evaluate(X):", '    """Outputs ``Y[n, m]`` for inputs ``X[n, k]``."""',
-           "    X = np.atleast_2d(np.asarray(X, dtype=float))",
-           f"    if X.shape[1] != {k}:",
-           f"        raise ValueError('expected {k} input columns: ' + ', '.join(INPUTS))",
+           "    X = _rows(X)",
            "    lo = np.array([u[0] for u in UNIVERSE]); hi = np.array([u[1] for u in UNIVERSE])",
            "    x = np.clip(X, lo, hi).T",
            "    Y = np.empty((X.shape[0], len(OUTPUTS)))"]
