@@ -254,3 +254,25 @@ def test_examples_on_a_corner_give_the_slope_of_the_side_where_q_falls():
     assert slope > 0 and g[knot] == pytest.approx(slope, rel=1e-4)
     result = adapt(c, X, T, epochs=20)
     assert result.values[knot] < p.values[knot] and result.q_after < 0.5 * q
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_a_direction_with_each_knot_its_own_step_descends_and_keeps_the_constraints(seed):
+    """The metric of the per-knot steps (``adapt``'s first trial direction): still a descent
+    direction, ties, symmetric triangles and frozen knots kept, and knots at a bound or
+    touching a neighbour not pushed through it."""
+    from mitos_cli.teach.adapt import _knot_steps, descent_direction
+
+    compiled = load_rulebase().compiled
+    p = parameterise(compiled)
+    rng = np.random.default_rng(seed)
+    values = p.values.copy()
+    values[:] = np.clip(values, p.lo, p.hi)
+    g = rng.normal(size=len(values)) / p.scale
+    factor, _ = _knot_steps(np.ones(len(values)), rng.normal(size=len(values)), g * p.scale)
+    assert set(np.unique(factor)) <= {0.5, 1.0}
+    d = descent_direction(p, values, g, metric=factor)
+    assert (g * p.scale) @ d < 0
+    assert np.allclose(p.constraints @ d, 0.0, atol=1e-9)
+    step = d * (0.025 / np.abs(d).max())
+    assert feasible(p, values + step * p.scale)

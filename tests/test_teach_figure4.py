@@ -132,6 +132,22 @@ def test_500_epochs_of_the_lesson_hold_order_coverage_and_points_at_every_epoch(
     assert {("heading", "AHEAD"), ("steering", "ST")} <= {(v, t) for v, t, _ in p.held}
 
 
+def test_500_epochs_of_the_lesson_do_not_stop_beside_a_kink(taught):
+    """The steepest step, scaled to the knot that moves most, stopped at Q 367.6 after 500
+    epochs (367.1 when converged) where Q still fell along a feasible direction: `heading`'s
+    knot at -25.8 deg lay 0.0008 deg from an example's input, where Q's slope in it turns, so
+    every full step carried it over and was halved until the other knots hardly moved. Tried
+    beside it once it is halved, a step with each knot its own share (halved where its slope
+    turns) goes on to 334.9."""
+    from mitos_cli.teach.adapt import adapt
+
+    session, _, _ = taught
+    compiled = compile_untaught(session)
+    X, T = session.training_set(compiled)
+    result = adapt(compiled, X, T, epochs=500, rate=0.5)
+    assert result.q_after < 345
+
+
 def compile_untaught(session):
     from mitos_cli.engine.compile import compile_rulebase
 

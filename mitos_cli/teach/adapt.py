@@ -36,7 +36,12 @@ frozen rules (``frozen r4``) and shapes that are not piecewise linear keep their
 **The step** (eq. 14, ``w <- w - eta dQ/dw`` with ``eta`` in (0, 1)): parameters are measured
 in fractions of their universe, the projected gradient is normalised so that the parameter
 that moves most moves ``eta`` x :data:`STEP` of its universe, and the step is halved until
-``Q`` decreases and every constraint holds; so ``Q`` never increases. Learned values are
+``Q`` decreases and every constraint holds; so ``Q`` never increases. When that step had to be
+halved, the same step along a second direction is tried too and the lower ``Q`` kept: the
+projected gradient with each knot's component scaled by the knot's own share of the step
+(:func:`_knot_steps`: halved each time the knot's slope turns, as Rprop's step sizes). A knot
+lying beside a kink of ``Q`` (an example's input just past it) otherwise sets the size of every
+step and the others hardly move: the shipped lesson's steepest descent stopped there. Learned values are
 rounded to a readable grid (``decimals``) and kept only if ``Q`` is still no worse.
 """
 
@@ -1034,16 +1039,27 @@ def _need(p: Parameters, ids: np.ndarray, k: int) -> np.ndarray:
 
 
 def descent_direction(p: Parameters, values: np.ndarray, grad: np.ndarray,
-                      held: tuple[int, ...] = ()) -> np.ndarray:
+                      held: tuple[int, ...] = (), metric: np.ndarray | None = None) -> np.ndarray:
     """The projected steepest-descent direction (scaled coordinates) that does not push a knot
     through a bound or a neighbour it already touches (active constraints held fixed), nor
-    move the knots ``held`` (whose move breaks a partition's coverage or distinctness)."""
+    move the knots ``held`` (whose move breaks a partition's coverage or distinctness).
+
+    ``metric`` (positive, one per knot) measures a knot's move as cheaper the larger its entry:
+    the direction is steepest in the coordinates ``y = u / sqrt(metric)``, so that it is
+    ``-metric * grad`` where nothing binds and still a descent direction
+    (``grad . d = -|P sqrt(metric) grad|^2``) that keeps every linear constraint."""
     g = grad * p.scale
     base = p.constraints if p.constraints is not None else np.zeros((0, len(values)))
     extra: list[np.ndarray] = [np.eye(len(values))[i] for i in held]
-    projector = _null_projector(np.vstack([base] + extra)) if held else p.projector
+    root = None if metric is None else np.sqrt(metric)
+
+    def null(rows: list[np.ndarray]) -> np.ndarray:
+        C = np.vstack([base] + rows)
+        return _null_projector(C if root is None else C * root)
+
+    projector = null(extra) if held or root is not None else p.projector
     for _ in range(len(values) + 1):
-        d = -(projector @ g)
+        d = -(projector @ g) if root is None else -root * (projector @ (root * g))
         tol = 1e-7 * p.scale
         rows = []
         for i in np.flatnonzero(((values - p.lo <= tol) & (d < 0))
@@ -1061,7 +1077,7 @@ def descent_direction(p: Parameters, values: np.ndarray, grad: np.ndarray,
         if not rows:
             return d
         extra += rows
-        projector = _null_projector(np.vstack([base] + extra))
+        projector = null(extra)
     return np.zeros_like(values)                         # pragma: no cover - all blocked
 
 
@@ -1118,6 +1134,58 @@ def partitions_hold(p: Parameters, values: np.ndarray) -> bool:
     return True
 
 
+#: A knot's share of the step shrinks by this when its slope changes sign (it stepped over a
+#: kink or a minimum of Q in it), and grows by :data:`GROW` (up to the whole step) when not.
+SHRINK = 0.5
+GROW = 1.2
+#: The least share of the step a knot keeps.
+FLOOR = 1e-6
+
+
+def _knot_steps(factor: np.ndarray, previous: np.ndarray,
+                g: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Each knot's share of the step (in (0, 1]) after one more slope ``g`` (scaled
+    coordinates), as Rprop sets its step sizes (Riedmiller and Braun, 1993; iRprop-, Igel and
+    Huesken, 2000): halved where the slope turned, grown where it kept its sign; a turned
+    slope is forgotten, so that it shrinks the share once. And the slope to compare with next."""
+    turned = g * previous < 0
+    kept = g * previous > 0
+    factor = np.where(turned, np.maximum(factor * SHRINK, FLOOR),
+                      np.where(kept, np.minimum(factor * GROW, 1.0), factor))
+    return factor, np.where(turned, 0.0, g)
+
+
+def _line(p: Parameters, values: np.ndarray, grad: np.ndarray, Q: float, X: np.ndarray,
+          targets: np.ndarray, rate: float, step: float, metric: np.ndarray | None,
+          plain: np.ndarray) -> tuple[np.ndarray, float, float, bool]:
+    """One epoch's trial steps along the direction of ``metric`` (``None``: the steepest,
+    ``plain``): halved until ``Q`` falls and every constraint holds; a step that lowers ``Q``
+    but breaks a partition holds the knots that break it and is tried again at the same size.
+    ``(candidate, Q there, step, accepted)``."""
+    direction = plain if metric is None else descent_direction(p, values, grad, metric=metric)
+    direction = _scaled(direction, rate)
+    candidate, q_new = values, Q
+    if not direction.any():
+        return candidate, q_new, step, False
+    held: tuple[int, ...] = ()
+    for _ in range(HALVINGS):
+        candidate = values + step * direction * p.scale
+        if feasible(p, candidate, partitions=False):       # the cheap checks first
+            q_new = loss(with_values(p, candidate), X, targets)
+            if q_new < Q and partitions_hold(p, candidate):
+                return candidate, q_new, step, True
+            if q_new < Q:               # a partition breaks: hold the knots that break it
+                more = blocking(p, values, step * direction * p.scale)
+                if more and not set(more) <= set(held):
+                    held = tuple(sorted(set(held) | set(more)))
+                    direction = _scaled(descent_direction(p, values, grad, held, metric), rate)
+                    if not direction.any():
+                        break
+                    continue                # the others at the same step
+        step *= 0.5
+    return candidate, q_new, step, False
+
+
 def adapt(compiled: CompiledRuleBase, X: np.ndarray, targets: np.ndarray, *, epochs: int = 50,
           rate: float = 0.5, on_epoch: Callable[[int, float], None] | None = None,
           parameters: Parameters | None = None, constrained: bool = True,
@@ -1134,37 +1202,29 @@ def adapt(compiled: CompiledRuleBase, X: np.ndarray, targets: np.ndarray, *, epo
     Q, grad = gradient(p, values, X, targets)
     history = [Q]
     step = 1.0
+    factor = np.ones(len(values))        # each knot's share of the step (_knot_steps)
+    previous = np.zeros(len(values))
     converged = False
     interrupted = False
     try:
         for epoch in range(1, epochs + 1):
-            direction = descent_direction(p, values, grad)       # scaled coordinates
-            biggest = np.max(np.abs(direction)) if direction.size else 0.0
+            plain = descent_direction(p, values, grad)           # scaled coordinates
+            biggest = np.max(np.abs(plain)) if plain.size else 0.0
             if biggest <= 1e-15 or Q <= 0.0:
                 converged = True
                 break
-            direction *= rate * STEP / biggest
-            accepted = False
-            held: tuple[int, ...] = ()
-            for _ in range(HALVINGS):
-                candidate = values + step * direction * p.scale
-                if feasible(p, candidate, partitions=False):       # the cheap checks first
-                    q_new = loss(with_values(p, candidate), X, targets)
-                    if q_new < Q and partitions_hold(p, candidate):
-                        accepted = True
-                        break
-                    if q_new < Q:               # a partition breaks: hold the knots that break it
-                        more = blocking(p, values, step * direction * p.scale)
-                        if more and not set(more) <= set(held):
-                            held = tuple(sorted(set(held) | set(more)))
-                            direction = _scaled(descent_direction(p, values, grad, held), rate)
-                            if not direction.any():
-                                break
-                            continue                # the others at the same step
-                step *= 0.5
+            factor, previous = _knot_steps(factor, previous, grad * p.scale)
+            candidate, q_new, trial, accepted = _line(p, values, grad, Q, X, targets, rate,
+                                                      step, None, plain)
+            if (not accepted or trial < step) and factor.min() < 1.0:
+                # halved: a knot by a kink may set the step; each knot its own share
+                other = _line(p, values, grad, Q, X, targets, rate, step, factor, plain)
+                if other[3] and (not accepted or other[1] < q_new):
+                    candidate, q_new, trial, accepted = other
             if not accepted:
                 converged = True
                 break
+            step = trial
             values = candidate
             Q, grad = gradient(p, values, X, targets)
             history.append(Q)
