@@ -242,6 +242,8 @@ def _robot(world, **changes):
     (lambda w: {"agents": _robot(w, max_speed=float("nan"))},
      "`agents[0].robot.max_speed` must be a finite number"),
     (lambda w: {"agents": _robot(w, wheelbase=30.0)}, "`agents[0].robot.wheelbase` must be at most"),
+    (lambda w: {"agents": _robot(w, steering_min=150.0, steering_max=30.0)},
+     "`agents[0].robot.steering_min` must be below steering_max (30), not 150.0"),
     (lambda w: {"sensors": dataclasses.replace(w.sensors, range=0.0)},
      "`sensors.range` must be positive"),
     (lambda w: {"sensors": dataclasses.replace(w.sensors, count=0)},
@@ -250,6 +252,8 @@ def _robot(world, **changes):
      "`obstacles[0].radius` must be positive"),
     (lambda w: {"corridors": (dataclasses.replace(w.corridors[0], width=float("inf")),)},
      "`corridors[0].width` must be a finite number"),
+    (lambda w: {"corridors": (dataclasses.replace(w.corridors[0], points=((0.0, 0.0),)),)},
+     "`corridors[0].points` must be a list of at least 2 points (x, y), not ((0.0, 0.0),)"),
 ])
 def test_a_world_changed_in_python_is_checked_as_its_file_would_be(change, says):
     """time_limit=0 said "no tick recorded yet" (the Gymnasium environment "the run has
@@ -267,6 +271,17 @@ def test_a_world_changed_in_python_is_checked_as_its_file_would_be(change, says)
     with pytest.raises(WorldError, match=re.escape(says)):
         gymnasium.make("mitos/World-v0", world=bad)
     assert Simulation(dataclasses.replace(world, seed=np.int64(3))).seed == 3   # an integer
+
+
+def test_a_misspelt_robot_model_in_python_is_refused_with_the_readers_hint():
+    """`model="tricycl"` ran as a tricycle, where the reader says "did you mean `tricycle`?"."""
+    from mitos_cli.errors import WorldError
+
+    world = short("corridor.yaml", 0.2)
+    with pytest.raises(WorldError, match=re.escape("`agents[0].robot.model` must be one of "
+                                                   "tricycle, not 'tricycl'")) as exc:
+        Simulation(dataclasses.replace(world, agents=_robot(world, model="tricycl")))
+    assert exc.value.hint == "did you mean `tricycle`?"
 
 
 def test_a_world_built_in_python_with_a_turn_too_tight_is_refused_before_the_run():

@@ -11,10 +11,10 @@ import math
 from numbers import Integral, Real
 from typing import NoReturn
 
-from ..errors import WorldError
+from ..errors import WorldError, did_you_mean
 from .safety import TIGHTEST_TURN, tightest_turn
 from .world import REPLANS, Agent, Obstacle, World
-from .worldfile import BEYOND, LARGEST, LAYOUTS, MAX_TICKS, MODES, SHAPES
+from .worldfile import BEYOND, LARGEST, LAYOUTS, MAX_TICKS, MODELS, MODES, SHAPES
 
 #: what a world's ``knows`` may be (:func:`.worldfile.read_given`)
 KNOWS = ("map", "given", "none")
@@ -42,6 +42,9 @@ def check_built(world: World) -> None:
         _agent(c, f"agents[{i}]", agent)
     _sensors(c, world)
     for i, corridor in enumerate(world.corridors):
+        if not isinstance(corridor.points, (tuple, list)) or len(corridor.points) < 2:
+            c.refuse(f"corridors[{i}].points", corridor.points,   # (min() of no points in NumPy)
+                     "a list of at least 2 points (x, y)")
         for j, p in enumerate(corridor.points):
             c.point(f"corridors[{i}].points[{j}]", p)
         c.number(f"corridors[{i}].width", corridor.width, positive=True)
@@ -69,6 +72,7 @@ def check_built(world: World) -> None:
 
 def _agent(c: _Fields, at: str, agent: Agent) -> None:
     r = agent.robot
+    c.choice(f"{at}.robot.model", r.model, MODELS)
     length = c.number(f"{at}.robot.length", r.length, positive=True)
     c.number(f"{at}.robot.width", r.width, positive=True)
     wheelbase = c.number(f"{at}.robot.wheelbase", r.wheelbase, positive=True)
@@ -78,6 +82,8 @@ def _agent(c: _Fields, at: str, agent: Agent) -> None:
     c.number(f"{at}.robot.safety_margin", r.safety_margin, minimum=0)
     low = c.number(f"{at}.robot.steering_min", r.steering_min, minimum=0, maximum=180)
     high = c.number(f"{at}.robot.steering_max", r.steering_max, minimum=0, maximum=180)
+    if low >= high:                 # (else the straight wheel was blamed for lying between)
+        c.refuse(f"{at}.robot.steering_min", low, f"below steering_max ({high:g})")
     straight = c.number(f"{at}.robot.steering_straight", r.steering_straight)
     if not low < straight < high:
         c.refuse(f"{at}.robot.steering_straight", straight,
@@ -152,11 +158,12 @@ class _Fields:
     def __init__(self, world: str) -> None:
         self.world = world
 
-    def refuse(self, field: str, value: object, expected: str) -> NoReturn:
+    def refuse(self, field: str, value: object, expected: str, hint: str | None = None
+               ) -> NoReturn:
         shown = repr(float(value)) if isinstance(value, float) else f"{value!r:.60}"
         raise WorldError(f"world `{self.world}`: `{field}` must be {expected}, not {shown}",
-                         hint="a World built or changed in Python is checked as its world file "
-                              "would be")
+                         hint=hint or "a World built or changed in Python is checked as its "
+                                      "world file would be")
 
     def number(self, field: str, value: object, *, positive: bool = False,
                minimum: float | None = None, maximum: float | None = None,
@@ -195,6 +202,9 @@ class _Fields:
         return lo, hi
 
     def choice(self, field: str, value: object, options: tuple[str, ...]) -> None:
+        """One of ``options``, a misspelt one with a "did you mean" as the reader gives
+        (``model="tricycl"`` ran as a tricycle)."""
         if value not in options:
+            near = did_you_mean(value, options) if isinstance(value, str) else None
             self.refuse(field, value, "one of " + ", ".join(options) if options
-                        else "a name the world has, and it has none")
+                        else "a name the world has, and it has none", near)
