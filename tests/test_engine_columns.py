@@ -103,6 +103,8 @@ _WIDE = pytest.mark.skipif(not np.isfinite(np.longdouble("1e400")),
     (bytearray(b"5"), r"input `road` must be a number, not bytes: `bytearray\(b'5'\)`"),  # 53
     (b"78", "input `road` must be a number, not bytes"),
     ("5_0", "input `road` must be a number, not `5_0`"),                              # 50
+    ("78\x00", r"input `road` must be a number, not `78\\x00`"),                      # 78
+    (["78\x00", "5"], r"input `road` must be a number, not `\['78\\x00', '5'\]`"),       # 78
     ("\uff15\uff10", "input `road` must be a number, not `\uff15\uff10`"),            # 50
     (np.array(["78", "7_8"]), r"input `road` must be a number, not `\['78' '7_8'\]`"),
     ("1e400", "input `road` has a number too large for a float: `1e400`"),         # inf

@@ -46,6 +46,8 @@ def floats(value: object, what: str, many: bool = False) -> np.ndarray:
             raise _NotNumbers(raw.dtype.kind)
         if raw.dtype.kind in "iuf" and isinstance(value, (list, tuple)) and _holds_bool(value):
             raise _NotNumbers("b")                 # [True, 2.5] is [1.0, 2.5] to NumPy
+        if raw.dtype.kind == "U" and not isinstance(value, np.ndarray):
+            raw = np.asarray(value, dtype=object)  # as written: "U" drops trailing NULs ("78\0")
         if raw.dtype.kind == "U" or raw.dtype == object:
             return _one_by_one(raw)
         with np.errstate(over="raise"):            # a long double past 1.8e308
