@@ -157,7 +157,26 @@ class _Gives:
         return self.steer, self.speed
 
 
+class _Returns:
+    """A user's planner that returns what it is given, whatever it is."""
+
+    name = "returns"
+
+    def __init__(self, given) -> None:
+        self.given = given
+
+    def plan(self, p):
+        return self.given
+
+
 @pytest.mark.parametrize("planner, says", [
+    # Python's "not enough values to unpack" and "cannot unpack non-iterable NoneType object"
+    (_Returns(np.array([[90.0, 20.0]])),
+     "planner `returns` must return (steering[n], speed[n]), not ndarray of shape (1, 2)"),
+    (_Returns(None), "planner `returns` must return (steering[n], speed[n]), not None"),
+    (_Returns([90.0, 20.0, 1.0]),
+     "planner `returns` must return (steering[n], speed[n]), not list of 3 items"),
+    (_Gives(np.array([True]), 10.0), "planner `gives` must return numbers, not bools"),  # 1 deg
     (_Gives(np.full(3, 90.0), np.full(3, 10.0)),
      "planner `gives` gave (3,) steering and (3,) speed values for 1 active robot"),
     (_Gives(np.nan, 10.0), "the command of planner `gives` at 0 s must be finite numbers"),
@@ -165,9 +184,11 @@ class _Gives:
 ])
 def test_a_planners_wrong_command_is_named_where_it_is_given(planner, says):
     # a NaN became the robot's pose and failed a tick later, deep in the loop
-    with pytest.raises(ValueError) as exc:
+    from mitos_cli.errors import CommandError
+
+    with pytest.raises(CommandError) as exc:
         Simulation(short("corridor.yaml", 1.0), planner).step()
-    assert says in str(exc.value)
+    assert says in str(exc.value) and isinstance(exc.value, ValueError)
 
 
 def test_a_wrong_command_from_outside_and_an_early_result_say_what_is_wrong():

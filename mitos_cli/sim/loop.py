@@ -23,6 +23,7 @@ import operator
 import os
 from collections.abc import Sequence
 from dataclasses import dataclass, field, fields
+from typing import Any
 
 import numpy as np
 
@@ -979,7 +980,7 @@ class Simulation:
             sub = Percepts(dict(zip(perception.INPUTS, block)), rows(s.ranges),
                            self.angles, rows(s.pose), rows(self._v), rows(s.targets),
                            rows(self._goals), rows(self._steer), idx, self._path(idx))
-            c_steer, c_speed = self.planner.plan(sub)
+            c_steer, c_speed = _planned(self.planner.plan(sub), self._planner_name)
             try:
                 cmd[idx, 0], cmd[idx, 1] = c_steer, c_speed
             except (TypeError, ValueError):
@@ -1561,6 +1562,37 @@ def _check_planner(planner: Planner) -> Planner:
                  "`plan(percepts)`")
     raise InputError(f"a planner is an object with a `plan(percepts)` method, not "
                      f"{type(planner).__name__} `{planner!r:.60}`", hint=hint)
+
+
+def _planned(given: Any, who: str) -> tuple[Any, Any]:
+    """What a planner returned as its ``(steering, speed)``, else a :class:`CommandError` in
+    words: one ``[n, 2]`` array met Python's "not enough values to unpack" inside the loop,
+    ``None`` "cannot unpack non-iterable NoneType", and a bool was a command of 1 deg or 1
+    in/s, where every other entry point refuses bools."""
+    from ..engine.inputs import holds_bool
+
+    try:
+        steer, speed = given
+    except (TypeError, ValueError):
+        raise CommandError(f"{who} must return (steering[n], speed[n]), not {_kind(given)}",
+                           hint="return two arrays (or numbers), one value each for the "
+                                "percepts' rows (the active robots)") from None
+    if holds_bool(steer) or holds_bool(speed):
+        raise CommandError(f"{who} must return numbers, not bools: `{given!r:.80}`",
+                           hint="give numbers: True and False would be read as 1 and 0")
+    return steer, speed
+
+
+def _kind(value: object) -> str:
+    """``value`` in a message: its type and shape or length (``ndarray of shape (1, 2)``)."""
+    name = type(value).__name__
+    if isinstance(value, np.ndarray):
+        return f"{name} of shape {value.shape}"
+    if value is None:
+        return "None"
+    if isinstance(value, (list, tuple)):
+        return f"{name} of {plural(len(value), 'item')}"
+    return f"{name} `{value!r:.40}`"
 
 
 def _finite(command: np.ndarray, what: str) -> np.ndarray:
