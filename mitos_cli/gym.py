@@ -143,6 +143,7 @@ class MitosEnv(gymnasium.Env):
             dtype=np.float64)
         self.sim = Simulation(loaded, _Commanded(), loaded.seed)
         self._seeded = False
+        self._trail: list[np.ndarray] | None = None        # the robot's places; None till reset
         self._frame = None
         self._live = None
 
@@ -189,12 +190,13 @@ class MitosEnv(gymnasium.Env):
 
     def step(self, action):
         sim = self.sim
+        trail = _begun(self._trail, "step")
         if sim.done:
             raise RuntimeError("the episode has ended: call reset()")
         command = _command(action)
         sim.step(command)
         if not sim.done:
-            self._trail.append(sim.pose[0, :2].copy())
+            trail.append(sim.pose[0, :2].copy())
             obs = self._observe()
             if sim.ending:                  # contact or arrival: the run ends at this tick
                 sim.step(command)
@@ -219,6 +221,7 @@ class MitosEnv(gymnasium.Env):
             gymnasium.logger.warn("render() without a render_mode: give render_mode='rgb_array' "
                                   "or 'human' to gymnasium.make")
             return None
+        trail = _begun(self._trail, "render")
         sim = self.sim
         pose = sim.record[-1].pose[0] if sim.record else sim.pose[0]
         obstacles = sim.record[-1].obstacles if sim.record else np.zeros((0, 2))
@@ -243,8 +246,8 @@ class MitosEnv(gymnasium.Env):
                 self._live.update(0, self._state())
                 return None
         if self.render_mode == "rgb_array":
-            return self._frame.rgb(pose, obstacles, self._trail, sim.time)
-        self._frame.update(pose, obstacles, self._trail, sim.time)
+            return self._frame.rgb(pose, obstacles, trail, sim.time)
+        self._frame.update(pose, obstacles, trail, sim.time)
         import matplotlib.pyplot as plt
 
         plt.pause(0.001)
@@ -292,6 +295,17 @@ class MitosEnv(gymnasium.Env):
         return {"t": round(sim.ticks * sim.dt, 6), "pose": sim.pose[0],
                 "clearance": float(sim.clearance[0]),
                 "outcome": sim.robot_outcomes[0] if sim.done else "driving"}
+
+
+def _begun(trail: list[np.ndarray] | None, call: str) -> list[np.ndarray]:
+    """The episode's trail, else Gymnasium's :class:`~gymnasium.error.ResetNeeded` in its
+    words, which its ``OrderEnforcing`` wrapper gives: the environment used without it
+    (``env.unwrapped``, a vector or SB3 wrapper) met "'MitosEnv' object has no attribute
+    '_trail'", or drew nothing without a word."""
+    if trail is None:
+        raise gymnasium.error.ResetNeeded(f"Cannot call env.{call}() before calling "
+                                          "env.reset(): the episode has not begun")
+    return trail
 
 
 def _check_options(others: dict[str, Any], observe_ranges: object, render_mode: object,

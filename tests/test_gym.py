@@ -254,6 +254,24 @@ def test_fuzzy_policy_of_a_batch_says_it_takes_one_observation():
     assert np.array_equal(env.unwrapped.fuzzy_policy(list(obs)), env.unwrapped.fuzzy_policy(obs))
 
 
+def test_stepping_or_drawing_before_reset_is_gymnasiums_reset_needed():
+    """Used without Gymnasium's OrderEnforcing wrapper (`env.unwrapped`, a vector or SB3
+    wrapper), step() and render() before reset() met "'MitosEnv' object has no attribute
+    '_trail'"; render_mode="human" drew nothing without a word."""
+    for mode in ("rgb_array", "human"):
+        env = mgym.MitosEnv("corridor", render_mode=mode)
+        with pytest.raises(gymnasium.error.ResetNeeded,
+                           match=r"Cannot call env\.render\(\) before calling env\.reset\(\)"):
+            env.render()
+    env = gymnasium.make("mitos/Corridor-v0").unwrapped
+    with pytest.raises(gymnasium.error.ResetNeeded,
+                       match=r"Cannot call env\.step\(\) before calling env\.reset\(\)"):
+        env.step(np.array([90.0, 10.0]))
+    env.reset(seed=1)
+    env.step(np.array([90.0, 10.0]))
+    assert env.sim.ticks == 1
+
+
 def test_a_loaded_world_makes_an_environment_and_a_non_world_says_what_is_taken():
     """A World loaded (or changed) in Python: `expected str, bytes or os.PathLike object,
     not World`; now it is driven as it is."""
