@@ -101,7 +101,7 @@ class MitosEnv(gymnasium.Env):
 
     metadata = {"render_modes": ["rgb_array", "human"], "render_fps": 20}
 
-    def __init__(self, world: str | Path | World = "corridor", *,
+    def __init__(self, world: str | Path | World | None = None, *,
                  rulebase: str | Path | None = None,
                  behavior: str | None = None, observe_ranges: bool = False,
                  render_mode: str | None = None, **others: Any) -> None:
@@ -111,6 +111,11 @@ class MitosEnv(gymnasium.Env):
         from .sim.worldfile import load_world
 
         _check_options(others, observe_ranges, render_mode, self.metadata["render_modes"])
+        if world is None:            # (mitos/World-v0 without world= drove the corridor)
+            raise EnvOptionError("mitos/World-v0 needs world=: a world file, a packaged "
+                                 "world's name or a loaded World",
+                                 hint='gymnasium.make("mitos/World-v0", world="path.yaml"); '
+                                      'a packaged world has its own: "mitos/Corridor-v0"')
 
         # a World loaded (or changed) in Python, else a file or a packaged world's name
         loaded = world if isinstance(world, World) else load_world(world)

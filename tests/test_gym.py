@@ -284,7 +284,17 @@ def test_a_loaded_world_makes_an_environment_and_a_non_world_says_what_is_taken(
     _, _, terminated, truncated, info = drive(env, seed=2)
     assert truncated and not terminated and info["t"] == 1.0
     with pytest.raises(WorldError, match="expected a path or a packaged world's name"):
-        gymnasium.make("mitos/World-v0", world=None)
+        gymnasium.make("mitos/World-v0", world=3)
+
+
+@pytest.mark.parametrize("kwargs", [{}, {"world": None}])
+def test_world_v0_without_a_world_says_it_needs_one(kwargs):
+    """`make("mitos/World-v0")` without `world=` trained on the packaged corridor without a
+    word."""
+    with pytest.raises(mgym.EnvOptionError, match="mitos/World-v0 needs world=: a world file, "
+                                                  "a packaged world's name or a loaded World"):
+        gymnasium.make("mitos/World-v0", **kwargs)
+    assert gymnasium.make("mitos/Corridor-v0").unwrapped.world.name == "corridor"
 
 
 def test_a_collision_run_differs_from_simulate_only_in_the_last_command():
