@@ -170,10 +170,15 @@ class MitosEnv(gymnasium.Env):
         from .engine.inputs import floats
 
         row = floats(x, "the observation's values", many=True)
-        if row.ndim != 1:
-            raise InputError(f"an observation is one row of the {len(self.input_names)} inputs "
+        k = len(self.input_names)
+        if row.ndim > 1:
+            raise InputError(f"an observation is one row of the {k} inputs "
                              f"({', '.join(self.input_names)}), not of shape {row.shape}",
                              hint="for a batch of observations, call it on each row")
+        if row.shape != (k,):        # (the engine said "of shape [n, 13] ..., not (1, 3)")
+            raise InputError(f"an observation is the {k} inputs ({', '.join(self.input_names)}), "
+                             f"not of shape {row.shape}",
+                             hint="give it the observation reset() or step() returned")
         return row.tolist()
 
     # -- Gymnasium ----------------------------------------------------------------------------

@@ -251,6 +251,10 @@ def test_fuzzy_policy_of_a_batch_says_it_takes_one_observation():
     obs, _ = env.reset(seed=1)
     with pytest.raises(InputError, match=r"one row of the 13 inputs .* not of shape \(1, 13\)"):
         env.unwrapped.fuzzy_policy(obs[None])
+    # the engine said "expected inputs of shape [n, 13] (...), not (1, 3)"
+    with pytest.raises(InputError, match=r"an observation is the 13 inputs \(road, .*\), "
+                                         r"not of shape \(3,\)\n"):
+        env.unwrapped.fuzzy_policy(obs[:3])
     assert np.array_equal(env.unwrapped.fuzzy_policy(list(obs)), env.unwrapped.fuzzy_policy(obs))
 
 
