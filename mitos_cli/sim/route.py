@@ -31,8 +31,9 @@ class Route:
     cum: np.ndarray                # [M] arc length at each point
     goal: np.ndarray               # [2] the goal (near the last point, maybe off the line)
 
-    def __hash__(self) -> int:
-        return id(self)
+    # by identity, in C (a Python ``__hash__`` was three calls a robot-tick in lockstep:
+    # :func:`_laid`'s cache hashes the batch's routes)
+    __hash__ = object.__hash__
 
     @classmethod
     def of(cls, points, goal=None) -> Route:
