@@ -1587,6 +1587,9 @@ def _planned(given: Any, who: str) -> tuple[Any, Any]:
         raise CommandError(f"{who} must return (steering[n], speed[n]), not {_kind(given)}",
                            hint="return two arrays (or numbers), one value each for the "
                                 "percepts' rows (the active robots)") from None
+    if (type(steer) is np.ndarray and type(speed) is np.ndarray
+            and steer.dtype.kind == speed.dtype.kind == "f"):
+        return steer, speed                          # (the packaged planners', every tick)
     if holds_bool(steer) or holds_bool(speed):
         raise CommandError(f"{who} must return numbers, not bools: `{given!r:.80}`",
                            hint="give numbers: True and False would be read as 1 and 0")
