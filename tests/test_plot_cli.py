@@ -464,3 +464,20 @@ def test_a_formula_term_outside_0_1_is_drawn_with_a_warning(capsys, tmp_path):
     assert "warning: term `x.HI` gives 1." in err and "a membership degree lies in [0, 1]" in err
     code, _, err = run(["plot", "terms"], capsys)
     assert code == 0 and "membership degree" not in err
+
+
+def test_a_formula_term_that_is_nan_somewhere_is_drawn_in_the_terminal(capsys, tmp_path):
+    """`sqrt(x - 6)` is NaN below 6: the terminal sheet raised Python's "cannot convert float
+    NaN to integer" (its label's place was the plateau of a curve holding NaN)."""
+    (tmp_path / "n.terms.yaml").write_text(
+        "variables:\n"
+        "  x: {role: input, universe: [0, 10], terms: {LO: {shape: left_shoulder, points: [2, 8]},"
+        " HI: {shape: formula, formula: \"sqrt(x - 6) / 2\"}}}\n"
+        "  y: {role: output, universe: [0, 100], default: 50, terms: {A: 0, B: 100}}\n")
+    rules = tmp_path / "n.rules"
+    rules.write_text('terms "n.terms.yaml"\nr1: if x is LO then y is A\nr2: if x is HI then y is B\n')
+    code, out, err = run(["plot", "terms", str(rules), "--width", "50", "--no-color"], capsys)
+    assert code == 0, err
+    assert "HI" in out and "gives nan" in err and "Traceback" not in err
+    lines = out.splitlines()
+    assert any("HI" in line for line in lines[:3])

@@ -71,8 +71,12 @@ class Canvas:
 
 
 def _to_dot_row(mu: np.ndarray, height: int) -> np.ndarray:
-    """Membership 0..1 -> dot row (0 at the top)."""
-    return np.rint((1.0 - np.clip(mu, 0.0, 1.0)) * (height - 1)).astype(int)
+    """Membership 0..1 -> dot row (0 at the top); NaN (a formula term's, `sqrt(x - 6)` below
+    6) -> ``height``, below the canvas: nothing is drawn there."""
+    rows = np.full(mu.shape, height)
+    finite = np.isfinite(mu)
+    rows[finite] = np.rint((1.0 - np.clip(mu[finite], 0.0, 1.0)) * (height - 1))
+    return rows
 
 
 def _dot_x(plot: VariablePlot, width: int) -> np.ndarray:
@@ -101,9 +105,9 @@ def _draw_curve(canvas: Canvas, plot: VariablePlot, curve: TermCurve, tag: int) 
     right = np.interp(xs + step / 2, curve.x, curve.y)
     rows, rl, rr = (_to_dot_row(v, canvas.height) for v in (ys, left, right))
     for c in range(canvas.width):
-        top = min(rows[c], rl[c], rr[c])
-        bottom = max(rows[c], rl[c], rr[c])
-        canvas.column(c, top, bottom, tag)
+        drawn = [r for r in (rows[c], rl[c], rr[c]) if r < canvas.height]
+        if drawn:
+            canvas.column(c, min(drawn), max(drawn), tag)
 
 
 def _label_lines(items: list[tuple[int, str, int]], width: int, color: bool) -> list[str]:

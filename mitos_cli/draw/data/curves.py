@@ -105,9 +105,17 @@ def _term_curve(term: Term, x: np.ndarray, inputs: tuple[str, ...]) -> TermCurve
         c = term.center
         return TermCurve(term.name, "singleton", np.array([c]), np.array([1.0]), c, c)
     y = np.asarray(term.membership(x), dtype=float)
-    top = x[y >= y.max()] if y.size else x
-    label_x = float((top.min() + top.max()) / 2) if top.size else term.center
-    return TermCurve(term.name, "curve", x, y, term.center, label_x)
+    return TermCurve(term.name, "curve", x, y, term.center, _label_x(x, y, term.center))
+
+
+def _label_x(x: np.ndarray, y: np.ndarray, center: float) -> float:
+    """The middle of the curve's plateau, among its finite values: a formula term may be NaN
+    somewhere (``sqrt(x - 6)``), and one NaN made the plateau empty and the label NaN."""
+    finite = np.isfinite(y)
+    if finite.any():
+        top = x[finite & (y >= y[finite].max())]
+        return float((top.min() + top.max()) / 2)
+    return center if np.isfinite(center) else float((x.min() + x.max()) / 2) if x.size else 0.0
 
 
 def termset_inputs(rulebase: RuleBase, variable: str) -> tuple[str, ...]:
