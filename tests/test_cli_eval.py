@@ -282,6 +282,34 @@ def test_a_hedged_consequent_hedges_its_rules_dof_for_that_output(tmp_path, caps
         (wide * 110 + medium * 70) / (wide + medium))
 
 
+@pytest.mark.parametrize("inference", ["weighted_average", "weighted_sum", "tsukamoto"])
+def test_a_consequent_hedged_with_any_counts_only_where_its_rule_fires(tmp_path, capsys,
+                                                                         inference):
+    """`any` is 1 at every degree, 0 included: `then speed is any FAST` weighed a rule that did
+    not fire fully, so at road=150 (NARROW 0) speed was 35 (beside r2's 20), and with r2 gone
+    50 printed as "its default" (0). A hedged consequent now weighs a rule only where it fires,
+    as the trace and `mitos check` say."""
+    (tmp_path / "t.terms.yaml").write_text(
+        "variables:\n"
+        "  road: {role: input, universe: [0, 160], terms: {NARROW: {shape: left_shoulder, "
+        "points: [40, 70]}, WIDE: {shape: right_shoulder, points: [70, 100]}}}\n"
+        "  speed: {role: output, universe: [0, 60], default: 0, terms: {"
+        "SLOW: {shape: ramp, points: [60, 0]}, FAST: {shape: ramp, points: [0, 60]}}}\n",
+        encoding="utf-8")
+    rules = tmp_path / "t.rules"
+    rules.write_text(f'terms "t.terms.yaml"\noperators: inference = {inference}\n'
+                     "r1: if road is NARROW then speed is any FAST\n"
+                     "r2: if road is WIDE then speed is SLOW\n", encoding="utf-8")
+    code, out, _ = run_main(["eval", str(rules), "road=150", "--json"], capsys)
+    assert code == 0 and json.loads(out)["outputs"]["speed"] == 0.0   # SLOW's point at DOF 1
+    rules.write_text(f'terms "t.terms.yaml"\noperators: inference = {inference}\n'
+                     "r1: if road is NARROW then speed is any FAST\n", encoding="utf-8")
+    code, out, _ = run_main(["eval", str(rules), "road=150"], capsys)
+    assert code == 0 and "speed = 0.0   (its default: no rule sets it here)" in out
+    code, out, _ = run_main(["eval", str(rules), "road=20", "--json"], capsys)
+    assert json.loads(out)["outputs"]["speed"] > 0                  # where it fires, it counts
+
+
 def test_trace_says_when_an_output_is_its_default(tmp_path, capsys):
     """With `and = drastic` no rule fires at the sample run: both outputs are their defaults,
     and the trace says so instead of printing 90 / 0 as if the rules had computed them."""

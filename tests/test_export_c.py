@@ -330,3 +330,21 @@ def test_export_refuses_tsukamoto_at_the_operators_line(tmp_path: Path, capsys) 
         assert "t.rules:2:12: format error: `mitos export` has no code for Tsukamoto " \
                "inference" in err
         assert "^^^^" in err
+
+
+@needs_cc
+def test_a_consequent_hedged_with_any_counts_only_where_its_rule_fires(tmp_path: Path) -> None:
+    """`any` is 1 at a DOF of 0 too: the exported code weighed a rule that did not fire
+    fully, as the engine did; both now weigh it only where it fires, and agree."""
+    (tmp_path / "t.terms.yaml").write_text(
+        "variables:\n"
+        "  a: {role: input, universe: [0, 10], terms: {low: {shape: left_shoulder, points: [2, 6]},"
+        " high: {shape: right_shoulder, points: [4, 8]}}}\n"
+        "  y: {role: output, universe: [0, 100], default: 50, terms: {lo: 10, hi: 90}}\n")
+    path = tmp_path / "t.rules"
+    path.write_text('terms "t.terms.yaml"\nr1: if a is low then y is any lo\n'
+                    "r2: if a is high then y is very hi\n")
+    c, X, want = reference(path)
+    assert want[X[:, 0] >= 6, 0] == pytest.approx(90.0)           # r1 does not fire there
+    agree(run_c(c, X, tmp_path), want)
+    agree(run_python(c, X, tmp_path), want)

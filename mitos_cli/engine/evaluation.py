@@ -375,7 +375,7 @@ def _hedged_average(compiled: CompiledRuleBase, dof: np.ndarray, Xt: np.ndarray 
         column = [compiled.cons_hedges[r][j] for r in range(compiled.n_rules)]
         for hedges in dict.fromkeys(h for h in column if h):
             rows = np.array([h == hedges for h in column])
-            D[rows] = hedge_mod.apply(hedges, dof[rows])
+            D[rows] = hedge_mod.weigh(hedges, dof[rows])
         y = Y[j] if Y is not None else compiled.cons_value[:, j, None]
         dens[j] = tree_sum(D.copy())
         nums[j] = tree_sum(np.multiply(D, y))

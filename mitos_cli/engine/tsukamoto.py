@@ -59,7 +59,7 @@ def tsukamoto_outputs(compiled, dof: np.ndarray) -> np.ndarray:
         W = np.empty((len(terms), b))
         WZ = np.empty((len(terms), b))
         for t, term in enumerate(terms):
-            parts = [hedge_mod.apply(h, dof[rows]) if h else dof[rows] for h, rows in term.groups]
+            parts = [hedge_mod.weigh(h, dof[rows]) if h else dof[rows] for h, rows in term.groups]
             w = tree_sum(np.concatenate(parts))
             with np.errstate(invalid="ignore"):
                 z = TSUKAMOTO[term.shape](w, *term.params)

@@ -92,6 +92,12 @@ def fuzzylite_names() -> dict[str, str]:
             if h.fuzzylite is not None and h.name != "more_or_less"}
 
 
+def weigh(names: tuple[str, ...], dof: np.ndarray) -> np.ndarray:
+    """A hedged consequent's weight: ``names`` applied to the rule's DOF where it fires, 0 where
+    it does not (``any`` is 1 even at 0, and a rule that did not fire counted fully)."""
+    return np.where(dof > 0, apply(names, dof), dof)
+
+
 def apply(names: tuple[str, ...], x: np.ndarray) -> np.ndarray:
     """Apply hedges written left to right (``very somewhat X`` = very(somewhat(X)))."""
     for name in reversed(names):

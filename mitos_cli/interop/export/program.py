@@ -148,6 +148,8 @@ def weighted_sums(c: CompiledRuleBase, j: int) -> tuple[str, str]:
         if j in c.hedged_outputs:             # the hedge weights the rule (evaluation.py)
             for h in reversed(c.cons_hedges[r][j]):
                 dof = f"hedge_{h}({dof})"
+            if "any" in c.cons_hedges[r][j]:  # 1 at a DOF of 0: only a rule that fires counts
+                dof = f"(dof_{r} > 0.0) * {dof}"
         terms.append((dof, value))
     numerator = " + ".join(f"{d} * {v}" for d, v in terms) or "0.0"
     denominator = " + ".join(d for d, _ in terms) or "0.0"
