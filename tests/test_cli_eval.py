@@ -310,6 +310,19 @@ def test_a_consequent_hedged_with_any_counts_only_where_its_rule_fires(tmp_path,
     assert json.loads(out)["outputs"]["speed"] > 0                  # where it fires, it counts
 
 
+def test_the_trace_shows_every_membership_its_fired_rules_read(capsys):
+    """At position=6.7, CENTER is 0.043: the fuzzified line left it out ("RIGHT/1.0" alone),
+    yet four rules on `position is CENTER` were listed as fired with DOF 0.04. A membership
+    the digits round to 0 is shown as a small DOF is, with its first significant digit."""
+    code, out, _ = run_main(["eval", "road=78", "size=45", "position=6.7"], capsys)
+    assert code == 0
+    assert "position = (CENTER/0.04, RIGHT/1.0)" in out
+    assert "position is CENTER then steering is LS and speed is MEDIUM, DOF = 0.04" in out
+    code, out, _ = run_main(["eval", "road=78", "size=45", "position=4", "--digits", "0"],
+                            capsys)
+    assert "position = (CENTER/0.4, RIGHT/1)" in out
+
+
 def test_trace_says_when_an_output_is_its_default(tmp_path, capsys):
     """With `and = drastic` no rule fires at the sample run: both outputs are their defaults,
     and the trace says so instead of printing 90 / 0 as if the rules had computed them."""

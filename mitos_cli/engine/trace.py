@@ -93,7 +93,9 @@ class Trace:
                  f"({plural(self.n_rules, 'rule')}; {self.operators})", "", "fuzzified inputs:"]
         fuzzified = []
         for i in self.inputs:
-            shown = [f"{t}/{num(mu)}" for t, mu in i.memberships if round(mu, digits) > 0]
+            # every term above 0, as every rule above 0: a term the digits round to 0 is one
+            # the fired rules may read (`CENTER/0.04` beside `RIGHT/1.0`)
+            shown = [f"{t}/{num(mu)}" for t, mu in i.memberships if mu > 0]
             fuzzified.append(f"{i.name} = ({', '.join(shown)})")
         width = max(len(f) for f in fuzzified) if fuzzified else 0
         for text, i in zip(fuzzified, self.inputs):
