@@ -481,3 +481,20 @@ def test_a_formula_term_that_is_nan_somewhere_is_drawn_in_the_terminal(capsys, t
     assert "HI" in out and "gives nan" in err and "Traceback" not in err
     lines = out.splitlines()
     assert any("HI" in line for line in lines[:3])
+
+
+def test_the_rule_viewer_sums_a_hedged_consequent_as_the_engine_weighs_it(tmp_path):
+    """`then y is very LO` weighs its rule by DOF^2 in the average; the viewer's aggregate
+    summed the DOF (0.3 for 0.09), so its stems did not average to the output it printed."""
+    (tmp_path / "h.terms.yaml").write_text(
+        "variables:\n"
+        "  x: {role: input, universe: [0, 10], terms: {R: {shape: ramp, points: [0, 10]}}}\n"
+        "  y: {role: output, universe: [0, 100], terms: {LO: 10, HI: 90}}\n")
+    rules = tmp_path / "h.rules"
+    rules.write_text('terms "h.terms.yaml"\nr1: if x is R then y is HI\n'
+                     "r2: if x is R then y is very LO\n")
+    view = plotdata.rule_view(load_rulebase(rules).compiled, {"x": 3.0})
+    (out,) = view.outputs
+    assert dict(out.stems) == pytest.approx({10.0: 0.09, 90.0: 0.3})
+    values, weights = np.array(out.stems).T
+    assert out.value == pytest.approx(float((values * weights).sum() / weights.sum()))

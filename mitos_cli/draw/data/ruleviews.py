@@ -10,6 +10,7 @@ import numpy as np
 from ...engine.compile import CompiledRuleBase
 from ...errors import InputError
 from ...fuzzy.hedges import apply as apply_hedges
+from ...fuzzy.hedges import weigh
 from ...lang.model import And, Expr, Not, Or, Prop, format_expr
 from ...lang.terms import Variable
 from .curves import curve_grid
@@ -208,15 +209,24 @@ def rule_view(compiled: CompiledRuleBase, values: dict[str, float]) -> RuleView:
         if sets is not None:
             _, grid, agg = sets[j]
         else:
-            summed: dict[float, float] = {}
-            for r in np.flatnonzero(setting):
-                summed[float(crisp[r, j])] = summed.get(float(crisp[r, j]), 0.0) + float(dof[r])
-            stems = tuple(sorted(summed.items()))
+            stems = _summed(compiled, j, np.flatnonzero(setting), crisp, dof)
         outputs.append(OutputView(name, var.unit, tuple(var.universe),
                                   compiled.operators.inference, value, not setting.any(),
                                   stems, grid, agg))
     return RuleView(compiled.behavior, compiled.operators.describe(), compiled.n_rules,
                     tuple(inputs), tuple(rows), tuple(outputs))
+
+
+def _summed(compiled: CompiledRuleBase, j: int, rules: np.ndarray, crisp: np.ndarray,
+            dof: np.ndarray) -> tuple[tuple[float, float], ...]:
+    """Output ``j``'s consequent values with the summed weights the engine averages them by: a
+    hedged consequent's is ``hedge(dof)`` (``very`` squares it), not the rule's DOF."""
+    summed: dict[float, float] = {}
+    for r in rules.tolist():
+        hedges = compiled.cons_hedges[r][j]
+        w = float(weigh(hedges, np.asarray(dof[r]))) if hedges else float(dof[r])
+        summed[float(crisp[r, j])] = summed.get(float(crisp[r, j]), 0.0) + w
+    return tuple(sorted(summed.items()))
 
 
 def _mamdani_sets(compiled: CompiledRuleBase, dof: np.ndarray):
