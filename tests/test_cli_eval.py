@@ -323,6 +323,29 @@ def test_the_trace_shows_every_membership_its_fired_rules_read(capsys):
     assert "position = (CENTER/0.4, RIGHT/1)" in out
 
 
+def test_no_output_is_negative_zero(tmp_path, capsys):
+    """A weighted sum of rules that did not fire over a negative value is 0 * -10 = -0.0, and
+    a crisp `-0` averages to -0.0: the trace, --json, --batch and the library said `-0.0`."""
+    (tmp_path / "t.terms.yaml").write_text(
+        "variables:\n"
+        "  x: {role: input, universe: [0, 10], terms: {LO: {shape: left_shoulder, points: [2, 4]},"
+        " HI: {shape: right_shoulder, points: [6, 8]}}}\n"
+        "  y: {role: output, universe: [-20, 20], terms: {NEG: -10, POS: 10}}\n",
+        encoding="utf-8")
+    rules = tmp_path / "t.rules"
+    rules.write_text('terms "t.terms.yaml"\noperators: inference = weighted_sum\n'
+                     "r1: if x is LO then y is NEG\nr2: if x is HI then y is -0\n",
+                     encoding="utf-8")
+    code, out, _ = run_main(["eval", str(rules), "x=5"], capsys)
+    assert code == 0 and "y = 0.0" in out and "-0" not in out.split("outputs:")[1]
+    code, out, _ = run_main(["eval", str(rules), "x=9", "--json"], capsys)
+    assert out.count('"y": 0.0') == 1
+    rb = load_rulebase(rules)
+    for x in (5.0, 9.0):
+        assert np.signbit(rb.evaluate(x=np.array([x]))["y"]).sum() == 0
+        assert not np.signbit(rb.evaluate(x=x)["y"])
+
+
 def test_trace_says_when_an_output_is_its_default(tmp_path, capsys):
     """With `and = drastic` no rule fires at the sample run: both outputs are their defaults,
     and the trace says so instead of printing 90 / 0 as if the rules had computed them."""

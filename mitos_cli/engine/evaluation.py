@@ -655,7 +655,9 @@ def _grid_columns(compiled: CompiledRuleBase, g, columns: list, out: np.ndarray)
             return unfired
         finally:
             np.setbufsize(old)
-    return any(map_blocks(blocks, n, width))
+    unfired = any(map_blocks(blocks, n, width))
+    _no_negative_zero(out)
+    return unfired
 
 
 def _grid_width(g, n: int) -> int:
@@ -789,7 +791,14 @@ def infer(compiled: CompiledRuleBase, dof: np.ndarray,
         return tsukamoto_outputs(compiled, dof)
     if compiled.cons_linear is not None and Xt is None:
         raise ValueError("linear consequents need the inputs: infer(compiled, dof, Xt)")
-    return weighted_average(compiled, dof, Xt)
+    return _no_negative_zero(weighted_average(compiled, dof, Xt))
+
+
+def _no_negative_zero(out: np.ndarray) -> np.ndarray:
+    """``out`` with -0.0 made 0.0 (``x + 0.0``; every other value, NaN too, keeps its bits): a
+    weighted sum of rules that did not fire over negative values (``0 * -10``), or a crisp
+    ``-0``, was printed ``-0.0``."""
+    return np.add(out, 0.0, out=out)
 
 
 def declares_nan(compiled: CompiledRuleBase, output: str) -> bool:

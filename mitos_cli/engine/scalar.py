@@ -179,11 +179,11 @@ def _outputs(c: CompiledRuleBase, emit) -> None:
             size = half
         emit(f"    s{row} = {terms[0] if terms else '0.0'}")
         sums.append(f"s{row}")
-    if c.operators.inference == "weighted_sum":
-        results = [sums[j] for j in range(m)]
+    if c.operators.inference == "weighted_sum":          # + 0.0: no -0.0, as infer() gives
+        results = [f"({sums[j]} + 0.0)" for j in range(m)]
     else:
-        results = [f"({sums[j]} / {sums[int(c.den_row[j])]} if {sums[int(c.den_row[j])]} > 0.0 "
-                   f"else nan)" for j in range(m)]
+        results = [f"({sums[j]} / {sums[int(c.den_row[j])]} + 0.0 if {sums[int(c.den_row[j])]} "
+                   f"> 0.0 else nan)" for j in range(m)]
     emit(f"    return ({', '.join(results)},)")
 
 
