@@ -104,6 +104,17 @@ def test_operators_command_json(capsys):
     assert [e["name"] for e in data["implication"]] == list(IMPLICATIONS) == list(norms.TNORMS)
 
 
+def test_operators_command_lists_every_sampling(capsys):
+    """`sampling = left` (jFuzzyLogic's grid) is taken by a rule file but was missing from
+    `mitos operators`, which docs/language.md says lists what a rule file can select."""
+    from mitos_cli.lang.operators import SAMPLINGS
+
+    code, out, _ = run(capsys, "operators", "--json")
+    assert [e["name"] for e in json.loads(out)["sampling"]] == list(SAMPLINGS)
+    code, out, _ = run(capsys, "operators")
+    assert "  left       the left ends of `resolution` equal cells (jFuzzyLogic's)" in out
+
+
 def test_unknown_operator_in_a_rule_file(capsys, tmp_path):
     path = rules_file(tmp_path, "operators: aggregation = probabilistic_summ\n"
                                 "if road is WIDE then speed is MEDIUM\n")

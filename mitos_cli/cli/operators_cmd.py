@@ -25,6 +25,7 @@ IMPLICATION = {
 SAMPLING = {
     "midpoints": "the midpoints of `resolution` equal cells (fuzzylite's integration rule)",
     "endpoints": "`resolution` evenly spaced points including both ends (MATLAB's evalfis)",
+    "left": "the left ends of `resolution` equal cells (jFuzzyLogic's)",
 }
 DEFUZZIFY = {
     "centroid": "sum(y mu(y)) / sum(mu(y)) over the samples (midpoint rule)",
