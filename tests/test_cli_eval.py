@@ -346,6 +346,26 @@ def test_no_output_is_negative_zero(tmp_path, capsys):
         assert not np.signbit(rb.evaluate(x=x)["y"])
 
 
+@pytest.mark.parametrize("policy", [[], ["--on-no-rule", "error"], ["--on-no-rule", "default"]])
+def test_a_batch_where_no_rule_fires_hints_only_choices_that_work(tmp_path, capsys, policy):
+    """Without a default, `--on-no-rule default` is what just failed (it is what a batch does
+    when not told), yet the hint offered it: it offers nan and skip, and declaring one."""
+    (tmp_path / "t.terms.yaml").write_text(
+        "variables:\n"
+        "  x: {role: input, universe: [0, 10], terms: {LO: {shape: left_shoulder, points: [2, 4]},"
+        " HI: {shape: right_shoulder, points: [6, 8]}}}\n"
+        "  y: {role: output, universe: [0, 100], terms: {A: 10, B: 90}}\n", encoding="utf-8")
+    rules = tmp_path / "t.rules"
+    rules.write_text('terms "t.terms.yaml"\nr1: if x is LO then y is A\nr2: if x is HI then y is B\n',
+                     encoding="utf-8")
+    (tmp_path / "in.csv").write_text("x\n1\n5\n", encoding="utf-8")
+    code, _, err = run_main(["eval", str(rules), "--batch", str(tmp_path / "in.csv"), *policy],
+                            capsys)
+    assert code == 1 and "no rule sets `y` for x=5" in err
+    assert "hint: `y` declares no default: declare one, or give --on-no-rule nan or skip" in err
+    assert "default, nan or skip" not in err
+
+
 def test_trace_says_when_an_output_is_its_default(tmp_path, capsys):
     """With `and = drastic` no rule fires at the sample run: both outputs are their defaults,
     and the trace says so instead of printing 90 / 0 as if the rules had computed them."""

@@ -332,6 +332,15 @@ def run_batch(rb, source: str, on_no_rule: NoRule | None = None,
                 extra, [c if everything else c[keep] for c in batch.columns], digits)
 
 
+def _no_rule_hint(output: str, declared: bool) -> str:
+    """What writes the other rows: ``--on-no-rule default`` only where ``output`` declares a
+    default (without one it is the choice that just failed)."""
+    if declared:
+        return "--on-no-rule default, nan or skip writes the other rows (docs/interop.md)"
+    return (f"`{output}` declares no default: declare one, or give --on-no-rule nan or skip "
+            "to write the other rows (docs/interop.md)")
+
+
 def no_rule_policy(compiled, result, policy: NoRule, where=None):
     """``(outputs, rows to keep, no_rule column)`` after applying ``policy`` to the rows where
     no rule set an output; a warning says how many rows each output's choice changed. An
@@ -359,9 +368,7 @@ def no_rule_policy(compiled, result, policy: NoRule, where=None):
             raise NoRuleFiredError(
                 f"no rule sets `{out}` for {values} (row {row + 1}; {count} of {n} rows)",
                 span=None if where is None else where(row),
-                hint=("" if policy is NoRule.error else
-                      f"`{out}` declares no default. ") +
-                     "--on-no-rule default, nan or skip writes the other rows (docs/interop.md)")
+                hint=_no_rule_hint(out, declared))
         if policy is NoRule.default:
             warn(f"no rule sets `{out}` in {plural(count, 'row')} of {n}: the file's default "
                  f"({shown}) is written there")
