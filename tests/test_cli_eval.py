@@ -366,6 +366,24 @@ def test_a_batch_where_no_rule_fires_hints_only_choices_that_work(tmp_path, caps
     assert "default, nan or skip" not in err
 
 
+def test_batch_digits_write_a_huge_output_in_full_not_in_300_digits(tmp_path, capsys):
+    """`--digits 2` wrote an output of 1e300 as 301 digits and 2 decimals, most of them
+    noise; from 1e15 on it is written in full (`1e+300`), as the trace writes it."""
+    (tmp_path / "t.terms.yaml").write_text(
+        "variables:\n"
+        "  x: {role: input, universe: [0, 1e150], terms: {R: {shape: ramp, points: [0, 1e150]}}}\n"
+        "  y: {role: output, universe: [-1e150, 1e150], terms: {L: {shape: linear, "
+        "coefficients: {x: 1e150}, constant: 0}, S: 5}}\n", encoding="utf-8")
+    rules = tmp_path / "t.rules"
+    rules.write_text('terms "t.terms.yaml"\nr1: if x is R then y is L\nr2: if x is not R then y is S\n',
+                     encoding="utf-8")
+    (tmp_path / "in.csv").write_text("x\n1e150\n0\n", encoding="utf-8")
+    code, out, _ = run_main(["eval", str(rules), "--batch", str(tmp_path / "in.csv"),
+                             "--digits", "2"], capsys)
+    assert code == 0
+    assert out.splitlines()[1:] == ["1e150,9.999999999999999e+299", "0,5.00"]
+
+
 def test_trace_says_when_an_output_is_its_default(tmp_path, capsys):
     """With `and = drastic` no rule fires at the sample run: both outputs are their defaults,
     and the trace says so instead of printing 90 / 0 as if the rules had computed them."""

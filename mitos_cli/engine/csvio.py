@@ -442,7 +442,7 @@ def write_batch(out: TextIO, inputs: Sequence[str], given: Sequence[np.ndarray],
     reads back as the same double) or with ``digits`` decimals."""
     names = [*inputs, *outputs, *extra, *(() if no_rule is None else ("no_rule",))]
     out.write(",".join(_quoted(list(names))) + "\n")
-    number = repr if digits is None else f"{{:.{digits}f}}".format
+    number = repr if digits is None else _decimals(digits)
     for start in range(0, len(Y), CHUNK):
         part = slice(start, start + CHUNK)
         cells = [_quoted((g[part].astype("U") if g.dtype.kind == "S" else g[part]).tolist())
@@ -452,6 +452,16 @@ def write_batch(out: TextIO, inputs: Sequence[str], given: Sequence[np.ndarray],
         if no_rule is not None:
             cells.append(_quoted([str(s) for s in no_rule[part]]))
         out.write("\n".join(map(",".join, zip(*cells))) + "\n")
+
+
+def _decimals(digits: int):
+    """``x`` with ``digits`` decimals; from 1e15 on in full (``1e+300``), as the trace does
+    (:data:`~.trace.LONG`): a float's digits end there, and 1e300 took 301 digits and 2
+    decimals of noise."""
+    from .trace import LONG
+
+    fixed = f"{{:.{digits}f}}".format
+    return lambda x: repr(x) if abs(x) >= LONG else fixed(x)
 
 
 def _quoted(cells: list[str]) -> list[str]:
