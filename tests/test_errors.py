@@ -111,6 +111,13 @@ def caret_under(exc: MitosError) -> str:
     # a variable's name before a missing `is` is no misspelt keyword (`temp` is not `terms`)
     ("r1: if size is SMALL_SZ and temp SMALL_SZ then speed is SLOW", 34, "SMALL_SZ",
      "unexpected `SMALL_SZ`", "`is`", "a condition reads `variable is TERM`"),
+    # a hedge (or `is`) before `then`: `then` is read as the term, and the error is at the
+    # word after it, "expected `then`"; the hint says what happened
+    ("r1: if road is any then speed is SLOW", 25, "speed", "unexpected `speed`", "`then`",
+     "`then` was read as a term: after `is` (and `not` and hedges) a term is named "
+     "(`is any TERM`)"),
+    ("r1: if road is WIDE and size is not then speed is SLOW", 42, "speed",
+     "unexpected `speed`", "`then`", "(`is not TERM`)"),
     # a number past a float's range read as inf: "steering = inf lies outside its universe"
     ("r1: if road is WIDE then steering is 2e400", 38, "2e400", "`2e400` is past a float's range",
      "a number within", None),

@@ -172,7 +172,8 @@ def syntax_error(exc: UnexpectedInput, text: str, path: str | None) -> RuleSynta
         else:
             hint = "a condition reads `variable is TERM`"
     elif "THEN" in expected and token.type in ("NAME",):
-        hint = _hedge_hint(text, token) or keyword_hint(token, expected) or \
+        hint = _keyword_as_term(text, token) or _hedge_hint(text, token) or \
+            keyword_hint(token, expected) or \
             "join conditions with `and` / `or`, and start the actions with `then`"
     else:
         hint = keyword_hint(token, expected)
@@ -287,6 +288,22 @@ def _hedge_hint(text: str, token: Token, allowed: tuple[str, ...] | None = None)
     close = did_you_mean(word, pool)            # only a near miss is taken for a hedge
     where = "hedges" if allowed is None else "hedges of a target"
     return f"`{word}` is not a hedge ({where}: {', '.join(pool)}); {close}" if close else None
+
+
+def _keyword_as_term(text: str, token: Token) -> str | None:
+    """``if road is any then speed is FAST``: after ``is``, ``not`` and hedges a term must
+    come, so ``then`` was read as the term, and the error ("expected `then`") stood at
+    ``speed``, after the `then` it asked for."""
+    from ..fuzzy.hedges import HEDGES
+
+    words = "|".join(("not", *HEDGES))
+    found = re.search(rf"\bis\s+((?:(?:{words})\s+)*)(then|and|or|with|when)\s*\Z",
+                      text[:token.start_pos])
+    if found is None:
+        return None
+    given = " ".join([*found.group(1).split(), "TERM"])
+    return (f"`{found.group(2)}` was read as a term: after `is` (and `not` and hedges) a term "
+            f"is named (`is {given}`)")
 
 
 #: words of the language that can also be read as names where a name is expected
