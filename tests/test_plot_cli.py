@@ -498,3 +498,22 @@ def test_the_rule_viewer_sums_a_hedged_consequent_as_the_engine_weighs_it(tmp_pa
     assert dict(out.stems) == pytest.approx({10.0: 0.09, 90.0: 0.3})
     values, weights = np.array(out.stems).T
     assert out.value == pytest.approx(float((values * weights).sum() / weights.sum()))
+
+
+def test_rules_take_the_inputs_eval_takes(capsys):
+    """`mitos eval -b keep_right ...` takes an input of the file the behavior does not test
+    (and drops it); `plot rules` with the same words said "does not use input" (exit 1),
+    though plots.md says it takes its inputs as `mitos eval` does."""
+    from mitos_cli.cli.eval_cmd import unused_inputs
+
+    rb = load_rulebase(None, "avoid_obstacle")
+    extra = unused_inputs(rb)[0]
+    words = [*SAMPLE, f"{extra}=1"]
+    code, _, err = run(["eval", "-b", "avoid_obstacle", *words], capsys)
+    assert code == 0, err
+    code, out, err = run(["plot", "rules", "-b", "avoid_obstacle", *words], capsys)
+    assert code == 0, err
+    assert "rules fired (8 of 27)" in out
+    code, _, err = run(["plot", "rules", "-b", "avoid_obstacle", *SAMPLE, f"{extra}=nan"],
+                       capsys)
+    assert code == 1 and f"input `{extra}` is not a number (NaN)" in err

@@ -18,7 +18,7 @@ from typing import Annotated, Optional
 import typer
 
 from ..numbers import parse_number
-from .eval_cmd import parse_values, split_args
+from .eval_cmd import parse_values, refuse_nan, split_args, unused_inputs
 from .help import epilog
 from .output import emit, err, warn
 from .params import OnceCommand, choice, choices, completer, named
@@ -292,6 +292,16 @@ def surface_command(
     _done(output, why)
 
 
+def _used_values(rb, texts: dict[str, str]) -> dict[str, float]:
+    """The ``NAME=VALUE`` inputs as `mitos eval` takes them: an input of the file that the
+    behavior does not test is taken and dropped (``eval -b main road=78 size=5`` ran, the same
+    words here said "does not use input"), NaN refused for every input."""
+    numbers = parse_values(texts)
+    refuse_nan(numbers)
+    unused = unused_inputs(rb)
+    return {k: v for k, v in numbers.items() if k not in unused}
+
+
 def rules_command(
     args: Annotated[Optional[list[str]], typer.Argument(
         metavar="[RULEBASE] NAME=VALUE...",
@@ -321,7 +331,7 @@ def rules_command(
     if not texts:
         raise typer.BadParameter(
             "give one NAME=VALUE per input: " + " ".join(f"{k}=..." for k in rb.inputs))
-    view = rule_view(rb.compiled, parse_values(texts))
+    view = rule_view(rb.compiled, _used_values(rb, texts))
     for i in view.inputs:
         if i.clamped:
             lo, hi = i.universe
