@@ -517,3 +517,20 @@ def test_rules_take_the_inputs_eval_takes(capsys):
     code, _, err = run(["plot", "rules", "-b", "avoid_obstacle", *SAMPLE, f"{extra}=nan"],
                        capsys)
     assert code == 1 and f"input `{extra}` is not a number (NaN)" in err
+
+
+def test_an_output_whose_default_is_nan_is_not_said_to_have_none(tmp_path, capsys):
+    """`default: .nan` is a declared default (fuzzylite's `default: nan`); where no rule fires
+    the viewer said "it has no default", and so did the surface's note."""
+    (tmp_path / "n.terms.yaml").write_text(
+        "variables:\n"
+        "  x: {role: input, universe: [0, 10], terms: {LO: {shape: left_shoulder, points: [2, 4]},"
+        " HI: {shape: right_shoulder, points: [6, 8]}}}\n"
+        "  y: {role: output, universe: [-20, 20], default: .nan, terms: {NEG: -10, POS: 10}}\n")
+    rules = tmp_path / "n.rules"
+    rules.write_text('terms "n.terms.yaml"\nr1: if x is LO then y is NEG\nr2: if x is HI then y is POS\n')
+    code, out, _ = run(["plot", "rules", str(rules), "x=5"], capsys)
+    assert code == 0 and "y: no rule fired and its default is nan" in out
+    code, _, err = run(["plot", "surface", str(rules), "y", "--x", "x", "-n", "5"], capsys)
+    assert code == 0 and "no rule sets `y` at 1 of 5 grid points and its default is nan" in err
+    assert "no default" not in err

@@ -151,7 +151,8 @@ def draw_aggregate(ax, out: OutputView) -> None:
         ax.set_ylim(0, 1.45)                 # room for the summed DOFs under the title
     unit = f" {out.unit}" if out.unit else ""
     if np.isnan(out.value):
-        ax.text(0.5, 0.5, "no rule fired,\nno default", transform=ax.transAxes, fontsize=8,
+        ax.text(0.5, 0.5, "no rule fired,\n" + ("default nan" if out.nan_default else "no default"),
+                transform=ax.transAxes, fontsize=8,
                 ha="center", va="center", color=VALUE_COLOR)
     else:
         ax.axvline(out.value, color=VALUE_COLOR, linewidth=1.6, gid=f"result:{out.name}")

@@ -28,11 +28,12 @@ def title_of(s: Surface) -> str:
     return text
 
 
-def _no_rule_patch():
+def _no_rule_patch(s: Surface):
     from matplotlib.patches import Patch
 
     return Patch(facecolor="white", edgecolor=HATCH_COLOR, hatch="///",
-                 label="no rule fires (no default)")
+                 label="no rule fires (default nan)" if s.nan_default else
+                 "no rule fires (no default)")
 
 
 def draw_curve(ax, s: Surface) -> None:
@@ -44,7 +45,7 @@ def draw_curve(ax, s: Surface) -> None:
         ax.fill_between(x, 0, 1, where=mask, transform=ax.get_xaxis_transform(),
                         facecolor="none", edgecolor=HATCH_COLOR, hatch="///", linewidth=0,
                         step="mid")
-        ax.legend(handles=[ax.lines[0], _no_rule_patch()], fontsize=8)
+        ax.legend(handles=[ax.lines[0], _no_rule_patch(s)], fontsize=8)
     ax.set_xlim(x[0], x[-1])
     ax.set_xlabel(s.x.label)
     ax.set_ylabel(s.label)
@@ -80,7 +81,7 @@ def draw_heatmap(fig, ax, s: Surface) -> None:
     ax.set_xlabel(s.x.label)
     ax.set_ylabel(s.y.label)
     if z.mask.any():
-        ax.legend(handles=[_no_rule_patch()], loc="upper right", fontsize=8)
+        ax.legend(handles=[_no_rule_patch(s)], loc="upper right", fontsize=8)
 
 
 def _background(ax):
@@ -120,7 +121,8 @@ def draw_surface3d(fig, ax, s: Surface) -> None:
     bar = fig.colorbar(surf, ax=ax, shrink=0.55, pad=0.1)
     bar.set_label(s.label)
     if z.mask.any():
-        ax.text2D(0.0, 0.0, "holes: no rule fires and the output has no default",
+        ax.text2D(0.0, 0.0, "holes: no rule fires and the output's default is nan"
+                  if s.nan_default else "holes: no rule fires and the output has no default",
                   transform=ax.transAxes, fontsize=8, color="#555555")
 
 

@@ -251,7 +251,8 @@ def render_rule_view(view: RuleView, width: int = 72, color: bool = False) -> st
     for o in view.outputs:
         unit = f" {o.unit}" if o.unit else ""
         if np.isnan(o.value):
-            out.append(f"  {o.name}: no rule fired and it has no default")
+            out.append(f"  {o.name}: no rule fired and "
+                       f"{'its default is nan' if o.nan_default else 'it has no default'}")
             continue
         how = " (no rule fired: its default)" if o.defaulted else ""
         out.append(f"  {o.name} = {o.value:.2f}{unit}{how}")

@@ -86,6 +86,7 @@ class OutputView:
     stems: tuple[tuple[float, float], ...] = ()       # (consequent value, summed DOF)
     grid: np.ndarray | None = None
     aggregate: np.ndarray | None = None
+    nan_default: bool = False          # declares NaN as its default (`default: .nan`)
 
     @property
     def label(self) -> str:
@@ -154,7 +155,7 @@ def rule_view(compiled: CompiledRuleBase, values: dict[str, float]) -> RuleView:
     carries the rule's implied output set and each output the aggregated set
     (:mod:`mitos_cli.engine.mamdani`).
     """
-    from ...engine.evaluation import as_batch, evaluate
+    from ...engine.evaluation import as_batch, declares_nan, evaluate
 
     X = as_batch(compiled, values)
     if X.shape[0] != 1:
@@ -212,7 +213,7 @@ def rule_view(compiled: CompiledRuleBase, values: dict[str, float]) -> RuleView:
             stems = _summed(compiled, j, np.flatnonzero(setting), crisp, dof)
         outputs.append(OutputView(name, var.unit, tuple(var.universe),
                                   compiled.operators.inference, value, not setting.any(),
-                                  stems, grid, agg))
+                                  stems, grid, agg, declares_nan(compiled, name)))
     return RuleView(compiled.behavior, compiled.operators.describe(), compiled.n_rules,
                     tuple(inputs), tuple(rows), tuple(outputs))
 

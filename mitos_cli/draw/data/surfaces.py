@@ -46,6 +46,9 @@ class Surface:
     z: np.ndarray
     fixed: tuple[Fixed, ...]
     behavior: str
+    #: the output declares NaN as its default (`default: .nan`): where no rule fires it is
+    #: that, not "no default"
+    nan_default: bool = False
 
     @property
     def no_rule(self) -> np.ndarray:
@@ -67,8 +70,14 @@ class Surface:
         n = int(self.no_rule.sum())
         if n:
             out.append(f"no rule sets `{self.output}` at {n} of {self.z.size} grid points "
-                       f"and it has no default: shown as a blank (masked) region")
+                       f"and {no_default_words(self.nan_default)}: shown as a blank (masked) "
+                       f"region")
         return out
+
+
+def no_default_words(nan_default: bool) -> str:
+    """Why an output is NaN where no rule fires: it has no default, or its default is NaN."""
+    return "its default is nan" if nan_default else "it has no default"
 
 
 def _input_axis(compiled: CompiledRuleBase, name: str, what: str) -> int:
@@ -103,7 +112,7 @@ def surface(compiled: CompiledRuleBase, output: str, x: str, y: str | None = Non
     ``strict=False``: where no rule fires and the output has no default, ``z`` is NaN.
     ``x_range`` / ``y_range`` zoom into part of a universe.
     """
-    from ...engine.evaluation import evaluate
+    from ...engine.evaluation import declares_nan, evaluate
 
     if output not in compiled.outputs:
         raise unknown("output", output, compiled.outputs, cls=InputError)
@@ -174,6 +183,7 @@ def surface(compiled: CompiledRuleBase, output: str, x: str, y: str | None = Non
     if ax_y is not None:
         z = z.reshape(len(ax_y.values), len(ax_x.values))
     unit = compiled.variables[output].unit
-    return Surface(output, unit, ax_x, ax_y, z, tuple(held), compiled.behavior)
+    return Surface(output, unit, ax_x, ax_y, z, tuple(held), compiled.behavior,
+                   declares_nan(compiled, output))
 
 
