@@ -283,3 +283,24 @@ def test_every_panel_title_of_the_packaged_sheet_stays_inside_the_figure(mitos):
     assert len(titles) == 15 and all(t.get_text() for t in titles)     # 13 inputs, 2 outputs
     for title in titles:
         assert title.get_window_extent(renderer).x1 <= fig.bbox.x1, title.get_text()
+
+
+def test_a_lone_sample_where_no_rule_fires_is_hatched(tmp_path):
+    """On a coarse grid a single sample where nothing fires was drawn zero wide by
+    `fill_between(where=...)`: the legend named the hatching, and there was none. Each run of
+    such samples is hatched up to half a step from its neighbours."""
+    from test_plotdata import GAP_RULES, GAP_TERMS
+
+    from mitos_cli.draw.surface import _nan_spans
+
+    (tmp_path / "gap.terms.yaml").write_text(GAP_TERMS)
+    (tmp_path / "gap.rules").write_text(GAP_RULES)
+    rb = load_rulebase(tmp_path / "gap.rules")
+    for n in (5, 11, 61):
+        curve = plotdata.surface(rb.compiled, "out", "x", None, {"y": 0.5}, resolution=n)
+        x, mask = curve.x.values, curve.no_rule
+        assert mask.any()
+        spans = _nan_spans(x, mask)
+        covered = [any(lo <= xi <= hi for lo, hi in spans) for xi in x]
+        assert covered == mask.tolist() and all(hi > lo for lo, hi in spans)
+        assert len(by_gid(draw_surface(curve), "no-rule")) == len(spans)

@@ -36,15 +36,31 @@ def _no_rule_patch(s: Surface):
                  "no rule fires (no default)")
 
 
+def _nan_spans(x: np.ndarray, mask: np.ndarray) -> list[tuple[float, float]]:
+    """The stretches of ``x`` nearer a masked sample than an unmasked one: each run of masked
+    samples, widened half a step each side (``fill_between(where=...)`` drew a lone masked
+    sample, the usual case on a coarse grid, zero wide: the legend's hatching was nowhere)."""
+    edges = np.concatenate(([x[0]], (x[1:] + x[:-1]) / 2, [x[-1]]))
+    spans = []
+    start = None
+    for i, masked in enumerate([*mask.tolist(), False]):
+        if masked and start is None:
+            start = i
+        elif not masked and start is not None:
+            spans.append((float(edges[start]), float(edges[i])))
+            start = None
+    return spans
+
+
 def draw_curve(ax, s: Surface) -> None:
     """One input: the output as a line; spans where nothing fires shaded and hatched."""
     x, z = s.x.values, s.z
     ax.plot(x, z, color="#1f77b4", linewidth=2.2, label=s.output)
     mask = np.isnan(z)
     if mask.any():
-        ax.fill_between(x, 0, 1, where=mask, transform=ax.get_xaxis_transform(),
-                        facecolor="none", edgecolor=HATCH_COLOR, hatch="///", linewidth=0,
-                        step="mid")
+        for lo, hi in _nan_spans(x, mask):
+            ax.axvspan(lo, hi, facecolor="none", edgecolor=HATCH_COLOR, hatch="///",
+                       linewidth=0, gid="no-rule")
         ax.legend(handles=[ax.lines[0], _no_rule_patch(s)], fontsize=8)
     ax.set_xlim(x[0], x[-1])
     ax.set_xlabel(s.x.label)
