@@ -39,9 +39,9 @@ import numpy as np
 
 from . import movers
 from . import obstacles as obs_mod
-from .geometry import CACHED, points_in_polygon, ray_circles, ray_segments
+from .geometry import CACHED, ray_circles, ray_segments
 from .route import Clearance, NarrowPassage, Prepared, Route, grid_route
-from .staticmap import StaticMap, carve, corridor_rects, grid_walls
+from .staticmap import StaticMap, carve, cells_inside, corridor_rects, grid_walls
 from .world import Goal, Grid, Pose, World
 
 RASTER = 2.0            # in: cells of the robot's map when the world gives no grid
@@ -98,7 +98,7 @@ def _stamp(grid: Grid, world: World) -> Grid:
         hit |= np.hypot(*(pts - c).T) <= r + half
     if len(corners):
         grown = corners + np.sign(corners - corners.mean(axis=1, keepdims=True)) * half
-        hit |= points_in_polygon(pts, grown).any(axis=1)
+        hit |= cells_inside(grid, grown).ravel()
     return Grid(grid.occupied | hit.reshape(rows, cols), grid.resolution, grid.origin,
                 grid.source)
 
