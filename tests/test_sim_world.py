@@ -761,3 +761,31 @@ def test_cells_inside_is_every_cell_against_every_polygon():
     whole = points_in_polygon(centres, polys).any(axis=1).reshape(50, 60)
     assert whole.any()
     assert (cells_inside(grid, polys) == whole).all()
+
+
+def test_a_corridor_side_is_clipped_only_by_the_rectangles_near_it(monkeypatch):
+    """Each rectangle's four sides were clipped by every other rectangle: a polyline of 400
+    points took 22 s to load. Only the rectangles whose bounding box meets a side are asked
+    now, and the walls are what asking every rectangle made."""
+    import numpy as np
+
+    from mitos_cli.sim import staticmap
+    from mitos_cli.sim.geometry import clip_segment_outside
+
+    world = parse_world(BASE.replace("[[0, 0], [400, 0]]", "[" + ", ".join(
+        f"[{i * 10}, {(i % 7) * 3}]" for i in range(101)) + "]").replace("300, y: 0", "900, y: 0")
+        .replace("x: 30, y: 0", "x: 30, y: 3"), "p.yaml")
+    rects = staticmap.corridor_rects(world.corridors)
+    asked = []
+
+    def counting(side, others, *args):
+        asked.append(len(others))
+        return clip_segment_outside(side, others, *args)
+
+    monkeypatch.setattr(staticmap, "clip_segment_outside", counting)
+    walls = staticmap.corridor_walls(rects)
+    assert sum(asked) < 20 * len(asked)           # (every other: 99 a side)
+    every = [clip_segment_outside(np.concatenate([c[k], c[(k + 1) % 4]]),
+                                  np.delete(rects, i, axis=0))
+             for i, c in enumerate(rects) for k in range(4)]
+    assert np.array_equal(walls, np.array([w for ws in every for w in ws]).reshape(-1, 4))

@@ -36,12 +36,18 @@ def corridor_rects(corridors: tuple[Corridor, ...]) -> np.ndarray:
 
 
 def corridor_walls(rects: np.ndarray) -> np.ndarray:
+    """Every rectangle's sides less what lies inside the others. A side is clipped by the
+    rectangles whose bounding box meets its own only (the others cut nothing): each side by
+    every other rectangle took 22 s for a polyline of 400 points."""
+    lo, hi = rects.min(axis=1), rects.max(axis=1)
     walls = []
     for i, corners in enumerate(rects):
-        others = np.delete(rects, i, axis=0)
         for k in range(4):
             side = np.concatenate([corners[k], corners[(k + 1) % 4]])
-            walls.extend(clip_segment_outside(side, others))
+            meets = ((lo <= np.maximum(side[:2], side[2:])).all(axis=1)
+                     & (hi >= np.minimum(side[:2], side[2:])).all(axis=1))
+            meets[i] = False
+            walls.extend(clip_segment_outside(side, rects[meets]))
     return np.array(walls).reshape(-1, 4)
 
 
