@@ -789,3 +789,21 @@ def test_a_corridor_side_is_clipped_only_by_the_rectangles_near_it(monkeypatch):
                                   np.delete(rects, i, axis=0))
              for i, c in enumerate(rects) for k in range(4)]
     assert np.array_equal(walls, np.array([w for ws in every for w in ws]).reshape(-1, 4))
+
+
+ROBOT_2 = "robots:\n  - {name: NAME, q_init: {x: 300, y: 20, heading: 180}, q_goal: {x: 30, y: 20}}\n"
+BOX = "obstacles:\n  - {name: NAME, shape: circle, at: [200, 25], radius: 5}\n"
+
+
+@pytest.mark.parametrize("part", [ROBOT_2, BOX])
+@pytest.mark.parametrize("written, said", [
+    ("", "`name` is empty"), ('""', "`name` is empty"), ("' '", "`name` is empty"),
+    ("[a, b]", "`name` must be text"), ("7", 'quote it: name: "7"'),
+    ('"a\\tb"', "name holds a control character")])
+def test_a_robots_or_obstacles_name_is_text_and_not_blank(part, written, said):
+    """A robot's or an obstacle's `name` was taken as written: `name:` named it `None`, `name:
+    ""` left its table row and CSV rows blank, `name: [a, b]` printed `['a', 'b']`."""
+    text = error(BASE + part.replace("NAME", written))
+    whose = "robot 2's" if part is ROBOT_2 else "obstacle 1's"
+    assert whose in text and said in text and "w.yaml:" in text
+    assert parse_world(BASE + part.replace("NAME", '"7"'), "w.yaml")

@@ -304,7 +304,8 @@ def read_goal(r: _Reader, value: Any, span: Span, what: str) -> Goal:
 
 def read_obstacle(r: _Reader, value: Any, span: Span, index: int) -> Obstacle:
     m = r.mapping(value, span, f"obstacle {index + 1}", OBSTACLE_KEYS)
-    name = str(m.get("name", f"obstacle{index + 1}"))
+    name = (_label(m, f"obstacle {index + 1}'s", "box (`randomise` and pictures use it)")
+            if "name" in m else f"obstacle{index + 1}")
     what = f"obstacle `{name}`"
     shape = r.choice(m, "shape", SHAPES, what)
     at = r.point(yamlpos.require(m, "at", WorldError, what), m.value_span("at"), f"`at` of {what}")
@@ -467,17 +468,25 @@ def parse_world(text: str, path: str) -> World:
 
 def _name(top: YMap) -> str:
     """The world's ``name``: text, printable (it is printed in every table and title)."""
-    name = yamlpos.require(top, "name", WorldError, "the world file")
+    yamlpos.require(top, "name", WorldError, "the world file")
+    return _label(top, "the world's", "corridor (it heads every verdict and table)")
+
+
+def _label(m: YMap, whose: str, example: str) -> str:
+    """``m``'s ``name`` as text, printable and not blank: a robot's or an obstacle's was taken
+    as written, so `name:` named it `None`, `name: ""` left its table row and CSV rows blank
+    and `name: [a, b]` printed `['a', 'b']`."""
+    name, span = m["name"], m.value_span("name")
+    name = "" if name is None else name             # `name:` written with nothing
     if not isinstance(name, str):                   # `name: [1, 2]` printed as a title
-        raise WorldError("the world's `name` must be text", span=top.value_span("name"),
-                         hint=f'quote it: name: "{name}"' if isinstance(name, (int, float))
-                         else "name: corridor")
+        raise WorldError(f"{whose} `name` must be text", span=span,
+                         hint=f'quote it: name: "{name}"' if type(name) in (int, float)
+                         else f"name: {example.split(' (')[0]}")
     if any(not c.isprintable() for c in name):
-        raise WorldError("the world's name holds a control character",
-                         span=top.value_span("name"), hint="letters, digits, `-`, `_`, spaces")
+        raise WorldError(f"{whose} name holds a control character", span=span,
+                         hint="letters, digits, `-`, `_`, spaces")
     if not name.strip():                            # a verdict of `: TIMEOUT after 1 s`
-        raise WorldError("the world's `name` is empty", span=top.value_span("name"),
-                         hint="name: corridor (it heads every verdict and table)")
+        raise WorldError(f"{whose} `name` is empty", span=span, hint=f"name: {example}")
     return name
 
 
@@ -518,7 +527,8 @@ def _agents(r: _Reader, top: YMap,
     for i, item in enumerate(_list(top, "robots")):
         span = top["robots"].item_span(i)
         a = r.mapping(item, span, f"robot {i + 2}", AGENT_KEYS)
-        aname = str(a.get("name", f"robot{i + 2}"))
+        aname = (_label(a, f"robot {i + 2}'s", "oncoming (it heads its column and CSV rows)")
+                 if "name" in a else f"robot{i + 2}")
         if any(b.name == aname for b in agents):
             raise WorldError(f"two robots are named `{aname}` (the first robot is `robot`): "
                              "give each a name of its own",
