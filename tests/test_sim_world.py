@@ -807,3 +807,12 @@ def test_a_robots_or_obstacles_name_is_text_and_not_blank(part, written, said):
     whose = "robot 2's" if part is ROBOT_2 else "obstacle 1's"
     assert whose in text and said in text and "w.yaml:" in text
     assert parse_world(BASE + part.replace("NAME", '"7"'), "w.yaml")
+
+
+def test_a_fraction_of_substeps_is_refused_not_cut_to_a_whole_one():
+    """`substeps: 2.5` ran 2 substeps a tick without a word (a World built in Python with 2.5
+    was refused, as a world file's sensor `count: 3.5` is)."""
+    text = error(BASE.replace("time_limit: 10", "time_limit: 10\nsubsteps: 2.5"))
+    assert "w.yaml:5:11" in text and "`substeps` in the world file must be a whole number" in text
+    assert parse_world(BASE.replace("time_limit: 10", "time_limit: 10\nsubsteps: 3.0"),
+                       "w.yaml").substeps == 3

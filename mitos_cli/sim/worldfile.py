@@ -504,6 +504,10 @@ def _timing(r: _Reader, top: YMap) -> tuple[float, float, int]:
                          hint="a larger dt (0.05 s is the packaged worlds'), or a shorter "
                               "time_limit")
     substeps = r.number(top, "substeps", "the world file", 1.0, minimum=1, maximum=100)
+    if substeps != int(substeps):                   # `substeps: 2.5` ran 2, without a word
+        raise WorldError("`substeps` in the world file must be a whole number",
+                         span=top.value_span("substeps"), expected="a count of integration steps "
+                         "per tick, such as 4 (the packaged worlds')")
     return dt, limit, int(substeps)
 
 
