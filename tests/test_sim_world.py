@@ -816,3 +816,12 @@ def test_a_fraction_of_substeps_is_refused_not_cut_to_a_whole_one():
     assert "w.yaml:5:11" in text and "`substeps` in the world file must be a whole number" in text
     assert parse_world(BASE.replace("time_limit: 10", "time_limit: 10\nsubsteps: 3.0"),
                        "w.yaml").substeps == 3
+
+
+@pytest.mark.parametrize("nan", [".nan", ".NaN", ".NAN"])
+def test_a_nan_is_not_said_to_be_past_a_floats_range(nan):
+    """`dt: .nan` was refused as "`.nan` is past a float's range", the words for `1e400`."""
+    text = error(BASE.replace("dt: 0.05", f"dt: {nan}"))
+    assert f"`dt` in the world file must be a finite number, not `{nan}`" in text
+    assert "past a float's range" not in text
+    assert "past a float's range" in error(BASE.replace("dt: 0.05", "dt: 1e400"))

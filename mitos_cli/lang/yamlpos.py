@@ -263,7 +263,10 @@ def expect_number(value: Any, span: Span, error: type[MitosError], what: str) ->
     except OverflowError:
         raise error(f"{what} must be a finite number, not an integer of "
                     f"{len(str(abs(value)))} digits", span=span) from None
-    if number != number or number in (float("inf"), float("-inf")):
+    if number != number:                            # `.nan`: not a number, of any range
+        raise error(f"{what} must be a finite number, not `{_written(span) or 'nan'}`",
+                    span=span)
+    if number in (float("inf"), float("-inf")):
         text = _written(span)
         if text is not None and "inf" not in text.lower():    # 1.0e400: YAML read inf
             raise error(f"{what} must be a finite number: `{text}` is past a float's range",
