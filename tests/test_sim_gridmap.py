@@ -280,3 +280,18 @@ def test_a_bad_origin_number_is_pointed_at_itself(tmp_path: Path):
     assert text.startswith(f"{tmp_path / 'm.yaml'}:3:16: world error: origin must be a number, "
                            "not `half`")
     assert text.splitlines()[2] == " " * 19 + "^"
+
+
+@pytest.mark.parametrize("yaw", ["1e300", "-1e17"])
+def test_a_yaw_beyond_a_worlds_numbers_is_refused_at_itself(tmp_path: Path, yaw):
+    """`origin: [0, 0, 1e300]` loaded as no turn at all: past 2**53 quarter turns every yaw
+    is a whole number of them in floating point. Every number of a world lies within ±1e7."""
+    (tmp_path / "m.pgm").write_bytes(b"P2\n2 2\n255\n254 254 254 254\n")
+    (tmp_path / "m.yaml").write_text(f"image: m.pgm\nresolution: 0.05\norigin: [0, 0, {yaw}]\n")
+    with pytest.raises(WorldError) as info:
+        load_map_yaml(tmp_path / "m.yaml")
+    text = info.value.render()
+    assert text.startswith(f"{tmp_path / 'm.yaml'}:3:16: world error: the origin's yaw must be "
+                           "within ±1e+07 (radians)")
+    (tmp_path / "m.yaml").write_text("image: m.pgm\nresolution: 0.05\norigin: [0, 0, 1e6]\n")
+    assert load_map_yaml(tmp_path / "m.yaml").occupied.any()

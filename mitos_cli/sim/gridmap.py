@@ -226,6 +226,10 @@ def load_map_yaml(path: Path, *, unknown_occupied: bool = True,
     ox, oy, yaw = (yamlpos.expect_number(v, _item_span(origin, i, spec.value_span("origin")),
                                          WorldError, "origin")
                    for i, v in enumerate(origin))
+    if abs(yaw) > LARGEST:                          # 1e300 read as an exact quarter turn, 0
+        raise WorldError(f"the origin's yaw must be within ±{LARGEST:g} (radians), not {yaw:g}",
+                         span=_item_span(origin, 2, spec.value_span("origin")),
+                         hint="the yaw is in radians: 3.14 is a half turn")
     negate = _negate(spec)
     mode = spec.get("mode", "trinary")
     if mode not in MODES:
