@@ -825,3 +825,16 @@ def test_a_nan_is_not_said_to_be_past_a_floats_range(nan):
     assert f"`dt` in the world file must be a finite number, not `{nan}`" in text
     assert "past a float's range" not in text
     assert "past a float's range" in error(BASE.replace("dt: 0.05", "dt: 1e400"))
+
+
+def test_a_pipe_or_a_device_named_as_the_world_is_not_said_to_be_missing(tmp_path: Path):
+    """`mitos simulate w.yaml` on a FIFO said "world file `w.yaml` not found" and offered a
+    file beside it; `/dev/zero` was "not found" too. Both are there, and not world files."""
+    import os
+
+    os.mkfifo(tmp_path / "w.yaml")
+    for name in (tmp_path / "w.yaml", Path("/dev/zero")):
+        with pytest.raises(WorldError) as info:
+            resolve_world_path(str(name))
+        text = info.value.render()
+        assert "is not a regular file" in text and "not found" not in text

@@ -997,7 +997,7 @@ def resolve_world_path(name: str | Path, base: Path | None = None) -> Path:
     """The one way a world is found: a file as given (relative to ``base`` first, when a
     lesson names it), else the packaged world of that name (``figure4`` or ``figure4.yaml``);
     an unknown name gets the packaged names and a "did you mean"."""
-    from ..resources import is_dir, resolve
+    from ..resources import exists, is_dir, resolve
 
     _named(name)
     found = resolve("worlds", name, ".yaml", base)
@@ -1007,6 +1007,9 @@ def resolve_world_path(name: str | Path, base: Path | None = None) -> Path:
     if is_dir(where):
         raise UnknownWorld(f"`{name}` is a directory, not a world file",
                            hint="name one of the world files (.yaml) in it")
+    if exists(where):                               # a FIFO, a device: there, but not found
+        raise UnknownWorld(f"`{name}` is not a regular file (a pipe or a device), not a world "
+                           "file", hint="name a world file (.yaml), or a packaged world")
     from ..fileio import broken_link
 
     for given in dict.fromkeys([where, Path(name)]):    # a dangling link, a loop: it is there
