@@ -94,3 +94,15 @@ def test_animate_run_takes_the_fps_and_width_the_cli_takes(short_world, tmp_path
             animate_run(result, gif, width_px=width)
     assert not gif.exists()
     assert animate_run(result, gif, fps=np.float64(2.5), width_px=np.int64(100)) == 6
+
+
+def test_one_frame_is_counted_in_the_singular(tmp_path):
+    """A run of one tick (the robot starts at its goal) said "wrote 1 frames"."""
+    text = packaged_path("worlds", "corridor.yaml").read_text(encoding="utf-8")
+    world = tmp_path / "there.yaml"
+    world.write_text(text.replace("q_goal: {x: 570, y: -10", "q_goal: {x: 30, y: -10"),
+                     encoding="utf-8")
+    gif = tmp_path / "run.gif"
+    out = RUNNER.invoke(app, ["simulate", str(world), "--animate", str(gif)])
+    assert out.exit_code == 0, out.output
+    assert f"wrote 1 frame to {gif}" in out.output

@@ -8,7 +8,7 @@ from typing import Annotated, Optional
 
 import typer
 
-from ..words import clearance
+from ..words import clearance, plural
 from . import complete
 from .output import emit, err, json_text, warn
 from .params import MAX_RUNS, file_arg, finite, named, option_names
@@ -325,7 +325,7 @@ def _simulate_many(loaded, runs: int, seed, planner, workers, plot, as_json: boo
         result = _draw_runs(result, loaded[0], plot)
     emit(json_text(result.to_json()) if as_json else _runs_table(result))
     if plot is not None:
-        err(f"wrote picture of {len(result.worlds[0].summaries)} runs to {plot}")
+        err(f"wrote picture of {plural(len(result.worlds[0].summaries), 'run')} to {plot}")
     if stopped is not None:
         done = sum(len(w.summaries) for w in result.worlds)
         what = "the JSON has" if as_json else "the table has"
@@ -370,7 +370,7 @@ def _simulate_one(world, planner, seed, randomise: bool, live: bool, speed, trac
     else:
         emit(_verdict(res))
         emit(_summary(res))
-    for path, what in ((out, "ticks"), (plot, "picture"), (animate, f"{frames} frames")):
+    for path, what in ((out, "ticks"), (plot, "picture"), (animate, plural(frames, "frame"))):
         if path is not None:
             err(f"wrote {what} to {path}")
     if require and res.outcome != require:
