@@ -144,3 +144,20 @@ def test_one_origin_and_the_same_origin_per_beam_hit_alike_bit_for_bit():
         per_beam = geometry.ray_hits(np.tile(o, (24, 1)), dirs, seg)
         assert one.shape == (24, 20) and one.tobytes() == per_beam.tobytes()
         assert np.isfinite(one).any()
+
+
+def test_a_rings_beams_go_round_to_the_left_as_the_csv_columns_say():
+    """worlds/README said `range_<b>` runs "from 0 = leftmost, clockwise": true of a fan, but
+    a ring's beam 0 looks straight ahead and the next ones round to the left. A robot 10 in
+    right of a 70 in corridor's centre, heading +x: beam 9 reads the left wall, 27 the right."""
+    from pathlib import Path
+
+    walls = walls_of(Corridor(((0, 0), (400, 0)), 70))
+    ring, fan = Sensors("ring", 36), Sensors("fan", 3, fov=180)
+    ranges = sensors.ray_segments(np.array([100.0, -10.0]),
+                                  sensors.beam_directions(0.0, ring.angles), walls, 150.0)
+    assert ranges[9] == pytest.approx(45) and ranges[27] == pytest.approx(25)
+    assert ranges[0] == 150 and ranges[18] == pytest.approx(135)
+    assert np.rad2deg(fan.angles).tolist() == [90, 0, -90]        # left, ahead, right
+    readme = (Path(__file__).parent.parent / "worlds" / "README.md").read_text(encoding="utf-8")
+    assert "9\nleft, 18 behind, 27 right" in readme or "9 left, 18 behind, 27 right" in readme

@@ -61,7 +61,8 @@ class Sensors:
 
     @property
     def angles(self) -> np.ndarray:
-        """Beam directions relative to the heading (rad), clockwise order from the left."""
+        """Beam directions relative to the heading (rad, counter-clockwise): a ring's from
+        straight ahead round to the left, a fan's from its left edge clockwise."""
         if self.layout == "ring":
             return np.deg2rad(np.arange(self.count) * (360.0 / self.count))
         half = np.deg2rad(self.fov) / 2.0
