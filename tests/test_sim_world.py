@@ -838,3 +838,27 @@ def test_a_pipe_or_a_device_named_as_the_world_is_not_said_to_be_missing(tmp_pat
             resolve_world_path(str(name))
         text = info.value.render()
         assert "is not a regular file" in text and "not found" not in text
+
+
+@pytest.mark.parametrize("change, said", [
+    (("  footprint: {length: 24, width: 18}",
+      "  footprint: {length: 24, width: 18}\n  max_speed: 100000\n  acceleration: 1000000"),
+     "at max_speed 100000 in/s the robot drives 5e+03 in a tick"),
+    (("dt: 0.05", "dt: 1"), "at max_speed 60 in/s the robot drives 60 in a tick (dt 1 s)"),
+    (("  footprint: {length: 24, width: 18}",
+      "  footprint: {length: 24, width: 18}\n  max_reverse: 600"), "at max_reverse 600 in/s")])
+def test_a_robot_that_drives_past_its_length_in_a_tick_is_refused(change, said):
+    """Contact is checked once a tick: `max_speed: 100000` with `acceleration: 1000000` drove
+    through the walls and 4,000 in outside the map with "no collision" (potential_field), and
+    DWA hung. One tick's drive is at most the robot's length."""
+    text = error(BASE.replace(*change))
+    assert said in text and "farther than its own length (24 in)" in text
+    assert parse_world(BASE.replace("  footprint: {length: 24, width: 18}",
+                                    "  footprint: {length: 24, width: 18}\n  max_speed: 480"),
+                       "w.yaml").robot.max_speed == 480
+
+
+def test_another_robot_that_drives_past_its_length_in_a_tick_is_refused():
+    text = error(BASE + "robots:\n  - {name: r2, q_init: {x: 300, y: 20, heading: 180}, "
+                 "q_goal: {x: 30, y: 20}, robot: {max_speed: 1000}}\n")
+    assert "at max_speed 1000 in/s the robot drives 50 in a tick" in text

@@ -183,7 +183,8 @@ class _Reader:
         return lo + 0.0, hi + 0.0       # [0, -0.0]: a draw from it refused -0.0 below 0.0
 
 
-def read_robot(r: _Reader, value: Any, span: Span, base: Robot | None = None) -> Robot:
+def read_robot(r: _Reader, value: Any, span: Span, base: Robot | None = None,
+               dt: float | None = None) -> Robot:
     m = r.mapping(value, span, "robot", ROBOT_KEYS)
     d = base or Robot()
     if base is None or "model" in m:
@@ -222,7 +223,26 @@ def read_robot(r: _Reader, value: Any, span: Span, base: Robot | None = None) ->
         max_reverse=r.number(m, "max_reverse", "robot", d.max_reverse, minimum=0),
         brake=r.flag(m, "brake", "robot", d.brake))
     _check_turn(m, st, robot)
+    if dt is not None:
+        _check_tick(m, robot, dt)
     return robot
+
+
+def _check_tick(m: YMap, robot: Robot, dt: float) -> None:
+    """Refuse a robot that can drive farther in one tick than its own length: contact is
+    checked once a tick, so `max_speed: 100000` (with `acceleration: 1000000`) drove through
+    the walls and 4,000 in outside the map with "no collision", and DWA hung."""
+    key = "max_speed" if robot.max_speed >= robot.max_reverse else "max_reverse"
+    fastest = getattr(robot, key)
+    if fastest * dt <= robot.length:
+        return
+    raise WorldError(f"at {key} {fastest:g} in/s the robot drives {fastest * dt:.3g} in a tick "
+                     f"(dt {dt:g} s), farther than its own length ({robot.length:g} in): contact "
+                     f"is checked once a tick, so it could pass through a wall unseen",
+                     span=m.value_span(key) if key in m else m.span,
+                     expected=f"a {key} of at most {robot.length / dt:.4g} in/s at this dt",
+                     hint="speeds are in inches a second (the packaged robots' top speed: 60); "
+                          "or a smaller `dt`")
 
 
 def _check_turn(m: YMap, st: YMap, robot: Robot) -> None:
@@ -445,9 +465,9 @@ def parse_world(text: str, path: str) -> World:
     seed = _seed(r, top)
     dt, limit, substeps = _timing(r, top)
     robot = read_robot(r, yamlpos.require(top, "robot", WorldError, "the world file"),
-                       top.value_span("robot"))
+                       top.value_span("robot"), dt=dt)
     sensors = _sensors(r, top)
-    agents, agent_spans = _agents(r, top, robot)
+    agents, agent_spans = _agents(r, top, robot, dt)
     corridors, grid, knows, given = _map(r, top, path)
     min_clearance, replan = _route(r, top, agents)
     obstacles = _obstacles(r, top)
@@ -517,8 +537,8 @@ def _sensors(r: _Reader, top: YMap) -> Sensors:
             if "sensors" in top else Sensors())
 
 
-def _agents(r: _Reader, top: YMap,
-            robot: Robot) -> tuple[list[Agent], list[tuple[Span, Span]]]:
+def _agents(r: _Reader, top: YMap, robot: Robot,
+            dt: float) -> tuple[list[Agent], list[tuple[Span, Span]]]:
     """The first robot (``robot``, read already, ``q_init``, ``q_goal``) and the others under
     ``robots`` (their own ``robot`` or the first's), each with the spans of its start and
     goal (their checks point there)."""
@@ -537,7 +557,7 @@ def _agents(r: _Reader, top: YMap,
             raise WorldError(f"two robots are named `{aname}` (the first robot is `robot`): "
                              "give each a name of its own",
                              span=a.value_span("name") if "name" in a else span)
-        arobot = (read_robot(r, a["robot"], a.value_span("robot"), robot) if "robot" in a
+        arobot = (read_robot(r, a["robot"], a.value_span("robot"), robot, dt) if "robot" in a
                   else robot)
         agents.append(Agent(aname, arobot,
                             read_pose(r, yamlpos.require(a, "q_init", WorldError, f"robot `{aname}`"),
