@@ -13,7 +13,7 @@ from typing import NoReturn
 
 from ..errors import WorldError, did_you_mean
 from .safety import TIGHTEST_TURN, tightest_turn
-from .world import REPLANS, Agent, Obstacle, World
+from .world import REPLANS, Agent, Obstacle, Robot, World
 from .worldfile import BEYOND, LARGEST, LAYOUTS, MAX_TICKS, MODELS, MODES, SHAPES
 
 #: what a world's ``knows`` may be (:func:`.worldfile.read_given`)
@@ -40,6 +40,7 @@ def check_built(world: World) -> None:
         c.refuse("agents", world.agents, "at least one Agent (the robot)")
     for i, agent in enumerate(world.agents):
         _agent(c, f"agents[{i}]", agent)
+        _tick_drive(c, f"agents[{i}]", agent.robot, dt)
     _sensors(c, world)
     for i, corridor in enumerate(world.corridors):
         if not isinstance(corridor.points, (tuple, list)) or len(corridor.points) < 2:
@@ -104,6 +105,17 @@ def _agent(c: _Fields, at: str, agent: Agent) -> None:
     c.number(f"{at}.start.heading", agent.start.heading)
     c.point(f"{at}.goal", (agent.goal.x, agent.goal.y), XY)
     c.number(f"{at}.goal.tolerance", agent.goal.tolerance, positive=True)
+
+
+def _tick_drive(c: _Fields, at: str, robot: Robot, dt: float) -> None:
+    """A tick's drive at most the robot's length, as a world file's (contact is checked once a
+    tick: faster, the robot passed through walls unseen)."""
+    for key in ("max_speed", "max_reverse"):
+        if getattr(robot, key) * dt > robot.length:
+            c.refuse(f"{at}.robot.{key}", getattr(robot, key),
+                     f"at most {robot.length / dt:.4g} in/s at dt {dt:g} s: a tick's drive "
+                     f"farther than the robot's length ({robot.length:g} in) can pass through "
+                     "a wall unseen")
 
 
 def _sensors(c: _Fields, world: World) -> None:
