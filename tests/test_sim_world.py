@@ -862,3 +862,10 @@ def test_another_robot_that_drives_past_its_length_in_a_tick_is_refused():
     text = error(BASE + "robots:\n  - {name: r2, q_init: {x: 300, y: 20, heading: 180}, "
                  "q_goal: {x: 30, y: 20}, robot: {max_speed: 1000}}\n")
     assert "at max_speed 1000 in/s the robot drives 50 in a tick" in text
+
+
+def test_a_tick_count_past_any_reading_is_written_short():
+    """`dt: 1e-300` was refused with a tick count of 302 digits, most of them a float's noise."""
+    text = error(BASE.replace("dt: 0.05", "dt: 1e-300"))
+    assert "time_limit 10 s at dt 1e-300 s is 1e+301 ticks; a run takes at most 100,000" in text
+    assert "is 200,000 ticks" in error(BASE.replace("dt: 0.05", "dt: 0.00005"))

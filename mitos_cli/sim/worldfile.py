@@ -510,6 +510,12 @@ def _label(m: YMap, whose: str, example: str) -> str:
     return name
 
 
+def _count(n: float) -> str:
+    """A large count in words a reader takes in: `1e-300` as dt made time_limit 60 a count
+    of 302 digits, most of them a float's noise."""
+    return f"{n:,.0f}" if n < 1e15 else f"{n:.3g}"
+
+
 def _timing(r: _Reader, top: YMap) -> tuple[float, float, int]:
     """``dt``, ``time_limit`` and ``substeps``: at least one tick, at most ``MAX_TICKS``."""
     dt = r.number(top, "dt", "the world file", None, positive=True, maximum=1.0)
@@ -519,7 +525,7 @@ def _timing(r: _Reader, top: YMap) -> tuple[float, float, int]:
                          span=top.value_span("time_limit"),
                          expected=f"a time_limit of at least dt ({dt:g} s)")
     if limit / dt > MAX_TICKS:
-        raise WorldError(f"time_limit {limit:g} s at dt {dt:g} s is {limit / dt:,.0f} ticks; a "
+        raise WorldError(f"time_limit {limit:g} s at dt {dt:g} s is {_count(limit / dt)} ticks; a "
                          f"run takes at most {MAX_TICKS:,}", span=top.value_span("dt"),
                          hint="a larger dt (0.05 s is the packaged worlds'), or a shorter "
                               "time_limit")
