@@ -521,3 +521,15 @@ def test_the_readme_says_the_default_trace_size(capsys):
     size = len(capsys.readouterr().out.encode("utf-8"))
     assert info.value.code in (0, None)
     assert abs(size / 1000 - int(said.group(1))) < 1 and size < 64 * 1024, size
+
+
+@pytest.mark.parametrize("planner", ["fuzzy", "dwa"])
+def test_a_trace_of_a_robot_at_its_goal_from_the_start_says_so(tmp_path: Path, planner):
+    """A robot that starts at its goal drives no tick: `--trace` printed a bare blank line."""
+    world = tmp_path / "there.yaml"
+    world.write_text(SHORT.replace("q_goal: {x: 500, y: -10}", "q_goal: {x: 30, y: -10}"),
+                     encoding="utf-8")
+    res = run(world, "--trace", "--planner", planner)
+    assert res.exit_code == 0, res.output
+    assert "(robot drove no tick: it stood at its goal from the start)\n" in res.stdout
+    assert not res.stdout.startswith("\n")

@@ -105,6 +105,8 @@ def traces(result: SimResult, planner, every: int, digits: int = 1) -> str:
         if detail is not None:
             lines += ["", trace_of(detail, k).render(digits)]
         blocks.append("\n".join(lines))
+    if len(blocks) == (detail is None):             # not a tick of its own: a bare blank line
+        blocks.append(f"({who} drove no tick: it stood at its goal from the start)")
     return "\n\n".join(blocks)
 
 
