@@ -1,10 +1,12 @@
 """Numbers written as text (a CSV cell, a foreign file's value), read the one way every format
 here means them: ASCII decimal, an optional exponent, ``nan``, ``inf``. Python's ``float``
-alone also takes ``7_8`` (78) and other scripts' digits, which no file format writes."""
+alone also takes ``7_8`` (78) and other scripts' digits, which no file format writes. And the
+one test of a whole number given in Python (a count, a width, a number of decimals)."""
 
 from __future__ import annotations
 
 import math
+import operator
 import re
 
 #: The largest magnitude a number of a term set or a foreign file may have. The engine
@@ -32,3 +34,16 @@ def parse_value(text: str) -> float:
     if math.isinf(x) and "inf" not in text.lower():
         raise OverflowError(f"too large for a float: {text!r}")
     return x
+
+
+def whole_number(value: object) -> int | None:
+    """``value`` as an ``int`` where it is a whole number (an ``int``, NumPy's too), else
+    ``None``: ``True`` is no 1, and ``2.5`` or ``"3"`` no whole number."""
+    import numpy as np
+
+    if isinstance(value, (bool, np.bool_)):
+        return None
+    try:
+        return operator.index(value)  # type: ignore[arg-type]
+    except TypeError:
+        return None

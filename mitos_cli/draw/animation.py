@@ -13,12 +13,12 @@ from __future__ import annotations
 import functools
 import math
 import numbers
-import operator
 from pathlib import Path
 
 import numpy as np
 
 from ..errors import InputError, WriteError
+from ..numbers import whole_number
 from .frame import OBSTACLE_COLOUR, ROBOT_COLOUR, TRAIL_COLOUR, draw_background
 from .output import DrawError, _matplotlib, literal_text, new_figure
 
@@ -76,12 +76,8 @@ def check_width(width_px: object) -> int:
     """``width_px`` as a whole number of pixels in :data:`WIDTH_PX`, else an
     :class:`InputError` (0 met an IndexError inside, -5 matplotlib's "figure size must be
     positive", and a width of millions of pixels would fill the memory)."""
-    try:
-        n = (-1 if isinstance(width_px, (bool, np.bool_))
-             else operator.index(width_px))  # type: ignore[arg-type]
-    except TypeError:
-        n = -1
-    if not WIDTH_PX[0] <= n <= WIDTH_PX[1]:
+    n = whole_number(width_px)
+    if n is None or not WIDTH_PX[0] <= n <= WIDTH_PX[1]:
         raise InputError(f"width_px is a whole number of pixels from {WIDTH_PX[0]} to "
                          f"{WIDTH_PX[1]}, not `{width_px!r:.40}`")
     return n

@@ -7,12 +7,12 @@ for machines (the ``mitos eval --json`` contract).
 
 from __future__ import annotations
 
-import operator
 from dataclasses import dataclass
 
 import numpy as np
 
 from ..errors import InputError
+from ..numbers import whole_number
 from ..resources import display_path
 from ..words import plural, with_unit
 from .evaluation import Result, declares_nan
@@ -118,11 +118,8 @@ class Trace:
 def _digits(value: object) -> int:
     """``value`` as a number of decimals, else an :class:`InputError` (-1 and ``True`` met
     "Format specifier missing precision", 1.5 a TypeError, and 99 was taken)."""
-    try:
-        n = -1 if isinstance(value, (bool, np.bool_)) else operator.index(value)  # type: ignore[arg-type]
-    except TypeError:
-        n = -1
-    if not DIGITS[0] <= n <= DIGITS[1]:
+    n = whole_number(value)
+    if n is None or not DIGITS[0] <= n <= DIGITS[1]:
         raise InputError(f"digits is a whole number from {DIGITS[0]} to {DIGITS[1]} "
                          f"(as `mitos eval --digits`), not `{value!r:.40}`")
     return n

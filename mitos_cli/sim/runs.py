@@ -8,7 +8,6 @@ not depend on the number of workers or on which worker ran what.
 
 from __future__ import annotations
 
-import operator
 import os
 from collections import Counter
 from collections.abc import Callable, Iterator
@@ -18,6 +17,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import InputError, MitosError
+from ..numbers import whole_number
 from .lockstep import BATCH, Lockstep
 from .loop import OUTCOMES, ROBOT_OUTCOMES, check_seed, shared_scene
 from .world import World
@@ -200,11 +200,8 @@ def _check_worlds(worlds: object) -> list[World]:
 def whole(what: str, value: object, least: int) -> int:
     """``value`` as an int of at least ``least``, else an :class:`InputError` (``runs=2.5``
     and ``workers=0`` met a TypeError, a ZeroDivisionError inside; ``True`` is not 1)."""
-    try:
-        n = -1 if isinstance(value, (bool, np.bool_)) else operator.index(value)  # type: ignore[arg-type]
-    except TypeError:
-        n = least - 1
-    if n < least:
+    n = whole_number(value)
+    if n is None or n < least:
         raise InputError(f"`{what}` is a whole number, {least} or more, not `{value!r:.40}`")
     return n
 
