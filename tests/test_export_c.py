@@ -141,13 +141,18 @@ def run_c(c, X: np.ndarray, tmp_path: Path) -> np.ndarray:
     return run_c_status(c, X, tmp_path)[1]
 
 
-def run_python(c, X: np.ndarray, tmp_path: Path) -> np.ndarray:
+def exported_module(c, tmp_path: Path):
+    """The module `mitos export --to python` writes for ``c``, imported."""
     path = tmp_path / "exported.py"
     path.write_text(to_python(c, "test"))
     spec = importlib.util.spec_from_file_location("exported", path)
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
-    return module.evaluate(X)
+    return module
+
+
+def run_python(c, X: np.ndarray, tmp_path: Path) -> np.ndarray:
+    return exported_module(c, tmp_path).evaluate(X)
 
 
 def agree(got: np.ndarray, want: np.ndarray) -> None:
@@ -259,11 +264,7 @@ def test_python_export_evaluate_one_names_a_missing_or_unknown_input(tmp_path: P
     """`evaluate_one(road=78, size=45)` raised a bare KeyError and unknown keywords were
     ignored: a TypeError as Python's own calls give, with the closest input."""
     c = load_rulebase(ROOT / "rulebases" / "mitos.rules").compiled
-    path = tmp_path / "planner.py"
-    path.write_text(to_python(c, "test"))
-    spec = importlib.util.spec_from_file_location("planner", path)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
+    module = exported_module(c, tmp_path)
     with pytest.raises(TypeError, match=r"missing 1 required keyword argument: 'position'$"):
         module.evaluate_one(road=78, size=45)
     with pytest.raises(TypeError, match=r"missing 2 required keyword arguments: 'size', 'posi"):
@@ -283,11 +284,7 @@ def test_python_export_checks_its_values_and_hints_a_swap(tmp_path: Path) -> Non
     "could not broadcast", bools were read as 1 and 0, and an array for one input met NumPy's
     "only 0-dimensional arrays can be converted"."""
     c = load_rulebase(ROOT / "rulebases" / "mitos.rules").compiled
-    path = tmp_path / "planner.py"
-    path.write_text(to_python(c, "test"))
-    spec = importlib.util.spec_from_file_location("planner", path)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
+    module = exported_module(c, tmp_path)
     for typo in ("raod", "Road", "szie", "postiion"):
         with pytest.raises(TypeError, match=rf"argument '{typo}'; did you mean '(road|size|posi)"):
             module.evaluate_one(**{typo: 1})
