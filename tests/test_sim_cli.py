@@ -401,6 +401,25 @@ def test_an_empty_path_is_a_usage_error(args):
     assert "directory" not in said
 
 
+@pytest.mark.parametrize("args", [
+    ["simulate", "corridor", "-o", "d.csv/"],
+    ["simulate", "corridor", "--plot", "run.png/"],
+    ["convert", "rulebases/mitos.rules", "--to", "fcl", "-o", "x.fcl/"],
+    ["export", "rulebases/mitos.rules", "--to", "c", "-o", "x.c/"],
+    ["plot", "terms", "rulebases/mitos.rules", "--var", "road", "-o", "p.png/"],
+])
+def test_a_file_named_with_a_trailing_slash_is_a_usage_error(args, tmp_path, monkeypatch):
+    """`Path('d.csv/')` is `d.csv`: the slash, which names a directory, was dropped and a
+    file written under the name without it."""
+    monkeypatch.chdir(tmp_path)
+    root = Path(__file__).parents[1]
+    args = [str(root / a) if a.startswith("rulebases/") else a for a in args]
+    res = CliRunner().invoke(app, args)
+    said = re.sub(r"[\s\u2502]+", " ", res.output)
+    assert res.exit_code == 2 and "so it names a directory, not a file" in said
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_a_world_that_is_a_link_to_nothing_is_said_so(tmp_path, capsys, monkeypatch):
     """A loop or a dangling link was "world file `loop1.yaml` not found", with "did you mean
     `loop1.yaml`?"."""

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import os
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from enum import Enum
@@ -50,7 +51,17 @@ def file_arg(text: str) -> Path:
     current directory) before any callback sees it, so that ``-o ''`` said "`.` has no
     extension" or "cannot write `.`: it is a directory", exit 1."""
     named(text)
-    return Path(text)
+    return Path(not_a_directory_name(text))
+
+
+def not_a_directory_name(text: str) -> str:
+    """A file's name does not end in a separator: ``Path('d.csv/')`` is ``d.csv``, so ``-o
+    d.csv/`` wrote a file where the user named a directory."""
+    if text.endswith(("/", os.sep)) and text.strip("/" + os.sep):
+        raise typer.BadParameter(f"`{text}` ends in `{text[-1]}`, so it names a directory, not a "
+                                 f"file: give the file's name (`{text.rstrip('/' + os.sep)}`, or "
+                                 f"a name inside that directory)")
+    return text
 
 
 def choice(kind: type[E], value: str, what: str) -> E:

@@ -21,7 +21,7 @@ from ..numbers import parse_number
 from .eval_cmd import parse_values, refuse_nan, split_args, unused_inputs
 from .help import epilog
 from .output import emit, err, warn
-from .params import OnceCommand, choice, choices, completer, named
+from .params import OnceCommand, choice, choices, completer, named, not_a_directory_name
 
 FORMATS = ("png", "svg")
 RULE_SUFFIXES = (".rules", ".fcl", ".fis", ".fll")
@@ -49,7 +49,7 @@ def picture_path(path: Optional[str], option: str) -> Optional[str]:
     """The picture file an ``option`` names, a .png or .svg one (usage error otherwise)."""
     if path is None:
         return None
-    suffix = Path(path).suffix.lower().lstrip(".")
+    suffix = Path(not_a_directory_name(path)).suffix.lower().lstrip(".")
     if suffix not in FORMATS:
         raise typer.BadParameter(
             f"`{path}` has {'extension .' + suffix if suffix else 'no extension'}; "
