@@ -263,6 +263,16 @@ def test_clamped_values_are_warned(capsys):
     assert code == 0 and "warning: `road` outside its universe [0, 160] was clamped" in err
 
 
+@pytest.mark.parametrize("pick", [["--var", "road"], ["-b", "keep_right"]])
+def test_a_value_of_a_variable_left_off_the_sheet_is_warned(capsys, pick):
+    """`--var road size=3` marked nothing and said nothing: `size` is a variable, not drawn."""
+    code, out, err = run(["plot", "terms", *pick, "size=3"], capsys)
+    assert code == 0 and "warning: `size` is given a value but not drawn" in err
+    assert "add --var size to draw it" in err
+    code, out, err = run(["plot", "terms", "--var", "road", "road=3"], capsys)
+    assert code == 0 and "not drawn" not in err
+
+
 # ---------------------------------------------------------------- imported FIS / FCL files
 
 

@@ -69,6 +69,18 @@ TitleOpt = Annotated[Optional[str], typer.Option(
     "--title", help="The picture's title (default: says what is drawn).")]
 
 
+def _warn_undrawn(values: dict[str, float], plots, chose: str) -> None:
+    """A value given for a variable that ``--var`` or ``-b`` leaves off the sheet marks
+    nothing: say so, where it was dropped without a word."""
+    drawn = {p.name for p in plots}
+    left = [name for name in values if name not in drawn]
+    if left:
+        names = ", ".join(f"`{n}`" for n in left)
+        warn(f"{names} {'is' if len(left) == 1 else 'are'} given a value but not drawn: "
+             f"{chose} leaves {'it' if len(left) == 1 else 'them'} off the sheet "
+             f"(add {' '.join('--var ' + n for n in left)} to draw {'it' if len(left) == 1 else 'them'})")
+
+
 def _wants_picture(output: Optional[str], show: bool) -> bool:
     return output is not None or show
 
@@ -144,7 +156,9 @@ def terms_command(
 
     path, texts = split_args(args or [])
     rulebase = read_rulebase(path)
-    plots = sheet(rulebase, var, parse_values(texts), behavior)
+    values = parse_values(texts)
+    plots = sheet(rulebase, var, values, behavior)
+    _warn_undrawn(values, plots, "--var" if var else "-b")
     for p in plots:
         if p.clamped:
             lo, hi = p.universe
