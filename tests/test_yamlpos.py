@@ -41,3 +41,22 @@ def test_booleans_are_read_as_yaml_1_2_reads_them():
     assert [yamlpos.yaml11_bool(v) for v in data["b"]] == [True] * 3 + [False] * 3 + \
         [True] * 3 + [False] * 3 + [None, None]
     assert yamlpos.yaml11_bool("oN") is None and yamlpos.yaml11_bool(True) is None
+
+
+@pytest.mark.parametrize("text,where,words,expected", [
+    ("a:\n\t- 1\n", (2, 1), "a tab, which YAML does not take", "spaces: YAML indents with spaces"),
+    ("a: b: c\n", (1, 5), "a `:` where no new key can start", "one `key: value` a line"),
+    ("x:\n  - 1\n y: 2\n", (3, 2), "indentation matches no key above it", "the indentation of a key"),
+    ('a: 1\nx: "abc\n', (2, 4), "a quoted value is not closed", "its closing quote"),
+    ("x: [1, 2\n", (2, 1), "expected ',' or ']', but got the end of the file", None),
+])
+def test_the_commonest_yaml_mistakes_are_said_in_words_with_what_was_expected(
+        text, where, words, expected):
+    """PyYAML's "found character '\\t' that cannot start any token" said neither that a tab
+    was the trouble nor what YAML expected; an unclosed quote pointed past the file's end."""
+    with pytest.raises(TermSetError) as info:
+        yamlpos.load(text, "f.yaml", TermSetError)
+    err = info.value
+    assert (err.span.line, err.span.column) == where
+    assert words in err.message
+    assert err.expected == expected if expected is None else expected in err.expected

@@ -212,10 +212,11 @@ def load(text: str, path: str | None, error: type[MitosError]) -> Any:
     try:
         return yaml.load(text, Loader=_build_loader(text, path))  # noqa: S506 (SafeLoader)
     except yaml.MarkedYAMLError as exc:
-        mark = exc.problem_mark or exc.context_mark
+        unclosed = exc.problem == "found unexpected end of stream" and "quoted" in (exc.context or "")
+        mark = (exc.context_mark if unclosed else None) or exc.problem_mark or exc.context_mark
         span = _span(mark, text, path) if mark is not None else None
-        problem = exc.problem or exc.context or "malformed YAML"
-        raise error(f"invalid YAML: {problem}", span=span) from None
+        problem, expected = _in_words(exc.problem or exc.context or "malformed YAML", exc.context)
+        raise error(f"invalid YAML: {problem}", span=span, expected=expected) from None
     except yaml.reader.ReaderError as exc:       # a character YAML does not allow
         pos = min(exc.position, len(text))
         line = text.count("\n", 0, pos) + 1
@@ -225,6 +226,30 @@ def load(text: str, path: str | None, error: type[MitosError]) -> Any:
                     span=Span.at(text, path, pos, line, column)) from None
     except yaml.YAMLError as exc:  # pragma: no cover - other YAML errors carry no mark
         raise error(f"invalid YAML: {exc}", span=Span(path, 1, 1)) from None
+
+
+#: PyYAML's words for the mistakes people make most, and what YAML expected there
+_WORDS = {
+    "found character '\\t' that cannot start any token":
+        ("a tab, which YAML does not take as indentation or to start a value",
+         "spaces: YAML indents with spaces only"),
+    "mapping values are not allowed here":
+        ("a `:` where no new key can start",
+         "one `key: value` a line, the keys of one mapping indented alike, and a value that "
+         "holds `: ` in quotes"),
+    "expected <block end>, but found '<block mapping start>'":
+        ("this line's indentation matches no key above it",
+         "the indentation of a key above it, or a key ending in `:` on the line above"),
+}
+
+
+def _in_words(problem: str, context: str | None) -> tuple[str, str | None]:
+    """PyYAML's problem in plain words, with what was expected where PyYAML does not say."""
+    if problem in _WORDS:
+        return _WORDS[problem]
+    if problem == "found unexpected end of stream" and context and "quoted" in context:
+        return "a quoted value is not closed before the end of the file", "its closing quote"
+    return problem.replace("'<stream end>'", "the end of the file"), None
 
 
 def check_keys(mapping: YMap, allowed: Iterable[str], error: type[MitosError],
