@@ -869,3 +869,34 @@ def test_a_tick_count_past_any_reading_is_written_short():
     text = error(BASE.replace("dt: 0.05", "dt: 1e-300"))
     assert "time_limit 10 s at dt 1e-300 s is 1e+301 ticks; a run takes at most 100,000" in text
     assert "is 200,000 ticks" in error(BASE.replace("dt: 0.05", "dt: 0.00005"))
+
+
+@pytest.mark.parametrize("obstacle, said", [
+    ("{name: cart, shape: circle, at: [200, 20], radius: 6, velocity: [-1500, 0]}",
+     "obstacle `cart` moves 75 in a tick (at 1500 in/s, dt 0.05 s), farther than its own size "
+     "(12 in)"),
+    ("{name: cart, shape: rectangle, at: [200, 20], length: 30, width: 4, "
+     "waypoints: [[100, 0]], speed: 100}", "moves 5 in a tick (at 100 in/s, dt 0.05 s), "
+     "farther than its own size (4 in)")])
+def test_an_obstacle_that_moves_past_its_size_in_a_tick_is_refused(obstacle, said):
+    """Contact is checked once a tick, as for the robot: a cart at 1500 in/s jumped 75 in a
+    tick and could pass through the robot unseen."""
+    text = error(BASE + f"obstacles:\n  - {obstacle}\n")
+    assert said in text and "expected a speed of at most" in text
+    ok = BASE + "obstacles:\n  - {name: cart, shape: circle, at: [200, 20], radius: 6, " \
+                "velocity: [-240, 0]}\n"
+    assert parse_world(ok, "w.yaml").obstacles[0].speed == 240
+
+
+def test_an_obstacle_built_in_python_that_moves_past_its_size_is_refused():
+    from dataclasses import replace
+
+    from mitos_cli.sim import Simulation
+    from mitos_cli.sim.world import Motion
+
+    world = parse_world(BASE + "obstacles:\n  - {name: cart, shape: circle, at: [200, 20], "
+                               "radius: 6, velocity: [-15, 0]}\n", "w.yaml")
+    fast = replace(world.obstacles[0], motion=Motion("velocity", velocity=(-1500.0, 0.0)))
+    with pytest.raises(WorldError, match=r"obstacles\[0\]\.motion\.velocity` must be at most "
+                                         r"240 in/s at dt 0\.05 s"):
+        Simulation(replace(world, obstacles=(fast,)), seed=1)

@@ -6,6 +6,7 @@ mathematical convention; steering 90 = straight, below 90 = left).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -114,6 +115,18 @@ class Obstacle:
     angle: float = 0.0             # deg
     motion: Motion = field(default_factory=Motion)
     known: bool = False            # drawn on the robot's map (the route avoids it)
+
+    @property
+    def size(self) -> float:
+        """Its narrowest extent (in): the diameter, or the shorter side."""
+        return 2 * self.radius if self.shape == "circle" else min(self.length, self.width)
+
+    @property
+    def speed(self) -> float:
+        """How fast it moves (in/s): 0 when it stands."""
+        m = self.motion
+        return (math.hypot(*m.velocity) if m.kind == "velocity" else
+                m.speed if m.kind == "waypoints" else 0.0)
 
 
 @dataclass(frozen=True)

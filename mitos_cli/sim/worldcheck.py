@@ -56,6 +56,12 @@ def check_built(world: World) -> None:
             c.point(f"{name}.origin", grid.origin)
     for i, o in enumerate(world.obstacles):
         _obstacle(c, f"obstacles[{i}]", o)
+        if o.speed * dt > o.size:           # (as a world file's; see worldfile._obstacles)
+            key = "velocity" if o.motion.kind == "velocity" else "speed"
+            c.refuse(f"obstacles[{i}].motion.{key}", getattr(o.motion, key),
+                     f"at most {o.size / dt:.4g} in/s at dt {dt:g} s: a tick's move farther "
+                     f"than the obstacle's own size ({o.size:g} in) can pass through the robot "
+                     "unseen")
     _randomise(c, world)
     c.choice("replan", world.replan, REPLANS)
     c.choice("knows", world.knows, KNOWS)

@@ -470,7 +470,7 @@ def parse_world(text: str, path: str) -> World:
     agents, agent_spans = _agents(r, top, robot, dt)
     corridors, grid, knows, given = _map(r, top, path)
     min_clearance, replan = _route(r, top, agents)
-    obstacles = _obstacles(r, top)
+    obstacles = _obstacles(r, top, dt)
     randomise = (read_randomise(r, top["randomise"], top.value_span("randomise"),
                                 [o.name for o in obstacles])
                  if "randomise" in top else Randomise())
@@ -635,8 +635,8 @@ def _check_squeeze(least: float, span: Span, agents: list[Agent]) -> None:
                           f"`min_clearance: {half:g}`")
 
 
-def _obstacles(r: _Reader, top: YMap) -> list[Obstacle]:
-    """``obstacles``, each named once."""
+def _obstacles(r: _Reader, top: YMap, dt: float) -> list[Obstacle]:
+    """``obstacles``, each named once, none moving farther in a tick than its own size."""
     obstacles = [read_obstacle(r, item, top["obstacles"].item_span(i), i)
                  for i, item in enumerate(_list(top, "obstacles"))]
     counts = Counter(o.name for o in obstacles)     # names.count per obstacle was N^2
@@ -644,6 +644,16 @@ def _obstacles(r: _Reader, top: YMap) -> list[Obstacle]:
         if counts[o.name] > 1:
             raise WorldError(f"two obstacles are named `{o.name}`",
                              span=top["obstacles"].item_span(i))
+        if o.speed * dt > o.size:
+            m = top["obstacles"][i]
+            key = "velocity" if "velocity" in m else "speed"
+            raise WorldError(f"obstacle `{o.name}` moves {o.speed * dt:.3g} in a tick (at "
+                             f"{o.speed:g} in/s, dt {dt:g} s), farther than its own size "
+                             f"({o.size:g} in): contact is checked once a tick, so it could pass "
+                             "through the robot unseen", span=m.value_span(key),
+                             expected=f"a speed of at most {o.size / dt:.4g} in/s at this dt",
+                             hint="speeds are in inches a second (the packaged cart's: 15); "
+                                  "or a smaller `dt`")
     return obstacles
 
 
