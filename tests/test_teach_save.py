@@ -497,3 +497,35 @@ def test_save_names_the_rule_file_it_could_not_write_and_the_directory_it_made(
     s.run(f"save {tmp_path / 'nodir' / 'x.rules'}")
     assert out[0] == f"created the directory {tmp_path / 'nodir'}"
     assert out[1].startswith(f"saved {tmp_path / 'nodir' / 'x.rules'}")
+
+
+def _two_termsets_named_alike(tmp_path):
+    """A rule file reading `a/x.terms.yaml` (its input) and `b/x.terms.yaml` (its output)."""
+    (tmp_path / "a").mkdir()
+    (tmp_path / "b").mkdir()
+    (tmp_path / "a" / "x.terms.yaml").write_text(
+        "variables:\n  x:\n    role: input\n    universe: [0, 10]\n    terms:\n"
+        "      LO: {shape: left_shoulder, points: [2, 5]}\n"
+        "      MID: {shape: triangle, peak: 5, width: 3}\n"
+        "      HI: {shape: right_shoulder, points: [5, 8]}\n")
+    (tmp_path / "b" / "x.terms.yaml").write_text(
+        "variables:\n  y:\n    role: output\n    universe: [0, 100]\n    default: 50\n"
+        "    terms: {A: 0, B: 25, C: 50, D: 75, E: 100}\n")
+    rules = tmp_path / "two.rules"
+    rules.write_text('terms "a/x.terms.yaml", "b/x.terms.yaml"\n\nbehavior main:\n'
+                     "    r0: if x is LO then y is A\n    r1: if x is MID then y is C\n"
+                     "    r2: if x is HI then y is E\nend\n")
+    return rules
+
+
+def test_two_term_sets_of_one_file_name_are_saved_to_two_files(tmp_path):
+    """Named by file name alone, both went to `out.x.terms.yaml`, the output's over the
+    input's: the save said so and succeeded, and the saved rule base did not load."""
+    s = Session(_two_termsets_named_alike(tmp_path), out=[].append)
+    s.run("correct x=3 -> y=20")
+    s.run("adapt epochs 5")
+    s.run(f"save {tmp_path / 'out.rules'}")
+    assert (tmp_path / "out.rules").read_text().splitlines()[0] == \
+        'terms "out.a.x.terms.yaml", "out.b.x.terms.yaml"'
+    back = load_rules_file(tmp_path / "out.rules")
+    assert variables(back) == variables(s.rulebase)

@@ -57,7 +57,22 @@ def termset_targets(rules_target: Path, original_rules: Path,
         else rules_target.stem
     if len(termset_paths) == 1:
         return (rules_target.parent / f"{stem}.terms.yaml",)
-    return tuple(rules_target.parent / f"{stem}.{Path(p).name}" for p in termset_paths)
+    return tuple(rules_target.parent / f"{stem}.{name}" for name in distinct_names(termset_paths))
+
+
+def distinct_names(termset_paths: tuple[str, ...]) -> list[str]:
+    """Each term set's file name, with its directories where two term sets share one
+    (`a/x.terms.yaml` and `b/x.terms.yaml`: `a.x.terms.yaml` and `b.x.terms.yaml`): by file
+    name alone both were written to one `OUT.x.terms.yaml`, the second over the first, and
+    the saved rule base named it twice, so that it did not load."""
+    names = [Path(p).name for p in termset_paths]
+    out = [".".join([d for d in Path(p).parent.parts if d not in (".", "..", "/")] + [name])
+           if names.count(name) > 1 else name for p, name in zip(termset_paths, names)]
+    for i, name in enumerate(out):          # `../a/x` beside `a/x`: numbered
+        if name in out[:i]:
+            out[i] = next(f"{n}.{name}" for n in range(2, len(out) + 2)
+                          if f"{n}.{name}" not in out)
+    return out
 
 
 def save_rulebase(original: RuleBase, current: RuleBase, target: Path) -> Saved:
