@@ -1,5 +1,6 @@
 """Saving keeps the rule base linguistic: text surgery, atomic writes, round trip."""
 
+import json
 import re
 import shutil
 
@@ -529,3 +530,18 @@ def test_two_term_sets_of_one_file_name_are_saved_to_two_files(tmp_path):
         'terms "out.a.x.terms.yaml", "out.b.x.terms.yaml"'
     back = load_rules_file(tmp_path / "out.rules")
     assert variables(back) == variables(s.rulebase)
+
+
+def test_a_terms_line_with_an_escape_json_does_not_know_is_saved(tmp_path):
+    """`terms "b\\s.terms.yaml"` (a backslash, as in a path written on Windows) loads, the
+    escape kept as written; saving it under another name raised a Python traceback."""
+    src = _two_termsets_named_alike(tmp_path)
+    (tmp_path / "b\\s.terms.yaml").write_text((tmp_path / "b" / "x.terms.yaml").read_text())
+    rules = tmp_path / "one.rules"
+    rules.write_text(src.read_text().replace('"b/x.terms.yaml"', '"b\\s.terms.yaml"'))
+    s = Session(rules, out=[].append)
+    s.run("correct x=3 -> y=20")
+    s.run("adapt epochs 2")
+    for name in ("out.rules", 'q"uote.rules'):       # a `"` in the new name: escaped
+        s.run(f"save {json.dumps(str(tmp_path / name))}")
+        assert variables(load_rules_file(tmp_path / name)) == variables(s.rulebase)

@@ -17,6 +17,7 @@ updated; saving over the original rule file rewrites its term sets in place.
 from __future__ import annotations
 
 import contextlib
+import json
 import os
 import re
 from dataclasses import dataclass, field
@@ -29,6 +30,7 @@ from ..fileio import atomic_write, atomic_write_set, finish_saves  # noqa: F401 
 from ..fuzzy.shapes import SHAPES
 from ..lang import yamlpos
 from ..lang.model import Behavior, RuleBase, format_number, format_rule, format_use
+from ..lang.parse import _unquote
 from ..lang.parse import parser as rule_parser
 from ..lang.terms import Term
 from ..words import plural
@@ -453,11 +455,11 @@ def edit_rules(text: str, path: str, original: RuleBase, current: RuleBase,
     edits: list[tuple[int, int, str]] = []
     changes: list[str] = []
     for tok, name in zip(terms_tokens, termset_names):
-        import json
-
-        if json.loads(str(tok)) != name:
+        # read as the rule parser reads it (`"sets\\x.terms.yaml"`: a JSON-unknown escape is
+        # kept as written, where `json.loads` raised), written escaped (a `"` in the name)
+        if _unquote(tok) != name:
             assert tok.start_pos is not None and tok.end_pos is not None  # the lexer's tokens
-            edits.append((tok.start_pos, tok.end_pos, '"' + name + '"'))
+            edits.append((tok.start_pos, tok.end_pos, json.dumps(name, ensure_ascii=False)))
     appended: list[str] = []
     old_behaviors = {b.name: b for b in original.behaviors}
     for b in current.behaviors:
