@@ -296,6 +296,16 @@ def test_speed_and_wall_instructions():
                                        w), [110, 70])           # away from the nearer side
 
 
+def test_keeping_from_the_wall_needs_a_nearer_side():
+    """Equal gaps (150 and 150 in the open of a crossing: no wall in sight) have no nearer side:
+    they gave a target one term to the right; now no example, and a window of them is refused."""
+    wall = instruction(tuple(["keep", "further", "from", "the", "wall"]))
+    w = window([70, 70, 90], gap_left=[150, 150, 40], gap_right=[150, 150, 5])
+    np.testing.assert_allclose(targets(wall, w), [np.nan, np.nan, 70])
+    with pytest.raises(LessonError, match="equal on both sides at every tick"):
+        targets(wall, window([70, 90], gap_left=[150, 150], gap_right=[150, 150]))
+
+
 def test_unknown_instruction_says_did_you_mean_and_lists_them():
     with pytest.raises(LessonError) as info:
         instruction(("make", "a", "wide", "turn"))

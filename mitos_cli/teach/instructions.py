@@ -21,7 +21,7 @@ instruction                     targets at each tick of the window
                                 or when every tick goes straight (within 1 %)
 ``slow down`` / ``speed up``    speed one term lower / higher
 ``keep further from the wall``  steering one term away from the nearer side
-                                (``gap_left`` / ``gap_right``)
+                                (``gap_left`` / ``gap_right``; equal gaps give no example)
 ``keep right``                  steering one term to the right
 ==============================  ==============================================================
 
@@ -39,6 +39,7 @@ import numpy as np
 
 from ..errors import LessonError, Span, did_you_mean
 from ..lang.interpretability import mirror_point
+from ..lang.model import format_number
 from ..lang.terms import Variable
 
 #: Term steps each hedge moves a crisp target: + away from the scale's centre, - toward it.
@@ -190,8 +191,17 @@ def _from_wall(scale: Scale, w: Window) -> np.ndarray:
         raise LessonError("`keep further from the wall` reads the gaps beside the robot, "
                           "and this behavior has no input " + ", ".join(f"`{m}`" for m in missing),
                           hint="use a behavior with inputs gap_left and gap_right (drive)")
-    away = np.where(w.inputs["gap_left"] <= w.inputs["gap_right"], 1.0, -1.0)  # right: +
-    return scale.value(scale.steps(w.outputs[scale.variable]) + away)
+    # right: +; equal gaps (150 and 150: no wall in sight) have no nearer side, and gave an
+    # example one term to the right
+    away = np.sign(w.inputs["gap_right"] - w.inputs["gap_left"])
+    if not np.any(away):
+        gaps = sorted({format_number(float(g)) for g in w.inputs["gap_left"]})
+        raise LessonError("`keep further from the wall`: the gaps beside the robot were equal "
+                          "on both sides at every tick of the window (" + ", ".join(gaps[:3])
+                          + (", ..." if len(gaps) > 3 else "") + " in), so no wall was nearer "
+                          "on one side", hint="name a window where a wall is nearer on one side")
+    target = scale.value(scale.steps(w.outputs[scale.variable]) + away)
+    return np.where(away != 0, target, np.nan)
 
 
 INSTRUCTIONS: dict[str, Instruction] = {i.words: i for i in (
