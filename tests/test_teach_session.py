@@ -551,6 +551,18 @@ def test_ctrl_c_in_a_lessons_adapt_stops_the_lesson(monkeypatch):
     assert len(s.state.examples) == 1
 
 
+def test_a_lessons_lines_are_counted_as_an_editor_counts_them():
+    """A form feed (a page break) or U+0085 ends no line in an editor, but ``splitlines``
+    broke the lesson there: every error after it was named a line too far on."""
+    from mitos_cli.teach.lesson import run_lesson
+
+    for odd in ("\f", "\x85", "\x1c"):
+        s = Session(default_rulebase_path(), out=[].append)
+        with pytest.raises(MitosError) as info:
+            run_lesson(s, f"# a page{odd}\nuse avoid_obstacle\ncorect road=78\n", "l.lesson")
+        assert (info.value.span.line, info.value.span.column) == (3, 1)
+
+
 def test_a_resumed_session_can_correct_the_run_it_recorded(tmp_path, monkeypatch):
     """`simulate` is journaled (a record, not a change): `--resume` drives the last run again
     on the rule base as it was then, so `at` corrects the same run; a seed is exact."""

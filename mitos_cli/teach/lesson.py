@@ -8,6 +8,7 @@ reproducible and testable (``mitos teach ... --lesson FILE`` exits 1).
 
 from __future__ import annotations
 
+import re
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -20,7 +21,7 @@ from .text import quoted_column
 
 def commands(text: str) -> Iterator[tuple[int, str]]:
     """``(first line number, command text)`` for each command of a lesson."""
-    lines = text.splitlines()
+    lines = lines_of(text)
     i = 0
     while i < len(lines):
         line = lines[i]
@@ -67,9 +68,16 @@ def run_lesson(session: Session, text: str, path: str) -> bool:
     return True
 
 
+def lines_of(text: str) -> list[str]:
+    """The lines of a lesson as an editor counts them: ``str.splitlines`` also breaks at a form
+    feed, U+2028 or U+0085 inside a line, so every line after one was named one too far on."""
+    lines = re.split(r"\r\n|\r|\n", text)
+    return lines[:-1] if lines[-1:] == [""] else lines
+
+
 def lesson_end(text: str, path: str) -> Span:
     """Just after the last character of the lesson (where a missing ``end`` would go)."""
-    lines = text.splitlines() or [""]
+    lines = lines_of(text) or [""]
     return Span.in_text(text, path, len(lines), len(lines[-1]) + 1)
 
 
