@@ -272,6 +272,14 @@ def test_prompt_continues_a_wrapped_rule_and_an_empty_line_ends_it(work):
     assert "r30: if road is NARROW then speed is CREEP  (new)" in res.stdout
 
 
+def test_a_rule_cut_short_by_the_end_of_the_input_is_said(work):
+    """Ctrl-D (the end of piped input) inside a wrapped rule dropped the rule without a word,
+    where a lesson says it ends too early."""
+    res = mitos("teach", "rb/mitos.rules", cwd=work, stdin="show behaviors\nr30: if road is NARROW\n")
+    assert res.returncode == 0
+    assert "<prompt>:2:23: syntax error: the line ends too early" in res.stderr
+
+
 def test_prompt_errors_are_command_errors_at_the_prompts_line(work):
     """A mistyped line at the prompt said `lesson error` at `<prompt>:1` whatever line it was:
     it is a command error, placed at the line read (blank, comment and wrapped lines count)."""

@@ -129,12 +129,17 @@ def interact(session: Session, history: Path | None = None) -> None:
                 "commands; Ctrl-D or `quit` leaves (nothing is lost).")
     try:
         while True:
+            ended = False                        # the input ended inside a wrapped rule
             try:
                 line = input(prompt_text(session) if tty else "")
                 lines_read += 1
                 lineno = lines_read
                 while incomplete(line):          # a rule continued on the next line
-                    more = input("... " if tty else "")
+                    try:
+                        more = input("... " if tty else "")
+                    except EOFError:             # the rule is said cut short, not dropped
+                        ended = True
+                        break
                     lines_read += 1
                     if not more.strip():         # an empty line ends it (and says why)
                         break
@@ -159,6 +164,9 @@ def interact(session: Session, history: Path | None = None) -> None:
                 session.replay()            # the state is exactly what the journal holds
                 print("interrupted", file=err)
             sys.stdout.flush()
+            if ended:
+                session.out("")
+                break
     finally:
         if session.state.block is not None:
             print(f"behavior `{session.state.block}` is still open; `mitos teach --resume` "
