@@ -852,6 +852,32 @@ def test_a_converted_controller_keeps_the_end_of_its_universe_covered(tmp_path):
             assert "a gap the terms as written did not have" in "\n".join(out)
 
 
+def test_a_variable_with_a_term_of_another_shape_keeps_its_coverage(tmp_path):
+    """`mitos convert robot_jfuzzylogic.fcl`: `dist` has a `discrete` term `far` beside two
+    triangles. A variable with any term adaptation does not move was no partition, so its
+    coverage was not kept: one `adapt` moved `near` [0, 0, 1] off 0 and left dist in [0, 0.057]
+    to no term, which only the interpretability line said. It is now measured on samples."""
+    from mitos_cli.teach.session import Session
+
+    (tmp_path / "r.terms.yaml").write_text(
+        "variables:\n  dist:\n    role: input\n    universe: [0, 3]\n    terms:\n"
+        "      near: {shape: triangle, points: [0, 0, 1]}\n"
+        "      ok: {shape: triangle, points: [0, 1, 2]}\n"
+        "      far: {shape: discrete, points: [1, 0, 2, 1, 3, 1]}\n"
+        "  turn: {role: output, universe: [-45, 45], default: 0, terms: {L: -30, N: 0, R: 30}}\n")
+    (tmp_path / "r.rules").write_text('terms "r.terms.yaml"\n\nr1: if dist is near then turn is L\n'
+                                      "r2: if dist is ok then turn is N\n"
+                                      "r3: if dist is far then turn is R\n")
+    s = Session(tmp_path / "r.rules", out=[].append)
+    s.run("correct dist=1 -> turn=-30")
+    s.run("adapt epochs 5")
+    dist = s.rulebase.variables["dist"]
+    assert dist.term("ok").corners != (0.0, 1.0, 1.0, 2.0)           # it learned
+    assert meaning.term_gaps(dist) == []
+    x = np.linspace(0, 3, 3001)
+    assert meaning.sampled(dist.terms, x).max(axis=0).min() >= 0.5 - 1e-9
+
+
 def _said(before: dict[str, float], after: dict[str, float]) -> list[str]:
     """What `in_words` says when the crisp output `o` (deg) moves from ``before`` to
     ``after``."""

@@ -193,6 +193,10 @@ class Partition:
     most_similar: float
     #: a tied Ruspini partition: it holds at every ordered point, so it is never measured
     by_construction: bool = False
+    #: the variable's terms adaptation does not move (shapes that are not piecewise linear, a
+    #: converted ``discrete`` or ``gaussian`` term), measured with the others on ``x``
+    fixed: tuple = ()
+    x: np.ndarray | None = None
 
     def corners(self, values: np.ndarray) -> np.ndarray:
         return np.where(self.knot >= 0, values[np.maximum(self.knot, 0)], self.written)
@@ -201,21 +205,58 @@ class Partition:
         if self.by_construction:
             return True
         corners = self.corners(values)
+        if self.fixed:
+            return self._holds_on_samples(corners)
         if self.cover is not None:
             ends, least = self.cover
             if np.any(meaning.span_coverage(corners, self.universe, ends) < least - 1e-12):
                 return False
         return meaning.measures(corners, self.universe)[1] <= self.most_similar + 1e-12
 
+    def _holds_on_samples(self, corners: np.ndarray) -> bool:
+        """Beside terms of other shapes the variable is measured as `mitos check` measures
+        it, on samples (:func:`_sampled_partition`), and on the moving terms' bends now."""
+        assert self.x is not None
+        x = np.union1d(self.x, meaning.breakpoints(corners, self.universe))
+        mu = np.vstack([meaning.memberships(corners, x), meaning.sampled(self.fixed, x)])
+        if self.cover is not None:
+            ends, least = self.cover
+            stretch = np.clip(np.searchsorted(ends, x, side="right") - 1, 0, len(least) - 1)
+            if np.any(mu.max(axis=0) < least[stretch] - 1e-12):
+                return False
+        return meaning.most_similar_on(mu, x)[0] <= self.most_similar + 1e-12
+
 
 def partition(var: str, universe: tuple[float, float], knot: np.ndarray, written: np.ndarray,
-              covered: bool) -> Partition:
+              covered: bool, fixed: tuple = ()) -> Partition:
     """A :class:`Partition` with its thresholds (see there)."""
+    if fixed:
+        return _sampled_partition(var, universe, knot, written, covered, fixed)
     cover = meaning.coverage_spans(written, universe) if covered else None
     most = max(meaning.SIMILARITY, meaning.most_similar(written, universe)[0]) \
         if len(written) > 1 else 1.0
     return Partition(var, universe, knot, written, cover, most,
                      by_construction=ruspini(knot, written, universe))
+
+
+def _sampled_partition(var: str, universe: tuple[float, float], knot: np.ndarray,
+                       written: np.ndarray, covered: bool, fixed: tuple) -> Partition:
+    """A variable with terms adaptation does not move (``fixed``) beside the moving ones,
+    measured on :func:`~mitos_cli.lang.interpretability.sample_points`: such a variable was
+    no partition at all, so its coverage and distinctness were not kept (a converted
+    controller's `dist.near`, [0, 0, 1] beside a `discrete` `far`, moved off 0 and left
+    [0, 0.057] to no term). Coverage is kept per run of samples covered to 0.5, or not."""
+    x = np.union1d(meaning.sample_points(fixed, universe), meaning.breakpoints(written, universe))
+    mu = np.vstack([meaning.memberships(written, x), meaning.sampled(fixed, x)])
+    cover = None
+    if covered:
+        top = mu.max(axis=0)
+        ok = top >= meaning.COVERAGE - 1e-12
+        starts = np.concatenate([[0], np.flatnonzero(ok[1:] != ok[:-1]) + 1])
+        cover = (np.append(x[starts], x[-1]),
+                 np.minimum(np.minimum.reduceat(top, starts), meaning.COVERAGE))
+    most = max(meaning.SIMILARITY, meaning.most_similar_on(mu, x)[0])
+    return Partition(var, universe, knot, written, cover, most, fixed=fixed, x=x)
 
 
 def ruspini(knot: np.ndarray, written: np.ndarray, universe: tuple[float, float]) -> bool:
@@ -368,11 +409,13 @@ class _Builder:
         if self.constrained:
             self._keep_places(var.universe, [(term.corners[1:3], out[key][1:3])
                                              for key, term in items])
-        if self.constrained and len(items) == len(var.terms) and items:
+        if self.constrained and items:
             written = np.array([term.corners for _, term in items], dtype=float)
+            moving = {term.name for _, term in items}
             self.partitions.append(partition(vname, var.universe,
                                              np.array([out[k] for k, _ in items]), written,
-                                             covered=kind == "input"))
+                                             covered=kind == "input", fixed=tuple(
+                                                 t for t in var.terms if t.name not in moving)))
         return out
 
     def _keep_places(self, universe: tuple[float, float], cores: list) -> None:
