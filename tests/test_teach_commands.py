@@ -112,6 +112,9 @@ def test_rule_lines_are_rules_of_the_rule_language():
      "did you mean `very`?"),
     ("r1: if road is vry WIDE then speed is SLOW", "unexpected `WIDE`", None,
      "(hedges: very, extremely, somewhat, more_or_less, seldom, intensely, any)"),
+    # what to show: the one meant (it said only the list)
+    ("show rule", "unexpected `rule`", "rules, terms", "did you mean `rules`?"),
+    ("show Terms", "unexpected `Terms`", "rules, terms", "did you mean `terms`?"),
 ])
 def test_mistyped_lines_say_what_was_expected(line, message, expected, hint):
     with pytest.raises(RuleSyntaxError) as info:

@@ -637,6 +637,10 @@ def _teach_hint(text: str, token: Token, before: list[str]) -> str | None:
     at = token.start_pos or 0
     if any(ord(c) > 127 for c in str(token.value)) or (at and ord(text[at - 1]) > 127):
         return "names are written in ASCII letters, digits, `_` and `-`"
+    if before == ["show"]:                  # `show rule`: which one was meant
+        from ..errors import did_you_mean
+
+        return did_you_mean(str(token.value), SHOW_WHAT)
     if token.value == "," and before[:1] in (["eval"], ["correct"], ["at"]):
         return "values are separated by spaces, not commas: `road=78 size=45`"
     glued = at > 0 and not text[at - 1].isspace()
