@@ -563,6 +563,21 @@ def test_a_lessons_lines_are_counted_as_an_editor_counts_them():
         assert (info.value.span.line, info.value.span.column) == (3, 1)
 
 
+def test_a_name_said_in_an_error_is_placed_after_the_command_word_that_repeats_it():
+    """`help help` and `simulate simulate` put the caret under the command, the first place
+    the quoted name was found."""
+    from mitos_cli.teach.lesson import run_lesson
+
+    s = Session(default_rulebase_path(), out=[].append)
+    for line, column in (("help help", 6), ("simulate simulate", 10)):
+        with pytest.raises(MitosError) as info:
+            s.run(line)
+        assert at_prompt(info.value, line, 2).span.column == column
+        with pytest.raises(MitosError) as info:
+            run_lesson(s, line + "\n", "l.lesson")
+        assert (info.value.span.line, info.value.span.column) == (1, column)
+
+
 def test_a_resumed_session_can_correct_the_run_it_recorded(tmp_path, monkeypatch):
     """`simulate` is journaled (a record, not a change): `--resume` drives the last run again
     on the rule base as it was then, so `at` corrects the same run; a seed is exact."""

@@ -161,13 +161,16 @@ def interpretability_text(rb: RuleBase, written: RuleBase | None = None) -> str:
 def quoted_column(message: str, line: str) -> tuple[int, int]:
     """Where in ``line`` the first name an error message quotes (`` `NARROWW` ``) is written,
     as 1-based columns ``(start, end)``; ``(1, None)``-like ``(1, 0)`` when none is (the caret
-    then stands at the start of the line)."""
+    then stands at the start of the line). A name is looked for after the command word
+    first: `help help`, `simulate simulate` said the unknown topic or world at the command."""
     import re
 
+    command = re.match(r"\s*\S+", line)
     for name in re.findall(r"`([^`\s]+)`", message):
-        found = re.search(r"(?<![\w.])" + re.escape(name) + r"(?![\w])", line)
-        if found is None and "." not in name:
-            found = re.search(r"(?<=\.)" + re.escape(name) + r"(?![\w])", line)  # `TERM`
-        if found is not None:
-            return found.start() + 1, found.end() + 1
+        for start in (command.end() if command else 0, 0):
+            found = re.compile(r"(?<![\w.])" + re.escape(name) + r"(?![\w])").search(line, start)
+            if found is None and "." not in name:                                  # `TERM`
+                found = re.compile(r"(?<=\.)" + re.escape(name) + r"(?![\w])").search(line, start)
+            if found is not None:
+                return found.start() + 1, found.end() + 1
     return 1, 0
