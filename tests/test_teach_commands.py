@@ -231,3 +231,20 @@ def test_an_adapt_whose_gain_rounds_away_says_so():
     assert "lowered Q to 1.6e-06" in said and "rounds back" in said and "stays 0.0011" in said
     assert "cannot go lower" in _nothing_changed([2.0, 2.0, 2.0], rounded=True)
     assert "cannot go lower" in _nothing_changed([2.0, 2.0], rounded=False)
+
+
+def test_an_adapt_at_a_rate_too_small_to_move_anything_says_so():
+    """`adapt rate 1e-300` moves no number: it said "Q cannot go lower from here", which the
+    next `adapt` at the default rate showed false."""
+    from mitos_cli.api import default_rulebase_path
+    from mitos_cli.teach.session import Session
+
+    out: list[str] = []
+    s = Session(default_rulebase_path(), out=out.append)
+    s.run("correct road=78 size=45 position=4 -> steering=60")
+    out.clear()
+    s.run("adapt epochs 5 rate 1e-300")
+    said = "\n".join(out)
+    assert "cannot go lower" not in said
+    assert "the steps this rate takes are too small to lower Q; one epoch at the default " \
+           "rate takes it to" in said and "(`adapt rate 0.5`)" in said

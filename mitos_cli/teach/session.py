@@ -78,6 +78,8 @@ def _consequents(rule: Rule) -> dict:
 _NUMBERED = re.compile(r"r(\d+)")
 #: how many rules with a told rule's condition the answer names (the rest are counted)
 SHOWN_SAME = 5
+#: the paper's learning factor eta when `adapt` names none
+DEFAULT_RATE = 0.5
 
 
 @dataclasses.dataclass
@@ -749,7 +751,7 @@ class Session:
         if epochs > cmd.MAX_EPOCHS:     # 10^300 epochs is a hang, not a lesson
             raise LessonError(f"at most {cmd.MAX_EPOCHS:,} epochs in one `adapt`, not {epochs:,}",
                               hint="adapt again to go on from where it stopped")
-        rate = 0.5 if c.rate is None else c.rate
+        rate = DEFAULT_RATE if c.rate is None else c.rate
         result = self._learn(c, compiled, X, T, epochs, rate)
         self.interrupted = result.interrupted
         before = self.rulebase
@@ -761,7 +763,8 @@ class Session:
         if not terms and not crisp:
             if kept:
                 self.out("not adapted: " + "; ".join(kept))
-            self.out(_nothing_changed(history, result.rounded))
+            self.out(_nothing_changed(history, result.rounded,
+                                      self._lower(c, compiled, X, T, rate, history[0])))
             return
         self.change("adapt", line, behavior=compiled.behavior, terms=terms, crisp=crisp,
                     q=[history[0], history[-1]], epochs=epochs, rate=rate)
@@ -798,6 +801,19 @@ class Session:
         finally:
             if progress:
                 progress.close()
+
+    def _lower(self, c: cmd.Adapt, compiled: CompiledRuleBase, X: np.ndarray, T: np.ndarray,
+               rate: float, q: float) -> float | None:
+        """The Q one epoch at the default rate reaches, when an ``adapt`` at a smaller rate
+        changed nothing: `adapt rate 1e-300` moves no number, and said Q could not go lower."""
+        from .adapt import adapt, parameterise
+
+        if rate >= DEFAULT_RATE:
+            return None
+        params = parameterise(compiled, constrained=c.constrained,
+                              frozen_terms=self.state.frozen_terms, released=self.state.released)
+        lower = adapt(compiled, X, T, epochs=1, rate=DEFAULT_RATE, parameters=params).history[-1]
+        return lower if lower < q else None
 
     def _plot_terms(self, before: RuleBase, after: RuleBase, path: str) -> None:
         try:
@@ -954,11 +970,16 @@ def _reaches(rb: RuleBase, start: str, target: str) -> bool:
     return False
 
 
-def _nothing_changed(history: list[float], rounded: bool) -> str:
+def _nothing_changed(history: list[float], rounded: bool, lower: float | None = None) -> str:
     """Why an ``adapt`` changed nothing: the descent found nothing lower, or what it found
     was lost to the grid learned values are kept to (``history``: Q per epoch, the rounded
-    one last when ``rounded``)."""
+    one last when ``rounded``); or its rate was too small, when one epoch at the default rate
+    reaches ``lower``."""
     descent = history[:-1] if rounded else history
+    if lower is not None:
+        return (f"nothing changed: the steps this rate takes are too small to lower Q; one "
+                f"epoch at the default rate takes it to {lower:.6g} (`adapt rate "
+                f"{DEFAULT_RATE:g}`)")
     if rounded and min(descent) < history[0]:
         return (f"nothing changed: the descent lowered Q to {min(descent):.6g}, but every value "
                 f"it moved rounds back to what it was (learned values are kept to a readable "
