@@ -298,6 +298,20 @@ def test_prompt_errors_are_command_errors_at_the_prompts_line(work):
     assert "lesson error" not in res.stderr
 
 
+def test_a_journal_that_is_a_directory_is_no_session(tmp_path):
+    """`.mitos/teach/x/journal.jsonl` made a directory: `--resume` ended in a traceback
+    (IsADirectoryError); the newest session is the newest whose journal is a file."""
+    from mitos_cli.errors import LessonError
+    from mitos_cli.teach.journal import JOURNAL, ROOT, find_session
+
+    (tmp_path / ROOT / "x" / JOURNAL).mkdir(parents=True)
+    with pytest.raises(LessonError, match="no teaching session to resume"):
+        find_session(None, tmp_path)
+    (tmp_path / ROOT / "a").mkdir()
+    (tmp_path / ROOT / "a" / JOURNAL).write_text('{"seq":1,"op":"start"}\n')
+    assert find_session(None, tmp_path).name == "a"
+
+
 def test_an_unknown_session_lists_the_newest(tmp_path):
     """Twenty sessions: the list a misspelt --session gets is the newest twelve by time (not
     by name: a session is named after its rule file), newest first, and it is a name error."""

@@ -56,7 +56,8 @@ def find_session(name: str | None, base: Path | None = None) -> Path:
     root = sessions_dir(base)
     # a session killed before its first entry was written has an empty journal: nothing to
     # resume there, so the newest session is the newest with a journal that holds something
-    found = sorted((p for p in root.glob("*/" + JOURNAL) if p.stat().st_size),
+    # (a file: a directory of that name raised IsADirectoryError, a traceback)
+    found = sorted((p for p in root.glob("*/" + JOURNAL) if p.is_file() and p.stat().st_size),
                    key=lambda p: p.stat().st_mtime) if root.is_dir() else []
     if name is not None:
         direct = Path(name)
