@@ -299,6 +299,25 @@ def test_behavior_main_and_top_level_rules(tmp_path):
     path = write(tmp_path, GOOD_RULE + "\nbehavior main:\n  " + GOOD_RULE + "\nend\n")
     exc = error_of(lambda: load_rules_file(path), RuleBaseError)
     assert "behavior `main` is defined twice" in exc.message and exc.span.line == 3
+    assert exc.message.endswith("(also by the rules outside any behavior)")
+
+
+def test_behavior_main_written_twice_says_where_the_first_is(tmp_path):
+    """Two `behavior main:` blocks and no top-level rule were said to clash with "the rules
+    outside any behavior", which the file has none of."""
+    body = "  " + GOOD_RULE + "\nend\n"
+    path = write(tmp_path, "behavior main:\n" + body + "behavior main:\n" + body)
+    exc = error_of(lambda: load_rules_file(path), RuleBaseError)
+    assert exc.message == "behavior `main` is defined twice (first at line 2)"
+
+
+def test_top_level_rules_after_behavior_main_are_placed(tmp_path):
+    """`behavior main: ... end` and then a rule outside any behavior: the clash was said
+    with no file:line:col at all; it is said at the first top-level rule."""
+    path = write(tmp_path, "behavior main:\n  " + GOOD_RULE + "\nend\n" + GOOD_RULE + "\n")
+    exc = error_of(lambda: load_rules_file(path), RuleBaseError)
+    assert exc.message.endswith("(also by the rules outside any behavior)")
+    assert (exc.span.line, exc.span.column) == (5, 1)
 
 
 def test_duplicate_label(tmp_path):

@@ -228,9 +228,12 @@ def _main_place(parsed: ParsedFile) -> int:
 def _defined_twice(second: Behavior, first: Behavior) -> RuleBaseError:
     """A behavior defined again, at the second definition, saying where the first is."""
     where = f" (first at line {first.span.line})" if first.span else ""
-    if second.name == MAIN:             # the file's top-level rules, then `behavior main:`
-        where = " (also by the rules outside any behavior)"
+    if second.name == MAIN and None in (first.span, second.span):   # the top-level rules
+        where = " (also by the rules outside any behavior)"           # are the other one
     span = second.span and second.span.naming(second.name)
+    if second.span is None:         # the top-level rules after `behavior main:`: at the first
+        span = min((x.span for x in second.rules + second.uses if x.span is not None),
+                   key=lambda x: (x.line, x.column), default=None)
     return RuleBaseError(f"behavior `{second.name}` is defined twice{where}", span=span,
                          hint="rename one of them, or move its rules into the other")
 
