@@ -545,3 +545,22 @@ def test_a_terms_line_with_an_escape_json_does_not_know_is_saved(tmp_path):
     for name in ("out.rules", 'q"uote.rules'):       # a `"` in the new name: escaped
         s.run(f"save {json.dumps(str(tmp_path / name))}")
         assert variables(load_rules_file(tmp_path / name)) == variables(s.rulebase)
+
+
+def test_a_rule_base_written_with_crlf_is_saved_with_crlf(rules, tmp_path):
+    """Read with universal newlines, a rule base written on Windows was saved with `\\n`:
+    `git diff` showed every line changed where only numbers were learned."""
+    for f in rules.parent.iterdir():
+        f.write_bytes(f.read_bytes().replace(b"\n", b"\r\n"))
+    s = Session(rules, out=[].append)
+    s.run("correct road=78 size=45 position=4 -> steering=60")
+    s.run("adapt epochs 5")
+    s.run(f"save {tmp_path / 'out.rules'}")
+    for name, src in (("out.rules", "mitos.rules"), ("out.mitos.terms.yaml", "mitos.terms.yaml")):
+        before = (rules.parent / src).read_bytes().split(b"\r\n")
+        after = (tmp_path / name).read_bytes()
+        assert after.count(b"\n") == after.count(b"\r\n")
+        lines = after.split(b"\r\n")
+        assert len(lines) == len(before)
+        assert sum(a != b for a, b in zip(before, lines)) < len(lines) // 3
+    assert variables(load_rules_file(tmp_path / "out.rules")) == variables(s.rulebase)

@@ -99,10 +99,13 @@ def save_rulebase(original: RuleBase, current: RuleBase, target: Path) -> Saved:
     new_rules, changed = edit_rules(rules_text, str(src), original, current, names)
     changes += changed
     _check_reads_back(current, new_rules, texts, target, names)
+    written = [(dest, _breaks_as(text, src.parent / rel))
+               for (dest, text), rel in zip(texts, original.termset_paths)]
     created = _directory_for(target)
     try:
         finish_saves(target, error=LessonError)        # one a crash left half done
-        atomic_write_set(texts + [(target, new_rules)], target, error=LessonError)
+        atomic_write_set(written + [(target, _breaks_as(new_rules, src))], target,
+                         error=LessonError)
     except LessonError as exc:          # it names the file it failed on: often a term set
         if created is not None:
             with contextlib.suppress(OSError):
@@ -111,6 +114,17 @@ def save_rulebase(original: RuleBase, current: RuleBase, target: Path) -> Saved:
                           hint=f"save where you can write files (`save ~/{target.name}`); "
                                "the session keeps every change") from None
     return Saved(target, tuple(d for d, _ in texts), tuple(changes), created)
+
+
+def _breaks_as(text: str | bytes, original: Path) -> str | bytes:
+    """``text`` (read with universal newlines) with the line breaks of the file it was read
+    from: a rule base written on Windows (``\\r\\n``) was saved with ``\\n``, so that `git diff`
+    showed every line changed where only numbers were learned."""
+    if isinstance(text, bytes):
+        return text
+    raw = original.read_bytes()
+    first = raw.find(b"\n")
+    return text.replace("\n", "\r\n") if first > 0 and raw[first - 1:first] == b"\r" else text
 
 
 def check_save_target(original: RuleBase, target: Path) -> tuple[Path, ...]:
