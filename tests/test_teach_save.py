@@ -564,3 +564,17 @@ def test_a_rule_base_written_with_crlf_is_saved_with_crlf(rules, tmp_path):
         assert len(lines) == len(before)
         assert sum(a != b for a, b in zip(before, lines)) < len(lines) // 3
     assert variables(load_rules_file(tmp_path / "out.rules")) == variables(s.rulebase)
+
+
+def test_a_rule_base_written_with_a_bom_is_saved_with_it(rules, tmp_path):
+    """A rule file beginning with a byte-order mark (Notepad's UTF-8) loads, but `save` parsed
+    it with the mark: a Python traceback (lark's UnexpectedCharacters) ended the session."""
+    for f in rules.parent.iterdir():
+        f.write_bytes(b"\xef\xbb\xbf" + f.read_bytes())
+    s = Session(rules, out=[].append)
+    s.run("correct road=78 size=45 position=4 -> steering=60")
+    s.run("adapt epochs 5")
+    s.run(f"save {tmp_path / 'out.rules'}")
+    for name in ("out.rules", "out.mitos.terms.yaml", "out.drive.terms.yaml"):
+        assert (tmp_path / name).read_bytes().startswith(b"\xef\xbb\xbf# ")     # one mark
+    assert variables(load_rules_file(tmp_path / "out.rules")) == variables(s.rulebase)

@@ -16,6 +16,7 @@ updated; saving over the original rule file rewrites its term sets in place.
 
 from __future__ import annotations
 
+import codecs
 import contextlib
 import json
 import os
@@ -90,11 +91,11 @@ def save_rulebase(original: RuleBase, current: RuleBase, target: Path) -> Saved:
     texts: list[tuple[Path, str | bytes]] = []
     for ts_old, ts_new, rel, dest in zip(original.termsets, current.termsets,
                                         original.termset_paths, targets):
-        text = (src.parent / rel).read_text(encoding="utf-8")
+        text = (src.parent / rel).read_text(encoding="utf-8-sig")     # as the loader reads it
         new_text, changed = edit_termset(text, str(src.parent / rel), ts_old, ts_new)
         changes += changed
         texts.append((dest, new_text))
-    rules_text = src.read_text(encoding="utf-8")
+    rules_text = src.read_text(encoding="utf-8-sig")    # a BOM is no token of the rule language
     names = tuple(os.path.relpath(dest, target.parent).replace(os.sep, "/") for dest in targets)
     new_rules, changed = edit_rules(rules_text, str(src), original, current, names)
     changes += changed
@@ -117,14 +118,16 @@ def save_rulebase(original: RuleBase, current: RuleBase, target: Path) -> Saved:
 
 
 def _breaks_as(text: str | bytes, original: Path) -> str | bytes:
-    """``text`` (read with universal newlines) with the line breaks of the file it was read
-    from: a rule base written on Windows (``\\r\\n``) was saved with ``\\n``, so that `git diff`
-    showed every line changed where only numbers were learned."""
+    """``text`` (read with universal newlines, a BOM dropped) with the line breaks and the BOM
+    of the file it was read from: a rule base written on Windows (``\\r\\n``) was saved with
+    ``\\n``, so that `git diff` showed every line changed where only numbers were learned."""
     if isinstance(text, bytes):
         return text
     raw = original.read_bytes()
     first = raw.find(b"\n")
-    return text.replace("\n", "\r\n") if first > 0 and raw[first - 1:first] == b"\r" else text
+    if first > 0 and raw[first - 1:first] == b"\r":
+        text = text.replace("\n", "\r\n")
+    return "\ufeff" + text if raw.startswith(codecs.BOM_UTF8) else text
 
 
 def check_save_target(original: RuleBase, target: Path) -> tuple[Path, ...]:
