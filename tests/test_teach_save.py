@@ -578,3 +578,28 @@ def test_a_rule_base_written_with_a_bom_is_saved_with_it(rules, tmp_path):
     for name in ("out.rules", "out.mitos.terms.yaml", "out.drive.terms.yaml"):
         assert (tmp_path / name).read_bytes().startswith(b"\xef\xbb\xbf# ")     # one mark
     assert variables(load_rules_file(tmp_path / "out.rules")) == variables(s.rulebase)
+
+
+def test_operators_told_for_the_top_level_rules_keep_the_other_behaviors_as_they_were(tmp_path):
+    """The file has no block of `main`'s own: its operators go on the top-level `operators:`
+    line, every behavior's default. Beside any behavior (in the file, or told) the save read
+    back as another rule base and was refused as "a bug in MITOS"."""
+    from mitos_cli.lang.operators import of_behavior
+
+    src = _two_termsets_named_alike(tmp_path)
+    rules = tmp_path / "mixed.rules"
+    rules.write_text('terms "a/x.terms.yaml", "b/x.terms.yaml"\noperators: or = max\n'
+                     "r0: if x is LO then y is A\nr1: if x is MID then y is C\n\n"
+                     "behavior other:\n    r0: if x is HI then y is E\nend\n")
+    assert src.exists()
+    s = Session(rules, out=[].append)
+    s.run("operators: and = product, or = probor")
+    s.run("behavior told")
+    s.run("if x is HI then y is D")
+    s.run("end")
+    s.run(f"save {tmp_path / 'out.rules'}")
+    back = load_rules_file(tmp_path / "out.rules")
+    for name in ("main", "other", "told"):
+        assert of_behavior(back, back.behavior(name)) == \
+            of_behavior(s.rulebase, s.rulebase.behavior(name))
+    assert of_behavior(back, back.behavior("other")).and_ == "min"

@@ -479,14 +479,21 @@ def edit_rules(text: str, path: str, original: RuleBase, current: RuleBase,
             edits.append((tok.start_pos, tok.end_pos, json.dumps(name, ensure_ascii=False)))
     appended: list[str] = []
     old_behaviors = {b.name: b for b in original.behaviors}
+    restore = _kept_from_the_top(original, current, places)
     for b in current.behaviors:
         old = old_behaviors.get(b.name)
+        keep = {} if b.name == "main" else {
+            key: value for key, value in restore.items() if key not in _last_values(b.operators)}
         if old is None:
-            appended.append(_behavior_text(b))
+            appended.append(_behavior_text(b, keep))
             changes.append(f"new behavior {b.name} ({plural(len(b.rules), 'rule')})")
             continue
         place = places.get(b.name)
         inserted: list[str] = []
+        if keep:
+            inserted.append("operators: " + ", ".join(f"{k} = {v}" for k, v in keep.items()))
+            changes.append(f"{b.name}: operators {inserted[-1][len('operators: '):]} (as before: "
+                           f"the file's own `operators:` line now sets what `main` was told)")
         for i, rule in enumerate(b.rules):
             # a rule told again under its label stays in its place, a new one is added at
             # the end (`state._put_rule`): the first rules are the file's, in its order,
@@ -570,10 +577,30 @@ def _only_crisp_changed(before, after) -> bool:
     return True
 
 
-def _behavior_text(b: Behavior) -> str:
+def _kept_from_the_top(original: RuleBase, current: RuleBase, places: dict) -> dict[str, str]:
+    """The operators told for the rules outside any behavior (`main`), each with the value
+    the file set for every behavior before. The file has no block of `main`'s own: they are
+    written on its top-level `operators:` line, the default of every behavior, so each other
+    behavior that does not set them itself is written with the value it had. Without that a
+    save of `operators: and = product` told for `main` beside any behavior read back as
+    another rule base and was refused as "a bug in MITOS"."""
+    from ..lang.operators import KEYS, resolve
+
+    now = next((b for b in current.behaviors if b.name == "main"), None)
+    was = next((b for b in original.behaviors if b.name == "main"), None)
+    place = places.get("main")
+    if now is None or was is None or place is None or place.end_line_start is not None:
+        return {}
+    before = resolve(original.operators)
+    return {key: str(getattr(before, KEYS[key]))
+            for key in _last_values(now.operators[len(was.operators):])}
+
+
+def _behavior_text(b: Behavior, keep: dict[str, str] | None = None) -> str:
     lines = [f"behavior {b.name}:"]
-    if b.operators:
-        lines.append("    operators: " + _operators_text(b.operators))
+    settings = {**(keep or {}), **_last_values(b.operators)}
+    if settings:
+        lines.append("    operators: " + ", ".join(f"{k} = {v}" for k, v in settings.items()))
     lines += ["    " + format_rule(r) for r in b.rules]
     lines += ["    " + format_use(u) for u in b.uses]
     if b.frozen:
