@@ -603,3 +603,16 @@ def test_operators_told_for_the_top_level_rules_keep_the_other_behaviors_as_they
         assert of_behavior(back, back.behavior(name)) == \
             of_behavior(s.rulebase, s.rulebase.behavior(name))
     assert of_behavior(back, back.behavior("other")).and_ == "min"
+
+
+def test_a_file_where_the_directory_goes_is_said_to_be_one(rules, tmp_path):
+    """`save notes.txt/x.rules` beside a file `notes.txt` said "cannot create `notes.txt`:
+    File exists", and `save notes.txt/a/x.rules` that the directory does not exist."""
+    (tmp_path / "notes.txt").write_text("mine\n")
+    s = Session(rules, out=[].append)
+    s.run("correct road=78 size=45 position=4 -> steering=60")
+    for name in ("notes.txt/x.rules", "notes.txt/a/x.rules"):
+        with pytest.raises(LessonError) as info:
+            s.run(f"save {tmp_path / name}")
+        assert info.value.message.endswith(f"`{tmp_path / 'notes.txt'}` is a file, not a directory")
+    assert (tmp_path / "notes.txt").read_text() == "mine\n"

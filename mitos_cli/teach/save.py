@@ -250,6 +250,10 @@ def _directory_for(target: Path) -> Path | None:
     parent = target.parent
     if parent.is_dir():
         return None
+    for up in (parent, parent.parent):  # `save notes.txt/x.rules`: said "File exists"
+        if up.exists() and not up.is_dir():
+            raise LessonError(f"cannot save `{target}`: `{up}` is a file, not a directory",
+                              hint="name a directory, or a new one to be made")
     if not parent.parent.is_dir():
         raise LessonError(f"cannot save `{target}`: the directory `{parent.parent}` does not "
                           f"exist", hint="check the path, or create the directory first")
