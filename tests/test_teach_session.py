@@ -578,6 +578,21 @@ def test_a_name_said_in_an_error_is_placed_after_the_command_word_that_repeats_i
         assert (info.value.span.line, info.value.span.column) == (1, column)
 
 
+def test_a_rule_frozen_already_is_said_so_and_not_journaled(rules, tmp_path):
+    """`frozen r4` again was journaled as a change (an unsaved change with nothing to save),
+    and `frozen r4, r4` was saved as written; as for terms, what is frozen already is said."""
+    s, out = session(rules)
+    assert say(s, out, "frozen r4, r4") == \
+        "avoid_obstacle: adaptation leaves the consequents of r4 alone"
+    assert say(s, out, "frozen r4") == "avoid_obstacle: r4 is frozen already; nothing changes"
+    assert say(s, out, "frozen r5, r4").splitlines() == [
+        "avoid_obstacle: adaptation leaves the consequents of r5 alone",
+        "avoid_obstacle: r4 is frozen already"]
+    assert [e.get("labels") for e in s.journal.entries[1:]] == [["r4"], ["r5"]]
+    s.run(f"save {tmp_path / 'out.rules'}")
+    assert "    frozen r4, r5\n" in (tmp_path / "out.rules").read_text()
+
+
 def test_a_resumed_session_can_correct_the_run_it_recorded(tmp_path, monkeypatch):
     """`simulate` is journaled (a record, not a change): `--resume` drives the last run again
     on the rule base as it was then, so `at` corrects the same run; a seed is exact."""

@@ -435,13 +435,23 @@ class Session:
         self.out(f"{format_use(use)}\n  added to {self.state.block}")
 
     def _tellfrozen(self, c: cmd.TellFrozen, line: str) -> None:
+        """Freeze rules; one named twice counts once, and one frozen already is said so and
+        not journaled, as `frozen` of a frozen term (`frozen r1` again was a change that
+        `save` wrote nothing new for; `frozen r0, r0` was saved as written)."""
         b = self.rulebase.behavior(self.focus)
         labels = [r.label for r in b.rules]
         for label in c.labels:
             if label not in labels:
                 raise unknown("rule label", label, labels, owner=b.name)
-        self.change("frozen", line, behavior=b.name, labels=list(c.labels))
-        self.out(f"{b.name}: adaptation leaves the consequents of {', '.join(c.labels)} alone")
+        named = list(dict.fromkeys(c.labels))
+        new = [x for x in named if x not in b.frozen]
+        already = [x for x in named if x in b.frozen]
+        if new:
+            self.change("frozen", line, behavior=b.name, labels=new)
+            self.out(f"{b.name}: adaptation leaves the consequents of {', '.join(new)} alone")
+        if already:
+            self.out(f"{b.name}: {', '.join(already)} {'is' if len(already) == 1 else 'are'} "
+                     "frozen already" + ("; nothing changes" if not new else ""))
 
     def _term_refs(self, refs) -> list[list[str]]:
         variables = self.rulebase.variables
