@@ -286,6 +286,17 @@ def test_help(rules):
     assert s.run("quit") is False
 
 
+def test_every_command_of_the_table_has_help():
+    """`operators:` is a command of docs/teach.md's table and of the prompt, but `help`
+    listed no line for it and `help operators` was an unknown topic."""
+    from mitos_cli.teach.commands import COMMAND_WORDS
+    from mitos_cli.teach.help import SUMMARY, help_text
+
+    for word in COMMAND_WORDS:
+        assert help_text(word)
+    assert "operators: and = product" in SUMMARY
+
+
 def test_simulate_and_at_and_their_mistakes(rules, tmp_path):
     s, out = session(rules)
     s.run("use drive")
@@ -564,12 +575,12 @@ def test_a_lessons_lines_are_counted_as_an_editor_counts_them():
 
 
 def test_a_name_said_in_an_error_is_placed_after_the_command_word_that_repeats_it():
-    """`help help` and `simulate simulate` put the caret under the command, the first place
+    """`save save` and `simulate simulate` put the caret under the command, the first place
     the quoted name was found."""
     from mitos_cli.teach.lesson import run_lesson
 
     s = Session(default_rulebase_path(), out=[].append)
-    for line, column in (("help help", 6), ("simulate simulate", 10)):
+    for line, column in (("save save", 6), ("simulate simulate", 10)):
         with pytest.raises(MitosError) as info:
             s.run(line)
         assert at_prompt(info.value, line, 2).span.column == column

@@ -17,6 +17,7 @@ Tell rules, correct outputs, let the robot adapt, save. Every change is journale
   at 12.5s steering=55   |   at 11s to 13s steering is LM    corrections during that drive
   at 13s to 14.5s make a wider turn              ... or in words (`help at` lists them)
   frozen heading.AHEAD  |  unfrozen heading.AHEAD    keep a term as it is, or let it move
+  operators: and = product                       operators of the open (or active) behavior
   adapt [epochs N] [rate ETA] [plot FILE]        learn from the examples (Q never increases)
   show rules|terms|examples|behaviors|history [plot FILE]
   undo        take back the last change
@@ -46,6 +47,11 @@ frozen r4, r5     adaptation leaves the consequents of rules r4 and r5 of the op
                   behavior alone. A term is frozen in the YAML term set with `frozen: true`.
 frozen heading.AHEAD      adaptation leaves this term as it is (`save` writes `frozen: true`)
 unfrozen heading.AHEAD    lift a freeze, or the hold of a centre term at its point""",
+    "operators": """\
+operators: and = product, or = probor
+The operator settings of the open (or active) behavior, as an `operators:` line of a rule file
+means (`inference = mamdani`, `defuzzify = bisector`, ...; `mitos operators` lists every norm
+and inference). Settings its rules cannot be evaluated with are refused before they are kept.""",
     "eval": """\
 eval road=78 size=45 position=4
 The fuzzified inputs, the rules that fire with their DOFs, and the outputs, as `mitos eval`.""",
@@ -103,7 +109,7 @@ ALIASES = {"if": "rule", "rules": "rule", "end": "behavior", "exit": "quit", "te
 
 
 def help_text(topic: str | None = None) -> str:
-    if topic is None:
+    if topic is None or topic == "help":
         return SUMMARY
     key = ALIASES.get(topic, topic)
     if key not in TOPICS:
