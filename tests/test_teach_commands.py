@@ -248,3 +248,15 @@ def test_an_adapt_at_a_rate_too_small_to_move_anything_says_so():
     assert "cannot go lower" not in said
     assert "the steps this rate takes are too small to lower Q; one epoch at the default " \
            "rate takes it to" in said and "(`adapt rate 0.5`)" in said
+
+
+def test_a_window_without_a_target_does_not_ask_for_its_to_again():
+    """`at 5s to 6s` ending there was told it expected "`to` or a name" (LALR's merged
+    states): the `to` is written already."""
+    with pytest.raises(RuleSyntaxError) as info:
+        parse_command("at 5s to 6s", "l.lesson", 3)
+    assert info.value.message == "the line ends too early"
+    assert info.value.expected == "a name" and (info.value.span.line, info.value.span.column) == (3, 12)
+    with pytest.raises(RuleSyntaxError) as info:
+        parse_command("at 5s")
+    assert "`to`" in info.value.expected

@@ -581,6 +581,8 @@ def _syntax_error(exc: UnexpectedInput, text: str, path: str) -> RuleSyntaxError
                                           and exc.token.type == "$END"):
         line = len(text.rstrip().splitlines()) or 1
         column = len(lines[line - 1]) + 1 if line <= len(lines) else 1
+        if text.split()[:1] == ["at"] and "to" in text.split()[2:3]:   # LALR's merged states:
+            expected = {e for e in expected if e.upper() != "TO"}     # the `to` is behind us
         return RuleSyntaxError("the line ends too early",
                                span=Span.in_text(text, path, line, column),
                                expected=_expected(expected), hint=_eof_hint(text))
