@@ -604,6 +604,18 @@ def test_a_rule_frozen_already_is_said_so_and_not_journaled(rules, tmp_path):
     assert "    frozen r4, r5\n" in (tmp_path / "out.rules").read_text()
 
 
+def test_a_window_reaches_the_last_tick_one_time_reaches(rules):
+    """The tick at which the robot arrives is recorded and `at END` corrects it, but a window
+    ending there left it out (the robot is no longer active at it)."""
+    s, out = session(rules)
+    s.run("use drive")
+    s.run("simulate corridor")
+    rec = s.simulation
+    last = len(rec.t) - 1
+    assert list(rec.rows(rec.end - 0.1, rec.end)) == [last - 2, last - 1, last]
+    assert list(rec.rows(rec.end, None)) == [last]
+
+
 def test_a_resumed_session_can_correct_the_run_it_recorded(tmp_path, monkeypatch):
     """`simulate` is journaled (a record, not a change): `--resume` drives the last run again
     on the rule base as it was then, so `at` corrects the same run; a seed is exact."""

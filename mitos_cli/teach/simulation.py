@@ -129,7 +129,11 @@ class Recording:
         if stop < start:
             raise LessonError(f"`at {start:g}s to {stop:g}s`: the window ends before it starts",
                               span=_between(*places))
-        rows = np.flatnonzero((t >= start - 1e-9) & (t <= stop + 1e-9) & active)
+        # up to the tick at which it arrived, as one time reaches it (`active` is False there:
+        # a window ending at the end of the run left out its last tick, and a robot that
+        # starts at its goal had "no recorded tick between 0 s and 0 s" where `at 0s` had one)
+        rows = np.flatnonzero((t >= start - 1e-9) & (t <= stop + 1e-9)
+                              & (active | (np.arange(len(t)) == self._last)))
         if rows.size == 0:
             raise LessonError(f"no recorded tick between {start:g} s and {stop:g} s",
                               span=_between(*places))
