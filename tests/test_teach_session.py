@@ -616,6 +616,22 @@ def test_a_window_reaches_the_last_tick_one_time_reaches(rules):
     assert list(rec.rows(rec.end, None)) == [last]
 
 
+def test_a_world_naming_a_behavior_the_rule_base_lacks_is_not_offered_to_use(rules, tmp_path):
+    """A world file naming a behavior the rule base does not have (which `mitos simulate`
+    refuses) got "`use cruise_ctl` to drive it so here": a name error if followed."""
+    from mitos_cli.teach.simulation import world_path
+
+    world = tmp_path / "wb.yaml"
+    world.write_text(world_path("corridor").read_text().replace("behavior: drive",
+                                                                "behavior: cruise_ctl"))
+    s, out = session(rules)
+    s.run("use drive")
+    said = say(s, out, f"simulate {world}")
+    assert "`use cruise_ctl`" not in said
+    assert "(wb's world file names behavior `cruise_ctl`, which this rule base does not have)" \
+        in said
+
+
 def test_a_resumed_session_can_correct_the_run_it_recorded(tmp_path, monkeypatch):
     """`simulate` is journaled (a record, not a change): `--resume` drives the last run again
     on the rule base as it was then, so `at` corrects the same run; a seed is exact."""

@@ -42,6 +42,8 @@ class Recording:
     robot: int = 0                     # the column of the robot whose run is corrected
     robot_name: str = ""
     seed: int | None = None            # as given to `simulate` (None: the world's own)
+    #: the behaviors of the rule base that drove it (the world's own may not be among them)
+    behaviors: tuple[str, ...] = ()
 
     @property
     def t(self) -> np.ndarray:
@@ -107,6 +109,9 @@ class Recording:
         own = self.result.world.behavior
         if own == self.behavior:
             return ""
+        if self.behaviors and own not in self.behaviors:   # `use` it would be a name error
+            return (f"\n  ({self.name}'s world file names behavior `{own}`, which this rule "
+                    "base does not have)")
         return (f"\n  (`mitos simulate` drives {self.name} with behavior {own}: "
                 f"`use {own}` to drive it so here)")
 
@@ -178,7 +183,8 @@ def run_world(name: str, rulebase: RuleBase, behavior: str, seed: int | None = N
         raise
     result = simulate(world, planner, seed=seed)
     return Recording(Path(name).stem, behavior, result, index,
-                     names[index] if len(names) > 1 else "", seed)
+                     names[index] if len(names) > 1 else "", seed,
+                     tuple(b.name for b in rulebase.behaviors))
 
 
 def _between(first: Span | None, last: Span | None) -> Span | None:
