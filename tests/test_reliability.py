@@ -252,6 +252,24 @@ def test_damaged_middle_line_is_named_and_recoverable(tmp_path, monkeypatch, bad
     assert journal.aside.is_file()
 
 
+def test_a_damaged_start_offers_no_recovery_and_recovery_keeps_the_journal(tmp_path,
+                                                                           monkeypatch):
+    """A damaged first line (the session's start) was offered `--recover`, which then cut the
+    journal to nothing and said "not a teaching journal"; there is nothing before it."""
+    from mitos_cli.teach.journal import Journal
+
+    d = _session(tmp_path, monkeypatch)
+    path = d / "journal.jsonl"
+    path.write_bytes(path.read_bytes().replace(b'"op":"start"', b'"op":"strt"', 1))
+    damaged = path.read_bytes()
+    for recover in (False, True):
+        with pytest.raises(LessonError) as info:
+            Journal.open(d, recover=recover)
+        assert info.value.span.line == 1 and "--recover" not in info.value.hint
+        assert "nothing to continue" in info.value.hint
+    assert path.read_bytes() == damaged
+
+
 def test_entry_that_cannot_be_applied_names_its_line(tmp_path, monkeypatch):
     from mitos_cli.teach.journal import Journal
     from mitos_cli.teach.session import Session

@@ -128,13 +128,16 @@ class Journal:
                 continue
             if i == len(lines) - 1:                # no newline after it: cut short by a kill
                 journal.skipped_tail = True
-            elif not recover:
+            elif not recover or not journal.entries:
                 shown = line[:120].decode("utf-8", "replace")
+                # before the session's start there is nothing to continue: `--recover` then
+                # said "not a teaching journal", where this hint had offered it
+                hint = ("`mitos teach --resume --recover` continues the session with the "
+                        f"changes before line {i + 1} (the damaged journal is kept aside)"
+                        if journal.entries else "the session's start is damaged, so there is "
+                        "nothing to continue: start a new session with `mitos teach RULES`")
                 raise LessonError(f"the journal is damaged: {problem}",
-                                  span=Span(str(journal.path), i + 1, 1, shown),
-                                  hint="`mitos teach --resume --recover` continues the session "
-                                       f"with the changes before line {i + 1} (the damaged "
-                                       "journal is kept aside)")
+                                  span=Span(str(journal.path), i + 1, 1, shown), hint=hint)
             else:
                 journal.recovered_at = i + 1
             journal.cut(start, raw)
