@@ -632,6 +632,18 @@ def test_a_world_naming_a_behavior_the_rule_base_lacks_is_not_offered_to_use(rul
         in said
 
 
+def test_an_output_the_behavior_does_not_set_is_said_alike_in_words(rules):
+    """`correct heading=5 -> speed=20` of `follow_route` (no speed) said the behavior does not
+    use `speed`; the same in words, `speed is SLOW`, said "unknown output variable"."""
+    s, out = session(rules)
+    s.run("use follow_route")
+    for target in ("speed=20", "speed is SLOW"):
+        with pytest.raises(LessonError) as info:
+            s.run(f"correct heading=5 -> {target}")
+        assert info.value.message == "behavior `follow_route` does not use output `speed`"
+        assert info.value.expected == "outputs steering"
+
+
 def test_a_resumed_session_can_correct_the_run_it_recorded(tmp_path, monkeypatch):
     """`simulate` is journaled (a record, not a change): `--resume` drives the last run again
     on the rule base as it was then, so `at` corrects the same run; a seed is exact."""

@@ -549,12 +549,7 @@ class Session:
         out = {}
         for a in given:
             if a.name not in names:
-                known = [v.name for v in compiled.variables.values() if v.role == role]
-                if a.name in known:
-                    raise LessonError(f"behavior `{compiled.behavior}` does not use "
-                                      f"{role} `{a.name}`", span=a.span,
-                                      expected=f"{role}s " + ", ".join(names))
-                raise unknown(f"{role} variable", a.name, names, span=a.span, cls=LessonError)
+                raise _not_its(a.name, a.span, role, names, compiled)
             if a.name in out:
                 raise LessonError(f"`{a.name}` is given twice", span=a.span)
             if not math.isfinite(a.value):      # (a guard: the grammar reads 1e400 as an error)
@@ -603,8 +598,7 @@ class Session:
         out = []
         for t in said:
             if t.name not in compiled.outputs:
-                raise unknown("output variable", t.name, compiled.outputs, span=t.span,
-                              cls=LessonError)
+                raise _not_its(t.name, t.span, "output", compiled.outputs, compiled)
             if t.term is None:
                 out.append(cmd.Assign(t.name, t.value, t.span))
                 continue
@@ -965,6 +959,20 @@ def _drawing() -> Iterator[None]:
     except (DrawError, WriteError) as exc:
         raise LessonError(exc.message, span=exc.span, expected=exc.expected,
                           hint=exc.hint) from None
+
+
+def _not_its(name: str, span: Span | None, role: str, names: tuple[str, ...],
+             compiled: CompiledRuleBase) -> LessonError:
+    """A name that is not one of the behavior's inputs or outputs: one of the rule base's it
+    does not use (`speed` of `follow_route`), else unknown; said alike for `speed=20` and
+    `speed is SLOW` (the words said "unknown output variable" of a variable that exists)."""
+    known = [v.name for v in compiled.variables.values() if v.role == role]
+    if name in known:
+        return LessonError(f"behavior `{compiled.behavior}` does not use {role} `{name}`",
+                           span=span, expected=f"{role}s " + ", ".join(names))
+    error = unknown(f"{role} variable", name, names, span=span, cls=LessonError)
+    assert isinstance(error, LessonError)
+    return error
 
 
 def _reaches(rb: RuleBase, start: str, target: str) -> bool:
