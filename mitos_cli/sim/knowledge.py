@@ -655,10 +655,12 @@ def _add_marks(maps: list[RobotMap], grid: Grid, k: np.ndarray, row: np.ndarray,
         m.fresh.append(centres[a:e])
 
 
-def accounted_all(maps: list[RobotMap], cells: np.ndarray, reach: int = 2) -> np.ndarray:
+def accounted_all(maps: list[RobotMap], cells: np.ndarray, reach: int = 2,
+                  kept: Dilations | None = None) -> np.ndarray:
     """``[m.accounted_cells(c, reach) for m, c in zip(maps, cells [R, B, 2])]`` as ``[R, B]``:
     the cells inside tested and their places in a dilation worked out in one pass, then one
-    ``take`` a map (maps alike: the runs of a world)."""
+    ``take`` a map (maps alike: the runs of a world), or one for all from ``kept`` (a
+    lockstep batch's :class:`Dilations`)."""
     grid = _alike(maps) if len(maps) > 1 else None
     if grid is None:
         return np.array([m.accounted_cells(c, reach) for m, c in zip(maps, cells)], dtype=bool
@@ -670,10 +672,52 @@ def accounted_all(maps: list[RobotMap], cells: np.ndarray, reach: int = 2) -> np
     everywhere = np.count_nonzero(inside) == inside.size
     if not everywhere:
         flat[~inside] = 0                   # looked up at a cell of the dilation, then left
-    out = np.empty(inside.shape, dtype=bool)
-    for j, m in enumerate(maps):
-        np.take(m._dilation(reach), flat[j], out=out[j])
+    dilations = [m._dilation(reach) for m in maps]
+    stacked = None if kept is None else kept.of(dilations)
+    if kept is not None and stacked is not None:
+        flat += kept.starts
+        out = stacked.take(flat)
+    else:
+        out = np.empty(inside.shape, dtype=bool)
+        for j, near in enumerate(dilations):
+            near.take(flat[j], out=out[j])
     return out if everywhere else out & inside
+
+
+class Dilations:
+    """The maps' dilations (:meth:`RobotMap._dilation`) of a lockstep batch, one after the
+    other in one flat array, so :func:`accounted_all` looks every robot's cells up in one
+    ``take``: a map's part is copied again only when its dilation is a new array (it
+    plans again), and none is kept past :data:`STACKED_BYTES` (large maps look up map by
+    map)."""
+
+    #: The most a batch's dilations are stacked to (bytes): office's 64 maps would be 23 MB.
+    STACKED_BYTES = 4 << 20
+
+    def __init__(self) -> None:
+        self._parts: list[np.ndarray] = []
+        self._flat = np.zeros(0, dtype=bool)
+        self._starts = np.zeros((0, 1), dtype=np.int64)
+
+    def of(self, parts: list[np.ndarray]) -> np.ndarray | None:
+        """The flat array of ``parts`` (dilations of one shape), or ``None`` past the cap."""
+        size = parts[0].size
+        if size * len(parts) > self.STACKED_BYTES:
+            return None
+        if len(parts) != len(self._parts) or self._flat.size != size * len(parts):
+            self._flat = np.concatenate([p.reshape(-1) for p in parts])
+            self._starts = (np.arange(len(parts), dtype=np.int64) * size)[:, None]
+        else:
+            for j, (new, old) in enumerate(zip(parts, self._parts)):
+                if new is not old:
+                    self._flat[j * size:(j + 1) * size] = new.reshape(-1)
+        self._parts = parts
+        return self._flat
+
+    @property
+    def starts(self) -> np.ndarray:
+        """``[maps, 1]``: where each map's part begins in the flat array :meth:`of` gave."""
+        return self._starts
 
 
 def expected_ranges(g: Given, rmap: RobotMap | None, origin: np.ndarray, dirs: np.ndarray,

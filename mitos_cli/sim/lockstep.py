@@ -189,7 +189,7 @@ def _observe_together(batch: Batch) -> None:
     gaps = perception.route_gaps(aims)
     # (after the aims: a route planned again is planned round the cells marked by then)
     if world.replan == "clearance" and beyond is not None:
-        accounted = knowledge.accounted_all(maps, beyond)
+        accounted = knowledge.accounted_all(maps, beyond, kept=batch.dilations)
     else:
         accounted = np.concatenate([run.accounted(s) for run, s in zip(fresh, sensed)])
     sights = batch.aimed(aims, targets, gaps, accounted)

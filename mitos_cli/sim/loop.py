@@ -1217,6 +1217,7 @@ class Batch:
         self._rows = [(j, i) for j, run in enumerate(runs) for i in range(run.n)]
         self._radius = [m.grid.resolution / 2 for m in self.maps]
         self._need = [least + run._cfg.lookahead_room for run in runs for _, least in run._asked]
+        self.dilations = knowledge.Dilations()       # (knowledge.accounted_all)
         # (Simulation.aimed)
         self._robots = [r for run in runs for r in run.robots]
         self._spacing, _, self._least, self._squeeze = (
