@@ -309,3 +309,42 @@ def test_a_batch_aims_and_replans_each_robot_as_its_run_alone(monkeypatch):
     monkeypatch.setattr(Batch, "aims", checked)
     run_lockstep(world, None, [7000, 7001, 7002], randomise=True)
     assert len(replans) > 10 and replans[-1] >= 2         # checks made, routes planned again
+
+
+def stacked_tick_by_tick(run: Simulation) -> dict:
+    """A run's recorded fields joined an array a tick (:meth:`Simulation.result`'s plain way)."""
+    return {f: np.array([getattr(tick, f) for tick in run.record]) for f in loop._RECORDED}
+
+
+@pytest.mark.parametrize("name", ["slalom", "multirobot"])
+def test_a_result_read_from_the_batches_pages_is_the_record_joined_tick_by_tick(name):
+    """A run stepped in lockstep batches (pages filled, runs dropping out) gets its result
+    from the batches' pages; the same arrays as its ticks joined one by one."""
+    lock = Lockstep(_short(name, 5.0), None, [1, 2, 3], randomise=True)
+    lock.runs[1].steps = 70                  # ends first: the others go on in a new batch
+    lock.results()
+    for run in lock.runs:
+        booked = run._booked()
+        assert booked is not None and len(run._pages) > 1
+        for f, value in stacked_tick_by_tick(run).items():
+            assert booked[f].shape == value.shape and booked[f].dtype == value.dtype, f
+            assert booked[f].tobytes() == value.tobytes(), f
+
+
+def test_a_result_of_ticks_recorded_otherwise_is_joined_tick_by_tick():
+    """A tick stepped alone, or a copy of the run, is not read from the pages."""
+    lock = Lockstep(_short("slalom", 2.0), None, [1, 2], randomise=True)
+    lock.step()
+    lock.step()
+    copied = copy.deepcopy(lock.runs[1])
+    assert lock.runs[1]._booked() is not None and copied._booked() is None
+    lock.runs[0].step()                     # a tick of its own, then the lockstep again
+    lock.step()
+    assert lock.runs[0]._booked() is None
+    for run in (lock.runs[0], copied):
+        res = run.result()
+        for f, value in stacked_tick_by_tick(run).items():
+            got = res.perceived if f == "block" else getattr(res, f)
+            if f == "block":
+                got = np.stack([got[k] for k in run.record[0].inputs], axis=1)
+            assert np.asarray(got).tobytes() == value.tobytes(), f

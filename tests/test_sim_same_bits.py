@@ -214,10 +214,11 @@ def test_many_maps_marked_and_looked_up_at_once_are_each_maps_own():
     grid = Grid(rng.random((30, 40)) < 0.03, 2.0, (-7.0, 3.0))
     together = [knowledge.RobotMap.of(grid) for _ in range(7)]
     alone = [knowledge.RobotMap.of(grid) for _ in range(7)]
+    kept = knowledge.Dilations()        # a lockstep batch's, kept from look-up to look-up
     flags: list[bool] = []
     for k in range(40):
-        if k == 20:                     # some plan again: a dilation of their own
-            for m, a in zip(together[::2], alone[::2]):
+        if k in (20, 30):               # some plan again: a dilation of their own
+            for m, a in zip(together[k % 3::2], alone[k % 3::2]):
                 m.planned, a.planned = m.occupied.copy(), a.occupied.copy()
         if k % 5 == 4:                  # marks seen through are freed, then marked again
             origins = rng.uniform([-5.0, 5.0], [70.0, 60.0], (len(together), 2))
@@ -234,6 +235,7 @@ def test_many_maps_marked_and_looked_up_at_once_are_each_maps_own():
         assert marked == [a.mark_cells(c[w]) for a, c, w in zip(alone, cells, seen)]
         flags += marked
         got = knowledge.accounted_all(together, cells)
+        assert np.array_equal(knowledge.accounted_all(together, cells, kept=kept), got)
         for m, a, c, row in zip(together, alone, cells, got):
             assert np.array_equal(m.occupied, a.occupied) and np.array_equal(m.marks, a.marks)
             assert m.marks.dtype == a.marks.dtype and m._changes == a._changes

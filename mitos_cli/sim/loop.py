@@ -455,6 +455,7 @@ class Simulation:
         self._observed: _Sensed | None = None
         self._deciding: _Sensed | None = None
         self.record: list[Tick] = []
+        self._pages: list[tuple[_Book, int, int]] = []  # see _Book: (book, column, first tick)
 
     # -- state ------------------------------------------------------------------------------
 
@@ -1076,12 +1077,16 @@ class Simulation:
         if not T:
             raise RuntimeError("no tick recorded yet: result() reports the ticks step() ran")
 
-        # every recorded field's arrays gathered in one pass over the ticks (one getter call
-        # a tick, where a pass a field made ten getattr a tick)
-        columns = dict(zip(_RECORDED, map(list, zip(*map(_RECORD_OF, rec)))))
+        columns = self._booked()
+        if columns is None:
+            # every recorded field's arrays gathered in one pass over the ticks (one getter
+            # call a tick, where a pass a field made ten getattr a tick)
+            parts = dict(zip(_RECORDED, map(list, zip(*map(_RECORD_OF, rec)))))
+            columns = {name: (_repeated if name == "obstacles" else _stacked)(parts[name])
+                       for name in _RECORDED}
 
         def stack(attr: str) -> np.ndarray:
-            return _stacked(columns[attr])
+            return columns[attr]
 
         inputs = stack("block")                         # [T, inputs, n]
         res = SimResult(
@@ -1100,11 +1105,83 @@ class Simulation:
         res.metrics = _metrics(res, dt)
         return res
 
+    def _booked(self) -> dict[str, np.ndarray] | None:
+        """The recorded fields stacked ``[T, ...]`` from the :class:`_Book` pages of the
+        lockstep batches that recorded every tick of the run (a slice of a page a field, not
+        an array a tick); ``None`` when a tick was recorded otherwise (the run alone, or
+        stepped by hand) or the record is not the ticks the pages hold."""
+        rec, pages = self.record, self._pages
+        if not pages:
+            return None
+        parts: list[list[np.ndarray]] = [[] for _ in _BOOKED]
+        at = 0
+        for book, j, start in pages:
+            ticks = book.ticks[j]
+            n = len(ticks)
+            if start != at or not n or not all(map(operator.is_, ticks, rec[at:at + n])) \
+                    or ticks[0].pose.base is not book.pose:     # (a copy's: its own arrays)
+                return None
+            a, b = book.spans[j]
+            for into, name in zip(parts, _BOOKED):
+                into.append(book.rows(name, n, a, b))
+            at += n
+        if at != len(rec):
+            return None
+        out = {name: np.concatenate(into) for name, into in zip(_BOOKED, parts)}
+        out["obstacles"] = _repeated([tick.obstacles for tick in rec])
+        return out
+
 
 #: The fields of a :class:`Tick` that :meth:`Simulation.result` stacks, and their getter.
 _RECORDED = ("pose", "speed", "steering", "command", "ranges", "block", "clearance",
              "obstacles", "active", "progress")
 _RECORD_OF = operator.attrgetter(*_RECORDED)
+
+
+#: The fields of a :class:`Tick` a lockstep batch keeps in its :class:`_Book` pages.
+_BOOKED = ("pose", "speed", "steering", "command", "ranges", "block", "clearance", "active",
+           "progress")
+
+
+def _repeated(parts: list[np.ndarray]) -> np.ndarray:
+    """:func:`_stacked`, or one array repeated when every part is that array (obstacles that
+    stand still: the same places every tick)."""
+    first = parts[0]
+    if all(map(operator.is_, parts, itertools.repeat(first))):
+        return np.broadcast_to(first, (len(parts), *first.shape)).copy()
+    return _stacked(parts)
+
+
+class _Book:
+    """Ticks a lockstep batch recorded, up to :attr:`TICKS` of them: each recorded field of
+    all the batch's rows at each tick in one array ``[ticks, rows, ...]`` (a page), each
+    run's :class:`Tick` views of its rows, and the ticks of each run (``ticks``; ``spans``:
+    its rows). A run's result then copies its rows of a page in one slice a field instead of
+    joining an array a tick (:meth:`Simulation._booked`)."""
+
+    TICKS = 64
+
+    def __init__(self, spans: list[tuple[int, int]], beams: int) -> None:
+        rows = spans[-1][1]
+        self.spans = spans
+        self.pose = np.empty((self.TICKS, rows, 3))
+        self.speed, self.steering, self.clearance, self.progress = (
+            np.empty((self.TICKS, rows)) for _ in range(4))
+        self.command = np.empty((self.TICKS, rows, 2))
+        self.ranges = np.empty((self.TICKS, rows, beams))
+        self.block = np.empty((self.TICKS, rows, len(perception.INPUTS)))   # a row's inputs
+        self.active = np.empty((self.TICKS, rows), dtype=bool)
+        self.ticks: list[list[Tick]] = [[] for _ in spans]
+
+    @property
+    def full(self) -> bool:
+        return len(self.ticks[0]) == self.TICKS
+
+    def rows(self, name: str, n: int, a: int, b: int) -> np.ndarray:
+        """Rows ``a:b`` of the first ``n`` ticks of field ``name``, laid out as
+        :func:`_stacked` lays out the ticks' arrays (a view)."""
+        got = getattr(self, name)[:n, a:b]
+        return got.transpose(0, 2, 1) if name == "block" else got
 
 
 def _stacked(parts: list[np.ndarray]) -> np.ndarray:
@@ -1218,6 +1295,7 @@ class Batch:
         self._radius = [m.grid.resolution / 2 for m in self.maps]
         self._need = [least + run._cfg.lookahead_room for run in runs for _, least in run._asked]
         self.dilations = knowledge.Dilations()       # (knowledge.accounted_all)
+        self._book: _Book | None = None              # the ticks it recorded last (verdict)
         # (Simulation.aimed)
         self._robots = [r for run in runs for r in run.robots]
         self._spacing, _, self._least, self._squeeze = (
@@ -1465,24 +1543,50 @@ class Batch:
             run._backed.append((run._k, i))
 
     def verdict(self) -> list[Simulation]:
-        """:meth:`Simulation.verdict` of every run, once the guard has had its say: each
-        run's tick recorded; the runs whose robots move now."""
+        """:meth:`Simulation.verdict` of every run, once the guard has had its say: the
+        tick's fields written into a page of the batch's :class:`_Book`, each run's tick
+        recorded (views of its rows) and judged; the runs whose robots move now."""
+        book, i = self._page()
         x, y, h = self._ticked()
-        pose = _columns(x, y, np.rad2deg(h))
-        speed, steering = (part.copy() for part in self._drive)  # (the runs' own: kept apart)
-        hint = self._hint
-        hit = np.logical_or.reduceat(self.hit, self._starts).tolist()
-        driving = np.logical_or.reduceat(self.active, self._starts).tolist()
-        moving = []
-        for run, s, touch, drives, mine, *state in zip(
-                self.runs, self.ticks, hit, driving, self._each(self.hit), self._each(pose),
-                self._each(speed), self._each(steering), self._each(self.active),
-                self._each(hint)):
+        pose = book.pose[i]
+        pose[:, 0], pose[:, 1], pose[:, 2] = x, y, np.rad2deg(h)
+        book.speed[i], book.steering[i] = self._drive      # (the runs' own: kept apart)
+        book.command[i], book.ranges[i], book.clearance[i] = (self.command, self.got.ranges,
+                                                              self.got.clearance)
+        book.block[i], book.active[i], book.progress[i] = self.block.T, self.active, self._hint
+        blocks = (list(book.block[i][:, :, None]) if self._single
+                  else [book.block[i, a:b].T for a, b in self.spans])
+        hit = np.logical_or.reduceat(self.hit, self._starts)
+        driving = np.logical_or.reduceat(self.active, self._starts)
+        for run, s, mine, tick_pose, speed, steering, command, ranges, block, clearance, \
+                active, progress, kept in zip(
+                    self.runs, self.ticks, self._each(self.hit),
+                    *map(self._each, (pose, book.speed[i], book.steering[i], book.command[i],
+                                      book.ranges[i])), blocks,
+                    *map(self._each, (book.clearance[i], book.active[i], book.progress[i])),
+                    book.ticks):
             run._hit = mine
-            run._keep(s, *state)
-            if run._judge(s, touch, drives):
-                moving.append(run)
-        return moving
+            tick = Tick(run._k, s.t, tick_pose, speed, steering, command, ranges, block,
+                        clearance, s.where, active, progress)
+            run.record.append(tick)
+            kept.append(tick)
+        if np.count_nonzero(hit) == 0 and np.count_nonzero(driving) == len(driving):
+            for run, s in zip(self.runs, self.ticks):      # (Simulation._judge: all drive on)
+                run._deciding = s
+            return list(self.runs)
+        return [run for run, s, touch, drives in zip(self.runs, self.ticks, hit.tolist(),
+                                                       driving.tolist())
+                if run._judge(s, touch, drives)]
+
+    def _page(self) -> tuple[_Book, int]:
+        """The batch's :class:`_Book` with room for this tick's page, and the page: each run
+        told when its ticks begin in a book (:meth:`Simulation._booked`)."""
+        book = self._book
+        if book is None or book.full:
+            book = self._book = _Book(self.spans, self.got.ranges.shape[1])
+            for j, run in enumerate(self.runs):
+                run._pages.append((book, j, len(run.record)))
+        return book, len(book.ticks[0])
 
     def move(self) -> None:
         """:meth:`Simulation.act` and :meth:`Simulation.moved` of every run (each one's
