@@ -121,7 +121,7 @@ def test_q_falls_substantially_and_never_rises(ops, factor, n):
     seen = []
     result = adapt(c, X, T, epochs=40, rate=0.5, on_epoch=lambda e, q: seen.append(q))
     history = learned_epochs(result)
-    assert np.all(np.diff(history) < 0)                  # every epoch lowers Q
+    assert np.all(np.diff(history) <= 0)                 # no epoch raises Q (a compass epoch may keep it)
     assert seen == list(history[1:len(seen) + 1])        # the progress bar saw each epoch
     assert result.q_after <= factor * result.q_before
     assert result.q_after == loss(with_values(result.parameters, result.values), X, T)

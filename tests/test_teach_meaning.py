@@ -62,7 +62,7 @@ def test_random_corrections_keep_order_coverage_distinctness_and_points(seed, n,
     for v in seen + [result.values]:                       # every epoch, and the rounded end
         constraints_hold(compiled, p, v)
     epochs = result.history[:-1] if result.rounded else result.history
-    assert all(b < a for a, b in zip(epochs, epochs[1:]))  # Q never increases
+    assert all(b <= a for a, b in zip(epochs, epochs[1:]))  # Q never increases
     assert result.q_after <= result.q_before
 
 
@@ -817,7 +817,8 @@ def test_a_converted_controller_keeps_the_end_of_its_universe_covered(tmp_path):
     so the one coverage bound was 0, and examples that want `rancid` off at the most rancid
     food moved its vertical edge on 0 inward (food in [0, 0.22] in no term), which neither
     adapt nor save reported. The edge now stays (the descent goes on with the other knots),
-    and a gap adaptation does open (`unconstrained`) is in the interpretability line."""
+    the written gap may shrink but not widen, and a gap adaptation does open
+    (`unconstrained`) is in the interpretability line."""
     from mitos_cli.teach.session import Session
 
     (tmp_path / "tipper.terms.yaml").write_text(TIPPER_TERMS)
@@ -840,9 +841,11 @@ def test_a_converted_controller_keeps_the_end_of_its_universe_covered(tmp_path):
         assert "changed (before -> after)" in text            # the descent went on
         if constrained:
             assert food.term("rancid").corners[:2] == (0.0, 0.0)
-            assert gaps == [(3.0, 7.0)] and "did not have" not in text
-            assert "input `food`: every term is 0 for food in [3, 7] (widen a neighbouring " \
-                   "term" in text
+            # the written gap [3, 7] may shrink (the compass closes part of it), not widen
+            (a, b), = gaps
+            assert 3.0 <= a < b <= 7.0 and "did not have" not in text
+            assert f"input `food`: every term is 0 for food in [{a:g}, {b:g}] (widen a " \
+                   "neighbouring term" in text
         else:
             assert gaps[0][0] == 0.0 and gaps[0][1] > 0.0
             assert (f"input `food`: every term is 0 for food in [0, {gaps[0][1]:.6g}], a gap "

@@ -41,8 +41,13 @@ halved, the same step along a second direction is tried too and the lower ``Q`` 
 projected gradient with each knot's component scaled by the knot's own share of the step
 (:func:`_knot_steps`: halved each time the knot's slope turns, as Rprop's step sizes). A knot
 lying beside a kink of ``Q`` (an example's input just past it) otherwise sets the size of every
-step and the others hardly move: the shipped lesson's steepest descent stopped there. Learned values are
-rounded to a readable grid (``decimals``) and kept only if ``Q`` is still no worse.
+step and the others hardly move: the shipped lesson's steepest descent stopped there. Where the
+step stalls all the same (refused, or gaining less than :data:`STALL` of the starting ``Q``:
+kinks crowd, and no slope the gradient sees points down), a deterministic compass search
+(:class:`_Compass`) polls the free directions one knot at a time and takes the first point that
+keeps every constraint and lowers ``Q``; the gradient step goes on from there, and adaptation
+has converged when the compass's mesh has shrunk to its floor. Learned values are rounded to a
+readable grid (``decimals``) and kept only if ``Q`` is still no worse.
 """
 
 from __future__ import annotations
@@ -1229,14 +1234,103 @@ def _line(p: Parameters, values: np.ndarray, grad: np.ndarray, Q: float, X: np.n
     return candidate, q_new, step, False
 
 
+#: A step gaining less than this fraction of the starting ``Q`` is creeping along kinks: the
+#: compass polls next.
+STALL = 1e-6
+#: Least gain (fraction of the starting ``Q``) of a point the compass takes, so that float
+#: noise never makes it cycle.
+GAIN = 1e-9
+#: Free directions the compass tries in one epoch (two trial points each, at most), so that an
+#: epoch costs at most a few evaluations of ``Q`` more than a gradient step.
+POLL = 16
+#: The compass stops (adaptation has converged) when its mesh falls below this fraction of
+#: its first one, after a whole round of the directions at every mesh on the way down.
+POLL_FLOOR = 2.0 ** -10
+
+
+def _step(p: Parameters, values: np.ndarray, grad: np.ndarray, Q: float, X: np.ndarray,
+          targets: np.ndarray, rate: float, step: float,
+          factor: np.ndarray) -> tuple[np.ndarray | None, float]:
+    """One epoch's gradient step: the steepest, and (when it had to be halved) the one with
+    each knot its own share of the step; the lower ``Q`` of the two. ``(values, step)``, or
+    ``None`` when neither lowers ``Q`` inside the constraints."""
+    plain = descent_direction(p, values, grad)                   # scaled coordinates
+    if not np.max(np.abs(plain), initial=0.0) > 1e-15:
+        return None, step
+    candidate, q_new, trial, accepted = _line(p, values, grad, Q, X, targets, rate, step,
+                                              None, plain)
+    if (not accepted or trial < step) and factor.min() < 1.0:
+        # halved: a knot by a kink may set the step; each knot its own share
+        other = _line(p, values, grad, Q, X, targets, rate, step, factor, plain)
+        if other[3] and (not accepted or other[1] < q_new):
+            candidate, q_new, trial, accepted = other
+    return (candidate if accepted else None), trial
+
+
+@dataclass
+class _Compass:
+    """A deterministic compass (pattern) search on the free directions, for where the gradient
+    step stalls. Q is piecewise smooth: it has a kink wherever a knot crosses an example's
+    input or a min / max changes hands, and where those kinks crowd, no slope the gradient
+    sees points down although Q still falls along a free direction a little way off (the
+    shipped lesson's descent crept to 334.6; polled, it reaches 298.7). Each direction
+    is a knot's own move through the linear constraints (``projector``'s column: its ties and
+    symmetric partners move with it); it is tried at the mesh on the side the slope says Q
+    falls first, and a point is taken only if it keeps every constraint and lowers Q by at
+    least ``gain``. A round of every direction with no point taken halves the mesh."""
+
+    directions: np.ndarray                 # [D, P], the largest entry of each 1
+    mesh: float                            # fraction of the universes
+    first: float
+    at: int = 0                            # the direction tried next
+    misses: int = 0                        # directions tried in a row without a point taken
+
+    @classmethod
+    def of(cls, p: Parameters, rate: float) -> _Compass:
+        rows: list[np.ndarray] = []
+        for column in p.projector.T:
+            biggest = np.max(np.abs(column))
+            if biggest > 1e-9 and not any(np.allclose(column / biggest, s * r)
+                                          for r in rows for s in (1.0, -1.0)):
+                rows.append(column / biggest)
+        first = rate * STEP
+        return cls(np.array(rows).reshape(len(rows), len(p.values)), first, first)
+
+    @property
+    def done(self) -> bool:
+        return not len(self.directions) or self.mesh < self.first * POLL_FLOOR
+
+    def poll(self, p: Parameters, values: np.ndarray, Q: float, grad: np.ndarray,
+             X: np.ndarray, targets: np.ndarray, gain: float) -> np.ndarray | None:
+        """Up to :data:`POLL` directions from where the last poll left off: the first point
+        that keeps every constraint and lowers ``Q`` by ``gain``, or ``None``."""
+        for _ in range(POLL):
+            if self.done:
+                return None
+            move = self.directions[self.at] * p.scale
+            side = -1.0 if grad @ move > 0 else 1.0
+            for sign in (side, -side):
+                trial = values + sign * self.mesh * move
+                if feasible(p, trial) and loss(with_values(p, trial), X, targets) < Q - gain:
+                    self.misses = 0
+                    return trial
+            self.at = (self.at + 1) % len(self.directions)
+            self.misses += 1
+            if self.misses >= len(self.directions):
+                self.misses, self.mesh = 0, self.mesh * 0.5
+        return None
+
+
 def adapt(compiled: CompiledRuleBase, X: np.ndarray, targets: np.ndarray, *, epochs: int = 50,
           rate: float = 0.5, on_epoch: Callable[[int, float], None] | None = None,
           parameters: Parameters | None = None, constrained: bool = True,
           on_values: Callable[[np.ndarray], None] | None = None) -> Adaptation:
     """Gradient descent on ``Q`` (eqs. 13-14): ``epochs`` full-batch steps of learning factor
     ``rate`` in (0, 1), each halved until ``Q`` decreases inside the constraints
-    (``parameters``, else :func:`parameterise` with ``constrained``). ``on_epoch`` hears
-    ``(epoch, Q)`` and ``on_values`` the values after each epoch."""
+    (``parameters``, else :func:`parameterise` with ``constrained``); where the step stalls,
+    an epoch is a few of the compass's trials (:class:`_Compass`), which lower ``Q`` or keep
+    it. ``on_epoch`` hears ``(epoch, Q)`` and ``on_values`` the values after
+    each epoch."""
     if not 0.0 < rate < 1.0:
         raise LessonError(f"the learning factor must lie in (0, 1), not {rate:g}",
                           hint="the paper's eta: try `rate 0.5`")
@@ -1247,37 +1341,38 @@ def adapt(compiled: CompiledRuleBase, X: np.ndarray, targets: np.ndarray, *, epo
     step = 1.0
     factor = np.ones(len(values))        # each knot's share of the step (_knot_steps)
     previous = np.zeros(len(values))
+    compass = _Compass.of(p, rate)       # polls the free directions where the step stalls
+    polling = False
     converged = False
     interrupted = False
     try:
         for epoch in range(1, epochs + 1):
-            plain = descent_direction(p, values, grad)           # scaled coordinates
-            biggest = np.max(np.abs(plain)) if plain.size else 0.0
-            if biggest <= 1e-15 or Q <= 0.0:
+            if Q <= 0.0:
                 converged = True
                 break
-            factor, previous = _knot_steps(factor, previous, grad * p.scale)
-            candidate, q_new, trial, accepted = _line(p, values, grad, Q, X, targets, rate,
-                                                      step, None, plain)
-            if (not accepted or trial < step) and factor.min() < 1.0:
-                # halved: a knot by a kink may set the step; each knot its own share
-                other = _line(p, values, grad, Q, X, targets, rate, step, factor, plain)
-                if other[3] and (not accepted or other[1] < q_new):
-                    candidate, q_new, trial, accepted = other
-            if not accepted:
-                converged = True
-                break
-            step = trial
-            values = candidate
-            Q, grad = gradient(p, values, X, targets)
+            moved = False
+            if not polling:
+                factor, previous = _knot_steps(factor, previous, grad * p.scale)
+                candidate, trial = _step(p, values, grad, Q, X, targets, rate, step, factor)
+                moved = candidate is not None
+                if candidate is not None:
+                    step, values = trial, candidate
+                    Q, grad = gradient(p, values, X, targets)
+                # refused, or gaining too little to be worth a step: the slopes mislead here
+                polling = not moved or history[-1] - Q <= STALL * history[0]
+            if polling and not moved:
+                found = compass.poll(p, values, Q, grad, X, targets, GAIN * history[0])
+                if found is None and compass.done:
+                    converged = True
+                    break
+                if found is not None:        # else an epoch of the compass's search, Q kept
+                    values, polling, step = found, False, 1.0
+                    Q, grad = gradient(p, values, X, targets)
             history.append(Q)
             if on_epoch is not None:
                 on_epoch(epoch, Q)
             if on_values is not None:
                 on_values(values)
-            if history[-2] - Q <= 1e-9 * history[0]:
-                converged = True                     # no longer worth a step
-                break
             step = min(1.0, step * 2.0)
     except KeyboardInterrupt:
         interrupted = True            # keep what the completed epochs learned
