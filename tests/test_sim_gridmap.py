@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import struct
+import warnings
+import zlib
 from pathlib import Path
 
 import numpy as np
@@ -175,6 +178,37 @@ def test_a_file_that_is_no_image_is_refused_at_the_image_line(tmp_path):
     (tmp_path / "m.png").write_bytes(b"not an image")
     with pytest.raises(WorldError, match="does not recognise it as an image"):
         load_map_yaml(_map(tmp_path, "m.png"))
+
+
+def _png_header(width: int, height: int) -> bytes:
+    """A PNG's signature and header for an 8-bit grey image, then a scrap of its data (a
+    decoder that goes on reads past the end)."""
+    def chunk(kind: bytes, data: bytes) -> bytes:
+        return (struct.pack(">I", len(data)) + kind + data
+                + struct.pack(">I", zlib.crc32(kind + data) & 0xFFFFFFFF))
+    return (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", width, height, 8, 0, 0,
+                                                                 0, 0))
+            + chunk(b"IDAT", zlib.compress(b"\0" * 64)))
+
+
+@pytest.mark.parametrize("name, data", [
+    ("m.png", _png_header(10_000, 9_500)),
+    ("m.pgm", b"P5\n10000 9500\n255\n"),
+], ids=["png", "pgm"])
+def test_an_image_of_too_many_pixels_is_refused_before_it_is_read(tmp_path, name, data):
+    """A 114 KB PNG of 10,000 x 9,500 pixels: Pillow's own warning on stderr, then 9.7 GB and
+    a minute before the first tick. Any map image is held to 8,000 x 8,000 pixels, far beyond
+    a building, and refused at its `image:` line before a pixel is decoded."""
+    if name.endswith(".png"):
+        pytest.importorskip("PIL")
+    (tmp_path / name).write_bytes(data)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(WorldError, match=r"it has 95,000,000 pixels \(10,000 x 9,500\); a "
+                                             r"map image may have at most 64,000,000") as exc:
+            load_map_yaml(_map(tmp_path, name))
+    assert (exc.value.span.line, exc.value.span.column) == (1, 8)
+    assert exc.value.hint == "crop the image to the part the robot drives in"
 
 
 def test_a_half_turned_origin_puts_the_map_on_the_other_side(tmp_path):

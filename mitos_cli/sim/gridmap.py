@@ -21,6 +21,7 @@ resampling), any other yaw moves walls by at most half a cell's diagonal.
 from __future__ import annotations
 
 import math
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -29,7 +30,7 @@ from ..errors import Span, WorldError, unknown
 from ..fileio import unreadable
 from ..lang import yamlpos
 from ..resources import exists
-from .pgm import read_pgm
+from .pgm import TooLarge, check_size, read_pgm
 from .world import Grid
 from .worldfile import LARGEST
 
@@ -111,7 +112,11 @@ def read_image(path: Path) -> tuple[np.ndarray, int]:
         raise ImportError("reading a map image other than PGM needs Pillow: "
                           "pip install 'mitos[maps]' (or convert the image to PGM)") from None
     try:
-        with Image.open(path) as im:
+        with warnings.catch_warnings():     # (Pillow's own warning of a large image: refused)
+            warnings.simplefilter("ignore", Image.DecompressionBombWarning)
+            im = Image.open(path)
+        with im:
+            check_size(*im.size)
             if im.mode in ("I;16", "I;16B", "I;16L", "I"):
                 px = np.asarray(im, dtype=np.int64)
                 return px.clip(0, 65535).astype(np.uint16), 65535
@@ -119,7 +124,7 @@ def read_image(path: Path) -> tuple[np.ndarray, int]:
     except UnidentifiedImageError:
         raise ValueError("Pillow does not recognise it as an image") from None
     except Image.DecompressionBombError as exc:
-        raise ValueError(str(exc)) from None
+        raise TooLarge(str(exc)) from None
 
 
 def rotate(blocked: np.ndarray, res: float, origin: tuple[float, float],
@@ -254,6 +259,10 @@ def load_map_yaml(path: Path, *, unknown_occupied: bool = True,
                          hint=f"{close} (the image path is relative to the map's YAML file)"
                          if close else "the image path is relative to the map's YAML file") \
             from None
+    except TooLarge as exc:
+        raise WorldError(f"cannot read map image `{image_path}`: {exc}",
+                         span=spec.value_span("image"),
+                         hint="crop the image to the part the robot drives in") from None
     except ValueError as exc:
         raise WorldError(f"cannot read map image `{image_path}`: {exc}",
                          span=spec.value_span("image"),

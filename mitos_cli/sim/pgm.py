@@ -41,6 +41,23 @@ def _header(data: bytes, count: int) -> tuple[list[int], int]:
     return values, i + 1
 
 
+#: the most pixels a map image may have (8,000 x 8,000, far beyond any building): the simulator
+#: keeps about 100 bytes for each, and a 114 KB PNG of 10,000 x 9,500 pixels took 9.7 GB and
+#: over a minute before its first tick
+MAX_PIXELS = 8000 * 8000
+
+
+class TooLarge(ValueError):
+    """A map image of more than :data:`MAX_PIXELS` pixels."""
+
+
+def check_size(width: int, height: int) -> None:
+    """Refuse an image of more than :data:`MAX_PIXELS` pixels, before any is decoded."""
+    if width * height > MAX_PIXELS:
+        raise TooLarge(f"it has {width * height:,} pixels ({width:,} x {height:,}); a map "
+                       f"image may have at most {MAX_PIXELS:,}")
+
+
 def parse_pgm(data: bytes) -> tuple[np.ndarray, int]:
     magic = data[:2]
     if magic not in (b"P5", b"P2"):
@@ -48,6 +65,7 @@ def parse_pgm(data: bytes) -> tuple[np.ndarray, int]:
     (width, height, maxval), offset = _header(data, 3)
     if width <= 0 or height <= 0 or not 0 < maxval < 65536:
         raise ValueError(f"bad PGM size {width} x {height} or maximum value {maxval}")
+    check_size(width, height)
     n = width * height
     depth = 2 if maxval > 255 else 1
     if magic == b"P5" and len(data) - offset < n * depth:   # before allocating anything
