@@ -224,6 +224,7 @@ def test_a_torn_last_journal_line_is_dropped(rules, tmp_path):
     (lambda e: e["examples"][0]["inputs"].update(size=[1, 2]), "given as numbers by name"),
     (lambda e: e["examples"][0]["targets"].update(steering=True), "given as numbers by name"),
     (lambda e: e["examples"][0]["inputs"].update(size=float("nan")), "given as numbers"),
+    (lambda e: e["examples"][0]["inputs"].update(size=10**400), "given as numbers"),  # no float
     (lambda e: e.update(behavior=1.5), "`behavior` is 1.5, not a name"),
     (lambda e: e["examples"][0]["inputs"].pop("size"), "no value for `size`"),
     (lambda e: e["examples"][0]["targets"].update(spead=1.0), "`spead` is not one of its outputs"),
@@ -250,6 +251,13 @@ def test_a_journal_whose_examples_were_edited_is_refused_at_their_line(rules, tm
     ("adapt", lambda e: e.update(terms={"steering": {"LM": "x"}}), "`terms` are not parameters"),
     ("adapt", lambda e: e.update(crisp=[["x"]]), "`crisp` are not [behavior, rule, output"),
     ("start", lambda e: e.update(rules="a\0b"), "`rules` holds a NUL byte"),
+    # JSON that Python reads but cannot use: an OverflowError, a UnicodeEncodeError (tracebacks)
+    ("adapt", lambda e: e.update(q=[10**400, 1.0]), "`q` is not its Q before and after"),
+    ("adapt", lambda e: e.update(terms={"road": {"NARROW": [10**400, 70]}}), "`terms` are not"),
+    ("adapt", lambda e: e.update(crisp=[["b", 0, "steering", -10**400]]), "`crisp` are not"),
+    ("start", lambda e: e.update(rules="a\ud800.rules"), "half a character (a lone surrogate)"),
+    ("rule", lambda e: e.update(text="r27: if road is NARROW then steering is \udcff"),
+     "half a character"),
     ("rule", lambda e: e.update(text="r27: if road is NOPE then steering is LB"),
      "unknown term `NOPE` of `road`"),
     ("rule", lambda e: e.update(text="r27: if road is NARROW then nope is LB"), "`nope`"),

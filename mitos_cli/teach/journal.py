@@ -16,6 +16,7 @@ from __future__ import annotations
 import json
 import math
 import os
+import sys
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -269,10 +270,18 @@ def _shown(entry: dict, key: str) -> str:
     return f"a JSON {_JSON_TYPE.get(type(value), 'string')}"
 
 
+def _finite(x: object) -> bool:
+    """Whether ``x`` is a JSON number a float holds: finite, and not an integer of 400 digits
+    (``math.isfinite`` of one raised ``OverflowError``)."""
+    if type(x) is int:
+        return abs(x) <= sys.float_info.max
+    return type(x) is float and math.isfinite(x)
+
+
 def _numbers(values: object) -> bool:
     """Whether ``values`` is a JSON object of finite numbers by name."""
     return isinstance(values, dict) and all(
-        isinstance(k, str) and type(v) in (int, float) and math.isfinite(v)
+        isinstance(k, str) and _finite(v)
         for k, v in values.items())
 
 
@@ -295,18 +304,18 @@ def _adapt_problem(entry: dict) -> str | None:
     terms = entry["terms"]
     if not all(isinstance(v, str) and isinstance(ts, dict) and all(
             isinstance(t, str) and isinstance(ps, list) and ps and all(
-                type(x) in (int, float) and math.isfinite(x) for x in ps)
+                _finite(x) for x in ps)
             for t, ps in ts.items()) for v, ts in terms.items()):
         return "the `adapt` change's `terms` are not parameters by variable and term"
     crisp = entry.get("crisp", [])
     if not isinstance(crisp, list) or not all(
             isinstance(c, list) and len(c) == 4 and isinstance(c[0], str)
             and type(c[1]) is int and c[1] >= 0 and isinstance(c[2], str)
-            and type(c[3]) in (int, float) and math.isfinite(c[3]) for c in crisp):
+            and _finite(c[3]) for c in crisp):
         return "the `adapt` change's `crisp` are not [behavior, rule, output, value] rows"
     q = entry.get("q", [0.0, 0.0])
     if not isinstance(q, list) or len(q) != 2 or not all(
-            type(x) in (int, float) and math.isfinite(x) for x in q):
+            _finite(x) for x in q):
         return "the `adapt` change's `q` is not its Q before and after"
     return None
 
@@ -319,6 +328,10 @@ def _problem(line: bytes, seq: int) -> str | None:
         return "the line is not JSON"
     if not isinstance(entry, dict):
         return "the line is not a JSON object"
+    try:                     # a `\ud800` escape: half a character, which no path or text holds
+        json.dumps(entry, ensure_ascii=False).encode("utf-8")
+    except UnicodeEncodeError:
+        return "the line holds a `\\u` escape of half a character (a lone surrogate)"
     if entry.get("seq") != seq or type(entry.get("seq")) is not int:
         return f"expected change number {seq}, found {_shown(entry, 'seq')}"
     op = entry.get("op")
