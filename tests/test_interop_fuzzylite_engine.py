@@ -261,8 +261,11 @@ def test_a_formula_membership_outside_0_1_is_refused_at_evaluation():
     from mitos_cli.errors import InputError
 
     text = FUNCTION.replace("1 - 4 * (x - 0.5)^2", "2 * x")
-    with pytest.raises(InputError, match=r"gives 1\.8 at u = 0\.9"):
+    with pytest.raises(InputError, match=r"gives 1\.8 at u = 0\.9") as info:
         run(text, [[0.9]])
+    # said where the term is written (it had no place: `mitos eval` and `check` printed none)
+    assert (info.value.span.path, info.value.span.line) == ("t.fll", 4)
+    assert "term: bump Function 2 * x" in info.value.render()
 
 
 def test_formula_terms_round_trip_through_fll_and_term_sets(tmp_path):

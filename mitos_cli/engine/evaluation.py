@@ -219,6 +219,7 @@ def _formula_memberships(compiled: CompiledRuleBase, g, x: np.ndarray) -> np.nda
         var, term = compiled.term_names[int(g.cols[row]) - 2]
         raise InputError(f"term `{var}.{term}` (formula `{g.formula.text}`) gives {mu[row, col]:g} "
                          f"at {var} = {x[row, col]:g}: a membership degree lies in [0, 1]",
+                         span=compiled.variables[var].term(term).span,    # (where it is written)
                          hint="change the formula so it stays within [0, 1] on the universe")
     return mu
 
