@@ -265,6 +265,14 @@ def test_a_journal_whose_examples_were_edited_is_refused_at_their_line(rules, tm
     ("adapt", lambda e: e.update(terms={"road": {"NARROW": [-1e9, 1e9]}}),
      "term `road.NARROW`: its core"),                      # learned where no term can be
     ("adapt", lambda e: e.update(terms={"rood": {"NARROW": [0, 10]}}), "unknown variable `rood`"),
+    # taken in, then every later `eval` refused at `<prompt>`
+    ("activate", lambda e: e.update(behavior="avoid_obstacel"), "unknown behavior"),
+    ("operators", lambda e: e.update(text="operators: and = prodcut"), "unknown T-norm `prodcut`"),
+    ("operators", lambda e: e.update(text="operators: inference = tsukamoto"),
+     "cannot be evaluated with these operators"),
+    ("frozen", lambda e: e.update(labels=["r99"]), "unknown rule label `r99`"),
+    ("freeze", lambda e: e.update(terms=[["steering", "LX"]]), "unknown term `LX`"),
+    ("release", lambda e: e.update(terms=[["steerin", "LS"]]), "unknown variable `steerin`"),
 ])
 def test_a_journal_whose_changes_were_edited_is_refused_at_their_line(rules, tmp_path, op,
                                                                         edit, says):
@@ -272,7 +280,8 @@ def test_a_journal_whose_changes_were_edited_is_refused_at_their_line(rules, tmp
     s, _ = session(rules, journal=journal)
     for line in ["r27: if road is NARROW then steering is LB", "behavior b", "use avoid_obstacle",
                  "end", "use avoid_obstacle", "frozen r4",
-                 "correct road=78 size=45 position=4 -> steering=60", "adapt epochs 2"]:
+                 "correct road=78 size=45 position=4 -> steering=60", "adapt epochs 2",
+                 "operators: and = product", "frozen steering.LS", "unfrozen steering.LS"]:
         s.run(line)
     lines = journal.path.read_text().splitlines()
     entries = [json.loads(x) for x in lines]

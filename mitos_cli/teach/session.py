@@ -229,10 +229,27 @@ class Session:
                 return
 
     def _check_entry(self, entry: dict) -> None:
-        """What the prompt checks of a rule or a `use` when it is told, checked again of a
-        replayed entry (a journal edited by hand): the rule's names, the `use`'s cycle."""
+        """What the prompt checks of a change when it is told, checked again of a replayed
+        entry (a journal edited by hand): the rule's names, the `use`'s cycle, the behavior
+        made active, the operators, the rule labels and terms frozen. (An unknown behavior or
+        T-norm was taken in, and every later `eval` refused it at `<prompt>`.)"""
         op = entry["op"]
-        if op == "rule":
+        if op == "activate":
+            self.rulebase.behavior(entry["behavior"])          # unknown: did you mean
+        elif op == "operators":
+            b = self.rulebase.behavior(entry["behavior"])
+            settings = journaled(entry, cmd.TellOperators).settings
+            resolve(settings, resolve(b.operators, resolve(self.rulebase.operators)))
+            self._check_operators(b, settings)
+        elif op == "frozen":
+            b = self.rulebase.behavior(entry["behavior"])
+            labels = [r.label for r in b.rules]
+            for label in entry["labels"]:
+                if label not in labels:
+                    raise unknown("rule label", label, labels, owner=b.name)
+        elif op in ("freeze", "release"):
+            self._term_refs([*entry["terms"], *entry.get("holds", [])])
+        elif op == "rule":
             check_rule(parse_rule(entry["text"]), self.rulebase.variables)
         elif op == "use":
             use = journaled(entry, cmd.TellUse).use
