@@ -641,6 +641,12 @@ def test_unreadable_manifest_on_resume(tmp_path):
     ('{"seed": 1, "digests": 5}', "is not a study manifest"),
     ('{"seed": ' + "9" * 5000 + "}", "is not a study manifest"),   # past int()'s digits
     ('{"seed": 1, "command": []}', "is not a study manifest"),
+    # a seed that is no whole number: "made with --seed 1, not 1", "resume with --seed None"
+    ('{"seed": "1"}', 'its `seed` is `"1"`, not a whole number'),
+    ('{"seed": null}', "its `seed` is `null`, not a whole number"),
+    ('{"seed": true}', "its `seed` is `true`, not a whole number"),    # (true == 1: resumed)
+    ('{"seed": 1.0}', "its `seed` is `1.0`, not a whole number"),
+    ("{}", "its `seed` is missing, not a whole number"),
     ("[" * 100_000, "nests too deep to read"),             # past the JSON reader's recursion
     (b"{\"seed\": \xff}", "it is not UTF-8 text"),
 ])

@@ -17,6 +17,7 @@ import io
 import json
 import math
 import os
+import re
 import shlex
 from collections.abc import Iterable
 from pathlib import Path
@@ -239,7 +240,8 @@ class ResultStore:
         hint = (f"choose another output directory with -o, or remove {self.manifest_path} "
                 f"and {self.path} to run the study again")
         try:
-            got = json.loads(read_text(self.manifest_path))
+            text = read_text(self.manifest_path)
+            got = json.loads(text)
         except (OSError, UnicodeDecodeError) as exc:
             raise StudyError(unreadable("study manifest", self.manifest_path, exc),
                              span=bad_byte(self.manifest_path, exc), hint=hint) from None
@@ -262,6 +264,12 @@ class ResultStore:
                                       "its `digests` an object of file digests, its "
                                       "`command` a string)",
                              hint=hint)
+        seed = got.get("seed")
+        if type(seed) is not int or seed < 0:      # `"1"` said "made with --seed 1, not 1"
+            raise StudyError(f"{self.manifest_path} is not a study manifest: its `seed` is "
+                             f"{_shown(got, 'seed')}, not a whole number",
+                             span=_key_span(text, str(self.manifest_path), "seed"),
+                             expected="the study's --seed, such as 1", hint=hint)
         return got
 
     # -- writing -----------------------------------------------------------------------------
@@ -393,6 +401,25 @@ def write_atomic(path: Path, text: str) -> None:
     from ..fileio import atomic_write
 
     atomic_write(path, text)
+
+
+def _shown(got: dict, key: str) -> str:
+    """``got[key]`` for a message: its JSON text, cut short, or ``missing``."""
+    if key not in got:
+        return "missing"
+    text = json.dumps(got[key], ensure_ascii=False)
+    return f"`{text if len(text) <= 40 else text[:37] + '...'}`"
+
+
+def _key_span(text: str, path: str, key: str) -> Span | None:
+    """Where ``"key":`` is written in the JSON ``text`` (its first place); ``None`` where it
+    is not."""
+    found = re.search(rf'"{re.escape(key)}"\s*:', text)
+    if found is None:
+        return None
+    line = text.count("\n", 0, found.start()) + 1
+    column = found.start() - (text.rfind("\n", 0, found.start()) + 1) + 1
+    return Span.in_text(text, path, line, column, column + len(key) + 2)
 
 
 def _check_unchanged(old: dict, new: dict, path: Path) -> None:
