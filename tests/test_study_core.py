@@ -379,6 +379,11 @@ def test_resume_may_add_runs_but_not_leave_finished_ones_out(tmp_path):
     assert exc.value.message.endswith("holds 3 finished runs this study leaves out (the "
                                       "first: run 0 of w2.yaml, fuzzy, and=min); resuming "
                                       "would report on part of the file")
+    # at that run's row, its key underlined (it had no place)
+    span = exc.value.span
+    lines = (tmp_path / "results.csv").read_text().splitlines()
+    assert span is not None and lines[span.line - 1].startswith("w2.yaml,fuzzy,min,,,0,")
+    assert (span.column, span.end_column) == (1, 1 + len("w2.yaml,fuzzy,min,,,0"))
     assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before
     wider = run_study(small_study(runs=2), tmp_path, workers=1, resume=True, task_fn=fake_sim)
     assert (wider.skipped, wider.executed) == (6, 6)
@@ -415,6 +420,8 @@ def test_hand_edited_results_are_reported(tmp_path):
     with pytest.raises(StudyError) as exc:
         ResultStore(tmp_path).load()
     assert "not a results file" in exc.value.message
+    assert (exc.value.span.line, exc.value.span.column) == (1, 1)       # the header's line
+    assert exc.value.span.source_line == "world,oops"
 
 
 def test_a_results_file_with_a_byte_order_mark_resumes(tmp_path):

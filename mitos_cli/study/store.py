@@ -152,14 +152,15 @@ class ResultStore:
         reader = csv.reader(io.StringIO(text, newline=""))
         try:
             header = next(reader)
+            top = Span(str(self.path), 1, 1, text.splitlines()[0][:200])   # (the header's line)
             if tuple(header) == COLUMNS_BEFORE_REPLANS:
                 raise StudyError(f"{self.path} was written by an earlier version of mitos: its "
                                  f"rows have no replans and backouts, which this version "
-                                 f"reports for every run",
+                                 f"reports for every run", span=top,
                                  hint="run the study again in another directory with -o")
             if tuple(header) != COLUMNS:
                 raise StudyError(f"{self.path} is not a results file of this version of mitos",
-                                 expected="the columns " + ",".join(COLUMNS),
+                                 span=top, expected="the columns " + ",".join(COLUMNS),
                                  hint="choose another output directory with -o")
             lines, rows, self._at = text.splitlines(), [], []
             for values in reader:
@@ -327,9 +328,11 @@ class ResultStore:
         manifest = _renamed(manifest, self._names)
         finished, todo = rows_for(tasks, rows)
         kept = {key_of(r) for r in finished}
-        left = [r for r in rows if key_of(r) not in kept]
-        if left:
-            _refuse_narrower(left, old or {}, self.path, self.dir, given)
+        at = [i for i, r in enumerate(rows) if key_of(r) not in kept]
+        if at:
+            line_no, line, values = self._at[at[0]]
+            _refuse_narrower([rows[i] for i in at], old or {}, self.path, self.dir, given,
+                             self._span(line_no, line, values, 0, len(KEY_FIELDS) - 1))
         write_atomic(self.manifest_path, json.dumps(manifest, indent=2) + "\n")
         if not rows:
             write_atomic(self.path, ",".join(COLUMNS) + "\n")
@@ -434,7 +437,7 @@ def _check_unchanged(old: dict, new: dict, path: Path) -> None:
 
 
 def _refuse_narrower(left: list[dict], old: dict, path: Path, out: Path,
-                     worlds: list[str]) -> None:
+                     worlds: list[str], span: Span | None = None) -> None:
     """A resumed study that leaves out runs already in ``results.csv`` (fewer worlds, norms,
     planners or runs; ``left``: their rows): its report would cover part of the file, and the
     study's own report would be replaced by it. Resuming may add runs, never drop them.
@@ -451,7 +454,7 @@ def _refuse_narrower(left: list[dict], old: dict, path: Path, out: Path,
     raise StudyError(
         f"{path} holds {plural(len(left), 'finished run')} this study leaves out (the first: "
         f"run {first['run']} of {Path(named).name}, {_label(first)}){other}; resuming would "
-        f"report on part of the file",
+        f"report on part of the file", span=span,
         hint=(f"resume the study as it was made: {command} --resume" if command else
               "resume with the worlds, choices and runs the study was made with")
         + ", or choose another directory with -o")
