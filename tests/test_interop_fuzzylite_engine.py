@@ -268,6 +268,21 @@ def test_a_formula_membership_outside_0_1_is_refused_at_evaluation():
     assert "term: bump Function 2 * x" in info.value.render()
 
 
+@pytest.mark.parametrize("again", ["1 - 4 * (x - 0.5)^2", "x"])
+def test_a_formula_term_named_twice_keeps_its_formula(again):
+    """fuzzylite 8 reads the last of two terms of one name; the other is read as `bump_2`,
+    which was made a new term without its formula: `check` and `eval` ended in a TypeError
+    ("a formula term is evaluated by its Formula")."""
+    from mitos_cli.fuzzy.formula import parse
+
+    text = FUNCTION.replace("  term: edge", f"  term: bump Function {again}\n  term: edge")
+    rb = parse_fll(text, "t.fll")
+    u = rb.variables["u"]
+    assert u.term("bump_2").formula == parse("1 - 4 * (x - 0.5)^2")
+    assert u.term("bump").formula == parse(again)
+    assert np.isfinite(run(text, [[0.2], [0.7]])).all()
+
+
 def test_formula_terms_round_trip_through_fll_and_term_sets(tmp_path):
     from mitos_cli.api import read_rulebase
     from mitos_cli.interop import write_foreign

@@ -11,7 +11,7 @@ other direction. Anything a format names that MITOS cannot compute exactly is re
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 from ..errors import FormatError, MitosError, Span, did_you_mean
@@ -270,7 +270,7 @@ def distinct_names(terms: list[Term], variable: str, notes: list[str], why: str,
             taken.add(new)
             notes.append(f"{t.span}: `{variable}` has more than one term named `{t.name}`; "
                          f"this one is read as `{new}` ({why})")
-            t = Term(new, t.shape, t.params, t.span)
+            t = replace(t, name=new)    # (a new Term lost a formula term's formula: a traceback)
         seen.add(t.name)
         out.append(t)
     return list(reversed(out)) if keep_last else out
