@@ -173,6 +173,32 @@ def test_a_malformed_number_is_named_at_its_own_place(line, message, column, hin
     assert err.hint == hint or hint in err.hint
 
 
+@pytest.mark.parametrize("line, name", [
+    ('save "C:\\Users\\me\\taught.rules"', "C:\\Users\\me\\taught.rules"),   # `\U`: no escape
+    ('simulate "a\\qb.yaml"', "a\\qb.yaml"),
+    ('save "out/\\u0074.rules"', "out/t.rules"),                     # a JSON escape, as `terms`
+])
+def test_a_quoted_file_name_is_read_as_a_rule_files_terms(line, name):
+    """A quoted name with a backslash that is no JSON escape (a Windows path) ended in a Lark
+    VisitError traceback; it is read as the rule language reads `terms "..."`."""
+    got = parse_command(line)
+    assert (got.world if isinstance(got, c.Simulate) else got.path) == name
+
+
+@pytest.mark.parametrize("line, column", [
+    ("save out/t\0.rules", 11),
+    ('save "out/t\0.rules"', 12),
+    ("adapt epochs 1 plot a\0.png", 22),
+    ("simulate a\0.yaml", 11),
+])
+def test_a_file_name_with_a_nul_byte_is_refused_at_it(line, column):
+    """`save out/t<NUL>.rules` and `adapt ... plot a<NUL>.png` ended in the system's
+    "ValueError: embedded null byte" traceback."""
+    with pytest.raises(LessonError, match="the file name holds a NUL byte") as info:
+        parse_command(line, "lesson.lesson", 3)
+    assert (info.value.span.line, info.value.span.column) == (3, column)
+
+
 @pytest.mark.parametrize("line", ["eval " + "a" * 30_000,
                                   "at 1s to 2s steering is S" + "a" * 30_000 + "T",
                                   "correct road=78 -> " + "a" * 30_000])

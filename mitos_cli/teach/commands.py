@@ -10,7 +10,6 @@ was expected, in words.
 from __future__ import annotations
 
 import functools
-import json
 import math
 import re
 from dataclasses import dataclass, field
@@ -27,6 +26,7 @@ from ..lang.parse import (
     UNSAID,
     _hedge_hint,
     _ToModel,
+    _unquote,
     check_modifiers,
     check_nesting,
     check_settings,
@@ -285,8 +285,8 @@ class _ToCommand(_ToModel):
         return Correct(items[0], items[2])
 
     def filename(self, items):
-        token = items[0]
-        return json.loads(str(token)) if token.type == "STRING" else str(token)
+        token = items[0]    # quoted as a rule file's `terms` ("C:\Users\..." ended in a traceback)
+        return _unquote(token) if token.type == "STRING" else str(token)
 
     def simulate_cmd(self, items):
         return Simulate(items[0], None if items[1] is None else str(items[1]),
@@ -430,11 +430,16 @@ def _bad_number(line: str, where: str) -> RuleSyntaxError | None:
 def _check_file_name(c: Command, line: str, where: str, lineno: int) -> None:
     """`simulate ""`, `save ""`, `plot ""`: a quoted file name that is empty names no file
     (``Path('')`` is the current directory: `simulate ""` said "`` is a directory"), as an
-    empty path on the command line is a usage error."""
+    empty path on the command line is a usage error; nor does one that holds a NUL byte."""
     name, example = ((c.world, "simulate worlds/figure4.yaml") if isinstance(c, Simulate) else
                      (c.path, "save taught.rules") if isinstance(c, Save) else
                      (c.plot, "plot terms.png") if isinstance(c, (Show, Adapt)) else
                      (None, ""))
+    if name is not None and "\0" in name:     # (`save`, `plot`: a ValueError from the system)
+        at = (line.find("\0") + 1) or 1        # (`\u0000`: at the line's start)
+        raise LessonError("the file name holds a NUL byte, which no file name can",
+                          span=Span.in_text("\n" * (lineno - 1) + line, where, lineno, at, at + 1),
+                          hint=f"give a file name, e.g. `{example}`")
     if name is None or name.strip():
         return
     quoted = re.search(r'"\s*"', line)
