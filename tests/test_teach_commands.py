@@ -2,6 +2,7 @@
 expected, in words, at path:line:col."""
 
 import contextlib
+import re
 import time
 
 import pytest
@@ -185,16 +186,19 @@ def test_a_quoted_file_name_is_read_as_a_rule_files_terms(line, name):
     assert (got.world if isinstance(got, c.Simulate) else got.path) == name
 
 
-@pytest.mark.parametrize("line, column", [
-    ("save out/t\0.rules", 11),
-    ('save "out/t\0.rules"', 12),
-    ("adapt epochs 1 plot a\0.png", 22),
-    ("simulate a\0.yaml", 11),
+@pytest.mark.parametrize("line, column, says", [
+    ("save out/t\0.rules", 6, "holds a NUL byte"),
+    ('save "out/t\0.rules"', 7, "holds a NUL byte"),
+    ("adapt epochs 1 plot a\0.png", 21, "holds a NUL byte"),
+    ("simulate a\0.yaml", 10, "holds a NUL byte"),
+    ('save "out/\\ud800.rules"', 6, "half a character (a lone surrogate)"),
+    ("save out/" + "a" * 300 + ".rules", 6, "a part of more than 255 bytes"),
 ])
-def test_a_file_name_with_a_nul_byte_is_refused_at_it(line, column):
-    """`save out/t<NUL>.rules` and `adapt ... plot a<NUL>.png` ended in the system's
-    "ValueError: embedded null byte" traceback."""
-    with pytest.raises(LessonError, match="the file name holds a NUL byte") as info:
+def test_a_file_name_no_system_can_open_is_refused_at_it(line, column, says):
+    """`save out/t<NUL>.rules`, `adapt ... plot a<NUL>.png` and `save "\\ud800.rules"` ended in
+    the system's ValueError or UnicodeEncodeError traceback; a name too long for a file system
+    was said with no place."""
+    with pytest.raises(LessonError, match=re.escape(says)) as info:
         parse_command(line, "lesson.lesson", 3)
     assert (info.value.span.line, info.value.span.column) == (3, column)
 

@@ -430,16 +430,19 @@ def _bad_number(line: str, where: str) -> RuleSyntaxError | None:
 def _check_file_name(c: Command, line: str, where: str, lineno: int) -> None:
     """`simulate ""`, `save ""`, `plot ""`: a quoted file name that is empty names no file
     (``Path('')`` is the current directory: `simulate ""` said "`` is a directory"), as an
-    empty path on the command line is a usage error; nor does one that holds a NUL byte."""
+    empty path on the command line is a usage error; nor does one no system can open
+    (:func:`_name_problem`)."""
     name, example = ((c.world, "simulate worlds/figure4.yaml") if isinstance(c, Simulate) else
                      (c.path, "save taught.rules") if isinstance(c, Save) else
                      (c.plot, "plot terms.png") if isinstance(c, (Show, Adapt)) else
                      (None, ""))
-    if name is not None and "\0" in name:     # (`save`, `plot`: a ValueError from the system)
-        at = (line.find("\0") + 1) or 1        # (`\u0000`: at the line's start)
-        raise LessonError("the file name holds a NUL byte, which no file name can",
-                          span=Span.in_text("\n" * (lineno - 1) + line, where, lineno, at, at + 1),
-                          hint=f"give a file name, e.g. `{example}`")
+    problem = _name_problem(name) if name is not None else None
+    if name is not None and problem is not None:    # (`save`, `plot`: a system's traceback)
+        at = line.find(name)
+        at = at if at >= 0 else max(line.find('"'), 0)         # (a name written with escapes)
+        raise LessonError(f"the file name {problem}", span=Span.in_text(
+            "\n" * (lineno - 1) + line, where, lineno, at + 1, at + 1 + len(name)),
+            hint=f"give a file name, e.g. `{example}`")
     if name is None or name.strip():
         return
     quoted = re.search(r'"\s*"', line)
@@ -447,6 +450,21 @@ def _check_file_name(c: Command, line: str, where: str, lineno: int) -> None:
     raise LessonError("the file name is empty: it names no file",
                       span=Span.in_text("\n" * (lineno - 1) + line, where, lineno, column, end),
                       hint=f"give a file name, e.g. `{example}`")
+
+
+def _name_problem(name: str) -> str | None:
+    """What keeps ``name`` from naming a file anywhere (``None``: nothing): a NUL byte, a
+    `\\ud800` escape (half a character, which no path can be written in), or a part of more
+    than 255 bytes (the longest a file system allows)."""
+    if "\0" in name:
+        return "holds a NUL byte, which no file name can"
+    try:
+        parts = name.encode("utf-8").split(b"/")
+    except UnicodeEncodeError:
+        return "holds a `\\u` escape of half a character (a lone surrogate)"
+    if any(len(part) > 255 for part in parts):
+        return "has a part of more than 255 bytes, more than a file system allows"
+    return None
 
 
 def _check_once(c: Adapt, line: str, where: str, lineno: int) -> None:
