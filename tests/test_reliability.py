@@ -107,7 +107,9 @@ def test_map_negate_unquoted_still_reads(tmp_path):
 
 def test_pgm_huge_header_is_checked_against_the_data_first():
     with pytest.raises(ValueError, match="holds 2 of its"):
-        parse_pgm(b"P5 99999999999 99999999999 255\n\0\0")
+        parse_pgm(b"P5 7999 7999 255\n\0\0")
+    with pytest.raises(ValueError, match="a map image may have at most 64,000,000"):
+        parse_pgm(b"P5 99999999999 99999999999 255\n\0\0")      # (past any map: said so)
     with pytest.raises(ValueError):
         parse_pgm(b"P2 3 1 9\n1 2 " + b"9" * 40 + b"\n")
 
