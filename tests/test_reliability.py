@@ -290,6 +290,23 @@ def test_entry_that_cannot_be_applied_names_its_line(tmp_path, monkeypatch):
     assert session.journal.recovered_at == 2 and not session.state.examples
 
 
+
+def test_entry_naming_an_unknown_behavior_keeps_its_did_you_mean(tmp_path, monkeypatch):
+    """The journal's refusal said "unknown behavior `drvie`" and dropped the inner error's
+    "did you mean" for its own hint (--recover); it now gives both."""
+    from mitos_cli.teach.journal import Journal
+    from mitos_cli.teach.session import Session
+
+    d = _session(tmp_path, monkeypatch)
+    path = d / "journal.jsonl"
+    with path.open("a") as f:
+        f.write(json.dumps({"seq": 4, "op": "activate", "line": "use drvie",
+                            "behavior": "drvie"}) + "\n")
+    with pytest.raises(LessonError) as info:
+        Session.resume(Journal.open(d), out=lambda s: None)
+    assert info.value.span.line == 4
+    assert "did you mean `drive`?" in info.value.hint and "--recover" in info.value.hint
+
 # ---- the command line --------------------------------------------------------------------------------
 
 @pytest.mark.parametrize("args", [["eval", "{long}.rules", "road=1"], ["check", "{long}.rules"],

@@ -219,11 +219,13 @@ class Session:
                 why = exc.message if isinstance(exc, MitosError) else \
                     f"{type(exc).__name__}: {exc}"
                 if not recover or not line:
+                    inner = exc.hint if isinstance(exc, MitosError) and exc.hint else None
                     raise LessonError(
                         f"change {entry.get('seq')} of the journal cannot be applied ({why})",
                         span=Span(str(self.journal.path), line or 1, 1),
-                        hint="`mitos teach --resume --recover` continues the session with the "
-                             "changes before it (the journal is kept aside)") from None
+                        hint=_then(inner, "`mitos teach --resume --recover` continues the "
+                                          "session with the changes before it (the journal "
+                                          "is kept aside)")) from None
                 self.journal.recovered_at = line
                 self._cut_journal(line)
                 return
@@ -1036,3 +1038,10 @@ def _whole(value: float, what: str, least: int) -> int:
         raise LessonError(f"{what} must be a whole number of at least {least}, not {value:g}")
     return int(value)
 
+
+
+def _then(first: str | None, second: str) -> str:
+    """Two hints as one: the inner error's (a "did you mean") before what to do next."""
+    if not first:
+        return second
+    return f"{first.rstrip('.')}; {second}" if not first.endswith("?") else f"{first} {second}"
