@@ -869,6 +869,8 @@ def test_a_tick_count_past_any_reading_is_written_short():
     text = error(BASE.replace("dt: 0.05", "dt: 1e-300"))
     assert "time_limit 10 s at dt 1e-300 s is 1e+301 ticks; a run takes at most 100,000" in text
     assert "is 200,000 ticks" in error(BASE.replace("dt: 0.05", "dt: 0.00005"))
+    # dt 5e-324 made the count overflow: "is inf ticks"
+    assert "is over 1e308 ticks" in error(BASE.replace("dt: 0.05", "dt: 5e-324"))
 
 
 @pytest.mark.parametrize("obstacle, said", [

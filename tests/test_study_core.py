@@ -5,6 +5,7 @@ from __future__ import annotations
 import functools
 import math
 import os
+import re
 import signal
 import zlib
 from pathlib import Path
@@ -664,6 +665,26 @@ def test_a_broken_manifest_is_refused_with_what_it_is(tmp_path, manifest, says):
     with pytest.raises(StudyError, match=says) as exc:
         run_study(small_study(runs=1), tmp_path, workers=1, resume=True, task_fn=fake_sim)
     assert "remove" in (exc.value.hint or "")
+
+
+@pytest.mark.parametrize("manifest, says, place", [
+    # these named no place: the whole, `digests`, `command`, a number past int()'s digits
+    ("[1]", "it holds a list, not an object", (1, 1)),
+    ('{"seed": 1,\n "digests": 5}', "its `digests` is `5`, not an object of file digests",
+     (2, 2)),
+    ('{"seed": 1,\n  "command": []}', "its `command` is `[]`, not a string", (2, 3)),
+    ('{"seed": ' + "9" * 5000 + "}", "is not a study manifest", (1, 10)),
+    # 1e400 is read as infinity, and was shown as `Infinity`
+    ('{"seed": 1e400}', "its `seed` is `1e400`, not a whole number", (1, 2)),
+])
+def test_a_misshapen_manifest_is_refused_at_its_place(tmp_path, manifest, says, place):
+    run_study(small_study(runs=1), tmp_path, workers=1, task_fn=fake_sim)
+    (tmp_path / "study.json").write_text(manifest)
+    with pytest.raises(StudyError, match=re.escape(says)) as exc:
+        run_study(small_study(runs=1), tmp_path, workers=1, resume=True, task_fn=fake_sim)
+    span = exc.value.span
+    assert span is not None and span.path.endswith("study.json")
+    assert (span.line, span.column) == place
 
 
 @pytest.mark.parametrize("results, says, line", [

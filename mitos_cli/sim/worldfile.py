@@ -512,7 +512,9 @@ def _label(m: YMap, whose: str, example: str) -> str:
 
 def _count(n: float) -> str:
     """A large count in words a reader takes in: `1e-300` as dt made time_limit 60 a count
-    of 302 digits, most of them a float's noise."""
+    of 302 digits, most of them a float's noise; `5e-324` made it `inf`."""
+    if n == math.inf:
+        return "over 1e308"
     return f"{n:,.0f}" if n < 1e15 else f"{n:.3g}"
 
 

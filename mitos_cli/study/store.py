@@ -254,22 +254,25 @@ class ResultStore:
             raise StudyError(f"{self.manifest_path} is not a study manifest: it nests too "
                              f"deep to read", hint=hint) from None
         except ValueError as exc:                # a number of more digits than int() reads
+            long = re.search(r"[0-9]{4000,}", text)
             raise StudyError(f"{self.manifest_path} is not a study manifest: {exc}",
+                             span=long and _at(text, str(self.manifest_path), long.start()),
                              hint=hint) from None
-        digests = got.get("digests", {}) if isinstance(got, dict) else None
-        if not isinstance(digests, dict) or not all(
-                isinstance(v, str) for v in digests.values()) \
-                or not isinstance(got.get("command", ""), str):
-            raise StudyError(f"{self.manifest_path} is not a study manifest",
+        path = str(self.manifest_path)
+        wrong = _misshapen(got)
+        if wrong is not None:
+            key, why = wrong
+            raise StudyError(f"{path} is not a study manifest: {why}",
+                             span=(key and _key_span(text, path, key)) or Span(path, 1, 1),
                              expected="a JSON object (the study's seed, worlds and choices; "
                                       "its `digests` an object of file digests, its "
                                       "`command` a string)",
                              hint=hint)
         seed = got.get("seed")
         if type(seed) is not int or seed < 0:      # `"1"` said "made with --seed 1, not 1"
-            raise StudyError(f"{self.manifest_path} is not a study manifest: its `seed` is "
-                             f"{_shown(got, 'seed')}, not a whole number",
-                             span=_key_span(text, str(self.manifest_path), "seed"),
+            raise StudyError(f"{path} is not a study manifest: its `seed` is "
+                             f"{_written(text, 'seed') or _shown(got, 'seed')}, not a whole "
+                             f"number", span=_key_span(text, path, "seed"),
                              expected="the study's --seed, such as 1", hint=hint)
         return got
 
@@ -414,15 +417,49 @@ def _shown(got: dict, key: str) -> str:
     return f"`{text if len(text) <= 40 else text[:37] + '...'}`"
 
 
+def _misshapen(got: object) -> tuple[str | None, str] | None:
+    """What is wrong with the shape of a study manifest read as ``got``: the key at fault
+    (``None``: the whole) and why; ``None`` where nothing is. It is not an object, or its
+    `digests` or `command` is not what the study wrote."""
+    if not isinstance(got, dict):
+        return None, f"it holds {_kind(got)}, not an object"
+    digests = got.get("digests", {})
+    if not isinstance(digests, dict) or not all(isinstance(v, str) for v in digests.values()):
+        return "digests", f"its `digests` is {_shown(got, 'digests')}, not an object of file digests"
+    if not isinstance(got.get("command", ""), str):
+        return "command", f"its `command` is {_shown(got, 'command')}, not a string"
+    return None
+
+
+def _kind(value: object) -> str:
+    """A JSON value's kind, as a reader of the file names it."""
+    return ("a list" if isinstance(value, list) else "a string" if isinstance(value, str)
+            else "null" if value is None else "a boolean" if isinstance(value, bool)
+            else "a number")
+
+
+def _written(text: str, key: str) -> str | None:
+    """``key``'s value as the file writes it (`1e400`, which JSON reads as infinity and
+    would show as `Infinity`), cut short; ``None`` where it is not a plain number."""
+    found = re.search(rf'"{re.escape(key)}"\s*:\s*(-?[0-9][0-9.eE+-]*)', text)
+    if found is None:
+        return None
+    value = found.group(1)
+    return f"`{value if len(value) <= 40 else value[:37] + '...'}`"
+
+
 def _key_span(text: str, path: str, key: str) -> Span | None:
     """Where ``"key":`` is written in the JSON ``text`` (its first place); ``None`` where it
     is not."""
     found = re.search(rf'"{re.escape(key)}"\s*:', text)
-    if found is None:
-        return None
-    line = text.count("\n", 0, found.start()) + 1
-    column = found.start() - (text.rfind("\n", 0, found.start()) + 1) + 1
-    return Span.in_text(text, path, line, column, column + len(key) + 2)
+    return None if found is None else _at(text, path, found.start(), len(key) + 2)
+
+
+def _at(text: str, path: str, index: int, width: int = 1) -> Span:
+    """The place of ``text[index:index + width]``."""
+    line = text.count("\n", 0, index) + 1
+    column = index - (text.rfind("\n", 0, index) + 1) + 1
+    return Span.in_text(text, path, line, column, column + width)
 
 
 def _check_unchanged(old: dict, new: dict, path: Path) -> None:
