@@ -56,31 +56,40 @@ def _envelope(f: np.ndarray) -> np.ndarray:
     return d
 
 
-def _column_distance(blocked: np.ndarray) -> np.ndarray:
-    """Distance (cells) along each column to the nearest blocked cell (``inf`` if none)."""
-    n = blocked.shape[0]
-    idx = np.arange(n, dtype=float)[:, None]
-    above = np.maximum.accumulate(np.where(blocked, idx, -np.inf), axis=0)
-    below = np.minimum.accumulate(np.where(blocked, idx, np.inf)[::-1], axis=0)[::-1]
-    return np.minimum(idx - above, below - idx)
-
-
 def _capped(blocked: np.ndarray, cap: int,
             part: tuple[int, int, int, int] | None = None) -> np.ndarray:
     """Exact squared distances up to ``cap`` cells (larger ones read ``cap**2`` or more): the
     column distances, then the minimum over row offsets within the cap, all as array shifts.
     ``part``: only rows ``r0:r1`` and columns ``c0:c1`` of the answer (each cell's minimum is
-    its own, so the bits of the whole)."""
-    g = np.minimum(_column_distance(blocked), cap + 1.0) ** 2
+    its own, so the bits of the whole). The squares are small whole numbers, worked out in the
+    narrowest integers that hold them (a quarter of float64's memory and traffic on a large
+    map) and given as float64: the same numbers, so the same bits."""
+    far = cap + 1
+    kind = np.uint16 if far * far + cap * cap <= np.iinfo(np.uint16).max else np.int64
+    g = np.minimum(_column_steps(blocked, far), far).astype(kind)
+    g *= g
     rows, cols = g.shape
     r0, r1, c0, c1 = (0, rows, 0, cols) if part is None else part
-    padded = np.full((r1 - r0, cols + 2 * cap), (cap + 1.0) ** 2)
+    padded = np.full((r1 - r0, cols + 2 * cap), far * far, dtype=kind)
     padded[:, cap:cap + cols] = g[r0:r1]
     d = g[r0:r1, c0:c1].copy()
+    shifted = np.empty_like(d)
     for dc in range(1, cap + 1):
-        np.minimum(d, padded[:, cap + dc + c0:cap + dc + c1] + dc * dc, out=d)
-        np.minimum(d, padded[:, cap - dc + c0:cap - dc + c1] + dc * dc, out=d)
-    return d
+        for start in (cap + dc, cap - dc):
+            np.add(padded[:, start + c0:start + c1], kind(dc * dc), out=shifted)
+            np.minimum(d, shifted, out=d)
+    return d.astype(np.float64)
+
+
+def _column_steps(blocked: np.ndarray, far: int) -> np.ndarray:
+    """Cells along each column to the nearest blocked cell, as whole numbers (``far`` or
+    more where it is ``far`` or more away, or there is none)."""
+    n = blocked.shape[0]
+    kind = np.int32 if n + far < np.iinfo(np.int32).max else np.int64
+    idx = np.arange(n, dtype=kind)[:, None]
+    above = np.maximum.accumulate(np.where(blocked, idx, kind(-far)), axis=0)
+    below = np.minimum.accumulate(np.where(blocked, idx, kind(n + far))[::-1], axis=0)[::-1]
+    return np.minimum(idx - above, below - idx)
 
 
 def distance_transform(blocked: np.ndarray, spacing: float = 1.0,

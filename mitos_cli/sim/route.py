@@ -895,26 +895,31 @@ def _steps(moves: Sequence[tuple[int, int, float]], blocked: np.ndarray, ok: np.
 
 @functools.lru_cache(maxsize=4)
 def _distances(R: int, C: int) -> np.ndarray:
-    """``[2R - 1, 2C - 1]``: ``math.dist`` from node ``(R - 1, C - 1)`` to every node of a
-    grid twice the size less one, each worked out by ``math.dist`` itself (it depends on
-    the differences alone), so that A*'s heuristic is read, not worked out, with its bits.
-    Kept (read-only)."""
-    out = np.array([[math.dist((r, c), (R - 1, C - 1)) for c in range(2 * C - 1)]
-                    for r in range(2 * R - 1)])
+    """``[R, C]``: ``math.dist`` from node ``(0, 0)`` to every node, each worked out by
+    ``math.dist`` itself, so that A*'s heuristic is read, not worked out, with its bits. It
+    depends on the absolute differences alone, so this quarter gives every node's distance
+    to any goal (:func:`_heuristic`). Kept (read-only)."""
+    out = np.array([[math.dist((r, c), (0, 0)) for c in range(C)] for r in range(R)])
     out.flags.writeable = False
     return out
+
+
+def _heuristic(R: int, C: int, goal: int) -> list[float]:
+    """``math.dist`` from every node of the grid ``[R, C]`` to node ``goal``, flat."""
+    gr, gc = divmod(goal, C)
+    rows, cols = np.abs(np.arange(R) - gr), np.abs(np.arange(C) - gc)
+    return _distances(R, C)[rows[:, None], cols[None, :]].ravel().tolist()
 
 
 def _grid_astar(costs: memoryview, offsets: list[int], R: int, C: int, start: int,
                 goal: int) -> list[int] | None:
     """:func:`_astar` over the node grid ``[R, C]`` with the steps of :func:`_steps` (the
     same pushes in the same order, so the same path), without a Python call per neighbour:
-    the heuristic to the goal is read from :func:`_distances`, and a node popped again at
+    the heuristic to the goal is read from :func:`_heuristic`, and a node popped again at
     the cost it was expanded at is not expanded again (it would push nothing: no step from
     it is cheaper than it was)."""
     size, k = R * C, len(offsets)
-    gr, gc = divmod(goal, C)
-    h = _distances(R, C)[R - 1 - gr:2 * R - 1 - gr, C - 1 - gc:2 * C - 1 - gc].ravel().tolist()
+    h = _heuristic(R, C, goal)
     frontier = [(0.0, 0, start)]
     came = [-1] * size                   # lists by node: cheaper to read than dicts
     cost = [math.inf] * (size + C + 1)   # a step off the grid (costing inf) reads the padding
