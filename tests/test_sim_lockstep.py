@@ -71,6 +71,33 @@ def test_finished_gives_each_run_as_it_ends_with_its_bits_alone():
         assert_same_run(simulate(world, planner, seeds[i], randomise=True, scene=scene), res)
 
 
+def test_a_large_map_is_stepped_in_smaller_batches_with_the_same_bits(monkeypatch):
+    """A batch of 64 runs on a 4,000 x 4,000 map kept 20 GB of the robots' maps; a batch now
+    takes as many runs as :data:`MAP_MEMORY` holds, and the runs keep their bits."""
+    from mitos_cli.sim import lockstep, runs
+
+    world = dataclasses.replace(load_world(packaged_path("worlds", "office.yaml")),
+                                time_limit=1.0)
+    assert lockstep.batch_for(world) == lockstep.BATCH        # 600 x 600: a full batch
+    big = dataclasses.replace(world.grid, occupied=np.zeros((4000, 4000), dtype=bool))
+    assert lockstep.batch_for(dataclasses.replace(world, grid=big)) == 2
+    monkeypatch.setattr(lockstep, "MAP_MEMORY", 2 * 360_000 * lockstep.CELL_BYTES)
+    assert lockstep.batch_for(world) == 2
+    planner, scene = FuzzyPlanner(None, world.behavior), prepare(world)
+    seeds = [1, 2, 3, 4, 5]
+    made = []
+    monkeypatch.setattr(lockstep, "Lockstep", lambda *a, **k: made.append(len(a[2])) or
+                        Lockstep(*a, **k))
+    got = run_lockstep(world, planner, seeds, randomise=True, scene=scene)
+    assert made == [2, 2, 1]
+    for seed, res in zip(seeds, got):
+        assert_same_run(simulate(world, planner, seed, randomise=True, scene=scene), res)
+    made.clear()
+    summaries = runs.run_many([world], runs=5, seed=1, planner=planner, workers=1)
+    assert made == [2, 2, 1]
+    assert list(summaries.worlds[0].summaries) == [res.summary() for res in got]
+
+
 @pytest.mark.parametrize("name", ["potential_field", "dwa"])   # dwa: with the route ahead
 def test_a_planner_other_than_the_fuzzy_one_plans_each_run_itself(name):
     world = dataclasses.replace(load_world(TINY), time_limit=1.0)

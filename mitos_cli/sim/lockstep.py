@@ -44,6 +44,13 @@ _ROW = {key: j for j, key in enumerate(perception.INPUTS)}
 #: few enough that the runs' recorded ticks stay small.
 BATCH = 64
 
+#: What the runs of one batch may keep of their maps together (bytes), and what a robot
+#: keeps a cell of the map it plans on (its copy of the cells and what its route searches
+#: worked out on them: about 21 bytes, measured on a 4,000 x 4,000 map). A batch of 64 runs
+#: there took 20 GB; the packaged worlds' maps (600 x 600 at most) still fill a batch of 64.
+MAP_MEMORY = 1 << 30
+CELL_BYTES = 24
+
 
 class Lockstep:
     """Runs of ``world`` from ``seeds`` stepped together (``randomise``: each run draws its
@@ -225,14 +232,47 @@ def _guard_together(runs: list[Simulation], ticks: list) -> None:
         run._guard(s)
 
 
+def batch_for(world: World, most: int = BATCH) -> int:
+    """How many runs of ``world`` one lockstep batch steps: ``most``, fewer where their
+    robots' maps would take more than :data:`MAP_MEMORY` together (at least one)."""
+    per_run = _plan_cells(world) * CELL_BYTES * len(world.agents)
+    return max(1, min(most, MAP_MEMORY // max(1, per_run)))
+
+
+def _plan_cells(world: World) -> int:
+    """About how many cells the map a robot plans on holds: the grid it is given or the
+    world's, else the corridors' bounds rasterised (:data:`.knowledge.RASTER`)."""
+    grid = world.given if world.given is not None else world.grid
+    if grid is not None:
+        return int(grid.occupied.size)
+    points = np.array([p for c in world.corridors for p in c.points]).reshape(-1, 2)
+    if not len(points):
+        return 0
+    pad = max(c.width for c in world.corridors) + 2 * knowledge.RASTER
+    span = points.max(axis=0) - points.min(axis=0) + pad
+    return int(np.prod(np.ceil(span / knowledge.RASTER)))
+
+
+def finished(world: World, planner: Planner | None, seeds: Sequence[int], *,
+             randomise: bool = False, scene: Scene | None = None,
+             batch: int | None = None) -> Iterator[tuple[int, SimResult]]:
+    """The runs of ``world`` from ``seeds``, ``batch`` at a time in lockstep (default:
+    :func:`batch_for`), each run's place among the seeds and its result as it ends."""
+    size = max(1, batch_for(world) if batch is None else batch)
+    for i in range(0, len(seeds), size):
+        for j, res in Lockstep(world, planner, seeds[i:i + size], randomise=randomise,
+                               scene=scene).finished():
+            yield i + j, res
+
+
 def run_lockstep(world: World, planner: Planner | None, seeds: Sequence[int], *,
                  randomise: bool = False, scene: Scene | None = None,
-                 batch: int = BATCH) -> list[SimResult]:
-    """The runs of ``world`` from ``seeds``, ``batch`` at a time in lockstep: the same results,
-    bit for bit, as ``[simulate(world, planner, s, randomise=randomise, scene=scene) for s in
-    seeds]``."""
-    out: list[SimResult] = []
-    for i in range(0, len(seeds), max(1, batch)):
-        out += Lockstep(world, planner, seeds[i:i + batch], randomise=randomise,
-                        scene=scene).results()
-    return out
+                 batch: int | None = None) -> list[SimResult]:
+    """The runs of ``world`` from ``seeds``, ``batch`` at a time in lockstep (default:
+    :func:`batch_for`): the same results, bit for bit, as ``[simulate(world, planner, s,
+    randomise=randomise, scene=scene) for s in seeds]``."""
+    out: list[SimResult | None] = [None] * len(seeds)
+    for i, res in finished(world, planner, seeds, randomise=randomise, scene=scene,
+                           batch=batch):
+        out[i] = res
+    return [res for res in out if res is not None]

@@ -18,7 +18,7 @@ import numpy as np
 
 from ..errors import InputError, MitosError
 from ..numbers import whole_number
-from .lockstep import BATCH, Lockstep
+from .lockstep import batch_for, finished
 from .loop import OUTCOMES, ROBOT_OUTCOMES, check_seed, shared_scene
 from .world import World
 
@@ -33,7 +33,7 @@ def _chunk_runs(task: tuple) -> Iterator[tuple[int, int, dict]]:
     are those it has alone): ``(chunk, place in the chunk, summary)`` as each run ends."""
     index, world, planner, seeds, randomise, measure, scene = task
     scene = scene if scene is not None else shared_scene(world, randomise)
-    for j, res in Lockstep(world, planner, seeds, randomise=randomise, scene=scene).finished():
+    for j, res in finished(world, planner, seeds, randomise=randomise, scene=scene):
         yield index, j, {**res.summary(), **(measure(res) if measure is not None else {})}
 
 
@@ -150,12 +150,13 @@ def run_many(worlds: list[World], runs: int = 0, seed: int | None = None, planne
     for place, w in enumerate(worlds):
         base = w.seed if seed is None else seed
         seeds = [base] if runs <= 0 else [base + j for j in range(runs)]
-        # each worker's share in lockstep batches of up to BATCH runs (a batch of 5 runs costs
-        # about twice what a batch of 40 does a robot-tick); a world cut into several
+        # each worker's share in lockstep batches of up to 64 runs, fewer on a large map
+        # (batch_for; a batch of 5 runs costs about twice what a batch of 40 does a
+        # robot-tick); a world cut into several
         # chunks has its map and routes prepared once, here, and sent along (a grid map's
         # route search costs about as much as a run), unless its draws move what the robots
         # are given (shared_scene)
-        size = even_chunks(len(seeds), workers, BATCH)
+        size = even_chunks(len(seeds), workers, batch_for(w))
         scene = shared_scene(w, runs > 0) if len(seeds) > size else None
         for i in range(0, len(seeds), size):
             tasks.append((place, tuple(seeds[i:i + size]), scene))

@@ -155,16 +155,16 @@ def run_tasks(context: StudyContext, tasks: Sequence[Task]) -> Iterator[tuple[Ta
     """Simulate ``tasks``, those of each world and choice stepped together
     (:class:`~mitos_cli.sim.lockstep.Lockstep`: each run's bits are those :func:`run_task`
     gives it alone), giving each task and its fields as its run ends."""
-    from ..sim.lockstep import Lockstep
+    from ..sim.lockstep import finished
 
     groups: dict[tuple[str, Choice], list[Task]] = {}
     for task in tasks:
         groups.setdefault((task.world, task.choice), []).append(task)
     for (path, choice), group in groups.items():
         key = _world_key(context, path)
-        runs = Lockstep(_world(path, key), _planner(context, choice, path),
+        runs = finished(_world(path, key), _planner(context, choice, path),
                         [task.seed for task in group], randomise=True, scene=_scene(path, key))
-        for j, result in runs.finished():
+        for j, result in runs:
             yield group[j], _fields(result)
 
 
