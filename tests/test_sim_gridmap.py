@@ -59,6 +59,25 @@ def test_rows_are_flipped_and_thresholds_applied():
     assert lenient.tolist() == [[True, True], [False, False], [False, False]]
 
 
+@pytest.mark.parametrize("mode", ["trinary", "scale", "raw"])
+@pytest.mark.parametrize("maxval", [255, 1000, 65535])
+def test_a_large_image_classified_through_a_table_is_classified_pixel_by_pixel(mode, maxval):
+    """A large image's pixels are classified through a table of their values (the float
+    occupancies took 18 bytes a pixel): the same cells as each pixel's own reading."""
+    from mitos_cli.sim.gridmap import _blocked
+
+    rng = np.random.default_rng(maxval)
+    px = rng.integers(0, maxval + 1, (60, 70)).astype(np.uint16)
+    px[0, :4] = (0, maxval, 100, 101)
+    for negate, unknown in ((False, True), (True, False)):
+        for occ_t, free_t in ((0.65, 0.196), (0.5, 0.5), (1.0, 0.0)):
+            got = classify(px, maxval, negate=negate, occupied_thresh=occ_t,
+                           free_thresh=free_t, unknown_occupied=unknown, mode=mode)
+            want = _blocked(px, maxval, negate, occ_t, free_t, unknown, mode)[::-1]
+            assert got.dtype == bool and got.flags.c_contiguous
+            assert np.array_equal(got, want)
+
+
 def test_negate_swaps_black_and_white():
     px = np.array(PIXELS).reshape(3, 2)
     blocked = classify(px, 255, negate=True, occupied_thresh=0.65, free_thresh=0.196,

@@ -7,6 +7,7 @@ world loader turns them into a :class:`~mitos_cli.errors.WorldError` at the ``im
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 import numpy as np
@@ -95,7 +96,10 @@ def parse_pgm(data: bytes) -> tuple[np.ndarray, int]:
 
 def _within(pixels: np.ndarray, maxval: int, width: int) -> None:
     """Refuse a pixel outside ``0..maxval`` (binary or ASCII alike: read as it stands, a
-    pixel above the maximum is an occupancy below 0, free, or with ``negate`` a wall)."""
+    pixel above the maximum is an occupancy below 0, free, or with ``negate`` a wall). The
+    extremes first: the masks of a large image are three of its size."""
+    if not pixels.size or pixels.min() >= 0 and pixels.max() <= maxval:
+        return
     bad = np.flatnonzero((pixels < 0) | (pixels > maxval))
     if len(bad):
         row, col = divmod(int(bad[0]), width)
@@ -116,8 +120,8 @@ def read_pgm(path: str | Path) -> tuple[np.ndarray, int]:
     path = Path(path)
     if exists(path) and not path.is_file():
         raise ValueError("it is not a regular file")
-    with open(path, "rb") as fh:
-        data = fh.read(MAX_BYTES + 1)
+    with open(path, "rb") as fh:            # (read(n) takes n bytes first: ask for the size)
+        data = fh.read(min(os.fstat(fh.fileno()).st_size, MAX_BYTES) + 1)
     if len(data) > MAX_BYTES:
         raise ValueError(f"it is larger than {MAX_BYTES >> 20} MB")
     return parse_pgm(data)
