@@ -369,7 +369,7 @@ def test_steps_clearance_from_their_least_distance_is_the_least_of_their_samples
         nodes = route._nodes(field.dist, int(rng.integers(1, 4)))
         xy = route._node_xy(grid, nodes)
         if k % 4 == 0:          # samples off the field (a field smaller than the nodes' grid)
-            field = route.Clearance(field.dist[:-2, :-3], field.resolution, field.origin)
+            field = route.Clearance(field.squares[:-2, :-3], field.resolution, field.origin)
         t = route._samples(field, xy)
         got = np.full((len(route.MOVES), *xy.shape[:2]), -np.inf)
         route._edges_from(got, field, xy, t, route.MOVES, (0, xy.shape[0]), (0, xy.shape[1]))
@@ -384,7 +384,7 @@ def test_the_steps_clearance_of_a_block_of_nodes_is_that_block_of_the_whole():
         field = route.Clearance.of(grid.occupied, grid.resolution, grid.origin, cap=20.0)
         xy = route._node_xy(grid, route._nodes(field.dist, int(rng.integers(1, 4))))
         if k % 4 == 0:          # samples off the field (a field smaller than the nodes' grid)
-            field = route.Clearance(field.dist[:-2, :-3], field.resolution, field.origin)
+            field = route.Clearance(field.squares[:-2, :-3], field.resolution, field.origin)
         t = route._samples(field, xy)
         R, C = xy.shape[:2]
         r0, c0 = int(rng.integers(-1, R)), int(rng.integers(-1, C))
@@ -449,6 +449,45 @@ def test_the_heuristic_read_from_one_quarter_is_math_dist_to_the_goal(R, C, data
     goal = data.draw(st.integers(0, R * C - 1))
     want = [math.dist((r, c), divmod(goal, C)) for r in range(R) for c in range(C)]
     assert same(np.array(_heuristic(R, C, goal)), np.array(want))
+
+
+@hypothesis.settings(max_examples=40, deadline=None)
+@hypothesis.given(st.integers(0, 2**32 - 1), st.sampled_from([None, 3.0, 9.5, 400.0]))
+def test_a_field_kept_as_squares_reads_the_distances_it_held(seed, cap):
+    """The clearance field is kept as squared cells (2 bytes a cell, not 8) and read as
+    distances where it is looked up: every read gives the bits the float64 field gave."""
+    from mitos_cli.sim.distance import distance_transform
+
+    rng = np.random.default_rng(seed)
+    rows, cols = (int(n) for n in rng.integers(3, 40, 2))
+    occ = rng.random((rows, cols)) < float(rng.uniform(0.0, 0.2))
+    res, origin = float(rng.choice([0.5, 2.0, 1.9685])), (-3.0, 1.5)
+    field = route.Clearance.of(occ, res, origin, cap=cap)
+    dist = distance_transform(occ, res, cap)
+    assert same(field.dist, dist)
+    pts = rng.uniform(-6, max(rows, cols) * res + 6, (50, 2))
+    col = np.floor((pts[:, 0] - origin[0]) / res).astype(np.int64)
+    row = np.floor((pts[:, 1] - origin[1]) / res).astype(np.int64)
+    inside = (row >= 0) & (row < rows) & (col >= 0) & (col < cols)
+    want = np.zeros(len(pts))
+    want[inside] = np.maximum(dist[row[inside], col[inside]] - res / 2, 0.0)
+    assert same(field.cells(pts), want)
+    centre = np.stack([origin[0] + (col + 0.5) * res, origin[1] + (row + 0.5) * res], axis=1)
+    off = np.hypot(*(pts - centre)[inside].T)
+    want[inside] = np.maximum(dist[row[inside], col[inside]] - off - res / 2, 0.0)
+    assert same(field.at(pts), want)
+    xy = route._node_xy(Grid(occ, res, origin), route._nodes(dist, 2))
+    R, C = xy.shape[:2]
+    src, dst = np.arange(R * C), np.roll(np.arange(R * C), 1)
+    t = route._samples(field, xy)
+    x = xy[..., 0].reshape(-1)[src] + t[:, None] * (xy[..., 0].reshape(-1)[dst]
+                                                     - xy[..., 0].reshape(-1)[src])
+    y = xy[..., 1].reshape(-1)[src] + t[:, None] * (xy[..., 1].reshape(-1)[dst]
+                                                     - xy[..., 1].reshape(-1)[src])
+    c = np.floor((x - origin[0]) / res).astype(np.int64)
+    r = np.floor((y - origin[1]) / res).astype(np.int64)
+    least = np.maximum(dist[r, c].min(axis=0) - res / 2, 0.0)
+    assert same(route._least(field, xy, t, src, dst), least)
 
 
 def test_the_prepared_search_patches_only_round_the_changed_cells():

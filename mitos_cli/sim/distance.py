@@ -58,12 +58,18 @@ def _envelope(f: np.ndarray) -> np.ndarray:
 
 def _capped(blocked: np.ndarray, cap: int,
             part: tuple[int, int, int, int] | None = None) -> np.ndarray:
+    """:func:`_capped_squares` as float64 (the same numbers)."""
+    return _capped_squares(blocked, cap, part).astype(np.float64)
+
+
+def _capped_squares(blocked: np.ndarray, cap: int,
+                    part: tuple[int, int, int, int] | None = None) -> np.ndarray:
     """Exact squared distances up to ``cap`` cells (larger ones read ``cap**2`` or more): the
     column distances, then the minimum over row offsets within the cap, all as array shifts.
     ``part``: only rows ``r0:r1`` and columns ``c0:c1`` of the answer (each cell's minimum is
-    its own, so the bits of the whole). The squares are small whole numbers, worked out in the
-    narrowest integers that hold them (a quarter of float64's memory and traffic on a large
-    map) and given as float64: the same numbers, so the same bits."""
+    its own, so the bits of the whole). The squares are small whole numbers, worked out and
+    given in the narrowest integers that hold them (uint16 up to a cap of 180 cells: a
+    quarter of float64's memory and traffic on a large map)."""
     far = cap + 1
     kind = np.uint16 if far * far + cap * cap <= np.iinfo(np.uint16).max else np.int64
     g = np.minimum(_column_steps(blocked, far), far).astype(kind)
@@ -78,7 +84,7 @@ def _capped(blocked: np.ndarray, cap: int,
         for start in (cap + dc, cap - dc):
             np.add(padded[:, start + c0:start + c1], kind(dc * dc), out=shifted)
             np.minimum(d, shifted, out=d)
-    return d.astype(np.float64)
+    return d
 
 
 def _column_steps(blocked: np.ndarray, far: int) -> np.ndarray:
@@ -98,13 +104,27 @@ def distance_transform(blocked: np.ndarray, spacing: float = 1.0,
     ``spacing`` (0 on blocked cells; ``inf`` everywhere when nothing is blocked). With ``cap``
     (same unit), distances are exact up to the cap and read at least the cap beyond it: a
     route needs no more, and the capped transform is all array operations."""
+    return from_squares(squared_distances(blocked, spacing, cap), spacing)
+
+
+def squared_distances(blocked: np.ndarray, spacing: float = 1.0,
+                      cap: float | None = None) -> np.ndarray:
+    """What :func:`distance_transform` takes the square root of: squared distances in cells,
+    whole numbers (narrow integers when capped, float64 otherwise; ``inf`` everywhere when
+    nothing is blocked). A field kept as these takes 2 bytes a cell, not 8."""
     blocked = np.asarray(blocked, dtype=bool)
     if not blocked.any():
         return np.full(blocked.shape, np.inf)
     if cap is not None:
         n = int(math.ceil(cap / spacing))
         if n < max(blocked.shape):
-            return np.sqrt(_capped(blocked, n)) * spacing
+            return _capped_squares(blocked, n)
     f = np.where(blocked, 0.0, _FAR)
-    d = _envelope(_envelope(f.T).T)       # columns, then rows
-    return np.sqrt(np.minimum(d, _FAR)) * spacing
+    return np.minimum(_envelope(_envelope(f.T).T), _FAR)       # columns, then rows
+
+
+def from_squares(squares: np.ndarray, spacing: float) -> np.ndarray:
+    """The distances of :func:`squared_distances`' ``squares`` (any part of them), times
+    ``spacing``: ``sqrt(s) * spacing`` in float64. It never falls as ``s`` grows, so the
+    distance of the least square is the least distance, bit for bit."""
+    return np.sqrt(np.asarray(squares, dtype=np.float64)) * spacing

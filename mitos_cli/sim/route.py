@@ -19,7 +19,7 @@ import numpy as np
 
 from ..errors import WorldError
 from ..words import tenths
-from .distance import _capped, distance_transform
+from .distance import _capped_squares, from_squares, squared_distances
 from .geometry import CACHED, box_segment_distance, clip_arrays, point_segment_distance
 from .staticmap import StaticMap
 from .world import Corridor, Goal, Grid, Pose, Robot
@@ -521,9 +521,12 @@ BRAKE_PROMISE = 2.0
 class Clearance:
     """Clearance of points from the occupied cells of a grid: the exact Euclidean distance
     transform of the cell centres (:mod:`.distance`), read as the distance to the nearest
-    occupied cell treated as a disc of half a cell, never more than the truth at the point."""
+    occupied cell treated as a disc of half a cell, never more than the truth at the point.
+    Kept as the squared distances in cells (:func:`.distance.squared_distances`: 2 bytes a
+    cell where 8 held the distances; a robot on a large map keeps one for its own map) and
+    read as distances where they are looked up (:func:`.distance.from_squares`: the same bits)."""
 
-    dist: np.ndarray               # [rows, cols] in, centre to the nearest occupied centre
+    squares: np.ndarray            # [rows, cols] squared cells, centre to nearest occupied
     resolution: float
     origin: tuple[float, float]
 
@@ -533,8 +536,19 @@ class Clearance:
     @classmethod
     def of(cls, occupied: np.ndarray, resolution: float, origin: tuple[float, float],
            cap: float | None = None) -> Clearance:
-        """The field of a grid, exact up to ``cap`` inches (see :func:`distance_transform`)."""
-        return cls(distance_transform(occupied, resolution, cap), resolution, origin)
+        """The field of a grid, exact up to ``cap`` inches (see
+        :func:`.distance.distance_transform`)."""
+        return cls(squared_distances(occupied, resolution, cap), resolution, origin)
+
+    @property
+    def dist(self) -> np.ndarray:
+        """``[rows, cols]`` in, each cell centre to the nearest occupied centre (worked out
+        afresh: for a window or a block, not a hot path's whole grid)."""
+        return from_squares(self.squares, self.resolution)
+
+    def dist_at(self, squares: np.ndarray) -> np.ndarray:
+        """The distances (in) of ``squares`` looked up in :attr:`squares`."""
+        return from_squares(squares, self.resolution)
 
     def at(self, points: np.ndarray) -> np.ndarray:
         """A lower bound on the clearance (in) at each point ``[P, 2]`` (0 outside the grid):
@@ -545,7 +559,7 @@ class Clearance:
         r, c = row[inside], col[inside]
         centre = np.stack([ox + (c + 0.5) * res, oy + (r + 0.5) * res], axis=1)
         off = np.hypot(*(pts[inside] - centre).T)
-        out[inside] = np.maximum(self.dist[r, c] - off - res / 2, 0.0)
+        out[inside] = np.maximum(self.dist_at(self.squares[r, c]) - off - res / 2, 0.0)
         return out
 
     def cells(self, points: np.ndarray) -> np.ndarray:
@@ -553,7 +567,8 @@ class Clearance:
         a route node there keeps; 0 outside the grid)."""
         pts, row, col, inside = self._cell_of(points)
         out = np.zeros(len(pts))
-        out[inside] = np.maximum(self.dist[row[inside], col[inside]] - self.resolution / 2, 0.0)
+        out[inside] = np.maximum(self.dist_at(self.squares[row[inside], col[inside]])
+                                 - self.resolution / 2, 0.0)
         return out
 
     def _cell_of(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray,
@@ -563,7 +578,7 @@ class Clearance:
         res, (ox, oy) = self.resolution, self.origin
         col = np.floor((pts[:, 0] - ox) / res).astype(np.int64)
         row = np.floor((pts[:, 1] - oy) / res).astype(np.int64)
-        rows, cols = self.dist.shape
+        rows, cols = self.squares.shape
         inside = (row >= 0) & (row < rows) & (col >= 0) & (col < cols)
         return pts, row, col, inside
 
@@ -997,7 +1012,7 @@ def _least(field: Clearance, xy: np.ndarray, t: np.ndarray, src: np.ndarray,
     of the nodes ``xy [R, C, 2]``; ``src`` broadcast against ``dst``), sampled at ``t`` (see
     :func:`_edges_from`), ``dst``'s shape."""
     res, (ox, oy) = field.resolution, field.origin
-    rows_n, cols_n = field.dist.shape
+    rows_n, cols_n = field.squares.shape
     xs, ys = xy[..., 0].reshape(-1), xy[..., 1].reshape(-1)
     ax, ay, tt = xs[src], ys[src], t.reshape((-1,) + (1,) * dst.ndim)
     x = ax + tt * (xs[dst] - ax)                                         # [T, *dst.shape]
@@ -1007,7 +1022,8 @@ def _least(field: Clearance, xy: np.ndarray, t: np.ndarray, src: np.ndarray,
     if col.min() >= 0 and col.max() < cols_n and row.min() >= 0 and row.max() < rows_n:
         row *= cols_n
         row += col
-        least = np.minimum.reduce(field.dist.reshape(-1)[row], axis=0) - res / 2
+        least = field.dist_at(np.minimum.reduce(field.squares.reshape(-1)[row], axis=0)) \
+            - res / 2
         return np.maximum(least, 0.0)
     cells = field.cells(np.stack([x.reshape(-1), y.reshape(-1)], axis=1)).reshape(x.shape)
     return np.minimum.reduce(cells, axis=0)
@@ -1059,7 +1075,7 @@ def _planned_on(grid: Grid, cap: float, k: int):
     t = _samples(field, xy)
     edge = np.full((len(MOVES), *xy.shape[:2]), -np.inf)
     _edges_from(edge, field, xy, t, MOVES, (0, xy.shape[0]), (0, xy.shape[1]))
-    for a in (field.dist, *nodes, edge):
+    for a in (field.squares, *nodes, edge):
         a.flags.writeable = False
     return field, nodes, edge, len(t)
 
@@ -1093,7 +1109,7 @@ def _prepared(grid: Grid, occ: np.ndarray, cap: float, k: int, keep: bool = True
     the cells ``occ`` (the grid's own, or a robot's map of it): from the grid's own, or from
     what was worked out for the same robot's map ``last`` time (kept there again), worked
     out again only where the cells that differ can reach. The capped field at a cell depends
-    on the cells within ``n`` cells of it each way (:func:`.distance._capped`), a node on its
+    on the cells within ``n`` cells of it each way (:func:`.distance._capped_squares`), a node on its
     block's field, a step's clearance on its two nodes and the cells between them (which lie
     in the two nodes' blocks and, a diagonal step's, the two beside both): the rest keeps its
     bits."""
@@ -1159,20 +1175,20 @@ def _patched(grid: Grid, occ: np.ndarray, base_occ: np.ndarray, cap: float, k: i
     e0, e1 = max(int(changed_cols[0]) - n, 0), min(int(changed_cols[-1]) + 1 + n, cols)
     f0, f1 = max(d0 - n, 0), min(d1 + n, rows)
     g0, g1 = max(e0 - n, 0), min(e1 + n, cols)
-    part = np.sqrt(_capped(occ[f0:f1, g0:g1], n, (d0 - f0, d1 - f0, e0 - g0, e1 - g0))) * res
-    moved = part != base_field.dist[d0:d1, e0:e1]
+    part = _capped_squares(occ[f0:f1, g0:g1], n, (d0 - f0, d1 - f0, e0 - g0, e1 - g0))
+    moved = part != base_field.squares[d0:d1, e0:e1]
     moved_rows = np.flatnonzero(np.logical_or.reduce(moved, axis=1))
     if not len(moved_rows):                     # no cell's distance changed: nor anything else
         return base_field, base_nodes, base_edge, samples
     moved_cols = np.flatnonzero(np.logical_or.reduce(moved, axis=0))
-    dist = base_field.dist.copy()
-    dist[d0:d1, e0:e1] = part
-    field = Clearance(dist, res, grid.origin)
+    squares = base_field.squares.copy()
+    squares[d0:d1, e0:e1] = part
+    field = Clearance(squares, res, grid.origin)
     # the nodes of the blocks that hold a cell whose distance changed
     b0, b1 = (d0 + int(moved_rows[0])) // k, -(-(d0 + int(moved_rows[-1]) + 1) // k)
     c0, c1 = (e0 + int(moved_cols[0])) // k, -(-(e0 + int(moved_cols[-1]) + 1) // k)
     fr, fc, node_d = (a.copy() for a in base_nodes)
-    sub = _nodes(dist[b0 * k:b1 * k, c0 * k:c1 * k], k)
+    sub = _nodes(field.dist_at(squares[b0 * k:b1 * k, c0 * k:c1 * k]), k)
     fr[b0:b1, c0:c1] = sub[0] + b0 * k
     fc[b0:b1, c0:c1] = sub[1] + c0 * k
     node_d[b0:b1, c0:c1] = sub[2]
