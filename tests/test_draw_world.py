@@ -101,3 +101,29 @@ def test_a_dollar_in_a_worlds_name_is_drawn_as_written(tmp_path, monkeypatch, ca
         main(["simulate", "w.yaml", *args])
     assert exc.value.code == 0, capsys.readouterr().err
     assert (tmp_path / args[-1]).stat().st_size > 0
+
+
+def test_a_large_map_is_drawn_in_blocks_that_keep_every_occupied_cell():
+    """A 4,000 x 4,000 map's cells were colour-mapped and resampled one by one (4 s and 700 MB
+    of a picture a few thousand pixels wide); a map of more than DRAWN_CELLS along a side is
+    drawn in blocks, grey where any of its cells is occupied, each block where its cells are."""
+    pytest.importorskip("matplotlib")
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import numpy as np
+
+    from mitos_cli.draw.world import DRAWN_CELLS, draw_grid
+    from mitos_cli.sim.world import Grid
+
+    cells = np.zeros((DRAWN_CELLS + 1, 30), dtype=bool)
+    cells[DRAWN_CELLS, 7] = True                      # one cell in the last, partial block
+    fig, ax = plt.subplots()
+    draw_grid(ax, Grid(cells, 2.0, (-5.0, 1.0)))
+    image = ax.get_images()[0]
+    drawn = np.asarray(image.get_array())
+    assert drawn.shape == (DRAWN_CELLS // 2 + 1, 15)          # blocks of 2 x 2 cells
+    assert (drawn < 1.0).sum() == 1 and drawn[-1, 3] < 1.0    # the occupied cell's block
+    assert image.get_extent() == [-5.0, -5.0 + 30 * 2.0, 1.0, 1.0 + (DRAWN_CELLS + 2) * 2.0]
+    plt.close(fig)

@@ -8,6 +8,7 @@ from __future__ import annotations
 import numpy as np
 
 from .output import _matplotlib, literal_text, new_figure
+from .world import draw_grid
 
 ROBOT_COLOUR = "#1f5fbf"     # the footprint (a test looks for this colour in the frames)
 TRAIL_COLOUR = "#2ca02c"
@@ -96,12 +97,7 @@ def draw_background(ax, world, static, routes) -> None:
     from matplotlib.patches import Circle, Polygon
 
     if static.grid is not None:
-        g = static.grid
-        rows, cols = g.occupied.shape
-        ax.imshow(np.where(g.occupied, 0.55, 1.0), origin="lower", cmap="gray", vmin=0,
-                  vmax=1, extent=(g.origin[0], g.origin[0] + cols * g.resolution,
-                                  g.origin[1], g.origin[1] + rows * g.resolution),
-                  interpolation="nearest")
+        draw_grid(ax, static.grid)
     for corners in static.rects:
         ax.add_patch(Polygon(corners, closed=True, facecolor="white", edgecolor="none"))
     ax.add_collection(LineCollection(static.walls.reshape(-1, 2, 2), colors="black",
