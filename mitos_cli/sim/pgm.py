@@ -42,9 +42,9 @@ def _header(data: bytes, count: int) -> tuple[list[int], int]:
     return values, i + 1
 
 
-#: the most pixels a map image may have (8,000 x 8,000, far beyond any building): the simulator
-#: keeps about 100 bytes for each, and a 114 KB PNG of 10,000 x 9,500 pixels took 9.7 GB and
-#: over a minute before its first tick
+#: the most pixels a map image may have (8,000 x 8,000, far beyond any building): a run peaks at
+#: about 50 bytes for each (it was 100 when a 114 KB PNG of 10,000 x 9,500 pixels took 9.7 GB
+#: and over a minute before its first tick)
 MAX_PIXELS = 8000 * 8000
 
 
