@@ -80,7 +80,7 @@ def test_a_large_map_is_stepped_in_smaller_batches_with_the_same_bits(monkeypatc
                                 time_limit=1.0)
     assert lockstep.batch_for(world) == lockstep.BATCH        # 600 x 600: a full batch
     big = dataclasses.replace(world.grid, occupied=np.zeros((4000, 4000), dtype=bool))
-    assert lockstep.batch_for(dataclasses.replace(world, grid=big)) == 4
+    assert lockstep.batch_for(dataclasses.replace(world, grid=big)) == 6
     monkeypatch.setattr(lockstep, "MAP_MEMORY", 2 * 360_000 * lockstep.CELL_BYTES)
     assert lockstep.batch_for(world) == 2
     planner, scene = FuzzyPlanner(None, world.behavior), prepare(world)

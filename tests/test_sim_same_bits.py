@@ -371,9 +371,9 @@ def test_steps_clearance_from_their_least_distance_is_the_least_of_their_samples
         if k % 4 == 0:          # samples off the field (a field smaller than the nodes' grid)
             field = route.Clearance(field.squares[:-2, :-3], field.resolution, field.origin)
         t = route._samples(field, xy)
-        got = np.full((len(route.MOVES), *xy.shape[:2]), -np.inf)
+        got = route._no_steps(field, xy)            # kept as squares, read as inches
         route._edges_from(got, field, xy, t, route.MOVES, (0, xy.shape[0]), (0, xy.shape[1]))
-        assert same(got, steps_clearance_sample_by_sample(field, xy, t))
+        assert same(route.step_rooms(field, got), steps_clearance_sample_by_sample(field, xy, t))
 
 
 def test_the_steps_clearance_of_a_block_of_nodes_is_that_block_of_the_whole():
@@ -389,14 +389,15 @@ def test_the_steps_clearance_of_a_block_of_nodes_is_that_block_of_the_whole():
         R, C = xy.shape[:2]
         r0, c0 = int(rng.integers(-1, R)), int(rng.integers(-1, C))
         r1, c1 = int(rng.integers(r0 + 1, R + 2)), int(rng.integers(c0 + 1, C + 2))
-        got = np.full((len(route.MOVES), R, C), 7.0)        # what is not measured stays
+        kind = field.squares.dtype
+        got = np.full((len(route.MOVES), R, C), 7, dtype=kind)   # what is not measured stays
         route._edges_from(got, field, xy, t, route.MOVES, (r0, r1), (c0, c1))
         want = steps_clearance_sample_by_sample(field, xy, t)
         inside = np.zeros((R, C), dtype=bool)
         inside[max(r0, 0):r1, max(c0, 0):c1] = True
-        want[:, ~inside] = 7.0
-        want[np.isneginf(want)] = 7.0                       # steps off the grid
-        assert same(got, want)
+        stays = ~inside[None] | np.isneginf(want)            # (steps off the grid too)
+        assert (got[stays] == 7).all()
+        assert same(route.step_rooms(field, got)[~stays], want[~stays])
 
 
 def test_a_part_of_the_capped_distances_is_that_part_of_the_whole():
@@ -487,7 +488,7 @@ def test_a_field_kept_as_squares_reads_the_distances_it_held(seed, cap):
     c = np.floor((x - origin[0]) / res).astype(np.int64)
     r = np.floor((y - origin[1]) / res).astype(np.int64)
     least = np.maximum(dist[r, c].min(axis=0) - res / 2, 0.0)
-    assert same(route._least(field, xy, t, src, dst), least)
+    assert same(route.step_rooms(field, route._least(field, xy, t, src, dst)), least)
 
 
 def _widest_way_by_scalars(free_c, s, t, edge=None):

@@ -834,8 +834,9 @@ def grid_route(static: StaticMap, start: Pose, goal: Goal, clearance: float,
     k = max(1, int(round(cell / g.resolution)))
     rows, cols = occ.shape
     R, C = -(-rows // k), -(-cols // k)
-    field, (fr, fc, node_c), edge = _prepared(g, occ, reach + 2 * g.resolution, k, keep,
+    field, (fr, fc, node_c), kept = _prepared(g, occ, reach + 2 * g.resolution, k, keep,
                                                last)
+    edge = step_rooms(field, kept)                             # clearance of each step (in)
     node_c = node_c - g.resolution / 2                         # clearance at each node (in)
     size = k * g.resolution
 
@@ -1001,14 +1002,15 @@ def _edges_from(out: np.ndarray, field: Clearance, xy: np.ndarray, t: np.ndarray
     nodes in ``rows`` x ``cols`` (half-open ranges of node rows and columns) to its neighbour
     in each move, sampled at ``t`` along it and measured as the nodes are
     (:meth:`Clearance.cells`); each step's clearance is its own samples' alone, so any part
-    gives the bits of the whole. Steps off the grid are left as they are (``-inf``).
+    gives the bits of the whole, as the least square of its samples (:func:`_least`). Steps off
+    the grid are left as they are (:func:`_no_steps`).
 
     A sample's clearance, ``max(dist - res / 2, 0)``, never falls as ``dist`` grows (nor
     does a rounded subtraction), so the smallest is that of the smallest ``dist``: one
-    subtraction a step, not one a sample. Every move's samples are worked out at once, the
-    samples outermost (long inner loops), a step off the grid as a step to the node itself
-    (and left out). Samples lie between two nodes, inside the grid (one that does not sends
-    the steps to :meth:`Clearance.cells`)."""
+    subtraction a step, and none until a search reads it (:func:`step_rooms`). Every move's
+    samples are worked out at once, the samples outermost (long inner loops), a step off the
+    grid as a step to the node itself (and left out). A sample off the field counts a square
+    of 0, as :meth:`Clearance.cells` reads its clearance 0."""
     R, C = xy.shape[:2]
     r0, r1 = max(rows[0], 0), min(rows[1], R)
     c0, c1 = max(cols[0], 0), min(cols[1], C)
@@ -1033,7 +1035,9 @@ def _least(field: Clearance, xy: np.ndarray, t: np.ndarray, src: np.ndarray,
            dst: np.ndarray) -> np.ndarray:
     """The smallest clearance on each step from node ``src`` to node ``dst`` (flat indices
     of the nodes ``xy [R, C, 2]``; ``src`` broadcast against ``dst``), sampled at ``t`` (see
-    :func:`_edges_from`), ``dst``'s shape."""
+    :func:`_edges_from`), ``dst``'s shape: as the least square of its samples (0 for one off
+    the field, whose clearance :meth:`Clearance.cells` reads 0), which :func:`step_rooms`
+    reads as inches."""
     res, (ox, oy) = field.resolution, field.origin
     rows_n, cols_n = field.squares.shape
     xs, ys = xy[..., 0].reshape(-1), xy[..., 1].reshape(-1)
@@ -1045,11 +1049,34 @@ def _least(field: Clearance, xy: np.ndarray, t: np.ndarray, src: np.ndarray,
     if col.min() >= 0 and col.max() < cols_n and row.min() >= 0 and row.max() < rows_n:
         row *= cols_n
         row += col
-        least = field.dist_at(np.minimum.reduce(field.squares.reshape(-1)[row], axis=0)) \
-            - res / 2
-        return np.maximum(least, 0.0)
-    cells = field.cells(np.stack([x.reshape(-1), y.reshape(-1)], axis=1)).reshape(x.shape)
-    return np.minimum.reduce(cells, axis=0)
+        return np.minimum.reduce(field.squares.reshape(-1)[row], axis=0)
+    inside = (row >= 0) & (row < rows_n) & (col >= 0) & (col < cols_n)
+    squares = np.zeros(row.shape, dtype=field.squares.dtype)
+    squares[inside] = field.squares[row[inside], col[inside]]
+    return np.minimum.reduce(squares, axis=0)
+
+
+def _off_grid(kind: np.dtype) -> int | float:
+    """What a kept step off the grid holds: a square no step has (the largest integer of a
+    capped field's squares, which stay below ``(cap + 1)**2``; ``-inf`` for float ones)."""
+    return int(np.iinfo(kind).max) if kind.kind in "iu" else -math.inf
+
+
+def _no_steps(field: Clearance, xy: np.ndarray) -> np.ndarray:
+    """``[len(MOVES), R, C]`` of steps not yet measured: every one off the grid."""
+    kind = field.squares.dtype
+    return np.full((len(MOVES), *xy.shape[:2]), _off_grid(kind), dtype=kind)
+
+
+def step_rooms(field: Clearance, kept: np.ndarray) -> np.ndarray:
+    """The clearance (in) of each step whose least square ``kept`` holds (:func:`_least`):
+    ``max(distance - res / 2, 0)``, as :meth:`Clearance.cells` reads a sample (it never
+    falls as the square grows, so the step's least), ``-inf`` off the grid. Kept as squares,
+    the steps take a quarter of the memory; read as inches where a search needs them."""
+    off = kept == _off_grid(kept.dtype)
+    room = np.maximum(field.dist_at(np.where(off, 0, kept)) - field.resolution / 2, 0.0)
+    room[off] = -np.inf
+    return room
 
 
 def _edges_near(out: np.ndarray, field: Clearance, xy: np.ndarray, t: np.ndarray,
@@ -1096,7 +1123,7 @@ def _planned_on(grid: Grid, cap: float, k: int):
     nodes = _nodes(field.dist, k)
     xy = _node_xy(grid, nodes)
     t = _samples(field, xy)
-    edge = np.full((len(MOVES), *xy.shape[:2]), -np.inf)
+    edge = _no_steps(field, xy)
     _edges_from(edge, field, xy, t, MOVES, (0, xy.shape[0]), (0, xy.shape[1]))
     for a in (field.squares, *nodes, edge):
         a.flags.writeable = False
@@ -1122,7 +1149,7 @@ class Prepared:
     occ: np.ndarray | None = None  # a copy of the cells
     field: Clearance | None = None
     nodes: tuple = ()
-    edge: np.ndarray | None = None
+    edge: np.ndarray | None = None  # each step's least square (read by step_rooms)
     samples: int = 0
 
 
@@ -1148,7 +1175,7 @@ def _prepared(grid: Grid, occ: np.ndarray, cap: float, k: int, keep: bool = True
         field = Clearance.of(occ, res, grid.origin, cap=cap)      # no shortcut applies
         nodes = _nodes(field.dist, k)
         xy = _node_xy(grid, nodes)
-        edge = np.full((len(MOVES), *xy.shape[:2]), -np.inf)
+        edge = _no_steps(field, xy)
         t = _samples(field, xy)
         _edges_from(edge, field, xy, t, MOVES, (0, xy.shape[0]), (0, xy.shape[1]))
         out = field, nodes, edge, len(t)
