@@ -145,6 +145,29 @@ def test_a_robot_still_driving_when_another_is_stuck_reads_stopped(rear_end):
     assert sim.time < STUCK_TIME + 1
 
 
+def test_a_robot_parked_at_its_goal_that_a_cart_drives_into_has_collided(rear_end):
+    """`robot` parks at its goal after 1.6 s; a cart from behind drives into it at 3.8 s
+    while `second` still drives. The run read a timeout with no collision, the cart 19 in
+    deep in the parked robot and `near_miss` true ("without colliding")."""
+    from mitos_cli.sim.lockstep import run_lockstep
+
+    text = rear_end.read_text().replace("time_limit: 5", "time_limit: 8").replace(
+        "{name: ram, shape: rectangle, at: [-150, 185], length: 20, width: 20, "
+        "velocity: [120, 0]}",
+        "{name: cart, shape: rectangle, at: [300, -15], length: 20, width: 20, "
+        "velocity: [60, 0]}")
+    world = parse_world(text, "parked.yaml")
+    res = simulate(world)
+    data = res.summary()
+    assert res.robot_outcomes == ("collision", "stopped") and data["outcome"] == "collision"
+    assert data["collisions"] == 1 and data["near_miss"] is False
+    assert res.active[-1].tolist() == [False, True]          # parked, hit, the run ends
+    assert res.clearance[-1, 0] <= 0 < res.clearance[:-1, 0].min()
+    assert 3.0 < data["time_s"] < 4.0
+    (together,) = run_lockstep(world, None, [world.seed])       # the same rule in lockstep
+    assert together.summary() == data
+
+
 def _write(path: Path, text: str) -> Path:
     out = path.with_name("variant.yaml")
     out.write_text(text, encoding="utf-8")

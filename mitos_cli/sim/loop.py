@@ -956,7 +956,8 @@ class Simulation:
                             waiting=rmap.refuge is not None)
 
     def check(self, s: _Sensed) -> None:
-        """Contact (clearance <= 0) and arrival; an arrived robot stops driving."""
+        """Contact (clearance <= 0, of a robot parked at its goal too) and arrival; an
+        arrived robot stops driving."""
         active = self._active
         self._hit, arrived = _arrivals(active, s.clearance, self._x, self._y, self._goal_x,
                                        self._goal_y, self._tol)
@@ -1218,9 +1219,12 @@ def _news(ranges: np.ndarray, expected: np.ndarray | None, far: float,
 def _arrivals(active: np.ndarray, clearance: np.ndarray, x: np.ndarray, y: np.ndarray,
               goal_x: np.ndarray, goal_y: np.ndarray, tol: np.ndarray
               ) -> tuple[np.ndarray, np.ndarray]:
-    """Which driving robots touch something (clearance 0 or less) and which are at their
-    goals: one rule for a run alone and for runs in lockstep."""
-    return (active & (clearance <= 0.0),
+    """Which robots touch something (clearance 0 or less) and which driving robots are at
+    their goals: one rule for a run alone and for runs in lockstep. A robot parked at its
+    goal counts too: a cart or another robot that drives into it has collided with it (only
+    the driving robots counted, a cart drove 15 in deep into a parked robot and the run read
+    a success without a collision)."""
+    return (clearance <= 0.0,
             active & (np.hypot(x - goal_x, y - goal_y) <= tol))
 
 
