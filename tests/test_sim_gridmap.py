@@ -178,8 +178,33 @@ def test_a_png_map_reads_as_the_same_pgm(tmp_path):
     png = load_map_yaml(_map(tmp_path, "m.png"))
     pgm = load_map_yaml(_map(tmp_path, "m.pgm"))
     assert png.occupied.tolist() == pgm.occupied.tolist()
-    Image.fromarray(np.stack([px] * 3, axis=-1)).convert("RGBA").save(tmp_path / "c.png")
+    Image.fromarray(np.stack([px] * 3, axis=-1)).save(tmp_path / "c.png")
     assert load_map_yaml(_map(tmp_path, "c.png")).occupied.tolist() == pgm.occupied.tolist()
+
+
+def test_a_colour_map_reads_as_the_mean_of_its_channels_as_map_server_does(tmp_path):
+    """map_server averages a pixel's channels: yellow (255, 255, 0) is 170, occupancy 0.33,
+    unknown; green (0, 255, 0) is 85, occupancy 0.67, a wall. Read as luminance (226 and
+    150), yellow was free and green unknown: free space with `unknown: free`."""
+    Image = pytest.importorskip("PIL.Image")
+    px = np.array([[[255, 255, 0], [0, 255, 0], [254, 254, 254]]], dtype=np.uint8)
+    Image.fromarray(px, "RGB").save(tmp_path / "c.png")
+    assert load_map_yaml(_map(tmp_path, "c.png")).occupied.tolist() == [[True, True, False]]
+    lenient = load_map_yaml(_map(tmp_path, "c.png"), unknown_occupied=False)
+    assert lenient.occupied.tolist() == [[False, True, False]]
+
+
+def test_an_alpha_channel_is_averaged_in_in_trinary_mode_as_map_server_does(tmp_path):
+    """map_server's trinary mode averages alpha in with the colours ("to preserve existing
+    behavior"): an opaque grey 205 (unknown in a grey image) is (3 x 205 + 255) / 4 = 217.5,
+    occupancy 0.15, free; black stays a wall. Scale mode leaves alpha out."""
+    Image = pytest.importorskip("PIL.Image")
+    grey = np.array([[205, 0, 254]], dtype=np.uint8)
+    Image.fromarray(np.stack([grey] * 3, axis=-1)).convert("RGBA").save(tmp_path / "c.png")
+    assert load_map_yaml(_map(tmp_path, "c.png")).occupied.tolist() == [[False, True, False]]
+    scale = _map(tmp_path, "c.png")
+    scale.write_text(scale.read_text() + "mode: scale\n", encoding="utf-8")
+    assert load_map_yaml(scale).occupied.tolist() == [[True, True, False]]
 
 
 def test_without_pillow_a_png_is_refused_with_what_to_install(tmp_path, monkeypatch):

@@ -9,9 +9,10 @@ maps often draw walls in unknown grey. Image rows run top to bottom, so they are
 row 0 at the bottom. Metres become inches.
 
 The image is a PGM (read here, no dependency) or anything Pillow reads (PNG, BMP, TIFF, ...;
-Pillow is the optional extra ``mitos[maps]``, which matplotlib already brings): colour images
-are read as luminance, an alpha channel is ignored, as map_server does in its default
-``trinary`` mode; ``mode: raw`` reads pixel values as occupancy percentages (:data:`MODES`).
+Pillow is the optional extra ``mitos[maps]``, which matplotlib already brings): a colour
+pixel is the mean of its channels, as map_server reads it (:func:`shade`; an alpha channel
+averaged in with the colours in the default ``trinary`` mode, as map_server does);
+``mode: raw`` reads pixel values as occupancy percentages (:data:`MODES`).
 An origin with a yaw rotates the map about its origin: the grid the simulator keeps is
 axis-aligned, so a rotated map is resampled (nearest cell, same resolution) onto the
 axis-aligned cells covering it; a quarter, half or three-quarter turn is exact (no
@@ -116,8 +117,24 @@ def _negate(spec: yamlpos.YMap) -> bool:
                      hint="write `negate: 0` (dark pixels are walls) or `negate: 1`, unquoted")
 
 
+def shade(pixels: np.ndarray, mode: str = "trinary") -> np.ndarray:
+    """Each pixel's value ``[rows, cols]`` as map_server reads it: a grey image's as it is, a
+    colour image's (``[rows, cols, channels]``, red, green, blue and alpha) the mean of its
+    channels, alpha included in ``trinary`` mode and left out in the others (ROS 1's
+    ``image_loader.cpp`` and ROS 2's ``map_io.cpp`` alike). Luminance, as read before, took
+    a yellow pixel (occupancy 0.33 there, unknown) for free and a green one (0.67, a wall)
+    for unknown."""
+    if pixels.ndim == 2:
+        return pixels
+    if mode != "trinary" and pixels.shape[-1] == 4:
+        pixels = pixels[..., :3]
+    return pixels.mean(axis=-1)
+
+
 def read_image(path: Path) -> tuple[np.ndarray, int]:
-    """Pixels ``[rows, cols]`` (top row first) and the maximum value of a map image."""
+    """Pixels ``[rows, cols]`` (top row first) of a grey map image, ``[rows, cols, channels]``
+    of a colour one (red, green, blue, and alpha where it has one: :func:`shade` averages
+    them), and the maximum value."""
     if exists(path) and not path.is_file():     # /dev/zero, a FIFO: would read without end
         raise ValueError("it is not a regular file")
     if path.suffix.lower() in (".pgm", ".pnm"):
@@ -136,7 +153,10 @@ def read_image(path: Path) -> tuple[np.ndarray, int]:
             if im.mode in ("I;16", "I;16B", "I;16L", "I"):
                 px = np.asarray(im, dtype=np.int64)
                 return px.clip(0, 65535).astype(np.uint16), 65535
-            return np.asarray(im.convert("L"), dtype=np.uint16), 255
+            if im.mode in ("1", "L"):
+                return np.asarray(im.convert("L"), dtype=np.uint16), 255
+            alpha = "A" in im.getbands() or "transparency" in im.info
+            return np.asarray(im.convert("RGBA" if alpha else "RGB"), dtype=np.uint16), 255
     except UnidentifiedImageError:
         raise ValueError("Pillow does not recognise it as an image") from None
     except Image.DecompressionBombError as exc:
@@ -283,7 +303,7 @@ def load_map_yaml(path: Path, *, unknown_occupied: bool = True,
         raise WorldError(f"cannot read map image `{image_path}`: {exc}",
                          span=spec.value_span("image"),
                          hint="give a PGM (P5 or P2) or an image Pillow reads (PNG)") from None
-    blocked = classify(pixels, maxval, negate=negate, occupied_thresh=occ_t,
+    blocked = classify(shade(pixels, mode), maxval, negate=negate, occupied_thresh=occ_t,
                        free_thresh=free_t, unknown_occupied=unknown_occupied, mode=mode)
     _check_extent(spec, (ox, oy), res_m, blocked.shape)
     res, origin = res_m * INCH_PER_M, (ox * INCH_PER_M, oy * INCH_PER_M)
