@@ -382,6 +382,31 @@ def test_a_randomise_range_that_reaches_a_start_or_goal_is_refused(jitter, what)
     assert "w.yaml:19:10" in msg and f"randomise can move obstacle `box` over the {what}" in msg
 
 
+@pytest.mark.parametrize("obstacle, jitter, refused", [
+    # the body spans x 18..42, y -9..9; none of these reaches the start point (30, 0)
+    ("{name: box, shape: circle, at: [150, 5], radius: 9}", "{dx: [-100, -98]}", True),
+    ("{name: box, shape: circle, at: [150, 5], radius: 9}", "{dx: [-99, -97]}", False),
+    ("{name: box, shape: rectangle, at: [150, 20], length: 20, width: 10}",
+     "{dx: [-120, -118], dy: [-8, -8]}", True),
+    ("{name: box, shape: rectangle, at: [150, 22], length: 20, width: 10, angle: 10}",
+     "{dx: [-120, -118], dy: [-8, -8]}", True),
+    ("{name: box, shape: rectangle, at: [150, 22], length: 20, width: 10}",
+     "{dx: [-120, -118], dy: [-8, -8]}", False),                    # 1 in to spare
+])
+def test_a_randomise_range_that_reaches_the_body_at_the_start_is_refused(obstacle, jitter,
+                                                                         refused):
+    """Only the start point was tested: a draw over the robot's nose began every run of it in
+    a collision at its first tick, counted against the planner (`--runs 3`: 100% collision,
+    path 0), where the same obstacle written there is refused."""
+    text = BASE + f"obstacles:\n  - {obstacle}\nrandomise:\n  obstacles:\n    box: {jitter}\n"
+    if not refused:
+        assert parse_world(text, "w.yaml")
+        return
+    msg = error(text)
+    assert "w.yaml:19:10" in msg and "randomise can move obstacle `box` over the start " \
+        "(q_init) at (30, 0): into the robot's body (24 x 18 in) there" in msg
+
+
 def test_a_moving_obstacle_may_start_over_the_goal_it_leaves():
     text = (BASE + "obstacles:\n  - {name: cart, shape: circle, at: [330, 0], radius: 9, "
             "velocity: [-10, 0]}\nrandomise:\n  obstacles:\n    cart: {dx: [-40, 0]}\n")

@@ -915,9 +915,10 @@ def check_starts(world: World, spans: list[Span]) -> None:
 
 
 def check_jitters(world: World, written: YMap) -> None:
-    """Refuse a `randomise` range that can move an obstacle over a start or a goal: every run
-    drawn there would end at its first tick or never reach its goal (``written``: the
-    `randomise: obstacles:` mapping, for the positions)."""
+    """Refuse a `randomise` range that can move an obstacle into a robot's body at its start
+    or over a goal: every run drawn there would end at its first tick (a collision charged to
+    the planner) or never reach its goal (``written``: the `randomise: obstacles:` mapping,
+    for the positions)."""
     import numpy as np
 
     obstacles = {o.name: o for o in world.obstacles}
@@ -928,17 +929,72 @@ def check_jitters(world: World, written: YMap) -> None:
             ends = (("start (q_init)", agent.start),) + (
                 (("goal (q_goal)", agent.goal),) if o.motion.kind == "static" else ())
             for what, p in ends:
-                # the obstacle reaches p for some offset (dx, dy) in the ranges exactly when
-                # it meets the box of the points p - (dx, dy)
-                lo = np.array([p.x - j.dx[1], p.y - j.dy[1]])
-                hi = np.array([p.x - j.dx[0], p.y - j.dy[0]])
-                hl, hw = (hi - lo) / 2
-                if _box_meets(float(hl), float(hw), (lo + hi) / 2, 0.0, o, (o.x, o.y)):
+                if what.startswith("start"):
+                    meets = _jitter_reaches_body(agent, o, j)
+                    body = (f": into the robot's body ({agent.robot.length:g} x "
+                            f"{agent.robot.width:g} in) there")
+                else:
+                    # the obstacle reaches p for some offset (dx, dy) in the ranges exactly
+                    # when it meets the box of the points p - (dx, dy)
+                    lo = np.array([p.x - j.dx[1], p.y - j.dy[1]])
+                    hi = np.array([p.x - j.dx[0], p.y - j.dy[0]])
+                    hl, hw = (hi - lo) / 2
+                    meets = _box_meets(float(hl), float(hw), (lo + hi) / 2, 0.0, o, (o.x, o.y))
+                    body = ""
+                if meets:
                     raise WorldError(
                         f"randomise can move obstacle `{o.name}` over the {what}"
-                        f"{_who(agent)} at ({p.x:g}, {p.y:g}) (dx {_range(j.dx)}, "
+                        f"{_who(agent)} at ({p.x:g}, {p.y:g}){body} (dx {_range(j.dx)}, "
                         f"dy {_range(j.dy)} in)", span=written.value_span(o.name),
                         hint="narrow its dx and dy, or move the obstacle")
+
+
+def _jitter_reaches_body(agent, o, j) -> bool:
+    """Whether obstacle ``o``, moved by an offset within jitter ``j``, reaches into
+    ``agent``'s body at its start (touching is not reaching in): the body moved back by
+    every offset (its footprint swept over the offsets' box) meets the obstacle where it
+    stands. Only the start point was tested: a draw over the body's nose, not its centre,
+    began every run of it in a collision."""
+    import math
+
+    import numpy as np
+
+    from .geometry import box_polygon_depth, point_segment_distance, polygon_segments
+
+    offsets = np.array([[dx, dy] for dx in j.dx for dy in j.dy])
+    swept = _hull((_body_corners(agent)[:, None, :] - offsets[None]).reshape(-1, 2))
+    if o.shape == "circle":
+        centre = np.array([[o.x, o.y]])
+        gap = float(point_segment_distance(centre, polygon_segments(swept[None])).min())
+        edges = np.roll(swept, -1, axis=0) - swept
+        to = centre - swept
+        inside = bool((edges[:, 0] * to[:, 1] - edges[:, 1] * to[:, 0] > 0).all())
+        return inside or gap < o.radius
+    a = math.radians(o.angle)
+    c, s = math.cos(a), math.sin(a)
+    local = (swept - [o.x, o.y]) @ np.array([[c, -s], [s, c]])       # into its frame
+    return bool(box_polygon_depth(o.length / 2, o.width / 2, local[None])[0] > 0.0)
+
+
+def _hull(points) -> np.ndarray:
+    """The convex hull ``[k, 2]`` of ``points [P, 2]``, counter-clockwise (Andrew's monotone
+    chain)."""
+    import numpy as np
+
+    pts = sorted(set(map(tuple, np.asarray(points, float).tolist())))
+    if len(pts) < 3:
+        return np.array(pts, float).reshape(-1, 2)
+
+    def half(seq: list) -> list:
+        out: list = []
+        for p in seq:
+            while len(out) >= 2 and ((out[-1][0] - out[-2][0]) * (p[1] - out[-2][1])
+                                     - (out[-1][1] - out[-2][1]) * (p[0] - out[-2][0])) <= 0:
+                out.pop()
+            out.append(p)
+        return out
+
+    return np.array(half(pts)[:-1] + half(pts[::-1])[:-1], float)
 
 
 def _range(r: tuple[float, float]) -> str:
