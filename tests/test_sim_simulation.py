@@ -367,3 +367,16 @@ def test_a_command_that_is_not_numbers_is_a_command_error(command, says):
     with pytest.raises(CommandError, match="must be numbers, not bools"):    # read as 1.0
         sim.step([[True, 30.0]])
     assert sim.ticks == 0
+
+
+@pytest.mark.parametrize("written", [720.0, -1080.0, 360.0])
+def test_a_start_heading_past_a_half_turn_is_recorded_within_it(written):
+    """A start written as 720 deg was recorded as 720 at tick 0 (`--out`'s pose_heading_deg,
+    `--trace`, the Gymnasium pose) and as 0 from tick 1 on. It is the run of heading 0."""
+    world = short("corridor.yaml", 1.0)
+    agent = world.agents[0]
+    turned = world.with_changes(agents=(dataclasses.replace(
+        agent, start=dataclasses.replace(agent.start, heading=written)),))
+    sim = Simulation(turned, seed=1)
+    assert sim.pose[0, 2] == 0.0 and str(sim.pose[0, 2]) == "0.0"
+    same_run(simulate(turned, seed=1), simulate(world, seed=1))

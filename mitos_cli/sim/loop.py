@@ -416,7 +416,7 @@ class Simulation:
         agents, n = self.world.agents, self.n
         self._x = np.array([a.start.x for a in agents], float)
         self._y = np.array([a.start.y for a in agents], float)
-        self._h = np.deg2rad(np.array([a.start.heading for a in agents], float))
+        self._h = np.deg2rad(np.array([_half_turn(a.start.heading) for a in agents], float))
         self._v = np.zeros(n)
         self._steer = self.limits.straight.copy()
         self._s_hint = np.zeros(n)
@@ -1214,6 +1214,13 @@ def _news(ranges: np.ndarray, expected: np.ndarray | None, far: float,
     if expected is not None:
         seen &= ranges < expected - threshold
     return seen
+
+
+def _half_turn(deg: float) -> float:
+    """A start heading (deg) within ±180, as every later tick's is: a start written as 720
+    was recorded as 720 at tick 0 (`--out`, `--trace`, the Gymnasium pose) and as 0 from tick
+    1 on. One within ±180 is kept as written, to the bit."""
+    return deg if -180.0 <= deg <= 180.0 else math.remainder(deg, 360.0) + 0.0   # (not -0)
 
 
 def _arrivals(active: np.ndarray, clearance: np.ndarray, x: np.ndarray, y: np.ndarray,
