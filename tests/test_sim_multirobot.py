@@ -166,6 +166,13 @@ def test_a_robot_parked_at_its_goal_that_a_cart_drives_into_has_collided(rear_en
     assert 3.0 < data["time_s"] < 4.0
     (together,) = run_lockstep(world, None, [world.seed])       # the same rule in lockstep
     assert together.summary() == data
+    from mitos_cli.sim.export import csv_text
+    from mitos_cli.sim.planner import FuzzyPlanner
+
+    rows = [r for r in csv_text(res, FuzzyPlanner(None, "drive")).splitlines()[1:]
+            if r.split(",")[2] == "robot"]          # its drive, then the tick it was hit
+    last = rows[-1].split(",")
+    assert int(last[0]) == res.ticks - 1 and float(last[10]) <= 0 and last[-1] == ""
 
 
 def _write(path: Path, text: str) -> Path:

@@ -53,13 +53,14 @@ def _num(v: float) -> str:
     """A CSV number: 6 significant digits, and to the hundredth from 10,000 on. At 6 digits a
     robot 2.5 km from the origin (a map's origin far from its corner) was written to the
     inch: its moves of 1-2 in a tick were lost, and the path recomputed from the file came
-    out 1% long."""
+    out 5% long."""
     return f"{v:.6g}" if abs(v) < 1e4 else f"{v:.2f}"
 
 
 def write_csv(result: SimResult, planner, out) -> None:
     """One row per tick and active robot, columns :func:`columns` (``fired``: ``label=DOF``
-    by DOF)."""
+    by DOF), and the last tick's row of a robot something drove into where it stood parked
+    at its goal (its collision; ``fired`` empty: it planned nothing)."""
     n = result.pose.shape[1]
     B = result.ranges.shape[2]
     details = [explain(result, planner, i) for i in range(n)]
@@ -68,7 +69,9 @@ def write_csv(result: SimResult, planner, out) -> None:
     names = [a.name for a in result.world.agents]
     for k in range(result.ticks):
         for i in range(n):
-            if result.active is not None and not result.active[k, i]:
+            driving = result.active is None or bool(result.active[k, i])
+            if not driving and not (k == result.ticks - 1
+                                    and result.robot_outcomes[i] == "collision"):
                 continue
             row = [k, _num(result.t[k]), names[i],
                    *map(_num, result.pose[k, i]),
@@ -78,7 +81,7 @@ def write_csv(result: SimResult, planner, out) -> None:
                    *map(_num, result.ranges[k, i]),
                    *(_num(result.perceived[key][k, i]) for key in INPUTS),
                    *(_num(result.true[key][k, i]) for key in INPUTS),
-                   fired_text(details[i], k) if details[i] is not None else ""]
+                   fired_text(details[i], k) if details[i] is not None and driving else ""]
             w.writerow(row)
 
 
