@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -161,3 +162,15 @@ def test_a_rings_beams_go_round_to_the_left_as_the_csv_columns_say():
     assert np.rad2deg(fan.angles).tolist() == [90, 0, -90]        # left, ahead, right
     readme = (Path(__file__).parent.parent / "worlds" / "README.md").read_text(encoding="utf-8")
     assert "9\nleft, 18 behind, 27 right" in readme or "9 left, 18 behind, 27 right" in readme
+
+
+def test_a_beam_measures_along_its_axis_not_its_cone():
+    """worlds/README.md: a reading is the first thing on the beam's axis, not the nearest in
+    its cone; a pole between two beams' axes (10 deg apart) is seen by neither."""
+    dirs = sensors.beam_directions(0.0, np.deg2rad([0.0, 10.0]))
+    pole = np.array([[50 * math.cos(math.radians(5)), 50 * math.sin(math.radians(5))]])
+    _, seen = sensors.cast(np.zeros(2), dirs, np.zeros((0, 4)), np.zeros((0, 4)), pole,
+                           np.array([1.0]), 150.0)
+    assert seen.tolist() == [150.0, 150.0]
+    readme = (Path(__file__).resolve().parents[1] / "worlds" / "README.md").read_text()
+    assert "Each beam measures along its axis" in readme
