@@ -302,7 +302,7 @@ class MitosEnv(gymnasium.Env):
 
     def _info(self) -> dict:
         sim = self.sim
-        return {"t": round(sim.ticks * sim.dt, 6), "pose": sim.pose[0],
+        return {"t": round(sim.time, 6), "pose": sim.pose[0],
                 "clearance": float(sim.clearance[0]),
                 "outcome": sim.robot_outcomes[0] if sim.done else "driving"}
 

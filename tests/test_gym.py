@@ -146,6 +146,21 @@ def test_a_collision_terminates_with_the_penalty(short_world):
     assert rewards[-1] <= mgym.COLLISION_PENALTY + 1.0
 
 
+def test_the_step_that_ends_an_episode_is_timed_as_every_other(short_world):
+    """`t` is the steps taken times dt on every step: the step that ended an episode (a
+    contact here) read one dt more (1.7 s after 33 steps of 0.05 s), as `mitos simulate`
+    timed the run; both now time it to the tick of the contact."""
+    text = short_world.read_text(encoding="utf-8")
+    short_world.write_text(text.replace("  acceleration: 40", "  acceleration: 40\n  brake: false"),
+                           encoding="utf-8")
+    env = gymnasium.make("mitos/World-v0", world=str(short_world))
+    seen, _, terminated, _, info = drive(env, seed=1, policy=lambda obs: np.array([50.0, 60.0]))
+    steps = len(seen) - 1
+    assert terminated and info["outcome"] == "collision"
+    assert info["t"] == round(steps * 0.05, 6)
+    assert env.unwrapped.sim.result().summary()["time_s"] == info["t"]
+
+
 def test_the_same_seed_gives_the_same_observations_and_another_seed_others(short_world):
     env = gymnasium.make("mitos/World-v0", world=str(short_world), observe_ranges=True)
     a = drive(env, seed=7)[0]

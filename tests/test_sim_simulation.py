@@ -380,3 +380,19 @@ def test_a_start_heading_past_a_half_turn_is_recorded_within_it(written):
     sim = Simulation(turned, seed=1)
     assert sim.pose[0, 2] == 0.0 and str(sim.pose[0, 2]) == "0.0"
     same_run(simulate(turned, seed=1), simulate(world, seed=1))
+
+
+def test_a_run_is_timed_by_the_ticks_it_moved():
+    """A run that ends on what a tick observed (a contact, every robot at its goal) is timed
+    to that tick: figure4's contact, recorded at 14.65 s, read "after 14.70 s" (the ticks
+    recorded times dt). A timeout moved every tick it recorded."""
+    crash = simulate(load_world(packaged_path("worlds", "figure4.yaml")))
+    assert crash.outcome == "collision" and crash.clearance[-1, 0] <= 0
+    assert crash.summary()["time_s"] == round(float(crash.t[-1]), 6) == 14.65
+    home = simulate(load_world(packaged_path("worlds", "corridor.yaml")))
+    assert home.outcome == "success"
+    assert home.summary()["time_s"] == round(float(home.t[-1]), 6) == 17.9
+    assert home.summary()["mean_speed_in_s"] == pytest.approx(
+        home.summary()["path_length_in"] / 17.9)
+    out = simulate(short("corridor.yaml", 1.0))
+    assert out.outcome == "timeout" and out.summary()["time_s"] == 1.0 == out.ticks * 0.05

@@ -390,12 +390,12 @@ def test_a_world_driven_with_another_behavior_than_its_own_says_so(rules):
     after 2 s, not at B; the verdict says which behavior `mitos simulate` drives it with."""
     s, out = session(rules)
     text = say(s, out, "simulate figure4")
-    assert text.startswith("figure4 with behavior avoid_obstacle: collision after 2.2 s")
+    assert text.startswith("figure4 with behavior avoid_obstacle: collision after 2.15 s")
     assert text.endswith("(`mitos simulate` drives figure4 with behavior drive: `use drive` "
                          "to drive it so here)")
     s.run("use drive")
     text = say(s, out, "simulate figure4")
-    assert text.startswith("figure4 with behavior drive: collision after 14.7 s")
+    assert text.startswith("figure4 with behavior drive: collision after 14.65 s")
     assert "mitos simulate" not in text
 
 
@@ -683,7 +683,7 @@ def test_a_resumed_session_can_correct_the_run_it_recorded(tmp_path, monkeypatch
 
 def test_a_resumed_session_says_when_the_run_driven_again_is_another(tmp_path, monkeypatch):
     """The world file edited between the run and `--resume`: the run driven again is another
-    (8.75 s, not 7.7 s), and `at` would correct it without a word; the journal keeps what
+    (8.7 s, not 7.65 s), and `at` would correct it without a word; the journal keeps what
     tells the runs apart, and the resumed session says they differ."""
     monkeypatch.chdir(tmp_path)
     world = tmp_path / "tiny.yaml"
@@ -697,8 +697,8 @@ def test_a_resumed_session_says_when_the_run_driven_again_is_another(tmp_path, m
     world.write_text(world.read_text().replace("at: [150, -12]", "at: [150, 20]"))
     said.clear()
     Session.resume(Journal.open(tmp_path / "j"), out=said.append)
-    assert said[1] == ("warning: this is not the run recorded before (success after 8.75 s, "
-                       "now success after 7.7 s): `tiny.yaml` or a file it reads changed "
+    assert said[1] == ("warning: this is not the run recorded before (success after 8.7 s, "
+                       "now success after 7.65 s): `tiny.yaml` or a file it reads changed "
                        "since; `at` corrects the run driven now")
 
 

@@ -212,16 +212,34 @@ def _stop_ticks(res: SimResult) -> np.ndarray:
     return np.where(stopped.any(axis=0), stopped.argmax(axis=0) + 1, res.ticks)
 
 
+def _moves(res: SimResult) -> int:
+    """How many ticks the robots moved: every recorded tick, but for the last where the run
+    ended on what was observed there (every robot at its goal, or a contact), which nothing
+    moved on from. Timed as recorded ticks, a run read one tick late: figure4's contact,
+    recorded at 14.65 s (its `--out` row, the `--runs` plot's label), read "after 14.70 s"."""
+    ended_there = res.ticks and res.outcome in ("success", "collision")
+    return res.ticks - 1 if ended_there else res.ticks
+
+
+def _driven(res: SimResult) -> np.ndarray:
+    """``[n]`` ticks each robot moved: until the tick it was observed at its goal, else as
+    the run moved (:func:`_moves`)."""
+    assert res.active is not None, "Simulation.result() records who was active"
+    stopped = ~res.active.reshape(res.ticks, len(res.robot_outcomes))
+    return np.where(stopped.any(axis=0), stopped.argmax(axis=0), _moves(res))
+
+
 def _robot_metrics(res: SimResult, dt: float) -> tuple[dict, ...]:
     """Each robot's figures up to the tick it stopped (at its goal) or the run ended: its time,
     path, mean speed over that time and steering variation; its clearance over the whole run
     (a robot at its goal is still something the others can hit)."""
     out = []
-    for i, (agent, outcome, ticks) in enumerate(zip(res.world.agents, res.robot_outcomes,
-                                                   _stop_ticks(res).tolist())):
+    for i, (agent, outcome, ticks, moved) in enumerate(zip(
+            res.world.agents, res.robot_outcomes, _stop_ticks(res).tolist(),
+            _driven(res).tolist())):
         xy = res.pose[:ticks, i, :2]
         path = float(np.hypot(*np.diff(xy, axis=0).T).sum()) if len(xy) > 1 else 0.0
-        time_s = float(ticks * dt)
+        time_s = float(moved * dt)
         out.append({
             "name": agent.name, "outcome": outcome, "reached_goal": outcome == "success",
             "time_s": round(time_s, 6), "path_length_in": path,
@@ -240,9 +258,9 @@ def _metrics(res: SimResult, dt: float) -> dict:
     all the driving (total path over total driving time), the smallest clearance of any."""
     each = res.robot_metrics
     path = sum(m["path_length_in"] for m in each)
-    driving = float(_stop_ticks(res).sum() * dt)
+    driving = float(_driven(res).sum() * dt)
     return {"collisions": sum(m["outcome"] == "collision" for m in each),
-            "time_s": round(float(res.ticks * dt), 6), "path_length_in": path,
+            "time_s": round(float(_moves(res) * dt), 6), "path_length_in": path,
             "min_clearance_in": min(m["min_clearance_in"] for m in each),
             "replans": sum(m["replans"] for m in each),
             "backouts": sum(m["backouts"] for m in each),

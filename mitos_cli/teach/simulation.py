@@ -84,7 +84,7 @@ class Recording:
 
     @property
     def verdict(self) -> str:
-        """``success after 8.75 s``: the outcome and the time of the corrected robot."""
+        """``success after 8.7 s``: the outcome and the time of the corrected robot."""
         s = self.result.summary()
         if self.robot_name:
             s = {**s, **self.result.robot_metrics[self.robot]}
