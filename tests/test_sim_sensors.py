@@ -80,6 +80,9 @@ def test_ring_and_fan_layouts():
     assert np.rad2deg(ring) == pytest.approx([0, 90, 180, 270])
     fan = Sensors(layout="fan", count=3, fov=180).angles
     assert np.rad2deg(fan) == pytest.approx([90, 0, -90])
+    # a fan of 360 deg had its first and last beams on one line (+180 and -180)
+    whole = Sensors(layout="fan", count=4, fov=360).angles
+    assert np.rad2deg(whole) == pytest.approx([180, 90, 0, -90])
 
 
 def test_box_to_segment_distance_matches_the_polygon_distance():

@@ -63,11 +63,15 @@ class Sensors:
     @property
     def angles(self) -> np.ndarray:
         """Beam directions relative to the heading (rad, counter-clockwise): a ring's from
-        straight ahead round to the left, a fan's from its left edge clockwise."""
+        straight ahead round to the left, a fan's from its left edge clockwise (a fan of 360
+        deg stops a step short of its right edge, which is its left: its first and last beams
+        looked along one line)."""
         if self.layout == "ring":
             return np.deg2rad(np.arange(self.count) * (360.0 / self.count))
         half = np.deg2rad(self.fov) / 2.0
-        return np.linspace(half, -half, self.count) if self.count > 1 else np.zeros(1)
+        if self.count == 1:
+            return np.zeros(1)
+        return np.linspace(half, -half, self.count, endpoint=self.fov < 360.0)
 
 
 @dataclass(frozen=True)
