@@ -152,10 +152,9 @@ def run_many(worlds: list[World], runs: int = 0, seed: int | None = None, planne
         seeds = [base] if runs <= 0 else [base + j for j in range(runs)]
         # each worker's share in lockstep batches of up to 64 runs, fewer on a large map
         # (batch_for; a batch of 5 runs costs about twice what a batch of 40 does a
-        # robot-tick); a world cut into several
-        # chunks has its map and routes prepared once, here, and sent along (a grid map's
-        # route search costs about as much as a run), unless its draws move what the robots
-        # are given (shared_scene)
+        # robot-tick); a world cut into several chunks has its map and routes prepared once,
+        # here, and sent along (a grid map's route search costs about as much as a run),
+        # unless its draws move what the robots are given (shared_scene)
         size = even_chunks(len(seeds), workers, batch_for(w))
         scene = shared_scene(w, runs > 0) if len(seeds) > size else None
         for i in range(0, len(seeds), size):
