@@ -28,6 +28,7 @@ from pathlib import Path
 
 import numpy as np
 from options import ROOT, guarded, positive_int, revision
+from revision import differs
 
 TASK = r"""
 import json, sys, hashlib
@@ -105,10 +106,11 @@ def main(argv: list[str] | None = None) -> None:
                     shown = "" if kind == "runs" else f", {answer}"
                     print(f"   {label:8s} {name:>12s}: {wall:6.2f} s, peak {peak:6.0f} MB{shown}")
                 if len(trees) > 1:
+                    if len(answers) > 1:         # timed on the same work, or not at all
+                        raise differs(f"the {label} of {n} x {n} pixels", args.against)
                     (w0, p0, _), (w1, p1, _) = best.values()
-                    same = "same results" if len(answers) == 1 else "DIFFERENT RESULTS"
                     print(f"   {'':8s} {'':>12s}  {w1 / w0:.2f}x faster, {p1 / p0:.2f}x less "
-                          f"memory, {same}")
+                          f"memory, same results")
         print(f"\nload average {os.getloadavg()[0]:.2f} at the end")
 
 
