@@ -919,3 +919,23 @@ def test_learned_words_say_past_a_neighbour_not_a_share_over_the_whole_way():
     said = _said({"LO": 0.0, "MID": 30.0, "HI": 40.0}, {"LO": 0.0, "MID": 37.0, "HI": 60.0})
     assert said[0] == ("  o.MID: 30 -> 37 deg, toward HI (70% of the way: it now means "
                        "nearly what HI meant)")
+
+
+def test_learned_words_name_the_rules_whose_crisp_values_moved(tmp_path):
+    """When only a rule's own crisp value was learned (`main/r1: y is 40 -> 45` in the table),
+    the words said "no term moved", as if nothing had been learned."""
+    from mitos_cli.teach.session import Session
+
+    (tmp_path / "r.terms.yaml").write_text(
+        "variables:\n  x: {role: input, universe: [0, 1], terms: {A: {shape: left_shoulder, "
+        "points: [0, 1]}, B: {shape: right_shoulder, points: [0, 1]}}}\n"
+        "  y: {role: output, universe: [0, 100], terms: {LO: 10, HI: 90}}\n")
+    (tmp_path / "r.rules").write_text('terms "r.terms.yaml"\n\nr1: if x is A then y is 40\n'
+                                      "r2: if x is B then y is HI\n")
+    said: list[str] = []
+    s = Session(tmp_path / "r.rules", out=said.append)
+    s.run("correct x=0 -> y=45")
+    s.run("adapt epochs 50")
+    words = next(x for x in said if x.startswith("learned, in words:")).splitlines()
+    assert words[1] == ("  no term moved; only the crisp value written in rule `main/r1` did "
+                        "(the table above)")

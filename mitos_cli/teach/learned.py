@@ -15,6 +15,8 @@ and never ``110 -> 110`` for a move to 109.97.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 from ..lang.interpretability import centre
 from ..lang.model import RuleBase, format_number
 
@@ -35,9 +37,10 @@ def _moved(a: float, b: float) -> tuple[str, str]:
     return (before, after) if before != after or a == b else (repr(a), repr(b))
 
 
-def in_words(before: RuleBase, after: RuleBase, parameters) -> str:
+def in_words(before: RuleBase, after: RuleBase, parameters, rules: Sequence[str] = ()) -> str:
     """The learned changes of ``before`` -> ``after`` in words (``parameters``: what was
-    adapted and what was held)."""
+    adapted and what was held; ``rules``: the labels of rules whose own crisp values were
+    learned, so that "no term moved" does not read as "nothing was learned")."""
     held = {(v, t): point for v, t, point in parameters.held}
     adapted = {k.var for k in parameters.knots}
     lines = ["learned, in words:"]
@@ -74,11 +77,22 @@ def in_words(before: RuleBase, after: RuleBase, parameters) -> str:
                 text += _toward(a, b, order[j].name, centre(order[j]), unit)
             lines.append(text)
     if len(lines) == 1:
-        lines.append("  no term moved")
+        lines.append("  no term moved" + (f"; only {_written_in(rules)} did (the table above)"
+                                          if rules else ""))
     elif any("held at" in x for x in lines):
         lines.append("  (a held term is the centre of mirror-symmetric terms; `unfrozen "
                      "VARIABLE.TERM` lets it move)")
     return "\n".join(lines)
+
+
+def _written_in(rules: Sequence[str]) -> str:
+    """``the crisp value written in rule `r1```, ``the crisp values written in rules `r1`,
+    `r2` and `r3``` (each rule once, in order)."""
+    names = [f"`{r}`" for r in dict.fromkeys(rules)]
+    values = "values" if len(rules) > 1 else "value"
+    if len(names) == 1:
+        return f"the crisp {values} written in rule {names[0]}"
+    return f"the crisp values written in rules {', '.join(names[:-1])} and {names[-1]}"
 
 
 def _toward(a: float, b: float, neighbour: str, there: float, unit: str) -> str:

@@ -794,7 +794,8 @@ class Session:
         self.out(text.changed_table(before, self.rulebase, crisp))
         if kept:
             self.out("not adapted: " + "; ".join(kept))
-        self.out(in_words(before, self.rulebase, result.parameters))
+        labels = [f"{owner}/{before.behavior(owner).rules[i].label}" for owner, i, _, _ in crisp]
+        self.out(in_words(before, self.rulebase, result.parameters, labels))
         self.out(self.interpretability())
         if c.plot is not None:
             self._plot_terms(before, self.rulebase, c.plot)
