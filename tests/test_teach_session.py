@@ -102,6 +102,20 @@ def test_behavior_end_use_and_recall_by_name(rules):
     assert s2.state.active == "b"
 
 
+def test_frozen_in_a_behavior_without_rules_names_the_behavior_that_has_the_rule(rules):
+    """`use drive` then `frozen r1`: `drive` has no rules of its own, and the refusal listed
+    none and hinted nothing; it now says whose rule `r1` is and how to freeze it."""
+    s, _ = session(rules)
+    s.run("use drive")
+    with pytest.raises(NameError_) as caught:
+        s.run("frozen r1")
+    assert caught.value.hint == ("`drive` has no rules of its own; `r1` is a rule of "
+                                 "`avoid_obstacle`: `use avoid_obstacle`, then `frozen r1`")
+    with pytest.raises(NameError_) as caught:
+        s.run("frozen zork")
+    assert caught.value.hint == "`drive` has no rules of its own"
+
+
 def test_frozen_and_operators(rules):
     s, out = session(rules)
     assert "leaves the consequents of r4, r5 alone" in say(s, out, "frozen r4, r5")

@@ -248,7 +248,7 @@ class Session:
             labels = [r.label for r in b.rules]
             for label in entry["labels"]:
                 if label not in labels:
-                    raise unknown("rule label", label, labels, owner=b.name)
+                    raise self._unknown_label(b, label, labels)
         elif op in ("freeze", "release"):
             self._term_refs([*entry["terms"], *entry.get("holds", [])])
         elif op == "rule":
@@ -461,7 +461,7 @@ class Session:
         labels = [r.label for r in b.rules]
         for label in c.labels:
             if label not in labels:
-                raise unknown("rule label", label, labels, owner=b.name)
+                raise self._unknown_label(b, label, labels)
         named = list(dict.fromkeys(c.labels))
         new = [x for x in named if x not in b.frozen]
         already = [x for x in named if x in b.frozen]
@@ -471,6 +471,22 @@ class Session:
         if already:
             self.out(f"{b.name}: {', '.join(already)} {'is' if len(already) == 1 else 'are'} "
                      "frozen already" + ("; nothing changes" if not new else ""))
+
+    def _unknown_label(self, b: Behavior, label: str, labels: list[str]) -> MitosError:
+        """``frozen LABEL`` of a rule the active behavior does not have; when no label is
+        close, the hint names the behavior that has it (`drive` has no rules of its own: it
+        uses the behaviors that do)."""
+        exc = unknown("rule label", label, labels, owner=b.name)
+        if exc.hint is None:
+            owners = [o.name for o in self.rulebase.behaviors
+                      if o.name != b.name and any(r.label == label for r in o.rules)]
+            own = "" if labels else f"`{b.name}` has no rules of its own; "
+            if owners:
+                exc.hint = (f"{own}`{label}` is a rule of `{owners[0]}`: `use {owners[0]}`, "
+                            f"then `frozen {label}`")
+            elif own:
+                exc.hint = own.rstrip("; ")
+        return exc
 
     def _term_refs(self, refs) -> list[list[str]]:
         variables = self.rulebase.variables
