@@ -5,9 +5,13 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
+import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from mitos_cli.errors import WorldError
+from mitos_cli.sim.world import Robot
 from mitos_cli.sim.worldfile import load_world, parse_world, resolve_world_path
 
 BASE = """\
@@ -643,7 +647,7 @@ def test_a_turn_tighter_than_half_an_inch_is_refused_at_the_value_that_makes_it(
                            "of 5.78e-321 in (wheelbase 1e-320 in at a lock of 60 deg)")
     assert "expected a wheelbase of at least 0.866 in at this lock" in text
     assert "wheelbase 0.01 in" in error(BASE.replace("wheelbase: 16", "wheelbase: 0.01"))
-    assert parse_world(BASE.replace("wheelbase: 16", "wheelbase: 1"), "w.yaml")
+    assert parse_world(BASE.replace("wheelbase: 16", "wheelbase: 1\n  max_speed: 20"), "w.yaml")
     steer = "  wheelbase: 16\n  steering: {min: 0, max: 180}\n"
     text = error(BASE.replace("  wheelbase: 16\n", steer))
     assert text.startswith("w.yaml:8:19: world error: the steering's lock is 90 deg off straight")
@@ -868,25 +872,57 @@ def test_a_pipe_or_a_device_named_as_the_world_is_not_said_to_be_missing(tmp_pat
 @pytest.mark.parametrize("change, said", [
     (("  footprint: {length: 24, width: 18}",
       "  footprint: {length: 24, width: 18}\n  max_speed: 100000\n  acceleration: 1000000"),
-     "at max_speed 100000 in/s the robot drives 5e+03 in a tick"),
-    (("dt: 0.05", "dt: 1"), "at max_speed 60 in/s the robot drives 60 in a tick (dt 1 s)"),
+     "at max_speed 100000 in/s the robot's body moves up to 7.33e+03 in a tick"),
+    (("dt: 0.05", "dt: 1"),
+     "at max_speed 60 in/s the robot's body moves up to 87.9 in a tick (dt 1 s; at full lock its "
+     "outer front corner moves 1.47x as fast as its wheel)"),
     (("  footprint: {length: 24, width: 18}",
       "  footprint: {length: 24, width: 18}\n  max_reverse: 600"), "at max_reverse 600 in/s")])
 def test_a_robot_that_drives_past_its_length_in_a_tick_is_refused(change, said):
     """Contact is checked once a tick: `max_speed: 100000` with `acceleration: 1000000` drove
     through the walls and 4,000 in outside the map with "no collision" (potential_field), and
-    DWA hung. One tick's drive is at most the robot's length."""
+    DWA hung. One tick's move of any point of the body is at most the robot's length."""
     text = error(BASE.replace(*change))
     assert said in text and "farther than its own length (24 in)" in text
-    assert parse_world(BASE.replace("  footprint: {length: 24, width: 18}",
-                                    "  footprint: {length: 24, width: 18}\n  max_speed: 480"),
-                       "w.yaml").robot.max_speed == 480
+
+
+def test_a_turn_counts_in_a_tick_s_move():
+    """A tick's drive of the wheel was held to the robot's length (480 in/s at dt 0.05), but in
+    a turn at full lock the outer front corner moves 1.47x as fast as the wheel: at 480 in/s it
+    swept past a 1 in pole between two ticks with no collision. The bound is on that corner."""
+    def world(speed):
+        return BASE.replace("  footprint: {length: 24, width: 18}",
+                            f"  footprint: {{length: 24, width: 18}}\n  max_speed: {speed}")
+
+    assert parse_world(world(327), "w.yaml").robot.max_speed == 327
+    text = error(world(480))
+    assert "moves up to 35.2 in a tick" in text and "at most 327.6 in/s" in text
+
+
+@settings(max_examples=200, deadline=None)
+@given(length=st.floats(2, 100), width=st.floats(1, 100), share=st.floats(0.05, 1),
+       lock=st.floats(1, 89.9))
+def test_the_fastest_point_is_the_fastest_corner(length, width, share, lock):
+    """:func:`fastest_point` against the four corners' speeds about the turn's centre,
+    sampled over every lock up to full lock: never below them, and at most a sample's
+    spacing above."""
+    from mitos_cli.sim.safety import fastest_point
+
+    wb = share * length
+    robot = Robot(length=length, width=width, wheelbase=wb, steering_min=90 - lock,
+                  steering_max=90 + lock)
+    d = np.radians(np.linspace(1e-9, lock, 4001))[:, None]
+    x = np.array([-1, -1, 1, 1]) * length / 2 + wb / 2          # from the rear axle
+    y = np.array([-1, 1, -1, 1]) * width / 2
+    corners = (np.hypot(x, y - wb / np.tan(d)) * np.sin(d) / wb).max()
+    assert max(corners, 1.0) <= fastest_point(robot) * (1 + 1e-12)
+    assert fastest_point(robot) <= max(corners, 1.0) * (1 + 1e-4)
 
 
 def test_another_robot_that_drives_past_its_length_in_a_tick_is_refused():
     text = error(BASE + "robots:\n  - {name: r2, q_init: {x: 300, y: 20, heading: 180}, "
                  "q_goal: {x: 30, y: 20}, robot: {max_speed: 1000}}\n")
-    assert "at max_speed 1000 in/s the robot drives 50 in a tick" in text
+    assert "at max_speed 1000 in/s the robot's body moves up to 73.3 in a tick" in text
 
 
 def test_a_tick_count_past_any_reading_is_written_short():

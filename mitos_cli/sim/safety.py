@@ -251,6 +251,33 @@ def tightest_turn(robot: Robot) -> float:
     return robot.wheelbase / math.tan(math.radians(lock)) if lock < 90 else 0.0
 
 
+def fastest_point(robot: Robot) -> float:
+    """How far the body's fastest point moves per inch the front wheel drives, at most: 1
+    straight on, more in a turn, where the footprint's front corner on the outside swings
+    wider than the wheel (the packaged robots: 1.47 at full lock). A contact that begins and
+    ends between two ticks' checks goes at most half as deep as that point moves in a tick
+    (an obstacle point inside the body mid-tick lies within that of the body at one end).
+
+    At a lock ``d`` the robot turns about a point on its rear axle's line, ``wheelbase /
+    tan(d)`` out, at ``sin(d) / wheelbase`` rad per inch of the wheel; that corner lies
+    ``(length + wheelbase) / 2`` ahead of the axle and ``width / 2`` beyond the robot's far
+    side, so (squared, times the wheelbase squared) it moves ``wb^2 + A sin^2 d + B sin 2d``
+    with ``A = ((l + wb) / 2)^2 + (w / 2)^2 - wb^2`` and ``B = wb w / 2``: a sine in ``2d``
+    whose crest is taken where the lock reaches it."""
+    wb, lock = robot.wheelbase, math.radians(min(full_lock(robot), 90.0))
+    a, b = (robot.length + wb) / 2, robot.width / 2
+    big, cross = a * a + b * b - wb * wb, wb * b
+    crest = (math.atan2(big / 2, cross) + math.pi / 2) / 2
+    at = min(lock, crest)
+    return math.sqrt(wb * wb + big * math.sin(at) ** 2 + cross * math.sin(2 * at)) / wb
+
+
+def swing_words(swing: float) -> str:
+    """What :func:`fastest_point`'s ``swing`` means, for a message."""
+    return (f"at full lock its outer front corner moves {swing:.3g}x as fast as its wheel"
+            if swing > 1.0 else "straight on, every point as fast as its wheel")
+
+
 def _far(robot: Robot, radius: float, step: float) -> float:
     """:func:`_spacing`'s reach of a turn: half the wheelbase, half the footprint's diagonal,
     a cell's diagonal and the step."""

@@ -12,7 +12,7 @@ from numbers import Integral, Real
 from typing import NoReturn
 
 from ..errors import WorldError, did_you_mean
-from .safety import TIGHTEST_TURN, tightest_turn
+from .safety import TIGHTEST_TURN, fastest_point, swing_words, tightest_turn
 from .world import REPLANS, Agent, Obstacle, Robot, World
 from .worldfile import BEYOND, LARGEST, LAYOUTS, MAX_TICKS, MODELS, MODES, SHAPES
 
@@ -114,14 +114,15 @@ def _agent(c: _Fields, at: str, agent: Agent) -> None:
 
 
 def _tick_drive(c: _Fields, at: str, robot: Robot, dt: float) -> None:
-    """A tick's drive at most the robot's length, as a world file's (contact is checked once a
-    tick: faster, the robot passed through walls unseen)."""
+    """A tick's move of any point of the body at most the robot's length, as a world file's
+    (contact is checked once a tick: faster, the robot passed through walls unseen)."""
+    swing = fastest_point(robot)
     for key in ("max_speed", "max_reverse"):
-        if getattr(robot, key) * dt > robot.length:
+        if getattr(robot, key) * dt * swing > robot.length:
             c.refuse(f"{at}.robot.{key}", getattr(robot, key),
-                     f"at most {robot.length / dt:.4g} in/s at dt {dt:g} s: a tick's drive "
-                     f"farther than the robot's length ({robot.length:g} in) can pass through "
-                     "a wall unseen")
+                     f"at most {robot.length / (dt * swing):.4g} in/s at dt {dt:g} s: a "
+                     f"tick's move of the body farther than the robot's length "
+                     f"({robot.length:g} in) can pass through a wall unseen ({swing_words(swing)})")
 
 
 def _sensors(c: _Fields, world: World) -> None:

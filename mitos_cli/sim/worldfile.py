@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING, Any
 from ..errors import NameError_, Span, WorldError, did_you_mean, unknown
 from ..lang import yamlpos
 from ..lang.yamlpos import YList, YMap
-from .safety import TIGHTEST_TURN, full_lock, tightest_turn
+from .safety import TIGHTEST_TURN, fastest_point, full_lock, swing_words, tightest_turn
 from .world import (
     REPLANS,
     Agent,
@@ -229,18 +229,22 @@ def read_robot(r: _Reader, value: Any, span: Span, base: Robot | None = None,
 
 
 def _check_tick(m: YMap, robot: Robot, dt: float) -> None:
-    """Refuse a robot that can drive farther in one tick than its own length: contact is
-    checked once a tick, so `max_speed: 100000` (with `acceleration: 1000000`) drove through
-    the walls and 4,000 in outside the map with "no collision", and DWA hung."""
+    """Refuse a robot whose body can move farther in one tick than its own length: contact
+    is checked once a tick, so `max_speed: 100000` (with `acceleration: 1000000`) drove
+    through the walls and 4,000 in outside the map with "no collision", and DWA hung. In a
+    turn the outer front corner moves faster than the wheel (:func:`~.safety.fastest_point`):
+    at the 480 in/s a straight drive allowed, full lock swept it past a 1 in pole unseen."""
     key = "max_speed" if robot.max_speed >= robot.max_reverse else "max_reverse"
-    fastest = getattr(robot, key)
-    if fastest * dt <= robot.length:
+    fastest, swing = getattr(robot, key), fastest_point(robot)
+    if fastest * dt * swing <= robot.length:
         return
-    raise WorldError(f"at {key} {fastest:g} in/s the robot drives {fastest * dt:.3g} in a tick "
-                     f"(dt {dt:g} s), farther than its own length ({robot.length:g} in): contact "
-                     f"is checked once a tick, so it could pass through a wall unseen",
+    raise WorldError(f"at {key} {fastest:g} in/s the robot's body moves up to "
+                     f"{fastest * dt * swing:.3g} in a tick (dt {dt:g} s; {swing_words(swing)}), "
+                     f"farther than its own length ({robot.length:g} in): contact is checked "
+                     f"once a tick, so it could pass through a wall unseen",
                      span=m.value_span(key) if key in m else m.span,
-                     expected=f"a {key} of at most {robot.length / dt:.4g} in/s at this dt",
+                     expected=f"a {key} of at most {robot.length / (dt * swing):.4g} in/s at "
+                              f"this dt",
                      hint="speeds are in inches a second (the packaged robots' top speed: 60); "
                           "or a smaller `dt`")
 
