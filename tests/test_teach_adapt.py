@@ -299,3 +299,19 @@ def test_the_compass_moves_along_free_directions_and_only_where_q_falls():
     assert found is not None and again is not None and np.array_equal(found, again)
     assert feasible(p, found) and loss(with_values(p, found), X, T) < q
     assert _Compass.of(p, 0.5).poll(p, p.values, q, g, X, T, q) is None   # nothing gains Q
+
+
+@pytest.mark.parametrize("width, value, decimals, shown", [
+    (2e149, -6.2499999999999996e+147, -145, -6.25e147),   # was written with its float noise
+    (2e5, 123456.789, -1, 123460.0),
+    (100.0, 130.8712, 2, 130.87),
+    (2e-30, 1.23456789e-31, 34, 1.235e-31)])
+def test_learned_values_are_rounded_to_a_readable_grid_at_any_scale(width, value, decimals, shown):
+    """The grid has about 10^4 steps over a universe: at 2e149 a learned knot was kept as
+    `-6.2499999999999996e+147` (the grid stopped at whole numbers, and 10^-145 is no double);
+    it is now the double nearest -6.25e147, written `-6.25e+147`."""
+    from mitos_cli.teach.adapt import _decimals, _on_grid
+
+    assert _decimals(width) == decimals
+    got = float(_on_grid(np.array([value]), np.array([decimals]))[0])
+    assert got == shown and repr(got) == repr(shown)

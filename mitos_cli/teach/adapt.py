@@ -308,7 +308,9 @@ def _owners(rb: RuleBase, name: str) -> list[tuple[str, int]]:
 
 
 def _decimals(width: float) -> int:
-    return int(max(0, 4 - math.floor(math.log10(width))))
+    """The decimals of a readable grid over a universe ``width`` wide: about 10^4 steps, so
+    0 at 10^4 and below 0 past it (tens, hundreds, ... ``-145`` on a universe of 2e149)."""
+    return 4 - math.floor(math.log10(width))
 
 
 def _supported(compiled: CompiledRuleBase) -> None:
@@ -1395,8 +1397,7 @@ def _round(p: Parameters, values: np.ndarray, X: np.ndarray, targets: np.ndarray
         return p.values.copy(), q_start
     for extra in range(3):
         decimals = p.decimals + extra
-        out = np.where(changed, np.round(values * 10.0 ** decimals) / 10.0 ** decimals,
-                       values) + 0.0             # + 0.0: a knot rounded to -0.0 is 0
+        out = np.where(changed, _on_grid(values, decimals), values) + 0.0   # (-0.0 is 0)
         for dep, others, coef in p.dependents:        # symmetric triangles stay symmetric
             out[dep] = round(float(coef @ out[others]), int(decimals[dep]))
         if feasible(p, out):
@@ -1404,6 +1405,19 @@ def _round(p: Parameters, values: np.ndarray, X: np.ndarray, targets: np.ndarray
             if q <= q_start:
                 return out, q
     return values.copy(), q_learned
+
+
+def _on_grid(values: np.ndarray, decimals: np.ndarray) -> np.ndarray:
+    """``values`` rounded to ``decimals`` (``-2``: to hundreds), each the double nearest its
+    decimal: a power of ten up to 10^22 is exact, so one product or quotient of it rounds
+    once; past that Python's ``round`` rounds in decimal (a universe of 1e149 learned
+    ``-6.2499999999999996e+147`` for -6.25e147, NumPy scaling by an inexact 10^-145)."""
+    scale = 10.0 ** np.minimum(np.abs(decimals), 22)
+    out = np.where(decimals >= 0, np.round(values * scale) / scale,
+                   np.round(values / scale) * scale)
+    for i in np.flatnonzero(np.abs(decimals) > 22):
+        out[i] = round(float(values[i]), int(decimals[i]))
+    return out
 
 
 # ---- writing the learned values back into the model -------------------------------------------
