@@ -330,7 +330,9 @@ def test_an_unknown_instruction_at_the_prompt_names_its_place_and_the_list():
                           "--lesson", "-"], cwd=root, input=lesson, capture_output=True,
                          text=True, timeout=120)
     assert res.returncode == 1
-    assert "<stdin>:3:1: lesson error: unknown instruction `make a wide turn`" in res.stderr
+    # marked at its words (it was marked from the `at`, at column 1)
+    assert "<stdin>:3:15: lesson error: unknown instruction `make a wide turn`" in res.stderr
+    assert "    at 13s to 14s make a wide turn\n" + " " * 18 + "^" * 16 + "\n" in res.stderr
     assert "did you mean `make a wider turn`?" in res.stderr
     assert "`turn harder`, `turn less`, `make a wider turn`, `slow down`" in res.stderr
     assert "Traceback" not in res.stderr

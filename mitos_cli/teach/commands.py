@@ -13,6 +13,7 @@ import functools
 import math
 import re
 from dataclasses import dataclass, field
+from types import SimpleNamespace
 
 from lark import Lark, Token, Tree, v_args
 from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken
@@ -275,8 +276,14 @@ class _ToCommand(_ToModel):
 
     @v_args(meta=True)
     def at_instruction(self, meta, items):
+        """The span is the instruction's words' (an unknown one is marked there, not from
+        the `at`)."""
         (start, stop), places, words = _window(items)
-        return AtInstruction(start, stop, tuple(str(w) for w in words), self._s(meta), places)
+        first, last = words[0], words[-1]
+        said = SimpleNamespace(empty=False, start_pos=first.start_pos, line=first.line,
+                               column=first.column, end_line=last.end_line,
+                               end_column=last.end_column)
+        return AtInstruction(start, stop, tuple(str(w) for w in words), self._s(said), places)
 
     def eval_cmd(self, items):
         return Eval(tuple(items))
