@@ -71,3 +71,28 @@ def test_commands_are_clamped_to_the_robot():
     s, v = kinematics.limit_commands(np.array([90.0]), np.array([0.0]), np.array([0.0]),
                                      np.array([99.0]), limits, 0.1)
     assert s[0] == 30.0 and v[0] == 60.0
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_along_is_step_at_its_ends_and_at_each_substep(seed):
+    """:func:`kinematics.along` (where the contact check between ticks looks) has the robots
+    where they start at 0, where :func:`kinematics.step` puts them at 1, and after k of its
+    substeps where a tick of k substeps as long puts them."""
+    rng = np.random.default_rng(seed)
+    n = 6
+    limits = kinematics.Limits.of([Robot()] * n)
+    state = (rng.uniform(-100, 100, n), rng.uniform(-100, 100, n), rng.uniform(-3, 3, n),
+             rng.uniform(-15, 60, n), rng.uniform(30, 150, n), rng.uniform(0, 180, n),
+             rng.uniform(-30, 90, n))
+    assert np.allclose(np.stack(kinematics.along(*state, limits, 0.05, 4, 0.0)),
+                       np.stack(state[:3]), atol=1e-12)
+    assert np.allclose(np.stack(kinematics.along(*state, limits, 0.05, 4, 1.0)),
+                       np.stack(kinematics.step(*state, limits, 0.05, 4)[:3]), atol=1e-9)
+    for k in (1, 2, 3):
+        assert np.allclose(np.stack(kinematics.along(*state, limits, 0.05, 4, k / 4)),
+                           np.stack(kinematics.step(*state, limits, 0.05 * k / 4, k)[:3]),
+                           atol=1e-9)
+    # between substeps it stays on the arc: a hundredth of a tick moves it a hundredth
+    points = np.array([kinematics.along(*state, limits, 0.05, 4, f)[:2]
+                       for f in np.linspace(0, 1, 101)])
+    assert np.hypot(*np.diff(points, axis=0).transpose(1, 0, 2)).max() <= 60 * 0.05 / 100 + 1e-9

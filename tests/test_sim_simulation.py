@@ -396,3 +396,97 @@ def test_a_run_is_timed_by_the_ticks_it_moved():
         home.summary()["path_length_in"] / 17.9)
     out = simulate(short("corridor.yaml", 1.0))
     assert out.outcome == "timeout" and out.summary()["time_s"] == 1.0 == out.ticks * 0.05
+
+
+class _Spin:
+    """Full lock to the left at full speed: the body's outer front corner sweeps wide."""
+
+    name = "spin"
+
+    def plan(self, p):
+        n = len(p.pose)
+        return np.full(n, 30.0), np.full(n, 320.0)
+
+
+def _spinning_world(poles=()):
+    from mitos_cli.sim.world import Obstacle
+
+    w = load_world(packaged_path("worlds", "corridor.yaml"))
+    robot = dataclasses.replace(w.robot, max_speed=320.0, acceleration=1e5,
+                                max_steering_rate=1e5, brake=False)
+    agent = dataclasses.replace(w.agents[0], robot=robot,
+                                start=dataclasses.replace(w.agents[0].start, x=200.0, y=-60.0,
+                                                          heading=0.0))
+    return w.with_changes(corridors=(dataclasses.replace(w.corridors[0], width=300.0),),
+                          agents=(agent,), obstacles=tuple(
+                              Obstacle(name=f"pole{j}", shape="circle", x=x, y=y, radius=0.5)
+                              for j, (x, y) in enumerate(poles)),
+                          randomise=dataclasses.replace(w.randomise, obstacles=()))
+
+
+def _swept_unseen(sim, tick: int) -> tuple[float, float]:
+    """A point 0.6 in deep in the body part of the way through the move after ``tick``,
+    more than 0.6 in outside it at both ends (contact is checked at ticks)."""
+    from mitos_cli.sim import kinematics
+    from mitos_cli.sim.geometry import rect_corners
+
+    robot = sim.robots[0]
+    motion = sim._came.of_run()
+
+    def body(f):
+        x, y, h = kinematics.along(*motion, sim.limits, sim.dt, sim.world.substeps, f)
+        return x[0], y[0], h[0]
+
+    def inside(pose, q, by):      # q at least `by` inside the footprint at `pose`
+        d = np.array(q) - pose[:2]
+        h = pose[2]
+        along, across = d @ (np.cos(h), np.sin(h)), d @ (-np.sin(h), np.cos(h))
+        return abs(along) <= robot.length / 2 - by and abs(across) <= robot.width / 2 - by
+
+    assert tick == sim.ticks - 1
+    start, end = body(0.0), body(1.0)
+    for f in np.linspace(0.02, 0.98, 49):
+        x, y, h = mid = body(f)
+        for corner in rect_corners(*(np.array([v]) for v in (x, y, h, robot.length,
+                                                            robot.width)))[0]:
+            q = corner + (np.array([x, y]) - corner) / np.hypot(x - corner[0], y - corner[1])
+            if inside(mid, q, 0.6) and not inside(start, q, -0.6) and not inside(end, q, -0.6):
+                return float(q[0]), float(q[1])
+    raise AssertionError("no point swept unseen")
+
+
+def test_a_contact_between_two_ticks_is_a_collision():
+    """Contact is checked at ticks; at 320 in/s on full lock the outer front corner swept a
+    1 in pole between two of them with no collision (clearance 0.7 in before, 7.3 after).
+    The move between is now looked at where the two clearances leave room for a contact:
+    the run collides at the later tick, with the clearance found there, and moves as before
+    up to it."""
+    sim = Simulation(_spinning_world(), planner=_Spin(), seed=1)
+    sim.step()
+    sim.step()
+    pole = _swept_unseen(sim, 1)
+    free = Simulation(_spinning_world(), planner=_Spin(), seed=1)
+    for _ in range(3):
+        free.step()
+    hit = Simulation(_spinning_world([pole]), planner=_Spin(), seed=1)
+    while not hit.done:
+        hit.step()
+    res = hit.result()
+    assert res.summary()["outcome"] == "collision" and res.ticks == 3
+    assert res.clearance[2, 0] <= 0.0 < res.clearance[1, 0]
+    assert np.array_equal(res.pose, free.result().pose)
+
+
+def test_a_contact_between_ticks_is_found_alike_in_lockstep():
+    """Runs in lockstep look between ticks as a run alone does, bit for bit."""
+    from mitos_cli.sim.lockstep import run_lockstep
+
+    sim = Simulation(_spinning_world(), planner=_Spin(), seed=1)
+    sim.step()
+    sim.step()
+    world = _spinning_world([_swept_unseen(sim, 1)])
+    alone = [simulate(world, _Spin(), seed) for seed in (1, 2, 3)]
+    together = run_lockstep(world, _Spin(), [1, 2, 3], batch=3)
+    assert [r.summary() for r in together] == [r.summary() for r in alone]
+    assert all(np.array_equal(a.clearance, b.clearance) for a, b in zip(alone, together))
+    assert {r.summary()["outcome"] for r in alone} == {"collision"}

@@ -23,7 +23,7 @@ import operator
 import os
 from collections.abc import Sequence
 from dataclasses import dataclass, field, fields
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -43,6 +43,8 @@ STUCK_TIME = 6.0        # s
 STUCK_DISTANCE = 3.0    # in
 BEHIND = 30.0           # in: a replanned route that starts this near behind the robot costs more
 NEAR_SLACK = 24.0       # in: a robot's set of nearby walls is gathered again after this move
+#: in: the deepest contact the check between ticks may miss (:meth:`Simulation._between`)
+GRAZE = 0.01
 PATH_STEP = 4.0         # in: the spacing of the route points a planner is given (Percepts.path)
 OUTCOMES = ("success", "collision", "timeout", "stuck")
 # a robot's own outcome may also be `stopped`: still driving when another robot's collision or
@@ -283,6 +285,20 @@ def _columns(*columns: np.ndarray) -> np.ndarray:
     return out
 
 
+class _Came(NamedTuple):
+    """The move that brought a run's robots where they are: what :func:`kinematics.step`
+    moved from (:meth:`Simulation.motion`), rows ``start:stop`` of its arrays (a batch's)."""
+
+    motion: kinematics.Motion
+    start: int
+    stop: int
+
+    def of_run(self) -> kinematics.Motion:
+        a, b = self.start, self.stop
+        m = self.motion
+        return m if b - a == len(m[0]) else tuple(c[a:b] for c in m)   # type: ignore[return-value]
+
+
 @dataclass(frozen=True)
 class Tick:
     """What one tick recorded, rows are robots: the state the robots were in when they sensed,
@@ -403,6 +419,10 @@ class Simulation:
         self._cfg = perception.Settings()
         self.dt = world.dt
         self.steps = int(math.floor(world.time_limit / self.dt + 1e-9))
+        # (_between) how far each robot's body moves in a tick per in/s of its wheel, and the
+        # fastest obstacle's move in a tick
+        self._swing = np.array([safety.fastest_point(r) for r in self.robots]) * self.dt
+        self._drift = max((o.speed for o in world.obstacles), default=0.0) * self.dt
         self._goals = np.array([[a.goal.x, a.goal.y] for a in world.agents], float)
         self._goal_x, self._goal_y = self._goals[:, 0].copy(), self._goals[:, 1].copy()
         self._tol = np.array([a.goal.tolerance for a in world.agents], float)
@@ -466,6 +486,7 @@ class Simulation:
         self._beyond_at: tuple = (None, [])             # see _beyond()
         self._epoch = next(_EPOCHS)                     # this start's (a Batch is of one)
         self._moved_by: object = None                   # the Batch.move that moved it last
+        self._came: _Came | None = None                 # the move that brought it here
         self._watched: tuple = (None, [], [])           # see watching()
         beams = len(self.angles)                        # what watching() gives for no robot
         self._unseen = (np.zeros((0, 2)), np.zeros((0, beams)), np.zeros((0, beams, 2)),
@@ -979,10 +1000,90 @@ class Simulation:
         active = self._active
         self._hit, arrived = _arrivals(active, s.clearance, self._x, self._y, self._goal_x,
                                        self._goal_y, self._tol)
+        self._between(s.clearance, self._hit)
         if np.count_nonzero(arrived):
             for i in arrived.nonzero()[0]:
                 self._outcomes[i] = "success"
             active &= ~arrived
+
+    # -- contact between ticks ----------------------------------------------------------------
+
+    def _between(self, clearance: np.ndarray, hit: np.ndarray) -> None:
+        """Contact that began and ended between the last tick and this one, where contact is
+        checked: looked for along the move (:meth:`_touched_between`) where a robot's
+        clearance then and now add up to no more than its body and what it may touch came
+        closer in the move (:meth:`_travel`), and a collision at this tick where found, its
+        clearance the least found (``hit`` and ``clearance [n]`` are written in place).
+        Elsewhere nothing can have touched: a point of the obstacle inside the body between
+        the two ticks lay within that travel of the body at one of them."""
+        if self._came is None or not self.record:
+            return
+        before, speed = self.record[-1].clearance, self._came.of_run()[3]
+        if self.n == 1:             # (most worlds: the same sums as Batch's, in floats)
+            room = max(abs(float(speed[0])), abs(float(self._v[0]))) * float(self._swing[0])
+            if float(before[0]) + float(clearance[0]) > room + self._drift or hit[0]:
+                return
+        travel = self._travel(speed)
+        maybe = (before + clearance <= travel) & ~hit
+        if np.count_nonzero(maybe):
+            self._look_between(maybe.nonzero()[0], before, clearance, hit, travel)
+
+    def _travel(self, speed: np.ndarray) -> np.ndarray:
+        """``[n]`` how much closer each robot's body and what it may touch can have come in
+        its last move, from ``speed [n]`` its wheel's then: its fastest point's path
+        (:func:`.safety.fastest_point`, at the faster of its speeds then and now; the speed
+        ramps between them), the fastest other robot's and the fastest obstacle's."""
+        own = np.maximum(np.abs(speed), np.abs(self._v)) * self._swing
+        return own + self._drift + (own.max() if self.n > 1 else 0.0)    # (as Batch's)
+
+    def _look_between(self, robots: np.ndarray, before: np.ndarray, clearance: np.ndarray,
+                      hit: np.ndarray, travel: np.ndarray) -> None:
+        """:meth:`_touched_between` of ``robots``; a contact found is a hit, at the least
+        clearance found."""
+        for i in robots.tolist():
+            found = self._touched_between(i, float(before[i]), float(clearance[i]),
+                                          float(travel[i]))
+            if found is not None:
+                hit[i], clearance[i] = True, found
+
+    def _touched_between(self, i: int, before: float, now: float, travel: float) -> float | None:
+        """Robot ``i``'s clearance where it touched something along its last move (else
+        ``None``), by halving the move: a part whose ends' clearances add up to more than
+        what the part's share of ``travel`` allows cannot have touched, the others are
+        halved, down to parts too short for a contact deeper than :data:`GRAZE`."""
+        parts = [(0.0, before, 1.0, now)]
+        while parts:
+            f0, a, f1, b = parts.pop()
+            span = travel * (f1 - f0)
+            if a + b > span or span <= 2.0 * GRAZE:
+                continue
+            f = (f0 + f1) / 2.0
+            c = self._clearance_at(i, f)
+            if c <= 0.0:
+                return c
+            parts += [(f, c, f1, b), (f0, a, f, c)]          # the earlier half first
+        return None
+
+    def _clearance_at(self, i: int, f: float) -> float:
+        """Robot ``i``'s clearance the share ``f`` of the way through the last move: every
+        robot where that move had it then (:func:`kinematics.along`), the obstacles where
+        they were then; walls farther than a tick's sensing gathers are not looked at, so
+        the clearance is at most what that leaves room for."""
+        assert self._came is not None
+        x, y, h = kinematics.along(*self._came.of_run(), self.limits, self.dt,
+                                   self.world.substeps, f)
+        _, (centres, radii, _, _, _, boxes) = self._obstacles_at(self.record[-1].t + f * self.dt)
+        if self.n > 1:
+            feet = _footprints(_columns(x, y, h), self.robots)
+            boxes = np.concatenate([boxes, feet[:i], feet[i + 1:]])
+        reach = self._reach + NEAR_SLACK
+        px, py = float(x[i]), float(y[i])
+        walls = self.scene.static.near(px, py, reach)
+        robot = self.robots[i]
+        row = rows.SenseRow(px, py, float(h[i]), robot, walls, walls, boxes, rows.discs(boxes),
+                            centres, radii, 0.0, self._streams[1 + i])
+        return min(float(rows.clearance([row])[0]),
+                   reach - math.hypot(robot.length, robot.width) / 2)
 
     def plan(self, s: _Sensed) -> None:
         """The planner's commands for the active robots, in one batch (the others: straight
@@ -1038,8 +1139,9 @@ class Simulation:
     def act(self, s: _Sensed) -> None:
         """Steering-rate and acceleration limits and exact arcs, substep by substep; stopped
         robots stay put."""
-        self.move_to(*kinematics.step(*self.motion(s), self.limits, self.dt,
-                                      self.world.substeps))
+        motion = self.motion(s)
+        self.move_to(*kinematics.step(*motion, self.limits, self.dt, self.world.substeps))
+        self._came = _Came(motion, 0, self.n)
 
     def motion(self, s: _Sensed | None = None) -> kinematics.Motion:
         """What :func:`kinematics.step` moves from, ``[n]`` each: x, y, heading, speed (0 for
@@ -1057,6 +1159,7 @@ class Simulation:
         self._odometer.append(self._odometer[-1] + driven if self._odometer else driven)
         self._x, self._y, self._h, self._v, self._steer = x, y, h, v, steer
         self._moved_by = None                           # (its own arrays, not a batch's)
+        self._came = None                               # (act says how, when it moved it)
 
     def _check_stuck(self) -> bool:
         """A driving robot that drove less than ``STUCK_DISTANCE`` in ``STUCK_TIME`` is stuck
@@ -1338,6 +1441,12 @@ class Batch:
         self._watching = np.zeros(0, dtype=np.intp)         # the rows that follow something
         self._limits: kinematics.Limits | None = None
         self._fleet = safety.Fleet.joined([run._fleet for run in runs])
+        # (_between) each row's swing and its run's drift; what move() moved from last, and
+        # the clearances verdict() recorded last
+        self._swing = self._gather("_swing")
+        self._drift = np.repeat([run._drift for run in runs], [b - a for a, b in self.spans])
+        self._came: kinematics.Motion | None = None
+        self._before = np.zeros(0)
         # the tick observed last (:meth:`sensed`): its runs' ticks, x, y and heading, readings,
         # robots' places, inputs (a row each), targets, commands, contacts and who drives
         self.ticks: list[_Sensed] = []
@@ -1523,6 +1632,7 @@ class Batch:
         x, y, _ = self._ticked()
         self.hit, arrived = _arrivals(self._active, self.got.clearance, x, y, self._goal_x,
                                       self._goal_y, self._tol)    # (hit: each run's at verdict)
+        self._between()
         for row in arrived.nonzero()[0].tolist():
             run, i = self._owner[row]
             run._outcomes[i] = "success"
@@ -1532,6 +1642,30 @@ class Batch:
     def _ticked(self) -> tuple[np.ndarray, ...]:
         assert self._now is not None, "sensed() first"
         return self._now
+
+    def _between(self) -> None:
+        """:meth:`Simulation._between` of every run, the robots whose clearance then and now
+        leaves no room for a contact between found in one comparison. The clearances then
+        and the move are this batch's while it recorded and moved every run last; a run
+        recorded or moved otherwise looks for itself."""
+        runs, clearance, hit, moved = self.runs, self.got.clearance, self.hit, self._moved
+        if (self._came is None or moved is None or len(self._before) != len(clearance)
+                or not all(run._moved_by is moved[1] for run in runs)):
+            for run, c, touched in zip(runs, self._each(clearance), self._each(hit)):
+                run._between(c, touched)
+            return
+        own = np.maximum(np.abs(self._came[3]), np.abs(self._drive[0])) * self._swing
+        travel = own + self._drift
+        if not self._single:
+            travel += np.repeat(np.maximum.reduceat(own, self._starts),
+                                [b - a for a, b in self.spans])
+        maybe = (self._before + clearance <= travel) & ~hit
+        for row in maybe.nonzero()[0].tolist():
+            run, i = self._owner[row]
+            found = run._touched_between(i, float(self._before[row]), float(clearance[row]),
+                                         float(travel[row]))
+            if found is not None:
+                hit[row], clearance[row] = True, found
 
     def commanded(self, commands: np.ndarray | None) -> list[_Sensed]:
         """:meth:`Simulation.commanded` of every run: ``commands [rows, 2]`` for all (the
@@ -1582,6 +1716,7 @@ class Batch:
         book.speed[i], book.steering[i] = self._drive      # (the runs' own: kept apart)
         book.command[i], book.ranges[i], book.clearance[i] = (self.command, self.got.ranges,
                                                               self.got.clearance)
+        self._before = self.got.clearance
         book.block[i], book.active[i], book.progress[i] = self.block.T, self.active, self._hint
         blocks = (list(book.block[i][:, :, None]) if self._single
                   else [book.block[i, a:b].T for a, b in self.spans])
@@ -1635,8 +1770,8 @@ class Batch:
                 [getattr(run.limits, f.name) for run in runs]) for f in fields(kinematics.Limits)))
         world = runs[0].world
         command = self.command.T.copy()
-        after = kinematics.step(x, y, h, np.where(self.active, v, 0.0), steer, command[0],
-                                command[1], self._limits, world.dt, world.substeps)
+        motion = (x, y, h, np.where(self.active, v, 0.0), steer, command[0], command[1])
+        after = kinematics.step(*motion, self._limits, world.dt, world.substeps)
         driven = np.hypot(after[0] - x, after[1] - y)         # (Simulation.move_to)
         ticks = len(runs[0]._odometer)
         assert all(len(run._odometer) == ticks for run in runs), "runs ticked together"
@@ -1654,10 +1789,12 @@ class Batch:
                                                            self._each(driven))):
             run._x, run._y, run._h, run._v, run._steer = state
             run._moved_by = token
+            run._came = _Came(motion, a, b)
             run._odometer.append(gone)
             run._k += 1
             run._go_on(stuck is not None and stuck_any[j] and run._stuck(stuck[a:b]))
         self._moved = (after, token)
+        self._came = motion
         self._now = None
 
 

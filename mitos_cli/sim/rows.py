@@ -97,6 +97,13 @@ def sense(rows: list[SenseRow], angles: np.ndarray, max_range: float,
     return Sensed(dirs, static, ranges, _clearance(stacks, origin, heading))
 
 
+def clearance(rows: list[SenseRow]) -> np.ndarray:
+    """The clearance of each row's footprint ``[R]``, as :func:`sense` gives it, without the
+    beams (the contact check between ticks looks at poses no beam is cast from)."""
+    return _clearance(_Stacks(rows), np.array([(r.x, r.y) for r in rows]),
+                      np.array([r.heading for r in rows]))
+
+
 def _stacked(arrays: list[np.ndarray], width: int | None = None) -> np.ndarray:
     """``[R, width, ...]``: the arrays one above the other, each padded with zeros to
     ``width`` rows (default: the longest's; a view of the one array, when there is one that

@@ -254,9 +254,8 @@ def tightest_turn(robot: Robot) -> float:
 def fastest_point(robot: Robot) -> float:
     """How far the body's fastest point moves per inch the front wheel drives, at most: 1
     straight on, more in a turn, where the footprint's front corner on the outside swings
-    wider than the wheel (the packaged robots: 1.47 at full lock). A contact that begins and
-    ends between two ticks' checks goes at most half as deep as that point moves in a tick
-    (an obstacle point inside the body mid-tick lies within that of the body at one end).
+    wider than the wheel (the packaged robots: 1.47 at full lock). It bounds how much closer
+    the body can come to anything in a tick (:meth:`.loop.Simulation._between`).
 
     At a lock ``d`` the robot turns about a point on its rear axle's line, ``wheelbase /
     tan(d)`` out, at ``sin(d) / wheelbase`` rad per inch of the wheel; that corner lies

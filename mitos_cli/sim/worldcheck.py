@@ -60,8 +60,8 @@ def check_built(world: World) -> None:
             key = "velocity" if o.motion.kind == "velocity" else "speed"
             c.refuse(f"obstacles[{i}].motion.{key}", getattr(o.motion, key),
                      f"at most {o.size / dt:.4g} in/s at dt {dt:g} s: a tick's move farther "
-                     f"than the obstacle's own size ({o.size:g} in) can pass through the robot "
-                     "unseen")
+                     f"than the obstacle's own size ({o.size:g} in) passes the robots between "
+                     "two of their looks")
     _randomise(c, world)
     c.choice("replan", world.replan, REPLANS)
     c.choice("knows", world.knows, KNOWS)
@@ -115,14 +115,15 @@ def _agent(c: _Fields, at: str, agent: Agent) -> None:
 
 def _tick_drive(c: _Fields, at: str, robot: Robot, dt: float) -> None:
     """A tick's move of any point of the body at most the robot's length, as a world file's
-    (contact is checked once a tick: faster, the robot passed through walls unseen)."""
+    (it senses and brakes once a tick)."""
     swing = fastest_point(robot)
     for key in ("max_speed", "max_reverse"):
         if getattr(robot, key) * dt * swing > robot.length:
             c.refuse(f"{at}.robot.{key}", getattr(robot, key),
                      f"at most {robot.length / (dt * swing):.4g} in/s at dt {dt:g} s: a "
                      f"tick's move of the body farther than the robot's length "
-                     f"({robot.length:g} in) can pass through a wall unseen ({swing_words(swing)})")
+                     f"({robot.length:g} in) passes things between two of its looks "
+                     f"({swing_words(swing)})")
 
 
 def _sensors(c: _Fields, world: World) -> None:

@@ -229,19 +229,19 @@ def read_robot(r: _Reader, value: Any, span: Span, base: Robot | None = None,
 
 
 def _check_tick(m: YMap, robot: Robot, dt: float) -> None:
-    """Refuse a robot whose body can move farther in one tick than its own length: contact
-    is checked once a tick, so `max_speed: 100000` (with `acceleration: 1000000`) drove
-    through the walls and 4,000 in outside the map with "no collision", and DWA hung. In a
-    turn the outer front corner moves faster than the wheel (:func:`~.safety.fastest_point`):
-    at the 480 in/s a straight drive allowed, full lock swept it past a 1 in pole unseen."""
+    """Refuse a robot whose body can move farther in one tick than its own length: it
+    senses and brakes once a tick (`max_speed: 100000`, with `acceleration: 1000000`, drove
+    through the walls and 4,000 in outside the map with "no collision" before contact was
+    looked for between ticks, and DWA hung). In a turn the outer front corner moves faster
+    than the wheel (:func:`~.safety.fastest_point`)."""
     key = "max_speed" if robot.max_speed >= robot.max_reverse else "max_reverse"
     fastest, swing = getattr(robot, key), fastest_point(robot)
     if fastest * dt * swing <= robot.length:
         return
     raise WorldError(f"at {key} {fastest:g} in/s the robot's body moves up to "
                      f"{fastest * dt * swing:.3g} in a tick (dt {dt:g} s; {swing_words(swing)}), "
-                     f"farther than its own length ({robot.length:g} in): contact is checked "
-                     f"once a tick, so it could pass through a wall unseen",
+                     f"farther than its own length ({robot.length:g} in): it senses and "
+                     f"brakes once a tick, so it would pass things between two looks",
                      span=m.value_span(key) if key in m else m.span,
                      expected=f"a {key} of at most {robot.length / (dt * swing):.4g} in/s at "
                               f"this dt",
@@ -655,8 +655,8 @@ def _obstacles(r: _Reader, top: YMap, dt: float) -> list[Obstacle]:
             key = "velocity" if "velocity" in m else "speed"
             raise WorldError(f"obstacle `{o.name}` moves {o.speed * dt:.3g} in a tick (at "
                              f"{o.speed:g} in/s, dt {dt:g} s), farther than its own size "
-                             f"({o.size:g} in): contact is checked once a tick, so it could pass "
-                             "through the robot unseen", span=m.value_span(key),
+                             f"({o.size:g} in): the robots sense it once a tick, so it "
+                             "would pass them between two looks", span=m.value_span(key),
                              expected=f"a speed of at most {o.size / dt:.4g} in/s at this dt",
                              hint="speeds are in inches a second (the packaged cart's: 15); "
                                   "or a smaller `dt`")
