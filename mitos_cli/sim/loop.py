@@ -346,8 +346,9 @@ class _Sensed:
 class Simulation:
     """One run of a world, stepped a tick at a time; :func:`simulate` is a loop over
     :meth:`step`. Each tick runs the stages :meth:`sense` (obstacle places, beams, noise,
-    clearance), :meth:`perceive` (rule inputs), :meth:`check` (contact and arrival),
-    :meth:`plan` (one batch for the active robots) and :meth:`act` (kinematics), in that order,
+    clearance), :meth:`perceive` (rule inputs), :meth:`check` (contact, along the move to
+    the tick too, and arrival), :meth:`plan` (one batch for the active robots) and
+    :meth:`act` (kinematics), in that order,
     then records a :class:`Tick`. :meth:`perceive` also keeps each robot's own map and
     replans its route when what it sensed shuts its way (:mod:`.knowledge`).
 
