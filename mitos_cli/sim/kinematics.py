@@ -122,6 +122,18 @@ def advance(x: np.ndarray, y: np.ndarray, heading: np.ndarray, speed: np.ndarray
     return rx + half * np.cos(h), ry + half * np.sin(h), h
 
 
+def _substeps(steering, speed, cmd_steering, cmd_speed, lim: Limits, dt: float,
+              substeps: int) -> tuple[_Ramp, np.ndarray, np.ndarray]:
+    """The wheel and the speed after each substep, ``[substeps, n]`` each, moved toward the
+    commands within their limits (and the :class:`_Ramp` they were moved by)."""
+    ramp = _ramp(lim, dt, substeps)
+    target = _clip(cmd_steering, lim.steering_min, lim.steering_max)
+    target_v = _clip(cmd_speed, ramp.reverse, lim.max_speed)
+    steer_k = steering + _clip(target - steering, ramp.steer_down, ramp.steer_up)
+    speed_k = speed + _clip(target_v - speed, ramp.speed_down, ramp.speed_up)
+    return ramp, steer_k, speed_k
+
+
 def step(x, y, heading, speed, steering, cmd_steering, cmd_speed, lim: Limits, dt: float,
          substeps: int):
     """One tick: in each of ``substeps`` equal parts of ``dt``, move the steering and speed
@@ -129,11 +141,8 @@ def step(x, y, heading, speed, steering, cmd_steering, cmd_speed, lim: Limits, d
     rows ``k = 1..substeps`` of ``[substeps, n]`` arrays (the ramp toward a clipped target is
     ``start + clip(target - start, -k d, k d)``). Returns (x, y, heading, speed, steering)."""
     sdt = dt / substeps
-    ramp = _ramp(lim, dt, substeps)
-    target = _clip(cmd_steering, lim.steering_min, lim.steering_max)
-    target_v = _clip(cmd_speed, ramp.reverse, lim.max_speed)
-    steer_k = steering + _clip(target - steering, ramp.steer_down, ramp.steer_up)
-    speed_k = speed + _clip(target_v - speed, ramp.speed_down, ramp.speed_up)
+    ramp, steer_k, speed_k = _substeps(steering, speed, cmd_steering, cmd_speed, lim, dt,
+                                       substeps)
     delta = np.deg2rad(steer_k - lim.straight)
     dh = speed_k * np.sin(delta) / ramp.back_wheelbase * sdt        # -v sin(delta) / wb dt
     half_dh = dh / 2.0
@@ -155,11 +164,8 @@ def along(x, y, heading, speed, steering, cmd_steering, cmd_speed, lim: Limits, 
     of its tick: its whole substeps, then that part of the next one's arc (the contact check
     between ticks looks there). ``f = 1`` gives :func:`step`'s pose, up to rounding."""
     sdt = dt / substeps
-    ramp = _ramp(lim, dt, substeps)
-    target = _clip(cmd_steering, lim.steering_min, lim.steering_max)
-    target_v = _clip(cmd_speed, ramp.reverse, lim.max_speed)
-    steer_k = steering + _clip(target - steering, ramp.steer_down, ramp.steer_up)
-    speed_k = speed + _clip(target_v - speed, ramp.speed_down, ramp.speed_up)
+    ramp, steer_k, speed_k = _substeps(steering, speed, cmd_steering, cmd_speed, lim, dt,
+                                       substeps)
     whole = min(int(f * substeps), substeps)
     part = f * substeps - whole
     share = np.zeros((substeps, 1))
