@@ -490,3 +490,21 @@ def test_a_contact_between_ticks_is_found_alike_in_lockstep():
     assert [r.summary() for r in together] == [r.summary() for r in alone]
     assert all(np.array_equal(a.clearance, b.clearance) for a, b in zip(alone, together))
     assert {r.summary()["outcome"] for r in alone} == {"collision"}
+
+
+@pytest.mark.parametrize("name", ["corridor", "office", "moving", "multirobot", "detour"])
+def test_the_clearance_between_ticks_is_the_tick_s_at_the_tick(name):
+    """What the check between ticks measures part of the way through a move
+    (:meth:`Simulation._clearance_at`) is, at the move's end, the clearance the next tick
+    senses there: the same walls (corridors, map cells), obstacles where they then are, and
+    the other robots."""
+    world = load_world(packaged_path("worlds", f"{name}.yaml"))
+    sim = Simulation(world, seed=world.seed)
+    for k in range(120):
+        sim.step()
+        if sim.done:
+            break
+        if k % 10 == 9:
+            ahead = [sim._clearance_at(i, 1.0) for i in range(sim.n)]
+            tick = sim.step()
+            assert np.allclose(ahead, tick.clearance, rtol=0, atol=1e-9), (k, ahead)
