@@ -8,6 +8,8 @@ import re
 
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, assume, given, settings
+from hypothesis import strategies as st
 
 from mitos_cli.engine.evaluation import evaluate_one
 from mitos_cli.resources import packaged_path
@@ -508,3 +510,50 @@ def test_the_clearance_between_ticks_is_the_tick_s_at_the_tick(name):
             ahead = [sim._clearance_at(i, 1.0) for i in range(sim.n)]
             tick = sim.step()
             assert np.allclose(ahead, tick.clearance, rtol=0, atol=1e-9), (k, ahead)
+
+
+class _Drive:
+    name = "drive"
+
+    def __init__(self, steering: float, speed: float) -> None:
+        self.steering, self.speed = steering, speed
+
+    def plan(self, p):
+        n = len(p.pose)
+        return np.full(n, self.steering), np.full(n, self.speed)
+
+
+@settings(max_examples=20, deadline=None, suppress_health_check=[HealthCheck.filter_too_much])
+@given(steering=st.one_of(st.floats(30, 60), st.floats(120, 150)), speed=st.floats(150, 320),
+       f=st.floats(0.2, 0.8), corner=st.integers(0, 3), inset=st.floats(0.0, 1.5))
+def test_no_contact_between_ticks_is_missed(steering, speed, f, corner, inset):
+    """Against the clearance sampled at 201 places along the move: wherever the body went
+    more than :data:`GRAZE` into a pole between two ticks, the check finds a contact. The
+    pole is put where a corner of the body passes part of the way through a fast turn (a
+    quarter of them clear of the body at both ticks: the others are not this test's)."""
+    from mitos_cli.sim import kinematics
+    from mitos_cli.sim.geometry import rect_corners
+    from mitos_cli.sim.loop import GRAZE
+
+    free = Simulation(_spinning_world(), planner=_Drive(steering, speed), seed=1)
+    free.step()
+    free.step()
+    r = free.robots[0]
+    x, y, h = kinematics.along(*free._came.of_run(), free.limits, free.dt,
+                               free.world.substeps, f)
+    q = rect_corners(x, y, h, np.array([r.length]), np.array([r.width]))[0][corner]
+    pole = q + (np.array([x[0], y[0]]) - q) * inset / np.hypot(x[0] - q[0], y[0] - q[1])
+    sim = Simulation(_spinning_world([tuple(pole)]), planner=_Drive(steering, speed), seed=1)
+    sim.step()
+    assume(not sim.done)
+    tick = sim.step()
+    assume(not sim.done)
+    before, now = float(tick.clearance[0]), sim._clearance_at(0, 1.0)   # tick 1, and 2 ahead
+    assume(before > 0 and now > 0)
+    least = min(sim._clearance_at(0, g) for g in np.linspace(0.0, 1.0, 201))
+    travel = float(sim._travel(sim._came.of_run()[3])[0])
+    found = sim._touched_between(0, before, now, travel)
+    if least < -2 * GRAZE:
+        assert found is not None and found <= 0.0
+    if found is not None:
+        assert found <= 0.0
