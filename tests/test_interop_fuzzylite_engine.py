@@ -162,6 +162,74 @@ def test_hedged_sugeno_consequents_agree_with_fuzzylite():
     assert np.allclose(run(HEDGED, X[:, None]), theirs, atol=1e-12)
 
 
+#: A Mamdani engine with a hedged consequent: fuzzylite 6 and 8 hedge the rule's activation
+#: degree (min(very(dof), mu_lo)); MITOS's rules hedge the set (min(dof, mu_lo^2)). At x = 0.5
+#: pyfuzzylite 8 gives y = 5.577 (fuzzylite 6 at its 100 points 5.576), the set reading 5.373.
+HEDGED_MAMDANI = """\
+Engine: hm
+InputVariable: x
+  range: 0 1
+  term: low Triangle 0 0 1
+  term: high Triangle 0 1 1
+OutputVariable: y
+  range: 0 10
+  aggregation: Maximum
+  defuzzifier: Centroid 1000
+  default: nan
+  term: lo Triangle 0 3 6
+  term: hi Triangle 4 7 10
+RuleBlock: b
+  conjunction: Minimum
+  disjunction: Maximum
+  implication: Minimum
+  rule: if x is low then y is hi
+  rule: if x is high then y is very lo
+"""
+
+
+def test_a_hedged_mamdani_consequent_is_refused_where_fuzzylite_writes_it(tmp_path):
+    """It was read as MITOS's hedged set where fuzzylite hedges the degree: another number
+    (5.37 where fuzzylite gives 5.58), and not a word."""
+    from mitos_cli.interop.fcl import parse_fcl
+
+    text = HEDGED_MAMDANI
+    with pytest.raises(FormatError, match="hedges a Mamdani consequent") as info:
+        parse_fll(text, "t.fll")
+    line = text.splitlines().index("  rule: if x is high then y is very lo") + 1
+    assert str(info.value.span) == f"t.fll:{line}:27"
+    assert "move the hedge onto the condition" in info.value.hint
+    fcl = ("FUNCTION_BLOCK hm\nVAR_INPUT x : REAL; END_VAR\nVAR_OUTPUT y : REAL; END_VAR\n"
+           "FUZZIFY x\nRANGE := (0 .. 1);\nTERM low := Triangle 0 0 1;\nEND_FUZZIFY\n"
+           "DEFUZZIFY y\nRANGE := (0 .. 10);\nTERM lo := Triangle 0 3 6;\nMETHOD : COG;\n"
+           "ACCU : MAX;\nEND_DEFUZZIFY\nRULEBLOCK b\nAND : MIN;\nACT : MIN;\n"
+           "RULE 1 : if x is low then y is somewhat lo\nEND_RULEBLOCK\nEND_FUNCTION_BLOCK\n")
+    with pytest.raises(FormatError, match="`y is somewhat lo` hedges a Mamdani") as info:
+        parse_fcl(fcl, "t.fcl")
+    assert str(info.value.span) == "t.fcl:17:27"
+
+
+def test_a_hedged_mamdani_consequent_is_not_written_for_fuzzylite(tmp_path):
+    """MITOS's `then y is very lo` under Mamdani inference (the hedged set) was written to FLL
+    and FCL as it stands, which fuzzylite reads as the hedged degree: other outputs."""
+    from mitos_cli.api import read_rulebase
+    from mitos_cli.interop import write_foreign
+
+    (tmp_path / "t.terms.yaml").write_text(
+        "variables:\n  x: {role: input, universe: [0, 1], terms: {low: {shape: triangle, "
+        "points: [0, 0, 1]}}}\n  y: {role: output, universe: [0, 10], terms: {lo: {shape: "
+        "triangle, points: [0, 3, 6]}}}\n")
+    path = tmp_path / "t.rules"
+    path.write_text('terms "t.terms.yaml"\noperators: inference = mamdani\n'
+                    "r1: if x is low then y is very lo\n")
+    rb = read_rulebase(path)
+    for fmt, dialect in (("fll", None), ("fcl", None), ("fcl", "iec")):
+        with pytest.raises(FormatError, match="`y is very lo` hedges a Mamdani") as info:
+            write_foreign(rb, fmt, dialect=dialect)
+        assert str(info.value.span) == f"{path}:3:22"
+    path.write_text('terms "t.terms.yaml"\nr1: if x is low then y is very lo\n')
+    assert "y is very lo" in write_foreign(read_rulebase(path), "fll")   # weighted: the degree
+
+
 # ---------------------------------------------------------------------------------------------
 # Function terms: a membership given by a formula of x, parsed (never eval'd)
 

@@ -142,7 +142,8 @@ def test_a_hedge_fuzzylite_lacks_is_refused_where_the_rule_uses_it(tmp_path, fmt
         "  y: {role: output, universe: [0, 1], terms: {hi: {shape: triangle, "
         "points: [0.5, 1, 1]}}}\n")
     path = tmp_path / "t.rules"
-    path.write_text(f'terms "t.terms.yaml"\noperators: inference = mamdani\nr1: {rule}\n')
+    # weighted inference: a hedged Mamdani consequent is refused before its hedge is named
+    path.write_text(f'terms "t.terms.yaml"\noperators: inference = weighted_average\nr1: {rule}\n')
     with pytest.raises(FormatError, match="fuzzylite has no hedge like MITOS's `extremely`") \
             as info:
         write_foreign(read_rulebase(path), fmt)

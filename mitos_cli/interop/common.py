@@ -137,11 +137,22 @@ def to_fuzzylite_hedge(name: str, span: Span | None = None) -> str:
     return MITOS_TO_FUZZYLITE_HEDGES[name]
 
 
-def written_consequents(rule: Rule) -> list[tuple[Consequent, tuple[str, ...]]]:
+def written_consequents(rule: Rule, inference: str | None = None
+                        ) -> list[tuple[Consequent, tuple[str, ...]]]:
     """A rule's consequents as fuzzylite's rule text must list them, each with the hedges to
     write before its term: fuzzylite carries a consequent's hedges on to the ones after it
     (:func:`.ruletree.conclusions`), so less-hedged consequents come first and each writes
-    only the hedges it adds. Hedges that cannot be carried that way are refused by name."""
+    only the hedges it adds. Hedges that cannot be carried that way are refused by name, and
+    so is any hedge on a consequent under ``inference`` ``mamdani``: fuzzylite would hedge the
+    rule's activation degree where MITOS hedges the output set."""
+    hedged = next((c for c in rule.consequents if c.hedges), None)
+    if inference == "mamdani" and hedged is not None:
+        raise FormatError(f"rule `{rule.label}`: `{hedged_text(hedged)}` hedges a Mamdani "
+                          f"consequent's set, which fuzzylite would read as the hedged "
+                          f"activation degree of the rule, computing other outputs",
+                          span=hedged.span or rule.span,
+                          hint="move the hedge onto the condition (`if x is very A`), or give "
+                               "the output a term shaped as the hedged one")
     ordered = sorted(rule.consequents, key=lambda c: len(c.hedges))
     out = []
     carried: tuple[str, ...] = ()
@@ -156,6 +167,11 @@ def written_consequents(rule: Rule) -> list[tuple[Consequent, tuple[str, ...]]]:
         out.append((c, c.hedges[:own]))
         carried = c.hedges
     return out
+
+
+def hedged_text(c: Consequent) -> str:
+    """``y is very lo``: a hedged consequent as messages quote it."""
+    return f"{c.var} is {' '.join(c.hedges)} {c.term}"
 
 
 def concluded_term(c: Consequent) -> str:
@@ -582,11 +598,27 @@ def _check_block(rules: list[Rule], settings: Settings, by_name: dict[str, Varia
                 raise FormatError(f"output term `{v.name}.{t.name}`: linear terms need a "
                                   f"weighted-average (Takagi-Sugeno) defuzzifier", span=t.span)
     for rule in rules:
+        if not sugeno:
+            _unhedged_mamdani(rule)
         try:
             check_rule(rule, by_name)
         except MitosError as exc:
             raise FormatError(exc.message, span=exc.span or rule.span, expected=exc.expected,
                               hint=exc.hint) from None
+
+
+def _unhedged_mamdani(rule: Rule) -> None:
+    """Refuse a hedged Mamdani consequent read from fuzzylite's language: fuzzylite hedges the
+    rule's activation degree there (``Consequent.modify``), MITOS hedges the output set, so
+    reading it would change the outputs without a word."""
+    c = next((c for c in rule.consequents if c.hedges), None)
+    if c is not None:
+        raise FormatError(
+            f"rule `{rule.label}`: `{hedged_text(c)}` hedges a Mamdani consequent, which "
+            f"fuzzylite computes as the hedged activation degree of the rule and MITOS as the "
+            f"hedged output set: not supported", span=c.span,
+            hint="move the hedge onto the condition (`if x is very A`), the same where the "
+                 "condition is one proposition without `not` and the rule's weight is 1")
 
 
 # ---------------------------------------------------------------------------------------------

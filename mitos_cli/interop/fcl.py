@@ -722,7 +722,7 @@ def _rule_text(r: Rule, dialect: str = DEFAULT_DIALECT, ops=None) -> str:
     joint = " and " if dialect == "fuzzylite" else ", "
     cons = joint.join(f"{c.var} is " + " ".join(
         [common.to_fuzzylite_hedge(h, c.span) for h in hedges] + [common.concluded_term(c)])
-        for c, hedges in common.written_consequents(r))
+        for c, hedges in common.written_consequents(r, ops and ops.inference))
     text = f"if {expr(r.antecedent, 'top')} then {cons}"
     if r.weight != 1.0:
         text += f" with {fmt_number(r.weight)}"

@@ -542,7 +542,7 @@ def fuzzylite_rule_text(rule: Rule, ops, dialect: str) -> str:
     cons = f" {kw('and')} ".join(
         f"{c.var} {kw('is')} " + " ".join([common.to_fuzzylite_hedge(h, c.span) for h in hedges]
                                           + [common.concluded_term(c)])
-        for c, hedges in common.written_consequents(rule))
+        for c, hedges in common.written_consequents(rule, ops.inference))
     text = f"{kw('if')} {expr(antecedent, 'top')} {kw('then')} {cons}"
     if rule.weight != 1.0:
         text += f" {kw('with')} {_fmt_weight(rule.weight)}"
