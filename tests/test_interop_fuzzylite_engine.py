@@ -273,6 +273,18 @@ def test_function_terms_are_their_formulas_on_inputs_and_outputs():
                        atol=1e-12, equal_nan=True)
 
 
+@pytest.mark.parametrize("formula, value", [
+    ("~x^2", 0.49), ("1 - 0.5 * ~x^2", 0.755), ("~(x - 0.5)^2 + 0.5", 0.54),
+    ("2^~x^2", 2 ** 0.49), ("~x ^ 2 ^ 2", 0.7 ** 4), ("!x^0", 1.0), ("-x^2 + 1", 0.51)])
+def test_fuzzylites_negation_binds_tighter_than_its_power(formula, value):
+    """fuzzylite 6 and 8 give `~` and `!` precedence 100 and `^` 90, so `~x^2` is x squared;
+    MITOS read it as -(x^2), another membership (0.755 became 1.245 on `1 - 0.5 * ~x^2`).
+    `-` (which fuzzylite does not read) stays looser than `^`, as in mathematics."""
+    text = FUNCTION.replace("1 - 4 * (x - 0.5)^2", formula)
+    term = parse_fll(text, "t.fll").variables["u"].term("bump")
+    assert term.formula(np.array([0.7]))[0] == pytest.approx(value, abs=1e-15)
+
+
 @pytest.mark.parametrize("formula, column, words", [
     ("1 - sin(x", 10, "expected `)`"),
     ("1 - sine(x)", 5, "unknown name `sine`"),

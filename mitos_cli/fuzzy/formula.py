@@ -2,7 +2,8 @@
 
 ``parse("lt(x, 0.5) * x / 0.5 + gt(x, 0.5) * (1 - x) / 0.5")`` returns a :class:`Formula`: a
 tree of operators, functions, numbers and the variable ``x``, evaluated elementwise with NumPy
-on arrays of any shape. The language is fuzzylite's: ``+ - * / % ^ **``, unary ``- + ~ !``,
+on arrays of any shape. The language is fuzzylite's: ``+ - * / % ^ **``, unary ``- + ~ !``
+(``~`` and ``!`` bind tighter than ``^``, as in fuzzylite; ``-`` looser, as in mathematics),
 ``and`` / ``or``, the comparison functions ``gt ge eq neq le lt`` (1 or 0), ``min max pow
 atan2 fmod`` and the one-argument functions of :data:`FUNCTIONS`, ``pi``. A precedence-climbing
 parser (linear in the text) reports the column of what it could not read and what it expected.
@@ -55,7 +56,10 @@ BINARY: dict[str, tuple[int, bool, Callable]] = {
 }
 UNARY: dict[str, Callable] = {"-": np.negative, "+": np.positive, "~": np.negative,
                               "!": lambda a: np.logical_not(a).astype(float)}
-UNARY_PRECEDENCE = 5          # -x^2 is -(x^2), as in fuzzylite and mathematics
+UNARY_PRECEDENCE = 5          # -x^2 is -(x^2), as in mathematics (fuzzylite has no unary -)
+#: fuzzylite's own unary operators bind tighter than ``^`` (its precedence 100 against 90):
+#: ``~x^2`` is ``(~x)^2``, x squared, as fuzzylite 6 and 8 compute it
+TIGHT_UNARY = ("~", "!")
 
 _TOKEN = re.compile(r"\s*(?:(?P<num>(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)|"
                     r"(?P<name>[A-Za-z_][A-Za-z_0-9]*)|(?P<op>\*\*|[-+*/%^(),~!]))")
@@ -205,7 +209,8 @@ class _Parser:
         if tok is not None and tok[0] == "op" and tok[1] in UNARY:
             self.nest(tok[2])
             self.i += 1
-            node = ("un", tok[1], self.expression(UNARY_PRECEDENCE))
+            operand = self.unary() if tok[1] in TIGHT_UNARY else self.expression(UNARY_PRECEDENCE)
+            node = ("un", tok[1], operand)
             self.depth -= 1
             return node
         return self.atom()
