@@ -116,3 +116,28 @@ def test_einstein_after_or_is_the_einstein_sum():
     assert compile_rulebase(rb).operators.or_ == "einstein_sum"
     rb = parse_fcl(BASE.replace("AND : MIN;", "AND : HAMACHER;"), "probe.fcl")
     assert compile_rulebase(rb).operators.and_ == "hamacher"
+
+
+@pytest.mark.parametrize("condition, warned", [
+    ("a IS high OR b IS high AND a IS low", True),
+    ("a IS low AND b IS low OR a IS high AND b IS high", True),
+    ("NOT (a IS high OR b IS high AND a IS low)", True),
+    ("a IS high OR (b IS high AND a IS low)", False),
+    ("(a IS high OR b IS high) AND a IS low", False),
+    ("a IS low AND b IS low OR a IS high", False),
+    ("a IS high OR b IS high", False)])
+def test_or_before_an_unparenthesized_and_says_how_it_is_grouped(condition, warned):
+    """jFuzzyLogic's `condition : subcondition ((AND | OR) subcondition)*` groups AND and OR
+    left to right, `(a OR b) AND c`, where MITOS (as fuzzylite) takes AND first: such a rule
+    was read one way without a word, though the file may be jFuzzyLogic's."""
+    old = "IF a IS high OR b IS high THEN"
+    text = BASE.replace(old, f"IF {condition} THEN")
+    rb = parse_fcl(text, "probe.fcl")
+    notes = [n for n in rb.notes if "`OR` before an `AND`" in n]
+    assert bool(notes) == warned, rb.notes
+    if warned:
+        line = text.splitlines().index(f"    RULE 2 : IF {condition} THEN y IS hi;") + 1
+        column = len(f"    RULE 2 : IF {condition}") - len(condition) + \
+            condition.index(" OR ") + 5
+        assert notes[0].startswith(f"probe.fcl:{line}:{column}: ")
+        assert "jFuzzyLogic reads AND and OR left to right" in notes[0]

@@ -241,8 +241,9 @@ def _function_block(fb: Tree, span_of) -> RuleBase:
         elif "or_" in keys and "and_" not in keys:
             or_ = next(v for k, v, *_ in record if k == "or_")
             record.set("and_", norms.lookup("snorm", or_).dual, None, "AND")
-        rules = [_rule(item, variables, span_of, i) for i, item in
-                 enumerate(x for x in block.children[1:] if x.data == "rule")]
+        rule_items = [x for x in block.children[1:] if x.data == "rule"]
+        rules = [_rule(item, variables, span_of, i) for i, item in enumerate(rule_items)]
+        _grouping_note(rule_items, span_of, notes)
         name = str(block.children[0]) if block.children[0] is not None else ""
         parsed.append((name, record, rules))
     parsed = [p for p in parsed if p[2]] or parsed[:1]
@@ -559,6 +560,36 @@ def _norm(table: dict, value: str, what: str, span: Span) -> str:
             if names[FLL] == value:
                 return mitos
         raise
+
+
+def _grouping_note(rule_items: list[Tree], span_of, notes: list[str]) -> None:
+    """Say where a condition reads ``a OR b AND c`` without parentheses around the AND: MITOS
+    (as fuzzylite) reads AND first, jFuzzyLogic's grammar (``condition : subcondition ((AND |
+    OR) subcondition)*``) left to right, ``(a OR b) AND c``, and the file does not say which
+    engine wrote it."""
+    found = [span for item in rule_items if (span := _or_before_and(item.children[1], span_of))]
+    if found:
+        notes.append(f"{found[0]}: `OR` before an `AND` without parentheses "
+                     f"({plural(len(found), 'rule')}): read with AND first (`a OR (b AND c)`), "
+                     f"as fuzzylite reads it; jFuzzyLogic reads AND and OR left to right "
+                     f"(`(a OR b) AND c`): add parentheses to say which")
+
+
+def _or_before_and(tree, span_of) -> Span | None:
+    """Where an AND group follows an OR without parentheses of its own, else None."""
+    if not isinstance(tree, Tree):
+        return None
+    for node in tree.iter_subtrees_topdown():
+        if node.data != "or_expr":
+            continue
+        for child in node.children[1:]:
+            if isinstance(child, Tree) and child.data == "and_expr":
+                span = span_of(child)
+                line = span.source_line or ""
+                before = line[:max(span.column - span.source_start, 0)].rstrip()
+                if before and not before.endswith("("):
+                    return span
+    return None
 
 
 def _rule(item: Tree, variables: dict[str, Variable], span_of, index: int) -> Rule:
