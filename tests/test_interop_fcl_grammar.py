@@ -141,3 +141,13 @@ def test_or_before_an_unparenthesized_and_says_how_it_is_grouped(condition, warn
             condition.index(" OR ") + 5
         assert notes[0].startswith(f"probe.fcl:{line}:{column}: ")
         assert "jFuzzyLogic reads AND and OR left to right" in notes[0]
+
+
+@pytest.mark.parametrize("written, universe", [
+    ("(0..10)", (0.0, 10.0)), ("(0.. 10)", (0.0, 10.0)), ("(-5..5)", (-5.0, 5.0)),
+    ("(0.5..1e1)", (0.5, 10.0))])
+def test_a_range_without_spaces_around_the_dots_is_read(written, universe):
+    """`RANGE := (0..10);` (fuzzylite 6 and jFuzzyLogic read it) was refused with "unexpected
+    `.10`": the number took `0.` and left `.10`. A number now stops before `..`."""
+    text = BASE.replace("FUZZIFY a\n    RANGE := (0 .. 10);", f"FUZZIFY a\n    RANGE := {written};")
+    assert parse_fcl(text, "probe.fcl").variables["a"].universe == universe
