@@ -445,6 +445,22 @@ def test_convert_warns_with_the_measured_difference(tmp_path: Path):
     assert "moves by" not in result.stderr          # .fis to .fis: unchanged
 
 
+def test_a_default_nan_against_a_number_is_told_as_such_not_as_inf(tmp_path: Path):
+    """Where no rule fires a .fis file gives MATLAB's mid-range and the FLL its declared NaN:
+    the round trip said "`y` moves by up to inf", an infinity nobody computed."""
+    from mitos_cli.interop import round_trip_difference, write_foreign
+
+    text = FLL_HEDGE_PREFIX.split("RuleBlock:")[0].replace("high Triangle 0", "high Triangle 5")
+    text += ("RuleBlock: b\n  conjunction: Minimum\n  disjunction: Maximum\n"
+             "  implication: Minimum\n  rule: if x is high then y is low\n")
+    rb = parse_fll(text, "d.fll")
+    notes = round_trip_difference(rb, parse_fis(write_foreign(rb, "fis"), "d.fis"), "fis")
+    assert not any("inf" in n.split("(")[0] for n in notes), notes
+    told = [n for n in notes if "where the rule base gives nan" in n]
+    assert len(told) == 1 and "`y` is 5 where the rule base gives nan, on " in told[0]
+    assert " of 2,000 seeded inputs (first at x=" in told[0]
+
+
 def test_fidelity_chooses_the_reference_engines_sampling():
     from mitos_cli.engine.mamdani import grid
 

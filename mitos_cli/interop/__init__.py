@@ -214,13 +214,24 @@ def round_trip_difference(rb: RuleBase, written: RuleBase, fmt: str,
     cols = [before.inputs.index(name) for name in after.inputs]
     Y1 = evaluate(after, X[:, cols], detail=False, strict=False).outputs
     notes = []
+
+    def where(row: int) -> str:
+        return ", ".join(f"{k}={X[row, i]:.4g}" for i, k in enumerate(before.inputs))
+
     for j1, name in enumerate(after.outputs):
         j0 = before.outputs.index(name)
         a, b = Y0[:, j0], Y1[:, j1]
-        same = (np.isnan(a) & np.isnan(b)) | (a == b)          # NaN = NaN, inf = inf
+        one_sided = np.isnan(a) != np.isnan(b)               # a default NaN against a number
+        if one_sided.any():
+            row = int(np.argmax(one_sided))
+            notes.append(f"reading the written {fmt.upper()} back, `{name}` is {b[row]:.6g} "
+                         f"where the rule base gives {a[row]:.6g}, on "
+                         f"{int(one_sided.sum()):,} of {samples:,} seeded inputs "
+                         f"(first at {where(row)})")
+        same = (np.isnan(a) & np.isnan(b)) | (a == b) | one_sided   # NaN = NaN, inf = inf
         with np.errstate(invalid="ignore"):                   # inf - inf, masked out
             diff = np.where(same, 0.0, np.abs(a - b))
-        diff = np.where(np.isnan(diff), np.inf, diff)         # NaN on one side only
+        diff = np.where(np.isnan(diff), np.inf, diff)
         worst = int(np.argmax(diff))
         v = renamed.variables[name]
         width = v.universe[1] - v.universe[0]
@@ -228,12 +239,11 @@ def round_trip_difference(rb: RuleBase, written: RuleBase, fmt: str,
             np.abs(a), initial=1.0)))
         if diff[worst] <= 1e-9 * scale:
             continue
-        where = ", ".join(f"{k}={X[worst, i]:.4g}" for i, k in enumerate(before.inputs))
         share = (f" ({100 * diff[worst] / width:.2g}% of its range)" if np.isfinite(width)
                  and np.isfinite(diff[worst]) else "")
         notes.append(f"reading the written {fmt.upper()} back, `{name}` moves by up to "
                      f"{diff[worst]:.3g}{share} on {samples:,} seeded inputs (largest at "
-                     f"{where})")
+                     f"{where(worst)})")
     return notes
 
 
