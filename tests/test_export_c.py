@@ -179,6 +179,54 @@ def test_c_export_operators_hedges_uses(case: dict, tmp_path: Path) -> None:
     agree(run_python(c, X, tmp_path), want)
 
 
+#: A MATLAB file whose output spans 0, so that MATLAB's som and lom (by absolute value) are
+#: neither the leftmost nor the rightmost sample of a maximum
+STEER_FIS = """\
+[System]
+Name='steer'
+Type='mamdani'
+NumInputs=1
+NumOutputs=1
+NumRules=3
+AndMethod='min'
+OrMethod='max'
+ImpMethod='prod'
+AggMethod='max'
+DefuzzMethod='{method}'
+
+[Input1]
+Name='x'
+Range=[0 10]
+NumMFs=3
+MF1='lo':'trimf',[-10 0 6]
+MF2='mid':'trapmf',[2 4 6 8]
+MF3='hi':'trimf',[4 10 20]
+
+[Output1]
+Name='steer'
+Range=[-10 10]
+NumMFs=3
+MF1='left':'trapmf',[-9 -7 -3 -1]
+MF2='ahead':'trapmf',[-4 -1 1 4]
+MF3='right':'trapmf',[1 3 7 9]
+
+[Rules]
+1, 1 (1) : 1
+2, 2 (1) : 1
+3, 3 (0.8) : 1
+"""
+
+
+@needs_cc
+@pytest.mark.parametrize("method", ["bisector", "som", "lom", "mom", "centroid"])
+def test_matlabs_defuzzifiers_export_as_eval_computes_them(method: str, tmp_path: Path) -> None:
+    path = tmp_path / "steer.fis"
+    path.write_text(STEER_FIS.format(method=method))
+    c, X, want = reference(path)
+    agree(run_c(c, X, tmp_path), want)
+    agree(run_python(c, X, tmp_path), want)
+
+
 @needs_cc
 def test_c_export_every_fuzzylite_shape(tmp_path: Path) -> None:
     from test_conformance import EXAMPLES

@@ -445,6 +445,78 @@ def test_convert_warns_with_the_measured_difference(tmp_path: Path):
     assert "moves by" not in result.stderr          # .fis to .fis: unchanged
 
 
+NEG_FIS = """\
+[System]
+Name='neg'
+Type='mamdani'
+NumInputs=1
+NumOutputs=1
+NumRules=2
+AndMethod='min'
+OrMethod='max'
+ImpMethod='min'
+AggMethod='max'
+DefuzzMethod='{method}'
+
+[Input1]
+Name='x'
+Range=[0 10]
+NumMFs=2
+MF1='lo':'trimf',[-10 0 10]
+MF2='hi':'trimf',[0 10 20]
+
+[Output1]
+Name='steer'
+Range=[-10 10]
+NumMFs=2
+MF1='left':'trapmf',[-9 -7 -3 -1]
+MF2='right':'trapmf',[1 3 7 9]
+
+[Rules]
+1, 1 (1) : 1
+2, 2 (1) : 1
+"""
+
+
+@pytest.mark.parametrize("method, x, want", [
+    ("som", 2.1, -2.6), ("lom", 2.1, -7.4), ("som", 7.9, 2.6), ("lom", 7.9, 7.4),
+    ("som", 5.0, -2.0), ("lom", 5.0, -8.0),            # ties of -2 and 2, -8 and 8: the first
+    ("mom", 2.1, -5.0), ("bisector", 2.1, -4.0), ("bisector", 5.0, -1.2)])
+def test_a_fis_files_defuzzifier_is_matlabs(method: str, x: float, want: float):
+    """The values are MATLAB's rules applied to Octave's aggregated sets. MATLAB's evalfis takes som and lom by absolute value (its `defuzzSmallestOfMax` keeps
+    the maximum's sample nearest 0) and its bisector as the first sample whose running area
+    reaches half the total. MITOS took fuzzylite's: the leftmost and rightmost samples (-7.4
+    for som where MATLAB gives -2.6, 24% of the range) and the sample whose running area is
+    closest to half (one sample off on about half of the inputs)."""
+    rb = parse_fis(NEG_FIS.format(method=method), "n.fis")
+    from mitos_cli.api import LoadedRuleBase
+
+    got = LoadedRuleBase(rb).run(np.array([[x]]), detail=False).outputs[0, 0]
+    assert got == pytest.approx(want, abs=1e-9)
+
+
+def test_converting_matlabs_som_to_fuzzylites_says_that_it_moves():
+    from mitos_cli.interop import conversion_notes, write_foreign
+
+    rb = parse_fis(NEG_FIS.format(method="som"), "n.fis")
+    assert any("FLL has no MATLAB `som`" in n for n in conversion_notes(rb, "fll"))
+    assert not any("MATLAB `som`" in n for n in conversion_notes(rb, "rules"))
+    fll = parse_fll(write_foreign(parse_fis(NEG_FIS.format(method="lom"), "n.fis"), "fll"), "n.fll")
+    assert any("a .fis file's `lom` is MATLAB's" in n for n in conversion_notes(fll, "fis"))
+
+
+def test_matlabs_bisector_is_the_first_sample_reaching_half_the_area():
+    from mitos_cli.engine.mamdani import defuzzify
+
+    x = np.array([0.0, 1.0, 2.0, 3.0])
+    Y = np.array([[1.0, 0.0, 0.9, 0.1]])             # running area 1, 1, 1.9, 2: half is 1
+    assert defuzzify(Y, x, "matlab_bisector")[0] == 0.0       # reached at the first sample
+    assert defuzzify(Y, x, "bisector")[0] == 0.5              # closest: a tie of 0 and 1
+    Y = np.array([[0.0, 0.3, 0.3, 0.4]])             # 0, 0.3, 0.6, 1: half reached at x = 2
+    assert defuzzify(Y, x, "matlab_bisector")[0] == 2.0
+    assert defuzzify(Y, x, "matlab_som")[0] == defuzzify(Y, x, "matlab_lom")[0] == 3.0
+
+
 def test_a_default_nan_against_a_number_is_told_as_such_not_as_inf(tmp_path: Path):
     """Where no rule fires a .fis file gives MATLAB's mid-range and the FLL its declared NaN:
     the round trip said "`y` moves by up to inf", an infinity nobody computed."""

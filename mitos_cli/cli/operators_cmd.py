@@ -33,6 +33,10 @@ DEFUZZIFY = {
     "mom": "mean of the samples where mu(y) is maximal",
     "som": "smallest sample where mu(y) is maximal",
     "lom": "largest sample where mu(y) is maximal",
+    "matlab_bisector": "the first sample where the running area reaches half the total "
+                       "(MATLAB's evalfis, a .fis file's bisector)",
+    "matlab_som": "the sample where mu(y) is maximal smallest in absolute value (MATLAB's som)",
+    "matlab_lom": "the sample where mu(y) is maximal largest in absolute value (MATLAB's lom)",
 }
 
 

@@ -10,6 +10,9 @@ rules' sets are joined by the aggregation S-norm, and the result is defuzzified:
 ``mom``        mean of the samples where ``mu`` is maximal (and > 0)
 ``som``        smallest of them
 ``lom``        largest of them
+``matlab_*``   MATLAB's ``evalfis`` (a ``.fis`` file's): ``matlab_bisector`` the first sample
+               whose running area reaches half the total; ``matlab_som`` / ``matlab_lom`` the
+               maximum's sample smallest / largest in absolute value (the first of a tie)
 
 **Grid.** The universe ``[lo, hi]`` is cut into ``resolution`` equal cells and sampled at their
 midpoints, ``x_i = lo + (i + 1/2) (hi - lo) / resolution``: the midpoint rule of integration,
@@ -241,10 +244,13 @@ def defuzzify(Y: np.ndarray, x: np.ndarray, method: str) -> np.ndarray:
         num = (Y * x).sum(axis=1)
         np.divide(num, den, out=out, where=den > 0)
         return out
-    if method == "bisector":
+    if method in ("bisector", "matlab_bisector"):
         area = np.cumsum(Y, axis=1)
         total = area[:, -1:]
         ok = total[:, 0] > 0
+        if method == "matlab_bisector":     # the first sample whose running area reaches half
+            out[ok] = x[np.argmax(area >= total / 2, axis=1)][ok]
+            return out
         with np.errstate(invalid="ignore", divide="ignore"):
             gap = np.abs(area / total - 0.5)
         ties = gap == gap.min(axis=1, keepdims=True)
@@ -260,6 +266,10 @@ def defuzzify(Y: np.ndarray, x: np.ndarray, method: str) -> np.ndarray:
         out[ok] = x[np.argmax(peak, axis=1)][ok]
     elif method == "lom":
         out[ok] = x[len(x) - 1 - np.argmax(peak[:, ::-1], axis=1)][ok]
+    elif method == "matlab_som":            # the maximum's sample nearest 0 (the first of two)
+        out[ok] = x[np.argmin(np.where(peak, np.abs(x), np.inf), axis=1)][ok]
+    elif method == "matlab_lom":            # the maximum's sample farthest from 0
+        out[ok] = x[np.argmax(np.where(peak, np.abs(x), -1.0), axis=1)][ok]
     else:
         raise ValueError(f"unknown defuzzifier {method!r}")
     return out

@@ -156,6 +156,31 @@ SAMPLED_AT = {"endpoints": "evenly spaced points including both ends (MATLAB's)"
               "left": "the cells' left ends (jFuzzyLogic's)"}
 
 
+#: MATLAB's defuzzifiers that fuzzylite (FLL, FCL) defines otherwise, and what each means
+MATLAB_MEANS = {"bisector": "the first sample whose running area reaches half the total",
+                "som": "the maximum's sample smallest in absolute value",
+                "lom": "the maximum's sample largest in absolute value"}
+FUZZYLITE_MEANS = {"bisector": "the sample whose running area is closest to half the total",
+                   "som": "the maximum's smallest sample", "lom": "the maximum's largest sample"}
+
+
+def _defuzzifier_notes(ops, fmt: str) -> list[str]:
+    """A bisector, som or lom written where the target defines it otherwise: MATLAB's into FLL
+    or FCL, fuzzylite's (MITOS's own) into a .fis file."""
+    if ops.inference != "mamdani":
+        return []
+    name = ops.defuzzify.removeprefix("matlab_")
+    if name not in MATLAB_MEANS:
+        return []
+    if fmt in ("fll", "fcl") and ops.defuzzify.startswith("matlab_"):
+        return [f"{fmt.upper()} has no MATLAB `{name}` ({MATLAB_MEANS[name]}): fuzzylite's is "
+                f"written ({FUZZYLITE_MEANS[name]}), so results move where the two differ"]
+    if fmt == "fis" and not ops.defuzzify.startswith("matlab_"):
+        return [f"a .fis file's `{name}` is MATLAB's ({MATLAB_MEANS[name]}), not this rule "
+                f"base's ({FUZZYLITE_MEANS[name]}), so results move where the two differ"]
+    return []
+
+
 def conversion_notes(rb: RuleBase, fmt: str, behavior: str | None = None) -> list[str]:
     """What writing ``rb`` as ``fmt`` (``rules`` included) leaves out or changes; the file is
     written anyway and ``mitos convert`` prints these as warnings."""
@@ -167,11 +192,12 @@ def conversion_notes(rb: RuleBase, fmt: str, behavior: str | None = None) -> lis
     rb, out = legal_names(rb, fmt)
     if left:
         out.append(left)
+    ops = of_behavior(rb, b)
+    out += _defuzzifier_notes(ops, fmt)
     if fmt == "fis":
         from .fis import notes
 
         return out + notes(rb, behavior)
-    ops = of_behavior(rb, b)
     if fmt in ("fcl", "fll") and ops.inference == "mamdani" and ops.sampling != "midpoints":
         out.append(f"{fmt.upper()} Mamdani outputs are sampled at cell midpoints (fuzzylite's "
                    f"rule); this rule base samples at {SAMPLED_AT[ops.sampling]}, so results "

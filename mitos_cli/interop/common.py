@@ -39,6 +39,10 @@ DEFUZZIFIERS = {
     "mom": ("MeanOfMaximum", "mom", "MM"),
     "som": ("SmallestOfMaximum", "som", "LM"),
     "lom": ("LargestOfMaximum", "lom", "RM"),
+    # MATLAB's (read from .fis); FLL and FCL get fuzzylite's, and `convert` measures the change
+    "matlab_bisector": ("Bisector", "bisector", "COA"),
+    "matlab_som": ("SmallestOfMaximum", "som", "LM"),
+    "matlab_lom": ("LargestOfMaximum", "lom", "RM"),
     "weighted_average": ("WeightedAverage", "wtaver", "COGS"),
     "weighted_sum": ("WeightedSum", "wtsum", "COGSS"),
 }

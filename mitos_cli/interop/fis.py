@@ -12,7 +12,8 @@ Mapping: ``trimf trapmf gaussmf gauss2mf gbellmf sigmf dsigmf psigmf pimf smf zm
 constant linear``, and the types fuzzylite's exporter adds (``rampmf cosinemf discretemf spikemf
 concavemf rectmf binarymf``, read as its terms); ``and``: min, prod; ``or``: max, probor;
 ``imp``: min, prod; ``agg``: max, probor (``sum`` is refused); defuzzifiers centroid, bisector,
-mom, som, lom (Mamdani) and wtaver, wtsum (Sugeno). When no rule fires MATLAB returns the middle
+mom, som, lom (Mamdani; bisector, som and lom as MATLAB defines them, ``matlab_*``) and
+wtaver, wtsum (Sugeno). When no rule fires MATLAB returns the middle
 of the output range (with a warning); the reader makes that the output's ``default``. An
 antecedent's fractional MF index is Octave's hedge (``-2.3``: not extremely MF 2; ``.05 .2 .3
 .4``: somewhat, very, extremely, very very). Custom MF functions, other fractions, and negative
@@ -66,6 +67,9 @@ MF_TYPES = {
 FUZZYLITE_MF_TYPES = {"binarymf": "Binary", "concavemf": "Concave", "cosinemf": "Cosine",
                       "discretemf": "Discrete", "rampmf": "Ramp", "rectmf": "Rectangle",
                       "spikemf": "Spike"}
+#: MATLAB's evalfis defines these its own way (its bisector is the first sample whose running
+#: area reaches half, its som and lom are by absolute value): a .fis file means MATLAB's
+MATLAB_DEFUZZIFIERS = {"bisector": "matlab_bisector", "som": "matlab_som", "lom": "matlab_lom"}
 SYSTEM_KEYS = ("Name", "Type", "Version", "NumInputs", "NumOutputs", "NumRules", "AndMethod",
                "OrMethod", "ImpMethod", "AggMethod", "DefuzzMethod",
                "DisableStructuralChecks")     # MATLAB R2018b+; only affects MATLAB's editor
@@ -163,7 +167,7 @@ def parse_fis(text: str, path: str | None = None) -> RuleBase:
     if sugeno != (kind == "sugeno"):
         raise FormatError(f"defuzzification `{_string(*system['DefuzzMethod'])}` does not fit a "
                           f"{kind} system", span=system["DefuzzMethod"][1])
-    settings.set("defuzzify", defuzz, None, "defuzzifier")
+    settings.set("defuzzify", MATLAB_DEFUZZIFIERS.get(defuzz, defuzz), None, "defuzzifier")
     if not sugeno:        # MATLAB ignores ImpMethod / AggMethod for Sugeno systems
         settings.set("implication", common.check_implication(
             method("ImpMethod", common.TNORMS, "implication method", "min"),

@@ -17,7 +17,8 @@ INFERENCES = ("weighted_average", "weighted_sum", "mamdani", "tsukamoto")
 #: Mamdani implications: any T-norm (min and product are the classic ones; FLL files also use
 #: e.g. EinsteinProduct).
 IMPLICATIONS = tuple(norms.TNORMS)
-DEFUZZIFIERS = ("centroid", "bisector", "mom", "som", "lom")
+DEFUZZIFIERS = ("centroid", "bisector", "mom", "som", "lom",
+                "matlab_bisector", "matlab_som", "matlab_lom")      # MATLAB's evalfis
 #: Where Mamdani outputs are sampled: cell midpoints (fuzzylite's rule, the default),
 #: ``resolution`` evenly spaced points including both ends (MATLAB's ``evalfis``), or the
 #: cells' left ends (jFuzzyLogic's ``min + i (max - min) / resolution``).

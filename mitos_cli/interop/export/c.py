@@ -313,6 +313,13 @@ def _c_defuzzify(method: str, res: int, j: int, fallback: str) -> list[str]:
         return ["{", "    double num = 0.0, den = 0.0, value = NAN;",
                 f"    for (i = 0; i < {res}; ++i) {{ num += y[i] * grid[i]; den += y[i]; }}",
                 "    if (den > 0.0) value = num / den;", *("    " + d for d in done), "}"]
+    if method == "matlab_bisector":
+        return ["{", "    double total = 0.0, area = 0.0, value = NAN;",
+                f"    for (i = 0; i < {res}; ++i) total += y[i];",
+                f"    if (total > 0.0) for (i = 0; i < {res}; ++i) {{",
+                "        area += y[i];",
+                "        if (area >= total / 2) { value = grid[i]; break; }",
+                "    }", *("    " + d for d in done), "}"]
     if method == "bisector":
         return ["{", "    double total = 0.0, area = 0.0, best = INFINITY, sum = 0.0, value = NAN;",
                 "    int count = 0;",
@@ -333,7 +340,14 @@ def _c_defuzzify(method: str, res: int, j: int, fallback: str) -> list[str]:
             "som": [f"        for (i = 0; i < {res}; ++i) if (y[i] == top) {{ value = grid[i]; "
                     f"break; }}"],
             "lom": [f"        for (i = {res} - 1; i >= 0; --i) if (y[i] == top) {{ value = "
-                    f"grid[i]; break; }}"]}[method]
+                    f"grid[i]; break; }}"],
+            "matlab_som": ["        double best = INFINITY;",
+                           f"        for (i = 0; i < {res}; ++i) if (y[i] == top && "
+                           f"fabs(grid[i]) < best) {{ best = fabs(grid[i]); value = grid[i]; }}"],
+            "matlab_lom": ["        double best = -1.0;",
+                           f"        for (i = 0; i < {res}; ++i) if (y[i] == top && "
+                           f"fabs(grid[i]) > best) {{ best = fabs(grid[i]); value = grid[i]; }}"],
+            }[method]
     return ["{", "    double top = 0.0, value = NAN;",
             f"    for (i = 0; i < {res}; ++i) if (y[i] > top) top = y[i];",
             "    if (top > 0.0) {", *pick, "    }", *("    " + d for d in done), "}"]

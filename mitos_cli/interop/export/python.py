@@ -259,6 +259,10 @@ def _py_defuzzify(method: str) -> list[str]:
         return ["den = Yj.sum(axis=1)",
                 "value = np.where(den > 0, (Yj * grid).sum(axis=1) / np.where(den > 0, den, 1), "
                 "np.nan)"]
+    if method == "matlab_bisector":
+        return ["area = np.cumsum(Yj, axis=1)", "total = area[:, -1:]",
+                "value = np.where(total[:, 0] > 0, "
+                "grid[np.argmax(area >= total / 2, axis=1)], np.nan)"]
     if method == "bisector":
         return ["area = np.cumsum(Yj, axis=1)", "total = area[:, -1:]",
                 "gap = np.abs(area / total - 0.5)",
@@ -267,6 +271,9 @@ def _py_defuzzify(method: str) -> list[str]:
                 "/ np.maximum(ties.sum(axis=1), 1), np.nan)"]
     pick = {"mom": "np.where(peak, grid, 0.0).sum(axis=1) / np.maximum(peak.sum(axis=1), 1)",
             "som": "grid[np.argmax(peak, axis=1)]",
-            "lom": "grid[len(grid) - 1 - np.argmax(peak[:, ::-1], axis=1)]"}[method]
+            "lom": "grid[len(grid) - 1 - np.argmax(peak[:, ::-1], axis=1)]",
+            "matlab_som": "grid[np.argmin(np.where(peak, np.abs(grid), np.inf), axis=1)]",
+            "matlab_lom": "grid[np.argmax(np.where(peak, np.abs(grid), -1.0), axis=1)]",
+            }[method]
     return ["top = Yj.max(axis=1, keepdims=True)", "peak = (Yj > 0) & (Yj == top)",
             f"value = np.where(peak.any(axis=1), {pick}, np.nan)"]
