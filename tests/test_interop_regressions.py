@@ -495,6 +495,20 @@ def test_a_fis_files_defuzzifier_is_matlabs(method: str, x: float, want: float):
     assert got == pytest.approx(want, abs=1e-9)
 
 
+@pytest.mark.parametrize("engine, want", [("matlab", -2.6), ("fuzzylite6", -7.3),
+                                           ("fuzzylite", -7.41)])
+def test_a_fidelity_computes_som_as_its_engine_defines_it(engine: str, want: float):
+    """`--fidelity fuzzylite6` on a .fis file with `som` gave MATLAB's -2.6 at fuzzylite 6's
+    sampling, where the `fuzzylite` binary gives -7.3: a fidelity now takes its engine's own
+    bisector, som and lom too."""
+    from mitos_cli.api import LoadedRuleBase
+    from mitos_cli.interop.common import fidelity_settings
+
+    rb = parse_fis(NEG_FIS.format(method="som"), "n.fis")
+    loaded = LoadedRuleBase(rb, None, fidelity_settings(rb, engine))
+    assert loaded.run(np.array([[2.1]]), detail=False).outputs[0, 0] == pytest.approx(want)
+
+
 def test_converting_matlabs_som_to_fuzzylites_says_that_it_moves():
     from mitos_cli.interop import conversion_notes, write_foreign
 

@@ -942,4 +942,14 @@ def fidelity_settings(rb: RuleBase, engine: str, behavior: str | None = None
         written = not foreign or (setting_span(rb, behavior, "resolution") is not None
                                   and ops.sampling != "endpoints")
         resolution = ops.resolution if written else UNWRITTEN_RESOLUTION[engine]
-    return (Setting("resolution", str(resolution)), Setting("sampling", sampling))
+    return (Setting("resolution", str(resolution)), Setting("sampling", sampling),
+            *_engines_defuzzifier(ops.defuzzify, engine))
+
+
+def _engines_defuzzifier(method: str, engine: str) -> tuple[Setting, ...]:
+    """``engine``'s own bisector, som or lom: MATLAB defines them otherwise than fuzzylite and
+    jFuzzyLogic (:data:`.fis.MATLAB_DEFUZZIFIERS`), and a fidelity computes as its engine."""
+    plain = method.removeprefix("matlab_")
+    if plain not in ("bisector", "som", "lom"):
+        return ()
+    return (Setting("defuzzify", f"matlab_{plain}" if engine == "matlab" else plain),)
