@@ -179,6 +179,38 @@ def test_c_export_operators_hedges_uses(case: dict, tmp_path: Path) -> None:
     agree(run_python(c, X, tmp_path), want)
 
 
+BINARY_FLL = """\
+Engine: b
+InputVariable: x
+  range: 0 10
+  term: right Binary 3 inf
+  term: left Binary 7 -inf
+OutputVariable: y
+  range: 0 10
+  aggregation: none
+  defuzzifier: WeightedAverage TakagiSugeno
+  default: 5
+  term: lo Constant 2
+  term: hi Constant 8
+RuleBlock: r
+  rule: if x is right then y is hi
+  rule: if x is left then y is lo with 0.5
+"""
+
+
+@needs_cc
+def test_a_binary_input_term_with_an_infinite_direction_exports(tmp_path: Path) -> None:
+    """`Binary 3 inf`, fuzzylite's way to write a step (pyfuzzylite's `terms/binary.fll`), made
+    `mitos export` stop with a Python traceback: an infinity has no C or Python literal."""
+    path = tmp_path / "b.fll"
+    path.write_text(BINARY_FLL)
+    c, X, want = reference(path)
+    X = np.vstack([X, [[3.0], [7.0], [2.999], [7.001]]])
+    want = load_rulebase(path).run(X, strict=False, detail=False).outputs
+    agree(run_c(c, X, tmp_path), want)
+    agree(run_python(c, X, tmp_path), want)
+
+
 #: A MATLAB file whose output spans 0, so that MATLAB's som and lom (by absolute value) are
 #: neither the leftmost nor the rightmost sample of a maximum
 STEER_FIS = """\

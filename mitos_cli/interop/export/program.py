@@ -33,6 +33,15 @@ def num(value: float) -> str:
     return text if ("." in text or "e" in text or "n" in text) else text + ".0"
 
 
+def finite_binary(params: tuple[float, ...]) -> tuple[float, ...]:
+    """A ``binary`` term's direction as a finite number on the same side of its start: only
+    which side counts, and ``Binary 3 inf`` (fuzzylite's way to write it) has no literal."""
+    start, direction = params
+    step = max(1.0, abs(start))
+    return (start, start + step if direction > start else start - step if direction < start
+            else start)
+
+
 def ident(name: str) -> str:
     """``name`` as a C / Python identifier fragment: ``[A-Za-z0-9_]``, not starting with a
     digit."""
@@ -124,7 +133,8 @@ def program(compiled: CompiledRuleBase) -> Program:
                 raise FormatError(f"term `{key[0]}.{key[1]}`: `mitos export` has no code for "
                                   f"formula terms (`{term.formula.text}`)", span=term.span)
             kernel = kernel_params(term.corners) if term.corners is not None else None
-            terms.append((int(compiled.term_var[i]), names[key], term.shape, term.params, kernel))
+            params = finite_binary(term.params) if term.shape == "binary" else term.params
+            terms.append((int(compiled.term_var[i]), names[key], term.shape, params, kernel))
     shapes = {t[2] for t in terms if t[4] is None}
     if any(t[4] is not None for t in terms):
         used.add("kernel")
