@@ -509,6 +509,30 @@ def test_a_fidelity_computes_som_as_its_engine_defines_it(engine: str, want: flo
     assert loaded.run(np.array([[2.1]]), detail=False).outputs[0, 0] == pytest.approx(want)
 
 
+STEP_FIS = NEG_FIS.replace("DefuzzMethod='{method}'", "DefuzzMethod='centroid'").replace(
+    "NumMFs=2\nMF1='lo':'trimf',[-10 0 10]\nMF2='hi':'trimf',[0 10 20]", "NumMFs=2\n{mfs}")
+
+
+@pytest.mark.parametrize("mf, inside, outside", [
+    ("'smf',[3 3]", (3.0, 5.0), (2.999, 0.0)), ("'zmf',[3 3]", (3.0, 0.0), (3.001, 10.0)),
+    ("'smf',[5 3]", (4.0, 4.5), (3.999,)), ("'zmf',[5 3]", (4.0, 3.5), (4.001,)),
+    ("'pimf',[2 2 6 6]", (2.0, 6.0, 4.0), (1.999, 6.001))])
+def test_matlabs_step_smf_zmf_and_pimf_are_1_at_the_step(mf: str, inside, outside, tmp_path):
+    """MATLAB's `smf [a b]` with a >= b is the step x >= (a + b) / 2 (its `fisSMf`), `zmf` the
+    step x <= (a + b) / 2, `pimf` their product. `smf [3 3]` was read as fuzzylite's S shape,
+    0 at x = 3 where MATLAB gives 1, and `smf [5 3]` was refused."""
+    from mitos_cli.interop import write_foreign
+
+    text = STEP_FIS.format(mfs=f"MF1='lo':{mf}\nMF2='hi':'trimf',[0 10 20]")
+    rb = parse_fis(text, "s.fis")
+    lo = rb.variables["x"].term("lo")
+    assert (lo.membership(np.array(inside)) == 1.0).all()
+    assert (lo.membership(np.array(outside)) == 0.0).all()
+    again = parse_fis(write_foreign(rb, "fis"), "again.fis").variables["x"].term("lo")
+    x = np.linspace(0, 10, 1001)
+    assert (again.membership(x) == lo.membership(x)).all()
+
+
 def test_converting_matlabs_som_to_fuzzylites_says_that_it_moves():
     from mitos_cli.interop import conversion_notes, write_foreign
 

@@ -331,8 +331,23 @@ def _mf(value: str, vspan: Span, role: str, kind: str, n_inputs: int) -> Term:
     if len(params) != count:
         raise FormatError(f"MF `{name}`: {mf} takes {plural(count, 'number')}, not {len(params)}",
                           span=vspan)
+    step = _step(mf, params)
+    if step is not None:
+        return common.make_term(name, *step, vspan)
     return common.make_term(name, *common.shoulder(shape, tuple(params[i] for i in order)),
                             vspan)
+
+
+def _step(mf: str, params: list[float]) -> tuple[str, tuple[float, ...]] | None:
+    """MATLAB's ``smf`` and ``zmf`` whose feet meet or cross (``a >= b``) are a step at their
+    midpoint, ``x >= (a + b) / 2`` and ``x <= (a + b) / 2`` (its ``fisSMf``, ``fisZMf``): 1 at
+    the midpoint itself, where fuzzylite's S and Z shapes give 0 and 1. ``pimf`` is their
+    product, a closed rectangle when both are steps. None for the other MFs."""
+    if mf in ("smf", "zmf") and params[0] >= params[1]:
+        return "binary", ((params[0] + params[1]) / 2, math.inf if mf == "smf" else -math.inf)
+    if mf == "pimf" and params[0] >= params[1] and params[2] >= params[3]:
+        return "rectangle", ((params[0] + params[1]) / 2, (params[2] + params[3]) / 2)
+    return None
 
 
 #: Octave's fuzzy-logic-toolkit: the fraction of an antecedent's MF index is a hedge, the
@@ -506,6 +521,9 @@ def _mf_text(t: Term, v: Variable) -> str:
         return f"'{t.name}':'trapmf',[{' '.join(fmt_number(x) for x in (a, b, c, d))}]"
     if shape == "ramp" and p[0] > p[1]:
         return f"'{t.name}':'linzmf',[{fmt_number(p[1])} {fmt_number(p[0])}]"
+    if shape == "binary" and math.isinf(p[1]):      # MATLAB's step: smf or zmf [s s]
+        mf = "smf" if p[1] > 0 else "zmf"
+        return f"'{t.name}':'{mf}',[{fmt_number(p[0])} {fmt_number(p[0])}]"
     if shape not in INVERSE:
         raise FormatError(f"term `{v.name}.{t.name}`: MATLAB has no `{shape}` membership "
                           f"function", span=t.span)
