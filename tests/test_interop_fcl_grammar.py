@@ -151,3 +151,32 @@ def test_a_range_without_spaces_around_the_dots_is_read(written, universe):
     `.10`": the number took `0.` and left `.10`. A number now stops before `..`."""
     text = BASE.replace("FUZZIFY a\n    RANGE := (0 .. 10);", f"FUZZIFY a\n    RANGE := {written};")
     assert parse_fcl(text, "probe.fcl").variables["a"].universe == universe
+
+
+def test_the_iec_dialect_writes_what_jfuzzylogics_grammar_reads():
+    """jFuzzyLogic's `Fcl.g` has an input's RANGE after its declaration (`var_def : ID COLON
+    data_type SEMICOLON (range)?`), FUZZIFY blocks of terms only, `DEFAULT := REAL | NC` and
+    its own names for the smooth shapes. The IEC dialect wrote RANGE in FUZZIFY, `DEFAULT :=
+    nan;` and fuzzylite's `Gaussian`, none of which that grammar reads."""
+    from mitos_cli.interop import write_foreign
+
+    text = BASE.replace(HIGH, "TERM high := GAUSS 8 2;").replace(
+        "TERM high := (4, 0) (10, 1);", "TERM high := GBELL 2 3 8;").replace(
+        "DEFAULT := 0;", "DEFAULT := nan;")
+    rb = parse_fcl(text, "probe.fcl")
+    written = write_foreign(rb, "fcl", dialect="iec")
+    lines = [line.strip() for line in written.splitlines()]
+    fuzzify = [i for i, line in enumerate(lines) if line.startswith("FUZZIFY")]
+    for i in fuzzify:
+        block = lines[i + 1:lines.index("END_FUZZIFY", i)]
+        assert all(line.startswith("TERM ") for line in block), block
+    assert "a : REAL; RANGE := (0 .. 10);" in lines and "b : REAL; RANGE := (0 .. 10);" in lines
+    assert "TERM high := GAUSS 8 2;" in lines and "TERM high := GBELL 2 3 8;" in lines
+    assert not any(line.startswith("DEFAULT") for line in lines)
+    back = parse_fcl(written, "back.fcl")
+    X = np.random.default_rng(5).uniform(0, 10, size=(200, 2))
+    before = evaluate(compile_rulebase(rb), X, strict=False, detail=False).outputs
+    after = evaluate(compile_rulebase(back), X, strict=False, detail=False).outputs
+    np.testing.assert_array_equal(after, before)
+    fuzzylite = write_foreign(rb, "fcl")            # fuzzylite 6 reads RANGE in FUZZIFY
+    assert "FUZZIFY a\n    RANGE := (0 .. 10);" in fuzzylite and "DEFAULT := nan;" in fuzzylite

@@ -21,7 +21,8 @@ MITOS's model. Both dialects are read:
 
 Without a ``RANGE``, a variable's range is the extent of its piecewise-linear terms.
 The writer writes one of two dialects (:data:`DIALECTS`): fuzzylite 6's (the default) or IEC
-61131-7 as jFuzzyLogic reads it; both have lower-case rule keywords, point lists for
+61131-7 as jFuzzyLogic reads it (an input's RANGE after its declaration, no ``DEFAULT := nan``,
+jFuzzyLogic's names for its shapes); both have lower-case rule keywords, point lists for
 piecewise-linear terms and no resolution after METHOD. Shapes IEC has no notation for use
 jFuzzyLogic's or fuzzylite's names, which this reader reads back.
 """
@@ -643,15 +644,19 @@ def write_fcl(rb: RuleBase, behavior: str | None = None, dialect: str = DEFAULT_
         common.SNORMS, FCL, ops.aggregation, "S-norm", span=at("aggregation"))
     out = [f"// {DIALECTS[dialect]}; written by MITOS", "", f"FUNCTION_BLOCK {flat.name}", "",
            "VAR_INPUT"]
-    out += [f"    {v.name} : REAL;" for v in inputs] + ["END_VAR", "", "VAR_OUTPUT"]
+    # jFuzzyLogic's grammar has an input's RANGE after its declaration (`var_def`), not in
+    # FUZZIFY, which holds terms only; fuzzylite 6 reads it in FUZZIFY
+    iec = dialect == "iec"
+    out += [f"    {v.name} : REAL;" + (f" {_range(v)}" if iec else "") for v in inputs]
+    out += ["END_VAR", "", "VAR_OUTPUT"]
     out += [f"    {v.name} : REAL;" for v in flat.outputs] + ["END_VAR", ""]
     for v in inputs:
         out.append(f"FUZZIFY {v.name}")
-        out.append(f"    RANGE := ({fmt_number(v.universe[0])} .. {fmt_number(v.universe[1])});")
-        out += [f"    TERM {t.name} := {_term_text(t, v)};" for t in v.terms]
+        out += [] if iec else [f"    {_range(v)}"]
+        out += [f"    TERM {t.name} := {_term_text(t, v, dialect)};" for t in v.terms]
         out += ["END_FUZZIFY", ""]
     for v in flat.outputs:
-        out += _defuzzify(rb, v, ops, inputs, at, accu if dialect == "fuzzylite" else None)
+        out += _defuzzify(rb, v, ops, inputs, at, dialect, accu)
         out += ["END_DEFUZZIFY", ""]
     out.append(f"RULEBLOCK {flat.name}")
     and_ = common.foreign_name(common.TNORMS, FCL, ops.and_, "T-norm", span=at("and"))
@@ -669,13 +674,16 @@ def write_fcl(rb: RuleBase, behavior: str | None = None, dialect: str = DEFAULT_
     return "\n".join(out) + "\n"
 
 
-def _defuzzify(rb: RuleBase, v: Variable, ops, inputs: Sequence[Variable], at,
+def _range(v: Variable) -> str:
+    return f"RANGE := ({fmt_number(v.universe[0])} .. {fmt_number(v.universe[1])});"
+
+
+def _defuzzify(rb: RuleBase, v: Variable, ops, inputs: Sequence[Variable], at, dialect: str,
                accu: str | None) -> list[str]:
-    """An output's DEFUZZIFY block up to its END; ``accu``: an ACCU line after METHOD, where
-    fuzzylite's own exporter writes it."""
+    """An output's DEFUZZIFY block up to its END; ``accu``: the ACCU line fuzzylite's dialect
+    writes after METHOD, where fuzzylite's own exporter writes it."""
     sugeno = ops.inference in ("weighted_average", "weighted_sum")
-    out = [f"DEFUZZIFY {v.name}",
-           f"    RANGE := ({fmt_number(v.universe[0])} .. {fmt_number(v.universe[1])});"]
+    out = [f"DEFUZZIFY {v.name}", f"    {_range(v)}"]
     for t in v.terms:
         if sugeno and t.shape == "linear":
             coefficients = common.linear_coefficients(rb, v.name, t)
@@ -684,7 +692,7 @@ def _defuzzify(rb: RuleBase, v: Variable, ops, inputs: Sequence[Variable], at,
         elif sugeno:
             text = fmt_number(t.center)
         else:
-            text = _term_text(t, v)
+            text = _term_text(t, v, dialect)
         out.append(f"    TERM {t.name} := {text};")
     if sugeno:
         out.append(f"    METHOD : {common.DEFUZZIFIERS[ops.inference][FCL]};")
@@ -692,14 +700,26 @@ def _defuzzify(rb: RuleBase, v: Variable, ops, inputs: Sequence[Variable], at,
         method = common.foreign_name(common.DEFUZZIFIERS, FCL, ops.defuzzify, "defuzzifier",
                                      span=at("defuzzify"))
         out.append(f"    METHOD : {method};")
-    if accu is not None:
+    if accu is not None and dialect == "fuzzylite":
         out.append(f"    ACCU : {accu};")
-    if v.default is not None:           # none: no DEFAULT line (the output is NaN)
+    # none: no DEFAULT line (the output is NaN); jFuzzyLogic's DEFAULT takes a number or NC,
+    # and NaN is its default when no line gives one
+    if v.default is not None and not (dialect == "iec" and math.isnan(v.default)):
         out.append(f"    DEFAULT := {fmt_number(v.default)};")
     return out
 
 
-def _term_text(t: Term, v: Variable) -> str:
+#: MITOS shapes jFuzzyLogic names (the IEC dialect writes them so): MITOS params -> its own
+JFUZZY_NAMES = {
+    "gaussian": ("GAUSS", lambda p: p),
+    "gaussian2": ("GAUSS2", lambda p: p),
+    "bell": ("GBELL", lambda p: (p[1], p[2], p[0])),
+    "sigmoid": ("SIGM", lambda p: (p[1], p[0])),
+    "cosine": ("COSINE", lambda p: (p[1] / 2.0, p[0])),
+}
+
+
+def _term_text(t: Term, v: Variable, dialect: str = DEFAULT_DIALECT) -> str:
     if t.formula is not None:
         raise FormatError(f"term `{v.name}.{t.name}`: FCL has no formula terms (fuzzylite's "
                           f"`Function`); write it to FLL or a term set", span=t.span)
@@ -715,6 +735,9 @@ def _term_text(t: Term, v: Variable) -> str:
         pts = _corner_points(t.corners)
         if pts is not None:
             return " ".join(f"({fmt_number(x)}, {fmt_number(y)})" for x, y in pts)
+    if dialect == "iec" and t.shape in JFUZZY_NAMES:
+        name, order = JFUZZY_NAMES[t.shape]
+        return f"{name} " + " ".join(fmt_number(x) for x in order(t.params))
     return common.fuzzylite_term_text(t, v.name)
 
 
