@@ -698,3 +698,19 @@ def test_fis_notes_where_a_sugeno_aggmethod_changes_other_engines_outputs():
                for n in parse_fis(shared, "s.fis").notes)
     assert not any("AggMethod" in n for n in parse_fis(
         sugeno.replace(rules, "[Rules]\n1, 1 (1) : 1\n2, 2 (1) : 1\n"), "s.fis").notes)
+
+
+def test_an_fll_name_with_a_letter_beyond_ascii_is_read_in_rules():
+    """pyfuzzylite 8 reads `term: lö Triangle ...` and `if x is lö`; MITOS took the
+    declaration and then refused the rule ("cannot read this rule" at the `ö`)."""
+    text = FLL_HEDGE_PREFIX.replace("InputVariable: x", "InputVariable: xö").replace(
+        "term: high Triangle", "term: veryö Triangle").replace(
+        "rule: if x is veryhigh then y is anyway\n", "rule: if xö is veryhigh then y is anyway\n"
+    ).replace("rule: if x is notable then y is low\n", "rule: if xö is veryö then y is low\n")
+    rb = parse_fll(text, "u.fll")
+    second = rb.behaviors[0].rules[1].antecedent
+    assert (second.var, second.term, second.hedges) == ("xö", "veryö", ())
+    X = np.array([[10.0]])                          # both terms 1: (8 + 2) / 2
+    from mitos_cli.api import LoadedRuleBase
+
+    assert LoadedRuleBase(rb).run(X, detail=False).outputs[0, 0] == pytest.approx(5.0)
