@@ -187,25 +187,53 @@ RuleBlock: b
 """
 
 
-def test_a_hedged_mamdani_consequent_is_refused_where_fuzzylite_writes_it(tmp_path):
+def test_a_hedged_mamdani_consequent_is_read_as_fuzzylite_computes_it():
     """It was read as MITOS's hedged set where fuzzylite hedges the degree: another number
-    (5.37 where fuzzylite gives 5.58), and not a word."""
+    (5.37 where fuzzylite gives 5.58), and not a word. With one proposition as the condition
+    the hedge is moved onto it, which computes fuzzylite's degree exactly."""
+    assert run(HEDGED_MAMDANI, [[0.5]])[0, 0] == pytest.approx(5.576923076923077, abs=1e-12)
+    rb = parse_fll(HEDGED_MAMDANI, "t.fll")
+    moved = rb.behaviors[0].rules[1]
+    assert moved.antecedent.hedges == ("very",) and moved.consequents[0].hedges == ()
+    line = HEDGED_MAMDANI.splitlines().index("  rule: if x is high then y is very lo") + 1
+    assert any(n.startswith(f"t.fll:{line}:") and "1 rule hedges a Mamdani consequent" in n
+               for n in rb.notes)
+
+
+def test_a_hedged_mamdani_consequent_agrees_with_fuzzylite():
+    fl = pytest.importorskip("fuzzylite")
+    engine = fl.FllImporter().from_string(HEDGED_MAMDANI.replace(      # pyfuzzylite reserves x
+        "InputVariable: x", "InputVariable: v").replace("if x is", "if v is").replace(
+        "RuleBlock: b\n", "RuleBlock: b\n  activation: General\n"))
+    X = np.linspace(0.0, 1.0, 41)
+    engine.input_variable("v").value = X
+    engine.process()
+    ours = run(HEDGED_MAMDANI, X[:, None])[:, 0]
+    assert np.allclose(ours, engine.output_variable("y").value, atol=1e-12, equal_nan=True)
+
+
+@pytest.mark.parametrize("rule", [
+    "if x is high then y is very lo with 0.5",        # fuzzylite hedges 0.5 * dof
+    "if x is not high then y is very lo",             # very(1 - mu): no hedge of MITOS's
+    "if x is high or x is low then y is very lo",     # very(max(...)): a hedge on a group
+    "if x is high then y is any lo"])                 # fuzzylite skips a rule of degree 0
+def test_a_hedged_mamdani_consequent_no_condition_can_carry_is_refused(rule):
     from mitos_cli.interop.fcl import parse_fcl
 
-    text = HEDGED_MAMDANI
+    text = HEDGED_MAMDANI.replace("if x is high then y is very lo", rule)
     with pytest.raises(FormatError, match="hedges a Mamdani consequent") as info:
         parse_fll(text, "t.fll")
-    line = text.splitlines().index("  rule: if x is high then y is very lo") + 1
-    assert str(info.value.span) == f"t.fll:{line}:27"
+    line = text.splitlines().index(f"  rule: {rule}") + 1
+    assert str(info.value.span) == f"t.fll:{line}:{len('  rule: ' + rule.split(' then')[0]) + 7}"
     assert "move the hedge onto the condition" in info.value.hint
     fcl = ("FUNCTION_BLOCK hm\nVAR_INPUT x : REAL; END_VAR\nVAR_OUTPUT y : REAL; END_VAR\n"
-           "FUZZIFY x\nRANGE := (0 .. 1);\nTERM low := Triangle 0 0 1;\nEND_FUZZIFY\n"
-           "DEFUZZIFY y\nRANGE := (0 .. 10);\nTERM lo := Triangle 0 3 6;\nMETHOD : COG;\n"
-           "ACCU : MAX;\nEND_DEFUZZIFY\nRULEBLOCK b\nAND : MIN;\nACT : MIN;\n"
-           "RULE 1 : if x is low then y is somewhat lo\nEND_RULEBLOCK\nEND_FUNCTION_BLOCK\n")
-    with pytest.raises(FormatError, match="`y is somewhat lo` hedges a Mamdani") as info:
+           "FUZZIFY x\nRANGE := (0 .. 1);\nTERM low := Triangle 0 0 1;\n"
+           "TERM high := Triangle 0 1 1;\nEND_FUZZIFY\nDEFUZZIFY y\nRANGE := (0 .. 10);\n"
+           "TERM lo := Triangle 0 3 6;\nMETHOD : COG;\nACCU : MAX;\nEND_DEFUZZIFY\n"
+           f"RULEBLOCK b\nAND : MIN;\nACT : MIN;\nRULE 1 : {rule}\nEND_RULEBLOCK\n"
+           "END_FUNCTION_BLOCK\n")
+    with pytest.raises(FormatError, match="hedges a Mamdani consequent"):
         parse_fcl(fcl, "t.fcl")
-    assert str(info.value.span) == "t.fcl:17:27"
 
 
 def test_a_hedged_mamdani_consequent_is_not_written_for_fuzzylite(tmp_path):

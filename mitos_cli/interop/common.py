@@ -559,6 +559,8 @@ def assemble_blocks(path: str | None, variables: list[Variable],
         aggregation = settings.aggregation or (None if settings.sugeno else "max")
         rules = rewrite.unchain(rules, outputs, and_, or_, aggregation,
                                 notes if notes is not None else [])
+        if not settings.sugeno:
+            rules = _hedges_moved(rules, notes if notes is not None else [])
         _check_block(rules, settings, by_name, len(blocks) == 1)
         operators = settings.operators(default_resolution)
         try:
@@ -602,8 +604,6 @@ def _check_block(rules: list[Rule], settings: Settings, by_name: dict[str, Varia
                 raise FormatError(f"output term `{v.name}.{t.name}`: linear terms need a "
                                   f"weighted-average (Takagi-Sugeno) defuzzifier", span=t.span)
     for rule in rules:
-        if not sugeno:
-            _unhedged_mamdani(rule)
         try:
             check_rule(rule, by_name)
         except MitosError as exc:
@@ -611,18 +611,41 @@ def _check_block(rules: list[Rule], settings: Settings, by_name: dict[str, Varia
                               hint=exc.hint) from None
 
 
-def _unhedged_mamdani(rule: Rule) -> None:
-    """Refuse a hedged Mamdani consequent read from fuzzylite's language: fuzzylite hedges the
-    rule's activation degree there (``Consequent.modify``), MITOS hedges the output set, so
-    reading it would change the outputs without a word."""
+def _hedges_moved(rules: list[Rule], notes: list[str]) -> list[Rule]:
+    """Mamdani rules whose consequents fuzzylite hedges, restated so that MITOS computes what
+    fuzzylite does (:func:`_hedge_moved`), with a note; a rule that cannot be is refused."""
+    out = [_hedge_moved(r) for r in rules]
+    moved = [r for r, new in zip(rules, out) if new is not r]
+    if moved:
+        verb = "hedges" if len(moved) == 1 else "hedge"
+        notes.append(f"{moved[0].span or moved[0].label}: {plural(len(moved), 'rule')} {verb} a "
+                     f"Mamdani consequent, which fuzzylite computes as the hedged degree of the "
+                     f"rule: the hedge is read on the condition (`then y is very lo` as `if x "
+                     f"is very A then y is lo`), the same there")
+    return out
+
+
+def _hedge_moved(rule: Rule) -> Rule:
+    """``if x is A then y is very B`` as ``if x is very A then y is B``: fuzzylite hedges a
+    Mamdani consequent's activation degree (``Consequent.modify``), MITOS's rules would hedge
+    the output set. The same where the condition is one proposition without ``not``, the
+    weight 1 (fuzzylite hedges ``w * dof``), every consequent carries the same hedges and none
+    is ``any`` (fuzzylite skips a rule of degree 0 before hedging); otherwise refused by name."""
     c = next((c for c in rule.consequents if c.hedges), None)
-    if c is not None:
-        raise FormatError(
-            f"rule `{rule.label}`: `{hedged_text(c)}` hedges a Mamdani consequent, which "
-            f"fuzzylite computes as the hedged activation degree of the rule and MITOS as the "
-            f"hedged output set: not supported", span=c.span,
-            hint="move the hedge onto the condition (`if x is very A`), the same where the "
-                 "condition is one proposition without `not` and the rule's weight is 1")
+    if c is None:
+        return rule
+    e = rule.antecedent
+    if (isinstance(e, Prop) and not e.negated and rule.weight == 1.0 and "any" not in c.hedges
+            and all(k.hedges == c.hedges for k in rule.consequents)):
+        return replace(rule, antecedent=replace(e, hedges=c.hedges + e.hedges),
+                       consequents=tuple(replace(k, hedges=()) for k in rule.consequents))
+    raise FormatError(
+        f"rule `{rule.label}`: `{hedged_text(c)}` hedges a Mamdani consequent, which fuzzylite "
+        f"computes as the hedged activation degree of the rule and MITOS as the hedged output "
+        f"set: not supported here", span=c.span,
+        hint="move the hedge onto the condition (`if x is very A`), the same where the "
+             "condition is one proposition without `not` and the rule's weight is 1 (such a "
+             "rule is read so)")
 
 
 # ---------------------------------------------------------------------------------------------
