@@ -81,6 +81,26 @@ def test_mcnemar_exact():
     assert mcnemar(3, 3) == 1.0
 
 
+@pytest.mark.parametrize("wins, losses", [(0, 2000), (500, 600), (1000, 1024), (7, 1500)])
+def test_mcnemar_past_a_thousand_pairs(wins, losses):
+    """Over 1023 discordant pairs ``2.0 ** n`` is no float: a study of that many runs stopped
+    at its end with an OverflowError, its report unwritten."""
+    n = wins + losses
+    exact = 2 * sum(math.comb(n, i) for i in range(min(wins, losses) + 1)) / 2 ** n
+    assert mcnemar(wins, losses) == pytest.approx(min(1.0, exact), rel=1e-9, abs=1e-300)
+
+
+def test_rank_of_a_study_with_thousands_of_discordant_runs():
+    rows = [{"world": "w", "planner": p, "and": "", "or": "", "inference": "", "run": r,
+             "outcome": "success" if p == "dwa" else "collision",
+             **dict.fromkeys(("time_s", "path_length_in", "min_clearance_in", "mean_speed_in_s",
+                              "steering_total_variation_deg", "replans", "backouts"), 1.0)}
+            for r in range(1100) for p in ("dwa", "potential_field")]
+    ranks = rank(rows, summaries(rows, ["w"], [Choice("dwa"), Choice("potential_field")]))
+    assert [(r.wins, r.losses) for r in ranks] == [(0, 0), (0, 1100)]
+    assert ranks[1].p_value == 0.0
+
+
 # -- choices and seeds ---------------------------------------------------------------------
 
 def test_choices_cross_and_dual():

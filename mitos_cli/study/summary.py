@@ -94,8 +94,32 @@ def mcnemar(wins: int, losses: int) -> float:
     if n == 0:
         return 1.0
     k = min(wins, losses)
-    tail = sum(math.comb(n, i) for i in range(k + 1)) / 2.0 ** n
-    return min(1.0, 2.0 * tail)
+    if n <= EXACT_PAIRS:
+        tail = sum(math.comb(n, i) for i in range(k + 1)) / 2.0 ** n
+        return min(1.0, 2.0 * tail)
+    return min(1.0, 2.0 * math.exp(_log_lower_tail(n, k)))
+
+
+#: the most discordant pairs whose tail is summed as integers over ``2.0 ** n`` (beyond 1023
+#: that is no float: a study of more runs stopped at its end with an OverflowError)
+EXACT_PAIRS = 1000
+
+
+def _log_lower_tail(n: int, k: int) -> float:
+    """``log P(X <= k)`` for ``X ~ Binomial(n, 1/2)``, ``k <= n / 2``: its terms in logs, from
+    ``k`` down (each no larger than the one before) until they no longer count."""
+    def log_term(i: int) -> float:
+        return (math.lgamma(n + 1) - math.lgamma(i + 1) - math.lgamma(n - i + 1)
+                - n * math.log(2.0))
+
+    top = log_term(k)
+    total = 0.0
+    for i in range(k, -1, -1):
+        step = log_term(i) - top
+        if step < -40.0:               # (e^-40: below a double's precision of the sum)
+            break
+        total += math.exp(step)
+    return top + math.log(total)
 
 
 def _sort_key(s: Summary):
