@@ -249,6 +249,37 @@ def test_resume_refuses_a_world_that_changed(tmp_path, compare):
     assert compare(*args, "--runs", 2, "--resume").exit_code == 0
 
 
+def grid_world(directory: Path) -> Path:
+    """``tiny.yaml`` on a map_server map (a 10 x 2 m hall, 5 cm a pixel) beside it."""
+    width, height = 200, 40
+    (directory / "m.pgm").write_bytes(b"P5\n%d %d\n255\n" % (width, height) + bytes(
+        0 if y in (0, height - 1) else 254 for y in range(height) for _ in range(width)))
+    (directory / "m.yaml").write_text("image: m.pgm\nresolution: 0.05\norigin: [0, -1, 0]\n")
+    world = directory / "g.yaml"
+    world.write_text(TINY.replace("  corridors:\n    - points: [[0, 0], [280, 0]]\n"
+                                  "      width: 70\n", "  grid: m.yaml\n"))
+    return world
+
+
+@pytest.mark.parametrize("edit", ["m.yaml", "m.pgm"])
+def test_resume_refuses_a_map_that_changed(tmp_path, compare, edit):
+    """A world's digest was of its own file: a map (its YAML or its image) edited between a
+    study and its resume was resumed as the same world, the runs of both maps averaged."""
+    world = grid_world(tmp_path)
+    out = tmp_path / "s"
+    args = (world, "--planner", "dwa", "-o", out, "-j", 1, "--no-plots")
+    assert compare(*args, "--runs", 1).exit_code == 0
+    before = (tmp_path / edit).read_bytes()
+    (tmp_path / edit).write_bytes(before.replace(b"0.05", b"0.04") if edit == "m.yaml"
+                                  else before[:-1] + bytes([255 - before[-1]]))
+    r = compare(*args, "--runs", 2, "--resume")
+    assert r.exit_code == 1 and "`" + str(world) + "` or a map file it reads changed since" \
+        in r.stderr, r.output
+    assert len(read_rows(out)) == 1
+    (tmp_path / edit).write_bytes(before)                   # put back: it resumes
+    assert compare(*args, "--runs", 2, "--resume").exit_code == 0
+
+
 def test_a_study_resumes_from_another_directory(tmp_path, compare, monkeypatch):
     """A world is the file, not the path typed: a study made with `tiny.yaml` from its own
     directory "left out" its runs when resumed from anywhere else, even with the command its

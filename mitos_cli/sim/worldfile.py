@@ -15,7 +15,7 @@ from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from ..errors import NameError_, Span, WorldError, did_you_mean, unknown
+from ..errors import MitosError, NameError_, Span, WorldError, did_you_mean, unknown
 from ..lang import yamlpos
 from ..lang.yamlpos import YList, YMap
 from .safety import TIGHTEST_TURN, fastest_point, full_lock, swing_words, tightest_turn
@@ -1057,6 +1057,33 @@ def load_world(path: str | Path) -> World:
             raise WorldError(f"`{path}` is not a world file", span=Span(str(path), 1, 1),
                              expected="a YAML file with `map:` (see worlds/README.md)")
     return parse_world(text, str(path))
+
+
+def map_files(path: str | Path) -> list[Path]:
+    """The files the world file at ``path`` reads besides itself: the map_server YAML of
+    ``map.grid`` and of ``map.given``, and each one's image, as far as they are named (a
+    world that does not read is refused where it is loaded). A study's digest of a world
+    covers them: an edited map was resumed as the same world, its runs mixed with the old."""
+    from ..fileio import read_text
+
+    def named(file: Path, key: str, within: str) -> Path | None:
+        try:
+            doc = yamlpos.load(read_text(file), str(file), WorldError)
+        except (MitosError, OSError, UnicodeDecodeError, ValueError):
+            return None
+        if within:
+            doc = doc.get(within) if isinstance(doc, dict) else None
+        value = doc.get(key) if isinstance(doc, dict) else None
+        return file.parent / value if isinstance(value, str) and value.strip() else None
+
+    out = []
+    for key in ("grid", "given"):
+        spec = named(Path(path), key, "map")
+        if spec is None or spec.suffix.lower() not in (".yaml", ".yml"):   # (`given: none`)
+            continue
+        image = named(spec, "image", "")
+        out += [spec] + ([image] if image is not None else [])
+    return out
 
 
 def _world_path_given(path: object) -> str | os.PathLike:

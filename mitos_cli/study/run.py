@@ -56,14 +56,14 @@ class Study:
                 "digests": self.digests()}
 
     def digests(self) -> dict[str, str]:
-        """A digest of each input file (the worlds, the rule base and its term sets), so that
-        `--resume` can refuse to mix runs of a file that changed with runs of the new one.
-        The simulator's caches are keyed on them (:mod:`.simtask`)."""
+        """A digest of each input file (the worlds with the maps they read, the rule base and
+        its term sets), so that `--resume` can refuse to mix runs of a file that changed with
+        runs of the new one. The simulator's caches are keyed on them (:mod:`.simtask`)."""
         from ..api import read_rulebase
         from ..errors import MitosError
-        from .simtask import RULEBASE, file_digest, rulebase_digest
+        from .simtask import RULEBASE, rulebase_digest, world_digest
 
-        found = {path: file_digest([Path(path)]) for path in self.worlds}
+        found = {path: world_digest(path) for path in self.worlds}
         with contextlib.suppress(MitosError):    # (reported where the rule base is read)
             found[RULEBASE] = rulebase_digest(read_rulebase(self.rulebase))
         return {name: d for name, d in found.items() if d is not None}

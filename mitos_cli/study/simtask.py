@@ -49,6 +49,14 @@ def file_digest(paths: Sequence[Path]) -> str | None:
     return h.hexdigest()[:16]
 
 
+def world_digest(path: str) -> str | None:
+    """A digest of a world file and the map files it reads (:func:`.worldfile.map_files`);
+    a world without any has the digest of its own bytes, as before."""
+    from ..sim.worldfile import map_files
+
+    return file_digest([Path(path), *map_files(path)])
+
+
 def rulebase_digest(rb) -> str | None:
     """A digest of the files a rule base was read from: its own and its term sets."""
     if rb.path is None:
@@ -58,7 +66,7 @@ def rulebase_digest(rb) -> str | None:
 
 
 def _world_key(context: StudyContext, path: str) -> str | None:
-    return context.digest(path) or file_digest([Path(path)])
+    return context.digest(path) or world_digest(path)
 
 
 def _rulebase_key(context: StudyContext) -> str | None:
@@ -84,7 +92,7 @@ def _world(path: str, key: str | None):
     from ..sim.worldfile import load_world
 
     world = load_world(path)
-    _unchanged(f"the world file `{path}`", key, file_digest([Path(path)]))
+    _unchanged(f"the world file `{path}` (or a map it reads)", key, world_digest(path))
     return world
 
 

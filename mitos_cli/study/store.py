@@ -467,10 +467,20 @@ def _check_unchanged(old: dict, new: dict, path: Path) -> None:
     file, and resuming would average them with runs of the new one."""
     changed = [name for name, digest in new.items() if name in old and old[name] != digest]
     if changed:
-        what = ", ".join("the rule base" if n == "rulebase" else f"`{n}`" for n in changed)
+        what = ", ".join(_changed_file(n) for n in changed)
         raise StudyError(f"{what} changed since the runs in {path} were made; resuming would "
                          f"mix runs of the old and the new file",
                          hint="choose another directory with -o (or put the file back)")
+
+
+def _changed_file(name: str) -> str:
+    """A file of ``study.json``'s digests as a message names it (a world with a map: it or
+    the map files it reads)."""
+    from ..sim.worldfile import map_files
+
+    if name == "rulebase":
+        return "the rule base"
+    return f"`{name}`" + (" or a map file it reads" if map_files(name) else "")
 
 
 def _refuse_narrower(left: list[dict], old: dict, path: Path, out: Path,
