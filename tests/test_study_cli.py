@@ -249,6 +249,22 @@ def test_resume_refuses_a_world_that_changed(tmp_path, compare):
     assert compare(*args, "--runs", 2, "--resume").exit_code == 0
 
 
+def test_resume_refuses_another_behavior(tiny, tmp_path, compare):
+    """No column of a row names the behavior: a resume with another `--behavior` averaged
+    runs of `drive` with runs of `avoid_obstacle`, and study.json then said all were the
+    latter's."""
+    out = tmp_path / "s"
+    args = (tiny, "--and", "min", "--planner", "fuzzy", "-o", out, "-j", 1, "--no-plots")
+    assert compare(*args, "--runs", 1).exit_code == 0
+    r = compare(*args, "--runs", 2, "--resume", "--behavior", "avoid_obstacle")
+    assert r.exit_code == 1 and "were made with each world's own behavior, not --behavior " \
+        "avoid_obstacle" in r.stderr, r.output
+    assert "resume without --behavior" in r.stderr and len(read_rows(out)) == 1
+    assert compare(*args, "--runs", 2, "--resume").exit_code == 0
+    r = compare(*args, "--runs", 3, "--resume", "--behavior", "drive")
+    assert r.exit_code == 1 and "resume without --behavior" in r.stderr
+
+
 def grid_world(directory: Path) -> Path:
     """``tiny.yaml`` on a map_server map (a 10 x 2 m hall, 5 cm a pixel) beside it."""
     width, height = 200, 40

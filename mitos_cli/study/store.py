@@ -318,6 +318,8 @@ class ResultStore:
                              f"not {manifest.get('seed')}",
                              hint=f"resume with --seed {old.get('seed')}, or choose another "
                                   "directory with -o")
+        if old is not None:
+            _check_behavior(old, manifest, self.path)
         given = list(manifest.get("worlds") or [])
         worlds = _worlds_of(rows, old or {}, manifest)
         if old is not None:
@@ -471,6 +473,22 @@ def _check_unchanged(old: dict, new: dict, path: Path) -> None:
         raise StudyError(f"{what} changed since the runs in {path} were made; resuming would "
                          f"mix runs of the old and the new file",
                          hint="choose another directory with -o (or put the file back)")
+
+
+def _check_behavior(old: dict, new: dict, path: Path) -> None:
+    """A resume with another ``--behavior`` than the runs were made with: no column of a row
+    names it, and its runs were averaged with the others (and study.json said all were)."""
+    if "behavior" not in old or old["behavior"] == new.get("behavior"):
+        return
+
+    def said(behavior) -> str:
+        return f"--behavior {behavior}" if behavior else "each world's own behavior"
+
+    was = old["behavior"]
+    raise StudyError(f"the runs in {path} were made with {said(was)}, not "
+                     f"{said(new.get('behavior'))}; resuming would mix runs of the two",
+                     hint=(f"resume with --behavior {was}" if was else "resume without "
+                           "--behavior") + ", or choose another directory with -o")
 
 
 def _changed_file(name: str) -> str:
