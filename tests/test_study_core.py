@@ -370,6 +370,23 @@ def test_resume_of_a_directory_without_a_study_is_refused(tmp_path):
     assert outcome.skipped == 0 and outcome.executed == 6
 
 
+def test_a_directory_a_study_runs_in_is_refused_to_another(tmp_path):
+    """Two studies in one directory (a --resume started while the study still ran) both
+    appended to its results.csv: each run was there twice, and both said they had finished."""
+    study = small_study(runs=1)
+    running = ResultStore(tmp_path)
+    running.start(study.manifest(), study.tasks(), resume=False)
+    for resume in (True, False):
+        with pytest.raises(StudyError) as exc:
+            run_study(study, tmp_path, workers=1, resume=resume, task_fn=fake_sim)
+        assert exc.value.message == f"`{tmp_path}` is in use by another study (a `mitos " \
+                                    f"compare` still running there)"
+    assert ResultStore(tmp_path).load() == []
+    running.close()
+    outcome = run_study(study, tmp_path, workers=1, resume=True, task_fn=fake_sim)
+    assert outcome.executed == 6 and len(ResultStore(tmp_path).load()) == 6
+
+
 def test_resume_with_another_seed_is_refused(tmp_path):
     run_study(small_study(runs=1), tmp_path, workers=1, task_fn=fake_sim)
     other = Study(**{**small_study(runs=1).__dict__, "seed": 4})

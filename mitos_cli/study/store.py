@@ -123,6 +123,7 @@ class ResultStore:
         self._unended = False              # a whole last row without its newline
         self._at: list[tuple[int, str, list[str]]] = []   # each row's line: number, text, values
         self._names: dict[str, str] = {}   # a world as given now -> as the rows name it
+        self._held: int | None = None      # the directory, locked while a study runs in it
 
     # -- reading -----------------------------------------------------------------------------
 
@@ -307,6 +308,7 @@ class ResultStore:
         except OSError as exc:
             raise StudyError(f"cannot create the output directory {self.dir}: "
                              f"{exc.strerror or exc}") from None
+        self._hold()
         rows = self.load()
         if rows and not resume:
             raise StudyError(f"{self.path} already holds {plural(len(rows), 'result')}",
@@ -347,6 +349,31 @@ class ResultStore:
         self._file = open(self.path, "a", encoding="utf-8", newline="")  # noqa: SIM115
         return finished, todo
 
+    def _hold(self) -> None:
+        """Lock the directory for this study until :meth:`close` (or the process's end, a
+        kill included): two studies in one directory both appended to its results.csv, each
+        run held twice, and both said they had finished. Where locks are not to be had (not
+        POSIX, a file system without them), the study goes on as before."""
+        try:
+            import fcntl
+        except ImportError:
+            return
+        try:
+            fd = os.open(self.dir, os.O_RDONLY)
+        except OSError:
+            return
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            os.close(fd)
+            raise StudyError(f"`{self.dir}` is in use by another study (a `mitos compare` "
+                             f"still running there)", hint="wait for it to end, or choose "
+                             "another directory with -o") from None
+        except OSError:
+            os.close(fd)
+            return
+        self._held = fd
+
     def _mend(self) -> None:
         """End the file where its last whole row ends, before rows are appended to it: a row
         cut short by a kill is cut off, a whole last row without its newline gets one."""
@@ -374,6 +401,9 @@ class ResultStore:
         if self._file is not None:
             self._file.close()
             self._file = None
+        if self._held is not None:
+            os.close(self._held)            # (which lets the lock go)
+            self._held = None
 
     def __enter__(self) -> ResultStore:
         return self
