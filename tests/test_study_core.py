@@ -387,6 +387,17 @@ def test_a_directory_a_study_runs_in_is_refused_to_another(tmp_path):
     assert outcome.executed == 6 and len(ResultStore(tmp_path).load()) == 6
 
 
+def test_a_choice_given_twice_is_refused(tmp_path):
+    """Its runs shared one key: each summarized both (n = 2 of 1 run) and were written
+    twice, which the study's own --resume then refused."""
+    with pytest.raises(MitosError) as exc:
+        Study(["w.yaml"], [Choice("fuzzy", "min"), Choice("dwa"), Choice("fuzzy", "min")],
+              runs=1, seed=1)
+    assert exc.value.message == "the choice `fuzzy and=min` is given twice"
+    assert Study(["w.yaml"], (Choice("dwa"), Choice("fuzzy")), runs=1, seed=1).choices == [
+        Choice("dwa"), Choice("fuzzy")]
+
+
 def test_resume_with_another_seed_is_refused(tmp_path):
     run_study(small_study(runs=1), tmp_path, workers=1, task_fn=fake_sim)
     other = Study(**{**small_study(runs=1).__dict__, "seed": 4})

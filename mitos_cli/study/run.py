@@ -43,6 +43,7 @@ class Study:
         from ..sim.runs import whole
 
         object.__setattr__(self, "worlds", world_files(self.worlds))
+        object.__setattr__(self, "choices", _once(self.choices))
         object.__setattr__(self, "runs", whole("runs", self.runs, 1))
         object.__setattr__(self, "seed", check_seed(self.seed))
 
@@ -101,6 +102,21 @@ def world_files(worlds: object) -> list[str]:
                              hint="give each world once; more runs of it: runs=N")
         seen[key] = name
         out.append(name)
+    return out
+
+
+def _once(choices) -> list[Choice]:
+    """``choices`` as a list, else an :class:`InputError` for one given twice: its runs share
+    one key, so each row of it summarized both (``n`` twice the runs), and its --resume
+    refused the results file it had written."""
+    from ..errors import InputError
+
+    out = list(choices)
+    for i, choice in enumerate(out):
+        if choice in out[:i]:
+            raise InputError(f"the choice `{choice.label}` is given twice",
+                             hint="give each choice once (make_choices does); more runs of "
+                                  "it: runs=N")
     return out
 
 
