@@ -233,6 +233,15 @@ def test_compare_json_is_the_documented_object(tiny, tmp_path, monkeypatch, comp
     assert len(read_rows("st")) == data["tasks"] == data["executed"] == 6
 
 
+@pytest.mark.parametrize("order", [("--runs", 3, "-n", 1), ("-n", 1, "--runs", 3)])
+def test_runs_and_its_old_spelling_together_are_a_usage_error(tiny, tmp_path, compare, order):
+    """`-n` is `--runs`: `--runs 3 -n 1` ran one run a choice, its warning only about the
+    spelling."""
+    r = compare(tiny, "--planner", "dwa", *order, "-o", tmp_path / "s")
+    assert r.exit_code == 2 and "are one option, given twice" in r.stderr
+    assert not (tmp_path / "s").exists()
+
+
 def test_resume_refuses_a_world_that_changed(tmp_path, compare):
     """Resuming after the world file was edited would average runs of two different worlds
     (it did: 50% success, where the edited world alone gives 0%)."""

@@ -123,12 +123,23 @@ def refuse_repeats(ctx: typer.Context, order: list) -> None:
     """A usage error (exit 2) for the first single-value option given twice in ``order``
     (the parameters as the parser met them, once per occurrence). Flags and options that
     take several values (``--fix``, ``--world``) may repeat."""
-    seen: set[str] = set()
+    seen: dict[str, Any] = {}
     for param in order:
         if not isinstance(param, TyperOption) or param.multiple or param.count \
                 or param.is_flag or param.name is None:
             continue
-        if param.name in seen:
+        key = SPELLINGS.get(param.name, param.name)
+        first = seen.get(key)
+        if first is not None and first.name != param.name:
+            raise GivenTwice(f"{first.get_error_hint(ctx)} and {param.get_error_hint(ctx)} are "
+                             f"one option, given twice: give it once (one would be dropped "
+                             f"without a word)", ctx=ctx, param=param)
+        if first is not None:
             raise GivenTwice(f"{param.get_error_hint(ctx)} is given twice: give it once (the "
                              f"last would be kept without a word)", ctx=ctx, param=param)
-        seen.add(param.name)
+        seen[key] = param
+
+
+#: options that are one option under two names (``compare -n``, the old spelling of --runs:
+#: ``--runs 3 -n 1`` ran one run a choice, with a word only on the spelling)
+SPELLINGS = {"runs_n": "runs"}
