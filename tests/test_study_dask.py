@@ -66,6 +66,21 @@ def test_unreachable_scheduler_is_a_clear_error():
     assert "dask scheduler" in exc.value.hint
 
 
+def test_an_unreachable_scheduler_leaves_the_directory_as_it_was(tmp_path, monkeypatch):
+    """The scheduler was reached only once the study had written study.json and the header
+    of results.csv: a refused `--scheduler` left a study behind in a new directory."""
+    from mitos_cli.study import executors
+    from mitos_cli.study.store import StudyError
+
+    reach = executors.dask_client
+    monkeypatch.setattr(executors, "dask_client",
+                        lambda scheduler, workers: reach(scheduler, workers, timeout="0.5s"))
+    with pytest.raises(StudyError, match="cannot reach the Dask scheduler"):
+        run_study(small_study(runs=1), tmp_path / "s", executor="dask",
+                  scheduler="tcp://127.0.0.1:9", task_fn=fake_sim)
+    assert not (tmp_path / "s").exists()
+
+
 @pytest.mark.filterwarnings("ignore:Port 8787 is already in use")
 def test_a_plain_local_cluster_runs_a_strangers_code():
     """The attack on the cluster the Dask executor used to start: any local process that

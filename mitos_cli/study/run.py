@@ -196,12 +196,15 @@ def run_study(study: Study, out_dir: str | Path, *, executor: str = "local",
     tasks = study.tasks()
     manifest = study.manifest()
     fn = task_fn or default_task_fn(study, manifest["digests"])
-    with ResultStore(out_dir) as store:
+    own = _scheduler_client(executor, scheduler, client, workers)
+    with ResultStore(out_dir) as store, contextlib.ExitStack() as stack:
+        if own is not None:
+            stack.callback(own.close)
         finished, todo = store.start(manifest, tasks, resume=resume)
         if on_start is not None:
             on_start(len(finished), len(tasks))
         by_index: dict[int, dict] = {}
-        for task, result in execute(fn, todo, executor, workers, scheduler, client):
+        for task, result in execute(fn, todo, executor, workers, scheduler, own or client):
             row = row_of(task, result)
             store.append(row)
             by_index[task.index] = row
@@ -217,6 +220,17 @@ def run_study(study: Study, out_dir: str | Path, *, executor: str = "local",
     outcome.summaries = summaries(rows, study.worlds, study.choices)
     outcome.ranks = rank(rows, outcome.pooled())
     return outcome
+
+
+def _scheduler_client(executor: str, scheduler: str | None, client, workers: int | None):
+    """A client of the Dask scheduler at ``scheduler``, reached before the study writes
+    anything (``None``: no scheduler to reach, or a ``client`` given): one that could not be
+    reached left study.json and results.csv's header behind in a directory that held none."""
+    if executor != "dask" or not scheduler or client is not None:
+        return None
+    from . import executors
+
+    return executors.dask_client(scheduler, workers or 1)
 
 
 def write_report(outcome: Outcome, out_dir: str | Path, plots: bool = True) -> Path:
