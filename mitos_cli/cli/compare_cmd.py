@@ -254,11 +254,24 @@ def run_with_progress(study, out, executor, workers, scheduler, resume, quiet=Fa
                              on_result=on_result)
         except KeyboardInterrupt:
             pass
-    done = kept["before"] + kept["now"]
     if not kept["total"] and not resume:      # before on_start: no run of it is kept
         err(f"interrupted before the study began in {out}; start it with:\n  {study.command}")
         raise typer.Exit(INTERRUPTED)
+    done = max(kept["before"] + kept["now"], _rows_in(out))
     err(f"interrupted: {done} of {plural(kept['total'], 'run')} kept in "
-        f"{Path(out) / 'results.csv'} ({kept['now']} now, {kept['before']} from before); "
-        f"go on with:\n  {study.command} --resume")
+        f"{Path(out) / 'results.csv'} ({done - kept['before']} now, {kept['before']} from "
+        f"before); go on with:\n  {study.command} --resume")
     raise typer.Exit(INTERRUPTED)
+
+
+def _rows_in(out: str) -> int:
+    """The runs ``out/results.csv`` holds (0 where it cannot be read): a row written as the
+    Ctrl-C came (in its fsync) was kept but not yet counted, and the message said one run
+    fewer than the file held."""
+    from ..errors import MitosError
+    from ..study.store import ResultStore
+
+    try:
+        return len(ResultStore(out).load())
+    except MitosError:
+        return 0
