@@ -138,6 +138,28 @@ def test_study_boxes_have_black_medians(tmp_path, monkeypatch):
     assert len(medians) == 2 and all(ln.get_color() == "black" for ln in medians)
 
 
+def test_study_plots_tell_worlds_of_one_stem_apart(tmp_path, monkeypatch):
+    """`a/t.yaml` and `b/t.yaml` were two groups, two panels, both named `t`, where the
+    tables name them by their paths."""
+    from types import SimpleNamespace
+
+    from mitos_cli.draw import study
+
+    worlds = ["a/t.yaml", "b/t.yaml", "c/u.yaml"]
+    seen = []
+    monkeypatch.setattr(study, "_save", lambda fig, plt, path: seen.append(fig))
+    rows = [{"world": w, "min_clearance_in": 1.0, "c": "x"} for w in worlds]
+    study.clearance_boxes(rows, worlds, ["x"], lambda r: r["c"], tmp_path / "c.png")
+    rate = SimpleNamespace(k=1, n=2, lo=0.1, hi=0.9)
+    summaries = [SimpleNamespace(world=w, choice=SimpleNamespace(label="x"),
+                                 rates={"success": rate}) for w in worlds]
+    study.success_bars(summaries, worlds, ["x"], tmp_path / "s.png")
+    boxes, bars = seen
+    assert [ax.get_title() for ax in boxes.axes[:3]] == ["a/t.yaml", "b/t.yaml", "u"]
+    assert [t.get_text() for t in bars.axes[0].get_xticklabels()] == ["a/t.yaml", "b/t.yaml",
+                                                                       "u"]
+
+
 def test_no_robot_takes_a_colour_the_picture_uses_for_something_else(tmp_path):
     """A new user's third review: in a three-robot world the third robot's path was the
     purple of the "replanned route" line. No robot colour is one the plot gives the route, a

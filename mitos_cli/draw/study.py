@@ -24,6 +24,13 @@ def _short(world: str) -> str:
     return Path(world).stem if "/" in world or world.endswith((".yaml", ".yml")) else world
 
 
+def _names(worlds: list[str]) -> dict[str, str]:
+    """Each world as the plots name it: its file's stem, or its path as given where two
+    worlds share a stem, as the tables do (`a/t.yaml` and `b/t.yaml` were two groups `t`)."""
+    stems = [_short(w) for w in worlds]
+    return {w: w if stems.count(_short(w)) > 1 else _short(w) for w in worlds}
+
+
 def success_bars(summaries, worlds: list[str], labels: list[str], path: str | Path) -> Path:
     """Grouped bars: success rate per world (groups) and choice (bars), Wilson 95% whiskers.
 
@@ -60,7 +67,8 @@ def success_bars(summaries, worlds: list[str], labels: list[str], path: str | Pa
                 ax.text(xi, 1.0, "0", ha="center", va="bottom", fontsize=7,
                         color=cmap(j % 10))
     ax.set_xticks(x)
-    ax.set_xticklabels([_short(w) for w in worlds], rotation=15 if n_w > 4 else 0)
+    names = _names(worlds)
+    ax.set_xticklabels([names[w] for w in worlds], rotation=15 if n_w > 4 else 0)
     ax.set_ylim(0, 105)
     ax.set_ylabel("success rate (%)")
     ax.set_title("Success rate per world (whiskers: Wilson 95% interval)")
@@ -82,6 +90,7 @@ def clearance_boxes(rows: list[dict], worlds: list[str], labels: list[str],
     fig, axes = plt.subplots(n_rows, cols, figsize=(4.2 * cols, 3.4 * n_rows + 0.6),
                              squeeze=False, sharey=False)
     cmap = plt.get_cmap("tab10")
+    names = _names(worlds)
     for k, world in enumerate(worlds):
         ax = axes[k // cols][k % cols]
         data = [[r["min_clearance_in"] for r in rows
@@ -99,7 +108,7 @@ def clearance_boxes(rows: list[dict], worlds: list[str], labels: list[str],
         ax.axhline(0.0, color="black", linewidth=0.6, alpha=0.6)
         ax.set_xticks(range(1, len(labels) + 1))
         ax.set_xticklabels([str(j + 1) for j in range(len(labels))])
-        ax.set_title(_short(world), fontsize=10)
+        ax.set_title(names[world], fontsize=10)
         ax.set_ylabel("min clearance (in)")
         ax.grid(axis="y", alpha=0.3)
     for k in range(n_w, n_rows * cols):
