@@ -1,6 +1,7 @@
 """Counted nouns for messages: ``plural(1, "rule")`` is ``1 rule``, ``plural(27, "rule")``
 ``27 rules``, so no user reads "(1 rules)"; and a clearance as it is printed beside the
-margin it is compared with (:func:`clearance`)."""
+margin it is compared with (:func:`clearance`); a rate that is neither none nor all never
+printed as 0% or 100% (:func:`percent`)."""
 
 from __future__ import annotations
 
@@ -42,3 +43,15 @@ def tenths(x: float) -> str:
     corridor 18.5 in wide was "18 in wide" beside a centre that keeps "9.2 in" of it."""
     text = f"{x:.1f}"
     return text[:-2] if text.endswith(".0") else text
+
+
+def percent(k: int, n: int) -> str:
+    """``k`` of ``n`` as a whole percentage, with as many more digits as it takes not to read
+    as none or all when it is neither: 1 collision in 200 runs is ``0.5%``, not ``0%``, and
+    199 successes in 200 ``99.5%``, not ``100%`` (in a published table, a planner that never
+    collided)."""
+    for digits in range(8):
+        text = f"{100 * k / n:.{digits}f}"
+        if not ((float(text) == 0 and k > 0) or (float(text) == 100 and k < n)):
+            break
+    return text + "%"

@@ -574,3 +574,14 @@ def test_a_trace_of_a_robot_at_its_goal_from_the_start_says_so(tmp_path: Path, p
     assert res.exit_code == 0, res.output
     assert "(robot drove no tick: it stood at its goal from the start)\n" in res.stdout
     assert not res.stdout.startswith("\n")
+
+
+def test_runs_table_never_rounds_a_rate_to_none_or_all():
+    """1 collision in 200 runs read `0%` (and 199 successes `100%`) in `simulate --runs`."""
+    from mitos_cli.cli.simulate_cmd import _runs_table
+    from mitos_cli.sim.runs import METRICS, Runs, WorldRuns
+
+    summaries = tuple({"outcome": "collision" if i == 0 else "success",
+                       **dict.fromkeys(METRICS, 1.0)} for i in range(200))
+    row = _runs_table(Runs((WorldRuns("w", summaries),))).splitlines()[1].split()
+    assert row[:6] == ["w", "200", "99.5%", "0.5%", "0%", "0%"]

@@ -101,6 +101,20 @@ def test_rank_of_a_study_with_thousands_of_discordant_runs():
     assert ranks[1].p_value == 0.0
 
 
+@pytest.mark.parametrize("k, n, shown", [(1, 200, "0.5%"), (199, 200, "99.5%"),
+                                         (1, 3000, "0.03%"), (2999, 3000, "99.97%"),
+                                         (0, 200, "0%"), (200, 200, "100%"), (3, 8, "38%"),
+                                         (1, 7, "14%")])
+def test_a_rate_that_is_neither_none_nor_all_never_reads_as_either(k, n, shown):
+    """199 successes in 200 runs read `100%`, 1 collision in 200 `0%`: in a published table,
+    a planner that never failed, never collided."""
+    from mitos_cli.study.report import _compact_rate, fmt_rate
+
+    rate = wilson(k, n)
+    assert fmt_rate(rate, ci=False) == shown
+    assert fmt_rate(rate).startswith(shown + " [") and _compact_rate(rate).startswith(shown)
+
+
 # -- choices and seeds ---------------------------------------------------------------------
 
 def test_choices_cross_and_dual():

@@ -8,7 +8,7 @@ from typing import Annotated, Optional
 
 import typer
 
-from ..words import clearance, plural
+from ..words import clearance, percent, plural
 from . import complete
 from .output import emit, err, json_text, warn
 from .params import MAX_RUNS, file_arg, finite, named, option_names
@@ -108,7 +108,8 @@ def _runs_table(runs) -> str:
     for w in runs.worlds:
         for label, r in [(w.world, w)] + [(f"  {x.world}", x) for x in w.robots]:
             row = [label, str(len(r.summaries))]
-            row += [f"{100 * r.rate(o):.0f}%" if o in r.outcomes else "-" for o in outcomes]
+            row += [percent(r.count(o), len(r.summaries)) if o in r.outcomes else "-"
+                    for o in outcomes]
             for _, key in _RUNS_FIGURES:
                 mean, std = r.stat(key)
                 row.append(f"{mean:.1f}" if len(r.summaries) == 1 else f"{mean:.1f} ± {std:.1f}")

@@ -66,8 +66,11 @@ class WorldRuns:
     summaries: tuple[dict, ...]
     outcomes: tuple[str, ...] = OUTCOMES       # whose rates figures() gives (a robot: + stopped)
 
+    def count(self, outcome: str) -> int:
+        return sum(s["outcome"] == outcome for s in self.summaries)
+
     def rate(self, outcome: str) -> float:
-        return sum(s["outcome"] == outcome for s in self.summaries) / len(self.summaries)
+        return self.count(outcome) / len(self.summaries)
 
     def stat(self, key: str) -> tuple[float, float]:
         x = np.array([s[key] for s in self.summaries], dtype=float)

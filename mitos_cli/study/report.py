@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-from ..words import plural
+from ..words import percent, plural
 from .spec import Choice
 from .stats import Mean, Rate
 from .summary import ALL_WORLDS, METRICS, Rank, Summary
@@ -19,7 +19,7 @@ TABLE_METRICS = ("time_s", "path_length_in", "min_clearance_in", "steering_total
 def fmt_rate(r: Rate, ci: bool = True) -> str:
     if r.n == 0:
         return "-"
-    text = f"{100 * r.k / r.n:.0f}%"
+    text = percent(r.k, r.n)
     return f"{text} [{100 * r.lo:.0f}, {100 * r.hi:.0f}]" if ci else text
 
 
@@ -65,7 +65,7 @@ def _world_names(summaries: list[Summary]) -> dict[str, str]:
 def _compact_rate(r: Rate) -> str:
     if r.n == 0:
         return "-"
-    return f"{100 * r.k / r.n:.0f}% [{100 * r.lo:.0f},{100 * r.hi:.0f}]"
+    return f"{percent(r.k, r.n)} [{100 * r.lo:.0f},{100 * r.hi:.0f}]"
 
 
 def _compact_mean(m: Mean) -> str:
