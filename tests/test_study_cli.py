@@ -369,6 +369,19 @@ def test_without_matplotlib_the_report_has_no_plots(tiny, tmp_path, compare, mon
     assert (out / "report.md").is_file() and not (out / "success.png").exists()
 
 
+def test_a_report_without_plots_leaves_no_plots_of_before(tiny, tmp_path, compare):
+    """A study extended with `--resume --no-plots` (or where matplotlib is missing) kept the
+    plots of its earlier report beside the new one: figures of fewer runs, to be published
+    as the study's."""
+    out = tmp_path / "study"
+    args = (tiny, "--planner", "dwa", "-o", out, "-j", 1)
+    assert compare(*args, "--runs", 1).exit_code == 0
+    assert (out / "success.png").is_file() and (out / "clearance.png").is_file()
+    assert compare(*args, "--runs", 2, "--resume", "--no-plots").exit_code == 0
+    assert not (out / "success.png").exists() and not (out / "clearance.png").exists()
+    assert ".png" not in (out / "report.md").read_text()
+
+
 @pytest.mark.parametrize("missing, words", [
     ("distributed", "the Dask executor needs dask.distributed, which is not installed"),
     ("cryptography", "the local Dask cluster needs `cryptography`"),

@@ -234,7 +234,8 @@ def _scheduler_client(executor: str, scheduler: str | None, client, workers: int
 
 
 def write_report(outcome: Outcome, out_dir: str | Path, plots: bool = True) -> Path:
-    """``report.md`` (and its plots ``success.png``, ``clearance.png``) in ``out_dir``."""
+    """``report.md`` (and its plots ``success.png``, ``clearance.png``; without them, those
+    of an earlier report are removed) in ``out_dir``."""
     from .report import render_markdown
     from .store import write_atomic
 
@@ -252,8 +253,23 @@ def write_report(outcome: Outcome, out_dir: str | Path, plots: bool = True) -> P
                         out / "clearance.png")
         images = {"Success rate per world and choice": "success.png",
                   "Minimum clearance per world and choice": "clearance.png"}
+    else:
+        _drop_plots(out)
     text = render_markdown(outcome.study.manifest(), outcome.summaries, outcome.ranks, images,
                            len(outcome.rows), outcome.n_tasks)
     path = out / "report.md"
     write_atomic(path, text)
     return path
+
+
+#: the plots :func:`write_report` draws beside report.md
+PLOTS = ("success.png", "clearance.png")
+
+
+def _drop_plots(out: Path) -> None:
+    """Remove the plots an earlier report of the study drew: a report written without plots
+    (``--no-plots``, no matplotlib) left them beside it, figures of fewer runs than the
+    report's, to be taken for the study's."""
+    for name in PLOTS:
+        with contextlib.suppress(FileNotFoundError):
+            (out / name).unlink()
