@@ -412,6 +412,20 @@ def test_a_choice_given_twice_is_refused(tmp_path):
         Choice("dwa"), Choice("fuzzy")]
 
 
+@pytest.mark.parametrize("name", ["results.csv", "study.json"])
+@pytest.mark.parametrize("resume", [False, True])
+def test_a_pipe_or_device_in_the_study_directory_is_refused(tmp_path, name, resume):
+    """A named pipe (or a link to /dev/zero) where results.csv or study.json goes: the study
+    waited for ever, reading it or writing study.json to it."""
+    if name == "results.csv":
+        os.symlink(os.devnull if resume else "/dev/zero", tmp_path / name)
+    else:
+        os.mkfifo(tmp_path / name)
+    with pytest.raises(StudyError) as exc:
+        run_study(small_study(runs=1), tmp_path, workers=1, resume=resume, task_fn=fake_sim)
+    assert exc.value.message.startswith(f"`{tmp_path / name}` is not a regular file, so not a")
+
+
 def test_resume_with_another_seed_is_refused(tmp_path):
     run_study(small_study(runs=1), tmp_path, workers=1, task_fn=fake_sim)
     other = Study(**{**small_study(runs=1).__dict__, "seed": 4})

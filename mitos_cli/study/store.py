@@ -135,6 +135,7 @@ class ResultStore:
         self._keep, self._unended = None, False
         if not self.path.exists():
             return []
+        _refuse_special(self.path, "results file")
         try:
             data = self.path.read_bytes()
             cut = data.rfind(b"\n") + 1
@@ -239,6 +240,7 @@ class ResultStore:
         """What ``study.json`` says the study was; ``None`` when there is none."""
         if not self.manifest_path.exists():
             return None
+        _refuse_special(self.manifest_path, "study manifest")
         hint = (f"choose another output directory with -o, or remove {self.manifest_path} "
                 f"and {self.path} to run the study again")
         try:
@@ -309,6 +311,7 @@ class ResultStore:
             raise StudyError(f"cannot create the output directory {self.dir}: "
                              f"{exc.strerror or exc}") from None
         self._hold()
+        _refuse_special(self.manifest_path, "study manifest")   # (written to below)
         rows = self.load()
         if rows and not resume:
             raise StudyError(f"{self.path} already holds {plural(len(rows), 'result')}",
@@ -410,6 +413,15 @@ class ResultStore:
 
     def __exit__(self, *exc) -> None:
         self.close()
+
+
+def _refuse_special(path: Path, kind: str) -> None:
+    """A :class:`StudyError` for ``path`` there but neither a regular file nor a directory
+    (which has its own message): a named pipe, a device, a link to one. Reading it waited
+    for ever (a pipe nothing writes to, /dev/zero), and so did writing study.json to one."""
+    if path.exists() and not path.is_file() and not path.is_dir():
+        raise StudyError(f"`{path}` is not a regular file, so not a {kind}",
+                         hint=f"choose another output directory with -o, or remove {path}")
 
 
 def _whole_line(data: bytes, header: bool) -> str | None:
