@@ -382,6 +382,15 @@ def test_a_report_without_plots_leaves_no_plots_of_before(tiny, tmp_path, compar
     assert ".png" not in (out / "report.md").read_text()
 
 
+def test_workers_with_a_scheduler_are_a_usage_error(tiny, tmp_path, compare):
+    """`-j 8` with `--scheduler` was dropped without a word: the cluster's workers run it."""
+    r = compare(tiny, "--planner", "dwa", "--executor", "dask", "--scheduler",
+                "tcp://127.0.0.1:9", "-j", 8, "-o", tmp_path / "s")
+    said = " ".join(r.stderr.replace("│", " ").split())          # (as rich's box wraps it)
+    assert r.exit_code == 2 and "the cluster at --scheduler runs its own workers" in said
+    assert not (tmp_path / "s").exists()
+
+
 @pytest.mark.parametrize("missing, words", [
     ("distributed", "the Dask executor needs dask.distributed, which is not installed"),
     ("cryptography", "the local Dask cluster needs `cryptography`"),

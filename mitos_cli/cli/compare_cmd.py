@@ -86,6 +86,10 @@ def compare_command(
         raise unknown("executor", executor, EXECUTORS, cls=UsageError)
     if scheduler and executor != "dask":
         raise typer.BadParameter("--scheduler needs --executor dask", param_hint="--scheduler")
+    if scheduler and workers is not None:      # (it was dropped without a word)
+        raise typer.BadParameter("the cluster at --scheduler runs its own workers; -j sets "
+                                 "those of a local pool or LocalCluster",
+                                 param_hint="--workers")
     if executor == "dask":                      # before study.json or the progress bar
         from ..study.executors import require_dask
 
