@@ -426,6 +426,17 @@ def test_a_pipe_or_device_in_the_study_directory_is_refused(tmp_path, name, resu
     assert exc.value.message.startswith(f"`{tmp_path / name}` is not a regular file, so not a")
 
 
+def test_a_world_named_as_the_pooled_rows_is_refused(tmp_path):
+    """A world file `all worlds` (given so) had its rows taken for the pooled ones: the
+    ranking listed each choice twice, once with that world's figures alone."""
+    with pytest.raises(MitosError) as exc:
+        Study(["all worlds", "w.yaml"], [Choice("dwa")], runs=1, seed=1)
+    assert exc.value.message == "a world named `all worlds` is not told apart from the rows " \
+                                "pooled over the worlds"
+    assert Study([str(tmp_path / "all worlds")], [Choice("dwa")], runs=1, seed=1).worlds == [
+        str(tmp_path / "all worlds")]
+
+
 def test_resume_with_another_seed_is_refused(tmp_path):
     run_study(small_study(runs=1), tmp_path, workers=1, task_fn=fake_sim)
     other = Study(**{**small_study(runs=1).__dict__, "seed": 4})

@@ -95,6 +95,10 @@ def world_files(worlds: object) -> list[str]:
     seen: dict[Path, str] = {}
     for w in given:
         name = _world_file(w)
+        if name == ALL_WORLDS:              # (its rows were taken for the pooled ones)
+            raise InputError(f"a world named `{name}` is not told apart from the rows pooled "
+                             f"over the worlds", hint=f"give it by its full path: "
+                                                  f"{str(Path(name).resolve())!r}")
         key = Path(name).resolve()
         if key in seen:
             also = "" if seen[key] == name else f" (as `{seen[key]}`)"
