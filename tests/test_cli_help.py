@@ -52,6 +52,14 @@ def test_examples_parse_and_name_files_that_exist(name):
                 assert (ROOT / word).exists(), f"{line}: {word} does not exist"
 
 
+def test_compare_examples_run_one_after_another():
+    """Run in their order, the second was refused ("study/results.csv already holds 120
+    results"): the first had made its study in the same directory."""
+    fresh = [shlex.split(line) for line, _ in EXAMPLES["compare"] if "--resume" not in line]
+    outs = [words[words.index("-o") + 1] for words in fresh]
+    assert len(set(outs)) == len(outs), outs
+
+
 def test_help_ends_with_the_examples_and_exit_codes():
     env = {**os.environ, "COLUMNS": "120", "PYTHONPATH": str(ROOT)}
     out = subprocess.run([sys.executable, "-m", "mitos_cli", "simulate", "--help"],

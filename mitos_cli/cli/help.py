@@ -42,8 +42,8 @@ EXAMPLES: dict[str, tuple[tuple[str, str], ...]] = {
     "compare": (
         ("mitos compare corridor slalom --and min,product -o study",
          "two T-norms and the potential field, 20 runs each"),
-        ("mitos compare corridor --planner fuzzy,dwa --runs 10 -j 2 -o study",
-         "two planners, two processes"),
+        ("mitos compare corridor --planner fuzzy,dwa --runs 10 -j 2 -o study-dwa",
+         "the fuzzy planner's four T-norms and DWA, two processes"),
         ("mitos compare corridor slalom --and min,product -o study --resume",
          "go on after Ctrl-C"),
     ),
