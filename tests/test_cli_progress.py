@@ -193,6 +193,24 @@ def test_compare_ctrl_c_counts_a_run_written_as_it_came(capsys, monkeypatch, tmp
            f"from before)" in err
 
 
+def test_compare_ctrl_c_while_the_report_is_written_says_how_to_write_it(capsys, monkeypatch,
+                                                                          tmp_path):
+    """A Ctrl-C in the plots exited 130 without a word, report.md perhaps of fewer runs than
+    results.csv held."""
+    import mitos_cli.study as study_mod
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(study_mod, "write_report", interrupted)
+    code, _, err = run(capsys, "compare", TINY, "--planner", "dwa", "--runs", 1, "-j", 1,
+                       "-o", tmp_path / "s")
+    assert code == 130 and "Traceback" not in err
+    assert f"interrupted while writing the report: every run of the study (1 run) is in " \
+           f"{tmp_path / 's' / 'results.csv'}; write it with:" in err
+    assert err.rstrip().endswith("--resume")
+
+
 def test_compare_ctrl_c_before_the_study_began_says_start_it_again(capsys, monkeypatch,
                                                                     tmp_path):
     """Stopped before a study was there, `... --resume` would be refused (no study in DIR)."""

@@ -105,7 +105,14 @@ def compare_command(
     outcome = run_with_progress(study, out, executor, workers, scheduler, resume,
                                 quiet=as_json)
 
-    report = _report(outcome, out, plots)       # (before stdout, which a reader may close)
+    try:
+        report = _report(outcome, out, plots)   # (before stdout, which a reader may close)
+    except KeyboardInterrupt:
+        # exit 130 without a word, report.md perhaps of fewer runs than results.csv
+        err(f"interrupted while writing the report: every run of the study "
+            f"({plural(outcome.n_tasks, 'run')}) is in {Path(out) / 'results.csv'}; write it "
+            f"with:\n  {study.command} --resume")
+        raise typer.Exit(INTERRUPTED) from None
     if as_json:
         emit(json_text(outcome_json(outcome, out)))
     else:
