@@ -666,6 +666,9 @@ def test_non_numeric_value_in_results(tmp_path):
     ("replans", "-1", "which no run reports"),
     ("backouts", "-2", "which no run reports"),
     ("collisions", "-1", "which no run reports"),
+    ("path_length_in", "1e308", "more than any run reports"),   # a mean of inf: `inf±inf`
+    ("min_clearance_in", "-2e15", "more than any run reports"),
+    ("backouts", "1" + "0" * 39, "more than any run reports"),  # an OverflowError in the mean
 ])
 def test_a_row_no_run_reports_is_refused(tmp_path, field, value, said):
     """A hand-edited row that parses but is no run's (``--resume`` once took a misspelt
@@ -685,8 +688,10 @@ def test_a_row_no_run_reports_is_refused(tmp_path, field, value, said):
     assert exc.value.span.line == 2
     if field == "outcome":
         assert exc.value.hint == "did you mean `success`?"
-    if value.startswith("-") and value != "-inf":
+    if value.startswith("-") and value != "-inf" and said != "more than any run reports":
         assert exc.value.expected.endswith(", 0 or more")
+    if said == "more than any run reports":
+        assert exc.value.expected.endswith(", within ±1e+15")
 
 
 @pytest.mark.parametrize("outcome, collisions", [("success", "3"), ("timeout", "1"),

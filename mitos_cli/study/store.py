@@ -49,6 +49,13 @@ NON_NEGATIVE = frozenset({"collisions", "time_s", "path_length_in", "mean_speed_
                           "seed"})
 
 
+#: the largest size of a figure any run reports (a world's numbers are at most 1e7: 1e7 in/s
+#: for 1e7 s), and small enough that no mean or spread of a study's figures overflows (a
+#: `1e308`, or a count of 400 digits, made the tables `inf±inf`, or an OverflowError)
+LARGEST_FIGURE = 1e15
+TOO_LARGE = "more than any run reports"
+
+
 class StudyError(MitosError):
     """A study directory that cannot be written or resumed."""
 
@@ -92,6 +99,8 @@ def _wrong(field: str, value) -> str | None:
         return "not an outcome of a run"
     if field in FLOAT_FIELDS and not math.isfinite(value):
         return "which no run reports"
+    if field in RESULT_FIELDS and field != "outcome" and abs(value) > LARGEST_FIGURE:
+        return TOO_LARGE
     if field in NON_NEGATIVE and value < 0:
         return "which no run reports"
     return None
@@ -197,8 +206,10 @@ class ResultStore:
             bad = _wrong(f, value)
             if bad:
                 hint = did_you_mean(v, OUTCOMES) if f == "outcome" else None
-                raise StudyError(f"`{f}` is `{v}`, {bad}",
-                                 span=self._span(line_no, line, values, j), expected=_expected(f),
+                raise StudyError(f"`{f}` is `{v:.40}`, {bad}",
+                                 span=self._span(line_no, line, values, j),
+                                 expected=_expected(f) + (f", within ±{LARGEST_FIGURE:g}"
+                                                          if bad == TOO_LARGE else ""),
                                  hint=hint or "the file was edited by hand; remove that line")
         if (row["outcome"] == "collision") != (row["collisions"] > 0):
             j = COLUMNS.index("collisions")
