@@ -382,6 +382,15 @@ def test_a_report_without_plots_leaves_no_plots_of_before(tiny, tmp_path, compar
     assert ".png" not in (out / "report.md").read_text()
 
 
+@pytest.mark.parametrize("flag, what", [("--and", "T-norm"), ("--or", "S-norm"),
+                                        ("--inference", "inference method")])
+def test_a_list_of_no_names_is_a_usage_error(tiny, tmp_path, compare, flag, what):
+    """`--and ,` compared the rule base's own operators, labelled `fuzzy`, without a word."""
+    r = compare(tiny, "--planner", "fuzzy", flag, ",", "-o", tmp_path / "s")
+    assert r.exit_code == 2 and f"name at least one {what}" in r.stderr
+    assert not (tmp_path / "s").exists()
+
+
 def test_workers_with_a_scheduler_are_a_usage_error(tiny, tmp_path, compare):
     """`-j 8` with `--scheduler` was dropped without a word: the cluster's workers run it."""
     r = compare(tiny, "--planner", "dwa", "--executor", "dask", "--scheduler",

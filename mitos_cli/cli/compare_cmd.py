@@ -129,6 +129,10 @@ def _planners(planner: str, and_: str, or_, inference, rulebase, behavior) -> li
     planners = split_list(planner)
     if not planners:
         raise typer.BadParameter("name at least one planner", param_hint="--planner")
+    for flag, names, what in (("--and", and_, "T-norm"), ("--or", or_, "S-norm"),
+                              ("--inference", inference, "inference method")):
+        if names is not None and not split_list(names):     # (`--and ,` ran the rule base's)
+            raise typer.BadParameter(f"name at least one {what}", param_hint=flag)
     fuzzy_only = [flag for flag, given in (("--and", and_ != DEFAULT_AND), ("--or", or_),
                                            ("--inference", inference), ("--rulebase", rulebase),
                                            ("--behavior", behavior)) if given]
