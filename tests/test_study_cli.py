@@ -382,6 +382,17 @@ def test_a_report_without_plots_leaves_no_plots_of_before(tiny, tmp_path, compar
     assert ".png" not in (out / "report.md").read_text()
 
 
+def test_a_directory_where_a_plot_goes_is_a_clear_error(tiny, tmp_path, compare):
+    """`success.png` a directory: the plot's rename into it was an IsADirectoryError
+    traceback, its `success.tmp.png` left beside it."""
+    out = tmp_path / "s"
+    (out / "success.png").mkdir(parents=True)
+    r = compare(tiny, "--planner", "dwa", "--runs", 1, "-o", out, "-j", 1)
+    assert r.exit_code == 1 and "Traceback" not in r.output
+    assert f"cannot write `{out / 'success.png'}`: it is a directory" in r.stderr
+    assert sorted(p.name for p in out.iterdir()) == ["results.csv", "study.json", "success.png"]
+
+
 @pytest.mark.parametrize("flag, what", [("--and", "T-norm"), ("--or", "S-norm"),
                                         ("--inference", "inference method")])
 def test_a_list_of_no_names_is_a_usage_error(tiny, tmp_path, compare, flag, what):

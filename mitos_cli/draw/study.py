@@ -126,10 +126,16 @@ def clearance_boxes(rows: list[dict], worlds: list[str], labels: list[str],
 
 
 def _save(fig, plt, path) -> Path:
+    """Write ``fig`` to ``path`` as PNG, atomically: a directory (or an unwritable place)
+    there is the :class:`WriteError` every command gives, where the rename into it was a
+    traceback at the end of the study, its temporary file left behind."""
+    from ..fileio import atomic_file
+
     path = Path(path)
-    tmp = path.with_name(path.stem + ".tmp" + path.suffix)
     literal_text(fig)
-    fig.savefig(tmp, dpi=110)
-    plt.close(fig)
-    tmp.replace(path)
+    try:
+        with atomic_file(path, binary=True) as fh:
+            fig.savefig(fh, format="png", dpi=110)
+    finally:
+        plt.close(fig)
     return path
