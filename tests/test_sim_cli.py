@@ -585,3 +585,16 @@ def test_runs_table_never_rounds_a_rate_to_none_or_all():
                        **dict.fromkeys(METRICS, 1.0)} for i in range(200))
     row = _runs_table(Runs((WorldRuns("w", summaries),))).splitlines()[1].split()
     assert row[:6] == ["w", "200", "99.5%", "0.5%", "0%", "0%"]
+
+
+def test_runs_of_a_world_that_randomises_nothing_are_said_to_be_copies(short):
+    """`--runs 3` of a world with no `randomise:` range and no sensor noise ran one run three
+    times, its `± 0.0` read as a spread of three runs, without a word."""
+    said = "the world randomises nothing (no `randomise:` range, no sensor noise): its 2 runs " \
+           "are one run 2 times"
+    res = run(short, "--runs", 2)
+    assert res.exit_code == 0 and said in res.stderr
+    assert "randomises nothing" not in run(short).stderr                    # one run, as written
+    noisy = short.with_name("noisy.yaml")
+    noisy.write_text(SHORT + "randomise:\n  sensor_noise: [0, 1]\n", encoding="utf-8")
+    assert "randomises nothing" not in run(noisy, "--runs", 2).stderr

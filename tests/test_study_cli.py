@@ -382,6 +382,18 @@ def test_a_report_without_plots_leaves_no_plots_of_before(tiny, tmp_path, compar
     assert ".png" not in (out / "report.md").read_text()
 
 
+def test_a_world_that_randomises_nothing_is_said_to_give_copies(tmp_path, compare):
+    """A world with no `randomise:` range and no sensor noise gave `n = 3` of one run, its
+    intervals of zero width, without a word."""
+    world = tmp_path / "fixed.yaml"
+    world.write_text(TINY.split("randomise:")[0].replace("noise: 0.5", "noise: 0"))
+    r = compare(world, "--planner", "dwa", "--runs", 3, "-o", tmp_path / "s", "-j", 1,
+                "--no-plots")
+    assert r.exit_code == 0 and "the world randomises nothing" in r.stderr
+    assert "its 3 runs are one run 3 times" in r.stderr
+    assert len({row["time_s"] for row in read_rows(tmp_path / "s")}) == 1
+
+
 def test_a_directory_where_a_plot_goes_is_a_clear_error(tiny, tmp_path, compare):
     """`success.png` a directory: the plot's rename into it was an IsADirectoryError
     traceback, its `success.tmp.png` left beside it."""

@@ -98,7 +98,7 @@ def compare_command(
     with option_names():                        # --planner, --and, --or, --inference: exit 2
         choices = make_choices(planners, split_list(and_), split_list(or_),
                                split_list(inference))
-    paths = check_inputs(worlds, choices, rulebase, behavior)
+    paths = check_inputs(worlds, choices, rulebase, behavior, runs)
     study = Study(paths, choices, runs, seed, rulebase, behavior,
                   command=_command_line(worlds, and_, or_, inference, planner, rulebase,
                                         behavior, runs, seed, out))
@@ -222,9 +222,11 @@ def outcome_json(outcome, out: str) -> dict:
 
 
 def check_inputs(worlds: list[str], choices, rulebase: str | None,
-                 behavior: str | None) -> list[str]:
+                 behavior: str | None, runs: int = 0) -> list[str]:
     """Read every world and compile every choice once here, so a mistake is reported before
-    any worker starts. Returns the world paths as the workers will open them."""
+    any worker starts (and a world whose ``runs`` are copies of one is said). Returns the
+    world paths as the workers will open them."""
+    from ..sim.obstacles import copies_note
     from ..sim.worldfile import load_world, resolve_world_path
     from ..study.simtask import StudyContext, check_choice
 
@@ -232,8 +234,10 @@ def check_inputs(worlds: list[str], choices, rulebase: str | None,
     files: set[Path] = set()
     for name in worlds:
         path = str(resolve_world_path(name))
-        for note in load_world(path).notes:    # likely mistakes the file may hold
-            warn(note)
+        world = load_world(path)
+        for note in [*world.notes, copies_note(world, runs)]:   # likely mistakes, said
+            if note:
+                warn(note)
         if Path(path).resolve() in files:     # (`a.yaml` and `./a.yaml` too, as Study says)
             raise typer.BadParameter(f"the world `{name}` is given twice")
         files.add(Path(path).resolve())

@@ -247,8 +247,10 @@ def simulate_command(
                                  f"`{planner_name}` has none", param_hint="--planner")
     live = live or speed is not None
     loaded = [load_world(resolve_world_path(n)) for n in worlds or [DEFAULT_WORLD]]
-    for note in (n for w in loaded for n in w.notes):   # likely mistakes: said, not refused
-        warn(note)
+    from ..sim.obstacles import copies_note
+
+    for note in (n for w in loaded for n in (*w.notes, copies_note(w, runs)) if n):
+        warn(note)                            # likely mistakes: said, not refused
     _check_outputs((("--out", out), ("--plot", plot), ("--animate", animate)),
                    [Path(w.path) for w in loaded if w.path] + ([Path(rulebase)] if rulebase else []))
     for path in (out, plot, animate):         # before the run, not after it

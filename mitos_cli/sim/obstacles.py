@@ -69,6 +69,25 @@ def shapes_at(obstacles: tuple[Obstacle, ...], where: np.ndarray):
     return centres, radii, np.asarray(circ, dtype=int), sides, owner, corners
 
 
+def randomises_nothing(world: World) -> bool:
+    """Whether every randomised run of ``world`` is the same run: no obstacle range wider
+    than a point and no sensor noise, drawn or fixed (a study's n and intervals then count
+    copies of one run)."""
+    r = world.randomise
+    moved = any(j.dx[0] != j.dx[1] or j.dy[0] != j.dy[1] for j in r.obstacles)
+    noisy = world.sensors.noise > 0 or (r.sensor_noise is not None and max(r.sensor_noise) > 0)
+    return not moved and not noisy
+
+
+def copies_note(world: World, runs: int) -> str | None:
+    """The warning for ``runs`` randomised runs of a world that randomises nothing."""
+    if runs < 2 or not randomises_nothing(world):
+        return None
+    return (f"{world.path or world.name}: the world randomises nothing (no `randomise:` range, "
+            f"no sensor noise): its {runs} runs are one run {runs} times, and their spread "
+            f"and intervals count copies")
+
+
 def randomised(world: World, rng: np.random.Generator) -> World:
     """A copy of ``world`` with obstacles moved and sensor noise drawn within its ranges.
 
