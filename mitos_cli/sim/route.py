@@ -850,34 +850,11 @@ def grid_route(static: StaticMap, start: Pose, goal: Goal, clearance: float,
     s, t = cell_of(start.x, start.y), cell_of(goal.x, goal.y)
     for rc, what, (x, y) in ((s, "start", (start.x, start.y)), (t, "goal", (goal.x, goal.y))):
         if not (0 <= rc[0] < R and 0 <= rc[1] < C):
-            name = f" `{Path(g.source).name}`" if g.source else ""
-            raise NarrowPassage(
-                f"the {what} ({x:g}, {y:g}) lies outside the map{name} the robot plans on "
-                f"(x {g.origin[0]:g} to {g.origin[0] + cols * g.resolution:g}, y "
-                f"{g.origin[1]:g} to {g.origin[1] + rows * g.resolution:g} in)",
-                hint="a `given` map must cover the start and the goal" if g.source else None,
-                end=what)
+            raise _outside(g, occ.shape, what, x, y)
     moves = MOVES
     floor = clearance if minimum is None else min(minimum, clearance)
-    # prefer the middle; a node closer than `clearance` (but not than `floor`) costs
-    # NARROW_COST times more, so the route squeezes through only where nothing wider leads on
-    penalty = (np.clip(reach - node_c, 0.0, reach) / reach * 4.0
-               + np.where(node_c < clearance, NARROW_COST, 0.0))
-    if behind > 0:      # a tricycle cannot turn on the spot: the way back costs a squeeze
-        x = g.origin[0] + (fc + 0.5) * g.resolution
-        y = g.origin[1] + (fr + 0.5) * g.resolution
-        h = math.radians(start.heading)
-        rx, ry = x - start.x, y - start.y
-        back = (rx * math.cos(h) + ry * math.sin(h) < 0) & (np.hypot(rx, ry) <= behind)
-        penalty = penalty + np.where(back, NARROW_COST, 0.0)
-    blocked = node_c < floor
-    blocked[s] = blocked[t] = False      # the robot stands there: let the search leave it
-    if leave > 0:
-        n = int(math.ceil(leave / size))
-        r0, c0 = max(s[0] - n, 0), max(s[1] - n, 0)
-        rr, cc = np.mgrid[r0:min(s[0] + n + 1, R), c0:min(s[1] + n + 1, C)]
-        near = (np.hypot(rr - s[0], cc - s[1]) * size <= leave) & (node_c[rr, cc] > 0)
-        blocked[rr[near], cc[near]] = False
+    penalty = _penalty(g, node_c, fr, fc, clearance, reach, start, behind)
+    blocked = _blocked(node_c, floor, s, t, leave, size)
 
     # an edge between two nodes keeps the floor too (nodes sit at their block's clearest
     # cell, so two clear nodes may face each other across a thin wall); edges that leave the
@@ -903,14 +880,68 @@ def grid_route(static: StaticMap, start: Pose, goal: Goal, clearance: float,
             if found is not None:
                 return found
         raise refusal
-    r, c = np.divmod(np.array(path[1:-1], dtype=np.int64), C)
-    pts = np.empty((len(r) + 2, 2))       # the start, centre() of every node between, the goal
-    pts[1:-1, 0] = g.origin[0] + (fc[r, c] + 0.5) * g.resolution
-    pts[1:-1, 1] = g.origin[1] + (fr[r, c] + 0.5) * g.resolution
-    pts[0], pts[-1] = (start.x, start.y), (goal.x, goal.y)
+    pts = _route_points(g, path, C, fr, fc, start, goal)
     pts = _simplify(pts, size * 0.75, field, clearance,
                     Squares(occ, g.resolution, g.origin), floor)
     return Route.of(pts, goal=(goal.x, goal.y))
+
+
+def _outside(g: Grid, shape: tuple[int, ...], what: str, x: float, y: float) -> NarrowPassage:
+    """The refusal of a start or goal off the grid (of ``shape`` cells) the robot plans on."""
+    rows, cols = shape
+    name = f" `{Path(g.source).name}`" if g.source else ""
+    return NarrowPassage(
+        f"the {what} ({x:g}, {y:g}) lies outside the map{name} the robot plans on "
+        f"(x {g.origin[0]:g} to {g.origin[0] + cols * g.resolution:g}, y "
+        f"{g.origin[1]:g} to {g.origin[1] + rows * g.resolution:g} in)",
+        hint="a `given` map must cover the start and the goal" if g.source else None,
+        end=what)
+
+
+def _penalty(g: Grid, node_c: np.ndarray, fr: np.ndarray, fc: np.ndarray, clearance: float,
+             reach: float, start: Pose, behind: float) -> np.ndarray:
+    """Each node's extra cost per step: up to 4 off the middle (within ``reach`` of the
+    walls), :data:`NARROW_COST` closer than ``clearance`` (so the route squeezes through only
+    where nothing wider leads on), and :data:`NARROW_COST` within ``behind`` inches behind the
+    start (a tricycle cannot turn on the spot: the way back costs a squeeze)."""
+    penalty = (np.clip(reach - node_c, 0.0, reach) / reach * 4.0
+               + np.where(node_c < clearance, NARROW_COST, 0.0))
+    if behind > 0:
+        x = g.origin[0] + (fc + 0.5) * g.resolution
+        y = g.origin[1] + (fr + 0.5) * g.resolution
+        h = math.radians(start.heading)
+        rx, ry = x - start.x, y - start.y
+        back = (rx * math.cos(h) + ry * math.sin(h) < 0) & (np.hypot(rx, ry) <= behind)
+        penalty = penalty + np.where(back, NARROW_COST, 0.0)
+    return penalty
+
+
+def _blocked(node_c: np.ndarray, floor: float, s: tuple[int, int], t: tuple[int, int],
+             leave: float, size: float) -> np.ndarray:
+    """The nodes closer than ``floor`` to what is occupied, except the start and the goal
+    (the robot stands there: let the search leave it) and, within ``leave`` inches of the
+    start, any node off the occupied cells."""
+    blocked = node_c < floor
+    blocked[s] = blocked[t] = False
+    if leave > 0:
+        R, C = node_c.shape
+        n = int(math.ceil(leave / size))
+        r0, c0 = max(s[0] - n, 0), max(s[1] - n, 0)
+        rr, cc = np.mgrid[r0:min(s[0] + n + 1, R), c0:min(s[1] + n + 1, C)]
+        near = (np.hypot(rr - s[0], cc - s[1]) * size <= leave) & (node_c[rr, cc] > 0)
+        blocked[rr[near], cc[near]] = False
+    return blocked
+
+
+def _route_points(g: Grid, path: list[int], C: int, fr: np.ndarray, fc: np.ndarray,
+                  start: Pose, goal: Goal) -> np.ndarray:
+    """The start, the centre of every node of ``path`` between, and the goal."""
+    r, c = np.divmod(np.array(path[1:-1], dtype=np.int64), C)
+    pts = np.empty((len(r) + 2, 2))
+    pts[1:-1, 0] = g.origin[0] + (fc[r, c] + 0.5) * g.resolution
+    pts[1:-1, 1] = g.origin[1] + (fr[r, c] + 0.5) * g.resolution
+    pts[0], pts[-1] = (start.x, start.y), (goal.x, goal.y)
+    return pts
 
 
 def _steps(moves: Sequence[tuple[int, int, float]], blocked: np.ndarray, ok: np.ndarray,
