@@ -186,7 +186,51 @@ def _num(tree) -> float:
 
 
 def _function_block(fb: Tree, span_of) -> RuleBase:
-    declared: dict[str, tuple[Role, Span, tuple[float, float] | None]] = {}
+    """The rule base of one FUNCTION_BLOCK: its declared variables, their FUZZIFY and
+    DEFUZZIFY blocks, and its RULEBLOCKs (one behavior, or one per block where their
+    operators differ and their outputs do not meet)."""
+    declared, fuzzify, defuzzify, blocks = _declarations(fb, span_of)
+    n_inputs = sum(1 for role, _, _ in declared.values() if role == "input")
+    records: dict[str, common.Record] = {}           # per output: METHOD, ACCU
+    notes: list[str] = []
+    locks: dict[str, Span] = {}
+    constants: list[tuple[str, Term]] = []
+    variables: dict[str, Variable] = {}
+    ranges: common.Places = {}                        # where each RANGE and DEFAULT is written
+    for node in fuzzify + defuzzify:
+        role: Role = "input" if node.data == "fuzzify" else "output"
+        record = records.setdefault(str(node.children[0]), common.Record())
+        v = _variable(node, role, declared, record, locks, constants, n_inputs, span_of, notes,
+                      ranges)
+        if v.name in variables:
+            raise FormatError(f"variable `{v.name}` is defined twice"
+                              + first_at(variables[v.name].span), span=v.span)
+        variables[v.name] = v
+    for name, (role, span, _) in declared.items():
+        if name not in variables:
+            kind = "FUZZIFY" if role == "input" else "DEFUZZIFY"
+            raise FormatError(f"variable `{name}` is declared but has no {kind} block",
+                              span=span)
+    parsed = [_rule_block(block, variables, span_of, notes) for block in blocks]
+    parsed = [p for p in parsed if p[2]] or parsed[:1]
+    outputs = [n for n in declared if declared[n][0] == "output"]
+    for n in outputs:
+        _tsukamoto(records[n], variables[n], notes)
+    groups = _groups(parsed, records, outputs)
+    _check_outputs(groups, locks, constants)
+    ordered = [variables[n] for n in declared]
+    rb = common.assemble_blocks(span_of(fb).path, ordered, groups, DEFAULT_RESOLUTION,
+                                span_of(fb), notes, ranges)
+    return dataclasses.replace(rb, notes=tuple(notes))
+
+
+Declared = dict[str, tuple[Role, Span, tuple[float, float] | None]]
+
+
+def _declarations(fb: Tree, span_of) -> tuple[Declared, list[Tree], list[Tree], list[Tree]]:
+    """The VAR_INPUT / VAR_OUTPUT declarations by name (role, place, RANGE), and the
+    FUZZIFY, DEFUZZIFY and RULEBLOCK blocks in the order written."""
+    declared: Declared = {}
     fuzzify, defuzzify, blocks = [], [], []
     for item in fb.children[1:]:
         if item.data in ("var_input", "var_output"):
@@ -208,67 +252,62 @@ def _function_block(fb: Tree, span_of) -> RuleBase:
             defuzzify.append(item)
         else:
             blocks.append(item)
-    n_inputs = sum(1 for role, _, _ in declared.values() if role == "input")
-    records: dict[str, common.Record] = {}           # per output: METHOD, ACCU
-    notes: list[str] = []
-    locks: dict[str, Span] = {}
-    constants: list[tuple[str, Term]] = []
-    variables: dict[str, Variable] = {}
-    ranges: common.Places = {}                        # where each RANGE and DEFAULT is written
-    for node in fuzzify + defuzzify:
-        role = "input" if node.data == "fuzzify" else "output"
-        record = records.setdefault(str(node.children[0]), common.Record())
-        v = _variable(node, role, declared, record, locks, constants, n_inputs, span_of, notes,
-                      ranges)
-        if v.name in variables:
-            raise FormatError(f"variable `{v.name}` is defined twice"
-                              + first_at(variables[v.name].span), span=v.span)
-        variables[v.name] = v
-    for name, (role, span, _) in declared.items():
-        if name not in variables:
-            kind = "FUZZIFY" if role == "input" else "DEFUZZIFY"
-            raise FormatError(f"variable `{name}` is declared but has no {kind} block",
-                              span=span)
-    parsed = []                                       # (name, record, rules) per RULEBLOCK
-    for block in blocks:
-        record = common.Record()
-        for item in block.children[1:]:
-            if item.data == "option":
-                _option(item, record, span_of, {})
-        keys = {key for key, *_ in record}
-        if "and_" in keys and "or_" not in keys:      # IEC: the other one is the dual
-            and_ = next(v for k, v, *_ in record if k == "and_")
-            record.set("or_", norms.lookup("tnorm", and_).dual, None, "OR")
-        elif "or_" in keys and "and_" not in keys:
-            or_ = next(v for k, v, *_ in record if k == "or_")
-            record.set("and_", norms.lookup("snorm", or_).dual, None, "AND")
-        rule_items = [x for x in block.children[1:] if x.data == "rule"]
-        rules = [_rule(item, variables, span_of, i) for i, item in enumerate(rule_items)]
-        _grouping_note(rule_items, span_of, notes)
-        name = str(block.children[0]) if block.children[0] is not None else ""
-        parsed.append((name, record, rules))
-    parsed = [p for p in parsed if p[2]] or parsed[:1]
-    outputs = [n for n in declared if declared[n][0] == "output"]
-    for n in outputs:
-        _tsukamoto(records[n], variables[n], notes)
+    return declared, fuzzify, defuzzify, blocks
+
+
+def _rule_block(block: Tree, variables: dict[str, Variable], span_of,
+                notes: list[str]) -> tuple[str, common.Record, list[Rule]]:
+    """One RULEBLOCK's name, operators and rules. IEC 61131-7 names one of AND and OR: the
+    other one is its dual."""
+    record = common.Record()
+    for item in block.children[1:]:
+        if item.data == "option":
+            _option(item, record, span_of, {})
+    keys = {key for key, *_ in record}
+    if "and_" in keys and "or_" not in keys:
+        and_ = next(v for k, v, *_ in record if k == "and_")
+        record.set("or_", norms.lookup("tnorm", and_).dual, None, "OR")
+    elif "or_" in keys and "and_" not in keys:
+        or_ = next(v for k, v, *_ in record if k == "or_")
+        record.set("and_", norms.lookup("snorm", or_).dual, None, "AND")
+    rule_items = [x for x in block.children[1:] if x.data == "rule"]
+    rules = [_rule(item, variables, span_of, i) for i, item in enumerate(rule_items)]
+    _grouping_note(rule_items, span_of, notes)
+    name = str(block.children[0]) if block.children[0] is not None else ""
+    return name, record, rules
+
+
+def _groups(parsed: list[tuple[str, common.Record, list[Rule]]],
+            records: dict[str, common.Record], outputs: list[str]) -> list:
+    """The behaviors of the rule blocks ``parsed``: one holding every rule (relabelled
+    ``r1``... where two blocks reuse a label), or, where the blocks' operators conflict and
+    their outputs do not meet, one per block (named after it)."""
     try:
         all_rules = [r for _, _, rules in parsed for r in rules]
         if len({r.label for r in all_rules}) < len(all_rules):
             all_rules = [Rule(f"r{i + 1}", r.antecedent, r.consequents, r.weight, r.span)
                          for i, r in enumerate(all_rules)]
-        groups = [(MAIN, all_rules, common.replay([rec for _, rec, _ in parsed] +
-                                                  [records[n] for n in outputs]))]
+        return [(MAIN, all_rules, common.replay([rec for _, rec, _ in parsed] +
+                                                [records[n] for n in outputs]))]
     except FormatError as conflict:
         if len(parsed) < 2 or not common.disjoint_outputs([r for _, _, r in parsed]):
             raise conflict
-        groups = []                  # blocks with different operators: one behavior each
-        for i, (name, record, rules) in enumerate(parsed):
-            concluded = {c.var for r in rules for c in r.consequents}
-            groups.append((name or f"block{i + 1}", rules,
-                           common.replay([record] + [records[n] for n in outputs
-                                                     if n in concluded])))
+    groups = []
+    for i, (name, record, rules) in enumerate(parsed):
+        concluded = {c.var for r in rules for c in r.consequents}
+        groups.append((name or f"block{i + 1}", rules,
+                       common.replay([record] + [records[n] for n in outputs
+                                                 if n in concluded])))
+    return groups
+
+
+def _check_outputs(groups: list, locks: dict[str, Span],
+                   constants: list[tuple[str, Term]]) -> None:
+    """Refuse what a behavior's inference cannot mean: `LOCK : RANGE` on a Takagi-Sugeno
+    output, and fuzzylite's `Constant` term in a Mamdani one."""
     for _, rules, settings in groups:
         concluded = {c.var for r in rules for c in r.consequents}
+
         def mine(n: str, concluded: set = concluded) -> bool:
             return n in concluded or len(groups) == 1
         if settings.sugeno:
@@ -285,10 +324,6 @@ def _function_block(fb: Tree, span_of) -> RuleBase:
                         f"`Constant` is a flat membership of that height everywhere, which "
                         f"MITOS does not support", span=term.span,
                         hint=f"for a singleton write `TERM {term.name} := value;`")
-    ordered = [variables[n] for n in declared]
-    rb = common.assemble_blocks(span_of(fb).path, ordered, groups, DEFAULT_RESOLUTION,
-                                span_of(fb), notes, ranges)
-    return dataclasses.replace(rb, notes=tuple(notes))
 
 
 def _tsukamoto(record: common.Record, v: Variable, notes: list[str]) -> None:
