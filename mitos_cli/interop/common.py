@@ -438,6 +438,31 @@ def disjoint_outputs(blocks: list[list[Rule]]) -> bool:
     return True
 
 
+def rule_blocks(blocks: list[tuple[str, Record, list[Rule]]], outputs: dict[str, Record],
+                renumber: bool) -> list[tuple[str, list[Rule], Settings]]:
+    """The behaviors of a file's rule blocks (name, operators, rules), with each output's own
+    settings in ``outputs``: one, ``main``, holding every rule (numbered ``r1``... through when
+    ``renumber``), or, where the blocks' operators conflict and no output is concluded by two
+    of them (fuzzylite's hybrid engines), one per block, named after it."""
+    rules = [r for _, _, block in blocks for r in block]
+    try:
+        settings = replay([record for _, record, _ in blocks] + list(outputs.values()))
+    except FormatError as conflict:
+        if len(blocks) < 2 or not disjoint_outputs([block for _, _, block in blocks]):
+            raise conflict
+    else:
+        if renumber:
+            rules = [Rule(f"r{i + 1}", r.antecedent, r.consequents, r.weight, r.span)
+                     for i, r in enumerate(rules)]
+        return [(MAIN, rules, settings)]
+    behaviors = []
+    for i, (name, record, block) in enumerate(blocks):
+        concluded = {c.var for r in block for c in r.consequents}
+        behaviors.append((name or f"block{i + 1}", block,
+                          replay([record] + [outputs[n] for n in outputs if n in concluded])))
+    return behaviors
+
+
 
 #: Where an infinite parameter is meaningful, as (index, sign): the open end of a shoulder
 #: (fuzzylite writes ``Trapezoid -inf -inf c d``, ``Triangle -inf b c``) and the direction of

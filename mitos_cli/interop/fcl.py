@@ -45,7 +45,6 @@ from ..fuzzy.shapes import TSUKAMOTO
 from ..lang.bulk import without_cyclic_gc
 from ..lang.cache import lark_parser
 from ..lang.model import And, Expr, Not, Or, Prop, Rule, RuleBase
-from ..lang.resolve import MAIN
 from ..lang.terms import Role, Term, Variable, first_at
 from ..words import plural
 from . import common
@@ -216,7 +215,9 @@ def _function_block(fb: Tree, span_of) -> RuleBase:
     outputs = [n for n in declared if declared[n][0] == "output"]
     for n in outputs:
         _tsukamoto(records[n], variables[n], notes)
-    groups = _groups(parsed, records, outputs)
+    all_rules = [r for _, _, rules in parsed for r in rules]
+    groups = common.rule_blocks(parsed, {n: records[n] for n in outputs},
+                                renumber=len({r.label for r in all_rules}) < len(all_rules))
     _check_outputs(groups, locks, constants)
     ordered = [variables[n] for n in declared]
     rb = common.assemble_blocks(span_of(fb).path, ordered, groups, DEFAULT_RESOLUTION,
@@ -275,30 +276,6 @@ def _rule_block(block: Tree, variables: dict[str, Variable], span_of,
     _grouping_note(rule_items, span_of, notes)
     name = str(block.children[0]) if block.children[0] is not None else ""
     return name, record, rules
-
-
-def _groups(parsed: list[tuple[str, common.Record, list[Rule]]],
-            records: dict[str, common.Record], outputs: list[str]) -> list:
-    """The behaviors of the rule blocks ``parsed``: one holding every rule (relabelled
-    ``r1``... where two blocks reuse a label), or, where the blocks' operators conflict and
-    their outputs do not meet, one per block (named after it)."""
-    try:
-        all_rules = [r for _, _, rules in parsed for r in rules]
-        if len({r.label for r in all_rules}) < len(all_rules):
-            all_rules = [Rule(f"r{i + 1}", r.antecedent, r.consequents, r.weight, r.span)
-                         for i, r in enumerate(all_rules)]
-        return [(MAIN, all_rules, common.replay([rec for _, rec, _ in parsed] +
-                                                [records[n] for n in outputs]))]
-    except FormatError as conflict:
-        if len(parsed) < 2 or not common.disjoint_outputs([r for _, _, r in parsed]):
-            raise conflict
-    groups = []
-    for i, (name, record, rules) in enumerate(parsed):
-        concluded = {c.var for r in rules for c in r.consequents}
-        groups.append((name or f"block{i + 1}", rules,
-                       common.replay([record] + [records[n] for n in outputs
-                                                 if n in concluded])))
-    return groups
 
 
 def _check_outputs(groups: list, locks: dict[str, Span],

@@ -36,7 +36,6 @@ from ..lang.bulk import without_cyclic_gc
 from ..lang.cache import lark_parser
 from ..lang.model import Rule, RuleBase
 from ..lang.model import format_number as _fmt_weight
-from ..lang.resolve import MAIN
 from ..lang.terms import Role, Term, Variable
 from . import common
 from .common import FLL, Settings, fmt_number
@@ -190,21 +189,9 @@ def parse_fll(text: str, path: str | None = None) -> RuleBase:
         b.rules = [_rule(value, text, path, lineno, vcol, by_name, b.conj, i)
                    for i, (value, lineno, vcol) in enumerate(b.lines)]
     blocks = [b for b in blocks if b.rules] or blocks[:1]
-    try:
-        groups = [(MAIN, [r for b in blocks for r in b.rules],
-                   common.replay([b.record for b in blocks]
-                                 + [v.record for v in outputs.values()]))]
-        if len(blocks) > 1:
-            _relabel(groups[0][1])
-    except FormatError as conflict:
-        if len(blocks) < 2 or not common.disjoint_outputs([b.rules for b in blocks]):
-            raise conflict
-        groups = []                  # blocks with different operators: one behavior each
-        for i, b in enumerate(blocks):
-            concluded = {c.var for r in b.rules for c in r.consequents}
-            groups.append((b.name or f"block{i + 1}", b.rules,
-                           common.replay([b.record] + [outputs[n].record for n in outputs
-                                                        if n in concluded])))
+    groups = common.rule_blocks([(b.name, b.record, b.rules) for b in blocks],
+                                {n: v.record for n, v in outputs.items()},
+                                renumber=len(blocks) > 1)
     for _, rules, settings in groups:
         concluded = {c.var for r in rules for c in r.consequents}
         mine = [v for v in variables if v.role == "input" or v.name in concluded or
@@ -216,12 +203,6 @@ def parse_fll(text: str, path: str | None = None) -> RuleBase:
     rb = common.assemble_blocks(path, built, groups, DEFAULT_RESOLUTION, engine_span, notes,
                                 places)
     return dataclasses.replace(rb, notes=tuple(notes))
-
-
-def _relabel(rules: list[Rule]) -> None:
-    """Merged blocks: number the rules through (r1, r2, ...) so labels stay unique."""
-    for i, r in enumerate(rules):
-        rules[i] = Rule(f"r{i + 1}", r.antecedent, r.consequents, r.weight, r.span)
 
 
 def _check_outputs(variables: list[_Var], rules: list[Rule], settings: Settings) -> None:
