@@ -30,7 +30,7 @@ from ..errors import LessonError, MitosError, TermSetError
 from ..fileio import atomic_write, atomic_write_set, finish_saves  # noqa: F401 (re-exported)
 from ..fuzzy.shapes import SHAPES
 from ..lang import yamlpos
-from ..lang.model import Behavior, RuleBase, format_number, format_rule, format_use
+from ..lang.model import Behavior, Rule, RuleBase, format_number, format_rule, format_use
 from ..lang.parse import _unquote
 from ..lang.parse import parser as rule_parser
 from ..lang.terms import Term
@@ -493,57 +493,7 @@ def edit_rules(text: str, path: str, original: RuleBase, current: RuleBase,
             changes.append(f"new behavior {b.name} ({plural(len(b.rules), 'rule')})")
             continue
         place = places.get(b.name)
-        inserted: list[str] = []
-        if keep:
-            inserted.append("operators: " + ", ".join(f"{k} = {v}" for k, v in keep.items()))
-            changes.append(f"{b.name}: operators {inserted[-1][len('operators: '):]} (as before: "
-                           f"the file's own `operators:` line now sets what `main` was told)")
-        for i, rule in enumerate(b.rules):
-            # a rule told again under its label stays in its place, a new one is added at
-            # the end (`state._put_rule`): the first rules are the file's, in its order,
-            # labelled or not
-            before = old.rules[i] if i < len(old.rules) else None
-            if before is None:
-                inserted.append(format_rule(rule))
-                changes.append(f"{b.name}: new rule {format_rule(rule)}")
-                continue
-            if before == rule:
-                continue
-            if place is None or i >= len(place.rules) or place.rules[i][0] != before.label:
-                raise LessonError(f"{path} changed since the lesson began: rule "    # since
-                                  f"`{before.label or f'#{i + 1}'}` of behavior {b.name} is no "
-                                  f"longer there",
-                                  hint="start the lesson again on the file as it is now")
-            start, end, crisp = place.rules[i][1]
-            if _only_crisp_changed(before, rule) and all(c.var in crisp for c in rule.consequents
-                                                         if c.term is None):
-                for c_old, c_new in zip(before.consequents, rule.consequents):
-                    if c_old.value != c_new.value:
-                        assert c_new.value is not None   # same terms, so a crisp value changed
-                        s, e = crisp[c_new.var]
-                        edits.append((s, e, format_number(c_new.value)))
-            else:
-                edits.append((start, end, format_rule(rule)))
-            changes.append(f"{b.name}: {format_rule(rule)}")
-        for use in b.uses[len(old.uses):]:
-            inserted.append(format_use(use))
-            changes.append(f"{b.name}: {format_use(use)}")
-        told = b.operators[len(old.operators):]
-        if told:
-            changes.append(f"{b.name}: operators {_operators_text(told)}")
-            kept = [s for s in told if place is None or s.key not in place.settings]
-            if place is not None:
-                # set where the file (or the behavior) already sets it: a second line
-                # setting the same key is read with a warning
-                for key, value in _last_values(told).items():
-                    if key in place.settings:
-                        edits.append((*place.settings[key], f"{key} = {value}"))
-            if kept:
-                inserted.append("operators: " + _operators_text(kept))
-        new_frozen = [label for label in b.frozen if label not in old.frozen]
-        if new_frozen:
-            inserted.append("frozen " + ", ".join(new_frozen))
-            changes.append(f"{b.name}: frozen {', '.join(new_frozen)}")
+        inserted = _edited_behavior(b, old, place, keep, path, edits, changes)
         if inserted:
             if place is None or place.end_line_start is None:
                 appended += inserted                      # top-level rules: at the end
@@ -558,6 +508,74 @@ def edit_rules(text: str, path: str, original: RuleBase, current: RuleBase,
             out += "\n"
         out += "\n# told in `mitos teach`\n" + "\n".join(appended) + "\n"
     return out, changes
+
+
+def _edited_behavior(b: Behavior, old: Behavior, place: _Place | None, keep: dict[str, str],
+                     path: str, edits: list[tuple[int, int, str]],
+                     changes: list[str]) -> list[str]:
+    """The edits (into ``edits``) of behavior ``b``'s rules, uses, operators and freezes
+    since ``old``, where the file at ``place`` writes it; returns the lines to insert at its
+    end (new rules, uses, operators and freezes)."""
+    inserted: list[str] = []
+    if keep:
+        inserted.append("operators: " + ", ".join(f"{k} = {v}" for k, v in keep.items()))
+        changes.append(f"{b.name}: operators {inserted[-1][len('operators: '):]} (as before: "
+                       f"the file's own `operators:` line now sets what `main` was told)")
+    for i, rule in enumerate(b.rules):
+        # a rule told again under its label stays in its place, a new one is added at
+        # the end (`state._put_rule`): the first rules are the file's, in its order,
+        # labelled or not
+        before = old.rules[i] if i < len(old.rules) else None
+        if before is None:
+            inserted.append(format_rule(rule))
+            changes.append(f"{b.name}: new rule {format_rule(rule)}")
+            continue
+        if before == rule:
+            continue
+        if place is None or i >= len(place.rules) or place.rules[i][0] != before.label:
+            raise LessonError(f"{path} changed since the lesson began: rule "    # since
+                              f"`{before.label or f'#{i + 1}'}` of behavior {b.name} is no "
+                              f"longer there",
+                              hint="start the lesson again on the file as it is now")
+        edits += _rule_edits(before, rule, *place.rules[i][1])
+        changes.append(f"{b.name}: {format_rule(rule)}")
+    for use in b.uses[len(old.uses):]:
+        inserted.append(format_use(use))
+        changes.append(f"{b.name}: {format_use(use)}")
+    told = b.operators[len(old.operators):]
+    if told:
+        changes.append(f"{b.name}: operators {_operators_text(told)}")
+        kept = [s for s in told if place is None or s.key not in place.settings]
+        if place is not None:
+            # set where the file (or the behavior) already sets it: a second line
+            # setting the same key is read with a warning
+            for key, value in _last_values(told).items():
+                if key in place.settings:
+                    edits.append((*place.settings[key], f"{key} = {value}"))
+        if kept:
+            inserted.append("operators: " + _operators_text(kept))
+    new_frozen = [label for label in b.frozen if label not in old.frozen]
+    if new_frozen:
+        inserted.append("frozen " + ", ".join(new_frozen))
+        changes.append(f"{b.name}: frozen {', '.join(new_frozen)}")
+    return inserted
+
+
+def _rule_edits(before: Rule, rule: Rule, start: int, end: int,
+                crisp: dict[str, tuple[int, int]]) -> list[tuple[int, int, str]]:
+    """``before``, written at ``start:end``, changed into ``rule``: where only crisp values
+    changed, those numbers (at ``crisp``, by output) and the rest of the line as the
+    instructor wrote it; else the whole rule."""
+    if not (_only_crisp_changed(before, rule)
+            and all(c.var in crisp for c in rule.consequents if c.term is None)):
+        return [(start, end, format_rule(rule))]
+    edits = []
+    for c_old, c_new in zip(before.consequents, rule.consequents):
+        if c_old.value != c_new.value:
+            assert c_new.value is not None   # same terms, so a crisp value changed
+            s, e = crisp[c_new.var]
+            edits.append((s, e, format_number(c_new.value)))
+    return edits
 
 
 def _operators_text(settings) -> str:
