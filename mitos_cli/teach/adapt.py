@@ -879,11 +879,27 @@ def gradient(p: Parameters, values: np.ndarray, X: np.ndarray,
     res = evaluate(c, X, keep_values=True, strict=False)
     assert res.values is not None and res.dof is not None    # keep_values, detail (default)
     V = res.values.T                                 # [cols, n]
-    Xt = res.inputs.T                                # [k, n] clamped
-    n = V.shape[1]
-    dof = res.dof.T                                  # [R, n]
-    y = res.outputs.T                                # [m, n]
-    tgt = targets.T
+    Q, gdof, gcons = _output_layer(c, res.dof.T, res.outputs.T, targets.T)
+    G = _network_grad(c, V, gdof)
+    grad = np.zeros(len(values))
+    up = down = None
+    rows = np.flatnonzero((p.corner_knot >= 0).any(axis=1))
+    if rows.size:
+        up, down = _membership_layer(p, values, c, rows, res.inputs.T, G, grad)
+    ok = p.cons_knot >= 0
+    np.add.at(grad, p.cons_knot[ok], gcons[ok])
+    if up is not None and down is not None:
+        np.add.at(up, p.cons_knot[ok], gcons[ok])
+        np.add.at(down, p.cons_knot[ok], gcons[ok])
+        grad = _falling_side(up, down)
+    return Q, grad
+
+
+def _output_layer(c: CompiledRuleBase, dof: np.ndarray, y: np.ndarray,
+                  tgt: np.ndarray) -> tuple[float, np.ndarray, np.ndarray]:
+    """``Q`` of the outputs ``y[m, n]`` against the targets ``tgt[m, n]`` (NaN: not
+    corrected), and its gradient by each rule's DOF ``[R, n]`` and by each rule's crisp
+    consequents ``[R, m]``, through the weighted average (or sum) of the DOFs ``[R, n]``."""
     given = ~np.isnan(tgt)
     M = c.cons_mask.astype(float)                    # [R, m]
     S = M.T @ dof                                    # [m, n]
@@ -899,9 +915,15 @@ def gradient(p: Parameters, values: np.ndarray, X: np.ndarray,
         gy = np.divide(err, S, out=np.zeros_like(err), where=fired)     # dQ/dy / S
         gdof = Yc @ gy - M @ (gy * np.where(fired, y, 0.0))            # (y_r - y) / S
     gcons = (dof @ gy.T) * M                         # [R, m]: dof_r / S
+    return Q, gdof, gcons
 
+
+def _network_grad(c: CompiledRuleBase, V: np.ndarray, gdof: np.ndarray) -> np.ndarray:
+    """The gradient by every value of the network ``V[cols, n]``, from the gradient by each
+    rule's DOF: through the rule's weight and contexts (``dof_r = V[rule_col] * prod
+    V[context] * weight``), then the AND / OR / NOT / hedge neurons, last level first."""
     G = np.zeros_like(V)
-    # dof_r = V[rule_col] * prod V[context] * weight
+    n = V.shape[1]
     ctx = c.context
     w = c.weight[:, None]
     base = V[c.rule_col]
@@ -915,32 +937,31 @@ def gradient(p: Parameters, values: np.ndarray, X: np.ndarray,
     for level in reversed(c.levels):
         for group in reversed(level):
             _backward_group(group, V, G, tnorm, snorm)
+    return G
 
-    grad = np.zeros(len(values))
-    up = down = None
-    # membership layer
-    rows = np.flatnonzero((p.corner_knot >= 0).any(axis=1))
-    if rows.size:
-        corners = np.array([[values[i] if i >= 0 else o for i, o in
-                             zip(p.corner_knot[t], _orig_corners(p, t))] for t in rows.tolist()])
-        x = Xt[c.term_var[rows]]
-        dmu = _membership_grad(corners, x)                          # [4, t, n]
-        gmu = G[2 + rows]                                           # [t, n]
-        idx = p.corner_knot[rows]
-        ok = idx >= 0
-        np.add.at(grad, idx[ok], np.einsum("ctn,tn->tc", dmu, gmu)[ok])
-        sides = _corner_grad(corners, x)                            # examples on a corner
-        if sides is not None:
-            up, down = grad.copy(), grad.copy()
-            np.add.at(up, idx[ok], np.einsum("ctn,tn->tc", sides[0], gmu)[ok])
-            np.add.at(down, idx[ok], np.einsum("ctn,tn->tc", sides[1], gmu)[ok])
-    ok = p.cons_knot >= 0
-    np.add.at(grad, p.cons_knot[ok], gcons[ok])
-    if up is not None and down is not None:
-        np.add.at(up, p.cons_knot[ok], gcons[ok])
-        np.add.at(down, p.cons_knot[ok], gcons[ok])
-        grad = _falling_side(up, down)
-    return Q, grad
+
+def _membership_layer(p: Parameters, values: np.ndarray, c: CompiledRuleBase, rows: np.ndarray,
+                      Xt: np.ndarray, G: np.ndarray,
+                      grad: np.ndarray) -> tuple[np.ndarray | None, np.ndarray | None]:
+    """Add to ``grad`` the slopes of the corners of the terms ``rows`` (those with a free
+    knot) at the clamped inputs ``Xt[k, n]``, from the gradient ``G`` by the network's values;
+    where an example lies exactly on a corner, also return the one-sided gradients (moving
+    each knot up, and down), else ``None, None``."""
+    corners = np.array([[values[i] if i >= 0 else o for i, o in
+                         zip(p.corner_knot[t], _orig_corners(p, t))] for t in rows.tolist()])
+    x = Xt[c.term_var[rows]]
+    dmu = _membership_grad(corners, x)                          # [4, t, n]
+    gmu = G[2 + rows]                                           # [t, n]
+    idx = p.corner_knot[rows]
+    ok = idx >= 0
+    np.add.at(grad, idx[ok], np.einsum("ctn,tn->tc", dmu, gmu)[ok])
+    sides = _corner_grad(corners, x)                            # examples on a corner
+    if sides is None:
+        return None, None
+    up, down = grad.copy(), grad.copy()
+    np.add.at(up, idx[ok], np.einsum("ctn,tn->tc", sides[0], gmu)[ok])
+    np.add.at(down, idx[ok], np.einsum("ctn,tn->tc", sides[1], gmu)[ok])
+    return up, down
 
 
 def _falling_side(up: np.ndarray, down: np.ndarray) -> np.ndarray:
