@@ -243,6 +243,11 @@ def test_runs_and_its_old_spelling_together_are_a_usage_error(tiny, tmp_path, co
     assert not (tmp_path / "s").exists()
 
 
+def _line_of(path, text: str) -> int:
+    """The number of the first line of ``path`` holding ``text``."""
+    return next(i for i, line in enumerate(path.read_text().splitlines(), 1) if text in line)
+
+
 def test_resume_refuses_a_world_that_changed(tmp_path, compare):
     """Resuming after the world file was edited would average runs of two different worlds
     (it did: 50% success, where the edited world alone gives 0%)."""
@@ -254,6 +259,9 @@ def test_resume_refuses_a_world_that_changed(tmp_path, compare):
     world.write_text(TINY + "\n# edited\n")
     r = compare(*args, "--runs", 2, "--resume")
     assert r.exit_code == 1 and "changed since the runs in" in r.stderr
+    # the place: the digest study.json recorded for it, the line shown and marked
+    line = _line_of(out / "study.json", 'w.yaml": "')
+    assert f"study.json:{line}:5: study error" in r.stderr and 'w.yaml": "' in r.stderr
     assert len(read_rows(out)) == 1
     world.write_text(TINY)                               # put back: it resumes
     assert compare(*args, "--runs", 2, "--resume").exit_code == 0
@@ -269,6 +277,8 @@ def test_resume_refuses_another_behavior(tiny, tmp_path, compare):
     r = compare(*args, "--runs", 2, "--resume", "--behavior", "avoid_obstacle")
     assert r.exit_code == 1 and "were made with each world's own behavior, not --behavior " \
         "avoid_obstacle" in r.stderr, r.output
+    line = _line_of(out / "study.json", '"behavior": null')
+    assert f"study.json:{line}:3: study error" in r.stderr and '"behavior": null,' in r.stderr
     assert "resume without --behavior" in r.stderr and len(read_rows(out)) == 1
     assert compare(*args, "--runs", 2, "--resume").exit_code == 0
     r = compare(*args, "--runs", 3, "--resume", "--behavior", "drive")

@@ -443,6 +443,9 @@ def test_resume_with_another_seed_is_refused(tmp_path):
     with pytest.raises(StudyError) as exc:
         run_study(other, tmp_path, workers=1, resume=True, task_fn=fake_sim)
     assert "was made with --seed 3, not 4" in exc.value.message
+    span = exc.value.span                                # where study.json records it
+    assert span is not None and str(span.path).endswith("study.json")
+    assert span.source_line is not None and span.source_line.strip().startswith('"seed": 3')
 
 
 def test_resume_with_worlds_reordered_is_refused(tmp_path):

@@ -132,6 +132,7 @@ class ResultStore:
         self._unended = False              # a whole last row without its newline
         self._at: list[tuple[int, str, list[str]]] = []   # each row's line: number, text, values
         self._names: dict[str, str] = {}   # a world as given now -> as the rows name it
+        self._manifest_text = ""           # study.json as :meth:`manifest` read it last
         self._held: int | None = None      # the directory, locked while a study runs in it
 
     # -- reading -----------------------------------------------------------------------------
@@ -273,6 +274,7 @@ class ResultStore:
                              span=long and _at(text, str(self.manifest_path), long.start()),
                              hint=hint) from None
         path = str(self.manifest_path)
+        self._manifest_text = text
         wrong = _misshapen(got)
         if wrong is not None:
             key, why = wrong
@@ -289,6 +291,11 @@ class ResultStore:
                              f"number", span=_key_span(text, path, "seed"),
                              expected="the study's --seed, such as 1", hint=hint)
         return got
+
+    def _said(self, key: str) -> Span | None:
+        """Where ``study.json`` (as :meth:`manifest` read it) writes ``key``, the place a
+        refusal of what it records shows."""
+        return _key_span(self._manifest_text, str(self.manifest_path), key)
 
     # -- writing -----------------------------------------------------------------------------
 
@@ -331,17 +338,18 @@ class ResultStore:
         old = self.manifest() if rows else None
         if old is not None and old.get("seed") != manifest.get("seed"):
             raise StudyError(f"{self.path} was made with --seed {old.get('seed')}, "
-                             f"not {manifest.get('seed')}",
+                             f"not {manifest.get('seed')}", span=self._said("seed"),
                              hint=f"resume with --seed {old.get('seed')}, or choose another "
                                   "directory with -o")
         if old is not None:
-            _check_behavior(old, manifest, self.path)
+            _check_behavior(old, manifest, self.path, self._said("behavior"))
         given = list(manifest.get("worlds") or [])
         worlds = _worlds_of(rows, old or {}, manifest)
         if old is not None:
             now = manifest.get("digests") or {}
             _check_unchanged(old.get("digests") or {}, {
-                **now, **{name: now[w] for name, w in worlds.items() if w in now}}, self.path)
+                **now, **{name: now[w] for name, w in worlds.items() if w in now}}, self.path,
+                self._said)
         if any(name != w for name, w in worlds.items()):   # the rows, their worlds named as now
             rows = [{**r, "world": worlds.get(r["world"], r["world"])} for r in rows]
             self._refuse_twice(rows)         # (one world under two of its names)
@@ -517,18 +525,19 @@ def _at(text: str, path: str, index: int, width: int = 1) -> Span:
     return Span.in_text(text, path, line, column, column + width)
 
 
-def _check_unchanged(old: dict, new: dict, path: Path) -> None:
+def _check_unchanged(old: dict, new: dict, path: Path, said) -> None:
     """A world or rule base edited since the study began: its finished runs are of the old
-    file, and resuming would average them with runs of the new one."""
+    file, and resuming would average them with runs of the new one. ``said(name)``: where
+    ``study.json`` records the first changed file's digest."""
     changed = [name for name, digest in new.items() if name in old and old[name] != digest]
     if changed:
         what = ", ".join(_changed_file(n) for n in changed)
         raise StudyError(f"{what} changed since the runs in {path} were made; resuming would "
-                         f"mix runs of the old and the new file",
+                         f"mix runs of the old and the new file", span=said(changed[0]),
                          hint="choose another directory with -o (or put the file back)")
 
 
-def _check_behavior(old: dict, new: dict, path: Path) -> None:
+def _check_behavior(old: dict, new: dict, path: Path, span: Span | None = None) -> None:
     """A resume with another ``--behavior`` than the runs were made with: no column of a row
     names it, and its runs were averaged with the others (and study.json said all were)."""
     if "behavior" not in old or old["behavior"] == new.get("behavior"):
@@ -540,7 +549,7 @@ def _check_behavior(old: dict, new: dict, path: Path) -> None:
     was = old["behavior"]
     raise StudyError(f"the runs in {path} were made with {said(was)}, not "
                      f"{said(new.get('behavior'))}; resuming would mix runs of the two",
-                     hint=(f"resume with --behavior {was}" if was else "resume without "
+                     span=span, hint=(f"resume with --behavior {was}" if was else "resume without "
                            "--behavior") + ", or choose another directory with -o")
 
 
