@@ -582,3 +582,32 @@ def test_the_findings_name_a_packaged_file_as_the_summary_does(tmp_path, monkeyp
     located = [line for line in out.splitlines() if ": warning: " in line or ": note: " in line]
     assert located and all(line.startswith("rulebases/") for line in located), located
     assert "\nchecked rulebases/mitos.rules (packaged): " in out
+
+
+def _many_triangles(tmp_path: Path, n: int) -> Path:
+    """A rule file whose input `x` has ``n`` narrow triangles, one of them used."""
+    terms = "".join(f"      T{i}: {{shape: triangle, peak: {i + 1}, width: 1}}\n" for i in range(n))
+    (tmp_path / "big.terms.yaml").write_text(
+        f"variables:\n  x:\n    role: input\n    universe: [0, {n + 1}]\n    terms:\n{terms}"
+        "  y:\n    role: output\n    universe: [0, 10]\n    terms:\n"
+        "      A: {shape: triangle, peak: 5, width: 5}\n")
+    (tmp_path / "big.rules").write_text('terms "big.terms.yaml"\nr1: if x is T0 then y is A\n')
+    return tmp_path / "big.rules"
+
+
+def test_a_variable_of_many_terms_is_checked_in_blocks(tmp_path):
+    """`mitos check` of 10,000 triangles took 2 GB (20,000: 7 GB): its grid evaluated every
+    term at 8,192 samples a block, and the term gaps took every term's memberships at every
+    corner at once. Both now go a few terms' worth at a time."""
+    import tracemalloc
+
+    rb = read_rulebase(_many_triangles(tmp_path, 3000))
+    tracemalloc.start()
+    try:
+        report = check_rulebase(rb)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert peak < 120e6                                    # was over 500 MB
+    codes = {f.code for f in report.findings}
+    assert {"no-rule-fires", "term-gap"} <= codes

@@ -160,6 +160,17 @@ def _clamp_columns(compiled: CompiledRuleBase, Xt: np.ndarray, first: int = 0,
 #: column-wise (per sample), so results do not depend on the block size.
 BLOCK = 8192
 
+#: Most neuron values of one block (16 MB): a network of more than 256 neurons takes blocks of
+#: fewer samples (:func:`block_width`). Without it a variable of 10,000 terms made blocks of
+#: 655 MB, and `mitos check` of one 1.3 GB.
+BLOCK_CELLS = BLOCK * 256
+
+
+def block_width(compiled: CompiledRuleBase) -> int:
+    """Samples per block of ``compiled``'s network: :data:`BLOCK`, or as many as
+    :data:`BLOCK_CELLS` neuron values hold (at least 16)."""
+    return max(16, min(BLOCK, BLOCK_CELLS // max(1, compiled.n_columns)))
+
 #: Elements between the rows of a buffer whose halves are added in place. NumPy 1.x takes its
 #: scalar loop, at twice the time, when an input ends exactly where the output begins (so
 #: ``np.add(W[:h], W[h:], out=W[:h])`` on a contiguous ``W``); rows a cache line apart are
@@ -462,7 +473,7 @@ def evaluate(compiled: CompiledRuleBase, X, *, detail: bool = True, keep_values:
             if values is not None:                      # keep_values
                 values[:, block] = V
         return counts
-    counts = sum(map_blocks(blocks, n, BLOCK), np.zeros(k, dtype=np.intp))
+    counts = sum(map_blocks(blocks, n, block_width(compiled)), np.zeros(k, dtype=np.intp))
     X = clamped_in.T
     no_rule = np.isnan(out.T)
     outputs = fill_defaults(compiled, out.T, X, strict)
@@ -489,8 +500,9 @@ def rule_dofs(compiled: CompiledRuleBase, X) -> np.ndarray:
     X = _rows(compiled, X)
     n = X.shape[0]
     dof = np.empty((compiled.plan.n_rules, n))
-    for start in range(0, n, BLOCK):
-        block = slice(start, min(start + BLOCK, n))
+    width = block_width(compiled)
+    for start in range(0, n, width):
+        block = slice(start, min(start + width, n))
         Xt, _ = _clamp(compiled, X[block], start, n)
         dof[:, block] = rule_dof(compiled, network_values(compiled, Xt))
     return dof.T
@@ -524,7 +536,7 @@ def evaluate_columns(compiled: CompiledRuleBase, Xt, *, strict: bool = True) -> 
                 Xc, _ = _clamp_columns(compiled, Xt[:, start:end], start, n)
                 out[:, start:end] = infer(compiled, rule_dof(compiled, network_values(compiled, Xc)),
                                           Xc)
-        map_blocks(blocks, n, BLOCK)
+        map_blocks(blocks, n, block_width(compiled))
         unfired = True
     if unfired and np.isnan(out).any():      # rare: the clamped rows, for the message
         rows = np.minimum(np.maximum(np.array(columns).T, compiled.plan.lo),
