@@ -560,30 +560,8 @@ def _sampled(compiled: CompiledRuleBase, threshold: float,
             boxes, uncovered = boxes_of(mask.reshape(shape), axes, compiled.inputs)
             share = volume_share(mask.reshape(shape), axes,
                                  inner=kind == "no-rule-fires" and not skipped)
-            what = " and ".join(f"`{o}`" for o in outs)
-            summed = compiled.operators.inference == "weighted_sum"
-            if kind == "no-rule-fires":
-                severity = "warning" if has_default or summed else "error"
-                where = (f"in {_pct(share)} of the input space" if share > 0 else
-                         "on lines or points of the input space (none of its volume)")
-                message = f"behavior `{name}`: no rule sets {what} {where}"
-                message += thinned
-                if summed:                    # a weighted sum of nothing is 0, not an error
-                    message += " (the weighted sum is 0 there)"
-                    hint = "add rules that cover these inputs"
-                elif has_default:
-                    values = ", ".join(
-                        f"{o} = {compiled.default[compiled.outputs.index(o)]:g}" for o in outs)
-                    message += f" (the default applies there: {values})"
-                    hint = "add rules that cover these inputs"
-                else:
-                    hint = (f"add rules that cover these inputs, or add `default: VALUE` to "
-                            f"{what} in the term set to define the output when no rule fires")
-            else:
-                severity = "warning"
-                message = (f"behavior `{name}`: the rules setting {what} fire with a total DOF "
-                           f"below {threshold:g} in {_pct(share)} of the input space{thinned}")
-                hint = "widen the terms or add rules, so that more than a trace of a rule fires"
+            severity, message, hint = _coverage_words(compiled, kind, outs, share,
+                                                      has_default, threshold, thinned)
             out.append(Finding(severity, kind, message, span, name, hint,
                                tuple(boxes[:MAX_BOXES]), max(0, len(boxes) - MAX_BOXES), share,
                                uncovered))
@@ -595,6 +573,33 @@ def _sampled(compiled: CompiledRuleBase, threshold: float,
                    dtype=bool)
     out += _unreachable(compiled, np.flatnonzero(~fires & own), resolution)
     return out, info
+
+
+def _coverage_words(compiled: CompiledRuleBase, kind: str, outs: list[str], share: float,
+                    has_default: bool, threshold: float, thinned: str) -> tuple[str, str, str]:
+    """The severity, message and hint of a coverage finding (``no-rule-fires`` or
+    ``low-dof``) of the outputs ``outs`` over ``share`` of the input space: no rule firing is
+    an error only where the output has no default and is not a weighted sum (of nothing, 0)."""
+    name = compiled.behavior
+    what = " and ".join(f"`{o}`" for o in outs)
+    if kind != "no-rule-fires":
+        return ("warning",
+                f"behavior `{name}`: the rules setting {what} fire with a total DOF below "
+                f"{threshold:g} in {_pct(share)} of the input space{thinned}",
+                "widen the terms or add rules, so that more than a trace of a rule fires")
+    summed = compiled.operators.inference == "weighted_sum"
+    where = (f"in {_pct(share)} of the input space" if share > 0 else
+             "on lines or points of the input space (none of its volume)")
+    message = f"behavior `{name}`: no rule sets {what} {where}{thinned}"
+    if summed:
+        return ("warning", message + " (the weighted sum is 0 there)",
+                "add rules that cover these inputs")
+    if has_default:
+        values = ", ".join(f"{o} = {compiled.default[compiled.outputs.index(o)]:g}" for o in outs)
+        return ("warning", message + f" (the default applies there: {values})",
+                "add rules that cover these inputs")
+    return ("error", message, f"add rules that cover these inputs, or add `default: VALUE` to "
+                              f"{what} in the term set to define the output when no rule fires")
 
 
 #: Samples evaluated at once when a rule is looked at on a grid of its own inputs.
