@@ -137,24 +137,55 @@ def parse_fis(text: str, path: str | None = None) -> RuleBase:
         raise FormatError("the file has no [System] section",
                           span=Span.in_text(text, path, 1, 1))
     sys_span, sys_items = by_kind["System"]
+    system = _system(sys_items)
+    kind = _string(*system.get("Type", ("'mamdani'", sys_span))).lower()
+    if kind not in ("mamdani", "sugeno"):
+        raise FormatError(f"FIS type `{kind}` is not supported", span=system["Type"][1],
+                          expected="mamdani or sugeno")
+    settings, unset, sugeno = _settings(system, sys_span, kind)
+    notes: list[str] = []
+    ranges: common.Places = {}
+    inputs = _variables(sections, "Input", "input", kind, notes, 0, ranges)
+    n_inputs = len(inputs)
+    outputs = _variables(sections, "Output", "output", kind, notes, n_inputs, ranges)
+    _check_count(system, "NumInputs", len(inputs), sys_span)
+    _check_count(system, "NumOutputs", len(outputs), sys_span)
+    variables = inputs + outputs
+    rules = [_rule(line, lineno, span, inputs, outputs, text, path, i)
+             for i, (line, lineno, span) in enumerate(rule_lines)]
+    _check_count(system, "NumRules", len(rules), sys_span)
+    _check_unset(unset, rules)
+    if sugeno:
+        _sugeno_aggregation(system, rules, notes)
+    rb = common.assemble(path, variables, rules, settings, DEFAULT_RESOLUTION, sys_span, notes,
+                         ranges)
+    return dataclasses.replace(rb, notes=tuple(notes))
+
+
+def _system(items) -> dict[str, tuple[str, Span]]:
+    """The [System] section's values (and their places) by key; an unknown key is refused."""
     system = {}
-    for key, value, span, vspan in sys_items:
+    for key, value, span, vspan in items:
         if key not in SYSTEM_KEYS:
             raise FormatError(f"unknown [System] key `{key}`", span=span,
                               expected="one of " + ", ".join(SYSTEM_KEYS),
                               hint=did_you_mean(key, SYSTEM_KEYS))
         system[key] = (value, vspan)
-    kind = _string(*system.get("Type", ("'mamdani'", sys_span))).lower()
-    if kind not in ("mamdani", "sugeno"):
-        raise FormatError(f"FIS type `{kind}` is not supported", span=system["Type"][1],
-                          expected="mamdani or sugeno")
+    return system
+
+
+def _settings(system: dict[str, tuple[str, Span]], sys_span: Span,
+              kind: str) -> tuple[Settings, dict[str, Span], bool]:
+    """The operators the [System] section names (MATLAB's defaults for those it leaves out),
+    where a method is written as ``''`` (fuzzylite writes that for an operator its rules
+    never use), and whether the system is Takagi-Sugeno."""
     settings = Settings()
     unset: dict[str, Span] = {}
 
     def method(key: str, table: dict, what: str, default: str) -> str:
         value, vspan = system.get(key, (f"'{default}'", sys_span))
         name = _string(value, vspan)
-        if not name:               # fuzzylite writes '' for an operator its rules never use
+        if not name:
             unset[key] = vspan
             return default
         return common.table_lookup(table, FIS, name, what, vspan)
@@ -176,18 +207,11 @@ def parse_fis(text: str, path: str | None = None) -> RuleBase:
                                            "max"), None, "aggregation")
         settings.set("resolution", DEFAULT_RESOLUTION, None, "resolution")
         settings.set("sampling", "endpoints", None, "sampling")
+    return settings, unset, sugeno
 
-    notes: list[str] = []
-    ranges: common.Places = {}
-    inputs = _variables(sections, "Input", "input", kind, notes, 0, ranges)
-    n_inputs = len(inputs)
-    outputs = _variables(sections, "Output", "output", kind, notes, n_inputs, ranges)
-    _check_count(system, "NumInputs", len(inputs), sys_span)
-    _check_count(system, "NumOutputs", len(outputs), sys_span)
-    variables = inputs + outputs
-    rules = [_rule(line, lineno, span, inputs, outputs, text, path, i)
-             for i, (line, lineno, span) in enumerate(rule_lines)]
-    _check_count(system, "NumRules", len(rules), sys_span)
+
+def _check_unset(unset: dict[str, Span], rules: list[Rule]) -> None:
+    """``AndMethod=''`` (or ``OrMethod``) with a rule that joins its conditions so."""
     for key, connective in (("AndMethod", And), ("OrMethod", Or)):
         used = next((r for r in rules if isinstance(r.antecedent, connective)), None)
         if key in unset and used is not None:
@@ -195,11 +219,6 @@ def parse_fis(text: str, path: str | None = None) -> RuleBase:
                               f"{'AND' if connective is And else 'OR'}", span=used.span,
                               hint=f"give {key} a method, e.g. "
                                    f"'{'min' if connective is And else 'max'}'")
-    if sugeno:
-        _sugeno_aggregation(system, rules, notes)
-    rb = common.assemble(path, variables, rules, settings, DEFAULT_RESOLUTION, sys_span, notes,
-                         ranges)
-    return dataclasses.replace(rb, notes=tuple(notes))
 
 
 def _sugeno_aggregation(system: dict, rules: list[Rule], notes: list[str]) -> None:
