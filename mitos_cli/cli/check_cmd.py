@@ -29,12 +29,15 @@ def render(report, trace_path: str) -> str:
     it (``rulebases/...``, not its place in site-packages)."""
     from ..resources import packaged_name
 
+    shown_as: dict[str | None, str] = {}     # each file once (20,000 findings took 10 s)
     lines = []
     for f in report.findings:
         where = ""
         if f.span:
-            path = (f.span.path and packaged_name(f.span.path)) or show_path(f.span.path)
-            where = f"{path}:{f.span.line}:{f.span.column}: "
+            if f.span.path not in shown_as:
+                shown_as[f.span.path] = ((f.span.path and packaged_name(f.span.path))
+                                         or show_path(f.span.path))
+            where = f"{shown_as[f.span.path]}:{f.span.line}:{f.span.column}: "
         shown = "note" if f.severity == "info" else f.severity     # as the summary counts it
         lines.append(f"{where}{shown}: {f.message} [{f.code}]")
         for box in f.regions:

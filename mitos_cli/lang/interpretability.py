@@ -333,7 +333,7 @@ def most_similar_on(mu: np.ndarray, x: np.ndarray) -> tuple[float, int, int]:
     some = above.any(axis=1)
     start = np.where(some, above.argmax(axis=1), 0)
     end = np.where(some, distinct.shape[1] - 1 - above[:, ::-1].argmax(axis=1), -1)
-    return _most_similar(lambda k: distinct[k], x, which, counts, start, end)
+    return _most_similar(lambda k, at: distinct[k[:, None], at], x, which, counts, start, end)
 
 
 def most_similar(corners: np.ndarray, universe: tuple[float, float]) -> tuple[float, int, int]:
@@ -350,14 +350,16 @@ def _linear_most(corners: np.ndarray, x: np.ndarray) -> tuple[float, int, int]:
     # the points from the term's left corner to its right one: all where it is above 0
     start = np.searchsorted(x, distinct[:, 0], side="left")
     end = np.searchsorted(x, distinct[:, 3], side="right") - 1
-    return _most_similar(lambda k: memberships(distinct[k], x), x, which, counts, start, end)
+    return _most_similar(lambda k, at: memberships(distinct[k], x[at]), x, which, counts, start,
+                         end)
 
 
 def _most_similar(rows, x: np.ndarray, which: np.ndarray, counts: np.ndarray, start: np.ndarray,
                   end: np.ndarray) -> tuple[float, int, int]:
     """:func:`most_similar_on` of the terms ``which`` (indices of distinct terms, each
-    occurring ``counts`` times), whose memberships ``rows(k)`` gives for distinct terms ``k``
-    and are 0 outside the points ``start`` ... ``end`` (an empty stretch: ``end < start``)."""
+    occurring ``counts`` times), whose memberships ``rows(k, at)`` gives for distinct terms
+    ``k[p]`` at the points ``x[at[p]]``, and are 0 outside the points ``start`` ... ``end``
+    (an empty stretch: ``end < start``)."""
     some = start <= end
     best = np.zeros(len(counts))            # each row's largest: 0 for a term beside any other
     order = np.flatnonzero(some)[np.argsort(start[some], kind="stable")]
@@ -370,7 +372,7 @@ def _most_similar(rows, x: np.ndarray, which: np.ndarray, counts: np.ndarray, st
         vs.append(v)
         if sum(map(len, vs)) * len(x) >= PAIR_BLOCK or p == len(order) - 1:
             k_, v_ = np.concatenate(ks), np.concatenate(vs)
-            s = _pair_similarity(rows, x, k_, v_)
+            s = _pair_similarity(rows, x, k_, v_, start, end)
             np.maximum.at(best, k_, s)
             np.maximum.at(best, v_, s)
             ks, vs = [], []
@@ -378,7 +380,7 @@ def _most_similar(rows, x: np.ndarray, which: np.ndarray, counts: np.ndarray, st
     k = which[r]
     near = np.flatnonzero(some & (start <= end[k]) & (end >= start[k]))
     row = np.zeros(len(counts))
-    row[near] = _pair_similarity(rows, x, np.full(len(near), k), near)
+    row[near] = _pair_similarity(rows, x, np.full(len(near), k), near, start, end)
     full = row[which]
     full[r] = -1.0
     j = int(np.argmax(full))
@@ -397,24 +399,51 @@ def _distinct_rows(mu: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return mu[first], which, np.bincount(which, minlength=len(seen))
 
 
-def _pair_similarity(rows, x: np.ndarray, k: np.ndarray, v: np.ndarray) -> np.ndarray:
-    """The similarity of the terms ``rows(k[p])`` and ``rows(v[p])`` for each pair ``p`` as
-    :func:`similarity_on` forms it (0 for two terms never both above 0), in blocks of
-    :data:`PAIR_BLOCK` memberships."""
-    dx = np.diff(x)
-
-    def area(m: np.ndarray) -> np.ndarray:
-        return ((m[..., 1:] + m[..., :-1]) * 0.5 * dx).sum(axis=-1)
-
+def _pair_similarity(rows, x: np.ndarray, k: np.ndarray, v: np.ndarray, start: np.ndarray,
+                     end: np.ndarray) -> np.ndarray:
+    """The similarity of the terms ``k[p]`` and ``v[p]`` for each pair ``p`` as
+    :func:`similarity_on` forms it (0 for two terms never both above 0), each on its own
+    stretch of the points: from the point before the first of the two to rise above 0
+    (``start``) to the one after the last to fall back (``end``); outside it both are 0, and
+    so is every trapezoid. Over every point, 20,000 narrow triangles took 70 s in `mitos
+    check`. The sums are of the same trapezoids in another grouping, so a similarity may
+    differ in its last bit from :func:`similarity_on`'s. Pairs of stretches of like length
+    go together, in blocks of :data:`PAIR_BLOCK` memberships."""
+    last = len(x) - 1
+    lo = np.maximum(np.minimum(start[k], start[v]) - 1, 0)
+    hi = np.minimum(np.maximum(end[k], end[v]) + 1, last)
     out = np.zeros(len(k))
-    step = max(1, PAIR_BLOCK // max(1, len(x)))
-    for i in range(0, len(k), step):
-        a, b = rows(k[i:i + step]), rows(v[i:i + step])
-        inter, union = area(np.minimum(a, b)), area(np.maximum(a, b))
+    order = np.argsort(hi - lo, kind="stable")
+    widths = (hi - lo + 1)[order]                   # ascending
+    i = 0
+    while i < len(order):
+        j = _block_end(widths, i)
+        width = int(widths[j - 1])                  # the longest of the block
+        p = order[i:j]
+        at = np.minimum(lo[p, None] + np.arange(width), hi[p, None])    # past hi: dx 0
+        a, b = rows(k[p], at), rows(v[p], at)
+        dx = np.diff(x[at], axis=1)
+        inter = ((np.minimum(a[:, 1:], b[:, 1:]) + np.minimum(a[:, :-1], b[:, :-1]))
+                 * 0.5 * dx).sum(axis=1)
+        union = ((np.maximum(a[:, 1:], b[:, 1:]) + np.maximum(a[:, :-1], b[:, :-1]))
+                 * 0.5 * dx).sum(axis=1)
         meets = ((a > 0) & (b > 0)).any(axis=1)
-        out[i:i + step] = np.divide(inter, union, out=np.zeros_like(inter),
-                                    where=meets & (union > 0))
+        out[p] = np.divide(inter, union, out=np.zeros_like(inter), where=meets & (union > 0))
+        i = j
     return out
+
+
+def _block_end(widths: np.ndarray, i: int) -> int:
+    """The end of the block of pairs from ``i`` on (their ``widths`` ascending): as many as
+    :data:`PAIR_BLOCK` memberships of the block's longest hold, at least one."""
+    lo, hi = i + 1, len(widths)                    # (j - i) * widths[j - 1] grows with j
+    while lo < hi:
+        mid = (lo + hi + 1) // 2
+        if (mid - i) * int(widths[mid - 1]) <= PAIR_BLOCK:
+            lo = mid
+        else:
+            hi = mid - 1
+    return lo
 
 
 def least_distance(values: np.ndarray) -> float:
