@@ -292,6 +292,21 @@ class ResultStore:
                              expected="the study's --seed, such as 1", hint=hint)
         return got
 
+    def _check_same_study(self, old: dict, manifest: dict, worlds: dict[str, str]) -> None:
+        """The rows in the directory were made by the study ``manifest`` describes now: the
+        same seed and behavior, and every world (``worlds``: as the rows name them -> as
+        given now) and the rule base unchanged since."""
+        if old.get("seed") != manifest.get("seed"):
+            raise StudyError(f"{self.path} was made with --seed {old.get('seed')}, "
+                             f"not {manifest.get('seed')}", span=self._said("seed"),
+                             hint=f"resume with --seed {old.get('seed')}, or choose another "
+                                  "directory with -o")
+        _check_behavior(old, manifest, self.path, self._said("behavior"))
+        now = manifest.get("digests") or {}
+        _check_unchanged(old.get("digests") or {}, {
+            **now, **{name: now[w] for name, w in worlds.items() if w in now}}, self.path,
+            self._said)
+
     def _said(self, key: str) -> Span | None:
         """Where ``study.json`` (as :meth:`manifest` read it) writes ``key``, the place a
         refusal of what it records shows."""
@@ -336,20 +351,10 @@ class ResultStore:
                              hint="pass --resume to continue that study, or choose another "
                                   "directory with -o")
         old = self.manifest() if rows else None
-        if old is not None and old.get("seed") != manifest.get("seed"):
-            raise StudyError(f"{self.path} was made with --seed {old.get('seed')}, "
-                             f"not {manifest.get('seed')}", span=self._said("seed"),
-                             hint=f"resume with --seed {old.get('seed')}, or choose another "
-                                  "directory with -o")
-        if old is not None:
-            _check_behavior(old, manifest, self.path, self._said("behavior"))
         given = list(manifest.get("worlds") or [])
         worlds = _worlds_of(rows, old or {}, manifest)
         if old is not None:
-            now = manifest.get("digests") or {}
-            _check_unchanged(old.get("digests") or {}, {
-                **now, **{name: now[w] for name, w in worlds.items() if w in now}}, self.path,
-                self._said)
+            self._check_same_study(old, manifest, worlds)
         if any(name != w for name, w in worlds.items()):   # the rows, their worlds named as now
             rows = [{**r, "world": worlds.get(r["world"], r["world"])} for r in rows]
             self._refuse_twice(rows)         # (one world under two of its names)
