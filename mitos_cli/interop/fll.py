@@ -122,6 +122,37 @@ def read_fll(path: str | Path) -> RuleBase:
 def parse_fll(text: str, path: str | None = None) -> RuleBase:
     """Read FLL ``text`` into a rule base: one behavior ``main``, or, when rule blocks need
     different operators (fuzzylite's hybrid engines), one behavior per block."""
+    variables, blocks, engine_span = _sections(text, path)
+    notes: list[str] = []
+    for v in variables:
+        _tsukamoto(v, notes)
+    inputs = [x.name for x in variables if x.role == "input"]     # once: per variable, N^2
+    built = [_build_variable(v, inputs, notes) for v in variables]
+    by_name = {v.name: v for v in built}
+    outputs = {v.name: v for v in variables if v.role == "output"}
+    for b in blocks:
+        b.rules = [_rule(value, text, path, lineno, vcol, by_name, b.conj, i)
+                   for i, (value, lineno, vcol) in enumerate(b.lines)]
+    blocks = [b for b in blocks if b.rules] or blocks[:1]
+    groups = common.rule_blocks([(b.name, b.record, b.rules) for b in blocks],
+                                {n: v.record for n, v in outputs.items()},
+                                renumber=len(blocks) > 1)
+    for _, rules, settings in groups:
+        concluded = {c.var for r in rules for c in r.consequents}
+        mine = [v for v in variables if v.role == "input" or v.name in concluded or
+                len(groups) == 1]
+        _check_outputs(mine, rules, settings)
+    places: common.Places = {(v.name, what): at for v in variables
+                             for what, at in (("range", v.range_span), ("default", v.default_span))
+                             if at is not None}
+    rb = common.assemble_blocks(path, built, groups, DEFAULT_RESOLUTION, engine_span, notes,
+                                places)
+    return dataclasses.replace(rb, notes=tuple(notes))
+
+
+def _sections(text: str, path: str | None) -> tuple[list[_Var], list[_Block], Span]:
+    """The FLL ``text``'s variables and rule blocks as written, line by line (each key checked
+    against its section's), and where the ``Engine:`` line is (else the file's start)."""
     variables: list[_Var] = []
     blocks: list[_Block] = []
     section: str | None = None
@@ -178,31 +209,7 @@ def parse_fll(text: str, path: str | None = None) -> RuleBase:
         else:
             _block_key(key, value, vspan, blocks[-1].record, blocks[-1].conj)
 
-    notes: list[str] = []
-    for v in variables:
-        _tsukamoto(v, notes)
-    inputs = [x.name for x in variables if x.role == "input"]     # once: per variable, N^2
-    built = [_build_variable(v, inputs, notes) for v in variables]
-    by_name = {v.name: v for v in built}
-    outputs = {v.name: v for v in variables if v.role == "output"}
-    for b in blocks:
-        b.rules = [_rule(value, text, path, lineno, vcol, by_name, b.conj, i)
-                   for i, (value, lineno, vcol) in enumerate(b.lines)]
-    blocks = [b for b in blocks if b.rules] or blocks[:1]
-    groups = common.rule_blocks([(b.name, b.record, b.rules) for b in blocks],
-                                {n: v.record for n, v in outputs.items()},
-                                renumber=len(blocks) > 1)
-    for _, rules, settings in groups:
-        concluded = {c.var for r in rules for c in r.consequents}
-        mine = [v for v in variables if v.role == "input" or v.name in concluded or
-                len(groups) == 1]
-        _check_outputs(mine, rules, settings)
-    places: common.Places = {(v.name, what): at for v in variables
-                             for what, at in (("range", v.range_span), ("default", v.default_span))
-                             if at is not None}
-    rb = common.assemble_blocks(path, built, groups, DEFAULT_RESOLUTION, engine_span, notes,
-                                places)
-    return dataclasses.replace(rb, notes=tuple(notes))
+    return variables, blocks, engine_span
 
 
 def _check_outputs(variables: list[_Var], rules: list[Rule], settings: Settings) -> None:
