@@ -78,6 +78,22 @@ def test_a_large_image_classified_through_a_table_is_classified_pixel_by_pixel(m
             assert np.array_equal(got, want)
 
 
+@pytest.mark.parametrize("pixel, maxval, free_thresh", [(204, 255, 0.2), (804, 1000, 0.196)])
+def test_a_pixel_at_the_free_threshold_is_unknown_not_free(pixel, maxval, free_thresh):
+    """map_server's occupancy is ``(255 - v) / 255``: a grey 204 is 0.2, not below a
+    ``free_thresh`` of 0.2, so unknown (a wall here by default). Computed as ``1 - v / 255``
+    it was 0.19999999999999996, and free."""
+    px = np.array([[pixel, maxval]])
+    blocked = classify(px, maxval, negate=False, occupied_thresh=0.65, free_thresh=free_thresh)
+    assert blocked.tolist() == [[True, False]]
+    lenient = classify(px, maxval, negate=False, occupied_thresh=0.65, free_thresh=free_thresh,
+                       unknown_occupied=False)
+    assert lenient.tolist() == [[False, False]]
+    big = np.full((40, 40), pixel, dtype=np.uint16)        # classified through a table
+    assert classify(big, maxval, negate=False, occupied_thresh=0.65,
+                    free_thresh=free_thresh).all()
+
+
 def test_negate_swaps_black_and_white():
     px = np.array(PIXELS).reshape(3, 2)
     blocked = classify(px, 255, negate=True, occupied_thresh=0.65, free_thresh=0.196,

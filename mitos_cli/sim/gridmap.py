@@ -65,9 +65,12 @@ def _check_extent(spec: yamlpos.YMap, origin: tuple[float, float], res_m: float,
 
 
 def occupancy(pixels: np.ndarray, maxval: int, negate: bool) -> np.ndarray:
-    """Occupancy probability of each pixel in [0, 1] (map_server's trinary reading)."""
-    p = pixels.astype(float) / float(maxval)
-    return p if negate else 1.0 - p
+    """Occupancy probability of each pixel in [0, 1] (map_server's trinary reading), as
+    map_server computes it: ``(255 - v) / 255``, one rounding. ``1 - v / 255`` rounds twice,
+    and a grey 204 read 0.19999999999999996, below a ``free_thresh`` of 0.2 it equals: free
+    where map_server's wiki and ``image_loader.cpp`` make it unknown."""
+    p = pixels.astype(float)
+    return (p if negate else float(maxval) - p) / float(maxval)
 
 
 #: map_server's modes: ``trinary`` and ``scale`` read a pixel as above (``scale`` grades the
