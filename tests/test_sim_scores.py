@@ -57,6 +57,28 @@ def test_a_bad_mrpb_test_line_is_positioned(tmp_path):
     assert err.span.line == 2 and "not an MRPB start/goal test" in str(err)
 
 
+
+@pytest.mark.parametrize("pose, column, words", [
+    ("(8.6.71, 2, 0)", 16, "`8.6.71` in an MRPB test is not a number"),
+    ("(1e999, 2, 0)", 16, "`1e999` in an MRPB test is not a finite number"),
+    ("(1, 3e5, 0)", 19, r"`3e5` in an MRPB test lies beyond ±254,000 m"),
+])
+def test_a_bad_number_in_an_mrpb_test_is_refused_at_its_column(tmp_path, pose, column, words):
+    """`8.6.71` fits the line's pattern and was a ValueError's traceback (from
+    `bench_nav.py --mrpb DIR`); `1e999` put the start at infinity."""
+    path = tmp_path / "tests.txt"
+    path.write_text(f"test 1: start {pose} -> goal (3, 4, 0)\n")
+    with pytest.raises(WorldError, match=words) as info:
+        mrpb.read_tests(path)
+    assert (info.value.span.line, info.value.span.column) == (1, column)
+
+
+def test_an_mrpb_tests_file_with_a_byte_order_mark_is_read(tmp_path):
+    path = tmp_path / "tests.txt"
+    path.write_text("\ufefftest 1: start (1, 2, 0) -> goal (3, 4, 0)\n", encoding="utf-8")
+    [(number, start, _)] = mrpb.read_tests(path)
+    assert number == 1 and start.x == pytest.approx(INCH_PER_M)
+
 def test_a_scenario_becomes_one_world_per_test(tmp_path):
     folder = tmp_path / "box"
     folder.mkdir()

@@ -36,6 +36,7 @@ from __future__ import annotations
 
 import math
 import re
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -44,6 +45,7 @@ from ..fileio import bad_byte, unreadable
 from .gridmap import INCH_PER_M, load_map_yaml
 from .loop import prepare
 from .world import Agent, Goal, Pose, Randomise, Robot, Sensors, World
+from .worldfile import LARGEST
 
 COMPLETE = ("maze", "narrow_graph", "office01add", "office02", "room02", "shopping_mall",
             "track")
@@ -60,9 +62,10 @@ _TEST = re.compile(r"^\s*test\s+(\d+)\s*:\s*start\s*" + _POSE + r"\s*->\s*goal\s
 
 
 def read_tests(path: Path) -> list[tuple[int, Pose, Pose]]:
-    """The tests of a ``tests.txt``: (number, start, goal) with poses in inches and degrees."""
+    """The tests of a ``tests.txt``: (number, start, goal) with poses in inches and degrees.
+    A byte-order mark (a Windows editor's) is read past, as a world file's is."""
     try:
-        text = path.read_text(encoding="utf-8")
+        text = path.read_text(encoding="utf-8-sig")
     except (OSError, UnicodeDecodeError) as exc:
         raise WorldError(unreadable("MRPB tests", path, exc), span=bad_byte(path, exc)) from None
     out = []
@@ -74,13 +77,34 @@ def read_tests(path: Path) -> list[tuple[int, Pose, Pose]]:
             raise WorldError("not an MRPB start/goal test", span=Span(str(path), i, 1, line),
                              expected="`test N: start (x, y, yaw) -> goal (x, y, yaw)` in "
                                       "metres and radians")
-        v = [float(g) for g in m.groups()[1:]]
+        v = [_number(m, k, Span(str(path), i, 1, line)) for k in range(2, 8)]
         out.append((int(m.group(1)),
                     Pose(v[0] * INCH_PER_M, v[1] * INCH_PER_M, math.degrees(v[2])),
                     Pose(v[3] * INCH_PER_M, v[4] * INCH_PER_M, math.degrees(v[5]))))
     if not out:
         raise WorldError(f"`{path}` holds no MRPB start/goal test", span=Span(str(path), 1, 1))
     return out
+
+
+def _number(m: re.Match, group: int, span: Span) -> float:
+    """Group ``group`` of a test line (x, y, yaw; x, y, yaw from group 2) as a finite number
+    within a world's reach once in inches and degrees, refused at its column: `8.6.71` (the
+    pattern takes digits and dots) was a ValueError's traceback, and `1e999` a start at
+    infinity."""
+    written, at = m.group(group), replace(span, column=m.start(group) + 1)
+    try:
+        value = float(written)
+    except ValueError:
+        raise WorldError(f"`{written}` in an MRPB test is not a number", span=at,
+                         expected="a number (metres, or radians for a yaw)") from None
+    if not math.isfinite(value):
+        raise WorldError(f"`{written}` in an MRPB test is not a finite number", span=at)
+    yaw = group in (4, 7)
+    if abs(math.degrees(value) if yaw else value * INCH_PER_M) > LARGEST:
+        reach = f"{math.radians(LARGEST):,.0f} rad" if yaw else f"{LARGEST / INCH_PER_M:,.0f} m"
+        raise WorldError(f"`{written}` in an MRPB test lies beyond ±{reach}, where a world's "
+                         "numbers lie", span=at, expected="metres and radians in the map frame")
+    return value
 
 
 def scenario_worlds(root: Path, name: str, robot: Robot | None = None,
