@@ -173,6 +173,31 @@ def test_a_goal_off_the_map_is_outside_the_map_not_inside_a_wall(tmp_path: Path)
     assert "check the map's `origin` and `resolution`" in msg
 
 
+
+def test_a_goal_in_an_unknown_cell_says_so_and_how_to_read_it_free(tmp_path: Path):
+    """A goal in the grey (unknown) part of a SLAM map was "inside a wall ... move it into a
+    corridor": the user looked for a wall in a room the scan had left grey."""
+    path = _free_map(tmp_path)
+    pixels = bytearray([254]) * 120 * 120
+    for row in range(50, 70):                       # grey 205 round (100, 60): unknown
+        pixels[row * 120 + 90:row * 120 + 110] = bytes([205]) * 20
+    (tmp_path / "map.pgm").write_bytes(b"P5 120 120 255\n" + bytes(pixels))
+    path.write_text(path.read_text().replace("q_goal: {x: 300, y: 0}", "q_goal: {x: 100, y: 60}"))
+    with pytest.raises(WorldError) as info:
+        load_world(path)
+    msg = info.value.render()
+    assert ("w.yaml:10:9: world error: the goal (q_goal) at (100, 60) lies in an unknown cell of "
+            "the map `map.yaml` (grey, between its free_thresh and occupied_thresh), which counts "
+            "as a wall") in msg
+    assert "`unknown: free` under `map:`" in msg
+    path.write_text(path.read_text().replace("  grid: map.yaml\n",
+                                             "  grid: map.yaml\n  unknown: free\n"))
+    assert load_world(path).grid is not None
+    (tmp_path / "map.pgm").write_bytes(b"P5 120 120 255\n" + bytes(pixels).replace(b"\xcd", b"\0"))
+    path.write_text(path.read_text().replace("  unknown: free\n", ""))
+    with pytest.raises(WorldError, match=r"at \(100, 60\) lies inside a wall"):
+        load_world(path)                            # black there: a wall, as before
+
 def test_a_corridor_carved_past_the_maps_edge_grows_the_map(tmp_path: Path):
     """A corridor carved into a map ended at the map's edge without a word (all beyond it
     solid), and a goal in it was "inside a wall": the map now grows, by whole cells of wall,

@@ -729,6 +729,11 @@ def check_free(world: World, spans: list[tuple[Span, Span]]) -> StaticMap:
                     raise WorldError(f"the {what}{who} at ({p.x:g}, {p.y:g}) {off}", span=span,
                                      hint="check the map's `origin` and `resolution` (metres, "
                                           "in its YAML) and the point (inches)")
+                grey = _unknown_cell(world, p.x, p.y)
+                if grey is not None:
+                    raise WorldError(f"the {what}{who} at ({p.x:g}, {p.y:g}) {grey}", span=span,
+                                     hint="move it where the map is free, or write `unknown: "
+                                          "free` under `map:` to read unknown cells as free")
                 raise WorldError(f"the {what}{who} at ({p.x:g}, {p.y:g}) lies inside a wall",
                                  span=span, hint=_units_hint(world, agent)
                                  or "move it into a corridor (free space)")
@@ -739,6 +744,32 @@ def check_free(world: World, spans: list[tuple[Span, Span]]) -> StaticMap:
                                  hint="move it, or the obstacle")
         _check_body(world, agent, static, s_span)
     return static
+
+
+def _unknown_cell(world: World, x: float, y: float) -> str | None:
+    """``lies in an unknown cell of the map `m.yaml` ...`` for a point whose cell is blocked
+    only because it is unknown (grey, between the thresholds), else ``None``: "inside a wall
+    ... move it into a corridor" sent the user of a SLAM map looking for a wall in a room its
+    scan left grey. The map is read again, unknown cells free (only for this refusal)."""
+    import numpy as np
+
+    from .gridmap import load_map_yaml
+    from .staticmap import StaticMap
+
+    g = world.grid
+    if g is None or not g.source:
+        return None
+    try:
+        lenient = load_map_yaml(Path(g.source), unknown_occupied=False)
+    except MitosError:
+        return None
+    rows, cols = lenient.occupied.shape
+    ox, oy = lenient.origin
+    bounds = (ox, oy, ox + cols * lenient.resolution, oy + rows * lenient.resolution)
+    if not StaticMap(np.zeros((0, 4)), np.zeros((0, 4, 2)), lenient, bounds).free(np.array([[x, y]]))[0]:
+        return None
+    return (f"lies in an unknown cell of the map `{Path(g.source).name}` (grey, between its "
+            "free_thresh and occupied_thresh), which counts as a wall")
 
 
 def _off_the_grid(static: StaticMap, x: float, y: float) -> str | None:
