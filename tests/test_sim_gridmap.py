@@ -311,6 +311,32 @@ def test_a_yaw_of_3_14_as_in_the_stata_basement_map_is_turned_not_refused(tmp_pa
     assert np.hypot(centres[:, 0] - x, centres[:, 1] - y).min() < 0.71
 
 
+
+def test_a_turned_map_is_resampled_a_block_of_rows_at_a_time():
+    """A map turned by a yaw that is no quarter turn was resampled all at once, about 75
+    bytes a cell of the turned map (10 GB for an 8,000 x 8,000 image at 45 degrees, which the
+    size limit lets through); a block of rows at a time now, with the same cells."""
+    import tracemalloc
+
+    from mitos_cli.sim.gridmap import rotate
+
+    rng = np.random.default_rng(3)
+    blocked = rng.random((600, 600)) < 0.3
+    tracemalloc.start()
+    try:
+        turned, corner = rotate(blocked, 2.0, (5.0, -7.0), 0.785)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert peak < 12 * turned.size
+    c, s = np.cos(0.785), np.sin(0.785)                    # each cell as the map holds it
+    rows, cols = turned.shape
+    for r, k in rng.integers(0, (rows, cols), (200, 2)):
+        px, py = corner[0] - 5.0 + (k + 0.5) * 2.0, corner[1] + 7.0 + (r + 0.5) * 2.0
+        mc, mr = int(np.floor((c * px + s * py) / 2.0)), int(np.floor((-s * px + c * py) / 2.0))
+        inside = 0 <= mr < 600 and 0 <= mc < 600
+        assert turned[r, k] == (blocked[mr, mc] if inside else True)
+
 def test_map_modes_raw_and_an_unknown_one(tmp_path: Path):
     """`mode: raw` reads pixel values as occupancy percent (0 free, 100 occupied, above 100
     unknown), as map_server does; an unknown mode was silently read as trinary."""
