@@ -353,6 +353,28 @@ def test_map_modes_raw_and_an_unknown_one(tmp_path: Path):
     assert info.value.span.line == 4 and info.value.hint == "did you mean `raw`?"
 
 
+
+def test_raw_pixels_are_read_on_the_scale_of_0_to_255_as_map_server_reads_them(tmp_path):
+    """`mode: raw` took the pixel value as it stood: a 16-bit map's 100 % (25,700 of 65,535)
+    was unknown, a PGM of maximum 100 read 100 as occupied (map_server: 255, unknown) and a
+    colour pixel's mean of 100.33 unknown (map_server rounds it: 100, occupied)."""
+    from mitos_cli.sim.gridmap import shade
+
+    (tmp_path / "r.pgm").write_bytes(b"P5 3 1 65535\n" + np.array([0, 25700, 65535], ">u2")
+                                     .tobytes())
+    (tmp_path / "r.yaml").write_text("image: r.pgm\nresolution: 0.05\norigin: [0, 0, 0]\n"
+                                     "mode: raw\n")
+    assert load_map_yaml(tmp_path / "r.yaml", unknown_occupied=False).occupied.tolist() == \
+        [[False, True, False]]
+    (tmp_path / "r.pgm").write_bytes(b"P2 3 1 100\n0 10 100\n")   # 0, 26 and 255 of 255
+    assert load_map_yaml(tmp_path / "r.yaml", unknown_occupied=False).occupied.tolist() == \
+        [[False, False, False]]
+    assert load_map_yaml(tmp_path / "r.yaml").occupied.tolist() == [[False, True, True]]
+    colour = np.array([[[100, 100, 101], [100, 101, 101]]])        # means 100.33 and 100.67
+    assert classify(shade(colour, "raw"), 255, negate=False, occupied_thresh=0.65,
+                    free_thresh=0.196, unknown_occupied=False, mode="raw").tolist() == \
+        [[True, False]]
+
 def test_a_map_named_by_its_image_points_at_its_yaml(tmp_path: Path):
     (tmp_path / "m.pgm").write_bytes(b"P5 2 3 255\n" + bytes(PIXELS))
     (tmp_path / "m.yaml").write_text("image: m.pgm\nresolution: 0.05\norigin: [0, 0, 0]\n")

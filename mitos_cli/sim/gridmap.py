@@ -12,7 +12,7 @@ The image is a PGM (read here, no dependency) or anything Pillow reads (PNG, BMP
 Pillow is the optional extra ``mitos[maps]``, which matplotlib already brings): a colour
 pixel is the mean of its channels, as map_server reads it (:func:`shade`; an alpha channel
 averaged in with the colours in the default ``trinary`` mode, as map_server does);
-``mode: raw`` reads pixel values as occupancy percentages (:data:`MODES`).
+``mode: raw`` reads pixel values (0 to 255) as occupancy percentages (:data:`MODES`).
 An origin with a yaw rotates the map about its origin: the grid the simulator keeps is
 axis-aligned, so a rotated map is resampled (nearest cell, same resolution) onto the
 axis-aligned cells covering it; a quarter, half or three-quarter turn is exact (no
@@ -75,9 +75,19 @@ def occupancy(pixels: np.ndarray, maxval: int, negate: bool) -> np.ndarray:
 
 #: map_server's modes: ``trinary`` and ``scale`` read a pixel as above (``scale`` grades the
 #: cells between the thresholds, which a grid of free and blocked cells cannot hold: they are
-#: unknown in both); ``raw`` takes the pixel value as the occupancy in percent (0 free, 100
-#: occupied, above 100 unknown; ``negate`` does not apply), as map_server writes it
+#: unknown in both); ``raw`` takes the pixel value, on the scale of 0 to 255 and rounded, as
+#: the occupancy in percent (0 free, 100 occupied, above 100 unknown; ``negate`` does not
+#: apply), as map_server writes and reads it (:func:`raw_percent`)
 MODES = ("trinary", "scale", "raw")
+
+
+def raw_percent(pixels: np.ndarray, maxval: int) -> np.ndarray:
+    """A ``raw`` pixel's occupancy in percent, as ROS 2's map_server reads it
+    (``round(shade * 255)``): the value on the scale of 0 to 255, rounded half up. The value
+    as it stood made a 16-bit map's 100 % (25,700 of 65,535) unknown, a PGM of maximum 100
+    read 100 as occupied where map_server reads 255, unknown, and a colour pixel's mean of
+    100.33 was unknown where map_server has 100."""
+    return np.floor(pixels / float(maxval) * 255.0 + 0.5)
 
 
 def classify(pixels: np.ndarray, maxval: int, *, negate: bool, occupied_thresh: float,
@@ -102,7 +112,8 @@ def _blocked(pixels: np.ndarray, maxval: int, negate: bool, occupied_thresh: flo
              free_thresh: float, unknown_occupied: bool, mode: str) -> np.ndarray:
     """Whether each of ``pixels`` is a blocked cell (see :func:`classify`)."""
     if mode == "raw":
-        occ = np.where(pixels > 100, np.nan, pixels / 100.0)      # NaN: unknown
+        percent = raw_percent(pixels, maxval)
+        occ = np.where(percent > 100, np.nan, percent / 100.0)    # NaN: unknown
     else:
         occ = occupancy(pixels, maxval, negate)
     occupied = occ > occupied_thresh
