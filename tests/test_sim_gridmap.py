@@ -375,6 +375,23 @@ def test_raw_pixels_are_read_on_the_scale_of_0_to_255_as_map_server_reads_them(t
                     free_thresh=0.196, unknown_occupied=False, mode="raw").tolist() == \
         [[True, False]]
 
+
+@pytest.mark.parametrize("line, said, column", [
+    ("image:", "`image` in a map file is empty", 7),
+    ("image: ''", "`image` in a map file is empty", 8),
+    ("image: [m.pgm]", "`image` in a map file must be a path, not a list", 8),
+    ("image: m.pgm\nmode:", "`mode` in a map file is empty", 6),
+])
+def test_an_empty_image_or_mode_is_said_so_not_none(tmp_path: Path, line, said, column):
+    """An empty `image:` was "map image `None` not found", and an empty `mode:` an "unknown
+    map_server mode `None`"."""
+    (tmp_path / "m.pgm").write_bytes(b"P5 2 3 255\n" + bytes(PIXELS))
+    (tmp_path / "m.yaml").write_text("resolution: 0.05\norigin: [0, 0, 0]\n" + line + "\n")
+    with pytest.raises(WorldError) as info:
+        load_map_yaml(tmp_path / "m.yaml")
+    assert info.value.message == said and "None" not in info.value.render()
+    assert (info.value.span.line, info.value.span.column) == (line.count("\n") + 3, column)
+
 def test_a_map_named_by_its_image_points_at_its_yaml(tmp_path: Path):
     (tmp_path / "m.pgm").write_bytes(b"P5 2 3 255\n" + bytes(PIXELS))
     (tmp_path / "m.yaml").write_text("image: m.pgm\nresolution: 0.05\norigin: [0, 0, 0]\n")

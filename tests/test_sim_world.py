@@ -198,6 +198,20 @@ def test_a_goal_in_an_unknown_cell_says_so_and_how_to_read_it_free(tmp_path: Pat
     with pytest.raises(WorldError, match=r"at \(100, 60\) lies inside a wall"):
         load_world(path)                            # black there: a wall, as before
 
+
+@pytest.mark.parametrize("grid, said", [("", "`grid` in map is empty"),
+                                        ("[map.yaml]", "`grid` in map must be a map_server "
+                                                       "YAML file, not a list")])
+def test_an_empty_grid_is_said_so_not_a_map_file_none(tmp_path: Path, grid, said):
+    """`grid:` left empty was "map file `None` not found"; `grid: [map.yaml]` was "map file
+    `['map.yaml']` not found"."""
+    path = _free_map(tmp_path)
+    path.write_text(path.read_text().replace("grid: map.yaml", f"grid: {grid}".rstrip()))
+    with pytest.raises(WorldError) as info:
+        load_world(path)
+    assert info.value.message == said and info.value.span.source_line.startswith("  grid:")
+    assert "None" not in info.value.render() and "maps/office.yaml" in info.value.hint
+
 def test_a_corridor_carved_past_the_maps_edge_grows_the_map(tmp_path: Path):
     """A corridor carved into a map ended at the map's edge without a word (all beyond it
     solid), and a goal in it was "inside a wall": the map now grows, by whole cells of wall,

@@ -213,6 +213,13 @@ def rotate(blocked: np.ndarray, res: float, origin: tuple[float, float],
     return out, (origin[0] + lo[0], origin[1] + lo[1])
 
 
+def not_a_path(value: object) -> str:
+    """What a YAML value that is no path is, in words: ``a list``, ``a mapping``, ``true``."""
+    if isinstance(value, bool):
+        return "`true`" if value else "`false`"
+    return "a list" if isinstance(value, list) else "a mapping"
+
+
 def _item_span(value: list, index: int, span: Span) -> Span:
     """Where item ``index`` of a YAML list is written (``half`` of ``[0, 0, half]``, not its
     ``[``); ``span`` where that is not known."""
@@ -269,6 +276,13 @@ def load_map_yaml(path: Path, *, unknown_occupied: bool = True,
     yamlpos.check_keys(spec, MAP_KEYS, WorldError, "a map_server map file")
     what = f"map file `{path.name}`"
     image = yamlpos.require(spec, "image", WorldError, what)
+    if image is None or isinstance(image, (list, dict, bool)) or not str(image).strip():
+        # (an empty `image:` was "map image `None` not found")
+        raise WorldError("`image` in a map file " + ("is empty" if image is None or
+                                                      isinstance(image, str) else
+                                                      f"must be a path, not {not_a_path(image)}"),
+                         span=spec.value_span("image"), expected="the image's path, such as "
+                         "map.pgm (relative to this YAML file)")
     res_m = yamlpos.expect_number(yamlpos.require(spec, "resolution", WorldError, what),
                                   spec.value_span("resolution"), WorldError, "resolution")
     if res_m <= 0:
@@ -293,6 +307,10 @@ def load_map_yaml(path: Path, *, unknown_occupied: bool = True,
                          hint="the yaw is in radians: 3.14 is a half turn")
     negate = _negate(spec)
     mode = spec.get("mode", "trinary")
+    if mode is None:                                         # read "unknown mode `None`"
+        raise WorldError("`mode` in a map file is empty", span=spec.value_span("mode"),
+                         expected="one of " + ", ".join(MODES),
+                         hint="leave `mode` out for trinary, map_server's default")
     if mode not in MODES:
         raise unknown("map_server mode", str(mode), MODES, span=spec.value_span("mode"),
                       cls=WorldError)

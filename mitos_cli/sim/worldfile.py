@@ -597,6 +597,7 @@ def _map(r: _Reader, top: YMap, path: str):
     if "grid" in mp:
         from .gridmap import load_map_yaml
 
+        _check_grid_path(mp)
         grid = load_map_yaml(Path(path).parent / str(mp["grid"]),
                              unknown_occupied=unknown_occupied, where=mp.value_span("grid"),
                              written=str(mp["grid"]))
@@ -607,6 +608,20 @@ def _map(r: _Reader, top: YMap, path: str):
         _check_extent(corridors, mp.value_span("corridors"))
     knows, given = read_given(mp, path, unknown_occupied)
     return corridors, grid, knows, given
+
+
+def _check_grid_path(mp: YMap) -> None:
+    """``map.grid`` is a path: an empty ``grid:`` was "map file `None` not found", and
+    ``grid: [m.yaml]`` "map file `['m.yaml']` not found"."""
+    value, span = mp["grid"], mp.value_span("grid")
+    if value is not None and not isinstance(value, (list, dict, bool)) and str(value).strip():
+        return
+    from .gridmap import not_a_path
+
+    what = "is empty" if value is None or isinstance(value, str) else \
+        f"must be a map_server YAML file, not {not_a_path(value)}"
+    raise WorldError(f"`grid` in map {what}", span=span, expected="PATH.yaml",
+                     hint="`grid: maps/office.yaml`: the map's YAML, relative to this world file")
 
 
 def _route(r: _Reader, top: YMap, agents: list[Agent]) -> tuple[float | None, str]:
