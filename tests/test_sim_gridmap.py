@@ -169,6 +169,22 @@ def test_bad_thresholds(tmp_path: Path):
         load_map_yaml(tmp_path / "m.yaml")
 
 
+
+@pytest.mark.parametrize("thresholds, said, line", [
+    ("occupied_thresh: 1.5\nfree_thresh: 0.196\n", "occupied_thresh must lie between 0 and 1, "
+                                                    "not 1.5", 4),
+    ("occupied_thresh: 0.65\nfree_thresh: -0.1\n", "free_thresh must lie between 0 and 1, "
+                                                    "not -0.1", 5),
+    ("occupied_thresh: 0.1\n", "free_thresh 0.196 lies above occupied_thresh 0.1", 4),
+])
+def test_a_bad_threshold_is_pointed_at_itself(tmp_path: Path, thresholds, said, line):
+    """`occupied_thresh: 1.5` was refused at the `free_thresh` line (or at none)."""
+    (tmp_path / "m.yaml").write_text("image: m.pgm\nresolution: 0.05\norigin: [0, 0, 0]\n"
+                                     + thresholds)
+    with pytest.raises(WorldError) as info:
+        load_map_yaml(tmp_path / "m.yaml")
+    assert info.value.message == said and info.value.span.line == line
+
 def test_the_shipped_real_map_loads():
     from mitos_cli.resources import packaged_path
 

@@ -121,6 +121,21 @@ def _blocked(pixels: np.ndarray, maxval: int, negate: bool, occupied_thresh: flo
     return occupied | (~free if unknown_occupied else np.zeros_like(occupied))
 
 
+def _check_thresholds(spec: yamlpos.YMap, occ_t: float, free_t: float) -> None:
+    """``0 <= free_thresh <= occupied_thresh <= 1``, refused at the threshold that breaks it
+    (an ``occupied_thresh`` of 1.5 was pointed at the ``free_thresh`` line)."""
+    for key, value in (("occupied_thresh", occ_t), ("free_thresh", free_t)):
+        if not 0 <= value <= 1:
+            raise WorldError(f"{key} must lie between 0 and 1, not {value:g}",
+                             span=spec.value_span(key),
+                             hint="it is an occupancy: 0.65 and 0.196 are map_server's usual")
+    if free_t > occ_t:
+        key = "free_thresh" if "free_thresh" in spec else "occupied_thresh"
+        raise WorldError(f"free_thresh {free_t:g} lies above occupied_thresh {occ_t:g}",
+                         span=spec.value_span(key),
+                         expected="0 <= free_thresh <= occupied_thresh <= 1")
+
+
 def _negate(spec: yamlpos.YMap) -> bool:
     """``negate`` as map_server reads it: 0 or 1 (``false``/``true`` too). A quoted ``"0"``
     is a string, which Python would take for true and silently invert the map: refused."""
@@ -317,9 +332,7 @@ def load_map_yaml(path: Path, *, unknown_occupied: bool = True,
     occ_t, free_t = (yamlpos.expect_number(spec.get(key, default), spec.value_span(key),
                                            WorldError, key)
                      for key, default in (("occupied_thresh", 0.65), ("free_thresh", 0.196)))
-    if not 0 <= free_t <= occ_t <= 1:
-        raise WorldError("need 0 <= free_thresh <= occupied_thresh <= 1",
-                         span=spec.value_span("free_thresh"))
+    _check_thresholds(spec, occ_t, free_t)
     image_path = path.parent / str(image)
     try:
         pixels, maxval = read_image(image_path)
