@@ -214,6 +214,20 @@ def test_a_png_map_reads_as_the_same_pgm(tmp_path):
     assert load_map_yaml(_map(tmp_path, "c.png")).occupied.tolist() == pgm.occupied.tolist()
 
 
+
+def test_a_damaged_png_is_said_to_be_damaged_not_looked_for_elsewhere(tmp_path):
+    """A truncated PNG ("image file is truncated") got the hint that the image path is
+    relative to the map's YAML file, as if it had not been found."""
+    Image = pytest.importorskip("PIL.Image")
+    Image.fromarray(np.full((40, 60), 254, dtype=np.uint8)).save(tmp_path / "m.png")
+    (tmp_path / "m.png").write_bytes((tmp_path / "m.png").read_bytes()[:60])
+    with pytest.raises(WorldError, match="cannot read map image .*m.png") as info:
+        load_map_yaml(_map(tmp_path, "m.png"))
+    assert "damaged" in info.value.hint and "relative" not in info.value.hint
+    with pytest.raises(WorldError) as info:
+        load_map_yaml(_map(tmp_path, "gone.png"))
+    assert info.value.hint == "the image path is relative to the map's YAML file"
+
 def test_a_colour_map_reads_as_the_mean_of_its_channels_as_map_server_does(tmp_path):
     """map_server averages a pixel's channels: yellow (255, 255, 0) is 170, occupancy 0.33,
     unknown; green (0, 255, 0) is 85, occupancy 0.67, a wall. Read as luminance (226 and

@@ -256,6 +256,20 @@ def _beside(path: Path, written: str | None, exc: OSError | UnicodeDecodeError,
     return f"did you mean `{(Path(written).parent if written else path.parent) / name}`?"
 
 
+def _unread_hint(path: Path, written: str, exc: OSError) -> str | None:
+    """The hint of a map image that could not be read: where it is looked for, where it is
+    not there; that it is damaged, where Pillow could not decode it whole (a truncated PNG
+    was told "the image path is relative to the map's YAML file")."""
+    if isinstance(exc, PermissionError):
+        return None
+    if exists(path) and path.is_file():
+        return "the file is there but its image could not be decoded whole: is it damaged? " \
+               "(save it again, as PGM or PNG)"
+    close = _beside(path, written, exc, IMAGE_SUFFIXES)
+    return f"{close} (the image path is relative to the map's YAML file)" if close else \
+        "the image path is relative to the map's YAML file"
+
+
 def load_map_yaml(path: Path, *, unknown_occupied: bool = True,
                   where: Span | None = None, written: str | None = None) -> Grid:
     """Read a map_server ``map.yaml`` and its image into a :class:`Grid` in inches
@@ -340,12 +354,8 @@ def load_map_yaml(path: Path, *, unknown_occupied: bool = True,
         raise WorldError(f"cannot read map image `{image_path}`: {exc}",
                          span=spec.value_span("image")) from None
     except OSError as exc:
-        close = _beside(image_path, str(image), exc, IMAGE_SUFFIXES)
-        raise WorldError(unreadable("map image", image_path, exc),
-                         span=spec.value_span("image"),
-                         hint=f"{close} (the image path is relative to the map's YAML file)"
-                         if close else "the image path is relative to the map's YAML file") \
-            from None
+        raise WorldError(unreadable("map image", image_path, exc), span=spec.value_span("image"),
+                         hint=_unread_hint(image_path, str(image), exc)) from None
     except TooLarge as exc:
         raise WorldError(f"cannot read map image `{image_path}`: {exc}",
                          span=spec.value_span("image"),
