@@ -30,6 +30,15 @@ def test_ascii_pgm():
     assert px[2].tolist() == [0, 0]
 
 
+
+def test_an_ascii_pgm_with_comments_in_its_raster_reads_as_map_server_reads_it():
+    """map_server's image readers skip a `#` comment among an ASCII PGM's pixels; it was
+    "something that is not a number", and a word that is none is now named."""
+    px, _ = parse_pgm(b"P2\n2 3\n255\n254 254\n# the grey row\n205 205 # unknown\n0 0\n")
+    assert px.tolist() == [[254, 254], [205, 205], [0, 0]]
+    with pytest.raises(ValueError, match="holds `x` as its pixel 3, which is not a whole number"):
+        parse_pgm(b"P2 2 3 255 254 254 x 205 0 0")
+
 def test_sixteen_bit_pgm():
     px, maxval = parse_pgm(b"P5 1 2 65535\n" + bytes([0xFF, 0xFF, 0x00, 0x01]))
     assert maxval == 65535 and px.ravel().tolist() == [65535, 1]

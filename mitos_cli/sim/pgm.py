@@ -8,6 +8,7 @@ world loader turns them into a :class:`~mitos_cli.errors.WorldError` at the ``im
 from __future__ import annotations
 
 import os
+import re
 from pathlib import Path
 
 import numpy as np
@@ -82,16 +83,29 @@ def parse_pgm(data: bytes) -> tuple[np.ndarray, int]:
         pixels = body[:n].astype(np.uint16)
         _within(pixels, maxval, width)
     else:
-        try:
-            pixels = np.array(data[offset - 1:].split(), dtype=np.int64)
-        except (ValueError, OverflowError):
-            raise ValueError("the ASCII PGM image holds something that is not a number") from None
+        pixels = _ascii_pixels(data[offset - 1:])
         if pixels.size < n:
             raise ValueError(f"the PGM image holds {pixels.size} of its {plural(n, 'pixel')}")
         pixels = pixels[:n]
         _within(pixels, maxval, width)
         pixels = pixels.astype(np.uint16)
     return pixels.reshape(height, width), maxval
+
+
+def _ascii_pixels(raster: bytes) -> np.ndarray:
+    """The numbers of an ASCII (``P2``) raster, ``#`` comments skipped as map_server's image
+    readers skip them (a comment line in the raster was "something that is not a number");
+    the first word that is no number is named."""
+    if b"#" in raster:
+        raster = re.sub(rb"#[^\r\n]*", b" ", raster)
+    words = raster.split()
+    try:
+        return np.array(words, dtype=np.int64)
+    except (ValueError, OverflowError):
+        bad = next((i for i, w in enumerate(words) if not w.isdigit() or len(w) > 18), 0)
+        shown = words[bad][:20].decode("ascii", "replace") if words else ""
+        raise ValueError(f"the ASCII PGM image holds `{shown}` as its pixel {bad + 1:,}, "
+                         "which is not a whole number from 0 to its maximum value") from None
 
 
 def _within(pixels: np.ndarray, maxval: int, width: int) -> None:
