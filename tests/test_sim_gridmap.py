@@ -224,6 +224,20 @@ def test_a_png_map_reads_as_the_same_pgm(tmp_path):
 
 
 
+
+def test_a_png_named_pgm_is_read_by_its_content_as_map_server_reads_it(tmp_path):
+    """map_server's readers tell an image by its content: a PNG saved as `map.pgm` was
+    refused as "not a PGM image". A file that is neither still is."""
+    Image = pytest.importorskip("PIL.Image")
+    px = np.array(PIXELS, dtype=np.uint8).reshape(3, 2)
+    Image.fromarray(px).save(tmp_path / "png.pgm", format="PNG")
+    (tmp_path / "m.pgm").write_bytes(b"P5 2 3 255\n" + px.tobytes())
+    assert load_map_yaml(_map(tmp_path, "png.pgm")).occupied.tolist() == \
+        load_map_yaml(_map(tmp_path, "m.pgm")).occupied.tolist()
+    (tmp_path / "junk.pgm").write_bytes(b"\x89PNG not a pgm")
+    with pytest.raises(WorldError, match="not a PGM image"):
+        load_map_yaml(_map(tmp_path, "junk.pgm"))
+
 def test_a_damaged_png_is_said_to_be_damaged_not_looked_for_elsewhere(tmp_path):
     """A truncated PNG ("image file is truncated") got the hint that the image path is
     relative to the map's YAML file, as if it had not been found."""

@@ -31,7 +31,7 @@ from ..errors import Span, WorldError, unknown
 from ..fileio import unreadable
 from ..lang import yamlpos
 from ..resources import exists
-from .pgm import TooLarge, check_size, read_pgm
+from .pgm import NotPGM, TooLarge, check_size, read_pgm
 from .world import Grid
 from .worldfile import LARGEST
 
@@ -160,6 +160,18 @@ def shade(pixels: np.ndarray, mode: str = "trinary") -> np.ndarray:
     return pixels.mean(axis=-1)
 
 
+def _pillow_knows(path: Path) -> bool:
+    """Whether Pillow is there and recognises ``path`` as an image."""
+    try:
+        from PIL import Image
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", Image.DecompressionBombWarning)
+            Image.open(path).close()
+    except Exception:               # (ImportError, not an image, a bomb: the PGM's message)
+        return False
+    return True
+
+
 def read_image(path: Path) -> tuple[np.ndarray, int]:
     """Pixels ``[rows, cols]`` (top row first) of a grey map image, ``[rows, cols, channels]``
     of a colour one (red, green, blue, and alpha where it has one: :func:`shade` averages
@@ -167,7 +179,11 @@ def read_image(path: Path) -> tuple[np.ndarray, int]:
     if exists(path) and not path.is_file():     # /dev/zero, a FIFO: would read without end
         raise ValueError("it is not a regular file")
     if path.suffix.lower() in (".pgm", ".pnm"):
-        return read_pgm(path)
+        try:
+            return read_pgm(path)
+        except NotPGM:              # a PNG (or a colour PNM) named .pgm, which map_server's
+            if not _pillow_knows(path):     # readers tell by its content, not its name
+                raise
     try:
         from PIL import Image, UnidentifiedImageError
     except ImportError:

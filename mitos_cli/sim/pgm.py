@@ -60,10 +60,14 @@ def check_size(width: int, height: int) -> None:
                        f"image may have at most {MAX_PIXELS:,}")
 
 
+class NotPGM(ValueError):
+    """A file that does not start as a PGM does (``P5`` or ``P2``)."""
+
+
 def parse_pgm(data: bytes) -> tuple[np.ndarray, int]:
     magic = data[:2]
     if magic not in (b"P5", b"P2"):
-        raise ValueError("not a PGM image (it does not start with P5 or P2)")
+        raise NotPGM("not a PGM image (it does not start with P5 or P2)")
     (width, height, maxval), offset = _header(data, 3)
     if width <= 0 or height <= 0 or not 0 < maxval < 65536:
         raise ValueError(f"bad PGM size {width} x {height} or maximum value {maxval}")
