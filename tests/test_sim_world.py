@@ -212,6 +212,27 @@ def test_an_empty_grid_is_said_so_not_a_map_file_none(tmp_path: Path, grid, said
     assert info.value.message == said and info.value.span.source_line.startswith("  grid:")
     assert "None" not in info.value.render() and "maps/office.yaml" in info.value.hint
 
+
+def test_a_yaw_past_a_whole_turn_is_warned_of_as_likely_degrees(tmp_path: Path):
+    """`origin: [0, 0, 90]` (90 degrees meant) turned the map by 90 rad, 116.6 degrees past 14
+    turns, without a word: map_server's yaw is in radians, within ±pi as map_saver writes it."""
+    path = _free_map(tmp_path)
+    path.write_text(path.read_text().replace("q_init: {x: 30, y: 60, heading: 0}",
+                                             "q_init: {x: -80, y: 27, heading: 0}")
+                    .replace("q_goal: {x: 300, y: 0}", "q_goal: {x: -60, y: 27}"))
+    (tmp_path / "map.yaml").write_text("image: map.pgm\nresolution: 0.0254\n"
+                                       "origin: [0, 0, 90]\n", encoding="utf-8")
+    [note] = load_world(path).notes
+    assert note == (f"{tmp_path / 'map.yaml'}:3:16: the origin's yaw 90 is in radians and turns "
+                    "the map by 116.6 degrees (a yaw past a whole turn is likely degrees: 90 "
+                    "degrees is 1.5708 rad)")
+    (tmp_path / "map.yaml").write_text("image: map.pgm\nresolution: 0.0254\n"
+                                       "origin: [0, 0, -3.14]\n", encoding="utf-8")
+    path.write_text(path.read_text().replace("{x: -80, y: 27, heading: 0}",
+                                             "{x: -60, y: -60, heading: 0}")
+                    .replace("{x: -60, y: 27}", "{x: -40, y: -60}"))
+    assert load_world(path).notes == ()
+
 def test_a_corridor_carved_past_the_maps_edge_grows_the_map(tmp_path: Path):
     """A corridor carved into a map ended at the map's edge without a word (all beyond it
     solid), and a goal in it was "inside a wall": the map now grows, by whole cells of wall,

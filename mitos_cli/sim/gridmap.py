@@ -339,16 +339,17 @@ def load_map_yaml(path: Path, *, unknown_occupied: bool = True,
                          expected=f"at least {FINEST:g} (metres per pixel)",
                          hint="the resolution is in metres per pixel: 0.05 is 5 cm, as ROS "
                               "maps usually are")
-    origin = yamlpos.require(spec, "origin", WorldError, what)
-    if not isinstance(origin, list) or len(origin) != 3:
+    origin_written = yamlpos.require(spec, "origin", WorldError, what)
+    if not isinstance(origin_written, list) or len(origin_written) != 3:
         raise WorldError("origin must be [x, y, yaw] (metres, metres, radians)",
                          span=spec.value_span("origin"))
-    ox, oy, yaw = (yamlpos.expect_number(v, _item_span(origin, i, spec.value_span("origin")),
+    ox, oy, yaw = (yamlpos.expect_number(v, _item_span(origin_written, i,
+                                                       spec.value_span("origin")),
                                          WorldError, "origin")
-                   for i, v in enumerate(origin))
+                   for i, v in enumerate(origin_written))
     if abs(yaw) > LARGEST:                          # 1e300 read as an exact quarter turn, 0
         raise WorldError(f"the origin's yaw must be within ±{LARGEST:g} (radians), not {yaw:g}",
-                         span=_item_span(origin, 2, spec.value_span("origin")),
+                         span=_item_span(origin_written, 2, spec.value_span("origin")),
                          hint="the yaw is in radians: 3.14 is a half turn")
     negate = _negate(spec)
     mode = spec.get("mode", "trinary")
@@ -386,4 +387,16 @@ def load_map_yaml(path: Path, *, unknown_occupied: bool = True,
     res, origin = res_m * INCH_PER_M, (ox * INCH_PER_M, oy * INCH_PER_M)
     if abs(math.remainder(yaw, 2 * math.pi)) > 1e-12:
         blocked, origin = rotate(blocked, res, origin, yaw)
-    return Grid(blocked, res, origin, str(path))
+    note = _yaw_note(yaw, _item_span(origin_written, 2, spec.value_span("origin")))
+    return Grid(blocked, res, origin, str(path), notes=(note,) if note else ())
+
+
+def _yaw_note(yaw: float, span: Span) -> str | None:
+    """A warning for a yaw past a whole turn: map_server's is in radians (map_saver writes
+    it within ±pi), so ``origin: [0, 0, 90]`` is likely 90 degrees, and turned the map by
+    90 rad (5,157 degrees: 116.6 past 14 turns) without a word."""
+    if abs(yaw) <= 2 * math.pi:
+        return None
+    return (f"{span}: the origin's yaw {yaw:g} is in radians and turns the map by "
+            f"{math.degrees(math.remainder(yaw, 2 * math.pi)):.4g} degrees (a yaw past a whole "
+            f"turn is likely degrees: {yaw:g} degrees is {math.radians(yaw):.6g} rad)")

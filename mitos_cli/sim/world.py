@@ -90,6 +90,8 @@ class Grid:
     resolution: float              # in per cell
     origin: tuple[float, float]    # in, lower-left corner of cell (0, 0)
     source: str = ""
+    notes: tuple[str, ...] = field(default=(), compare=False, repr=False)
+    # what its map file says that is legal but likely a mistake (``path:line:col: ...``)
 
     __hash__ = object.__hash__     # frozen dataclass with an array: hash by identity, in C
 

@@ -486,7 +486,8 @@ def parse_world(text: str, path: str) -> World:
     check_starts(world, [s for s, _ in agent_spans])
     if "randomise" in top:
         check_jitters(world, top["randomise"].get("obstacles"))
-    notes = walled_in(world, static, top)
+    notes = [*(grid.notes if grid else ()), *(given.notes if given else ()),
+             *walled_in(world, static, top)]
     return replace(world, notes=tuple(notes)) if notes else world
 
 
