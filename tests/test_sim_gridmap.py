@@ -44,6 +44,13 @@ def test_sixteen_bit_pgm():
     assert maxval == 65535 and px.ravel().tolist() == [65535, 1]
 
 
+
+def test_a_sixteen_bit_pgm_followed_by_a_newline_reads_as_an_eight_bit_one_does():
+    """An 8-bit PGM with a byte after its pixels (a writer's last newline) read; a 16-bit one
+    was refused with NumPy's "buffer size must be a multiple of element size"."""
+    px, maxval = parse_pgm(b"P5 1 2 65535\n" + bytes([0xFF, 0xFF, 0x00, 0x01]) + b"\n")
+    assert maxval == 65535 and px.ravel().tolist() == [65535, 1]
+
 @pytest.mark.parametrize("data, words", [
     (b"P6 1 1 255\n\x00\x00\x00", "not a PGM"),
     (b"P5 2 2 255\n\x00", "holds 1 of its 4 pixels"),

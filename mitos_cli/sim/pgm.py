@@ -81,7 +81,9 @@ def parse_pgm(data: bytes) -> tuple[np.ndarray, int]:
         raise ValueError(f"the PGM image is too short for its {plural(n, 'pixel')}")
     if magic == b"P5":
         dtype = np.dtype(">u2") if maxval > 255 else np.dtype("u1")
-        body = np.frombuffer(data, dtype=dtype, count=-1, offset=offset)
+        # its n pixels only: all the bytes to the end made a 16-bit image followed by a
+        # newline NumPy's "buffer size must be a multiple of element size"
+        body = np.frombuffer(data, dtype=dtype, count=n, offset=offset)
         if body.size < n:
             raise ValueError(f"the PGM image holds {body.size} of its {plural(n, 'pixel')}")
         pixels = body[:n].astype(np.uint16)
