@@ -51,6 +51,16 @@ def test_a_sixteen_bit_pgm_followed_by_a_newline_reads_as_an_eight_bit_one_does(
     px, maxval = parse_pgm(b"P5 1 2 65535\n" + bytes([0xFF, 0xFF, 0x00, 0x01]) + b"\n")
     assert maxval == 65535 and px.ravel().tolist() == [65535, 1]
 
+
+def test_a_binary_pgm_whose_header_ends_in_cr_lf_is_refused_not_shifted():
+    """A header written with CR LF line ends: one whitespace byte ends it, so its LF was read
+    as the first pixel, every pixel one place late, the last one left over, and the map
+    loaded shifted without a word. The same pixels after an LF header read as they are."""
+    with pytest.raises(ValueError, match="its header ends in CR LF .* one place late"):
+        parse_pgm(b"P5\r\n2 3\r\n255\r\n" + bytes(PIXELS))
+    px, _ = parse_pgm(b"P5\n2 3\n255\n" + bytes(PIXELS))
+    assert px.ravel().tolist() == PIXELS
+
 @pytest.mark.parametrize("data, words", [
     (b"P6 1 1 255\n\x00\x00\x00", "not a PGM"),
     (b"P5 2 2 255\n\x00", "holds 1 of its 4 pixels"),

@@ -77,6 +77,8 @@ def parse_pgm(data: bytes) -> tuple[np.ndarray, int]:
     if magic == b"P5" and len(data) - offset < n * depth:   # before allocating anything
         raise ValueError(f"the PGM image holds {(len(data) - offset) // depth:,} of its "
                          f"{plural(n, 'pixel')}")
+    if magic == b"P5":
+        _check_line_end(data, offset, n * depth)
     if magic == b"P2" and (len(data) - offset + 2) // 2 < n:  # at least "0 " per pixel
         raise ValueError(f"the PGM image is too short for its {plural(n, 'pixel')}")
     if magic == b"P5":
@@ -96,6 +98,18 @@ def parse_pgm(data: bytes) -> tuple[np.ndarray, int]:
         _within(pixels, maxval, width)
         pixels = pixels.astype(np.uint16)
     return pixels.reshape(height, width), maxval
+
+
+def _check_line_end(data: bytes, offset: int, size: int) -> None:
+    """Refuse a binary PGM whose header ends in CR LF and whose image holds one byte more
+    than its pixels: one whitespace byte ends the header, so its LF was read as the first
+    pixel and every pixel came one place late, the map shifted without a word (map_server
+    reads it so too: the file is mended, not guessed at)."""
+    if data[offset - 1:offset + 1] == b"\r\n" and len(data) - offset == size + 1:
+        raise ValueError("its header ends in CR LF (a Windows line end) and its image holds "
+                         "one byte more than its pixels: read as the format says, every pixel "
+                         "would come one place late, as map_server reads it; write the "
+                         "header's line ends as LF")
 
 
 def _ascii_pixels(raster: bytes) -> np.ndarray:
