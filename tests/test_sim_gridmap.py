@@ -500,6 +500,24 @@ def test_a_misspelt_map_or_image_gets_a_did_you_mean_as_it_is_written(tmp_path: 
     assert info.value.hint == "the image path is relative to the map's YAML file"
 
 
+
+def test_an_absolute_image_path_from_another_machine_points_beside_the_yaml(tmp_path: Path):
+    """ROS 1's map_saver given an absolute name writes the image's absolute path; moved to
+    another machine, the map was told "the image path is relative to the map's YAML file"."""
+    (tmp_path / "office.pgm").write_bytes(b"P5 2 3 255\n" + bytes(PIXELS))
+    gone = tmp_path / "another" / "machine" / "office.pgm"
+    (tmp_path / "m.yaml").write_text(f"image: {gone}\nresolution: 0.05\norigin: [0, 0, 0]\n")
+    with pytest.raises(WorldError, match="map image .* not found") as info:
+        load_map_yaml(tmp_path / "m.yaml")
+    assert info.value.hint == ("did you mean `office.pgm`, beside the map's YAML? It names its "
+                               "image by an absolute path, as map_saver writes one: write "
+                               "`image: office.pgm`")
+    (tmp_path / "office.pgm").unlink()
+    with pytest.raises(WorldError) as info:
+        load_map_yaml(tmp_path / "m.yaml")
+    assert info.value.hint == ("the image path is absolute: it is looked for there, not beside "
+                               "the map's YAML")
+
 def test_a_bad_origin_number_is_pointed_at_itself(tmp_path: Path):
     """`origin: [0, 0, half]` put the caret on the `[`."""
     (tmp_path / "m.yaml").write_text("image: m.pgm\nresolution: 0.05\norigin: [0, 0, half]\n")

@@ -272,7 +272,18 @@ def _beside(path: Path, written: str | None, exc: OSError | UnicodeDecodeError,
     return f"did you mean `{(Path(written).parent if written else path.parent) / name}`?"
 
 
-def _unread_hint(path: Path, written: str, exc: OSError) -> str | None:
+def _moved_hint(path: Path, written: str, yaml_dir: Path) -> str:
+    """The hint of an absolute image path that is not there: ROS 1's map_saver writes the
+    name it was given (``-f`` with an absolute name writes an absolute ``image:``), so a map
+    moved to another machine names an image that now lies beside its YAML. It was told the
+    path "is relative to the map's YAML file", which it is not."""
+    if exists(yaml_dir / path.name) and (yaml_dir / path.name).is_file():
+        return (f"did you mean `{path.name}`, beside the map's YAML? It names its image by an "
+                f"absolute path, as map_saver writes one: write `image: {path.name}`")
+    return "the image path is absolute: it is looked for there, not beside the map's YAML"
+
+
+def _unread_hint(path: Path, written: str, exc: OSError, yaml_dir: Path) -> str | None:
     """The hint of a map image that could not be read: where it is looked for, where it is
     not there; that it is damaged, where Pillow could not decode it whole (a truncated PNG
     was told "the image path is relative to the map's YAML file")."""
@@ -281,6 +292,8 @@ def _unread_hint(path: Path, written: str, exc: OSError) -> str | None:
     if exists(path) and path.is_file():
         return "the file is there but its image could not be decoded whole: is it damaged? " \
                "(save it again, as PGM or PNG)"
+    if Path(written).is_absolute():
+        return _moved_hint(path, written, yaml_dir)
     close = _beside(path, written, exc, IMAGE_SUFFIXES)
     return f"{close} (the image path is relative to the map's YAML file)" if close else \
         "the image path is relative to the map's YAML file"
@@ -372,7 +385,7 @@ def load_map_yaml(path: Path, *, unknown_occupied: bool = True,
                          span=spec.value_span("image")) from None
     except OSError as exc:
         raise WorldError(unreadable("map image", image_path, exc), span=spec.value_span("image"),
-                         hint=_unread_hint(image_path, str(image), exc)) from None
+                         hint=_unread_hint(image_path, str(image), exc, path.parent)) from None
     except TooLarge as exc:
         raise WorldError(f"cannot read map image `{image_path}`: {exc}",
                          span=spec.value_span("image"),
