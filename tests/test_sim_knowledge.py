@@ -300,6 +300,27 @@ def test_a_start_in_a_wall_of_the_given_map_is_said_at_the_start(tmp_path):
         "map `given.yaml` the robot is given\n")
 
 
+
+def test_a_goal_in_an_unknown_cell_of_the_given_map_says_so(tmp_path):
+    """A goal in the grey (unknown) part of the map the robot is given was "inside a wall" of
+    it; it is said to lie in an unknown cell, with `unknown: free` offered. A cell drawn
+    black is a wall as before."""
+    told = hall(120)
+    path = grid_world(tmp_path, hall(120), told)
+    px = np.where(told[::-1], 254, 0).astype(np.uint8)
+    rows = len(px)
+    px[rows - 80:rows - 60, 375:385] = 205                  # grey round the goal (380, 70)
+    (tmp_path / "given.pgm").write_bytes(f"P5 {px.shape[1]} {rows} 255\n".encode()
+                                         + px.tobytes())
+    with pytest.raises(NarrowPassage) as info:
+        prepare(load_world(path))
+    text = info.value.render().replace(f"{tmp_path}/", "")
+    assert text.startswith("w.yaml:12:9: world error: the goal (q_goal) at (380, 70) lies in an "
+                           "unknown cell of the map `given.yaml` the robot is given (grey, "
+                           "between its free_thresh and occupied_thresh), which counts as a "
+                           "wall\n")
+    assert "or write `unknown: free` under `map:`" in info.value.hint
+
 def test_a_start_too_near_a_wall_of_the_given_map_to_leave_is_said_at_the_start(tmp_path):
     told = hall(120)
     told[60:64, 25:40] = told[76:80, 25:40] = told[60:80, 25:30] = False   # a pocket

@@ -27,7 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import Span, WorldError, unknown
+from ..errors import MitosError, Span, WorldError, unknown
 from ..fileio import unreadable
 from ..lang import yamlpos
 from ..resources import exists
@@ -270,6 +270,34 @@ def _beside(path: Path, written: str | None, exc: OSError | UnicodeDecodeError,
     if name is None:
         return None
     return f"did you mean `{(Path(written).parent if written else path.parent) / name}`?"
+
+
+def unknown_at(source: str, x: float, y: float) -> bool:
+    """Whether the point (in) lies in an unknown cell (grey, between the thresholds) of the
+    map file ``source``: blocked as read with unknown cells occupied, free with them free.
+    The map is read twice, so only for a refusal's words (a cell of a robot's map may be
+    blocked by what is drawn on it, which the map file does not say)."""
+    if not source:
+        return False
+    try:
+        strict, lenient = (load_map_yaml(Path(source), unknown_occupied=u) for u in (True, False))
+    except MitosError:
+        return False
+    return _blocked_at(strict, x, y) and not _blocked_at(lenient, x, y)
+
+
+def _blocked_at(g: Grid, x: float, y: float) -> bool:
+    """Whether the point (in) lies in a blocked cell of ``g`` (off it counts as blocked)."""
+    col, row = math.floor((x - g.origin[0]) / g.resolution), \
+        math.floor((y - g.origin[1]) / g.resolution)
+    rows, cols = g.occupied.shape
+    return not (0 <= row < rows and 0 <= col < cols) or bool(g.occupied[row, col])
+
+
+def unknown_words(mapped: str) -> str:
+    """How a refusal says a point lies in an unknown cell of ``mapped`` (``the map `m.yaml```)."""
+    return (f"lies in an unknown cell of {mapped} (grey, between its free_thresh and "
+            "occupied_thresh), which counts as a wall")
 
 
 def _moved_hint(path: Path, written: str, yaml_dir: Path) -> str:

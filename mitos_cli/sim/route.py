@@ -873,7 +873,7 @@ def grid_route(static: StaticMap, start: Pose, goal: Goal, clearance: float,
         ends = ((what, p, _end_room(field, occ, p)) for what, p in
                 (("start", (start.x, start.y)), ("goal", (goal.x, goal.y))))
         refusal = _refusal(node_c, s, t, centre, floor, edge, half_width, tuple(ends),
-                           _map_words(g, given), size)
+                           _map_words(g, given), size, source=g.source if given else "")
         gap = getattr(refusal, "gap", None)
         if between and gap is not None and floor - gap < g.resolution * math.sqrt(0.5):
             found = _between_cells(g, occ, start, goal, clearance, floor, cell)
@@ -1291,12 +1291,17 @@ def _patched(grid: Grid, occ: np.ndarray, base_occ: np.ndarray, cap: float, k: i
 def _refusal(node_c: np.ndarray, s, t, centre, floor: float,
              edge: np.ndarray | None = None, half_width: float = 0.0,
              ends: tuple[tuple[str, tuple[float, float], float], ...] = (),
-             mapped: str = "the map", step: float = 0.0) -> WorldError:
+             mapped: str = "the map", step: float = 0.0, source: str = "") -> WorldError:
     """Why no way keeps ``floor``: a start or goal (``ends``: each with its clearance, -1
-    inside a wall) in a wall of the map the robot plans on (``mapped``, in words) or too near
+    inside a wall) in a wall of the map the robot plans on (``mapped``, in words; read from
+    the map file ``source``, where one says whether the wall is an unknown cell) or too near
     one to leave it (the widest way's narrowest place lies within ``floor`` and a node
     ``step`` of it), no way at all, or the narrowest place of the widest way."""
+    from .gridmap import unknown_at, unknown_words
+
     for what, (x, y), room in ends:
+        if room < 0 and unknown_at(source, x, y):
+            return _end_refused(what, x, y, unknown_words(mapped), mapped, grey=True)
         if room < 0:
             return _end_refused(what, x, y, f"lies inside a wall of {mapped}", mapped)
     free_c = np.maximum(node_c, 0.0)
@@ -1391,12 +1396,16 @@ def _map_words(g: Grid, given: bool) -> str:
         "the map the robot is given"
 
 
-def _end_refused(what: str, x: float, y: float, why: str, mapped: str) -> NarrowPassage:
-    """The refusal of a start or goal its route cannot leave or reach, at its own line."""
+def _end_refused(what: str, x: float, y: float, why: str, mapped: str,
+                 grey: bool = False) -> NarrowPassage:
+    """The refusal of a start or goal its route cannot leave or reach, at its own line (in
+    an unknown cell, ``grey``: with how to read those free)."""
     name = {"start": "start (q_init)", "goal": "goal (q_goal)"}[what]
     hint = (f"move the {what}, or give the robot a map that shows it clear: it plans on the "
             "map it is given, not on the map itself" if mapped != "the map" else
             f"move the {what} further from the walls")
+    if grey:
+        hint += "; or write `unknown: free` under `map:` to read unknown cells as free"
     return NarrowPassage(f"the {name} at ({x:g}, {y:g}) {why}", hint=hint, end=what)
 
 

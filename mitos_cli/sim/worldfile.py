@@ -766,26 +766,13 @@ def _unknown_cell(world: World, x: float, y: float) -> str | None:
     """``lies in an unknown cell of the map `m.yaml` ...`` for a point whose cell is blocked
     only because it is unknown (grey, between the thresholds), else ``None``: "inside a wall
     ... move it into a corridor" sent the user of a SLAM map looking for a wall in a room its
-    scan left grey. The map is read again, unknown cells free (only for this refusal)."""
-    import numpy as np
-
-    from .gridmap import load_map_yaml
-    from .staticmap import StaticMap
+    scan left grey."""
+    from .gridmap import unknown_at, unknown_words
 
     g = world.grid
-    if g is None or not g.source:
+    if g is None or not unknown_at(g.source, x, y):
         return None
-    try:
-        lenient = load_map_yaml(Path(g.source), unknown_occupied=False)
-    except MitosError:
-        return None
-    rows, cols = lenient.occupied.shape
-    ox, oy = lenient.origin
-    bounds = (ox, oy, ox + cols * lenient.resolution, oy + rows * lenient.resolution)
-    if not StaticMap(np.zeros((0, 4)), np.zeros((0, 4, 2)), lenient, bounds).free(np.array([[x, y]]))[0]:
-        return None
-    return (f"lies in an unknown cell of the map `{Path(g.source).name}` (grey, between its "
-            "free_thresh and occupied_thresh), which counts as a wall")
+    return unknown_words(f"the map `{Path(g.source).name}`")
 
 
 def _off_the_grid(static: StaticMap, x: float, y: float) -> str | None:
