@@ -316,6 +316,22 @@ def test_resume_refuses_a_map_that_changed(tmp_path, compare, edit):
     assert compare(*args, "--runs", 2, "--resume").exit_code == 0
 
 
+
+def test_a_grid_map_file_not_named_yaml_is_in_the_worlds_digest(tmp_path):
+    """A `grid:` map file is read by its content whatever its name, but the digest took only
+    one ending in .yaml: an edited `m.map` (or its image) resumed as the same world."""
+    from mitos_cli.sim.worldfile import map_files
+    from mitos_cli.study.simtask import world_digest
+
+    world = grid_world(tmp_path)
+    (tmp_path / "m.yaml").rename(tmp_path / "m.map")
+    world.write_text(world.read_text().replace("grid: m.yaml", "grid: m.map"))
+    assert map_files(world) == [tmp_path / "m.map", tmp_path / "m.pgm"]
+    before = world_digest(str(world))
+    image = (tmp_path / "m.pgm").read_bytes()
+    (tmp_path / "m.pgm").write_bytes(image[:-1] + bytes([255 - image[-1]]))
+    assert world_digest(str(world)) != before
+
 def test_a_study_resumes_from_another_directory(tmp_path, compare, monkeypatch):
     """A world is the file, not the path typed: a study made with `tiny.yaml` from its own
     directory "left out" its runs when resumed from anywhere else, even with the command its

@@ -1113,7 +1113,8 @@ def map_files(path: str | Path) -> list[Path]:
     out = []
     for key in ("grid", "given"):
         spec = named(Path(path), key, "map")
-        if spec is None or spec.suffix.lower() not in (".yaml", ".yml"):   # (`given: none`)
+        # (`given: none`; a given map is a .yaml, a grid any file that reads as a map file)
+        if spec is None or key == "given" and spec.suffix.lower() not in (".yaml", ".yml"):
             continue
         image = named(spec, "image", "")
         out += [spec] + ([image] if image is not None else [])
