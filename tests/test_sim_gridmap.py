@@ -39,6 +39,7 @@ def test_an_ascii_pgm_with_comments_in_its_raster_reads_as_map_server_reads_it()
     with pytest.raises(ValueError, match="holds `x` as its pixel 3, which is not a whole number"):
         parse_pgm(b"P2 2 3 255 254 254 x 205 0 0")
 
+
 def test_sixteen_bit_pgm():
     px, maxval = parse_pgm(b"P5 1 2 65535\n" + bytes([0xFF, 0xFF, 0x00, 0x01]))
     assert maxval == 65535 and px.ravel().tolist() == [65535, 1]
@@ -60,6 +61,7 @@ def test_a_binary_pgm_whose_header_ends_in_cr_lf_is_refused_not_shifted():
         parse_pgm(b"P5\r\n2 3\r\n255\r\n" + bytes(PIXELS))
     px, _ = parse_pgm(b"P5\n2 3\n255\n" + bytes(PIXELS))
     assert px.ravel().tolist() == PIXELS
+
 
 @pytest.mark.parametrize("data, words", [
     (b"P6 1 1 255\n\x00\x00\x00", "not a PGM"),
@@ -211,6 +213,7 @@ def test_a_bad_threshold_is_pointed_at_itself(tmp_path: Path, thresholds, said, 
         load_map_yaml(tmp_path / "m.yaml")
     assert info.value.message == said and info.value.span.line == line
 
+
 def test_the_shipped_real_map_loads():
     from mitos_cli.resources import packaged_path
 
@@ -255,6 +258,7 @@ def test_a_png_named_pgm_is_read_by_its_content_as_map_server_reads_it(tmp_path)
     with pytest.raises(WorldError, match="not a PGM image"):
         load_map_yaml(_map(tmp_path, "junk.pgm"))
 
+
 def test_a_damaged_png_is_said_to_be_damaged_not_looked_for_elsewhere(tmp_path):
     """A truncated PNG ("image file is truncated") got the hint that the image path is
     relative to the map's YAML file, as if it had not been found."""
@@ -267,6 +271,7 @@ def test_a_damaged_png_is_said_to_be_damaged_not_looked_for_elsewhere(tmp_path):
     with pytest.raises(WorldError) as info:
         load_map_yaml(_map(tmp_path, "gone.png"))
     assert info.value.hint == "the image path is relative to the map's YAML file"
+
 
 def test_a_colour_map_reads_as_the_mean_of_its_channels_as_map_server_does(tmp_path):
     """map_server averages a pixel's channels: yellow (255, 255, 0) is 170, occupancy 0.33,
@@ -407,6 +412,7 @@ def test_a_turned_map_is_resampled_a_block_of_rows_at_a_time():
         inside = 0 <= mr < 600 and 0 <= mc < 600
         assert turned[r, k] == (blocked[mr, mc] if inside else True)
 
+
 def test_map_modes_raw_and_an_unknown_one(tmp_path: Path):
     """`mode: raw` reads pixel values as occupancy percent (0 free, 100 occupied, above 100
     unknown), as map_server does; an unknown mode was silently read as trinary."""
@@ -461,6 +467,7 @@ def test_an_empty_image_or_mode_is_said_so_not_none(tmp_path: Path, line, said, 
         load_map_yaml(tmp_path / "m.yaml")
     assert info.value.message == said and "None" not in info.value.render()
     assert (info.value.span.line, info.value.span.column) == (line.count("\n") + 3, column)
+
 
 def test_a_map_named_by_its_image_points_at_its_yaml(tmp_path: Path):
     (tmp_path / "m.pgm").write_bytes(b"P5 2 3 255\n" + bytes(PIXELS))
@@ -517,6 +524,7 @@ def test_an_absolute_image_path_from_another_machine_points_beside_the_yaml(tmp_
         load_map_yaml(tmp_path / "m.yaml")
     assert info.value.hint == ("the image path is absolute: it is looked for there, not beside "
                                "the map's YAML")
+
 
 def test_a_bad_origin_number_is_pointed_at_itself(tmp_path: Path):
     """`origin: [0, 0, half]` put the caret on the `[`."""

@@ -321,6 +321,7 @@ def test_a_goal_in_an_unknown_cell_of_the_given_map_says_so(tmp_path):
                            "wall\n")
     assert "or write `unknown: free` under `map:`" in info.value.hint
 
+
 def test_a_start_too_near_a_wall_of_the_given_map_to_leave_is_said_at_the_start(tmp_path):
     told = hall(120)
     told[60:64, 25:40] = told[76:80, 25:40] = told[60:80, 25:30] = False   # a pocket

@@ -79,6 +79,7 @@ def test_an_mrpb_tests_file_with_a_byte_order_mark_is_read(tmp_path):
     [(number, start, _)] = mrpb.read_tests(path)
     assert number == 1 and start.x == pytest.approx(INCH_PER_M)
 
+
 def test_a_scenario_becomes_one_world_per_test(tmp_path):
     folder = tmp_path / "box"
     folder.mkdir()

@@ -233,6 +233,7 @@ def test_a_yaw_past_a_whole_turn_is_warned_of_as_likely_degrees(tmp_path: Path):
                     .replace("{x: -60, y: 27}", "{x: -40, y: -60}"))
     assert load_world(path).notes == ()
 
+
 def test_a_corridor_carved_past_the_maps_edge_grows_the_map(tmp_path: Path):
     """A corridor carved into a map ended at the map's edge without a word (all beyond it
     solid), and a goal in it was "inside a wall": the map now grows, by whole cells of wall,

@@ -332,6 +332,7 @@ def test_a_grid_map_file_not_named_yaml_is_in_the_worlds_digest(tmp_path):
     (tmp_path / "m.pgm").write_bytes(image[:-1] + bytes([255 - image[-1]]))
     assert world_digest(str(world)) != before
 
+
 def test_a_study_resumes_from_another_directory(tmp_path, compare, monkeypatch):
     """A world is the file, not the path typed: a study made with `tiny.yaml` from its own
     directory "left out" its runs when resumed from anywhere else, even with the command its
