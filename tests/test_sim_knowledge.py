@@ -323,10 +323,12 @@ def test_a_goal_in_an_unknown_cell_of_the_given_map_says_so(tmp_path):
 
 
 def test_a_start_too_near_a_wall_of_the_given_map_to_leave_is_said_at_the_start(tmp_path):
+    """The pocket's walls stand 6 in from the start on three sides. It was said to lie 5.5 in
+    from a wall: the clearance of its cell, measured from the cell's centre, not its own."""
     told = hall(120)
     told[60:64, 25:40] = told[76:80, 25:40] = told[60:80, 25:30] = False   # a pocket
     assert _refusal(tmp_path, told, start=(36, 70)).startswith(
-        "w.yaml:11:9: world error: the start (q_init) at (36, 70) lies 5.5 in from a wall "
+        "w.yaml:11:9: world error: the start (q_init) at (36, 70) lies 6.0 in from a wall "
         "of the map `given.yaml` the robot is given, and its route needs 11.0 in to leave it")
 
 

@@ -870,7 +870,8 @@ def grid_route(static: StaticMap, start: Pose, goal: Goal, clearance: float,
     if path is None:
         if not explain:
             raise NarrowPassage("no way to the goal on what the robot knows")
-        ends = ((what, p, _end_room(field, occ, p)) for what, p in
+        squares = Squares(occ, g.resolution, g.origin)
+        ends = ((what, p, _end_room(field, occ, p), _end_gap(squares, p, floor)) for what, p in
                 (("start", (start.x, start.y)), ("goal", (goal.x, goal.y))))
         refusal = _refusal(node_c, s, t, centre, floor, edge, half_width, tuple(ends),
                            _map_words(g, given), size, source=g.source if given else "")
@@ -1290,16 +1291,17 @@ def _patched(grid: Grid, occ: np.ndarray, base_occ: np.ndarray, cap: float, k: i
 
 def _refusal(node_c: np.ndarray, s, t, centre, floor: float,
              edge: np.ndarray | None = None, half_width: float = 0.0,
-             ends: tuple[tuple[str, tuple[float, float], float], ...] = (),
+             ends: tuple[tuple[str, tuple[float, float], float, float], ...] = (),
              mapped: str = "the map", step: float = 0.0, source: str = "") -> WorldError:
-    """Why no way keeps ``floor``: a start or goal (``ends``: each with its clearance, -1
-    inside a wall) in a wall of the map the robot plans on (``mapped``, in words; read from
-    the map file ``source``, where one says whether the wall is an unknown cell) or too near
-    one to leave it (the widest way's narrowest place lies within ``floor`` and a node
-    ``step`` of it), no way at all, or the narrowest place of the widest way."""
+    """Why no way keeps ``floor``: a start or goal (``ends``: each with its cell's clearance,
+    -1 inside a wall, and its own distance to the nearest wall) in a wall of the map the
+    robot plans on (``mapped``, in words; read from the map file ``source``, where one says
+    whether the wall is an unknown cell) or too near one to leave it (the widest way's
+    narrowest place lies within ``floor`` and a node ``step`` of it), no way at all, or the
+    narrowest place of the widest way."""
     from .gridmap import unknown_at, unknown_words
 
-    for what, (x, y), room in ends:
+    for what, (x, y), room, _ in ends:
         if room < 0 and unknown_at(source, x, y):
             return _end_refused(what, x, y, unknown_words(mapped), mapped, grey=True)
         if room < 0:
@@ -1327,9 +1329,12 @@ def _refusal(node_c: np.ndarray, s, t, centre, floor: float,
                                   "its way as it goes)")
     (r, c), gap = widest
     x, y = centre((r, c))
-    for what, end, room in ends:
+    for what, end, room, gap_there in ends:
         if room < floor and math.dist((x, y), end) <= floor + step:
-            return _end_refused(what, *end, f"lies {room:.1f} in from a wall of {mapped}, "
+            # the point's own distance; its cell's where that keeps the floor (the cell's
+            # clearance, measured from its centre, undercuts the point's there)
+            near = gap_there if gap_there < floor else room
+            return _end_refused(what, *end, f"lies {near:.1f} in from a wall of {mapped}, "
                                 f"and its route needs {floor:.1f} in to leave it", mapped)
     out = narrow_passage(x, y, gap, floor, "passage", f"about {tenths(2 * gap)}", half_width)
     out.gap = gap
@@ -1386,6 +1391,15 @@ def _end_room(field: Clearance, occ: np.ndarray, p: tuple[float, float]) -> floa
     if inside[0] and occ[row[0], col[0]]:
         return -1.0
     return float(field.cells(np.array([p]))[0])
+
+
+def _end_gap(squares: Squares, p: tuple[float, float], reach: float) -> float:
+    """The exact distance (in) from the point ``p`` to the nearest occupied cell (each the
+    square it is), at most ``reach``: what a refusal says it "lies ... in from a wall". The
+    clearance of its cell (:func:`_end_room`, what the route's node there keeps) was said,
+    measured from the cell's centre: "4.9 in" of a goal 3.98 in from the wall."""
+    a = np.array(p, dtype=float)
+    return squares.room(a, a, reach)
 
 
 def _map_words(g: Grid, given: bool) -> str:
