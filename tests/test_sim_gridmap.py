@@ -259,6 +259,16 @@ def test_a_png_named_pgm_is_read_by_its_content_as_map_server_reads_it(tmp_path)
         load_map_yaml(_map(tmp_path, "junk.pgm"))
 
 
+def test_a_png_named_pgm_too_large_for_pillow_is_too_large_not_no_pgm(tmp_path):
+    """A PNG named `.pgm` of 200 million pixels, past Pillow's own limit, was "not a PGM
+    image" once such a file went to Pillow; it is refused as too large, at its line."""
+    pytest.importorskip("PIL.Image")
+    (tmp_path / "big.pgm").write_bytes(_png_header(20_000, 10_000))
+    with pytest.raises(WorldError, match="exceeds limit") as info:
+        load_map_yaml(_map(tmp_path, "big.pgm"))
+    assert info.value.hint == "crop the image to the part the robot drives in"
+
+
 def test_a_damaged_png_is_said_to_be_damaged_not_looked_for_elsewhere(tmp_path):
     """A truncated PNG ("image file is truncated") got the hint that the image path is
     relative to the map's YAML file, as if it had not been found."""

@@ -161,13 +161,18 @@ def shade(pixels: np.ndarray, mode: str = "trinary") -> np.ndarray:
 
 
 def _pillow_knows(path: Path) -> bool:
-    """Whether Pillow is there and recognises ``path`` as an image."""
+    """Whether Pillow is there and recognises ``path`` as an image (one too large for it
+    too: :func:`read_image` refuses it as too large, not as "not a PGM image")."""
     try:
         from PIL import Image
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", Image.DecompressionBombWarning)
             Image.open(path).close()
-    except Exception:               # (ImportError, not an image, a bomb: the PGM's message)
+    except ImportError:
+        return False
+    except Image.DecompressionBombError:
+        return True
+    except Exception:               # (not an image Pillow knows: the PGM's message)
         return False
     return True
 
