@@ -199,6 +199,26 @@ def test_a_goal_in_an_unknown_cell_says_so_and_how_to_read_it_free(tmp_path: Pat
         load_world(path)                            # black there: a wall, as before
 
 
+def test_a_start_whose_body_reaches_into_grey_says_so(tmp_path: Path):
+    """A body reaching into the grey (unknown) part of a map was said to reach "into a wall";
+    black there, it still is."""
+    path = _free_map(tmp_path)                      # the start at (30, 60) heading 0
+    path.write_text(path.read_text().replace("q_goal: {x: 300, y: 0}", "q_goal: {x: 100, y: 100}"))
+    pixels = bytearray([254]) * 120 * 120
+    for row in range(50, 70):                       # grey from x = 40, under the body's nose
+        pixels[row * 120 + 40:row * 120 + 60] = bytes([205]) * 20
+    (tmp_path / "map.pgm").write_bytes(b"P5 120 120 255\n" + bytes(pixels))
+    with pytest.raises(WorldError) as info:
+        load_world(path)
+    assert info.value.message.endswith("the robot's body (24 x 18 in) reaches into an unknown "
+                                       "cell of the map `map.yaml` (grey, between its "
+                                       "free_thresh and occupied_thresh), which counts as a wall")
+    assert "`unknown: free` under `map:`" in info.value.hint
+    (tmp_path / "map.pgm").write_bytes(b"P5 120 120 255\n" + bytes(pixels).replace(b"\xcd", b"\0"))
+    with pytest.raises(WorldError, match=r"reaches into a wall\n"):
+        load_world(path)
+
+
 @pytest.mark.parametrize("grid, said", [("", "`grid` in map is empty"),
                                         ("[map.yaml]", "`grid` in map must be a map_server "
                                                        "YAML file, not a list")])

@@ -1041,28 +1041,61 @@ def _range(r: tuple[float, float]) -> str:
 
 def _check_body(world: World, agent, static, span: Span) -> None:
     """Refuse a start where the robot's footprint already touches a wall: the run would end
-    in a collision at its first tick."""
+    in a collision at its first tick. Where it touches only unknown (grey) cells of the map,
+    the refusal says so."""
+    import math
+
+    robot, (x, y, h) = agent.robot, (agent.start.x, agent.start.y,
+                                      math.radians(agent.start.heading))
+    if not _touches(static, x, y, h, robot.length / 2, robot.width / 2):
+        return
+    where = f"at the start (q_init){_who(agent)}, ({x:g}, {y:g}) heading {agent.start.heading:g} " \
+        f"deg, the robot's body ({robot.length:g} x {robot.width:g} in) reaches into"
+    lenient = _lenient_static(world)
+    if lenient is not None and lenient.grid is not None and \
+            not _touches(lenient, x, y, h, robot.length / 2, robot.width / 2):
+        raise WorldError(f"{where} an unknown cell of the map `{Path(lenient.grid.source).name}` "
+                         "(grey, between its free_thresh and occupied_thresh), which counts as "
+                         "a wall", span=span,
+                         hint="move the start further from the grey, or write `unknown: free` "
+                              "under `map:` to read unknown cells as free")
+    raise WorldError(f"{where} a wall", span=span,
+                     hint=_units_hint(world, agent) or "move the start further from the wall, "
+                                                       "or turn it along the corridor")
+
+
+def _touches(static, x: float, y: float, h: float, hl: float, hw: float) -> bool:
+    """Whether a box of half-length ``hl`` and half-width ``hw`` at (x, y) heading ``h``
+    (rad) touches a wall of ``static``."""
     import math
 
     import numpy as np
 
     from .geometry import box_segment_distance
 
-    robot, (x, y, h) = agent.robot, (agent.start.x, agent.start.y,
-                                      math.radians(agent.start.heading))
-    hl, hw = robot.length / 2, robot.width / 2
     walls = static.near(x, y, math.hypot(hl, hw))
     if not len(walls):
-        return
+        return False
     c, s = math.cos(h), math.sin(h)
     rel = walls.reshape(-1, 2) - (x, y)
     local = np.stack([rel[:, 0] * c + rel[:, 1] * s, -rel[:, 0] * s + rel[:, 1] * c], axis=1)
-    if box_segment_distance(hl, hw, local.reshape(-1, 4)).min() <= 0.0:
-        raise WorldError(
-            f"at the start (q_init){_who(agent)}, ({x:g}, {y:g}) heading {agent.start.heading:g} deg, "
-            f"the robot's body ({robot.length:g} x {robot.width:g} in) reaches into a wall",
-            span=span, hint=_units_hint(world, agent) or "move the start further from the "
-                                                         "wall, or turn it along the corridor")
+    return bool(box_segment_distance(hl, hw, local.reshape(-1, 4)).min() <= 0.0)
+
+
+def _lenient_static(world: World) -> StaticMap | None:
+    """The world's static map with its grid's unknown cells read free (for a refusal's
+    words only: the map is read again), or ``None`` without a grid read from a file."""
+    from .gridmap import load_map_yaml
+    from .staticmap import build_static
+
+    g = world.grid
+    if g is None or not g.source:
+        return None
+    try:
+        lenient = load_map_yaml(Path(g.source), unknown_occupied=False)
+    except MitosError:
+        return None
+    return build_static(world.with_changes(grid=lenient))
 
 
 def load_world(path: str | Path) -> World:
