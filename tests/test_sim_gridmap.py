@@ -536,6 +536,19 @@ def test_an_absolute_image_path_from_another_machine_points_beside_the_yaml(tmp_
                                "the map's YAML")
 
 
+def test_a_number_in_quotes_is_said_to_be_text_in_quotes(tmp_path: Path):
+    """`resolution: "0.05"` was "resolution must be a number, not `0.05`", which did not say
+    what is wrong with 0.05: YAML reads it in quotes as text."""
+    (tmp_path / "m.yaml").write_text('image: m.pgm\nresolution: "0.05"\norigin: [0, 0, 0]\n')
+    with pytest.raises(WorldError) as info:
+        load_map_yaml(tmp_path / "m.yaml")
+    assert info.value.message == ('resolution must be a number, not the text "0.05": YAML reads '
+                                  "a value in quotes as text; write the number without them")
+    (tmp_path / "m.yaml").write_text("image: m.pgm\nresolution: 0.05\norigin: [0, 0, half]\n")
+    with pytest.raises(WorldError, match="origin must be a number, not `half`\n"):
+        load_map_yaml(tmp_path / "m.yaml")
+
+
 def test_a_bad_origin_number_is_pointed_at_itself(tmp_path: Path):
     """`origin: [0, 0, half]` put the caret on the `[`."""
     (tmp_path / "m.yaml").write_text("image: m.pgm\nresolution: 0.05\norigin: [0, 0, half]\n")

@@ -281,7 +281,8 @@ def expect_number(value: Any, span: Span, error: type[MitosError], what: str) ->
     """``value`` as a finite float, or ``error`` saying a number was expected."""
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         shown = ("nothing (an empty value or `~`)" if value is None else
-                 f"`{str(value).lower()}`" if isinstance(value, bool) else f"`{value}`")
+                 f"`{str(value).lower()}`" if isinstance(value, bool) else
+                 _quoted_number(value, span) or f"`{value}`")
         raise error(f"{what} must be a number, not {shown}", span=span)   # (YAML's `true`)
     try:
         number = float(value)
@@ -298,6 +299,19 @@ def expect_number(value: Any, span: Span, error: type[MitosError], what: str) ->
                         span=span)
         raise error(f"{what} must be a finite number, not `{value}`", span=span)
     return number
+
+
+def _quoted_number(value: Any, span: Span) -> str | None:
+    """``the text `"0.05"` ...`` for a number written in quotes, which YAML reads as text:
+    "resolution must be a number, not `0.05`" did not say what was wrong with 0.05."""
+    text = _written(span)
+    if not isinstance(value, str) or text is None or text[:1] not in ("'", '"'):
+        return None
+    try:
+        float(value)
+    except ValueError:
+        return None
+    return f"the text {text}: YAML reads a value in quotes as text; write the number without them"
 
 
 def _written(span: Span) -> str | None:
