@@ -52,6 +52,23 @@ def test_examples_parse_and_name_files_that_exist(name):
                 assert (ROOT / word).exists(), f"{line}: {word} does not exist"
 
 
+#: Options whose value is a file an example writes, not one it reads.
+WRITES = {"-o", "--out", "--output", "--save-as", "--plot", "--animate"}
+
+
+@pytest.mark.parametrize("name", sorted(EXAMPLES))
+def test_examples_read_only_files_of_the_repository(name):
+    """`mitos eval --batch inputs.csv` ran from the repository root only to say that
+    `inputs.csv` was not found: a file named without a directory was never checked."""
+    for line, _ in EXAMPLES[name]:
+        words = shlex.split(line.split(">")[0])
+        for before, word in zip(words, words[1:]):
+            if before in WRITES or word.startswith("-") or "=" in word:
+                continue
+            if Path(word).suffix:
+                assert (ROOT / word).exists(), f"{line}: {word} does not exist"
+
+
 def test_compare_examples_run_one_after_another():
     """Run in their order, the second was refused ("study/results.csv already holds 120
     results"): the first had made its study in the same directory."""

@@ -13,7 +13,7 @@ EXAMPLES: dict[str, tuple[tuple[str, str], ...]] = {
     "eval": (
         ("mitos eval road=78 size=45 position=4", "the paper's sample run"),
         ("mitos eval rulebases/mitos.rules road=78 size=45 position=4 --json", "as JSON"),
-        ("mitos eval --batch inputs.csv > outputs.csv", "every row of a CSV, one batch"),
+        ("mitos eval --batch tests/data/inputs.csv > outputs.csv", "every row of a CSV, one batch"),
         ("mitos eval tests/data/interop/tipper.fis service=2 food=1", "a MATLAB .fis"),
         ("mitos eval --network", "the compiled neurons, layer by layer"),
     ),
