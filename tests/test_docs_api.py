@@ -32,6 +32,20 @@ def test_worlds_readme_python_example_says_what_it_prints(monkeypatch, capsys):
     assert printed[-1] == said.group(1)
 
 
+def test_worlds_readme_annotated_world_runs_as_written(tmp_path):
+    """worlds/README.md's "The format, annotated", saved as a file, was refused: its second
+    robot started at x = 770 in a corridor that ends at 600. It loads, and both robots arrive,
+    as the paragraph after it says."""
+    import re
+
+    from mitos_cli.sim import load_world, simulate
+
+    text = (ROOT / "worlds" / "README.md").read_text(encoding="utf-8")
+    world = tmp_path / "annotated.yaml"
+    world.write_text(re.findall(r"```yaml\n(.*?)```", text, re.S)[0], encoding="utf-8")
+    assert simulate(load_world(world)).outcome == "success"
+
+
 
 def test_every_python_block_of_the_readme_runs_as_written(monkeypatch):
     """README.md's Python blocks, each pasted as it stands (one used arrays it never made),
