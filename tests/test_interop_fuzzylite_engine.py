@@ -200,6 +200,14 @@ def test_a_hedged_mamdani_consequent_is_read_as_fuzzylite_computes_it():
                for n in rb.notes)
 
 
+def test_the_note_on_a_hedged_mamdani_consequent_quotes_the_rule_it_moved():
+    """The note gave a fixed example, `then y is very lo` as `if x is very A then y is lo`,
+    beside the file's line as if it were that rule: it quotes the rule read so, in its names."""
+    rb = parse_fll(HEDGED_MAMDANI.replace("very lo", "very hi"), "t.fll")
+    note = next(n for n in rb.notes if "hedges a Mamdani consequent" in n)
+    assert "(`then y is very hi` as `if x is very high then y is hi`)" in note
+
+
 def test_a_hedged_mamdani_consequent_agrees_with_fuzzylite():
     fl = pytest.importorskip("fuzzylite")
     engine = fl.FllImporter().from_string(HEDGED_MAMDANI.replace(      # pyfuzzylite reserves x

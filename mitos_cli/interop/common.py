@@ -20,7 +20,7 @@ from ..fuzzy.formula import Formula
 from ..fuzzy.hedges import HEDGES, fuzzylite_names
 from ..fuzzy.shapes import SHAPES, TSUKAMOTO
 from ..lang import operators as ops_mod
-from ..lang.model import And, Behavior, Consequent, Expr, Not, Or, Prop, Rule, RuleBase, Setting
+from ..lang.model import And, Behavior, Consequent, Expr, Not, Or, Prop, Rule, RuleBase, Setting, format_expr
 from ..lang.resolve import MAIN, check_rule
 from ..lang.terms import Term, TermSet, Variable, first_at, universe_problem
 from ..numbers import LARGEST, parse_value
@@ -640,14 +640,21 @@ def _hedges_moved(rules: list[Rule], notes: list[str]) -> list[Rule]:
     """Mamdani rules whose consequents fuzzylite hedges, restated so that MITOS computes what
     fuzzylite does (:func:`_hedge_moved`), with a note; a rule that cannot be is refused."""
     out = [_hedge_moved(r) for r in rules]
-    moved = [r for r, new in zip(rules, out) if new is not r]
+    moved = [(r, new) for r, new in zip(rules, out) if new is not r]
     if moved:
-        verb = "hedges" if len(moved) == 1 else "hedge"
-        notes.append(f"{moved[0].span or moved[0].label}: {plural(len(moved), 'rule')} {verb} a "
+        (first, read), verb = moved[0], "hedges" if len(moved) == 1 else "hedge"
+        notes.append(f"{first.span or first.label}: {plural(len(moved), 'rule')} {verb} a "
                      f"Mamdani consequent, which fuzzylite computes as the hedged degree of the "
-                     f"rule: the hedge is read on the condition (`then y is very lo` as `if x "
-                     f"is very A then y is lo`), the same there")
+                     f"rule: the hedge is read on the condition ({_moved_text(first, read)}), "
+                     f"the same there")
     return out
+
+
+def _moved_text(rule: Rule, read: Rule) -> str:
+    """The first moved rule as the note quotes it, in its own names (a fixed example, `y is
+    very lo` as `x is very A`, read as if about the user's rule)."""
+    c = next(c for c in rule.consequents if c.hedges)
+    return f"`then {hedged_text(c)}` as `if {format_expr(read.antecedent)} then {c.var} is {c.term}`"
 
 
 def _hedge_moved(rule: Rule) -> Rule:
