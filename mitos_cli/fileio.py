@@ -41,7 +41,8 @@ def nearby_name(path: str | Path, suffixes: tuple[str, ...] = RULE_SUFFIXES,
                 also: Iterable[str] = ()) -> str | None:
     """The name :func:`nearby` suggests, without its directory: never the name given, nor a
     link that leads nowhere (a dangling link or a loop is listed in its directory, and
-    "`loop1.yaml` not found, did you mean `loop1.yaml`?" was said of it)."""
+    "`loop1.yaml` not found, did you mean `loop1.yaml`?" was said of it), nor a directory
+    (`mitos.rules/` was offered for `mitoss.rules`, and then refused as a directory)."""
     where, given = Path(path).parent, Path(path).name
     try:
         names = [p.name for p in where.iterdir() if p.suffix.lower() in suffixes
@@ -52,9 +53,10 @@ def nearby_name(path: str | Path, suffixes: tuple[str, ...] = RULE_SUFFIXES,
 
 
 def _there(path: Path) -> bool:
-    """Whether ``path`` leads to something (a link to nothing, or in a loop, does not)."""
+    """Whether ``path`` leads to something a file may be read from (a link to nothing, or in a
+    loop, does not, nor a directory; a named pipe does)."""
     try:
-        return path.exists()
+        return path.exists() and not path.is_dir()
     except OSError:
         return False
 

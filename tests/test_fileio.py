@@ -188,3 +188,19 @@ def test_did_you_mean_never_names_the_file_given_nor_a_broken_link(links):
     assert nearby_name(links / "danglin.yaml", (".yaml",)) is None
     (links / "office.yaml").write_text("x")
     assert nearby_name(links / "ofice.yaml", (".yaml",)) == "office.yaml"
+
+
+def test_did_you_mean_never_names_a_directory(tmp_path, capsys):
+    """`mitos eval mitoss.rules` beside a directory `mitos.rules` said "did you mean
+    `mitos.rules`?", which was then refused: "`mitos.rules` is a directory"."""
+    from mitos_cli.cli.app import main
+    from mitos_cli.fileio import nearby_name
+
+    (tmp_path / "mitos.rules").mkdir()
+    assert nearby_name(tmp_path / "mitoss.rules") is None
+    with pytest.raises(SystemExit) as done:
+        main(["eval", str(tmp_path / "mitoss.rules"), "road=1"])
+    assert done.value.code == 1
+    assert "did you mean" not in capsys.readouterr().err
+    (tmp_path / "mitos.fll").write_text("x")
+    assert nearby_name(tmp_path / "mitoss.rules") == "mitos.fll"
