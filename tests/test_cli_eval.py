@@ -527,6 +527,18 @@ def test_eval_finds_rule_files_as_the_other_commands_do(files, tmp_path, monkeyp
     assert code == 1 and "rule file `nosuch.txt` not found" in err
 
 
+def test_a_mistyped_batch_file_gets_the_one_beside_it(tmp_path, monkeypatch, capsys):
+    """`--batch bach.csv` beside `batch.csv` was "not found" with no guess, where a mistyped
+    rule file or world gets the file beside it."""
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "batch.csv").write_text("road,size,position\n78,45,4\n")
+    code, _, err = run_main(["eval", "--batch", "bach.csv"], capsys)
+    assert code == 1 and "batch file `bach.csv` not found" in err
+    assert "hint: did you mean `batch.csv`?" in err
+    code, _, err = run_main(["eval", "--batch", "nosuch.csv"], capsys)
+    assert code == 1 and "did you mean" not in err
+
+
 def test_used_rules_take_the_operators_of_the_behavior_that_uses_them(tmp_path):
     """docs/language.md: `cruise` (and = product) evaluates avoid_obstacle's rules with
     product, so their DOFs there are not the ones avoid_obstacle alone gives."""

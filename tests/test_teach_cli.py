@@ -99,6 +99,9 @@ def test_usage_errors(work):
     assert res.returncode == 1 and "did you mean" not in res.stderr
     res = mitos("teach", "rb/mitos.rules", "--lesson", "missing.lesson", cwd=work)
     assert res.returncode == 1 and "lesson `missing.lesson` not found" in res.stderr
+    (work / "wider.lesson").write_text("show rules\n")      # a lesson beside it: the guess
+    res = mitos("teach", "rb/mitos.rules", "--lesson", "widr.lesson", cwd=work)
+    assert res.returncode == 1 and "hint: did you mean `wider.lesson`?" in res.stderr
     res = mitos("teach", "rb", cwd=work)
     assert res.returncode == 1 and "`rb` is a directory, not a rule file" in res.stderr
     res = mitos("teach", "rb/mitos.rules", "-b", "drvie", cwd=work)

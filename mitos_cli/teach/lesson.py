@@ -102,11 +102,12 @@ def read_lesson(source: str) -> tuple[str, str]:
     except (OSError, UnicodeDecodeError) as exc:
         error = LessonError(unreadable("lesson", source, exc), span=bad_byte(source, exc))
         if isinstance(exc, FileNotFoundError) and broken_link("lesson", path) is None:
-            # a mistyped name: the packaged lessons
+            # a mistyped name: a lesson file beside it, else the packaged lessons
             from ..errors import did_you_mean
+            from ..fileio import nearby
             from ..resources import packaged_names
 
             names = [n[:-len(".lesson")] for n in packaged_names("rulebases/lessons", ".lesson")]
             error.expected = "a lesson file, or a packaged lesson: " + ", ".join(names)
-            error.hint = did_you_mean(path.stem, names)
+            error.hint = nearby(path, (".lesson",)) or did_you_mean(path.stem, names)
         raise error from None
