@@ -472,3 +472,16 @@ def test_dask_not_installed_is_said_before_anything_is_written(tiny, tmp_path, c
     assert r.exit_code == 1 and words in r.stderr
     assert "pip install 'mitos[dask]', or use --executor local" in r.stderr
     assert "runs (dask)" not in r.stderr and not out.exists()
+
+
+def test_compare_help_names_every_inference_method():
+    """`--inference`'s help listed weighted_average, weighted_sum and mamdani; `tsukamoto`,
+    which the option takes, was named on no page."""
+    import typer.main
+
+    from mitos_cli.cli.app import build_app
+    from mitos_cli.lang.operators import INFERENCES
+
+    command = typer.main.get_group(build_app("compare")).commands["compare"]
+    option = next(p for p in command.params if p.name == "inference")
+    assert all(name in option.help for name in INFERENCES), option.help

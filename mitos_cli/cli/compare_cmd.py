@@ -31,8 +31,8 @@ def compare_command(
              "its De Morgan dual. Default: the rule base's.")] = None,
     inference: Annotated[Optional[str], typer.Option(
         "--inference", metavar="METHODS",
-        help="Inference methods: weighted_average, weighted_sum, mamdani. "
-             "Default: the rule base's.")] = None,
+        help="Inference methods, comma-separated: weighted_average, weighted_sum, mamdani, "
+             "tsukamoto (monotonic consequent terms only). Default: the rule base's.")] = None,
     planner: Annotated[str, typer.Option(
         "--planner", metavar="PLANNERS", autocompletion=complete.planner_list,
         help="Planners to compare: fuzzy, potential_field, dwa.")] = "fuzzy,potential_field",
