@@ -234,6 +234,18 @@ def test_a_bad_option_value_is_a_usage_error_whatever_its_kind(short, capsys):
     assert code == 1 and "did you mean `drive`?" in err
 
 
+def test_an_option_without_the_one_it_tunes_is_a_usage_error(short, capsys, monkeypatch):
+    """`--every 5` without `--trace` printed no trace, `--fps 5` without `--animate` drew
+    nothing and `-j 4` of one run started no process: each ran without a word."""
+    from mitos_cli.sim import loop
+
+    monkeypatch.setattr(loop, "simulate", lambda *a, **k: pytest.fail("the run started"))
+    for args, partner in ((["--every", "5"], "--trace"), (["--fps", "5"], "--animate"),
+                          (["-j", "2"], "--runs")):
+        code, err = run_main(capsys, short, *args)
+        assert code == 2 and f"add {partner}" in " ".join(err.replace("│", " ").split()), args
+
+
 def test_a_plot_that_is_not_a_picture_is_refused_before_the_run(short, capsys, monkeypatch):
     """As `plot -o` refuses it (a usage error, exit 2), not after the run (exit 1)."""
     from mitos_cli.sim import loop

@@ -203,7 +203,8 @@ def simulate_command(
                         "perceived vs true inputs, then the paper-style DOF trace (none for a "
                         "planner that is not a rule base); of the first robot where there are "
                         "several; on stderr with --json, which keeps stdout for the JSON.")] = False,
-    every: Annotated[int, typer.Option("--every", min=1, help="Ticks between traces.")] = 20,
+    every: Annotated[Optional[int], typer.Option(
+        "--every", min=1, help="Ticks between traces (default 20); with --trace.")] = None,
     plot: Annotated[Optional[Path], typer.Option(
         "--plot", parser=file_arg, metavar="FILE.png|FILE.svg",
         help="Draw the run (world, obstacles, path); with --runs, every run's path in one "
@@ -218,9 +219,10 @@ def simulate_command(
         "--animate", parser=file_arg, metavar="FILE.gif|FILE.mp4",
         help="Write the run as an animation: map, footprint, sonar cones, trail, obstacles, "
              "time and the fired rules' DOFs (.mp4 needs ffmpeg).")] = None,
-    fps: Annotated[float, typer.Option(
+    fps: Annotated[Optional[float], typer.Option(
         "--fps", min=0.1, max=60.0, callback=finite,
-        help="Animation frames per second of simulated time (plays in real time).")] = 10.0,
+        help="Animation frames per second of simulated time (plays in real time; default 10); "
+             "with --animate.")] = None,
     require: Annotated[Optional[str], typer.Option(
         "--require", metavar="success", help="Exit 3 unless every run ends in this outcome.")] = None,
     workers: Annotated[Optional[int], typer.Option(
@@ -260,12 +262,25 @@ def simulate_command(
         check_suffix(out, ".csv", "the table of ticks (--out)", "'--out' / '-o'")
     many = len(loaded) > 1 or runs > 0
     _check_run_options(many, len(loaded), runs, randomise, out, trace, live, animate, plot)
+    _check_partners(many, trace, every, animate, fps, workers)
     planner = make_planner(planner_name, loaded[0], rulebase, behavior)
     if many:
         _simulate_many(loaded, runs, seed, planner, workers, plot, as_json, require)
     else:
-        _simulate_one(loaded[0], planner, seed, randomise, live, speed, trace, every, as_json,
-                      out, plot, animate, fps, require)
+        _simulate_one(loaded[0], planner, seed, randomise, live, speed, trace, every or 20,
+                      as_json, out, plot, animate, fps or 10.0, require)
+
+
+def _check_partners(many: bool, trace: bool, every, animate, fps, workers) -> None:
+    """An option that tunes another, given without it, is a usage error: `--every 5` alone
+    printed no trace, `--fps 5` no animation, `-j 4` of one run started no process, each
+    without a word."""
+    for given, needed, partner, what in (
+            (every, trace, "--trace", "--every sets the ticks between traces"),
+            (fps, animate, "--animate FILE.gif", "--fps sets the animation's frames a second"),
+            (workers, many, "--runs N (or several worlds)", "-j sets the processes of --runs")):
+        if given is not None and not needed:
+            raise typer.BadParameter(f"{what}: add {partner}, or leave it out")
 
 
 def _checked_require(require: str | None) -> str | None:
