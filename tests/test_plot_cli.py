@@ -544,3 +544,22 @@ def test_an_output_whose_default_is_nan_is_not_said_to_have_none(tmp_path, capsy
     code, _, err = run(["plot", "surface", str(rules), "y", "--x", "x", "-n", "5"], capsys)
     assert code == 0 and "no rule sets `y` at 1 of 5 grid points and its default is nan" in err
     assert "no default" not in err
+
+
+@pytest.mark.parametrize("args", [
+    ["terms", "--title", "T"],
+    ["surface", "steering", "--x", "road", "--title", "T"],
+    ["rules", "road=78", "size=45", "position=4", "--title", "T"],
+    ["terms", "--width", "50", "-o", "t.png"],
+    ["terms", "--no-color", "-o", "t.png"],
+    ["rules", "road=78", "size=45", "position=4", "--width", "40", "-o", "r.png"],
+])
+def test_an_option_of_the_other_way_of_drawing_is_a_usage_error(args, capsys, tmp_path,
+                                                               monkeypatch):
+    """`--title` in the terminal, `--width` or `--color` with a picture, was ignored without a
+    word: exit 2, saying which way of drawing the option belongs to, and nothing drawn."""
+    monkeypatch.chdir(tmp_path)
+    code, out, err = run(["plot", *args], capsys)
+    assert code == 2 and out == "" and not list(tmp_path.iterdir()), err
+    said = " ".join(err.replace("│", " ").split())
+    assert ("names the picture" in said) if "--title" in args else ("terminal drawing" in said)

@@ -85,6 +85,20 @@ def _wants_picture(output: Optional[str], show: bool) -> bool:
     return output is not None or show
 
 
+def _one_way(output: Optional[str], show: bool, *, title: Optional[str] = None,
+             width: Optional[int] = None, color: Optional[bool] = None) -> None:
+    """An option of the other way of drawing is a usage error: `--title` in the terminal, or
+    `--width` / `--color` with a picture, was ignored without a word."""
+    if _wants_picture(output, show):
+        for name, given in (("--width", width), ("--color/--no-color", color)):
+            if given is not None:
+                raise typer.BadParameter(f"{name} shapes the terminal drawing; -o and --show "
+                                         f"draw a picture: leave {name} out")
+    elif title is not None:
+        raise typer.BadParameter("--title names the picture: add -o FILE.png (or --show), or "
+                                 "leave --title out")
+
+
 def _done(output: Optional[str], no_window: Optional[str] = None) -> None:
     if output is not None:
         err(f"wrote {output}")
@@ -154,6 +168,7 @@ def terms_command(
     from ..draw.data import sheet
     from ..resources import display_path
 
+    _one_way(output, show, title=title, width=width, color=color)
     path, texts = split_args(args or [])
     rulebase = read_rulebase(path)
     values = parse_values(texts)
@@ -282,6 +297,7 @@ def surface_command(
     from ..draw.data import surface
 
     style = choice(Style, style_name, "style")
+    _one_way(output, show, title=title)
     path, out_name = _surface_args(args or [])
     rb = load_rulebase(path, behavior)
     if out_name is None:
@@ -328,9 +344,10 @@ def rules_command(
     max_rules: Annotated[int, typer.Option(
         "--max-rules", min=1, max=500,
         help="Draw at most this many fired rules (the strongest).")] = 30,
-    width: Annotated[int, typer.Option(
+    width: Annotated[Optional[int], typer.Option(
         "--width", min=30, max=400,
-        help="Width in characters of a Mamdani output's plot in the text viewer.")] = 72,
+        help="Width in characters of a Mamdani output's plot in the text viewer "
+             "(default 72).")] = None,
     color: ColorOpt = None,
 ) -> None:
     """Rule viewer: each fired rule with its memberships, DOF and consequent.
@@ -340,6 +357,7 @@ def rules_command(
     from ..api import load_rulebase
     from ..draw.data import rule_view
 
+    _one_way(output, show, title=title, width=width, color=color)
     path, texts = split_args(args or [])
     rb = load_rulebase(path, behavior)
     if not texts:
@@ -353,7 +371,7 @@ def rules_command(
     if not _wants_picture(output, show):
         from ..draw.terminal import render_rule_view
 
-        emit(render_rule_view(view, width=width, color=_use_color(color)))
+        emit(render_rule_view(view, width=width or 72, color=_use_color(color)))
         return
     from ..draw.rules import draw_rules
 
