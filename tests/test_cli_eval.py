@@ -858,6 +858,21 @@ def test_a_fired_rule_concluding_a_term_between_the_sample_points_is_told(capsys
     assert "tip = 14.3" in out and "undersampled" not in err and "warning" not in err
 
 
+def test_a_fidelity_that_changes_nothing_says_so(capsys):
+    """`--fidelity matlab` on a weighted-average rule base (nothing sampled) gave the same
+    numbers without a word, as if MATLAB's sampling had been applied and agreed."""
+    sample = ["road=78", "size=45", "position=4"]
+    code, plain, _ = run_main(["eval", *sample], capsys)
+    code, out, err = run_main(["eval", *sample, "--fidelity", "matlab"], capsys)
+    assert code == 0 and out == plain
+    assert ("warning: --fidelity matlab changes nothing here: behavior `avoid_obstacle` infers "
+            "by weighted_average, and only Mamdani outputs are sampled") in err
+    tipper = str(ROOT / "tests" / "data" / "interop" / "tipper.fis")
+    code, _, err = run_main(["eval", tipper, "service=2", "food=1", "--fidelity", "matlab"],
+                            capsys)
+    assert code == 0 and "changes nothing" not in err
+
+
 def test_the_batch_tells_it_once_too(capsys, tmp_path):
     fis = _narrow_cheap(tmp_path)
     csv = tmp_path / "in.csv"

@@ -226,8 +226,12 @@ def _loaded(path: str | None, behavior: str | None, fidelity):
         return rb
     from ..interop.common import fidelity_settings
 
-    return LoadedRuleBase(rb.rulebase, behavior,
-                          fidelity_settings(rb.rulebase, fidelity.value, behavior))
+    settings = fidelity_settings(rb.rulebase, fidelity.value, behavior)
+    if not settings:                  # it changed nothing, and nothing said so
+        warn(f"--fidelity {fidelity.value} changes nothing here: behavior `{rb.compiled.behavior}` "
+             f"infers by {rb.compiled.operators.inference}, and only Mamdani outputs are "
+             f"sampled")
+    return LoadedRuleBase(rb.rulebase, behavior, settings)
 
 
 def _names_file(word: str) -> bool:
