@@ -319,6 +319,22 @@ def test_export_cli(tmp_path: Path) -> None:
     assert result.exit_code == 2 and "not a C identifier" in result.output
 
 
+def test_a_prefix_for_python_is_a_usage_error(tmp_path: Path) -> None:
+    """`--to python --prefix foo` wrote the module without a word: a Python module has no C
+    names. `--prefix ''` stays "not a C identifier"."""
+    from typer.testing import CliRunner
+
+    runner = CliRunner()
+    out = tmp_path / "t.py"
+    result = runner.invoke(app, ["export", str(DATA / "tipper.fis"), "--to", "python",
+                                 "--prefix", "foo", "-o", str(out)])
+    assert result.exit_code == 2 and not out.exists()
+    assert "--prefix names the C code" in " ".join(result.output.replace("│", " ").split())
+    result = runner.invoke(app, ["export", str(DATA / "tipper.fis"), "--to", "c",
+                                 "--prefix", ""])
+    assert result.exit_code == 2 and "not a C identifier" in result.output
+
+
 @needs_cc
 def test_c_export_agrees_with_mitos_eval_command(tmp_path: Path) -> None:
     """The same numbers as the command a user runs: `mitos eval ... --json`."""

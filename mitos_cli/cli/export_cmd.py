@@ -33,9 +33,9 @@ def export_command(
              "stdout).")] = None,
     behavior: Annotated[Optional[str], typer.Option(
         "--behavior", "-b", callback=named, help="Behavior to export (default: the file's first).")] = None,
-    prefix: Annotated[str, typer.Option(
-        "--prefix", help="C names: PREFIX_eval, PREFIX_IN_<INPUT>, PREFIX_OUT_<OUTPUT>.")
-    ] = "mitos",
+    prefix: Annotated[Optional[str], typer.Option(
+        "--prefix", help="C names: PREFIX_eval, PREFIX_IN_<INPUT>, PREFIX_OUT_<OUTPUT> "
+                         "(default: mitos); --to c only.")] = None,
 ) -> None:
     """Export a rule base as code that computes its outputs from its inputs.
 
@@ -51,6 +51,10 @@ def export_command(
     to = choice(Language, to_name, "export language")
     if output is not None:
         check_suffix(output, SUFFIX[to], f"--to {to.value}")
+    if prefix is not None and to is not Language.c:      # it was ignored without a word
+        raise typer.BadParameter(f"--prefix names the C code's functions and macros; --to "
+                                 f"{to.value} has none: leave --prefix out")
+    prefix = "mitos" if prefix is None else prefix
     if not ident(prefix) == prefix:
         raise typer.BadParameter(f"--prefix `{prefix}` is not a C identifier")
     rb = load_rulebase(path, behavior)
