@@ -454,7 +454,7 @@ def test_a_surface_of_many_fixed_inputs_wraps_its_title_and_warns_of_nothing(tmp
     with warnings.catch_warnings():
         warnings.simplefilter("error")            # matplotlib's "constrained_layout not applied"
         code, _, err = run(["plot", "surface", "steering", "--x", "size", "-b", "drive", "-n", "5",
-                            "--style", "heatmap", "-o", str(out)], capsys)
+                            "-o", str(out)], capsys)         # a curve: no --style
     assert code == 0, err
     assert "Warning" not in err and out.read_bytes().startswith(PNG)
 
@@ -547,6 +547,8 @@ def test_an_output_whose_default_is_nan_is_not_said_to_have_none(tmp_path, capsy
 
 
 @pytest.mark.parametrize("args", [
+    ["surface", "steering", "--x", "road", "--y", "position", "--style", "heatmap"],
+    ["surface", "steering", "--x", "road", "--style", "heatmap", "-o", "c.png"],
     ["terms", "--title", "T"],
     ["surface", "steering", "--x", "road", "--title", "T"],
     ["rules", "road=78", "size=45", "position=4", "--title", "T"],
@@ -562,4 +564,6 @@ def test_an_option_of_the_other_way_of_drawing_is_a_usage_error(args, capsys, tm
     code, out, err = run(["plot", *args], capsys)
     assert code == 2 and out == "" and not list(tmp_path.iterdir()), err
     said = " ".join(err.replace("│", " ").split())
-    assert ("names the picture" in said) if "--title" in args else ("terminal drawing" in said)
+    assert ("names the picture" in said if "--title" in args else
+            "a picture of two inputs" in said if "--style" in args else
+            "terminal drawing" in said)

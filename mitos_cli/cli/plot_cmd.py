@@ -281,9 +281,10 @@ def surface_command(
              "midpoint of their universe, with a note).")] = None,
     resolution: Annotated[int, typer.Option(
         "--resolution", "-n", min=2, max=1000, help="Grid points per axis.")] = 61,
-    style_name: Annotated[str, typer.Option(
+    style_name: Annotated[Optional[str], typer.Option(
         "--style", metavar=choices(Style), autocompletion=completer(Style),
-        help="3-D surface or heat map with contours (two inputs).")] = Style.surface.value,
+        help="3-D surface (the default) or heat map with contours: a picture of two inputs "
+             "(--y, with -o or --show).")] = None,
     output: OutputOpt = None,
     show: ShowOpt = False,
     title: TitleOpt = None,
@@ -296,8 +297,11 @@ def surface_command(
     from ..api import load_rulebase
     from ..draw.data import surface
 
-    style = choice(Style, style_name, "style")
+    style = choice(Style, style_name or Style.surface.value, "style")
     _one_way(output, show, title=title)
+    if style_name is not None and (y is None or not _wants_picture(output, show)):
+        raise typer.BadParameter("--style chooses how a picture of two inputs is drawn: add "
+                                 "--y and -o FILE.png (or --show), or leave --style out")
     path, out_name = _surface_args(args or [])
     rb = load_rulebase(path, behavior)
     if out_name is None:
