@@ -350,6 +350,23 @@ def test_run_many_says_what_is_wrong_with_its_arguments(kwargs, says):
         run_many(world)          # type: ignore[arg-type]
 
 
+def test_a_misspelt_outcome_or_figure_of_the_runs_is_named():
+    """rate("sucess") was 0.0, a rate of a run that may all have succeeded; stat("time") a
+    KeyError."""
+    from mitos_cli.errors import InputError
+    from mitos_cli.sim import run_many
+
+    runs = run_many([short("corridor.yaml", 0.2)], runs=2, seed=1, workers=1).worlds[0]
+    assert runs.rate("timeout") == 1.0 and runs.count("success") == 0
+    for call, says in ((lambda: runs.rate("sucess"), "did you mean `success`?"),
+                       (lambda: runs.count(None), "unknown outcome `None`"),
+                       (lambda: runs.stat("time"), "did you mean `time_s`?"),
+                       (lambda: runs.stat("world"), "unknown figure `world`")):
+        with pytest.raises(InputError, match=re.escape(says)):
+            call()
+    assert runs.stat("time_s") == (0.2, 0.0)
+
+
 @pytest.mark.parametrize("command, says", [
     ("fast", "not `'fast'`"),
     (5.0, "not `5.0`"),                 # (None is no command: the planner drives)

@@ -16,7 +16,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import InputError, MitosError
+from ..errors import InputError, MitosError, unknown
 from ..numbers import whole_number
 from .lockstep import batch_for, finished
 from .loop import OUTCOMES, ROBOT_OUTCOMES, check_seed, shared_scene
@@ -67,12 +67,24 @@ class WorldRuns:
     outcomes: tuple[str, ...] = OUTCOMES       # whose rates figures() gives (a robot: + stopped)
 
     def count(self, outcome: str) -> int:
+        """Runs that ended in ``outcome``; a name not among :attr:`outcomes` is an
+        :class:`InputError` with a "did you mean" (``rate("sucess")`` was a silent 0.0)."""
+        if not isinstance(outcome, str) or outcome not in self.outcomes:
+            raise unknown("outcome", f"{outcome!s:.40}", self.outcomes, cls=InputError)
         return sum(s["outcome"] == outcome for s in self.summaries)
 
     def rate(self, outcome: str) -> float:
         return self.count(outcome) / len(self.summaries)
 
     def stat(self, key: str) -> tuple[float, float]:
+        """The mean and sample standard deviation of figure ``key`` over the runs; a name that
+        is no figure of theirs is an :class:`InputError` with a "did you mean" (it was a
+        ``KeyError``)."""
+        figures = ([k for k, v in self.summaries[0].items()
+                    if isinstance(v, (int, float, np.number)) and not isinstance(v, bool)]
+                   if self.summaries else list(METRICS))
+        if not isinstance(key, str) or key not in figures:
+            raise unknown("figure", f"{key!s:.40}", figures, cls=InputError)
         x = np.array([s[key] for s in self.summaries], dtype=float)
         return float(x.mean()), float(x.std(ddof=1)) if len(x) > 1 else 0.0
 
