@@ -108,6 +108,18 @@ def test_state_between_ticks_and_a_users_planner():
         sim.step()
 
 
+def test_the_state_between_ticks_is_a_copy_of_the_record():
+    """sim.clearance was the recorded tick's own array: writing into it (a reward shaped in
+    place) changed the run's min_clearance_in, 8.2 in to 14.1 in, and the contact check."""
+    world = short("corridor.yaml", 3.0)
+    sim = Simulation(world, seed=1)
+    while not sim.done:
+        sim.step()
+        for state in (sim.clearance, sim.pose, sim.speed, sim.steering, sim.progress):
+            state[...] = 1000.0
+    same_run(sim.result(), simulate(world, seed=1))
+
+
 def test_the_verdicts_end_the_run():
     world = load_world(packaged_path("worlds", "figure4.yaml"))     # collides at B
     sim = Simulation(world)

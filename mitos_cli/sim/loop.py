@@ -532,10 +532,12 @@ class Simulation:
     @property
     def clearance(self) -> np.ndarray:
         """``[n]`` each robot's clearance (in) where it stands: of the tick observed, else of
-        the last tick recorded (``inf`` before the first is observed)."""
+        the last tick recorded (``inf`` before the first is observed). A copy, as the other
+        state is: the recorded tick's own array was given, and writing into it changed the
+        run's clearance and the next tick's contact check."""
         if self._observed is not None:
-            return self._observed.clearance
-        return self.record[-1].clearance if self.record else np.full(self.n, math.inf)
+            return self._observed.clearance.copy()
+        return self.record[-1].clearance.copy() if self.record else np.full(self.n, math.inf)
 
     @property
     def done(self) -> bool:
