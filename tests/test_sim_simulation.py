@@ -239,6 +239,19 @@ def test_a_seed_that_is_not_a_whole_number_of_0_or_more_is_refused(seed):
         Simulation(world).reset(seed)
 
 
+@pytest.mark.parametrize("randomise", ["no", 0, None, np.array([False])])
+def test_randomise_that_is_not_a_bool_is_refused(randomise):
+    """simulate(world, randomise="no") ran randomised: any true value was taken."""
+    from mitos_cli.errors import InputError
+
+    world = short("corridor.yaml", 0.2)
+    with pytest.raises(InputError, match="randomise is True or False"):
+        simulate(world, seed=1, randomise=randomise)
+    with pytest.raises(InputError, match="randomise is True or False"):
+        Simulation(world, randomise=randomise)
+    same_run(simulate(world, seed=1, randomise=np.False_), simulate(world, seed=1))
+
+
 def test_numpy_and_huge_seeds_are_the_runs_of_their_value():
     world = short("moving.yaml", 0.5)
     same_run(simulate(world, seed=np.int64(5), randomise=True),

@@ -380,7 +380,7 @@ class Simulation:
 
             planner = FuzzyPlanner(None, world.behavior)
         self.planner = _check_planner(planner)
-        self.randomise = randomise
+        self.randomise = _check_randomise(randomise)
         self._given_world, self._given_scene = world, scene
         self.reset(seed)
 
@@ -1846,6 +1846,16 @@ def _check_planner(planner: Planner) -> Planner:
                  "`plan(percepts)`")
     raise InputError(f"a planner is an object with a `plan(percepts)` method, not "
                      f"{type(planner).__name__} `{planner!r:.60}`", hint=hint)
+
+
+def _check_randomise(randomise: object) -> bool:
+    """``randomise`` if it is ``True`` or ``False``; else an :class:`InputError` (``"no"``
+    was true: a randomised run where the world as written was asked for, without a word)."""
+    if isinstance(randomise, (bool, np.bool_)):
+        return bool(randomise)
+    raise InputError(f"randomise is True or False, not `{randomise!r:.40}`",
+                     hint="randomise=True draws obstacle places and sensor noise from the "
+                          "world's randomise: ranges, as `mitos simulate --randomise`")
 
 
 def _planned(given: Any, who: str) -> tuple[Any, Any]:
