@@ -210,8 +210,8 @@ class MitosEnv(gymnasium.Env):
             obs = self._observe()
             if sim.ending:                  # contact or arrival: the run ends at this tick
                 sim.step(command)
-        else:
-            obs = self._last_obs
+        else:                               # no tick past the end: the last one perceived
+            obs = _copied(self._last_obs)
         left = self._left()
         reward = PROGRESS_REWARD * (self._remaining - left)
         self._remaining = left
@@ -305,6 +305,15 @@ class MitosEnv(gymnasium.Env):
         return {"t": round(sim.time, 6), "pose": sim.pose[0],
                 "clearance": float(sim.clearance[0]),
                 "outcome": sim.robot_outcomes[0] if sim.done else "driving"}
+
+
+def _copied(obs: Any) -> Any:
+    """A copy of an observation given already: the step that ends an episode at the time limit
+    returned the very array (or dict) of the step before, so writing into that one (an
+    in-place normalisation, a buffer's row) changed the final observation too."""
+    if isinstance(obs, dict):
+        return {key: value.copy() for key, value in obs.items()}
+    return obs.copy()
 
 
 def _begun(trail: list[np.ndarray] | None, call: str) -> list[np.ndarray]:

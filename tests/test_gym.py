@@ -161,6 +161,23 @@ def test_the_step_that_ends_an_episode_is_timed_as_every_other(short_world):
     assert env.unwrapped.sim.result().summary()["time_s"] == info["t"]
 
 
+@pytest.mark.parametrize("observe_ranges", [False, True])
+def test_the_observation_at_the_time_limit_is_not_the_step_befores_object(short_world,
+                                                                          observe_ranges):
+    """At the time limit no tick is perceived past the end, and the step returned the very
+    observation of the step before: a policy normalising that one in place changed the last
+    one too (out of its space)."""
+    env = gymnasium.make("mitos/World-v0", world=str(short_world), observe_ranges=observe_ranges)
+    seen, _, _, truncated, info = drive(env, seed=1, policy=lambda obs: np.array([90.0, 10.0]))
+    assert truncated and info["outcome"] == "timeout"
+    before, last = seen[-2], seen[-1]
+    for key in (("inputs", "ranges") if observe_ranges else (None,)):
+        a, b = (before[key], last[key]) if key else (before, last)
+        assert np.array_equal(a, b) and not np.shares_memory(a, b)
+        a[...] = -1.0
+    assert env.observation_space.contains(last)
+
+
 def test_the_same_seed_gives_the_same_observations_and_another_seed_others(short_world):
     env = gymnasium.make("mitos/World-v0", world=str(short_world), observe_ranges=True)
     a = drive(env, seed=7)[0]
