@@ -406,6 +406,9 @@ def _command(action) -> np.ndarray:
                            hint="give numbers: True and False would be read as 1 and 0")
     try:
         command = np.asarray(action, dtype=np.float64)
+    except OverflowError:               # (an int past a float's range: 10**400)
+        raise CommandError("the action must be finite numbers: one is too large for a float",
+                           expected="numbers of magnitude at most 1.8e308") from None
     except (TypeError, ValueError):
         command = None
     if command is None or command.size != 2:

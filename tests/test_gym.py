@@ -276,6 +276,17 @@ def test_an_action_holding_a_bool_is_refused(action):
     assert env.unwrapped.sim.ticks == 0
 
 
+def test_an_action_past_a_floats_range_is_refused_and_the_episode_goes_on():
+    """step([90, 10**400]) met NumPy's bare OverflowError ("int too large to convert")."""
+    from mitos_cli.errors import CommandError
+
+    env = gymnasium.make("mitos/Corridor-v0")
+    env.reset(seed=1)
+    with pytest.raises(CommandError, match="the action must be finite numbers: one is too large"):
+        env.step([90.0, 10**400])
+    assert env.step([90.0, 10.0])[4]["t"] == 0.05
+
+
 def test_fuzzy_policy_of_a_batch_says_it_takes_one_observation():
     from mitos_cli.errors import InputError
 

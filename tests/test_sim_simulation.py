@@ -413,6 +413,26 @@ def test_a_command_that_is_not_numbers_is_a_command_error(command, says):
     assert sim.ticks == 0
 
 
+def test_a_command_past_a_floats_range_is_a_command_error():
+    """10**400 in a command given from outside, or returned by a planner, met NumPy's bare
+    OverflowError ("int too large to convert to float")."""
+    from mitos_cli.errors import CommandError
+
+    class Huge:
+        name = "huge"
+
+        def plan(self, p):
+            return [10**400], [10.0]
+
+    sim = Simulation(short("corridor.yaml", 1.0))
+    for command in ([[10**400, 20.0]], [90.0, -10**5000]):
+        with pytest.raises(CommandError, match="the command must be finite numbers .* too large"):
+            sim.step(command)
+    assert sim.ticks == 0
+    with pytest.raises(CommandError, match="planner `huge` must be finite numbers .* too large"):
+        simulate(short("corridor.yaml", 1.0), Huge())
+
+
 @pytest.mark.parametrize("written", [720.0, -1080.0, 360.0])
 def test_a_start_heading_past_a_half_turn_is_recorded_within_it(written):
     """A start written as 720 deg was recorded as 720 at tick 0 (`--out`'s pose_heading_deg,

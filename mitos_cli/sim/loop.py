@@ -653,6 +653,8 @@ class Simulation:
                                hint="give numbers: True and False would be read as 1 and 0")
         try:
             given = np.asarray(command, float)
+        except OverflowError:           # (an int past a float's range: 10**400)
+            raise _too_large("the command") from None
         except (TypeError, ValueError):
             given = None
         if given is None or given.size != 2 * self.n:
@@ -1107,6 +1109,8 @@ class Simulation:
             c_steer, c_speed = _planned(self.planner.plan(sub), self._planner_name)
             try:
                 cmd[idx, 0], cmd[idx, 1] = c_steer, c_speed
+            except OverflowError:
+                raise _too_large(f"the command of {self._planner_name}") from None
             except (TypeError, ValueError):
                 raise CommandError(f"{self._planner_name} gave {np.shape(c_steer)} steering and "
                                  f"{np.shape(c_speed)} speed values for "
@@ -1890,6 +1894,13 @@ def _kind(value: object) -> str:
     if isinstance(value, (list, tuple)):
         return f"{name} of {plural(len(value), 'item')}"
     return f"{name} `{value!r:.40}`"
+
+
+def _too_large(what: str) -> CommandError:
+    """The refusal of a command holding an int past a float's range (``10**400``), which
+    NumPy's conversion met with a bare ``OverflowError``."""
+    return CommandError(f"{what} must be finite numbers (steering deg, speed in/s): one is too "
+                        f"large for a float", expected="numbers of magnitude at most 1.8e308")
 
 
 def _finite(command: np.ndarray, what: str) -> np.ndarray:
