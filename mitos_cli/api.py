@@ -81,13 +81,16 @@ def _read_by_extension(path: Path) -> RuleBase:
 
 def _path_given(path: object) -> str | Path:
     """``path`` if it can name a file; else a :class:`RuleBaseError` saying what is taken
-    (``load_rulebase(3)`` met pathlib's TypeError)."""
-    if isinstance(path, str):
+    (``load_rulebase(3)`` met pathlib's TypeError; ``""`` was read as ``.``, "a directory")."""
+    if isinstance(path, str) and path:
         return path
     if isinstance(path, os.PathLike):
         return Path(path)
     from .errors import RuleBaseError
 
+    if path == "":
+        raise RuleBaseError("the rule base's name is empty",
+                            hint="give a rule file's path, or None for the packaged one")
     raise RuleBaseError(f"a rule base is read from a file: expected a path or a packaged rule "
                         f"base's name, not {type(path).__name__} `{path!r:.60}`",
                         hint="load_rulebase('rulebases/mitos.rules'), or load_rulebase() for "
@@ -96,8 +99,9 @@ def _path_given(path: object) -> str | Path:
 
 def _behavior_given(rulebase: RuleBase, name: object) -> str | None:
     """``name`` if it can name a behavior (``None``: the first); else the unknown-behavior
-    error with the behaviors' names (an int met "'int' object is not iterable" inside)."""
-    if name is None or isinstance(name, str):
+    error with the behaviors' names (an int met "'int' object is not iterable" inside; ``""``
+    compiled the first behavior, as ``None`` does)."""
+    if name is None or isinstance(name, str) and name:
         return name
     from .errors import unknown
 

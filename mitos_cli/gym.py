@@ -128,7 +128,7 @@ class MitosEnv(gymnasium.Env):
         self.render_mode = render_mode
         self.observe_ranges = observe_ranges
         self.metadata = {**self.metadata, "render_fps": round(1.0 / loaded.dt)}
-        self.fuzzy = FuzzyPlanner(rulebase, behavior or loaded.behavior)
+        self.fuzzy = FuzzyPlanner(rulebase, loaded.behavior if behavior is None else behavior)
         compiled = self.fuzzy.compiled
         self.input_names: tuple[str, ...] = tuple(compiled.inputs)
         self._lo = np.ascontiguousarray(compiled.universe[:, 0], dtype=np.float64)

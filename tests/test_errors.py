@@ -524,6 +524,26 @@ def test_a_behavior_that_is_not_text_is_an_unknown_behavior(rb, name, close):
     assert rb.behavior("drive") is rb.behavior("drive")      # still compiled once
 
 
+def test_an_empty_rule_base_or_behavior_name_is_refused(rb):
+    """load_rulebase("") said "`.` is a directory", a path never given, and a behavior ""
+    compiled the first behavior, as None does."""
+    exc = error_of(lambda: load_rulebase(""), RuleBaseError)
+    assert exc.message == "the rule base's name is empty"
+    for call in (lambda: rb.behavior(""), lambda: load_rulebase(None, "")):
+        assert error_of(call, NameError_).message == "unknown behavior `''`"
+
+
+def test_a_planner_of_a_rule_base_that_is_not_one_says_what_it_takes():
+    """FuzzyPlanner(3) (and a Gymnasium environment's rulebase=3) met "'int' object has no
+    attribute 'behavior'"."""
+    from mitos_cli.sim import FuzzyPlanner
+
+    for rulebase in (3, 2.5, ["mitos.rules"]):
+        exc = error_of(lambda: FuzzyPlanner(rulebase), RuleBaseError)
+        assert exc.message.startswith("a rule base is read from a file: expected a path")
+    assert FuzzyPlanner(load_rulebase().rulebase).name == "fuzzy:drive"
+
+
 def test_no_rule_fired_without_default(tmp_path):
     terms = TERMS.replace("    default: 90\n", "")
     path = write(tmp_path, "r1: if road is WIDE then steering is RS and speed is SLOW", terms)

@@ -287,6 +287,17 @@ def test_an_action_past_a_floats_range_is_refused_and_the_episode_goes_on():
     assert env.step([90.0, 10.0])[4]["t"] == 0.05
 
 
+def test_a_rulebase_or_behavior_the_environment_cannot_read_says_so():
+    """rulebase=3 met "'int' object has no attribute 'behavior'"; behavior="" drove the
+    world's behavior, as if none were given."""
+    from mitos_cli.errors import NameError_, RuleBaseError
+
+    with pytest.raises(RuleBaseError, match="a rule base is read from a file"):
+        gymnasium.make("mitos/Corridor-v0", rulebase=3)
+    with pytest.raises(NameError_, match="unknown behavior `''`"):
+        gymnasium.make("mitos/Corridor-v0", behavior="")
+
+
 def test_fuzzy_policy_of_a_batch_says_it_takes_one_observation():
     from mitos_cli.errors import InputError
 

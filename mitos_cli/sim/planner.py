@@ -110,14 +110,15 @@ class FuzzyPlanner:
 
     def __init__(self, rulebase=None, behavior: str = "drive") -> None:
         from ..api import LoadedRuleBase, load_rulebase
+        from ..lang.model import RuleBase
 
-        if rulebase is None or isinstance(rulebase, (str, bytes)) or hasattr(rulebase, "__fspath__"):
-            loaded = load_rulebase(rulebase, behavior)
-        elif isinstance(rulebase, LoadedRuleBase):
+        if isinstance(rulebase, LoadedRuleBase):
             loaded = rulebase if rulebase.compiled.behavior == behavior else \
                 rulebase.behavior(behavior)
-        else:
+        elif isinstance(rulebase, RuleBase):
             loaded = LoadedRuleBase(rulebase, behavior)
+        else:           # a path, None (the packaged one); anything else load_rulebase refuses
+            loaded = load_rulebase(rulebase, behavior)   # (3 met "'int' has no 'behavior'")
         self.loaded = loaded
         self.compiled = loaded.compiled
         self.name = f"fuzzy:{self.compiled.behavior}"
