@@ -233,8 +233,7 @@ class MitosEnv(gymnasium.Env):
             return None
         trail = _begun(self._trail, "render")
         sim = self.sim
-        pose = sim.record[-1].pose[0] if sim.record else sim.pose[0]
-        obstacles = sim.record[-1].obstacles if sim.record else np.zeros((0, 2))
+        pose, obstacles = self._shown()
         if self.render_mode == "human" and self._live is not None:
             self._live.update(0, self._state())
             return None
@@ -256,8 +255,8 @@ class MitosEnv(gymnasium.Env):
                 self._live.update(0, self._state())
                 return None
         if self.render_mode == "rgb_array":
-            return self._frame.rgb(pose, obstacles, trail, sim.time)
-        self._frame.update(pose, obstacles, trail, sim.time)
+            return self._frame.rgb(pose, obstacles, trail, sim.time, sim.routes)
+        self._frame.update(pose, obstacles, trail, sim.time, sim.routes)
         import matplotlib.pyplot as plt
 
         plt.pause(0.001)
@@ -289,6 +288,17 @@ class MitosEnv(gymnasium.Env):
         measured its progress along the old route)."""
         sim = self.sim
         return max(0.0, sim.routes[0].length - float(sim.progress[0]))
+
+    def _shown(self) -> tuple[np.ndarray, np.ndarray]:
+        """The robot's pose and the obstacles' places a frame shows: of the tick the last
+        observation perceived (the frame drew the tick before it, one ``dt`` behind the
+        observation, ``info`` and its own title), else of the last tick the run recorded."""
+        sim = self.sim
+        if not sim.done and sim.observed:
+            return sim.pose[0], sim.observe().where
+        if sim.record:
+            return sim.record[-1].pose[0], sim.record[-1].obstacles
+        return sim.pose[0], np.zeros((0, 2))
 
     def _state(self) -> dict:
         sim = self.sim

@@ -57,6 +57,25 @@ def test_animate_writes_a_gif_of_the_run(short_world, tmp_path):
     assert not list(tmp_path.glob(".*.part.*"))
 
 
+def test_each_frame_shows_the_route_as_planned_at_its_tick(tmp_path, monkeypatch):
+    """The animation drew the first route to the end: past detour's replan (at 8.65 s), the
+    dashed line still ran through the stack the robot had turned back from."""
+    from mitos_cli.draw import animation
+    from mitos_cli.sim import load_world, simulate
+
+    text = packaged_path("worlds", "detour.yaml").read_text(encoding="utf-8")
+    path = tmp_path / "detour10.yaml"
+    path.write_text(text.replace("time_limit: 90", "time_limit: 10"), encoding="utf-8")
+    result = simulate(load_world(path))
+    (tick, _, replanned), = result.replanned
+    shown = []
+    monkeypatch.setattr(animation, "show_routes", lambda lines, routes: shown.append(routes[0]))
+    animate_run(result, tmp_path / "run.gif", fps=0.5)
+    picked = frame_ticks(result.ticks, result.world.dt, 0.5)
+    assert [route is replanned for route in shown] == [k >= tick for k in picked]
+    assert shown[-1] is replanned and shown[0] is result.routes[0]
+
+
 def test_animate_refuses_other_formats_and_many_runs(short_world, tmp_path, capsys):
     code, err = run_main(capsys, short_world, "--animate", tmp_path / "a.avi")
     # an extension the option does not take is a usage error, as --plot's (README)

@@ -220,6 +220,34 @@ def test_rgb_array_shows_the_robot(short_world):
     env.close()
 
 
+def test_a_frame_is_of_the_tick_observed_with_the_route_as_replanned(tmp_path):
+    """The frame drew the robot and the obstacles one tick behind the observation, `info` and
+    its own title, and the first route to the end (through the stack detour's robot turned
+    back from at 8.65 s)."""
+    from mitos_cli.sim.geometry import rect_corners
+
+    text = packaged_path("worlds", "detour.yaml").read_text(encoding="utf-8")
+    path = tmp_path / "detour10.yaml"
+    path.write_text(text.replace("time_limit: 90", "time_limit: 10"), encoding="utf-8")
+    env = gymnasium.make("mitos/World-v0", world=str(path), render_mode="rgb_array")
+    obs, _ = env.reset(seed=4)
+    u = env.unwrapped
+    while u.sim.routes[0] is u.sim.scene.routes[0]:          # until it replans
+        obs, _, _, _, info = env.step(u.fuzzy_policy(obs))
+    env.render()
+    frame = u._frame
+    x, y, heading = info["pose"]
+    robot = u.world.agents[0].robot
+    assert np.allclose(frame._robot.get_xy()[:4],
+                       rect_corners(x, y, np.deg2rad(heading), robot.length, robot.width))
+    where = u.sim.observe().where
+    assert all(np.allclose(patch.get_xy()[:4], rect_corners(
+        *where[j], np.deg2rad(o.angle), o.length, o.width))
+        for j, (o, patch) in enumerate(frame._obstacles))
+    assert np.array_equal(frame._routes[0].get_xydata(), u.sim.routes[0].points)
+    env.close()
+
+
 def test_rgb_array_draws_a_dollar_in_the_worlds_name_as_written(short_world):
     # the frame's texts went to matplotlib's mathtext, which stopped on `$x^$`
     text = short_world.read_text(encoding="utf-8")

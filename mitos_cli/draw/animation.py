@@ -19,7 +19,7 @@ import numpy as np
 
 from ..errors import InputError, WriteError
 from ..numbers import whole_number
-from .frame import OBSTACLE_COLOUR, ROBOT_COLOUR, TRAIL_COLOUR, draw_background
+from .frame import OBSTACLE_COLOUR, ROBOT_COLOUR, TRAIL_COLOUR, draw_background, show_routes
 from .output import DrawError, _matplotlib, literal_text, new_figure
 
 FORMATS = ("gif", "mp4")
@@ -112,7 +112,7 @@ def animate_run(result, path: str | Path, *, fps: float = 10.0, detail=None,
     ax.set_aspect("equal")
     ax.set_axis_off()
     ax.set_facecolor("#d9d9d9")
-    draw_background(ax, world, static, result.routes)
+    route_lines = draw_background(ax, world, static, result.routes)
     ax.set_xlim(xmin - pad, xmax + pad)
     ax.set_ylim(ymin - pad, ymax + pad)
     title = fig.text(0.01, 1.0 - 0.17 / fh, "", fontsize=10, va="center")
@@ -159,6 +159,8 @@ def animate_run(result, path: str | Path, *, fps: float = 10.0, detail=None,
     def draw(k: int):
         t = result.t[k]
         title.set_text(f"{world.name}   t = {t:5.2f} s   ({result.planner})")
+        if result.replanned:                # each robot's route as it was at tick k
+            show_routes(route_lines, [result.route_at(k, i) for i in range(len(route_lines))])
         for (o, patch), (cx, cy) in zip(obstacles, result.obstacles[k].reshape(-1, 2)):
             if isinstance(patch, Circle):
                 patch.set_center((cx, cy))

@@ -38,7 +38,7 @@ class RunFrame:
         ax.set_axis_off()
         ax.set_facecolor("#d9d9d9")
         self.fig.patch.set_facecolor("#d9d9d9")
-        draw_background(ax, world, static, routes)
+        self._routes = draw_background(ax, world, static, routes)
         self._obstacles = []
         for o in world.obstacles:
             patch = (Circle((o.x, o.y), o.radius) if o.shape == "circle"
@@ -57,11 +57,15 @@ class RunFrame:
         ax.set_ylim(ymin - pad, ymax + pad)
         literal_text(self.fig)          # a world's name or label is drawn as written
 
-    def update(self, pose, obstacles, trail, t: float | None = None) -> None:
-        """Move the artists to this moment."""
+    def update(self, pose, obstacles, trail, t: float | None = None, routes=None) -> None:
+        """Move the artists to this moment; ``routes``, the robots' routes now (a replan
+        changes them; the frame showed the first ones to the end)."""
         from matplotlib.patches import Circle
 
         from ..sim.geometry import rect_corners
+
+        if routes is not None:
+            show_routes(self._routes, routes)
 
         x, y, h = (float(v) for v in pose)
         self._robot.set_xy(rect_corners(x, y, np.deg2rad(h), *self._size))
@@ -75,9 +79,9 @@ class RunFrame:
         if t is not None:
             self._title.set_text(f"{self.world.name}  t = {t:5.2f} s")
 
-    def rgb(self, pose, obstacles, trail, t: float | None = None) -> np.ndarray:
+    def rgb(self, pose, obstacles, trail, t: float | None = None, routes=None) -> np.ndarray:
         """The frame as ``uint8 [H, W, 3]``."""
-        self.update(pose, obstacles, trail, t)
+        self.update(pose, obstacles, trail, t, routes)
         canvas = self.fig.canvas
         canvas.draw()
         return np.asarray(canvas.buffer_rgba())[..., :3].copy()
@@ -91,8 +95,15 @@ class RunFrame:
             plt.close(self.fig)
 
 
-def draw_background(ax, world, static, routes) -> None:
-    """What does not move: free space, walls, the routes and the goals."""
+def show_routes(lines: list, routes) -> None:
+    """Move each robot's route line (:func:`draw_background`'s) to its route now."""
+    for line, route in zip(lines, routes):
+        line.set_data(route.points[:, 0], route.points[:, 1])
+
+
+def draw_background(ax, world, static, routes) -> list:
+    """What does not move but the routes: free space, walls, the routes (whose lines it
+    returns: a replan moves them, :func:`show_routes`) and the goals."""
     from matplotlib.collections import LineCollection
     from matplotlib.patches import Circle, Polygon
 
@@ -102,8 +113,9 @@ def draw_background(ax, world, static, routes) -> None:
         ax.add_patch(Polygon(corners, closed=True, facecolor="white", edgecolor="none"))
     ax.add_collection(LineCollection(static.walls.reshape(-1, 2, 2), colors="black",
                                      linewidths=1.0))
-    for route in routes:
-        ax.plot(route.points[:, 0], route.points[:, 1], ls="--", lw=0.7, color="#4a78b5")
+    lines = [ax.plot(route.points[:, 0], route.points[:, 1], ls="--", lw=0.7,
+                     color="#4a78b5")[0] for route in routes]
     for agent in world.agents:
         ax.add_patch(Circle((agent.goal.x, agent.goal.y), agent.goal.tolerance, fill=False,
                             edgecolor="#2f6b2f", lw=1.0, ls="--"))
+    return lines
