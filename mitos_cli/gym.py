@@ -156,7 +156,7 @@ class MitosEnv(gymnasium.Env):
 
     def fuzzy_policy(self, observation) -> np.ndarray:
         """The rule base's command for ``observation``: what ``mitos simulate`` would do."""
-        x = observation["inputs"] if isinstance(observation, dict) else observation
+        x = _inputs_of(observation)
         from .engine.evaluation import evaluate_one
 
         out = evaluate_one(self.fuzzy.compiled, self._row(x))
@@ -315,6 +315,19 @@ class MitosEnv(gymnasium.Env):
         return {"t": round(sim.time, 6), "pose": sim.pose[0],
                 "clearance": float(sim.clearance[0]),
                 "outcome": sim.robot_outcomes[0] if sim.done else "driving"}
+
+
+def _inputs_of(observation: object) -> object:
+    """The inputs of an observation: itself, or a ``Dict`` observation's ``inputs`` (a dict
+    without them met a bare ``KeyError: 'inputs'``)."""
+    if not isinstance(observation, dict):
+        return observation
+    if "inputs" not in observation:
+        keys = ", ".join(f"`{k!s:.20}`" for k in list(observation)[:5]) or "none"
+        raise InputError(f"an observation given as a dict holds `inputs` (and `ranges`), not "
+                         f"keys {keys}",
+                         hint="give it the observation reset() or step() returned")
+    return observation["inputs"]
 
 
 def _copied(obs: Any) -> Any:

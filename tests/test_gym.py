@@ -411,6 +411,17 @@ def test_fuzzy_policy_refuses_an_observation_that_is_not_numbers():
         env.unwrapped.fuzzy_policy(record)
 
 
+def test_fuzzy_policy_of_a_dict_without_inputs_says_what_it_holds():
+    """{"x": 1} met a bare KeyError: 'inputs'."""
+    from mitos_cli.errors import InputError
+
+    env = gymnasium.make("mitos/Corridor-v0", observe_ranges=True)
+    obs, _ = env.reset(seed=1)
+    with pytest.raises(InputError, match=r"holds `inputs` \(and `ranges`\), not keys `ranges`"):
+        env.unwrapped.fuzzy_policy({"ranges": obs["ranges"]})
+    assert np.array_equal(env.unwrapped.fuzzy_policy(obs), env.unwrapped.fuzzy_policy(obs["inputs"]))
+
+
 @pytest.mark.parametrize(("seed", "says"), [
     (-1, "a seed must be 0 or more, not -1"),
     (np.int64(-2), "a seed must be 0 or more, not -2"),
