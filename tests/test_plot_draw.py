@@ -4,6 +4,8 @@ rule. No pixels are compared."""
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 
@@ -304,3 +306,40 @@ def test_a_lone_sample_where_no_rule_fires_is_hatched(tmp_path):
         covered = [any(lo <= xi <= hi for lo, hi in spans) for xi in x]
         assert covered == mask.tolist() and all(hi > lo for lo, hi in spans)
         assert len(by_gid(draw_surface(curve), "no-rule")) == len(spans)
+
+
+def test_the_library_drawings_say_what_is_wrong_with_their_arguments(mitos, tmp_path):
+    """A path that is not one met pathlib's TypeError, an unknown style a bare ValueError, an
+    empty sheet max()'s "empty sequence", and surface()'s resolution 10.5 or "10", a held
+    value "abc" or None and a range not a pair TypeErrors and ValueErrors from inside."""
+    from mitos_cli.draw.animation import animate_run
+    from mitos_cli.draw.world import draw_run
+    from mitos_cli.errors import InputError
+    from mitos_cli.sim import Simulation, load_world
+
+    sim = Simulation(load_world("corridor"), seed=1)
+    sim.step()
+    with pytest.raises(DrawError, match="a picture is written to a file: expected a path, not "
+                                        "int `3`"):
+        draw_run(sim.result(), 3)
+    with pytest.raises(DrawError, match="an animation is written to a file"):
+        animate_run(sim.result(), None)
+    c = mitos.compiled
+    surface = plotdata.surface(c, "steering", "road", "position", resolution=5)
+    with pytest.raises(InputError, match="unknown style `heat`") as exc:
+        draw_surface(surface, tmp_path / "s.png", style="heat")
+    assert exc.value.hint == "did you mean `heatmap`?"
+    with pytest.raises(InputError, match="a sheet draws at least one variable"):
+        draw_sheet([])
+    for kwargs, says in (({"resolution": 10.5}, "resolution is a whole number, 2 or more"),
+                         ({"resolution": "10"}, "resolution is a whole number, 2 or more"),
+                         ({"fixed": {"size": "abc"}}, "the value held for `size` must be a"),
+                         ({"fixed": {"size": None}}, "the value held for `size` is None"),
+                         ({"x_range": (1, 2, 3)}, "the range of `road` is a pair (low, high)"),
+                         ({"x": 3}, "unknown input (--x) `3`")):
+        with pytest.raises(InputError, match=re.escape(says)):
+            plotdata.surface(c, "steering", **{"x": "road", **kwargs})
+    with pytest.raises(InputError, match="must be a number, not `abc`"):
+        plotdata.variable_plot(mitos.rulebase.variables["road"], "abc")
+    with pytest.raises(InputError, match="names is a list of variable names, not the text"):
+        plotdata.sheet(mitos.rulebase, "road")

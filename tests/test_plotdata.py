@@ -221,7 +221,7 @@ def test_surface_masks_where_no_rule_fires_and_no_default(gap):
     (dict(output="steering", x="road", fixed={"road": 3}), "on an axis and cannot also be fixed"),
     (dict(output="steering", x="road", fixed={"size": 400}), "outside its universe"),
     (dict(output="steering", x="road", x_range=(50, 300)), "is not inside its universe"),
-    (dict(output="steering", x="road", resolution=1), "resolution must be at least 2"),
+    (dict(output="steering", x="road", resolution=1), "resolution is a whole number, 2 or more"),
 ])
 def test_surface_errors(mitos, kwargs, message):
     with pytest.raises(InputError) as exc:

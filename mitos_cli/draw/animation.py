@@ -20,7 +20,7 @@ import numpy as np
 from ..errors import InputError, WriteError
 from ..numbers import whole_number
 from .frame import OBSTACLE_COLOUR, ROBOT_COLOUR, TRAIL_COLOUR, draw_background, show_routes
-from .output import DrawError, _matplotlib, literal_text, new_figure
+from .output import DrawError, _matplotlib, file_path, literal_text, new_figure
 
 FORMATS = ("gif", "mp4")
 BARS = 8                    # fired rules shown, by DOF
@@ -33,7 +33,7 @@ WIDTH_PX = (100, 4000)
 
 def check_format(path: str | Path) -> str:
     """``gif`` or ``mp4`` by the extension (mp4 only where ffmpeg is found)."""
-    suffix = Path(path).suffix.lower().lstrip(".")
+    suffix = file_path(path, "an animation").suffix.lower().lstrip(".")
     if suffix not in FORMATS:
         raise DrawError(f"cannot write `{path}`: unknown animation format "
                         f"`{suffix or '(no extension)'}`",

@@ -26,9 +26,19 @@ class DrawError(MitosError):
     kind = "error"
 
 
+def file_path(path: object, what: str = "a picture") -> Path:
+    """``path`` as a :class:`Path`, else a :class:`DrawError` saying what is taken
+    (``draw_run(result, 3)`` met pathlib's "expected str, bytes or os.PathLike object")."""
+    if isinstance(path, (str, os.PathLike)):
+        return Path(path)
+    raise DrawError(f"{what} is written to a file: expected a path, not "
+                    f"{type(path).__name__} `{path!r:.40}`",
+                    hint="give the file's name, such as 'run.png'")
+
+
 def check_format(path: str | Path) -> str:
     """The format of ``path`` by its extension; :class:`DrawError` unless png or svg."""
-    suffix = Path(path).suffix.lower().lstrip(".")
+    suffix = file_path(path).suffix.lower().lstrip(".")
     if suffix not in FORMATS:
         raise DrawError(f"cannot write `{path}`: unknown picture format "
                         f"`{suffix or '(no extension)'}`",
@@ -101,7 +111,7 @@ def finish(fig, path: str | Path | None = None, show: bool = False, dpi: int = 1
     it when asked; ``tight`` trims the margins (one more layout pass). Returns the figure."""
     literal_text(fig)
     if path is not None:
-        path = Path(path)
+        path = file_path(path)
         fmt = check_format(path)
         import matplotlib
 

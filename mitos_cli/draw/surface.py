@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..errors import InputError, unknown
 from .data import Surface
 from .output import finish, new_figure
 
@@ -145,8 +146,8 @@ def draw_surface3d(fig, ax, s: Surface) -> None:
 def draw_surface(s: Surface, path: str | Path | None = None, *, style: str = "surface",
                  title: str | None = None, show: bool = False):
     """Draw ``s`` (a curve when it has one input) to ``path`` (.png/.svg) and/or a window."""
-    if style not in STYLES:
-        raise ValueError(f"style must be one of {STYLES}, not {style!r}")
+    if style not in STYLES:         # (a bare ValueError, without a "did you mean")
+        raise unknown("style", f"{style!s:.40}", STYLES, cls=InputError)
     if s.y is None:
         fig = new_figure((7.0, 4.2), show, layout="constrained")
         ax = fig.subplots()

@@ -14,7 +14,9 @@ from pathlib import Path
 
 import numpy as np
 
+from ..errors import InputError
 from ..lang.terms import Variable
+from ..numbers import whole_number
 from .data import VariablePlot, variable_plot, visible
 from .output import finish, literal_text, new_figure
 
@@ -156,6 +158,11 @@ def draw_sheet(plots: Sequence[VariablePlot], path: str | Path | None = None, *,
     of their own (the paper's Figures 5-7 above, 8-9 below), each row filling the width.
     Written to ``path`` (.png or .svg) and/or shown; returns the figure."""
     plots = list(plots)
+    if not plots:                   # (max() met an empty sequence)
+        raise InputError("a sheet draws at least one variable, and none was given",
+                         hint="sheet(rulebase) gives every variable's plot")
+    if (n := whole_number(columns)) is None or n < 1:
+        raise InputError(f"columns is a whole number, 1 or more, not `{columns!r:.40}`")
     rows: list[list[VariablePlot]] = []
     for group in ([p for p in plots if p.role == "input"],
                   [p for p in plots if p.role != "input"]):

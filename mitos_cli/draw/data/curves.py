@@ -136,8 +136,14 @@ def variable_plot(variable: Variable, value: float | None = None, *,
     mus: tuple[tuple[str, float], ...] = ()
     clamped = False
     if value is not None:
+        from ...engine.inputs import floats
+
         lo, hi = variable.universe
-        value = float(value)
+        marked = floats(value, f"the value marked on `{variable.name}`")   # ("abc": float())
+        if marked.ndim:
+            raise InputError(f"the value marked on `{variable.name}` is one number, not of "
+                             f"shape {marked.shape}")
+        value = float(marked)
         if np.isnan(value):
             raise InputError(f"`{variable.name}` must be a number, not NaN")
         clamped = not lo <= value <= hi
@@ -155,6 +161,9 @@ def sheet(rulebase: RuleBase, names: list[str] | None = None,
     only those ``behavior`` uses, or the ``names`` asked for; ``values`` marked. Unknown
     names get a "did you mean"."""
     variables = rulebase.variables
+    if isinstance(names, str):      # ("road" was read letter by letter: unknown variable `r`)
+        raise InputError(f"names is a list of variable names, not the text `{names:.40}`",
+                         hint=f"sheet(rulebase, [{names[:40]!r}])")
     values = dict(values or {})
     for name in list(names or []) + list(values):
         if name not in variables:

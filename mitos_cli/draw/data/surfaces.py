@@ -10,6 +10,7 @@ import numpy as np
 
 from ...engine.compile import CompiledRuleBase
 from ...errors import InputError, unknown
+from ...numbers import whole_number
 
 
 @dataclass(frozen=True)
@@ -81,6 +82,8 @@ def no_default_words(nan_default: bool) -> str:
 
 
 def _input_axis(compiled: CompiledRuleBase, name: str, what: str) -> int:
+    if not isinstance(name, str):   # (an int met difflib's "'int' object is not iterable")
+        raise unknown(f"input ({what})", f"{name!r:.40}", compiled.inputs, cls=InputError)
     if name in compiled.inputs:
         return compiled.inputs.index(name)
     known = [v.name for v in compiled.variables.values() if v.role == "input"]
@@ -88,6 +91,24 @@ def _input_axis(compiled: CompiledRuleBase, name: str, what: str) -> int:
         raise InputError(f"behavior `{compiled.behavior}` does not use input `{name}` ({what})",
                          expected="one of " + ", ".join(compiled.inputs))
     raise unknown(f"input ({what})", name, compiled.inputs, cls=InputError)
+
+
+def _number(value: object, what: str) -> float:
+    """``value`` as one float, else the engine's :class:`InputError` about ``what`` (text
+    met ``float()``'s ValueError, ``None`` its TypeError)."""
+    from ...engine.inputs import floats
+
+    x = floats(value, what)
+    if x.ndim:
+        raise InputError(f"{what} is one number, not of shape {x.shape}")
+    return float(x)
+
+
+def _pair(limits: object, what: str) -> tuple[float, float]:
+    """A zoom range ``(low, high)`` as two floats, else an :class:`InputError`."""
+    if not isinstance(limits, (tuple, list)) or len(limits) != 2:
+        raise InputError(f"{what} is a pair (low, high), not `{limits!r:.40}`")
+    return _number(limits[0], what), _number(limits[1], what)
 
 
 def _finite(what: str, values: tuple[float, ...], universe: tuple[float, float]) -> None:
@@ -114,10 +135,11 @@ def surface(compiled: CompiledRuleBase, output: str, x: str, y: str | None = Non
     """
     from ...engine.evaluation import declares_nan, evaluate
 
-    if output not in compiled.outputs:
-        raise unknown("output", output, compiled.outputs, cls=InputError)
-    if resolution < 2:
-        raise InputError(f"resolution must be at least 2, not {resolution}")
+    if not isinstance(output, str) or output not in compiled.outputs:
+        raise unknown("output", f"{output!s:.40}", compiled.outputs, cls=InputError)
+    if (n := whole_number(resolution)) is None or n < 2:     # (2.5 and "10" met TypeErrors)
+        raise InputError(f"resolution is a whole number, 2 or more, not `{resolution!r:.40}`")
+    resolution = n
     ix = _input_axis(compiled, x, "--x")
     iy = _input_axis(compiled, y, "--y") if y is not None else None
     if iy == ix:
@@ -132,8 +154,8 @@ def surface(compiled: CompiledRuleBase, output: str, x: str, y: str | None = Non
     def axis(k: int, limits: tuple[float, float] | None) -> Axis:
         lo, hi = compiled.universe[k]
         if limits is not None:
-            a, b = limits
             name = compiled.inputs[k]
+            a, b = _pair(limits, f"the range of `{name}`")
             _finite(f"range {a:g}:{b:g} of `{name}`", (a, b), (lo, hi))
             if a > b:
                 raise InputError(f"range {a:g}:{b:g} of `{name}` is reversed: LOW comes first",
@@ -157,7 +179,8 @@ def surface(compiled: CompiledRuleBase, output: str, x: str, y: str | None = Non
             continue
         var = compiled.variables[name]
         if name in fixed:
-            held.append(Fixed(name, float(fixed[name]), var.unit, False))
+            held.append(Fixed(name, _number(fixed[name], f"the value held for `{name}`"),
+                              var.unit, False))
         else:
             lo, hi = compiled.universe[k]
             held.append(Fixed(name, float((lo + hi) / 2), var.unit, True))
