@@ -40,3 +40,19 @@ def test_a_finished_run_prints_a_line_and_draws_itself():
         f"success after {(ticks - 1) * 0.05:g} s ({ticks} ticks)" in text
     pytest.importorskip("matplotlib")
     assert result._repr_png_().startswith(b"\x89PNG")
+
+
+def test_many_runs_print_a_line_each_not_every_summary():
+    """Runs and WorldRuns printed every run's summary: 1,000 runs were some 370,000
+    characters in a notebook."""
+    from mitos_cli.sim.runs import Runs, WorldRuns
+
+    summary = {"world": "tiny", "seed": 1, "outcome": "success", "time_s": 8.3}
+    world = WorldRuns("tiny", tuple({**summary, "seed": j} for j in range(1000)))
+    runs = Runs((world,) * 8)
+    for text in (repr(world), repr(runs)):
+        assert "\n" not in text and len(text) < 200, text
+    assert repr(world) == ("<WorldRuns 'tiny': 1,000 runs: success 100%, collision 0%, "
+                           "timeout 0%, stuck 0%>")
+    assert repr(runs).startswith("<Runs of 8 worlds: 'tiny' x 1000, ") and "(2 more)" in repr(runs)
+    assert repr(WorldRuns("none", ())) == "<WorldRuns 'none': 0 runs>"

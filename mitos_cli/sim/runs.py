@@ -18,6 +18,7 @@ import numpy as np
 
 from ..errors import InputError, MitosError, unknown
 from ..numbers import whole_number
+from ..words import plural
 from .lockstep import batch_for, finished
 from .loop import OUTCOMES, ROBOT_OUTCOMES, check_seed, shared_scene
 from .world import World
@@ -66,6 +67,11 @@ class WorldRuns:
     summaries: tuple[dict, ...]
     outcomes: tuple[str, ...] = OUTCOMES       # whose rates figures() gives (a robot: + stopped)
 
+    def __repr__(self) -> str:      # the generated one printed every run's summary
+        n = len(self.summaries)
+        rates = ", ".join(f"{o} {self.count(o) / n:.0%}" for o in self.outcomes) if n else ""
+        return f"<WorldRuns {self.world!r}: {plural(n, 'run')}{': ' + rates if rates else ''}>"
+
     def count(self, outcome: str) -> int:
         """Runs that ended in ``outcome``; a name not among :attr:`outcomes` is an
         :class:`InputError` with a "did you mean" (``rate("sucess")`` was a silent 0.0)."""
@@ -112,6 +118,11 @@ class WorldRuns:
 @dataclass(frozen=True)
 class Runs:
     worlds: tuple[WorldRuns, ...]
+
+    def __repr__(self) -> str:      # the generated one printed every run's summary
+        shown = ", ".join(f"{w.world!r} x {len(w.summaries)}" for w in self.worlds[:6])
+        more = f", ... ({len(self.worlds) - 6} more)" if len(self.worlds) > 6 else ""
+        return f"<Runs of {plural(len(self.worlds), 'world')}: {shown}{more}>"
 
     def to_json(self) -> list[dict]:
         out = []
