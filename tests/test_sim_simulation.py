@@ -120,6 +120,22 @@ def test_the_state_between_ticks_is_a_copy_of_the_record():
     same_run(sim.result(), simulate(world, seed=1))
 
 
+def test_a_route_given_out_cannot_be_changed_under_the_run():
+    """sim.routes[0].points was the array the robot followed: writing into it (to draw the
+    route turned, say) moved the route mid-run, and the corridor's run timed out."""
+    world = short("corridor.yaml", 3.0)
+    sim = Simulation(world, seed=1)
+    route = sim.routes[0]
+    for array in (route.points, route.cum, route.goal):
+        with pytest.raises(ValueError, match="read-only"):
+            array[...] = 0.0
+    turned = route.points.copy()
+    turned[:, 1] += 30.0                                 # a copy is the caller's to change
+    while not sim.done:
+        sim.step()
+    same_run(sim.result(), simulate(world, seed=1))
+
+
 def test_the_verdicts_end_the_run():
     world = load_world(packaged_path("worlds", "figure4.yaml"))     # collides at B
     sim = Simulation(world)

@@ -43,7 +43,12 @@ class Route:
         if len(pts) == 1:
             pts = np.vstack([pts, pts])
         cum = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(pts, axis=0).T))])
-        return cls(pts, cum, pts[-1].copy() if goal is None else np.asarray(goal, float))
+        end = pts[-1].copy() if goal is None else np.array(goal, float)
+        # read-only, as the dataclass is frozen: writing into `sim.routes[0].points` (to draw
+        # it turned, say) moved the route the robot was following, mid-run
+        for a in (pts, cum, end):
+            a.flags.writeable = False
+        return cls(pts, cum, end)
 
     @functools.cached_property
     def length(self) -> float:
