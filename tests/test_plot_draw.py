@@ -343,3 +343,17 @@ def test_the_library_drawings_say_what_is_wrong_with_their_arguments(mitos, tmp_
         plotdata.variable_plot(mitos.rulebase.variables["road"], "abc")
     with pytest.raises(InputError, match="names is a list of variable names, not the text"):
         plotdata.sheet(mitos.rulebase, "road")
+
+
+@pytest.mark.parametrize("style", ["heatmap", "surface"])
+def test_no_contour_runs_along_a_plateau_at_its_last_bit(mitos, style):
+    """speed over road x size is 40 across its top, computed as 40 in some cells and
+    40 + 1.4e-14 in others: a contour at 40 ran wherever the last bit changed, four stripes
+    labelled 40 across a flat region."""
+    from matplotlib.contour import ContourSet
+
+    s = plotdata.surface(mitos.compiled, "speed", "road", "size", fixed={"position": 4.0})
+    assert s.z.max() > 40.0 and np.isclose(s.z.max(), 40.0)          # the noise is there
+    fig = draw_surface(s, style=style)
+    (contours,) = [c for ax in fig.axes for c in ax.get_children() if isinstance(c, ContourSet)]
+    assert len(contours.levels) > 0 and max(contours.levels) < 40.0

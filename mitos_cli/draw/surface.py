@@ -71,6 +71,18 @@ def draw_curve(ax, s: Surface) -> None:
         ax.spines[side].set_visible(False)
 
 
+def settled(z: np.ndarray) -> np.ndarray:
+    """``z`` rounded to 10 significant digits of its largest value, for contouring: a plateau
+    the engine computes as 40 in one cell and 40 + 1.4e-14 in the next was crossed by
+    contour lines at 40 wherever the last bit changed (four stripes labelled 40 across the
+    flat top of the speed heat map)."""
+    finite = np.abs(z[np.isfinite(z)])
+    if not finite.size or not finite.max():
+        return z
+    digits = 9 - int(np.floor(np.log10(finite.max())))
+    return np.round(z, digits)
+
+
 def _levels(z: np.ndarray, n: int = 10) -> np.ndarray | None:
     finite = z[np.isfinite(z)]
     if finite.size == 0 or finite.min() == finite.max():
@@ -89,9 +101,11 @@ def draw_heatmap(fig, ax, s: Surface) -> None:
     ax.add_patch(_background(ax))
     mesh = ax.pcolormesh(X, Y, z, cmap=CMAP, shading="gouraud" if not z.mask.any() else "nearest",
                          rasterized=True)
-    levels = _levels(s.z)
+    flat = settled(s.z)
+    levels = _levels(flat)
     if levels is not None and len(levels):
-        cs = ax.contour(X, Y, z, levels=levels, colors="white", linewidths=0.8, alpha=0.9)
+        cs = ax.contour(X, Y, np.ma.masked_invalid(flat), levels=levels, colors="white",
+                        linewidths=0.8, alpha=0.9)
         ax.clabel(cs, fontsize=7.5, fmt="%g", inline=True)
     bar = fig.colorbar(mesh, ax=ax, pad=0.02)
     bar.set_label(s.label)
@@ -126,10 +140,11 @@ def draw_surface3d(fig, ax, s: Surface) -> None:
                            linewidth=0.15, edgecolor=(1, 1, 1, 0.25), antialiased=True,
                            rasterized=True)     # an SVG keeps one image, not 3,600 polygons
     if finite.size:
-        levels = _levels(s.z)
+        flat = settled(s.z)
+        levels = _levels(flat)
         if levels is not None and len(levels):
-            ax.contour(X, Y, z, levels=levels, zdir="z", offset=floor, cmap=CMAP,
-                       linewidths=0.8)
+            ax.contour(X, Y, np.ma.masked_invalid(flat), levels=levels, zdir="z", offset=floor,
+                       cmap=CMAP, linewidths=0.8)
     ax.set_zlim(floor, hi + 0.02 * (hi - lo))
     ax.set_xlabel(s.x.label, labelpad=8)
     ax.set_ylabel(s.y.label, labelpad=8)
