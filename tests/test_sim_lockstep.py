@@ -375,3 +375,28 @@ def test_a_result_of_ticks_recorded_otherwise_is_joined_tick_by_tick():
             if f == "block":
                 got = np.stack([got[k] for k in run.record[0].inputs], axis=1)
             assert np.asarray(got).tobytes() == value.tobytes(), f
+
+
+@pytest.mark.parametrize("call, says", [
+    (lambda w: run_lockstep(w, None, seeds=5), "seeds is a list of seeds, not int `5`"),
+    (lambda w: run_lockstep(w, None, seeds=None), "seeds is a list of seeds, not NoneType"),
+    (lambda w: run_lockstep(w, None, seeds=[-1]), "a seed is a whole number, 0 or more"),
+    (lambda w: run_lockstep(w, None, seeds=[1], batch=2.5), "batch is a whole number of runs"),
+    (lambda w: run_lockstep(w, None, seeds=[1], batch=0), "batch is a whole number of runs"),
+    (lambda w: run_lockstep("moving", None, seeds=[1]), "a simulation runs a loaded World"),
+    (lambda w: Lockstep("moving"), "a simulation runs a loaded World, not str `'moving'`"),
+    (lambda w: Lockstep(w, seeds=3), "seeds is a list of seeds, not int `3`"),
+])
+def test_run_lockstep_says_what_is_wrong_with_its_arguments(call, says):
+    """seeds=5 met "object of type 'int' has no len()", a path for the world "'str' object
+    has no attribute 'given'" (or 'behavior'), batch=2.5 range()'s TypeError, and batch=0
+    was taken as 1."""
+    import re
+
+    from mitos_cli.errors import InputError, WorldError
+
+    world = dataclasses.replace(load_world(packaged_path("worlds", "moving.yaml")),
+                                time_limit=0.2)
+    with pytest.raises((InputError, WorldError), match=re.escape(says)):
+        call(world)
+    assert len(run_lockstep(world, None, seeds=range(2), batch=1)) == 2

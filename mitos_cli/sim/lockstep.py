@@ -32,8 +32,10 @@ from collections.abc import Iterator, Sequence
 
 import numpy as np
 
+from ..errors import InputError
+from ..numbers import whole_number
 from . import knowledge, movers, perception, rows
-from .loop import Batch, Scene, SimResult, Simulation, row_spans, shared_scene
+from .loop import Batch, Scene, SimResult, Simulation, check_seed, check_world, row_spans, shared_scene
 from .planner import FuzzyPlanner, Planner
 from .world import World
 
@@ -60,6 +62,8 @@ class Lockstep:
     def __init__(self, world: World, planner: Planner | None = None,
                  seeds: Sequence[int] = (), *, randomise: bool = False,
                  scene: Scene | None = None) -> None:
+        check_world(world)              # (a path met "'str' object has no attribute ...")
+        seeds = seed_list(seeds)
         if planner is None:
             planner = FuzzyPlanner(None, world.behavior)
         self.planner = planner
@@ -259,11 +263,26 @@ def finished(world: World, planner: Planner | None, seeds: Sequence[int], *,
              batch: int | None = None) -> Iterator[tuple[int, SimResult]]:
     """The runs of ``world`` from ``seeds``, ``batch`` at a time in lockstep (default:
     :func:`batch_for`), each run's place among the seeds and its result as it ends."""
+    check_world(world)
+    seeds = seed_list(seeds)
+    if batch is not None and ((b := whole_number(batch)) is None or b < 1):
+        raise InputError(f"batch is a whole number of runs, 1 or more, not `{batch!r:.40}`",
+                         hint="leave it out: batch_for(world) sizes it")
     size = max(1, batch_for(world) if batch is None else batch)
     for i in range(0, len(seeds), size):
         for j, res in Lockstep(world, planner, seeds[i:i + size], randomise=randomise,
                                scene=scene).finished():
             yield i + j, res
+
+
+def seed_list(seeds: object) -> list[int]:
+    """``seeds`` as a list of seeds (each checked as :func:`.loop.check_seed` checks one),
+    else an :class:`InputError`: one seed not in a list met "object of type 'int' has no
+    len()"."""
+    if isinstance(seeds, (str, bytes)) or not hasattr(seeds, "__iter__"):
+        raise InputError(f"seeds is a list of seeds, not {type(seeds).__name__} "
+                         f"`{seeds!r:.40}`", hint="seeds=[1], or seeds=range(64)")
+    return [check_seed(seed) for seed in seeds]
 
 
 def run_lockstep(world: World, planner: Planner | None, seeds: Sequence[int], *,
@@ -272,6 +291,7 @@ def run_lockstep(world: World, planner: Planner | None, seeds: Sequence[int], *,
     """The runs of ``world`` from ``seeds``, ``batch`` at a time in lockstep (default:
     :func:`batch_for`): the same results, bit for bit, as ``[simulate(world, planner, s,
     randomise=randomise, scene=scene) for s in seeds]``."""
+    seeds = seed_list(seeds)
     out: list[SimResult | None] = [None] * len(seeds)
     for i, res in finished(world, planner, seeds, randomise=randomise, scene=scene,
                            batch=batch):

@@ -374,7 +374,7 @@ class Simulation:
 
     def __init__(self, world: World, planner: Planner | None = None, seed: int | None = None,
                  *, randomise: bool = False, scene: Scene | None = None) -> None:
-        _check_world(world)
+        check_world(world)
         if planner is None:
             from .planner import FuzzyPlanner
 
@@ -1822,7 +1822,7 @@ def check_seed(seed: object) -> int:
     return value
 
 
-def _check_world(world: object) -> None:
+def check_world(world: object) -> None:
     """A :class:`World` whose numbers a world file could hold, else a :class:`WorldError`
     saying how to get one (a path got as far as ``'str' object has no attribute 'behavior'``)
     or naming the field (a World changed in Python: :mod:`.worldcheck`)."""
