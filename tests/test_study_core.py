@@ -412,6 +412,21 @@ def test_a_choice_given_twice_is_refused(tmp_path):
         Choice("dwa"), Choice("fuzzy")]
 
 
+@pytest.mark.parametrize("choices, says", [
+    ([], "a Study needs at least one choice"),
+    (Choice("fuzzy"), "a Study's choices are a list of choices, not Choice"),
+    (["fuzzy"], "a Study's choices are choices, not str `'fuzzy'`"),
+    (None, "a Study's choices are a list of choices, not NoneType"),
+])
+def test_choices_that_are_not_a_list_of_choices_are_refused(choices, says):
+    """No choice ran 0 of 0 runs into a report that compared nothing (runs=0 is refused for
+    that); one Choice not in a list met "'Choice' object is not iterable", a name an
+    AttributeError later."""
+    with pytest.raises(MitosError) as exc:
+        Study(["w.yaml"], choices, runs=1, seed=1)
+    assert exc.value.message.startswith(says) and "make_choices" in exc.value.hint
+
+
 @pytest.mark.parametrize("name", ["results.csv", "study.json"])
 @pytest.mark.parametrize("resume", [False, True])
 def test_a_pipe_or_device_in_the_study_directory_is_refused(tmp_path, name, resume):

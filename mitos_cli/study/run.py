@@ -115,7 +115,17 @@ def _once(choices) -> list[Choice]:
     refused the results file it had written."""
     from ..errors import InputError
 
+    hint = "make_choices(['fuzzy'], ['min', 'product'], [], []) makes a list of them"
+    if isinstance(choices, (Choice, str, bytes)) or not hasattr(choices, "__iter__"):
+        raise InputError(f"a Study's choices are a list of choices, not {type(choices).__name__} "
+                         f"`{choices!r:.60}`", hint=hint)    # (one met "not iterable")
     out = list(choices)
+    if not out:                         # (0 of 0 runs, and a report that compared nothing)
+        raise InputError("a Study needs at least one choice", hint=hint)
+    for choice in out:
+        if not isinstance(choice, Choice):
+            raise InputError(f"a Study's choices are choices, not {type(choice).__name__} "
+                             f"`{choice!r:.60}`", hint=hint)
     for i, choice in enumerate(out):
         if choice in out[:i]:
             raise InputError(f"the choice `{choice.label}` is given twice",
