@@ -412,6 +412,15 @@ def test_a_choice_given_twice_is_refused(tmp_path):
         Choice("dwa"), Choice("fuzzy")]
 
 
+def test_write_report_takes_plots_true_or_false(tmp_path):
+    """plots="no" drew the pictures, as any true value did."""
+    from mitos_cli.study import write_report
+
+    with pytest.raises(MitosError, match="plots is True or False, not `'no'`"):
+        write_report(None, tmp_path, plots="no")          # type: ignore[arg-type]
+    assert not list(tmp_path.iterdir())
+
+
 @pytest.mark.parametrize("choices, says", [
     ([], "a Study needs at least one choice"),
     (Choice("fuzzy"), "a Study's choices are a list of choices, not Choice"),

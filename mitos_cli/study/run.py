@@ -250,9 +250,13 @@ def _scheduler_client(executor: str, scheduler: str | None, client, workers: int
 def write_report(outcome: Outcome, out_dir: str | Path, plots: bool = True) -> Path:
     """``report.md`` (and its plots ``success.png``, ``clearance.png``; without them, those
     of an earlier report are removed) in ``out_dir``."""
+    from ..errors import InputError
     from .report import render_markdown
     from .store import write_atomic
 
+    if not isinstance(plots, bool):     # ("no" drew them, as any true value did)
+        raise InputError(f"plots is True or False, not `{plots!r:.40}`",
+                         hint="plots=False writes report.md without its pictures")
     out = Path(out_dir)
     images: dict[str, str] = {}
     if plots and outcome.rows:
