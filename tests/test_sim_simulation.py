@@ -120,6 +120,28 @@ def test_the_state_between_ticks_is_a_copy_of_the_record():
     same_run(sim.result(), simulate(world, seed=1))
 
 
+def test_what_observe_and_step_hand_out_is_read_only():
+    """A tick's arrays and an observation's are the record: writing into them (tick.pose, the
+    ranges scaled in place) changed result(), and an observation's inputs what the planner
+    then decided (another run)."""
+    world = short("moving.yaml", 2.0)
+    sim = Simulation(world, seed=3, randomise=True)
+    while not sim.done:
+        seen = sim.observe()
+        for array in (seen.pose, seen.ranges, seen.clearance, seen.inputs["road"], seen.where):
+            with pytest.raises(ValueError, match="read-only"):
+                array[...] = 0.0
+        tick = sim.step()
+        for array in (tick.pose, tick.speed, tick.steering, tick.command, tick.ranges,
+                      tick.clearance, tick.obstacles, tick.active, tick.progress, tick.block):
+            with pytest.raises(ValueError, match="read-only"):
+                array[...] = 0
+    res = sim.result()
+    same_run(res, simulate(world, seed=3, randomise=True))
+    res.pose[...] = 0.0                                  # the result's arrays are the caller's
+    assert not np.array_equal(sim.result().pose, res.pose)
+
+
 def test_a_route_given_out_cannot_be_changed_under_the_run():
     """sim.routes[0].points was the array the robot followed: writing into it (to draw the
     route turned, say) moved the route mid-run, and the corridor's run timed out."""

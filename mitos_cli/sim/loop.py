@@ -597,6 +597,7 @@ class Simulation:
         """The last stage of :meth:`observe`, once ``s`` is sensed and perceived: the check;
         ``s`` is then this tick's observation."""
         self.check(s)
+        _read_only(s.where, s.pose, s.ranges, s.targets, s.clearance, s.block)
         self._observed = s
 
     @property
@@ -1194,6 +1195,7 @@ class Simulation:
         tick changes in place: the record keeps them)."""
         tick = Tick(self._k, s.t, pose, speed, steering, s.command, s.ranges, s.block,
                     s.clearance, s.where, active, progress)
+        _read_only(pose, speed, steering, s.command, active, progress)
         self.record.append(tick)
         return tick
 
@@ -1894,6 +1896,15 @@ def _kind(value: object) -> str:
     if isinstance(value, (list, tuple)):
         return f"{name} of {plural(len(value), 'item')}"
     return f"{name} `{value!r:.40}`"
+
+
+def _read_only(*arrays: np.ndarray) -> None:
+    """Make a tick's arrays read-only once observed or recorded: they are the record, and
+    what :meth:`Simulation.observe` and :meth:`Simulation.step` hand out. Writing into them
+    (``tick.pose``, an observation's ranges scaled in place) changed ``result()``, and an
+    observation's inputs what the planner then decided."""
+    for a in arrays:
+        a.flags.writeable = False
 
 
 def _too_large(what: str) -> CommandError:
