@@ -567,3 +567,20 @@ def test_an_option_of_the_other_way_of_drawing_is_a_usage_error(args, capsys, tm
     assert ("names the picture" in said if "--title" in args else
             "a picture of two inputs" in said if "--style" in args else
             "terminal drawing" in said)
+@pytest.mark.parametrize("backend, args, says", [
+    ("nonsense", ["-o", "x.png"], "matplotlib cannot use the backend `nonsense` that "
+                                  "MPLBACKEND names: not a backend matplotlib has"),
+    ("module://no_such_backend", ["--show"], "cannot open a window: matplotlib cannot use the "
+                                             "backend `module://no_such_backend`"),
+])
+def test_a_backend_matplotlib_cannot_use_is_said_without_a_traceback(backend, args, says,
+                                                                     tmp_path):
+    """MPLBACKEND=nonsense met matplotlib's ValueError on its import (a file asked for too),
+    and a backend module that is not there its ModuleNotFoundError at the first window."""
+    pytest.importorskip("matplotlib")
+    env = {**os.environ, "MPLBACKEND": backend, "DISPLAY": ":0"}
+    done = subprocess.run([sys.executable, "-m", "mitos_cli", "plot", "terms", "--var", "road",
+                           *args], capture_output=True, text=True, env=env, timeout=60,
+                          cwd=tmp_path)
+    assert done.returncode == 1 and "Traceback" not in done.stderr, done.stderr
+    assert says in done.stderr and "hint: unset MPLBACKEND" in done.stderr

@@ -52,7 +52,17 @@ def _matplotlib():
     except ImportError:
         raise DrawError("drawing pictures needs matplotlib, which is not installed",
                         hint="pip install 'mitos[plot]' (or pip install matplotlib)") from None
+    except ValueError:              # its import reads MPLBACKEND, and refuses a name it lacks
+        raise _bad_backend(os.environ.get("MPLBACKEND", "")) from None
     return matplotlib
+
+
+def _bad_backend(name: str, why: str = "not a backend matplotlib has") -> DrawError:
+    """The refusal of the backend the environment variable ``MPLBACKEND`` names (matplotlib
+    met it with a ValueError on import, or an ImportError when a window was asked for)."""
+    return DrawError(f"matplotlib cannot use the backend `{name:.60}` that MPLBACKEND names: "
+                     f"{why}", hint="unset MPLBACKEND, or set it to agg (files only) or a GUI "
+                                    "backend such as tkagg or qtagg")
 
 
 def require_matplotlib() -> None:
@@ -86,7 +96,12 @@ def new_figure(figsize: tuple[float, float], show: bool = False, **kwargs):
         if why is not None:
             raise DrawError(f"cannot open a window: {why}",
                             hint="write a file instead with -o FILE.png or -o FILE.svg")
-        return plt.figure(figsize=figsize, **kwargs)
+        try:
+            return plt.figure(figsize=figsize, **kwargs)
+        except ImportError as exc:      # the backend's module is loaded with the first window
+            raise DrawError(f"cannot open a window: "
+                            f"{_bad_backend(os.environ.get('MPLBACKEND', ''), str(exc)).message}",
+                            hint="unset MPLBACKEND, or write a file with -o FILE.png") from None
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
