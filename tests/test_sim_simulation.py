@@ -471,6 +471,27 @@ def test_a_command_past_a_floats_range_is_a_command_error():
         simulate(short("corridor.yaml", 1.0), Huge())
 
 
+@pytest.mark.parametrize("reach", [np.nan, np.inf, 1e308, -5.0, "far", True, 10**400],
+                         ids=["nan", "inf", "1e308", "-5", "text", "True", "10**400"])
+def test_a_path_reach_that_is_no_distance_is_named_with_the_planner(reach):
+    """NaN, infinity, 1e308, text or 10**400 met NumPy's arange ("cannot compute length",
+    "Maximum allowed size exceeded") or float()'s errors at the first tick; -5 gave an empty
+    path and True one of 1 in, without a word."""
+    from mitos_cli.errors import InputError
+
+    class Ahead:
+        name = "ahead"
+        path_reach = reach
+
+        def plan(self, p):
+            return np.full(len(p.pose), 90.0), np.full(len(p.pose), 10.0)
+
+    with pytest.raises(InputError, match="planner `ahead` asks for a `path_reach` of `"):
+        simulate(short("corridor.yaml", 0.2), Ahead())
+    Ahead.path_reach = 40
+    assert simulate(short("corridor.yaml", 0.2), Ahead()).ticks == 4
+
+
 @pytest.mark.parametrize("written", [720.0, -1080.0, 360.0])
 def test_a_start_heading_past_a_half_turn_is_recorded_within_it(written):
     """A start written as 720 deg was recorded as 720 at tick 0 (`--out`'s pose_heading_deg,

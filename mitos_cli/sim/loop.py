@@ -46,6 +46,7 @@ NEAR_SLACK = 24.0       # in: a robot's set of nearby walls is gathered again af
 #: in: the deepest contact the check between ticks may miss (:meth:`Simulation._between`)
 GRAZE = 0.01
 PATH_STEP = 4.0         # in: the spacing of the route points a planner is given (Percepts.path)
+PATH_REACH = 100_000.0  # in: the farthest `path_reach` a planner may ask for (25,000 points)
 OUTCOMES = ("success", "collision", "timeout", "stuck")
 # a robot's own outcome may also be `stopped`: still driving when another robot's collision or
 # stuck ended the run (the run's outcome is then that collision or stuck)
@@ -1126,7 +1127,7 @@ class Simulation:
         reach = getattr(self.planner, "path_reach", None)
         if reach is None:
             return None
-        ahead = np.arange(0.0, float(reach) + PATH_STEP / 2, PATH_STEP)
+        ahead = np.arange(0.0, _reach(reach, self._planner_name) + PATH_STEP / 2, PATH_STEP)
         return np.stack([self._routes[i].points_at(self._s_hint[i] + ahead) for i in idx])
 
     @property
@@ -1896,6 +1897,24 @@ def _kind(value: object) -> str:
     if isinstance(value, (list, tuple)):
         return f"{name} of {plural(len(value), 'item')}"
     return f"{name} `{value!r:.40}`"
+
+
+def _reach(reach: object, who: str) -> float:
+    """A planner's ``path_reach`` as inches from 0 to :data:`PATH_REACH`, else an
+    :class:`InputError` naming the planner: NaN, infinity, 1e308 or text met NumPy's
+    ``arange`` errors at the first tick, and a negative reach gave an empty path silently."""
+    value = math.nan
+    if isinstance(reach, (int, float, np.integer, np.floating)) and not isinstance(reach, bool):
+        try:
+            value = float(reach)
+        except OverflowError:           # (10**400)
+            value = math.inf
+    if not 0.0 <= value <= PATH_REACH:
+        raise InputError(f"{who} asks for a `path_reach` of `{reach!r:.40}`: the route ahead it "
+                         f"is given, in inches from 0 to {PATH_REACH:,.0f}",
+                         hint="set path_reach to a number of inches, or leave it out (None) "
+                              "for no path")
+    return value
 
 
 def _read_only(*arrays: np.ndarray) -> None:
