@@ -3,6 +3,8 @@ the formats refused with a clear message."""
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 from typer.testing import CliRunner
@@ -125,3 +127,25 @@ def test_one_frame_is_counted_in_the_singular(tmp_path):
     out = RUNNER.invoke(app, ["simulate", str(world), "--animate", str(gif)])
     assert out.exit_code == 0, out.output
     assert f"wrote 1 frame to {gif}" in out.output
+
+
+def test_a_detail_of_another_run_or_robot_is_refused(short_world, tmp_path):
+    """The DOF panel of another run was drawn under this run's frames without a word, and
+    explain(result, planner, robot=3) of a run of one robot met an IndexError."""
+    from mitos_cli.sim import load_world, simulate
+    from mitos_cli.sim.export import explain
+    from mitos_cli.sim.planner import FuzzyPlanner
+
+    result = simulate(load_world(short_world))
+    planner = FuzzyPlanner()
+    other = simulate(dataclasses.replace(load_world(short_world), time_limit=1.0))
+    with pytest.raises(InputError, match=r"detail has 20 rows, and the run 40 ticks: it is of "
+                                         r"another run"):
+        animate_run(result, tmp_path / "run.gif", detail=explain(other, planner))
+    with pytest.raises(InputError, match="detail is the engine's result for the run's ticks"):
+        animate_run(result, tmp_path / "run.gif", detail="dof")
+    with pytest.raises(InputError, match="robot is the index of one of the run's 1 robot"):
+        explain(result, planner, robot=3)
+    assert not (tmp_path / "run.gif").exists()
+    assert animate_run(result, tmp_path / "run.gif", fps=2.5,
+                       detail=explain(result, planner)) == 6

@@ -19,6 +19,7 @@ import numpy as np
 
 from ..errors import InputError, WriteError
 from ..numbers import whole_number
+from ..words import plural
 from .frame import OBSTACLE_COLOUR, ROBOT_COLOUR, TRAIL_COLOUR, draw_background, show_routes
 from .output import DrawError, _matplotlib, file_path, literal_text, new_figure
 
@@ -83,6 +84,24 @@ def check_width(width_px: object) -> int:
     return n
 
 
+def _check_detail(detail, ticks: int) -> None:
+    """``detail`` if it is an engine result of one row per tick of the run (``explain(result,
+    planner)``), else an :class:`InputError`: another run's drew its fired rules under this
+    one's frames without a word, and a shorter one met an IndexError."""
+    if detail is None:
+        return
+    dof = getattr(detail, "dof", None)
+    if dof is None or getattr(detail, "compiled", None) is None:
+        raise InputError(f"detail is the engine's result for the run's ticks, not "
+                         f"{type(detail).__name__} `{detail!r:.40}`",
+                         hint="detail=mitos_cli.sim.export.explain(result, planner)")
+    if len(dof) != ticks:
+        raise InputError(f"detail has {plural(len(dof), 'row')}, and the run "
+                         f"{plural(ticks, 'tick')}: it is of another run",
+                         hint="detail=mitos_cli.sim.export.explain(result, planner), of this "
+                              "result")
+
+
 def animate_run(result, path: str | Path, *, fps: float = 10.0, detail=None,
                 width_px: int = 720) -> int:
     """Write ``result`` as an animation to ``path``; ``detail`` is the planner's engine result
@@ -90,6 +109,7 @@ def animate_run(result, path: str | Path, *, fps: float = 10.0, detail=None,
     Returns the number of frames written."""
     fps, width_px = check_fps(fps), check_width(width_px)
     fmt = check_format(path)
+    _check_detail(detail, result.ticks)
     _matplotlib()
     from matplotlib import animation
     from matplotlib.collections import PolyCollection

@@ -12,6 +12,9 @@ import io
 
 import numpy as np
 
+from ..errors import InputError
+from ..numbers import whole_number
+from ..words import plural
 from .loop import SimResult
 from .perception import INPUTS
 
@@ -21,7 +24,11 @@ def explain(result: SimResult, planner, robot: int = 0):
     planner is not a rule base."""
     if not hasattr(planner, "explain"):
         return None
-    return planner.explain({k: v[:, robot] for k, v in result.perceived.items()})
+    robots = len(result.robot_outcomes)
+    if (i := whole_number(robot)) is None or not 0 <= i < robots:   # (3 met an IndexError)
+        raise InputError(f"robot is the index of one of the run's {plural(robots, 'robot')}, "
+                         f"0 to {robots - 1}, not `{robot!r:.40}`")
+    return planner.explain({k: v[:, i] for k, v in result.perceived.items()})
 
 
 def fired_text(detail, row: int, digits: int = 2) -> str:
