@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
+import dataclasses
 import sys
 
+import numpy as np
 import pytest
 
 from mitos_cli.cli.app import main
@@ -127,3 +129,19 @@ def test_a_large_map_is_drawn_in_blocks_that_keep_every_occupied_cell():
     assert (drawn < 1.0).sum() == 1 and drawn[-1, 3] < 1.0    # the occupied cell's block
     assert image.get_extent() == [-5.0, -5.0 + 30 * 2.0, 1.0, 1.0 + (DRAWN_CELLS + 2) * 2.0]
     plt.close(fig)
+
+
+@pytest.mark.parametrize("every", [np.nan, np.inf, -1.0, "1", True, 10**400],
+                         ids=["nan", "inf", "-1", "text", "True", "10**400"])
+def test_footprint_every_that_is_no_time_is_refused(every):
+    """NaN, infinity and 10**400 met int()'s and float()'s errors, text a TypeError, and -1
+    drew a footprint every tick without a word."""
+    from mitos_cli.draw.world import draw_run
+    from mitos_cli.errors import InputError
+    from mitos_cli.sim import load_world, simulate
+
+    result = simulate(dataclasses.replace(load_world("corridor"), time_limit=0.5))
+    with pytest.raises(InputError, match="footprint_every is a number of seconds, 0 or more"):
+        draw_run(result, footprint_every=every)
+    draw_run(result, footprint_every=1e308)              # one footprint: the first tick's
+    draw_run(result, footprint_every=0)                  # every tick

@@ -4,11 +4,13 @@ at intervals. Draws a finished :class:`~mitos_cli.sim.loop.SimResult`; never ste
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
+from ..errors import InputError
 from ..words import clearance
 from .output import _matplotlib, finish, new_figure
 
@@ -143,7 +145,7 @@ def draw_run(result, path: str | Path | None = None, *, footprint_every: float =
     tracked = _draw_obstacles(ax, result, marks)
     # one robot: its path coloured by speed; several: a colour and a legend entry each
     vmax = max(1.0, float(np.nanmax(result.speed)) if result.speed.size else 1.0)
-    every = max(1, int(round(footprint_every / world.dt)))
+    every = _every(footprint_every, world.dt)
     line = None
     for i, agent in enumerate(world.agents):
         line = _draw_robot(ax, result, i, agent, every, vmax, marks, tracked) or line
@@ -159,6 +161,24 @@ def draw_run(result, path: str | Path | None = None, *, footprint_every: float =
                  f"(seed {result.seed}, min clearance {clearance(m['min_clearance_in'])} in)",
                  fontsize=9)
     return finish(fig, path, show)
+
+
+def _every(seconds: object, dt: float) -> int:
+    """Ticks between drawn footprints, for one every ``seconds`` (0: every tick), else an
+    :class:`InputError` (NaN, infinity, 1e308 and text met ``int()``'s and ``round()``'s
+    errors; -1 drew one every tick without a word)."""
+    import numbers
+
+    value = math.nan
+    if isinstance(seconds, numbers.Real) and not isinstance(seconds, bool):
+        try:
+            value = float(seconds)
+        except OverflowError:           # (10**400)
+            value = math.inf
+    if not (math.isfinite(value) and value >= 0):
+        raise InputError(f"footprint_every is a number of seconds, 0 or more, not "
+                         f"`{seconds!r:.40}`", hint="footprint_every=1.0 draws one a second")
+    return max(1, int(round(min(value / dt, 1e9))))
 
 
 @dataclass(frozen=True)
