@@ -357,3 +357,16 @@ def test_no_contour_runs_along_a_plateau_at_its_last_bit(mitos, style):
     fig = draw_surface(s, style=style)
     (contours,) = [c for ax in fig.axes for c in ax.get_children() if isinstance(c, ContourSet)]
     assert len(contours.levels) > 0 and max(contours.levels) < 40.0
+
+
+def test_before_and_after_are_one_variable(mitos):
+    """road before and size after were drawn as one variable's terms moved, without a word;
+    None met an AttributeError."""
+    from mitos_cli.errors import InputError
+
+    road, size = mitos.rulebase.variables["road"], mitos.rulebase.variables["size"]
+    with pytest.raises(InputError, match="before and after are two variables, `road` and `size`"):
+        draw_terms_before_after(road, size, None)
+    with pytest.raises(InputError, match="a variable before and after is a Variable, not NoneType"):
+        draw_terms_before_after(road, None, None)
+    assert draw_terms_before_after(road, road, None) is not None

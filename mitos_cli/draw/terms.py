@@ -201,6 +201,14 @@ def draw_terms_before_after(variable_before: Variable, variable_after: Variable,
     Raises :class:`mitos_cli.draw.output.DrawError` (a ``MitosError``) for another extension
     or when matplotlib is missing.
     """
+    for given in (variable_before, variable_after):     # (None met an AttributeError)
+        if not isinstance(given, Variable):
+            raise InputError(f"a variable before and after is a Variable, not "
+                             f"{type(given).__name__} `{given!r:.40}`",
+                             hint="loaded.rulebase.variables['road'], before and after teach")
+    if variable_before.name != variable_after.name:     # (drawn as one moved, without a word)
+        raise InputError(f"before and after are two variables, `{variable_before.name}` and "
+                         f"`{variable_after.name}`: give the same variable twice")
     before = variable_plot(variable_before)
     after = variable_plot(variable_after)
     changes = []
