@@ -370,3 +370,19 @@ def test_before_and_after_are_one_variable(mitos):
     with pytest.raises(InputError, match="a variable before and after is a Variable, not NoneType"):
         draw_terms_before_after(road, None, None)
     assert draw_terms_before_after(road, road, None) is not None
+
+
+def test_the_rule_viewer_and_the_sheet_say_what_they_draw(mitos):
+    """draw_rules(view, max_rows="x") and 2.5 met TypeErrors, 0 and -1 were taken; a view or a
+    plot that is not one met AttributeErrors."""
+    from mitos_cli.errors import InputError
+
+    view = plotdata.rule_view(mitos.compiled, SAMPLE)
+    for most in ("x", 2.5, 0, -1, True, None):
+        with pytest.raises(InputError, match="max_rows is a whole number, 1 or more"):
+            draw_rules(view, max_rows=most)
+    with pytest.raises(InputError, match="draw_rules draws a RuleView, not NoneType"):
+        draw_rules(None)
+    with pytest.raises(InputError, match="a sheet draws VariablePlots, not NoneType"):
+        draw_sheet([None])
+    assert draw_rules(view, max_rows=2) is not None

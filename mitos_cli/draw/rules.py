@@ -20,6 +20,8 @@ from pathlib import Path
 
 import numpy as np
 
+from ..errors import InputError
+from ..numbers import whole_number
 from ..words import plural
 from .data import OutputView, RuleRow, RuleView
 from .output import finish, new_figure
@@ -170,7 +172,14 @@ def draw_rules(view: RuleView, path: str | Path | None = None, *, title: str | N
 
     With more than ``max_rows`` fired rules the strongest ``max_rows`` are drawn (in
     rule-base order) and the title says how many were left out."""
-    rows, hidden = _strongest(list(view.rows), max_rows)
+    if not isinstance(view, RuleView):          # (None met an AttributeError)
+        raise InputError(f"draw_rules draws a RuleView, not {type(view).__name__}",
+                         hint="rule_view(compiled, values) from mitos_cli.draw.data makes one")
+    # ("x" and 2.5 met TypeErrors inside; 0 and -1 were taken without a word)
+    if (most := whole_number(max_rows)) is None or most < 1:
+        raise InputError(f"max_rows is a whole number, 1 or more, not `{max_rows!r:.40}`",
+                         hint=f"max_rows={MAX_ROWS}, as --max-rules")
+    rows, hidden = _strongest(list(view.rows), most)
     used = {p.var for r in rows for p in r.props}
     inputs = [i for i in view.inputs if i.name in used] or list(view.inputs)
     outputs = list(view.outputs)

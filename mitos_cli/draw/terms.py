@@ -161,6 +161,10 @@ def draw_sheet(plots: Sequence[VariablePlot], path: str | Path | None = None, *,
     if not plots:                   # (max() met an empty sequence)
         raise InputError("a sheet draws at least one variable, and none was given",
                          hint="sheet(rulebase) gives every variable's plot")
+    if not all(isinstance(p, VariablePlot) for p in plots):     # (an AttributeError)
+        wrong = next(p for p in plots if not isinstance(p, VariablePlot))
+        raise InputError(f"a sheet draws VariablePlots, not {type(wrong).__name__} "
+                         f"`{wrong!r:.40}`", hint="sheet(rulebase) gives every variable's plot")
     if (n := whole_number(columns)) is None or n < 1:
         raise InputError(f"columns is a whole number, 1 or more, not `{columns!r:.40}`")
     rows: list[list[VariablePlot]] = []
