@@ -820,3 +820,24 @@ def test_not_adapted_names_the_frozen_input_terms_too(rules):
     text = say(s, out, "adapt epochs 30")
     assert ("not adapted: heading.FAR_LEFT is frozen; heading.LEFT is frozen; steering.LB is "
             "frozen") in text.splitlines()
+
+
+def test_a_journal_write_the_disk_took_half_of_is_taken_back(rules, tmp_path):
+    """A full disk (here: the file size limit) that took part of a change's line left the
+    half line, and the next change, appended after it, made one damaged line of both: the
+    resume refused the journal, and `--recover` dropped the change that was acknowledged."""
+    resource = pytest.importorskip("resource")
+    journal = Journal.create(tmp_path / "j")
+    s, _ = session(rules, journal=journal)
+    s.run("r27: if road is NARROW then steering is LB")
+    soft, hard = resource.getrlimit(resource.RLIMIT_FSIZE)
+    resource.setrlimit(resource.RLIMIT_FSIZE, (journal.path.stat().st_size + 30, hard))
+    try:
+        with pytest.raises(LessonError, match="the change was not made"):
+            s.run("r28: if road is WIDE then speed is FAST")
+    finally:
+        resource.setrlimit(resource.RLIMIT_FSIZE, (soft, hard))
+    s.run("r29: if road is MEDIUM then speed is MEDIUM")
+    again = Session.resume(Journal.open(tmp_path / "j"), out=[].append)
+    labels = [r.label for r in again.rulebase.behavior("avoid_obstacle").rules]
+    assert labels[-2:] == ["r27", "r29"] and again.rulebase == s.rulebase

@@ -13,6 +13,8 @@ state is the replay of the changes not undone.
 
 from __future__ import annotations
 
+import contextlib
+import errno
 import json
 import math
 import os
@@ -174,10 +176,7 @@ class Journal:
         entry = {"seq": self.next_seq, "op": op, **data}
         line = json.dumps(entry, ensure_ascii=False, separators=(",", ":")) + "\n"
         try:
-            with open(self.path, "a", encoding="utf-8") as fh:
-                fh.write(line)
-                fh.flush()
-                os.fsync(fh.fileno())
+            _append_line(self.path, line.encode("utf-8"))
         except OSError as exc:
             raise LessonError(f"cannot write the journal {self.path}: "
                               f"{exc.strerror or exc}; the change was not made") from None
@@ -198,6 +197,27 @@ class Journal:
         entries = self.entries if upto is None else [e for e in self.entries if e["seq"] <= upto]
         undone = {e["of"] for e in entries if e["op"] == "undo"}
         return [e for e in entries if e["seq"] not in undone and e["op"] not in RECORDS]
+
+
+def _append_line(path: Path, data: bytes) -> None:
+    """Append ``data`` whole and durably, or not at all: a write the disk could take only part
+    of (full, or over the size limit) is cut off again, since the next change appended after
+    its half line would be read as one damaged line, and `--recover` would drop it."""
+    with open(path, "ab", buffering=0) as fh:
+        start = os.fstat(fh.fileno()).st_size
+        try:
+            view = memoryview(data)
+            while view:
+                written = fh.write(view)
+                if not written:                 # (a regular file takes at least a byte)
+                    raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+                view = view[written:]
+            os.fsync(fh.fileno())
+        except OSError:
+            with contextlib.suppress(OSError):
+                fh.truncate(start)
+                os.fsync(fh.fileno())
+            raise
 
 
 #: the sessions this process holds (their lock files stay open until it exits)
