@@ -616,3 +616,55 @@ def test_a_file_where_the_directory_goes_is_said_to_be_one(rules, tmp_path):
             s.run(f"save {tmp_path / name}")
         assert info.value.message.endswith(f"`{tmp_path / 'notes.txt'}` is a file, not a directory")
     assert (tmp_path / "notes.txt").read_text() == "mine\n"
+
+
+def test_saving_over_the_original_twice_and_elsewhere_after_it(rules, tmp_path):
+    """A second save after a save over the original edited the file that save had written
+    against the rule base read before it, wrote its new rules twice, and was refused as "a
+    bug in MITOS": the session could save nothing more, under any name."""
+    s = Session(rules, out=[].append)
+    s.run("r27: if road is NARROW then speed is SLOW")
+    s.run(f"save {rules}")
+    s.run("r28: if road is WIDE then speed is FAST")
+    s.run(f"save {rules}")
+    s.run(f"save {tmp_path / 'other.rules'}")
+    for path in (rules, tmp_path / "other.rules"):
+        text = path.read_text()
+        assert text.count("r27:") == text.count("r28:") == 1
+        assert load_rules_file(path).behaviors == s.rulebase.behaviors
+
+
+def test_a_resumed_session_undoes_what_its_save_over_the_original_wrote(rules, tmp_path):
+    """--resume read the original as the session's own save had left it and applied the
+    journal over it again: it warned that the files had changed, and `undo` said a rule was
+    taken back that stayed in the rule base (and in the next save)."""
+    from mitos_cli.teach.journal import Journal
+
+    s = Session(rules, journal=Journal.create(tmp_path / "j"), out=[].append)
+    s.run("r27: if road is NARROW then speed is SLOW")
+    s.run("r28: if road is WIDE then speed is FAST")
+    s.run(f"save {rules}")
+    out: list[str] = []
+    again = Session.resume(Journal.open(tmp_path / "j"), out=out.append)
+    assert not any("changed since" in x for x in out)
+    again.run("undo")
+    assert [r.label for r in again.rulebase.behavior("avoid_obstacle").rules][-1] == "r27"
+    again.run("save")
+    assert "r28:" not in rules.read_text() and "r27:" in rules.read_text()
+
+
+def test_a_save_over_an_original_another_program_changed_is_refused(rules, tmp_path):
+    """Another program's change of the original since the session read it made every save
+    fail as "a bug in MITOS"; a save over it would undo that change, so it is refused and
+    says why, and a save under another name writes the session's rule base."""
+    s = Session(rules, out=[].append)
+    s.run("r27: if road is NARROW then speed is SLOW")
+    edited = rules.read_text().replace("then steering is RM and speed is MEDIUM",
+                                       "then steering is RB and speed is SLOW", 1)
+    rules.write_text(edited)
+    with pytest.raises(LessonError, match="changed since this session read them") as err:
+        s.run(f"save {rules}")
+    assert "mitos teach --resume" in err.value.hint
+    assert rules.read_text() == edited
+    s.run(f"save {tmp_path / 'taught.rules'}")
+    assert load_rules_file(tmp_path / "taught.rules").behaviors == s.rulebase.behaviors

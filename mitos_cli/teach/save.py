@@ -16,7 +16,6 @@ updated; saving over the original rule file rewrites its term sets in place.
 
 from __future__ import annotations
 
-import codecs
 import contextlib
 import json
 import os
@@ -39,6 +38,71 @@ from ..words import plural
 NUMBER = re.compile(r"[-+]?(?:\d[\d_]*\.?\d*|\.\d+)(?:[eE][-+]?\d+)?")
 #: a plain YAML scalar such as ``true`` (up to a space, comma, ``}`` or comment)
 SCALAR = re.compile(r"[^\s,}#]*")
+
+
+@dataclass(frozen=True)
+class Sources:
+    """The texts a session's rule base was read from: the rule file and its term sets (in the
+    order it names them), as they were, byte-order mark and line breaks kept.
+
+    ``save`` edits these, not the files as they are when it runs: a first `save` over the
+    original rule file put its new rules in the file, and the next save, editing that file
+    against the rule base read before, wrote them twice (refused as "a bug in MITOS": the
+    session could not save again). Kept in the journal's start, they let ``--resume`` read
+    the rule base as the session began, so that `undo` takes back what a save wrote."""
+
+    rules: str
+    terms: tuple[str, ...]
+
+    @classmethod
+    def read(cls, rb: RuleBase) -> Sources:
+        """The files of ``rb`` (read from its path) as they are now."""
+        src = Path(rb.path or "")
+        return cls(src.read_bytes().decode("utf-8"),
+                   tuple((src.parent / rel).read_bytes().decode("utf-8")
+                         for rel in rb.termset_paths))
+
+    @classmethod
+    def from_json(cls, data: object) -> Sources | None:
+        """The sources a journal's start holds (``None``: an older journal keeps none)."""
+        if not isinstance(data, dict) or not isinstance(data.get("rules"), str) \
+                or not isinstance(data.get("terms"), list) \
+                or not all(isinstance(t, str) for t in data["terms"]):
+            return None
+        return cls(data["rules"], tuple(data["terms"]))
+
+    def to_json(self) -> dict:
+        return {"rules": self.rules, "terms": list(self.terms)}
+
+    def rulebase(self, path: Path) -> RuleBase:
+        """The rule base these texts hold, read as if from ``path`` (where the rule file is)."""
+        from ..lang.parse import parse_rules
+        from ..lang.resolve import build_rulebase
+        from ..lang.termfile import parse_termset
+
+        parsed = parse_rules(self.rules.removeprefix("\ufeff"), str(path))
+        names = tuple(n for n, _ in parsed.terms)
+        if len(names) != len(self.terms):
+            raise LessonError(f"the session's copy of {path} names {len(names)} term sets, "
+                              f"and holds {len(self.terms)}")
+        return build_rulebase(parsed, tuple(
+            parse_termset(t.removeprefix("\ufeff"), str(path.parent / n))
+            for n, t in zip(names, self.terms)), names)
+
+    def digest(self) -> str:
+        """As :func:`~mitos_cli.teach.state.files_digest` of the files these were read from."""
+        import hashlib
+
+        h = hashlib.sha256()
+        for text in (self.rules, *self.terms):
+            h.update(text.encode("utf-8"))
+        return h.hexdigest()[:16]
+
+
+def _as_read(text: str) -> str:
+    """``text`` as ``Path.read_text(encoding="utf-8-sig")`` reads a file of it: no byte-order
+    mark, every line break a ``\\n``."""
+    return text.removeprefix("\ufeff").replace("\r\n", "\n").replace("\r", "\n")
 
 
 @dataclass(frozen=True)
@@ -78,8 +142,10 @@ def distinct_names(termset_paths: tuple[str, ...]) -> list[str]:
     return out
 
 
-def save_rulebase(original: RuleBase, current: RuleBase, target: Path) -> Saved:
-    """Write ``current`` to ``target`` (and its term sets), as edits of ``original``'s files."""
+def save_rulebase(original: RuleBase, current: RuleBase, target: Path,
+                  sources: Sources | None = None) -> Saved:
+    """Write ``current`` to ``target`` (and its term sets), as edits of the texts ``original``
+    was read from: ``sources``, else its files as they are now."""
     if original.path is None:
         raise LessonError("this rule base has no file to save from")
     src = Path(original.path)
@@ -87,25 +153,25 @@ def save_rulebase(original: RuleBase, current: RuleBase, target: Path) -> Saved:
         raise LessonError(f"`{src.name}` is not in the rule language; saving keeps the rule "
                           f"language only", hint="save to a `.rules` file after converting it")
     targets = check_save_target(original, target)
+    if sources is None:
+        sources = Sources.read(original)
     changes: list[str] = []
     texts: list[tuple[Path, str | bytes]] = []
-    for ts_old, ts_new, rel, dest in zip(original.termsets, current.termsets,
-                                        original.termset_paths, targets):
-        text = (src.parent / rel).read_text(encoding="utf-8-sig")     # as the loader reads it
-        new_text, changed = edit_termset(text, str(src.parent / rel), ts_old, ts_new)
+    for ts_old, ts_new, rel, dest, raw in zip(original.termsets, current.termsets,
+                                             original.termset_paths, targets, sources.terms):
+        new_text, changed = edit_termset(_as_read(raw), str(src.parent / rel), ts_old, ts_new)
         changes += changed
         texts.append((dest, new_text))
-    rules_text = src.read_text(encoding="utf-8-sig")    # a BOM is no token of the rule language
     names = tuple(os.path.relpath(dest, target.parent).replace(os.sep, "/") for dest in targets)
-    new_rules, changed = edit_rules(rules_text, str(src), original, current, names)
+    # a BOM is no token of the rule language
+    new_rules, changed = edit_rules(_as_read(sources.rules), str(src), original, current, names)
     changes += changed
     _check_reads_back(current, new_rules, texts, target, names)
-    written = [(dest, _breaks_as(text, src.parent / rel))
-               for (dest, text), rel in zip(texts, original.termset_paths)]
+    written = [(dest, _breaks_as(text, raw)) for (dest, text), raw in zip(texts, sources.terms)]
     created = _directory_for(target)
     try:
         finish_saves(target, error=LessonError)        # one a crash left half done
-        atomic_write_set(written + [(target, _breaks_as(new_rules, src))], target,
+        atomic_write_set(written + [(target, _breaks_as(new_rules, sources.rules))], target,
                          error=LessonError)
     except LessonError as exc:          # it names the file it failed on: often a term set
         if created is not None:
@@ -117,17 +183,17 @@ def save_rulebase(original: RuleBase, current: RuleBase, target: Path) -> Saved:
     return Saved(target, tuple(d for d, _ in texts), tuple(changes), created)
 
 
-def _breaks_as(text: str | bytes, original: Path) -> str | bytes:
+def _breaks_as(text: str | bytes, raw: str) -> str | bytes:
     """``text`` (read with universal newlines, a BOM dropped) with the line breaks and the BOM
-    of the file it was read from: a rule base written on Windows (``\\r\\n``) was saved with
-    ``\\n``, so that `git diff` showed every line changed where only numbers were learned."""
+    of ``raw``, the file it was read from: a rule base written on Windows (``\\r\\n``) was
+    saved with ``\\n``, so that `git diff` showed every line changed where only numbers were
+    learned."""
     if isinstance(text, bytes):
         return text
-    raw = original.read_bytes()
-    first = raw.find(b"\n")
-    if first > 0 and raw[first - 1:first] == b"\r":
+    first = raw.find("\n")
+    if first > 0 and raw[first - 1:first] == "\r":
         text = text.replace("\n", "\r\n")
-    return "\ufeff" + text if raw.startswith(codecs.BOM_UTF8) else text
+    return "\ufeff" + text if raw.startswith("\ufeff") else text
 
 
 def check_save_target(original: RuleBase, target: Path) -> tuple[Path, ...]:

@@ -55,6 +55,7 @@ from ..words import plural
 from . import commands as cmd
 from . import text
 from .journal import RECORDS, Journal, MemoryJournal
+from .save import Sources
 from .state import State, apply, files_digest, journaled, learned_changes, variables
 
 if TYPE_CHECKING:
@@ -141,19 +142,27 @@ class Session:
     def __init__(self, rules_path: str | Path, behavior: str | None = None,
                  journal: Journal | None = None, save_as: str | Path | None = None,
                  out: Callable[[str], None] | None = None,
-                 progress: Callable | None = None) -> None:
+                 progress: Callable | None = None, sources: Sources | None = None) -> None:
         # as `mitos teach` and read_rulebase: the file, else a packaged rule base by its path
         # or name (a name the system cannot look up, too long, is simply not found)
         from ..resources import resolve
 
         self.rules_path = resolve("rulebases", rules_path, ".rules") or Path(rules_path)
-        try:
-            self.original = load_rules_file(self.rules_path)
-        except MitosError as exc:       # a .fis, .fcl or .fll: convert it first
-            from ..interop import hint_wrong_reader
+        if sources is not None:                     # the files as the session began
+            self.original = sources.rulebase(self.rules_path)
+        else:
+            try:
+                self.original = load_rules_file(self.rules_path)
+            except MitosError as exc:       # a .fis, .fcl or .fll: convert it first
+                from ..interop import hint_wrong_reader
 
-            hint_wrong_reader(exc, self.rules_path, "mitos teach")
-            raise
+                hint_wrong_reader(exc, self.rules_path, "mitos teach")
+                raise
+            sources = _sources(self.original)
+        self.sources = sources
+        #: the digest the original's files have as far as the session knows (read, or saved
+        #: over by it): a save over them refuses files another program changed since
+        self.files_seen = files_digest(self.original)
         self.journal = journal if journal is not None else MemoryJournal()
         self.save_as = Path(save_as) if save_as is not None else None
         self.out = out or print
@@ -172,8 +181,9 @@ class Session:
         self._indexes: dict[str, _RuleIndex] = {}
         if not self.journal.entries:
             self.journal.append("start", rules=str(self.rules_path.resolve()),
-                                behavior=active, digest=files_digest(self.original),
-                                save_as=None if self.save_as is None else str(self.save_as))
+                                behavior=active, digest=self.files_seen,
+                                save_as=None if self.save_as is None else str(self.save_as),
+                                **({} if sources is None else {"sources": sources.to_json()}))
 
     # -- resume ------------------------------------------------------------------------------
     @classmethod
@@ -187,13 +197,22 @@ class Session:
         try:
             session = cls(start["rules"], start["behavior"], journal, start.get("save_as"),
                           out, progress)
+            known = _own_digest(journal.entries, session.rules_path)
+            sources = Sources.from_json(start.get("sources"))
+            if session.files_seen == known and sources is not None:
+                # as it began (the files may hold its own saves, which `undo` takes back)
+                with contextlib.suppress(MitosError):    # (a copy edited by hand: as now)
+                    session = cls(start["rules"], start["behavior"], journal,
+                                  start.get("save_as"), out, progress, sources)
+                    session.files_seen = known
         except MitosError as exc:       # the rule file or behavior the journal names
             if exc.span is None:
                 exc.span = first
             raise
-        if files_digest(session.original) != start.get("digest"):
+        if session.files_seen != known:
             session.out(f"warning: {start['rules']} or its term set changed since the session "
-                        f"started; the journal's changes are applied to the files as they are now")
+                        f"{'started' if known == start.get('digest') else 'saved over them'}; "
+                        f"the journal's changes are applied to the files as they are now")
         session.replay(recover)
         session._simulate_again()
         saves = [e for e in journal.entries if e["op"] == "save"]
@@ -927,8 +946,14 @@ class Session:
         if target.is_dir():                 # checked before any term set is written beside it
             raise LessonError(f"`{target}` is a directory; save names the rule file to write",
                               hint=f"save {(target / 'taught.rules').as_posix()}")
-        saved = save_rulebase(self.original, self.rulebase, target)
-        entry = self.journal.append("save", path=str(target), line=line)
+        over = _same_file(target, self.rules_path)
+        if over:
+            self._check_unchanged()
+        saved = save_rulebase(self.original, self.rulebase, target, self.sources)
+        if over:
+            self.files_seen = files_digest(self.original)
+        entry = self.journal.append("save", path=str(target), line=line,
+                                    **({"digest": self.files_seen} if over else {}))
         self.saved_seq = entry["seq"]
         self.save_as = target                      # a later bare `save` goes here too
         files = ", ".join(str(p) for p in (saved.rules,) + saved.termsets)
@@ -939,6 +964,18 @@ class Session:
         for change in saved.changes:
             self.out(f"  {change}")
         self.out(self.interpretability())
+
+    def _check_unchanged(self) -> None:
+        """Refuse a save over the original files when another program (or session) changed
+        them since this session read or saved them: the save would undo that change."""
+        if files_digest(self.original) == self.files_seen:
+            return
+        raise LessonError(f"{self.rules_path} or its term sets changed since this session read "
+                          f"them (another program or session wrote them); saving over them "
+                          f"would undo that change",
+                          hint="save under another name (`save taught.rules`), or quit and "
+                               "`mitos teach --resume`, which applies this session's changes to "
+                               "the files as they are now")
 
     def interpretability(self) -> str:
         """The interpretability line of `adapt` and `save` (new term gaps marked)."""
@@ -1055,6 +1092,31 @@ def _whole(value: float, what: str, least: int) -> int:
         raise LessonError(f"{what} must be a whole number of at least {least}, not {value:g}")
     return int(value)
 
+
+
+def _sources(original: RuleBase) -> Sources | None:
+    """The texts of ``original``'s files (``None`` for a rule base that has none to keep)."""
+    if original.path is None or Path(original.path).suffix.lower() != ".rules":
+        return None
+    with contextlib.suppress(OSError, UnicodeDecodeError):
+        return Sources.read(original)
+    return None
+
+
+def _same_file(a: Path, b: Path) -> bool:
+    with contextlib.suppress(OSError):
+        return a.resolve() == b.resolve()
+    return False
+
+
+def _own_digest(entries: list[dict], rules: Path) -> str | None:
+    """The digest the original files had when the session last knew them: after its last
+    save over them, else when it started."""
+    for e in reversed(entries):
+        if e["op"] == "save" and isinstance(e.get("digest"), str) \
+                and _same_file(Path(e["path"]), rules):
+            return e["digest"]
+    return entries[0].get("digest") if entries else None
 
 
 def _then(first: str | None, second: str) -> str:
