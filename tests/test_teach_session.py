@@ -841,3 +841,24 @@ def test_a_journal_write_the_disk_took_half_of_is_taken_back(rules, tmp_path):
     again = Session.resume(Journal.open(tmp_path / "j"), out=[].append)
     labels = [r.label for r in again.rulebase.behavior("avoid_obstacle").rules]
     assert labels[-2:] == ["r27", "r29"] and again.rulebase == s.rulebase
+
+
+def test_a_journal_damaged_twice_keeps_both_as_they_were(rules, tmp_path):
+    """A second damage (a torn last line after a `--recover`) kept the journal over the first
+    copy kept aside, and the changes told after the first damaged line were lost with it."""
+    journal = Journal.create(tmp_path / "j")
+    s, _ = session(rules, journal=journal)
+    for line in ["r27: if road is NARROW then steering is LB", "r28: if road is WIDE then speed is FAST",
+                 "r29: if road is MEDIUM then speed is MEDIUM"]:
+        s.run(line)
+    lines = journal.path.read_text().splitlines(keepends=True)
+    journal.path.write_text("".join(lines[:2] + ["x" + lines[2]] + lines[3:]))
+    first = Journal.open(tmp_path / "j", recover=True)
+    assert first.recovered_at == 3
+    Session.resume(first, out=[].append).run("r28: if road is WIDE then speed is SLOW")
+    with open(first.path, "a") as fh:
+        fh.write('{"seq": 4, "op": "rule", "beh')
+    second = Journal.open(tmp_path / "j")
+    assert second.skipped_tail and second.aside.name == "journal.jsonl.damaged.2"
+    assert "r29: if road is MEDIUM" in (tmp_path / "j" / "journal.jsonl.damaged").read_text()
+    assert "speed is SLOW" in second.aside.read_text()

@@ -92,6 +92,8 @@ class Journal:
     lines: list[int] = field(default_factory=list)
     #: the damaged line the session was recovered up to (``open(recover=True)``), if any
     recovered_at: int | None = None
+    #: where :meth:`cut` kept the journal as it was (``journal.jsonl.damaged``, or ``.2``, ...)
+    kept: Path | None = None
 
     @property
     def path(self) -> Path:
@@ -157,7 +159,8 @@ class Journal:
         from ..fileio import atomic_write
 
         raw = self.path.read_bytes() if raw is None else raw
-        atomic_write(self.aside, raw)
+        self.kept = _unused(self.path.with_name(JOURNAL + ".damaged"))
+        atomic_write(self.kept, raw)
         with open(self.path, "r+b") as fh:
             fh.truncate(at)
             fh.flush()
@@ -165,7 +168,8 @@ class Journal:
 
     @property
     def aside(self) -> Path:
-        return self.path.with_name(JOURNAL + ".damaged")
+        """Where :meth:`cut` kept the journal as it was."""
+        return self.kept or self.path.with_name(JOURNAL + ".damaged")
 
     @property
     def next_seq(self) -> int:
@@ -197,6 +201,17 @@ class Journal:
         entries = self.entries if upto is None else [e for e in self.entries if e["seq"] <= upto]
         undone = {e["of"] for e in entries if e["op"] == "undo"}
         return [e for e in entries if e["seq"] not in undone and e["op"] not in RECORDS]
+
+
+def _unused(path: Path) -> Path:
+    """``path``, or ``path.2``, ``path.3``, ... when it is taken: a journal damaged a second
+    time was kept over the first one kept aside, which may hold changes told after the first
+    damaged line (`--recover` continued before them), so they were lost."""
+    n = 1
+    while path.exists() or path.is_symlink():
+        n += 1
+        path = path.with_name(f"{JOURNAL}.damaged.{n}")
+    return path
 
 
 def _append_line(path: Path, data: bytes) -> None:
