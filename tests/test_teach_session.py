@@ -862,3 +862,23 @@ def test_a_journal_damaged_twice_keeps_both_as_they_were(rules, tmp_path):
     assert second.skipped_tail and second.aside.name == "journal.jsonl.damaged.2"
     assert "r29: if road is MEDIUM" in (tmp_path / "j" / "journal.jsonl.damaged").read_text()
     assert "speed is SLOW" in second.aside.read_text()
+
+
+def test_a_session_resumed_elsewhere_saves_where_its_last_save_went(rules, tmp_path,
+                                                                    monkeypatch):
+    """The journal kept `save`'s path (and `--save-as`) as typed, relative to the directory
+    the session ran in: resumed from another (`--resume --session DIR`), a bare `save` wrote
+    a new file there, and the one saved before stayed as it was."""
+    here, there = tmp_path / "here", tmp_path / "there"
+    here.mkdir()
+    there.mkdir()
+    monkeypatch.chdir(here)
+    s, _ = session(rules, journal=Journal.create(tmp_path / "j"))
+    s.run("r27: if road is NARROW then steering is LB")
+    s.run("save t1.rules")
+    monkeypatch.chdir(there)
+    again = Session.resume(Journal.open(tmp_path / "j"), out=[].append)
+    again.run("r28: if road is WIDE then speed is FAST")
+    again.run("save")
+    assert "r28:" in (here / "t1.rules").read_text()
+    assert list(there.iterdir()) == []

@@ -24,6 +24,7 @@ from __future__ import annotations
 import contextlib
 import dataclasses
 import math
+import os
 import re
 from collections.abc import Callable, Iterator
 from pathlib import Path
@@ -182,7 +183,8 @@ class Session:
         if not self.journal.entries:
             self.journal.append("start", rules=str(self.rules_path.resolve()),
                                 behavior=active, digest=self.files_seen,
-                                save_as=None if self.save_as is None else str(self.save_as),
+                                save_as=None if self.save_as is None
+                                else os.path.abspath(self.save_as),
                                 **({} if sources is None else {"sources": sources.to_json()}))
 
     # -- resume ------------------------------------------------------------------------------
@@ -952,7 +954,9 @@ class Session:
         saved = save_rulebase(self.original, self.rulebase, target, self.sources)
         if over:
             self.files_seen = files_digest(self.original)
-        entry = self.journal.append("save", path=str(target), line=line,
+        # the path as it names the file from anywhere: `--resume --session DIR` may run
+        # elsewhere, and a bare `save` then wrote a new file there
+        entry = self.journal.append("save", path=os.path.abspath(target), line=line,
                                     **({"digest": self.files_seen} if over else {}))
         self.saved_seq = entry["seq"]
         self.save_as = target                      # a later bare `save` goes here too
