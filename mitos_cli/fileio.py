@@ -4,7 +4,7 @@ Every file MITOS writes (saved rule bases and term sets, converted and exported 
 traces, study results) goes through :func:`atomic_file`: the data goes to a temporary file in
 the same directory, is flushed to disk, and only then replaces the target in one rename. A
 crash leaves either the old file or the new one. New files get the usual permissions (0666
-less the umask), not a temporary file's 0600.
+less the umask), not a temporary file's 0600; a file replaced keeps its own.
 """
 
 from __future__ import annotations
@@ -13,6 +13,7 @@ import contextlib
 import errno
 import os
 import secrets
+import stat
 from collections.abc import Iterable, Iterator
 from pathlib import Path
 from typing import IO
@@ -201,6 +202,7 @@ def atomic_file(path: str | Path, binary: bool = False,
     except OSError as exc:
         raise error(f"cannot write `{path}`: {exc.strerror or exc}",
                     hint="check that the directory exists and is writable") from None
+    _keep_mode(fd, path)
     try:
         with (os.fdopen(fd, "wb") if binary else
               os.fdopen(fd, "w", encoding="utf-8", newline="")) as fh:
@@ -213,6 +215,18 @@ def atomic_file(path: str | Path, binary: bool = False,
     finally:
         with contextlib.suppress(OSError):
             os.unlink(tmp)
+
+
+def _keep_mode(fd: int, path: Path) -> None:
+    """Give the temporary file ``fd`` the permissions of the file ``path`` it replaces: a
+    private (0600) rule file saved over became readable by all (0644), and a script lost its
+    execute bit, where an editor or `cp` keeps them. A new file keeps 0666 less the umask."""
+    try:
+        st = os.stat(path)
+        if stat.S_ISREG(st.st_mode):
+            os.fchmod(fd, stat.S_IMODE(st.st_mode) & 0o777)
+    except OSError:             # not there (a new file), or not ours to read: as it was
+        pass
 
 
 def _target(path: Path) -> Path:
@@ -273,6 +287,7 @@ def atomic_write_set(files: list[tuple[Path, str | bytes]], anchor: Path,
             try:
                 fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666)
                 pending.append((tmp, path))
+                _keep_mode(fd, path)
                 with os.fdopen(fd, "wb") as fh:
                     fh.write(data.encode("utf-8") if isinstance(data, str) else data)
                     fh.flush()

@@ -204,3 +204,17 @@ def test_did_you_mean_never_names_a_directory(tmp_path, capsys):
     assert "did you mean" not in capsys.readouterr().err
     (tmp_path / "mitos.fll").write_text("x")
     assert nearby_name(tmp_path / "mitoss.rules") == "mitos.fll"
+@pytest.mark.parametrize("mode", [0o600, 0o755, 0o640])
+def test_a_file_replaced_keeps_its_permissions(tmp_path, mode):
+    """The temporary file that replaced a file had 0666 less the umask: a private (0600) rule
+    file saved over became readable by all, an exported script lost its execute bit."""
+    from mitos_cli.fileio import atomic_write_set
+
+    one, two = tmp_path / "one.rules", tmp_path / "two.yaml"
+    for path in (one, two):
+        path.write_text("old\n")
+        path.chmod(mode)
+    atomic_write(one, "new\n")
+    assert one.read_text() == "new\n" and one.stat().st_mode & 0o777 == mode
+    atomic_write_set([(two, "new\n"), (one, "newer\n")], one)
+    assert {p.stat().st_mode & 0o777 for p in (one, two)} == {mode}
