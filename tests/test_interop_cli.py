@@ -687,3 +687,24 @@ def test_fidelity_fuzzylite6_samples_100_points_where_the_file_gives_none(capsys
 
     assert LoadedRuleBase(rb, None, fidelity_settings(rb, "fuzzylite6")).evaluate(
         Ambient=0.3) == pytest.approx(dict(LoadedRuleBase(rb).evaluate(Ambient=0.3)))
+
+
+def test_convert_to_rules_writes_both_files_or_neither(tmp_path: Path, monkeypatch) -> None:
+    """The term set was written first and the rule file after it: a rule file that could
+    not be written (a directory of its name) left the new term set there alone, and a kill
+    between the two a new term set beside the old rule file."""
+    import mitos_cli.fileio as fileio
+
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "out.rules").mkdir()
+    result = runner.invoke(app, ["convert", str(DATA / "tipper.fis"), "--to", "rules",
+                                 "-o", "out.rules"])
+    assert result.exit_code == 1 and "is a directory" in result.exception.message
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out.rules"]
+    (tmp_path / "out.rules").rmdir()
+    sets: list = []
+    monkeypatch.setattr(fileio, "atomic_write_set", lambda files, anchor, **kw: sets.append(
+        ([p.name for p, _ in files], anchor.name)))
+    assert runner.invoke(app, ["convert", str(DATA / "tipper.fis"), "--to", "rules", "-o",
+                               "out.rules"]).exit_code == 0
+    assert sets == [(["out.terms.yaml", "out.rules"], "out.rules")]

@@ -81,8 +81,7 @@ def convert_command(
         for note in conversion_notes(rb, "rules", behavior):
             warn(note)
         back = _read_back(rules_text, terms_text, rules_path, terms_path)
-        atomic_write(terms_path, terms_text)
-        atomic_write(rules_path, rules_text)
+        _write_pair(rules_path, rules_text, terms_path, terms_text)
         for note in round_trip_difference(rb, back, "rules", behavior):
             warn(note)
         err(f"wrote {rules_path} and {terms_path}")
@@ -100,6 +99,17 @@ def convert_command(
     else:
         atomic_write(output, text)
         err(f"wrote {output}")
+
+
+def _write_pair(rules_path: Path, rules_text: str, terms_path: Path, terms_text: str) -> None:
+    """The rule file and its term set as one set, as `teach` saves them: written one after
+    the other, a kill between them, or a rule file that could not be written (a directory
+    of its name), left a new term set beside the old rule file, or beside none."""
+    from ..fileio import atomic_write_set, check_writable
+
+    check_writable(terms_path)
+    check_writable(rules_path)
+    atomic_write_set([(terms_path, terms_text), (rules_path, rules_text)], rules_path)
 
 
 def _read_back(rules_text: str, terms_text: str, rules_path: Path, terms_path: Path):
