@@ -229,6 +229,21 @@ def _keep_mode(fd: int, path: Path) -> None:
         pass
 
 
+def replace_with(part: Path, path: str | Path) -> None:
+    """Rename a finished file ``part`` (written beside ``path`` by a writer that wants a
+    file name, as matplotlib's animation writers do) over ``path`` as :func:`atomic_file`
+    does: through a link to the file it names, keeping a replaced file's permissions.
+    Raises ``OSError``."""
+    target = _target(Path(path))
+    fd = os.open(part, os.O_RDONLY)
+    try:
+        _keep_mode(fd, target)
+        os.fsync(fd)
+    finally:
+        os.close(fd)
+    os.replace(part, target)
+
+
 def _target(path: Path) -> Path:
     """The file a write goes to: through a symbolic link to the file it names (the link
     stays a link)."""

@@ -149,3 +149,19 @@ def test_a_detail_of_another_run_or_robot_is_refused(short_world, tmp_path):
     assert not (tmp_path / "run.gif").exists()
     assert animate_run(result, tmp_path / "run.gif", fps=2.5,
                        detail=explain(result, planner)) == 6
+def test_an_animation_written_onto_a_link_goes_to_the_file_it_names(short_world, tmp_path):
+    """`--animate link.gif` replaced the link with the animation, and the file it named kept
+    the old one, where `--plot` and `--out` write through a link; a replaced file's
+    permissions are kept, as theirs are."""
+    real = tmp_path / "real"
+    real.mkdir()
+    (real / "run.gif").write_bytes(b"old")
+    (real / "run.gif").chmod(0o600)
+    link = tmp_path / "link.gif"
+    link.symlink_to(real / "run.gif")
+    out = RUNNER.invoke(app, ["simulate", str(short_world), "--animate", str(link),
+                              "--fps", "2.5"])
+    assert out.exit_code == 0, out.output
+    assert link.is_symlink() and (real / "run.gif").read_bytes()[:3] == b"GIF"
+    assert (real / "run.gif").stat().st_mode & 0o777 == 0o600
+    assert not list(tmp_path.glob("**/.*.part.*"))

@@ -317,17 +317,21 @@ def _gif_writer() -> type:
 def _save(fig, draw, picked, writer, path: Path, fmt: str, dpi: int) -> None:
     """One canvas draw per frame into matplotlib's writer. The writers want a file name:
     write beside the target, then rename it into place (a stopped run leaves no half-written
-    animation)."""
+    animation), through a link as every other file is written (the link was replaced by the
+    animation, and the file it named kept the old one), under a name of this process's (two
+    runs wrote one part file)."""
     import os
 
-    part = path.with_name(f".{path.name}.part.{fmt}")
+    from ..fileio import replace_with
+
+    part = path.with_name(f".{path.name}.{os.getpid()}.part.{fmt}")
     literal_text(fig)
     try:
         with writer.saving(fig, str(part), dpi):
             for k in picked:
                 draw(int(k))
                 writer.grab_frame()
-        os.replace(part, path)
+        replace_with(part, path)
     except OSError as exc:
         raise WriteError(f"cannot write `{path}`: {exc.strerror or exc}") from None
     finally:
