@@ -882,3 +882,25 @@ def test_a_session_resumed_elsewhere_saves_where_its_last_save_went(rules, tmp_p
     again.run("save")
     assert "r28:" in (here / "t1.rules").read_text()
     assert list(there.iterdir()) == []
+
+
+def test_undo_replays_without_checking_or_parsing_again(rules, monkeypatch):
+    """`undo` replays every change left: it checked each again (compiling the behavior of
+    every `correct`) and parsed each rule again, so each undo of a long lesson took longer
+    (0.4 s at 470 changes; a 3,000-line lesson with undos did not end in a minute)."""
+    import mitos_cli.teach.state as state
+
+    s, _ = session(rules)
+    for i in range(12):
+        s.run(f"r{100 + i}: if road is WIDE and size is SMALL_SZ then speed is FAST")
+        s.run(f"correct road={40 + i} size=45 position=4 -> steering=60")
+    checks, parses = [], []
+    monkeypatch.setattr(Session, "_check_entry", lambda self, e: checks.append(e))
+    monkeypatch.setattr(state, "parse_rule", lambda text: parses.append(text))
+    before = s.rulebase
+    for _ in range(4):
+        s.run("undo")
+    assert checks == [] and parses == []
+    labels = [r.label for r in s.rulebase.behavior("avoid_obstacle").rules]
+    assert labels[-2:] == ["r108", "r109"] and len(s.state.examples) == 10
+    assert s.rulebase != before

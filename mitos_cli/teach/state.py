@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import contextlib
 import dataclasses
+import functools
 import hashlib
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -96,12 +97,19 @@ def _set_crisp(rb: RuleBase, crisp: list) -> RuleBase:
     return rb
 
 
+@functools.lru_cache(maxsize=4096)
+def _told(text: str) -> Rule:
+    """A journaled rule's text, parsed once: `undo` replays every change, and parsing each
+    rule again was most of its time in a long lesson (a rule is immutable)."""
+    return parse_rule(text)
+
+
 def apply(state: State, entry: dict) -> None:
     """Apply one journal entry to ``state`` (no checks: entries were checked when told)."""
     op = entry["op"]
     rb = state.rulebase
     if op == "rule":
-        rule = parse_rule(entry["text"])
+        rule = _told(entry["text"])
         state.rulebase = _replace_behavior(rb, _put_rule(state, rb.behavior(entry["behavior"]),
                                                          rule))
     elif op == "behavior":
