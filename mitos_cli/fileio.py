@@ -156,11 +156,37 @@ def unreadable(kind: str, path: object, exc: OSError | UnicodeDecodeError) -> st
     return f"cannot read {kind} `{path}`: {why_unreadable(exc)}"
 
 
+def link_loop(path: str | Path) -> str | None:
+    """The system's words when ``path`` is a symbolic link in a loop ("Too many levels of
+    symbolic links"), else ``None``: ``Path.resolve`` of one raised a ``RuntimeError``, which
+    every writer showed as a traceback."""
+    try:
+        if not Path(path).is_symlink():
+            return None
+        os.stat(path)
+    except OSError as exc:
+        return exc.strerror or str(exc) if exc.errno == errno.ELOOP else None
+    return None
+
+
+def real_path(path: str | Path) -> Path:
+    """``path`` resolved (links followed), or as an absolute path where a link loop leaves
+    nothing to resolve it to (``Path.resolve`` raised a ``RuntimeError`` there)."""
+    try:
+        return Path(path).resolve()
+    except (OSError, RuntimeError):
+        return Path(os.path.abspath(path))
+
+
 def check_writable(path: str | Path) -> None:
     """Refuse, before any work, a file that cannot be written where it is named: its directory
-    missing or not writable, or the name a directory's (a device or a pipe, /dev/stdout, is
-    written as it is). The words are those :func:`atomic_file` says when it writes."""
+    missing or not writable, the name a directory's, or a link in a loop (a device or a pipe,
+    /dev/stdout, is written as it is). The words are those :func:`atomic_file` says when it
+    writes."""
     path = Path(path)
+    loop = link_loop(path)
+    if loop is not None:
+        raise WriteError(f"cannot write `{path}`: {loop}", hint=LOOP_HINT)
     try:
         if _special(path) and not path.is_dir():
             return
@@ -179,6 +205,10 @@ def check_writable(path: str | Path) -> None:
                          hint="check that the directory exists and is writable")
 
 
+#: what to do about an output named by a link in a loop
+LOOP_HINT = "the symbolic link leads back to itself: remove it, or name another file"
+
+
 @contextlib.contextmanager
 def atomic_file(path: str | Path, binary: bool = False,
                 error: type[MitosError] = WriteError) -> Iterator[IO]:
@@ -190,7 +220,10 @@ def atomic_file(path: str | Path, binary: bool = False,
         with _in_place(Path(path), binary, error) as fh:
             yield fh
         return
-    path = _target(Path(path))
+    try:
+        path = _target(Path(path))
+    except OSError as exc:
+        raise error(f"cannot write `{path}`: {exc.strerror or exc}", hint=LOOP_HINT) from None
     if _special(path):
         with _in_place(path, binary, error) as fh:
             yield fh
@@ -246,7 +279,11 @@ def replace_with(part: Path, path: str | Path) -> None:
 
 def _target(path: Path) -> Path:
     """The file a write goes to: through a symbolic link to the file it names (the link
-    stays a link)."""
+    stays a link). A link in a loop names no file: ``OSError`` (renaming over it replaced
+    the link)."""
+    loop = link_loop(path)
+    if loop is not None:
+        raise OSError(errno.ELOOP, loop, str(path))
     try:
         return path.resolve() if path.is_symlink() else path
     except OSError:             # a name too long to look up: the write reports it
@@ -297,9 +334,9 @@ def atomic_write_set(files: list[tuple[Path, str | bytes]], anchor: Path,
     pending: list[tuple[Path, Path]] = []
     try:
         for path, data in files:
-            path = _target(Path(path))
-            tmp = path.parent / f".{path.name}.{os.getpid()}.{secrets.token_hex(4)}.tmp"
             try:
+                path = _target(Path(path))
+                tmp = path.parent / f".{path.name}.{os.getpid()}.{secrets.token_hex(4)}.tmp"
                 fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666)
                 pending.append((tmp, path))
                 _keep_mode(fd, path)

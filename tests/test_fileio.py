@@ -218,3 +218,36 @@ def test_a_file_replaced_keeps_its_permissions(tmp_path, mode):
     assert one.read_text() == "new\n" and one.stat().st_mode & 0o777 == mode
     atomic_write_set([(two, "new\n"), (one, "newer\n")], one)
     assert {p.stat().st_mode & 0o777 for p in (one, two)} == {mode}
+
+
+@pytest.mark.parametrize("argv, name", [
+    (["simulate", "figure4", "--out", "{}"], "out.csv"),
+    (["simulate", "figure4", "--plot", "{}"], "out.png"),
+    (["convert", "{rules}", "--to", "fis", "-b", "avoid_obstacle", "-o", "{}"], "out.fis"),
+    (["convert", "{rules}", "--to", "rules", "-b", "avoid_obstacle", "-o", "{}"], "out.rules"),
+    (["export", "{rules}", "--to", "python", "-o", "{}"], "out.py"),
+    (["plot", "terms", "{rules}", "-o", "{}"], "out.png"),
+    (["teach", "{rules}", "--save-as", "{}"], "out.rules"),
+])
+def test_an_output_named_by_a_link_in_a_loop_is_refused(tmp_path, capsys, monkeypatch, argv,
+                                                         name):
+    """`Path.resolve` of a link in a loop raised a RuntimeError: every command writing a file
+    there ended in a traceback."""
+    from mitos_cli.api import default_rulebase_path
+    from mitos_cli.cli.app import main
+    from mitos_cli.fileio import check_writable
+
+    monkeypatch.chdir(tmp_path)
+    stem, suffix = name.split(".")
+    (tmp_path / name).symlink_to(f"{stem}2.{suffix}")
+    (tmp_path / f"{stem}2.{suffix}").symlink_to(name)
+    rules = str(default_rulebase_path())
+    with pytest.raises(SystemExit) as info:
+        main([a.format(tmp_path / name, rules=rules) for a in argv])
+    err = capsys.readouterr().err
+    assert info.value.code == 1 and "Too many levels of symbolic links" in err, err
+    assert "Traceback" not in err and (tmp_path / name).is_symlink()
+    with pytest.raises(MitosError, match="symbolic links"):
+        check_writable(tmp_path / name)
+    with pytest.raises(MitosError, match="symbolic links"):
+        atomic_write(tmp_path / name, "x")

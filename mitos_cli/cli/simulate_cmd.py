@@ -21,12 +21,14 @@ REQUIRE = ("success",)
 def _check_outputs(written, read: list[Path]) -> None:
     """Refuse an output file that is a file the command reads or another output's: it was
     overwritten without a word (``--out world.yaml`` replaced the world with the CSV)."""
-    inputs = {p.resolve() for p in read}
+    from ..fileio import real_path
+
+    inputs = {real_path(p) for p in read}
     seen: dict[Path, str] = {}
     for option, path in written:
         if path is None:
             continue
-        key = Path(path).resolve()
+        key = real_path(path)
         if key in inputs:
             raise typer.BadParameter(f"`{path}` is a file this command reads; write to another "
                                      "file", param_hint=option)

@@ -79,13 +79,12 @@ def refuse_existing(targets: list[Path], named: str) -> None:
 def same_file(a: Path, b: Path) -> bool:
     """Whether ``a`` and ``b`` are one file (a link to it included); a path that is not there
     yet is compared by its resolved name."""
+    from ..fileio import real_path
+
     try:
         return os.path.samefile(a, b)
-    except OSError:
-        try:
-            return a.resolve() == b.resolve()
-        except OSError:
-            return False
+    except OSError:             # (a link in a loop is no file: the write says so)
+        return real_path(a) == real_path(b)
 
 
 def _special(path: Path) -> bool:

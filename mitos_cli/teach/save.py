@@ -200,6 +200,11 @@ def check_save_target(original: RuleBase, target: Path) -> tuple[Path, ...]:
     """The term-set files a save of ``original`` as ``target`` writes, after refusing a save
     that would replace a file it must not (:func:`_check_targets`); ``mitos teach
     --save-as`` asks before a session starts, ``save`` again when it writes."""
+    from ..fileio import LOOP_HINT, link_loop
+
+    loop = link_loop(target)
+    if loop is not None:            # (`Path.resolve` of it raised a RuntimeError)
+        raise LessonError(f"cannot save `{target}`: {loop}", hint=LOOP_HINT)
     src = Path(original.path or target)
     targets = termset_targets(target, src, original.termset_paths)
     _check_targets(target, src, original, targets)

@@ -1116,9 +1116,9 @@ def _sources(original: RuleBase) -> Sources | None:
 
 
 def _same_file(a: Path, b: Path) -> bool:
-    with contextlib.suppress(OSError):
-        return a.resolve() == b.resolve()
-    return False
+    from ..fileio import real_path
+
+    return real_path(a) == real_path(b)
 
 
 def _own_digest(entries: list[dict], rules: Path) -> str | None:
