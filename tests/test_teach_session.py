@@ -904,3 +904,34 @@ def test_undo_replays_without_checking_or_parsing_again(rules, monkeypatch):
     labels = [r.label for r in s.rulebase.behavior("avoid_obstacle").rules]
     assert labels[-2:] == ["r108", "r109"] and len(s.state.examples) == 10
     assert s.rulebase != before
+
+
+def test_ctrl_c_during_the_journal_write_keeps_the_journal_whole(rules, tmp_path, monkeypatch):
+    """Ctrl-C while the journal's line was being synced to disk (the longest part of a
+    change) raised after the line was written and before the session counted it: the next
+    change was numbered alike, and `--resume` refused the journal at it."""
+    import os
+    import signal
+    import time
+
+    import mitos_cli.teach.journal as journal_module
+
+    journal = Journal.create(tmp_path / "j")
+    s, _ = session(rules, journal=journal)
+    real = os.fsync
+
+    def interrupted(fd):
+        real(fd)
+        monkeypatch.setattr(journal_module.os, "fsync", real)
+        os.kill(os.getpid(), signal.SIGINT)
+        time.sleep(0.05)                 # the signal is taken here, as after a slow fsync
+
+    monkeypatch.setattr(journal_module.os, "fsync", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        s.run("r27: if road is NARROW then steering is LB")
+    s.replay()                           # what the prompt does after a Ctrl-C
+    s.run("r28: if road is WIDE then speed is FAST")
+    again = Session.resume(Journal.open(tmp_path / "j"), out=[].append)
+    assert again.rulebase == s.rulebase
+    assert [r.label for r in again.rulebase.behavior("avoid_obstacle").rules][-2:] == \
+        ["r27", "r28"]

@@ -18,8 +18,11 @@ import errno
 import json
 import math
 import os
+import signal
 import sys
+import threading
 import time
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -179,13 +182,14 @@ class Journal:
         """Add an entry and make it durable before returning."""
         entry = {"seq": self.next_seq, "op": op, **data}
         line = json.dumps(entry, ensure_ascii=False, separators=(",", ":")) + "\n"
-        try:
-            _append_line(self.path, line.encode("utf-8"))
-        except OSError as exc:
-            raise LessonError(f"cannot write the journal {self.path}: "
-                              f"{exc.strerror or exc}; the change was not made") from None
-        self.entries.append(entry)
-        self.lines.append((self.lines[-1] + 1) if self.lines else 1)
+        with _held_interrupt():
+            try:
+                _append_line(self.path, line.encode("utf-8"))
+            except OSError as exc:
+                raise LessonError(f"cannot write the journal {self.path}: "
+                                  f"{exc.strerror or exc}; the change was not made") from None
+            self.entries.append(entry)
+            self.lines.append((self.lines[-1] + 1) if self.lines else 1)
         return entry
 
     def line_of(self, entry: dict) -> int:
@@ -201,6 +205,28 @@ class Journal:
         entries = self.entries if upto is None else [e for e in self.entries if e["seq"] <= upto]
         undone = {e["of"] for e in entries if e["op"] == "undo"}
         return [e for e in entries if e["seq"] not in undone and e["op"] not in RECORDS]
+
+
+@contextlib.contextmanager
+def _held_interrupt() -> Iterator[None]:
+    """Hold a Ctrl-C (SIGINT) until the block ends, then raise it: one during the journal's
+    fsync (the longest part of a change) was raised after the line was on disk and before
+    the session counted it, so the next change was numbered alike and the journal was
+    damaged there. (Only the main thread may set a handler: elsewhere, as before.)"""
+    if threading.current_thread() is not threading.main_thread() \
+            or signal.getsignal(signal.SIGINT) is None:      # (a handler set outside Python)
+        yield
+        return
+    caught: list[tuple] = []
+    old = signal.signal(signal.SIGINT, lambda *args: caught.append(args))
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, old)
+        if caught and callable(old):
+            old(*caught[0])                       # Python's: raises KeyboardInterrupt
+        elif caught and old != signal.SIG_IGN:
+            raise KeyboardInterrupt
 
 
 def _unused(path: Path) -> Path:
