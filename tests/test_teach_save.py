@@ -668,3 +668,20 @@ def test_a_save_over_an_original_another_program_changed_is_refused(rules, tmp_p
     assert rules.read_text() == edited
     s.run(f"save {tmp_path / 'taught.rules'}")
     assert load_rules_file(tmp_path / "taught.rules").behaviors == s.rulebase.behaviors
+
+
+def test_a_save_whose_term_set_name_is_too_long_is_a_command_error(rules, tmp_path):
+    """`save OUT.rules` with a name of 240 characters: the term set's, 257, could not be
+    looked up, and the `OSError` ended the teaching prompt with a bare "error:", no place."""
+    from mitos_cli.teach.save import check_save_target
+
+    s = Session(rules, out=[].append)
+    s.run("r27: if road is NARROW then speed is SLOW")
+    target = tmp_path / ("x" * 240 + ".rules")
+    with pytest.raises(LessonError, match="File name too long") as err:
+        s.run(f"save {target}")
+    assert "at most 255 characters" in err.value.hint
+    with pytest.raises(LessonError, match="File name too long"):
+        check_save_target(s.original, target)
+    s.run(f"save {tmp_path / 'short.rules'}")                 # the session goes on
+    assert "r27:" in (tmp_path / "short.rules").read_text()

@@ -17,6 +17,7 @@ updated; saving over the original rule file rewrites its term sets in place.
 from __future__ import annotations
 
 import contextlib
+import errno
 import json
 import os
 import re
@@ -207,8 +208,24 @@ def check_save_target(original: RuleBase, target: Path) -> tuple[Path, ...]:
         raise LessonError(f"cannot save `{target}`: {loop}", hint=LOOP_HINT)
     src = Path(original.path or target)
     targets = termset_targets(target, src, original.termset_paths)
-    _check_targets(target, src, original, targets)
+    try:
+        _check_targets(target, src, original, targets)
+    except OSError as exc:          # a name the system cannot look up
+        raise _cannot_look_up(target, exc) from None
     return targets
+
+
+def _cannot_look_up(target: Path, exc: OSError) -> LessonError:
+    """A save whose files the system cannot look up: a term set's name of over 255
+    characters (`OUT.mitos.terms.yaml` of a long `OUT`) raised an ``OSError`` that ended the
+    teaching prompt, with no place."""
+    name = Path(exc.filename).name if isinstance(exc.filename, str) else ""
+    too_long = exc.errno == errno.ENAMETOOLONG
+    shown = f"`{name[:40]}...` ({len(name):,} characters)" if len(name) > 60 else f"`{name}`"
+    return LessonError(f"cannot save `{target}`: {exc.strerror or exc}"
+                       + (f": {shown}" if name else ""),
+                       hint="each part of a path may have at most 255 characters: save under a "
+                            "shorter name" if too_long else None)
 
 
 def _check_targets(target: Path, src: Path, original: RuleBase, targets: tuple[Path, ...]) -> None:

@@ -953,7 +953,7 @@ class Session:
         if self.state.block is not None:
             raise LessonError(f"behavior `{self.state.block}` is still open",
                               hint="close it with `end` before saving")
-        if target.is_dir():                 # checked before any term set is written beside it
+        if _is_dir(target):                 # checked before any term set is written beside it
             raise LessonError(f"`{target}` is a directory; save names the rule file to write",
                               hint=f"save {(target / 'taught.rules').as_posix()}")
         over = _same_file(target, self.rules_path)
@@ -1113,6 +1113,15 @@ def _sources(original: RuleBase) -> Sources | None:
     with contextlib.suppress(OSError, UnicodeDecodeError):
         return Sources.read(original)
     return None
+
+
+def _is_dir(path: Path) -> bool:
+    """Whether ``path`` is a directory; a name the system cannot look up (too long) is not
+    one (the save's checks say what is wrong with it)."""
+    try:
+        return path.is_dir()
+    except OSError:
+        return False
 
 
 def _same_file(a: Path, b: Path) -> bool:
