@@ -685,3 +685,22 @@ def test_a_save_whose_term_set_name_is_too_long_is_a_command_error(rules, tmp_pa
         check_save_target(s.original, target)
     s.run(f"save {tmp_path / 'short.rules'}")                 # the session goes on
     assert "r27:" in (tmp_path / "short.rules").read_text()
+
+
+def test_a_save_over_the_original_killed_before_its_record_is_the_sessions_own(rules,
+                                                                              tmp_path):
+    """A kill after a save over the original wrote its files and before the journal recorded
+    it: `--resume` said the files had been changed by another program and applied the
+    journal over them, so `undo` could not take back what the save wrote."""
+    from mitos_cli.teach.journal import Journal
+
+    s = Session(rules, journal=Journal.create(tmp_path / "j"), out=[].append)
+    s.run("r27: if road is NARROW then speed is SLOW")
+    original = rules.read_text()
+    save_rulebase(s.original, s.rulebase, rules, s.sources)      # the files, not the record
+    out: list[str] = []
+    again = Session.resume(Journal.open(tmp_path / "j"), out=out.append)
+    assert not any("changed since" in x for x in out), out
+    again.run("undo")
+    again.run(f"save {rules}")
+    assert rules.read_text() == original

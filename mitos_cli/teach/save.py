@@ -153,6 +153,27 @@ def save_rulebase(original: RuleBase, current: RuleBase, target: Path,
     if src.suffix.lower() in (".fcl", ".fis", ".fll"):
         raise LessonError(f"`{src.name}` is not in the rule language; saving keeps the rule "
                           f"language only", hint="save to a `.rules` file after converting it")
+    files, changes = saved_files(original, current, target, sources)
+    created = _directory_for(target)
+    try:
+        finish_saves(target, error=LessonError)        # one a crash left half done
+        atomic_write_set(files, target, error=LessonError)
+    except LessonError as exc:          # it names the file it failed on: often a term set
+        if created is not None:
+            with contextlib.suppress(OSError):
+                created.rmdir()                         # made for this save: nothing in it
+        raise LessonError(f"cannot save `{target}`: {exc.message}",
+                          hint=f"save where you can write files (`save ~/{target.name}`); "
+                               "the session keeps every change") from None
+    return Saved(target, tuple(d for d, _ in files[:-1]), changes, created)
+
+
+def saved_files(original: RuleBase, current: RuleBase, target: Path,
+                sources: Sources | None = None
+                ) -> tuple[list[tuple[Path, str | bytes]], tuple[str, ...]]:
+    """What a save of ``current`` as ``target`` writes, not yet written: the term sets, then
+    the rule file (each with its text, read back as ``current``), and the changes in words."""
+    src = Path(original.path or target)
     targets = check_save_target(original, target)
     if sources is None:
         sources = Sources.read(original)
@@ -169,19 +190,7 @@ def save_rulebase(original: RuleBase, current: RuleBase, target: Path,
     changes += changed
     _check_reads_back(current, new_rules, texts, target, names)
     written = [(dest, _breaks_as(text, raw)) for (dest, text), raw in zip(texts, sources.terms)]
-    created = _directory_for(target)
-    try:
-        finish_saves(target, error=LessonError)        # one a crash left half done
-        atomic_write_set(written + [(target, _breaks_as(new_rules, sources.rules))], target,
-                         error=LessonError)
-    except LessonError as exc:          # it names the file it failed on: often a term set
-        if created is not None:
-            with contextlib.suppress(OSError):
-                created.rmdir()                         # made for this save: nothing in it
-        raise LessonError(f"cannot save `{target}`: {exc.message}",
-                          hint=f"save where you can write files (`save ~/{target.name}`); "
-                               "the session keeps every change") from None
-    return Saved(target, tuple(d for d, _ in texts), tuple(changes), created)
+    return written + [(target, _breaks_as(new_rules, sources.rules))], tuple(changes)
 
 
 def _breaks_as(text: str | bytes, raw: str) -> str | bytes:

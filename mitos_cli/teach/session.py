@@ -201,7 +201,13 @@ class Session:
                           out, progress)
             known = _own_digest(journal.entries, session.rules_path)
             sources = Sources.from_json(start.get("sources"))
-            if session.files_seen == known and sources is not None:
+            live = session.files_seen
+            if live != known and sources is not None:
+                with contextlib.suppress(MitosError):    # (a copy edited by hand: as now)
+                    known = _killed_save(cls(start["rules"], start["behavior"], journal,
+                                             start.get("save_as"), out, progress, sources),
+                                         live) or known
+            if live == known and sources is not None:
                 # as it began (the files may hold its own saves, which `undo` takes back)
                 with contextlib.suppress(MitosError):    # (a copy edited by hand: as now)
                     session = cls(start["rules"], start["behavior"], journal,
@@ -1128,6 +1134,26 @@ def _same_file(a: Path, b: Path) -> bool:
     from ..fileio import real_path
 
     return real_path(a) == real_path(b)
+
+
+def _killed_save(began: Session, live: str) -> str | None:
+    """``live`` when the files are what a save over them of the whole session writes: its
+    last command, a save whose files were written and whose journal record a kill cut off
+    (its digest is not journaled, and the files were said to be changed by another program,
+    the journal applied over them again); else ``None``."""
+    from .save import saved_files
+
+    try:
+        began.replay(checked=False)
+        files, _ = saved_files(began.original, began.rulebase, began.rules_path, began.sources)
+    except (MitosError, OSError, KeyError, TypeError, ValueError, AttributeError, IndexError):
+        return None
+    *terms, (_, rules) = files
+    texts = (rules, *(t for _, t in terms))
+    if not all(isinstance(t, str) for t in texts):
+        return None
+    written = Sources(str(texts[0]), tuple(str(t) for t in texts[1:])).digest()
+    return live if written == live else None
 
 
 def _own_digest(entries: list[dict], rules: Path) -> str | None:
