@@ -935,3 +935,13 @@ def test_ctrl_c_during_the_journal_write_keeps_the_journal_whole(rules, tmp_path
     assert again.rulebase == s.rulebase
     assert [r.label for r in again.rulebase.behavior("avoid_obstacle").rules][-2:] == \
         ["r27", "r28"]
+
+
+def test_a_rule_file_of_a_long_name_gets_a_session(tmp_path):
+    """The session's directory is named after the rule file: a name of 245 characters made
+    one of 261, which no file system allows, and the rule file could not be taught."""
+    from mitos_cli.teach.journal import new_session_dir
+
+    directory = new_session_dir("z" * 245, tmp_path)
+    assert directory.is_dir() and directory.name.startswith("z" * 64 + "-")
+    assert len(directory.name) < 100

@@ -32,14 +32,21 @@ ROOT = Path(".mitos") / "teach"
 JOURNAL = "journal.jsonl"
 
 
+#: the most characters of the rule file's name a session directory's name takes
+STEM_CHARS = 64
+
+
 def sessions_dir(base: Path | None = None) -> Path:
     return (base or Path.cwd()) / ROOT
 
 
 def new_session_dir(stem: str, base: Path | None = None) -> Path:
-    """A fresh directory ``.mitos/teach/<stem>-<date>-<time>[-n]``."""
+    """A fresh directory ``.mitos/teach/<stem>-<date>-<time>[-n]``, the stem cut to
+    :data:`STEM_CHARS` characters: a rule file of a 245-character name could not be taught
+    (the directory's name went over the 255 a file system allows, and the refusal blamed the
+    directory the command ran in)."""
     root = sessions_dir(base)
-    name = f"{stem}-{time.strftime('%Y%m%d-%H%M%S')}"
+    name = f"{stem[:STEM_CHARS]}-{time.strftime('%Y%m%d-%H%M%S')}"
     try:
         root.mkdir(parents=True, exist_ok=True)
         for n in range(1000):
