@@ -704,3 +704,36 @@ def test_a_save_over_the_original_killed_before_its_record_is_the_sessions_own(r
     again.run("undo")
     again.run(f"save {rules}")
     assert rules.read_text() == original
+
+
+def test_ctrl_c_once_a_save_over_the_original_is_written_keeps_the_next_save(rules,
+                                                                             monkeypatch):
+    """A Ctrl-C after a save over the original wrote its files and before the session took
+    note of them: the next save over them was refused, as if another program had changed
+    them."""
+    import os
+    import signal
+    import time
+
+    import mitos_cli.teach.session as session_module
+
+    s = Session(rules, out=[].append)
+    s.run("r27: if road is NARROW then speed is SLOW")
+    real = session_module.files_digest
+    calls: list = []
+
+    def interrupted(rb):
+        calls.append(rb)
+        if len(calls) == 2:              # after the files are written (the first: before)
+            monkeypatch.setattr(session_module, "files_digest", real)
+            os.kill(os.getpid(), signal.SIGINT)
+            time.sleep(0.05)             # the signal is taken here
+        return real(rb)
+
+    monkeypatch.setattr(session_module, "files_digest", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        s.run(f"save {rules}")
+    s.replay()                           # what the prompt does after a Ctrl-C
+    s.run("r28: if road is WIDE then speed is FAST")
+    s.run(f"save {rules}")
+    assert "r28:" in rules.read_text() and not s.unsaved

@@ -189,7 +189,7 @@ class Journal:
         """Add an entry and make it durable before returning."""
         entry = {"seq": self.next_seq, "op": op, **data}
         line = json.dumps(entry, ensure_ascii=False, separators=(",", ":")) + "\n"
-        with _held_interrupt():
+        with held_interrupt():
             try:
                 _append_line(self.path, line.encode("utf-8"))
             except OSError as exc:
@@ -215,7 +215,7 @@ class Journal:
 
 
 @contextlib.contextmanager
-def _held_interrupt() -> Iterator[None]:
+def held_interrupt() -> Iterator[None]:
     """Hold a Ctrl-C (SIGINT) until the block ends, then raise it: one during the journal's
     fsync (the longest part of a change) was raised after the line was on disk and before
     the session counted it, so the next change was numbered alike and the journal was

@@ -55,7 +55,7 @@ from ..lang.terms import check_term
 from ..words import plural
 from . import commands as cmd
 from . import text
-from .journal import RECORDS, Journal, MemoryJournal
+from .journal import RECORDS, Journal, MemoryJournal, held_interrupt
 from .save import Sources
 from .state import State, apply, files_digest, journaled, learned_changes, variables
 
@@ -965,15 +965,18 @@ class Session:
         over = _same_file(target, self.rules_path)
         if over:
             self._check_unchanged()
-        saved = save_rulebase(self.original, self.rulebase, target, self.sources)
-        if over:
-            self.files_seen = files_digest(self.original)
-        # the path as it names the file from anywhere: `--resume --session DIR` may run
-        # elsewhere, and a bare `save` then wrote a new file there
-        entry = self.journal.append("save", path=os.path.abspath(target), line=line,
-                                    **({"digest": self.files_seen} if over else {}))
-        self.saved_seq = entry["seq"]
-        self.save_as = target                      # a later bare `save` goes here too
+        # a Ctrl-C once the files are written waits for what the session knows of them: the
+        # next save over them was refused as if another program had changed them
+        with held_interrupt():
+            saved = save_rulebase(self.original, self.rulebase, target, self.sources)
+            if over:
+                self.files_seen = files_digest(self.original)
+            # the path as it names the file from anywhere: `--resume --session DIR` may run
+            # elsewhere, and a bare `save` then wrote a new file there
+            entry = self.journal.append("save", path=os.path.abspath(target), line=line,
+                                        **({"digest": self.files_seen} if over else {}))
+            self.saved_seq = entry["seq"]
+            self.save_as = target                      # a later bare `save` goes here too
         files = ", ".join(str(p) for p in (saved.rules,) + saved.termsets)
         if saved.created is not None:
             self.out(f"created the directory {saved.created}")
