@@ -977,7 +977,7 @@ class Session:
                                         **({"digest": self.files_seen} if over else {}))
             self.saved_seq = entry["seq"]
             self.save_as = target                      # a later bare `save` goes here too
-        files = ", ".join(str(p) for p in (saved.rules,) + saved.termsets)
+        files = ", ".join(_named(p) for p in (saved.rules,) + saved.termsets)
         if saved.created is not None:
             self.out(f"created the directory {saved.created}")
         self.out(f"saved {files}" + (f" ({plural(len(saved.changes), 'change')})" if saved.changes
@@ -1174,3 +1174,14 @@ def _then(first: str | None, second: str) -> str:
     if not first:
         return second
     return f"{first.rstrip('.')}; {second}" if not first.endswith("?") else f"{first} {second}"
+
+
+def _named(path: Path) -> str:
+    """A saved file as the prompt names it: relative to the working directory when below it.
+    A resumed session's save path is absolute (the journal keeps it so, to save where it did
+    from anywhere), and `saved a.rules` read `saved /home/.../a.rules`."""
+    try:
+        relative = os.path.relpath(os.path.abspath(path))
+    except ValueError:                  # (another drive, on Windows)
+        return str(path)
+    return str(path) if relative.startswith("..") else relative
