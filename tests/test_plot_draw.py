@@ -386,3 +386,19 @@ def test_the_rule_viewer_and_the_sheet_say_what_they_draw(mitos):
     with pytest.raises(InputError, match="a sheet draws VariablePlots, not NoneType"):
         draw_sheet([None])
     assert draw_rules(view, max_rows=2) is not None
+
+
+def test_a_picture_named_with_a_trailing_separator_names_a_directory(tmp_path, monkeypatch):
+    """`animate_run(result, "run.gif/")` wrote `run.gif`, where `--animate run.gif/` on the
+    command line is refused: `Path('run.gif/')` is `run.gif`."""
+    from mitos_cli.draw.animation import animate_run
+    from mitos_cli.draw.world import draw_run
+    from mitos_cli.sim import Simulation, load_world
+
+    monkeypatch.chdir(tmp_path)
+    sim = Simulation(load_world("corridor"), seed=1)
+    sim.step()
+    for draw, name in ((animate_run, "run.gif/"), (draw_run, "run.png/")):
+        with pytest.raises(DrawError, match=f"`{name}` ends in `/`, so it names a directory"):
+            draw(sim.result(), name)
+    assert not list(tmp_path.iterdir())

@@ -28,7 +28,13 @@ class DrawError(MitosError):
 
 def file_path(path: object, what: str = "a picture") -> Path:
     """``path`` as a :class:`Path`, else a :class:`DrawError` saying what is taken
-    (``draw_run(result, 3)`` met pathlib's "expected str, bytes or os.PathLike object")."""
+    (``draw_run(result, 3)`` met pathlib's "expected str, bytes or os.PathLike object"). A
+    name ending in a separator names a directory, as on the command line: ``Path('run.gif/')``
+    is ``run.gif``, which was written."""
+    if isinstance(path, str) and path.endswith(("/", os.sep)) and path.strip("/" + os.sep):
+        raise DrawError(f"`{path}` ends in `{path[-1]}`, so it names a directory, not a file",
+                        hint=f"give the file's name (`{path.rstrip('/' + os.sep)}`, or a name "
+                             f"inside that directory)")
     if isinstance(path, (str, os.PathLike)):
         return Path(path)
     raise DrawError(f"{what} is written to a file: expected a path, not "
