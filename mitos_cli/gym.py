@@ -112,8 +112,9 @@ class MitosEnv(gymnasium.Env):
 
         _check_options(others, observe_ranges, render_mode, self.metadata["render_modes"])
         if world is None:            # (mitos/World-v0 without world= drove the corridor)
-            raise EnvOptionError("mitos/World-v0 needs world=: a world file, a packaged "
-                                 "world's name or a loaded World",
+            # (any id: `make("mitos/Corridor-v0", world=None)` lands here too)
+            raise EnvOptionError("the environment needs world=: a world file, a packaged "
+                                 "world's name or a loaded World, not None",
                                  hint='gymnasium.make("mitos/World-v0", world="path.yaml"); '
                                       'a packaged world has its own: "mitos/Corridor-v0"')
 

@@ -373,13 +373,16 @@ def test_a_loaded_world_makes_an_environment_and_a_non_world_says_what_is_taken(
         gymnasium.make("mitos/World-v0", world=3)
 
 
-@pytest.mark.parametrize("kwargs", [{}, {"world": None}])
-def test_world_v0_without_a_world_says_it_needs_one(kwargs):
+@pytest.mark.parametrize("name, kwargs", [("mitos/World-v0", {}),
+                                          ("mitos/World-v0", {"world": None}),
+                                          ("mitos/Corridor-v0", {"world": None})])
+def test_world_v0_without_a_world_says_it_needs_one(name, kwargs):
     """`make("mitos/World-v0")` without `world=` trained on the packaged corridor without a
-    word."""
-    with pytest.raises(mgym.EnvOptionError, match="mitos/World-v0 needs world=: a world file, "
+    word; `world=None` given to a packaged world's id was told "mitos/World-v0 needs world=",
+    an id it did not use."""
+    with pytest.raises(mgym.EnvOptionError, match="the environment needs world=: a world file, "
                                                   "a packaged world's name or a loaded World"):
-        gymnasium.make("mitos/World-v0", **kwargs)
+        gymnasium.make(name, **kwargs)
     assert gymnasium.make("mitos/Corridor-v0").unwrapped.world.name == "corridor"
 
 
