@@ -737,3 +737,27 @@ def test_ctrl_c_once_a_save_over_the_original_is_written_keeps_the_next_save(rul
     s.run("r28: if road is WIDE then speed is FAST")
     s.run(f"save {rules}")
     assert "r28:" in rules.read_text() and not s.unsaved
+
+
+def test_save_refuses_a_link_into_another_directory(tmp_path):
+    """The rule file went where the link leads and its term sets beside the link, so the file
+    written did not load; a link within the directory saves as before."""
+    (tmp_path / "a.rules").write_text('terms "t.terms.yaml"\nr0: if x is LO then y is A\n')
+    (tmp_path / "t.terms.yaml").write_text(
+        "variables:\n  x: {role: input, universe: [0, 10], terms: {LO: {shape: left_shoulder, "
+        "points: [2, 8]}}}\n  y: {role: output, universe: [0, 10], terms: {A: 2}}\n")
+    (tmp_path / "real").mkdir()
+    (tmp_path / "real" / "kept.rules").write_text("keep\n")
+    (tmp_path / "link.rules").symlink_to(tmp_path / "real" / "kept.rules")
+    s = Session(tmp_path / "a.rules", out=[].append)
+    s.run("correct x=5 -> y=3")
+    with pytest.raises(LessonError, match="is a link to .*kept.rules`, in another directory") as e:
+        s.run(f"save {tmp_path / 'link.rules'}")
+    assert e.value.hint == f"save to `{tmp_path / 'real' / 'kept.rules'}` itself, or under a name " \
+                           "that is no link"
+    assert (tmp_path / "real" / "kept.rules").read_text() == "keep\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.rules", "link.rules", "real",
+                                                          "t.terms.yaml"]
+    (tmp_path / "same.rules").symlink_to("kept2.rules")
+    s.run(f"save {tmp_path / 'same.rules'}")
+    assert load_rules_file(tmp_path / "kept2.rules").termset_paths == ("same.terms.yaml",)

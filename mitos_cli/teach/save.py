@@ -253,6 +253,7 @@ def _check_targets(target: Path, src: Path, original: RuleBase, targets: tuple[P
                           hint=f"save {_rules_name(target, src).as_posix()}")
     if target.resolve() == src.resolve():
         return                            # over the original: its term sets in place
+    _check_link_elsewhere(target)
     originals = {(src.parent / rel).resolve(): rel for rel in original.termset_paths}
     for dest in targets:
         rel = originals.get(dest.resolve())
@@ -270,6 +271,19 @@ def _check_targets(target: Path, src: Path, original: RuleBase, targets: tuple[P
             f"`{dest}` is already there and no term set of `{target}`; saving as "
             f"`{target.name}` would write its term set over it",
             hint="remove it, or save under another name")
+
+
+def _check_link_elsewhere(target: Path) -> None:
+    """Refuse a save onto a symbolic link into another directory: the rule file is written
+    where the link leads, its term sets beside the link (where the link's name looks for
+    them), so the file the link leads to would not load."""
+    if not target.is_symlink() or target.resolve().parent == target.parent.resolve():
+        return
+    real = target.resolve()
+    raise LessonError(f"`{target}` is a link to `{real}`, in another directory: the rule file "
+                      "would be written there and its term sets beside the link, so "
+                      f"`{real.name}` would not find them",
+                      hint=f"save to `{real}` itself, or under a name that is no link")
 
 
 def nameless(target: str | Path) -> bool:
