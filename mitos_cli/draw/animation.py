@@ -112,30 +112,98 @@ def animate_run(result, path: str | Path, *, fps: float = 10.0, detail=None,
     _check_detail(detail, result.ticks)
     _matplotlib()
     from matplotlib import animation
-    from matplotlib.collections import PolyCollection
-    from matplotlib.patches import Circle, Polygon, Rectangle
 
-    from ..sim.geometry import rect_corners
-
-    world, static = result.world, result.static
-    xmin, ymin, xmax, ymax = static.bounds
-    pad = 20.0
-    w, h = xmax - xmin + 2 * pad, ymax - ymin + 2 * pad
     dpi = 80
-    fw = width_px / dpi
-    map_h = max(1.0, min(fw * h / w, 9.0))
-    panel_h = 1.6 if detail is not None else 0.0
-    fh = map_h + panel_h + 0.35
-    fig = new_figure((fw, fh), dpi=dpi)
-    fig.patch.set_facecolor("white")
-    ax = fig.add_axes((0.0, (panel_h + 0.05) / fh, 1.0, map_h / fh))
-    ax.set_aspect("equal")
-    ax.set_axis_off()
-    ax.set_facecolor("#d9d9d9")
-    route_lines = draw_background(ax, world, static, result.routes)
-    ax.set_xlim(xmin - pad, xmax + pad)
-    ax.set_ylim(ymin - pad, ymax + pad)
-    title = fig.text(0.01, 1.0 - 0.17 / fh, "", fontsize=10, va="center")
+    scene = _Scene(result, detail, width_px, dpi)
+    picked = frame_ticks(result.ticks, result.world.dt, fps)
+    writer = (_gif_writer()(fps=fps) if fmt == "gif"
+              else animation.FFMpegWriter(fps=fps))  # type: ignore[arg-type]
+    _save(scene.fig, scene.draw, picked, writer, Path(path), fmt, dpi)
+    return len(picked)
+
+
+class _Scene:
+    """The figure of a run and its moving parts (obstacles, robots and trails, sonar cones,
+    the DOF panel), which :meth:`draw` sets to a tick."""
+
+    PAD = 20.0                                 # world units round the map
+
+    def __init__(self, result, detail, width_px: int, dpi: int) -> None:
+        self.result, self.detail = result, detail
+        xmin, ymin, xmax, ymax = result.static.bounds
+        w, h = xmax - xmin + 2 * self.PAD, ymax - ymin + 2 * self.PAD
+        fw = width_px / dpi
+        map_h = max(1.0, min(fw * h / w, 9.0))
+        panel_h = 1.6 if detail is not None else 0.0
+        fh = map_h + panel_h + 0.35
+        self.fig = new_figure((fw, fh), dpi=dpi)
+        self.fig.patch.set_facecolor("white")
+        ax = self.fig.add_axes((0.0, (panel_h + 0.05) / fh, 1.0, map_h / fh))
+        ax.set_aspect("equal")
+        ax.set_axis_off()
+        ax.set_facecolor("#d9d9d9")
+        self.route_lines = draw_background(ax, result.world, result.static, result.routes)
+        ax.set_xlim(xmin - self.PAD, xmax + self.PAD)
+        ax.set_ylim(ymin - self.PAD, ymax + self.PAD)
+        self.title = self.fig.text(0.01, 1.0 - 0.17 / fh, "", fontsize=10, va="center")
+        self.obstacles = _obstacle_patches(ax, result.world)
+        self.robots, self.trails = _robot_patches(ax, result.world, result.pose.shape[1])
+        self.cones = _cone_collection(ax, result.static.bounds)
+        self.half_cone = max(result.world.sensors.cone, 2.0) / 2
+        self.bars: list | None = None
+        self.texts: list[_SlotText] | None = None
+        if detail is not None:
+            self.bars, self.texts = _dof_panel(self.fig, fh, panel_h, dpi)
+
+    def draw(self, k: int) -> None:
+        """The frame of tick ``k``."""
+        result, world = self.result, self.result.world
+        self.title.set_text(f"{world.name}   t = {result.t[k]:5.2f} s   ({result.planner})")
+        if result.replanned:                # each robot's route as it was at tick k
+            show_routes(self.route_lines,
+                        [result.route_at(k, i) for i in range(len(self.route_lines))])
+        self._draw_obstacles(k)
+        self._draw_robots(k)
+        if self.bars is not None and self.texts is not None:
+            self._draw_dofs(k, self.bars, self.texts)
+
+    def _draw_obstacles(self, k: int) -> None:
+        from matplotlib.patches import Circle
+
+        from ..sim.geometry import rect_corners
+
+        for (o, patch), (cx, cy) in zip(self.obstacles, self.result.obstacles[k].reshape(-1, 2)):
+            if isinstance(patch, Circle):
+                patch.set_center((cx, cy))
+            else:
+                patch.set_xy(rect_corners(cx, cy, np.deg2rad(o.angle), o.length, o.width))
+
+    def _draw_robots(self, k: int) -> None:
+        from ..sim.geometry import rect_corners
+
+        result, sen = self.result, self.result.world.sensors
+        sectors = []
+        for i, ((robot, body), trail) in enumerate(zip(self.robots, self.trails)):
+            x, y, heading = result.pose[k, i]
+            body.set_xy(rect_corners(x, y, np.deg2rad(heading), robot.length, robot.width))
+            trail.set_data(result.pose[:k + 1, i, 0], result.pose[:k + 1, i, 1])
+            sectors.append(_sectors(x, y, np.rad2deg(sen.angles) + heading, result.ranges[k, i],
+                                    self.half_cone))
+        self.cones.set_verts(list(np.concatenate(sectors)))
+
+    def _draw_dofs(self, k: int, bars: list, texts: list[_SlotText]) -> None:
+        dof, compiled = self.detail.dof[k], self.detail.compiled
+        order = [r for r in np.argsort(-dof, kind="stable")[:BARS] if dof[r] > 0]
+        for slot, (bar, text) in enumerate(zip(bars, texts)):
+            r = order[slot] if slot < len(order) else None
+            bar.set_width(float(dof[r]) if r is not None else 0.0)
+            text.show(None if r is None else (f"{dof[r]:.2f}",
+                                              f"{compiled.labels[r]}: {compiled.rule_text(r)}"))
+
+
+def _obstacle_patches(ax, world) -> list:
+    """Each obstacle of ``world`` with its patch (placed by :meth:`_Scene.draw`)."""
+    from matplotlib.patches import Circle, Polygon
 
     obstacles = []
     for o in world.obstacles:
@@ -144,7 +212,14 @@ def animate_run(result, path: str | Path, *, fps: float = 10.0, detail=None,
         patch.set(facecolor=OBSTACLE_COLOUR, edgecolor="#5c1f1a", lw=0.8, zorder=3)
         ax.add_patch(patch)
         obstacles.append((o, patch))
-    n = result.pose.shape[1]
+    return obstacles
+
+
+def _robot_patches(ax, world, n: int) -> tuple[list, list]:
+    """Each robot's body (with its robot) and trail: the first in the robot's colours, the
+    others in :data:`OTHER_ROBOTS`."""
+    from matplotlib.patches import Polygon
+
     colours = [ROBOT_COLOUR] + [OTHER_ROBOTS[i % len(OTHER_ROBOTS)] for i in range(n - 1)]
     robots, trails = [], []
     for i, agent in enumerate(world.agents):
@@ -155,58 +230,31 @@ def animate_run(result, path: str | Path, *, fps: float = 10.0, detail=None,
         ax.add_patch(body)
         robots.append((agent.robot, body))
         trails.append(trail)
+    return robots, trails
+
+
+def _cone_collection(ax, bounds):
+    """The sonar cones' collection, clipped to the map: no cone past the outer walls."""
+    from matplotlib.collections import PolyCollection
+    from matplotlib.patches import Rectangle
+
+    xmin, ymin, xmax, ymax = bounds
     cones = PolyCollection([], facecolor="#f2c14e", edgecolor="none", alpha=0.35, zorder=2)
     ax.add_collection(cones)
-    cones.set_clip_path(Rectangle((xmin, ymin), xmax - xmin, ymax - ymin,
-                                  transform=ax.transData))     # no cone past the outer walls
-    sen = world.sensors
-    half_cone = max(sen.cone, 2.0) / 2
+    cones.set_clip_path(Rectangle((xmin, ymin), xmax - xmin, ymax - ymin, transform=ax.transData))
+    return cones
 
-    bars = texts = None
-    if detail is not None:
-        bax = fig.add_axes((0.01, 0.05 / fh, 0.98, (panel_h - 0.1) / fh))
-        bax.set_xlim(0, 1)
-        bax.set_ylim(BARS - 0.5, -1.3)
-        bax.set_axis_off()
-        bax.text(0.0, -1.0, "fired rules, by DOF (the bar's length: 0 to 1)", fontsize=7,
-                 va="center", color="#333333")
-        bars = bax.barh(range(BARS), np.zeros(BARS), color="#b8cbe6", height=0.8)
-        texts = [_SlotText(fig, bax, slot, dpi) for slot in range(BARS)]
-        compiled = detail.compiled
 
-    picked = frame_ticks(result.ticks, world.dt, fps)
-
-    def draw(k: int):
-        t = result.t[k]
-        title.set_text(f"{world.name}   t = {t:5.2f} s   ({result.planner})")
-        if result.replanned:                # each robot's route as it was at tick k
-            show_routes(route_lines, [result.route_at(k, i) for i in range(len(route_lines))])
-        for (o, patch), (cx, cy) in zip(obstacles, result.obstacles[k].reshape(-1, 2)):
-            if isinstance(patch, Circle):
-                patch.set_center((cx, cy))
-            else:
-                patch.set_xy(rect_corners(cx, cy, np.deg2rad(o.angle), o.length, o.width))
-        sectors = []
-        for i, ((robot, body), trail) in enumerate(zip(robots, trails)):
-            x, y, heading = result.pose[k, i]
-            body.set_xy(rect_corners(x, y, np.deg2rad(heading), robot.length, robot.width))
-            trail.set_data(result.pose[:k + 1, i, 0], result.pose[:k + 1, i, 1])
-            sectors.append(_sectors(x, y, np.rad2deg(sen.angles) + heading, result.ranges[k, i],
-                                    half_cone))
-        cones.set_verts(list(np.concatenate(sectors)))
-        if bars is not None and texts is not None:
-            dof = detail.dof[k]
-            order = [r for r in np.argsort(-dof, kind="stable")[:BARS] if dof[r] > 0]
-            for slot, (bar, text) in enumerate(zip(bars, texts)):
-                r = order[slot] if slot < len(order) else None
-                bar.set_width(float(dof[r]) if r is not None else 0.0)
-                text.show(None if r is None else (f"{dof[r]:.2f}",
-                                                  f"{compiled.labels[r]}: {compiled.rule_text(r)}"))
-
-    writer = (_gif_writer()(fps=fps) if fmt == "gif"
-              else animation.FFMpegWriter(fps=fps))  # type: ignore[arg-type]
-    _save(fig, draw, picked, writer, Path(path), fmt, dpi)
-    return len(picked)
+def _dof_panel(fig, fh: float, panel_h: float, dpi: int) -> tuple[list, list]:
+    """The panel of the fired rules under the map: :data:`BARS` bars and their texts."""
+    bax = fig.add_axes((0.01, 0.05 / fh, 0.98, (panel_h - 0.1) / fh))
+    bax.set_xlim(0, 1)
+    bax.set_ylim(BARS - 0.5, -1.3)
+    bax.set_axis_off()
+    bax.text(0.0, -1.0, "fired rules, by DOF (the bar's length: 0 to 1)", fontsize=7,
+             va="center", color="#333333")
+    bars = bax.barh(range(BARS), np.zeros(BARS), color="#b8cbe6", height=0.8)
+    return list(bars), [_SlotText(fig, bax, slot, dpi) for slot in range(BARS)]
 
 
 def _sectors(x: float, y: float, bearings: np.ndarray, ranges: np.ndarray,
