@@ -139,43 +139,56 @@ def surface(compiled: CompiledRuleBase, output: str, x: str, y: str | None = Non
         raise unknown("output", f"{output!s:.40}", compiled.outputs, cls=InputError)
     if (n := whole_number(resolution)) is None or n < 2:     # (2.5 and "10" met TypeErrors)
         raise InputError(f"resolution is a whole number, 2 or more, not `{resolution!r:.40}`")
-    resolution = n
     ix = _input_axis(compiled, x, "--x")
     iy = _input_axis(compiled, y, "--y") if y is not None else None
     if iy == ix:
         raise InputError(f"`{x}` is on both axes", hint="choose two different inputs")
     fixed = dict(fixed or {})
     for name in fixed:
-        k = _input_axis(compiled, name, "--fix")
-        if k in (ix, iy):
+        if _input_axis(compiled, name, "--fix") in (ix, iy):
             raise InputError(f"`{name}` is on an axis and cannot also be fixed",
                              hint=f"drop --fix {name}=...")
+    ax_x = _axis(compiled, ix, x_range, n)
+    ax_y = _axis(compiled, iy, y_range, n) if iy is not None else None
+    held = _held(compiled, fixed, (ix, iy))
+    X = _grid(compiled, ix, ax_x, iy, ax_y, held)
+    z = evaluate(compiled, X, detail=False, strict=False).output(output)
+    if ax_y is not None:
+        z = z.reshape(len(ax_y.values), len(ax_x.values))
+    unit = compiled.variables[output].unit
+    return Surface(output, unit, ax_x, ax_y, z, tuple(held), compiled.behavior,
+                   declares_nan(compiled, output))
 
-    def axis(k: int, limits: tuple[float, float] | None) -> Axis:
-        lo, hi = compiled.universe[k]
-        if limits is not None:
-            name = compiled.inputs[k]
-            a, b = _pair(limits, f"the range of `{name}`")
-            _finite(f"range {a:g}:{b:g} of `{name}`", (a, b), (lo, hi))
-            if a > b:
-                raise InputError(f"range {a:g}:{b:g} of `{name}` is reversed: LOW comes first",
-                                 hint=f"write {name}={b:g}:{a:g}")
-            if a == b:
-                raise InputError(f"range {a:g}:{b:g} of `{name}` is empty: LOW and HIGH are "
-                                 f"the same", hint="give LOW:HIGH with LOW < HIGH")
-            if not (lo <= a < b <= hi):
-                raise InputError(f"range {a:g}:{b:g} of `{compiled.inputs[k]}` is not inside "
-                                 f"its universe [{lo:g}, {hi:g}]",
-                                 hint="give LOW:HIGH with LOW < HIGH inside the universe")
-            lo, hi = a, b
-        var = compiled.variables[compiled.inputs[k]]
-        return Axis(var.name, var.unit, np.linspace(lo, hi, resolution))
 
-    ax_x = axis(ix, x_range)
-    ax_y = axis(iy, y_range) if iy is not None else None
+def _axis(compiled: CompiledRuleBase, k: int, limits: tuple[float, float] | None,
+          resolution: int) -> Axis:
+    """Input ``k``'s axis: its universe, or the part ``limits`` zooms into."""
+    lo, hi = compiled.universe[k]
+    if limits is not None:
+        name = compiled.inputs[k]
+        a, b = _pair(limits, f"the range of `{name}`")
+        _finite(f"range {a:g}:{b:g} of `{name}`", (a, b), (lo, hi))
+        if a > b:
+            raise InputError(f"range {a:g}:{b:g} of `{name}` is reversed: LOW comes first",
+                             hint=f"write {name}={b:g}:{a:g}")
+        if a == b:
+            raise InputError(f"range {a:g}:{b:g} of `{name}` is empty: LOW and HIGH are "
+                             f"the same", hint="give LOW:HIGH with LOW < HIGH")
+        if not (lo <= a < b <= hi):
+            raise InputError(f"range {a:g}:{b:g} of `{name}` is not inside its universe "
+                             f"[{lo:g}, {hi:g}]",
+                             hint="give LOW:HIGH with LOW < HIGH inside the universe")
+        lo, hi = a, b
+    var = compiled.variables[compiled.inputs[k]]
+    return Axis(var.name, var.unit, np.linspace(lo, hi, resolution))
+
+
+def _held(compiled: CompiledRuleBase, fixed: dict[str, float],
+          axes: tuple[int, int | None]) -> list[Fixed]:
+    """The inputs on no axis, each at its value in ``fixed`` or its universe's midpoint."""
     held = []
     for k, name in enumerate(compiled.inputs):
-        if k in (ix, iy):
+        if k in axes:
             continue
         var = compiled.variables[name]
         if name in fixed:
@@ -190,9 +203,14 @@ def surface(compiled: CompiledRuleBase, output: str, x: str, y: str | None = Non
         if not lo <= f.value <= hi:
             raise InputError(f"--fix {f.name}={f.value:g} is outside its universe "
                              f"[{lo:g}, {hi:g}]")
+    return held
 
-    if ax_y is None:
-        X = np.empty((resolution, len(compiled.inputs)))
+
+def _grid(compiled: CompiledRuleBase, ix: int, ax_x: Axis, iy: int | None, ax_y: Axis | None,
+          held: list[Fixed]) -> np.ndarray:
+    """The inputs' rows: the axes' points (``y`` major), the held inputs' values."""
+    if ax_y is None or iy is None:
+        X = np.empty((len(ax_x.values), len(compiled.inputs)))
         X[:, ix] = ax_x.values
     else:
         gx, gy = np.meshgrid(ax_x.values, ax_y.values)        # [ny, nx]
@@ -201,12 +219,4 @@ def surface(compiled: CompiledRuleBase, output: str, x: str, y: str | None = Non
         X[:, iy] = gy.ravel()
     for f in held:
         X[:, compiled.inputs.index(f.name)] = f.value
-    result = evaluate(compiled, X, detail=False, strict=False)
-    z = result.output(output)
-    if ax_y is not None:
-        z = z.reshape(len(ax_y.values), len(ax_x.values))
-    unit = compiled.variables[output].unit
-    return Surface(output, unit, ax_x, ax_y, z, tuple(held), compiled.behavior,
-                   declares_nan(compiled, output))
-
-
+    return X
