@@ -205,16 +205,49 @@ def draw_terms_before_after(variable_before: Variable, variable_after: Variable,
     Raises :class:`mitos_cli.draw.output.DrawError` (a ``MitosError``) for another extension
     or when matplotlib is missing.
     """
-    for given in (variable_before, variable_after):     # (None met an AttributeError)
+    _check_pair(variable_before, variable_after)
+    before = variable_plot(variable_before)
+    after = variable_plot(variable_after)
+    changes = term_changes(variable_before, variable_after)
+    fig = new_figure((8.0, 4.2 + 0.22 * len(changes)), show, layout="constrained")
+    ax = fig.subplots()
+    style_axes(ax, after)
+    order = _colour_order(before, after)
+    draw_curves(ax, before, colors=[color(order[c.name]) for c in before.curves],
+                linestyle="--", alpha=0.55, fill=False, labels=False)
+    draw_curves(ax, after, colors=[color(order[c.name]) for c in after.curves])
+    stagger_labels(fig)
+    from matplotlib.lines import Line2D
+
+    ax.legend(handles=[Line2D([], [], color="#555555", linestyle="--", alpha=0.6,
+                              label="before"),
+                       Line2D([], [], color="#555555", linestyle="-", label="after")],
+              loc="center right", fontsize=8)
+    ax.set_title(title or f"{after.name}: terms before and after adaptation", loc="left",
+                 fontsize=11)
+    if changes:
+        ax.text(0.0, -0.2, "changed: " + "\n         ".join(changes), transform=ax.transAxes,
+                va="top", fontsize=8, family="monospace")
+    return finish(fig, path, show)
+
+
+
+def _check_pair(variable_before: Variable, variable_after: Variable) -> None:
+    """Refuse anything but one :class:`Variable` twice (None met an AttributeError, and two
+    variables were drawn as one moved, without a word)."""
+    for given in (variable_before, variable_after):
         if not isinstance(given, Variable):
             raise InputError(f"a variable before and after is a Variable, not "
                              f"{type(given).__name__} `{given!r:.40}`",
                              hint="loaded.rulebase.variables['road'], before and after teach")
-    if variable_before.name != variable_after.name:     # (drawn as one moved, without a word)
+    if variable_before.name != variable_after.name:
         raise InputError(f"before and after are two variables, `{variable_before.name}` and "
                          f"`{variable_after.name}`: give the same variable twice")
-    before = variable_plot(variable_before)
-    after = variable_plot(variable_after)
+
+
+def term_changes(variable_before: Variable, variable_after: Variable) -> list[str]:
+    """One line per term that changed: new, removed, another shape, or its parameters
+    (``MEDIUM: peak 70 → 74, width 30 → 34``)."""
     changes = []
     old = {t.name: t for t in variable_before.terms}
     for t in variable_after.terms:
@@ -232,32 +265,16 @@ def draw_terms_before_after(variable_before: Variable, variable_after: Variable,
     for name in old:
         if name not in variable_after.term_names:
             changes.append(f"{name}: removed")
-    fig = new_figure((8.0, 4.2 + 0.22 * len(changes)), show, layout="constrained")
-    ax = fig.subplots()
-    style_axes(ax, after)
-    # the same term keeps its colour in both: colour by the after-term's position
-    order = {c.name: i for i, c in enumerate(after.curves)}
-    extra = len(order)
-    for c in before.curves:
-        if c.name not in order:
-            order[c.name] = extra
-            extra += 1
-    draw_curves(ax, before, colors=[color(order[c.name]) for c in before.curves],
-                linestyle="--", alpha=0.55, fill=False, labels=False)
-    draw_curves(ax, after, colors=[color(order[c.name]) for c in after.curves])
-    stagger_labels(fig)
-    from matplotlib.lines import Line2D
+    return changes
 
-    ax.legend(handles=[Line2D([], [], color="#555555", linestyle="--", alpha=0.6,
-                              label="before"),
-                       Line2D([], [], color="#555555", linestyle="-", label="after")],
-              loc="center right", fontsize=8)
-    ax.set_title(title or f"{after.name}: terms before and after adaptation", loc="left",
-                 fontsize=11)
-    if changes:
-        ax.text(0.0, -0.2, "changed: " + "\n         ".join(changes), transform=ax.transAxes,
-                va="top", fontsize=8, family="monospace")
-    return finish(fig, path, show)
+
+def _colour_order(before, after) -> dict[str, int]:
+    """Each term's colour index: a term keeps its colour in both plots (by its place among
+    the after-terms; a removed term after them)."""
+    order = {c.name: i for i, c in enumerate(after.curves)}
+    for c in before.curves:
+        order.setdefault(c.name, len(order))
+    return order
 
 
 __all__ = ["draw_sheet", "draw_panel", "draw_terms_before_after"]
