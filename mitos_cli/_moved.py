@@ -47,7 +47,7 @@ class _Loader:
 
     def exec_module(self, module) -> None:  # the import system stamped the old name's spec on it
         module.__spec__ = self.spec
-        module.__loader__ = self.spec.loader
+        module.__loader__ = self.spec.loader if self.spec is not None else None
 
 
 class _Finder:
@@ -57,7 +57,8 @@ class _Finder:
             return None
         new = f"mitos_cli.{MOVED[tail]}"
         warn_moved(fullname, new, stacklevel=4)
-        return importlib.util.spec_from_loader(fullname, _Loader(new))
+        # a duck-typed loader: importlib.abc costs start-up (docs/benchmarks.md)
+        return importlib.util.spec_from_loader(fullname, _Loader(new))  # type: ignore[arg-type]
 
 
 def install() -> None:

@@ -45,7 +45,7 @@ from __future__ import annotations
 
 import re
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -60,6 +60,10 @@ except ImportError as exc:  # pragma: no cover - the extra is missing
 
 from .errors import CommandError, InputError, WorldError, closest, unknown
 from .sim.world import World
+
+if TYPE_CHECKING:                      # drawn only when rendered: imported there
+    from .draw.frame import RunFrame
+    from .sim.live import LiveView
 
 PROGRESS_REWARD = 0.01      # per inch of route
 COLLISION_PENALTY = -10.0
@@ -150,8 +154,8 @@ class MitosEnv(gymnasium.Env):
         self.sim = Simulation(loaded, _Commanded(), loaded.seed)
         self._seeded = False
         self._trail: list[np.ndarray] | None = None        # the robot's places; None till reset
-        self._frame = None
-        self._live = None
+        self._frame: RunFrame | None = None
+        self._live: LiveView | None = None
 
     # -- the policy mitos simulate uses -------------------------------------------------------
 

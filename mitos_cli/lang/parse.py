@@ -27,7 +27,7 @@ from ..fuzzy.hedges import HEDGES
 from ..resources import grammar_text
 from .bulk import without_cyclic_gc
 from .cache import lark_parser
-from .model import And, Behavior, Consequent, Not, Or, Prop, Rule, Setting, Use
+from .model import And, Behavior, Consequent, Expr, Not, Or, Prop, Rule, Setting, Use
 
 HEDGE_NAMES = tuple(HEDGES)          # the grammar's HEDGE words (tests/test_registries.py)
 
@@ -416,14 +416,14 @@ class _ToModel(Transformer):
 
     @v_args(meta=True)
     def and_expr(self, meta, items):
-        flat = []
+        flat: list[Expr] = []
         for item in items:
             flat.extend(item.items if isinstance(item, And) else [item])
         return And(tuple(flat), self._s(meta))
 
     @v_args(meta=True)
     def or_expr(self, meta, items):
-        flat = []
+        flat: list[Expr] = []
         for item in items:
             flat.extend(item.items if isinstance(item, Or) else [item])
         return Or(tuple(flat), self._s(meta))
