@@ -116,12 +116,14 @@ def _lines(text: str) -> tuple[str, ...]:
 SHOWN = 240
 #: a quoted token of input in a message (`...`, no spaces: the words between two quotes of
 #: one message are not a token) too long to be read
-_QUOTED = re.compile(r"`([^`\s]{81,})`")
+_QUOTED = re.compile(r"`([^`\s]{201,})`")
 
 
 def _shorten(match: re.Match[str]) -> str:
     """A long quoted piece of a message as its start and end (a mutated file's 200,000-digit
-    number quoted whole buries the message)."""
+    number quoted whole buries the message). Past 200 characters, not 80: a file's path in a
+    deep directory (`/home/.../taught.rules`, 85 characters) was abridged where the user needs
+    it whole."""
     quoted = match.group(1)
     return f"`{quoted[:40]}...{quoted[-20:]}` ({len(quoted):,} characters)"
 

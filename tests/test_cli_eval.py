@@ -127,9 +127,11 @@ def test_batch_errors(capsys, tmp_path, text, message):
     assert code == 1 and message in err and out == ""
 
 
-def test_a_batch_that_is_not_utf8_is_placed_at_its_byte(capsys, tmp_path):
-    """The fuzz audit: the place was in prose only, where every other reader puts it first."""
-    csv = tmp_path / "bad.csv"
+def test_a_batch_that_is_not_utf8_is_placed_at_its_byte(capsys, tmp_path, monkeypatch):
+    """The fuzz audit: the place was in prose only, where every other reader puts it first.
+    (Named relative: a long temporary path is shortened in the message.)"""
+    monkeypatch.chdir(tmp_path)
+    csv = Path("bad.csv")
     csv.write_bytes(b"road,size,position\n78,45,4\n78,\xff,4\n")
     code, out, err = run_main(["eval", "--batch", str(csv)], capsys)
     assert code == 1 and err.startswith(f"{csv}:3:4: input error: cannot read batch file `{csv}`: "

@@ -214,7 +214,7 @@ def test_a_missing_rule_file_guesses_only_a_close_name(tmp_path, capsys):
         with pytest.raises(SystemExit) as info:
             main(args)
         err = capsys.readouterr().err
-        # a long temporary path is abridged: `.../x.rules` (85 characters) not found
+        # a path over 200 characters is abridged: `.../x.rules` (230 characters) not found
         assert info.value.code == 1
         assert re.search(r"rule file `.*` (\(\d+ characters\) )?not found", err), err
         assert (f"hint: {hint}" in err) if hint else "did you mean" not in err, err
