@@ -26,6 +26,7 @@ from .engine.evaluation import (
 from .engine.trace import Trace, trace_of
 from .errors import MitosError
 from .lang.model import RuleBase
+from .lang.terms import TermSet
 from .resources import DEFAULT_RULEBASE, packaged_path
 
 #: The types the one-sample path of :meth:`LoadedRuleBase.evaluate` takes as they are (not
@@ -56,7 +57,8 @@ def read_rulebase(path: str | Path | None = None) -> RuleBase:
 
         raise RuleBaseError(f"`{path}` is a YAML file (a term set, or a world), not a rule "
                             f"base", hint="a rule base is a .rules, .fcl, .fis or .fll file; "
-                            "a term set is read through the `terms` line of its .rules file")
+                            "a term set is read through the `terms` line of its .rules file "
+                            "(`mitos plot terms` and `mitos check` also take one alone)")
     try:
         return _read_by_extension(path)
     except MitosError as exc:
@@ -64,6 +66,33 @@ def read_rulebase(path: str | Path | None = None) -> RuleBase:
 
         hint_wrong_reader(exc, path)
         raise
+
+
+def is_termset_name(path: str | Path | None) -> bool:
+    """Whether ``path`` names a YAML file, which the commands that draw or check terms read
+    as a term set on its own."""
+    return path is not None and Path(path).suffix.lower() in (".yaml", ".yml")
+
+
+def read_termset(path: str | Path) -> TermSet:
+    """Read a term set (YAML) on its own, to draw or check its terms before any rule reads
+    them; a packaged one by its name (``rulebases/mitos.terms.yaml``) from anywhere."""
+    from .errors import TermSetError
+    from .fileio import nearby
+    from .lang.termfile import load_termset
+    from .resources import packaged_names, packaged_place, resolve
+
+    given = _path_given(path)
+    found = resolve("rulebases", given, ".terms.yaml") or Path(given)
+    try:
+        return load_termset(found)
+    except TermSetError as exc:
+        if exc.hint is not None or found.exists():
+            raise
+        packaged = (packaged_names("rulebases", ".yaml")
+                    if packaged_place(found.parent.as_posix(), "rulebases") else ())
+        raise TermSetError(exc.message, span=exc.span,
+                           hint=nearby(found, (".yaml", ".yml"), packaged)) from None
 
 
 def _read_by_extension(path: Path) -> RuleBase:

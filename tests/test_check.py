@@ -625,3 +625,37 @@ def test_a_report_names_each_file_once(tmp_path, monkeypatch):
     report = check_rulebase(read_rulebase(_many_triangles(tmp_path, 300)))
     text = render(report, "big.rules")
     assert text.count("big.terms.yaml:") >= 300 and len(asked) == len(set(asked)) <= 2
+
+
+def test_a_term_set_alone_is_checked_for_its_terms(tmp_path, capsys):
+    """`mitos check X.terms.yaml`: the findings terms have before any rule reads them (a
+    gap, terms out of order), at their lines; a world or a map named there is said to be one."""
+    (tmp_path / "t.terms.yaml").write_text(
+        "variables:\n"
+        "  x:\n    role: input\n    universe: [0, 10]\n    terms:\n"
+        "      LO: {shape: triangle, points: [0, 2, 5]}\n"
+        "      MID: {shape: triangle, points: [5, 8, 10]}\n"
+        "      HI: {shape: triangle, points: [2, 5, 8]}\n"
+        "  g:\n    role: input\n    universe: [0, 10]\n    terms:\n"
+        "      A: {shape: triangle, points: [0, 1, 2]}\n"
+        "      B: {shape: triangle, points: [8, 9, 10]}\n")
+    code, out, _ = run(["check", str(tmp_path / "t.terms.yaml")], capsys)
+    assert code == 0
+    assert f"{tmp_path / 't.terms.yaml'}:7:7: warning: `x.HI` (5) is written after `MID` (8) " \
+        "but does not lie above it: the terms are out of order [term-order]" in out
+    assert "[term-gap]" in out and "[unused-term]" not in out
+    assert "the term set's 2 variables (no rules)" in out
+    code, out, _ = run(["check", "--json", str(tmp_path / "t.terms.yaml")], capsys)
+    data = json.loads(out)
+    assert data["termset"].endswith("t.terms.yaml") and data["behaviors"] == []
+    assert {f["code"] for f in data["findings"]} >= {"term-order", "term-gap"}
+    code, _, err = run(["check", str(tmp_path / "t.terms.yaml"), "-b", "drive"], capsys)
+    assert code == 2 and "is a term set, which has no behaviors" in err
+    code, out, _ = run(["check", "rulebases/drive.terms.yaml"], capsys)   # packaged, anywhere
+    assert code == 0 and "0 errors, 0 warnings, 0 notes - OK" in out
+    world = tmp_path / "w.yaml"
+    world.write_text("name: w\nq_init: [0, 0, 0]\nq_goal: [9, 0]\n")
+    code, _, err = run(["check", str(world)], capsys)
+    assert code == 1 and "is a world file, not a term set" in err and "mitos simulate" in err
+    code, _, err = run(["check", str(tmp_path / "t.term.yaml")], capsys)
+    assert code == 1 and "did you mean `" in err and "t.terms.yaml`?" in err

@@ -584,3 +584,25 @@ def test_a_backend_matplotlib_cannot_use_is_said_without_a_traceback(backend, ar
                           cwd=tmp_path)
     assert done.returncode == 1 and "Traceback" not in done.stderr, done.stderr
     assert says in done.stderr and "hint: unset MPLBACKEND" in done.stderr
+
+
+def test_terms_of_a_term_set_alone(tmp_path, capsys):
+    """`mitos plot terms X.terms.yaml`: its variables drawn as the rule file's sheet draws
+    them (a packaged one from anywhere), values marked; `-b` needs the rule file."""
+    code, out, err = run(["plot", "terms", "rulebases/mitos.terms.yaml", "road=78"], capsys)
+    assert code == 0, err
+    assert "road = 78 in: MEDIUM 0.73, WIDE 0.27" in out and "steering:" in out
+    code, out, err = run(["plot", "terms", "rulebases/drive.terms.yaml", "-v", "heading",
+                          "-o", str(tmp_path / "h.png")], capsys)
+    assert code == 0 and (tmp_path / "h.png").read_bytes()[:8] == PNG
+    code, _, err = run(["plot", "terms", "rulebases/drive.terms.yaml", "-b", "drive"], capsys)
+    assert code == 2 and "is a term set, which has no behaviors" in err
+    code, _, err = run(["plot", "terms", "rulebases/mitos.terms.yaml", "-v", "roadd"], capsys)
+    assert code == 1 and "did you mean `road`?" in err
+    rb = load_rulebase().rulebase
+    alone = plotdata.sheet(rb.termsets[0])
+    beside = plotdata.sheet(rb, sorted((v.name for v in rb.termsets[0].variables),
+                                       key=lambda n: rb.variables[n].role != "input"))
+    assert [p.name for p in alone] == [p.name for p in beside]
+    assert all(np.array_equal(a.y, b.y) for p, q in zip(alone, beside)
+               for a, b in zip(p.curves, q.curves))

@@ -55,12 +55,29 @@ def render(report, trace_path: str) -> str:
               (("error", "error"), ("warning", "warning"), ("info", "note"))]
     if lines:
         lines.append("")
-    lines.append(f"checked {trace_path}: {grids}")
+    if report.rulebase.behaviors:
+        lines.append(f"checked {trace_path}: {grids}")
+    else:                                   # a term set alone: its terms, no rules
+        lines.append(f"checked {trace_path}: the term set's "
+                     f"{plural(len(report.rulebase.variables), 'variable')} (no rules)")
     for g in report.grids:
         if g.skipped:
             lines.append(skipped_note(g))
     lines.append(", ".join(counts) + (" - OK" if report.ok else ""))
     return "\n".join(lines)
+
+
+def _check_termset(path, behavior: str | None):
+    """A term set's own findings (:func:`..engine.check.check_termset`); ``-b`` needs the
+    rule file that reads it."""
+    from ..api import read_termset
+    from ..engine.check import check_termset
+    from ..errors import UsageError
+
+    if behavior is not None:
+        raise UsageError(f"`{path}` is a term set, which has no behaviors: -b {behavior} needs "
+                         "the rule file that reads it")
+    return check_termset(read_termset(path))
 
 
 def skipped_note(grid) -> str:
@@ -76,7 +93,7 @@ def skipped_note(grid) -> str:
 
 def to_json(report, trace_path: str) -> dict:
     return {
-        "rulebase": trace_path,
+        ("rulebase" if report.rulebase.behaviors else "termset"): trace_path,
         "ok": report.ok,
         "threshold": report.threshold,
         "behaviors": [{"name": g.behavior, "samples": g.samples,
@@ -115,14 +132,17 @@ def check_command(
     Also low total DOF, contradictions, and gaps between the terms of an input. Exits 1 on
     an error: inputs where no rule sets an output that has no default, or rules with the
     same condition and different actions."""
-    from ..api import read_rulebase
+    from ..api import is_termset_name, read_rulebase
     from ..engine.check import check_rulebase
     from ..resources import display_path
 
-    rb = read_rulebase(rulebase)
-    warn_notes(rb)
-    report = check_rulebase(rb, behavior, threshold=threshold, resolution=resolution)
-    name = display_path(rb.path)
+    if is_termset_name(rulebase):
+        report = _check_termset(rulebase, behavior)
+    else:
+        rb = read_rulebase(rulebase)
+        warn_notes(rb)
+        report = check_rulebase(rb, behavior, threshold=threshold, resolution=resolution)
+    name = display_path(report.rulebase.path)
     if as_json:
         emit(json_text(to_json(report, name)))
     else:

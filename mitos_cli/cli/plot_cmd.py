@@ -17,6 +17,7 @@ from typing import Annotated, Optional
 
 import typer
 
+from ..errors import UsageError
 from ..numbers import parse_number
 from .eval_cmd import parse_values, refuse_nan, split_args, unused_inputs
 from .help import epilog
@@ -164,13 +165,17 @@ def terms_command(
 
     All variables on one sheet (the paper's Figures 5-9) unless --var picks some. Without -o or
     --show the plot is drawn in the terminal with Unicode characters."""
-    from ..api import read_rulebase
+    from ..api import is_termset_name, read_rulebase, read_termset
     from ..draw.data import sheet
     from ..resources import display_path
 
     _one_way(output, show, title=title, width=width, color=color)
     path, texts = split_args(args or [])
-    rulebase = read_rulebase(path)
+    if is_termset_name(path) and behavior is not None:
+        raise UsageError(f"`{path}` is a term set, which has no behaviors: -b {behavior} needs "
+                         "the rule file that reads it")
+    rulebase = (read_termset(path) if path is not None and is_termset_name(path)
+                else read_rulebase(path))
     values = parse_values(texts)
     plots = sheet(rulebase, var, values, behavior)
     _warn_undrawn(values, plots, "--var" if var else "-b")

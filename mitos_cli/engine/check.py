@@ -78,7 +78,7 @@ from ..lang.model import (
     format_consequent,
     format_expr,
 )
-from ..lang.terms import Variable
+from ..lang.terms import TermSet, Variable
 from .compile import CompiledRuleBase, compile_rulebase
 from .evaluation import BLOCK_CELLS, declares_nan, rule_dofs
 
@@ -205,6 +205,17 @@ def check_rulebase(rb: RuleBase, behavior: str | None = None, *, threshold: floa
     order = {s: i for i, s in enumerate(SEVERITIES)}
     findings.sort(key=lambda f: (order[f.severity], _span_key(f.span)))
     return Report(rb, tuple(findings), tuple(grids), threshold, tuple(names))
+
+
+def check_termset(ts: TermSet) -> Report:
+    """The findings a term set has on its own, before any rule reads it: input terms that
+    never reach 1 or leave gaps, and the interpretability checks (order, coverage, distinct
+    terms, centre terms on their points). The rules' findings need a rule file."""
+    rb = RuleBase(ts.path, (ts,), ())
+    findings = _term_gaps(rb) + _interpretability(rb)
+    order = {s: i for i, s in enumerate(SEVERITIES)}
+    findings.sort(key=lambda f: (order[f.severity], _span_key(f.span)))
+    return Report(rb, tuple(findings), (), 0.0)
 
 
 #: operator settings that only Mamdani inference reads

@@ -93,6 +93,10 @@ def parse_termset(text: str, path: str | None = None) -> TermSet:
     top = Span.in_text(text, path, 1, 1)
     if not isinstance(data, YMap):
         raise TermSetError("a term set must be a mapping with a `variables:` key", span=top)
+    other = _other_kind(data)
+    if other is not None:
+        raise TermSetError(f"`{path}` is {other[0]}, not a term set", span=top,
+                           expected="a YAML file with a `variables:` key", hint=other[1])
     yamlpos.check_keys(data, ("variables",), TermSetError, "the term set")
     variables = yamlpos.require(data, "variables", TermSetError, "the term set")
     variables = yamlpos.expect_map(variables, data.value_span("variables"), TermSetError,
@@ -105,6 +109,26 @@ def parse_termset(text: str, path: str | None = None) -> TermSet:
     if not out:
         raise TermSetError("the term set defines no variables", span=data.span)
     return TermSet(out, path)
+
+
+#: The keys that tell a world file or a map's YAML, named where a term set was expected.
+_OTHER_KINDS = (
+    (("q_init", "q_goal", "obstacles", "robots", "robot", "sensors"), "a world file",
+     "`mitos simulate` reads worlds; a term set is a mapping with a `variables:` key"),
+    (("image", "resolution", "origin", "occupied_thresh"), "a map's YAML (ROS map_server)",
+     "a world names it under `map:`; a term set is a mapping with a `variables:` key"),
+)
+
+
+def _other_kind(data: YMap) -> tuple[str, str] | None:
+    """What a YAML mapping without ``variables`` is instead (a world, a map), with a hint:
+    "unknown key `name` in the term set" said nothing of what the file was."""
+    if "variables" in data:
+        return None
+    for keys, what, hint in _OTHER_KINDS:
+        if any(k in data for k in keys):
+            return what, hint
+    return None
 
 
 #: a name a rule can write (the rule language's NAME)

@@ -9,7 +9,7 @@ import numpy as np
 
 from ...errors import InputError, unknown
 from ...lang.model import RuleBase
-from ...lang.terms import Term, Variable
+from ...lang.terms import Term, TermSet, Variable
 
 #: Samples per term curve (corner points are added to these).
 CURVE_POINTS = 401
@@ -118,13 +118,17 @@ def _label_x(x: np.ndarray, y: np.ndarray, center: float) -> float:
     return center if np.isfinite(center) else float((x.min() + x.max()) / 2) if x.size else 0.0
 
 
-def termset_inputs(rulebase: RuleBase, variable: str) -> tuple[str, ...]:
+def termset_inputs(source: RuleBase | TermSet, variable: str) -> tuple[str, ...]:
     """The input variables of the term set that defines ``variable`` (the layout of its
     ``linear`` terms' coefficients)."""
-    for ts in rulebase.termsets:
+    for ts in _termsets(source):
         if any(v.name == variable for v in ts.variables):
             return tuple(v.name for v in ts.variables if v.role == "input")
     return ()
+
+
+def _termsets(source: RuleBase | TermSet) -> tuple[TermSet, ...]:
+    return (source,) if isinstance(source, TermSet) else source.termsets
 
 
 def variable_plot(variable: Variable, value: float | None = None, *,
@@ -154,13 +158,13 @@ def variable_plot(variable: Variable, value: float | None = None, *,
                         (variable.universe[0], variable.universe[1]), curves, value, mus, clamped)
 
 
-def sheet(rulebase: RuleBase, names: list[str] | None = None,
+def sheet(rulebase: RuleBase | TermSet, names: list[str] | None = None,
           values: dict[str, float] | None = None, behavior: str | None = None,
           points: int = CURVE_POINTS) -> tuple[VariablePlot, ...]:
-    """The membership sheet: every variable of the rule base (inputs first, in file order),
-    only those ``behavior`` uses, or the ``names`` asked for; ``values`` marked. Unknown
-    names get a "did you mean"."""
-    variables = rulebase.variables
+    """The membership sheet: every variable of the rule base or term set (inputs first, in
+    file order), only those ``behavior`` uses, or the ``names`` asked for; ``values`` marked.
+    Unknown names get a "did you mean"."""
+    variables = {v.name: v for ts in _termsets(rulebase) for v in ts.variables}
     if isinstance(names, str):      # ("road" was read letter by letter: unknown variable `r`)
         raise InputError(f"names is a list of variable names, not the text `{names:.40}`",
                          hint=f"sheet(rulebase, [{names[:40]!r}])")
@@ -172,7 +176,10 @@ def sheet(rulebase: RuleBase, names: list[str] | None = None,
         chosen = [variables[n] for n in dict.fromkeys(names)]
     else:
         chosen = sorted(variables.values(), key=lambda v: v.role != "input")
-        if behavior is not None:
+        if behavior is not None and isinstance(rulebase, TermSet):
+            raise InputError(f"a term set has no behaviors: behavior `{behavior:.40}` needs "
+                             "the rule file that reads it")
+        if behavior is not None and isinstance(rulebase, RuleBase):
             from ...engine.compile import compile_rulebase
 
             compiled = compile_rulebase(rulebase, behavior)
