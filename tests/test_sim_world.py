@@ -1044,3 +1044,15 @@ def test_an_obstacle_built_in_python_that_moves_past_its_size_is_refused():
     with pytest.raises(WorldError, match=r"obstacles\[0\]\.motion\.velocity` must be at most "
                                          r"240 in/s at dt 0\.05 s"):
         Simulation(replace(world, obstacles=(fast,)), seed=1)
+
+
+def test_a_term_set_named_as_a_world_is_said_to_be_one():
+    """"unknown key `variables` in the world file" said nothing of what the file was."""
+    text = (Path(__file__).parents[1] / "rulebases" / "mitos.terms.yaml").read_text()
+    with pytest.raises(WorldError) as info:
+        parse_world(text, "m.terms.yaml")
+    assert info.value.message == "`m.terms.yaml` is a term set, not a world file"
+    assert (info.value.span.line, info.value.span.column) == (1, 1)
+    assert "mitos plot terms" in info.value.hint
+    with pytest.raises(WorldError, match="unknown key `variables`"):   # a world with it
+        parse_world(BASE + "variables: {}\n", "w.yaml")

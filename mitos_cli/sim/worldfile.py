@@ -460,10 +460,21 @@ def _check_extent(corridors: list[Corridor], span: Span | None) -> None:
                          hint="a smaller building, or a `grid` map at a coarser resolution")
 
 
+def _not_a_termset(doc: Any, span: Span) -> None:
+    """Refuse a term set named as a world, saying so: "unknown key `variables` in the world
+    file" said nothing of what the file was."""
+    if isinstance(doc, YMap) and "variables" in doc and not any(k in doc for k in TOP_KEYS):
+        raise WorldError(f"`{span.path}` is a term set, not a world file", span=span,
+                         expected="a world: `name`, `q_init`, `q_goal`, `map` and more",
+                         hint="a rule file reads a term set through its `terms` line; "
+                              "`mitos plot terms` and `mitos check` take one alone")
+
+
 def parse_world(text: str, path: str) -> World:
     """Parse world YAML ``text`` (read from ``path``, which anchors relative map paths)."""
     r = _Reader(path)
     doc = yamlpos.load(text, path, WorldError)
+    _not_a_termset(doc, Span.in_text(text, path, 1, 1))
     top = r.mapping(doc, Span.in_text(text, path, 1, 1), "the world file", TOP_KEYS)
     name = _name(top)
     seed = _seed(r, top)
