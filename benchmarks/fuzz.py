@@ -602,6 +602,10 @@ class Kinds:
         # beside the shipped term sets, which a rule file names relative to itself
         return ["check", self._file(self.rb_dir, "fuzz.rules", text), "-n", "5"]
 
+    def argv_termset(self, text: str, work: Path) -> list[str]:
+        # `mitos check` reads a term set alone (plot terms reads it the same way)
+        return ["check", self._file(work, "fuzz.terms.yaml", text)]
+
     def argv_foreign(self, ext: str) -> Callable:
         def argv(text: str, work: Path) -> list[str]:
             return ["check", self._file(work, "fuzz" + ext, text), "-n", "5"]
@@ -742,7 +746,8 @@ class Kinds:
         k = self
         return [
             Kind("rule files", rules, rule_mut, k.run_rules, ".rules", k.argv_rules),
-            Kind("term-set YAML", termsets, ymut, k.run_termset, ".terms.yaml"),
+            Kind("term-set YAML", termsets, ymut, k.run_termset, ".terms.yaml",
+                 k.argv_termset),
             Kind("world YAML", worlds, ymut, k.run_world, ".yaml"),
             Kind("map YAML + PGM", maps + small_pgms, ymut, k.run_map, ".yaml"),
             Kind("FCL", fcl, fmut, k.run_foreign("fcl"), ".fcl", k.argv_foreign(".fcl")),
