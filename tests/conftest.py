@@ -6,6 +6,8 @@ import os
 import sys
 import tempfile
 
+import pytest
+
 # The parsed-rule-base cache of this test run lives in a fresh directory (inherited by the
 # CLI subprocesses the tests start), never in the user's ~/.cache.
 os.environ.setdefault("MITOS_CACHE_DIR", tempfile.mkdtemp(prefix="mitos-test-cache-"))
@@ -23,3 +25,15 @@ from hypothesis import settings  # noqa: E402
 settings.register_profile("repeatable", derandomize=True, database=None)
 settings.register_profile("explore", max_examples=500)
 settings.load_profile("repeatable")
+
+
+@pytest.fixture
+def sigint():
+    """Ctrl-C as Python takes it by default, for a test that sends itself one: a test run
+    started in the background inherits SIGINT ignored, and the signal was then lost ("DID NOT
+    RAISE KeyboardInterrupt")."""
+    import signal
+
+    old = signal.signal(signal.SIGINT, signal.default_int_handler)
+    yield
+    signal.signal(signal.SIGINT, old)

@@ -706,8 +706,8 @@ def test_a_save_over_the_original_killed_before_its_record_is_the_sessions_own(r
     assert rules.read_text() == original
 
 
-def test_ctrl_c_once_a_save_over_the_original_is_written_keeps_the_next_save(rules,
-                                                                             monkeypatch):
+def test_ctrl_c_once_a_save_over_the_original_is_written_keeps_the_next_save(rules, monkeypatch,
+                                                                             sigint):
     """A Ctrl-C after a save over the original wrote its files and before the session took
     note of them: the next save over them was refused, as if another program had changed
     them."""

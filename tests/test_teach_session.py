@@ -906,7 +906,8 @@ def test_undo_replays_without_checking_or_parsing_again(rules, monkeypatch):
     assert s.rulebase != before
 
 
-def test_ctrl_c_during_the_journal_write_keeps_the_journal_whole(rules, tmp_path, monkeypatch):
+def test_ctrl_c_during_the_journal_write_keeps_the_journal_whole(rules, tmp_path, monkeypatch,
+                                                                sigint):
     """Ctrl-C while the journal's line was being synced to disk (the longest part of a
     change) raised after the line was written and before the session counted it: the next
     change was numbered alike, and `--resume` refused the journal at it."""
