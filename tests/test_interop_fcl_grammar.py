@@ -76,7 +76,7 @@ REFUSED = [
     (HIGH, "TERM high := TRIAN 0 mid 10;", "a parameter given by a variable (`mid`)"),
     (HIGH, "TERM high := (0, 0) (mid, 1);", "a parameter given by a variable (`mid`)"),
     ("DEFAULT := 0;", "DEFAULT := NC;", "`DEFAULT := NC` (no change"),
-    ("METHOD : COG;", "METHOD : COGF;", "fast centre of gravity"),
+    ("METHOD : COG;", "METHOD : COGF;", "centre of gravity of FUNCTION terms"),
     ("METHOD : COG;", "METHOD : COGS;", "not a `triangle` term"),
     ("ACCU : MAX;", "ACCU : NSUM;", "the normalized sum"),
     ("ACCU : MAX;", "ACCU : SUM;", "the unbounded sum"),
@@ -180,3 +180,43 @@ def test_the_iec_dialect_writes_what_jfuzzylogics_grammar_reads():
     np.testing.assert_array_equal(after, before)
     fuzzylite = write_foreign(rb, "fcl")            # fuzzylite 6 reads RANGE in FUZZIFY
     assert "FUZZIFY a\n    RANGE := (0 .. 10);" in fuzzylite and "DEFAULT := nan;" in fuzzylite
+
+
+SINGLETONS = BASE.replace("TERM lo := (0, 0) (2, 1) (4, 0);", "TERM lo := 2;").replace(
+    "TERM hi := (6, 0) (8, 1) (10, 0);", "TERM hi := 8;").replace("METHOD : COG;", "METHOD : COGS;")
+
+
+@pytest.mark.parametrize("accu, third, warned", [
+    ("ACCU : MAX;", "RULE 3 : IF b IS high THEN y IS hi;", True),
+    ("ACCU : PROBOR;", "RULE 3 : IF b IS high THEN y IS hi;", True),
+    ("", "RULE 3 : IF b IS high THEN y IS hi;", False),         # jFuzzyLogic's default: SUM
+    ("ACCU : MAX;", "", False),                             # each term concluded once
+])
+def test_several_rules_of_one_singleton_under_accu_are_said_to_be_summed(accu, third, warned):
+    """jFuzzyLogic joins the rules that conclude one singleton with the ACCU norm before COGS
+    (IEC 61131-7 too); MITOS, as fuzzylite 6, sums them: the outputs differ where two fire,
+    and that was silent. (Without ACCU jFuzzyLogic sums, as MITOS does.)"""
+    text = SINGLETONS.replace("ACCU : MAX;", accu).replace(
+        "END_RULEBLOCK", f"    {third}\nEND_RULEBLOCK")
+    rb = parse_fcl(text, "s.fcl")
+    notes = [n for n in rb.notes if "concluded by" in n]
+    if not warned:
+        assert notes == []
+        return
+    name = {"ACCU : MAX;": "max", "ACCU : PROBOR;": "probabilistic_sum"}[accu]
+    assert notes == [f"s.fcl:35:32: `y IS hi` is concluded by `r2` and `r3` under the "
+                     f"accumulation `{name}` (`ACCU`): MITOS sums their weights, as fuzzylite 6 "
+                     "does; jFuzzyLogic and IEC 61131-7 first join them at the singleton with the "
+                     "ACCU norm, so outputs differ where two of them fire"]
+    assert text.splitlines()[34][31:].startswith("y IS hi")       # the third rule's consequent
+
+
+def test_a_function_of_an_output_is_refused_as_a_consequent_not_a_membership():
+    """jFuzzyLogic's FUNCTION in DEFUZZIFY is a Takagi-Sugeno consequent (COGF), which the
+    refusal called a membership; the hint says how to write a linear one."""
+    text = SINGLETONS.replace("TERM hi := 8;", "TERM hi := FUNCTION (a * 0.8) + 1;")
+    with pytest.raises(FormatError) as info:
+        parse_fcl(text, "f.fcl")
+    assert info.value.message == ("term `hi`: FUNCTION terms (Takagi-Sugeno consequents given by "
+                                  "a formula of the inputs) are not supported")
+    assert "`Linear c1 ... cn k`" in info.value.hint and "METHOD : COGS" in info.value.hint

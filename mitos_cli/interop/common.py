@@ -67,8 +67,11 @@ UNSUPPORTED_NORMS = {
     "UNSUM": "the unbounded sum is not an S-norm MITOS computes",
     "SUM": "the unbounded sum is not an S-norm MITOS computes",
     "sum": "MATLAB's `sum` aggregation (unbounded) is not an S-norm MITOS computes",
-    "COGF": "jFuzzyLogic's fast centre of gravity (a coarser integration) is not supported; "
-            "COG is the exact one",
+    # jFuzzyLogic's DefuzzifierCenterOfGravityFunctions: the weighted average of its FUNCTION
+    # terms' values (Takagi-Sugeno), not a faster COG (as this said until 2026-12-06)
+    "COGF": "jFuzzyLogic's centre of gravity of FUNCTION terms (a Takagi-Sugeno weighted "
+            "average of the functions' values), and FUNCTION terms, are not read; a linear "
+            "FUNCTION is fuzzylite's `Linear` term under `METHOD : COGS`",
 }
 
 FLL, FIS, FCL = 0, 1, 2

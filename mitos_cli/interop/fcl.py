@@ -219,6 +219,7 @@ def _function_block(fb: Tree, span_of) -> RuleBase:
     groups = common.rule_blocks(parsed, {n: records[n] for n in outputs},
                                 renumber=len({r.label for r in all_rules}) < len(all_rules))
     _check_outputs(groups, locks, constants)
+    _accumulation_note(groups, notes)
     ordered = [variables[n] for n in declared]
     rb = common.assemble_blocks(span_of(fb).path, ordered, groups, DEFAULT_RESOLUTION,
                                 span_of(fb), notes, ranges)
@@ -472,11 +473,7 @@ def _term(item: Tree, role: str, n_inputs: int, span_of) -> Term:
     if definition.data == "singleton_def":
         return common.make_term(name, "singleton", (_num(definition.children[0]),), span)
     if definition.data == "formula_def":
-        word = str(definition.children[0]).split()[0].split("(")[0]
-        raise FormatError(f"term `{name}`: {word} terms (a membership given by a formula) are "
-                          f"not supported", span=span_of(definition.children[0]),
-                          hint="replace the formula by one of the shapes (trian, trape, gauss, "
-                               "gbell, sigm, ...) or a point list")
+        raise _formula_term(name, role, definition.children[0], span_of)
     if definition.data == "singletons_def":
         raise FormatError(f"term `{name}`: SINGLETONS terms (several weighted singletons in one "
                           f"term) are not supported", span=span_of(definition.children[0]),
@@ -510,6 +507,23 @@ def _term(item: Tree, role: str, n_inputs: int, span_of) -> Term:
     raise FormatError(f"term `{name}`: unknown membership function `{kind}`", span=span,
                       expected="a point list (x, y) ..., a number, or one of " + ", ".join(known),
                       hint=did_you_mean(kind, known))
+
+
+def _formula_term(name: str, role: str, token, span_of) -> FormatError:
+    """The refusal of a term given by a formula: an input's membership, or (jFuzzyLogic's
+    ``FUNCTION`` in DEFUZZIFY, under ``METHOD : COGF``) a Takagi-Sugeno consequent, a
+    function of the inputs, which was called a membership too."""
+    word = str(token).split()[0].split("(")[0]
+    if role == "output":
+        return FormatError(f"term `{name}`: {word} terms (Takagi-Sugeno consequents given by a "
+                           f"formula of the inputs) are not supported", span=span_of(token),
+                           hint="a linear one is fuzzylite's `Linear c1 ... cn k` (a "
+                                "coefficient per input in the order they are declared, then "
+                                "the constant) under `METHOD : COGS`")
+    return FormatError(f"term `{name}`: {word} terms (a membership given by a formula) are "
+                       f"not supported", span=span_of(token),
+                       hint="replace the formula by one of the shapes (trian, trape, gauss, "
+                            "gbell, sigm, ...) or a point list")
 
 
 def _points_term(name: str, pts: list[tuple[float, float]], span: Span) -> Term:
@@ -573,6 +587,34 @@ def _norm(table: dict, value: str, what: str, span: Span) -> str:
             if names[FLL] == value:
                 return mitos
         raise
+
+
+def _accumulation_note(groups: list[tuple[str, list[Rule], common.Settings]],
+                       notes: list[str]) -> None:
+    """Say where several rules conclude one term of a weighted (COGS) output under an ``ACCU``:
+    MITOS sums their weights, as fuzzylite 6 does; jFuzzyLogic (and IEC 61131-7) first joins
+    them with the ACCU norm at the singleton (`RuleActivationMethod.imply`), fuzzylite 8 per
+    term: the outputs differ wherever two of them fire at once. The FLL reader refuses this
+    (fuzzylite 8 is FLL's reference); an FCL file does not say which engine wrote it."""
+    for _, rules, settings in groups:
+        if not settings.sugeno or settings.aggregation is None:
+            continue
+        by_term: dict[tuple[str, str | None], list[Rule]] = {}
+        for r in rules:
+            for c in r.consequents:
+                by_term.setdefault((c.var, c.term), []).append(r)
+        shared = [(key, rs) for key, rs in by_term.items() if len(rs) > 1]
+        if not shared:
+            continue
+        (var, term), (first, second, *_) = shared[0]
+        span = next(c.span for c in second.consequents if (c.var, c.term) == (var, term))
+        more = f" ({plural(len(shared), 'term')} in all)" if len(shared) > 1 else ""
+        notes.append(
+            f"{span}: `{var} IS {term}` is concluded by `{first.label}` and `{second.label}`"
+            f"{more} under the accumulation `{settings.aggregation}` (`ACCU`): MITOS sums their "
+            f"weights, "
+            f"as fuzzylite 6 does; jFuzzyLogic and IEC 61131-7 first join them at the singleton "
+            f"with the ACCU norm, so outputs differ where two of them fire")
 
 
 def _grouping_note(rule_items: list[Tree], span_of, notes: list[str]) -> None:
