@@ -95,6 +95,20 @@ def read_termset(path: str | Path) -> TermSet:
                            hint=nearby(found, (".yaml", ".yml"), packaged)) from None
 
 
+def read_terms(path: str | Path | None) -> RuleBase | TermSet:
+    """What draws or checks terms reads: a rule base; a term set (YAML) alone; or the terms of
+    a foreign file that has no rules (jFuzzyLogic's membership-function tests), which every
+    other command refuses."""
+    from .errors import NoRulesError
+
+    if path is not None and is_termset_name(path):
+        return read_termset(path)
+    try:
+        return read_rulebase(path)
+    except NoRulesError as exc:
+        return exc.termset
+
+
 def _read_by_extension(path: Path) -> RuleBase:
     """The rule base at ``path``, read by the reader its extension names."""
     if path.suffix.lower() in (".fcl", ".fis", ".fll"):

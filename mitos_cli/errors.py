@@ -261,6 +261,16 @@ class FormatError(MitosError):
     kind = "format error"
 
 
+class NoRulesError(FormatError):
+    """A foreign file whose variables and terms are whole but that has no rules (jFuzzyLogic's
+    membership-function tests): no rule base, but ``termset`` for what draws or checks terms."""
+
+    def __init__(self, message: str, *, termset, span: Span | None = None) -> None:
+        super().__init__(message, span=span, hint="`mitos plot terms` and `mitos check` read "
+                                                  "its terms alone")
+        self.termset = termset
+
+
 def closest(name: str, candidates: Iterable[str]) -> str | None:
     """The candidate closest to ``name`` (as written, then in any case, then the one name it
     begins), or ``None`` when nothing is close."""

@@ -650,7 +650,7 @@ def test_a_term_set_alone_is_checked_for_its_terms(tmp_path, capsys):
     assert data["termset"].endswith("t.terms.yaml") and data["behaviors"] == []
     assert {f["code"] for f in data["findings"]} >= {"term-order", "term-gap"}
     code, _, err = run(["check", str(tmp_path / "t.terms.yaml"), "-b", "drive"], capsys)
-    assert code == 2 and "is a term set, which has no behaviors" in err
+    assert code == 2 and "has no behaviors (its terms only)" in err
     code, out, _ = run(["check", "rulebases/drive.terms.yaml"], capsys)   # packaged, anywhere
     assert code == 0 and "0 errors, 0 warnings, 0 notes - OK" in out
     world = tmp_path / "w.yaml"

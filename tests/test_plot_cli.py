@@ -596,7 +596,7 @@ def test_terms_of_a_term_set_alone(tmp_path, capsys):
                           "-o", str(tmp_path / "h.png")], capsys)
     assert code == 0 and (tmp_path / "h.png").read_bytes()[:8] == PNG
     code, _, err = run(["plot", "terms", "rulebases/drive.terms.yaml", "-b", "drive"], capsys)
-    assert code == 2 and "is a term set, which has no behaviors" in err
+    assert code == 2 and "has no behaviors (its terms only)" in err
     code, _, err = run(["plot", "terms", "rulebases/mitos.terms.yaml", "-v", "roadd"], capsys)
     assert code == 1 and "did you mean `road`?" in err
     rb = load_rulebase().rulebase
@@ -606,3 +606,41 @@ def test_terms_of_a_term_set_alone(tmp_path, capsys):
     assert [p.name for p in alone] == [p.name for p in beside]
     assert all(np.array_equal(a.y, b.y) for p, q in zip(alone, beside)
                for a, b in zip(p.curves, q.curves))
+
+
+NO_RULES_FCL = """\
+FUNCTION_BLOCK terms_only
+VAR_INPUT
+    x : REAL;
+END_VAR
+FUZZIFY x
+    TERM low := GAUSS 0 2;
+    TERM high := GAUSS 10 2;
+END_FUZZIFY
+END_FUNCTION_BLOCK
+"""
+
+
+def test_terms_of_a_foreign_file_without_rules(tmp_path, capsys):
+    """jFuzzyLogic's membership-function tests have terms and no rules: every command refused
+    them; `plot terms` and `check` read their terms alone (said so), the others say they can."""
+    fcl = tmp_path / "t.fcl"
+    fcl.write_text(NO_RULES_FCL)
+    code, out, err = run(["plot", "terms", str(fcl), "x=3"], capsys)
+    assert code == 0 and f"warning: `{fcl}` has no rules: its terms alone are drawn" in err
+    assert out.rstrip().endswith("x = 3: low 0.32")
+    code, out, err = run(["check", str(fcl)], capsys)
+    assert code == 0 and "its terms alone are checked" in err
+    assert "the term set's 1 variable (no rules)" in out
+    code, _, err = run(["eval", str(fcl), "x=3"], capsys)
+    assert code == 1 and "the file has no rules" in err
+    assert "hint: `mitos plot terms` and `mitos check` read its terms alone" in err
+    code, _, err = run(["plot", "terms", str(fcl), "-b", "main"], capsys)
+    assert code == 2 and "has no behaviors (its terms only)" in err
+
+
+def test_no_tick_reads_minus_zero():
+    from mitos_cli.draw.terminal import _ticks
+
+    ticks = _ticks(-8.0, 24.0, 67)
+    assert ticks[0] == 0.0 and f"{ticks[0]:g}" == "0"

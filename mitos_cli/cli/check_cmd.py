@@ -8,7 +8,7 @@ from typing import Annotated, Optional
 import typer
 
 from ..words import plural
-from .output import emit, json_text, warn_notes
+from .output import emit, json_text, warn, warn_notes
 from .params import finite, named
 
 
@@ -67,17 +67,19 @@ def render(report, trace_path: str) -> str:
     return "\n".join(lines)
 
 
-def _check_termset(path, behavior: str | None):
-    """A term set's own findings (:func:`..engine.check.check_termset`); ``-b`` needs the
-    rule file that reads it."""
-    from ..api import read_termset
+def _check_termset(termset, path: str | None, behavior: str | None):
+    """A term set's own findings (:func:`..engine.check.check_termset`), of a YAML term set or
+    of a foreign file that has no rules (said so); ``-b`` needs rules."""
+    from ..api import is_termset_name
     from ..engine.check import check_termset
     from ..errors import UsageError
 
     if behavior is not None:
-        raise UsageError(f"`{path}` is a term set, which has no behaviors: -b {behavior} needs "
-                         "the rule file that reads it")
-    return check_termset(read_termset(path))
+        raise UsageError(f"`{path}` has no behaviors (its terms only): -b {behavior} needs "
+                         "a rule file that reads them")
+    if not is_termset_name(path):
+        warn(f"`{path}` has no rules: its terms alone are checked")
+    return check_termset(termset)
 
 
 def skipped_note(grid) -> str:
@@ -132,16 +134,17 @@ def check_command(
     Also low total DOF, contradictions, and gaps between the terms of an input. Exits 1 on
     an error: inputs where no rule sets an output that has no default, or rules with the
     same condition and different actions."""
-    from ..api import is_termset_name, read_rulebase
+    from ..api import read_terms
     from ..engine.check import check_rulebase
+    from ..lang.model import RuleBase
     from ..resources import display_path
 
-    if is_termset_name(rulebase):
-        report = _check_termset(rulebase, behavior)
+    source = read_terms(rulebase)
+    if isinstance(source, RuleBase):
+        warn_notes(source)
+        report = check_rulebase(source, behavior, threshold=threshold, resolution=resolution)
     else:
-        rb = read_rulebase(rulebase)
-        warn_notes(rb)
-        report = check_rulebase(rb, behavior, threshold=threshold, resolution=resolution)
+        report = _check_termset(source, rulebase, behavior)
     name = display_path(report.rulebase.path)
     if as_json:
         emit(json_text(to_json(report, name)))

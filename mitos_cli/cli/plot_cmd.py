@@ -165,17 +165,20 @@ def terms_command(
 
     All variables on one sheet (the paper's Figures 5-9) unless --var picks some. Without -o or
     --show the plot is drawn in the terminal with Unicode characters."""
-    from ..api import is_termset_name, read_rulebase, read_termset
+    from ..api import is_termset_name, read_terms
     from ..draw.data import sheet
+    from ..lang.model import RuleBase
     from ..resources import display_path
 
     _one_way(output, show, title=title, width=width, color=color)
     path, texts = split_args(args or [])
-    if is_termset_name(path) and behavior is not None:
-        raise UsageError(f"`{path}` is a term set, which has no behaviors: -b {behavior} needs "
-                         "the rule file that reads it")
-    rulebase = (read_termset(path) if path is not None and is_termset_name(path)
-                else read_rulebase(path))
+    rulebase = read_terms(path)
+    if not isinstance(rulebase, RuleBase):
+        if behavior is not None:
+            raise UsageError(f"`{path}` has no behaviors (its terms only): -b {behavior} needs "
+                             "a rule file that reads them")
+        if not is_termset_name(path):
+            warn(f"`{path}` has no rules: its terms alone are drawn")
     values = parse_values(texts)
     plots = sheet(rulebase, var, values, behavior)
     _warn_undrawn(values, plots, "--var" if var else "-b")

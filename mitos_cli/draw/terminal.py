@@ -132,13 +132,14 @@ def _label_lines(items: list[tuple[int, str, int]], width: int, color: bool) -> 
 
 
 def _ticks(lo: float, hi: float, width: int) -> list[float]:
-    """Round tick values across the universe (about one per 12 columns)."""
+    """Round tick values across the universe (about one per 12 columns); never ``-0`` (the
+    first tick of a universe from -8 was ``ceil(-0.8) * 10``, a negative zero)."""
     n = max(2, width // 12)
     raw = (hi - lo) / n
     mag = 10 ** np.floor(np.log10(raw))
     step = min((s * mag for s in (1, 2, 2.5, 5, 10) if s * mag >= raw), default=raw)
     first = np.ceil(lo / step) * step
-    return [float(t) for t in np.arange(first, hi + step * 1e-9, step)]
+    return [float(t) + 0.0 for t in np.arange(first, hi + step * 1e-9, step)]
 
 
 def render_variable(plot: VariablePlot, width: int = 72, height: int = 6,

@@ -14,7 +14,7 @@ import math
 from dataclasses import dataclass, replace
 from pathlib import Path
 
-from ..errors import FormatError, MitosError, Span, did_you_mean
+from ..errors import FormatError, MitosError, NoRulesError, Span, did_you_mean
 from ..fuzzy import norms as norm_registry
 from ..fuzzy.formula import Formula
 from ..fuzzy.hedges import HEDGES, fuzzylite_names
@@ -576,9 +576,10 @@ def assemble_blocks(path: str | None, variables: list[Variable],
                               + first_at(first[v.name].span), span=v.span)
     if not any(v.role == "input" for v in variables):
         raise FormatError("the file defines no input variable", span=span)
-    if not any(rules for _, rules, _ in blocks):
-        raise FormatError("the file has no rules", span=span)
     check_numbers(variables, places)
+    if not any(rules for _, rules, _ in blocks):
+        raise NoRulesError("the file has no rules", span=span,
+                           termset=TermSet(tuple(variables), path))     # its terms: for plot, check
     by_name = {v.name: v for v in variables}
     behaviors = []
     outputs = {v.name for v in variables if v.role == "output"}
