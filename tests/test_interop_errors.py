@@ -269,7 +269,7 @@ def test_a_name_defined_twice_is_reported_at_the_second_definition() -> None:
 
 FCL_CASES = [
     ("END_FUNCTION_BLOCK", "END_FUNCTION_BLOCK\nFUNCTION_BLOCK two\nEND_FUNCTION_BLOCK",
-     "the file has 2 function blocks"),
+     "the file defines no input variable"),                   # the second block, at its line
     ("END_FUNCTION_BLOCK", "", "unexpected end of file"),
     ("METHOD : COG;", "METHOD : COG", "unexpected `DEFAULT`"),
     ("TERM poor := (0, 1) (4, 0) ;", "TERM poor := (0, 1) (4, 0) $;", "unexpected character `$`"),

@@ -81,8 +81,8 @@ REFUSED = [
     ("ACCU : MAX;", "ACCU : NSUM;", "the normalized sum"),
     ("ACCU : MAX;", "ACCU : SUM;", "the unbounded sum"),
     ("IF a IS low AND b IS low THEN", "IF a AND b IS low THEN", "a condition without `IS`"),
-    ("END_FUNCTION_BLOCK\n", "END_FUNCTION_BLOCK\nFUNCTION_BLOCK two\nEND_FUNCTION_BLOCK\n",
-     "MITOS reads one"),
+    ("END_FUNCTION_BLOCK\n", "END_FUNCTION_BLOCK\nFUNCTION_BLOCK probe\nEND_FUNCTION_BLOCK\n",
+     "two function blocks are named `probe`"),
 ]
 
 

@@ -202,14 +202,37 @@ def test_fcl_dsigm_is_jfuzzylogics_clipped_difference():
     assert got[0] == 0.0 and np.isnan(got[-1])     # |s1 - s2| would give 3.4e-4 at -2
 
 
-def test_fcl_function_terms_and_multiple_blocks_are_refused_by_name():
+def test_fcl_function_terms_and_blocks_of_one_name_are_refused_by_name():
     text = JFUZZY.replace("TERM b := gbell 2 3 8;", "TERM b := FUNCTION (x * 2);")
     with pytest.raises(MitosError) as info:
         parse_fcl(text, "t.fcl")
     assert "FUNCTION terms" in info.value.message and info.value.span.line == 18
     with pytest.raises(MitosError) as info:
         parse_fcl(JFUZZY + JFUZZY, "t.fcl")
-    assert "2 function blocks" in info.value.message and info.value.span.line == 30
+    assert info.value.message == "two function blocks are named `t`"
+    assert info.value.span.line == 30
+
+
+def test_fcl_function_blocks_are_behaviors_of_their_names():
+    """jFuzzyLogic reads several FUNCTION_BLOCKs in one file, each by its name (its junit2 and
+    scarled examples); MITOS refused the file. Each is now a behavior of that name, over the
+    variables of all; one variable defined alike is shared, differently refused."""
+    second = JFUZZY.replace("FUNCTION_BLOCK t", "FUNCTION_BLOCK u")
+    rb = parse_fcl(JFUZZY + second, "t.fcl")
+    assert [b.name for b in rb.behaviors] == ["t", "u"] and rb.default_behavior == "t"
+    assert list(rb.variables) == [v.name for v in parse_fcl(JFUZZY, "t.fcl").termsets[0].variables]
+    from mitos_cli.engine.compile import compile_rulebase
+    from mitos_cli.engine.evaluation import evaluate
+
+    X = np.array([[3.0], [8.5]])
+    alone = evaluate(compile_rulebase(parse_fcl(JFUZZY, "t.fcl")), X).outputs
+    assert np.array_equal(evaluate(compile_rulebase(rb, "u"), X).outputs, alone)
+    other = second.replace("TERM b := gbell 2 3 8;", "TERM b := gbell 2 3 7;")
+    with pytest.raises(MitosError) as info:
+        parse_fcl(JFUZZY + other, "t.fcl")
+    assert info.value.message == ("variable `y` is defined in two function blocks, differently "
+                                  "(first at line 16)")
+    assert info.value.span.line == 45
 
 
 def test_batch_accepts_a_column_for_an_input_no_rule_tests(tmp_path: Path):

@@ -39,13 +39,13 @@ import numpy as np
 from lark import Lark, Token, Tree
 from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken
 
-from ..errors import FormatError, Span, did_you_mean
+from ..errors import FormatError, NoRulesError, Span, did_you_mean
 from ..fuzzy import norms
 from ..fuzzy.shapes import TSUKAMOTO
 from ..lang.bulk import without_cyclic_gc
 from ..lang.cache import lark_parser
-from ..lang.model import And, Expr, Not, Or, Prop, Rule, RuleBase
-from ..lang.terms import Role, Term, Variable, first_at
+from ..lang.model import And, Behavior, Expr, Not, Or, Prop, Rule, RuleBase
+from ..lang.terms import Role, Term, TermSet, Variable, first_at
 from ..words import plural
 from . import common
 from .common import FCL, FLL, fmt_number
@@ -170,13 +170,51 @@ def parse_fcl(text: str, path: str | None = None) -> RuleBase:
     for token in tree.scan_values(lambda v: isinstance(v, Token) and v.type == "SIGNED_NUMBER"):
         if math.isinf(float(token)):
             raise common.past_range(str(token), span_of(token))
-    blocks = tree.children
-    if len(blocks) > 1:
-        raise FormatError(f"the file has {len(blocks)} function blocks; MITOS reads one",
-                          span=span_of(blocks[1]), hint="split the file, one block per file")
-    block = blocks[0]
-    assert isinstance(block, Tree)              # the grammar's function_block
-    return _function_block(block, span_of)
+    blocks = [b for b in tree.children if isinstance(b, Tree)]     # the grammar's blocks
+    if len(blocks) == 1:
+        return _function_block(blocks[0], span_of)
+    return _blocks_as_behaviors(blocks, span_of)
+
+
+def _blocks_as_behaviors(blocks: list[Tree], span_of) -> RuleBase:
+    """Several FUNCTION_BLOCKs (jFuzzyLogic reads each by its name): a behavior each, named
+    after its block, over the variables of all of them. A variable two blocks define
+    differently, and two blocks of one name, are refused: a rule base has one of each."""
+    parts: list[tuple[str, RuleBase | None, TermSet]] = []
+    for i, fb in enumerate(blocks):
+        token = fb.children[0]
+        name = str(token) if isinstance(token, Token) else f"block{i + 1}"
+        if any(name == n for n, _, _ in parts):
+            raise FormatError(f"two function blocks are named `{name}`", span=span_of(fb),
+                              hint="rename one: each becomes a behavior of that name")
+        try:
+            rb = _function_block(fb, span_of)
+        except NoRulesError as exc:          # a block of terms only: its variables count
+            parts.append((name, None, exc.termset))
+            continue
+        parts.append((name, rb, rb.termsets[0]))
+    termset = TermSet(tuple(_shared_variables(parts)), span_of(blocks[0]).path)
+    behaviors = [Behavior(name if len(rb.behaviors) == 1 else f"{name}_{b.name}", b.rules,
+                          b.uses, b.operators or rb.operators)
+                 for name, rb, _ in parts if rb is not None for b in rb.behaviors]
+    if not behaviors:
+        raise NoRulesError("the file has no rules", span=span_of(blocks[0]), termset=termset)
+    notes = tuple(n for _, rb, _ in parts if rb is not None for n in rb.notes)
+    return RuleBase(termset.path, (termset,), tuple(behaviors), (), notes=notes)
+
+
+def _shared_variables(parts: list[tuple[str, RuleBase | None, TermSet]]) -> list[Variable]:
+    """The variables of every block, each once: one two blocks define alike is shared."""
+    variables: dict[str, Variable] = {}
+    for _, _, ts in parts:
+        for v in ts.variables:
+            first = variables.setdefault(v.name, v)
+            if first != v:
+                raise FormatError(f"variable `{v.name}` is defined in two function blocks, "
+                                  f"differently" + first_at(first.span), span=v.span,
+                                  hint="rename it in one of them: the blocks' behaviors share "
+                                       "one set of variables")
+    return list(variables.values())
 
 
 def _num(tree) -> float:
