@@ -737,3 +737,19 @@ def test_an_fll_name_with_a_letter_beyond_ascii_is_read_in_rules():
     from mitos_cli.api import LoadedRuleBase
 
     assert LoadedRuleBase(rb).run(X, detail=False).outputs[0, 0] == pytest.approx(5.0)
+
+
+def test_an_output_without_defuzzify_in_a_file_without_rules_gives_its_terms():
+    """jFuzzyLogic's junit4 and membershipFunctionsDemo declare an output they never define
+    and have no rules: their inputs' terms are what `plot terms` and `check` read; with rules,
+    the missing block is refused as before."""
+    from mitos_cli.errors import NoRulesError
+
+    text = JFUZZY.split("DEFUZZIFY y")[0] + "END_FUNCTION_BLOCK\n"
+    with pytest.raises(NoRulesError) as info:
+        parse_fcl(text, "t.fcl")
+    assert [v.name for v in info.value.termset.variables] == ["x", "unused"]
+    with_rules = text.replace("END_FUNCTION_BLOCK", "RULEBLOCK r\n    RULE 1 : IF x IS low THEN "
+                                                    "y IS a;\nEND_RULEBLOCK\nEND_FUNCTION_BLOCK")
+    with pytest.raises(MitosError, match="variable `y` is declared but has no DEFUZZIFY block"):
+        parse_fcl(with_rules, "t.fcl")

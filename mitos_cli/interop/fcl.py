@@ -244,10 +244,15 @@ def _function_block(fb: Tree, span_of) -> RuleBase:
                               + first_at(variables[v.name].span), span=v.span)
         variables[v.name] = v
     for name, (role, span, _) in declared.items():
-        if name not in variables:
-            kind = "FUZZIFY" if role == "input" else "DEFUZZIFY"
-            raise FormatError(f"variable `{name}` is declared but has no {kind} block",
-                              span=span)
+        if name in variables:
+            continue
+        if variables and not any(isinstance(r, Tree) and r.data == "rule"
+                                 for b in blocks for r in b.children):
+            raise NoRulesError("the file has no rules", span=span_of(fb),   # terms only (tests
+                               termset=TermSet(tuple(variables.values()),   # of jFuzzyLogic's)
+                                               span_of(fb).path))
+        kind = "FUZZIFY" if role == "input" else "DEFUZZIFY"
+        raise FormatError(f"variable `{name}` is declared but has no {kind} block", span=span)
     parsed = [_rule_block(block, variables, span_of, notes) for block in blocks]
     parsed = [p for p in parsed if p[2]] or parsed[:1]
     outputs = [n for n in declared if declared[n][0] == "output"]
