@@ -246,6 +246,34 @@ def test_a_passage_narrower_than_the_robot_needs_is_refused_with_its_place(tmp_p
     assert "it needs 11.0 in" in text and "route: {min_clearance:" in text
 
 
+class _Straight:
+    """A planner that drives straight on at 30 in/s, whatever is ahead."""
+
+    name = "straight"
+
+    def plan(self, p):
+        n = len(p.pose)
+        return np.full(n, 90.0), np.full(n, 30.0)
+
+
+def test_beyond_the_maps_edge_is_solid_to_the_robot_as_it_is_to_the_truth(tmp_path):
+    """A map whose border is free (MIT's Building 31, outside the building): the robot's map
+    read beyond its edge as free, so its route ran along the edge, through a 16 in gap
+    between a block and the edge that the 18 in robot cannot pass, and it drove into the
+    edge; its brake, counting only the map's cells, let a planner drive straight into it."""
+    free = np.ones((100, 400), dtype=bool)            # no wall round it: the edge is the end
+    free[16:, 195:205] = False                         # a block leaving 16 in along the edge
+    with pytest.raises(NarrowPassage, match="a passage about"):
+        prepare(load_world(grid_world(tmp_path, free, start=(40, 60), goal=(360, 60))))
+    free[16:, 195:205], free[40:, 195:205] = True, False          # now a 40 in way there
+    world = load_world(grid_world(tmp_path, free, start=(40, 60), goal=(360, 60)))
+    assert occupied_distance(dense(prepare(world).routes[0].points), free) >= 11.0 - 1e-9
+    toward = load_world(grid_world(tmp_path, np.ones((100, 400), dtype=bool), limit=4,
+                                   start=(330, 50), goal=(60, 50)))
+    res = simulate(toward, _Straight())
+    assert res.outcome != "collision" and res.clearance.min() > 0
+
+
 def test_a_grid_squeeze_hint_says_what_the_body_keeps(tmp_path):
     """The hint said the route's centre clearance where it means the body's: "keeps as
     little as 9.5 in" for a 20 in door and an 18 in robot, whose body keeps 0.5 in."""

@@ -40,8 +40,8 @@ import numpy as np
 from . import movers
 from . import obstacles as obs_mod
 from .geometry import CACHED, ray_circles, ray_segments
-from .route import Clearance, NarrowPassage, Prepared, Route, grid_route
-from .staticmap import StaticMap, carve, cells_inside, corridor_rects, grid_walls
+from .route import NODE, Clearance, NarrowPassage, Prepared, Route, grid_route
+from .staticmap import StaticMap, carve, cells_inside, corridor_rects, grid_walls, walled
 from .world import Goal, Grid, Pose, World
 
 RASTER = 2.0            # in: cells of the robot's map when the world gives no grid
@@ -103,6 +103,12 @@ def _stamp(grid: Grid, world: World) -> Grid:
                 grid.source)
 
 
+def _walled(grid: Grid) -> Grid:
+    """:func:`.staticmap.walled` by a whole route node's block of cells, so the nodes of the
+    map's own cells fall where they fell on the map."""
+    return walled(grid, max(1, int(round(NODE / grid.resolution))))
+
+
 def given(world: World, static: StaticMap) -> Given:
     """What ``world`` gives its robots (the truth is ``static``)."""
     known = world.known_obstacles
@@ -110,7 +116,7 @@ def given(world: World, static: StaticMap) -> Given:
     centres, radii, _, sides, _, _ = obs_mod.shapes_at(known, where)
     if world.knows == "map":
         walls = static.walls
-        grid = static.grid
+        grid = None if static.grid is None else _walled(static.grid)
         if known and grid is None:
             grid = _raster(static, world, RASTER, free=False)
     elif world.knows == "given" and world.given is not None:
@@ -118,6 +124,7 @@ def given(world: World, static: StaticMap) -> Given:
         if world.corridors:
             grid = carve(grid, corridor_rects(world.corridors))
         walls = grid_walls(grid)
+        grid = _walled(grid)
     else:
         res = static.grid.resolution if static.grid is not None else RASTER
         grid = _raster(static, world, res, free=True)

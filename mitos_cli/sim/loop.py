@@ -84,7 +84,7 @@ def prepare(world: World, between: bool = True) -> Scene:
     for a in world.agents:
         asked, least = clearances(world, a)
         try:
-            if given.plain:
+            if given.plain and given.grid is None:
                 routes.append(plan_route(static, world.corridors, a.start, a.goal, asked, least,
                                          half_width=a.robot.width / 2, between=between))
             else:

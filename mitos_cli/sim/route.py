@@ -805,10 +805,11 @@ def _nodes(dist: np.ndarray, k: int) -> tuple[np.ndarray, np.ndarray, np.ndarray
 
 
 NARROW_COST = 20.0      # extra cost per step (in steps) of a node closer than the asked clearance
+NODE = 6.0              # in: a route node's block, about (whole cells)
 
 
 def grid_route(static: StaticMap, start: Pose, goal: Goal, clearance: float,
-               cell: float = 6.0, minimum: float | None = None,
+               cell: float = NODE, minimum: float | None = None,
                occupied: np.ndarray | None = None, explain: bool = True,
                leave: float = 0.0, behind: float = 0.0, keep: bool = True,
                last: Prepared | None = None, half_width: float = 0.0,

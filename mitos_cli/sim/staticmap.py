@@ -82,6 +82,20 @@ def grid_walls(grid: Grid) -> np.ndarray:
 MAX_GROWN = 64_000_000
 
 
+def walled(grid: Grid, cells: int = 1) -> Grid:
+    """``grid`` with a ring ``cells`` wide of occupied cells round it (its own cells where
+    they were), or ``grid`` itself where its border is occupied already: what a map does
+    not cover is solid (:func:`grid_walls`, the truth, counts it so), and a robot's map read
+    as free beyond its edge let the route run along the edge of a map whose border is free
+    (MIT's Building 31, outside the building) and the brake drive into it."""
+    occ = grid.occupied
+    if occ[0].all() and occ[-1].all() and occ[:, 0].all() and occ[:, -1].all():
+        return grid
+    res, (ox, oy) = grid.resolution, grid.origin
+    return Grid(np.pad(occ, cells, constant_values=True), res,
+                (ox - cells * res, oy - cells * res), grid.source, grid.notes)
+
+
 def carve(grid: Grid, rects: np.ndarray) -> Grid:
     """The grid with every cell whose centre lies in a corridor made free, grown first by
     whole cells of wall to hold every corridor (:func:`covering`)."""
