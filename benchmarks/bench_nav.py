@@ -45,7 +45,7 @@ from pathlib import Path
 import numpy as np
 from options import guarded, positive_int, writable
 
-from mitos_cli.errors import MitosError, unknown
+from mitos_cli.errors import MitosError, Span, unknown
 from mitos_cli.sim import barn, mrpb
 from mitos_cli.sim.clutter import clutter
 from mitos_cli.sim.loop import Scene, prepare, simulate
@@ -360,11 +360,16 @@ def aims(results: dict, ticks: dict | None) -> list[str]:
 ROW_KEYS = {"suite": str, "world": str, "runs": dict}
 
 
+ROW_EXPECTED = "a JSON object with `suite`, `world` and `runs`, as `--rows` writes"
+
+
 def read_rows(path: Path) -> list[dict]:
     """The rows of a ``--rows`` file, each line checked; a torn last line (a run killed while
-    it appended) is dropped with a note, a damaged line elsewhere is refused by its number."""
+    it appended) is dropped with a note, a damaged line elsewhere is refused at its place,
+    with the line. A byte-order mark (a Windows editor's save) is read past, as a world
+    file's is: it was refused as line 1's "Unexpected UTF-8 BOM"."""
     try:
-        text = path.read_text(encoding="utf-8")
+        text = path.read_text(encoding="utf-8-sig")
     except (OSError, UnicodeDecodeError) as exc:
         raise MitosError(f"cannot read rows from `{path}`: {exc}") from None
     numbered = [(n, line) for n, line in enumerate(text.splitlines(), 1) if line.strip()]
@@ -372,17 +377,18 @@ def read_rows(path: Path) -> list[dict]:
     for n, line in numbered:
         try:
             row = json.loads(line)
-        except ValueError as exc:
+        except json.JSONDecodeError as exc:
             if n == numbered[-1][0] and not text.endswith("\n"):      # written in part
                 print(f"note: {path.name}:{n}: a torn last line (a stopped run) is left out",
                       file=sys.stderr)
                 break
-            raise MitosError(f"cannot read rows from `{path}`: line {n}: {exc.msg}") from None
+            raise MitosError(f"cannot read rows from `{path}`: line {n}: {exc.msg}",
+                             span=Span(str(path), n, exc.colno, line),
+                             expected=ROW_EXPECTED) from None
         if not isinstance(row, dict) or any(not isinstance(row.get(k), t)
                                             for k, t in ROW_KEYS.items()):
             raise MitosError(f"cannot read rows from `{path}`: line {n} is not a row",
-                             expected="a JSON object with `suite`, `world` and `runs`, as "
-                                      "`--rows` writes")
+                             span=Span(str(path), n, 1, line), expected=ROW_EXPECTED)
         rows.append(row)
     return rows
 

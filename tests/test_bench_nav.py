@@ -83,6 +83,26 @@ def test_from_rows_names_a_damaged_line_by_its_number_and_drops_a_torn_last_one(
     assert "from 3 rows of `rows.jsonl`" in out
 
 
+def test_from_rows_reads_past_a_byte_order_mark_and_shows_a_damaged_line(tmp_path, monkeypatch,
+                                                                         capsys):
+    """A rows file saved by a Windows editor starts with a byte-order mark: it was refused as
+    "line 1: Unexpected UTF-8 BOM". A damaged line is shown at its place, with what a line
+    should be."""
+    monkeypatch.chdir(tmp_path)
+    good = json.dumps({"suite": "mrpb", "world": "a", "refused": None, "length": 787.4,
+                       "runs": {"fuzzy": run("success")}}) + "\n"
+    kept = tmp_path / "rows.jsonl"
+    kept.write_bytes(b"\xef\xbb\xbf" + (good * 2).encode())
+    assert bench_nav.main(["--from-rows", "rows.jsonl", "--suites", "mrpb",
+                           "--planners", "fuzzy"]) == 0
+    assert "from 2 rows of `rows.jsonl`" in capsys.readouterr().out
+    kept.write_text(good + '{"suite": 1,, }\n' + good)
+    assert bench_nav.main(["--from-rows", "rows.jsonl"]) == 1
+    err = capsys.readouterr().err
+    assert err.startswith("rows.jsonl:2:13: error: cannot read rows from `rows.jsonl`: line 2: ")
+    assert '    {"suite": 1,, }\n' in err and "expected a JSON object with `suite`" in err
+
+
 @pytest.mark.parametrize("text", ["[1, 2]\n", '{"runs": 5}\n', '{"suite": "mrpb"}\n'])
 def test_from_rows_refuses_json_that_is_not_a_row(text, tmp_path, monkeypatch, capsys):
     monkeypatch.chdir(tmp_path)
