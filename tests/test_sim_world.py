@@ -492,6 +492,25 @@ def test_a_randomise_range_that_reaches_the_body_at_the_start_is_refused(obstacl
         "(q_init) at (30, 0): into the robot's body (24 x 18 in) there" in msg
 
 
+def test_a_randomised_draw_that_shuts_the_known_way_is_said_to_be_the_draws():
+    """A draw that moves an obstacle the robot is told of across its only way was refused as
+    the world's own "the only way to the goal passes ...", though the world as written has
+    its route: the refusal names the draw and the seed that replays it."""
+    from mitos_cli.sim.loop import Simulation
+
+    text = (BASE + "obstacles:\n  - {name: box, shape: circle, at: [150, 30], radius: 20, "
+            "known: true}\nrandomise:\n  obstacles:\n    box: {dy: [-30, -30]}\n")
+    world = parse_world(text, "w.yaml")
+    Simulation(world, seed=5)                          # as written, it has its way
+    with pytest.raises(WorldError) as info:
+        Simulation(world, seed=5, randomise=True)
+    msg = info.value.render()
+    assert msg.startswith("w.yaml:10:9: world error: the randomised run of seed 5 drew `box` "
+                          "to (150, 0), where the robot is told it stands (`known: true`), "
+                          "and then the only way to the goal passes (")
+    assert "`--seed 5 --randomise` replays this one" in msg
+
+
 def test_a_moving_obstacle_may_start_over_the_goal_it_leaves():
     text = (BASE + "obstacles:\n  - {name: cart, shape: circle, at: [330, 0], radius: 9, "
             "velocity: [-10, 0]}\nrandomise:\n  obstacles:\n    cart: {dx: [-40, 0]}\n")

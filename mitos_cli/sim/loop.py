@@ -100,6 +100,26 @@ def prepare(world: World, between: bool = True) -> Scene:
     return Scene(static, tuple(routes), given, knowledge.plan_grid(given, static, world))
 
 
+def _prepare_draw(world: World, randomised: bool, seed: int) -> Scene:
+    """:func:`prepare` of a run's world; where the run is randomised and its draw moved an
+    obstacle the robots are told of (``known: true``) so that no route is left, the refusal
+    says so, with the seed that replays it: it read as the world's own ("the only way to the
+    goal passes ..." at `q_goal`), though the world as written has its route."""
+    try:
+        return prepare(world)
+    except WorldError as exc:
+        drawn = {j.obstacle for j in world.randomise.obstacles}
+        moved = [o for o in world.obstacles if o.known and o.name in drawn]
+        if not randomised or not moved:
+            raise
+        where = ", ".join(f"`{o.name}` to ({o.x:.6g}, {o.y:.6g})" for o in moved)
+        raise WorldError(
+            f"the randomised run of seed {seed} drew {where}, where the robot is told it "
+            f"stands (`known: true`), and then {exc.message}", span=exc.span,
+            hint="narrow its range under `randomise:` so that every draw leaves the robot a "
+                 f"way (`--seed {seed} --randomise` replays this one)") from None
+
+
 def shared_scene(world: World, randomise: bool) -> Scene | None:
     """The scene every run of ``world`` can start from, prepared once; ``None`` when each
     randomised run must prepare its own, because its draw moves an obstacle drawn on the
@@ -396,7 +416,7 @@ class Simulation:
         if self.randomise:
             world = obs_mod.randomised(world, self._streams[0])
         self.world = world
-        self.scene = self._given_scene or prepare(world)
+        self.scene = self._given_scene or _prepare_draw(world, self.randomise, self.seed)
         fresh = getattr(self.planner, "fresh", None)     # a planner with a memory: empty it
         if fresh is not None:
             self.planner = fresh()
