@@ -517,6 +517,19 @@ def test_a_moving_obstacle_may_start_over_the_goal_it_leaves():
     assert parse_world(text, "w.yaml")
 
 
+def test_a_moving_obstacle_may_start_over_the_goal_as_written_too():
+    """A cart written over the goal it drives off was refused ("the goal ... lies inside
+    obstacle `cart` (where it stands at the start)"), where a `randomise` range that moves it
+    there is taken; a still one over the goal, or a cart over the start, is still refused."""
+    cart = "obstacles:\n  - {name: cart, shape: circle, at: [300, 0], radius: 9, %s}\n"
+    world = parse_world(BASE + cart % "velocity: [-10, 0]", "w.yaml")
+    assert world.obstacles[0].motion.kind == "velocity"
+    msg = error(BASE + cart % "known: false")
+    assert "w.yaml:10:9" in msg and "lies inside obstacle `cart`" in msg
+    moving = cart.replace("[300, 0]", "[30, 0]") % "velocity: [10, 0]"
+    assert "w.yaml:9:9" in error(BASE + moving)
+
+
 def test_an_empty_number_says_so():
     msg = error(BASE.replace("time_limit: 10", "time_limit: ~"))
     assert "w.yaml:4:13" in msg and "must be a number, not nothing (an empty value or `~`)" in msg

@@ -764,7 +764,9 @@ def check_free(world: World, spans: list[tuple[Span, Span]]) -> StaticMap:
                 raise WorldError(f"the {what}{who} at ({p.x:g}, {p.y:g}) lies inside a wall",
                                  span=span, hint=_units_hint(world, agent)
                                  or "move it into a corridor (free space)")
-            hit = _obstacle_at(world, p.x, p.y)
+            # a moving obstacle leaves the goal (as `randomise` may move one over it); over
+            # the start it is there at the first tick
+            hit = _obstacle_at(world, p.x, p.y, still=what.startswith("goal"))
             if hit is not None:
                 raise WorldError(f"the {what}{who} at ({p.x:g}, {p.y:g}) lies inside obstacle "
                                  f"`{hit}` (where it stands at the start)", span=span,
@@ -879,26 +881,28 @@ def _inside_wall(static: StaticMap, o, at: tuple[float, float]) -> bool:
     return bool(box_segment_distance(o.length / 2, o.width / 2, local.reshape(-1, 4)).min() > 0)
 
 
-def _obstacle_at(world: World, x: float, y: float) -> str | None:
-    """The name of the first obstacle that covers (x, y) when the run starts, or None."""
+def _obstacle_at(world: World, x: float, y: float, still: bool = False) -> str | None:
+    """The name of the first obstacle that covers (x, y) when the run starts, or None;
+    ``still``: of the obstacles that stay where they are (a goal under a cart that drives
+    off was refused, where a `randomise` range that moves the cart over it is taken)."""
     import numpy as np
 
     from .geometry import points_in_polygon
     from .obstacles import positions, shapes_at
 
-    if not world.obstacles:
+    obstacles = tuple(o for o in world.obstacles if not still or o.motion.kind == "static")
+    if not obstacles:
         return None
-    centres, radii, circ, _, _, corners = shapes_at(world.obstacles,
-                                                    positions(world.obstacles, 0.0))
+    centres, radii, circ, _, _, corners = shapes_at(obstacles, positions(obstacles, 0.0))
     p = np.array([[x, y]])
     inside = np.hypot(*(centres - p).T) < radii
     if inside.any():
-        return world.obstacles[int(circ[int(np.argmax(inside))])].name
-    rect = [i for i, o in enumerate(world.obstacles) if o.shape == "rectangle"]
+        return obstacles[int(circ[int(np.argmax(inside))])].name
+    rect = [i for i, o in enumerate(obstacles) if o.shape == "rectangle"]
     if rect:
         within = np.asarray(points_in_polygon(p, corners))[0]
         if within.any():
-            return world.obstacles[rect[int(np.argmax(within))]].name
+            return obstacles[rect[int(np.argmax(within))]].name
     return None
 
 
