@@ -6,6 +6,8 @@ from __future__ import annotations
 
 import argparse
 import functools
+import io
+import os
 import subprocess
 import sys
 from collections.abc import Callable
@@ -78,9 +80,25 @@ def guarded(main: Callable[..., int | None]) -> Callable[..., int]:
         except MitosError as exc:
             print(exc.render(), file=sys.stderr)
             return 1
+        except BrokenPipeError:
+            # the reader went away (`| head`): said nothing, as `mitos` says nothing; it read
+            # "error: Broken pipe"
+            _quiet_stdout()
+            return 1
         except OSError as exc:
             where = f": `{exc.filename}`" if exc.filename else ""
             print(f"error: {exc.strerror or exc}{where}", file=sys.stderr)
             return 1
 
     return run
+
+
+def _quiet_stdout() -> None:
+    """Stdout on the null device, so that the interpreter's last flush, of what the closed
+    pipe did not take, raises nothing more at exit."""
+    try:
+        null = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(null, sys.stdout.fileno())
+        os.close(null)
+    except (OSError, ValueError, io.UnsupportedOperation):
+        pass

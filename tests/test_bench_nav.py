@@ -103,6 +103,23 @@ def test_from_rows_reads_past_a_byte_order_mark_and_shows_a_damaged_line(tmp_pat
     assert '    {"suite": 1,, }\n' in err and "expected a JSON object with `suite`" in err
 
 
+def test_a_reader_that_goes_away_is_not_an_error(tmp_path):
+    """`bench_nav.py --from-rows rows.jsonl | head -1`: the table's later lines met a closed
+    pipe and the script said "error: Broken pipe"; it says nothing, as `mitos` does."""
+    import subprocess
+
+    kept = tmp_path / "rows.jsonl"
+    kept.write_text(json.dumps({"suite": "mrpb", "world": "a", "refused": None,
+                                "length": 787.4, "runs": {"fuzzy": run("success")}}) + "\n")
+    p = subprocess.Popen([sys.executable, str(ROOT / "benchmarks" / "bench_nav.py"),
+                          "--from-rows", str(kept)], stdout=subprocess.PIPE,
+                         stderr=subprocess.PIPE)
+    assert p.stdout is not None and p.stderr is not None
+    p.stdout.close()                                   # the reader is gone before a line
+    err = p.stderr.read().decode()
+    assert p.wait() == 1 and err == ""
+
+
 @pytest.mark.parametrize("text", ["[1, 2]\n", '{"runs": 5}\n', '{"suite": "mrpb"}\n'])
 def test_from_rows_refuses_json_that_is_not_a_row(text, tmp_path, monkeypatch, capsys):
     monkeypatch.chdir(tmp_path)
