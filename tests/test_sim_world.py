@@ -530,6 +530,24 @@ def test_a_moving_obstacle_may_start_over_the_goal_as_written_too():
     assert "w.yaml:9:9" in error(BASE + moving)
 
 
+def test_a_goal_the_body_cannot_reach_within_its_tolerance_is_refused():
+    """A goal 2 in from a wall with a tolerance of 5 in: the robot's centre keeps half its
+    width (9 in) from the wall, 7 in from the goal at best, so the run was driven at until
+    its time limit. It is refused where it is written, with what the body needs."""
+    near = BASE.replace("q_goal: {x: 300, y: 0}", "q_goal: {x: 300, y: -33, tolerance: 5}")
+    msg = error(near)
+    assert msg.startswith("w.yaml:10:9: world error: the goal (q_goal) at (300, -33) cannot be "
+                          "reached: within its tolerance (5 in) the robot's centre keeps at "
+                          "most 7.0 in from the walls and still obstacles")
+    assert "18 in wide, needs 9 in to stand there at all" in msg and "`tolerance: 1" in msg
+    assert parse_world(near.replace("tolerance: 5", "tolerance: 8"), "w.yaml")
+    # a round box leaves 16 in beside the wall at the goal: 8.2 in for the centre at best
+    gap = BASE.replace("q_goal: {x: 300, y: 0}", "q_goal: {x: 300, y: -27, tolerance: 5}")
+    box = "obstacles:\n  - {name: box, shape: circle, at: [300, 0], radius: 19%s}\n"
+    assert "keeps at most 8.2 in" in error(gap + box % "")
+    assert parse_world(gap + box % ", velocity: [0, 30]", "w.yaml")     # a cart drives off
+
+
 def test_an_empty_number_says_so():
     msg = error(BASE.replace("time_limit: 10", "time_limit: ~"))
     assert "w.yaml:4:13" in msg and "must be a number, not nothing (an empty value or `~`)" in msg

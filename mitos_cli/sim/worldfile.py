@@ -772,7 +772,90 @@ def check_free(world: World, spans: list[tuple[Span, Span]]) -> StaticMap:
                                  f"`{hit}` (where it stands at the start)", span=span,
                                  hint="move it, or the obstacle")
         _check_body(world, agent, static, s_span)
+        _check_goal_room(world, agent, static, g_span)
     return static
+
+
+#: in: how far apart the points of a goal's disc are looked at at most, and in how many
+#: rings at most (:func:`_check_goal_room`): a wide tolerance is looked at more coarsely
+GOAL_SAMPLE, GOAL_RINGS = 0.5, 40
+
+
+def _check_goal_room(world: World, agent, static, span: Span) -> None:
+    """Refuse a goal whose tolerance the robot's centre can never come within: every point of
+    the disc lies nearer a wall or a still obstacle than half the robot's width, so no pose
+    of its body puts its centre there (a goal 2 in from a wall with a tolerance of 5 in was
+    driven at until the time limit, a timeout no planner could avoid). The disc is looked at
+    every ``step`` in, and a goal is refused only where it falls short by more than that, so
+    a goal the body can reach is never refused."""
+    import numpy as np
+
+    g, half = agent.goal, agent.robot.width / 2
+    step = max(GOAL_SAMPLE, g.tolerance / GOAL_RINGS)
+    reach = g.tolerance + half + step
+    if _room(world, static, np.array([[g.x, g.y]]), reach)[0] >= half:
+        return                                  # the goal itself has room: most goals
+    pts = _disc(g.x, g.y, g.tolerance, step)
+    walls = max(1, len(static.near(g.x, g.y, reach)))
+    size = max(1, 2_000_000 // walls)           # points at a time: a bounded [P, walls]
+    room = np.concatenate([_room(world, static, pts[i:i + size], reach, (g.x, g.y))
+                           for i in range(0, len(pts), size)])
+    best = float(room.max())
+    if best + step >= half:
+        return
+    near = pts[int(np.argmax(room))]
+    keep = max(agent.robot.length, agent.robot.width) / 2 + agent.robot.safety_margin
+    raise WorldError(
+        f"the goal (q_goal){_who(agent)} at ({g.x:g}, {g.y:g}) cannot be reached: within its "
+        f"tolerance ({g.tolerance:g} in) the robot's centre keeps at most {best:.1f} in from "
+        f"the walls and still obstacles (at ({near[0]:.1f}, {near[1]:.1f})), and its body, "
+        f"{agent.robot.width:g} in wide, needs {half:g} in to stand there at all", span=span,
+        hint=f"move the goal into the open, or widen its tolerance so that the robot can "
+             f"reach it head-on, its centre half its length and its safety margin ({keep:g} "
+             f"in) off the wall (`tolerance: {math.ceil(g.tolerance + keep - best - 1e-9)}` or more)")
+
+
+def _disc(x: float, y: float, radius: float, step: float):
+    """Points ``[P, 2]`` of the disc of ``radius`` round (x, y): its centre and rings ``step``
+    apart, their points about as far apart along each ring."""
+    import numpy as np
+
+    out = [np.array([[x, y]])]
+    rings = int(np.ceil(radius / step))
+    for k in range(1, rings + 1):
+        r = radius * k / rings
+        n = max(6, int(np.ceil(2 * np.pi * r / step)))
+        a = np.arange(n) * (2 * np.pi / n)
+        out.append(np.stack([x + r * np.cos(a), y + r * np.sin(a)], axis=1))
+    return np.concatenate(out)
+
+
+def _room(world: World, static, pts, reach: float, centre: tuple[float, float] | None = None):
+    """Each point's distance ``[P]`` (in) to the nearest wall or still obstacle (0 off the
+    free space and inside an obstacle; ``reach`` where none lies nearer than ``reach`` of
+    ``centre``, default the first point)."""
+    import numpy as np
+
+    from .geometry import point_segment_distance, points_in_polygon
+    from .obstacles import positions, shapes_at
+
+    x, y = centre if centre is not None else (float(pts[0, 0]), float(pts[0, 1]))
+    room = np.full(len(pts), reach)
+    walls = static.near(x, y, reach)
+    if len(walls):
+        room = np.minimum(room, point_segment_distance(pts, walls).min(axis=1))
+    still = tuple(o for o in world.obstacles if o.motion.kind == "static")
+    if still:
+        centres, radii, _, sides, _, corners = shapes_at(still, positions(still, 0.0))
+        if len(centres):
+            gap = np.hypot(pts[:, None, 0] - centres[None, :, 0],
+                           pts[:, None, 1] - centres[None, :, 1]) - radii[None]
+            room = np.minimum(room, np.maximum(gap, 0.0).min(axis=1))
+        if len(sides):
+            room = np.minimum(room, point_segment_distance(pts, sides).min(axis=1))
+            room[np.asarray(points_in_polygon(pts, corners)).any(axis=1)] = 0.0
+    room[~static.free(pts)] = 0.0
+    return room
 
 
 def _unknown_cell(world: World, x: float, y: float) -> str | None:
