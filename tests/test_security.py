@@ -216,3 +216,75 @@ def with_map(block: str) -> str:
     while j < len(lines) and (lines[j].startswith(" ") or not lines[j].strip()):
         j += 1
     return "\n".join(lines[:i]) + "\n" + block + "\n".join(lines[j:])
+
+
+# ---- hostile sizes: deep conditions, huge names ---------------------------------------------
+
+DEEP_FCL = """FUNCTION_BLOCK b
+VAR_INPUT
+    a : REAL;
+END_VAR
+VAR_OUTPUT
+    y : REAL;
+END_VAR
+FUZZIFY a
+    RANGE := (0 .. 1);
+    TERM lo := (0, 1) (1, 0);
+END_FUZZIFY
+DEFUZZIFY y
+    RANGE := (0 .. 1);
+    TERM on := 1;
+    METHOD : COGS;
+    DEFAULT := 0;
+END_DEFUZZIFY
+RULEBLOCK r
+    AND : MIN;
+    OR : MAX;
+    RULE 1 : IF {cond} THEN y IS on;
+END_RULEBLOCK
+END_FUNCTION_BLOCK
+"""
+
+DEEP_FLL = """Engine: b
+InputVariable: a
+  range: 0 1
+  term: lo Triangle 0 0 1
+OutputVariable: y
+  range: 0 1
+  defuzzifier: WeightedAverage
+  default: 0
+  term: on Constant 1
+RuleBlock: r
+  conjunction: Minimum
+  disjunction: Maximum
+  rule: if {cond} then y is on
+"""
+
+
+@pytest.mark.parametrize("suffix, template, cond", [
+    ("fcl", DEEP_FCL, "NOT " * 400 + "a IS lo"),
+    ("fcl", DEEP_FCL, "NOT " * 10_000 + "a IS lo"),
+    ("fcl", DEEP_FCL, "(a IS lo OR " * 3_000 + "a IS lo" + ")" * 3_000),
+    ("fll", DEEP_FLL, "(a is lo or " * 400 + "a is lo" + ")" * 400),
+    ("fll", DEEP_FLL, "(a is lo and " * 3_000 + "a is lo" + ")" * 3_000),
+])
+def test_a_deeply_nested_foreign_rule_is_refused_not_a_recursion_error(tmp_path, suffix,
+                                                                       template, cond):
+    """400 NOTs of an FCL rule, or nested parentheses of an FLL one, were a RecursionError."""
+    from mitos_cli.errors import FormatError
+
+    path = tmp_path / f"deep.{suffix}"
+    path.write_text(template.replace("{cond}", cond))
+    with pytest.raises(FormatError, match="nested more than 100 deep") as exc:
+        api.read_rulebase(path)
+    assert exc.value.span is not None and exc.value.span.line > 1
+
+
+@pytest.mark.parametrize("suffix, template, cond", [
+    ("fcl", DEEP_FCL, "NOT " * 50 + "a IS lo"),
+    ("fll", DEEP_FLL, "(" * 500 + "a is lo" + ")" * 500),     # parentheses alone nest nothing
+])
+def test_a_foreign_rule_within_the_limit_still_reads(tmp_path, suffix, template, cond):
+    path = tmp_path / f"ok.{suffix}"
+    path.write_text(template.replace("{cond}", cond))
+    assert api.read_rulebase(path).behaviors

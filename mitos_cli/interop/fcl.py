@@ -49,7 +49,7 @@ from ..lang.terms import Role, Term, TermSet, Variable, first_at
 from ..words import plural
 from . import common
 from .common import FCL, FLL, fmt_number
-from .ruletree import conclusions, expression
+from .ruletree import check_depth, conclusions, expression
 from .text import read_foreign_file
 
 DEFAULT_RESOLUTION = 1000
@@ -167,6 +167,7 @@ def parse_fcl(text: str, path: str | None = None) -> RuleBase:
         end = meta.end_column if meta.end_line == meta.line else None
         return Span.in_text(text, path, meta.line, meta.column, end)
 
+    check_depth(tree, span_of)                  # before scan_values, which recurses
     for token in tree.scan_values(lambda v: isinstance(v, Token) and v.type == "SIGNED_NUMBER"):
         if math.isinf(float(token)):
             raise common.past_range(str(token), span_of(token))

@@ -14,6 +14,7 @@ from lark import Token, Tree
 
 from ..errors import FormatError, Span
 from ..lang.model import And, Consequent, Expr, Not, Or, Prop
+from ..lang.parse import MAX_NESTING
 from ..lang.terms import Variable
 from .common import fuzzylite_hedge
 
@@ -21,17 +22,43 @@ SpanOf = Callable[[object], Span]
 
 
 def expression(tree, span_of: SpanOf, variables: dict[str, Variable]) -> Expr:
-    """An antecedent tree as a MITOS expression."""
+    """An antecedent tree as a MITOS expression, refused past :data:`MAX_NESTING` levels
+    first: 400 ``NOT``s or nested parentheses of an FCL or FLL rule were a RecursionError."""
+    if isinstance(tree, Tree):
+        check_depth(tree, span_of)
+    return _expression(tree, span_of, variables)
+
+
+#: the nodes that nest a condition (parentheses add none: the grammars inline them)
+NESTING = ("or_expr", "and_expr", "negation")
+
+
+def check_depth(tree, span_of: SpanOf, limit: int = MAX_NESTING) -> None:
+    """Refuse a condition (or a whole file's tree) whose ``and`` / ``or`` / ``not`` nest
+    deeper than ``limit``, at the first node past it, as the rule language refuses one. Walked
+    without recursion: Lark's ``scan_values`` and every later pass recurse."""
+    stack = [(tree, 0)]
+    while stack:
+        node, depth = stack.pop()
+        depth += node.data in NESTING
+        if depth > limit:
+            raise FormatError(f"conditions nested more than {limit} deep", span=span_of(node),
+                              hint="split the condition into several rules, or drop doubled "
+                                   "`NOT`s and parentheses")
+        stack.extend((child, depth) for child in node.children if isinstance(child, Tree))
+
+
+def _expression(tree, span_of: SpanOf, variables: dict[str, Variable]) -> Expr:
     if isinstance(tree, Token):
         raise FormatError(f"unexpected `{tree}`", span=span_of(tree))
     kind = tree.data
     if kind in ("or_expr", "and_expr"):
-        items = tuple(expression(c, span_of, variables) for c in tree.children
+        items = tuple(_expression(c, span_of, variables) for c in tree.children
                       if not isinstance(c, Token))
         cls = Or if kind == "or_expr" else And
         return cls(items, span_of(tree))
     if kind == "negation":
-        return Not(expression(tree.children[-1], span_of, variables), span_of(tree))
+        return Not(_expression(tree.children[-1], span_of, variables), span_of(tree))
     if kind == "bare_hedge":
         var, *words = tree.children
         if [w.lower() for w in words] != ["any"]:
@@ -49,7 +76,7 @@ def expression(tree, span_of: SpanOf, variables: dict[str, Variable]) -> Expr:
         negated, hedges = _words(words, span_of, tree, allow_not=True)
         return Prop(str(var), str(term), hedges, negated, span_of(tree))
     if len(tree.children) == 1:
-        return expression(tree.children[0], span_of, variables)
+        return _expression(tree.children[0], span_of, variables)
     raise FormatError(f"unexpected `{kind}` in a rule", span=span_of(tree))
 
 
