@@ -273,8 +273,12 @@ class NoRulesError(FormatError):
 
 def closest(name: str, candidates: Iterable[str]) -> str | None:
     """The candidate closest to ``name`` (as written, then in any case, then the one name it
-    begins), or ``None`` when nothing is close."""
+    begins), or ``None`` when nothing is close. A name over thrice the longest candidate is
+    close to none (difflib's ratio stays below 0.5) and is not handed to difflib, which indexes
+    it whole: a 100 MB name in a rule file was a MemoryError."""
     pool = list(candidates)
+    if not pool or len(name) > 3 * max(map(len, pool)):
+        return None
     close = difflib.get_close_matches(name, pool, n=1, cutoff=0.6)
     if not close:
         lowered = {c.lower(): c for c in pool}

@@ -288,3 +288,25 @@ def test_a_foreign_rule_within_the_limit_still_reads(tmp_path, suffix, template,
     path = tmp_path / f"ok.{suffix}"
     path.write_text(template.replace("{cond}", cond))
     assert api.read_rulebase(path).behaviors
+
+
+def test_a_huge_unknown_name_is_not_handed_to_difflib(tmp_path, monkeypatch):
+    """difflib indexes the name whole: a 100 MB term name in a rule file took 3.8 GB and
+    ended in a MemoryError traceback. Here difflib fails as it did, on any call."""
+    import difflib
+
+    from mitos_cli.errors import NameError_, closest
+
+    def out_of_memory(*args, **kwargs):
+        raise MemoryError
+
+    monkeypatch.setattr(difflib, "get_close_matches", out_of_memory)
+    assert closest("R" * 1_000_000, ["LS", "RS"]) is None
+    (tmp_path / "t.terms.yaml").write_text(
+        "variables:\n  a: {role: input, universe: [0, 1], terms: {lo: 1}}\n"
+        "  y: {role: output, universe: [0, 1], terms: {hi: 1}}\n")
+    rules = tmp_path / "r.rules"
+    rules.write_text('terms "t.terms.yaml"\nif a is lo then y is ' + "R" * 1_000_000 + "\n")
+    with pytest.raises(NameError_, match="unknown term") as exc:
+        api.read_rulebase(rules)
+    assert exc.value.hint is None and "one of hi" in exc.value.render()
