@@ -169,6 +169,13 @@ def link_loop(path: str | Path) -> str | None:
     return None
 
 
+def named_yaml(path: str | Path) -> bool:
+    """Whether ``path`` is named ``.yaml`` / ``.yml``, and so is the file its links lead to:
+    such a file may be quoted in an error (docs/security.md), and a link ``x.yaml`` to
+    ``/etc/shadow`` quoted a line of it."""
+    return all(p.suffix.lower() in (".yaml", ".yml") for p in (Path(path), real_path(path)))
+
+
 def real_path(path: str | Path) -> Path:
     """``path`` resolved (links followed), or as an absolute path where a link loop leaves
     nothing to resolve it to (``Path.resolve`` raised a ``RuntimeError`` there)."""

@@ -310,3 +310,29 @@ def test_a_huge_unknown_name_is_not_handed_to_difflib(tmp_path, monkeypatch):
     with pytest.raises(NameError_, match="unknown term") as exc:
         api.read_rulebase(rules)
     assert exc.value.hint is None and "one of hi" in exc.value.render()
+
+
+@pytest.mark.parametrize("secret", SECRETS)
+def test_a_link_named_yaml_to_a_foreign_file_quotes_no_line_of_it(tmp_path, secret):
+    """The check was of the name as written: ``x.yaml`` linked to ``/etc/shadow`` printed
+    its first line in a term set, map or world error."""
+    from mitos_cli.errors import TermSetError, WorldError
+    from mitos_cli.sim.worldfile import load_world
+
+    (tmp_path / "private").write_text(secret)
+    (tmp_path / "x.yaml").symlink_to(tmp_path / "private")
+    rules = tmp_path / "r.rules"
+    rules.write_text('terms "x.yaml"\nif a is lo then y is hi\n')
+    (tmp_path / "w.yaml").write_text(with_map("  grid: x.yaml\n"))
+    shown = []
+    with pytest.raises(TermSetError) as exc:
+        api.read_rulebase(rules)
+    shown.append(exc.value.render())
+    for named in (tmp_path / "x.yaml", tmp_path / "w.yaml"):    # `simulate x.yaml`, `grid:`
+        with pytest.raises(WorldError) as exc:
+            load_world(named)
+        shown.append(exc.value.render())
+    for text in shown:
+        assert "is not a" in text
+        for line in secret.splitlines():
+            assert line not in text and line.split(":")[0] not in text.split("\n", 1)[1]

@@ -76,9 +76,12 @@ def parse_termset(text: str, path: str | None = None) -> TermSet:
     A rule file names its term sets, and a rule file may come from someone else: until
     ``path`` is known to hold a term set (it is named ``.yaml`` / ``.yml``, or it is a YAML
     mapping with a ``variables:`` key) an error quotes nothing of it, so that ``terms
-    "/etc/shadow"`` cannot print a line of a file the user can read.
+    "/etc/shadow"`` cannot print a line of a file the user can read (nor a link named
+    ``x.yaml`` to it: the name its links lead to counts too).
     """
-    named = path is None or path.lower().endswith((".yaml", ".yml"))
+    from ..fileio import named_yaml
+
+    named = path is None or named_yaml(path)
     try:
         data = yamlpos.load(text, path, TermSetError)
     except TermSetError:

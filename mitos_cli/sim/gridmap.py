@@ -337,7 +337,7 @@ def load_map_yaml(path: Path, *, unknown_occupied: bool = True,
     """Read a map_server ``map.yaml`` and its image into a :class:`Grid` in inches
     (``written``: the path as the world file writes it, for a "did you mean" as it would be
     written there)."""
-    from ..fileio import bad_byte, read_text
+    from ..fileio import bad_byte, named_yaml, read_text
 
     if path.suffix.lower() in IMAGE_SUFFIXES:        # the image named where its YAML goes
         beside = [p for p in (path.with_suffix(".yaml"), path.parent / "map.yaml") if exists(p)]
@@ -353,7 +353,7 @@ def load_map_yaml(path: Path, *, unknown_occupied: bool = True,
         raise WorldError(unreadable("map file", path, exc), span=bad_byte(path, exc) or where,
                          hint=_beside(path, written, exc, (".yaml", ".yml"))) from None
     # Until the file is known to be a map file, an error quotes nothing of it (docs/security.md).
-    named = path.suffix.lower() in (".yaml", ".yml")
+    named = named_yaml(path)
     try:
         spec = yamlpos.load(text, str(path), WorldError)
     except WorldError:
