@@ -139,6 +139,13 @@ def visible(text: str) -> str:
     return _CONTROL.sub(lambda m: f"\\x{ord(m.group()):02x}", text)
 
 
+def control_character(text: str) -> str | None:
+    """The first control character of ``text`` as its escape (``\\x1b``), or None: a name
+    that holds one would act on the terminal wherever it is printed."""
+    found = _CONTROL.search(text)
+    return visible(found.group()) if found else None
+
+
 class MitosError(Exception):
     """An error in something the user wrote or asked for.
 

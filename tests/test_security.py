@@ -336,3 +336,60 @@ def test_a_link_named_yaml_to_a_foreign_file_quotes_no_line_of_it(tmp_path, secr
         assert "is not a" in text
         for line in secret.splitlines():
             assert line not in text and line.split(":")[0] not in text.split("\n", 1)[1]
+
+
+# ---- names printed to the terminal ------------------------------------------------------------
+
+ESC_FIS = """[System]
+Name='s'
+Type='sugeno'
+NumInputs=1
+NumOutputs=1
+NumRules=1
+
+[Input1]
+Name='{input}'
+Range=[0 1]
+NumMFs=1
+MF1='{term}':'trimf',[0 0 1]
+
+[Output1]
+Name='y'
+Range=[0 1]
+NumMFs=1
+MF1='hi':'constant',[1]
+
+[Rules]
+1, 1 (1) : 1
+"""
+
+
+@pytest.mark.parametrize("input_name, term_name", [
+    ("a\x1b]0;title\x07", "lo"),          # an OSC sequence: set the terminal's title
+    ("a", "lo\x1b[2J"),                   # clear the screen
+    ("a\x9b31m", "lo"),                   # a C1 control sequence introducer
+])
+def test_a_control_character_in_a_fis_name_is_refused(tmp_path, input_name, term_name):
+    """`mitos eval` and `check` printed a .fis file's names as written: an ESC in one acted
+    on the terminal."""
+    from mitos_cli.errors import FormatError
+
+    path = tmp_path / "esc.fis"
+    path.write_text(ESC_FIS.replace("{input}", input_name).replace("{term}", term_name),
+                    encoding="utf-8")
+    with pytest.raises(FormatError, match="holds the control character") as exc:
+        api.read_rulebase(path)
+    assert not any(c in exc.value.render() for c in "\x1b\x07\x9b")
+
+
+@pytest.mark.parametrize("key", ["description", "unit"])
+def test_a_control_character_in_a_term_sets_text_is_refused(tmp_path, key):
+    from mitos_cli.errors import TermSetError
+
+    (tmp_path / "t.terms.yaml").write_text(
+        f'variables:\n  a: {{role: input, universe: [0, 1], {key}: "in\\e[2J", '
+        f"terms: {{lo: 1}}}}\n  y: {{role: output, universe: [0, 1], terms: {{hi: 1}}}}\n")
+    rules = tmp_path / "r.rules"
+    rules.write_text('terms "t.terms.yaml"\nif a is lo then y is hi\n')
+    with pytest.raises(TermSetError, match=f"its {key} holds the control character `.x1b`"):
+        api.read_rulebase(rules)

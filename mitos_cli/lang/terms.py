@@ -13,7 +13,7 @@ from typing import Literal
 
 import numpy as np
 
-from ..errors import Span, TermSetError, unknown
+from ..errors import Span, TermSetError, control_character, unknown
 from ..fuzzy.formula import Formula
 from ..fuzzy.shapes import SHAPES, STEEP, Shape
 
@@ -117,12 +117,29 @@ class Variable:
         if problem:
             raise TermSetError(f"variable `{self.name}`: {problem[0]}", span=self.span,
                                hint=problem[1])
+        self._check_plain()
         seen: dict[str, Term] = {}
         for term in self.terms:
             first = seen.setdefault(term.name, term)
             if first is not term:
                 raise TermSetError(f"variable `{self.name}`: duplicate term `{term.name}`"
                                    + first_at(first.span), span=term.span)
+
+    def _check_plain(self) -> None:
+        """Refuse a control character in a name, description or unit (a .fis name may hold
+        any character, a YAML text any escape): `eval`, `check` and `teach` print them, and
+        an ESC there was sent to the terminal as written (``\\x1b]0;...`` set its title)."""
+        texts = [(f"variable `{self.name}`", "its name", self.name, self.span),
+                 (f"variable `{self.name}`", "its description", self.description, self.span),
+                 (f"variable `{self.name}`", "its unit", self.unit, self.span)]
+        texts += [(f"term `{self.name}.{t.name}`", "its name", t.name, t.span or self.span)
+                  for t in self.terms]
+        for what, part, text, span in texts:
+            char = control_character(text)
+            if char is not None:
+                raise TermSetError(f"{what}: {part} holds the control character `{char}`",
+                                   span=span, hint="names and texts are printed to the "
+                                   "terminal: write them without control characters")
 
     @property
     def term_names(self) -> tuple[str, ...]:
