@@ -393,3 +393,47 @@ def test_a_control_character_in_a_term_sets_text_is_refused(tmp_path, key):
     rules.write_text('terms "t.terms.yaml"\nif a is lo then y is hi\n')
     with pytest.raises(TermSetError, match=f"its {key} holds the control character `.x1b`"):
         api.read_rulebase(rules)
+
+
+# ---- a world naming a pipe ----------------------------------------------------------------------
+
+def _finishes(call, fifo: Path, seconds: float = 20.0):
+    """``call()``'s result or exception, run in a thread; a call still waiting on ``fifo``
+    after ``seconds`` is released (a writer opens and closes it) and fails the test."""
+    import threading
+
+    box: dict = {}
+
+    def run():
+        try:
+            box["value"] = call()
+        except BaseException as exc:        # noqa: BLE001 (handed to the test)
+            box["error"] = exc
+
+    thread = threading.Thread(target=run, daemon=True)
+    thread.start()
+    thread.join(seconds)
+    if thread.is_alive():
+        os.close(os.open(fifo, os.O_WRONLY | os.O_NONBLOCK))
+        thread.join(seconds)
+        pytest.fail(f"waited on the pipe {fifo.name} for {seconds:g} s")
+    return box
+
+
+@pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="no named pipes here")
+def test_a_world_whose_map_is_a_named_pipe_is_refused_not_waited_on(tmp_path):
+    """`grid: PIPE.yaml` waited without end for a writer, in `simulate` and in `compare`'s
+    digest of the files a world reads; a term set or a world file so named is refused."""
+    from mitos_cli.errors import WorldError
+    from mitos_cli.sim.worldfile import load_world, map_files
+    from mitos_cli.study.simtask import world_digest
+
+    fifo = tmp_path / "pipe.yaml"
+    os.mkfifo(fifo)
+    world = tmp_path / "w.yaml"
+    world.write_text(with_map("  grid: pipe.yaml\n"))
+    box = _finishes(lambda: load_world(world), fifo)
+    assert isinstance(box.get("error"), WorldError)
+    assert "`pipe.yaml` is not a regular file" in box["error"].render()
+    assert _finishes(lambda: map_files(world), fifo).get("value") == [fifo]
+    assert _finishes(lambda: world_digest(str(world)), fifo).get("value") is None

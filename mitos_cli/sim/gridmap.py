@@ -347,6 +347,10 @@ def load_map_yaml(path: Path, *, unknown_occupied: bool = True,
                          hint=f"did you mean `{beside[0]}`?" if beside else
                          "write a YAML beside it: `image: " + path.name + "`, `resolution: 0.05`, "
                          "`origin: [0, 0, 0]`")
+    if exists(path) and not path.is_file() and not path.is_dir():
+        # a FIFO waited for a writer without end (a world file may name any path)
+        raise WorldError(f"map file `{written or path}` is not a regular file (a pipe or a "
+                         "device)", span=where, expected="PATH.yaml, a map_server map file")
     try:
         text = read_text(path)
     except (OSError, UnicodeDecodeError) as exc:

@@ -1233,6 +1233,8 @@ def map_files(path: str | Path) -> list[Path]:
 
     def named(file: Path, key: str, within: str) -> Path | None:
         try:
+            if not file.is_file():              # (a FIFO would be waited on without end)
+                return None
             doc = yamlpos.load(read_text(file), str(file), WorldError)
         except (MitosError, OSError, UnicodeDecodeError, ValueError):
             return None

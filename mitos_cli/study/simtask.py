@@ -39,10 +39,12 @@ class StudyContext:
 
 def file_digest(paths: Sequence[Path]) -> str | None:
     """A digest of the files' bytes (16 hex digits); None when one cannot be read (reported
-    where the file is read)."""
+    where the file is read), or is no regular file (a FIFO a world names was waited on)."""
     h = hashlib.sha256()
     try:
         for p in paths:
+            if not p.is_file():
+                return None
             h.update(p.read_bytes())
     except OSError:
         return None
