@@ -437,3 +437,36 @@ def test_a_world_whose_map_is_a_named_pipe_is_refused_not_waited_on(tmp_path):
     assert "`pipe.yaml` is not a regular file" in box["error"].render()
     assert _finishes(lambda: map_files(world), fifo).get("value") == [fifo]
     assert _finishes(lambda: world_digest(str(world)), fifo).get("value") is None
+
+
+# ---- what a lesson may write -------------------------------------------------------------------
+
+def test_a_lessons_save_stays_below_the_working_directory(tmp_path, monkeypatch):
+    """A lesson's `save /any/where.rules` (or `../`, `~/`, a link that leads out) wrote over
+    that file without a word; at the prompt, and with `--save-as`, the user names the place."""
+    from mitos_cli.errors import LessonError
+    from mitos_cli.teach.lesson import run_lesson
+    from mitos_cli.teach.session import Session
+
+    work, away = tmp_path / "work", tmp_path / "away"
+    work.mkdir()
+    away.mkdir()
+    for f in (REPO / "rulebases").iterdir():
+        if f.is_file():
+            shutil.copy(f, work / f.name)
+    victim = away / "mine.rules"
+    victim.write_text("# the user's own\n")
+    (work / "out").symlink_to(away)
+    monkeypatch.chdir(work)
+    monkeypatch.setenv("HOME", str(away))               # `~/mine.rules`, were it written
+    session = Session(work / "mitos.rules", out=lambda s: None)
+    for target in (victim, "../away/mine.rules", "out/mine.rules", "~/mine.rules"):
+        with pytest.raises(LessonError, match="a lesson saves below the working directory") \
+                as exc:
+            run_lesson(session, f"save {target}\n", "evil.lesson")
+        assert exc.value.span.path == "evil.lesson" and exc.value.span.column == 6
+    assert victim.read_text() == "# the user's own\n"
+    assert run_lesson(session, "save taught/ok.rules\n", "ok.lesson")
+    assert (work / "taught" / "ok.rules").is_file()
+    session.run(f"save {away / 'asked.rules'}")        # at the prompt: where the user says
+    assert (away / "asked.rules").is_file()

@@ -38,7 +38,16 @@ def commands(text: str) -> Iterator[tuple[int, str]]:
 
 def run_lesson(session: Session, text: str, path: str) -> bool:
     """Run every command of ``text``; False when the lesson said ``quit``. Ctrl-C stops the
-    lesson (``KeyboardInterrupt``), also when an ``adapt`` caught it to keep its epochs."""
+    lesson (``KeyboardInterrupt``), also when an ``adapt`` caught it to keep its epochs. Its
+    ``save PATH`` stays below the working directory (:attr:`Session.confined`)."""
+    session.confined = Path.cwd()
+    try:
+        return _run(session, text, path)
+    finally:
+        session.confined = None
+
+
+def _run(session: Session, text: str, path: str) -> bool:
     for lineno, line in commands(text):
         session.echo(f"{path}:{lineno}> {visible(line.splitlines()[0])}")
         session.interrupted = False

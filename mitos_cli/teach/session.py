@@ -175,6 +175,9 @@ class Session:
         self.simulation: Recording | None = None
         self._noted: tuple[int, str] | None = None     # `at` said whom the run corrects
         self.base: Path | None = None       # where a lesson's relative world paths start
+        #: the directory a lesson's `save PATH` must lie below (set while a lesson runs): a
+        #: lesson may come from anyone, and its `save /any/where.rules` wrote over that file
+        self.confined: Path | None = None
         self.saved_seq = 0
         self.interrupted = False            # the last command's adaptation was cut short
         self.opened_at: Span | None = None  # where a lesson opened the behavior still open
@@ -959,6 +962,8 @@ class Session:
         if self.state.block is not None:
             raise LessonError(f"behavior `{self.state.block}` is still open",
                               hint="close it with `end` before saving")
+        if c.path is not None and self.confined is not None:
+            _check_below(c.path, self.confined)
         if _is_dir(target):                 # checked before any term set is written beside it
             raise LessonError(f"`{target}` is a directory; save names the rule file to write",
                               hint=f"save {(target / 'taught.rules').as_posix()}")
@@ -1131,6 +1136,21 @@ def _is_dir(path: Path) -> bool:
         return path.is_dir()
     except OSError:
         return False
+
+
+def _check_below(written: str, root: Path) -> None:
+    """Refuse a lesson's ``save`` outside ``root`` (absolute, ``~``, a ``..`` or a link that
+    leads out): the files a lesson writes are the user's to place (``--save-as``)."""
+    from ..fileio import real_path
+
+    inside = real_path(root)
+    target = real_path(root / written)
+    if Path(written).is_absolute() or written.startswith("~") or \
+            inside not in target.parents:
+        raise LessonError(f"a lesson saves below the working directory only, and `{written}` "
+                          f"lies outside it", expected="a relative path such as taught.rules",
+                          hint="a lesson may come from anyone: name the place yourself, with "
+                               "`--save-as PATH` or a `save PATH` at the prompt")
 
 
 def _same_file(a: Path, b: Path) -> bool:
