@@ -461,8 +461,8 @@ def test_a_lessons_save_stays_below_the_working_directory(tmp_path, monkeypatch)
     monkeypatch.setenv("HOME", str(away))               # `~/mine.rules`, were it written
     session = Session(work / "mitos.rules", out=lambda s: None)
     for target in (victim, "../away/mine.rules", "out/mine.rules", "~/mine.rules"):
-        with pytest.raises(LessonError, match="a lesson saves below the working directory") \
-                as exc:
+        with pytest.raises(LessonError, match="a lesson writes files below the working "
+                                              "directory") as exc:
             run_lesson(session, f"save {target}\n", "evil.lesson")
         assert exc.value.span.path == "evil.lesson" and exc.value.span.column == 6
     assert victim.read_text() == "# the user's own\n"
@@ -470,3 +470,25 @@ def test_a_lessons_save_stays_below_the_working_directory(tmp_path, monkeypatch)
     assert (work / "taught" / "ok.rules").is_file()
     session.run(f"save {away / 'asked.rules'}")        # at the prompt: where the user says
     assert (away / "asked.rules").is_file()
+
+
+def test_a_lessons_plots_stay_below_the_working_directory(tmp_path, monkeypatch):
+    """`adapt ... plot /elsewhere/x.png` and `show terms plot ...` in a lesson wrote (over)
+    pictures wherever the lesson said."""
+    from mitos_cli.errors import LessonError
+    from mitos_cli.teach.lesson import run_lesson
+    from mitos_cli.teach.session import Session
+
+    pytest.importorskip("matplotlib")
+    work, away = tmp_path / "work", tmp_path / "away"
+    work.mkdir()
+    away.mkdir()
+    monkeypatch.chdir(work)
+    session = Session(REPO / "rulebases" / "mitos.rules", out=lambda s: None)
+    run_lesson(session, "correct road=78 size=45 position=4 -> steering is LM\n", "a.lesson")
+    for line in (f"adapt epochs 1 plot {away / 'p.png'}", f"show terms plot {away / 'p.png'}",
+                 "adapt epochs 1 plot ../away/p.png"):
+        with pytest.raises(LessonError, match="a lesson writes files below the working "
+                                              "directory"):
+            run_lesson(session, line + "\n", "evil.lesson")
+    assert list(away.iterdir()) == []

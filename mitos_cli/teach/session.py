@@ -871,6 +871,7 @@ class Session:
 
             with _drawing():
                 check_format(c.plot)
+                _check_below(c.plot, self.confined, "terms.png")
                 check_writable(c.plot)
         progress = self.progress(epochs) if self.progress else None
         try:
@@ -924,6 +925,7 @@ class Session:
 
                 with _drawing():
                     check_format(c.plot)
+                _check_below(c.plot, self.confined, "terms.png")
             self.out(text.terms_table(self.original, self.rulebase, self._shownvariables()))
             if c.plot is not None:
                 self._plot_terms(self.original, self.rulebase, c.plot)
@@ -962,7 +964,7 @@ class Session:
         if self.state.block is not None:
             raise LessonError(f"behavior `{self.state.block}` is still open",
                               hint="close it with `end` before saving")
-        if c.path is not None and self.confined is not None:
+        if c.path is not None:
             _check_below(c.path, self.confined)
         if _is_dir(target):                 # checked before any term set is written beside it
             raise LessonError(f"`{target}` is a directory; save names the rule file to write",
@@ -1138,19 +1140,23 @@ def _is_dir(path: Path) -> bool:
         return False
 
 
-def _check_below(written: str, root: Path) -> None:
-    """Refuse a lesson's ``save`` outside ``root`` (absolute, ``~``, a ``..`` or a link that
-    leads out): the files a lesson writes are the user's to place (``--save-as``)."""
+def _check_below(written: str, root: Path | None, example: str = "taught.rules") -> None:
+    """Refuse a file a lesson writes (``save``, ``plot``) outside ``root`` (absolute, ``~``, a
+    ``..`` or a link that leads out): where a lesson runs (``root`` set), the files it writes
+    are the user's to place (``--save-as``, the prompt)."""
     from ..fileio import real_path
 
+    if root is None:
+        return
     inside = real_path(root)
     target = real_path(root / written)
     if Path(written).is_absolute() or written.startswith("~") or \
             inside not in target.parents:
-        raise LessonError(f"a lesson saves below the working directory only, and `{written}` "
-                          f"lies outside it", expected="a relative path such as taught.rules",
+        raise LessonError(f"a lesson writes files below the working directory only, and "
+                          f"`{written}` lies outside it",
+                          expected=f"a relative path such as {example}",
                           hint="a lesson may come from anyone: name the place yourself, with "
-                               "`--save-as PATH` or a `save PATH` at the prompt")
+                               "`--save-as PATH` or at the prompt")
 
 
 def _same_file(a: Path, b: Path) -> bool:
