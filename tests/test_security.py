@@ -492,3 +492,22 @@ def test_a_lessons_plots_stay_below_the_working_directory(tmp_path, monkeypatch)
                                               "directory"):
             run_lesson(session, line + "\n", "evil.lesson")
     assert list(away.iterdir()) == []
+
+
+def test_a_line_break_in_a_unit_is_refused_a_description_may_have_lines(tmp_path):
+    """`eval` prints the unit within its lines: `unit: "in\\noutputs:\\n  y = 1"` wrote output
+    lines of its own. A description (drawn as a title) may hold several lines."""
+    from mitos_cli.errors import TermSetError
+
+    def termset(extra: str) -> Path:
+        (tmp_path / "t.terms.yaml").write_text(
+            f"variables:\n  a: {{role: input, universe: [0, 1], {extra}, terms: {{lo: 1}}}}\n"
+            "  y: {role: output, universe: [0, 1], terms: {hi: 1}}\n")
+        rules = tmp_path / "r.rules"
+        rules.write_text('terms "t.terms.yaml"\nif a is lo then y is hi\n')
+        return rules
+
+    with pytest.raises(TermSetError, match=r"its unit holds the control character `\\n`"):
+        api.read_rulebase(termset('unit: "in\\n\\noutputs:\\n  y = 1"'))
+    rb = api.read_rulebase(termset('description: "two\\nlines\\tand a tab"'))
+    assert rb.termsets[0].variables[0].description == "two\nlines\tand a tab"

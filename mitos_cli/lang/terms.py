@@ -92,6 +92,15 @@ class Term:
         return replace(self, params=tuple(float(p) for p in params))
 
 
+def _control_in(text: str, one_line: bool) -> str | None:
+    """The first control character of ``text`` as its escape; in a ``one_line`` text a line
+    break counts too (a tab does not: a .fis name may hold one, and it writes no line)."""
+    found = control_character(text)
+    if found is None and one_line and "\n" in text:
+        found = "\\n"
+    return found
+
+
 def first_at(span: Span | None) -> str:
     """`` (first at line N)``, said of a name given twice, at the second; empty without a
     position."""
@@ -128,14 +137,17 @@ class Variable:
     def _check_plain(self) -> None:
         """Refuse a control character in a name, description or unit (a .fis name may hold
         any character, a YAML text any escape): `eval`, `check` and `teach` print them, and
-        an ESC there was sent to the terminal as written (``\\x1b]0;...`` set its title)."""
-        texts = [(f"variable `{self.name}`", "its name", self.name, self.span),
-                 (f"variable `{self.name}`", "its description", self.description, self.span),
-                 (f"variable `{self.name}`", "its unit", self.unit, self.span)]
-        texts += [(f"term `{self.name}.{t.name}`", "its name", t.name, t.span or self.span)
+        an ESC there was sent to the terminal as written (``\\x1b]0;...`` set its title).
+        A name or unit is one line besides: `eval` prints the unit within its lines, and a
+        line break in it wrote lines of output of its own (``outputs: steering = 150``)."""
+        texts = [(f"variable `{self.name}`", "its name", self.name, self.span, True),
+                 (f"variable `{self.name}`", "its description", self.description, self.span,
+                  False),
+                 (f"variable `{self.name}`", "its unit", self.unit, self.span, True)]
+        texts += [(f"term `{self.name}.{t.name}`", "its name", t.name, t.span or self.span, True)
                   for t in self.terms]
-        for what, part, text, span in texts:
-            char = control_character(text)
+        for what, part, text, span, one_line in texts:
+            char = _control_in(text, one_line)
             if char is not None:
                 raise TermSetError(f"{what}: {part} holds the control character `{char}`",
                                    span=span, hint="names and texts are printed to the "
