@@ -511,3 +511,18 @@ def test_a_line_break_in_a_unit_is_refused_a_description_may_have_lines(tmp_path
         api.read_rulebase(termset('unit: "in\\n\\noutputs:\\n  y = 1"'))
     rb = api.read_rulebase(termset('description: "two\\nlines\\tand a tab"'))
     assert rb.termsets[0].variables[0].description == "two\nlines\tand a tab"
+
+
+def test_a_yaml_file_of_too_many_values_is_refused_early(tmp_path, monkeypatch):
+    """A 4 MB term set of one list of 2,000,000 numbers took a GB and over a minute to read
+    (PyYAML builds a node and a value for each). Here with a limit of 1,000 for speed."""
+    from mitos_cli.errors import TermSetError
+    from mitos_cli.lang import yamlpos
+
+    monkeypatch.setattr(yamlpos, "MAX_NODES", 1_000, raising=False)
+    text = "variables:\n  a: {role: input, universe: [0, 1], terms: {lo: 1}}\n" \
+           "junk: [" + ", ".join(["1"] * 2_000) + "]\n"
+    with pytest.raises(TermSetError, match="more than 1,000 values") as exc:
+        yamlpos.load(text, "t.terms.yaml", TermSetError)
+    assert exc.value.span.line == 3
+    assert yamlpos.load(text.split("junk")[0], "t.terms.yaml", TermSetError)

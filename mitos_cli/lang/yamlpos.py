@@ -54,6 +54,9 @@ def _span(mark: Any, text: str, path: str | None) -> Span:
 
 #: deeper nesting than any of our formats needs (and than Python's recursion allows)
 MAX_DEPTH = 64
+#: more values (scalars, lists and mappings) than any term set, world or map file holds: a 4 MB
+#: list of 2,000,000 took a GB and over a minute to read; this many take some 8 s
+MAX_NODES = 100_000
 
 
 def _refuse(problem: str, mark: Any) -> yaml.constructor.ConstructorError:
@@ -128,9 +131,11 @@ def _build_loader(text: str, path: str | None) -> type:
     class Loader(_Yaml12Scalars):
         """Safe loading without aliases, anchors, merge keys or tags (no format here has
         them, and an alias bomb expands a few lines into billions of values), nested at most
-        :data:`MAX_DEPTH` deep, and with the constructors' own errors kept at their node."""
+        :data:`MAX_DEPTH` deep, of at most :data:`MAX_NODES` values, and with the
+        constructors' own errors kept at their node."""
 
         depth = 0
+        nodes = 0
 
         def compose_node(self, parent, index):
             event = self.peek_event()
@@ -147,6 +152,10 @@ def _build_loader(text: str, path: str | None) -> type:
                 shown = tag.replace("tag:yaml.org,2002:", "!!")
                 raise _refuse(f"YAML tags (`{shown}`) are not supported here",
                               event.start_mark)
+            self.nodes += 1
+            if self.nodes > MAX_NODES:
+                raise _refuse(f"more than {MAX_NODES:,} values, far more than any term set, "
+                              f"world or map file holds", event.start_mark)
             self.depth += 1
             try:
                 if self.depth > MAX_DEPTH:
