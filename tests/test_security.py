@@ -17,6 +17,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from mitos_cli import api
@@ -526,3 +527,79 @@ def test_a_yaml_file_of_too_many_values_is_refused_early(tmp_path, monkeypatch):
         yamlpos.load(text, "t.terms.yaml", TermSetError)
     assert exc.value.span.line == 3
     assert yamlpos.load(text.split("junk")[0], "t.terms.yaml", TermSetError)
+
+
+# ---- a world whose corridors double back -----------------------------------------------------
+
+def test_a_world_of_too_many_corridor_points_is_refused(tmp_path):
+    """A 60 KB world of one corridor of 1,500 points doubling back on itself took 39 s and
+    2 GB to load (every piece's walls clipped by every other piece), 4,000 over minutes."""
+    from mitos_cli.errors import WorldError
+    from mitos_cli.sim.worldfile import load_world
+
+    def world(n: int) -> Path:
+        points = ", ".join(f"[{(i % 2) * 100 + i * 0.01:g}, 0]" for i in range(n))
+        path = tmp_path / f"w{n}.yaml"
+        path.write_text(with_map(f"  corridors:\n    - points: [[0, 0], [600, 0]]\n"
+                                 f"      width: 70\n    - points: [{points}]\n      width: 70\n"))
+        return path
+
+    with pytest.raises(WorldError, match="more than 1,000 points") as exc:
+        load_world(world(999))                              # and 2 in the first corridor
+    assert exc.value.span.line > 1 and "corridor 2" in exc.value.message
+    assert load_world(world(998)).corridors
+
+
+def _clip_one_by_one(seg, rects, shrink=1e-6):
+    """The clipping as it was, one rectangle at a time: the reference for the bits."""
+    p0, p1 = seg[:2], seg[2:]
+    pieces = [(0.0, 1.0)]
+    for corners in rects:
+        centre = corners.mean(axis=0)
+        u, v = corners[1] - corners[0], corners[3] - corners[0]
+        nu, nv = np.linalg.norm(u), np.linalg.norm(v)
+        if not (nu > 0 and nv > 0):
+            continue
+        u, v = u / nu, v / nv
+        t0, t1 = 0.0, 1.0
+        for axis, half in ((u, nu / 2 - shrink), (v, nv / 2 - shrink)):
+            a0, da = float(np.dot(p0 - centre, axis)), float(np.dot(p1 - p0, axis))
+            if abs(da) < 1e-9:
+                if abs(a0) >= half:
+                    t0, t1 = 1.0, 0.0
+                continue
+            ta, tb = float((-half - a0) / da), float((half - a0) / da)
+            t0, t1 = max(t0, min(ta, tb)), min(t1, max(ta, tb))
+        if t1 <= t0:
+            continue
+        cut = []
+        for a, b in pieces:
+            if b <= t0 or a >= t1:
+                cut.append((a, b))
+                continue
+            cut += [(a, t0)] * (a < t0) + [(t1, b)] * (b > t1)
+        pieces = cut
+    length = float(np.hypot(*(p1 - p0)))
+    return [np.concatenate([p0 + a * (p1 - p0), p0 + b * (p1 - p0)]) for a, b in pieces
+            if (b - a) * length > 1e-6]
+
+
+def test_clipping_all_rectangles_at_once_keeps_every_bit():
+    """The walls (so every run) are those of one rectangle at a time, to the last bit."""
+    from mitos_cli.sim.geometry import clip_segment_outside
+
+    rng = np.random.default_rng(7)
+    for _ in range(2_000):
+        rects = []
+        for _ in range(rng.integers(0, 7)):
+            c, a = rng.uniform(-500, 500, 2), rng.uniform(0, np.pi)
+            length, width = rng.choice([0.0, rng.uniform(0.1, 600)]), rng.uniform(0.1, 40)
+            u, v = np.array([np.cos(a), np.sin(a)]), np.array([-np.sin(a), np.cos(a)])
+            rects.append([c + (sx * u * length + sy * v * width) / 2
+                          for sx, sy in ((-1, -1), (1, -1), (1, 1), (-1, 1))])
+        rects = np.array(rects, float).reshape(-1, 4, 2)
+        seg = rng.uniform(-600, 600, 4)
+        if len(rects) and rng.random() < 0.3:
+            seg = np.concatenate([rects[0][0], rects[0][1]])        # a side of its own
+        got, want = clip_segment_outside(seg, rects), _clip_one_by_one(seg, rects)
+        assert len(got) == len(want) and all(map(np.array_equal, got, want))

@@ -594,6 +594,27 @@ def _agents(r: _Reader, top: YMap, robot: Robot,
     return agents, agent_spans
 
 
+#: the most corridor points a world may have in all: each corridor piece's walls are clipped by
+#: the pieces they meet, so a polyline doubling back on itself costs the square of its points
+#: (1,500 such points took 39 s and 2 GB to load); a building of more is a `grid:` map
+MAX_CORRIDOR_POINTS = 1000
+
+
+def _check_corridor_points(corridors: list[Corridor], mp: YMap) -> None:
+    """Refuse more than :data:`MAX_CORRIDOR_POINTS` corridor points, at the corridor that
+    passes the limit."""
+    total = 0
+    for i, c in enumerate(corridors):
+        total += len(c.points)
+        if total > MAX_CORRIDOR_POINTS:
+            raise WorldError(f"the corridors have more than {MAX_CORRIDOR_POINTS:,} points "
+                             f"({total:,} up to corridor {i + 1})",
+                             span=mp["corridors"].item_span(i),
+                             expected=f"at most {MAX_CORRIDOR_POINTS:,} points in all",
+                             hint="draw a building of more as a map image (`grid: map.yaml`), "
+                                  "or drop points along the straight stretches")
+
+
 def _map(r: _Reader, top: YMap, path: str):
     """``map``: its corridors, its grid (a map_server YAML), and what the robot is given."""
     mp = r.mapping(yamlpos.require(top, "map", WorldError, "the world file"),
@@ -604,6 +625,7 @@ def _map(r: _Reader, top: YMap, path: str):
         pts = r.points(yamlpos.require(c, "points", WorldError, f"corridor {i + 1}"),
                        c.value_span("points"), f"`points` of corridor {i + 1}", 2)
         corridors.append(Corridor(pts, r.number(c, "width", f"corridor {i + 1}", positive=True)))
+    _check_corridor_points(corridors, mp)
     unknown_occupied = r.choice(mp, "unknown", ("occupied", "free"), "map", "occupied") == "occupied"
     grid = None
     if "grid" in mp:
