@@ -603,3 +603,17 @@ def test_clipping_all_rectangles_at_once_keeps_every_bit():
             seg = np.concatenate([rects[0][0], rects[0][1]])        # a side of its own
         got, want = clip_segment_outside(seg, rects), _clip_one_by_one(seg, rects)
         assert len(got) == len(want) and all(map(np.array_equal, got, want))
+
+
+def test_a_yaml_file_too_long_is_refused_before_it_is_scanned(monkeypatch):
+    """A 250 MB term set (one long description) ran past a minute in PyYAML's scanner.
+    Here with a limit of 1,000 characters for speed; the error quotes nothing of the file."""
+    from mitos_cli.errors import TermSetError
+    from mitos_cli.lang import yamlpos
+
+    monkeypatch.setattr(yamlpos, "MAX_CHARS", 1_000, raising=False)
+    text = "variables:\n  a:\n    description: " + "x" * 2_000 + "\n"
+    with pytest.raises(TermSetError, match="holds 2,034 characters; .* at most 1,000") as exc:
+        yamlpos.load(text, "t.terms.yaml", TermSetError)
+    assert "xxx" not in exc.value.render()
+    assert yamlpos.load(text[:900], "t.terms.yaml", TermSetError)

@@ -216,8 +216,18 @@ def _build_loader(text: str, path: str | None) -> type:
     return Loader
 
 
+#: the longest YAML text read (characters): PyYAML scans some 3 MB a second here, and a 250 MB
+#: term set (one long description) ran for minutes; the packaged files hold a few KB
+MAX_CHARS = 16 << 20
+
+
 def load(text: str, path: str | None, error: type[MitosError]) -> Any:
-    """Parse YAML ``text`` (from ``path``) into positioned values, raising ``error`` when bad."""
+    """Parse YAML ``text`` (from ``path``) into positioned values, raising ``error`` when bad
+    (or longer than :data:`MAX_CHARS`, refused before a character is scanned)."""
+    if len(text) > MAX_CHARS:
+        raise error(f"`{path}` holds {len(text):,} characters; a term set, world or map file "
+                    f"may hold at most {MAX_CHARS:,} ({MAX_CHARS >> 20} MB)",
+                    span=Span(path, 1, 1) if path else None)
     try:
         return yaml.load(text, Loader=_build_loader(text, path))  # noqa: S506 (SafeLoader)
     except yaml.MarkedYAMLError as exc:
