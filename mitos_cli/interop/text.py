@@ -21,6 +21,7 @@ from ..errors import FormatError, RuleBaseError
 from ..fileio import byte_span as _at
 from ..fileio import read_bytes, unreadable
 from ..lang.model import RuleBase
+from ..lang.parse import check_rule_file_size
 from ..lang.resolve import rule_file_hint
 
 #: The encoding a file that is not UTF-8 is read in: what MATLAB and Java write on Windows.
@@ -30,6 +31,7 @@ LEGACY = "cp1252"
 def read_foreign_file(path: Path, parse: Callable[[str, str], RuleBase]) -> RuleBase:
     """The rule base ``parse`` reads from ``path``'s text, noting a legacy encoding."""
     text, note = foreign_text(path)
+    check_rule_file_size(text, str(path))
     rb = parse(text, str(path))
     return rb if note is None else dataclasses.replace(rb, notes=(note, *rb.notes))
 
