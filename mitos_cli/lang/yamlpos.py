@@ -54,9 +54,10 @@ def _span(mark: Any, text: str, path: str | None) -> Span:
 
 #: deeper nesting than any of our formats needs (and than Python's recursion allows)
 MAX_DEPTH = 64
-#: more values (scalars, lists and mappings) than any term set, world or map file holds: a 4 MB
-#: list of 2,000,000 took a GB and over a minute to read; this many take some 8 s
-MAX_NODES = 100_000
+#: more values (scalars, lists and mappings) than a term set, world or map file holds: a 4 MB
+#: list of 2,000,000 took a GB and over a minute to read; 100,000 take some 8 s. 500,000, not
+#: 100,000: a world of 16,000 obstacles (a size the reliability page times) holds about 96,000
+MAX_NODES = 500_000
 
 
 def _refuse(problem: str, mark: Any) -> yaml.constructor.ConstructorError:
