@@ -131,3 +131,43 @@ def test_a_file_that_cannot_be_written_is_said_alike_by_every_command(args, targ
     assert len(said) == 1 and said[0].startswith(f"error: cannot write `{target}`: "), \
         proc.stderr
     assert "Traceback" not in proc.stderr
+
+
+def test_a_ctrl_c_in_pythons_clean_up_ends_the_process_without_a_word(tmp_path) -> None:
+    """A Ctrl-C landing after the command, in Python's clean-up (here: the clean-up that joins
+    the batch threads), printed "Exception ignored ... KeyboardInterrupt" and exited 0. It
+    ends the process as the signal does now, after what the command wrote is flushed."""
+    import os
+    import signal
+
+    root = Path(__file__).resolve().parents[1]
+    script = ("import os, signal, sys, threading, time\n"
+              "def ctrl_c():\n"
+              "    os.kill(os.getpid(), signal.SIGINT)\n"
+              "    time.sleep(1)\n"
+              "threading._register_atexit(ctrl_c)\n"
+              "sys.argv = ['mitos', 'list', '--json']\n"
+              "import runpy\n"
+              "runpy.run_module('mitos_cli', run_name='__main__')\n")
+    proc = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
+                          cwd=tmp_path, env=dict(os.environ, PYTHONPATH=str(root)), timeout=120)
+    assert proc.stderr == ""
+    assert proc.returncode == -signal.SIGINT
+    assert proc.stdout.rstrip().endswith("}")          # the JSON, whole
+
+
+def test_a_ctrl_c_before_the_command_runs_exits_130_without_a_traceback(monkeypatch) -> None:
+    """While Typer builds the command (before it answers Ctrl-C itself), a Ctrl-C printed a
+    traceback of Typer's inspection of the signatures."""
+    import mitos_cli.cli.app as app
+
+    def interrupted(only=None):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(app, "build_app", interrupted)
+    try:
+        app.main(["eval", "road=78"])
+    except KeyboardInterrupt:
+        pytest.fail("the Ctrl-C went through main as a traceback")
+    except SystemExit as exc:
+        assert exc.code == 130

@@ -84,7 +84,40 @@ def __getattr__(name: str):
 
 
 def main(argv: list[str] | None = None) -> None:
-    """Entry point of the console script and ``python -m mitos_cli``."""
+    """Entry point of the console script and ``python -m mitos_cli``.
+
+    Typer answers a Ctrl-C during a command (exit 130, quietly); one while the command is
+    being built, or after it, printed a traceback, or "Exception ignored" when it landed in
+    Python's own clean-up (joining the batch threads, the atexit callbacks)."""
+    try:
+        _main(argv)
+    except KeyboardInterrupt:
+        from .progress import INTERRUPTED
+
+        sys.exit(INTERRUPTED)
+    finally:
+        if argv is None:               # the process's own command line (not a caller's)
+            _end_quietly()
+
+
+def _end_quietly() -> None:
+    """What the command wrote, flushed; then a Ctrl-C ends the process as the signal does
+    (its status says interrupted, as a shell expects), not with a Python traceback from
+    the clean-up it interrupts."""
+    import signal
+    import threading
+
+    for stream in (sys.stdout, sys.stderr):
+        try:
+            if stream is not None:
+                stream.flush()
+        except (OSError, ValueError):   # said by the command already, or by Python at exit
+            pass
+    if threading.current_thread() is threading.main_thread():
+        signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
+def _main(argv: list[str] | None) -> None:
     args = sys.argv[1:] if argv is None else list(argv)
     first = args[0] if args else None
     app = build_app(first if first in COMMANDS else None)
