@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import errno
 import importlib
+import io
 import sys
 from typing import Annotated
 
@@ -117,7 +118,42 @@ def _end_quietly() -> None:
         signal.signal(signal.SIGINT, signal.SIG_DFL)
 
 
+class _ClosedOutput(io.TextIOBase):
+    """Standard output the shell closed (``>&-``): Python makes ``sys.stdout`` None, and the
+    first line written was an AttributeError's traceback (``--help``: nothing, exit 0). A
+    write fails as one to a closed descriptor does (EBADF), which :func:`main` says."""
+
+    def writable(self) -> bool:
+        return True
+
+    def write(self, text: str) -> int:
+        raise OSError(errno.EBADF, "standard output is closed")
+
+
+def _closed_streams() -> None:
+    """Stand in for a closed stdout or stderr (Python makes them None), and keep descriptors
+    1 and 2 taken by /dev/null, so that no file the command opens gets their number. With
+    stderr closed, ``print(..., file=sys.stderr)`` writes to stdout: the warnings and errors
+    went into the data (the first line of `export --to c 2>&- > planner.c`)."""
+    import os
+
+    for fd, name in ((1, "stdout"), (2, "stderr")):
+        if getattr(sys, name) is not None:
+            continue
+        try:
+            os.fstat(fd)
+        except OSError:                     # free: hold it
+            null = os.open(os.devnull, os.O_WRONLY)
+            if null != fd:
+                os.dup2(null, fd)
+                os.close(null)
+        # stderr: what would be said has nowhere to go (the exit code still says it)
+        setattr(sys, name, _ClosedOutput() if fd == 1
+                else open(os.devnull, "w"))   # noqa: SIM115  (for the process's life)
+
+
 def _main(argv: list[str] | None) -> None:
+    _closed_streams()
     args = sys.argv[1:] if argv is None else list(argv)
     first = args[0] if args else None
     app = build_app(first if first in COMMANDS else None)
@@ -139,6 +175,9 @@ def _main(argv: list[str] | None) -> None:
 
         if exc.errno in (errno.ENAMETOOLONG, errno.ELOOP):
             report_error(path_error(exc))
+        elif exc.errno == errno.EBADF and isinstance(sys.stdout, _ClosedOutput):
+            report_error(WriteError("cannot write the output: standard output is closed",
+                                    hint="write it to a file, or to /dev/null to drop it"))
         elif exc.errno in (errno.ENOSPC, errno.EDQUOT, errno.EIO, errno.EFBIG):
             report_error(WriteError(f"cannot write the output: {exc.strerror}",
                                     hint="free some space, or write somewhere else"))
