@@ -152,8 +152,38 @@ def _closed_streams() -> None:
                 else open(os.devnull, "w"))   # noqa: SIM115  (for the process's life)
 
 
+#: The widths the help and the usage errors may be laid out in: Rich takes COLUMNS as it is,
+#: and at COLUMNS=0 (as some CI runners set it) printed an empty help and a usage error
+#: without its message (exit 2, nothing said); below 20 the message was cut to pieces, and
+#: COLUMNS=99999999999 ended in a MemoryError.
+WIDTHS = (20, 1000)
+
+
+def _sane_widths() -> None:
+    """COLUMNS (Rich's) and TERMINAL_WIDTH (Typer's) within :data:`WIDTHS`; 0 means unknown
+    (unset), and a TERMINAL_WIDTH that is not a number is dropped (Typer's ``int()`` of it
+    was a ValueError's traceback)."""
+    import os
+
+    for name in ("COLUMNS", "TERMINAL_WIDTH"):
+        text = os.environ.get(name, "").strip()
+        if not text:
+            continue
+        if not (text.isascii() and text.isdigit()):
+            if name == "TERMINAL_WIDTH":
+                del os.environ[name]
+            continue                                    # (Rich ignores it)
+        digits = text.lstrip("0")               # (int() of 5,000 digits raises)
+        width = int(digits or "0") if len(digits) <= 6 else WIDTHS[1] + 1
+        if width == 0:
+            del os.environ[name]
+        elif not WIDTHS[0] <= width <= WIDTHS[1]:
+            os.environ[name] = str(min(max(width, WIDTHS[0]), WIDTHS[1]))
+
+
 def _main(argv: list[str] | None) -> None:
     _closed_streams()
+    _sane_widths()
     args = sys.argv[1:] if argv is None else list(argv)
     first = args[0] if args else None
     app = build_app(first if first in COMMANDS else None)
