@@ -644,3 +644,30 @@ def test_no_tick_reads_minus_zero():
 
     ticks = _ticks(-8.0, 24.0, 67)
     assert ticks[0] == 0.0 and f"{ticks[0]:g}" == "0"
+def test_terms_on_a_dumb_terminal_are_not_coloured(tmp_path):
+    """On a terminal of TERM=dumb the colour codes were printed as text (`^[[34m`); Rich's own
+    output is plain there, and so is the drawing now (unless --color asks)."""
+    import pty
+
+    def drawn(term: str, *extra: str) -> str:
+        master, slave = pty.openpty()
+        env = {**{k: v for k, v in os.environ.items() if k != "NO_COLOR"}, "TERM": term}
+        subprocess.run([sys.executable, "-m", "mitos_cli", "plot", "terms", "--var", "road",
+                        "--width", "40", *extra], stdout=slave, stderr=subprocess.DEVNULL,
+                       env=env, timeout=60, check=True)
+        os.close(slave)
+        out = b""
+        while True:
+            try:
+                chunk = os.read(master, 65536)
+            except OSError:                  # EIO: the terminal's other end is closed
+                break
+            if not chunk:
+                break
+            out += chunk
+        os.close(master)
+        return out.decode()
+
+    assert "\x1b[" in drawn("xterm")
+    assert "\x1b[" not in drawn("dumb")
+    assert "\x1b[" in drawn("dumb", "--color")

@@ -123,9 +123,12 @@ def _window(output: Optional[str], show: bool) -> tuple[bool, Optional[str]]:
 
 
 def _use_color(color: Optional[bool]) -> bool:
+    """``--color/--no-color``, else colour on a terminal that shows it: not with NO_COLOR, nor
+    on TERM=dumb, which printed the escape codes as text (as Rich does not colour there)."""
     if color is not None:
         return color
-    return sys.stdout.isatty() and not os.environ.get("NO_COLOR")
+    return (sys.stdout.isatty() and not os.environ.get("NO_COLOR")
+            and os.environ.get("TERM") != "dumb")
 
 
 #: the terminal drawing's options
@@ -134,7 +137,7 @@ WidthOpt = Annotated[Optional[int], typer.Option(
     help="Terminal plot width in characters (default: the terminal's, at most 100).")]
 ColorOpt = Annotated[Optional[bool], typer.Option(
     "--color/--no-color", help="Colour the terminal plot (default: when stdout is a "
-                               "terminal and NO_COLOR is unset).")]
+                               "terminal, TERM is not dumb and NO_COLOR is unset).")]
 
 
 def _terminal_width(width: Optional[int]) -> int:
