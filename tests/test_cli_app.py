@@ -212,3 +212,18 @@ def test_a_terminal_width_out_of_reason_still_shows_the_message(name, value) -> 
                           capture_output=True, text=True, timeout=120)
     assert proc.returncode == 0 and "Usage: mitos" in proc.stdout, proc.stderr
     assert max(len(line) for line in proc.stdout.splitlines()) <= 1000
+
+
+def test_the_names_of_every_fixed_list_are_read_in_any_case(capsys) -> None:
+    """`--to FLL`, `--style HEATMAP` and `--fidelity MATLAB` were read, `--planner DWA`,
+    `--and MIN` and `--executor LOCAL` refused ("unknown planner `DWA`, did you mean `dwa`?",
+    exit 2). Each is read now: these commands go on to the world, which is not there (exit 1)."""
+    from mitos_cli.cli.app import main
+
+    for args in (["simulate", "nosuch", "--planner", "DWA"],
+                 ["compare", "nosuch", "--planner", "DWA,Fuzzy", "--and", "MIN", "--or", "Max",
+                  "--inference", "MAMDANI", "--executor", "LOCAL"]):
+        with pytest.raises(SystemExit) as info:
+            main(args)
+        err = capsys.readouterr().err
+        assert info.value.code == 1 and "world file `nosuch` not found" in err, err

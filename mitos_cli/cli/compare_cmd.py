@@ -78,6 +78,10 @@ def compare_command(
     if runs_n is not None:
         warn("`-n` is --resolution in `check` and `plot surface`; write --runs here")
         runs = runs_n
+    # names in any case, as every option's fixed list reads them (--to FLL, --style HEATMAP;
+    # `--planner DWA` was "unknown planner `DWA`, did you mean `dwa`?")
+    and_, planner, executor = and_.lower(), planner.lower(), executor.lower()
+    or_, inference = (None if v is None else v.lower() for v in (or_, inference))
     from ..study import Study, make_choices
     from ..study.executors import EXECUTORS
     from ..study.spec import split_list

@@ -240,6 +240,7 @@ def simulate_command(
     from ..sim.worldfile import load_world, resolve_world_path
 
     require = _checked_require(require)
+    planner_name = planner_name.lower()        # any case, as every option's fixed list
     with option_names():                        # an unknown name fails before any file is read
         planner_kind(planner_name)
     if plot is not None:                        # before the run, as `plot -o` does
