@@ -222,3 +222,21 @@ def test_a_network_of_many_neurons_takes_narrower_blocks_with_the_same_bits(tmp_
                       for i in range(0, 8192, 997)])
     assert got[::997].tobytes() == alone.tobytes() and np.isfinite(got).all()
     assert evaluation.block_width(compiled) * compiled.n_columns <= evaluation.BLOCK_CELLS
+
+
+def test_a_wrong_thread_count_leaves_the_help_version_and_completion_alone():
+    """`MITOS_NUM_THREADS=two mitos --help` (or `--version`, or the shell's completion, which
+    printed the refusal as the words it offered) was refused: nothing of it is used there."""
+    import os
+    import subprocess
+    import sys
+
+    env = {**os.environ, threads.ENV: "two"}
+    for args in (["--help"], ["eval", "-h"], ["--version"]):
+        done = subprocess.run([sys.executable, "-m", "mitos_cli", *args], capture_output=True,
+                              text=True, env=env)
+        assert done.returncode == 0 and done.stderr == "", (args, done.stderr)
+    env.update(_MITOS_COMPLETE="complete_bash", COMP_WORDS="mitos sim", COMP_CWORD="1")
+    done = subprocess.run([sys.executable, "-m", "mitos_cli"], capture_output=True, text=True,
+                          env=env)
+    assert done.stdout.split() == ["simulate"] and done.stderr == ""

@@ -190,7 +190,8 @@ def _main(argv: list[str] | None) -> None:
     try:
         from ..engine.threads import given
 
-        given()                    # MITOS_NUM_THREADS, refused before any command runs
+        if not _asks_about(args):
+            given()                # MITOS_NUM_THREADS, refused before any command runs
         app(args=args, prog_name="mitos", standalone_mode=True)
     except MitosError as exc:
         from .output import report_error
@@ -214,6 +215,19 @@ def _main(argv: list[str] | None) -> None:
         else:
             raise
         sys.exit(1)
+
+
+#: Options that ask what MITOS or a command is, and run nothing.
+ABOUT = ("-h", "--help", "--version", "--show-completion", "--install-completion")
+
+
+def _asks_about(args: list[str]) -> bool:
+    """The help, the version or the shell's completion: nothing of a wrong MITOS_NUM_THREADS
+    is used there, and it refused them all (the completion printed its error as words)."""
+    import os
+
+    options = args[:args.index("--")] if "--" in args else args
+    return not args or "_MITOS_COMPLETE" in os.environ or any(a in ABOUT for a in options)
 
 
 def path_error(exc: OSError) -> MitosError:
