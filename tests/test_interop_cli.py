@@ -708,3 +708,14 @@ def test_convert_to_rules_writes_both_files_or_neither(tmp_path: Path, monkeypat
     assert runner.invoke(app, ["convert", str(DATA / "tipper.fis"), "--to", "rules", "-o",
                                "out.rules"]).exit_code == 0
     assert sets == [(["out.terms.yaml", "out.rules"], "out.rules")]
+
+
+def test_convert_to_rules_names_what_it_wrote_as_the_user_would(tmp_path: Path, capsys,
+                                                                 monkeypatch) -> None:
+    """`mitos convert tipper.fis --to rules` said `wrote /home/.../tipper.rules and ...`
+    (absolute), where `export -o` and `convert -o` name what they wrote as given."""
+    source = DATA / "tipper.fis"
+    monkeypatch.chdir(tmp_path)
+    code, err = _run(capsys, "convert", str(source), "--to", "rules")
+    assert code == 0 and err.splitlines()[-1] == "wrote tipper.rules and tipper.terms.yaml"
+    assert (tmp_path / "tipper.rules").is_file() and (tmp_path / "tipper.terms.yaml").is_file()

@@ -71,7 +71,7 @@ def convert_command(
     if to is Target.rules:
         from ..interop.rules_writer import write_rules
 
-        rules_path = output if output is not None else Path.cwd() / f"{path.stem}.rules"
+        rules_path = output if output is not None else Path(f"{path.stem}.rules")   # (here)
         terms_path = rules_path.with_name(rules_path.stem + ".terms.yaml")
         refuse_inputs([rules_path, terms_path], sources)
         refuse_strays(rules_path, [terms_path])       # a term set no rule file here reads
