@@ -227,3 +227,16 @@ def test_the_names_of_every_fixed_list_are_read_in_any_case(capsys) -> None:
             main(args)
         err = capsys.readouterr().err
         assert info.value.code == 1 and "world file `nosuch` not found" in err, err
+
+
+def test_a_closed_stdin_reads_as_empty() -> None:
+    """`<&-`: Python makes sys.stdin None, and `eval --batch -`, `teach --lesson -` and the
+    teaching prompt ended in an AttributeError's traceback."""
+    import os
+
+    root = Path(__file__).resolve().parents[1]
+    env = dict(os.environ, PYTHONPATH=str(root))
+    proc = subprocess.run(["bash", "-c", f"{sys.executable} -m mitos_cli eval --batch - <&-"],
+                          capture_output=True, text=True, env=env, cwd=root, timeout=120)
+    assert proc.returncode == 1
+    assert proc.stderr.startswith("<stdin>:1:1: input error: the batch CSV is empty\n")

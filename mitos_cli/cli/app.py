@@ -131,25 +131,28 @@ class _ClosedOutput(io.TextIOBase):
 
 
 def _closed_streams() -> None:
-    """Stand in for a closed stdout or stderr (Python makes them None), and keep descriptors
-    1 and 2 taken by /dev/null, so that no file the command opens gets their number. With
-    stderr closed, ``print(..., file=sys.stderr)`` writes to stdout: the warnings and errors
-    went into the data (the first line of `export --to c 2>&- > planner.c`)."""
+    """Stand in for a closed stdin, stdout or stderr (Python makes them None), and keep
+    descriptors 0-2 taken by /dev/null, so that no file the command opens gets their number.
+    A closed stdin reads as empty (`teach` ends as at Ctrl-D, `eval --batch -` says the CSV
+    is empty; each was an AttributeError's traceback). With stderr closed,
+    ``print(..., file=sys.stderr)`` writes to stdout: the warnings and errors went into the
+    data (the first line of `export --to c 2>&- > planner.c`)."""
     import os
 
-    for fd, name in ((1, "stdout"), (2, "stderr")):
+    for fd, name in ((0, "stdin"), (1, "stdout"), (2, "stderr")):
         if getattr(sys, name) is not None:
             continue
         try:
             os.fstat(fd)
         except OSError:                     # free: hold it
-            null = os.open(os.devnull, os.O_WRONLY)
+            null = os.open(os.devnull, os.O_RDONLY if fd == 0 else os.O_WRONLY)
             if null != fd:
                 os.dup2(null, fd)
                 os.close(null)
         # stderr: what would be said has nowhere to go (the exit code still says it)
-        setattr(sys, name, _ClosedOutput() if fd == 1
-                else open(os.devnull, "w"))   # noqa: SIM115  (for the process's life)
+        stand_in = _ClosedOutput() if fd == 1 else open(   # noqa: SIM115  (the process's)
+            os.devnull, "r" if fd == 0 else "w")
+        setattr(sys, name, stand_in)
 
 
 #: The widths the help and the usage errors may be laid out in: Rich takes COLUMNS as it is,
