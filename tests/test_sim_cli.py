@@ -610,3 +610,22 @@ def test_runs_of_a_world_that_randomises_nothing_are_said_to_be_copies(short):
     noisy = short.with_name("noisy.yaml")
     noisy.write_text(SHORT + "randomise:\n  sensor_noise: [0, 1]\n", encoding="utf-8")
     assert "randomises nothing" not in run(noisy, "--runs", 2).stderr
+
+
+def test_a_ctrl_c_while_the_runs_files_are_written_says_which_are_there(
+        tmp_path: Path, capsys, monkeypatch) -> None:
+    """Ctrl-C while `--plot` drew (after `--out` was written) ended the command with exit 130
+    and not a word: run.csv was there, and nothing said so."""
+    import mitos_cli.draw.world as world_draw
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(world_draw, "draw_run", interrupted)
+    out, plot = tmp_path / "run.csv", tmp_path / "run.png"
+    with pytest.raises(SystemExit) as info:
+        main(["simulate", "corridor", "--out", str(out), "--plot", str(plot)])
+    err = capsys.readouterr().err
+    assert info.value.code == 130
+    assert err.endswith(f"interrupted: wrote the ticks to {out}; the rest is not written\n"), err
+    assert out.is_file() and not plot.exists()

@@ -372,20 +372,12 @@ def _simulate_one(world, planner, seed, randomise: bool, live: bool, speed, trac
             err(text)
         else:
             emit(text + "\n")
-    if out is not None:
-        from ..sim.export import csv_text
-
-        _write_text(out, csv_text(res, planner))
-    if plot is not None:
-        from ..draw.world import draw_run
-
-        draw_run(res, plot)
-    frames = 0
-    if animate is not None:
-        from ..draw.animation import animate_run
-        from ..sim.export import explain
-
-        frames = animate_run(res, animate, fps=fps, detail=explain(res, planner))
+    written: list[str] = []
+    try:
+        frames = _write_outputs(res, planner, out, plot, animate, fps, written)
+    except KeyboardInterrupt:
+        err(_interrupted_writing(written))
+        raise typer.Exit(INTERRUPTED) from None
     if as_json:
         emit(json_text(res.summary()))
     else:
@@ -397,6 +389,35 @@ def _simulate_one(world, planner, seed, randomise: bool, live: bool, speed, trac
     if require and res.outcome != require:
         raise typer.Exit(3)
     sys.stdout.flush()
+
+
+def _write_outputs(res, planner, out, plot, animate, fps: float, written: list[str]) -> int:
+    """The CSV, picture and animation asked for (each named in ``written`` once it is), and
+    the animation's frames."""
+    if out is not None:
+        from ..sim.export import csv_text
+
+        _write_text(out, csv_text(res, planner))
+        written.append(f"the ticks to {out}")
+    if plot is not None:
+        from ..draw.world import draw_run
+
+        draw_run(res, plot)
+        written.append(f"the picture to {plot}")
+    if animate is None:
+        return 0
+    from ..draw.animation import animate_run
+    from ..sim.export import explain
+
+    return animate_run(res, animate, fps=fps, detail=explain(res, planner))
+
+
+def _interrupted_writing(written: list[str]) -> str:
+    """What a Ctrl-C while the run's files were written leaves (it ended the command
+    without a word, not saying which of them were there)."""
+    if not written:
+        return "interrupted after the run, before its files were written: nothing written"
+    return f"interrupted: wrote {' and '.join(written)}; the rest is not written"
 
 
 def _run_one(world, planner, seed, randomise: bool, live: bool, speed):
