@@ -240,3 +240,17 @@ def test_a_closed_stdin_reads_as_empty() -> None:
                           capture_output=True, text=True, env=env, cwd=root, timeout=120)
     assert proc.returncode == 1
     assert proc.stderr.startswith("<stdin>:1:1: input error: the batch CSV is empty\n")
+
+
+def test_output_its_encoding_cannot_write_is_said() -> None:
+    """PYTHONIOENCODING=ascii (or an ASCII or Latin-1 locale, a Windows code page): the plots'
+    Braille or a table's `±` ended in a UnicodeEncodeError's traceback."""
+    import os
+
+    env = {**os.environ, "PYTHONIOENCODING": "ascii"}
+    proc = subprocess.run([sys.executable, "-m", "mitos_cli", "plot", "terms", "--var", "road"],
+                          env=env, capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 1 and "Traceback" not in proc.stderr
+    assert proc.stderr == ("error: cannot write the output: standard output's encoding (ascii) "
+                           "has no `\\u2524` (U+2524)\n"
+                           "hint: set PYTHONIOENCODING=utf-8, or use a UTF-8 locale\n")

@@ -218,6 +218,34 @@ def _main(argv: list[str] | None) -> None:
         else:
             raise
         sys.exit(1)
+    except UnicodeEncodeError as exc:
+        from .output import report_error
+
+        if not _of_stdout(exc):
+            raise
+        report_error(_unencodable(exc))
+        sys.exit(1)
+
+
+def _of_stdout(exc: UnicodeEncodeError) -> bool:
+    """Whether ``exc`` is stdout's encoding failing (an ASCII or Latin-1 locale,
+    PYTHONIOENCODING=ascii, a Windows console's code page)."""
+    import codecs
+
+    encoding = getattr(sys.stdout, "encoding", None)
+    try:
+        return encoding is not None and codecs.lookup(exc.encoding) == codecs.lookup(encoding)
+    except LookupError:
+        return False
+
+
+def _unencodable(exc: UnicodeEncodeError) -> MitosError:
+    """Output stdout's encoding cannot write (the plots' Braille, a table's ``±``, a name):
+    it was a UnicodeEncodeError's traceback after part of the output."""
+    char = exc.object[exc.start]
+    return WriteError(f"cannot write the output: standard output's encoding ({exc.encoding}) "
+                      f"has no `{char}` (U+{ord(char):04X})",
+                      hint="set PYTHONIOENCODING=utf-8, or use a UTF-8 locale")
 
 
 #: Options that ask what MITOS or a command is, and run nothing.
