@@ -234,8 +234,10 @@ def _of_stdout(exc: UnicodeEncodeError) -> bool:
 
     encoding = getattr(sys.stdout, "encoding", None)
     try:
-        return encoding is not None and codecs.lookup(exc.encoding) == codecs.lookup(encoding)
-    except LookupError:
+        codec = codecs.lookup(exc.encoding)
+        return (encoding is not None and codec == codecs.lookup(encoding)
+                and not codec.name.startswith("utf"))     # (UTF-8 writes every character:
+    except LookupError:                                   # a lone surrogate is a file's)
         return False
 
 
