@@ -719,3 +719,23 @@ def test_convert_to_rules_names_what_it_wrote_as_the_user_would(tmp_path: Path, 
     code, err = _run(capsys, "convert", str(source), "--to", "rules")
     assert code == 0 and err.splitlines()[-1] == "wrote tipper.rules and tipper.terms.yaml"
     assert (tmp_path / "tipper.rules").is_file() and (tmp_path / "tipper.terms.yaml").is_file()
+
+
+def test_convert_to_rules_of_a_file_named_in_another_encoding(tmp_path: Path, capsys,
+                                                               monkeypatch) -> None:
+    """A source named in bytes that are not UTF-8 (`t\\xff.fis`): `--to rules` was refused
+    inside its own output ("invalid YAML: character '\\udcff'", "a defect of `mitos
+    convert`"). Its name is written as text (U+FFFD), and a term-set name that cannot be
+    (the default one, from the source's) is a usage error asking for -o."""
+    import os
+
+    source = Path(os.fsdecode(bytes(tmp_path) + b"/t\xff.fis"))
+    source.write_bytes((DATA / "tipper.fis").read_bytes())
+    monkeypatch.chdir(tmp_path)
+    code, err = _run(capsys, "convert", str(source), "--to", "rules")
+    assert code == 2 and "name the output with -o OUT.rules" in " ".join(
+        err.replace("│", " ").split()), err
+    code, err = _run(capsys, "convert", str(source), "--to", "rules", "-o", "ok.rules")
+    assert code == 0, err
+    assert (tmp_path / "ok.rules").read_text().startswith(
+        "# main: written by `mitos convert` from t\ufffd.fis\n")

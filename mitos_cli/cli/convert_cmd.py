@@ -73,11 +73,12 @@ def convert_command(
 
         rules_path = output if output is not None else Path(f"{path.stem}.rules")   # (here)
         terms_path = rules_path.with_name(rules_path.stem + ".terms.yaml")
+        _refuse_undecodable(terms_path, output is None)
         refuse_inputs([rules_path, terms_path], sources)
         refuse_strays(rules_path, [terms_path])       # a term set no rule file here reads
         if output is None:
             refuse_existing([rules_path, terms_path], rules_path.name)
-        rules_text, terms_text = write_rules(rb, terms_path.name, behavior, path.name)
+        rules_text, terms_text = write_rules(rb, terms_path.name, behavior, _text(path.name))
         for note in conversion_notes(rb, "rules", behavior):
             warn(note)
         back = _read_back(rules_text, terms_text, rules_path, terms_path)
@@ -99,6 +100,24 @@ def convert_command(
     else:
         atomic_write(output, text)
         err(f"wrote {output}")
+
+
+def _text(name: str) -> str:
+    """A file name as text: a byte that is not UTF-8 (Python's lone surrogate) as U+FFFD."""
+    return name.encode("utf-8", "surrogateescape").decode("utf-8", "replace")
+
+
+def _refuse_undecodable(terms_path: Path, derived: bool) -> None:
+    """The term set's name goes into the rule file's `terms` line, which is UTF-8 text: a name
+    that is not (a source file named in another encoding) was refused inside MITOS's own
+    output, as "a defect of `mitos convert`"."""
+    if _text(terms_path.name) == terms_path.name:
+        return
+    shown = terms_path.name.encode("utf-8", "surrogateescape").decode("utf-8", "backslashreplace")
+    raise typer.BadParameter(
+        f"the term set's name `{shown}` is not UTF-8 text, which the rule file's `terms` line "
+        f"is: {'name the output with -o OUT.rules' if derived else 'choose another name'}",
+        param_hint="'-o' / '--output'")
 
 
 def _write_pair(rules_path: Path, rules_text: str, terms_path: Path, terms_text: str) -> None:
