@@ -254,3 +254,24 @@ def test_output_its_encoding_cannot_write_is_said() -> None:
     assert proc.stderr == ("error: cannot write the output: standard output's encoding (ascii) "
                            "has no `\\u2524` (U+2524)\n"
                            "hint: set PYTHONIOENCODING=utf-8, or use a UTF-8 locale\n")
+
+
+def test_a_ctrl_c_while_the_last_output_is_flushed_is_not_a_traceback(tmp_path) -> None:
+    """The output left in stdout's buffer is flushed once the command is done, which a slow
+    reader can hold up; a Ctrl-C there escaped main as a traceback. It ends the process as
+    the signal does, as one in the clean-up after it does."""
+    import os
+    import signal
+
+    root = Path(__file__).resolve().parents[1]
+    script = ("import io, os, runpy, signal, sys, time\n"
+              "class Held(io.StringIO):\n"
+              "    def flush(self):\n"
+              "        os.kill(os.getpid(), signal.SIGINT)\n"
+              "        time.sleep(1)\n"
+              "sys.stdout = Held()\n"
+              "sys.argv = ['mitos', 'list', '--json']\n"
+              "runpy.run_module('mitos_cli', run_name='__main__')\n")
+    proc = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
+                          cwd=tmp_path, env=dict(os.environ, PYTHONPATH=str(root)), timeout=120)
+    assert proc.stderr == "" and proc.returncode == -signal.SIGINT

@@ -102,20 +102,21 @@ def main(argv: list[str] | None = None) -> None:
 
 
 def _end_quietly() -> None:
-    """What the command wrote, flushed; then a Ctrl-C ends the process as the signal does
-    (its status says interrupted, as a shell expects), not with a Python traceback from
-    the clean-up it interrupts."""
+    """From here a Ctrl-C ends the process as the signal does (its status says interrupted,
+    as a shell expects), not with a Python traceback from the clean-up it interrupts; what
+    the command wrote is flushed now, so that none of it waits for that clean-up (a flush
+    blocked on a slow reader is interrupted as the signal does too)."""
     import signal
     import threading
 
+    if threading.current_thread() is threading.main_thread():
+        signal.signal(signal.SIGINT, signal.SIG_DFL)
     for stream in (sys.stdout, sys.stderr):
         try:
             if stream is not None:
                 stream.flush()
         except (OSError, ValueError):   # said by the command already, or by Python at exit
             pass
-    if threading.current_thread() is threading.main_thread():
-        signal.signal(signal.SIGINT, signal.SIG_DFL)
 
 
 class _ClosedOutput(io.TextIOBase):
