@@ -629,3 +629,19 @@ def test_a_ctrl_c_while_the_runs_files_are_written_says_which_are_there(
     assert info.value.code == 130
     assert err.endswith(f"interrupted: wrote the ticks to {out}; the rest is not written\n"), err
     assert out.is_file() and not plot.exists()
+
+
+def test_runs_default_to_no_more_processes_than_the_cpus_allowed(monkeypatch) -> None:
+    """`simulate --runs`' default -j ("up to 2") counted the machine's CPUs: under `taskset
+    -c 0` it started two processes on one CPU, where `compare` counts the CPUs allowed."""
+    import os
+
+    from mitos_cli.sim.runs import default_workers
+
+    if not hasattr(os, "sched_getaffinity"):
+        pytest.skip("no CPU affinity on this platform")
+    monkeypatch.setattr(os, "sched_getaffinity", lambda pid: {0})
+    monkeypatch.setattr(os, "cpu_count", lambda: 8)
+    assert default_workers() == 1
+    monkeypatch.setattr(os, "sched_getaffinity", lambda pid: {0, 1, 2})
+    assert default_workers() == 2

@@ -228,7 +228,8 @@ def simulate_command(
     require: Annotated[Optional[str], typer.Option(
         "--require", metavar="success", help="Exit 3 unless every run ends in this outcome.")] = None,
     workers: Annotated[Optional[int], typer.Option(
-        "--workers", "-j", min=1, help="Processes for --runs (default: up to 2).")] = None,
+        "--workers", "-j", min=1, help="Processes for --runs (default: up to 2, no more than the CPUs "
+                              "allowed).")] = None,
     planner_name: Annotated[str, typer.Option(
         "--planner", metavar="NAME", autocompletion=complete.planners,
         help="Who drives: fuzzy (the rule base), potential_field or dwa (baselines that "

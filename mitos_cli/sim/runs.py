@@ -136,9 +136,16 @@ class Runs:
 
 
 def default_workers() -> int:
+    """``-j``'s default: up to 2 processes, no more than the CPUs this process may run on
+    (``os.cpu_count()`` counted the machine's: under ``taskset -c 0``, two processes on one
+    CPU, where `compare` and the batch threads count the CPUs allowed)."""
     import os
 
-    return max(1, min(2, os.cpu_count() or 1))
+    try:
+        cpus = len(os.sched_getaffinity(0))
+    except AttributeError:              # not on Linux
+        cpus = os.cpu_count() or 1
+    return max(1, min(2, cpus))
 
 
 class RunsInterrupted(KeyboardInterrupt):
