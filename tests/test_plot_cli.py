@@ -644,6 +644,8 @@ def test_no_tick_reads_minus_zero():
 
     ticks = _ticks(-8.0, 24.0, 67)
     assert ticks[0] == 0.0 and f"{ticks[0]:g}" == "0"
+
+
 def test_terms_on_a_dumb_terminal_are_not_coloured(tmp_path):
     """On a terminal of TERM=dumb the colour codes were printed as text (`^[[34m`); Rich's own
     output is plain there, and so is the drawing now (unless --color asks)."""
