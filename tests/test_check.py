@@ -139,6 +139,17 @@ def test_coverage_gap_with_weighted_sum_is_a_warning(tmp_path):
     assert report.ok and gap.severity == "warning" and "weighted sum is 0" in gap.message
 
 
+def test_coverage_gap_with_weighted_sum_and_a_default_says_the_default_applies(tmp_path):
+    """Under weighted_sum an output's declared default applies where none of its rules fires
+    (`mitos eval` gives it); the finding said the sum was 0 there."""
+    (tmp_path / "t.terms.yaml").write_text(TERMS, encoding="utf-8")
+    (tmp_path / "t.rules").write_text('terms "t.terms.yaml"\noperators: inference = '
+                                      "weighted_sum\nif road is WIDE then speed is FAST\n",
+                                      encoding="utf-8")
+    (gap,) = by_code(check_rulebase(read_rulebase(tmp_path / "t.rules")), "no-rule-fires")
+    assert gap.severity == "warning" and "(the default applies there: speed = 0)" in gap.message
+
+
 def test_low_total_dof(flawed):
     low = by_code(check_rulebase(read_rulebase(flawed)), "low-dof")[0]
     # r7 alone: LARGE(42.5) = 0.083 < 0.1 on the wide road

@@ -294,6 +294,25 @@ def test_python_export_agrees_with_eval(tmp_path: Path) -> None:
         agree(run_python(c, X, tmp_path), want)
 
 
+def test_exports_give_a_weighted_sums_default_where_no_rule_fires(tmp_path: Path) -> None:
+    """A weighted sum where none of an output's rules fires takes the output's declared
+    default, as `mitos eval` gives it (it gave 0, the empty sum); without one it stays 0."""
+    (tmp_path / "g.terms.yaml").write_text(
+        "variables:\n"
+        "  x: {role: input, universe: [0, 10], terms: {LO: {shape: triangle, points: [0, 0, 4]},"
+        " HI: {shape: triangle, points: [6, 10, 10]}}}\n"
+        "  w: {role: output, universe: [-100, 100], default: 42, terms: {A: -10, B: 50}}\n"
+        "  u: {role: output, universe: [-100, 100], terms: {A: -10, B: 50}}\n")
+    path = tmp_path / "g.rules"
+    path.write_text('terms "g.terms.yaml"\noperators: inference = weighted_sum\n'
+                    "r1: if x is LO then w is A and u is A\nr2: if x is HI then w is B and u is B\n")
+    c, X, want = reference(path)
+    assert (want[(X[:, 0] > 4) & (X[:, 0] < 6)] == [42.0, 0.0]).all()
+    agree(run_python(c, X, tmp_path), want)
+    if CC is not None:
+        agree(run_c(c, X, tmp_path), want)
+
+
 def test_c_file_is_self_contained(tmp_path: Path) -> None:
     text = to_c(load_rulebase(ROOT / "rulebases" / "mitos.rules").compiled, "robot")
     includes = [line for line in text.splitlines() if line.startswith("#include")]

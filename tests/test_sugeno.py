@@ -156,3 +156,49 @@ def test_linear_term_on_an_input_is_refused():
                         "NARROW: {shape: linear, constant: 1}")
     with pytest.raises(TermSetError, match="belongs to an output variable"):
         parse_termset(bad)
+
+
+GAPPED = """\
+variables:
+  x:
+    role: input
+    universe: [0, 10]
+    terms:
+      LO: {shape: triangle, points: [0, 0, 4]}
+      HI: {shape: triangle, points: [6, 10, 10]}
+  y:
+    role: input
+    universe: [0, 10]
+    terms:
+      LO: {shape: triangle, points: [0, 0, 4]}
+      HI: {shape: triangle, points: [6, 10, 10]}
+  w: {role: output, universe: [-100, 100], default: 42, terms: {A: -10, B: 50}}
+  u: {role: output, universe: [-100, 100], terms: {A: -10, B: 50}}
+  n: {role: output, universe: [-100, 100], default: .nan, terms: {A: -10, B: 50}}
+"""
+
+
+@pytest.mark.parametrize("hedge", ["", "very "])
+def test_a_weighted_sum_where_no_rule_fires_takes_the_declared_default(tmp_path, hedge):
+    """Where none of an output's rules fired, a weighted sum gave 0, the empty sum, even for
+    an output that declares a default, while `mitos eval` printed it as "its default" (42);
+    fuzzylite gives the default there, MATLAB a `.fis` output's middle, which the reader makes
+    its default. The default applies now on every path (one sample, a grid batch, the
+    detailed one); an output without a default keeps 0; `default: .nan` gives NaN."""
+    path = write(tmp_path, terms=GAPPED, rules=(
+        'terms "s.terms.yaml"\noperators: inference = weighted_sum\n'
+        f"r1: if x is LO and y is LO then w is {hedge}A and u is A and n is A\n"
+        "r2: if x is LO and y is HI then w is B and u is B and n is B\n"
+        "r3: if x is HI and y is LO then w is B and u is A and n is B\n"
+        "r4: if x is HI and y is HI then w is A and u is B and n is A\n"))
+    rb = load_rulebase(path)
+    assert rb.evaluate(x=5, y=5) == pytest.approx({"w": 42.0, "u": 0.0, "n": float("nan")},
+                                                  nan_ok=True)
+    X = np.array([[5.0, 5.0], [1.0, 1.0], [5.0, 1.0], [9.0, 9.0]] * 300)
+    batch = rb.evaluate(x=X[:, 0], y=X[:, 1])
+    detailed = evaluate(rb.compiled, X).outputs
+    for got in (np.column_stack([batch["w"], batch["u"], batch["n"]]), detailed):
+        np.testing.assert_array_equal(got[:4, 0], [42.0, -5.625 if hedge else -7.5, 42.0, -7.5])
+        np.testing.assert_array_equal(got[:4, 1], [0.0, -7.5, 0.0, 37.5])
+        assert np.isnan(got[[0, 2], 2]).all() and not np.isnan(got[[1, 3], 2]).any()
+    assert "w = 42.0   (its default: no rule sets it here)" in rb.trace(x=5, y=5).render()

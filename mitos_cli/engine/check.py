@@ -13,7 +13,8 @@ code                  severity    meaning
 ``no-rule-fires``     error       a region of the input space where no rule sets an output
                                   that declares no ``default`` (``mitos eval`` fails there)
 ``no-rule-fires``     warning     the same, but the output falls back to its ``default`` (or
-                                  the inference is ``weighted_sum``, which gives 0 there)
+                                  the inference is ``weighted_sum`` and it declares none:
+                                  the sum is 0 there)
 ``low-dof``           warning     a region where some rule fires but the total DOF of the
                                   rules setting an output is below ``threshold``
 ``conflict``          error       rules with the same antecedent and different consequents
@@ -590,7 +591,8 @@ def _coverage_words(compiled: CompiledRuleBase, kind: str, outs: list[str], shar
                     has_default: bool, threshold: float, thinned: str) -> tuple[str, str, str]:
     """The severity, message and hint of a coverage finding (``no-rule-fires`` or
     ``low-dof``) of the outputs ``outs`` over ``share`` of the input space: no rule firing is
-    an error only where the output has no default and is not a weighted sum (of nothing, 0)."""
+    an error only where the output has no default and is not a weighted sum (of nothing, 0;
+    with a default, the default applies there, as under the other inferences)."""
     name = compiled.behavior
     what = " and ".join(f"`{o}`" for o in outs)
     if kind != "no-rule-fires":
@@ -602,7 +604,7 @@ def _coverage_words(compiled: CompiledRuleBase, kind: str, outs: list[str], shar
     where = (f"in {_pct(share)} of the input space" if share > 0 else
              "on lines or points of the input space (none of its volume)")
     message = f"behavior `{name}`: no rule sets {what} {where}{thinned}"
-    if summed:
+    if summed and not has_default:
         return ("warning", message + " (the weighted sum is 0 there)",
                 "add rules that cover these inputs")
     if has_default:

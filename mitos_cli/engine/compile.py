@@ -121,6 +121,18 @@ class CompiledRuleBase:
         return K.reshape(len(self.outputs) + len(distinct), self.n_rules), rows
 
     @functools.cached_property
+    def summed_defaults(self) -> tuple[int, ...]:
+        """Outputs of ``weighted_sum`` inference that declare a ``default`` (a number, or
+        fuzzylite's ``nan``): where none of their rules fires the default applies, as it
+        does under the other inferences (and in fuzzylite and MATLAB), not the empty sum's
+        0. An output without one keeps 0 there."""
+        if self.operators.inference != "weighted_sum":
+            return ()
+        return tuple(j for j, name in enumerate(self.outputs)
+                     if not np.isnan(self.default[j])
+                     or ((v := self.variables.get(name)) is not None and v.default is not None))
+
+    @functools.cached_property
     def hedged_outputs(self) -> tuple[int, ...]:
         """Outputs of weighted inference with a hedged consequent (each hedges its rule's
         weight, :func:`mitos_cli.engine.evaluation.weighted_average`); none under Mamdani,

@@ -363,7 +363,7 @@ def weighted_average(compiled: CompiledRuleBase, dof: np.ndarray,
     if compiled.hedged_outputs:
         return _hedged_average(compiled, dof, Xt, sums)
     if compiled.operators.inference == "weighted_sum":
-        return sums[:m].copy()
+        return _unset_sums(compiled, sums[:m].copy(), sums[plan.den_row])
     den = sums[plan.den_row]
     fired = den > 0
     if fired.all():
@@ -392,9 +392,19 @@ def _hedged_average(compiled: CompiledRuleBase, dof: np.ndarray, Xt: np.ndarray 
         dens[j] = tree_sum(D.copy())
         nums[j] = tree_sum(np.multiply(D, y))
     if compiled.operators.inference == "weighted_sum":
-        return nums
+        return _unset_sums(compiled, nums, dens)
     fired = dens > 0
     return np.divide(nums, dens, out=np.full(nums.shape, np.nan), where=fired)
+
+
+def _unset_sums(compiled: CompiledRuleBase, nums: np.ndarray, dens: np.ndarray) -> np.ndarray:
+    """A weighted sum ``nums[m, b]`` with NaN where none of an output's rules fired (its
+    denominator ``dens`` 0) and the output declares a default, which then applies there
+    (:func:`fill_defaults`), as under every other inference; elsewhere the sum, 0 where
+    nothing fired for an output without a default."""
+    for j in compiled.summed_defaults:
+        nums[j][dens[j] <= 0] = np.nan
+    return nums
 
 
 def _constant_sums(plan, dof: np.ndarray) -> np.ndarray:
@@ -727,7 +737,13 @@ def _grid_block(compiled: CompiledRuleBase, g, b: _GridBlock, columns: list, ins
     if g.weighted_sum:
         for j, num in enumerate(b.nums):
             part[j] = num
-        return False
+        unset = False
+        for j in compiled.summed_defaults:        # _unset_sums()
+            den = b.dens[j]
+            if den.min() <= 0:
+                part[j][den <= 0] = np.nan
+                unset = True
+        return unset
     if b.shared:
         den = b.dens[0]
         if den.min() > 0:

@@ -180,7 +180,9 @@ def _outputs(c: CompiledRuleBase, emit) -> None:
         emit(f"    s{row} = {terms[0] if terms else '0.0'}")
         sums.append(f"s{row}")
     if c.operators.inference == "weighted_sum":          # + 0.0: no -0.0, as infer() gives
-        results = [f"({sums[j]} + 0.0)" for j in range(m)]
+        # NaN where an output with a default has no rule firing (the default then applies)
+        results = [f"({sums[j]} + 0.0 if {sums[int(c.den_row[j])]} > 0.0 else nan)"
+                   if j in c.summed_defaults else f"({sums[j]} + 0.0)" for j in range(m)]
     else:
         results = [f"({sums[j]} / {sums[int(c.den_row[j])]} + 0.0 if {sums[int(c.den_row[j])]} "
                    f"> 0.0 else nan)" for j in range(m)]

@@ -260,8 +260,12 @@ def _c_outputs(c: CompiledRuleBase, P: str) -> list[str]:
         fallback = "NAN" if np.isnan(default) else num(default)
         out.append(f"    {{   /* {comment(name)} */")
         out.append(f"        double num = {numerator};")
-        if ops.inference == "weighted_sum":
-            out.append(f"        out[{j}] = num;")
+        if ops.inference == "weighted_sum" and j not in c.summed_defaults:
+            out.append(f"        out[{j}] = num;")     # no rule firing: the empty sum, 0
+        elif ops.inference == "weighted_sum":
+            out.append(f"        double den = {denominator};")
+            out.append(f"        if (den > 0.0) out[{j}] = num;")
+            out.append(f"        else {{ out[{j}] = {fallback}; ++fallback; }}")
         else:
             out.append(f"        double den = {denominator};")
             out.append(f"        if (den > 0.0) out[{j}] = num / den;")

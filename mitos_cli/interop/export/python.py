@@ -241,8 +241,11 @@ def _py_outputs(c: CompiledRuleBase) -> list[str]:
         for j in range(len(c.outputs)):
             numerator, denominator = weighted_sums(c, j)
             out.append(f"    num = {numerator} + np.zeros(X.shape[0])")
-            if ops.inference == "weighted_sum":
-                out.append(f"    Y[:, {j}] = num")
+            if ops.inference == "weighted_sum" and j not in c.summed_defaults:
+                out.append(f"    Y[:, {j}] = num")          # no rule firing: the empty sum, 0
+            elif ops.inference == "weighted_sum":
+                out.append(f"    den = {denominator} + np.zeros(X.shape[0])")
+                out.append(f"    Y[:, {j}] = np.where(den > 0, num, np.nan)")
             else:
                 out.append(f"    den = {denominator} + np.zeros(X.shape[0])")
                 out.append(f"    Y[:, {j}] = _div(num, np.where(den > 0, den, 1.0), 0.0)")
