@@ -244,6 +244,14 @@ class NoRuleFiredError(MitosError):
     kind = "no rule fired"
 
 
+class EmptyOutputError(NoRuleFiredError):
+    """Rules that set an output fired, yet left it no value (a Mamdani set that its sampling
+    misses), and the output declares no default: a :class:`NoRuleFiredError` to a caller,
+    told as what happened, not as "no rule fired"."""
+
+    kind = "no output value"
+
+
 class WorldError(MitosError):
     """A world file that is malformed or impossible."""
 

@@ -242,3 +242,42 @@ def test_huge_rule_stacks_are_built_in_chunks_of_rules(tmp_path, monkeypatch):
     np.testing.assert_allclose(chunked, whole, rtol=0, atol=1e-12)
     want = [reference(r, s, "min", "einstein_sum", "centroid", 1001) for r, s in SAMPLES]
     np.testing.assert_allclose(chunked[:, 0], want, rtol=0, atol=1e-9)
+
+
+MISSED = """\
+variables:
+  x: {role: input, universe: [0, 10], terms: {LO: {shape: left_shoulder, points: [3, 7]},
+      HI: {shape: right_shoulder, points: [3, 7]}}}
+  w: {role: output, universe: [0, 100], terms: {A: {shape: triangle, points: [50, 50, 50]},
+      B: {shape: triangle, points: [60, 80, 100]}}}
+"""
+
+
+def test_fired_rules_whose_sets_the_sampling_misses_are_told_as_such(tmp_path, capsys):
+    """A rule firing fully on a set narrower than the output's sampling step (a triangle of
+    width 0 between the 100 midpoints) left nothing to defuzzify, and `mitos eval` said "no
+    rule fired: no rule sets `w` for x=1" while r1 fired at DOF 1; `mitos check` said OK
+    (0 errors) for a rule base that `mitos eval` refused at every input."""
+    from mitos_cli.api import read_rulebase
+    from mitos_cli.cli.app import main
+    from mitos_cli.engine.check import check_rulebase
+    from mitos_cli.errors import EmptyOutputError
+
+    (tmp_path / "m.terms.yaml").write_text(MISSED, encoding="utf-8")
+    path = tmp_path / "m.rules"
+    path.write_text('terms "m.terms.yaml"\noperators: inference = mamdani, resolution = 100\n'
+                    "r1: if x is LO then w is A\nr2: if x is HI then w is B\n", encoding="utf-8")
+    with pytest.raises(EmptyOutputError) as err:          # still a NoRuleFiredError
+        load_rulebase(path).evaluate(x=1)
+    assert isinstance(err.value, NoRuleFiredError)
+    assert "the rules that set `w` fire (r1 at DOF 1) but give it no value for x=1" in str(
+        err.value) and "no rule fired" not in str(err.value)
+    assert load_rulebase(path).evaluate(x=9)["w"] == pytest.approx(80, abs=0.5)
+    report = check_rulebase(read_rulebase(path))
+    (gap,) = [f for f in report.findings if f.code == "no-rule-fires"]
+    assert gap.severity == "error" and not report.ok and "undersampled-term" in gap.message
+    assert gap.share == pytest.approx(0.3)                  # x <= 3, where r2 is 0
+    with pytest.raises(SystemExit) as info:
+        main(["eval", str(path), "x=1"])
+    assert info.value.code == 1
+    assert "no output value: the rules that set `w` fire" in capsys.readouterr().err

@@ -552,7 +552,8 @@ def _sampled(compiled: CompiledRuleBase, threshold: float,
     span = _behavior_span(compiled.rulebase, name)
 
     # coverage, per output (grouping outputs that share the same gap)
-    total = dof @ compiled.cons_mask.astype(float)     # [n, m] total DOF per output
+    counting, missed = _counting(compiled)
+    total = dof @ counting                             # [n, m] total DOF per output
     reported: dict[tuple, list[str]] = {}
     for kind, mask_of in (("no-rule-fires", lambda t: t <= 0.0),
                           ("low-dof", lambda t: (t > 0.0) & (t < threshold))):
@@ -574,6 +575,9 @@ def _sampled(compiled: CompiledRuleBase, threshold: float,
                                  inner=kind == "no-rule-fires" and not skipped)
             severity, message, hint = _coverage_words(compiled, kind, outs, share,
                                                       has_default, threshold, thinned)
+            if missed.intersection(outs):
+                message += (" (counting only the rules whose sets its sampling does not miss: "
+                            "undersampled-term)")
             out.append(Finding(severity, kind, message, span, name, hint,
                                tuple(boxes[:MAX_BOXES]), max(0, len(boxes) - MAX_BOXES), share,
                                uncovered))
@@ -585,6 +589,22 @@ def _sampled(compiled: CompiledRuleBase, threshold: float,
                    dtype=bool)
     out += _unreachable(compiled, np.flatnonzero(~fires & own), resolution)
     return out, info
+
+
+def _counting(compiled: CompiledRuleBase) -> tuple[np.ndarray, set[str]]:
+    """``[R, m]`` weights of the rules' DOFs in each output's coverage sum, and the outputs
+    some of whose rules do not count: a Mamdani rule whose concluded set is 0 at every point
+    its output is sampled at (narrower than a step, or outside the range) fires without
+    giving the output anything, and where only such rules fire `mitos eval` finds no value."""
+    from .mamdani import undersampled
+
+    counting = compiled.cons_mask.astype(float)
+    missed = set()
+    for u in undersampled(compiled):
+        if u.peak <= 0.0 or u.outside:
+            counting[u.rules, compiled.outputs.index(u.output)] = 0.0
+            missed.add(u.output)
+    return counting, missed
 
 
 def _coverage_words(compiled: CompiledRuleBase, kind: str, outs: list[str], share: float,

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import InputError, NoRuleFiredError
+from ..errors import EmptyOutputError, InputError, NoRuleFiredError
 from ..fuzzy import hedges as hedge_mod
 from ..fuzzy import norms
 from ..fuzzy.shapes import SHAPES
@@ -855,10 +855,35 @@ def fill_defaults(compiled: CompiledRuleBase, out: np.ndarray, X: np.ndarray,
         elif strict:
             row = int(np.argmax(col))
             values = ", ".join(f"{k}={X[row, i]:g}" for i, k in enumerate(compiled.inputs))
-            raise NoRuleFiredError(
-                f"no rule sets `{name}` for {values}" +
-                (f" ({int(col.sum())} of {len(col)} samples)" if len(col) > 1 else ""),
-                hint=f"declare a default for `{name}` (`default: VALUE` on the variable in a YAML "
-                     f"term set, `DEFAULT := VALUE` in FCL, `default: VALUE` in FLL) to define "
-                     f"the output when no rule fires, or add rules that cover these inputs")
+            many = f" ({int(col.sum())} of {len(col)} samples)" if len(col) > 1 else ""
+            declare = (f"declare a default for `{name}` (`default: VALUE` on the variable in a "
+                       f"YAML term set, `DEFAULT := VALUE` in FCL, `default: VALUE` in FLL) to "
+                       f"define the output when no rule fires")
+            fired = _fired_setting(compiled, j, X[row])
+            if fired:
+                raise EmptyOutputError(
+                    f"the rules that set `{name}` fire ({fired}) but give it no value "
+                    f"for {values}{many}: {_why_empty(compiled, j)}",
+                    hint=f"widen the terms they conclude or raise `resolution` (`mitos check` "
+                         f"names the terms: undersampled-term), or {declare}")
+            raise NoRuleFiredError(f"no rule sets `{name}` for {values}{many}",
+                                   hint=f"{declare}, or add rules that cover these inputs")
     return out
+
+
+def _fired_setting(compiled: CompiledRuleBase, j: int, x: np.ndarray) -> str:
+    """The rules setting output ``j`` that fire at the (clamped) inputs ``x``, with their
+    DOFs (the first three), or "" where none does: asked only on the way to an error."""
+    dof = rule_dofs(compiled, x[None])[0]
+    fired = [r for r in np.flatnonzero(compiled.cons_mask[:, j]) if dof[r] > 0]
+    told = ", ".join(f"{compiled.labels[r]} at DOF {dof[r]:.2g}" for r in fired[:3])
+    return told + (" ..." if len(fired) > 3 else "")
+
+
+def _why_empty(compiled: CompiledRuleBase, j: int) -> str:
+    """Why output ``j``'s fired rules left it no value."""
+    if compiled.operators.inference == "mamdani":
+        points = len(compiled.mamdani[j].grid)
+        return (f"the sets they conclude, implied at those DOFs, are 0 at all {points} points "
+                f"`{compiled.outputs[j]}` is sampled at, so there is nothing to defuzzify")
+    return "their weights in it are 0 (a hedged consequent of a DOF so small that it underflows)"
