@@ -36,6 +36,15 @@ def parse_value(text: str) -> float:
     return x
 
 
+def exact(x: float) -> str:
+    """``x`` as ``:g`` writes it where that reads back as ``x`` (``78``, ``1e+308``, ``nan``),
+    else the shortest text that does (``10.0000001``, which ``:g`` writes ``10``): a message
+    that compares two numbers, or echoes one given, must not print different ones alike
+    ("w = 100 lies outside its universe [0, 100]")."""
+    text = f"{x:g}"
+    return text if x != x or float(text) == x else repr(float(x))
+
+
 def whole_number(value: object) -> int | None:
     """``value`` as an ``int`` where it is a whole number (an ``int``, NumPy's too), else
     ``None``: ``True`` is no 1, and ``2.5`` or ``"3"`` no whole number."""

@@ -881,3 +881,25 @@ def test_the_batch_tells_it_once_too(capsys, tmp_path):
     csv.write_text("service,food\n2,1\n3,2\n", encoding="utf-8")
     code, out, err = run_main(["eval", str(fis), "--batch", str(csv)], capsys)
     assert code == 0 and err.count("term `cheap` of output `tip` falls between") == 1
+
+
+def test_inputs_are_echoed_as_given_where_six_digits_do_not_tell(tmp_path, capsys):
+    """The trace printed an input to six significant digits: `road=160.0000001` read "road =
+    160 (given 160, clamped to its universe)", `position=3.14159265` read "position =
+    3.14159", and "no rule sets `y` for x=5" was said of x=5.0000001 where a rule fires at 5."""
+    code, out, _ = run_main(["eval", "road=160.0000001", "size=45", "position=3.14159265"],
+                            capsys)
+    assert code == 0
+    assert "road = 160 in (given 160.0000001, clamped to its universe)" in out
+    assert "position = 3.14159265 in" in out
+    (tmp_path / "t.terms.yaml").write_text(
+        "variables:\n"
+        "  x: {role: input, universe: [0, 10], terms: {LO: {shape: triangle, points: [0, 0, 4]},"
+        " MID: {shape: triangle, points: [5, 5, 5]}}}\n"
+        "  y: {role: output, universe: [0, 100], terms: {A: 10, B: 50}}\n", encoding="utf-8")
+    rules = tmp_path / "t.rules"
+    rules.write_text('terms "t.terms.yaml"\nr1: if x is LO then y is A\nr2: if x is MID then y is B\n',
+                     encoding="utf-8")
+    assert run_main(["eval", str(rules), "x=5"], capsys)[0] == 0
+    code, _, err = run_main(["eval", str(rules), "x=5.0000001"], capsys)
+    assert code == 1 and "no rule sets `y` for x=5.0000001" in err

@@ -858,3 +858,24 @@ def test_a_resolution_refused_is_shown_as_written(written, shown):
     with pytest.raises(MitosError) as exc:
         resolve(parsed.operators)
     assert exc.value.message.endswith(f"from 3 to 100000, {shown}")
+
+
+@pytest.mark.parametrize("rules, terms_edit, says", [
+    ("r: if road is WIDE then steering is 150.0000001\n", None,
+     "steering = 150.0000001 lies outside its universe [30, 150]"),
+    ("r: if road is WIDE then steering is LS with 1.0000001\n", None,
+     "a rule weight must lie in [0, 1], not 1.0000001"),
+    ("r: if road is WIDE then steering is LS\n", ("points: [40, 70]}", "points: [70.0000001, 70]}"),
+     "points must be in order, but a = 70.0000001 > b = 70"),
+    ("r: if road is WIDE then steering is LS\n", ("default: 90", "default: 150.0000001"),
+     "default 150.0000001 lies outside the universe [30, 150]"),
+])
+def test_a_message_that_compares_numbers_prints_them_as_different(tmp_path, rules, terms_edit,
+                                                                   says):
+    """Numbers were printed to six significant digits: "steering = 150 lies outside its
+    universe [30, 150]", "a rule weight must lie in [0, 1], not 1", "b = 5 > c = 5". A number
+    that six digits do not tell apart is printed in full."""
+    terms = TERMS if terms_edit is None else TERMS.replace(*terms_edit, 1)
+    assert terms != TERMS or terms_edit is None
+    exc = error_of(lambda: load_rulebase(write(tmp_path, rules, terms)))
+    assert says in str(exc)

@@ -11,6 +11,7 @@ from typing import Annotated, Optional
 import typer
 
 from ..errors import InputError
+from ..numbers import exact
 from ..words import plural
 from .output import emit, json_text, warn, warn_notes
 from .params import choice, choices, completer, named
@@ -116,9 +117,9 @@ def warn_outside(compiled, Y) -> None:
                                   | (col > hi + 1e-9 * max(1.0, abs(hi))))
         if out.any():
             many = (f" in {plural(int(out.sum()), 'sample')}" if len(col) > 1
-                    else f" ({col[out][0]:g})")
-            warn(f"output `{name}` lies outside its universe [{lo:g}, {hi:g}]{many}: the "
-                 f"behavior's inference or a linear consequent can leave it")
+                    else f" ({exact(col[out][0])})")
+            warn(f"output `{name}` lies outside its universe [{exact(lo)}, {exact(hi)}]{many}: "
+                 f"the behavior's inference or a linear consequent can leave it")
 
 
 def warn_undersampled(rb, dof) -> None:
@@ -368,7 +369,7 @@ def no_rule_policy(compiled, result, policy: NoRule, where=None):
         shown = "nan" if np.isnan(compiled.default[j]) else f"{compiled.default[j]:g}"
         if policy is NoRule.error or (policy is NoRule.default and not declared):
             row = int(np.argmax(rows))
-            values = ", ".join(f"{k}={result.inputs[row, i]:g}"
+            values = ", ".join(f"{k}={exact(result.inputs[row, i])}"
                                for i, k in enumerate(compiled.inputs))
             raise NoRuleFiredError(
                 f"no rule sets `{out}` for {values} (row {row + 1}; {count} of {n} rows)",

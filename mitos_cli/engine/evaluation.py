@@ -19,6 +19,7 @@ from ..errors import EmptyOutputError, InputError, NoRuleFiredError
 from ..fuzzy import hedges as hedge_mod
 from ..fuzzy import norms
 from ..fuzzy.shapes import SHAPES
+from ..numbers import exact
 from .compile import CompiledRuleBase
 from .inputs import floats
 from .threads import Blocks, map_blocks, thread_count
@@ -228,8 +229,8 @@ def _formula_memberships(compiled: CompiledRuleBase, g, x: np.ndarray) -> np.nda
     if bad.any():
         row, col = map(int, np.argwhere(bad)[0])
         var, term = compiled.term_names[int(g.cols[row]) - 2]
-        raise InputError(f"term `{var}.{term}` (formula `{g.formula.text}`) gives {mu[row, col]:g} "
-                         f"at {var} = {x[row, col]:g}: a membership degree lies in [0, 1]",
+        raise InputError(f"term `{var}.{term}` (formula `{g.formula.text}`) gives {exact(mu[row, col])} "
+                         f"at {var} = {exact(x[row, col])}: a membership degree lies in [0, 1]",
                          span=compiled.variables[var].term(term).span,    # (where it is written)
                          hint="change the formula so it stays within [0, 1] on the universe")
     return mu
@@ -854,7 +855,7 @@ def fill_defaults(compiled: CompiledRuleBase, out: np.ndarray, X: np.ndarray,
             continue                           # the rule base asked for NaN here
         elif strict:
             row = int(np.argmax(col))
-            values = ", ".join(f"{k}={X[row, i]:g}" for i, k in enumerate(compiled.inputs))
+            values = ", ".join(f"{k}={exact(X[row, i])}" for i, k in enumerate(compiled.inputs))
             many = f" ({int(col.sum())} of {len(col)} samples)" if len(col) > 1 else ""
             declare = (f"declare a default for `{name}` (`default: VALUE` on the variable in a "
                        f"YAML term set, `DEFAULT := VALUE` in FCL, `default: VALUE` in FLL) to "

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import InputError
-from ..numbers import whole_number
+from ..numbers import exact, whole_number
 from ..resources import display_path
 from ..words import plural, with_unit
 from .evaluation import Result, declares_nan
@@ -100,9 +100,9 @@ class Trace:
         width = max(len(f) for f in fuzzified) if fuzzified else 0
         for text, i in zip(fuzzified, self.inputs):
             note = "" if not i.clamped else " (clamped to its universe)" if i.given is None \
-                else f" (given {i.given:g}, clamped to its universe)"
+                else f" (given {exact(i.given)}, clamped to its universe)"
             lines.append(f"  {text.ljust(width)}   {i.name} = "
-                         f"{with_unit(f'{i.value:g}', i.unit)}".rstrip() + note)
+                         f"{with_unit(exact(i.value), i.unit)}".rstrip() + note)
         lines += ["", f"rules fired ({len(self.rules)} of {self.n_rules}):"]
         for r in self.rules:
             lines.append(f"  {r.label}: {r.text}, DOF = {num(r.dof)}")

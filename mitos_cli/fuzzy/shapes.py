@@ -17,6 +17,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..numbers import exact
+
 INF = float("inf")
 
 
@@ -93,7 +95,7 @@ def _ordered(names: tuple[str, ...]) -> Callable[[tuple[float, ...]], str | None
     def check(p: tuple[float, ...]) -> str | None:
         for (n1, v1), (n2, v2) in zip(zip(names, p), zip(names[1:], p[1:])):
             if v1 > v2:
-                return f"points must be in order, but {n1} = {v1:g} > {n2} = {v2:g}"
+                return f"points must be in order, but {n1} = {exact(v1)} > {n2} = {exact(v2)}"
         return None
     return check
 
@@ -102,7 +104,7 @@ def _positive(names: tuple[str, ...], *indices: int) -> Callable[[tuple[float, .
     def check(p: tuple[float, ...]) -> str | None:
         for i in indices:
             if not p[i] > 0:
-                return f"{names[i]} must be > 0, not {p[i]:g}"
+                return f"{names[i]} must be > 0, not {exact(p[i])}"
         return None
     return check
 

@@ -11,6 +11,7 @@ from pathlib import Path
 
 from ..errors import MitosError, RuleBaseError, Span, TermSetError, unknown
 from ..fuzzy.hedges import HEDGES
+from ..numbers import exact
 from ..resources import exists, is_dir, is_file
 from . import operators as ops_mod
 from .bulk import without_cyclic_gc
@@ -290,7 +291,7 @@ def check_rule(rule: Rule, variables: dict[str, Variable]) -> None:
 
 def _check_weight(weight: float, span: Span | None) -> None:
     if not 0.0 <= weight <= 1.0:
-        raise RuleBaseError(f"a rule weight must lie in [0, 1], not {weight:g}", span=span)
+        raise RuleBaseError(f"a rule weight must lie in [0, 1], not {exact(weight)}", span=span)
 
 
 def _variable(name: str, role: str, variables: dict[str, Variable], span: Span | None) -> Variable:
@@ -332,8 +333,8 @@ def _check_consequent(c: Consequent, variables: dict[str, Variable]) -> None:
     elif c.value is not None:
         lo, hi = v.universe
         if not lo <= c.value <= hi:
-            raise RuleBaseError(f"{c.var} = {c.value:g} lies outside its universe "
-                                f"[{lo:g}, {hi:g}]", span=c.span)
+            raise RuleBaseError(f"{c.var} = {exact(c.value)} lies outside its universe "
+                                f"[{exact(lo)}, {exact(hi)}]", span=c.span)
 
 
 #: The longest chain of behaviors each using the next (a rule's conditions may nest 100 deep

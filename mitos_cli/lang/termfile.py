@@ -37,7 +37,7 @@ from ..errors import Span, TermSetError, did_you_mean
 from ..fuzzy.formula import parse as parse_formula
 from ..fuzzy.hedges import HEDGES
 from ..fuzzy.shapes import SHAPES
-from ..numbers import LARGEST
+from ..numbers import LARGEST, exact
 from ..words import plural
 from . import yamlpos
 from .terms import Term, TermSet, Variable, check_term, universe_problem
@@ -200,8 +200,8 @@ def _variable(name: str, spec: Any, key_span: Span, value_span: Span,
         else:
             default = _number(value, spec.value_span("default"), f"{what}: default")
         if default == default and not lo <= default <= hi:
-            raise TermSetError(f"{what}: default {default:g} lies outside the universe "
-                               f"[{lo:g}, {hi:g}]", span=spec.value_span("default"))
+            raise TermSetError(f"{what}: default {exact(default)} lies outside the universe "
+                               f"[{exact(lo)}, {exact(hi)}]", span=spec.value_span("default"))
     text_of = {k: spec.get(k, "") for k in ("description", "unit")}
     for key, value in text_of.items():
         if not isinstance(value, (str, int, float)):

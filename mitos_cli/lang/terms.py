@@ -16,6 +16,7 @@ import numpy as np
 from ..errors import Span, TermSetError, control_character, unknown
 from ..fuzzy.formula import Formula
 from ..fuzzy.shapes import SHAPES, STEEP, Shape
+from ..numbers import exact
 
 Role = Literal["input", "output"]
 
@@ -225,17 +226,17 @@ def check_term(term: Term, universe: tuple[float, float], variable: str,
     lo, hi = universe
     corners = term.corners
     if corners is not None and (corners[2] < lo or corners[1] > hi):
-        where = (f"its peak {corners[1]:g}" if corners[1] == corners[2]
-                 else f"its core [{corners[1]:g}, {corners[2]:g}]")
+        where = (f"its peak {exact(corners[1])}" if corners[1] == corners[2]
+                 else f"its core [{exact(corners[1])}, {exact(corners[2])}]")
         raise TermSetError(
             f"term `{variable}.{term.name}`: {where} lies outside the universe "
-            f"[{lo:g}, {hi:g}]", span=term.span,
+            f"[{exact(lo)}, {exact(hi)}]", span=term.span,
             hint="move the term or widen the variable's universe")
     if not peak_inside:
         return
     center = term.center          # NaN for a linear (Takagi-Sugeno) consequent: no peak
     if not np.isnan(center) and not lo <= center <= hi:
         raise TermSetError(
-            f"term `{variable}.{term.name}`: its peak {center:g} lies outside the universe "
-            f"[{lo:g}, {hi:g}]", span=term.span,
+            f"term `{variable}.{term.name}`: its peak {exact(center)} lies outside the "
+            f"universe [{exact(lo)}, {exact(hi)}]", span=term.span,
             hint="move the term or widen the variable's universe")
