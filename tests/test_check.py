@@ -670,3 +670,36 @@ def test_a_term_set_alone_is_checked_for_its_terms(tmp_path, capsys):
     assert code == 1 and "is a world file, not a term set" in err and "mitos simulate" in err
     code, _, err = run(["check", str(tmp_path / "t.term.yaml")], capsys)
     assert code == 1 and "did you mean `" in err and "t.terms.yaml`?" in err
+def test_a_rule_weighted_0_is_no_conflict(tmp_path):
+    """`with 0` (or `use B with 0`) switches a rule off: it never fires, as `unreachable`
+    says; `conflict` reported it as an error (exit 1) against the rule it was written
+    beside."""
+    (tmp_path / "t.terms.yaml").write_text(TERMS, encoding="utf-8")
+    (tmp_path / "t.rules").write_text(
+        'terms "t.terms.yaml"\nbehavior a:\n    r1: if road is WIDE then steering is LS\n'
+        "    r2: if road is WIDE then steering is RS with 0\n    use b with 0\nend\n"
+        "behavior b:\n    q: if road is WIDE then steering is ST\nend\n", encoding="utf-8")
+    report = check_rulebase(read_rulebase(tmp_path / "t.rules"), "a")
+    assert by_code(report, "conflict") == []
+    assert {f.code for f in report.findings if f.severity == "error"} == {"no-rule-fires"}
+    assert [f.message.split(":")[0] for f in by_code(report, "unreachable")] == [
+        "`r2` never fires"]
+
+
+@pytest.mark.parametrize("operators, says", [
+    ("", "it counts twice in the weighted average"),
+    ("operators: inference = weighted_sum\n", "it counts twice in the weighted sum"),
+    ("operators: inference = mamdani\n",
+     "it changes nothing (max aggregation keeps the stronger of the two)"),
+    ("operators: inference = mamdani, aggregation = bounded_sum\n",
+     "its set is aggregated twice (bounded_sum)"),
+])
+def test_a_duplicate_says_what_it_does_under_the_inference(tmp_path, operators, says):
+    """A rule written twice "counts twice in the weighted average", said under Mamdani
+    inference too, where with max aggregation the second changes nothing."""
+    (tmp_path / "t.terms.yaml").write_text(TERMS, encoding="utf-8")
+    (tmp_path / "t.rules").write_text(
+        'terms "t.terms.yaml"\n' + operators + "r1: if road is WIDE then speed is FAST\n"
+        "r2: if road is WIDE then speed is FAST\n", encoding="utf-8")
+    (dup,) = by_code(check_rulebase(read_rulebase(tmp_path / "t.rules")), "duplicate")
+    assert dup.message.endswith(says)

@@ -188,7 +188,7 @@ def check_rulebase(rb: RuleBase, behavior: str | None = None, *, threshold: floa
     for name in names:
         rb.behavior(name)                       # unknown behavior: did-you-mean error
         compiled = compile_rulebase(rb, name)
-        findings += _rule_pairs(rb, name)
+        findings += _rule_pairs(rb, name, compiled.operators)
         findings += _contradictions(rb, name)
         findings += _idle_settings(rb, name, compiled)
         findings += _undersampled(rb, name, compiled, seen)
@@ -360,10 +360,12 @@ def _same(a: Consequent, b: Consequent, variables: dict[str, Variable]) -> bool:
     return value(a) == value(b)
 
 
-def _rule_pairs(rb: RuleBase, behavior: str) -> list[Finding]:
+def _rule_pairs(rb: RuleBase, behavior: str, operators) -> list[Finding]:
     flat = flatten(rb, behavior)
     groups: dict[object, list[int]] = {}
     for i, (_, rule, contexts) in enumerate(flat):
+        if rule.weight == 0 or any(u.weight == 0 for u in contexts):
+            continue                 # it never fires (`unreachable` says so): no twin of any
         key = (canonical(rule.antecedent),
                tuple(canonical(u.condition) if u.condition is not None else None
                      for u in contexts))
@@ -390,13 +392,23 @@ def _rule_pairs(rb: RuleBase, behavior: str) -> list[Finding]:
                         f" (weights {rule_i.weight:g} and {rule_j.weight:g})"
                     out.append(Finding(
                         "warning", "duplicate",
-                        f"{where} and the same consequents{extra}: it counts twice in the "
-                        f"weighted average", rule_j.span, behavior,
+                        f"{where} and the same consequents{extra}: {_twice(operators)}",
+                        rule_j.span, behavior,
                         hint="delete one of them, or give one rule a weight (`with 0.5`)"))
                 else:
                     continue
                 break                         # report each rule against its first twin only
     return out
+
+
+def _twice(operators) -> str:
+    """What a rule written twice does to the outputs, under the behavior's inference."""
+    if operators.inference != "mamdani":      # Tsukamoto's output is a weighted average too
+        summed = operators.inference == "weighted_sum"
+        return f"it counts twice in the weighted {'sum' if summed else 'average'}"
+    if operators.aggregation == "max":
+        return "it changes nothing (max aggregation keeps the stronger of the two)"
+    return f"its set is aggregated twice ({operators.aggregation})"
 
 
 # ---------------------------------------------------------------------------------------------
