@@ -121,6 +121,11 @@ def caret_under(exc: MitosError) -> str:
     # a number past a float's range read as inf: "steering = inf lies outside its universe"
     ("r1: if road is WIDE then steering is 2e400", 38, "2e400", "`2e400` is past a float's range",
      "a number within", None),
+    # one too small, read as 0: `with 1e-400` switched the rule off without a word
+    ("r1: if road is WIDE then speed is SLOW with 1e-400", 45, "1e-400",
+     "`1e-400` is too small for a float: it would read as 0", "at least 5e-324", None),
+    ("r1: if road is WIDE then speed is -2.5e-400", 35, "-2.5e-400",
+     "`-2.5e-400` is too small for a float", "at least 5e-324", None),
 ])
 def test_syntax_errors(tmp_path, line, col, at, message, expected, hint):
     path = write(tmp_path, line)

@@ -393,6 +393,11 @@ class _ToModel(Transformer):
         if math.isinf(value):             # the grammar's numbers have no `inf`: 1e400 overflowed
             raise RuleSyntaxError(f"`{items[0]}` is past a float's range", span=self._s(meta),
                                   expected="a number within ±1.8e308")
+        if value == 0 and any(c in "123456789" for c in items[0].lower().partition("e")[0]):
+            # 1e-400 underflowed: `with 1e-400` would switch the rule off without a word
+            raise RuleSyntaxError(f"`{items[0]}` is too small for a float: it would read as 0",
+                                  span=self._s(meta),
+                                  expected="0, or a number of magnitude at least 5e-324")
         return value
 
     def NAME(self, token):
