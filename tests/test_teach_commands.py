@@ -251,7 +251,7 @@ def test_a_rule_may_continue_on_the_next_line():
 
 
 @pytest.mark.parametrize("line, message, column", [
-    ("adapt rate 1e-400", "not 1e-400 (too small for a float: it reads as 0)", 12),
+    ("adapt rate 1e-400", "`1e-400` is too small for a float: it would read as 0", 12),
     ("adapt rate 0", "must lie in (0, 1), not 0", 12),
     ("adapt epochs 3 rate 1e400", "`1e400` is past a float's range", 21),
     ("adapt epochs 2.5", "epochs must be a whole number of at least 1, not 2.5", 14),
