@@ -903,3 +903,19 @@ def test_inputs_are_echoed_as_given_where_six_digits_do_not_tell(tmp_path, capsy
     assert run_main(["eval", str(rules), "x=5"], capsys)[0] == 0
     code, _, err = run_main(["eval", str(rules), "x=5.0000001"], capsys)
     assert code == 1 and "no rule sets `y` for x=5.0000001" in err
+
+
+def test_a_hedged_consequent_whose_weight_underflows_is_told_without_mamdanis_hint(tmp_path,
+                                                                                    capsys):
+    """A rule firing at 1e-16 through `very` five times weighs 0: the output has no value,
+    which is said as such, with no hint to widen terms or raise a Mamdani `resolution`."""
+    (tmp_path / "t.terms.yaml").write_text(
+        "variables:\n"
+        "  x: {role: input, universe: [0, 10], terms: {LO: {shape: left_shoulder, points: [0, 10]}}}\n"
+        "  w: {role: output, universe: [0, 100], terms: {A: 10}}\n", encoding="utf-8")
+    rules = tmp_path / "t.rules"
+    rules.write_text('terms "t.terms.yaml"\nq: if x is LO then w is very very very very very A\n',
+                     encoding="utf-8")
+    code, _, err = run_main(["eval", str(rules), "x=9.999999999999998"], capsys)
+    assert code == 1 and "the rules that set `w` fire (q at DOF 1.1e-16)" in err
+    assert "underflows" in err and "resolution" not in err

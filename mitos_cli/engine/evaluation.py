@@ -862,11 +862,10 @@ def fill_defaults(compiled: CompiledRuleBase, out: np.ndarray, X: np.ndarray,
                        f"define the output when no rule fires")
             fired = _fired_setting(compiled, j, X[row])
             if fired:
+                why, fix = _why_empty(compiled, j)
                 raise EmptyOutputError(
                     f"the rules that set `{name}` fire ({fired}) but give it no value "
-                    f"for {values}{many}: {_why_empty(compiled, j)}",
-                    hint=f"widen the terms they conclude or raise `resolution` (`mitos check` "
-                         f"names the terms: undersampled-term), or {declare}")
+                    f"for {values}{many}: {why}", hint=f"{fix}{declare}")
             raise NoRuleFiredError(f"no rule sets `{name}` for {values}{many}",
                                    hint=f"{declare}, or add rules that cover these inputs")
     return out
@@ -881,10 +880,13 @@ def _fired_setting(compiled: CompiledRuleBase, j: int, x: np.ndarray) -> str:
     return told + (" ..." if len(fired) > 3 else "")
 
 
-def _why_empty(compiled: CompiledRuleBase, j: int) -> str:
-    """Why output ``j``'s fired rules left it no value."""
+def _why_empty(compiled: CompiledRuleBase, j: int) -> tuple[str, str]:
+    """Why output ``j``'s fired rules left it no value, and the start of a hint."""
     if compiled.operators.inference == "mamdani":
         points = len(compiled.mamdani[j].grid)
         return (f"the sets they conclude, implied at those DOFs, are 0 at all {points} points "
-                f"`{compiled.outputs[j]}` is sampled at, so there is nothing to defuzzify")
-    return "their weights in it are 0 (a hedged consequent of a DOF so small that it underflows)"
+                f"`{compiled.outputs[j]}` is sampled at, so there is nothing to defuzzify",
+                "widen the terms they conclude or raise `resolution` (`mitos check` names the "
+                "terms: undersampled-term), or ")
+    return ("their weights in it are 0 (a hedged consequent of a DOF so small that it "
+            "underflows)", "")
