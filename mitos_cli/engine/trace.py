@@ -102,7 +102,7 @@ class Trace:
             note = "" if not i.clamped else " (clamped to its universe)" if i.given is None \
                 else f" (given {exact(i.given)}, clamped to its universe)"
             lines.append(f"  {text.ljust(width)}   {i.name} = "
-                         f"{with_unit(exact(i.value), i.unit)}".rstrip() + note)
+                         f"{with_unit(f'{i.value:g}', i.unit)}".rstrip() + note)
         lines += ["", f"rules fired ({len(self.rules)} of {self.n_rules}):"]
         for r in self.rules:
             lines.append(f"  {r.label}: {r.text}, DOF = {num(r.dof)}")
