@@ -304,7 +304,22 @@ def closest(name: str, candidates: Iterable[str]) -> str | None:
     if not close and len(name) >= 3:         # `avoid` for `avoid_obstacle`: too short for difflib
         close = [c for c in pool if c.lower().startswith(name.lower())]
         close = close if len(close) == 1 else []
+    if not close and 2 <= len(name) <= 3:    # `HJ` for `HI`: difflib's ratio is 0.5
+        close = [c for c in pool if _one_letter_off(name, c)]
+        close = close if len(close) == 1 else []
     return close[0] if close else None
+
+
+def _one_letter_off(a: str, b: str) -> bool:
+    """Whether ``a`` and ``b`` (short names, as fuzzy terms often are: NB, ZE, PS) differ in
+    one letter, or in two neighbours swapped; not in a digit (`r9` is no typo of `r1`)."""
+    if len(a) != len(b) or a == b:
+        return False
+    off = [i for i, (x, y) in enumerate(zip(a, b)) if x != y]
+    if not all(a[i].isalpha() and b[i].isalpha() for i in off):
+        return False
+    return len(off) == 1 or (len(off) == 2 and off[1] == off[0] + 1
+                             and a[off[0]] == b[off[1]] and a[off[1]] == b[off[0]])
 
 
 def closest_file(name: str, candidates: Iterable[str]) -> str | None:

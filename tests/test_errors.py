@@ -884,3 +884,20 @@ def test_a_message_that_compares_numbers_prints_them_as_different(tmp_path, rule
     assert terms != TERMS or terms_edit is None
     exc = error_of(lambda: load_rulebase(write(tmp_path, rules, terms)))
     assert says in str(exc)
+
+
+@pytest.mark.parametrize("name, pool, hint", [
+    ("HJ", ["HI", "LO", "SAME"], "HI"),           # one letter off: difflib's ratio is 0.5
+    ("ZO", ["NB", "NS", "ZE", "PS", "PB"], "ZE"),
+    ("SP", ["NB", "NS", "ZE", "PS", "PB"], "PS"),  # two neighbours swapped
+    ("PM", ["NB", "NS", "ZE", "PS", "PB"], None),  # PS and PB both: no guess
+    ("QQ", ["NB", "NS", "ZE", "PS", "PB"], None),
+    ("x", ["y", "z"], None),                      # one letter is no name to guess from
+    ("r9", ["r1", "LO"], None),                   # nor is a digit a typo
+])
+def test_a_short_name_one_letter_off_gets_a_did_you_mean(name, pool, hint):
+    """`x is HJ` for the term HI listed the terms but suggested none: names of two or three
+    letters (NB, ZE, PS, as fuzzy terms often are) are too short for difflib's ratio."""
+    from mitos_cli.errors import closest
+
+    assert closest(name, pool) == hint
