@@ -311,6 +311,10 @@ def test_exports_give_a_weighted_sums_default_where_no_rule_fires(tmp_path: Path
     agree(run_python(c, X, tmp_path), want)
     if CC is not None:
         agree(run_c(c, X, tmp_path), want)
+    # and their comments say so: "(NaN when it has none)" was said of `u`'s 0
+    assert "(0, the empty sum, when it has none)" in " ".join(
+        line.lstrip(" *") for line in to_c(c, "demo", "test").splitlines())
+    assert "default (0, the empty sum, when it has none)" in to_python(c, "test")
 
 
 def test_c_file_is_self_contained(tmp_path: Path) -> None:

@@ -140,6 +140,12 @@ def to_c(compiled: CompiledRuleBase, prefix: str = "mitos", source: str = "") ->
     return "\n".join(out)
 
 
+def _without_default(c: CompiledRuleBase) -> str:
+    """What an output without a default is where no rule sets it: NaN, but a weighted sum's
+    is 0, the sum of nothing."""
+    return "0, the empty sum," if c.operators.inference == "weighted_sum" else "NaN"
+
+
 def _c_header(p: Program, P: str, U: str, source: str) -> list[str]:
     """The opening comment (what, from where, how to build) and the index macros."""
     c = p.compiled
@@ -149,7 +155,8 @@ def _c_header(p: Program, P: str, U: str, source: str) -> list[str]:
            " * C99, no allocation, only <math.h>: cc -std=c99 -c FILE.c, link with -lm.",
            f" * int {P}_eval(const double in[{U}_N_INPUTS], double out[{U}_N_OUTPUTS]):",
            " * inputs are clamped to their universes; an output no rule sets takes its default",
-           " * (NaN when it has none). Returns how many outputs took that fallback (0: the rules",
+           f" * ({_without_default(c)} when it has none). Returns how many outputs took that"
+           " fallback (0: the rules",
            f" * set every output), or {U}_NAN_INPUT (-1) when an input is NaN: then every",
            " * output is NaN. */",
            "", "#include <math.h>", "",

@@ -155,7 +155,8 @@ def _py_header(p: Program, source: str) -> list[str]:
         f"{doc_text(c.operators.describe())}).", "",
         "``evaluate(X)`` maps inputs ``X[n, k]`` (columns in INPUTS order, clamped to their",
         "universes) to outputs ``Y[n, m]`` (OUTPUTS order); an output no rule sets takes its",
-        'default (NaN when it has none). Needs only NumPy."""', "",
+        f'default ({"0, the empty sum," if c.operators.inference == "weighted_sum" else "NaN"} '
+        'when it has none). Needs only NumPy."""', "",
         "import numpy as np", "",
         f"INPUTS = {tuple(map(str, c.inputs))!r}", f"OUTPUTS = {tuple(map(str, c.outputs))!r}",
         f"UNIVERSE = {[tuple(map(float, u)) for u in c.universe]!r}",
