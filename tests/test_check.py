@@ -703,3 +703,27 @@ def test_a_duplicate_says_what_it_does_under_the_inference(tmp_path, operators, 
         "r2: if road is WIDE then speed is FAST\n", encoding="utf-8")
     (dup,) = by_code(check_rulebase(read_rulebase(tmp_path / "t.rules")), "duplicate")
     assert dup.message.endswith(says)
+
+
+@pytest.mark.parametrize("terms, share", [
+    # crisp steps: no rule fires on [0, 2), (5, 7) and (9, 10], half the universe
+    ("{A: {shape: rectangle, points: [2, 5]}, B: {shape: rectangle, points: [7, 9]}}", 0.5),
+    # a zero-width term fires at 5 alone: none fires on (4, 5) and (5, 6)
+    ("{A: {shape: triangle, points: [0, 0, 4]}, B: {shape: triangle, points: [5, 5, 5]},"
+     " C: {shape: triangle, points: [6, 10, 10]}}", 0.2),
+])
+def test_where_no_rule_fires_is_measured_exactly_beside_vertical_edges(tmp_path, terms, share):
+    """A cell between samples counted as unset only when no rule fired at any of its ends, so
+    the cells beside a crisp step (a rectangle's edge) or a zero-width term, where the rules
+    are 0 inside and above 0 at one end, counted as set: 40% for 50%, 15% for 20%. A cell
+    is judged at its centre now, which is exact on a grid that holds the corner points."""
+    (tmp_path / "t.terms.yaml").write_text(
+        f"variables:\n  x: {{role: input, universe: [0, 10], terms: {terms}}}\n"
+        "  w: {role: output, universe: [0, 100], terms: {P: 10, Q: 50, R: 90}}\n",
+        encoding="utf-8")
+    names = "ABC" if "C:" in terms else "AB"
+    (tmp_path / "t.rules").write_text('terms "t.terms.yaml"\n' + "".join(
+        f"r{i}: if x is {t} then w is {'PQR'[i]}\n" for i, t in enumerate(names)),
+        encoding="utf-8")
+    (gap,) = by_code(check_rulebase(read_rulebase(tmp_path / "t.rules")), "no-rule-fires")
+    assert gap.share == pytest.approx(share, abs=1e-12)

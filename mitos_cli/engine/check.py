@@ -566,6 +566,7 @@ def _sampled(compiled: CompiledRuleBase, threshold: float,
     # coverage, per output (grouping outputs that share the same gap)
     counting, missed = _counting(compiled)
     total = dof @ counting                             # [n, m] total DOF per output
+    centres = None                                     # the same at the cells' centres
     reported: dict[tuple, list[str]] = {}
     for kind, mask_of in (("no-rule-fires", lambda t: t <= 0.0),
                           ("low-dof", lambda t: (t > 0.0) & (t < threshold))):
@@ -583,8 +584,13 @@ def _sampled(compiled: CompiledRuleBase, threshold: float,
         for key, outs in reported.items():
             mask, has_default = masks[key], key[1]
             boxes, uncovered = boxes_of(mask.reshape(shape), axes, compiled.inputs)
-            share = volume_share(mask.reshape(shape), axes,
-                                 inner=kind == "no-rule-fires" and not skipped)
+            inner = kind == "no-rule-fires" and not skipped
+            if inner and all(len(a) > 1 for a in axes):
+                if centres is None:
+                    centres = _centre_totals(compiled, axes, counting)
+                share = _unset_share(centres, axes, compiled.outputs.index(outs[0]))
+            else:
+                share = volume_share(mask.reshape(shape), axes, inner=inner)
             severity, message, hint = _coverage_words(compiled, kind, outs, share,
                                                       has_default, threshold, thinned)
             if missed.intersection(outs):
@@ -721,12 +727,34 @@ def _fires_on(compiled: CompiledRuleBase, rules: np.ndarray, inputs: list[int],
     return fires
 
 
+def _centre_totals(compiled: CompiledRuleBase, axes: list[np.ndarray],
+                   counting: np.ndarray) -> np.ndarray:
+    """``[cells, m]`` total DOF per output at the centre of each cell between neighbouring
+    samples (every axis has two or more)."""
+    mesh = np.meshgrid(*(0.5 * (a[:-1] + a[1:]) for a in axes), indexing="ij")
+    X = np.stack([m.reshape(-1) for m in mesh], axis=1) if axes else np.zeros((1, 0))
+    return rule_dofs(compiled, X) @ counting
+
+
+def _unset_share(centres: np.ndarray, axes: list[np.ndarray], j: int) -> float:
+    """The share of the input space's volume where no rule sets output ``j``: the cells
+    whose centre it is unset at. On a grid that holds the terms' corner points a membership
+    is linear on each open cell, so a DOF of min or product that is 0 at the centre is 0 all
+    over the cell, and one above 0 there is 0 at most on its boundary: exact, also where a
+    term is 0 on the cell and above 0 at its ends (a vertical edge, a zero-width term),
+    which a count of the cells unset at every vertex took for set."""
+    m = (centres[:, j] <= 0.0).astype(float).reshape([len(a) - 1 for a in axes])
+    for a in axes:                           # contract each axis with its cells' widths
+        m = np.tensordot(np.diff(a) / (a[-1] - a[0]), m, axes=(0, 0))
+    return float(m)
+
+
 def volume_share(mask: np.ndarray, axes: list[np.ndarray], inner: bool) -> float:
     """The share of the input space's volume that the grid ``mask`` stands for (not of its
     samples: the corner points crowd some stretches). Each cell between neighbouring samples
     counts its volume times the share of its vertices in the mask, or (``inner``) only when
-    all are: where no rule fires is bounded by corner points (a piecewise-linear term is 0
-    on a whole cell or only at its ends), so on a grid that holds them that is exact."""
+    all are (:func:`_unset_share`, which judges a cell at its centre, is exact where this
+    is not: beside a vertical edge or a zero-width term)."""
     if any(len(a) < 2 for a in axes):
         return float(mask.mean())
     m = mask.astype(float)
