@@ -874,6 +874,8 @@ def test_a_resolution_refused_is_shown_as_written(written, shown):
      "points must be in order, but a = 70.0000001 > b = 70"),
     ("r: if road is WIDE then steering is LS\n", ("default: 90", "default: 150.0000001"),
      "default 150.0000001 lies outside the universe [30, 150]"),
+    ("r: if road is WIDE then steering is LS\n", ("universe: [0, 160]", "universe: [0, 1.0000001e150]"),
+     "is 1.0000001e+150: numbers beyond ±1e+150 cannot be evaluated"),
 ])
 def test_a_message_that_compares_numbers_prints_them_as_different(tmp_path, rules, terms_edit,
                                                                    says):

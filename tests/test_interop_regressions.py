@@ -385,6 +385,8 @@ def test_fll_non_finite_and_out_of_range_numbers_are_refused(old, new, words):
 @pytest.mark.parametrize("old, new, words", [
     ("Range=[0 30]", "Range=[0 inf]", "the range is inf"),
     ("Range=[0 10]", "Range=[0 1e300]", "beyond"),
+    # six digits printed 1.0000001e150 as 1e+150, "beyond ±1e+150"
+    ("Range=[0 10]", "Range=[0 1.0000001e150]", "is 1.0000001e+150: numbers beyond ±1e+150"),
     ("1 1, 1 (1) : 2", "9" * 400 + " 1, 1 (1) : 2", "`9999999999...999999` (400 characters) is past"),
     ("1 1, 1 (1) : 2", "1 1, 1.5 (1) : 2", "fractional"),
     ("1 1, 1 (1) : 2", "1 1, 1 (1) : 99999999999999999999", "connection"),

@@ -540,7 +540,7 @@ def _finite(value: float, what: str, span: Span | None) -> None:
         raise FormatError(f"{what} is {fmt_number(value)}: it must be a finite number",
                           span=span)
     if abs(value) > LARGEST:
-        raise FormatError(f"{what} is {value:g}: numbers beyond ±{LARGEST:g} cannot be "
+        raise FormatError(f"{what} is {fmt_number(value)}: numbers beyond ±{LARGEST:g} cannot be "
                           f"evaluated in floating point without overflow", span=span)
 
 

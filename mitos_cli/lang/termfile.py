@@ -275,7 +275,7 @@ def _number(value: Any, span: Span, what: str) -> float:
     average's sum overflows to ``inf`` or ``nan`` with nothing said."""
     number = yamlpos.expect_number(value, span, TermSetError, what)
     if abs(number) > LARGEST:
-        raise TermSetError(f"{what} is {number:g}: numbers beyond ±{LARGEST:g} cannot be "
+        raise TermSetError(f"{what} is {exact(number)}: numbers beyond ±{LARGEST:g} cannot be "
                            "evaluated in floating point without overflow", span=span,
                            hint="measure the variable in a larger unit")
     return number
