@@ -920,3 +920,19 @@ def test_a_hedged_consequent_whose_weight_underflows_is_told_without_mamdanis_hi
     code, _, err = run_main(["eval", str(rules), "x=9.999999999999998"], capsys)
     assert code == 1 and "the rules that set `w` fire (q at DOF 1.1e-16)" in err
     assert "underflows" in err and "resolution" not in err
+
+
+def test_the_no_rule_column_is_not_named_like_an_output(tmp_path, capsys):
+    """An output named `no_rule` and `--on-no-rule`'s column made a header `x,no_rule,no_rule`:
+    which column was which could not be told. The flag column is `mitos_no_rule` then."""
+    (tmp_path / "t.terms.yaml").write_text(
+        "variables:\n"
+        "  x: {role: input, universe: [0, 10], terms: {LO: {shape: left_shoulder, points: [3, 7]}}}\n"
+        "  no_rule: {role: output, universe: [0, 100], terms: {A: 10}}\n", encoding="utf-8")
+    rules = tmp_path / "t.rules"
+    rules.write_text('terms "t.terms.yaml"\nq: if x is LO then no_rule is A\n', encoding="utf-8")
+    (tmp_path / "in.csv").write_text("x\n1\n9\n", encoding="utf-8")
+    code, out, _ = run_main(["eval", str(rules), "--batch", str(tmp_path / "in.csv"),
+                             "--on-no-rule", "nan"], capsys)
+    assert code == 0 and out.splitlines() == ["x,no_rule,mitos_no_rule", "1,10.0,",
+                                              "9,nan,no_rule"]

@@ -292,7 +292,7 @@ def unused_inputs(rb) -> tuple[str, ...]:
 def run_batch(rb, source: str, on_no_rule: NoRule | None = None,
               digits: int | None = None) -> None:
     """Read the CSV, evaluate all rows as one batch, write inputs and outputs as CSV."""
-    from ..engine.csvio import passed_names, read_table, row_span, write_batch
+    from ..engine.csvio import flag_name, passed_names, read_table, row_span, write_batch
     from ..engine.evaluation import rule_dofs
     from ..engine.mamdani import undersampled
 
@@ -324,8 +324,9 @@ def run_batch(rb, source: str, on_no_rule: NoRule | None = None,
     Y, keep, flags = no_rule_policy(rb.compiled, result, on_no_rule or NoRule.default,
                                     lambda row: row_span(text, name, row))
     warn_outside(rb.compiled, Y[keep])
+    flag = flag_name(rb.compiled.inputs, rb.compiled.outputs)
     taken = (*rb.compiled.inputs, *rb.compiled.outputs, *(() if on_no_rule is None
-                                                         else ("no_rule",)))
+                                                         else (flag,)))
     extra = passed_names(batch.extra, taken)
     renamed = [f"`{a}` as `{b}`" for a, b in zip(batch.extra, extra) if a != b]
     if renamed:

@@ -415,6 +415,15 @@ def _raise_csv_error(text: str, path: str) -> NoReturn:
 
 # ---- writing ---------------------------------------------------------------------------------
 
+def flag_name(inputs: Sequence[str], outputs: Sequence[str]) -> str:
+    """The name of ``--on-no-rule``'s column: ``no_rule``, or ``mitos_no_rule`` where an input
+    or output has that name (a header naming two columns alike says neither)."""
+    name = "no_rule"
+    while name in inputs or name in outputs:
+        name = "mitos_" + name
+    return name
+
+
 def passed_names(extra: tuple[str, ...], taken: tuple[str, ...]) -> tuple[str, ...]:
     """The names the passed-through columns are written under: their own, or ``given_NAME``
     where the output CSV already has a column ``NAME`` (an output such as the ``steering`` of
@@ -440,7 +449,8 @@ def write_batch(out: TextIO, inputs: Sequence[str], given: Sequence[np.ndarray],
     (``columns``, as read) and, with ``no_rule`` (per row, the outputs no rule set, joined by
     ``;``), a last column ``no_rule``. Outputs are written in full (the shortest text that
     reads back as the same double) or with ``digits`` decimals."""
-    names = [*inputs, *outputs, *extra, *(() if no_rule is None else ("no_rule",))]
+    names = [*inputs, *outputs, *extra,
+             *(() if no_rule is None else (flag_name(inputs, outputs),))]
     out.write(",".join(_quoted(list(names))) + "\n")
     number = repr if digits is None else _decimals(digits)
     for start in range(0, len(Y), CHUNK):
