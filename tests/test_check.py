@@ -113,6 +113,8 @@ def test_coverage_gap_with_default_is_a_warning(flawed):
 @pytest.mark.parametrize("points, where, share", [
     ("[2, 4]", "in 20% of the input space", 0.2),        # x in [4, 6]: 9 of the 41 samples
     ("[2, 5]", "on lines or points of the input space (none of its volume)", 0.0)])   # x = 5
+
+
 def test_no_rule_fires_gives_the_share_of_the_input_space(tmp_path, points, where, share):
     """It gave the share of the samples (22%, 9 of 41, for a gap of 20%), which the terms'
     corner points crowd; it is the share of the volume now, exact where the grid holds them."""
@@ -227,6 +229,8 @@ def test_term_peaking_outside_the_universe(tmp_path):
 @pytest.mark.parametrize("shape", ["sigmoid, inflection: 120, slope: 0.5",
                                    "sigmoid_product, left: 110, rising: 1, falling: 1, "
                                    "right: 150"])
+
+
 def test_a_sigmoid_shoulder_is_not_a_term_outside_the_universe(tmp_path, shape):
     """A sigmoid comes within 1e-4 of 1 at the universe's end but never reaches it: check said
     "never reaches 1 inside the universe (at most 1)" and told the user to move its peak in."""
@@ -494,6 +498,8 @@ def test_the_coverage_check_reads_the_rules_dofs_only(tmp_path, monkeypatch):
 
 @pytest.mark.parametrize("name", ["check_termless_input.fll", "check_formula_output.fll",
                                   "check_formula_input.fll"])
+
+
 def test_files_eval_reads_are_checked_too(name, capsys):
     # found in fuzzylite's examples: an input with no terms (a ValueError from the term
     # gaps), a formula term on an output (StopIteration in the term order) or on an input
@@ -670,6 +676,8 @@ def test_a_term_set_alone_is_checked_for_its_terms(tmp_path, capsys):
     assert code == 1 and "is a world file, not a term set" in err and "mitos simulate" in err
     code, _, err = run(["check", str(tmp_path / "t.term.yaml")], capsys)
     assert code == 1 and "did you mean `" in err and "t.terms.yaml`?" in err
+
+
 def test_a_rule_weighted_0_is_no_conflict(tmp_path):
     """`with 0` (or `use B with 0`) switches a rule off: it never fires, as `unreachable`
     says; `conflict` reported it as an error (exit 1) against the rule it was written
@@ -694,6 +702,8 @@ def test_a_rule_weighted_0_is_no_conflict(tmp_path):
     ("operators: inference = mamdani, aggregation = bounded_sum\n",
      "its set is aggregated twice (bounded_sum)"),
 ])
+
+
 def test_a_duplicate_says_what_it_does_under_the_inference(tmp_path, operators, says):
     """A rule written twice "counts twice in the weighted average", said under Mamdani
     inference too, where with max aggregation the second changes nothing."""
@@ -712,6 +722,8 @@ def test_a_duplicate_says_what_it_does_under_the_inference(tmp_path, operators, 
     ("{A: {shape: triangle, points: [0, 0, 4]}, B: {shape: triangle, points: [5, 5, 5]},"
      " C: {shape: triangle, points: [6, 10, 10]}}", 0.2),
 ])
+
+
 def test_where_no_rule_fires_is_measured_exactly_beside_vertical_edges(tmp_path, terms, share):
     """A cell between samples counted as unset only when no rule fired at any of its ends, so
     the cells beside a crisp step (a rectangle's edge) or a zero-width term, where the rules
