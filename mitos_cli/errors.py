@@ -130,13 +130,20 @@ def _shorten(match: re.Match[str]) -> str:
 
 _NEWLINE = re.compile(r"\n")
 #: control characters (C0 but tab and newline, DEL, C1): what a mutated file or a pasted
-#: escape sequence holds, shown rather than sent to the terminal (an ESC would act there)
-_CONTROL = re.compile(r"[\x00-\x08\x0b-\x1f\x7f-\x9f]")
+#: escape sequence holds, shown rather than sent to the terminal (an ESC would act there); and
+#: Unicode's bidirectional embeddings, overrides and isolates, which reorder what the terminal
+#: shows (a name with U+202E reads backwards: "Trojan Source", CVE-2021-42574)
+_CONTROL = re.compile(r"[\x00-\x08\x0b-\x1f\x7f-\x9f\u202a-\u202e\u2066-\u2069]")
+
+
+def _escape(char: str) -> str:
+    code = ord(char)
+    return f"\\x{code:02x}" if code < 0x100 else f"\\u{code:04x}"
 
 
 def visible(text: str) -> str:
-    """``text`` with each control character as its escape (``\\x1b``)."""
-    return _CONTROL.sub(lambda m: f"\\x{ord(m.group()):02x}", text)
+    """``text`` with each control character as its escape (``\\x1b``, ``\\u202e``)."""
+    return _CONTROL.sub(lambda m: _escape(m.group()), text)
 
 
 def control_character(text: str) -> str | None:

@@ -369,6 +369,8 @@ MF1='hi':'constant',[1]
     ("a\x1b]0;title\x07", "lo"),          # an OSC sequence: set the terminal's title
     ("a", "lo\x1b[2J"),                   # clear the screen
     ("a\x9b31m", "lo"),                   # a C1 control sequence introducer
+    ("a\u202etxt.exe", "lo"),             # a right-to-left override: shown as `aexe.txt`
+    ("a", "lo\u2066hidden\u2069"),         # a bidirectional isolate
 ])
 def test_a_control_character_in_a_fis_name_is_refused(tmp_path, input_name, term_name):
     """`mitos eval` and `check` printed a .fis file's names as written: an ESC in one acted
@@ -380,7 +382,7 @@ def test_a_control_character_in_a_fis_name_is_refused(tmp_path, input_name, term
                     encoding="utf-8")
     with pytest.raises(FormatError, match="holds the control character") as exc:
         api.read_rulebase(path)
-    assert not any(c in exc.value.render() for c in "\x1b\x07\x9b")
+    assert not any(c in exc.value.render() for c in "\x1b\x07\x9b\u202e\u2066\u2069")
 
 
 @pytest.mark.parametrize("key", ["description", "unit"])
@@ -638,3 +640,13 @@ def test_a_rule_file_too_long_is_refused_before_it_is_parsed(tmp_path, monkeypat
                                          f"hold at most 4,000") as exc:
         api.read_rulebase(path)
     assert exc.value.span.line == 1
+
+
+def test_a_bidirectional_override_is_shown_as_its_escape():
+    """Unicode's bidirectional overrides and isolates reorder what a terminal shows ("Trojan
+    Source"): refused in names as control characters are, and escaped in messages."""
+    from mitos_cli.errors import control_character, visible
+
+    assert visible("a\u202eb\u2066c\x1b") == "a\\u202eb\\u2066c\\x1b"
+    assert control_character("road\u202e") == "\\u202e" and control_character("route") is None
+    assert visible("Straße, café, 路") == "Straße, café, 路"      # letters are letters
