@@ -337,6 +337,31 @@ def load_map_yaml(path: Path, *, unknown_occupied: bool = True,
     """Read a map_server ``map.yaml`` and its image into a :class:`Grid` in inches
     (``written``: the path as the world file writes it, for a "did you mean" as it would be
     written there)."""
+    spec = _map_spec(path, where, written)
+    image = _image_name(spec, f"map file `{path.name}`")
+    res_m = _resolution(spec, f"map file `{path.name}`")
+    origin_written, (ox, oy, yaw) = _origin(spec, f"map file `{path.name}`")
+    negate = _negate(spec)
+    mode = _mode(spec)
+    occ_t, free_t = (yamlpos.expect_number(spec.get(key, default), spec.value_span(key),
+                                           WorldError, key)
+                     for key, default in (("occupied_thresh", 0.65), ("free_thresh", 0.196)))
+    _check_thresholds(spec, occ_t, free_t)
+    pixels, maxval = _map_image(path, spec, image)
+    blocked = classify(shade(pixels, mode), maxval, negate=negate, occupied_thresh=occ_t,
+                       free_thresh=free_t, unknown_occupied=unknown_occupied, mode=mode)
+    _check_extent(spec, (ox, oy), res_m, blocked.shape)
+    res, origin = res_m * INCH_PER_M, (ox * INCH_PER_M, oy * INCH_PER_M)
+    if abs(math.remainder(yaw, 2 * math.pi)) > 1e-12:
+        blocked, origin = rotate(blocked, res, origin, yaw)
+    note = _yaw_note(yaw, _item_span(origin_written, 2, spec.value_span("origin")))
+    return Grid(blocked, res, origin, str(path), notes=(note,) if note else ())
+
+
+def _map_spec(path: Path, where: Span | None, written: str | None) -> yamlpos.YMap:
+    """The map file's YAML mapping, its keys checked; an image named where the YAML goes, a
+    pipe or a device, and a file that is no map_server map are refused (until the file is
+    known to be a map file, an error quotes nothing of it: docs/security.md)."""
     from ..fileio import bad_byte, named_yaml, read_text
 
     if path.suffix.lower() in IMAGE_SUFFIXES:        # the image named where its YAML goes
@@ -356,7 +381,6 @@ def load_map_yaml(path: Path, *, unknown_occupied: bool = True,
     except (OSError, UnicodeDecodeError) as exc:
         raise WorldError(unreadable("map file", path, exc), span=bad_byte(path, exc) or where,
                          hint=_beside(path, written, exc, (".yaml", ".yml"))) from None
-    # Until the file is known to be a map file, an error quotes nothing of it (docs/security.md).
     named = named_yaml(path)
     try:
         spec = yamlpos.load(text, str(path), WorldError)
@@ -369,15 +393,24 @@ def load_map_yaml(path: Path, *, unknown_occupied: bool = True,
                          expected="a YAML file with `image:` and `resolution:`") from None
     spec = yamlpos.expect_map(spec, Span(str(path), 1, 1), WorldError, "a map file")
     yamlpos.check_keys(spec, MAP_KEYS, WorldError, "a map_server map file")
-    what = f"map file `{path.name}`"
+    return spec
+
+
+def _image_name(spec: yamlpos.YMap, what: str):
+    """The image's path as the map file writes it (an empty `image:` was "map image `None`
+    not found")."""
     image = yamlpos.require(spec, "image", WorldError, what)
     if image is None or isinstance(image, (list, dict, bool)) or not str(image).strip():
-        # (an empty `image:` was "map image `None` not found")
         raise WorldError("`image` in a map file " + ("is empty" if image is None or
                                                       isinstance(image, str) else
                                                       f"must be a path, not {not_a_path(image)}"),
                          span=spec.value_span("image"), expected="the image's path, such as "
                          "map.pgm (relative to this YAML file)")
+    return image
+
+
+def _resolution(spec: yamlpos.YMap, what: str) -> float:
+    """Metres per pixel: positive, and no finer than :data:`FINEST`."""
     res_m = yamlpos.expect_number(yamlpos.require(spec, "resolution", WorldError, what),
                                   spec.value_span("resolution"), WorldError, "resolution")
     if res_m <= 0:
@@ -389,19 +422,27 @@ def load_map_yaml(path: Path, *, unknown_occupied: bool = True,
                          expected=f"at least {FINEST:g} (metres per pixel)",
                          hint="the resolution is in metres per pixel: 0.05 is 5 cm, as ROS "
                               "maps usually are")
-    origin_written = yamlpos.require(spec, "origin", WorldError, what)
-    if not isinstance(origin_written, list) or len(origin_written) != 3:
+    return res_m
+
+
+def _origin(spec: yamlpos.YMap, what: str) -> tuple[list, tuple[float, float, float]]:
+    """The origin as written and as ``(x, y, yaw)`` (metres, metres, radians)."""
+    written = yamlpos.require(spec, "origin", WorldError, what)
+    if not isinstance(written, list) or len(written) != 3:
         raise WorldError("origin must be [x, y, yaw] (metres, metres, radians)",
                          span=spec.value_span("origin"))
-    ox, oy, yaw = (yamlpos.expect_number(v, _item_span(origin_written, i,
-                                                       spec.value_span("origin")),
+    ox, oy, yaw = (yamlpos.expect_number(v, _item_span(written, i, spec.value_span("origin")),
                                          WorldError, "origin")
-                   for i, v in enumerate(origin_written))
+                   for i, v in enumerate(written))
     if abs(yaw) > LARGEST:                          # 1e300 read as an exact quarter turn, 0
         raise WorldError(f"the origin's yaw must be within ±{LARGEST:g} (radians), not {yaw:g}",
-                         span=_item_span(origin_written, 2, spec.value_span("origin")),
+                         span=_item_span(written, 2, spec.value_span("origin")),
                          hint="the yaw is in radians: 3.14 is a half turn")
-    negate = _negate(spec)
+    return written, (ox, oy, yaw)
+
+
+def _mode(spec: yamlpos.YMap) -> str:
+    """map_server's ``mode`` (trinary when left out)."""
     mode = spec.get("mode", "trinary")
     if mode is None:                                         # read "unknown mode `None`"
         raise WorldError("`mode` in a map file is empty", span=spec.value_span("mode"),
@@ -410,13 +451,14 @@ def load_map_yaml(path: Path, *, unknown_occupied: bool = True,
     if mode not in MODES:
         raise unknown("map_server mode", str(mode), MODES, span=spec.value_span("mode"),
                       cls=WorldError)
-    occ_t, free_t = (yamlpos.expect_number(spec.get(key, default), spec.value_span(key),
-                                           WorldError, key)
-                     for key, default in (("occupied_thresh", 0.65), ("free_thresh", 0.196)))
-    _check_thresholds(spec, occ_t, free_t)
+    return mode
+
+
+def _map_image(path: Path, spec: yamlpos.YMap, image) -> tuple[np.ndarray, int]:
+    """The image's pixels and maxval, each way of failing said at the map file's `image:`."""
     image_path = path.parent / str(image)
     try:
-        pixels, maxval = read_image(image_path)
+        return read_image(image_path)
     except ImportError as exc:
         raise WorldError(f"cannot read map image `{image_path}`: {exc}",
                          span=spec.value_span("image")) from None
@@ -431,14 +473,6 @@ def load_map_yaml(path: Path, *, unknown_occupied: bool = True,
         raise WorldError(f"cannot read map image `{image_path}`: {exc}",
                          span=spec.value_span("image"),
                          hint="give a PGM (P5 or P2) or an image Pillow reads (PNG)") from None
-    blocked = classify(shade(pixels, mode), maxval, negate=negate, occupied_thresh=occ_t,
-                       free_thresh=free_t, unknown_occupied=unknown_occupied, mode=mode)
-    _check_extent(spec, (ox, oy), res_m, blocked.shape)
-    res, origin = res_m * INCH_PER_M, (ox * INCH_PER_M, oy * INCH_PER_M)
-    if abs(math.remainder(yaw, 2 * math.pi)) > 1e-12:
-        blocked, origin = rotate(blocked, res, origin, yaw)
-    note = _yaw_note(yaw, _item_span(origin_written, 2, spec.value_span("origin")))
-    return Grid(blocked, res, origin, str(path), notes=(note,) if note else ())
 
 
 def _yaw_note(yaw: float, span: Span) -> str | None:
