@@ -42,6 +42,12 @@ def test_every_packaged_file_is_listed_by_a_name_the_commands_accept():
     for e in cat["lessons"]:
         assert resolve("rulebases/lessons", e["name"], ".lesson") is not None
         assert e["description"]
+    # the term sets, by the name `plot terms` and `check` take from anywhere
+    from mitos_cli.api import read_termset
+
+    assert [e["name"] for e in cat["termsets"]] == ["drive.terms.yaml", "mitos.terms.yaml"]
+    for e in cat["termsets"]:
+        assert [v.name for v in read_termset(e["name"]).variables] == e["variables"]
 
 
 @pytest.mark.parametrize("text, expected", [

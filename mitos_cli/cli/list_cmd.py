@@ -1,9 +1,9 @@
-"""``mitos list``: the packaged worlds, rule bases and lessons, a line each.
+"""``mitos list``: the packaged worlds, rule bases, term sets and lessons, a line each.
 
 A world is described by its ``name`` and the first line of its leading comment, a rule base by
-its behaviors, a lesson by the first line of its leading comment. Each is listed by the name
-the commands accept (``mitos simulate corridor``, ``--rulebase mitos.rules``,
-``--lesson wider-turn``).
+its behaviors, a term set by its variables, a lesson by the first line of its leading comment.
+Each is listed by the name the commands accept (``mitos simulate corridor``, ``--rulebase
+mitos.rules``, ``mitos plot terms drive.terms.yaml``, ``--lesson wider-turn``).
 """
 
 from __future__ import annotations
@@ -18,6 +18,8 @@ from .output import emit, json_text
 SECTIONS = {
     "worlds": ("worlds (mitos simulate NAME)", "worlds", ".yaml"),
     "rulebases": ("rule bases (--rulebase NAME)", "rulebases", ".rules"),
+    "termsets": ("term sets (mitos plot terms NAME, mitos check NAME)", "rulebases",
+                 ".terms.yaml"),
     "lessons": ("lessons (mitos teach --lesson NAME)", "rulebases/lessons", ".lesson"),
 }
 
@@ -58,16 +60,24 @@ def _rulebase(path) -> dict:
             "description": "behaviors: " + ", ".join(b.name for b in rb.behaviors)}
 
 
+def _termset(path) -> dict:
+    from ..lang.termfile import load_termset
+
+    names = [v.name for v in load_termset(path).variables]
+    return {"name": path.name, "variables": names, "description": "variables: " + ", ".join(names)}
+
+
 def _lesson(path) -> dict:
     return {"name": path.stem,
             "description": first_comment_line(path.read_text(encoding="utf-8"))}
 
 
 def catalogue() -> dict[str, list[dict]]:
-    """Every packaged world, rule base and lesson, by section, in file-name order."""
+    """Every packaged world, rule base, term set and lesson, by section, in file-name order."""
     from ..resources import packaged_names, packaged_path
 
-    describe = {"worlds": _world, "rulebases": _rulebase, "lessons": _lesson}
+    describe = {"worlds": _world, "rulebases": _rulebase, "termsets": _termset,
+                "lessons": _lesson}
     return {key: [describe[key](packaged_path(folder, filename))
                   for filename in packaged_names(folder, suffix)]
             for key, (_, folder, suffix) in SECTIONS.items()}
@@ -93,7 +103,7 @@ def render(cat: dict[str, list[dict]]) -> str:
 def list_command(
     as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
 ) -> None:
-    """List the packaged worlds, rule bases and lessons, a line each.
+    """List the packaged worlds, rule bases, term sets and lessons, a line each.
 
     Example: `mitos list`, then `mitos simulate slalom`.
     """
