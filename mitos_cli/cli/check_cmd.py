@@ -115,7 +115,8 @@ def _shown(finding: dict) -> dict:
 def check_command(
     rulebase: Annotated[Optional[str], typer.Argument(
         metavar="[RULEBASE]", callback=named,
-        help="Rule file (default: the packaged MITOS rule base).")] = None,
+        help="Rule file (default: the packaged MITOS rule base), or a term set "
+             "(FILE.terms.yaml) checked alone.")] = None,
     behavior: Annotated[Optional[str], typer.Option(
         "--behavior", "-b", callback=named,
         help="Check only this behavior, and the term sets' variables it reads or sets "

@@ -152,7 +152,8 @@ def _terminal_width(width: Optional[int]) -> int:
 def terms_command(
     args: Annotated[Optional[list[str]], typer.Argument(
         metavar="[RULEBASE] [NAME=VALUE]...",
-        help="Rule file (default: the packaged MITOS rule base), then values to mark, "
+        help="Rule file (default: the packaged MITOS rule base) or a term set "
+             "(FILE.terms.yaml), then values to mark, "
              "e.g. road=78.")] = None,
     var: Annotated[Optional[list[str]], typer.Option(
         "--var", "-v", help="Draw only this variable (repeat for more).")] = None,
