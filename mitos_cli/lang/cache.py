@@ -179,13 +179,35 @@ def _digest(data: bytes) -> str:
     return hashlib.sha256(data).hexdigest()
 
 
+@functools.cache
+def _code_stamp() -> bytes:
+    """The size and time of each module a parsed rule base is made by (the package's own,
+    `lang/`, `fuzzy/`): in an editable install (`pip install -e`, a checkout that pulls) the
+    code changes without a new version, and an entry the old code parsed was served as the
+    new code's (the format number below catches only the changes someone remembers to count).
+    A stat a module, no read (under a millisecond), and none for an installed copy, whose
+    code changes only with its version."""
+    root = Path(__file__).resolve().parent.parent
+    if root.parent.name in ("site-packages", "dist-packages"):
+        return b""
+    parts = []
+    for module in sorted([*root.glob("*.py"), *(root / "lang").glob("*.py"),
+                          *(root / "fuzzy").glob("*.py")]):
+        try:
+            st = module.stat()
+        except OSError:
+            continue
+        parts.append(f"{module.relative_to(root)}:{st.st_size}:{st.st_mtime_ns}")
+    return "\n".join(parts).encode()
+
+
 def _key(path: Path, data: bytes) -> str:
     from ..resources import data_dir
 
     grammar = (data_dir("grammar") / "mitos.lark").read_bytes()
     # The path as given and resolved: spans in the cached model quote the path as given.
-    return _digest(b"\0".join([str(_FORMAT).encode(), __version__.encode(), grammar,
-                               str(path).encode(), str(path.resolve()).encode(),
+    return _digest(b"\0".join([str(_FORMAT).encode(), __version__.encode(), _code_stamp(),
+                               grammar, str(path).encode(), str(path.resolve()).encode(),
                                os.getcwd().encode(), data]))
 
 
