@@ -82,6 +82,10 @@ def read_termset(path: str | Path) -> TermSet:
     from .lang.termfile import load_termset
     from .resources import packaged_names, packaged_place, resolve
 
+    if not (isinstance(path, str) and path or isinstance(path, os.PathLike)):
+        raise TermSetError(f"a term set is read from a file: expected its path, not "
+                           f"{type(path).__name__} `{path!r:.60}`",
+                           hint="read_termset('rulebases/mitos.terms.yaml')")
     given = _path_given(path)
     found = resolve("rulebases", given, ".terms.yaml") or Path(given)
     try:

@@ -739,3 +739,13 @@ def test_where_no_rule_fires_is_measured_exactly_beside_vertical_edges(tmp_path,
         encoding="utf-8")
     (gap,) = by_code(check_rulebase(read_rulebase(tmp_path / "t.rules")), "no-rule-fires")
     assert gap.share == pytest.approx(share, abs=1e-12)
+
+
+@pytest.mark.parametrize("given", ["", 3, None])
+def test_read_termset_says_a_term_set_is_read_from_a_file(given):
+    """From Python, `read_termset(3)` was told "a rule base is read from a file"."""
+    from mitos_cli.api import read_termset
+    from mitos_cli.errors import TermSetError
+
+    with pytest.raises(TermSetError, match="a term set is read from a file: expected its path"):
+        read_termset(given)
