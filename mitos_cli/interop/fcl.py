@@ -260,6 +260,8 @@ def _function_block(fb: Tree, span_of) -> RuleBase:
     for n in outputs:
         _tsukamoto(records[n], variables[n], notes)
     all_rules = [r for _, _, rules in parsed for r in rules]
+    for n in outputs:
+        _singletons_note(records[n], variables[n], all_rules, notes)
     groups = common.rule_blocks(parsed, {n: records[n] for n in outputs},
                                 renumber=len({r.label for r in all_rules}) < len(all_rules))
     _check_outputs(groups, locks, constants)
@@ -360,6 +362,24 @@ def _tsukamoto(record: common.Record, v: Variable, notes: list[str]) -> None:
                 notes.append(f"{where}: `{v.name}` inverts sigmoid terms (Tsukamoto inference); "
                              f"a sigmoid reaches 1 only at infinity, so where a rule fires "
                              f"fully the output is +-inf, as in fuzzylite")
+
+
+def _singletons_note(record: common.Record, v: Variable, rules: list[Rule],
+                     notes: list[str]) -> None:
+    """A singleton term concluded under a continuous METHOD (COG, also where none is written):
+    jFuzzyLogic throws on every evaluation (`RuleActivationMethod.imply`: a discrete term under
+    a continuous defuzzifier), MITOS computes its centroid of spikes (engine/mamdani.py)."""
+    method, where = next(((value, span) for key, value, span, _ in record
+                          if key == "defuzzify"), ("centroid", None))
+    singles = {t.name for t in v.terms if t.shape == "singleton"}
+    used = [c.term for r in rules for c in r.consequents if c.var == v.name and c.term in singles]
+    if not used or method in ("weighted_average", "weighted_sum", "tsukamoto"):
+        return
+    written = f"`METHOD : {common.DEFUZZIFIERS[method][FCL]}`" if where else "no METHOD (COG)"
+    notes.append(f"{where or v.span}: `{v.name} IS {used[0]}` concludes a singleton under "
+                 f"{written}: jFuzzyLogic throws on every evaluation (a discrete term under a "
+                 f"continuous defuzzifier); MITOS averages the singletons, each snapped to "
+                 f"its nearest sample, weighted by their aggregated degrees")
 
 
 def _variable(node: Tree, role: Role, declared, settings: common.Record, locks: dict,
