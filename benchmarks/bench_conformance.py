@@ -3,6 +3,7 @@
     python benchmarks/bench_conformance.py            # everything (a few minutes)
     python benchmarks/bench_conformance.py --quick    # pyfuzzylite's examples only
     python benchmarks/bench_conformance.py --quick --fcl-dir DIR   # and every .fcl under DIR
+    python benchmarks/bench_conformance.py --quick --fcl-dir DIR --jfuzzylogic JAR   # and 5.
 
 1. pyfuzzylite's example engines (inside the installed package) through the command line,
    ``mitos eval X.fll --batch IN.csv [-b BEHAVIOR]``, against their ``.fld`` tables to 1e-6,
@@ -18,6 +19,10 @@
    documented tipper values.
 4. Every file that loads is converted to every other format and read back: outputs unchanged
    (1e-9 of the output's range), or the converter's warning gives the measured difference.
+5. With ``--jfuzzylogic JAR`` (a jFuzzyLogic jar; needs Java): every ``.fcl`` under
+   ``--fcl-dir`` evaluated on a grid of inputs by jFuzzyLogic itself and by MITOS, as MITOS
+   reads it and with ``--fidelity jfuzzylogic``; the largest difference per file and output,
+   with its cause where it is known (``jfl_oracle.py``).
 
 Missing Debian packages are installed with ``apt-get`` when it is available (and said so);
 without them parts 2 and 3 are skipped, saying why. CI does not run this.
@@ -42,6 +47,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
+import jfl_oracle  # noqa: E402
 from options import directory  # noqa: E402
 from peers import require  # noqa: E402
 
@@ -352,12 +358,28 @@ def report_rows(title: str, part: dict) -> None:
         print(f"  largest difference among the matching: {max(errors):.2g}")
 
 
+def jar(text: str) -> Path:
+    """A jFuzzyLogic jar (or a directory of its classes) that exists."""
+    path = Path(text)
+    if not path.exists():
+        raise argparse.ArgumentTypeError(f"`{text}` does not exist")
+    return path
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="pyfuzzylite's examples only")
     parser.add_argument("--fcl-dir", type=directory, metavar="DIR",
                         help="also read every .fcl under DIR (e.g. a jFuzzyLogic checkout)")
+    parser.add_argument("--jfuzzylogic", type=jar, metavar="JAR",
+                        help="compare every .fcl under --fcl-dir with this jFuzzyLogic jar's "
+                             "outputs (needs java; javac for full precision)")
     args = parser.parse_args()
+    if args.jfuzzylogic and not args.fcl_dir:
+        parser.error("--jfuzzylogic compares the files of --fcl-dir: give --fcl-dir DIR")
+    if args.jfuzzylogic and not shutil.which("java"):
+        sys.exit("bench_conformance.py: --jfuzzylogic runs the jar with `java`, which is not "
+                 "on the PATH")
     all_files: list[Path] = []
     examples = pyfuzzylite_examples()
     if examples is None and args.quick and not args.fcl_dir:    # --quick: part 1 alone
@@ -396,6 +418,8 @@ def main() -> None:
         print(f"  refused without naming a construct: {len(unexpected)}"
               + (f" ({', '.join(unexpected)})" if unexpected else ""))
         all_files += sorted(args.fcl_dir.rglob("*.fcl"))
+        if args.jfuzzylogic:
+            jfl_oracle.report(jfl_oracle.part_jfuzzylogic(args.fcl_dir, args.jfuzzylogic, tmp))
     rt = round_trips(all_files, tmp)
     print("\n## 4. Round trips of every file that loads (each behavior, each other format)")
     for fmt in ("fcl", "fis", "fll", "rules"):

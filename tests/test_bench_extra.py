@@ -116,6 +116,8 @@ def script(name: str, monkeypatch):
     ("bench_nav", ["--json", "{tmp}/no/x.json"], "cannot write `{tmp}/no/x.json`: No such file or directory"),
     ("route_clearance", ["--json", "{tmp}"], "cannot write `{tmp}`: it is a directory"),
     ("bench_conformance", ["--quick", "--fcl-dir", "{tmp}/no"], "`{tmp}/no` is not a directory"),
+    ("bench_conformance", ["--quick", "--jfuzzylogic", "{tmp}/no.jar"], "`{tmp}/no.jar` does not exist"),
+    ("bench_conformance", ["--quick", "--jfuzzylogic", "{tmp}"], "give --fcl-dir DIR"),
     ("bench_teach", ["--only-fit", "--epochs", "-3"], "argument --epochs: `-3`: must be at least 1"),
     ("bench_teach", ["--only-fit", "--lesson", "{tmp}"], "`{tmp}` is a directory, not a lesson"),
     ("fuzz", ["--per-format", "-1"], "argument --per-format: `-1`: must be at least 1"),

@@ -1,7 +1,11 @@
-"""What running jFuzzyLogic itself (built from source) on its own ``.fcl`` files showed. No
-Java runs here: jFuzzyLogic's outputs are recorded."""
+"""What running jFuzzyLogic itself (built from source) on its own ``.fcl`` files showed, and
+the benchmark's reading of what jFuzzyLogic prints (``bench_conformance.py --jfuzzylogic
+JAR``). No Java runs here: jFuzzyLogic's outputs are recorded strings."""
 
 from __future__ import annotations
+
+import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -9,6 +13,8 @@ import pytest
 from mitos_cli.engine.compile import compile_rulebase
 from mitos_cli.engine.evaluation import evaluate
 from mitos_cli.interop.fcl import parse_fcl
+
+ROOT = Path(__file__).resolve().parents[1]
 
 #: jFuzzyLogic's ``junit1.fcl``, shortened: singleton output terms and no METHOD (COG)
 SINGLETONS_UNDER_COG = """FUNCTION_BLOCK junit1
@@ -57,3 +63,79 @@ def test_singletons_under_cog_are_said_to_be_what_jfuzzylogic_cannot_evaluate(me
     # midpoints 0.0005 and 0.9995 of 1000 cells, under COGS they stay where they are
     got = evaluate(compile_rulebase(rb), np.array([[10.0]])).outputs[0, 0]
     assert got == pytest.approx(2 / 3 * 0.0005 + 1 / 3 * 0.9995 if warned else 1 / 3)
+
+
+# ---------------------------------------------------------------------------------------------
+# The benchmark's reading of jFuzzyLogic's output
+
+
+@pytest.fixture()
+def oracle(monkeypatch):
+    monkeypatch.syspath_prepend(str(ROOT / "benchmarks"))
+    sys.modules.pop("jfl_oracle", None)
+    import jfl_oracle
+
+    return jfl_oracle
+
+
+#: JflGrid on tipper.fcl (service, food) = (3, 7), (9, 3), and a point that threw; recorded
+GRID = """in tipper.food tipper.service
+universe tipper.food=0.0:9.0 tipper.service=0.0:9.0
+out tipper.tip=11.701603788948043
+out tipper.tip=0.0
+error java.lang.RuntimeException: MembershipFunction and Defuzzifier are neither both
+"""
+
+#: ``java -jar jFuzzyLogic.jar -e tipper.fcl 7 3`` (food, service), recorded from the oracle
+EVAL = """FUNCITON_BLOCK tipper
+\tVAR_INPUT \t      food = 7.000000
+\tVAR_INPUT \t   service = 3.000000
+\tVAR_OUTPUT\t       tip = 11.701604
+\tRULE_BLOCK No1
+\t\tSupport  \tRule name \tRule
+\t\t0.250000\t1         \tIF (service IS poor) OR (food IS rancid) THEN tip IS cheap;
+"""
+
+
+def test_the_driver_s_lines_are_read(oracle):
+    grid = oracle.parse_grid(GRID)
+    assert grid.inputs == ["tipper.food", "tipper.service"]
+    assert grid.universe == {"tipper.food": (0.0, 9.0), "tipper.service": (0.0, 9.0)}
+    assert grid.rows[:2] == [{"tipper.tip": 11.701603788948043}, {"tipper.tip": 0.0}]
+    assert grid.rows[2].startswith("java.lang.RuntimeException: MembershipFunction")
+    assert grid.load_error is None
+    assert oracle.parse_grid("load-error java.lang.NullPointerException\n").load_error == \
+        "java.lang.NullPointerException"
+
+
+def test_the_jar_s_own_evaluation_is_read(oracle):
+    assert oracle.parse_eval(EVAL) == {"tipper.tip": 11.701604}
+    asked = ("Missing argument 'tipper.food' (input variable 'food' in FunctionBlock 'tipper').\n"
+             "Missing argument 'tipper.service' (input variable 'service' in FunctionBlock "
+             "'tipper').\n")
+    assert oracle.parse_missing(asked) == ["tipper.food", "tipper.service"]
+    assert oracle.syntax_errors("line 27:4 missing SEMICOLON at 'TERM'\nGpr.debug(1): x\n"
+                                "line 34:1 missing ID at 'ACT'\n") == 2
+
+
+def test_the_grid_holds_both_ends_and_stays_in_its_budget(oracle):
+    points = oracle.grid_points([(0.0, 9.0), (-1.0, 1.0)])
+    assert len(points) == 17 * 17 and [0.0, -1.0] in points and [9.0, 1.0] in points
+    assert len(oracle.grid_points([(0.0, 1.0)] * 6)) <= oracle.POINTS
+    assert oracle.grid_points([]) == [[]]
+
+
+def test_a_difference_counts_nan_against_a_number_as_infinite(oracle):
+    nan = float("nan")
+    assert oracle.difference(np.array([1.0, nan]), np.array([1.5, nan])) == 0.5
+    assert oracle.difference(np.array([1.0]), np.array([nan])) == float("inf")
+
+
+def test_a_difference_names_its_cause(oracle):
+    assert oracle.cause_of("a.fcl", 1e-12, 1e-12, ()) == ""
+    assert oracle.cause_of("a.fcl", 0.01, 1e-13, ()).startswith("sampling (1000 midpoints")
+    assert oracle.cause_of("a.fcl", 0.5, 0.5, ("a.fcl:3:1: `y IS hi` is concluded by `r1` and "
+                                               "`r2` under the accumulation `max` (`ACCU`)",)
+                           ).startswith("MITOS warned: `y IS hi` is concluded")
+    assert "8.7e-16" in oracle.cause_of("x/junit_shashankrao.fcl", 0.05, 0.05, ())
+    assert oracle.cause_of("a.fcl", 0.5, 0.5, ()) == "not explained"
