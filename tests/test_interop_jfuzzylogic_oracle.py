@@ -65,6 +65,60 @@ def test_singletons_under_cog_are_said_to_be_what_jfuzzylogic_cannot_evaluate(me
     assert got == pytest.approx(2 / 3 * 0.0005 + 1 / 3 * 0.9995 if warned else 1 / 3)
 
 
+#: jFuzzyLogic's testDeMorgan files (every connective pair under NOT), with terms that span
+#: their ranges, so that MITOS loads them (the originals' single-point terms give no range)
+DE_MORGAN = """FUNCTION_BLOCK dm
+VAR_INPUT
+    x1 : REAL; RANGE := (0 .. 1);
+    x2 : REAL; RANGE := (0 .. 1);
+END_VAR
+VAR_OUTPUT
+    y : REAL;
+END_VAR
+FUZZIFY x1
+    TERM value := (0, 0) (0.3, 1) (1, 0);
+END_FUZZIFY
+FUZZIFY x2
+    TERM value2 := (0, 0.2) (0.6, 1) (1, 0.4);
+END_FUZZIFY
+DEFUZZIFY y
+    TERM a := TRIAN 0 0.1 0.3;
+    TERM b := TRIAN 0.2 0.4 0.6;
+    TERM c := TRIAN 0.4 0.6 0.8;
+    TERM d := TRIAN 0.7 0.9 1;
+    METHOD : COG;
+    DEFAULT := 0;
+    RANGE := (0 .. 1);
+END_DEFUZZIFY
+RULEBLOCK No1
+    CONNECTIVE;
+    ACT : MIN;
+    ACCU : MAX;
+    RULE 1 : IF NOT(x1 IS value OR x2 IS value2) THEN y IS a;
+    RULE 2 : IF NOT(x1 IS value) AND NOT(x2 IS value2) THEN y IS b;
+    RULE 3 : IF NOT(x1 IS value AND x2 IS value2) THEN y IS c;
+    RULE 4 : IF x1 IS NOT value OR x2 IS value2 THEN y IS d;
+END_RULEBLOCK
+END_FUNCTION_BLOCK
+"""
+
+
+@pytest.mark.parametrize("connective", ["AND : HAMACHER", "OR : EINSTEIN"])
+def test_hamacher_goes_with_the_einstein_sum_as_in_jfuzzylogic(connective):
+    """jFuzzyLogic sets both connectives from either line (RuleBlock.fclTree): HAMACHER with
+    the Einstein sum. MITOS took the De Morgan dual, the Hamacher sum (or, from `OR :
+    EINSTEIN`, the Einstein product), and its outputs differed by up to 0.044."""
+    from mitos_cli.interop.common import fidelity_settings
+
+    rb = parse_fcl(DE_MORGAN.replace("CONNECTIVE", connective), "dm.fcl")
+    c = compile_rulebase(rb, None, fidelity_settings(rb, "jfuzzylogic"))
+    assert (c.operators.and_, c.operators.or_) == ("hamacher", "einstein_sum")
+    got = evaluate(c, np.array([[0.2, 0.5], [0.9, 0.1], [0.5, 0.95]])).outputs[:, 0]
+    # recorded from jFuzzyLogic (built from source), the same for both lines
+    np.testing.assert_allclose(got, [0.6998437099120048, 0.5260472489886552,
+                                     0.6265296810386404], rtol=0, atol=1e-9)
+
+
 # ---------------------------------------------------------------------------------------------
 # The benchmark's reading of jFuzzyLogic's output
 

@@ -11,7 +11,7 @@ MITOS's model. Both dialects are read:
   (``Triangle``, ``Gaussian``, ``Linear``, ...; every one but ``Function``);
 - ``ACCU`` in the RULEBLOCK (IEC, jFuzzyLogic) or in DEFUZZIFY (fuzzylite); ``ACT`` is the
   implication; with only ``AND`` (or only ``OR``) given the other is its De Morgan dual, as
-  IEC 61131-7 says;
+  IEC 61131-7 says (jFuzzyLogic's ``HAMACHER`` and ``EINSTEIN``: each other, as it pairs them);
 - ``METHOD``: COG, COA (BIS), MM (MOM), LM (SOM), RM (LOM) for Mamdani; COGS (weighted
   average of singletons) and COGSS (weighted sum) for Takagi-Sugeno;
 - ``DEFAULT := v`` -> ``Variable.default``; ``DEFAULT := nan`` -> none; ``| NC`` (no change:
@@ -312,17 +312,33 @@ def _rule_block(block: Tree, variables: dict[str, Variable], span_of,
         if item.data == "option":
             _option(item, record, span_of, {})
     keys = {key for key, *_ in record}
+    pair = _jfl_pair(block)
     if "and_" in keys and "or_" not in keys:
         and_ = next(v for k, v, *_ in record if k == "and_")
-        record.set("or_", norms.lookup("tnorm", and_).dual, None, "OR")
+        record.set("or_", pair or norms.lookup("tnorm", and_).dual, None, "OR")
     elif "or_" in keys and "and_" not in keys:
         or_ = next(v for k, v, *_ in record if k == "or_")
-        record.set("and_", norms.lookup("snorm", or_).dual, None, "AND")
+        record.set("and_", pair or norms.lookup("snorm", or_).dual, None, "AND")
     rule_items = [x for x in block.children[1:] if x.data == "rule"]
     rules = [_rule(item, variables, span_of, i) for i, item in enumerate(rule_items)]
     _grouping_note(rule_items, span_of, notes)
     name = str(block.children[0]) if block.children[0] is not None else ""
     return name, record, rules
+
+
+#: jFuzzyLogic's own names that set the other connective too, to a pair that is not De
+#: Morgan's (`RuleBlock.fclTree`: HAMACHER goes with the Einstein sum, not the Hamacher sum)
+JFL_PAIRS = {("AND", "HAMACHER"): "einstein_sum", ("OR", "EINSTEIN"): "hamacher"}
+
+
+def _jfl_pair(block: Tree) -> str | None:
+    """The other connective a RULEBLOCK's `AND : HAMACHER` or `OR : EINSTEIN` sets."""
+    for item in block.children[1:]:
+        if item.data == "option":
+            key, value = (str(t).upper() for t in item.children[:2])
+            if (key, value) in JFL_PAIRS:
+                return JFL_PAIRS[key, value]
+    return None
 
 
 def _check_outputs(groups: list, locks: dict[str, Span],
