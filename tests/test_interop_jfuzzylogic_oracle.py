@@ -119,6 +119,33 @@ def test_hamacher_goes_with_the_einstein_sum_as_in_jfuzzylogic(connective):
                                      0.6265296810386404], rtol=0, atol=1e-9)
 
 
+@pytest.mark.parametrize("lines, ours, theirs", [
+    ("AND : PROD;\n    OR : MAX", ("product", "max"), ("min", "max")),
+    ("AND : MIN;\n    OR : ASUM", ("min", "probabilistic_sum"), ("product", "probabilistic_sum")),
+    ("OR : MAX;\n    AND : HAMACHER", ("hamacher", "max"), ("hamacher", "einstein_sum")),
+    ("AND : PROD;\n    OR : ASUM", ("product", "probabilistic_sum"), None),       # a pair
+    ("AND : HAMACHER;\n    OR : EINSTEIN", ("hamacher", "einstein_sum"), None),   # its pair
+    ("AND : AlgebraicProduct;\n    OR : Maximum", ("product", "max"), None),      # fuzzylite's
+])
+def test_and_and_or_both_given_not_as_a_pair_say_what_jfuzzylogic_takes(lines, ours, theirs):
+    """jFuzzyLogic sets both connectives from each AND or OR line, so the last one decides both
+    (`AND : MIN; OR : ASUM;` is the product with the probabilistic sum there: the oracle's
+    outputs differed by up to 1.4 on jFuzzyLogic's grammar cases); MITOS, as fuzzylite, uses
+    each, and now says so."""
+    rb = parse_fcl(DE_MORGAN.replace("CONNECTIVE", lines), "dm.fcl")
+    c = compile_rulebase(rb)
+    assert (c.operators.and_, c.operators.or_) == ours
+    notes = [n for n in rb.notes if "not as a pair" in n]
+    if theirs is None:
+        assert notes == []
+        return
+    last = lines.split("\n")[-1].strip()
+    assert notes == [f"dm.fcl:26:5: both AND (`{ours[0]}`) and OR (`{ours[1]}`) are given, not as "
+                     f"a pair: MITOS uses each, as fuzzylite does; jFuzzyLogic sets both from "
+                     f"each line, so its last, `{last}`, gives AND `{theirs[0]}` and OR "
+                     f"`{theirs[1]}`: give one of them, or their pair"]
+
+
 # ---------------------------------------------------------------------------------------------
 # The benchmark's reading of jFuzzyLogic's output
 

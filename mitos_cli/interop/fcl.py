@@ -319,6 +319,8 @@ def _rule_block(block: Tree, variables: dict[str, Variable], span_of,
     elif "or_" in keys and "and_" not in keys:
         or_ = next(v for k, v, *_ in record if k == "or_")
         record.set("and_", pair or norms.lookup("snorm", or_).dual, None, "AND")
+    else:
+        _both_note(block, record, span_of, notes)
     rule_items = [x for x in block.children[1:] if x.data == "rule"]
     rules = [_rule(item, variables, span_of, i) for i, item in enumerate(rule_items)]
     _grouping_note(rule_items, span_of, notes)
@@ -339,6 +341,32 @@ def _jfl_pair(block: Tree) -> str | None:
             if (key, value) in JFL_PAIRS:
                 return JFL_PAIRS[key, value]
     return None
+
+
+#: jFuzzyLogic's names of the connectives (``Fcl.g``)
+JFL_NAMES = {"AND": {"MIN", "PROD", "BDIF", "DMIN", "NIPMIN", "HAMACHER"},
+             "OR": {"MAX", "ASUM", "BSUM", "DMAX", "NIPMAX", "EINSTEIN"}}
+
+
+def _both_note(block: Tree, record: common.Record, span_of, notes: list[str]) -> None:
+    """Say where a RULEBLOCK gives both AND and OR in jFuzzyLogic's names, not as the pair its
+    last line sets: MITOS uses each, as fuzzylite does; jFuzzyLogic sets both connectives from
+    each line, so the last one decides both (`RuleBlock.fclTree`)."""
+    lines = [(k, v, item) for item in block.children[1:] if item.data == "option"
+             for k, v in [(str(t).upper() for t in item.children[:2])] if k in JFL_NAMES]
+    if {k for k, _, _ in lines} != {"AND", "OR"} or any(v not in JFL_NAMES[k]
+                                                         for k, v, _ in lines):
+        return
+    ops = {k: v for k, v, *_ in record}
+    key, value, item = lines[-1]
+    other = JFL_PAIRS.get((key, value))
+    theirs = (ops["and_"], other or norms.lookup("tnorm", ops["and_"]).dual) if key == "AND" \
+        else (other or norms.lookup("snorm", ops["or_"]).dual, ops["or_"])
+    if theirs != (ops["and_"], ops["or_"]):
+        notes.append(f"{span_of(item)}: both AND (`{ops['and_']}`) and OR (`{ops['or_']}`) are "
+                     f"given, not as a pair: MITOS uses each, as fuzzylite does; jFuzzyLogic "
+                     f"sets both from each line, so its last, `{key} : {value}`, gives AND "
+                     f"`{theirs[0]}` and OR `{theirs[1]}`: give one of them, or their pair")
 
 
 def _check_outputs(groups: list, locks: dict[str, Span],
