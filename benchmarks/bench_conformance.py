@@ -22,7 +22,8 @@
 5. With ``--jfuzzylogic JAR`` (a jFuzzyLogic jar; needs Java): every ``.fcl`` under
    ``--fcl-dir`` evaluated on a grid of inputs by jFuzzyLogic itself and by MITOS, as MITOS
    reads it and with ``--fidelity jfuzzylogic``; the largest difference per file and output,
-   with its cause where it is known (``jfl_oracle.py``).
+   with its cause where it is known (``jfl_oracle.py``); then the same on the construct-by-
+   construct cases of ``tests/test_interop_fcl_grammar.py``.
 
 Missing Debian packages are installed with ``apt-get`` when it is available (and said so);
 without them parts 2 and 3 are skipped, saying why. CI does not run this.
@@ -419,7 +420,11 @@ def main() -> None:
               + (f" ({', '.join(unexpected)})" if unexpected else ""))
         all_files += sorted(args.fcl_dir.rglob("*.fcl"))
         if args.jfuzzylogic:
-            jfl_oracle.report(jfl_oracle.part_jfuzzylogic(args.fcl_dir, args.jfuzzylogic, tmp))
+            jfl_oracle.report(jfl_oracle.part_jfuzzylogic(args.fcl_dir, args.jfuzzylogic, tmp),
+                              f"5. jFuzzyLogic itself on {args.fcl_dir}")
+            cases = jfl_oracle.grammar_cases(tmp / "grammar")
+            jfl_oracle.report(jfl_oracle.part_jfuzzylogic(cases, args.jfuzzylogic, tmp),
+                              "5b. jFuzzyLogic itself on tests/test_interop_fcl_grammar.py's cases")
     rt = round_trips(all_files, tmp)
     print("\n## 4. Round trips of every file that loads (each behavior, each other format)")
     for fmt in ("fcl", "fis", "fll", "rules"):

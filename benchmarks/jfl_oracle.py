@@ -11,6 +11,7 @@ without ``javac``, each point is one ``java -jar JAR -e FILE IN...``, which prin
 
 from __future__ import annotations
 
+import ast
 import itertools
 import os
 import re
@@ -28,6 +29,7 @@ from mitos_cli.errors import MitosError
 from mitos_cli.interop.common import fidelity_settings
 
 DRIVER = Path(__file__).with_name("JflGrid.java")
+GRAMMAR_CASES = Path(__file__).resolve().parents[1] / "tests" / "test_interop_fcl_grammar.py"
 #: points per file at most (a grid of k points per input, k**n <= POINTS, 3 <= k <= 21)
 POINTS = 300
 #: points per file without javac (a JVM per point)
@@ -44,6 +46,14 @@ KNOWN = {
         "zero-width terms at 0 (`TRIAN 0 0 0`, the peak of `TRIAN -0.4 0 0`): jFuzzyLogic "
         "steps x += step from -1 (RuleActivationMethod.imply), so its sample near 0 is "
         "8.7e-16, where those terms are 0; MITOS samples -1 + 500 step = 0 exactly",
+    # the grammar cases (grammar_cases)
+    "09_METHOD_COA.fcl": "jFuzzyLogic's COA walks in from both ends until they meet "
+        "(DefuzzifierCenterOfArea), which in a gap of zeros between two equal areas stops at "
+        "its left edge (3.99 where MITOS's bisector gives the middle, 4.995)",
+    "10_METHOD_LM.fcl": "one sample: on a plateau jFuzzyLogic's memberships at its accumulated "
+        "positions (x += step) differ in the last bits, and LM takes the first strict maximum",
+    "12_METHOD_MM.fcl": "jFuzzyLogic's MM averages the samples exactly equal to the maximum; "
+        "at its accumulated positions (x += step) some plateau samples differ in the last bits",
 }
 
 
@@ -211,7 +221,8 @@ def cause_of(name: str, diff: float, fidelity: float, notes: tuple[str, ...],
         return ""
     if fidelity <= tolerance:
         return "sampling (1000 midpoints; jFuzzyLogic: 1000 left ends): --fidelity closes it"
-    said = [n.split(": ", 1)[-1] for n in notes if re.search(r"ACCU|precedence|OR before", n)]
+    said = [n.split(": ", 1)[-1] for n in notes
+            if re.search(r"ACCU|OR` before|not as a pair|singleton under", n)]
     if said:
         return "MITOS warned: " + said[0][:160]
     return KNOWN.get(Path(name).name, "not explained")
@@ -299,6 +310,25 @@ def compare_outputs(name: str, rb, compiled: dict, grid: Grid, points: list[list
                       d, f, cause_of(name, d, f, rb.notes, tolerance))
 
 
+def grammar_cases(dest: Path) -> Path:
+    """The construct-by-construct files of ``tests/test_interop_fcl_grammar.py`` (its BASE and
+    each of its LOADS cases) written to ``dest``, the input's RANGE moved from FUZZIFY to its
+    declaration, where jFuzzyLogic's grammar has it (it does not load a RANGE in FUZZIFY)."""
+    tree = ast.parse(GRAMMAR_CASES.read_text(encoding="utf-8"))
+    wanted = [n for n in tree.body if isinstance(n, ast.Assign) and any(
+        isinstance(t, ast.Name) and t.id in ("BASE", "HIGH", "LOADS") for t in n.targets)]
+    space: dict = {}
+    exec(compile(ast.Module(wanted, []), str(GRAMMAR_CASES), "exec"), space)
+    base = space["BASE"].replace("    a : REAL;\n", "    a : REAL; RANGE := (0 .. 10);\n") \
+        .replace("FUZZIFY a\n    RANGE := (0 .. 10);\n", "FUZZIFY a\n")
+    dest.mkdir(parents=True, exist_ok=True)
+    (dest / "00_base.fcl").write_text(base)
+    for i, (old, new) in enumerate(space["LOADS"], 1):
+        name = re.sub(r"[^A-Za-z0-9]+", "_", new.strip()).strip("_")[:40]
+        (dest / f"{i:02d}_{name}.fcl").write_text(base.replace(old, new, 1))
+    return dest
+
+
 def part_jfuzzylogic(directory: Path, jar: Path, tmp: Path) -> dict:
     jfl = Jfl(jar, tmp)
     rows = [row for path in sorted(directory.rglob("*.fcl"))
@@ -306,10 +336,10 @@ def part_jfuzzylogic(directory: Path, jar: Path, tmp: Path) -> dict:
     return {"rows": rows, "exact": jfl.exact, "tolerance": jfl.tolerance}
 
 
-def report(part: dict) -> None:
+def report(part: dict, title: str) -> None:
     rows: list[Row] = part["rows"]
     files = sorted({r.file for r in rows})
-    print(f"\n## 5. jFuzzyLogic itself (--jfuzzylogic): {len(files)} files, "
+    print(f"\n## {title}: {len(files)} files, "
           + ("full precision (JflGrid)" if part["exact"] else "6 decimals (-e; no javac)"))
     print("| file | MITOS | jFuzzyLogic | output | max abs diff | with --fidelity jfuzzylogic "
           "| cause |")

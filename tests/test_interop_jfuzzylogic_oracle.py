@@ -220,3 +220,12 @@ def test_a_difference_names_its_cause(oracle):
                            ).startswith("MITOS warned: `y IS hi` is concluded")
     assert "8.7e-16" in oracle.cause_of("x/junit_shashankrao.fcl", 0.05, 0.05, ())
     assert oracle.cause_of("a.fcl", 0.5, 0.5, ()) == "not explained"
+
+
+def test_the_grammar_cases_are_written_as_jfuzzylogic_s_grammar_reads_them(oracle, tmp_path):
+    files = sorted(oracle.grammar_cases(tmp_path).glob("*.fcl"))
+    base = files[0].read_text()
+    assert files[0].name == "00_base.fcl" and len(files) > 30
+    assert "a : REAL; RANGE := (0 .. 10);" in base and "FUZZIFY a\n    TERM" in base
+    names = {f.name for f in files}
+    assert all(name in names for name in oracle.KNOWN if name[:2].isdigit())   # causes found
