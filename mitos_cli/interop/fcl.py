@@ -266,6 +266,7 @@ def _function_block(fb: Tree, span_of) -> RuleBase:
                                 renumber=len({r.label for r in all_rules}) < len(all_rules))
     _check_outputs(groups, locks, constants)
     _accumulation_note(groups, notes)
+    _no_accu_note(groups, notes)
     ordered = [variables[n] for n in declared]
     rb = common.assemble_blocks(span_of(fb).path, ordered, groups, DEFAULT_RESOLUTION,
                                 span_of(fb), notes, ranges)
@@ -367,6 +368,28 @@ def _both_note(block: Tree, record: common.Record, span_of, notes: list[str]) ->
                      f"given, not as a pair: MITOS uses each, as fuzzylite does; jFuzzyLogic "
                      f"sets both from each line, so its last, `{key} : {value}`, gives AND "
                      f"`{theirs[0]}` and OR `{theirs[1]}`: give one of them, or their pair")
+
+
+def _no_accu_note(groups: list[tuple[str, list[Rule], common.Settings]],
+                  notes: list[str]) -> None:
+    """Say where two rules conclude a Mamdani output and no ``ACCU`` is given: jFuzzyLogic
+    then sums their sets (its default, ``ACCU : SUM``, `RuleBlock.fclTree`), which MITOS does
+    not compute; MITOS takes their maximum, its default."""
+    for _, rules, settings in groups:
+        if settings.sugeno or settings.aggregation is not None:
+            continue
+        by_var: dict[str, list[tuple[Rule, Span | None]]] = {}
+        for r in rules:
+            for c in r.consequents:
+                by_var.setdefault(c.var, []).append((r, c.span))
+        shared = [(var, found) for var, found in by_var.items() if len(found) > 1]
+        if shared:
+            var, ((first, _), (second, span), *_) = shared[0]
+            notes.append(f"{span}: `{var}` is concluded by `{first.label}` and `{second.label}` "
+                         f"with no `ACCU`: MITOS takes the maximum of their sets (its default); "
+                         f"jFuzzyLogic sums them (its default, `ACCU : SUM`, which MITOS does not "
+                         f"compute), so outputs differ where two overlapping sets fire: write "
+                         f"`ACCU : MAX;` to say which")
 
 
 def _check_outputs(groups: list, locks: dict[str, Span],
