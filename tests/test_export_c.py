@@ -317,6 +317,30 @@ def test_exports_give_a_weighted_sums_default_where_no_rule_fires(tmp_path: Path
     assert "default (0, the empty sum, when it has none)" in to_python(c, "test")
 
 
+@pytest.mark.parametrize("operators", [
+    "accumulation = max", "accumulation = probabilistic_sum, inference = weighted_sum",
+    "accumulation = einstein_sum"])
+def test_exports_join_the_rules_of_one_value_as_eval_does(operators: str, tmp_path: Path) -> None:
+    """Under `accumulation = S` the exports weigh each value by `accumulate(...)` of the rules
+    concluding it (a linear function, two terms of one crisp value and a hedged consequent),
+    and join the linear function's value with another where they meet, as the engine does
+    (`lin` = 40 + 3 a - 20 b is 90 at the clamped corner a = 10, b = -1)."""
+    path = sugeno(tmp_path, "weighted_average")
+    (tmp_path / "s.terms.yaml").write_text((tmp_path / "s.terms.yaml").read_text().replace(
+        "hi: 90}", "hi: 90, top: 90}"))
+    path.write_text(path.read_text().replace("inference = weighted_average", operators)
+                    + "r4: if b is neg then y is lin\nr5: if a is high then y is very top\n"
+                      "r6: if b is zero then y is lo with 0.7\n")
+    c, X, want = reference(path)
+    assert c.accumulated is not None and len(c.accumulated[0].first) == 3   # lo, lin, 90
+    text = to_python(c, "test")
+    assert "w2 = accumulate(dof_2, hedge_very(dof_4)) + np.zeros(X.shape[0])" in text
+    assert "w2 = np.where(same, accumulate(w1, w2), w2)" in text   # lin meets 90 at a corner
+    agree(run_python(c, X, tmp_path), want)
+    if CC is not None:
+        agree(run_c(c, X, tmp_path), want)
+
+
 def test_c_file_is_self_contained(tmp_path: Path) -> None:
     text = to_c(load_rulebase(ROOT / "rulebases" / "mitos.rules").compiled, "robot")
     includes = [line for line in text.splitlines() if line.startswith("#include")]

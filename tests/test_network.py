@@ -115,6 +115,16 @@ def test_operators_command_lists_every_sampling(capsys):
     assert "  left       the left ends of `resolution` equal cells (jFuzzyLogic's)" in out
 
 
+def test_operators_command_lists_the_accumulations(capsys):
+    code, out, _ = run(capsys, "operators", "--json")
+    data = json.loads(out)["accumulation"]
+    assert [e["name"] for e in data] == ["sum", *norms.SNORMS]
+    assert [e["name"] for e in data if e["default"]] == ["sum"]
+    code, out, _ = run(capsys, "operators")
+    assert "operators: accumulation = NAME" in out
+    assert "  max                the rules of one value weigh max of their DOFs" in out
+
+
 def test_unknown_operator_in_a_rule_file(capsys, tmp_path):
     path = rules_file(tmp_path, "operators: aggregation = probabilistic_summ\n"
                                 "if road is WIDE then speed is MEDIUM\n")

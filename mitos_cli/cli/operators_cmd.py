@@ -61,6 +61,10 @@ def catalogue() -> dict[str, list[dict]]:
                               d.implication) for n in norms.TNORMS.values()],
         "defuzzify": [entry(k, v, d.defuzzify) for k, v in DEFUZZIFY.items()],
         "sampling": [entry(k, v, d.sampling) for k, v in SAMPLING.items()],
+        "accumulation": [entry("sum", "every rule counts: y = sum(dof y) / sum(dof)",
+                               d.accumulation)] + [
+            entry(n.name, f"the rules of one value weigh {n.name} of their DOFs",
+                  d.accumulation) for n in norms.SNORMS.values()],
         "hedges": [entry(h.name, h.formula, None) for h in HEDGES.values()],
     }
 
@@ -74,6 +78,7 @@ TITLES = {
     "defuzzify": "Mamdani defuzzifiers                     operators: defuzzify = NAME, "
                  "resolution = N (default {resolution})",
     "sampling": "Mamdani grid                             operators: sampling = NAME",
+    "accumulation": "rules of one value (weighted inference)  operators: accumulation = NAME",
     "hedges": "hedges (activations, eqs. 10-11)         `road is very WIDE`",
 }
 

@@ -226,11 +226,18 @@ MAMDANI_ONLY = ("implication", "aggregation", "defuzzify", "resolution", "sampli
 def _idle_settings(rb: RuleBase, name: str, compiled) -> list[Finding]:
     """Settings that the behavior's inference method ignores (``defuzzify = lom`` without
     ``inference = mamdani`` is almost certainly a mistake)."""
-    if compiled.operators.inference == "mamdani":
-        return []
+    inference = compiled.operators.inference
+    weighted = inference in ("weighted_average", "weighted_sum")
     out = []
     for setting in tuple(rb.operators) + tuple(rb.behavior(name).operators):
-        if setting.key in MAMDANI_ONLY:
+        if setting.key == "accumulation" and not weighted:
+            out.append(Finding(
+                "warning", "idle-setting",
+                f"`{setting.key} = {setting.value}` has no effect: behavior `{name}` uses "
+                f"{inference} inference", setting.span, name,
+                "accumulation joins the rules of one value under weighted_average or "
+                "weighted_sum inference; remove the setting"))
+        if setting.key in MAMDANI_ONLY and inference != "mamdani":
             out.append(Finding(
                 "warning", "idle-setting",
                 f"`{setting.key} = {setting.value}` has no effect: behavior `{name}` uses "
@@ -403,6 +410,10 @@ def _rule_pairs(rb: RuleBase, behavior: str, operators) -> list[Finding]:
 
 def _twice(operators) -> str:
     """What a rule written twice does to the outputs, under the behavior's inference."""
+    if operators.accumulated:
+        if operators.accumulation == "max":
+            return "it changes nothing (max accumulation keeps the stronger of the two)"
+        return f"its DOF is accumulated twice ({operators.accumulation})"
     if operators.inference != "mamdani":      # Tsukamoto's output is a weighted average too
         summed = operators.inference == "weighted_sum"
         return f"it counts twice in the weighted {'sum' if summed else 'average'}"

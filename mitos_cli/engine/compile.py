@@ -18,6 +18,7 @@ samples.
 from __future__ import annotations
 
 import functools
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -142,6 +143,23 @@ class CompiledRuleBase:
         return tuple(j for j in range(len(self.outputs))
                      if any(row[j] for row in self.cons_hedges))
 
+    @functools.cached_property
+    def accumulated(self) -> tuple[Accumulation, ...] | None:
+        """Per output, its rules grouped by the value they conclude, which the behavior's
+        ``accumulation`` S-norm joins before the average; None under the default ``sum``."""
+        if not self.operators.accumulated:
+            return None
+        return tuple(_accumulation(self, j) for j in range(len(self.outputs)))
+
+    @property
+    def joins(self) -> bool:
+        """Whether an ``accumulation`` S-norm may join two rules anywhere: two of one value,
+        or (at some inputs) two values of which one is linear; else it changes nothing
+        (``S(0, d) = d``)."""
+        return self.accumulated is not None and any(
+            a.steps or (self.cons_linear is not None and len(a.first) > 1)
+            for a in self.accumulated)
+
     @property
     def n_rules(self) -> int:
         return len(self.labels)
@@ -201,6 +219,36 @@ class CompiledRuleBase:
         from .mamdani import build_tables
 
         return build_tables(self)
+
+
+@dataclass(frozen=True, eq=False)
+class Accumulation:
+    """One output's rules grouped by the value they conclude (a crisp value, or one linear
+    function: jFuzzyLogic keys its singletons by value), groups in the order of their first
+    rule. The S-norm folds each group left to right in rule order, one step per depth: at step
+    ``k`` the groups ``steps[k][0]`` take in their ``k``-th rule ``steps[k][1]``."""
+
+    first: np.ndarray                              # [G] the first rule of each group
+    steps: tuple[tuple[np.ndarray, np.ndarray], ...]   # depth 1, 2, ...: (groups, rules)
+
+
+def _accumulation(c: CompiledRuleBase, j: int) -> Accumulation:
+    """Output ``j``'s :class:`Accumulation`: a linear consequent's key is its coefficients
+    and constant, a crisp one's its value (a linear one of zero coefficients is that value)."""
+    groups: dict[tuple[float, ...], list[int]] = {}
+    for r in np.flatnonzero(c.cons_mask[:, j]):
+        value = float(c.cons_value[r, j])
+        key: tuple[float, ...] = (value, math.copysign(1.0, value))   # 0.0 and -0.0: two
+        if c.cons_linear is not None:
+            row = tuple(c.cons_linear[r, j].tolist())
+            key = row if any(row[:-1]) else (row[-1], math.copysign(1.0, row[-1]))
+        groups.setdefault(key, []).append(int(r))
+    members = list(groups.values())
+    depth = max((len(g) for g in members), default=0)
+    steps = tuple((np.array([g for g, m in enumerate(members) if len(m) > k], dtype=np.intp),
+                   np.array([m[k] for m in members if len(m) > k], dtype=np.intp))
+                  for k in range(1, depth))
+    return Accumulation(np.array([m[0] for m in members], dtype=np.intp), steps)
 
 
 @dataclass(frozen=True, eq=False)
@@ -302,7 +350,7 @@ class GridBatch:
 def _grid_batch(c: CompiledRuleBase, grids: dict, rules, weight, sum_rows) -> GridBatch | None:
     """The :class:`GridBatch` of ``c``, or None when its rules are not exactly one grid."""
     if (c.operators.inference not in ("weighted_average", "weighted_sum")
-            or c.cons_linear is not None or c.hedged_outputs or c.shape_groups
+            or c.operators.accumulated or c.cons_linear is not None or c.hedged_outputs or c.shape_groups
             or c.context.shape[1] or len(c.levels) != 1
             or len(c.levels[0]) != 1 or (0, 0) not in grids):
         return None

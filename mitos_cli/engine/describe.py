@@ -92,13 +92,17 @@ def describe_network(compiled: CompiledRuleBase) -> str:
                 f"{plural(len(table_j.labels), 'consequent set')} ({', '.join(table_j.labels)})")
     else:
         kind = "Takagi-Sugeno, " if c.cons_linear is not None else ""
+        joined = (f"; the rules of one value first joined by {ops.accumulation} "
+                  f"(accumulation)" if ops.accumulated else "")
         row(f"layer {len(c.levels) + 2}", len(c.outputs),
-            "output neurons, " + kind + INFERENCE_TEXT[ops.inference])
+            "output neurons, " + kind + INFERENCE_TEXT[ops.inference] + joined)
         for j, name in enumerate(c.outputs):
             n = int(c.cons_mask[:, j].sum())
             linear = 0 if c.cons_linear is None else int(
                 (c.cons_linear[:, j, :-1] != 0).any(axis=1).sum())
             what = f"  {name}: {plural(n, 'rule')}"
+            if c.accumulated is not None:
+                what += f" of {plural(len(c.accumulated[j].first), 'value')}"
             if linear:
                 what += f", {linear} with linear consequents y = a . x + c"
             default = c.default[j]

@@ -352,9 +352,11 @@ def weighted_average(compiled: CompiledRuleBase, dof: np.ndarray,
     """
     plan = compiled.plan
     m = len(compiled.outputs)
-    if compiled.cons_linear is not None:
-        if Xt is None:
-            raise ValueError("linear consequents need the inputs: weighted_average(compiled, dof, Xt)")
+    if compiled.cons_linear is not None and Xt is None:
+        raise ValueError("linear consequents need the inputs: weighted_average(compiled, dof, Xt)")
+    if compiled.accumulated is not None:
+        return _accumulated_average(compiled, dof, Xt)
+    if compiled.cons_linear is not None and Xt is not None:
         W = np.multiply(dof[:, None], plan.sums)     # [R, k, b]: numerators, denominators
         np.multiply(dof[:, None], linear_consequents(compiled, Xt).transpose(1, 0, 2),
                     out=W[:, :m])
@@ -384,11 +386,7 @@ def _hedged_average(compiled: CompiledRuleBase, dof: np.ndarray, Xt: np.ndarray 
     Y = linear_consequents(compiled, Xt) if compiled.cons_linear is not None and Xt is not None \
         else None
     for j in compiled.hedged_outputs:
-        D = dof * compiled.cons_mask[:, j, None]
-        column = [compiled.cons_hedges[r][j] for r in range(compiled.n_rules)]
-        for hedges in dict.fromkeys(h for h in column if h):
-            rows = np.array([h == hedges for h in column])
-            D[rows] = hedge_mod.weigh(hedges, dof[rows])
+        D = _rule_weights(compiled, dof, j)
         y = Y[j] if Y is not None else compiled.cons_value[:, j, None]
         dens[j] = tree_sum(D.copy())
         nums[j] = tree_sum(np.multiply(D, y))
@@ -396,6 +394,69 @@ def _hedged_average(compiled: CompiledRuleBase, dof: np.ndarray, Xt: np.ndarray 
         return _unset_sums(compiled, nums, dens)
     fired = dens > 0
     return np.divide(nums, dens, out=np.full(nums.shape, np.nan), where=fired)
+
+
+def _rule_weights(compiled: CompiledRuleBase, dof: np.ndarray, j: int) -> np.ndarray:
+    """``[R, b]``: each rule's weight in output ``j``: its DOF where it sets ``j`` (0 where it
+    does not), hedged where its consequent is (a loop over the output's few distinct hedges)."""
+    D = dof * compiled.cons_mask[:, j, None]
+    if j in compiled.hedged_outputs:
+        column = [compiled.cons_hedges[r][j] for r in range(compiled.n_rules)]
+        for hedges in dict.fromkeys(h for h in column if h):
+            rows = np.array([h == hedges for h in column])
+            D[rows] = hedge_mod.weigh(hedges, dof[rows])
+    return D
+
+
+def _accumulated_average(compiled: CompiledRuleBase, dof: np.ndarray,
+                         Xt: np.ndarray | None) -> np.ndarray:
+    """Weighted inference under ``accumulation = S``: the rules concluding one value of an
+    output are joined by the S-norm into one weight (jFuzzyLogic's ``ACCU`` at a singleton),
+    then ``sum(w_g y_g) / sum(w_g)`` over the values. The fold runs per depth of the groups
+    (a loop over the most rules one value has, never over rules or samples) in rule order,
+    and the sums are :func:`tree_sum` over the groups: a sample's bits do not depend on the
+    batch."""
+    snorm = norms.lookup("snorm", compiled.operators.accumulation)
+    m, b = len(compiled.outputs), dof.shape[1]
+    nums, dens = np.zeros((m, b)), np.zeros((m, b))
+    Y = linear_consequents(compiled, Xt) if compiled.cons_linear is not None and Xt is not None \
+        else None
+    assert compiled.accumulated is not None
+    for j, acc in enumerate(compiled.accumulated):
+        if not len(acc.first):
+            continue
+        D = _rule_weights(compiled, dof, j)
+        W = D[acc.first]                                   # [G, b], a copy
+        for groups, rules in acc.steps:
+            W[groups] = snorm(W[groups], D[rules])
+        y = Y[j][acc.first] if Y is not None else compiled.cons_value[acc.first, j, None]
+        if Y is not None and len(acc.first) > 1:
+            W, y = _join_equal_values(W, y, snorm)
+        nums[j] = tree_sum(np.multiply(W, y))
+        dens[j] = tree_sum(W.copy())
+    if compiled.operators.inference == "weighted_sum":
+        return _unset_sums(compiled, nums, dens)
+    fired = dens > 0
+    return np.divide(nums, dens, out=np.full(nums.shape, np.nan), where=fired)
+
+
+def _join_equal_values(W: np.ndarray, y: np.ndarray,
+                       snorm: norms.Norm) -> tuple[np.ndarray, np.ndarray]:
+    """Groups of different linear functions whose values are equal at a sample (``[G, b]``
+    weights and values) joined there too, as jFuzzyLogic keys its table by the value (a
+    ``Double``: ``0.0`` and ``-0.0`` are two keys). Each sample's values are sorted, stably,
+    and a run of equal ones is folded into its last row (a loop over the few groups of an
+    output, never over samples): the order depends on the sample alone."""
+    order = np.argsort(y, axis=0, kind="stable")
+    ys = np.take_along_axis(y, order, axis=0)
+    ws = np.take_along_axis(W, order, axis=0)
+    sign = np.signbit(ys)
+    for k in range(1, len(ys)):
+        same = (ys[k] == ys[k - 1]) & (sign[k] == sign[k - 1])
+        if same.any():
+            ws[k] = np.where(same, snorm(ws[k - 1], ws[k]), ws[k])
+            ws[k - 1] = np.where(same, 0.0, ws[k - 1])
+    return ws, ys
 
 
 def _unset_sums(compiled: CompiledRuleBase, nums: np.ndarray, dens: np.ndarray) -> np.ndarray:

@@ -9,9 +9,9 @@ them, with exactly the engine's operations in exactly its order. IEEE 754 makes 
 function returns the same bits as the sample's row in a batch (property-tested).
 
 Operations outside that set (the non-linear membership shapes, which call ``exp`` and ``pow``,
-whose NumPy implementations may differ from the C library's in the last bit) and Mamdani
-inference have no scalar form: :func:`scalar_function` returns ``None`` and the engine keeps
-its NumPy path for them.
+whose NumPy implementations may differ from the C library's in the last bit), Mamdani
+inference, hedged consequents and an ``accumulation`` S-norm have no scalar form:
+:func:`scalar_function` returns ``None`` and the engine keeps its NumPy path for them.
 """
 
 from __future__ import annotations
@@ -60,7 +60,8 @@ def scalar_function(c: CompiledRuleBase) -> ScalarFn | None:
 def _source(c: CompiledRuleBase) -> str:
     ops = c.operators
     if (c.shape_groups or ops.inference in ("mamdani", "tsukamoto") or c.n_columns > MAX_COLUMNS
-            or c.hedged_outputs or ops.and_ not in NORMS or ops.or_ not in NORMS):
+            or c.hedged_outputs or ops.accumulated or ops.and_ not in NORMS
+            or ops.or_ not in NORMS):
         raise _Unsupported
     plan = c.plan
     k = len(c.inputs)

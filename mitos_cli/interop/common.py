@@ -1012,3 +1012,28 @@ def _engines_defuzzifier(method: str, engine: str) -> tuple[Setting, ...]:
     if plain not in ("bisector", "som", "lom"):
         return ()
     return (Setting("defuzzify", f"matlab_{plain}" if engine == "matlab" else plain),)
+
+
+def refuse_accumulation(rb: RuleBase, behavior: str | None, flat: Flat, fmt: str) -> None:
+    """Refuse to write a behavior whose ``accumulation`` S-norm joins several rules of one
+    value to a format that cannot say so (fuzzylite and MATLAB average every rule); where
+    each value is concluded once, the S-norm changes nothing and the file is written."""
+    if not flat.operators.accumulated:
+        return
+    seen: dict[tuple, str] = {}
+    outputs = {v.name: v for v in flat.outputs}
+    for r in flat.rules:
+        for c in r.consequents:
+            term = outputs[c.var].term(c.term) if c.term is not None else None
+            key = (c.var, term.params if term is not None and term.shape == "linear"
+                   else term.center if term is not None else c.value)
+            if key in seen:
+                value = (f"the linear function of `{c.term}`" if isinstance(key[1], tuple)
+                         else fmt_number(float(key[1] or 0.0)))
+                raise FormatError(
+                    f"{fmt} has no accumulation of the rules that conclude one value: "
+                    f"`{seen[key]}` and `{r.label}` both set `{c.var}` to {value}, which "
+                    f"`accumulation = {flat.operators.accumulation}` joins",
+                    span=setting_span(rb, behavior, "accumulation"),
+                    hint="write it to FCL (ACCU) or a rule file, or merge the rules")
+            seen[key] = r.label

@@ -445,6 +445,7 @@ def write_fis(rb: RuleBase, behavior: str | None = None) -> str:
     """``.fis`` text for one behavior of ``rb``. Rules must be flat: propositions (possibly
     negated, without hedges) joined all by AND or all by OR, as MATLAB's rule list is."""
     flat = common.flatten_for_export(rb, behavior)
+    common.refuse_accumulation(rb, behavior, flat, "MATLAB's .fis")
     ops = flat.operators
     at = partial(common.setting_span, rb, behavior)       # where an operator was chosen
     if ops.inference == "tsukamoto":

@@ -419,6 +419,7 @@ def _check_grouping(variables: list[_Var], rules: list[Rule], settings: Settings
 def write_fll(rb: RuleBase, behavior: str | None = None) -> str:
     """FLL text for one behavior of ``rb`` (reading it back gives the same outputs)."""
     flat = common.flatten_for_export(rb, behavior)
+    common.refuse_accumulation(rb, behavior, flat, "FLL")
     ops = flat.operators
     at = functools.partial(common.setting_span, rb, behavior)       # where an operator was chosen
     tsukamoto = ops.inference == "tsukamoto"

@@ -23,6 +23,10 @@ DEFUZZIFIERS = ("centroid", "bisector", "mom", "som", "lom",
 #: ``resolution`` evenly spaced points including both ends (MATLAB's ``evalfis``), or the
 #: cells' left ends (jFuzzyLogic's ``min + i (max - min) / resolution``).
 SAMPLINGS = ("midpoints", "endpoints", "left")
+#: How weighted inference joins the rules that conclude one value of an output: ``sum`` counts
+#: each rule in the average (fuzzylite 6, MATLAB); an S-norm first joins their DOFs into one
+#: weight for that value (jFuzzyLogic's ``ACCU`` under ``METHOD : COGS``).
+ACCUMULATIONS = ("sum",)
 #: The least and the most points a Mamdani output is sampled on.
 RESOLUTION = (3, 100_000)
 
@@ -39,6 +43,7 @@ class Operators:
     defuzzify: str = "centroid"
     resolution: int = 101
     sampling: str = "midpoints"
+    accumulation: str = "sum"
 
     @property
     def tnorm(self) -> norms.Norm:
@@ -55,7 +60,15 @@ class Operators:
                      f"defuzzify = {self.defuzzify}, resolution = {self.resolution}")
             if self.sampling != "midpoints":
                 text += f", sampling = {self.sampling}"
+        elif self.accumulated:
+            text += f", accumulation = {self.accumulation}"
         return text
+
+    @property
+    def accumulated(self) -> bool:
+        """Weighted inference that joins the rules concluding one value with an S-norm."""
+        return (self.accumulation != "sum"
+                and self.inference in ("weighted_average", "weighted_sum"))
 
     def settings(self) -> dict[str, str]:
         """The non-default settings as ``operators:`` keys (for writing a rule file back)."""
@@ -70,7 +83,7 @@ class Operators:
 
 KEYS = {"and": "and_", "or": "or_", "inference": "inference", "implication": "implication",
         "aggregation": "aggregation", "defuzzify": "defuzzify", "resolution": "resolution",
-        "sampling": "sampling"}
+        "sampling": "sampling", "accumulation": "accumulation"}
 
 
 def _check(key: str, value: str, span: Span | None) -> str | int:
@@ -80,16 +93,19 @@ def _check(key: str, value: str, span: Span | None) -> str | int:
         except KeyError:
             what = "T-norm" if key == "and" else "implication"
             raise unknown(what, value, norms.names("tnorm"), span=span) from None
-    if key in ("or", "aggregation"):
+    if key == "accumulation" and value in ACCUMULATIONS:
+        return value
+    if key in ("or", "aggregation", "accumulation"):
         try:
             return norms.lookup("snorm", value).name
         except KeyError:
-            raise unknown("S-norm", value, norms.names("snorm"), span=span) from None
-    choices = {"inference": INFERENCES, "defuzzify": DEFUZZIFIERS,
-               "sampling": SAMPLINGS}.get(key)
-    if choices is not None:
-        if value not in choices:
-            raise unknown(key, value, choices, span=span)
+            choices = norms.names("snorm") + (list(ACCUMULATIONS) if key == "accumulation" else [])
+            raise unknown("S-norm", value, choices, span=span) from None
+    among = {"inference": INFERENCES, "defuzzify": DEFUZZIFIERS,
+             "sampling": SAMPLINGS}.get(key)
+    if among is not None:
+        if value not in among:
+            raise unknown(key, value, among, span=span)
         return value
     # resolution
     try:

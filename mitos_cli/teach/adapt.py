@@ -321,6 +321,12 @@ def _supported(compiled: CompiledRuleBase) -> None:
     if compiled.operators.inference == "tsukamoto" or compiled.hedged_outputs:
         raise LessonError("adaptation does not cover Tsukamoto inference or hedged "
                           "weighted-average consequents (no gradient is derived for them)")
+    if compiled.operators.accumulated:
+        raise LessonError(f"adaptation does not cover `accumulation = "
+                          f"{compiled.operators.accumulation}` (the S-norm joining the rules "
+                          f"of one value has no gradient derived for it)",
+                          hint="adapt a copy without the setting (the default `sum` counts "
+                               "every rule), or merge the rules that conclude one value")
     if compiled.operators.inference == "mamdani":
         return                                       # differences need no derivatives
     for op, names in SUPPORTED_NORMS.items():

@@ -195,6 +195,9 @@ def _c_helpers(p: Program) -> list[str]:
         if f"{kind}norm" in p.norms:
             out += [f"static double {kind}norm(double a, double b) {{", f"    {C_NORMS[name]}",
                     "}", ""]
+    if p.compiled.joins:
+        out += ["static double accumulate(double a, double b) {",
+                f"    {C_NORMS[ops.accumulation]}", "}", ""]
     if ops.inference == "mamdani":
         out += ["static double aggregate(double a, double b) {",
                 f"    {C_NORMS[ops.aggregation]}", "}", ""]
@@ -262,10 +265,11 @@ def _c_outputs(c: CompiledRuleBase, P: str) -> list[str]:
     if ops.inference == "mamdani":
         return _c_mamdani(c, P)
     for j, name in enumerate(c.outputs):
-        numerator, denominator = weighted_sums(c, j)
+        statements, numerator, denominator = weighted_sums(c, j, "c")
         default = c.default[j]
         fallback = "NAN" if np.isnan(default) else num(default)
         out.append(f"    {{   /* {comment(name)} */")
+        out += [f"        {line}" for line in statements]
         out.append(f"        double num = {numerator};")
         if ops.inference == "weighted_sum" and j not in c.summed_defaults:
             out.append(f"        out[{j}] = num;")     # no rule firing: the empty sum, 0

@@ -142,10 +142,48 @@ def program(compiled: CompiledRuleBase) -> Program:
                    tuple(sorted(hedges)), tuple(sorted(used)))
 
 
-def weighted_sums(c: CompiledRuleBase, j: int) -> tuple[str, str]:
+def weighted_sums(c: CompiledRuleBase, j: int, lang: str = "c") -> tuple[list[str], str, str]:
     """Output ``j``'s weighted sums as expressions over ``dof_<r>`` and ``x[i]``, the same
     text in C and in Python: ``sum(dof * y)`` (``y`` crisp or linear) and ``sum(dof)``, each
-    ``dof`` hedged where the consequent is."""
+    ``dof`` hedged where the consequent is; under an ``accumulation`` S-norm one term per
+    value, its weight ``accumulate(...)`` of the rules concluding it, in rule order. First,
+    the statements (in ``lang``, ``c`` or ``python``) that join the values of different
+    linear functions where they meet, as the engine does (:func:`_meeting_values`)."""
+    terms = _weighted_terms(c, j)
+    statements: list[str] = []
+    if c.accumulated is not None and c.cons_linear is not None and len(terms) > 1:
+        statements, terms = _meeting_values(terms, lang)
+    numerator = " + ".join(f"{d} * {v}" for d, v in terms) or "0.0"
+    denominator = " + ".join(d for d, _ in terms) or "0.0"
+    return statements, numerator, denominator
+
+
+def _meeting_values(terms: list[tuple[str, str]], lang: str) -> tuple[list[str], list]:
+    """Each value's weight and value as a variable, then, for every pair ``h < g`` in order,
+    ``g`` takes in ``h``'s weight where their values are equal (the same sign of zero too),
+    which is the engine's fold of a run of equal values into its last member
+    (``evaluation._join_equal_values``; ``accumulate(0, w)`` is ``w``)."""
+    out = []
+    for g, (w, v) in enumerate(terms):
+        if lang == "c":
+            out += [f"double w{g} = {w};", f"double v{g} = {v};"]
+        else:
+            out += [f"w{g} = {w} + np.zeros(X.shape[0])", f"v{g} = {v} + np.zeros(X.shape[0])"]
+    for g in range(1, len(terms)):
+        for h in range(g):
+            if lang == "c":
+                out.append(f"if (v{h} == v{g} && !signbit(v{h}) == !signbit(v{g})) "
+                           f"{{ w{g} = accumulate(w{h}, w{g}); w{h} = 0.0; }}")
+            else:
+                out += [f"same = (v{h} == v{g}) & (np.signbit(v{h}) == np.signbit(v{g}))",
+                        f"w{g} = np.where(same, accumulate(w{h}, w{g}), w{g})",
+                        f"w{h} = np.where(same, 0.0, w{h})"]
+    return out, [(f"w{g}", f"v{g}") for g in range(len(terms))]
+
+
+def _weighted_terms(c: CompiledRuleBase, j: int) -> list[tuple[str, str]]:
+    """``(weight, value)`` expressions of output ``j``: per rule, or per value under an
+    ``accumulation`` S-norm."""
     terms = []
     for r in np.flatnonzero(c.cons_mask[:, j]):
         value = num(c.cons_value[r, j])
@@ -161,6 +199,17 @@ def weighted_sums(c: CompiledRuleBase, j: int) -> tuple[str, str]:
             if "any" in c.cons_hedges[r][j]:  # 1 at a DOF of 0: only a rule that fires counts
                 dof = f"(dof_{r} > 0.0) * {dof}"
         terms.append((dof, value))
-    numerator = " + ".join(f"{d} * {v}" for d, v in terms) or "0.0"
-    denominator = " + ".join(d for d, _ in terms) or "0.0"
-    return numerator, denominator
+    if c.accumulated is not None:             # one weight per value: the S-norm of its rules
+        terms = _accumulated(c.accumulated[j], terms, np.flatnonzero(c.cons_mask[:, j]))
+    return terms
+
+
+def _accumulated(acc, terms: list[tuple[str, str]], rules) -> list[tuple[str, str]]:
+    """``terms`` (per rule setting the output, in ``rules`` order) joined per group of
+    :class:`~mitos_cli.engine.compile.Accumulation`: ``accumulate(accumulate(d1, d2), d3)``."""
+    at = {int(r): i for i, r in enumerate(rules)}
+    weights = {int(g): terms[at[int(r)]][0] for g, r in enumerate(acc.first)}
+    for groups, members in acc.steps:
+        for g, r in zip(groups.tolist(), members.tolist()):
+            weights[g] = f"accumulate({weights[g]}, {terms[at[r]][0]})"
+    return [(weights[g], terms[at[int(r)]][1]) for g, r in enumerate(acc.first)]

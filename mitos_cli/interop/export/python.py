@@ -132,6 +132,8 @@ def to_python(compiled: CompiledRuleBase, source: str = "") -> str:
     out += _py_shapes(p.shapes)
     out += ["def tnorm(a, b):", f"    return {PY_NORMS[ops.and_]}", "", "",
             "def snorm(a, b):", f"    return {PY_NORMS[ops.or_]}", "", ""]
+    if compiled.joins:
+        out += ["def accumulate(a, b):", f"    return {PY_NORMS[ops.accumulation]}", "", ""]
     for h in p.hedges:
         out += [f"def hedge_{h}(x):", "    with np.errstate(invalid='ignore'):",
                 f"        return {PY_HEDGES[h]}", "", ""]
@@ -240,7 +242,8 @@ def _py_outputs(c: CompiledRuleBase) -> list[str]:
             out.append(f"        Y[:, {j}] = value")
     else:
         for j in range(len(c.outputs)):
-            numerator, denominator = weighted_sums(c, j)
+            statements, numerator, denominator = weighted_sums(c, j, "python")
+            out += [f"    {line}" for line in statements]
             out.append(f"    num = {numerator} + np.zeros(X.shape[0])")
             if ops.inference == "weighted_sum" and j not in c.summed_defaults:
                 out.append(f"    Y[:, {j}] = num")          # no rule firing: the empty sum, 0
