@@ -16,6 +16,7 @@ from mitos_cli.engine.evaluation import evaluate, evaluate_one
 from mitos_cli.errors import LessonError, MitosError
 from mitos_cli.fuzzy.norms import SNORMS
 from mitos_cli.interop import write_foreign
+from mitos_cli.interop.fcl import parse_fcl
 from mitos_cli.lang.model import Behavior, Consequent, Prop, Rule, RuleBase, Setting
 from mitos_cli.lang.parse import parse_rules
 from mitos_cli.lang.resolve import build_rulebase
@@ -157,6 +158,18 @@ def test_adaptation_refuses_it():
 def _rulebase(operators: str, rules: str = RULES) -> RuleBase:
     termset = parse_termset(TERMS, "a.terms.yaml")
     return build_rulebase(parse_rules(rules.format(operators=operators), "a.rules"), (termset,))
+
+
+@pytest.mark.parametrize("dialect", ["iec", "fuzzylite"])
+def test_fcl_writes_it_as_accu_and_reads_back_the_same_bits(dialect: str):
+    rb = _rulebase("accumulation = probabilistic_sum")
+    text = write_foreign(rb, "fcl", dialect=dialect)
+    assert "METHOD : COGS;" in text and text.count("ACCU : ASUM;") == 1
+    back = parse_fcl(text, "back.fcl")
+    X = np.linspace(-1, 11, 97)[:, None]
+    before = evaluate(compile_rulebase(rb), X, detail=False).outputs
+    after = evaluate(compile_rulebase(back), X, detail=False).outputs
+    assert np.array_equal(bits(after), bits(before))
 
 
 @pytest.mark.parametrize("fmt, name", [("fll", "FLL"), ("fis", "MATLAB's .fis")])

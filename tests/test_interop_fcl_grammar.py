@@ -186,29 +186,36 @@ SINGLETONS = BASE.replace("TERM lo := (0, 0) (2, 1) (4, 0);", "TERM lo := 2;").r
     "TERM hi := (6, 0) (8, 1) (10, 0);", "TERM hi := 8;").replace("METHOD : COG;", "METHOD : COGS;")
 
 
-@pytest.mark.parametrize("accu, third, warned", [
-    ("ACCU : MAX;", "RULE 3 : IF b IS high THEN y IS hi;", True),
-    ("ACCU : PROBOR;", "RULE 3 : IF b IS high THEN y IS hi;", True),
-    ("", "RULE 3 : IF b IS high THEN y IS hi;", False),         # jFuzzyLogic's default: SUM
-    ("ACCU : MAX;", "", False),                             # each term concluded once
+def _memberships(a: float, b: float) -> tuple[float, float, float, float]:
+    """The BASE file's input terms by hand: a low, a high, b low, b high."""
+    return (max(0.0, (5 - a) / 5), a / 10, min(1.0, max(0.0, (6 - b) / 4)),
+            max(0.0, (b - 4) / 6))
+
+
+THIRD = "    RULE 3 : IF b IS high THEN y IS hi;\nEND_RULEBLOCK"
+
+
+@pytest.mark.parametrize("accu, join", [
+    ("ACCU : MAX;", max),
+    ("ACCU : PROBOR;", lambda p, q: p + q - p * q),
+    ("", lambda p, q: p + q),                     # jFuzzyLogic's default without ACCU: SUM
 ])
-def test_several_rules_of_one_singleton_under_accu_are_said_to_be_summed(accu, third, warned):
-    """jFuzzyLogic joins the rules that conclude one singleton with the ACCU norm before COGS
-    (IEC 61131-7 too); MITOS, as fuzzylite 6, sums them: the outputs differ where two fire,
-    and that was silent. (Without ACCU jFuzzyLogic sums, as MITOS does.)"""
-    text = SINGLETONS.replace("ACCU : MAX;", accu).replace(
-        "END_RULEBLOCK", f"    {third}\nEND_RULEBLOCK")
+def test_cogs_under_accu_joins_the_rules_of_one_singleton_as_jfuzzylogic(accu, join):
+    """jFuzzyLogic adds each rule's degree into its COGS defuzzifier's point at the singleton's
+    value with the ACCU norm, then averages the points; MITOS summed every rule (fuzzylite 6)
+    and only warned. COGS + ACCU now reads as `accumulation = ACCU`: the numbers by hand."""
+    text = SINGLETONS.replace("ACCU : MAX;", accu).replace("END_RULEBLOCK", THIRD)
     rb = parse_fcl(text, "s.fcl")
-    notes = [n for n in rb.notes if "concluded by" in n]
-    if not warned:
-        assert notes == []
-        return
-    name = {"ACCU : MAX;": "max", "ACCU : PROBOR;": "probabilistic_sum"}[accu]
-    assert notes == [f"s.fcl:35:32: `y IS hi` is concluded by `r2` and `r3` under the "
-                     f"accumulation `{name}` (`ACCU`): MITOS sums their weights, as fuzzylite 6 "
-                     "does; jFuzzyLogic and IEC 61131-7 first join them at the singleton with the "
-                     "ACCU norm, so outputs differ where two of them fire"]
-    assert text.splitlines()[34][31:].startswith("y IS hi")       # the third rule's consequent
+    assert not [n for n in rb.notes if "concluded by" in n]
+    c = compile_rulebase(rb)
+    assert c.operators.accumulation == {"ACCU : MAX;": "max", "ACCU : PROBOR;":
+                                        "probabilistic_sum", "": "sum"}[accu]
+    for a, b in [(3.0, 5.0), (1.0, 9.0), (8.0, 4.5), (2.5, 0.0)]:
+        a_low, a_high, b_low, b_high = _memberships(a, b)
+        w2, w8 = min(a_low, b_low), join(max(a_high, b_high), b_high)
+        want = (2 * w2 + 8 * w8) / (w2 + w8)
+        got = evaluate(c, np.array([[a, b]]), detail=False).outputs[0, 0]
+        assert got == pytest.approx(want, rel=1e-14), (a, b)
 
 
 def test_a_function_of_an_output_is_refused_as_a_consequent_not_a_membership():

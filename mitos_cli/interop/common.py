@@ -356,6 +356,8 @@ class Settings:
     defuzzify: str | None = None        # a DEFUZZIFIERS key
     resolution: int | None = None
     sampling: str | None = None         # "endpoints" for MATLAB, else MITOS's midpoints
+    #: weighted inference's S-norm over the rules of one value (FCL's ACCU under COGS)
+    accumulation: str | None = None
     spans: dict | None = None
 
     def set(self, key: str, value: str | int, span: Span | None, what: str) -> None:
@@ -380,6 +382,9 @@ class Settings:
         defuzz = self.defuzzify or "centroid"
         if defuzz in ("weighted_average", "weighted_sum", "tsukamoto"):
             out.append(Setting("inference", defuzz, spans.get("defuzzify")))
+            if self.accumulation and defuzz != "tsukamoto":
+                out.append(Setting("accumulation", self.accumulation,
+                                   spans.get("aggregation")))
         else:
             out.append(Setting("inference", "mamdani"))
             out.append(Setting("implication", self.implication or "min",

@@ -267,6 +267,7 @@ def _function_block(fb: Tree, span_of) -> RuleBase:
     _check_outputs(groups, locks, constants)
     _accumulation_note(groups, notes)
     _no_accu_note(groups, notes)
+    _accumulation(groups)
     ordered = [variables[n] for n in declared]
     rb = common.assemble_blocks(span_of(fb).path, ordered, groups, DEFAULT_RESOLUTION,
                                 span_of(fb), notes, ranges)
@@ -720,32 +721,14 @@ def _norm(table: dict, value: str, what: str, span: Span) -> str:
         raise
 
 
-def _accumulation_note(groups: list[tuple[str, list[Rule], common.Settings]],
-                       notes: list[str]) -> None:
-    """Say where several rules conclude one term of a weighted (COGS) output under an ``ACCU``:
-    MITOS sums their weights, as fuzzylite 6 does; jFuzzyLogic (and IEC 61131-7) first joins
-    them with the ACCU norm at the singleton (`RuleActivationMethod.imply`), fuzzylite 8 per
-    term: the outputs differ wherever two of them fire at once. The FLL reader refuses this
-    (fuzzylite 8 is FLL's reference); an FCL file does not say which engine wrote it."""
-    for _, rules, settings in groups:
-        if not settings.sugeno or settings.aggregation is None:
-            continue
-        by_term: dict[tuple[str, str | None], list[Rule]] = {}
-        for r in rules:
-            for c in r.consequents:
-                by_term.setdefault((c.var, c.term), []).append(r)
-        shared = [(key, rs) for key, rs in by_term.items() if len(rs) > 1]
-        if not shared:
-            continue
-        (var, term), (first, second, *_) = shared[0]
-        span = next(c.span for c in second.consequents if (c.var, c.term) == (var, term))
-        more = f" ({plural(len(shared), 'term')} in all)" if len(shared) > 1 else ""
-        notes.append(
-            f"{span}: `{var} IS {term}` is concluded by `{first.label}` and `{second.label}`"
-            f"{more} under the accumulation `{settings.aggregation}` (`ACCU`): MITOS sums their "
-            f"weights, "
-            f"as fuzzylite 6 does; jFuzzyLogic and IEC 61131-7 first join them at the singleton "
-            f"with the ACCU norm, so outputs differ where two of them fire")
+def _accumulation(groups: list[tuple[str, list[Rule], common.Settings]]) -> None:
+    """``ACCU`` under ``METHOD : COGS`` (or COGSS, COGF) is the behavior's ``accumulation``:
+    jFuzzyLogic (and IEC 61131-7) join the rules that conclude one singleton value with the
+    ACCU norm (`RuleActivationMethod.imply` at the defuzzifier's point of that value) before
+    the weighted average; without ACCU it sums them, which is MITOS's default."""
+    for _, _, settings in groups:
+        if settings.defuzzify in ("weighted_average", "weighted_sum") and settings.aggregation:
+            settings.accumulation = settings.aggregation
 
 
 def _grouping_note(rule_items: list[Tree], span_of, notes: list[str]) -> None:
@@ -827,6 +810,9 @@ def write_fcl(rb: RuleBase, behavior: str | None = None, dialect: str = DEFAULT_
     inputs = common.all_inputs(rb, flat)
     accu = None if sugeno else common.foreign_name(
         common.SNORMS, FCL, ops.aggregation, "S-norm", span=at("aggregation"))
+    if ops.accumulated:                 # ACCU under COGS: jFuzzyLogic's join at a singleton
+        accu = common.foreign_name(common.SNORMS, FCL, ops.accumulation, "S-norm",
+                                   span=at("accumulation"))
     out = [f"// {DIALECTS[dialect]}; written by MITOS", "", f"FUNCTION_BLOCK {flat.name}", "",
            "VAR_INPUT"]
     # jFuzzyLogic's grammar has an input's RANGE after its declaration (`var_def`), not in
@@ -851,8 +837,8 @@ def write_fcl(rb: RuleBase, behavior: str | None = None, dialect: str = DEFAULT_
         act = common.foreign_name(common.TNORMS, FCL, ops.implication, "T-norm",
                                   span=at("implication"))
         out.append(f"    ACT : {act};")
-        if dialect == "iec":
-            out.append(f"    ACCU : {accu};")
+    if accu is not None and dialect == "iec":
+        out.append(f"    ACCU : {accu};")
     for i, r in enumerate(flat.rules, 1):
         out.append(f"    RULE {i} : {_rule_text(r, dialect, ops)};")
     out += ["END_RULEBLOCK", "", "END_FUNCTION_BLOCK"]
