@@ -308,7 +308,7 @@ FCL_CASES = [
     ("METHOD : COG;", "METHOD : COG 2.5;", "resolution must be a whole number"),
     ("METHOD : COG;", "METHOD : CENTER;", "unknown METHOD `CENTER`"),
     ("ACCU : MAX;", "ACCU : NSUM;", "normalized sum is not an S-norm"),
-    ("METHOD : COG;", "METHOD : cogf;", "jFuzzyLogic's centre of gravity of FUNCTION terms"),
+    ("METHOD : COG;", "METHOD : cogf;", "a weighted-average output needs constant or linear"),
     ("RULE 2 : IF service IS good", "RULE 2 : IF service IS goood", "of `service`"),
     ("TERM cheap := trian 0 5 10;", "TERM cheap := Constant 5;",
      "fuzzylite's `Constant` is a flat membership"),    ("RANGE := (0 .. 30);", "RANGE := (0 .. 3e400);", "`3e400` is past a float's range"),

@@ -76,7 +76,7 @@ REFUSED = [
     (HIGH, "TERM high := TRIAN 0 mid 10;", "a parameter given by a variable (`mid`)"),
     (HIGH, "TERM high := (0, 0) (mid, 1);", "a parameter given by a variable (`mid`)"),
     ("DEFAULT := 0;", "DEFAULT := NC;", "`DEFAULT := NC` (no change"),
-    ("METHOD : COG;", "METHOD : COGF;", "centre of gravity of FUNCTION terms"),
+    ("METHOD : COG;", "METHOD : COGF;", "not a `triangle` term"),     # COGF is COGS
     ("METHOD : COG;", "METHOD : COGS;", "not a `triangle` term"),
     ("ACCU : MAX;", "ACCU : NSUM;", "the normalized sum"),
     ("ACCU : MAX;", "ACCU : SUM;", "the unbounded sum"),
@@ -218,12 +218,56 @@ def test_cogs_under_accu_joins_the_rules_of_one_singleton_as_jfuzzylogic(accu, j
         assert got == pytest.approx(want, rel=1e-14), (a, b)
 
 
-def test_a_function_of_an_output_is_refused_as_a_consequent_not_a_membership():
-    """jFuzzyLogic's FUNCTION in DEFUZZIFY is a Takagi-Sugeno consequent (COGF), which the
-    refusal called a membership; the hint says how to write a linear one."""
-    text = SINGLETONS.replace("TERM hi := 8;", "TERM hi := FUNCTION (a * 0.8) + 1;")
+FUNCTIONS = SINGLETONS.replace("TERM lo := 2;", "TERM lo := FUNCTION (a * 0.5) + 1;").replace(
+    "TERM hi := 8;", "TERM hi := FUNCTION 2 * (b - 1) + a / 4;").replace(
+    "METHOD : COGS;", "METHOD : COGF;").replace("    RANGE := (0 .. 10);\nEND_DEFUZZIFY",
+                                                "END_DEFUZZIFY")
+
+
+def test_cogf_reads_linear_functions_as_linear_consequents():
+    """jFuzzyLogic's COGF: each FUNCTION term a singleton at its value, averaged as COGS (its
+    ACCU joining rules of one function). A linear one is a `linear` term; by hand at 4 inputs."""
+    rb = parse_fcl(FUNCTIONS.replace("END_RULEBLOCK", THIRD), "f.fcl")
+    y = rb.variables["y"]
+    assert [(t.shape, t.params) for t in y.terms] == [("linear", (0.5, 0.0, 1.0)),
+                                                      ("linear", (0.25, 2.0, -2.0))]
+    assert y.universe == (-2.0, 20.5)             # every value over the inputs' ranges
+    assert any("`y` has no RANGE; its universe [-2, 20.5] holds every value" in n
+               for n in rb.notes)
+    c = compile_rulebase(rb)
+    for a, b in [(3.0, 5.0), (1.0, 9.0), (8.0, 4.5), (2.5, 0.0)]:
+        a_low, a_high, b_low, b_high = _memberships(a, b)
+        w_lo, w_hi = min(a_low, b_low), max(max(a_high, b_high), b_high)
+        want = (w_lo * (0.5 * a + 1) + w_hi * (2 * (b - 1) + a / 4)) / (w_lo + w_hi)
+        got = evaluate(c, np.array([[a, b]]), detail=False).outputs[0, 0]
+        assert got == pytest.approx(want, rel=1e-14), (a, b)
+
+
+@pytest.mark.parametrize("function, at, words", [
+    ("a * b", "*", "a product of two inputs is not linear in the inputs"),
+    ("(a * 3.0) + 5 * SIN(a)", "SIN", "`SIN` of an input is not linear"),
+    ("a ^ 2", "^", "a power of an input is not linear"),
+    ("1 / (a + 1)", "/", "a division by an input is not linear"),
+    ("c * 2", "c", "`c` is not an input variable"),
+    ("a * 2)", ")", "unexpected `)`"),
+])
+def test_a_function_that_is_not_linear_is_refused_where_it_stops_being_so(function, at, words):
+    text = FUNCTIONS.replace("FUNCTION (a * 0.5) + 1;", f"FUNCTION {function};")
     with pytest.raises(FormatError) as info:
         parse_fcl(text, "f.fcl")
-    assert info.value.message == ("term `hi`: FUNCTION terms (Takagi-Sugeno consequents given by "
-                                  "a formula of the inputs) are not supported")
-    assert "`Linear c1 ... cn k`" in info.value.hint and "METHOD : COGS" in info.value.hint
+    assert words in info.value.message, info.value.render()
+    span = info.value.span
+    assert span.line == 22 and span.source_line[span.column - 1:].startswith(at)
+    if "linear" in words:
+        assert "linear Takagi-Sugeno consequent" in info.value.message
+
+
+def test_constants_of_a_function_are_folded_and_an_input_function_stays_refused():
+    rb = parse_fcl(FUNCTIONS.replace("FUNCTION (a * 0.5) + 1;",
+                                     "FUNCTION -a * 2 ^ 3 / 4 - abs(-1) + 10 % 4;"), "f.fcl")
+    assert rb.variables["y"].term("lo").params == (-2.0, 0.0, 1.0)
+    with pytest.raises(FormatError) as info:      # an input's membership by formula
+        parse_fcl(FUNCTIONS.replace("TERM high := (4, 0) (10, 1);",
+                                    "TERM high := FUNCTION b / 10;"), "f.fcl")
+    assert "FUNCTION terms (a membership given by a formula)" in info.value.message
+

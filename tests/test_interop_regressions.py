@@ -203,10 +203,13 @@ def test_fcl_dsigm_is_jfuzzylogics_clipped_difference():
 
 
 def test_fcl_function_terms_and_blocks_of_one_name_are_refused_by_name():
+    """A FUNCTION term is a linear Takagi-Sugeno consequent now: under a Mamdani METHOD it is
+    refused as such (jFuzzyLogic throws there too: a discrete term, a continuous defuzzifier)."""
     text = JFUZZY.replace("TERM b := gbell 2 3 8;", "TERM b := FUNCTION (x * 2);")
     with pytest.raises(MitosError) as info:
         parse_fcl(text, "t.fcl")
-    assert "FUNCTION terms" in info.value.message and info.value.span.line == 18
+    assert info.value.message == ("output term `y.b`: linear terms need a weighted-average "
+                                  "(Takagi-Sugeno) defuzzifier") and info.value.span.line == 18
     with pytest.raises(MitosError) as info:
         parse_fcl(JFUZZY + JFUZZY, "t.fcl")
     assert info.value.message == "two function blocks are named `t`"

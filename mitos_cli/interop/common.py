@@ -48,6 +48,9 @@ DEFUZZIFIERS = {
 }
 #: Extra spellings readers accept (older fuzzylite, jFuzzyLogic), upper-cased for FCL.
 FCL_ALIASES = {"BIS": "bisector", "MOM": "mom", "SOM": "som", "LOM": "lom",
+               # jFuzzyLogic's centre of gravity of FUNCTION terms: the same weighted average
+               # of singletons as its COGS (DefuzzifierCenterOfGravityFunctions)
+               "COGF": "weighted_average",
                "ALGEBRAIC_PRODUCT": "product", "PROBOR": "probabilistic_sum",
                "DMIN": "drastic", "DMAX": "drastic_sum", "NIPMIN": "nilpotent_minimum",
                "NIPMAX": "nilpotent_maximum", "EINSTEIN": "einstein", "HAMACHER": "hamacher"}
@@ -67,11 +70,6 @@ UNSUPPORTED_NORMS = {
     "UNSUM": "the unbounded sum is not an S-norm MITOS computes",
     "SUM": "the unbounded sum is not an S-norm MITOS computes",
     "sum": "MATLAB's `sum` aggregation (unbounded) is not an S-norm MITOS computes",
-    # jFuzzyLogic's DefuzzifierCenterOfGravityFunctions: the weighted average of its FUNCTION
-    # terms' values (Takagi-Sugeno), not a faster COG (as this said until 2026-12-06)
-    "COGF": "jFuzzyLogic's centre of gravity of FUNCTION terms (a Takagi-Sugeno weighted "
-            "average of the functions' values), and FUNCTION terms, are not read; a linear "
-            "FUNCTION is fuzzylite's `Linear` term under `METHOD : COGS`",
 }
 
 FLL, FIS, FCL = 0, 1, 2

@@ -49,6 +49,7 @@ from ..lang.terms import Role, Term, TermSet, Variable, first_at
 from ..words import plural
 from . import common
 from .common import FCL, FLL, fmt_number
+from .fclfunction import linear_function
 from .ruletree import check_depth, conclusions, expression
 from .text import read_foreign_file
 
@@ -239,7 +240,7 @@ def _function_block(fb: Tree, span_of) -> RuleBase:
         role: Role = "input" if node.data == "fuzzify" else "output"
         record = records.setdefault(str(node.children[0]), common.Record())
         v = _variable(node, role, declared, record, locks, constants, n_inputs, span_of, notes,
-                      ranges)
+                      ranges, variables)
         if v.name in variables:
             raise FormatError(f"variable `{v.name}` is defined twice"
                               + first_at(variables[v.name].span), span=v.span)
@@ -452,7 +453,8 @@ def _singletons_note(record: common.Record, v: Variable, rules: list[Rule],
 
 def _variable(node: Tree, role: Role, declared, settings: common.Record, locks: dict,
               constants: list, n_inputs: int, span_of, notes: list[str],
-              ranges: common.Places | None = None) -> Variable:
+              ranges: common.Places | None = None,
+              known: dict[str, Variable] | None = None) -> Variable:
     name_token = node.children[0]
     name = str(name_token)
     if name not in declared:
@@ -468,7 +470,8 @@ def _variable(node: Tree, role: Role, declared, settings: common.Record, locks: 
     for item in node.children[1:]:
         kind = item.data
         if kind == "term":
-            terms.append(_term(item, role, n_inputs, span_of))
+            inputs = tuple(n for n, (r, _, _) in declared.items() if r == "input")
+            terms.append(_term(item, role, n_inputs, span_of, inputs))
             definition = item.children[1]
             if role == "output" and definition.data == "shape_def" and \
                     str(definition.children[0]).lower() == "constant":
@@ -518,6 +521,10 @@ def _variable(node: Tree, role: Role, declared, settings: common.Record, locks: 
         raise FormatError(f"variable `{name}` has no terms", span=span_of(node),
                           hint=None if role == "output" else "an input without terms (it only "
                           "feeds linear consequents) needs `RANGE := (min .. max);`")
+    if universe is None and any(t.shape == "linear" for t in terms):
+        names = [n for n, (r, _, _) in declared.items() if r == "input"]
+        universe = _linear_extent(terms, names, known or {}, default, name, span_of(node),
+                                  notes)
     if universe is None:
         universe = _extent(terms, name, span_of(node), notes)
     lo, hi = universe
@@ -584,6 +591,38 @@ def _extent(terms: list[Term], name: str, span: Span,
     return min(xs), max(xs)
 
 
+def _linear_extent(terms: list[Term], inputs: list[str], known: dict[str, Variable],
+                   default: float | None, name: str, span: Span,
+                   notes: list[str]) -> tuple[float, float]:
+    """The range of a Takagi-Sugeno output without a RANGE (jFuzzyLogic's FUNCTION terms):
+    every value its terms take over the inputs' ranges, its default included. jFuzzyLogic
+    averages the functions' values wherever they lie, so the range only has to hold them."""
+    missing = [x for x in inputs if x not in known]
+    if missing:
+        raise FormatError(f"variable `{name}` has no RANGE, and its linear terms' values "
+                          f"cannot be bounded before `{missing[0]}`'s FUZZIFY block", span=span,
+                          hint="add `RANGE := (min .. max);`, or move the FUZZIFY blocks first")
+    xs = [] if default is None or default != default else [default]
+    others = [t for t in terms if t.shape != "linear"]
+    if others:
+        xs += list(_extent(others, name, span) if len(others) > 1 or others[0].shape != "singleton"
+                   else (others[0].params[0],))
+    for t in terms:
+        if t.shape != "linear":
+            continue
+        lo = hi = t.params[-1]
+        for x, a in zip(inputs, t.params[:-1]):
+            ends = (a * known[x].universe[0], a * known[x].universe[1])
+            lo, hi = lo + min(ends), hi + max(ends)
+        xs += [lo, hi]
+    if not all(math.isfinite(x) for x in xs) or min(xs) == max(xs):
+        raise FormatError(f"variable `{name}` has no RANGE and its terms do not span one",
+                          span=span, hint="add `RANGE := (min .. max);`")
+    notes.append(f"{span}: `{name}` has no RANGE; its universe [{min(xs):g}, {max(xs):g}] holds "
+                 f"every value of its linear terms over the inputs' ranges")
+    return min(xs), max(xs)
+
+
 def _no_variable(term: str, node, span_of) -> None:
     """jFuzzyLogic lets a membership parameter be a variable's name (optimised by its
     learning code); MITOS's terms have numbers."""
@@ -599,11 +638,16 @@ def _point_values(term: str, points, span_of):
     return points
 
 
-def _term(item: Tree, role: str, n_inputs: int, span_of) -> Term:
+def _term(item: Tree, role: str, n_inputs: int, span_of, inputs: tuple[str, ...] = ()) -> Term:
     name_token, definition = item.children
     name, span = str(name_token), span_of(item)
     if definition.data == "singleton_def":
         return common.make_term(name, "singleton", (_num(definition.children[0]),), span)
+    if definition.data == "formula_def" and role == "output":
+        # jFuzzyLogic's Takagi-Sugeno consequent: a singleton at the function's value
+        token = definition.children[0]
+        coefficients = list(linear_function(str(token), span_of(token), inputs))
+        return common.fuzzylite_term(name, "Linear", coefficients, n_inputs, span)
     if definition.data == "formula_def":
         raise _formula_term(name, role, definition.children[0], span_of)
     if definition.data == "singletons_def":
@@ -642,16 +686,9 @@ def _term(item: Tree, role: str, n_inputs: int, span_of) -> Term:
 
 
 def _formula_term(name: str, role: str, token, span_of) -> FormatError:
-    """The refusal of a term given by a formula: an input's membership, or (jFuzzyLogic's
-    ``FUNCTION`` in DEFUZZIFY, under ``METHOD : COGF``) a Takagi-Sugeno consequent, a
-    function of the inputs, which was called a membership too."""
+    """The refusal of an input's membership given by a formula (an output's ``FUNCTION`` is
+    a Takagi-Sugeno consequent: :func:`.fclfunction.linear_function`)."""
     word = str(token).split()[0].split("(")[0]
-    if role == "output":
-        return FormatError(f"term `{name}`: {word} terms (Takagi-Sugeno consequents given by a "
-                           f"formula of the inputs) are not supported", span=span_of(token),
-                           hint="a linear one is fuzzylite's `Linear c1 ... cn k` (a "
-                                "coefficient per input in the order they are declared, then "
-                                "the constant) under `METHOD : COGS`")
     return FormatError(f"term `{name}`: {word} terms (a membership given by a formula) are "
                        f"not supported", span=span_of(token),
                        hint="replace the formula by one of the shapes (trian, trape, gauss, "
