@@ -271,3 +271,22 @@ def test_constants_of_a_function_are_folded_and_an_input_function_stays_refused(
                                     "TERM high := FUNCTION b / 10;"), "f.fcl")
     assert "FUNCTION terms (a membership given by a formula)" in info.value.message
 
+
+def test_one_rule_concluding_two_terms_of_an_output_is_two_rules():
+    """jFuzzyLogic's junit3 ``THEN valve IS drainage, valve IS closed WITH 0.8``: each
+    conclusion is implied at the rule's degree (its weight included) and accumulated like
+    another rule's, so two rules of its condition and weight are exact; MITOS refused it."""
+    third = "    RULE 3 : IF b IS high THEN y IS lo, y IS hi WITH 0.5;\nEND_RULEBLOCK"
+    rb = parse_fcl(SINGLETONS.replace("END_RULEBLOCK", third), "s.fcl")
+    rules = rb.behaviors[0].rules
+    assert [(r.label, r.consequents[0].term, r.weight) for r in rules[2:]] == [
+        ("r3", "lo", 0.5), ("r3_2", "hi", 0.5)]
+    assert rules[2].antecedent == rules[3].antecedent
+    assert any("rule `r3` concludes 2 terms of one output: read as the rules `r3`, `r3_2`" in n
+               and n.startswith("s.fcl:35:5:") for n in rb.notes)
+    c = compile_rulebase(rb)
+    for a, b in [(3.0, 5.0), (1.0, 9.0), (8.0, 4.5)]:
+        a_low, a_high, b_low, b_high = _memberships(a, b)
+        w2, w8 = max(min(a_low, b_low), 0.5 * b_high), max(max(a_high, b_high), 0.5 * b_high)
+        got = evaluate(c, np.array([[a, b]]), detail=False).outputs[0, 0]
+        assert got == pytest.approx((2 * w2 + 8 * w8) / (w2 + w8), rel=1e-14)

@@ -13,7 +13,11 @@ MITOS's model. Both dialects are read:
   implication; with only ``AND`` (or only ``OR``) given the other is its De Morgan dual, as
   IEC 61131-7 says (jFuzzyLogic's ``HAMACHER`` and ``EINSTEIN``: each other, as it pairs them);
 - ``METHOD``: COG, COA (BIS), MM (MOM), LM (SOM), RM (LOM) for Mamdani; COGS (weighted
-  average of singletons) and COGSS (weighted sum) for Takagi-Sugeno;
+  average of singletons), COGF (jFuzzyLogic's, the same over ``FUNCTION`` terms, read as
+  linear terms where they are linear) and COGSS (weighted sum) for Takagi-Sugeno, where an
+  ``ACCU`` is the behavior's ``accumulation`` (jFuzzyLogic joins the rules of one singleton
+  value with it);
+- a rule concluding several terms of one output: one rule per term (jFuzzyLogic fires each);
 - ``DEFAULT := v`` -> ``Variable.default``; ``DEFAULT := nan`` -> none; ``| NC`` (no change:
   keep the previous output) and ``LOCK : PREVIOUS`` need state and are refused; ``LOCK : RANGE``
   is accepted for Mamdani outputs (a no-op there) and refused for Takagi-Sugeno ones;
@@ -325,7 +329,8 @@ def _rule_block(block: Tree, variables: dict[str, Variable], span_of,
     else:
         _both_note(block, record, span_of, notes)
     rule_items = [x for x in block.children[1:] if x.data == "rule"]
-    rules = [_rule(item, variables, span_of, i) for i, item in enumerate(rule_items)]
+    rules = [part for i, item in enumerate(rule_items)
+             for part in _split(_rule(item, variables, span_of, i), notes)]
     _grouping_note(rule_items, span_of, notes)
     name = str(block.children[0]) if block.children[0] is not None else ""
     return name, record, rules
@@ -796,6 +801,29 @@ def _or_before_and(tree, span_of) -> Span | None:
                 if before and not before.endswith("("):
                     return span
     return None
+
+
+def _split(rule: Rule, notes: list[str]) -> list[Rule]:
+    """A rule concluding several terms of one output (``THEN v IS a, v IS b``), as rules with
+    its condition and weight, one per term (``r5``, ``r5_2``, ...): jFuzzyLogic implies each
+    conclusion at the rule's degree and accumulates it like another rule's, so this is exact
+    under every ACCU and METHOD."""
+    layers: list[list] = []
+    for c in rule.consequents:              # the k-th conclusion of an output: rule k
+        layer = next((lay for lay in layers if all(d.var != c.var for d in lay)), None)
+        if layer is None:
+            layers.append([c])
+        else:
+            layer.append(c)
+    if len(layers) == 1:
+        return [rule]
+    labels = [rule.label] + [f"{rule.label}_{i + 1}" for i in range(1, len(layers))]
+    notes.append(f"{rule.span}: rule `{rule.label}` concludes {plural(len(layers), 'term')} of "
+                 f"one output: read as the rules {', '.join(f'`{x}`' for x in labels)} with its "
+                 f"condition and weight, each concluding one (jFuzzyLogic fires every "
+                 f"conclusion); `mitos check` reports them as a conflict")
+    return [Rule(label, rule.antecedent, tuple(layer), rule.weight, rule.span)
+            for label, layer in zip(labels, layers)]
 
 
 def _rule(item: Tree, variables: dict[str, Variable], span_of, index: int) -> Rule:
