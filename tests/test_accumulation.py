@@ -188,6 +188,14 @@ def test_fll_and_fis_refuse_it_where_it_joins_rules_and_write_it_where_it_cannot
         "a.rules"), (parse_termset(TERMS.replace(", L: {shape: linear, coefficients: {x: 2}, "
                                                  "constant: 3}", ""), "a.terms.yaml"),))
     assert write_foreign(once, fmt)                 # each value once: the S-norm changes nothing
+    meets = build_rulebase(parse_rules(RULES.replace("r2: if x is MID then y is A\n", "").replace(
+        "then y is C with 0.5", "then y is L").format(operators="accumulation = max"), "a.rules"),
+        (parse_termset(TERMS, "a.terms.yaml"),))
+    with pytest.raises(MitosError) as info:         # L = 2 x + 3 is 10 (A) at x = 3.5
+        write_foreign(meets, fmt)
+    assert info.value.message == (f"{name} has no accumulation of the rules that conclude one "
+                                  f"value: `y`'s linear function (`r4`) meets its other values "
+                                  f"at some inputs, where `accumulation = max` joins their rules")
 
 
 # ---------------------------------------------------------------------------------------------

@@ -1019,8 +1019,10 @@ def _engines_defuzzifier(method: str, engine: str) -> tuple[Setting, ...]:
 
 def refuse_accumulation(rb: RuleBase, behavior: str | None, flat: Flat, fmt: str) -> None:
     """Refuse to write a behavior whose ``accumulation`` S-norm joins several rules of one
-    value to a format that cannot say so (fuzzylite and MATLAB average every rule); where
-    each value is concluded once, the S-norm changes nothing and the file is written."""
+    value to a format that cannot say so (fuzzylite and MATLAB average every rule): two rules
+    of one value, or a linear function among an output's values (they meet at some inputs,
+    where the engine joins them). Where neither happens the S-norm changes nothing and the
+    file is written."""
     if not flat.operators.accumulated:
         return
     seen: dict[tuple, str] = {}
@@ -1040,3 +1042,13 @@ def refuse_accumulation(rb: RuleBase, behavior: str | None, flat: Flat, fmt: str
                     span=setting_span(rb, behavior, "accumulation"),
                     hint="write it to FCL (ACCU) or a rule file, or merge the rules")
             seen[key] = r.label
+    for var in dict.fromkeys(k[0] for k in seen):
+        keys = [k for k in seen if k[0] == var]
+        linear = [k for k in keys if isinstance(k[1], tuple)]
+        if linear and len(keys) > 1:         # the engine joins two values where they meet
+            raise FormatError(
+                f"{fmt} has no accumulation of the rules that conclude one value: `{var}`'s "
+                f"linear function (`{seen[linear[0]]}`) meets its other values at some inputs, "
+                f"where `accumulation = {flat.operators.accumulation}` joins their rules",
+                span=setting_span(rb, behavior, "accumulation"),
+                hint="write it to FCL (ACCU) or a rule file")
