@@ -742,7 +742,10 @@ def _option(item: Tree, settings: common.Record, span_of, conj: dict) -> None:
             raise FormatError(f"activation `{value}` is not supported: MITOS activates every "
                               f"rule", span=span)
     elif key == "ACCU":
-        settings.set("aggregation", _norm(common.SNORMS, value, "ACCU", span), span, "ACCU")
+        if value.upper() == "SUM":          # jFuzzyLogic's default: read under COGS (below)
+            settings.set("aggregation", "sum", span, "ACCU")
+        else:
+            settings.set("aggregation", _norm(common.SNORMS, value, "ACCU", span), span, "ACCU")
     elif key == "METHOD":
         method = _norm(common.DEFUZZIFIERS, value, "METHOD", span)
         settings.set("defuzzify", method, span, "METHOD")
@@ -767,10 +770,21 @@ def _accumulation(groups: list[tuple[str, list[Rule], common.Settings]]) -> None
     """``ACCU`` under ``METHOD : COGS`` (or COGSS, COGF) is the behavior's ``accumulation``:
     jFuzzyLogic (and IEC 61131-7) join the rules that conclude one singleton value with the
     ACCU norm (`RuleActivationMethod.imply` at the defuzzifier's point of that value) before
-    the weighted average; without ACCU it sums them, which is MITOS's default."""
+    the weighted average; without ACCU (or with ``ACCU : SUM``) it sums them, which is
+    MITOS's default. Elsewhere the unbounded sum is no S-norm, and refused."""
     for _, _, settings in groups:
-        if settings.defuzzify in ("weighted_average", "weighted_sum") and settings.aggregation:
+        weighted = settings.defuzzify in ("weighted_average", "weighted_sum")
+        if settings.aggregation == "sum" and not weighted:
+            raise FormatError("ACCU `SUM` is not supported: the unbounded sum is not an S-norm "
+                              "MITOS computes", span=(settings.spans or {}).get("aggregation"),
+                              expected="one of " + ", ".join(
+                                  str(n[FCL]) for n in common.SNORMS.values() if n[FCL]),
+                              hint="it is read under METHOD : COGS or COGF, where it sums "
+                                   "the rules of one value as MITOS's default does")
+        if weighted and settings.aggregation:
             settings.accumulation = settings.aggregation
+            if settings.aggregation == "sum":
+                settings.aggregation = None
 
 
 def _grouping_note(rule_items: list[Tree], span_of, notes: list[str]) -> None:
