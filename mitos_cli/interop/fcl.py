@@ -270,7 +270,6 @@ def _function_block(fb: Tree, span_of) -> RuleBase:
     groups = common.rule_blocks(parsed, {n: records[n] for n in outputs},
                                 renumber=len({r.label for r in all_rules}) < len(all_rules))
     _check_outputs(groups, locks, constants)
-    _accumulation_note(groups, notes)
     _no_accu_note(groups, notes)
     _accumulation(groups)
     ordered = [variables[n] for n in declared]
