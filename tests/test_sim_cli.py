@@ -277,11 +277,14 @@ def test_an_output_that_cannot_be_written_is_refused_before_the_run(short, tmp_p
         assert code == 1 and f"cannot write `{name}`: No such file or directory" in err
 
 
-def test_runs_print_a_table_of_rates(short):
-    res = run(short, short, "--json")
+def test_runs_print_a_table_of_rates(short, tmp_path):
+    other = tmp_path / "other.yaml"
+    other.write_text(SHORT.replace("name: short", "name: other"), encoding="utf-8")
+    res = run(short, other, "--json")
     assert res.exit_code == 0
     rows = json.loads(res.stdout)
     assert len(rows) == 2 and rows[0]["timeout_rate"] == 1.0
+    assert [r["world"] for r in rows] == ["short", "other"]
     assert set(rows[0]["time_s"]) == {"mean", "std"}
     table = run(short, "--runs", 2, "--workers", 1).stdout
     assert "success" in table.splitlines()[0] and "±" in table
@@ -289,6 +292,16 @@ def test_runs_print_a_table_of_rates(short):
     assert ("(time, path, min clear, speed, replans and backed out: mean ± standard deviation "
             "over every run, a collision's or a timeout's until it ended;") in " ".join(
                 table.split())
+
+
+@pytest.mark.parametrize("again", ["{p}", "{d}/./short.yaml", "corridor.yaml"])
+def test_a_world_given_twice_is_a_usage_error(short, again):
+    """`simulate corridor corridor` ran the world twice and printed two identical rows under
+    one name; `compare` refuses it, and so does `simulate` now (exit 2, before any run)."""
+    first = "corridor" if again == "corridor.yaml" else str(short)
+    res = run(first, again.format(p=short, d=short.parent))
+    assert res.exit_code == 2, res.output
+    assert "is given twice" in res.output and "success" not in res.output
 
 
 def test_runs_report_replans_and_backouts_beside_the_other_figures(short):

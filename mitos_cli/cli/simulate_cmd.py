@@ -238,7 +238,6 @@ def simulate_command(
     """Simulate the rule base driving a tricycle robot through corridor worlds."""
     from ..resources import DEFAULT_WORLD
     from ..sim.planner import make_planner, planner_kind
-    from ..sim.worldfile import load_world, resolve_world_path
 
     require = _checked_require(require)
     planner_name = planner_name.lower()        # any case, as every option's fixed list
@@ -252,7 +251,7 @@ def simulate_command(
         raise typer.BadParameter(f"--rulebase and --behavior choose the fuzzy planner's rules; "
                                  f"`{planner_name}` has none", param_hint="--planner")
     live = live or speed is not None
-    loaded = [load_world(resolve_world_path(n)) for n in worlds or [DEFAULT_WORLD]]
+    loaded = _load_worlds(worlds or [DEFAULT_WORLD])
     from ..sim.obstacles import copies_note
 
     for note in (n for w in loaded for n in (*w.notes, copies_note(w, runs)) if n):
@@ -273,6 +272,21 @@ def simulate_command(
     else:
         _simulate_one(loaded[0], planner, seed, randomise, live, speed, trace, every or 20,
                       as_json, out, plot, animate, fps or 10.0, require)
+
+
+def _load_worlds(names: list[str]) -> list:
+    """Each world, in order; one named twice (`a.yaml ./a.yaml` too) is a usage error, as
+    `compare` says: it ran twice and printed two identical rows under one name."""
+    from ..sim.worldfile import load_world, resolve_world_path
+
+    loaded, seen = [], set()
+    for name in names:
+        path = resolve_world_path(name)
+        if path.resolve() in seen:
+            raise typer.BadParameter(f"the world `{name}` is given twice")
+        seen.add(path.resolve())
+        loaded.append(load_world(path))
+    return loaded
 
 
 def _check_partners(many: bool, trace: bool, every, animate, fps, workers) -> None:
