@@ -9,6 +9,7 @@ expected, in words.
 from __future__ import annotations
 
 import functools
+import inspect
 import math
 import re
 from dataclasses import dataclass
@@ -364,14 +365,51 @@ def _span(meta, text: str, path: str | None) -> Span | None:
                    if meta.end_line == meta.line else None)
 
 
+#: what ``v_args(meta=True)`` marks a method with
+_WITH_META = getattr(v_args(meta=True)(lambda self, meta, items: None), "visit_wrapper")  # noqa: B009
+
+
+@functools.cache
+def _callback(cls: type, name: str):
+    """``cls``'s method for the rule ``name`` as ``f(self, meta, children)``; None where Lark's
+    own dispatch must decide (no such method, or another kind of ``v_args``)."""
+    if name.startswith("_") or not hasattr(cls, name):
+        return None
+    found = next(vars(k)[name] for k in cls.__mro__ if name in vars(k))
+    wrapper = getattr(found, "visit_wrapper", None)
+    if wrapper is _WITH_META:
+        base = found.base_func
+        return lambda self, meta, children: base(self, meta, children)
+    if wrapper is None and inspect.isfunction(found):
+        return lambda self, meta, children: found(self, children)
+    return None
+
+
 class _ToModel(Transformer):
     """Tree -> model objects. Only builds: names are checked later."""
 
     def __init__(self, text: str, path: str | None, line_offset: int = 0) -> None:
-        super().__init__()
+        super().__init__(visit_tokens=False)  # tokens are kept as they are
         self.text, self.path = text, path
         self.counter = 0
         self.line_offset = line_offset        # the text starts at this line + 1 of its file
+
+    def _transform_tree(self, tree):
+        """Lark's walk, without its generator per node (tokens are kept as they are)."""
+        return self._call_userfunc(tree, [self._transform_tree(c) if isinstance(c, Tree) else c
+                                          for c in tree.children])
+
+    def _call_userfunc(self, tree, new_children=None):
+        """Lark's dispatch makes a new wrapper object at each node for a ``v_args`` method
+        (a third of the transform of 10,000 rules); the method is found once per class."""
+        call = _callback(type(self), tree.data)
+        if call is None:
+            return super()._call_userfunc(tree, new_children)
+        children = tree.children if new_children is None else new_children
+        try:
+            return call(self, tree.meta, children)
+        except Exception as exc:
+            raise VisitError(tree.data, tree, exc) from exc
 
     def _s(self, meta) -> Span | None:
         span = _span(meta, self.text, self.path)
@@ -399,9 +437,6 @@ class _ToModel(Transformer):
                                   span=self._s(meta),
                                   expected="0, or a number of magnitude at least 5e-324")
         return value
-
-    def NAME(self, token):
-        return token
 
     @v_args(meta=True)
     def proposition(self, meta, items):
@@ -536,7 +571,9 @@ def check_modifiers(tree: Tree, text: str, path: str | None,
     would be evaluated as ``not very LOW`` (1 - 0.7^2 = 0.51 where very(1 - 0.7) = 0.09 was
     written). Refused, at the ``not``, rather than read as a different number.
     """
-    for node in tree.iter_subtrees():
+    if not any(_misplaced_not(node) for node in _subtrees(tree)):
+        return                            # the usual case, without Lark's ordered walk
+    for node in tree.iter_subtrees():     # the first in Lark's order, as before
         if node.data == "term_consequent":
             _check_action(node, text, path, actions)
         if node.data != "proposition":
@@ -556,6 +593,27 @@ def check_modifiers(tree: Tree, text: str, path: str | None,
             hint=f"`{var} is not {hedge} {term}` means 1 - {hedge}({term}), a different "
                  f"number; for {hedge}(1 - {term}), define the complement of `{term}` as a "
                  f"term of `{var}` in the term set and write `{var} is {hedge} THAT_TERM`")
+
+
+def _subtrees(tree: Tree):
+    """Every subtree, in no particular order (a plain stack: Lark's ``iter_subtrees`` orders
+    them and costs as much as the checks themselves)."""
+    stack = [tree]
+    while stack:
+        node = stack.pop()
+        yield node
+        stack.extend(child for child in node.children if isinstance(child, Tree))
+
+
+def _misplaced_not(node: Tree) -> bool:
+    """Whether :func:`check_modifiers` refuses ``node``: a ``not`` in an action, or after a
+    hedge."""
+    if node.data == "term_consequent":
+        return any(isinstance(m, Token) and m.type == "ACTION_NOT" for m in node.children[1:-1])
+    if node.data != "proposition":
+        return False
+    types = [m.type for m in node.children[1:-1] if isinstance(m, Token)]
+    return "HEDGE" in types and "NOT" in types[types.index("HEDGE"):]
 
 
 def check_nesting(tree: Tree, text: str, path: str | None, limit: int = MAX_NESTING) -> None:
