@@ -86,6 +86,31 @@ def test_lesson_from_stdin(work):
     assert "steering = 65.4 deg" in res.stdout and "<stdin>:3>" not in res.stdout
 
 
+def test_a_lesson_past_its_limits_is_refused_before_it_runs(work):
+    """Lessons had no limit (rule files have 16 MB): a lesson of millions of commands ran for
+    hours, a told rule about 1 ms each. Past 100,000 lines of commands, or 16 MB, a lesson is
+    refused at the line past the limit, before a session exists and before any command."""
+    from mitos_cli.teach.lesson import MAX_LESSON_LINES, check_lesson_size
+
+    many = "# many\n\n" + "show rules\n" * MAX_LESSON_LINES
+    (work / "many.lesson").write_text(many + "\nshow rules\n")
+    res = mitos("teach", "rb/mitos.rules", "--lesson", "many.lesson", cwd=work)
+    assert res.returncode == 1, res.stderr
+    line = MAX_LESSON_LINES + 4
+    assert (f"many.lesson:{line}:1: lesson error: the lesson holds more than 100,000 lines of "
+            f"commands") in res.stderr and "hint: split it into several lessons" in res.stderr
+    assert "session" not in res.stderr and "many.lesson:3>" not in res.stdout
+    assert not (work / ".mitos").exists()
+    res = mitos("teach", "rb/mitos.rules", "--lesson", "-", cwd=work, stdin=many + "\nshow rules")
+    assert res.returncode == 1 and f"<stdin>:{line}:1: lesson error" in res.stderr
+    (work / "long.lesson").write_text("# " + "x" * (16 << 20) + "\nshow rules\n")
+    res = mitos("teach", "rb/mitos.rules", "--lesson", "long.lesson", cwd=work)
+    assert res.returncode == 1 and "long.lesson:1:1: lesson error: the lesson holds 16,777,230 " \
+        "characters; a lesson may hold at most 16,777,216 (16 MB)" in res.stderr
+    check_lesson_size(many + "\n# more\n\n", "many.lesson")        # at the limits: run
+    check_lesson_size("#" * ((16 << 20) - 11) + "\nshow rules", "long.lesson")
+
+
 def test_usage_errors(work):
     res = mitos("teach", "--session", "x", cwd=work)
     assert res.returncode == 2 and "add --resume" in res.stderr

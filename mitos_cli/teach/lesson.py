@@ -12,7 +12,8 @@ import re
 from collections.abc import Iterator
 from pathlib import Path
 
-from ..errors import MitosError, Span, WorldError, visible
+from ..errors import LessonError, MitosError, Span, WorldError, visible
+from ..lang.parse import MAX_RULE_FILE_CHARS
 from ..resources import exists
 from .commands import incomplete
 from .session import Session
@@ -36,10 +37,39 @@ def commands(text: str) -> Iterator[tuple[int, str]]:
         yield start, line
 
 
+#: the longest lesson read (characters), as a rule file (:data:`MAX_RULE_FILE_CHARS`)
+MAX_LESSON_CHARS = MAX_RULE_FILE_CHARS
+#: the most lines of commands a lesson may hold (blank lines and comments aside): a told rule
+#: takes about 1 ms, so 100,000 run in some two minutes, as many rules as a rule file's
+#: documented size; a lesson of millions ran for hours, with no limit
+MAX_LESSON_LINES = 100_000
+
+
+def check_lesson_size(text: str, path: str) -> None:
+    """Refuse a lesson past :data:`MAX_LESSON_CHARS` or :data:`MAX_LESSON_LINES` before any
+    of it runs, at its first line or at the first line past the limit."""
+    if len(text) > MAX_LESSON_CHARS:
+        raise LessonError(f"the lesson holds {len(text):,} characters; a lesson may hold at "
+                          f"most {MAX_LESSON_CHARS:,} ({MAX_LESSON_CHARS >> 20} MB)",
+                          span=Span(path, 1, 1), hint="split it into several lessons")
+    said = 0
+    for lineno, line in enumerate(lines_of(text), 1):
+        if line.strip() and not line.lstrip().startswith("#"):
+            said += 1
+            if said > MAX_LESSON_LINES:
+                raise LessonError(
+                    f"the lesson holds more than {MAX_LESSON_LINES:,} lines of commands",
+                    span=Span.in_text("\n" * (lineno - 1) + line, path, lineno, 1),
+                    expected=f"at most {MAX_LESSON_LINES:,} lines of commands (blank lines "
+                             f"and comments aside)", hint="split it into several lessons")
+
+
 def run_lesson(session: Session, text: str, path: str) -> bool:
     """Run every command of ``text``; False when the lesson said ``quit``. Ctrl-C stops the
     lesson (``KeyboardInterrupt``), also when an ``adapt`` caught it to keep its epochs. Its
-    ``save PATH`` stays below the working directory (:attr:`Session.confined`)."""
+    ``save PATH`` stays below the working directory (:attr:`Session.confined`). A lesson past
+    the limits (:func:`check_lesson_size`) is refused before it runs."""
+    check_lesson_size(text, path)
     session.confined = Path.cwd()
     try:
         return _run(session, text, path)
@@ -94,11 +124,12 @@ def read_lesson(source: str) -> tuple[str, str]:
     """The lesson text and the name to report (``-`` reads stdin)."""
     import sys
 
-    from ..errors import LessonError
     from ..resources import resolve
 
-    if source == "-":
-        return sys.stdin.read(), "<stdin>"
+    if source == "-":                       # no more than the limit and a character, kept
+        text = sys.stdin.read(MAX_LESSON_CHARS + 1)
+        check_lesson_size(text, "<stdin>")
+        return text, "<stdin>"
     path = Path(source)
     if not exists(path):                   # a packaged lesson by name: `--lesson wider-turn`
         found = resolve("rulebases/lessons", source, ".lesson")
@@ -107,7 +138,7 @@ def read_lesson(source: str) -> tuple[str, str]:
     from ..fileio import bad_byte, broken_link, read_text, unreadable
 
     try:
-        return read_text(path), source
+        text = read_text(path)
     except (OSError, UnicodeDecodeError) as exc:
         error = LessonError(unreadable("lesson", source, exc), span=bad_byte(source, exc))
         if isinstance(exc, FileNotFoundError) and broken_link("lesson", path) is None:
@@ -120,3 +151,5 @@ def read_lesson(source: str) -> tuple[str, str]:
             error.expected = "a lesson file, or a packaged lesson: " + ", ".join(names)
             error.hint = nearby(path, (".lesson",)) or did_you_mean(path.stem, names)
         raise error from None
+    check_lesson_size(text, source)             # before a session exists
+    return text, source
