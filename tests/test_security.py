@@ -149,6 +149,44 @@ def test_the_directory_is_made_private(rules, tmp_path):
     assert entry_of(rules).stat().st_mode & 0o077 == 0
 
 
+def test_a_linked_cache_directory_is_checked_and_used_where_it_leads(rules, tmp_path,
+                                                                    monkeypatch):
+    """A symbolic link as the cache directory was followed, then used by its name: the cache
+    is now the directory it leads to (checked as any other), so a link changed after the
+    check leads nowhere new; a link to a directory others may write is refused."""
+    target = tmp_path / "elsewhere"
+    target.mkdir(mode=0o700)
+    link = tmp_path / "linked"
+    link.symlink_to(target)
+    monkeypatch.setenv("MITOS_CACHE_DIR", str(link))
+    assert cache.status().path == target.resolve()
+    api.read_rulebase(rules)
+    assert (target / "key").exists() and entry_of(rules).exists()
+    target.chmod(0o777)
+    st = cache.status()
+    assert st.path is None and st.refused and f"{target.resolve()} is writable" in st.reason
+
+
+@pytest.mark.skipif(not hasattr(os, "lchown") or os.geteuid() != 0,
+                    reason="giving a link to another user takes root")
+def test_a_link_of_another_user_on_the_way_to_the_cache_is_refused(tmp_path, monkeypatch):
+    """A link another user made (in a shared XDG_CACHE_HOME) could lead the cache to any
+    directory of ours, which passes the checks: refused, naming the link."""
+    target = tmp_path / "mine"
+    target.mkdir(mode=0o700)
+    shared = tmp_path / "shared"
+    shared.mkdir()
+    (shared / "mitos").symlink_to(target)
+    os.lchown(shared / "mitos", 4242, 4242)
+    monkeypatch.delenv("MITOS_CACHE_DIR", raising=False)
+    monkeypatch.setenv("XDG_CACHE_HOME", str(shared))
+    st = cache.status()
+    assert st.path is None and st.refused
+    assert st.reason == (f"no cache: {shared / 'mitos'} is a symbolic link of another user "
+                         f"(uid 4242); set MITOS_CACHE_DIR to a directory of yours")
+    assert not (target / "key").exists()
+
+
 def test_without_home_there_is_no_cache_and_it_says_why(monkeypatch):
     for name in ("MITOS_CACHE_DIR", "XDG_CACHE_HOME", "HOME"):
         monkeypatch.delenv(name, raising=False)

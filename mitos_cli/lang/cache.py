@@ -13,6 +13,8 @@ and only after a keyed hash proves this user wrote them:
   ``$HOME/.cache/mitos``; with none of these set (or ``MITOS_CACHE_DIR=off``) there is no cache;
 - it is created with mode 0700; one that exists but is not a directory owned by this user, or
   that its group or others may write, is refused with a warning and no cache is used;
+- a symbolic link on the way is followed if this user (or root) owns it, and the directory
+  it leads to is the one checked and used; another user's link is refused;
 - every entry starts with an HMAC-SHA256 of its name and contents under a random 32-byte key
   (``key`` in the directory, mode 0600, created on first use); an entry whose tag does not
   match is never unpickled.
@@ -83,7 +85,11 @@ def status() -> Status:
                             "HOME is set")
     try:
         where.mkdir(mode=0o700, parents=True, exist_ok=True)
-        st = os.stat(where)
+        foreign = _foreign_link(where)
+        if foreign:
+            return Status(None, foreign, refused=True)
+        where = Path(os.path.realpath(where))      # used from here on: a link changed after
+        st = os.stat(where)                        # this check is not followed
     except OSError as exc:
         return Status(None, f"no cache: cannot create {where}: {exc.strerror}")
     if not stat.S_ISDIR(st.st_mode):
@@ -96,6 +102,20 @@ def status() -> Status:
                             f"(mode {stat.S_IMODE(st.st_mode):04o}); `chmod 700` it to use it",
                       refused=True)
     return Status(where)
+
+
+def _foreign_link(where: Path) -> str:
+    """Why ``where`` is refused for a symbolic link on its way that another user owns (one
+    in a shared ``XDG_CACHE_HOME`` could point the cache at any directory of ours); empty when
+    there is none. A link of this user's (or root's: ``/var`` on macOS) is followed, and the
+    directory it leads to is checked as any other."""
+    path = Path(os.path.abspath(where))
+    for part in [*reversed(path.parents), path]:
+        st = os.lstat(part)
+        if stat.S_ISLNK(st.st_mode) and st.st_uid not in (os.geteuid(), 0):
+            return (f"no cache: {part} is a symbolic link of another user (uid {st.st_uid}); "
+                    f"set MITOS_CACHE_DIR to a directory of yours")
+    return ""
 
 
 @functools.cache
