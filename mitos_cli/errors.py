@@ -11,6 +11,7 @@ from __future__ import annotations
 import difflib
 import functools
 import re
+import unicodedata
 from collections.abc import Iterable
 from dataclasses import dataclass, replace
 
@@ -143,14 +144,38 @@ _NEWLINE = re.compile(r"\n")
 _CONTROL = re.compile(r"[\x00-\x08\x0b-\x1f\x7f-\x9f\u202a-\u202e\u2066-\u2069]")
 
 
+#: Unicode's format characters (category Cf, as of Unicode 15) besides those: zero-width
+#: spaces and joiners, LRM/RLM and the Arabic letter mark, the word joiner, a BOM inside the
+#: text, soft hyphens, tags. Invisible, so two names that differ by one look the same
+#: (``road`` and ``ro\u200bad``) and a caret after one stands a column off
+_INVISIBLE = re.compile("[\u00ad\u0600-\u0605\u061c\u06dd\u070f\u0890\u0891\u08e2\u180e"
+                        "\u200b-\u200f\u202a-\u202e\u2060-\u2064\u2066-\u206f\ufeff"
+                        "\ufff9-\ufffb\U000110bd\U000110cd\U00013430-\U0001343f"
+                        "\U0001bca0-\U0001bca3\U0001d173-\U0001d17a\U000e0001"
+                        "\U000e0020-\U000e007f]")
+
+
 def _escape(char: str) -> str:
     code = ord(char)
-    return f"\\x{code:02x}" if code < 0x100 else f"\\u{code:04x}"
+    return (f"\\x{code:02x}" if code < 0x100 else f"\\u{code:04x}" if code < 0x10000
+            else f"\\U{code:08x}")
 
 
 def visible(text: str) -> str:
-    """``text`` with each control character as its escape (``\\x1b``, ``\\u202e``)."""
-    return _CONTROL.sub(lambda m: _escape(m.group()), text)
+    """``text`` with each control or format character as its escape (``\\x1b``,
+    ``\\u202e``, ``\\u200b``)."""
+    text = _CONTROL.sub(lambda m: _escape(m.group()), text)
+    return _INVISIBLE.sub(lambda m: _escape(m.group()), text)
+
+
+def invisible_character(text: str) -> str | None:
+    """The first format character of ``text`` (:data:`_INVISIBLE`) as its escape and name
+    (`` `\\u200b` (ZERO WIDTH SPACE)``), or None: a name that holds one looks like another."""
+    found = None if text.isascii() else _INVISIBLE.search(text)
+    if found is None:
+        return None
+    char = found.group()
+    return f"`{_escape(char)}` ({unicodedata.name(char, 'a format character')})"
 
 
 def control_character(text: str) -> str | None:
@@ -190,6 +215,7 @@ class MitosError(Exception):
                 first = min(max(0, col - SHOWN // 2), len(raw) - SHOWN)
                 raw, col = raw[first:first + SHOWN], col - first
             raw = _CONTROL.sub("\ufffd", raw)        # (one character each: the caret stays)
+            raw = _INVISIBLE.sub("\ufffd", raw)      # (a zero-width one put it a column off)
             src = raw.expandtabs(4)
             col = len(raw[:max(0, col)].expandtabs(4))
             width = max(1, (self.span.end_column or self.span.column + 1) - self.span.column)

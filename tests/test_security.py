@@ -436,6 +436,48 @@ def test_a_control_character_in_a_term_sets_text_is_refused(tmp_path, key):
         api.read_rulebase(rules)
 
 
+@pytest.mark.parametrize("char, name", [
+    ("\u200b", "ZERO WIDTH SPACE"), ("\u200c", "ZERO WIDTH NON-JOINER"),
+    ("\u200d", "ZERO WIDTH JOINER"), ("\u200e", "LEFT-TO-RIGHT MARK"),
+    ("\u200f", "RIGHT-TO-LEFT MARK"), ("\u061c", "ARABIC LETTER MARK"),
+    ("\u2060", "WORD JOINER"), ("\ufeff", "ZERO WIDTH NO-BREAK SPACE"),
+    ("\U000e0041", "TAG LATIN CAPITAL LETTER A")])
+def test_an_invisible_character_in_a_name_is_refused_by_its_code_point(tmp_path, char, name):
+    """Unicode's format characters other than the bidirectional ones were taken in names:
+    `road` and `ro\u200bad` printed alike and were two names (a .fis input, a term set's
+    term). Refused in every reader's names, the character named; texts keep them (Persian
+    writes a zero-width non-joiner), shown as escapes in messages."""
+    from mitos_cli.errors import FormatError, MitosError, TermSetError, visible
+
+    escape = visible(char)
+    path = tmp_path / "zw.fis"
+    path.write_text(ESC_FIS.replace("{input}", f"ro{char}ad").replace("{term}", "lo"),
+                    encoding="utf-8")
+    with pytest.raises(FormatError) as exc:
+        api.read_rulebase(path)
+    assert f"its name holds the invisible character `{escape}` ({name})" in exc.value.message
+    text = exc.value.render()
+    assert char not in text and f"variable `ro{escape}ad`" in text
+    (tmp_path / "t.terms.yaml").write_text(
+        f'variables:\n  a: {{role: input, universe: [0, 1], description: "a{char}b", '
+        f'unit: "in", terms: {{lo: 1, "l{char}o": 1}}}}\n'
+        f"  y: {{role: output, universe: [0, 1], terms: {{hi: 1}}}}\n", encoding="utf-8")
+    rules = tmp_path / "r.rules"
+    rules.write_text('terms "t.terms.yaml"\nif a is lo then y is hi\n')
+    with pytest.raises(TermSetError) as exc:
+        api.read_rulebase(rules)
+    assert exc.value.message == (f"term `a.l{char}o` holds the invisible character "
+                                 f"`{escape}` ({name})")
+    lines = exc.value.render().splitlines()              # the caret under the name
+    assert lines[2].index("^") == lines[1].index('"l\ufffdo"')
+    (tmp_path / "t.terms.yaml").write_text((tmp_path / "t.terms.yaml").read_text(
+        encoding="utf-8").replace(f', "l{char}o": 1', ""), encoding="utf-8")
+    assert api.read_rulebase(rules).variables["a"].description == f"a{char}b"
+    with pytest.raises(MitosError, match="unexpected character"):
+        rules.write_text(f'terms "t.terms.yaml"\nif a is l{char}o then y is hi\n', encoding="utf-8")
+        api.read_rulebase(rules)
+
+
 # ---- a world naming a pipe ----------------------------------------------------------------------
 
 def _finishes(call, fifo: Path, seconds: float = 20.0):

@@ -40,7 +40,7 @@ from ..fuzzy.shapes import SHAPES
 from ..numbers import LARGEST, exact
 from ..words import plural
 from . import yamlpos
-from .terms import Term, TermSet, Variable, check_term, universe_problem
+from .terms import Term, TermSet, Variable, check_term, invisible_name, universe_problem
 from .yamlpos import YList, YMap
 
 VARIABLE_KEYS = ("description", "unit", "role", "universe", "terms", "default")
@@ -146,6 +146,7 @@ def _writable(name: Any, span: Span, what: str) -> None:
     text = str(name)
     if _NAME.fullmatch(text) and text not in HEDGES and text != "not":
         return
+    invisible_name(text, span, what)          # said by its code point: it shows as nothing
     why = ("is a hedge word" if text in HEDGES else "is a keyword" if text == "not" else
            "holds what a name in a rule cannot (letters, digits, `_` and `-`, starting with a "
            "letter or `_`)")

@@ -13,7 +13,7 @@ from typing import Literal
 
 import numpy as np
 
-from ..errors import Span, TermSetError, control_character, unknown
+from ..errors import Span, TermSetError, control_character, invisible_character, unknown
 from ..fuzzy.formula import Formula
 from ..fuzzy.shapes import SHAPES, STEEP, Shape
 from ..numbers import exact
@@ -102,6 +102,18 @@ def _control_in(text: str, one_line: bool) -> str | None:
     return found
 
 
+def invisible_name(name: str, span: Span | None, what: str) -> None:
+    """Refuse a format character in a name (a zero-width space, LRM, a BOM inside it): it
+    prints as nothing, so `road` and `ro\\u200bad` look alike and are two names. Texts
+    (descriptions, units) may hold them: Persian writes a zero-width non-joiner, mixed
+    scripts an LRM."""
+    char = invisible_character(name)
+    if char is not None:
+        raise TermSetError(f"{what} holds the invisible character {char}", span=span,
+                           hint="it prints as nothing, so the name looks like another it is "
+                                "not: write it without")
+
+
 def first_at(span: Span | None) -> str:
     """`` (first at line N)``, said of a name given twice, at the second; empty without a
     position."""
@@ -153,6 +165,10 @@ class Variable:
                 raise TermSetError(f"{what}: {part} holds the control character `{char}`",
                                    span=span, hint="names and texts are printed to the "
                                    "terminal: write them without control characters")
+        for what, part, text, span, _ in texts:
+            if part == "its name":
+                invisible_name(text, span, f"{what}: its name")
+
 
     @property
     def term_names(self) -> tuple[str, ...]:
