@@ -101,6 +101,50 @@ def test_coverage_gap_without_default_is_an_error(flawed):
     assert gap.share == pytest.approx(50 / 160 * 0.6 + 60 / 160 * 0.4)
 
 
+STEPS = """\
+variables:
+  x:
+    role: input
+    universe: [0, 4]
+    terms:
+      LOW: {shape: rectangle, points: [0, 2]}
+      TRI: {shape: triangle, points: [2, 3, 4]}
+      MID: {shape: rectangle, points: [1, 3]}
+  z:
+    role: input
+    universe: [0, 10]
+    terms:
+      LEFT: {shape: rectangle, points: [0, 5]}
+      RAMP: {shape: triangle, points: [5, 7.5, 10]}
+  y:
+    role: output
+    universe: [0, 1]
+    terms:
+      A: {shape: triangle, points: [0, 0.5, 1]}
+"""
+
+
+@pytest.mark.parametrize("condition, boxes", [
+    ("x is LOW", ["x in (2, 4]"]),                      # a crisp step down at 2
+    ("not x is LOW", ["x in [0, 2]"]),
+    ("x is MID", ["x in [0, 1)", "x in (3, 4]"]),
+    ("x is TRI", ["x in [0, 2]", "x = 4"]),             # a foot, not a step: 0 at 2 itself
+    ("x is LOW and z is LEFT", ["z in (5, 10]", "x in (2, 4]"]),
+    ("x is MID and z is RAMP", ["z in [0, 5]", "x in [0, 1)", "x in (3, 4]", "z = 10"]),
+    ("x is LOW or z is LEFT", ["x in (2, 4] and z in (5, 10]"]),
+])
+def test_a_regions_end_at_a_crisp_step_is_the_step(tmp_path, condition, boxes):
+    """A `no-rule-fires` box was read from the samples alone, so beside a crisp step it
+    stopped one sample short: `x in [0, 1.75]` for [0, 2). An end whose next cell is unset
+    all through now runs on to the step, left out (an open end)."""
+    (tmp_path / "t.terms.yaml").write_text(STEPS)
+    (tmp_path / "t.rules").write_text(f'terms "t.terms.yaml"\nbehavior b:\n  r1: if '
+                                      f"{condition} then y is A\nend\n")
+    report = check_rulebase(read_rulebase(tmp_path / "t.rules"))
+    (gap,) = by_code(report, "no-rule-fires")
+    assert [b.describe() for b in gap.regions] == boxes
+
+
 def test_coverage_gap_with_default_is_a_warning(flawed):
     report = check_rulebase(read_rulebase(flawed))
     gap = [f for f in by_code(report, "no-rule-fires") if f.severity == "warning"][0]

@@ -98,17 +98,22 @@ NEARLY_ONE = 0.99
 
 @dataclass(frozen=True)
 class Box:
-    """A box of the input space: ``ranges[var] = (lo, hi)``; inputs not named are free."""
+    """A box of the input space: ``ranges[var] = (lo, hi)``; inputs not named are free.
+    ``open`` says, range by range, which ends are left out: an end at a crisp step, where
+    the region runs up to the step but not onto it (``x in [0, 2)``)."""
 
     ranges: tuple[tuple[str, float, float], ...]
+    open: tuple[tuple[bool, bool], ...] = ()
 
     def describe(self) -> str:
         if not self.ranges:
             return "everywhere"
         parts = []
-        for name, lo, hi in self.ranges:
+        ends = self.open or ((False, False),) * len(self.ranges)
+        for (name, lo, hi), (open_lo, open_hi) in zip(self.ranges, ends):
             parts.append(f"{name} = {_num(lo)}" if lo == hi else
-                         f"{name} in [{_num(lo)}, {_num(hi)}]")
+                         f"{name} in {'(' if open_lo else '['}{_num(lo)}, {_num(hi)}"
+                         f"{')' if open_hi else ']'}")
         return " and ".join(parts)
 
     def to_json(self) -> dict:
@@ -594,14 +599,18 @@ def _sampled(compiled: CompiledRuleBase, threshold: float,
             masks[key] = mask
         for key, outs in reported.items():
             mask, has_default = masks[key], key[1]
-            boxes, uncovered = boxes_of(mask.reshape(shape), axes, compiled.inputs)
             inner = kind == "no-rule-fires" and not skipped
+            cells = None
             if inner and all(len(a) > 1 for a in axes):
                 if centres is None:
                     centres = _centre_totals(compiled, axes, counting)
                 share = _unset_share(centres, axes, compiled.outputs.index(outs[0]))
+                unset = centres[:, [compiled.outputs.index(o) for o in outs]] <= 0.0
+                cells = unset.all(axis=1).reshape([len(a) - 1 for a in axes])
             else:
                 share = volume_share(mask.reshape(shape), axes, inner=inner)
+            boxes, uncovered = boxes_of(mask.reshape(shape), axes, compiled.inputs,
+                                        cells=cells)
             severity, message, hint = _coverage_words(compiled, kind, outs, share,
                                                       has_default, threshold, thinned)
             if missed.intersection(outs):
@@ -783,14 +792,37 @@ def _pct(share: float) -> str:
     return f"{pct:.2g}%" if pct < 10 else f"{pct:.0f}%"
 
 
+def _steps(cells: np.ndarray, lo: list, hi: list) -> list[tuple[bool, bool]]:
+    """For a box of samples ``lo``..``hi - 1``, which ends run on to the next sample, left
+    out: where every cell just beyond the end (along the box's own cells) is unset at its
+    centre. On a grid that holds the corner points a membership is linear on each open cell,
+    so the region then fills the cell and stops at the next sample, a crisp step: a box read
+    from the samples alone stopped one sample short (``x in [0, 1.75]`` for ``[0, 2)``)."""
+    ends = []
+    for d in range(cells.ndim):
+        across = [slice(a, b - 1) for a, b in zip(lo, hi)]      # the box's cells elsewhere
+        if any(b - a < 2 for e, (a, b) in enumerate(zip(lo, hi)) if e != d):
+            ends.append((False, False))       # a box one sample thin has no cells to judge
+            continue
+        sides = []
+        for beyond in (lo[d] - 1, hi[d] - 1):     # the cells below and above the box
+            face = list(across)
+            face[d] = slice(beyond, beyond + 1)
+            sides.append(bool(0 <= beyond < cells.shape[d] and cells[tuple(face)].all()))
+        ends.append((sides[0], sides[1]))
+    return ends
+
+
 def boxes_of(mask: np.ndarray, axes: list[np.ndarray], names: tuple[str, ...],
-             limit: int = 200) -> tuple[list[Box], int]:
+             limit: int = 200, cells: np.ndarray | None = None) -> tuple[list[Box], int]:
     """Cover the true cells of a k-dimensional grid mask with boxes, largest first.
 
     Each box starts at the first uncovered true cell and grows along every axis in turn (up,
     then down) while the grown box stays inside the mask; boxes may overlap. Ranges spanning a
     whole axis are left out. Returns the boxes (at most ``limit``) and the number of true cells
-    they leave uncovered (0 unless the mask is too ragged for ``limit`` boxes).
+    they leave uncovered (0 unless the mask is too ragged for ``limit`` boxes). ``cells``: which
+    cells between samples are in the region at their centre (:func:`_unset_share`'s), to run
+    an end on to a crisp step beyond the last sample (:func:`_steps`).
     """
     remaining = mask.copy()
     boxes: list[tuple[int, Box]] = []
@@ -815,11 +847,13 @@ def boxes_of(mask: np.ndarray, axes: list[np.ndarray], names: tuple[str, ...],
                         lo[d] -= 1
         region = tuple(slice(a, b) for a, b in zip(lo, hi))
         remaining[region] = False
-        ranges = tuple((names[d], float(axes[d][lo[d]]), float(axes[d][hi[d] - 1]))
-                       for d in range(mask.ndim)
-                       if not (lo[d] == 0 and hi[d] == mask.shape[d]))
+        ends = _steps(cells, lo, hi) if cells is not None else [(False, False)] * mask.ndim
+        kept = [d for d in range(mask.ndim) if not (lo[d] == 0 and hi[d] == mask.shape[d])]
+        ranges = tuple((names[d], float(axes[d][lo[d] - ends[d][0]]),
+                        float(axes[d][hi[d] - 1 + ends[d][1]])) for d in kept)
         size = int(np.prod([b - a for a, b in zip(lo, hi)]))
-        boxes.append((size, Box(ranges)))
+        boxes.append((size, Box(ranges, tuple(ends[d] for d in kept) if cells is not None
+                                else ())))
     boxes.sort(key=lambda sb: -sb[0])
     return [b for _, b in boxes], int(remaining.sum())
 
