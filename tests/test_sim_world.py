@@ -923,6 +923,113 @@ def test_cells_inside_is_every_cell_against_every_polygon():
     assert (cells_inside(grid, polys) == whole).all()
 
 
+def _crossing(n: int, seed: int = 3) -> list[list[float]]:
+    """A corridor of ``n`` random points in a 3,000 in square: it crosses itself all over."""
+    import random
+
+    rng = random.Random(seed)
+    return [[round(rng.uniform(0, 3000)), round(rng.uniform(0, 3000))] for _ in range(n)]
+
+
+def _room_every_pair(adj, coords, walls):
+    """The room of each edge as it was found: every edge against every wall at once."""
+    import numpy as np
+
+    from mitos_cli.sim.geometry import point_segment_distance
+
+    edges = sorted({(u, v) for u, out in adj.items() for v, _ in out})
+    a = np.array([coords[u] for u, _ in edges])
+    b = np.array([coords[v] for _, v in edges])
+    to_walls = point_segment_distance(np.concatenate([a, b]), walls).reshape(
+        2, len(edges), -1).min(axis=0)
+    corners = np.concatenate([walls[:, :2], walls[:, 2:]])
+    to_edges = point_segment_distance(corners, np.concatenate([a, b], axis=1)).reshape(
+        2, len(walls), -1).min(axis=0)
+    return dict(zip(edges, np.minimum(to_walls.min(axis=1), to_edges.min(axis=0)).tolist()))
+
+
+def test_a_routes_room_is_measured_near_each_edge_the_same_to_the_bit(monkeypatch):
+    """Each edge of the centre-line graph was measured against every wall at once: a corridor
+    of 300 points crossing itself took 8 GB and 42 s to start (`mitos simulate`). Edges are
+    measured in blocks of neighbours, against the walls that can be nearest only, and the
+    room is the same to the bit; the block's memory stays small."""
+    import tracemalloc
+    from types import SimpleNamespace
+
+    import numpy as np
+
+    from mitos_cli.sim import route
+    from mitos_cli.sim.staticmap import corridor_rects, corridor_walls
+
+    captured = {}
+    real = route._edge_room
+
+    def keep(adj, coords, walls):
+        captured.update(adj=adj, coords=coords, walls=walls)
+        return real(adj, coords, walls)
+
+    corridors = (SimpleNamespace(points=_crossing(60), width=60.0),)
+    walls = corridor_walls(corridor_rects(corridors))
+    monkeypatch.setattr(route, "_edge_room", keep)
+    route.corridor_route(corridors, SimpleNamespace(x=0.0, y=0.0), SimpleNamespace(x=1.0, y=1.0),
+                         walls)
+    adj, coords = captured["adj"], captured["coords"]
+    assert len(adj) > 400 and len(walls) > 800          # 1,698 edges
+    expected = _room_every_pair(adj, coords, walls)
+    tracemalloc.start()
+    try:
+        assert real(adj, coords, walls) == expected
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert peak < 64 << 20, f"measuring the room held {peak / 2**20:.0f} MB"    # (was 222)
+    monkeypatch.setattr(route, "ROOM_PAIRS", 20_000, raising=False)    # many small blocks
+    assert real(adj, coords, walls) == expected
+    grid = np.array([[float(x), float(y), float(x + 5 * (i % 3)), float(y)]
+                     for i, (x, y) in enumerate(_crossing(50, 4))])
+    assert real(adj, coords, grid) == _room_every_pair(adj, coords, grid)
+
+
+def test_a_diagonal_corridor_is_carved_near_itself_only(monkeypatch):
+    """A corridor's cells were tested over its bounding box, the whole map for a diagonal
+    one (300 crossing corridors: 14 s). A band of rows is tested between the polygon's own
+    sides now, with the same cells found."""
+    import random
+
+    import numpy as np
+
+    from mitos_cli.sim import staticmap
+    from mitos_cli.sim.geometry import points_in_polygon, rect_corners
+    from mitos_cli.sim.staticmap import cells_inside
+    from mitos_cli.sim.world import Grid
+
+    rng = random.Random(2)
+    for _ in range(30):
+        polys = np.array([rect_corners(rng.uniform(-50, 150), rng.uniform(-50, 150),
+                                       rng.uniform(-4, 4), rng.uniform(0.5, 300),
+                                       rng.choice([0.3, 2, 8, 30]))
+                          for _ in range(rng.randint(1, 12))])
+        rows, cols, res = rng.randint(5, 120), rng.randint(5, 120), rng.choice([0.7, 1.0, 2.5])
+        grid = Grid(np.ones((rows, cols), dtype=bool), res,
+                    (rng.uniform(-30, 0), rng.uniform(-30, 0)), "")
+        ys, xs = np.mgrid[0:rows, 0:cols]
+        centres = np.stack([grid.origin[0] + (xs.ravel() + 0.5) * res,
+                            grid.origin[1] + (ys.ravel() + 0.5) * res], 1)
+        whole = points_in_polygon(centres, polys).any(axis=1).reshape(rows, cols)
+        assert (cells_inside(grid, polys) == whole).all()
+    tested = []
+
+    def counting(points, corners):
+        tested.append(len(points))
+        return points_in_polygon(points, corners)
+
+    monkeypatch.setattr(staticmap, "points_in_polygon", counting)
+    diagonal = np.array([rect_corners(500.0, 500.0, 0.7853981633974483, 1400.0, 20.0)])
+    grid = Grid(np.ones((500, 500), dtype=bool), 2.0, (0.0, 0.0), "")
+    assert cells_inside(grid, diagonal).sum() > 3000
+    assert sum(tested) < 40_000          # its bounding box: 250,000 cells
+
+
 def test_a_corridor_side_is_clipped_only_by_the_rectangles_near_it(monkeypatch):
     """Each rectangle's four sides were clipped by every other rectangle: a polyline of 400
     points took 22 s to load. Only the rectangles whose bounding box meets a side are asked

@@ -459,13 +459,58 @@ def _edge_room(adj: dict[int, list[tuple[int, float]]], coords: list[np.ndarray]
         return {e: math.inf for e in edges}
     a = np.array([coords[u] for u, _ in edges])
     b = np.array([coords[v] for _, v in edges])
-    ends = np.concatenate([a, b])                                            # [2E, 2]
-    to_walls = point_segment_distance(ends, walls).reshape(2, len(edges), -1).min(axis=0)
     segs = np.concatenate([a, b], axis=1)                                    # [E, 4]
+    block = max(16, ROOM_PAIRS // len(walls))
+    order = _nearby_first(segs, block)
+    least = np.empty(len(segs))
+    for i in range(0, len(segs), block):
+        least[order[i:i + block]] = _room_of(segs[order[i:i + block]], walls)
+    return {e: float(d) for e, d in zip(edges, least)}
+
+
+def _nearby_first(segs: np.ndarray, block: int) -> np.ndarray:
+    """The edges in an order that keeps neighbours together (by square cells of about
+    ``block / 4`` edges, column by column): a block of far-flung edges is near most walls."""
+    mid = 0.5 * (segs[:, :2] + segs[:, 2:])
+    extent = float(np.max(np.ptp(mid, axis=0)))
+    cells = max(1.0, np.sqrt(len(segs) / max(1.0, block / 4)))
+    size = extent / cells if extent > 0 else 1.0
+    key = np.floor((mid - mid.min(axis=0)) / size)
+    return np.lexsort((mid[:, 1], key[:, 1], key[:, 0]))
+
+
+#: edge-wall pairs looked at at once (some 40 bytes a pair in a block's arrays: 10 MB)
+ROOM_PAIRS = 250_000
+#: walls first measured exactly per edge, the nearest by their bounding boxes
+ROOM_NEAREST = 4
+
+
+def _segment_distances(segs: np.ndarray, walls: np.ndarray) -> np.ndarray:
+    """``[E, W]`` distances between segments that cross no wall and walls: that of the
+    nearer end of one to the other."""
+    ends = np.concatenate([segs[:, :2], segs[:, 2:]])                       # [2E, 2]
+    to_walls = point_segment_distance(ends, walls).reshape(2, len(segs), -1).min(axis=0)
     corners = np.concatenate([walls[:, :2], walls[:, 2:]])                  # [2W, 2]
     to_edges = point_segment_distance(corners, segs).reshape(2, len(walls), -1).min(axis=0)
-    least = np.minimum(to_walls.min(axis=1), to_edges.min(axis=0))
-    return {e: float(d) for e, d in zip(edges, least)}
+    return np.minimum(to_walls, to_edges.T)
+
+
+def _room_of(segs: np.ndarray, walls: np.ndarray) -> np.ndarray:
+    """The least distance ``[E]`` from each of ``segs`` to the walls, measured exactly only
+    for the walls whose bounding box is no farther than a wall already measured: each edge
+    against every wall held edges x walls x 8 floats (8 GB for a corridor of 300 points
+    that crosses itself everywhere). Each distance is computed as before, pair by pair, so
+    the least is the same to the bit."""
+    lo, hi = np.minimum(segs[:, :2], segs[:, 2:]), np.maximum(segs[:, :2], segs[:, 2:])
+    wlo, whi = np.minimum(walls[:, :2], walls[:, 2:]), np.maximum(walls[:, :2], walls[:, 2:])
+    gap = np.maximum(np.maximum(wlo[None] - hi[:, None], lo[:, None] - whi[None]), 0.0)
+    bound = np.hypot(gap[..., 0], gap[..., 1])          # [E, W]: at most the distance
+    k = min(ROOM_NEAREST, walls.shape[0])
+    near = np.unique(np.argpartition(bound, k - 1, axis=1)[:, :k])
+    reach = _segment_distances(segs, walls[near]).min(axis=1)      # [E]: some wall's distance
+    # (with room for the rounding of either: a wall left out must be farther for sure)
+    ask = np.flatnonzero((bound <= reach[:, None] * (1 + 1e-9) + 1e-9).any(axis=0))
+    return _segment_distances(segs, walls[ask]).min(axis=1)
 
 
 def _narrow_corridor(adj, coords, room, s_id: int, g_id: int, walls: np.ndarray,
