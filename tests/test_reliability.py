@@ -187,6 +187,27 @@ def test_parsing_makes_no_wrapper_per_node_and_no_ordered_walk(monkeypatch):
     assert made == [] and functools.update_wrapper is real
 
 
+def test_a_names_span_is_placed_without_compiling_a_pattern_per_name(monkeypatch):
+    """Each name of each rule was placed (``Span.naming``) by escaping and compiling its
+    pattern again, a third of the checks of 10,000 FCL rules: a name's pattern is compiled
+    once now, and the spans are the same."""
+    import re
+    import types
+
+    from mitos_cli import errors
+
+    text = 'terms "mitos.terms.yaml"\n' + "\n".join(
+        f"z{i}: if road is WIDE and size is SMALL_SZ then speed is SLOW" for i in range(20))
+    span = Span.in_text(text, "r.rules", 2, 1, 60)
+    first = [span.naming(w) for w in ("road", "size", "WIDE", "speed")]
+    compiled = []
+    proxy = types.SimpleNamespace(**{k: getattr(re, k) for k in dir(re) if not k.startswith("__")})
+    proxy.compile = lambda *a, **k: compiled.append(a) or re.compile(*a, **k)
+    monkeypatch.setattr(errors, "re", proxy)
+    assert [span.naming(w) for w in ("road", "size", "WIDE", "speed")] == first
+    assert compiled == [] and [s.column for s in first] == [8, 25, 16, 47]
+
+
 def test_a_span_is_the_same_without_the_regex():
     """``Span.at`` finds a line's ends by ``str.find`` where it looks for newlines (every
     node of a parse): the same span as the regex search it replaces, short or long lines."""
