@@ -167,6 +167,15 @@ def test_a_linked_cache_directory_is_checked_and_used_where_it_leads(rules, tmp_
     assert st.path is None and st.refused and f"{target.resolve()} is writable" in st.reason
 
 
+def test_a_cache_directory_that_is_a_link_to_nothing_is_said_so(tmp_path, monkeypatch):
+    """A dangling link as the cache directory said "cannot create ...: File exists"."""
+    (tmp_path / "linked").symlink_to(tmp_path / "gone")
+    monkeypatch.setenv("MITOS_CACHE_DIR", str(tmp_path / "linked"))
+    st = cache.status()
+    assert st.path is None and st.reason == (f"no cache: {tmp_path / 'linked'} is a symbolic "
+                                             f"link to {tmp_path / 'gone'}, which does not exist")
+
+
 @pytest.mark.skipif(not hasattr(os, "lchown") or os.geteuid() != 0,
                     reason="giving a link to another user takes root")
 def test_a_link_of_another_user_on_the_way_to_the_cache_is_refused(tmp_path, monkeypatch):
