@@ -86,7 +86,9 @@ def test_the_command_writes_the_picture_and_the_usual_output(rear_end, tmp_path)
 
 
 def test_plot_of_several_worlds_is_refused(rear_end, tmp_path):
-    res = RUNNER.invoke(app, ["simulate", str(rear_end), str(rear_end), "--runs", "2",
+    other = tmp_path / "other.yaml"              # (one world twice is refused before that)
+    other.write_text(REAR_END, encoding="utf-8")
+    res = RUNNER.invoke(app, ["simulate", str(rear_end), str(other), "--runs", "2",
                               "--plot", str(tmp_path / "runs.png")])
     assert res.exit_code == 2
     assert "--plot draws one world" in res.output
