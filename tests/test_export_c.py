@@ -80,6 +80,10 @@ OPERATOR_CASES = [
     dict(and_="drastic", or_="drastic_sum", imp="min", agg="max", defuzz="centroid"),
     dict(and_="nilpotent_minimum", or_="nilpotent_maximum", imp="product",
          agg="nilpotent_maximum", defuzz="centroid"),
+    # the unbounded sum: an aggregation only (MATLAB's `sum`), the set may exceed 1
+    dict(and_="product", or_="max", imp="product", agg="sum", defuzz="centroid"),
+    dict(and_="min", or_="probabilistic_sum", imp="min", agg="sum", defuzz="bisector"),
+    dict(and_="min", or_="max", imp="min", agg="sum", defuzz="mom"),
 ]
 
 
@@ -172,7 +176,8 @@ def test_c_export_agrees_with_eval(tmp_path: Path) -> None:
 
 
 @needs_cc
-@pytest.mark.parametrize("case", OPERATOR_CASES, ids=[c["and_"] for c in OPERATOR_CASES])
+@pytest.mark.parametrize("case", OPERATOR_CASES,
+                         ids=[f"{c['and_']}-{c['agg']}" for c in OPERATOR_CASES])
 def test_c_export_operators_hedges_uses(case: dict, tmp_path: Path) -> None:
     c, X, want = reference(synthetic(tmp_path, case))
     agree(run_c(c, X, tmp_path), want)

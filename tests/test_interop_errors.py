@@ -182,7 +182,7 @@ FIS_CASES = [
     ("Type='mamdani'", "Type=mamdani", "expected a quoted text"),
     ("DefuzzMethod='centroid'", "DefuzzMethod='wtaver'", "does not fit a mamdani system"),
     ("AndMethod='min'", "AndMethod='bounded'", "unknown AND method `bounded`"),
-    ("AggMethod='max'", "AggMethod='sum'", "MATLAB's `sum` aggregation"),
+    ("OrMethod='max'", "OrMethod='sum'", "a Mamdani aggregation only"),
     ("[Input2]", "[Input3]", "expected [Input2], found [Input3]"),
     ("[Rules]", "[Ruels]", "unknown section [Ruels]"),
     ("NumInputs=2", "NumInputs=3", "NumInputs=3 but the file has 2"),

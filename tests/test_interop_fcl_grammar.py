@@ -61,7 +61,7 @@ LOADS = [
     *[("OR : MAX;", f"OR : {o};") for o in ("ASUM", "BSUM", "DMAX", "NIPMAX", "EINSTEIN")],
     *[("AND : MIN;", f"AND : {o};") for o in ("PROD", "BDIF", "DMIN", "NIPMIN", "HAMACHER")],
     ("ACT : MIN;", "ACT : PROD;"), ("ACCU : MAX;", "ACCU : BSUM;"),
-    ("ACCU : MAX;", "ACCU : PROBOR;"),
+    ("ACCU : MAX;", "ACCU : PROBOR;"), ("ACCU : MAX;", "ACCU : SUM;"), ("ACCU : MAX;", "ACCU : UNSUM;"),
     ("IF a IS low AND", "IF NOT a IS low AND"), ("IF a IS low AND", "IF a IS NOT low AND"),
     ("IF a IS low AND b IS low THEN", "IF (a IS low AND b IS low) THEN"),
     ("IF a IS low AND b IS low THEN", "IF NOT (a IS low OR b IS high) THEN"),
@@ -79,7 +79,7 @@ REFUSED = [
     ("METHOD : COG;", "METHOD : COGF;", "not a `triangle` term"),     # COGF is COGS
     ("METHOD : COG;", "METHOD : COGS;", "not a `triangle` term"),
     ("ACCU : MAX;", "ACCU : NSUM;", "the normalized sum"),
-    ("ACCU : MAX;", "ACCU : SUM;", "the unbounded sum"),
+    ("OR : MAX;", "OR : SUM;", "the unbounded sum is a Mamdani aggregation only"),
     ("IF a IS low AND b IS low THEN", "IF a AND b IS low THEN", "a condition without `IS`"),
     ("END_FUNCTION_BLOCK\n", "END_FUNCTION_BLOCK\nFUNCTION_BLOCK probe\nEND_FUNCTION_BLOCK\n",
      "two function blocks are named `probe`"),

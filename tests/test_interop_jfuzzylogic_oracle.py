@@ -146,23 +146,20 @@ def test_and_and_or_both_given_not_as_a_pair_say_what_jfuzzylogic_takes(lines, o
                      f"`{theirs[1]}`: give one of them, or their pair"]
 
 
-@pytest.mark.parametrize("accu, warned", [("", True), ("ACCU : MAX;", False),
-                                          ("ACCU : BSUM;", False)])
-def test_a_mamdani_output_without_accu_says_that_jfuzzylogic_sums(accu, warned):
-    """Without ACCU jFuzzyLogic sums the rules' sets (`ACCU : SUM`, its default), MITOS takes
-    their maximum: on two overlapping output terms the oracle's outputs differed by 0.142,
-    silently."""
+@pytest.mark.parametrize("accu, aggregation", [("", "sum"), ("ACCU : SUM;", "sum"),
+                                               ("ACCU : MAX;", "max"), ("ACCU : BSUM;", "bounded_sum")])
+def test_a_mamdani_output_without_accu_sums_as_jfuzzylogic_does(accu, aggregation):
+    """Without ACCU jFuzzyLogic sums the rules' sets (`ACCU : SUM`, its default,
+    `RuleBlock.fclTree`); MITOS took their maximum with a note (the oracle's outputs differed by
+    0.142 on two overlapping output terms) and now reads `aggregation = sum`, with no note."""
     text = DE_MORGAN.replace("CONNECTIVE", "AND : MIN").replace("ACCU : MAX;", accu)
     rb = parse_fcl(text, "dm.fcl")
-    notes = [n for n in rb.notes if "no `ACCU`" in n]
-    assert notes == (["dm.fcl:29:61: `y` is concluded by `r1` and `r2` with no "
-                      "`ACCU`: MITOS takes the maximum of their sets (its default); jFuzzyLogic "
-                      "sums them (its default, `ACCU : SUM`, which MITOS does not compute), so "
-                      "outputs differ where two overlapping sets fire: write `ACCU : MAX;` to "
-                      "say which"] if warned else [])
+    assert not [n for n in rb.notes if "ACCU" in n]
+    assert compile_rulebase(rb).operators.aggregation == aggregation
     weighted = SINGLETONS_UNDER_COG.replace("    ACCU : MAX;\n", "").replace(
         "END_DEFUZZIFY", "    METHOD : COGS;\nEND_DEFUZZIFY")
-    assert not [n for n in parse_fcl(weighted, "w.fcl").notes if "no `ACCU`" in n]
+    ops = compile_rulebase(parse_fcl(weighted, "w.fcl")).operators
+    assert (ops.inference, ops.accumulation) == ("weighted_average", "sum")
 
 
 # ---------------------------------------------------------------------------------------------

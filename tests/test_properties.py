@@ -231,6 +231,21 @@ def test_batch_row_equals_single_evaluation(rule_list, X):
         assert np.array_equal(bits(single.memberships[0]), bits(batch.memberships[i]))
 
 
+@given(rule_list=st.lists(rules(), min_size=1, max_size=6),
+       X=st.lists(st.tuples(st.floats(-20, 120), st.floats(-15, 15)), min_size=1, max_size=12))
+@settings(max_examples=40, deadline=None)
+def test_batch_row_equals_single_evaluation_under_a_summed_mamdani(rule_list, X):
+    """``aggregation = sum`` adds the implied sets in an order fixed by the rules alone."""
+    text = rulebase_text(rule_list).replace(
+        "\n", "\noperators: inference = mamdani, aggregation = sum, implication = product\n", 1)
+    compiled = compiled_of(text)
+    X = np.array(X, dtype=float)[:, [("a", "b").index(name) for name in compiled.inputs]]
+    batch = evaluate(compiled, X, strict=False)
+    for i in range(len(X)):
+        single = evaluate(compiled, X[i:i + 1], strict=False)
+        assert np.array_equal(bits(single.outputs[0]), bits(batch.outputs[i]))
+
+
 def test_batch_row_equals_single_across_blocks():
     """Rows in later cache blocks of a large batch equal their single evaluation too."""
     from mitos_cli import load_rulebase

@@ -56,6 +56,8 @@ def catalogue() -> dict[str, list[dict]]:
                 for n in norms.TNORMS.values()],
         "or / aggregation": [entry(n.name, n.formula, d.or_, aliases=list(n.aliases),
                                    dual=n.dual) for n in norms.SNORMS.values()],
+        "aggregation only": [entry(norms.UNBOUNDED_SUM.name, norms.UNBOUNDED_SUM.formula,
+                                   d.aggregation, aliases=list(norms.UNBOUNDED_SUM.aliases))],
         "inference": [entry(k, v, d.inference) for k, v in INFERENCE.items()],
         "implication": [entry(n.name, IMPLICATION.get(n.name, f"mu'(y) = {n.name}(dof, mu(y))"),
                               d.implication) for n in norms.TNORMS.values()],
@@ -73,6 +75,7 @@ TITLES = {
     "and": "T-norms (AND neurons)                    operators: and = NAME",
     "or / aggregation": "S-norms (OR neurons, Mamdani aggregation)  operators: or = NAME, "
                         "aggregation = NAME",
+    "aggregation only": "the unbounded sum (Mamdani only, not `or`)  operators: aggregation = sum",
     "inference": "inference methods (output layer)         operators: inference = NAME",
     "implication": "Mamdani implication (any T-norm)         operators: implication = NAME",
     "defuzzify": "Mamdani defuzzifiers                     operators: defuzzify = NAME, "

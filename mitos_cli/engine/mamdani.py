@@ -1,9 +1,11 @@
-"""Mamdani inference: implication, aggregation by an S-norm, defuzzification.
+"""Mamdani inference: implication, aggregation by an S-norm (or the sum), defuzzification.
 
 For each output variable the consequent sets are sampled once per compiled rule base on a grid
 of ``resolution`` points (:func:`build_tables`, cached as ``CompiledRuleBase.mamdani``). For a
 block of samples, each rule's DOF cuts (``min``) or scales (``product``) its consequent set, the
-rules' sets are joined by the aggregation S-norm, and the result is defuzzified:
+rules' sets are joined by the aggregation S-norm, or added (``aggregation = sum``, the unbounded
+sum of MATLAB's ``AggMethod='sum'`` and jFuzzyLogic's ``ACCU : SUM``: the set may exceed 1),
+and the result is defuzzified:
 
 ``centroid``   ``sum(x mu) / sum(mu)``
 ``bisector``   the sample where the cumulative area is closest to half the total (mean of ties)
@@ -33,11 +35,11 @@ a midpoint rarely hits, and returns NaN.)
 **Speed.** With ``max`` aggregation the rules that share a consequent set are first joined on
 their DOFs (``max_r I(d_r, mu) = I(max_r d_r, mu)`` for a monotone implication, exactly), so
 the sampled work scales with the number of distinct consequent sets, not of rules; other
-S-norms reduce the ``[rules, samples, resolution]`` stack by a pairwise tree (log2 R vectorized
-steps). Samples are processed in sub-blocks so that no intermediate array exceeds
-:data:`MAX_BYTES` (when one sample's stack alone exceeds :data:`MAX_STACK_BYTES`, its rules
-are taken in chunks, joined by the same S-norm). Everything is elementwise per sample or a reduction
-along one sample's own
+S-norms and the sum reduce the ``[rules, samples, resolution]`` stack by a pairwise tree (log2
+R vectorized steps, in an order fixed by R alone, as ``evaluation.tree_sum``). Samples are
+processed in sub-blocks so that no intermediate array exceeds :data:`MAX_BYTES` (when one
+sample's stack alone exceeds :data:`MAX_STACK_BYTES`, its rules are taken in chunks, joined by
+the same S-norm). Everything is elementwise per sample or a reduction along one sample's own
 row, so a single evaluation is bit for bit its row in a batch.
 """
 
@@ -278,7 +280,7 @@ def defuzzify(Y: np.ndarray, x: np.ndarray, method: str) -> np.ndarray:
 def mamdani_outputs(compiled, dof: np.ndarray) -> np.ndarray:
     """Output layer of a Mamdani behavior: DOFs ``[R, b]`` -> crisp outputs ``[m, b]``."""
     ops = compiled.operators
-    aggregation = norms.lookup("snorm", ops.aggregation)
+    aggregation = norms.aggregation(ops.aggregation)
     b = dof.shape[1]
     out = np.empty((len(compiled.outputs), b))
     for j, table in enumerate(compiled.mamdani):      # loop over outputs (one or two)

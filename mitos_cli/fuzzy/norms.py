@@ -250,6 +250,21 @@ for _norm in (
     register(_norm)
 
 
+#: The unbounded sum ``a + b``: a Mamdani aggregation only (MATLAB's ``AggMethod='sum'``,
+#: jFuzzyLogic's ``ACCU : SUM``, fuzzylite's ``UnboundedSum``), not an S-norm: it leaves
+#: [0, 1], so it is kept out of :data:`SNORMS` and cannot join conditions (``or``).
+UNBOUNDED_SUM = Norm("sum", "snorm", np.add, "a + b (unbounded: may exceed 1)", "",
+                     ("unbounded_sum",), scalar="r = a + b", c="return a + b;", numpy="a + b",
+                     fll="UnboundedSum", fis="sum", fcl="SUM")
+
+
+def aggregation(name: str) -> Norm:
+    """The Mamdani aggregation called ``name``: an S-norm, or the unbounded sum."""
+    if name == UNBOUNDED_SUM.name or name in UNBOUNDED_SUM.aliases:
+        return UNBOUNDED_SUM
+    return lookup("snorm", name)
+
+
 def get(name: str) -> Norm:
     """The T- or S-norm of this canonical name (the two tables share no name)."""
     return TNORMS[name] if name in TNORMS else SNORMS[name]

@@ -32,6 +32,9 @@ from . import rewrite
 
 TNORMS = {n.name: (n.fll, n.fis, n.fcl) for n in norm_registry.TNORMS.values()}
 SNORMS = {n.name: (n.fll, n.fis, n.fcl) for n in norm_registry.SNORMS.values()}
+#: Mamdani aggregations: the S-norms and the unbounded sum (an aggregation only, not for OR).
+_SUM = norm_registry.UNBOUNDED_SUM
+AGGREGATIONS = {**SNORMS, _SUM.name: (_SUM.fll, _SUM.fis, _SUM.fcl)}
 #: Defuzzifiers of Mamdani inference; the two weighted ones are MITOS inferences.
 DEFUZZIFIERS = {
     "centroid": ("Centroid", "centroid", "COG"),
@@ -52,6 +55,7 @@ FCL_ALIASES = {"BIS": "bisector", "MOM": "mom", "SOM": "som", "LOM": "lom",
                # of singletons as its COGS (DefuzzifierCenterOfGravityFunctions)
                "COGF": "weighted_average",
                "ALGEBRAIC_PRODUCT": "product", "PROBOR": "probabilistic_sum",
+               "UNSUM": "sum",                  # fuzzylite 6's FclExporter: UnboundedSum
                "DMIN": "drastic", "DMAX": "drastic_sum", "NIPMIN": "nilpotent_minimum",
                "NIPMAX": "nilpotent_maximum", "EINSTEIN": "einstein", "HAMACHER": "hamacher"}
 #: The names Octave's fuzzy-logic-toolkit (and fuzzylite's .fis exporter) give the norms
@@ -62,14 +66,16 @@ FIS_ALIASES = {"algebraic_product": "product", "bounded_difference": "lukasiewic
                "algebraic_sum": "probabilistic_sum", "bounded_sum": "bounded_sum",
                "drastic_sum": "drastic_sum", "einstein_sum": "einstein_sum",
                "hamacher_sum": "hamacher_sum", "nilpotent_maximum": "nilpotent_maximum"}
+_ONLY_AGGREGATION = ("the unbounded sum is a Mamdani aggregation only (`aggregation = sum`), "
+                     "not an S-norm joining conditions")
 #: Names formats use for operators MITOS does not have (refused with this explanation).
 UNSUPPORTED_NORMS = {
     "NormalizedSum": "the normalized sum is not an S-norm MITOS computes",
-    "UnboundedSum": "the unbounded sum is not an S-norm MITOS computes",
+    "UnboundedSum": _ONLY_AGGREGATION,
     "NSUM": "the normalized sum is not an S-norm MITOS computes",
-    "UNSUM": "the unbounded sum is not an S-norm MITOS computes",
-    "SUM": "the unbounded sum is not an S-norm MITOS computes",
-    "sum": "MATLAB's `sum` aggregation (unbounded) is not an S-norm MITOS computes",
+    "UNSUM": _ONLY_AGGREGATION,
+    "SUM": _ONLY_AGGREGATION,
+    "sum": _ONLY_AGGREGATION,
 }
 
 FLL, FIS, FCL = 0, 1, 2

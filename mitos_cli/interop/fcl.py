@@ -270,7 +270,6 @@ def _function_block(fb: Tree, span_of) -> RuleBase:
     groups = common.rule_blocks(parsed, {n: records[n] for n in outputs},
                                 renumber=len({r.label for r in all_rules}) < len(all_rules))
     _check_outputs(groups, locks, constants)
-    _no_accu_note(groups, notes)
     _accumulation(groups)
     ordered = [variables[n] for n in declared]
     rb = common.assemble_blocks(span_of(fb).path, ordered, groups, DEFAULT_RESOLUTION,
@@ -374,28 +373,6 @@ def _both_note(block: Tree, record: common.Record, span_of, notes: list[str]) ->
                      f"given, not as a pair: MITOS uses each, as fuzzylite does; jFuzzyLogic "
                      f"sets both from each line, so its last, `{key} : {value}`, gives AND "
                      f"`{theirs[0]}` and OR `{theirs[1]}`: give one of them, or their pair")
-
-
-def _no_accu_note(groups: list[tuple[str, list[Rule], common.Settings]],
-                  notes: list[str]) -> None:
-    """Say where two rules conclude a Mamdani output and no ``ACCU`` is given: jFuzzyLogic
-    then sums their sets (its default, ``ACCU : SUM``, `RuleBlock.fclTree`), which MITOS does
-    not compute; MITOS takes their maximum, its default."""
-    for _, rules, settings in groups:
-        if settings.sugeno or settings.aggregation is not None:
-            continue
-        by_var: dict[str, list[tuple[Rule, Span | None]]] = {}
-        for r in rules:
-            for c in r.consequents:
-                by_var.setdefault(c.var, []).append((r, c.span))
-        shared = [(var, found) for var, found in by_var.items() if len(found) > 1]
-        if shared:
-            var, ((first, _), (second, span), *_) = shared[0]
-            notes.append(f"{span}: `{var}` is concluded by `{first.label}` and `{second.label}` "
-                         f"with no `ACCU`: MITOS takes the maximum of their sets (its default); "
-                         f"jFuzzyLogic sums them (its default, `ACCU : SUM`, which MITOS does not "
-                         f"compute), so outputs differ where two overlapping sets fire: write "
-                         f"`ACCU : MAX;` to say which")
 
 
 def _check_outputs(groups: list, locks: dict[str, Span],
@@ -741,10 +718,8 @@ def _option(item: Tree, settings: common.Record, span_of, conj: dict) -> None:
             raise FormatError(f"activation `{value}` is not supported: MITOS activates every "
                               f"rule", span=span)
     elif key == "ACCU":
-        if value.upper() == "SUM":          # jFuzzyLogic's default: read under COGS (below)
-            settings.set("aggregation", "sum", span, "ACCU")
-        else:
-            settings.set("aggregation", _norm(common.SNORMS, value, "ACCU", span), span, "ACCU")
+        # SUM: jFuzzyLogic's default, the unbounded sum (under COGS the accumulation, below)
+        settings.set("aggregation", _norm(common.AGGREGATIONS, value, "ACCU", span), span, "ACCU")
     elif key == "METHOD":
         method = _norm(common.DEFUZZIFIERS, value, "METHOD", span)
         settings.set("defuzzify", method, span, "METHOD")
@@ -770,16 +745,12 @@ def _accumulation(groups: list[tuple[str, list[Rule], common.Settings]]) -> None
     jFuzzyLogic (and IEC 61131-7) join the rules that conclude one singleton value with the
     ACCU norm (`RuleActivationMethod.imply` at the defuzzifier's point of that value) before
     the weighted average; without ACCU (or with ``ACCU : SUM``) it sums them, which is
-    MITOS's default. Elsewhere the unbounded sum is no S-norm, and refused."""
+    MITOS's default. A Mamdani output without ACCU sums its rules' sets, jFuzzyLogic's
+    default (`RuleBlock.fclTree`), ``aggregation = sum``."""
     for _, _, settings in groups:
         weighted = settings.defuzzify in ("weighted_average", "weighted_sum")
-        if settings.aggregation == "sum" and not weighted:
-            raise FormatError("ACCU `SUM` is not supported: the unbounded sum is not an S-norm "
-                              "MITOS computes", span=(settings.spans or {}).get("aggregation"),
-                              expected="one of " + ", ".join(
-                                  str(n[FCL]) for n in common.SNORMS.values() if n[FCL]),
-                              hint="it is read under METHOD : COGS or COGF, where it sums "
-                                   "the rules of one value as MITOS's default does")
+        if not weighted and not settings.sugeno and settings.aggregation is None:
+            settings.aggregation = "sum"
         if weighted and settings.aggregation:
             settings.accumulation = settings.aggregation
             if settings.aggregation == "sum":
@@ -887,7 +858,7 @@ def write_fcl(rb: RuleBase, behavior: str | None = None, dialect: str = DEFAULT_
     sugeno = ops.inference in ("weighted_average", "weighted_sum")
     inputs = common.all_inputs(rb, flat)
     accu = None if sugeno else common.foreign_name(
-        common.SNORMS, FCL, ops.aggregation, "S-norm", span=at("aggregation"))
+        common.AGGREGATIONS, FCL, ops.aggregation, "S-norm", span=at("aggregation"))
     if ops.accumulated:                 # ACCU under COGS: jFuzzyLogic's join at a singleton
         accu = common.foreign_name(common.SNORMS, FCL, ops.accumulation, "S-norm",
                                    span=at("accumulation"))

@@ -203,7 +203,7 @@ def _settings(system: dict[str, tuple[str, Span]], sys_span: Span,
         settings.set("implication", common.check_implication(
             method("ImpMethod", common.TNORMS, "implication method", "min"),
             system.get("ImpMethod", ("", sys_span))[1]), None, "implication")
-        settings.set("aggregation", method("AggMethod", common.SNORMS, "aggregation method",
+        settings.set("aggregation", method("AggMethod", common.AGGREGATIONS, "aggregation method",
                                            "max"), None, "aggregation")
         settings.set("resolution", DEFAULT_RESOLUTION, None, "resolution")
         settings.set("sampling", "endpoints", None, "sampling")
@@ -466,7 +466,7 @@ def write_fis(rb: RuleBase, behavior: str | None = None) -> str:
     else:
         imp = common.foreign_name(common.TNORMS, FIS, ops.implication, "implication",
                                   span=at("implication"))
-        agg = common.foreign_name(common.SNORMS, FIS, ops.aggregation, "aggregation",
+        agg = common.foreign_name(common.AGGREGATIONS, FIS, ops.aggregation, "aggregation",
                                   span=at("aggregation"))
         defuzz = common.foreign_name(common.DEFUZZIFIERS, FIS, ops.defuzzify, "defuzzifier",
                                      span=at("defuzzify"))

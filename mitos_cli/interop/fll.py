@@ -266,7 +266,7 @@ def _variable_key(v: _Var, key: str, value: str, span: Span, vspan: Span,
         v.default_span = vspan
     elif key in ("aggregation", "accumulation"):
         if value != "none":
-            settings.set("aggregation", common.table_lookup(common.SNORMS, FLL, value,
+            settings.set("aggregation", common.table_lookup(common.AGGREGATIONS, FLL, value,
                                                             "aggregation", vspan), vspan,
                           "aggregation")
     elif key == "defuzzifier":
@@ -447,7 +447,7 @@ def write_fll(rb: RuleBase, behavior: str | None = None) -> str:
                 kind = common.DEFUZZIFIERS[ops.inference][FLL]
                 out.append(f"  defuzzifier: {kind} TakagiSugeno")
         else:
-            aggregation = common.foreign_name(common.SNORMS, FLL, ops.aggregation, "S-norm",
+            aggregation = common.foreign_name(common.AGGREGATIONS, FLL, ops.aggregation, "S-norm",
                                               span=at("aggregation"))
             out.append(f"  aggregation: {aggregation}")
             kind = common.foreign_name(common.DEFUZZIFIERS, FLL, ops.defuzzify, "defuzzifier",

@@ -95,11 +95,19 @@ def _check(key: str, value: str, span: Span | None) -> str | int:
             raise unknown(what, value, norms.names("tnorm"), span=span) from None
     if key == "accumulation" and value in ACCUMULATIONS:
         return value
+    if key == "aggregation" and value in ("sum",) + norms.UNBOUNDED_SUM.aliases:
+        return "sum"
+    if key == "or" and value in ("sum",) + norms.UNBOUNDED_SUM.aliases:
+        raise RuleBaseError(f"`or = {value}`: the unbounded sum is a Mamdani aggregation only "
+                            f"(`aggregation = sum`), not an S-norm: it leaves [0, 1]",
+                            span=span, hint="did you mean `or = bounded_sum` (min(1, a + b)) "
+                                            "or `or = probabilistic_sum` (a + b - a b)?")
     if key in ("or", "aggregation", "accumulation"):
         try:
             return norms.lookup("snorm", value).name
         except KeyError:
-            choices = norms.names("snorm") + (list(ACCUMULATIONS) if key == "accumulation" else [])
+            extra = {"accumulation": list(ACCUMULATIONS), "aggregation": ["sum"]}.get(key, [])
+            choices = norms.names("snorm") + extra
             raise unknown("S-norm", value, choices, span=span) from None
     among = {"inference": INFERENCES, "defuzzify": DEFUZZIFIERS,
              "sampling": SAMPLINGS}.get(key)

@@ -238,7 +238,7 @@ def _mamdani_sets(compiled: CompiledRuleBase, dof: np.ndarray):
     from ...fuzzy import norms
 
     ops = compiled.operators
-    aggregation = norms.lookup("snorm", ops.aggregation)
+    aggregation = norms.aggregation(ops.aggregation)
     out = []
     for table in compiled.mamdani:            # one per output
         sets = table.sets[table.set_of]                           # [R_j, res]

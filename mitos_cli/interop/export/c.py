@@ -23,7 +23,7 @@ import numpy as np
 from ...engine.compile import CompiledRuleBase
 from ...errors import FormatError
 from ...fuzzy.hedges import HEDGES
-from ...fuzzy.norms import SNORMS, TNORMS
+from ...fuzzy.norms import SNORMS, TNORMS, UNBOUNDED_SUM
 from ...words import plural
 from .program import PLAIN, Program, ident, num, program, unique_idents, weighted_sums
 
@@ -105,7 +105,7 @@ double f, double rt) {
 }""",
 }
 
-C_NORMS = {n.name: n.c for n in (*TNORMS.values(), *SNORMS.values())}   # fuzzy/norms.py
+C_NORMS = {n.name: n.c for n in (*TNORMS.values(), *SNORMS.values(), UNBOUNDED_SUM)}   # fuzzy/norms.py
 
 C_HEDGES = {h.name: h.c for h in HEDGES.values()}   # fuzzy/hedges.py
 

@@ -14,11 +14,11 @@ import numpy as np
 
 from ...engine.compile import CompiledRuleBase
 from ...fuzzy.hedges import HEDGES
-from ...fuzzy.norms import SNORMS, TNORMS
+from ...fuzzy.norms import SNORMS, TNORMS, UNBOUNDED_SUM
 from ...words import plural
 from .program import PLAIN, Program, num, program, weighted_sums
 
-PY_NORMS = {n.name: n.numpy for n in (*TNORMS.values(), *SNORMS.values())}   # fuzzy/norms.py
+PY_NORMS = {n.name: n.numpy for n in (*TNORMS.values(), *SNORMS.values(), UNBOUNDED_SUM)}   # fuzzy/norms.py
 
 PY_HEDGES = {h.name: h.numpy for h in HEDGES.values()}   # fuzzy/hedges.py
 
