@@ -244,3 +244,37 @@ def test_a_format_s_sum_as_or_is_refused(text, name, words):
     with pytest.raises(FormatError) as info:
         parse(text, name)
     assert words in info.value.message
+
+
+def test_a_takagi_sugeno_output_with_unbounded_sum_reads_as_none():
+    """fuzzylite 8 joins the weights of the rules concluding one term with the output's
+    aggregation: the unbounded sum adds them, as MITOS counts every rule (`aggregation: none`)."""
+    text = """Engine: ts
+InputVariable: a
+  range: 0 10
+  term: low Triangle 0 2 5
+  term: high Triangle 5 8 10
+InputVariable: b
+  range: 0 1
+  term: small Ramp 1 0
+  term: big Ramp 0 1
+OutputVariable: y
+  range: 0 1
+  aggregation: none
+  defuzzifier: WeightedAverage TakagiSugeno
+  term: off Constant 0.2
+  term: on Linear 0.01 0.5 0.1
+RuleBlock: main
+  conjunction: Minimum
+  disjunction: Maximum
+  implication: none
+  rule: if a is low and b is small then y is off
+  rule: if a is high or b is big then y is off with 0.5
+  rule: if b is big then y is on
+"""
+    none = compile_rulebase(parse_fll(text, "s.fll"))
+    summed = compile_rulebase(parse_fll(text.replace("aggregation: none",
+                                                     "aggregation: UnboundedSum"), "s.fll"))
+    assert summed.operators == none.operators
+    grid = np.array([[1.0, 0.2], [6.0, 0.7], [3.0, 0.9]])
+    assert np.array_equal(evaluate(summed, grid).outputs, evaluate(none, grid).outputs)

@@ -114,6 +114,7 @@ def test_difference_gradient_is_the_slope_of_q(seed):
     ("implication = product, aggregation = probabilistic_sum, defuzzify = centroid", 0.05, 100),
     ("defuzzify = bisector", 0.1, 300),
     ("defuzzify = mom", 0.2, 300),
+    ("implication = product, aggregation = sum, defuzzify = centroid", 0.05, 100),
 ])
 def test_q_falls_substantially_and_never_rises(ops, factor, n):
     c = compiled(ops)

@@ -397,8 +397,9 @@ def _check_operators(tree, conj: dict, span_of) -> None:
 
 def _check_grouping(variables: list[_Var], rules: list[Rule], settings: Settings) -> None:
     """fuzzylite 8 aggregates the activations of one output term (weighted defuzzifiers) with
-    the output's aggregation; without one (``none``) it sums them, as MITOS does per rule."""
-    if settings.aggregation is None:
+    the output's aggregation; without one (``none``) or with ``UnboundedSum`` it sums them, as
+    MITOS does per rule."""
+    if settings.aggregation in (None, "sum"):
         return
     seen: dict[tuple[str, str | None], Span | None] = {}
     for r in rules:
