@@ -278,3 +278,23 @@ RuleBlock: main
     assert summed.operators == none.operators
     grid = np.array([[1.0, 0.2], [6.0, 0.7], [3.0, 0.9]])
     assert np.array_equal(evaluate(summed, grid).outputs, evaluate(none, grid).outputs)
+
+
+def test_the_rule_view_shows_a_summed_set_above_1():
+    """The aggregate's axis stopped at 1.12: a summed set above 1 was cut off."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from mitos_cli.draw.data.ruleviews import OutputView
+    from mitos_cli.draw.rules import draw_aggregate
+
+    grid = np.linspace(0, 10, 101)
+    fig, ax = plt.subplots()
+    try:
+        draw_aggregate(ax, OutputView("y", "", (0.0, 10.0), "mamdani", 5.0, False, grid=grid,
+                                      aggregate=1.6 * np.exp(-(grid - 5) ** 2)))
+        assert ax.get_ylim()[1] > 1.6
+    finally:
+        plt.close(fig)

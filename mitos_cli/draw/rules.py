@@ -132,17 +132,20 @@ def draw_aggregate(ax, out: OutputView) -> None:
     gid = f"aggregate:{out.name}"
     stems = (spikes(out.grid, out.aggregate)
              if out.aggregate is not None and out.grid is not None else None)
+    # `aggregation = sum` may lift the set above 1: the axis grows with it
+    tall = max(1.0, float(np.nanmax(out.aggregate, initial=0.0))) if out.aggregate is not None \
+        else 1.0
     if stems is not None:                    # Mamdani over singletons: the heights as stems
         for v, w in stems:
             ax.vlines([v], 0, [w], color=OUT_COLOR, linewidth=2.4, gid=gid)
             ax.text(v, w + 0.03, f"{w:.2f}", fontsize=6.5, ha="center", va="bottom",
                     color="#333333")
-        ax.set_ylim(0, 1.25)
+        ax.set_ylim(0, 1.25 * tall)
     elif out.aggregate is not None and out.grid is not None:
         ax.fill_between(out.grid, out.aggregate, color=OUT_COLOR, alpha=0.7, linewidth=0,
                         gid=gid)
         ax.plot(out.grid, out.aggregate, color=OUT_COLOR, linewidth=0.8, gid=gid)
-        ax.set_ylim(0, 1.12)
+        ax.set_ylim(0, 1.12 * tall)
     else:
         top = max((w for _, w in out.stems), default=1.0)
         # summed DOFs, scaled so the tallest stem fills the cell (its value is printed)
