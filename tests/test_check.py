@@ -745,6 +745,8 @@ def test_a_rule_weighted_0_is_no_conflict(tmp_path):
      "it changes nothing (max aggregation keeps the stronger of the two)"),
     ("operators: inference = mamdani, aggregation = bounded_sum\n",
      "its set is aggregated twice (bounded_sum)"),
+    ("operators: inference = mamdani, aggregation = sum\n",
+     "its set is added twice (aggregation = sum)"),
 ])
 
 

@@ -298,3 +298,11 @@ def test_the_rule_view_shows_a_summed_set_above_1():
         assert ax.get_ylim()[1] > 1.6
     finally:
         plt.close(fig)
+
+
+def test_check_samples_a_summed_behavior():
+    """`mitos check`'s grid evaluates the summed Mamdani behavior like any other."""
+    from mitos_cli.engine.check import check_rulebase
+
+    report = check_rulebase(parse_fcl(FCL, "s.fcl"))
+    assert [f for f in report.findings if f.severity == "error"] == []

@@ -424,6 +424,8 @@ def _twice(operators) -> str:
         return f"it counts twice in the weighted {'sum' if summed else 'average'}"
     if operators.aggregation == "max":
         return "it changes nothing (max aggregation keeps the stronger of the two)"
+    if operators.aggregation == "sum":
+        return "its set is added twice (aggregation = sum)"
     return f"its set is aggregated twice ({operators.aggregation})"
 
 
