@@ -97,6 +97,9 @@ def test_operators_command_json(capsys):
     data = json.loads(out)
     assert [e["name"] for e in data["and"]] == list(norms.TNORMS)
     assert [e["name"] for e in data["or / aggregation"]] == list(norms.SNORMS)
+    # the unbounded sum: an aggregation only, listed apart from the S-norms
+    assert [(e["name"], e["aliases"]) for e in data["aggregation only"]] == [
+        ("sum", ["unbounded_sum"])]
     assert {e["name"] for e in data["inference"] if e["default"]} == {"weighted_average"}
     # every T-norm is accepted as a Mamdani implication, so every one is listed as one
     from mitos_cli.lang.operators import IMPLICATIONS

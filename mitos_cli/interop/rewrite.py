@@ -88,7 +88,7 @@ def unchain(rules: list[Rule], outputs: set[str], and_: str, or_: str,
             if len(found) > 1 and aggregation != or_:
                 raise FormatError(
                     f"rule `{rule.label}` tests the output `{expr.var}`, which aggregates "
-                    f"{len(found)} rules with `{aggregation or 'the unbounded sum'}`; MITOS "
+                    f"{len(found)} rules with `{aggregation or 'sum'}`; MITOS "
                     f"can restate that only when the rule block's disjunction is the same "
                     f"(here `{or_}`)", span=expr.span or rule.span)
             joined = found[0] if len(found) == 1 else Or(tuple(found), expr.span)
