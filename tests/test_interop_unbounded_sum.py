@@ -11,6 +11,7 @@ triangles, two rules concluding ``m``: the summed set exceeds the max one where 
 
 from __future__ import annotations
 
+from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -181,9 +182,12 @@ def test_every_reader_reads_the_sum_and_every_writer_writes_it():
     for rb in rbs:
         assert compile_rulebase(rb).operators.aggregation == "sum"
         assert "AggMethod='sum'" in write_fis(rb)
-        assert "ACCU : SUM;" in write_fcl(rb)
+        assert "ACCU : SUM;" in write_fcl(rb, dialect="iec")             # jFuzzyLogic's name
+        # fuzzylite 6's FCL reader knows it by class name only (`ACCU : SUM` fails its import)
+        assert "ACCU : UnboundedSum;" in write_fcl(rb)
         assert "aggregation: UnboundedSum" in write_fll(rb)
         for parse, write, name in ((parse_fis, write_fis, "b.fis"), (parse_fcl, write_fcl, "b.fcl"),
+                                   (parse_fcl, partial(write_fcl, dialect="iec"), "b.fcl"),
                                    (parse_fll, write_fll, "b.fll")):
             back = compile_rulebase(parse(write(rb), name))
             assert back.operators.aggregation == "sum"

@@ -55,7 +55,7 @@ FCL_ALIASES = {"BIS": "bisector", "MOM": "mom", "SOM": "som", "LOM": "lom",
                # of singletons as its COGS (DefuzzifierCenterOfGravityFunctions)
                "COGF": "weighted_average",
                "ALGEBRAIC_PRODUCT": "product", "PROBOR": "probabilistic_sum",
-               "UNSUM": "sum",                  # fuzzylite 6's FclExporter: UnboundedSum
+               "UNSUM": "sum",                  # the unbounded sum's other abbreviation
                "DMIN": "drastic", "DMAX": "drastic_sum", "NIPMIN": "nilpotent_minimum",
                "NIPMAX": "nilpotent_maximum", "EINSTEIN": "einstein", "HAMACHER": "hamacher"}
 #: The names Octave's fuzzy-logic-toolkit (and fuzzylite's .fis exporter) give the norms

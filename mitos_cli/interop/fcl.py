@@ -859,6 +859,9 @@ def write_fcl(rb: RuleBase, behavior: str | None = None, dialect: str = DEFAULT_
     inputs = common.all_inputs(rb, flat)
     accu = None if sugeno else common.foreign_name(
         common.AGGREGATIONS, FCL, ops.aggregation, "S-norm", span=at("aggregation"))
+    if accu is not None and ops.aggregation == "sum" and dialect == "fuzzylite":
+        # fuzzylite 6's FCL reader has no abbreviation for it (`SUM` fails the whole import)
+        accu = common.AGGREGATIONS["sum"][FLL]
     if ops.accumulated:                 # ACCU under COGS: jFuzzyLogic's join at a singleton
         accu = common.foreign_name(common.SNORMS, FCL, ops.accumulation, "S-norm",
                                    span=at("accumulation"))
