@@ -310,3 +310,12 @@ def test_check_samples_a_summed_behavior():
 
     report = check_rulebase(parse_fcl(FCL, "s.fcl"))
     assert [f for f in report.findings if f.severity == "error"] == []
+
+
+def test_a_study_s_or_of_sum_is_refused_as_an_aggregation_only():
+    from mitos_cli.study.spec import canonical_snorm
+
+    with pytest.raises(MitosError) as info:
+        canonical_snorm("sum", "min")
+    assert "a Mamdani aggregation only" in info.value.message
+    assert "bounded_sum" in (info.value.hint or "")

@@ -89,6 +89,10 @@ def canonical_snorm(name: str, tnorm: str) -> str:
         if not tnorm:
             return ""
         return norms.lookup("tnorm", tnorm).dual
+    if name in (norms.UNBOUNDED_SUM.name, *norms.UNBOUNDED_SUM.aliases):
+        raise InputError(f"S-norm `{name}`: the unbounded sum is a Mamdani aggregation only, not "
+                         f"an S-norm for `or`", hint="did you mean `bounded_sum` (min(1, a + b)) "
+                                                     "or `probabilistic_sum` (a + b - a b)?")
     try:
         return norms.lookup("snorm", name).name
     except KeyError:
