@@ -42,18 +42,10 @@ ROUNDED = 5e-7 + 1e-12
 #: Causes read in jFuzzyLogic's source for differences :func:`cause_of` does not recognise, by
 #: file name
 KNOWN = {
-    "junit_shashankrao.fcl":
-        "zero-width terms at 0 (`TRIAN 0 0 0`, the peak of `TRIAN -0.4 0 0`): jFuzzyLogic "
-        "steps x += step from -1 (RuleActivationMethod.imply), so its sample near 0 is "
-        "8.7e-16, where those terms are 0; MITOS samples -1 + 500 step = 0 exactly",
     # the grammar cases (grammar_cases)
     "09_METHOD_COA.fcl": "jFuzzyLogic's COA walks in from both ends until they meet "
         "(DefuzzifierCenterOfArea), which in a gap of zeros between two equal areas stops at "
         "its left edge (3.99 where MITOS's bisector gives the middle, 4.995)",
-    "10_METHOD_LM.fcl": "one sample: on a plateau jFuzzyLogic's memberships at its accumulated "
-        "positions (x += step) differ in the last bits, and LM takes the first strict maximum",
-    "12_METHOD_MM.fcl": "jFuzzyLogic's MM averages the samples exactly equal to the maximum; "
-        "at its accumulated positions (x += step) some plateau samples differ in the last bits",
 }
 
 

@@ -84,9 +84,20 @@ def grid(lo: float, hi: float, resolution: int, sampling: str = "midpoints") -> 
     ``"left"``: the cells' left ends, as jFuzzyLogic)."""
     if sampling == "endpoints":
         return np.linspace(lo, hi, resolution)
-    if sampling == "left":                    # jFuzzyLogic: the cells' left ends
-        return lo + np.arange(resolution) * ((hi - lo) / resolution)
+    if sampling == "left":    # jFuzzyLogic: the cells' left ends, reached as it reaches them
+        return _stepped(lo, (hi - lo) / resolution, resolution)
     return lo + (np.arange(resolution) + 0.5) * ((hi - lo) / resolution)
+
+
+def _stepped(lo: float, step: float, n: int) -> np.ndarray:
+    """``n`` points from ``lo`` by adding ``step`` to the one before, one at a time, as
+    jFuzzyLogic's loops do (``x += step``): the rounding accumulates, so its points drift from
+    ``lo + i step`` by a few units in the last place, and a term 1 only at one point (a zero-
+    width triangle at 0) may be hit by one and missed by the other. ``np.add.accumulate`` adds
+    in order, one element after another."""
+    steps = np.full(n, step)
+    steps[0] = lo
+    return np.add.accumulate(steps)
 
 
 def spike(lo: float, hi: float, resolution: int, value: float,

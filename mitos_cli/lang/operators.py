@@ -21,7 +21,7 @@ DEFUZZIFIERS = ("centroid", "bisector", "mom", "som", "lom",
                 "matlab_bisector", "matlab_som", "matlab_lom")      # MATLAB's evalfis
 #: Where Mamdani outputs are sampled: cell midpoints (fuzzylite's rule, the default),
 #: ``resolution`` evenly spaced points including both ends (MATLAB's ``evalfis``), or the
-#: cells' left ends (jFuzzyLogic's ``min + i (max - min) / resolution``).
+#: cells' left ends (jFuzzyLogic's, each reached from the one before: ``x += (max - min) / resolution``).
 SAMPLINGS = ("midpoints", "endpoints", "left")
 #: How weighted inference joins the rules that conclude one value of an output: ``sum`` counts
 #: each rule in the average (fuzzylite 6, MATLAB); an S-norm first joins their DOFs into one
