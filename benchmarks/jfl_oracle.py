@@ -44,8 +44,9 @@ ROUNDED = 5e-7 + 1e-12
 KNOWN = {
     # the grammar cases (grammar_cases)
     "09_METHOD_COA.fcl": "jFuzzyLogic's COA walks in from both ends until they meet "
-        "(DefuzzifierCenterOfArea), which in a gap of zeros between two equal areas stops at "
-        "its left edge (3.99 where MITOS's bisector gives the middle, 4.995)",
+        "(DefuzzifierCenterOfArea), which in a gap of zeros between two areas need not stop "
+        "in its middle (3.99 where MITOS's bisector gives 4.995): --fidelity jfuzzylogic computes "
+        "it so (`defuzzify = jfuzzylogic_bisector`)",
 }
 
 
@@ -212,7 +213,8 @@ def cause_of(name: str, diff: float, fidelity: float, notes: tuple[str, ...],
     if diff <= tolerance:
         return ""
     if fidelity <= tolerance:
-        return "sampling (1000 midpoints; jFuzzyLogic: 1000 left ends): --fidelity closes it"
+        known = KNOWN.get(Path(name).name)
+        return known or "sampling (1000 midpoints; jFuzzyLogic: 1000 left ends): --fidelity closes it"
     said = [n.split(": ", 1)[-1] for n in notes
             if re.search(r"ACCU|OR` before|not as a pair|singleton under", n)]
     if said:

@@ -18,6 +18,7 @@ import pytest
 
 from mitos_cli.api import load_rulebase
 from mitos_cli.cli.app import app
+from mitos_cli.engine.evaluation import evaluate
 from mitos_cli.interop.export import to_c, to_python
 
 ROOT = Path(__file__).parents[1]
@@ -262,6 +263,28 @@ def test_matlabs_defuzzifiers_export_as_eval_computes_them(method: str, tmp_path
     c, X, want = reference(path)
     agree(run_c(c, X, tmp_path), want)
     agree(run_python(c, X, tmp_path), want)
+
+
+@needs_cc
+def test_jfuzzylogics_coa_exports_as_eval_computes_it(tmp_path: Path) -> None:
+    """``--fidelity jfuzzylogic``'s COA (``jfuzzylogic_bisector``): the C function runs
+    jFuzzyLogic's loop, the Python module the engine's loop-free count; both give eval's
+    bits, on the grammar case where it is 1 from fuzzylite's bisector."""
+    from test_interop_fcl_grammar import BASE
+
+    from mitos_cli.api import LoadedRuleBase
+    from mitos_cli.interop.common import fidelity_settings
+    from mitos_cli.interop.fcl import parse_fcl
+
+    rb = parse_fcl(BASE.replace("METHOD : COG;", "METHOD : COA;"), "probe.fcl")
+    c = LoadedRuleBase(rb, None, fidelity_settings(rb, "jfuzzylogic")).compiled
+    assert c.operators.defuzzify == "jfuzzylogic_bisector"
+    k = np.linspace(0, 10, 17)
+    X = np.array([(a, b) for a in k for b in k])
+    want = evaluate(c, X, detail=False).outputs
+    assert want[np.flatnonzero((X == [2.5, 5.0]).all(axis=1))[0], 0] == 3.99
+    assert np.array_equal(run_c(c, X, tmp_path), want)
+    assert np.array_equal(run_python(c, X, tmp_path), want)
 
 
 @needs_cc

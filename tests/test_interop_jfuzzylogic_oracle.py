@@ -4,6 +4,7 @@ JAR``). No Java runs here: jFuzzyLogic's outputs are recorded strings."""
 
 from __future__ import annotations
 
+import json
 import sys
 from pathlib import Path
 
@@ -235,6 +236,8 @@ def test_a_difference_names_its_cause(oracle):
                                                "`r2` under the accumulation `max` (`ACCU`)",)
                            ).startswith("MITOS warned: `y IS hi` is concluded")
     assert "walks in from both ends" in oracle.cause_of("x/09_METHOD_COA.fcl", 1.0, 1.0, ())
+    assert "--fidelity jfuzzylogic computes it" in oracle.cause_of("x/09_METHOD_COA.fcl", 1.0,
+                                                                   1e-13, ())
     assert oracle.cause_of("a.fcl", 0.5, 0.5, ()) == "not explained"
 
 
@@ -262,3 +265,46 @@ def test_jfuzzylogic_s_samples_are_reached_as_it_reaches_them():
     ours = grid(lo, hi, n, "left")
     assert ours.tobytes() == np.array(java).tobytes()
     assert 0.0 not in ours and ours[500] == pytest.approx(0.0, abs=1e-15)
+
+
+def test_coa_under_fidelity_is_jfuzzylogics_walk_from_both_ends(tmp_path):
+    """`METHOD : COA` on the grammar cases' base file (its inputs' RANGE in their declarations,
+    as jFuzzyLogic's grammar reads them): at a = 2.5, b = 5 jFuzzyLogic 3.3 (built from
+    source, docs/benchmarks.md) gave 3.99, where MITOS's bisector gives 4.995; `--fidelity
+    jfuzzylogic` now computes jFuzzyLogic's COA; the default (fuzzylite's bisector) stays."""
+    from test_interop_fcl_grammar import BASE
+    from typer.testing import CliRunner
+
+    from mitos_cli.cli.app import app
+
+    path = tmp_path / "coa.fcl"
+    path.write_text(BASE.replace("METHOD : COG;", "METHOD : COA;"))
+    run = CliRunner().invoke
+    got = run(app, ["eval", str(path), "a=2.5", "b=5", "--fidelity", "jfuzzylogic", "--json"])
+    assert got.exit_code == 0, got.output
+    assert json.loads(got.stdout)["outputs"]["y"] == 3.99
+    plain = run(app, ["eval", str(path), "a=2.5", "b=5", "--json"])
+    assert json.loads(plain.stdout)["outputs"]["y"] == pytest.approx(4.995, abs=1e-9)
+
+
+@pytest.mark.parametrize("fmt, words", [
+    ("fcl", "FCL's `COA` is written, which jFuzzyLogic computes as this rule base does"),
+    ("fll", "FLL has no jFuzzyLogic `bisector`"),
+    ("fis", "a .fis file has no jFuzzyLogic `bisector`"),
+    ("rules", None)])
+def test_writing_jfuzzylogics_coa_says_what_the_target_reads(fmt, words):
+    """A behavior with `defuzzify = jfuzzylogic_bisector` written: FCL's COA is jFuzzyLogic's,
+    but is read back as fuzzylite's bisector; FLL and .fis have only their own."""
+    import dataclasses
+
+    from test_interop_fcl_grammar import BASE
+
+    from mitos_cli.interop import conversion_notes
+    from mitos_cli.lang.model import Setting
+
+    rb = parse_fcl(BASE.replace("METHOD : COG;", "METHOD : COA;"), "probe.fcl")
+    coa = (Setting("defuzzify", "jfuzzylogic_bisector"),)
+    rb = dataclasses.replace(rb, behaviors=tuple(dataclasses.replace(b, operators=b.operators + coa)
+                                                 for b in rb.behaviors))
+    notes = [n for n in conversion_notes(rb, fmt) if "jFuzzyLogic" in n]
+    assert bool(notes) == (words is not None) and (words is None or words in notes[0]), notes

@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from mitos_cli.api import load_rulebase, read_rulebase
 from mitos_cli.engine import mamdani
@@ -281,3 +283,57 @@ def test_fired_rules_whose_sets_the_sampling_misses_are_told_as_such(tmp_path, c
         main(["eval", str(path), "x=1"])
     assert info.value.code == 1
     assert "no output value: the rules that set `w` fire" in capsys.readouterr().err
+
+
+def _jfuzzylogic_coa(values: list[float], lo: float, hi: float) -> float:
+    """jFuzzyLogic 3.3's ``DefuzzifierCenterOfArea.defuzzify``, transcribed loop for loop
+    (``values`` its sampled set, ``min``/``max`` the universe, ``stepSize = (max - min) /
+    values.length``)."""
+    sum_low = sum_high = 0.0
+    low, high = 0, len(values) - 1
+    while low < high:
+        if sum_low <= sum_high:
+            low += 1
+            sum_low += values[low]
+        else:
+            high -= 1
+            sum_high += values[high]
+    if sum_low <= 0:
+        return float("nan")
+    return lo + (hi - lo) / len(values) * low
+
+
+_SAMPLE = st.one_of(st.just(0.0), st.just(0.25), st.just(1.0), st.floats(0, 1), st.floats(0, 3))
+
+
+@given(st.lists(st.lists(_SAMPLE, min_size=3, max_size=40), min_size=1, max_size=6)
+       .filter(lambda rows: len({len(r) for r in rows}) == 1),
+       st.floats(-100, 100), st.floats(0.001, 100))
+@settings(max_examples=300, deadline=None)
+def test_jfuzzylogic_bisector_is_its_walk_from_both_ends_bit_for_bit(rows, lo, width):
+    """Without a loop over samples, the same bits as jFuzzyLogic's loop on every row: gaps of
+    zeros, ties (0.25, 1.0), all zeros (NaN), sums above 1 (``aggregation = sum``)."""
+    Y = np.array(rows)
+    got = mamdani.defuzzify(Y, mamdani.grid(lo, lo + width, Y.shape[1], "left"),
+                            "jfuzzylogic_bisector", (lo, lo + width))
+    want = np.array([_jfuzzylogic_coa(r, lo, lo + width) for r in rows])
+    assert np.array_equal(got, want, equal_nan=True)
+    alone = mamdani.defuzzify(Y[-1:], mamdani.grid(lo, lo + width, Y.shape[1], "left"),
+                              "jfuzzylogic_bisector", (lo, lo + width))
+    assert np.array_equal(alone, got[-1:], equal_nan=True)
+
+
+def test_jfuzzylogic_bisector_stops_at_a_gap_where_fuzzylites_takes_the_middle():
+    """Two equal blocks with zeros between, by hand: low takes 1 (sums 1, 0), high takes 8
+    (1, 1), low 2 (2, 1), high 7 (2, 2); the sums are equal, so low walks the gap, 3 to 6,
+    adding zeros, and meets high at 7: jFuzzyLogic answers 0 + 1 * 7 = 7. fuzzylite's (and
+    MITOS's) bisector takes the middle of the samples whose running area is closest to half
+    (2 of 4: samples 2 to 6), 4."""
+    x = mamdani.grid(0, 10, 10, "left")
+    Y = np.array([[0, 1, 1, 0, 0, 0, 0, 1, 1, 0.0]])
+    assert mamdani.defuzzify(Y, x, "jfuzzylogic_bisector", (0.0, 10.0))[0] == 7.0
+    assert _jfuzzylogic_coa(list(Y[0]), 0.0, 10.0) == 7.0
+    assert mamdani.defuzzify(Y, x, "bisector")[0] == 4.0
+    # only the first sample set: jFuzzyLogic never counts it, so no area: NaN (its default)
+    first = np.array([[1.0, 0, 0, 0, 0]])
+    assert np.isnan(mamdani.defuzzify(first, x[:5], "jfuzzylogic_bisector", (0.0, 5.0))[0])

@@ -37,6 +37,8 @@ DEFUZZIFY = {
                        "(MATLAB's evalfis, a .fis file's bisector)",
     "matlab_som": "the sample where mu(y) is maximal smallest in absolute value (MATLAB's som)",
     "matlab_lom": "the sample where mu(y) is maximal largest in absolute value (MATLAB's lom)",
+    "jfuzzylogic_bisector": "where two running areas walking in from both ends meet, the "
+                            "smaller taking the next sample (jFuzzyLogic's COA)",
 }
 
 

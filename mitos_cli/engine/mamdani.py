@@ -15,6 +15,10 @@ and the result is defuzzified:
 ``matlab_*``   MATLAB's ``evalfis`` (a ``.fis`` file's): ``matlab_bisector`` the first sample
                whose running area reaches half the total; ``matlab_som`` / ``matlab_lom`` the
                maximum's sample smallest / largest in absolute value (the first of a tie)
+``jfuzzylogic_bisector``  jFuzzyLogic's ``METHOD : COA`` (``DefuzzifierCenterOfArea``): two
+               running sums walk in from both ends, the smaller one taking the next sample (the
+               left one on a tie), the first and last samples never counted; the result is
+               ``lo + step * i`` where they meet (:func:`walk_from_both_ends`)
 
 **Grid.** The universe ``[lo, hi]`` is cut into ``resolution`` equal cells and sampled at their
 midpoints, ``x_i = lo + (i + 1/2) (hi - lo) / resolution``: the midpoint rule of integration,
@@ -248,10 +252,13 @@ def aggregate(dof: np.ndarray, sets: np.ndarray, implication: str,
     return norms.tree_reduce(aggregation, stack, axis=0)
 
 
-def defuzzify(Y: np.ndarray, x: np.ndarray, method: str) -> np.ndarray:
+def defuzzify(Y: np.ndarray, x: np.ndarray, method: str,
+              universe: tuple[float, float] = (0.0, 1.0)) -> np.ndarray:
     """Crisp values ``[b]`` of output sets ``Y[b, res]`` sampled at ``x[res]`` (NaN where the
-    set is empty)."""
+    set is empty). ``universe`` is the output's range (only jFuzzyLogic's COA reads it)."""
     out = np.full(Y.shape[0], np.nan)
+    if method == "jfuzzylogic_bisector":
+        return walk_from_both_ends(Y, *universe)
     if method == "centroid":
         den = Y.sum(axis=1)
         num = (Y * x).sum(axis=1)
@@ -288,6 +295,32 @@ def defuzzify(Y: np.ndarray, x: np.ndarray, method: str) -> np.ndarray:
     return out
 
 
+def walk_from_both_ends(Y: np.ndarray, lo: float, hi: float) -> np.ndarray:
+    """jFuzzyLogic's center of area (``DefuzzifierCenterOfArea.defuzzify``) of ``Y[b, n]``,
+    without its loop. There ``low`` starts at sample 0 and ``hi`` at sample n - 1, each with a
+    sum of 0; while ``low < hi``, if ``sumLow <= sumHigh`` then ``low`` moves right and adds
+    its sample, else ``hi`` moves left and adds its one; the answer is ``lo + step * low``
+    (``step = (hi - lo) / n``), NaN when ``sumLow`` ends at 0. Samples 0 and n - 1 are only
+    counted by a walk that reaches them, so a set split by a gap of zeros is cut where the
+    sums first balance, which need not be its middle.
+
+    The walk is a merge of two fixed non-decreasing sequences: the left sums
+    ``a_k = Y[1] + ... + Y[k]`` and the right sums ``c_j = Y[n-2] + ... + Y[n-1-j]``, each
+    added in jFuzzyLogic's order (``np.cumsum`` adds one element after another). After its
+    n - 1 moves ``low`` has made as many moves as there are ``i`` in 1..n-1 with
+    ``a_{i-1} <= c_{n-1-i}`` (the ``i``-th left move comes before the right move that would
+    meet it exactly then, ties going left), so counting that condition gives ``low`` with the
+    same sums, compared the same way: bit for bit the loop's answer (checked against a
+    transcription of it in ``tests/test_mamdani.py``)."""
+    b, n = Y.shape
+    zero = np.zeros((b, 1))
+    left = np.concatenate([zero, np.cumsum(Y[:, 1:], axis=1)], axis=1)         # a_0 .. a_{n-1}
+    right = np.concatenate([zero, np.cumsum(Y[:, n - 2:0:-1], axis=1)], axis=1)  # c_0 .. c_{n-2}
+    low = np.count_nonzero(left[:, :n - 1] <= right[:, ::-1], axis=1)
+    out = lo + ((hi - lo) / n) * low
+    return np.where(left[np.arange(b), low] > 0.0, out, np.nan)
+
+
 def mamdani_outputs(compiled, dof: np.ndarray) -> np.ndarray:
     """Output layer of a Mamdani behavior: DOFs ``[R, b]`` -> crisp outputs ``[m, b]``."""
     ops = compiled.operators
@@ -309,7 +342,8 @@ def mamdani_outputs(compiled, dof: np.ndarray) -> np.ndarray:
         for start in range(0, b, per):                # sub-blocks of samples
             block = slice(start, min(start + per, b))
             Y = _aggregate_chunked(D[:, block], sets, ops.implication, aggregation)
-            out[j, block] = defuzzify(Y, table.grid, ops.defuzzify)
+            out[j, block] = defuzzify(Y, table.grid, ops.defuzzify,
+                                      compiled.variables[table.name].universe)
     return out
 
 

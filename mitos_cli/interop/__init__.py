@@ -162,12 +162,25 @@ MATLAB_MEANS = {"bisector": "the first sample whose running area reaches half th
                 "lom": "the maximum's sample largest in absolute value"}
 FUZZYLITE_MEANS = {"bisector": "the sample whose running area is closest to half the total",
                    "som": "the maximum's smallest sample", "lom": "the maximum's largest sample"}
+JFUZZYLOGIC_COA = "where two running areas walking in from both ends meet"
 
 
 def _defuzzifier_notes(ops, fmt: str) -> list[str]:
     """A bisector, som or lom written where the target defines it otherwise: MATLAB's into FLL
     or FCL, fuzzylite's (MITOS's own) into a .fis file."""
     if ops.inference != "mamdani":
+        return []
+    if ops.defuzzify == "jfuzzylogic_bisector":
+        if fmt == "fcl":
+            return ["FCL's `COA` is written, which jFuzzyLogic computes as this rule base does "
+                    f"({JFUZZYLOGIC_COA}), but which MITOS and fuzzylite read as fuzzylite's "
+                    f"bisector ({FUZZYLITE_MEANS['bisector']}): evaluate the file with "
+                    f"`--fidelity jfuzzylogic` to get this rule base's numbers"]
+        if fmt in ("fll", "fis"):
+            means = FUZZYLITE_MEANS if fmt == "fll" else MATLAB_MEANS
+            return [f"{fmt.upper() if fmt == 'fll' else 'a .fis file'} has no jFuzzyLogic "
+                    f"`bisector` ({JFUZZYLOGIC_COA}): {'fuzzylite' if fmt == 'fll' else 'MATLAB'}"
+                    f"'s is written ({means['bisector']}), so results move where the two differ"]
         return []
     name = ops.defuzzify.removeprefix("matlab_")
     if name not in MATLAB_MEANS:

@@ -46,6 +46,8 @@ DEFUZZIFIERS = {
     "matlab_bisector": ("Bisector", "bisector", "COA"),
     "matlab_som": ("SmallestOfMaximum", "som", "LM"),
     "matlab_lom": ("LargestOfMaximum", "lom", "RM"),
+    # jFuzzyLogic's COA (``--fidelity jfuzzylogic``); FCL files' COA is read as fuzzylite's
+    "jfuzzylogic_bisector": ("Bisector", "bisector", "COA"),
     "weighted_average": ("WeightedAverage", "wtaver", "COGS"),
     "weighted_sum": ("WeightedSum", "wtsum", "COGSS"),
 }
@@ -1015,12 +1017,17 @@ def fidelity_settings(rb: RuleBase, engine: str, behavior: str | None = None
 
 
 def _engines_defuzzifier(method: str, engine: str) -> tuple[Setting, ...]:
-    """``engine``'s own bisector, som or lom: MATLAB defines them otherwise than fuzzylite and
-    jFuzzyLogic (:data:`.fis.MATLAB_DEFUZZIFIERS`), and a fidelity computes as its engine."""
-    plain = method.removeprefix("matlab_")
+    """``engine``'s own bisector, som or lom: MATLAB defines them otherwise than fuzzylite
+    (:data:`.fis.MATLAB_DEFUZZIFIERS`), jFuzzyLogic its bisector (COA) otherwise than both
+    (``jfuzzylogic_bisector``), and a fidelity computes as its engine."""
+    plain = method.removeprefix("matlab_").removeprefix("jfuzzylogic_")
     if plain not in ("bisector", "som", "lom"):
         return ()
-    return (Setting("defuzzify", f"matlab_{plain}" if engine == "matlab" else plain),)
+    if engine == "matlab":
+        return (Setting("defuzzify", f"matlab_{plain}"),)
+    if engine == "jfuzzylogic" and plain == "bisector":
+        return (Setting("defuzzify", "jfuzzylogic_bisector"),)
+    return (Setting("defuzzify", plain),)
 
 
 def refuse_accumulation(rb: RuleBase, behavior: str | None, flat: Flat, fmt: str) -> None:

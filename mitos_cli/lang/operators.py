@@ -18,7 +18,8 @@ INFERENCES = ("weighted_average", "weighted_sum", "mamdani", "tsukamoto")
 #: e.g. EinsteinProduct).
 IMPLICATIONS = tuple(norms.TNORMS)
 DEFUZZIFIERS = ("centroid", "bisector", "mom", "som", "lom",
-                "matlab_bisector", "matlab_som", "matlab_lom")      # MATLAB's evalfis
+                "matlab_bisector", "matlab_som", "matlab_lom",      # MATLAB's evalfis
+                "jfuzzylogic_bisector")                             # jFuzzyLogic's COA
 #: Where Mamdani outputs are sampled: cell midpoints (fuzzylite's rule, the default),
 #: ``resolution`` evenly spaced points including both ends (MATLAB's ``evalfis``), or the
 #: cells' left ends (jFuzzyLogic's, each reached from the one before: ``x += (max - min) / resolution``).

@@ -297,7 +297,8 @@ def _c_mamdani(c: CompiledRuleBase, P: str) -> list[str]:
         rows = ",\n".join("        {" + ", ".join(num(v) for v in row) + "}" for row in table.sets)
         grid = ", ".join(num(v) for v in table.grid)
         out.append(f"    {{   /* {comment(name)}: Mamdani, {plural(res, 'sample')} */")
-        out.append(f"        static const double grid[{res}] = {{{grid}}};")
+        if ops.defuzzify != "jfuzzylogic_bisector":    # which reads the universe's ends only
+            out.append(f"        static const double grid[{res}] = {{{grid}}};")
         out.append(f"        static const double sets[{len(table.sets)}][{res}] = {{\n"
                    f"{rows}\n        }};")
         dofs = ", ".join(f"dof_{r}" for r in table.rules)
@@ -316,14 +317,26 @@ def _c_mamdani(c: CompiledRuleBase, P: str) -> list[str]:
         out.append("            }")
         out.append("            y[i] = acc;")
         out.append("        }")
-        out += ["        " + line for line in _c_defuzzify(ops.defuzzify, res, j, fallback)]
+        out += ["        " + line for line in _c_defuzzify(ops.defuzzify, res, j, fallback,
+                                                      c.variables[name].universe)]
         out.append("    }")
     return out
 
 
-def _c_defuzzify(method: str, res: int, j: int, fallback: str) -> list[str]:
+def _c_defuzzify(method: str, res: int, j: int, fallback: str,
+                 universe: tuple[float, float] = (0.0, 1.0)) -> list[str]:
     done = [f"if (value != value) {{ out[{j}] = {fallback}; ++fallback; }}",
             f"else out[{j}] = value;"]
+    if method == "jfuzzylogic_bisector":     # jFuzzyLogic's DefuzzifierCenterOfArea loop
+        lo, hi = (num(float(v)) for v in universe)
+        return ["{", "    double sum_low = 0.0, sum_high = 0.0, value = NAN;",
+                f"    int low = 0, high = {res} - 1;",
+                "    while (low < high) {",
+                "        if (sum_low <= sum_high) sum_low += y[++low];",
+                "        else sum_high += y[--high];",
+                "    }",
+                f"    if (sum_low > 0.0) value = {lo} + (({hi} - {lo}) / {res}) * low;",
+                *("    " + d for d in done), "}"]
     if method == "centroid":
         return ["{", "    double num = 0.0, den = 0.0, value = NAN;",
                 f"    for (i = 0; i < {res}; ++i) {{ num += y[i] * grid[i]; den += y[i]; }}",

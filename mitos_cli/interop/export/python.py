@@ -238,7 +238,8 @@ def _py_outputs(c: CompiledRuleBase) -> list[str]:
                     f"        S = sets[{[int(s) for s in table.set_of]!r}][:, None, :]",
                     f"        I = {imp}", "        a = I[0]", "        for b in I[1:]:",
                     f"            a = {agg}", "        Yj = a"]
-            out += ["        " + line for line in _py_defuzzify(ops.defuzzify)]
+            universe = c.variables[table.name].universe
+            out += ["        " + line for line in _py_defuzzify(ops.defuzzify, universe)]
             out.append(f"        Y[:, {j}] = value")
     else:
         for j in range(len(c.outputs)):
@@ -261,7 +262,7 @@ def _py_outputs(c: CompiledRuleBase) -> list[str]:
     return out
 
 
-def _py_defuzzify(method: str) -> list[str]:
+def _py_defuzzify(method: str, universe: tuple[float, float]) -> list[str]:
     if method == "centroid":
         return ["den = Yj.sum(axis=1)",
                 "value = np.where(den > 0, (Yj * grid).sum(axis=1) / np.where(den > 0, den, 1), "
@@ -270,6 +271,14 @@ def _py_defuzzify(method: str) -> list[str]:
         return ["area = np.cumsum(Yj, axis=1)", "total = area[:, -1:]",
                 "value = np.where(total[:, 0] > 0, "
                 "grid[np.argmax(area >= total / 2, axis=1)], np.nan)"]
+    if method == "jfuzzylogic_bisector":   # mamdani.walk_from_both_ends
+        lo, hi = (num(float(v)) for v in universe)
+        return ["n, z = Yj.shape[1], np.zeros((len(Yj), 1))",
+                "left = np.concatenate([z, np.cumsum(Yj[:, 1:], axis=1)], axis=1)",
+                "right = np.concatenate([z, np.cumsum(Yj[:, n - 2:0:-1], axis=1)], axis=1)",
+                "low = np.count_nonzero(left[:, :n - 1] <= right[:, ::-1], axis=1)",
+                f"value = np.where(left[np.arange(len(Yj)), low] > 0, "
+                f"{lo} + (({hi} - {lo}) / n) * low, np.nan)"]
     if method == "bisector":
         return ["area = np.cumsum(Yj, axis=1)", "total = area[:, -1:]",
                 "gap = np.abs(area / total - 0.5)",
