@@ -307,7 +307,7 @@ FCL_CASES = [
     ("ACT : MIN;", "ACTIVATION : Highest;", "activation `Highest` is not supported"),
     ("METHOD : COG;", "METHOD : COG 2.5;", "resolution must be a whole number"),
     ("METHOD : COG;", "METHOD : CENTER;", "unknown METHOD `CENTER`"),
-    ("ACCU : MAX;", "ACCU : NSUM;", "normalized sum is not an S-norm"),
+    ("ACCU : MAX;", "ACCU : NormalizedSum;", "the normalized sum is not an S-norm"),
     ("METHOD : COG;", "METHOD : cogf;", "a weighted-average output needs constant or linear"),
     ("RULE 2 : IF service IS good", "RULE 2 : IF service IS goood", "of `service`"),
     ("TERM cheap := trian 0 5 10;", "TERM cheap := Constant 5;",

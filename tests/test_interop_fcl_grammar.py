@@ -62,6 +62,7 @@ LOADS = [
     *[("AND : MIN;", f"AND : {o};") for o in ("PROD", "BDIF", "DMIN", "NIPMIN", "HAMACHER")],
     ("ACT : MIN;", "ACT : PROD;"), ("ACCU : MAX;", "ACCU : BSUM;"),
     ("ACCU : MAX;", "ACCU : PROBOR;"), ("ACCU : MAX;", "ACCU : SUM;"), ("ACCU : MAX;", "ACCU : UNSUM;"),
+    ("ACCU : MAX;", "ACCU : NSUM;"),
     ("IF a IS low AND", "IF NOT a IS low AND"), ("IF a IS low AND", "IF a IS NOT low AND"),
     ("IF a IS low AND b IS low THEN", "IF (a IS low AND b IS low) THEN"),
     ("IF a IS low AND b IS low THEN", "IF NOT (a IS low OR b IS high) THEN"),
@@ -78,7 +79,7 @@ REFUSED = [
     ("DEFAULT := 0;", "DEFAULT := NC;", "`DEFAULT := NC` (no change"),
     ("METHOD : COG;", "METHOD : COGF;", "not a `triangle` term"),     # COGF is COGS
     ("METHOD : COG;", "METHOD : COGS;", "not a `triangle` term"),
-    ("ACCU : MAX;", "ACCU : NSUM;", "the normalized sum"),
+    ("OR : MAX;", "OR : NSUM;", "jFuzzyLogic's normalized sum is an accumulation"),
     ("OR : MAX;", "OR : SUM;", "the unbounded sum is a Mamdani aggregation only"),
     ("IF a IS low AND b IS low THEN", "IF a AND b IS low THEN", "a condition without `IS`"),
     ("END_FUNCTION_BLOCK\n", "END_FUNCTION_BLOCK\nFUNCTION_BLOCK probe\nEND_FUNCTION_BLOCK\n",

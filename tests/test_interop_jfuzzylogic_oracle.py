@@ -10,6 +10,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from mitos_cli.engine.compile import compile_rulebase
 from mitos_cli.engine.evaluation import evaluate
@@ -308,3 +310,48 @@ def test_writing_jfuzzylogics_coa_says_what_the_target_reads(fmt, words):
                                                  for b in rb.behaviors))
     notes = [n for n in conversion_notes(rb, fmt) if "jFuzzyLogic" in n]
     assert bool(notes) == (words is not None) and (words is None or words in notes[0]), notes
+
+
+def _jfuzzylogic_nsum(a: float, b: float) -> float:
+    """jFuzzyLogic 3.3's ``RuleAccumulationMethodNormedSum.aggregate``, transcribed."""
+    return (a + b) / max(1.0, a + b)
+
+
+@given(st.floats(0, 1), st.floats(0, 1), st.floats(0, 1))
+@settings(max_examples=200, deadline=None)
+def test_nsum_is_the_bounded_sum_bit_for_bit(a, b, c):
+    """jFuzzyLogic folds its rules' sets into each sample from 0 with ``(v + x) / max(1, v +
+    x)``: ``v + x`` up to 1, and ``s / s``, exactly 1, above; the bounded sum does the same."""
+    from mitos_cli.fuzzy.norms import SNORMS
+
+    bsum = SNORMS["bounded_sum"].fn
+    folded = _jfuzzylogic_nsum(_jfuzzylogic_nsum(_jfuzzylogic_nsum(0.0, a), b), c)
+    ours = float(bsum(bsum(np.float64(a), np.float64(b)), np.float64(c)))
+    assert folded == ours
+
+
+@pytest.mark.parametrize("method", ["COG", "COGS"])
+def test_accu_nsum_is_read_as_the_bounded_sum_with_a_note(method):
+    """`ACCU : NSUM` was refused ("not an S-norm MITOS computes"); jFuzzyLogic's is the bounded
+    sum exactly. Under COGS it joins the rules of one singleton, as BSUM does there."""
+    from test_interop_fcl_grammar import BASE
+
+    text = BASE.replace("ACCU : MAX;", "ACCU : NSUM;")
+    if method == "COGS":
+        text = text.replace("METHOD : COG;", "METHOD : COGS;").replace(
+            "TERM lo := (0, 0) (2, 1) (4, 0);", "TERM lo := 2;").replace(
+            "TERM hi := (6, 0) (8, 1) (10, 0);", "TERM hi := 8;")
+    rb = parse_fcl(text, "n.fcl")
+    c = compile_rulebase(rb)
+    got = (c.operators.accumulation if method == "COGS" else c.operators.aggregation)
+    assert got == "bounded_sum"
+    line = text.splitlines().index("    ACCU : NSUM;") + 1
+    assert [n for n in rb.notes if "NSUM" in n] == [
+        f"n.fcl:{line}:12: `ACCU : NSUM` is read as jFuzzyLogic's normalized sum, (a + b) / "
+        "max(1, a + b), which is the bounded sum min(1, a + b) exactly (`bounded_sum`); "
+        "fuzzylite's `NormalizedSum` computes a + b / max(1, max(a, b)) instead, which is the "
+        "plain sum while both are at most 1"]
+    bsum = compile_rulebase(parse_fcl(text.replace("NSUM", "BSUM"), "n.fcl"))
+    X = np.array([[a, b] for a in np.linspace(0, 10, 11) for b in np.linspace(0, 10, 11)])
+    assert np.array_equal(evaluate(c, X, detail=False).outputs,
+                          evaluate(bsum, X, detail=False).outputs)

@@ -74,7 +74,8 @@ _ONLY_AGGREGATION = ("the unbounded sum is a Mamdani aggregation only (`aggregat
 UNSUPPORTED_NORMS = {
     "NormalizedSum": "the normalized sum is not an S-norm MITOS computes",
     "UnboundedSum": _ONLY_AGGREGATION,
-    "NSUM": "the normalized sum is not an S-norm MITOS computes",
+    "NSUM": "jFuzzyLogic's normalized sum is an accumulation (`ACCU : NSUM`, read as the "
+            "bounded sum, which it equals), not a connective; write `BSUM`",
     "UNSUM": _ONLY_AGGREGATION,
     "SUM": _ONLY_AGGREGATION,
     "sum": _ONLY_AGGREGATION,

@@ -315,7 +315,7 @@ def _rule_block(block: Tree, variables: dict[str, Variable], span_of,
     record = common.Record()
     for item in block.children[1:]:
         if item.data == "option":
-            _option(item, record, span_of, {})
+            _option(item, record, span_of, {}, notes)
     keys = {key for key, *_ in record}
     pair = _jfl_pair(block)
     if "and_" in keys and "or_" not in keys:
@@ -466,7 +466,7 @@ def _variable(node: Tree, role: Role, declared, settings: common.Record, locks: 
             key = str(item.children[0]).upper()
             if role == "input":
                 raise FormatError(f"`{key}` has no meaning in FUZZIFY", span=span_of(item))
-            _option(item, settings, span_of, {})
+            _option(item, settings, span_of, {}, notes)
         elif kind == "default_item":
             value, flag = item.children
             if flag is not None:
@@ -701,7 +701,15 @@ def _points_term(name: str, pts: list[tuple[float, float]], span: Span) -> Term:
 OR_ALIASES = {"EINSTEIN": "einstein_sum", "HAMACHER": "hamacher_sum"}
 
 
-def _option(item: Tree, settings: common.Record, span_of, conj: dict) -> None:
+#: jFuzzyLogic's ``ACCU : NSUM`` (``RuleAccumulationMethodNormedSum``): ``(a + b) / max(1, a +
+#: b)``, which is ``a + b`` up to 1 and ``(a + b) / (a + b)``, exactly 1, above: the bounded sum
+#: ``min(1, a + b)`` bit for bit. fuzzylite's ``NormalizedSum`` is another function.
+NSUM_MEANS = ("jFuzzyLogic's normalized sum, (a + b) / max(1, a + b), which is the bounded "
+              "sum min(1, a + b) exactly")
+
+
+def _option(item: Tree, settings: common.Record, span_of, conj: dict,
+            notes: list[str] | None = None) -> None:
     key_token, value_token, number = item.children
     key, value, span = str(key_token).upper(), str(value_token), span_of(value_token)
     if key == "AND":
@@ -717,6 +725,12 @@ def _option(item: Tree, settings: common.Record, span_of, conj: dict) -> None:
         if value.lower() != "general":
             raise FormatError(f"activation `{value}` is not supported: MITOS activates every "
                               f"rule", span=span)
+    elif key == "ACCU" and value.upper() == "NSUM":
+        settings.set("aggregation", "bounded_sum", span, "ACCU")
+        if notes is not None:
+            notes.append(f"{span}: `ACCU : NSUM` is read as {NSUM_MEANS} (`bounded_sum`); "
+                         f"fuzzylite's `NormalizedSum` computes a + b / max(1, max(a, b)) "
+                         f"instead, which is the plain sum while both are at most 1")
     elif key == "ACCU":
         # SUM: jFuzzyLogic's default, the unbounded sum (under COGS the accumulation, below)
         settings.set("aggregation", _norm(common.AGGREGATIONS, value, "ACCU", span), span, "ACCU")
