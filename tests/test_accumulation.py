@@ -129,8 +129,29 @@ def test_nothing_firing_takes_the_default_and_describe_names_it():
 def test_an_unknown_accumulation_is_refused_with_the_choices():
     with pytest.raises(MitosError) as info:
         compiled("accumulation = maximum_sum")
-    assert info.value.message == "unknown S-norm `maximum_sum`"
-    assert "sum" in info.value.expected and "probabilistic_sum" in info.value.expected
+    assert info.value.message == "unknown accumulation `maximum_sum`"
+    # `sum` first, with what it means here, then each S-norm once (no aliases, no cut)
+    assert info.value.expected == ("`sum` (each rule counted in the average, the default) or an "
+                                   "S-norm: max, probabilistic_sum, bounded_sum, drastic_sum, "
+                                   "einstein_sum, hamacher_sum, nilpotent_maximum")
+    assert info.value.hint == "did you mean `maximum`?"
+
+
+@pytest.mark.parametrize("key, value, hint", [
+    ("accumulation", "SUM", "did you mean `sum`?"),
+    ("aggregation", "summ", "did you mean `sum`?"),
+    ("aggregation", "unbounded", "did you mean `unbounded_sum`?"),
+    ("aggregation", "probor_sum", "did you mean `probor`?"),
+    ("aggregation", "nsum", "jFuzzyLogic's `NSUM` is `bounded_sum` (the two are equal)"),
+    ("accumulation", "NSUM", "jFuzzyLogic's `NSUM` is `bounded_sum` (the two are equal)")])
+def test_an_unknown_aggregation_or_accumulation_hints_sum_and_foreign_names(key, value, hint):
+    """The list used to be every S-norm name and alias, cut at 12 before `sum`."""
+    with pytest.raises(MitosError) as info:
+        compiled(f"inference = mamdani, {key} = {value}" if key == "aggregation"
+                 else f"{key} = {value}")
+    assert info.value.message == f"unknown {key} `{value}`"
+    assert info.value.expected.startswith("`sum` (")
+    assert info.value.hint == hint
 
 
 def test_check_calls_it_idle_outside_weighted_inference_and_words_duplicates():

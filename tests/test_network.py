@@ -133,5 +133,5 @@ def test_unknown_operator_in_a_rule_file(capsys, tmp_path):
                                 "if road is WIDE then speed is MEDIUM\n")
     code, _, err = run(capsys, "eval", str(path), "road=90")
     assert code == 1
-    assert "unknown S-norm `probabilistic_summ`" in err
+    assert "unknown aggregation `probabilistic_summ`" in err
     assert "did you mean `probabilistic_sum`?" in err

@@ -9,7 +9,7 @@ from __future__ import annotations
 from dataclasses import dataclass, fields, replace
 from typing import Any
 
-from ..errors import RuleBaseError, Span, unknown
+from ..errors import NameError_, RuleBaseError, Span, did_you_mean, unknown
 from ..fuzzy import norms
 from ..lang.model import Behavior, RuleBase, Setting
 
@@ -107,9 +107,9 @@ def _check(key: str, value: str, span: Span | None) -> str | int:
         try:
             return norms.lookup("snorm", value).name
         except KeyError:
-            extra = {"accumulation": list(ACCUMULATIONS), "aggregation": ["sum"]}.get(key, [])
-            choices = norms.names("snorm") + extra
-            raise unknown("S-norm", value, choices, span=span) from None
+            if key == "or":
+                raise unknown("S-norm", value, norms.names("snorm"), span=span) from None
+            raise _unknown_join(key, value, span) from None
     among = {"inference": INFERENCES, "defuzzify": DEFUZZIFIERS,
              "sampling": SAMPLINGS}.get(key)
     if among is not None:
@@ -125,6 +125,25 @@ def _check(key: str, value: str, span: Span | None) -> str | int:
         raise RuleBaseError(f"resolution must be a whole number from {RESOLUTION[0]} to "
                             f"{RESOLUTION[1]}, not {value}", span=span)
     return int(number)
+
+
+#: What ``sum`` means where it is not an S-norm, by setting.
+SUM_MEANS = {"aggregation": "the unbounded sum of the rules' sets",
+             "accumulation": "each rule counted in the average, the default"}
+#: Other engines' names for one of the S-norms, said as a hint where they are written.
+FOREIGN_JOINS = {"nsum": "bounded_sum", "normalized_sum": "bounded_sum",
+                 "normalizedsum": "bounded_sum"}
+
+
+def _unknown_join(key: str, value: str, span: Span | None) -> NameError_:
+    """An unknown ``aggregation`` or ``accumulation``: ``sum`` first, then the S-norms by
+    their names (each alias is still taken, and a did-you-mean looks among them too)."""
+    sum_names = ["sum", *norms.UNBOUNDED_SUM.aliases] if key == "aggregation" else ["sum"]
+    hint = (f"jFuzzyLogic's `NSUM` is `{FOREIGN_JOINS[value.lower()]}` (the two are equal)"
+            if value.lower() in FOREIGN_JOINS
+            else did_you_mean(value, sum_names + norms.names("snorm")))
+    expected = (f"`sum` ({SUM_MEANS[key]}) or an S-norm: " + ", ".join(norms.SNORMS))
+    return NameError_(f"unknown {key} `{value}`", span=span, expected=expected, hint=hint)
 
 
 def resolve(settings: tuple[Setting, ...], base: Operators | None = None) -> Operators:
