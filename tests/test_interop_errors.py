@@ -292,7 +292,7 @@ FCL_CASES = [
     ("TERM rancid := (0, 1) (1, 1) (3,0) ;", "TERM rancid := Spike 0 1;",
      "has no RANGE and its `rancid` term (spike)"),
     ("	TERM rancid := (0, 1) (1, 1) (3,0) ;\n	TERM delicious := (7,0) (9,1);\n",
-     "	TERM rancid := 3;\n", "its terms do not span one"),
+     "	TERM rancid := 3;\n", "its terms lie at the one point 3: jFuzzyLogic takes [3, 3]"),
     ("RANGE := (0 .. 30);", "RANGE := (30 .. 0);", "RANGE [30, 0] is empty"),
     ("TERM rancid := (0, 1) (1, 1) (3,0) ;", "TERM rancid := (0, 1) (3, 1) (1,0) ;",
      "the points' x values must ascend"),

@@ -15,6 +15,7 @@ from hypothesis import strategies as st
 
 from mitos_cli.engine.compile import compile_rulebase
 from mitos_cli.engine.evaluation import evaluate
+from mitos_cli.errors import FormatError
 from mitos_cli.interop.fcl import parse_fcl
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -355,3 +356,19 @@ def test_accu_nsum_is_read_as_the_bounded_sum_with_a_note(method):
     X = np.array([[a, b] for a in np.linspace(0, 10, 11) for b in np.linspace(0, 10, 11)])
     assert np.array_equal(evaluate(c, X, detail=False).outputs,
                           evaluate(bsum, X, detail=False).outputs)
+
+
+def test_de_morgan_files_are_refused_with_what_jfuzzylogic_makes_of_them():
+    """jFuzzyLogic's `testDeMorgan_1` to `_6` give every variable one-point terms and no RANGE:
+    its `Variable.estimateUniverse` takes [0, 0] (the terms' extent), and the oracle measured 0
+    at every point (the files test its rule degrees, not outputs). MITOS keeps refusing: no
+    sampled output, default or not, can be anything but that point; the message says so where
+    it said only that the terms "do not span" a universe."""
+    text = DE_MORGAN.replace("CONNECTIVE", "AND : MIN").replace(" RANGE := (0 .. 1);", "")
+    text = text.replace("TERM value := (0, 0) (0.3, 1) (1, 0);", "TERM value := (0, 1) (0, 1);")
+    with pytest.raises(FormatError) as info:
+        parse_fcl(text, "dm.fcl")
+    assert info.value.message.startswith(
+        "variable `x1` has no RANGE and its terms lie at the one point 0: jFuzzyLogic takes "
+        "[0, 0] for its universe")
+    assert info.value.span.line == text.splitlines().index("FUZZIFY x1") + 1

@@ -566,7 +566,15 @@ def _extent(terms: list[Term], name: str, span: Span,
         notes.append(f"{span}: `{name}` has no RANGE; its universe [{min(xs):g}, {max(xs):g}] "
                      f"is derived from its terms ({', '.join(estimated)} unbounded) as "
                      f"jFuzzyLogic estimates one")
-    if not xs or min(xs) == max(xs):
+    if xs and min(xs) == max(xs):
+        raise FormatError(
+            f"variable `{name}` has no RANGE and its terms lie at the one point "
+            f"{fmt_number(xs[0])}: jFuzzyLogic takes [{fmt_number(xs[0])}, {fmt_number(xs[0])}] "
+            f"for its universe (`Variable.estimateUniverse`: the extent of the terms), where an "
+            f"output can be nothing but {fmt_number(xs[0])} and an input is out of range at any "
+            f"other value; MITOS needs a universe with two ends", span=span,
+            hint="add `RANGE := (min .. max);` with the values the variable takes")
+    if not xs:
         raise FormatError(f"variable `{name}` has no RANGE and its terms do not span one",
                           span=span, hint="add `RANGE := (min .. max);`")
     return min(xs), max(xs)
