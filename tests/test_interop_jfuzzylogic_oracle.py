@@ -372,3 +372,23 @@ def test_de_morgan_files_are_refused_with_what_jfuzzylogic_makes_of_them():
         "variable `x1` has no RANGE and its terms lie at the one point 0: jFuzzyLogic takes "
         "[0, 0] for its universe")
     assert info.value.span.line == text.splitlines().index("FUZZIFY x1") + 1
+
+
+def test_a_clamped_input_under_fidelity_says_jfuzzylogic_does_not_clamp(tmp_path):
+    """jFuzzyLogic's `Variable.setValue` warns ("Value out of range?") and keeps the value, so
+    its terms are evaluated outside the RANGE; MITOS clamps, under every fidelity, and now
+    says so under `--fidelity jfuzzylogic` (`TRIAN 0 10 10` is 1 at the clamped a = 10 and 0
+    at a = 12 in jFuzzyLogic's `MembershipFunctionTriangular`)."""
+    from test_interop_fcl_grammar import BASE
+    from typer.testing import CliRunner
+
+    from mitos_cli.cli.app import app
+
+    path = tmp_path / "base.fcl"
+    path.write_text(BASE)
+    said = "jFuzzyLogic does not clamp (`Variable.setValue` only warns)"
+    got = CliRunner().invoke(app, ["eval", str(path), "a=12", "b=5", "--fidelity", "jfuzzylogic"])
+    assert got.exit_code == 0 and "`a` outside its universe [0, 10] was clamped; " + said in \
+        got.stderr, got.stderr
+    plain = CliRunner().invoke(app, ["eval", str(path), "a=12", "b=5"])
+    assert "was clamped" in plain.stderr and said not in plain.stderr

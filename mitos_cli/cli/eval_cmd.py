@@ -95,13 +95,22 @@ def parse_values(values: dict[str, str]) -> dict[str, float]:
     return out
 
 
-def warn_clamped(result) -> None:
+#: What an engine ``--fidelity`` names does with an input outside its universe, where that
+#: is not MITOS's clamp (fuzzylite's ``lock-range: true`` clamps; MATLAB's ``evalfis`` clamps).
+UNCLAMPED = {"jfuzzylogic": "jFuzzyLogic does not clamp (`Variable.setValue` only warns): it "
+                            "evaluates the terms at the value given, so its outputs can differ "
+                            "there"}
+
+
+def warn_clamped(result, engine: str | None = None) -> None:
     c = result.compiled
     for k, count in enumerate(result.clamped):
         if count:
             lo, hi = c.universe[k]
             many = f" ({plural(int(count), 'sample')})" if result.inputs.shape[0] > 1 else ""
-            warn(f"`{c.inputs[k]}` outside its universe [{lo:g}, {hi:g}] was clamped{many}")
+            theirs = f"; {UNCLAMPED[engine]}" if engine in UNCLAMPED else ""
+            warn(f"`{c.inputs[k]}` outside its universe [{lo:g}, {hi:g}] was clamped{many}"
+                 f"{theirs}")
 
 
 def warn_outside(compiled, Y) -> None:
@@ -197,7 +206,7 @@ def eval_command(
         if as_json:
             raise typer.BadParameter("--batch writes a CSV; --json is for one evaluation "
                                      "(leave one of them out)")
-        run_batch(rb, batch, on_no_rule, digits)
+        run_batch(rb, batch, on_no_rule, digits, fidelity and fidelity.value)
         return
     if on_no_rule is not None:
         raise typer.BadParameter("--on-no-rule applies to --batch")
@@ -208,7 +217,7 @@ def eval_command(
         raise typer.BadParameter("--json gives every digit (the shortest text that reads back "
                                  "as the same number); --digits rounds the trace and a "
                                  "--batch's outputs: leave one of them out")
-    _evaluate_one(rb, values, as_json, digits)
+    _evaluate_one(rb, values, as_json, digits, fidelity and fidelity.value)
 
 
 def _loaded(path: str | None, behavior: str | None, fidelity):
@@ -250,7 +259,8 @@ def _names_file(word: str) -> bool:
             or rule_file_hint(word) is not None)
 
 
-def _evaluate_one(rb, values: dict[str, str], as_json: bool, digits: int | None) -> None:
+def _evaluate_one(rb, values: dict[str, str], as_json: bool, digits: int | None,
+                  engine: str | None = None) -> None:
     """One sample from its ``NAME=VALUE`` texts: its trace (or JSON), and warnings on stderr for
     clamped inputs, outputs outside their universes and undersampled terms that fired."""
     from ..engine.evaluation import as_batch, evaluate
@@ -262,7 +272,7 @@ def _evaluate_one(rb, values: dict[str, str], as_json: bool, digits: int | None)
     given: dict[str, object] = {k: v for k, v in numbers.items() if k not in unused}
     X = as_batch(rb.compiled, given)
     result = evaluate(rb.compiled, X)
-    warn_clamped(result)
+    warn_clamped(result, engine)
     warn_outside(rb.compiled, result.outputs)
     warn_undersampled(rb, result.dof)
     trace = trace_of(result, given=X)
@@ -290,7 +300,7 @@ def unused_inputs(rb) -> tuple[str, ...]:
 
 
 def run_batch(rb, source: str, on_no_rule: NoRule | None = None,
-              digits: int | None = None) -> None:
+              digits: int | None = None, engine: str | None = None) -> None:
     """Read the CSV, evaluate all rows as one batch, write inputs and outputs as CSV."""
     from ..engine.csvio import flag_name, passed_names, read_table, row_span, write_batch
     from ..engine.evaluation import rule_dofs
@@ -318,7 +328,7 @@ def run_batch(rb, source: str, on_no_rule: NoRule | None = None,
     batch = read_table(text, name, rb.compiled.inputs, unused_inputs(rb))
     X = batch.X
     result = rb.run(X, strict=False, detail=False)
-    warn_clamped(result)
+    warn_clamped(result, engine)
     if undersampled(rb.compiled):       # the rules' DOFs, only when there is a term to tell
         warn_undersampled(rb, rule_dofs(rb.compiled, X))
     Y, keep, flags = no_rule_policy(rb.compiled, result, on_no_rule or NoRule.default,
