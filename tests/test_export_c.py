@@ -18,6 +18,7 @@ import pytest
 
 from mitos_cli.api import load_rulebase
 from mitos_cli.cli.app import app
+from mitos_cli.engine.compile import compile_rulebase
 from mitos_cli.engine.evaluation import evaluate
 from mitos_cli.interop.export import to_c, to_python
 
@@ -285,6 +286,35 @@ def test_jfuzzylogics_coa_exports_as_eval_computes_it(tmp_path: Path) -> None:
     assert want[np.flatnonzero((X == [2.5, 5.0]).all(axis=1))[0], 0] == 3.99
     assert np.array_equal(run_c(c, X, tmp_path), want)
     assert np.array_equal(run_python(c, X, tmp_path), want)
+
+
+@needs_cc
+@pytest.mark.parametrize("method", ["COG", "COGS"])
+def test_inputs_as_given_export_as_eval_computes_them(method: str, tmp_path: Path) -> None:
+    """``inputs = as_given`` (``--fidelity jfuzzylogic``): the exports do not clamp either, on
+    inputs up to half a range outside; an infinite input gives the C status -1 and NaN
+    outputs, NaN from the Python module (eval refuses it)."""
+    from test_interop_fcl_grammar import BASE
+
+    from mitos_cli.api import LoadedRuleBase
+    from mitos_cli.interop.common import fidelity_settings
+    from mitos_cli.interop.fcl import parse_fcl
+
+    text = BASE if method == "COG" else BASE.replace("METHOD : COG;", "METHOD : COGS;").replace(
+        "TERM lo := (0, 0) (2, 1) (4, 0);", "TERM lo := 2;").replace(
+        "TERM hi := (6, 0) (8, 1) (10, 0);", "TERM hi := 8;")
+    rb = parse_fcl(text, "probe.fcl")
+    c = LoadedRuleBase(rb, None, fidelity_settings(rb, "jfuzzylogic")).compiled
+    assert c.operators.inputs == "as_given"
+    X = np.array([(a, b) for a in np.linspace(-5, 15, 9) for b in np.linspace(-5, 15, 9)])
+    want = evaluate(c, X, detail=False, strict=False).outputs
+    clamped = evaluate(compile_rulebase(rb), X, detail=False, strict=False).outputs
+    assert not np.array_equal(want, clamped, equal_nan=True)      # the clamp mattered here
+    agree(run_c(c, X, tmp_path), want)
+    agree(run_python(c, X, tmp_path), want)
+    status, out = run_c_status(c, np.array([[np.inf, 1.0]]), tmp_path)
+    assert status[0] == -1 and np.isnan(out).all()
+    assert np.isnan(run_python(c, np.array([[np.inf, 1.0]]), tmp_path)).all()
 
 
 @needs_cc

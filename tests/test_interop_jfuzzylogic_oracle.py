@@ -374,11 +374,13 @@ def test_de_morgan_files_are_refused_with_what_jfuzzylogic_makes_of_them():
     assert info.value.span.line == text.splitlines().index("FUZZIFY x1") + 1
 
 
-def test_a_clamped_input_under_fidelity_says_jfuzzylogic_does_not_clamp(tmp_path):
+def test_an_input_outside_its_range_is_evaluated_as_given_under_fidelity(tmp_path):
     """jFuzzyLogic's `Variable.setValue` warns ("Value out of range?") and keeps the value, so
-    its terms are evaluated outside the RANGE; MITOS clamps, under every fidelity, and now
-    says so under `--fidelity jfuzzylogic` (`TRIAN 0 10 10` is 1 at the clamped a = 10 and 0
-    at a = 12 in jFuzzyLogic's `MembershipFunctionTriangular`)."""
+    its terms are evaluated outside the RANGE: `TRIAN 0 10 10` (`MembershipFunctionTriangular`)
+    is 0 at a = 12, where MITOS's clamp to 10 gives 1. `--fidelity jfuzzylogic` now sets
+    `inputs = as_given`; without it the input is clamped, as before. By hand at a = 12,
+    b = 5: `a IS low` 0 (the point list is flat past (5, 0)), `a IS high` 0, `b IS high`
+    (4, 0) (10, 1) 1/6; so rule 2 (`a IS high OR b IS high`) has DOF 1/6 (clamped: 1)."""
     from test_interop_fcl_grammar import BASE
     from typer.testing import CliRunner
 
@@ -386,9 +388,104 @@ def test_a_clamped_input_under_fidelity_says_jfuzzylogic_does_not_clamp(tmp_path
 
     path = tmp_path / "base.fcl"
     path.write_text(BASE)
-    said = "jFuzzyLogic does not clamp (`Variable.setValue` only warns)"
-    got = CliRunner().invoke(app, ["eval", str(path), "a=12", "b=5", "--fidelity", "jfuzzylogic"])
-    assert got.exit_code == 0 and "`a` outside its universe [0, 10] was clamped; " + said in \
-        got.stderr, got.stderr
-    plain = CliRunner().invoke(app, ["eval", str(path), "a=12", "b=5"])
-    assert "was clamped" in plain.stderr and said not in plain.stderr
+    got = CliRunner().invoke(app, ["eval", str(path), "a=12", "b=5", "--fidelity", "jfuzzylogic",
+                                   "--json"])
+    assert got.exit_code == 0, got.output
+    data = json.loads(got.stdout)
+    assert data["inputs"]["a"]["memberships"] == {"low": 0.0, "high": 0.0}
+    assert [r["dof"] for r in data["rules"]] == [pytest.approx(1 / 6, abs=1e-15)]
+    assert ("`a` lies outside its universe [0, 10] (12): its terms are evaluated there, not "
+            "clamped (`inputs = as_given`, jFuzzyLogic's reading)") in got.stderr
+    plain = CliRunner().invoke(app, ["eval", str(path), "a=12", "b=5", "--json"])
+    assert [r["dof"] for r in json.loads(plain.stdout)["rules"]] == [1.0]
+    assert "`a` outside its universe [0, 10] was clamped" in plain.stderr
+    inf = CliRunner().invoke(app, ["eval", str(path), "a=inf", "b=5", "--fidelity",
+                                   "jfuzzylogic"])
+    assert inf.exit_code == 1            # (the app's main prints it; here it is the exception)
+    assert inf.exception.message.startswith("input `a` is inf: with `inputs = as_given`")
+
+
+def test_as_given_batch_rows_equal_single_evaluations_bit_for_bit():
+    """Outside the ranges too, and through the scalar form (weighted average) and the NumPy
+    path alike; a linear FUNCTION (jFuzzyLogic's COGF) at the input as given."""
+    from mitos_cli.api import LoadedRuleBase
+    from mitos_cli.engine.evaluation import evaluate_one
+    from mitos_cli.interop.common import fidelity_settings
+
+    sugeno = """FUNCTION_BLOCK f
+VAR_INPUT
+    a : REAL; RANGE := (0 .. 10);
+END_VAR
+VAR_OUTPUT
+    y : REAL; RANGE := (0 .. 40);
+END_VAR
+FUZZIFY a
+    TERM low := (0, 1) (10, 0);
+    TERM high := TRIAN 0 10 10;
+END_FUZZIFY
+DEFUZZIFY y
+    TERM lin := FUNCTION 2 * a + 1;
+    TERM flat := 3;
+    METHOD : COGF;
+    DEFAULT := 0;
+END_DEFUZZIFY
+RULEBLOCK r
+    RULE 1 : IF a IS low THEN y IS flat;
+    RULE 2 : IF a IS high THEN y IS lin;
+END_RULEBLOCK
+END_FUNCTION_BLOCK
+"""
+    rb = parse_fcl(sugeno, "f.fcl")
+    c = LoadedRuleBase(rb, None, fidelity_settings(rb, "jfuzzylogic")).compiled
+    assert c.operators.inputs == "as_given"
+    X = np.array([[-3.0], [0.0], [2.5], [10.0], [11.0], [-0.0], [1e6]])
+    batch = evaluate(c, X, detail=False).outputs[:, 0]
+    alone = [evaluate_one(c, [float(x)])[0] for x in X[:, 0]]
+    assert batch.tobytes() == np.array(alone).tobytes()
+    # by hand, jFuzzyLogic's way: a = -3: low 1 (flat past (0, 1)), high 0: 3;
+    # a = 2.5: low 0.75 at 3, high 0.25 at 2 * 2.5 + 1 = 6: (0.75 * 3 + 0.25 * 6) / 1
+    assert batch[0] == 3.0 and batch[2] == pytest.approx(3.75, abs=1e-12)
+    # a = 11: both terms 0 (the triangle ends at 10, the point list is flat at 0): the default
+    assert batch[4] == 0.0
+
+
+@pytest.mark.parametrize("fmt", ["fcl", "fll", "fis", "rules"])
+def test_writing_inputs_as_given_says_it_is_left_out(fmt):
+    import dataclasses
+
+    from test_interop_fcl_grammar import BASE
+
+    from mitos_cli.interop import conversion_notes
+    from mitos_cli.interop.rules_writer import write_rules
+    from mitos_cli.lang.model import Setting
+
+    rb = parse_fcl(BASE, "probe.fcl")
+    given = (Setting("inputs", "as_given"),)
+    rb = dataclasses.replace(rb, behaviors=tuple(dataclasses.replace(b, operators=b.operators + given)
+                                                 for b in rb.behaviors))
+    notes = [n for n in conversion_notes(rb, fmt) if "as_given" in n]
+    assert bool(notes) == (fmt != "rules"), notes
+    if fmt == "rules":
+        assert "inputs = as_given" in write_rules(rb, "probe.terms.yaml")[0]
+
+
+def test_inputs_in_a_rule_file_and_an_unknown_value(tmp_path):
+    from mitos_cli.api import load_rulebase
+    from mitos_cli.errors import MitosError
+
+    (tmp_path / "t.terms.yaml").write_text(
+        "variables:\n  a: {role: input, universe: [0, 10], terms: {hi: {shape: triangle, "
+        "points: [0, 10, 10]}}}\n  y: {role: output, universe: [0, 1], default: 0, "
+        "terms: {z: 1}}\n")
+    path = tmp_path / "t.rules"
+    path.write_text('terms "t.terms.yaml"\noperators: inputs = as_given\nr1: if a is hi then y is z\n')
+    rb = load_rulebase(path)
+    assert rb.compiled.operators.inputs == "as_given"
+    got = rb.run(np.array([[12.0], [10.0], [9.0]]), detail=False).outputs[:, 0]
+    assert got.tolist() == [0.0, 1.0, 1.0]      # 12: the triangle is 0 there (clamped: 1)
+    path.write_text('terms "t.terms.yaml"\noperators: inputs = as_giv\nr1: if a is hi then y is z\n')
+    with pytest.raises(MitosError) as info:
+        _ = load_rulebase(path).compiled
+    assert info.value.message == "unknown inputs `as_giv`"
+    assert info.value.hint == "did you mean `as_given`?"
+    assert info.value.span is not None and info.value.span.line == 2

@@ -95,22 +95,24 @@ def parse_values(values: dict[str, str]) -> dict[str, float]:
     return out
 
 
-#: What an engine ``--fidelity`` names does with an input outside its universe, where that
-#: is not MITOS's clamp (fuzzylite's ``lock-range: true`` clamps; MATLAB's ``evalfis`` clamps).
-UNCLAMPED = {"jfuzzylogic": "jFuzzyLogic does not clamp (`Variable.setValue` only warns): it "
-                            "evaluates the terms at the value given, so its outputs can differ "
-                            "there"}
-
-
-def warn_clamped(result, engine: str | None = None) -> None:
+def warn_clamped(result) -> None:
     c = result.compiled
+    if c.operators.inputs == "as_given":          # jFuzzyLogic's reading: said, not clamped
+        lo, hi = c.universe[:, 0], c.universe[:, 1]
+        outside = ((result.inputs < lo) | (result.inputs > hi)).sum(axis=0)
+        for k, count in enumerate(outside):
+            if count:
+                many = (f" ({plural(int(count), 'sample')})" if result.inputs.shape[0] > 1
+                        else f" ({exact(result.inputs[0, k])})")
+                warn(f"`{c.inputs[k]}` lies outside its universe [{lo[k]:g}, {hi[k]:g}]{many}: "
+                     f"its terms are evaluated there, not clamped (`inputs = as_given`, "
+                     f"jFuzzyLogic's reading)")
+        return
     for k, count in enumerate(result.clamped):
         if count:
             lo, hi = c.universe[k]
             many = f" ({plural(int(count), 'sample')})" if result.inputs.shape[0] > 1 else ""
-            theirs = f"; {UNCLAMPED[engine]}" if engine in UNCLAMPED else ""
-            warn(f"`{c.inputs[k]}` outside its universe [{lo:g}, {hi:g}] was clamped{many}"
-                 f"{theirs}")
+            warn(f"`{c.inputs[k]}` outside its universe [{lo:g}, {hi:g}] was clamped{many}")
 
 
 def warn_outside(compiled, Y) -> None:
@@ -206,7 +208,7 @@ def eval_command(
         if as_json:
             raise typer.BadParameter("--batch writes a CSV; --json is for one evaluation "
                                      "(leave one of them out)")
-        run_batch(rb, batch, on_no_rule, digits, fidelity and fidelity.value)
+        run_batch(rb, batch, on_no_rule, digits)
         return
     if on_no_rule is not None:
         raise typer.BadParameter("--on-no-rule applies to --batch")
@@ -217,7 +219,7 @@ def eval_command(
         raise typer.BadParameter("--json gives every digit (the shortest text that reads back "
                                  "as the same number); --digits rounds the trace and a "
                                  "--batch's outputs: leave one of them out")
-    _evaluate_one(rb, values, as_json, digits, fidelity and fidelity.value)
+    _evaluate_one(rb, values, as_json, digits)
 
 
 def _loaded(path: str | None, behavior: str | None, fidelity):
@@ -259,8 +261,7 @@ def _names_file(word: str) -> bool:
             or rule_file_hint(word) is not None)
 
 
-def _evaluate_one(rb, values: dict[str, str], as_json: bool, digits: int | None,
-                  engine: str | None = None) -> None:
+def _evaluate_one(rb, values: dict[str, str], as_json: bool, digits: int | None) -> None:
     """One sample from its ``NAME=VALUE`` texts: its trace (or JSON), and warnings on stderr for
     clamped inputs, outputs outside their universes and undersampled terms that fired."""
     from ..engine.evaluation import as_batch, evaluate
@@ -272,7 +273,7 @@ def _evaluate_one(rb, values: dict[str, str], as_json: bool, digits: int | None,
     given: dict[str, object] = {k: v for k, v in numbers.items() if k not in unused}
     X = as_batch(rb.compiled, given)
     result = evaluate(rb.compiled, X)
-    warn_clamped(result, engine)
+    warn_clamped(result)
     warn_outside(rb.compiled, result.outputs)
     warn_undersampled(rb, result.dof)
     trace = trace_of(result, given=X)
@@ -300,7 +301,7 @@ def unused_inputs(rb) -> tuple[str, ...]:
 
 
 def run_batch(rb, source: str, on_no_rule: NoRule | None = None,
-              digits: int | None = None, engine: str | None = None) -> None:
+              digits: int | None = None) -> None:
     """Read the CSV, evaluate all rows as one batch, write inputs and outputs as CSV."""
     from ..engine.csvio import flag_name, passed_names, read_table, row_span, write_batch
     from ..engine.evaluation import rule_dofs
@@ -328,7 +329,7 @@ def run_batch(rb, source: str, on_no_rule: NoRule | None = None,
     batch = read_table(text, name, rb.compiled.inputs, unused_inputs(rb))
     X = batch.X
     result = rb.run(X, strict=False, detail=False)
-    warn_clamped(result, engine)
+    warn_clamped(result)
     if undersampled(rb.compiled):       # the rules' DOFs, only when there is a term to tell
         warn_undersampled(rb, rule_dofs(rb.compiled, X))
     Y, keep, flags = no_rule_policy(rb.compiled, result, on_no_rule or NoRule.default,

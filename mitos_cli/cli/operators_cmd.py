@@ -22,6 +22,10 @@ IMPLICATION = {
     "min": "mu'(y) = min(dof, mu(y)) (clipping)",
     "product": "mu'(y) = dof * mu(y) (scaling)",
 }
+INPUTS = {
+    "clamped": "taken at the universe's nearer end (MATLAB's evalfis; fuzzylite's lock-range: true)",
+    "as_given": "its terms evaluated at the value given (jFuzzyLogic's: --fidelity jfuzzylogic)",
+}
 SAMPLING = {
     "midpoints": "the midpoints of `resolution` equal cells (fuzzylite's integration rule)",
     "endpoints": "`resolution` evenly spaced points including both ends (MATLAB's evalfis)",
@@ -69,6 +73,7 @@ def catalogue() -> dict[str, list[dict]]:
                                d.accumulation)] + [
             entry(n.name, f"the rules of one value weigh {n.name} of their DOFs",
                   d.accumulation) for n in norms.SNORMS.values()],
+        "inputs": [entry(k, v, d.inputs) for k, v in INPUTS.items()],
         "hedges": [entry(h.name, h.formula, None) for h in HEDGES.values()],
     }
 
@@ -84,6 +89,7 @@ TITLES = {
                  "resolution = N (default {resolution})",
     "sampling": "Mamdani grid                             operators: sampling = NAME",
     "accumulation": "rules of one value (weighted inference)  operators: accumulation = NAME",
+    "inputs": "an input outside its universe            operators: inputs = NAME",
     "hedges": "hedges (activations, eqs. 10-11)         `road is very WIDE`",
 }
 

@@ -140,8 +140,26 @@ def _clamp(compiled: CompiledRuleBase, X: np.ndarray, first: int = 0,
 
 def _clamp_columns(compiled: CompiledRuleBase, Xt: np.ndarray, first: int = 0,
                    total: int | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`_clamp` of a block given as columns ``Xt[k, b]`` (any strides)."""
+    """:func:`_clamp` of a block given as columns ``Xt[k, b]`` (any strides). Under ``inputs =
+    as_given`` nothing is clamped (and nothing counted), but a NaN or an infinite input is
+    refused: a term or linear function has no number there."""
     plan = compiled.plan
+    if compiled.operators.inputs == "as_given":
+        Xc = np.array(Xt, dtype=float, order="C") + 0.0          # -0.0 -> 0.0, as the clamp
+        if not np.isfinite(Xc).all():
+            bad = ~np.isfinite(Xc)
+            row = int(np.argmax(bad.any(axis=0)))
+            col = int(np.argmax(bad[:, row]))
+            where = f" (sample {first + row + 1})" if (total or Xt.shape[1]) > 1 else ""
+            value = Xc[col, row]
+            if value != value:
+                raise InputError(f"input `{compiled.inputs[col]}` is not a number (NaN){where}",
+                                 hint="give every input a finite number")
+            raise InputError(f"input `{compiled.inputs[col]}` is {value}{where}: with `inputs = "
+                             f"as_given` (jFuzzyLogic's reading) it is not clamped to its "
+                             f"universe, and its terms have no number there",
+                             hint="give every input a finite number")
+        return Xc, np.zeros(len(plan.lo), dtype=np.intp)
     Xc = np.maximum(Xt, plan.lo_col, order="C")  # NaN stays NaN, and differs from itself
     np.minimum(Xc, plan.hi_col, out=Xc)
     Xc += 0.0     # -0.0 -> 0.0: which zero max(-0.0, 0.0) returns is NumPy's choice, per loop
@@ -611,8 +629,9 @@ def evaluate_columns(compiled: CompiledRuleBase, Xt, *, strict: bool = True) -> 
         map_blocks(blocks, n, block_width(compiled))
         unfired = True
     if unfired and np.isnan(out).any():      # rare: the clamped rows, for the message
-        rows = np.minimum(np.maximum(np.array(columns).T, compiled.plan.lo),
-                          compiled.plan.hi) + 0.0
+        rows = np.array(columns).T + 0.0
+        if compiled.operators.inputs == "clamped":
+            rows = np.minimum(np.maximum(rows, compiled.plan.lo), compiled.plan.hi) + 0.0
         fill_defaults(compiled, out.T, rows, strict)
     return out
 
@@ -861,6 +880,8 @@ def _evaluate_one(compiled: CompiledRuleBase,
     outputs = fn(*values)
     if outputs is None or (total := sum(outputs)) != total:      # NaN: as evaluate_floats
         return None
+    if compiled.operators.inputs == "as_given":
+        return [x + 0.0 for x in values], outputs
     lo, hi = compiled.plan.bounds
     clamped = [(a if x < a else b if x > b else x) + 0.0 for x, a, b in zip(values, lo, hi)]
     return clamped, outputs

@@ -73,6 +73,11 @@ def _source(c: CompiledRuleBase) -> str:
     emit(f"    if {' or '.join(f'{x} != {x}' for x in args)}:")
     emit("        return None")
     for i, x in enumerate(args):
+        if ops.inputs == "as_given":      # not clamped: infinite ones go to the NumPy path
+            emit(f"    if {x} - {x} != 0.0:")
+            emit("        return None")
+            emit(f"    {x} = {x} + 0.0")
+            continue
         lo, hi = float(plan.lo[i]), float(plan.hi[i])
         emit(f"    {x} = {lo!r} if {x} < {lo!r} else {x}")
         emit(f"    {x} = ({hi!r} if {x} > {hi!r} else {x}) + 0.0")   # -0.0 -> 0.0, as the engine

@@ -207,6 +207,10 @@ def conversion_notes(rb: RuleBase, fmt: str, behavior: str | None = None) -> lis
         out.append(left)
     ops = of_behavior(rb, b)
     out += _defuzzifier_notes(ops, fmt)
+    if ops.inputs == "as_given" and fmt != "rules":
+        out.append(f"`inputs = as_given` is not written: {fmt.upper()} has no word for it, and "
+                   f"the file is read back with inputs clamped to their universes (jFuzzyLogic "
+                   f"evaluates an FCL file's inputs as given: `--fidelity jfuzzylogic`)")
     if fmt == "fis":
         from .fis import notes
 

@@ -992,6 +992,9 @@ def legal_names(rb: RuleBase, fmt: str) -> tuple[RuleBase, list[str]]:
 FIDELITY = {"matlab": (101, "endpoints"), "jfuzzylogic": (1000, "left"),
             "fuzzylite": (None, "midpoints"), "fuzzylite6": (None, "midpoints")}
 UNWRITTEN_RESOLUTION = {"fuzzylite": 1000, "fuzzylite6": 100}
+#: Engines that evaluate an input outside its universe as given (``inputs = as_given``):
+#: jFuzzyLogic's ``Variable.setValue`` only warns.
+UNCLAMPED = ("jfuzzylogic",)
 
 
 def fidelity_settings(rb: RuleBase, engine: str, behavior: str | None = None
@@ -1003,8 +1006,10 @@ def fidelity_settings(rb: RuleBase, engine: str, behavior: str | None = None
                           hint=did_you_mean(engine, FIDELITY))
     b = rb.behavior(behavior)
     ops = ops_mod.of_behavior(rb, b)
+    # jFuzzyLogic evaluates an input outside its RANGE as given (Variable.setValue only warns)
+    given = (Setting("inputs", "as_given"),) if engine in UNCLAMPED else ()
     if ops.inference != "mamdani":
-        return ()
+        return given
     resolution, sampling = FIDELITY[engine]
     if resolution is None:
         foreign = (rb.path or "").lower().endswith((".fll", ".fcl", ".fis"))
@@ -1013,7 +1018,7 @@ def fidelity_settings(rb: RuleBase, engine: str, behavior: str | None = None
         written = not foreign or (setting_span(rb, behavior, "resolution") is not None
                                   and ops.sampling != "endpoints")
         resolution = ops.resolution if written else UNWRITTEN_RESOLUTION[engine]
-    return (Setting("resolution", str(resolution)), Setting("sampling", sampling),
+    return (*given, Setting("resolution", str(resolution)), Setting("sampling", sampling),
             *_engines_defuzzifier(ops.defuzzify, engine))
 
 

@@ -28,6 +28,10 @@ SAMPLINGS = ("midpoints", "endpoints", "left")
 #: each rule in the average (fuzzylite 6, MATLAB); an S-norm first joins their DOFs into one
 #: weight for that value (jFuzzyLogic's ``ACCU`` under ``METHOD : COGS``).
 ACCUMULATIONS = ("sum",)
+#: What an input outside its universe is evaluated at: the universe's nearer end (MITOS's and
+#: fuzzylite's ``lock-range: true``, MATLAB's), or the value as given (jFuzzyLogic's, whose
+#: ``Variable.setValue`` only warns).
+INPUTS = ("clamped", "as_given")
 #: The least and the most points a Mamdani output is sampled on.
 RESOLUTION = (3, 100_000)
 
@@ -45,6 +49,7 @@ class Operators:
     resolution: int = 101
     sampling: str = "midpoints"
     accumulation: str = "sum"
+    inputs: str = "clamped"
 
     @property
     def tnorm(self) -> norms.Norm:
@@ -63,6 +68,8 @@ class Operators:
                 text += f", sampling = {self.sampling}"
         elif self.accumulated:
             text += f", accumulation = {self.accumulation}"
+        if self.inputs != "clamped":
+            text += f", inputs = {self.inputs}"
         return text
 
     @property
@@ -84,7 +91,7 @@ class Operators:
 
 KEYS = {"and": "and_", "or": "or_", "inference": "inference", "implication": "implication",
         "aggregation": "aggregation", "defuzzify": "defuzzify", "resolution": "resolution",
-        "sampling": "sampling", "accumulation": "accumulation"}
+        "sampling": "sampling", "accumulation": "accumulation", "inputs": "inputs"}
 
 
 def _check(key: str, value: str, span: Span | None) -> str | int:
@@ -111,7 +118,7 @@ def _check(key: str, value: str, span: Span | None) -> str | int:
                 raise unknown("S-norm", value, norms.names("snorm"), span=span) from None
             raise _unknown_join(key, value, span) from None
     among = {"inference": INFERENCES, "defuzzify": DEFUZZIFIERS,
-             "sampling": SAMPLINGS}.get(key)
+             "sampling": SAMPLINGS, "inputs": INPUTS}.get(key)
     if among is not None:
         if value not in among:
             raise unknown(key, value, among, span=span)

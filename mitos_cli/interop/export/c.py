@@ -133,7 +133,7 @@ def to_c(compiled: CompiledRuleBase, prefix: str = "mitos", source: str = "") ->
         out += tables + [""]
     out += [signature, "{", f"    double x[{U}_N_INPUTS > 0 ? {U}_N_INPUTS : 1];",
             "    int fallback = 0;"]
-    out += _c_nan_inputs(U)
+    out += _c_nan_inputs(U, compiled.operators.inputs == "as_given")
     out += _c_body(p)
     out += _c_outputs(compiled, P)
     out += ["    return fallback;", "}", ""]
@@ -154,7 +154,10 @@ def _c_header(p: Program, P: str, U: str, source: str) -> list[str]:
            f"{comment(c.operators.describe())}).",
            " * C99, no allocation, only <math.h>: cc -std=c99 -c FILE.c, link with -lm.",
            f" * int {P}_eval(const double in[{U}_N_INPUTS], double out[{U}_N_OUTPUTS]):",
-           " * inputs are clamped to their universes; an output no rule sets takes its default",
+           (" * inputs are clamped to their universes; an output no rule sets takes its default"
+            if c.operators.inputs == "clamped" else
+            " * inputs are not clamped (inputs = as_given); an output no rule sets takes its "
+            "default"),
            f" * ({_without_default(c)} when it has none). Returns how many outputs took that"
            " fallback (0: the rules",
            f" * set every output), or {U}_NAN_INPUT (-1) when an input is NaN: then every",
@@ -209,12 +212,15 @@ def _c_helpers(p: Program) -> list[str]:
     return out
 
 
-def _c_nan_inputs(U: str) -> list[str]:
+def _c_nan_inputs(U: str, as_given: bool = False) -> list[str]:
     """A NaN input makes every output NaN and the status negative: the clamp and the min
-    t-norm (``a < b ? a : b``) would otherwise turn it into a plausible number."""
-    return [f"    {{   /* a NaN input: every output NaN, return {U}_NAN_INPUT */",
+    t-norm (``a < b ? a : b``) would otherwise turn it into a plausible number. Under
+    ``inputs = as_given`` (not clamped) an infinite input too: its terms have no number."""
+    bad = "isnan(in[i]) || isinf(in[i])" if as_given else "isnan(in[i])"
+    what = "a NaN or infinite input" if as_given else "a NaN input"
+    return [f"    {{   /* {what}: every output NaN, return {U}_NAN_INPUT */",
             "        int i;",
-            f"        for (i = 0; i < {U}_N_INPUTS; ++i) if (isnan(in[i])) {{",
+            f"        for (i = 0; i < {U}_N_INPUTS; ++i) if ({bad}) {{",
             f"            for (i = 0; i < {U}_N_OUTPUTS; ++i) out[i] = NAN;",
             f"            return {U}_NAN_INPUT;",
             "        }",
@@ -227,6 +233,9 @@ def _c_body(p: Program) -> list[str]:
     out = []
     for i in range(len(c.inputs)):
         lo, hi = c.universe[i]
+        if c.operators.inputs == "as_given":        # jFuzzyLogic's reading: not clamped
+            out.append(f"    x[{i}] = in[{i}] + 0.0;")
+            continue
         out.append(f"    x[{i}] = in[{i}] < {num(lo)} ? {num(lo)} : "
                    f"(in[{i}] > {num(hi)} ? {num(hi)} : in[{i}]);")
     for var, col, shape, params, kernel in p.terms:

@@ -156,7 +156,11 @@ def _py_header(p: Program, source: str) -> list[str]:
         f"(behavior `{doc_text(c.behavior)}`: {plural(len(p.rules), 'rule')}; "
         f"{doc_text(c.operators.describe())}).", "",
         "``evaluate(X)`` maps inputs ``X[n, k]`` (columns in INPUTS order, clamped to their",
-        "universes) to outputs ``Y[n, m]`` (OUTPUTS order); an output no rule sets takes its",
+        "universes) to outputs ``Y[n, m]`` (OUTPUTS order); an output no rule sets takes its"
+        if c.operators.inputs == "clamped" else
+        "``evaluate(X)`` maps inputs ``X[n, k]`` (columns in INPUTS order, not clamped: an\n"
+        "infinite one gives NaN) to outputs ``Y[n, m]`` (OUTPUTS order); an output no rule "
+        "sets takes its",
         f'default ({"0, the empty sum," if c.operators.inference == "weighted_sum" else "NaN"} '
         'when it has none). Needs only NumPy."""', "",
         "import numpy as np", "",
@@ -175,7 +179,9 @@ def _py_evaluate(p: Program) -> list[str]:
     out = ["def evaluate(X):", '    """Outputs ``Y[n, m]`` for inputs ``X[n, k]``."""',
            "    X = _rows(X)",
            "    lo = np.array([u[0] for u in UNIVERSE]); hi = np.array([u[1] for u in UNIVERSE])",
-           "    x = np.clip(X, lo, hi).T",
+           "    x = np.clip(X, lo, hi).T" if c.operators.inputs == "clamped" else
+           "    X = np.where(np.isinf(X), np.nan, X)  # not clamped: infinite reads as NaN\n"
+           "    x = X.T + 0.0",
            "    Y = np.empty((X.shape[0], len(OUTPUTS)))"]
     for var, col, shape, params, kernel in p.terms:
         if kernel is not None:
