@@ -489,3 +489,25 @@ def test_inputs_in_a_rule_file_and_an_unknown_value(tmp_path):
     assert info.value.message == "unknown inputs `as_giv`"
     assert info.value.hint == "did you mean `as_given`?"
     assert info.value.span is not None and info.value.span.line == 2
+
+
+@given(st.lists(st.tuples(st.floats(-1e6, 1e6), st.floats(-30, 40)), min_size=1, max_size=20))
+@settings(max_examples=60, deadline=None)
+def test_as_given_rows_are_the_same_bits_alone_or_batched(rows):
+    """The paper's determinism under `inputs = as_given`: a row gives the same bits alone
+    (the scalar form where there is one) as in any batch, inside or outside the ranges."""
+    from test_interop_fcl_grammar import BASE
+
+    from mitos_cli.api import LoadedRuleBase
+    from mitos_cli.engine.evaluation import evaluate_one
+    from mitos_cli.interop.common import fidelity_settings
+
+    for text in (BASE, BASE.replace("METHOD : COG;", "METHOD : COGS;").replace(
+            "TERM lo := (0, 0) (2, 1) (4, 0);", "TERM lo := 2;").replace(
+            "TERM hi := (6, 0) (8, 1) (10, 0);", "TERM hi := 8;")):
+        rb = parse_fcl(text, "p.fcl")
+        c = LoadedRuleBase(rb, None, fidelity_settings(rb, "jfuzzylogic")).compiled
+        X = np.array(rows)
+        batch = evaluate(c, X, detail=False, strict=False).outputs
+        alone = np.array([evaluate_one(c, list(r), strict=False) for r in rows])
+        assert batch.tobytes() == alone.tobytes()
