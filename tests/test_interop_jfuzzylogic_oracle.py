@@ -350,8 +350,8 @@ def test_accu_nsum_is_read_as_the_bounded_sum_with_a_note(method):
     assert [n for n in rb.notes if "NSUM" in n] == [
         f"n.fcl:{line}:12: `ACCU : NSUM` is read as jFuzzyLogic's normalized sum, (a + b) / "
         "max(1, a + b), which is the bounded sum min(1, a + b) exactly (`bounded_sum`); "
-        "fuzzylite's `NormalizedSum` computes a + b / max(1, max(a, b)) instead, which is the "
-        "plain sum while both are at most 1"]
+        "fuzzylite 6 reads it as its `NormalizedSum`, a + b / max(1, max(a, b)), the plain sum "
+        "while both are at most 1"]
     bsum = compile_rulebase(parse_fcl(text.replace("NSUM", "BSUM"), "n.fcl"))
     X = np.array([[a, b] for a in np.linspace(0, 10, 11) for b in np.linspace(0, 10, 11)])
     assert np.array_equal(evaluate(c, X, detail=False).outputs,

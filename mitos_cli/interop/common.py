@@ -72,7 +72,10 @@ _ONLY_AGGREGATION = ("the unbounded sum is a Mamdani aggregation only (`aggregat
                      "not an S-norm joining conditions")
 #: Names formats use for operators MITOS does not have (refused with this explanation).
 UNSUPPORTED_NORMS = {
-    "NormalizedSum": "the normalized sum is not an S-norm MITOS computes",
+    "NormalizedSum": "fuzzylite 8's normalized sum, (a + b) / max(1, a + b), is the bounded sum "
+                     "exactly, but fuzzylite 6's is a + b / max(1, max(a, b)), which depends on "
+                     "the order of the rules past 1, and the file does not say which wrote it; "
+                     "write `BoundedSum` for fuzzylite 8's",
     "UnboundedSum": _ONLY_AGGREGATION,
     "NSUM": "jFuzzyLogic's normalized sum is an accumulation (`ACCU : NSUM`, read as the "
             "bounded sum, which it equals), not a connective; write `BSUM`",

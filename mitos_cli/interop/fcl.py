@@ -711,7 +711,8 @@ OR_ALIASES = {"EINSTEIN": "einstein_sum", "HAMACHER": "hamacher_sum"}
 
 #: jFuzzyLogic's ``ACCU : NSUM`` (``RuleAccumulationMethodNormedSum``): ``(a + b) / max(1, a +
 #: b)``, which is ``a + b`` up to 1 and ``(a + b) / (a + b)``, exactly 1, above: the bounded sum
-#: ``min(1, a + b)`` bit for bit. fuzzylite's ``NormalizedSum`` is another function.
+#: ``min(1, a + b)`` bit for bit (and pyfuzzylite 8's ``NormalizedSum``). fuzzylite 6's
+#: ``NormalizedSum``, which its FCL reader makes of ``NSUM``, is ``a + b / max(1, max(a, b))``.
 NSUM_MEANS = ("jFuzzyLogic's normalized sum, (a + b) / max(1, a + b), which is the bounded "
               "sum min(1, a + b) exactly")
 
@@ -737,8 +738,8 @@ def _option(item: Tree, settings: common.Record, span_of, conj: dict,
         settings.set("aggregation", "bounded_sum", span, "ACCU")
         if notes is not None:
             notes.append(f"{span}: `ACCU : NSUM` is read as {NSUM_MEANS} (`bounded_sum`); "
-                         f"fuzzylite's `NormalizedSum` computes a + b / max(1, max(a, b)) "
-                         f"instead, which is the plain sum while both are at most 1")
+                         f"fuzzylite 6 reads it as its `NormalizedSum`, a + b / max(1, max(a, "
+                         f"b)), the plain sum while both are at most 1")
     elif key == "ACCU":
         # SUM: jFuzzyLogic's default, the unbounded sum (under COGS the accumulation, below)
         settings.set("aggregation", _norm(common.AGGREGATIONS, value, "ACCU", span), span, "ACCU")
