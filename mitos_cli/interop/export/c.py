@@ -160,7 +160,8 @@ def _c_header(p: Program, P: str, U: str, source: str) -> list[str]:
             "default"),
            f" * ({_without_default(c)} when it has none). Returns how many outputs took that"
            " fallback (0: the rules",
-           f" * set every output), or {U}_NAN_INPUT (-1) when an input is NaN: then every",
+           f" * set every output), or {U}_NAN_INPUT (-1) when an input is NaN"
+           + (" or infinite" if c.operators.inputs == "as_given" else "") + ": then every",
            " * output is NaN. */",
            "", "#include <math.h>", "",
            f"#define {U}_N_INPUTS {len(c.inputs)}", f"#define {U}_N_OUTPUTS {len(c.outputs)}",
