@@ -182,7 +182,8 @@ def eval_command(
     fidelity_name: Annotated[Optional[str], typer.Option(
         "--fidelity", metavar=choices(Engine), autocompletion=completer(Engine),
         help="Sample Mamdani outputs as this engine does, to reproduce its published tables: "
-             "matlab (101 points with both ends), jfuzzylogic (1000 left cell ends), "
+             "matlab (101 points with both ends), jfuzzylogic (1000 left cell ends, its COA, "
+             "and inputs outside their ranges not clamped), "
              "fuzzylite (fuzzylite 8: cell midpoints at the file's resolution, 1000 where it "
              "gives none), fuzzylite6 (fuzzylite 6, Debian's `fuzzylite`: the same, 100 where "
              "it gives none, as in every FCL `METHOD : COG;` and .fis).")] = None,
