@@ -1023,7 +1023,8 @@ def _engines_defuzzifier(method: str, engine: str) -> tuple[Setting, ...]:
     return (Setting("defuzzify", f"matlab_{plain}" if engine == "matlab" else plain),)
 
 
-def refuse_accumulation(rb: RuleBase, behavior: str | None, flat: Flat, fmt: str) -> None:
+def refuse_accumulation(rb: RuleBase, behavior: str | None, flat: Flat, fmt: str,
+                        hint: str = "write it to FCL (ACCU) or a rule file") -> None:
     """Refuse to write a behavior whose ``accumulation`` S-norm joins several rules of one
     value to a format that cannot say so (fuzzylite and MATLAB average every rule): two rules
     of one value, or a linear function among an output's values (they meet at some inputs,
@@ -1046,7 +1047,7 @@ def refuse_accumulation(rb: RuleBase, behavior: str | None, flat: Flat, fmt: str
                     f"`{seen[key]}` and `{r.label}` both set `{c.var}` to {value}, which "
                     f"`accumulation = {flat.operators.accumulation}` joins",
                     span=setting_span(rb, behavior, "accumulation"),
-                    hint="write it to FCL (ACCU) or a rule file, or merge the rules")
+                    hint=f"{hint}, or merge the rules")
             seen[key] = r.label
     for var in dict.fromkeys(k[0] for k in seen):
         keys = [k for k in seen if k[0] == var]
@@ -1056,5 +1057,4 @@ def refuse_accumulation(rb: RuleBase, behavior: str | None, flat: Flat, fmt: str
                 f"{fmt} has no accumulation of the rules that conclude one value: `{var}`'s "
                 f"linear function (`{seen[linear[0]]}`) meets its other values at some inputs, "
                 f"where `accumulation = {flat.operators.accumulation}` joins their rules",
-                span=setting_span(rb, behavior, "accumulation"),
-                hint="write it to FCL (ACCU) or a rule file")
+                span=setting_span(rb, behavior, "accumulation"), hint=hint)
