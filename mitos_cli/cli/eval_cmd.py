@@ -225,14 +225,14 @@ def _loaded(path: str | None, behavior: str | None, fidelity):
     warn_notes(rb.rulebase)
     if fidelity is None:
         return rb
-    from ..interop.common import fidelity_settings
+    from ..interop.common import fidelity_rulebase, fidelity_settings
 
     settings = fidelity_settings(rb.rulebase, fidelity.value, behavior)
     if not settings:                  # it changed nothing, and nothing said so
         warn(f"--fidelity {fidelity.value} changes nothing here: behavior `{rb.compiled.behavior}` "
              f"infers by {rb.compiled.operators.inference}, and only Mamdani outputs are "
              f"sampled")
-    return LoadedRuleBase(rb.rulebase, behavior, settings)
+    return LoadedRuleBase(fidelity_rulebase(rb.rulebase, fidelity.value), behavior, settings)
 
 
 def _names_file(word: str) -> bool:

@@ -299,10 +299,10 @@ def undersampled_hint(path: str | None, u) -> str:
         return "move the term into the range, or widen the output's range"
     if u.outside:
         return "change the term so that it is above 0 somewhere in the output's range"
-    return resolution_hint(path, u.points)
+    return resolution_hint(path, u.points, u.output if u.own else None)
 
 
-def resolution_hint(path: str | None, points: int) -> str:
+def resolution_hint(path: str | None, points: int, own: str | None = None) -> str:
     """How to sample an output more finely, in the words of the file's format."""
     suffix = (path or "").rsplit(".", 1)[-1].lower()
     finer = 1001 if points < 1001 else min(points * 10, 100_000)
@@ -316,6 +316,9 @@ def resolution_hint(path: str | None, points: int) -> str:
     if suffix == "fcl":
         return (f"widen it, or raise the defuzzifier's resolution (`METHOD : COG "
                 f"{finer};`, which MITOS reads; fuzzylite 6 and jFuzzyLogic read none)")
+    if own is not None:          # the output's own resolution, which the operators' do not set
+        return (f"widen it, or raise `{own}`'s own resolution (now {points}): `resolution: "
+                f"{finer}` under `{own}` in its term set")
     return (f"widen it, or raise the resolution (now {points}): `resolution = {finer}` in "
             f"the behavior's (or the file's) `operators:` line")
 

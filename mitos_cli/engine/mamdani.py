@@ -16,7 +16,9 @@ and the result is defuzzified:
                whose running area reaches half the total; ``matlab_som`` / ``matlab_lom`` the
                maximum's sample smallest / largest in absolute value (the first of a tie)
 
-**Grid.** The universe ``[lo, hi]`` is cut into ``resolution`` equal cells and sampled at their
+**Grid.** The universe ``[lo, hi]`` is cut into ``resolution`` equal cells (the output's own
+``resolution`` where its variable has one, as fuzzylite gives each output its defuzzifier's:
+each output has a table of its own, so this costs nothing per sample) and sampled at their
 midpoints, ``x_i = lo + (i + 1/2) (hi - lo) / resolution``: the midpoint rule of integration,
 the same as fuzzylite's integral defuzzifiers with ``resolution`` divisions, so MITOS and
 fuzzylite agree to rounding on the same rule base.
@@ -114,12 +116,13 @@ def spike(lo: float, hi: float, resolution: int, value: float,
 
 
 def build_tables(compiled) -> tuple[OutputTable, ...]:
-    """Sample every consequent set the rules use, per output (done once, then cached)."""
-    res = compiled.operators.resolution
+    """Sample every consequent set the rules use, per output (done once, then cached), on the
+    output's own ``resolution`` where it has one, else its behavior's."""
     sampling = compiled.operators.sampling
     tables = []
     for j, name in enumerate(compiled.outputs):
         var = compiled.variables[name]
+        res = var.resolution or compiled.operators.resolution
         lo, hi = var.universe
         x = grid(lo, hi, res, sampling)
         rules = np.flatnonzero(compiled.cons_mask[:, j])
@@ -181,6 +184,7 @@ class Undersampled:
     #: formula): no resolution makes its rules count
     outside: str = ""
     universe: tuple[float, float] = (0.0, 0.0)
+    own: bool = False         # sampled at the output's own resolution, not its behavior's
 
     def describe(self) -> str:
         """What is wrong, for ``check`` and ``eval``."""
@@ -218,7 +222,8 @@ def undersampled(compiled) -> tuple[Undersampled, ...]:
                 "outside" if term.corners is not None else "zero"
             out.append(Undersampled(table.name, label, term.name, peak, len(table.grid), step,
                                     table.rules[table.set_of == i], outside,
-                                    (float(var.universe[0]), float(var.universe[1]))))
+                                    (float(var.universe[0]), float(var.universe[1])),
+                                    var.resolution is not None))
     return tuple(out)
 
 

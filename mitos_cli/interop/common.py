@@ -409,11 +409,31 @@ class Settings:
         return self.defuzzify in ("weighted_average", "weighted_sum", "tsukamoto")
 
 
+def own_resolutions(records: dict[str, Record]) -> dict[str, int]:
+    """Each Mamdani output's own resolution, taken out of its ``records`` (the settings its
+    format writes per output: fuzzylite's ``defuzzifier: Centroid 200``), where the outputs'
+    resolutions are not all one written number; else none, and the one number stays the
+    behavior's. An output that writes none is left to the behavior's (the reader's default,
+    which ``--fidelity`` may replace: fuzzylite 8 takes 1000 there, fuzzylite 6 100)."""
+    mamdani = {n: r for n, r in records.items() if any(
+        key == "defuzzify" and value not in ("weighted_average", "weighted_sum", "tsukamoto")
+        for key, value, _, _ in r)}
+    written = {n: [e for e in r if e[0] == "resolution"] for n, r in mamdani.items()}
+    values = {e[1] for entries in written.values() for e in entries}
+    if len(values) < 2 and (not values or all(written.values())):
+        return {}
+    own = {}
+    for n, entries in written.items():
+        for entry in entries:
+            own[n] = entry[1]
+            mamdani[n].remove(entry)
+    return own
+
+
 def _same_hint(key: str) -> str:
     """What to do when two outputs or rule blocks set ``key`` differently."""
     if key == "resolution":
-        return ("give every output the same resolution (MITOS samples one rule base's "
-                "outputs alike; the larger resolution samples finer)")
+        return "give the rule block one resolution (the larger samples finer)"
     if key == "sampling":
         return "give every output the same sampling"
     return "use the same operator for every output and rule block"
@@ -1012,6 +1032,19 @@ def fidelity_settings(rb: RuleBase, engine: str, behavior: str | None = None
         resolution = ops.resolution if written else UNWRITTEN_RESOLUTION[engine]
     return (Setting("resolution", str(resolution)), Setting("sampling", sampling),
             *_engines_defuzzifier(ops.defuzzify, engine))
+
+
+def fidelity_rulebase(rb: RuleBase, engine: str) -> RuleBase:
+    """``rb`` as ``engine`` samples its outputs: fuzzylite (8 and 6) gives each Mamdani output
+    its defuzzifier's resolution, so the outputs' own ``resolution`` stays; MATLAB and
+    jFuzzyLogic sample every output alike (:data:`FIDELITY`), so it goes, and the behavior's
+    (:func:`fidelity_settings`) is every output's."""
+    if FIDELITY.get(engine, (None,))[0] is None or not any(
+            v.resolution is not None for v in rb.variables.values()):
+        return rb
+    termsets = tuple(replace(ts, variables=tuple(replace(v, resolution=None)
+                                                 for v in ts.variables)) for ts in rb.termsets)
+    return replace(rb, termsets=termsets)
 
 
 def _engines_defuzzifier(method: str, engine: str) -> tuple[Setting, ...]:

@@ -259,6 +259,9 @@ def _function_block(fb: Tree, span_of) -> RuleBase:
                                                span_of(fb).path))
         kind = "FUZZIFY" if role == "input" else "DEFUZZIFY"
         raise FormatError(f"variable `{name}` is declared but has no {kind} block", span=span)
+    outputs_written = {n: records[n] for n in declared if declared[n][0] == "output"}
+    for name, points in common.own_resolutions(outputs_written).items():   # `COG 200`, MITOS's
+        variables[name] = dataclasses.replace(variables[name], resolution=points)
     parsed = [_rule_block(block, variables, span_of, notes) for block in blocks]
     parsed = [p for p in parsed if p[2]] or parsed[:1]
     outputs = [n for n in declared if declared[n][0] == "output"]

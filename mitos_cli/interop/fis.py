@@ -505,11 +505,12 @@ def notes(rb: RuleBase, behavior: str | None = None) -> list[str]:
             now = "NaN / an error" if v.default is None else f"{v.default:g}"
             out.append(f"output `{v.name}`: when no rule fires MATLAB returns the middle of the "
                        f"range ({mid:g}), not {now}")
-    if ops.inference == "mamdani" and (ops.resolution, ops.sampling) != (DEFAULT_RESOLUTION,
-                                                                         "endpoints"):
+    points = list(dict.fromkeys(v.resolution or ops.resolution for v in flat.outputs))
+    if ops.inference == "mamdani" and (points, ops.sampling) != ([DEFAULT_RESOLUTION],
+                                                                 "endpoints"):
         out.append(f"MATLAB samples Mamdani outputs at 101 points including the ends; this rule "
-                   f"base uses {ops.resolution} {ops.sampling}, so results move by the "
-                   f"discretisation")
+                   f"base uses {' and '.join(map(str, points))} {ops.sampling}, so results "
+                   f"move by the discretisation")
     return out
 
 

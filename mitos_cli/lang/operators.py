@@ -53,11 +53,16 @@ class Operators:
     def snorm(self) -> norms.Norm:
         return norms.lookup("snorm", self.or_)
 
-    def describe(self) -> str:
+    def describe(self, own: dict[str, int] | None = None, every: bool = False) -> str:
+        """The settings in an ``operators:`` line's words; ``own``: outputs sampled at a
+        resolution of their own, ``every`` output (``resolution = 200 for Power, 500 for
+        InversePower``) or some (``resolution = 1000, 200 for Power``)."""
         text = f"and = {self.and_}, or = {self.or_}, inference = {self.inference}"
         if self.inference == "mamdani":
+            points = ", ".join(([] if own and every else [str(self.resolution)])
+                               + [f"{r} for {n}" for n, r in (own or {}).items()])
             text += (f", implication = {self.implication}, aggregation = {self.aggregation}, "
-                     f"defuzzify = {self.defuzzify}, resolution = {self.resolution}")
+                     f"defuzzify = {self.defuzzify}, resolution = {points}")
             if self.sampling != "midpoints":
                 text += f", sampling = {self.sampling}"
         elif self.accumulated:
