@@ -18,7 +18,7 @@ and the result is defuzzified:
 
 **Grid.** The universe ``[lo, hi]`` is cut into ``resolution`` equal cells (the output's own
 ``resolution`` where its variable has one, as fuzzylite gives each output its defuzzifier's:
-each output has a table of its own, so this costs nothing per sample) and sampled at their
+each output has a table of its own, and the batch path is the same) and sampled at their
 midpoints, ``x_i = lo + (i + 1/2) (hi - lo) / resolution``: the midpoint rule of integration,
 the same as fuzzylite's integral defuzzifiers with ``resolution`` divisions, so MITOS and
 fuzzylite agree to rounding on the same rule base.
