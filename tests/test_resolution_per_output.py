@@ -272,3 +272,18 @@ def test_fcl_cog_with_a_resolution_per_output_reads_the_same_way():
                                                                "METHOD : COG 200;"), "one.fcl")
     assert all(v.resolution is None for v in same.variables.values())
     assert compile_rulebase(same).operators.resolution == 200
+
+
+def test_the_exported_python_samples_each_output_on_its_own_grid(tmp_path):
+    import importlib.util
+
+    from mitos_cli.interop.export import to_python
+
+    c = compile_rulebase(parse_fll(OWN, "own.fll"))
+    path = tmp_path / "exported.py"
+    path.write_text(to_python(c, "own.fll"))
+    spec = importlib.util.spec_from_file_location("exported", path)
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    np.testing.assert_allclose(module.evaluate(X), FUZZYLITE8, rtol=0, atol=1e-12)
