@@ -1014,7 +1014,8 @@ UNWRITTEN_RESOLUTION = {"fuzzylite": 1000, "fuzzylite6": 100}
 def fidelity_settings(rb: RuleBase, engine: str, behavior: str | None = None
                       ) -> tuple[Setting, ...]:
     """Operator overrides that make ``rb``'s Mamdani outputs sample as ``engine`` does (none
-    for a weighted-average rule base, whose outputs are not sampled)."""
+    for a weighted-average rule base, whose outputs are not sampled). An output's own
+    ``resolution`` beats them: compile :func:`fidelity_rulebase` ``(rb, engine)`` with them."""
     if engine not in FIDELITY:
         raise FormatError(f"unknown engine `{engine}`", expected="one of " + ", ".join(FIDELITY),
                           hint=did_you_mean(engine, FIDELITY))
