@@ -287,3 +287,17 @@ def test_the_exported_python_samples_each_output_on_its_own_grid(tmp_path):
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     np.testing.assert_allclose(module.evaluate(X), FUZZYLITE8, rtol=0, atol=1e-12)
+
+
+def test_check_calls_an_outputs_own_resolution_idle_outside_mamdani():
+    rules = RULES.replace("operators: inference = mamdani, resolution = 1001\n", "").replace(
+        "then y is thin", "then y is 15")
+    terms = TERMS.replace("a: {shape: triangle, points: [0, 5, 10]}", "a: 5").replace(
+        "thin: {shape: triangle, points: [14.6, 15, 15.4]}", "thin: 15").replace(
+        "b: {shape: triangle, points: [20, 25, 30]}", "b: 25")
+    rb = build_rulebase(parse_rules(rules, "t.rules"), (parse_termset(terms, "t.terms.yaml"),))
+    idle = [f for f in check_rulebase(rb).findings if f.code == "idle-setting"]
+    assert [f.message for f in idle] == ["`y`'s own `resolution: 30` has no effect: behavior "
+                                         "`main` uses weighted_average inference"]
+    assert (idle[0].span.line, idle[0].span.column) == (6, 3)
+    assert not [f for f in check_rulebase(_rule_file()).findings if f.code == "idle-setting"]

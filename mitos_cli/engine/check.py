@@ -20,8 +20,9 @@ code                  severity    meaning
 ``conflict``          error       rules with the same antecedent and different consequents
 ``duplicate``         warning     rules with the same antecedent and the same consequents
 ``contradiction``     warning     an antecedent that asks for ``x is A`` and ``x is not A``
-``idle-setting``      warning     a Mamdani-only operator setting (``defuzzify``, ...) where
-                                  the inference is not Mamdani
+``idle-setting``      warning     a Mamdani-only operator setting (``defuzzify``, ...), or an
+                                  output's own ``resolution:``, where the inference is not
+                                  Mamdani
 ``infinite-output``   warning     a sigmoid a Tsukamoto rule concludes: it reaches 1 only at
                                   infinity, so where the rule fires fully the output is +-inf
 ``unreachable``       warning     a rule that fires nowhere: its DOF is 0 on a grid of the
@@ -248,6 +249,16 @@ def _idle_settings(rb: RuleBase, name: str, compiled) -> list[Finding]:
                 f"`{setting.key} = {setting.value}` has no effect: behavior `{name}` uses "
                 f"{compiled.operators.inference} inference", setting.span, name,
                 "add `inference = mamdani` to the operators line, or remove the setting"))
+    if inference != "mamdani":        # an output's own resolution, from its term set
+        for output in compiled.outputs:
+            var = compiled.variables.get(output)
+            if var is not None and var.resolution is not None:
+                out.append(Finding(
+                    "warning", "idle-setting",
+                    f"`{output}`'s own `resolution: {var.resolution}` has no effect: behavior "
+                    f"`{name}` uses {inference} inference", var.span, name,
+                    "add `inference = mamdani` to the operators line, or remove the "
+                    "resolution"))
     return out
 
 
