@@ -78,13 +78,16 @@ class OutputTable:
     set_of: np.ndarray        # [R_j] row of ``sets`` for each of those rules
     order: np.ndarray         # [R_j] those rules (positions in ``rules``) sorted by set
     starts: np.ndarray        # [t] start of each set's run in ``order`` (for reduceat)
+    #: [res] each point's weight in the centroid's and bisector's sums (``sampling =
+    #: trapezoid``: the two ends half); None: every point 1
+    weights: np.ndarray | None = None
 
 
 def grid(lo: float, hi: float, resolution: int, sampling: str = "midpoints") -> np.ndarray:
     """The midpoints of ``resolution`` equal cells of ``[lo, hi]`` (``sampling="endpoints"``:
     ``resolution`` evenly spaced points from ``lo`` to ``hi``, as MATLAB's ``evalfis``;
     ``"left"``: the cells' left ends, as jFuzzyLogic)."""
-    if sampling == "endpoints":
+    if sampling in ("endpoints", "trapezoid"):
         return np.linspace(lo, hi, resolution)
     if sampling == "left":    # jFuzzyLogic: the cells' left ends, reached as it reaches them
         return _stepped(lo, (hi - lo) / resolution, resolution)
@@ -107,7 +110,7 @@ def spike(lo: float, hi: float, resolution: int, value: float,
     """A singleton at ``value`` as sampled set: 1 at the midpoint of the cell holding it (with
     ``endpoints`` sampling: at the nearest sample point)."""
     row = np.zeros(resolution)
-    if sampling == "endpoints":
+    if sampling in ("endpoints", "trapezoid"):
         i = int(np.rint((value - lo) / (hi - lo) * (resolution - 1)))
     else:
         i = int(np.floor((value - lo) / ((hi - lo) / resolution)))
@@ -156,8 +159,17 @@ def build_tables(compiled) -> tuple[OutputTable, ...]:
         order = np.argsort(set_of, kind="stable").astype(np.intp)
         starts = np.searchsorted(set_of[order], np.arange(len(rows))).astype(np.intp)
         sets = np.array(rows, dtype=float).reshape(len(rows), res)
-        tables.append(OutputTable(name, x, sets, tuple(labels), rules, set_of, order, starts))
+        tables.append(OutputTable(name, x, sets, tuple(labels), rules, set_of, order, starts,
+                                  trapezoid_weights(res) if sampling == "trapezoid" else None))
     return tuple(tables)
+
+
+def trapezoid_weights(points: int) -> np.ndarray:
+    """The trapezoid rule's weights on ``points`` evenly spaced points (the common step left
+    out: it cancels in a centroid and in a bisector's half): 1, the two ends 1/2."""
+    w = np.ones(points)
+    w[[0, -1]] = 0.5
+    return w
 
 
 #: A consequent set whose largest membership over its output's sample points is below this
@@ -253,10 +265,14 @@ def aggregate(dof: np.ndarray, sets: np.ndarray, implication: str,
     return norms.tree_reduce(aggregation, stack, axis=0)
 
 
-def defuzzify(Y: np.ndarray, x: np.ndarray, method: str) -> np.ndarray:
+def defuzzify(Y: np.ndarray, x: np.ndarray, method: str,
+              weights: np.ndarray | None = None) -> np.ndarray:
     """Crisp values ``[b]`` of output sets ``Y[b, res]`` sampled at ``x[res]`` (NaN where the
-    set is empty)."""
+    set is empty); ``weights[res]``: each point's weight in the centroid's and the bisector's
+    sums (the trapezoid rule's), else 1."""
     out = np.full(Y.shape[0], np.nan)
+    if weights is not None and method in ("centroid", "bisector", "matlab_bisector"):
+        Y = Y * weights
     if method == "centroid":
         den = Y.sum(axis=1)
         num = (Y * x).sum(axis=1)
@@ -314,7 +330,7 @@ def mamdani_outputs(compiled, dof: np.ndarray) -> np.ndarray:
         for start in range(0, b, per):                # sub-blocks of samples
             block = slice(start, min(start + per, b))
             Y = _aggregate_chunked(D[:, block], sets, ops.implication, aggregation)
-            out[j, block] = defuzzify(Y, table.grid, ops.defuzzify)
+            out[j, block] = defuzzify(Y, table.grid, ops.defuzzify, table.weights)
     return out
 
 

@@ -153,7 +153,9 @@ def left_out(rb: RuleBase, behavior: str | None, done: str) -> str | None:
 
 #: Where a sampling other than fuzzylite's midpoints takes its points, and whose rule it is.
 SAMPLED_AT = {"endpoints": "evenly spaced points including both ends (MATLAB's)",
-              "left": "the cells' left ends (jFuzzyLogic's)"}
+              "left": "the cells' left ends (jFuzzyLogic's)",
+              "trapezoid": "evenly spaced points including both ends, the ends weighing half "
+                           "(Octave's)"}
 
 
 #: MATLAB's defuzzifiers that fuzzylite (FLL, FCL) defines otherwise, and what each means

@@ -1007,7 +1007,8 @@ def legal_names(rb: RuleBase, fmt: str) -> tuple[RuleBase, list[str]]:
 #: FCL and .fis): the same with 100 by default (``IntegralDefuzzifier::_defaultResolution``),
 #: which is every FCL ``METHOD : COG;`` and every .fis ``centroid``.
 FIDELITY = {"matlab": (101, "endpoints"), "jfuzzylogic": (1000, "left"),
-            "fuzzylite": (None, "midpoints"), "fuzzylite6": (None, "midpoints")}
+            "fuzzylite": (None, "midpoints"), "fuzzylite6": (None, "midpoints"),
+            "octave": (101, "trapezoid")}
 UNWRITTEN_RESOLUTION = {"fuzzylite": 1000, "fuzzylite6": 100}
 
 
@@ -1021,6 +1022,8 @@ def fidelity_settings(rb: RuleBase, engine: str, behavior: str | None = None
                           hint=did_you_mean(engine, FIDELITY))
     b = rb.behavior(behavior)
     ops = ops_mod.of_behavior(rb, b)
+    if engine == "octave" and ops.inference in ("weighted_average", "weighted_sum"):
+        return _octave_accumulation(rb)
     if ops.inference != "mamdani":
         return ()
     resolution, sampling = FIDELITY[engine]
@@ -1035,9 +1038,28 @@ def fidelity_settings(rb: RuleBase, engine: str, behavior: str | None = None
             *_engines_defuzzifier(ops.defuzzify, engine))
 
 
+def _octave_accumulation(rb: RuleBase) -> tuple[Setting, ...]:
+    """Octave's toolkit joins the rules of one Sugeno output value with the file's
+    ``AggMethod`` before the weighted average (``aggregate_fis_output``: the rules' values
+    sorted, equal ones joined), which is ``accumulation = AggMethod``; MATLAB, and MITOS's
+    reading of a ``.fis``, count every rule. Only a ``.fis`` file says it."""
+    from .fis import aggregation_method
+
+    path = rb.path or ""
+    if not path.lower().endswith(".fis"):
+        return ()
+    try:
+        text = Path(path).read_text(encoding="utf-8", errors="replace")
+    except OSError as exc:
+        raise FormatError(f"--fidelity octave reads the file's AggMethod, and `{path}` cannot "
+                          f"be read again: {exc.strerror}") from None
+    method = aggregation_method(text, path)
+    return () if method in (None, "sum") else (Setting("accumulation", method),)
+
+
 def fidelity_rulebase(rb: RuleBase, engine: str) -> RuleBase:
     """``rb`` as ``engine`` samples its outputs: fuzzylite (8 and 6) gives each Mamdani output
-    its defuzzifier's resolution, so the outputs' own ``resolution`` stays; MATLAB and
+    its defuzzifier's resolution, so the outputs' own ``resolution`` stays; MATLAB, Octave and
     jFuzzyLogic sample every output alike (:data:`FIDELITY`), so it goes, and the behavior's
     (:func:`fidelity_settings`) is every output's."""
     if FIDELITY.get(engine, (None,))[0] is None or not any(

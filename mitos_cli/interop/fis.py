@@ -213,6 +213,19 @@ def _settings(system: dict[str, tuple[str, Span]], sys_span: Span,
     return settings, unset, sugeno
 
 
+def aggregation_method(text: str, path: str | None = None) -> str | None:
+    """The MITOS name of a ``.fis`` text's ``AggMethod`` (None where it writes none): what
+    Octave's toolkit joins a Sugeno output's rules of one value with (``--fidelity octave``)."""
+    sections, _ = _sections(text, path)
+    items: list = next((items for name, _, items in sections if name == "System"), [])
+    system = _system(items)
+    if "AggMethod" not in system:
+        return None
+    name = _string(*system["AggMethod"])
+    return common.table_lookup(common.AGGREGATIONS, FIS, name, "aggregation method",
+                               system["AggMethod"][1]) if name else None
+
+
 def _check_unset(unset: dict[str, Span], rules: list[Rule]) -> None:
     """``AndMethod=''`` (or ``OrMethod``) with a rule that joins its conditions so."""
     for key, connective in (("AndMethod", And), ("OrMethod", Or)):

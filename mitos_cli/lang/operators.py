@@ -21,8 +21,10 @@ DEFUZZIFIERS = ("centroid", "bisector", "mom", "som", "lom",
                 "matlab_bisector", "matlab_som", "matlab_lom")      # MATLAB's evalfis
 #: Where Mamdani outputs are sampled: cell midpoints (fuzzylite's rule, the default),
 #: ``resolution`` evenly spaced points including both ends (MATLAB's ``evalfis``), or the
-#: cells' left ends (jFuzzyLogic's, each reached from the one before: ``x += (max - min) / resolution``).
-SAMPLINGS = ("midpoints", "endpoints", "left")
+#: cells' left ends (jFuzzyLogic's, each reached from the one before: ``x += (max - min) / resolution``),
+#: or the end points with the two ends weighing half in the centroid and bisector's areas: the
+#: trapezoid rule of Octave's fuzzy-logic-toolkit (``trapz`` in its ``defuzz.m``).
+SAMPLINGS = ("midpoints", "endpoints", "left", "trapezoid")
 #: How weighted inference joins the rules that conclude one value of an output: ``sum`` counts
 #: each rule in the average (fuzzylite 6, MATLAB); an S-norm first joins their DOFs into one
 #: weight for that value (jFuzzyLogic's ``ACCU`` under ``METHOD : COGS``).

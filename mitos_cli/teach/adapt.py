@@ -824,7 +824,7 @@ def difference_steps(p: Parameters) -> np.ndarray:
     # the coarsest output's grid (outputs may have resolutions of their own)
     points = min((len(t.grid) for t in p.compiled.mamdani), default=ops.resolution) \
         if ops.inference == "mamdani" else ops.resolution
-    cells = points - 1 if ops.sampling == "endpoints" else points
+    cells = points - 1 if ops.sampling in ("endpoints", "trapezoid") else points
     rel = np.full(len(p.values), DIFF_STEP if ops.defuzzify == "centroid" else 1.0 / cells)
     single = np.array([k.kind in ("output", "crisp") for k in p.knots], dtype=bool)
     rel[single] = 1.0 / cells
