@@ -198,7 +198,8 @@ class LoadedRuleBase:
 
     def with_operators(self, **settings: str) -> LoadedRuleBase:
         """The same behavior compiled with other operators, e.g. ``with_operators(and_="product")``
-        (keys as in an ``operators:`` line; a trailing underscore is dropped)."""
+        (keys as in an ``operators:`` line; a trailing underscore is dropped). An output with a
+        ``resolution`` of its own (its term set's) keeps it."""
         from .lang.model import Setting
 
         extra = tuple(Setting(k.rstrip("_"), str(v)) for k, v in settings.items())

@@ -181,16 +181,105 @@ def _rulebase(operators: str, rules: str = RULES) -> RuleBase:
     return build_rulebase(parse_rules(rules.format(operators=operators), "a.rules"), (termset,))
 
 
-@pytest.mark.parametrize("dialect", ["iec", "fuzzylite"])
-def test_fcl_writes_it_as_accu_and_reads_back_the_same_bits(dialect: str):
+def test_fcl_writes_it_as_accu_and_reads_back_the_same_bits():
     rb = _rulebase("accumulation = probabilistic_sum")
-    text = write_foreign(rb, "fcl", dialect=dialect)
+    text = write_foreign(rb, "fcl", dialect="iec")
     assert "METHOD : COGS;" in text and text.count("ACCU : ASUM;") == 1
     back = parse_fcl(text, "back.fcl")
     X = np.linspace(-1, 11, 97)[:, None]
     before = evaluate(compile_rulebase(rb), X, detail=False).outputs
     after = evaluate(compile_rulebase(back), X, detail=False).outputs
     assert np.array_equal(bits(after), bits(before))
+
+
+def test_fuzzylites_fcl_refuses_it_where_it_joins_rules_as_its_engine_would_not():
+    """fuzzylite 6 counts every rule under COGS whatever the DEFUZZIFY's ACCU says, so that
+    dialect cannot carry an accumulation that joins two rules; where every value is concluded
+    once it changes nothing and is written."""
+    with pytest.raises(MitosError) as info:
+        write_foreign(_rulebase("accumulation = max"), "fcl", dialect="fuzzylite")
+    assert info.value.message == ("fuzzylite's FCL has no accumulation of the rules that "
+                                  "conclude one value: `r1` and `r2` both set `y` to 10, which "
+                                  "`accumulation = max` joins")
+    assert "--dialect iec" in info.value.hint
+    once = RULES.replace("r2: if x is MID then y is A\n", "").replace("then y is C with 0.5",
+                                                                      "then y is 33")
+    terms = TERMS.replace(", L: {shape: linear, coefficients: {x: 2}, constant: 3}", "")
+    rb = build_rulebase(parse_rules(once.format(operators="accumulation = max"), "a.rules"),
+                        (parse_termset(terms, "a.terms.yaml"),))
+    back = parse_fcl(write_foreign(rb, "fcl", dialect="fuzzylite"), "back.fcl")
+    X = np.linspace(-1, 11, 97)[:, None]
+    assert np.array_equal(bits(evaluate(compile_rulebase(back), X, detail=False).outputs),
+                          bits(evaluate(compile_rulebase(rb), X, detail=False).outputs))
+
+
+#: fuzzylite's FCL (ACCU in DEFUZZIFY) with two rules concluding `a` under COGS + ACCU MAX.
+FUZZYLITE_COGS = """\
+//Code automatically generated with fuzzylite 6.0.
+
+FUNCTION_BLOCK accu
+
+VAR_INPUT
+  x: REAL;
+END_VAR
+
+VAR_OUTPUT
+  y: REAL;
+END_VAR
+
+FUZZIFY x
+  RANGE := (0.000 .. 1.000);
+  TERM low := Triangle 0.000 0.250 0.500;
+  TERM mid := Triangle 0.250 0.500 0.750;
+  TERM high := Triangle 0.250 0.750 1.000;
+END_FUZZIFY
+
+DEFUZZIFY y
+  RANGE := (0.000 .. 1.000);
+  TERM a := 0.200;
+  TERM b := 0.800;
+  METHOD : COGS;
+  ACCU : MAX;
+  DEFAULT := nan;
+END_DEFUZZIFY
+
+RULEBLOCK
+  AND : MIN;
+  OR : MAX;
+  ACT : MIN;
+  RULE 1 : if x is low then y is a
+  RULE 2 : if x is mid then y is a
+  RULE 3 : if x is high then y is b
+END_RULEBLOCK
+
+END_FUNCTION_BLOCK
+"""
+
+
+def test_fuzzylites_accu_in_defuzzify_under_cogs_counts_every_rule_as_fuzzylite_6():
+    """The `fuzzylite` 6 binary (Debian's 6.0+dfsg-6, `-of fld -values 9 -decimals 12`) gives
+    0.32, 0.4 and 0.56 at x = 0.375, 0.5, 0.625: every rule counted, the ACCU unused (joined
+    by MAX, 0.375 would give 0.4). The same ACCU in the RULEBLOCK is jFuzzyLogic's dialect
+    (fuzzylite 6 fails to read it there) and joins them."""
+    X = np.array([[0.375], [0.5], [0.625]])
+    rb = parse_fcl(FUZZYLITE_COGS, "accu.fcl")
+    assert [n for n in rb.notes if "fuzzylite's dialect" in n] == [
+        "accu.fcl:25:10: `ACCU : MAX` in DEFUZZIFY under a weighted `METHOD` is fuzzylite's "
+        "dialect, whose engine (fuzzylite 6) counts every rule there: read so, `r1` and `r2` "
+        "both adding `y is a`; jFuzzyLogic would join them with MAX (write the ACCU in the "
+        "RULEBLOCK for that)"]
+    c = compile_rulebase(rb)
+    assert not c.operators.accumulated
+    got = evaluate(c, X, detail=False).outputs[:, 0]
+    np.testing.assert_allclose(got, [0.32, 0.4, 0.56], rtol=0, atol=1e-12)
+    iec = FUZZYLITE_COGS.replace("  ACCU : MAX;\n", "").replace("  ACT : MIN;\n",
+                                                                "  ACT : MIN;\n  ACCU : MAX;\n")
+    joined = compile_rulebase(parse_fcl(iec, "accu.fcl"))
+    assert joined.operators.accumulation == "max"
+    np.testing.assert_allclose(evaluate(joined, X, detail=False).outputs[:, 0],
+                               [0.4, 0.4, 0.56], rtol=0, atol=1e-12)
+    single = FUZZYLITE_COGS.replace("  RULE 2 : if x is mid then y is a\n", "")
+    assert not [n for n in parse_fcl(single, "accu.fcl").notes if "dialect" in n]
 
 
 @pytest.mark.parametrize("fmt, name", [("fll", "FLL"), ("fis", "MATLAB's .fis")])

@@ -24,6 +24,7 @@ class Engine(str, enum.Enum):
     jfuzzylogic = "jfuzzylogic"
     fuzzylite = "fuzzylite"       # fuzzylite 8 (pyfuzzylite): 1000 where the file says none
     fuzzylite6 = "fuzzylite6"     # fuzzylite 6 (Debian's binary): 100 where the file says none
+    octave = "octave"             # Octave's fuzzy-logic-toolkit: trapezoid centroid, AggMethod
 
 
 class NoRule(str, enum.Enum):
@@ -237,14 +238,21 @@ def _loaded(path: str | None, behavior: str | None, fidelity):
     warn_notes(rb.rulebase)
     if fidelity is None:
         return rb
-    from ..interop.common import fidelity_settings
+    from ..interop.common import fidelity_rulebase, fidelity_settings
 
     settings = fidelity_settings(rb.rulebase, fidelity.value, behavior)
-    if not settings:                  # it changed nothing, and nothing said so
+    ops = rb.compiled.operators
+    if not settings and fidelity.value == "octave" and ops.inference != "mamdani":
+        warn(f"--fidelity octave changes nothing here: behavior `{rb.compiled.behavior}` infers "
+             f"by {ops.inference}, where Octave joins the rules of one value by a .fis file's "
+             f"AggMethod, and this file is no .fis or its AggMethod is sum")
+    elif not settings:                # it changed nothing, and nothing said so
         warn(f"--fidelity {fidelity.value} changes nothing here: behavior `{rb.compiled.behavior}` "
-             f"infers by {rb.compiled.operators.inference}, and only Mamdani outputs are "
-             f"sampled")
-    return LoadedRuleBase(rb.rulebase, behavior, settings)
+             f"infers by {ops.inference}, and only Mamdani outputs are sampled")
+    if fidelity.value == "octave" and ops.inference == "mamdani" and "bisector" in ops.defuzzify:
+        warn("Octave's bisector gives the index of its sample, not the sample (defuzz.m): "
+             "--fidelity octave gives the sample, by the trapezoid rule's areas")
+    return LoadedRuleBase(fidelity_rulebase(rb.rulebase, fidelity.value), behavior, settings)
 
 
 def _names_file(word: str) -> bool:

@@ -30,6 +30,8 @@ SAMPLING = {
     "midpoints": "the midpoints of `resolution` equal cells (fuzzylite's integration rule)",
     "endpoints": "`resolution` evenly spaced points including both ends (MATLAB's evalfis)",
     "left": "the left ends of `resolution` equal cells (jFuzzyLogic's)",
+    "trapezoid": "`resolution` evenly spaced points including both ends, the two ends weighing "
+                 "half in the centroid and bisector (Octave's trapz)",
 }
 DEFUZZIFY = {
     "centroid": "sum(y mu(y)) / sum(mu(y)) over the samples (midpoint rule)",

@@ -20,8 +20,9 @@ code                  severity    meaning
 ``conflict``          error       rules with the same antecedent and different consequents
 ``duplicate``         warning     rules with the same antecedent and the same consequents
 ``contradiction``     warning     an antecedent that asks for ``x is A`` and ``x is not A``
-``idle-setting``      warning     a Mamdani-only operator setting (``defuzzify``, ...) where
-                                  the inference is not Mamdani
+``idle-setting``      warning     a Mamdani-only operator setting (``defuzzify``, ...), or an
+                                  output's own ``resolution:``, where the inference is not
+                                  Mamdani
 ``infinite-output``   warning     a sigmoid a Tsukamoto rule concludes: it reaches 1 only at
                                   infinity, so where the rule fires fully the output is +-inf
 ``unreachable``       warning     a rule that fires nowhere: its DOF is 0 on a grid of the
@@ -248,6 +249,16 @@ def _idle_settings(rb: RuleBase, name: str, compiled) -> list[Finding]:
                 f"`{setting.key} = {setting.value}` has no effect: behavior `{name}` uses "
                 f"{compiled.operators.inference} inference", setting.span, name,
                 "add `inference = mamdani` to the operators line, or remove the setting"))
+    if inference != "mamdani":        # an output's own resolution, from its term set
+        for output in compiled.outputs:
+            var = compiled.variables.get(output)
+            if var is not None and var.resolution is not None:
+                out.append(Finding(
+                    "warning", "idle-setting",
+                    f"`{output}`'s own `resolution: {var.resolution}` has no effect: behavior "
+                    f"`{name}` uses {inference} inference", var.span, name,
+                    "add `inference = mamdani` to the operators line, or remove the "
+                    "resolution"))
     return out
 
 
@@ -299,10 +310,10 @@ def undersampled_hint(path: str | None, u) -> str:
         return "move the term into the range, or widen the output's range"
     if u.outside:
         return "change the term so that it is above 0 somewhere in the output's range"
-    return resolution_hint(path, u.points)
+    return resolution_hint(path, u.points, u.output if u.own else None)
 
 
-def resolution_hint(path: str | None, points: int) -> str:
+def resolution_hint(path: str | None, points: int, own: str | None = None) -> str:
     """How to sample an output more finely, in the words of the file's format."""
     suffix = (path or "").rsplit(".", 1)[-1].lower()
     finer = 1001 if points < 1001 else min(points * 10, 100_000)
@@ -316,6 +327,9 @@ def resolution_hint(path: str | None, points: int) -> str:
     if suffix == "fcl":
         return (f"widen it, or raise the defuzzifier's resolution (`METHOD : COG "
                 f"{finer};`, which MITOS reads; fuzzylite 6 and jFuzzyLogic read none)")
+    if own is not None:          # the output's own resolution, which the operators' do not set
+        return (f"widen it, or raise `{own}`'s own resolution (now {points}): `resolution: "
+                f"{finer}` under `{own}` in its term set")
     return (f"widen it, or raise the resolution (now {points}): `resolution = {finer}` in "
             f"the behavior's (or the file's) `operators:` line")
 

@@ -90,7 +90,20 @@ class CompiledRuleBase:
         return (f"<CompiledRuleBase {self.behavior!r}: {len(self.inputs)} inputs "
                 f"({', '.join(self.inputs)}), {len(self.outputs)} outputs "
                 f"({', '.join(self.outputs)}), {self.n_rules} rules, {self.n_terms} terms, "
-                f"{len(self.levels)} levels, {self.n_columns} neurons; {self.operators.describe()}>")
+                f"{len(self.levels)} levels, {self.n_columns} neurons; {self.describe_operators()}>")
+
+    def describe_operators(self) -> str:
+        """:meth:`Operators.describe` with the Mamdani outputs' own resolutions."""
+        own = self.own_resolutions
+        return self.operators.describe(own, every=len(own) == len(self.outputs))
+
+    @property
+    def own_resolutions(self) -> dict[str, int]:
+        """The Mamdani outputs sampled at a resolution of their own (not the behavior's)."""
+        if self.operators.inference != "mamdani":
+            return {}
+        own = ((n, self.variables[n].resolution) for n in self.outputs if n in self.variables)
+        return {n: r for n, r in own if r is not None and r != self.operators.resolution}
 
     @property
     def kernel_columns(self) -> np.ndarray:

@@ -57,7 +57,7 @@ def describe_network(compiled: CompiledRuleBase) -> str:
     lines = [f"behavior {c.behavior}: {plural(len(c.inputs), 'input')}, "
              f"{plural(c.n_rules, 'rule')}, "
              f"{plural(len(c.outputs), 'output')}, {plural(c.n_columns - 2, 'neuron')}",
-             f"operators: {ops.describe()}", ""]
+             f"operators: {c.describe_operators()}", ""]
     table: list[tuple[str, str, str]] = []
 
     def row(name: str, size: object, what: str) -> None:
@@ -86,10 +86,16 @@ def describe_network(compiled: CompiledRuleBase) -> str:
     if ops.inference == "mamdani":
         row(f"layer {len(c.levels) + 2}", len(c.outputs),
             f"output neurons, Mamdani: implication {ops.implication}, aggregation {ops.aggregation}, "
-            f"defuzzify {ops.defuzzify} on {plural(ops.resolution, 'sample')}")
+            f"defuzzify {ops.defuzzify}"
+            + ("" if len(c.own_resolutions) == len(c.outputs) else
+               f" on {plural(ops.resolution, 'sample')}"
+               + (" (or its own)" if c.own_resolutions else "")))
         for table_j in c.mamdani:
+            own = (f", on its own {plural(len(table_j.grid), 'sample')}"
+                   if table_j.name in c.own_resolutions else "")
             row("", "", f"  {table_j.name}: {plural(len(table_j.rules), 'rule')} -> "
-                f"{plural(len(table_j.labels), 'consequent set')} ({', '.join(table_j.labels)})")
+                f"{plural(len(table_j.labels), 'consequent set')} ({', '.join(table_j.labels)})"
+                + own)
     else:
         kind = "Takagi-Sugeno, " if c.cons_linear is not None else ""
         joined = (f"; the rules of one value first joined by {ops.accumulation} "

@@ -20,7 +20,9 @@ and the result is defuzzified:
                left one on a tie), the first and last samples never counted; the result is
                ``lo + step * i`` where they meet (:func:`walk_from_both_ends`)
 
-**Grid.** The universe ``[lo, hi]`` is cut into ``resolution`` equal cells and sampled at their
+**Grid.** The universe ``[lo, hi]`` is cut into ``resolution`` equal cells (the output's own
+``resolution`` where its variable has one, as fuzzylite gives each output its defuzzifier's:
+each output has a table of its own, and the batch path is the same) and sampled at their
 midpoints, ``x_i = lo + (i + 1/2) (hi - lo) / resolution``: the midpoint rule of integration,
 the same as fuzzylite's integral defuzzifiers with ``resolution`` divisions, so MITOS and
 fuzzylite agree to rounding on the same rule base.
@@ -80,13 +82,16 @@ class OutputTable:
     set_of: np.ndarray        # [R_j] row of ``sets`` for each of those rules
     order: np.ndarray         # [R_j] those rules (positions in ``rules``) sorted by set
     starts: np.ndarray        # [t] start of each set's run in ``order`` (for reduceat)
+    #: [res] each point's weight in the centroid's and bisector's sums (``sampling =
+    #: trapezoid``: the two ends half); None: every point 1
+    weights: np.ndarray | None = None
 
 
 def grid(lo: float, hi: float, resolution: int, sampling: str = "midpoints") -> np.ndarray:
     """The midpoints of ``resolution`` equal cells of ``[lo, hi]`` (``sampling="endpoints"``:
     ``resolution`` evenly spaced points from ``lo`` to ``hi``, as MATLAB's ``evalfis``;
     ``"left"``: the cells' left ends, as jFuzzyLogic)."""
-    if sampling == "endpoints":
+    if sampling in ("endpoints", "trapezoid"):
         return np.linspace(lo, hi, resolution)
     if sampling == "left":    # jFuzzyLogic: the cells' left ends, reached as it reaches them
         return _stepped(lo, (hi - lo) / resolution, resolution)
@@ -109,7 +114,7 @@ def spike(lo: float, hi: float, resolution: int, value: float,
     """A singleton at ``value`` as sampled set: 1 at the midpoint of the cell holding it (with
     ``endpoints`` sampling: at the nearest sample point)."""
     row = np.zeros(resolution)
-    if sampling == "endpoints":
+    if sampling in ("endpoints", "trapezoid"):
         i = int(np.rint((value - lo) / (hi - lo) * (resolution - 1)))
     else:
         i = int(np.floor((value - lo) / ((hi - lo) / resolution)))
@@ -118,12 +123,13 @@ def spike(lo: float, hi: float, resolution: int, value: float,
 
 
 def build_tables(compiled) -> tuple[OutputTable, ...]:
-    """Sample every consequent set the rules use, per output (done once, then cached)."""
-    res = compiled.operators.resolution
+    """Sample every consequent set the rules use, per output (done once, then cached), on the
+    output's own ``resolution`` where it has one, else its behavior's."""
     sampling = compiled.operators.sampling
     tables = []
     for j, name in enumerate(compiled.outputs):
         var = compiled.variables[name]
+        res = var.resolution or compiled.operators.resolution
         lo, hi = var.universe
         x = grid(lo, hi, res, sampling)
         rules = np.flatnonzero(compiled.cons_mask[:, j])
@@ -157,8 +163,17 @@ def build_tables(compiled) -> tuple[OutputTable, ...]:
         order = np.argsort(set_of, kind="stable").astype(np.intp)
         starts = np.searchsorted(set_of[order], np.arange(len(rows))).astype(np.intp)
         sets = np.array(rows, dtype=float).reshape(len(rows), res)
-        tables.append(OutputTable(name, x, sets, tuple(labels), rules, set_of, order, starts))
+        tables.append(OutputTable(name, x, sets, tuple(labels), rules, set_of, order, starts,
+                                  trapezoid_weights(res) if sampling == "trapezoid" else None))
     return tuple(tables)
+
+
+def trapezoid_weights(points: int) -> np.ndarray:
+    """The trapezoid rule's weights on ``points`` evenly spaced points (the common step left
+    out: it cancels in a centroid and in a bisector's half): 1, the two ends 1/2."""
+    w = np.ones(points)
+    w[[0, -1]] = 0.5
+    return w
 
 
 #: A consequent set whose largest membership over its output's sample points is below this
@@ -185,6 +200,7 @@ class Undersampled:
     #: formula): no resolution makes its rules count
     outside: str = ""
     universe: tuple[float, float] = (0.0, 0.0)
+    own: bool = False         # sampled at the output's own resolution, not its behavior's
 
     def describe(self) -> str:
         """What is wrong, for ``check`` and ``eval``."""
@@ -222,7 +238,8 @@ def undersampled(compiled) -> tuple[Undersampled, ...]:
                 "outside" if term.corners is not None else "zero"
             out.append(Undersampled(table.name, label, term.name, peak, len(table.grid), step,
                                     table.rules[table.set_of == i], outside,
-                                    (float(var.universe[0]), float(var.universe[1]))))
+                                    (float(var.universe[0]), float(var.universe[1])),
+                                    var.resolution is not None))
     return tuple(out)
 
 
@@ -253,12 +270,17 @@ def aggregate(dof: np.ndarray, sets: np.ndarray, implication: str,
 
 
 def defuzzify(Y: np.ndarray, x: np.ndarray, method: str,
-              universe: tuple[float, float] = (0.0, 1.0)) -> np.ndarray:
+              universe: tuple[float, float] = (0.0, 1.0),
+              weights: np.ndarray | None = None) -> np.ndarray:
     """Crisp values ``[b]`` of output sets ``Y[b, res]`` sampled at ``x[res]`` (NaN where the
-    set is empty). ``universe`` is the output's range (only jFuzzyLogic's COA reads it)."""
+    set is empty). ``universe`` is the output's range (only jFuzzyLogic's COA reads it);
+    ``weights[res]``: each point's weight in the centroid's and the bisector's sums (the
+    trapezoid rule's), else 1."""
     out = np.full(Y.shape[0], np.nan)
     if method == "jfuzzylogic_bisector":
         return walk_from_both_ends(Y, *universe)
+    if weights is not None and method in ("centroid", "bisector", "matlab_bisector"):
+        Y = Y * weights
     if method == "centroid":
         den = Y.sum(axis=1)
         num = (Y * x).sum(axis=1)
@@ -343,7 +365,7 @@ def mamdani_outputs(compiled, dof: np.ndarray) -> np.ndarray:
             block = slice(start, min(start + per, b))
             Y = _aggregate_chunked(D[:, block], sets, ops.implication, aggregation)
             out[j, block] = defuzzify(Y, table.grid, ops.defuzzify,
-                                      compiled.variables[table.name].universe)
+                                      compiled.variables[table.name].universe, table.weights)
     return out
 
 

@@ -154,5 +154,5 @@ def trace_of(result: Result, row: int = 0, given: np.ndarray | None = None) -> T
                       if (not np.isnan(c.default[j]) or declares_nan(c, name))
                       and not fired[c.cons_mask[:, j]].any())
     path = display_path(c.rulebase.path)
-    return Trace(path, c.behavior, c.operators.describe(), c.n_rules, tuple(inputs), rules,
+    return Trace(path, c.behavior, c.describe_operators(), c.n_rules, tuple(inputs), rules,
                  outputs, defaulted)

@@ -153,7 +153,9 @@ def left_out(rb: RuleBase, behavior: str | None, done: str) -> str | None:
 
 #: Where a sampling other than fuzzylite's midpoints takes its points, and whose rule it is.
 SAMPLED_AT = {"endpoints": "evenly spaced points including both ends (MATLAB's)",
-              "left": "the cells' left ends (jFuzzyLogic's)"}
+              "left": "the cells' left ends (jFuzzyLogic's)",
+              "trapezoid": "evenly spaced points including both ends, the ends weighing half "
+                           "(Octave's)"}
 
 
 #: MATLAB's defuzzifiers that fuzzylite (FLL, FCL) defines otherwise, and what each means
@@ -219,15 +221,30 @@ def conversion_notes(rb: RuleBase, fmt: str, behavior: str | None = None) -> lis
         out.append(f"{fmt.upper()} Mamdani outputs are sampled at cell midpoints (fuzzylite's "
                    f"rule); this rule base samples at {SAMPLED_AT[ops.sampling]}, so results "
                    f"move by the discretisation")
-    if fmt == "fcl" and ops.inference == "mamdani" and ops.resolution != 1000:
+    points = sampled_at(rb, behavior) if ops.inference == "mamdani" else []
+    if fmt == "fcl" and ops.inference == "mamdani" and points != [1000]:
         from .common import DEFUZZIFIERS
 
         method = DEFUZZIFIERS.get(ops.defuzzify, ("", "", "COG"))[2]
         out.append(f"FCL has no resolution that fuzzylite 6, jFuzzyLogic and IEC 61131-7 read: "
                    f"`METHOD : {method};` is written without this rule base's "
-                   f"{ops.resolution} points, and read as 1000 (MITOS, jFuzzyLogic) or 100 "
-                   f"(fuzzylite 6)")
+                   f"{' and '.join(map(str, points))} points, and read as 1000 (MITOS, "
+                   f"jFuzzyLogic) or 100 (fuzzylite 6)")
     return out
+
+
+def sampled_at(rb: RuleBase, behavior: str | None = None) -> list[int]:
+    """The resolutions a Mamdani behavior's outputs are sampled at (its own, then its outputs'
+    own), each once, in that order."""
+    from ..lang.model import flatten
+    from ..lang.operators import of_behavior
+
+    name = behavior or rb.default_behavior
+    ops = of_behavior(rb, rb.behavior(name))
+    concluded = dict.fromkeys(c.var for _, r, _ in flatten(rb, name) for c in r.consequents)
+    own = [rb.variables[n].resolution for n in concluded]
+    every = bool(own) and all(own)
+    return list(dict.fromkeys(([] if every else [ops.resolution]) + [r for r in own if r]))
 
 
 

@@ -415,11 +415,31 @@ class Settings:
         return self.defuzzify in ("weighted_average", "weighted_sum", "tsukamoto")
 
 
+def own_resolutions(records: dict[str, Record]) -> dict[str, int]:
+    """Each Mamdani output's own resolution, taken out of its ``records`` (the settings its
+    format writes per output: fuzzylite's ``defuzzifier: Centroid 200``), where the outputs'
+    resolutions are not all one written number; else none, and the one number stays the
+    behavior's. An output that writes none is left to the behavior's (the reader's default,
+    which ``--fidelity`` may replace: fuzzylite 8 takes 1000 there, fuzzylite 6 100)."""
+    mamdani = {n: r for n, r in records.items() if any(
+        key == "defuzzify" and value not in ("weighted_average", "weighted_sum", "tsukamoto")
+        for key, value, _, _ in r)}
+    written = {n: [e for e in r if e[0] == "resolution"] for n, r in mamdani.items()}
+    values = {e[1] for entries in written.values() for e in entries}
+    if len(values) < 2 and (not values or all(written.values())):
+        return {}
+    own = {}
+    for n, entries in written.items():
+        for entry in entries:
+            own[n] = entry[1]
+            mamdani[n].remove(entry)
+    return own
+
+
 def _same_hint(key: str) -> str:
     """What to do when two outputs or rule blocks set ``key`` differently."""
     if key == "resolution":
-        return ("give every output the same resolution (MITOS samples one rule base's "
-                "outputs alike; the larger resolution samples finer)")
+        return "give the rule block one resolution (the larger samples finer)"
     if key == "sampling":
         return "give every output the same sampling"
     return "use the same operator for every output and rule block"
@@ -993,7 +1013,8 @@ def legal_names(rb: RuleBase, fmt: str) -> tuple[RuleBase, list[str]]:
 #: FCL and .fis): the same with 100 by default (``IntegralDefuzzifier::_defaultResolution``),
 #: which is every FCL ``METHOD : COG;`` and every .fis ``centroid``.
 FIDELITY = {"matlab": (101, "endpoints"), "jfuzzylogic": (1000, "left"),
-            "fuzzylite": (None, "midpoints"), "fuzzylite6": (None, "midpoints")}
+            "fuzzylite": (None, "midpoints"), "fuzzylite6": (None, "midpoints"),
+            "octave": (101, "trapezoid")}
 UNWRITTEN_RESOLUTION = {"fuzzylite": 1000, "fuzzylite6": 100}
 #: Engines that evaluate an input outside its universe as given (``inputs = as_given``):
 #: jFuzzyLogic's ``Variable.setValue`` only warns.
@@ -1003,7 +1024,8 @@ UNCLAMPED = ("jfuzzylogic",)
 def fidelity_settings(rb: RuleBase, engine: str, behavior: str | None = None
                       ) -> tuple[Setting, ...]:
     """Operator overrides that make ``rb``'s Mamdani outputs sample as ``engine`` does (none
-    for a weighted-average rule base, whose outputs are not sampled)."""
+    for a weighted-average rule base, whose outputs are not sampled). An output's own
+    ``resolution`` beats them: compile :func:`fidelity_rulebase` ``(rb, engine)`` with them."""
     if engine not in FIDELITY:
         raise FormatError(f"unknown engine `{engine}`", expected="one of " + ", ".join(FIDELITY),
                           hint=did_you_mean(engine, FIDELITY))
@@ -1011,6 +1033,8 @@ def fidelity_settings(rb: RuleBase, engine: str, behavior: str | None = None
     ops = ops_mod.of_behavior(rb, b)
     # jFuzzyLogic evaluates an input outside its RANGE as given (Variable.setValue only warns)
     given = (Setting("inputs", "as_given"),) if engine in UNCLAMPED else ()
+    if engine == "octave" and ops.inference in ("weighted_average", "weighted_sum"):
+        return _octave_accumulation(rb)
     if ops.inference != "mamdani":
         return given
     resolution, sampling = FIDELITY[engine]
@@ -1023,6 +1047,38 @@ def fidelity_settings(rb: RuleBase, engine: str, behavior: str | None = None
         resolution = ops.resolution if written else UNWRITTEN_RESOLUTION[engine]
     return (*given, Setting("resolution", str(resolution)), Setting("sampling", sampling),
             *_engines_defuzzifier(ops.defuzzify, engine))
+
+
+def _octave_accumulation(rb: RuleBase) -> tuple[Setting, ...]:
+    """Octave's toolkit joins the rules of one Sugeno output value with the file's
+    ``AggMethod`` before the weighted average (``aggregate_fis_output``: the rules' values
+    sorted, equal ones joined), which is ``accumulation = AggMethod``; MATLAB, and MITOS's
+    reading of a ``.fis``, count every rule. Only a ``.fis`` file says it."""
+    from .fis import aggregation_method
+
+    path = rb.path or ""
+    if not path.lower().endswith(".fis"):
+        return ()
+    try:
+        text = Path(path).read_text(encoding="utf-8", errors="replace")
+    except OSError as exc:
+        raise FormatError(f"--fidelity octave reads the file's AggMethod, and `{path}` cannot "
+                          f"be read again: {exc.strerror}") from None
+    method = aggregation_method(text, path)
+    return () if method in (None, "sum") else (Setting("accumulation", method),)
+
+
+def fidelity_rulebase(rb: RuleBase, engine: str) -> RuleBase:
+    """``rb`` as ``engine`` samples its outputs: fuzzylite (8 and 6) gives each Mamdani output
+    its defuzzifier's resolution, so the outputs' own ``resolution`` stays; MATLAB, Octave and
+    jFuzzyLogic sample every output alike (:data:`FIDELITY`), so it goes, and the behavior's
+    (:func:`fidelity_settings`) is every output's."""
+    if FIDELITY.get(engine, (None,))[0] is None or not any(
+            v.resolution is not None for v in rb.variables.values()):
+        return rb
+    termsets = tuple(replace(ts, variables=tuple(replace(v, resolution=None)
+                                                 for v in ts.variables)) for ts in rb.termsets)
+    return replace(rb, termsets=termsets)
 
 
 def _engines_defuzzifier(method: str, engine: str) -> tuple[Setting, ...]:
@@ -1039,7 +1095,8 @@ def _engines_defuzzifier(method: str, engine: str) -> tuple[Setting, ...]:
     return (Setting("defuzzify", plain),)
 
 
-def refuse_accumulation(rb: RuleBase, behavior: str | None, flat: Flat, fmt: str) -> None:
+def refuse_accumulation(rb: RuleBase, behavior: str | None, flat: Flat, fmt: str,
+                        hint: str = "write it to FCL (ACCU) or a rule file") -> None:
     """Refuse to write a behavior whose ``accumulation`` S-norm joins several rules of one
     value to a format that cannot say so (fuzzylite and MATLAB average every rule): two rules
     of one value, or a linear function among an output's values (they meet at some inputs,
@@ -1062,7 +1119,7 @@ def refuse_accumulation(rb: RuleBase, behavior: str | None, flat: Flat, fmt: str
                     f"`{seen[key]}` and `{r.label}` both set `{c.var}` to {value}, which "
                     f"`accumulation = {flat.operators.accumulation}` joins",
                     span=setting_span(rb, behavior, "accumulation"),
-                    hint="write it to FCL (ACCU) or a rule file, or merge the rules")
+                    hint=f"{hint}, or merge the rules")
             seen[key] = r.label
     for var in dict.fromkeys(k[0] for k in seen):
         keys = [k for k in seen if k[0] == var]
@@ -1072,5 +1129,4 @@ def refuse_accumulation(rb: RuleBase, behavior: str | None, flat: Flat, fmt: str
                 f"{fmt} has no accumulation of the rules that conclude one value: `{var}`'s "
                 f"linear function (`{seen[linear[0]]}`) meets its other values at some inputs, "
                 f"where `accumulation = {flat.operators.accumulation}` joins their rules",
-                span=setting_span(rb, behavior, "accumulation"),
-                hint="write it to FCL (ACCU) or a rule file")
+                span=setting_span(rb, behavior, "accumulation"), hint=hint)

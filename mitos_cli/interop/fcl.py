@@ -48,7 +48,7 @@ from ..fuzzy import norms
 from ..fuzzy.shapes import TSUKAMOTO
 from ..lang.bulk import without_cyclic_gc
 from ..lang.cache import lark_parser
-from ..lang.model import And, Behavior, Expr, Not, Or, Prop, Rule, RuleBase
+from ..lang.model import And, Behavior, Expr, Not, Or, Prop, Rule, RuleBase, format_consequent
 from ..lang.terms import Role, Term, TermSet, Variable, first_at
 from ..words import plural
 from . import common
@@ -259,6 +259,9 @@ def _function_block(fb: Tree, span_of) -> RuleBase:
                                                span_of(fb).path))
         kind = "FUZZIFY" if role == "input" else "DEFUZZIFY"
         raise FormatError(f"variable `{name}` is declared but has no {kind} block", span=span)
+    outputs_written = {n: records[n] for n in declared if declared[n][0] == "output"}
+    for name, points in common.own_resolutions(outputs_written).items():   # `COG 200`, MITOS's
+        variables[name] = dataclasses.replace(variables[name], resolution=points)
     parsed = [_rule_block(block, variables, span_of, notes) for block in blocks]
     parsed = [p for p in parsed if p[2]] or parsed[:1]
     outputs = [n for n in declared if declared[n][0] == "output"]
@@ -270,7 +273,9 @@ def _function_block(fb: Tree, span_of) -> RuleBase:
     groups = common.rule_blocks(parsed, {n: records[n] for n in outputs},
                                 renumber=len({r.label for r in all_rules}) < len(all_rules))
     _check_outputs(groups, locks, constants)
-    _accumulation(groups)
+    in_defuzzify = {(e[2].line, e[2].column) for n in outputs for e in records[n]
+                    if e[0] == "aggregation" and e[2] is not None}
+    _accumulation(groups, in_defuzzify, notes)
     ordered = [variables[n] for n in declared]
     rb = common.assemble_blocks(span_of(fb).path, ordered, groups, DEFAULT_RESOLUTION,
                                 span_of(fb), notes, ranges)
@@ -763,21 +768,58 @@ def _norm(table: dict, value: str, what: str, span: Span) -> str:
         raise
 
 
-def _accumulation(groups: list[tuple[str, list[Rule], common.Settings]]) -> None:
+def _accumulation(groups: list[tuple[str, list[Rule], common.Settings]],
+                  in_defuzzify: set[tuple[int, int]], notes: list[str]) -> None:
     """``ACCU`` under ``METHOD : COGS`` (or COGSS, COGF) is the behavior's ``accumulation``:
     jFuzzyLogic (and IEC 61131-7) join the rules that conclude one singleton value with the
     ACCU norm (`RuleActivationMethod.imply` at the defuzzifier's point of that value) before
     the weighted average; without ACCU (or with ``ACCU : SUM``) it sums them, which is
     MITOS's default. A Mamdani output without ACCU sums its rules' sets, jFuzzyLogic's
-    default (`RuleBlock.fclTree`), ``aggregation = sum``."""
-    for _, _, settings in groups:
+    default (`RuleBlock.fclTree`), ``aggregation = sum``.
+
+    An ``ACCU`` inside DEFUZZIFY (its place at ``(line, column)`` in ``in_defuzzify``) is
+    fuzzylite's dialect: jFuzzyLogic's grammar has none there, and fuzzylite 6, the engine
+    that reads it, does not use the aggregation under a weighted defuzzifier (each rule is
+    counted: its binary gives 0.32 where joining by MAX gives 0.4,
+    ``tests/test_accumulation.py``), so it is read as the sum, and said where two rules
+    conclude one term."""
+    for _, rules, settings in groups:
         weighted = settings.defuzzify in ("weighted_average", "weighted_sum")
         if not weighted and not settings.sugeno and settings.aggregation is None:
             settings.aggregation = "sum"
-        if weighted and settings.aggregation:
-            settings.accumulation = settings.aggregation
-            if settings.aggregation == "sum":
-                settings.aggregation = None
+        if not (weighted and settings.aggregation):
+            continue
+        span = (settings.spans or {}).get("aggregation")
+        if span is not None and (span.line, span.column) in in_defuzzify:
+            _fuzzylite_accu(rules, settings, span, notes)
+            settings.aggregation = None
+            continue
+        settings.accumulation = settings.aggregation
+        if settings.aggregation == "sum":
+            settings.aggregation = None
+
+
+def _fuzzylite_accu(rules: list[Rule], settings: common.Settings, span: Span,
+                    notes: list[str]) -> None:
+    """Say where fuzzylite's reading of a DEFUZZIFY ``ACCU`` under COGS (every rule counted)
+    gives another number than jFuzzyLogic's would (the rules of one term joined)."""
+    aggregation = settings.aggregation
+    if aggregation is None or aggregation == "sum":
+        return
+    seen: dict[tuple[str, str | None, float | None], str] = {}
+    for r in rules:
+        for c in r.consequents:
+            key = (c.var, c.term, c.value if c.term is None else None)
+            if key in seen:
+                what = f"`{format_consequent(c)}`"
+                name = common.AGGREGATIONS[aggregation][FCL] or aggregation
+                notes.append(f"{span}: `ACCU : {name}` in DEFUZZIFY under a weighted `METHOD` "
+                             f"is fuzzylite's dialect, whose engine (fuzzylite 6) counts every "
+                             f"rule there: read so, `{seen[key]}` and `{r.label}` both adding "
+                             f"{what}; jFuzzyLogic would join them with {name} (write the ACCU "
+                             f"in the RULEBLOCK for that)")
+                return
+            seen[key] = r.label
 
 
 def _grouping_note(rule_items: list[Tree], span_of, notes: list[str]) -> None:
@@ -885,6 +927,11 @@ def write_fcl(rb: RuleBase, behavior: str | None = None, dialect: str = DEFAULT_
     if accu is not None and ops.aggregation == "sum" and dialect == "fuzzylite":
         # fuzzylite 6's FCL reader has no abbreviation for it (`SUM` fails the whole import)
         accu = common.AGGREGATIONS["sum"][FLL]
+    if ops.accumulated and dialect == "fuzzylite":
+        # fuzzylite 6 counts every rule under COGS whatever the ACCU (and so reads MITOS)
+        common.refuse_accumulation(rb, behavior, flat, "fuzzylite's FCL",
+                                   hint="write `--dialect iec` (jFuzzyLogic's ACCU) or a rule "
+                                        "file")
     if ops.accumulated:                 # ACCU under COGS: jFuzzyLogic's join at a singleton
         accu = common.foreign_name(common.SNORMS, FCL, ops.accumulation, "S-norm",
                                    span=at("accumulation"))

@@ -151,9 +151,12 @@ def parse_fis(text: str, path: str | None = None) -> RuleBase:
     _check_count(system, "NumInputs", len(inputs), sys_span)
     _check_count(system, "NumOutputs", len(outputs), sys_span)
     variables = inputs + outputs
-    rules = [_rule(line, lineno, span, inputs, outputs, text, path, i)
-             for i, (line, lineno, span) in enumerate(rule_lines)]
-    _check_count(system, "NumRules", len(rules), sys_span)
+    fuzzylites = bool(FUZZYLITE_EXPORT.match(text))
+    read = [_rule(line, lineno, span, inputs, outputs, text, path, i, fuzzylites)
+            for i, (line, lineno, span) in enumerate(rule_lines)]
+    _check_count(system, "NumRules", len(read), sys_span)
+    rules = [r for r in read if isinstance(r, Rule)]
+    _unloaded_note([r for r in read if not isinstance(r, Rule)], rules, outputs, notes)
     _check_unset(unset, rules)
     if sugeno:
         _sugeno_aggregation(system, rules, notes)
@@ -208,6 +211,19 @@ def _settings(system: dict[str, tuple[str, Span]], sys_span: Span,
         settings.set("resolution", DEFAULT_RESOLUTION, None, "resolution")
         settings.set("sampling", "endpoints", None, "sampling")
     return settings, unset, sugeno
+
+
+def aggregation_method(text: str, path: str | None = None) -> str | None:
+    """The MITOS name of a ``.fis`` text's ``AggMethod`` (None where it writes none): what
+    Octave's toolkit joins a Sugeno output's rules of one value with (``--fidelity octave``)."""
+    sections, _ = _sections(text, path)
+    items: list = next((items for name, _, items in sections if name == "System"), [])
+    system = _system(items)
+    if "AggMethod" not in system:
+        return None
+    name = _string(*system["AggMethod"])
+    return common.table_lookup(common.AGGREGATIONS, FIS, name, "aggregation method",
+                               system["AggMethod"][1]) if name else None
 
 
 def _check_unset(unset: dict[str, Span], rules: list[Rule]) -> None:
@@ -389,8 +405,33 @@ def _hedges(idx: float, k: int, span: Span) -> tuple[str, ...]:
     return OCTAVE_HEDGES[power]
 
 
+#: The first line fuzzylite's ``FisExporter`` writes: the file is fuzzylite's, and fuzzylite 6
+#: is the engine that reads it as its writer meant it.
+FUZZYLITE_EXPORT = re.compile(r"\s*#\s*Code automatically generated with fuzzylite")
+
+
+def _unloaded_note(dropped: list[Span], rules: list[Rule], outputs: list[Variable],
+                   notes: list[str]) -> None:
+    """Say which rules of a fuzzylite export were left out as fuzzylite 6 leaves them out (a
+    rule with no condition, the exporter's 0 for a condition on an output), and which outputs
+    no rule sets then."""
+    if not dropped:
+        return
+    unset = [v.name for v in outputs if not any(c.var == v.name for r in rules
+                                                for c in r.consequents)]
+    notes.append(f"{dropped[0]}: {plural(len(dropped), 'rule')} with no condition (fuzzylite's "
+                 f"exporter writes 0 for a condition on an output, a chained engine's, which a "
+                 f".fis file cannot say): left out, as fuzzylite 6 leaves them out (it does not "
+                 f"load them, so they never fire)"
+                 + (f"; no rule sets {', '.join(f'`{n}`' for n in unset)} then, so MITOS "
+                    f"computes no value for it (fuzzylite 6: NaN on every row)" if unset else "")
+                 + "; the engine's FLL or FCL keeps the conditions")
+
+
 def _rule(line: str, lineno: int, span: Span, inputs: list[Variable], outputs: list[Variable],
-          text: str, path: str | None, index: int) -> Rule:
+          text: str, path: str | None, index: int, fuzzylites: bool = False) -> Rule | Span:
+    """Rule ``index`` of the [Rules] section; in fuzzylite's export (``fuzzylites``) a rule with
+    no condition, which fuzzylite 6 does not load, is its place instead (left out)."""
     m = re.fullmatch(r"([-\d.\s]+),([-\d.\s]+)\(\s*([-+\d.eE]+)\s*\)\s*:\s*(\d+)", line)
     if not m:
         raise FormatError("expected a rule `in1 in2 ..., out1 ... (weight) : 1|2`", span=span)
@@ -429,6 +470,8 @@ def _rule(line: str, lineno: int, span: Span, inputs: list[Variable], outputs: l
         if idx > len(v.terms):
             raise FormatError(f"`{v.name}` has {len(v.terms)} MFs, not {int(idx)}", span=span)
         cons.append(Consequent(v.name, v.terms[int(idx) - 1].name, None, (), span))
+    if not props and cons and fuzzylites:
+        return span
     if not props or not cons:
         raise FormatError("the rule has no " + ("condition" if not props else "consequent"),
                           span=span)
@@ -505,11 +548,12 @@ def notes(rb: RuleBase, behavior: str | None = None) -> list[str]:
             now = "NaN / an error" if v.default is None else f"{v.default:g}"
             out.append(f"output `{v.name}`: when no rule fires MATLAB returns the middle of the "
                        f"range ({mid:g}), not {now}")
-    if ops.inference == "mamdani" and (ops.resolution, ops.sampling) != (DEFAULT_RESOLUTION,
-                                                                         "endpoints"):
+    points = list(dict.fromkeys(v.resolution or ops.resolution for v in flat.outputs))
+    if ops.inference == "mamdani" and (points, ops.sampling) != ([DEFAULT_RESOLUTION],
+                                                                 "endpoints"):
         out.append(f"MATLAB samples Mamdani outputs at 101 points including the ends; this rule "
-                   f"base uses {ops.resolution} {ops.sampling}, so results move by the "
-                   f"discretisation")
+                   f"base uses {' and '.join(map(str, points))} {ops.sampling}, so results "
+                   f"move by the discretisation")
     return out
 
 

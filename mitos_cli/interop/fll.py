@@ -80,6 +80,7 @@ class _Var:
     lock_range: Span | None = None      # `lock-range: true` on an output
     record: common.Record = field(default_factory=common.Record)
     weighted_type: tuple[str, Span] | None = None   # a weighted defuzzifier's type, where
+    resolution: int | None = None       # its own, where outputs' resolutions differ
 
 
 def _tsukamoto(v: _Var, notes: list[str]) -> None:
@@ -126,6 +127,7 @@ def parse_fll(text: str, path: str | None = None) -> RuleBase:
     notes: list[str] = []
     for v in variables:
         _tsukamoto(v, notes)
+    _own_resolutions(variables)
     inputs = [x.name for x in variables if x.role == "input"]     # once: per variable, N^2
     built = [_build_variable(v, inputs, notes) for v in variables]
     by_name = {v.name: v for v in built}
@@ -210,6 +212,15 @@ def _sections(text: str, path: str | None) -> tuple[list[_Var], list[_Block], Sp
             _block_key(key, value, vspan, blocks[-1].record, blocks[-1].conj)
 
     return variables, blocks, engine_span
+
+
+def _own_resolutions(variables: list[_Var]) -> None:
+    """fuzzylite samples each Mamdani output at its own defuzzifier's resolution (1000 where
+    it writes none): where they differ each becomes its variable's own
+    (:func:`.common.own_resolutions`)."""
+    outputs = {v.name: v for v in variables if v.role == "output"}
+    for name, points in common.own_resolutions({n: v.record for n, v in outputs.items()}).items():
+        outputs[name].resolution = points
 
 
 def _check_outputs(variables: list[_Var], rules: list[Rule], settings: Settings) -> None:
@@ -346,7 +357,7 @@ def _build_variable(v: _Var, inputs: list[str], notes: list[str]) -> Variable:
                           f"empty", span=v.span)
     try:
         return Variable(v.name, v.role, universe, tuple(terms), v.description, "", v.default,
-                        v.span)
+                        v.span, v.resolution)
     except Exception as exc:                     # duplicate terms: TermSetError with a span
         raise FormatError(getattr(exc, "message", str(exc)),
                           span=getattr(exc, "span", None) or v.span) from None
@@ -453,7 +464,8 @@ def write_fll(rb: RuleBase, behavior: str | None = None) -> str:
             out.append(f"  aggregation: {aggregation}")
             kind = common.foreign_name(common.DEFUZZIFIERS, FLL, ops.defuzzify, "defuzzifier",
                                        span=at("defuzzify"))
-            res = "" if ops.resolution == DEFAULT_RESOLUTION else f" {ops.resolution}"
+            points = v.resolution or ops.resolution
+            res = "" if points == DEFAULT_RESOLUTION else f" {points}"
             out.append(f"  defuzzifier: {kind}{res}")
         out.append(f"  default: {'nan' if v.default is None else fmt_number(v.default)}")
         out.append("  lock-previous: false")

@@ -188,6 +188,8 @@ def write_termset(rb: RuleBase, inputs, outputs, source: str = "") -> str:
         lines.append(f"    universe: [{_scalar(lo)}, {_scalar(hi)}]")
         if v.default is not None:
             lines.append(f"    default: {_scalar(v.default)}")
+        if v.resolution is not None:
+            lines.append(f"    resolution: {v.resolution}")
         lines.append("    terms:")
         for t in v.terms:
             lines.append(f"      {_scalar(t.name)}: {_term_spec(rb, v, t, input_names)}")

@@ -22,8 +22,10 @@ DEFUZZIFIERS = ("centroid", "bisector", "mom", "som", "lom",
                 "jfuzzylogic_bisector")                             # jFuzzyLogic's COA
 #: Where Mamdani outputs are sampled: cell midpoints (fuzzylite's rule, the default),
 #: ``resolution`` evenly spaced points including both ends (MATLAB's ``evalfis``), or the
-#: cells' left ends (jFuzzyLogic's, each reached from the one before: ``x += (max - min) / resolution``).
-SAMPLINGS = ("midpoints", "endpoints", "left")
+#: cells' left ends (jFuzzyLogic's, each reached from the one before: ``x += (max - min) / resolution``),
+#: or the end points with the two ends weighing half in the centroid and bisector's areas: the
+#: trapezoid rule of Octave's fuzzy-logic-toolkit (``trapz`` in its ``defuzz.m``).
+SAMPLINGS = ("midpoints", "endpoints", "left", "trapezoid")
 #: How weighted inference joins the rules that conclude one value of an output: ``sum`` counts
 #: each rule in the average (fuzzylite 6, MATLAB); an S-norm first joins their DOFs into one
 #: weight for that value (jFuzzyLogic's ``ACCU`` under ``METHOD : COGS``).
@@ -59,11 +61,16 @@ class Operators:
     def snorm(self) -> norms.Norm:
         return norms.lookup("snorm", self.or_)
 
-    def describe(self) -> str:
+    def describe(self, own: dict[str, int] | None = None, every: bool = False) -> str:
+        """The settings in an ``operators:`` line's words; ``own``: outputs sampled at a
+        resolution of their own, ``every`` output (``resolution = 200 for Power, 500 for
+        InversePower``) or some (``resolution = 1000, 200 for Power``)."""
         text = f"and = {self.and_}, or = {self.or_}, inference = {self.inference}"
         if self.inference == "mamdani":
+            points = ", ".join(([] if own and every else [str(self.resolution)])
+                               + [f"{r} for {n}" for n, r in (own or {}).items()])
             text += (f", implication = {self.implication}, aggregation = {self.aggregation}, "
-                     f"defuzzify = {self.defuzzify}, resolution = {self.resolution}")
+                     f"defuzzify = {self.defuzzify}, resolution = {points}")
             if self.sampling != "midpoints":
                 text += f", sampling = {self.sampling}"
         elif self.accumulated:

@@ -1,7 +1,8 @@
 """Reading term sets from YAML.
 
 A term set file holds ``variables:``; each variable has ``role``, ``universe``, ``terms`` and
-optionally ``description``, ``unit`` and (outputs) ``default``. A term is a mapping naming its
+optionally ``description``, ``unit`` and (outputs) ``default`` and ``resolution`` (a Mamdani
+output's own sample points, where they differ from its behavior's). A term is a mapping naming its
 ``shape`` and parameters, or a bare number for a crisp output value::
 
     variables:
@@ -40,10 +41,11 @@ from ..fuzzy.shapes import SHAPES
 from ..numbers import LARGEST, exact
 from ..words import plural
 from . import yamlpos
+from .operators import RESOLUTION
 from .terms import Term, TermSet, Variable, check_term, invisible_name, universe_problem
 from .yamlpos import YList, YMap
 
-VARIABLE_KEYS = ("description", "unit", "role", "universe", "terms", "default")
+VARIABLE_KEYS = ("description", "unit", "role", "universe", "terms", "default", "resolution")
 TRIANGLE_FORMS = {
     ("points",): "triangle",
     ("peak", "width"): "triangle_pw",
@@ -208,7 +210,23 @@ def _variable(name: str, spec: Any, key_span: Span, value_span: Span,
         if not isinstance(value, (str, int, float)):
             raise TermSetError(f"{what}: {key} must be text", span=spec.value_span(key))
     return Variable(name, role, (lo, hi), terms, str(text_of["description"]),
-                    str(text_of["unit"]), default, key_span)
+                    str(text_of["unit"]), default, key_span,
+                    _resolution(spec, role, what) if "resolution" in spec else None)
+
+
+def _resolution(spec: YMap, role: str, what: str) -> int:
+    """An output's own ``resolution:`` (its Mamdani sample points), checked at its place."""
+    if role != "output":
+        raise TermSetError(f"{what}: only outputs take a `resolution` (an input is not "
+                           f"sampled)", span=spec.key_span("resolution"))
+    value, lo, hi = spec["resolution"], *RESOLUTION
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not (
+            float(value).is_integer() and lo <= value <= hi):
+        raise TermSetError(f"{what}: resolution must be a whole number from {lo} to {hi}, not "
+                           f"{value!r}", span=spec.value_span("resolution"),
+                           hint="the points its Mamdani output is sampled at, e.g. "
+                                "`resolution: 1001`")
+    return int(value)
 
 
 def _term(name: str, spec: Any, key_span: Span, value_span: Span, variable: str,

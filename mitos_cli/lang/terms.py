@@ -132,6 +132,9 @@ class Variable:
     unit: str = ""
     default: float | None = None
     span: Span | None = field(default=None, compare=False)
+    #: A Mamdani output's own number of sample points, where it differs from its behavior's
+    #: ``resolution`` (fuzzylite gives each output its defuzzifier's); None: the behavior's.
+    resolution: int | None = None
 
     def __post_init__(self) -> None:
         lo, hi = self.universe
@@ -139,6 +142,8 @@ class Variable:
         if problem:
             raise TermSetError(f"variable `{self.name}`: {problem[0]}", span=self.span,
                                hint=problem[1])
+        if self.resolution is not None:
+            self._check_resolution()
         self._check_plain()
         seen: dict[str, Term] = {}
         for term in self.terms:
@@ -146,6 +151,17 @@ class Variable:
             if first is not term:
                 raise TermSetError(f"variable `{self.name}`: duplicate term `{term.name}`"
                                    + first_at(first.span), span=term.span)
+
+    def _check_resolution(self) -> None:
+        from .operators import RESOLUTION
+
+        if self.role != "output":
+            raise TermSetError(f"variable `{self.name}`: only outputs take a `resolution` (an "
+                               f"input is not sampled)", span=self.span)
+        lo, hi = RESOLUTION
+        if not (isinstance(self.resolution, int) and lo <= self.resolution <= hi):
+            raise TermSetError(f"variable `{self.name}`: resolution must be a whole number "
+                               f"from {lo} to {hi}, not {self.resolution}", span=self.span)
 
     def _check_plain(self) -> None:
         """Refuse a control character in a name, description or unit (a .fis name may hold

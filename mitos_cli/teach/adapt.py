@@ -758,17 +758,18 @@ def output_tables(p: Parameters, values: np.ndarray) -> tuple[OutputTable, ...]:
     for j, spec in enumerate(p.sets):
         var = c.variables[c.outputs[j]]
         lo, hi = var.universe
+        res = len(spec.table.grid)                   # the output's own resolution, or the behavior's
         rows = []
         for term, extra in spec.rows:
             if term is None:                         # a crisp consequent: extra is its knot
-                rows.append(spike(lo, hi, ops.resolution, float(values[extra]), ops.sampling))
+                rows.append(spike(lo, hi, res, float(values[extra]), ops.sampling))
                 continue
             t = _output_term(p, var, term, values)
-            mu = (spike(lo, hi, ops.resolution, t.params[0], ops.sampling)
+            mu = (spike(lo, hi, res, t.params[0], ops.sampling)
                   if t.shape == "singleton"
                   else np.asarray(t.membership(spec.table.grid), dtype=float))
             rows.append(hedge_mod.apply(extra, mu))
-        sets = np.array(rows, dtype=float).reshape(len(rows), ops.resolution)
+        sets = np.array(rows, dtype=float).reshape(len(rows), res)
         tables.append(dataclasses.replace(spec.table, sets=sets))
     return tuple(tables)
 
@@ -820,7 +821,10 @@ def difference_steps(p: Parameters) -> np.ndarray:
     scale the outputs can resolve, which is what a descent step of a few per cent needs.
     """
     ops = p.compiled.operators
-    cells = ops.resolution - 1 if ops.sampling == "endpoints" else ops.resolution
+    # the coarsest output's grid (outputs may have resolutions of their own)
+    points = min((len(t.grid) for t in p.compiled.mamdani), default=ops.resolution) \
+        if ops.inference == "mamdani" else ops.resolution
+    cells = points - 1 if ops.sampling in ("endpoints", "trapezoid") else points
     rel = np.full(len(p.values), DIFF_STEP if ops.defuzzify == "centroid" else 1.0 / cells)
     single = np.array([k.kind in ("output", "crisp") for k in p.knots], dtype=bool)
     rel[single] = 1.0 / cells

@@ -214,7 +214,7 @@ def rule_view(compiled: CompiledRuleBase, values: dict[str, float]) -> RuleView:
         outputs.append(OutputView(name, var.unit, tuple(var.universe),
                                   compiled.operators.inference, value, not setting.any(),
                                   stems, grid, agg, declares_nan(compiled, name)))
-    return RuleView(compiled.behavior, compiled.operators.describe(), compiled.n_rules,
+    return RuleView(compiled.behavior, compiled.describe_operators(), compiled.n_rules,
                     tuple(inputs), tuple(rows), tuple(outputs))
 
 

@@ -90,6 +90,12 @@ def program(compiled: CompiledRuleBase) -> Program:
                           span=setting_span(compiled.rulebase, compiled.behavior, "inference"),
                           hint="export it with another inference, or convert it to FLL (`mitos "
                                "convert --to fll`) to run it in fuzzylite")
+    if compiled.operators.inference == "mamdani" and compiled.operators.sampling == "trapezoid":
+        raise FormatError("`mitos export` has no code for `sampling = trapezoid` (Octave's "
+                          "centroid, the ends weighing half)",
+                          span=setting_span(compiled.rulebase, compiled.behavior, "sampling"),
+                          hint="export it with `sampling = endpoints` (MATLAB's) or "
+                               "`midpoints`; the outputs move by the ends' half weight")
     names = term_columns(compiled)
     hedges: set[str] = set()
     used: set[str] = set()

@@ -1,0 +1,185 @@
+"""``--fidelity octave``: Octave's fuzzy-logic-toolkit (0.4.6, Debian's
+``octave-fuzzy-logic-toolkit``) where it computes a ``.fis`` otherwise than MATLAB: its centroid
+is the trapezoid rule (``trapz (x, x.*y) / trapz (x, y)`` in ``defuzz.m``, the two end points
+weighing half: ``sampling = trapezoid``), and it joins a Sugeno output's rules of one value
+with the file's ``AggMethod`` before the weighted average (``aggregate_fis_output``:
+``accumulation = AggMethod``). The numbers are Octave's ``evalfis`` on the two files below
+(ours), printed with ``dlmwrite (..., 'precision', '%.17g')``."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from mitos_cli.api import LoadedRuleBase
+from mitos_cli.engine.compile import compile_rulebase
+from mitos_cli.engine.evaluation import evaluate
+from mitos_cli.engine.mamdani import defuzzify, trapezoid_weights
+from mitos_cli.errors import MitosError
+from mitos_cli.interop.common import fidelity_rulebase, fidelity_settings
+from mitos_cli.interop.export import to_python
+from mitos_cli.interop.fis import parse_fis
+
+MAMDANI = """\
+[System]
+Name='pump'
+Type='mamdani'
+Version=2.0
+NumInputs=2
+NumOutputs=1
+NumRules=3
+AndMethod='min'
+OrMethod='max'
+ImpMethod='min'
+AggMethod='max'
+DefuzzMethod='centroid'
+
+[Input1]
+Name='level'
+Range=[0 10]
+NumMFs=2
+MF1='low':'trimf',[-5 0 6]
+MF2='high':'trimf',[4 10 15]
+
+[Input2]
+Name='inflow'
+Range=[0 4]
+NumMFs=2
+MF1='slow':'trapmf',[-1 0 1 3]
+MF2='fast':'trapmf',[1 3 4 5]
+
+[Output1]
+Name='pump'
+Range=[0 100]
+NumMFs=3
+MF1='off':'trimf',[-40 0 40]
+MF2='half':'trimf',[20 50 80]
+MF3='full':'trimf',[60 100 140]
+
+[Rules]
+1 1, 1 (1) : 1
+2 0, 3 (1) : 1
+1 2, 2 (0.8) : 1
+"""
+
+SUGENO = """\
+[System]
+Name='heat'
+Type='sugeno'
+Version=2.0
+NumInputs=1
+NumOutputs=1
+NumRules=3
+AndMethod='min'
+OrMethod='max'
+ImpMethod='prod'
+AggMethod='max'
+DefuzzMethod='wtaver'
+
+[Input1]
+Name='temp'
+Range=[0 40]
+NumMFs=3
+MF1='cold':'trimf',[-20 0 20]
+MF2='mild':'trimf',[5 20 35]
+MF3='hot':'trimf',[10 40 70]
+
+[Output1]
+Name='heat'
+Range=[0 10]
+NumMFs=2
+MF1='on':'constant',[8]
+MF2='off':'linear',[0.1 1]
+
+[Rules]
+1, 1 (1) : 1
+2, 1 (1) : 1
+3, 2 (1) : 1
+"""
+
+X_M = np.array([[1.0, 0.5], [5.0, 2.0], [7.0, 3.5], [9.0, 1.2]])
+OCTAVE_M = [13.644663523360485, 50.000000000000057, 84.450000000000003, 86.355336476639536]
+X_S = np.array([[5.0], [12.0], [18.0], [30.0]])
+OCTAVE_S = [8.0, 7.2749999999999995, 6.776470588235294, 5.333333333333333]
+
+
+def _octave(text: str, name: str, tmp_path) -> np.ndarray:
+    path = tmp_path / name                   # Octave's AggMethod is read from the file
+    path.write_text(text)
+    from mitos_cli.api import read_rulebase
+
+    rb = read_rulebase(path)
+    c = LoadedRuleBase(fidelity_rulebase(rb, "octave"), None,
+                       fidelity_settings(rb, "octave")).compiled
+    X = X_M if c.operators.inference == "mamdani" else X_S
+    return evaluate(c, X, strict=False, detail=False).outputs[:, 0]
+
+
+def test_the_trapezoid_centroid_is_octaves(tmp_path):
+    got = _octave(MAMDANI, "pump.fis", tmp_path)
+    np.testing.assert_allclose(got, OCTAVE_M, rtol=0, atol=1e-12)
+    matlab = evaluate(compile_rulebase(parse_fis(MAMDANI, "pump.fis")), X_M, detail=False)
+    assert abs(matlab.outputs[0, 0] - OCTAVE_M[0]) > 0.2      # 13.358: MATLAB's sum
+
+
+def test_a_sugeno_output_joins_the_rules_of_one_value_by_aggmethod(tmp_path):
+    got = _octave(SUGENO, "heat.fis", tmp_path)
+    np.testing.assert_allclose(got, OCTAVE_S, rtol=0, atol=1e-12)
+    rb = parse_fis(SUGENO, "gone.fis")
+    with pytest.raises(MitosError) as info:                   # read from text, no file behind
+        fidelity_settings(rb, "octave")
+    assert info.value.message.startswith("--fidelity octave reads the file's AggMethod, and "
+                                         "`gone.fis` cannot be read again")
+    assert fidelity_settings(parse_fis(SUGENO, None), "octave") == ()
+    matlab = evaluate(compile_rulebase(rb), X_S, detail=False).outputs[:, 0]
+    assert matlab[1] == pytest.approx(7.585714285714285, abs=1e-12)   # every rule counted
+    summed = SUGENO.replace("AggMethod='max'", "AggMethod='sum'")
+    path = tmp_path / "summed.fis"
+    path.write_text(summed)
+    from mitos_cli.api import read_rulebase
+
+    assert fidelity_settings(read_rulebase(path), "octave") == ()
+
+
+def test_trapezoid_weights_are_the_trapezoid_rule_by_hand():
+    x = np.linspace(0.0, 10.0, 11)
+    Y = np.array([[1.0, 0.5, 0, 0, 0, 0, 0, 0, 0, 0.25, 0.75]])
+    def trapz(f):                      # Octave's trapz (x, f), written out (NumPy 1 and 2)
+        return float(np.sum((f[1:] + f[:-1]) / 2 * np.diff(x)))
+
+    want = trapz(x * Y[0]) / trapz(Y[0])
+    got = defuzzify(Y, x, "centroid", trapezoid_weights(11))
+    assert got[0] == pytest.approx(want, rel=1e-15)
+    assert list(trapezoid_weights(4)) == [0.5, 1.0, 1.0, 0.5]
+
+
+def test_a_batch_row_is_the_row_alone_and_export_refuses_it():
+    rb = parse_fis(MAMDANI, "pump.fis")
+    c = LoadedRuleBase(rb, None, fidelity_settings(rb, "octave")).compiled
+    X = np.random.default_rng(4).uniform([0, 0], [10, 4], size=(129, 2))
+    batch = evaluate(c, X, strict=False, detail=False).outputs
+    for i in (0, 64, 128):
+        one = evaluate(c, X[i:i + 1], strict=False, detail=False).outputs
+        assert one[0, 0].tobytes() == batch[i, 0].tobytes()
+    with pytest.raises(MitosError) as info:
+        to_python(c, "pump.fis")
+    assert info.value.message == ("`mitos export` has no code for `sampling = trapezoid` "
+                                  "(Octave's centroid, the ends weighing half)")
+
+
+def test_eval_says_what_octave_does_otherwise(tmp_path, capsys):
+    from mitos_cli.cli.app import main
+
+    path = tmp_path / "pump.fis"
+    path.write_text(MAMDANI.replace("DefuzzMethod='centroid'", "DefuzzMethod='bisector'"))
+    with pytest.raises(SystemExit) as info:
+        main(["eval", str(path), "level=1", "inflow=0.5", "--fidelity", "octave"])
+    assert not info.value.code
+    assert "Octave's bisector gives the index of its sample, not the sample" in \
+        capsys.readouterr().err
+    summed = tmp_path / "summed.fis"
+    summed.write_text(SUGENO.replace("AggMethod='max'", "AggMethod='sum'"))
+    with pytest.raises(SystemExit) as info:
+        main(["eval", str(summed), "temp=12", "--fidelity", "octave"])
+    assert not info.value.code
+    assert "--fidelity octave changes nothing here" in capsys.readouterr().err
