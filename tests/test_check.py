@@ -259,6 +259,30 @@ def test_term_gap_over_a_range(tmp_path):
     assert [g.message for g in gaps] == ["input `size`: every term is 0 for size in [20, 50]"]
 
 
+@pytest.mark.parametrize(("small", "large", "says"), [
+    # a gap that ends at a crisp step ran one sample short of it: [20, 30] for [20, 30.01)
+    ("{shape: left_shoulder, points: [10, 20]}", "{shape: rectangle, points: [30.01, 100]}",
+     "for size in [20, 30.01)"),
+    ("{shape: rectangle, points: [0, 20.01]}", "{shape: right_shoulder, points: [30, 40]}",
+     "for size in (20.01, 30]"),
+    # two steps with no sample between them: a gap that was not reported at all
+    ("{shape: rectangle, points: [0, 20.01]}", "{shape: rectangle, points: [20.02, 100]}",
+     "for size in (20.01, 20.02)"),
+    ("{shape: rectangle, points: [0, 20]}", "{shape: rectangle, points: [20, 100]}", None),
+])
+def test_a_term_gap_beside_a_crisp_step_ends_at_the_step(tmp_path, capsys, small, large, says):
+    terms = TERMS.replace("{shape: left_shoulder, points: [10, 40]}", small).replace(
+        "{shape: right_shoulder, points: [40, 70]}", large)
+    (tmp_path / "t.terms.yaml").write_text(terms, encoding="utf-8")
+    (tmp_path / "t.rules").write_text(RULES, encoding="utf-8")
+    gaps = by_code(check_rulebase(read_rulebase(tmp_path / "t.rules")), "term-gap")
+    assert [g.message for g in gaps if "size" in g.message] == (
+        [f"input `size`: every term is 0 {says}"] if says else [])
+    _, out, _ = run(["check", str(tmp_path / "t.rules")], capsys)
+    assert (f"warning: input `size`: every term is 0 {says} [term-gap]" in out) if says else \
+        "input `size`: every term is 0" not in out
+
+
 def test_term_peaking_outside_the_universe(tmp_path):
     terms = TERMS.replace("HUGE:   {shape: right_shoulder, points: [140, 150]}",
                           "HUGE:   {shape: gaussian, mean: 180, sigma: 10}")

@@ -852,13 +852,14 @@ def test_a_converted_controller_keeps_the_end_of_its_universe_covered(tmp_path):
         if constrained:
             assert food.term("rancid").corners[:2] == (0.0, 0.0)
             # the written gap [3, 7] may shrink (the compass closes part of it), not widen
-            (a, b), = gaps
+            (a, b, _, _), = gaps
             assert 3.0 <= a < b <= 7.0 and "did not have" not in text
             assert f"input `food`: every term is 0 for food in [{a:g}, {b:g}] (widen a " \
                    "neighbouring term" in text
         else:
-            assert gaps[0][0] == 0.0 and gaps[0][1] > 0.0
-            assert (f"input `food`: every term is 0 for food in [0, {gaps[0][1]:.6g}], a gap "
+            assert gaps[0].left == 0.0 and gaps[0].right > 0.0
+            end = ")" if gaps[0].open_right else "]"       # up to a vertical edge, or onto 0
+            assert (f"input `food`: every term is 0 for food in [0, {gaps[0].right:.6g}{end}, a gap "
                     "the terms as written did not have (widen") in text
             out.clear()
             s.run(f"save {tmp_path / 'u.rules'}")
