@@ -698,6 +698,29 @@ def test_a_variable_of_many_terms_is_checked_in_blocks(tmp_path):
     assert {"no-rule-fires", "term-gap"} <= codes
 
 
+def test_a_term_repeated_thousands_of_times_is_checked_in_little_memory(tmp_path, capsys):
+    """The fuzzer's FLL file with one `term:` line repeated 17,500 times: `mitos check` crossed
+    every two of the copies' edges and grew to 24 GB (the campaign's worker: a MemoryError).
+    A repeated edge is crossed once now."""
+    import tracemalloc
+
+    path = tmp_path / "many.fll"
+    path.write_text("Engine: e\nInputVariable: x\n  range: 0 1\n  term: A Triangle 0 0.5 1\n"
+                    "OutputVariable: y\n  range: 0 1\n  default: 0.5\n"
+                    + "  term: A Triangle 0 0.5 1\n" * 3000
+                    + "RuleBlock: r\n  rule: if x is A then y is A\n", encoding="utf-8")
+    code, out, _ = run(["check", str(path)], capsys)
+    assert code == 0 and "are hard to tell apart (similarity 1.00 > 0.5) [indistinct]" in out
+    rb = read_rulebase(path)
+    tracemalloc.start()
+    try:
+        check_rulebase(rb)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert peak < 50e6                                     # was 470 MB for 3,000 copies
+
+
 def test_a_report_names_each_file_once(tmp_path, monkeypatch):
     """Each finding's file was looked up among the packaged rule bases again (resolving
     paths): 20,000 findings of one term set took 10 s to print."""

@@ -727,6 +727,16 @@ def test_many_triangles_have_breakpoints_in_proportion():
     assert len(meaning.breakpoints(triangles, (-1.0, 2.0))) < 10 * len(triangles)
 
 
+def test_a_repeated_term_is_crossed_once():
+    """A fuzzed FLL output of 17,500 copies of one triangle: every two of its 35,000 edges
+    were crossed (600 million pairs), and `mitos check` grew to 24 GB before it was killed.
+    Each different edge is crossed once now: the breakpoints of one copy."""
+    one = np.array([[0.0, 0.5, 0.5, 1.0], [0.25, 0.75, 0.75, 1.25]])
+    many = np.repeat(one, 17_500, axis=0)
+    assert meaning.breakpoints(many, (0.0, 1.0)).tobytes() == \
+        meaning.breakpoints(one, (0.0, 1.0)).tobytes()
+
+
 @settings(max_examples=200, deadline=None)
 @given(seed=st.integers(0, 2**32 - 1), t=st.integers(1, 10), whole=st.booleans(),
        repeats=st.integers(0, 2))

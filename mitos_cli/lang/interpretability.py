@@ -114,8 +114,13 @@ def breakpoints(corners: np.ndarray, universe: tuple[float, float]) -> np.ndarra
     with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
         slope = np.concatenate([1.0 / (b[rise] - a[rise]), -1.0 / (d[fall] - c[fall])])
         offset = np.concatenate([-a[rise] / (b[rise] - a[rise]), d[fall] / (d[fall] - c[fall])])
-        i, j = _overlapping(np.concatenate([a[rise], c[fall]]),
-                            np.concatenate([b[rise], d[fall]]))
+        # each edge once: a term repeated gives the same edge again, which crosses its twin
+        # nowhere (17,500 copies of one triangle were 600 million pairs: 24 GB, then killed)
+        edges = np.unique(np.stack([np.concatenate([a[rise], c[fall]]),
+                                    np.concatenate([b[rise], d[fall]]), slope, offset], axis=1),
+                          axis=0)
+        slope, offset = edges[:, 2], edges[:, 3]
+        i, j = _overlapping(edges[:, 0], edges[:, 1])
         cross = (offset[j] - offset[i]) / (slope[i] - slope[j])
     x = np.concatenate([[lo, hi], corners[np.isfinite(corners)], cross])
     return np.unique(x[np.isfinite(x) & (x >= lo) & (x <= hi)])
