@@ -25,10 +25,10 @@ result. :func:`status` says where the cache is, or why there is none.
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import hashlib
 import hmac
-import contextlib
 import io
 import os
 import pickle
