@@ -596,12 +596,24 @@ class Session:
                 + (f" ({'; '.join(notes)})" if notes else "")), True
 
     def _telloperators(self, c: cmd.TellOperators, line: str) -> None:
+        from ..engine.check import MAMDANI_ONLY
+
         b = self.rulebase.behavior(self.focus)
-        resolve(c.settings, resolve(b.operators, resolve(self.rulebase.operators)))
+        ops = resolve(c.settings, resolve(b.operators, resolve(self.rulebase.operators)))
         self._check_operators(b, c.settings)
         text = "operators: " + ", ".join(f"{s.key} = {s.value}" for s in c.settings)
         self.change("operators", line, behavior=b.name, text=text)
         self.out(f"{b.name}: {text}")
+        # as `mitos check`'s idle-setting says of the saved file: told at the prompt it was
+        # taken without a word, though it changes no number
+        weighted = ops.inference in ("weighted_average", "weighted_sum")
+        for setting in c.settings:
+            if (setting.key == "accumulation" and not weighted) or \
+                    (setting.key in MAMDANI_ONLY and ops.inference != "mamdani"):
+                self.out(f"note: `{setting.key} = {setting.value}` has no effect: behavior "
+                         f"`{b.name}` uses {ops.inference} inference"
+                         + (" (add `inference = mamdani` to use it)"
+                            if setting.key in MAMDANI_ONLY else ""))
 
     def _check_operators(self, b: Behavior, settings) -> None:
         """Refuse operators the behavior's rules cannot be evaluated with (Tsukamoto
