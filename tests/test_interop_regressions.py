@@ -760,9 +760,6 @@ def test_an_output_without_defuzzify_in_a_file_without_rules_gives_its_terms():
         parse_fcl(with_rules, "t.fcl")
 
 
-TIPPER_FIS = Path(__file__).parent / "data" / "interop" / "tipper.fis"
-
-
 @pytest.mark.parametrize(("key", "says"), [
     ("AggMethod", "t.fis:11:11: format error: AggMethod='' but rules r1 and r2 both set `tip`: "
                   "a Mamdani system joins their sets with its aggregation"),
@@ -776,7 +773,7 @@ def test_an_empty_mamdani_method_that_changes_the_number_is_refused(tmp_path, ca
     change the number; one rule per output leaves the aggregation nothing to join."""
     from mitos_cli.cli.app import main
 
-    text = TIPPER_FIS.read_text(encoding="utf-8")
+    text = TIPPER_FIS
     line = next(x for x in text.splitlines() if x.startswith(key))
     path = tmp_path / "t.fis"
     path.write_text(text.replace(line, f"{key}=''"), encoding="utf-8")

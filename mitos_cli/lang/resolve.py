@@ -110,10 +110,11 @@ def strays(rules_target: str | Path, companions) -> list[Path]:
 def _present(path: Path) -> bool:
     """Whether something is at ``path`` (a link to nothing included); a path in a directory
     this user cannot enter is not known to be (its write is refused in words: `convert -o`
-    into such a directory was a `PermissionError` traceback here)."""
+    into such a directory was a `PermissionError` traceback here). Any other failure, a name
+    too long to look up, is the caller's to say."""
     try:
         return path.exists() or path.is_symlink()
-    except OSError:
+    except PermissionError:
         return False
 
 
