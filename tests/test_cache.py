@@ -93,7 +93,7 @@ def test_changed_code_of_a_checkout_is_a_miss(copy, monkeypatch):
 
 
 def test_a_cache_under_a_home_this_user_cannot_enter_is_no_cache(copy, monkeypatch):
-    """`sudo -u other mitos ...` keeps HOME=/root: the cache's mkdir was refused, and then
+    """`sudo -u other mitos ...` keeps root's HOME: the cache's mkdir was refused, and then
     asking whether the path was a broken symbolic link was refused too, a `PermissionError`
     traceback from every command that reads a rule file. It is no cache, said why."""
     from pathlib import Path as P
