@@ -212,6 +212,52 @@ def check_writable(path: str | Path) -> None:
                          hint="check that the directory exists and is writable")
 
 
+#: how long a save waits for another process's save into the same directory (s)
+SAVE_LOCK_WAIT = 30.0
+
+
+@contextlib.contextmanager
+def save_lock(path: str | Path, error: type[MitosError] = WriteError) -> Iterator[None]:
+    """Hold the directory that ``path`` is saved into (its nearest existing one) while a save
+    checks what is there and writes: two processes that checked, then wrote, at once lost the
+    first one's save without a word. An advisory ``flock`` on the directory itself (no file
+    is left beside the user's), released by the system when the process ends; another save
+    into the directory waits for it, up to :data:`SAVE_LOCK_WAIT` seconds. Where the system
+    has no ``flock``, or the directory cannot be opened, saves are not locked."""
+    try:
+        import fcntl
+    except ImportError:                          # pragma: no cover - not POSIX
+        yield
+        return
+    import time
+
+    directory = real_path(path).parent
+    while not directory.is_dir() and directory != directory.parent:
+        directory = directory.parent             # `save new/dir/taught.rules` makes new/
+    try:
+        fd = os.open(directory, os.O_RDONLY)
+    except OSError:
+        yield
+        return
+    try:
+        deadline = time.monotonic() + SAVE_LOCK_WAIT
+        while True:
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+                break
+            except BlockingIOError:
+                if time.monotonic() > deadline:
+                    raise error(f"another program has been saving into {directory} for "
+                                f"{SAVE_LOCK_WAIT:g} s; nothing was written",
+                                hint="save again when it is done") from None
+                time.sleep(0.01)
+            except OSError:                      # a file system without locks
+                break
+        yield
+    finally:
+        os.close(fd)                             # releases the lock
+
+
 #: what to do about an output named by a link in a loop
 LOOP_HINT = "the symbolic link leads back to itself: remove it, or name another file"
 

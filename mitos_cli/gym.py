@@ -33,8 +33,9 @@ as ``mitos simulate`` does (sensor noise, moving obstacles, replanning, the verd
   live view of ``mitos simulate --live`` on stderr.
 - **seeding**: ``reset(seed=s)`` runs the world from seed ``s`` (``SeedSequence(s)``, as
   ``mitos simulate --seed s``): the same seed and actions give the same observations bit for
-  bit. ``reset()`` without a seed uses the world's on the first call and continues the
-  environment's own generator after.
+  bit. ``reset()`` without a seed uses the world's on the first call, seeds the
+  environment's own generator with it, and draws each later episode's seed from that
+  generator: the same resets give the same episodes in every process.
 
 Worlds with several robots are refused (one agent acts). The fuzzy planner is the policy of
 ``mitos simulate``: driving this environment with ``env.unwrapped.fuzzy_policy`` gives the
@@ -191,9 +192,16 @@ class MitosEnv(gymnasium.Env):
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
         seed = _check_seed(seed)
         self.sim.randomise = _randomise(options)
-        super().reset(seed=seed)
-        if seed is None:
-            seed = (int(self.np_random.integers(2**31)) if self._seeded else self.world.seed)
+        if seed is None and not self._seeded:
+            # the first reset without a seed runs the world's seed, and seeds the generator
+            # later resets draw from with it: Gymnasium's own would take the OS's entropy, a
+            # different second episode in every process (docs/gym.md)
+            super().reset(seed=self.world.seed)
+            seed = self.world.seed
+        else:
+            super().reset(seed=seed)
+            if seed is None:
+                seed = int(self.np_random.integers(2**31))
         self._seeded = True
         self.sim.reset(seed)
         self._trail = [self.sim.pose[0, :2].copy()]

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import pickle
 import shutil
 from pathlib import Path
@@ -89,3 +90,40 @@ def test_changed_code_of_a_checkout_is_a_miss(copy, monkeypatch):
     calls = []
     cache.cached_rulebase(copy / "mitos.rules", lambda p: calls.append(p))
     assert calls == [copy / "mitos.rules"]                      # a miss: parsed again
+
+
+def test_a_cache_under_a_home_this_user_cannot_enter_is_no_cache(copy, monkeypatch):
+    """`sudo -u other mitos ...` keeps root's HOME: the cache's mkdir was refused, and then
+    asking whether the path was a broken symbolic link was refused too, a `PermissionError`
+    traceback from every command that reads a rule file. It is no cache, said why."""
+    from pathlib import Path as P
+
+    def denied(self, *args, **kwargs):
+        raise PermissionError(13, "Permission denied", str(self))
+
+    where = copy / "home" / ".cache" / "mitos"
+    monkeypatch.setenv("MITOS_CACHE_DIR", str(where))
+    monkeypatch.setattr(P, "mkdir", denied)
+    monkeypatch.setattr(P, "is_symlink", denied)
+    status = cache.status()
+    assert status.path is None and not status.refused
+    assert status.reason == f"no cache: cannot create {where}: Permission denied"
+    assert api.read_rulebase(copy / "mitos.rules").behaviors    # read, not cached
+
+
+@pytest.mark.skipif(not hasattr(os, "geteuid") or os.geteuid() == 0,
+                    reason="root enters any directory")
+def test_mitos_runs_with_a_cache_it_cannot_enter(copy, monkeypatch, capsys):
+    from mitos_cli.cli.app import main
+
+    home = copy / "home"
+    (home / ".cache").mkdir(parents=True)
+    home.chmod(0o000)
+    try:
+        monkeypatch.setenv("MITOS_CACHE_DIR", str(home / ".cache" / "mitos"))
+        with pytest.raises(SystemExit) as info:
+            main(["eval", str(copy / "mitos.rules"), "road=78", "size=45", "position=4",
+                  "-b", "avoid_obstacle"])
+        assert info.value.code == 0 and "Traceback" not in capsys.readouterr().err
+    finally:
+        home.chmod(0o700)

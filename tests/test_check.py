@@ -259,6 +259,30 @@ def test_term_gap_over_a_range(tmp_path):
     assert [g.message for g in gaps] == ["input `size`: every term is 0 for size in [20, 50]"]
 
 
+@pytest.mark.parametrize(("small", "large", "says"), [
+    # a gap that ends at a crisp step ran one sample short of it: [20, 30] for [20, 30.01)
+    ("{shape: left_shoulder, points: [10, 20]}", "{shape: rectangle, points: [30.01, 100]}",
+     "for size in [20, 30.01)"),
+    ("{shape: rectangle, points: [0, 20.01]}", "{shape: right_shoulder, points: [30, 40]}",
+     "for size in (20.01, 30]"),
+    # two steps with no sample between them: a gap that was not reported at all
+    ("{shape: rectangle, points: [0, 20.01]}", "{shape: rectangle, points: [20.02, 100]}",
+     "for size in (20.01, 20.02)"),
+    ("{shape: rectangle, points: [0, 20]}", "{shape: rectangle, points: [20, 100]}", None),
+])
+def test_a_term_gap_beside_a_crisp_step_ends_at_the_step(tmp_path, capsys, small, large, says):
+    terms = TERMS.replace("{shape: left_shoulder, points: [10, 40]}", small).replace(
+        "{shape: right_shoulder, points: [40, 70]}", large)
+    (tmp_path / "t.terms.yaml").write_text(terms, encoding="utf-8")
+    (tmp_path / "t.rules").write_text(RULES, encoding="utf-8")
+    gaps = by_code(check_rulebase(read_rulebase(tmp_path / "t.rules")), "term-gap")
+    assert [g.message for g in gaps if "size" in g.message] == (
+        [f"input `size`: every term is 0 {says}"] if says else [])
+    _, out, _ = run(["check", str(tmp_path / "t.rules")], capsys)
+    assert (f"warning: input `size`: every term is 0 {says} [term-gap]" in out) if says else \
+        "input `size`: every term is 0" not in out
+
+
 def test_term_peaking_outside_the_universe(tmp_path):
     terms = TERMS.replace("HUGE:   {shape: right_shoulder, points: [140, 150]}",
                           "HUGE:   {shape: gaussian, mean: 180, sigma: 10}")
@@ -672,6 +696,29 @@ def test_a_variable_of_many_terms_is_checked_in_blocks(tmp_path):
     assert peak < 120e6                                    # was over 500 MB
     codes = {f.code for f in report.findings}
     assert {"no-rule-fires", "term-gap"} <= codes
+
+
+def test_a_term_repeated_thousands_of_times_is_checked_in_little_memory(tmp_path, capsys):
+    """The fuzzer's FLL file with one `term:` line repeated 17,500 times: `mitos check` crossed
+    every two of the copies' edges and grew to 24 GB (the campaign's worker: a MemoryError).
+    A repeated edge is crossed once now."""
+    import tracemalloc
+
+    path = tmp_path / "many.fll"
+    path.write_text("Engine: e\nInputVariable: x\n  range: 0 1\n  term: A Triangle 0 0.5 1\n"
+                    "OutputVariable: y\n  range: 0 1\n  default: 0.5\n"
+                    + "  term: A Triangle 0 0.5 1\n" * 3000
+                    + "RuleBlock: r\n  rule: if x is A then y is A\n", encoding="utf-8")
+    code, out, _ = run(["check", str(path)], capsys)
+    assert code == 0 and "are hard to tell apart (similarity 1.00 > 0.5) [indistinct]" in out
+    rb = read_rulebase(path)
+    tracemalloc.start()
+    try:
+        check_rulebase(rb)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert peak < 50e6                                     # was 470 MB for 3,000 copies
 
 
 def test_a_report_names_each_file_once(tmp_path, monkeypatch):

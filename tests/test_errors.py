@@ -170,6 +170,33 @@ def test_a_header_without_its_colon_is_said_at_its_end(tmp_path, header):
     assert exc.render().splitlines()[2] == "    " + " " * len("behavior a") + "^"
 
 
+@pytest.mark.parametrize(("operators", "after", "message", "col"), [
+    # the next line's first word was read as the value: "unexpected `r1`, expected `if`" two
+    # lines down, or "unexpected `:`" at the next rule
+    ("operators: accumulation = ", "behavior b:\n  r1: if road is WIDE then speed is SLOW\nend\n",
+     "the operators line ends after `accumulation =`: a value is missing", 25),
+    ("operators: and =   # the AND", "r1: if road is WIDE then speed is SLOW\n",
+     "the operators line ends after `and =`: a value is missing", 16),
+    ("operators: and = min,", "\nr1: if road is WIDE then speed is SLOW\n",
+     "the operators line ends after `and = min,`: a setting is missing", 21),
+])
+def test_an_operators_line_cut_short_is_said_at_its_end(tmp_path, operators, after, message,
+                                                        col):
+    path = write(tmp_path, operators + "\n" + after)
+    exc = error_of(lambda: load_rules_file(path), RuleSyntaxError)
+    assert exc.message == message and str(exc.span) == f"{path}:2:{col}"
+    assert "`NAME = VALUE` settings" in exc.expected
+
+
+def test_an_operators_line_wrapped_on_purpose_still_reads(tmp_path):
+    path = write(tmp_path, "operators: and = min,\n    or = max\n"
+                           "r1: if road is WIDE then speed is SLOW\n")
+    assert load_rules_file(path).behaviors
+    bad = write(tmp_path, "operators: and = min,\n    or = max\n"
+                          "r1: if road is WIDE then speed SLOW\n")
+    assert "operators line" not in error_of(lambda: load_rules_file(bad), RuleSyntaxError).message
+
+
 def test_syntax_error_in_a_wrapped_rule_points_at_its_line(tmp_path):
     path = write(tmp_path, "r1: if road is WIDE\n    and size SMALL_SZ\n    then speed is SLOW\n")
     exc = error_of(lambda: load_rules_file(path), RuleSyntaxError)

@@ -461,6 +461,35 @@ def test_the_seeds_gymnasium_takes_give_its_runs_and_a_numpy_int_its_int():
     assert env.unwrapped.sim.seed is not None
 
 
+def _unseeded_resets(n=3):
+    env = gymnasium.make("mitos/Corridor-v0")
+    first = env.reset()[0]
+    return [first] + [env.reset()[0] for _ in range(n - 1)], env.unwrapped.sim.seed
+
+
+def test_resets_without_a_seed_give_the_same_episodes_in_every_environment():
+    # the second reset drew its seed from Gymnasium's generator, which a reset without a seed
+    # left seeded from the OS's entropy: another episode in every process
+    a, seed_a = _unseeded_resets()
+    b, seed_b = _unseeded_resets()
+    assert all(np.array_equal(x, y) for x, y in zip(a, b)) and seed_a == seed_b
+    world = load_world(packaged_path("worlds", "corridor.yaml"))
+    env = gymnasium.make("mitos/Corridor-v0")
+    assert np.array_equal(env.reset()[0], env.reset(seed=world.seed)[0])   # the world's seed first
+    assert not np.array_equal(a[0], a[1])                 # later episodes are other episodes
+
+
+def test_a_vector_environment_reset_without_seeds_is_the_same_in_every_process():
+    def episodes(seed):
+        envs = gymnasium.make_vec("mitos/Corridor-v0", num_envs=2, vectorization_mode="sync")
+        return [envs.reset(seed=seed)[0], envs.reset()[0], envs.reset()[0]]
+
+    for seed in (None, 5):
+        assert all(np.array_equal(x, y) for x, y in zip(episodes(seed), episodes(seed)))
+    seeded = episodes(5)                        # seed s: sub-environment i runs s + i
+    assert not np.array_equal(seeded[0][0], seeded[0][1])
+
+
 @pytest.mark.parametrize(("kwargs", "says", "hint"), [
     ({"obsreve_ranges": True}, "unknown keyword `obsreve_ranges` of the MITOS environment",
      "did you mean `observe_ranges`?"),

@@ -292,3 +292,42 @@ def test_one_rule_concluding_two_terms_of_an_output_is_two_rules():
         w2, w8 = max(min(a_low, b_low), 0.5 * b_high), max(max(a_high, b_high), 0.5 * b_high)
         got = evaluate(c, np.array([[a, b]]), detail=False).outputs[0, 0]
         assert got == pytest.approx((2 * w2 + 8 * w8) / (w2 + w8), rel=1e-14)
+
+
+@pytest.mark.parametrize(("expr", "column", "says"), [
+    # a RecursionError (a traceback) at each: 50,000 parentheses, 100,000 signs, 5,000 exp(
+    ("(" * 50_000 + "a" + ")" * 50_000, 125, "FUNCTION: nested more than 100 deep"),
+    ("-" * 100_000 + "a", 125, "FUNCTION: nested more than 100 deep"),
+    ("exp(" * 5_000 + "0" + ")" * 5_000, 225, "FUNCTION: nested more than 100 deep"),
+    ("(" * 100 + "a" + ")" * 100, None, None),                  # at the limit: read
+    # complex: float() of it was a TypeError
+    ("(-8) ^ 0.5", 30, "FUNCTION: -8 ^ 0.5 is not a number"),
+    # past a float's range without an exception: a coefficient of inf, or NaN
+    ("1e308 * 10 * a", 24, "FUNCTION: its coefficient of a comes to inf, past a float's range"),
+    ("a*1e308*10 - a*1e308*10", 24,
+     "FUNCTION: its coefficient of a comes to nan, past a float's range"),
+    ("1e308 + 1e308", 24, "FUNCTION: its constant comes to inf, past a float's range"),
+])
+def test_hostile_functions_are_refused_at_their_place(tmp_path, capsys, expr, column, says):
+    from mitos_cli.cli.app import main
+
+    path = tmp_path / "f.fcl"
+    path.write_text(FUNCTIONS.replace("TERM lo := FUNCTION (a * 0.5) + 1;",
+                                      f"TERM lo := FUNCTION {expr};"), encoding="utf-8")
+    with pytest.raises(SystemExit) as info:
+        main(["check", str(path)])
+    err = capsys.readouterr().err
+    assert "Traceback" not in err
+    if says is None:
+        assert info.value.code == 0
+    else:
+        assert info.value.code == 1 and f"f.fcl:22:{column}: format error: {says}" in err
+
+
+def test_a_function_of_200000_terms_is_read_in_linear_time():
+    """Each token sliced the rest of the text (`text[pos:]`): a FUNCTION of 200,000 terms
+    (1.2 MB) took past a minute; read as the sum it is."""
+    text = FUNCTIONS.replace("TERM lo := FUNCTION (a * 0.5) + 1;",
+                             "TERM lo := FUNCTION " + " + ".join(["a"] * 200_000) + ";")
+    lo = parse_fcl(text, "f.fcl").variables["y"].term("lo")
+    assert lo.params == (200_000.0, 0.0, 0.0)

@@ -758,3 +758,31 @@ def test_an_output_without_defuzzify_in_a_file_without_rules_gives_its_terms():
                                                     "y IS a;\nEND_RULEBLOCK\nEND_FUNCTION_BLOCK")
     with pytest.raises(MitosError, match="variable `y` is declared but has no DEFUZZIFY block"):
         parse_fcl(with_rules, "t.fcl")
+
+
+@pytest.mark.parametrize(("key", "says"), [
+    ("AggMethod", "t.fis:11:11: format error: AggMethod='' but rules r1 and r2 both set `tip`: "
+                  "a Mamdani system joins their sets with its aggregation"),
+    ("ImpMethod", "t.fis:10:11: format error: ImpMethod='' but rule r1 concludes `tip`: a "
+                  "Mamdani system cuts each rule's set with its implication"),
+])
+def test_an_empty_mamdani_method_that_changes_the_number_is_refused(tmp_path, capsys, key,
+                                                                    says):
+    """`AggMethod=''` / `ImpMethod=''` in a Mamdani .fis were read as MATLAB's defaults (max,
+    min) without a word, where fuzzylite refuses to run without them. Refused where they
+    change the number; one rule per output leaves the aggregation nothing to join."""
+    from mitos_cli.cli.app import main
+
+    text = TIPPER_FIS
+    line = next(x for x in text.splitlines() if x.startswith(key))
+    path = tmp_path / "t.fis"
+    path.write_text(text.replace(line, f"{key}=''"), encoding="utf-8")
+    with pytest.raises(SystemExit) as info:
+        main(["eval", str(path), "service=3", "food=8"])
+    err = capsys.readouterr().err
+    assert info.value.code == 1 and says in err
+    assert f"give {key} a method" in err
+    if key == "AggMethod":                            # one rule: nothing to join, read
+        one = path.read_text(encoding="utf-8").replace("NumRules=3", "NumRules=1").replace(
+            "2 0, 2 (1) : 1\n", "").replace("3 2, 3 (1) : 2\n", "")
+        assert [r.label for r in parse_fis(one, "one.fis").behaviors[0].rules] == ["r1"]

@@ -7,6 +7,7 @@ reproducer, and a bounded fuzzing run per input kind (the campaign's own mutator
 from __future__ import annotations
 
 import json
+import os
 import sys
 import time
 from pathlib import Path
@@ -1173,3 +1174,63 @@ def test_repeated_term_names_are_renamed_in_linear_time():
     names = [t.name for t in distinct_names(many, "x", notes, "why")]
     assert time.process_time() - t0 < 2.0
     assert len(set(names)) == 20_000 and names[-1] == "low_2_19999"
+
+
+# --- paths in a directory this user cannot enter -----------------------------------------------
+
+LOCKED_COMMANDS = [
+    (["convert", "{rules}", "--to", "rules", "-o", "{locked}/y.rules"], "cannot write"),
+    (["compare", "corridor", "--runs", "1", "--out", "{locked}/study"],
+     "study error: cannot use the output directory"),
+    (["teach", "{locked}/r.rules"], "rule base error: cannot read rule file"),
+]
+
+
+def _locked_run(args, tmp_path, capsys):
+    from mitos_cli.api import default_rulebase_path
+    from mitos_cli.cli.app import main
+
+    filled = [a.format(rules=default_rulebase_path(), locked=tmp_path / "locked") for a in args]
+    with pytest.raises(SystemExit) as info:
+        main(filled)
+    return info.value.code, capsys.readouterr().err
+
+
+@pytest.mark.parametrize(("args", "says"), LOCKED_COMMANDS)
+def test_a_path_in_a_directory_that_cannot_be_entered_is_said_in_words(args, says, tmp_path,
+                                                                       capsys, monkeypatch):
+    """As another user (`sudo -u`, a HOME of 0700), asking whether a path inside such a
+    directory exists is itself refused: `convert -o` (its term set's stray check), `compare
+    --out` and `teach FILE` ended in a `PermissionError` traceback. Each is a message and
+    exit 1 now. (Root enters every directory: the refusal is played by the path's stat.)"""
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "locked").mkdir()
+    real_stat, real_lstat = Path.stat, Path.lstat
+
+    def denied(real):
+        def stat(self, *a, **k):
+            if "locked" in self.parts and self.name != "locked":
+                raise PermissionError(13, "Permission denied", str(self))
+            return real(self, *a, **k)
+        return stat
+
+    monkeypatch.setattr(Path, "stat", denied(real_stat))
+    monkeypatch.setattr(Path, "lstat", denied(real_lstat))
+    code, err = _locked_run(args, tmp_path, capsys)
+    assert code == 1 and says in err and "Traceback" not in err
+
+
+@pytest.mark.skipif(not hasattr(os, "geteuid") or os.geteuid() == 0,
+                    reason="root enters any directory")
+@pytest.mark.parametrize(("args", "says"), LOCKED_COMMANDS)
+def test_a_directory_that_cannot_be_entered_as_its_user_meets_it(args, says, tmp_path, capsys,
+                                                                monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    locked = tmp_path / "locked"
+    locked.mkdir()
+    locked.chmod(0o000)
+    try:
+        code, err = _locked_run(args, tmp_path, capsys)
+    finally:
+        locked.chmod(0o700)
+    assert code == 1 and says in err and "Traceback" not in err

@@ -69,7 +69,8 @@ def test_a_binary_pgm_whose_header_ends_in_cr_lf_is_refused_not_shifted():
     (b"P5 2", "cut short"),
     (b"P2 1 1 255 300", "outside 0..255"),
     # a binary pixel above the header's maximum was read as it stood: an occupancy below 0
-    (b"P5 2 1 100\n\x00\xfe", "column 1, row 0 .* is 254, outside 0..100"),
+    (b"P5 2 1 100\n\x00\xfe", r"column 2, row 1 \(counted from 1 at the top left\) is 254, "
+                                 "outside 0..100"),
     (b"P5\n" + b"9" * 5000 + b" 1\n255\n\x00", "a number of 5,000 digits"),
 ])
 def test_broken_pgms_are_refused_in_words(data, words):
@@ -243,6 +244,18 @@ def test_a_png_map_reads_as_the_same_pgm(tmp_path):
     assert load_map_yaml(_map(tmp_path, "c.png")).occupied.tolist() == pgm.occupied.tolist()
 
 
+
+
+def test_a_pixel_out_of_range_is_said_at_the_maps_image_line_counted_from_1(tmp_path):
+    """The pixel was said from 0 (`column 1, row 0` for the second pixel of the first row),
+    where every other position MITOS gives, the ASCII image's `pixel 1` among them, counts
+    from 1."""
+    (tmp_path / "m.pgm").write_bytes(b"P5 3 2 100\n" + bytes([0, 0, 0, 0, 0, 254]))
+    with pytest.raises(WorldError) as info:
+        load_map_yaml(_map(tmp_path, "m.pgm"))
+    assert info.value.span.line == 1
+    assert "the pixel in column 3, row 2 (counted from 1 at the top left) is 254, outside " \
+           "0..100" in str(info.value)
 
 
 def test_a_png_named_pgm_is_read_by_its_content_as_map_server_reads_it(tmp_path):

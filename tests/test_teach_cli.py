@@ -111,6 +111,24 @@ def test_a_lesson_past_its_limits_is_refused_before_it_runs(work):
     check_lesson_size("#" * ((16 << 20) - 11) + "\nshow rules", "long.lesson")
 
 
+@pytest.mark.parametrize(("window", "col", "says"), [
+    ("at -1s to 2s", 4, "the run lasted 0 to 17.9 s; -1 s is outside it"),
+    ("at -5s to -1s", 4, "the run lasted 0 to 17.9 s; -5 s is outside it"),
+    ("at 2.001s to 2.02s", 4, "no recorded tick between 2.001 s and 2.02 s"),
+    ("at 3s to 2s", 4, "`at 3s to 2s`: the window ends before it starts"),
+])
+def test_a_window_before_the_run_or_without_a_tick_is_refused_at_its_line(work, window, col,
+                                                                           says):
+    """A time below 0 and a window between two ticks: each refused at its words, exit 1,
+    no example taken."""
+    (work / "w.lesson").write_text(f"use drive\nsimulate corridor seed 1\n{window} steering=80\n"
+                                   "show examples\n")
+    res = mitos("teach", "rb/mitos.rules", "--lesson", "w.lesson", cwd=work)
+    assert res.returncode == 1 and "Traceback" not in res.stderr
+    assert f"w.lesson:3:{col}: lesson error: {says}" in res.stderr
+    assert "w.lesson:4>" not in res.stdout
+
+
 def test_usage_errors(work):
     res = mitos("teach", "--session", "x", cwd=work)
     assert res.returncode == 2 and "add --resume" in res.stderr

@@ -727,6 +727,16 @@ def test_many_triangles_have_breakpoints_in_proportion():
     assert len(meaning.breakpoints(triangles, (-1.0, 2.0))) < 10 * len(triangles)
 
 
+def test_a_repeated_term_is_crossed_once():
+    """A fuzzed FLL output of 17,500 copies of one triangle: every two of its 35,000 edges
+    were crossed (600 million pairs), and `mitos check` grew to 24 GB before it was killed.
+    Each different edge is crossed once now: the breakpoints of one copy."""
+    one = np.array([[0.0, 0.5, 0.5, 1.0], [0.25, 0.75, 0.75, 1.25]])
+    many = np.repeat(one, 17_500, axis=0)
+    assert meaning.breakpoints(many, (0.0, 1.0)).tobytes() == \
+        meaning.breakpoints(one, (0.0, 1.0)).tobytes()
+
+
 @settings(max_examples=200, deadline=None)
 @given(seed=st.integers(0, 2**32 - 1), t=st.integers(1, 10), whole=st.booleans(),
        repeats=st.integers(0, 2))
@@ -852,13 +862,14 @@ def test_a_converted_controller_keeps_the_end_of_its_universe_covered(tmp_path):
         if constrained:
             assert food.term("rancid").corners[:2] == (0.0, 0.0)
             # the written gap [3, 7] may shrink (the compass closes part of it), not widen
-            (a, b), = gaps
+            (a, b, _, _), = gaps
             assert 3.0 <= a < b <= 7.0 and "did not have" not in text
             assert f"input `food`: every term is 0 for food in [{a:g}, {b:g}] (widen a " \
                    "neighbouring term" in text
         else:
-            assert gaps[0][0] == 0.0 and gaps[0][1] > 0.0
-            assert (f"input `food`: every term is 0 for food in [0, {gaps[0][1]:.6g}], a gap "
+            assert gaps[0].left == 0.0 and gaps[0].right > 0.0
+            end = ")" if gaps[0].open_right else "]"       # up to a vertical edge, or onto 0
+            assert (f"input `food`: every term is 0 for food in [0, {gaps[0].right:.6g}{end}, a gap "
                     "the terms as written did not have (widen") in text
             out.clear()
             s.run(f"save {tmp_path / 'u.rules'}")

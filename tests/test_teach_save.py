@@ -670,6 +670,64 @@ def test_a_save_over_an_original_another_program_changed_is_refused(rules, tmp_p
     assert load_rules_file(tmp_path / "taught.rules").behaviors == s.rulebase.behaviors
 
 
+def test_two_sessions_saving_one_file_at_once_never_lose_a_save_silently(rules, monkeypatch):
+    """Two `mitos teach` saving over the original at the same moment: each checked that the
+    files were as it read them, then wrote, so B's save between A's check and A's write was
+    undone by A's without a word (both said `saved`). The check and the write now hold the
+    directory's lock: B waits for A, then finds the files changed and is refused."""
+    import threading
+
+    from mitos_cli.teach import save as save_module
+
+    a, b = Session(rules, out=[].append), Session(rules, out=[].append)
+    a.run("r27: if road is NARROW then speed is SLOW")
+    b.run("r28: if road is WIDE then speed is FAST")
+    real = save_module.save_rulebase
+    outcome: dict[str, object] = {}
+
+    def b_saves() -> None:
+        try:
+            b.run(f"save {rules}")
+            outcome["b"] = "saved"
+        except LessonError as exc:
+            outcome["b"] = exc
+
+    def a_save_with_b_inside(*args, **kwargs):
+        if threading.current_thread() is threading.main_thread():
+            outcome["thread"] = thread = threading.Thread(target=b_saves)
+            thread.start()
+            thread.join(1.0)                   # B saves now, between A's check and write
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(save_module, "save_rulebase", a_save_with_b_inside)
+    a.run(f"save {rules}")
+    outcome["thread"].join(30)
+    text = rules.read_text()
+    assert "r27:" in text and "r28:" not in text
+    assert isinstance(outcome["b"], LessonError)
+    assert "changed since this session read them" in outcome["b"].message
+
+
+def test_a_save_over_what_another_session_saved_there_since_is_refused(rules, tmp_path):
+    """Two sessions saving `taught.rules` in turn: A's second save undid B's without a word.
+    A save over files this session saved is refused when another wrote them since."""
+    target = tmp_path / "taught.rules"
+    a, b = Session(rules, out=[].append), Session(rules, out=[].append)
+    a.run("r27: if road is NARROW then speed is SLOW")
+    a.run(f"save {target}")
+    b.run("r28: if road is WIDE then speed is FAST")
+    b.run(f"save {target}")
+    a.run("r29: if road is MEDIUM then speed is SLOW")
+    with pytest.raises(LessonError, match="changed since this session saved them there") as err:
+        a.run("save")
+    assert "save under another name" in err.value.hint
+    assert "r28:" in target.read_text() and "r29:" not in target.read_text()
+    a.run(f"save {tmp_path / 'taught2.rules'}")             # the session goes on
+    b.run("r30: if road is NARROW then speed is FAST")
+    b.run("save")                                            # its own files, unchanged since
+    assert "r30:" in target.read_text()
+
+
 def test_a_save_whose_term_set_name_is_too_long_is_a_command_error(rules, tmp_path):
     """`save OUT.rules` with a name of 240 characters: the term set's, 257, could not be
     looked up, and the `OSError` ended the teaching prompt with a bare "error:", no place."""

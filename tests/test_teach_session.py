@@ -946,3 +946,21 @@ def test_a_rule_file_of_a_long_name_gets_a_session(tmp_path):
     directory = new_session_dir("z" * 245, tmp_path)
     assert directory.is_dir() and directory.name.startswith("z" * 64 + "-")
     assert len(directory.name) < 100
+
+
+@pytest.mark.parametrize(("told", "note"), [
+    ("operators: aggregation = sum", "note: `aggregation = sum` has no effect: behavior `drive` "
+     "uses weighted_average inference (add `inference = mamdani` to use it)"),
+    ("operators: accumulation = max, inference = mamdani",
+     "note: `accumulation = max` has no effect: behavior `drive` uses mamdani inference"),
+    ("operators: inference = mamdani, aggregation = sum", None),
+    ("operators: accumulation = max", None),
+])
+def test_a_told_operator_the_inference_ignores_is_noted(rules, told, note):
+    """`operators: aggregation = sum` told to a weighted-average behavior was taken without a
+    word (it changes no number; `mitos check` of the saved file says `idle-setting`)."""
+    s, out = session(rules)
+    s.run("use drive")
+    text = say(s, out, told)
+    assert text.startswith("drive: " + told)
+    assert (note in text) if note else "note:" not in text

@@ -150,7 +150,7 @@ def _new_session(rules, behavior, lesson, save_as, out):
     lesson is refused before a session exists (an empty session would be the newest, the one
     ``mitos teach --resume`` picks)."""
     from ..api import default_rulebase_path, load_rulebase
-    from ..errors import MitosError
+    from ..errors import MitosError, RuleBaseError
     from ..resources import resolve
     from ..teach.journal import Journal, new_session_dir
     from ..teach.lesson import read_lesson
@@ -159,10 +159,13 @@ def _new_session(rules, behavior, lesson, save_as, out):
     from .output import err
 
     path = Path(rules) if rules is not None else default_rulebase_path()
-    if rules is not None and not path.exists():
-        path = resolve("rulebases", rules, ".rules") or path
-    if not path.is_file():
-        from ..errors import RuleBaseError
+    try:                # in a directory this user cannot enter: a PermissionError traceback
+        if rules is not None and not path.exists():
+            path = resolve("rulebases", rules, ".rules") or path
+        is_file = path.is_file()
+    except OSError as exc:
+        raise RuleBaseError(f"cannot read rule file `{path}`: {exc.strerror or exc}") from None
+    if not is_file:
         from ..fileio import broken_link
         from ..lang.resolve import rule_file_hint
 

@@ -890,6 +890,7 @@ def _term_gaps(rb: RuleBase, scope: set[str] | None = None) -> list[Finding]:
         lo, hi = var.universe
         x = meaning.gap_points(var)
         top, envelope = _tops(var.terms, x)
+        middle = _tops(var.terms, meaning.cell_middles(x))[1] if len(x) > 1 else None
         for term, most in zip(var.terms, top):
             if most < NEARLY_ONE:
                 out.append(Finding(
@@ -897,9 +898,8 @@ def _term_gaps(rb: RuleBase, scope: set[str] | None = None) -> list[Finding]:
                     f"input term `{var.name}.{term.name}` never reaches 1 inside the universe "
                     f"[{_num(lo)}, {_num(hi)}] (at most {most:.3g})", term.span, None,
                     hint="move the term's peak into the universe, or widen the universe"))
-        for left, right in meaning.gaps_on(envelope, x):
-            # a gap between two sample points around a single zero is a touching point
-            out.append(Finding("warning", "term-gap", meaning.gap_message(var, left, right),
+        for gap in meaning.gaps_on(envelope, x, middle):
+            out.append(Finding("warning", "term-gap", meaning.gap_message(var, gap),
                                var.span, None, hint=meaning.GAP_HINT))
     return out
 

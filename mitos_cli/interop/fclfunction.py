@@ -35,7 +35,19 @@ def linear_function(text: str, span: Span, inputs: Sequence[str]) -> tuple[float
     body = text[len("function"):]
     parser = _Parser(body, len("function"), span, set(inputs))
     form = parser.parse()
-    return tuple(form.get(x, 0.0) for x in inputs) + (form.get("", 0.0),)
+    params = tuple(form.get(x, 0.0) for x in inputs) + (form.get("", 0.0),)
+    if not all(math.isfinite(p) for p in params):   # 1e308 * 10: inf, and inf - inf NaN
+        k = next(i for i, p in enumerate(params) if not math.isfinite(p))
+        what = f"coefficient of {inputs[k]}" if k < len(inputs) else "constant"
+        raise FormatError(f"FUNCTION: its {what} comes to {params[k]:g}, past a float's range",
+                          span=parser.at(0, len(body)), expected="numbers whose products and "
+                          "sums stay within a float (about 1.8e308)")
+    return params
+
+
+#: how deep parentheses, unary signs and functions may nest in one FUNCTION (as conditions
+#: nest: ``lang.parse.MAX_NESTING``); the parser recurses at each level
+MAX_DEPTH = 100
 
 
 class _Parser:
@@ -44,8 +56,9 @@ class _Parser:
     def __init__(self, text: str, offset: int, span: Span, inputs: set[str]) -> None:
         self.span, self.inputs, self.offset = span, inputs, offset
         self.tokens: list[tuple[str, str, int]] = []
-        pos = 0
-        while text[pos:].strip():
+        self.depth = 0
+        pos, end = 0, len(text.rstrip())   # (`text[pos:]` at each token: quadratic)
+        while pos < end:
             m = TOKEN.match(text, pos)
             if m is None or not m.group(m.lastgroup or ""):
                 at = pos + len(text[pos:]) - len(text[pos:].lstrip())
@@ -127,16 +140,29 @@ class _Parser:
             try:
                 value = a ** b if token[1] == "^" else math.fmod(a, b)
             except (ArithmeticError, ValueError):
+                value = None
+            if not isinstance(value, float):   # (-8) ^ 0.5 is complex: float() a TypeError
                 raise FormatError(f"FUNCTION: {a:g} {token[1]} {b:g} is not a number",
-                                  span=self.at(token[2], 1)) from None
-            form = {"": float(value)}
+                                  span=self.at(token[2], 1))
+            form = {"": value}
         return form
+
+    def deeper(self, token: tuple[str, str, int]) -> None:
+        """One level more of nesting at ``token``; past :data:`MAX_DEPTH`, refused there (50,000
+        parentheses were a RecursionError, a traceback)."""
+        self.depth += 1
+        if self.depth > MAX_DEPTH:
+            raise FormatError(f"FUNCTION: nested more than {MAX_DEPTH} deep",
+                              span=self.at(token[2], len(token[1])),
+                              hint="drop doubled signs and parentheses, or write the value")
 
     def unary(self) -> Form:
         token = self.peek()
         if token is not None and token[1] in "+-":
             self.take()
+            self.deeper(token)
             form = self.unary()
+            self.depth -= 1
             return form if token[1] == "+" else {k: -v for k, v in form.items()}
         return self.atom()
 
@@ -145,14 +171,18 @@ class _Parser:
         if kind == "num":
             return {"": float(value)}
         if value == "(":
+            self.deeper((kind, value, position))
             form = self.sum()
             closing = self.take()
             if closing[1] != ")":
                 raise FormatError(f"FUNCTION: unexpected `{closing[1]}`",
                                   span=self.at(closing[2], len(closing[1])), expected="`)`")
+            self.depth -= 1
             return form
         if kind == "name" and value.lower() in FUNCTIONS:
+            self.deeper((kind, value, position))
             argument = self.atom()
+            self.depth -= 1
             if not _constant(argument):
                 raise self.nonlinear((kind, value, position), f"`{value}` of an input")
             try:

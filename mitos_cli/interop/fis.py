@@ -227,7 +227,11 @@ def aggregation_method(text: str, path: str | None = None) -> str | None:
 
 
 def _check_unset(unset: dict[str, Span], rules: list[Rule]) -> None:
-    """``AndMethod=''`` (or ``OrMethod``) with a rule that joins its conditions so."""
+    """``AndMethod=''`` (or ``OrMethod``) with a rule that joins its conditions so; in a
+    Mamdani system, ``ImpMethod=''`` with any rule and ``AggMethod=''`` with two rules that
+    set one output (where the method changes the number: one set joined with nothing is
+    itself under any S-norm). Those two were read as MATLAB's defaults, min and max, without
+    a word, where fuzzylite refuses to run an engine without them."""
     for key, connective in (("AndMethod", And), ("OrMethod", Or)):
         used = next((r for r in rules if isinstance(r.antecedent, connective)), None)
         if key in unset and used is not None:
@@ -235,6 +239,23 @@ def _check_unset(unset: dict[str, Span], rules: list[Rule]) -> None:
                               f"{'AND' if connective is And else 'OR'}", span=used.span,
                               hint=f"give {key} a method, e.g. "
                                    f"'{'min' if connective is And else 'max'}'")
+    if "ImpMethod" in unset and rules:
+        rule = rules[0]
+        raise FormatError(f"ImpMethod='' but rule {rule.label} concludes "
+                          f"`{rule.consequents[0].var}`: a Mamdani system cuts each rule's set "
+                          f"with its implication", span=unset["ImpMethod"],
+                          hint="give ImpMethod a method, e.g. 'min' (MATLAB's default)")
+    if "AggMethod" in unset:
+        first: dict[str, Rule] = {}
+        for rule in rules:
+            for c in rule.consequents:
+                if c.var in first and first[c.var] is not rule:
+                    raise FormatError(
+                        f"AggMethod='' but rules {first[c.var].label} and {rule.label} both set "
+                        f"`{c.var}`: a Mamdani system joins their sets with its aggregation",
+                        span=unset["AggMethod"],
+                        hint="give AggMethod a method, e.g. 'max' (MATLAB's default)")
+                first.setdefault(c.var, rule)
 
 
 def _sugeno_aggregation(system: dict, rules: list[Rule], notes: list[str]) -> None:

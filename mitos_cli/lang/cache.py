@@ -25,6 +25,7 @@ result. :func:`status` says where the cache is, or why there is none.
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import hashlib
 import hmac
@@ -92,9 +93,10 @@ def status() -> Status:
         where = Path(os.path.realpath(where))      # used from here on: a link changed after
         st = os.stat(where)                        # this check is not followed
     except OSError as exc:
-        if where.is_symlink() and not where.exists():      # "File exists" said nothing
-            return Status(None, f"no cache: {where} is a symbolic link to "
-                                f"{os.readlink(where)}, which does not exist")
+        with contextlib.suppress(OSError):     # a HOME this user cannot enter (`sudo -u`):
+            if where.is_symlink() and not where.exists():   # "File exists" said nothing
+                return Status(None, f"no cache: {where} is a symbolic link to "
+                                    f"{os.readlink(where)}, which does not exist")
         return Status(None, f"no cache: cannot create {where}: {exc.strerror}")
     if not stat.S_ISDIR(st.st_mode):
         return Status(None, f"no cache: {where} is not a directory", refused=True)

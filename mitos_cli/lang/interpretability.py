@@ -46,6 +46,7 @@ vectorized over points (and over terms, for piecewise-linear ones).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
@@ -113,8 +114,13 @@ def breakpoints(corners: np.ndarray, universe: tuple[float, float]) -> np.ndarra
     with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
         slope = np.concatenate([1.0 / (b[rise] - a[rise]), -1.0 / (d[fall] - c[fall])])
         offset = np.concatenate([-a[rise] / (b[rise] - a[rise]), d[fall] / (d[fall] - c[fall])])
-        i, j = _overlapping(np.concatenate([a[rise], c[fall]]),
-                            np.concatenate([b[rise], d[fall]]))
+        # each edge once: a term repeated gives the same edge again, which crosses its twin
+        # nowhere (17,500 copies of one triangle were 600 million pairs: 24 GB, then killed)
+        edges = np.unique(np.stack([np.concatenate([a[rise], c[fall]]),
+                                    np.concatenate([b[rise], d[fall]]), slope, offset], axis=1),
+                          axis=0)
+        slope, offset = edges[:, 2], edges[:, 3]
+        i, j = _overlapping(edges[:, 0], edges[:, 1])
         cross = (offset[j] - offset[i]) / (slope[i] - slope[j])
     x = np.concatenate([[lo, hi], corners[np.isfinite(corners)], cross])
     return np.unique(x[np.isfinite(x) & (x >= lo) & (x <= hi)])
@@ -745,27 +751,64 @@ def gap_points(var: Variable) -> np.ndarray:
     return np.unique(np.concatenate([np.linspace(lo, hi, GAP_RESOLUTION), corners]))
 
 
-def gaps_on(top: np.ndarray, x: np.ndarray) -> list[tuple[float, float]]:
-    """``(left, right)`` of each run of the points ``x`` where the largest membership ``top``
-    is 0 (``left == right``: the terms only touch 0 there)."""
-    padded = np.concatenate([[False], top <= 0.0, [False]])
+class Gap(NamedTuple):
+    """A stretch of a universe where every term is 0: ``[left, right]``, an end left out
+    (``open_left``, ``open_right``) where the terms step there from 0 to above it, so the gap
+    runs up to the step but not onto it (``[20, 30.01)`` beside a rectangle from 30.01)."""
+
+    left: float
+    right: float
+    open_left: bool = False
+    open_right: bool = False
+
+
+def gaps_on(top: np.ndarray, x: np.ndarray, middle: np.ndarray | None = None) -> list[Gap]:
+    """Each run of the points ``x`` (ascending) where the largest membership ``top`` is 0
+    (``left == right``: the terms only touch 0 there). ``middle``, the largest membership
+    at the centre of each cell between neighbouring points, runs a gap on over a cell that
+    is 0 at its centre: on points that hold the terms' corners a membership is linear on
+    each open cell, so such a cell is 0 all over and the gap ends at the next point, a crisp
+    step, left out (read from the points alone, it stopped one point short, ``[20, 30]`` for
+    ``[20, 30.01)``, and a gap between two steps with no point inside it was not seen)."""
+    if middle is None or len(x) < 2:
+        padded = np.concatenate([[False], top <= 0.0, [False]])
+        edges = np.flatnonzero(padded[1:] != padded[:-1])
+        return [Gap(float(x[a]), float(x[b - 1])) for a, b in zip(edges[::2], edges[1::2])]
+    zero = np.empty(2 * len(x) - 1, dtype=bool)     # point, cell, point, ..., cell, point
+    zero[0::2] = top <= 0.0
+    zero[1::2] = middle <= 0.0
+    padded = np.concatenate([[False], zero, [False]])
     edges = np.flatnonzero(padded[1:] != padded[:-1])
-    return [(float(x[a]), float(x[b - 1])) for a, b in zip(edges[::2], edges[1::2])]
+    gaps = []
+    for a, b in zip(edges[::2], edges[1::2]):       # items a .. b - 1 (a cell is odd)
+        first, last = int(a), int(b) - 1
+        gaps.append(Gap(float(x[first // 2]), float(x[(last + 1) // 2]),
+                        first % 2 == 1, last % 2 == 1))
+    return gaps
 
 
-def term_gaps(var: Variable) -> list[tuple[float, float]]:
+def cell_middles(x: np.ndarray) -> np.ndarray:
+    """The centre of each cell between neighbouring points of ``x``."""
+    return 0.5 * (x[:-1] + x[1:])
+
+
+def term_gaps(var: Variable) -> list[Gap]:
     """The stretches of an input's universe where every term is 0 (``mitos check``'s
     ``term-gap``); none for an output or a variable without terms."""
     if var.role != "input" or not var.terms:
         return []
     x = gap_points(var)
-    return gaps_on(np.array([t.membership(x) for t in var.terms]).max(axis=0), x)
+    mid = cell_middles(x)
+    return gaps_on(np.array([t.membership(x) for t in var.terms]).max(axis=0), x,
+                   np.array([t.membership(mid) for t in var.terms]).max(axis=0))
 
 
-def gap_message(var: Variable, left: float, right: float) -> str:
+def gap_message(var: Variable, gap: Gap) -> str:
     """How a gap is said: ``input `food`: every term is 0 for food in [0, 0.53]``."""
+    left, right, open_left, open_right = gap
     where = f"at {var.name} = {left:.6g}" if left == right else \
-        f"for {var.name} in [{left:.6g}, {right:.6g}]"
+        f"for {var.name} in {'(' if open_left else '['}{left:.6g}, {right:.6g}" \
+        f"{')' if open_right else ']'}"
     return f"input `{var.name}`: every term is 0 {where}"
 
 
@@ -775,7 +818,8 @@ def rulebase_issues(variables) -> list[Issue]:
 
 
 __all__ = ["COVERAGE", "DISTINCT", "GAP_HINT", "GAP_RESOLUTION", "PAIR_BLOCK", "RESOLUTION",
-           "SIMILARITY", "Issue", "centre", "core", "coverage", "coverage_on", "coverage_spans",
+           "SIMILARITY", "Gap", "Issue", "cell_middles", "centre", "core", "coverage",
+           "coverage_on", "coverage_spans",
            "envelope", "gap_message", "gap_points", "gaps_on", "held_term", "least_top",
            "memberships", "mirror_point", "most_similar", "most_similar_on", "rulebase_issues",
            "sample_points", "sampled", "similarity", "similarity_on", "span_coverage",

@@ -149,6 +149,9 @@ def syntax_error(exc: UnexpectedInput, text: str, path: str | None) -> RuleSynta
                                "with `end`)")
     assert isinstance(exc, UnexpectedToken)
     token = exc.token
+    cut = _operators_cut_short(text, path, token.line)
+    if cut is not None:
+        return cut
     stray = _stray_label(exc, text, path)
     if isinstance(stray, RuleSyntaxError):
         return stray
@@ -181,6 +184,40 @@ def syntax_error(exc: UnexpectedInput, text: str, path: str | None) -> RuleSynta
     hint = _statement_hint(text, token.start_pos) or stray or hint
     return RuleSyntaxError(f"unexpected {_describe(token)}", span=span,
                            expected=_expected(expected), hint=hint)
+
+
+#: a line that begins a statement: a keyword, or a label and its colon
+_STATEMENT_START = re.compile(r"[ \t]*(?:(?:behavior|end|use|terms|operators)\b|"
+                              r"[A-Za-z_][\w\-]*[ \t]*:)")
+
+
+def _operators_cut_short(text: str, path: str | None, line: int | None
+                         ) -> RuleSyntaxError | None:
+    """An ``operators:`` line that ends in ``=`` or ``,`` before a line that begins a statement
+    (``operators: accumulation =`` then ``behavior b:``): its value is missing. Newlines do
+    not end a statement, so the next line's first word was read as the value, and the error
+    fell lines later (``unexpected `r1` ... expected `if```, two lines down); it is said at
+    the end of the operators line. A setting wrapped on purpose (``and = min,`` then ``or =
+    max``) goes on with a setting, not a statement, and is not this."""
+    if line is None:
+        return None
+    lines = text.splitlines()
+    for i in range(min(line, len(lines)) - 2, max(line - 5, -1), -1):
+        code = lines[i].split("#", 1)[0].rstrip()
+        if not re.match(r"[ \t]*operators[ \t]*:", code) or not code.endswith(("=", ",")):
+            continue
+        after = next((x for x in lines[i + 1:line] if x.split("#", 1)[0].strip()), "")
+        if not _STATEMENT_START.match(after):
+            return None
+        last = code.rsplit(None, 2)
+        shown = " ".join(last[-2:]) if code.endswith("=") else code.split(":", 1)[1].strip()
+        return RuleSyntaxError(
+            f"the operators line ends after `{shown}`: a "
+            f"{'value' if code.endswith('=') else 'setting'} is missing",
+            span=Span.in_text(text, path, i + 1, len(code), len(code) + 1),
+            expected="`NAME = VALUE` settings, separated by commas "
+                     "(`operators: and = min, or = max`)")
+    return None
 
 
 def _missing_colon(exc: UnexpectedToken, text: str, path: str | None) -> RuleSyntaxError | None:

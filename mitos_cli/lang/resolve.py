@@ -100,11 +100,22 @@ def strays(rules_target: str | Path, companions) -> list[Path]:
     """The files among ``companions`` (written beside ``rules_target``, which the user named)
     that are already there and that the rule file at ``rules_target`` does not read: files
     the user did not name, which writing would replace."""
-    there = [Path(p) for p in companions if Path(p).exists() or Path(p).is_symlink()]
+    there = [Path(p) for p in companions if _present(Path(p))]
     if not there:
         return []
     own = termsets_read(rules_target)
     return [p for p in there if p.resolve() not in own]
+
+
+def _present(path: Path) -> bool:
+    """Whether something is at ``path`` (a link to nothing included); a path in a directory
+    this user cannot enter is not known to be (its write is refused in words: `convert -o`
+    into such a directory was a `PermissionError` traceback here). Any other failure, a name
+    too long to look up, is the caller's to say."""
+    try:
+        return path.exists() or path.is_symlink()
+    except PermissionError:
+        return False
 
 
 def _named_once(target: Path, name: str, span: Span | None, seen: dict[Path, str]) -> None:

@@ -136,8 +136,9 @@ def _within(pixels: np.ndarray, maxval: int, width: int) -> None:
         return
     bad = np.flatnonzero((pixels < 0) | (pixels > maxval))
     if len(bad):
-        row, col = divmod(int(bad[0]), width)
-        raise ValueError(f"the pixel at column {col}, row {row} (from the top left) is "
+        row, col = divmod(int(bad[0]), width)     # said from 1, as every position is
+        raise ValueError(f"the pixel in column {col + 1:,}, row {row + 1:,} (counted from 1 at "
+                         f"the top left) is "
                          f"{int(pixels[bad[0]])}, outside 0..{maxval}, the range its header "
                          f"gives ({plural(len(bad), 'such pixel')})")
 

@@ -329,10 +329,17 @@ class ResultStore:
         Everything is checked before anything is written: a refused study leaves the directory
         as it was.
         """
-        if self.dir.exists() and not self.dir.is_dir():
+        try:                  # a directory this user cannot enter: a traceback here
+            there = self.dir.exists()
+            previous = self.manifest_path.exists() or self.path.exists()
+        except OSError as exc:
+            raise StudyError(f"cannot use the output directory {self.dir}: "
+                             f"{exc.strerror or exc}",
+                             hint="choose a directory you can write to with -o") from None
+        if there and not self.dir.is_dir():
             raise StudyError(f"`{self.dir}` is a file, not a directory for the study's results",
                              hint="choose a directory with -o (a new one is made)")
-        if resume and not (self.manifest_path.exists() or self.path.exists()):
+        if resume and not previous:
             # a mistyped -o began a new study under the name, and "0 from before" was all
             # that said the study meant was not resumed
             raise StudyError(f"`{self.dir}` holds no study to resume (no study.json or "

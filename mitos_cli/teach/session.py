@@ -34,6 +34,7 @@ import numpy as np
 
 from ..engine.compile import CompiledRuleBase, compile_rulebase
 from ..errors import LessonError, MitosError, RuleBaseError, Span, unknown
+from ..fileio import real_path, save_lock
 from ..lang.interpretability import held_term
 from ..lang.model import (
     And,
@@ -166,6 +167,9 @@ class Session:
         self.files_seen = files_digest(self.original)
         self.journal = journal if journal is not None else MemoryJournal()
         self.save_as = Path(save_as) if save_as is not None else None
+        #: the digest of the files each save wrote, by where (resolved): a later save there
+        #: refuses files another program or session wrote since
+        self.saves_seen: dict[Path, tuple[tuple[Path, ...], str]] = {}
         self.out = out or print
         self.progress = progress
         self.echo: Callable[[str], None] = lambda text: None     # lessons echo their lines
@@ -592,12 +596,24 @@ class Session:
                 + (f" ({'; '.join(notes)})" if notes else "")), True
 
     def _telloperators(self, c: cmd.TellOperators, line: str) -> None:
+        from ..engine.check import MAMDANI_ONLY
+
         b = self.rulebase.behavior(self.focus)
-        resolve(c.settings, resolve(b.operators, resolve(self.rulebase.operators)))
+        ops = resolve(c.settings, resolve(b.operators, resolve(self.rulebase.operators)))
         self._check_operators(b, c.settings)
         text = "operators: " + ", ".join(f"{s.key} = {s.value}" for s in c.settings)
         self.change("operators", line, behavior=b.name, text=text)
         self.out(f"{b.name}: {text}")
+        # as `mitos check`'s idle-setting says of the saved file: told at the prompt it was
+        # taken without a word, though it changes no number
+        weighted = ops.inference in ("weighted_average", "weighted_sum")
+        for setting in c.settings:
+            if (setting.key == "accumulation" and not weighted) or \
+                    (setting.key in MAMDANI_ONLY and ops.inference != "mamdani"):
+                self.out(f"note: `{setting.key} = {setting.value}` has no effect: behavior "
+                         f"`{b.name}` uses {ops.inference} inference"
+                         + (" (add `inference = mamdani` to use it)"
+                            if setting.key in MAMDANI_ONLY else ""))
 
     def _check_operators(self, b: Behavior, settings) -> None:
         """Refuse operators the behavior's rules cannot be evaluated with (Tsukamoto
@@ -970,20 +986,26 @@ class Session:
             raise LessonError(f"`{target}` is a directory; save names the rule file to write",
                               hint=f"save {(target / 'taught.rules').as_posix()}")
         over = _same_file(target, self.rules_path)
-        if over:
-            self._check_unchanged()
-        # a Ctrl-C once the files are written waits for what the session knows of them: the
-        # next save over them was refused as if another program had changed them
-        with held_interrupt():
-            saved = save_rulebase(self.original, self.rulebase, target, self.sources)
+        # the check and the write hold the directory: another session's save between them was
+        # undone by this one without a word (two `mitos teach` saving one file at once)
+        with save_lock(target, LessonError):
             if over:
-                self.files_seen = files_digest(self.original)
-            # the path as it names the file from anywhere: `--resume --session DIR` may run
-            # elsewhere, and a bare `save` then wrote a new file there
-            entry = self.journal.append("save", path=os.path.abspath(target), line=line,
-                                        **({"digest": self.files_seen} if over else {}))
-            self.saved_seq = entry["seq"]
-            self.save_as = target                      # a later bare `save` goes here too
+                self._check_unchanged()
+            self._check_own_save(target)
+            # a Ctrl-C once the files are written waits for what the session knows of them:
+            # the next save over them was refused as if another program had changed them
+            with held_interrupt():
+                saved = save_rulebase(self.original, self.rulebase, target, self.sources)
+                if over:
+                    self.files_seen = files_digest(self.original)
+                written = (saved.rules,) + saved.termsets
+                self.saves_seen[real_path(target)] = (written, _saved_digest(written))
+                # the path as it names the file from anywhere: `--resume --session DIR` may
+                # run elsewhere, and a bare `save` then wrote a new file there
+                entry = self.journal.append("save", path=os.path.abspath(target), line=line,
+                                            **({"digest": self.files_seen} if over else {}))
+                self.saved_seq = entry["seq"]
+                self.save_as = target                  # a later bare `save` goes here too
         files = ", ".join(_named(p) for p in (saved.rules,) + saved.termsets)
         if saved.created is not None:
             self.out(f"created the directory {saved.created}")
@@ -1004,6 +1026,19 @@ class Session:
                           hint="save under another name (`save taught.rules`), or quit and "
                                "`mitos teach --resume`, which applies this session's changes to "
                                "the files as they are now")
+
+    def _check_own_save(self, target: Path) -> None:
+        """Refuse a save over files this session saved at ``target`` before when another
+        program or session wrote them since (two sessions saving `taught.rules` in turn):
+        the save would undo that change."""
+        seen = self.saves_seen.get(real_path(target))
+        if seen is None or _saved_digest(seen[0]) == seen[1]:
+            return
+        raise LessonError(f"{target} or its term sets changed since this session saved them "
+                          f"there (another program or session wrote them); saving over them "
+                          f"would undo that change",
+                          hint="save under another name (`save taught2.rules`), or compare "
+                               "the two first")
 
     def interpretability(self) -> str:
         """The interpretability line of `adapt` and `save` (new term gaps marked)."""
@@ -1157,6 +1192,18 @@ def _check_below(written: str, root: Path | None, example: str = "taught.rules")
                           expected=f"a relative path such as {example}",
                           hint="a lesson may come from anyone: name the place yourself, with "
                                "`--save-as PATH` or at the prompt")
+
+
+def _saved_digest(paths) -> str:
+    """A digest of the bytes of ``paths`` as they are now (a file missing counts as empty)."""
+    import hashlib
+
+    h = hashlib.sha256()
+    for path in paths:
+        with contextlib.suppress(OSError):
+            h.update(Path(path).read_bytes())
+        h.update(b"\0")
+    return h.hexdigest()[:16]
 
 
 def _same_file(a: Path, b: Path) -> bool:

@@ -146,10 +146,10 @@ def interpretability_text(rb: RuleBase, written: RuleBase | None = None) -> str:
         before = written.variables.get(var.name) if written is not None else None
         old = meaning.term_gaps(before) if before is not None else []
         slack = (var.universe[1] - var.universe[0]) / (meaning.GAP_RESOLUTION - 1)
-        for left, right in meaning.term_gaps(var):
-            new = before is not None and not any(a - slack <= left and right <= b + slack
-                                                 for a, b in old)
-            lines.append(f"  {meaning.gap_message(var, left, right)}"
+        for gap in meaning.term_gaps(var):
+            new = before is not None and not any(g.left - slack <= gap.left and
+                                                 gap.right <= g.right + slack for g in old)
+            lines.append(f"  {meaning.gap_message(var, gap)}"
                          + (", a gap the terms as written did not have" if new
                             else "") + f" ({meaning.GAP_HINT})")
     if not lines:
