@@ -148,7 +148,7 @@ def test_trapezoid_weights_are_the_trapezoid_rule_by_hand():
         return float(np.sum((f[1:] + f[:-1]) / 2 * np.diff(x)))
 
     want = trapz(x * Y[0]) / trapz(Y[0])
-    got = defuzzify(Y, x, "centroid", trapezoid_weights(11))
+    got = defuzzify(Y, x, "centroid", weights=trapezoid_weights(11))
     assert got[0] == pytest.approx(want, rel=1e-15)
     assert list(trapezoid_weights(4)) == [0.5, 1.0, 1.0, 0.5]
 
