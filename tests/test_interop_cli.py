@@ -505,6 +505,32 @@ def test_a_term_set_given_as_the_rule_base_says_so(tmp_path: Path, capsys, name:
                 f"base: a term set is read through the `terms` line of its .rules file") in err
 
 
+@pytest.mark.parametrize("command", [["eval"], ["check"], ["teach", "--lesson", "-"]])
+def test_a_batch_csv_given_as_the_rule_base_points_to_batch(tmp_path: Path, capsys,
+                                                             command: list[str]) -> None:
+    """`mitos eval inputs.csv` (the `--batch` left out) said "unexpected `,` ... expected `:`"
+    with the hint that `road` is read as a rule's label."""
+    (tmp_path / "inputs.csv").write_bytes((ROOT / "tests" / "data" / "inputs.csv").read_bytes())
+    path = (tmp_path / "inputs.csv").as_posix()
+    code, err = _run(capsys, command[0], path, *command[1:])
+    assert code == 1
+    assert "inputs.csv:1:5: syntax error: unexpected `,`" in err
+    assert (f"hint: `inputs.csv` is a CSV file, not a rule base: to evaluate each of its rows, "
+            f"give it to --batch (`mitos eval [RULEBASE] --batch {path}`)") in err
+    assert "read as a rule's label" not in err and "Traceback" not in err
+
+
+def test_a_lesson_given_as_the_rule_base_points_to_lesson(capsys, monkeypatch) -> None:
+    """`mitos teach rulebases/lessons/wider-turn.lesson` (the `--lesson` left out) said
+    "`simulate` is read as a rule's label", at the lesson's first command past `use drive`."""
+    monkeypatch.chdir(ROOT)
+    code, err = _run(capsys, "teach", "rulebases/lessons/wider-turn.lesson")
+    assert code == 1
+    assert "rulebases/lessons/wider-turn.lesson:17:10: syntax error: unexpected `worlds`" in err
+    assert ("hint: `wider-turn.lesson` is a lesson, not a rule base: a lesson is run with "
+            "--lesson (`mitos teach [RULES] --lesson rulebases/lessons/wider-turn.lesson`)") in err
+
+
 def test_a_rule_file_with_a_mistake_gets_no_format_hint(tmp_path: Path, capsys) -> None:
     rules = (ROOT / "rulebases" / "mitos.rules").read_text().replace("then steering", "thn steering", 1)
     (tmp_path / "m.rules").write_text(rules)

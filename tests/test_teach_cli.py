@@ -468,3 +468,28 @@ def test_teach_help_names_the_term_sets_save_as_writes(work):
     res = mitos("teach", "-h", cwd=work)
     text = " ".join(res.stdout.replace("│", " ").split())
     assert "OUT.mitos.terms.yaml and OUT.drive.terms.yaml" in text
+
+
+def test_a_lesson_misspelling_a_world_is_offered_a_world_that_is_there(work):
+    """A lesson in `lessons/` that says `simulate worlds/figur4.yaml` was offered
+    `lessons/worlds/figure4.yaml`, a file that is not there: the packaged world's name was put
+    in the lesson's directory. The guess is now a file beside the lesson, else one from the
+    working directory, else the packaged world as the lesson may write it."""
+    (work / "lessons").mkdir()
+    (work / "lessons" / "a.lesson").write_text("simulate worlds/figur4.yaml\n")
+    res = mitos("teach", "rb/mitos.rules", "--lesson", "lessons/a.lesson", cwd=work)
+    assert res.returncode == 1
+    assert "lessons/a.lesson:1:10: world error: world file `worlds/figur4.yaml` not found" \
+        in res.stderr
+    assert "hint: did you mean `worlds/figure4.yaml`?" in res.stderr
+    (work / "lessons" / "b.lesson").write_text("simulate worlds/figure4.yaml\n")
+    assert mitos("teach", "rb/mitos.rules", "--lesson", "lessons/b.lesson",
+                 cwd=work).returncode == 0                      # the guess, written, runs
+    (work / "lessons" / "mine.yaml").write_text("x: 1\n")   # beside the lesson
+    (work / "lessons" / "c.lesson").write_text("simulate mne.yaml\n")
+    res = mitos("teach", "rb/mitos.rules", "--lesson", "lessons/c.lesson", cwd=work)
+    assert res.returncode == 1 and "hint: did you mean `lessons/mine.yaml`?" in res.stderr
+    (work / "here.yaml").write_text("x: 1\n")              # beside the working directory
+    (work / "lessons" / "d.lesson").write_text("simulate hre.yaml\n")
+    res = mitos("teach", "rb/mitos.rules", "--lesson", "lessons/d.lesson", cwd=work)
+    assert res.returncode == 1 and "hint: did you mean `here.yaml`?" in res.stderr
