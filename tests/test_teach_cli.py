@@ -493,3 +493,25 @@ def test_a_lesson_misspelling_a_world_is_offered_a_world_that_is_there(work):
     (work / "lessons" / "d.lesson").write_text("simulate hre.yaml\n")
     res = mitos("teach", "rb/mitos.rules", "--lesson", "lessons/d.lesson", cwd=work)
     assert res.returncode == 1 and "hint: did you mean `here.yaml`?" in res.stderr
+
+
+@pytest.mark.parametrize("lesson, says", [
+    ("rb/mitos.rules", "hint: `mitos.rules` is a rule base, not a lesson: give it before the "
+                       "options (`mitos teach rb/mitos.rules [--lesson LESSON]`)"),
+    ("w.yaml", "hint: `w.yaml` is a YAML file (a world, or a term set), not a lesson: a lesson "
+               "drives a world with `simulate w.yaml`"),
+    ("in.csv", "hint: `in.csv` is a CSV file, not a lesson: `mitos eval --batch in.csv` "
+               "evaluates its rows"),
+    ("t.fis", "hint: `t.fis` is a rule base, not a lesson: `mitos teach` reads the rule "
+              "language, so convert it (`mitos convert t.fis --to rules`)"),
+])
+def test_a_file_of_another_kind_given_as_the_lesson_says_what_it_is(work, lesson, says):
+    """`mitos teach --lesson rulebases/mitos.rules` stopped at `terms` with "type `help`"; a
+    world stopped at `name: figure4` with "expected `if`" and nothing more."""
+    (work / "w.yaml").write_text("# a world\nname: w\nseed: 1\n")
+    (work / "in.csv").write_text("road,size,position\n78,45,4\n")
+    (work / "t.fis").write_text("[System]\nName='t'\n")
+    res = mitos("teach", "rb/mitos.rules", "--lesson", lesson, cwd=work)
+    assert res.returncode == 1 and "syntax error" in res.stderr, res.stderr
+    assert says in res.stderr, res.stderr
+    assert "Traceback" not in res.stderr
