@@ -100,6 +100,25 @@ def test_a_short_option_means_one_thing_in_every_command():
     assert meaning["-r"] == {"--rulebase"} and meaning["-b"] == {"--behavior"}
 
 
+def test_every_option_that_takes_a_value_names_it_in_words():
+    """The help showed Click's type names for 27 options (`--behavior <str>`, `--seed <int
+    range> [x>=0]`, `--fps <float range>`): each now names what it takes (NAME, N, SEED, DOF,
+    ...), as the options with a metavar did (`--out FILE.csv`)."""
+    bare = []
+    for name, cmd in commands().items():
+        for param in cmd.params:
+            if param.param_type_name != "option" or param.is_flag or param.hidden:
+                continue
+            if param.metavar is None:
+                bare.append(f"{name} {param.opts[0]}")
+    assert bare == []
+    help_text = subprocess.run([sys.executable, "-m", "mitos_cli", "simulate", "--help"],
+                               capture_output=True, text=True,
+                               env={**os.environ, "COLUMNS": "200"}).stdout
+    assert "--seed               SEED [x>=0]" in help_text
+    assert "<int range>" not in help_text and "<float range>" not in help_text
+
+
 def test_the_old_spelling_of_compare_runs_still_works(tmp_path, capsys):
     cmd = commands()["compare"]
     ctx = cmd.make_context("mitos compare", ["corridor", "-n", "3", "-o", str(tmp_path)])

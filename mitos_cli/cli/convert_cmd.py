@@ -40,7 +40,8 @@ def convert_command(
              "existing files). -o OUT.rules also writes OUT.terms.yaml, never over a file "
              "there that OUT.rules does not read.")] = None,
     behavior: Annotated[Optional[str], typer.Option(
-        "--behavior", "-b", callback=named, help="Behavior to convert (default: the file's first).")] = None,
+        "--behavior", "-b", metavar="NAME", callback=named,
+        help="Behavior to convert (default: the file's first).")] = None,
     dialect_name: Annotated[Optional[str], typer.Option(
         "--dialect", metavar=choices(Dialect), autocompletion=completer(Dialect),
         help="With --to fcl, the readers to write for: fuzzylite (fuzzylite 6, the default) "

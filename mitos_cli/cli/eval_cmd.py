@@ -149,7 +149,7 @@ def eval_command(
         help="Rule file (.rules, .fcl, .fis, .fll; default: the packaged MITOS rule base), "
              "then one NAME=VALUE per input.")] = None,
     behavior: Annotated[Optional[str], typer.Option(
-        "--behavior", "-b", callback=named,
+        "--behavior", "-b", metavar="NAME", callback=named,
         help="Evaluate this behavior (default: the file's first).")] = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
     batch: Annotated[Optional[str], typer.Option(
@@ -157,7 +157,7 @@ def eval_command(
         help="Evaluate every row of a CSV whose header names the inputs; write a CSV of the "
              "inputs, the outputs and the CSV's other columns as they were.")] = None,
     digits: Annotated[Optional[int], typer.Option(
-        "--digits", min=0, max=12,
+        "--digits", metavar="N", min=0, max=12,
         help="Decimals in the trace (default 1, as the paper prints) and, with --batch, in the "
              "outputs (default: every digit, the shortest text that reads back as the same "
              "number).")] = None,

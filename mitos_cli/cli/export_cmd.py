@@ -32,10 +32,12 @@ def export_command(
         help="File to write: a .c file for --to c, a .py file for --to python (default: "
              "stdout).")] = None,
     behavior: Annotated[Optional[str], typer.Option(
-        "--behavior", "-b", callback=named, help="Behavior to export (default: the file's first).")] = None,
+        "--behavior", "-b", metavar="NAME", callback=named,
+        help="Behavior to export (default: the file's first).")] = None,
     prefix: Annotated[Optional[str], typer.Option(
-        "--prefix", help="C names: PREFIX_eval, PREFIX_IN_<INPUT>, PREFIX_OUT_<OUTPUT> "
-                         "(default: mitos); --to c only.")] = None,
+        "--prefix", metavar="PREFIX",
+        help="C names: PREFIX_eval, PREFIX_IN_<INPUT>, PREFIX_OUT_<OUTPUT> "
+             "(default: mitos); --to c only.")] = None,
 ) -> None:
     """Export a rule base as code that computes its outputs from its inputs.
 

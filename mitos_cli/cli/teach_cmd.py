@@ -45,7 +45,8 @@ def teach_command(
         metavar="[RULES]", callback=named,
         help="Rule file to teach (default: the packaged MITOS rule base).")] = None,
     behavior: Annotated[str | None, typer.Option(
-        "--behavior", "-b", callback=named, help="The behavior to teach first (default: the file's first).")]
+        "--behavior", "-b", metavar="NAME", callback=named,
+        help="The behavior to teach first (default: the file's first).")]
         = None,
     lesson: Annotated[str | None, typer.Option(
         "--lesson", "-l", metavar="FILE|-", callback=named,
