@@ -91,8 +91,29 @@ def parse_values(values: dict[str, str]) -> dict[str, float]:
                              expected="numbers of magnitude at most 1.8e308") from None
         except ValueError:
             raise InputError(f"input `{name}` must be a number, not `{text}`",
-                             expected="a decimal number such as 78, -4.5 or 1e3") from None
+                             expected="a decimal number such as 78, -4.5 or 1e3",
+                             hint=_glued(name, text)) from None
     return out
+
+
+def _glued(name: str, text: str) -> str | None:
+    """"give each input as a word of its own" for inputs run together with commas or
+    semicolons (`road=78,size=45,position=4`), which read as one input whose value is
+    `78,size=45,position=4`; the same for a separator left after a number (`road=78,`)."""
+    import re
+
+    from ..numbers import parse_value
+
+    if "=" not in text:                         # `road=78,` of `road=78, size=45`
+        bare = text.rstrip(",; ")
+        try:
+            parse_value(bare)
+        except (ValueError, OverflowError):
+            return None
+        return (f"inputs are apart with spaces only: write `{name}={bare}`, without "
+                f"`{text[len(bare):].strip()}`") if bare != text else None
+    words = [w for w in re.split(r"[,;\s]+", f"{name}={text}") if w]
+    return "give each input as a word of its own, apart with spaces: `" + " ".join(words) + "`"
 
 
 def warn_clamped(result) -> None:
