@@ -328,14 +328,15 @@ def run_batch(rb, source: str, on_no_rule: NoRule | None = None,
                              span=bad_byte("<stdin>", exc)) from None
         name = "<stdin>"
     else:
-        from ..fileio import bad_byte, nearby, read_text, unreadable
+        from ..fileio import bad_byte, nearby, read_text, repository_only, unreadable
 
         try:
             text, name = read_text(source), source
         except (OSError, UnicodeDecodeError) as exc:
             missing = isinstance(exc, FileNotFoundError)      # a mistyped name: did you mean
             raise InputError(unreadable("batch file", source, exc), span=bad_byte(source, exc),
-                             hint=nearby(source, (".csv",)) if missing else None) from None
+                             hint=nearby(source, (".csv",)) or repository_only(source)
+                             if missing else None) from None
     batch = read_table(text, name, rb.compiled.inputs, unused_inputs(rb))
     X = batch.X
     result = rb.run(X, strict=False, detail=False)
