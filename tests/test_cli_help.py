@@ -119,6 +119,14 @@ def test_every_option_that_takes_a_value_names_it_in_words():
     assert "<int range>" not in help_text and "<float range>" not in help_text
 
 
+def test_a_rule_base_argument_is_called_the_same_in_every_command():
+    """`teach` called its rule file `[RULES]` where eval, check and plot say `[RULEBASE]`."""
+    for name, cmd in commands().items():
+        args = [p.metavar for p in cmd.params if p.param_type_name == "argument"]
+        if name in ("eval", "check", "teach") or name.startswith("plot"):
+            assert args[0].startswith("[RULEBASE]"), (name, args)
+
+
 def test_the_old_spelling_of_compare_runs_still_works(tmp_path, capsys):
     cmd = commands()["compare"]
     ctx = cmd.make_context("mitos compare", ["corridor", "-n", "3", "-o", str(tmp_path)])

@@ -528,7 +528,7 @@ def test_a_lesson_given_as_the_rule_base_points_to_lesson(capsys, monkeypatch) -
     assert code == 1
     assert "rulebases/lessons/wider-turn.lesson:17:10: syntax error: unexpected `worlds`" in err
     assert ("hint: `wider-turn.lesson` is a lesson, not a rule base: a lesson is run with "
-            "--lesson (`mitos teach [RULES] --lesson rulebases/lessons/wider-turn.lesson`)") in err
+            "--lesson (`mitos teach [RULEBASE] --lesson rulebases/lessons/wider-turn.lesson`)") in err
 
 
 def test_a_rule_file_with_a_mistake_gets_no_format_hint(tmp_path: Path, capsys) -> None:

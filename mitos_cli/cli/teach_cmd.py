@@ -42,7 +42,7 @@ class Transcript:
 
 def teach_command(
     rules: Annotated[str | None, typer.Argument(
-        metavar="[RULES]", callback=named,
+        metavar="[RULEBASE]", callback=named,
         help="Rule file to teach (default: the packaged MITOS rule base).")] = None,
     behavior: Annotated[str | None, typer.Option(
         "--behavior", "-b", metavar="NAME", callback=named,

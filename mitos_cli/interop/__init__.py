@@ -121,7 +121,7 @@ def _not_a_rulebase(path: Path, command: str | None) -> str | None:
                 f"give it to --batch (`mitos eval [RULEBASE] --batch {path.as_posix()}`)")
     if suffix == ".lesson":
         return (f"`{path.name}` is a lesson, not a rule base: a lesson is run with --lesson "
-                f"(`mitos teach [RULES] --lesson {path.as_posix()}`)")
+                f"(`mitos teach [RULEBASE] --lesson {path.as_posix()}`)")
     return None
 
 
