@@ -176,3 +176,17 @@ def test_the_completion_script_is_shown_for_bash(capsys, monkeypatch):
         main(["--show-completion", "bash"])
     assert info.value.code == 0
     assert "complete -o default -F _mitos_completion mitos" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("words", [[], ["simulate"], ["plot", "terms"]])
+def test_mitos_help_is_the_help_of_the_command_named(words):
+    """`mitos help` (as `git help`, `pip help`) said "No such command 'help'", exit 2: it
+    prints what `--help` prints, of `mitos` or of the command named."""
+    def run(*args):
+        return subprocess.run([sys.executable, "-m", "mitos_cli", *args], capture_output=True,
+                              text=True, env={**os.environ, "COLUMNS": "100"})
+    helped, asked = run("help", *words), run(*words, "--help")
+    assert helped.returncode == asked.returncode == 0
+    assert helped.stdout == asked.stdout and "Usage: mitos" in helped.stdout
+    wrong = run("help", "simulat")
+    assert wrong.returncode == 2 and "Did you mean 'simulate'?" in wrong.stderr
