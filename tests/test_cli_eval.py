@@ -787,8 +787,19 @@ def test_inputs_run_together_are_shown_apart(args, capsys):
     code, _, err = run_main(["eval", "road=78,", "size=45,", "position=4"], capsys)
     assert code == 1
     assert "hint: inputs are apart with spaces only: write `road=78`, without `,`" in err
+    code, _, err = run_main(["eval", "road=78,5", "size=45", "position=4"], capsys)
+    assert code == 1 and "hint: the decimal separator is `.`: `road=78.5`" in err
     code, _, err = run_main(["eval", "road=7x", "size=45", "position=4"], capsys)
     assert code == 1 and "hint" not in err               # a mistyped number: no such hint
+
+
+def test_a_decimal_comma_in_a_batch_says_the_separator_is_a_point(tmp_path, capsys):
+    """A spreadsheet's `"78,5"` said only "`78,5` is not a number"."""
+    (tmp_path / "b.csv").write_text('road,size,position\n"78,5",45,4\n', encoding="utf-8")
+    code, out, err = run_main(["eval", "--batch", str(tmp_path / "b.csv")], capsys)
+    assert code == 1 and out == ""
+    assert "b.csv:2:1: input error: `78,5` is not a number (input `road`, row 1)" in err
+    assert "hint: the decimal separator is `.`: `78.5`" in err
 
 
 @pytest.mark.parametrize("value", ["1e400", "-1e999"])

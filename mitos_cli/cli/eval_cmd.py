@@ -104,6 +104,8 @@ def _glued(name: str, text: str) -> str | None:
 
     from ..numbers import parse_value
 
+    if re.fullmatch(r"[-+]?\d+,\d+", text):      # `road=78,5`: a decimal comma
+        return f"the decimal separator is `.`: `{name}={text.replace(',', '.')}`"
     if "=" not in text:                         # `road=78,` of `road=78, size=45`
         bare = text.rstrip(",; ")
         try:

@@ -290,8 +290,16 @@ def _bad_row(rows: list[list[str]], done: int, header: list[str], order: list[in
                 parse_number(cell)
             except ValueError:
                 return InputError(f"`{cell.strip()}` is not a number (input `{header[c]}`, "
-                                  f"row {row + 1})", span=_cell_span(text, path, row, c))
+                                  f"row {row + 1})", span=_cell_span(text, path, row, c),
+                                  hint=_decimal_comma(cell.strip()))
     return None
+
+
+def _decimal_comma(cell: str) -> str | None:
+    """`78,5` (a spreadsheet's decimal comma, the cell quoted): the decimal point is `.`."""
+    if re.fullmatch(r"[-+]?\d+,\d+", cell) is None:
+        return None
+    return f"the decimal separator is `.`: `{cell.replace(',', '.')}`"
 
 
 # ---- positions, found again only for an error --------------------------------------------------
