@@ -789,6 +789,9 @@ def test_inputs_run_together_are_shown_apart(args, capsys):
     assert "hint: inputs are apart with spaces only: write `road=78`, without `,`" in err
     code, _, err = run_main(["eval", "road=78,5", "size=45", "position=4"], capsys)
     assert code == 1 and "hint: the decimal separator is `.`: `road=78.5`" in err
+    code, _, err = run_main(["eval", "road=1,000", "size=45", "position=4"], capsys)
+    assert code == 1 and "hint: a number has `.` for its decimals and no thousands " \
+                         "separator: `road=1.000` or `road=1000`" in err
     code, _, err = run_main(["eval", "road=7x", "size=45", "position=4"], capsys)
     assert code == 1 and "hint" not in err               # a mistyped number: no such hint
 

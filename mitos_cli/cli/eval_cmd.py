@@ -102,10 +102,12 @@ def _glued(name: str, text: str) -> str | None:
     `78,size=45,position=4`; the same for a separator left after a number (`road=78,`)."""
     import re
 
+    from ..engine.csvio import comma_in_number
     from ..numbers import parse_value
 
-    if re.fullmatch(r"[-+]?\d+,\d+", text):      # `road=78,5`: a decimal comma
-        return f"the decimal separator is `.`: `{name}={text.replace(',', '.')}`"
+    comma = comma_in_number(text, f"{name}=")      # `road=78,5`: a decimal comma
+    if comma is not None:
+        return comma
     if "=" not in text:                         # `road=78,` of `road=78, size=45`
         bare = text.rstrip(",; ")
         try:
