@@ -515,3 +515,17 @@ def test_a_file_of_another_kind_given_as_the_lesson_says_what_it_is(work, lesson
     assert res.returncode == 1 and "syntax error" in res.stderr, res.stderr
     assert says in res.stderr, res.stderr
     assert "Traceback" not in res.stderr
+
+
+def test_a_packaged_lesson_is_shown_by_its_name_in_the_repository(work):
+    """`mitos teach --lesson wider-turn` echoed each command as
+    `/.../site-packages/.../wider-turn.lesson:16> use drive` (the path pip put it at); it is
+    shown as `rulebases/lessons/wider-turn.lesson`, as the packaged rule base is shown as
+    `rulebases/mitos.rules (packaged)`. A lesson of one's own keeps the name it was given."""
+    (work / "w.lesson").write_text("use drve\n")
+    res = mitos("teach", "--lesson", "w.lesson", cwd=work)
+    assert res.returncode == 1 and res.stdout.startswith("w.lesson:1> use drve")
+    assert "w.lesson:1:1: name error: unknown behavior `drve`" in res.stderr
+    res = mitos("teach", "--lesson", "wider-turn", cwd=work)
+    assert res.returncode == 0, res.stderr
+    assert res.stdout.startswith("rulebases/lessons/wider-turn.lesson:16> use drive\n")
