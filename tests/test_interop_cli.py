@@ -212,6 +212,42 @@ def test_output_extension_must_match_the_format(args, expected, tmp_path, monkey
     assert good.exit_code == 0, good.output          # any case
 
 
+@pytest.mark.parametrize("command, out, format_", [
+    ("convert", "out.fll", "fll"), ("convert", "out.fcl", "fcl"), ("convert", "out.fis", "fis"),
+    ("convert", "out.rules", "rules"), ("export", "out.c", "c"), ("export", "out.py", "python"),
+])
+def test_without_to_the_format_is_the_one_o_names(command, out, format_, tmp_path,
+                                                  monkeypatch) -> None:
+    """`mitos convert tipper.fis -o tipper.fll` said "Missing option '--to'": the file's
+    extension names the format, and what is written is what `--to` writes."""
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "tipper.fis").write_text((DATA / "tipper.fis").read_text())
+    result = runner.invoke(app, [command, "tipper.fis", "-o", out])
+    assert result.exit_code == 0, result.output
+    written = (tmp_path / out).read_bytes()
+    for path in tmp_path.iterdir():
+        if path.name != "tipper.fis":
+            path.unlink()                               # out.rules: and its out.terms.yaml
+    result = runner.invoke(app, [command, "tipper.fis", "--to", format_, "-o", out])
+    assert result.exit_code == 0 and (tmp_path / out).read_bytes() == written
+
+
+@pytest.mark.parametrize("command, args, said", [
+    ("convert", [], "say which format to write: --to rules, fcl, fis, fll; or give -o a file "
+                    "with the format's extension"),
+    ("convert", ["-o", "out.txt"], "say which format to write: --to rules, fcl, fis, fll; "
+                                   "`out.txt` has no extension that names one"),
+    ("export", [], "say which export language to write: --to c, python"),
+])
+def test_without_to_or_an_extension_the_format_is_asked_for(command, args, said, tmp_path,
+                                                           monkeypatch) -> None:
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "tipper.fis").write_text((DATA / "tipper.fis").read_text())
+    result = runner.invoke(app, [command, "tipper.fis", *args])
+    assert result.exit_code == 2 and said in flat(result.output), result.output
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["tipper.fis"]
+
+
 def test_convert_to_rules_without_o_never_overwrites(tmp_path: Path, monkeypatch) -> None:
     monkeypatch.chdir(tmp_path)
     assert runner.invoke(app, ["convert", str(DATA / "tipper.fis"), "--to", "rules"]) \
