@@ -470,11 +470,25 @@ def _not_a_termset(doc: Any, span: Span) -> None:
                               "`mitos plot terms` and `mitos check` take one alone")
 
 
+def _not_a_map(doc: Any, span: Span) -> None:
+    """Refuse a map_server map YAML named as a world (`mitos simulate worlds/maps/m.yaml`),
+    saying so: "unknown key `image` in the world file" said nothing of what the file was."""
+    if isinstance(doc, YMap) and "image" in doc and "resolution" in doc \
+            and not any(k in doc for k in TOP_KEYS):
+        name = Path(span.path or "map.yaml").name
+        raise WorldError(f"`{span.path}` is a map (map_server's YAML: `image`, `resolution`), "
+                         f"not a world file", span=span,
+                         expected="a world: `name`, `q_init`, `q_goal`, `map` and more",
+                         hint=f"a world drives on it by naming it, `map: {{grid: {name}}}` "
+                              f"(worlds/README.md; `worlds/office.yaml` is one)")
+
+
 def parse_world(text: str, path: str) -> World:
     """Parse world YAML ``text`` (read from ``path``, which anchors relative map paths)."""
     r = _Reader(path)
     doc = yamlpos.load(text, path, WorldError)
     _not_a_termset(doc, Span.in_text(text, path, 1, 1))
+    _not_a_map(doc, Span.in_text(text, path, 1, 1))
     top = r.mapping(doc, Span.in_text(text, path, 1, 1), "the world file", TOP_KEYS)
     name = _name(top)
     seed = _seed(r, top)
