@@ -100,6 +100,8 @@ def compare_command(
         from ..study.executors import require_dask
 
         require_dask(scheduler)
+    _no_stray_choice(worlds, {"--planner": planner, "--and": and_, "--or": or_,
+                              "--inference": inference})
     planners = _planners(planner, and_, or_, inference, rulebase, behavior)
     with option_names():                        # --planner, --and, --or, --inference: exit 2
         choices = make_choices(planners, split_list(and_), split_list(or_),
@@ -125,6 +127,30 @@ def compare_command(
         _print_tables(outcome)
     err(f"{plural(outcome.executed, 'run')} now, {outcome.skipped} from before; "
         f"wrote {report.parent / 'results.csv'} and {report}")
+
+
+def _no_stray_choice(worlds: list[str], given: dict[str, str | None]) -> None:
+    """`--planner fuzzy potential_field` (a space for the comma) read `potential_field` as a
+    world: "world file `potential_field` not found". A world argument that is no file and is
+    the name of a planner, norm or inference method is a usage error that says so."""
+    from ..fuzzy.norms import names
+    from ..lang.operators import INFERENCES
+    from ..study.spec import PLANNERS
+
+    kinds = (("--planner", "a planner", PLANNERS), ("--and", "a T-norm", names("tnorm")),
+             ("--or", "an S-norm", names("snorm")),
+             ("--inference", "an inference method", INFERENCES))
+    for world in worlds:
+        if Path(world).exists():
+            continue
+        for flag, what, known in kinds:
+            if world.lower() in known:
+                before = given[flag]
+                listed = (before if before and world.lower() in before.split(",") else
+                          f"{before},{world}" if before else world)
+                raise typer.BadParameter(
+                    f"`{world}` is {what}, read here as a world: {flag} takes its names "
+                    f"comma-separated, without spaces (`{flag} {listed}`)")
 
 
 def _planners(planner: str, and_: str, or_, inference, rulebase, behavior) -> list[str]:
