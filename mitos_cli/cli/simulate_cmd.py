@@ -238,7 +238,7 @@ def simulate_command(
 ) -> None:
     """Simulate the rule base driving a tricycle robot through corridor worlds."""
     from ..resources import DEFAULT_WORLD
-    from ..sim.planner import make_planner, planner_kind
+    from ..sim.planner import PLANNERS, make_planner, planner_kind
 
     require = _checked_require(require)
     planner_name = planner_name.lower()        # any case, as every option's fixed list
@@ -252,6 +252,11 @@ def simulate_command(
         raise typer.BadParameter(f"--rulebase and --behavior choose the fuzzy planner's rules; "
                                  f"`{planner_name}` has none", param_hint="--planner")
     live = live or speed is not None
+    for world in worlds or []:        # `--planner dwa potential_field`: one planner drives
+        if world.lower() in PLANNERS and not Path(world).exists():
+            raise typer.BadParameter(f"`{world}` is a planner, read here as a world: simulate "
+                                     f"drives with one (--planner NAME); `mitos compare "
+                                     f"--planner {planner_name},{world}` compares them")
     loaded = _load_worlds(worlds or [DEFAULT_WORLD])
     from ..sim.obstacles import copies_note
 
