@@ -430,7 +430,9 @@ def test_no_term_set(tmp_path):
      "unknown key `unti` in variable `road`"),
     ("    unit: in\n    role: input\n    universe: [0, 160]",
      "    unit: in\n    universe: [0, 160]", "description: width of the road", "missing `role` in variable `road`"),
-    ("universe: [0, 160]", "universe: [0, 160", "terms:", "invalid YAML: expected ',' or ']'"),
+    # said at the `[` not closed, not at the next line's `terms:` (where PyYAML noticed)
+    ("universe: [0, 160]", "universe: [0, 160", "universe: [0, 160",
+     "invalid YAML: this `[` is not closed before line"),
     ("universe: [0, 160]", "universe: [160, 0]", "[160, 0]", "universe [160, 0] is empty"),
     # a subnormal width: every term a vertical edge, 1 on both sides of it
     ("universe: [0, 160]", "universe: [0, 1e-320]", "[0, 1e-320]",
