@@ -38,6 +38,24 @@ def nearby(path: str | Path, suffixes: tuple[str, ...] = RULE_SUFFIXES,
     return f"did you mean `{Path(path).parent / name}`?" if name is not None else None
 
 
+#: folders of the repository that `pip install` does not copy, which the README's and the
+#: help's examples name (`tests/data/inputs.csv`, `tests/data/interop/tipper.fis`)
+REPOSITORY_ONLY = ("tests", "benchmarks")
+
+
+def repository_only(path: str | Path) -> str | None:
+    """What to do about an example's file that is not there because the command runs outside
+    the repository: `mitos eval tests/data/interop/tipper.fis ...` from another directory said
+    "not found" and no more, though the file is the repository's (the packaged rule bases and
+    worlds are found from anywhere; these are not packaged)."""
+    parts = Path(path).parts
+    if Path(path).is_absolute() or len(parts) < 2 or parts[0] not in REPOSITORY_ONLY \
+            or Path(parts[0]).exists():
+        return None
+    return (f"`{parts[0]}/` is a folder of the MITOS repository, which `pip install` does not "
+            f"copy: run the example from the repository's root, or name a file of your own")
+
+
 def nearby_name(path: str | Path, suffixes: tuple[str, ...] = RULE_SUFFIXES,
                 also: Iterable[str] = ()) -> str | None:
     """The name :func:`nearby` suggests, without its directory: never the name given, nor a

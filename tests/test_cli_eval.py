@@ -774,6 +774,37 @@ def test_a_single_value_is_read_as_a_batch_cell_is(value, capsys):
     assert code == 0
 
 
+@pytest.mark.parametrize("args", [["road=78,size=45,position=4"],
+                                  ["road=78;size=45;position=4"],
+                                  ["road=78, size=45, position=4"]])
+def test_inputs_run_together_are_shown_apart(args, capsys):
+    """`mitos eval road=78,size=45,position=4` said only that `road` must be a number, not
+    `78,size=45,position=4`: the hint now writes the inputs as the command takes them."""
+    code, out, err = run_main(["eval", *args], capsys)
+    assert code == 1 and out == ""
+    assert "hint: give each input as a word of its own, apart with spaces: " \
+           "`road=78 size=45 position=4`" in err
+    code, _, err = run_main(["eval", "road=78,", "size=45,", "position=4"], capsys)
+    assert code == 1
+    assert "hint: inputs are apart with spaces only: write `road=78`, without `,`" in err
+    code, _, err = run_main(["eval", "road=78,5", "size=45", "position=4"], capsys)
+    assert code == 1 and "hint: the decimal separator is `.`: `road=78.5`" in err
+    code, _, err = run_main(["eval", "road=1,000", "size=45", "position=4"], capsys)
+    assert code == 1 and "hint: a number has `.` for its decimals and no thousands " \
+                         "separator: `road=1.000` or `road=1000`" in err
+    code, _, err = run_main(["eval", "road=7x", "size=45", "position=4"], capsys)
+    assert code == 1 and "hint" not in err               # a mistyped number: no such hint
+
+
+def test_a_decimal_comma_in_a_batch_says_the_separator_is_a_point(tmp_path, capsys):
+    """A spreadsheet's `"78,5"` said only "`78,5` is not a number"."""
+    (tmp_path / "b.csv").write_text('road,size,position\n"78,5",45,4\n', encoding="utf-8")
+    code, out, err = run_main(["eval", "--batch", str(tmp_path / "b.csv")], capsys)
+    assert code == 1 and out == ""
+    assert "b.csv:2:1: input error: `78,5` is not a number (input `road`, row 1)" in err
+    assert "hint: the decimal separator is `.`: `78.5`" in err
+
+
 @pytest.mark.parametrize("value", ["1e400", "-1e999"])
 def test_a_single_value_past_a_floats_range_is_refused(value, capsys):
     """`road=1e400` was read as inf and only warned of as clamped; `road=inf` is still

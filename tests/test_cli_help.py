@@ -100,6 +100,33 @@ def test_a_short_option_means_one_thing_in_every_command():
     assert meaning["-r"] == {"--rulebase"} and meaning["-b"] == {"--behavior"}
 
 
+def test_every_option_that_takes_a_value_names_it_in_words():
+    """The help showed Click's type names for 27 options (`--behavior <str>`, `--seed <int
+    range> [x>=0]`, `--fps <float range>`): each now names what it takes (NAME, N, SEED, DOF,
+    ...), as the options with a metavar did (`--out FILE.csv`)."""
+    bare = []
+    for name, cmd in commands().items():
+        for param in cmd.params:
+            if param.param_type_name != "option" or param.is_flag or param.hidden:
+                continue
+            if param.metavar is None:
+                bare.append(f"{name} {param.opts[0]}")
+    assert bare == []
+    help_text = subprocess.run([sys.executable, "-m", "mitos_cli", "simulate", "--help"],
+                               capture_output=True, text=True,
+                               env={**os.environ, "COLUMNS": "200"}).stdout
+    assert "--seed               SEED [x>=0]" in help_text
+    assert "<int range>" not in help_text and "<float range>" not in help_text
+
+
+def test_a_rule_base_argument_is_called_the_same_in_every_command():
+    """`teach` called its rule file `[RULES]` where eval, check and plot say `[RULEBASE]`."""
+    for name, cmd in commands().items():
+        args = [p.metavar for p in cmd.params if p.param_type_name == "argument"]
+        if name in ("eval", "check", "teach") or name.startswith("plot"):
+            assert args[0].startswith("[RULEBASE]"), (name, args)
+
+
 def test_the_old_spelling_of_compare_runs_still_works(tmp_path, capsys):
     cmd = commands()["compare"]
     ctx = cmd.make_context("mitos compare", ["corridor", "-n", "3", "-o", str(tmp_path)])
@@ -149,3 +176,17 @@ def test_the_completion_script_is_shown_for_bash(capsys, monkeypatch):
         main(["--show-completion", "bash"])
     assert info.value.code == 0
     assert "complete -o default -F _mitos_completion mitos" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("words", [[], ["simulate"], ["plot", "terms"]])
+def test_mitos_help_is_the_help_of_the_command_named(words):
+    """`mitos help` (as `git help`, `pip help`) said "No such command 'help'", exit 2: it
+    prints what `--help` prints, of `mitos` or of the command named."""
+    def run(*args):
+        return subprocess.run([sys.executable, "-m", "mitos_cli", *args], capture_output=True,
+                              text=True, env={**os.environ, "COLUMNS": "100"})
+    helped, asked = run("help", *words), run(*words, "--help")
+    assert helped.returncode == asked.returncode == 0
+    assert helped.stdout == asked.stdout and "Usage: mitos" in helped.stdout
+    wrong = run("help", "simulat")
+    assert wrong.returncode == 2 and "Did you mean 'simulate'?" in wrong.stderr

@@ -108,3 +108,68 @@ def test_the_counts_of_the_drive_behavior_the_benchmark_pages_give_are_its_own()
     assert said and (int(said[1]), int(said[2])) == (len(p.values), p.n_free)
     said = re.search(r"behavior ``drive``, (\d+) rules", script)
     assert said and int(said[1]) == len(compiled.rules)
+
+
+def _mitos_commands() -> dict:
+    """Every command by its name after ``mitos`` (``plot terms`` for a subcommand)."""
+    import typer.main
+
+    from mitos_cli.cli.app import build_app
+
+    group = typer.main.get_group(build_app())
+    out = {}
+    for name, cmd in group.commands.items():
+        subs = getattr(cmd, "commands", None)
+        out.update({f"{name} {s}": c for s, c in subs.items()} if subs else {name: cmd})
+    return out
+
+
+def _shell_blocks(text: str) -> list[str]:
+    """The fenced blocks of a Markdown page that hold commands (no language, or a shell's),
+    fence by fence: a regular expression from one ``` to the next paired a block's closing
+    fence with the next one's opening, and read the prose between as a block."""
+    blocks, lines, language = [], None, None
+    for line in text.splitlines():
+        if line.lstrip().startswith("```"):
+            if lines is None:
+                lines, language = [], line.strip()[3:].strip()
+            else:
+                if language in ("", "sh", "bash", "console", "shell"):
+                    blocks.append("\n".join(lines))
+                lines = None
+        elif lines is not None:
+            lines.append(line)
+    return blocks
+
+
+def test_every_mitos_command_the_pages_show_parses_with_its_commands_options():
+    """The README's and docs' shell blocks were run by no test (only the help's examples
+    were): each `mitos ...` line of them (comments, pipes and redirections cut, `...` lines
+    left out) parses with its command's own options and arguments, so an option renamed or
+    dropped leaves no page showing it, and each file it names under the repository is there."""
+    import re
+    import shlex
+
+    commands = _mitos_commands()
+    pages = [ROOT / "README.md", ROOT / "worlds" / "README.md",
+             *sorted(p for p in (ROOT / "docs").glob("*.md") if p.name != "changelog.md")]
+    checked, wrong = 0, []
+    for page in pages:
+        for block in _shell_blocks(page.read_text(encoding="utf-8")):
+            for line in block.replace("\\\n", " ").splitlines():
+                line = line.strip().removeprefix("$ ")
+                if not line.startswith("mitos ") or "..." in line:
+                    continue
+                code = re.split(r"\s#\s|\s[|>]\s|\s2?>|\s<\s", line)[0]
+                words = shlex.split(code)[1:]
+                name = " ".join(words[:2]) if " ".join(words[:2]) in commands else words[0]
+                args = words[len(name.split()):]
+                try:
+                    commands[name].make_context(f"mitos {name}", list(args))
+                except Exception as exc:  # noqa: BLE001 - any refusal is the page's mistake
+                    wrong.append(f"{page.name}: {line}: {exc}")
+                wrong += [f"{page.name}: {line}: {word} is not there" for word in args
+                          if word.startswith(("tests/", "rulebases/", "worlds/"))
+                          and "*" not in word and not (ROOT / word).exists()]
+                checked += 1
+    assert checked > 40 and wrong == [], wrong

@@ -126,6 +126,17 @@ def caret_under(exc: MitosError) -> str:
      "`1e-400` is too small for a float: it would read as 0", "at least 5e-324", None),
     ("r1: if road is WIDE then speed is -2.5e-400", 35, "-2.5e-400",
      "`-2.5e-400` is too small for a float", "at least 5e-324", None),
+    # joined with a comma, or with nothing, and two words after `is`: said how they are written
+    ('r1: if road is WIDE, size is SMALL_SZ then speed is SLOW', 20, ',', 'unexpected `,`', None,
+     'conditions are joined with `and` or `or`, not `,`'),
+    ('r1: if road is WIDE then steering is RS, speed is SLOW', 40, ',', 'unexpected `,`', None,
+     'actions are joined with `and`, not `,`'),
+    ('r1: if road is WIDE then steering is RS speed is SLOW', 47, 'is', 'unexpected `is`', '`:`',
+     'actions are joined with `and`: `... and speed is ...`'),
+    ('r1: if road is FAR WIDE then speed is SLOW', 20, 'WIDE', 'unexpected `WIDE`', '`then`',
+     "`FAR WIDE`: a term's name is one word (`FAR_WIDE`), and `FAR` is not a hedge"),
+    ('r1: if road is sorta WIDE then speed is SLOW', 22, 'WIDE', 'unexpected `WIDE`', '`then`',
+     '`sorta` is not a hedge (very, extremely, somewhat'),
 ])
 def test_syntax_errors(tmp_path, line, col, at, message, expected, hint):
     path = write(tmp_path, line)
@@ -446,7 +457,9 @@ def test_no_term_set(tmp_path):
      "unknown key `unti` in variable `road`"),
     ("    unit: in\n    role: input\n    universe: [0, 160]",
      "    unit: in\n    universe: [0, 160]", "description: width of the road", "missing `role` in variable `road`"),
-    ("universe: [0, 160]", "universe: [0, 160", "terms:", "invalid YAML: expected ',' or ']'"),
+    # said at the `[` not closed, not at the next line's `terms:` (where PyYAML noticed)
+    ("universe: [0, 160]", "universe: [0, 160", "universe: [0, 160",
+     "invalid YAML: this `[` is not closed before line"),
     ("universe: [0, 160]", "universe: [160, 0]", "[160, 0]", "universe [160, 0] is empty"),
     # a subnormal width: every term a vertical edge, 1 on both sides of it
     ("universe: [0, 160]", "universe: [0, 1e-320]", "[0, 1e-320]",

@@ -212,6 +212,42 @@ def test_output_extension_must_match_the_format(args, expected, tmp_path, monkey
     assert good.exit_code == 0, good.output          # any case
 
 
+@pytest.mark.parametrize("command, out, format_", [
+    ("convert", "out.fll", "fll"), ("convert", "out.fcl", "fcl"), ("convert", "out.fis", "fis"),
+    ("convert", "out.rules", "rules"), ("export", "out.c", "c"), ("export", "out.py", "python"),
+])
+def test_without_to_the_format_is_the_one_o_names(command, out, format_, tmp_path,
+                                                  monkeypatch) -> None:
+    """`mitos convert tipper.fis -o tipper.fll` said "Missing option '--to'": the file's
+    extension names the format, and what is written is what `--to` writes."""
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "tipper.fis").write_text((DATA / "tipper.fis").read_text())
+    result = runner.invoke(app, [command, "tipper.fis", "-o", out])
+    assert result.exit_code == 0, result.output
+    written = (tmp_path / out).read_bytes()
+    for path in tmp_path.iterdir():
+        if path.name != "tipper.fis":
+            path.unlink()                               # out.rules: and its out.terms.yaml
+    result = runner.invoke(app, [command, "tipper.fis", "--to", format_, "-o", out])
+    assert result.exit_code == 0 and (tmp_path / out).read_bytes() == written
+
+
+@pytest.mark.parametrize("command, args, said", [
+    ("convert", [], "say which format to write: --to rules, fcl, fis, fll; or give -o a file "
+                    "with the format's extension"),
+    ("convert", ["-o", "out.txt"], "say which format to write: --to rules, fcl, fis, fll; "
+                                   "`out.txt` has no extension that names one"),
+    ("export", [], "say which export language to write: --to c, python"),
+])
+def test_without_to_or_an_extension_the_format_is_asked_for(command, args, said, tmp_path,
+                                                           monkeypatch) -> None:
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "tipper.fis").write_text((DATA / "tipper.fis").read_text())
+    result = runner.invoke(app, [command, "tipper.fis", *args])
+    assert result.exit_code == 2 and said in flat(result.output), result.output
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["tipper.fis"]
+
+
 def test_convert_to_rules_without_o_never_overwrites(tmp_path: Path, monkeypatch) -> None:
     monkeypatch.chdir(tmp_path)
     assert runner.invoke(app, ["convert", str(DATA / "tipper.fis"), "--to", "rules"]) \
@@ -503,6 +539,32 @@ def test_a_term_set_given_as_the_rule_base_says_so(tmp_path: Path, capsys, name:
         assert code == 1
         assert (f"hint: `{name}` looks like a YAML term set (`variables:` on line 3), not a rule "
                 f"base: a term set is read through the `terms` line of its .rules file") in err
+
+
+@pytest.mark.parametrize("command", [["eval"], ["check"], ["teach", "--lesson", "-"]])
+def test_a_batch_csv_given_as_the_rule_base_points_to_batch(tmp_path: Path, capsys,
+                                                             command: list[str]) -> None:
+    """`mitos eval inputs.csv` (the `--batch` left out) said "unexpected `,` ... expected `:`"
+    with the hint that `road` is read as a rule's label."""
+    (tmp_path / "inputs.csv").write_bytes((ROOT / "tests" / "data" / "inputs.csv").read_bytes())
+    path = (tmp_path / "inputs.csv").as_posix()
+    code, err = _run(capsys, command[0], path, *command[1:])
+    assert code == 1
+    assert "inputs.csv:1:5: syntax error: unexpected `,`" in err
+    assert (f"hint: `inputs.csv` is a CSV file, not a rule base: to evaluate each of its rows, "
+            f"give it to --batch (`mitos eval [RULEBASE] --batch {path}`)") in err
+    assert "read as a rule's label" not in err and "Traceback" not in err
+
+
+def test_a_lesson_given_as_the_rule_base_points_to_lesson(capsys, monkeypatch) -> None:
+    """`mitos teach rulebases/lessons/wider-turn.lesson` (the `--lesson` left out) said
+    "`simulate` is read as a rule's label", at the lesson's first command past `use drive`."""
+    monkeypatch.chdir(ROOT)
+    code, err = _run(capsys, "teach", "rulebases/lessons/wider-turn.lesson")
+    assert code == 1
+    assert "rulebases/lessons/wider-turn.lesson:17:10: syntax error: unexpected `worlds`" in err
+    assert ("hint: `wider-turn.lesson` is a lesson, not a rule base: a lesson is run with "
+            "--lesson (`mitos teach [RULEBASE] --lesson rulebases/lessons/wider-turn.lesson`)") in err
 
 
 def test_a_rule_file_with_a_mistake_gets_no_format_hint(tmp_path: Path, capsys) -> None:

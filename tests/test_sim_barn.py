@@ -138,6 +138,24 @@ def test_a_bad_option_value_is_a_usage_error(tmp_path, capsys, args, says):
     assert not out.exists()
 
 
+@pytest.mark.parametrize("args, says", [
+    (["--sed", "7"], "error: unknown option --sed; did you mean `--seed`?"),
+    (["--sed=7"], "error: unknown option --sed; did you mean `--seed`?"),
+    (["--see", "7"], "error: unknown option --see; did you mean `--seed`?"),   # no abbreviation
+    (["--xyz"], "error: unknown option --xyz\n"),
+])
+def test_a_misspelt_option_is_named_with_a_did_you_mean(tmp_path, capsys, args, says):
+    """`--sed 7` said "unrecognized arguments: --sed 7" (or, without --out, only that --out
+    is required); `--see 7` was taken for `--seed` by argparse's abbreviations, which
+    `mitos` (Click) does not take."""
+    for tail in (["--out", str(tmp_path / "w.yaml")], []):
+        with pytest.raises(SystemExit) as exc:
+            barn.main(args + tail)
+        assert exc.value.code == 2
+        assert says in capsys.readouterr().err
+    assert not (tmp_path / "w.yaml").exists()
+
+
 def test_the_out_file_must_be_yaml(tmp_path, capsys):
     with pytest.raises(SystemExit) as exc:
         barn.main(["--out", str(tmp_path / "w.txt")])

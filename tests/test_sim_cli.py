@@ -658,3 +658,13 @@ def test_runs_default_to_no_more_processes_than_the_cpus_allowed(monkeypatch) ->
     assert default_workers() == 1
     monkeypatch.setattr(os, "sched_getaffinity", lambda pid: {0, 1, 2})
     assert default_workers() == 2
+
+
+def test_a_second_planner_given_apart_is_said_to_be_a_planner(capsys):
+    """`mitos simulate slalom --planner dwa potential_field` read `potential_field` as a world
+    ("world file `potential_field` not found", exit 1): simulate drives with one planner."""
+    code, err = run_main(capsys, "slalom", "--planner", "dwa", "potential_field")
+    flat = " ".join(err.replace("│", " ").split())
+    assert code == 2
+    assert ("`potential_field` is a planner, read here as a world: simulate drives with one "
+            "(--planner NAME); `mitos compare --planner dwa,potential_field` compares them") in flat

@@ -586,3 +586,24 @@ def test_a_yaw_beyond_a_worlds_numbers_is_refused_at_itself(tmp_path: Path, yaw)
                            "within ±1e+07 (radians)")
     (tmp_path / "m.yaml").write_text("image: m.pgm\nresolution: 0.05\norigin: [0, 0, 1e6]\n")
     assert load_map_yaml(tmp_path / "m.yaml").occupied.any()
+
+
+def test_a_packaged_world_copied_elsewhere_is_told_where_its_map_is(tmp_path: Path):
+    """`cp worlds/office.yaml mine.yaml; mitos simulate mine.yaml` said "map file
+    `maps/mrpb_office02.yaml` not found" and no more: the map lies beside the packaged worlds.
+    The hint names its full path, which the copy then loads from."""
+    from mitos_cli.resources import packaged_path
+
+    office = packaged_path("worlds", "office.yaml").read_text(encoding="utf-8")
+    (tmp_path / "mine.yaml").write_text(office, encoding="utf-8")
+    with pytest.raises(WorldError) as info:
+        load_world(tmp_path / "mine.yaml")
+    full = packaged_path("worlds", "maps/mrpb_office02.yaml").as_posix()
+    assert info.value.message.endswith("/maps/mrpb_office02.yaml` not found")
+    assert info.value.hint == (
+        "a map path is relative to the world file, and `maps/mrpb_office02.yaml` lies beside "
+        f"the packaged worlds: write its full path, `{full}`, or copy that `maps/` folder "
+        "beside this world file")
+    (tmp_path / "mine.yaml").write_text(office.replace("grid: maps/mrpb_office02.yaml",
+                                                       f"grid: {full}"), encoding="utf-8")
+    assert load_world(tmp_path / "mine.yaml").name == "office"

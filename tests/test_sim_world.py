@@ -1203,6 +1203,20 @@ def test_an_obstacle_built_in_python_that_moves_past_its_size_is_refused():
         Simulation(replace(world, obstacles=(fast,)), seed=1)
 
 
+def test_a_map_named_as_a_world_is_said_to_be_one():
+    """`mitos simulate worlds/maps/mrpb_office02.yaml` said "unknown key `image` in the world
+    file" and listed the world's keys."""
+    text = (Path(__file__).parents[1] / "worlds" / "maps" / "mrpb_office02.yaml").read_text()
+    with pytest.raises(WorldError) as info:
+        parse_world(text, "maps/m.yaml")
+    assert info.value.message == ("`maps/m.yaml` is a map (map_server's YAML: `image`, "
+                                  "`resolution`), not a world file")
+    assert (info.value.span.line, info.value.span.column) == (1, 1)
+    assert info.value.hint.startswith("a world drives on it by naming it, `map: {grid: m.yaml}`")
+    with pytest.raises(WorldError, match="unknown key `image`"):   # a world with the key
+        parse_world(BASE + "image: m.pgm\nresolution: 0.05\n", "w.yaml")
+
+
 def test_a_term_set_named_as_a_world_is_said_to_be_one():
     """"unknown key `variables` in the world file" said nothing of what the file was."""
     text = (Path(__file__).parents[1] / "rulebases" / "mitos.terms.yaml").read_text()

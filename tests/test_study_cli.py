@@ -486,3 +486,24 @@ def test_compare_help_names_every_inference_method():
     command = typer.main.get_group(build_app("compare")).commands["compare"]
     option = next(p for p in command.params if p.name == "inference")
     assert all(name in option.help for name in INFERENCES), option.help
+
+
+@pytest.mark.parametrize("args, said", [
+    (["--planner", "fuzzy", "potential_field"],
+     "`potential_field` is a planner, read here as a world: --planner takes its names "
+     "comma-separated, without spaces (`--planner fuzzy,potential_field`)"),
+    (["--and", "min", "product"],
+     "`product` is a T-norm, read here as a world: --and takes its names comma-separated, "
+     "without spaces (`--and min,product`)"),
+    (["--or", "max", "probabilistic_sum"], "`probabilistic_sum` is an S-norm"),
+    (["--inference", "weighted_average", "Mamdani"], "`Mamdani` is an inference method"),
+    (["lukasiewicz"], "(`--and min,product,lukasiewicz,einstein`)"),     # --and left as it was
+])
+def test_a_choice_given_apart_from_its_option_is_said_to_be_one(tiny, tmp_path, compare, args,
+                                                                said):
+    """`--planner fuzzy potential_field` (a space for the comma) read `potential_field` as a
+    world: "world file `potential_field` not found", exit 1. Nothing is run or written."""
+    ran = compare(tiny, *args, "--runs", "1", "-o", tmp_path / "s")
+    assert ran.exit_code == 2, ran.output
+    assert said in " ".join(ran.stderr.replace("│", " ").split()), ran.stderr
+    assert not (tmp_path / "s").exists()

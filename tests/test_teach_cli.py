@@ -486,3 +486,64 @@ def test_teach_help_names_the_term_sets_save_as_writes(work):
     res = mitos("teach", "-h", cwd=work)
     text = " ".join(res.stdout.replace("│", " ").split())
     assert "OUT.mitos.terms.yaml and OUT.drive.terms.yaml" in text
+
+
+def test_a_lesson_misspelling_a_world_is_offered_a_world_that_is_there(work):
+    """A lesson in `lessons/` that says `simulate worlds/figur4.yaml` was offered
+    `lessons/worlds/figure4.yaml`, a file that is not there: the packaged world's name was put
+    in the lesson's directory. The guess is now a file beside the lesson, else one from the
+    working directory, else the packaged world as the lesson may write it."""
+    (work / "lessons").mkdir()
+    (work / "lessons" / "a.lesson").write_text("simulate worlds/figur4.yaml\n")
+    res = mitos("teach", "rb/mitos.rules", "--lesson", "lessons/a.lesson", cwd=work)
+    assert res.returncode == 1
+    assert "lessons/a.lesson:1:10: world error: world file `worlds/figur4.yaml` not found" \
+        in res.stderr
+    assert "hint: did you mean `worlds/figure4.yaml`?" in res.stderr
+    (work / "lessons" / "b.lesson").write_text("simulate worlds/figure4.yaml\n")
+    assert mitos("teach", "rb/mitos.rules", "--lesson", "lessons/b.lesson",
+                 cwd=work).returncode == 0                      # the guess, written, runs
+    (work / "lessons" / "mine.yaml").write_text("x: 1\n")   # beside the lesson
+    (work / "lessons" / "c.lesson").write_text("simulate mne.yaml\n")
+    res = mitos("teach", "rb/mitos.rules", "--lesson", "lessons/c.lesson", cwd=work)
+    assert res.returncode == 1 and "hint: did you mean `lessons/mine.yaml`?" in res.stderr
+    (work / "here.yaml").write_text("x: 1\n")              # beside the working directory
+    (work / "lessons" / "d.lesson").write_text("simulate hre.yaml\n")
+    res = mitos("teach", "rb/mitos.rules", "--lesson", "lessons/d.lesson", cwd=work)
+    assert res.returncode == 1 and "hint: did you mean `here.yaml`?" in res.stderr
+
+
+@pytest.mark.parametrize("lesson, says", [
+    ("rb/mitos.rules", "hint: `mitos.rules` is a rule base, not a lesson: give it before the "
+                       "options (`mitos teach rb/mitos.rules [--lesson LESSON]`)"),
+    ("w.yaml", "hint: `w.yaml` is a YAML file (a world, or a term set), not a lesson: a lesson "
+               "drives a world with `simulate w.yaml`"),
+    ("in.csv", "hint: `in.csv` is a CSV file, not a lesson: `mitos eval --batch in.csv` "
+               "evaluates its rows"),
+    ("t.fis", "hint: `t.fis` is a rule base, not a lesson: `mitos teach` reads the rule "
+              "language, so convert it (`mitos convert t.fis --to rules`)"),
+])
+def test_a_file_of_another_kind_given_as_the_lesson_says_what_it_is(work, lesson, says):
+    """`mitos teach --lesson rulebases/mitos.rules` stopped at `terms` with "type `help`"; a
+    world stopped at `name: figure4` with "expected `if`" and nothing more."""
+    (work / "w.yaml").write_text("# a world\nname: w\nseed: 1\n")
+    (work / "in.csv").write_text("road,size,position\n78,45,4\n")
+    (work / "t.fis").write_text("[System]\nName='t'\n")
+    res = mitos("teach", "rb/mitos.rules", "--lesson", lesson, cwd=work)
+    assert res.returncode == 1 and "syntax error" in res.stderr, res.stderr
+    assert says in res.stderr, res.stderr
+    assert "Traceback" not in res.stderr
+
+
+def test_a_packaged_lesson_is_shown_by_its_name_in_the_repository(work):
+    """`mitos teach --lesson wider-turn` echoed each command as
+    `/.../site-packages/.../wider-turn.lesson:16> use drive` (the path pip put it at); it is
+    shown as `rulebases/lessons/wider-turn.lesson`, as the packaged rule base is shown as
+    `rulebases/mitos.rules (packaged)`. A lesson of one's own keeps the name it was given."""
+    (work / "w.lesson").write_text("use drve\n")
+    res = mitos("teach", "--lesson", "w.lesson", cwd=work)
+    assert res.returncode == 1 and res.stdout.startswith("w.lesson:1> use drve")
+    assert "w.lesson:1:1: name error: unknown behavior `drve`" in res.stderr
+    res = mitos("teach", "--lesson", "wider-turn", cwd=work)
+    assert res.returncode == 0, res.stderr
+    assert res.stdout.startswith("rulebases/lessons/wider-turn.lesson:16> use drive\n")

@@ -144,8 +144,23 @@ def test_unlabelled_rules_are_saved_in_their_places(tmp_path):
 
 def test_save_mistakes(rules, tmp_path):
     s = Session(rules, out=[].append)
-    with pytest.raises(LessonError, match="say where to save"):
+    with pytest.raises(LessonError, match="say where to save") as info:
         s.run("save")
+    assert info.value.hint == f"the original {rules} is kept unless you name it (`save {rules}`)"
+
+
+def test_save_without_a_path_does_not_offer_to_write_over_the_packaged_rule_base():
+    """`mitos teach` (the packaged rule base), then `save`, was told the original is kept
+    unless named, with the packaged file's own path to name: where pip installed it."""
+    from mitos_cli.api import default_rulebase_path
+
+    s = Session(default_rulebase_path(), out=[].append)
+    with pytest.raises(LessonError, match="say where to save") as info:
+        s.run("save")
+    assert info.value.hint == ("the session teaches the packaged rulebases/mitos.rules (the one "
+                               "every command reads when none is named): save a copy of your "
+                               "own")
+    assert str(default_rulebase_path()) not in info.value.render()
 
 
 def test_save_makes_one_missing_directory_and_refuses_a_missing_path(rules, tmp_path):

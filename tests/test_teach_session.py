@@ -964,3 +964,24 @@ def test_a_told_operator_the_inference_ignores_is_noted(rules, told, note):
     text = say(s, out, told)
     assert text.startswith("drive: " + told)
     assert (note in text) if note else "note:" not in text
+
+
+@pytest.mark.parametrize("line, hint", [
+    ("if road is WIDE, size is SMALL_SZ then steering is LS",
+     "conditions are joined with `and` or `or`, not `,`: `if a is X and b is Y`"),
+    ("if road is WIDE then steering is LS, speed is SLOW",
+     "actions are joined with `and`, not `,`: `then steering is LS and speed is SLOW`"),
+    ("if road is WIDE then steering is LS speed is SLOW",
+     "actions are joined with `and`: `... and speed is ...`"),
+    ("correct road=78 size=45 position=4 -> steering is LS, speed is SLOW",
+     "targets in words are joined with `and`, not `,`: `steering is LS and speed is SLOW`"),
+])
+def test_conditions_actions_and_targets_joined_with_a_comma_say_how_they_are_joined(rules, line,
+                                                                                      hint):
+    """A told rule with a comma between its conditions or actions, or two actions with no
+    `and`, got no hint (the rule file's parser said "unexpected `,`" alone too); a target in
+    words with a comma got the hint for values, "separated by spaces"."""
+    s, _ = session(rules)
+    with pytest.raises(RuleSyntaxError) as info:
+        s.run(line)
+    assert info.value.hint == hint

@@ -48,7 +48,16 @@ def test_booleans_are_read_as_yaml_1_2_reads_them():
     ("a: b: c\n", (1, 5), "a `:` where no new key can start", "one `key: value` a line"),
     ("x:\n  - 1\n y: 2\n", (3, 2), "indentation matches no key above it", "the indentation of a key"),
     ('a: 1\nx: "abc\n', (2, 4), "a quoted value is not closed", "its closing quote"),
-    ("x: [1, 2\n", (2, 1), "expected ',' or ']', but got the end of the file", None),
+    # a `[` or `{` not closed is said at the bracket: PyYAML said "expected ',' or ']', but
+    # got '<scalar>'" at the next line's first word (or at the end of the file, line 2)
+    ("x: [1, 2\n", (1, 4), "this `[` is not closed before the end of the file",
+     "`]` after its last item"),
+    ("p: [[0, 0], [600, 0]\nw: 70\n", (1, 4), "this `[` is not closed before line 2",
+     "`]` after its last item (its items apart with `,`)"),
+    ("s: {a: 1, b: 2\nw: 70\n", (1, 4), "this `{` is not closed before line 2",
+     "`}` after its last item"),
+    # on the bracket's own line PyYAML's words stand
+    ("s: {a: 1, b: 2 c: 3}\n", (1, 17), "expected ',' or '}', but got ':'", None),
 ])
 def test_the_commonest_yaml_mistakes_are_said_in_words_with_what_was_expected(
         text, where, words, expected):

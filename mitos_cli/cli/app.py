@@ -105,6 +105,8 @@ def _main(argv: list[str] | None) -> None:
     closed_streams()
     sane_widths()
     args = sys.argv[1:] if argv is None else list(argv)
+    if args[:1] == ["help"]:        # `mitos help`, `mitos help plot terms`: as git's and pip's
+        args = [*args[1:], "--help"]    # (it said "No such command 'help'", exit 2)
     first = args[0] if args else None
     app = build_app(first if first in COMMANDS else None)
     try:

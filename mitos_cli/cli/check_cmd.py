@@ -118,14 +118,14 @@ def check_command(
         help="Rule file (default: the packaged MITOS rule base), or a term set "
              "(FILE.terms.yaml) checked alone.")] = None,
     behavior: Annotated[Optional[str], typer.Option(
-        "--behavior", "-b", callback=named,
+        "--behavior", "-b", metavar="NAME", callback=named,
         help="Check only this behavior, and the term sets' variables it reads or sets "
              "(default: every behavior and variable).")] = None,
     threshold: Annotated[float, typer.Option(
-        "--threshold", "-t", min=0.0, callback=finite,
+        "--threshold", "-t", metavar="DOF", min=0.0, callback=finite,
         help="Report regions where the total DOF of an output's rules is below this.")] = 0.1,
     resolution: Annotated[int, typer.Option(
-        "--resolution", "-n", min=2, max=10_000,
+        "--resolution", "-n", metavar="N", min=2, max=10_000,
         help="Grid points per input (plus the terms' corners; lowered to keep the grid at "
              "most 300,000 samples).")] = 41,
     as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,

@@ -37,13 +37,14 @@ def compare_command(
         "--planner", metavar="PLANNERS", autocompletion=complete.planner_list,
         help="Planners to compare: fuzzy, potential_field, dwa.")] = "fuzzy,potential_field",
     runs: Annotated[int, typer.Option(
-        "--runs", min=1, max=MAX_RUNS,
+        "--runs", metavar="N", min=1, max=MAX_RUNS,
         help="Randomised runs per world and choice (a comparison needs many; `simulate` "
              "runs a world once as written unless given --runs).")] = 20,
     runs_n: Annotated[Optional[int], typer.Option(
         "-n", min=1, max=MAX_RUNS, hidden=True, help="The old spelling of --runs.")] = None,
     seed: Annotated[int, typer.Option(
-        "--seed", min=0, help="Seed of the whole study (runs are paired across choices).")] = 1,
+        "--seed", metavar="SEED", min=0,
+        help="Seed of the whole study (runs are paired across choices).")] = 1,
     out: Annotated[str, typer.Option(
         "--out", "-o", metavar="DIR", callback=named,
         help="Directory for results.csv, report.md and the plots.")] = "study",
@@ -51,7 +52,7 @@ def compare_command(
         "--executor", metavar="local|dask", autocompletion=complete.executors,
         help="local: a process pool on this machine; dask: dask.distributed.")] = "local",
     workers: Annotated[Optional[int], typer.Option(
-        "--workers", "-j", min=1,
+        "--workers", "-j", metavar="N", min=1,
         help="Processes (local) or LocalCluster workers (dask). Default: the cores.")] = None,
     scheduler: Annotated[Optional[str], typer.Option(
         "--scheduler", metavar="ADDR",
@@ -63,7 +64,8 @@ def compare_command(
         "--rulebase", "-r", metavar="PATH", callback=named,
         help="Rule base of the fuzzy planner (default: the packaged one).")] = None,
     behavior: Annotated[Optional[str], typer.Option(
-        "--behavior", "-b", callback=named, help="Behavior to drive with (default: the world's).")] = None,
+        "--behavior", "-b", metavar="NAME", callback=named,
+        help="Behavior to drive with (default: the world's).")] = None,
     plots: Annotated[bool, typer.Option(
         "--plots/--no-plots", help="Draw the plots of report.md (needs matplotlib).")] = True,
     as_json: Annotated[bool, typer.Option(
@@ -98,6 +100,8 @@ def compare_command(
         from ..study.executors import require_dask
 
         require_dask(scheduler)
+    _no_stray_choice(worlds, {"--planner": planner, "--and": and_, "--or": or_,
+                              "--inference": inference})
     planners = _planners(planner, and_, or_, inference, rulebase, behavior)
     with option_names():                        # --planner, --and, --or, --inference: exit 2
         choices = make_choices(planners, split_list(and_), split_list(or_),
@@ -123,6 +127,30 @@ def compare_command(
         _print_tables(outcome)
     err(f"{plural(outcome.executed, 'run')} now, {outcome.skipped} from before; "
         f"wrote {report.parent / 'results.csv'} and {report}")
+
+
+def _no_stray_choice(worlds: list[str], given: dict[str, str | None]) -> None:
+    """`--planner fuzzy potential_field` (a space for the comma) read `potential_field` as a
+    world: "world file `potential_field` not found". A world argument that is no file and is
+    the name of a planner, norm or inference method is a usage error that says so."""
+    from ..fuzzy.norms import names
+    from ..lang.operators import INFERENCES
+    from ..study.spec import PLANNERS
+
+    kinds = (("--planner", "a planner", PLANNERS), ("--and", "a T-norm", names("tnorm")),
+             ("--or", "an S-norm", names("snorm")),
+             ("--inference", "an inference method", INFERENCES))
+    for world in worlds:
+        if Path(world).exists():
+            continue
+        for flag, what, known in kinds:
+            if world.lower() in known:
+                before = given[flag]
+                listed = (before if before and world.lower() in before.split(",") else
+                          f"{before},{world}" if before else world)
+                raise typer.BadParameter(
+                    f"`{world}` is {what}, read here as a world: {flag} takes its names "
+                    f"comma-separated, without spaces (`{flag} {listed}`)")
 
 
 def _planners(planner: str, and_: str, or_, inference, rulebase, behavior) -> list[str]:

@@ -9,7 +9,7 @@ from typing import Annotated, Optional
 import typer
 
 from .output import emit, err, warn, warn_notes
-from .params import choice, choices, completer, file_arg, named
+from .params import choice, choices, completer, file_arg, named, target_of
 from .targets import check_suffix, refuse_existing, refuse_inputs, refuse_strays, source_files
 
 
@@ -30,9 +30,10 @@ class Dialect(str, Enum):
 def convert_command(
     path: Annotated[Path, typer.Argument(
         parser=file_arg, metavar="FILE", help="Rule base to convert (.rules, .fcl, .fis or .fll).")],
-    to_name: Annotated[str, typer.Option(
+    to_name: Annotated[Optional[str], typer.Option(
         "--to", metavar=choices(Target), autocompletion=completer(Target),
-        help="Format to write: rules (NAME.rules + NAME.terms.yaml), fcl, fis or fll.")],
+        help="Format to write: rules (NAME.rules + NAME.terms.yaml), fcl, fis or fll "
+             "(default: the one -o's extension names).")] = None,
     output: Annotated[Optional[Path], typer.Option(
         "--output", "-o", parser=file_arg, metavar="OUT",
         help="File to write, ending in the format's extension (default: stdout; for --to "
@@ -40,7 +41,8 @@ def convert_command(
              "existing files). -o OUT.rules also writes OUT.terms.yaml, never over a file "
              "there that OUT.rules does not read.")] = None,
     behavior: Annotated[Optional[str], typer.Option(
-        "--behavior", "-b", callback=named, help="Behavior to convert (default: the file's first).")] = None,
+        "--behavior", "-b", metavar="NAME", callback=named,
+        help="Behavior to convert (default: the file's first).")] = None,
     dialect_name: Annotated[Optional[str], typer.Option(
         "--dialect", metavar=choices(Dialect), autocompletion=completer(Dialect),
         help="With --to fcl, the readers to write for: fuzzylite (fuzzylite 6, the default) "
@@ -56,7 +58,7 @@ def convert_command(
     from ..interop import conversion_notes, parse_foreign, round_trip_difference, write_foreign
     from ..interop.common import atomic_write
 
-    to = choice(Target, to_name, "format")
+    to = target_of(Target, to_name, output, {t: f".{t.value}" for t in Target}, "format")
     dialect = None if dialect_name is None else choice(Dialect, dialect_name, "FCL dialect")
     if dialect is not None and to is not Target.fcl:
         raise typer.BadParameter(f"--dialect chooses between FCL's dialects; --to {to.value} "

@@ -92,8 +92,33 @@ def parse_values(values: dict[str, str]) -> dict[str, float]:
                              expected="numbers of magnitude at most 1.8e308") from None
         except ValueError:
             raise InputError(f"input `{name}` must be a number, not `{text}`",
-                             expected="a decimal number such as 78, -4.5 or 1e3") from None
+                             expected="a decimal number such as 78, -4.5 or 1e3",
+                             hint=_glued(name, text)) from None
     return out
+
+
+def _glued(name: str, text: str) -> str | None:
+    """"give each input as a word of its own" for inputs run together with commas or
+    semicolons (`road=78,size=45,position=4`), which read as one input whose value is
+    `78,size=45,position=4`; the same for a separator left after a number (`road=78,`)."""
+    import re
+
+    from ..engine.csvio import comma_in_number
+    from ..numbers import parse_value
+
+    comma = comma_in_number(text, f"{name}=")      # `road=78,5`: a decimal comma
+    if comma is not None:
+        return comma
+    if "=" not in text:                         # `road=78,` of `road=78, size=45`
+        bare = text.rstrip(",; ")
+        try:
+            parse_value(bare)
+        except (ValueError, OverflowError):
+            return None
+        return (f"inputs are apart with spaces only: write `{name}={bare}`, without "
+                f"`{text[len(bare):].strip()}`") if bare != text else None
+    words = [w for w in re.split(r"[,;\s]+", f"{name}={text}") if w]
+    return "give each input as a word of its own, apart with spaces: `" + " ".join(words) + "`"
 
 
 def warn_clamped(result) -> None:
@@ -161,7 +186,7 @@ def eval_command(
         help="Rule file (.rules, .fcl, .fis, .fll; default: the packaged MITOS rule base), "
              "then one NAME=VALUE per input.")] = None,
     behavior: Annotated[Optional[str], typer.Option(
-        "--behavior", "-b", callback=named,
+        "--behavior", "-b", metavar="NAME", callback=named,
         help="Evaluate this behavior (default: the file's first).")] = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
     batch: Annotated[Optional[str], typer.Option(
@@ -169,7 +194,7 @@ def eval_command(
         help="Evaluate every row of a CSV whose header names the inputs; write a CSV of the "
              "inputs, the outputs and the CSV's other columns as they were.")] = None,
     digits: Annotated[Optional[int], typer.Option(
-        "--digits", min=0, max=12,
+        "--digits", metavar="N", min=0, max=12,
         help="Decimals in the trace (default 1, as the paper prints) and, with --batch, in the "
              "outputs (default: every digit, the shortest text that reads back as the same "
              "number).")] = None,
@@ -327,14 +352,15 @@ def run_batch(rb, source: str, on_no_rule: NoRule | None = None,
                              span=bad_byte("<stdin>", exc)) from None
         name = "<stdin>"
     else:
-        from ..fileio import bad_byte, nearby, read_text, unreadable
+        from ..fileio import bad_byte, nearby, read_text, repository_only, unreadable
 
         try:
             text, name = read_text(source), source
         except (OSError, UnicodeDecodeError) as exc:
             missing = isinstance(exc, FileNotFoundError)      # a mistyped name: did you mean
             raise InputError(unreadable("batch file", source, exc), span=bad_byte(source, exc),
-                             hint=nearby(source, (".csv",)) if missing else None) from None
+                             hint=nearby(source, (".csv",)) or repository_only(source)
+                             if missing else None) from None
     batch = read_table(text, name, rb.compiled.inputs, unused_inputs(rb))
     X = batch.X
     result = rb.run(X, strict=False, detail=False)

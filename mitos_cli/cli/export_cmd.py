@@ -9,7 +9,7 @@ from typing import Annotated, Optional
 import typer
 
 from .output import emit, err, warn, warn_notes
-from .params import choice, choices, completer, file_arg, named
+from .params import choices, completer, file_arg, named, target_of
 from .targets import check_suffix, refuse_inputs, source_files
 
 
@@ -24,18 +24,21 @@ SUFFIX = {Language.c: ".c", Language.python: ".py"}
 def export_command(
     path: Annotated[Path, typer.Argument(
         parser=file_arg, metavar="FILE", help="Rule base to export (.rules, .fcl, .fis or .fll).")],
-    to_name: Annotated[str, typer.Option(
+    to_name: Annotated[Optional[str], typer.Option(
         "--to", metavar=choices(Language), autocompletion=completer(Language),
-        help="c: one C99 file (no allocation, only libm); python: a NumPy-only module.")],
+        help="c: one C99 file (no allocation, only libm); python: a NumPy-only module "
+             "(default: the one -o's extension names, .c or .py).")] = None,
     output: Annotated[Optional[Path], typer.Option(
         "--output", "-o", parser=file_arg, metavar="OUT",
         help="File to write: a .c file for --to c, a .py file for --to python (default: "
              "stdout).")] = None,
     behavior: Annotated[Optional[str], typer.Option(
-        "--behavior", "-b", callback=named, help="Behavior to export (default: the file's first).")] = None,
+        "--behavior", "-b", metavar="NAME", callback=named,
+        help="Behavior to export (default: the file's first).")] = None,
     prefix: Annotated[Optional[str], typer.Option(
-        "--prefix", help="C names: PREFIX_eval, PREFIX_IN_<INPUT>, PREFIX_OUT_<OUTPUT> "
-                         "(default: mitos); --to c only.")] = None,
+        "--prefix", metavar="PREFIX",
+        help="C names: PREFIX_eval, PREFIX_IN_<INPUT>, PREFIX_OUT_<OUTPUT> "
+             "(default: mitos); --to c only.")] = None,
 ) -> None:
     """Export a rule base as code that computes its outputs from its inputs.
 
@@ -48,7 +51,7 @@ def export_command(
     from ..interop.common import atomic_write
     from ..interop.export import ident, to_c, to_python
 
-    to = choice(Language, to_name, "export language")
+    to = target_of(Language, to_name, output, SUFFIX, "export language")
     if output is not None:
         check_suffix(output, SUFFIX[to], f"--to {to.value}")
     if prefix is not None and to is not Language.c:      # it was ignored without a word

@@ -64,6 +64,24 @@ def not_a_directory_name(text: str) -> str:
     return text
 
 
+def target_of(kind: type[E], given: str | None, output: Path | None,
+              suffixes: dict[E, str], what: str) -> E:
+    """The member of ``kind`` that ``--to`` names, or, without ``--to``, the one whose file
+    extension ``-o`` has (`mitos convert tipper.fis -o tipper.fll`): Click's "Missing option
+    '--to'" said nothing of the extension given. Neither: a usage error naming both ways."""
+    if given is not None:
+        return choice(kind, given, what)
+    if output is not None:
+        for member, suffix in suffixes.items():
+            if output.suffix.lower() == suffix:
+                return member
+    names = ", ".join(m.value for m in kind)
+    told = (f"`{output}` has no extension that names one" if output is not None else
+            "or give -o a file with the format's extension")
+    raise typer.BadParameter(f"say which {what} to write: --to {names}; {told}",
+                             param_hint="'--to'")
+
+
 def choice(kind: type[E], value: str, what: str) -> E:
     """The member of ``kind`` named ``value`` (any case). An unknown name is a mistake in the
     command line, as an unknown planner or T-norm is: exit 2, the names, and "did you mean"."""

@@ -65,9 +65,10 @@ OutputOpt = Annotated[Optional[str], typer.Option(
 ShowOpt = Annotated[bool, typer.Option(
     "--show", help="Open the picture in a window (where a display is available).")]
 BehaviorOpt = Annotated[Optional[str], typer.Option(
-    "--behavior", "-b", callback=named, help="Use this behavior (default: the file's first).")]
+    "--behavior", "-b", metavar="NAME", callback=named,
+    help="Use this behavior (default: the file's first).")]
 TitleOpt = Annotated[Optional[str], typer.Option(
-    "--title", help="The picture's title (default: says what is drawn).")]
+    "--title", metavar="TEXT", help="The picture's title (default: says what is drawn).")]
 
 
 def _warn_undrawn(values: dict[str, float], plots, chose: str) -> None:
@@ -133,7 +134,7 @@ def _use_color(color: Optional[bool]) -> bool:
 
 #: the terminal drawing's options
 WidthOpt = Annotated[Optional[int], typer.Option(
-    "--width", min=30, max=400,
+    "--width", metavar="N", min=30, max=400,
     help="Terminal plot width in characters (default: the terminal's, at most 100).")]
 ColorOpt = Annotated[Optional[bool], typer.Option(
     "--color/--no-color", help="Colour the terminal plot (default: when stdout is a "
@@ -156,9 +157,10 @@ def terms_command(
              "(FILE.terms.yaml), then values to mark, "
              "e.g. road=78.")] = None,
     var: Annotated[Optional[list[str]], typer.Option(
-        "--var", "-v", help="Draw only this variable (repeat for more).")] = None,
+        "--var", "-v", metavar="NAME", help="Draw only this variable (repeat for more).")] = None,
     behavior: Annotated[Optional[str], typer.Option(
-        "--behavior", "-b", callback=named, help="Draw only the variables this behavior uses.")] = None,
+        "--behavior", "-b", metavar="NAME", callback=named,
+        help="Draw only the variables this behavior uses.")] = None,
     output: OutputOpt = None,
     show: ShowOpt = False,
     title: TitleOpt = None,
@@ -292,7 +294,7 @@ def surface_command(
         help="Hold another input at a value (repeat; inputs not fixed are held at the "
              "midpoint of their universe, with a note).")] = None,
     resolution: Annotated[int, typer.Option(
-        "--resolution", "-n", min=2, max=1000, help="Grid points per axis.")] = 61,
+        "--resolution", "-n", metavar="N", min=2, max=1000, help="Grid points per axis.")] = 61,
     style_name: Annotated[Optional[str], typer.Option(
         "--style", metavar=choices(Style), autocompletion=completer(Style),
         help="3-D surface (the default) or heat map with contours: a picture of two inputs "
@@ -358,10 +360,10 @@ def rules_command(
     title: TitleOpt = None,
     behavior: BehaviorOpt = None,
     max_rules: Annotated[int, typer.Option(
-        "--max-rules", min=1, max=500,
+        "--max-rules", metavar="N", min=1, max=500,
         help="Draw at most this many fired rules (the strongest).")] = 30,
     width: Annotated[Optional[int], typer.Option(
-        "--width", min=30, max=400,
+        "--width", metavar="N", min=30, max=400,
         help="Width in characters of a Mamdani output's plot in the text viewer "
              "(default 72).")] = None,
     color: ColorOpt = None,

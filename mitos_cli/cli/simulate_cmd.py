@@ -185,12 +185,13 @@ def simulate_command(
         "--rulebase", "-r", metavar="PATH", callback=named,
         help="Rule base (default: the packaged one).")] = None,
     behavior: Annotated[Optional[str], typer.Option(
-        "--behavior", "-b", callback=named,
+        "--behavior", "-b", metavar="NAME", callback=named,
         help="Behavior that drives (default: the world's, else `drive`).")] = None,
     seed: Annotated[Optional[int], typer.Option(
-        "--seed", min=0, help="Seed (default: the world's); with --runs, run j uses SEED+j.")] = None,
+        "--seed", metavar="SEED", min=0,
+        help="Seed (default: the world's); with --runs, run j uses SEED+j.")] = None,
     runs: Annotated[int, typer.Option(
-        "--runs", min=0, max=MAX_RUNS,
+        "--runs", metavar="N", min=0, max=MAX_RUNS,
         help="Randomised runs per world (obstacle places, sensor noise); 0: the world once, "
              "as written (`compare` defaults to 20: it needs many).")] = 0,
     randomise: Annotated[bool, typer.Option(
@@ -206,7 +207,7 @@ def simulate_command(
                         "planner that is not a rule base); of the first robot where there are "
                         "several; on stderr with --json, which keeps stdout for the JSON.")] = False,
     every: Annotated[Optional[int], typer.Option(
-        "--every", min=1, help="Ticks between traces (default 20); with --trace.")] = None,
+        "--every", metavar="N", min=1, help="Ticks between traces (default 20); with --trace.")] = None,
     plot: Annotated[Optional[Path], typer.Option(
         "--plot", parser=file_arg, metavar="FILE.png|FILE.svg",
         help="Draw the run (world, obstacles, path); with --runs, every run's path in one "
@@ -222,14 +223,14 @@ def simulate_command(
         help="Write the run as an animation: map, footprint, sonar cones, trail, obstacles, "
              "time and the fired rules' DOFs (.mp4 needs ffmpeg).")] = None,
     fps: Annotated[Optional[float], typer.Option(
-        "--fps", min=0.1, max=60.0, callback=finite,
+        "--fps", metavar="FPS", min=0.1, max=60.0, callback=finite,
         help="Animation frames per second of simulated time (plays in real time; default 10); "
              "with --animate.")] = None,
     require: Annotated[Optional[str], typer.Option(
         "--require", metavar="success", help="Exit 3 unless every run ends in this outcome.")] = None,
     workers: Annotated[Optional[int], typer.Option(
-        "--workers", "-j", min=1, help="Processes for --runs (default: up to 2, no more than the CPUs "
-                              "allowed).")] = None,
+        "--workers", "-j", metavar="N", min=1,
+        help="Processes for --runs (default: up to 2, no more than the CPUs allowed).")] = None,
     planner_name: Annotated[str, typer.Option(
         "--planner", metavar="NAME", autocompletion=complete.planners,
         help="Who drives: fuzzy (the rule base), potential_field or dwa (baselines that "
@@ -237,7 +238,7 @@ def simulate_command(
 ) -> None:
     """Simulate the rule base driving a tricycle robot through corridor worlds."""
     from ..resources import DEFAULT_WORLD
-    from ..sim.planner import make_planner, planner_kind
+    from ..sim.planner import PLANNERS, make_planner, planner_kind
 
     require = _checked_require(require)
     planner_name = planner_name.lower()        # any case, as every option's fixed list
@@ -251,6 +252,11 @@ def simulate_command(
         raise typer.BadParameter(f"--rulebase and --behavior choose the fuzzy planner's rules; "
                                  f"`{planner_name}` has none", param_hint="--planner")
     live = live or speed is not None
+    for world in worlds or []:        # `--planner dwa potential_field`: one planner drives
+        if world.lower() in PLANNERS and not Path(world).exists():
+            raise typer.BadParameter(f"`{world}` is a planner, read here as a world: simulate "
+                                     f"drives with one (--planner NAME); `mitos compare "
+                                     f"--planner {planner_name},{world}` compares them")
     loaded = _load_worlds(worlds or [DEFAULT_WORLD])
     from ..sim.obstacles import copies_note
 

@@ -42,10 +42,11 @@ class Transcript:
 
 def teach_command(
     rules: Annotated[str | None, typer.Argument(
-        metavar="[RULES]", callback=named,
+        metavar="[RULEBASE]", callback=named,
         help="Rule file to teach (default: the packaged MITOS rule base).")] = None,
     behavior: Annotated[str | None, typer.Option(
-        "--behavior", "-b", callback=named, help="The behavior to teach first (default: the file's first).")]
+        "--behavior", "-b", metavar="NAME", callback=named,
+        help="The behavior to teach first (default: the file's first).")]
         = None,
     lesson: Annotated[str | None, typer.Option(
         "--lesson", "-l", metavar="FILE|-", callback=named,
@@ -215,14 +216,18 @@ def _ended_open(session, text: str, name: str) -> None:
 def _teach_lesson(session, lesson: str, lesson_text, transcript: Transcript | None) -> None:
     """Run a lesson file (or stdin) in ``session``; save where ``--save-as`` says if it ends
     with changes unsaved. Ctrl-C keeps every change (the journal has them)."""
+    from ..resources import packaged_name
     from ..teach.lesson import read_lesson, run_lesson
     from .output import emit, err
 
-    text, name = lesson_text if lesson_text is not None else read_lesson(lesson)
+    text, found = lesson_text if lesson_text is not None else read_lesson(lesson)
     directory = session.journal.directory
     session.echo = transcript.command if transcript is not None else emit
     if lesson != "-":
-        session.base = Path(name).parent
+        session.base = Path(found).parent
+    # a packaged lesson (`--lesson wider-turn`) is shown by its name in the repository, as the
+    # packaged rule base is, not by the path pip put it at
+    name = packaged_name(found) or found if lesson != "-" else found
     try:
         run_lesson(session, text, name)
     except KeyboardInterrupt:

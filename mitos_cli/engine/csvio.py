@@ -290,8 +290,22 @@ def _bad_row(rows: list[list[str]], done: int, header: list[str], order: list[in
                 parse_number(cell)
             except ValueError:
                 return InputError(f"`{cell.strip()}` is not a number (input `{header[c]}`, "
-                                  f"row {row + 1})", span=_cell_span(text, path, row, c))
+                                  f"row {row + 1})", span=_cell_span(text, path, row, c),
+                                  hint=comma_in_number(cell.strip()))
     return None
+
+
+def comma_in_number(cell: str, name: str = "") -> str | None:
+    """`78,5` (a spreadsheet's decimal comma, the cell quoted): the decimal point is `.`;
+    `1,000` may be a thousands separator too, so both readings are offered. ``name``: the
+    input, written before the number (`road=78.5`)."""
+    if re.fullmatch(r"[-+]?\d+,\d+", cell) is None:
+        return None
+    whole, _, part = cell.partition(",")
+    if len(part) == 3:
+        return (f"a number has `.` for its decimals and no thousands separator: "
+                f"`{name}{whole}.{part}` or `{name}{whole}{part}`")
+    return f"the decimal separator is `.`: `{name}{whole}.{part}`"
 
 
 # ---- positions, found again only for an error --------------------------------------------------

@@ -87,6 +87,10 @@ def wrong_reader_hint(path: str | Path, reader: str, command: str | None = None)
     the reader goes by extension (there is no option to choose it). ``command``: a command
     that reads the rule language whatever the extension (``mitos teach``)."""
     path = Path(path)
+    if reader == "rules":
+        other = _not_a_rulebase(path, command)
+        if other is not None:
+            return other
     looks = looks_like(path)
     if looks is None or looks[0] == reader:
         return None
@@ -104,6 +108,21 @@ def wrong_reader_hint(path: str | Path, reader: str, command: str | None = None)
     return (f"{seen} but is read as {LANGUAGES[reader]}: the reader is chosen by the file's "
             f"extension (.fcl, .fis, .fll, anything else the rule language; no option chooses "
             f"another): rename it to `{named.name}`")
+
+
+def _not_a_rulebase(path: Path, command: str | None) -> str | None:
+    """What to do with a file of another of MITOS's kinds, named where a rule base goes and
+    read (by its extension) as the rule language: a batch CSV (`mitos eval inputs.csv`, the
+    `--batch` left out) or a lesson (`mitos teach wider-turn.lesson`, the `--lesson` left
+    out). Lark's "`road` is read as a rule's label" said nothing of either."""
+    suffix = path.suffix.lower()
+    if suffix == ".csv":
+        return (f"`{path.name}` is a CSV file, not a rule base: to evaluate each of its rows, "
+                f"give it to --batch (`mitos eval [RULEBASE] --batch {path.as_posix()}`)")
+    if suffix == ".lesson":
+        return (f"`{path.name}` is a lesson, not a rule base: a lesson is run with --lesson "
+                f"(`mitos teach [RULEBASE] --lesson {path.as_posix()}`)")
+    return None
 
 
 def hint_wrong_reader(exc: MitosError, path: str | Path, command: str | None = None) -> None:

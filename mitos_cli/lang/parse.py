@@ -177,10 +177,10 @@ def syntax_error(exc: UnexpectedInput, text: str, path: str | None) -> RuleSynta
             hint = "a condition reads `variable is TERM`"
     elif "THEN" in expected and token.type in ("NAME",):
         hint = _keyword_as_term(text, token) or _hedge_hint(text, token) or \
-            keyword_hint(token, expected) or \
+            keyword_hint(token, expected) or _two_words(text, token) or \
             "join conditions with `and` / `or`, and start the actions with `then`"
     else:
-        hint = keyword_hint(token, expected)
+        hint = keyword_hint(token, expected) or _joined_with_comma(text, token)
     hint = _statement_hint(text, token.start_pos) or stray or hint
     return RuleSyntaxError(f"unexpected {_describe(token)}", span=span,
                            expected=_expected(expected), hint=hint)
@@ -287,6 +287,9 @@ def _stray_label(exc: UnexpectedToken, text: str, path: str | None) -> RuleSynta
         return None
     close = _keyword_near(text, word, accepts)
     if same_line and close is None:                 # `foo bar`
+        if token.type == "IS" and _in_actions(text[:word.start_pos]):
+            return (f"actions are joined with `and`: `... and {word} is ...` (as it stands, "
+                    f"`{word}` is read as the label of a new rule, which ends with `:`)")
         return f"`{word}` is read as a rule's label, which ends with `:` (`{word}: if ...`)"
     after = f" after {_describe(last)}" if last is not None else ""
     span = Span.in_text(text, path, word.line or 1, word.column or 1,
@@ -326,6 +329,60 @@ def _hedge_hint(text: str, token: Token, allowed: tuple[str, ...] | None = None)
     close = did_you_mean(word, pool)            # only a near miss is taken for a hedge
     where = "hedges" if allowed is None else "hedges of a target"
     return f"`{word}` is not a hedge ({where}: {', '.join(pool)}); {close}" if close else None
+
+
+#: `is`, then `not` and hedges, then a term or a number, at the end of the text before a token
+_PROPOSITION_END = r"\bis\s+(?:[A-Za-z_][\w\-]*\s+)*[-+\w.]+\s*\Z"
+
+
+def _in_actions(before: str) -> bool:
+    """Whether ``before`` (the text up to a token) ends in an action: a `then` after the
+    rule's `if`, and a proposition last."""
+    keywords = re.findall(r"\b(if|then)\b", before)
+    return keywords[-1:] == ["then"] and re.search(_PROPOSITION_END, before) is not None
+
+
+def _joined_with_comma(text: str, token: Token) -> str | None:
+    """``then steering is RS, speed is MEDIUM`` and ``if road is WIDE, size is SMALL_SZ``: a
+    comma between actions or conditions, where the language joins them with words. The error
+    said only "unexpected `,`, expected a name"."""
+    before = text[:token.start_pos]
+    if token.type != "COMMA" and str(token.value) != ",":
+        return None
+    if re.search(_PROPOSITION_END, before) is None:
+        return None
+    if _in_actions(before):
+        return "actions are joined with `and`, not `,`: `then steering is LS and speed is SLOW`"
+    return "conditions are joined with `and` or `or`, not `,`: `if a is X and b is Y`"
+
+
+def joined_hint(text: str, token: Token) -> str | None:
+    """How conditions and actions are joined, for an error at ``token`` where a rule's
+    were joined with a comma, or two actions with nothing (``then steering is LS speed is
+    SLOW``, where the teaching prompt expects `and` or `with` before `speed`)."""
+    comma = _joined_with_comma(text, token)
+    if comma is not None or token.type != "NAME":
+        return comma
+    before = text[:token.start_pos]
+    if _in_actions(before) and re.match(r"\s*is\b", text[token.end_pos:]):
+        return f"actions are joined with `and`: `... and {token} is ...`"
+    return None
+
+
+def _two_words(text: str, token: Token) -> str | None:
+    """``position is FAR RIGHT``: two words after `is`, the first neither a hedge nor close to
+    one (``vary``: :func:`_hedge_hint`). A term's name is one word; a missing `and` before a
+    new condition (``road is WIDE size is ...``) is not this: there `is` follows."""
+    from ..fuzzy.hedges import HEDGES
+
+    before = re.search(r"\bis\s+(?:not\s+)?([A-Za-z_][\w\-]*)\s*$", text[:token.start_pos])
+    if before is None or before.group(1) in HEDGES or before.group(1) == "not":
+        return None
+    if re.match(r"\s*is\b", text[token.end_pos:]):
+        return None
+    word = before.group(1)
+    return (f"`{word} {token}`: a term's name is one word (`{word}_{token}`), and `{word}` is "
+            f"not a hedge ({', '.join(HEDGES)}), which would stand before the term")
 
 
 def _keyword_as_term(text: str, token: Token) -> str | None:

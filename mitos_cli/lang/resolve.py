@@ -29,12 +29,12 @@ def rule_file_hint(path: str | Path) -> str | None:
     (``mitos.rule``, ``rulebases/mitoss.rules`` from anywhere), the packaged ones, as a world
     file's name gets the packaged worlds: a `mitos.fll` here was suggested for `mitos.rule`,
     which every command reads as the packaged `mitos.rules` once spelt right."""
-    from ..fileio import RULE_SUFFIXES, nearby
+    from ..fileio import RULE_SUFFIXES, nearby, repository_only
     from ..resources import packaged_names, packaged_place
 
     packaged = ([n for suffix in RULE_SUFFIXES for n in packaged_names("rulebases", suffix)]
                 if packaged_place(Path(path).parent.as_posix(), "rulebases") else [])
-    return nearby(path, RULE_SUFFIXES, packaged)
+    return nearby(path, RULE_SUFFIXES, packaged) or repository_only(path)
 
 
 def termset_hint(target: Path, name: str) -> str:

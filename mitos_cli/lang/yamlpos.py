@@ -232,6 +232,7 @@ def load(text: str, path: str | None, error: type[MitosError]) -> Any:
     try:
         return yaml.load(text, Loader=_build_loader(text, path))  # noqa: S506 (SafeLoader)
     except yaml.MarkedYAMLError as exc:
+        unclosed_flow(exc, text, path, error)
         unclosed = exc.problem == "found unexpected end of stream" and "quoted" in (exc.context or "")
         mark = (exc.context_mark if unclosed else None) or exc.problem_mark or exc.context_mark
         span = _span(mark, text, path) if mark is not None else None
@@ -246,6 +247,25 @@ def load(text: str, path: str | None, error: type[MitosError]) -> Any:
                     span=Span.at(text, path, pos, line, column)) from None
     except yaml.YAMLError as exc:  # pragma: no cover - other YAML errors carry no mark
         raise error(f"invalid YAML: {exc}", span=Span(path, 1, 1)) from None
+
+
+def unclosed_flow(exc: yaml.MarkedYAMLError, text: str, path: str | None,
+                  error: type[MitosError]) -> None:
+    """A `[` list or `{` mapping not closed before a later line (`points: [[0, 0], [600, 0]`
+    and the next key): PyYAML said "expected ',' or ']', but got '<scalar>'" at the next
+    line's first word. Said at the bracket that is not closed."""
+    flows = {"while parsing a flow sequence": ("[", "]"), "while parsing a flow mapping":
+             ("{", "}")}
+    brackets = flows.get(exc.context or "")
+    opened, seen = exc.context_mark, exc.problem_mark
+    if brackets is None or opened is None or seen is None or seen.line <= opened.line:
+        return
+    got = "the end of the file" if "<stream end>" in (exc.problem or "") else \
+        f"line {seen.line + 1}"
+    raise error(f"invalid YAML: this `{brackets[0]}` is not closed before {got}",
+                span=_span(opened, text, path),
+                expected=f"`{brackets[1]}` after its last item (its items apart with `,`)") \
+        from None
 
 
 #: PyYAML's words for the mistakes people make most, and what YAML expected there
@@ -269,7 +289,8 @@ def _in_words(problem: str, context: str | None) -> tuple[str, str | None]:
         return _WORDS[problem]
     if problem == "found unexpected end of stream" and context and "quoted" in context:
         return "a quoted value is not closed before the end of the file", "its closing quote"
-    return problem.replace("'<stream end>'", "the end of the file"), None
+    return (problem.replace("'<stream end>'", "the end of the file")
+            .replace("'<scalar>'", "a value")), None
 
 
 def check_keys(mapping: YMap, allowed: Iterable[str], error: type[MitosError],

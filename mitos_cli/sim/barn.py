@@ -379,9 +379,30 @@ def _out(text: str) -> Path:
     return path
 
 
+class _Parser(argparse.ArgumentParser):
+    """argparse, with "did you mean" for a misspelt option, as `mitos` says it: `--sed 7`
+    was "the following arguments are required: --out" (or "unrecognized arguments: --sed 7")
+    and no more. An unknown option is looked for first, so that it is not hidden behind a
+    required one it was meant to be."""
+
+    def parse_args(self, args=None, namespace=None):
+        import sys
+
+        from ..errors import did_you_mean
+
+        words = list(sys.argv[1:] if args is None else args)
+        known = [o for a in self._actions for o in a.option_strings]
+        for word in words:
+            name = word.split("=", 1)[0]
+            if name.startswith("--") and name not in known:
+                close = did_you_mean(name, known)
+                self.error(f"unknown option {name}" + (f"; {close}" if close else ""))
+        return super().parse_args(words, namespace)
+
+
 def _parser() -> argparse.ArgumentParser:
-    ap = argparse.ArgumentParser(prog="python -m mitos_cli.sim.barn",
-                                 description="Write a BARN-style world file.")
+    ap = _Parser(prog="python -m mitos_cli.sim.barn", description="Write a BARN-style world file.",
+                 allow_abbrev=False)
     ap.add_argument("--seed", type=_seed, default=0,
                     help="whole number >= 0 that draws the field, and the difficulty when "
                          "--fill or --smoothing is not given (default: 0)")

@@ -277,6 +277,24 @@ def _beside(path: Path, written: str | None, exc: OSError | UnicodeDecodeError,
     return f"did you mean `{(Path(written).parent if written else path.parent) / name}`?"
 
 
+def _packaged_map(written: str | None, exc: OSError | UnicodeDecodeError) -> str | None:
+    """A packaged world copied elsewhere (`cp worlds/office.yaml mine.yaml`) names its map
+    as `maps/mrpb_office02.yaml`, beside the packaged world: said "not found" and no more."""
+    from ..resources import data_dir, packaged_path
+
+    if not isinstance(exc, FileNotFoundError) or not written or Path(written).is_absolute():
+        return None
+    try:
+        if not (data_dir("worlds") / written).is_file():
+            return None
+        full = packaged_path("worlds", written).as_posix()
+    except OSError:
+        return None
+    return (f"a map path is relative to the world file, and `{written}` lies beside the "
+            f"packaged worlds: write its full path, `{full}`, or copy that "
+            f"`{Path(written).parts[0]}/` folder beside this world file")
+
+
 def unknown_at(source: str, x: float, y: float) -> bool:
     """Whether the point (in) lies in an unknown cell (grey, between the thresholds) of the
     map file ``source``: blocked as read with unknown cells occupied, free with them free.
@@ -380,7 +398,8 @@ def _map_spec(path: Path, where: Span | None, written: str | None) -> yamlpos.YM
         text = read_text(path)
     except (OSError, UnicodeDecodeError) as exc:
         raise WorldError(unreadable("map file", path, exc), span=bad_byte(path, exc) or where,
-                         hint=_beside(path, written, exc, (".yaml", ".yml"))) from None
+                         hint=_beside(path, written, exc, (".yaml", ".yml"))
+                         or _packaged_map(written, exc)) from None
     named = named_yaml(path)
     try:
         spec = yamlpos.load(text, str(path), WorldError)

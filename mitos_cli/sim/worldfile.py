@@ -470,11 +470,25 @@ def _not_a_termset(doc: Any, span: Span) -> None:
                               "`mitos plot terms` and `mitos check` take one alone")
 
 
+def _not_a_map(doc: Any, span: Span) -> None:
+    """Refuse a map_server map YAML named as a world (`mitos simulate worlds/maps/m.yaml`),
+    saying so: "unknown key `image` in the world file" said nothing of what the file was."""
+    if isinstance(doc, YMap) and "image" in doc and "resolution" in doc \
+            and not any(k in doc for k in TOP_KEYS):
+        name = Path(span.path or "map.yaml").name
+        raise WorldError(f"`{span.path}` is a map (map_server's YAML: `image`, `resolution`), "
+                         f"not a world file", span=span,
+                         expected="a world: `name`, `q_init`, `q_goal`, `map` and more",
+                         hint=f"a world drives on it by naming it, `map: {{grid: {name}}}` "
+                              f"(worlds/README.md; `worlds/office.yaml` is one)")
+
+
 def parse_world(text: str, path: str) -> World:
     """Parse world YAML ``text`` (read from ``path``, which anchors relative map paths)."""
     r = _Reader(path)
     doc = yamlpos.load(text, path, WorldError)
     _not_a_termset(doc, Span.in_text(text, path, 1, 1))
+    _not_a_map(doc, Span.in_text(text, path, 1, 1))
     top = r.mapping(doc, Span.in_text(text, path, 1, 1), "the world file", TOP_KEYS)
     name = _name(top)
     seed = _seed(r, top)
@@ -1334,13 +1348,29 @@ def resolve_world_path(name: str | Path, base: Path | None = None) -> Path:
     raise world_not_found(name, where)
 
 
+def _beside(where: Path, given: Path, packaged: list[str]) -> str | None:
+    """"did you mean" a file that is there: one beside ``where`` (the path looked for first:
+    beside the lesson that names the world), else beside ``given`` (the working directory),
+    else a packaged world's name, written in ``given``'s directory, which finds it. A lesson's
+    `simulate worlds/figur4.yaml` was offered `LESSONDIR/worlds/figure4.yaml`, a file that is
+    not there: the packaged name was put in the lesson's directory."""
+    from ..fileio import nearby_name
+    from ..resources import is_file
+
+    for place in dict.fromkeys([where, given]):
+        name = nearby_name(place, (".yaml", ".yml"), packaged)
+        if name is not None:
+            at = place.parent if is_file(place.parent / name) else given.parent
+            return f"did you mean `{(at / name).as_posix()}`?"
+    return None
+
+
 def world_not_found(name: str | Path, where: Path) -> UnknownWorld:
     """"world file `X` not found" (``where``: the path looked for), with the closest of the
     files beside it and, where the name may be a packaged world's, the packaged worlds. The packaged names are
     listed when the name was one's (``slalm``) or is close to one, not for any path
     (``nosuch.yaml``, ``foo/nosuch.yaml``: "did you mean office.yaml" was the shared ``.yaml``)."""
     from ..errors import closest_file
-    from ..fileio import nearby
     from ..resources import packaged_names, packaged_place
 
     given = Path(name)
@@ -1352,7 +1382,7 @@ def world_not_found(name: str | Path, where: Path) -> UnknownWorld:
     close = closest_file(given.name, shown) if len(given.parts) == 1 else None
     hint = f"did you mean `{close}`?" if close else None
     if given.suffix or len(where.parts) > 1:      # a path: a file beside it first
-        hint = nearby(where, (".yaml", ".yml"), maybe_packaged) or hint
+        hint = _beside(where, given, maybe_packaged) or hint
     same_name = given.name if given.name.endswith(".yaml") else given.name + ".yaml"
     if len(given.parts) > 1 and same_name in packaged:
         hint = (f"there is no `{given}`; the packaged world of that name is "

@@ -31,6 +31,7 @@ from ..lang.parse import (
     check_modifiers,
     check_nesting,
     check_settings,
+    joined_hint,
     keyword_hint,
     not_in_action_before,
     shift,
@@ -645,7 +646,8 @@ def _syntax_error(exc: UnexpectedInput, text: str, path: str) -> RuleSyntaxError
     elif "EQUAL" in expected:
         hint = "give values as NAME=VALUE, e.g. `road=78`"
     else:
-        hint = keyword_hint(token, expected)
+        hint = keyword_hint(token, expected) or (
+            joined_hint(text, token) if "if" in before and "->" not in before else None)
     return RuleSyntaxError(f"unexpected {_describe(token)}", span=span,
                            expected=_expected(expected), hint=hint)
 
@@ -673,6 +675,9 @@ def _teach_hint(text: str, token: Token, before: list[str]) -> str | None:
 
         return did_you_mean(str(token.value), SHOW_WHAT)
     if token.value == "," and before[:1] in (["eval"], ["correct"], ["at"]):
+        if re.search(r"\bis\s+\S+\s*\Z", text[:at]):     # a target in words: `-> steering is LS,`
+            return ("targets in words are joined with `and`, not `,`: `steering is LS and "
+                    "speed is SLOW`")
         return "values are separated by spaces, not commas: `road=78 size=45`"
     glued = at > 0 and not text[at - 1].isspace()
     if before[:1] == ["simulate"] and (before[-1:] == ["seed"]                  # `seed x`

@@ -87,7 +87,7 @@ def find_session(name: str | None, base: Path | None = None) -> Path:
         raise err
     if not found:
         raise LessonError(f"no teaching session to resume in {ROOT}/",
-                          hint="start one with `mitos teach RULES`")
+                          hint="start one with `mitos teach RULEBASE`")
     return found[-1].parent
 
 
@@ -150,7 +150,7 @@ class Journal:
                 hint = ("`mitos teach --resume --recover` continues the session with the "
                         f"changes before line {i + 1} (the damaged journal is kept aside)"
                         if journal.entries else "the session's start is damaged, so there is "
-                        "nothing to continue: start a new session with `mitos teach RULES`")
+                        "nothing to continue: start a new session with `mitos teach RULEBASE`")
                 raise LessonError(f"the journal is damaged: {problem}",
                                   span=Span(str(journal.path), i + 1, 1, shown), hint=hint)
             else:

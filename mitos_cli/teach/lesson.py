@@ -12,7 +12,7 @@ import re
 from collections.abc import Iterator
 from pathlib import Path
 
-from ..errors import LessonError, MitosError, Span, WorldError, visible
+from ..errors import LessonError, MitosError, RuleSyntaxError, Span, WorldError, visible
 from ..lang.parse import MAX_RULE_FILE_CHARS
 from ..resources import exists
 from .commands import incomplete
@@ -91,6 +91,8 @@ def _run(session: Session, text: str, path: str) -> bool:
                 session.opened_at = None if session.state.block is None else Span.in_text(
                     "\n" * (lineno - 1) + line, path, lineno, len(line) - len(line.lstrip()) + 1)
         except MitosError as exc:
+            if isinstance(exc, RuleSyntaxError):
+                exc.hint = not_a_lesson(path) or exc.hint
             if isinstance(exc, WorldError) and exc.span is not None \
                     and exc.span.path not in (None, "<prompt>", path):
                 exc.message += f" (simulated from {path}:{lineno})"   # where the world is wrong
@@ -105,6 +107,29 @@ def _run(session: Session, text: str, path: str) -> bool:
                 exc.span = where
             raise
     return True
+
+
+def not_a_lesson(path: str) -> str | None:
+    """What a file of another of MITOS's kinds, given to --lesson, is (by its extension):
+    `mitos teach --lesson rulebases/mitos.rules` stopped at `terms` with "type `help`", a
+    world at `name: figure4` with "expected `if`"."""
+    name = Path(path).name
+    suffix = Path(path).suffix.lower()
+    if suffix == ".rules":
+        return (f"`{name}` is a rule base, not a lesson: give it before the options "
+                f"(`mitos teach {path} [--lesson LESSON]`)")
+    if suffix in (".fcl", ".fis", ".fll"):
+        return (f"`{name}` is a rule base, not a lesson: `mitos teach` reads the rule "
+                f"language, so convert it (`mitos convert {path} --to rules`) and give the "
+                f".rules file before the options")
+    if suffix in (".yaml", ".yml"):
+        return (f"`{name}` is a YAML file (a world, or a term set), not a lesson: a lesson "
+                f"drives a world with `simulate {path}`")
+    if suffix == ".csv":
+        return (f"`{name}` is a CSV file, not a lesson: `mitos eval --batch {path}` "
+                f"evaluates its rows; a lesson gives examples with `correct NAME=VALUE ... -> "
+                f"OUTPUT=VALUE`")
+    return None
 
 
 def lines_of(text: str) -> list[str]:

@@ -974,9 +974,14 @@ class Session:
         # `save ~/taught.rules` at the prompt, where no shell expands the `~`
         target = Path(c.path).expanduser() if c.path is not None else self.save_as
         if target is None:
+            from ..resources import packaged_name
+
+            packaged = packaged_name(str(self.rules_path))
             raise LessonError("say where to save: `save taught.rules`",
                               hint=f"the original {self.rules_path} is kept unless you name "
-                                   f"it (`save {self.rules_path}`)")
+                                   f"it (`save {self.rules_path}`)" if packaged is None else
+                              f"the session teaches the packaged {packaged} (the one every "
+                              f"command reads when none is named): save a copy of your own")
         if self.state.block is not None:
             raise LessonError(f"behavior `{self.state.block}` is still open",
                               hint="close it with `end` before saving")
