@@ -29,20 +29,24 @@ GOLDEN = ROOT / "tests" / "golden"
 CASES = sorted(p.name for p in GOLDEN.iterdir() if (p / "cmd").is_file())
 
 
-def run_cli(argv: list[str], stdin: str | None = None) -> subprocess.CompletedProcess:
+def run_cli(argv: list[str], stdin: str | None = None,
+            cwd: Path = ROOT) -> subprocess.CompletedProcess:
     env = dict(os.environ, COLUMNS="100", NO_COLOR="1")
-    return subprocess.run([sys.executable, "-m", "mitos_cli", *argv], cwd=ROOT, input=stdin,
+    return subprocess.run([sys.executable, "-m", "mitos_cli", *argv], cwd=cwd, input=stdin,
                           capture_output=True, text=True, timeout=120, env=env)
 
 
 @pytest.mark.parametrize("case", CASES)
-def test_golden(case):
+def test_golden(case, tmp_path):
     folder = GOLDEN / case
     argv = shlex.split((folder / "cmd").read_text(encoding="utf-8"))
     assert argv[0] == "mitos"
     stdin = (folder / "stdin").read_text(encoding="utf-8") if (folder / "stdin").exists() \
         else None
-    proc = run_cli(argv[1:], stdin)
+    # a teaching session's journal lives where the command runs: not in the repository, where
+    # `mitos teach --resume` would continue the test's session (the packaged files are found
+    # from anywhere)
+    proc = run_cli(argv[1:], stdin, cwd=tmp_path if argv[1] == "teach" else ROOT)
     expected_code = int((folder / "exit_code").read_text()) if (folder / "exit_code").exists() \
         else 0
     if os.environ.get("MITOS_UPDATE_GOLDEN"):
