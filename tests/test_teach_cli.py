@@ -547,3 +547,20 @@ def test_a_packaged_lesson_is_shown_by_its_name_in_the_repository(work):
     res = mitos("teach", "--lesson", "wider-turn", cwd=work)
     assert res.returncode == 0, res.stderr
     assert res.stdout.startswith("rulebases/lessons/wider-turn.lesson:16> use drive\n")
+
+
+def test_a_lesson_refused_at_its_first_commands_leaves_no_session(work):
+    """Every failed lesson left a session (12 in an audit's directory), the newest of which
+    `--resume` continued; one refused before anything but the choice of a behavior holds
+    nothing to continue. One that ran something keeps its session."""
+    (work / "bad.lesson").write_text("use drive\nfoo bar\n")
+    res = mitos("teach", "rb/mitos.rules", "--lesson", "bad.lesson", cwd=work)
+    assert res.returncode == 1 and "bad.lesson:2:1: syntax error" in res.stderr
+    assert "removed: the lesson stopped before any change" in res.stderr
+    assert not list((work / ".mitos" / "teach").iterdir())
+    (work / "run.lesson").write_text("use drive\nsimulate figure4\nfoo bar\n")
+    res = mitos("teach", "rb/mitos.rules", "--lesson", "run.lesson", cwd=work)
+    assert res.returncode == 1 and "removed" not in res.stderr
+    [kept] = (work / ".mitos" / "teach").iterdir()
+    resumed = mitos("teach", "--resume", cwd=work, stdin="quit\n")
+    assert resumed.returncode == 0 and f"resumed session {kept.name}" in resumed.stderr

@@ -216,6 +216,7 @@ def _ended_open(session, text: str, name: str) -> None:
 def _teach_lesson(session, lesson: str, lesson_text, transcript: Transcript | None) -> None:
     """Run a lesson file (or stdin) in ``session``; save where ``--save-as`` says if it ends
     with changes unsaved. Ctrl-C keeps every change (the journal has them)."""
+    from ..errors import MitosError
     from ..resources import packaged_name
     from ..teach.lesson import read_lesson, run_lesson
     from .output import emit, err
@@ -230,6 +231,10 @@ def _teach_lesson(session, lesson: str, lesson_text, transcript: Transcript | No
     name = packaged_name(found) or found if lesson != "-" else found
     try:
         run_lesson(session, text, name)
+    except MitosError:
+        if session.journal.discard_if_unused():
+            err(f"session {directory.name} removed: the lesson stopped before any change")
+        raise
     except KeyboardInterrupt:
         err(f"interrupted: every change so far is in the journal; `mitos teach --resume "
             f"--session {directory.name}` continues")

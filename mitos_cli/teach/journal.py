@@ -176,6 +176,28 @@ class Journal:
             fh.flush()
             os.fsync(fh.fileno())
 
+    def discard_if_unused(self) -> bool:
+        """Remove this session when its journal holds nothing but its start and the choice of a
+        behavior (a lesson refused at its first commands): it would be the newest, the one
+        ``mitos teach --resume`` picks, and holds nothing to continue (a run, a rule, an example
+        is kept). True when removed; a directory holding anything else (a kept damaged journal,
+        a file of the user's) stays."""
+        if any(e["op"] not in ("start", "activate") for e in self.entries):
+            return False
+        known = {JOURNAL, "lock", "history"}
+        try:
+            if any(p.name not in known for p in self.directory.iterdir()):
+                return False
+            held = _HELD.pop(self.directory.resolve(), None)
+            if held is not None:
+                held.close()                    # type: ignore[attr-defined]
+            for name in known:
+                (self.directory / name).unlink(missing_ok=True)
+            self.directory.rmdir()
+        except OSError:
+            return False
+        return True
+
     @property
     def aside(self) -> Path:
         """Where :meth:`cut` kept the journal as it was."""
