@@ -3,7 +3,6 @@ backing out of a pocket; and in a run: it stops short of a wall a policy drives 
 
 from __future__ import annotations
 
-import functools
 import math
 
 import numpy as np
@@ -423,10 +422,6 @@ def _fleet_case(rng: np.random.Generator, n: int):
         if rng.random() < 0.5:                                     # just ahead of its front
             front = robots[j].length / 2
             own = np.vstack([own, [rng.uniform(front + 1, front + 3), rng.uniform(-5, 5)]])
-        if rng.random() < 0.4:                         # beside a wall with a doorway ahead
-            along = np.arange(-40.0, 90.0, 1.0)
-            along = along[(along < 35.0) | (along > 70.0)]
-            own = np.vstack([own, np.column_stack([along, np.full(len(along), 13.0)])])
         c, s = math.cos(h[j]), math.sin(h[j])
         cells.append(np.column_stack([x[j] + own[:, 0] * c - own[:, 1] * s,
                                       y[j] + own[:, 0] * s + own[:, 1] * c]))
@@ -442,11 +437,10 @@ def _fleet_case(rng: np.random.Generator, n: int):
 def test_a_fleet_guarded_at_once_carries_out_what_each_robot_does_alone():
     """:meth:`safety.Fleet.guard` (most robots decided with arrays, the rest by
     :func:`safety.guard` with their first sweep known) gives every robot the command, the
-    backing-out and the recovery state :func:`safety.guard` gives it alone, to the bit (with
-    the cap for what it cannot see worked out for it alone); the robots that do not brake, or
-    are not among the rows, are left as they were."""
+    backing-out and the recovery state :func:`safety.guard` gives it alone, to the bit; the
+    robots that do not brake, or are not among the rows, are left as they were."""
     rng = np.random.default_rng(5)
-    kinds = {"eased": 0, "kept": 0, "held": 0, "backs": 0, "backing": 0, "blind": 0}
+    kinds = {"eased": 0, "kept": 0, "held": 0, "backs": 0, "backing": 0}
     for _ in range(100):
         n = int(rng.integers(1, 12))
         fleet, now, cells, state, command = _fleet_case(rng, n)
@@ -457,10 +451,7 @@ def test_a_fleet_guarded_at_once_carries_out_what_each_robot_does_alone():
             body = safety.Body(fleet.robots[i], (x, y, h), wheel, cells[i], float(fleet.radius[i]),
                                side, float(fleet.reach[i]), speed)
             rec = safety.Recovery(*state[i].tolist())
-            one = np.array([i])
-            cap = fleet.caps(one, *(v[one] for v in now[:3]), now[5][one], command[one, 1],
-                             [cells[i]]).item()
-            carried, backs = safety.guard(tuple(command[i].tolist()), body, rec, 0.05, cap=cap)
+            carried, backs = safety.guard(tuple(command[i].tolist()), body, rec, 0.05)
             want_command[i], want_state[i] = carried, (rec.held, rec.left, rec.wheel)
             want_backs += [i] if backs else []
             kinds["eased"] += carried[1] != command[i, 1]
@@ -468,7 +459,6 @@ def test_a_fleet_guarded_at_once_carries_out_what_each_robot_does_alone():
             kinds["held"] += rec.held > state[i, 0]
             kinds["backs"] += int(backs)
             kinds["backing"] += state[i, 1] > 0
-            kinds["blind"] += math.isfinite(cap)
         got = fleet.guard(rows, command, state, now, [cells[i] for i in rows.tolist()])
         assert got == want_backs
         assert command.tobytes() == want_command.tobytes()
@@ -560,125 +550,3 @@ def test_a_sweep_of_no_place_among_others_keeps_its_reach():
             got = safety.free_travels(sweeps)
         assert got[1] == safety.free_travels(sweeps[1:])[0]
         assert got[0] == before
-
-
-def _doorway(side: float = 13.0, open_from: float = 35.0, open_to: float = 70.0) -> np.ndarray:
-    """Cells of a wall ``side`` in left of a robot at the origin facing +x, from 40 in behind
-    it to 90 in ahead, with a doorway from ``open_from`` to ``open_to`` in ahead."""
-    along = np.arange(-40.0, 90.0, 1.0)
-    along = along[(along < open_from) | (along > open_to)]
-    return np.column_stack([along, np.full(len(along), side)])
-
-
-def _blind(cells: np.ndarray, x: float = 0.0, reach: float = 40.0) -> float:
-    fleet = safety.Fleet([ROBOT], [1.0], [reach], 0.05)
-    return float(safety.blind_ahead([cells], fleet.radius, np.array([x]), np.zeros(1),
-                                    np.zeros(1), np.ones(1), fleet.hl, fleet.reach,
-                                    fleet.squares, fleet.cfg)[0])
-
-
-def test_a_doorway_beside_the_way_it_cannot_see_into_is_blind_from_its_near_jamb():
-    """Beyond a doorway in the wall beside its way lies free space the robot cannot see (the
-    wall stands between): its front may drive on to the first place from which a line 30 deg
-    forward of across its way passes the near jamb (35 in ahead of the centre, less 13 in /
-    tan 60 deg: 27.5 in, 15.5 in ahead of its front, taken on a 3 in step: 18), no further."""
-    assert _blind(_doorway()) == 18.0
-    # the same wall with no doorway hides nothing it could come out of
-    assert _blind(_doorway(open_from=200.0, open_to=201.0)) == math.inf
-    # nothing known: nothing hidden (what lies beyond its sensors' range is not an opening)
-    assert _blind(np.zeros((0, 2))) == math.inf
-    # a doorway beyond how far its brake looks does not slow it yet
-    assert _blind(_doorway(open_from=60.0, open_to=90.0), reach=30.0) == math.inf
-
-
-def test_a_doorway_the_robot_has_come_level_with_is_seen_into():
-    """Once its centre (its sensors) is past the near jamb, the space beyond the doorway is
-    in sight: no longer blind."""
-    assert _blind(_doorway(), x=40.0) == math.inf
-
-
-def test_the_cap_for_what_it_cannot_see_slows_the_robot_but_never_holds_it():
-    """The guard caps the forward speed at what stops the robot before the blind place, a
-    tick's drive and the margin included, never below the floor; a robot slowed by it is not
-    counted as held (it does not back out for it), and backing is not capped."""
-    fleet = safety.Fleet([ROBOT], [1.0], [40.0], 0.05)
-    cfg = fleet.cfg
-    fast = np.array([60.0])
-    cap = fleet.caps(np.array([0]), np.zeros(1), np.zeros(1), np.zeros(1), np.zeros(1), fast,
-                     [_doorway()]).item()
-    assert cap == safety.brake(18.0, ROBOT.acceleration, cfg.margin, 0.05)
-    near = fleet.caps(np.array([0]), np.array([25.0]), np.zeros(1), np.zeros(1), np.zeros(1),
-                      fast, [_doorway()]).item()
-    assert near == cfg.blind_floor
-    body = safety.Body(ROBOT, AT, 90.0, np.zeros((0, 2)), 1.0, 0.0, 40.0, 0.0)
-    rec = safety.Recovery()
-    for _ in range(40):                                         # 2 s, past its patience
-        (steer, speed), backs = safety.guard((90.0, 60.0), body, rec, 0.05, cap=near)
-        assert (steer, speed, backs) == (90.0, near, False)
-    assert rec.held == 0.0
-    (_, speed), _ = safety.guard((90.0, -10.0), body, rec, 0.05, cap=near)
-    assert speed == -10.0
-
-
-CROSSING = """
-name: crossing
-dt: 0.05
-time_limit: 30
-substeps: 4
-robot: {model: tricycle, wheelbase: 16, footprint: {length: 24, width: 18}, max_speed: 60, acceleration: 40}
-sensors: {layout: ring, count: 36, cone: 15, range: 150, noise: 0}
-q_init: {x: 30, y: -10, heading: 0}
-q_goal: {x: 570, y: -10, tolerance: 12}
-map:
-  corridors:
-    - points: [[0, 0], [600, 0]]
-      width: 70
-    - points: [[300, -300], [300, 300]]
-      width: 60
-"""
-
-
-def _driven(world, blind: bool, monkeypatch):
-    """The trace of ``world``'s planner from seed 1 with the blind corner on or off."""
-    from mitos_cli.sim import Simulation
-
-    with monkeypatch.context() as m:
-        m.setattr(safety, "Settings", functools.partial(safety.Settings, blind=blind))
-        sim = Simulation(world, seed=1)
-    while not sim.done:
-        sim.step()
-    return sim.result()
-
-
-def test_a_crossing_it_cannot_see_into_slows_the_robot_to_its_corner(tmp_path, monkeypatch):
-    """Through a crossing whose side corridors its walls hide, the planner's robot comes to
-    the near corner (its front at 268 in, the corner at 270) at 20 in/s and edges past it at
-    the floor (8 in/s), then goes on to its goal; without the blind corner it keeps its
-    34.5 in/s all the way through."""
-    from mitos_cli.sim import load_world
-
-    path = tmp_path / "crossing.yaml"
-    path.write_text(CROSSING)
-    world = load_world(path)
-    cfg = safety.Settings()
-    runs = {b: _driven(world, b, monkeypatch) for b in (True, False)}
-    front = {b: r.pose[:, 0, 0] + 12.0 for b, r in runs.items()}
-    v = {b: r.speed[:, 0] for b, r in runs.items()}
-    corner = {b: v[b][np.flatnonzero(front[b] >= 268.0)[0]] for b in runs}
-    by = {b: v[b][(front[b] > 240.0) & (front[b] < 300.0)] for b in runs}
-    assert runs[True].outcome == runs[False].outcome == "success"
-    assert corner[True] <= 20.0 and by[True].min() == cfg.blind_floor
-    assert corner[False] > 34.0 and by[False].min() > 34.0
-
-
-def test_a_corridor_with_no_side_opening_is_driven_to_the_bit_as_without_it(monkeypatch):
-    """The shipped corridor has no side opening: its planner's run is the same trace, bit
-    for bit, with the blind corner as without it."""
-    from mitos_cli.resources import packaged_path
-    from mitos_cli.sim import load_world
-
-    world = load_world(packaged_path("worlds", "corridor.yaml"))
-    on, off = (_driven(world, b, monkeypatch) for b in (True, False))
-    assert on.outcome == off.outcome == "success"
-    assert on.pose.tobytes() == off.pose.tobytes()
-    assert on.speed.tobytes() == off.speed.tobytes()

@@ -1161,10 +1161,8 @@ class Simulation:
         fleet = self._fleet
         rows = (self._active & fleet.brakes).nonzero()[0]
         cells = [self._maps[i].near(s.pose[i, :2], fleet.squares.item(i)) for i in rows.tolist()]
-        given = [self._maps[i].near(s.pose[i, :2], fleet.squares.item(i), given=True)
-                 for i in rows.tolist()]
         now = (self._x, self._y, self._h, self._steer, self._v, s.inputs["heading"])
-        for i in fleet.guard(rows, s.command, self._recovery, now, cells, given):
+        for i in fleet.guard(rows, s.command, self._recovery, now, cells):
             self._backed.append((self._k, i))
 
     def act(self, s: _Sensed) -> None:
@@ -1729,11 +1727,10 @@ class Batch:
             return
         maps = self.maps if len(rows) == len(self.maps) else [self.maps[i] for i in rows.tolist()]
         cells = knowledge.near_all(maps, self.at[rows], fleet.squares[rows])
-        given = knowledge.near_all(maps, self.at[rows], fleet.squares[rows], given=True)
         x, y, h = self._ticked()
         v, steer = self._drive
         backs = fleet.guard(rows, self.command, self._recovery,     # (the runs' too)
-                            (x, y, h, steer, v, self.block[_SIDE]), cells, given)
+                            (x, y, h, steer, v, self.block[_SIDE]), cells)
         for row in backs:
             run, i = self._owner[row]
             run._backed.append((run._k, i))

@@ -17,11 +17,6 @@ them away, as the paper's robot had none):
   more room: the brake bounds the speed on one arc, and a hard turn at speed (a planner
   swerving just after it passed another robot) swung a robot into a wall it could then not
   stop before.
-- **the blind corner** (:meth:`Fleet.caps`): no faster than it can stop, the same way,
-  before the first place its way passes a side opening of the map it was given that it
-  cannot see into (:func:`blind_ahead`: a side corridor or a door whose inside the walls
-  hide), where a mover could come out in front of it; never slower than ``blind_floor``,
-  since it sees in only as it comes to the corner. A robot slowed by it is not held.
 - **backing out** (:class:`Recovery`): held by the brake for ``patience`` seconds while its
   planner wants to go on, the robot backs out for ``back_time`` seconds on the opposite lock
   (which swings its nose toward the side its route lies on), as far as the way behind is
@@ -54,15 +49,6 @@ class Settings:
     back_time: float = 1.5         # s: how long one backing-out lasts
     back_room: float = 4.0         # in: it backs out only with this much free behind
     want: float = 2.0              # in/s: a planner asking for more than this wants to go on
-    blind: bool = True             # no faster than it can stop before a side opening of its
-                                   # map it cannot see into (:func:`blind_ahead`)
-    blind_side: float = 72.0       # in: how far from its way's middle it looks for one
-                                   # (past the wall of a corridor 80 in wide, into the opening)
-    blind_width: float = 12.0      # in: the least size of hidden free space that counts (a
-                                   # cart's), across its way and along it
-    blind_step: float = 3.0        # in: between the places along its way
-    blind_floor: float = 8.0       # in/s: it edges past an opening no slower than this (it
-                                   # sees in only once its sensors are past the corner)
 
 
 def free_travel(cells: np.ndarray, radius: float, pose: tuple[float, float, float],
@@ -535,133 +521,6 @@ def _brakes(free: np.ndarray, acceleration: np.ndarray, margin: float,
     return np.sqrt(lag * lag + 2.0 * acceleration * np.maximum(free - margin, 0.0)) - lag
 
 
-def _raster(cells: list[np.ndarray], radius: np.ndarray, x: np.ndarray, y: np.ndarray,
-            square: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """What each of ``R`` robots knows is occupied near it (``cells``, centres of squares of
-    half side ``radius [R]``, in the square of half side ``square [R]`` round ``x, y``), as
-    one flat block of ``R`` squares of ``G x G`` cells (a free cell all round each, where
-    every point off it is read), with each row's lower-left corner and cell side ``[R]``:
-    the corner lies on the map's own cell lines (a cell of each robot's map is a cell of its
-    row); cells too fine for a block of 600 a side are grouped."""
-    side = np.maximum(2.0 * radius, 2.0 * square / 598.0)
-    first = np.array([c[0] if len(c) else (xi, yi) for c, xi, yi in zip(cells, x, y)], float)
-    first = first.reshape(len(cells), 2)
-    ax = first[:, 0] - radius - side * (np.ceil((first[:, 0] - radius - (x - square)) / side) + 1)
-    ay = first[:, 1] - radius - side * (np.ceil((first[:, 1] - radius - (y - square)) / side) + 1)
-    g = int(np.ceil(2.0 * square / side).max()) + 4
-    block = np.zeros(len(cells) * g * g, dtype=bool)
-    owner = np.repeat(np.arange(len(cells)), [len(c) for c in cells])
-    if len(owner):
-        every = np.concatenate(cells)
-        ix = np.floor((every[:, 0] - ax[owner]) / side[owner]).astype(np.intp)
-        iy = np.floor((every[:, 1] - ay[owner]) / side[owner]).astype(np.intp)
-        keep = (ix >= 1) & (ix < g - 1) & (iy >= 1) & (iy < g - 1)
-        block[(owner[keep] * g + iy[keep]) * g + ix[keep]] = True
-    return block, ax, ay, side
-
-
-def _occupied(block: np.ndarray, ax: np.ndarray, ay: np.ndarray, side: np.ndarray,
-              row: np.ndarray, px: np.ndarray, py: np.ndarray) -> np.ndarray:
-    """Whether the points ``px, py`` of the rows ``row`` (all three of one shape) lie in a
-    cell of their row's square of ``block`` (:func:`_raster`); a point off it is free."""
-    g = math.isqrt(len(block) // len(ax))
-    ix = np.clip(np.floor((px - ax[row]) / side[row]), 0, g - 1).astype(np.intp)
-    iy = np.clip(np.floor((py - ay[row]) / side[row]), 0, g - 1).astype(np.intp)
-    return block[(row * g + iy) * g + ix]
-
-
-def _runs(ok: np.ndarray, width: np.ndarray) -> np.ndarray:
-    """Where a run of ``width`` true values along the last axis of ``ok [R, ..., K]`` begins,
-    ``width [R]`` a row's own (a run that would end past ``K`` does not begin)."""
-    k = ok.shape[-1]
-    count = np.cumsum(ok, axis=-1, dtype=np.int64)
-    count = np.concatenate([np.zeros(ok.shape[:-1] + (1,), np.int64), count], axis=-1)
-    w = width.reshape((len(width),) + (1,) * (ok.ndim - 1))
-    end = np.arange(k) + w                                      # [R, 1, ..., K]
-    inside = end <= k
-    ends = np.take_along_axis(count, np.broadcast_to(np.minimum(end, k), ok.shape), axis=-1)
-    return inside & (ends - count[..., :k] == w)
-
-
-@functools.lru_cache(maxsize=1)
-def _fan() -> tuple[np.ndarray, np.ndarray]:
-    """The cosines and sines ``[1, 1, D, 1]`` of the directions :func:`blind_ahead` looks
-    along from each place of a robot's way, off the way's direction: 60, 90 and 120 deg
-    left, and right."""
-    angles = [math.radians(a) for a in (60.0, 90.0, 120.0, -60.0, -90.0, -120.0)]
-    fan_c = np.array([math.cos(a) for a in angles]).reshape(1, 1, -1, 1)
-    fan_s = np.array([math.sin(a) for a in angles]).reshape(1, 1, -1, 1)
-    fan_c.flags.writeable = fan_s.flags.writeable = False
-    return fan_c, fan_s
-
-
-def blind_ahead(cells: list[np.ndarray], radius: np.ndarray, x: np.ndarray, y: np.ndarray,
-                sin_h: np.ndarray, cos_h: np.ndarray, hl: np.ndarray, reach: np.ndarray,
-                square: np.ndarray, cfg: Settings) -> np.ndarray:
-    """``[R]`` how far (in) each robot's front may drive on, along its way (``sin_h, cos_h``
-    of the way's direction), before it comes beside a side opening it cannot see into: free
-    space beside its way (from the way's middle to ``cfg.blind_side`` either side), as wide
-    as a cart across and along (``cfg.blind_width``), that a mover could drive from onto its
-    way (nothing of ``cells`` between) and that the robot cannot see: a cell of ``cells``
-    (squares of half side ``radius``, :func:`_raster`: the simulator gives its map as it was
-    given, walls and doors) stands on the line from the robot's centre (its sensors) to it.
-    Each place of its way is looked from across it and 30 deg either side of across, so a
-    way that bends still passes the opening's mouth. A mover hidden there could come out in
-    front of it. ``inf`` where none lies within ``reach``. Only the robot's own map is read,
-    never the world. Every robot is worked out in its own
-    numbers (its cells' size sets how finely it looks), so it gets the same bits in any
-    batch as alone; only the places within its ``reach`` are looked at (one every
-    ``cfg.blind_step`` along its way; across it, reached every ``fine`` and looked at from
-    every other, ``2 fine`` apart), none by a robot of negative ``reach``."""
-    n = len(cells)
-    out = np.full(n, np.inf)
-    look = (reach >= 0) & np.array([len(c) > 0 for c in cells], dtype=bool)
-    if not look.any():
-        return out
-    block, ax, ay, side = _raster(cells, radius, x, y, square)
-    step = cfg.blind_step
-    fine = np.minimum(step, 0.75 * side)            # across: no wall's cell stepped over
-    across = np.maximum(np.ceil(cfg.blind_side / fine), 2.0).astype(np.intp)
-    wide = np.maximum(np.ceil(cfg.blind_width / (2 * fine)), 1.0).astype(np.intp)
-    width = max(int(math.ceil(cfg.blind_width / step)), 1)
-    places = int(math.floor(float(reach[look].max()) / step)) + 1
-    u = np.arange(places) * step                              # [J] the front's travel
-    along = (hl[:, None] + u)[:, :, None, None]               # [R, J, 1, 1] from the centre
-    k = np.arange(int(across.max()))
-    lateral = (k * fine[:, None])[:, None, None, :]            # [R, 1, 1, K]
-    c, s = cos_h[:, None, None, None], sin_h[:, None, None, None]
-    ox, oy = x[:, None, None, None], y[:, None, None, None]
-    # across its way and 30 deg either side of across, left and right: a way that bends
-    # (the route point's bearing swings as it swerves) still passes the opening's mouth
-    fan_c, fan_s = _fan()                                      # [D] off the way's direction
-    dc = (c * fan_c - s * fan_s)                               # [R, 1, D, 1]
-    ds = (s * fan_c + c * fan_s)
-    px = ox + along * c + lateral * dc                         # [R, J, D, K]
-    py = oy + along * s + lateral * ds
-    row = np.broadcast_to(np.arange(n)[:, None, None, None], px.shape)
-    free = ~_occupied(block, ax, ay, side, row, px, py)
-    free &= (k < across[:, None])[:, None, None, :] & (u <= reach[:, None])[:, :, None, None]
-    free &= look[:, None, None, None]
-    open_ = np.logical_and.accumulate(free, axis=3)[..., ::2]  # reached from the way's middle
-    # the lines of sight to the points reached, ``0.75`` of a cell a step
-    r, j, e, q = open_.nonzero()
-    qx, qy = px[r, j, e, 2 * q], py[r, j, e, 2 * q]
-    far = np.sqrt((hl + reach + step) ** 2 + (across * fine) ** 2)
-    ticks = np.maximum(np.ceil(far / (0.75 * side)), 2.0)      # [R] steps along each line
-    i = np.arange(1, int(ticks[look].max()))
-    t = i / ticks[r, None]                                     # [P, T]
-    rx = x[r, None] + t * (qx - x[r])[:, None]
-    ry = y[r, None] + t * (qy - y[r])[:, None]
-    hit = _occupied(block, ax, ay, side, np.broadcast_to(r[:, None], rx.shape), rx, ry)
-    hidden = np.zeros(open_.shape, dtype=bool)
-    hidden[r, j, e, q] = (hit & (i < ticks[r, None])).any(axis=1)
-    room = np.asarray(_runs(hidden, wide).any(axis=(2, 3)))    # [R, J]
-    blind = _runs(room, np.full(n, width))                     # [R, J] where one begins
-    has = blind.any(axis=1)
-    out[has] = u[blind.argmax(axis=1)[has]]
-    return out
-
-
 def reach_of(robot: Robot, dt: float, cfg: Settings, sight: float) -> float:
     """How far along its arc a robot's brake looks (in): what stopping from its top speed
     takes, a tick's drive and the margin included, a step over (so that nothing in sight
@@ -709,8 +568,7 @@ class Body:
 
 def guard(command: tuple[float, float], body: Body, rec: Recovery, dt: float,
           cfg: Settings = Settings(),
-          known: tuple[float, bool, float] | None = None,
-          cap: float = math.inf) -> tuple[tuple[float, float], bool]:
+          known: tuple[float, bool, float] | None = None) -> tuple[tuple[float, float], bool]:
     """The command the robot carries out (steering deg, speed in/s) and whether it begins to
     back out now, from its planner's ``command``: a backing-out under way goes on while the
     way behind is free; otherwise the brake holds the speed to what the arc the wheel will be
@@ -718,9 +576,7 @@ def guard(command: tuple[float, float], body: Body, rec: Recovery, dt: float,
     (on the lock that swings its nose toward its route, else straight), if it has the room.
     ``rec`` is updated. ``known``: the first sweep already measured (wheel, backward, free
     travel: :func:`first_sweep`'s for ``command``, ``body`` and ``rec``, measured with other
-    robots' by :meth:`Fleet.guard`), whose wheel is not worked out again. ``cap``: the most
-    (in/s) it may drive forward for what it cannot see (:meth:`Fleet.caps`); a robot slowed by
-    it is not held (it does not back out for it)."""
+    robots' by :meth:`Fleet.guard`), whose wheel is not worked out again."""
     robot = body.robot
 
     def free(wheel: float, backward: bool) -> float:
@@ -750,8 +606,7 @@ def guard(command: tuple[float, float], body: Body, rec: Recovery, dt: float,
         hold = brake(free(body.wheel, want < 0), robot.acceleration, cfg.margin, dt)
         if hold > limit:
             steer, limit = body.wheel, hold
-    top = min(limit, cap) if want > 0 else limit
-    speed = math.copysign(top, want) if abs(want) > top else want
+    speed = math.copysign(limit, want) if abs(want) > limit else want
     rec.held = rec.held + dt if abs(want) > cfg.want and limit < cfg.want else 0.0
     if rec.held < cfg.patience or robot.max_reverse <= 0:
         return (steer, speed), False
@@ -839,26 +694,20 @@ class Fleet:
         return out
 
     def guard(self, rows: np.ndarray, command: np.ndarray, state: np.ndarray,
-              now: tuple[np.ndarray, ...], cells: list[np.ndarray],
-              given: list[np.ndarray] | None = None) -> list[int]:
+              now: tuple[np.ndarray, ...], cells: list[np.ndarray]) -> list[int]:
         """:func:`guard` of the robots ``rows`` (ascending) at once, on their ``command [N,
         2]`` and their :class:`Recovery` ``state [N, 3]`` (:func:`rest`), both updated in
         place; the rows that begin to back out, in order. ``now``: every row's x, y (in),
         heading (rad), wheel (deg), speed (in/s) and route side, ``[N]`` each; ``cells``:
-        what each of ``rows`` knows is occupied near it; ``given``: what of it its map was
-        given with (the building, without what it sensed), where it looks for the side
-        openings it cannot see into (:meth:`caps`; ``cells`` when ``None``). Their first sweeps
+        what each of ``rows`` knows is occupied near it. Their first sweeps
         (:func:`first_sweep`) are measured together; a robot whose command the brake alone
         decides (no backing out under way or to begin, no wheel to hold: most, most ticks)
         is decided here, the rest by :func:`guard` itself, with its first sweep known. One
         robot is guarded as alone: the arrays would cost more than they save."""
-        x, y, h, wheel, speed, route = (v[rows] for v in now)
-        sight = cells if given is None else given
-        cap = self.caps(rows, x, y, h, route, command[rows, 1], sight)
         if len(rows) <= 1:
-            return [i for i in rows.tolist()
-                    if self._one(i, command, state, now, cells[0], cap=cap.item(0))]
+            return [i for i in rows.tolist() if self._one(i, command, state, now, cells[0])]
         cfg, dt = self.cfg, self.dt
+        x, y, h, wheel, speed, _ = (v[rows] for v in now)
         held, left, lock = state[rows].T
         steer, want = command[rows].T
         backing = left > 0
@@ -872,44 +721,14 @@ class Fleet:
         hard = (backing | ((limit < slowest) & (turned != wheel))
                 | ((held >= cfg.patience) & (self.reverse[rows] > 0)))
         easy = rows[~hard]
-        top = np.where(want > 0, _least(limit, cap), limit)
-        command[easy, 1] = np.where(np.abs(want) > top, np.copysign(top, want), want)[~hard]
+        command[easy, 1] = np.where(np.abs(want) > limit, np.copysign(limit, want), want)[~hard]
         state[easy, 0] = held[~hard]
         return [int(rows[j]) for j in hard.nonzero()[0].tolist()
                 if self._one(int(rows[j]), command, state, now, cells[j],
-                             (turned.item(j), bool(back[j]), free.item(j)), cap.item(j))]
-
-    def caps(self, rows: np.ndarray, x: np.ndarray, y: np.ndarray, h: np.ndarray,
-             route: np.ndarray, want: np.ndarray, cells: list[np.ndarray]) -> np.ndarray:
-        """``[R]`` the most (in/s) each of the robots ``rows`` at ``x, y, h`` may drive forward
-        for what it cannot see: no faster than it can stop, a tick's drive and the margin
-        included, before the first side opening of ``cells`` (its map as it was given,
-        :meth:`guard`) it cannot see into (:func:`blind_ahead`)
-        along the way to its route point (``route``: its bearing, deg off the heading,
-        positive right), and no slower than ``cfg.blind_floor`` (it sees in only as its
-        sensors pass the corner); ``inf`` where none lies ahead, or ``cfg.blind`` is off.
-        Only as far ahead is looked as the speed it wants (``want``, in/s) needs to stop, and
-        a cart's length more: a cap beyond would not slow it (and none is worked out for a
-        robot that wants no more than the floor): the command it carries out is the same."""
-        cfg, n = self.cfg, len(rows)
-        if not cfg.blind or n == 0:
-            return np.full(n, np.inf)
-        way = [a - math.radians(b) if math.isfinite(b) else a
-               for a, b in zip(h.tolist(), route.tolist())]
-        sin_h = np.fromiter(map(math.sin, way), float, n)
-        cos_h = np.fromiter(map(math.cos, way), float, n)
-        a, dt = self.acceleration[rows], self.dt
-        stop = want * dt + want * want / (2.0 * a) + cfg.margin + cfg.blind_width + cfg.blind_step
-        reach = np.where(want > cfg.blind_floor, _least(self.reach[rows], stop), -1.0)
-        travel = blind_ahead(cells, self.radius[rows], x, y, sin_h, cos_h, self.hl[rows],
-                             reach, self.squares[rows], cfg)
-        seen = np.isinf(travel)
-        limit = _brakes(np.where(seen, 0.0, travel), a, cfg.margin, dt)
-        return np.where(seen, np.inf, _most(limit, np.full(n, cfg.blind_floor)))
+                             (turned.item(j), bool(back[j]), free.item(j)))]
 
     def _one(self, i: int, command: np.ndarray, state: np.ndarray, now: tuple[np.ndarray, ...],
-             cells: np.ndarray, known: tuple[float, bool, float] | None = None,
-             cap: float = math.inf) -> bool:
+             cells: np.ndarray, known: tuple[float, bool, float] | None = None) -> bool:
         """:func:`guard` of the robot of row ``i`` (:meth:`guard`'s arguments, ``cells`` its
         own, ``known`` its first sweep if measured): whether it begins to back out."""
         x, y, h, wheel, speed, side = (v.item(i) for v in now)
@@ -917,7 +736,7 @@ class Fleet:
                     self.reach.item(i), speed)
         rec = Recovery(*state[i].tolist())
         command[i], backs = guard((command.item(i, 0), command.item(i, 1)), body, rec, self.dt,
-                                  self.cfg, known, cap)
+                                  self.cfg, known)
         state[i] = rec.held, rec.left, rec.wheel
         return backs
 
