@@ -319,15 +319,14 @@ def test_scale_centre_is_the_mirror_point():
     assert scale_of(PAPER.variables["steering"]).centre == 3.0       # ST
 
 
-def test_an_unknown_instruction_at_the_prompt_names_its_place_and_the_list():
+def test_an_unknown_instruction_at_the_prompt_names_its_place_and_the_list(tmp_path):
     import subprocess
     import sys
-    from pathlib import Path
 
-    root = Path(__file__).resolve().parents[1]
     lesson = "use drive\nsimulate figure4\nat 13s to 14s make a wide turn\n"
+    # run where the session may live: in the repository it would stay, for `--resume` there
     res = subprocess.run([sys.executable, "-m", "mitos_cli", "teach", "rulebases/mitos.rules",
-                          "--lesson", "-"], cwd=root, input=lesson, capture_output=True,
+                          "--lesson", "-"], cwd=tmp_path, input=lesson, capture_output=True,
                          text=True, timeout=120)
     assert res.returncode == 1
     # marked at its words (it was marked from the `at`, at column 1)
