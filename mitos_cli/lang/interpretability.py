@@ -350,6 +350,66 @@ def most_similar(corners: np.ndarray, universe: tuple[float, float]) -> tuple[fl
     return _linear_most(corners, breakpoints(corners, universe))
 
 
+def most_similar_by_pairs(corners: np.ndarray, universe: tuple[float, float]
+                          ) -> tuple[float, int, int] | None:
+    """:func:`most_similar`, each overlapping pair summed on its own points: the universe's
+    ends, the pair's corners and the crossings of its edges, where the min and the max of
+    two piecewise-linear terms can bend, so the trapezoid rule is as exact there as on every
+    breakpoint of the variable (about 14 points a pair, where those are quadratic in the
+    terms: 300 triangles that all overlap took 56 s in `mitos check`). Repeated terms are
+    measured once. ``None`` where a term has a vertical edge (a crisp step: its trapezoids
+    depend on the points beside it) or there are fewer than two terms."""
+    lo, hi = universe
+    distinct, which, counts = _distinct_rows(corners + 0.0)
+    a, b, c, d = distinct.T
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+        lines = (1.0 / (b - a), -a / (b - a), -1.0 / (d - c), d / (d - c))
+    rise, fall = np.isfinite(a) & np.isfinite(b), np.isfinite(c) & np.isfinite(d)
+    if len(corners) < 2 or not (np.isfinite(lines[0][rise]).all()
+                                and np.isfinite(lines[2][fall]).all()
+                                and (b[rise] > a[rise]).all() and (d[fall] > c[fall]).all()):
+        return None
+    i, j = _overlapping(a, d)
+    twice = np.flatnonzero(counts > 1)                  # a repeated term against its copy
+    i, j = np.concatenate([np.minimum(i, j), twice]), np.concatenate([np.maximum(i, j), twice])
+    s = np.zeros(len(i))
+    step = max(1, PAIR_BLOCK // 16)
+    for k in range(0, len(i), step):                    # blocks of pairs, a row of points each
+        s[k:k + step] = _pairs_on_own_points(distinct, i[k:k + step], j[k:k + step], lines,
+                                             lo, hi)
+    top = float(s.max()) if len(s) else 0.0
+    if top <= 0:
+        return 0.0, 0, 1
+    # the whole matrix's first in reading order: the smallest row, then the smallest column
+    occurs = [np.flatnonzero(which == k)[:2] for k in range(len(distinct))]
+    best: tuple[int, int] | None = None
+    for k, v in zip(i[s == top], j[s == top]):
+        p, q = (occurs[k][0], occurs[k][1]) if k == v else sorted((occurs[k][0], occurs[v][0]))
+        best = (int(p), int(q)) if best is None else min(best, (int(p), int(q)))
+    assert best is not None
+    return top, best[0], best[1]
+
+
+def _pairs_on_own_points(corners, i, j, lines, lo: float, hi: float) -> np.ndarray:
+    """The Jaccard similarity of terms ``i[p]`` and ``j[p]`` on the points of each pair."""
+    rs, ro, fs, fo = lines
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+        cross = np.stack([(ro[j] - ro[i]) / (rs[i] - rs[j]), (fo[j] - ro[i]) / (rs[i] - fs[j]),
+                          (ro[j] - fo[i]) / (fs[i] - rs[j]), (fo[j] - fo[i]) / (fs[i] - fs[j])],
+                         axis=1)
+    pts = np.concatenate([np.full((len(i), 1), lo), np.full((len(i), 1), hi), corners[i],
+                          corners[j], cross], axis=1)
+    pts = np.sort(np.where(np.isfinite(pts) & (pts >= lo) & (pts <= hi), pts, lo), axis=1)
+    m = np.stack([memberships_at(corners[np.repeat(k, pts.shape[1])], pts.reshape(-1))
+                  .reshape(pts.shape) for k in (i, j)])
+    dx = np.diff(pts, axis=1)
+    lo_m, hi_m = np.minimum(m[0], m[1]), np.maximum(m[0], m[1])
+    inter = ((lo_m[:, 1:] + lo_m[:, :-1]) * 0.5 * dx).sum(axis=1)
+    union = ((hi_m[:, 1:] + hi_m[:, :-1]) * 0.5 * dx).sum(axis=1)
+    meets = ((m[0] > 0) & (m[1] > 0)).any(axis=1)
+    return np.divide(inter, union, out=np.zeros_like(inter), where=meets & (union > 0))
+
+
 def _linear_most(corners: np.ndarray, x: np.ndarray) -> tuple[float, int, int]:
     """:func:`most_similar` at the points ``x``."""
     distinct, which, counts = _distinct_rows(corners)
@@ -619,7 +679,9 @@ def variable_issues(var: Variable) -> list[Issue]:
                     var, low, where, spans, gaps=bool(np.any(top <= 0.0))),
                     "widen the neighbouring terms so that they overlap there"))
         if len(sets) >= 2:
-            s, i, j = most_similar_on(mu, x) if corners is None else _linear_most(corners, x)
+            found = None if corners is None else most_similar_by_pairs(corners, var.universe)
+            s, i, j = found or (most_similar_on(mu, x) if corners is None
+                                else _linear_most(corners, x))
             if s > SIMILARITY + 1e-9:
                 out.append(Issue("indistinct", var.name, (sets[i].name, sets[j].name), (
                     f"`{var.name}.{sets[i].name}` and `{sets[j].name}` are hard to tell apart "
