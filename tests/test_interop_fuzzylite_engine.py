@@ -533,3 +533,105 @@ END_FUNCTION_BLOCK
     X = np.linspace(0, 1, 11)[:, None]
     assert np.array_equal(evaluate(c, X, strict=False, detail=False).outputs,
                           run(TSUKAMOTO, X), equal_nan=True)
+
+
+# ---------------------------------------------------------------------------------------------
+# Input ranges: fuzzylite clamps an input only under `lock-range: true` (its default is false)
+
+RANGES = """\
+Engine: ranges
+InputVariable: x
+  range: 0 10
+LOCK_X
+  term: low Triangle 0 0 10
+  term: high Triangle 0 10 10
+InputVariable: z
+  range: 0 10
+LOCK_Z
+  term: wide Triangle -10 0 20
+OutputVariable: y
+  range: 0 1
+  aggregation: none
+  defuzzifier: WeightedAverage TakagiSugeno
+  default: nan
+  term: a Constant 0
+  term: b Constant 1
+RuleBlock: r
+  conjunction: Minimum
+  activation: General
+  rule: if x is low and z is wide then y is a
+  rule: if x is high and z is wide then y is b
+"""
+
+
+def ranges(x: str, z: str) -> str:
+    return RANGES.replace("LOCK_X", x).replace("LOCK_Z", z)
+
+
+@pytest.mark.parametrize("lock", ["  lock-range: false", "  description: lock-range unwritten"])
+def test_an_input_not_locked_to_its_range_is_evaluated_as_given(lock):
+    """By hand: at x = 12 both triangles of x are 0 (they end at 10), so no rule fires and y is
+    its default, NaN; clamped to 10, `high` is 1 and y is 1. z = 5 is inside its range."""
+    rb = parse_fll(ranges(lock, lock), "t.fll")
+    assert compile_rulebase(rb).operators.inputs == "as_given"
+    got = run(ranges(lock, lock), [[12.0, 5.0], [5.0, 5.0], [-3.0, 5.0]])[:, 0]
+    assert np.isnan(got[0]) and got[1] == 0.5 and np.isnan(got[2])
+    assert not rb.notes
+
+
+def test_inputs_locked_to_their_ranges_are_clamped():
+    text = ranges("  lock-range: true", "  lock-range: true")
+    assert compile_rulebase(parse_fll(text, "t.fll")).operators.inputs == "clamped"
+    assert run(text, [[12.0, 5.0], [-3.0, 5.0]])[:, 0].tolist() == [1.0, 0.0]
+
+
+def test_inputs_locked_and_not_are_all_clamped_with_a_note_naming_the_others():
+    rb = parse_fll(ranges("  lock-range: true", "  lock-range: false"), "t.fll")
+    assert compile_rulebase(rb).operators.inputs == "clamped"
+    assert len(rb.notes) == 1 and rb.notes[0].startswith("t.fll:9:15: ")
+    assert "`z` not locked to its range (`lock-range: false`" in rb.notes[0]
+
+
+@pytest.mark.parametrize("lock", ["true", "false"])
+def test_the_fll_writer_says_whether_inputs_are_clamped(lock):
+    from mitos_cli.interop.fll import write_fll
+
+    text = write_fll(parse_fll(ranges(f"  lock-range: {lock}", f"  lock-range: {lock}"), "t.fll"))
+    inputs = text.split("OutputVariable:")[0]
+    assert inputs.count(f"lock-range: {lock}") == 2 and inputs.count("lock-range:") == 2
+    again = compile_rulebase(parse_fll(text, "back.fll"))
+    assert again.operators.inputs == ("clamped" if lock == "true" else "as_given")
+
+
+def test_fidelity_fuzzylite_evaluates_fcl_inputs_as_given_and_keeps_an_fll_files_locks():
+    """fuzzylite's FCL and `.fis` importers leave `lock-range` false (FCL has no word for an
+    input's); an FLL file says its own, which its reading already kept."""
+    from mitos_cli.interop.common import fidelity_settings
+    from mitos_cli.interop.fcl import parse_fcl
+    from mitos_cli.lang.model import Setting
+
+    fcl = parse_fcl("FUNCTION_BLOCK t\nVAR_INPUT u : REAL; END_VAR\nVAR_OUTPUT y : REAL; END_VAR\n"
+                    "FUZZIFY u RANGE := (0 .. 1); TERM low := Triangle 0 0 1; END_FUZZIFY\n"
+                    "DEFUZZIFY y RANGE := (0 .. 1); TERM z := 1; METHOD : COGS; DEFAULT := 0; "
+                    "END_DEFUZZIFY\nRULEBLOCK b RULE 1 : IF u IS low THEN y IS z; END_RULEBLOCK\n"
+                    "END_FUNCTION_BLOCK\n", "t.fcl")
+    given = Setting("inputs", "as_given")
+    for engine in ("fuzzylite", "fuzzylite6", "jfuzzylogic"):
+        assert given in fidelity_settings(fcl, engine)
+    assert given not in fidelity_settings(fcl, "matlab")
+    locked = parse_fll(ranges("  lock-range: true", "  lock-range: true"), "t.fll")
+    assert given not in fidelity_settings(locked, "fuzzylite")
+
+
+def test_inputs_outside_their_ranges_agree_with_fuzzylite():
+    fl = pytest.importorskip("fuzzylite", reason="pyfuzzylite is not installed")
+    for x_lock, z_lock in (("false", "false"), ("true", "true")):
+        text = ranges(f"  lock-range: {x_lock}", f"  lock-range: {z_lock}")
+        engine = fl.FllImporter().from_string(text)
+        X = np.array([[x, z] for x in (-3.0, 0.0, 4.0, 10.0, 12.5) for z in (-20.0, 5.0, 25.0)])
+        want = []
+        for x, z in X:
+            engine.input_variable("x").value, engine.input_variable("z").value = x, z
+            engine.process()
+            want.append(float(np.asarray(engine.output_variable("y").value).ravel()[0]))
+        np.testing.assert_allclose(run(text, X)[:, 0], want, rtol=0, atol=1e-15)

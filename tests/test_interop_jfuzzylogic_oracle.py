@@ -395,7 +395,7 @@ def test_an_input_outside_its_range_is_evaluated_as_given_under_fidelity(tmp_pat
     assert data["inputs"]["a"]["memberships"] == {"low": 0.0, "high": 0.0}
     assert [r["dof"] for r in data["rules"]] == [pytest.approx(1 / 6, abs=1e-15)]
     assert ("`a` lies outside its universe [0, 10] (12): its terms are evaluated there, not "
-            "clamped (`inputs = as_given`, jFuzzyLogic's reading)") in got.stderr
+            "clamped (`inputs = as_given`, fuzzylite's and jFuzzyLogic's reading)") in got.stderr
     plain = CliRunner().invoke(app, ["eval", str(path), "a=12", "b=5", "--json"])
     assert [r["dof"] for r in json.loads(plain.stdout)["rules"]] == [1.0]
     assert "`a` outside its universe [0, 10] was clamped" in plain.stderr
@@ -450,7 +450,9 @@ END_FUNCTION_BLOCK
 
 
 @pytest.mark.parametrize("fmt", ["fcl", "fll", "fis", "rules"])
-def test_writing_inputs_as_given_says_it_is_left_out(fmt):
+def test_writing_inputs_as_given_says_it_is_left_out_where_the_format_has_no_word(fmt):
+    """FCL and `.fis` cannot say it (a note); FLL says `lock-range: false` on every input, the
+    rule language `inputs = as_given`."""
     import dataclasses
 
     from test_interop_fcl_grammar import BASE
@@ -464,7 +466,13 @@ def test_writing_inputs_as_given_says_it_is_left_out(fmt):
     rb = dataclasses.replace(rb, behaviors=tuple(dataclasses.replace(b, operators=b.operators + given)
                                                  for b in rb.behaviors))
     notes = [n for n in conversion_notes(rb, fmt) if "as_given" in n]
-    assert bool(notes) == (fmt != "rules"), notes
+    assert bool(notes) == (fmt in ("fcl", "fis")), notes
+    if fmt == "fll":
+        from mitos_cli.interop.fll import parse_fll, write_fll
+
+        text = write_fll(rb)
+        assert text.count("lock-range: false") == 3 and "lock-range: true" not in text
+        assert parse_fll(text, "back.fll").operators[-1] == Setting("inputs", "as_given")
     if fmt == "rules":
         assert "inputs = as_given" in write_rules(rb, "probe.terms.yaml")[0]
 

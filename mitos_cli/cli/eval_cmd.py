@@ -123,7 +123,7 @@ def _glued(name: str, text: str) -> str | None:
 
 def warn_clamped(result) -> None:
     c = result.compiled
-    if c.operators.inputs == "as_given":          # jFuzzyLogic's reading: said, not clamped
+    if c.operators.inputs == "as_given":    # fuzzylite's, jFuzzyLogic's reading: said, not clamped
         lo, hi = c.universe[:, 0], c.universe[:, 1]
         outside = ((result.inputs < lo) | (result.inputs > hi)).sum(axis=0)
         for k, count in enumerate(outside):
@@ -132,7 +132,7 @@ def warn_clamped(result) -> None:
                         else f" ({exact(result.inputs[0, k])})")
                 warn(f"`{c.inputs[k]}` lies outside its universe [{lo[k]:g}, {hi[k]:g}]{many}: "
                      f"its terms are evaluated there, not clamped (`inputs = as_given`, "
-                     f"jFuzzyLogic's reading)")
+                     f"fuzzylite's and jFuzzyLogic's reading)")
         return
     for k, count in enumerate(result.clamped):
         if count:

@@ -24,7 +24,8 @@ IMPLICATION = {
 }
 INPUTS = {
     "clamped": "taken at the universe's nearer end (MATLAB's evalfis; fuzzylite's lock-range: true)",
-    "as_given": "its terms evaluated at the value given (jFuzzyLogic's: --fidelity jfuzzylogic)",
+    "as_given": ("its terms evaluated at the value given (jFuzzyLogic's; fuzzylite's lock-range: "
+                 "false)"),
 }
 SAMPLING = {
     "midpoints": "the midpoints of `resolution` equal cells (fuzzylite's integration rule)",

@@ -156,8 +156,8 @@ def _clamp_columns(compiled: CompiledRuleBase, Xt: np.ndarray, first: int = 0,
                 raise InputError(f"input `{compiled.inputs[col]}` is not a number (NaN){where}",
                                  hint="give every input a finite number")
             raise InputError(f"input `{compiled.inputs[col]}` is {value}{where}: with `inputs = "
-                             f"as_given` (jFuzzyLogic's reading) it is not clamped to its "
-                             f"universe, and its terms have no number there",
+                             f"as_given` (fuzzylite's and jFuzzyLogic's reading) it is not "
+                             f"clamped to its universe, and its terms have no number there",
                              hint="give every input a finite number")
         return Xc, np.zeros(len(plan.lo), dtype=np.intp)
     Xc = np.maximum(Xt, plan.lo_col, order="C")  # NaN stays NaN, and differs from itself

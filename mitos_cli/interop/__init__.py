@@ -228,10 +228,11 @@ def conversion_notes(rb: RuleBase, fmt: str, behavior: str | None = None) -> lis
         out.append(left)
     ops = of_behavior(rb, b)
     out += _defuzzifier_notes(ops, fmt)
-    if ops.inputs == "as_given" and fmt != "rules":
+    if ops.inputs == "as_given" and fmt not in ("rules", "fll"):     # FLL: `lock-range: false`
         out.append(f"`inputs = as_given` is not written: {fmt.upper()} has no word for it, and "
-                   f"the file is read back with inputs clamped to their universes (jFuzzyLogic "
-                   f"evaluates an FCL file's inputs as given: `--fidelity jfuzzylogic`)")
+                   f"the file is read back with inputs clamped to their universes (fuzzylite and "
+                   f"jFuzzyLogic evaluate its inputs as given: `--fidelity fuzzylite` or "
+                   f"`jfuzzylogic`)")
     if fmt == "fis":
         from .fis import notes
 

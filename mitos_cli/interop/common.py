@@ -1017,8 +1017,9 @@ FIDELITY = {"matlab": (101, "endpoints"), "jfuzzylogic": (1000, "left"),
             "octave": (101, "trapezoid")}
 UNWRITTEN_RESOLUTION = {"fuzzylite": 1000, "fuzzylite6": 100}
 #: Engines that evaluate an input outside its universe as given (``inputs = as_given``):
-#: jFuzzyLogic's ``Variable.setValue`` only warns.
-UNCLAMPED = ("jfuzzylogic",)
+#: jFuzzyLogic's ``Variable.setValue`` only warns; fuzzylite clamps only an input whose
+#: ``lock-range`` is true, which no FCL or ``.fis`` file can say (an FLL file's is read).
+UNCLAMPED = {"jfuzzylogic": None, "fuzzylite": (".fcl", ".fis"), "fuzzylite6": (".fcl", ".fis")}
 
 
 def fidelity_settings(rb: RuleBase, engine: str, behavior: str | None = None
@@ -1031,8 +1032,9 @@ def fidelity_settings(rb: RuleBase, engine: str, behavior: str | None = None
                           hint=did_you_mean(engine, FIDELITY))
     b = rb.behavior(behavior)
     ops = ops_mod.of_behavior(rb, b)
-    # jFuzzyLogic evaluates an input outside its RANGE as given (Variable.setValue only warns)
-    given = (Setting("inputs", "as_given"),) if engine in UNCLAMPED else ()
+    files = UNCLAMPED.get(engine, ())       # None: every file
+    unclamped = files is None or (rb.path or "").lower().endswith(files)
+    given = (Setting("inputs", "as_given"),) if unclamped else ()
     if engine == "octave" and ops.inference in ("weighted_average", "weighted_sum"):
         return _octave_accumulation(rb)
     if ops.inference != "mamdani":

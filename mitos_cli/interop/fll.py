@@ -12,9 +12,12 @@ Mapping (details and refusals in ``docs/interop.md``):
 - ``default: nan`` -> no default (an output no rule sets is NaN / :class:`NoRuleFiredError`);
   a number -> ``Variable.default``.
 - ``lock-previous: true`` (keep the last output when no rule fires: state between evaluations)
-  is refused; ``lock-range: true`` on an input is what MITOS always does (inputs are clamped to
-  their range); on an output it is accepted for Mamdani defuzzifiers, whose result lies in the
-  range anyway, and refused for weighted (Takagi-Sugeno) ones.
+  is refused. ``lock-range`` on inputs: ``true`` on every input is MITOS's default (clamped to
+  the range), ``false`` or unwritten on every input (fuzzylite's default) is ``inputs =
+  as_given`` (the terms evaluated at the value given), and a mixture is clamped with a note;
+  the writer says ``true`` or ``false`` by ``inputs``. On an output ``true`` is accepted for
+  Mamdani defuzzifiers, whose result lies in the range anyway, and refused for weighted
+  (Takagi-Sugeno) ones.
 - several rule blocks are merged when their operators agree, else refused; ``enabled: false``
   is refused (MITOS has no disabled parts); activation ``General`` only.
 """
@@ -34,7 +37,7 @@ from ..fuzzy.formula import parse as parse_formula
 from ..fuzzy.shapes import TSUKAMOTO
 from ..lang.bulk import without_cyclic_gc
 from ..lang.cache import lark_parser
-from ..lang.model import Rule, RuleBase
+from ..lang.model import Rule, RuleBase, Setting
 from ..lang.model import format_number as _fmt_weight
 from ..lang.terms import Role, Term, Variable
 from . import common
@@ -78,6 +81,8 @@ class _Var:
     default: float | None = None
     description: str = ""
     lock_range: Span | None = None      # `lock-range: true` on an output
+    #: an input's `lock-range` as written (value, where); unwritten is fuzzylite's `false`
+    input_lock: tuple[bool, Span] | None = None
     record: common.Record = field(default_factory=common.Record)
     weighted_type: tuple[str, Span] | None = None   # a weighted defuzzifier's type, where
     resolution: int | None = None       # its own, where outputs' resolutions differ
@@ -149,7 +154,28 @@ def parse_fll(text: str, path: str | None = None) -> RuleBase:
                              if at is not None}
     rb = common.assemble_blocks(path, built, groups, DEFAULT_RESOLUTION, engine_span, notes,
                                 places)
-    return dataclasses.replace(rb, notes=tuple(notes))
+    return _input_ranges(dataclasses.replace(rb, notes=tuple(notes)), variables)
+
+
+def _input_ranges(rb: RuleBase, variables: list[_Var]) -> RuleBase:
+    """fuzzylite clamps an input to its range only under ``lock-range: true`` (its default is
+    ``false``: the terms evaluated at the value given). MITOS has one setting for all inputs:
+    when no input is locked, ``inputs = as_given``; when some are and some are not, they are
+    all clamped, with a note naming the others (they differ only outside their ranges)."""
+    inputs = [v for v in variables if v.role == "input"]
+    free = [v for v in inputs if not (v.input_lock and v.input_lock[0])]
+    if not free:
+        return rb
+    if len(free) < len(inputs):
+        names = ", ".join(f"`{v.name}`" for v in free)
+        first = free[0].input_lock[1] if free[0].input_lock else free[0].span
+        note = (f"{first}: {names} not locked to {'its' if len(free) == 1 else 'their'} range "
+                f"(`lock-range: false`, fuzzylite's default) beside inputs that are: MITOS "
+                f"clamps every input of a rule base or none, so these are clamped too (the "
+                f"outputs differ from fuzzylite's only for inputs outside their ranges)")
+        return dataclasses.replace(rb, notes=(*rb.notes, note))
+    where = next((v.input_lock[1] for v in free if v.input_lock), None)
+    return dataclasses.replace(rb, operators=(*rb.operators, Setting("inputs", "as_given", where)))
 
 
 def _sections(text: str, path: str | None) -> tuple[list[_Var], list[_Block], Span]:
@@ -267,6 +293,8 @@ def _variable_key(v: _Var, key: str, value: str, span: Span, vspan: Span,
     elif key == "lock-range":
         if value == "true" and v.role == "output":
             v.lock_range = vspan
+        elif v.role == "input":
+            v.input_lock = (value == "true", vspan)
     elif key in ("lock-previous", "lock-valid"):
         if value == "true":
             raise FormatError(f"`{key}: true` (keep the previous output when no rule fires) "
@@ -437,13 +465,14 @@ def write_fll(rb: RuleBase, behavior: str | None = None) -> str:
     tsukamoto = ops.inference == "tsukamoto"
     sugeno = ops.inference in ("weighted_average", "weighted_sum") or tsukamoto
     inputs = common.all_inputs(rb, flat)
+    lock = "false" if ops.inputs == "as_given" else "true"     # clamped: fuzzylite's `true`
     out = [f"Engine: {flat.name}"]
     for v in inputs:
         out += [f"InputVariable: {v.name}"]
         if v.description:
             out.append(f"  description: {_one_line(v.description)}")
         out += ["  enabled: true", f"  range: {fmt_number(v.universe[0])} "
-                f"{fmt_number(v.universe[1])}", "  lock-range: true"]
+                f"{fmt_number(v.universe[1])}", f"  lock-range: {lock}"]
         out += [f"  term: {t.name} {common.fuzzylite_term_text(t, v.name)}" for t in v.terms]
     for v in flat.outputs:
         out += [f"OutputVariable: {v.name}"]

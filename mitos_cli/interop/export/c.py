@@ -234,7 +234,7 @@ def _c_body(p: Program) -> list[str]:
     out = []
     for i in range(len(c.inputs)):
         lo, hi = c.universe[i]
-        if c.operators.inputs == "as_given":        # jFuzzyLogic's reading: not clamped
+        if c.operators.inputs == "as_given":        # fuzzylite's, jFuzzyLogic's reading: not clamped
             out.append(f"    x[{i}] = in[{i}] + 0.0;")
             continue
         out.append(f"    x[{i}] = in[{i}] < {num(lo)} ? {num(lo)} : "
