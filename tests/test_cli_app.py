@@ -275,3 +275,28 @@ def test_a_ctrl_c_while_the_last_output_is_flushed_is_not_a_traceback(tmp_path) 
     proc = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
                           cwd=tmp_path, env=dict(os.environ, PYTHONPATH=str(root)), timeout=120)
     assert proc.stderr == "" and proc.returncode == -signal.SIGINT
+
+
+def test_no_argument_shows_a_type_name_in_help():
+    """Typer prints an argument's type beside its metavar (`<str>`, `<file_arg>`), which tells a
+    user nothing the metavar does not; every positional argument's type leaves it out."""
+    import re
+
+    from typer.testing import CliRunner
+
+    app = build_app()
+    runner = CliRunner()
+    group = typer.main.get_command(app)
+
+    def commands(cmd, words):
+        subs = getattr(cmd, "commands", {})
+        yield words
+        for name, sub in subs.items():
+            yield from commands(sub, [*words, name])
+
+    seen = 0
+    for words in commands(group, []):
+        out = runner.invoke(app, [*words, "--help"], env={"COLUMNS": "160"}).output
+        assert not re.search(r"<(str|function|file_arg|text)>", out), (words, out)
+        seen += "Arguments" in out
+    assert seen >= 10

@@ -9,7 +9,7 @@ import typer
 
 from ..words import plural
 from .output import emit, json_text, warn, warn_notes
-from .params import finite, named
+from .params import WORDS, finite, named
 
 
 def show_path(path: str | None) -> str:
@@ -114,7 +114,7 @@ def _shown(finding: dict) -> dict:
 
 def check_command(
     rulebase: Annotated[Optional[str], typer.Argument(
-        metavar="[RULEBASE]", callback=named,
+        click_type=WORDS, metavar="[RULEBASE]", callback=named,
         help="Rule file (default: the packaged MITOS rule base), or a term set "
              "(FILE.terms.yaml) checked alone.")] = None,
     behavior: Annotated[Optional[str], typer.Option(

@@ -12,7 +12,7 @@ from ..errors import UsageError, unknown
 from ..words import plural
 from . import complete
 from .output import emit, err, json_text, warn
-from .params import MAX_RUNS, named, option_names
+from .params import MAX_RUNS, WORDS, named, option_names
 from .progress import INTERRUPTED, progress_bar
 
 DEFAULT_AND = "min,product,lukasiewicz,einstein"
@@ -20,7 +20,7 @@ DEFAULT_AND = "min,product,lukasiewicz,einstein"
 
 def compare_command(
     worlds: Annotated[list[str], typer.Argument(
-        metavar="WORLDS...", autocompletion=complete.worlds, callback=named,
+        click_type=WORDS, metavar="WORLDS...", autocompletion=complete.worlds, callback=named,
         help="World files (or names of packaged worlds such as corridor.yaml).")],
     and_: Annotated[str, typer.Option(
         "--and", metavar="TNORMS", callback=named,

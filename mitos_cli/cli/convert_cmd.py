@@ -9,7 +9,7 @@ from typing import Annotated, Optional
 import typer
 
 from .output import emit, err, warn, warn_notes
-from .params import choice, choices, completer, file_arg, named, target_of
+from .params import FILE, choice, choices, completer, file_arg, named, target_of
 from .targets import check_suffix, refuse_existing, refuse_inputs, refuse_strays, source_files
 
 
@@ -29,7 +29,7 @@ class Dialect(str, Enum):
 
 def convert_command(
     path: Annotated[Path, typer.Argument(
-        parser=file_arg, metavar="FILE", help="Rule base to convert (.rules, .fcl, .fis or .fll).")],
+        click_type=FILE, metavar="FILE", help="Rule base to convert (.rules, .fcl, .fis or .fll).")],
     to_name: Annotated[Optional[str], typer.Option(
         "--to", metavar=choices(Target), autocompletion=completer(Target),
         help="Format to write: rules (NAME.rules + NAME.terms.yaml), fcl, fis or fll "

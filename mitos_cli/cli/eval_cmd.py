@@ -14,7 +14,7 @@ from ..errors import InputError
 from ..numbers import exact
 from ..words import plural
 from .output import emit, json_text, warn, warn_notes
-from .params import choice, choices, completer, named
+from .params import WORDS, choice, choices, completer, named
 
 
 class Engine(str, enum.Enum):
@@ -182,7 +182,7 @@ def warn_undersampled(rb, dof) -> None:
 
 def eval_command(
     args: Annotated[Optional[list[str]], typer.Argument(
-        metavar="[RULEBASE] NAME=VALUE...", callback=named,
+        click_type=WORDS, metavar="[RULEBASE] NAME=VALUE...", callback=named,
         help="Rule file (.rules, .fcl, .fis, .fll; default: the packaged MITOS rule base), "
              "then one NAME=VALUE per input.")] = None,
     behavior: Annotated[Optional[str], typer.Option(

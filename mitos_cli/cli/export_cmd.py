@@ -9,7 +9,7 @@ from typing import Annotated, Optional
 import typer
 
 from .output import emit, err, warn, warn_notes
-from .params import choices, completer, file_arg, named, target_of
+from .params import FILE, choices, completer, file_arg, named, target_of
 from .targets import check_suffix, refuse_inputs, source_files
 
 
@@ -23,7 +23,7 @@ SUFFIX = {Language.c: ".c", Language.python: ".py"}
 
 def export_command(
     path: Annotated[Path, typer.Argument(
-        parser=file_arg, metavar="FILE", help="Rule base to export (.rules, .fcl, .fis or .fll).")],
+        click_type=FILE, metavar="FILE", help="Rule base to export (.rules, .fcl, .fis or .fll).")],
     to_name: Annotated[Optional[str], typer.Option(
         "--to", metavar=choices(Language), autocompletion=completer(Language),
         help="c: one C99 file (no allocation, only libm); python: a NumPy-only module "

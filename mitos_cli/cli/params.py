@@ -11,6 +11,8 @@ from pathlib import Path
 from typing import Any, TypeVar
 
 import typer
+from typer._click import Context, Parameter
+from typer._click.types import ParamType
 from typer.core import TyperCommand, TyperOption
 
 from ..errors import NameError_, UsageError, unknown
@@ -52,6 +54,30 @@ def file_arg(text: str) -> Path:
     extension" or "cannot write `.`: it is a directory", exit 1."""
     named(text)
     return Path(not_a_directory_name(text))
+
+
+class Positional(ParamType):
+    """The type of a positional argument whose metavar says what it takes (``FILE``,
+    ``[RULEBASE] NAME=VALUE...``): Typer's help prints the type's name beside it otherwise,
+    ``<str>`` or ``<file_arg>``, which tells a user nothing. ``parse`` checks and converts.
+    (Typer 0.26-0.28, the versions allowed, carry their own Click as ``typer._click``.)"""
+
+    name = "text"
+
+    def __init__(self, parse: Callable[[str], Any] | None = None) -> None:
+        self.parse = parse
+
+    def get_metavar(self, param: Parameter, ctx: Context | None = None) -> str:
+        return ""
+
+    def convert(self, value: Any, param: Parameter | None, ctx: Context | None) -> Any:
+        return self.parse(value) if self.parse is not None and isinstance(value, str) else value
+
+
+#: A positional argument of words or file names (kept as given).
+WORDS = Positional()
+#: A positional argument naming a file, as :func:`file_arg` reads it.
+FILE = Positional(file_arg)
 
 
 def not_a_directory_name(text: str) -> str:

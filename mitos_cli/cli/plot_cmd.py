@@ -22,7 +22,7 @@ from ..numbers import parse_number
 from .eval_cmd import parse_values, refuse_nan, split_args, unused_inputs
 from .help import epilog
 from .output import emit, err, warn
-from .params import OnceCommand, choice, choices, completer, named, not_a_directory_name
+from .params import WORDS, OnceCommand, choice, choices, completer, named, not_a_directory_name
 
 FORMATS = ("png", "svg")
 RULE_SUFFIXES = (".rules", ".fcl", ".fis", ".fll")
@@ -152,7 +152,7 @@ def _terminal_width(width: Optional[int]) -> int:
 
 def terms_command(
     args: Annotated[Optional[list[str]], typer.Argument(
-        metavar="[RULEBASE] [NAME=VALUE]...",
+        click_type=WORDS, metavar="[RULEBASE] [NAME=VALUE]...",
         help="Rule file (default: the packaged MITOS rule base) or a term set "
              "(FILE.terms.yaml), then values to mark, "
              "e.g. road=78.")] = None,
@@ -280,7 +280,7 @@ def _surface_args(args: list[str]) -> tuple[Optional[str], Optional[str]]:
 
 def surface_command(
     args: Annotated[Optional[list[str]], typer.Argument(
-        metavar="[RULEBASE] OUTPUT",
+        click_type=WORDS, metavar="[RULEBASE] OUTPUT",
         help="Rule file (default: the packaged MITOS rule base), then the output to draw "
              "(may be left out when the rule base has one output).")] = None,
     x: Annotated[str, typer.Option(
@@ -352,7 +352,7 @@ def _used_values(rb, texts: dict[str, str]) -> dict[str, float]:
 
 def rules_command(
     args: Annotated[Optional[list[str]], typer.Argument(
-        metavar="[RULEBASE] NAME=VALUE...",
+        click_type=WORDS, metavar="[RULEBASE] NAME=VALUE...",
         help="Rule file (default: the packaged MITOS rule base), then one NAME=VALUE per "
              "input.")] = None,
     output: OutputOpt = None,

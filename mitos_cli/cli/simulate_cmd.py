@@ -11,7 +11,7 @@ import typer
 from ..words import clearance, percent, plural
 from . import complete
 from .output import emit, err, json_text, warn
-from .params import MAX_RUNS, file_arg, finite, named, option_names
+from .params import MAX_RUNS, WORDS, file_arg, finite, named, option_names
 from .progress import INTERRUPTED, progress_bar
 from .targets import check_directory, check_suffix
 
@@ -178,7 +178,7 @@ def _write_text(path: Path, text: str) -> None:
 
 def simulate_command(
     worlds: Annotated[Optional[list[str]], typer.Argument(
-        metavar="[WORLD.yaml]...", autocompletion=complete.worlds, callback=named,
+        click_type=WORDS, metavar="[WORLD.yaml]...", autocompletion=complete.worlds, callback=named,
         help="World files (default: the packaged corridor.yaml); names of packaged worlds "
              "such as figure4.yaml work from anywhere.")] = None,
     rulebase: Annotated[Optional[str], typer.Option(

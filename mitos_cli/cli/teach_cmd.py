@@ -8,7 +8,7 @@ from typing import Annotated
 import typer
 
 from ..words import plural
-from .params import named
+from .params import WORDS, named
 
 
 class Transcript:
@@ -42,7 +42,7 @@ class Transcript:
 
 def teach_command(
     rules: Annotated[str | None, typer.Argument(
-        metavar="[RULEBASE]", callback=named,
+        click_type=WORDS, metavar="[RULEBASE]", callback=named,
         help="Rule file to teach (default: the packaged MITOS rule base).")] = None,
     behavior: Annotated[str | None, typer.Option(
         "--behavior", "-b", metavar="NAME", callback=named,
