@@ -220,20 +220,21 @@ def _objects(routes: list[Route], frames: list[Frame], a, points, ahead, blockin
              length: np.ndarray, cfg: Settings) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Each row's distance, size and position of the object its nearest blocking point
     belongs to (the points ahead within ``cluster`` of it; ``length``: half the robots'
-    lengths): the nearest points, the objects and their distances for all rows at once
-    (elementwise, exact minima), where each object stands on its route in one
-    :func:`.route.projections`; how wide it is there, row by row (a row's own product)."""
+    lengths), all rows at once: the nearest points, the objects, their middles and their
+    distances elementwise (exact minima; a middle is the sum of its points, added one after
+    the other as ``np.mean`` of the row's alone adds them, divided by their count), where
+    each object stands on its route in one :func:`.route.projections`, and how wide it is
+    there in one stacked product of each row's points by its road's normal (each row's
+    matrix-vector product, bit for bit; an object of one point is a dot product, worked out
+    again as one, as :func:`_own_frames` does)."""
+    rows = np.arange(len(points))
     i = np.where(blocking, a, np.inf).argmin(axis=1)
-    gap = points - points[np.arange(len(points)), i][:, None]
+    gap = points - points[rows, i][:, None]
     near = ahead & (np.hypot(gap[..., 0], gap[..., 1]) <= cfg.cluster)
     distance = np.minimum.reduce(a, axis=1, initial=np.inf, where=near) - length
     distance = np.where(distance > 0.0, distance, 0.0)              # max(0.0, distance)
-    pts, wide = points[near], widen[near]                       # the rows' one after another
-    ends = np.cumsum(np.count_nonzero(near, axis=1)).tolist()
-    spans = list(zip([0, *ends[:-1]], ends))
-    # (np.mean's arithmetic: the sum of the points, divided by their count)
-    centres = np.array([np.add.reduce(pts[start:stop], axis=0) / (stop - start)
-                        for start, stop in spans]).reshape(-1, 2)
+    count = np.count_nonzero(near, axis=1)                             # [R], each at least 1
+    centres = np.add.reduce(points, axis=1, where=near[..., None]) / count[:, None]
     hints = [f.s for f in frames]
     reach = cfg.sight + cfg.cluster
     # size and position across the road where the object stands (around a corner that is
@@ -241,13 +242,18 @@ def _objects(routes: list[Route], frames: list[Frame], a, points, ahead, blockin
     where = ([routes[0].project(centres[0], hints[0], back=0.0, ahead=reach)]
              if len(routes) == 1 else projections(routes, centres, hints, 0.0, reach))
     t = np.array([t_o for _, _, t_o in where]).reshape(-1, 2)
-    normal = np.empty_like(t)
-    normal[:, 0], normal[:, 1] = t[:, 1], -t[:, 0]
-    lo, hi = np.empty(len(spans)), np.empty(len(spans))
-    for j, ((start, stop), centre, (_, e_o, _)) in enumerate(zip(spans, centres, where)):
-        across = (pts[start:stop] - centre) @ normal[j] + e_o
-        lo[j] = np.minimum.reduce(across - wide[start:stop])
-        hi[j] = np.maximum.reduce(across + wide[start:stop])
+    e_o = np.array([e for _, e, _ in where], dtype=float)[:, None]
+    normal = np.empty((len(t), 2, 1))
+    normal[:, 0, 0], normal[:, 1, 0] = t[:, 1], -t[:, 0]
+    rel = points - centres[:, None]                                     # [R, K, 2]
+    across = np.matmul(rel, normal)[..., 0]                             # rel @ normal, [R, K]
+    lone = (count == 1).nonzero()[0]
+    if len(lone):
+        k = i[lone]                                 # (the nearest point is its object's)
+        across[lone, k] = np.matmul(rel[lone, k][:, None], normal[lone])[:, 0, 0]
+    across += e_o
+    lo = np.minimum.reduce(across - widen, axis=1, initial=np.inf, where=near)
+    hi = np.maximum.reduce(across + widen, axis=1, initial=-np.inf, where=near)
     return distance, hi - lo, (lo + hi) / 2
 
 
