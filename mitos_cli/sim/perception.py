@@ -550,13 +550,15 @@ def _sides(a, b, ah, bh, valid, walls, body: dict[str, np.ndarray], cfg: Setting
     ahead = cfg.wall_ahead if objects is None else np.where(objects, body["length"],
                                                             cfg.wall_ahead)
     near = valid & (a >= -cfg.wall_behind) & (a <= ahead) & (np.abs(b) >= body["half"])
-    sides = np.array([b < 0, b > 0])
-    road = np.minimum.reduce(np.where(sides & (walls & (np.abs(a) <= cfg.window)), centre,
-                                      np.inf), axis=-1)
-    gaps = np.minimum.reduce(np.where(sides & near, axis, np.inf), axis=-1)
-    half = body["half"][:, 0]
-    return (_or(road[0], far) + _or(road[1], far), np.maximum(_or(gaps[0], far, half), 0.0),
-            np.maximum(_or(gaps[1], far, half), 0.0))
+    sides = np.array([b < 0, b > 0])                                   # [2, R, K]: left, right
+    # both sides at once, each row's least (exact) of its points on that side
+    road = np.minimum.reduce(np.broadcast_to(centre, sides.shape), axis=-1, initial=np.inf,
+                             where=sides & (walls & (np.abs(a) <= cfg.window)))
+    gaps = np.minimum.reduce(np.broadcast_to(axis, sides.shape), axis=-1, initial=np.inf,
+                             where=sides & near)
+    road = _or(road, far)
+    gaps = np.maximum(_or(gaps, far, body["half"][:, 0]), 0.0)
+    return road[0] + road[1], gaps[0], gaps[1]
 
 
 def _common(route: Route, p, heading: float, f: Frame, road: float, robot: Robot,
