@@ -645,11 +645,12 @@ def pursuit_points(aims: list[Aim], cfg: Settings) -> tuple[np.ndarray, np.ndarr
     some = np.logical_or.reduce(near, axis=1).nonzero()[0]
     if not len(some):
         return out_ahead, targets
-    # the rows with cells near their chords, those cells first (the others padded far away)
+    # the rows with cells near their chords, those cells first in their order (picked out
+    # by the mask, set in by another; no sort), the others padded far away
     near, q, p = near[some], q[some], p[some, None]                           # p [S, 1, 2]
-    order = np.argsort(~near, axis=1, kind="stable")[:, :int(near.sum(axis=1).max())]
-    rel = np.take_along_axis(cells[some], order[..., None], axis=1)
-    rel[~np.take_along_axis(near, order, axis=1)] = _FAR
+    count = np.add.reduce(near, axis=1)
+    rel = np.full((len(some), int(count.max()), 2), _FAR)
+    rel[np.arange(rel.shape[1]) < count[:, None]] = cells[some][near]
     rel -= p                                                                  # [S, P, 2]
     e = q - p
     ee = np.maximum(e[..., 0] * e[..., 0] + e[..., 1] * e[..., 1], 1e-12)     # [S, J]
