@@ -225,8 +225,10 @@ def _objects(routes: list[Route], frames: list[Frame], a, points, ahead, blockin
     the other as ``np.mean`` of the row's alone adds them, divided by their count), where
     each object stands on its route in one :func:`.route.projections`, and how wide it is
     there in one stacked product of each row's points by its road's normal (each row's
-    matrix-vector product, bit for bit; an object of one point is a dot product, worked out
-    again as one, as :func:`_own_frames` does)."""
+    matrix-vector product, bit for bit). An object of one point is its own middle, so its
+    offset is a zero whatever the product; it is still worked out as the one-point dot
+    product it was (as :func:`_own_frames` does), so that even the sign of that zero is
+    kept."""
     rows = np.arange(len(points))
     i = np.where(blocking, a, np.inf).argmin(axis=1)
     gap = points - points[rows, i][:, None]
