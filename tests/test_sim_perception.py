@@ -273,3 +273,44 @@ def test_rings_of_all_rows_at_once_are_each_rows_own_test():
         want = [len(d) > 2 and float(d[0] @ d[-1]) >= float(d[0] @ d[1]) - 1e-9 for d in dirs]
         assert perception._rings(dirs).tolist() == want
         assert perception._rings(dirs[:1]).tolist() == want[:1]
+
+
+def test_obstructions_of_all_rows_at_once_are_each_objects_own_bits():
+    """Each row's obstructing object, its distance, middle and width across the road,
+    measured for all rows at once (:func:`perception._objects`), are the bits of the plain
+    formula of that object's points alone: the sum of its points over their count, where it
+    stands on the route (:meth:`Route.project`), each point's offset ``(point - middle) @
+    normal + e`` (objects of one point and of many, batches of one row and of many)."""
+    rng = np.random.default_rng(11)
+    cfg = perception.Settings()
+    route = Route.of([(0.0, 0.0), (300.0, 40.0), (600.0, 0.0)])
+    reach = cfg.sight + cfg.cluster
+    for beams in (1, 2, 5, 36):
+        n = 30
+        p = np.stack([rng.uniform(0, 500, n), rng.uniform(-20, 20, n)], axis=1)
+        points = p[:, None] + rng.normal(size=(n, beams, 2)) * rng.choice([2.0, 20.0, 60.0],
+                                                                         size=(n, 1, 1))
+        frames = [perception.frame(route, q, float(q[0])) for q in p]
+        a = np.array([(pts - q) @ f.t for pts, q, f in zip(points, p, frames)])
+        blocking = rng.random((n, beams)) < 0.5
+        blocking[np.arange(n), rng.integers(0, beams, n)] = True            # one at least
+        ahead = blocking | (rng.random((n, beams)) < 0.8)
+        widen = rng.uniform(0.0, 5.0, (n, beams))
+        length = np.full(n, 12.0)
+        args = (a, points, ahead, blocking, widen, length)
+        together = perception._objects([route] * n, frames, *args, cfg)
+        for i in range(n):
+            k = np.where(blocking[i], a[i], np.inf).argmin()
+            gap = points[i] - points[i, k]
+            near = ahead[i] & (np.hypot(gap[:, 0], gap[:, 1]) <= cfg.cluster)
+            pts = points[i][near]
+            middle = np.add.reduce(pts, axis=0) / len(pts)
+            _, e, t = route.project(middle, frames[i].s, back=0.0, ahead=reach)
+            across = (pts - middle) @ np.array([t[1], -t[0]]) + e
+            lo = np.minimum.reduce(across - widen[i][near])
+            hi = np.maximum.reduce(across + widen[i][near])
+            distance = np.minimum.reduce(a[i][near]) - 12.0
+            want = (distance if distance > 0.0 else 0.0, hi - lo, (lo + hi) / 2)
+            alone = perception._objects([route], [frames[i]], *(x[i:i + 1] for x in args), cfg)
+            for got, j in ((together, i), (alone, 0)):
+                assert np.array([x[j] for x in got]).tobytes() == np.array(want).tobytes()

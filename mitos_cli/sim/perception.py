@@ -220,20 +220,23 @@ def _objects(routes: list[Route], frames: list[Frame], a, points, ahead, blockin
              length: np.ndarray, cfg: Settings) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Each row's distance, size and position of the object its nearest blocking point
     belongs to (the points ahead within ``cluster`` of it; ``length``: half the robots'
-    lengths): the nearest points, the objects and their distances for all rows at once
-    (elementwise, exact minima), where each object stands on its route in one
-    :func:`.route.projections`; how wide it is there, row by row (a row's own product)."""
+    lengths), all rows at once: the nearest points, the objects, their middles and their
+    distances elementwise (exact minima; a middle is the sum of its points, added one after
+    the other as ``np.mean`` of the row's alone adds them, divided by their count), where
+    each object stands on its route in one :func:`.route.projections`, and how wide it is
+    there in one stacked product of each row's points by its road's normal (each row's
+    matrix-vector product, bit for bit). An object of one point is its own middle, so its
+    offset is a zero whatever the product; it is still worked out as the one-point dot
+    product it was (as :func:`_own_frames` does), so that even the sign of that zero is
+    kept."""
+    rows = np.arange(len(points))
     i = np.where(blocking, a, np.inf).argmin(axis=1)
-    gap = points - points[np.arange(len(points)), i][:, None]
+    gap = points - points[rows, i][:, None]
     near = ahead & (np.hypot(gap[..., 0], gap[..., 1]) <= cfg.cluster)
     distance = np.minimum.reduce(a, axis=1, initial=np.inf, where=near) - length
     distance = np.where(distance > 0.0, distance, 0.0)              # max(0.0, distance)
-    pts, wide = points[near], widen[near]                       # the rows' one after another
-    ends = np.cumsum(np.count_nonzero(near, axis=1)).tolist()
-    spans = list(zip([0, *ends[:-1]], ends))
-    # (np.mean's arithmetic: the sum of the points, divided by their count)
-    centres = np.array([np.add.reduce(pts[start:stop], axis=0) / (stop - start)
-                        for start, stop in spans]).reshape(-1, 2)
+    count = np.count_nonzero(near, axis=1)                             # [R], each at least 1
+    centres = np.add.reduce(points, axis=1, where=near[..., None]) / count[:, None]
     hints = [f.s for f in frames]
     reach = cfg.sight + cfg.cluster
     # size and position across the road where the object stands (around a corner that is
@@ -241,13 +244,18 @@ def _objects(routes: list[Route], frames: list[Frame], a, points, ahead, blockin
     where = ([routes[0].project(centres[0], hints[0], back=0.0, ahead=reach)]
              if len(routes) == 1 else projections(routes, centres, hints, 0.0, reach))
     t = np.array([t_o for _, _, t_o in where]).reshape(-1, 2)
-    normal = np.empty_like(t)
-    normal[:, 0], normal[:, 1] = t[:, 1], -t[:, 0]
-    lo, hi = np.empty(len(spans)), np.empty(len(spans))
-    for j, ((start, stop), centre, (_, e_o, _)) in enumerate(zip(spans, centres, where)):
-        across = (pts[start:stop] - centre) @ normal[j] + e_o
-        lo[j] = np.minimum.reduce(across - wide[start:stop])
-        hi[j] = np.maximum.reduce(across + wide[start:stop])
+    e_o = np.array([e for _, e, _ in where], dtype=float)[:, None]
+    normal = np.empty((len(t), 2, 1))
+    normal[:, 0, 0], normal[:, 1, 0] = t[:, 1], -t[:, 0]
+    rel = points - centres[:, None]                                     # [R, K, 2]
+    across = np.matmul(rel, normal)[..., 0]                             # rel @ normal, [R, K]
+    lone = (count == 1).nonzero()[0]
+    if len(lone):
+        k = i[lone]                                 # (the nearest point is its object's)
+        across[lone, k] = np.matmul(rel[lone, k][:, None], normal[lone])[:, 0, 0]
+    across += e_o
+    lo = np.minimum.reduce(across - widen, axis=1, initial=np.inf, where=near)
+    hi = np.maximum.reduce(across + widen, axis=1, initial=-np.inf, where=near)
     return distance, hi - lo, (lo + hi) / 2
 
 
@@ -394,7 +402,8 @@ def _grid_free(ah: np.ndarray, bh: np.ndarray, widen: np.ndarray, body: dict[str
     """``[2, R, G]``: :func:`_free_along` of the ``way_step`` grid of ways (``G`` of them), each
     point on the ways its bands may reach (:func:`_free_ways_near`): the pairs listed point by
     point, their distances along and across worked out as :func:`_free_along` does, and
-    those in a band set in a table of each row's points by way, whose least is taken."""
+    the least of those in a band kept for each row and way (``np.minimum.at``, exact: a
+    table of each row's points by way, filled and then reduced, measured slower)."""
     grid = body["ways"][2:]
     cos, sin = _grid_trig(cfg)
     rows, g = len(ah), len(grid)
@@ -408,14 +417,13 @@ def _grid_free(ah: np.ndarray, bh: np.ndarray, widen: np.ndarray, body: dict[str
         first = clip_arrays(lo, 0, g).astype(np.intp)
         count = clip_arrays(hi, 0, g).astype(np.intp) - first
     count[far == 0.0] = 0                          # at the robot's centre: ahead on no way
-    place = np.cumsum(count > 0, axis=1) - 1       # each point's place among its row's tried
-    table = np.full((2, int(place[:, -1].max()) + 1, rows, g), np.inf)
+    table = np.full((2, rows * g), np.inf)
     each = np.add.reduce(count, axis=1)            # the pairs of each row, one row after another
     count = count.ravel()
     pairs = int(each.sum())
     if pairs:
         j = np.arange(pairs) - np.repeat(np.cumsum(count) - count - first.ravel(), count)
-        at = j + np.repeat(((place * rows + np.arange(rows)[:, None]) * g).ravel(), count)
+        at = j + np.repeat(np.arange(0, rows * g, g), each)
         a, b = np.repeat(ah.ravel(), count), np.repeat(bh.ravel(), count)
         c, s = cos[j], sin[j]
         along = a * c
@@ -428,8 +436,8 @@ def _grid_free(ah: np.ndarray, bh: np.ndarray, widen: np.ndarray, body: dict[str
         for out, band in zip(table, (body["way"], body["roomy"])):
             inside = across < np.repeat(band[:, 0], each)
             inside &= ahead
-            out.ravel()[at[inside]] = along[inside]
-    return np.minimum.reduce(table, axis=1, initial=np.inf)
+            np.minimum.at(out, at[inside], along[inside])
+    return table.reshape(2, rows, g)
 
 
 @functools.lru_cache(maxsize=8)
@@ -544,13 +552,15 @@ def _sides(a, b, ah, bh, valid, walls, body: dict[str, np.ndarray], cfg: Setting
     ahead = cfg.wall_ahead if objects is None else np.where(objects, body["length"],
                                                             cfg.wall_ahead)
     near = valid & (a >= -cfg.wall_behind) & (a <= ahead) & (np.abs(b) >= body["half"])
-    sides = np.array([b < 0, b > 0])
-    road = np.minimum.reduce(np.where(sides & (walls & (np.abs(a) <= cfg.window)), centre,
-                                      np.inf), axis=-1)
-    gaps = np.minimum.reduce(np.where(sides & near, axis, np.inf), axis=-1)
-    half = body["half"][:, 0]
-    return (_or(road[0], far) + _or(road[1], far), np.maximum(_or(gaps[0], far, half), 0.0),
-            np.maximum(_or(gaps[1], far, half), 0.0))
+    sides = np.array([b < 0, b > 0])                                   # [2, R, K]: left, right
+    # both sides at once, each row's least (exact) of its points on that side
+    road = np.minimum.reduce(np.broadcast_to(centre, sides.shape), axis=-1, initial=np.inf,
+                             where=sides & (walls & (np.abs(a) <= cfg.window)))
+    gaps = np.minimum.reduce(np.broadcast_to(axis, sides.shape), axis=-1, initial=np.inf,
+                             where=sides & near)
+    road = _or(road, far)
+    gaps = np.maximum(_or(gaps, far, body["half"][:, 0]), 0.0)
+    return road[0] + road[1], gaps[0], gaps[1]
 
 
 def _common(route: Route, p, heading: float, f: Frame, road: float, robot: Robot,
@@ -637,11 +647,12 @@ def pursuit_points(aims: list[Aim], cfg: Settings) -> tuple[np.ndarray, np.ndarr
     some = np.logical_or.reduce(near, axis=1).nonzero()[0]
     if not len(some):
         return out_ahead, targets
-    # the rows with cells near their chords, those cells first (the others padded far away)
+    # the rows with cells near their chords, those cells first in their order (picked out
+    # by the mask, set in by another; no sort), the others padded far away
     near, q, p = near[some], q[some], p[some, None]                           # p [S, 1, 2]
-    order = np.argsort(~near, axis=1, kind="stable")[:, :int(near.sum(axis=1).max())]
-    rel = np.take_along_axis(cells[some], order[..., None], axis=1)
-    rel[~np.take_along_axis(near, order, axis=1)] = _FAR
+    count = np.add.reduce(near, axis=1)
+    rel = np.full((len(some), int(count.max()), 2), _FAR)
+    rel[np.arange(rel.shape[1]) < count[:, None]] = cells[some][near]
     rel -= p                                                                  # [S, P, 2]
     e = q - p
     ee = np.maximum(e[..., 0] * e[..., 0] + e[..., 1] * e[..., 1], 1e-12)     # [S, J]

@@ -82,11 +82,10 @@ def sense(rows: list[SenseRow], angles: np.ndarray, max_range: float,
     clearance of its footprint, row by row the bits of one robot alone. ``kept``: what the
     last :func:`sense` of these rows stacked (runs in lockstep keep it from tick to tick),
     taken again where every row's array is the very one it was, and updated."""
-    if len(rows) > 1 and any(r.boxes.shape != rows[0].boxes.shape
-                             or len(r.centres) != len(rows[0].centres) for r in rows):
+    if len(rows) > 1 and len({(r.boxes.shape, len(r.centres)) for r in rows}) > 1:
         raise ValueError("rows sensed together have as many obstacles each")
     heading = np.array([r.heading for r in rows])
-    origin = np.array([(r.x, r.y) for r in rows])
+    origin = np.array([[r.x for r in rows], [r.y for r in rows]]).T     # (no tuple a row)
     a = heading[:, None] + angles
     dirs = np.empty((*a.shape, 2))                                      # [R, B, 2]
     dirs[..., 0] = np.cos(a)
@@ -217,16 +216,16 @@ def _cast(stacks: _Stacks, origin: np.ndarray, dirs: np.ndarray,
                          max_range)
         static = np.minimum(static, max_range)
     else:
-        t = _ray_hits(stacks.segments, origin, dirs, keep=True)
-        hit = np.minimum(t.min(axis=2, initial=np.inf), max_range)
+        t = _ray_hits(stacks.segments, origin, dirs, keep=True)        # [R, N, B]
+        hit = np.minimum(t.min(axis=1, initial=np.inf), max_range)
         if walls == total:                              # no sides: the walls are all there is
             static = hit
         elif min(walls) == max(walls):                  # the walls come first in every row
-            static = np.minimum(t[..., :walls[0]].min(axis=2, initial=np.inf), max_range)
+            static = np.minimum(t[:, :walls[0]].min(axis=1, initial=np.inf), max_range)
         else:
-            is_wall = np.arange(t.shape[2]) < np.array(walls)[:, None]
-            static = np.minimum(np.where(is_wall[:, None], t, np.inf)
-                                .min(axis=2, initial=np.inf), max_range)
+            is_wall = np.arange(t.shape[1]) < np.array(walls)[:, None]
+            static = np.minimum(np.minimum.reduce(t, axis=1, initial=np.inf,
+                                                  where=is_wall[..., None]), max_range)
     if not len(rows[0].centres):
         return static, hit
     return static, np.minimum(hit, _circles(stacks, origin, dirs, max_range))
@@ -234,14 +233,16 @@ def _cast(stacks: _Stacks, origin: np.ndarray, dirs: np.ndarray,
 
 def _ray_hits(seg: np.ndarray, origin: np.ndarray, dirs: np.ndarray, keep: bool = False):
     """How far along each beam ``dirs [R, B, 2]`` from ``origin [R, 2]`` it meets each
-    segment ``seg [R, N, 4]`` (``inf`` where it does not): ``[R, B, N]`` when ``keep``, else
-    the nearest ``[R, B]``."""
+    segment ``seg [R, N, 4]`` (``inf`` where it does not): ``[R, N, B]`` when ``keep``, else
+    the nearest ``[R, B]``. The beams run along the last axis: the minimum over the few
+    segments is then one elementwise pass per segment, not a reduction of a few elements
+    per beam (at 55 rows of 36 beams and 6 segments: 10 us, against 66)."""
     run = seg[..., 2:] - seg[..., :2]                                   # [R, N, 2]
     start = seg[..., :2] - origin[:, None]
-    t = _along(dirs[..., 0, None], dirs[..., 1, None],                  # [R, B, 1]
-               run[:, None, :, 0], run[:, None, :, 1],                  # [R, 1, N]
-               start[:, None, :, 0], start[:, None, :, 1])
-    return t if keep else t.min(axis=2, initial=np.inf)
+    t = _along(dirs[:, None, :, 0], dirs[:, None, :, 1],                # [R, 1, B]
+               run[..., 0, None], run[..., 1, None],                    # [R, N, 1]
+               start[..., 0, None], start[..., 1, None])
+    return t if keep else t.min(axis=1, initial=np.inf)
 
 
 def _along(dx, dy, ex, ey, px, py) -> np.ndarray:
@@ -292,14 +293,15 @@ def _circles(stacks: _Stacks, origin: np.ndarray, dirs: np.ndarray,
     """:func:`.geometry.ray_circles` of every row, ``[R, B]``."""
     off = origin[:, None] - stacks.centres                              # [R, C, 2]
     radii = stacks.radii                                                # [R, C]
-    mx, my = off[..., 0], off[..., 1]
-    b = mx[:, None] * dirs[..., 0, None] + my[:, None] * dirs[..., 1, None] + 0.0
-    c = (mx * mx + my * my - radii ** 2)[:, None]                       # [R, 1, C]
+    mx, my = off[..., 0, None], off[..., 1, None]                       # [R, C, 1]
+    # the beams along the last axis (as :func:`_ray_hits`)
+    b = mx * dirs[:, None, :, 0] + my * dirs[:, None, :, 1] + 0.0        # [R, C, B]
+    c = mx * mx + my * my - radii[..., None] ** 2                       # [R, C, 1]
     disc = b * b - c
     root = np.sqrt(np.maximum(disc, 0.0))
     t = np.where(c <= 0.0, 0.0, -b - root)
     hit = (disc >= 0.0) & (t >= 0.0)
-    return np.minimum(np.where(hit, t, np.inf).min(axis=2), max_range)
+    return np.minimum(np.minimum.reduce(t, axis=1, initial=np.inf, where=hit), max_range)
 
 
 def _noisy(rows: list[SenseRow], ranges: np.ndarray, max_range: float) -> np.ndarray:
@@ -320,12 +322,12 @@ def _clearance(stacks: _Stacks, origin: np.ndarray, heading: np.ndarray) -> np.n
     own frame (the gap when apart, 0 touching, minus the penetration depth when
     overlapping)."""
     rows = stacks.rows
+    if len({(r.robot.length, r.robot.width) for r in rows}) == 1:     # (most batches)
+        return _group_clearance(stacks, origin, heading, rows[0].robot.length / 2,
+                                rows[0].robot.width / 2)
     groups: dict[tuple[float, float], list[int]] = {}
     for i, r in enumerate(rows):
         groups.setdefault((r.robot.length / 2, r.robot.width / 2), []).append(i)
-    if len(groups) == 1:
-        (hl, hw), _ = groups.popitem()
-        return _group_clearance(stacks, origin, heading, hl, hw)
     out = np.empty(len(rows))
     for (hl, hw), idx in groups.items():
         out[idx] = _group_clearance(_Stacks([rows[i] for i in idx]), origin[idx], heading[idx],
