@@ -859,6 +859,8 @@ def test_many_maps_near_cells_asked_at_once_are_each_maps_own():
         res = float(rng.choice([0.5, 2.0, 3.0]))
         grid = Grid(rng.random((rows, cols)) < 0.2, res, tuple(rng.normal(0, 5, 2).tolist()))
         maps = [knowledge.RobotMap.of(grid) for _ in range(int(rng.integers(2, 8)))]
+        if rng.random() < 0.3:             # alike, not one grid: each map's cells copied
+            maps.append(knowledge.RobotMap.of(Grid(grid.occupied.copy(), res, grid.origin)))
         for m in maps:
             m.mark(rng.uniform(-10, cols * res + 10, (5, 2)), np.tile([1.0, 0.0], (5, 1)))
         # squares inside, across the edges and wholly outside the grid, of one cell or more

@@ -330,7 +330,7 @@ class RobotMap:
         """The rows, columns and centres ``[M, 2]`` of :attr:`marks` and the marks as a
         list, worked out again only once the marks changed (a new array each time)."""
         if self._decoded is None or self._decoded[0] is not self.marks:
-            r, c = np.divmod(self.marks, self.occupied.shape[1])
+            r, c = _divmod(self.marks, self.occupied.shape[1])
             xs, ys = _centre_lines(self.grid)
             centres = np.empty((len(r), 2))
             centres[:, 0], centres[:, 1] = xs[c], ys[r]
@@ -395,10 +395,11 @@ class RobotMap:
 def near_all(maps: list[RobotMap], points: np.ndarray, reaches: np.ndarray,
              given: bool = False) -> list[np.ndarray]:
     """``[m.near(p, reach, given) for m, p, reach in zip(maps, points [R, 2], reaches [R])]``
-    in one pass (runs in lockstep ask together): every square's cells copied into one block
-    of windows of the largest square's size, the rest left unoccupied, and one ``nonzero``:
-    the same cells, in the same order, with the same centres. Maps that do not share their
-    cells' shape, size and origin answer one by one."""
+    in one pass (runs in lockstep ask together): every square's cells in one block of
+    windows of the largest square's size (:func:`_windows`, maps on one grid: the runs of a
+    world), the rest left unoccupied, and one ``nonzero``: the same cells, in the same order,
+    with the same centres. Maps that do not share their cells' shape, size and origin answer
+    one by one."""
     grid = _alike(maps) if len(maps) > 1 else None
     if grid is None:
         return [m.near(p, reach, given) for m, p, reach in zip(maps, points, reaches)]
@@ -406,12 +407,15 @@ def near_all(maps: list[RobotMap], points: np.ndarray, reaches: np.ndarray,
     high, wide = int((r1 - r0).max()), int((c1 - c0).max())
     if high <= 0 or wide <= 0:
         return [np.zeros((0, 2)) for _ in maps]
-    block = np.zeros((len(maps), high, wide), dtype=bool)
-    for j, (m, a, b, e, f) in enumerate(zip(maps, r0.tolist(), r1.tolist(), c0.tolist(),
-                                             c1.tolist())):
-        block[j, :b - a, :f - e] = (m.grid.occupied if given else m.occupied)[a:b, e:f]
-    k, at = np.divmod(np.flatnonzero(block), high * wide)
-    r, c = np.divmod(at, wide)
+    if all(m.grid is grid for m in maps):
+        block = _windows(maps, grid, (r0, r1, c0, c1), (high, wide), given)
+    else:
+        block = np.zeros((len(maps), high, wide), dtype=bool)
+        for j, (m, a, b, e, f) in enumerate(zip(maps, r0.tolist(), r1.tolist(), c0.tolist(),
+                                                 c1.tolist())):
+            block[j, :b - a, :f - e] = (m.grid.occupied if given else m.occupied)[a:b, e:f]
+    k, at = _divmod(np.flatnonzero(block), high * wide)
+    r, c = _divmod(at, wide)
     r += r0[k]
     c += c0[k]
     xs, ys = _centre_lines(grid)
@@ -420,6 +424,51 @@ def near_all(maps: list[RobotMap], points: np.ndarray, reaches: np.ndarray,
     centres.flags.writeable = False                  # (as near's)
     ends = np.cumsum(np.bincount(k, minlength=len(maps))).tolist()
     return [centres[a:b] for a, b in zip([0, *ends[:-1]], ends)]
+
+
+def _windows(maps: list[RobotMap], grid: Grid, square: tuple[np.ndarray, ...],
+             shape: tuple[int, int], given: bool) -> np.ndarray:
+    """``[R, high, wide]``: each map's cells in its square (rows ``r0:r1``, columns
+    ``c0:c1``), from the top left corner, the rest unoccupied; every map on ``grid``. A map's
+    cells are the grid's plus its marks (none of them a grid's cell), so the grid's windows
+    are gathered for all maps in one copy (of the grid padded with unoccupied cells) and the
+    marks in the squares set in one more; a copy a map cost more than the two."""
+    r0, r1, c0, c1 = square
+    high, wide = shape
+    block = np.lib.stride_tricks.sliding_window_view(_padded(grid, high, wide), shape)[r0, c0]
+    if np.count_nonzero(r1 - r0 - high):                 # rows below a short square's
+        block &= (np.arange(high) < (r1 - r0)[:, None])[:, :, None]
+    if np.count_nonzero(c1 - c0 - wide):                 # columns right of a narrow one's
+        block &= (np.arange(wide) < (c1 - c0)[:, None])[:, None, :]
+    counts = [len(m.marks) for m in maps]
+    if given or not sum(counts):
+        return block
+    k = np.repeat(np.arange(len(maps)), counts)
+    r, c = _divmod(np.concatenate([m.marks for m in maps]), grid.occupied.shape[1])
+    inside = ((r >= r0[k]) & (r < r1[k]) & (c >= c0[k]) & (c < c1[k])).nonzero()[0]
+    k = k[inside]
+    block[k, r[inside] - r0[k], c[inside] - c0[k]] = True
+    return block
+
+
+@functools.lru_cache(maxsize=8)
+def _padded(grid: Grid, high: int, wide: int) -> np.ndarray:
+    """The grid's cells with ``high`` unoccupied rows above and ``wide`` unoccupied columns
+    right of them (a window of that shape may start at any cell), kept (read-only)."""
+    rows, cols = grid.occupied.shape
+    out = np.zeros((rows + high, cols + wide), dtype=bool)
+    out[:rows, :cols] = grid.occupied
+    out.flags.writeable = False
+    return out
+
+
+def _divmod(a: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """``np.divmod(a, n)`` of integers ``a`` by a positive ``n``, as a floor division and
+    what it leaves (``a - q * n``: the same numbers): NumPy's own integer divmod took
+    twice as long as the two (a cell index split into row and column, a few thousand a
+    tick)."""
+    q = a // n
+    return q, a - q * n
 
 
 def _alike(maps: list[RobotMap]) -> Grid | None:
@@ -515,7 +564,7 @@ def _in_sight_all(maps: list[RobotMap], origins: np.ndarray, max_range: float) -
     if not ends[-1]:
         return _none_in_sight()
     k = np.repeat(np.arange(len(maps)), counts)
-    r, c = np.divmod(np.concatenate([m.marks for m in maps]), grid.occupied.shape[1])
+    r, c = _divmod(np.concatenate([m.marks for m in maps]), grid.occupied.shape[1])
     r0, r1, c0, c1 = _squares(grid, origins, np.full(len(maps), max_range))
     sel = ((r >= r0[k]) & (r < r1[k]) & (c >= c0[k]) & (c < c1[k])).nonzero()[0]
     k, r, c = k[sel], r[sel], c[sel]
@@ -563,7 +612,7 @@ def _seen_through(rel: np.ndarray, k: np.ndarray, dx: np.ndarray, dy: np.ndarray
     across = rx * dy.astype(kind)[k]
     across -= ry * dx.astype(kind)[k]
     np.abs(across, out=across)
-    i, b = np.divmod(np.flatnonzero(across < bound[k, None]), dx.shape[1])
+    i, b = _divmod(np.flatnonzero(across < bound[k, None]), dx.shape[1])
     j = k[i]
     x, y = rel[i, 0], rel[i, 1]
     near = np.abs(x * dy[j, b] - y * dx[j, b]) < half[j]
