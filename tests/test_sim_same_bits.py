@@ -605,6 +605,22 @@ def test_steps_worked_out_again_only_near_the_changed_distances_are_those_of_the
     assert same(patched[2], whole[2])
 
 
+@hypothesis.given(st.integers(0, 2**32 - 1))
+@hypothesis.settings(max_examples=40, deadline=None)
+def test_clearance_of_points_all_on_the_grid_is_the_masked_reads(seed):
+    """:meth:`.route.Clearance.at` reads points all on the grid without masks: the bits of
+    the masked reads it takes with one point off the grid."""
+    rng = np.random.default_rng(seed)
+    rows, cols = (int(n) for n in rng.integers(3, 30, 2))
+    res = float(rng.choice([0.05, 0.5, 2.0, 3.0]))
+    origin = tuple(rng.normal(0, 7, 2).tolist())
+    field = route.Clearance.of(rng.random((rows, cols)) < 0.1, res, origin, cap=5 * res)
+    inside = np.asarray(origin) + rng.uniform(0, 1, (50, 2)) * [cols * res, rows * res]
+    inside = inside[field._cell_of(inside)[3]]           # (none on the far edge, rounded)
+    off = np.vstack([inside, [[origin[0] - 1.0, origin[1] - 1.0]]])
+    assert same(field.at(inside), field.at(off)[:-1])
+
+
 def test_a_star_over_flat_tables_takes_the_generic_searchs_path():
     rng = np.random.default_rng(8)
     for _ in range(200):

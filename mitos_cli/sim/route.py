@@ -605,6 +605,10 @@ class Clearance:
         the cell's distance less the point's offset from the cell centre and half a cell."""
         pts, row, col, inside = self._cell_of(points)
         res, (ox, oy) = self.resolution, self.origin
+        if np.count_nonzero(inside) == len(pts):      # all inside (a route's): no masks
+            off = np.hypot(pts[:, 0] - (ox + (col + 0.5) * res),
+                           pts[:, 1] - (oy + (row + 0.5) * res))
+            return np.maximum(self.dist_at(self.squares[row, col]) - off - res / 2, 0.0)
         out = np.zeros(len(pts))
         r, c = row[inside], col[inside]
         centre = np.stack([ox + (c + 0.5) * res, oy + (r + 0.5) * res], axis=1)
@@ -1167,25 +1171,44 @@ def _edges_near(out: np.ndarray, field: Clearance, xy: np.ndarray, t: np.ndarray
     """:func:`_edges_from` of the steps that may sample a cell of a ``dirty`` block (``[R,
     C]``, a node's): a step's samples lie between its two nodes' cell centres, so in its own
     block, the block it steps into or (a diagonal step) the two beside both. The rest keep
-    their bits; the steps are worked out a slice at a time (arrays of tens of MB at most)."""
+    their bits; the steps are worked out a slice at a time (arrays of tens of MB at most).
+    The steps of every move are picked at once (``dirty`` shifted by each move: views of it
+    padded, in the moves' order and row-major within each, as they are taken move by move):
+    a pass a move cost more in calls than in work."""
     R, C = dirty.shape
     pad = np.zeros((R + 2, C + 2), dtype=bool)
     pad[1:-1, 1:-1] = dirty
-    picked = []
-    for m, (dr, dc, _) in enumerate(moves):
-        near = dirty | pad[1 + dr:1 + dr + R, 1:-1] | pad[1:-1, 1 + dc:1 + dc + C] \
-            | pad[1 + dr:1 + dr + R, 1 + dc:1 + dc + C]
-        if dr:                                              # no step off the grid
-            near[R - 1 if dr > 0 else 0] = False
-        if dc:
-            near[:, C - 1 if dc > 0 else 0] = False
-        r, c = near.nonzero()
-        picked.append((np.full(len(r), m), r, c, r * C + c, (r + dr) * C + c + dc))
-    move, r, c, src, dst = (np.concatenate(part) for part in zip(*picked))
+    shifted = np.lib.stride_tricks.sliding_window_view(pad, (R, C))  # [3, 3]: pad[i:, j:]
+    dr, dc, on = _shifts(moves, R, C)
+    near = shifted[1 + dr, 1] | shifted[1, 1 + dc]                    # [M, R, C]
+    near |= shifted[1 + dr, 1 + dc]
+    near |= dirty
+    near &= on                                                        # no step off the grid
+    flat = np.flatnonzero(near)
+    move = flat // (R * C)
+    src = flat - move * (R * C)                                       # the node, row-major
+    r = src // C
+    c = src - r * C
+    dst = src + dr[move] * C + dc[move]
     step = max(1, _EDGE_SAMPLES // len(t))
     for a in range(0, len(src), step):
         s = slice(a, a + step)
         out[move[s], r[s], c[s]] = _least(field, xy, t, src[s], dst[s])
+
+
+@functools.lru_cache(maxsize=4)
+def _shifts(moves: tuple[tuple[int, int, float], ...], R: int,
+            C: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Each move's rows and columns ``[M]`` and whether its step from each node of ``[R, C]``
+    stays on the grid, ``[M, R, C]``; kept (read-only)."""
+    dr = np.array([m[0] for m in moves], dtype=np.intp)
+    dc = np.array([m[1] for m in moves], dtype=np.intp)
+    r, c = np.arange(R)[:, None], np.arange(C)[None, :]
+    d, e = dr[:, None, None], dc[:, None, None]
+    on = (r + d >= 0) & (r + d < R) & (c + e >= 0) & (c + e < C)
+    for a in (dr, dc, on):
+        a.flags.writeable = False
+    return dr, dc, on
 
 
 #: samples :func:`_edges_from` works out in one pass (about 40 bytes each at its peak)
