@@ -340,7 +340,7 @@ class RobotMap:
     def _free(self, where: np.ndarray, r: np.ndarray, c: np.ndarray) -> None:
         """Unmark the marks at places ``where`` of :attr:`marks` (cells ``r``, ``c``)."""
         self._changes += 1
-        self.occupied[r, c] = False
+        self.occupied.put(self.marks[where], False)      # (a mark is its cell's flat index)
         keep = np.ones(len(self.marks), dtype=bool)      # (np.delete's Python costs more)
         keep[where] = False
         self.marks = self.marks[keep]
@@ -695,19 +695,23 @@ def _add_marks(maps: list[RobotMap], grid: Grid, k: np.ndarray, row: np.ndarray,
     which = np.unique(k)
     js = which.tolist()
     old = [maps[j].marks for j in js]
+    flat = row * cols + col
     keys = np.concatenate([np.concatenate(old) + np.repeat(which * size, [len(o) for o in old]),
-                           np.unique(k * size + row * cols + col)])
+                           np.unique(k * size + flat)])
     keys.sort()
     bounds = np.searchsorted(keys, np.concatenate([which, which + 1]) * size).tolist()
+    marks = keys - keys // size * size                 # every map's marks, each map's part
     xs, ys = _centre_lines(grid)
     centres = np.empty((len(k), 2))
     centres[:, 0], centres[:, 1] = xs[col], ys[row]
     ends = np.searchsorted(k, which, side="right").tolist()
+    # a map's part of each array is a slice: only the cells are set map by map (each map's
+    # own array), by flat index (a quarter of the time of rows and columns)
     for j, a, e, lo, hi in zip(js, [0, *ends[:-1]], ends, bounds[:len(js)], bounds[len(js):]):
         m = maps[j]
         m._changes += 1
-        m.occupied[row[a:e], col[a:e]] = True
-        m.marks = keys[lo:hi] - j * size
+        m.occupied.put(flat[a:e], True)
+        m.marks = marks[lo:hi]
         m.fresh.append(centres[a:e])
 
 
