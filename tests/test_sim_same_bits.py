@@ -452,6 +452,28 @@ def test_the_heuristic_read_from_one_quarter_is_math_dist_to_the_goal(R, C, data
     assert same(np.array(_heuristic(R, C, goal)), np.array(want))
 
 
+@hypothesis.settings(max_examples=60, deadline=None)
+@hypothesis.given(st.integers(0, 2**32 - 1), st.integers(1, 30))
+def test_capped_squares_that_stop_shifting_early_are_every_shifts_minimum(seed, cap):
+    """:func:`.distance._capped_squares` stops shifting once no shift can lower a square:
+    the bits of the minimum over every shift up to the cap, beyond the cap too, whole or in
+    part."""
+    rng = np.random.default_rng(seed)
+    rows, cols = (int(n) for n in rng.integers(1, 50, 2))
+    blocked = rng.random((rows, cols)) < float(rng.choice([0.0, 0.01, 0.05, 0.3]))
+    far = cap + 1
+    g = np.minimum(distance._column_steps(blocked, far), far).astype(np.int64) ** 2
+    padded = np.full((rows, cols + 2 * cap), far * far, dtype=np.int64)
+    padded[:, cap:cap + cols] = g
+    every = np.min([padded[:, cap + dc:cap + dc + cols] + dc * dc for dc in range(-cap, cap + 1)],
+                   axis=0)
+    r0, c0 = int(rng.integers(0, rows)), int(rng.integers(0, cols))
+    r1, c1 = int(rng.integers(r0 + 1, rows + 1)), int(rng.integers(c0 + 1, cols + 1))
+    assert np.array_equal(distance._capped_squares(blocked, cap), every)
+    assert np.array_equal(distance._capped_squares(blocked, cap, (r0, r1, c0, c1)),
+                          every[r0:r1, c0:c1])
+
+
 @hypothesis.settings(max_examples=40, deadline=None)
 @hypothesis.given(st.integers(0, 2**32 - 1), st.sampled_from([None, 3.0, 9.5, 400.0]))
 def test_a_field_kept_as_squares_reads_the_distances_it_held(seed, cap):
