@@ -268,7 +268,7 @@ def points_along(routes: Sequence[Route], s: np.ndarray) -> np.ndarray:
     s = np.where(asked < 0.0, 0.0, asked)          # max(s, 0.0), then min(s, length),
     s = np.where(length < s, length, s)            # as Python's max and min pick
     count = np.add.reduce(cum[:, None, :] <= s[..., None], axis=2)
-    got = table[base[:, None] + np.minimum(count - 1, last - 1)]                  # [R, J, 8]
+    got = table.take(base[:, None] + np.minimum(count - 1, last - 1), axis=0)     # [R, J, 8]
     ok = got[..., 5] > 0
     out = got[..., 1:3].copy()
     at = got[ok]
@@ -300,7 +300,8 @@ def projected(routes: Sequence[Route], points: np.ndarray, hints: Sequence[float
     empty = lo >= hi                                            # none in it: the first one
     lo, hi = np.where(empty, 0, lo), np.where(empty, 1, hi)
     width = int((hi - lo).max())
-    rows = table[base[:, None] + np.minimum(lo[:, None] + np.arange(width), hi[:, None] - 1)]
+    rows = table.take(base[:, None] + np.minimum(lo[:, None] + np.arange(width), hi[:, None] - 1),
+                      axis=0)
     ax, ay, ex, ey = rows[..., 1], rows[..., 2], rows[..., 3], rows[..., 4]    # [R, M] each
     ee, root = rows[..., 6], rows[..., 7]
     px, py = points[:, 0, None], points[:, 1, None]                           # [R, 1]
@@ -335,8 +336,8 @@ def distances(routes: Sequence[Route], s: Sequence[float], ahead: float,
     if not len(rows) or not points.shape[1]:
         return out
     at = base[rows, None] + np.minimum(first[rows, None] + np.arange(width), stop[rows, None] - 1)
-    a = table[at, 1:3]                                          # [H, M, 2]: each segment's
-    e = table[at + 1, 1:3] - a                                  # ends, as the route has them
+    a = table.take(at, axis=0)[..., 1:3]                        # [H, M, 2]: each segment's
+    e = table.take(at + 1, axis=0)[..., 1:3] - a                # ends, as the route has them
     ee = np.maximum(e[..., 0] * e[..., 0] + e[..., 1] * e[..., 1], 1e-12)
     block = max(1, CACHED // (points.shape[1] * width))
     for lo in range(0, len(rows), block):
