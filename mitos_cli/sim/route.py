@@ -203,16 +203,19 @@ class Route:
 
     def distance(self, points: np.ndarray, s: float, ahead: float) -> np.ndarray:
         """The distance ``[P]`` of each point from the route between arc lengths ``s`` and
-        ``s + ahead`` (``inf`` with no route there)."""
+        ``s + ahead`` (``inf`` with no route there). A coordinate at a time, ``[P, M]``: a
+        sum over x and y is one addition, written out (the sums over an axis of two took
+        twice as long, 19 against 10 us for 24 points and 5 segments)."""
         first, stop = self._window(s, s + ahead)
         if first >= stop or not len(points):
             return np.full(len(points), np.inf)
         a, e, ee, _, _ = self._segments
-        a, e, ee = a[first:stop], e[first:stop], ee[first:stop]
-        rel = points[:, None] - a                                  # [P, M, 2]
-        t = clip_arrays(np.add.reduce(rel * e, axis=2) / ee, 0.0, 1.0)
-        d = rel - t[..., None] * e
-        return np.sqrt(np.minimum.reduce(np.add.reduce(d * d, axis=2), axis=1))
+        ex, ey, ee = e[first:stop, 0], e[first:stop, 1], ee[first:stop]
+        rx = points[:, 0, None] - a[first:stop, 0]                      # [P, M]
+        ry = points[:, 1, None] - a[first:stop, 1]
+        t = clip_arrays((rx * ex + ry * ey) / ee, 0.0, 1.0)
+        dx, dy = rx - t * ex, ry - t * ey
+        return np.sqrt(np.minimum.reduce(dx * dx + dy * dy, axis=1))
 
 
 def _laid(routes: Sequence[Route]) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
