@@ -904,13 +904,15 @@ def test_a_maps_near_cells_read_from_the_last_square_are_the_cells_of_a_fresh_lo
             assert same(kept.near(p, reach, given), fresh.near(p, reach, given))
 
 
-def test_many_maps_near_cells_asked_at_once_are_each_maps_own():
+@pytest.mark.parametrize("one_gather", [1, knowledge.ONE_GATHER])     # all in one copy or not
+def test_many_maps_near_cells_asked_at_once_are_each_maps_own(monkeypatch, one_gather):
+    monkeypatch.setattr(knowledge, "ONE_GATHER", one_gather)
     rng = np.random.default_rng(16)
     for _ in range(60):
         rows, cols = (int(n) for n in rng.integers(1, 40, 2))
         res = float(rng.choice([0.5, 2.0, 3.0]))
         grid = Grid(rng.random((rows, cols)) < 0.2, res, tuple(rng.normal(0, 5, 2).tolist()))
-        maps = [knowledge.RobotMap.of(grid) for _ in range(int(rng.integers(2, 8)))]
+        maps = [knowledge.RobotMap.of(grid) for _ in range(int(rng.integers(2, 16)))]
         if rng.random() < 0.3:             # alike, not one grid: each map's cells copied
             maps.append(knowledge.RobotMap.of(Grid(grid.occupied.copy(), res, grid.origin)))
         for m in maps:
