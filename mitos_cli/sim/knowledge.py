@@ -622,13 +622,15 @@ def _seen_through(rel: np.ndarray, k: np.ndarray, dx: np.ndarray, dy: np.ndarray
     across -= ry * dx.astype(kind).take(k, axis=0)
     np.abs(across, out=across)
     i, b = _divmod(np.flatnonzero(across < bound.take(k)[:, None]), dx.shape[1])
-    j = k[i]
+    j = k.take(i)
+    beam = j * dx.shape[1] + b                  # the beams' places in [R, B], looked up flat
     x, y = rel[i, 0], rel[i, 1]
-    near = np.abs(x * dy[j, b] - y * dx[j, b]) < half[j]
-    i, b, j, x, y = i[near], b[near], j[near], x[near], y[near]
-    along = x * dx[j, b] + y * dy[j, b]
+    ex, ey = dx.take(beam), dy.take(beam)
+    near = np.abs(x * ey - y * ex) < half.take(j)
+    i, x, y, ex, ey, beam = i[near], x[near], y[near], ex[near], ey[near], beam[near]
+    along = x * ex + y * ey
     out = np.zeros(len(rel), dtype=bool)
-    out[i[(along > 0) & (along < reach[j, b])]] = True
+    out[i[(along > 0) & (along < reach.take(beam))]] = True
     return out
 
 
