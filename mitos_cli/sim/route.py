@@ -1193,17 +1193,19 @@ def _edges_near(out: np.ndarray, field: Clearance, xy: np.ndarray, t: np.ndarray
     pad = np.zeros((R + 2, C + 2), dtype=bool)
     pad[1:-1, 1:-1] = dirty
     shifted = np.lib.stride_tricks.sliding_window_view(pad, (R, C))  # [3, 3]: pad[i:, j:]
-    dr, dc, on = _shifts(moves, R, C)
+    dr, dc = _shifts(moves)
     near = shifted[1 + dr, 1] | shifted[1, 1 + dc]                    # [M, R, C]
     near |= shifted[1 + dr, 1 + dc]
     near |= dirty
-    near &= on                                                        # no step off the grid
     flat = np.flatnonzero(near)
     move = flat // (R * C)
     src = flat - move * (R * C)                                       # the node, row-major
     r = src // C
     c = src - r * C
-    dst = src + dr[move] * C + dc[move]
+    to_r, to_c = r + dr[move], c + dc[move]
+    on = (to_r >= 0) & (to_r < R) & (to_c >= 0) & (to_c < C)          # no step off the grid
+    move, r, c, src = move[on], r[on], c[on], src[on]
+    dst = to_r[on] * C + to_c[on]
     step = max(1, _EDGE_SAMPLES // len(t))
     for a in range(0, len(src), step):
         s = slice(a, a + step)
@@ -1211,18 +1213,13 @@ def _edges_near(out: np.ndarray, field: Clearance, xy: np.ndarray, t: np.ndarray
 
 
 @functools.lru_cache(maxsize=4)
-def _shifts(moves: tuple[tuple[int, int, float], ...], R: int,
-            C: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Each move's rows and columns ``[M]`` and whether its step from each node of ``[R, C]``
-    stays on the grid, ``[M, R, C]``; kept (read-only)."""
+def _shifts(moves: tuple[tuple[int, int, float], ...]) -> tuple[np.ndarray, np.ndarray]:
+    """Each move's rows and columns, ``[M]`` each; kept (read-only)."""
     dr = np.array([m[0] for m in moves], dtype=np.intp)
     dc = np.array([m[1] for m in moves], dtype=np.intp)
-    r, c = np.arange(R)[:, None], np.arange(C)[None, :]
-    d, e = dr[:, None, None], dc[:, None, None]
-    on = (r + d >= 0) & (r + d < R) & (c + e >= 0) & (c + e < C)
-    for a in (dr, dc, on):
+    for a in (dr, dc):
         a.flags.writeable = False
-    return dr, dc, on
+    return dr, dc
 
 
 #: samples :func:`_edges_from` works out in one pass (about 40 bytes each at its peak)
