@@ -912,7 +912,7 @@ def test_many_maps_near_cells_asked_at_once_are_each_maps_own(monkeypatch, one_g
         rows, cols = (int(n) for n in rng.integers(1, 40, 2))
         res = float(rng.choice([0.5, 2.0, 3.0]))
         grid = Grid(rng.random((rows, cols)) < 0.2, res, tuple(rng.normal(0, 5, 2).tolist()))
-        maps = [knowledge.RobotMap.of(grid) for _ in range(int(rng.integers(2, 16)))]
+        maps = [knowledge.RobotMap.of(grid) for _ in range(int(rng.integers(2, 20)))]
         if rng.random() < 0.3:             # alike, not one grid: each map's cells copied
             maps.append(knowledge.RobotMap.of(Grid(grid.occupied.copy(), res, grid.origin)))
         for m in maps:

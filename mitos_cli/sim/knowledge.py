@@ -428,9 +428,9 @@ def near_all(maps: list[RobotMap], points: np.ndarray, reaches: np.ndarray,
 
 #: The fewest maps whose windows :func:`near_all` gathers in one copy (:func:`_windows`); fewer
 #: are copied map by map. Measured on randomised slalom runs' calls, a call in one copy against
-#: map by map: 43 against 36 us for 4 maps, 52 against 49 for 8, 72 against 77 for 16, 187
-#: against 245 for 64.
-ONE_GATHER = 12
+#: map by map: 45 against 35 us for 4 maps, 56 against 49 for 8, 75 against 76 for 16, 189
+#: against 238 for 64.
+ONE_GATHER = 16
 
 
 def _windows(maps: list[RobotMap], grid: Grid, square: tuple[np.ndarray, ...],
@@ -438,11 +438,21 @@ def _windows(maps: list[RobotMap], grid: Grid, square: tuple[np.ndarray, ...],
     """``[R, high, wide]``: each map's cells in its square (rows ``r0:r1``, columns
     ``c0:c1``), from the top left corner, the rest unoccupied; every map on ``grid``. A map's
     cells are the grid's plus its marks (none of them a grid's cell), so the grid's windows
-    are gathered for all maps in one copy (of the grid padded with unoccupied cells) and the
-    marks in the squares set in one more; a copy a map cost more than the two."""
+    are gathered for all maps in one copy (of views of the grid's cells; a square whose
+    window would reach past the grid's far edges is copied on its own) and the marks in the
+    squares set in one more; a copy a map cost more than the two."""
     r0, r1, c0, c1 = square
     high, wide = shape
-    block = _padded(grid, high, wide)[r0, c0]
+    rows, cols = grid.occupied.shape
+    windows = _window_view(grid, high, wide)      # (squares are clipped to the grid: it fits)
+    fits = (r0 + high <= rows) & (c0 + wide <= cols)
+    if np.count_nonzero(fits) == len(fits):
+        block = windows[r0, c0]
+    else:
+        block = np.zeros((len(maps), high, wide), dtype=bool)
+        block[fits] = windows[r0[fits], c0[fits]]
+        for j in np.flatnonzero(~fits).tolist():
+            block[j, :r1[j] - r0[j], :c1[j] - c0[j]] = grid.occupied[r0[j]:r1[j], c0[j]:c1[j]]
     if np.count_nonzero(r1 - r0 - high):                 # rows below a short square's
         block &= (np.arange(high) < (r1 - r0)[:, None])[:, :, None]
     if np.count_nonzero(c1 - c0 - wide):                 # columns right of a narrow one's
@@ -451,7 +461,7 @@ def _windows(maps: list[RobotMap], grid: Grid, square: tuple[np.ndarray, ...],
     if given or not sum(counts):
         return block
     k = np.repeat(np.arange(len(maps)), counts)
-    r, c = _divmod(np.concatenate([m.marks for m in maps]), grid.occupied.shape[1])
+    r, c = _divmod(np.concatenate([m.marks for m in maps]), cols)
     inside = ((r >= r0[k]) & (r < r1[k]) & (c >= c0[k]) & (c < c1[k])).nonzero()[0]
     k = k[inside]
     block[k, r[inside] - r0[k], c[inside] - c0[k]] = True
@@ -459,15 +469,10 @@ def _windows(maps: list[RobotMap], grid: Grid, square: tuple[np.ndarray, ...],
 
 
 @functools.lru_cache(maxsize=8)
-def _padded(grid: Grid, high: int, wide: int) -> np.ndarray:
-    """``[rows + 1, cols + 1, high, wide]``: the window of that shape from every cell of the
-    grid (views of its cells with ``high`` unoccupied rows above and ``wide`` unoccupied
-    columns right of them: a window may start at any cell), kept (read-only)."""
-    rows, cols = grid.occupied.shape
-    out = np.zeros((rows + high, cols + wide), dtype=bool)
-    out[:rows, :cols] = grid.occupied
-    out.flags.writeable = False
-    return np.lib.stride_tricks.sliding_window_view(out, (high, wide))
+def _window_view(grid: Grid, high: int, wide: int) -> np.ndarray:
+    """``[rows - high + 1, cols - wide + 1, high, wide]``: the window of that shape from every
+    cell of the grid it fits from (views of the grid's cells, no copy), kept (read-only)."""
+    return np.lib.stride_tricks.sliding_window_view(grid.occupied, (high, wide))
 
 
 def _divmod(a: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
