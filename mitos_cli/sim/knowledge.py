@@ -722,13 +722,14 @@ def _add_marks(maps: list[RobotMap], grid: Grid, k: np.ndarray, row: np.ndarray,
     centres = np.empty((len(k), 2))
     centres[:, 0], centres[:, 1] = xs[col], ys[row]
     ends = np.searchsorted(k, which, side="right").tolist()
-    # a map's part of each array is a slice: only the cells are set map by map (each map's
-    # own array), by flat index (a quarter of the time of rows and columns)
+    # a map's part of each array is a slice (its marks a copy of theirs: a slice would keep
+    # the whole batch's marks of that tick alive as long as the map keeps them); its cells
+    # are set by flat index (a quarter of the time of rows and columns)
     for j, a, e, lo, hi in zip(js, [0, *ends[:-1]], ends, bounds[:len(js)], bounds[len(js):]):
         m = maps[j]
         m._changes += 1
         m.occupied.put(flat[a:e], True)
-        m.marks = marks[lo:hi]
+        m.marks = marks[lo:hi].copy()
         m.fresh.append(centres[a:e])
 
 
