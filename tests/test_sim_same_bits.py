@@ -243,6 +243,15 @@ def test_many_maps_marked_and_looked_up_at_once_are_each_maps_own():
             assert all(same(x, y) for x, y in zip(m.fresh, a.fresh))   # centres, in order
             assert np.array_equal(row, a.accounted_cells(c))
     assert any(flags) and not all(flags)
+    for few in (together[1:], together[1:], together[:0:-1]):   # a run ends; others, turned
+        cells = rng.integers([-6, -6], [46, 36], (len(few), 25, 2))
+        want = [m.accounted_cells(c) for m, c in zip(few, cells)]
+        assert np.array_equal(knowledge.accounted_all(few, cells, kept=kept), want)
+    other = knowledge.RobotMap.of(Grid(rng.random((30, 40)) < 0.03, 2.0, (-7.0, 3.0)))
+    for few in ([together[1], other], [other, together[1]]):     # alike grids, turned
+        cells = rng.integers([-6, -6], [46, 36], (len(few), 25, 2))
+        want = [m.accounted_cells(c) for m, c in zip(few, cells)]
+        assert np.array_equal(knowledge.accounted_all(few, cells, kept=kept), want)
 
 
 def clear_by_scanning(occupied: np.ndarray, given: np.ndarray, grid: Grid, origin, dirs,

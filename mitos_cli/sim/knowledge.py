@@ -32,6 +32,7 @@ import bisect
 import functools
 import itertools
 import math
+import operator
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
@@ -750,15 +751,14 @@ def accounted_all(maps: list[RobotMap], cells: np.ndarray, reach: int = 2,
     everywhere = np.count_nonzero(inside) == inside.size
     if not everywhere:
         flat[~inside] = 0                   # looked up at a cell of the dilation, then left
-    dilations = [m._dilation(reach) for m in maps]
-    stacked = None if kept is None else kept.of(dilations)
+    stacked = None if kept is None else kept.of_maps(maps, reach)
     if kept is not None and stacked is not None:
         flat += kept.starts
         out = stacked.take(flat)
     else:
         out = np.empty(inside.shape, dtype=bool)
-        for j, near in enumerate(dilations):
-            near.take(flat[j], out=out[j])
+        for j, m in enumerate(maps):
+            m._dilation(reach).take(flat[j], out=out[j])
     return out if everywhere else out & inside
 
 
@@ -776,6 +776,25 @@ class Dilations:
         self._parts: list[np.ndarray] = []
         self._flat = np.zeros(0, dtype=bool)
         self._starts = np.zeros((0, 1), dtype=np.int64)
+        self._asked: tuple | None = None     # (reach, maps, their planned cells) of the last
+
+    def of_maps(self, maps: list[RobotMap], reach: int) -> np.ndarray | None:
+        """:meth:`of` the dilations of ``maps`` at ``reach`` (:meth:`RobotMap._dilation`),
+        or the flat array it gave last, without asking each map again, when the maps and the
+        cells each planned on are the very arrays they were then (a map that plans again
+        keeps a new array; the given grid's dilation does not change): asking every map each
+        tick took a third of :func:`accounted_all`'s time."""
+        planned = [m.planned for m in maps]
+        last = self._asked
+        if last is not None and reach == last[0] and len(maps) == len(last[1]) \
+                and all(map(operator.is_, maps, last[1])) \
+                and all(map(operator.is_, planned, last[2])):
+            return self._flat
+        self._asked = None
+        flat = self.of([m._dilation(reach) for m in maps])
+        if flat is not None:
+            self._asked = (reach, list(maps), planned)
+        return flat
 
     def of(self, parts: list[np.ndarray]) -> np.ndarray | None:
         """The flat array of ``parts`` (dilations of one shape), or ``None`` past the cap."""
