@@ -243,6 +243,15 @@ def test_many_maps_marked_and_looked_up_at_once_are_each_maps_own():
             assert all(same(x, y) for x, y in zip(m.fresh, a.fresh))   # centres, in order
             assert np.array_equal(row, a.accounted_cells(c))
     assert any(flags) and not all(flags)
+    for few in (together[1:], together[1:], together[:0:-1]):   # a run ends; others, turned
+        cells = rng.integers([-6, -6], [46, 36], (len(few), 25, 2))
+        want = [m.accounted_cells(c) for m, c in zip(few, cells)]
+        assert np.array_equal(knowledge.accounted_all(few, cells, kept=kept), want)
+    other = knowledge.RobotMap.of(Grid(rng.random((30, 40)) < 0.03, 2.0, (-7.0, 3.0)))
+    for few in ([together[1], other], [other, together[1]]):     # alike grids, turned
+        cells = rng.integers([-6, -6], [46, 36], (len(few), 25, 2))
+        want = [m.accounted_cells(c) for m, c in zip(few, cells)]
+        assert np.array_equal(knowledge.accounted_all(few, cells, kept=kept), want)
 
 
 def clear_by_scanning(occupied: np.ndarray, given: np.ndarray, grid: Grid, origin, dirs,
@@ -452,6 +461,28 @@ def test_the_heuristic_read_from_one_quarter_is_math_dist_to_the_goal(R, C, data
     assert same(np.array(_heuristic(R, C, goal)), np.array(want))
 
 
+@hypothesis.settings(max_examples=60, deadline=None)
+@hypothesis.given(st.integers(0, 2**32 - 1), st.integers(1, 30))
+def test_capped_squares_that_stop_shifting_early_are_every_shifts_minimum(seed, cap):
+    """:func:`.distance._capped_squares` stops shifting once no shift can lower a square:
+    the bits of the minimum over every shift up to the cap, beyond the cap too, whole or in
+    part."""
+    rng = np.random.default_rng(seed)
+    rows, cols = (int(n) for n in rng.integers(1, 50, 2))
+    blocked = rng.random((rows, cols)) < float(rng.choice([0.0, 0.01, 0.05, 0.3]))
+    far = cap + 1
+    g = np.minimum(distance._column_steps(blocked, far), far).astype(np.int64) ** 2
+    padded = np.full((rows, cols + 2 * cap), far * far, dtype=np.int64)
+    padded[:, cap:cap + cols] = g
+    every = np.min([padded[:, cap + dc:cap + dc + cols] + dc * dc for dc in range(-cap, cap + 1)],
+                   axis=0)
+    r0, c0 = int(rng.integers(0, rows)), int(rng.integers(0, cols))
+    r1, c1 = int(rng.integers(r0 + 1, rows + 1)), int(rng.integers(c0 + 1, cols + 1))
+    assert np.array_equal(distance._capped_squares(blocked, cap), every)
+    assert np.array_equal(distance._capped_squares(blocked, cap, (r0, r1, c0, c1)),
+                          every[r0:r1, c0:c1])
+
+
 @hypothesis.settings(max_examples=40, deadline=None)
 @hypothesis.given(st.integers(0, 2**32 - 1), st.sampled_from([None, 3.0, 9.5, 400.0]))
 def test_a_field_kept_as_squares_reads_the_distances_it_held(seed, cap):
@@ -603,6 +634,36 @@ def test_steps_worked_out_again_only_near_the_changed_distances_are_those_of_the
     assert same(patched[0].dist, whole[0].dist)
     assert all(same(a, b) for a, b in zip(patched[1], whole[1]))
     assert same(patched[2], whole[2])
+
+
+@hypothesis.given(st.integers(0, 2**32 - 1))
+@hypothesis.settings(max_examples=60, deadline=None)
+def test_set_cells_are_numpys_nonzero(seed):
+    """:func:`.route.set_cells` (a flat nonzero split into rows and columns) gives NumPy's
+    2-D ``nonzero``: the same cells in the same order, of grids and of windows into them."""
+    rng = np.random.default_rng(seed)
+    grid = rng.random(tuple(int(n) for n in rng.integers(0, 40, 2))) < float(rng.random())
+    r0, c0 = (int(rng.integers(0, n + 1)) for n in grid.shape)
+    r1, c1 = int(rng.integers(r0, grid.shape[0] + 1)), int(rng.integers(c0, grid.shape[1] + 1))
+    for mask in (grid, grid[r0:r1, c0:c1]):
+        got, want = route.set_cells(mask), mask.nonzero()
+        assert all(same(a, b) and a.dtype == b.dtype for a, b in zip(got, want))
+
+
+@hypothesis.given(st.integers(0, 2**32 - 1))
+@hypothesis.settings(max_examples=40, deadline=None)
+def test_clearance_of_points_all_on_the_grid_is_the_masked_reads(seed):
+    """:meth:`.route.Clearance.at` reads points all on the grid without masks: the bits of
+    the masked reads it takes with one point off the grid."""
+    rng = np.random.default_rng(seed)
+    rows, cols = (int(n) for n in rng.integers(3, 30, 2))
+    res = float(rng.choice([0.05, 0.5, 2.0, 3.0]))
+    origin = tuple(rng.normal(0, 7, 2).tolist())
+    field = route.Clearance.of(rng.random((rows, cols)) < 0.1, res, origin, cap=5 * res)
+    inside = np.asarray(origin) + rng.uniform(0, 1, (50, 2)) * [cols * res, rows * res]
+    inside = inside[field._cell_of(inside)[3]]           # (none on the far edge, rounded)
+    off = np.vstack([inside, [[origin[0] - 1.0, origin[1] - 1.0]]])
+    assert same(field.at(inside), field.at(off)[:-1])
 
 
 def test_a_star_over_flat_tables_takes_the_generic_searchs_path():
@@ -852,13 +913,17 @@ def test_a_maps_near_cells_read_from_the_last_square_are_the_cells_of_a_fresh_lo
             assert same(kept.near(p, reach, given), fresh.near(p, reach, given))
 
 
-def test_many_maps_near_cells_asked_at_once_are_each_maps_own():
+@pytest.mark.parametrize("one_gather", [1, knowledge.ONE_GATHER])     # all in one copy or not
+def test_many_maps_near_cells_asked_at_once_are_each_maps_own(monkeypatch, one_gather):
+    monkeypatch.setattr(knowledge, "ONE_GATHER", one_gather)
     rng = np.random.default_rng(16)
     for _ in range(60):
         rows, cols = (int(n) for n in rng.integers(1, 40, 2))
         res = float(rng.choice([0.5, 2.0, 3.0]))
         grid = Grid(rng.random((rows, cols)) < 0.2, res, tuple(rng.normal(0, 5, 2).tolist()))
-        maps = [knowledge.RobotMap.of(grid) for _ in range(int(rng.integers(2, 8)))]
+        maps = [knowledge.RobotMap.of(grid) for _ in range(int(rng.integers(2, 20)))]
+        if rng.random() < 0.3:             # alike, not one grid: each map's cells copied
+            maps.append(knowledge.RobotMap.of(Grid(grid.occupied.copy(), res, grid.origin)))
         for m in maps:
             m.mark(rng.uniform(-10, cols * res + 10, (5, 2)), np.tile([1.0, 0.0], (5, 1)))
         # squares inside, across the edges and wholly outside the grid, of one cell or more
