@@ -322,10 +322,11 @@ def test_a_backing_out_waits_for_its_wheel_where_the_arcs_on_the_way_are_shut():
 def test_the_coarse_pass_leaves_out_no_cell_that_comes_within_a_step_of_the_body():
     """:func:`safety._near` looks at every ``COARSE``-th place only; a cell it leaves out must
     be below ``-step`` at every place (never touched, nor a pair of places :func:`_between`
-    looks between), on sweeps of every size and curvature (a small robot at full lock with a
-    long step has no bound), with cells strewn about the footprint at every place."""
+    looks between), and a cell it keeps at every place outside its window, on sweeps of every
+    size and curvature (a small robot at full lock with a long step has no bound), with cells
+    strewn about the footprint at every place."""
     rng = np.random.default_rng(20261205)
-    left_out, gaps = 0, []
+    left_out, gaps, windows = 0, [], []
     for _ in range(300):
         wb = float(rng.choice([4.0, rng.uniform(8, 40)]))
         robot = Robot(wheelbase=wb, length=wb * rng.uniform(1.0, 2.0), width=wb * rng.uniform(0.5, 1.5))
@@ -344,12 +345,19 @@ def test_the_coarse_pass_leaves_out_no_cell_that_comes_within_a_step_of_the_body
         reach = safety._depth(px - cx, py - cy, c, s, hl, hw, radius).max(axis=1)   # every place
         places = (c, s, cx, cy, *safety._room(c, s, hl, hw, radius))
         bound = safety._bound(*(np.full((1, 1), v) for v in (k, du, hl, hw, half, radius)), step)
-        near, _ = safety._near(px, py, np.zeros(300, dtype=np.intp), places, bound[:, 0],
+        near, _, lo, hi = safety._near(px, py, np.zeros(300, dtype=np.intp), places, bound[:, 0],
                                np.array([u[0, -1] < 0]))
         assert not np.count_nonzero(~near & (reach >= -step))
+        # each cell kept is below -step at every place outside its window
+        depth = safety._depth(px - cx, py - cy, c, s, hl, hw, radius)         # [300, K]
+        place = np.arange(u.shape[1])
+        outside = (place < lo[:, None]) | (place > hi[:, None])
+        assert not np.count_nonzero(outside[near] & (depth[near] >= -step))
+        windows.append(float(np.mean(hi[near] - lo[near] + 1)) / u.shape[1])
         left_out += np.count_nonzero(~near)
         gaps += list(-step - reach[~near])
     assert left_out > 20_000 and min(gaps) < 1.0      # it leaves out many, some near the edge
+    assert np.mean(windows) < 0.8                     # and the windows leave out places
 
 
 def test_sweeps_measured_a_few_cells_at_a_time_get_the_bits_they_get_at_once(monkeypatch):
@@ -510,15 +518,16 @@ def test_sweeps_measured_only_up_to_their_first_sure_touch_get_the_bits_they_get
     """:func:`safety._travels` looks at each sweep's places only up to the first where the
     coarse pass finds a cell touched for sure (:func:`safety._near`); every sweep still gets
     what it gets alone, among walls close ahead, cells the body touches at the start (backing
-    away from them) and no cell in reach, its places split among chunks or not."""
+    away from them) and no cell in reach, its places split among chunks or not; each cell is
+    looked at in its window of places alone (:func:`safety._near`)."""
     monkeypatch.setattr(safety, "CHUNK", chunk)
     rng = np.random.default_rng(14)
     trimmed = []
     touches = safety._touches
 
-    def spy(px, py, owner, places, back, step, upto):
-        trimmed.append(int(np.count_nonzero(upto < places[0].shape[1])))
-        return touches(px, py, owner, places, back, step, upto)
+    def spy(px, py, owner, places, back, step, lo, hi):
+        trimmed.append(int(np.count_nonzero(hi - lo + 1 < places[0].shape[1])))
+        return touches(px, py, owner, places, back, step, lo, hi)
 
     monkeypatch.setattr(safety, "_touches", spy)
     for _ in range(40):

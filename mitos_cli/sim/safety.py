@@ -354,15 +354,22 @@ def _travels(cells: list[np.ndarray], numbers, radius: np.ndarray, reach: np.nda
     if not len(owner):
         return out
     places = (c, s, cx, cy, *_room(c, s, hl, hw, rad))
-    near, sure = _near(px, py, owner, places, _bound(k, du, hl, hw, half, rad, step)[:, 0], back)
-    px, py, owner = px[near], py[near], owner[near]
+    near, sure, lo, hi = _near(px, py, owner, places,
+                               _bound(k, du, hl, hw, half, rad, step)[:, 0], back)
+    px, py, owner, lo, hi = px[near], py[near], owner[near], lo[near], hi[near]
     if not len(owner):
         return out
     # each sweep's places up to the first where a cell is touched for sure (its own at most):
     # no later place changes where it first touches, nor a pair _between looks at
     upto = np.maximum(own[:, 0], 0)            # (a sweep of no place: a reach below 0)
     np.minimum.at(upto, owner, sure[near] + 1)
-    hit, cell, j = _touches(px, py, owner, places, back, step, upto)
+    hi = np.minimum(hi, upto[owner] - 1)       # each cell's window, up to its sweep's last
+    some = hi >= lo
+    if not np.count_nonzero(some):
+        return out
+    if not some.all():
+        px, py, owner, lo, hi = px[some], py[some], owner[some], lo[some], hi[some]
+    hit, cell, j = _touches(px, py, owner, places, back, step, lo, hi)
     _between(hit, own[:, 0], cell, j, owner, u, arc, px, py, hl[owner], hw[owner], rad[owner])
     first = np.maximum(hit.argmax(axis=1) - 1, 0) * du[:, 0]
     return np.where(np.logical_or.reduce(hit, axis=1), first, out)
@@ -394,7 +401,8 @@ def _in_boxes(known: list[np.ndarray], cx: np.ndarray, cy: np.ndarray,
 
 
 def _near(px: np.ndarray, py: np.ndarray, owner: np.ndarray, places: tuple[np.ndarray, ...],
-          bound: np.ndarray, back: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+          bound: np.ndarray, back: np.ndarray
+          ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """``[M]`` which cells (``px, py [M, 1]`` of sweeps ``owner [M]``) may reach a depth of
     ``-step`` at one of their sweep's ``places`` (``c, s, cx, cy`` and :func:`_room`, each
     ``[R, K]``), from their depths at the :func:`_coarse` places alone: a cell deeper than
@@ -404,54 +412,66 @@ def _near(px: np.ndarray, py: np.ndarray, owner: np.ndarray, places: tuple[np.nd
     Leaving it out changes no bit of the answer, and most of the cells in a sweep's box are
     out of its reach. Also ``[M]``: the first of those places where each cell is touched for
     sure (:func:`_touched`, backing out of sweeps ``back [R]``: its depth 0 or more, and not
-    a cell touched at the start backed away from), past the last place where none is. (The
-    places a cell is looked at run down a column: NumPy takes the greatest of each column at
-    once, and of each short row one row at a time.)"""
+    a cell touched at the start backed away from), past the last place where none is; and
+    each cell's window, the places ``lo`` to ``hi`` (``[M]`` each) from the coarse place
+    before its first deeper than ``-bound`` to the one after its last: by the same bound,
+    every place outside lies between two coarse places below ``-bound``, so the cell is
+    below ``-step`` there (a cell passes the footprint in a short stretch of a sweep, and
+    :func:`_touches` looks at that stretch alone: a third of the places). (The places a cell
+    is looked at run down a column: NumPy takes the greatest of each column at once, and of
+    each short row one row at a time.)"""
     width = places[0].shape[1]
     at = _coarse(width)[:, None]                                # [C, 1]
+    last = len(at) - 1
 
-    def deep(part: slice) -> tuple[np.ndarray, np.ndarray]:
+    def deep(part: slice) -> tuple[np.ndarray, ...]:
         where = at + owner[part] * width                        # [C, M]: in places, flat
         c, s, cx, cy, *room = (np.take(v, where) for v in places)
         depth = _depth_in(px[part, 0] - cx, py[part, 0] - cy, c, s, room)
         sure = depth >= 0
         sure &= (depth[:1] < 0) | ~back[owner[part]]
+        within = depth >= -bound[owner[part]]
+        first = np.maximum(within.argmax(axis=0) - 1, 0)
+        after = np.minimum(last - within[::-1].argmax(axis=0) + 1, last)
         return (depth.max(axis=0) >= -bound[owner[part]],
-                np.where(np.logical_or.reduce(sure, axis=0), at[sure.argmax(axis=0), 0], width))
+                np.where(np.logical_or.reduce(sure, axis=0), at[sure.argmax(axis=0), 0], width),
+                at[first, 0], at[after, 0])
 
-    near, sure = zip(*(deep(part) for part in _chunks(len(owner), len(at))))
-    return np.concatenate(near), np.concatenate(sure)
+    near, sure, lo, hi = zip(*(deep(part) for part in _chunks(len(owner), len(at))))
+    return np.concatenate(near), np.concatenate(sure), np.concatenate(lo), np.concatenate(hi)
 
 
 def _touches(px: np.ndarray, py: np.ndarray, owner: np.ndarray, places: tuple[np.ndarray, ...],
-             back: np.ndarray, step: float, upto: np.ndarray
+             back: np.ndarray, step: float, lo: np.ndarray, hi: np.ndarray
              ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Where each sweep touches a cell (``[R, K]``, :func:`_touched`; backing out, ``back
-    [R]``) within its first ``upto [R]`` places, and the pairs of those places a cell may be
-    touched between (:func:`_pairs`), worked out :data:`CHUNK` elements at a time: the cells
-    ``px, py [M, 1]`` of sweeps ``owner [M]`` (sorted) at their sweep's ``places`` (as
-    :func:`_near` takes them), each cell's places one after the other (up to its sweep's
-    first sure touch, :func:`_near`)."""
+    [R]``) and the pairs of places a cell may be touched between (:func:`_pairs`), worked
+    out :data:`CHUNK` elements at a time: the cells ``px, py [M, 1]`` of sweeps ``owner
+    [M]`` (sorted) at their sweep's ``places`` (as :func:`_near` takes them), each cell at
+    the places of its window ``lo`` to ``hi`` (``[M]`` each, not empty: :func:`_near`'s, up
+    to its sweep's first sure touch) one after the other. Outside its window a cell is
+    below ``-step``: neither touched nor half of a pair, and below 0 at the start."""
     width = places[0].shape[1]
     hit = np.zeros(places[0].shape, dtype=bool)
     flat_hit = hit.reshape(-1)
     pairs = []
-    for part in _spans(upto[owner]):
-        count = upto[owner[part]]
+    for part in _spans(hi - lo + 1):
+        count = hi[part] - lo[part] + 1
         cell = np.repeat(np.arange(part.start, part.stop), count)             # [N]
         first = np.cumsum(count) - count               # where each cell's places begin
-        j = np.arange(len(cell)) - np.repeat(first, count)
+        j = np.arange(len(cell)) - np.repeat(first - lo[part], count)
         at = owner[cell] * width + j                                            # in places
         c, s, cx, cy, *room = (np.take(v, at) for v in places)
         depth = _depth_in(px[cell, 0] - cx, py[cell, 0] - cy, c, s, room)      # [N]
         inside = depth >= 0
-        start = depth[first][cell - part.start]        # each cell's depth at the start
+        # each cell's depth at the start (below 0 where its window begins later)
+        start = np.where(lo[part] == 0, depth[first], -np.inf)[cell - part.start]
         if np.count_nonzero(back[owner[part]]):        # (_touched, a cell at a time)
             away = back[owner[cell]] & (start >= 0)
             inside[away] = depth[away] > start[away]
         flat_hit[at[inside]] = True
         maybe = (depth[:-1] + depth[1:] >= -step) & ~inside[:-1] & ~inside[1:]    # (_pairs)
-        maybe &= (j[1:] != 0) & (start[:-1] < 0)       # one cell's places, not touched at first
+        maybe &= (cell[1:] == cell[:-1]) & (start[:-1] < 0)   # one cell's, not touched at first
         k = np.flatnonzero(maybe)
         pairs.append((cell[k], j[k]))
     cell, j = (np.concatenate(v) for v in zip(*pairs))
