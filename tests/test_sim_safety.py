@@ -559,3 +559,44 @@ def test_a_sweep_of_no_place_among_others_keeps_its_reach():
             got = safety.free_travels(sweeps)
         assert got[1] == safety.free_travels(sweeps[1:])[0]
         assert got[0] == before
+
+
+def test_a_fleet_asking_its_maps_round_each_sweeps_box_carries_out_what_it_does_with_its_squares():
+    """:meth:`safety.Fleet.guard` given the robots' maps (:data:`safety.Near`: the first
+    sweeps' cells asked round each sweep's box, the robot's square where the box reaches out
+    of it, as :func:`.knowledge.near_all` asks them) gives the commands, recovery states and
+    backings-out it gives with every robot's whole square of cells, to the bit: on maps of
+    strewn cells and walls, robots near the map's edge and sweeps whose box leaves the
+    square (long reaches at full lock)."""
+    from mitos_cli.sim import knowledge
+    from mitos_cli.sim.world import Grid
+
+    rng = np.random.default_rng(8)
+    boxes = {"inside": 0, "outside": 0}
+    for _ in range(60):
+        n = int(rng.integers(1, 10))
+        fleet, now, _, state, command = _fleet_case(rng, n)
+        fleet.reach[:] = rng.choice([30.0, 40.0, 150.0], n)       # (150: its box leaves it)
+        fleet.squares[:] = fleet.reach + [math.hypot(r.length, r.width) for r in fleet.robots]
+        res = float(rng.choice([1.0, 2.0, 2.5]))
+        occupied = rng.random((220, 230)) < rng.choice([0.02, 0.1])
+        occupied[:, int(rng.integers(0, 230))] = True                          # a wall
+        grid = Grid(occupied, res, (-230.0 * res / 2, -220.0 * res / 2), "")
+        maps = [knowledge.RobotMap.of(grid) for _ in range(n)]
+        rows = np.flatnonzero(rng.random(n) < 0.8)
+
+        def near(j, points, half, rows=rows, maps=maps):
+            inside = half < fleet.squares[rows[j]]
+            boxes["inside"] += int(np.count_nonzero(inside))
+            boxes["outside"] += int(np.count_nonzero(~inside))
+            return knowledge.near_all([maps[i] for i in rows[j].tolist()], points, half)
+
+        squares = knowledge.near_all([maps[i] for i in rows.tolist()],
+                                     np.column_stack([now[0], now[1]])[rows],
+                                     fleet.squares[rows]) if len(rows) else []
+        want_command, want_state = command.copy(), state.copy()
+        want = fleet.guard(rows, want_command, want_state, now, squares)
+        assert fleet.guard(rows, command, state, now, near) == want
+        assert command.tobytes() == want_command.tobytes()
+        assert state.tobytes() == want_state.tobytes()
+    assert boxes["inside"] > 100 and boxes["outside"] > 20, boxes

@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import functools
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -335,10 +336,11 @@ def free_travels(sweeps: list[tuple[Body, float, bool]], step: float = 1.0) -> n
     return out
 
 
-def _travels(cells: list[np.ndarray], numbers, radius: np.ndarray, reach: np.ndarray,
+def _travels(cells: list[np.ndarray] | Boxed, numbers, radius: np.ndarray, reach: np.ndarray,
              back: np.ndarray, step: float) -> np.ndarray:
     """The free travel ``[R]`` of ``R`` sweeps (runs in lockstep brake together), each with
-    cells (``[P, 2]`` each, of half side ``radius [R]``), backward or not (``back [R]``), as
+    cells (``[P, 2]`` each, of half side ``radius [R]``; or what a :data:`Boxed` finds round
+    each sweep's box), backward or not (``back [R]``), as
     far as ``reach [R]``; ``numbers``: each sweep's :func:`_sweep_of`, ``[R]`` each. Worked
     out elementwise over ``[R, K]`` places (each sweep's own, its last repeated to the
     longest) and ``[M, K]`` for the ``M`` cells in the sweeps' boxes that :func:`_near`
@@ -350,7 +352,7 @@ def _travels(cells: list[np.ndarray], numbers, radius: np.ndarray, reach: np.nda
     u = np.minimum(np.arange(int(own.max())), own - 1) * np.where(back[:, None], -du, du)
     arc = Arc(h, k, a, b, sin_h, cos_h, half, np.abs(k) > 1e-9)
     c, s, cx, cy = arc.centres(u)              # [R, K]: the footprint at each sweep's places
-    px, py, owner = _in_boxes(cells, cx, cy, disc[:, 0])                # [M, 1], by sweep
+    px, py, owner = _in_boxes(cells, cx, cy, disc[:, 0], 2 * radius)    # [M, 1], by sweep
     if not len(owner):
         return out
     places = (c, s, cx, cy, *_room(c, s, hl, hw, rad))
@@ -382,13 +384,19 @@ COARSE = 8
 ROUNDING = 1e-3
 
 
-def _in_boxes(known: list[np.ndarray], cx: np.ndarray, cy: np.ndarray,
-              disc: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The cells (``px, py [M, 1]``) of ``known`` (each sweep's) in the box each sweep may
-    touch (its centres ``cx, cy [R, K]``, grown by ``disc [R]``), and their sweep (``owner
-    [M]``, sorted)."""
+def _in_boxes(known: list[np.ndarray] | Boxed, cx: np.ndarray, cy: np.ndarray,
+              disc: np.ndarray, side: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The cells (``px, py [M, 1]``) of ``known`` (each sweep's, or what the :data:`Boxed`
+    finds round each sweep's box) in the box each sweep may touch (its centres ``cx, cy [R,
+    K]``, grown by ``disc [R]``), and their sweep (``owner [M]``, sorted). A :data:`Boxed`
+    is asked for the square round each box grown by a cell's ``side [R]``: a cell whose
+    centre lies in the box has its row and column in that square's."""
     lo_x, hi_x = cx.min(axis=1) - disc, cx.max(axis=1) + disc
     lo_y, hi_y = cy.min(axis=1) - disc, cy.max(axis=1) + disc
+    if callable(known):
+        centre = np.empty((len(lo_x), 2))
+        centre[:, 0], centre[:, 1] = (lo_x + hi_x) / 2, (lo_y + hi_y) / 2
+        known = known(centre, np.maximum(hi_x - lo_x, hi_y - lo_y) / 2 + side)
     cells = np.concatenate(known)                                               # [P, 2]
     counts = [len(c) for c in known]
     px, py = cells[:, 0], cells[:, 1]
@@ -663,6 +671,17 @@ def rest(n: int) -> np.ndarray:
     return np.tile([calm.held, calm.left, calm.wheel], (n, 1))
 
 
+#: What robots' maps hold: ``near(j, centres [R, 2], half [R])``, the centres ``[P, 2]`` of
+#: the occupied cells of the maps of robots ``j`` (places in a guard's rows) in the squares
+#: of half side ``half`` round ``centres``, a cell taken where its row and column lie in the
+#: square's (:meth:`.knowledge.RobotMap.near`, :func:`.knowledge.near_all`).
+Near = Callable[[np.ndarray, np.ndarray, np.ndarray], list[np.ndarray]]
+
+#: What sweeps' robots know round their boxes: ``boxed(centres [R, 2], half [R])``, the cells
+#: of each sweep's robot in the square of half side ``half`` round ``centres``
+#: (:meth:`Fleet.free`).
+Boxed = Callable[[np.ndarray, np.ndarray], list[np.ndarray]]
+
 #: The arrays of a :class:`Fleet`, a row per robot.
 _FLEET_ROWS = ("radius", "reach", "brakes", "wheelbase", "half", "hl", "hw", "straight", "lo",
                "hi", "turn", "acceleration", "reverse", "squares", "disc", "far")
@@ -714,18 +733,21 @@ class Fleet:
         return out
 
     def guard(self, rows: np.ndarray, command: np.ndarray, state: np.ndarray,
-              now: tuple[np.ndarray, ...], cells: list[np.ndarray]) -> list[int]:
+              now: tuple[np.ndarray, ...], cells: list[np.ndarray] | Near) -> list[int]:
         """:func:`guard` of the robots ``rows`` (ascending) at once, on their ``command [N,
         2]`` and their :class:`Recovery` ``state [N, 3]`` (:func:`rest`), both updated in
         place; the rows that begin to back out, in order. ``now``: every row's x, y (in),
         heading (rad), wheel (deg), speed (in/s) and route side, ``[N]`` each; ``cells``:
-        what each of ``rows`` knows is occupied near it. Their first sweeps
-        (:func:`first_sweep`) are measured together; a robot whose command the brake alone
-        decides (no backing out under way or to begin, no wheel to hold: most, most ticks)
-        is decided here, the rest by :func:`guard` itself, with its first sweep known. One
-        robot is guarded as alone: the arrays would cost more than they save."""
+        what each of ``rows`` knows is occupied near it, or its map (:data:`Near`), asked
+        for the square of half side :attr:`squares` round it, and for its first sweep only
+        round the sweep's box (:meth:`free`). Their first sweeps (:func:`first_sweep`) are
+        measured together; a robot whose command the brake alone decides (no backing out
+        under way or to begin, no wheel to hold: most, most ticks) is decided here, the rest
+        by :func:`guard` itself, with its first sweep known. One robot is guarded as alone:
+        the arrays would cost more than they save."""
         if len(rows) <= 1:
-            return [i for i in rows.tolist() if self._one(i, command, state, now, cells[0])]
+            return [i for i in rows.tolist()
+                    if self._one(i, command, state, now, self._own(cells, rows, now, [0])[0])]
         cfg, dt = self.cfg, self.dt
         x, y, h, wheel, speed, _ = (v[rows] for v in now)
         held, left, lock = state[rows].T
@@ -743,9 +765,24 @@ class Fleet:
         easy = rows[~hard]
         command[easy, 1] = np.where(np.abs(want) > limit, np.copysign(limit, want), want)[~hard]
         state[easy, 0] = held[~hard]
-        return [int(rows[j]) for j in hard.nonzero()[0].tolist()
-                if self._one(int(rows[j]), command, state, now, cells[j],
+        hard_rows = hard.nonzero()[0].tolist()
+        if not hard_rows:
+            return []
+        own = self._own(cells, rows, now, hard_rows)
+        return [int(rows[j]) for j, mine in zip(hard_rows, own)
+                if self._one(int(rows[j]), command, state, now, mine,
                              (turned.item(j), bool(back[j]), free.item(j)))]
+
+    def _own(self, cells: list[np.ndarray] | Near, rows: np.ndarray,
+             now: tuple[np.ndarray, ...], picked: list[int]) -> list[np.ndarray]:
+        """What the robots ``rows[picked]`` know in their squares (:attr:`squares`): theirs
+        of ``cells``, or asked of their maps."""
+        if not callable(cells):
+            return [cells[j] for j in picked]
+        which = rows[picked]
+        at = np.empty((len(which), 2))
+        at[:, 0], at[:, 1] = now[0][which], now[1][which]
+        return cells(np.array(picked, dtype=np.intp), at, self.squares[which])
 
     def _one(self, i: int, command: np.ndarray, state: np.ndarray, now: tuple[np.ndarray, ...],
              cells: np.ndarray, known: tuple[float, bool, float] | None = None) -> bool:
@@ -768,21 +805,48 @@ class Fleet:
         return wheel + _least(_most(target - wheel, -turn), turn)
 
     def free(self, rows: np.ndarray, x: np.ndarray, y: np.ndarray, h: np.ndarray,
-             wheel: np.ndarray, back: np.ndarray, cells: list[np.ndarray]) -> np.ndarray:
+             wheel: np.ndarray, back: np.ndarray, cells: list[np.ndarray] | Near) -> np.ndarray:
         """:func:`free_travels` of the robots ``rows`` at ``x, y, h``, their wheels at
         ``wheel`` (deg), backward or not (``back``), what each knows being ``cells``, ``[R]``
-        each; each sweep's numbers (:func:`_sweep_of`) worked out for all at once in the
-        same Python floats."""
+        each (or asked of their maps, :data:`Near`: round each sweep's box alone, a few
+        times fewer cells than the robot's square holds, where that square holds the box;
+        its square where not, so the cells in the box are those of the square); each
+        sweep's numbers (:func:`_sweep_of`) worked out for all at once in the same Python
+        floats."""
         step, reach = self.cfg.step, self.reach[rows]
-        some = np.fromiter(map(len, cells), np.intp, len(cells)).nonzero()[0]
-        if not len(some):
-            return reach
+        if callable(cells):
+            some = np.arange(len(rows))
+            known: list[np.ndarray] | Boxed = self._boxed(cells, rows, x, y)
+        else:
+            some = np.fromiter(map(len, cells), np.intp, len(cells)).nonzero()[0]
+            if not len(some):
+                return reach
+            known = [cells[j] for j in some.tolist()]
         which = rows[some]
-        reach[some] = _travels([cells[j] for j in some.tolist()],
-                               self._sweeps(which, x[some], y[some], h[some],
-                                            wheel[some] - self.straight[which]),
+        reach[some] = _travels(known, self._sweeps(which, x[some], y[some], h[some],
+                                                   wheel[some] - self.straight[which]),
                                self.radius[which], reach[some], back[some], step)
         return reach
+
+    def _boxed(self, near: Near, rows: np.ndarray, x: np.ndarray, y: np.ndarray) -> Boxed:
+        """What the maps of the robots ``rows`` (at ``x, y``) hold round their sweeps' boxes,
+        as :func:`_in_boxes` asks: the square round a box where it lies in the robot's own
+        square (:attr:`squares`), else that square, so that no cell outside it is found.
+        (The same sums as :func:`.knowledge.near_all`'s corners: a square inside another
+        in these floats has its rows and columns among the other's.)"""
+        square = self.squares[rows]
+
+        def boxed(centre: np.ndarray, half: np.ndarray) -> list[np.ndarray]:
+            bx, by = centre[:, 0], centre[:, 1]
+            inside = ((bx - half >= x - square) & (bx + half <= x + square)
+                      & (by - half >= y - square) & (by + half <= y + square))
+            if not inside.all():
+                centre = centre.copy()
+                centre[~inside, 0], centre[~inside, 1] = x[~inside], y[~inside]
+                half = np.where(inside, half, square)
+            return near(np.arange(len(rows)), centre, half)
+
+        return boxed
 
     def _sweeps(self, rows: np.ndarray, x: np.ndarray, y: np.ndarray, h: np.ndarray,
                 delta: np.ndarray) -> tuple[np.ndarray, ...]:
