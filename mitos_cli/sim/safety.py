@@ -136,19 +136,31 @@ class Arc:
 
         h, k, a, b = pick(self.h), pick(self.k), pick(self.a), pick(self.b)
         sin_h, cos_h, turning = pick(self.sin_h), pick(self.cos_h), pick(self.turning)
-        hk = h + k * u
-        c, s = np.cos(hk), np.sin(hk)
+        # (the sums worked in place where they are arrays: a batch's [R, K] are 200 KB each,
+        # and each one more fresh from the system is some fifty page faults; a + b is b + a)
+        hk = k * u
+        hk += h
+        c = np.cos(hk)
+        s = np.sin(hk, out=hk)
         if np.ndim(turning) == 0:                     # one sweep: one formula
             rx = a + (s - sin_h) / k if turning else a + u * cos_h
             ry = b + (cos_h - c) / k if turning else b + u * sin_h
         elif turning.all():                           # (a wheel is seldom exactly straight)
-            rx, ry = a + (s - sin_h) / k, b + (cos_h - c) / k
+            rx = np.subtract(s, sin_h)
+            rx /= k
+            rx += a
+            ry = np.subtract(cos_h, c)
+            ry /= k
+            ry += b
         else:
             bend = np.where(turning, k, 1.0)          # a straight sweep divides by nothing
             rx = np.where(turning, a + (s - sin_h) / bend, a + u * cos_h)
             ry = np.where(turning, b + (cos_h - c) / bend, b + u * sin_h)
         half = pick(self.half)
-        return c, s, rx + half * c, ry + half * s
+        cx, cy = half * c, half * s
+        cx += rx
+        cy += ry
+        return c, s, cx, cy
 
 
 #: Places looked at between two of a sweep's where a cell may be touched between them.
@@ -300,8 +312,18 @@ def _room(c, s, hl, hw, r) -> tuple[Any, Any, Any, Any]:
     footprint's half extents grown by the cell's, along its own axes and along the grid's
     (worked out once a place, not once a cell and place, in the order :func:`_depth` sums)."""
     ac, as_ = np.abs(c), np.abs(s)
-    e = r * (ac + as_)                   # the cell's half extent along the footprint's axes
-    return hl + e, hw + e, r + hl * ac + hw * as_, r + hl * as_ + hw * ac
+    e = ac + as_
+    e *= r                               # the cell's half extent along the footprint's axes
+    along = hl + e
+    e += hw                              # (in place, as Arc.centres: the same sums, in order)
+    x = hl * ac
+    x += r
+    part = hw * as_
+    x += part                            # r + hl ac + hw as
+    y = hl * as_
+    y += r
+    y += np.multiply(hw, ac, out=part)   # r + hl as + hw ac
+    return along, e, x, y
 
 
 def _depth_in(dx, dy, c, s, room) -> np.ndarray:
