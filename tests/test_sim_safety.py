@@ -322,10 +322,11 @@ def test_a_backing_out_waits_for_its_wheel_where_the_arcs_on_the_way_are_shut():
 def test_the_coarse_pass_leaves_out_no_cell_that_comes_within_a_step_of_the_body():
     """:func:`safety._near` looks at every ``COARSE``-th place only; a cell it leaves out must
     be below ``-step`` at every place (never touched, nor a pair of places :func:`_between`
-    looks between), on sweeps of every size and curvature (a small robot at full lock with a
-    long step has no bound), with cells strewn about the footprint at every place."""
+    looks between), and a cell it keeps at every place outside its window, on sweeps of every
+    size and curvature (a small robot at full lock with a long step has no bound), with cells
+    strewn about the footprint at every place."""
     rng = np.random.default_rng(20261205)
-    left_out, gaps = 0, []
+    left_out, gaps, windows = 0, [], []
     for _ in range(300):
         wb = float(rng.choice([4.0, rng.uniform(8, 40)]))
         robot = Robot(wheelbase=wb, length=wb * rng.uniform(1.0, 2.0), width=wb * rng.uniform(0.5, 1.5))
@@ -344,12 +345,19 @@ def test_the_coarse_pass_leaves_out_no_cell_that_comes_within_a_step_of_the_body
         reach = safety._depth(px - cx, py - cy, c, s, hl, hw, radius).max(axis=1)   # every place
         places = (c, s, cx, cy, *safety._room(c, s, hl, hw, radius))
         bound = safety._bound(*(np.full((1, 1), v) for v in (k, du, hl, hw, half, radius)), step)
-        near, _ = safety._near(px, py, np.zeros(300, dtype=np.intp), places, bound[:, 0],
+        near, _, lo, hi = safety._near(px, py, np.zeros(300, dtype=np.intp), places, bound[:, 0],
                                np.array([u[0, -1] < 0]))
         assert not np.count_nonzero(~near & (reach >= -step))
+        # each cell kept is below -step at every place outside its window
+        depth = safety._depth(px - cx, py - cy, c, s, hl, hw, radius)         # [300, K]
+        place = np.arange(u.shape[1])
+        outside = (place < lo[:, None]) | (place > hi[:, None])
+        assert not np.count_nonzero(outside[near] & (depth[near] >= -step))
+        windows.append(float(np.mean(hi[near] - lo[near] + 1)) / u.shape[1])
         left_out += np.count_nonzero(~near)
         gaps += list(-step - reach[~near])
     assert left_out > 20_000 and min(gaps) < 1.0      # it leaves out many, some near the edge
+    assert np.mean(windows) < 0.8                     # and the windows leave out places
 
 
 def test_sweeps_measured_a_few_cells_at_a_time_get_the_bits_they_get_at_once(monkeypatch):
@@ -510,15 +518,16 @@ def test_sweeps_measured_only_up_to_their_first_sure_touch_get_the_bits_they_get
     """:func:`safety._travels` looks at each sweep's places only up to the first where the
     coarse pass finds a cell touched for sure (:func:`safety._near`); every sweep still gets
     what it gets alone, among walls close ahead, cells the body touches at the start (backing
-    away from them) and no cell in reach, its places split among chunks or not."""
+    away from them) and no cell in reach, its places split among chunks or not; each cell is
+    looked at in its window of places alone (:func:`safety._near`)."""
     monkeypatch.setattr(safety, "CHUNK", chunk)
     rng = np.random.default_rng(14)
     trimmed = []
     touches = safety._touches
 
-    def spy(px, py, owner, places, back, step, upto):
-        trimmed.append(int(np.count_nonzero(upto < places[0].shape[1])))
-        return touches(px, py, owner, places, back, step, upto)
+    def spy(px, py, owner, places, back, step, lo, hi):
+        trimmed.append(int(np.count_nonzero(hi - lo + 1 < places[0].shape[1])))
+        return touches(px, py, owner, places, back, step, lo, hi)
 
     monkeypatch.setattr(safety, "_touches", spy)
     for _ in range(40):
@@ -550,3 +559,44 @@ def test_a_sweep_of_no_place_among_others_keeps_its_reach():
             got = safety.free_travels(sweeps)
         assert got[1] == safety.free_travels(sweeps[1:])[0]
         assert got[0] == before
+
+
+def test_a_fleet_asking_its_maps_round_each_sweeps_box_carries_out_what_it_does_with_its_squares():
+    """:meth:`safety.Fleet.guard` given the robots' maps (:data:`safety.Near`: the first
+    sweeps' cells asked round each sweep's box, the robot's square where the box reaches out
+    of it, as :func:`.knowledge.near_all` asks them) gives the commands, recovery states and
+    backings-out it gives with every robot's whole square of cells, to the bit: on maps of
+    strewn cells and walls, robots near the map's edge and sweeps whose box leaves the
+    square (long reaches at full lock)."""
+    from mitos_cli.sim import knowledge
+    from mitos_cli.sim.world import Grid
+
+    rng = np.random.default_rng(8)
+    boxes = {"inside": 0, "outside": 0}
+    for _ in range(60):
+        n = int(rng.integers(1, 10))
+        fleet, now, _, state, command = _fleet_case(rng, n)
+        fleet.reach[:] = rng.choice([30.0, 40.0, 150.0], n)       # (150: its box leaves it)
+        fleet.squares[:] = fleet.reach + [math.hypot(r.length, r.width) for r in fleet.robots]
+        res = float(rng.choice([1.0, 2.0, 2.5]))
+        occupied = rng.random((220, 230)) < rng.choice([0.02, 0.1])
+        occupied[:, int(rng.integers(0, 230))] = True                          # a wall
+        grid = Grid(occupied, res, (-230.0 * res / 2, -220.0 * res / 2), "")
+        maps = [knowledge.RobotMap.of(grid) for _ in range(n)]
+        rows = np.flatnonzero(rng.random(n) < 0.8)
+
+        def near(j, points, half, rows=rows, maps=maps):
+            inside = half < fleet.squares[rows[j]]
+            boxes["inside"] += int(np.count_nonzero(inside))
+            boxes["outside"] += int(np.count_nonzero(~inside))
+            return knowledge.near_all([maps[i] for i in rows[j].tolist()], points, half)
+
+        squares = knowledge.near_all([maps[i] for i in rows.tolist()],
+                                     np.column_stack([now[0], now[1]])[rows],
+                                     fleet.squares[rows]) if len(rows) else []
+        want_command, want_state = command.copy(), state.copy()
+        want = fleet.guard(rows, want_command, want_state, now, squares)
+        assert fleet.guard(rows, command, state, now, near) == want
+        assert command.tobytes() == want_command.tobytes()
+        assert state.tobytes() == want_state.tobytes()
+    assert boxes["inside"] > 100 and boxes["outside"] > 20, boxes

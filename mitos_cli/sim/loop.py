@@ -1160,9 +1160,13 @@ class Simulation:
         measured together (:meth:`.safety.Fleet.guard`)."""
         fleet = self._fleet
         rows = (self._active & fleet.brakes).nonzero()[0]
-        cells = [self._maps[i].near(s.pose[i, :2], fleet.squares.item(i)) for i in rows.tolist()]
+        maps = [self._maps[i] for i in rows.tolist()]
+
+        def near(j: np.ndarray, points: np.ndarray, half: np.ndarray) -> list[np.ndarray]:
+            return [maps[k].near(p, r) for k, p, r in zip(j.tolist(), points, half.tolist())]
+
         now = (self._x, self._y, self._h, self._steer, self._v, s.inputs["heading"])
-        for i in fleet.guard(rows, s.command, self._recovery, now, cells):
+        for i in fleet.guard(rows, s.command, self._recovery, now, near):
             self._backed.append((self._k, i))
 
     def act(self, s: _Sensed) -> None:
@@ -1717,20 +1721,25 @@ class Batch:
 
     def guard(self) -> None:
         """:meth:`Simulation._guard` of every run at once, on the commands :meth:`commanded`
-        set: what the maps hold round the robots that brake found in one
-        :func:`.knowledge.near_all`, one :meth:`.safety.Fleet.guard` for all on the robots'
-        recovery (the batch's array, each run's its view), and the backing-outs given back
-        to each robot's run."""
+        set: one :meth:`.safety.Fleet.guard` for all on the robots' recovery (the batch's
+        array, each run's its view), what the maps hold round the first sweeps of the robots
+        that brake found in one :func:`.knowledge.near_all` (round each sweep's box, a
+        quarter of the cells of the robot's square), and the backing-outs given back to each
+        robot's run."""
         fleet = self._fleet
         rows = (self.active & fleet.brakes).nonzero()[0]
         if not len(rows):
             return
         maps = self.maps if len(rows) == len(self.maps) else [self.maps[i] for i in rows.tolist()]
-        cells = knowledge.near_all(maps, self.at[rows], fleet.squares[rows])
+
+        def near(j: np.ndarray, points: np.ndarray, half: np.ndarray) -> list[np.ndarray]:
+            return knowledge.near_all(maps if len(j) == len(maps) else
+                                      [maps[k] for k in j.tolist()], points, half)
+
         x, y, h = self._ticked()
         v, steer = self._drive
         backs = fleet.guard(rows, self.command, self._recovery,     # (the runs' too)
-                            (x, y, h, steer, v, self.block[_SIDE]), cells)
+                            (x, y, h, steer, v, self.block[_SIDE]), near)
         for row in backs:
             run, i = self._owner[row]
             run._backed.append((run._k, i))

@@ -517,9 +517,12 @@ def entered(spaces: Sequence[FreeSpace], now: float, points: np.ndarray, dirs: n
         live = live & (k >= 0) & (k < beams)
         k = clip_arrays(k, 0, beams - 1).astype(np.int64)
     off = np.mod(bearing - k * first.step + np.pi, 2 * np.pi) - np.pi        # from that beam
-    reach = ranges.reshape(-1)[row + k]                                       # [P, J]
     on = (np.abs(off) < np.pi / 2) & (dist * np.abs(np.sin(off)) < first.near) & live
-    passed = on & (dist * np.cos(off) < reach - SHORT)
+    # (how far along its beam, only where it lies on one: a few of the [P, J])
+    at = np.flatnonzero(on)
+    passed = np.zeros(on.shape, dtype=bool)
+    reach = ranges.reshape(-1)[(row + k).reshape(-1)[at]]
+    passed.reshape(-1)[at] = dist.reshape(-1)[at] * np.cos(off.reshape(-1)[at]) < reach - SHORT
     return np.logical_or.reduce(on, axis=1), np.logical_or.reduce(passed, axis=1)
 
 

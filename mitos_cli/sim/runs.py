@@ -183,7 +183,7 @@ def run_many(worlds: list[World], runs: int = 0, seed: int | None = None, planne
     for place, w in enumerate(worlds):
         base = w.seed if seed is None else seed
         seeds = [base] if runs <= 0 else [base + j for j in range(runs)]
-        # each worker's share in lockstep batches of up to 64 runs, fewer on a large map
+        # each worker's share in lockstep batches of up to 128 runs, fewer on a large map
         # (batch_for; a batch of 5 runs costs about twice what a batch of 40 does a
         # robot-tick); a world cut into several chunks has its map and routes prepared once,
         # here, and sent along (a grid map's route search costs about as much as a run),

@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import functools
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -135,19 +136,31 @@ class Arc:
 
         h, k, a, b = pick(self.h), pick(self.k), pick(self.a), pick(self.b)
         sin_h, cos_h, turning = pick(self.sin_h), pick(self.cos_h), pick(self.turning)
-        hk = h + k * u
-        c, s = np.cos(hk), np.sin(hk)
+        # (the sums worked in place where they are arrays: a batch's [R, K] are 200 KB each,
+        # and each one more fresh from the system is some fifty page faults; a + b is b + a)
+        hk = k * u
+        hk += h
+        c = np.cos(hk)
+        s = np.sin(hk, out=hk)
         if np.ndim(turning) == 0:                     # one sweep: one formula
             rx = a + (s - sin_h) / k if turning else a + u * cos_h
             ry = b + (cos_h - c) / k if turning else b + u * sin_h
         elif turning.all():                           # (a wheel is seldom exactly straight)
-            rx, ry = a + (s - sin_h) / k, b + (cos_h - c) / k
+            rx = np.subtract(s, sin_h)
+            rx /= k
+            rx += a
+            ry = np.subtract(cos_h, c)
+            ry /= k
+            ry += b
         else:
             bend = np.where(turning, k, 1.0)          # a straight sweep divides by nothing
             rx = np.where(turning, a + (s - sin_h) / bend, a + u * cos_h)
             ry = np.where(turning, b + (cos_h - c) / bend, b + u * sin_h)
         half = pick(self.half)
-        return c, s, rx + half * c, ry + half * s
+        cx, cy = half * c, half * s
+        cx += rx
+        cy += ry
+        return c, s, cx, cy
 
 
 #: Places looked at between two of a sweep's where a cell may be touched between them.
@@ -299,8 +312,18 @@ def _room(c, s, hl, hw, r) -> tuple[Any, Any, Any, Any]:
     footprint's half extents grown by the cell's, along its own axes and along the grid's
     (worked out once a place, not once a cell and place, in the order :func:`_depth` sums)."""
     ac, as_ = np.abs(c), np.abs(s)
-    e = r * (ac + as_)                   # the cell's half extent along the footprint's axes
-    return hl + e, hw + e, r + hl * ac + hw * as_, r + hl * as_ + hw * ac
+    e = ac + as_
+    e *= r                               # the cell's half extent along the footprint's axes
+    along = hl + e
+    e += hw                              # (in place, as Arc.centres: the same sums, in order)
+    x = hl * ac
+    x += r
+    part = hw * as_
+    x += part                            # r + hl ac + hw as
+    y = hl * as_
+    y += r
+    y += np.multiply(hw, ac, out=part)   # r + hl as + hw ac
+    return along, e, x, y
 
 
 def _depth_in(dx, dy, c, s, room) -> np.ndarray:
@@ -335,10 +358,11 @@ def free_travels(sweeps: list[tuple[Body, float, bool]], step: float = 1.0) -> n
     return out
 
 
-def _travels(cells: list[np.ndarray], numbers, radius: np.ndarray, reach: np.ndarray,
+def _travels(cells: list[np.ndarray] | Boxed, numbers, radius: np.ndarray, reach: np.ndarray,
              back: np.ndarray, step: float) -> np.ndarray:
     """The free travel ``[R]`` of ``R`` sweeps (runs in lockstep brake together), each with
-    cells (``[P, 2]`` each, of half side ``radius [R]``), backward or not (``back [R]``), as
+    cells (``[P, 2]`` each, of half side ``radius [R]``; or what a :data:`Boxed` finds round
+    each sweep's box), backward or not (``back [R]``), as
     far as ``reach [R]``; ``numbers``: each sweep's :func:`_sweep_of`, ``[R]`` each. Worked
     out elementwise over ``[R, K]`` places (each sweep's own, its last repeated to the
     longest) and ``[M, K]`` for the ``M`` cells in the sweeps' boxes that :func:`_near`
@@ -350,19 +374,26 @@ def _travels(cells: list[np.ndarray], numbers, radius: np.ndarray, reach: np.nda
     u = np.minimum(np.arange(int(own.max())), own - 1) * np.where(back[:, None], -du, du)
     arc = Arc(h, k, a, b, sin_h, cos_h, half, np.abs(k) > 1e-9)
     c, s, cx, cy = arc.centres(u)              # [R, K]: the footprint at each sweep's places
-    px, py, owner = _in_boxes(cells, cx, cy, disc[:, 0])                # [M, 1], by sweep
+    px, py, owner = _in_boxes(cells, cx, cy, disc[:, 0], 2 * radius)    # [M, 1], by sweep
     if not len(owner):
         return out
     places = (c, s, cx, cy, *_room(c, s, hl, hw, rad))
-    near, sure = _near(px, py, owner, places, _bound(k, du, hl, hw, half, rad, step)[:, 0], back)
-    px, py, owner = px[near], py[near], owner[near]
+    near, sure, lo, hi = _near(px, py, owner, places,
+                               _bound(k, du, hl, hw, half, rad, step)[:, 0], back)
+    px, py, owner, lo, hi = px[near], py[near], owner[near], lo[near], hi[near]
     if not len(owner):
         return out
     # each sweep's places up to the first where a cell is touched for sure (its own at most):
     # no later place changes where it first touches, nor a pair _between looks at
     upto = np.maximum(own[:, 0], 0)            # (a sweep of no place: a reach below 0)
     np.minimum.at(upto, owner, sure[near] + 1)
-    hit, cell, j = _touches(px, py, owner, places, back, step, upto)
+    hi = np.minimum(hi, upto[owner] - 1)       # each cell's window, up to its sweep's last
+    some = hi >= lo
+    if not np.count_nonzero(some):
+        return out
+    if not some.all():
+        px, py, owner, lo, hi = px[some], py[some], owner[some], lo[some], hi[some]
+    hit, cell, j = _touches(px, py, owner, places, back, step, lo, hi)
     _between(hit, own[:, 0], cell, j, owner, u, arc, px, py, hl[owner], hw[owner], rad[owner])
     first = np.maximum(hit.argmax(axis=1) - 1, 0) * du[:, 0]
     return np.where(np.logical_or.reduce(hit, axis=1), first, out)
@@ -375,13 +406,19 @@ COARSE = 8
 ROUNDING = 1e-3
 
 
-def _in_boxes(known: list[np.ndarray], cx: np.ndarray, cy: np.ndarray,
-              disc: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The cells (``px, py [M, 1]``) of ``known`` (each sweep's) in the box each sweep may
-    touch (its centres ``cx, cy [R, K]``, grown by ``disc [R]``), and their sweep (``owner
-    [M]``, sorted)."""
+def _in_boxes(known: list[np.ndarray] | Boxed, cx: np.ndarray, cy: np.ndarray,
+              disc: np.ndarray, side: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The cells (``px, py [M, 1]``) of ``known`` (each sweep's, or what the :data:`Boxed`
+    finds round each sweep's box) in the box each sweep may touch (its centres ``cx, cy [R,
+    K]``, grown by ``disc [R]``), and their sweep (``owner [M]``, sorted). A :data:`Boxed`
+    is asked for the square round each box grown by a cell's ``side [R]``: a cell whose
+    centre lies in the box has its row and column in that square's."""
     lo_x, hi_x = cx.min(axis=1) - disc, cx.max(axis=1) + disc
     lo_y, hi_y = cy.min(axis=1) - disc, cy.max(axis=1) + disc
+    if callable(known):
+        centre = np.empty((len(lo_x), 2))
+        centre[:, 0], centre[:, 1] = (lo_x + hi_x) / 2, (lo_y + hi_y) / 2
+        known = known(centre, np.maximum(hi_x - lo_x, hi_y - lo_y) / 2 + side)
     cells = np.concatenate(known)                                               # [P, 2]
     counts = [len(c) for c in known]
     px, py = cells[:, 0], cells[:, 1]
@@ -394,7 +431,8 @@ def _in_boxes(known: list[np.ndarray], cx: np.ndarray, cy: np.ndarray,
 
 
 def _near(px: np.ndarray, py: np.ndarray, owner: np.ndarray, places: tuple[np.ndarray, ...],
-          bound: np.ndarray, back: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+          bound: np.ndarray, back: np.ndarray
+          ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """``[M]`` which cells (``px, py [M, 1]`` of sweeps ``owner [M]``) may reach a depth of
     ``-step`` at one of their sweep's ``places`` (``c, s, cx, cy`` and :func:`_room`, each
     ``[R, K]``), from their depths at the :func:`_coarse` places alone: a cell deeper than
@@ -404,54 +442,66 @@ def _near(px: np.ndarray, py: np.ndarray, owner: np.ndarray, places: tuple[np.nd
     Leaving it out changes no bit of the answer, and most of the cells in a sweep's box are
     out of its reach. Also ``[M]``: the first of those places where each cell is touched for
     sure (:func:`_touched`, backing out of sweeps ``back [R]``: its depth 0 or more, and not
-    a cell touched at the start backed away from), past the last place where none is. (The
-    places a cell is looked at run down a column: NumPy takes the greatest of each column at
-    once, and of each short row one row at a time.)"""
+    a cell touched at the start backed away from), past the last place where none is; and
+    each cell's window, the places ``lo`` to ``hi`` (``[M]`` each) from the coarse place
+    before its first deeper than ``-bound`` to the one after its last: by the same bound,
+    every place outside lies between two coarse places below ``-bound``, so the cell is
+    below ``-step`` there (a cell passes the footprint in a short stretch of a sweep, and
+    :func:`_touches` looks at that stretch alone: a third of the places). (The places a cell
+    is looked at run down a column: NumPy takes the greatest of each column at once, and of
+    each short row one row at a time.)"""
     width = places[0].shape[1]
     at = _coarse(width)[:, None]                                # [C, 1]
+    last = len(at) - 1
 
-    def deep(part: slice) -> tuple[np.ndarray, np.ndarray]:
+    def deep(part: slice) -> tuple[np.ndarray, ...]:
         where = at + owner[part] * width                        # [C, M]: in places, flat
         c, s, cx, cy, *room = (np.take(v, where) for v in places)
         depth = _depth_in(px[part, 0] - cx, py[part, 0] - cy, c, s, room)
         sure = depth >= 0
         sure &= (depth[:1] < 0) | ~back[owner[part]]
+        within = depth >= -bound[owner[part]]
+        first = np.maximum(within.argmax(axis=0) - 1, 0)
+        after = np.minimum(last - within[::-1].argmax(axis=0) + 1, last)
         return (depth.max(axis=0) >= -bound[owner[part]],
-                np.where(np.logical_or.reduce(sure, axis=0), at[sure.argmax(axis=0), 0], width))
+                np.where(np.logical_or.reduce(sure, axis=0), at[sure.argmax(axis=0), 0], width),
+                at[first, 0], at[after, 0])
 
-    near, sure = zip(*(deep(part) for part in _chunks(len(owner), len(at))))
-    return np.concatenate(near), np.concatenate(sure)
+    near, sure, lo, hi = zip(*(deep(part) for part in _chunks(len(owner), len(at))))
+    return np.concatenate(near), np.concatenate(sure), np.concatenate(lo), np.concatenate(hi)
 
 
 def _touches(px: np.ndarray, py: np.ndarray, owner: np.ndarray, places: tuple[np.ndarray, ...],
-             back: np.ndarray, step: float, upto: np.ndarray
+             back: np.ndarray, step: float, lo: np.ndarray, hi: np.ndarray
              ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Where each sweep touches a cell (``[R, K]``, :func:`_touched`; backing out, ``back
-    [R]``) within its first ``upto [R]`` places, and the pairs of those places a cell may be
-    touched between (:func:`_pairs`), worked out :data:`CHUNK` elements at a time: the cells
-    ``px, py [M, 1]`` of sweeps ``owner [M]`` (sorted) at their sweep's ``places`` (as
-    :func:`_near` takes them), each cell's places one after the other (up to its sweep's
-    first sure touch, :func:`_near`)."""
+    [R]``) and the pairs of places a cell may be touched between (:func:`_pairs`), worked
+    out :data:`CHUNK` elements at a time: the cells ``px, py [M, 1]`` of sweeps ``owner
+    [M]`` (sorted) at their sweep's ``places`` (as :func:`_near` takes them), each cell at
+    the places of its window ``lo`` to ``hi`` (``[M]`` each, not empty: :func:`_near`'s, up
+    to its sweep's first sure touch) one after the other. Outside its window a cell is
+    below ``-step``: neither touched nor half of a pair, and below 0 at the start."""
     width = places[0].shape[1]
     hit = np.zeros(places[0].shape, dtype=bool)
     flat_hit = hit.reshape(-1)
     pairs = []
-    for part in _spans(upto[owner]):
-        count = upto[owner[part]]
+    for part in _spans(hi - lo + 1):
+        count = hi[part] - lo[part] + 1
         cell = np.repeat(np.arange(part.start, part.stop), count)             # [N]
         first = np.cumsum(count) - count               # where each cell's places begin
-        j = np.arange(len(cell)) - np.repeat(first, count)
+        j = np.arange(len(cell)) - np.repeat(first - lo[part], count)
         at = owner[cell] * width + j                                            # in places
         c, s, cx, cy, *room = (np.take(v, at) for v in places)
         depth = _depth_in(px[cell, 0] - cx, py[cell, 0] - cy, c, s, room)      # [N]
         inside = depth >= 0
-        start = depth[first][cell - part.start]        # each cell's depth at the start
+        # each cell's depth at the start (below 0 where its window begins later)
+        start = np.where(lo[part] == 0, depth[first], -np.inf)[cell - part.start]
         if np.count_nonzero(back[owner[part]]):        # (_touched, a cell at a time)
             away = back[owner[cell]] & (start >= 0)
             inside[away] = depth[away] > start[away]
         flat_hit[at[inside]] = True
         maybe = (depth[:-1] + depth[1:] >= -step) & ~inside[:-1] & ~inside[1:]    # (_pairs)
-        maybe &= (j[1:] != 0) & (start[:-1] < 0)       # one cell's places, not touched at first
+        maybe &= (cell[1:] == cell[:-1]) & (start[:-1] < 0)   # one cell's, not touched at first
         k = np.flatnonzero(maybe)
         pairs.append((cell[k], j[k]))
     cell, j = (np.concatenate(v) for v in zip(*pairs))
@@ -643,6 +693,17 @@ def rest(n: int) -> np.ndarray:
     return np.tile([calm.held, calm.left, calm.wheel], (n, 1))
 
 
+#: What robots' maps hold: ``near(j, centres [R, 2], half [R])``, the centres ``[P, 2]`` of
+#: the occupied cells of the maps of robots ``j`` (places in a guard's rows) in the squares
+#: of half side ``half`` round ``centres``, a cell taken where its row and column lie in the
+#: square's (:meth:`.knowledge.RobotMap.near`, :func:`.knowledge.near_all`).
+Near = Callable[[np.ndarray, np.ndarray, np.ndarray], list[np.ndarray]]
+
+#: What sweeps' robots know round their boxes: ``boxed(centres [R, 2], half [R])``, the cells
+#: of each sweep's robot in the square of half side ``half`` round ``centres``
+#: (:meth:`Fleet.free`).
+Boxed = Callable[[np.ndarray, np.ndarray], list[np.ndarray]]
+
 #: The arrays of a :class:`Fleet`, a row per robot.
 _FLEET_ROWS = ("radius", "reach", "brakes", "wheelbase", "half", "hl", "hw", "straight", "lo",
                "hi", "turn", "acceleration", "reverse", "squares", "disc", "far")
@@ -694,18 +755,21 @@ class Fleet:
         return out
 
     def guard(self, rows: np.ndarray, command: np.ndarray, state: np.ndarray,
-              now: tuple[np.ndarray, ...], cells: list[np.ndarray]) -> list[int]:
+              now: tuple[np.ndarray, ...], cells: list[np.ndarray] | Near) -> list[int]:
         """:func:`guard` of the robots ``rows`` (ascending) at once, on their ``command [N,
         2]`` and their :class:`Recovery` ``state [N, 3]`` (:func:`rest`), both updated in
         place; the rows that begin to back out, in order. ``now``: every row's x, y (in),
         heading (rad), wheel (deg), speed (in/s) and route side, ``[N]`` each; ``cells``:
-        what each of ``rows`` knows is occupied near it. Their first sweeps
-        (:func:`first_sweep`) are measured together; a robot whose command the brake alone
-        decides (no backing out under way or to begin, no wheel to hold: most, most ticks)
-        is decided here, the rest by :func:`guard` itself, with its first sweep known. One
-        robot is guarded as alone: the arrays would cost more than they save."""
+        what each of ``rows`` knows is occupied near it, or its map (:data:`Near`), asked
+        for the square of half side :attr:`squares` round it, and for its first sweep only
+        round the sweep's box (:meth:`free`). Their first sweeps (:func:`first_sweep`) are
+        measured together; a robot whose command the brake alone decides (no backing out
+        under way or to begin, no wheel to hold: most, most ticks) is decided here, the rest
+        by :func:`guard` itself, with its first sweep known. One robot is guarded as alone:
+        the arrays would cost more than they save."""
         if len(rows) <= 1:
-            return [i for i in rows.tolist() if self._one(i, command, state, now, cells[0])]
+            return [i for i in rows.tolist()
+                    if self._one(i, command, state, now, self._own(cells, rows, now, [0])[0])]
         cfg, dt = self.cfg, self.dt
         x, y, h, wheel, speed, _ = (v[rows] for v in now)
         held, left, lock = state[rows].T
@@ -723,9 +787,24 @@ class Fleet:
         easy = rows[~hard]
         command[easy, 1] = np.where(np.abs(want) > limit, np.copysign(limit, want), want)[~hard]
         state[easy, 0] = held[~hard]
-        return [int(rows[j]) for j in hard.nonzero()[0].tolist()
-                if self._one(int(rows[j]), command, state, now, cells[j],
+        hard_rows = hard.nonzero()[0].tolist()
+        if not hard_rows:
+            return []
+        own = self._own(cells, rows, now, hard_rows)
+        return [int(rows[j]) for j, mine in zip(hard_rows, own)
+                if self._one(int(rows[j]), command, state, now, mine,
                              (turned.item(j), bool(back[j]), free.item(j)))]
+
+    def _own(self, cells: list[np.ndarray] | Near, rows: np.ndarray,
+             now: tuple[np.ndarray, ...], picked: list[int]) -> list[np.ndarray]:
+        """What the robots ``rows[picked]`` know in their squares (:attr:`squares`): theirs
+        of ``cells``, or asked of their maps."""
+        if not callable(cells):
+            return [cells[j] for j in picked]
+        which = rows[picked]
+        at = np.empty((len(which), 2))
+        at[:, 0], at[:, 1] = now[0][which], now[1][which]
+        return cells(np.array(picked, dtype=np.intp), at, self.squares[which])
 
     def _one(self, i: int, command: np.ndarray, state: np.ndarray, now: tuple[np.ndarray, ...],
              cells: np.ndarray, known: tuple[float, bool, float] | None = None) -> bool:
@@ -748,21 +827,48 @@ class Fleet:
         return wheel + _least(_most(target - wheel, -turn), turn)
 
     def free(self, rows: np.ndarray, x: np.ndarray, y: np.ndarray, h: np.ndarray,
-             wheel: np.ndarray, back: np.ndarray, cells: list[np.ndarray]) -> np.ndarray:
+             wheel: np.ndarray, back: np.ndarray, cells: list[np.ndarray] | Near) -> np.ndarray:
         """:func:`free_travels` of the robots ``rows`` at ``x, y, h``, their wheels at
         ``wheel`` (deg), backward or not (``back``), what each knows being ``cells``, ``[R]``
-        each; each sweep's numbers (:func:`_sweep_of`) worked out for all at once in the
-        same Python floats."""
+        each (or asked of their maps, :data:`Near`: round each sweep's box alone, a few
+        times fewer cells than the robot's square holds, where that square holds the box;
+        its square where not, so the cells in the box are those of the square); each
+        sweep's numbers (:func:`_sweep_of`) worked out for all at once in the same Python
+        floats."""
         step, reach = self.cfg.step, self.reach[rows]
-        some = np.fromiter(map(len, cells), np.intp, len(cells)).nonzero()[0]
-        if not len(some):
-            return reach
+        if callable(cells):
+            some = np.arange(len(rows))
+            known: list[np.ndarray] | Boxed = self._boxed(cells, rows, x, y)
+        else:
+            some = np.fromiter(map(len, cells), np.intp, len(cells)).nonzero()[0]
+            if not len(some):
+                return reach
+            known = [cells[j] for j in some.tolist()]
         which = rows[some]
-        reach[some] = _travels([cells[j] for j in some.tolist()],
-                               self._sweeps(which, x[some], y[some], h[some],
-                                            wheel[some] - self.straight[which]),
+        reach[some] = _travels(known, self._sweeps(which, x[some], y[some], h[some],
+                                                   wheel[some] - self.straight[which]),
                                self.radius[which], reach[some], back[some], step)
         return reach
+
+    def _boxed(self, near: Near, rows: np.ndarray, x: np.ndarray, y: np.ndarray) -> Boxed:
+        """What the maps of the robots ``rows`` (at ``x, y``) hold round their sweeps' boxes,
+        as :func:`_in_boxes` asks: the square round a box where it lies in the robot's own
+        square (:attr:`squares`), else that square, so that no cell outside it is found.
+        (The same sums as :func:`.knowledge.near_all`'s corners: a square inside another
+        in these floats has its rows and columns among the other's.)"""
+        square = self.squares[rows]
+
+        def boxed(centre: np.ndarray, half: np.ndarray) -> list[np.ndarray]:
+            bx, by = centre[:, 0], centre[:, 1]
+            inside = ((bx - half >= x - square) & (bx + half <= x + square)
+                      & (by - half >= y - square) & (by + half <= y + square))
+            if not inside.all():
+                centre = centre.copy()
+                centre[~inside, 0], centre[~inside, 1] = x[~inside], y[~inside]
+                half = np.where(inside, half, square)
+            return near(np.arange(len(rows)), centre, half)
+
+        return boxed
 
     def _sweeps(self, rows: np.ndarray, x: np.ndarray, y: np.ndarray, h: np.ndarray,
                 delta: np.ndarray) -> tuple[np.ndarray, ...]:
