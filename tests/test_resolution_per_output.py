@@ -190,7 +190,9 @@ def test_a_batch_row_is_the_row_alone_bit_for_bit():
 def test_the_header_and_the_network_name_them():
     c = compile_rulebase(parse_fll(OWN, "own.fll"))
     assert c.own_resolutions == {"lamp": 200, "shade": 7}
-    assert c.describe_operators().endswith("resolution = 1000, 200 for lamp, 7 for shade")
+    # (its inputs say no `lock-range`: fuzzylite's default, read as `inputs = as_given`)
+    assert c.describe_operators().endswith("resolution = 1000, 200 for lamp, 7 for shade, "
+                                           "inputs = as_given")
     text = describe_network(c)
     assert "defuzzify centroid on 1,000 samples (or its own)" in text
     assert "shade: 3 rules -> 3 consequent sets (open, half, closed), on its own 7 samples" in text
