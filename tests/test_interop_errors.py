@@ -73,6 +73,8 @@ FLL_CASES = [
     ("  range: 0 10", "  range: 0 ten", "expected a number, not `ten`"),
     ("term: low Triangle 0 2 5", "term: low", "`term` takes a name, a type"),
     ("  lock-previous: false", "  lock-previous: true", "needs state between evaluations"),
+    ("  lock-range: false", "  lock-range: yes", "`lock-range` is `true` or `false`, not `yes`"),
+    ("  lock-previous: false", "  lock-previous: 1", "`lock-previous` is `true` or `false`"),
     ("defuzzifier: Centroid 200", "defuzzifier:", "`defuzzifier` needs a name"),
     ("defuzzifier: Centroid 200", "defuzzifier: Centroid 2.5", "resolution must be a whole"),
     ("defuzzifier: Centroid 200", "defuzzifier: Centriod", "unknown defuzzifier `Centriod`"),

@@ -290,6 +290,9 @@ def _variable_key(v: _Var, key: str, value: str, span: Span, vspan: Span,
             v.terms.append((words[0], "Function", formula, fspan))
             return
         v.terms.append((words[0], words[1], [common.number(w, vspan) for w in words[2:]], vspan))
+    elif key in ("lock-range", "lock-previous", "lock-valid") and value not in ("true", "false"):
+        raise FormatError(f"`{key}` is `true` or `false`, not `{value}`", span=vspan,
+                          expected="true or false")
     elif key == "lock-range":
         if value == "true" and v.role == "output":
             v.lock_range = vspan
