@@ -19,6 +19,7 @@ from mitos_cli.errors import MitosError
 from mitos_cli.interop.common import fidelity_rulebase, fidelity_settings
 from mitos_cli.interop.export import to_python
 from mitos_cli.interop.fis import parse_fis
+from mitos_cli.lang.model import Setting
 
 MAMDANI = """\
 [System]
@@ -125,12 +126,10 @@ def test_the_trapezoid_centroid_is_octaves(tmp_path):
 def test_a_sugeno_output_joins_the_rules_of_one_value_by_aggmethod(tmp_path):
     got = _octave(SUGENO, "heat.fis", tmp_path)
     np.testing.assert_allclose(got, OCTAVE_S, rtol=0, atol=1e-12)
-    rb = parse_fis(SUGENO, "gone.fis")
-    with pytest.raises(MitosError) as info:                   # read from text, no file behind
-        fidelity_settings(rb, "octave")
-    assert info.value.message.startswith("--fidelity octave reads the file's AggMethod, and "
-                                         "`gone.fis` cannot be read again")
-    assert fidelity_settings(parse_fis(SUGENO, None), "octave") == ()
+    rb = parse_fis(SUGENO, "gone.fis")          # read from text, no file behind: the reader
+    accumulation = (Setting("accumulation", "max"),)         # kept the AggMethod it read
+    assert fidelity_settings(rb, "octave") == accumulation
+    assert fidelity_settings(parse_fis(SUGENO, None), "octave") == accumulation
     matlab = evaluate(compile_rulebase(rb), X_S, detail=False).outputs[:, 0]
     assert matlab[1] == pytest.approx(7.585714285714285, abs=1e-12)   # every rule counted
     summed = SUGENO.replace("AggMethod='max'", "AggMethod='sum'")
@@ -139,6 +138,12 @@ def test_a_sugeno_output_joins_the_rules_of_one_value_by_aggmethod(tmp_path):
     from mitos_cli.api import read_rulebase
 
     assert fidelity_settings(read_rulebase(path), "octave") == ()
+    odd = parse_fis(SUGENO.replace("AggMethod='max'", "AggMethod='maxx'"), "odd.fis")
+    with pytest.raises(MitosError) as info:      # MATLAB reads it (a Sugeno file's is unused)
+        fidelity_settings(odd, "octave")         # Octave's toolkit would use it
+    assert info.value.span is not None and info.value.span.line == SUGENO[
+        :SUGENO.index("AggMethod")].count("\n") + 1
+    assert "did you mean `max`" in str(info.value.hint)
 
 
 def test_trapezoid_weights_are_the_trapezoid_rule_by_hand():

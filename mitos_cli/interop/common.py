@@ -1055,19 +1055,13 @@ def _octave_accumulation(rb: RuleBase) -> tuple[Setting, ...]:
     """Octave's toolkit joins the rules of one Sugeno output value with the file's
     ``AggMethod`` before the weighted average (``aggregate_fis_output``: the rules' values
     sorted, equal ones joined), which is ``accumulation = AggMethod``; MATLAB, and MITOS's
-    reading of a ``.fis``, count every rule. Only a ``.fis`` file says it."""
-    from .fis import aggregation_method
-
-    path = rb.path or ""
-    if not path.lower().endswith(".fis"):
+    reading of a ``.fis``, count every rule. Only a ``.fis`` file says it, and its reader
+    keeps it (:attr:`.RuleBase.unused`)."""
+    given = next((s for s in rb.unused if s.key == "AggMethod"), None)
+    if given is None:
         return ()
-    try:
-        text = Path(path).read_text(encoding="utf-8", errors="replace")
-    except OSError as exc:
-        raise FormatError(f"--fidelity octave reads the file's AggMethod, and `{path}` cannot "
-                          f"be read again: {exc.strerror}") from None
-    method = aggregation_method(text, path)
-    return () if method in (None, "sum") else (Setting("accumulation", method),)
+    method = table_lookup(AGGREGATIONS, FIS, given.value, "aggregation method", given.span)
+    return () if method == "sum" else (Setting("accumulation", method),)
 
 
 def fidelity_rulebase(rb: RuleBase, engine: str) -> RuleBase:

@@ -36,7 +36,7 @@ from pathlib import Path
 
 from ..errors import FormatError, Span, did_you_mean
 from ..lang.bulk import without_cyclic_gc
-from ..lang.model import And, Consequent, Or, Prop, Rule, RuleBase
+from ..lang.model import And, Consequent, Or, Prop, Rule, RuleBase, Setting
 from ..lang.terms import Role, Term, Variable
 from ..words import plural
 from . import common
@@ -162,7 +162,10 @@ def parse_fis(text: str, path: str | None = None) -> RuleBase:
         _sugeno_aggregation(system, rules, notes)
     rb = common.assemble(path, variables, rules, settings, DEFAULT_RESOLUTION, sys_span, notes,
                          ranges)
-    return dataclasses.replace(rb, notes=tuple(notes))
+    agg = system.get("AggMethod")                # Octave's toolkit uses it: RuleBase.unused
+    unused = (Setting("AggMethod", name, agg[1]),) if sugeno and agg and (
+        name := _string(*agg)) else ()
+    return dataclasses.replace(rb, notes=tuple(notes), unused=unused)
 
 
 def _system(items) -> dict[str, tuple[str, Span]]:
@@ -211,19 +214,6 @@ def _settings(system: dict[str, tuple[str, Span]], sys_span: Span,
         settings.set("resolution", DEFAULT_RESOLUTION, None, "resolution")
         settings.set("sampling", "endpoints", None, "sampling")
     return settings, unset, sugeno
-
-
-def aggregation_method(text: str, path: str | None = None) -> str | None:
-    """The MITOS name of a ``.fis`` text's ``AggMethod`` (None where it writes none): what
-    Octave's toolkit joins a Sugeno output's rules of one value with (``--fidelity octave``)."""
-    sections, _ = _sections(text, path)
-    items: list = next((items for name, _, items in sections if name == "System"), [])
-    system = _system(items)
-    if "AggMethod" not in system:
-        return None
-    name = _string(*system["AggMethod"])
-    return common.table_lookup(common.AGGREGATIONS, FIS, name, "aggregation method",
-                               system["AggMethod"][1]) if name else None
 
 
 def _check_unset(unset: dict[str, Span], rules: list[Rule]) -> None:
