@@ -240,6 +240,43 @@ def test_a_wheel_is_not_turned_toward_what_the_robot_can_no_longer_stop_short_of
     assert steer == 150.0
 
 
+def test_a_robot_still_rolling_back_keeps_its_wheel_where_turning_it_swings_its_rear_in():
+    """Rolling back at 20 in/s, its wheel at 120, with a pole just behind its rear right
+    corner, the robot is told to go forward at full right lock (150: a backing-out has just
+    ended). Braking, it rolls on back about 5 in, and the wheel turned on to 129 swings its
+    rear into the pole; so the wheel stays at 120, whose arc passes it. Measured along the
+    forward arc alone, as before, the wheel turned. Standing, or rolling forward, it turns."""
+    cfg = safety.Settings()
+    cells = np.array([[-14.0, -11.5]])
+
+    def at(speed: float) -> safety.Body:
+        return safety.Body(ROBOT, AT, 120.0, cells, 1.0, 0.0, 40.0, speed)
+
+    rolling, a = at(-20.0), ROBOT.acceleration
+    turned = safety.brake(rolling.free(129.0, True, cfg), a, cfg.margin, 0.05)
+    kept = safety.brake(rolling.free(120.0, True, cfg), a, cfg.margin, 0.05)
+    assert turned < 20.0 - a * 0.05 < kept
+    assert rolling.free(129.0, False, cfg) == rolling.free(120.0, False, cfg) == 40.0
+    (steer, speed), backs = safety.guard((150.0, 10.0), rolling, safety.Recovery(), 0.05, cfg)
+    assert (steer, speed, backs) == (120.0, 10.0, False)
+    for speed in (0.0, 20.0):
+        (steer, _), _ = safety.guard((150.0, 10.0), at(speed), safety.Recovery(), 0.05, cfg)
+        assert steer == 150.0
+
+
+def test_a_robot_rolling_back_inside_its_margin_keeps_the_arc_with_more_room():
+    """Within the brake's 1 in margin of a pole behind its rear right corner, rolling back
+    at 8 in/s, told to go forward at full left lock: neither arc leaves room to stop (the
+    brake allows 0 on both), but straight back leaves 1 in and the wheel turned left 0.79,
+    so the wheel stays straight (a BARN field's robot turned it and touched the pole)."""
+    cfg = safety.Settings()
+    rolling = safety.Body(ROBOT, AT, 90.0, np.array([[-14.5, -9.5]]), 1.0, 0.0, 40.0, -8.0)
+    turned, kept = rolling.free(81.0, True, cfg), rolling.free(90.0, True, cfg)
+    assert turned < kept <= cfg.margin
+    (steer, _), _ = safety.guard((30.0, 10.0), rolling, safety.Recovery(), 0.05, cfg)
+    assert steer == 90.0
+
+
 def _first_touch(cells, radius, pose, robot, delta, backward, reach, fine=0.002, deeper=0.0):
     """Where along the rear axle's path the footprint first touches a cell (reaches ``deeper``
     than ``deeper`` into one), found by placing it every ``fine`` inch (``math.inf``: nowhere
@@ -435,7 +472,7 @@ def _fleet_case(rng: np.random.Generator, n: int):
                                       y[j] + own[:, 0] * s + own[:, 1] * c]))
     lock = np.where(rng.random(n) < 0.5, fleet.lo, fleet.hi)
     wheel = np.where(rng.random(n) < 0.3, lock, rng.uniform(30, 150, n))
-    now = (x, y, h, wheel, rng.uniform(-10, 50, n), rng.uniform(-1, 1, n))
+    now = (x, y, h, wheel, rng.uniform(-20, 50, n), rng.uniform(-1, 1, n))
     state = np.column_stack([rng.choice([0.0, 0.5, 0.98], n), rng.choice([0.0, 0.0, 1.0], n),
                              lock])
     command = np.column_stack([rng.uniform(20, 160, n), rng.uniform(-20, 60, n)])
@@ -448,7 +485,7 @@ def test_a_fleet_guarded_at_once_carries_out_what_each_robot_does_alone():
     backing-out and the recovery state :func:`safety.guard` gives it alone, to the bit; the
     robots that do not brake, or are not among the rows, are left as they were."""
     rng = np.random.default_rng(5)
-    kinds = {"eased": 0, "kept": 0, "held": 0, "backs": 0, "backing": 0}
+    kinds = {"eased": 0, "kept": 0, "rolled": 0, "held": 0, "backs": 0, "backing": 0}
     for _ in range(100):
         n = int(rng.integers(1, 12))
         fleet, now, cells, state, command = _fleet_case(rng, n)
@@ -463,7 +500,9 @@ def test_a_fleet_guarded_at_once_carries_out_what_each_robot_does_alone():
             want_command[i], want_state[i] = carried, (rec.held, rec.left, rec.wheel)
             want_backs += [i] if backs else []
             kinds["eased"] += carried[1] != command[i, 1]
-            kinds["kept"] += carried[0] == wheel != command[i, 0] and not state[i, 1] > 0
+            kept = carried[0] == wheel != command[i, 0] and not state[i, 1] > 0
+            kinds["kept"] += kept
+            kinds["rolled"] += kept and (speed < 0) != (command[i, 1] < 0)   # against it
             kinds["held"] += rec.held > state[i, 0]
             kinds["backs"] += int(backs)
             kinds["backing"] += state[i, 1] > 0

@@ -16,7 +16,8 @@ them away, as the paper's robot had none):
   longer stop short of, at the speed it has, is held where it is when its own arc leaves
   more room: the brake bounds the speed on one arc, and a hard turn at speed (a planner
   swerving just after it passed another robot) swung a robot into a wall it could then not
-  stop before.
+  stop before. A robot that still rolls against its command (a backing-out just ended) is
+  measured the way it rolls, not the way it is told to go (:func:`_rolling`).
 - **backing out** (:class:`Recovery`): held by the brake for ``patience`` seconds while its
   planner wants to go on, the robot backs out for ``back_time`` seconds on the opposite lock
   (which swings its nose toward the side its route lies on), as far as the way behind is
@@ -650,7 +651,9 @@ def guard(command: tuple[float, float], body: Body, rec: Recovery, dt: float,
     wheel = _wheel(steer, body, dt) if first is None else first[0]
     limit = brake(free(wheel, want < 0), robot.acceleration, cfg.margin, dt)
     slowest = max(abs(body.speed) - robot.acceleration * dt, 0.0)
-    if limit < slowest and wheel != body.wheel:
+    if slowest > 0 and (body.speed < 0) != (want < 0) and wheel != body.wheel:
+        steer, limit = _rolling(steer, limit, wheel, want, slowest, body, free, cfg, dt)
+    elif limit < slowest and wheel != body.wheel:
         # turning the wheel puts what it would hit nearer than it can stop: hold the wheel
         # where it is when that arc leaves more room
         hold = brake(free(body.wheel, want < 0), robot.acceleration, cfg.margin, dt)
@@ -667,6 +670,26 @@ def guard(command: tuple[float, float], body: Body, rec: Recovery, dt: float,
             rec.left, rec.wheel, rec.held = cfg.back_time, wheel, 0.0
             return (wheel, -robot.max_reverse), True
     return (steer, speed), False
+
+
+def _rolling(steer: float, limit: float, wheel: float, want: float, slowest: float, body: Body,
+             free: Callable[[float, bool], float], cfg: Settings,
+             dt: float) -> tuple[float, float]:
+    """The steer and speed limit of a robot that still rolls against its command (backing
+    out just ended, the way ahead of it free again): braking, it rolls on the old way, on
+    the arc its wheel turns to, before it can go the new. Where that arc leaves less room
+    than the roll needs and the arc it is on leaves more, the wheel stays where it is (and
+    the limit is the new way's on that arc): measured along the new way alone, a rear
+    swung into a pole while the robot still rolled back at 7.6 in/s. The room is compared,
+    not the speeds it allows: inside the margin both allow none, and the arc with more
+    room is still the one that stays clear longer."""
+    robot, back = body.robot, body.speed < 0
+    turned = free(wheel, back)
+    if brake(turned, robot.acceleration, cfg.margin, dt) >= slowest:
+        return steer, limit
+    if free(body.wheel, back) <= turned:
+        return steer, limit
+    return body.wheel, brake(free(body.wheel, want < 0), robot.acceleration, cfg.margin, dt)
 
 
 def first_sweep(command: tuple[float, float], body: Body, rec: Recovery,
@@ -782,7 +805,8 @@ class Fleet:
         limit = _brakes(free, acceleration, cfg.margin, dt)
         slowest = np.maximum(np.abs(speed) - acceleration * dt, 0.0)
         held = np.where((np.abs(want) > cfg.want) & (limit < cfg.want), held + dt, 0.0)
-        hard = (backing | ((limit < slowest) & (turned != wheel))
+        rolling = (slowest > 0) & ((speed < 0) != (want < 0))       # against its command
+        hard = (backing | (((limit < slowest) | rolling) & (turned != wheel))
                 | ((held >= cfg.patience) & (self.reverse[rows] > 0)))
         easy = rows[~hard]
         command[easy, 1] = np.where(np.abs(want) > limit, np.copysign(limit, want), want)[~hard]
