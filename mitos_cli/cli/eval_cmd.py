@@ -212,7 +212,10 @@ def eval_command(
              "and inputs outside their ranges not clamped), "
              "fuzzylite (fuzzylite 8: cell midpoints at the file's resolution, 1000 where it "
              "gives none), fuzzylite6 (fuzzylite 6, Debian's `fuzzylite`: the same, 100 where "
-             "it gives none, as in every FCL `METHOD : COG;` and .fis).")] = None,
+             "it gives none, as in every FCL `METHOD : COG;` and .fis), both with an FCL or "
+             ".fis file's inputs not clamped; octave (Octave's fuzzy-logic-toolkit on a .fis: "
+             "101 points, the trapezoid rule, a Sugeno output's equal values joined by the "
+             "file's AggMethod).")] = None,
 ) -> None:
     """Evaluate a rule base: fuzzified inputs, fired rules with DOFs, crisp outputs."""
     on_no_rule = (None if on_no_rule_name is None
