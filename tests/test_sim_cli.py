@@ -500,6 +500,27 @@ def test_randomise_with_runs_says_why(short, capsys):
     assert code == 2 and "--runs randomises every run already" in said     # was "give one world"
 
 
+def test_one_run_options_say_the_way_out_that_fits(short, capsys, tmp_path):
+    """`simulate corridor --runs 3 --out x.csv` said "drop --runs or give one world" to a user
+    who gave one world: the message names the options given and the one way out that fits."""
+    csv = tmp_path / "x.csv"
+    cases = [((short, "--runs", 3, "--out", csv),
+              "--out works on one run of one world, not --runs 3: drop --runs (--randomise "
+              "--seed SEED replays one randomised run)"),
+             ((short, short.with_name("other.yaml"), "--trace"),
+              "--trace works on one run of one world, not 2 worlds: give one world"),
+             ((short, short.with_name("other.yaml"), "--runs", 2, "--speed", 3, "--out", csv),
+              "--out and --live/--speed work on one run of one world, not 2 worlds and --runs "
+              "2: drop --runs and give one world")]
+    short.with_name("other.yaml").write_text(short.read_text())
+    for args, message in cases:
+        code, err = run_main(capsys, *args)
+        said = " ".join(err.replace("│", " ").split())
+        assert code == 2 and message in said, said
+        assert "or give one world" not in said
+    assert not csv.exists()
+
+
 def test_one_runs_spread_is_null_as_in_compare(short):
     data = json.loads(run(short, "--runs", 1, "--json").stdout)
     row = data[0] if isinstance(data, list) else data["worlds"][0]
