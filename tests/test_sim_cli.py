@@ -521,6 +521,18 @@ def test_one_run_options_say_the_way_out_that_fits(short, capsys, tmp_path):
     assert not csv.exists()
 
 
+def test_a_pattern_the_shell_did_not_expand_is_said_to_be_one(capsys, tmp_path, monkeypatch):
+    """The README's `mitos simulate worlds/*.yaml --runs 20` away from the checkout reached
+    MITOS as the pattern itself ("world file `worlds/*.yaml` not found", and a hint about
+    `mitos list` that did not say why): the hint says no file matched the pattern."""
+    monkeypatch.chdir(tmp_path)
+    code, err = run_main(capsys, "worlds/*.yaml", "--runs", 2)
+    assert code == 1 and err.splitlines() == [
+        "world error: world file `worlds/*.yaml` not found",
+        "hint: no file here matches the pattern, so the shell passed `worlds/*.yaml` on as "
+        "written; the packaged worlds go by name: `mitos list` shows them"]
+
+
 def test_one_runs_spread_is_null_as_in_compare(short):
     data = json.loads(run(short, "--runs", 1, "--json").stdout)
     row = data[0] if isinstance(data, list) else data["worlds"][0]

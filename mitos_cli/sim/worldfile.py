@@ -1390,6 +1390,9 @@ def world_not_found(name: str | Path, where: Path) -> UnknownWorld:
         hint = (f"there is no `{given}`; the packaged world of that name is "
                 f"`{same_name[:-len('.yaml')]}`")
     listing = ("one of the packaged worlds: " + ", ".join(shown)) if bare or close else None
+    if any(c in given.name for c in "*?["):       # `worlds/*.yaml` away from the repository
+        hint = (f"no file here matches the pattern, so the shell passed `{name}` on as "
+                f"written; the packaged worlds go by name: `mitos list` shows them")
     if hint is None and listing is None:
         hint = "`mitos list` shows the packaged worlds, which are found by name (`slalom`)"
     return UnknownWorld(f"world file `{name}` not found", expected=listing, hint=hint)
