@@ -202,7 +202,8 @@ def simulate_command(
         "--out", "-o", parser=file_arg, metavar="FILE.csv",
         help="Write one CSV row per tick to FILE.csv (a name ending in .csv).")] = None,
     trace: Annotated[bool, typer.Option(
-        "--trace", help="Every --every ticks, print the pose, speed, steering, clearance and "
+        "--trace", help="Every --every ticks (and at each replan and the last tick), print "
+                        "the pose, speed, steering, clearance and "
                         "perceived vs true inputs, then the paper-style DOF trace (none for a "
                         "planner that is not a rule base); of the first robot where there are "
                         "several; on stderr with --json, which keeps stdout for the JSON.")] = False,
