@@ -778,6 +778,15 @@ def test_a_single_value_is_read_as_a_batch_cell_is(value, capsys):
     assert code == 0
 
 
+def test_an_input_without_a_value_is_said_to_be_empty(capsys):
+    """`mitos eval road= size=45 position=4` said "must be a number, not ``"."""
+    code, out, err = run_main(["eval", "road=", "size=45", "position=4"], capsys)
+    assert code == 1 and out == ""
+    assert err.splitlines() == ["input error: input `road` must be a number, not empty",
+                                "expected a decimal number such as 78, -4.5 or 1e3",
+                                "hint: give it after the `=`, in the same word: `road=78`"]
+
+
 @pytest.mark.parametrize("args", [["road=78,size=45,position=4"],
                                   ["road=78;size=45;position=4"],
                                   ["road=78, size=45, position=4"]])

@@ -91,9 +91,11 @@ def parse_values(values: dict[str, str]) -> dict[str, float]:
             raise InputError(f"input `{name}` has a number too large for a float: `{text}`",
                              expected="numbers of magnitude at most 1.8e308") from None
         except ValueError:
-            raise InputError(f"input `{name}` must be a number, not `{text}`",
+            shown = f"`{text}`" if text else "empty"               # `road=`: not "not ``"
+            raise InputError(f"input `{name}` must be a number, not {shown}",
                              expected="a decimal number such as 78, -4.5 or 1e3",
-                             hint=_glued(name, text)) from None
+                             hint=_glued(name, text) if text else
+                             f"give it after the `=`, in the same word: `{name}=78`") from None
     return out
 
 
