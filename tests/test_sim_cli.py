@@ -533,6 +533,17 @@ def test_a_pattern_the_shell_did_not_expand_is_said_to_be_one(capsys, tmp_path, 
         "written; the packaged worlds go by name: `mitos list` shows them"]
 
 
+def test_a_rule_base_without_the_worlds_behavior_says_how_to_choose_one(short, capsys):
+    """`mitos simulate figure4 --rulebase tipper.fis` stood at the world's `behavior: drive`
+    with "unknown behavior `drive`, expected one of main" and no word of how to go on."""
+    tipper = Path(__file__).parent / "data" / "interop" / "tipper.fis"
+    code, err = run_main(capsys, short, "--rulebase", tipper)
+    assert code == 1 and "unknown behavior `drive`" in err
+    assert err.splitlines()[-1] == (
+        "hint: the world is driven by its `behavior: drive`, which this rule base lacks: "
+        "choose one of its behaviors (--behavior NAME; behavior= from Python)")
+
+
 def test_one_runs_spread_is_null_as_in_compare(short):
     data = json.loads(run(short, "--runs", 1, "--json").stdout)
     row = data[0] if isinstance(data, list) else data["worlds"][0]

@@ -182,6 +182,13 @@ def _fuzzy(world, rulebase=None, behavior: str | None = None) -> Planner:
         if behavior or exc.span is not None or not exc.message.startswith("unknown behavior"):
             raise
         exc.span = getattr(world, "behavior_span", None)
+        # `simulate figure4 --rulebase tipper.fis`: the error stood at the world's line with
+        # no word of why the world's behavior was looked for, nor how to choose another
+        said = (f"the world is driven by its `behavior: {world.behavior}`, which "
+                f"{'this rule base' if rulebase is not None else 'the rule base'} lacks: "
+                f"choose one of its behaviors (--behavior NAME; behavior= from Python)")
+        exc.hint = (f"{exc.hint} (--behavior NAME drives with another than the world's "
+                    f"`behavior: {world.behavior}`)" if exc.hint else said)
         raise
 
 
