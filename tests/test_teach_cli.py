@@ -564,3 +564,17 @@ def test_a_lesson_refused_at_its_first_commands_leaves_no_session(work):
     [kept] = (work / ".mitos" / "teach").iterdir()
     resumed = mitos("teach", "--resume", cwd=work, stdin="quit\n")
     assert resumed.returncode == 0 and f"resumed session {kept.name}" in resumed.stderr
+
+
+def test_a_yaml_file_given_as_the_rule_base_says_what_teach_takes(work):
+    """`mitos teach tip.terms.yaml` was told that "a rule base is a .rules, .fcl, .fis or .fll
+    file", three of which `mitos teach` refuses: the hint says what it teaches, and where a
+    term set and a world go."""
+    (work / "w.yaml").write_text("# a world\nname: w\nseed: 1\n")
+    res = mitos("teach", "w.yaml", cwd=work)
+    assert res.returncode == 1
+    assert res.stderr.splitlines() == [
+        "rule base error: `w.yaml` is a YAML file (a term set, or a world), not a rule base",
+        "hint: `mitos teach` teaches a .rules file (convert a .fcl, .fis or .fll one with "
+        "`mitos convert FILE --to rules`); a term set is read through the `terms` line of its "
+        ".rules file, and a world is driven from the prompt (`simulate WORLD`)"]

@@ -180,6 +180,12 @@ def _new_session(rules, behavior, lesson, save_as, out):
         from ..interop import hint_wrong_reader
 
         hint_wrong_reader(exc, path, "mitos teach")
+        if path.suffix.lower() in (".yaml", ".yml") and exc.span is None:
+            # the loader's hint named .fcl, .fis and .fll rule bases, which teach refuses
+            exc.hint = ("`mitos teach` teaches a .rules file (convert a .fcl, .fis or .fll one "
+                        "with `mitos convert FILE --to rules`); a term set is read through the "
+                        "`terms` line of its .rules file, and a world is driven from the "
+                        "prompt (`simulate WORLD`)")
         raise
     if save_as is not None:         # refused now, not when the lesson ends and saves
         from ..teach.save import check_save_target
