@@ -578,3 +578,16 @@ def test_a_yaml_file_given_as_the_rule_base_says_what_teach_takes(work):
         "hint: `mitos teach` teaches a .rules file (convert a .fcl, .fis or .fll one with "
         "`mitos convert FILE --to rules`); a term set is read through the `terms` line of its "
         ".rules file, and a world is driven from the prompt (`simulate WORLD`)"]
+
+
+def test_save_as_into_a_missing_path_is_refused_before_the_lesson_runs(work):
+    """`--save-as /nonexistent/dir/x.rules` ran the whole lesson (simulations, adaptation)
+    and failed only at its end, where only the last directory of a path is made: the path is
+    checked with the other save checks, before a session starts."""
+    (work / "l.lesson").write_text("eval road=78 size=45 position=4\n")
+    res = mitos("teach", "rb/mitos.rules", "--lesson", "l.lesson", "--save-as",
+                "nope/deeper/x.rules", cwd=work)
+    assert res.returncode == 1 and res.stdout == ""           # the lesson did not run
+    assert "lesson error: cannot save `nope/deeper/x.rules`: the directory `nope` does not " \
+           "exist" in res.stderr
+    assert not (work / ".mitos").exists() and not (work / "nope").exists()
