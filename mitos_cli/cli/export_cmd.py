@@ -59,7 +59,10 @@ def export_command(
                                  f"{to.value} has none: leave --prefix out")
     prefix = "mitos" if prefix is None else prefix
     if not ident(prefix) == prefix:
-        raise typer.BadParameter(f"--prefix `{prefix}` is not a C identifier")
+        close = ident(prefix).strip("_")
+        raise typer.BadParameter(f"--prefix `{prefix}` is not a C identifier (letters, digits "
+                                 f"and `_`, not starting with a digit)"
+                                 + (f"; did you mean `{ident(prefix)}`?" if close else ""))
     rb = load_rulebase(path, behavior)
     if output is not None:
         refuse_inputs([output], source_files(rb.rulebase, path))
