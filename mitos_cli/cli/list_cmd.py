@@ -9,7 +9,6 @@ mitos.rules``, ``mitos plot terms drive.terms.yaml``, ``--lesson wider-turn``).
 from __future__ import annotations
 
 import re
-
 from typing import Annotated
 
 import typer
