@@ -17,3 +17,9 @@ def __getattr__(name: str):
 
         return load_rulebase
     raise AttributeError(name)
+
+
+def __dir__() -> list[str]:
+    # `dir(mitos_cli)` (and a notebook's tab completion) listed no `load_rulebase`, which
+    # __getattr__ gives: the lazy names are listed with the module's own.
+    return sorted(set(globals()) | set(__all__))

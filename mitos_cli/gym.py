@@ -111,7 +111,7 @@ class MitosEnv(gymnasium.Env):
                  behavior: str | None = None, observe_ranges: bool = False,
                  render_mode: str | None = None, **others: Any) -> None:
         from .sim.loop import Simulation
-        from .sim.planner import FuzzyPlanner
+        from .sim.planner import fuzzy_planner
         from .sim.worldcheck import check_built
         from .sim.worldfile import load_world
 
@@ -134,7 +134,7 @@ class MitosEnv(gymnasium.Env):
         self.render_mode = render_mode
         self.observe_ranges = observe_ranges
         self.metadata = {**self.metadata, "render_fps": round(1.0 / loaded.dt)}
-        self.fuzzy = FuzzyPlanner(rulebase, loaded.behavior if behavior is None else behavior)
+        self.fuzzy = fuzzy_planner(loaded, rulebase, behavior)
         compiled = self.fuzzy.compiled
         self.input_names: tuple[str, ...] = tuple(compiled.inputs)
         self._lo = np.ascontiguousarray(compiled.universe[:, 0], dtype=np.float64)

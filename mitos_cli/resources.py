@@ -106,6 +106,21 @@ def display_path(path: str | None) -> str:
         return str(path)
 
 
+def display_world(path: str) -> str:
+    """A world's path as a study's report shows it: a packaged world by its name, marked as
+    packaged (`corridor (packaged)`, not where pip put it), any other as given."""
+    from pathlib import Path
+
+    try:
+        packaged = Path(str(data_dir("worlds"))).resolve()
+        p = Path(path).resolve()
+        if p.parent == packaged and p.suffix == ".yaml":
+            return f"{p.stem} (packaged)"
+    except (OSError, ValueError):
+        pass
+    return path
+
+
 def packaged_name(path: str) -> str | None:
     """``rulebases/NAME`` for a file of the packaged rule bases (wherever pip put them),
     else None."""

@@ -778,6 +778,29 @@ def test_a_single_value_is_read_as_a_batch_cell_is(value, capsys):
     assert code == 0
 
 
+def test_a_rule_file_not_found_points_at_the_packaged_ones(capsys, tmp_path, monkeypatch):
+    """`mitos eval nope.rules road=1` said "rule file `nope.rules` not found" and no more,
+    where a world not found points at `mitos list`; nothing close beside it, it does too."""
+    monkeypatch.chdir(tmp_path)
+    code, out, err = run_main(["eval", "nope.rules", "road=1"], capsys)
+    assert code == 1 and out == ""
+    assert err.splitlines() == [
+        "rule base error: rule file `nope.rules` not found",
+        "hint: `mitos list` shows the packaged rule bases, which are found by name "
+        "(`mitos.rules`)"]
+    code, _, err = run_main(["eval", "some/dir/nope.rules", "road=1"], capsys)
+    assert code == 1 and "hint" not in err          # a path of its own: not a packaged name
+
+
+def test_an_input_without_a_value_is_said_to_be_empty(capsys):
+    """`mitos eval road= size=45 position=4` said "must be a number, not ``"."""
+    code, out, err = run_main(["eval", "road=", "size=45", "position=4"], capsys)
+    assert code == 1 and out == ""
+    assert err.splitlines() == ["input error: input `road` must be a number, not empty",
+                                "expected a decimal number such as 78, -4.5 or 1e3",
+                                "hint: give it after the `=`, in the same word: `road=78`"]
+
+
 @pytest.mark.parametrize("args", [["road=78,size=45,position=4"],
                                   ["road=78;size=45;position=4"],
                                   ["road=78, size=45, position=4"]])

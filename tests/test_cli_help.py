@@ -119,6 +119,24 @@ def test_every_option_that_takes_a_value_names_it_in_words():
     assert "<int range>" not in help_text and "<float range>" not in help_text
 
 
+def test_every_choice_an_option_lists_is_said_in_its_help():
+    """`eval --fidelity [matlab|jfuzzylogic|fuzzylite|fuzzylite6|octave]` said what four of
+    its five engines do and nothing of `octave`: an option whose metavar lists its choices
+    names each of them in its help."""
+    import re
+
+    unsaid = []
+    for name, cmd in commands().items():
+        for param in cmd.params:
+            metavar = getattr(param, "metavar", None) or ""
+            if param.param_type_name != "option" or not re.fullmatch(r"\[[\w|]+\]", metavar):
+                continue
+            for value in metavar[1:-1].split("|"):
+                if not re.search(rf"\b{value}\b", param.help or ""):
+                    unsaid.append(f"{name} {param.opts[0]} {value}")
+    assert unsaid == []
+
+
 def test_a_rule_base_argument_is_called_the_same_in_every_command():
     """`teach` called its rule file `[RULES]` where eval, check and plot say `[RULEBASE]`."""
     for name, cmd in commands().items():

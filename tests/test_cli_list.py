@@ -54,6 +54,9 @@ def test_every_packaged_file_is_listed_by_a_name_the_commands_accept():
     ("# One line.\nname: x\n", "One line."),
     ("\n#\n#   Indented words\nname: x\n", "Indented words"),
     ("# goes on\n# in the next line\n", "goes on ..."),
+    # a sentence that ends in the line, then one cut short: the whole sentence alone
+    ("# A robot. It is given the corridors (its\n# map)\n", "A robot."),
+    ("# Maps at 0.05 m. It is\n# given\n", "Maps at 0.05 m."),
     ("# a list follows:\n# - one\n", "a list follows:"),
     ("# last comment line\nname: x\n", "last comment line"),
     ("name: x\n# a later comment\n", ""),

@@ -173,3 +173,30 @@ def test_every_mitos_command_the_pages_show_parses_with_its_commands_options():
                           and "*" not in word and not (ROOT / word).exists()]
                 checked += 1
     assert checked > 40 and wrong == [], wrong
+
+
+def test_every_link_between_the_pages_leads_somewhere():
+    """docs/navigation.md linked `[The aims](#the-aims)`, a heading no page has: every relative
+    link of the README, docs/ and worlds/README.md names a file that is there and, with a
+    `#fragment`, a heading of that file (GitHub's slug: lower case, punctuation dropped,
+    spaces as `-`)."""
+    import re
+
+    def slugs(page: Path) -> set[str]:
+        heads = re.findall(r"^#+ (.*)$", page.read_text(encoding="utf-8"), re.M)
+        return {re.sub(r"[^\w\- ]", "", h.strip().lower()).replace(" ", "-") for h in heads}
+
+    pages = [ROOT / "README.md", ROOT / "worlds" / "README.md",
+             *sorted((ROOT / "docs").glob("*.md"))]
+    broken = []
+    for page in pages:
+        text = page.read_text(encoding="utf-8")
+        for target, fragment in re.findall(r"\]\(([^)#\s]*)(?:#([^)\s]+))?\)", text):
+            if target.startswith(("http://", "https://", "mailto:")):
+                continue
+            where = page.parent / target if target else page
+            if not where.exists():
+                broken.append(f"{page.relative_to(ROOT)}: {target}")
+            elif fragment and where.suffix == ".md" and fragment not in slugs(where):
+                broken.append(f"{page.relative_to(ROOT)}: {target}#{fragment}")
+    assert broken == []

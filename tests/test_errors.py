@@ -84,6 +84,14 @@ def caret_under(exc: MitosError) -> str:
      "`iff` is read as a variable's name: did you mean `if`?"),
     ("r1: if road is WIDE thn speed is SLOW", 21, "thn", "unexpected `thn`", "`then`",
      "did you mean `then`?"),
+    # `=` for `is`, and FCL's `;` at a rule's end: said how a rule file writes them
+    ("r1: if road = WIDE then speed is SLOW", 13, "=", "unexpected `=`", "`is`",
+     "write `road is ...`: a condition or action reads `variable is TERM` (or `is 5` for a "
+     "crisp value), not `=`"),
+    ("r1: if road is WIDE then speed = 5", 32, "=", "unexpected `=`", "`is`",
+     "write `speed is ...`"),
+    ("r1: if road is WIDE then speed is SLOW;", 39, ";", "unexpected character `;`", None,
+     "a rule needs no `;` at its end"),
     ("behavior b:\n  r1: if road is WIDE then speed is SLOW\n", 41, None,
      "unexpected end of the input", "`end`", "a behavior ends with `end`"),
     # a misspelt statement keyword is read as a rule's label: the word is reported, with

@@ -422,6 +422,12 @@ def test_export_cli(tmp_path: Path) -> None:
     result = runner.invoke(app, ["export", str(DATA / "tipper.fis"), "--to", "c",
                                  "--prefix", "1x"])
     assert result.exit_code == 2 and "not a C identifier" in result.output
+    said = " ".join(result.output.replace("│", " ").split())
+    assert "did you mean `_1x`?" in said
+    result = runner.invoke(app, ["export", str(DATA / "tipper.fis"), "--to", "c",
+                                 "--prefix", "my-planner"])            # the name it meant
+    said = " ".join(result.output.replace("│", " ").split())
+    assert result.exit_code == 2 and "did you mean `my_planner`?" in said
 
 
 def test_a_prefix_for_python_is_a_usage_error(tmp_path: Path) -> None:

@@ -326,6 +326,21 @@ def test_a_rulebase_or_behavior_the_environment_cannot_read_says_so():
         gymnasium.make("mitos/Corridor-v0", behavior="")
 
 
+def test_a_rulebase_without_the_worlds_behavior_is_said_at_the_world_with_behavior_eq():
+    """`make("mitos/Figure4-v0", rulebase="tipper.fis")` said "unknown behavior `drive`,
+    expected one of main", with no place and no word of `behavior=`: as `mitos simulate`, at
+    the world's `behavior:` line, with how to choose another."""
+    from pathlib import Path
+
+    from mitos_cli.errors import NameError_
+
+    tipper = Path(__file__).parent / "data" / "interop" / "tipper.fis"
+    with pytest.raises(NameError_, match="unknown behavior `drive`") as info:
+        gymnasium.make("mitos/Figure4-v0", rulebase=str(tipper))
+    assert info.value.span is not None and info.value.span.path.endswith("figure4.yaml")
+    assert "behavior= from Python" in info.value.hint
+
+
 def test_fuzzy_policy_of_a_batch_says_it_takes_one_observation():
     from mitos_cli.errors import InputError
 

@@ -429,8 +429,12 @@ def test_fuzzylite_writer_refusals(tmp_path: Path) -> None:
     (tmp_path / "t.rules").write_text('terms "t.terms.yaml"\nbehavior inner:\n'
                                       "  r1: if a is low then y is lo\nend\n"
                                       "behavior outer:\n  use inner when a is high\nend\n")
-    with pytest.raises(FormatError, match="a conditional include cannot be written"):
+    with pytest.raises(FormatError, match="a conditional include cannot be written") as info:
         write_foreign(read_rulebase(tmp_path / "t.rules"), "fll", "outer")
+    # the hint said "convert the behavior it is used by alone", which is `outer`, refused here
+    assert info.value.hint == ("convert `inner` alone (--behavior inner), or write the "
+                               "condition into its rules; `mitos export` (C, Python) keeps "
+                               "`outer` whole")
 
 
 def test_rules_writer_refusals() -> None:

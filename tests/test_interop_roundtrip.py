@@ -171,3 +171,21 @@ def test_fll_writer_text_reads_in_pyfuzzylite(tmp_path: Path) -> None:
     theirs = np.asarray(engine.output_variables[0].value, dtype=float)
     _, ours = outputs(rb, X[:, None], ("Ambient",))
     np.testing.assert_allclose(ours[:, 0], theirs, rtol=0, atol=1e-9, equal_nan=True)
+
+
+@pytest.mark.parametrize("dialect", ["fuzzylite", "iec"])
+def test_fcl_keeps_the_rule_labels_it_can_number(dialect: str, tmp_path: Path) -> None:
+    """The packaged rule base counts its rules from r0; FCL wrote them `RULE 1`, `RULE 2`, ...,
+    so read back its r4 was r5 and `mitos eval` of the FCL named other rules than the rule
+    file's for the same DOFs. A label `rN` is written `RULE N` and reads back as itself; labels
+    of another form (or repeated numbers) are numbered by position, as before."""
+    from mitos_cli.interop.fcl import write_fcl
+
+    rb = read_rulebase(ROOT / "rulebases" / "mitos.rules")
+    (tmp_path / "m.fcl").write_text(write_fcl(rb, "avoid_obstacle", dialect))
+    back = read_rulebase(tmp_path / "m.fcl")
+    labels = [r.label for r in rb.behavior("avoid_obstacle").rules]
+    assert labels[:2] == ["r0", "r1"]
+    assert [r.label for r in back.behavior(back.default_behavior).rules] == labels
+    text = write_fcl(rb, "cruise", dialect)                      # c1, c2, ...: by position
+    assert "RULE 1 : " in text and "RULE c1" not in text

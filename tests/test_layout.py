@@ -31,3 +31,13 @@ def test_old_engine_names_are_served_from_evaluation():
     assert evaluate is evaluation.evaluate
     with pytest.raises(ImportError):
         from mitos_cli.engine import no_such_name  # noqa: F401
+
+
+def test_the_package_lists_the_names_it_gives_lazily():
+    """`dir(mitos_cli)` (a notebook's tab completion) had no `load_rulebase`, which the
+    package gives through its module `__getattr__`: every name of `__all__` is listed, and
+    each is there."""
+    import mitos_cli
+
+    assert set(mitos_cli.__all__) <= set(dir(mitos_cli))
+    assert all(getattr(mitos_cli, name) is not None for name in mitos_cli.__all__)

@@ -98,6 +98,19 @@ def test_terms_terminal_colour_on_request(capsys):
     assert code == 0 and "\x1b[" in out
 
 
+def test_many_inputs_not_fixed_are_one_note(capsys):
+    """`mitos plot surface -b drive steering --x heading` printed twelve notes, one an input
+    held at its midpoint: more than two are one note that lists them."""
+    code, _, err = run(["plot", "surface", "-b", "drive", "steering", "--x", "heading",
+                        "-n", "3"], capsys)
+    notes = [line for line in err.splitlines() if line.startswith("note:")]
+    assert code == 0 and notes == [
+        "note: 12 inputs not fixed, each held at the midpoint of its universe: road = 80, "
+        "size = 50, position = 0, obstacle = 100, lane = 0, goal = 200, gap_left = 75, "
+        "gap_right = 75, front = 75, opening = 0, clutter = 10, nearest = 30 (give --fix "
+        "NAME=VALUE)"]
+
+
 def test_surface_table_and_notes(capsys):
     code, out, err = run(["plot", "surface", "steering", "--x", "road", "--y", "position",
                           "-n", "5"], capsys)

@@ -47,3 +47,19 @@ def test_an_example_file_of_the_repository_named_from_elsewhere_says_where_it_is
     res = subprocess.run([sys.executable, "-m", "mitos_cli", "eval", "tests/tipper.fis", "x=1"],
                          cwd=tmp_path, capture_output=True, text=True)
     assert res.returncode == 1 and "not found" in res.stderr and "repository" not in res.stderr
+
+
+def test_a_studys_report_names_a_packaged_world_by_its_name(tmp_path):
+    """report.md listed `mitos compare corridor`'s world as the path pip put it at
+    (`/.../site-packages/.../worlds/corridor.yaml`): a packaged world is shown by its name,
+    marked packaged; any other world as given."""
+    from mitos_cli.resources import display_world, packaged_path
+    from mitos_cli.study.report import render_markdown
+
+    assert display_world(str(packaged_path("worlds", "corridor.yaml"))) == "corridor (packaged)"
+    mine = tmp_path / "corridor.yaml"
+    mine.write_text("name: mine\n")
+    assert display_world(str(mine)) == str(mine)
+    text = render_markdown({"worlds": [str(packaged_path("worlds", "slalom.yaml")), str(mine)],
+                            "choices": [], "runs": 1, "seed": 1}, [], [], {}, 0, 0)
+    assert f"- worlds: `slalom (packaged)`, `{mine}`" in text.splitlines()

@@ -500,6 +500,50 @@ def test_randomise_with_runs_says_why(short, capsys):
     assert code == 2 and "--runs randomises every run already" in said     # was "give one world"
 
 
+def test_one_run_options_say_the_way_out_that_fits(short, capsys, tmp_path):
+    """`simulate corridor --runs 3 --out x.csv` said "drop --runs or give one world" to a user
+    who gave one world: the message names the options given and the one way out that fits."""
+    csv = tmp_path / "x.csv"
+    cases = [((short, "--runs", 3, "--out", csv),
+              "--out works on one run of one world, not --runs 3: drop --runs (--randomise "
+              "--seed SEED replays one randomised run)"),
+             ((short, short.with_name("other.yaml"), "--trace"),
+              "--trace works on one run of one world, not 2 worlds: give one world"),
+             ((short, short.with_name("other.yaml"), "--runs", 2, "--speed", 3, "--out", csv),
+              "--out and --live/--speed work on one run of one world, not 2 worlds and --runs "
+              "2: drop --runs and give one world")]
+    short.with_name("other.yaml").write_text(short.read_text())
+    for args, message in cases:
+        code, err = run_main(capsys, *args)
+        said = " ".join(err.replace("│", " ").split())
+        assert code == 2 and message in said, said
+        assert "or give one world" not in said
+    assert not csv.exists()
+
+
+def test_a_pattern_the_shell_did_not_expand_is_said_to_be_one(capsys, tmp_path, monkeypatch):
+    """The README's `mitos simulate worlds/*.yaml --runs 20` away from the checkout reached
+    MITOS as the pattern itself ("world file `worlds/*.yaml` not found", and a hint about
+    `mitos list` that did not say why): the hint says no file matched the pattern."""
+    monkeypatch.chdir(tmp_path)
+    code, err = run_main(capsys, "worlds/*.yaml", "--runs", 2)
+    assert code == 1 and err.splitlines() == [
+        "world error: world file `worlds/*.yaml` not found",
+        "hint: no file here matches the pattern, so the shell passed `worlds/*.yaml` on as "
+        "written; the packaged worlds go by name: `mitos list` shows them"]
+
+
+def test_a_rule_base_without_the_worlds_behavior_says_how_to_choose_one(short, capsys):
+    """`mitos simulate figure4 --rulebase tipper.fis` stood at the world's `behavior: drive`
+    with "unknown behavior `drive`, expected one of main" and no word of how to go on."""
+    tipper = Path(__file__).parent / "data" / "interop" / "tipper.fis"
+    code, err = run_main(capsys, short, "--rulebase", tipper)
+    assert code == 1 and "unknown behavior `drive`" in err
+    assert err.splitlines()[-1] == (
+        "hint: the world is driven by its `behavior: drive`, which this rule base lacks: "
+        "choose one of its behaviors (--behavior NAME; behavior= from Python)")
+
+
 def test_one_runs_spread_is_null_as_in_compare(short):
     data = json.loads(run(short, "--runs", 1, "--json").stdout)
     row = data[0] if isinstance(data, list) else data["worlds"][0]

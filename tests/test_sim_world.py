@@ -105,6 +105,18 @@ def test_a_number_that_is_not_one():
     assert "w.yaml:3:5" in msg and "must be a number" in msg
 
 
+@pytest.mark.parametrize("old, new, unit", [("dt: 0.05", "dt: 50ms", "ms"),
+                                             ("wheelbase: 16", "wheelbase: 16 in", "in"),
+                                             ("x: 300", "x: 300in", "in")])
+def test_a_number_with_a_unit_is_told_to_drop_it(old, new, unit):
+    """`wheelbase: 16in` said "must be a number, not `16in`" and no more: the hint says to write
+    the number alone and what a world's numbers are in (not `50`: 50ms is not 50 s)."""
+    msg = error(BASE.replace(old, new))
+    assert msg.splitlines()[-1] == (f"hint: write the number alone, without `{unit}`: a world's "
+                                    f"numbers are in inches, seconds and degrees")
+    assert "hint" not in error(BASE.replace("dt: 0.05", "dt: fast"))    # no unit: no hint
+
+
 def test_steering_limits_must_bracket_straight():
     msg = error(BASE.replace("  wheelbase: 16\n", "  wheelbase: 16\n  steering: {min: 100}\n"))
     assert "min < straight < max" in msg

@@ -564,3 +564,30 @@ def test_a_lesson_refused_at_its_first_commands_leaves_no_session(work):
     [kept] = (work / ".mitos" / "teach").iterdir()
     resumed = mitos("teach", "--resume", cwd=work, stdin="quit\n")
     assert resumed.returncode == 0 and f"resumed session {kept.name}" in resumed.stderr
+
+
+def test_a_yaml_file_given_as_the_rule_base_says_what_teach_takes(work):
+    """`mitos teach tip.terms.yaml` was told that "a rule base is a .rules, .fcl, .fis or .fll
+    file", three of which `mitos teach` refuses: the hint says what it teaches, and where a
+    term set and a world go."""
+    (work / "w.yaml").write_text("# a world\nname: w\nseed: 1\n")
+    res = mitos("teach", "w.yaml", cwd=work)
+    assert res.returncode == 1
+    assert res.stderr.splitlines() == [
+        "rule base error: `w.yaml` is a YAML file (a term set, or a world), not a rule base",
+        "hint: `mitos teach` teaches a .rules file (convert a .fcl, .fis or .fll one with "
+        "`mitos convert FILE --to rules`); a term set is read through the `terms` line of its "
+        ".rules file, and a world is driven from the prompt (`simulate WORLD`)"]
+
+
+def test_save_as_into_a_missing_path_is_refused_before_the_lesson_runs(work):
+    """`--save-as /nonexistent/dir/x.rules` ran the whole lesson (simulations, adaptation)
+    and failed only at its end, where only the last directory of a path is made: the path is
+    checked with the other save checks, before a session starts."""
+    (work / "l.lesson").write_text("eval road=78 size=45 position=4\n")
+    res = mitos("teach", "rb/mitos.rules", "--lesson", "l.lesson", "--save-as",
+                "nope/deeper/x.rules", cwd=work)
+    assert res.returncode == 1 and res.stdout == ""           # the lesson did not run
+    assert "lesson error: cannot save `nope/deeper/x.rules`: the directory `nope` does not " \
+           "exist" in res.stderr
+    assert not (work / ".mitos").exists() and not (work / "nope").exists()

@@ -119,6 +119,12 @@ def test_rule_lines_are_rules_of_the_rule_language():
     # what to show: the one meant (it said only the list)
     ("show rule", "unexpected `rule`", "rules, terms", "did you mean `rules`?"),
     ("show Terms", "unexpected `Terms`", "rules, terms", "did you mean `terms`?"),
+    # `=` for `is`, and FCL's `;` (which was "`SLOW` is not a hedge ... did you mean `seldom`?")
+    ("if road = WIDE then speed is SLOW", "unexpected `=`", "`is`",
+     "write `road is ...`: a condition or action reads `variable is TERM`"),
+    ("r9: if road is WIDE then speed = 5", "unexpected `=`", "`is`", "write `speed is ...`"),
+    ("r9: if road is WIDE then speed is SLOW;", "unexpected `;`", "`and` or `with`",
+     "a rule or command needs no `;` at its end"),
 ])
 def test_mistyped_lines_say_what_was_expected(line, message, expected, hint):
     with pytest.raises(RuleSyntaxError) as info:

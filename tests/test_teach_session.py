@@ -178,6 +178,21 @@ def test_correct_adapt_and_show(rules, tmp_path):
     assert any(p.name.startswith("terms-") for p in tmp_path.iterdir())
 
 
+def test_adapt_without_examples_gives_an_example_of_the_behaviors_own_inputs(rules):
+    """With `drive` active, `adapt` offered `correct road=78 size=45 position=4 ->
+    steering=60`, which `correct` refuses there (drive reads 13 inputs)."""
+    s, _ = session(rules)
+    with pytest.raises(LessonError) as info:
+        s.run("adapt")
+    assert "`correct road=78 size=45 position=4 -> steering=60`" in info.value.hint
+    s.run("use drive")
+    with pytest.raises(LessonError) as info:
+        s.run("adapt")
+    assert info.value.hint.startswith("give corrections: `correct road=... size=... "
+                                      "position=... ... -> steering=...` (every input of "
+                                      "`drive`)")
+
+
 def test_adapt_without_examples_or_with_everything_frozen(rules):
     s, out = session(rules)
     with pytest.raises(LessonError, match="no examples for behavior `avoid_obstacle`"):

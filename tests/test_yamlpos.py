@@ -69,3 +69,17 @@ def test_the_commonest_yaml_mistakes_are_said_in_words_with_what_was_expected(
     assert (err.span.line, err.span.column) == where
     assert words in err.message
     assert err.expected == expected if expected is None else expected in err.expected
+
+
+@pytest.mark.parametrize("written, hint", [
+    ("70in", "write the number alone, without `in`: the numbers are in inches"),
+    ("-4.5 in/s", "write the number alone, without `in/s`: the numbers are in inches"),
+    ("1e3mm", "write the number alone, without `mm`: the numbers are in inches"),
+    ("far", None), ("12 34", None), ("in", None)])
+def test_a_number_written_with_a_unit_gets_a_hint(written, hint):
+    data = yamlpos.load(f"a: {written}\n", "f.yaml", TermSetError)
+    with pytest.raises(TermSetError) as info:
+        yamlpos.expect_number(data["a"], data.value_span("a"), TermSetError, "`a`",
+                              units="the numbers are in inches")
+    assert info.value.message == f"`a` must be a number, not `{written}`"
+    assert info.value.hint == hint

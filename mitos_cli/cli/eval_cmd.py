@@ -91,9 +91,11 @@ def parse_values(values: dict[str, str]) -> dict[str, float]:
             raise InputError(f"input `{name}` has a number too large for a float: `{text}`",
                              expected="numbers of magnitude at most 1.8e308") from None
         except ValueError:
-            raise InputError(f"input `{name}` must be a number, not `{text}`",
+            shown = f"`{text}`" if text else "empty"               # `road=`: not "not ``"
+            raise InputError(f"input `{name}` must be a number, not {shown}",
                              expected="a decimal number such as 78, -4.5 or 1e3",
-                             hint=_glued(name, text)) from None
+                             hint=_glued(name, text) if text else
+                             f"give it after the `=`, in the same word: `{name}=78`") from None
     return out
 
 
@@ -212,7 +214,10 @@ def eval_command(
              "and inputs outside their ranges not clamped), "
              "fuzzylite (fuzzylite 8: cell midpoints at the file's resolution, 1000 where it "
              "gives none), fuzzylite6 (fuzzylite 6, Debian's `fuzzylite`: the same, 100 where "
-             "it gives none, as in every FCL `METHOD : COG;` and .fis).")] = None,
+             "it gives none, as in every FCL `METHOD : COG;` and .fis), both with an FCL or "
+             ".fis file's inputs not clamped; octave (Octave's fuzzy-logic-toolkit on a .fis: "
+             "101 points, the trapezoid rule, a Sugeno output's equal values joined by the "
+             "file's AggMethod).")] = None,
 ) -> None:
     """Evaluate a rule base: fuzzified inputs, fired rules with DOFs, crisp outputs."""
     on_no_rule = (None if on_no_rule_name is None

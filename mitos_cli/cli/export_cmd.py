@@ -58,8 +58,11 @@ def export_command(
         raise typer.BadParameter(f"--prefix names the C code's functions and macros; --to "
                                  f"{to.value} has none: leave --prefix out")
     prefix = "mitos" if prefix is None else prefix
-    if not ident(prefix) == prefix:
-        raise typer.BadParameter(f"--prefix `{prefix}` is not a C identifier")
+    if ident(prefix) != prefix:
+        close = ident(prefix)
+        raise typer.BadParameter(f"--prefix `{prefix}` is not a C identifier (letters, digits "
+                                 f"and `_`, not starting with a digit)"
+                                 + (f"; did you mean `{close}`?" if close.strip("_") else ""))
     rb = load_rulebase(path, behavior)
     if output is not None:
         refuse_inputs([output], source_files(rb.rulebase, path))

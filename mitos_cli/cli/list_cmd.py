@@ -8,6 +8,7 @@ mitos.rules``, ``mitos plot terms drive.terms.yaml``, ``--lesson wider-turn``).
 
 from __future__ import annotations
 
+import re
 from typing import Annotated
 
 import typer
@@ -26,7 +27,8 @@ SECTIONS = {
 
 def first_comment_line(text: str) -> str:
     """The first line of the comment a file starts with, without its ``#``; ``...`` marks a
-    sentence that goes on in the next comment line. Empty when the file starts otherwise."""
+    sentence that goes on in the next comment line, and a line whose first sentences end in
+    it gives those alone. Empty when the file starts otherwise."""
     lines = [line.strip() for line in text.splitlines()]
     lines = [line for line in lines if line]
     for i, line in enumerate(lines):
@@ -37,7 +39,12 @@ def first_comment_line(text: str) -> str:
             continue
         after = lines[i + 1].lstrip("#").strip() if i + 1 < len(lines) and \
             lines[i + 1].startswith("#") else ""
-        return words + " ..." if after and not words.endswith((".", "!", "?", ":")) else words
+        if not after or words.endswith((".", "!", "?", ":")):
+            return words
+        # a sentence that ends in the line: that sentence, not the next one cut short
+        # (detour's "... today's state of it. It is given the corridors (its ...")
+        ends = [m.end() - 1 for m in re.finditer(r"[.!?](?=\s+[A-Z])", words)]
+        return words[:ends[-1] + 1] if ends else words + " ..."
     return ""
 
 

@@ -297,8 +297,8 @@ def surface_command(
         "--resolution", "-n", metavar="N", min=2, max=1000, help="Grid points per axis.")] = 61,
     style_name: Annotated[Optional[str], typer.Option(
         "--style", metavar=choices(Style), autocompletion=completer(Style),
-        help="3-D surface (the default) or heat map with contours: a picture of two inputs "
-             "(--y, with -o or --show).")] = None,
+        help="surface: a 3-D surface (the default); heatmap: a heat map with contour lines. "
+             "For a picture of two inputs (--y, with -o or --show).")] = None,
     output: OutputOpt = None,
     show: ShowOpt = False,
     title: TitleOpt = None,

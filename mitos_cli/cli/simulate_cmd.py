@@ -202,7 +202,8 @@ def simulate_command(
         "--out", "-o", parser=file_arg, metavar="FILE.csv",
         help="Write one CSV row per tick to FILE.csv (a name ending in .csv).")] = None,
     trace: Annotated[bool, typer.Option(
-        "--trace", help="Every --every ticks, print the pose, speed, steering, clearance and "
+        "--trace", help="Every --every ticks (and at each replan and the last tick), print "
+                        "the pose, speed, steering, clearance and "
                         "perceived vs true inputs, then the paper-style DOF trace (none for a "
                         "planner that is not a rule base); of the first robot where there are "
                         "several; on stderr with --json, which keeps stdout for the JSON.")] = False,
@@ -319,6 +320,12 @@ def _checked_require(require: str | None) -> str | None:
     return require
 
 
+def _many(worlds: int, runs: int) -> str:
+    """What ``simulate`` was asked to run, in words: ``3 worlds``, ``--runs 20``."""
+    return " and ".join(part for part in (f"{worlds} worlds" if worlds > 1 else "",
+                                          f"--runs {runs}" if runs > 0 else "") if part)
+
+
 def _check_run_options(many: bool, worlds: int, runs: int, randomise: bool, out, trace: bool,
                        live: bool, animate, plot) -> None:
     """Usage errors among the options, and a picture format or a missing matplotlib, all
@@ -326,9 +333,15 @@ def _check_run_options(many: bool, worlds: int, runs: int, randomise: bool, out,
     if randomise and runs > 0:                # not "give one world": it was one
         raise typer.BadParameter("--runs randomises every run already; --randomise replays "
                                  "one of them (with --seed)", param_hint="--randomise")
-    if many and (out or trace or live or randomise or animate):
-        raise typer.BadParameter("--out, --animate, --trace, --live, --speed and --randomise "
-                                 "work on one world and one run; drop --runs or give one world")
+    given = [name for name, on in (("--out", out), ("--animate", animate), ("--trace", trace),
+                                   ("--live/--speed", live), ("--randomise", randomise)) if on]
+    if many and given:                        # the way out that fits: one world had "give one"
+        fix = ("drop --runs (--randomise --seed SEED replays one randomised run)"
+               if worlds == 1 else "give one world" if runs == 0
+               else "drop --runs and give one world")
+        raise typer.BadParameter(f"{' and '.join(given)} "
+                                 f"{'works' if len(given) == 1 else 'work'} on one run of one "
+                                 f"world, not {_many(worlds, runs)}: {fix}")
     if plot is not None and worlds > 1:
         raise typer.BadParameter("--plot draws one world (with --runs, all its runs in one "
                                  "picture); give one world", param_hint="--plot")

@@ -168,18 +168,24 @@ def _new_session(rules, behavior, lesson, save_as, out):
         raise RuleBaseError(f"cannot read rule file `{path}`: {exc.strerror or exc}") from None
     if not is_file:
         from ..fileio import broken_link
-        from ..lang.resolve import rule_file_hint
+        from ..lang.resolve import rule_file_not_found_hint
 
         link = broken_link("rule file", path)       # a dangling link, a loop: as eval says it
         raise RuleBaseError(link or (f"`{path}` is a directory, not a rule file" if path.is_dir()
                                      else f"rule file `{path}` not found"),
-                            hint=None if path.is_dir() or link else rule_file_hint(path))
+                            hint=None if path.is_dir() or link else rule_file_not_found_hint(path))
     try:
         loaded = load_rulebase(path, behavior)
     except MitosError as exc:           # a .fis, .fcl or .fll (by its name or not): convert it
         from ..interop import hint_wrong_reader
 
         hint_wrong_reader(exc, path, "mitos teach")
+        if path.suffix.lower() in (".yaml", ".yml") and exc.span is None:
+            # the loader's hint named .fcl, .fis and .fll rule bases, which teach refuses
+            exc.hint = ("`mitos teach` teaches a .rules file (convert a .fcl, .fis or .fll one "
+                        "with `mitos convert FILE --to rules`); a term set is read through the "
+                        "`terms` line of its .rules file, and a world is driven from the "
+                        "prompt (`simulate WORLD`)")
         raise
     if save_as is not None:         # refused now, not when the lesson ends and saves
         from ..teach.save import check_save_target

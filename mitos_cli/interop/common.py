@@ -755,9 +755,11 @@ def flatten_for_export(rb: RuleBase, behavior: str | None = None, *,
             if use.condition is not None:
                 raise FormatError(f"rule `{label}` comes from `use {use.behavior} when ...`: "
                                   f"a conditional include cannot be written in FCL, FIS or FLL",
-                                  span=use.span, hint="convert the behavior it is used by alone "
-                                                      "(--behavior), or write the condition "
-                                                      "into the rules")
+                                  span=use.span,
+                                  hint=f"convert `{use.behavior}` alone (--behavior "
+                                       f"{use.behavior}), or write the condition into its "
+                                       f"rules; `mitos export` (C, Python) keeps `{name}` "
+                                       f"whole")
             w *= use.weight
         rules.append(Rule(label, rule.antecedent, rule.consequents, w, rule.span))
     variables = rb.variables

@@ -36,6 +36,7 @@ from __future__ import annotations
 import dataclasses
 import functools
 import math
+import re
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -961,10 +962,22 @@ def write_fcl(rb: RuleBase, behavior: str | None = None, dialect: str = DEFAULT_
         out.append(f"    ACT : {act};")
     if accu is not None and dialect == "iec":
         out.append(f"    ACCU : {accu};")
-    for i, r in enumerate(flat.rules, 1):
+    for i, r in zip(_rule_numbers(flat.rules), flat.rules):
         out.append(f"    RULE {i} : {_rule_text(r, dialect, ops)};")
     out += ["END_RULEBLOCK", "", "END_FUNCTION_BLOCK"]
     return "\n".join(out) + "\n"
+
+
+def _rule_numbers(rules: Sequence[Rule]) -> list[int]:
+    """The number after each ``RULE``: a rule labelled ``rN`` keeps N, which the reader reads
+    back as ``rN``, where every label is of that form and none repeats (the packaged rule base
+    counts from r0: written 1, 2, ... its r4 came back as r5); else 1, 2, ... by position (IEC
+    61131-7 numbers its rules, so other labels are not written)."""
+    numbers = [int(m.group(1)) if (m := re.fullmatch(r"r(0|[1-9][0-9]*)", r.label)) else None
+               for r in rules]
+    if None in numbers or len(set(numbers)) < len(numbers):
+        return list(range(1, len(rules) + 1))
+    return [n for n in numbers if n is not None]
 
 
 def _range(v: Variable) -> str:

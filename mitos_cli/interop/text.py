@@ -22,7 +22,7 @@ from ..fileio import byte_span as _at
 from ..fileio import read_bytes, unreadable
 from ..lang.model import RuleBase
 from ..lang.parse import check_rule_file_size
-from ..lang.resolve import rule_file_hint
+from ..lang.resolve import rule_file_not_found_hint
 
 #: The encoding a file that is not UTF-8 is read in: what MATLAB and Java write on Windows.
 LEGACY = "cp1252"
@@ -43,7 +43,7 @@ def foreign_text(path: Path) -> tuple[str, str | None]:
         raw = read_bytes(path)
     except OSError as exc:
         raise RuleBaseError(unreadable("rule file", path, exc),
-                            hint=rule_file_hint(path)) from None
+                            hint=rule_file_not_found_hint(path)) from None
     try:
         text = raw.decode("utf-8-sig")
     except UnicodeDecodeError as exc:

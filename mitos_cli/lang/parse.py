@@ -125,6 +125,9 @@ def syntax_error(exc: UnexpectedInput, text: str, path: str | None) -> RuleSynta
         if char.isalpha() and not char.isascii():     # `température`: names are ASCII
             hint = ("names are ASCII letters, digits, `_` and `-` (`temperature`); other text "
                     "belongs in a term set's `description`")
+        elif char == ";":                               # FCL's `... then speed is SLOW;`
+            hint = ("a rule needs no `;` at its end (FCL's rules have one: `mitos convert "
+                    "FILE.fcl --to rules` reads an FCL file)")
         return RuleSyntaxError(message, span=Span.in_text(text, path, line, column),
                                expected=allowed, hint=hint)
     if isinstance(exc, UnexpectedInput):
@@ -175,6 +178,10 @@ def syntax_error(exc: UnexpectedInput, text: str, path: str | None) -> RuleSynta
             hint = f"`{before}` is read as a variable's name: {close}"
         else:
             hint = "a condition reads `variable is TERM`"
+    elif str(token.value) == "=" and "IS" in expected and _word_before(text, token):
+        # `then speed = 5`: a proposition is `speed is 5`, not an assignment
+        hint = f"write `{_word_before(text, token)} is ...`: a condition or action reads " \
+               f"`variable is TERM` (or `is 5` for a crisp value), not `=`"
     elif "THEN" in expected and token.type in ("NAME",):
         hint = _keyword_as_term(text, token) or _hedge_hint(text, token) or \
             keyword_hint(token, expected) or _two_words(text, token) or \

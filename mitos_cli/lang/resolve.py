@@ -37,6 +37,17 @@ def rule_file_hint(path: str | Path) -> str | None:
     return nearby(path, RULE_SUFFIXES, packaged) or repository_only(path)
 
 
+def rule_file_not_found_hint(path: str | Path) -> str | None:
+    """The hint of "rule file `X` not found": :func:`rule_file_hint`, else, for a name the
+    packaged rule bases are looked up by, where to see them (`mitos eval nope.rules` said
+    "not found" and no more, where a world's name gets `mitos list`)."""
+    from ..resources import packaged_place
+
+    return rule_file_hint(path) or (
+        "`mitos list` shows the packaged rule bases, which are found by name (`mitos.rules`)"
+        if packaged_place(Path(path).parent.as_posix(), "rulebases") else None)
+
+
 def termset_hint(target: Path, name: str) -> str:
     """What to write in the ``terms`` line for a term set that is not there: the YAML file
     beside it whose name is close (`mitos.terms.yaml` for `mitos.term.yaml`), as the line
@@ -63,7 +74,7 @@ def load_rules_file(path: str | Path) -> RuleBase:
                             "is not UTF-8)", span=bad_byte(path, exc)) from None
     except OSError as exc:
         raise RuleBaseError(unreadable("rule file", path, exc),
-                            hint=rule_file_hint(path)) from None
+                            hint=rule_file_not_found_hint(path)) from None
     parsed = parse_rules(text, str(path))
     termsets = []
     seen: dict[Path, str] = {}

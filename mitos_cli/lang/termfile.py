@@ -292,7 +292,8 @@ def _number(value: Any, span: Span, what: str) -> float:
     """``value`` as a finite float within ±:data:`~mitos_cli.numbers.LARGEST`, as the foreign
     readers take numbers: beyond it a universe's width, a Mamdani grid's step or a weighted
     average's sum overflows to ``inf`` or ``nan`` with nothing said."""
-    number = yamlpos.expect_number(value, span, TermSetError, what)
+    number = yamlpos.expect_number(value, span, TermSetError, what,
+                                   units="a term set's numbers are in its variable's `unit`")
     if abs(number) > LARGEST:
         raise TermSetError(f"{what} is {exact(number)}: numbers beyond ±{LARGEST:g} cannot be "
                            "evaluated in floating point without overflow", span=span,

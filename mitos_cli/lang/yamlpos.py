@@ -318,13 +318,16 @@ def expect_map(value: Any, span: Span, error: type[MitosError], what: str) -> YM
     return value
 
 
-def expect_number(value: Any, span: Span, error: type[MitosError], what: str) -> float:
-    """``value`` as a finite float, or ``error`` saying a number was expected."""
+def expect_number(value: Any, span: Span, error: type[MitosError], what: str, *,
+                  units: str | None = None) -> float:
+    """``value`` as a finite float, or ``error`` saying a number was expected. ``units`` says
+    what the file's numbers are in, for a number written with a unit (``16in``, ``50ms``)."""
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         shown = ("nothing (an empty value or `~`)" if value is None else
                  f"`{str(value).lower()}`" if isinstance(value, bool) else
                  _quoted_number(value, span) or f"`{value}`")
-        raise error(f"{what} must be a number, not {shown}", span=span)   # (YAML's `true`)
+        raise error(f"{what} must be a number, not {shown}", span=span,   # (YAML's `true`)
+                    hint=_unit_hint(value, units))
     try:
         number = float(value)
     except OverflowError:
@@ -340,6 +343,21 @@ def expect_number(value: Any, span: Span, error: type[MitosError], what: str) ->
                         span=span)
         raise error(f"{what} must be a finite number, not `{value}`", span=span)
     return number
+
+
+#: A number followed by a unit: ``16in``, ``50 ms``, ``90deg``, ``-4.5 in/s``.
+_WITH_UNIT = re.compile(r"\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*([^\d\s.+-][^\s]*)\s*")
+
+
+def _unit_hint(value: Any, units: str | None) -> str | None:
+    """What to write instead of a number with a unit (``dt: 50ms`` said only "must be a
+    number, not `50ms`"): the number alone, in the file's units (which ``units`` names; the
+    number is not repeated: `50` would be 50 s)."""
+    found = _WITH_UNIT.fullmatch(value) if isinstance(value, str) else None
+    if found is None:
+        return None
+    return (f"write the number alone, without `{found.group(2)}`"
+            + (f": {units}" if units else ": a value takes no unit"))
 
 
 def _quoted_number(value: Any, span: Span) -> str | None:

@@ -176,12 +176,27 @@ class PlannerKind:
 
 
 def _fuzzy(world, rulebase=None, behavior: str | None = None) -> Planner:
+    return fuzzy_planner(world, rulebase, behavior or None)     # (as it was: "" is the world's)
+
+
+def fuzzy_planner(world, rulebase=None, behavior: str | None = None) -> FuzzyPlanner:
+    """The rule base's ``behavior`` (default: the world's ``behavior:``) as a planner; the
+    world's behavior missing from the rule base is said at the world's line, with how to
+    choose another (`mitos simulate`, and the Gymnasium environments)."""
     try:
-        return FuzzyPlanner(rulebase, behavior or world.behavior)
+        return FuzzyPlanner(rulebase, world.behavior if behavior is None else behavior)
     except NameError_ as exc:       # the world file's `behavior:` names none of the rule base's
-        if behavior or exc.span is not None or not exc.message.startswith("unknown behavior"):
+        if behavior is not None or exc.span is not None \
+                or not exc.message.startswith("unknown behavior"):
             raise
         exc.span = getattr(world, "behavior_span", None)
+        # `simulate figure4 --rulebase tipper.fis`: the error stood at the world's line with
+        # no word of why the world's behavior was looked for, nor how to choose another
+        said = (f"the world is driven by its `behavior: {world.behavior}`, which "
+                f"{'this rule base' if rulebase is not None else 'the rule base'} lacks: "
+                f"choose one of its behaviors (--behavior NAME; behavior= from Python)")
+        exc.hint = (f"{exc.hint} (--behavior NAME drives with another than the world's "
+                    f"`behavior: {world.behavior}`)" if exc.hint else said)
         raise
 
 

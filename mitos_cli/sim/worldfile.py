@@ -52,6 +52,8 @@ OBSTACLE_KEYS = ("name", "shape", "at", "radius", "length", "width", "angle", "v
 AGENT_KEYS = ("name", "q_init", "q_goal", "robot")
 RANDOMISE_KEYS = ("obstacles", "sensor_noise")
 MODELS = ("tricycle",)
+#: What a world's numbers are in, for one written with a unit (`wheelbase: 16in`).
+UNITS = "a world's numbers are in inches, seconds and degrees"
 LAYOUTS = ("ring", "fan")
 SHAPES = ("circle", "rectangle")
 MODES = ("loop", "ping-pong", "stop")
@@ -113,7 +115,7 @@ class _Reader:
                 return yamlpos.require(m, key, WorldError, what)   # raises: `key` is missing
             return float(default)
         span = m.value_span(key)
-        x = yamlpos.expect_number(m[key], span, WorldError, f"`{key}` in {what}")
+        x = yamlpos.expect_number(m[key], span, WorldError, f"`{key}` in {what}", units=UNITS)
         if sane and (maximum is None or x <= maximum):     # else "at most", below
             _sane(x, span, f"`{key}` in {what}", key)
         if positive and x <= 0:
@@ -131,7 +133,7 @@ class _Reader:
         if not isinstance(value, list) or len(value) != 2:
             raise WorldError(f"{what} must be {shape}", span=span)
         spans = value.item_spans if isinstance(value, YList) else [span] * 2
-        x, y = (_sane(yamlpos.expect_number(v, at, WorldError, what), at, what)
+        x, y = (_sane(yamlpos.expect_number(v, at, WorldError, what, units=UNITS), at, what)
                 for v, at in zip(value, spans))
         return x, y
 
@@ -1388,6 +1390,9 @@ def world_not_found(name: str | Path, where: Path) -> UnknownWorld:
         hint = (f"there is no `{given}`; the packaged world of that name is "
                 f"`{same_name[:-len('.yaml')]}`")
     listing = ("one of the packaged worlds: " + ", ".join(shown)) if bare or close else None
+    if any(c in given.name for c in "*?["):       # `worlds/*.yaml` away from the repository
+        hint = (f"no file here matches the pattern, so the shell passed `{name}` on as "
+                f"written; the packaged worlds go by name: `mitos list` shows them")
     if hint is None and listing is None:
         hint = "`mitos list` shows the packaged worlds, which are found by name (`slalom`)"
     return UnknownWorld(f"world file `{name}` not found", expected=listing, hint=hint)

@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
+from ..resources import display_world
 from ..words import percent, plural
 from .spec import Choice
 from .stats import Mean, Rate
@@ -167,7 +168,7 @@ def render_markdown(manifest: dict, summaries: list[Summary], ranks: list[Rank],
     lines = [
         "# MITOS comparison study",
         "",
-        f"- worlds: {', '.join(f'`{w}`' for w in worlds)}",
+        f"- worlds: {', '.join(f'`{display_world(w)}`' for w in worlds)}",
         f"- choices: {', '.join(f'`{c}`' for c in choices)}",
         f"- runs per world and choice: {manifest.get('runs')}, seed {manifest.get('seed')}"
         f" ({n_rows} of {plural(n_tasks, 'run')} finished)",

@@ -634,11 +634,18 @@ def _syntax_error(exc: UnexpectedInput, text: str, path: str) -> RuleSyntaxError
         # a target reuses the rule language's consequent, which a rule's `with` may follow;
         # a target takes no weight, and the line may end after it
         expected = expected - {"WITH"} | {"$END"}
-    hint = _teach_hint(text, token, before)
+    hint = _teach_hint(text, token, before) if str(token.value) != ";" else None
     if hint is not None:
         pass
+    elif str(token.value) == ";":          # FCL's `... then speed is SLOW;` (not a hedge)
+        hint = "a rule or command needs no `;` at its end"
     elif not before:
         hint = FIRST_WORDS_HINT
+    elif str(token.value) == "=" and "IS" in expected and before and "->" not in before \
+            and before[:1] != ["at"]:
+        # `if road = WIDE then ...`: as in a rule file (`mitos_cli.lang.parse`)
+        hint = f"write `{before[-1]} is ...`: a condition or action reads `variable is " \
+               f"TERM` (or `is 5` for a crisp value), not `=`"
     elif token.type == "NAME" and "IS" in expected and "->" in before:
         hint = _target_hint(before)
     elif token.type == "NAME" and "IS" in expected:

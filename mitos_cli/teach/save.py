@@ -218,7 +218,8 @@ def check_save_target(original: RuleBase, target: Path) -> tuple[Path, ...]:
     src = Path(original.path or target)
     targets = termset_targets(target, src, original.termset_paths)
     try:
-        _check_targets(target, src, original, targets)
+        _check_directory(target)    # (`--save-as /nonexistent/dir/x.rules` ran the whole
+        _check_targets(target, src, original, targets)     # lesson, then failed to save)
     except OSError as exc:          # a name the system cannot look up
         raise _cannot_look_up(target, exc) from None
     return targets
@@ -353,6 +354,21 @@ def _terms(rb: RuleBase) -> dict:
             for name, v in rb.variables.items()}
 
 
+def _check_directory(target: Path) -> None:
+    """Refuse a save whose directory cannot be had: a file where a directory goes, or a
+    missing directory whose parent is missing too (only the last one is made)."""
+    parent = target.parent
+    if parent.is_dir():
+        return
+    for up in (parent, parent.parent):  # `save notes.txt/x.rules`: said "File exists"
+        if up.exists() and not up.is_dir():
+            raise LessonError(f"cannot save `{target}`: `{up}` is a file, not a directory",
+                              hint="name a directory, or a new one to be made")
+    if not parent.parent.is_dir():
+        raise LessonError(f"cannot save `{target}`: the directory `{parent.parent}` does not "
+                          f"exist", hint="check the path, or create the directory first")
+
+
 def _directory_for(target: Path) -> Path | None:
     """Make the directory ``target`` goes in when only that last one is missing (`save
     taught/new.rules`), and return it (the session says so); a path whose parents are
@@ -361,13 +377,7 @@ def _directory_for(target: Path) -> Path | None:
     parent = target.parent
     if parent.is_dir():
         return None
-    for up in (parent, parent.parent):  # `save notes.txt/x.rules`: said "File exists"
-        if up.exists() and not up.is_dir():
-            raise LessonError(f"cannot save `{target}`: `{up}` is a file, not a directory",
-                              hint="name a directory, or a new one to be made")
-    if not parent.parent.is_dir():
-        raise LessonError(f"cannot save `{target}`: the directory `{parent.parent}` does not "
-                          f"exist", hint="check the path, or create the directory first")
+    _check_directory(target)
     try:
         parent.mkdir()
     except OSError as exc:

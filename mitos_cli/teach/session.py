@@ -823,10 +823,17 @@ class Session:
         usable = [e for e in self.state.examples if e.behavior == compiled.behavior]
         if not usable:
             others = sorted({e.behavior for e in self.state.examples})
+            # the example is of this behavior's own inputs (`drive` reads 13: `road=78 size=45
+            # position=4` was an example that `correct` refuses there)
+            shown = " ".join(f"{k}=..." for k in compiled.inputs[:3]) + (
+                " ..." if len(compiled.inputs) > 3 else "")
+            example = ("correct road=78 size=45 position=4 -> steering=60"
+                       if tuple(compiled.inputs) == ("road", "size", "position") else
+                       f"correct {shown} -> {compiled.outputs[0]}=...")
             hint = (f"the examples given so far correct {', '.join(others)}: `use "
                     f"{others[0]}` to adapt it" if others else
-                    "give corrections: `correct road=78 size=45 position=4 -> steering=60`, "
-                    "or `simulate WORLD` then `at 12.5s steering=55`")
+                    f"give corrections: `{example}` (every input of `{compiled.behavior}`), "
+                    f"or `simulate WORLD` then `at 12.5s {compiled.outputs[0]}=55`")
             raise LessonError(f"no examples for behavior `{compiled.behavior}` to learn from",
                               hint=hint)
         X = np.array([[e.inputs[k] for k in compiled.inputs] for e in usable], dtype=float)

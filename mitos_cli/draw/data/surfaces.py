@@ -66,8 +66,14 @@ class Surface:
 
     def notes(self) -> list[str]:
         """What a user should be told: defaulted inputs, regions where nothing fires."""
-        out = [f"`{f.name}` not fixed: held at {f.value:g}, the midpoint of its universe "
-               f"(give --fix {f.name}=VALUE)" for f in self.fixed if f.defaulted]
+        held = [f for f in self.fixed if f.defaulted]
+        if len(held) > 2:           # `drive` over one input: 12 lines of notes, one an input
+            out = [f"{len(held)} inputs not fixed, each held at the midpoint of its universe: "
+                   + ", ".join(f"{f.name} = {f.value:g}" for f in held)
+                   + " (give --fix NAME=VALUE)"]
+        else:
+            out = [f"`{f.name}` not fixed: held at {f.value:g}, the midpoint of its universe "
+                   f"(give --fix {f.name}=VALUE)" for f in held]
         n = int(self.no_rule.sum())
         if n:
             out.append(f"no rule sets `{self.output}` at {n} of {self.z.size} grid points "
