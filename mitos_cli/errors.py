@@ -194,6 +194,29 @@ def control_character(text: str) -> str | None:
     return visible(found.group()) if found else None
 
 
+def excerpt(span: Span | None, whole_lines: bool = True) -> list[str]:
+    """The line ``span`` points into and a caret under what it covers, indented, as an error
+    and a ``mitos check`` finding show them (nothing where the span kept no line);
+    ``whole_lines`` false: one caret where the span runs to the line's end (a finding about
+    a whole rule, or a behavior, which points at its first rule)."""
+    if span is None or span.source_line is None:
+        return []
+    raw = span.source_line.rstrip("\r\n")
+    col = span.column - span.source_start                # 0-based in ``raw``
+    if len(raw) > SHOWN:                # a very long line: only the part around the column
+        first = min(max(0, col - SHOWN // 2), len(raw) - SHOWN)
+        raw, col = raw[first:first + SHOWN], col - first
+    raw = _CONTROL.sub("\ufffd", raw)            # (one character each: the caret stays)
+    raw = _INVISIBLE.sub("\ufffd", raw)          # (a zero-width one put it a column off)
+    src = raw.expandtabs(4)
+    col = len(raw[:max(0, col)].expandtabs(4))
+    width = max(1, (span.end_column or span.column + 1) - span.column)
+    if not whole_lines and span.end_column is not None \
+            and span.end_column - span.source_start >= len(raw.rstrip()):
+        width = 1
+    return [f"    {src}", "    " + " " * col + "^" * min(width, max(1, len(src) - col))]
+
+
 class MitosError(Exception):
     """An error in something the user wrote or asked for.
 
@@ -217,19 +240,7 @@ class MitosError(Exception):
         """The message as the CLI prints it: ``path:line:col: error: ...``, line, caret, hint."""
         head = f"{self.span}: " if self.span else ""
         out = [f"{head}{self.kind}: {visible(_QUOTED.sub(_shorten, self.message))}"]
-        if self.span and self.span.source_line is not None:
-            raw = self.span.source_line.rstrip("\r\n")
-            col = self.span.column - self.span.source_start      # 0-based in ``raw``
-            if len(raw) > SHOWN:          # a very long line: only the part around the column
-                first = min(max(0, col - SHOWN // 2), len(raw) - SHOWN)
-                raw, col = raw[first:first + SHOWN], col - first
-            raw = _CONTROL.sub("\ufffd", raw)        # (one character each: the caret stays)
-            raw = _INVISIBLE.sub("\ufffd", raw)      # (a zero-width one put it a column off)
-            src = raw.expandtabs(4)
-            col = len(raw[:max(0, col)].expandtabs(4))
-            width = max(1, (self.span.end_column or self.span.column + 1) - self.span.column)
-            out.append(f"    {src}")
-            out.append("    " + " " * col + "^" * min(width, max(1, len(src) - col)))
+        out += excerpt(self.span)
         if self.expected:
             out.append(f"expected {visible(self.expected)}")
         if self.hint:

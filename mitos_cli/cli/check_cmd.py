@@ -24,9 +24,11 @@ def show_path(path: str | None) -> str:
 
 
 def render(report, trace_path: str) -> str:
-    """The report for people: one ``path:line:col: severity: message`` block per finding,
-    each path as the user gave it, a packaged file as the summary's ``checked PATH`` names
-    it (``rulebases/...``, not its place in site-packages)."""
+    """The report for people: one ``path:line:col: severity: message`` block per finding, with
+    the line it points into and a caret, each path as the user gave it, a packaged file as
+    the summary's ``checked PATH`` names it (``rulebases/...``, not its place in
+    site-packages)."""
+    from ..errors import excerpt
     from ..resources import packaged_name
 
     shown_as: dict[str | None, str] = {}     # each file once (20,000 findings took 10 s)
@@ -40,6 +42,7 @@ def render(report, trace_path: str) -> str:
             where = f"{shown_as[f.span.path]}:{f.span.line}:{f.span.column}: "
         shown = "note" if f.severity == "info" else f.severity     # as the summary counts it
         lines.append(f"{where}{shown}: {f.message} [{f.code}]")
+        lines += excerpt(f.span, whole_lines=False)      # the line it points into
         for box in f.regions:
             lines.append(f"    {box.describe()}")
         if f.more_regions:
