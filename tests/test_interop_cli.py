@@ -310,6 +310,18 @@ def test_convert_errors_exit_1_with_location(tmp_path: Path, capsys) -> None:
     assert code == 1 and "cannot write" in output and "No such file or directory" in output
 
 
+def test_an_error_in_a_packaged_rule_base_names_it_as_the_user_does(tmp_path: Path, capsys,
+                                                                   monkeypatch) -> None:
+    """From anywhere, a place in the packaged rule base reads ``rulebases/mitos.rules:L:C``
+    (as ``check`` names it), not where pip put the file."""
+    monkeypatch.chdir(tmp_path)
+    code, output = run_main(["convert", "rulebases/mitos.rules", "-b", "drive", "--to", "fis",
+                             "-o", "x.fis"], capsys)
+    assert code == 1
+    first = output.splitlines()[0]
+    assert first.startswith("rulebases/mitos.rules:") and ": format error: " in first, first
+
+
 def test_convert_to_rules_keeps_behaviors_and_uses(tmp_path: Path) -> None:
     out = tmp_path / "drive.rules"
     result = runner.invoke(app, ["convert", str(ROOT / "rulebases" / "mitos.rules"), "--to",

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import sys
 
 from ..errors import MitosError
@@ -23,6 +24,14 @@ def warn_notes(rulebase) -> None:
 
 
 def report_error(exc: MitosError) -> None:
+    """``exc`` on stderr, a place in a packaged rule base named as the user names it
+    (``rulebases/mitos.rules:146:5``, as ``check`` does), not where pip put it."""
+    span = exc.span
+    if span is not None and span.path:
+        from ..resources import packaged_name
+
+        if (name := packaged_name(span.path)) is not None:
+            exc.span = dataclasses.replace(span, path=name)
     err(exc.render())
 
 
