@@ -50,6 +50,8 @@ from typing import NamedTuple
 
 import numpy as np
 
+from .envelope import regular as upper_envelope_regular
+from .envelope import upper_envelope
 from .terms import Term, Variable
 
 #: Least largest-membership anywhere on an input's universe (a Ruspini partition has 0.5).
@@ -159,11 +161,21 @@ def envelope(corners: np.ndarray, x: np.ndarray) -> np.ndarray:
     above 0, a block of :data:`PAIR_BLOCK` memberships at a time. (Every term at every point
     is terms times points, quadratic in the terms, which have about four breakpoints each:
     20,000 triangles took most of a minute.)"""
-    order = np.argsort(x, kind="stable")
-    xs = x[order]
+    order = None if len(x) < 2 or np.all(x[1:] >= x[:-1]) else np.argsort(x, kind="stable")
+    xs = x if order is None else x[order]
+    if len(corners) * len(x) >= SWEEP_FROM and len(x) and np.isfinite(xs[[0, -1]]).all() \
+            and xs[-1] > xs[0] and np.all(corners[:, 1:] >= corners[:, :-1]):
+        return _swept(corners, x, order, xs)
+    return _over_supports(corners, order, xs)
+
+
+def _over_supports(corners: np.ndarray, order: np.ndarray | None, xs: np.ndarray
+                   ) -> np.ndarray:
+    """:func:`envelope`, each term measured at every point of its support (``xs``: the points
+    in order, ``order`` where each comes from, ``None`` if they were in order)."""
     start = np.searchsorted(xs, corners[:, 0], side="left")
     count = np.maximum(np.searchsorted(xs, corners[:, 3], side="right") - start, 0)
-    top = np.zeros(len(x))
+    top = np.zeros(len(xs))
     ends = np.cumsum(count)
     first = 0
     while first < len(corners):
@@ -171,8 +183,31 @@ def envelope(corners: np.ndarray, x: np.ndarray) -> np.ndarray:
                                                   side="right")))
         term, at = _supports(start[first:last], count[first:last])
         mu = memberships_at(corners[first + term], xs[at])
-        np.maximum.at(top, order[at], mu)
+        np.maximum.at(top, at if order is None else order[at], mu)
         first = last
+    return top
+
+
+def _swept(corners: np.ndarray, x: np.ndarray, order: np.ndarray | None, xs: np.ndarray
+           ) -> np.ndarray:
+    """:func:`envelope` of terms whose corners are in order, at finite points ``x`` (``xs`` in
+    order, ``order`` as for :func:`_over_supports`), from the upper envelope of the terms'
+    edges and cores (:func:`~mitos_cli.lang.envelope.upper_envelope`; terms that are not three
+    such segments in floating point measured over their support). The same bits: each
+    point's largest membership is one term's, measured with the same operations; and a
+    largest membership of 0 is -0.0 only at the point -0.0, on an edge rising from 0 (``-0.0
+    - 0.0``), where it is the sign of the last term measured there, as in
+    :func:`_over_supports` (elsewhere every term measured at a point gives +0.0 or more)."""
+    distinct = np.unique(corners + 0.0, axis=0)          # a repeated term measured once
+    fast = upper_envelope_regular(distinct)
+    top = upper_envelope(distinct[fast], xs, memberships_at)
+    if not fast.all():
+        np.maximum(top, _over_supports(distinct[~fast], None, xs), out=top)
+    if order is not None:
+        top[order] = top.copy()
+    signed = np.flatnonzero((x == 0) & np.signbit(x) & (top == 0))
+    if len(signed):
+        top[signed] = _over_supports(corners, None, x[signed])
     return top
 
 
@@ -319,6 +354,11 @@ def similarity_on(mu: np.ndarray, x: np.ndarray) -> np.ndarray:
             out[i, j] = np.divide(inter, union, out=np.zeros_like(inter), where=union > 0)
     return out
 
+
+#: Least terms times points from which :func:`envelope` sweeps the terms' upper envelope
+#: (:func:`~mitos_cli.lang.envelope.upper_envelope`) rather than measure every term at every
+#: point of its support.
+SWEEP_FROM = 1 << 14
 
 #: Most memberships :func:`most_similar_on` and :func:`envelope` form in one array (terms or
 #: pairs times points): 8 MB, a few such arrays at once, whatever the number of terms.
@@ -706,9 +746,11 @@ def _dips_beside_gaps(sets: list[Term], corners: np.ndarray | None, x: np.ndarra
     at the gap), which the breakpoints alone never show; the envelope is linear between
     them, so a dip shows at one of those thirds."""
     width = np.diff(x)
-    at = np.concatenate([x, x[:-1] + width / 3, x[:-1] + 2 * width / 3])
-    top = envelope(corners, at) if corners is not None else sampled(sets, at).max(axis=0)
-    return bool(np.any((top > 0.0) & (top < COVERAGE - 1e-9)))
+    for at in (x, x[:-1] + width / 3, x[:-1] + 2 * width / 3):      # a third of the memory
+        top = envelope(corners, at) if corners is not None else sampled(sets, at).max(axis=0)
+        if np.any((top > 0.0) & (top < COVERAGE - 1e-9)):
+            return True
+    return False
 
 
 #: Stretches named in one coverage finding; more are counted.
