@@ -6,6 +6,7 @@ overlap").
 
     python benchmarks/bench_check.py                          # 100, 300, 600 and 2,000 terms
     python benchmarks/bench_check.py --sizes 100,300 --role output
+    python benchmarks/bench_check.py --sizes 100,200,300 --step     # and one crisp step
     python benchmarks/bench_check.py --against OTHER/bin/mitos  # the same files, both timed
     python benchmarks/bench_check.py --write DIR               # only write the files
 
@@ -42,11 +43,14 @@ def triangles(n: int, seed: int) -> np.ndarray:
     return np.round(np.stack([left, peak, right], axis=1), 3)
 
 
-def write_case(folder: Path, n: int, seed: int, role: str) -> Path:
-    """The rule file and term set of ``n`` terms of one ``role`` variable; the rule file."""
+def write_case(folder: Path, n: int, seed: int, role: str, step: bool = False) -> Path:
+    """The rule file and term set of ``n`` terms of one ``role`` variable (and a crisp step,
+    ``S``, if ``step``); the rule file."""
     tri = triangles(n, seed)
     terms = "\n".join(f"      T{k}: {{shape: triangle, points: [{a:g}, {b:g}, {c:g}]}}"
                       for k, (a, b, c) in enumerate(tri))
+    if step:
+        terms += "\n      S: {shape: trapezoid, points: [50, 50, 60, 70]}"
     few = "      LO: {shape: triangle, points: [0, 0, 100]}\n" \
           "      HI: {shape: triangle, points: [0, 100, 100]}"
     many_in, many_out = (terms, few) if role == "input" else (few, terms)
@@ -63,12 +67,11 @@ def write_case(folder: Path, n: int, seed: int, role: str) -> Path:
     return rules
 
 
-def run(command: list[str], rules: Path) -> tuple[float, float, int, bytes]:
+def run(command: list[str], rules: Path, env: dict[str, str]) -> tuple[float, float, int, bytes]:
     """Wall seconds, largest resident set (MB), exit code and stdout of one check."""
     t = time.perf_counter()
     proc = subprocess.Popen([*command, "check", str(rules)], stdout=subprocess.PIPE,
-                            stderr=subprocess.DEVNULL, env={**os.environ,
-                                                            "MITOS_CACHE_DIR": "off"})
+                            stderr=subprocess.DEVNULL, env={**env, "MITOS_CACHE_DIR": "off"})
     out = proc.stdout.read() if proc.stdout else b""
     _, status, usage = os.wait4(proc.pid, 0)
     wall = time.perf_counter() - t
@@ -83,6 +86,8 @@ def main() -> int:
     parser.add_argument("--seed", type=positive_int, default=11)
     parser.add_argument("--role", choices=("input", "output"), default="input",
                         help="the role of the variable with many terms (default input)")
+    parser.add_argument("--step", action="store_true",
+                        help="add a crisp step (a trapezoid with an upright edge) to the terms")
     parser.add_argument("--against", metavar="MITOS",
                         help="another `mitos` command to time on the same files")
     parser.add_argument("--write", metavar="DIR", help="write the files there and stop")
@@ -95,11 +100,13 @@ def main() -> int:
         folder = Path(args.write)
         folder.mkdir(parents=True, exist_ok=True)
         for n in sizes:
-            print(write_case(folder, n, args.seed, args.role))
+            print(write_case(folder, n, args.seed, args.role, args.step))
         return 0
     ours = [sys.executable, "-m", "mitos_cli"]
-    os.environ["PYTHONPATH"] = str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", "")
-    print(f"mitos check, {args.role} of n random overlapping triangles (seed {args.seed}), "
+    here = {**os.environ, "PYTHONPATH": os.pathsep.join(
+        [str(ROOT)] + ([os.environ["PYTHONPATH"]] if os.environ.get("PYTHONPATH") else []))}
+    print(f"mitos check, {args.role} of n random overlapping triangles (seed {args.seed})"
+          + (" and a crisp step" if args.step else "") + ", "
           f"one run each, load {os.getloadavg()[0]:.1f}")
     print(f"{'terms':>6} {'this tree s':>12} {'MB':>7}" + (
         f" {'against s':>10} {'MB':>7} {'ratio':>6}" if args.against else "")
@@ -108,11 +115,11 @@ def main() -> int:
     last: tuple[int, float] | None = None
     with tempfile.TemporaryDirectory() as tmp:
         for n in sizes:
-            rules = write_case(Path(tmp), n, args.seed, args.role)
-            wall, mb, code, out = run(ours, rules)
+            rules = write_case(Path(tmp), n, args.seed, args.role, args.step)
+            wall, mb, code, out = run(ours, rules, here)
             line = f"{n:>6} {wall:>12.2f} {mb:>7.0f}"
             if args.against:
-                w2, mb2, code2, out2 = run([args.against], rules)
+                w2, mb2, code2, out2 = run([args.against], rules, dict(os.environ))
                 line += f" {w2:>10.2f} {mb2:>7.0f} {w2 / wall:>5.1f}x"
                 if (code, out) != (code2, out2):
                     failed = True
