@@ -82,11 +82,14 @@ def upper_envelope(corners: np.ndarray, xs: np.ndarray,
     left, right = np.maximum(left[inside], lo), np.minimum(right[inside], hi)
     m, p, q, term, core = m[inside], p[inside], q[inside], term[inside], core[inside]
 
-    # where a core holds the point, the largest is 1 (every membership is clipped to 1)
-    ones = np.zeros(len(xs) + 1, dtype=np.int32)
-    np.add.at(ones, np.searchsorted(xs, left[core], side="left"), 1)
-    np.add.at(ones, np.searchsorted(xs, right[core], side="right"), -1)
-    one = np.cumsum(ones[:-1], dtype=np.int32) > 0
+    # where a core holds the point, the largest is 1 (every membership is clipped to 1): the
+    # cores joined where they overlap, so the count of cores holding a point is 0 or 1
+    ones = np.zeros(len(xs) + 1, dtype=np.int8)
+    fro, to = _joined(left[core], right[core])
+    np.add.at(ones, np.searchsorted(xs, fro, side="left"), 1)
+    np.add.at(ones, np.searchsorted(xs, to, side="right"), -1)
+    one = np.cumsum(ones[:-1], dtype=np.int8) > 0
+    del ones
 
     wide = right > left                 # a segment of one point is its neighbours' end
     lines = (np.concatenate([[0.0], m[wide]]), np.concatenate([[0.0], p[wide]]),
@@ -113,6 +116,18 @@ def upper_envelope(corners: np.ndarray, xs: np.ndarray,
         done = stop
     top[one] = 1.0
     return top
+
+
+def _joined(left: np.ndarray, right: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The closed stretches ``[left, right]`` joined where they overlap or touch: their union
+    as stretches apart from each other."""
+    if not len(left):
+        return left, right
+    order = np.argsort(left, kind="stable")
+    left, right = left[order], np.maximum.accumulate(right[order])
+    new = np.append(True, left[1:] > right[:-1])       # begins after all before it end
+    ends = np.append(np.flatnonzero(new)[1:] - 1, len(left) - 1)
+    return left[new], right[ends]
 
 
 def _measure_on(top: np.ndarray, xs: np.ndarray, one: np.ndarray, corners: np.ndarray,
