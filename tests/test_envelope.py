@@ -281,3 +281,45 @@ def test_many_triangles_and_a_step_are_checked_in_quadratic_time_with_the_same_r
     assert new == old
     assert "indistinct" in [i.code for i in new]
     assert few < 10 < n * (n - 1) // 2 < sum(summed) - few
+
+
+def test_no_point_of_a_pair_lies_between_a_step_and_the_breakpoint_before_it():
+    """A rising edge left of the universe and a falling edge on the right cross, as lines,
+    at 0.107: between the step at 1.358 and the breakpoint before it (0), where no edge is.
+    That point cut the trapezoid beside the step: 0.6464 for 0.6523, and the pair was missed."""
+    corners = np.array([[1.3579015095288418, 1.3579015095288418, 5.174128937276878,
+                         7.975326627313585],
+                        [-1.0367901235837957, -0.6293931233462313, 7.836767693809696,
+                         10.268965523068811],
+                        [-1.0994638153938379, 1.7066463907066298, 4.239508097461754,
+                         5.345204029513129],
+                        [5.938989282851545, 6.749862398604467, np.inf, np.inf]])
+    x = meaning.breakpoints(corners, UNIVERSE)
+    old = meaning._linear_most(corners, x)
+    assert old[1:] == (0, 1)
+    assert meaning.most_similar_beside_steps(corners, UNIVERSE, x, above=-1.0) == old
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_random_stepped_sets_give_the_pair_over_every_breakpoint(seed):
+    """Random trapezoids, shoulders, repeated terms and steps on either side (25 sets a
+    seed, up to 11 terms): the same triple to the bit as over every breakpoint."""
+    rng = np.random.default_rng(seed)
+    for _ in range(25):
+        t = int(rng.integers(2, 12))
+        corners = np.sort(rng.uniform(-2, 12, (t, 4)), axis=1)
+        if rng.random() < 0.5:
+            corners = np.round(corners) + 0.0
+        corners[rng.integers(t), :2] = -np.inf
+        corners[rng.integers(t), 2:] = np.inf
+        k = rng.integers(t)
+        corners[k, 1] = corners[k, 0]
+        k = rng.integers(t)
+        corners[k, 2] = corners[k, 3]
+        corners[rng.integers(t)] = corners[rng.integers(t)]
+        x = meaning.breakpoints(corners, UNIVERSE)
+        old = meaning._linear_most(corners, x)
+        new = meaning.most_similar_beside_steps(corners, UNIVERSE, x, above=-1.0)
+        assert new is not None
+        assert (np.float64(new[0]).tobytes(), new[1:]) == (np.float64(old[0]).tobytes(),
+                                                            old[1:])

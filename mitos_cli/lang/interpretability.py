@@ -426,11 +426,23 @@ def most_similar_by_pairs(corners: np.ndarray, universe: tuple[float, float]
     i, j = _overlapping(a, d)
     twice = np.flatnonzero(counts > 1)                  # a repeated term against its copy
     i, j = np.concatenate([np.minimum(i, j), twice]), np.concatenate([np.maximum(i, j), twice])
-    s = np.zeros(len(i))
+    # |A and B| <= the smaller area and |A or B| >= the larger: pairs measured from the
+    # likeliest down, until no pair left can reach the largest found (each pair's sum is
+    # its own row, so the same bits however many are measured)
+    area = _areas(distinct, lo, hi)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        bound = np.minimum(area[i], area[j]) / np.maximum(area[i], area[j])
+    bound = np.where(np.isfinite(bound), bound, 1.0)
+    likeliest = np.argsort(-bound, kind="stable")
+    s = np.full(len(i), -1.0)                           # not measured: below the largest
     step = max(1, PAIR_BLOCK // 16)
+    most = 0.0
     for k in range(0, len(i), step):                    # blocks of pairs, a row of points each
-        s[k:k + step] = _pairs_on_own_points(distinct, i[k:k + step], j[k:k + step], lines,
-                                             lo, hi)
+        p = likeliest[k:k + step]
+        if bound[p[0]] < most - NEAR_MOST:
+            break
+        s[p] = _pairs_on_own_points(distinct, i[p], j[p], lines, lo, hi)
+        most = max(most, float(s[p].max()))
     top = float(s.max()) if len(s) else 0.0
     if top <= 0:
         return 0.0, 0, 1
@@ -484,6 +496,11 @@ def most_similar_beside_steps(corners: np.ndarray, universe: tuple[float, float]
     extra = np.stack([np.where(up & (before >= 0), x[np.clip(before, 0, len(x) - 1)], lo),
                       np.where(down & (after < len(x)), x[np.clip(after, 0, len(x) - 1)], lo)],
                      axis=1)
+    # no breakpoint lies between a step and the one beside it, so no point of a pair may
+    # (the lines of two edges cross there, where the edges are not: that cut the half area)
+    beside = np.stack([np.stack([np.where(up, extra[:, 0], lo), np.where(up, a, lo)], axis=1),
+                       np.stack([np.where(down, d, lo), np.where(down, extra[:, 1], lo)],
+                                axis=1)], axis=1)
     i, j = _overlapping(a, d)
     twice = np.flatnonzero(counts > 1)                  # a repeated term against its copy
     i, j = np.concatenate([np.minimum(i, j), twice]), np.concatenate([np.maximum(i, j), twice])
@@ -493,11 +510,22 @@ def most_similar_beside_steps(corners: np.ndarray, universe: tuple[float, float]
     some = start <= end
     both = some[i] & some[j]
     di, dj = i[both], j[both]
-    s = np.zeros(len(di))
+    # the likeliest pairs first, as in most_similar_by_pairs (the area beside a step too)
+    area = _areas(distinct + 0.0, lo, hi, extra)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        bound = np.minimum(area[di], area[dj]) / np.maximum(area[di], area[dj])
+    bound = np.where(np.isfinite(bound), bound, 1.0)
+    likeliest = np.argsort(-bound, kind="stable")
+    s = np.full(len(di), -1.0)                          # not measured: below the largest
     step = max(1, PAIR_BLOCK // 20)
+    found = 0.0
     for k in range(0, len(di), step):
-        s[k:k + step] = _pairs_on_own_points(distinct + 0.0, di[k:k + step], dj[k:k + step],
-                                             lines, lo, hi, extra)
+        p = likeliest[k:k + step]
+        if bound[p[0]] < found - NEAR_MOST:
+            break
+        s[p] = _pairs_on_own_points(distinct + 0.0, di[p], dj[p], lines, lo, hi, extra,
+                                    beside)
+        found = max(found, float(s[p].max()))
     most = float(s.max()) if len(s) else 0.0
     if most < above:
         return most, 0, 1
@@ -516,9 +544,9 @@ def most_similar_beside_steps(corners: np.ndarray, universe: tuple[float, float]
     sizes = np.maximum(upto - fro, 0)
     batch = np.empty(len(order), dtype=np.intp)
     n, total = 0, 0
-    for p in range(len(order)):                     # as _most_similar closes its batches
-        batch[p] = n
-        total += int(sizes[p])
+    for q in range(len(order)):                     # as _most_similar closes its batches
+        batch[q] = n
+        total += int(sizes[q])
         if total * len(x) >= PAIR_BLOCK:
             n, total = n + 1, 0
     pk = np.where(place[di] <= place[dj], di, dj)         # the pair as the batch has it
@@ -548,10 +576,25 @@ def most_similar_beside_steps(corners: np.ndarray, universe: tuple[float, float]
     return float(full[col]), r, col
 
 
+def _areas(corners: np.ndarray, lo: float, hi: float, extra: np.ndarray | None = None
+           ) -> np.ndarray:
+    """Each piecewise-linear term's area on ``[lo, hi]``: the trapezoid rule on the ends and
+    its corners, between which it is linear (and on the points ``extra[t]``, if given: the
+    breakpoints beside an upright edge, as :func:`most_similar_beside_steps` measures it)."""
+    pts = np.concatenate([np.full((len(corners), 1), lo), np.full((len(corners), 1), hi),
+                          corners] + ([] if extra is None else [extra]), axis=1)
+    pts = np.sort(np.where(np.isfinite(pts) & (pts >= lo) & (pts <= hi), pts, lo), axis=1)
+    m = memberships_at(np.repeat(corners, pts.shape[1], axis=0), pts.reshape(-1)
+                       ).reshape(pts.shape)
+    return ((m[:, 1:] + m[:, :-1]) * 0.5 * np.diff(pts, axis=1)).sum(axis=1)
+
+
 def _pairs_on_own_points(corners, i, j, lines, lo: float, hi: float,
-                         extra: np.ndarray | None = None) -> np.ndarray:
+                         extra: np.ndarray | None = None, beside: np.ndarray | None = None
+                         ) -> np.ndarray:
     """The Jaccard similarity of terms ``i[p]`` and ``j[p]`` on the points of each pair (and
-    on the points ``extra[t]`` of each of its terms ``t``, if given)."""
+    on the points ``extra[t]`` of each of its terms ``t``, if given; none strictly inside the
+    stretches ``beside[t, s]``, ``(left, right)``, if given)."""
     rs, ro, fs, fo = lines
     with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
         cross = np.stack([(ro[j] - ro[i]) / (rs[i] - rs[j]), (fo[j] - ro[i]) / (rs[i] - fs[j]),
@@ -560,7 +603,13 @@ def _pairs_on_own_points(corners, i, j, lines, lo: float, hi: float,
     pts = np.concatenate([np.full((len(i), 1), lo), np.full((len(i), 1), hi), corners[i],
                           corners[j], cross] + ([] if extra is None else [extra[i], extra[j]]),
                          axis=1)
-    pts = np.sort(np.where(np.isfinite(pts) & (pts >= lo) & (pts <= hi), pts, lo), axis=1)
+    pts = np.where(np.isfinite(pts) & (pts >= lo) & (pts <= hi), pts, lo)
+    if beside is not None:
+        for t in (i, j):
+            for s in range(beside.shape[1]):
+                pts = np.where((pts > beside[t, s, 0, None]) & (pts < beside[t, s, 1, None]),
+                               lo, pts)
+    pts = np.sort(pts, axis=1)
     m = np.stack([memberships_at(corners[np.repeat(k, pts.shape[1])], pts.reshape(-1))
                   .reshape(pts.shape) for k in (i, j)])
     dx = np.diff(pts, axis=1)
