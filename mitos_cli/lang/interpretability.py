@@ -50,6 +50,8 @@ from typing import NamedTuple
 
 import numpy as np
 
+from .envelope import regular as upper_envelope_regular
+from .envelope import upper_envelope
 from .terms import Term, Variable
 
 #: Least largest-membership anywhere on an input's universe (a Ruspini partition has 0.5).
@@ -159,11 +161,21 @@ def envelope(corners: np.ndarray, x: np.ndarray) -> np.ndarray:
     above 0, a block of :data:`PAIR_BLOCK` memberships at a time. (Every term at every point
     is terms times points, quadratic in the terms, which have about four breakpoints each:
     20,000 triangles took most of a minute.)"""
-    order = np.argsort(x, kind="stable")
-    xs = x[order]
+    order = None if len(x) < 2 or np.all(x[1:] >= x[:-1]) else np.argsort(x, kind="stable")
+    xs = x if order is None else x[order]
+    if len(corners) * len(x) >= SWEEP_FROM and len(x) and np.isfinite(xs[[0, -1]]).all() \
+            and xs[-1] > xs[0] and np.all(corners[:, 1:] >= corners[:, :-1]):
+        return _swept(corners, x, order, xs)
+    return _over_supports(corners, order, xs)
+
+
+def _over_supports(corners: np.ndarray, order: np.ndarray | None, xs: np.ndarray
+                   ) -> np.ndarray:
+    """:func:`envelope`, each term measured at every point of its support (``xs``: the points
+    in order, ``order`` where each comes from, ``None`` if they were in order)."""
     start = np.searchsorted(xs, corners[:, 0], side="left")
     count = np.maximum(np.searchsorted(xs, corners[:, 3], side="right") - start, 0)
-    top = np.zeros(len(x))
+    top = np.zeros(len(xs))
     ends = np.cumsum(count)
     first = 0
     while first < len(corners):
@@ -171,8 +183,31 @@ def envelope(corners: np.ndarray, x: np.ndarray) -> np.ndarray:
                                                   side="right")))
         term, at = _supports(start[first:last], count[first:last])
         mu = memberships_at(corners[first + term], xs[at])
-        np.maximum.at(top, order[at], mu)
+        np.maximum.at(top, at if order is None else order[at], mu)
         first = last
+    return top
+
+
+def _swept(corners: np.ndarray, x: np.ndarray, order: np.ndarray | None, xs: np.ndarray
+           ) -> np.ndarray:
+    """:func:`envelope` of terms whose corners are in order, at finite points ``x`` (``xs`` in
+    order, ``order`` as for :func:`_over_supports`), from the upper envelope of the terms'
+    edges and cores (:func:`~mitos_cli.lang.envelope.upper_envelope`; terms that are not three
+    such segments in floating point measured over their support). The same bits: each
+    point's largest membership is one term's, measured with the same operations; and a
+    largest membership of 0 is -0.0 only at the point -0.0, on an edge rising from 0 (``-0.0
+    - 0.0``), where it is the sign of the last term measured there, as in
+    :func:`_over_supports` (elsewhere every term measured at a point gives +0.0 or more)."""
+    distinct = np.unique(corners + 0.0, axis=0)          # a repeated term measured once
+    fast = upper_envelope_regular(distinct)
+    top = upper_envelope(distinct[fast], xs, memberships_at)
+    if not fast.all():
+        np.maximum(top, _over_supports(distinct[~fast], None, xs), out=top)
+    if order is not None:
+        top[order] = top.copy()
+    signed = np.flatnonzero((x == 0) & np.signbit(x) & (top == 0))
+    if len(signed):
+        top[signed] = _over_supports(corners, None, x[signed])
     return top
 
 
@@ -206,8 +241,8 @@ def least_top(top: np.ndarray, x: np.ndarray, universe: tuple[float, float],
     return float(top[k]), float(x[k])
 
 
-def coverage_spans(corners: np.ndarray, universe: tuple[float, float]
-                   ) -> tuple[np.ndarray, np.ndarray]:
+def coverage_spans(corners: np.ndarray, universe: tuple[float, float], *,
+                   bends: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """The universe cut into stretches the terms cover to :data:`COVERAGE` and stretches
     they cover less, as ``(ends[s + 1], least[s])``: stretch ``s`` is ``[ends[s], ends[s +
     1]]`` and ``least[s]`` the least largest-membership on it (exactly, as
@@ -217,28 +252,32 @@ def coverage_spans(corners: np.ndarray, universe: tuple[float, float]
     as soon as the written terms leave a gap anywhere (a converted tipper's ``food`` is 0 on
     [3, 7]), and then a term could leave the end of the universe uncovered. The envelope
     crosses the level only where an edge does, or jumps at a vertical edge (a breakpoint), so
-    between those points each piece lies wholly on one side of it."""
+    between those points each piece lies wholly on one side of it. ``bends``: the
+    :func:`breakpoints`, if already known (at 2,000 terms that all overlap, 4.8 million
+    points and 0.3 s)."""
     lo, hi = universe
+    bends = breakpoints(corners, universe) if bends is None else bends
     a, b, c, d = corners.T
     with np.errstate(invalid="ignore", over="ignore"):
         half = np.concatenate([a + COVERAGE * (b - a), d - COVERAGE * (d - c)])
-    x = np.union1d(breakpoints(corners, universe), half[np.isfinite(half) & (half > lo)
-                                                         & (half < hi)])
+    x = np.union1d(bends, half[np.isfinite(half) & (half > lo) & (half < hi)])
     if len(x) < 2:
         return np.array([lo, hi], dtype=float), np.array([span_coverage(
-            corners, universe, np.array([lo, hi], dtype=float))[0]])
+            corners, universe, np.array([lo, hi], dtype=float), bends=bends)[0]])
     mid = 0.5 * (x[:-1] + x[1:])
     covered = envelope(corners, mid) >= COVERAGE - 1e-12
     cut = np.flatnonzero(covered[1:] != covered[:-1]) + 1
     ends = np.concatenate([[x[0]], x[cut], [x[-1]]]).astype(float)
-    least = span_coverage(corners, universe, ends)
+    least = span_coverage(corners, universe, ends, bends=bends)
     return ends, np.minimum(least, COVERAGE)
 
 
-def uncovered(corners: np.ndarray, universe: tuple[float, float]) -> list[tuple[float, float]]:
+def uncovered(corners: np.ndarray, universe: tuple[float, float], *,
+              bends: np.ndarray | None = None) -> list[tuple[float, float]]:
     """The stretches ``(left, right)`` of the universe where the largest membership of these
-    piecewise-linear terms is below :data:`COVERAGE`, exactly (:func:`coverage_spans`)."""
-    ends, least = coverage_spans(corners, universe)
+    piecewise-linear terms is below :data:`COVERAGE`, exactly (:func:`coverage_spans`;
+    ``bends`` as there)."""
+    ends, least = coverage_spans(corners, universe, bends=bends)
     return [(float(a), float(b)) for a, b, m in zip(ends[:-1], ends[1:], least)
             if m < COVERAGE - 1e-9 and b > a]
 
@@ -265,18 +304,28 @@ def _crossing(x_in: float, x_out: float, m_in: float, m_out: float) -> float:
 
 
 def span_coverage(corners: np.ndarray, universe: tuple[float, float],
-                  ends: np.ndarray) -> np.ndarray:
+                  ends: np.ndarray, *, bends: np.ndarray | None = None) -> np.ndarray:
     """The least largest-membership on each stretch ``[ends[s], ends[s + 1]]``, exactly: at
     the :func:`breakpoints` inside it and its ends, and at both ends of each piece between
     them as the piece's line reaches them (a term is 1 on its vertical edge, and 0 just
     beside it: ``[0, 0, 3, 3]`` and ``[7, 7, 10, 10]`` leave (3, 7) uncovered although both
-    are 1 at 3 and at 7)."""
-    x = np.union1d(breakpoints(corners, universe), ends)
+    are 1 at 3 and at 7). ``bends``: the :func:`breakpoints`, if already known."""
+    x = np.union1d(breakpoints(corners, universe) if bends is None else bends, ends)
     top = envelope(corners, x)
     width = np.diff(x)
     m1 = envelope(corners, x[:-1] + width / 3)
     m2 = envelope(corners, x[:-1] + 2 * width / 3)
-    piece = np.clip(np.minimum(2 * m1 - m2, 2 * m2 - m1), 0.0, 1.0)   # the line's ends
+    del width
+    # the line's ends, clip(min(2 m1 - m2, 2 m2 - m1)), in place (each array is millions of
+    # points where many terms overlap)
+    piece = 2 * m1
+    piece -= m2
+    m2 *= 2
+    m2 -= m1
+    del m1
+    np.minimum(piece, m2, out=piece)
+    del m2
+    np.clip(piece, 0.0, 1.0, out=piece)
     first = np.searchsorted(x, ends[:-1])
     last = np.searchsorted(x, ends[1:])
     return np.array([min(top[i:j + 1].min(), piece[i:j].min(initial=1.0))
@@ -319,6 +368,11 @@ def similarity_on(mu: np.ndarray, x: np.ndarray) -> np.ndarray:
             out[i, j] = np.divide(inter, union, out=np.zeros_like(inter), where=union > 0)
     return out
 
+
+#: Least terms times points from which :func:`envelope` sweeps the terms' upper envelope
+#: (:func:`~mitos_cli.lang.envelope.upper_envelope`) rather than measure every term at every
+#: point of its support.
+SWEEP_FROM = 1 << 14
 
 #: Most memberships :func:`most_similar_on` and :func:`envelope` form in one array (terms or
 #: pairs times points): 8 MB, a few such arrays at once, whatever the number of terms.
@@ -372,11 +426,23 @@ def most_similar_by_pairs(corners: np.ndarray, universe: tuple[float, float]
     i, j = _overlapping(a, d)
     twice = np.flatnonzero(counts > 1)                  # a repeated term against its copy
     i, j = np.concatenate([np.minimum(i, j), twice]), np.concatenate([np.maximum(i, j), twice])
-    s = np.zeros(len(i))
+    # |A and B| <= the smaller area and |A or B| >= the larger: pairs measured from the
+    # likeliest down, until no pair left can reach the largest found (each pair's sum is
+    # its own row, so the same bits however many are measured)
+    area = _areas(distinct, lo, hi)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        bound = np.minimum(area[i], area[j]) / np.maximum(area[i], area[j])
+    bound = np.where(np.isfinite(bound), bound, 1.0)
+    likeliest = np.argsort(-bound, kind="stable")
+    s = np.full(len(i), -1.0)                           # not measured: below the largest
     step = max(1, PAIR_BLOCK // 16)
+    most = 0.0
     for k in range(0, len(i), step):                    # blocks of pairs, a row of points each
-        s[k:k + step] = _pairs_on_own_points(distinct, i[k:k + step], j[k:k + step], lines,
-                                             lo, hi)
+        p = likeliest[k:k + step]
+        if bound[p[0]] < most - NEAR_MOST:
+            break
+        s[p] = _pairs_on_own_points(distinct, i[p], j[p], lines, lo, hi)
+        most = max(most, float(s[p].max()))
     top = float(s.max()) if len(s) else 0.0
     if top <= 0:
         return 0.0, 0, 1
@@ -390,16 +456,160 @@ def most_similar_by_pairs(corners: np.ndarray, universe: tuple[float, float]
     return top, best[0], best[1]
 
 
-def _pairs_on_own_points(corners, i, j, lines, lo: float, hi: float) -> np.ndarray:
-    """The Jaccard similarity of terms ``i[p]`` and ``j[p]`` on the points of each pair."""
+#: How far below the largest similarity measured a pair's own points (to rounding) a pair
+#: is measured again over every breakpoint, in :func:`most_similar_beside_steps`.
+NEAR_MOST = 1e-9
+
+
+def most_similar_beside_steps(corners: np.ndarray, universe: tuple[float, float],
+                              x: np.ndarray, above: float) -> tuple[float, int, int] | None:
+    """:func:`most_similar` of terms some of which have an upright edge (a crisp step),
+    whose trapezoids over the breakpoints ``x`` depend on the breakpoint beside the step
+    (the trapezoid from it to the step is half the area between them, where the term is 0):
+    with the same bits where the largest similarity is above ``above``, and its value only
+    (to rounding, with the pair ``0, 1``) where it is not; ``None`` where an edge is too
+    narrow for its slope to be a normal number, or there are fewer than two terms.
+
+    Each overlapping pair is measured first on its own points, as in
+    :func:`most_similar_by_pairs`, with the breakpoint before each rising step and after
+    each falling one: on those the trapezoid rule is the one over every breakpoint, to
+    rounding. Only the pairs within :data:`NEAR_MOST` of the largest are then summed over
+    every breakpoint, each as :func:`_linear_most` sums it (in its batch and block, so with
+    the same bits), and the first row and column holding the largest picked as it picks
+    them. Over every breakpoint, every pair: 300 triangles that all overlap and one crisp
+    step took 200 s in `mitos check`."""
+    lo, hi = universe
+    if len(corners) < 2:
+        return None
+    distinct, which, counts = _distinct_rows(corners)
+    a, b, c, d = (distinct + 0.0).T
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+        lines = (1.0 / (b - a), -a / (b - a), -1.0 / (d - c), d / (d - c))
+    rise, fall = np.isfinite(a) & np.isfinite(b), np.isfinite(c) & np.isfinite(d)
+    up, down = rise & (a == b), fall & (c == d)                     # upright edges
+    if not (np.isfinite(lines[0][rise & ~up]).all() and np.isfinite(lines[2][fall & ~down]).all()
+            and (b[rise] >= a[rise]).all() and (d[fall] >= c[fall]).all()):
+        return None
+    # the breakpoint before a rising step and after a falling one (lo where there is none)
+    before = np.searchsorted(x, a, side="left") - 1
+    after = np.searchsorted(x, d, side="right")
+    extra = np.stack([np.where(up & (before >= 0), x[np.clip(before, 0, len(x) - 1)], lo),
+                      np.where(down & (after < len(x)), x[np.clip(after, 0, len(x) - 1)], lo)],
+                     axis=1)
+    # no breakpoint lies between a step and the one beside it, so no point of a pair may
+    # (the lines of two edges cross there, where the edges are not: that cut the half area)
+    beside = np.stack([np.stack([np.where(up, extra[:, 0], lo), np.where(up, a, lo)], axis=1),
+                       np.stack([np.where(down, d, lo), np.where(down, extra[:, 1], lo)],
+                                axis=1)], axis=1)
+    i, j = _overlapping(a, d)
+    twice = np.flatnonzero(counts > 1)                  # a repeated term against its copy
+    i, j = np.concatenate([np.minimum(i, j), twice]), np.concatenate([np.maximum(i, j), twice])
+    # the terms as _linear_most has them: where each is above 0 on x
+    start = np.searchsorted(x, distinct[:, 0], side="left")
+    end = np.searchsorted(x, distinct[:, 3], side="right") - 1
+    some = start <= end
+    both = some[i] & some[j]
+    di, dj = i[both], j[both]
+    # the likeliest pairs first, as in most_similar_by_pairs (the area beside a step too)
+    area = _areas(distinct + 0.0, lo, hi, extra)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        bound = np.minimum(area[di], area[dj]) / np.maximum(area[di], area[dj])
+    bound = np.where(np.isfinite(bound), bound, 1.0)
+    likeliest = np.argsort(-bound, kind="stable")
+    s = np.full(len(di), -1.0)                          # not measured: below the largest
+    step = max(1, PAIR_BLOCK // 20)
+    found = 0.0
+    for k in range(0, len(di), step):
+        p = likeliest[k:k + step]
+        if bound[p[0]] < found - NEAR_MOST:
+            break
+        s[p] = _pairs_on_own_points(distinct + 0.0, di[p], dj[p], lines, lo, hi, extra,
+                                    beside)
+        found = max(found, float(s[p].max()))
+    most = float(s.max()) if len(s) else 0.0
+    if most < above:
+        return most, 0, 1
+    near = s >= most - NEAR_MOST
+
+    def rows(k: np.ndarray, at: np.ndarray) -> np.ndarray:
+        return memberships(distinct[k], x[at])
+
+    # the first pass of _most_similar: each term's pairs with the later ones, in batches
+    order = np.flatnonzero(some)[np.argsort(start[some], kind="stable")]
+    starts = start[order]
+    place = np.full(len(distinct), -1)
+    place[order] = np.arange(len(order))
+    upto = np.searchsorted(starts, end[order], side="right")
+    fro = np.arange(len(order)) + (counts[order] < 2)
+    sizes = np.maximum(upto - fro, 0)
+    batch = np.empty(len(order), dtype=np.intp)
+    n, total = 0, 0
+    for q in range(len(order)):                     # as _most_similar closes its batches
+        batch[q] = n
+        total += int(sizes[q])
+        if total * len(x) >= PAIR_BLOCK:
+            n, total = n + 1, 0
+    pk = np.where(place[di] <= place[dj], di, dj)         # the pair as the batch has it
+    pv = np.where(place[di] <= place[dj], dj, di)
+    best = np.zeros(len(distinct))
+    for bn in np.unique(batch[place[pk[near]]]):
+        ps = np.flatnonzero(batch == bn)
+        ks = np.repeat(order[ps], sizes[ps])
+        vs = np.concatenate([order[fro[p]:upto[p]] for p in ps])
+        wanted = set(zip(pk[near].tolist(), pv[near].tolist()))
+        only = np.array([(k, v) in wanted for k, v in zip(ks.tolist(), vs.tolist())],
+                        dtype=bool)
+        sim = _pair_similarity(rows, x, ks, vs, start, end, only)
+        np.maximum.at(best, ks[only], sim[only])
+        np.maximum.at(best, vs[only], sim[only])
+    r = int(np.argmax(best[which]))                 # the first row holding the largest
+    k = which[r]
+    # the second pass: k against every term near it, only the pairs near the largest
+    around = np.flatnonzero(some & (start <= end[k]) & (end >= start[k]))
+    close = set(pv[near & (pk == k)].tolist()) | set(pk[near & (pv == k)].tolist())
+    only = np.isin(around, list(close))
+    row = np.zeros(len(counts))
+    row[around] = _pair_similarity(rows, x, np.full(len(around), k), around, start, end, only)
+    full = row[which]
+    full[r] = -1.0
+    col = int(np.argmax(full))
+    return float(full[col]), r, col
+
+
+def _areas(corners: np.ndarray, lo: float, hi: float, extra: np.ndarray | None = None
+           ) -> np.ndarray:
+    """Each piecewise-linear term's area on ``[lo, hi]``: the trapezoid rule on the ends and
+    its corners, between which it is linear (and on the points ``extra[t]``, if given: the
+    breakpoints beside an upright edge, as :func:`most_similar_beside_steps` measures it)."""
+    pts = np.concatenate([np.full((len(corners), 1), lo), np.full((len(corners), 1), hi),
+                          corners] + ([] if extra is None else [extra]), axis=1)
+    pts = np.sort(np.where(np.isfinite(pts) & (pts >= lo) & (pts <= hi), pts, lo), axis=1)
+    m = memberships_at(np.repeat(corners, pts.shape[1], axis=0), pts.reshape(-1)
+                       ).reshape(pts.shape)
+    return ((m[:, 1:] + m[:, :-1]) * 0.5 * np.diff(pts, axis=1)).sum(axis=1)
+
+
+def _pairs_on_own_points(corners, i, j, lines, lo: float, hi: float,
+                         extra: np.ndarray | None = None, beside: np.ndarray | None = None
+                         ) -> np.ndarray:
+    """The Jaccard similarity of terms ``i[p]`` and ``j[p]`` on the points of each pair (and
+    on the points ``extra[t]`` of each of its terms ``t``, if given; none strictly inside the
+    stretches ``beside[t, s]``, ``(left, right)``, if given)."""
     rs, ro, fs, fo = lines
     with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
         cross = np.stack([(ro[j] - ro[i]) / (rs[i] - rs[j]), (fo[j] - ro[i]) / (rs[i] - fs[j]),
                           (ro[j] - fo[i]) / (fs[i] - rs[j]), (fo[j] - fo[i]) / (fs[i] - fs[j])],
                          axis=1)
     pts = np.concatenate([np.full((len(i), 1), lo), np.full((len(i), 1), hi), corners[i],
-                          corners[j], cross], axis=1)
-    pts = np.sort(np.where(np.isfinite(pts) & (pts >= lo) & (pts <= hi), pts, lo), axis=1)
+                          corners[j], cross] + ([] if extra is None else [extra[i], extra[j]]),
+                         axis=1)
+    pts = np.where(np.isfinite(pts) & (pts >= lo) & (pts <= hi), pts, lo)
+    if beside is not None:
+        for t in (i, j):
+            for s in range(beside.shape[1]):
+                pts = np.where((pts > beside[t, s, 0, None]) & (pts < beside[t, s, 1, None]),
+                               lo, pts)
+    pts = np.sort(pts, axis=1)
     m = np.stack([memberships_at(corners[np.repeat(k, pts.shape[1])], pts.reshape(-1))
                   .reshape(pts.shape) for k in (i, j)])
     dx = np.diff(pts, axis=1)
@@ -466,7 +676,7 @@ def _distinct_rows(mu: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 
 def _pair_similarity(rows, x: np.ndarray, k: np.ndarray, v: np.ndarray, start: np.ndarray,
-                     end: np.ndarray) -> np.ndarray:
+                     end: np.ndarray, only: np.ndarray | None = None) -> np.ndarray:
     """The similarity of the terms ``k[p]`` and ``v[p]`` for each pair ``p`` as
     :func:`similarity_on` forms it (0 for two terms never both above 0), each on its own
     stretch of the points: from the point before the first of the two to rise above 0
@@ -474,7 +684,9 @@ def _pair_similarity(rows, x: np.ndarray, k: np.ndarray, v: np.ndarray, start: n
     so is every trapezoid. Over every point, 20,000 narrow triangles took 70 s in `mitos
     check`. The sums are of the same trapezoids in another grouping, so a similarity may
     differ in its last bit from :func:`similarity_on`'s. Pairs of stretches of like length
-    go together, in blocks of :data:`PAIR_BLOCK` memberships."""
+    go together, in blocks of :data:`PAIR_BLOCK` memberships. ``only``: the pairs measured
+    (the others 0), each in the block it would be in with all of them, so with the same
+    bits."""
     last = len(x) - 1
     lo = np.maximum(np.minimum(start[k], start[v]) - 1, 0)
     hi = np.minimum(np.maximum(end[k], end[v]) + 1, last)
@@ -486,6 +698,11 @@ def _pair_similarity(rows, x: np.ndarray, k: np.ndarray, v: np.ndarray, start: n
         j = _block_end(widths, i)
         width = int(widths[j - 1])                  # the longest of the block
         p = order[i:j]
+        i = j
+        if only is not None:
+            p = p[only[p]]
+            if not len(p):
+                continue
         at = np.minimum(lo[p, None] + np.arange(width), hi[p, None])    # past hi: dx 0
         a, b = rows(k[p], at), rows(v[p], at)
         dx = np.diff(x[at], axis=1)
@@ -495,7 +712,6 @@ def _pair_similarity(rows, x: np.ndarray, k: np.ndarray, v: np.ndarray, start: n
                  * 0.5 * dx).sum(axis=1)
         meets = ((a > 0) & (b > 0)).any(axis=1)
         out[p] = np.divide(inter, union, out=np.zeros_like(inter), where=meets & (union > 0))
-        i = j
     return out
 
 
@@ -664,7 +880,8 @@ def variable_issues(var: Variable) -> list[Issue]:
         if all(learnable(t) for t in sets):                     # exact
             corners = np.array([t.corners for t in sets], dtype=float)
             x = breakpoints(corners, var.universe)
-            top = envelope(corners, x)          # never every term's memberships at once
+            # never every term's memberships at once; only an input's coverage is measured
+            top = envelope(corners, x) if var.role == "input" else x[:0]
         else:                                                   # any shape: on samples
             corners = None
             x = sample_points(sets, var.universe)
@@ -674,12 +891,14 @@ def variable_issues(var: Variable) -> list[Issue]:
             low, where = least_top(top, x, var.universe, besides_gaps=True)   # see term-gap
             if low < COVERAGE - 1e-9 or _dips_beside_gaps(sets, corners, x):
                 spans = (uncovered_on(top, x) if corners is None
-                         else uncovered(corners, var.universe))
+                         else uncovered(corners, var.universe, bends=x))
                 out.append(Issue("coverage", var.name, (), _coverage_message(
                     var, low, where, spans, gaps=bool(np.any(top <= 0.0))),
                     "widen the neighbouring terms so that they overlap there"))
         if len(sets) >= 2:
-            found = None if corners is None else most_similar_by_pairs(corners, var.universe)
+            found = None if corners is None else (
+                most_similar_by_pairs(corners, var.universe)
+                or most_similar_beside_steps(corners, var.universe, x, SIMILARITY - 1e-6))
             s, i, j = found or (most_similar_on(mu, x) if corners is None
                                 else _linear_most(corners, x))
             if s > SIMILARITY + 1e-9:
@@ -706,9 +925,11 @@ def _dips_beside_gaps(sets: list[Term], corners: np.ndarray | None, x: np.ndarra
     at the gap), which the breakpoints alone never show; the envelope is linear between
     them, so a dip shows at one of those thirds."""
     width = np.diff(x)
-    at = np.concatenate([x, x[:-1] + width / 3, x[:-1] + 2 * width / 3])
-    top = envelope(corners, at) if corners is not None else sampled(sets, at).max(axis=0)
-    return bool(np.any((top > 0.0) & (top < COVERAGE - 1e-9)))
+    for at in (x, x[:-1] + width / 3, x[:-1] + 2 * width / 3):      # a third of the memory
+        top = envelope(corners, at) if corners is not None else sampled(sets, at).max(axis=0)
+        if np.any((top > 0.0) & (top < COVERAGE - 1e-9)):
+            return True
+    return False
 
 
 #: Stretches named in one coverage finding; more are counted.
