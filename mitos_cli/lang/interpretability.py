@@ -430,10 +430,7 @@ def most_similar_by_pairs(corners: np.ndarray, universe: tuple[float, float]
     # likeliest down, until no pair left can reach the largest found (each pair's sum is
     # its own row, so the same bits however many are measured)
     area = _areas(distinct, lo, hi)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        bound = np.minimum(area[i], area[j]) / np.maximum(area[i], area[j])
-    bound = np.where(np.isfinite(bound), bound, 1.0)
-    likeliest = np.argsort(-bound, kind="stable")
+    bound, likeliest = _likeliest(area[i], area[j])
     s = np.full(len(i), -1.0)                           # not measured: below the largest
     step = max(1, PAIR_BLOCK // 16)
     most = 0.0
@@ -512,10 +509,7 @@ def most_similar_beside_steps(corners: np.ndarray, universe: tuple[float, float]
     di, dj = i[both], j[both]
     # the likeliest pairs first, as in most_similar_by_pairs (the area beside a step too)
     area = _areas(distinct + 0.0, lo, hi, extra)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        bound = np.minimum(area[di], area[dj]) / np.maximum(area[di], area[dj])
-    bound = np.where(np.isfinite(bound), bound, 1.0)
-    likeliest = np.argsort(-bound, kind="stable")
+    bound, likeliest = _likeliest(area[di], area[dj])
     s = np.full(len(di), -1.0)                          # not measured: below the largest
     step = max(1, PAIR_BLOCK // 20)
     found = 0.0
@@ -574,6 +568,16 @@ def most_similar_beside_steps(corners: np.ndarray, universe: tuple[float, float]
     full[r] = -1.0
     col = int(np.argmax(full))
     return float(full[col]), r, col
+
+
+def _likeliest(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Each pair's bound on its similarity from its terms' areas ``a`` and ``b`` (|A and B|
+    is at most the smaller, |A or B| at least the larger; 1 where that is no number) and the
+    pairs from the likeliest down (a stable order: ties as the pairs come)."""
+    with np.errstate(invalid="ignore", divide="ignore"):
+        bound = np.minimum(a, b) / np.maximum(a, b)
+    bound = np.where(np.isfinite(bound), bound, 1.0)
+    return bound, np.argsort(-bound, kind="stable")
 
 
 def _areas(corners: np.ndarray, lo: float, hi: float, extra: np.ndarray | None = None
