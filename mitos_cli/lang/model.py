@@ -121,8 +121,8 @@ class RuleBase:
     #: a renamed duplicate, a derived range); the CLI prints them as warnings.
     notes: tuple[str, ...] = field(default=(), compare=False)
     #: What a foreign file sets that MITOS's reading of it does not use, kept for the engines
-    #: that do (a Sugeno ``.fis`` file's ``AggMethod``, as its MITOS name: MATLAB ignores
-    #: it, Octave's toolkit does not, ``--fidelity octave``).
+    #: that do (a Sugeno ``.fis`` file's ``AggMethod``, as the file spells it, with its
+    #: place: MATLAB ignores it, Octave's toolkit does not, ``--fidelity octave``).
     unused: tuple[Setting, ...] = field(default=(), compare=False)
 
     def __repr__(self) -> str:   # the generated one spells out every rule and term
