@@ -479,7 +479,53 @@ def most_similar_beside_steps(corners: np.ndarray, universe: tuple[float, float]
     if len(corners) < 2:
         return None
     distinct, which, counts = _distinct_rows(corners)
-    a, b, c, d = (distinct + 0.0).T
+    edges = _step_edges(distinct + 0.0, x, lo)
+    if edges is None:
+        return None
+    i, j = _overlapping(distinct[:, 0], distinct[:, 3])
+    twice = np.flatnonzero(counts > 1)                  # a repeated term against its copy
+    i, j = np.concatenate([np.minimum(i, j), twice]), np.concatenate([np.maximum(i, j), twice])
+    # the terms as _linear_most has them: where each is above 0 on x
+    start = np.searchsorted(x, distinct[:, 0], side="left")
+    end = np.searchsorted(x, distinct[:, 3], side="right") - 1
+    some = start <= end
+    both = some[i] & some[j]
+    di, dj = i[both], j[both]
+    s = _screened(distinct + 0.0, di, dj, edges, lo, hi)
+    most = float(s.max()) if len(s) else 0.0
+    if most < above:
+        return most, 0, 1
+    near = s >= most - NEAR_MOST
+    spans = _Spans(start, end, some)
+    pk, pv, best = _first_pass(distinct, x, counts, spans, di[near], dj[near])
+    r = int(np.argmax(best[which]))                 # the first row holding the largest
+    k = which[r]
+    # the second pass: k against every term near it, only the pairs near the largest
+    around = np.flatnonzero(some & (start <= end[k]) & (end >= start[k]))
+    close = set(pv[pk == k].tolist()) | set(pk[pv == k].tolist())
+    only = np.isin(around, list(close))
+    row = np.zeros(len(counts))
+    row[around] = _pair_similarity(_rows_of(distinct, x), x, np.full(len(around), k), around,
+                                   start, end, only)
+    full = row[which]
+    full[r] = -1.0
+    col = int(np.argmax(full))
+    return float(full[col]), r, col
+
+
+class _Edges(NamedTuple):
+    """The lines of distinct terms' edges and, for a crisp step, the breakpoint beside it."""
+
+    lines: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
+    extra: np.ndarray       # [terms, 2]: the breakpoint before a rising step, after a falling
+    beside: np.ndarray      # [terms, 2, 2]: the stretch between each step and that breakpoint
+
+
+def _step_edges(distinct: np.ndarray, x: np.ndarray, lo: float) -> _Edges | None:
+    """Each term's edge lines, and where it has an upright edge the breakpoint of ``x``
+    beside it (``lo`` where there is none); ``None`` where a slanted edge is too narrow for
+    its slope to be a normal number, or runs backwards."""
+    a, b, c, d = distinct.T
     with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
         lines = (1.0 / (b - a), -a / (b - a), -1.0 / (d - c), d / (d - c))
     rise, fall = np.isfinite(a) & np.isfinite(b), np.isfinite(c) & np.isfinite(d)
@@ -487,7 +533,6 @@ def most_similar_beside_steps(corners: np.ndarray, universe: tuple[float, float]
     if not (np.isfinite(lines[0][rise & ~up]).all() and np.isfinite(lines[2][fall & ~down]).all()
             and (b[rise] >= a[rise]).all() and (d[fall] >= c[fall]).all()):
         return None
-    # the breakpoint before a rising step and after a falling one (lo where there is none)
     before = np.searchsorted(x, a, side="left") - 1
     after = np.searchsorted(x, d, side="right")
     extra = np.stack([np.where(up & (before >= 0), x[np.clip(before, 0, len(x) - 1)], lo),
@@ -498,42 +543,53 @@ def most_similar_beside_steps(corners: np.ndarray, universe: tuple[float, float]
     beside = np.stack([np.stack([np.where(up, extra[:, 0], lo), np.where(up, a, lo)], axis=1),
                        np.stack([np.where(down, d, lo), np.where(down, extra[:, 1], lo)],
                                 axis=1)], axis=1)
-    i, j = _overlapping(a, d)
-    twice = np.flatnonzero(counts > 1)                  # a repeated term against its copy
-    i, j = np.concatenate([np.minimum(i, j), twice]), np.concatenate([np.maximum(i, j), twice])
-    # the terms as _linear_most has them: where each is above 0 on x
-    start = np.searchsorted(x, distinct[:, 0], side="left")
-    end = np.searchsorted(x, distinct[:, 3], side="right") - 1
-    some = start <= end
-    both = some[i] & some[j]
-    di, dj = i[both], j[both]
-    # the likeliest pairs first, as in most_similar_by_pairs (the area beside a step too)
-    area = _areas(distinct + 0.0, lo, hi, extra)
+    return _Edges(lines, extra, beside)
+
+
+def _screened(distinct: np.ndarray, di: np.ndarray, dj: np.ndarray, edges: _Edges,
+              lo: float, hi: float) -> np.ndarray:
+    """The similarity of each pair ``di, dj`` on its own points, likeliest pairs first, as
+    in :func:`most_similar_by_pairs` (the area beside a step too); -1 for the pairs whose
+    bound shows they are below the largest, which are not measured."""
+    area = _areas(distinct, lo, hi, edges.extra)
     bound, likeliest = _likeliest(area[di], area[dj])
-    s = np.full(len(di), -1.0)                          # not measured: below the largest
+    s = np.full(len(di), -1.0)
     step = max(1, PAIR_BLOCK // 20)
     found = 0.0
     for k in range(0, len(di), step):
         p = likeliest[k:k + step]
         if bound[p[0]] < found - NEAR_MOST:
             break
-        s[p] = _pairs_on_own_points(distinct + 0.0, di[p], dj[p], lines, lo, hi, extra,
-                                    beside)
+        s[p] = _pairs_on_own_points(distinct, di[p], dj[p], edges.lines, lo, hi, edges.extra,
+                                    edges.beside)
         found = max(found, float(s[p].max()))
-    most = float(s.max()) if len(s) else 0.0
-    if most < above:
-        return most, 0, 1
-    near = s >= most - NEAR_MOST
+    return s
 
+
+class _Spans(NamedTuple):
+    """Where each distinct term is above 0 on the breakpoints, as :func:`_linear_most` has it."""
+
+    start: np.ndarray
+    end: np.ndarray
+    some: np.ndarray        # above 0 somewhere
+
+
+def _rows_of(distinct: np.ndarray, x: np.ndarray):
     def rows(k: np.ndarray, at: np.ndarray) -> np.ndarray:
         return memberships(distinct[k], x[at])
+    return rows
 
-    # the first pass of _most_similar: each term's pairs with the later ones, in batches
+
+def _first_pass(distinct: np.ndarray, x: np.ndarray, counts: np.ndarray, spans: _Spans,
+                ni: np.ndarray, nj: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The first pass of :func:`_most_similar` (each term's pairs with the later ones, in
+    its batches), summing only the pairs ``ni, nj``: each pair as the batch has it, and each
+    term's largest similarity among them."""
+    start, end, some = spans
     order = np.flatnonzero(some)[np.argsort(start[some], kind="stable")]
-    starts = start[order]
     place = np.full(len(distinct), -1)
     place[order] = np.arange(len(order))
-    upto = np.searchsorted(starts, end[order], side="right")
+    upto = np.searchsorted(start[order], end[order], side="right")
     fro = np.arange(len(order)) + (counts[order] < 2)
     sizes = np.maximum(upto - fro, 0)
     batch = np.empty(len(order), dtype=np.intp)
@@ -543,31 +599,21 @@ def most_similar_beside_steps(corners: np.ndarray, universe: tuple[float, float]
         total += int(sizes[q])
         if total * len(x) >= PAIR_BLOCK:
             n, total = n + 1, 0
-    pk = np.where(place[di] <= place[dj], di, dj)         # the pair as the batch has it
-    pv = np.where(place[di] <= place[dj], dj, di)
+    pk = np.where(place[ni] <= place[nj], ni, nj)         # the pair as the batch has it
+    pv = np.where(place[ni] <= place[nj], nj, ni)
+    wanted = set(zip(pk.tolist(), pv.tolist()))
+    rows = _rows_of(distinct, x)
     best = np.zeros(len(distinct))
-    for bn in np.unique(batch[place[pk[near]]]):
+    for bn in np.unique(batch[place[pk]]):
         ps = np.flatnonzero(batch == bn)
         ks = np.repeat(order[ps], sizes[ps])
         vs = np.concatenate([order[fro[p]:upto[p]] for p in ps])
-        wanted = set(zip(pk[near].tolist(), pv[near].tolist()))
         only = np.array([(k, v) in wanted for k, v in zip(ks.tolist(), vs.tolist())],
                         dtype=bool)
         sim = _pair_similarity(rows, x, ks, vs, start, end, only)
         np.maximum.at(best, ks[only], sim[only])
         np.maximum.at(best, vs[only], sim[only])
-    r = int(np.argmax(best[which]))                 # the first row holding the largest
-    k = which[r]
-    # the second pass: k against every term near it, only the pairs near the largest
-    around = np.flatnonzero(some & (start <= end[k]) & (end >= start[k]))
-    close = set(pv[near & (pk == k)].tolist()) | set(pk[near & (pv == k)].tolist())
-    only = np.isin(around, list(close))
-    row = np.zeros(len(counts))
-    row[around] = _pair_similarity(rows, x, np.full(len(around), k), around, start, end, only)
-    full = row[which]
-    full[r] = -1.0
-    col = int(np.argmax(full))
-    return float(full[col]), r, col
+    return pk, pv, best
 
 
 def _likeliest(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
