@@ -39,6 +39,7 @@ import math
 import re
 from collections.abc import Sequence
 from pathlib import Path
+from typing import cast
 
 import numpy as np
 from lark import Lark, Token, Tree
@@ -197,7 +198,7 @@ def _blocks_as_behaviors(blocks: list[Tree], span_of) -> RuleBase:
         try:
             rb = _function_block(fb, span_of)
         except NoRulesError as exc:          # a block of terms only: its variables count
-            parts.append((name, None, exc.termset))
+            parts.append((name, None, cast(TermSet, exc.termset)))
             continue
         parts.append((name, rb, rb.termsets[0]))
     termset = TermSet(tuple(_shared_variables(parts)), span_of(blocks[0]).path)
