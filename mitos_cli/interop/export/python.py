@@ -9,7 +9,7 @@ base appear only as ``repr`` literals (``INPUTS``, ``OUTPUTS``), in the docstrin
 from __future__ import annotations
 
 import re
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, cast
 
 import numpy as np
 
@@ -222,7 +222,8 @@ def _py_shapes(shapes: Iterable[str]) -> list[str]:
         # the header without its annotations, which name the type checker's aliases (ArrayLike,
         # Param): the program defines none of them, and would fail at the `def`
         lines = inspect.getsource(fn).splitlines()
-        first = ast.parse(inspect.getsource(fn)).body[0].body[0].lineno   # (the docstring)
+        node = cast(ast.FunctionDef, ast.parse(inspect.getsource(fn)).body[0])
+        first = node.body[0].lineno                                   # (the docstring)
         params = ", ".join(str(p.replace(annotation=p.empty))
                            for p in inspect.signature(fn).parameters.values())
         src = "\n".join([f"def mf_{name}({params}):", *lines[first - 1:]]) + "\n"
