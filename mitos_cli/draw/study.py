@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING
 from .output import literal_text
 
 if TYPE_CHECKING:
-    from collections.abc import Mapping, Sequence
+    from collections.abc import Callable, Mapping, Sequence
     from types import ModuleType
     from typing import Protocol
 
@@ -116,7 +116,7 @@ def success_bars(summaries: Sequence[_Summary], worlds: list[str], labels: list[
 
 
 def clearance_boxes(rows: list[dict], worlds: list[str], labels: list[str],
-                    label_of, path: str | Path) -> Path:
+                    label_of: Callable[[dict], str], path: str | Path) -> Path:
     """One panel per world, one box per choice: minimum clearance (in) over all runs."""
     plt = _pyplot()
     n_w = len(worlds)
