@@ -14,6 +14,12 @@ import importlib
 import importlib.util
 import sys
 import warnings
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from collections.abc import Sequence
+    from importlib.machinery import ModuleSpec
+    from types import ModuleType
 
 #: old module -> new module (docs/changelog.md lists the same table)
 MOVED = {
@@ -40,18 +46,19 @@ class _Loader:
     def __init__(self, new: str) -> None:
         self.new = new
 
-    def create_module(self, spec):          # the new module itself, not a copy
+    def create_module(self, spec: ModuleSpec) -> ModuleType:   # the new module itself, not a copy
         module = importlib.import_module(self.new)
         self.spec = module.__spec__
         return module
 
-    def exec_module(self, module) -> None:  # the import system stamped the old name's spec on it
+    def exec_module(self, module: ModuleType) -> None:  # the import system stamped the old name's spec on it
         module.__spec__ = self.spec
         module.__loader__ = self.spec.loader if self.spec is not None else None
 
 
 class _Finder:
-    def find_spec(self, fullname, path, target=None):
+    def find_spec(self, fullname: str, path: Sequence[str] | None,
+                  target: ModuleType | None = None) -> ModuleSpec | None:
         head, _, tail = fullname.partition(".")
         if head != "mitos_cli" or tail not in MOVED:
             return None

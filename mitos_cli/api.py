@@ -11,6 +11,7 @@ from __future__ import annotations
 import functools
 import os
 from pathlib import Path
+from typing import TYPE_CHECKING, cast
 
 import numpy as np
 
@@ -28,6 +29,9 @@ from .errors import MitosError
 from .lang.model import RuleBase
 from .lang.terms import TermSet
 from .resources import DEFAULT_RULEBASE, packaged_path
+
+if TYPE_CHECKING:
+    from numpy.typing import ArrayLike
 
 #: The types the one-sample path of :meth:`LoadedRuleBase.evaluate` takes as they are (not
 #: ``bool``, whose type is its own: ``True`` is refused, not read as 1)
@@ -110,7 +114,7 @@ def read_terms(path: str | Path | None) -> RuleBase | TermSet:
     try:
         return read_rulebase(path)
     except NoRulesError as exc:
-        return exc.termset
+        return cast(TermSet, exc.termset)
 
 
 def _read_by_extension(path: Path) -> RuleBase:
@@ -205,11 +209,11 @@ class LoadedRuleBase:
         extra = tuple(Setting(k.rstrip("_"), str(v)) for k, v in settings.items())
         return LoadedRuleBase(self.rulebase, self.compiled.behavior, self.overrides + extra)
 
-    def run(self, X, **kwargs) -> Result:
+    def run(self, X: ArrayLike, **kwargs: bool) -> Result:
         """Evaluate a batch ``X[n, k]`` (columns in :attr:`inputs` order)."""
         return evaluate(self.compiled, X, **kwargs)
 
-    def evaluate(self, **inputs) -> dict[str, float | np.ndarray]:
+    def evaluate(self, **inputs: float | np.ndarray) -> dict[str, float | np.ndarray]:
         """Outputs for inputs given by name (floats, or arrays evaluated as one batch)."""
         c = self.compiled
         if len(inputs) == len(c.inputs) and _NUMBERS.issuperset(map(type, inputs.values())):
@@ -226,7 +230,7 @@ class LoadedRuleBase:
         out = evaluate_columns(c, columns)
         return {name: out[j] for j, name in enumerate(c.outputs)}
 
-    def trace(self, **inputs) -> Trace:
+    def trace(self, **inputs: float) -> Trace:
         """The paper-style DOF trace of one evaluation."""
         X = as_batch(self.compiled, inputs)
         if X.shape[0] != 1:

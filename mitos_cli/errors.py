@@ -340,7 +340,7 @@ class NoRulesError(FormatError):
     """A foreign file whose variables and terms are whole but that has no rules (jFuzzyLogic's
     membership-function tests): no rule base, but ``termset`` for what draws or checks terms."""
 
-    def __init__(self, message: str, *, termset, span: Span | None = None) -> None:
+    def __init__(self, message: str, *, termset: object, span: Span | None = None) -> None:
         super().__init__(message, span=span, hint="`mitos plot terms` and `mitos check` read "
                                                   "its terms alone")
         self.termset = termset

@@ -65,6 +65,10 @@ from .sim.world import World
 if TYPE_CHECKING:                      # drawn only when rendered: imported there
     from .draw.frame import RunFrame
     from .sim.live import LiveView
+    from .sim.planner import Percepts
+
+    #: an observation: the inputs, or with observe_ranges a dict of them and the ranges
+    Observation = np.ndarray | dict[str, np.ndarray]
 
 PROGRESS_REWARD = 0.01      # per inch of route
 COLLISION_PENALTY = -10.0
@@ -97,7 +101,8 @@ class _Commanded:
 
     name = "gym"
 
-    def plan(self, percepts):  # pragma: no cover - step() always passes the command
+    def plan(self, percepts: Percepts  # pragma: no cover - step() always passes the command
+             ) -> tuple[np.ndarray, np.ndarray]:
         raise RuntimeError("the environment passes every command")
 
 
@@ -160,7 +165,7 @@ class MitosEnv(gymnasium.Env):
 
     # -- the policy mitos simulate uses -------------------------------------------------------
 
-    def fuzzy_policy(self, observation) -> np.ndarray:
+    def fuzzy_policy(self, observation: object) -> np.ndarray:
         """The rule base's command for ``observation``: what ``mitos simulate`` would do."""
         x = _inputs_of(observation)
         from .engine.evaluation import evaluate_one
@@ -169,7 +174,7 @@ class MitosEnv(gymnasium.Env):
         outputs = self.fuzzy.compiled.outputs
         return np.array([out[outputs.index("steering")], out[outputs.index("speed")]])
 
-    def _row(self, x) -> list[float]:
+    def _row(self, x: object) -> list[float]:
         """One observation as the floats the rule base reads, else an :class:`InputError` (a
         batch ``[1, k]`` met "only 0-dimensional arrays can be converted to Python scalars";
         bools, dates and structured arrays are refused as the engine's inputs are)."""
@@ -189,7 +194,8 @@ class MitosEnv(gymnasium.Env):
 
     # -- Gymnasium ----------------------------------------------------------------------------
 
-    def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
+    def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None
+              ) -> tuple[Observation, dict]:
         seed = _check_seed(seed)
         self.sim.randomise = _randomise(options)
         if seed is None and not self._seeded:
@@ -211,7 +217,7 @@ class MitosEnv(gymnasium.Env):
             self.render()
         return obs, self._info()
 
-    def step(self, action):
+    def step(self, action: object) -> tuple[Observation, float, bool, bool, dict]:
         sim = self.sim
         trail = _begun(self._trail, "step")
         if sim.done:
@@ -239,7 +245,7 @@ class MitosEnv(gymnasium.Env):
             self.render()
         return obs, float(reward), terminated, truncated, self._info()
 
-    def render(self):
+    def render(self) -> np.ndarray | None:
         if self.render_mode is None:
             gymnasium.logger.warn("render() without a render_mode: give render_mode='rgb_array' "
                                   "or 'human' to gymnasium.make")
@@ -285,7 +291,7 @@ class MitosEnv(gymnasium.Env):
 
     # -- helpers ------------------------------------------------------------------------------
 
-    def _observe(self):
+    def _observe(self) -> Observation:
         s = self.sim.observe()
         x = np.array([s.inputs[k][0] for k in self.input_names], dtype=np.float64)
         x = np.minimum(np.maximum(x, self._lo), self._hi)
@@ -431,7 +437,7 @@ def _check_seed(seed: object) -> int | None:
                     f": `{seed!r:.40}`", expected=expected, hint=hint)
 
 
-def _command(action) -> np.ndarray:
+def _command(action: object) -> np.ndarray:
     """``action`` as the ``[1, 2]`` command it is, else a :class:`CommandError` saying what an
     action is (``step(5)`` met NumPy's "cannot reshape array of size 1 into shape (1,2)"; a
     bool was read as 1 or 0, where every other entry point refuses it)."""

@@ -10,12 +10,16 @@ from __future__ import annotations
 import importlib.resources
 from collections.abc import Iterator
 from pathlib import Path
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from importlib.abc import Traversable
 
 DEFAULT_RULEBASE = "mitos.rules"
 DEFAULT_WORLD = "corridor.yaml"
 
 
-def data_dir(kind: str):
+def data_dir(kind: str) -> Traversable:
     """The ``grammar``, ``rulebases`` or ``worlds`` directory as a Traversable."""
     packaged = importlib.resources.files("mitos_cli") / "_data" / kind
     if packaged.is_dir():
@@ -65,7 +69,7 @@ def packaged_place(directory: str, kind: str) -> bool:
     return directory == "." or directory == kind or kind.endswith("/" + directory)
 
 
-def is_file(path: Path) -> bool:
+def is_file(path: Path | Traversable) -> bool:
     """``path.is_file()``, False for a name the system cannot look up (longer than 255
     characters): such a name is simply not found, and the caller says so in words."""
     try:

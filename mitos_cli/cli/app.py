@@ -78,7 +78,7 @@ def build_app(only: str | None = None) -> typer.Typer:
     return app
 
 
-def __getattr__(name: str):
+def __getattr__(name: str) -> typer.Typer:
     if name == "app":                     # the whole app, for tests and embedding
         return build_app()
     raise AttributeError(name)

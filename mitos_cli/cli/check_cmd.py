@@ -3,13 +3,17 @@
 from __future__ import annotations
 
 import os
-from typing import Annotated, Optional
+from typing import TYPE_CHECKING, Annotated, Optional
 
 import typer
 
 from ..words import plural
 from .output import emit, json_text, warn, warn_notes
 from .params import WORDS, finite, named
+
+if TYPE_CHECKING:
+    from ..engine.check import GridInfo, Report
+    from ..lang.terms import TermSet
 
 
 def show_path(path: str | None) -> str:
@@ -23,7 +27,7 @@ def show_path(path: str | None) -> str:
     return path if rel.startswith("..") else rel
 
 
-def render(report, trace_path: str) -> str:
+def render(report: Report, trace_path: str) -> str:
     """The report for people: one ``path:line:col: severity: message`` block per finding, with
     the line it points into and a caret, each path as the user gave it, a packaged file as
     the summary's ``checked PATH`` names it (``rulebases/...``, not its place in
@@ -70,7 +74,7 @@ def render(report, trace_path: str) -> str:
     return "\n".join(lines)
 
 
-def _check_termset(termset, path: str | None, behavior: str | None):
+def _check_termset(termset: TermSet, path: str | None, behavior: str | None) -> Report:
     """A term set's own findings (:func:`..engine.check.check_termset`), of a YAML term set or
     of a foreign file that has no rules (said so); ``-b`` needs rules."""
     from ..api import is_termset_name
@@ -85,7 +89,7 @@ def _check_termset(termset, path: str | None, behavior: str | None):
     return check_termset(termset)
 
 
-def skipped_note(grid) -> str:
+def skipped_note(grid: GridInfo) -> str:
     """Says that a behavior's grid is coarser than its terms (too many inputs), so that its
     `no-rule-fires` and `low-dof` findings, or their absence, claim no more than was seen."""
     from ..engine.check import MAX_SAMPLES, listed_names
@@ -96,7 +100,7 @@ def skipped_note(grid) -> str:
             f"between them")
 
 
-def to_json(report, trace_path: str) -> dict:
+def to_json(report: Report, trace_path: str) -> dict:
     return {
         ("rulebase" if report.rulebase.behaviors else "termset"): trace_path,
         "ok": report.ok,

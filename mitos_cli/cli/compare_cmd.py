@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import shlex
 from pathlib import Path
-from typing import Annotated, Optional
+from typing import TYPE_CHECKING, Annotated, Optional
 
 import typer
 
@@ -14,6 +14,14 @@ from . import complete
 from .output import emit, err, json_text, warn
 from .params import MAX_RUNS, WORDS, named, option_names
 from .progress import INTERRUPTED, progress_bar
+
+if TYPE_CHECKING:
+    from collections.abc import Sequence
+
+    from ..study import Outcome, Study
+    from ..study.spec import Choice, Task
+    from ..study.stats import Mean, Rate
+    from ..study.summary import Summary
 
 DEFAULT_AND = "min,product,lukasiewicz,einstein"
 
@@ -153,7 +161,8 @@ def _no_stray_choice(worlds: list[str], given: dict[str, str | None]) -> None:
                     f"comma-separated, without spaces (`{flag} {listed}`)")
 
 
-def _planners(planner: str, and_: str, or_, inference, rulebase, behavior) -> list[str]:
+def _planners(planner: str, and_: str, or_: str | None, inference: str | None, rulebase: str | None,
+              behavior: str | None) -> list[str]:
     """``--planner``'s names; the fuzzy planner's options without it are refused (they were
     dropped without a word)."""
     from ..study.spec import split_list
@@ -176,7 +185,8 @@ def _planners(planner: str, and_: str, or_, inference, rulebase, behavior) -> li
     return planners
 
 
-def _command_line(worlds, and_, or_, inference, planner, rulebase, behavior, runs: int,
+def _command_line(worlds: list[str], and_: str, or_: str | None, inference: str | None, planner: str,
+                  rulebase: str | None, behavior: str | None, runs: int,
                   seed: int, out: str) -> str:
     """The command that runs this study again, for report.md."""
     words = ["mitos", "compare", *worlds, "--and", and_, "--planner", planner]
@@ -188,7 +198,7 @@ def _command_line(worlds, and_, or_, inference, planner, rulebase, behavior, run
     return " ".join(shlex.quote(w) for w in words)
 
 
-def _report(outcome, out: str, plots: bool) -> Path:
+def _report(outcome: Outcome, out: str, plots: bool) -> Path:
     """report.md (and its plots, unless matplotlib is missing: then without, and a warning)."""
     from ..study import write_report
 
@@ -200,7 +210,7 @@ def _report(outcome, out: str, plots: bool) -> Path:
         return write_report(outcome, out, plots=False)
 
 
-def _print_tables(outcome) -> None:
+def _print_tables(outcome: Outcome) -> None:
     from rich.console import Console
 
     from ..study.report import overlap_note, rich_tables
@@ -216,20 +226,20 @@ def _print_tables(outcome) -> None:
         console.print(note, markup=False)
 
 
-def outcome_json(outcome, out: str) -> dict:
+def outcome_json(outcome: Outcome, out: str) -> dict:
     """The ``--json`` object: the study, a summary per world and choice (and pooled over
     the worlds), and the ranking (docs/study.md, "compare --json")."""
-    def rate(r) -> dict:
+    def rate(r: Rate) -> dict:
         return {"k": r.k, "n": r.n, "value": r.value, "lo": r.lo, "hi": r.hi}
 
     def number(x: float | None) -> float | None:
         return None if x is None or not math.isfinite(x) else x      # JSON has no inf / NaN
 
-    def mean(m) -> dict:
+    def mean(m: Mean) -> dict:
         return {"n": m.n, "mean": number(m.mean), "std": number(m.std), "lo": number(m.lo),
                 "hi": number(m.hi)}
 
-    def summary(s) -> dict:
+    def summary(s: Summary) -> dict:
         return {"world": s.world, "choice": s.choice.label, "runs": s.n,
                 "rates": {k: rate(v) for k, v in s.rates.items()},
                 "metrics": {k: mean(v) for k, v in s.metrics.items()}}
@@ -253,7 +263,7 @@ def outcome_json(outcome, out: str) -> dict:
     }
 
 
-def check_inputs(worlds: list[str], choices, rulebase: str | None,
+def check_inputs(worlds: list[str], choices: Sequence[Choice], rulebase: str | None,
                  behavior: str | None, runs: int = 0) -> list[str]:
     """Read every world and compile every choice once here, so a mistake is reported before
     any worker starts (and a world whose ``runs`` are copies of one is said). Returns the
@@ -281,7 +291,8 @@ def check_inputs(worlds: list[str], choices, rulebase: str | None,
     return paths
 
 
-def run_with_progress(study, out, executor, workers, scheduler, resume, quiet=False):
+def run_with_progress(study: Study, out: str, executor: str, workers: int | None, scheduler: str | None,
+                      resume: bool, quiet: bool = False) -> Outcome:
     """Run the study with a progress bar on stderr (on a terminal, without ``--json``; piped,
     a line every few percent). On Ctrl-C: say how many runs are kept in ``out`` and how to go
     on, and exit 130."""
@@ -295,7 +306,7 @@ def run_with_progress(study, out, executor, workers, scheduler, resume, quiet=Fa
             if skipped:
                 bar.note(f"resuming: {skipped} of {plural(total, 'run')} already in {out}")
 
-        def on_result(task, row) -> None:
+        def on_result(task: Task, row: dict) -> None:
             kept["now"] += 1
             bar.update(kept["before"] + kept["now"], kept["total"])
 

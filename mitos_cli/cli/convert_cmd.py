@@ -4,13 +4,16 @@ from __future__ import annotations
 
 from enum import Enum
 from pathlib import Path
-from typing import Annotated, Optional
+from typing import TYPE_CHECKING, Annotated, Optional
 
 import typer
 
 from .output import emit, err, warn, warn_notes
 from .params import FILE, choice, choices, completer, file_arg, named, target_of
 from .targets import check_suffix, refuse_existing, refuse_inputs, refuse_strays, source_files
+
+if TYPE_CHECKING:
+    from ..lang.model import RuleBase
 
 
 class Target(str, Enum):
@@ -133,7 +136,7 @@ def _write_pair(rules_path: Path, rules_text: str, terms_path: Path, terms_text:
     atomic_write_set([(terms_path, terms_text), (rules_path, rules_text)], rules_path)
 
 
-def _read_back(rules_text: str, terms_text: str, rules_path: Path, terms_path: Path):
+def _read_back(rules_text: str, terms_text: str, rules_path: Path, terms_path: Path) -> RuleBase:
     """The rule base the two files will hold, read before they are written: a conversion
     no command could read is refused with nothing written (it used to be written, then
     refused inside MITOS's own output)."""

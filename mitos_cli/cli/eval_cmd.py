@@ -6,7 +6,7 @@ import enum
 import re
 import sys
 from pathlib import Path
-from typing import Annotated, Optional
+from typing import TYPE_CHECKING, Annotated, Optional
 
 import typer
 
@@ -15,6 +15,17 @@ from ..numbers import exact
 from ..words import plural
 from .output import emit, json_text, warn, warn_notes
 from .params import WORDS, choice, choices, completer, named
+
+if TYPE_CHECKING:
+    from collections.abc import Callable
+
+    import numpy as np
+    from numpy.typing import ArrayLike
+
+    from ..api import LoadedRuleBase
+    from ..engine.compile import CompiledRuleBase
+    from ..engine.evaluation import Result
+    from ..errors import Span
 
 
 class Engine(str, enum.Enum):
@@ -123,7 +134,7 @@ def _glued(name: str, text: str) -> str | None:
     return "give each input as a word of its own, apart with spaces: `" + " ".join(words) + "`"
 
 
-def warn_clamped(result) -> None:
+def warn_clamped(result: Result) -> None:
     c = result.compiled
     if c.operators.inputs == "as_given":    # fuzzylite's, jFuzzyLogic's reading: said, not clamped
         lo, hi = c.universe[:, 0], c.universe[:, 1]
@@ -143,7 +154,7 @@ def warn_clamped(result) -> None:
             warn(f"`{c.inputs[k]}` outside its universe [{lo:g}, {hi:g}] was clamped{many}")
 
 
-def warn_outside(compiled, Y) -> None:
+def warn_outside(compiled: CompiledRuleBase, Y: ArrayLike) -> None:
     """An output outside its universe, which a weighted sum or a linear consequent can give
     (the rules' values are what they are: said, not clamped)."""
     import numpy as np
@@ -161,7 +172,7 @@ def warn_outside(compiled, Y) -> None:
                  f"the behavior's inference or a linear consequent can leave it")
 
 
-def warn_undersampled(rb, dof) -> None:
+def warn_undersampled(rb: LoadedRuleBase, dof: np.ndarray | None) -> None:
     """Once per term: a fired rule concludes a Mamdani output term that falls between its
     output's sample points (:func:`~mitos_cli.engine.mamdani.undersampled`), so the number
     printed hardly reflects it. The number is kept as it is (MATLAB samples the same way)."""
@@ -254,7 +265,7 @@ def eval_command(
     _evaluate_one(rb, values, as_json, digits)
 
 
-def _loaded(path: str | None, behavior: str | None, fidelity):
+def _loaded(path: str | None, behavior: str | None, fidelity: Engine | None) -> LoadedRuleBase:
     """The rule base (the packaged one without ``path``), its notes said, read as the engine
     ``fidelity`` names where one is asked for; a lone word that is no file is a lost ``=``."""
     from ..api import LoadedRuleBase, load_rulebase
@@ -300,7 +311,7 @@ def _names_file(word: str) -> bool:
             or rule_file_hint(word) is not None)
 
 
-def _evaluate_one(rb, values: dict[str, str], as_json: bool, digits: int | None) -> None:
+def _evaluate_one(rb: LoadedRuleBase, values: dict[str, str], as_json: bool, digits: int | None) -> None:
     """One sample from its ``NAME=VALUE`` texts: its trace (or JSON), and warnings on stderr for
     clamped inputs, outputs outside their universes and undersampled terms that fired."""
     from ..engine.evaluation import as_batch, evaluate
@@ -332,14 +343,14 @@ def refuse_nan(numbers: dict[str, float]) -> None:
                              hint="give every input a finite number")
 
 
-def unused_inputs(rb) -> tuple[str, ...]:
+def unused_inputs(rb: LoadedRuleBase) -> tuple[str, ...]:
     """Inputs the file declares but the behavior's rules never test: a table of the file's
     inputs may still give them (and their values change nothing)."""
     return tuple(v.name for v in rb.rulebase.variables.values()
                  if v.role == "input" and v.name not in rb.compiled.inputs)
 
 
-def run_batch(rb, source: str, on_no_rule: NoRule | None = None,
+def run_batch(rb: LoadedRuleBase, source: str, on_no_rule: NoRule | None = None,
               digits: int | None = None) -> None:
     """Read the CSV, evaluate all rows as one batch, write inputs and outputs as CSV."""
     from ..engine.csvio import flag_name, passed_names, read_table, row_span, write_batch
@@ -399,7 +410,9 @@ def _no_rule_hint(output: str, declared: bool) -> str:
             "to write the other rows (docs/interop.md)")
 
 
-def no_rule_policy(compiled, result, policy: NoRule, where=None):
+def no_rule_policy(compiled: CompiledRuleBase, result: Result, policy: NoRule,
+                   where: Callable[[int], Span | None] | None = None
+                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``(outputs, rows to keep, no_rule column)`` after applying ``policy`` to the rows where
     no rule set an output; a warning says how many rows each output's choice changed. An
     error stops at the first such row, at ``where(row)`` (its place in the batch file)."""

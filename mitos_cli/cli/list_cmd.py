@@ -9,11 +9,14 @@ mitos.rules``, ``mitos plot terms drive.terms.yaml``, ``--lesson wider-turn``).
 from __future__ import annotations
 
 import re
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
 import typer
 
 from .output import emit, json_text
+
+if TYPE_CHECKING:
+    from pathlib import Path
 
 #: Each section: its title in the listing, where the files are and the suffix they end in.
 SECTIONS = {
@@ -48,7 +51,7 @@ def first_comment_line(text: str) -> str:
     return ""
 
 
-def _world(path) -> dict:
+def _world(path: Path) -> dict:
     from ..errors import WorldError
     from ..lang import yamlpos
 
@@ -59,7 +62,7 @@ def _world(path) -> dict:
             "description": first_comment_line(text)}
 
 
-def _rulebase(path) -> dict:
+def _rulebase(path: Path) -> dict:
     from ..lang.resolve import load_rules_file
 
     rb = load_rules_file(path)
@@ -67,14 +70,14 @@ def _rulebase(path) -> dict:
             "description": "behaviors: " + ", ".join(b.name for b in rb.behaviors)}
 
 
-def _termset(path) -> dict:
+def _termset(path: Path) -> dict:
     from ..lang.termfile import load_termset
 
     names = [v.name for v in load_termset(path).variables]
     return {"name": path.name, "variables": names, "description": "variables: " + ", ".join(names)}
 
 
-def _lesson(path) -> dict:
+def _lesson(path: Path) -> dict:
     return {"name": path.stem,
             "description": first_comment_line(path.read_text(encoding="utf-8"))}
 

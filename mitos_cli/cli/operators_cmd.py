@@ -57,7 +57,7 @@ def catalogue() -> dict[str, list[dict]]:
 
     d = Operators()
 
-    def entry(name, formula, default, **extra):
+    def entry(name: str, formula: str, default: str | None, **extra: object) -> dict:
         return {"name": name, "formula": formula, "default": name == default, **extra}
 
     return {

@@ -17,7 +17,7 @@ def warn(message: str) -> None:
     err(f"warning: {message}")
 
 
-def warn_notes(rulebase) -> None:
+def warn_notes(rulebase: object) -> None:
     """What a foreign file's reader changed to make the file fit, one warning each."""
     for note in getattr(rulebase, "notes", ()):
         warn(note)
@@ -35,7 +35,7 @@ def report_error(exc: MitosError) -> None:
     err(exc.render())
 
 
-def json_text(value, infinity_as_text: bool = False) -> str:
+def json_text(value: object, infinity_as_text: bool = False) -> str:
     """``value`` as strict JSON (indented): a NaN or an infinity, which ``json.dumps`` would
     write as the bare ``NaN``/``Infinity`` that strict parsers refuse, is ``null``; with
     ``infinity_as_text`` an infinity is the text ``"inf"`` or ``"-inf"`` (an input given as
@@ -43,7 +43,7 @@ def json_text(value, infinity_as_text: bool = False) -> str:
     import json
     import math
 
-    def strict(v):
+    def strict(v: object) -> object:
         if isinstance(v, float) and not math.isfinite(v):
             if infinity_as_text and math.isinf(v):
                 return "inf" if v > 0 else "-inf"

@@ -13,7 +13,7 @@ import os
 import sys
 from enum import Enum
 from pathlib import Path
-from typing import Annotated, Optional
+from typing import TYPE_CHECKING, Annotated, Optional
 
 import typer
 
@@ -23,6 +23,12 @@ from .eval_cmd import parse_values, refuse_nan, split_args, unused_inputs
 from .help import epilog
 from .output import emit, err, warn
 from .params import WORDS, OnceCommand, choice, choices, completer, named, not_a_directory_name
+
+if TYPE_CHECKING:
+    from collections.abc import Sequence
+
+    from ..api import LoadedRuleBase
+    from ..draw.data.curves import VariablePlot
 
 FORMATS = ("png", "svg")
 RULE_SUFFIXES = (".rules", ".fcl", ".fis", ".fll")
@@ -71,7 +77,7 @@ TitleOpt = Annotated[Optional[str], typer.Option(
     "--title", metavar="TEXT", help="The picture's title (default: says what is drawn).")]
 
 
-def _warn_undrawn(values: dict[str, float], plots, chose: str) -> None:
+def _warn_undrawn(values: dict[str, float], plots: Sequence[VariablePlot], chose: str) -> None:
     """A value given for a variable that ``--var`` or ``-b`` leaves off the sheet marks
     nothing: say so, where it was dropped without a word."""
     drawn = {p.name for p in plots}
@@ -213,7 +219,7 @@ def terms_command(
     _done(output, why)
 
 
-def _warn_no_degree(plot) -> None:
+def _warn_no_degree(plot: VariablePlot) -> None:
     """Say where a drawn term (a formula) leaves [0, 1], which `eval` and `check` refuse: the
     picture shows it, and without a word it looked like a term that works."""
     import numpy as np
@@ -340,7 +346,7 @@ def surface_command(
     _done(output, why)
 
 
-def _used_values(rb, texts: dict[str, str]) -> dict[str, float]:
+def _used_values(rb: LoadedRuleBase, texts: dict[str, str]) -> dict[str, float]:
     """The ``NAME=VALUE`` inputs as `mitos eval` takes them: an input of the file that the
     behavior does not test is taken and dropped (``eval -b main road=78 size=5`` ran, the same
     words here said "does not use input"), NaN refused for every input."""

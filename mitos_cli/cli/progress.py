@@ -7,6 +7,11 @@ from __future__ import annotations
 
 from collections.abc import Iterator
 from contextlib import contextmanager
+from typing import TYPE_CHECKING, cast
+
+if TYPE_CHECKING:
+    from rich.console import Console
+    from rich.progress import Progress, TaskID
 
 #: The exit code of a command stopped by Ctrl-C (128 + SIGINT), as shells report it.
 INTERRUPTED = 130
@@ -21,14 +26,14 @@ class Bar:
     Without a rich progress, ``lines`` prints ``what: done of total (p%)`` every few
     percent instead (nothing when it is false)."""
 
-    def __init__(self, progress, console, lines: bool = False) -> None:
+    def __init__(self, progress: Progress | None, console: Console, lines: bool = False) -> None:
         self.progress, self.console, self.lines = progress, console, lines
         self.task = progress.add_task("", total=None) if progress is not None else None
         self.what, self.shown = "", -1
 
     def update(self, done: int, total: int) -> None:
         if self.progress is not None:
-            self.progress.update(self.task, completed=done, total=total)
+            self.progress.update(cast("TaskID", self.task), completed=done, total=total)
         elif self.lines and total > 0:
             step = done * 100 // total // LINE_EVERY_PERCENT
             if step > self.shown:
@@ -38,7 +43,7 @@ class Bar:
     def describe(self, text: str) -> None:
         self.what = text
         if self.progress is not None:
-            self.progress.update(self.task, description=text)
+            self.progress.update(cast("TaskID", self.task), description=text)
 
     def note(self, text: str) -> None:
         """A line above the bar (on stderr, plain text: never read as markup)."""

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import sys
 from pathlib import Path
-from typing import Annotated, Optional
+from typing import TYPE_CHECKING, Annotated, Optional
 
 import typer
 
@@ -15,10 +15,18 @@ from .params import MAX_RUNS, WORDS, file_arg, finite, named, option_names
 from .progress import INTERRUPTED, progress_bar
 from .targets import check_directory, check_suffix
 
+if TYPE_CHECKING:
+    from collections.abc import Iterable
+
+    from ..sim.loop import SimResult
+    from ..sim.planner import Planner
+    from ..sim.runs import Runs
+    from ..sim.world import World
+
 REQUIRE = ("success",)
 
 
-def _check_outputs(written, read: list[Path]) -> None:
+def _check_outputs(written: Iterable[tuple[str, Path | None]], read: list[Path]) -> None:
     """Refuse an output file that is a file the command reads or another output's: it was
     overwritten without a word (``--out world.yaml`` replaced the world with the CSV)."""
     from ..fileio import real_path
@@ -38,7 +46,7 @@ def _check_outputs(written, read: list[Path]) -> None:
         seen[key] = option
 
 
-def _verdict(res) -> str:
+def _verdict(res: SimResult) -> str:
     m = res.metrics
     agents = res.world.agents
     close = [a for a, r in zip(agents, res.robot_metrics)
@@ -71,7 +79,7 @@ _ROWS = (   # label, key, format (the overall figures, then each robot's)
     ("replans", "replans", str), ("backed out", "backouts", str))
 
 
-def _summary(res) -> str:
+def _summary(res: SimResult) -> str:
     """The figures over all robots; with several, a column per robot beside them (path and
     steering variation are sums over the robots, the clearance the smallest)."""
     overall = res.summary()
@@ -99,7 +107,7 @@ _RUNS_FIGURES = (   # heading, key: the runs table's figures, each a mean (± st
     ("speed in/s", "mean_speed_in_s"), ("replans", "replans"), ("backed out", "backouts"))
 
 
-def _runs_table(runs) -> str:
+def _runs_table(runs: Runs) -> str:
     """One row per world; under a world of several robots, one row per robot (its outcome
     rates and figures: the world's row counts a run a success only if every robot's was)."""
     outcomes = ["success", "collision", "timeout", "stuck"]
@@ -122,7 +130,7 @@ def _runs_table(runs) -> str:
     return table + _runs_footnote(runs)
 
 
-def _runs_footnote(runs) -> str:
+def _runs_footnote(runs: Runs) -> str:
     """What the figures of the runs table are: means (± standard deviations) over every run,
     a failed run's until it ended."""
     spread = any(len(r.summaries) > 1 for w in runs.worlds for r in (w, *w.robots))
@@ -139,7 +147,7 @@ def _runs_footnote(runs) -> str:
     return note + ")"
 
 
-def _draw_runs(result, world, plot: Path):
+def _draw_runs(result: Runs, world: World, plot: Path) -> Runs:
     """Every run's path in one picture (``--runs N --plot``); the runs without their trails
     (which are the picture's, not the table's or the JSON's)."""
     from dataclasses import replace
@@ -155,7 +163,8 @@ def _draw_runs(result, world, plot: Path):
     return replace(result, worlds=(replace(w, summaries=bare),))
 
 
-def _run_many(loaded, runs, seed, planner, workers, plot, quiet):
+def _run_many(loaded: list[World], runs: int, seed: int | None, planner: Planner, workers: int | None,
+             plot: Path | None, quiet: bool) -> tuple[Runs, int | None]:
     """``run_many`` with a progress bar on a terminal. Returns the runs and, when Ctrl-C
     stopped them, how many were asked for (``None`` otherwise): the finished ones are kept."""
     from ..sim.runs import RunsInterrupted, run_many, trail
@@ -296,7 +305,8 @@ def _load_worlds(names: list[str]) -> list:
     return loaded
 
 
-def _check_partners(many: bool, trace: bool, every, animate, fps, workers) -> None:
+def _check_partners(many: bool, trace: bool, every: int | None, animate: Path | None, fps: float | None,
+                    workers: int | None) -> None:
     """An option that tunes another, given without it, is a usage error: `--every 5` alone
     printed no trace, `--fps 5` no animation, `-j 4` of one run started no process, each
     without a word."""
@@ -326,8 +336,8 @@ def _many(worlds: int, runs: int) -> str:
                                           f"--runs {runs}" if runs > 0 else "") if part)
 
 
-def _check_run_options(many: bool, worlds: int, runs: int, randomise: bool, out, trace: bool,
-                       live: bool, animate, plot) -> None:
+def _check_run_options(many: bool, worlds: int, runs: int, randomise: bool, out: Path | None, trace: bool,
+                       live: bool, animate: Path | None, plot: Path | None) -> None:
     """Usage errors among the options, and a picture format or a missing matplotlib, all
     before any run: a mistake found after a long run costs the run."""
     if randomise and runs > 0:                # not "give one world": it was one
@@ -366,7 +376,8 @@ def _check_run_options(many: bool, worlds: int, runs: int, randomise: bool, out,
         require_matplotlib()
 
 
-def _simulate_many(loaded, runs: int, seed, planner, workers, plot, as_json: bool,
+def _simulate_many(loaded: list[World], runs: int, seed: int | None, planner: Planner,
+                  workers: int | None, plot: Path | None, as_json: bool,
                    require: str | None) -> None:
     """Several worlds or ``--runs``: the outcome table (or JSON) and the runs' picture; after
     Ctrl-C, what finished."""
@@ -392,8 +403,9 @@ def _simulate_many(loaded, runs: int, seed, planner, workers, plot, as_json: boo
         raise typer.Exit(3)
 
 
-def _simulate_one(world, planner, seed, randomise: bool, live: bool, speed, trace: bool,
-                  every: int, as_json: bool, out, plot, animate, fps: float,
+def _simulate_one(world: World, planner: Planner, seed: int | None, randomise: bool, live: bool,
+                  speed: float | None, trace: bool, every: int, as_json: bool, out: Path | None,
+                  plot: Path | None, animate: Path | None, fps: float,
                   require: str | None) -> None:
     """One run: its verdict and figures (or JSON), and the trace, CSV, picture and
     animation asked for."""
@@ -425,7 +437,8 @@ def _simulate_one(world, planner, seed, randomise: bool, live: bool, speed, trac
     sys.stdout.flush()
 
 
-def _write_outputs(res, planner, out, plot, animate, fps: float, written: list[str]) -> int:
+def _write_outputs(res: SimResult, planner: Planner, out: Path | None, plot: Path | None,
+                  animate: Path | None, fps: float, written: list[str]) -> int:
     """The CSV, picture and animation asked for (each named in ``written`` once it is), and
     the animation's frames."""
     if out is not None:
@@ -454,7 +467,8 @@ def _interrupted_writing(written: list[str]) -> str:
     return f"interrupted: wrote {' and '.join(written)}; the rest is not written"
 
 
-def _run_one(world, planner, seed, randomise: bool, live: bool, speed):
+def _run_one(world: World, planner: Planner, seed: int | None, randomise: bool, live: bool,
+            speed: float | None) -> SimResult:
     """The run, shown live on the terminal if asked; Ctrl-C ends the command, writing
     nothing."""
     from ..sim.loop import prepare, shared_scene, simulate

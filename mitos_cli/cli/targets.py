@@ -33,7 +33,7 @@ def check_directory(path: Path) -> None:
     check_writable(path)
 
 
-def source_files(rulebase, path: Path) -> list[tuple[Path, str]]:
+def source_files(rulebase: object, path: Path) -> list[tuple[Path, str]]:
     """The files ``rulebase`` was read from, each with a phrase saying what it is: the rule
     file and the term sets its ``terms`` line names."""
     files = [(path, "the input")]

@@ -3,12 +3,17 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
 import typer
 
 from ..words import plural
 from .params import WORDS, named
+
+if TYPE_CHECKING:
+    from collections.abc import Callable
+
+    from ..teach.session import Session
 
 
 class Transcript:
@@ -29,7 +34,7 @@ class Transcript:
         target = self.commands[-1]["output"] if self.commands else self.before
         target.extend(str(text).splitlines())
 
-    def to_json(self, session_dir: Path, session) -> str:
+    def to_json(self, session_dir: Path, session: Session) -> str:
         import json
 
         state = session.state
@@ -90,7 +95,8 @@ def teach_command(
     interact(session, session.journal.directory / "history")
 
 
-def _check_options(rules, behavior, lesson, save_as, resume: bool, session_name, recover: bool,
+def _check_options(rules: str | None, behavior: str | None, lesson: str | None, save_as: str | None,
+                  resume: bool, session_name: str | None, recover: bool,
                    as_json: bool) -> None:
     """The options that do not go together, before a session is opened or created."""
     from ..teach.save import nameless
@@ -113,7 +119,8 @@ def _check_options(rules, behavior, lesson, save_as, resume: bool, session_name,
                                  "behavior; give neither RULES nor --behavior")
 
 
-def _resumed(session_name, recover: bool, save_as, out):
+def _resumed(session_name: str | None, recover: bool, save_as: str | None,
+            out: Callable[[str], None]) -> Session:
     """The session ``--resume`` continues, replayed from its journal; what was found in the
     journal is said on stderr."""
     from ..errors import LessonError
@@ -145,7 +152,8 @@ def _resumed(session_name, recover: bool, save_as, out):
     return session
 
 
-def _new_session(rules, behavior, lesson, save_as, out):
+def _new_session(rules: str | None, behavior: str | None, lesson: str | None, save_as: str | None,
+                out: Callable[[str], None]) -> tuple[Session, tuple[str, str] | None]:
     """A new session on ``rules`` (a path, or a packaged rule base's name, as ``eval`` and
     ``check`` take it) and the lesson's text, read first: a bad rule file, behavior or
     lesson is refused before a session exists (an empty session would be the newest, the one
@@ -199,7 +207,7 @@ def _new_session(rules, behavior, lesson, save_as, out):
     return session, lesson_text
 
 
-def _ended_open(session, text: str, name: str) -> None:
+def _ended_open(session: Session, text: str, name: str) -> None:
     """A lesson that ends with a behavior still open, told at the line that opened it (or at
     the lesson's end, when it was open before): a warning, since the session keeps it open
     for ``--resume`` to close; with ``--save-as`` an error, since the save asked for cannot be
@@ -219,7 +227,8 @@ def _ended_open(session, text: str, name: str) -> None:
         f"`end` closes it (`{resume}`)")
 
 
-def _teach_lesson(session, lesson: str, lesson_text, transcript: Transcript | None) -> None:
+def _teach_lesson(session: Session, lesson: str, lesson_text: tuple[str, str] | None,
+                  transcript: Transcript | None) -> None:
     """Run a lesson file (or stdin) in ``session``; save where ``--save-as`` says if it ends
     with changes unsaved. Ctrl-C keeps every change (the journal has them)."""
     from ..errors import MitosError

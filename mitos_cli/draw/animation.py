@@ -14,6 +14,7 @@ import functools
 import math
 import numbers
 from pathlib import Path
+from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 
@@ -22,6 +23,20 @@ from ..numbers import whole_number
 from ..words import plural
 from .frame import OBSTACLE_COLOUR, ROBOT_COLOUR, TRAIL_COLOUR, draw_background, show_routes
 from .output import DrawError, _matplotlib, file_path, literal_text, new_figure
+
+if TYPE_CHECKING:
+    from collections.abc import Callable, Iterable
+
+    from matplotlib.animation import AbstractMovieWriter
+    from matplotlib.axes import Axes
+    from matplotlib.backend_bases import RendererBase
+    from matplotlib.collections import PolyCollection
+    from matplotlib.figure import Figure
+
+    from ..engine.evaluation import Result
+    from ..sim.loop import SimResult
+    from ..sim.staticmap import StaticMap
+    from ..sim.world import World
 
 FORMATS = ("gif", "mp4")
 BARS = 8                    # fired rules shown, by DOF
@@ -84,7 +99,7 @@ def check_width(width_px: object) -> int:
     return n
 
 
-def _check_detail(detail, ticks: int) -> None:
+def _check_detail(detail: object, ticks: int) -> None:
     """``detail`` if it is an engine result of one row per tick of the run (``explain(result,
     planner)``), else an :class:`InputError`: another run's drew its fired rules under this
     one's frames without a word, and a shorter one met an IndexError."""
@@ -102,7 +117,7 @@ def _check_detail(detail, ticks: int) -> None:
                               "result")
 
 
-def animate_run(result, path: str | Path, *, fps: float = 10.0, detail=None,
+def animate_run(result: SimResult, path: str | Path, *, fps: float = 10.0, detail: Result | None = None,
                 width_px: int = 720) -> int:
     """Write ``result`` as an animation to ``path``; ``detail`` is the planner's engine result
     for robot 0 (rows = ticks, :func:`mitos_cli.sim.export.explain`) for the DOF panel.
@@ -128,9 +143,10 @@ class _Scene:
 
     PAD = 20.0                                 # world units round the map
 
-    def __init__(self, result, detail, width_px: int, dpi: int) -> None:
+    def __init__(self, result: SimResult, detail: Result | None, width_px: int, dpi: int) -> None:
         self.result, self.detail = result, detail
-        xmin, ymin, xmax, ymax = result.static.bounds
+        static = cast("StaticMap", result.static)                  # (a run has its map)
+        xmin, ymin, xmax, ymax = static.bounds
         w, h = xmax - xmin + 2 * self.PAD, ymax - ymin + 2 * self.PAD
         fw = width_px / dpi
         map_h = max(1.0, min(fw * h / w, 9.0))
@@ -142,13 +158,13 @@ class _Scene:
         ax.set_aspect("equal")
         ax.set_axis_off()
         ax.set_facecolor("#d9d9d9")
-        self.route_lines = draw_background(ax, result.world, result.static, result.routes)
+        self.route_lines = draw_background(ax, result.world, static, result.routes)
         ax.set_xlim(xmin - self.PAD, xmax + self.PAD)
         ax.set_ylim(ymin - self.PAD, ymax + self.PAD)
         self.title = self.fig.text(0.01, 1.0 - 0.17 / fh, "", fontsize=10, va="center")
         self.obstacles = _obstacle_patches(ax, result.world)
         self.robots, self.trails = _robot_patches(ax, result.world, result.pose.shape[1])
-        self.cones = _cone_collection(ax, result.static.bounds)
+        self.cones = _cone_collection(ax, static.bounds)
         self.half_cone = max(result.world.sensors.cone, 2.0) / 2
         self.bars: list | None = None
         self.texts: list[_SlotText] | None = None
@@ -192,7 +208,8 @@ class _Scene:
         self.cones.set_verts(list(np.concatenate(sectors)))
 
     def _draw_dofs(self, k: int, bars: list, texts: list[_SlotText]) -> None:
-        dof, compiled = self.detail.dof[k], self.detail.compiled
+        detail = cast("Result", self.detail)                       # (drawn only with a detail)
+        dof, compiled = cast(np.ndarray, detail.dof)[k], detail.compiled
         order = [r for r in np.argsort(-dof, kind="stable")[:BARS] if dof[r] > 0]
         for slot, (bar, text) in enumerate(zip(bars, texts)):
             r = order[slot] if slot < len(order) else None
@@ -201,7 +218,7 @@ class _Scene:
                                               f"{compiled.labels[r]}: {compiled.rule_text(r)}"))
 
 
-def _obstacle_patches(ax, world) -> list:
+def _obstacle_patches(ax: Axes, world: World) -> list:
     """Each obstacle of ``world`` with its patch (placed by :meth:`_Scene.draw`)."""
     from matplotlib.patches import Circle, Polygon
 
@@ -215,7 +232,7 @@ def _obstacle_patches(ax, world) -> list:
     return obstacles
 
 
-def _robot_patches(ax, world, n: int) -> tuple[list, list]:
+def _robot_patches(ax: Axes, world: World, n: int) -> tuple[list, list]:
     """Each robot's body (with its robot) and trail: the first in the robot's colours, the
     others in :data:`OTHER_ROBOTS`."""
     from matplotlib.patches import Polygon
@@ -233,7 +250,7 @@ def _robot_patches(ax, world, n: int) -> tuple[list, list]:
     return robots, trails
 
 
-def _cone_collection(ax, bounds):
+def _cone_collection(ax: Axes, bounds: tuple[float, float, float, float]) -> PolyCollection:
     """The sonar cones' collection, clipped to the map: no cone past the outer walls."""
     from matplotlib.collections import PolyCollection
     from matplotlib.patches import Rectangle
@@ -245,7 +262,7 @@ def _cone_collection(ax, bounds):
     return cones
 
 
-def _dof_panel(fig, fh: float, panel_h: float, dpi: int) -> tuple[list, list]:
+def _dof_panel(fig: Figure, fh: float, panel_h: float, dpi: int) -> tuple[list, list]:
     """The panel of the fired rules under the map: :data:`BARS` bars and their texts."""
     bax = fig.add_axes((0.01, 0.05 / fh, 0.98, (panel_h - 0.1) / fh))
     bax.set_xlim(0, 1)
@@ -278,7 +295,7 @@ class _SlotText:
     FONTSIZE = 7
     _cache: dict[tuple[str, int], np.ndarray] = {}
 
-    def __init__(self, fig, bax, slot: int, dpi: int) -> None:
+    def __init__(self, fig: Figure, bax: Axes, slot: int, dpi: int) -> None:
         self.dpi = dpi
         x, y = bax.transData.transform((0.003, slot))      # pixels; the text's middle
         gap = self.bitmap("0.00  ").shape[1]                # the rule after the DOF
@@ -289,7 +306,7 @@ class _SlotText:
     def show(self, texts: tuple[str, str] | None) -> None:
         """Show ``(dof, rule)``, or nothing."""
         for image, text in zip((self.dof, self.rule), texts or ("", "")):
-            image.pixels = self.bitmap(text) if text else None
+            image.pixels = self.bitmap(text) if text else None   # type: ignore[attr-defined]  # (a Bitmap)
 
     def bitmap(self, text: str) -> np.ndarray:
         """``text`` drawn in black on a clear ground, cropped to its line (RGBA, uint8)."""
@@ -314,7 +331,7 @@ def _bitmap_class() -> type:
             self.pixels: np.ndarray | None = None
             self.set_zorder(5)
 
-        def draw(self, renderer) -> None:
+        def draw(self, renderer: RendererBase) -> None:
             if self.pixels is None or not self.get_visible():
                 return
             gc = renderer.new_gc()
@@ -353,7 +370,7 @@ def _gif_writer() -> type:
     class GifWriter(animation.PillowWriter):
         _frames: list                            # PillowWriter's, set up by its setup()
 
-        def grab_frame(self, **savefig_kwargs) -> None:
+        def grab_frame(self, **savefig_kwargs: Any) -> None:      # savefig's own
             super().grab_frame(**savefig_kwargs)
             frame = self._frames[-1]
             if frame.mode == "RGB":              # not a frame with transparency
@@ -362,7 +379,8 @@ def _gif_writer() -> type:
     return GifWriter
 
 
-def _save(fig, draw, picked, writer, path: Path, fmt: str, dpi: int) -> None:
+def _save(fig: Figure, draw: Callable[[int], object], picked: Iterable[int], writer: AbstractMovieWriter,
+          path: Path, fmt: str, dpi: int) -> None:
     """One canvas draw per frame into matplotlib's writer. The writers want a file name:
     write beside the target, then rename it into place (a stopped run leaves no half-written
     animation), through a link as every other file is written (the link was replaced by the

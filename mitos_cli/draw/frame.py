@@ -5,10 +5,22 @@ environment's ``rgb_array`` render)."""
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from .output import _matplotlib, literal_text, new_figure
 from .world import draw_grid
+
+if TYPE_CHECKING:
+    from collections.abc import Iterable, Sequence
+
+    from matplotlib.axes import Axes
+    from numpy.typing import ArrayLike
+
+    from ..sim.route import Route
+    from ..sim.staticmap import StaticMap
+    from ..sim.world import World
 
 ROBOT_COLOUR = "#1f5fbf"     # the footprint (a test looks for this colour in the frames)
 TRAIL_COLOUR = "#2ca02c"
@@ -21,7 +33,8 @@ class RunFrame:
     places, ``trail [T, 2]`` the path so far. ``show`` draws into a window instead (pyplot;
     :class:`~mitos_cli.draw.output.DrawError` where none can open)."""
 
-    def __init__(self, world, static, routes, *, width_px: int = 640, show: bool = False) -> None:
+    def __init__(self, world: World, static: StaticMap, routes: Sequence[Route], *, width_px: int = 640,
+                 show: bool = False) -> None:
         _matplotlib()
         from matplotlib.patches import Circle, Polygon
 
@@ -57,7 +70,8 @@ class RunFrame:
         ax.set_ylim(ymin - pad, ymax + pad)
         literal_text(self.fig)          # a world's name or label is drawn as written
 
-    def update(self, pose, obstacles, trail, t: float | None = None, routes=None) -> None:
+    def update(self, pose: np.ndarray, obstacles: np.ndarray, trail: ArrayLike,
+               t: float | None = None, routes: Sequence[Route] | None = None) -> None:
         """Move the artists to this moment; ``routes``, the robots' routes now (a replan
         changes them; the frame showed the first ones to the end)."""
         from matplotlib.patches import Circle
@@ -79,12 +93,13 @@ class RunFrame:
         if t is not None:
             self._title.set_text(f"{self.world.name}  t = {t:5.2f} s")
 
-    def rgb(self, pose, obstacles, trail, t: float | None = None, routes=None) -> np.ndarray:
+    def rgb(self, pose: np.ndarray, obstacles: np.ndarray, trail: ArrayLike,
+            t: float | None = None, routes: Sequence[Route] | None = None) -> np.ndarray:
         """The frame as ``uint8 [H, W, 3]``."""
         self.update(pose, obstacles, trail, t, routes)
         canvas = self.fig.canvas
         canvas.draw()
-        return np.asarray(canvas.buffer_rgba())[..., :3].copy()
+        return np.asarray(canvas.buffer_rgba())[..., :3].copy()    # type: ignore[attr-defined]  # (Agg)
 
     def close(self) -> None:
         import sys
@@ -95,13 +110,13 @@ class RunFrame:
             plt.close(self.fig)
 
 
-def show_routes(lines: list, routes) -> None:
+def show_routes(lines: list, routes: Iterable[Route]) -> None:
     """Move each robot's route line (:func:`draw_background`'s) to its route now."""
     for line, route in zip(lines, routes):
         line.set_data(route.points[:, 0], route.points[:, 1])
 
 
-def draw_background(ax, world, static, routes) -> list:
+def draw_background(ax: Axes, world: World, static: StaticMap, routes: Sequence[Route]) -> list:
     """What does not move but the routes: free space, walls, the routes (whose lines it
     returns: a replan moves them, :func:`show_routes`) and the goals."""
     from matplotlib.collections import LineCollection
@@ -111,7 +126,8 @@ def draw_background(ax, world, static, routes) -> list:
         draw_grid(ax, static.grid)
     for corners in static.rects:
         ax.add_patch(Polygon(corners, closed=True, facecolor="white", edgecolor="none"))
-    ax.add_collection(LineCollection(static.walls.reshape(-1, 2, 2), colors="black",
+    ax.add_collection(LineCollection(static.walls.reshape(-1, 2, 2),  # type: ignore[arg-type]
+                                     colors="black",
                                      linewidths=1.0))
     lines = [ax.plot(route.points[:, 0], route.points[:, 1], ls="--", lw=0.7,
                      color="#4a78b5")[0] for route in routes]

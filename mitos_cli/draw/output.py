@@ -10,8 +10,14 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 from ..errors import MitosError
+
+if TYPE_CHECKING:
+    from types import ModuleType
+
+    from matplotlib.figure import Figure
 
 #: The file formats a picture can be written in, by extension.
 FORMATS = ("png", "svg")
@@ -52,7 +58,7 @@ def check_format(path: str | Path) -> str:
     return suffix
 
 
-def _matplotlib():
+def _matplotlib() -> ModuleType:
     try:
         import matplotlib
     except ImportError:
@@ -91,7 +97,7 @@ def no_window() -> str | None:
     return f"matplotlib's backend `{backend}` cannot open windows"
 
 
-def new_figure(figsize: tuple[float, float], show: bool = False, **kwargs):
+def new_figure(figsize: tuple[float, float], show: bool = False, **kwargs: Any) -> Figure:  # Figure's own
     """A new figure: managed by pyplot (and an interactive backend) when ``show``, else a
     bare Figure on an Agg canvas."""
     _matplotlib()
@@ -116,7 +122,7 @@ def new_figure(figsize: tuple[float, float], show: bool = False, **kwargs):
     return fig
 
 
-def literal_text(fig) -> None:
+def literal_text(fig: Figure) -> None:
     """Every text of ``fig`` drawn as it is written: a ``$`` in a title, a world's name or a
     unit is a dollar sign, not the start of matplotlib's mathtext (which stops on ``$x^$``
     with a traceback when the figure is drawn)."""
@@ -126,8 +132,8 @@ def literal_text(fig) -> None:
         text.set_parse_math(False)
 
 
-def finish(fig, path: str | Path | None = None, show: bool = False, dpi: int = 150,
-           tight: bool = True):
+def finish(fig: Figure, path: str | Path | None = None, show: bool = False, dpi: int = 150,
+           tight: bool = True) -> Figure:
     """Save ``fig`` to ``path`` (atomically: a temporary file renamed into place), then show
     it when asked; ``tight`` trims the margins (one more layout pass). Returns the figure."""
     literal_text(fig)

@@ -17,6 +17,7 @@ an axes per column with the scales. Artists carry ``gid`` ``"<label>:<variable>"
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -25,6 +26,12 @@ from ..numbers import whole_number
 from ..words import plural
 from .data import OutputView, RuleRow, RuleView
 from .output import finish, new_figure
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
+
+    from .data.ruleviews import InputValue
 
 TERM_COLOR = "#1f77b4"
 FILL_COLOR = "#f2b134"
@@ -38,13 +45,13 @@ LABEL_PAD = 6.0     # pt between a row's label and its first cell
 LABEL_SIZE = 8      # pt, the row labels and "aggregate"
 
 
-def _bare(ax) -> None:
+def _bare(ax: Axes) -> None:
     ax.set_yticks([])
     for side in ("top", "right", "left"):
         ax.spines[side].set_visible(False)
 
 
-def _label(ax, x: float, y: float, text: str) -> None:
+def _label(ax: Axes, x: float, y: float, text: str) -> None:
     """A cell's caption at its top left (``x`` in axes fraction, ``y`` in data)."""
     ax.text(x, y, text, transform=ax.get_yaxis_transform(), fontsize=7, va="top",
             color="#333333", zorder=10,
@@ -52,7 +59,7 @@ def _label(ax, x: float, y: float, text: str) -> None:
                       alpha=0.75))
 
 
-def draw_antecedent(ax, base: float, row: RuleRow, var: str) -> None:
+def draw_antecedent(ax: Axes, base: float, row: RuleRow, var: str) -> None:
     """The propositions of ``row`` on ``var`` in the band at ``base``: each term curve, filled
     up to its membership (after hedges and ``not``)."""
     props = [p for p in row.props if p.var == var]
@@ -95,7 +102,7 @@ def spikes(grid: np.ndarray, y: np.ndarray, cells: int = 3) -> list[tuple[float,
     return [(float(grid[k]), float(y[k])) for k in peaks]
 
 
-def draw_consequent(ax, base: float, row: RuleRow, out: OutputView) -> None:
+def draw_consequent(ax: Axes, base: float, row: RuleRow, out: OutputView) -> None:
     """The consequent of ``row`` for ``out`` in the band at ``base``."""
     for c in (c for c in row.consequents if c.output == out.name):
         gid = f"{row.label}:{out.name}"
@@ -126,7 +133,7 @@ def draw_consequent(ax, base: float, row: RuleRow, out: OutputView) -> None:
         _label(ax, 0.02, base + BAND + 0.12, name)
 
 
-def draw_aggregate(ax, out: OutputView) -> None:
+def draw_aggregate(ax: Axes, out: OutputView) -> None:
     """An output's aggregate (summed DOFs or aggregated set) and its crisp result."""
     lo, hi = out.universe
     gid = f"aggregate:{out.name}"
@@ -170,7 +177,7 @@ def draw_aggregate(ax, out: OutputView) -> None:
 
 
 def draw_rules(view: RuleView, path: str | Path | None = None, *, title: str | None = None,
-               show: bool = False, max_rows: int = MAX_ROWS):
+               show: bool = False, max_rows: int = MAX_ROWS) -> Figure:
     """Draw the rule viewer to ``path`` (.png/.svg) and/or a window; returns the figure.
 
     With more than ``max_rows`` fired rules the strongest ``max_rows`` are drawn (in
@@ -251,7 +258,7 @@ def _strongest(rows: list, max_rows: int) -> tuple[list, int]:
     return [rows[i] for i in keep], len(rows) - max_rows
 
 
-def _input_column(ax, inp, rows: list, bases: list[int], n: int, first: bool) -> None:
+def _input_column(ax: Axes, inp: InputValue, rows: list, bases: list[int], n: int, first: bool) -> None:
     """An input's column: each rule's antecedent term on its row, the input's value across;
     the first column also labels the rows with the rules and their DOFs."""
     _bare(ax)
@@ -274,7 +281,7 @@ def _input_column(ax, inp, rows: list, bases: list[int], n: int, first: bool) ->
         ax.text(0.02, 0.5, "no rule fired", transform=ax.transAxes, fontsize=9)
 
 
-def _output_column(ax, out, rows: list, bases: list[int], n: int) -> None:
+def _output_column(ax: Axes, out: OutputView, rows: list, bases: list[int], n: int) -> None:
     """An output's column: each rule's consequent, clipped by its DOF, on its row."""
     _bare(ax)
     ax.set_xticks([])
@@ -289,7 +296,7 @@ def _output_column(ax, out, rows: list, bases: list[int], n: int) -> None:
     ax.set_title(out.name, fontsize=9, pad=3)
 
 
-def _input_scale(ax, inp, first: bool) -> None:
+def _input_scale(ax: Axes, inp: InputValue, first: bool) -> None:
     """Under an input's column, its scale and value (the first labels the row)."""
     _bare(ax)
     ax.tick_params(axis="x", labelsize=7, length=2)

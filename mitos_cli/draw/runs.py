@@ -6,17 +6,26 @@ randomised runs move them). Draws a :class:`~mitos_cli.draw.data.overlay.RunsOve
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from .output import _matplotlib, finish
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
+
+    from ..sim.loop import Scene
+    from ..sim.world import World
+    from .data.overlay import RunsOverlay
 
 #: a colour per outcome (success green, collision red, timeout amber, stuck purple)
 COLOURS = {"success": "#2f8f3f", "collision": "#c8322a", "timeout": "#d99a1e",
            "stuck": "#7a4ab5"}
 
 
-def draw_runs(overlay, world, scene, path: str | Path | None = None, *, show: bool = False):
+def draw_runs(overlay: RunsOverlay, world: World, scene: Scene, path: str | Path | None = None, *,
+              show: bool = False) -> Figure:
     """Draw ``overlay`` (the runs of ``world``, whose map and routes are ``scene``'s); save to
     ``path`` (.png or .svg) and/or ``show``. Returns the figure."""
     _matplotlib()

@@ -7,11 +7,45 @@ from __future__ import annotations
 
 import textwrap
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from .output import literal_text
 
+if TYPE_CHECKING:
+    from collections.abc import Callable, Mapping, Sequence
+    from types import ModuleType
+    from typing import Protocol
 
-def _pyplot():
+    from matplotlib.figure import Figure
+
+    # what success_bars reads of a study's summaries (mitos_cli.study.summary.Summary, of a
+    # layer above this one, which it may not import)
+    class _Rate(Protocol):
+        @property
+        def value(self) -> float | None: ...
+        @property
+        def lo(self) -> float: ...
+        @property
+        def hi(self) -> float: ...
+        @property
+        def k(self) -> int: ...
+        @property
+        def n(self) -> int: ...
+
+    class _Choice(Protocol):
+        @property
+        def label(self) -> str: ...
+
+    class _Summary(Protocol):
+        @property
+        def world(self) -> str: ...
+        @property
+        def choice(self) -> _Choice: ...
+        @property
+        def rates(self) -> Mapping[str, _Rate]: ...
+
+
+def _pyplot() -> ModuleType:
     import matplotlib
 
     matplotlib.use("Agg", force=False)
@@ -31,7 +65,8 @@ def _names(worlds: list[str]) -> dict[str, str]:
     return {w: w if stems.count(_short(w)) > 1 else _short(w) for w in worlds}
 
 
-def success_bars(summaries, worlds: list[str], labels: list[str], path: str | Path) -> Path:
+def success_bars(summaries: Sequence[_Summary], worlds: list[str], labels: list[str],
+                 path: str | Path) -> Path:
     """Grouped bars: success rate per world (groups) and choice (bars), Wilson 95% whiskers.
 
     ``summaries`` are :class:`mitos_cli.study.summary.Summary` objects.
@@ -81,7 +116,7 @@ def success_bars(summaries, worlds: list[str], labels: list[str], path: str | Pa
 
 
 def clearance_boxes(rows: list[dict], worlds: list[str], labels: list[str],
-                    label_of, path: str | Path) -> Path:
+                    label_of: Callable[[dict], str], path: str | Path) -> Path:
     """One panel per world, one box per choice: minimum clearance (in) over all runs."""
     plt = _pyplot()
     n_w = len(worlds)
@@ -125,7 +160,7 @@ def clearance_boxes(rows: list[dict], worlds: list[str], labels: list[str],
     return _save(fig, plt, path)
 
 
-def _save(fig, plt, path) -> Path:
+def _save(fig: Figure, plt: ModuleType, path: str | Path) -> Path:
     """Write ``fig`` to ``path`` as PNG, atomically: a directory (or an unwritable place)
     there is the :class:`WriteError` every command gives, where the rename into it was a
     traceback at the end of the study, its temporary file left behind."""

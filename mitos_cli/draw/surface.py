@@ -9,12 +9,19 @@ from __future__ import annotations
 
 import textwrap
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..errors import InputError, unknown
 from .data import Surface
 from .output import finish, new_figure
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
+    from matplotlib.patches import Patch, Rectangle
+    from mpl_toolkits.mplot3d import Axes3D
 
 STYLES = ("surface", "heatmap")
 CMAP = "viridis"
@@ -29,7 +36,7 @@ def title_of(s: Surface) -> str:
     return text
 
 
-def _no_rule_patch(s: Surface):
+def _no_rule_patch(s: Surface) -> Patch:
     from matplotlib.patches import Patch
 
     return Patch(facecolor="white", edgecolor=HATCH_COLOR, hatch="///",
@@ -53,7 +60,7 @@ def _nan_spans(x: np.ndarray, mask: np.ndarray) -> list[tuple[float, float]]:
     return spans
 
 
-def draw_curve(ax, s: Surface) -> None:
+def draw_curve(ax: Axes, s: Surface) -> None:
     """One input: the output as a line; spans where nothing fires shaded and hatched."""
     x, z = s.x.values, s.z
     ax.plot(x, z, color="#1f77b4", linewidth=2.2, label=s.output)
@@ -93,7 +100,7 @@ def _levels(z: np.ndarray, n: int = 10) -> np.ndarray | None:
     return levels[(levels > finite.min()) & (levels < finite.max())]
 
 
-def draw_heatmap(fig, ax, s: Surface) -> None:
+def draw_heatmap(fig: Figure, ax: Axes, s: Surface) -> None:
     """Heat map with labelled contour lines; masked (blank, hatched) where nothing fires."""
     assert s.y is not None, "a heat map has two inputs"
     z = np.ma.masked_invalid(s.z)
@@ -115,7 +122,7 @@ def draw_heatmap(fig, ax, s: Surface) -> None:
         ax.legend(handles=[_no_rule_patch(s)], loc="upper right", fontsize=8)
 
 
-def _background(ax):
+def _background(ax: Axes) -> Rectangle:
     """A hatched rectangle under the mesh: it shows through the masked cells."""
     from matplotlib.patches import Rectangle
 
@@ -123,7 +130,7 @@ def _background(ax):
                      edgecolor=HATCH_COLOR, hatch="///", linewidth=0, zorder=0)
 
 
-def draw_surface3d(fig, ax, s: Surface) -> None:
+def draw_surface3d(fig: Figure, ax: Axes3D, s: Surface) -> None:
     """A shaded 3-D surface with its contours projected on the floor; masked cells are
     left out (holes), and a note says so."""
     assert s.y is not None, "a surface has two inputs"
@@ -159,7 +166,7 @@ def draw_surface3d(fig, ax, s: Surface) -> None:
 
 
 def draw_surface(s: Surface, path: str | Path | None = None, *, style: str = "surface",
-                 title: str | None = None, show: bool = False):
+                 title: str | None = None, show: bool = False) -> Figure:
     """Draw ``s`` (a curve when it has one input) to ``path`` (.png/.svg) and/or a window."""
     if style not in STYLES:         # (a bare ValueError, without a "did you mean")
         raise unknown("style", f"{style!s:.40}", STYLES, cls=InputError)

@@ -9,10 +9,15 @@ term that owns most of its dots.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING, cast
+
 import numpy as np
 
 from ..words import plural
 from .data import RuleView, Surface, TermCurve, VariablePlot, visible
+
+if TYPE_CHECKING:
+    from .data.ruleviews import ConsequentView, OutputView
 
 BRAILLE = 0x2800
 #: dot (row, column) inside a cell -> bit of the Braille code point
@@ -221,7 +226,7 @@ def _bar(value: float, width: int = 10) -> str:
     return text.ljust(width)
 
 
-def _consequent_text(c) -> str:
+def _consequent_text(c: ConsequentView) -> str:
     if c.term is None:
         return f"{c.output} is {c.value:g}"
     text = f"{c.output} is {' '.join(c.hedges + (c.term,))}"
@@ -265,9 +270,10 @@ def render_rule_view(view: RuleView, width: int = 72, color: bool = False) -> st
     return "\n".join(out)
 
 
-def _aggregate_plot(o, width: int, color: bool) -> str:
+def _aggregate_plot(o: OutputView, width: int, color: bool) -> str:
     """A Mamdani output's aggregated set as a small Braille plot with the result marked."""
-    curve = TermCurve("aggregate", "curve", o.grid, o.aggregate, o.value, o.value)
+    grid, aggregate = cast(np.ndarray, o.grid), cast(np.ndarray, o.aggregate)    # (Mamdani's)
+    curve = TermCurve("aggregate", "curve", grid, aggregate, o.value, o.value)
     plot = VariablePlot(o.name, "output", o.unit, "", o.universe, (curve,), o.value)
     lines = render_variable(plot, width=width - 4, height=5, color=color).splitlines()
     return "\n".join("    " + line for line in lines[2:-1])   # no heading, labels, value line

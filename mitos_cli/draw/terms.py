@@ -11,6 +11,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -19,6 +20,10 @@ from ..lang.terms import Variable
 from ..numbers import whole_number
 from .data import VariablePlot, variable_plot, visible
 from .output import finish, literal_text, new_figure
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
 
 #: term colours (matplotlib's tab10, colour-blind friendlier than the default cycle's order)
 COLORS = ("#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#17becf", "#8c564b",
@@ -32,7 +37,7 @@ def color(i: int) -> str:
     return COLORS[i % len(COLORS)]
 
 
-def style_axes(ax, plot: VariablePlot) -> None:
+def style_axes(ax: Axes, plot: VariablePlot) -> None:
     """Limits, labels and a light grid for a membership panel."""
     lo, hi = plot.universe
     # stems at the ends of the universe stay visible with a small margin
@@ -48,12 +53,12 @@ def style_axes(ax, plot: VariablePlot) -> None:
         ax.spines[side].set_visible(False)
 
 
-def draw_curves(ax, plot: VariablePlot, *, colors: Sequence[str] | None = None,
+def draw_curves(ax: Axes, plot: VariablePlot, *, colors: Sequence[str] | None = None,
                 linestyle: str = "-", alpha: float = 1.0, fill: bool = True,
                 labels: bool = True) -> list:
     """The terms of ``plot`` on ``ax`` (``colors[i]`` for curve ``i``, default the palette);
     returns the artists, whose data are the curves'."""
-    artists = []
+    artists: list = []
     for i, curve in enumerate(plot.curves):
         c = colors[i] if colors is not None else color(i)
         if curve.kind == "curve":
@@ -81,7 +86,7 @@ def draw_curves(ax, plot: VariablePlot, *, colors: Sequence[str] | None = None,
     return artists
 
 
-def stagger_labels(fig) -> None:
+def stagger_labels(fig: Figure) -> None:
     """Lift a term label one step where it would overlap the one to its left, measured on the
     laid-out figure (so long names such as MODERATE next to MEDIUM stay readable). The texts
     are made literal first: laying out parses them, and a `$$` in a description is no
@@ -90,7 +95,7 @@ def stagger_labels(fig) -> None:
     engine = fig.get_layout_engine()
     if engine is not None:
         engine.execute(fig)                     # place the axes as the saved figure has them
-    renderer = fig.canvas.get_renderer()
+    renderer = fig.canvas.get_renderer()     # type: ignore[attr-defined]  # (an Agg canvas)
     for ax in fig.axes:
         labels = sorted((t for t in ax.texts if t.get_gid() == "term-label"),
                         key=lambda t: t.get_position()[0])
@@ -106,7 +111,7 @@ def stagger_labels(fig) -> None:
                 text.set_position((x, y + LABEL_STEP))
 
 
-def mark_value(ax, plot: VariablePlot) -> None:
+def mark_value(ax: Axes, plot: VariablePlot) -> None:
     """The value as a dashed line, its memberships as dots with their numbers."""
     if plot.value is None:
         return
@@ -143,7 +148,7 @@ def panel_title(plot: VariablePlot, width: int = 60) -> str:
     return title
 
 
-def draw_panel(ax, plot: VariablePlot, title_width: int = 60) -> list:
+def draw_panel(ax: Axes, plot: VariablePlot, title_width: int = 60) -> list:
     """One variable on one axes: terms, labels, the marked value and its memberships."""
     style_axes(ax, plot)
     artists = draw_curves(ax, plot)
@@ -153,7 +158,7 @@ def draw_panel(ax, plot: VariablePlot, title_width: int = 60) -> list:
 
 
 def draw_sheet(plots: Sequence[VariablePlot], path: str | Path | None = None, *,
-               title: str | None = None, show: bool = False, columns: int = 3):
+               title: str | None = None, show: bool = False, columns: int = 3) -> Figure:
     """All variables on one sheet: inputs in rows of up to ``columns`` panels, outputs on rows
     of their own (the paper's Figures 5-7 above, 8-9 below), each row filling the width.
     Written to ``path`` (.png or .svg) and/or shown; returns the figure."""
@@ -193,7 +198,7 @@ def draw_sheet(plots: Sequence[VariablePlot], path: str | Path | None = None, *,
 
 def draw_terms_before_after(variable_before: Variable, variable_after: Variable,
                             path: str | Path | None, *, title: str | None = None,
-                            show: bool = False):
+                            show: bool = False) -> Figure:
     """Show how adaptation moved the terms of one variable.
 
     ``variable_before`` and ``variable_after`` are :class:`mitos_cli.lang.terms.Variable` objects
@@ -268,7 +273,7 @@ def term_changes(variable_before: Variable, variable_after: Variable) -> list[st
     return changes
 
 
-def _colour_order(before, after) -> dict[str, int]:
+def _colour_order(before: VariablePlot, after: VariablePlot) -> dict[str, int]:
     """Each term's colour index: a term keeps its colour in both plots (by its place among
     the after-terms; a removed term after them)."""
     order = {c.name: i for i, c in enumerate(after.curves)}

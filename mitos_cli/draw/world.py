@@ -7,12 +7,22 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING, cast
 
 import numpy as np
 
 from ..errors import InputError
 from ..words import clearance
 from .output import _matplotlib, finish, new_figure
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+    from matplotlib.collections import LineCollection
+    from matplotlib.figure import Figure
+
+    from ..sim.loop import SimResult
+    from ..sim.staticmap import StaticMap
+    from ..sim.world import Agent, Grid
 
 PAD = 20.0      # in round the map
 #: the colours of what is drawn besides the robots: the route, a replanned route, obstacles
@@ -27,7 +37,7 @@ ROBOT_COLOURS = ("#1f5fbf", "#d9731e", "#1f9e89", "#c23b8a", "#8c6d31", "#c9a400
 TIME_STEPS = (1, 2, 5, 10, 15, 20, 30, 60, 120, 300, 600)     # s between time marks
 
 
-def inward(ax, x: float, y: float, gap: float = 7.0, above: bool | None = None) -> dict:
+def inward(ax: Axes, x: float, y: float, gap: float = 7.0, above: bool | None = None) -> dict:
     """``annotate`` arguments that put a label beside ``(x, y)`` on the side facing the middle
     of the axes, so that a label near an edge is not cut off (or pressed against it);
     ``above`` forces the vertical side."""
@@ -39,7 +49,7 @@ def inward(ax, x: float, y: float, gap: float = 7.0, above: bool | None = None) 
             "va": "bottom" if above else "top"}
 
 
-def place_legend(ax, static) -> None:
+def place_legend(ax: Axes, static: StaticMap) -> None:
     """The legend inside the map where there is room, under a long thin map (where inside it
     would cover the corridor)."""
     xmin, ymin, xmax, ymax = static.bounds
@@ -55,7 +65,7 @@ def time_step(t_end: float, most: int = 6) -> float:
     return next((s for s in TIME_STEPS if t_end / s <= most), TIME_STEPS[-1])
 
 
-def time_marks(ax, t: np.ndarray, xy: np.ndarray, step: float, colour: str, *,
+def time_marks(ax: Axes, t: np.ndarray, xy: np.ndarray, step: float, colour: str, *,
                label: str | None = None, near: float = 0.0, above: bool | None = None) -> None:
     """Dots on a track ``xy[T, 2]`` at every ``step`` s of ``t[T]``, each with its time; a label
     is left out where it would fall within ``near`` in of an earlier one (a track that
@@ -73,7 +83,7 @@ def time_marks(ax, t: np.ndarray, xy: np.ndarray, step: float, colour: str, *,
                     **inward(ax, float(xy[k, 0]), float(xy[k, 1]), gap=4.0, above=above))
 
 
-def map_axes(static, *, show: bool = False, extra_width: float = 1.6):
+def map_axes(static: StaticMap, *, show: bool = False, extra_width: float = 1.6) -> tuple[Figure, Axes]:
     """A figure sized to the map and its axes with the map drawn: solid space grey, the free
     grid cells and corridors white, the walls black. Returns ``(fig, ax)``."""
     from matplotlib.collections import LineCollection
@@ -91,7 +101,8 @@ def map_axes(static, *, show: bool = False, extra_width: float = 1.6):
         draw_grid(ax, static.grid)
     for corners in static.rects:
         ax.add_patch(Polygon(corners, closed=True, facecolor="white", edgecolor="none"))
-    ax.add_collection(LineCollection(static.walls.reshape(-1, 2, 2), colors="black",
+    ax.add_collection(LineCollection(static.walls.reshape(-1, 2, 2),  # type: ignore[arg-type]
+                                     colors="black",
                                      linewidths=1.2))
     ax.set_xlim(xmin - PAD, xmax + PAD)
     ax.set_ylim(ymin - PAD, ymax + PAD)
@@ -105,11 +116,11 @@ def map_axes(static, *, show: bool = False, extra_width: float = 1.6):
 DRAWN_CELLS = 2000
 
 
-def draw_grid(ax, grid) -> None:
+def draw_grid(ax: Axes, grid: Grid) -> None:
     """The grid's cells, occupied grey and free white. A map of more than
     :data:`DRAWN_CELLS` cells along a side is drawn in blocks of cells, a block grey where any
     of its cells is occupied (the walls are drawn as lines over it)."""
-    cells = grid.occupied
+    cells: np.ndarray | np.bool_ = grid.occupied   # (NumPy types .any(axis=...) so)
     k = -(-max(cells.shape) // DRAWN_CELLS)
     if k > 1:
         rows, cols = cells.shape
@@ -122,7 +133,7 @@ def draw_grid(ax, grid) -> None:
               extent=(ox, ox + cols * size, oy, oy + rows * size), interpolation="nearest")
 
 
-def _drove(result, i: int) -> np.ndarray:
+def _drove(result: SimResult, i: int) -> np.ndarray:
     """The ticks robot ``i`` drove, and the one it stopped at (arrived or collided)."""
     if result.active is None:
         return np.ones(len(result.t), dtype=bool)
@@ -131,12 +142,12 @@ def _drove(result, i: int) -> np.ndarray:
     return drove
 
 
-def draw_run(result, path: str | Path | None = None, *, footprint_every: float = 1.0,
-             show: bool = False):
+def draw_run(result: SimResult, path: str | Path | None = None, *, footprint_every: float = 1.0,
+             show: bool = False) -> Figure:
     """Draw ``result``; save to ``path`` (.png or .svg) and/or ``show``. Footprints every
     ``footprint_every`` seconds. Returns the figure."""
     _matplotlib()                      # a clear error, not a traceback, without matplotlib
-    world, static = result.world, result.static
+    world, static = result.world, cast("StaticMap", result.static)    # (a run has its map)
     xmin, ymin, xmax, ymax = static.bounds
     fig, ax = map_axes(static, show=show)
     _draw_routes(ax, result)
@@ -189,7 +200,7 @@ class Marks:
     near: float
 
 
-def _draw_routes(ax, result) -> None:
+def _draw_routes(ax: Axes, result: SimResult) -> None:
     """The routes planned at the start (dashed) and each replan (dash-dotted)."""
     for route in result.routes:
         ax.plot(route.points[:, 0], route.points[:, 1], ls="--", lw=0.8, color=ROUTE_COLOUR,
@@ -199,7 +210,7 @@ def _draw_routes(ax, result) -> None:
                 label="replanned route" if n == 0 else None)
 
 
-def _draw_obstacles(ax, result, marks: Marks) -> list[int]:
+def _draw_obstacles(ax: Axes, result: SimResult, marks: Marks) -> list[int]:
     """Each obstacle where it ended; a moving one also where it started (faint) and its
     track with time marks. Returns the moving ones."""
     from matplotlib.patches import Circle, Polygon
@@ -235,8 +246,8 @@ def _draw_obstacles(ax, result, marks: Marks) -> list[int]:
     return tracked
 
 
-def _draw_robot(ax, result, i: int, agent, every: int, vmax: float, marks: Marks,
-                tracked: list[int]):
+def _draw_robot(ax: Axes, result: SimResult, i: int, agent: Agent, every: int, vmax: float, marks: Marks,
+                tracked: list[int]) -> LineCollection | None:
     """Robot ``i``: footprints every ``every`` ticks, its path (coloured by speed when it is
     alone: the line returned, for the colour bar), time marks where obstacles moved, a
     collision, its start and goal."""
@@ -293,7 +304,7 @@ def _draw_robot(ax, result, i: int, agent, every: int, vmax: float, marks: Marks
 LABEL_LIMIT = 12        # obstacles named on a plot; beyond this only the one hit is
 
 
-def _labelled(result) -> set[int]:
+def _labelled(result: SimResult) -> set[int]:
     """The obstacles whose names help: all of a few, else only the one a robot hit (nearest
     to where it stopped), so a generated field of a hundred poles is not written over."""
     obstacles = result.world.obstacles

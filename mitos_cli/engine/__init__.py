@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 
-def __getattr__(name: str):
+def __getattr__(name: str) -> object:
     # 0.1's module mitos_cli.engine held what mitos_cli.engine.evaluation holds now.
     import importlib
 

@@ -63,6 +63,7 @@ Regions are reported as boxes of sampled values, e.g.
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -83,6 +84,13 @@ from ..lang.model import (
 from ..lang.terms import TermSet, Variable
 from .compile import CompiledRuleBase, compile_rulebase
 from .evaluation import BLOCK_CELLS, declares_nan, rule_dofs
+
+if TYPE_CHECKING:
+    from collections.abc import Iterator, Sequence
+
+    from ..lang.operators import Operators
+    from ..lang.terms import Term
+    from .mamdani import Undersampled
 
 SEVERITIES = ("error", "warning", "info")
 #: Most grid points one behavior is sampled on (the per-input resolution shrinks to fit).
@@ -229,7 +237,7 @@ def check_termset(ts: TermSet) -> Report:
 MAMDANI_ONLY = ("implication", "aggregation", "defuzzify", "resolution", "sampling")
 
 
-def _idle_settings(rb: RuleBase, name: str, compiled) -> list[Finding]:
+def _idle_settings(rb: RuleBase, name: str, compiled: CompiledRuleBase) -> list[Finding]:
     """Settings that the behavior's inference method ignores (``defuzzify = lom`` without
     ``inference = mamdani`` is almost certainly a mistake)."""
     inference = compiled.operators.inference
@@ -262,7 +270,7 @@ def _idle_settings(rb: RuleBase, name: str, compiled) -> list[Finding]:
     return out
 
 
-def _undersampled(rb: RuleBase, name: str, compiled, seen: set[tuple]) -> list[Finding]:
+def _undersampled(rb: RuleBase, name: str, compiled: CompiledRuleBase, seen: set[tuple]) -> list[Finding]:
     """Output terms that the Mamdani sampling misses (:func:`.mamdani.undersampled`), once
     per term and sampling however many behaviors conclude them."""
     from .mamdani import undersampled
@@ -280,7 +288,8 @@ def _undersampled(rb: RuleBase, name: str, compiled, seen: set[tuple]) -> list[F
     return out
 
 
-def _infinite_inverses(rb: RuleBase, name: str, compiled, seen: set[tuple]) -> list[Finding]:
+def _infinite_inverses(rb: RuleBase, name: str, compiled: CompiledRuleBase,
+                      seen: set[tuple]) -> list[Finding]:
     """Sigmoids a Tsukamoto behavior concludes, once per term: a sigmoid reaches 1 only at
     infinity, so where its rules fire fully the output is +-inf."""
     if compiled.operators.inference != "tsukamoto":
@@ -303,7 +312,7 @@ def _infinite_inverses(rb: RuleBase, name: str, compiled, seen: set[tuple]) -> l
     return out
 
 
-def undersampled_hint(path: str | None, u) -> str:
+def undersampled_hint(path: str | None, u: Undersampled) -> str:
     """What to do about a term its output's sampling misses: a finer sampling, or (a term
     outside the range, or 0 all over it) moving it in."""
     if u.outside == "outside":
@@ -350,7 +359,7 @@ def _behavior_span(rb: RuleBase, name: str) -> Span | None:
 # ---------------------------------------------------------------------------------------------
 # rules compared with each other (conflicts, duplicates)
 
-def canonical(expr: Expr):
+def canonical(expr: Expr) -> tuple:   # nested tuples and frozensets of names and flags
     """A key equal for antecedents that differ only in the order of `and` / `or` items."""
     if isinstance(expr, Prop):
         return ("prop", expr.var, expr.term, expr.hedges, expr.negated)
@@ -386,7 +395,7 @@ def _same(a: Consequent, b: Consequent, variables: dict[str, Variable]) -> bool:
     return value(a) == value(b)
 
 
-def _rule_pairs(rb: RuleBase, behavior: str, operators) -> list[Finding]:
+def _rule_pairs(rb: RuleBase, behavior: str, operators: Operators) -> list[Finding]:
     flat = flatten(rb, behavior)
     groups: dict[object, list[int]] = {}
     for i, (_, rule, contexts) in enumerate(flat):
@@ -427,7 +436,7 @@ def _rule_pairs(rb: RuleBase, behavior: str, operators) -> list[Finding]:
     return out
 
 
-def _twice(operators) -> str:
+def _twice(operators: Operators) -> str:
     """What a rule written twice does to the outputs, under the behavior's inference."""
     if operators.accumulated:
         if operators.accumulation == "max":
@@ -446,7 +455,8 @@ def _twice(operators) -> str:
 # ---------------------------------------------------------------------------------------------
 # contradictory antecedents
 
-def _literals(expr: Expr, negated: bool = False):
+def _literals(expr: Expr, negated: bool = False
+             ) -> Iterator[tuple[str, str, tuple[str, ...], bool, Prop]]:
     """The propositions an `and` chain requires, as (var, term, hedges, negated)."""
     if isinstance(expr, Prop):
         yield (expr.var, expr.term, expr.hedges, expr.negated != negated, expr)
@@ -904,7 +914,7 @@ def _term_gaps(rb: RuleBase, scope: set[str] | None = None) -> list[Finding]:
     return out
 
 
-def _tops(terms, x: np.ndarray) -> tuple[list[float], np.ndarray]:
+def _tops(terms: Sequence[Term], x: np.ndarray) -> tuple[list[float], np.ndarray]:
     """Each term's largest membership on the points ``x``, and the largest of any term at
     each point: a few terms' memberships at a time (all at once, 10,000 terms on their 40,000
     corners were 3.2 GB)."""

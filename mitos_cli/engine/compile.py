@@ -20,6 +20,7 @@ from __future__ import annotations
 import functools
 import math
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -29,6 +30,18 @@ from ..lang import operators as ops_mod
 from ..lang.model import And, Expr, Not, Prop, Rule, RuleBase, Setting, Use, flatten, format_rule
 from ..lang.operators import Operators
 from ..lang.terms import Term, Variable
+
+if TYPE_CHECKING:
+    from collections.abc import Mapping
+
+    from ..lang.model import Consequent
+    from .mamdani import OutputTable
+    from .scalar import ScalarFn
+    from .tsukamoto import TermRules
+
+    #: a behavior's rules as :func:`~mitos_cli.lang.model.flatten` gives them
+    Flat = list[tuple[str, Rule, tuple[Use, ...]]]
+
 
 ZERO, ONE = 0, 1
 
@@ -203,7 +216,7 @@ class CompiledRuleBase:
         return _grid_batch(self, plan.grids, plan.rules, plan.weight, plan.sum_rows)
 
     @functools.cached_property
-    def scalar(self):
+    def scalar(self) -> ScalarFn | None:
         """The network as a Python function of one sample's floats (``None`` when it has no
         exact scalar form): see :mod:`mitos_cli.engine.scalar`. Written on first use."""
         from .scalar import scalar_function
@@ -220,14 +233,14 @@ class CompiledRuleBase:
         self.__dict__.update(state)
 
     @functools.cached_property
-    def tsukamoto(self):
+    def tsukamoto(self) -> tuple[tuple[TermRules, ...], ...]:
         """Per output, its terms and the rules concluding each, for Tsukamoto inference."""
         from .tsukamoto import build_plan
 
         return build_plan(self)
 
     @functools.cached_property
-    def mamdani(self):
+    def mamdani(self) -> tuple[OutputTable, ...]:
         """Sampled output terms for Mamdani inference (built once per compiled rule base)."""
         from .mamdani import build_tables
 
@@ -360,7 +373,9 @@ class GridBatch:
     weighted_sum: bool                 # inference = weighted_sum: no division
 
 
-def _grid_batch(c: CompiledRuleBase, grids: dict, rules, weight, sum_rows) -> GridBatch | None:
+def _grid_batch(c: CompiledRuleBase, grids: dict[tuple[int, int], Grid], rules: slice | np.ndarray,
+                weight: np.ndarray | None,
+                sum_rows: tuple[np.ndarray | None, ...]) -> GridBatch | None:
     """The :class:`GridBatch` of ``c``, or None when its rules are not exactly one grid."""
     if (c.operators.inference not in ("weighted_average", "weighted_sum")
             or c.operators.accumulated or c.cons_linear is not None or c.hedged_outputs or c.shape_groups
@@ -517,7 +532,8 @@ def compile_rulebase(rb: RuleBase, behavior: str | None = None,
         cons_linear=cons.linear)
 
 
-def _used_variables(rb: RuleBase, flat, operators: Operators):
+def _used_variables(rb: RuleBase, flat: Flat, operators: Operators
+                   ) -> tuple[tuple[str, ...], tuple[str, ...], dict[str, tuple[str, ...]]]:
     """The inputs the rules read (in declaration order), the outputs they set, and for each
     output with ``linear`` (Takagi-Sugeno) terms the inputs its coefficients follow."""
     variables = rb.variables
@@ -568,7 +584,7 @@ class _Members:
         return {key: i for i, key in enumerate(self.names)}
 
 
-def _membership_layer(inputs: tuple[str, ...], variables) -> _Members:
+def _membership_layer(inputs: tuple[str, ...], variables: Mapping[str, Variable]) -> _Members:
     names = tuple((v, t.name) for v in inputs for t in variables[v].terms)
     terms = tuple(t for v in inputs for t in variables[v].terms)
     term_var = [k for k, v in enumerate(inputs) for _ in variables[v].terms]
@@ -619,7 +635,7 @@ def _walk(builder: _Builder, term_index: dict, expr: Expr) -> tuple[int, int]:
     return builder.node((op, tuple(c for c, _ in children)), op, children)
 
 
-def _antecedents(flat, builder: _Builder, term_index: dict) -> _Antecedents:
+def _antecedents(flat: Flat, builder: _Builder, term_index: dict) -> _Antecedents:
     """Every rule's antecedent and ``use`` conditions as neurons, and its weight."""
     rule_col, weight, contexts = [], [], []
     for _, rule, uses in flat:
@@ -650,7 +666,8 @@ class _Consequents:
     linear: np.ndarray | None        # [R, m, k + 1] Takagi-Sugeno consequents, if any
 
 
-def _consequents(flat, variables, inputs: tuple[str, ...], outputs: tuple[str, ...],
+def _consequents(flat: Flat, variables: Mapping[str, Variable], inputs: tuple[str, ...],
+                 outputs: tuple[str, ...],
                  linear_inputs: dict[str, tuple[str, ...]]) -> _Consequents:
     """What each rule sets: a crisp value (a term's centre or a number), the term and hedges
     it names, and, for ``linear`` terms, the coefficients over :data:`inputs`."""
@@ -675,7 +692,8 @@ def _consequents(flat, variables, inputs: tuple[str, ...], outputs: tuple[str, .
                         tuple(tuple(row) for row in hedges), linear)
 
 
-def _linear_consequents(flat, variables, inputs, outputs, linear_inputs,
+def _linear_consequents(flat: Flat, variables: Mapping[str, Variable], inputs: tuple[str, ...],
+                        outputs: tuple[str, ...], linear_inputs: dict[str, tuple[str, ...]],
                         value: np.ndarray) -> np.ndarray:
     """``[R, m, k + 1]``: constants as rows with a = 0; zeroes ``value`` where a rule's
     consequent is linear (its centre means nothing there)."""
@@ -697,7 +715,8 @@ def _linear_consequents(flat, variables, inputs, outputs, linear_inputs,
     return out
 
 
-def _check_crisp_value(c, rule: Rule, variables, inference: str) -> None:
+def _check_crisp_value(c: Consequent, rule: Rule, variables: Mapping[str, Variable],
+                       inference: str) -> None:
     """Weighted inference needs each consequent term's crisp value (its centre); a ``formula``
     term has none (its centre was NaN, and the output then silently its default)."""
     if c.term is None or variables[c.var].term(c.term).shape != "formula":
@@ -711,7 +730,8 @@ def _check_crisp_value(c, rule: Rule, variables, inference: str) -> None:
              f"`inference = mamdani`")
 
 
-def _check_tsukamoto(c, rule: Rule, variables, concluded: dict) -> None:
+def _check_tsukamoto(c: Consequent, rule: Rule, variables: Mapping[str, Variable],
+                     concluded: dict[tuple[str, str | None], Rule]) -> None:
     """Tsukamoto inference inverts each consequent's term: only monotonic ones have one, and
     only at a degree in [0, 1], which a term concluded by several rules (their degrees are
     summed, fuzzylite's rule) may exceed."""

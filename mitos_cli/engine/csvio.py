@@ -109,7 +109,7 @@ def read_table(text: str, path: str, inputs: tuple[str, ...],
 Chunk = tuple[Callable[[], list[list[str]]], "list[Sequence[str]] | None"]
 
 
-def _csv_chunks(reader, width: int, text: str, path: str) -> Iterator[Chunk]:
+def _csv_chunks(reader: Iterator[list[str]], width: int, text: str, path: str) -> Iterator[Chunk]:
     """The data rows as the ``csv`` module reads them (a text with quotes)."""
     while True:
         try:
@@ -478,7 +478,7 @@ def write_batch(out: TextIO, inputs: Sequence[str], given: Sequence[np.ndarray],
         out.write("\n".join(map(",".join, zip(*cells))) + "\n")
 
 
-def _decimals(digits: int):
+def _decimals(digits: int) -> Callable[[float], str]:
     """``x`` with ``digits`` decimals; from 1e15 on in full (``1e+300``), as the trace does
     (:data:`~.trace.LONG`): a float's digits end there, and 1e300 took 301 digits and 2
     decimals of noise."""

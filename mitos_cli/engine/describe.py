@@ -3,11 +3,16 @@
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from ..fuzzy import hedges as hedge_mod
 from ..words import plural
 from .compile import CompiledRuleBase
+
+if TYPE_CHECKING:
+    from ..lang.terms import Term
 
 INFERENCE_TEXT = {
     "weighted_average": "weighted average of the rules' consequents, sum(dof y) / sum(dof) "
@@ -21,7 +26,7 @@ def _fmt(x: float) -> str:
     return f"{x:g}"
 
 
-def _term_text(term) -> str:
+def _term_text(term: Term) -> str:
     if term.shape == "singleton":
         return f"{term.name} = {_fmt(term.params[0])}"
     if term.shape == "linear":

@@ -12,6 +12,7 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -23,6 +24,16 @@ from ..numbers import exact
 from .compile import CompiledRuleBase
 from .inputs import floats
 from .threads import Blocks, map_blocks, thread_count
+
+if TYPE_CHECKING:
+    from collections.abc import Sequence
+
+    from numpy.typing import ArrayLike
+
+    from .compile import Grid, GridBatch, NodeGroup, Plan, ShapeGroup
+
+    #: inputs as columns: an array ``[k, n]``, or ``k`` 1-D arrays of one length
+    Columns = ArrayLike | Sequence[ArrayLike]
 
 
 @dataclass(frozen=True, eq=False)   # holds arrays: identity, not ==
@@ -113,12 +124,12 @@ def _column_list(compiled: CompiledRuleBase, columns: Mapping[str, object]) -> l
     return [arr if arr.shape == (n,) else np.broadcast_to(arr, (n,)) for arr in arrays]
 
 
-def check_inputs(compiled: CompiledRuleBase, X) -> tuple[np.ndarray, np.ndarray]:
+def check_inputs(compiled: CompiledRuleBase, X: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
     """Refuse NaN, clamp to each universe: ``X[n, k]`` -> (clamped ``Xt[k, n]``, counts)."""
     return _clamp(compiled, _rows(compiled, X))
 
 
-def _rows(compiled: CompiledRuleBase, X) -> np.ndarray:
+def _rows(compiled: CompiledRuleBase, X: ArrayLike) -> np.ndarray:
     """``X`` as a float array ``[n, k]`` (one sample may come as a flat ``[k]``)."""
     k = len(compiled.inputs)
     X = floats(X, "the inputs", many=True)
@@ -238,7 +249,7 @@ def memberships(compiled: CompiledRuleBase, Xt: np.ndarray, out: np.ndarray) -> 
         out[g.cols] = shape.fn(x, *(g.params[:, i:i + 1] for i in range(g.params.shape[1])))
 
 
-def _formula_memberships(compiled: CompiledRuleBase, g, x: np.ndarray) -> np.ndarray:
+def _formula_memberships(compiled: CompiledRuleBase, g: ShapeGroup, x: np.ndarray) -> np.ndarray:
     """A formula term's memberships; a value that is no degree (NaN, or outside [0, 1]) is
     refused with the term and the input, never passed on (a hedge would turn it into NaN)."""
     assert g.formula is not None
@@ -254,7 +265,7 @@ def _formula_memberships(compiled: CompiledRuleBase, g, x: np.ndarray) -> np.nda
     return mu
 
 
-def _apply_group(group, V: np.ndarray, tnorm: norms.Norm, snorm: norms.Norm) -> None:
+def _apply_group(group: NodeGroup, V: np.ndarray, tnorm: norms.Norm, snorm: norms.Norm) -> None:
     """One layer's neurons of one operator: gather their inputs, aggregate, write outputs."""
     op = group.op
     ch = group.children
@@ -298,7 +309,7 @@ def network_values(compiled: CompiledRuleBase, Xt: np.ndarray) -> np.ndarray:
     return V
 
 
-def _apply_grid(grid, V: np.ndarray) -> None:
+def _apply_grid(grid: Grid, V: np.ndarray) -> None:
     """AND neurons over every combination of terms: ``min`` broadcast over one membership
     vector per variable (``t1 + t1 t2 + ...`` minima instead of gathers)."""
     b = V.shape[1]
@@ -487,7 +498,7 @@ def _unset_sums(compiled: CompiledRuleBase, nums: np.ndarray, dens: np.ndarray) 
     return nums
 
 
-def _constant_sums(plan, dof: np.ndarray) -> np.ndarray:
+def _constant_sums(plan: Plan, dof: np.ndarray) -> np.ndarray:
     """``[k, b]``: each numerator and denominator row of the output layer by the pairwise
     :func:`tree_sum` over the rules (a loop over the few sums, never over rules). The first
     halving step reads the DOFs directly, products formed in place (a row of ones, a
@@ -515,7 +526,7 @@ def _constant_sums(plan, dof: np.ndarray) -> np.ndarray:
     return tree_sum(S)
 
 
-def evaluate(compiled: CompiledRuleBase, X, *, detail: bool = True, keep_values: bool = False,
+def evaluate(compiled: CompiledRuleBase, X: ArrayLike, *, detail: bool = True, keep_values: bool = False,
              strict: bool = True) -> Result:
     """Evaluate the network on ``X[n, k]``, in cache-sized blocks of samples.
 
@@ -564,14 +575,14 @@ def evaluate(compiled: CompiledRuleBase, X, *, detail: bool = True, keep_values:
                 values[:, block] = V
         return counts
     counts = sum(map_blocks(blocks, n, block_width(compiled)), np.zeros(k, dtype=np.intp))
-    X = clamped_in.T
+    clamped_rows = clamped_in.T        # (not X again: `blocks` reads X, the rows of the inputs)
     no_rule = np.isnan(out.T)
-    outputs = fill_defaults(compiled, out.T, X, strict)
-    return Result(compiled, X, None if mu is None else mu.T, None if dof is None else dof.T,
+    outputs = fill_defaults(compiled, out.T, clamped_rows, strict)
+    return Result(compiled, clamped_rows, None if mu is None else mu.T, None if dof is None else dof.T,
                   outputs, counts, None if values is None else values.T, no_rule)
 
 
-def _grid_result(compiled: CompiledRuleBase, g, X: np.ndarray, strict: bool) -> Result:
+def _grid_result(compiled: CompiledRuleBase, g: GridBatch, X: np.ndarray, strict: bool) -> Result:
     """:func:`evaluate` of ``X[n, k]`` without detail for a grid behavior: the inputs clamped
     (one contiguous row each; a NaN is named by its first sample, as the blocks of
     :func:`evaluate` name it), then the outputs by :func:`_grid_columns`."""
@@ -583,7 +594,7 @@ def _grid_result(compiled: CompiledRuleBase, g, X: np.ndarray, strict: bool) -> 
                   counts, None, no_rule)
 
 
-def rule_dofs(compiled: CompiledRuleBase, X) -> np.ndarray:
+def rule_dofs(compiled: CompiledRuleBase, X: ArrayLike) -> np.ndarray:
     """The rules' DOFs ``[n, R]`` on ``X[n, k]`` (clamped to the universes), the bits of
     :func:`evaluate`'s ``dof``, without inferring the outputs: what a coverage check needs,
     at a cost that does not grow with a Mamdani output's ``resolution``."""
@@ -598,7 +609,7 @@ def rule_dofs(compiled: CompiledRuleBase, X) -> np.ndarray:
     return dof.T
 
 
-def evaluate_columns(compiled: CompiledRuleBase, Xt, *, strict: bool = True) -> np.ndarray:
+def evaluate_columns(compiled: CompiledRuleBase, Xt: Columns, *, strict: bool = True) -> np.ndarray:
     """The outputs ``[m, n]`` (one contiguous row per output) for inputs given as columns
     ``Xt[k, n]`` (an array, or a sequence of ``k`` 1-D arrays of one length):
     :func:`evaluate` with ``detail=False``, bit for bit, without copying a large batch into
@@ -636,7 +647,8 @@ def evaluate_columns(compiled: CompiledRuleBase, Xt, *, strict: bool = True) -> 
     return out
 
 
-def _input_columns(compiled: CompiledRuleBase, Xt) -> tuple[object, list[np.ndarray]]:
+def _input_columns(compiled: CompiledRuleBase,
+                   Xt: Any) -> tuple[Columns, list[np.ndarray]]:   # any: checked here, at run time
     """``Xt`` (an array ``[k, n]`` or ``k`` columns) and its columns as float arrays, each
     through :func:`~.inputs.floats` as the rows' and the named inputs' values are (a bool,
     date, bytes or structured column was read as numbers here, a complex one with NumPy's
@@ -671,7 +683,7 @@ class _GridBlock:
     block uses the full blocks' memory) or new ones. Made once per call for the full blocks.
     """
 
-    def __init__(self, g, w: int, like: _GridBlock | None = None) -> None:
+    def __init__(self, g: GridBatch, w: int, like: _GridBlock | None = None) -> None:
         k, t = g.B.shape[:2]
         R, nw = g.Kw.shape[:2]
         if like is None:
@@ -721,7 +733,7 @@ class _GridBlock:
         self.all_nums = sums[:len(g.num)]
 
 
-def _grid_columns(compiled: CompiledRuleBase, g, columns: list, out: np.ndarray) -> bool:
+def _grid_columns(compiled: CompiledRuleBase, g: GridBatch, columns: list, out: np.ndarray) -> bool:
     """:func:`evaluate_columns` of a grid behavior: the outputs into ``out[m, n]``; True
     when some sample may have no rule fired (NaN in ``out``).
 
@@ -764,7 +776,7 @@ def _grid_columns(compiled: CompiledRuleBase, g, columns: list, out: np.ndarray)
     return unfired
 
 
-def _grid_width(g, n: int) -> int:
+def _grid_width(g: GridBatch, n: int) -> int:
     """The widest block of :func:`_grid_columns` for ``n`` samples: :data:`GRID_BLOCK` when
     they are spread over threads, else as many samples as :data:`CACHE_BYTES` holds of the
     buffers of :class:`_GridBlock` (a multiple of 256, at least 512 and at most
@@ -778,7 +790,7 @@ def _grid_width(g, n: int) -> int:
     return min(GRID_BLOCK, max(512, CACHE_BYTES // per_sample // 256 * 256))
 
 
-def _grid_block(compiled: CompiledRuleBase, g, b: _GridBlock, columns: list, inside: bool,
+def _grid_block(compiled: CompiledRuleBase, g: GridBatch, b: _GridBlock, columns: list, inside: bool,
                 out: np.ndarray, start: int, end: int) -> bool:
     """One block of :func:`_grid_columns`: ``out[:, start:end]``, True where a sample may have
     no rule fired."""

@@ -53,12 +53,17 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, cast
 
 import numpy as np
 
 from ..errors import TermSetError
 from ..fuzzy import hedges as hedge_mod
 from ..fuzzy import norms
+
+if TYPE_CHECKING:
+    from ..lang.terms import Term
+    from .compile import CompiledRuleBase
 
 #: Ceiling on the intermediate ``[rules, samples, resolution]`` array of one sub-block. Small
 #: enough to stay in cache: on the benchmark machine 1 MB ran about twice as fast as 8 MB and
@@ -122,7 +127,7 @@ def spike(lo: float, hi: float, resolution: int, value: float,
     return row
 
 
-def build_tables(compiled) -> tuple[OutputTable, ...]:
+def build_tables(compiled: CompiledRuleBase) -> tuple[OutputTable, ...]:
     """Sample every consequent set the rules use, per output (done once, then cached), on the
     output's own ``resolution`` where it has one, else its behavior's."""
     sampling = compiled.operators.sampling
@@ -143,7 +148,7 @@ def build_tables(compiled) -> tuple[OutputTable, ...]:
             if key not in keys:
                 keys[key] = len(rows)
                 if term is None:
-                    rows.append(spike(lo, hi, res, key[1], sampling))
+                    rows.append(spike(lo, hi, res, cast(float, key[1]), sampling))   # ("=", value)
                     labels.append(f"= {key[1]:g}")
                 else:
                     t = var.term(term)
@@ -218,7 +223,7 @@ class Undersampled:
                 f"its rules {effect} `{self.output}`")
 
 
-def undersampled(compiled) -> tuple[Undersampled, ...]:
+def undersampled(compiled: CompiledRuleBase) -> tuple[Undersampled, ...]:
     """The consequent sets of a Mamdani behavior that its outputs' sampling misses. A crisp
     value or a singleton is a spike of height 1 at its nearest point: never missed."""
     if compiled.operators.inference != "mamdani":
@@ -247,7 +252,7 @@ def undersampled(compiled) -> tuple[Undersampled, ...]:
 DENSE = 100_001
 
 
-def _above_zero(term, hedges: list[str], universe: tuple[float, float]) -> bool:
+def _above_zero(term: Term, hedges: list[str], universe: tuple[float, float]) -> bool:
     """Whether the (hedged) term is above 0 anywhere in the range: at :data:`DENSE` points
     and its corner points and centre inside it (a term as narrow as a float is still seen at
     its peak)."""
@@ -343,7 +348,7 @@ def walk_from_both_ends(Y: np.ndarray, lo: float, hi: float) -> np.ndarray:
     return np.where(left[np.arange(b), low] > 0.0, out, np.nan)
 
 
-def mamdani_outputs(compiled, dof: np.ndarray) -> np.ndarray:
+def mamdani_outputs(compiled: CompiledRuleBase, dof: np.ndarray) -> np.ndarray:
     """Output layer of a Mamdani behavior: DOFs ``[R, b]`` -> crisp outputs ``[m, b]``."""
     ops = compiled.operators
     aggregation = norms.aggregation(ops.aggregation)
@@ -374,7 +379,8 @@ def mamdani_outputs(compiled, dof: np.ndarray) -> np.ndarray:
 MAX_STACK_BYTES = 32 * 2 ** 20
 
 
-def _aggregate_chunked(dof, sets, implication, aggregation):
+def _aggregate_chunked(dof: np.ndarray, sets: np.ndarray, implication: str,
+                      aggregation: norms.Norm) -> np.ndarray:
     rules = max(1, MAX_STACK_BYTES // (8 * dof.shape[1] * sets.shape[1]))
     if rules >= dof.shape[0]:
         return aggregate(dof, sets, implication, aggregation)

@@ -25,7 +25,8 @@ from ..fuzzy.hedges import HEDGES as HEDGE_REGISTRY
 from ..fuzzy.norms import SNORMS, TNORMS
 
 if TYPE_CHECKING:
-    from .compile import CompiledRuleBase
+    from ..lang.operators import Operators
+    from .compile import CompiledRuleBase, Grid, NodeGroup
 
 #: Above this many neurons, writing and compiling the function costs more than it saves.
 MAX_COLUMNS = 4000
@@ -104,14 +105,14 @@ def _source(c: CompiledRuleBase) -> str:
     return "\n".join(lines) + "\n"
 
 
-def _statements(text: str, emit, **names: str) -> None:
+def _statements(text: str, emit: Callable[[str], None], **names: str) -> None:
     """Emit a statement template with its operands bound: ``a``/``b``/``x`` become columns."""
     prefix = "".join(f"{k} = {v}\n" for k, v in names.items())
     for line in (prefix + text).splitlines():
         emit("    " + line)
 
 
-def _grid(grid, emit) -> None:
+def _grid(grid: Grid, emit: Callable[[str], None]) -> None:
     """Every combination of the axes' memberships, folded with ``min`` outermost first (the
     engine's broadcast order), in the group's mixed-radix column order."""
     col = grid.out.start
@@ -126,7 +127,7 @@ def _grid(grid, emit) -> None:
         col += 1
 
 
-def _group(group, ops, emit) -> None:
+def _group(group: NodeGroup, ops: Operators, emit: Callable[[str], None]) -> None:
     op = group.op
     children = group.children.tolist()
     for out, ch in zip(group.out.tolist(), children):
@@ -148,7 +149,7 @@ def _group(group, ops, emit) -> None:
             emit(f"    v{out} = {acc}")
 
 
-def _outputs(c: CompiledRuleBase, emit) -> None:
+def _outputs(c: CompiledRuleBase, emit: Callable[[str], None]) -> None:
     """DOFs (contexts, then weights, as :func:`mitos_cli.engine.evaluation.rule_dof`) and the weighted
     sums by the engine's pairwise tree (:func:`mitos_cli.engine.evaluation.tree_sum`)."""
     plan = c.plan

@@ -14,11 +14,15 @@ sample gives the same bits alone or in any batch.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..fuzzy import hedges as hedge_mod
 from ..fuzzy.shapes import TSUKAMOTO
+
+if TYPE_CHECKING:
+    from .compile import CompiledRuleBase
 
 
 @dataclass(frozen=True, eq=False)
@@ -30,7 +34,7 @@ class TermRules:
     groups: tuple[tuple[tuple[str, ...], np.ndarray], ...]    # (hedges, rule rows)
 
 
-def build_plan(compiled) -> tuple[tuple[TermRules, ...], ...]:
+def build_plan(compiled: CompiledRuleBase) -> tuple[tuple[TermRules, ...], ...]:
     """Per output, its concluded terms in first-concluded order (fuzzylite's grouping)."""
     plan = []
     for j, name in enumerate(compiled.outputs):
@@ -47,7 +51,7 @@ def build_plan(compiled) -> tuple[tuple[TermRules, ...], ...]:
     return tuple(plan)
 
 
-def tsukamoto_outputs(compiled, dof: np.ndarray) -> np.ndarray:
+def tsukamoto_outputs(compiled: CompiledRuleBase, dof: np.ndarray) -> np.ndarray:
     """DOFs ``[R, b]`` -> outputs ``[m, b]``."""
     from .evaluation import tree_sum
 

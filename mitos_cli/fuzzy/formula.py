@@ -20,10 +20,14 @@ from __future__ import annotations
 import re
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
+from typing import TYPE_CHECKING, NoReturn
 
 import numpy as np
 
 from ..errors import MitosError, Span, TermSetError, did_you_mean
+
+if TYPE_CHECKING:
+    from numpy.typing import ArrayLike
 
 
 def _cmp(op: Callable) -> Callable:
@@ -79,7 +83,7 @@ class Formula:
     text: str
     tree: Node = field(compare=False, repr=False)
 
-    def __call__(self, x) -> np.ndarray:
+    def __call__(self, x: ArrayLike) -> np.ndarray:
         x = np.asarray(x, dtype=float)
         with np.errstate(all="ignore"):
             return np.broadcast_to(_eval(self.tree, x), x.shape).astype(float)
@@ -96,7 +100,7 @@ def _children(node: Node) -> tuple[Node, ...]:
     return ()
 
 
-def _apply(node: Node, values: list, x: np.ndarray):
+def _apply(node: Node, values: list, x: np.ndarray) -> np.ndarray | float:
     """``node``'s value from its children's ``values``: a chain folds from the left, or from
     the right for a right-associative operator (``x^2^3`` is ``x^(2^3)``)."""
     kind = node[0]
@@ -120,7 +124,7 @@ def _apply(node: Node, values: list, x: np.ndarray):
     return acc
 
 
-def _eval(tree: Node, x: np.ndarray):
+def _eval(tree: Node, x: np.ndarray) -> np.ndarray | float:
     """The tree's value, walked with a stack of its own (no recursion, whatever its depth)."""
     stack: list[tuple[Node, bool]] = [(tree, False)]
     values: list = []
@@ -157,7 +161,7 @@ class _Parser:
             pos = m.end()
         self.i = self.depth = 0
 
-    def fail(self, column: int, message: str, expected: str | None = None):
+    def fail(self, column: int, message: str, expected: str | None = None) -> NoReturn:
         span = self.span
         if span is not None:
             span = replace(span, column=span.column + column, end_column=span.column + column + 1)

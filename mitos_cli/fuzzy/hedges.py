@@ -57,12 +57,12 @@ register(Hedge("more_or_less", np.sqrt, _sqrt_derivative, "sqrt(x)",
 # Hedges of fuzzylite (FLL and its FCL dialect). fuzzylite's `extremely` is Zadeh's contrast
 # intensification, not MITOS's x^3, so it is called `intensely` here (the readers and writers
 # translate the name).
-def _seldom(x):
+def _seldom(x: np.ndarray) -> np.ndarray:
     with np.errstate(invalid="ignore"):
         return np.where(x <= 0.5, np.sqrt(0.5 * x), 1.0 - np.sqrt(0.5 * (1.0 - x)))
 
 
-def _seldom_derivative(x):
+def _seldom_derivative(x: np.ndarray) -> np.ndarray:
     with np.errstate(divide="ignore", invalid="ignore"):
         d = np.where(x <= 0.5, 0.25 / np.sqrt(np.maximum(0.5 * x, 1e-300)),
                      0.25 / np.sqrt(np.maximum(0.5 * (1.0 - x), 1e-300)))

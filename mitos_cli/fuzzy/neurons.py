@@ -20,11 +20,15 @@ folds run in the same order, so the values agree bit for bit (tests/test_neurons
 from __future__ import annotations
 
 from collections.abc import Callable
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from . import hedges as hedge_mod
 from . import norms
+
+if TYPE_CHECKING:
+    from numpy.typing import ArrayLike
 
 SYNAPSES: dict[str, tuple[Callable[..., np.ndarray], float, str]] = {
     "product": (np.multiply, 1.0, "d = x * w (eq. 5)"),
@@ -57,14 +61,15 @@ def activation_hedges(activation: str | tuple[str, ...]) -> tuple[str, ...]:
     return tuple(activation)
 
 
-def synapse(x, w, kind: str = "product") -> np.ndarray:
+def synapse(x: ArrayLike, w: ArrayLike, kind: str = "product") -> np.ndarray:
     """Synaptic weighting ``d = w(x)`` (eqs. 4-6): product ``x * w`` or max ``x v w``."""
     fn, _, _ = SYNAPSES[kind]
     return fn(np.asarray(x, dtype=float), np.asarray(w, dtype=float))
 
 
-def neuron(x, *, norm: str | norms.Norm = "min", weights=None, synapse_kind: str = "product",
-           inhibitory=None, activation: str | tuple[str, ...] = "identity") -> np.ndarray:
+def neuron(x: ArrayLike, *, norm: str | norms.Norm = "min", weights: ArrayLike | None = None,
+           synapse_kind: str = "product", inhibitory: ArrayLike | None = None,
+           activation: str | tuple[str, ...] = "identity") -> np.ndarray:
     """One fuzzy neuron (or a layer, by broadcasting) on inputs ``x[..., n]``.
 
     ``norm`` names the aggregation: a T-norm makes an AND neuron, an S-norm an OR neuron.
@@ -85,13 +90,13 @@ def neuron(x, *, norm: str | norms.Norm = "min", weights=None, synapse_kind: str
     return hedge_mod.apply(activation_hedges(activation), total)
 
 
-def negation(x) -> np.ndarray:
+def negation(x: ArrayLike) -> np.ndarray:
     """The negating neuron of Fig. 3(b): one inhibitory input, identity activation."""
     x = np.asarray(x, dtype=float)
     return neuron(x[..., None], norm="min", inhibitory=[True])
 
 
-def snorm_from_tnorm(x, tnorm: str | norms.Norm) -> np.ndarray:
+def snorm_from_tnorm(x: ArrayLike, tnorm: str | norms.Norm) -> np.ndarray:
     """Fig. 3(b): an OR neuron built from AND neurons, ``S(x) = 1 - T(1 - x_1, ..., 1 - x_n)``:
     a T-norm neuron whose inputs are all inhibitory, followed by a negating neuron."""
     x = np.asarray(x, dtype=float)

@@ -14,8 +14,12 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from numpy.typing import ArrayLike
 
 Binary = Callable[[np.ndarray, np.ndarray], np.ndarray]
 
@@ -48,13 +52,13 @@ class Norm:
     def identity(self) -> float:
         return 1.0 if self.kind == "tnorm" else 0.0
 
-    def __call__(self, a, b):
+    def __call__(self, a: ArrayLike, b: ArrayLike) -> np.ndarray:
         # broadcast first: the formulas work in place on temporaries shaped like their inputs
         a, b = np.broadcast_arrays(np.asarray(a, dtype=float), np.asarray(b, dtype=float))
         return self.fn(a, b)
 
 
-def _fresh(x) -> np.ndarray:
+def _fresh(x: ArrayLike) -> np.ndarray:
     """``x`` (a new result) as an array that may be overwritten (NumPy returns scalars for 0-d)."""
     return x if isinstance(x, np.ndarray) else np.asarray(x)
 
@@ -67,7 +71,7 @@ def _fresh(x) -> np.ndarray:
 # on blocks of thousands of samples, where each extra temporary costs.
 
 
-def _lukasiewicz(a, b):
+def _lukasiewicz(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     # max(0, a + b - 1) as min - (1 - max): exact at b = 1 (``fl(fl(a + 1) - 1)`` is not a)
     lo, hi = _fresh(np.minimum(a, b)), _fresh(np.maximum(a, b))
     np.subtract(1.0, hi, out=hi)
@@ -75,7 +79,7 @@ def _lukasiewicz(a, b):
     return np.maximum(lo, 0.0, out=lo)
 
 
-def _probabilistic_sum(a, b):
+def _probabilistic_sum(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     # a + b - a b as hi + lo (1 - hi): exact at b = 0 and b = 1, no cancellation
     hi, lo = _fresh(np.maximum(a, b)), _fresh(np.minimum(a, b))
     t = _fresh(np.subtract(1.0, hi))
@@ -83,20 +87,20 @@ def _probabilistic_sum(a, b):
     return np.add(t, hi, out=t)
 
 
-def _drastic_product(a, b):
+def _drastic_product(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     # b if a = 1, a if b = 1, else 0: min(a, b) where max(a, b) = 1
     lo = _fresh(np.minimum(a, b))
     return np.multiply(lo, np.maximum(a, b) == 1.0, out=lo)
 
 
-def _drastic_sum(a, b):
+def _drastic_sum(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     # b if a = 0, a if b = 0, else 1: max(a, b) where min(a, b) = 0
     hi = _fresh(np.maximum(a, b))
     np.copyto(hi, 1.0, where=np.minimum(a, b) != 0.0)
     return hi
 
 
-def _einstein_product(a, b):
+def _einstein_product(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     # a b / (2 - (a + b - a b)) with the denominator as 1 + (1 - a)(1 - b): exact at b = 1
     den = _fresh(np.subtract(1.0, a))
     np.multiply(den, np.subtract(1.0, b), out=den)
@@ -105,14 +109,14 @@ def _einstein_product(a, b):
     return np.divide(num, den, out=num)
 
 
-def _einstein_sum(a, b):
+def _einstein_sum(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     den = _fresh(np.multiply(a, b))
     np.add(1.0, den, out=den)
     num = _fresh(np.add(a, b))
     return np.divide(num, den, out=num)
 
 
-def _hamacher_product(a, b):
+def _hamacher_product(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     # a b / (a + b - a b), 0 at a = b = 0; the denominator is the probabilistic sum (exactly 1
     # at b = 1), and where it is 0 so is the numerator
     num = _fresh(np.multiply(a, b))
@@ -120,7 +124,7 @@ def _hamacher_product(a, b):
     return np.divide(num, den, out=num, where=den > 0.0)
 
 
-def _hamacher_sum(a, b):
+def _hamacher_sum(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     # (a + b - 2 a b) / (1 - a b), 1 at a = b = 1, with the numerator as a (1 - b) + b (1 - a):
     # exactly a at b = 0 and exactly 1 at b = 1 (numerator and denominator round alike)
     num = _fresh(np.multiply(a, np.subtract(1.0, b)))
@@ -131,21 +135,21 @@ def _hamacher_sum(a, b):
     return np.divide(num, den, out=out, where=den > 0.0)
 
 
-def _nilpotent_minimum(a, b):
+def _nilpotent_minimum(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     # a + b > 1 tested as lo > 1 - hi: for tiny a, fl(a + 1) > 1 is false and T(a, 1) would be 0
     lo, hi = _fresh(np.minimum(a, b)), _fresh(np.maximum(a, b))
     np.subtract(1.0, hi, out=hi)
     return np.multiply(lo, lo > hi, out=lo)
 
 
-def _nilpotent_maximum(a, b):
+def _nilpotent_maximum(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     # max(a, b) if a + b < 1, else 1
     hi = _fresh(np.maximum(a, b))
     np.copyto(hi, 1.0, where=np.add(a, b) >= 1.0)
     return hi
 
 
-def _bounded_sum(a, b):
+def _bounded_sum(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     s = _fresh(np.add(a, b))
     return np.minimum(s, 1.0, out=s)
 

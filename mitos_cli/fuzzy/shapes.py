@@ -12,17 +12,24 @@ limits of the shape (1 under a shoulder, 0 elsewhere).
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..numbers import exact
 
+if TYPE_CHECKING:
+    from numpy.typing import ArrayLike
+
+    #: A shape parameter: one value, or an array of them broadcast against ``x`` (one per term).
+    Param = float | np.ndarray
+
 INF = float("inf")
 
 
-def trapezoid(x, a, b, c, d):
+def trapezoid(x: ArrayLike, a: Param, b: Param, c: Param, d: Param) -> np.ndarray:
     """Trapezoid with feet ``a``, ``d`` and core ``[b, c]``; ``a = b = -inf`` or ``c = d = inf``
     make shoulders, ``a == b`` or ``c == d`` vertical edges."""
     x = np.asarray(x, dtype=float)
@@ -32,39 +39,39 @@ def trapezoid(x, a, b, c, d):
     return np.minimum(rise, fall)
 
 
-def triangle(x, a, b, c):
+def triangle(x: ArrayLike, a: Param, b: Param, c: Param) -> np.ndarray:
     """Triangle with feet ``a``, ``c`` and peak ``b``."""
     return trapezoid(x, a, b, b, c)
 
 
-def triangle_pw(x, peak, width):
+def triangle_pw(x: ArrayLike, peak: Param, width: Param) -> np.ndarray:
     """The paper's eq. 15: ``1 - |peak - x| / width``, clipped at 0."""
     return trapezoid(x, np.subtract(peak, width), peak, peak, np.add(peak, width))
 
 
-def triangle_plr(x, peak, left_width, right_width):
+def triangle_plr(x: ArrayLike, peak: Param, left_width: Param, right_width: Param) -> np.ndarray:
     """Eq. 15 with separate widths to the left and right of the peak."""
     return trapezoid(x, np.subtract(peak, left_width), peak, peak, np.add(peak, right_width))
 
 
-def left_shoulder(x, a, b):
+def left_shoulder(x: ArrayLike, a: Param, b: Param) -> np.ndarray:
     """1 up to ``a``, falling to 0 at ``b``."""
     return trapezoid(x, -INF, -INF, a, b)
 
 
-def right_shoulder(x, a, b):
+def right_shoulder(x: ArrayLike, a: Param, b: Param) -> np.ndarray:
     """0 up to ``a``, rising to 1 at ``b`` and beyond."""
     return trapezoid(x, a, b, INF, INF)
 
 
-def singleton(x, value):
+def singleton(x: ArrayLike, value: Param) -> np.ndarray:
     """1 at exactly ``value``, 0 elsewhere (a crisp output value)."""
     x = np.asarray(x, dtype=float)
     out = np.where(x == value, 1.0, 0.0)
     return np.where(np.isnan(x), np.nan, out)
 
 
-def linear(x, *params):
+def linear(x: ArrayLike, *params: float) -> np.ndarray:
     """Takagi-Sugeno linear consequent ``y = c_1 x_1 + ... + c_k x_k + constant``.
 
     Not a membership function: ``x`` stacks the ``k`` inputs on its first axis (``x[i]`` is
@@ -122,7 +129,7 @@ class Shape:
     doc: str
     variadic: bool = False        # any number of params (``discrete``: x1, y1, ..., xn, yn)
 
-    def membership(self, x, params) -> np.ndarray:
+    def membership(self, x: ArrayLike, params: Sequence[Param]) -> np.ndarray:
         return self.fn(x, *params)
 
 
@@ -196,17 +203,17 @@ def kernel_params(corners: tuple[float, float, float, float]) -> tuple[float, fl
 # shape's limits (1 beyond a shoulder, ramp or sigmoid plateau, 0 elsewhere).
 
 
-def _nan_of(x):
+def _nan_of(x: np.ndarray) -> np.ndarray:
     """1 where ``x`` is a number, NaN where it is NaN (multiplied into a membership)."""
     return np.where(np.isnan(x), np.nan, 1.0)
 
 
-def rectangle(x, start, end):
+def rectangle(x: ArrayLike, start: Param, end: Param) -> np.ndarray:
     """1 on ``[start, end]``, 0 elsewhere."""
     return trapezoid(x, start, start, end, end)
 
 
-def ramp(x, start, end):
+def ramp(x: ArrayLike, start: Param, end: Param) -> np.ndarray:
     """0 at ``start``, rising (or falling, when ``end < start``) linearly to 1 at ``end``, and
     1 beyond ``end``."""
     x = np.asarray(x, dtype=float)
@@ -214,7 +221,7 @@ def ramp(x, start, end):
     return np.where(up, trapezoid(x, start, end, INF, INF), trapezoid(x, -INF, -INF, end, start))
 
 
-def gaussian(x, mean, sigma):
+def gaussian(x: ArrayLike, mean: Param, sigma: Param) -> np.ndarray:
     """``exp(-(x - mean)^2 / (2 sigma^2))``, as ``((x - mean) / sigma)^2 / 2``: a sigma so
     small that its square is 0 (2e-321) still gives 1 at the mean, not 0 / 0."""
     x = np.asarray(x, dtype=float)
@@ -222,7 +229,7 @@ def gaussian(x, mean, sigma):
         return np.exp(-0.5 * np.square((x - mean) / np.asarray(sigma)))
 
 
-def gaussian2(x, mean1, sigma1, mean2, sigma2):
+def gaussian2(x: ArrayLike, mean1: Param, sigma1: Param, mean2: Param, sigma2: Param) -> np.ndarray:
     """Two-sided Gaussian (MATLAB ``gauss2mf``, fuzzylite ``GaussianProduct``): the left
     Gaussian below ``mean1``, the right one above ``mean2``, 1 between (when ``mean1 <= mean2``)."""
     x = np.asarray(x, dtype=float)
@@ -231,7 +238,7 @@ def gaussian2(x, mean1, sigma1, mean2, sigma2):
     return _nan_of(x) * a * b
 
 
-def bell(x, center, width, slope):
+def bell(x: ArrayLike, center: Param, width: Param, slope: Param) -> np.ndarray:
     """Generalized bell ``1 / (1 + |(x - center) / width|^(2 slope))`` (MATLAB ``gbellmf``)."""
     x = np.asarray(x, dtype=float)
     with np.errstate(over="ignore", divide="ignore", invalid="ignore"):
@@ -239,7 +246,7 @@ def bell(x, center, width, slope):
     return np.where(np.isinf(x), 0.0, out)
 
 
-def sigmoid(x, inflection, slope):
+def sigmoid(x: ArrayLike, inflection: Param, slope: Param) -> np.ndarray:
     """``1 / (1 + exp(-slope (x - inflection)))``: rising for slope > 0, falling for < 0."""
     x = np.asarray(x, dtype=float)
     with np.errstate(over="ignore", invalid="ignore"):
@@ -247,25 +254,26 @@ def sigmoid(x, inflection, slope):
     return out
 
 
-def sigmoid_difference(x, left, rising, falling, right):
+def sigmoid_difference(x: ArrayLike, left: Param, rising: Param, falling: Param, right: Param) -> np.ndarray:
     """``|sigmoid(left, rising) - sigmoid(right, falling)|`` (fuzzylite ``SigmoidDifference``;
     MATLAB's ``dsigmf`` is the signed difference, the same wherever it is a membership)."""
     return np.abs(sigmoid(x, left, rising) - sigmoid(x, right, falling))
 
 
-def clipped_sigmoid_difference(x, left, rising, falling, right):
+def clipped_sigmoid_difference(x: ArrayLike, left: Param, rising: Param, falling: Param,
+                               right: Param) -> np.ndarray:
     """``max(sigmoid(left, rising) - sigmoid(right, falling), 0)``: jFuzzyLogic's ``DSIGM``
     (and Octave's ``dsigmf``); it differs from :func:`sigmoid_difference` where the second
     sigmoid is the larger."""
     return np.maximum(sigmoid(x, left, rising) - sigmoid(x, right, falling), 0.0)
 
 
-def sigmoid_product(x, left, rising, falling, right):
+def sigmoid_product(x: ArrayLike, left: Param, rising: Param, falling: Param, right: Param) -> np.ndarray:
     """``sigmoid(left, rising) * sigmoid(right, falling)`` (MATLAB ``psigmf``)."""
     return sigmoid(x, left, rising) * sigmoid(x, right, falling)
 
 
-def s_shape(x, start, end):
+def s_shape(x: ArrayLike, start: Param, end: Param) -> np.ndarray:
     """Smooth step from 0 at ``start`` to 1 at ``end`` (two parabolas; MATLAB ``smf``)."""
     x = np.asarray(x, dtype=float)
     with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
@@ -275,7 +283,7 @@ def s_shape(x, start, end):
     return _nan_of(x) * out
 
 
-def z_shape(x, start, end):
+def z_shape(x: ArrayLike, start: Param, end: Param) -> np.ndarray:
     """Smooth step from 1 at ``start`` to 0 at ``end`` (MATLAB ``zmf``)."""
     x = np.asarray(x, dtype=float)
     with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
@@ -285,12 +293,12 @@ def z_shape(x, start, end):
     return _nan_of(x) * out
 
 
-def pi_shape(x, a, b, c, d):
+def pi_shape(x: ArrayLike, a: Param, b: Param, c: Param, d: Param) -> np.ndarray:
     """``s_shape(a, b) * z_shape(c, d)`` (MATLAB ``pimf``)."""
     return s_shape(x, a, b) * z_shape(x, c, d)
 
 
-def cosine(x, center, width):
+def cosine(x: ArrayLike, center: Param, width: Param) -> np.ndarray:
     """Raised cosine ``(1 + cos(2 pi (x - center) / width)) / 2`` on ``center +- width/2``."""
     x = np.asarray(x, dtype=float)
     with np.errstate(invalid="ignore", over="ignore"):      # outside: the 0 of np.where
@@ -302,13 +310,13 @@ def cosine(x, center, width):
     return _nan_of(x) * out
 
 
-def spike(x, center, width):
+def spike(x: ArrayLike, center: Param, width: Param) -> np.ndarray:
     """``exp(-|10 (x - center) / width|)``: a sharp peak at ``center``."""
     x = np.asarray(x, dtype=float)
     return np.exp(-np.abs(10.0 / np.asarray(width) * (x - center)))
 
 
-def concave(x, inflection, end):
+def concave(x: ArrayLike, inflection: Param, end: Param) -> np.ndarray:
     """Concave curve reaching 1 at ``end`` and 0.5 at ``inflection`` (increasing when
     ``inflection <= end``, decreasing otherwise); 1 beyond ``end``."""
     x = np.asarray(x, dtype=float)
@@ -320,7 +328,7 @@ def concave(x, inflection, end):
     return _nan_of(x) * out
 
 
-def semi_ellipse(x, start, end):
+def semi_ellipse(x: ArrayLike, start: Param, end: Param) -> np.ndarray:
     """Upper half of an ellipse over ``[start, end]``, 1 at its middle."""
     x = np.asarray(x, dtype=float)
     s, e = np.minimum(start, end), np.maximum(start, end)
@@ -331,7 +339,7 @@ def semi_ellipse(x, start, end):
     return _nan_of(x) * out
 
 
-def arc(x, start, end):
+def arc(x: ArrayLike, start: Param, end: Param) -> np.ndarray:
     """Quarter circle from 0 at ``start`` to 1 at ``end`` (fuzzylite ``Arc``), 1 beyond."""
     x = np.asarray(x, dtype=float)
     s, e = np.asarray(start, dtype=float), np.asarray(end, dtype=float)
@@ -345,7 +353,7 @@ def arc(x, start, end):
     return _nan_of(x) * out
 
 
-def binary(x, start, direction):
+def binary(x: ArrayLike, start: Param, direction: Param) -> np.ndarray:
     """1 from ``start`` on towards ``direction`` (``+inf``: x >= start; ``-inf``: x <= start)."""
     x = np.asarray(x, dtype=float)
     s, d = np.asarray(start, dtype=float), np.asarray(direction, dtype=float)
@@ -353,7 +361,7 @@ def binary(x, start, direction):
     return _nan_of(x) * out
 
 
-def discrete(x, *points):
+def discrete(x: ArrayLike, *points: Param) -> np.ndarray:
     """Piecewise-linear through ``(x1, y1), ..., (xn, yn)`` (x ascending), constant beyond the
     ends (``numpy.interp``). Vectorized over parameter rows: the loop runs over the n points."""
     x = np.asarray(x, dtype=float)
@@ -394,11 +402,11 @@ def _nonzero(i: int, what: str) -> Callable[[tuple[float, ...]], str | None]:
     return check
 
 
-def _sigmoid_center(p) -> float:
+def _sigmoid_center(p: tuple[float, ...]) -> float:
     return p[0]
 
 
-def _discrete_center(p) -> float:
+def _discrete_center(p: tuple[float, ...]) -> float:
     xs, ys = np.asarray(p[0::2]), np.asarray(p[1::2])
     return float(xs[int(np.argmax(ys))])
 
@@ -454,7 +462,7 @@ for _shape in (
     register(_shape)
 
 
-def _formula_fn(x, *params):
+def _formula_fn(x: ArrayLike, *params: float) -> np.ndarray:
     raise TypeError("a formula term is evaluated by its Formula (Term.membership), not by params")
 
 
@@ -471,33 +479,33 @@ register(Shape("formula", (), _formula_fn, lambda p: None, None, lambda p: float
 # concave term at w = 0) the inverse is infinite, as in fuzzylite.
 
 
-def _ramp_inverse(w, start, end):
+def _ramp_inverse(w: np.ndarray, start: float, end: float) -> np.ndarray:
     return start + (end - start) * w
 
 
-def _sigmoid_inverse(w, inflection, slope):
+def _sigmoid_inverse(w: np.ndarray, inflection: float, slope: float) -> np.ndarray:
     with np.errstate(divide="ignore"):
         return inflection + np.log(1.0 / w - 1.0) / -slope
 
 
-def _s_shape_inverse(w, start, end):
+def _s_shape_inverse(w: np.ndarray, start: float, end: float) -> np.ndarray:
     with np.errstate(invalid="ignore"):
         return np.where(w <= 0.5, start + (end - start) * np.sqrt(w / 2.0),
                         end - (end - start) * np.sqrt((1.0 - w) / 2.0))
 
 
-def _z_shape_inverse(w, start, end):
+def _z_shape_inverse(w: np.ndarray, start: float, end: float) -> np.ndarray:
     with np.errstate(invalid="ignore"):
         return np.where(w <= 0.5, end - (end - start) * np.sqrt(w / 2.0),
                         start + (end - start) * np.sqrt((1.0 - w) / 2.0))
 
 
-def _concave_inverse(w, inflection, end):
+def _concave_inverse(w: np.ndarray, inflection: float, end: float) -> np.ndarray:
     with np.errstate(divide="ignore"):
         return (inflection - end) / w + 2.0 * end - inflection
 
 
-def _arc_inverse(w, start, end):
+def _arc_inverse(w: np.ndarray, start: float, end: float) -> np.ndarray:
     r = end - start
     sign = -1.0 if start < end else 1.0
     return end + sign * np.sqrt(np.maximum(r * r - np.square(w * r), 0.0))

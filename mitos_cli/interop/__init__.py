@@ -11,9 +11,13 @@ from __future__ import annotations
 
 import re
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from ..errors import FormatError, MitosError
 from ..lang.model import RuleBase
+
+if TYPE_CHECKING:
+    from ..lang.operators import Operators
 
 READERS = {".fcl": "fcl", ".fis": "fis", ".fll": "fll"}
 FORMATS = ("fcl", "fis", "fll")
@@ -186,7 +190,7 @@ FUZZYLITE_MEANS = {"bisector": "the sample whose running area is closest to half
 JFUZZYLOGIC_COA = "where two running areas walking in from both ends meet"
 
 
-def _defuzzifier_notes(ops, fmt: str) -> list[str]:
+def _defuzzifier_notes(ops: Operators, fmt: str) -> list[str]:
     """A bisector, som or lom written where the target defines it otherwise: MATLAB's into FLL
     or FCL, fuzzylite's (MITOS's own) into a .fis file."""
     if ops.inference != "mamdani":

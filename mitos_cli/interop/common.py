@@ -13,6 +13,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, replace
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from ..errors import FormatError, MitosError, NoRulesError, Span, did_you_mean
 from ..fuzzy import norms as norm_registry
@@ -26,6 +27,9 @@ from ..lang.terms import Term, TermSet, Variable, first_at, universe_problem
 from ..numbers import LARGEST, parse_value
 from ..words import plural
 from . import rewrite
+
+if TYPE_CHECKING:
+    from collections.abc import Iterable, Iterator
 
 # ---------------------------------------------------------------------------------------------
 # Operators: MITOS name -> (FLL, FIS, FCL). None = the format has no name for it.
@@ -450,11 +454,11 @@ class Record(list):
     block and replayed into a :class:`Settings` once it is known which of them form one
     behavior (see :func:`replay`)."""
 
-    def set(self, key: str, value, span: Span | None, what: str) -> None:
+    def set(self, key: str, value: str | int, span: Span | None, what: str) -> None:
         self.append((key, value, span, what))
 
 
-def replay(records) -> Settings:
+def replay(records: Iterable[Record]) -> Settings:
     """One :class:`Settings` from several records; a conflict raises FormatError."""
     settings = Settings()
     for record in records:
@@ -822,7 +826,7 @@ def crisp_name(value: float) -> str:
     return f"crisp_{text}"
 
 
-def unique_name(name: str, taken, tried: dict[str, int] | None = None) -> str:
+def unique_name(name: str, taken: Iterable[str], tried: dict[str, int] | None = None) -> str:
     """``name``, else the first of ``name_2``, ``name_3``, ... not in ``taken`` (a set is used
     as it is; anything else is made one). ``tried`` remembers, per ``name``, the suffix
     reached: a caller that only adds to ``taken`` gets its next name without trying again
@@ -839,7 +843,7 @@ def unique_name(name: str, taken, tried: dict[str, int] | None = None) -> str:
     return out
 
 
-def props(expr: Expr):
+def props(expr: Expr) -> Iterator[Prop]:
     """The propositions of an expression, left to right."""
     if isinstance(expr, Prop):
         yield expr

@@ -39,6 +39,7 @@ import math
 import re
 from collections.abc import Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING, cast
 
 import numpy as np
 from lark import Lark, Token, Tree
@@ -57,6 +58,12 @@ from .common import FCL, FLL, fmt_number
 from .fclfunction import linear_function
 from .ruletree import check_depth, conclusions, expression
 from .text import read_foreign_file
+
+if TYPE_CHECKING:
+    from collections.abc import Callable, Iterable
+
+    from ..lang.operators import Operators
+    from .ruletree import Node, SpanOf
 
 DEFAULT_RESOLUTION = 1000
 
@@ -121,7 +128,7 @@ def _syntax_error(exc: UnexpectedInput, text: str, path: str | None) -> FormatEr
 OPTION_KEYS = ("METHOD", "ACCU", "AND", "OR", "ACT", "ACTIVATION", "IMPLICATION")
 
 
-def _keywords(terminals) -> list[str]:
+def _keywords(terminals: Iterable[str]) -> list[str]:
     """The keywords among ``terminals``, as FCL writes them (for "did you mean")."""
     words: list[str] = []
     for t in terminals:
@@ -164,7 +171,7 @@ def parse_fcl(text: str, path: str | None = None) -> RuleBase:
     except UnexpectedInput as exc:
         raise _syntax_error(exc, text, path) from None
 
-    def span_of(node) -> Span:
+    def span_of(node: Node) -> Span:
         if isinstance(node, Token):
             return Span.in_text(text, path, node.line or 1, node.column or 1, node.end_column)
         meta = node.meta
@@ -183,7 +190,7 @@ def parse_fcl(text: str, path: str | None = None) -> RuleBase:
     return _blocks_as_behaviors(blocks, span_of)
 
 
-def _blocks_as_behaviors(blocks: list[Tree], span_of) -> RuleBase:
+def _blocks_as_behaviors(blocks: list[Tree], span_of: SpanOf) -> RuleBase:
     """Several FUNCTION_BLOCKs (jFuzzyLogic reads each by its name): a behavior each, named
     after its block, over the variables of all of them. A variable two blocks define
     differently, and two blocks of one name, are refused: a rule base has one of each."""
@@ -197,7 +204,7 @@ def _blocks_as_behaviors(blocks: list[Tree], span_of) -> RuleBase:
         try:
             rb = _function_block(fb, span_of)
         except NoRulesError as exc:          # a block of terms only: its variables count
-            parts.append((name, None, exc.termset))
+            parts.append((name, None, cast(TermSet, exc.termset)))
             continue
         parts.append((name, rb, rb.termsets[0]))
     termset = TermSet(tuple(_shared_variables(parts)), span_of(blocks[0]).path)
@@ -224,12 +231,12 @@ def _shared_variables(parts: list[tuple[str, RuleBase | None, TermSet]]) -> list
     return list(variables.values())
 
 
-def _num(tree) -> float:
+def _num(tree: Node) -> float:
     token = tree.children[0] if isinstance(tree, Tree) else tree
     return float(str(token))
 
 
-def _function_block(fb: Tree, span_of) -> RuleBase:
+def _function_block(fb: Tree, span_of: SpanOf) -> RuleBase:
     """The rule base of one FUNCTION_BLOCK: its declared variables, their FUZZIFY and
     DEFUZZIFY blocks, and its RULEBLOCKs (one behavior, or one per block where their
     operators differ and their outputs do not meet)."""
@@ -286,7 +293,7 @@ def _function_block(fb: Tree, span_of) -> RuleBase:
 Declared = dict[str, tuple[Role, Span, tuple[float, float] | None]]
 
 
-def _declarations(fb: Tree, span_of) -> tuple[Declared, list[Tree], list[Tree], list[Tree]]:
+def _declarations(fb: Tree, span_of: SpanOf) -> tuple[Declared, list[Tree], list[Tree], list[Tree]]:
     """The VAR_INPUT / VAR_OUTPUT declarations by name (role, place, RANGE), and the
     FUZZIFY, DEFUZZIFY and RULEBLOCK blocks in the order written."""
     declared: Declared = {}
@@ -314,7 +321,7 @@ def _declarations(fb: Tree, span_of) -> tuple[Declared, list[Tree], list[Tree], 
     return declared, fuzzify, defuzzify, blocks
 
 
-def _rule_block(block: Tree, variables: dict[str, Variable], span_of,
+def _rule_block(block: Tree, variables: dict[str, Variable], span_of: SpanOf,
                 notes: list[str]) -> tuple[str, common.Record, list[Rule]]:
     """One RULEBLOCK's name, operators and rules. IEC 61131-7 names one of AND and OR: the
     other one is its dual."""
@@ -360,7 +367,7 @@ JFL_NAMES = {"AND": {"MIN", "PROD", "BDIF", "DMIN", "NIPMIN", "HAMACHER"},
              "OR": {"MAX", "ASUM", "BSUM", "DMAX", "NIPMAX", "EINSTEIN"}}
 
 
-def _both_note(block: Tree, record: common.Record, span_of, notes: list[str]) -> None:
+def _both_note(block: Tree, record: common.Record, span_of: SpanOf, notes: list[str]) -> None:
     """Say where a RULEBLOCK gives both AND and OR in jFuzzyLogic's names, not as the pair its
     last line sets: MITOS uses each, as fuzzylite does; jFuzzyLogic sets both connectives from
     each line, so the last one decides both (`RuleBlock.fclTree`)."""
@@ -438,8 +445,8 @@ def _singletons_note(record: common.Record, v: Variable, rules: list[Rule],
                  f"its nearest sample, weighted by their aggregated degrees")
 
 
-def _variable(node: Tree, role: Role, declared, settings: common.Record, locks: dict,
-              constants: list, n_inputs: int, span_of, notes: list[str],
+def _variable(node: Tree, role: Role, declared: Declared, settings: common.Record, locks: dict,
+              constants: list, n_inputs: int, span_of: SpanOf, notes: list[str],
               ranges: common.Places | None = None,
               known: dict[str, Variable] | None = None) -> Variable:
     name_token = node.children[0]
@@ -618,7 +625,7 @@ def _linear_extent(terms: list[Term], inputs: list[str], known: dict[str, Variab
     return min(xs), max(xs)
 
 
-def _no_variable(term: str, node, span_of) -> None:
+def _no_variable(term: str, node: Node, span_of: SpanOf) -> None:
     """jFuzzyLogic lets a membership parameter be a variable's name (optimised by its
     learning code); MITOS's terms have numbers."""
     if isinstance(node, Token) and node.type == "NAME":
@@ -626,14 +633,14 @@ def _no_variable(term: str, node, span_of) -> None:
                           f"supported", span=span_of(node), hint="write the number")
 
 
-def _point_values(term: str, points, span_of):
+def _point_values(term: str, points: list[Tree], span_of: SpanOf) -> list[Tree]:
     for p in points:
         for v in p.children:
             _no_variable(term, v, span_of)
     return points
 
 
-def _term(item: Tree, role: str, n_inputs: int, span_of, inputs: tuple[str, ...] = ()) -> Term:
+def _term(item: Tree, role: str, n_inputs: int, span_of: SpanOf, inputs: tuple[str, ...] = ()) -> Term:
     name_token, definition = item.children
     name, span = str(name_token), span_of(item)
     if definition.data == "singleton_def":
@@ -680,7 +687,7 @@ def _term(item: Tree, role: str, n_inputs: int, span_of, inputs: tuple[str, ...]
                       hint=did_you_mean(kind, known))
 
 
-def _formula_term(name: str, role: str, token, span_of) -> FormatError:
+def _formula_term(name: str, role: str, token: Node, span_of: SpanOf) -> FormatError:
     """The refusal of an input's membership given by a formula (an output's ``FUNCTION`` is
     a Takagi-Sugeno consequent: :func:`.fclfunction.linear_function`)."""
     word = str(token).split()[0].split("(")[0]
@@ -723,7 +730,7 @@ NSUM_MEANS = ("jFuzzyLogic's normalized sum, (a + b) / max(1, a + b), which is t
               "sum min(1, a + b) exactly")
 
 
-def _option(item: Tree, settings: common.Record, span_of, conj: dict,
+def _option(item: Tree, settings: common.Record, span_of: SpanOf, conj: dict,
             notes: list[str] | None = None) -> None:
     key_token, value_token, number = item.children
     key, value, span = str(key_token).upper(), str(value_token), span_of(value_token)
@@ -823,7 +830,7 @@ def _fuzzylite_accu(rules: list[Rule], settings: common.Settings, span: Span,
             seen[key] = r.label
 
 
-def _grouping_note(rule_items: list[Tree], span_of, notes: list[str]) -> None:
+def _grouping_note(rule_items: list[Tree], span_of: SpanOf, notes: list[str]) -> None:
     """Say where a condition reads ``a OR b AND c`` without parentheses around the AND: MITOS
     (as fuzzylite) reads AND first, jFuzzyLogic's grammar (``condition : subcondition ((AND |
     OR) subcondition)*``) left to right, ``(a OR b) AND c``, and the file does not say which
@@ -836,7 +843,7 @@ def _grouping_note(rule_items: list[Tree], span_of, notes: list[str]) -> None:
                      f"(`(a OR b) AND c`): add parentheses to say which")
 
 
-def _or_before_and(tree, span_of) -> Span | None:
+def _or_before_and(tree: Node, span_of: SpanOf) -> Span | None:
     """Where an AND group follows an OR without parentheses of its own, else None."""
     if not isinstance(tree, Tree):
         return None
@@ -876,7 +883,7 @@ def _split(rule: Rule, notes: list[str]) -> list[Rule]:
             for label, layer in zip(labels, layers)]
 
 
-def _rule(item: Tree, variables: dict[str, Variable], span_of, index: int) -> Rule:
+def _rule(item: Tree, variables: dict[str, Variable], span_of: SpanOf, index: int) -> Rule:
     label_tree, antecedent_tree, *rest = item.children
     weight_tree = rest[-1]
     label = str(label_tree.children[0])
@@ -984,7 +991,8 @@ def _range(v: Variable) -> str:
     return f"RANGE := ({fmt_number(v.universe[0])} .. {fmt_number(v.universe[1])});"
 
 
-def _defuzzify(rb: RuleBase, v: Variable, ops, inputs: Sequence[Variable], at, dialect: str,
+def _defuzzify(rb: RuleBase, v: Variable, ops: Operators, inputs: Sequence[Variable],
+               at: Callable[[str], Span | None], dialect: str,
                accu: str | None) -> list[str]:
     """An output's DEFUZZIFY block up to its END; ``accu``: the ACCU line fuzzylite's dialect
     writes after METHOD, where fuzzylite's own exporter writes it."""
@@ -1047,7 +1055,7 @@ def _term_text(t: Term, v: Variable, dialect: str = DEFAULT_DIALECT) -> str:
     return common.fuzzylite_term_text(t, v.name)
 
 
-def _corner_points(corners) -> list[tuple[float, float]] | None:
+def _corner_points(corners: tuple[float, float, float, float]) -> list[tuple[float, float]] | None:
     """The IEC point list drawing a trapezoid-family term exactly, or None (vertical edges)."""
     a, b, c, d = corners
     inf = float("inf")
@@ -1061,12 +1069,12 @@ def _corner_points(corners) -> list[tuple[float, float]] | None:
     return None
 
 
-def _rule_text(r: Rule, dialect: str = DEFAULT_DIALECT, ops=None) -> str:
+def _rule_text(r: Rule, dialect: str = DEFAULT_DIALECT, ops: Operators | None = None) -> str:
     """A rule in lower-case keywords; conclusions joined as ``dialect`` reads them. fuzzylite's
     ``not`` is a hedge on one proposition, so for it a ``not`` over a group is moved onto the
     propositions (De Morgan), which is exact when the rule block's `and` and `or` are duals
     (min and max, ...); otherwise it is refused by name."""
-    def expr(e, parent: str) -> str:
+    def expr(e: Expr, parent: str) -> str:
         if isinstance(e, Prop):
             words = (["not"] if e.negated else []) + [common.to_fuzzylite_hedge(h, e.span)
                                                        for h in e.hedges] + [e.term]
@@ -1082,14 +1090,14 @@ def _rule_text(r: Rule, dialect: str = DEFAULT_DIALECT, ops=None) -> str:
     joint = " and " if dialect == "fuzzylite" else ", "
     cons = joint.join(f"{c.var} is " + " ".join(
         [common.to_fuzzylite_hedge(h, c.span) for h in hedges] + [common.concluded_term(c)])
-        for c, hedges in common.written_consequents(r, ops and ops.inference))
+        for c, hedges in common.written_consequents(r, ops.inference if ops is not None else None))
     text = f"if {expr(r.antecedent, 'top')} then {cons}"
     if r.weight != 1.0:
         text += f" with {fmt_number(r.weight)}"
     return text
 
 
-def _de_morgan(e: Not, r: Rule, ops) -> Expr:
+def _de_morgan(e: Not, r: Rule, ops: Operators | None) -> Expr:
     """``not (a or b)`` as ``not a and not b`` (and the dual), down to the propositions."""
     if ops is None or norms.lookup("tnorm", ops.and_).dual != ops.or_:
         raise FormatError(f"rule `{r.label}`: fuzzylite's FCL has no `not` over a group (its "

@@ -33,6 +33,7 @@ import re
 from collections import Counter
 from functools import partial
 from pathlib import Path
+from typing import TYPE_CHECKING, cast
 
 from ..errors import FormatError, Span, did_you_mean
 from ..lang.bulk import without_cyclic_gc
@@ -42,6 +43,14 @@ from ..words import plural
 from . import common
 from .common import FIS, Settings, fmt_number
 from .text import read_foreign_file
+
+if TYPE_CHECKING:
+    from collections.abc import Sequence
+
+    #: a ``key=value`` line of a section: key, value, the line's span and the value's
+    Item = tuple[str, str, Span, Span]
+    #: a ``[Section]``: its name, its span and its lines
+    Section = tuple[str, Span, list[Item]]
 
 DEFAULT_RESOLUTION = 101
 
@@ -81,7 +90,7 @@ def read_fis(path: str | Path) -> RuleBase:
     return read_foreign_file(Path(path), parse_fis)
 
 
-def _sections(text: str, path: str | None):
+def _sections(text: str, path: str | None) -> tuple[list[Section], list[tuple[str, int, Span]]]:
     """``[(name, span, [(key, value, span, vspan), ...]), ...]`` and the rule lines."""
     sections: list = []
     rules: list = []
@@ -168,7 +177,7 @@ def parse_fis(text: str, path: str | None = None) -> RuleBase:
     return dataclasses.replace(rb, notes=tuple(notes), unused=unused)
 
 
-def _system(items) -> dict[str, tuple[str, Span]]:
+def _system(items: list[Item]) -> dict[str, tuple[str, Span]]:
     """The [System] section's values (and their places) by key; an unknown key is refused."""
     system = {}
     for key, value, span, vspan in items:
@@ -274,7 +283,7 @@ def _check_count(system: dict, key: str, found: int, span: Span) -> None:
             raise FormatError(f"{key}={value} but the file has {found}", span=vspan)
 
 
-def _variables(sections, prefix: str, role: Role, kind: str, notes: list[str],
+def _variables(sections: list[Section], prefix: str, role: Role, kind: str, notes: list[str],
                n_inputs: int = 0, ranges: common.Places | None = None) -> list[Variable]:
     """The ``[PrefixN]`` sections' variables, in order; ``ranges``: gets where each one's
     range (and fuzzylite's ``Default``) is written."""
@@ -288,7 +297,7 @@ def _variables(sections, prefix: str, role: Role, kind: str, notes: list[str],
             for _, span, items in found]
 
 
-def _variable(span: Span, items, role: Role, kind: str, n_inputs: int,
+def _variable(span: Span, items: list[Item], role: Role, kind: str, n_inputs: int,
               notes: list[str], ranges: common.Places | None = None) -> Variable:
     values = {}
     terms: list[Term] = []
@@ -609,7 +618,7 @@ def _mf_text(t: Term, v: Variable) -> str:
     return f"'{t.name}':'{mf}',[{' '.join(fmt_number(x) for x in values)}]"
 
 
-def _rule_text(r: Rule, inputs, outputs) -> str:
+def _rule_text(r: Rule, inputs: Sequence[Variable], outputs: Sequence[Variable]) -> str:
     e = r.antecedent
     if isinstance(e, Prop):
         props, connection = [e], 1
@@ -634,7 +643,7 @@ def _rule_text(r: Rule, inputs, outputs) -> str:
         if c.hedges:
             raise FormatError(f"rule `{r.label}`: hedges cannot be written to .fis", span=r.span)
         v = next(v for v in outputs if v.name == c.var)
-        outs[c.var] = v.index(c.term) + 1
+        outs[c.var] = v.index(cast(str, c.term)) + 1     # (flatten_for_export: crisp values are terms)
     ins = " ".join(str(index.get(v.name, 0)) for v in inputs)
     outs_text = " ".join(str(outs.get(v.name, 0)) for v in outputs)
     return f"{ins}, {outs_text} ({fmt_number(r.weight)}) : {connection}"

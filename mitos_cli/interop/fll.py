@@ -28,6 +28,7 @@ import dataclasses
 import functools
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 from lark import Lark, Tree
 from lark.exceptions import UnexpectedInput
@@ -45,6 +46,10 @@ from .common import FLL, Settings, fmt_number
 from .ruletree import conclusions as conclusions_of
 from .ruletree import expression
 from .text import read_foreign_file
+
+if TYPE_CHECKING:
+    from ..lang.operators import Operators
+    from .ruletree import Node, SpanOf
 
 #: fuzzylite's monotonic terms, which its weighted defuzzifiers invert (Tsukamoto inference)
 TSUKAMOTO_KINDS = ("Ramp", "Sigmoid", "SShape", "ZShape", "Concave", "Arc")
@@ -396,7 +401,7 @@ def _build_variable(v: _Var, inputs: list[str], notes: list[str]) -> Variable:
 
 def _rule(value: str, text: str, path: str | None, lineno: int, vcol: int,
           variables: dict[str, Variable], conj: dict, index: int) -> Rule:
-    def span_of(node) -> Span:
+    def span_of(node: object) -> Span:
         meta = getattr(node, "meta", None)
         column = getattr(node, "column", None) or (meta.column if meta and not meta.empty
                                                    else 1)
@@ -424,7 +429,7 @@ def _rule(value: str, text: str, path: str | None, lineno: int, vcol: int,
                 weight, span)
 
 
-def _check_operators(tree, conj: dict, span_of) -> None:
+def _check_operators(tree: Node, conj: dict, span_of: SpanOf) -> None:
     """fuzzylite refuses `and` / `or` when the block's conjunction / disjunction is none."""
     from lark import Tree
 
@@ -555,7 +560,7 @@ def _output_term(rb: RuleBase, t: Term, v: Variable, sugeno: bool,
     return common.fuzzylite_term_text(t, v.name)
 
 
-def fuzzylite_rule_text(rule: Rule, ops, dialect: str) -> str:
+def fuzzylite_rule_text(rule: Rule, ops: Operators, dialect: str) -> str:
     """A rule in fuzzylite's language (``dialect`` ``fll``: lower case; ``fcl``: upper-case
     keywords). ``not (...)`` groups are pushed onto propositions when the operators are duals."""
     from ..lang.model import And, Not, Prop
@@ -563,7 +568,7 @@ def fuzzylite_rule_text(rule: Rule, ops, dialect: str) -> str:
     antecedent = common.simple_nots(rule.antecedent, rule, ops)
     kw = (lambda w: w.upper()) if dialect == "fcl" else (lambda w: w)
 
-    def expr(e, parent: str) -> str:
+    def expr(e: Any, parent: str) -> str:      # an Expr without Not (simple_nots pushed them in)
         if isinstance(e, Prop):
             words = (["not"] if e.negated else []) + [common.to_fuzzylite_hedge(h, e.span)
                                                        for h in e.hedges] + [e.term]

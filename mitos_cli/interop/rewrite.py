@@ -14,9 +14,14 @@ Anything outside those conditions is refused by name, at the rule.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 from ..errors import FormatError
 from ..lang.model import And, Expr, Not, Or, Prop, Rule
 from ..lang.parse import MAX_NESTING
+
+if TYPE_CHECKING:
+    from collections.abc import Iterator
 
 #: how many propositions the chained conditions of one rule block may hold, written out. Each
 #: tested output becomes the conditions of the rules that set it, which may test outputs in
@@ -152,7 +157,7 @@ def _size(expr: Expr, memo: dict[int, tuple[Expr, int, int]]) -> tuple[int, int]
     return memo[id(expr)][1:]
 
 
-def _props(expr: Expr):
+def _props(expr: Expr) -> Iterator[Prop]:
     if isinstance(expr, Prop):
         yield expr
     elif isinstance(expr, Not):

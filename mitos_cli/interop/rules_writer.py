@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import json
 import re
+from typing import TYPE_CHECKING
 
 import numpy as np
 import yaml
@@ -19,6 +20,9 @@ from ..errors import FormatError
 from ..lang.model import Rule, RuleBase, format_rule
 from ..lang.terms import Term, Variable
 from . import common
+
+if TYPE_CHECKING:
+    from collections.abc import Iterable, Sequence
 
 NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_\-]*[A-Za-z0-9_]|[A-Za-z_]")
 RESERVED = common.RESERVED_NAMES["rules"]       # the rule language's keywords and hedge words
@@ -118,7 +122,7 @@ def write_rules(rb: RuleBase, termset_name: str, behavior: str | None = None,
                                                                       source)
 
 
-def _rule_lines(rules, indent: str) -> list[str]:
+def _rule_lines(rules: Iterable[Rule], indent: str) -> list[str]:
     labels: set[str] = set()
     lines = []
     for i, r in enumerate(rules):
@@ -135,7 +139,7 @@ def _quote(text: str) -> str:
     return '"' + text.replace("\\", "\\\\").replace('"', '\\"') + '"'
 
 
-def _scalar(value) -> str:
+def _scalar(value: str | float) -> str:
     if isinstance(value, str):
         return yaml.safe_dump(value, default_flow_style=True, width=1 << 16).strip() \
             .removesuffix("...").strip()
@@ -147,7 +151,7 @@ def _scalar(value) -> str:
     return common.fmt_number(value)
 
 
-def _written_universe(rb: RuleBase, v) -> tuple[float, float]:
+def _written_universe(rb: RuleBase, v: Variable) -> tuple[float, float]:
     """``v``'s universe, or for a weighted-average output without one (fuzzylite's
     ``range: 0 0``) the interval its terms can reach over the inputs' universes, which a term
     set needs and the weighted average never uses."""
@@ -169,7 +173,8 @@ def _written_universe(rb: RuleBase, v) -> tuple[float, float]:
     return (lo, hi) if lo < hi else (lo - 0.5, hi + 0.5)
 
 
-def write_termset(rb: RuleBase, inputs, outputs, source: str = "") -> str:
+def write_termset(rb: RuleBase, inputs: Sequence[Variable], outputs: Sequence[Variable],
+                  source: str = "") -> str:
     lines = ["# Term set written by `mitos convert`" + (f" from {source}" if source else ""),
              "variables:"]
     input_names = [v.name for v in inputs]

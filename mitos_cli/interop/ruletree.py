@@ -9,6 +9,7 @@ error points at the word in the file.
 from __future__ import annotations
 
 from collections.abc import Callable
+from typing import TYPE_CHECKING, Any
 
 from lark import Token, Tree
 
@@ -18,10 +19,17 @@ from ..lang.parse import MAX_NESTING
 from ..lang.terms import Variable
 from .common import fuzzylite_hedge
 
+if TYPE_CHECKING:
+    from collections.abc import Iterable, Sequence
+
+    #: a node of a Lark parse tree, a Tree or a Token as the grammar's position decides: Lark
+    #: types every child as either (``list[Token | Tree]``), so the readers name nodes by this
+    Node = Any
+
 SpanOf = Callable[[object], Span]
 
 
-def expression(tree, span_of: SpanOf, variables: dict[str, Variable]) -> Expr:
+def expression(tree: Node, span_of: SpanOf, variables: dict[str, Variable]) -> Expr:
     """An antecedent tree as a MITOS expression, refused past :data:`MAX_NESTING` levels
     first: 400 ``NOT``s or nested parentheses of an FCL or FLL rule were a RecursionError."""
     if isinstance(tree, Tree):
@@ -33,7 +41,7 @@ def expression(tree, span_of: SpanOf, variables: dict[str, Variable]) -> Expr:
 NESTING = ("or_expr", "and_expr", "negation")
 
 
-def check_depth(tree, span_of: SpanOf, limit: int = MAX_NESTING) -> None:
+def check_depth(tree: Node, span_of: SpanOf, limit: int = MAX_NESTING) -> None:
     """Refuse a condition (or a whole file's tree) whose ``and`` / ``or`` / ``not`` nest
     deeper than ``limit``, at the first node past it, as the rule language refuses one. Walked
     without recursion: Lark's ``scan_values`` and every later pass recurse."""
@@ -48,7 +56,7 @@ def check_depth(tree, span_of: SpanOf, limit: int = MAX_NESTING) -> None:
         stack.extend((child, depth) for child in node.children if isinstance(child, Tree))
 
 
-def _expression(tree, span_of: SpanOf, variables: dict[str, Variable]) -> Expr:
+def _expression(tree: Node, span_of: SpanOf, variables: dict[str, Variable]) -> Expr:
     if isinstance(tree, Token):
         raise FormatError(f"unexpected `{tree}`", span=span_of(tree))
     kind = tree.data
@@ -80,7 +88,7 @@ def _expression(tree, span_of: SpanOf, variables: dict[str, Variable]) -> Expr:
     raise FormatError(f"unexpected `{kind}` in a rule", span=span_of(tree))
 
 
-def conclusions(trees, span_of: SpanOf) -> tuple[Consequent, ...]:
+def conclusions(trees: Iterable[Tree], span_of: SpanOf) -> tuple[Consequent, ...]:
     """A rule's consequents as fuzzylite computes them: its hedges change the rule's activation
     degree for that consequent *and every one after it* (``Consequent.modify`` reassigns the
     degree), so ``then a is very x and b is y`` hedges ``b`` too. Each consequent gets the
@@ -100,7 +108,8 @@ def conclusion(tree: Tree, span_of: SpanOf) -> Consequent:
     return Consequent(str(var), str(term), None, hedges, span_of(tree))
 
 
-def _words(words, span_of: SpanOf, tree, allow_not: bool) -> tuple[bool, tuple[str, ...]]:
+def _words(words: Sequence[Node], span_of: SpanOf, tree: Tree, allow_not: bool
+           ) -> tuple[bool, tuple[str, ...]]:
     negated = False
     hedges = []
     for i, w in enumerate(words):

@@ -27,8 +27,13 @@ are measured at every point of their support, as before.
 from __future__ import annotations
 
 from collections.abc import Callable
+from typing import TYPE_CHECKING
 
 import numpy as np
+
+if TYPE_CHECKING:
+    #: three lines' slopes, points and values: line i is m[i] (x - p[i]) + q[i]
+    Lines = tuple[np.ndarray, np.ndarray, np.ndarray]
 
 #: How far below the envelope (in membership) a term's edge may lie on a piece and still be
 #: measured there: far more than the rounding of a membership or of the envelope's lines
@@ -131,7 +136,8 @@ def _joined(left: np.ndarray, right: np.ndarray) -> tuple[np.ndarray, np.ndarray
 
 
 def _measure_on(top: np.ndarray, xs: np.ndarray, one: np.ndarray, corners: np.ndarray,
-                term: np.ndarray, u0: np.ndarray, u1: np.ndarray, measure) -> None:
+                term: np.ndarray, u0: np.ndarray, u1: np.ndarray,
+                measure: Callable[[np.ndarray, np.ndarray], np.ndarray]) -> None:
     """Raise ``top`` to ``term[i]``'s membership at the points of ``xs`` in ``[u0[i],
     u1[i]]`` (those under a core are 1 anyway)."""
     start = np.searchsorted(xs, u0, side="left")
@@ -167,12 +173,12 @@ def _spread(start: np.ndarray, count: np.ndarray) -> tuple[np.ndarray, np.ndarra
     return start[i] + np.arange(len(i)) - np.repeat(np.cumsum(count) - count, count), i
 
 
-def _value(lines, k: np.ndarray, x: np.ndarray) -> np.ndarray:
+def _value(lines: Lines, k: np.ndarray, x: np.ndarray) -> np.ndarray:
     m, p, q = lines
     return m[k] * (x - p[k]) + q[k]
 
 
-def _envelope(left: np.ndarray, right: np.ndarray, lines, lo: float, hi: float
+def _envelope(left: np.ndarray, right: np.ndarray, lines: Lines, lo: float, hi: float
               ) -> tuple[np.ndarray, np.ndarray]:
     """The upper envelope of the segments ``i`` (line ``i + 1`` of ``lines`` on ``[left[i],
     right[i]]``, each wider than a point) and of 0 (line 0) on ``[lo, hi]``: the start of each
@@ -202,7 +208,7 @@ def _envelope(left: np.ndarray, right: np.ndarray, lines, lo: float, hi: float
     return start, line
 
 
-def _merge(block: np.ndarray, start: np.ndarray, line: np.ndarray, lines, hi: float
+def _merge(block: np.ndarray, start: np.ndarray, line: np.ndarray, lines: Lines, hi: float
            ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Envelopes ``2 k`` and ``2 k + 1`` (pieces sorted by block, then start) merged into
     envelope ``k``, every pair at once."""

@@ -46,13 +46,19 @@ vectorized over points (and over terms, for piecewise-linear ones).
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import NamedTuple
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
 from .envelope import regular as upper_envelope_regular
 from .envelope import upper_envelope
 from .terms import Term, Variable
+
+if TYPE_CHECKING:
+    from collections.abc import Callable, Iterable, Sequence
+
+    #: memberships of distinct terms k[p] at the points x[at[p]]: rows(k, at)
+    Rows = Callable[[np.ndarray, np.ndarray], np.ndarray]
 
 #: Least largest-membership anywhere on an input's universe (a Ruspini partition has 0.5).
 COVERAGE = 0.5
@@ -574,7 +580,7 @@ class _Spans(NamedTuple):
     some: np.ndarray        # above 0 somewhere
 
 
-def _rows_of(distinct: np.ndarray, x: np.ndarray):
+def _rows_of(distinct: np.ndarray, x: np.ndarray) -> Rows:
     def rows(k: np.ndarray, at: np.ndarray) -> np.ndarray:
         return memberships(distinct[k], x[at])
     return rows
@@ -639,7 +645,9 @@ def _areas(corners: np.ndarray, lo: float, hi: float, extra: np.ndarray | None =
     return ((m[:, 1:] + m[:, :-1]) * 0.5 * np.diff(pts, axis=1)).sum(axis=1)
 
 
-def _pairs_on_own_points(corners, i, j, lines, lo: float, hi: float,
+def _pairs_on_own_points(corners: np.ndarray, i: np.ndarray, j: np.ndarray,
+                         lines: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray],
+                         lo: float, hi: float,
                          extra: np.ndarray | None = None, beside: np.ndarray | None = None
                          ) -> np.ndarray:
     """The Jaccard similarity of terms ``i[p]`` and ``j[p]`` on the points of each pair (and
@@ -680,7 +688,7 @@ def _linear_most(corners: np.ndarray, x: np.ndarray) -> tuple[float, int, int]:
                          end)
 
 
-def _most_similar(rows, x: np.ndarray, which: np.ndarray, counts: np.ndarray, start: np.ndarray,
+def _most_similar(rows: Rows, x: np.ndarray, which: np.ndarray, counts: np.ndarray, start: np.ndarray,
                   end: np.ndarray) -> tuple[float, int, int]:
     """:func:`most_similar_on` of the terms ``which`` (indices of distinct terms, each
     occurring ``counts`` times), whose memberships ``rows(k, at)`` gives for distinct terms
@@ -725,7 +733,7 @@ def _distinct_rows(mu: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return mu[first], which, np.bincount(which, minlength=len(seen))
 
 
-def _pair_similarity(rows, x: np.ndarray, k: np.ndarray, v: np.ndarray, start: np.ndarray,
+def _pair_similarity(rows: Rows, x: np.ndarray, k: np.ndarray, v: np.ndarray, start: np.ndarray,
                      end: np.ndarray, only: np.ndarray | None = None) -> np.ndarray:
     """The similarity of the terms ``k[p]`` and ``v[p]`` for each pair ``p`` as
     :func:`similarity_on` forms it (0 for two terms never both above 0), each on its own
@@ -806,7 +814,7 @@ def measures(corners: np.ndarray, universe: tuple[float, float]) -> tuple[float,
 
 # ---- terms of any shape, on samples -------------------------------------------------------------
 
-def sample_points(terms, universe: tuple[float, float]) -> np.ndarray:
+def sample_points(terms: Sequence[Term], universe: tuple[float, float]) -> np.ndarray:
     """Where terms of any shape are measured: :data:`RESOLUTION` evenly spaced points of the
     universe, the :func:`breakpoints` of the piecewise-linear ones among ``terms`` (so they stay
     exact) and every term's centre (sorted)."""
@@ -818,7 +826,7 @@ def sample_points(terms, universe: tuple[float, float]) -> np.ndarray:
     return np.unique(x[np.isfinite(x) & (x >= lo) & (x <= hi)])
 
 
-def sampled(terms, x: np.ndarray) -> np.ndarray:
+def sampled(terms: Sequence[Term], x: np.ndarray) -> np.ndarray:
     """``mu[t, n]`` of ``terms`` (any shape of the registry) at the points ``x[n]``, in
     [0, 1] (a NaN membership counts as 0)."""
     mu = np.empty((len(terms), len(x)))                   # filled a term at a time
@@ -1145,7 +1153,7 @@ def gap_message(var: Variable, gap: Gap) -> str:
     return f"input `{var.name}`: every term is 0 {where}"
 
 
-def rulebase_issues(variables) -> list[Issue]:
+def rulebase_issues(variables: Iterable[Variable]) -> list[Issue]:
     """:func:`variable_issues` of each variable in turn."""
     return [i for v in variables for i in variable_issues(v)]
 

@@ -13,6 +13,7 @@ import inspect
 import math
 import re
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
 
 from lark import Lark, Token, Transformer, Tree, v_args
 from lark.exceptions import (
@@ -29,6 +30,12 @@ from ..resources import grammar_text
 from .bulk import without_cyclic_gc
 from .cache import lark_parser
 from .model import And, Behavior, Consequent, Expr, Not, Or, Prop, Rule, Setting, Use
+
+if TYPE_CHECKING:
+    from collections.abc import Callable, Iterable, Iterator
+    from types import SimpleNamespace
+
+    from lark.tree import Meta
 
 HEDGE_NAMES = tuple(HEDGES)          # the grammar's HEDGE words (tests/test_registries.py)
 
@@ -85,11 +92,11 @@ def _words(name: str, words: dict[str, str] = TERMINAL_WORDS) -> str:
     return f"`{name}`"
 
 
-def _expected(names) -> str:
+def _expected(names: Iterable[str]) -> str:
     return _expected_words(names, TERMINAL_WORDS)
 
 
-def _expected_words(names, words_of: dict[str, str]) -> str:
+def _expected_words(names: Iterable[str], words_of: dict[str, str]) -> str:
     """The terminals ``names`` as a sentence (``a, b or c``), named as in ``words_of``."""
     words = sorted({_words(n, words_of) for n in names
                     if not n.startswith("__") and n not in UNSAID})
@@ -98,7 +105,7 @@ def _expected_words(names, words_of: dict[str, str]) -> str:
     return words[0] if words else "something else"
 
 
-def keyword_hint(token: Token, expected) -> str | None:
+def keyword_hint(token: Token, expected: Iterable[str]) -> str | None:
     """A misspelt keyword (``adapt epocs``, ``iff``): "did you mean" the closest keyword the
     parser expected there, if one is close."""
     words = [n.lower() for n in expected if n.isupper() and n.isalpha() and n != "NAME"]
@@ -459,7 +466,7 @@ def shift(span: Span | None, lines: int) -> Span | None:
     return dataclasses.replace(span, line=span.line + lines)
 
 
-def _span(meta, text: str, path: str | None) -> Span | None:
+def _span(meta: Meta | SimpleNamespace, text: str, path: str | None) -> Span | None:
     if getattr(meta, "empty", True):
         return None
     return Span.at(text, path, meta.start_pos, meta.line, meta.column, meta.end_column
@@ -471,7 +478,7 @@ _WITH_META = getattr(v_args(meta=True)(lambda self, meta, items: None), "visit_w
 
 
 @functools.cache
-def _callback(cls: type, name: str):
+def _callback(cls: type, name: str) -> Callable[[Transformer, Meta, list], object] | None:
     """``cls``'s method for the rule ``name`` as ``f(self, meta, children)``; None where Lark's
     own dispatch must decide (no such method, or another kind of ``v_args``)."""
     if name.startswith("_") or not hasattr(cls, name):
@@ -495,12 +502,12 @@ class _ToModel(Transformer):
         self.counter = 0
         self.line_offset = line_offset        # the text starts at this line + 1 of its file
 
-    def _transform_tree(self, tree):
+    def _transform_tree(self, tree: Tree) -> Any:     # what the callbacks build (model objects, tuples)
         """Lark's walk, without its generator per node (tokens are kept as they are)."""
         return self._call_userfunc(tree, [self._transform_tree(c) if isinstance(c, Tree) else c
                                           for c in tree.children])
 
-    def _call_userfunc(self, tree, new_children=None):
+    def _call_userfunc(self, tree: Tree, new_children: list | None = None) -> Any:
         """Lark's dispatch makes a new wrapper object at each node for a ``v_args`` method
         (a third of the transform of 10,000 rules); the method is found once per class."""
         call = _callback(type(self), tree.data)
@@ -512,11 +519,11 @@ class _ToModel(Transformer):
         except Exception as exc:
             raise VisitError(tree.data, tree, exc) from exc
 
-    def _s(self, meta) -> Span | None:
+    def _s(self, meta: Meta | SimpleNamespace) -> Span | None:   # (teach builds a Meta's fields)
         span = _span(meta, self.text, self.path)
         return shift(span, self.line_offset)
 
-    def transform(self, tree):
+    def transform(self, tree: Tree) -> Any:
         """Lark wraps what a callback raises in ``VisitError``; a MITOS error raised while
         building (a number past a float's range) is the user's, so it comes out as itself."""
         try:
@@ -527,7 +534,7 @@ class _ToModel(Transformer):
             raise
 
     @v_args(meta=True)
-    def number(self, meta, items):
+    def number(self, meta: Meta, items: list[Token]) -> float:
         value = float(items[0])
         if math.isinf(value):             # the grammar's numbers have no `inf`: 1e400 overflowed
             raise RuleSyntaxError(f"`{items[0]}` is past a float's range", span=self._s(meta),
@@ -540,7 +547,7 @@ class _ToModel(Transformer):
         return value
 
     @v_args(meta=True)
-    def proposition(self, meta, items):
+    def proposition(self, meta: Meta, items: list[Token]) -> Prop:
         var, *mods, term = items
         negated = False
         hedges = []
@@ -552,41 +559,41 @@ class _ToModel(Transformer):
         return Prop(str(var), str(term), tuple(hedges), negated, self._s(meta))
 
     @v_args(meta=True)
-    def negation(self, meta, items):
+    def negation(self, meta: Meta, items: list[Expr]) -> Not:
         return Not(items[0], self._s(meta))
 
     @v_args(meta=True)
-    def and_expr(self, meta, items):
+    def and_expr(self, meta: Meta, items: list[Expr]) -> And:
         flat: list[Expr] = []
         for item in items:
             flat.extend(item.items if isinstance(item, And) else [item])
         return And(tuple(flat), self._s(meta))
 
     @v_args(meta=True)
-    def or_expr(self, meta, items):
+    def or_expr(self, meta: Meta, items: list[Expr]) -> Or:
         flat: list[Expr] = []
         for item in items:
             flat.extend(item.items if isinstance(item, Or) else [item])
         return Or(tuple(flat), self._s(meta))
 
     @v_args(meta=True)
-    def term_consequent(self, meta, items):
+    def term_consequent(self, meta: Meta, items: list[Token]) -> Consequent:
         var, *mods, term = items
         return Consequent(str(var), str(term), None, tuple(str(m) for m in mods), self._s(meta))
 
     @v_args(meta=True)
-    def crisp_consequent(self, meta, items):
+    def crisp_consequent(self, meta: Meta, items: list[Token | float]) -> Consequent:
         return Consequent(str(items[0]), None, float(items[1]), (), self._s(meta))
 
-    def label(self, items):
+    def label(self, items: list[Token]) -> str:
         return str(items[0])
 
     @v_args(meta=True)
-    def weight(self, meta, items):
+    def weight(self, meta: Meta, items: list[float]) -> _Weight:
         return _Weight(items[0], self._s(meta))
 
     @v_args(meta=True)
-    def rule(self, meta, items):
+    def rule(self, meta: Meta, items: list[Any]) -> Rule | tuple:   # (label, expr, consequents..., weight)
         label, antecedent, *consequents, weight = items
         for c in consequents:
             if isinstance(c, tuple):
@@ -596,18 +603,19 @@ class _ToModel(Transformer):
                     None if weight is None else weight.span)
 
     @v_args(meta=True)
-    def use_stmt(self, meta, items):
+    def use_stmt(self, meta: Meta, items: list[Any]) -> Use:        # (name, condition, weight)
         name, condition, weight = items
         return Use(str(name), condition, 1.0 if weight is None else weight.value, self._s(meta),
                    None if weight is None else weight.span)
 
-    def frozen_stmt(self, items):
+    def frozen_stmt(self, items: list[Any]  # tokens (Lark types their line and column Optional)
+                    ) -> tuple[str, tuple[str, ...], tuple[Span | None, ...]]:
         return ("frozen", tuple(str(i) for i in items),
                 tuple(shift(Span.at(self.text, self.path, i.start_pos, i.line, i.column,
                                     i.end_column), self.line_offset) for i in items))
 
     @v_args(meta=True)
-    def op_assign(self, meta, items):
+    def op_assign(self, meta: Meta, items: list[Any]) -> Setting:   # (name, a token or a number)
         value = items[1]
         if isinstance(value, Token):
             value = str(value)
@@ -615,11 +623,12 @@ class _ToModel(Transformer):
             value = self.text[meta.start_pos:meta.end_pos].split("=", 1)[1].strip()
         return Setting(str(items[0]), value, self._s(meta))
 
-    def operators_stmt(self, items):
+    def operators_stmt(self, items: list[Setting]) -> tuple[str, tuple[Setting, ...]]:
         return ("operators", tuple(items))
 
     @v_args(meta=True)
-    def terms_stmt(self, meta, items):
+    def terms_stmt(self, meta: Meta, items: list[Any]  # tokens, as frozen_stmt's
+                   ) -> tuple[str, tuple[tuple[str, Span], ...]]:
         spans = []
         for tok in items:
             spans.append((_unquote(tok), Span.at(self.text, self.path, tok.start_pos,
@@ -627,7 +636,7 @@ class _ToModel(Transformer):
         return ("terms", tuple(spans))
 
     @v_args(meta=True)
-    def behavior(self, meta, items):
+    def behavior(self, meta: Meta, items: list[Any]) -> tuple[str, str, list, Span | None]:
         name, *body = items
         return ("behavior", str(name), body, self._s(meta))
 
@@ -696,7 +705,7 @@ def check_modifiers(tree: Tree, text: str, path: str | None,
                  f"term of `{var}` in the term set and write `{var} is {hedge} THAT_TERM`")
 
 
-def _subtrees(tree: Tree):
+def _subtrees(tree: Tree) -> Iterator[Tree]:
     """Every subtree, in no particular order (a plain stack: Lark's ``iter_subtrees`` orders
     them and costs as much as the checks themselves)."""
     stack = [tree]
@@ -842,8 +851,8 @@ def check_settings(settings: tuple[Setting, ...]) -> tuple[Setting, ...]:
     return settings
 
 
-def _collect(item, terms: list[tuple[str, Span]], operators: list[Setting], rules: list[Rule],
-             uses: list[Use], frozen: list[str], behaviors: list[Behavior],
+def _collect(item: Rule | Use | tuple, terms: list[tuple[str, Span]], operators: list[Setting],
+             rules: list[Rule], uses: list[Use], frozen: list[str], behaviors: list[Behavior],
              frozen_spans: list[Span | None] | None = None) -> None:
     frozen_spans = [] if frozen_spans is None else frozen_spans
     if isinstance(item, Rule):
@@ -880,6 +889,6 @@ def parse_rule(text: str, path: str | None = None) -> Rule:
     return result
 
 
-def parse_expr(text: str, path: str | None = None):
+def parse_expr(text: str, path: str | None = None) -> Expr:
     """Parse a condition such as ``road is WIDE and not size is LARGE_SZ``."""
     return _ToModel(text, path).transform(parse_tree(text, path, start="expr"))

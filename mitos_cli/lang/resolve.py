@@ -8,6 +8,7 @@ actions; labels are unique within a behavior; ``use`` has no cycles; operator se
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from ..errors import MitosError, RuleBaseError, Span, TermSetError, unknown
 from ..fuzzy.hedges import HEDGES
@@ -19,6 +20,11 @@ from .model import And, Behavior, Consequent, Expr, Not, Or, Prop, Rule, RuleBas
 from .parse import ParsedFile, parse_rules
 from .termfile import load_termset
 from .terms import TermSet, Variable
+
+if TYPE_CHECKING:
+    from collections.abc import Iterable
+
+    from .operators import Operators
 
 MAIN = "main"
 
@@ -107,7 +113,7 @@ def termsets_read(path: str | Path) -> set[Path]:
         return set()
 
 
-def strays(rules_target: str | Path, companions) -> list[Path]:
+def strays(rules_target: str | Path, companions: Iterable[str | Path]) -> list[Path]:
     """The files among ``companions`` (written beside ``rules_target``, which the user named)
     that are already there and that the rule file at ``rules_target`` does not read: files
     the user did not name, which writing would replace."""
@@ -215,7 +221,8 @@ def set_again(settings: tuple[Setting, ...], behavior: str | None = None) -> tup
     return tuple(notes)
 
 
-def infinite_inverses(behaviors, variables: dict[str, Variable], base_ops) -> tuple[str, ...]:
+def infinite_inverses(behaviors: Iterable[Behavior], variables: dict[str, Variable],
+                      base_ops: Operators) -> tuple[str, ...]:
     """A note for each sigmoid a Tsukamoto behavior's rule concludes: a sigmoid reaches 1 only
     at infinity, so where the rule fires fully its inverse, and the output, is +-inf (as in
     fuzzylite, whose reader's note this is); nothing else said so."""

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
 from functools import cached_property
-from typing import Literal
+from typing import TYPE_CHECKING, Literal
 
 import numpy as np
 
@@ -17,6 +17,11 @@ from ..errors import Span, TermSetError, control_character, invisible_character,
 from ..fuzzy.formula import Formula
 from ..fuzzy.shapes import SHAPES, STEEP, Shape
 from ..numbers import exact
+
+if TYPE_CHECKING:
+    from collections.abc import Callable
+
+    from numpy.typing import ArrayLike
 
 Role = Literal["input", "output"]
 
@@ -68,7 +73,7 @@ class Term:
         """The shape as the term set writes it: ``triangle``, never ``triangle_pw``."""
         return TERM_SET_SHAPES.get(self.shape, self.shape)
 
-    def params_text(self, number=_number) -> str:
+    def params_text(self, number: Callable[[float], str] = _number) -> str:
         """The parameters as the term set names them, for people: ``peak 70, width 30``,
         ``a 40, b 70``, ``points [10, 40, 70]`` (a triangle by its corners or a ``discrete``
         term), a singleton's value alone. ``number`` formats each value."""
@@ -84,7 +89,7 @@ class Term:
             return f"points [{', '.join(number(v) for v in p)}]"
         return ", ".join(f"{n} {number(v)}" for n, v in zip(self.kind.params, p))
 
-    def membership(self, x) -> np.ndarray:
+    def membership(self, x: ArrayLike) -> np.ndarray:
         if self.formula is not None:
             return self.formula(x)
         return self.kind.membership(x, self.params)

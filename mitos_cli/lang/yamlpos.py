@@ -138,7 +138,7 @@ def _build_loader(text: str, path: str | None) -> type:
         depth = 0
         nodes = 0
 
-        def compose_node(self, parent, index):
+        def compose_node(self, parent: yaml.Node | None, index: int) -> yaml.Node | None:
             event = self.peek_event()
             if isinstance(event, yaml.AliasEvent):
                 raise _refuse(f"aliases (`*{event.anchor}`) are not supported here; write "
@@ -166,7 +166,7 @@ def _build_loader(text: str, path: str | None) -> type:
             finally:
                 self.depth -= 1
 
-        def construct_object(self, node, deep=False):
+        def construct_object(self, node: yaml.Node, deep: bool = False) -> Any:   # any YAML value
             try:
                 return super().construct_object(node, deep)
             except yaml.YAMLError:

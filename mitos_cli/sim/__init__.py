@@ -44,11 +44,26 @@ maps), ``staticmap`` (walls from corridors or grids), ``geometry``, ``kinematics
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:                  # what __getattr__ gives, for the type checker
+    from .lockstep import Lockstep as Lockstep
+    from .lockstep import run_lockstep as run_lockstep
+    from .loop import SimResult as SimResult
+    from .loop import Simulation as Simulation
+    from .loop import Tick as Tick
+    from .loop import simulate as simulate
+    from .planner import FuzzyPlanner as FuzzyPlanner
+    from .planner import Percepts as Percepts
+    from .planner import Planner as Planner
+    from .runs import run_many as run_many
+    from .worldfile import load_world as load_world
+
 __all__ = ["load_world", "simulate", "Simulation", "Tick", "run_many", "FuzzyPlanner", "Planner", "Percepts",
            "SimResult", "Lockstep", "run_lockstep"]
 
 
-def __getattr__(name: str):
+def __getattr__(name: str) -> object:
     if name == "load_world":
         from .worldfile import load_world
 

@@ -40,6 +40,7 @@ import argparse
 import sys
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -47,6 +48,9 @@ from .gridmap import INCH_PER_M
 from .route import NarrowPassage, clearances, grid_route
 from .staticmap import StaticMap
 from .world import Agent, Corridor, Goal, Grid, Obstacle, Pose, Randomise, Robot, Sensors, World
+
+if TYPE_CHECKING:
+    from collections.abc import Sequence
 
 M = INCH_PER_M                 # in per metre
 CELLS = 30                     # the field is CELLS x CELLS cells
@@ -385,7 +389,8 @@ class _Parser(argparse.ArgumentParser):
     and no more. An unknown option is looked for first, so that it is not hidden behind a
     required one it was meant to be."""
 
-    def parse_args(self, args=None, namespace=None):
+    def parse_args(self, args: Sequence[str] | None = None,  # type: ignore[override]
+                   namespace: None = None) -> argparse.Namespace:
         import sys
 
         from ..errors import did_you_mean

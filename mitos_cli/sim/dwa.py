@@ -47,8 +47,13 @@ bit for bit.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from .planner import Percepts
+    from .world import Robot, World
 
 
 @dataclass(frozen=True)
@@ -101,7 +106,7 @@ def _window(current: np.ndarray, step: np.ndarray, lo: np.ndarray, hi: np.ndarra
 
 
 def rollouts(speed: np.ndarray, steering: np.ndarray, cmd_speed: np.ndarray,
-             cmd_steering: np.ndarray, robot, horizon_s: float, steps: int) -> np.ndarray:
+             cmd_steering: np.ndarray, robot: Robot, horizon_s: float, steps: int) -> np.ndarray:
     """Poses ``[n, S, steps, 3]`` (x, y, heading in the robot's frame at the start: x ahead,
     y left, rad) of the footprint centre at times ``horizon_s * k / steps``, ``k = 1..steps``,
     when the commands ``cmd_speed``/``cmd_steering [n, S]`` (in/s, deg) are held from the
@@ -179,7 +184,7 @@ def _scaled(x: np.ndarray, ok: np.ndarray) -> np.ndarray:
 
 def dwa_command(params: DWAParams, target: np.ndarray, speed: np.ndarray,
                 steering: np.ndarray, ranges: np.ndarray, angles: np.ndarray,
-                max_range: float, robot, dt: float,
+                max_range: float, robot: Robot, dt: float,
                 memory: list[np.ndarray] | None = None,
                 path: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Commanded (wheel angle [n] deg, speed [n] in/s) for ``n`` robots at once.
@@ -214,7 +219,7 @@ def _obstacles(params: DWAParams, ranges: np.ndarray, angles: np.ndarray, max_ra
 
 
 def _command(params: DWAParams, target: np.ndarray, speed: np.ndarray, steering: np.ndarray,
-             ranges: np.ndarray, angles: np.ndarray, max_range: float, robot, dt: float,
+             ranges: np.ndarray, angles: np.ndarray, max_range: float, robot: Robot, dt: float,
              memory: list[np.ndarray] | None,
              path: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """:func:`dwa_command`, and which robots had no admissible trajectory (``path [n, K, 2]``:
@@ -334,7 +339,7 @@ class DWAPlanner:
 
     name = "dwa"
 
-    def __init__(self, robot, sensor_range: float, dt: float,
+    def __init__(self, robot: Robot, sensor_range: float, dt: float,
                  params: DWAParams | None = None) -> None:
         self.robot = robot
         self.sensor_range = float(sensor_range)
@@ -343,7 +348,7 @@ class DWAPlanner:
         self._maps: dict[int, Costmap] = {}
 
     @classmethod
-    def for_world(cls, world, params: DWAParams | None = None) -> DWAPlanner:
+    def for_world(cls, world: World, params: DWAParams | None = None) -> DWAPlanner:
         return cls(world.agents[0].robot, world.sensors.range, world.dt, params)
 
     @property
@@ -356,7 +361,7 @@ class DWAPlanner:
         """The same planner with nothing remembered (a run's start)."""
         return DWAPlanner(self.robot, self.sensor_range, self.dt, self.params)
 
-    def _memory(self, p) -> list[np.ndarray] | None:
+    def _memory(self, p: Percepts) -> list[np.ndarray] | None:
         """Each robot's costmap brought up to date with its readings, in its frame."""
         if not self.params.memory:
             return None
@@ -370,7 +375,7 @@ class DWAPlanner:
             out.append(cm.local(p.pose[row]))
         return out
 
-    def _recover(self, p, stuck: np.ndarray) -> None:
+    def _recover(self, p: Percepts, stuck: np.ndarray) -> None:
         """move_base's clear-costmap recovery: blocked for ``recovery_s``, a robot forgets
         all but what its current scan shows."""
         if not self.params.memory:
@@ -382,7 +387,7 @@ class DWAPlanner:
             if cm.blocked_s >= self.params.recovery_s:
                 cm.points, cm.blocked_s = np.zeros((0, 2)), 0.0
 
-    def plan(self, p) -> tuple[np.ndarray, np.ndarray]:
+    def plan(self, p: Percepts) -> tuple[np.ndarray, np.ndarray]:
         n = len(p.pose)
         h = p.pose[:, 2]
         dx, dy = p.target[:, 0] - p.pose[:, 0], p.target[:, 1] - p.pose[:, 1]

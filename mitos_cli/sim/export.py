@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import csv
 import io
+from typing import TYPE_CHECKING, cast
 
 import numpy as np
 
@@ -18,8 +19,14 @@ from ..words import plural
 from .loop import SimResult
 from .perception import INPUTS
 
+if TYPE_CHECKING:
+    from typing import TextIO
 
-def explain(result: SimResult, planner, robot: int = 0):
+    from ..engine.evaluation import Result
+    from .planner import Planner
+
+
+def explain(result: SimResult, planner: Planner, robot: int = 0) -> Result | None:
     """The detailed engine result for every tick of ``robot`` (rows = ticks), or None when the
     planner is not a rule base."""
     if not hasattr(planner, "explain"):
@@ -31,9 +38,9 @@ def explain(result: SimResult, planner, robot: int = 0):
     return planner.explain({k: v[:, i] for k, v in result.perceived.items()})
 
 
-def fired_text(detail, row: int, digits: int = 2) -> str:
+def fired_text(detail: Result, row: int, digits: int = 2) -> str:
     c = detail.compiled
-    dof = detail.dof[row]
+    dof = cast(np.ndarray, detail.dof)[row]             # (a planner's explain keeps the DOFs)
     order = np.argsort(-dof, kind="stable")
     return " ".join(f"{c.labels[r]}={dof[r]:.{digits}f}" for r in order if dof[r] > 0)
 
@@ -64,7 +71,7 @@ def _num(v: float) -> str:
     return f"{v:.6g}" if abs(v) < 1e4 else f"{v:.2f}"
 
 
-def write_csv(result: SimResult, planner, out) -> None:
+def write_csv(result: SimResult, planner: Planner, out: TextIO) -> None:
     """One row per tick and active robot, columns :func:`columns` (``fired``: ``label=DOF``
     by DOF), and the last tick's row of a robot something drove into where it stood parked
     at its goal (its collision; ``fired`` empty: it planned nothing)."""
@@ -88,17 +95,17 @@ def write_csv(result: SimResult, planner, out) -> None:
                    *map(_num, result.ranges[k, i]),
                    *(_num(result.perceived[key][k, i]) for key in INPUTS),
                    *(_num(result.true[key][k, i]) for key in INPUTS),
-                   fired_text(details[i], k) if details[i] is not None and driving else ""]
+                   fired_text(cast("Result", details[i]), k) if details[i] is not None and driving else ""]
             w.writerow(row)
 
 
-def csv_text(result: SimResult, planner) -> str:
+def csv_text(result: SimResult, planner: Planner) -> str:
     buf = io.StringIO()
     write_csv(result, planner, buf)
     return buf.getvalue()
 
 
-def traces(result: SimResult, planner, every: int, digits: int = 1) -> str:
+def traces(result: SimResult, planner: Planner, every: int, digits: int = 1) -> str:
     """The first robot every ``every`` ticks (and at the last tick, and at each tick it
     replanned): the time, the pose and the perceived vs true inputs, then the DOF trace. A
     planner that is not a rule base has no DOF trace: its ticks come without, under a line

@@ -9,8 +9,12 @@ from __future__ import annotations
 
 import functools
 import math
+from typing import TYPE_CHECKING
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from numpy.typing import ArrayLike
 
 EPS = 1e-9
 
@@ -36,7 +40,8 @@ def _clip_ufunc() -> np.ufunc:
 clip_arrays: np.ufunc = _clip_ufunc()
 
 
-def rect_corners(cx, cy, heading, length, width) -> np.ndarray:
+def rect_corners(cx: ArrayLike, cy: ArrayLike, heading: ArrayLike, length: ArrayLike,
+                 width: ArrayLike) -> np.ndarray:
     """Corners ``[..., 4, 2]`` of rectangles centred at (cx, cy), long side along ``heading``
     (rad), counter-clockwise from the rear right corner."""
     cx, cy, heading = np.broadcast_arrays(*(np.asarray(a, float) for a in (cx, cy, heading)))
@@ -83,7 +88,7 @@ def point_segment_distance(p: np.ndarray, seg: np.ndarray) -> np.ndarray:
     return np.hypot(off[..., 0], off[..., 1])
 
 
-def cross(ax, ay, bx, by):
+def cross(ax: np.ndarray, ay: np.ndarray, bx: np.ndarray, by: np.ndarray) -> np.ndarray:
     return ax * by - ay * bx
 
 
@@ -113,7 +118,7 @@ def points_in_polygon(points: np.ndarray, corners: np.ndarray) -> np.ndarray:
     a = corners[None]                       # [1, Q, K, 2]
     e = np.roll(corners, -1, axis=1)[None] - a
     d = points[:, None, None, :] - a
-    return (cross(e[..., 0], e[..., 1], d[..., 0], d[..., 1]) >= 0).all(axis=-1)
+    return (cross(e[..., 0], e[..., 1], d[..., 0], d[..., 1]) >= 0).all(axis=-1)  # type: ignore[return-value]
 
 
 def ray_segments(origin: np.ndarray, dirs: np.ndarray, seg: np.ndarray,

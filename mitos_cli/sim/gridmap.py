@@ -415,7 +415,7 @@ def _map_spec(path: Path, where: Span | None, written: str | None) -> yamlpos.YM
     return spec
 
 
-def _image_name(spec: yamlpos.YMap, what: str):
+def _image_name(spec: yamlpos.YMap, what: str) -> object:     # the YAML value, a path's text
     """The image's path as the map file writes it (an empty `image:` was "map image `None`
     not found")."""
     image = yamlpos.require(spec, "image", WorldError, what)
@@ -473,7 +473,7 @@ def _mode(spec: yamlpos.YMap) -> str:
     return mode
 
 
-def _map_image(path: Path, spec: yamlpos.YMap, image) -> tuple[np.ndarray, int]:
+def _map_image(path: Path, spec: yamlpos.YMap, image: object) -> tuple[np.ndarray, int]:
     """The image's pixels and maxval, each way of failing said at the map file's `image:`."""
     image_path = path.parent / str(image)
     try:

@@ -9,8 +9,14 @@ centre, half a wheelbase ahead of the rear axle. All functions work on arrays of
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from collections.abc import Sequence
+
+    from .world import Robot
 
 #: What :func:`step` moves from, ``[n]`` each: x, y, heading, speed, steering, and the
 #: commanded steering and speed.
@@ -32,8 +38,8 @@ class Limits:
     max_reverse: np.ndarray        # in/s, backward
 
     @classmethod
-    def of(cls, robots) -> Limits:
-        def col(attr):
+    def of(cls, robots: Sequence[Robot]) -> Limits:
+        def col(attr: str) -> np.ndarray:
             return np.array([getattr(r, attr) for r in robots], dtype=float)
 
         return cls(col("wheelbase"), col("steering_min"), col("steering_max"),
@@ -77,7 +83,7 @@ def _ramp(lim: Limits, dt: float, substeps: int) -> _Ramp:
     return ramp
 
 
-def _clip(x, lo, hi):
+def _clip(x: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
     return np.minimum(np.maximum(x, lo), hi)
 
 
@@ -95,7 +101,8 @@ def limit_commands(steering: np.ndarray, speed: np.ndarray, cmd_steering: np.nda
 
 
 def advance(x: np.ndarray, y: np.ndarray, heading: np.ndarray, speed: np.ndarray,
-            steering: np.ndarray, lim: Limits, dt: float, substeps: int = 1):
+            steering: np.ndarray, lim: Limits, dt: float, substeps: int = 1
+                        ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Integrate the pose over ``dt`` at constant speed and steering, in ``substeps`` exact arcs.
 
     ``heading`` in radians (CCW from +x). Returns the new (x, y, heading) of the centre.
@@ -122,7 +129,8 @@ def advance(x: np.ndarray, y: np.ndarray, heading: np.ndarray, speed: np.ndarray
     return rx + half * np.cos(h), ry + half * np.sin(h), h
 
 
-def _substeps(steering, speed, cmd_steering, cmd_speed, lim: Limits, dt: float,
+def _substeps(steering: np.ndarray, speed: np.ndarray, cmd_steering: np.ndarray, cmd_speed: np.ndarray,
+              lim: Limits, dt: float,
               substeps: int) -> tuple[_Ramp, np.ndarray, np.ndarray]:
     """The wheel and the speed after each substep, ``[substeps, n]`` each, moved toward the
     commands within their limits (and the :class:`_Ramp` they were moved by)."""
@@ -134,8 +142,9 @@ def _substeps(steering, speed, cmd_steering, cmd_speed, lim: Limits, dt: float,
     return ramp, steer_k, speed_k
 
 
-def step(x, y, heading, speed, steering, cmd_steering, cmd_speed, lim: Limits, dt: float,
-         substeps: int):
+def step(x: np.ndarray, y: np.ndarray, heading: np.ndarray, speed: np.ndarray, steering: np.ndarray,
+         cmd_steering: np.ndarray, cmd_speed: np.ndarray, lim: Limits, dt: float,
+         substeps: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """One tick: in each of ``substeps`` equal parts of ``dt``, move the steering and speed
     toward the commands within their limits, then drive an exact arc. All substeps at once:
     rows ``k = 1..substeps`` of ``[substeps, n]`` arrays (the ramp toward a clipped target is
@@ -158,7 +167,8 @@ def step(x, y, heading, speed, steering, cmd_steering, cmd_speed, lim: Limits, d
     return rx + half * np.cos(h), ry + half * np.sin(h), h, speed_k[-1], steer_k[-1]
 
 
-def along(x, y, heading, speed, steering, cmd_steering, cmd_speed, lim: Limits, dt: float,
+def along(x: np.ndarray, y: np.ndarray, heading: np.ndarray, speed: np.ndarray, steering: np.ndarray,
+          cmd_steering: np.ndarray, cmd_speed: np.ndarray, lim: Limits, dt: float,
           substeps: int, f: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Where :func:`step` from the same state has the robots after the share ``f`` (0 to 1)
     of its tick: its whole substeps, then that part of the next one's arc (the contact check

@@ -307,7 +307,8 @@ class RobotMap:
         as given. (:func:`clear_all` of one map.)"""
         clear_all([self], origin[None], dirs[None], measured[None], max_range)
 
-    def _in_sight(self, origin: np.ndarray, max_range: float):
+    def _in_sight(self, origin: np.ndarray, max_range: float
+                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None:
         """The marks within ``max_range`` (a square) of ``origin``: their place in
         :attr:`marks`, rows, columns and centres relative to ``origin``; ``None`` with none."""
         if not len(self.marks):

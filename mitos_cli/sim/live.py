@@ -11,8 +11,15 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from rich.console import Console
+
+    from .loop import Scene
+    from .world import World
 
 #: Wall-clock frames per second of the view (a terminal redraw is ~1 ms for the 72 x 30 map).
 FPS = 20.0
@@ -50,8 +57,8 @@ class LiveView:
     ``speed`` is the real-time factor (0: unpaced); ``fps`` caps the redraws per wall second.
     """
 
-    def __init__(self, world, scene, *, speed: float = 1.0, fps: float = FPS, cols: int = 72,
-                 console=None, clock: Callable[[], float] = time.monotonic,
+    def __init__(self, world: World, scene: Scene, *, speed: float = 1.0, fps: float = FPS, cols: int = 72,
+                 console: Console | None = None, clock: Callable[[], float] = time.monotonic,
                  sleep: Callable[[float], None] = time.sleep) -> None:
         from rich.console import Console
         from rich.live import Live
@@ -84,14 +91,14 @@ class LiveView:
         self.live.__enter__()
         return self
 
-    def __exit__(self, *exc) -> None:
+    def __exit__(self, *exc: Any) -> None:      # (rich's Live.__exit__ takes them as they come)
         if self.pending is not None:               # end on the last tick, however it ended
             self._draw(self.pending)
         self.live.__exit__(*exc)
         if not self.live.console.is_terminal:      # a file or pipe: end the frame's last line
             self.live.console.line()
 
-    def _cell(self, x: float, y: float):
+    def _cell(self, x: float, y: float) -> tuple[int, int] | None:
         xmin, ymin, xmax, ymax = self.box
         c = int((x - xmin) / (xmax - xmin) * self.cols)
         r = int((ymax - y) / (ymax - ymin) * self.rows)

@@ -23,7 +23,7 @@ import operator
 import os
 from collections.abc import Sequence
 from dataclasses import dataclass, field, fields
-from typing import Any, NamedTuple
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
 
@@ -38,6 +38,12 @@ from .route import NarrowPassage, Route, grid_route, plan_route
 from .route import clearances as route_clearances
 from .staticmap import StaticMap, build_static
 from .world import Agent, Grid, World
+
+if TYPE_CHECKING:
+    from collections.abc import Callable
+
+    from .obstacles import Shapes
+    from .world import Robot
 
 STUCK_TIME = 6.0        # s
 STUCK_DISTANCE = 3.0    # in
@@ -293,7 +299,7 @@ def _metrics(res: SimResult, dt: float) -> dict:
             "ticks": int(res.ticks)}
 
 
-def _footprints(pose: np.ndarray, robots) -> np.ndarray:
+def _footprints(pose: np.ndarray, robots: Sequence[Robot]) -> np.ndarray:
     return rect_corners(pose[:, 0], pose[:, 1], pose[:, 2],
                         np.array([r.length for r in robots]), np.array([r.width for r in robots]))
 
@@ -795,7 +801,7 @@ class Simulation:
             kept = self._cast_with[i] = (walls, sides, np.concatenate([walls, sides]))
         return kept[2]
 
-    def _obstacles_at(self, t: float):
+    def _obstacles_at(self, t: float) -> tuple[np.ndarray, Shapes]:
         """Obstacle places ``[O, 2]`` at time ``t`` and their shapes
         (:func:`obstacles.shapes_at`); worked out once when nothing moves."""
         if self._still is not None:
@@ -1973,7 +1979,7 @@ def _finite(command: np.ndarray, what: str) -> np.ndarray:
 
 def simulate(world: World, planner: Planner | None = None, seed: int | None = None, *,
              randomise: bool = False, scene: Scene | None = None,
-             on_tick=None) -> SimResult:
+             on_tick: Callable[[int, dict], None] | None = None) -> SimResult:
     """Run ``world`` with ``planner`` (default: the packaged rule base's ``drive``) from
     ``seed`` (default: the world's). ``randomise`` draws obstacle places and sensor noise from
     the world's ranges first. ``on_tick(k, state)`` is called after each tick (``--live``)."""

@@ -4,11 +4,17 @@ their outlines as segments and circles for sensing and collisions, and randomise
 from __future__ import annotations
 
 from dataclasses import replace
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from .geometry import polygon_segments, rect_corners
 from .world import Motion, Obstacle, World
+
+if TYPE_CHECKING:
+    #: circles (centres [C, 2], radii [C], obstacle of each), rectangle sides [S, 4] with
+    #: the obstacle of each, and the rectangles' corners [Q, 4, 2]
+    Shapes = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]
 
 
 def _along(path: np.ndarray, s: float) -> np.ndarray:
@@ -50,7 +56,7 @@ def positions(obstacles: tuple[Obstacle, ...], t: float) -> np.ndarray:
     return np.array([position(o, t) for o in obstacles], dtype=float).reshape(-1, 2)
 
 
-def shapes_at(obstacles: tuple[Obstacle, ...], where: np.ndarray):
+def shapes_at(obstacles: tuple[Obstacle, ...], where: np.ndarray) -> Shapes:
     """Circles (centres ``[C, 2]``, radii ``[C]``) and rectangle sides ``[S, 4]`` with the
     index of the obstacle each side belongs to."""
     circ = [i for i, o in enumerate(obstacles) if o.shape == "circle"]
@@ -111,7 +117,8 @@ def randomised(world: World, rng: np.random.Generator) -> World:
     return replace(world, obstacles=tuple(obstacles), sensors=sensors)
 
 
-def outline_points(obstacles: tuple[Obstacle, ...], where: np.ndarray, per: int = 16):
+def outline_points(obstacles: tuple[Obstacle, ...], where: np.ndarray, per: int = 16
+                   ) -> tuple[np.ndarray, np.ndarray]:
     """Points ``[P, 2]`` on every obstacle's outline and the obstacle index of each."""
     pts, owner = [], []
     angles = np.linspace(0, 2 * np.pi, per, endpoint=False)

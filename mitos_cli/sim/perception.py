@@ -145,7 +145,7 @@ def frame(route: Route, p: np.ndarray, s_hint: float) -> Frame:
     return Frame(s, e, t, np.array([t[1], -t[0]]))
 
 
-def frames(routes: list[Route], p: np.ndarray, hints) -> list[Frame]:
+def frames(routes: list[Route], p: np.ndarray, hints: np.ndarray) -> list[Frame]:
     """:func:`frame` of every robot at once (``p [R, 2]``; runs in lockstep together), each
     the bits of its own (:func:`.route.projected`; the normals turned all at once)."""
     if len(routes) == 1:
@@ -162,8 +162,9 @@ def _or(least: np.ndarray, none: float, less: float | np.ndarray = 0.0) -> np.nd
     return np.where(least < np.inf, least - less, none)
 
 
-def _obstruction(route: Route, a, b, points, valid, widen, robot: Robot, f: Frame,
-                 cfg: Settings, rel_heading):
+def _obstruction(route: Route, a: np.ndarray, b: np.ndarray, points: np.ndarray, valid: np.ndarray,
+                 widen: np.ndarray, robot: Robot, f: Frame,
+                 cfg: Settings, rel_heading: tuple[np.ndarray, np.ndarray]) -> tuple[float, float, float]:
     """(size, position, distance) of the nearest obstructing object among ``points``
     (:func:`_obstruction_rows` of one row, kept clear of nothing)."""
     ah, bh = rel_heading
@@ -174,9 +175,11 @@ def _obstruction(route: Route, a, b, points, valid, widen, robot: Robot, f: Fram
     return float(size[0]), float(position[0]), float(distance[0])
 
 
-def _obstruction_rows(routes: list[Route], frames: list[Frame], a, b, points, valid, widen,
-                      cfg: Settings, ah, bh, least: np.ndarray, kept: np.ndarray,
-                      gone: np.ndarray, body: dict[str, np.ndarray]):
+def _obstruction_rows(routes: list[Route], frames: list[Frame], a: np.ndarray, b: np.ndarray,
+                      points: np.ndarray, valid: np.ndarray, widen: np.ndarray,
+                      cfg: Settings, ah: np.ndarray, bh: np.ndarray, least: np.ndarray, kept: np.ndarray,
+                      gone: np.ndarray, body: dict[str, np.ndarray]
+                                            ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Each row's ``(size, position, distance)`` of the nearest obstructing object among its
     ``points [R, K, 2]`` (``a``, ``b``: along and across its route; ``ah``, ``bh``: along and
     across its heading; ``least [R]``, ``kept [R, K]``: :attr:`Sights.least` and
@@ -216,7 +219,8 @@ def _in_band(b: np.ndarray, widen: np.ndarray, half: np.ndarray) -> np.ndarray:
     return np.abs(b) - widen < half
 
 
-def _objects(routes: list[Route], frames: list[Frame], a, points, ahead, blocking, widen,
+def _objects(routes: list[Route], frames: list[Frame], a: np.ndarray, points: np.ndarray,
+             ahead: np.ndarray, blocking: np.ndarray, widen: np.ndarray,
              length: np.ndarray, cfg: Settings) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Each row's distance, size and position of the object its nearest blocking point
     belongs to (the points ahead within ``cluster`` of it; ``length``: half the robots'
@@ -528,8 +532,9 @@ def _previous(k: int) -> np.ndarray:
     return out
 
 
-def _sides(a, b, ah, bh, valid, walls, body: dict[str, np.ndarray], cfg: Settings, far: float,
-           objects=None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _sides(a: np.ndarray, b: np.ndarray, ah: np.ndarray, bh: np.ndarray, valid: np.ndarray,
+           walls: np.ndarray, body: dict[str, np.ndarray], cfg: Settings, far: float,
+           objects: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``road``, ``gap_left`` and ``gap_right`` of every row of points ``[R, K]``, given in the
     route's frame (``a``, ``b``) and in the robot's own (``ah``, ``bh``; ``body``: the
     robots' :func:`_bodies`); ``walls``: the points the road is measured to, ``objects``:
@@ -563,7 +568,7 @@ def _sides(a, b, ah, bh, valid, walls, body: dict[str, np.ndarray], cfg: Setting
     return road[0] + road[1], gaps[0], gaps[1]
 
 
-def _common(route: Route, p, heading: float, f: Frame, road: float, robot: Robot,
+def _common(route: Route, p: np.ndarray, heading: float, f: Frame, road: float, robot: Robot,
             cfg: Settings, target: np.ndarray, room: float) -> tuple[float, float, float]:
     d = target - p
     return _common_of(float(d[0]), float(d[1]), heading, route.length - f.s, f.e,
@@ -1090,7 +1095,7 @@ _BODIES: dict[tuple[int, ...], tuple[tuple[Robot, ...], Settings, dict[str, np.n
 @functools.lru_cache(maxsize=64)
 def _measures(robots: tuple[Robot, ...], cfg: Settings) -> dict[str, np.ndarray]:
     """:func:`_bodies` by value."""
-    def column(values) -> np.ndarray:
+    def column(values: Iterable[float]) -> np.ndarray:
         return np.array(list(values), dtype=float)[:, None]
 
     out = {"half": column(r.width / 2 for r in robots),

@@ -27,11 +27,23 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Protocol
+from typing import TYPE_CHECKING, Protocol
 
 import numpy as np
 
 from ..errors import NameError_, RuleBaseError, Span, unknown
+
+if TYPE_CHECKING:
+    from pathlib import Path
+
+    from ..api import LoadedRuleBase
+    from ..engine.evaluation import Result
+    from ..lang.model import Expr, RuleBase
+    from .world import World
+
+    #: what a fuzzy planner is made from: a loaded rule base, a rule base, a file (None: the
+    #: packaged one)
+    RuleBaseSource = LoadedRuleBase | RuleBase | str | Path | None
 
 
 @dataclass(frozen=True)
@@ -63,12 +75,12 @@ class Planner(Protocol):
         ...
 
 
-def first_use(rulebase, behavior: str, name: str) -> Span | None:
+def first_use(rulebase: RuleBase, behavior: str, name: str) -> Span | None:
     """Where ``behavior`` (or a behavior it uses, depth first) first reads variable ``name``
     in a rule's or a `use`'s condition; else where the term set declares it; else None."""
     from ..lang.model import And, Not, Or, Prop
 
-    def in_expr(e) -> Span | None:
+    def in_expr(e: Expr) -> Span | None:
         if isinstance(e, Prop):
             return e.span.naming(name) if e.var == name and e.span else None
         items = (e.expr,) if isinstance(e, Not) else e.items if isinstance(e, (And, Or)) else ()
@@ -100,7 +112,7 @@ def first_use(rulebase, behavior: str, name: str) -> Span | None:
     return span
 
 
-def _behavior_span(rulebase, behavior: str) -> Span | None:
+def _behavior_span(rulebase: RuleBase, behavior: str) -> Span | None:
     """Where ``behavior`` is declared in its rule file (None for top-level rules or text)."""
     return next((b.span for b in rulebase.behaviors if b.name == behavior), None)
 
@@ -108,7 +120,7 @@ def _behavior_span(rulebase, behavior: str) -> Span | None:
 class FuzzyPlanner:
     """A behavior of a rule base as the planner (default: the packaged ``drive``)."""
 
-    def __init__(self, rulebase=None, behavior: str = "drive") -> None:
+    def __init__(self, rulebase: RuleBaseSource = None, behavior: str = "drive") -> None:
         from ..api import LoadedRuleBase, load_rulebase
         from ..lang.model import RuleBase
 
@@ -157,7 +169,7 @@ class FuzzyPlanner:
         out = evaluate(self.compiled, self.matrix(inputs), detail=False).outputs
         return out[:, self._cols[0]], out[:, self._cols[1]]
 
-    def explain(self, inputs: dict[str, np.ndarray]):
+    def explain(self, inputs: dict[str, np.ndarray]) -> Result:
         """The detailed engine result (memberships, DOFs) for inputs ``[n]`` by name: rows are
         ticks or robots. Bit for bit what :meth:`plan` computed (the engine is row-exact)."""
         from ..engine.evaluation import evaluate
@@ -175,11 +187,11 @@ class PlannerKind:
     build: Callable[..., Planner]
 
 
-def _fuzzy(world, rulebase=None, behavior: str | None = None) -> Planner:
+def _fuzzy(world: World, rulebase: RuleBaseSource = None, behavior: str | None = None) -> Planner:
     return fuzzy_planner(world, rulebase, behavior or None)     # (as it was: "" is the world's)
 
 
-def fuzzy_planner(world, rulebase=None, behavior: str | None = None) -> FuzzyPlanner:
+def fuzzy_planner(world: World, rulebase: RuleBaseSource = None, behavior: str | None = None) -> FuzzyPlanner:
     """The rule base's ``behavior`` (default: the world's ``behavior:``) as a planner; the
     world's behavior missing from the rule base is said at the world's line, with how to
     choose another (`mitos simulate`, and the Gymnasium environments)."""
@@ -200,13 +212,13 @@ def fuzzy_planner(world, rulebase=None, behavior: str | None = None) -> FuzzyPla
         raise
 
 
-def _potential_field(world, rulebase=None, behavior: str | None = None) -> Planner:
+def _potential_field(world: World, rulebase: RuleBaseSource = None, behavior: str | None = None) -> Planner:
     from .potential_field import PotentialFieldPlanner
 
     return PotentialFieldPlanner.for_world(world)
 
 
-def _dwa(world, rulebase=None, behavior: str | None = None) -> Planner:
+def _dwa(world: World, rulebase: RuleBaseSource = None, behavior: str | None = None) -> Planner:
     from .dwa import DWAPlanner
 
     return DWAPlanner.for_world(world)
@@ -230,6 +242,7 @@ def planner_kind(name: str) -> PlannerKind:
         raise unknown("planner", name, PLANNERS) from None
 
 
-def make_planner(name: str, world, rulebase=None, behavior: str | None = None) -> Planner:
+def make_planner(name: str, world: World, rulebase: RuleBaseSource = None,
+                 behavior: str | None = None) -> Planner:
     """The planner ``name`` built for ``world`` (the fuzzy one from ``rulebase``/``behavior``)."""
     return planner_kind(name).build(world, rulebase, behavior)

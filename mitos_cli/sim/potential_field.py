@@ -29,8 +29,13 @@ stops or oscillates -- the simulator reports that as ``stuck`` or ``timeout``.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from .planner import Percepts
+    from .world import Robot, World
 
 
 @dataclass(frozen=True)
@@ -112,17 +117,17 @@ class PotentialFieldPlanner:
 
     name = "potential_field"
 
-    def __init__(self, robot, sensor_range: float,
+    def __init__(self, robot: Robot, sensor_range: float,
                  params: PotentialFieldParams | None = None) -> None:
         self.robot = robot
         self.sensor_range = float(sensor_range)   # in: a reading this far saw nothing
         self.params = params or PotentialFieldParams()
 
     @classmethod
-    def for_world(cls, world, params: PotentialFieldParams | None = None):
+    def for_world(cls, world: World, params: PotentialFieldParams | None = None) -> PotentialFieldPlanner:
         return cls(world.agents[0].robot, world.sensors.range, params)
 
-    def plan(self, p) -> tuple[np.ndarray, np.ndarray]:
+    def plan(self, p: Percepts) -> tuple[np.ndarray, np.ndarray]:
         r = self.robot
         n = len(p.pose)
         x, y, h = p.pose[:, 0], p.pose[:, 1], p.pose[:, 2]

@@ -14,6 +14,7 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -23,6 +24,17 @@ from .distance import _capped_squares, from_squares, squared_distances
 from .geometry import CACHED, box_segment_distance, clip_arrays, point_segment_distance
 from .staticmap import StaticMap
 from .world import Corridor, Goal, Grid, Pose, Robot
+
+if TYPE_CHECKING:
+    from collections.abc import Callable, Iterable
+
+    from numpy.typing import ArrayLike
+
+    #: the nodes of a grid: each block's row, column and clearance
+    Nodes = tuple[np.ndarray, np.ndarray, np.ndarray]
+    #: what grid_route works out before it searches: the field, the nodes, every step's
+    #: clearance and the samples per step
+    Planned = tuple["Clearance", Nodes, np.ndarray, int]
 
 
 @dataclass(frozen=True)
@@ -36,7 +48,7 @@ class Route:
     __hash__ = object.__hash__
 
     @classmethod
-    def of(cls, points, goal=None) -> Route:
+    def of(cls, points: ArrayLike, goal: tuple[float, float] | None = None) -> Route:
         pts = np.asarray(points, float)
         keep = np.concatenate([[True], np.hypot(*np.diff(pts, axis=0).T) > 1e-9])
         pts = pts[keep]
@@ -288,7 +300,7 @@ def projections(routes: Sequence[Route], points: np.ndarray, hints: Sequence[flo
     return list(zip(*projected(routes, points, hints, back, ahead)))
 
 
-def projected(routes: Sequence[Route], points: np.ndarray, hints: Sequence[float],
+def projected(routes: Sequence[Route], points: np.ndarray, hints: Sequence[float] | np.ndarray,
               back: float = 24.0, ahead: float = 120.0
               ) -> tuple[list[float], list[float], np.ndarray]:
     """:func:`projections` as the rows' arc lengths, lateral offsets and unit tangents
@@ -364,7 +376,8 @@ def _path(came: dict[int, int] | list[int], node: int) -> list[int]:
     return path[::-1]
 
 
-def _astar(neighbours, start: int, goal: int, pos) -> list[int] | None:
+def _astar(neighbours: Callable[[int], Iterable[tuple[int, float]]], start: int, goal: int,
+           pos: Callable[[int], np.ndarray]) -> list[int] | None:
     frontier = [(0.0, 0, start)]
     came = {start: -1}
     cost = {start: 0.0}
@@ -517,7 +530,8 @@ def _room_of(segs: np.ndarray, walls: np.ndarray) -> np.ndarray:
     return _segment_distances(segs, walls[ask]).min(axis=1)
 
 
-def _narrow_corridor(adj, coords, room, s_id: int, g_id: int, walls: np.ndarray,
+def _narrow_corridor(adj: dict[int, list[tuple[int, float]]], coords: list[np.ndarray],
+                     room: dict[tuple[int, int], float], s_id: int, g_id: int, walls: np.ndarray,
                      least: float, half_width: float) -> NarrowPassage:
     """The refusal of a corridor route: the widest way's narrowest edge (a bottleneck Dijkstra
     over the centre-line graph) and the point of it nearest a wall."""
@@ -773,14 +787,14 @@ class NarrowPassage(WorldError):
     """The only way to the goal is narrower than the robot needs (names the narrowest place).
     ``end``: the line of the world file it belongs at, the start's or (mostly) the goal's."""
 
-    def __init__(self, message: str, *, end: str = "goal", **kw) -> None:
+    def __init__(self, message: str, *, end: str = "goal", **kw: Any) -> None:   # WorldError's
         super().__init__(message, **kw)
         self.end = end
         self.gap: float | None = None      # the centre's clearance at the narrowest place
 
 
 def _widest_way(free_c: np.ndarray, s: tuple[int, int], t: tuple[int, int],
-                edge: np.ndarray | None = None):
+                edge: np.ndarray | None = None) -> tuple[tuple[int, int], float] | None:
     """The path from ``s`` to ``t`` whose narrowest place is widest (a bottleneck Dijkstra over
     the clearance ``free_c[R, C]`` of the nodes and ``edge[8, R, C]`` of the steps between
     them): the node at that narrowest place and its clearance, or None. Each step's room is
@@ -1230,7 +1244,7 @@ MOVES = tuple((dr, dc, math.hypot(dr, dc)) for dr in (-1, 0, 1) for dc in (-1, 0
 
 
 @functools.lru_cache(maxsize=4)
-def _planned_on(grid: Grid, cap: float, k: int):
+def _planned_on(grid: Grid, cap: float, k: int) -> Planned:
     """What :func:`grid_route` works out from a grid's own cells before it searches: the
     clearance field (exact up to ``cap``), the nodes (blocks of ``k`` cells), every step's
     clearance and where along a step it is sampled. Kept (read-only): every run of a world
@@ -1247,7 +1261,7 @@ def _planned_on(grid: Grid, cap: float, k: int):
     return field, nodes, edge, len(t)
 
 
-def _node_xy(grid: Grid, nodes) -> np.ndarray:
+def _node_xy(grid: Grid, nodes: Nodes) -> np.ndarray:
     """``[R, C, 2]`` the nodes' cell centres (as :func:`grid_route`'s ``centre``)."""
     fr, fc, _ = nodes
     return np.stack([grid.origin[0] + (fc + 0.5) * grid.resolution,
@@ -1271,7 +1285,7 @@ class Prepared:
 
 
 def _prepared(grid: Grid, occ: np.ndarray, cap: float, k: int, keep: bool = True,
-              last: Prepared | None = None):
+              last: Prepared | None = None) -> tuple[Clearance, Nodes, np.ndarray]:
     """The clearance field, the nodes and every step's clearance (:func:`_planned_on`) for
     the cells ``occ`` (the grid's own, or a robot's map of it): from the grid's own, or from
     what was worked out for the same robot's map ``last`` time (kept there again), worked
@@ -1280,6 +1294,7 @@ def _prepared(grid: Grid, occ: np.ndarray, cap: float, k: int, keep: bool = True
     block's field, a step's clearance on its two nodes and the cells between them (which lie
     in the two nodes' blocks and, a diagonal step's, the two beside both): the rest keeps its
     bits."""
+    out: tuple | None           # what _prepared_from gives, else the Planned worked out here
     if last is not None and keep and occ is not grid.occupied:
         out = _prepared_from(grid, occ, cap, k, last)
         if out is not None:
@@ -1303,7 +1318,8 @@ def _prepared(grid: Grid, occ: np.ndarray, cap: float, k: int, keep: bool = True
     return out[:3]
 
 
-def _prepared_from(grid: Grid, occ: np.ndarray, cap: float, k: int, last: Prepared):
+def _prepared_from(grid: Grid, occ: np.ndarray, cap: float, k: int, last: Prepared
+                   ) -> tuple[Clearance, Nodes, np.ndarray] | None:
     """:func:`_prepared` from what ``last`` holds (``None`` when it holds nothing for this
     grid, cap and block size, or when either's field is not the capped one: nothing
     occupied, or a cap beyond the grid)."""
@@ -1318,13 +1334,13 @@ def _prepared_from(grid: Grid, occ: np.ndarray, cap: float, k: int, last: Prepar
     return out[:3]
 
 
-def _keep(last: Prepared, grid: Grid, occ: np.ndarray, cap: float, k: int, out) -> None:
+def _keep(last: Prepared, grid: Grid, occ: np.ndarray, cap: float, k: int, out: Planned) -> None:
     last.key, last.occ = (grid, cap, k), occ.copy()
     last.field, last.nodes, last.edge, last.samples = out
 
 
 def _patched(grid: Grid, occ: np.ndarray, base_occ: np.ndarray, cap: float, k: int,
-             base_field: Clearance, base_nodes, base_edge: np.ndarray, samples: int):
+             base_field: Clearance, base_nodes: Nodes, base_edge: np.ndarray, samples: int) -> Planned:
     """The field, nodes, steps' clearance and samples per step for ``occ``, from those worked
     out for ``base_occ``: the field again where the cells that differ can reach, and the
     nodes and steps only round the cells whose distance changed (a node depends on its
@@ -1374,7 +1390,8 @@ def _patched(grid: Grid, occ: np.ndarray, base_occ: np.ndarray, cap: float, k: i
     return field, nodes, edge, len(t)
 
 
-def _refusal(node_c: np.ndarray, s, t, centre, floor: float,
+def _refusal(node_c: np.ndarray, s: tuple[int, int], t: tuple[int, int],
+             centre: Callable[[tuple[int, int]], tuple[float, float]], floor: float,
              edge: np.ndarray | None = None, half_width: float = 0.0,
              ends: tuple[tuple[str, tuple[float, float], float, float], ...] = (),
              mapped: str = "the map", step: float = 0.0, source: str = "") -> WorldError:

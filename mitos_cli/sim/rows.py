@@ -231,7 +231,7 @@ def _cast(stacks: _Stacks, origin: np.ndarray, dirs: np.ndarray,
     return static, np.minimum(hit, _circles(stacks, origin, dirs, max_range))
 
 
-def _ray_hits(seg: np.ndarray, origin: np.ndarray, dirs: np.ndarray, keep: bool = False):
+def _ray_hits(seg: np.ndarray, origin: np.ndarray, dirs: np.ndarray, keep: bool = False) -> np.ndarray:
     """How far along each beam ``dirs [R, B, 2]`` from ``origin [R, 2]`` it meets each
     segment ``seg [R, N, 4]`` (``inf`` where it does not): ``[R, N, B]`` when ``keep``, else
     the nearest ``[R, B]``. The beams run along the last axis: the minimum over the few
@@ -245,7 +245,8 @@ def _ray_hits(seg: np.ndarray, origin: np.ndarray, dirs: np.ndarray, keep: bool 
     return t if keep else t.min(axis=1, initial=np.inf)
 
 
-def _along(dx, dy, ex, ey, px, py) -> np.ndarray:
+def _along(dx: np.ndarray, dy: np.ndarray, ex: np.ndarray, ey: np.ndarray, px: np.ndarray,
+           py: np.ndarray) -> np.ndarray:
     """:func:`.geometry.ray_hits`' formula, elementwise: how far along the beam ``(dx, dy)``
     it meets the segment from ``(px, py)`` (relative to the beam's origin) running
     ``(ex, ey)``, or ``inf``."""
@@ -345,7 +346,7 @@ class _Frames:
         # [R, 1, 2, 2]: row j of a point's turn is (x * c + y * s, x * -s + y * c)
         self.turn = np.array([c, s, [-x for x in s], c]).T.reshape(len(h), 1, 2, 2)
 
-    def local(self, points: np.ndarray, idx=slice(None)) -> np.ndarray:
+    def local(self, points: np.ndarray, idx: slice | np.ndarray = slice(None)) -> np.ndarray:
         """``[r, K, 2]`` world points of rows ``idx`` in their footprints' frames."""
         rel = (points - self.origin[idx, None])[..., None, :] * self.turn[idx]    # [r, K, 2, 2]
         return rel[..., 0] + rel[..., 1]

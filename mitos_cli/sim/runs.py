@@ -12,7 +12,7 @@ import os
 from collections import Counter
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 
@@ -22,6 +22,13 @@ from ..words import plural
 from .lockstep import batch_for, finished
 from .loop import OUTCOMES, ROBOT_OUTCOMES, check_seed, shared_scene
 from .world import World
+
+if TYPE_CHECKING:
+    from multiprocessing.pool import AsyncResult
+    from multiprocessing.queues import Queue
+
+    from .loop import SimResult
+    from .planner import Planner
 
 #: each run's figures whose mean and std ``--runs`` reports (``replans`` and ``backouts``
 #: are counts: routes planned again, and times a robot backed out)
@@ -46,13 +53,14 @@ def ignore_interrupts() -> None:
     signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
-def trail(res) -> dict:
+def trail(res: SimResult) -> dict:
     """A ``measure`` for :func:`run_many` (``--runs N --plot``): where each robot drove (its
     ``[x, y]`` while driving and where it stopped: the colliding or arriving tick), each robot's
     outcome, and where the obstacles started in this run, under the key ``trail`` (not part of
     the JSON)."""
-    drove = res.active.copy()
-    drove[1:] |= res.active[:-1]                # the tick it arrived at (no longer active)
+    active = cast("np.ndarray", res.active)     # (Optional on SimResult; simulate records it)
+    drove = active.copy()
+    drove[1:] |= active[:-1]                    # the tick it arrived at (no longer active)
     paths = [res.pose[drove[:, i], i, :2].tolist() for i in range(len(res.robot_outcomes))]
     return {"trail": {"paths": paths, "robot_outcomes": list(res.robot_outcomes),
                       "t_end": float(res.t[-1]) if len(res.t) else 0.0,
@@ -161,8 +169,8 @@ class RunsInterrupted(KeyboardInterrupt):
         return sum(len(w.summaries) for w in self.runs.worlds)
 
 
-def run_many(worlds: list[World], runs: int = 0, seed: int | None = None, planner=None,
-             workers: int | None = None, measure=None,
+def run_many(worlds: list[World], runs: int = 0, seed: int | None = None, planner: Planner | None = None,
+             workers: int | None = None, measure: Callable[[SimResult], dict] | None = None,
              on_progress: Callable[[int, int], None] | None = None) -> Runs:
     """Run each world once (``runs=0``: its own seed, as written) or ``runs`` randomised times
     (seeds ``seed + j``, default base: the world's seed), on ``workers`` processes.
@@ -262,13 +270,13 @@ def even_chunks(n: int, workers: int, most: int) -> int:
 _outbox: Any = None
 
 
-def _streaming_worker(outbox) -> None:
+def _streaming_worker(outbox: Queue) -> None:
     global _outbox
     ignore_interrupts()
     _outbox = outbox
 
 
-def _stream(fn, job: tuple[int, Any]) -> None:
+def _stream(fn: Callable[[Any], Iterator[Any]], job: tuple[int, Any]) -> None:
     """Put what ``fn(item)`` yields, each part pickled here (an error raised in this thread
     reaches :func:`pool_streaming`, not the queue's feeder thread), and then an end."""
     import pickle
@@ -325,7 +333,7 @@ def pool_streaming(fn: Callable[[Any], Iterator[Any]], items: list,
         pool.join()
 
 
-def _check(pending, workers: set[int | None]) -> None:
+def _check(pending: AsyncResult, workers: set[int | None]) -> None:
     """Raise a worker's error, or :class:`WorkerLost` when one of the pool's ``workers`` is
     gone (a pool's workers end only when the pool does)."""
     import multiprocessing

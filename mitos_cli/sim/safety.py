@@ -33,11 +33,17 @@ import functools
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from .world import Robot
+
+if TYPE_CHECKING:
+    from collections.abc import Sequence
+
+    #: a footprint's number: one float, or one per sweep (``[R, 1]``) or per place
+    Num = float | np.ndarray
 
 
 @dataclass(frozen=True)
@@ -129,10 +135,11 @@ class Arc:
     half: Any
     turning: Any
 
-    def centres(self, u: np.ndarray, rows: np.ndarray | None = None):
+    def centres(self, u: np.ndarray, rows: np.ndarray | None = None
+                ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """``(cos, sin, x, y)`` of the heading and the footprint's centre after ``u`` inches
         of the rear axle's path (``[R, K]``, or ``rows``: of those sweeps, one per row)."""
-        def pick(v):
+        def pick(v: Any) -> Any:          # a field: a float, or [R, 1] (np.ndim tells)
             return v if rows is None or np.ndim(v) == 0 else v[rows]
 
         h, k, a, b = pick(self.h), pick(self.k), pick(self.a), pick(self.b)
@@ -168,7 +175,7 @@ class Arc:
 BETWEEN = 8
 
 
-def _touched(depth: np.ndarray, backward) -> np.ndarray:
+def _touched(depth: np.ndarray, backward: bool | np.ndarray) -> np.ndarray:
     """``[P, K]`` whether the footprint touches each cell at each place; backing away from a
     cell it touches already (a mark a noisy echo put at its edge), only the places deeper in
     (``backward``: a bool, or one per cell)."""
@@ -190,8 +197,8 @@ def _pairs(inside: np.ndarray, depth: np.ndarray, step: float) -> tuple[np.ndarr
     return np.divmod(np.flatnonzero(maybe), depth.shape[1] - 1)
 
 
-def _between(hit: np.ndarray, own, cell: np.ndarray, j: np.ndarray, owner: np.ndarray,
-             u: np.ndarray, arc: Arc, px, py, hl, hw, radius) -> None:
+def _between(hit: np.ndarray, own: int | np.ndarray, cell: np.ndarray, j: np.ndarray, owner: np.ndarray,
+             u: np.ndarray, arc: Arc, px: np.ndarray, py: np.ndarray, hl: Num, hw: Num, radius: Num) -> None:
     """Mark in ``hit [R, K]`` (where each sweep touches a cell, within its ``own`` places) the
     places ``j + 1`` of the :func:`_pairs` ``(cell, j)`` where one of :data:`BETWEEN` - 1
     places between ``j`` and ``j + 1`` touches the cell. Between two of those the depth
@@ -298,7 +305,8 @@ def _far(robot: Robot, radius: float, step: float) -> float:
             + 2 * math.sqrt(2) * radius + step)
 
 
-def _depth(dx, dy, c, s, hl, hw, r):
+def _depth(dx: np.ndarray, dy: np.ndarray, c: np.ndarray, s: np.ndarray, hl: Num, hw: Num,
+           r: Num) -> np.ndarray:
     """How deep a cell, the square of half side ``r`` centred ``(dx, dy)`` from the
     footprint's centre, reaches into the footprint (half length ``hl``, half width ``hw``,
     heading cosine ``c`` and sine ``s``): the least overlap along the four axes that can
@@ -308,7 +316,7 @@ def _depth(dx, dy, c, s, hl, hw, r):
     return _depth_in(dx, dy, c, s, _room(c, s, hl, hw, r))
 
 
-def _room(c, s, hl, hw, r) -> tuple[Any, Any, Any, Any]:
+def _room(c: np.ndarray, s: np.ndarray, hl: Num, hw: Num, r: Num) -> tuple[Any, Any, Any, Any]:
     """What of :func:`_depth` depends on the footprint's place alone, not on the cell: the
     footprint's half extents grown by the cell's, along its own axes and along the grid's
     (worked out once a place, not once a cell and place, in the order :func:`_depth` sums)."""
@@ -327,7 +335,8 @@ def _room(c, s, hl, hw, r) -> tuple[Any, Any, Any, Any]:
     return along, e, x, y
 
 
-def _depth_in(dx, dy, c, s, room) -> np.ndarray:
+def _depth_in(dx: np.ndarray, dy: np.ndarray, c: np.ndarray, s: np.ndarray,
+              room: Sequence[Any]) -> np.ndarray:      # _room's four
     """:func:`_depth` with the footprint's :func:`_room` at each place."""
     along, across, x, y = room
     along = along - np.abs(dx * c + dy * s)
@@ -359,7 +368,8 @@ def free_travels(sweeps: list[tuple[Body, float, bool]], step: float = 1.0) -> n
     return out
 
 
-def _travels(cells: list[np.ndarray] | Boxed, numbers, radius: np.ndarray, reach: np.ndarray,
+def _travels(cells: list[np.ndarray] | Boxed, numbers: np.ndarray | tuple[np.ndarray, ...],
+             radius: np.ndarray, reach: np.ndarray,
              back: np.ndarray, step: float) -> np.ndarray:
     """The free travel ``[R]`` of ``R`` sweeps (runs in lockstep brake together), each with
     cells (``[P, 2]`` each, of half side ``radius [R]``; or what a :data:`Boxed` finds round
@@ -744,7 +754,7 @@ class Fleet:
         self.robots, self.dt, self.cfg = tuple(robots), dt, cfg
         self.radius, self.reach = np.array(radius, float), np.array(reach, float)
 
-        def each(value) -> np.ndarray:
+        def each(value: Callable[[Robot], float]) -> np.ndarray:
             return np.array([value(r) for r in robots], float)
 
         step = cfg.step

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field, replace
+from typing import Any
 
 import numpy as np
 
@@ -202,5 +203,5 @@ class World:
     def known_obstacles(self) -> tuple[Obstacle, ...]:
         return tuple(o for o in self.obstacles if o.known)
 
-    def with_changes(self, **changes) -> World:
+    def with_changes(self, **changes: Any) -> World:     # World's own fields, each its type
         return replace(self, **changes)

@@ -38,6 +38,7 @@ if TYPE_CHECKING:
     import numpy as np
 
     from .staticmap import StaticMap
+    from .world import Grid
 
 TOP_KEYS = ("name", "seed", "dt", "time_limit", "substeps", "behavior", "robot", "sensors",
             "q_init", "q_goal", "map", "obstacles", "robots", "randomise", "route")
@@ -408,7 +409,7 @@ def _check_offsets(spec: Any, name: str) -> None:
                              hint="did you mean `dx` or `dy`? (a world is flat: x and y only)")
 
 
-def _list(mapping, key: str):
+def _list(mapping: YMap, key: str) -> list:
     """``mapping[key]`` as a list (absent or null: none); a mapping or a scalar there is an
     error at it (``obstacles:`` followed by a mapping was an ``AttributeError``)."""
     value = mapping.get(key)
@@ -631,7 +632,8 @@ def _check_corridor_points(corridors: list[Corridor], mp: YMap) -> None:
                                   "or drop points along the straight stretches")
 
 
-def _map(r: _Reader, top: YMap, path: str):
+def _map(r: _Reader, top: YMap, path: str
+         ) -> tuple[list[Corridor], Grid | None, str, Grid | None]:
     """``map``: its corridors, its grid (a map_server YAML), and what the robot is given."""
     mp = r.mapping(yamlpos.require(top, "map", WorldError, "the world file"),
                    top.value_span("map"), "map", MAP_KEYS)
@@ -737,7 +739,7 @@ def _left_empty(span: Span) -> bool:
     return not rest or rest[0] in "#,}]"
 
 
-def read_given(mp: YMap, path: str, unknown_occupied: bool):
+def read_given(mp: YMap, path: str, unknown_occupied: bool) -> tuple[str, Grid | None]:
     """``map.given``: the robot's own map (a map_server YAML), ``none``, or (absent) the map."""
     if "given" not in mp:
         return "map", None
@@ -819,7 +821,7 @@ def check_free(world: World, spans: list[tuple[Span, Span]]) -> StaticMap:
 GOAL_SAMPLE, GOAL_RINGS = 0.5, 40
 
 
-def _check_goal_room(world: World, agent, static, span: Span) -> None:
+def _check_goal_room(world: World, agent: Agent, static: StaticMap, span: Span) -> None:
     """Refuse a goal whose tolerance the robot's centre can never come within: every point of
     the disc lies nearer a wall or a still obstacle than half the robot's width, so no pose
     of its body puts its centre there (a goal 2 in from a wall with a tolerance of 5 in was
@@ -853,7 +855,7 @@ def _check_goal_room(world: World, agent, static, span: Span) -> None:
              f"in) off the wall (`tolerance: {math.ceil(g.tolerance + keep - best - 1e-9)}` or more)")
 
 
-def _disc(x: float, y: float, radius: float, step: float):
+def _disc(x: float, y: float, radius: float, step: float) -> np.ndarray:
     """Points ``[P, 2]`` of the disc of ``radius`` round (x, y): its centre and rings ``step``
     apart, their points about as far apart along each ring."""
     import numpy as np
@@ -868,7 +870,8 @@ def _disc(x: float, y: float, radius: float, step: float):
     return np.concatenate(out)
 
 
-def _room(world: World, static, pts, reach: float, centre: tuple[float, float] | None = None):
+def _room(world: World, static: StaticMap, pts: np.ndarray, reach: float,
+          centre: tuple[float, float] | None = None) -> np.ndarray:
     """Each point's distance ``[P]`` (in) to the nearest wall or still obstacle (0 off the
     free space and inside an obstacle; ``reach`` where none lies nearer than ``reach`` of
     ``centre``, default the first point)."""
@@ -922,7 +925,7 @@ def _off_the_grid(static: StaticMap, x: float, y: float) -> str | None:
     return f"lies outside the map{name} (x {x0:.6g} to {x1:.6g}, y {y0:.6g} to {y1:.6g} in)"
 
 
-def _units_hint(world: World, agent) -> str | None:
+def _units_hint(world: World, agent: Agent) -> str | None:
     """Where a corridor is narrower than the robot, a hint that world lengths are inches
     (`width: 1.8`, metres by mistake, made the start "lie inside a wall" and said no more)."""
     narrow = [c.width for c in world.corridors if c.width < agent.robot.width]
@@ -966,7 +969,7 @@ def walled_in(world: World, static: StaticMap, top: YMap) -> list[str]:
     return notes
 
 
-def _walled_offset(static: StaticMap, o, j) -> tuple[float, float] | None:
+def _walled_offset(static: StaticMap, o: Obstacle, j: Jitter) -> tuple[float, float] | None:
     """An offset in `randomise`'s ranges (a 5 x 5 lattice over them, corners included) that
     puts ``o`` entirely inside a wall, or None."""
     import numpy as np
@@ -978,7 +981,7 @@ def _walled_offset(static: StaticMap, o, j) -> tuple[float, float] | None:
     return None
 
 
-def _inside_wall(static: StaticMap, o, at: tuple[float, float]) -> bool:
+def _inside_wall(static: StaticMap, o: Obstacle, at: tuple[float, float]) -> bool:
     """Whether obstacle ``o`` standing at ``at`` lies entirely in solid space: its centre is
     not free and no wall crosses or touches it."""
     import math
@@ -1027,11 +1030,11 @@ def _obstacle_at(world: World, x: float, y: float, still: bool = False) -> str |
     return None
 
 
-def _who(agent) -> str:
+def _who(agent: Agent) -> str:
     return "" if agent.name == "robot" else f" of `{agent.name}`"
 
 
-def _body_corners(agent) -> np.ndarray:
+def _body_corners(agent: Agent) -> np.ndarray:
     """The corners ``[4, 2]`` of ``agent``'s footprint at its start."""
     import math
 
@@ -1041,7 +1044,8 @@ def _body_corners(agent) -> np.ndarray:
     return rect_corners(st.x, st.y, math.radians(st.heading), robot.length, robot.width)
 
 
-def _box_meets(hl: float, hw: float, centre, heading: float, o, at) -> bool:
+def _box_meets(hl: float, hw: float, centre: np.ndarray, heading: float, o: Obstacle,
+              at: tuple[float, float]) -> bool:
     """Whether obstacle ``o`` standing at ``at`` reaches into the box ``[-hl, hl] x [-hw, hw]``
     centred at ``centre`` and turned ``heading`` rad (touching is not reaching in)."""
     import math
@@ -1123,7 +1127,7 @@ def check_jitters(world: World, written: YMap) -> None:
                         hint="narrow its dx and dy, or move the obstacle")
 
 
-def _jitter_reaches_body(agent, o, j) -> bool:
+def _jitter_reaches_body(agent: Agent, o: Obstacle, j: Jitter) -> bool:
     """Whether obstacle ``o``, moved by an offset within jitter ``j``, reaches into
     ``agent``'s body at its start (touching is not reaching in): the body moved back by
     every offset (its footprint swept over the offsets' box) meets the obstacle where it
@@ -1150,7 +1154,7 @@ def _jitter_reaches_body(agent, o, j) -> bool:
     return bool(box_polygon_depth(o.length / 2, o.width / 2, local[None])[0] > 0.0)
 
 
-def _hull(points) -> np.ndarray:
+def _hull(points: np.ndarray) -> np.ndarray:
     """The convex hull ``[k, 2]`` of ``points [P, 2]``, counter-clockwise (Andrew's monotone
     chain)."""
     import numpy as np
@@ -1175,7 +1179,7 @@ def _range(r: tuple[float, float]) -> str:
     return f"{r[0]:g}" if r[0] == r[1] else f"{r[0]:g} to {r[1]:g}"
 
 
-def _check_body(world: World, agent, static, span: Span) -> None:
+def _check_body(world: World, agent: Agent, static: StaticMap, span: Span) -> None:
     """Refuse a start where the robot's footprint already touches a wall: the run would end
     in a collision at its first tick. Where it touches only unknown (grey) cells of the map,
     the refusal says so."""
@@ -1200,7 +1204,7 @@ def _check_body(world: World, agent, static, span: Span) -> None:
                                                        "or turn it along the corridor")
 
 
-def _touches(static, x: float, y: float, h: float, hl: float, hw: float) -> bool:
+def _touches(static: StaticMap, x: float, y: float, h: float, hl: float, hw: float) -> bool:
     """Whether a box of half-length ``hl`` and half-width ``hw`` at (x, y) heading ``h``
     (rad) touches a wall of ``static``."""
     import math

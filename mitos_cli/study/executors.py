@@ -14,9 +14,13 @@ import contextlib
 import functools
 import os
 from collections.abc import Callable, Iterator, Sequence
+from typing import TYPE_CHECKING
 
 from .spec import Task
 from .store import StudyError
+
+if TYPE_CHECKING:
+    from distributed import Client, LocalCluster
 
 TaskFn = Callable[[Task], dict]
 EXECUTORS = ("local", "dask")
@@ -114,7 +118,7 @@ def require_dask(scheduler: str | None) -> None:
                          hint="pip install 'mitos[dask]', or use --executor local")
 
 
-def dask_client(scheduler: str | None, workers: int, timeout: str = "10s"):
+def dask_client(scheduler: str | None, workers: int, timeout: str = "10s") -> Client:
     """A ``distributed.Client`` to ``scheduler`` (giving up after ``timeout``), or to a new
     LocalCluster of ``workers`` processes."""
     try:
@@ -134,7 +138,7 @@ def dask_client(scheduler: str | None, workers: int, timeout: str = "10s"):
     return Client(cluster, security=cluster.security)
 
 
-def local_cluster(workers: int):
+def local_cluster(workers: int) -> LocalCluster:
     """A LocalCluster of ``workers`` processes that only this process and its workers can use.
 
     Without ``security`` a LocalCluster accepts any connection on its port, and a client that
@@ -214,14 +218,14 @@ def quiet_logs() -> None:
 
 
 def run_dask(fn: TaskFn, tasks: Sequence[Task], workers: int, scheduler: str | None = None,
-             client=None) -> Iterator[tuple[Task, dict]]:
+             client: Client | None = None) -> Iterator[tuple[Task, dict]]:
     """Run on Dask's distributed scheduler (``client`` given: use it and leave it open).
 
     The workers of a remote cluster must have ``mitos`` installed and see the world files at
     the paths given on the command line (a shared file system).
     """
     own = client is None
-    if own:                        # a LocalCluster of no more processes than tasks (-j 500)
+    if client is None:             # a LocalCluster of no more processes than tasks (-j 500)
         client = dask_client(scheduler, min(workers, max(1, len(tasks))))
     try:
         from distributed import as_completed
@@ -252,7 +256,7 @@ def run_dask(fn: TaskFn, tasks: Sequence[Task], workers: int, scheduler: str | N
 
 def execute(fn: TaskFn, tasks: Sequence[Task], executor: str = "local",
             workers: int | None = None, scheduler: str | None = None,
-            client=None) -> Iterator[tuple[Task, dict]]:
+            client: Client | None = None) -> Iterator[tuple[Task, dict]]:
     """``(task, result)`` pairs as the tasks finish, on the chosen executor."""
     workers = workers or default_workers()
     if not tasks:

@@ -4,12 +4,16 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from ..resources import display_world
 from ..words import percent, plural
 from .spec import Choice
 from .stats import Mean, Rate
 from .summary import ALL_WORLDS, METRICS, Rank, Summary
+
+if TYPE_CHECKING:
+    from rich.table import Table
 
 RATE_COLUMNS = (("success", "success"), ("collision", "collision"), ("timeout", "timeout"),
                 ("stuck", "stuck"))
@@ -81,7 +85,7 @@ TERMINAL_HEADINGS = {"time_s": "time s*", "path_length_in": "path in*",
                      "replans": "replans", "backouts": "backed out"}
 
 
-def rich_tables(summaries: list[Summary], ranks: list[Rank]):
+def rich_tables(summaries: list[Summary], ranks: list[Rank]) -> tuple[Table, Table]:
     """The per-combination table and the ranking as rich renderables (compact: the metrics'
     t intervals are in report.md)."""
     from rich import box

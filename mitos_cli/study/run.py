@@ -13,11 +13,19 @@ import os
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from .executors import TaskFn, execute
 from .spec import Choice, Task, expand
 from .store import ResultStore, key_of, row_of
 from .summary import ALL_WORLDS, Rank, Summary, choice_of, rank, summaries
+
+if TYPE_CHECKING:
+    from collections.abc import Iterable
+
+    from distributed import Client
+
+    from ..sim.world import World
 
 
 @dataclass(frozen=True)
@@ -109,7 +117,7 @@ def world_files(worlds: object) -> list[str]:
     return out
 
 
-def _once(choices) -> list[Choice]:
+def _once(choices: Iterable[Choice]) -> list[Choice]:
     """``choices`` as a list, else an :class:`InputError` for one given twice: its runs share
     one key, so each row of it summarized both (``n`` twice the runs), and its --resume
     refused the results file it had written."""
@@ -150,7 +158,7 @@ def _world_file(world: object) -> str:
     return name
 
 
-def _world_hint(world) -> str:
+def _world_hint(world: World) -> str:
     """Where a loaded World can go instead: its file, or :func:`run_many`."""
     if world.path:
         return f"give its file: Study([{str(world.path)!r}], ...)"
@@ -193,7 +201,7 @@ def default_task_fn(study: Study, digests: dict[str, str] | None = None) -> Task
 
 def run_study(study: Study, out_dir: str | Path, *, executor: str = "local",
               workers: int | None = None, scheduler: str | None = None, resume: bool = False,
-              task_fn: TaskFn | None = None, client=None,
+              task_fn: TaskFn | None = None, client: Client | None = None,
               on_start: Callable[[int, int], None] | None = None,
               on_result: Callable[[Task, dict], None] | None = None) -> Outcome:
     """Run every unfinished task of ``study``, appending each result to ``out_dir/results.csv``
@@ -236,7 +244,8 @@ def run_study(study: Study, out_dir: str | Path, *, executor: str = "local",
     return outcome
 
 
-def _scheduler_client(executor: str, scheduler: str | None, client, workers: int | None):
+def _scheduler_client(executor: str, scheduler: str | None, client: Client | None,
+                      workers: int | None) -> Client | None:
     """A client of the Dask scheduler at ``scheduler``, reached before the study writes
     anything (``None``: no scheduler to reach, or a ``client`` given): one that could not be
     reached left study.json and results.csv's header behind in a directory that held none."""

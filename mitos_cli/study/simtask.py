@@ -14,9 +14,17 @@ import hashlib
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from .spec import Choice, Task
 from .store import RESULT_FIELDS, StudyError
+
+if TYPE_CHECKING:
+    from ..api import LoadedRuleBase
+    from ..lang.model import RuleBase
+    from ..sim.loop import Scene, SimResult
+    from ..sim.planner import Planner
+    from ..sim.world import World
 
 #: the key of the rule base's digest among a study's (the others are its world files)
 RULEBASE = "rulebase"
@@ -59,7 +67,7 @@ def world_digest(path: str) -> str | None:
     return file_digest([Path(path), *map_files(path)])
 
 
-def rulebase_digest(rb) -> str | None:
+def rulebase_digest(rb: RuleBase) -> str | None:
     """A digest of the files a rule base was read from: its own and its term sets."""
     if rb.path is None:
         return None
@@ -90,7 +98,7 @@ def _unchanged(what: str, key: str | None, now: str | None) -> None:
 
 
 @functools.lru_cache(maxsize=32)
-def _world(path: str, key: str | None):
+def _world(path: str, key: str | None) -> World:
     from ..sim.worldfile import load_world
 
     world = load_world(path)
@@ -99,7 +107,7 @@ def _world(path: str, key: str | None):
 
 
 @functools.lru_cache(maxsize=8)
-def _rulebase(path: str | None, key: str | None):
+def _rulebase(path: str | None, key: str | None) -> RuleBase:
     from ..api import read_rulebase
 
     rb = read_rulebase(path)
@@ -108,7 +116,8 @@ def _rulebase(path: str | None, key: str | None):
 
 
 @functools.lru_cache(maxsize=64)
-def loaded_rulebase(path: str | None, key: str | None, behavior: str | None, overrides: tuple):
+def loaded_rulebase(path: str | None, key: str | None, behavior: str | None,
+                    overrides: tuple[tuple[str, str], ...]) -> LoadedRuleBase:
     """The rule base compiled with the choice's operators (``overrides``: (key, value) pairs;
     ``key``: the digest of its files)."""
     from ..api import LoadedRuleBase
@@ -124,7 +133,7 @@ def check_choice(choice: Choice, context: StudyContext, world_path: str) -> None
 
 
 @functools.lru_cache(maxsize=32)
-def _scene(path: str, key: str | None):
+def _scene(path: str, key: str | None) -> Scene | None:
     """Walls and routes of a world, shared by its randomised runs (``None``: each run
     prepares its own, where a draw moves what the robots are given; :func:`shared_scene`)."""
     from ..sim.loop import shared_scene
@@ -132,14 +141,14 @@ def _scene(path: str, key: str | None):
     return shared_scene(_world(path, key), True)
 
 
-def _planner(context: StudyContext, choice: Choice, path: str):
+def _planner(context: StudyContext, choice: Choice, path: str) -> Planner:
     rulebase = _rulebase_key(context) if choice.planner == "fuzzy" else None
     return _make_planner(context, choice, path, _world_key(context, path), rulebase)
 
 
 @functools.lru_cache(maxsize=64)
 def _make_planner(context: StudyContext, choice: Choice, path: str, key: str | None,
-                  rulebase: str | None):
+                  rulebase: str | None) -> Planner:
     from ..sim.planner import make_planner
 
     world = _world(path, key)
@@ -178,7 +187,7 @@ def run_tasks(context: StudyContext, tasks: Sequence[Task]) -> Iterator[tuple[Ta
             yield group[j], _fields(result)
 
 
-def _fields(result) -> dict:
+def _fields(result: SimResult) -> dict:
     return {"outcome": result.outcome, **{f: result.metrics[f] for f in RESULT_FIELDS[1:]}}
 
 

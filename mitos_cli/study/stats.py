@@ -11,8 +11,12 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from statistics import NormalDist
+from typing import TYPE_CHECKING
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from collections.abc import Iterable
 
 LEVEL = 0.95
 
@@ -130,7 +134,7 @@ def t_quantile(p: float, df: float) -> float:
     return 0.5 * (lo + hi)
 
 
-def mean_interval(values, level: float = LEVEL) -> Mean:
+def mean_interval(values: Iterable[float | None], level: float = LEVEL) -> Mean:
     """Mean, sample std (``ddof=1``) and the t interval of the finite ``values``."""
     x = np.asarray([v for v in values if v is not None], dtype=float)
     x = x[np.isfinite(x)]

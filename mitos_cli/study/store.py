@@ -21,13 +21,16 @@ import re
 import shlex
 from collections.abc import Iterable
 from pathlib import Path
-from typing import TextIO
+from typing import TYPE_CHECKING, Any, TextIO
 
 from ..errors import MitosError, Span, did_you_mean
 from ..fileio import bad_byte, read_text, unreadable
 from ..resources import is_file
 from ..words import plural
 from .spec import KEY_FIELDS, Task
+
+if TYPE_CHECKING:
+    from collections.abc import Callable
 
 #: what a run reports, in this order, after the key and the seed (``replans``: routes planned
 #: again; ``backouts``: times a robot backed out; both summed over the robots)
@@ -76,7 +79,7 @@ def key_of(row: dict) -> tuple[str, ...]:
     return tuple(str(row[k]) for k in KEY_FIELDS)
 
 
-def _format(value) -> str:
+def _format(value: object) -> str:
     if isinstance(value, float):
         return repr(value)          # shortest string that reads back to the same double
     return str(value)
@@ -90,7 +93,7 @@ def _expected(field: str) -> str:
     return kind + (", 0 or more" if field in NON_NEGATIVE else "")
 
 
-def _wrong(field: str, value) -> str | None:
+def _wrong(field: str, value: Any) -> str | None:     # as parsed: the field decides str, int or float
     """What is wrong with a row's parsed ``value`` of ``field`` (``None``: did not parse),
     or ``None`` when nothing is."""
     if value is None:
@@ -112,7 +115,7 @@ def _label(row: dict) -> str:
                                          if row[k]])
 
 
-def _parse(field: str, text: str):
+def _parse(field: str, text: str) -> str | int | float:
     if field in FLOAT_FIELDS:
         return float(text)
     if field in INT_FIELDS:
@@ -198,7 +201,7 @@ class ResultStore:
             raise StudyError(f"expected {len(COLUMNS)} values in a row, found {len(values)}",
                              span=Span(str(self.path), line_no, 1, line[:200]),
                              hint="the file was edited by hand; remove that line")
-        row = {}
+        row: dict = {}                # each field's value as its kind parses it
         for j, (f, v) in enumerate(zip(COLUMNS, values)):
             try:
                 row[f] = value = _parse(f, v)
@@ -442,7 +445,7 @@ class ResultStore:
     def __enter__(self) -> ResultStore:
         return self
 
-    def __exit__(self, *exc) -> None:
+    def __exit__(self, *exc: object) -> None:
         self.close()
 
 
@@ -537,7 +540,7 @@ def _at(text: str, path: str, index: int, width: int = 1) -> Span:
     return Span.in_text(text, path, line, column, column + width)
 
 
-def _check_unchanged(old: dict, new: dict, path: Path, said) -> None:
+def _check_unchanged(old: dict, new: dict, path: Path, said: Callable[[str], Span | None]) -> None:
     """A world or rule base edited since the study began: its finished runs are of the old
     file, and resuming would average them with runs of the new one. ``said(name)``: where
     ``study.json`` records the first changed file's digest."""
@@ -555,7 +558,7 @@ def _check_behavior(old: dict, new: dict, path: Path, span: Span | None = None) 
     if "behavior" not in old or old["behavior"] == new.get("behavior"):
         return
 
-    def said(behavior) -> str:
+    def said(behavior: str | None) -> str:
         return f"--behavior {behavior}" if behavior else "each world's own behavior"
 
     was = old["behavior"]

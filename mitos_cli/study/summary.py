@@ -122,7 +122,7 @@ def _log_lower_tail(n: int, k: int) -> float:
     return top + math.log(total)
 
 
-def _sort_key(s: Summary):
+def _sort_key(s: Summary) -> tuple[float, float, float, str]:
     def num(m: Mean, sign: float) -> float:
         return sign * m.mean if m.mean is not None else math.inf
 

@@ -57,6 +57,7 @@ import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from functools import cached_property
+from typing import TYPE_CHECKING, cast
 
 import numpy as np
 
@@ -69,6 +70,13 @@ from ..fuzzy.norms import SNORMS, TNORMS, Norm
 from ..fuzzy.shapes import kernel_params
 from ..lang import interpretability as meaning
 from ..lang.model import Rule, RuleBase
+
+if TYPE_CHECKING:
+    from collections.abc import Iterable
+    from collections.abc import Set as AbstractSet
+
+    from ..engine.compile import NodeGroup
+    from ..lang.terms import Term, Variable
 
 #: Fraction of a universe the most-moving parameter moves in one full step (times eta).
 STEP = 0.05
@@ -164,7 +172,7 @@ class Parameters:
             empty = np.zeros(0, dtype=np.intp)
             return empty, empty, empty, empty, np.zeros(0), np.zeros(0)
 
-        def each(fn):
+        def each(fn: Callable[[np.ndarray], np.ndarray]) -> np.ndarray:
             return np.concatenate([fn(ids) for ids in groups])
         return (each(lambda ids: ids[:-1]), each(lambda ids: ids[1:]),
                 each(lambda ids: np.full(len(ids) - 1, ids[0])),
@@ -369,10 +377,10 @@ class _Builder:
         self.frozen.append(frozen)
         return len(self.knots) - 1
 
-    def term_frozen(self, vname: str, term) -> bool:
+    def term_frozen(self, vname: str, term: Term) -> bool:
         return term.frozen or (vname, term.name) in self.frozen_terms
 
-    def hold(self, vname: str):
+    def hold(self, vname: str) -> tuple[Term, float] | None:
         """The term of ``vname`` held at its point of symmetry, if any (and not released)."""
         if not self.constrained:
             return None
@@ -471,7 +479,8 @@ def _core_centre(core: tuple[float, float], universe: tuple[float, float]) -> fl
 
 
 def parameterise(compiled: CompiledRuleBase, *, constrained: bool = True,
-                 frozen_terms=frozenset(), released=frozenset()) -> Parameters:
+                 frozen_terms: AbstractSet[tuple[str, str]] = frozenset(),
+                                  released: AbstractSet[tuple[str, str]] = frozenset()) -> Parameters:
     """The learnable numbers of ``compiled`` (its input terms and output values).
 
     ``constrained`` (the default) keeps the terms' meaning as well as their order
@@ -688,7 +697,8 @@ def _null_projector(C: np.ndarray) -> np.ndarray:
     return projector
 
 
-def _constraints(P: int, frozen: np.ndarray, sym_rows) -> tuple[np.ndarray, tuple, np.ndarray]:
+def _constraints(P: int, frozen: np.ndarray, sym_rows: Iterable[tuple[int, int, int]]
+                 ) -> tuple[np.ndarray, tuple, np.ndarray]:
     """Projector onto the directions that keep frozen knots fixed and symmetric triangles
     symmetric; and, for rounding, which knots follow from which (see :func:`_round`)."""
     rows = []
@@ -774,7 +784,7 @@ def output_tables(p: Parameters, values: np.ndarray) -> tuple[OutputTable, ...]:
     return tuple(tables)
 
 
-def _output_term(p: Parameters, var, name: str, values: np.ndarray):
+def _output_term(p: Parameters, var: Variable, name: str, values: np.ndarray) -> Term:
     """Output term ``name`` with its knots' values (the term itself while they are unchanged,
     so the starting point is the engine's own table, bit for bit)."""
     term = var.term(name)
@@ -786,7 +796,8 @@ def _output_term(p: Parameters, var, name: str, values: np.ndarray):
         return term
     if term.shape == "singleton":
         return term.with_params((float(values[ids[0]]),))
-    corners = [float(values[i]) if i >= 0 else o for i, o in zip(ids, term.corners)]
+    corners = [float(values[i]) if i >= 0 else o                   # (a term with knots has corners)
+               for i, o in zip(ids, cast(tuple, term.corners))]
     return term.with_params(FROM_CORNERS[term.shape](*corners))
 
 
@@ -1019,7 +1030,7 @@ def _scatter_add(G: np.ndarray, idx: np.ndarray, vals: np.ndarray) -> None:
     G[sorted_idx[starts]] += np.add.reduceat(vals[order], starts, axis=0)
 
 
-def _backward_group(group, V: np.ndarray, G: np.ndarray, tnorm: Norm, snorm: Norm) -> None:
+def _backward_group(group: NodeGroup, V: np.ndarray, G: np.ndarray, tnorm: Norm, snorm: Norm) -> None:
     """Pass ``G[out]`` down to ``G[children]`` for one group of neurons."""
     gout = G[group.out]                                  # [g, n]
     ch = group.children                                  # [g, a]

@@ -14,6 +14,7 @@ import math
 import re
 from dataclasses import dataclass, field
 from types import SimpleNamespace
+from typing import TYPE_CHECKING, Any
 
 from lark import Lark, Token, Tree, v_args
 from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken
@@ -38,6 +39,13 @@ from ..lang.parse import (
 )
 from ..resources import grammar_text
 from .instructions import HEDGE_STEPS, INSTRUCTIONS
+
+if TYPE_CHECKING:
+    from collections.abc import Iterable
+
+    from lark.tree import Meta
+
+    from ..lang.model import Consequent
 
 WORDS = dict(TERMINAL_WORDS, PATH="a file name", INT="a whole number", ARROW="`->`",
              SHOW_WHAT="rules, terms, examples, behaviors or history", EQUAL="`=`",
@@ -225,7 +233,7 @@ Command = (TellRule | TellUse | TellFrozen | TellOperators | OpenBehavior | Clos
 class _ToCommand(_ToModel):
     """Tree -> command objects (the rule-language parts are the rule parser's own)."""
 
-    def command(self, items):
+    def command(self, items: list[Any]) -> Command:     # a Rule, a Use or a tagged tuple
         item = items[0]
         if isinstance(item, Rule):
             return TellRule(item)
@@ -234,49 +242,49 @@ class _ToCommand(_ToModel):
         kind, value = item[0], item[1]
         return TellFrozen(value) if kind == "frozen" else TellOperators(value)
 
-    def open_behavior(self, items):
+    def open_behavior(self, items: list[Token]) -> OpenBehavior:
         return OpenBehavior(str(items[0]))
 
-    def close_behavior(self, items):
+    def close_behavior(self, items: list[Token]) -> CloseBehavior:
         return CloseBehavior()
 
     @v_args(meta=True)
-    def assignment(self, meta, items):
+    def assignment(self, meta: Meta, items: list[Any]) -> Assign:    # (name, number)
         return Assign(str(items[0]), float(items[1]), self._s(meta))
 
-    def inputs(self, items):
+    def inputs(self, items: list[Assign]) -> tuple[Assign, ...]:
         return tuple(items)
 
     targets = inputs
 
     @v_args(meta=True)
-    def said(self, meta, items):
+    def said(self, meta: Meta, items: list[Consequent]) -> tuple[Said, ...]:
         out = []
         for c in items:
             out.append(Said(c.var, c.term, tuple(c.hedges), c.value, getattr(c, "span", None)
                             or self._s(meta)))
         return tuple(out)
 
-    def term_ref(self, items):
+    def term_ref(self, items: list[Token]) -> tuple[str, str]:
         return (str(items[0]), str(items[1]))
 
     @v_args(meta=True)
-    def freeze_terms(self, meta, items):
+    def freeze_terms(self, meta: Meta, items: list[tuple[str, str]]) -> FreezeTerms:
         return FreezeTerms(tuple(items), self._s(meta))
 
     @v_args(meta=True)
-    def release_terms(self, meta, items):
+    def release_terms(self, meta: Meta, items: list[tuple[str, str]]) -> ReleaseTerms:
         return ReleaseTerms(tuple(items), self._s(meta))
 
-    def correct_said(self, items):
+    def correct_said(self, items: list[Any]) -> CorrectSaid:          # (inputs, arrow, said)
         return CorrectSaid(items[0], items[2])
 
-    def at_said(self, items):
+    def at_said(self, items: list[Any]) -> AtSaid:
         (start, stop), places, (said,) = _window(items)
         return AtSaid(start, stop, said, places)
 
     @v_args(meta=True)
-    def at_instruction(self, meta, items):
+    def at_instruction(self, meta: Meta, items: list[Any]) -> AtInstruction:
         """The span is the instruction's words' (an unknown one is marked there, not from
         the `at`)."""
         (start, stop), places, words = _window(items)
@@ -286,56 +294,56 @@ class _ToCommand(_ToModel):
                                end_column=last.end_column)
         return AtInstruction(start, stop, tuple(str(w) for w in words), self._s(said), places)
 
-    def eval_cmd(self, items):
+    def eval_cmd(self, items: list[Assign]) -> Eval:
         return Eval(tuple(items))
 
-    def correct_cmd(self, items):
+    def correct_cmd(self, items: list[Any]) -> Correct:               # (inputs, arrow, targets)
         return Correct(items[0], items[2])
 
-    def filename(self, items):
+    def filename(self, items: list[Token]) -> str:
         token = items[0]    # quoted as a rule file's `terms` ("C:\Users\..." ended in a traceback)
         return _unquote(token) if token.type == "STRING" else str(token)
 
-    def simulate_cmd(self, items):
+    def simulate_cmd(self, items: list[Any]) -> Simulate:             # (world, seed or None, robot or None)
         return Simulate(items[0], None if items[1] is None else str(items[1]),
                         None if items[2] is None else str(items[2]))
 
     @v_args(meta=True)
-    def time(self, meta, items):
+    def time(self, meta: Meta, items: list[float]) -> tuple[float, Span | None]:
         return float(items[0]), self._s(meta)
 
-    def at_cmd(self, items):
+    def at_cmd(self, items: list[Any]) -> At:
         (start, stop), places, targets = _window(items)
         return At(start, stop, tuple(targets), places)
 
-    def epochs(self, items):
+    def epochs(self, items: list[Token]) -> tuple[str, float]:
         return ("epochs", float(items[0]))
 
-    def rate(self, items):
+    def rate(self, items: list[Token]) -> tuple[str, float]:
         return ("rate", float(items[0]))
 
-    def plot(self, items):
+    def plot(self, items: list[str]) -> tuple[str, str]:
         return ("plot", items[0])
 
-    def unconstrained(self, items):
+    def unconstrained(self, items: list[Token]) -> tuple[str, bool]:
         return ("constrained", False)
 
-    def adapt_cmd(self, items):
+    def adapt_cmd(self, items: list[tuple[str, Any]]) -> Adapt:      # (option, its value)
         return Adapt(**dict(items), given=tuple(key for key, _ in items))
 
-    def show_cmd(self, items):
+    def show_cmd(self, items: list[Any]) -> Show:                     # (what, plot file or None)
         return Show(str(items[0]), items[1])
 
-    def undo_cmd(self, items):
+    def undo_cmd(self, items: list[Token]) -> Undo:
         return Undo()
 
-    def save_cmd(self, items):
+    def save_cmd(self, items: list[str | None]) -> Save:
         return Save(items[0])
 
-    def help_cmd(self, items):
+    def help_cmd(self, items: list[Token | None]) -> Help:
         return Help(None if items[0] is None else str(items[0]))
 
-    def quit_cmd(self, items):
+    def quit_cmd(self, items: list[Token]) -> Quit:
         return Quit()
 
 
@@ -584,7 +592,7 @@ def _words(name: str) -> str:
     return words(name, WORDS)
 
 
-def _expected(names) -> str | None:
+def _expected(names: Iterable[str]) -> str | None:
     words = sorted({_words(n) for n in names if not n.startswith("__") and n not in UNSAID})
     if not words:
         return None

@@ -207,7 +207,7 @@ class Journal:
     def next_seq(self) -> int:
         return (self.entries[-1]["seq"] + 1) if self.entries else 1
 
-    def append(self, op: str, **data) -> dict:
+    def append(self, op: str, **data: object) -> dict:
         """Add an entry and make it durable before returning."""
         entry = {"seq": self.next_seq, "op": op, **data}
         line = json.dumps(entry, ensure_ascii=False, separators=(",", ":")) + "\n"
@@ -465,7 +465,7 @@ class MemoryJournal(Journal):
     def __init__(self) -> None:
         super().__init__(Path("."))
 
-    def append(self, op: str, **data) -> dict:
+    def append(self, op: str, **data: object) -> dict:
         entry = {"seq": self.next_seq, "op": op, **data}
         self.entries.append(entry)
         return entry

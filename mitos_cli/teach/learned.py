@@ -16,9 +16,13 @@ and never ``110 -> 110`` for a move to 109.97.
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import TYPE_CHECKING
 
 from ..lang.interpretability import centre
 from ..lang.model import RuleBase, format_number
+
+if TYPE_CHECKING:
+    from .adapt import Parameters
 
 #: Share of the distance to the next term beyond which a move "changes the meaning".
 MEANING_SHIFT = 0.5
@@ -37,7 +41,7 @@ def _moved(a: float, b: float) -> tuple[str, str]:
     return (before, after) if before != after or a == b else (repr(a), repr(b))
 
 
-def in_words(before: RuleBase, after: RuleBase, parameters, rules: Sequence[str] = ()) -> str:
+def in_words(before: RuleBase, after: RuleBase, parameters: Parameters, rules: Sequence[str] = ()) -> str:
     """The learned changes of ``before`` -> ``after`` in words (``parameters``: what was
     adapted and what was held; ``rules``: the labels of rules whose own crisp values were
     learned, so that "no term moved" does not read as "nothing was learned")."""

@@ -14,12 +14,16 @@ from __future__ import annotations
 import contextlib
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from ..errors import LessonError, MitosError, Span
 from ..fuzzy.hedges import HEDGES
 from .commands import COMMAND_WORDS, SHOW_WHAT, incomplete
 from .session import Session
 from .text import quoted_column
+
+if TYPE_CHECKING:
+    from types import ModuleType
 
 
 class Completer:
@@ -62,7 +66,7 @@ class Completer:
             return terms + ["not", *HEDGES]
         return list(rb.variables) + ["is", "and", "or", "not", "then", "with"]
 
-    def complete(self, text: str, state: int):
+    def complete(self, text: str, state: int) -> str | None:
         if state == 0:
             import readline
 
@@ -72,7 +76,7 @@ class Completer:
         return self.matches[state] if state < len(self.matches) else None
 
 
-def _setup_readline(session: Session, history: Path | None):
+def _setup_readline(session: Session, history: Path | None) -> ModuleType | None:
     try:
         import readline
     except ImportError:                              # pragma: no cover - Windows without it

@@ -23,6 +23,7 @@ import os
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from lark import Token, Tree
 
@@ -35,6 +36,13 @@ from ..lang.parse import _unquote
 from ..lang.parse import parser as rule_parser
 from ..lang.terms import Term
 from ..words import plural
+
+if TYPE_CHECKING:
+    from collections.abc import Iterable, Iterator
+
+    from ..errors import Span
+    from ..lang.model import Setting
+    from ..lang.terms import TermSet
 
 NUMBER = re.compile(r"[-+]?(?:\d[\d_]*\.?\d*|\.\d+)(?:[eE][-+]?\d+)?")
 #: a plain YAML scalar such as ``true`` (up to a space, comma, ``}`` or comment)
@@ -178,7 +186,7 @@ def saved_files(original: RuleBase, current: RuleBase, target: Path,
     if sources is None:
         sources = Sources.read(original)
     changes: list[str] = []
-    texts: list[tuple[Path, str | bytes]] = []
+    texts: list[tuple[Path, str]] = []
     for ts_old, ts_new, rel, dest, raw in zip(original.termsets, current.termsets,
                                              original.termset_paths, targets, sources.terms):
         new_text, changed = edit_termset(_as_read(raw), str(src.parent / rel), ts_old, ts_new)
@@ -315,7 +323,7 @@ def _rules_name(target: Path, src: Path) -> Path:
     return out
 
 
-def _check_reads_back(current: RuleBase, rules_text: str, texts, target: Path,
+def _check_reads_back(current: RuleBase, rules_text: str, texts: list[tuple[Path, str]], target: Path,
                       names: tuple[str, ...]) -> None:
     """The texts about to be written, read back, must be ``current``: a save never reports
     success for a file that does not load or that means something else."""
@@ -394,7 +402,7 @@ def _offsets(text: str) -> list[int]:
     return starts
 
 
-def edit_termset(text: str, path: str, old, new) -> tuple[str, list[str]]:
+def edit_termset(text: str, path: str, old: TermSet, new: TermSet) -> tuple[str, list[str]]:
     """``text`` with the parameters of every term that differs between ``old`` and ``new``
     (term sets of the same variables and terms) replaced in place."""
     data = yamlpos.load(text, path, TermSetError)
@@ -456,7 +464,7 @@ def _flag_edits(text: str, starts: list[int], terms: yamlpos.YMap, old: Term,
     was = _flags(old)
     flags = {key: value for key, value in _flags(new).items() if was[key] != value}
 
-    def offset(span) -> int:
+    def offset(span: Span) -> int:
         return starts[span.line - 1] + span.column - 1
 
     spec = terms[old.name]
@@ -523,7 +531,7 @@ class _Place:
     settings: dict[str, tuple[int, int]] = field(default_factory=dict)
 
 
-def _tokens(tree: Tree):
+def _tokens(tree: Tree) -> Iterator[tuple[Tree, Token]]:
     for node in tree.iter_subtrees_topdown():
         for child in node.children:
             if isinstance(child, Token):
@@ -699,18 +707,18 @@ def _rule_edits(before: Rule, rule: Rule, start: int, end: int,
     return edits
 
 
-def _operators_text(settings) -> str:
+def _operators_text(settings: Iterable[Setting]) -> str:
     """``settings`` as one ``operators:`` line's text, each key once with the value told last
     (one line may not set a key twice; two `operators:` lines at the prompt may)."""
     return ", ".join(f"{key} = {value}" for key, value in _last_values(settings).items())
 
 
-def _last_values(settings) -> dict[str, str]:
+def _last_values(settings: Iterable[Setting]) -> dict[str, str]:
     """Each key of ``settings`` with the value told last."""
     return {setting.key: setting.value for setting in settings}
 
 
-def _only_crisp_changed(before, after) -> bool:
+def _only_crisp_changed(before: Rule, after: Rule) -> bool:
     if before.label != after.label or before.antecedent != after.antecedent \
             or before.weight != after.weight or len(before.consequents) != len(after.consequents):
         return False

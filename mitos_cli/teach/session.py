@@ -28,7 +28,7 @@ import os
 import re
 from collections.abc import Callable, Iterator
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, cast
 
 import numpy as np
 
@@ -61,6 +61,10 @@ from .save import Sources
 from .state import State, apply, files_digest, journaled, learned_changes, variables
 
 if TYPE_CHECKING:
+    from collections.abc import Iterable, Sequence
+
+    from ..lang.model import Setting
+    from .adapt import Adaptation
     from .simulation import Recording
 
 
@@ -386,7 +390,7 @@ class Session:
                               hint="tell it a rule, or `use` another behavior")
         return compile_rulebase(self.rulebase, name)
 
-    def change(self, op: str, line: str, **data) -> dict:
+    def change(self, op: str, line: str, **data: object) -> dict:
         """Journal a change (durably), then apply it."""
         entry = self.journal.append(op, line=line, **data)
         apply(self.state, entry)
@@ -398,7 +402,7 @@ class Session:
         command = cmd.parse_command(line, path, lineno)
         return self.execute(command, line.strip())
 
-    def execute(self, c, line: str = "") -> bool:
+    def execute(self, c: cmd.Command, line: str = "") -> bool:
         handler = getattr(self, "_" + type(c).__name__.lower())
         return handler(c, line) is not False
 
@@ -530,7 +534,7 @@ class Session:
                 exc.hint = own.rstrip("; ")
         return exc
 
-    def _term_refs(self, refs) -> list[list[str]]:
+    def _term_refs(self, refs: Iterable[Sequence[str]]) -> list[list[str]]:
         variables = self.rulebase.variables
         for var, term in refs:
             if var not in variables:
@@ -615,7 +619,7 @@ class Session:
                          + (" (add `inference = mamdani` to use it)"
                             if setting.key in MAMDANI_ONLY else ""))
 
-    def _check_operators(self, b: Behavior, settings) -> None:
+    def _check_operators(self, b: Behavior, settings: tuple[Setting, ...]) -> None:
         """Refuse operators the behavior's rules cannot be evaluated with (Tsukamoto
         inference on terms that are not monotonic, ...) before they are journaled."""
         from .state import _replace_behavior
@@ -680,7 +684,7 @@ class Session:
                     examples=[{"inputs": inputs, "targets": targets, "source": "correct"}])
         self.out(f"example {len(self.state.examples)}: " + text.example_text(inputs, targets, now))
 
-    def _said(self, said, compiled: CompiledRuleBase) -> tuple[cmd.Assign, ...]:
+    def _said(self, said: tuple[cmd.Said, ...], compiled: CompiledRuleBase) -> tuple[cmd.Assign, ...]:
         """``steering is very LM`` -> ``steering=40`` (the hedged term's value)."""
         from .instructions import HEDGE_STEPS, hedged, not_a_target_hedge, past_the_end
 
@@ -689,7 +693,7 @@ class Session:
             if t.name not in compiled.outputs:
                 raise _not_its(t.name, t.span, "output", compiled.outputs, compiled)
             if t.term is None:
-                out.append(cmd.Assign(t.name, t.value, t.span))
+                out.append(cmd.Assign(t.name, cast(float, t.value), t.span))   # (a crisp value)
                 continue
             var = compiled.variables[t.name]
             var.term(t.term, t.span and t.span.ending(t.term))
@@ -699,8 +703,8 @@ class Session:
             value = hedged(var, t.term, t.hedges)
             end = past_the_end(var, t.term, t.hedges)
             if end is not None:
-                said = " ".join(t.hedges + (t.term,))
-                self.out(f"note: `{t.name} is {said}` lies past {end}, the end of the "
+                words = " ".join(t.hedges + (t.term,))
+                self.out(f"note: `{t.name} is {words}` lies past {end}, the end of the "
                          f"{t.name} scale: the target is {end}'s value, "
                          f"{t.name}={format_number(value)}")
             out.append(cmd.Assign(t.name, value, t.span))
@@ -802,7 +806,7 @@ class Session:
         inputs = [rec.inputs_at(i, compiled.inputs) for i in rows]
         self._add_window(compiled, rec, rows, inputs, [targets] * len(rows), line)
 
-    def _add_window(self, compiled: CompiledRuleBase, rec, rows, inputs: list[dict],
+    def _add_window(self, compiled: CompiledRuleBase, rec: Recording, rows: np.ndarray, inputs: list[dict],
                     targets: list[dict], line: str) -> None:
         """Examples from ticks ``rows`` of the recorded run, journaled and shown."""
         now = self._outputs(compiled, inputs)
@@ -878,7 +882,7 @@ class Session:
             self._plot_terms(before, self.rulebase, c.plot)
 
     def _learn(self, c: cmd.Adapt, compiled: CompiledRuleBase, X: np.ndarray, T: np.ndarray,
-               epochs: int, rate: float):
+               epochs: int, rate: float) -> Adaptation:
         """The descent itself, with the session's frozen and released terms and a progress
         bar."""
         from .adapt import adapt, parameterise
@@ -1206,7 +1210,7 @@ def _check_below(written: str, root: Path | None, example: str = "taught.rules")
                                "`--save-as PATH` or at the prompt")
 
 
-def _saved_digest(paths) -> str:
+def _saved_digest(paths: Iterable[Path]) -> str:
     """A digest of the bytes of ``paths`` as they are now (a file missing counts as empty)."""
     import hashlib
 

@@ -15,13 +15,16 @@ import functools
 import hashlib
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TypeVar
+from typing import TYPE_CHECKING, TypeVar
 
 from ..errors import LessonError
 from ..lang.model import Behavior, Rule, RuleBase
 from ..lang.parse import parse_rule
 from ..lang.terms import Term
 from . import commands as cmd
+
+if TYPE_CHECKING:
+    from ..lang.terms import Variable
 
 _C = TypeVar("_C")
 
@@ -226,7 +229,7 @@ def journaled(entry: dict, kind: type[_C]) -> _C:
     return parsed
 
 
-def variables(rb: RuleBase):
+def variables(rb: RuleBase) -> list[Variable]:
     """Every variable of every term set, in file order."""
     return [v for ts in rb.termsets for v in ts.variables]
 

@@ -4,15 +4,21 @@ behaviors and history it shows. Pure functions of the state; the session prints 
 from __future__ import annotations
 
 import contextlib
+from typing import TYPE_CHECKING, cast
 
 from ..lang.model import RuleBase, format_number, format_rule, format_use
 from ..words import plural
 from .state import variables
 
+if TYPE_CHECKING:
+    from ..lang.model import Behavior, Consequent
+    from ..lang.terms import Term
+    from .adapt import Adaptation
 
-def say(c) -> str:
+
+def say(c: Consequent) -> str:
     if c.term is None:
-        return f"{c.var} is {format_number(c.value)}"
+        return f"{c.var} is {format_number(cast(float, c.value))}"     # (a crisp value)
     return f"{c.var} is {' '.join(c.hedges + (c.term,))}"
 
 
@@ -29,7 +35,7 @@ def example_text(inputs: dict, targets: dict, now: dict | None) -> str:
     return text
 
 
-def q_lines(history: list[float], n: int, result) -> str:
+def q_lines(history: list[float], n: int, result: Adaptation) -> str:
     rounding = history[-1] if result.rounded else None
     if result.rounded:
         history = history[:-1]
@@ -51,7 +57,7 @@ def q_lines(history: list[float], n: int, result) -> str:
     return "\n".join(lines)
 
 
-def params_text(t) -> str:
+def params_text(t: Term) -> str:
     return t.params_text(format_number)
 
 
@@ -89,7 +95,7 @@ def terms_table(original: RuleBase, current: RuleBase, names: list[str]) -> str:
     return "\n".join(lines)
 
 
-def rules_text(b, original: RuleBase, open_block: str | None) -> str:
+def rules_text(b: Behavior, original: RuleBase, open_block: str | None) -> str:
     """Behavior ``b``'s rules, new and changed ones (against ``original``) marked."""
     from ..errors import MitosError
 

@@ -5,10 +5,14 @@ time. Built from the run summaries that :func:`mitos_cli.sim.runs.trail` filled 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ...sim.loop import OUTCOMES
+
+if TYPE_CHECKING:
+    from collections.abc import Sequence
 
 
 @dataclass(frozen=True)
@@ -53,7 +57,7 @@ class RunsOverlay:
         return f"{outcome} ({self.counts[outcome]} of {len(self.seeds)})"
 
 
-def runs_overlay(world: str, summaries, robot_names: list[str]) -> RunsOverlay:
+def runs_overlay(world: str, summaries: Sequence[dict], robot_names: list[str]) -> RunsOverlay:
     """The overlay of ``summaries`` (each with ``seed``, ``outcome`` and ``trail``)."""
     paths: dict[str, list[np.ndarray]] = {}
     counts: dict[str, int] = {}

@@ -230,7 +230,8 @@ def _summed(compiled: CompiledRuleBase, j: int, rules: np.ndarray, crisp: np.nda
     return tuple(sorted(summed.items()))
 
 
-def _mamdani_sets(compiled: CompiledRuleBase, dof: np.ndarray):
+def _mamdani_sets(compiled: CompiledRuleBase, dof: np.ndarray
+                  ) -> list[tuple[dict[int, tuple[np.ndarray, np.ndarray]], np.ndarray, np.ndarray]]:
     """Per output ``j``: ``({rule: (implied set, consequent set)}, grid, aggregate)`` for one
     sample's DOFs,
     from the sampled consequent sets the engine uses (:mod:`mitos_cli.engine.mamdani`)."""

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -19,6 +20,11 @@ from ...errors import FormatError
 from ...fuzzy.shapes import kernel_params
 from ...lang.model import And, Expr, Not, Prop, flatten
 from ..common import setting_span
+
+if TYPE_CHECKING:
+    from collections.abc import Callable, Iterable
+
+    from ...engine.compile import Accumulation
 
 #: Text that may stand as it is in a C comment or a Python docstring.
 PLAIN = re.compile(r"[A-Za-z0-9_ .,:;+=@%()\[\]<>~^!#&|{}-]*")
@@ -49,7 +55,7 @@ def ident(name: str) -> str:
     return out if out and not out[0].isdigit() else "_" + out
 
 
-def unique_idents(names, fold=str) -> list[str]:
+def unique_idents(names: Iterable[str], fold: Callable[[str], str] = str) -> list[str]:
     """:func:`ident` of each name, ``_2``, ``_3`` ... appended where two would coincide
     (after ``fold``: ``str.upper`` for C macros)."""
     seen: set[str] = set()
@@ -210,7 +216,7 @@ def _weighted_terms(c: CompiledRuleBase, j: int) -> list[tuple[str, str]]:
     return terms
 
 
-def _accumulated(acc, terms: list[tuple[str, str]], rules) -> list[tuple[str, str]]:
+def _accumulated(acc: Accumulation, terms: list[tuple[str, str]], rules: np.ndarray) -> list[tuple[str, str]]:
     """``terms`` (per rule setting the output, in ``rules`` order) joined per group of
     :class:`~mitos_cli.engine.compile.Accumulation`: ``accumulate(accumulate(d1, d2), d3)``."""
     at = {int(r): i for i, r in enumerate(rules)}

@@ -9,6 +9,7 @@ base appear only as ``repr`` literals (``INPUTS``, ``OUTPUTS``), in the docstrin
 from __future__ import annotations
 
 import re
+from typing import TYPE_CHECKING, cast
 
 import numpy as np
 
@@ -17,6 +18,9 @@ from ...fuzzy.hedges import HEDGES
 from ...fuzzy.norms import SNORMS, TNORMS, UNBOUNDED_SUM
 from ...words import plural
 from .program import PLAIN, Program, num, program, weighted_sums
+
+if TYPE_CHECKING:
+    from collections.abc import Iterable
 
 PY_NORMS = {n.name: n.numpy for n in (*TNORMS.values(), *SNORMS.values(), UNBOUNDED_SUM)}   # fuzzy/norms.py
 
@@ -194,8 +198,9 @@ def _py_evaluate(p: Program) -> list[str]:
     return out + _py_outputs(c) + ["    return Y", "", ""]
 
 
-def _py_shapes(shapes) -> list[str]:
+def _py_shapes(shapes: Iterable[str]) -> list[str]:
     """NumPy shape functions: MITOS's own (copied by source) so results agree exactly."""
+    import ast
     import inspect
 
     from ...fuzzy import shapes as shapes_mod
@@ -214,7 +219,14 @@ def _py_shapes(shapes) -> list[str]:
         for d in deps:
             emit(d)
         fn = getattr(shapes_mod, name)
-        src = inspect.getsource(fn).replace(f"def {name}(", f"def mf_{name}(", 1)
+        # the header without its annotations, which name the type checker's aliases (ArrayLike,
+        # Param): the program defines none of them, and would fail at the `def`
+        lines = inspect.getsource(fn).splitlines()
+        node = cast(ast.FunctionDef, ast.parse(inspect.getsource(fn)).body[0])
+        first = node.body[0].lineno                                   # (the docstring)
+        params = ", ".join(str(p.replace(annotation=p.empty))
+                           for p in inspect.signature(fn).parameters.values())
+        src = "\n".join([f"def mf_{name}({params}):", *lines[first - 1:]]) + "\n"
         for d in deps + ("_nan_of",):
             src = re.sub(rf"(?<![\w.]){d}\(", f"mf_{d}(", src)
         out.extend([src.rstrip(), "", ""])
