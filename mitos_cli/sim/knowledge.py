@@ -154,20 +154,31 @@ _NO_FACES = np.zeros((0, 2))
 _NO_FACES.flags.writeable = False
 
 
+def _with_faces(cells: np.ndarray, faces: np.ndarray, y: float, reach: float) -> np.ndarray:
+    """``cells``, then those of ``faces`` (the run of a square's x) within ``reach`` of
+    ``y``."""
+    if not len(faces):
+        return cells
+    keep = np.abs(faces[:, 1] - y) <= reach
+    return np.concatenate([cells, faces[keep]]) if np.count_nonzero(keep) else cells
+
+
 def wall_faces(walls: np.ndarray, grid: Grid) -> np.ndarray:
     """``[F, 2]``: the centres of squares of the size of ``grid``'s cells laid along each of
     ``walls [N, 4]`` (x0, y0, x1, y1) on its solid side, flush with it (a square whose sides
-    run along the wall's touches it with a whole side, a slanted one with a corner), at most
-    half a cell apart, from one end of the wall to the other: what the brake counts besides
-    the grid's cells (:meth:`RobotMap.brake_cells`).
+    run along the wall's touches it with a whole side, a slanted one with a corner), where the
+    wall runs through a free cell of the grid; a cell apart (half a cell along a slanted
+    wall), in the order of their x: what the brake counts besides the grid's cells
+    (:meth:`RobotMap.brake_cells`).
 
     A grid drawn from walls frees every cell whose centre lies on the free side, so a wall
     may run up to half a cell inside a free cell: the brake, which keeps its margin along the
     arc, not across it, then let a robot backing out at 17-19 deg toward BARN's corridor wall
-    (which lies 0.84 in inside the map's free row) touch it. The solid side of a wall is the
-    one whose cell a cell and a half from its middle is occupied while the other's is free
-    (outside the grid counts as occupied); a wall with both or neither (a pole stamped
-    against it) gets no squares: its cells are occupied on both sides already."""
+    (which lies 0.84 in inside the map's free row) touch it. Where the wall runs through an
+    occupied cell, or along a cell's edge, that cell covers it and no square is laid. The
+    solid side of a wall is the one whose cell a cell and a half from its middle is occupied
+    while the other's is free (outside the grid counts as occupied); a wall with both or
+    neither (a pole stamped against it) gets no squares."""
     if not len(walls):
         return _NO_FACES
     r = grid.resolution / 2
@@ -197,14 +208,26 @@ def wall_faces(walls: np.ndarray, grid: Grid) -> np.ndarray:
         return _NO_FACES
     # a square's centre this far beyond the wall touches it and no more
     off = r * (np.abs(normal[:, 0]) + np.abs(normal[:, 1]))
-    # along each wall from half a cell in from one end to half a cell in from the other
-    count = np.maximum(np.ceil((length - 2 * r) / r).astype(np.int64), 0) + 1
+    # along each wall from half a cell in from one end to half a cell in from the other, a
+    # cell apart along a wall that runs with the grid (they tile it), half a cell along a
+    # slanted one (whose squares touch it at a corner each)
+    step = np.where(np.minimum(np.abs(normal[:, 0]), np.abs(normal[:, 1])) < 1e-9, 2 * r, r)
+    count = np.maximum(np.ceil((length - 2 * r) / step - 1e-9).astype(np.int64), 0) + 1
     wall = np.repeat(np.arange(len(a)), count)
     k = np.arange(len(wall)) - np.repeat(np.cumsum(count) - count, count)
     span = np.maximum(length - 2 * r, 0.0)[wall]
     s = np.where(count[wall] > 1, r + span * k / np.maximum(count[wall] - 1, 1),
                  length[wall] / 2)
-    out = a[wall] + along[wall] * s[:, None] + normal[wall] * off[wall, None]
+    on = a[wall] + along[wall] * s[:, None]                # on the wall
+    # needed only where the wall runs through a free cell (a hair beyond it, there or half a
+    # cell along): where it runs through an occupied one, or along a cell's edge, that cell
+    # covers it already
+    beyond = on + normal[wall] * 1e-6
+    free = ~blocked(beyond)
+    for sign in (1.0, -1.0):
+        free |= ~blocked(beyond + along[wall] * (sign * r))
+    out = (on + normal[wall] * off[wall, None])[free]
+    out = out[np.lexsort((out[:, 1], out[:, 0]))]         # by x: a square's are one run
     out.flags.writeable = False
     return out
 
@@ -280,10 +303,12 @@ class RobotMap:
     _decoded: tuple | None = field(default=None, repr=False)   # see _marks_decoded()
     _origin: np.ndarray = field(init=False, repr=False)        # the grid's origin, [2]
     faces: np.ndarray = field(default_factory=lambda: _NO_FACES, repr=False)
-    # [F, 2] squares flush with the walls it is given, for the brake (wall_faces)
+    # [F, 2] squares flush with the walls it is given, for the brake (wall_faces), by x
+    _faces_x: np.ndarray = field(init=False, repr=False)      # their x, [F] (contiguous)
 
     def __post_init__(self) -> None:
         self._origin = np.array(self.grid.origin, float)
+        self._faces_x = np.ascontiguousarray(self.faces[:, 0])
 
     @classmethod
     def of(cls, grid: Grid, faces: np.ndarray | None = None) -> RobotMap:
@@ -298,8 +323,9 @@ class RobotMap:
         if not len(faces):
             return cells
         x, y = float(p[0]), float(p[1])
-        keep = (np.abs(faces[:, 0] - x) <= reach) & (np.abs(faces[:, 1] - y) <= reach)
-        return np.concatenate([cells, faces[keep]]) if np.count_nonzero(keep) else cells
+        lo = int(self._faces_x.searchsorted(x - reach, side="left"))
+        hi = int(self._faces_x.searchsorted(x + reach, side="right"))
+        return _with_faces(cells, faces[lo:hi], y, reach)
 
     def accounted(self, points: np.ndarray, reach: int = 2) -> np.ndarray:
         """Which points ``[P, 2]`` lie within ``reach`` cells of a cell the robot's route was
@@ -522,12 +548,12 @@ def brake_cells_all(maps: list[RobotMap], points: np.ndarray,
     if not all(m.faces is faces for m in maps):
         return [c if not len(m.faces) else m.brake_cells(p, reach)
                 for c, m, p, reach in zip(cells, maps, points, reaches)]
-    x, y = points[:, 0, None], points[:, 1, None]
-    half = np.asarray(reaches, float)[:, None]
-    keep = (np.abs(faces[None, :, 0] - x) <= half) & (np.abs(faces[None, :, 1] - y) <= half)
-    some = np.logical_or.reduce(keep, axis=1).tolist()
-    return [np.concatenate([c, faces[k]]) if any_ else c
-            for c, k, any_ in zip(cells, keep, some)]
+    x, half = points[:, 0], np.asarray(reaches, float)
+    along = maps[0]._faces_x
+    lo = along.searchsorted(x - half, side="left").tolist()
+    hi = along.searchsorted(x + half, side="right").tolist()
+    return [_with_faces(c, faces[a:b], y, reach)
+            for c, a, b, y, reach in zip(cells, lo, hi, points[:, 1].tolist(), half.tolist())]
 
 
 #: The fewest maps whose windows :func:`near_all` gathers in one copy (:func:`_windows`); fewer
