@@ -50,6 +50,25 @@ def test_each_shipped_world_runs_alone_and_in_a_batch_alike(name):
         assert_same_run(simulate(world, planner, seed, randomise=True, scene=scene), res)
 
 
+def test_runs_whose_brake_counts_the_squares_flush_with_a_wall_run_in_a_batch_as_alone():
+    """A BARN field (seed 2079, the poles unknown) whose top wall runs through its map's free
+    row: the brake's squares flush with it (:func:`.knowledge.wall_faces`) are found for the
+    whole batch at once, and each run keeps the bits it has alone while its robot backs out
+    beside that wall (10-14 s)."""
+    from mitos_cli.sim import barn
+
+    world = dataclasses.replace(barn.world_of(barn.field(2079, *barn.difficulty(2079))),
+                                time_limit=14.0)
+    planner, scene = FuzzyPlanner(None, world.behavior), prepare(world)
+    seeds = [world.seed, world.seed + 1, world.seed + 2]
+    together = run_lockstep(world, planner, seeds, scene=scene)
+    alone = [simulate(world, planner, s, scene=scene) for s in seeds]
+    assert len(Simulation(world, planner, seeds[0], scene=scene)._maps[0].faces)
+    assert any(len(r.backed_out) for r in alone)
+    for a, b in zip(alone, together):
+        assert_same_run(a, b)
+
+
 def test_runs_that_end_at_different_ticks_drop_out_and_the_rest_go_on():
     world = load_world(TINY)
     planner, scene = FuzzyPlanner(None, world.behavior), prepare(world)

@@ -639,3 +639,50 @@ def test_a_fleet_asking_its_maps_round_each_sweeps_box_carries_out_what_it_does_
         assert command.tobytes() == want_command.tobytes()
         assert state.tobytes() == want_state.tobytes()
     assert boxes["inside"] > 100 and boxes["outside"] > 20, boxes
+
+
+SLANT_WALL = """
+name: slant-wall
+dt: 0.05
+time_limit: 30
+substeps: 4
+robot: {{model: tricycle, wheelbase: 13, footprint: {{length: 20, width: 17}}, max_speed: 60,
+        acceleration: 40, max_reverse: 15}}
+sensors: {{layout: ring, count: 36, cone: 15, range: 150, noise: 0}}
+q_init: {{x: 200, y: 20, heading: {heading}}}
+q_goal: {{x: 380, y: 0, tolerance: 4}}
+map:
+  corridors:
+    - points: [[0, 0], [400, 0]]
+      width: {width}
+"""
+
+
+@pytest.mark.parametrize("speed", [15.0, 30.0, -15.0])
+def test_a_robot_driven_aslant_at_a_wall_inside_a_free_cell_of_its_map_stops_short_of_it(
+        tmp_path, speed):
+    """A map drawn from walls frees each cell whose centre lies inside: here the wall
+    (y = 35.58, a corridor 71.16 in wide) runs 1.16 in into the free row that reaches to
+    36.42, so the map shows it 0.84 in too far. The brake keeps its 1 in margin along the
+    arc, which at 17 deg is 0.3 in across it: a robot driving (or backing, as BARN's robots
+    at the end of a backing-out) aslant at the wall touched it. It now also counts squares
+    flush with the walls it is given (:func:`.knowledge.wall_faces`)."""
+    from mitos_cli.sim import Simulation, load_world
+    from mitos_cli.sim.knowledge import RASTER
+
+    path = tmp_path / "slant.yaml"
+    path.write_text(SLANT_WALL.format(heading=17.0 if speed > 0 else -17.0, width=71.16))
+    sim = Simulation(load_world(path), seed=1)
+    grid = sim._maps[0].grid
+    top = 71.16 / 2
+    row = math.floor((top - grid.origin[1]) / RASTER)
+    centre = grid.origin[1] + (row + 0.5) * RASTER
+    assert centre < top and not grid.occupied[row, 30:-30].any()      # the wall's row: free
+    while not sim.done and sim.time < 6.0:
+        sim.step(np.array([[90.0, speed]]))
+    res = sim.result()
+    assert res.outcome != "collision" and res.clearance.min() > 0.0, res.clearance.min()
+    assert res.clearance.min() < 3.0                      # and it came near it
+    faces = sim._maps[0].faces                            # a square flush with the wall
+    flush = faces[np.abs(faces[:, 1] - (top + RASTER / 2)) < 1e-9]
+    assert len(flush) and flush[:, 0].min() < 200.0 < flush[:, 0].max()

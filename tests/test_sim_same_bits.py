@@ -940,6 +940,30 @@ def test_many_maps_near_cells_asked_at_once_are_each_maps_own(monkeypatch, one_g
     assert all(same(cells, m.near(np.array([1.0, 1.0]), 5.0)) for m, cells in zip(two, got))
 
 
+def test_many_maps_brake_cells_asked_at_once_are_each_maps_own():
+    """The brake's cells of runs in lockstep (:func:`.knowledge.brake_cells_all`: the
+    occupied cells, then the squares flush with the given walls) are each map's alone, with
+    the faces shared by the runs of a world, and with a map of another world among them."""
+    rng = np.random.default_rng(12)
+    grid = Grid(np.pad(np.zeros((20, 60), bool), 1, constant_values=True), 2.0, (-2.0, -2.0))
+    walls = np.array([[0.0, 0.0, 120.0, 0.0], [120.0, 39.3, 0.0, 39.3]])
+    faces = knowledge.wall_faces(walls, grid)
+    # only along the wall that runs through free cells (39.3 in the row of 38 to 40), not the
+    # one along the cells' edge (y = 0)
+    assert len(faces) and np.unique(faces[:, 1]).tolist() == [40.3]
+    maps = [knowledge.RobotMap.of(grid, faces) for _ in range(6)]
+    for m in maps:
+        m.mark(rng.uniform(0, 120, (5, 2)), np.tile([1.0, 0.0], (5, 1)))
+    for mixed in (False, True):
+        group = maps + [knowledge.RobotMap.of(grid)] if mixed else maps
+        points = rng.uniform(-10, 130, (len(group), 2))
+        reaches = rng.choice([0.0, 3.0, float(rng.uniform(0, 40))], len(group))
+        got = knowledge.brake_cells_all(group, points, reaches)
+        for m, p, reach, cells in zip(group, points, reaches, got):
+            m._last_near = None
+            assert same(cells, m.brake_cells(p, float(reach)))
+
+
 @pytest.mark.parametrize("rows", [7, 400])             # 400: rows worked in blocks
 def test_distances_from_many_routes_at_once_are_each_routes_own(rows):
     rng = np.random.default_rng(9)

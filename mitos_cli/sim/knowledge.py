@@ -140,6 +140,98 @@ def plan_grid(g: Given, static: StaticMap, world: World) -> Grid:
     return g.grid if g.grid is not None else _raster(static, world, RASTER, free=False)
 
 
+@functools.lru_cache(maxsize=8)
+def faces_of(given: Given, grid: Grid, rastered: bool) -> np.ndarray:
+    """:func:`wall_faces` of the walls ``given`` on ``grid``, where the grid is a raster of
+    walls the robot is given exactly (``rastered``: a map of corridors, ``knows: map``); none
+    where the grid's cells are the map itself. Shared by the runs of a world."""
+    if not rastered or given.knows != "map" or not len(given.walls):
+        return _NO_FACES
+    return wall_faces(given.walls, grid)
+
+
+_NO_FACES = np.zeros((0, 2))
+_NO_FACES.flags.writeable = False
+
+
+def _with_faces(cells: np.ndarray, faces: np.ndarray, y: float, reach: float) -> np.ndarray:
+    """``cells``, then those of ``faces`` (the run of a square's x) within ``reach`` of
+    ``y``."""
+    if not len(faces):
+        return cells
+    keep = np.abs(faces[:, 1] - y) <= reach
+    return np.concatenate([cells, faces[keep]]) if np.count_nonzero(keep) else cells
+
+
+def wall_faces(walls: np.ndarray, grid: Grid) -> np.ndarray:
+    """``[F, 2]``: the centres of squares of the size of ``grid``'s cells laid along each of
+    ``walls [N, 4]`` (x0, y0, x1, y1) on its solid side, flush with it (a square whose sides
+    run along the wall's touches it with a whole side, a slanted one with a corner), where the
+    wall runs through a free cell of the grid; a cell apart (half a cell along a slanted
+    wall), in the order of their x: what the brake counts besides the grid's cells
+    (:meth:`RobotMap.brake_cells`).
+
+    A grid drawn from walls frees every cell whose centre lies on the free side, so a wall
+    may run up to half a cell inside a free cell: the brake, which keeps its margin along the
+    arc, not across it, then let a robot backing out at 17-19 deg toward BARN's corridor wall
+    (which lies 0.84 in inside the map's free row) touch it. Where the wall runs through an
+    occupied cell, or along a cell's edge, that cell covers it and no square is laid. The
+    solid side of a wall is the one whose cell a cell and a half from its middle is occupied
+    while the other's is free (outside the grid counts as occupied); a wall with both or
+    neither (a pole stamped against it) gets no squares."""
+    if not len(walls):
+        return _NO_FACES
+    r = grid.resolution / 2
+    a, b = walls[:, :2], walls[:, 2:]
+    length = np.hypot(*(b - a).T)
+    keep = length > 0
+    a, b, length = a[keep], b[keep], length[keep]
+    along = (b - a) / length[:, None]
+    normal = np.stack([-along[:, 1], along[:, 0]], axis=1)
+    middle = (a + b) / 2
+
+    def blocked(points: np.ndarray) -> np.ndarray:
+        cells = np.floor((points - np.array(grid.origin)) / grid.resolution).astype(np.int64)
+        rows, cols = grid.occupied.shape
+        inside = (cells[:, 0] >= 0) & (cells[:, 0] < cols) & (cells[:, 1] >= 0) \
+            & (cells[:, 1] < rows)
+        out = np.ones(len(points), dtype=bool)
+        out[inside] = grid.occupied[cells[inside, 1], cells[inside, 0]]
+        return out
+
+    left = blocked(middle + normal * (3 * r))
+    right = blocked(middle - normal * (3 * r))
+    side = np.where(left & ~right, 1.0, np.where(right & ~left, -1.0, 0.0))
+    keep = side != 0
+    a, along, normal, length = a[keep], along[keep], normal[keep] * side[keep, None], length[keep]
+    if not len(a):
+        return _NO_FACES
+    # a square's centre this far beyond the wall touches it and no more
+    off = r * (np.abs(normal[:, 0]) + np.abs(normal[:, 1]))
+    # along each wall from half a cell in from one end to half a cell in from the other, a
+    # cell apart along a wall that runs with the grid (they tile it), half a cell along a
+    # slanted one (whose squares touch it at a corner each)
+    step = np.where(np.minimum(np.abs(normal[:, 0]), np.abs(normal[:, 1])) < 1e-9, 2 * r, r)
+    count = np.maximum(np.ceil((length - 2 * r) / step - 1e-9).astype(np.int64), 0) + 1
+    wall = np.repeat(np.arange(len(a)), count)
+    k = np.arange(len(wall)) - np.repeat(np.cumsum(count) - count, count)
+    span = np.maximum(length - 2 * r, 0.0)[wall]
+    s = np.where(count[wall] > 1, r + span * k / np.maximum(count[wall] - 1, 1),
+                 length[wall] / 2)
+    on = a[wall] + along[wall] * s[:, None]                # on the wall
+    # needed only where the wall runs through a free cell (a hair beyond it, there or half a
+    # cell along): where it runs through an occupied one, or along a cell's edge, that cell
+    # covers it already
+    beyond = on + normal[wall] * 1e-6
+    free = ~blocked(beyond)
+    for sign in (1.0, -1.0):
+        free |= ~blocked(beyond + along[wall] * (sign * r))
+    out = (on + normal[wall] * off[wall, None])[free]
+    out = out[np.lexsort((out[:, 1], out[:, 0]))]         # by x: a square's are one run
+    out.flags.writeable = False
+    return out
+
+
 def _dilated(cells: np.ndarray, reach: int) -> np.ndarray:
     """``[rows + 2 reach, cols + 2 reach]``: whether a cell (row ``i - reach``, column
     ``j - reach``, inside the grid or up to ``reach`` outside it) lies within ``reach`` cells
@@ -210,13 +302,30 @@ class RobotMap:
     _last_near: tuple | None = field(default=None, repr=False)     # see near()
     _decoded: tuple | None = field(default=None, repr=False)   # see _marks_decoded()
     _origin: np.ndarray = field(init=False, repr=False)        # the grid's origin, [2]
+    faces: np.ndarray = field(default_factory=lambda: _NO_FACES, repr=False)
+    # [F, 2] squares flush with the walls it is given, for the brake (wall_faces), by x
+    _faces_x: np.ndarray = field(init=False, repr=False)      # their x, [F] (contiguous)
 
     def __post_init__(self) -> None:
         self._origin = np.array(self.grid.origin, float)
+        self._faces_x = np.ascontiguousarray(self.faces[:, 0])
 
     @classmethod
-    def of(cls, grid: Grid) -> RobotMap:
-        return cls(grid, grid.occupied.copy())
+    def of(cls, grid: Grid, faces: np.ndarray | None = None) -> RobotMap:
+        return cls(grid, grid.occupied.copy(), faces=_NO_FACES if faces is None else faces)
+
+    def brake_cells(self, p: np.ndarray, reach: float) -> np.ndarray:
+        """What the brake counts round ``p`` (the square of half side ``reach``): the
+        occupied cells (:meth:`near`), then the :attr:`faces` whose centres lie in the
+        square."""
+        cells = self.near(p, reach)
+        faces = self.faces
+        if not len(faces):
+            return cells
+        x, y = float(p[0]), float(p[1])
+        lo = int(self._faces_x.searchsorted(x - reach, side="left"))
+        hi = int(self._faces_x.searchsorted(x + reach, side="right"))
+        return _with_faces(cells, faces[lo:hi], y, reach)
 
     def accounted(self, points: np.ndarray, reach: int = 2) -> np.ndarray:
         """Which points ``[P, 2]`` lie within ``reach`` cells of a cell the robot's route was
@@ -426,6 +535,26 @@ def near_all(maps: list[RobotMap], points: np.ndarray, reaches: np.ndarray,
     centres.flags.writeable = False                  # (as near's)
     ends = np.cumsum(np.bincount(k, minlength=len(maps))).tolist()
     return [centres[a:b] for a, b in zip([0, *ends[:-1]], ends)]
+
+
+def brake_cells_all(maps: list[RobotMap], points: np.ndarray,
+                    reaches: np.ndarray) -> list[np.ndarray]:
+    """``[m.brake_cells(p, reach) for ...]`` of ``maps`` round ``points [R, 2]`` with
+    ``reaches [R]``: :func:`near_all`, then each map's faces in its square (the same cells
+    in the same order, the same comparisons: the same bits as one by one)."""
+    cells = near_all(maps, points, reaches)
+    faces = maps[0].faces if maps else _NO_FACES
+    if not len(faces) and all(not len(m.faces) for m in maps):
+        return cells
+    if not all(m.faces is faces for m in maps):
+        return [c if not len(m.faces) else m.brake_cells(p, reach)
+                for c, m, p, reach in zip(cells, maps, points, reaches)]
+    x, half = points[:, 0], np.asarray(reaches, float)
+    along = maps[0]._faces_x
+    lo = along.searchsorted(x - half, side="left").tolist()
+    hi = along.searchsorted(x + half, side="right").tolist()
+    return [_with_faces(c, faces[a:b], y, reach)
+            for c, a, b, y, reach in zip(cells, lo, hi, points[:, 1].tolist(), half.tolist())]
 
 
 #: The fewest maps whose windows :func:`near_all` gathers in one copy (:func:`_windows`); fewer

@@ -495,7 +495,8 @@ class Simulation:
         self._replanned: list[tuple[int, int, Route]] = []
         grid = self.scene.plan_grid or knowledge.plan_grid(self._given, self.scene.static,
                                                            self.world)
-        self._maps = [knowledge.RobotMap.of(grid) for _ in range(n)]
+        faces = knowledge.faces_of(self._given, grid, self.scene.static.grid is None)
+        self._maps = [knowledge.RobotMap.of(grid, faces) for _ in range(n)]
         self._trackers = [movers.Tracker() for _ in range(n)]
         ring = self.world.sensors.layout == "ring"
         self._free = [movers.FreeSpace.of(self.angles, ring, self.dt, grid.resolution)
@@ -1169,7 +1170,8 @@ class Simulation:
         maps = [self._maps[i] for i in rows.tolist()]
 
         def near(j: np.ndarray, points: np.ndarray, half: np.ndarray) -> list[np.ndarray]:
-            return [maps[k].near(p, r) for k, p, r in zip(j.tolist(), points, half.tolist())]
+            return [maps[k].brake_cells(p, r) for k, p, r in zip(j.tolist(), points,
+                                                                 half.tolist())]
 
         now = (self._x, self._y, self._h, self._steer, self._v, s.inputs["heading"])
         for i in fleet.guard(rows, s.command, self._recovery, now, near):
@@ -1739,8 +1741,8 @@ class Batch:
         maps = self.maps if len(rows) == len(self.maps) else [self.maps[i] for i in rows.tolist()]
 
         def near(j: np.ndarray, points: np.ndarray, half: np.ndarray) -> list[np.ndarray]:
-            return knowledge.near_all(maps if len(j) == len(maps) else
-                                      [maps[k] for k in j.tolist()], points, half)
+            return knowledge.brake_cells_all(maps if len(j) == len(maps) else
+                                             [maps[k] for k in j.tolist()], points, half)
 
         x, y, h = self._ticked()
         v, steer = self._drive
