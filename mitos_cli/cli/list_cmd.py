@@ -80,8 +80,8 @@ def first_sentence(text: str) -> str:
 
 
 def shorten(description: str, width: int = TEXT_WIDTH) -> str:
-    """A world's or lesson's ``description`` as the text listing prints it: whole up to ``width`` characters, else
-    cut at the last word that fits, with `` ...``."""
+    """A world's or lesson's ``description`` as the text listing prints it: whole up to
+    ``width`` characters, else cut at the last word that fits, with `` ...``."""
     if len(description) <= width:
         return description
     cut = description[:width - 3].rsplit(" ", 1)[0].rstrip(",;:")
