@@ -538,6 +538,18 @@ def _unknown_command(line: str, text: str, path: str, lineno: int) -> RuleSyntax
             span=Span.in_text(text, path, lineno, column, column + len(word)),
             expected="`at START [to END]` before one of the instructions " + INSTRUCTION_LIST,
             hint="`simulate WORLD` records a run; `help at` says more")
+    rest = line[match.end():].lstrip()
+    if rest.startswith("=") or rest.split()[:1] == ["is"]:
+        # `steering is very LM` or `speed=20` alone (the session knows which names are
+        # outputs; the parser does not, so the forms are named, not one to type)
+        said = " ".join(line.split())
+        return RuleSyntaxError(
+            f"unknown command `{word}`: `{said}` alone is neither a rule nor a correction",
+            span=Span.in_text(text, path, lineno, column, column + len(word)),
+            expected=f"a rule (`if ... then {said}`), or a correction (`at TIME {said}`, "
+                     f"`correct NAME=VALUE ... -> {said}`)",
+            hint="`at 12.5s ...` corrects the run `simulate WORLD` recorded; `help at` and "
+                 "`help correct` say more")
     return RuleSyntaxError(f"unknown command `{word}`",
                            span=Span.in_text(text, path, lineno, column, column + len(word)),
                            expected="a rule (`if ... then ...`, or `LABEL: if ...`) or one of "
