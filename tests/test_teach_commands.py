@@ -119,6 +119,9 @@ def test_rule_lines_are_rules_of_the_rule_language():
      "`help at` and `help correct` say more"),
     ("speed = 20", "unknown command `speed`: `speed = 20` alone is neither a rule nor a "
      "correction", "`correct NAME=VALUE ... -> speed = 20`", None),
+    # a rule without its `if` (also the second line of a wrapped rule after Ctrl-C)
+    ("size is SMALL_SZ then speed is SLOW", "unknown command `size`: a rule begins with `if`",
+     "`if CONDITION then ACTION`", "`if size is SMALL_SZ then speed is SLOW`"),
     # a target takes only the hedges that move a value along its scale
     ("at 1s to 2s steering is vry LM", "unexpected `LM`", None,
      "`vry` is not a hedge (hedges of a target: very, extremely, somewhat, more_or_less); "

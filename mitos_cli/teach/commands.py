@@ -539,10 +539,18 @@ def _unknown_command(line: str, text: str, path: str, lineno: int) -> RuleSyntax
             expected="`at START [to END]` before one of the instructions " + INSTRUCTION_LIST,
             hint="`simulate WORLD` records a run; `help at` says more")
     rest = line[match.end():].lstrip()
+    said = " ".join(line.split())
+    if rest.split()[:1] == ["is"] and "then" in rest.split():
+        # `size is SMALL_SZ then speed is SLOW`: a rule without its `if` (the second line of
+        # a wrapped rule whose first was dropped by Ctrl-C reads so too)
+        return RuleSyntaxError(
+            f"unknown command `{word}`: a rule begins with `if`",
+            span=Span.in_text(text, path, lineno, column, column + len(word)),
+            expected="a rule (`if CONDITION then ACTION`, or `LABEL: if ...`)",
+            hint=f"`if {said}`")
     if rest.startswith("=") or rest.split()[:1] == ["is"]:
         # `steering is very LM` or `speed=20` alone (the session knows which names are
         # outputs; the parser does not, so the forms are named, not one to type)
-        said = " ".join(line.split())
         return RuleSyntaxError(
             f"unknown command `{word}`: `{said}` alone is neither a rule nor a correction",
             span=Span.in_text(text, path, lineno, column, column + len(word)),
