@@ -68,8 +68,9 @@ class Completer:
     def target_words(self, line: str, tokens: list[str], outputs: list[str]) -> list[str]:
         """The words that go on a target (``correct ... ->`` or ``at TIME``): an output's
         terms after its ``is`` (and a target's hedges), ``and`` after a term, and after ``at
-        TIME [to TIME]`` the outputs and the next word of an instruction (``make a wider
-        turn``). It offered ``steering=`` and ``speed=`` alone, also after ``steering is``."""
+        TIME [to TIME]`` the outputs (``steering=``) and the next word of an instruction
+        (``make a wider turn``). It offered ``steering=`` and ``speed=`` alone, also after
+        ``steering is``."""
         rb = self.session.rulebase
         back = tokens if line.endswith(" ") else tokens[:-1]
         prev = back[-1] if back else ""
@@ -81,14 +82,14 @@ class Completer:
                 and back[-2] in HEDGE_STEPS:
             return ["and"]                                      # after a target's term
         if prev == "and" or prev == "->":
-            return [f"{o}=" for o in outputs] + outputs
+            return [f"{o}=" for o in outputs]           # (`st<tab>`: `steering=` at once)
         if back[:1] != ["at"]:
             return []
         # `at T`, `at T to T2`, then the outputs or the words of an instruction
         said = back[4:] if len(back) >= 4 and back[2] == "to" else back[2:]
         if len(back) < 2 or (len(back) == 3 and back[2] == "to"):
             return []                                           # a time goes here
-        words = [] if said else [f"{o}=" for o in outputs] + outputs
+        words = [] if said else [f"{o}=" for o in outputs]
         if len(back) == 2:
             words.append("to")
         for phrase in INSTRUCTIONS:
