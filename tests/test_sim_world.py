@@ -211,6 +211,34 @@ def test_a_goal_in_an_unknown_cell_says_so_and_how_to_read_it_free(tmp_path: Pat
         load_world(path)                            # black there: a wall, as before
 
 
+def test_a_start_or_goal_in_a_wall_of_a_map_is_offered_the_nearest_point_with_room(
+        tmp_path: Path):
+    """On a user's own map nothing says which coordinates are free, and the world cannot be
+    drawn until it loads: "lies inside a wall, move it into a corridor" left the user to guess.
+    The hint names the nearest point where the robot has room turned any way, and that point
+    loads."""
+    path = _free_map(tmp_path)
+    pixels = bytearray([254]) * 120 * 120
+    for row in range(120):                          # x 0 to 80 in: a wall; free beyond
+        pixels[row * 120:row * 120 + 80] = bytes([0]) * 80
+    (tmp_path / "map.pgm").write_bytes(b"P5 120 120 255\n" + bytes(pixels))
+    text = path.read_text().replace("q_goal: {x: 300, y: 0}", "q_goal: {x: 100, y: 30}")
+    for start in ("{x: 30, y: 60", "{x: 79, y: 100", "{x: 85, y: 60"):   # in the wall, at it
+        path.write_text(text.replace("q_init: {x: 30, y: 60", "q_init: " + start))
+        with pytest.raises(WorldError) as info:
+            load_world(path)
+        found = re.search(r"the nearest point with room for the robot turned any way: "
+                          r"\((-?\d+), (-?\d+)\)", info.value.hint or "")
+        assert found, info.value.render()
+        x, y = int(found.group(1)), int(found.group(2))
+        assert 80 + 15 <= x <= 120 - 15 and 15 <= y <= 120 - 15    # half the diagonal: 15
+        path.write_text(text.replace("q_init: {x: 30, y: 60", f"q_init: {{x: {x}, y: {y}"))
+        assert load_world(path).agents[0].start.x == x            # the point offered loads
+    # a map of corridors has no grid to look in: the hint stays as it was
+    assert "move it into a corridor" in error(BASE.replace("q_init: {x: 30, y: 0",
+                                                           "q_init: {x: 30, y: 100"))
+
+
 def test_a_start_whose_body_reaches_into_grey_says_so(tmp_path: Path):
     """A body reaching into the grey (unknown) part of a map was said to reach "into a wall";
     black there, it still is."""

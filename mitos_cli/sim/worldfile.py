@@ -795,13 +795,16 @@ def check_free(world: World, spans: list[tuple[Span, Span]]) -> StaticMap:
                                      hint="check the map's `origin` and `resolution` (metres, "
                                           "in its YAML) and the point (inches)")
                 grey = _unknown_cell(world, p.x, p.y)
+                room = _nearest_room(static, agent, p.x, p.y)
                 if grey is not None:
                     raise WorldError(f"the {what}{who} at ({p.x:g}, {p.y:g}) {grey}", span=span,
-                                     hint="move it where the map is free, or write `unknown: "
-                                          "free` under `map:` to read unknown cells as free")
+                                     hint=f"move it where the map is free{room}, or write "
+                                          "`unknown: free` under `map:` to read unknown cells "
+                                          "as free")
                 raise WorldError(f"the {what}{who} at ({p.x:g}, {p.y:g}) lies inside a wall",
                                  span=span, hint=_units_hint(world, agent)
-                                 or "move it into a corridor (free space)")
+                                 or (f"move it where the map is free{room}" if room else
+                                     "move it into a corridor (free space)"))
             # a moving obstacle leaves the goal (as `randomise` may move one over it); over
             # the start it is there at the first tick
             hit = _obstacle_at(world, p.x, p.y, still=what.startswith("goal"))
@@ -812,6 +815,38 @@ def check_free(world: World, spans: list[tuple[Span, Span]]) -> StaticMap:
         _check_body(world, agent, static, s_span)
         _check_goal_room(world, agent, static, g_span)
     return static
+
+
+def _nearest_room(static, agent, x: float, y: float) -> str:
+    """Where a start or goal given in a wall of a grid map might go instead: ``` (the nearest
+    point with room for the robot turned any way: (812, -340))``, the nearest whole-inch point
+    whose distance to every occupied (or unknown) cell leaves the robot's half diagonal and
+    its safety margin. A user's own map gives no hint of which coordinates are free (an
+    office map is mostly wall and unknown), and the world cannot be drawn until it loads.
+    Empty for a map of corridors (which says "move it into a corridor"), or where no cell
+    has that much room."""
+    import numpy as np
+
+    from .distance import distance_transform
+
+    g = static.grid
+    if g is None:
+        return ""
+    r = agent.robot
+    # cell centres measure to cell centres: a wall's edge lies up to half a cell's diagonal
+    # nearer, and a point rounded to whole inches up to 0.71 in further
+    need = math.hypot(r.length, r.width) / 2 + r.safety_margin + g.resolution + 1.0
+    # beyond the map's edge is solid: a border of occupied cells round it
+    blocked = np.pad(g.occupied, 1, constant_values=True)
+    dist = distance_transform(blocked, g.resolution, cap=need + g.resolution)[1:-1, 1:-1]
+    rows, cols = np.nonzero(dist >= need)
+    if not len(rows):
+        return ""
+    cx = g.origin[0] + (cols + 0.5) * g.resolution
+    cy = g.origin[1] + (rows + 0.5) * g.resolution
+    i = int(np.argmin((cx - x) ** 2 + (cy - y) ** 2))
+    return (f" (the nearest point with room for the robot turned any way: "
+            f"({cx[i]:.0f}, {cy[i]:.0f}))")
 
 
 #: in: how far apart the points of a goal's disc are looked at at most, and in how many
@@ -1193,11 +1228,12 @@ def _check_body(world: World, agent, static, span: Span) -> None:
         raise WorldError(f"{where} an unknown cell of the map `{Path(lenient.grid.source).name}` "
                          "(grey, between its free_thresh and occupied_thresh), which counts as "
                          "a wall", span=span,
-                         hint="move the start further from the grey, or write `unknown: free` "
+                         hint=f"move the start further from the grey"
+                              f"{_nearest_room(static, agent, x, y)}, or write `unknown: free` "
                               "under `map:` to read unknown cells as free")
     raise WorldError(f"{where} a wall", span=span,
-                     hint=_units_hint(world, agent) or "move the start further from the wall, "
-                                                       "or turn it along the corridor")
+                     hint=_units_hint(world, agent) or "move the start further from the wall"
+                     f"{_nearest_room(static, agent, x, y)}, or turn it along the corridor")
 
 
 def _touches(static, x: float, y: float, h: float, hl: float, hw: float) -> bool:
