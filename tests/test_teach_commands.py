@@ -103,6 +103,14 @@ def test_rule_lines_are_rules_of_the_rule_language():
      "`at 13s to 14.5s turn harder`"),
     ("correct heading=-5 -> go faster", "unexpected `faster`", "`is`",
      "a target reads `OUTPUT=VALUE` or `OUTPUT is TERM`; a relative instruction"),
+    # an instruction said as a term after `is`: "unexpected `harder`, expected `and`" alone
+    ("correct heading=-5 -> steering is turn harder", "unexpected `harder`",
+     "`and` or the end of the line", "`turn harder` is an instruction, not a term: say it "
+     "alone after the window, `at 13s to 14.5s turn harder`, not after inputs"),
+    ("at 13s to 14.5s steering is make a wider turn", "unexpected `a`", None,
+     "`make a wider turn` is an instruction, not a term: say it alone after the window, "
+     "`at 13s to 14.5s make a wider turn`"),
+    ("at 12s speed is slow down", "unexpected `down`", None, "`at 12s slow down`"),
     # a bare instruction: it is no command; the window, and the list
     ("turn harder", "unknown command `turn`: an instruction takes a window of the recorded "
      "run, `at 13s to 14.5s turn harder`", "`turn harder`, `turn less`, `make a wider turn`, "

@@ -720,6 +720,16 @@ def _teach_hint(text: str, token: Token, before: list[str]) -> str | None:
     if before[-2:] == ["is", "not"] and ("->" in before or before[:1] == ["at"]):
         return ("a target is a term, with hedges if need be (`steering is very LM`); `not` says "
                 "what it should not be, which is no target")
+    if ("->" in before or before[:1] == ["at"]) and "is" in before:
+        # `-> steering is turn harder`: an instruction said as a term (it was "unexpected
+        # `harder`, expected `and`", as if `turn` were a term of steering)
+        after = before[len(before) - before[::-1].index("is"):] + [str(token.value)]
+        said = starts_instruction(after) if len(after) > 1 else None
+        if said is not None:
+            where = ("`at 13s to 14.5s " if before[:1] != ["at"] else
+                     "`" + " ".join(before[:before.index("is") - 1]) + " ")
+            return (f"`{said}` is an instruction, not a term: say it alone after the window, "
+                    f"{where}{said}`" + (", not after inputs" if "->" in before else ""))
     if "->" in before or before[:1] == ["at"]:            # targets: the hedges they take
         return _hedge_hint(text, token, tuple(HEDGE_STEPS))
     return _hedge_hint(text, token)                      # a rule's condition: any hedge
