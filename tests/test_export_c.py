@@ -131,8 +131,9 @@ def run_c_status(c, X: np.ndarray, tmp_path: Path) -> tuple[np.ndarray, np.ndarr
     src, drv, exe = tmp_path / "demo.c", tmp_path / "driver.c", tmp_path / "demo"
     src.write_text(to_c(c, "demo", "test"))
     drv.write_text(DRIVER)
+    # -Wmissing-prototypes: an embedded build's usual flag (the export had no prototype)
     built = subprocess.run([CC, "-std=c99", "-O0", "-Wall", "-Wextra", "-pedantic", "-Werror",
-                            "-o", str(exe), str(src), str(drv), "-lm"],
+                            "-Wmissing-prototypes", "-o", str(exe), str(src), str(drv), "-lm"],
                            capture_output=True, text=True)
     assert built.returncode == 0, built.stderr
     rows = "\n".join(" ".join(repr(float(v)) for v in row) for row in X)
