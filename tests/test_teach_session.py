@@ -343,6 +343,18 @@ def test_every_command_of_the_table_has_help():
     assert "operators: and = product" in SUMMARY
 
 
+def test_help_on_an_instruction_or_a_target_is_the_help_that_holds_it():
+    """`help turn` (an instruction's first word, as `turn harder`) was "unknown help topic"."""
+    from mitos_cli.teach.help import help_text
+    from mitos_cli.teach.instructions import INSTRUCTIONS
+
+    for phrase in INSTRUCTIONS:
+        assert help_text(phrase.split()[0]) == help_text("at")
+    assert "make a wider turn" in help_text("turn")
+    for word in ("target", "targets", "hedges"):
+        assert help_text(word) == help_text("correct")
+
+
 def test_simulate_and_at_and_their_mistakes(rules, tmp_path):
     s, out = session(rules)
     s.run("use drive")
