@@ -499,6 +499,10 @@ def test_python_export_checks_its_values_and_hints_a_swap(tmp_path: Path) -> Non
     with pytest.raises(ValueError, match=r"X must be 2-D, one row of 3 inputs per sample "
                                          r"\(X\[n, 3\]\), not of shape \(2, 3, 3\)$"):
         module.evaluate(np.zeros((2, 3, 3)))
+    # as the library says it (it said the columns wanted, not the number given)
+    with pytest.raises(ValueError, match=r"^expected 3 input columns \(road, size, position\), "
+                                         r"not 2$"):
+        module.evaluate([[78, 45]])
     for X in ([[True, 45, 4]], np.ones((2, 3), dtype=bool), np.array([[78, False, 4]], dtype=object),
               (78.0, 45.0, np.True_)):
         with pytest.raises(TypeError, match=r"X must hold numbers, not bools"):
