@@ -1267,3 +1267,40 @@ def test_a_term_set_named_as_a_world_is_said_to_be_one():
     assert "mitos plot terms" in info.value.hint
     with pytest.raises(WorldError, match="unknown key `variables`"):   # a world with it
         parse_world(BASE + "variables: {}\n", "w.yaml")
+
+
+def test_the_nearest_point_with_room_is_the_whole_maps_nearest():
+    """The windowed search (a window round the point, widened until the nearest cell with
+    room lies inside it) finds a cell as near as the distance transform of the whole map."""
+    import math
+    from types import SimpleNamespace
+
+    from mitos_cli.sim.distance import distance_transform
+    from mitos_cli.sim.worldfile import _nearest_room
+
+    rng = np.random.default_rng(5)
+    res = 0.05 / 0.0254                                  # 5 cm cells, in inches
+    agent = SimpleNamespace(robot=SimpleNamespace(length=24.0, width=18.0, safety_margin=2.0))
+    need = math.hypot(24, 18) / 2 + 2 + res + 1.0
+    for trial in range(12):
+        rows, cols = rng.integers(20, 400, size=2)
+        occupied = rng.random((rows, cols)) < rng.choice([0.001, 0.01, 0.05])
+        grid = SimpleNamespace(occupied=occupied, origin=(-30.0, 12.0), resolution=res)
+        static = SimpleNamespace(grid=grid)
+        x = -30 + rng.uniform(0, cols * res)
+        y = 12 + rng.uniform(0, rows * res)
+        said = _nearest_room(static, agent, x, y)
+        dist = distance_transform(np.pad(occupied, 1, constant_values=True), res)[1:-1, 1:-1]
+        ok_r, ok_c = np.nonzero(dist >= need)
+        if not len(ok_r):
+            assert said == ""
+            continue
+        centres = np.stack([-30 + (ok_c + 0.5) * res, 12 + (ok_r + 0.5) * res], axis=1)
+        best = np.min(np.hypot(centres[:, 0] - x, centres[:, 1] - y))
+        found = re.search(r"\((-?\d+), (-?\d+)\)\)$", said)
+        assert found, said
+        px, py = float(found.group(1)), float(found.group(2))
+        col, row = int((px + 30) // res), int((py - 12) // res)
+        assert dist[row, col] >= need                      # the point's cell has room
+        got = math.hypot(-30 + (col + 0.5) * res - x, 12 + (row + 0.5) * res - y)
+        assert got == pytest.approx(best, abs=1e-9), trial

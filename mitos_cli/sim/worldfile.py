@@ -827,7 +827,7 @@ def _nearest_room(static, agent, x: float, y: float) -> str:
     has that much room."""
     import numpy as np
 
-    from .distance import distance_transform
+    from .distance import squared_distances
 
     g = static.grid
     if g is None:
@@ -836,17 +836,39 @@ def _nearest_room(static, agent, x: float, y: float) -> str:
     # cell centres measure to cell centres: a wall's edge lies up to half a cell's diagonal
     # nearer, and a point rounded to whole inches up to 0.71 in further
     need = math.hypot(r.length, r.width) / 2 + r.safety_margin + g.resolution + 1.0
-    # beyond the map's edge is solid: a border of occupied cells round it
-    blocked = np.pad(g.occupied, 1, constant_values=True)
-    dist = distance_transform(blocked, g.resolution, cap=need + g.resolution)[1:-1, 1:-1]
-    rows, cols = np.nonzero(dist >= need)
-    if not len(rows):
-        return ""
-    cx = g.origin[0] + (cols + 0.5) * g.resolution
-    cy = g.origin[1] + (rows + 0.5) * g.resolution
-    i = int(np.argmin((cx - x) ** 2 + (cy - y) ** 2))
+    need_sq = (need / g.resolution) ** 2                     # in cells, squared
+    margin = int(math.ceil(need / g.resolution)) + 1         # cells a distance there can see
+    rows, cols = g.occupied.shape
+    # the point's cell, clipped to the map (a point off it is refused before this is asked)
+    pr = min(max(int((y - g.origin[1]) // g.resolution), 0), rows - 1)
+    pc = min(max(int((x - g.origin[0]) // g.resolution), 0), cols - 1)
+    # a window round the point, widened until the nearest cell with room in it is nearer
+    # than the window's edge (then none outside is nearer): a large map is never measured
+    # whole, and a map whose every cell is far from the point ends at the whole map
+    padded = np.pad(g.occupied, 1, constant_values=True)    # beyond the edge is solid
+    reach = 32
+    while True:
+        r0, r1 = max(pr - reach, 0), min(pr + reach + 1, rows)
+        c0, c1 = max(pc - reach, 0), min(pc + reach + 1, cols)
+        # the window and the margin round it, in the padded map's indices (one more)
+        pr0, pc0 = max(r0 + 1 - margin, 0), max(c0 + 1 - margin, 0)
+        window = padded[pr0:r1 + 1 + margin, pc0:c1 + 1 + margin]
+        top, left = r0 + 1 - pr0, c0 + 1 - pc0
+        sq = squared_distances(window, 1.0, cap=margin)[top:top + r1 - r0, left:left + c1 - c0]
+        found_r, found_c = np.nonzero(sq >= need_sq)
+        whole = r0 == 0 and c0 == 0 and r1 == rows and c1 == cols
+        if len(found_r):
+            d2 = (found_r + r0 - pr) ** 2 + (found_c + c0 - pc) ** 2
+            i = int(np.argmin(d2))
+            if d2[i] <= reach ** 2 or whole:
+                break
+        elif whole:
+            return ""
+        reach *= 4
+    cx = g.origin[0] + (found_c[i] + c0 + 0.5) * g.resolution
+    cy = g.origin[1] + (found_r[i] + r0 + 0.5) * g.resolution
     return (f" (the nearest point with room for the robot turned any way: "
-            f"({cx[i]:.0f}, {cy[i]:.0f}))")
+            f"({cx:.0f}, {cy:.0f}))")
 
 
 #: in: how far apart the points of a goal's disc are looked at at most, and in how many
