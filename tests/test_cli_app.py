@@ -45,6 +45,8 @@ def test_version_is_the_package_version() -> None:
 
     out = run("--version")
     assert out.returncode == 0 and out.stdout == f"mitos {__version__}\n"
+    said = run("version")                # as `git version`: it was "No such command", exit 2
+    assert (said.returncode, said.stdout, said.stderr) == (0, out.stdout, "")
     pyproject = (Path(__file__).parent.parent / "pyproject.toml").read_text()
     assert 'dynamic = ["version"]' in pyproject          # one source: mitos_cli/_version.py
     from importlib.metadata import version

@@ -208,3 +208,23 @@ def test_mitos_help_is_the_help_of_the_command_named(words):
     assert helped.stdout == asked.stdout and "Usage: mitos" in helped.stdout
     wrong = run("help", "simulat")
     assert wrong.returncode == 2 and "Did you mean 'simulate'?" in wrong.stderr
+
+
+@pytest.mark.parametrize("name", sorted(EXAMPLES))
+def test_usage_writes_a_required_argument_by_its_bare_name(name):
+    """Typer wrote `mitos convert [OPTIONS] {FILE}` and `mitos compare [OPTIONS] {WORLDS...}`:
+    braces read as a choice, or as the shell's brace expansion. Click and POSIX write FILE."""
+    cmd = commands()[name]
+    ctx = cmd.make_context(f"mitos {name}", ["--help"], resilient_parsing=True)
+    usage = " ".join(cmd.collect_usage_pieces(ctx))
+    assert "{" not in usage and "}" not in usage, usage
+    assert usage.startswith("[OPTIONS]")
+
+
+def test_usage_of_convert_and_compare():
+    every = commands()
+    for name, expected in [("convert", "[OPTIONS] FILE"), ("export", "[OPTIONS] FILE"),
+                           ("compare", "[OPTIONS] WORLDS...")]:
+        cmd = every[name]
+        ctx = cmd.make_context(f"mitos {name}", ["--help"], resilient_parsing=True)
+        assert " ".join(cmd.collect_usage_pieces(ctx)) == expected

@@ -9,7 +9,7 @@ import json
 import pytest
 
 from mitos_cli.cli.app import main
-from mitos_cli.cli.list_cmd import catalogue, first_comment_line
+from mitos_cli.cli.list_cmd import catalogue, first_comment_line, first_sentence, shorten
 from mitos_cli.resources import packaged_names, resolve
 from mitos_cli.sim.worldfile import load_world, resolve_world_path
 
@@ -70,3 +70,41 @@ def test_an_argument_is_a_usage_error(capsys):
     code, out, err = run_main(["list", "worlds"], capsys)
     assert code == 2 and out == ""
     assert "unexpected extra argument" in err.lower()
+
+
+@pytest.mark.parametrize("text, expected", [
+    ("# One line.\nname: x\n", "One line."),
+    # a sentence over three lines: whole, up to its end
+    ("# goes on\n# in the next line\n# and ends here. Another one\n# follows\n",
+     "goes on in the next line and ends here."),
+    ("# goes on\n# in the next line\n", "goes on in the next line"),
+    # a blank comment line ends the paragraph
+    ("# goes on\n#\n# A new paragraph.\n", "goes on"),
+    ("# A robot. It is given the corridors (its\n# map)\n", "A robot."),
+    ("# a list follows:\n# - one\n", "a list follows:"),
+    ("# Maps (CC0-1.0; see\n# maps/LICENSE.md), at 5 cm. The robot\n",
+     "Maps (CC0-1.0; see maps/LICENSE.md), at 5 cm."),
+    ("name: x\n# a later comment\n", ""),
+    ("", ""),
+])
+def test_first_sentence(text, expected):
+    assert first_sentence(text) == expected
+
+
+def test_json_carries_whole_descriptions_and_the_text_cuts_them(capsys):
+    """`mitos list --json` cut figure4's description at its comment's first line, with "...":
+    JSON is for programs, which get the whole sentence; the text listing cuts at a word."""
+    cat = catalogue()
+    figure4 = next(e for e in cat["worlds"] if e["name"] == "figure4")
+    assert figure4["description"].endswith("a little right of the new corridor's centre line.")
+    for entries in cat.values():
+        for e in entries:
+            assert not e["description"].endswith("..."), e
+    assert shorten("a b c", 100) == "a b c"
+    assert shorten("word " * 30, 20) == "word word word ..."
+    assert len(shorten(figure4["description"])) <= 100
+    code, out, _ = run_main(["list"], capsys)
+    assert code in (0, None)
+    line = next(ln for ln in out.splitlines() if ln.strip().startswith("figure4"))
+    assert line.endswith(" ...") and "centre line" not in line
+    assert "take_opening, mind_the_body, drive" in out      # a rule base's behaviors: whole

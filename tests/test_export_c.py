@@ -131,8 +131,9 @@ def run_c_status(c, X: np.ndarray, tmp_path: Path) -> tuple[np.ndarray, np.ndarr
     src, drv, exe = tmp_path / "demo.c", tmp_path / "driver.c", tmp_path / "demo"
     src.write_text(to_c(c, "demo", "test"))
     drv.write_text(DRIVER)
+    # -Wmissing-prototypes: an embedded build's usual flag (the export had no prototype)
     built = subprocess.run([CC, "-std=c99", "-O0", "-Wall", "-Wextra", "-pedantic", "-Werror",
-                            "-o", str(exe), str(src), str(drv), "-lm"],
+                            "-Wmissing-prototypes", "-o", str(exe), str(src), str(drv), "-lm"],
                            capture_output=True, text=True)
     assert built.returncode == 0, built.stderr
     rows = "\n".join(" ".join(repr(float(v)) for v in row) for row in X)
@@ -498,6 +499,10 @@ def test_python_export_checks_its_values_and_hints_a_swap(tmp_path: Path) -> Non
     with pytest.raises(ValueError, match=r"X must be 2-D, one row of 3 inputs per sample "
                                          r"\(X\[n, 3\]\), not of shape \(2, 3, 3\)$"):
         module.evaluate(np.zeros((2, 3, 3)))
+    # as the library says it (it said the columns wanted, not the number given)
+    with pytest.raises(ValueError, match=r"^expected 3 input columns \(road, size, position\), "
+                                         r"not 2$"):
+        module.evaluate([[78, 45]])
     for X in ([[True, 45, 4]], np.ones((2, 3), dtype=bool), np.array([[78, False, 4]], dtype=object),
               (78.0, 45.0, np.True_)):
         with pytest.raises(TypeError, match=r"X must hold numbers, not bools"):

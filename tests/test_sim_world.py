@@ -211,6 +211,34 @@ def test_a_goal_in_an_unknown_cell_says_so_and_how_to_read_it_free(tmp_path: Pat
         load_world(path)                            # black there: a wall, as before
 
 
+def test_a_start_or_goal_in_a_wall_of_a_map_is_offered_the_nearest_point_with_room(
+        tmp_path: Path):
+    """On a user's own map nothing says which coordinates are free, and the world cannot be
+    drawn until it loads: "lies inside a wall, move it into a corridor" left the user to guess.
+    The hint names the nearest point where the robot has room turned any way, and that point
+    loads."""
+    path = _free_map(tmp_path)
+    pixels = bytearray([254]) * 120 * 120
+    for row in range(120):                          # x 0 to 80 in: a wall; free beyond
+        pixels[row * 120:row * 120 + 80] = bytes([0]) * 80
+    (tmp_path / "map.pgm").write_bytes(b"P5 120 120 255\n" + bytes(pixels))
+    text = path.read_text().replace("q_goal: {x: 300, y: 0}", "q_goal: {x: 100, y: 30}")
+    for start in ("{x: 30, y: 60", "{x: 79, y: 100", "{x: 85, y: 60"):   # in the wall, at it
+        path.write_text(text.replace("q_init: {x: 30, y: 60", "q_init: " + start))
+        with pytest.raises(WorldError) as info:
+            load_world(path)
+        found = re.search(r"the nearest point with room for the robot turned any way: "
+                          r"\((-?\d+), (-?\d+)\)", info.value.hint or "")
+        assert found, info.value.render()
+        x, y = int(found.group(1)), int(found.group(2))
+        assert 80 + 15 <= x <= 120 - 15 and 15 <= y <= 120 - 15    # half the diagonal: 15
+        path.write_text(text.replace("q_init: {x: 30, y: 60", f"q_init: {{x: {x}, y: {y}"))
+        assert load_world(path).agents[0].start.x == x            # the point offered loads
+    # a map of corridors has no grid to look in: the hint stays as it was
+    assert "move it into a corridor" in error(BASE.replace("q_init: {x: 30, y: 0",
+                                                           "q_init: {x: 30, y: 100"))
+
+
 def test_a_start_whose_body_reaches_into_grey_says_so(tmp_path: Path):
     """A body reaching into the grey (unknown) part of a map was said to reach "into a wall";
     black there, it still is."""
@@ -1239,3 +1267,40 @@ def test_a_term_set_named_as_a_world_is_said_to_be_one():
     assert "mitos plot terms" in info.value.hint
     with pytest.raises(WorldError, match="unknown key `variables`"):   # a world with it
         parse_world(BASE + "variables: {}\n", "w.yaml")
+
+
+def test_the_nearest_point_with_room_is_the_whole_maps_nearest():
+    """The windowed search (a window round the point, widened until the nearest cell with
+    room lies inside it) finds a cell as near as the distance transform of the whole map."""
+    import math
+    from types import SimpleNamespace
+
+    from mitos_cli.sim.distance import distance_transform
+    from mitos_cli.sim.worldfile import _nearest_room
+
+    rng = np.random.default_rng(5)
+    res = 0.05 / 0.0254                                  # 5 cm cells, in inches
+    agent = SimpleNamespace(robot=SimpleNamespace(length=24.0, width=18.0, safety_margin=2.0))
+    need = math.hypot(24, 18) / 2 + 2 + res + 1.0
+    for trial in range(12):
+        rows, cols = rng.integers(20, 400, size=2)
+        occupied = rng.random((rows, cols)) < rng.choice([0.001, 0.01, 0.05])
+        grid = SimpleNamespace(occupied=occupied, origin=(-30.0, 12.0), resolution=res)
+        static = SimpleNamespace(grid=grid)
+        x = -30 + rng.uniform(0, cols * res)
+        y = 12 + rng.uniform(0, rows * res)
+        said = _nearest_room(static, agent, x, y)
+        dist = distance_transform(np.pad(occupied, 1, constant_values=True), res)[1:-1, 1:-1]
+        ok_r, ok_c = np.nonzero(dist >= need)
+        if not len(ok_r):
+            assert said == ""
+            continue
+        centres = np.stack([-30 + (ok_c + 0.5) * res, 12 + (ok_r + 0.5) * res], axis=1)
+        best = np.min(np.hypot(centres[:, 0] - x, centres[:, 1] - y))
+        found = re.search(r"\((-?\d+), (-?\d+)\)\)$", said)
+        assert found, said
+        px, py = float(found.group(1)), float(found.group(2))
+        col, row = int((px + 30) // res), int((py - 12) // res)
+        assert dist[row, col] >= need                      # the point's cell has room
+        got = math.hypot(-30 + (col + 0.5) * res - x, 12 + (row + 0.5) * res - y)
+        assert got == pytest.approx(best, abs=1e-9), trial

@@ -899,3 +899,18 @@ def test_a_study_runs_world_paths_and_refuses_loaded_worlds(tmp_path):
         with pytest.raises(InputError, match="world files, not (loaded worlds|one World)") as exc:
             Study(worlds, [Choice("dwa")], runs=1, seed=1)
         assert exc.value.hint == f"give its file: Study([{tiny.path!r}], ...)"
+
+
+def test_an_output_directory_whose_parent_is_missing_is_refused(tmp_path):
+    """`compare -o a/b/study` made every missing directory where `simulate --out`, `convert
+    -o`, `export -o` and `plot -o` refuse a missing one: it makes the last one alone now, and
+    refuses before any run (nothing computed is lost, nothing made by a typo is left)."""
+    out = tmp_path / "a" / "b" / "study"
+    with pytest.raises(StudyError) as exc:
+        run_study(small_study(runs=1), out, workers=1, task_fn=fake_sim)
+    assert exc.value.message == (f"cannot create the output directory `{out}`: "
+                                 f"`{out.parent}` does not exist")
+    assert f"mkdir -p {out.parent}" in exc.value.hint
+    assert not (tmp_path / "a").exists()
+    run_study(small_study(runs=1), tmp_path / "new", workers=1, task_fn=fake_sim)   # one level
+    assert (tmp_path / "new" / "results.csv").is_file()

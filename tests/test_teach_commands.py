@@ -103,13 +103,33 @@ def test_rule_lines_are_rules_of_the_rule_language():
      "`at 13s to 14.5s turn harder`"),
     ("correct heading=-5 -> go faster", "unexpected `faster`", "`is`",
      "a target reads `OUTPUT=VALUE` or `OUTPUT is TERM`; a relative instruction"),
+    # an instruction said as a term after `is`: "unexpected `harder`, expected `and`" alone
+    ("correct heading=-5 -> steering is turn harder", "unexpected `harder`",
+     "`and` or the end of the line", "`turn harder` is an instruction, not a term: say it "
+     "alone after the window, `at 13s to 14.5s turn harder`, not after inputs"),
+    ("at 13s to 14.5s steering is make a wider turn", "unexpected `a`", None,
+     "`make a wider turn` is an instruction, not a term: say it alone after the window, "
+     "`at 13s to 14.5s make a wider turn`"),
+    ("at 12s speed is slow down", "unexpected `down`", None, "`at 12s slow down`"),
     # a bare instruction: it is no command; the window, and the list
     ("turn harder", "unknown command `turn`: an instruction takes a window of the recorded "
      "run, `at 13s to 14.5s turn harder`", "`turn harder`, `turn less`, `make a wider turn`, "
      "`slow down`, `speed up`, `keep further from the wall`, `keep right`", "simulate WORLD"),
     ("make a wider turn", "unknown command `make`: an instruction takes a window of the "
      "recorded run, `at 13s to 14.5s make a wider turn`", "`at START [to END]`", None),
-    ("speed=20", "unknown command `speed`", "one of behavior", None),
+    # a target alone (`at 12.5s steering is very LM` in the README, without its `at`): it
+    # said only "unknown command `steering`", "type `help`"
+    ("speed=20", "unknown command `speed`: `speed=20` alone is neither a rule nor a correction",
+     "a rule (`if ... then speed=20`), or a correction (`at TIME speed=20`, `correct "
+     "NAME=VALUE ... -> speed=20`)", "`at 12.5s ...` corrects the run `simulate WORLD` recorded"),
+    ("steering is  very LM", "unknown command `steering`: `steering is very LM` alone is "
+     "neither a rule nor a correction", "`at TIME steering is very LM`",
+     "`help at` and `help correct` say more"),
+    ("speed = 20", "unknown command `speed`: `speed = 20` alone is neither a rule nor a "
+     "correction", "`correct NAME=VALUE ... -> speed = 20`", None),
+    # a rule without its `if` (also the second line of a wrapped rule after Ctrl-C)
+    ("size is SMALL_SZ then speed is SLOW", "unknown command `size`: a rule begins with `if`",
+     "`if CONDITION then ACTION`", "`if size is SMALL_SZ then speed is SLOW`"),
     # a target takes only the hedges that move a value along its scale
     ("at 1s to 2s steering is vry LM", "unexpected `LM`", None,
      "`vry` is not a hedge (hedges of a target: very, extremely, somewhat, more_or_less); "

@@ -343,6 +343,18 @@ def test_every_command_of_the_table_has_help():
     assert "operators: and = product" in SUMMARY
 
 
+def test_help_on_an_instruction_or_a_target_is_the_help_that_holds_it():
+    """`help turn` (an instruction's first word, as `turn harder`) was "unknown help topic"."""
+    from mitos_cli.teach.help import help_text
+    from mitos_cli.teach.instructions import INSTRUCTIONS
+
+    for phrase in INSTRUCTIONS:
+        assert help_text(phrase.split()[0]) == help_text("at")
+    assert "make a wider turn" in help_text("turn")
+    for word in ("target", "targets", "hedges"):
+        assert help_text(word) == help_text("correct")
+
+
 def test_simulate_and_at_and_their_mistakes(rules, tmp_path):
     s, out = session(rules)
     s.run("use drive")
@@ -1000,3 +1012,38 @@ def test_conditions_actions_and_targets_joined_with_a_comma_say_how_they_are_joi
     with pytest.raises(RuleSyntaxError) as info:
         s.run(line)
     assert info.value.hint == hint
+
+
+def test_show_history_says_an_adaptation_that_stopped_short(monkeypatch):
+    """`show history` read `adapt epochs 100000 (Q 1.616e+04 -> 58.77)` for an adaptation
+    Ctrl-C stopped after 632 epochs: the entry keeps how it stopped and after how many."""
+    from mitos_cli.teach import adapt as adapt_module
+    from mitos_cli.teach.text import history_text
+
+    real = adapt_module.adapt
+
+    def interrupted(*args, **kwargs):
+        result = real(*args, **{**kwargs, "epochs": 2})
+        return dataclasses.replace(result, interrupted=True)
+
+    said: list[str] = []
+    s = Session(default_rulebase_path(), out=said.append)
+    s.run("correct road=78 size=45 position=4 -> steering=60")
+    monkeypatch.setattr(adapt_module, "adapt", interrupted)
+    s.run("adapt epochs 50")
+    entry = s.journal.entries[-1]
+    assert (entry["op"], entry["stopped"], entry["ran"], entry["epochs"]) == \
+        ("adapt", "interrupted", 2, 50)
+    assert history_text(s.journal.entries).splitlines()[-1].endswith(
+        "; interrupted after 2 epochs)")
+    monkeypatch.setattr(adapt_module, "adapt", real)
+    s.run("undo")
+    s.run("adapt epochs 5000")                          # one example: it converges
+    entry = s.journal.entries[-1]
+    assert entry["stopped"] == "converged" and 0 < entry["ran"] < 5000
+    assert f"; converged after {entry['ran']:,} epoch" in history_text(s.journal.entries)
+    s.run("undo")
+    s.run("adapt epochs 3")                             # all the epochs asked: as before
+    assert "stopped" not in s.journal.entries[-1]
+    last = history_text(s.journal.entries).splitlines()[-1]
+    assert "adapt epochs 3   (Q " in last and ";" not in last

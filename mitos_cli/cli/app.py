@@ -107,6 +107,8 @@ def _main(argv: list[str] | None) -> None:
     args = sys.argv[1:] if argv is None else list(argv)
     if args[:1] == ["help"]:        # `mitos help`, `mitos help plot terms`: as git's and pip's
         args = [*args[1:], "--help"]    # (it said "No such command 'help'", exit 2)
+    if args == ["version"]:         # `mitos version`, as `git version` (it was "No such command")
+        args = ["--version"]
     first = args[0] if args else None
     app = build_app(first if first in COMMANDS else None)
     try:

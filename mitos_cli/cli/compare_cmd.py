@@ -55,7 +55,8 @@ def compare_command(
         help="Seed of the whole study (runs are paired across choices).")] = 1,
     out: Annotated[str, typer.Option(
         "--out", "-o", metavar="DIR", callback=named,
-        help="Directory for results.csv, report.md and the plots.")] = "study",
+        help="Directory for results.csv, report.md and the plots (made when missing; its "
+             "parent must exist).")] = "study",
     executor: Annotated[str, typer.Option(
         "--executor", metavar="local|dask", autocompletion=complete.executors,
         help="local: a process pool on this machine; dask: dask.distributed.")] = "local",

@@ -1,7 +1,8 @@
 """``mitos list``: the packaged worlds, rule bases, term sets and lessons, a line each.
 
-A world is described by its ``name`` and the first line of its leading comment, a rule base by
-its behaviors, a term set by its variables, a lesson by the first line of its leading comment.
+A world is described by its ``name`` and the first sentence of its leading comment, a rule base
+by its behaviors, a term set by its variables, a lesson by the first sentence of its leading
+comment: whole in ``--json``, cut to a line (with ``...``) in the text listing.
 Each is listed by the name the commands accept (``mitos simulate corridor``, ``--rulebase
 mitos.rules``, ``mitos plot terms drive.terms.yaml``, ``--lesson wider-turn``).
 """
@@ -51,6 +52,45 @@ def first_comment_line(text: str) -> str:
     return ""
 
 
+#: The longest description the text listing prints whole; a longer one is cut at a word.
+TEXT_WIDTH = 100
+
+
+def first_sentence(text: str) -> str:
+    """The first sentence of the comment a file starts with, whole, over as many comment
+    lines as it takes (a blank ``#`` line ends it). Where the first line ends a sentence (or
+    a line ending in ``:`` introduces a list), it is :func:`first_comment_line`."""
+    line = first_comment_line(text)
+    if not line.endswith(" ..."):
+        return line
+    words: list[str] = []
+    for raw in text.splitlines():
+        raw = raw.strip()
+        if not raw:
+            if words:
+                break
+            continue
+        if not raw.startswith("#"):
+            break
+        part = raw.lstrip("#").strip()
+        if not part and words:
+            break
+        if part:
+            words.append(part)
+    paragraph = " ".join(words)
+    end = re.search(r"[.!?](?=\s+[A-Z])", paragraph)
+    return paragraph[:end.end()] if end else paragraph
+
+
+def shorten(description: str, width: int = TEXT_WIDTH) -> str:
+    """A world's or lesson's ``description`` as the text listing prints it: whole up to
+    ``width`` characters, else cut at the last word that fits, with `` ...``."""
+    if len(description) <= width:
+        return description
+    cut = description[:width - 3].rsplit(" ", 1)[0].rstrip(",;:")
+    return cut + " ..."
+
+
 def _world(path: Path) -> dict:
     from ..errors import WorldError
     from ..lang import yamlpos
@@ -59,7 +99,7 @@ def _world(path: Path) -> dict:
     data = yamlpos.load(text, str(path), WorldError)
     name = data.get("name") if isinstance(data, dict) else None
     return {"name": path.stem, "world_name": None if name is None else str(name),
-            "description": first_comment_line(text)}
+            "description": first_sentence(text)}
 
 
 def _rulebase(path: Path) -> dict:
@@ -79,7 +119,7 @@ def _termset(path: Path) -> dict:
 
 def _lesson(path: Path) -> dict:
     return {"name": path.stem,
-            "description": first_comment_line(path.read_text(encoding="utf-8"))}
+            "description": first_sentence(path.read_text(encoding="utf-8"))}
 
 
 def catalogue() -> dict[str, list[dict]]:
@@ -101,7 +141,10 @@ def render(cat: dict[str, list[dict]]) -> str:
             lines.append("")
         lines.append(SECTIONS[key][0])
         for e in entries:
-            description = e["description"] or "(no description)"
+            description = e["description"]
+            if key in ("worlds", "lessons"):            # a sentence; the names stay whole
+                description = shorten(description)
+            description = description or "(no description)"
             if key == "worlds" and e["world_name"] not in (None, e["name"]):
                 description = f"`{e['world_name']}`: {description}"
             lines.append(f"  {e['name'].ljust(width)}  {description}")

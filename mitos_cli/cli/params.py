@@ -162,6 +162,13 @@ class OnceCommand(TyperCommand):
             refuse_repeats(ctx, order)
         return super().parse_args(ctx, args)
 
+    def collect_usage_pieces(self, ctx: Any) -> list[str]:
+        """The usage line's pieces, a required argument written as its bare name (``mitos
+        convert [OPTIONS] FILE``), as Click and POSIX write it: Typer writes it in braces
+        (``{FILE}``), which reads as a choice or shell brace expansion."""
+        return [piece[1:-1] if piece.startswith("{") and piece.endswith("}") else piece
+                for piece in super().collect_usage_pieces(ctx)]
+
 
 def refuse_repeats(ctx: typer.Context, order: list) -> None:
     """A usage error (exit 2) for the first single-value option given twice in ``order``

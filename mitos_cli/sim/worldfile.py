@@ -797,13 +797,16 @@ def check_free(world: World, spans: list[tuple[Span, Span]]) -> StaticMap:
                                      hint="check the map's `origin` and `resolution` (metres, "
                                           "in its YAML) and the point (inches)")
                 grey = _unknown_cell(world, p.x, p.y)
+                room = _nearest_room(static, agent, p.x, p.y)
                 if grey is not None:
                     raise WorldError(f"the {what}{who} at ({p.x:g}, {p.y:g}) {grey}", span=span,
-                                     hint="move it where the map is free, or write `unknown: "
-                                          "free` under `map:` to read unknown cells as free")
+                                     hint=f"move it where the map is free{room}, or write "
+                                          "`unknown: free` under `map:` to read unknown cells "
+                                          "as free")
                 raise WorldError(f"the {what}{who} at ({p.x:g}, {p.y:g}) lies inside a wall",
                                  span=span, hint=_units_hint(world, agent)
-                                 or "move it into a corridor (free space)")
+                                 or (f"move it where the map is free{room}" if room else
+                                     "move it into a corridor (free space)"))
             # a moving obstacle leaves the goal (as `randomise` may move one over it); over
             # the start it is there at the first tick
             hit = _obstacle_at(world, p.x, p.y, still=what.startswith("goal"))
@@ -814,6 +817,60 @@ def check_free(world: World, spans: list[tuple[Span, Span]]) -> StaticMap:
         _check_body(world, agent, static, s_span)
         _check_goal_room(world, agent, static, g_span)
     return static
+
+
+def _nearest_room(static: StaticMap, agent: Agent, x: float, y: float) -> str:
+    """Where a start or goal given in a wall of a grid map might go instead: ``` (the nearest
+    point with room for the robot turned any way: (812, -340))``, the nearest whole-inch point
+    whose distance to every occupied (or unknown) cell leaves the robot's half diagonal and
+    its safety margin. A user's own map gives no hint of which coordinates are free (an
+    office map is mostly wall and unknown), and the world cannot be drawn until it loads.
+    Empty for a map of corridors (which says "move it into a corridor"), or where no cell
+    has that much room."""
+    import numpy as np
+
+    from .distance import squared_distances
+
+    g = static.grid
+    if g is None:
+        return ""
+    r = agent.robot
+    # cell centres measure to cell centres: a wall's edge lies up to half a cell's diagonal
+    # nearer, and a point rounded to whole inches up to 0.71 in further
+    need = math.hypot(r.length, r.width) / 2 + r.safety_margin + g.resolution + 1.0
+    need_sq = (need / g.resolution) ** 2                     # in cells, squared
+    margin = int(math.ceil(need / g.resolution)) + 1         # cells a distance there can see
+    rows, cols = g.occupied.shape
+    # the point's cell, clipped to the map (a point off it is refused before this is asked)
+    pr = min(max(int((y - g.origin[1]) // g.resolution), 0), rows - 1)
+    pc = min(max(int((x - g.origin[0]) // g.resolution), 0), cols - 1)
+    # a window round the point, widened until the nearest cell with room in it is nearer
+    # than the window's edge (then none outside is nearer): a large map is never measured
+    # whole, and a map whose every cell is far from the point ends at the whole map
+    padded = np.pad(g.occupied, 1, constant_values=True)    # beyond the edge is solid
+    reach = 32
+    while True:
+        r0, r1 = max(pr - reach, 0), min(pr + reach + 1, rows)
+        c0, c1 = max(pc - reach, 0), min(pc + reach + 1, cols)
+        # the window and the margin round it, in the padded map's indices (one more)
+        pr0, pc0 = max(r0 + 1 - margin, 0), max(c0 + 1 - margin, 0)
+        window = padded[pr0:r1 + 1 + margin, pc0:c1 + 1 + margin]
+        top, left = r0 + 1 - pr0, c0 + 1 - pc0
+        sq = squared_distances(window, 1.0, cap=margin)[top:top + r1 - r0, left:left + c1 - c0]
+        found_r, found_c = np.nonzero(sq >= need_sq)
+        whole = r0 == 0 and c0 == 0 and r1 == rows and c1 == cols
+        if len(found_r):
+            d2 = (found_r + r0 - pr) ** 2 + (found_c + c0 - pc) ** 2
+            i = int(np.argmin(d2))
+            if d2[i] <= reach ** 2 or whole:
+                break
+        elif whole:
+            return ""
+        reach *= 4
+    cx = g.origin[0] + (found_c[i] + c0 + 0.5) * g.resolution
+    cy = g.origin[1] + (found_r[i] + r0 + 0.5) * g.resolution
+    return (f" (the nearest point with room for the robot turned any way: "
+            f"({cx:.0f}, {cy:.0f}))")
 
 
 #: in: how far apart the points of a goal's disc are looked at at most, and in how many
@@ -1197,11 +1254,12 @@ def _check_body(world: World, agent: Agent, static: StaticMap, span: Span) -> No
         raise WorldError(f"{where} an unknown cell of the map `{Path(lenient.grid.source).name}` "
                          "(grey, between its free_thresh and occupied_thresh), which counts as "
                          "a wall", span=span,
-                         hint="move the start further from the grey, or write `unknown: free` "
+                         hint=f"move the start further from the grey"
+                              f"{_nearest_room(static, agent, x, y)}, or write `unknown: free` "
                               "under `map:` to read unknown cells as free")
     raise WorldError(f"{where} a wall", span=span,
-                     hint=_units_hint(world, agent) or "move the start further from the wall, "
-                                                       "or turn it along the corridor")
+                     hint=_units_hint(world, agent) or "move the start further from the wall"
+                     f"{_nearest_room(static, agent, x, y)}, or turn it along the corridor")
 
 
 def _touches(static: StaticMap, x: float, y: float, h: float, hl: float, hw: float) -> bool:

@@ -348,8 +348,17 @@ class ResultStore:
             raise StudyError(f"`{self.dir}` holds no study to resume (no study.json or "
                              f"results.csv)", hint="check the directory given with -o, or "
                              "leave out --resume to start a study there")
+        parent = self.dir.parent
+        if not there and not parent.is_dir():
+            # the directory alone is made, as every other writer makes only its file: a
+            # mistyped parent (`-o studeis/norms`) made a tree of directories without a word
+            raise StudyError(f"cannot create the output directory `{self.dir}`: `{parent}` "
+                             f"does not exist",
+                             hint=f"create it first (`mkdir -p {shlex.quote(str(parent))}`), "
+                                  f"or choose "
+                                  f"another directory with -o (compare makes the last one)")
         try:
-            self.dir.mkdir(parents=True, exist_ok=True)
+            self.dir.mkdir(exist_ok=True)
         except OSError as exc:
             raise StudyError(f"cannot create the output directory {self.dir}: "
                              f"{exc.strerror or exc}") from None

@@ -546,6 +546,26 @@ def _unknown_command(line: str, text: str, path: str, lineno: int) -> RuleSyntax
             span=Span.in_text(text, path, lineno, column, column + len(word)),
             expected="`at START [to END]` before one of the instructions " + INSTRUCTION_LIST,
             hint="`simulate WORLD` records a run; `help at` says more")
+    rest = line[match.end():].lstrip()
+    said = " ".join(line.split())
+    if rest.split()[:1] == ["is"] and "then" in rest.split():
+        # `size is SMALL_SZ then speed is SLOW`: a rule without its `if` (the second line of
+        # a wrapped rule whose first was dropped by Ctrl-C reads so too)
+        return RuleSyntaxError(
+            f"unknown command `{word}`: a rule begins with `if`",
+            span=Span.in_text(text, path, lineno, column, column + len(word)),
+            expected="a rule (`if CONDITION then ACTION`, or `LABEL: if ...`)",
+            hint=f"`if {said}`")
+    if rest.startswith("=") or rest.split()[:1] == ["is"]:
+        # `steering is very LM` or `speed=20` alone (the session knows which names are
+        # outputs; the parser does not, so the forms are named, not one to type)
+        return RuleSyntaxError(
+            f"unknown command `{word}`: `{said}` alone is neither a rule nor a correction",
+            span=Span.in_text(text, path, lineno, column, column + len(word)),
+            expected=f"a rule (`if ... then {said}`), or a correction (`at TIME {said}`, "
+                     f"`correct NAME=VALUE ... -> {said}`)",
+            hint="`at 12.5s ...` corrects the run `simulate WORLD` recorded; `help at` and "
+                 "`help correct` say more")
     return RuleSyntaxError(f"unknown command `{word}`",
                            span=Span.in_text(text, path, lineno, column, column + len(word)),
                            expected="a rule (`if ... then ...`, or `LABEL: if ...`) or one of "
@@ -708,6 +728,16 @@ def _teach_hint(text: str, token: Token, before: list[str]) -> str | None:
     if before[-2:] == ["is", "not"] and ("->" in before or before[:1] == ["at"]):
         return ("a target is a term, with hedges if need be (`steering is very LM`); `not` says "
                 "what it should not be, which is no target")
+    if ("->" in before or before[:1] == ["at"]) and "is" in before:
+        # `-> steering is turn harder`: an instruction said as a term (it was "unexpected
+        # `harder`, expected `and`", as if `turn` were a term of steering)
+        after = before[len(before) - before[::-1].index("is"):] + [str(token.value)]
+        said = starts_instruction(after) if len(after) > 1 else None
+        if said is not None:
+            where = ("`at 13s to 14.5s " if before[:1] != ["at"] else
+                     "`" + " ".join(before[:before.index("is") - 1]) + " ")
+            return (f"`{said}` is an instruction, not a term: say it alone after the window, "
+                    f"{where}{said}`" + (", not after inputs" if "->" in before else ""))
     if "->" in before or before[:1] == ["at"]:            # targets: the hedges they take
         return _hedge_hint(text, token, tuple(HEDGE_STEPS))
     return _hedge_hint(text, token)                      # a rule's condition: any hedge

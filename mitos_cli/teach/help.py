@@ -105,7 +105,11 @@ quit              leave the prompt (Ctrl-D too). Everything is in the journal un
 }
 ALIASES = {"if": "rule", "rules": "rule", "end": "behavior", "exit": "quit", "terms": "show",
            "unfrozen": "frozen", "instructions": "at",
-           "examples": "show", "history": "show", "behaviors": "show"}
+           "examples": "show", "history": "show", "behaviors": "show",
+           # an instruction's first word (`help turn`: "unknown help topic"), and targets
+           "instruction": "at", "turn": "at", "make": "at", "slow": "at", "speed": "at",
+           "keep": "at", "target": "correct", "targets": "correct", "hedge": "correct",
+           "hedges": "correct"}
 
 
 def help_text(topic: str | None = None) -> str:

@@ -19,6 +19,7 @@ from typing import TYPE_CHECKING
 from ..errors import LessonError, MitosError, Span
 from ..fuzzy.hedges import HEDGES
 from .commands import COMMAND_WORDS, SHOW_WHAT, incomplete
+from .instructions import HEDGE_STEPS, INSTRUCTIONS
 from .session import Session
 from .text import quoted_column
 
@@ -55,8 +56,10 @@ class Completer:
             return [r.label for r in b.rules if r.label]
         if first in ("eval", "correct", "at"):
             inputs = [f"{v.name}=" for v in rb.variables.values() if v.role == "input"]
-            outputs = [f"{v.name}=" for v in rb.variables.values() if v.role == "output"]
-            return outputs if first == "at" or "->" in tokens else inputs + ["->"]
+            outputs = [v.name for v in rb.variables.values() if v.role == "output"]
+            if first == "eval" or (first == "correct" and "->" not in tokens):
+                return inputs + ([] if first == "eval" else ["->"])
+            return self.target_words(line, tokens, outputs)
         # a rule: variables, then `is`, then that variable's terms and hedges
         prev = tokens[-1] if line.endswith(" ") else (tokens[-2] if len(tokens) > 1 else "")
         if prev in ("is", "not", *HEDGES):
@@ -65,6 +68,39 @@ class Completer:
             terms = list(rb.variables[var].term_names) if var else []
             return terms + ["not", *HEDGES]
         return list(rb.variables) + ["is", "and", "or", "not", "then", "with"]
+
+    def target_words(self, line: str, tokens: list[str], outputs: list[str]) -> list[str]:
+        """The words that go on a target (``correct ... ->`` or ``at TIME``): an output's
+        terms after its ``is`` (and a target's hedges), ``and`` after a term, and after ``at
+        TIME [to TIME]`` the outputs (``steering=``) and the next word of an instruction
+        (``make a wider turn``). It offered ``steering=`` and ``speed=`` alone, also after
+        ``steering is``."""
+        rb = self.session.rulebase
+        back = tokens if line.endswith(" ") else tokens[:-1]
+        prev = back[-1] if back else ""
+        if prev == "is" or prev in HEDGE_STEPS:
+            var = next((t for t in reversed(back) if t in outputs), None)
+            terms = list(rb.variables[var].term_names) if var else []
+            return terms + (list(HEDGE_STEPS) if prev == "is" else [])
+        if len(back) >= 2 and back[-2] == "is" or len(back) >= 3 and back[-3] == "is" \
+                and back[-2] in HEDGE_STEPS:
+            return ["and"]                                      # after a target's term
+        if prev == "and" or prev == "->":
+            return [f"{o}=" for o in outputs]           # (`st<tab>`: `steering=` at once)
+        if back[:1] != ["at"]:
+            return []
+        # `at T`, `at T to T2`, then the outputs or the words of an instruction
+        said = back[4:] if len(back) >= 4 and back[2] == "to" else back[2:]
+        if len(back) < 2 or (len(back) == 3 and back[2] == "to"):
+            return []                                           # a time goes here
+        words = [] if said else [f"{o}=" for o in outputs]
+        if len(back) == 2:
+            words.append("to")
+        for phrase in INSTRUCTIONS:
+            parts = phrase.split()
+            if len(parts) > len(said) and parts[:len(said)] == said:
+                words.append(parts[len(said)])
+        return words
 
     def complete(self, text: str, state: int) -> str | None:
         if state == 0:

@@ -870,8 +870,13 @@ class Session:
             self.out(_nothing_changed(history, result.rounded,
                                       self._lower(c, compiled, X, T, rate, history[0])))
             return
+        # an adaptation that stopped short says so in `show history` (it read as all epochs)
+        ran = len(history) - 1 - (1 if result.rounded else 0)
+        stopped = ("interrupted" if result.interrupted else
+                   "converged" if result.converged else None)
         self.change("adapt", line, behavior=compiled.behavior, terms=terms, crisp=crisp,
-                    q=[history[0], history[-1]], epochs=epochs, rate=rate)
+                    q=[history[0], history[-1]], epochs=epochs, rate=rate,
+                    **({"stopped": stopped, "ran": ran} if stopped else {}))
         self.out(text.changed_table(before, self.rulebase, crisp))
         if kept:
             self.out("not adapted: " + "; ".join(kept))

@@ -132,7 +132,11 @@ def history_text(entries: list[dict]) -> str:
             continue
         text = e.get("line") or e["op"]
         if e["op"] == "adapt":
-            text += f"   (Q {e['q'][0]:.4g} -> {e['q'][1]:.4g})"
+            stopped = e.get("stopped")
+            ran = e.get("ran")
+            after = (f"; {stopped} after {plural(ran, 'epoch')}"
+                     if stopped in ("interrupted", "converged") and isinstance(ran, int) else "")
+            text += f"   (Q {e['q'][0]:.4g} -> {e['q'][1]:.4g}{after})"
         if e["op"] == "save":
             text = f"save {e['path']}"
         mark = "  (undone)" if e["seq"] in undone else ""

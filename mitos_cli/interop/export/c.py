@@ -171,7 +171,10 @@ def _c_header(p: Program, P: str, U: str, source: str) -> list[str]:
         out.append(f"#define {U}_IN_{name.upper()} {i}  /* [{lo:g}, {hi:g}] */")
     for j, name in enumerate(unique_idents(c.outputs, str.upper)):
         out.append(f"#define {U}_OUT_{name.upper()} {j}")
-    return out + ["", "#define M_PI_ 3.14159265358979323846", ""]
+    # the prototype, so that `-Wmissing-prototypes` (common in embedded builds, often with
+    # -Werror) passes, and the lines a caller copies into its own header are in one place
+    return out + ["", f"int {P}_eval(const double in[{U}_N_INPUTS], double out[{U}_N_OUTPUTS]);",
+                  "", "#define M_PI_ 3.14159265358979323846", ""]
 
 
 def _c_helpers(p: Program) -> list[str]:
