@@ -75,6 +75,27 @@ def test_mean_interval_small_samples():
     assert one.mean == 5.0 and one.std is None and one.lo is None
 
 
+def test_mean_interval_cut_at_its_floor_only_below_it():
+    """Three runs' replans (0, 4, 4) read [-2.50, 7.84] with a t interval: a count cut at 0."""
+    free = mean_interval([0.0, 4.0, 4.0])
+    assert free.lo is not None and free.lo < 0
+    cut = mean_interval([0.0, 4.0, 4.0], floor=0.0)
+    assert (cut.mean, cut.std, cut.lo, cut.hi) == (free.mean, free.std, 0.0, free.hi)
+    assert mean_interval([10.0, 11.0, 12.0], floor=0.0) == mean_interval([10.0, 11.0, 12.0])
+
+
+def test_study_metrics_that_cannot_be_negative_have_intervals_from_0():
+    from mitos_cli.study.summary import METRICS, NOT_NEGATIVE, Choice, summarize
+
+    rows = [{"outcome": "success", "time_s": t, "path_length_in": 10.0, "min_clearance_in": c,
+             "steering_total_variation_deg": 1.0, "mean_speed_in_s": 5.0, "replans": k,
+             "backouts": 0} for t, c, k in ((1.0, -0.5, 0), (9.0, 0.5, 4), (9.0, 0.2, 4))]
+    s = summarize("w", Choice("fuzzy", "min", "max", "weighted_average"), rows)
+    assert s.metrics["replans"].lo == 0.0 and s.metrics["time_s"].lo == 0.0
+    assert s.metrics["min_clearance_in"].lo is not None and s.metrics["min_clearance_in"].lo < 0
+    assert {f for f, *_ in METRICS} > NOT_NEGATIVE
+
+
 def test_mcnemar_exact():
     assert mcnemar(0, 0) == 1.0
     assert mcnemar(0, 6) == pytest.approx(2 / 64)

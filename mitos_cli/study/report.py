@@ -198,7 +198,8 @@ def render_markdown(manifest: dict, summaries: list[Summary], ranks: list[Rank],
         "",
         "## Outcomes per world and choice",
         "",
-        "Rates with the Wilson 95% interval; metrics as mean ± std [95% t interval]. "
+        "Rates with the Wilson 95% interval; metrics as mean ± std [95% t interval, cut at 0 "
+        "where a metric cannot be negative]. "
         "Columns marked * use successful runs only; minimum clearance, replans and backed "
         "out (times a robot backed out) use all runs.",
         "",

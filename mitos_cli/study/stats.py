@@ -134,8 +134,11 @@ def t_quantile(p: float, df: float) -> float:
     return 0.5 * (lo + hi)
 
 
-def mean_interval(values: Iterable[float | None], level: float = LEVEL) -> Mean:
-    """Mean, sample std (``ddof=1``) and the t interval of the finite ``values``."""
+def mean_interval(values: Iterable[float | None], level: float = LEVEL, *,
+                  floor: float | None = None) -> Mean:
+    """Mean, sample std (``ddof=1``) and the t interval of the finite ``values``; the
+    interval cut at ``floor``, where the values cannot lie below it (so neither can their
+    mean: the cut interval covers it as often)."""
     x = np.asarray([v for v in values if v is not None], dtype=float)
     x = x[np.isfinite(x)]
     n = int(x.size)
@@ -146,4 +149,5 @@ def mean_interval(values: Iterable[float | None], level: float = LEVEL) -> Mean:
         return Mean(1, m, None, None, None)
     s = float(np.std(x, ddof=1))
     half = t_quantile(0.5 + level / 2, n - 1) * s / math.sqrt(n)
-    return Mean(n, m, s, m - half, m + half)
+    lo = m - half if floor is None else max(floor, m - half)
+    return Mean(n, m, s, lo, m + half)

@@ -40,6 +40,13 @@ METRICS = (
     ("backouts", "backed out", "", "all"),
 )
 
+#: The metrics no run can give below 0 (the others: clearance, negative where a body is
+#: inside another): their t intervals are cut at 0, which keeps every interval's coverage
+#: (the true mean cannot lie below 0) and reads as the quantity does. A count of 3 runs read
+#: "replans 2.67 +- 2.08 [-2.50, 7.84]".
+NOT_NEGATIVE = frozenset({"time_s", "path_length_in", "steering_total_variation_deg",
+                          "mean_speed_in_s", "replans", "backouts"})
+
 
 @dataclass(frozen=True)
 class Summary:
@@ -70,7 +77,8 @@ def summarize(world: str, choice: Choice, rows: list[dict]) -> Summary:
     n = len(rows)
     rates = {o: wilson(sum(r["outcome"] == o for r in rows), n) for o in OUTCOMES}
     ok = [r for r in rows if r["outcome"] == "success"]
-    metrics = {f: mean_interval(r[f] for r in (ok if which == "success" else rows))
+    metrics = {f: mean_interval((r[f] for r in (ok if which == "success" else rows)),
+                                floor=0.0 if f in NOT_NEGATIVE else None)
                for f, _label, _unit, which in METRICS}
     return Summary(world, choice, n, rates, metrics)
 
