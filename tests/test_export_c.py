@@ -187,6 +187,26 @@ def test_c_export_operators_hedges_uses(case: dict, tmp_path: Path) -> None:
     agree(run_python(c, X, tmp_path), want)
 
 
+@pytest.mark.parametrize("name", ["mitos.rules", "tipper.fis"])
+def test_python_export_gives_each_row_its_bits_in_any_block(name: str, tmp_path: Path) -> None:
+    """The exported ``evaluate`` works in blocks of ``BLOCK`` rows: 2.5 blocks give each
+    row the bits it gets alone, and a small ``BLOCK`` the bits of one large one."""
+    from mitos_cli.interop.export.python import BLOCK
+
+    path = ROOT / "rulebases" / name if name.endswith(".rules") else DATA / name
+    c = load_rulebase(path).compiled
+    rng = np.random.default_rng(12)
+    lo, hi = c.universe[:, 0], c.universe[:, 1]
+    X = rng.uniform(lo - 0.1 * (hi - lo), hi + 0.1 * (hi - lo), size=(BLOCK * 5 // 2, len(c.inputs)))
+    X[::101, 0] = np.nan
+    module = exported_module(c, tmp_path)
+    whole = module.evaluate(X)
+    rows = np.concatenate([module.evaluate(X[i:i + 1]) for i in range(0, len(X), 997)])
+    assert np.array_equal(whole[::997].view(np.uint64), rows.view(np.uint64))
+    module.BLOCK = 7
+    assert np.array_equal(module.evaluate(X[:500]).view(np.uint64), whole[:500].view(np.uint64))
+
+
 BINARY_FLL = """\
 Engine: b
 InputVariable: x

@@ -178,11 +178,26 @@ def _py_header(p: Program, source: str) -> list[str]:
         "    return np.clip(1.0 + np.minimum((x - b) * s1, (c - x) * s2), 0.0, 1.0)", "", ""]
 
 
+#: Rows the exported ``evaluate`` works on at a time: its arrays of a membership or a rule
+#: (128 KB each) stay in cache. 10^6 rows of the paper's 27 rules took 0.096 s in blocks of
+#: 16,384 against 0.20 s whole (8,192 to 65,536: 0.096-0.102 s; 1,024: 0.22 s); every
+#: operation is per row, so a row gets the same bits in any block.
+BLOCK = 16384
+
+
 def _py_evaluate(p: Program) -> list[str]:
-    """``evaluate(X)``: clamped inputs, one array per membership and per rule, the outputs."""
+    """``evaluate(X)`` over blocks of :data:`BLOCK` rows, and ``_evaluate_block``: clamped
+    inputs, one array per membership and per rule, the outputs."""
     c = p.compiled
-    out = ["def evaluate(X):", '    """Outputs ``Y[n, m]`` for inputs ``X[n, k]``."""',
+    out = [f"BLOCK = {BLOCK}  # rows at a time: a block's arrays stay in cache", "", "",
+           "def evaluate(X):", '    """Outputs ``Y[n, m]`` for inputs ``X[n, k]``."""',
            "    X = _rows(X)",
+           "    Y = np.empty((X.shape[0], len(OUTPUTS)))",
+           "    for i in range(0, X.shape[0], BLOCK):",
+           "        Y[i:i + BLOCK] = _evaluate_block(X[i:i + BLOCK])",
+           "    return Y", "", "",
+           "def _evaluate_block(X):",
+           '    """``evaluate`` of at most ``BLOCK`` rows ``X``, checked."""',
            "    lo = np.array([u[0] for u in UNIVERSE]); hi = np.array([u[1] for u in UNIVERSE])",
            "    x = np.clip(X, lo, hi).T" if c.operators.inputs == "clamped" else
            "    X = np.where(np.isinf(X), np.nan, X)  # not clamped: infinite reads as NaN\n"
