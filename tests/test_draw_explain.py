@@ -138,6 +138,30 @@ def test_study_boxes_have_black_medians(tmp_path, monkeypatch):
     assert len(medians) == 2 and all(ln.get_color() == "black" for ln in medians)
 
 
+def test_a_one_world_clearance_plot_keeps_its_title_and_legend_entries_whole(tmp_path,
+                                                                             monkeypatch):
+    """One world's panel is 4.2 in wide: the title ran off both edges ("m clearance over all
+    runs ... whiskers: 1"), and the legend was wrapped inside an entry ("3: fuzzy" /
+    "and=lukasiewicz")."""
+    from mitos_cli.draw import study
+
+    labels = ["fuzzy and=min", "fuzzy and=product", "fuzzy and=lukasiewicz",
+              "fuzzy and=einstein", "dwa"]
+    rows = [{"world": "w", "min_clearance_in": v, "c": c} for c in labels for v in (1.0, 3.0)]
+    seen = []
+    monkeypatch.setattr(study, "_save", lambda fig, plt, path: seen.append(fig))
+    study.clearance_boxes(rows, ["w"], labels, lambda r: r["c"], tmp_path / "c.png")
+    fig = seen[0]
+    fig.canvas.draw()
+    box = fig._suptitle.get_window_extent()
+    assert box.x0 >= 0 and box.x1 <= fig.bbox.width
+    legend = next(t for t in fig.texts if t is not fig._suptitle).get_text().split("\n")
+    assert [entry for line in legend for entry in line.split("   ")] == [
+        f"{j + 1}: {label}" for j, label in enumerate(labels)]
+    assert study._packed(["1: a b", "2: c d", "3: e"], 15) == ["1: a b   2: c d", "3: e"]
+    assert study._packed(["1: a b", "2: c d", "3: e"], 12) == ["1: a b", "2: c d", "3: e"]
+
+
 def test_study_plots_tell_worlds_of_one_stem_apart(tmp_path, monkeypatch):
     """`a/t.yaml` and `b/t.yaml` were two groups, two panels, both named `t`, where the
     tables name them by their paths."""

@@ -148,16 +148,29 @@ def clearance_boxes(rows: list[dict], worlds: list[str], labels: list[str],
         ax.grid(axis="y", alpha=0.3)
     for k in range(n_w, n_rows * cols):
         axes[k // cols][k % cols].set_visible(False)
-    fig.suptitle("Minimum clearance over all runs (boxes: quartiles; whiskers: 1.5 IQR)",
-                 fontsize=11)
-    legend = "   ".join(f"{j + 1}: {label}" for j, label in enumerate(labels))
+    width, height = fig.get_size_inches()
     # wrapped here: matplotlib's wrap=True measures the text as mathtext whatever parse_math
-    # says, and stops on a `$` in a choice's label
-    legend = textwrap.fill(legend, int(fig.get_size_inches()[0] * 14), break_long_words=False)
-    fig.text(0.5, 0.01, legend, ha="center", fontsize=8)
+    # says, and stops on a `$` in a choice's label; one panel's width cut the title's ends
+    title = textwrap.wrap("Minimum clearance over all runs (boxes: quartiles; whiskers: "
+                          "1.5 IQR)", int(width * 11), break_long_words=False)
+    fig.suptitle("\n".join(title), fontsize=11)
+    legend = _packed([f"{j + 1}: {label}" for j, label in enumerate(labels)], int(width * 14))
+    fig.text(0.5, 0.01, "\n".join(legend), ha="center", fontsize=8)
     literal_text(fig)
-    fig.tight_layout(rect=(0, 0.06, 1, 0.95))
+    fig.tight_layout(rect=(0, (0.1 + 0.13 * len(legend)) / height, 1, 1))   # (and the title)
     return _save(fig, plt, path)
+
+
+def _packed(entries: list[str], width: int) -> list[str]:
+    """``entries`` three spaces apart in lines of at most ``width`` characters, none split
+    across two lines (a line wrapped at any space read "3: fuzzy" / "and=lukasiewicz")."""
+    lines: list[str] = []
+    for entry in entries:
+        if lines and len(lines[-1]) + 3 + len(entry) <= width:
+            lines[-1] += "   " + entry
+        else:
+            lines.append(entry)
+    return lines
 
 
 def _save(fig: Figure, plt: ModuleType, path: str | Path) -> Path:
