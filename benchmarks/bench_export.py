@@ -14,8 +14,12 @@ it times, on the same 10^5 random inputs, best of 5 after a warm-up:
   loop, timed inside the C program with `clock()`),
 - pyfuzzylite 8's vectorized engine on the same system written by MITOS's FLL writer,
 
-after checking that all four compute the same outputs. It also times reading each file (the
-FCL, FIS and FLL readers, parse to checked model) against pyfuzzylite's FLL importer.
+after checking that all four compute the same outputs. Then one sample at a time, as a
+robot's control loop calls them (median of 2,000 calls over the first inputs): MITOS's
+``load_rulebase().evaluate(**inputs)``, the exported module's ``evaluate_one(**inputs)`` (the
+same bits as its ``evaluate`` row, checked on each sample) and pyfuzzylite's ``process()`` on
+scalar values. It also times reading each file (the FCL, FIS and FLL readers, parse to
+checked model) against pyfuzzylite's FLL importer.
 """
 
 from __future__ import annotations
@@ -44,6 +48,7 @@ from mitos_cli.interop.export import to_c, to_python  # noqa: E402
 
 N = 100_000
 REPEATS = 5
+ONE = 2000          # samples timed one at a time
 
 DRIVER = r"""
 #include <stdio.h>
@@ -132,6 +137,7 @@ def bench(label: str, path: Path, tmp: Path) -> None:
         assert np.allclose(theirs, want, rtol=0, atol=1e-9, equal_nan=True)
     t_fl = best_of(run_fl, 3)
 
+    singles = bench_one(rb, module, engine, X[:ONE])
     print(f"\n{label} ({path.relative_to(ROOT)}; {c.n_rules} rules, {c.operators.describe()})")
     print(f"  {'implementation':34s} {'total s':>9s} {'us/sample':>10s} {'vs engine':>10s}")
     for name, t in (("MITOS engine (batch)", t_engine), ("exported NumPy module (batch)", t_python),
@@ -141,6 +147,35 @@ def bench(label: str, path: Path, tmp: Path) -> None:
             print(f"  {name:34s} not timed: no C compiler (cc or gcc) on PATH")
         else:
             print(f"  {name:34s} {t:9.4f} {1e6 * t / N:10.3f} {t_engine / t:9.2f}x")
+    print(f"  {'one sample at a time':34s} {'':>9s} {'us/call':>10s} {'vs engine':>10s}")
+    for name, t in singles.items():
+        print(f"  {name:34s} {'':>9s} {1e6 * t:10.2f} {singles['MITOS evaluate(**inputs)'] / t:9.2f}x")
+
+
+def bench_one(rb, module, engine, X: np.ndarray) -> dict[str, float]:
+    """Median seconds a call, one sample at a time: MITOS, the exported ``evaluate_one`` (its
+    outputs checked against its ``evaluate`` row, bit for bit) and pyfuzzylite on scalars."""
+    rows = [dict(zip(rb.inputs, map(float, x))) for x in X]
+    for row, want in zip(rows, module.evaluate(X)):
+        assert np.array(list(module.evaluate_one(**row).values())).tobytes() == want.tobytes()
+
+    def fl_one(row: dict) -> None:
+        for name, v in row.items():
+            engine.input_variable(name).value = v
+        engine.process()
+
+    calls = {"MITOS evaluate(**inputs)": lambda row: rb.evaluate(**row),
+             "exported evaluate_one(**inputs)": lambda row: module.evaluate_one(**row),
+             "pyfuzzylite 8 process() on scalars": fl_one}
+    out = {}
+    for name, call in calls.items():
+        times = []
+        for row in rows:
+            t0 = time.perf_counter()
+            call(row)
+            times.append(time.perf_counter() - t0)
+        out[name] = float(np.median(times))
+    return out
 
 
 def bench_readers(tmp: Path) -> None:

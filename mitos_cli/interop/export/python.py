@@ -118,6 +118,8 @@ CHECK_VALUES = [
     "",
     "def _value(name, value):",
     '    """One input\'s value as a float: not a bool (read as 1 or 0), not several values."""',
+    "    if isinstance(value, float):   # (NumPy's float64 too; a bool is an int)",
+    "        return float(value)",
     "    if _holds_bool(value):",
     "        raise TypeError(f'evaluate_one() takes numbers, not bools: {name}={value!r} would be '",
     "                        'read as 1 or 0')",
@@ -143,13 +145,100 @@ def to_python(compiled: CompiledRuleBase, source: str = "") -> str:
         out += [f"def hedge_{h}(x):", "    with np.errstate(invalid='ignore'):",
                 f"        return {PY_HEDGES[h]}", "", ""]
     out += _py_evaluate(p)
+    out += _py_row(p)
     out += ["def evaluate_one(**inputs):",
             '    """Outputs by name for one value per input (by name)."""',
             "    _check_names(inputs)",
-            "    row = np.array([[_value(name, inputs[name]) for name in INPUTS]])",
-            "    return dict(zip(OUTPUTS, (float(v) for v in evaluate(row)[0])))", "", "",
+            "    values = [_value(name, inputs[name]) for name in INPUTS]",
+            "    y = None if _evaluate_row is None else _evaluate_row(*values)",
+            "    if y is None:",
+            "        y = evaluate(np.array([values]))[0]",
+            "    return dict(zip(OUTPUTS, (float(v) for v in y)))", "", "",
             *CHECK_NAMES, "", *CHECK_VALUES]
     return "\n".join(out)
+
+
+def _py_row(p: Program) -> list[str]:
+    """``_evaluate_row(x0, ...)``: ``evaluate``'s row for one sample in plain floats, for
+    ``evaluate_one``, whose forty-odd NumPy calls on one row took 130 us (the paper's base).
+    The same operations in the same order give the same bits (IEEE 754 rounds ``+ - * /``
+    and ``sqrt`` alike in Python and NumPy; tests/test_export_python_row.py holds them).
+    ``None`` (for the whole module) where a shape, hedge or join has no exact float form, and
+    from a call whose input is NaN or, not clamped, outside its universe: ``evaluate`` then."""
+    c = p.compiled
+    ops = c.operators
+    hedges = [h for h in p.hedges if HEDGES[h].scalar]
+    if (p.shapes or len(hedges) < len(p.hedges) or ops.inference == "mamdani"
+            or c.accumulated is not None):
+        return ["_evaluate_row = None  # (no exact form in floats: evaluate_one uses evaluate)",
+                "", ""]
+    out = []
+    for fn, name in (("tnorm", ops.and_), ("snorm", ops.or_)):
+        out += [f"def _{fn}1(a, b):", *_indented({**TNORMS, **SNORMS}[name].scalar),
+                "    return r", "", ""]
+    for h in hedges:
+        out += [f"def _hedge1_{h}(x):",
+                *_indented(HEDGES[h].scalar.replace("sqrt(", "math.sqrt(")), "    return x", "", ""]
+    args = [f"x{i}" for i in range(len(c.inputs))]
+    out += [f"def _evaluate_row({', '.join(args)}):",
+            '    """``evaluate``\'s row for one sample, or None (``evaluate`` then)."""',
+            f"    if {' or '.join(f'{x} != {x}' for x in args)}:", "        return None"]
+    for x, (lo, hi) in zip(args, c.universe.tolist()):
+        if ops.inputs == "clamped":       # np.clip: min(max(x, lo), hi), each as NumPy's
+            out += [f"    {x} = {x} if {x} > {num(lo)} else {num(lo)}",
+                    f"    {x} = {x} if {x} < {num(hi)} else {num(hi)}"]
+        else:                             # outside: evaluate (an infinite one is NaN there)
+            out += [f"    if not {num(lo)} <= {x} <= {num(hi)}:", "        return None",
+                    f"    {x} = {x} + 0.0"]
+    if any("x[" in text for _, text, _ in p.rules) or c.cons_linear is not None:
+        out.append(f"    x = [{', '.join(args)}]")
+    for var, col, _, _, kernel in p.terms:
+        out.append(f"    {col} = _kernel1(x{var}, {', '.join(num(v) for v in kernel)})")
+    for col, text, weight in p.rules:
+        w = "" if weight == 1.0 else f"{num(weight)} * "
+        out.append(f"    {col} = {w}{_floats(text)} + 0.0")
+    out += _py_row_outputs(c)
+    return out + ["", "", *KERNEL1]
+
+
+def _py_row_outputs(c: CompiledRuleBase) -> list[str]:
+    """``_py_outputs``' weighted sums, division and defaults on floats."""
+    out, ys = [], []
+    for j in range(len(c.outputs)):
+        _, numerator, denominator = weighted_sums(c, j, "python")
+        out.append(f"    num = {_floats(numerator)} + 0.0")
+        if c.operators.inference == "weighted_sum" and j not in c.summed_defaults:
+            out.append(f"    y{j} = num")
+        else:
+            out.append(f"    den = {_floats(denominator)} + 0.0")
+            out.append(f"    y{j} = num if den > 0.0 else math.nan" if c.operators.inference
+                       == "weighted_sum" else
+                       f"    y{j} = num / den if den > 0.0 else math.nan")
+        if not np.isnan(c.default[j]):
+            out.append(f"    y{j} = {num(c.default[j])} if y{j} != y{j} else y{j}")
+        ys.append(f"y{j}")
+    return out + [f"    return ({', '.join(ys)},)"]
+
+
+#: ``mf_kernel`` on floats inside the universe (no NaN): np.minimum, then np.clip as
+#: min(max(v, 0), 1); ``1.0 +`` leaves no signed zero to tell the two choices of a tie apart.
+KERNEL1 = [
+    "def _kernel1(x, b, s1, c, s2):",
+    "    r = (x - b) * s1",
+    "    f = (c - x) * s2",
+    "    v = 1.0 + (r if r <= f else f)",
+    "    v = v if v > 0.0 else 0.0",
+    "    return v if v < 1.0 else 1.0",
+    "", ""]
+
+
+def _indented(statements: str) -> list[str]:
+    return ["    " + line for line in statements.splitlines()]
+
+
+def _floats(text: str) -> str:
+    """A rule's or a sum's text calling the float forms of the norms and hedges."""
+    return re.sub(r"(?<![\w.])(tnorm|snorm|hedge)([_(])", r"_\g<1>1\2", text)
 
 
 def _py_header(p: Program, source: str) -> list[str]:
@@ -168,7 +257,7 @@ def _py_header(p: Program, source: str) -> list[str]:
         "sets takes its",
         f'default ({"0, the empty sum," if c.operators.inference == "weighted_sum" else "NaN"} '
         'when it has none). Needs only NumPy."""', "",
-        "import numpy as np", "",
+        "import math", "", "import numpy as np", "",
         f"INPUTS = {tuple(map(str, c.inputs))!r}", f"OUTPUTS = {tuple(map(str, c.outputs))!r}",
         f"UNIVERSE = {[tuple(map(float, u)) for u in c.universe]!r}",
         f"DEFAULT = {[None if np.isnan(d) else float(d) for d in c.default]!r}", "", "",
