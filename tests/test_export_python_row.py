@@ -9,7 +9,6 @@ outside the universe, infinite, NaN or a signed zero.
 
 from __future__ import annotations
 
-import importlib.util
 import itertools
 from pathlib import Path
 from types import ModuleType
@@ -18,12 +17,10 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from test_export_c import DATA, ROOT, exported_module
 
 from mitos_cli.api import load_rulebase
 from mitos_cli.fuzzy.norms import SNORMS, TNORMS
-from mitos_cli.interop.export import to_python
-
-ROOT = Path(__file__).resolve().parents[1]
 
 TERMS = """\
 variables:
@@ -63,17 +60,7 @@ def exported(tmp_path: Path, case: dict) -> ModuleType:
     (tmp_path / "t.terms.yaml").write_text(TERMS)
     path = tmp_path / "t.rules"
     path.write_text(RULES.format(**case))
-    return module_of(tmp_path, load_rulebase(path).compiled)
-
-
-def module_of(tmp_path: Path, compiled: object) -> ModuleType:
-    path = tmp_path / "exported.py"
-    path.write_text(to_python(compiled, "test"))
-    spec = importlib.util.spec_from_file_location("exported", path)
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return exported_module(load_rulebase(path).compiled, tmp_path)
 
 
 def same_bits(module: ModuleType, rows: np.ndarray) -> None:
@@ -105,7 +92,7 @@ def test_evaluate_one_gives_evaluates_row_bit_for_bit(case: dict, tmp_path: Path
 
 
 def test_the_paper_base_takes_the_float_path_with_evaluates_bits(tmp_path: Path) -> None:
-    module = module_of(tmp_path, load_rulebase(ROOT / "rulebases" / "mitos.rules").compiled)
+    module = exported_module(load_rulebase(ROOT / "rulebases" / "mitos.rules").compiled, tmp_path)
     assert module._evaluate_row is not None
     rng = np.random.default_rng(3)
     same_bits(module, rng.uniform(-200, 200, size=(2000, len(module.INPUTS))))
@@ -113,6 +100,6 @@ def test_the_paper_base_takes_the_float_path_with_evaluates_bits(tmp_path: Path)
 
 def test_a_base_without_a_float_form_keeps_evaluate_for_one_sample(tmp_path: Path) -> None:
     """A gaussian term (``exp``), a Mamdani base: ``evaluate_one`` is ``evaluate``'s row."""
-    module = module_of(tmp_path, load_rulebase(ROOT / "tests" / "data" / "interop" / "tipper.fis").compiled)
+    module = exported_module(load_rulebase(DATA / "tipper.fis").compiled, tmp_path)
     assert module._evaluate_row is None
     same_bits(module, np.array([[3.0, 7.0], [-1.0, 12.0], [np.nan, 5.0]]))
