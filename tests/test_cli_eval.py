@@ -481,6 +481,17 @@ def test_an_input_name_apart_from_its_number_is_told_as_meant(args, said, meant,
     assert said in text and f"did you mean `{meant}`?" in text, text
 
 
+def test_a_long_word_of_digits_is_told_as_neither_at_once(capsys):
+    """The lost `=` was looked for with a lazy name before `\\d+\\.?\\d*`, which tried every
+    split of a run of digits: 2,000 digits took 20 s, 5,000 would take minutes."""
+    word = "a" + "1" * 5000 + "x"
+    code, out, err = run_main(["eval", word, "road=78"], capsys)
+    assert code == 2 and out == "" and "is neither a rule file nor NAME=VALUE" in " ".join(
+        err.replace("│", " ").split())
+    code, _, err = run_main(["eval", "x2y78", "road=78"], capsys)
+    assert code == 2 and "did you mean `x2y=78`?" in " ".join(err.replace("│", " ").split())
+
+
 def test_a_misspelt_rule_file_or_its_term_set_named_instead_say_what_was_meant(capsys):
     code, _, err = run_main(["eval", "rulebases/mitos.rule", "road=78"], capsys)
     assert code == 1 and "did you mean `rulebases/mitos.rules`?" in err

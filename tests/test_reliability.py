@@ -75,6 +75,20 @@ def test_huge_integer_is_refused_not_overflowing():
         yamlpos.expect_number(doc["x"], doc.value_span("x"), TermSetError, "x")
 
 
+def test_a_long_run_of_digits_where_a_number_belongs_is_refused_at_once():
+    """A value of digits YAML reads as text (`111...1 2`) was searched for a unit with
+    `\\d+\\.?\\d*`, which split the run every way: a fuzzed 200,000-digit value in a teach
+    journal's term set ran past the campaign's limit (about half an hour alone)."""
+    doc = yamlpos.load("x: " + "1" * 200_000 + " 2\n", "t.yaml", TermSetError)
+    with pytest.raises(TermSetError, match="must be a number") as info:
+        yamlpos.expect_number(doc["x"], doc.value_span("x"), TermSetError, "x")
+    assert info.value.hint is None
+    doc = yamlpos.load("x: 16in\n", "t.yaml", TermSetError)
+    with pytest.raises(TermSetError) as info:
+        yamlpos.expect_number(doc["x"], doc.value_span("x"), TermSetError, "x", units="in")
+    assert info.value.hint == "write the number alone, without `in`: in"
+
+
 def test_span_of_a_long_line_keeps_the_part_around_the_column():
     text = "a" * 100_000 + " bad " + "b" * 100_000
     span = Span.at(text, "f", 100_001, 1, 100_002)

@@ -271,7 +271,9 @@ def _loaded(path: str | None, behavior: str | None, fidelity: Engine | None) -> 
     from ..api import LoadedRuleBase, load_rulebase
 
     if path is not None and not _names_file(path):  # `mitos eval road78 size=45`: a lost `=`
-        lost = re.fullmatch(r"([^\W\d]\w*?)([-+]?(?:\d+\.?\d*|\.\d+))", path)
+        # the name ends in a letter and the digits read one way (a lazy name before
+        # `\d+\.?\d*` split a run of digits every way: 2,000 digits took 20 s)
+        lost = re.fullmatch(r"([^\W\d](?:\w*[^\W\d])?)([-+]?(?:\d+(?:\.\d*)?|\.\d+))", path)
         raise typer.BadParameter(f"`{path}` is neither a rule file nor NAME=VALUE (no file "
                                  f"of that name; write each input as NAME=VALUE)"
                                  + (f"; did you mean `{lost[1]}={lost[2]}`?" if lost else ""))
