@@ -543,3 +543,13 @@ def test_a_packaged_world_is_named_as_the_user_named_it_in_every_output(tmp_path
     assert r.exit_code == 0, r.output
     assert "2 runs now, 2 from before" in r.stderr
     assert [row["world"] for row in read_rows("s")] == ["corridor", "mine/tiny.yaml"] * 2
+
+
+def test_a_world_file_found_as_given_keeps_the_name_given(tmp_path, compare, monkeypatch):
+    """In a checkout `worlds/corridor.yaml` is the user's file as given (an editable install's
+    packaged worlds are those very files): the rows name it so, not `corridor`."""
+    monkeypatch.chdir(ROOT)
+    r = compare("worlds/corridor.yaml", "--planner", "potential_field", "-o", tmp_path / "s",
+                "-j", 1, "--no-plots", "--runs", 1)
+    assert r.exit_code == 0, r.output
+    assert [row["world"] for row in read_rows(tmp_path / "s")] == ["worlds/corridor.yaml"]
