@@ -553,3 +553,19 @@ def test_a_world_file_found_as_given_keeps_the_name_given(tmp_path, compare, mon
                 "-j", 1, "--no-plots", "--runs", 1)
     assert r.exit_code == 0, r.output
     assert [row["world"] for row in read_rows(tmp_path / "s")] == ["worlds/corridor.yaml"]
+
+
+def test_a_study_that_named_a_packaged_world_by_its_path_resumes_by_its_name(tmp_path, compare,
+                                                                             monkeypatch):
+    """Rows that name the packaged corridor by its installed path (as compare wrote them
+    before, or as the user typed it) resume with `corridor` given, and keep their name."""
+    from mitos_cli.resources import data_dir
+
+    monkeypatch.chdir(tmp_path)
+    path = str(Path(str(data_dir("worlds"))).resolve() / "corridor.yaml")
+    args = ("--planner", "potential_field", "-o", "s", "-j", 1, "--no-plots")
+    assert compare(path, *args, "--runs", 1).exit_code == 0
+    r = compare("corridor", *args, "--runs", 2, "--resume")
+    assert r.exit_code == 0, r.output
+    assert "1 run now, 1 from before" in r.stderr
+    assert [row["world"] for row in read_rows("s")] == [path, path]
