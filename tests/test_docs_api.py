@@ -236,6 +236,47 @@ def test_the_block_rule_finds_the_blocks_the_pages_hold():
     assert [(n, i) for n, i, _ in fenced_blocks(page)] == [(1, "python no-run"), (5, "python")]
 
 
+# -- a shown session prints what it shows ------------------------------------------------------
+#
+# A block (no language, or `console`) whose first line is `$ mitos ...` shows a session: the
+# command runs (as above, in a directory laid out as the repository's root) and prints the
+# rest of the block, `...` standing for any text (doctest's ELLIPSIS, NORMALIZE_WHITESPACE).
+
+def shown_sessions(page: Path) -> list[tuple[int, str, str]]:
+    return [(line, code.splitlines()[0][2:], code.split("\n", 1)[1])
+            for line, info, code in fenced_blocks(page.read_text(encoding="utf-8"))
+            if info in ("", "console") and code.startswith("$ mitos ")]
+
+
+@pytest.mark.parametrize("page, line, command, shown", [
+    pytest.param(p, *s, id=f"{p.relative_to(ROOT)}:{s[0]}") for p in PAGES
+    for s in shown_sessions(p)])
+def test_a_shown_session_prints_what_the_page_shows(page, line, command, shown, tmp_path,
+                                                    monkeypatch, capsys):
+    import shlex
+
+    from mitos_cli.cli.app import main
+
+    _checkout_like(tmp_path)
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv("COLUMNS", "100")
+    try:
+        main(shlex.split(command)[1:])
+        code = 0
+    except SystemExit as exc:
+        code = exc.code or 0
+    out = capsys.readouterr().out
+    checker = doctest.OutputChecker()
+    assert code == 0 and checker.check_output(
+        shown, out, doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE), \
+        f"{page.relative_to(ROOT)}:{line}: {command}\n{out}"
+
+
+def test_the_pages_show_sessions():
+    found = {str(p.relative_to(ROOT)): len(shown_sessions(p)) for p in PAGES if shown_sessions(p)}
+    assert found == {"README.md": 1, "docs/operators.md": 1}
+
+
 # -- every relative link leads somewhere ----------------------------------------------------
 
 def github_anchors(text: str) -> set[str]:
