@@ -236,6 +236,37 @@ def test_the_block_rule_finds_the_blocks_the_pages_hold():
     assert [(n, i) for n, i, _ in fenced_blocks(page)] == [(1, "python no-run"), (5, "python")]
 
 
+def test_every_option_the_pages_name_in_their_text_exists():
+    """The shell blocks' options are parsed above; the prose names many more in `code`
+    (`--fidelity octave`, `--on-no-rule`, `--dialect iec`): each is an option of a `mitos`
+    command or of a script in benchmarks/, or one of the other tools' the pages name."""
+    import typer.main
+
+    from mitos_cli.cli.app import build_app
+
+    known = {"--install-completion", "--show-completion",      # Typer's, on `mitos` itself
+             "--hypothesis-profile",                           # pytest with hypothesis
+             "--tool"}                                         # valgrind --tool=callgrind
+
+    def walk(command) -> None:
+        for param in command.params:
+            known.update(o for o in [*param.opts, *param.secondary_opts] if o.startswith("--"))
+        for sub in getattr(command, "commands", {}).values():
+            walk(sub)
+
+    walk(typer.main.get_group(build_app()))
+    scripts = "".join(p.read_text(encoding="utf-8") for p in (ROOT / "benchmarks").glob("*.py"))
+    unknown = []
+    for page in [p for p in PAGES if p.name != "changelog.md"]:
+        text = page.read_text(encoding="utf-8")
+        for span in re.finditer(r"`([^`\n]+)`", text):
+            for option in re.findall(r"(?<![\w-])(--[a-z][a-z0-9-]*)", span.group(1)):
+                if option not in known and f'"{option}"' not in scripts:
+                    line = text.count("\n", 0, span.start()) + 1
+                    unknown.append(f"{page.relative_to(ROOT)}:{line}: {option}")
+    assert unknown == [], unknown
+
+
 # -- a shown session prints what it shows ------------------------------------------------------
 #
 # A block (no language, or `console`) whose first line is `$ mitos ...` shows a session: the
