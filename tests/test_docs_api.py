@@ -267,6 +267,50 @@ def test_every_option_the_pages_name_in_their_text_exists():
     assert unknown == [], unknown
 
 
+def test_the_readmes_quick_commands_run_as_written(tmp_path, monkeypatch, capsys):
+    """The README's commands run in the order a reader meets them, in a directory laid out as
+    the repository's root: every one that makes no picture and drives no more than one run
+    (no `--runs`, `--live`, `--speed`, `--plot`, `--animate`, `teach`, `compare`, `plot`; nor
+    `--planner`: DWA takes 4 s), its `> FILE` written, and a comment that gives an output's
+    value (`# tip = 7.0`) gives what it prints. `mitos eval -b drive --batch run.csv` came
+    before any command had written run.csv."""
+    import shlex
+
+    from mitos_cli.cli.app import main
+
+    slow = ("--runs", "--live", "--speed", "--plot", "--animate", "--planner")
+    _checkout_like(tmp_path)
+    monkeypatch.chdir(tmp_path)
+    ran, failed = [], []
+    for block in _shell_blocks((ROOT / "README.md").read_text(encoding="utf-8")):
+        for line in block.splitlines():
+            line = line.strip().removeprefix("$ ")
+            if not line.startswith("mitos ") or "..." in line:
+                continue
+            code, _, comment = line.partition(" # ")
+            words, target = shlex.split(code.split(" > ")[0]), None
+            if " > " in code:
+                target = code.split(" > ")[1].split()[0]
+            if words[1] in ("teach", "compare", "plot") or any(w in slow for w in words):
+                continue
+            capsys.readouterr()
+            try:
+                main(words[1:])
+                status = 0
+            except SystemExit as exc:
+                status = exc.code or 0
+            out, err = capsys.readouterr()
+            if target:
+                (tmp_path / target).write_text(out, encoding="utf-8")
+            ran.append(line)
+            if status != 0:
+                failed.append(f"{line}: exit {status}: {err.strip()[:300]}")
+            said = re.match(r"\s*(\w+ = [-\d.]+)(?:\s|$)", comment)
+            if said and said[1] not in out:
+                failed.append(f"{line}: printed no `{said[1]}`")
+    assert len(ran) > 12 and failed == [], failed
+
+
 # -- a shown session prints what it shows ------------------------------------------------------
 #
 # A block (no language, or `console`) whose first line is `$ mitos ...` shows a session: the
