@@ -113,16 +113,31 @@ def display_path(path: str | None) -> str:
 def display_world(path: str) -> str:
     """A world's path as a study's report shows it: a packaged world by its name, marked as
     packaged (`corridor (packaged)`, not where pip put it), any other as given."""
-    from pathlib import Path
+    name = packaged_world(world_file(path))
+    return path if name is None else f"{name} (packaged)"
 
+
+def world_file(name: str | Path) -> Path:
+    """The file a world ``name`` of a study opens: the file as given, else the packaged world
+    of that name (``corridor``, ``worlds/corridor.yaml``), else ``name`` as it is (said where
+    it is read)."""
+    found = resolve("worlds", name, ".yaml")
+    return Path(name) if found is None else found
+
+
+def packaged_world(path: str | Path) -> str | None:
+    """The name a study gives the packaged world at ``path`` (``corridor``, not where pip put
+    it), which opens that world from any directory; None for any other file (and for a
+    packaged world that a file of the working directory of its name would hide)."""
     try:
         packaged = Path(str(data_dir("worlds"))).resolve()
         p = Path(path).resolve()
-        if p.parent == packaged and p.suffix == ".yaml":
-            return f"{p.stem} (packaged)"
+        if p.parent != packaged or p.suffix != ".yaml":
+            return None
+        found = resolve("worlds", p.stem, ".yaml")
+        return p.stem if found is not None and Path(found).resolve() == p else None
     except (OSError, ValueError):
-        pass
-    return path
+        return None
 
 
 def packaged_name(path: str) -> str | None:

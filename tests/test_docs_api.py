@@ -1,20 +1,15 @@
-"""docs/api.md runs as written: every example on the page is a doctest, from the repository
-root."""
+"""The pages say what the code does: their Python runs as written (docs/api.md's examples are
+doctests), their `mitos` commands parse, their links lead somewhere."""
 
 from __future__ import annotations
 
 import doctest
+import re
 from pathlib import Path
 
+import pytest
+
 ROOT = Path(__file__).resolve().parent.parent
-
-
-def test_api_page_examples_run(monkeypatch):
-    monkeypatch.chdir(ROOT)
-    failed, tried = doctest.testfile(
-        str(ROOT / "docs" / "api.md"), module_relative=False, verbose=False, report=True,
-        optionflags=doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE)
-    assert tried > 40 and failed == 0
 
 
 def test_worlds_readme_python_example_says_what_it_prints(monkeypatch, capsys):
@@ -65,28 +60,6 @@ def test_worlds_readme_annotated_world_runs_as_written(tmp_path):
     world.write_text(re.findall(r"```yaml\n(.*?)```", text, re.S)[0], encoding="utf-8")
     assert simulate(load_world(world)).outcome == "success"
 
-
-
-def test_every_python_block_of_the_readme_runs_as_written(monkeypatch):
-    """README.md's Python blocks, each pasted as it stands (one used arrays it never made),
-    from the repository root; a line whose comment shows a result (``# {'steering': ...}``)
-    gives that result."""
-    import re
-
-    monkeypatch.chdir(ROOT)
-    text = (ROOT / "README.md").read_text(encoding="utf-8")
-    checker, shown = doctest.OutputChecker(), 0
-    for block in re.findall(r"```python\n(.*?)```", text, re.S):
-        namespace: dict = {}
-        exec(compile(block, "README.md", "exec"), namespace)
-        for line in block.splitlines():
-            code, _, comment = line.partition("#")
-            if comment.strip().startswith("{"):
-                got = repr(eval(code.strip(), namespace))
-                assert checker.check_output(comment.strip() + "\n", got + "\n",
-                                            doctest.ELLIPSIS), (line, got)
-                shown += 1
-    assert shown
 
 
 def test_the_counts_of_the_drive_behavior_the_benchmark_pages_give_are_its_own():
@@ -175,28 +148,272 @@ def test_every_mitos_command_the_pages_show_parses_with_its_commands_options():
     assert checked > 40 and wrong == [], wrong
 
 
+# -- every Python block of the pages runs ---------------------------------------------------
+#
+# The rule: every block fenced ```python (or ```py, ```pycon) of README.md and docs/*.md is
+# meant to run, and runs here. A block that is not (a fragment, a sketch of an API to come)
+# is fenced with a word after the language, ```python no-run, which GitHub still colours as
+# Python. A page's blocks run in order in one namespace (a reader's session: docs/api.md's
+# first block loads the `rb` its later ones use), in a temporary directory that holds the
+# repository root's `worlds/`, `rulebases/` and `tests/` (the files the examples name; what
+# they write stays there). A block of `>>>` lines is a doctest (ELLIPSIS,
+# NORMALIZE_WHITESPACE); in any other, a line whose comment shows a value
+# (`rb.evaluate(...)   # {'steering': 65.41..., ...}`) gives that value, and a `print(...)`
+# whose comment shows what it prints (`# success 17.9 15.33`) prints that.
+
+PAGES = [ROOT / "README.md", *sorted(p for p in (ROOT / "docs").glob("*.md"))]
+PYTHON = ("python", "py", "pycon")
+
+
+def fenced_blocks(text: str) -> list[tuple[int, str, str]]:
+    """Each fenced block of a Markdown page: the line its fence opens on (from 1), its info
+    string and its text, fence by fence (an indented fence too, as in a list)."""
+    blocks, body, info, start, fence = [], [], "", 0, ""
+    for number, line in enumerate(text.splitlines(), 1):
+        stripped = line.strip()
+        if not fence and stripped.startswith(("```", "~~~")):
+            fence = stripped[:3]
+            info, start, body = stripped[3:].strip(), number, []
+        elif fence and stripped.startswith(fence) and not stripped[3:].strip():
+            blocks.append((start, info, "\n".join(body) + "\n"))
+            fence = ""
+        elif fence:
+            body.append(line)
+    return blocks
+
+
+def python_blocks(page: Path) -> list[tuple[int, str]]:
+    """The blocks of ``page`` meant to run (the rule above), with their first lines."""
+    return [(line, code) for line, info, code in fenced_blocks(page.read_text(encoding="utf-8"))
+            if info.split()[:1] and info.split()[0].lower() in PYTHON and len(info.split()) == 1]
+
+
+def _checkout_like(directory: Path) -> None:
+    for name in ("worlds", "rulebases", "tests"):
+        (directory / name).symlink_to(ROOT / name, target_is_directory=True)
+
+
+@pytest.mark.parametrize("page", [p for p in PAGES if python_blocks(p)],
+                         ids=lambda p: str(p.relative_to(ROOT)))
+def test_every_python_block_of_the_pages_runs_as_written(page, tmp_path, monkeypatch, capsys):
+    import textwrap
+
+    _checkout_like(tmp_path)
+    monkeypatch.chdir(tmp_path)
+    name = str(page.relative_to(ROOT))
+    scope: dict = {"__name__": "__docs__"}
+    checker, flags = doctest.OutputChecker(), doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE
+    for line, code in python_blocks(page):
+        code = textwrap.dedent(code)
+        where = f"{name}:{line}"
+        if code.lstrip().startswith(">>>"):
+            test = doctest.DocTestParser().get_doctest(code, scope, where, name, line)
+            runner, report = doctest.DocTestRunner(optionflags=flags), []
+            runner.run(test, out=report.append, clear_globs=False)
+            assert runner.failures == 0, "".join(report)
+            scope.update(test.globs)
+            continue
+        capsys.readouterr()
+        exec(compile(code, where, "exec"), scope)
+        printed = capsys.readouterr().out
+        for text in code.splitlines():
+            statement, _, comment = text.partition("  #")
+            comment = comment.strip()
+            if comment.startswith("{"):
+                got = repr(eval(statement.strip(), scope))
+                assert checker.check_output(comment + "\n", got + "\n", flags), (where, text, got)
+            elif statement.startswith("print(") and comment:
+                assert checker.check_output(comment + "\n", printed.splitlines()[-1] + "\n",
+                                            flags), (where, text, printed)
+
+
+def test_the_block_rule_finds_the_blocks_the_pages_hold():
+    """The rule above reads the blocks it is meant to: those of the README and of the API,
+    Gymnasium and teaching pages, and a block fenced ``python no-run`` is left out."""
+    found = {str(p.relative_to(ROOT)): len(python_blocks(p)) for p in PAGES if python_blocks(p)}
+    assert found == {"README.md": 1, "docs/api.md": 9, "docs/gym.md": 1, "docs/teach.md": 1}
+    page = "```python no-run\nnot run\n```\n\n  ```python\n  x = 1\n  ```\n"
+    assert [(n, i) for n, i, _ in fenced_blocks(page)] == [(1, "python no-run"), (5, "python")]
+
+
+def test_every_option_the_pages_name_in_their_text_exists():
+    """The shell blocks' options are parsed above; the prose names many more in `code`
+    (`--fidelity octave`, `--on-no-rule`, `--dialect iec`): each is an option of a `mitos`
+    command or of a script in benchmarks/, or one of the other tools' the pages name."""
+    import typer.main
+
+    from mitos_cli.cli.app import build_app
+
+    known = {"--install-completion", "--show-completion",      # Typer's, on `mitos` itself
+             "--hypothesis-profile",                           # pytest with hypothesis
+             "--tool"}                                         # valgrind --tool=callgrind
+
+    def walk(command) -> None:
+        for param in command.params:
+            known.update(o for o in [*param.opts, *param.secondary_opts] if o.startswith("--"))
+        for sub in getattr(command, "commands", {}).values():
+            walk(sub)
+
+    walk(typer.main.get_group(build_app()))
+    scripts = "".join(p.read_text(encoding="utf-8") for p in (ROOT / "benchmarks").glob("*.py"))
+    unknown = []
+    for page in [p for p in PAGES if p.name != "changelog.md"]:
+        text = page.read_text(encoding="utf-8")
+        for span in re.finditer(r"`([^`\n]+)`", text):
+            for option in re.findall(r"(?<![\w-])(--[a-z][a-z0-9-]*)", span.group(1)):
+                if option not in known and f'"{option}"' not in scripts:
+                    line = text.count("\n", 0, span.start()) + 1
+                    unknown.append(f"{page.relative_to(ROOT)}:{line}: {option}")
+    assert unknown == [], unknown
+
+
+def test_the_readmes_quick_commands_run_as_written(tmp_path, monkeypatch, capsys):
+    """The README's commands run in the order a reader meets them, in a directory laid out as
+    the repository's root: every one that makes no picture and drives no more than one run
+    (no `--runs`, `--live`, `--speed`, `--plot`, `--animate`, `teach`, `compare`, `plot`; nor
+    `--planner`: DWA takes 4 s), its `> FILE` written, and a comment that gives an output's
+    value (`# tip = 7.0`) gives what it prints. `mitos eval -b drive --batch run.csv` came
+    before any command had written run.csv."""
+    import shlex
+
+    from mitos_cli.cli.app import main
+
+    slow = ("--runs", "--live", "--speed", "--plot", "--animate", "--planner")
+    _checkout_like(tmp_path)
+    monkeypatch.chdir(tmp_path)
+    ran, failed = [], []
+    for block in _shell_blocks((ROOT / "README.md").read_text(encoding="utf-8")):
+        for line in block.splitlines():
+            line = line.strip().removeprefix("$ ")
+            if not line.startswith("mitos ") or "..." in line:
+                continue
+            code, _, comment = line.partition(" # ")
+            words, target = shlex.split(code.split(" > ")[0]), None
+            if " > " in code:
+                target = code.split(" > ")[1].split()[0]
+            if words[1] in ("teach", "compare", "plot") or any(w in slow for w in words):
+                continue
+            capsys.readouterr()
+            try:
+                main(words[1:])
+                status = 0
+            except SystemExit as exc:
+                status = exc.code or 0
+            out, err = capsys.readouterr()
+            if target:
+                (tmp_path / target).write_text(out, encoding="utf-8")
+            ran.append(line)
+            if status != 0:
+                failed.append(f"{line}: exit {status}: {err.strip()[:300]}")
+            said = re.match(r"\s*(\w+ = [-\d.]+)(?:\s|$)", comment)
+            if said and said[1] not in out:
+                failed.append(f"{line}: printed no `{said[1]}`")
+    assert len(ran) > 12 and failed == [], failed
+
+
+# -- a shown session prints what it shows ------------------------------------------------------
+#
+# A block (no language, or `console`) whose first line is `$ mitos ...` shows a session: the
+# command runs (as above, in a directory laid out as the repository's root) and prints the
+# rest of the block, `...` standing for any text (doctest's ELLIPSIS, NORMALIZE_WHITESPACE).
+
+def shown_sessions(page: Path) -> list[tuple[int, str, str]]:
+    return [(line, code.splitlines()[0][2:], code.split("\n", 1)[1])
+            for line, info, code in fenced_blocks(page.read_text(encoding="utf-8"))
+            if info in ("", "console") and code.startswith("$ mitos ")]
+
+
+@pytest.mark.parametrize("page, line, command, shown", [
+    pytest.param(p, *s, id=f"{p.relative_to(ROOT)}:{s[0]}") for p in PAGES
+    for s in shown_sessions(p)])
+def test_a_shown_session_prints_what_the_page_shows(page, line, command, shown, tmp_path,
+                                                    monkeypatch, capsys):
+    import shlex
+
+    from mitos_cli.cli.app import main
+
+    _checkout_like(tmp_path)
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv("COLUMNS", "100")
+    try:
+        main(shlex.split(command)[1:])
+        code = 0
+    except SystemExit as exc:
+        code = exc.code or 0
+    out = capsys.readouterr().out
+    checker = doctest.OutputChecker()
+    assert code == 0 and checker.check_output(
+        shown, out, doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE), \
+        f"{page.relative_to(ROOT)}:{line}: {command}\n{out}"
+
+
+def test_the_pages_show_sessions():
+    found = {str(p.relative_to(ROOT)): len(shown_sessions(p)) for p in PAGES if shown_sessions(p)}
+    assert found == {"README.md": 1, "docs/operators.md": 1}
+
+
+# -- every relative link leads somewhere ----------------------------------------------------
+
+def github_anchors(text: str) -> set[str]:
+    """The ``#fragment`` GitHub gives each heading of a page (outside its code blocks): the
+    heading as it reads (links as their text, no backticks or tags), lower case, everything
+    but letters, digits, `_`, `-` and spaces dropped, spaces as `-`; the second heading of one
+    anchor gets `-1`, the third `-2`, ..."""
+    fenced = {n for start, _, code in fenced_blocks(text)
+              for n in range(start, start + code.count("\n") + 2)}
+    anchors, seen = set(), {}
+    for number, line in enumerate(text.splitlines(), 1):
+        heading = re.match(r" {0,3}#{1,6}\s+(.*?)(?:\s+#+)?\s*$", line)
+        if heading is None or number in fenced:
+            continue
+        words = re.sub(r"\[([^\]]*)\]\([^)]*\)", r"\1", heading.group(1))
+        words = re.sub(r"<[^>]+>", "", words)
+        anchor = re.sub(r"[^\w\- ]", "", words.lower()).replace(" ", "-")
+        n = seen.get(anchor, 0)
+        seen[anchor] = n + 1
+        anchors.add(anchor if n == 0 else f"{anchor}-{n}")
+    return anchors
+
+
+def relative_links(text: str) -> list[tuple[int, str, str]]:
+    """Each link of a page outside code (blocks and `spans`) to a file or a heading: its
+    line, its target (empty for the page itself) and its fragment."""
+    fenced = {n for start, _, code in fenced_blocks(text)
+              for n in range(start, start + code.count("\n") + 2)}
+    found = []
+    for number, line in enumerate(text.splitlines(), 1):
+        if number in fenced:
+            continue
+        line = re.sub(r"`[^`]*`", "", line)
+        for target, fragment in re.findall(r"\]\(<?([^)#\s>]*)(?:#([^)\s>]+))?>?"
+                                           r"(?:\s+\"[^\"]*\")?\)", line):
+            if not target.startswith(("http://", "https://", "mailto:")):
+                found.append((number, target, fragment))
+    return found
+
+
+def test_github_anchors_follow_githubs_rules():
+    page = ("# The aims\n## `mitos eval`: the paper's sample run\n## Speed\n## Speed\n"
+            "### Speed\n```\n# not a heading\n```\n## [Links](x.md) & <b>tags</b>\n")
+    assert github_anchors(page) == {"the-aims", "mitos-eval-the-papers-sample-run", "speed",
+                                    "speed-1", "speed-2", "links--tags"}
+    assert relative_links("[a](b.md#c) `[d](e.md)`\n```\n[f](g.md)\n```\n[h](#i)") == [
+        (1, "b.md", "c"), (5, "", "i")]
+
+
 def test_every_link_between_the_pages_leads_somewhere():
     """docs/navigation.md linked `[The aims](#the-aims)`, a heading no page has: every relative
     link of the README, docs/ and worlds/README.md names a file that is there and, with a
-    `#fragment`, a heading of that file (GitHub's slug: lower case, punctuation dropped,
-    spaces as `-`)."""
-    import re
-
-    def slugs(page: Path) -> set[str]:
-        heads = re.findall(r"^#+ (.*)$", page.read_text(encoding="utf-8"), re.M)
-        return {re.sub(r"[^\w\- ]", "", h.strip().lower()).replace(" ", "-") for h in heads}
-
-    pages = [ROOT / "README.md", ROOT / "worlds" / "README.md",
-             *sorted((ROOT / "docs").glob("*.md"))]
-    broken = []
+    `#fragment`, a heading of that file by GitHub's anchor rules (:func:`github_anchors`)."""
+    pages = [ROOT / "README.md", ROOT / "worlds" / "README.md", *PAGES[1:]]
+    broken, checked = [], 0
     for page in pages:
-        text = page.read_text(encoding="utf-8")
-        for target, fragment in re.findall(r"\]\(([^)#\s]*)(?:#([^)\s]+))?\)", text):
-            if target.startswith(("http://", "https://", "mailto:")):
-                continue
-            where = page.parent / target if target else page
+        for line, target, fragment in relative_links(page.read_text(encoding="utf-8")):
+            where = (page.parent / target) if target else page
+            checked += 1
             if not where.exists():
-                broken.append(f"{page.relative_to(ROOT)}: {target}")
-            elif fragment and where.suffix == ".md" and fragment not in slugs(where):
-                broken.append(f"{page.relative_to(ROOT)}: {target}#{fragment}")
-    assert broken == []
+                broken.append(f"{page.relative_to(ROOT)}:{line}: {target}")
+            elif fragment and where.suffix == ".md" and fragment not in github_anchors(
+                    where.read_text(encoding="utf-8")):
+                broken.append(f"{page.relative_to(ROOT)}:{line}: {target}#{fragment}")
+    assert checked > 50 and broken == [], broken

@@ -507,3 +507,65 @@ def test_a_choice_given_apart_from_its_option_is_said_to_be_one(tiny, tmp_path, 
     assert ran.exit_code == 2, ran.output
     assert said in " ".join(ran.stderr.replace("│", " ").split()), ran.stderr
     assert not (tmp_path / "s").exists()
+
+
+def test_a_packaged_world_is_named_as_the_user_named_it_in_every_output(tmp_path, compare,
+                                                                        monkeypatch):
+    """`mitos compare corridor` wrote the world in results.csv, study.json and --json by where
+    pip had put it (`.../site-packages/mitos_cli/_data/worlds/corridor.yaml`) while the report
+    said `corridor`: a packaged world is named by its stem everywhere (`worlds/corridor.yaml`
+    from outside a clone is the packaged one too), a file of the user's by the path given, and
+    the study resumes under those names."""
+    import json
+
+    from mitos_cli.resources import data_dir
+
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "mine").mkdir()
+    (tmp_path / "mine" / "tiny.yaml").write_text(TINY)
+    args = ("--planner", "potential_field", "-o", "s", "-j", 1, "--no-plots")
+    r = compare("worlds/corridor.yaml", "mine/tiny.yaml", *args, "--runs", 1, "--json")
+    assert r.exit_code == 0, r.output
+    assert [row["world"] for row in read_rows("s")] == ["corridor", "mine/tiny.yaml"]
+    manifest = json.loads((tmp_path / "s" / "study.json").read_text())
+    assert manifest["worlds"] == ["corridor", "mine/tiny.yaml"]
+    assert set(manifest["digests"]) == {"corridor", "mine/tiny.yaml", "rulebase"}
+    said = json.loads(r.stdout)
+    assert said["worlds"] == ["corridor", "mine/tiny.yaml"]
+    assert {s["world"] for s in said["summaries"]} >= {"corridor", "mine/tiny.yaml"}
+    report = (tmp_path / "s" / "report.md").read_text()
+    assert "`corridor (packaged)`, `mine/tiny.yaml`" in report
+    place = str(Path(str(data_dir("worlds"))).resolve())
+    for text in (r.stdout, r.stderr, report, (tmp_path / "s" / "results.csv").read_text(),
+                 json.dumps(manifest)):
+        assert place not in text
+    r = compare("corridor", "mine/tiny.yaml", *args, "--runs", 2, "--resume")
+    assert r.exit_code == 0, r.output
+    assert "2 runs now, 2 from before" in r.stderr
+    assert [row["world"] for row in read_rows("s")] == ["corridor", "mine/tiny.yaml"] * 2
+
+
+def test_a_world_file_found_as_given_keeps_the_name_given(tmp_path, compare, monkeypatch):
+    """In a checkout `worlds/corridor.yaml` is the user's file as given (an editable install's
+    packaged worlds are those very files): the rows name it so, not `corridor`."""
+    monkeypatch.chdir(ROOT)
+    r = compare("worlds/corridor.yaml", "--planner", "potential_field", "-o", tmp_path / "s",
+                "-j", 1, "--no-plots", "--runs", 1)
+    assert r.exit_code == 0, r.output
+    assert [row["world"] for row in read_rows(tmp_path / "s")] == ["worlds/corridor.yaml"]
+
+
+def test_a_study_that_named_a_packaged_world_by_its_path_resumes_by_its_name(tmp_path, compare,
+                                                                             monkeypatch):
+    """Rows that name the packaged corridor by its installed path (as compare wrote them
+    before, or as the user typed it) resume with `corridor` given, and keep their name."""
+    from mitos_cli.resources import data_dir
+
+    monkeypatch.chdir(tmp_path)
+    path = str(Path(str(data_dir("worlds"))).resolve() / "corridor.yaml")
+    args = ("--planner", "potential_field", "-o", "s", "-j", 1, "--no-plots")
+    assert compare(path, *args, "--runs", 1).exit_code == 0
+    r = compare("corridor", *args, "--runs", 2, "--resume")
+    assert r.exit_code == 0, r.output
+    assert "1 run now, 1 from before" in r.stderr
+    assert [row["world"] for row in read_rows("s")] == [path, path]

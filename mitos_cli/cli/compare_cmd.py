@@ -268,7 +268,10 @@ def check_inputs(worlds: list[str], choices: Sequence[Choice], rulebase: str | N
                  behavior: str | None, runs: int = 0) -> list[str]:
     """Read every world and compile every choice once here, so a mistake is reported before
     any worker starts (and a world whose ``runs`` are copies of one is said). Returns the
-    world paths as the workers will open them."""
+    worlds as the study names them: a packaged world by its name (``corridor``, which the
+    workers open wherever pip put it; its path named the world in results.csv, study.json and
+    --json), any other by the path given."""
+    from ..resources import is_file, packaged_world
     from ..sim.obstacles import copies_note
     from ..sim.worldfile import load_world, resolve_world_path
     from ..study.simtask import StudyContext, check_choice
@@ -284,7 +287,10 @@ def check_inputs(worlds: list[str], choices: Sequence[Choice], rulebase: str | N
         if Path(path).resolve() in files:     # (`a.yaml` and `./a.yaml` too, as Study says)
             raise typer.BadParameter(f"the world `{name}` is given twice")
         files.add(Path(path).resolve())
-        paths.append(path)
+        # a file found as given keeps its name (`worlds/corridor.yaml` in a checkout, even an
+        # editable one, whose packaged worlds are those files); one found among the packaged
+        # worlds is named as such
+        paths.append(path if is_file(Path(name)) else packaged_world(path) or path)
     context = StudyContext(rulebase, behavior)
     for path in paths:
         for choice in choices:

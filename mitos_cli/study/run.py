@@ -84,6 +84,7 @@ def world_files(worlds: object) -> list[str]:
     ``Path`` or a ``World`` failed later with a bare TypeError, and a world given twice had
     each of its rows summarize the runs of both (``mitos compare`` refuses it)."""
     from ..errors import InputError
+    from ..resources import world_file
     from ..sim.world import World
 
     if isinstance(worlds, (str, os.PathLike)):
@@ -107,7 +108,7 @@ def world_files(worlds: object) -> list[str]:
             raise InputError(f"a world named `{name}` is not told apart from the rows pooled "
                              f"over the worlds", hint=f"give it by its full path: "
                                                   f"{str(Path(name).resolve())!r}")
-        key = Path(name).resolve()
+        key = world_file(name).resolve()       # (`corridor` is where pip put corridor.yaml)
         if key in seen:
             also = "" if seen[key] == name else f" (as `{seen[key]}`)"
             raise InputError(f"the world `{name}` is given twice{also}",

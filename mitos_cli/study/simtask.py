@@ -61,10 +61,13 @@ def file_digest(paths: Sequence[Path]) -> str | None:
 
 def world_digest(path: str) -> str | None:
     """A digest of a world file and the map files it reads (:func:`.worldfile.map_files`);
-    a world without any has the digest of its own bytes, as before."""
+    a world without any has the digest of its own bytes, as before. A packaged world's name
+    (``corridor``) is its file's."""
+    from ..resources import world_file
     from ..sim.worldfile import map_files
 
-    return file_digest([Path(path), *map_files(path)])
+    file = world_file(path)
+    return file_digest([file, *map_files(file)])
 
 
 def rulebase_digest(rb: RuleBase) -> str | None:

@@ -649,8 +649,12 @@ def _written_names(worlds: dict[str, str]) -> dict[str, str]:
 
 
 def _file(path: str) -> str | None:
-    """The file ``path`` names from here, links followed; ``None`` when it names none."""
-    return os.path.realpath(path) if is_file(Path(path)) else None
+    """The file ``path`` names from here (a packaged world's name: its file), links followed;
+    ``None`` when it names none."""
+    from ..resources import world_file
+
+    found = world_file(path)
+    return os.path.realpath(found) if is_file(found) else None
 
 
 def _renamed(manifest: dict, names: dict[str, str]) -> dict:
