@@ -230,7 +230,7 @@ def test_near_the_robot_two_objects_16_in_apart_stay_two_tracks():
     tracker = movers.Tracker()
     hop_between_corners(tracker, 40.0, seconds=1.0)
     assert [tr.born for tr in tracker.tracks] == [0.0, 0.75]
-    near = movers.sight_lines(np.array([[40.0, 8.0], [70.0, 0.0]]), np.zeros((2, 2)),
+    near = movers.sight_lines(np.array([[40.0, 8.0], [100.0, 0.0]]), np.zeros((2, 2)),
                               np.deg2rad(10.0))
     assert near[0].tolist() == [1.0, 0.0, 1.0]              # the plain distance
     assert near[1, 2] < 1 and np.allclose(near[1, :2], (1, 0))   # wider across the line
@@ -257,6 +257,19 @@ def test_a_mover_whose_heading_is_not_known_yet_sweeps_only_down_the_robots_lane
     assert movers.swept(m, np.array([0.0, 40.0]), 0.0, length=24, width=18) == []
     (a, b, _), = movers.swept(m, np.array([0.0, 0.0]), 0.0, length=24, width=18)
     assert np.allclose(a, (200, 0)) and np.allclose(b, (0, 0))
+
+
+def test_a_mover_whose_path_overlaps_the_robots_lane_comes_down_it():
+    """The lane is where the robot's body goes (half its width each side of its line), and
+    a mover's path is ``HALF_WIDTH`` wide each side at least: a cart 19 in off the line of
+    a robot whose heading wavers (`moving+clutter5`, seed 0: -12 deg at 60 in) comes down
+    it; one whose path clears the lane does not."""
+    robot = np.array([0.0, 0.0])
+    for off, inside in ((19.0, True), (-20.5, True), (21.5, False)):
+        m = movers.Mover(np.array([60.0, off]), np.array([-15.0, 0.0]), 5.0, settled=False)
+        assert bool(movers.lane(m, robot, 0.0, 18.0)) is inside, off
+    wide = movers.Mover(np.array([60.0, 22.0]), np.array([-15.0, 0.0]), 14.0, settled=False)
+    assert movers.lane(wide, robot, 0.0, 18.0)                 # 9 + 14 in: a wide one
 
 
 def test_a_robot_keeps_right_of_what_comes_down_its_lane_with_room():
@@ -411,6 +424,20 @@ def test_a_robot_at_its_refuge_waits_while_a_mover_comes_whose_way_is_not_drawn(
                              moving=waiting)
     assert again is not None and math.dist(again.goal, place) < 1e-9
     assert rmap.refuge is not None
+
+
+def test_a_robot_at_its_refuge_waits_till_a_cart_beside_it_has_passed():
+    """A cart coming down the other lane is 60 deg or more off the robot's bearing as it
+    draws level with the robot at its refuge: it has not passed, and the robot that turned
+    round for its goal then would swing into its lane (`moving+clutter9` of the dev seed
+    6000). Waiting, the robot waits for it till it has passed; driving, it is not in its
+    way."""
+    tracker = movers.Tracker()
+    t = follow(tracker, (100, -40), (-15, 0), 2.0, moved=True)   # now at (70, -40)
+    robot = np.array([40.0, 15.0])                               # 62 deg off its heading
+    assert tracker.movers(t, robot, own=np.zeros(2)) == []
+    assert len(tracker.movers(t, robot, own=np.zeros(2), waiting=True)) == 1
+    assert tracker.movers(t, np.array([80.0, 15.0]), own=np.zeros(2), waiting=True) == []
 
 
 def test_a_robot_standing_in_a_movers_way_is_sent_out_of_it():

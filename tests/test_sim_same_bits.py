@@ -1519,7 +1519,7 @@ def plain_sighting(free: movers.FreeSpace, now: float, origin, ranges, dirs, see
     for c in centres:
         rel = c - origin
         r = float(np.hypot(*rel))
-        across = 2 * r * math.sin(abs(free.step) / 2) + movers.LINK / 2
+        across = 2 * r * math.sin(abs(free.step) / 2)
         sight.append((*(rel / r), movers.GATE / across) if across > movers.GATE else (1.0, 0.0, 1.0))
     return centres, np.maximum.reduceat(spread, starts), moved, np.array(sight)
 

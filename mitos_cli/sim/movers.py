@@ -218,15 +218,14 @@ def sight_lines(centres: np.ndarray, origins: np.ndarray, step: float) -> np.nda
     Neighbouring beams ``step`` rad apart are ``2 r sin(step / 2)`` apart at range ``r``,
     so an object wider than that is echoed now by one, now by the other, and its echoes hop
     that far across the line (a ring of 36 beams sees a cart's two front corners, 16 in
-    apart, from 90 in on), and its place (the mean of its echoes) by up to ``LINK / 2``
-    more as an echo at one end comes or goes; along the line they stay within ``GATE``.
-    Where that is less than ``GATE`` (beams close together, or objects near) the gate is
-    round, and the row ``(1, 0, 1)``: the plain distance."""
+    apart, from 90 in on); along the line they stay within ``GATE``. Where the beams lie
+    closer than ``GATE`` (a dense fan, or objects near) the gate is round, and the row
+    ``(1, 0, 1)``: the plain distance."""
     out = np.zeros((len(centres), 3))
     out[:, 0] = out[:, 2] = 1.0
     rel = centres - origins
     r = np.hypot(rel[:, 0], rel[:, 1])
-    across = 2 * r * math.sin(abs(step) / 2) + LINK / 2
+    across = 2 * r * math.sin(abs(step) / 2)
     wide = across > GATE
     out[wide, :2] = rel[wide] / r[wide, None]
     out[wide, 2] = GATE / across[wide]
@@ -344,11 +343,16 @@ class Tracker:
                     and MIN_SPEED <= speed <= MAX_SPEED)
         tr.v = v
 
-    def movers(self, now: float, robot: np.ndarray, own: np.ndarray) -> list[Mover]:
+    def movers(self, now: float, robot: np.ndarray, own: np.ndarray, waiting: bool = False
+               ) -> list[Mover]:
         """The tracks that move toward the robot at ``robot [2]`` driving at velocity ``own
         [2]`` (see the module docstring): those seen at ``now``, and the movers among those
         missed for at most ``MAX_MISS`` s, where they should be by now (a sonar ring loses a
-        cart between two beams for a tick or two)."""
+        cart between two beams for a tick or two). A robot ``waiting`` at a refuge waits for
+        what has not passed it yet: the cone is a half plane (a cart beside it, 60 deg or
+        more off its bearing, still comes on, and a tricycle that turns round for its goal
+        swings into its lane)."""
+        cone = 0.0 if waiting else APPROACH
         out = []
         for tr in self.tracks:
             v = tr.v
@@ -360,7 +364,7 @@ class Tracker:
             to_robot = robot - centre
             dist = float(np.hypot(*to_robot))
             # it heads for the robot, and the robot does not draw away from it faster
-            if float(v @ to_robot) < APPROACH * speed * dist or float((v - own) @ to_robot) <= 0:
+            if float(v @ to_robot) < cone * speed * dist or float((v - own) @ to_robot) <= 0:
                 continue
             out.append(Mover(centre, v, tr.radius, now - tr.born >= SETTLE))
         return out
@@ -568,9 +572,11 @@ Capsule = tuple[np.ndarray, np.ndarray, float]     # a segment's two ends and a 
 
 def lane(m: Mover, robot: np.ndarray, heading: float, width: float) -> bool:
     """Whether ``m`` comes down the lane of a robot at ``robot [2]`` heading ``heading``
-    (rad), ``width`` inches wide: its centre within a body width of the robot's line."""
+    (rad), ``width`` inches wide: its path (as wide as it, ``HALF_WIDTH`` each side at least)
+    overlaps the robot's lane."""
     to_robot = robot - m.centre
-    return abs(math.cos(heading) * to_robot[1] - math.sin(heading) * to_robot[0]) < width
+    return (abs(math.cos(heading) * to_robot[1] - math.sin(heading) * to_robot[0])
+            < width / 2 + max(m.radius, HALF_WIDTH))
 
 
 def swept(m: Mover, robot: np.ndarray, heading: float, length: float, width: float
