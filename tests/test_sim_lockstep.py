@@ -419,3 +419,29 @@ def test_run_lockstep_says_what_is_wrong_with_its_arguments(call, says):
     with pytest.raises((InputError, WorldError), match=re.escape(says)):
         call(world)
     assert len(run_lockstep(world, None, seeds=range(2), batch=1)) == 2
+
+
+def test_runs_stuck_without_progress_in_a_batch_are_stuck_at_the_tick_they_are_alone(
+        monkeypatch):
+    """BARN field 2079 (the poles unknown), three seeds, with ``PROGRESS_TIME`` shortened to
+    4 s: each robot replans and backs out, then comes no nearer its goal for 4 s and is
+    stuck (at 8.95-13.45 s, each at its own tick, while it still drives more than
+    ``STUCK_DISTANCE`` in ``STUCK_TIME``); in a batch each run ends at the tick, and with
+    the bits, it has alone."""
+    from mitos_cli.sim import barn
+    from mitos_cli.sim.loop import STUCK_DISTANCE
+
+    monkeypatch.setattr(loop, "PROGRESS_TIME", 4.0)
+    world = dataclasses.replace(barn.world_of(barn.field(2079, *barn.difficulty(2079))),
+                                time_limit=20.0)
+    planner, scene = FuzzyPlanner(None, world.behavior), prepare(world)
+    seeds = [world.seed, world.seed + 1, world.seed + 2]
+    together = run_lockstep(world, planner, seeds, scene=scene)
+    alone = [simulate(world, planner, s, scene=scene) for s in seeds]
+    assert len({r.ticks for r in alone}) == 3 and all(r.replanned for r in alone)
+    window = int(round(STUCK_TIME / world.dt))
+    for a, b in zip(alone, together):
+        assert a.outcome == "stuck" and a.metrics["time_s"] < world.time_limit
+        xy = a.pose[-window:, 0, :2]
+        assert np.hypot(*np.diff(xy, axis=0).T).sum() > STUCK_DISTANCE   # it still drove
+        assert_same_run(a, b)
