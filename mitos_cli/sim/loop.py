@@ -10,11 +10,11 @@ acceleration limits and integrate in ``substeps`` exact arcs. The run ends in ``
 robot at its goal), ``collision``, ``stuck`` or ``timeout``; a robot still driving when
 another's collision or stuck ends the run reads ``stopped`` in its own outcome. A driving robot
 is ``stuck`` when it drove less than ``STUCK_DISTANCE`` in ``STUCK_TIME`` (driven, not
-displaced), or when in ``PROGRESS_TIME`` it came no more than ``PROGRESS_DISTANCE`` nearer its
-goal than it had ever been, neither in a straight line nor along its route (the route's length
-left: a replanned route starts where the robot stands). The second ends a robot that backs
-out and drives in again and again in one pocket; the successes of the navigation benchmark
-went at most 32.1 s so (docs/navigation.md, night 13).
+displaced), or when in the last ``PROGRESS_TIME`` it came no more than ``PROGRESS_DISTANCE``
+nearer its goal than the nearest it had been before them, neither in a straight line nor along
+its route (the route's length left: a replanned route starts where the robot stands). The
+second ends a robot that backs out and drives in again and again in one pocket; the successes
+of the navigation benchmark went at most 32.1 s so (docs/navigation.md, night 13).
 
 Randomness: ``SeedSequence(seed).spawn(1 + robots)``: the first stream randomises the world
 (only when asked, for ``--runs``), then one stream of sensor noise per robot.
