@@ -24,7 +24,8 @@ as ``mitos simulate`` does (sensor noise, moving obstacles, replanning, the verd
   in the step (a replanned, longer route counts as going back), ``COLLISION_PENALTY`` (-10) when
   the robot touches something, ``GOAL_BONUS`` (+10) when it reaches its goal.
 - **terminated** on the goal or a collision; **truncated** at the world's time limit, and when
-  the simulator finds the robot stuck (it moved less than 3 in in 6 s). At truncation the
+  the simulator finds the robot stuck (it drove less than 3 in in 6 s, or came no more than
+  1 in nearer its goal, in a straight line or along its route, in 40 s). At truncation the
   observation is the last one perceived (the simulator senses no tick past its limit).
 - **info**: ``t`` (s simulated, ticks times ``dt`` as ``mitos simulate`` counts them),
   ``pose`` (x, y in, heading deg), ``clearance`` (in), ``outcome``.

@@ -570,3 +570,20 @@ def test_a_reset_option_the_environment_does_not_take_is_said_with_the_options(
     with pytest.raises(mgym.EnvOptionError) as info:
         env.reset(seed=1, options=options)
     assert (info.value.message, info.value.hint) == (says, hint)
+
+
+def test_an_episode_that_goes_back_and_forth_without_progress_is_truncated_stuck(monkeypatch):
+    """Forward 1 s, back 1 s, and again: the robot drives on, but comes no nearer its goal in
+    ``PROGRESS_TIME`` (shortened to 4 s): truncated, ``stuck``, at 4-6 s."""
+    from mitos_cli.sim import loop
+
+    monkeypatch.setattr(loop, "PROGRESS_TIME", 4.0)
+    env = gymnasium.make("mitos/Corridor-v0")
+    steps = iter(range(10_000))
+
+    def swing(obs):
+        return np.array([90.0, 15.0 if (next(steps) // 20) % 2 == 0 else -15.0])
+
+    _, _, terminated, truncated, info = drive(env, seed=1, policy=swing)
+    assert (terminated, truncated, info["outcome"]) == (False, True, "stuck")
+    assert 4.0 <= info["t"] <= 6.0

@@ -419,3 +419,58 @@ def test_run_lockstep_says_what_is_wrong_with_its_arguments(call, says):
     with pytest.raises((InputError, WorldError), match=re.escape(says)):
         call(world)
     assert len(run_lockstep(world, None, seeds=range(2), batch=1)) == 2
+
+
+def test_runs_stuck_without_progress_in_a_batch_are_stuck_at_the_tick_they_are_alone(
+        monkeypatch):
+    """BARN field 2079 (the poles unknown), three seeds, with ``PROGRESS_TIME`` shortened to
+    4 s: each robot replans and backs out, then comes no nearer its goal for 4 s and is
+    stuck (at 8.95-13.45 s, each at its own tick, while it still drives more than
+    ``STUCK_DISTANCE`` in ``STUCK_TIME``); in a batch each run ends at the tick, and with
+    the bits, it has alone."""
+    from mitos_cli.sim import barn
+    from mitos_cli.sim.loop import STUCK_DISTANCE
+
+    monkeypatch.setattr(loop, "PROGRESS_TIME", 4.0)
+    world = dataclasses.replace(barn.world_of(barn.field(2079, *barn.difficulty(2079))),
+                                time_limit=20.0)
+    planner, scene = FuzzyPlanner(None, world.behavior), prepare(world)
+    seeds = [world.seed, world.seed + 1, world.seed + 2]
+    together = run_lockstep(world, planner, seeds, scene=scene)
+    alone = [simulate(world, planner, s, scene=scene) for s in seeds]
+    assert len({r.ticks for r in alone}) == 3 and all(r.replanned for r in alone)
+    window = int(round(STUCK_TIME / world.dt))
+    for a, b in zip(alone, together):
+        assert a.outcome == "stuck" and a.metrics["time_s"] < world.time_limit
+        xy = a.pose[-window:, 0, :2]
+        assert np.hypot(*np.diff(xy, axis=0).T).sum() > STUCK_DISTANCE   # it still drove
+        assert_same_run(a, b)
+
+
+def test_robots_of_many_robot_runs_stuck_without_progress_in_a_batch_are_as_alone(monkeypatch):
+    """``multirobot`` (two robots head-on), each robot driving 8 in back and forth along its
+    start heading, ``PROGRESS_TIME`` shortened to 4 s: three randomised runs in lockstep (the
+    batch's rows two a run) end stuck at the tick, and with the bits, each has alone."""
+    monkeypatch.setattr(loop, "PROGRESS_TIME", 4.0)
+    world = dataclasses.replace(load_world(packaged_path("worlds", "multirobot.yaml")),
+                                time_limit=STUCK_TIME + 4.0)
+    starts = np.array([[a.start.x, a.start.y, np.radians(a.start.heading)]
+                       for a in world.agents])
+
+    class Swing:
+        name = "swing"
+
+        def plan(self, p):
+            s = starts[p.robots]
+            off = ((p.pose[:, 0] - s[:, 0]) * np.cos(s[:, 2])
+                   + (p.pose[:, 1] - s[:, 1]) * np.sin(s[:, 2]))
+            speed = np.where(off > 8.0, -15.0,
+                             np.where(off < 0.0, 15.0, np.where(p.speed >= 0.0, 15.0, -15.0)))
+            return np.full(len(off), 90.0), speed
+
+    lock = Lockstep(world, Swing(), [1, 2, 3], randomise=True)
+    for seed, res in zip([1, 2, 3], lock.results()):
+        # both robots, before STUCK_TIME, each having driven over 50 in
+        assert res.robot_outcomes == ("stuck", "stuck") and 4.0 <= res.metrics["time_s"] < 6.0
+        assert all(m["path_length_in"] > 50.0 for m in res.robot_metrics)
+        assert_same_run(simulate(world, Swing(), seed, randomise=True), res)

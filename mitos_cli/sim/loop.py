@@ -7,9 +7,14 @@ poses: :func:`true_inputs`); a robot whose footprint touches anything has collid
 (the run ends); a robot within its goal's tolerance is done (it stops and stays as an obstacle);
 the planner evaluates all active robots in one batch; the kinematics apply the steering-rate and
 acceleration limits and integrate in ``substeps`` exact arcs. The run ends in ``success`` (every
-robot at its goal), ``collision``, ``stuck`` (a robot drove less than ``STUCK_DISTANCE`` in
-``STUCK_TIME``) or ``timeout``; a robot still driving when another's collision or stuck ends
-the run reads ``stopped`` in its own outcome.
+robot at its goal), ``collision``, ``stuck`` or ``timeout``; a robot still driving when
+another's collision or stuck ends the run reads ``stopped`` in its own outcome. A driving robot
+is ``stuck`` when it drove less than ``STUCK_DISTANCE`` in ``STUCK_TIME`` (driven, not
+displaced), or when in the last ``PROGRESS_TIME`` it came no more than ``PROGRESS_DISTANCE``
+nearer its goal than the nearest it had been before them, neither in a straight line nor along
+its route (the route's length left: a replanned route starts where the robot stands). The
+second ends a robot that backs out and drives in again and again in one pocket; the successes
+of the navigation benchmark went at most 32.1 s so (docs/navigation.md, night 13).
 
 Randomness: ``SeedSequence(seed).spawn(1 + robots)``: the first stream randomises the world
 (only when asked, for ``--runs``), then one stream of sensor noise per robot.
@@ -45,8 +50,10 @@ if TYPE_CHECKING:
     from .obstacles import Shapes
     from .world import Robot
 
-STUCK_TIME = 6.0        # s
+STUCK_TIME = 6.0        # s: a robot that drove less than STUCK_DISTANCE in it is stuck
 STUCK_DISTANCE = 3.0    # in
+PROGRESS_TIME = 40.0    # s: a robot that came no nearer its goal by PROGRESS_DISTANCE, in a
+PROGRESS_DISTANCE = 1.0  # in  straight line or along its route, in it is stuck
 BEHIND = 30.0           # in: a replanned route that starts this near behind the robot costs more
 NEAR_SLACK = 24.0       # in: a robot's set of nearby walls is gathered again after this move
 #: in: the deepest contact the check between ticks may miss (:meth:`Simulation._between`)
@@ -455,6 +462,7 @@ class Simulation:
         self._goal_x, self._goal_y = self._goals[:, 0].copy(), self._goals[:, 1].copy()
         self._tol = np.array([a.goal.tolerance for a in world.agents], float)
         self._stuck_window = max(1, int(round(STUCK_TIME / self.dt)))
+        self._progress_window = max(1, int(round(PROGRESS_TIME / self.dt)))
         self._given = self.scene.given or knowledge.given(world, self.scene.static)
         self._plain = self._given.plain
         self._known_walls = StaticMap(self._given.walls, np.zeros((0, 4, 2)), None,
@@ -492,6 +500,7 @@ class Simulation:
         self._near_known = [np.zeros((0, 4))] * n
         self._cast_with: list[tuple | None] = [None] * n
         self._routes = list(self.scene.routes)          # replanning replaces them
+        self._lengths = np.array([r.length for r in self._routes])   # in: theirs, [n]
         self._replanned: list[tuple[int, int, Route]] = []
         grid = self.scene.plan_grid or knowledge.plan_grid(self._given, self.scene.static,
                                                            self.world)
@@ -503,6 +512,10 @@ class Simulation:
                       for _ in range(n)]
         self._seen = [np.zeros(len(self.angles), dtype=bool) for _ in range(n)]
         self._odometer: list[np.ndarray] = []      # in each robot has driven, after each move
+        # in: each robot's least distance to its goal so far, in a straight line and along
+        # its route, at the start and after each move (``[2, n]`` each, _check_stuck)
+        self._best = [np.stack([np.hypot(self._x - self._goal_x, self._y - self._goal_y),
+                                self._lengths.copy()])]
         self._fleet = safety.Fleet(self.robots, [m.grid.resolution / 2 for m in self._maps],
                                    self._brake_reach, self.dt, self._safety)
         self._recovery = safety.rest(n)                 # each robot's safety.Recovery, a row
@@ -911,6 +924,7 @@ class Simulation:
         if route is None:
             return f
         self._routes[i] = route
+        self._lengths[i] = route.length
         self._replanned.append((self._k, i, route))
         return perception.frame(route, s.pose[i, :2], 0.0)
 
@@ -1198,19 +1212,26 @@ class Simulation:
         place: the history keeps them)."""
         driven = np.hypot(x - self._x, y - self._y)
         self._odometer.append(self._odometer[-1] + driven if self._odometer else driven)
+        self._best.append(_nearer(self._best[-1], x, y, self._goal_x, self._goal_y,
+                                  self._lengths - self._s_hint))
         self._x, self._y, self._h, self._v, self._steer = x, y, h, v, steer
         self._moved_by = None                           # (its own arrays, not a batch's)
         self._came = None                               # (act says how, when it moved it)
 
     def _check_stuck(self) -> bool:
-        """A driving robot that drove less than ``STUCK_DISTANCE`` in ``STUCK_TIME`` is stuck
-        (the run ends). Driven, not displaced: a robot backing out of a pocket and turning
-        round may come back near where it was, and it was not stuck."""
-        odometer, window = self._odometer, self._stuck_window
-        if len(odometer) <= window:
+        """A driving robot is stuck (the run ends) when it drove less than ``STUCK_DISTANCE``
+        in ``STUCK_TIME``, or came no more than ``PROGRESS_DISTANCE`` nearer its goal than it
+        had been, in a straight line or along its route, in ``PROGRESS_TIME``
+        (:func:`_stalled`). Driven, not displaced: a robot backing out of a pocket and turning
+        round may come back near where it was, and it was not stuck; one that does so again
+        and again for ``PROGRESS_TIME`` without getting nearer its goal is."""
+        odometer, window, best, slow = (self._odometer, self._stuck_window, self._best,
+                                        self._progress_window)
+        if len(odometer) <= window and len(best) <= slow:
             return False
-        moved = odometer[-1] - odometer[-1 - window]
-        return self._stuck(self._active & (moved < STUCK_DISTANCE))
+        return self._stuck(_stalled(
+            self._active, odometer[-1], odometer[-1 - window] if len(odometer) > window else None,
+            best[-1], best[-1 - slow] if len(best) > slow else None))
 
     def _stuck(self, stuck: np.ndarray) -> bool:
         """Whether any robot is ``stuck [n]``; those read ``stuck``."""
@@ -1824,25 +1845,56 @@ class Batch:
         assert all(len(run._odometer) == ticks for run in runs), "runs ticked together"
         if ticks:
             driven = np.concatenate([run._odometer[-1] for run in runs]) + driven
-        window = runs[0]._stuck_window                          # (Simulation._check_stuck)
+        left = (np.concatenate([run._lengths for run in runs])
+                - np.concatenate([run._s_hint for run in runs]))
+        best = _nearer(np.concatenate([run._best[-1] for run in runs], axis=1), after[0],
+                       after[1], self._goal_x, self._goal_y, left)
+        window, slow = runs[0]._stuck_window, runs[0]._progress_window  # (_check_stuck)
         stuck = None
-        if ticks + 1 > window:
-            moved = driven - np.concatenate([run._odometer[-window] for run in runs])
-            stuck = self.active & (moved < STUCK_DISTANCE)
+        if ticks + 1 > window or ticks + 2 > slow:
+            stuck = _stalled(
+                self.active, driven, (np.concatenate([run._odometer[-window] for run in runs])
+                                      if ticks + 1 > window else None),
+                best, (np.concatenate([run._best[-slow] for run in runs], axis=1)
+                       if ticks + 2 > slow else None))
             stuck_any = np.logical_or.reduceat(stuck, self._starts).tolist()
         token = object()
-        for j, (run, (a, b), *state, gone) in enumerate(zip(runs, self.spans,
-                                                           *map(self._each, after),
-                                                           self._each(driven))):
+        for j, (run, (a, b), *state, gone, nearest) in enumerate(zip(
+                runs, self.spans, *map(self._each, after), self._each(driven),
+                self._each(best.T))):
             run._x, run._y, run._h, run._v, run._steer = state
             run._moved_by = token
             run._came = _Came(motion, a, b)
             run._odometer.append(gone)
+            run._best.append(nearest.T)
             run._k += 1
             run._go_on(stuck is not None and stuck_any[j] and run._stuck(stuck[a:b]))
         self._moved = (after, token)
         self._came = motion
         self._now = None
+
+
+def _nearer(best: np.ndarray, x: np.ndarray, y: np.ndarray, goal_x: np.ndarray,
+            goal_y: np.ndarray, left: np.ndarray) -> np.ndarray:
+    """``[2, n]`` each robot's least distance to its goal (in), in a straight line and along
+    its route: ``best`` so far, or where it stands now (``x``, ``y``; ``left``: its route
+    left, its route's length less how far along it it is) where that is nearer."""
+    return np.minimum(best, np.stack([np.hypot(x - goal_x, y - goal_y), left]))
+
+
+def _stalled(active: np.ndarray, driven: np.ndarray, driven_then: np.ndarray | None,
+             best: np.ndarray, best_then: np.ndarray | None) -> np.ndarray:
+    """``[n]`` the driving robots (``active``) that are stuck: their odometers now and
+    ``STUCK_TIME`` ago (``driven``, ``driven_then``) less than ``STUCK_DISTANCE`` apart, or
+    their least distances to their goals now and ``PROGRESS_TIME`` ago (``best``,
+    ``best_then``, ``[2, n]``: :func:`_nearer`) less than ``PROGRESS_DISTANCE`` apart both
+    in a straight line and along the route (``None``: the run is younger)."""
+    stuck = np.zeros(len(active), dtype=bool)
+    if driven_then is not None:
+        stuck |= driven - driven_then < STUCK_DISTANCE
+    if best_then is not None:
+        stuck |= np.logical_and.reduce(best_then - best < PROGRESS_DISTANCE)
+    return active & stuck
 
 
 def check_seed(seed: object) -> int:
