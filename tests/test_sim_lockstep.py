@@ -50,17 +50,23 @@ def test_each_shipped_world_runs_alone_and_in_a_batch_alike(name):
         assert_same_run(simulate(world, planner, seed, randomise=True, scene=scene), res)
 
 
+def _barn_2079(time_limit: float) -> tuple:
+    """BARN field 2079 (the poles unknown) cut to ``time_limit``, its planner, its scene and
+    three seeds: its robot backs out beside the corridor's wall and among the poles."""
+    from mitos_cli.sim import barn
+
+    world = dataclasses.replace(barn.world_of(barn.field(2079, *barn.difficulty(2079))),
+                                time_limit=time_limit)
+    return (world, FuzzyPlanner(None, world.behavior), prepare(world),
+            [world.seed, world.seed + 1, world.seed + 2])
+
+
 def test_runs_whose_brake_counts_the_squares_flush_with_a_wall_run_in_a_batch_as_alone():
     """A BARN field (seed 2079, the poles unknown) whose top wall runs through its map's free
     row: the brake's squares flush with it (:func:`.knowledge.wall_faces`) are found for the
     whole batch at once, and each run keeps the bits it has alone while its robot backs out
     beside that wall (10-14 s)."""
-    from mitos_cli.sim import barn
-
-    world = dataclasses.replace(barn.world_of(barn.field(2079, *barn.difficulty(2079))),
-                                time_limit=14.0)
-    planner, scene = FuzzyPlanner(None, world.behavior), prepare(world)
-    seeds = [world.seed, world.seed + 1, world.seed + 2]
+    world, planner, scene, seeds = _barn_2079(time_limit=14.0)
     together = run_lockstep(world, planner, seeds, scene=scene)
     alone = [simulate(world, planner, s, scene=scene) for s in seeds]
     assert len(Simulation(world, planner, seeds[0], scene=scene)._maps[0].faces)
@@ -428,14 +434,10 @@ def test_runs_stuck_without_progress_in_a_batch_are_stuck_at_the_tick_they_are_a
     stuck (at 8.95-13.45 s, each at its own tick, while it still drives more than
     ``STUCK_DISTANCE`` in ``STUCK_TIME``); in a batch each run ends at the tick, and with
     the bits, it has alone."""
-    from mitos_cli.sim import barn
     from mitos_cli.sim.loop import STUCK_DISTANCE
 
     monkeypatch.setattr(loop, "PROGRESS_TIME", 4.0)
-    world = dataclasses.replace(barn.world_of(barn.field(2079, *barn.difficulty(2079))),
-                                time_limit=20.0)
-    planner, scene = FuzzyPlanner(None, world.behavior), prepare(world)
-    seeds = [world.seed, world.seed + 1, world.seed + 2]
+    world, planner, scene, seeds = _barn_2079(time_limit=20.0)
     together = run_lockstep(world, planner, seeds, scene=scene)
     alone = [simulate(world, planner, s, scene=scene) for s in seeds]
     assert len({r.ticks for r in alone}) == 3 and all(r.replanned for r in alone)
