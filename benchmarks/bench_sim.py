@@ -61,7 +61,7 @@ from mitos_cli.sim.lockstep import run_lockstep
 from mitos_cli.sim.loop import Simulation, prepare, simulate
 from mitos_cli.sim.planner import FuzzyPlanner
 from mitos_cli.sim.runs import run_many
-from mitos_cli.sim.world import Corridor, Goal
+from mitos_cli.sim.world import Corridor, Goal, Randomise
 from mitos_cli.sim.worldfile import load_world
 
 
@@ -293,7 +293,7 @@ def single_robot(fuzzy) -> None:
     print(f"   fuzzy drive: best {best:.3f} s, median {med:.3f} s -> "
           f"{res.ticks / best:,.0f} ticks/s ({1e6 * best / res.ticks:.0f} us/tick); "
           f"CPU {time_runs.cpu:.3f} s")
-    empty = dataclasses.replace(world, obstacles=())
+    empty = dataclasses.replace(world, obstacles=(), randomise=Randomise())   # nothing to jitter
     ftimes, fres = time_runs(empty, fuzzy)
     fcpu = time_runs.cpu
     ctimes, cres = time_runs(empty, Constant())
