@@ -233,9 +233,10 @@ def test_fis_sugeno_linear_count_and_missing_system() -> None:
     ramp = sugeno.replace("MF1='cheap':'linear',[1 2]", "MF1='cheap':'rampmf',[0 0.25]")
     with pytest.raises(FormatError) as info:            # fuzzylite's Tsukamoto .fis
         parse_fis(ramp, "bad.fis")
-    assert info.value.message == ("MF `cheap`: the outputs of a Sugeno-type .fis take "
-                                  "`constant` or `linear` MFs, not `rampmf`")
-    assert "write the system as FLL" in info.value.hint
+    assert info.value.message == (     # `cheap` is fine alone; its neighbour is not
+        "MF `average`: the outputs of a Sugeno-type .fis take `constant` or `linear` MFs, or "
+        "only monotonic ones (rampmf, sigmf, smf, zmf, concavemf: fuzzylite's Tsukamoto "
+        "inference), not `trimf`")
     with pytest.raises(FormatError, match=r"no \[System\] section"):
         parse_fis(FIS[FIS.index("[Input1]"):], "bad.fis")
     with pytest.raises(FormatError, match="output `tip` has no membership functions"):

@@ -102,3 +102,126 @@ def test_elsewhere_a_rule_without_condition_is_still_refused():
                   "chain.fis")
     assert info.value.message == "the rule has no condition"
     assert (info.value.span.line, info.value.span.column) == (39, 1)
+
+
+# fuzzylite's Tsukamoto systems in .fis (fuzzylite ignores `Type` and infers Tsukamoto
+# inference from a weighted defuzzifier over monotonic terms; its exporter writes
+# `Type='tsukamoto'`): read as the same system written in FLL, bit for bit.
+TSUKAMOTO_FIS = """\
+[System]
+Name='tsk'
+Type='{kind}'
+NumInputs=1
+NumOutputs=2
+NumRules=3
+AndMethod='min'
+OrMethod='max'
+ImpMethod='min'
+AggMethod='max'
+DefuzzMethod='wtaver'
+
+[Input1]
+Name='X'
+Range=[-10 10]
+NumMFs=3
+MF1='small':'gbellmf',[5 3 -10]
+MF2='medium':'gbellmf',[5 3 0]
+MF3='large':'gbellmf',[5 3 10]
+
+[Output1]
+Name='Ramps'
+Range=[0 1]
+NumMFs=3
+MF1='a':'rampmf',[0 0.25]
+MF2='b':'rampmf',[0.6 0.4]
+MF3='c':{third}
+
+[Output2]
+Name='Shapes'
+Range=[0 1]
+NumMFs=3
+MF1='a':'smf',[0 0.25]
+MF2='b':'zmf',[0.3 0.6]
+MF3='c':'concavemf',[0.9 1]
+
+[Rules]
+1, 1 1 (1) : 1
+2, 2 2 (1) : 1
+3, 3 3 (1) : 1
+"""
+TSUKAMOTO_FLL = """\
+Engine: tsk
+InputVariable: X
+  range: -10 10
+  term: small Bell -10 5 3
+  term: medium Bell 0 5 3
+  term: large Bell 10 5 3
+OutputVariable: Ramps
+  range: 0 1
+  defuzzifier: WeightedAverage
+  default: nan
+  term: a Ramp 0 0.25
+  term: b Ramp 0.6 0.4
+  term: c Ramp 0.7 1
+OutputVariable: Shapes
+  range: 0 1
+  defuzzifier: WeightedAverage
+  default: nan
+  term: a SShape 0 0.25
+  term: b ZShape 0.3 0.6
+  term: c Concave 0.9 1
+RuleBlock:
+  conjunction: Minimum
+  disjunction: Maximum
+  implication: Minimum
+  rule: if X is small then Ramps is a and Shapes is a
+  rule: if X is medium then Ramps is b and Shapes is b
+  rule: if X is large then Ramps is c and Shapes is c
+"""
+
+
+@pytest.mark.parametrize("kind", ["tsukamoto", "sugeno"])
+def test_a_fis_of_monotonic_outputs_is_tsukamoto_as_its_fll_twin(kind):
+    from mitos_cli.interop.fll import parse_fll
+
+    fis = parse_fis(TSUKAMOTO_FIS.format(kind=kind, third="'rampmf',[0.7 1]"), "tsk.fis")
+    assert dict((s.key, s.value) for s in fis.operators)["inference"] == "tsukamoto"
+    assert any("Tsukamoto inference, as fuzzylite reads it" in n for n in fis.notes)
+    x = np.linspace(-10, 10, 401)
+    ours = LoadedRuleBase(fis).evaluate(X=x)
+    twin = LoadedRuleBase(parse_fll(TSUKAMOTO_FLL, "tsk.fll")).evaluate(X=x)
+    for name in ("Ramps", "Shapes"):
+        assert ours[name].tobytes() == twin[name].tobytes()
+    w = 1 / 65            # X = 0: `small` and `large` at 1 / (1 + (10 / 5)^6), `medium` at 1
+    by_hand = (w * 0.25 * w + 0.4 + w * (0.7 + 0.3 * w)) / (1 + 2 * w)   # ramps inverted
+    assert ours["Ramps"][200] == pytest.approx(by_hand, rel=1e-12)
+
+
+def test_a_tsukamoto_fis_with_an_mf_it_cannot_invert_is_refused_at_the_mf():
+    with pytest.raises(MitosError) as info:
+        parse_fis(TSUKAMOTO_FIS.format(kind="tsukamoto", third="'constant',[0.7]"), "tsk.fis")
+    assert info.value.message.startswith("output term `Ramps.c`: Tsukamoto inference inverts "
+                                         "monotonic terms")
+    assert info.value.span.line == 27
+
+
+def test_a_sugeno_fis_mixing_monotonic_and_constant_outputs_is_refused_at_the_mf():
+    ramps = ("MF1='a':'constant',[0]\nMF2='b':'constant',[0.5]\n"
+             "MF3='c':'constant',[1]")
+    text = TSUKAMOTO_FIS.format(kind="sugeno", third="'rampmf',[0.7 1]")
+    text = text.replace("MF1='a':'rampmf',[0 0.25]\nMF2='b':'rampmf',[0.6 0.4]\n"
+                        "MF3='c':'rampmf',[0.7 1]", ramps)
+    with pytest.raises(MitosError) as info:
+        parse_fis(text, "tsk.fis")
+    assert info.value.message == ("output `Ramps`'s MF `a` is a `singleton` term, where "
+                                  "`Shapes`'s are all monotonic (Tsukamoto): MITOS takes one "
+                                  "inference per rule base")
+    assert info.value.span.line == 25
+
+
+def test_a_tsukamoto_fis_summing_its_weights_is_refused_at_the_method():
+    text = TSUKAMOTO_FIS.format(kind="tsukamoto", third="'rampmf',[0.7 1]")
+    with pytest.raises(MitosError) as info:
+        parse_fis(text.replace("'wtaver'", "'wtsum'"), "tsk.fis")
+    assert info.value.message.startswith("Tsukamoto inference with a weighted sum")
+    assert info.value.span.line == 11

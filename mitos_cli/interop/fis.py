@@ -36,6 +36,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, cast
 
 from ..errors import FormatError, Span, did_you_mean
+from ..fuzzy.shapes import TSUKAMOTO
 from ..lang.bulk import without_cyclic_gc
 from ..lang.model import And, Consequent, Or, Prop, Rule, RuleBase, Setting
 from ..lang.terms import Role, Term, Variable
@@ -76,6 +77,10 @@ MF_TYPES = {
 FUZZYLITE_MF_TYPES = {"binarymf": "Binary", "concavemf": "Concave", "cosinemf": "Cosine",
                       "discretemf": "Discrete", "rampmf": "Ramp", "rectmf": "Rectangle",
                       "spikemf": "Spike"}
+#: the weighted systems: MATLAB's Sugeno, and fuzzylite's exporter's name for Tsukamoto
+WEIGHTED_TYPES = ("sugeno", "tsukamoto")
+#: output MFs Tsukamoto inference inverts, as fuzzylite names them in a .fis file
+MONOTONIC_MFS = ("rampmf", "sigmf", "smf", "zmf", "concavemf")
 #: MATLAB's evalfis defines these its own way (its bisector is the first sample whose running
 #: area reaches half, its som and lom are by absolute value): a .fis file means MATLAB's
 MATLAB_DEFUZZIFIERS = {"bisector": "matlab_bisector", "som": "matlab_som", "lom": "matlab_lom"}
@@ -148,9 +153,9 @@ def parse_fis(text: str, path: str | None = None) -> RuleBase:
     sys_span, sys_items = by_kind["System"]
     system = _system(sys_items)
     kind = _string(*system.get("Type", ("'mamdani'", sys_span))).lower()
-    if kind not in ("mamdani", "sugeno"):
+    if kind not in ("mamdani", "sugeno", "tsukamoto"):
         raise FormatError(f"FIS type `{kind}` is not supported", span=system["Type"][1],
-                          expected="mamdani or sugeno")
+                          expected="mamdani or sugeno (or fuzzylite's tsukamoto)")
     settings, unset, sugeno = _settings(system, sys_span, kind)
     notes: list[str] = []
     ranges: common.Places = {}
@@ -169,6 +174,7 @@ def parse_fis(text: str, path: str | None = None) -> RuleBase:
     _check_unset(unset, rules)
     if sugeno:
         _sugeno_aggregation(system, rules, notes)
+        _tsukamoto(kind, outputs, settings, system, sys_span, notes)
     rb = common.assemble(path, variables, rules, settings, DEFAULT_RESOLUTION, sys_span, notes,
                          ranges)
     agg = system.get("AggMethod")                # Octave's toolkit uses it: RuleBase.unused
@@ -210,7 +216,7 @@ def _settings(system: dict[str, tuple[str, Span]], sys_span: Span,
     defuzz = method("DefuzzMethod", common.DEFUZZIFIERS, "defuzzification method",
                     "centroid" if kind == "mamdani" else "wtaver")
     sugeno = defuzz in ("weighted_average", "weighted_sum")
-    if sugeno != (kind == "sugeno"):
+    if sugeno != (kind in WEIGHTED_TYPES):
         raise FormatError(f"defuzzification `{_string(*system['DefuzzMethod'])}` does not fit a "
                           f"{kind} system", span=system["DefuzzMethod"][1])
     settings.set("defuzzify", MATLAB_DEFUZZIFIERS.get(defuzz, defuzz), None, "defuzzifier")
@@ -223,6 +229,41 @@ def _settings(system: dict[str, tuple[str, Span]], sys_span: Span,
         settings.set("resolution", DEFAULT_RESOLUTION, None, "resolution")
         settings.set("sampling", "endpoints", None, "sampling")
     return settings, unset, sugeno
+
+
+def _tsukamoto(kind: str, outputs: list[Variable], settings: Settings,
+               system: dict[str, tuple[str, Span]], sys_span: Span, notes: list[str]) -> None:
+    """fuzzylite's reading of a weighted system whose outputs hold only monotonic terms
+    (``rampmf``, ``sigmf``, ``smf``, ``zmf``, ``concavemf``): Tsukamoto inference, each term
+    inverted at its activation. fuzzylite ignores ``Type`` and infers it from the terms; its
+    exporter writes ``Type='tsukamoto'``. MATLAB has no such system."""
+    monotonic = {v.name: all(t.shape in TSUKAMOTO for t in v.terms) for v in outputs}
+    if kind != "tsukamoto" and not all(monotonic.values()):
+        if any(monotonic.values()):
+            tsuk = next(n for n, m in monotonic.items() if m)
+            other = next(v for v in outputs if not monotonic[v.name])
+            term = next(t for t in other.terms if t.shape not in TSUKAMOTO)
+            raise FormatError(f"output `{other.name}`'s MF `{term.name}` is a `{term.shape}` "
+                              f"term, where `{tsuk}`'s are all monotonic (Tsukamoto): MITOS "
+                              f"takes one inference per rule base", span=term.span,
+                              hint="give every output monotonic MFs (rampmf, sigmf, smf, zmf, "
+                                   "concavemf) or constant and linear ones")
+        return                                    # Takagi-Sugeno
+    if settings.defuzzify == "weighted_sum":
+        raise FormatError("Tsukamoto inference with a weighted sum is not supported (MITOS's "
+                          "Tsukamoto takes the weighted average)",
+                          span=system.get("DefuzzMethod", ("", sys_span))[1],
+                          hint="write DefuzzMethod='wtaver'")
+    settings.defuzzify = "tsukamoto"
+    written = "says so" if kind == "tsukamoto" else "holds only monotonic output MFs"
+    notes.append(f"{sys_span}: the system {written}: Tsukamoto inference, as fuzzylite reads "
+                 f"it (each output MF inverted where its rules' activation meets it; MATLAB "
+                 f"has no such system)")
+    for v in outputs:
+        if any(t.shape == "sigmoid" for t in v.terms):
+            notes.append(f"{v.span}: `{v.name}` inverts sigmf terms (Tsukamoto inference); a "
+                         f"sigmoid reaches 1 only at infinity, so where a rule fires fully "
+                         f"the output is +-inf, as in fuzzylite")
 
 
 def _check_unset(unset: dict[str, Span], rules: list[Rule]) -> None:
@@ -314,7 +355,7 @@ def _variable(span: Span, items: list[Item], role: Role, kind: str, n_inputs: in
                               f"keep", span=vspan, hint="set `Default=` to the value to use")
         elif key in ("Default", "LockRange") and role != "output":
             raise FormatError(f"`{key}` belongs to outputs", span=kspan)
-        elif key == "LockRange" and value.strip() != "0" and kind == "sugeno":
+        elif key == "LockRange" and value.strip() != "0" and kind in WEIGHTED_TYPES:
             raise FormatError("`LockRange=1` on a Sugeno output (clipping the output to its "
                               "range) is not supported", span=vspan, hint="set LockRange=0")
         elif key in VAR_KEYS:
@@ -368,11 +409,11 @@ def _mf(value: str, vspan: Span, role: str, kind: str, n_inputs: int) -> Term:
             raise FormatError(f"MF `{name}`: linear takes {plural(n_inputs + 1, 'number')} (one "
                               f"per input and a constant), not {len(params)}", span=vspan)
         return common.make_term(name, "linear", tuple(params), vspan)
-    if role == "output" and kind == "sugeno" and mf != "constant":
-        raise FormatError(f"MF `{name}`: the outputs of a Sugeno-type .fis take `constant` or "
-                          f"`linear` MFs, not `{mf}`", span=vspan,
-                          hint="a .fis file has no Tsukamoto inference; for monotonic outputs "
-                               "(fuzzylite's Tsukamoto), write the system as FLL")
+    if role == "output" and kind in WEIGHTED_TYPES and mf not in ("constant", *MONOTONIC_MFS):
+        raise FormatError(f"MF `{name}`: the outputs of a {kind.capitalize()}-type .fis take "
+                          f"`constant` or `linear` MFs, or only monotonic ones "
+                          f"({', '.join(MONOTONIC_MFS)}: fuzzylite's Tsukamoto inference), not "
+                          f"`{mf}`", span=vspan)
     if mf in FUZZYLITE_MF_TYPES:
         return common.fuzzylite_term(name, FUZZYLITE_MF_TYPES[mf], params, n_inputs, vspan)
     if mf not in MF_TYPES:
