@@ -255,10 +255,10 @@ def _tsukamoto(kind: str, outputs: list[Variable], settings: Settings,
                           span=system.get("DefuzzMethod", ("", sys_span))[1],
                           hint="write DefuzzMethod='wtaver'")
     settings.defuzzify = "tsukamoto"
-    written = "says so" if kind == "tsukamoto" else "holds only monotonic output MFs"
-    notes.append(f"{sys_span}: the system {written}: Tsukamoto inference, as fuzzylite reads "
-                 f"it (each output MF inverted where its rules' activation meets it; MATLAB "
-                 f"has no such system)")
+    if kind == "sugeno":                         # `Type='tsukamoto'` says so itself
+        notes.append(f"{system['Type'][1]}: a Sugeno system whose outputs hold only monotonic "
+                     f"MFs, read as fuzzylite reads it: Tsukamoto inference, each MF inverted "
+                     f"where its rules' activation meets it (MATLAB refuses such a system)")
     for v in outputs:
         if any(t.shape == "sigmoid" for t in v.terms):
             notes.append(f"{v.span}: `{v.name}` inverts sigmf terms (Tsukamoto inference); a "
