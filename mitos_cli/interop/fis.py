@@ -238,7 +238,7 @@ def _tsukamoto(kind: str, outputs: list[Variable], settings: Settings,
     inverted at its activation. fuzzylite ignores ``Type`` and infers it from the terms; its
     exporter writes ``Type='tsukamoto'``. MATLAB has no such system."""
     monotonic = {v.name: all(t.shape in TSUKAMOTO for t in v.terms) for v in outputs}
-    if kind != "tsukamoto" and not all(monotonic.values()):
+    if kind != "tsukamoto" and not (outputs and all(monotonic.values())):
         if any(monotonic.values()):
             tsuk = next(n for n, m in monotonic.items() if m)
             other = next(v for v in outputs if not monotonic[v.name])
