@@ -273,3 +273,21 @@ def test_section_1_of_bench_sim_runs_to_its_last_line(monkeypatch, capsys):
     out = capsys.readouterr().out
     assert "without the obstacle: fuzzy drive best" in out
     assert "ratio fuzzy / constant loop (no obstacle, CPU):" in out
+
+
+def test_bench_knowledge_runs_every_row_to_its_last_line(monkeypatch, capsys):
+    """Its hall of poles kept the corridor's jitter of `box`, which the world check of night 5
+    refused: the script stopped after its first row, a traceback, for a week."""
+    import dataclasses
+
+    knowledge = script("bench_knowledge", monkeypatch)
+    real = knowledge.simulate
+    monkeypatch.setattr(knowledge.best_rate, "__defaults__", (1,))
+    monkeypatch.setattr(knowledge, "simulate", lambda world, planner, scene: real(
+        dataclasses.replace(world, time_limit=0.5), planner, scene=scene))
+    knowledge.main([])
+    out = capsys.readouterr().out
+    for row in ("corridor.yaml (the map only", "300 unknown poles", "300 known poles",
+                "detour.yaml (shut way", "detour.yaml with `given: none`", "route on office.yaml"):
+        assert row in out, row
+
