@@ -256,17 +256,24 @@ def _sections(text: str) -> set[int]:
 
 def _seconds(text: str) -> float:
     """``--seconds``: a finite number of simulated seconds, 0 or more."""
-    value = float(text)
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"`{text}` is not a number of seconds") from None
     if not math.isfinite(value) or value < 0:
-        raise ValueError(text)
+        raise argparse.ArgumentTypeError(f"`{text}`: give 0 (every run to its end) or more "
+                                         "simulated seconds")
     return value
 
 
 def _sizes(text: str) -> list[int]:
     """``--sizes``: batch sizes of 1 or more, comma-separated."""
-    sizes = [int(x) for x in text.split(",")]
-    if not sizes or min(sizes) < 1:
-        raise ValueError(text)
+    try:
+        sizes = [int(x) for x in text.split(",")]
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"`{text}`: give batch sizes, e.g. 16,64") from None
+    if min(sizes) < 1:
+        raise argparse.ArgumentTypeError(f"`{text}`: each batch size must be at least 1")
     return sizes
 
 
@@ -376,7 +383,8 @@ def batch_sizes(fuzzy, rev: str | None = None, theirs=None, seconds: float = 2.0
                                                        for r in theirs_res)
             if [r.summary() for r in theirs_res] != [r.summary() for r in res]:
                 raise differs(f"the batch of {size}'s runs", rev)
-            line += f"; {rev}: {1e6 * old_per:.0f} us ({old_per / per:.2f}x slower, same runs)"
+            # a ratio, not "slower": below 1 the other tree is the faster one
+            line += f"; {rev}: {1e6 * old_per:.0f} us ({old_per / per:.2f}x this tree's, same runs)"
         print(line)
 
 

@@ -105,6 +105,10 @@ def script(name: str, monkeypatch):
     ("bench_sim", ["--only", "9"], "argument --only: `9`: the sections are 1 to 5"),
     ("bench_sim", ["--only", "5", "--runs", "0"], "argument --runs: `0`: must be at least 1"),
     ("bench_sim", ["--only", "2", "--against", "nosuchrev"], "unknown revision `nosuchrev`"),
+    ("bench_sim", ["--only", "4", "--seconds", "x"], "argument --seconds: `x` is not a number of seconds"),
+    ("bench_sim", ["--only", "4", "--seconds", "-1"], "argument --seconds: `-1`: give 0"),
+    ("bench_sim", ["--only", "4", "--sizes", "16,0"], "argument --sizes: `16,0`: each batch size must be"),
+    ("bench_sim", ["--only", "4", "--sizes", "16,x"], "argument --sizes: `16,x`: give batch sizes"),
     ("bench_core", ["--against", "nosuchrev"], "unknown revision `nosuchrev`"),
     ("bench_norms", ["--quick", "--repeat", "0"], "argument --repeat: `0`: must be at least 1"),
     ("bench_compare", ["--runs", "0"], "argument --runs: `0`: must be at least 1"),
@@ -291,3 +295,23 @@ def test_bench_knowledge_runs_every_row_to_its_last_line(monkeypatch, capsys):
                 "detour.yaml (shut way", "detour.yaml with `given: none`", "route on office.yaml"):
         assert row in out, row
 
+
+def test_section_4_against_a_revision_gives_a_ratio_not_slower(tmp_path, monkeypatch, capsys):
+    """Section 4 with ``--against``: the other tree's batch beside this one's, both the same
+    runs; its ratio read "1.08x slower", and below 1 "0.93x slower" said the wrong way."""
+    sim = tmp_path / "samerev" / "sim"
+    sim.mkdir(parents=True)
+    (sim.parent / "__init__.py").write_text("")
+    (sim / "__init__.py").write_text("")
+    for module, names in (("worldfile", "load_world"), ("planner", "FuzzyPlanner"),
+                          ("loop", "prepare, simulate"), ("lockstep", "run_lockstep")):
+        (sim / f"{module}.py").write_text(f"from mitos_cli.sim.{module} import {names}\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    import importlib
+
+    bench_sim = script("bench_sim", monkeypatch)
+    bench_sim.batch_sizes(bench_sim.FuzzyPlanner(None, "drive"), "samerev",
+                          importlib.import_module("samerev"), seconds=0.25, sizes=[16])
+    out = capsys.readouterr().out
+    assert "batch    16 (16 runs):" in out and "x this tree's, same runs)" in out
+    assert "slower" not in out
