@@ -109,6 +109,7 @@ def script(name: str, monkeypatch):
     ("bench_sim", ["--only", "4", "--seconds", "-1"], "argument --seconds: `-1`: give 0"),
     ("bench_sim", ["--only", "4", "--sizes", "16,0"], "argument --sizes: `16,0`: each batch size must be"),
     ("bench_sim", ["--only", "4", "--sizes", "16,x"], "argument --sizes: `16,x`: give batch sizes"),
+    ("bench_bigmap", ["--sizes", "600"], "argument --sizes: `600`: each size from 1,700"),
     ("bench_core", ["--against", "nosuchrev"], "unknown revision `nosuchrev`"),
     ("bench_norms", ["--quick", "--repeat", "0"], "argument --repeat: `0`: must be at least 1"),
     ("bench_compare", ["--runs", "0"], "argument --runs: `0`: must be at least 1"),
@@ -315,3 +316,10 @@ def test_section_4_against_a_revision_gives_a_ratio_not_slower(tmp_path, monkeyp
     out = capsys.readouterr().out
     assert "batch    16 (16 runs):" in out and "x this tree's, same runs)" in out
     assert "slower" not in out
+
+
+def test_bigmap_compares_two_trees_in_ratios_not_faster(monkeypatch):
+    compared = script("bench_bigmap", monkeypatch).compared
+    line = compared("abc1234", (2.0, 100.0), (1.0, 110.0))
+    assert line.endswith("abc1234 / this tree: time 0.50x, peak memory 1.10x, same results")
+    assert "faster" not in line and "less" not in line
