@@ -110,6 +110,8 @@ def script(name: str, monkeypatch):
     ("bench_sim", ["--only", "4", "--sizes", "16,0"], "argument --sizes: `16,0`: each batch size must be"),
     ("bench_sim", ["--only", "4", "--sizes", "16,x"], "argument --sizes: `16,x`: give batch sizes"),
     ("bench_bigmap", ["--sizes", "600"], "argument --sizes: `600`: each size from 1,700"),
+    ("bench_check", ["--sizes", "20", "--against", "{tmp}/no-mitos"],
+     "argument --against: `{tmp}/no-mitos` is not a command that runs"),
     ("bench_core", ["--against", "nosuchrev"], "unknown revision `nosuchrev`"),
     ("bench_norms", ["--quick", "--repeat", "0"], "argument --repeat: `0`: must be at least 1"),
     ("bench_compare", ["--runs", "0"], "argument --runs: `0`: must be at least 1"),
