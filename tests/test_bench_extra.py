@@ -299,6 +299,13 @@ def test_bench_knowledge_runs_every_row_to_its_last_line(monkeypatch, capsys):
         assert row in out, row
 
 
+def test_a_ratio_far_below_one_keeps_its_digits_in_bench_export(monkeypatch):
+    """pyfuzzylite on scalars, some 500 times slower than the engine, printed as 0.00x."""
+    ratio_text = script("bench_export", monkeypatch).ratio_text
+    assert ratio_text(2.2 / 1200) == "0.0018"
+    assert (ratio_text(1.0), ratio_text(0.55), ratio_text(12.345)) == ("1.00", "0.55", "12.35")
+
+
 def test_section_4_against_a_revision_gives_a_ratio_not_slower(tmp_path, monkeypatch, capsys):
     """Section 4 with ``--against``: the other tree's batch beside this one's, both the same
     runs; its ratio read "1.08x slower", and below 1 "0.93x slower" said the wrong way."""
