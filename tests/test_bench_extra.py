@@ -332,3 +332,19 @@ def test_bigmap_compares_two_trees_in_ratios_not_faster(monkeypatch):
     line = compared("abc1234", (2.0, 100.0), (1.0, 110.0))
     assert line.endswith("abc1234 / this tree: time 0.50x, peak memory 1.10x, same results")
     assert "faster" not in line and "less" not in line
+
+
+@pytest.mark.parametrize("argv, said", [
+    (["--drive", "fuzy", "--barn", "0"], "unknown planner `fuzy`"),
+    (["--drive", "fuzzy", "--barn", "0", "--mrpb", "{tmp}/no"],
+     "`--drive fuzzy` drives MRPB's tests, and MRPB 1.0's maps are not in `{tmp}/no`"),
+])
+def test_route_clearance_says_a_drive_it_cannot_do_before_any_route(argv, said, tmp_path,
+                                                                   monkeypatch, capsys):
+    """``--drive`` was met at MRPB's first test, after every world's route, as a traceback;
+    without MRPB's maps it was dropped without a word."""
+    module = script("route_clearance", monkeypatch)
+    assert module.main([a.format(tmp=tmp_path) for a in argv]) == 1
+    captured = capsys.readouterr()
+    assert said.format(tmp=tmp_path) in captured.err and "Traceback" not in captured.err
+    assert "routes" not in captured.out
