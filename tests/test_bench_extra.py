@@ -113,6 +113,7 @@ def script(name: str, monkeypatch):
     ("bench_check", ["--sizes", "20", "--against", "{tmp}/no-mitos"],
      "argument --against: `{tmp}/no-mitos` is not a command that runs"),
     ("bench_core", ["--against", "nosuchrev"], "unknown revision `nosuchrev`"),
+    ("bench_core", ["--startup", "--against", "HEAD"], "--startup times this tree alone"),
     ("bench_norms", ["--quick", "--repeat", "0"], "argument --repeat: `0`: must be at least 1"),
     ("bench_compare", ["--runs", "0"], "argument --runs: `0`: must be at least 1"),
     ("bench_nav", ["--ticks-obstacles", "-5"], "`-5`: must be at least 1"),
