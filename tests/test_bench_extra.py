@@ -349,3 +349,50 @@ def test_route_clearance_says_a_drive_it_cannot_do_before_any_route(argv, said, 
     captured = capsys.readouterr()
     assert said.format(tmp=tmp_path) in captured.err and "Traceback" not in captured.err
     assert "routes" not in captured.out
+
+
+class _Parsed(BaseException):
+    """Raised in place of parsing: the script's own parser is what the test wanted."""
+
+
+def benchmark_options(name: str, monkeypatch) -> set[str]:
+    """The option strings the parser of ``benchmarks/{name}.py`` accepts (its ``main`` stopped
+    at ``parse_args``, before anything runs)."""
+    import argparse
+
+    module = script(name, monkeypatch)
+    seen: list[argparse.ArgumentParser] = []
+
+    def parse_args(self, args=None, namespace=None):
+        seen.append(self)
+        raise _Parsed
+
+    monkeypatch.setattr(argparse.ArgumentParser, "parse_args", parse_args)
+    with pytest.raises(_Parsed):
+        module.main([]) if "argv" in module.main.__code__.co_varnames else module.main()
+    monkeypatch.undo()
+    return set(seen[0]._option_string_actions)
+
+
+def test_every_benchmark_command_in_the_docs_names_options_its_script_takes(monkeypatch):
+    """A command a page gives (docs/*.md but the changelog's history, README.md) runs a
+    script that exists, with options its parser takes: a renamed or dropped option is met
+    here, not by the reader who copies the line."""
+    pages = [p for p in sorted((ROOT / "docs").glob("*.md")) if p.name != "changelog.md"]
+    commands = [(page.name, m.group(1), m.group(2))
+                for page in [*pages, ROOT / "README.md"]
+                for m in re.finditer(r"python3? benchmarks/(\w+)\.py([^`|#\n]*)",
+                                     page.read_text(encoding="utf-8"))]
+    assert len(commands) > 100
+    options: dict[str, set[str]] = {}
+    wrong = []
+    for page, name, rest in commands:
+        if not (ROOT / "benchmarks" / f"{name}.py").is_file():
+            wrong.append(f"{page}: benchmarks/{name}.py does not exist")
+            continue
+        if name not in options:
+            options[name] = benchmark_options(name, monkeypatch)
+        wrong += [f"{page}: {name}.py {option}"
+                  for option in re.findall(r"(?<!\S)--[a-z][\w-]*", rest)
+                  if option not in options[name]]
+    assert not wrong, wrong
