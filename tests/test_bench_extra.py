@@ -396,3 +396,15 @@ def test_every_benchmark_command_in_the_docs_names_options_its_script_takes(monk
                   for option in re.findall(r"(?<!\S)--[a-z][\w-]*", rest)
                   if option not in options[name]]
     assert not wrong, wrong
+
+
+def test_the_fuzz_help_gives_the_kinds_whose_count_is_a_share_of_per_format(monkeypatch,
+                                                                            capsys):
+    """``--per-format 20`` ran 1 lesson, 6 command lines and 28 CSVs; the help said "inputs
+    per input kind" and ``--quick`` "150 per kind"."""
+    fuzz = script("fuzz", monkeypatch)
+    with pytest.raises(SystemExit):
+        fuzz.main(["--help"])
+    help_text = " ".join(capsys.readouterr().out.split())
+    assert "(lessons 1/12, CLI arguments 1/3, eval --batch CSV 1.4x, teach journals 1.4x" in help_text
+    assert "a short campaign (--per-format 150)" in help_text
