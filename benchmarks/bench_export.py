@@ -12,7 +12,8 @@ it times, on the same 10^5 random inputs, best of 5 after a warm-up:
 - the exported NumPy module (`mitos export --to python`, `evaluate(X)`),
 - the exported C (`mitos export --to c`, compiled `cc -std=c99 -O2`, one call per sample in a
   loop, timed inside the C program with `clock()`),
-- pyfuzzylite 8's vectorized engine on the same system written by MITOS's FLL writer,
+- pyfuzzylite 8's vectorized engine on the same system written by MITOS's FLL writer (best
+  of 3),
 
 after checking that all four compute the same outputs. Then one sample at a time, as a
 robot's control loop calls them (median of 2,000 calls over the first inputs): MITOS's
