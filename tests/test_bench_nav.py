@@ -156,3 +156,16 @@ def test_the_run_line_names_the_suites_run():
                            "MRPB safety distance 3.94 in (0.1 m); 28 tasks in 61 s on 2 of ")
     assert bench_nav.run_line(("mrpb",), 10, 0, 2, 34, 5.0, 1).startswith(
         "MRPB safety distance 3.94 in (0.1 m); 34 tasks in 5 s on 1 of ")
+
+
+def test_the_barn_aim_is_not_met_by_a_run_without_dwa():
+    """"At least DWA's success" read "yes" in a run of the fuzzy planner alone."""
+    fuzzy = {"success_rate": 0.95, "collision_rate": 0.0, "runs": 20}
+    alone = bench_nav.aims({"barn-unknown": {"fuzzy": fuzzy}}, None)[2]
+    assert alone.endswith("DWA - (20 fields) | its fuzzy part yes; DWA not run |")
+    both = {"barn-unknown": {"fuzzy": fuzzy, "dwa": {**fuzzy, "success_rate": 0.97}}}
+    assert bench_nav.aims(both, None)[2].endswith("DWA 97% (20 fields) | no |")
+    both["barn-unknown"]["dwa"]["success_rate"] = 0.9
+    assert bench_nav.aims(both, None)[2].endswith("DWA 90% (20 fields) | yes |")
+    fuzzy["collision_rate"] = 0.1
+    assert bench_nav.aims({"barn-unknown": {"fuzzy": fuzzy}}, None)[2].endswith("| no |")
