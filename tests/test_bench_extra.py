@@ -408,3 +408,13 @@ def test_the_fuzz_help_gives_the_kinds_whose_count_is_a_share_of_per_format(monk
     help_text = " ".join(capsys.readouterr().out.split())
     assert "(lessons 1/12, CLI arguments 1/3, eval --batch CSV 1.4x, teach journals 1.4x" in help_text
     assert "a short campaign (--per-format 150)" in help_text
+
+
+def test_a_long_writer_refusal_is_cut_between_words_in_the_conformance_summary(monkeypatch):
+    kind = script("bench_conformance", monkeypatch).refusal_kind
+    cut = kind("input `x` has no terms (it only feeds linear consequents); a YAML term set "
+               "needs at least one term per variable")
+    assert cut == \
+        "input `...` has no terms (it only feeds linear consequents); a YAML term set needs at ..."
+    assert kind("term `a`: MATLAB has no `b` membership function") == \
+        "term `...`: MATLAB has no `...` membership function"
