@@ -216,6 +216,9 @@ def main(argv: list[str] | None = None) -> None:
                     "revision REV's, interleaved in one process")
     args = ap.parse_args(argv)
     sections = args.only
+    if args.against and not sections & {2, 4}:      # it imported REV's tree and compared nothing
+        ap.error(f"--against compares sections 2 and 4, and --only {_listed(sections)} has "
+                 "neither")
     print(f"{platform.python_version()}, numpy {np.__version__}, {_cpus()}, "
           f"load average {_load():.2f} at start")
     fuzzy = FuzzyPlanner(None, "drive")
@@ -252,6 +255,10 @@ def _sections(text: str) -> set[int]:
     if not sections <= {1, 2, 3, 4, 5}:
         raise argparse.ArgumentTypeError(f"`{text}`: the sections are 1 to 5")
     return sections
+
+
+def _listed(sections: set[int]) -> str:
+    return ",".join(map(str, sorted(sections)))
 
 
 def _seconds(text: str) -> float:

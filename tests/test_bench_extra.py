@@ -105,6 +105,8 @@ def script(name: str, monkeypatch):
     ("bench_sim", ["--only", "9"], "argument --only: `9`: the sections are 1 to 5"),
     ("bench_sim", ["--only", "5", "--runs", "0"], "argument --runs: `0`: must be at least 1"),
     ("bench_sim", ["--only", "2", "--against", "nosuchrev"], "unknown revision `nosuchrev`"),
+    ("bench_sim", ["--only", "5,1", "--against", "HEAD"],
+     "--against compares sections 2 and 4, and --only 1,5 has neither"),
     ("bench_sim", ["--only", "4", "--seconds", "x"], "argument --seconds: `x` is not a number of seconds"),
     ("bench_sim", ["--only", "4", "--seconds", "-1"], "argument --seconds: `-1`: give 0"),
     ("bench_sim", ["--only", "4", "--sizes", "16,0"], "argument --sizes: `16,0`: each batch size must be"),
