@@ -24,6 +24,7 @@ from __future__ import annotations
 import argparse
 import math
 import os
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -31,7 +32,7 @@ import time
 from pathlib import Path
 
 import numpy as np
-from options import ROOT, positive_int
+from options import ROOT, guarded, positive_int
 
 UNIVERSE = (0.0, 100.0)
 
@@ -82,7 +83,17 @@ def run(command: list[str], rules: Path, env: dict[str, str]
     return wall, usage.ru_utime + usage.ru_stime, usage.ru_maxrss / 1024.0, proc.returncode, out
 
 
-def main() -> int:
+def command(text: str) -> str:
+    """``--against``: a command that runs (a path to a ``mitos`` or a name on ``PATH``),
+    checked before the first size is timed, not met as a traceback after it."""
+    if shutil.which(text) is None:
+        raise argparse.ArgumentTypeError(f"`{text}` is not a command that runs (give the "
+                                         "path of another tree's `mitos`)")
+    return text
+
+
+@guarded
+def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--sizes", default="100,300,600,2000",
                         help="numbers of terms, comma-separated (default 100,300,600,2000)")
@@ -91,10 +102,10 @@ def main() -> int:
                         help="the role of the variable with many terms (default input)")
     parser.add_argument("--step", action="store_true",
                         help="add a crisp step (a trapezoid with an upright edge) to the terms")
-    parser.add_argument("--against", metavar="MITOS",
+    parser.add_argument("--against", metavar="MITOS", type=command,
                         help="another `mitos` command to time on the same files")
     parser.add_argument("--write", metavar="DIR", help="write the files there and stop")
-    args = parser.parse_args()
+    args = parser.parse_args(argv)
     try:
         sizes = [positive_int(s) for s in args.sizes.split(",")]
     except argparse.ArgumentTypeError as e:

@@ -417,6 +417,9 @@ def main(argv: list[str] | None = None) -> None:
                     help="only the column batch, one evaluation and start-up of this tree against "
                          "git revision REV's (e.g. main), in one process, rounds interleaved")
     args = ap.parse_args(argv)
+    if args.startup and args.against:       # --startup ran alone and --against went unsaid
+        ap.error("--startup times this tree alone; --against times its start-up against REV's "
+                 "too: give one of them")
     if args.startup:
         startup(runs=21)
         return

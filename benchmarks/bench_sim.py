@@ -216,6 +216,9 @@ def main(argv: list[str] | None = None) -> None:
                     "revision REV's, interleaved in one process")
     args = ap.parse_args(argv)
     sections = args.only
+    if args.against and not sections & {2, 4}:      # it imported REV's tree and compared nothing
+        ap.error(f"--against compares sections 2 and 4, and --only {_listed(sections)} has "
+                 "neither")
     print(f"{platform.python_version()}, numpy {np.__version__}, {_cpus()}, "
           f"load average {_load():.2f} at start")
     fuzzy = FuzzyPlanner(None, "drive")
@@ -254,19 +257,30 @@ def _sections(text: str) -> set[int]:
     return sections
 
 
+def _listed(sections: set[int]) -> str:
+    return ",".join(map(str, sorted(sections)))
+
+
 def _seconds(text: str) -> float:
     """``--seconds``: a finite number of simulated seconds, 0 or more."""
-    value = float(text)
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"`{text}` is not a number of seconds") from None
     if not math.isfinite(value) or value < 0:
-        raise ValueError(text)
+        raise argparse.ArgumentTypeError(f"`{text}`: give 0 (every run to its end) or more "
+                                         "simulated seconds")
     return value
 
 
 def _sizes(text: str) -> list[int]:
     """``--sizes``: batch sizes of 1 or more, comma-separated."""
-    sizes = [int(x) for x in text.split(",")]
-    if not sizes or min(sizes) < 1:
-        raise ValueError(text)
+    try:
+        sizes = [int(x) for x in text.split(",")]
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"`{text}`: give batch sizes, e.g. 16,64") from None
+    if min(sizes) < 1:
+        raise argparse.ArgumentTypeError(f"`{text}`: each batch size must be at least 1")
     return sizes
 
 
@@ -376,7 +390,8 @@ def batch_sizes(fuzzy, rev: str | None = None, theirs=None, seconds: float = 2.0
                                                        for r in theirs_res)
             if [r.summary() for r in theirs_res] != [r.summary() for r in res]:
                 raise differs(f"the batch of {size}'s runs", rev)
-            line += f"; {rev}: {1e6 * old_per:.0f} us ({old_per / per:.2f}x slower, same runs)"
+            # a ratio, not "slower": below 1 the other tree is the faster one
+            line += f"; {rev}: {1e6 * old_per:.0f} us ({old_per / per:.2f}x this tree's, same runs)"
         print(line)
 
 

@@ -2,7 +2,7 @@
 
 Run from the repository root (one command each)::
 
-    python benchmarks/fuzz.py --quick                       # a short campaign (150 per kind)
+    python benchmarks/fuzz.py --quick                       # a short campaign: --per-format 150
     python benchmarks/fuzz.py --per-format 9000 --out fuzz-found      # 100,950 inputs
     python benchmarks/fuzz.py --per-format 9000 --jobs 2 --out fuzz-found  # on 2 cores
     python benchmarks/fuzz.py --per-format 9000 --shard 0/4           # a quarter of them
@@ -1235,8 +1235,11 @@ def run_jobs(args) -> list[Kind]:
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--per-format", type=positive_int, default=2000, help="inputs per input kind")
-    ap.add_argument("--quick", action="store_true", help="a short campaign (150 per kind)")
+    ap.add_argument("--per-format", type=positive_int, default=2000,
+                    help="inputs per input kind (" + ", ".join(
+                        f"{kind} " + (f"1/{round(1 / share)}" if share < 1 else f"{share:g}x")
+                        for kind, share in SHARE.items()) + " of it: docs/reliability.md)")
+    ap.add_argument("--quick", action="store_true", help="a short campaign (--per-format 150)")
     ap.add_argument("--out", type=Path, default=None,
                     help="directory for minimal reproducers of new signatures")
     ap.add_argument("--only", default=None,

@@ -36,14 +36,14 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-from options import count, writable
+from options import count, guarded, writable
 
-from mitos_cli.errors import MitosError
+from mitos_cli.errors import MitosError, unknown
 from mitos_cli.sim import barn, knowledge, loop, mrpb
 from mitos_cli.sim import route as route_mod
 from mitos_cli.sim.geometry import box_segment_distance
 from mitos_cli.sim.loop import clearances, prepare, simulate
-from mitos_cli.sim.planner import make_planner
+from mitos_cli.sim.planner import PLANNERS, make_planner
 from mitos_cli.sim.worldfile import load_world
 
 HERE = Path(__file__).resolve().parent
@@ -190,6 +190,7 @@ def report(suite: str, name: str, m: dict) -> None:
           f"({ax:.1f}, {ay:.1f})-({bx:.1f}, {by:.1f})")
 
 
+@guarded
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--mrpb", type=Path, default=MRPB_DIR, help="MRPB 1.0's maps and tests")
@@ -199,6 +200,15 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--json", type=writable, default=None,
                     help="write every route's figures here")
     args = ap.parse_args(argv)
+    if args.drive is not None:
+        # said now, not as a traceback at MRPB's first test after the routes of every world
+        if args.drive not in PLANNERS:
+            raise unknown("planner", args.drive, PLANNERS)
+        if not args.mrpb.is_dir():
+            raise MitosError(f"`--drive {args.drive}` drives MRPB's tests, and MRPB 1.0's maps "
+                             f"are not in `{args.mrpb}`",
+                             hint="give their folder with `--mrpb DIR` (by default "
+                                  "../shared/maps/mrpb beside the repository)")
     rec = Recorder()
     old = rec.install()
     rows: list[dict] = []

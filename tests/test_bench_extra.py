@@ -105,7 +105,17 @@ def script(name: str, monkeypatch):
     ("bench_sim", ["--only", "9"], "argument --only: `9`: the sections are 1 to 5"),
     ("bench_sim", ["--only", "5", "--runs", "0"], "argument --runs: `0`: must be at least 1"),
     ("bench_sim", ["--only", "2", "--against", "nosuchrev"], "unknown revision `nosuchrev`"),
+    ("bench_sim", ["--only", "5,1", "--against", "HEAD"],
+     "--against compares sections 2 and 4, and --only 1,5 has neither"),
+    ("bench_sim", ["--only", "4", "--seconds", "x"], "argument --seconds: `x` is not a number of seconds"),
+    ("bench_sim", ["--only", "4", "--seconds", "-1"], "argument --seconds: `-1`: give 0"),
+    ("bench_sim", ["--only", "4", "--sizes", "16,0"], "argument --sizes: `16,0`: each batch size must be"),
+    ("bench_sim", ["--only", "4", "--sizes", "16,x"], "argument --sizes: `16,x`: give batch sizes"),
+    ("bench_bigmap", ["--sizes", "600"], "argument --sizes: `600`: each size from 1,700"),
+    ("bench_check", ["--sizes", "20", "--against", "{tmp}/no-mitos"],
+     "argument --against: `{tmp}/no-mitos` is not a command that runs"),
     ("bench_core", ["--against", "nosuchrev"], "unknown revision `nosuchrev`"),
+    ("bench_core", ["--startup", "--against", "HEAD"], "--startup times this tree alone"),
     ("bench_norms", ["--quick", "--repeat", "0"], "argument --repeat: `0`: must be at least 1"),
     ("bench_compare", ["--runs", "0"], "argument --runs: `0`: must be at least 1"),
     ("bench_nav", ["--ticks-obstacles", "-5"], "`-5`: must be at least 1"),
@@ -273,3 +283,140 @@ def test_section_1_of_bench_sim_runs_to_its_last_line(monkeypatch, capsys):
     out = capsys.readouterr().out
     assert "without the obstacle: fuzzy drive best" in out
     assert "ratio fuzzy / constant loop (no obstacle, CPU):" in out
+
+
+def test_bench_knowledge_runs_every_row_to_its_last_line(monkeypatch, capsys):
+    """Its hall of poles kept the corridor's jitter of `box`, which the world check of night 5
+    refused: the script stopped after its first row, a traceback, for a week."""
+    import dataclasses
+
+    knowledge = script("bench_knowledge", monkeypatch)
+    real = knowledge.simulate
+    monkeypatch.setattr(knowledge.best_rate, "__defaults__", (1,))
+    monkeypatch.setattr(knowledge, "simulate", lambda world, planner, scene: real(
+        dataclasses.replace(world, time_limit=0.5), planner, scene=scene))
+    knowledge.main([])
+    out = capsys.readouterr().out
+    for row in ("corridor.yaml (the map only", "300 unknown poles", "300 known poles",
+                "detour.yaml (shut way", "detour.yaml with `given: none`", "route on office.yaml"):
+        assert row in out, row
+
+
+def test_a_ratio_far_below_one_keeps_its_digits_in_bench_export(monkeypatch):
+    """pyfuzzylite on scalars, some 500 times slower than the engine, printed as 0.00x."""
+    ratio_text = script("bench_export", monkeypatch).ratio_text
+    assert ratio_text(2.2 / 1200) == "0.0018"
+    assert (ratio_text(1.0), ratio_text(0.55), ratio_text(12.345)) == ("1.00", "0.55", "12.35")
+
+
+def test_section_4_against_a_revision_gives_a_ratio_not_slower(tmp_path, monkeypatch, capsys):
+    """Section 4 with ``--against``: the other tree's batch beside this one's, both the same
+    runs; its ratio read "1.08x slower", and below 1 "0.93x slower" said the wrong way."""
+    sim = tmp_path / "samerev" / "sim"
+    sim.mkdir(parents=True)
+    (sim.parent / "__init__.py").write_text("")
+    (sim / "__init__.py").write_text("")
+    for module, names in (("worldfile", "load_world"), ("planner", "FuzzyPlanner"),
+                          ("loop", "prepare, simulate"), ("lockstep", "run_lockstep")):
+        (sim / f"{module}.py").write_text(f"from mitos_cli.sim.{module} import {names}\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    import importlib
+
+    bench_sim = script("bench_sim", monkeypatch)
+    bench_sim.batch_sizes(bench_sim.FuzzyPlanner(None, "drive"), "samerev",
+                          importlib.import_module("samerev"), seconds=0.25, sizes=[16])
+    out = capsys.readouterr().out
+    assert "batch    16 (16 runs):" in out and "x this tree's, same runs)" in out
+    assert "slower" not in out
+
+
+def test_bigmap_compares_two_trees_in_ratios_not_faster(monkeypatch):
+    compared = script("bench_bigmap", monkeypatch).compared
+    line = compared("abc1234", (2.0, 100.0), (1.0, 110.0))
+    assert line.endswith("abc1234 / this tree: time 0.50x, peak memory 1.10x, same results")
+    assert "faster" not in line and "less" not in line
+
+
+@pytest.mark.parametrize("argv, said", [
+    (["--drive", "fuzy", "--barn", "0"], "unknown planner `fuzy`"),
+    (["--drive", "fuzzy", "--barn", "0", "--mrpb", "{tmp}/no"],
+     "`--drive fuzzy` drives MRPB's tests, and MRPB 1.0's maps are not in `{tmp}/no`"),
+])
+def test_route_clearance_says_a_drive_it_cannot_do_before_any_route(argv, said, tmp_path,
+                                                                   monkeypatch, capsys):
+    """``--drive`` was met at MRPB's first test, after every world's route, as a traceback;
+    without MRPB's maps it was dropped without a word."""
+    module = script("route_clearance", monkeypatch)
+    assert module.main([a.format(tmp=tmp_path) for a in argv]) == 1
+    captured = capsys.readouterr()
+    assert said.format(tmp=tmp_path) in captured.err and "Traceback" not in captured.err
+    assert "routes" not in captured.out
+
+
+class _Parsed(BaseException):
+    """Raised in place of parsing: the script's own parser is what the test wanted."""
+
+
+def benchmark_options(name: str, monkeypatch) -> set[str]:
+    """The option strings the parser of ``benchmarks/{name}.py`` accepts (its ``main`` stopped
+    at ``parse_args``, before anything runs)."""
+    import argparse
+
+    module = script(name, monkeypatch)
+    seen: list[argparse.ArgumentParser] = []
+
+    def parse_args(self, args=None, namespace=None):
+        seen.append(self)
+        raise _Parsed
+
+    monkeypatch.setattr(argparse.ArgumentParser, "parse_args", parse_args)
+    with pytest.raises(_Parsed):
+        module.main([]) if "argv" in module.main.__code__.co_varnames else module.main()
+    monkeypatch.undo()
+    return set(seen[0]._option_string_actions)
+
+
+def test_every_benchmark_command_in_the_docs_names_options_its_script_takes(monkeypatch):
+    """A command a page gives (docs/*.md but the changelog's history, README.md) runs a
+    script that exists, with options its parser takes: a renamed or dropped option is met
+    here, not by the reader who copies the line."""
+    pages = [p for p in sorted((ROOT / "docs").glob("*.md")) if p.name != "changelog.md"]
+    commands = [(page.name, m.group(1), m.group(2))
+                for page in [*pages, ROOT / "README.md"]
+                for m in re.finditer(r"python3? benchmarks/(\w+)\.py([^`|#\n]*)",
+                                     page.read_text(encoding="utf-8"))]
+    assert len(commands) > 100
+    options: dict[str, set[str]] = {}
+    wrong = []
+    for page, name, rest in commands:
+        if not (ROOT / "benchmarks" / f"{name}.py").is_file():
+            wrong.append(f"{page}: benchmarks/{name}.py does not exist")
+            continue
+        if name not in options:
+            options[name] = benchmark_options(name, monkeypatch)
+        wrong += [f"{page}: {name}.py {option}"
+                  for option in re.findall(r"(?<!\S)--[a-z][\w-]*", rest)
+                  if option not in options[name]]
+    assert not wrong, wrong
+
+
+def test_the_fuzz_help_gives_the_kinds_whose_count_is_a_share_of_per_format(monkeypatch,
+                                                                            capsys):
+    """``--per-format 20`` ran 1 lesson, 6 command lines and 28 CSVs; the help said "inputs
+    per input kind" and ``--quick`` "150 per kind"."""
+    fuzz = script("fuzz", monkeypatch)
+    with pytest.raises(SystemExit):
+        fuzz.main(["--help"])
+    help_text = " ".join(capsys.readouterr().out.split())
+    assert "(lessons 1/12, CLI arguments 1/3, eval --batch CSV 1.4x, teach journals 1.4x" in help_text
+    assert "a short campaign (--per-format 150)" in help_text
+
+
+def test_a_long_writer_refusal_is_cut_between_words_in_the_conformance_summary(monkeypatch):
+    kind = script("bench_conformance", monkeypatch).refusal_kind
+    cut = kind("input `x` has no terms (it only feeds linear consequents); a YAML term set "
+               "needs at least one term per variable")
+    assert cut == \
+        "input `...` has no terms (it only feeds linear consequents); a YAML term set needs at ..."
+    assert kind("term `a`: MATLAB has no `b` membership function") == \
+        "term `...`: MATLAB has no `...` membership function"

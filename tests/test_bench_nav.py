@@ -133,3 +133,39 @@ def test_the_ticks_line_refuses_more_obstacles_than_its_field_holds():
     assert len(bench_nav.ticks_world(348, 0).obstacles) == 348
     with pytest.raises(bench_nav.MitosError, match="holds 348 poles, not 349"):
         bench_nav.ticks_world(349, 0)
+
+
+def test_the_ticks_line_alone_prints_no_empty_table_nor_suites_it_did_not_run(monkeypatch,
+                                                                              capsys):
+    """``--suites ticks`` printed the table's header with no row and ended with "BARN: 100
+    worlds from seed 0; clutter: 10 draws per world" of a run of neither."""
+    monkeypatch.setattr(bench_nav, "TICKS", 10)
+    assert bench_nav.main(["--suites", "ticks", "--planners", "fuzzy", "--jobs", "1",
+                           "--ticks-obstacles", "20"]) == 0
+    out = capsys.readouterr().out
+    assert out.startswith("ticks: 20 unknown obstacles (barn-poles-20), one core: fuzzy ")
+    assert "| 20 unknown obstacles: the fuzzy planner >= 100 ticks/s on one core |" in out
+    last = out.splitlines()[-1]
+    assert last.startswith("ticks: the field of seed 0; 0 tasks in ")
+    assert "BARN" not in out and "clutter" not in out and "planner  runs" not in out
+
+
+def test_the_run_line_names_the_suites_run():
+    line = bench_nav.run_line(("barn-unknown", "clutter"), 10, 1000, 2, 28, 61.0, 2)
+    assert line.startswith("BARN: 10 worlds from seed 1000; clutter: 2 draws per world; "
+                           "MRPB safety distance 3.94 in (0.1 m); 28 tasks in 61 s on 2 of ")
+    assert bench_nav.run_line(("mrpb",), 10, 0, 2, 34, 5.0, 1).startswith(
+        "MRPB safety distance 3.94 in (0.1 m); 34 tasks in 5 s on 1 of ")
+
+
+def test_the_barn_aim_is_not_met_by_a_run_without_dwa():
+    """"At least DWA's success" read "yes" in a run of the fuzzy planner alone."""
+    fuzzy = {"success_rate": 0.95, "collision_rate": 0.0, "runs": 20}
+    alone = bench_nav.aims({"barn-unknown": {"fuzzy": fuzzy}}, None)[2]
+    assert alone.endswith("DWA - (20 fields) | its fuzzy part yes; DWA not run |")
+    both = {"barn-unknown": {"fuzzy": fuzzy, "dwa": {**fuzzy, "success_rate": 0.97}}}
+    assert bench_nav.aims(both, None)[2].endswith("DWA 97% (20 fields) | no |")
+    both["barn-unknown"]["dwa"]["success_rate"] = 0.9
+    assert bench_nav.aims(both, None)[2].endswith("DWA 90% (20 fields) | yes |")
+    fuzzy["collision_rate"] = 0.1
+    assert bench_nav.aims({"barn-unknown": {"fuzzy": fuzzy}}, None)[2].endswith("| no |")
