@@ -678,3 +678,19 @@ def test_no_contact_between_ticks_is_missed(steering, speed, f, corner, inset):
         assert found is not None and found <= 0.0
     if found is not None:
         assert found <= 0.0
+
+
+def test_a_misnamed_jitter_among_many_obstacles_names_a_few_and_the_nearest():
+    """A world of 300 poles listed all 300 names after "must be one of" (6,000 characters)."""
+    from mitos_cli.errors import WorldError
+    from mitos_cli.sim.world import Jitter, Obstacle, Randomise
+
+    world = short("corridor.yaml", 0.2)
+    poles = tuple(Obstacle(f"pole_{i}", "circle", 100.0 + 3 * i, 30.0, radius=1.0)
+                  for i in range(300))
+    many = dataclasses.replace(world, obstacles=poles, randomise=Randomise((Jitter("pol_299"),)))
+    with pytest.raises(WorldError) as exc:
+        Simulation(many)
+    assert "must be one of 300 names: pole_0, pole_1, pole_2, pole_3, pole_4, pole_5, " \
+           "pole_6, pole_7, ..., not 'pol_299'" in exc.value.message
+    assert exc.value.hint == "did you mean `pole_299`?"

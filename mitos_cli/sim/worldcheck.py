@@ -226,5 +226,14 @@ class _Fields:
         (``model="tricycl"`` ran as a tricycle)."""
         if value not in options:
             near = did_you_mean(value, options) if isinstance(value, str) else None
-            self.refuse(field, value, "one of " + ", ".join(options) if options
-                        else "a name the world has, and it has none", near)
+            self.refuse(field, value, _one_of(options), near)
+
+
+def _one_of(options: tuple[str, ...], shown: int = 8) -> str:
+    """What a choice expects: its options, or the first few of many (a world of 300 obstacles
+    listed every name)."""
+    if not options:
+        return "a name the world has, and it has none"
+    if len(options) <= shown:
+        return "one of " + ", ".join(options)
+    return f"one of {len(options)} names: {', '.join(options[:shown])}, ..."
