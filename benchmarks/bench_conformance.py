@@ -50,7 +50,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 import jfl_oracle  # noqa: E402
-from options import directory  # noqa: E402
+from options import directory, guarded  # noqa: E402
 from peers import require  # noqa: E402
 
 from mitos_cli.api import LoadedRuleBase, read_rulebase  # noqa: E402
@@ -387,7 +387,8 @@ def jar(text: str) -> Path:
     return path
 
 
-def main() -> None:
+@guarded
+def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="pyfuzzylite's examples only")
     parser.add_argument("--fcl-dir", type=directory, metavar="DIR",
@@ -395,7 +396,7 @@ def main() -> None:
     parser.add_argument("--jfuzzylogic", type=jar, metavar="JAR",
                         help="compare every .fcl under --fcl-dir with this jFuzzyLogic jar's "
                              "outputs (needs java; javac for full precision)")
-    args = parser.parse_args()
+    args = parser.parse_args(argv)
     if args.jfuzzylogic and not args.fcl_dir:
         parser.error("--jfuzzylogic compares the files of --fcl-dir: give --fcl-dir DIR")
     if args.jfuzzylogic and not shutil.which("java"):
@@ -462,4 +463,4 @@ def main() -> None:
 
 if __name__ == "__main__":
     os.environ.setdefault("NO_COLOR", "1")
-    main()
+    sys.exit(main())

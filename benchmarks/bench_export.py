@@ -40,6 +40,7 @@ import numpy as np
 ROOT = Path(__file__).parents[1]
 sys.path.insert(0, str(ROOT))
 
+from options import guarded  # noqa: E402
 from peers import require  # noqa: E402
 
 from mitos_cli.api import load_rulebase, read_rulebase  # noqa: E402
@@ -201,6 +202,7 @@ def bench_readers(tmp: Path) -> None:
     print(f"  pyfuzzylite .fll {fll.name:22s} {1e3 * t:8.2f}")
 
 
+@guarded
 def main(argv: list[str] | None = None) -> None:
     argparse.ArgumentParser(description=__doc__,
                             formatter_class=argparse.RawDescriptionHelpFormatter).parse_args(argv)
@@ -214,4 +216,4 @@ def main(argv: list[str] | None = None) -> None:
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())

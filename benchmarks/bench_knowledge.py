@@ -21,6 +21,8 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
+from options import guarded  # noqa: E402
+
 from mitos_cli.sim.loop import prepare, simulate  # noqa: E402
 from mitos_cli.sim.planner import FuzzyPlanner  # noqa: E402
 from mitos_cli.sim.world import Obstacle  # noqa: E402
@@ -55,6 +57,7 @@ def best_rate(world, repeats: int = 3) -> tuple[float, object]:
     return best, res
 
 
+@guarded
 def main(argv: list[str] | None = None) -> None:
     argparse.ArgumentParser(description=__doc__,
                             formatter_class=argparse.RawDescriptionHelpFormatter).parse_args(argv)
@@ -83,4 +86,4 @@ def main(argv: list[str] | None = None) -> None:
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())

@@ -22,13 +22,14 @@ from __future__ import annotations
 import argparse
 import os
 import platform
+import sys
 import tempfile
 import time
 from pathlib import Path
 
 import numpy as np
 import yaml
-from options import positive_int
+from options import guarded, positive_int
 from peers import require
 
 FL_TNORM = {"min": "Minimum", "product": "AlgebraicProduct", "lukasiewicz": "BoundedDifference",
@@ -176,12 +177,13 @@ def best_of(fn, repeat: int) -> float:
     return best
 
 
-def main() -> None:
+@guarded
+def main(argv: list[str] | None = None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--quick", action="store_true", help="smaller batches")
     ap.add_argument("--repeat", type=positive_int, default=3)
     ap.add_argument("--seed", type=int, default=0)
-    args = ap.parse_args()
+    args = ap.parse_args(argv)
     require("bench_norms.py", "fuzzylite", "skfuzzy")
 
     import fuzzylite as fl
@@ -248,4 +250,4 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())

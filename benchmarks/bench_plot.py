@@ -31,6 +31,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from bench_core import _version, best_of, fmt_time, fuzzylite_engine, machine  # noqa: E402
+from options import guarded  # noqa: E402
 from peers import require  # noqa: E402
 
 from mitos_cli import load_rulebase
@@ -56,10 +57,11 @@ def process_times(argv: list[str], runs: int) -> tuple[float, float]:
     return statistics.median(wall), statistics.median(cpu)
 
 
-def main() -> None:
+@guarded
+def main(argv: list[str] | None = None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--quick", action="store_true", help="small sizes, for a smoke run")
-    args = ap.parse_args()
+    args = ap.parse_args(argv)
     require("bench_plot.py", "fuzzylite", "matplotlib")
     n = 51 if args.quick else 201
     loop_n = 21 if args.quick else 61          # per-point loops run on a coarser grid
@@ -169,5 +171,6 @@ def main() -> None:
 
 if __name__ == "__main__":
     t0 = time.perf_counter()
-    main()
+    code = main()
     print(f"\n(benchmark took {time.perf_counter() - t0:.0f} s)")
+    sys.exit(code)

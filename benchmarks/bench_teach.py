@@ -48,7 +48,7 @@ import time
 from pathlib import Path
 
 import numpy as np
-from options import positive_int
+from options import guarded, positive_int
 
 from mitos_cli import load_rulebase
 from mitos_cli.engine.compile import compile_rulebase
@@ -121,14 +121,15 @@ def lesson_time() -> float | None:
     return median_time(run, 2)
 
 
-def main() -> None:
+@guarded
+def main(argv: list[str] | None = None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="fewer repeats (a smoke run)")
     ap.add_argument("--epochs", type=positive_int, default=500, help="epochs of the lesson's examples")
     ap.add_argument("--lesson", type=Path, default=LESSON,
                     help="the lesson whose examples section e fits (default: the shipped one)")
     ap.add_argument("--only-fit", action="store_true", help="section e alone")
-    args = ap.parse_args()
+    args = ap.parse_args(argv)
     if args.lesson.is_dir():
         ap.error(f"argument --lesson: `{args.lesson}` is a directory, not a lesson file")
     repeats = 3 if args.quick else 15
@@ -325,4 +326,4 @@ def lesson_fit(epochs: int, lesson: Path = LESSON):
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())

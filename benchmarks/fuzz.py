@@ -64,7 +64,7 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))          # this tree's mitos_cli, not an installed one
-from options import positive_int  # noqa: E402
+from options import guarded, positive_int  # noqa: E402
 
 SEED = 20261201
 
@@ -1233,6 +1233,7 @@ def run_jobs(args) -> list[Kind]:
     return merged(parts)
 
 
+@guarded
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--per-format", type=positive_int, default=2000,

@@ -40,7 +40,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))          # this tree's mitos_cli, here and in the killed runs
-from options import positive_int  # noqa: E402
+from options import guarded, positive_int  # noqa: E402
 
 ENV = dict(os.environ, PYTHONPATH=str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", ""))
 ROUNDS = 6
@@ -244,6 +244,7 @@ def sweep_campaign(trials: int, seed: int, log=print) -> list[dict]:
         shutil.rmtree(base, ignore_errors=True)
 
 
+@guarded
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--trials", type=positive_int, default=50)

@@ -420,3 +420,20 @@ def test_a_long_writer_refusal_is_cut_between_words_in_the_conformance_summary(m
         "input `...` has no terms (it only feeds linear consequents); a YAML term set needs at ..."
     assert kind("term `a`: MATLAB has no `b` membership function") == \
         "term `...`: MATLAB has no `...` membership function"
+
+
+@pytest.mark.parametrize("name", ["bench_conformance", "bench_export", "bench_knowledge",
+                                  "bench_norms", "bench_plot", "bench_teach", "kill", "fuzz"])
+def test_every_benchmark_says_a_failing_disk_in_one_line(name, monkeypatch, capsys):
+    """Eight scripts' mains let an OSError out as a traceback, where the others say it in one
+    line and exit 1 (``options.guarded``)."""
+    import argparse
+
+    module = script(name, monkeypatch)
+
+    def full(self, args=None, namespace=None):
+        raise OSError(28, "No space left on device", "out.csv")
+
+    monkeypatch.setattr(argparse.ArgumentParser, "parse_args", full)
+    assert module.main([]) == 1
+    assert capsys.readouterr().err == "error: No space left on device: `out.csv`\n"
