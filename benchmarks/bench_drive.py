@@ -45,16 +45,24 @@ def rates(summaries: list[dict]) -> str:
 def main(argv: list[str] | None = None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--barn", type=count, default=0, help="BARN-style worlds to run")
-    ap.add_argument("--seed", type=int, default=1000, help="first BARN seed")
+    ap.add_argument("--seed", type=int, help="first BARN seed (1000)")
     ap.add_argument("--known", action="store_true", help="poles drawn in the robot's map")
     ap.add_argument("--shipped", action="store_true", help="the shipped worlds")
-    ap.add_argument("--runs", type=positive_int, default=20, help="randomised runs per shipped world")
+    ap.add_argument("--runs", type=positive_int, help="randomised runs per shipped world (20)")
     ap.add_argument("--rules", help="rule file (default: the packaged rule base)")
     ap.add_argument("--workers", type=positive_int)
     ap.add_argument("--show", action="store_true", help="print each failed run")
     args = ap.parse_args(argv)
     if not args.barn and not args.shipped:
         ap.error("nothing to run: give --barn N (BARN-style worlds) or --shipped")
+    for given, option, needs in ((args.seed is not None, "--seed", args.barn),
+                                 (args.known, "--known", args.barn),
+                                 (args.show, "--show", args.barn),
+                                 (args.runs is not None, "--runs", args.shipped)):
+        if given and not needs:     # (each was dropped without a word)
+            ap.error(f"{option} is for {'--barn N' if option != '--runs' else '--shipped'}")
+    args.seed = 1000 if args.seed is None else args.seed
+    args.runs = args.runs or 20
     planner = FuzzyPlanner(args.rules, "drive")
     print(f"# {platform.processor() or platform.machine()}, Python {platform.python_version()}")
     if args.barn:

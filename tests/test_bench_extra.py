@@ -437,3 +437,17 @@ def test_every_benchmark_says_a_failing_disk_in_one_line(name, monkeypatch, caps
     monkeypatch.setattr(argparse.ArgumentParser, "parse_args", full)
     assert module.main([]) == 1
     assert capsys.readouterr().err == "error: No space left on device: `out.csv`\n"
+
+
+@pytest.mark.parametrize("argv, said", [
+    (["--shipped", "--known"], "--known is for --barn N"),
+    (["--shipped", "--show"], "--show is for --barn N"),
+    (["--shipped", "--seed", "5"], "--seed is for --barn N"),
+    (["--barn", "2", "--runs", "5"], "--runs is for --shipped"),
+])
+def test_bench_drive_refuses_an_option_it_would_drop(argv, said, monkeypatch, capsys):
+    """`--runs` without `--shipped`, `--known`, `--show` or `--seed` without `--barn` ran as
+    if not given."""
+    with pytest.raises(SystemExit) as exc:
+        script("bench_drive", monkeypatch).main(argv)
+    assert exc.value.code == 2 and said in capsys.readouterr().err
