@@ -435,14 +435,14 @@ def main(argv: list[str] | None = None) -> None:
                                                          "*.fis"))))
     if args.fcl_dir:
         part = part_fcl_dir(args.fcl_dir)
-        report_rows(f"FCL files under {args.fcl_dir} (--fcl-dir; round trips in 4)", part)
+        report_rows(f"5. FCL files under {args.fcl_dir} (--fcl-dir; round trips in 4)", part)
         unexpected = [n for n, s, why, _ in part["rows"] if "unexpected" in why]
         print(f"  refused without naming a construct: {len(unexpected)}"
               + (f" ({', '.join(unexpected)})" if unexpected else ""))
         all_files += sorted(args.fcl_dir.rglob("*.fcl"))
         if args.jfuzzylogic:
             jfl_oracle.report(jfl_oracle.part_jfuzzylogic(args.fcl_dir, args.jfuzzylogic, tmp),
-                              f"5. jFuzzyLogic itself on {args.fcl_dir}")
+                              f"5a. jFuzzyLogic itself on {args.fcl_dir}")
             cases = jfl_oracle.grammar_cases(tmp / "grammar")
             jfl_oracle.report(jfl_oracle.part_jfuzzylogic(cases, args.jfuzzylogic, tmp),
                               "5b. jFuzzyLogic itself on tests/test_interop_fcl_grammar.py's cases")
