@@ -125,7 +125,7 @@ def test_run_many_reports_progress_and_keeps_what_finished_on_ctrl_c(monkeypatch
     seen = []
     result = runs_mod.run_many([world], runs=2, seed=4, workers=1,
                                on_progress=lambda d, t: seen.append((d, t)))
-    assert seen == [(1, 2), (2, 2)]
+    assert seen == [(0, 2), (1, 2), (2, 2)]     # the total from the start
     real = runs_mod._chunk_runs
 
     def interrupted_after_one(job):          # Ctrl-C while the chunk's second run goes on

@@ -205,6 +205,8 @@ def run_many(worlds: list[World], runs: int = 0, seed: int | None = None, planne
     total = sum(len(chunk) for _, chunk, _ in tasks)
     results: list[list[dict | None]] = [[None] * len(chunk) for _, chunk, _ in tasks]
     done = 0
+    if on_progress is not None:     # the total from the start: runs in lockstep end together,
+        on_progress(0, total)       # late in their batch, and the bar read "0/?" till then
     try:
         for k, j, summary in _execute(jobs, workers):
             results[k][j] = summary
