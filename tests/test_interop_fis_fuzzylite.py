@@ -226,3 +226,12 @@ def test_a_tsukamoto_fis_summing_its_weights_is_refused_at_the_method():
         parse_fis(text.replace("'wtaver'", "'wtsum'"), "tsk.fis")
     assert info.value.message.startswith("Tsukamoto inference with a weighted sum")
     assert info.value.span.line == 11
+
+
+def test_a_tsukamoto_fis_says_its_outputs_take_only_monotonic_mfs():
+    with pytest.raises(MitosError) as info:
+        parse_fis(TSUKAMOTO_FIS.format(kind="tsukamoto", third="'trimf',[0.6 0.8 1]"), "tsk.fis")
+    assert info.value.message == ("MF `c`: the outputs of a Tsukamoto-type .fis take only "
+                                  "monotonic MFs (rampmf, sigmf, smf, zmf, concavemf: "
+                                  "fuzzylite's Tsukamoto inference), not `trimf`")
+    assert info.value.span.line == 27

@@ -410,10 +410,11 @@ def _mf(value: str, vspan: Span, role: str, kind: str, n_inputs: int) -> Term:
                               f"per input and a constant), not {len(params)}", span=vspan)
         return common.make_term(name, "linear", tuple(params), vspan)
     if role == "output" and kind in WEIGHTED_TYPES and mf not in ("constant", *MONOTONIC_MFS):
+        takes = ("only monotonic MFs" if kind == "tsukamoto" else
+                 "`constant` or `linear` MFs, or only monotonic ones")
         raise FormatError(f"MF `{name}`: the outputs of a {kind.capitalize()}-type .fis take "
-                          f"`constant` or `linear` MFs, or only monotonic ones "
-                          f"({', '.join(MONOTONIC_MFS)}: fuzzylite's Tsukamoto inference), not "
-                          f"`{mf}`", span=vspan)
+                          f"{takes} ({', '.join(MONOTONIC_MFS)}: fuzzylite's Tsukamoto "
+                          f"inference), not `{mf}`", span=vspan)
     if mf in FUZZYLITE_MF_TYPES:
         return common.fuzzylite_term(name, FUZZYLITE_MF_TYPES[mf], params, n_inputs, vspan)
     if mf not in MF_TYPES:
