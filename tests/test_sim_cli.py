@@ -689,19 +689,58 @@ def test_a_ctrl_c_while_the_runs_files_are_written_says_which_are_there(
 
 
 def test_runs_default_to_no_more_processes_than_the_cpus_allowed(monkeypatch) -> None:
-    """`simulate --runs`' default -j ("up to 2") counted the machine's CPUs: under `taskset
-    -c 0` it started two processes on one CPU, where `compare` counts the CPUs allowed."""
+    """`simulate --runs`' default -j counted the machine's CPUs: under `taskset -c 0` it
+    started two processes on one CPU, where `compare` counts the CPUs allowed. It was also
+    capped at 2, so an 8-core machine ran `--runs 1000` on a quarter of its cores; the engine's
+    threads, `simulate` and `compare` now count the CPUs in one place."""
     import os
 
+    from mitos_cli import machine
+    from mitos_cli.engine.threads import thread_count
     from mitos_cli.sim.runs import default_workers
+    from mitos_cli.study import executors
 
     if not hasattr(os, "sched_getaffinity"):
         pytest.skip("no CPU affinity on this platform")
+    monkeypatch.delenv("MITOS_NUM_THREADS", raising=False)
+    monkeypatch.setattr(machine, "available_memory", lambda: None)
     monkeypatch.setattr(os, "sched_getaffinity", lambda pid: {0})
     monkeypatch.setattr(os, "cpu_count", lambda: 8)
-    assert default_workers() == 1
+    assert default_workers() == 1 and thread_count() == 1
     monkeypatch.setattr(os, "sched_getaffinity", lambda pid: {0, 1, 2})
-    assert default_workers() == 2
+    assert default_workers() == 3 and thread_count() == 3
+    monkeypatch.setattr(os, "sched_getaffinity", lambda pid: set(range(8)))
+    assert default_workers() == 8 and thread_count() == 4       # threads: at most DEFAULT_MAX
+    assert not hasattr(executors, "default_workers")            # one count, not three
+
+
+def test_runs_default_to_the_workers_the_memory_available_holds(monkeypatch) -> None:
+    """Each worker steps a lockstep batch of up to 128 runs with their maps (0.7 GB for
+    `office`): on 8 CPUs with 2 GB free, 8 workers of office would swap or be killed. The
+    default takes what the memory holds, at least one; a world of small maps takes more."""
+    import os
+
+    from mitos_cli import machine
+    from mitos_cli.resources import packaged_path
+    from mitos_cli.sim.lockstep import batch_for, map_bytes
+    from mitos_cli.sim.runs import RUN_BYTES, WORKER_BYTES, default_workers
+    from mitos_cli.sim.worldfile import load_world
+
+    if not hasattr(os, "sched_getaffinity"):
+        pytest.skip("no CPU affinity on this platform")
+    office = load_world(packaged_path("worlds", "office.yaml"))
+    slalom = load_world(packaged_path("worlds", "slalom.yaml"))
+    per = WORKER_BYTES + batch_for(office) * (map_bytes(office) + RUN_BYTES)
+    assert 0.5e9 < per < 1e9            # about what /usr/bin/time measured: 701 MB
+    monkeypatch.setattr(os, "sched_getaffinity", lambda pid: set(range(8)))
+    free = 2 * per + per // 2
+    monkeypatch.setattr(machine, "available_memory", lambda: free)
+    assert default_workers([office]) == 2
+    assert default_workers([slalom, office]) == 2                # the largest batch counts
+    small = WORKER_BYTES + batch_for(slalom) * (map_bytes(slalom) + RUN_BYTES)
+    assert default_workers([slalom]) == free // small > 2
+    monkeypatch.setattr(machine, "available_memory", lambda: per // 3)
+    assert default_workers([office]) == 1
 
 
 def test_a_second_planner_given_apart_is_said_to_be_a_planner(capsys):

@@ -62,7 +62,8 @@ def compare_command(
         help="local: a process pool on this machine; dask: dask.distributed.")] = "local",
     workers: Annotated[Optional[int], typer.Option(
         "--workers", "-j", metavar="N", min=1,
-        help="Processes (local) or LocalCluster workers (dask). Default: the cores.")] = None,
+        help="Processes (local) or LocalCluster workers (dask). Default: the CPUs allowed, "
+             "fewer where memory is short.")] = None,
     scheduler: Annotated[Optional[str], typer.Option(
         "--scheduler", metavar="ADDR",
         help="Dask scheduler address (tcp://host:8786); without it a LocalCluster.")] = None,

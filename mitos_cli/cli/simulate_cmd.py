@@ -240,7 +240,7 @@ def simulate_command(
         "--require", metavar="success", help="Exit 3 unless every run ends in this outcome.")] = None,
     workers: Annotated[Optional[int], typer.Option(
         "--workers", "-j", metavar="N", min=1,
-        help="Processes for --runs (default: up to 2, no more than the CPUs allowed).")] = None,
+        help="Processes for --runs (default: the CPUs allowed, fewer where memory is short).")] = None,
     planner_name: Annotated[str, typer.Option(
         "--planner", metavar="NAME", autocompletion=complete.planners,
         help="Who drives: fuzzy (the rule base), potential_field or dwa (baselines that "

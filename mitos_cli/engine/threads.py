@@ -16,6 +16,7 @@ from collections.abc import Callable, Iterable, Iterator
 from typing import TYPE_CHECKING, TypeVar
 
 from ..errors import InputError
+from ..machine import allowed_cpus
 
 if TYPE_CHECKING:           # imported when a batch first needs a thread (10 ms, with logging)
     from concurrent.futures import ThreadPoolExecutor
@@ -44,11 +45,7 @@ def thread_count() -> int:
     number = given()
     if number is not None:
         return number
-    try:
-        cpus = len(os.sched_getaffinity(0))
-    except AttributeError:                   # not on Linux
-        cpus = os.cpu_count() or 1
-    return max(1, min(cpus, DEFAULT_MAX))
+    return min(allowed_cpus(), DEFAULT_MAX)
 
 
 def given() -> int | None:

@@ -243,8 +243,13 @@ def _guard_together(runs: list[Simulation], ticks: list) -> None:
 def batch_for(world: World, most: int = BATCH) -> int:
     """How many runs of ``world`` one lockstep batch steps: ``most``, fewer where their
     robots' maps would take more than :data:`MAP_MEMORY` together (at least one)."""
-    per_run = _plan_cells(world) * CELL_BYTES * len(world.agents)
-    return max(1, min(most, MAP_MEMORY // max(1, per_run)))
+    return max(1, min(most, MAP_MEMORY // max(1, map_bytes(world))))
+
+
+def map_bytes(world: World) -> int:
+    """About what the maps of one run of ``world`` take: each robot's copy of the map it
+    plans on and what its route searches work out on it (:data:`CELL_BYTES` a cell)."""
+    return _plan_cells(world) * CELL_BYTES * len(world.agents)
 
 
 def _plan_cells(world: World) -> int:

@@ -10,16 +10,17 @@ from __future__ import annotations
 
 import os
 from collections import Counter
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 
+from .. import machine
 from ..errors import InputError, MitosError, unknown
 from ..numbers import whole_number
 from ..words import plural
-from .lockstep import batch_for, finished
+from .lockstep import batch_for, finished, map_bytes
 from .loop import OUTCOMES, ROBOT_OUTCOMES, check_seed, shared_scene
 from .world import World
 
@@ -143,17 +144,25 @@ class Runs:
         return out
 
 
-def default_workers() -> int:
-    """``-j``'s default: up to 2 processes, no more than the CPUs this process may run on
-    (``os.cpu_count()`` counted the machine's: under ``taskset -c 0``, two processes on one
-    CPU, where `compare` and the batch threads count the CPUs allowed)."""
-    import os
+#: What a worker process of ``simulate --runs`` holds besides its batch's maps (measured,
+#: ``/usr/bin/time``'s peak: one run in a process 60 MB; a batch of 128 ``slalom`` runs 294 MB,
+#: of which 28 MB maps, so about 1.6 MB of records a run; ``office``'s 701 MB, 483 MB maps).
+WORKER_BYTES = 64 << 20
+RUN_BYTES = 2 << 20
 
-    try:
-        cpus = len(os.sched_getaffinity(0))
-    except AttributeError:              # not on Linux
-        cpus = os.cpu_count() or 1
-    return max(1, min(2, cpus))
+
+def default_workers(worlds: Sequence[World] = ()) -> int:
+    """``-j``'s default: the CPUs this process may run on, fewer where the memory available
+    would not hold that many workers, each with a lockstep batch of the largest of
+    ``worlds`` (its maps, :func:`.lockstep.batch_for`, and its runs' records)."""
+    cpus = machine.allowed_cpus()
+    free = machine.available_memory()
+    if free is None:
+        return cpus
+    batches = [batch_for(w) for w in worlds]
+    per_worker = WORKER_BYTES + max((b * (map_bytes(w) + RUN_BYTES)
+                                     for w, b in zip(worlds, batches)), default=RUN_BYTES)
+    return max(1, min(cpus, free // per_worker))
 
 
 class RunsInterrupted(KeyboardInterrupt):
@@ -186,7 +195,7 @@ def run_many(worlds: list[World], runs: int = 0, seed: int | None = None, planne
         from .planner import FuzzyPlanner
 
         planner = FuzzyPlanner(None, worlds[0].behavior if worlds else "drive")
-    workers = default_workers() if workers is None else whole("workers", workers, 1)
+    workers = default_workers(worlds) if workers is None else whole("workers", workers, 1)
     tasks = []
     for place, w in enumerate(worlds):
         base = w.seed if seed is None else seed

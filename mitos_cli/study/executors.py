@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import contextlib
 import functools
-import os
 from collections.abc import Callable, Iterator, Sequence
 from typing import TYPE_CHECKING
 
@@ -24,13 +23,6 @@ if TYPE_CHECKING:
 
 TaskFn = Callable[[Task], dict]
 EXECUTORS = ("local", "dask")
-
-
-def default_workers() -> int:
-    try:
-        return max(1, len(os.sched_getaffinity(0)))
-    except AttributeError:              # not on Linux
-        return max(1, os.cpu_count() or 1)
 
 
 def run_chunk(fn: TaskFn, tasks: Sequence[Task]) -> Iterator[tuple[Task, dict]]:
@@ -258,7 +250,10 @@ def execute(fn: TaskFn, tasks: Sequence[Task], executor: str = "local",
             workers: int | None = None, scheduler: str | None = None,
             client: Client | None = None) -> Iterator[tuple[Task, dict]]:
     """``(task, result)`` pairs as the tasks finish, on the chosen executor."""
-    workers = workers or default_workers()
+    if workers is None:     # the worlds are loaded in the workers: counted without their maps
+        from ..sim.runs import default_workers
+
+        workers = default_workers()
     if not tasks:
         return iter(())
     if executor == "local":
