@@ -129,15 +129,35 @@ def test_run_many_reports_progress_and_keeps_what_finished_on_ctrl_c(monkeypatch
     real = runs_mod._chunk_runs
 
     def interrupted_after_one(job):          # Ctrl-C while the chunk's second run goes on
-        parts = real(job)
-        yield next(parts)
-        raise KeyboardInterrupt
+        for part in real(job):
+            yield part
+            if len(part) == 3:
+                raise KeyboardInterrupt
 
     monkeypatch.setattr(runs_mod, "_chunk_runs", interrupted_after_one)
     with pytest.raises(runs_mod.RunsInterrupted) as stop:
         runs_mod.run_many([world], runs=2, seed=4, workers=1)
     assert stop.value.finished == 1 and stop.value.total == 2
     assert stop.value.runs.worlds[0].summaries[0] in result.worlds[0].summaries
+
+
+def test_run_many_tells_where_its_batches_are_between_the_runs_ends():
+    """Runs in lockstep end together, late in their batch: `simulate --runs 60` showed 0/60
+    till its last seconds. Each chunk now sends where its runs are every simulated second;
+    ``on_clock`` hears the earliest batch going, and the runs are the same as without."""
+    world = load_world(TINY)
+    seen: list[tuple] = []
+    result = runs_mod.run_many([world], runs=3, seed=4, workers=1,
+                               on_progress=lambda d, t: seen.append(("runs", d)),
+                               on_clock=lambda s: seen.append(("clock", s)))
+    assert result == runs_mod.run_many([world], runs=3, seed=4, workers=1)
+    clocks = [s for what, s in seen if what == "clock"]
+    first_end = seen.index(("runs", 1))
+    assert seen[0] == ("runs", 0) and first_end > 1                  # clocks before any end
+    assert clocks == sorted(clocks) and clocks[0] >= runs_mod.CLOCK_EVERY
+    assert all(b - a <= runs_mod.CLOCK_EVERY + world.dt for a, b in zip(clocks, clocks[1:]))
+    ended = max(s["time_s"] for s in result.worlds[0].summaries)
+    assert clocks[-1] <= ended < clocks[-1] + runs_mod.CLOCK_EVERY + world.dt
 
 
 def test_simulate_runs_ctrl_c_prints_the_finished_runs_and_exits_130(capsys, monkeypatch):

@@ -96,6 +96,24 @@ def test_finished_gives_each_run_as_it_ends_with_its_bits_alone():
         assert_same_run(simulate(world, planner, seeds[i], randomise=True, scene=scene), res)
 
 
+def test_finished_with_a_clock_gives_the_same_runs_and_where_the_runs_going_are():
+    from mitos_cli.sim.lockstep import Clock
+
+    world = load_world(TINY)
+    planner, scene = FuzzyPlanner(None, world.behavior), prepare(world)
+    seeds = [3, 5, 8]
+    items = list(Lockstep(world, planner, seeds, randomise=True, scene=scene).finished(0.5))
+    runs = [item for item in items if not isinstance(item, Clock)]
+    clocks = [item.seconds for item in items if isinstance(item, Clock)]
+    plain = list(Lockstep(world, planner, seeds, randomise=True, scene=scene).finished())
+    assert [i for i, _ in runs] == [i for i, _ in plain]
+    for (_, a), (_, b) in zip(runs, plain):
+        assert_same_run(a, b)
+    first = min(res.ticks for _, res in runs) * world.dt      # no run ended before it
+    assert clocks[0] == pytest.approx(0.5) and len(clocks) >= int(first / 0.5) - 1
+    assert all(0.5 - 1e-9 <= b - a < 0.5 + world.dt for a, b in zip(clocks, clocks[1:]))
+
+
 def test_a_large_map_is_stepped_in_smaller_batches_with_the_same_bits(monkeypatch):
     """A batch of 64 runs on a 4,000 x 4,000 map kept 20 GB of the robots' maps; a batch now
     takes as many runs as :data:`MAP_MEMORY` holds, and the runs keep their bits."""

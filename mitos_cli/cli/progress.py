@@ -26,10 +26,12 @@ class Bar:
     Without a rich progress, ``lines`` prints ``what: done of total (p%)`` every few
     percent instead (nothing when it is false)."""
 
-    def __init__(self, progress: Progress | None, console: Console, lines: bool = False) -> None:
+    def __init__(self, progress: Progress | None, console: Console, lines: bool = False,
+                 what: str = "") -> None:
         self.progress, self.console, self.lines = progress, console, lines
-        self.task = progress.add_task("", total=None) if progress is not None else None
-        self.what, self.shown = "", -1
+        # described from the start: the bar's first frame had no words
+        self.task = progress.add_task(what, total=None) if progress is not None else None
+        self.what, self.shown = what, -1
 
     def update(self, done: int, total: int) -> None:
         if self.progress is not None:
@@ -59,9 +61,7 @@ def progress_bar(description: str, quiet: bool = False, lines: bool = False) -> 
 
     console = Console(stderr=True, highlight=False)
     if quiet or not console.is_terminal:
-        bar = Bar(None, console, lines=lines and not quiet)
-        bar.describe(description)
-        yield bar
+        yield Bar(None, console, lines=lines and not quiet, what=description)
         return
     from rich.progress import (
         BarColumn,
@@ -75,6 +75,4 @@ def progress_bar(description: str, quiet: bool = False, lines: bool = False) -> 
     with Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
                   TimeElapsedColumn(), TextColumn("eta"), TimeRemainingColumn(),
                   console=console, transient=True) as progress:
-        bar = Bar(progress, console)
-        bar.describe(description)
-        yield bar
+        yield Bar(progress, console, what=description)

@@ -29,6 +29,8 @@ from __future__ import annotations
 
 import itertools
 from collections.abc import Iterator, Sequence
+from dataclasses import dataclass
+from typing import overload
 
 import numpy as np
 
@@ -56,6 +58,14 @@ BATCH = 128
 #: worlds' maps (600 x 600 at most) still fill a batch of 128 (271 would fit).
 MAP_MEMORY = 1 << 30
 CELL_BYTES = 11
+
+
+@dataclass(frozen=True)
+class Clock:
+    """Where the runs still going of a lockstep batch are, in simulated seconds (the earliest
+    of them): what :meth:`Lockstep.finished` tells a progress bar between the runs' ends."""
+
+    seconds: float
 
 
 class Lockstep:
@@ -128,10 +138,19 @@ class Lockstep:
             self.step()
         return [run.result() for run in self.runs]
 
-    def finished(self) -> Iterator[tuple[int, SimResult]]:
+    @overload
+    def finished(self, every: None = None) -> Iterator[tuple[int, SimResult]]: ...
+    @overload
+    def finished(self, every: float) -> Iterator[tuple[int, SimResult] | Clock]: ...
+
+    def finished(self, every: float | None = None) -> Iterator[tuple[int, SimResult] | Clock]:
         """Step until every run has ended, giving each run's place among the seeds and its
-        :class:`SimResult` the tick it ends (a progress bar moves, a study writes it down)."""
+        :class:`SimResult` the tick it ends (a progress bar moves, a study writes it down).
+        With ``every`` (simulated seconds), also a :class:`Clock` each time the runs still
+        going pass a multiple of it: runs in lockstep end together, late in their batch, and a
+        bar that counts only ends stood still till then."""
         given = [False] * len(self.runs)
+        due = every
         while True:
             for i, run in enumerate(self.runs):
                 if run.done and not given[i]:
@@ -140,6 +159,11 @@ class Lockstep:
             if all(given):
                 return
             self.step()
+            if every is not None and due is not None:
+                now = min((run.time for run in self.runs if not run.done), default=None)
+                if now is not None and now >= due:
+                    yield Clock(now)
+                    due = (now // every + 1) * every
 
     def _commands(self, live: list[Simulation], blocks: np.ndarray,
                   active: np.ndarray) -> np.ndarray | None:
@@ -266,11 +290,22 @@ def _plan_cells(world: World) -> int:
     return int(np.prod(np.ceil(span / knowledge.RASTER)))
 
 
+@overload
 def finished(world: World, planner: Planner | None, seeds: Sequence[int], *,
-             randomise: bool = False, scene: Scene | None = None,
-             batch: int | None = None) -> Iterator[tuple[int, SimResult]]:
+             randomise: bool = ..., scene: Scene | None = ..., batch: int | None = ...,
+             every: None = None) -> Iterator[tuple[int, SimResult]]: ...
+@overload
+def finished(world: World, planner: Planner | None, seeds: Sequence[int], *,
+             randomise: bool = ..., scene: Scene | None = ..., batch: int | None = ...,
+             every: float) -> Iterator[tuple[int, SimResult] | Clock]: ...
+
+
+def finished(world: World, planner: Planner | None, seeds: Sequence[int], *,
+             randomise: bool = False, scene: Scene | None = None, batch: int | None = None,
+             every: float | None = None) -> Iterator[tuple[int, SimResult] | Clock]:
     """The runs of ``world`` from ``seeds``, ``batch`` at a time in lockstep (default:
-    :func:`batch_for`), each run's place among the seeds and its result as it ends."""
+    :func:`batch_for`), each run's place among the seeds and its result as it ends; with
+    ``every``, also each batch's :class:`Clock` (:meth:`Lockstep.finished`)."""
     check_world(world)
     seeds = seed_list(seeds)
     if batch is not None and ((b := whole_number(batch)) is None or b < 1):
@@ -278,9 +313,9 @@ def finished(world: World, planner: Planner | None, seeds: Sequence[int], *,
                          hint="leave it out: batch_for(world) sizes it")
     size = max(1, batch_for(world) if batch is None else batch)
     for i in range(0, len(seeds), size):
-        for j, res in Lockstep(world, planner, seeds[i:i + size], randomise=randomise,
-                               scene=scene).finished():
-            yield i + j, res
+        for item in Lockstep(world, planner, seeds[i:i + size], randomise=randomise,
+                             scene=scene).finished(every):
+            yield item if isinstance(item, Clock) else (i + item[0], item[1])
 
 
 def seed_list(seeds: object) -> list[int]:

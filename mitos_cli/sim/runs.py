@@ -20,7 +20,7 @@ from .. import machine
 from ..errors import InputError, MitosError, unknown
 from ..numbers import whole_number
 from ..words import plural
-from .lockstep import batch_for, finished, map_bytes
+from .lockstep import Clock, batch_for, finished, map_bytes
 from .loop import OUTCOMES, ROBOT_OUTCOMES, check_seed, shared_scene
 from .world import World
 
@@ -37,13 +37,25 @@ METRICS = ("time_s", "path_length_in", "min_clearance_in", "mean_speed_in_s",
            "steering_total_variation_deg", "replans", "backouts")
 
 
-def _chunk_runs(task: tuple) -> Iterator[tuple[int, int, dict]]:
+#: Simulated seconds between the clocks a chunk of runs sends while none of them ends.
+CLOCK_EVERY = 1.0
+
+Part = tuple[int, int, dict] | tuple[int, Clock]
+
+
+def _chunk_runs(task: tuple) -> Iterator[Part]:
     """One chunk's runs of a world, stepped in lockstep (:mod:`.lockstep`: each run's bits
-    are those it has alone): ``(chunk, place in the chunk, summary)`` as each run ends."""
+    are those it has alone): ``(chunk, place in the chunk, summary)`` as each run ends, and
+    ``(chunk, Clock)`` every :data:`CLOCK_EVERY` simulated seconds between."""
     index, world, planner, seeds, randomise, measure, scene = task
     scene = scene if scene is not None else shared_scene(world, randomise)
-    for j, res in finished(world, planner, seeds, randomise=randomise, scene=scene):
-        yield index, j, {**res.summary(), **(measure(res) if measure is not None else {})}
+    for item in finished(world, planner, seeds, randomise=randomise, scene=scene,
+                         every=CLOCK_EVERY):
+        if isinstance(item, Clock):
+            yield index, item
+        else:
+            j, res = item
+            yield index, j, {**res.summary(), **(measure(res) if measure is not None else {})}
 
 
 def ignore_interrupts() -> None:
@@ -180,12 +192,15 @@ class RunsInterrupted(KeyboardInterrupt):
 
 def run_many(worlds: list[World], runs: int = 0, seed: int | None = None, planner: Planner | None = None,
              workers: int | None = None, measure: Callable[[SimResult], dict] | None = None,
-             on_progress: Callable[[int, int], None] | None = None) -> Runs:
+             on_progress: Callable[[int, int], None] | None = None,
+             on_clock: Callable[[float], None] | None = None) -> Runs:
     """Run each world once (``runs=0``: its own seed, as written) or ``runs`` randomised times
     (seeds ``seed + j``, default base: the world's seed), on ``workers`` processes.
     ``measure(result) -> dict`` (a picklable function), when given, adds figures of its own to
     each run's summary in the worker (a benchmark's scores from the ticks).
-    ``on_progress(done, total)`` is called as runs finish (a progress bar). Ctrl-C terminates
+    ``on_progress(done, total)`` is called as runs finish (a progress bar), and
+    ``on_clock(seconds)`` between, with the simulated time the earliest batch going has
+    reached (runs in lockstep end together, late in their batch). Ctrl-C terminates
     the workers and raises :class:`RunsInterrupted` with the runs that had finished."""
     worlds = _check_worlds(worlds)
     runs = whole("runs", runs, 0)
@@ -217,9 +232,18 @@ def run_many(worlds: list[World], runs: int = 0, seed: int | None = None, planne
     if on_progress is not None:     # the total from the start: runs in lockstep end together,
         on_progress(0, total)       # late in their batch, and the bar read "0/?" till then
     try:
-        for k, j, summary in _execute(jobs, workers):
+        clocks: dict[int, float] = {}          # each chunk going: where its batch is
+        for part in _execute(jobs, workers):
+            if len(part) == 2:                  # (chunk, Clock)
+                clocks[part[0]] = part[1].seconds
+                if on_clock is not None:
+                    on_clock(min(clocks.values()))
+                continue
+            k, j, summary = part
             results[k][j] = summary
             done += 1
+            if all(r is not None for r in results[k]):
+                clocks.pop(k, None)
             if on_progress is not None:
                 on_progress(done, total)
     except KeyboardInterrupt:
@@ -258,8 +282,9 @@ def whole(what: str, value: object, least: int) -> int:
     return n
 
 
-def _execute(jobs: list[tuple], workers: int) -> Iterator[tuple[int, int, dict]]:
-    """``(chunk, place, summary)`` of each run as it ends: in this process, or on a pool
+def _execute(jobs: list[tuple], workers: int) -> Iterator[Part]:
+    """``(chunk, place, summary)`` of each run as it ends, and each chunk's clocks
+    (:func:`_chunk_runs`): in this process, or on a pool
     that is terminated at once on Ctrl-C or an error."""
     if workers <= 1 or len(jobs) <= 1:
         for job in jobs:
