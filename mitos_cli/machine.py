@@ -7,6 +7,20 @@ study's workers count the same CPUs (``os.cpu_count()`` counts the machine's: un
 from __future__ import annotations
 
 import os
+from pathlib import Path
+
+#: The memory controller's files of this process's cgroup (v2, then v1): a container's limit
+#: (``docker run -m 2g``) is not in ``/proc/meminfo``, which shows the host's memory.
+CGROUPS = (
+    (Path("/sys/fs/cgroup/memory.max"), Path("/sys/fs/cgroup/memory.current"),
+     Path("/sys/fs/cgroup/memory.stat"), "inactive_file"),
+    (Path("/sys/fs/cgroup/memory/memory.limit_in_bytes"),
+     Path("/sys/fs/cgroup/memory/memory.usage_in_bytes"),
+     Path("/sys/fs/cgroup/memory/memory.stat"), "total_inactive_file"),
+)
+
+#: A cgroup "limit" at or above this is none (v1 writes 2^63 rounded down to a page).
+NO_LIMIT = 1 << 60
 
 
 def allowed_cpus() -> int:
@@ -18,9 +32,15 @@ def allowed_cpus() -> int:
 
 
 def available_memory() -> int | None:
-    """Bytes of memory a new process could take without swapping (Linux's ``MemAvailable``:
-    free memory plus the caches it may drop), else the free pages POSIX counts; ``None``
-    where neither is known."""
+    """Bytes of memory new processes could take without swapping or meeting a container's
+    limit: Linux's ``MemAvailable`` (free memory plus the caches it may drop), or the free
+    pages POSIX counts, and no more than the cgroup's limit leaves; ``None`` where nothing is
+    known."""
+    found = [n for n in (_meminfo(), _cgroup_headroom()) if n is not None]
+    return min(found) if found else None
+
+
+def _meminfo() -> int | None:
     try:
         with open("/proc/meminfo", encoding="ascii") as f:
             for line in f:
@@ -32,3 +52,31 @@ def available_memory() -> int | None:
         return os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
     except (AttributeError, ValueError, OSError):
         return None
+
+
+def _cgroup_headroom() -> int | None:
+    """The cgroup's limit less what it holds (its file cache it may drop counted free, as a
+    container's working set is), ``None`` without a limit."""
+    for limit_file, usage_file, stat_file, inactive in CGROUPS:
+        try:
+            text = limit_file.read_text().strip()
+            if text == "max":
+                return None
+            limit, usage = int(text), int(usage_file.read_text())
+        except (OSError, ValueError):
+            continue
+        if limit >= NO_LIMIT:
+            return None
+        return max(0, limit - usage + _stat(stat_file, inactive))
+    return None
+
+
+def _stat(path: Path, key: str) -> int:
+    try:
+        for line in path.read_text().splitlines():
+            name, _, value = line.partition(" ")
+            if name == key:
+                return int(value)
+    except (OSError, ValueError):
+        pass
+    return 0
