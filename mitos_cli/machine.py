@@ -23,12 +23,39 @@ CGROUPS = (
 NO_LIMIT = 1 << 60
 
 
+#: The CPU controller's quota files (v2: ``"quota period"`` or ``"max period"``; v1: the two
+#: numbers apart, -1 for none): ``docker run --cpus 2`` on a 64-core host leaves the affinity
+#: at 64 CPUs and the time of 2.
+CPU_QUOTAS = (
+    (Path("/sys/fs/cgroup/cpu.max"), None),
+    (Path("/sys/fs/cgroup/cpu/cpu.cfs_quota_us"), Path("/sys/fs/cgroup/cpu/cpu.cfs_period_us")),
+)
+
+
 def allowed_cpus() -> int:
-    """The CPUs this process may run on (its affinity where the system has one), at least 1."""
+    """The CPUs this process may run on (its affinity where the system has one), no more than
+    its cgroup's CPU quota (rounded up), at least 1."""
     try:
-        return max(1, len(os.sched_getaffinity(0)))
+        cpus = len(os.sched_getaffinity(0))
     except AttributeError:              # not on Linux
-        return max(1, os.cpu_count() or 1)
+        cpus = os.cpu_count() or 1
+    quota = _cpu_quota()
+    return max(1, cpus if quota is None else min(cpus, quota))
+
+
+def _cpu_quota() -> int | None:
+    for quota_file, period_file in CPU_QUOTAS:
+        try:
+            words = quota_file.read_text().split()
+            if period_file is not None:
+                words = [words[0], period_file.read_text().strip()]
+            quota, period = (None if words[0] in ("max", "-1") else int(words[0])), int(words[1])
+        except (OSError, ValueError, IndexError):
+            continue
+        if quota is None or quota <= 0 or period <= 0:
+            return None
+        return -(-quota // period)
+    return None
 
 
 def available_memory() -> int | None:

@@ -1,4 +1,4 @@
-"""What the machine offers: the memory a container's limit leaves, not only the host's."""
+"""What the machine offers: the CPUs and memory a container's limits leave, not only the host's."""
 
 from __future__ import annotations
 
@@ -49,3 +49,27 @@ def test_this_machine_answers_with_whole_positive_numbers():
     assert machine.allowed_cpus() >= 1
     found = machine.available_memory()
     assert found is None or (isinstance(found, int) and found >= 0)
+
+
+@pytest.mark.parametrize("v2, v1, cpus", [
+    ("200000 100000", None, 2),          # docker run --cpus 2
+    ("150000 100000", None, 2),          # 1.5 CPUs of time: two processes can use it
+    ("max 100000", None, 8),
+    (None, ("50000", "100000"), 1),
+    (None, ("-1", "100000"), 8),
+    (None, None, 8),
+])
+def test_a_containers_cpu_quota_caps_the_cpus_allowed(tmp_path, monkeypatch, v2, v1, cpus):
+    import os
+
+    if not hasattr(os, "sched_getaffinity"):
+        pytest.skip("no CPU affinity on this platform")
+    monkeypatch.setattr(os, "sched_getaffinity", lambda pid: set(range(8)))
+    quota, period = tmp_path / "cfs_quota", tmp_path / "cfs_period"
+    if v2 is not None:
+        (tmp_path / "cpu.max").write_text(v2 + "\n")
+    if v1 is not None:
+        quota.write_text(v1[0] + "\n")
+        period.write_text(v1[1] + "\n")
+    monkeypatch.setattr(machine, "CPU_QUOTAS", ((tmp_path / "cpu.max", None), (quota, period)))
+    assert machine.allowed_cpus() == cpus
