@@ -235,3 +235,16 @@ def test_a_tsukamoto_fis_says_its_outputs_take_only_monotonic_mfs():
                                   "monotonic MFs (rampmf, sigmf, smf, zmf, concavemf: "
                                   "fuzzylite's Tsukamoto inference), not `trimf`")
     assert info.value.span.line == 27
+
+
+def test_a_hybrid_fis_is_refused_with_the_way_to_its_fll():
+    """fuzzylite writes an engine of Mamdani and Takagi-Sugeno outputs as `Type='hybrid'`
+    (its examples' hybrid/tipper.fis): one defuzzifier for both kinds, which fuzzylite 6 reads
+    back as a centroid over the constant terms too. MITOS refuses it and says where the
+    engine is whole: the FLL it was written from, whose rule blocks become behaviors."""
+    text = TSUKAMOTO_FIS.format(kind="hybrid", third="'rampmf',[0.7 1]")
+    with pytest.raises(MitosError) as info:
+        parse_fis(text, "tipper.fis")
+    assert info.value.message == "FIS type `hybrid` is not supported"
+    assert (info.value.span.line, info.value.span.column) == (3, 6)
+    assert "the FLL it was written from" in (info.value.hint or "")

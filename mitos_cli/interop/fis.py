@@ -142,6 +142,15 @@ def _vector(value: str, vspan: Span) -> list[float]:
     return [common.number(w, vspan) for w in value[1:-1].replace(",", " ").split()]
 
 
+#: fuzzylite writes an engine of Mamdani and Takagi-Sugeno outputs as `Type='hybrid'`, which
+#: MATLAB refuses and which keeps one defuzzifier for both kinds (fuzzylite 6 reads it back with
+#: a centroid over the constant terms too, and so writes it to FLL); the FLL the engine was
+#: written from keeps each output's, and MITOS reads that as one behavior per rule block.
+HYBRID_HINT = ("a .fis keeps one defuzzifier for both kinds of output; read the engine from "
+               "the FLL it was written from (fuzzylite's examples ship one beside each .fis), "
+               "whose rule blocks MITOS reads as behaviors")
+
+
 @without_cyclic_gc
 def parse_fis(text: str, path: str | None = None) -> RuleBase:
     """Read ``.fis`` text into a rule base (one behavior, ``main``)."""
@@ -154,8 +163,9 @@ def parse_fis(text: str, path: str | None = None) -> RuleBase:
     system = _system(sys_items)
     kind = _string(*system.get("Type", ("'mamdani'", sys_span))).lower()
     if kind not in ("mamdani", "sugeno", "tsukamoto"):
+        hint = HYBRID_HINT if kind == "hybrid" else None
         raise FormatError(f"FIS type `{kind}` is not supported", span=system["Type"][1],
-                          expected="mamdani or sugeno (or fuzzylite's tsukamoto)")
+                          expected="mamdani or sugeno (or fuzzylite's tsukamoto)", hint=hint)
     settings, unset, sugeno = _settings(system, sys_span, kind)
     notes: list[str] = []
     ranges: common.Places = {}
