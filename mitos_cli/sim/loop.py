@@ -1032,7 +1032,7 @@ class Simulation:
         # it all the same)
         own = (np.zeros(2) if rmap.refuge is not None
                else self._v[i] * np.array([math.cos(h), math.sin(h)]))
-        found = tracker.movers(s.t, p, own)
+        found = tracker.movers(s.t, p, own, waiting=rmap.refuge is not None)
         if not found:
             return None
         robot, grid = self.robots[i], rmap.grid
