@@ -14,6 +14,7 @@ from hypothesis import strategies as st
 from mitos_cli.sim import knowledge, movers
 from mitos_cli.sim.loop import clearances, prepare, simulate
 from mitos_cli.sim.route import Clearance
+from mitos_cli.sim.world import Goal
 from mitos_cli.sim.worldfile import parse_world
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -438,6 +439,61 @@ def test_a_robot_at_its_refuge_waits_till_a_cart_beside_it_has_passed():
     assert tracker.movers(t, robot, own=np.zeros(2)) == []
     assert len(tracker.movers(t, robot, own=np.zeros(2), waiting=True)) == 1
     assert tracker.movers(t, np.array([80.0, 15.0]), own=np.zeros(2), waiting=True) == []
+
+
+def test_a_robot_is_at_its_refuge_within_its_tolerance_not_on_its_way_there():
+    """It waits for what has not passed it only standing at its refuge: on its way there it
+    yields to what comes toward it, as a robot driving does (`worlds/README.md`'s annotated
+    world: a robot that waited so on its way to its refuge moved it four times in 1.6 s and
+    met the other robot)."""
+    _, rmap, _, _ = corridor_map()
+    assert not rmap.at_refuge(np.array([300.0, -10.0]))              # it holds none
+    rmap.refuge = Goal(300.0, 20.0)
+    assert rmap.refuge.tolerance == 12.0                              # a goal's
+    assert rmap.at_refuge(np.array([308.0, 28.0]))                    # 11.3 in off
+    assert rmap.at_refuge(np.array([312.0, 20.0]))                    # 12 in: reached
+    assert not rmap.at_refuge(np.array([312.5, 20.0]))
+    assert not rmap.at_refuge(np.array([300.0, -10.0]))               # on its way
+
+
+def moving_draw(seed: int, j: int):
+    """`moving` with the navigation benchmark's clutter draw ``j`` of ``seed`` (as
+    `bench_nav.py` builds it) and the base's scene."""
+    from mitos_cli.resources import packaged_path
+    from mitos_cli.sim.clutter import clutter
+    from mitos_cli.sim.worldfile import load_world
+
+    base = load_world(packaged_path("worlds", "moving.yaml"))
+    scene = prepare(base)
+    rng = np.random.default_rng(np.random.SeedSequence([seed, 3]).spawn(j + 1)[j])
+    world = clutter(base, scene.static, scene.routes[0], rng, int(rng.integers(3, 7)))
+    return world.with_changes(name=f"moving+clutter{j}", seed=base.seed + j), scene
+
+
+def test_a_robot_at_its_refuge_waits_till_the_cart_beside_it_has_passed_then_arrives():
+    """Dev seed 6000's `moving+clutter9`: the robot, sent up out of the cart's lane, stands
+    at its refuge facing away from its goal while the cart comes down the lower lane, 36 in
+    off its line; 60 deg off its bearing the cart has not passed it, and a robot that turned
+    round for its goal then swung into the cart's lane and was hit (24.9 s). Standing at its
+    refuge it waits till the cart has passed it, and arrives."""
+    from mitos_cli.sim.loop import Simulation
+    from mitos_cli.sim.planner import FuzzyPlanner
+
+    world, scene = moving_draw(6000, 9)
+    sim = Simulation(world, FuzzyPlanner(None, world.behavior), world.seed, scene=scene)
+    cart = next(o for o in world.obstacles if o.name == "oncoming")
+    waited = left = None
+    while not sim.done:
+        sim.step()
+        p, rmap = sim.pose[0, :2], sim._maps[0]
+        x = cart.x + cart.motion.velocity[0] * sim.time          # where the cart is (true)
+        if rmap.at_refuge(p) and x > p[0] + 12:                   # beside it, not passed
+            waited = sim.time
+        if waited is not None and left is None and rmap.refuge is None:
+            left = (sim.time, x - p[0])
+    assert waited is not None and left is not None
+    assert left[1] < 0                          # it left its refuge once the cart had passed
+    assert sim.outcome == "success"
 
 
 def test_a_robot_standing_in_a_movers_way_is_sent_out_of_it():
