@@ -29,8 +29,10 @@ robot's left, squeezing past on the right without the room rather than crossing 
 it: two robots that met swerved across each other's way);
 where no way to the goal is left,
 it sends the robot to the nearest place out of its way (a *refuge*), and the robot waits
-there until nothing comes toward it: planning in time, in the simplest form a route can
-say.
+there until nothing comes toward it (standing at its refuge, till what comes has passed it:
+a cart beside it is 60 deg off its bearing long before it has passed, and a tricycle that
+turns round for its goal swings into the cart's lane): planning in time, in the simplest
+form a route can say.
 """
 
 from __future__ import annotations
@@ -348,10 +350,10 @@ class Tracker:
         """The tracks that move toward the robot at ``robot [2]`` driving at velocity ``own
         [2]`` (see the module docstring): those seen at ``now``, and the movers among those
         missed for at most ``MAX_MISS`` s, where they should be by now (a sonar ring loses a
-        cart between two beams for a tick or two). A robot ``waiting`` at a refuge waits for
-        what has not passed it yet: the cone is a half plane (a cart beside it, 60 deg or
-        more off its bearing, still comes on, and a tricycle that turns round for its goal
-        swings into its lane)."""
+        cart between two beams for a tick or two). A robot ``waiting`` at its refuge (standing
+        there, :meth:`.knowledge.RobotMap.at_refuge`) waits for what has not passed it yet:
+        the cone is a half plane (a cart beside it, 60 deg or more off its bearing, still
+        comes on, and a tricycle that turns round for its goal swings into its lane)."""
         cone = 0.0 if waiting else APPROACH
         out = []
         for tr in self.tracks:
@@ -608,8 +610,8 @@ def sweep(found: list[Mover], robot: np.ndarray, heading: float, length: float, 
     none. With movers in its lane, :attr:`Sweep.keep_right` too: the same ways ``room``
     wider, and the robot's left of those movers up to ``far``; and :attr:`Sweep.left`, the
     robot's left alone, when one of them comes on its left (:func:`_on_left`). A robot
-    ``waiting`` at a
-    refuge waits while anything is ``found`` (an empty sweep): a mover whose heading is not
+    ``waiting`` (bound for a refuge, or at it) waits while anything is ``found`` (an empty
+    sweep): a mover whose heading is not
     known yet sweeps nothing once the robot has turned out of its lane for the refuge, and
     it comes on all the same."""
     cells = np.zeros(shape, dtype=bool)
