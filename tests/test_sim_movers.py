@@ -472,8 +472,8 @@ def moving_draw(seed: int, j: int):
 
 def test_a_robot_at_its_refuge_waits_till_the_cart_beside_it_has_passed_then_arrives():
     """Dev seed 6000's `moving+clutter9`: the robot, sent up out of the cart's lane, stands
-    at its refuge facing away from its goal while the cart comes down the lower lane, 36 in
-    off its line; 60 deg off its bearing the cart has not passed it, and a robot that turned
+    at its refuge facing away from its goal while the cart comes down the lower lane, 42 in
+    below it; 60 deg off its bearing the cart has not passed it, and a robot that turned
     round for its goal then swung into the cart's lane and was hit (24.9 s). Standing at its
     refuge it waits till the cart has passed it, and arrives."""
     from mitos_cli.sim.loop import Simulation
