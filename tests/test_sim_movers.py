@@ -14,6 +14,7 @@ from hypothesis import strategies as st
 from mitos_cli.sim import knowledge, movers
 from mitos_cli.sim.loop import clearances, prepare, simulate
 from mitos_cli.sim.route import Clearance
+from mitos_cli.sim.world import Goal
 from mitos_cli.sim.worldfile import parse_world
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -191,6 +192,51 @@ def test_a_mover_missed_for_a_tick_or_two_is_kept_where_it_should_be():
     assert tracker.movers(t + movers.MAX_MISS + 0.1, np.zeros(2), own=np.zeros(2)) == []
 
 
+def hop_between_corners(tracker: movers.Tracker, x0: float, seconds=2.0, dt=0.05) -> float:
+    """Feed ``tracker`` what a ring of 36 beams (10 deg apart) sees of a cart's face coming
+    head-on at 15 in/s from ``x0`` in ahead of a robot at the origin: one echo a tick, at
+    one front corner for 0.5 s, none for 0.25 s (the cart between two beams), then at the
+    other corner, 16 in across (as `moving+clutter5` of the benchmark's seed 0 saw it).
+    Returns the time of the last tick."""
+    t = 0.0
+    for k in range(int(round(seconds / dt))):
+        t = k * dt
+        if 0.5 <= t < 0.75:                                   # between two beams
+            tracker.follow(t, np.zeros((0, 2)), np.zeros(0), [], np.zeros((0, 3)))
+            continue
+        centre = np.array([[x0 - 15 * t, 8.0 if t > 0.5 else -8.0]])
+        tracker.follow(t, centre, np.zeros(1), [True],
+                       movers.sight_lines(centre, np.zeros((1, 2)), np.deg2rad(10.0)))
+    return t
+
+
+def test_a_carts_two_corners_echoed_by_two_beams_far_off_are_one_track():
+    """A ring's neighbouring beams lie 17 in apart 100 in off, so a cart 16 in wide is
+    echoed at one front corner, then (missed a moment) at the other: one object, one track,
+    found a mover. (On the tree before, each hop started a track, and none was followed
+    long enough to be fitted a velocity.)"""
+    tracker = movers.Tracker()
+    t = hop_between_corners(tracker, 110.0)
+    assert [tr.born for tr in tracker.tracks] == [0.0]          # followed from the first echo
+    found = tracker.movers(t, np.zeros(2), own=np.zeros(2))
+    assert len(found) == 1 and np.allclose(found[0].velocity, (-15, 0), atol=2)
+    soon = movers.Tracker()                  # a mover 1.3 s after the first echo (a track
+    t = hop_between_corners(soon, 110.0, seconds=1.3)     # started at the hop: 1.65 s)
+    assert len(soon.movers(t, np.zeros(2), own=np.zeros(2))) == 1
+
+
+def test_near_the_robot_two_objects_16_in_apart_stay_two_tracks():
+    """Near the robot its beams lie closer than the gate, which stays round there: what
+    lies 16 in apart 40 in off is two objects, as before."""
+    tracker = movers.Tracker()
+    hop_between_corners(tracker, 40.0, seconds=1.0)
+    assert [tr.born for tr in tracker.tracks] == [0.0, 0.75]
+    near = movers.sight_lines(np.array([[40.0, 8.0], [100.0, 0.0]]), np.zeros((2, 2)),
+                              np.deg2rad(10.0))
+    assert near[0].tolist() == [1.0, 0.0, 1.0]              # the plain distance
+    assert near[1, 2] < 1 and np.allclose(near[1, :2], (1, 0))   # wider across the line
+
+
 # --- where a mover will pass ---------------------------------------------------------------
 
 def test_a_settled_mover_sweeps_past_the_robot_and_down_its_lane():
@@ -212,6 +258,19 @@ def test_a_mover_whose_heading_is_not_known_yet_sweeps_only_down_the_robots_lane
     assert movers.swept(m, np.array([0.0, 40.0]), 0.0, length=24, width=18) == []
     (a, b, _), = movers.swept(m, np.array([0.0, 0.0]), 0.0, length=24, width=18)
     assert np.allclose(a, (200, 0)) and np.allclose(b, (0, 0))
+
+
+def test_a_mover_whose_path_overlaps_the_robots_lane_comes_down_it():
+    """The lane is where the robot's body goes (half its width each side of its line), and
+    a mover's path is ``HALF_WIDTH`` wide each side at least: a cart 19 in off the line of
+    a robot whose heading wavers (`moving+clutter5`, seed 0: -12 deg at 60 in) comes down
+    it; one whose path clears the lane does not."""
+    robot = np.array([0.0, 0.0])
+    for off, inside in ((19.0, True), (-20.5, True), (21.5, False)):
+        m = movers.Mover(np.array([60.0, off]), np.array([-15.0, 0.0]), 5.0, settled=False)
+        assert bool(movers.lane(m, robot, 0.0, 18.0)) is inside, off
+    wide = movers.Mover(np.array([60.0, 22.0]), np.array([-15.0, 0.0]), 14.0, settled=False)
+    assert movers.lane(wide, robot, 0.0, 18.0)                 # 9 + 14 in: a wide one
 
 
 def test_a_robot_keeps_right_of_what_comes_down_its_lane_with_room():
@@ -368,6 +427,75 @@ def test_a_robot_at_its_refuge_waits_while_a_mover_comes_whose_way_is_not_drawn(
     assert rmap.refuge is not None
 
 
+def test_a_robot_at_its_refuge_waits_till_a_cart_beside_it_has_passed():
+    """A cart coming down the other lane is 60 deg or more off the robot's bearing as it
+    draws level with the robot at its refuge: it has not passed, and the robot that turned
+    round for its goal then would swing into its lane (`moving+clutter9` of the dev seed
+    6000). Waiting, the robot waits for it till it has passed; driving, it is not in its
+    way."""
+    tracker = movers.Tracker()
+    t = follow(tracker, (100, -40), (-15, 0), 2.0, moved=True)   # now at (70, -40)
+    robot = np.array([40.0, 15.0])                               # 62 deg off its heading
+    assert tracker.movers(t, robot, own=np.zeros(2)) == []
+    assert len(tracker.movers(t, robot, own=np.zeros(2), waiting=True)) == 1
+    assert tracker.movers(t, np.array([80.0, 15.0]), own=np.zeros(2), waiting=True) == []
+
+
+def test_a_robot_is_at_its_refuge_within_its_tolerance_not_on_its_way_there():
+    """It waits for what has not passed it only standing at its refuge: on its way there it
+    yields to what comes toward it, as a robot driving does (`worlds/README.md`'s annotated
+    world: a robot that waited so on its way to its refuge moved it four times in 1.6 s and
+    met the other robot)."""
+    _, rmap, _, _ = corridor_map()
+    assert not rmap.at_refuge(np.array([300.0, -10.0]))              # it holds none
+    rmap.refuge = Goal(300.0, 20.0)
+    assert rmap.refuge.tolerance == 12.0                              # a goal's
+    assert rmap.at_refuge(np.array([308.0, 28.0]))                    # 11.3 in off
+    assert rmap.at_refuge(np.array([312.0, 20.0]))                    # 12 in: reached
+    assert not rmap.at_refuge(np.array([312.5, 20.0]))
+    assert not rmap.at_refuge(np.array([300.0, -10.0]))               # on its way
+
+
+def moving_draw(seed: int, j: int):
+    """`moving` with the navigation benchmark's clutter draw ``j`` of ``seed`` (as
+    `bench_nav.py` builds it) and the base's scene."""
+    from mitos_cli.resources import packaged_path
+    from mitos_cli.sim.clutter import clutter
+    from mitos_cli.sim.worldfile import load_world
+
+    base = load_world(packaged_path("worlds", "moving.yaml"))
+    scene = prepare(base)
+    rng = np.random.default_rng(np.random.SeedSequence([seed, 3]).spawn(j + 1)[j])
+    world = clutter(base, scene.static, scene.routes[0], rng, int(rng.integers(3, 7)))
+    return world.with_changes(name=f"moving+clutter{j}", seed=base.seed + j), scene
+
+
+def test_a_robot_at_its_refuge_waits_till_the_cart_beside_it_has_passed_then_arrives():
+    """Dev seed 6000's `moving+clutter9`: the robot, sent up out of the cart's lane, stands
+    at its refuge facing away from its goal while the cart comes down the lower lane, 42 in
+    below it; 60 deg off its bearing the cart has not passed it, and a robot that turned
+    round for its goal then swung into the cart's lane and was hit (24.9 s). Standing at its
+    refuge it waits till the cart has passed it, and arrives."""
+    from mitos_cli.sim.loop import Simulation
+    from mitos_cli.sim.planner import FuzzyPlanner
+
+    world, scene = moving_draw(6000, 9)
+    sim = Simulation(world, FuzzyPlanner(None, world.behavior), world.seed, scene=scene)
+    cart = next(o for o in world.obstacles if o.name == "oncoming")
+    waited = left = None
+    while not sim.done:
+        sim.step()
+        p, rmap = sim.pose[0, :2], sim._maps[0]
+        x = cart.x + cart.motion.velocity[0] * sim.time          # where the cart is (true)
+        if rmap.at_refuge(p) and x > p[0] + 12:                   # beside it, not passed
+            waited = sim.time
+        if waited is not None and left is None and rmap.refuge is None:
+            left = (sim.time, x - p[0])
+    assert waited is not None and left is not None
+    assert left[1] < 0                          # it left its refuge once the cart had passed
+    assert sim.outcome == "success"
+
+
 def test_a_robot_standing_in_a_movers_way_is_sent_out_of_it():
     world, rmap, route, (asked, least) = corridor_map()
     goal, p = world.agents[0].goal, np.array([300.0, -10.0])
@@ -404,6 +532,7 @@ def test_trackers_followed_together_follow_as_each_alone():
     alone = [movers.Tracker() for _ in range(12)]
     places = rng.uniform(-60, 60, (12, 4, 2))
     speeds = rng.choice([0.0, 20.0, 40.0], (12, 4, 1)) * rng.normal(size=(12, 4, 2))
+    robots = rng.uniform(-200, 200, (12, 2))
     for k in range(60):
         now = k * 0.05
         seen = []
@@ -413,8 +542,10 @@ def test_trackers_followed_together_follow_as_each_alone():
             if k % 9 == 0 and len(centres) > 1:
                 centres[1] = centres[0] + 3.0          # two objects as far from one track
             radii = rng.uniform(1, 30, len(centres))
+            # seen from robots near and far: round gates, and gates wide across the line
+            sight = movers.sight_lines(centres, robots[j], np.deg2rad(10.0))
             seen.append((centres, radii, [bool(m) if m < 2 else None
-                                          for m in rng.integers(0, 3, len(centres))]))
+                                          for m in rng.integers(0, 3, len(centres))], sight))
         movers.follow_all(together, now, seen)
         for tracker, got in zip(alone, seen):
             tracker.follow(now, *got)

@@ -1472,7 +1472,8 @@ def test_free_ways_of_many_rows_worked_in_blocks_are_each_rows_own():
 def plain_sighting(free: movers.FreeSpace, now: float, origin, ranges, dirs, seen, ring: bool):
     """What one robot sees that its map does not show, as the tracker worked it out robot by
     robot: the seen beams cut into objects, each echo tested against the beams kept in the
-    window (gathered), each object's vote, centre and half size."""
+    window (gathered), each object's vote, centre and half size, and its line of sight from
+    the robot with the gate across it (:func:`.movers.sight_lines`), object by object."""
     hits = origin + ranges[:, None] * dirs
     idx = seen.nonzero()[0]
     runs = []
@@ -1507,14 +1508,20 @@ def plain_sighting(free: movers.FreeSpace, now: float, origin, ranges, dirs, see
     moved = [None if not (n := np.count_nonzero(tested[at[r]]))
              else 2 * np.count_nonzero(entered[at[r]]) >= n for r in runs]
     if not runs:
-        return np.zeros((0, 2)), np.zeros(0), moved
+        return np.zeros((0, 2)), np.zeros(0), moved, np.zeros((0, 3))
     found = [hits[r] for r in runs]
     sizes = np.array([len(o) for o in found])
     starts = np.concatenate([[0], np.cumsum(sizes)[:-1]])
     pts = np.concatenate(found)
     centres = np.add.reduceat(pts, starts, axis=0) / sizes[:, None]
     spread = np.hypot(*(pts - centres.repeat(sizes, axis=0)).T)
-    return centres, np.maximum.reduceat(spread, starts), moved
+    sight = []
+    for c in centres:
+        rel = c - origin
+        r = float(np.hypot(*rel))
+        across = 2 * r * math.sin(abs(free.step) / 2)
+        sight.append((*(rel / r), movers.GATE / across) if across > movers.GATE else (1.0, 0.0, 1.0))
+    return centres, np.maximum.reduceat(spread, starts), moved, np.array(sight)
 
 
 @pytest.mark.parametrize("ring", [True, False])
@@ -1541,13 +1548,16 @@ def test_what_robots_see_together_is_what_each_sees_alone(ring):
     seen[::4, [0, -1]] = True                               # across a ring's first beam
     seen[5] = False
     together = movers.sightings(spaces, now, origins, ranges, dirs, seen)
-    for r, (centres, radii, moved) in enumerate(together):
+    for r, (centres, radii, moved, sight) in enumerate(together):
         plain = plain_sighting(spaces[r], now, origins[r], ranges[r], dirs[r], seen[r], ring)
         alone = movers.sightings(spaces[r:r + 1], now, origins[r:r + 1], ranges[r:r + 1],
                                  dirs[r:r + 1], seen[r:r + 1])[0]
-        for got in (alone, (centres, radii, moved)):
+        for got in (alone, (centres, radii, moved, sight)):
             assert same(got[0], plain[0]) and same(got[1], plain[1]) and got[2] == plain[2]
-    assert any(None in m and True in m and False in m for _, _, m in together)
+            assert np.allclose(got[3], plain[3], rtol=1e-12, atol=0)
+        assert same(alone[3], sight)
+    assert any(None in m and True in m and False in m for _, _, m, _ in together)
+    assert any((s[:, 2] < 1).any() and (s[:, 2] == 1).any() for *_, s in together)
 
 
 def test_cells_beyond_many_robots_readings_at_once_are_each_robots_own():

@@ -298,6 +298,12 @@ class RobotMap:
     # the cells it marked (none given), as row * cols + col, ascending (row-major order)
     _around: tuple | None = field(default=None, repr=False)   # (planned, reach, its dilation)
     prepared: Prepared = field(default_factory=Prepared, repr=False)   # for its next replan
+
+    def at_refuge(self, p: np.ndarray) -> bool:
+        """Whether a robot at ``p [2]`` stands at its refuge: it holds one and is within its
+        tolerance of it (as a goal is reached), not on its way there."""
+        r = self.refuge
+        return r is not None and math.hypot(float(p[0]) - r.x, float(p[1]) - r.y) <= r.tolerance
     _changes: int = field(default=0, repr=False)     # marks made and cleared so far
     _last_near: tuple | None = field(default=None, repr=False)     # see near()
     _decoded: tuple | None = field(default=None, repr=False)   # see _marks_decoded()

@@ -1029,10 +1029,10 @@ class Simulation:
             return None
         h = float(self._h[i])
         # (a robot on its way to a refuge draws away from what it yields to; it waits for
-        # it all the same)
+        # it all the same; once at its refuge, for what has not passed it)
         own = (np.zeros(2) if rmap.refuge is not None
                else self._v[i] * np.array([math.cos(h), math.sin(h)]))
-        found = tracker.movers(s.t, p, own)
+        found = tracker.movers(s.t, p, own, waiting=rmap.at_refuge(p))
         if not found:
             return None
         robot, grid = self.robots[i], rmap.grid

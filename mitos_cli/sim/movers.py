@@ -4,9 +4,11 @@ The robot is told nothing of what moves. Each tick, the readings its map does no
 news perception marks) are cut into objects along the ring of beams: neighbouring beams whose
 echoes lie within ``LINK`` of each other are one object (:func:`objects`), as a laser scan is
 segmented. A :class:`Tracker` matches each object to the track it kept from the ticks before
-(the nearest predicted place within ``GATE``) and fits its velocity to the centres it was
-seen at over the last ``WINDOW`` seconds (a Theil-Sen slope: the echoes of a cart hop from
-one end of it to the other, and a median does not follow them).
+(the nearest predicted place within ``GATE``; across the robot's line of sight, far off,
+within the spacing of its beams there too, :func:`sight_lines`: a cart wider than that is
+echoed at one front corner, then at the other, and stays one track) and fits its velocity to
+the centres it was seen at over the last ``WINDOW`` seconds (a Theil-Sen slope: the echoes
+of a cart hop from one end of it to the other, and a median does not follow them).
 
 A track is a *mover* when most of its recent echoes came from space a beam had passed
 through a moment before (:class:`FreeSpace`: something came where nothing was), its centre
@@ -27,8 +29,10 @@ robot's left, squeezing past on the right without the room rather than crossing 
 it: two robots that met swerved across each other's way);
 where no way to the goal is left,
 it sends the robot to the nearest place out of its way (a *refuge*), and the robot waits
-there until nothing comes toward it: planning in time, in the simplest form a route can
-say.
+there until nothing comes toward it (standing at its refuge, till what comes has passed it:
+a cart beside it is 60 deg off its bearing long before it has passed, and a tricycle that
+turns round for its goal swings into the cart's lane): planning in time, in the simplest
+form a route can say.
 """
 
 from __future__ import annotations
@@ -207,7 +211,36 @@ def shapes(pts: np.ndarray, starts: Sequence[int]) -> tuple[np.ndarray, np.ndarr
     return centres, np.maximum.reduceat(spread, starts)
 
 
-Seen = tuple[np.ndarray, np.ndarray, list[bool | None]]     # what :meth:`Tracker.follow` takes
+Seen = tuple[np.ndarray, np.ndarray, list[bool | None], np.ndarray]   # what :meth:`Tracker.follow` takes
+
+
+def sight_lines(centres: np.ndarray, origins: np.ndarray, step: float) -> np.ndarray:
+    """How far across its robot's line of sight each object seen may lie from its track's
+    place: ``[O, 3]``, the line's direction (unit) and ``GATE`` over the gate across it.
+    Neighbouring beams ``step`` rad apart are ``2 r sin(step / 2)`` apart at range ``r``,
+    so an object wider than that is echoed now by one, now by the other, and its echoes hop
+    that far across the line (a ring of 36 beams sees a cart's two front corners, 16 in
+    apart, from 90 in on); along the line they stay within ``GATE``. Where the beams lie
+    closer than ``GATE`` (a dense fan, or objects near) the gate is round, and the row
+    ``(1, 0, 1)``: the plain distance."""
+    out = np.zeros((len(centres), 3))
+    out[:, 0] = out[:, 2] = 1.0
+    rel = centres - origins
+    r = np.hypot(rel[:, 0], rel[:, 1])
+    across = 2 * r * math.sin(abs(step) / 2)
+    wide = across > GATE
+    out[wide, :2] = rel[wide] / r[wide, None]
+    out[wide, 2] = GATE / across[wide]
+    return out
+
+
+def _gated(gap: np.ndarray, sight: np.ndarray) -> np.ndarray:
+    """The length of ``gap [..., 2]`` (a track's place less an object's) in the gate of the
+    object's :func:`sight_lines` row ``sight [..., 3]``: along its line of sight as it is,
+    across it scaled down to ``GATE`` (``(1, 0, 1)``: ``hypot`` of the gap, bit for bit)."""
+    gx, gy = gap[..., 0], gap[..., 1]
+    ux, uy = sight[..., 0], sight[..., 1]
+    return np.hypot(gx * ux + gy * uy, (gy * ux - gx * uy) * sight[..., 2])
 
 
 def sightings(spaces: Sequence[FreeSpace], now: float, origins: np.ndarray, ranges: np.ndarray,
@@ -221,7 +254,7 @@ def sightings(spaces: Sequence[FreeSpace], now: float, origins: np.ndarray, rang
     echoes each, and one pass is cheaper than one each."""
     robot, beam = seen.nonzero()
     if not len(robot):
-        return [(np.zeros((0, 2)), np.zeros(0), []) for _ in range(len(seen))]
+        return [(np.zeros((0, 2)), np.zeros(0), [], np.zeros((0, 3))) for _ in range(len(seen))]
     along = dirs[robot, beam]
     pts = origins[robot] + ranges[robot, beam, None] * along                # the echoes
     crossed, came = entered(spaces, now, pts, along, robot)
@@ -229,13 +262,15 @@ def sightings(spaces: Sequence[FreeSpace], now: float, origins: np.ndarray, rang
     if order is not None:
         pts, robot, crossed, came = pts[order], robot[order], crossed[order], came[order]
     centres, radii = shapes(pts, starts)
+    sight = sight_lines(centres, origins[robot[starts]], spaces[0].step)
     crossed = np.add.reduceat(crossed, starts, dtype=np.intp).tolist()
     came = np.add.reduceat(came, starts, dtype=np.intp).tolist()
     moved = [None if not n else 2 * e >= n for n, e in zip(crossed, came)]
     if len(seen) == 1:
-        return [(centres, radii, moved)]
+        return [(centres, radii, moved, sight)]
     ends = [0, *itertools.accumulate(np.bincount(robot[starts], minlength=len(seen)).tolist())]
-    return [(centres[a:b], radii[a:b], moved[a:b]) for a, b in zip(ends[:-1], ends[1:])]
+    return [(centres[a:b], radii[a:b], moved[a:b], sight[a:b])
+            for a, b in zip(ends[:-1], ends[1:])]
 
 
 @dataclass
@@ -251,17 +286,21 @@ class Tracker:
         self.follow(now, *shapes(pts, starts), moved)
 
     def follow(self, now: float, centres: np.ndarray, radii: np.ndarray,
-               moved: list[bool | None]) -> None:
+               moved: list[bool | None], sight: np.ndarray | None = None) -> None:
         """Match the objects seen at time ``now`` (centres ``[O, 2]``, half sizes ``[O]``;
-        ``moved``: whether each has an echo in space a beam had passed through) to the
-        tracks (nearest first, each track and object once), start a track for each object
-        left, drop stale tracks (:func:`follow_all` of one)."""
-        follow_all([self], now, [(centres, radii, moved)])
+        ``moved``: whether each has an echo in space a beam had passed through; ``sight``:
+        their :func:`sight_lines`, ``None``: a round gate) to the tracks (nearest first in
+        that gate, each track and object once), start a track for each object left, drop
+        stale tracks (:func:`follow_all` of one)."""
+        if sight is None:
+            sight = sight_lines(centres, centres, 0.0)
+        follow_all([self], now, [(centres, radii, moved, sight)])
 
     def _match(self, now: float, live: list[Track], centres: np.ndarray, radii: np.ndarray,
-               moved: list[bool | None], apart: list[float], order: list[int]) -> None:
+               moved: list[bool | None], sight: np.ndarray, apart: list[float],
+               order: list[int]) -> None:
         """:meth:`follow` with the live tracks' distances to the objects ``apart`` (row-major
-        ``[T * O]``) and their order, nearest first."""
+        ``[T * O]``, in the objects' gates) and their order, nearest first."""
         half = radii.tolist()
         used_t: set[int] = set()
         used_o: set[int] = set()
@@ -280,7 +319,7 @@ class Tracker:
                 continue
             if taken is None:
                 taken = np.array([live[j].centres[-1] for j in sorted(used_t)]).reshape(-1, 2)
-            if len(taken) and np.hypot(*(taken - centres[i]).T).min() <= GATE:
+            if len(taken) and _gated(taken - centres[i], sight[i]).min() <= GATE:
                 continue
             live.append(Track([now], [centres[i]], half[i], [moved[i]], born=now))
         self.tracks = live
@@ -306,11 +345,16 @@ class Tracker:
                     and MIN_SPEED <= speed <= MAX_SPEED)
         tr.v = v
 
-    def movers(self, now: float, robot: np.ndarray, own: np.ndarray) -> list[Mover]:
+    def movers(self, now: float, robot: np.ndarray, own: np.ndarray, waiting: bool = False
+               ) -> list[Mover]:
         """The tracks that move toward the robot at ``robot [2]`` driving at velocity ``own
         [2]`` (see the module docstring): those seen at ``now``, and the movers among those
         missed for at most ``MAX_MISS`` s, where they should be by now (a sonar ring loses a
-        cart between two beams for a tick or two)."""
+        cart between two beams for a tick or two). A robot ``waiting`` at its refuge (standing
+        there, :meth:`.knowledge.RobotMap.at_refuge`) waits for what has not passed it yet:
+        the cone is a half plane (a cart beside it, 60 deg or more off its bearing, still
+        comes on, and a tricycle that turns round for its goal swings into its lane)."""
+        cone = 0.0 if waiting else APPROACH
         out = []
         for tr in self.tracks:
             v = tr.v
@@ -322,7 +366,7 @@ class Tracker:
             to_robot = robot - centre
             dist = float(np.hypot(*to_robot))
             # it heads for the robot, and the robot does not draw away from it faster
-            if float(v @ to_robot) < APPROACH * speed * dist or float((v - own) @ to_robot) <= 0:
+            if float(v @ to_robot) < cone * speed * dist or float((v - own) @ to_robot) <= 0:
                 continue
             out.append(Mover(centre, v, tr.radius, now - tr.born >= SETTLE))
         return out
@@ -335,11 +379,11 @@ def follow_all(trackers: Sequence[Tracker], now: float, seen: Sequence[Seen]) ->
     lives = [[tr for tr in t.tracks if now - tr.times[-1] <= MAX_MISS] for t in trackers]
     apart, order, pairs = _apart(lives, seen, now)
     start = 0
-    for tracker, live, (centres, radii, moved), n in zip(trackers, lives, seen, pairs):
+    for tracker, live, (centres, radii, moved, sight), n in zip(trackers, lives, seen, pairs):
         if not len(centres):
             tracker.tracks = live
             continue
-        tracker._match(now, live, centres, radii, moved, apart[start:start + n],
+        tracker._match(now, live, centres, radii, moved, sight, apart[start:start + n],
                        [k - start for k in order[start:start + n]])
         start += n
 
@@ -359,8 +403,7 @@ def _apart(lives: list[list[Track]], seen: Sequence[Seen], now: float
     pred = np.concatenate([tr.predicted(now) for live, t in zip(lives, sizes) if t
                            for tr in live]).reshape(-1, 2)                   # [T, 2]
     if len(seen) == 1:                                          # (one: no pairs to lay out)
-        gap = pred[:, None] - seen[0][0][None]
-        d = np.hypot(gap[..., 0], gap[..., 1]).ravel()
+        d = _gated(pred[:, None] - seen[0][0][None], seen[0][3][None]).ravel()
         return d.tolist(), d.argsort(kind="stable").tolist(), pairs
     counts, size, many = np.array(pairs), np.array(sizes), np.array(objects)
     owner = np.repeat(np.arange(len(seen)), counts)
@@ -368,8 +411,8 @@ def _apart(lives: list[list[Track]], seen: Sequence[Seen], now: float
     per = many[owner]
     track = (np.cumsum(size) - size)[owner] + k // per
     thing = (np.cumsum(many) - many)[owner] + k % per
-    gap = pred[track] - np.concatenate([got[0] for got in seen])[thing]
-    d = np.hypot(gap[:, 0], gap[:, 1])
+    d = _gated(pred[track] - np.concatenate([got[0] for got in seen])[thing],
+               np.concatenate([got[3] for got in seen])[thing])
     return d.tolist(), np.lexsort((d, owner)).tolist(), pairs
 
 
@@ -531,9 +574,11 @@ Capsule = tuple[np.ndarray, np.ndarray, float]     # a segment's two ends and a 
 
 def lane(m: Mover, robot: np.ndarray, heading: float, width: float) -> bool:
     """Whether ``m`` comes down the lane of a robot at ``robot [2]`` heading ``heading``
-    (rad), ``width`` inches wide: its centre within a body width of the robot's line."""
+    (rad), ``width`` inches wide: its path (as wide as it, ``HALF_WIDTH`` each side at least)
+    overlaps the robot's lane."""
     to_robot = robot - m.centre
-    return abs(math.cos(heading) * to_robot[1] - math.sin(heading) * to_robot[0]) < width
+    return (abs(math.cos(heading) * to_robot[1] - math.sin(heading) * to_robot[0])
+            < width / 2 + max(m.radius, HALF_WIDTH))
 
 
 def swept(m: Mover, robot: np.ndarray, heading: float, length: float, width: float
@@ -565,8 +610,8 @@ def sweep(found: list[Mover], robot: np.ndarray, heading: float, length: float, 
     none. With movers in its lane, :attr:`Sweep.keep_right` too: the same ways ``room``
     wider, and the robot's left of those movers up to ``far``; and :attr:`Sweep.left`, the
     robot's left alone, when one of them comes on its left (:func:`_on_left`). A robot
-    ``waiting`` at a
-    refuge waits while anything is ``found`` (an empty sweep): a mover whose heading is not
+    ``waiting`` (bound for a refuge, or at it) waits while anything is ``found`` (an empty
+    sweep): a mover whose heading is not
     known yet sweeps nothing once the robot has turned out of its lane for the refuge, and
     it comes on all the same."""
     cells = np.zeros(shape, dtype=bool)
