@@ -31,6 +31,8 @@ from .lang.terms import TermSet
 from .resources import DEFAULT_RULEBASE, packaged_path
 
 if TYPE_CHECKING:
+    from collections.abc import Mapping
+
     from numpy.typing import ArrayLike
 
 #: The types the one-sample path of :meth:`LoadedRuleBase.evaluate` takes as they are (not
@@ -209,8 +211,9 @@ class LoadedRuleBase:
         extra = tuple(Setting(k.rstrip("_"), str(v)) for k, v in settings.items())
         return LoadedRuleBase(self.rulebase, self.compiled.behavior, self.overrides + extra)
 
-    def run(self, X: ArrayLike, **kwargs: bool) -> Result:
-        """Evaluate a batch ``X[n, k]`` (columns in :attr:`inputs` order)."""
+    def run(self, X: ArrayLike | Mapping[str, ArrayLike], **kwargs: bool) -> Result:
+        """Evaluate a batch ``X[n, k]`` (columns in :attr:`inputs` order, or a mapping of
+        the inputs' names to their columns)."""
         return evaluate(self.compiled, X, **kwargs)
 
     def evaluate(self, **inputs: float | np.ndarray) -> dict[str, float | np.ndarray]:

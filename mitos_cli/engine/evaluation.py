@@ -32,8 +32,9 @@ if TYPE_CHECKING:
 
     from .compile import Grid, GridBatch, NodeGroup, Plan, ShapeGroup
 
-    #: inputs as columns: an array ``[k, n]``, or ``k`` 1-D arrays of one length
-    Columns = ArrayLike | Sequence[ArrayLike]
+    #: inputs as columns: an array ``[k, n]``, ``k`` 1-D arrays of one length, or a mapping
+    #: of each input's name to its column (or to one number)
+    Columns = ArrayLike | Sequence[ArrayLike] | Mapping[str, ArrayLike]
 
 
 @dataclass(frozen=True, eq=False)   # holds arrays: identity, not ==
@@ -129,8 +130,11 @@ def check_inputs(compiled: CompiledRuleBase, X: ArrayLike) -> tuple[np.ndarray, 
     return _clamp(compiled, _rows(compiled, X))
 
 
-def _rows(compiled: CompiledRuleBase, X: ArrayLike) -> np.ndarray:
-    """``X`` as a float array ``[n, k]`` (one sample may come as a flat ``[k]``)."""
+def _rows(compiled: CompiledRuleBase, X: ArrayLike | Mapping[str, ArrayLike]) -> np.ndarray:
+    """``X`` as a float array ``[n, k]`` (one sample may come as a flat ``[k]``; a mapping
+    gives the inputs by name, as :func:`as_batch` reads them)."""
+    if isinstance(X, Mapping):      # its keys were read as the values ("not a number: `road`")
+        return as_batch(compiled, X)
     k = len(compiled.inputs)
     X = floats(X, "the inputs", many=True)
     if X.ndim == 1 and X.shape[0] == k:
@@ -526,9 +530,10 @@ def _constant_sums(plan: Plan, dof: np.ndarray) -> np.ndarray:
     return tree_sum(S)
 
 
-def evaluate(compiled: CompiledRuleBase, X: ArrayLike, *, detail: bool = True, keep_values: bool = False,
-             strict: bool = True) -> Result:
-    """Evaluate the network on ``X[n, k]``, in cache-sized blocks of samples.
+def evaluate(compiled: CompiledRuleBase, X: ArrayLike | Mapping[str, ArrayLike], *,
+             detail: bool = True, keep_values: bool = False, strict: bool = True) -> Result:
+    """Evaluate the network on ``X[n, k]``, in cache-sized blocks of samples (or on inputs by
+    name: ``{"road": array, "size": 45, ...}``, as :func:`as_batch` reads them).
 
     ``detail`` keeps memberships and DOFs (``False`` returns only outputs, faster);
     ``keep_values`` also keeps every neuron's value (for training and the rule viewer). An
@@ -611,7 +616,8 @@ def rule_dofs(compiled: CompiledRuleBase, X: ArrayLike) -> np.ndarray:
 
 def evaluate_columns(compiled: CompiledRuleBase, Xt: Columns, *, strict: bool = True) -> np.ndarray:
     """The outputs ``[m, n]`` (one contiguous row per output) for inputs given as columns
-    ``Xt[k, n]`` (an array, or a sequence of ``k`` 1-D arrays of one length):
+    ``Xt[k, n]`` (an array, a sequence of ``k`` 1-D arrays of one length, or a mapping of
+    the inputs' names to their columns, numbers broadcast):
     :func:`evaluate` with ``detail=False``, bit for bit, without copying a large batch into
     rows or keeping its clamped inputs (``load_rulebase().evaluate(**arrays)``).
 
@@ -652,7 +658,11 @@ def _input_columns(compiled: CompiledRuleBase,
     """``Xt`` (an array ``[k, n]`` or ``k`` columns) and its columns as float arrays, each
     through :func:`~.inputs.floats` as the rows' and the named inputs' values are (a bool,
     date, bytes or structured column was read as numbers here, a complex one with NumPy's
-    warning); a float column is kept as it is, not copied."""
+    warning); a float column is kept as it is, not copied. A mapping gives the columns by
+    name, as :func:`as_columns` reads them."""
+    if isinstance(Xt, Mapping):     # its keys were read as the columns ("not a number: `road`")
+        columns = as_columns(compiled, Xt)
+        return columns, columns
     if isinstance(Xt, np.ndarray) or not hasattr(Xt, "__len__"):
         Xt = floats(Xt, "the input columns", many=True)
     if isinstance(Xt, np.ndarray) and Xt.ndim == 0:
@@ -856,16 +866,22 @@ def _grid_block(compiled: CompiledRuleBase, g: GridBatch, b: _GridBlock, columns
 _FLOAT = {float}
 
 
-def evaluate_one(compiled: CompiledRuleBase, values: list[float],
+def evaluate_one(compiled: CompiledRuleBase, values: list[float] | Mapping[str, float],
                  strict: bool = True) -> tuple[float, ...]:
     """The outputs for one sample (inputs in :attr:`CompiledRuleBase.inputs` order): the same
     bits as its row in :func:`evaluate`, through the network's scalar form where it has one
     (:mod:`mitos_cli.engine.scalar`, a few microseconds instead of some forty NumPy calls).
     Values other than floats are read as :func:`~.inputs.floats` reads them (the scalar form
-    would take ``True`` as 1)."""
-    if not _FLOAT.issuperset(map(type, values)):
-        values = floats(values, "the inputs", many=True).tolist()
-    return evaluate_floats(compiled, values, strict)
+    would take ``True`` as 1). A mapping gives the values by name (``{"road": 78, ...}``),
+    checked as :func:`as_batch` checks names."""
+    if isinstance(values, Mapping):  # it was "the inputs must be numbers, not `{...}`"
+        _check_names(compiled, values)
+        row = [values[name] for name in compiled.inputs]
+    else:
+        row = values
+    if not _FLOAT.issuperset(map(type, row)):
+        row = floats(row, "the inputs", many=True).tolist()
+    return evaluate_floats(compiled, row, strict)
 
 
 def evaluate_floats(compiled: CompiledRuleBase, values: list[float],
