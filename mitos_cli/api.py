@@ -205,9 +205,19 @@ class LoadedRuleBase:
     def with_operators(self, **settings: str) -> LoadedRuleBase:
         """The same behavior compiled with other operators, e.g. ``with_operators(and_="product")``
         (keys as in an ``operators:`` line; a trailing underscore is dropped). An output with a
-        ``resolution`` of its own (its term set's) keeps it."""
-        from .lang.model import Setting
+        ``resolution`` of its own (its term set's) keeps it. An unknown key is a
+        :class:`~mitos_cli.errors.NameError_` whose "did you mean" is a keyword this method
+        takes (``and_``, not the ``and`` of a rule file, which Python does not parse here)."""
+        import keyword
 
+        from .errors import unknown
+        from .lang.model import Setting
+        from .lang.operators import KEYS
+
+        for k in settings:
+            if k.rstrip("_") not in KEYS:
+                raise unknown("operator setting", k,
+                              [f"{key}_" if keyword.iskeyword(key) else key for key in KEYS])
         extra = tuple(Setting(k.rstrip("_"), str(v)) for k, v in settings.items())
         return LoadedRuleBase(self.rulebase, self.compiled.behavior, self.overrides + extra)
 
