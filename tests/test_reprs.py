@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 
 from mitos_cli import load_rulebase
@@ -56,3 +58,40 @@ def test_many_runs_print_a_line_each_not_every_summary():
                            "timeout 0%, stuck 0%>")
     assert repr(runs).startswith("<Runs of 8 worlds: 'tiny' x 1000, ") and "(2 more)" in repr(runs)
     assert repr(WorldRuns("none", ())) == "<WorldRuns 'none': 0 runs>"
+
+
+def test_a_world_a_simulation_a_lockstep_and_their_ticks_print_a_line_each():
+    """A World printed every field of every robot, sensor and obstacle (1,000-1,500
+    characters; a grid's array summary with it), a Simulation and a Lockstep their address,
+    a Tick every beam (840 characters a robot) and ``observe()`` 1,100: a notebook user
+    stepping a run by hand was flooded, or told nothing."""
+    from mitos_cli.resources import packaged_path
+    from mitos_cli.sim import Lockstep, Simulation, load_world
+
+    tiny = load_world(str(Path(__file__).parent / "data" / "tiny.yaml"))
+    office = load_world(str(packaged_path("worlds", "office.yaml")))
+    corridor = load_world(str(packaged_path("worlds", "corridor.yaml")))
+    two = load_world(str(packaged_path("worlds", "multirobot.yaml")))
+    sim = Simulation(corridor, seed=4)
+    tick = sim.step()
+    seen = sim.observe()
+    lock = Lockstep(corridor, None, seeds=[1, 2, 3])
+    pair = Simulation(two, randomise=True)
+    texts = [repr(w) for w in (office, corridor, two, tiny)]
+    texts += [repr(office.grid), repr(sim), repr(tick), repr(seen), repr(lock), repr(pair),
+              repr(pair.step())]
+    for text in texts:
+        assert "\n" not in text and len(text) < 300 and "array(" not in text, text
+    assert repr(corridor).startswith("<World 'corridor' (") and \
+        "1 robot (tricycle), 1 corridor, 1 obstacle, seed 1, dt 0.05 s, time limit 60 s>" \
+        in repr(corridor)
+    assert "600 x 600 grid" in repr(office) and repr(office.grid).startswith("<Grid 600 x 600 cells")
+    assert repr(sim) == "<Simulation 'corridor' seed 4, fuzzy:drive: driving, 1 tick (0.05 s)>"
+    assert repr(tick).startswith("<Tick 0 (t = 0 s): at (") and "36 beams a robot" in repr(tick)
+    assert repr(pair).startswith("<Simulation 'multirobot' seed 5, randomised, fuzzy:drive, "
+                                 "2 robots: driving, 1 tick")
+    assert repr(lock) == "<Lockstep of 3 runs of 'corridor', fuzzy:drive: 3 driving, 0 ended>"
+    while not sim.done:
+        sim.step()
+    assert repr(sim) == f"<Simulation 'corridor' seed 4, fuzzy:drive: ended: {sim.outcome} " \
+        f"({sim.ticks:,} ticks)>"

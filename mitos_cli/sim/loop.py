@@ -357,6 +357,16 @@ class Tick:
         a lockstep batch records a tick of each of its runs at once, and few are looked at)."""
         return dict(zip(perception.INPUTS, self.block))
 
+    def __repr__(self) -> str:   # the generated one printed every beam (840 characters a robot)
+        n, beams = self.ranges.shape
+        if n == 1:
+            x, y, h = self.pose[0].tolist()
+            state = (f"at ({x:.1f}, {y:.1f}) in heading {h:.1f} deg, speed "
+                     f"{float(self.speed[0]):.1f} in/s, clearance {float(self.clearance[0]):.1f} in")
+        else:
+            state = f"{plural(n, 'robot')} ({int(np.count_nonzero(self.active))} still driving)"
+        return f"<Tick {self.k} (t = {self.t:g} s): {state}; {plural(beams, 'beam')} a robot>"
+
 
 @dataclass
 class _Sensed:
@@ -375,6 +385,11 @@ class _Sensed:
     def inputs(self) -> dict[str, np.ndarray]:
         """name -> ``[n]``: the rows of :attr:`block` (made when asked)."""
         return dict(zip(perception.INPUTS, self.block))
+
+    def __repr__(self) -> str:   # what Simulation.observe() gives (1,100 characters a robot)
+        n, beams = self.ranges.shape
+        return (f"<observed tick (t = {self.t:g} s) of {plural(n, 'robot')}: .inputs (name -> [n]),"
+                f" .ranges [n, {beams}], .pose, .clearance>")
 
 
 class Simulation:
@@ -417,6 +432,14 @@ class Simulation:
         self.randomise = _check_randomise(randomise)
         self._given_world, self._given_scene = world, scene
         self.reset(seed)
+
+    def __repr__(self) -> str:
+        name = getattr(self.planner, "name", type(self.planner).__name__)
+        now = (f"ended: {self.outcome} ({plural(self.ticks, 'tick')})" if self.done
+               else f"driving, {plural(self.ticks, 'tick')} ({self.time:g} s)")
+        robots = f", {len(self.robots)} robots" if len(self.robots) > 1 else ""
+        drawn = ", randomised" if self.randomise else ""
+        return f"<Simulation {self.world.name!r} seed {self.seed}{drawn}, {name}{robots}: {now}>"
 
     # -- set-up -----------------------------------------------------------------------------
 
