@@ -95,3 +95,24 @@ def test_a_world_a_simulation_a_lockstep_and_their_ticks_print_a_line_each():
         sim.step()
     assert repr(sim) == f"<Simulation 'corridor' seed 4, fuzzy:drive: ended: {sim.outcome} " \
         f"({sim.ticks:,} ticks)>"
+
+
+def test_a_study_outcome_its_summaries_and_ranks_print_a_line_each(tmp_path):
+    """An Outcome printed every row and every summary's rates and means (11,000 characters
+    for a study of 12 runs; half a million for docs/study.md's 700), a Summary or a Rank
+    1,100-1,200."""
+    from mitos_cli.study import Study, make_choices, run_study
+
+    tiny = str(Path(__file__).parent / "data" / "tiny.yaml")
+    choices = make_choices(["fuzzy", "potential_field"], ["min", "product", "einstein"], [], [])
+    outcome = run_study(Study([tiny], choices, runs=2, seed=1), tmp_path, workers=1)
+    texts = [repr(outcome), *map(repr, outcome.summaries), *map(repr, outcome.ranks)]
+    for text in texts:
+        assert "\n" not in text and len(text) < 300, text
+    assert repr(outcome).startswith("<Outcome: 8 of 8 runs (8 now, 0 from before), 1 world x "
+                                    "4 choices; 1. ") and repr(outcome).endswith(" (1 more)>")
+    fuzzy_min = next(s for s in outcome.summaries if s.choice.label == "fuzzy and=min")
+    assert repr(fuzzy_min).startswith(f"<Summary {tiny!r}, fuzzy and=min: 2 runs, success ")
+    leader, last = outcome.ranks[0], outcome.ranks[-1]
+    assert repr(leader).startswith("<Rank 1: ") and repr(leader).endswith("; leader>")
+    assert f"{last.wins} won / {last.losses} lost vs leader, McNemar p " in repr(last)
