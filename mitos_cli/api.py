@@ -221,10 +221,22 @@ class LoadedRuleBase:
         extra = tuple(Setting(k.rstrip("_"), str(v)) for k, v in settings.items())
         return LoadedRuleBase(self.rulebase, self.compiled.behavior, self.overrides + extra)
 
-    def run(self, X: ArrayLike | Mapping[str, ArrayLike], **kwargs: bool) -> Result:
+    def run(self, X: ArrayLike | Mapping[str, ArrayLike], *, detail: bool = True,
+            keep_values: bool = False, strict: bool = True) -> Result:
         """Evaluate a batch ``X[n, k]`` (columns in :attr:`inputs` order, or a mapping of
-        the inputs' names to their columns)."""
-        return evaluate(self.compiled, X, **kwargs)
+        the inputs' names to their columns). ``detail`` keeps the memberships and DOFs,
+        ``keep_values`` every neuron's value; ``strict=False`` leaves NaN where no rule sets
+        an output that has no default (else a ``NoRuleFiredError``). Each is ``True`` or
+        ``False``: another value (``detail="no"``, which was true) is an ``InputError``."""
+        from .errors import InputError
+
+        flags = {"detail": detail, "keep_values": keep_values, "strict": strict}
+        for name, flag in flags.items():
+            if not isinstance(flag, (bool, np.bool_)):
+                raise InputError(f"`{name}` is True or False, not `{flag!r:.40}`",
+                                 hint=f"run(X, {name}=False)")
+        return evaluate(self.compiled, X, detail=bool(detail), keep_values=bool(keep_values),
+                        strict=bool(strict))
 
     def evaluate(self, **inputs: float | np.ndarray) -> dict[str, float | np.ndarray]:
         """Outputs for inputs given by name (floats, or arrays evaluated as one batch)."""

@@ -23,3 +23,24 @@ def test_with_operators_takes_and_underscore_and_suggests_it_for_a_misspelt_key(
     assert "and_, " in str(err.value) and "or_, " in str(err.value)
     with pytest.raises(NameError_, match="did you mean `inference`"):
         rb.with_operators(inferense="mamdani")
+
+
+def test_run_takes_its_flags_as_bools_and_names_them_in_its_signature():
+    """``run(X, **kwargs)`` passed anything on: ``detail="no"`` was true (memberships and DOFs
+    computed and kept), ``strict=0`` false. Its keywords are now its own, checked."""
+    import inspect
+
+    import numpy as np
+
+    from mitos_cli.errors import InputError
+
+    rb = load_rulebase()
+    X = np.array([[78.0, 45.0, 4.0]])
+    assert list(inspect.signature(rb.run).parameters) == ["X", "detail", "keep_values", "strict"]
+    assert rb.run(X, detail=False).dof is None and rb.run(X).dof is not None
+    assert rb.run(X, detail=np.bool_(False)).dof is None
+    for bad in ({"detail": "no"}, {"strict": 0}, {"keep_values": None}):
+        with pytest.raises(InputError, match=f"`{next(iter(bad))}` is True or False, not"):
+            rb.run(X, **bad)
+    with pytest.raises(TypeError, match="detial"):
+        rb.run(X, detial=False)
