@@ -427,7 +427,18 @@ def test_a_misspelt_outcome_or_figure_of_the_runs_is_named():
                        (lambda: runs.stat("world"), "unknown figure `world`")):
         with pytest.raises(InputError, match=re.escape(says)):
             call()
-    assert runs.stat("time_s") == (0.2, 0.0)
+    assert runs.stat("time_s") == (0.2, 0.0)       # two runs that agree: a spread of 0
+
+
+def test_the_spread_of_one_run_is_none_not_zero():
+    """stat() gave one run a standard deviation of 0.0, which reads as runs that agree (a
+    sample standard deviation of one value is undefined); figures(), `--json` and the table
+    said nothing (None, null, no ±) already."""
+    from mitos_cli.sim import run_many
+
+    one = run_many([short("corridor.yaml", 0.2)], runs=1, seed=1, workers=1).worlds[0]
+    assert one.stat("time_s") == (0.2, None)
+    assert one.figures()["time_s"] == {"mean": 0.2, "std": None}
 
 
 @pytest.mark.parametrize("command, says", [
