@@ -91,6 +91,7 @@ def test_a_world_a_simulation_a_lockstep_and_their_ticks_print_a_line_each():
     assert repr(pair).startswith("<Simulation 'multirobot' seed 5, randomised, fuzzy:drive, "
                                  "2 robots: driving, 1 tick")
     assert repr(lock) == "<Lockstep of 3 runs of 'corridor', fuzzy:drive: 3 driving, 0 ended>"
+    assert "(1 tick)" in repr(sim.result())           # a run cut after one tick ("1 ticks")
     while not sim.done:
         sim.step()
     assert repr(sim) == f"<Simulation 'corridor' seed 4, fuzzy:drive: ended: {sim.outcome} " \

@@ -199,7 +199,7 @@ class SimResult:
         m = self.metrics
         robots = len(self.robot_outcomes)
         return (f"<SimResult {self.world.name!r} seed {self.seed}, {self.planner}: {self.outcome} "
-                f"after {m.get('time_s', self.ticks * self.world.dt):g} s ({self.ticks} ticks"
+                f"after {m.get('time_s', self.ticks * self.world.dt):g} s ({plural(self.ticks, 'tick')}"
                 f"{f', {robots} robots' if robots > 1 else ''}), path "
                 f"{m.get('path_length_in', 0.0):.1f} in, min clearance "
                 f"{shown_clearance(m.get('min_clearance_in', 0.0))} in>")
