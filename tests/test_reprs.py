@@ -19,6 +19,7 @@ def test_reprs_are_one_line_with_the_sizes():
         assert "\n" not in text and len(text) < 300, text
     assert "27 rules" in repr(rb.compiled) and "and = min" in repr(rb.compiled)
     assert "1,000 samples x 2 outputs (steering, speed)" in repr(r)
+    assert "1 sample x 2 outputs" in repr(rb.run(np.array([[78.0, 45.0, 4.0]])))  # "1 samples"
     assert f"{len(rb.behaviors)} behaviors (avoid_obstacle, " in repr(rb.rulebase)
 
 

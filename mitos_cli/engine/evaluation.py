@@ -53,9 +53,11 @@ class Result:
     # memberships and dof are transposed views of [T, n] / [R, n] arrays (rows are samples).
 
     def __repr__(self) -> str:
+        from ..words import plural     # ("1 samples x 1 outputs")
+
         kept = [k for k in ("memberships", "dof", "values") if getattr(self, k) is not None]
-        return (f"<Result of {self.compiled.behavior!r}: {len(self.outputs):,} samples x "
-                f"{len(self.compiled.outputs)} outputs ({', '.join(self.compiled.outputs)})"
+        return (f"<Result of {self.compiled.behavior!r}: {plural(len(self.outputs), 'sample')} x "
+                f"{plural(len(self.compiled.outputs), 'output')} ({', '.join(self.compiled.outputs)})"
                 f"{'; with ' + ', '.join(kept) if kept else ''}>")
 
     def output(self, name: str) -> np.ndarray:
