@@ -21,6 +21,7 @@ from ..fuzzy import hedges as hedge_mod
 from ..fuzzy import norms
 from ..fuzzy.shapes import SHAPES
 from ..numbers import exact
+from ..words import plural
 from .compile import CompiledRuleBase
 from .inputs import floats
 from .threads import Blocks, map_blocks, thread_count
@@ -53,8 +54,6 @@ class Result:
     # memberships and dof are transposed views of [T, n] / [R, n] arrays (rows are samples).
 
     def __repr__(self) -> str:
-        from ..words import plural     # ("1 samples x 1 outputs")
-
         kept = [k for k in ("memberships", "dof", "values") if getattr(self, k) is not None]
         return (f"<Result of {self.compiled.behavior!r}: {plural(len(self.outputs), 'sample')} x "
                 f"{plural(len(self.compiled.outputs), 'output')} ({', '.join(self.compiled.outputs)})"
