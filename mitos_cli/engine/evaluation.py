@@ -875,7 +875,9 @@ def evaluate_one(compiled: CompiledRuleBase, values: list[float] | Mapping[str, 
     Values other than floats are read as :func:`~.inputs.floats` reads them (the scalar form
     would take ``True`` as 1). A mapping gives the values by name (``{"road": 78, ...}``),
     checked as :func:`as_batch` checks names."""
-    if isinstance(values, Mapping):  # it was "the inputs must be numbers, not `{...}`"
+    # a mapping gives the values by name (it was "the inputs must be numbers, not `{...}`");
+    # a list is ruled out first, so that the usual call does not pay for the ABC's isinstance
+    if type(values) is not list and isinstance(values, Mapping):
         _check_names(compiled, values)
         row = [values[name] for name in compiled.inputs]
     else:
