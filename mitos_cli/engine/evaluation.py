@@ -134,7 +134,7 @@ def check_inputs(compiled: CompiledRuleBase, X: ArrayLike) -> tuple[np.ndarray, 
 def _rows(compiled: CompiledRuleBase, X: ArrayLike | Mapping[str, ArrayLike]) -> np.ndarray:
     """``X`` as a float array ``[n, k]`` (one sample may come as a flat ``[k]``; a mapping
     gives the inputs by name, as :func:`as_batch` reads them)."""
-    if isinstance(X, Mapping):      # its keys were read as the values ("not a number: `road`")
+    if type(X) is not np.ndarray and isinstance(X, Mapping):   # its keys were read as values
         return as_batch(compiled, X)
     k = len(compiled.inputs)
     X = floats(X, "the inputs", many=True)
@@ -661,7 +661,7 @@ def _input_columns(compiled: CompiledRuleBase,
     date, bytes or structured column was read as numbers here, a complex one with NumPy's
     warning); a float column is kept as it is, not copied. A mapping gives the columns by
     name, as :func:`as_columns` reads them."""
-    if isinstance(Xt, Mapping):     # its keys were read as the columns ("not a number: `road`")
+    if type(Xt) is not np.ndarray and isinstance(Xt, Mapping):  # (its keys were read as columns)
         columns = as_columns(compiled, Xt)
         return columns, columns
     if isinstance(Xt, np.ndarray) or not hasattr(Xt, "__len__"):
