@@ -23,6 +23,19 @@ def test_reprs_are_one_line_with_the_sizes():
     assert f"{len(rb.behaviors)} behaviors (avoid_obstacle, " in repr(rb.rulebase)
 
 
+def test_a_trace_prints_a_line_outside_a_notebook():
+    """``rb.trace(...)`` at a Python prompt printed its nested dataclasses: 2,000 characters
+    for the paper's 27 rules, 2,700 for ``drive``."""
+    rb = load_rulebase()
+    assert repr(rb.trace(road=500, size=45, position=4)) == (
+        "<Trace of 'avoid_obstacle' at road=500, size=45, position=4: steering 63.93 deg, "
+        "speed 37.5 in/s; 4 of 27 rules fired>")
+    drive = rb.behavior("drive")
+    text = repr(drive.trace(**dict(zip(drive.inputs, [78, 45, 4, 100, 0, 0, 200, 50, 50, 100,
+                                                       0, 5, 30]))))
+    assert "\n" not in text and len(text) < 200 and "obstacle=100, ...: steering " in text
+
+
 def test_a_trace_shows_itself_in_a_notebook():
     html = load_rulebase().trace(road=78, size=45, position=4)._repr_html_()
     assert html.startswith("<pre>") and "steering = 65.4 deg" in html
