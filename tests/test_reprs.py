@@ -131,3 +131,23 @@ def test_a_study_outcome_its_summaries_and_ranks_print_a_line_each(tmp_path):
     leader, last = outcome.ranks[0], outcome.ranks[-1]
     assert repr(leader).startswith("<Rank 1: ") and repr(leader).endswith("; leader>")
     assert f"{last.wins} won / {last.losses} lost vs leader, McNemar p " in repr(last)
+
+
+def test_the_data_of_the_pictures_print_a_line_each():
+    """mitos_cli.draw.data's VariablePlot printed every curve's points (20,000 characters for
+    the packaged rule base's sheet), a Surface its axes and z, a RuleView every row's view
+    (6,000 characters)."""
+    from mitos_cli.draw.data import rule_view, sheet, surface
+
+    rb = load_rulebase()
+    plots = sheet(rb, values={"road": 78})
+    texts = [*map(repr, plots), repr(surface(rb, "steering", "road", "position")),
+             repr(rule_view(rb, {"road": 78, "size": 45, "position": 4}))]
+    for text in texts:
+        assert "\n" not in text and len(text) < 200 and "array(" not in text, text
+    assert texts[0] == ("<VariablePlot 'road' (input) [0, 160] in: 3 terms (NARROW, MEDIUM, "
+                        "WIDE), marked at 78>")
+    assert texts[-2] == ("<Surface of 'steering' over road x position (61 x 61 points, size=50 "
+                         "held; NaN at 0)>")
+    assert texts[-1] == ("<RuleView of 'avoid_obstacle': 8 of 27 rules fired; steering 65.41 "
+                         "deg, speed 32.42 in/s>")

@@ -53,6 +53,16 @@ class VariablePlot:
     memberships: tuple[tuple[str, float], ...] = ()   # (term, mu) at ``value``, curves only
     clamped: bool = False                             # ``value`` was outside the universe
 
+    def __repr__(self) -> str:   # the generated one printed every curve's points (20,000
+        # characters for the sheet of the packaged rule base)
+        lo, hi = self.universe
+        marked = "" if self.value is None else f", marked at {self.value:g}"
+        names = ", ".join(c.name for c in self.curves[:6]) + (", ..." if len(self.curves) > 6
+                                                               else "")
+        unit = f" {self.unit}" if self.unit else ""
+        return (f"<VariablePlot {self.name!r} ({self.role}) [{lo:g}, {hi:g}]{unit}: "
+                f"{len(self.curves)} terms ({names}){marked}>")
+
     @property
     def axis_label(self) -> str:
         return f"{self.name} [{self.unit}]" if self.unit else self.name

@@ -116,6 +116,12 @@ class RuleView:
     rows: tuple[RuleRow, ...]          # fired rules, in rule-base order
     outputs: tuple[OutputView, ...]
 
+    def __repr__(self) -> str:   # the generated one printed every row's view (6,000 characters)
+        outputs = ", ".join(f"{o.name} {o.value:.4g}{' ' + o.unit if o.unit else ''}"
+                            for o in self.outputs)
+        return (f"<RuleView of {self.behavior!r}: {len(self.rows)} of {self.n_rules} rules "
+                f"fired; {outputs}>")
+
 
 def props_of(expr: Expr) -> list[tuple[Prop, bool]]:
     """The propositions of an antecedent in reading order, each with whether an enclosing

@@ -56,6 +56,15 @@ class Surface:
     #: that, not "no default"
     nan_default: bool = False
 
+    def __repr__(self) -> str:   # the generated one printed the axes' and z's arrays
+        over = self.x.name if self.y is None else f"{self.x.name} x {self.y.name}"
+        fixed = ", ".join(f"{f.name}={f.value:g}" for f in self.fixed[:4]) + (
+            ", ..." if len(self.fixed) > 4 else "")
+        held = f", {fixed} held" if fixed else ""
+        unset = int(np.isnan(self.z).sum())
+        return (f"<Surface of {self.output!r} over {over} ({' x '.join(map(str, self.z.shape))}"
+                f" points{held}; NaN at {unset})>")
+
     @property
     def no_rule(self) -> np.ndarray:
         return np.isnan(self.z)
