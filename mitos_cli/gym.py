@@ -201,7 +201,7 @@ class MitosEnv(gymnasium.Env):
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None
               ) -> tuple[Observation, dict]:
         seed = _check_seed(seed)
-        self.sim.randomise = _randomise(options)
+        randomise = _randomise(options)          # (checked before the generator moves)
         if seed is None and not self._seeded:
             # the first reset without a seed runs the world's seed, and seeds the generator
             # later resets draw from with it: Gymnasium's own would take the OS's entropy, a
@@ -213,7 +213,7 @@ class MitosEnv(gymnasium.Env):
             if seed is None:
                 seed = int(self.np_random.integers(2**31))
         self._seeded = True
-        self.sim.reset(seed)
+        self.sim.reset(seed, randomise=randomise)
         self._trail = [self.sim.pose[0, :2].copy()]
         obs = self._observe()
         self._remaining = self._left()

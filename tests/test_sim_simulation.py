@@ -705,3 +705,32 @@ def test_a_misnamed_jitter_among_many_obstacles_names_a_few_and_the_nearest():
     assert "must be one of 300 names: pole_0, pole_1, pole_2, pole_3, pole_4, pole_5, " \
            "pole_6, pole_7, ..., not 'pol_299'" in exc.value.message
     assert exc.value.hint == "did you mean `pole_299`?"
+
+
+def test_reset_takes_randomise_and_runs_as_a_run_made_so():
+    """reset(seed) kept the constructor's randomise: a randomised episode of a Simulation made
+    as written meant writing its attribute. reset(seed, randomise=True) runs what
+    simulate(world, seed=seed, randomise=True) runs, also for a run of a Lockstep, whose
+    scene, shared by runs as written, is not the randomised run's (detour.yaml moves an
+    obstacle its robot is told of)."""
+    from mitos_cli.errors import InputError
+    from mitos_cli.resources import packaged_path
+    from mitos_cli.sim import Lockstep, load_world, simulate
+
+    world = load_world(str(packaged_path("worlds", "detour.yaml")))
+    drawn = simulate(world, seed=7, randomise=True)
+    sim = Simulation(world, seed=1)
+    sim.step()
+    for run in (sim, Lockstep(world, None, seeds=[1, 2]).runs[0]):
+        run.reset(seed=7, randomise=True)
+        while not run.done:
+            run.step()
+        assert np.array_equal(run.result().pose, drawn.pose) and run.randomise is True
+    sim.reset(seed=3)                                  # as before: still randomised
+    assert sim.randomise is True
+    sim.reset(seed=3, randomise=False)
+    while not sim.done:
+        sim.step()
+    assert np.array_equal(sim.result().pose, simulate(world, seed=3).pose)
+    with pytest.raises(InputError, match="randomise is True or False, not `'no'`"):
+        sim.reset(seed=1, randomise="no")

@@ -443,8 +443,16 @@ class Simulation:
 
     # -- set-up -----------------------------------------------------------------------------
 
-    def reset(self, seed: int | None = None) -> Simulation:
-        """Start the run again from ``seed`` (default: the world's)."""
+    def reset(self, seed: int | None = None, *, randomise: bool | None = None) -> Simulation:
+        """Start the run again from ``seed`` (default: the world's); ``randomise`` (``True``
+        or ``False``; default: as before) draws the obstacle places and sensor noise from the
+        world's ranges, as the constructor's does (it was settable only there, or by writing
+        the attribute)."""
+        if randomise is not None:
+            drawn = _check_randomise(randomise)
+            if drawn != self.randomise:     # a scene given for the other kind of run (a
+                self._given_scene = None    # lockstep's, shared) may not be this one's
+            self.randomise = drawn
         world = self._given_world
         self.seed = world.seed if seed is None else check_seed(seed)
         self._streams = [np.random.default_rng(s) for s in
