@@ -97,7 +97,7 @@ def test_state_between_ticks_and_a_users_planner():
     start = world.agents[0].start
     assert np.array_equal(sim.pose[0], [start.x, start.y, start.heading])
     tick = sim.step()
-    assert tick.t == 0.0 and sim.time == world.dt and sim.outcome == "timeout"
+    assert tick.t == 0.0 and sim.time == world.dt and sim.outcome == "driving"
     assert np.array_equal(tick.command[0], [90.0, 10.0])
     assert sim.speed[0] > 0.0 and sim.clearance[0] > 0.0
     while not sim.done:
@@ -734,3 +734,20 @@ def test_reset_takes_randomise_and_runs_as_a_run_made_so():
     assert np.array_equal(sim.result().pose, simulate(world, seed=3).pose)
     with pytest.raises(InputError, match="randomise is True or False, not `'no'`"):
         sim.reset(seed=1, randomise="no")
+
+
+def test_a_run_still_going_is_driving_and_its_result_so_far_a_timeout():
+    """sim.outcome read `timeout` from the first tick of a run with a minute to go (and
+    robot_outcomes too), where the Gymnasium environment's info says `driving`; result() of
+    a run cut short is still a `timeout`, and the verdicts at the end are unchanged."""
+    from mitos_cli.resources import packaged_path
+    from mitos_cli.sim import load_world
+
+    sim = Simulation(load_world(str(packaged_path("worlds", "multirobot.yaml"))))
+    sim.step()
+    assert sim.outcome == "driving" and sim.robot_outcomes == ("driving", "driving")
+    assert sim.result().outcome == "timeout" and sim.result().robot_outcomes == ("timeout",) * 2
+    while not sim.done:
+        sim.step()
+    assert sim.outcome == sim.result().outcome == "success"
+    assert sim.robot_outcomes == sim.result().robot_outcomes == ("success", "success")

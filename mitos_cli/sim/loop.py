@@ -617,12 +617,22 @@ class Simulation:
 
     @property
     def robot_outcomes(self) -> tuple[str, ...]:
-        return tuple(self._outcomes)
+        """Each robot's outcome; ``driving`` for a robot still driving while the run goes on
+        (as the Gymnasium environment's ``info`` says; it read ``timeout``)."""
+        if self._done:
+            return tuple(self._outcomes)
+        return tuple("driving" if going and o == "timeout" else o
+                     for o, going in zip(self._outcomes, self._active.tolist()))
 
     @property
     def outcome(self) -> str:
-        """``success`` (every robot at its goal), ``collision``, ``stuck`` or ``timeout``
-        (also while the run has not ended)."""
+        """``success`` (every robot at its goal), ``collision``, ``stuck`` or ``timeout``;
+        ``driving`` while the run goes on (it read ``timeout`` from the first tick, the
+        outcome a run cut there has: :meth:`result` still reports that one)."""
+        return self._verdict() if self._done else "driving"
+
+    def _verdict(self) -> str:
+        """The run's outcome were it to end now (a run cut short is a ``timeout``)."""
         outcomes = self._outcomes
         if "collision" in outcomes:
             return "collision"
@@ -1308,7 +1318,7 @@ class Simulation:
         res = SimResult(
             world=self.world, seed=self.seed,
             planner=getattr(self.planner, "name", type(self.planner).__name__),
-            outcome=self.outcome, robot_outcomes=tuple(self._outcomes),
+            outcome=self._verdict(), robot_outcomes=tuple(self._outcomes),
             collisions=self._collided, t=np.arange(T) * dt, pose=stack("pose"),
             speed=stack("speed"), steering=stack("steering"),
             command=stack("command"), ranges=stack("ranges"),
