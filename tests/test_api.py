@@ -44,3 +44,18 @@ def test_run_takes_its_flags_as_bools_and_names_them_in_its_signature():
             rb.run(X, **bad)
     with pytest.raises(TypeError, match="detial"):
         rb.run(X, detial=False)
+
+
+def test_a_results_output_by_a_name_it_lacks_says_did_you_mean():
+    """``run(X).output("steerign")`` was ``ValueError: tuple.index(x): x not in tuple``."""
+    import numpy as np
+
+    from mitos_cli.errors import InputError
+
+    result = load_rulebase().run(np.array([[78.0, 45.0, 4.0]]))
+    assert result.output("speed").tolist() == [result.outputs[0, 1]]
+    with pytest.raises(InputError, match="unknown output `steerign`") as err:
+        result.output("steerign")
+    assert "did you mean `steering`?" in str(err.value)
+    with pytest.raises(InputError, match="unknown output `0`"):
+        result.output(0)

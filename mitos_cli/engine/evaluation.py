@@ -60,7 +60,14 @@ class Result:
                 f"{'; with ' + ', '.join(kept) if kept else ''}>")
 
     def output(self, name: str) -> np.ndarray:
-        return self.outputs[:, self.compiled.outputs.index(name)]
+        """The column ``[n]`` of output ``name``; another name is an :class:`InputError`
+        with a "did you mean" (it was ``ValueError: tuple.index(x): x not in tuple``)."""
+        outputs = self.compiled.outputs
+        if not isinstance(name, str) or name not in outputs:
+            from ..errors import unknown
+
+            raise unknown("output", f"{name!s:.40}", outputs, cls=InputError)
+        return self.outputs[:, outputs.index(name)]
 
 
 def as_batch(compiled: CompiledRuleBase, columns: Mapping[str, object]) -> np.ndarray:
