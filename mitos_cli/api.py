@@ -31,6 +31,8 @@ from .lang.terms import TermSet
 from .resources import DEFAULT_RULEBASE, packaged_path
 
 if TYPE_CHECKING:
+    from collections.abc import Mapping
+
     from numpy.typing import ArrayLike
 
 #: The types the one-sample path of :meth:`LoadedRuleBase.evaluate` takes as they are (not
@@ -203,15 +205,38 @@ class LoadedRuleBase:
     def with_operators(self, **settings: str) -> LoadedRuleBase:
         """The same behavior compiled with other operators, e.g. ``with_operators(and_="product")``
         (keys as in an ``operators:`` line; a trailing underscore is dropped). An output with a
-        ``resolution`` of its own (its term set's) keeps it."""
-        from .lang.model import Setting
+        ``resolution`` of its own (its term set's) keeps it. An unknown key is a
+        :class:`~mitos_cli.errors.NameError_` whose "did you mean" is a keyword this method
+        takes (``and_``, not the ``and`` of a rule file, which Python does not parse here)."""
+        import keyword
 
+        from .errors import unknown
+        from .lang.model import Setting
+        from .lang.operators import KEYS
+
+        for k in settings:
+            if k.rstrip("_") not in KEYS:
+                raise unknown("operator setting", k,
+                              [f"{key}_" if keyword.iskeyword(key) else key for key in KEYS])
         extra = tuple(Setting(k.rstrip("_"), str(v)) for k, v in settings.items())
         return LoadedRuleBase(self.rulebase, self.compiled.behavior, self.overrides + extra)
 
-    def run(self, X: ArrayLike, **kwargs: bool) -> Result:
-        """Evaluate a batch ``X[n, k]`` (columns in :attr:`inputs` order)."""
-        return evaluate(self.compiled, X, **kwargs)
+    def run(self, X: ArrayLike | Mapping[str, ArrayLike], *, detail: bool = True,
+            keep_values: bool = False, strict: bool = True) -> Result:
+        """Evaluate a batch ``X[n, k]`` (columns in :attr:`inputs` order, or a mapping of
+        the inputs' names to their columns). ``detail`` keeps the memberships and DOFs,
+        ``keep_values`` every neuron's value; ``strict=False`` leaves NaN where no rule sets
+        an output that has no default (else a ``NoRuleFiredError``). Each is ``True`` or
+        ``False``: another value (``detail="no"``, which was true) is an ``InputError``."""
+        from .errors import InputError
+
+        flags = {"detail": detail, "keep_values": keep_values, "strict": strict}
+        for name, flag in flags.items():
+            if not isinstance(flag, (bool, np.bool_)):
+                raise InputError(f"`{name}` is True or False, not `{flag!r:.40}`",
+                                 hint=f"run(X, {name}=False)")
+        return evaluate(self.compiled, X, detail=bool(detail), keep_values=bool(keep_values),
+                        strict=bool(strict))
 
     def evaluate(self, **inputs: float | np.ndarray) -> dict[str, float | np.ndarray]:
         """Outputs for inputs given by name (floats, or arrays evaluated as one batch)."""

@@ -167,38 +167,41 @@ class MitosEnv(gymnasium.Env):
     # -- the policy mitos simulate uses -------------------------------------------------------
 
     def fuzzy_policy(self, observation: object) -> np.ndarray:
-        """The rule base's command for ``observation``: what ``mitos simulate`` would do."""
-        x = _inputs_of(observation)
-        from .engine.evaluation import evaluate_one
+        """The rule base's command for ``observation``: what ``mitos simulate`` would do,
+        ``[steering, speed]``. A batch of observations ``[n, k]`` (a vector environment's, or
+        its ``Dict`` one) gives the ``[n, 2]`` actions in one evaluation of the rule network,
+        each row the bits it has alone (it was refused: "call it on each row")."""
+        from .engine.evaluation import evaluate, evaluate_one
 
-        out = evaluate_one(self.fuzzy.compiled, self._row(x))
+        x = self._rows(_inputs_of(observation))
         outputs = self.fuzzy.compiled.outputs
-        return np.array([out[outputs.index("steering")], out[outputs.index("speed")]])
+        pick = [outputs.index("steering"), outputs.index("speed")]
+        if x.ndim == 2:
+            return evaluate(self.fuzzy.compiled, x, detail=False).outputs[:, pick]
+        out = evaluate_one(self.fuzzy.compiled, x.tolist())
+        return np.array([out[pick[0]], out[pick[1]]])
 
-    def _row(self, x: object) -> list[float]:
-        """One observation as the floats the rule base reads, else an :class:`InputError` (a
-        batch ``[1, k]`` met "only 0-dimensional arrays can be converted to Python scalars";
-        bools, dates and structured arrays are refused as the engine's inputs are)."""
+    def _rows(self, x: object) -> np.ndarray:
+        """One observation ``[k]`` or a batch ``[n, k]`` as the floats the rule base reads,
+        else an :class:`InputError` (bools, dates and structured arrays are refused as the
+        engine's inputs are)."""
         from .engine.inputs import floats
 
-        row = floats(x, "the observation's values", many=True)
+        rows = floats(x, "the observation's values", many=True)
         k = len(self.input_names)
-        if row.ndim > 1:
-            raise InputError(f"an observation is one row of the {k} inputs "
-                             f"({', '.join(self.input_names)}), not of shape {row.shape}",
-                             hint="for a batch of observations, call it on each row")
-        if row.shape != (k,):        # (the engine said "of shape [n, 13] ..., not (1, 3)")
+        if rows.shape != (k,) and (rows.ndim != 2 or rows.shape[1] != k):
+            # (the engine said "of shape [n, 13] ..., not (1, 3)")
             raise InputError(f"an observation is the {k} inputs ({', '.join(self.input_names)}), "
-                             f"not of shape {row.shape}",
+                             f"or a batch of them [n, {k}], not of shape {rows.shape}",
                              hint="give it the observation reset() or step() returned")
-        return row.tolist()
+        return rows
 
     # -- Gymnasium ----------------------------------------------------------------------------
 
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None
               ) -> tuple[Observation, dict]:
         seed = _check_seed(seed)
-        self.sim.randomise = _randomise(options)
+        randomise = _randomise(options)          # (checked before the generator moves)
         if seed is None and not self._seeded:
             # the first reset without a seed runs the world's seed, and seeds the generator
             # later resets draw from with it: Gymnasium's own would take the OS's entropy, a
@@ -210,7 +213,7 @@ class MitosEnv(gymnasium.Env):
             if seed is None:
                 seed = int(self.np_random.integers(2**31))
         self._seeded = True
-        self.sim.reset(seed)
+        self.sim.reset(seed, randomise=randomise)
         self._trail = [self.sim.pose[0, :2].copy()]
         obs = self._observe()
         self._remaining = self._left()

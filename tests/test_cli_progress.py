@@ -191,6 +191,28 @@ def test_compare_ctrl_c_says_what_is_kept_and_how_to_resume(capsys, monkeypatch,
     assert "(2 now, 1 from before)" in err and err.rstrip().endswith("--resume")
 
 
+def test_compare_ctrl_c_goes_on_the_way_the_study_was_run(capsys, monkeypatch, tmp_path):
+    """The command to go on was the study's alone: a study run with `--no-plots`, `--json` or
+    `-j 1` (or on a Dask cluster) went on drawing plots, printing tables, on every core (or
+    on the local pool). It keeps the options that say how the study runs and reports."""
+    import mitos_cli.study as study_mod
+
+    def interrupted(study, out, *, on_start, on_result, **kwargs):
+        on_start(0, 4)
+        on_result(None, {})
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(study_mod, "run_study", interrupted)
+    code, _, err = run(capsys, "compare", TINY, "--and", "min,product", "--runs", 2,
+                       "-o", tmp_path / "s", "-j", 1, "--no-plots", "--json")
+    assert code == 130
+    last = err.rstrip().splitlines()[-1]
+    assert last.endswith(f"-o {tmp_path / 's'} -j 1 --no-plots --json --resume"), last
+    code, _, err = run(capsys, "compare", TINY, "--and", "min", "--runs", 2,
+                       "-o", tmp_path / "t")
+    assert err.rstrip().endswith(f"-o {tmp_path / 't'} --resume")
+
+
 def test_compare_ctrl_c_counts_a_run_written_as_it_came(capsys, monkeypatch, tmp_path):
     """A Ctrl-C in the fsync of a run's row left the row in results.csv, but uncounted: the
     message said one run fewer than the file held (16 of 48 kept, 17 there)."""

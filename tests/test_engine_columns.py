@@ -237,3 +237,29 @@ def test_evaluate_one_reads_values_as_the_batch_does():
     expected = evaluate_one(c, [78.0, 45.0, 4.0])
     assert evaluate_one(c, [78, 45, 4]) == evaluate_one(c, np.array([78.0, 45.0, 4.0])) \
         == expected
+
+
+def test_inputs_by_name_in_a_mapping_are_read_by_name_not_as_their_keys():
+    """A dict given to ``run``, ``evaluate_columns`` or ``evaluate_one`` was iterated as a
+    sequence: its keys were read as the values (``input `road` must be a number, not
+    `road```), or the dict as one value. It gives the inputs by name, in any order, with the
+    named path's checks and "did you mean"."""
+    rb = load_rulebase()
+    c = rb.compiled
+    road = np.array([78.0, 120.0, 500.0])
+    rows = evaluate(c, np.column_stack([road, np.full(3, 45.0), np.full(3, 4.0)]),
+                    detail=False).outputs
+    by_name = {"position": 4, "road": road, "size": np.full(3, 45.0)}   # not in inputs order
+    assert np.array_equal(rb.run(by_name).outputs, rows)
+    assert np.array_equal(evaluate(c, by_name).dof, rb.run(np.column_stack(
+        [road, np.full(3, 45.0), np.full(3, 4.0)])).dof)
+    assert np.array_equal(evaluate_columns(c, by_name), rows.T)
+    assert evaluate_one(c, {"size": 45, "position": 4, "road": 78}) == tuple(rows[0].tolist())
+    for call in (rb.run, lambda m: evaluate_columns(c, m), lambda m: evaluate_one(c, m)):
+        with pytest.raises(InputError, match="unknown input `raod`") as err:
+            call({"raod": 78.0, "size": 45.0, "position": 4.0})
+        assert "did you mean `road`?" in str(err.value)
+        with pytest.raises(InputError, match="missing input `position`"):
+            call({"road": 78.0, "size": 45.0})
+        with pytest.raises(InputError, match="input `road` is not a number"):
+            call({"road": float("nan"), "size": 45.0, "position": 4.0})

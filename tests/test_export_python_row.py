@@ -103,3 +103,32 @@ def test_a_base_without_a_float_form_keeps_evaluate_for_one_sample(tmp_path: Pat
     module = exported_module(load_rulebase(DATA / "tipper.fis").compiled, tmp_path)
     assert module._evaluate_row is None
     same_bits(module, np.array([[3.0, 7.0], [-1.0, 12.0], [np.nan, 5.0]]))
+
+
+def test_a_module_whose_inputs_are_not_clamped_says_so_once_and_warns_of_nothing(
+        tmp_path: Path) -> None:
+    """With ``inputs = as_given`` the module's docstring gave the clamped sentence's first line
+    and then its own ("clamped to their ``evaluate(X)`` maps inputs ... not clamped"), and an
+    input far outside its universe made ``mf_kernel``'s slope overflow with NumPy's
+    ``RuntimeWarning: overflow encountered in multiply``, where the engine gives the same
+    numbers without a word."""
+    import warnings
+
+    case = dict(and_="lukasiewicz", or_="bounded_sum", inference="weighted_average",
+                inputs="as_given")
+    module = exported(tmp_path, case)
+    assert module.__doc__.count("maps inputs") == 1 and "clamped to their" not in module.__doc__
+    assert "not clamped: an\ninfinite one gives NaN" in module.__doc__
+    X = np.array([[1e300, 0.0], [5.0, 1e300], [-1e300, 0.5], [1e200, -1e200]])
+    want = load_rulebase(tmp_path / "t.rules").run(X, strict=False, detail=False).outputs
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        got = module.evaluate(X)
+        ones = [tuple(module.evaluate_one(a=a, b=b).values()) for a, b in X.tolist()]
+    assert np.array_equal(got, want, equal_nan=True)
+    assert np.array_equal(np.array(ones), want, equal_nan=True)
+    (tmp_path / "c").mkdir()
+    clamped = exported(tmp_path / "c", {**case, "inputs": "clamped"})
+    assert "not clamped" not in clamped.__doc__
+    assert clamped.__doc__.count("maps inputs ``X[n, k]`` (columns in INPUTS order, clamped to "
+                                 "their\nuniverses)") == 1

@@ -341,16 +341,35 @@ def test_a_rulebase_without_the_worlds_behavior_is_said_at_the_world_with_behavi
     assert "behavior= from Python" in info.value.hint
 
 
-def test_fuzzy_policy_of_a_batch_says_it_takes_one_observation():
+def test_fuzzy_policy_of_a_batch_gives_each_rows_action_in_one_evaluation():
+    """A vector environment's observations ``[n, 13]`` were refused ("call it on each row":
+    a Python loop over the samples); they give the ``[n, 2]`` actions, each row's bits those
+    of the observation alone, the Dict form too."""
     from mitos_cli.errors import InputError
 
     env = gymnasium.make("mitos/Corridor-v0")
     obs, _ = env.reset(seed=1)
-    with pytest.raises(InputError, match=r"one row of the 13 inputs .* not of shape \(1, 13\)"):
-        env.unwrapped.fuzzy_policy(obs[None])
+    policy = env.unwrapped.fuzzy_policy
+    assert np.array_equal(policy(obs[None]), policy(obs)[None])
+    envs = gymnasium.make_vec("mitos/Slalom-v0", num_envs=3)
+    batch, _ = envs.reset(seed=4)
+    for _ in range(40):                       # apart: each copy its own seed and place
+        batch, *_ = envs.step(policy(batch))
+    actions = policy(batch)
+    assert actions.shape == (3, 2)
+    assert all(np.array_equal(actions[i], policy(batch[i])) for i in range(3))
+    assert len({tuple(a) for a in actions.tolist()}) == 3
+    ranges = gymnasium.make_vec("mitos/Slalom-v0", num_envs=2, observe_ranges=True)
+    both, _ = ranges.reset(seed=4)
+    assert np.array_equal(policy(both), policy(both["inputs"])) and policy(both).shape == (2, 2)
+    assert policy(np.empty((0, 13))).shape == (0, 2)
+    with pytest.raises(InputError, match=r"or a batch of them \[n, 13\], not of shape \(2, 3\)"):
+        policy(obs[None, :3].repeat(2, axis=0))
+    with pytest.raises(InputError, match=r"not of shape \(1, 1, 13\)"):
+        policy(obs[None, None])
     # the engine said "expected inputs of shape [n, 13] (...), not (1, 3)"
     with pytest.raises(InputError, match=r"an observation is the 13 inputs \(road, .*\), "
-                                         r"not of shape \(3,\)\n"):
+                                         r"or a batch of them \[n, 13\], not of shape \(3,\)\n"):
         env.unwrapped.fuzzy_policy(obs[:3])
     assert np.array_equal(env.unwrapped.fuzzy_policy(list(obs)), env.unwrapped.fuzzy_policy(obs))
 

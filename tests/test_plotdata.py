@@ -336,3 +336,27 @@ def test_rule_view_nothing_fired(gap):
 def test_rule_view_missing_input_is_refused(mitos):
     with pytest.raises(InputError, match="missing input `position`"):
         plotdata.rule_view(mitos.compiled, {"road": 78, "size": 45})
+
+
+def test_the_data_of_the_pictures_take_what_load_rulebase_returns():
+    """``load_rulebase()`` is the documented way in, and its LoadedRuleBase met
+    AttributeErrors in sheet ('termsets'), surface ('universe') and rule_view
+    ('grid_batch'): each now takes it as its compiled behavior, and refuses anything else
+    in words."""
+    from mitos_cli.draw.data import rule_view, sheet, surface
+
+    loaded = load_rulebase(None, "avoid_obstacle")
+    values = {"road": 78.0, "size": 45.0, "position": 4.0}
+    assert surface(loaded, "steering", "road").z.tolist() == \
+        surface(loaded.compiled, "steering", "road").z.tolist()
+    view, direct = rule_view(loaded, values), rule_view(loaded.compiled, values)
+    assert [(r.label, r.dof) for r in view.rows] == [(r.label, r.dof) for r in direct.rows]
+    assert [o.value for o in view.outputs] == [o.value for o in direct.outputs]
+    names = [v.name for v in sheet(loaded)]
+    assert names == [v.name for v in sheet(loaded.rulebase, behavior="avoid_obstacle")]
+    assert names == ["road", "size", "position", "steering", "speed"]
+    assert len(sheet(loaded, behavior="drive")) > len(names)
+    for call, who in ((lambda: surface("my.rules", "steering", "road"), "surface"),
+                      (lambda: rule_view(None, values), "rule_view")):
+        with pytest.raises(InputError, match=f"{who} draws a compiled rule base, not "):
+            call()

@@ -97,7 +97,7 @@ def test_state_between_ticks_and_a_users_planner():
     start = world.agents[0].start
     assert np.array_equal(sim.pose[0], [start.x, start.y, start.heading])
     tick = sim.step()
-    assert tick.t == 0.0 and sim.time == world.dt and sim.outcome == "timeout"
+    assert tick.t == 0.0 and sim.time == world.dt and sim.outcome == "driving"
     assert np.array_equal(tick.command[0], [90.0, 10.0])
     assert sim.speed[0] > 0.0 and sim.clearance[0] > 0.0
     while not sim.done:
@@ -427,7 +427,18 @@ def test_a_misspelt_outcome_or_figure_of_the_runs_is_named():
                        (lambda: runs.stat("world"), "unknown figure `world`")):
         with pytest.raises(InputError, match=re.escape(says)):
             call()
-    assert runs.stat("time_s") == (0.2, 0.0)
+    assert runs.stat("time_s") == (0.2, 0.0)       # two runs that agree: a spread of 0
+
+
+def test_the_spread_of_one_run_is_none_not_zero():
+    """stat() gave one run a standard deviation of 0.0, which reads as runs that agree (a
+    sample standard deviation of one value is undefined); figures(), `--json` and the table
+    said nothing (None, null, no ±) already."""
+    from mitos_cli.sim import run_many
+
+    one = run_many([short("corridor.yaml", 0.2)], runs=1, seed=1, workers=1).worlds[0]
+    assert one.stat("time_s") == (0.2, None)
+    assert one.figures()["time_s"] == {"mean": 0.2, "std": None}
 
 
 @pytest.mark.parametrize("command, says", [
@@ -694,3 +705,49 @@ def test_a_misnamed_jitter_among_many_obstacles_names_a_few_and_the_nearest():
     assert "must be one of 300 names: pole_0, pole_1, pole_2, pole_3, pole_4, pole_5, " \
            "pole_6, pole_7, ..., not 'pol_299'" in exc.value.message
     assert exc.value.hint == "did you mean `pole_299`?"
+
+
+def test_reset_takes_randomise_and_runs_as_a_run_made_so():
+    """reset(seed) kept the constructor's randomise: a randomised episode of a Simulation made
+    as written meant writing its attribute. reset(seed, randomise=True) runs what
+    simulate(world, seed=seed, randomise=True) runs, also for a run of a Lockstep, whose
+    scene, shared by runs as written, is not the randomised run's (detour.yaml moves an
+    obstacle its robot is told of)."""
+    from mitos_cli.errors import InputError
+    from mitos_cli.resources import packaged_path
+    from mitos_cli.sim import Lockstep, load_world, simulate
+
+    world = load_world(str(packaged_path("worlds", "detour.yaml")))
+    drawn = simulate(world, seed=7, randomise=True)
+    sim = Simulation(world, seed=1)
+    sim.step()
+    for run in (sim, Lockstep(world, None, seeds=[1, 2]).runs[0]):
+        run.reset(seed=7, randomise=True)
+        while not run.done:
+            run.step()
+        assert np.array_equal(run.result().pose, drawn.pose) and run.randomise is True
+    sim.reset(seed=3)                                  # as before: still randomised
+    assert sim.randomise is True
+    sim.reset(seed=3, randomise=False)
+    while not sim.done:
+        sim.step()
+    assert np.array_equal(sim.result().pose, simulate(world, seed=3).pose)
+    with pytest.raises(InputError, match="randomise is True or False, not `'no'`"):
+        sim.reset(seed=1, randomise="no")
+
+
+def test_a_run_still_going_is_driving_and_its_result_so_far_a_timeout():
+    """sim.outcome read `timeout` from the first tick of a run with a minute to go (and
+    robot_outcomes too), where the Gymnasium environment's info says `driving`; result() of
+    a run cut short is still a `timeout`, and the verdicts at the end are unchanged."""
+    from mitos_cli.resources import packaged_path
+    from mitos_cli.sim import load_world
+
+    sim = Simulation(load_world(str(packaged_path("worlds", "multirobot.yaml"))))
+    sim.step()
+    assert sim.outcome == "driving" and sim.robot_outcomes == ("driving", "driving")
+    assert sim.result().outcome == "timeout" and sim.result().robot_outcomes == ("timeout",) * 2
+    while not sim.done:
+        sim.step()
+    assert sim.outcome == sim.result().outcome == "success"
+    assert sim.robot_outcomes == sim.result().robot_outcomes == ("success", "success")

@@ -147,6 +147,17 @@ def test_choices_cross_and_dual():
     assert split_list(" min, product,,min ") == ["min", "product"]
 
 
+def test_choices_default_to_the_rule_bases_settings_by_keyword():
+    """make_choices needed all four lists (``make_choices(["fuzzy"], ands=[...])`` was a
+    TypeError, "missing 2 required positional arguments"); the last three default to none,
+    the rule base's own setting, as an empty list does."""
+    assert make_choices(["fuzzy"], ands=["min", "product"]) == \
+        make_choices(["fuzzy"], ["min", "product"], [], [])
+    assert make_choices(["fuzzy", "dwa"]) == make_choices(["fuzzy", "dwa"], [], [], [])
+    assert [c.label for c in make_choices(["fuzzy"], inferences=("mamdani",))] == \
+        ["fuzzy inference=mamdani"]
+
+
 @pytest.mark.parametrize("args, message, hint", [
     ((["fuzzy"], ["einstien"], [], []), "unknown T-norm `einstien`", "einstein"),
     ((["fuzzy"], ["min"], ["mx"], []), "unknown S-norm `mx`", "max"),

@@ -120,8 +120,9 @@ def compare_command(
     study = Study(paths, choices, runs, seed, rulebase, behavior,
                   command=_command_line(worlds, and_, or_, inference, planner, rulebase,
                                         behavior, runs, seed, out))
+    how = _how_run(executor, workers, scheduler, plots, as_json)
     outcome = run_with_progress(study, out, executor, workers, scheduler, resume,
-                                quiet=as_json)
+                                quiet=as_json, how=how)
 
     try:
         report = _report(outcome, out, plots)   # (before stdout, which a reader may close)
@@ -129,7 +130,7 @@ def compare_command(
         # exit 130 without a word, report.md perhaps of fewer runs than results.csv
         err(f"interrupted while writing the report: every run of the study "
             f"({plural(outcome.n_tasks, 'run')}) is in {Path(out) / 'results.csv'}; write it "
-            f"with:\n  {study.command} --resume")
+            f"with:\n  {study.command}{how} --resume")
         raise typer.Exit(INTERRUPTED) from None
     if as_json:
         emit(json_text(outcome_json(outcome, out)))
@@ -198,6 +199,20 @@ def _command_line(worlds: list[str], and_: str, or_: str | None, inference: str 
             words += [flag, value]
     words += ["--runs", str(runs), "--seed", str(seed), "-o", out]
     return " ".join(shlex.quote(w) for w in words)
+
+
+def _how_run(executor: str, workers: int | None, scheduler: str | None, plots: bool,
+             as_json: bool) -> str:
+    """The options given that say how the study runs and reports, not what it is (so
+    ``study.json``'s command leaves them out), as words to add to the command that goes on
+    after a Ctrl-C: without them a study on a Dask cluster went on on the local pool, and
+    one asked for ``--no-plots`` or ``--json`` drew plots or printed tables."""
+    words = [] if executor == "local" else ["--executor", executor]
+    words += ["--scheduler", scheduler] if scheduler else []
+    words += ["-j", str(workers)] if workers is not None else []
+    words += [] if plots else ["--no-plots"]
+    words += ["--json"] if as_json else []
+    return "".join(" " + shlex.quote(w) for w in words)
 
 
 def _report(outcome: Outcome, out: str, plots: bool) -> Path:
@@ -300,10 +315,10 @@ def check_inputs(worlds: list[str], choices: Sequence[Choice], rulebase: str | N
 
 
 def run_with_progress(study: Study, out: str, executor: str, workers: int | None, scheduler: str | None,
-                      resume: bool, quiet: bool = False) -> Outcome:
+                      resume: bool, quiet: bool = False, how: str = "") -> Outcome:
     """Run the study with a progress bar on stderr (on a terminal, without ``--json``; piped,
     a line every few percent). On Ctrl-C: say how many runs are kept in ``out`` and how to go
-    on, and exit 130."""
+    on (the study's command, then ``how``: the options it was run with), and exit 130."""
     from ..study import run_study
 
     kept = {"before": 0, "now": 0, "total": 0}
@@ -325,12 +340,12 @@ def run_with_progress(study: Study, out: str, executor: str, workers: int | None
         except KeyboardInterrupt:
             pass
     if not kept["total"] and not resume:      # before on_start: no run of it is kept
-        err(f"interrupted before the study began in {out}; start it with:\n  {study.command}")
+        err(f"interrupted before the study began in {out}; start it with:\n  {study.command}{how}")
         raise typer.Exit(INTERRUPTED)
     done = max(kept["before"] + kept["now"], _rows_in(out))
     err(f"interrupted: {done} of {plural(kept['total'], 'run')} kept in "
         f"{Path(out) / 'results.csv'} ({done - kept['before']} now, {kept['before']} from "
-        f"before); go on with:\n  {study.command} --resume")
+        f"before); go on with:\n  {study.command}{how} --resume")
     raise typer.Exit(INTERRUPTED)
 
 

@@ -122,7 +122,7 @@ def _runs_table(runs: Runs) -> str:
                     for o in outcomes]
             for _, key in _RUNS_FIGURES:
                 mean, std = r.stat(key)
-                row.append(f"{mean:.1f}" if len(r.summaries) == 1 else f"{mean:.1f} ± {std:.1f}")
+                row.append(f"{mean:.1f}" if std is None else f"{mean:.1f} ± {std:.1f}")
             rows.append(row)
     widths = [max(len(r[i]) for r in rows) for i in range(len(head))]
     table = "\n".join("  ".join(c.ljust(wd) if i == 0 else c.rjust(wd)

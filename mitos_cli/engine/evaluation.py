@@ -21,6 +21,7 @@ from ..fuzzy import hedges as hedge_mod
 from ..fuzzy import norms
 from ..fuzzy.shapes import SHAPES
 from ..numbers import exact
+from ..words import plural
 from .compile import CompiledRuleBase
 from .inputs import floats
 from .threads import Blocks, map_blocks, thread_count
@@ -32,8 +33,9 @@ if TYPE_CHECKING:
 
     from .compile import Grid, GridBatch, NodeGroup, Plan, ShapeGroup
 
-    #: inputs as columns: an array ``[k, n]``, or ``k`` 1-D arrays of one length
-    Columns = ArrayLike | Sequence[ArrayLike]
+    #: inputs as columns: an array ``[k, n]``, ``k`` 1-D arrays of one length, or a mapping
+    #: of each input's name to its column (or to one number)
+    Columns = ArrayLike | Sequence[ArrayLike] | Mapping[str, ArrayLike]
 
 
 @dataclass(frozen=True, eq=False)   # holds arrays: identity, not ==
@@ -53,12 +55,19 @@ class Result:
 
     def __repr__(self) -> str:
         kept = [k for k in ("memberships", "dof", "values") if getattr(self, k) is not None]
-        return (f"<Result of {self.compiled.behavior!r}: {len(self.outputs):,} samples x "
-                f"{len(self.compiled.outputs)} outputs ({', '.join(self.compiled.outputs)})"
+        return (f"<Result of {self.compiled.behavior!r}: {plural(len(self.outputs), 'sample')} x "
+                f"{plural(len(self.compiled.outputs), 'output')} ({', '.join(self.compiled.outputs)})"
                 f"{'; with ' + ', '.join(kept) if kept else ''}>")
 
     def output(self, name: str) -> np.ndarray:
-        return self.outputs[:, self.compiled.outputs.index(name)]
+        """The column ``[n]`` of output ``name``; another name is an :class:`InputError`
+        with a "did you mean" (it was ``ValueError: tuple.index(x): x not in tuple``)."""
+        outputs = self.compiled.outputs
+        if not isinstance(name, str) or name not in outputs:
+            from ..errors import unknown
+
+            raise unknown("output", f"{name!s:.40}", outputs, cls=InputError)
+        return self.outputs[:, outputs.index(name)]
 
 
 def as_batch(compiled: CompiledRuleBase, columns: Mapping[str, object]) -> np.ndarray:
@@ -129,8 +138,11 @@ def check_inputs(compiled: CompiledRuleBase, X: ArrayLike) -> tuple[np.ndarray, 
     return _clamp(compiled, _rows(compiled, X))
 
 
-def _rows(compiled: CompiledRuleBase, X: ArrayLike) -> np.ndarray:
-    """``X`` as a float array ``[n, k]`` (one sample may come as a flat ``[k]``)."""
+def _rows(compiled: CompiledRuleBase, X: ArrayLike | Mapping[str, ArrayLike]) -> np.ndarray:
+    """``X`` as a float array ``[n, k]`` (one sample may come as a flat ``[k]``; a mapping
+    gives the inputs by name, as :func:`as_batch` reads them)."""
+    if type(X) is not np.ndarray and isinstance(X, Mapping):   # its keys were read as values
+        return as_batch(compiled, X)
     k = len(compiled.inputs)
     X = floats(X, "the inputs", many=True)
     if X.ndim == 1 and X.shape[0] == k:
@@ -526,9 +538,10 @@ def _constant_sums(plan: Plan, dof: np.ndarray) -> np.ndarray:
     return tree_sum(S)
 
 
-def evaluate(compiled: CompiledRuleBase, X: ArrayLike, *, detail: bool = True, keep_values: bool = False,
-             strict: bool = True) -> Result:
-    """Evaluate the network on ``X[n, k]``, in cache-sized blocks of samples.
+def evaluate(compiled: CompiledRuleBase, X: ArrayLike | Mapping[str, ArrayLike], *,
+             detail: bool = True, keep_values: bool = False, strict: bool = True) -> Result:
+    """Evaluate the network on ``X[n, k]``, in cache-sized blocks of samples (or on inputs by
+    name: ``{"road": array, "size": 45, ...}``, as :func:`as_batch` reads them).
 
     ``detail`` keeps memberships and DOFs (``False`` returns only outputs, faster);
     ``keep_values`` also keeps every neuron's value (for training and the rule viewer). An
@@ -611,7 +624,8 @@ def rule_dofs(compiled: CompiledRuleBase, X: ArrayLike) -> np.ndarray:
 
 def evaluate_columns(compiled: CompiledRuleBase, Xt: Columns, *, strict: bool = True) -> np.ndarray:
     """The outputs ``[m, n]`` (one contiguous row per output) for inputs given as columns
-    ``Xt[k, n]`` (an array, or a sequence of ``k`` 1-D arrays of one length):
+    ``Xt[k, n]`` (an array, a sequence of ``k`` 1-D arrays of one length, or a mapping of
+    the inputs' names to their columns, numbers broadcast):
     :func:`evaluate` with ``detail=False``, bit for bit, without copying a large batch into
     rows or keeping its clamped inputs (``load_rulebase().evaluate(**arrays)``).
 
@@ -652,7 +666,11 @@ def _input_columns(compiled: CompiledRuleBase,
     """``Xt`` (an array ``[k, n]`` or ``k`` columns) and its columns as float arrays, each
     through :func:`~.inputs.floats` as the rows' and the named inputs' values are (a bool,
     date, bytes or structured column was read as numbers here, a complex one with NumPy's
-    warning); a float column is kept as it is, not copied."""
+    warning); a float column is kept as it is, not copied. A mapping gives the columns by
+    name, as :func:`as_columns` reads them."""
+    if type(Xt) is not np.ndarray and isinstance(Xt, Mapping):  # (its keys were read as columns)
+        columns = as_columns(compiled, Xt)
+        return columns, columns
     if isinstance(Xt, np.ndarray) or not hasattr(Xt, "__len__"):
         Xt = floats(Xt, "the input columns", many=True)
     if isinstance(Xt, np.ndarray) and Xt.ndim == 0:
@@ -856,16 +874,24 @@ def _grid_block(compiled: CompiledRuleBase, g: GridBatch, b: _GridBlock, columns
 _FLOAT = {float}
 
 
-def evaluate_one(compiled: CompiledRuleBase, values: list[float],
+def evaluate_one(compiled: CompiledRuleBase, values: list[float] | Mapping[str, float],
                  strict: bool = True) -> tuple[float, ...]:
     """The outputs for one sample (inputs in :attr:`CompiledRuleBase.inputs` order): the same
     bits as its row in :func:`evaluate`, through the network's scalar form where it has one
     (:mod:`mitos_cli.engine.scalar`, a few microseconds instead of some forty NumPy calls).
     Values other than floats are read as :func:`~.inputs.floats` reads them (the scalar form
-    would take ``True`` as 1)."""
-    if not _FLOAT.issuperset(map(type, values)):
-        values = floats(values, "the inputs", many=True).tolist()
-    return evaluate_floats(compiled, values, strict)
+    would take ``True`` as 1). A mapping gives the values by name (``{"road": 78, ...}``),
+    checked as :func:`as_batch` checks names."""
+    # a mapping gives the values by name (it was "the inputs must be numbers, not `{...}`");
+    # a list is ruled out first, so that the usual call does not pay for the ABC's isinstance
+    if type(values) is not list and isinstance(values, Mapping):
+        _check_names(compiled, values)
+        row = [values[name] for name in compiled.inputs]
+    else:
+        row = values
+    if not _FLOAT.issuperset(map(type, row)):
+        row = floats(row, "the inputs", many=True).tolist()
+    return evaluate_floats(compiled, row, strict)
 
 
 def evaluate_floats(compiled: CompiledRuleBase, values: list[float],

@@ -55,6 +55,17 @@ class Trace:
     outputs: tuple[tuple[str, float, str], ...]
     defaulted: tuple[str, ...] = ()       # outputs no rule set: their `default` applies
 
+    def __repr__(self) -> str:
+        """A line: the behavior, the inputs as given, the outputs and how many rules fired
+        (the generated one was 2,000-2,700 characters of nested dataclasses);
+        ``print(trace.render())`` shows the trace, and a notebook shows it itself."""
+        given = ", ".join(f"{i.name}={i.value if i.given is None else i.given:g}"
+                          for i in self.inputs[:4]) + (", ..." if len(self.inputs) > 4 else "")
+        outputs = ", ".join(f"{name} {with_unit(f'{value:.4g}', unit)}".rstrip()
+                            for name, value, unit in self.outputs)
+        return (f"<Trace of {self.behavior!r} at {given}: {outputs}; {len(self.rules)} of "
+                f"{plural(self.n_rules, 'rule')} fired>")
+
     def _repr_html_(self) -> str:
         """A notebook shows the trace as the terminal does."""
         import html

@@ -22,7 +22,7 @@ API (everything in inches, seconds, degrees)::
     while not sim.done:
         tick = sim.step()          # a Tick: pose, speed, steering, command, ranges, inputs,
                                    # clearance, obstacles, active, progress (rows are robots)
-    sim.pose, sim.speed, sim.clearance, sim.time, sim.outcome   # the state now
+    sim.pose, sim.speed, sim.clearance, sim.time, sim.outcome   # the state now ("driving")
     sim.result()                   # the SimResult simulate() returns
 
     results = run_lockstep(world, None, seeds=range(64), randomise=True)  # runs stepped

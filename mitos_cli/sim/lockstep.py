@@ -92,6 +92,17 @@ class Lockstep:
         batch of them afresh."""
         return {**self.__dict__, "_batch": None}
 
+    def __repr__(self) -> str:
+        from ..words import plural
+
+        if not self.runs:
+            return "<Lockstep of 0 runs>"
+        first = self.runs[0]
+        name = getattr(self.planner, "name", type(self.planner).__name__)
+        going = sum(not run.done for run in self.runs)
+        return (f"<Lockstep of {plural(len(self.runs), 'run')} of {first.world.name!r}, {name}: "
+                f"{going} driving, {len(self.runs) - going} ended>")
+
     @property
     def done(self) -> bool:
         return all(run.done for run in self.runs)

@@ -199,7 +199,7 @@ class SimResult:
         m = self.metrics
         robots = len(self.robot_outcomes)
         return (f"<SimResult {self.world.name!r} seed {self.seed}, {self.planner}: {self.outcome} "
-                f"after {m.get('time_s', self.ticks * self.world.dt):g} s ({self.ticks} ticks"
+                f"after {m.get('time_s', self.ticks * self.world.dt):g} s ({plural(self.ticks, 'tick')}"
                 f"{f', {robots} robots' if robots > 1 else ''}), path "
                 f"{m.get('path_length_in', 0.0):.1f} in, min clearance "
                 f"{shown_clearance(m.get('min_clearance_in', 0.0))} in>")
@@ -357,6 +357,16 @@ class Tick:
         a lockstep batch records a tick of each of its runs at once, and few are looked at)."""
         return dict(zip(perception.INPUTS, self.block))
 
+    def __repr__(self) -> str:   # the generated one printed every beam (840 characters a robot)
+        n, beams = self.ranges.shape
+        if n == 1:
+            x, y, h = self.pose[0].tolist()
+            state = (f"at ({x:.1f}, {y:.1f}) in heading {h:.1f} deg, speed "
+                     f"{float(self.speed[0]):.1f} in/s, clearance {float(self.clearance[0]):.1f} in")
+        else:
+            state = f"{plural(n, 'robot')} ({int(np.count_nonzero(self.active))} still driving)"
+        return f"<Tick {self.k} (t = {self.t:g} s): {state}; {plural(beams, 'beam')} a robot>"
+
 
 @dataclass
 class _Sensed:
@@ -375,6 +385,11 @@ class _Sensed:
     def inputs(self) -> dict[str, np.ndarray]:
         """name -> ``[n]``: the rows of :attr:`block` (made when asked)."""
         return dict(zip(perception.INPUTS, self.block))
+
+    def __repr__(self) -> str:   # what Simulation.observe() gives (1,100 characters a robot)
+        n, beams = self.ranges.shape
+        return (f"<observed tick (t = {self.t:g} s) of {plural(n, 'robot')}: .inputs (name -> [n]),"
+                f" .ranges [n, {beams}], .pose, .clearance>")
 
 
 class Simulation:
@@ -418,10 +433,26 @@ class Simulation:
         self._given_world, self._given_scene = world, scene
         self.reset(seed)
 
+    def __repr__(self) -> str:
+        name = getattr(self.planner, "name", type(self.planner).__name__)
+        now = (f"ended: {self.outcome} ({plural(self.ticks, 'tick')})" if self.done
+               else f"driving, {plural(self.ticks, 'tick')} ({self.time:g} s)")
+        robots = f", {len(self.robots)} robots" if len(self.robots) > 1 else ""
+        drawn = ", randomised" if self.randomise else ""
+        return f"<Simulation {self.world.name!r} seed {self.seed}{drawn}, {name}{robots}: {now}>"
+
     # -- set-up -----------------------------------------------------------------------------
 
-    def reset(self, seed: int | None = None) -> Simulation:
-        """Start the run again from ``seed`` (default: the world's)."""
+    def reset(self, seed: int | None = None, *, randomise: bool | None = None) -> Simulation:
+        """Start the run again from ``seed`` (default: the world's); ``randomise`` (``True``
+        or ``False``; default: as before) draws the obstacle places and sensor noise from the
+        world's ranges, as the constructor's does (it was settable only there, or by writing
+        the attribute)."""
+        if randomise is not None:
+            drawn = _check_randomise(randomise)
+            if drawn != self.randomise:     # a scene given for the other kind of run (a
+                self._given_scene = None    # lockstep's, shared) may not be this one's
+            self.randomise = drawn
         world = self._given_world
         self.seed = world.seed if seed is None else check_seed(seed)
         self._streams = [np.random.default_rng(s) for s in
@@ -586,12 +617,22 @@ class Simulation:
 
     @property
     def robot_outcomes(self) -> tuple[str, ...]:
-        return tuple(self._outcomes)
+        """Each robot's outcome; ``driving`` for a robot still driving while the run goes on
+        (as the Gymnasium environment's ``info`` says; it read ``timeout``)."""
+        if self._done:
+            return tuple(self._outcomes)
+        return tuple("driving" if going and o == "timeout" else o
+                     for o, going in zip(self._outcomes, self._active.tolist()))
 
     @property
     def outcome(self) -> str:
-        """``success`` (every robot at its goal), ``collision``, ``stuck`` or ``timeout``
-        (also while the run has not ended)."""
+        """``success`` (every robot at its goal), ``collision``, ``stuck`` or ``timeout``;
+        ``driving`` while the run goes on (it read ``timeout`` from the first tick, the
+        outcome a run cut there has: :meth:`result` still reports that one)."""
+        return self._verdict() if self._done else "driving"
+
+    def _verdict(self) -> str:
+        """The run's outcome were it to end now (a run cut short is a ``timeout``)."""
         outcomes = self._outcomes
         if "collision" in outcomes:
             return "collision"
@@ -1277,7 +1318,7 @@ class Simulation:
         res = SimResult(
             world=self.world, seed=self.seed,
             planner=getattr(self.planner, "name", type(self.planner).__name__),
-            outcome=self.outcome, robot_outcomes=tuple(self._outcomes),
+            outcome=self._verdict(), robot_outcomes=tuple(self._outcomes),
             collisions=self._collided, t=np.arange(T) * dt, pose=stack("pose"),
             speed=stack("speed"), steering=stack("steering"),
             command=stack("command"), ranges=stack("ranges"),

@@ -48,7 +48,9 @@ if TYPE_CHECKING:
 
 @dataclass(frozen=True)
 class Percepts:
-    """What every robot perceives in one tick (rows are robots)."""
+    """What every robot perceives in one tick (rows are robots). The heading (``pose[:, 2]``)
+    and the beams' directions are in radians, where ``Simulation.pose``, a ``Tick`` and a
+    ``SimResult`` give the heading in degrees (docs/api.md)."""
 
     inputs: dict[str, np.ndarray]  # fuzzy inputs by name (perception.INPUTS), each [n]
     ranges: np.ndarray             # [n, B] noisy range readings (in)

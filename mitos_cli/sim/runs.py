@@ -103,17 +103,18 @@ class WorldRuns:
     def rate(self, outcome: str) -> float:
         return self.count(outcome) / len(self.summaries)
 
-    def stat(self, key: str) -> tuple[float, float]:
-        """The mean and sample standard deviation of figure ``key`` over the runs; a name that
-        is no figure of theirs is an :class:`InputError` with a "did you mean" (it was a
-        ``KeyError``)."""
+    def stat(self, key: str) -> tuple[float, float | None]:
+        """The mean and sample standard deviation of figure ``key`` over the runs (``None``
+        for one run, whose sample standard deviation is undefined: it was 0.0, which reads as
+        runs that agree, as :meth:`figures` and ``--json`` say it); a name that is no figure
+        of theirs is an :class:`InputError` with a "did you mean" (it was a ``KeyError``)."""
         figures = ([k for k, v in self.summaries[0].items()
                     if isinstance(v, (int, float, np.number)) and not isinstance(v, bool)]
                    if self.summaries else list(METRICS))
         if not isinstance(key, str) or key not in figures:
             raise unknown("figure", f"{key!s:.40}", figures, cls=InputError)
         x = np.array([s[key] for s in self.summaries], dtype=float)
-        return float(x.mean()), float(x.std(ddof=1)) if len(x) > 1 else 0.0
+        return float(x.mean()), float(x.std(ddof=1)) if len(x) > 1 else None
 
     @property
     def robots(self) -> tuple[WorldRuns, ...]:
@@ -132,7 +133,7 @@ class WorldRuns:
                                                                 for o in self.outcomes}
         for key in METRICS:
             mean, std = self.stat(key)
-            row[key] = {"mean": mean, "std": std if len(self.summaries) > 1 else None}
+            row[key] = {"mean": mean, "std": std}
         return row
 
 

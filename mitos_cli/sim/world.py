@@ -96,6 +96,11 @@ class Grid:
 
     __hash__ = object.__hash__     # frozen dataclass with an array: hash by identity, in C
 
+    def __repr__(self) -> str:      # the generated one printed a summary of the array
+        rows, cols = self.occupied.shape
+        source = f" from {self.source}" if self.source else ""
+        return f"<Grid {rows:,} x {cols:,} cells of {self.resolution:g} in{source}>"
+
 
 @dataclass(frozen=True)
 class Motion:
@@ -205,3 +210,18 @@ class World:
 
     def with_changes(self, **changes: Any) -> World:     # World's own fields, each its type
         return replace(self, **changes)
+
+    def __repr__(self) -> str:
+        """One line (the generated one was 1,000 to 1,500 characters, every robot limit and
+        obstacle field spelt out); the fields are attributes, ``dataclasses.asdict`` lists
+        them all."""
+        from ..words import plural
+
+        robots = len(self.agents)
+        models = sorted({a.robot.model for a in self.agents})
+        grid = (f", {self.grid.occupied.shape[0]:,} x {self.grid.occupied.shape[1]:,} grid"
+                if self.grid is not None else "")
+        corridors = f", {plural(len(self.corridors), 'corridor')}" if self.corridors else ""
+        return (f"<World {self.name!r} ({self.path}): {plural(robots, 'robot')} "
+                f"({', '.join(models)}){corridors}{grid}, {plural(len(self.obstacles), 'obstacle')}, "
+                f"seed {self.seed}, dt {self.dt:g} s, time limit {self.time_limit:g} s>")

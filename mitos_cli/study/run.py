@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from ..words import plural
 from .executors import TaskFn, execute
 from .spec import Choice, Task, expand
 from .store import ResultStore, key_of, row_of
@@ -177,6 +178,16 @@ class Outcome:
     executed: int                          # run now
     summaries: list[Summary] = field(default_factory=list)
     ranks: list[Rank] = field(default_factory=list)
+
+    def __repr__(self) -> str:
+        """A line: the runs and the first places (the generated one printed every row: 11,000
+        characters for 9 runs, half a million for the 700 of docs/study.md)."""
+        worlds = len(self.study.worlds)
+        head = ", ".join(f"{r.place}. {r.summary.choice.label}" for r in self.ranks[:3])
+        more = f" ({len(self.ranks) - 3} more)" if len(self.ranks) > 3 else ""
+        return (f"<Outcome: {len(self.rows):,} of {plural(self.n_tasks, 'run')} ({self.executed:,} "
+                f"now, {self.skipped:,} from before), {plural(worlds, 'world')} x "
+                f"{plural(len(self.study.choices), 'choice')}; {head or 'no ranking'}{more}>")
 
     @property
     def complete(self) -> bool:

@@ -12,6 +12,7 @@ worlds (obstacle placements, sensor noise): the comparison is paired.
 from __future__ import annotations
 
 import itertools
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -99,11 +100,12 @@ def canonical_snorm(name: str, tnorm: str) -> str:
         raise unknown("S-norm", name, [*norms.names("snorm"), "dual"]) from None
 
 
-def make_choices(planners: list[str], ands: list[str], ors: list[str],
-                 inferences: list[str]) -> list[Choice]:
+def make_choices(planners: Sequence[str], ands: Sequence[str] = (), ors: Sequence[str] = (),
+                 inferences: Sequence[str] = ()) -> list[Choice]:
     """Every fuzzy combination of T-norm x S-norm x inference, then the other planners.
 
-    An empty list keeps the rule base's setting. ``--or dual`` pairs each T-norm with its
+    An empty list (the default: ``make_choices(["fuzzy"], ands=["min", "product"])``) keeps
+    the rule base's setting. ``--or dual`` pairs each T-norm with its
     De Morgan dual instead of crossing them.
     """
     planners, ands = _names("planners", planners), _names("T-norms", ands)

@@ -23,6 +23,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from ..words import plural
 from .spec import Choice
 from .stats import Mean, Rate, mean_interval, wilson
 from .store import OUTCOMES
@@ -58,6 +59,15 @@ class Summary:
     rates: dict[str, Rate]
     metrics: dict[str, Mean]
 
+    def __repr__(self) -> str:   # the generated one spelt out every rate and mean (1,100 chars)
+        ok = self.rates.get("success")
+        rate = (f", success {ok.k / ok.n:.0%} [{ok.lo:.0%}, {ok.hi:.0%}]"
+                if ok is not None and ok.n else "")
+        time = self.metrics.get("time_s")
+        timed = f", time to goal {time.mean:.3g} s" if time is not None and time.mean is not None else ""
+        return (f"<Summary {self.world!r}, {self.choice.label}: {plural(self.n, 'run')}"
+                f"{rate}{timed}>")
+
 
 @dataclass(frozen=True)
 class Rank:
@@ -67,6 +77,13 @@ class Rank:
     wins: int                # runs this choice succeeded in and the leader did not
     losses: int              # runs the leader succeeded in and this choice did not
     p_value: float | None    # exact McNemar, None for the leader itself
+
+    def __repr__(self) -> str:   # the generated one held the Summary's (1,200 chars)
+        ok = self.summary.rates.get("success")
+        rate = f" {ok.k / ok.n:.0%} success" if ok is not None and ok.n else ""
+        against = ("leader" if self.p_value is None else
+                   f"{self.wins} won / {self.losses} lost vs leader, McNemar p {self.p_value:.3g}")
+        return f"<Rank {self.place}: {self.summary.choice.label},{rate}; {against}>"
 
 
 def choice_of(row: dict) -> Choice:

@@ -4,12 +4,17 @@ piecewise-linear curves are drawn exactly), and the memberships of a marked valu
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ...errors import InputError, unknown
 from ...lang.model import RuleBase
 from ...lang.terms import Term, TermSet, Variable
+
+if TYPE_CHECKING:
+    from ...api import LoadedRuleBase
+    from ...engine.compile import CompiledRuleBase
 
 #: Samples per term curve (corner points are added to these).
 CURVE_POINTS = 401
@@ -47,6 +52,16 @@ class VariablePlot:
     value: float | None = None
     memberships: tuple[tuple[str, float], ...] = ()   # (term, mu) at ``value``, curves only
     clamped: bool = False                             # ``value`` was outside the universe
+
+    def __repr__(self) -> str:   # the generated one printed every curve's points (20,000
+        # characters for the sheet of the packaged rule base)
+        lo, hi = self.universe
+        marked = "" if self.value is None else f", marked at {self.value:g}"
+        names = ", ".join(c.name for c in self.curves[:6]) + (", ..." if len(self.curves) > 6
+                                                               else "")
+        unit = f" {self.unit}" if self.unit else ""
+        return (f"<VariablePlot {self.name!r} ({self.role}) [{lo:g}, {hi:g}]{unit}: "
+                f"{len(self.curves)} terms ({names}){marked}>")
 
     @property
     def axis_label(self) -> str:
@@ -158,12 +173,34 @@ def variable_plot(variable: Variable, value: float | None = None, *,
                         (variable.universe[0], variable.universe[1]), curves, value, mus, clamped)
 
 
-def sheet(rulebase: RuleBase | TermSet, names: list[str] | None = None,
+def compiled_of(source: object, who: str) -> CompiledRuleBase:
+    """The compiled behavior of ``source``: a :class:`CompiledRuleBase` as it is, the one a
+    :class:`~mitos_cli.api.LoadedRuleBase` (what ``load_rulebase`` returns) holds; anything
+    else is an :class:`InputError` (a LoadedRuleBase met "has no attribute 'universe'")."""
+    from ...api import LoadedRuleBase
+    from ...engine.compile import CompiledRuleBase
+
+    if isinstance(source, LoadedRuleBase):
+        return source.compiled
+    if isinstance(source, CompiledRuleBase):
+        return source
+    raise InputError(f"{who} draws a compiled rule base, not {type(source).__name__} "
+                     f"`{source!r:.40}`", hint=f"{who}(load_rulebase('my.rules'), ...)")
+
+
+def sheet(rulebase: RuleBase | TermSet | LoadedRuleBase, names: list[str] | None = None,
           values: dict[str, float] | None = None, behavior: str | None = None,
           points: int = CURVE_POINTS) -> tuple[VariablePlot, ...]:
     """The membership sheet: every variable of the rule base or term set (inputs first, in
     file order), only those ``behavior`` uses, or the ``names`` asked for; ``values`` marked.
-    Unknown names get a "did you mean"."""
+    A :class:`~mitos_cli.api.LoadedRuleBase` (``load_rulebase(...)``) is its rule base with
+    its compiled behavior as ``behavior`` unless another is given. Unknown names get a "did
+    you mean"."""
+    from ...api import LoadedRuleBase
+
+    if isinstance(rulebase, LoadedRuleBase):    # (it met "has no attribute 'termsets'")
+        behavior = rulebase.compiled.behavior if behavior is None else behavior
+        rulebase = rulebase.rulebase
     variables = {v.name: v for ts in _termsets(rulebase) for v in ts.variables}
     if isinstance(names, str):      # ("road" was read letter by letter: unknown variable `r`)
         raise InputError(f"names is a list of variable names, not the text `{names:.40}`",

@@ -4,6 +4,7 @@ propositions, their DOFs and consequents, and each output's aggregate and result
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -13,7 +14,10 @@ from ...fuzzy.hedges import apply as apply_hedges
 from ...fuzzy.hedges import weigh
 from ...lang.model import And, Expr, Not, Or, Prop, format_expr
 from ...lang.terms import Variable
-from .curves import curve_grid
+from .curves import compiled_of, curve_grid
+
+if TYPE_CHECKING:
+    from ...api import LoadedRuleBase
 
 
 @dataclass(frozen=True)
@@ -112,6 +116,12 @@ class RuleView:
     rows: tuple[RuleRow, ...]          # fired rules, in rule-base order
     outputs: tuple[OutputView, ...]
 
+    def __repr__(self) -> str:   # the generated one printed every row's view (6,000 characters)
+        outputs = ", ".join(f"{o.name} {o.value:.4g}{' ' + o.unit if o.unit else ''}"
+                            for o in self.outputs)
+        return (f"<RuleView of {self.behavior!r}: {len(self.rows)} of {self.n_rules} rules "
+                f"fired; {outputs}>")
+
 
 def props_of(expr: Expr) -> list[tuple[Prop, bool]]:
     """The propositions of an antecedent in reading order, each with whether an enclosing
@@ -147,15 +157,17 @@ def _prop_view(prop: Prop, inverted: bool, variable: Variable, mu: float) -> Pro
     return PropView(prop.var, prop.term, prop.hedges, prop.negated, x, y, mu, hedged)
 
 
-def rule_view(compiled: CompiledRuleBase, values: dict[str, float]) -> RuleView:
+def rule_view(compiled: CompiledRuleBase | LoadedRuleBase, values: dict[str, float]) -> RuleView:
     """Evaluate one input and collect what the rule viewer draws.
 
     Memberships, DOFs and outputs are the engine's (the numbers ``mitos eval`` prints); the
     rows are the rules with DOF > 0 in rule-base order. For Mamdani inference each consequent
     carries the rule's implied output set and each output the aggregated set
-    (:mod:`mitos_cli.engine.mamdani`).
+    (:mod:`mitos_cli.engine.mamdani`). ``compiled`` may be what ``load_rulebase`` returns.
     """
     from ...engine.evaluation import as_batch, declares_nan, evaluate
+
+    compiled = compiled_of(compiled, "rule_view")
 
     X = as_batch(compiled, values)
     if X.shape[0] != 1:

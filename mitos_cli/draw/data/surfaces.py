@@ -5,12 +5,17 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ...engine.compile import CompiledRuleBase
 from ...errors import InputError, unknown
 from ...numbers import whole_number
+from .curves import compiled_of
+
+if TYPE_CHECKING:
+    from ...api import LoadedRuleBase
 
 
 @dataclass(frozen=True)
@@ -50,6 +55,15 @@ class Surface:
     #: the output declares NaN as its default (`default: .nan`): where no rule fires it is
     #: that, not "no default"
     nan_default: bool = False
+
+    def __repr__(self) -> str:   # the generated one printed the axes' and z's arrays
+        over = self.x.name if self.y is None else f"{self.x.name} x {self.y.name}"
+        fixed = ", ".join(f"{f.name}={f.value:g}" for f in self.fixed[:4]) + (
+            ", ..." if len(self.fixed) > 4 else "")
+        held = f", {fixed} held" if fixed else ""
+        unset = int(np.isnan(self.z).sum())
+        return (f"<Surface of {self.output!r} over {over} ({' x '.join(map(str, self.z.shape))}"
+                f" points{held}; NaN at {unset})>")
 
     @property
     def no_rule(self) -> np.ndarray:
@@ -128,7 +142,7 @@ def _finite(what: str, values: tuple[float, ...], universe: tuple[float, float])
                                   f"{universe[1]:g}]")
 
 
-def surface(compiled: CompiledRuleBase, output: str, x: str, y: str | None = None,
+def surface(compiled: CompiledRuleBase | LoadedRuleBase, output: str, x: str, y: str | None = None,
             fixed: dict[str, float] | None = None, resolution: int = 61,
             x_range: tuple[float, float] | None = None,
             y_range: tuple[float, float] | None = None) -> Surface:
@@ -137,9 +151,12 @@ def surface(compiled: CompiledRuleBase, output: str, x: str, y: str | None = Non
     Inputs not in ``fixed`` are held at the midpoint of their universe (:class:`Fixed` says
     so). The whole grid is one batch through :func:`mitos_cli.engine.evaluation.evaluate` with
     ``strict=False``: where no rule fires and the output has no default, ``z`` is NaN.
-    ``x_range`` / ``y_range`` zoom into part of a universe.
+    ``x_range`` / ``y_range`` zoom into part of a universe. ``compiled`` may be what
+    ``load_rulebase`` returns.
     """
     from ...engine.evaluation import declares_nan, evaluate
+
+    compiled = compiled_of(compiled, "surface")
 
     if not isinstance(output, str) or output not in compiled.outputs:
         raise unknown("output", f"{output!s:.40}", compiled.outputs, cls=InputError)

@@ -249,7 +249,8 @@ def _py_header(p: Program, source: str) -> list[str]:
         f'{doc_text(source or "a MITOS rule base")}',
         f"(behavior `{doc_text(c.behavior)}`: {plural(len(p.rules), 'rule')}; "
         f"{doc_text(c.describe_operators())}).", "",
-        "``evaluate(X)`` maps inputs ``X[n, k]`` (columns in INPUTS order, clamped to their",
+        # (one line; `inputs = as_given` had the clamped line too, then its own)
+        "``evaluate(X)`` maps inputs ``X[n, k]`` (columns in INPUTS order, clamped to their\n"
         "universes) to outputs ``Y[n, m]`` (OUTPUTS order); an output no rule sets takes its"
         if c.operators.inputs == "clamped" else
         "``evaluate(X)`` maps inputs ``X[n, k]`` (columns in INPUTS order, not clamped: an\n"
@@ -264,7 +265,10 @@ def _py_header(p: Program, source: str) -> list[str]:
         "def _div(n, d, zero):", "    with np.errstate(invalid='ignore', divide='ignore'):",
         "        q = n / d", "    return np.where(d == 0, zero, q)", "", "",
         "def mf_kernel(x, b, s1, c, s2):",
-        "    return np.clip(1.0 + np.minimum((x - b) * s1, (c - x) * s2), 0.0, 1.0)", "", ""]
+        # an input far outside the universe (not clamped: `inputs = as_given`) makes a slope
+        # overflow to +-inf, whose membership is then 0 or 1, as the engine's: no warning
+        "    with np.errstate(over='ignore'):",
+        "        return np.clip(1.0 + np.minimum((x - b) * s1, (c - x) * s2), 0.0, 1.0)", "", ""]
 
 
 #: Rows the exported ``evaluate`` works on at a time: its arrays of a membership or a rule
