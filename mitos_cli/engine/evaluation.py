@@ -23,7 +23,7 @@ from ..fuzzy.shapes import SHAPES
 from ..numbers import exact
 from ..words import plural
 from .compile import CompiledRuleBase
-from .inputs import floats
+from .inputs import floats, named_columns
 from .threads import Blocks, map_blocks, thread_count
 
 if TYPE_CHECKING:
@@ -139,10 +139,13 @@ def check_inputs(compiled: CompiledRuleBase, X: ArrayLike) -> tuple[np.ndarray, 
 
 
 def _rows(compiled: CompiledRuleBase, X: ArrayLike | Mapping[str, ArrayLike]) -> np.ndarray:
-    """``X`` as a float array ``[n, k]`` (one sample may come as a flat ``[k]``; a mapping
-    gives the inputs by name, as :func:`as_batch` reads them)."""
-    if type(X) is not np.ndarray and isinstance(X, Mapping):   # its keys were read as values
-        return as_batch(compiled, X)
+    """``X`` as a float array ``[n, k]`` (one sample may come as a flat ``[k]``; a mapping,
+    or a table that names its columns (:func:`~.inputs.named_columns`: a DataFrame, a
+    structured array), gives the inputs by name, as :func:`as_batch` reads them)."""
+    if type(X) is not np.ndarray or X.dtype.names:    # a mapping's keys were read as values,
+        named = named_columns(X)                        # a DataFrame's columns by position
+        if named is not None:
+            return as_batch(compiled, named)
     k = len(compiled.inputs)
     X = floats(X, "the inputs", many=True)
     if X.ndim == 1 and X.shape[0] == k:
@@ -668,9 +671,11 @@ def _input_columns(compiled: CompiledRuleBase,
     date, bytes or structured column was read as numbers here, a complex one with NumPy's
     warning); a float column is kept as it is, not copied. A mapping gives the columns by
     name, as :func:`as_columns` reads them."""
-    if type(Xt) is not np.ndarray and isinstance(Xt, Mapping):  # (its keys were read as columns)
-        columns = as_columns(compiled, Xt)
-        return columns, columns
+    if type(Xt) is not np.ndarray or Xt.dtype.names:   # (a mapping's keys were read as the
+        named = named_columns(Xt)                        # columns, a DataFrame's by position)
+        if named is not None:
+            columns = as_columns(compiled, named)
+            return columns, columns
     if isinstance(Xt, np.ndarray) or not hasattr(Xt, "__len__"):
         Xt = floats(Xt, "the input columns", many=True)
     if isinstance(Xt, np.ndarray) and Xt.ndim == 0:
@@ -882,16 +887,19 @@ def evaluate_one(compiled: CompiledRuleBase, values: list[float] | Mapping[str, 
     Values other than floats are read as :func:`~.inputs.floats` reads them (the scalar form
     would take ``True`` as 1). A mapping gives the values by name (``{"road": 78, ...}``),
     checked as :func:`as_batch` checks names."""
-    # a mapping gives the values by name (it was "the inputs must be numbers, not `{...}`");
-    # a list is ruled out first, so that the usual call does not pay for the ABC's isinstance
-    if type(values) is not list and isinstance(values, Mapping):
-        _check_names(compiled, values)
-        row = [values[name] for name in compiled.inputs]
-    else:
-        row = values
+    # a mapping or a pandas Series gives the values by name (a dict was "the inputs must be
+    # numbers, not `{...}`", a Series read in its own order); a list, the usual call, is not
+    # asked
+    named = None if type(values) is list else named_columns(values)
+    row: Any = values if named is None else _named_row(compiled, named)   # checked just below
     if not _FLOAT.issuperset(map(type, row)):
         row = floats(row, "the inputs", many=True).tolist()
     return evaluate_floats(compiled, row, strict)
+
+
+def _named_row(compiled: CompiledRuleBase, named: Mapping[str, object]) -> list:
+    _check_names(compiled, named)
+    return [named[name] for name in compiled.inputs]
 
 
 def evaluate_floats(compiled: CompiledRuleBase, values: list[float],

@@ -77,6 +77,36 @@ class _NotNumbers(Exception):
         self.dtype = dtype            # of a structured value ("V"), for its fields' names
 
 
+def named_columns(table: object) -> dict[str, object] | None:
+    """The columns of a table that names them, by name: a mapping or anything with ``keys()``
+    (a pandas DataFrame or Series), a polars DataFrame (``columns``), a pyarrow Table
+    (``column_names``), a structured NumPy array (its fields); ``None`` for anything else,
+    and for a table whose names are not all text (a DataFrame of an unnamed array, numbered
+    0, 1, ...: read by position). Read by position, a table whose columns come in another
+    order than the rule base's inputs gave the outputs of other inputs, without a word."""
+    if type(table) in (list, tuple) or table is None:                     # the usual calls
+        return None
+    if isinstance(table, np.ndarray):
+        names = table.dtype.names
+        return None if not names else {name: table[name] for name in names}
+    keys = getattr(table, "keys", None)
+    if callable(keys):
+        names = keys()
+    else:
+        names = getattr(table, "column_names", None)
+        if names is None:
+            names = getattr(table, "columns", None)
+    if names is None or isinstance(names, (str, bytes)):
+        return None
+    try:
+        names = list(names)
+    except TypeError:
+        return None
+    if not names or not all(isinstance(name, str) for name in names):
+        return None
+    return {name: table[name] for name in names}  # type: ignore[index]  # checked: it names them
+
+
 def _structured(what: str, value: object, dtype: np.dtype | None, many: bool) -> InputError:
     """The error for a structured array or record (NumPy's kind ``V``): NumPy casts one of a
     single number field to that number without a word, so which field was meant is asked
