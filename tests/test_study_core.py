@@ -235,6 +235,36 @@ def test_the_simulator_steps_a_chunk_together_with_each_task_s_bits_alone(tmp_pa
         assert together[task] == run_task(context, task)
 
 
+def test_a_studys_default_workers_are_counted_with_its_worlds_maps(monkeypatch):
+    """A study's default workers were counted without the worlds' maps (they are read in the
+    workers): 16 workers each stepping a batch of `office` runs (0.7 GB) on a machine with
+    2 GB free. The simulator gives the executors its tasks' worlds to count them with."""
+    from mitos_cli import machine
+    from mitos_cli.resources import packaged_path
+    from mitos_cli.sim.lockstep import batch_for, map_bytes
+    from mitos_cli.sim.runs import RUN_BYTES, WORKER_BYTES
+    from mitos_cli.study import executors
+    from mitos_cli.study.run import default_task_fn
+
+    if not hasattr(os, "sched_getaffinity"):
+        pytest.skip("no CPU affinity on this platform")
+    office, slalom = (str(packaged_path("worlds", f"{n}.yaml")) for n in ("office", "slalom"))
+    study = Study([slalom, office], make_choices(["fuzzy"], ["min"], [], []), runs=4, seed=1)
+    fn = default_task_fn(study)
+    assert [w.name for w in fn.worlds(study.tasks())] == ["slalom", "office"]
+    per = WORKER_BYTES + batch_for(fn.worlds(study.tasks())[1]) * (
+        map_bytes(fn.worlds(study.tasks())[1]) + RUN_BYTES)
+    monkeypatch.setattr(os, "sched_getaffinity", lambda pid: set(range(16)))
+    monkeypatch.setattr(machine, "available_memory", lambda: 2 * per + per // 2)
+    used = []
+    monkeypatch.setattr(executors, "run_local", lambda fn, tasks, workers: used.append(workers)
+                        or iter(()))
+    list(execute(fn, study.tasks()))
+    assert used == [2]
+    list(execute(fake_sim, study.tasks()))         # a task function without worlds: CPUs
+    assert used[-1] == 16
+
+
 def test_an_edited_world_or_rule_base_is_run_as_it_is_now(tmp_path):
     """The worker's caches were keyed on the path: a second study of the session ran the
     world and rule base as first read (a 10.55 s success in a world of time_limit 2), while

@@ -250,10 +250,11 @@ def execute(fn: TaskFn, tasks: Sequence[Task], executor: str = "local",
             workers: int | None = None, scheduler: str | None = None,
             client: Client | None = None) -> Iterator[tuple[Task, dict]]:
     """``(task, result)`` pairs as the tasks finish, on the chosen executor."""
-    if workers is None:     # the worlds are loaded in the workers: counted without their maps
+    if workers is None:     # as many as the memory holds with the tasks' worlds' batches
         from ..sim.runs import default_workers
 
-        workers = default_workers()
+        worlds = getattr(fn, "worlds", None)
+        workers = default_workers(worlds(tasks) if worlds is not None else ())
     if not tasks:
         return iter(())
     if executor == "local":

@@ -206,3 +206,9 @@ class Simulator:
 
     def each(self, tasks: Sequence[Task]) -> Iterator[tuple[Task, dict]]:
         return run_tasks(self.context, tasks)
+
+    def worlds(self, tasks: Sequence[Task]) -> list[World]:
+        """The worlds ``tasks`` run, as the workers read them: what a default number of
+        workers is counted from (each steps a batch of a world's runs with their maps)."""
+        paths = dict.fromkeys(task.world for task in tasks)
+        return [_world(path, _world_key(self.context, path)) for path in paths]
