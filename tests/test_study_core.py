@@ -265,6 +265,46 @@ def test_a_studys_default_workers_are_counted_with_its_worlds_maps(monkeypatch):
     assert used[-1] == 16
 
 
+def test_a_study_tells_where_its_runs_are_between_their_ends(tmp_path):
+    """Runs in lockstep end together, late in their chunk: a study of one world and choice
+    showed 0 of N till then. The simulator says where its chunk's runs are every simulated
+    second; ``on_clock`` hears the earliest chunk going, and the results are the same."""
+    from mitos_cli.study.executors import Going, chunk_list
+    from mitos_cli.study.run import default_task_fn
+
+    world = tmp_path / "tiny.yaml"
+    world.write_text((Path(__file__).parent / "data" / "tiny.yaml").read_text())
+    study = Study([str(world)], make_choices(["fuzzy"], ["min"], [], []), runs=3, seed=4)
+    seen: list[tuple] = []
+    outcome = run_study(study, tmp_path / "a", workers=1,
+                        on_result=lambda task, row: seen.append(("run", task.index)),
+                        on_clock=lambda s: seen.append(("clock", s)))
+    again = run_study(study, tmp_path / "b", workers=1)
+    assert outcome.rows == again.rows
+    clocks = [s for what, s in seen if what == "clock"]
+    assert seen[0][0] == "clock" and clocks == sorted(clocks) and clocks[0] >= 1.0
+    fn = default_task_fn(study)
+    assert not any(isinstance(p, Going) for p in chunk_list(fn, study.tasks()))   # Dask's
+
+
+def test_a_chunk_whose_run_ended_before_it_told_its_clock_is_forgotten_when_done():
+    from mitos_cli.study.executors import Going
+    from mitos_cli.study.run import Clocks
+
+    heard: list[float] = []
+    clocks = Clocks(heard.append)
+    clocks.ended(0)                             # a run of chunk (0, 1) ended in its first second
+    clocks.told(Going(1.0, (0, 1)))
+    clocks.told(Going(1.0, (2, 3)))
+    clocks.told(Going(5.0, (2, 3)))
+    clocks.ended(1)                             # chunk (0, 1) has ended: (2, 3) is the earliest
+    clocks.told(Going(6.0, (2, 3)))
+    assert heard == [1.0, 1.0, 1.0, 6.0]
+    clocks.ended(2)
+    clocks.ended(3)
+    assert clocks.seconds == {}
+
+
 def test_an_edited_world_or_rule_base_is_run_as_it_is_now(tmp_path):
     """The worker's caches were keyed on the path: a second study of the session ran the
     world and rule base as first read (a 10.55 s success in a world of time_limit 2), while

@@ -336,7 +336,8 @@ def run_with_progress(study: Study, out: str, executor: str, workers: int | None
         try:
             return run_study(study, out, executor=executor, workers=workers,
                              scheduler=scheduler, resume=resume, on_start=on_start,
-                             on_result=on_result)
+                             on_result=on_result,
+                             on_clock=lambda t: bar.status(f"at {t:.0f} s"))
         except KeyboardInterrupt:
             pass
     if not kept["total"] and not resume:      # before on_start: no run of it is kept

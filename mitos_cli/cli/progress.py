@@ -47,6 +47,12 @@ class Bar:
         if self.progress is not None:
             self.progress.update(cast("TaskID", self.task), description=text)
 
+    def status(self, text: str) -> None:
+        """Words after the description on the bar (``simulate slalom: runs at 12 s``) while
+        nothing it counts has changed; off a terminal nothing (the lines keep their words)."""
+        if self.progress is not None:
+            self.progress.update(cast("TaskID", self.task), description=f"{self.what}: {text}")
+
     def note(self, text: str) -> None:
         """A line above the bar (on stderr, plain text: never read as markup)."""
         self.console.print(text, markup=False, highlight=False)

@@ -169,12 +169,12 @@ def _run_many(loaded: list[World], runs: int, seed: int | None, planner: Planner
     stopped them, how many were asked for (``None`` otherwise): the finished ones are kept."""
     from ..sim.runs import RunsInterrupted, run_many, trail
 
-    label = f"simulate {len(loaded)} worlds" if len(loaded) > 1 else f"simulate {loaded[0].name}"
-    with progress_bar(label, quiet=quiet) as bar:
+    label = f"{len(loaded)} worlds" if len(loaded) > 1 else loaded[0].name
+    with progress_bar(f"simulate {label}", quiet=quiet) as bar:
         try:
             return run_many(loaded, runs, seed, planner, workers,
                             measure=trail if plot is not None else None, on_progress=bar.update,
-                            on_clock=lambda t: bar.describe(f"{label}: runs at {t:.0f} s")), None
+                            on_clock=lambda t: bar.status(f"runs at {t:.0f} s")), None
         except RunsInterrupted as stop:
             return stop.runs, stop.total
 

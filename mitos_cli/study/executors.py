@@ -13,6 +13,7 @@ from __future__ import annotations
 import contextlib
 import functools
 from collections.abc import Callable, Iterator, Sequence
+from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from .spec import Task
@@ -25,21 +26,38 @@ TaskFn = Callable[[Task], dict]
 EXECUTORS = ("local", "dask")
 
 
-def run_chunk(fn: TaskFn, tasks: Sequence[Task]) -> Iterator[tuple[Task, dict]]:
+@dataclass(frozen=True)
+class Going:
+    """Where the runs of a chunk still going are, in simulated seconds (what the simulator
+    tells between its runs' ends, :class:`~mitos_cli.sim.lockstep.Clock`), and the tasks the
+    chunk holds (so that a progress bar can tell when it has ended)."""
+
+    seconds: float
+    tasks: tuple[int, ...]
+
+
+Part = tuple[Task, dict] | Going
+
+
+def run_chunk(fn: TaskFn, tasks: Sequence[Task]) -> Iterator[Part]:
     """Run a chunk of tasks (what a worker does with one message), each ``(task, result)``
     as it finishes: together where the task function can (its ``each``: the simulator steps
-    the runs of a world and choice in lockstep), else one after the other."""
+    the runs of a world and choice in lockstep, and says where they are between their ends:
+    :class:`Going`), else one after the other."""
     each = getattr(fn, "each", None)
-    if each is not None:
-        yield from each(tasks)
+    if each is None:
+        for task in tasks:
+            yield task, fn(task)
         return
-    for task in tasks:
-        yield task, fn(task)
+    ids = tuple(task.index for task in tasks)
+    for item in each(tasks):
+        yield item if isinstance(item, tuple) else Going(item.seconds, ids)
 
 
 def chunk_list(fn: TaskFn, tasks: Sequence[Task]) -> list[tuple[Task, dict]]:
-    """:func:`run_chunk` as one list (a Dask future's result)."""
-    return list(run_chunk(fn, tasks))
+    """:func:`run_chunk`'s results as one list (a Dask future's result: it arrives when the
+    chunk has ended, so where its runs were on the way says nothing)."""
+    return [part for part in run_chunk(fn, tasks) if not isinstance(part, Going)]
 
 
 def chunks(tasks: Sequence[Task], workers: int, most: int = 8) -> list[list[Task]]:
@@ -74,12 +92,12 @@ def _chunks_for(fn: TaskFn, tasks: Sequence[Task], workers: int) -> list[list[Ta
             else chunks(tasks, workers))
 
 
-def run_serial(fn: TaskFn, tasks: Sequence[Task]) -> Iterator[tuple[Task, dict]]:
+def run_serial(fn: TaskFn, tasks: Sequence[Task]) -> Iterator[Part]:
     for chunk in _chunks_for(fn, tasks, 1):
         yield from run_chunk(fn, chunk)
 
 
-def run_local(fn: TaskFn, tasks: Sequence[Task], workers: int) -> Iterator[tuple[Task, dict]]:
+def run_local(fn: TaskFn, tasks: Sequence[Task], workers: int) -> Iterator[Part]:
     """A pool of ``workers`` processes (one worker: this process, no pool), each result
     arriving as its task finishes.
 
@@ -248,8 +266,10 @@ def run_dask(fn: TaskFn, tasks: Sequence[Task], workers: int, scheduler: str | N
 
 def execute(fn: TaskFn, tasks: Sequence[Task], executor: str = "local",
             workers: int | None = None, scheduler: str | None = None,
-            client: Client | None = None) -> Iterator[tuple[Task, dict]]:
-    """``(task, result)`` pairs as the tasks finish, on the chosen executor."""
+            client: Client | None = None) -> Iterator[Part]:
+    """``(task, result)`` pairs as the tasks finish, on the chosen executor, and where the
+    runs of each chunk going are between them (:class:`Going`; not from Dask, whose chunks'
+    results arrive when they end)."""
     if workers is None:     # as many as the memory holds with the tasks' worlds' batches
         from ..sim.runs import default_workers
 

@@ -16,7 +16,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from ..words import plural
-from .executors import TaskFn, execute
+from .executors import Going, TaskFn, execute
 from .spec import Choice, Task, expand
 from .store import ResultStore, key_of, row_of
 from .summary import ALL_WORLDS, Rank, Summary, choice_of, rank, summaries
@@ -215,11 +215,14 @@ def run_study(study: Study, out_dir: str | Path, *, executor: str = "local",
               workers: int | None = None, scheduler: str | None = None, resume: bool = False,
               task_fn: TaskFn | None = None, client: Client | None = None,
               on_start: Callable[[int, int], None] | None = None,
-              on_result: Callable[[Task, dict], None] | None = None) -> Outcome:
+              on_result: Callable[[Task, dict], None] | None = None,
+              on_clock: Callable[[float], None] | None = None) -> Outcome:
     """Run every unfinished task of ``study``, appending each result to ``out_dir/results.csv``
     as it arrives, and summarize all finished rows (in task order, whatever the executor).
 
-    ``on_start(skipped, total)`` is called once, ``on_result(task, row)`` per finished task.
+    ``on_start(skipped, total)`` is called once, ``on_result(task, row)`` per finished task,
+    ``on_clock(seconds)`` between, with where the earliest chunk of runs going is (runs in
+    lockstep end together, late in their chunk).
     ``workers`` is checked as :func:`~mitos_cli.sim.runs.run_many` checks it (0, -5, 2.5 and
     True all ran without a word).
     """
@@ -238,7 +241,13 @@ def run_study(study: Study, out_dir: str | Path, *, executor: str = "local",
         if on_start is not None:
             on_start(len(finished), len(tasks))
         by_index: dict[int, dict] = {}
-        for task, result in execute(fn, todo, executor, workers, scheduler, own or client):
+        going = Clocks(on_clock)
+        for part in execute(fn, todo, executor, workers, scheduler, own or client):
+            if isinstance(part, Going):
+                going.told(part)
+                continue
+            task, result = part
+            going.ended(task.index)
             row = row_of(task, result)
             store.append(row)
             by_index[task.index] = row
@@ -254,6 +263,33 @@ def run_study(study: Study, out_dir: str | Path, *, executor: str = "local",
     outcome.summaries = summaries(rows, study.worlds, study.choices)
     outcome.ranks = rank(rows, outcome.pooled())
     return outcome
+
+
+class Clocks:
+    """Where the chunks of runs going are, for ``on_clock``: the earliest of them, each
+    forgotten once every run of it has ended."""
+
+    def __init__(self, on_clock: Callable[[float], None] | None) -> None:
+        self.on_clock = on_clock
+        self.seconds: dict[tuple[int, ...], float] = {}
+        self.left: dict[tuple[int, ...], set[int]] = {}
+        self.done: set[int] = set()
+
+    def told(self, going: Going) -> None:
+        left = self.left.setdefault(going.tasks, set(going.tasks) - self.done)
+        if left:
+            self.seconds[going.tasks] = going.seconds
+        if self.on_clock is not None and self.seconds:
+            self.on_clock(min(self.seconds.values()))
+
+    def ended(self, index: int) -> None:
+        self.done.add(index)
+        for chunk, left in self.left.items():
+            if index in left:
+                left.discard(index)
+                if not left:
+                    self.seconds.pop(chunk, None)
+                return
 
 
 def _scheduler_client(executor: str, scheduler: str | None, client: Client | None,

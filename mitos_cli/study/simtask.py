@@ -22,6 +22,7 @@ from .store import RESULT_FIELDS, StudyError
 if TYPE_CHECKING:
     from ..api import LoadedRuleBase
     from ..lang.model import RuleBase
+    from ..sim.lockstep import Clock
     from ..sim.loop import Scene, SimResult
     from ..sim.planner import Planner
     from ..sim.world import World
@@ -173,11 +174,13 @@ def run_task(context: StudyContext, task: Task) -> dict:
     return _fields(result)
 
 
-def run_tasks(context: StudyContext, tasks: Sequence[Task]) -> Iterator[tuple[Task, dict]]:
+def run_tasks(context: StudyContext, tasks: Sequence[Task],
+              every: float | None = None) -> Iterator[tuple[Task, dict] | Clock]:
     """Simulate ``tasks``, those of each world and choice stepped together
     (:class:`~mitos_cli.sim.lockstep.Lockstep`: each run's bits are those :func:`run_task`
-    gives it alone), giving each task and its fields as its run ends."""
-    from ..sim.lockstep import finished
+    gives it alone), giving each task and its fields as its run ends; with ``every``, also
+    where the runs going are between their ends (:meth:`.Lockstep.finished`)."""
+    from ..sim.lockstep import Clock, finished
 
     groups: dict[tuple[str, Choice], list[Task]] = {}
     for task in tasks:
@@ -185,9 +188,10 @@ def run_tasks(context: StudyContext, tasks: Sequence[Task]) -> Iterator[tuple[Ta
     for (path, choice), group in groups.items():
         key = _world_key(context, path)
         runs = finished(_world(path, key), _planner(context, choice, path),
-                        [task.seed for task in group], randomise=True, scene=_scene(path, key))
-        for j, result in runs:
-            yield group[j], _fields(result)
+                        [task.seed for task in group], randomise=True, scene=_scene(path, key),
+                        every=every)
+        for item in runs:
+            yield item if isinstance(item, Clock) else (group[item[0]], _fields(item[1]))
 
 
 def _fields(result: SimResult) -> dict:
@@ -204,8 +208,10 @@ class Simulator:
     def __call__(self, task: Task) -> dict:
         return run_task(self.context, task)
 
-    def each(self, tasks: Sequence[Task]) -> Iterator[tuple[Task, dict]]:
-        return run_tasks(self.context, tasks)
+    def each(self, tasks: Sequence[Task]) -> Iterator[tuple[Task, dict] | Clock]:
+        from ..sim.runs import CLOCK_EVERY
+
+        return run_tasks(self.context, tasks, every=CLOCK_EVERY)
 
     def worlds(self, tasks: Sequence[Task]) -> list[World]:
         """The worlds ``tasks`` run, as the workers read them: what a default number of
