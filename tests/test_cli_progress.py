@@ -111,6 +111,17 @@ def test_progress_lines_off_a_terminal_every_few_percent(capsys):
     assert capsys.readouterr().err == ""
 
 
+def test_a_status_leaves_the_lines_off_a_terminal_as_they_were(capsys):
+    """Where the runs are (`runs at 12 s`) goes on the bar only: a piped log's lines keep
+    their words (describe() would have made them `runs (local): at 12 s: 2 of 40`)."""
+    with progress_bar("runs (local)", lines=True) as bar:
+        bar.update(0, 40)
+        bar.status("at 12 s")
+        bar.update(2, 40)
+    assert capsys.readouterr().err.splitlines() == ["runs (local): 0 of 40 (0%)",
+                                                     "runs (local): 2 of 40 (5%)"]
+
+
 def test_compare_piped_prints_progress_lines(capsys, tmp_path):
     code, _, err = run(capsys, "compare", TINY, "--runs", 2, "--out", tmp_path / "study")
     assert code == 0
