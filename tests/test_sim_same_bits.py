@@ -1503,8 +1503,6 @@ def plain_sighting(free: movers.FreeSpace, now: float, origin, ranges, dirs, see
         on = (np.abs(off) < np.pi / 2) & (dist * np.abs(np.sin(off)) < free.near)
         on &= True if ring else inside
         passed = on & (dist * np.cos(off) < kept[np.arange(len(pose))[None, :], k] - movers.SHORT)
-        # a beam of the last TELL s tells only if it passed the echo
-        on &= passed | (free.times[live] <= now - (movers.TELL - 1e-6))[None, :]
         tested, entered = on.any(axis=1), passed.any(axis=1)
     at = np.add.accumulate(seen, dtype=np.intp) - 1
     moved = [None if not (n := np.count_nonzero(tested[at[r]]))

@@ -17,10 +17,7 @@ longer than ``MAX_EXTENT`` (a cart, a person, a robot: not a wall); :meth:`Track
 lists those that come toward the robot (within 60 deg of the robot's bearing from it,
 closing faster than the robot draws away). The echoes of a standing object slide along its
 faces as the robot drives by, but seldom into space a beam had just passed through, nor
-farther than the object is long. A beam cast less than ``TELL`` s before is no witness that
-an echo on its line stood: a cart coming head-on at 15 in/s is 1-2 in nearer a tick or two
-later, within the noise the test allows, and a ring of rays 10 deg apart seldom passes where
-it now is from farther back (its votes would say the cart stands till it is 50 in off).
+farther than the object is long.
 
 Where a mover goes (:func:`swept`) is a capsule from its centre along its velocity, as wide
 as the object and ``HALF_WIDTH`` at least (a sonar ring sees one or two echoes of a cart:
@@ -68,8 +65,6 @@ SETTLE = 2.5         # s: a track followed this long has a heading to go by
 VOTE = 0.5           # s: the sightings a track's moving is voted over
 SHORT = 4.0          # in: a beam passes through what lies up to this short of its echo
 STEP = 2.0           # in: an echo is tested this far beyond it
-TELL = 0.2           # s: a beam cast more lately than this is no witness that an echo stood
-# (a cart at 15 in/s comes 3 in nearer in 0.2 s, less than the SHORT + STEP the test asks)
 
 
 @dataclass(frozen=True, eq=False)
@@ -466,8 +461,7 @@ class FreeSpace:
         """For echoes ``points [P, 2]`` (of beams ``dirs [P, 2]``), tested ``STEP`` beyond the
         echo against the beams kept from the last ``WINDOW`` s (before ``now``): which lie on
         the line of one (within ``near``: the robot's map clears a mark the same way), and
-        which of those lay short of its echo then (something came where nothing was); a
-        beam of the last ``TELL`` s counts on a line only if it passed the echo."""
+        which of those lay short of its echo then (something came where nothing was)."""
         return entered([self], now, points, dirs)
 
 
@@ -572,9 +566,6 @@ def entered(spaces: Sequence[FreeSpace], now: float, points: np.ndarray, dirs: n
     passed = np.zeros(on.shape, dtype=bool)
     reach = ranges.reshape(-1)[(row + k).reshape(-1)[at]]
     passed.reshape(-1)[at] = dist.reshape(-1)[at] * np.cos(off.reshape(-1)[at]) < reach - SHORT
-    # a beam of the last TELL s that did not pass the echo abstains: what comes head-on came
-    # too little nearer since for it to tell (a millionth of a second spare for the clock)
-    on &= passed | (times <= now - (TELL - 1e-6))
     return np.logical_or.reduce(on, axis=1), np.logical_or.reduce(passed, axis=1)
 
 
