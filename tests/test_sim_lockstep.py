@@ -75,25 +75,31 @@ def test_runs_whose_brake_counts_the_squares_flush_with_a_wall_run_in_a_batch_as
         assert_same_run(a, b)
 
 
+def moving_draw_in_a_batch_as_alone(seed: int, draw: int, limit: float) -> Simulation:
+    """`moving` with the navigation benchmark's clutter draw ``draw`` of ``seed`` (as
+    ``bench_nav.py`` builds it), cut to ``limit`` s: three runs of it in a batch, each held to
+    the bits it has alone; a fresh, unstepped :class:`Simulation` of the first, to replay."""
+    from mitos_cli.sim.clutter import clutter
+
+    base = load_world(packaged_path("worlds", "moving.yaml"))
+    base_scene = prepare(base)
+    rng = np.random.default_rng(np.random.SeedSequence([seed, 3]).spawn(draw + 1)[draw])
+    world = clutter(base, base_scene.static, base_scene.routes[0], rng, int(rng.integers(3, 7)))
+    world = dataclasses.replace(world, seed=base.seed + draw, time_limit=limit)
+    planner = FuzzyPlanner(None, world.behavior)
+    seeds = [world.seed, world.seed + 1, world.seed + 2]
+    together = run_lockstep(world, planner, seeds, scene=base_scene)
+    for s, b in zip(seeds, together):
+        assert_same_run(simulate(world, planner, s, scene=base_scene), b)
+    return Simulation(world, planner, seeds[0], scene=base_scene)
+
+
 def test_runs_that_follow_a_far_cart_as_one_track_run_in_a_batch_as_alone():
     """`moving` with the benchmark's clutter draw 5 of seed 0: the cart is echoed 100 in off
     at one front corner, then at the other, and matched in the gate its line of sight from
     the robot gives (:func:`.movers.sight_lines`), the whole batch's at once; each run keeps
     the bits it has alone while it follows the cart and gets out of its way (to 19 s)."""
-    from mitos_cli.sim.clutter import clutter
-
-    base = load_world(packaged_path("worlds", "moving.yaml"))
-    base_scene = prepare(base)
-    rng = np.random.default_rng(np.random.SeedSequence([0, 3]).spawn(6)[5])
-    world = clutter(base, base_scene.static, base_scene.routes[0], rng, int(rng.integers(3, 7)))
-    world = dataclasses.replace(world, seed=base.seed + 5, time_limit=19.0)
-    planner = FuzzyPlanner(None, world.behavior)
-    seeds = [world.seed, world.seed + 1, world.seed + 2]
-    together = run_lockstep(world, planner, seeds, scene=base_scene)
-    alone = [simulate(world, planner, s, scene=base_scene) for s in seeds]
-    for a, b in zip(alone, together):
-        assert_same_run(a, b)
-    sim = Simulation(world, planner, seeds[0], scene=base_scene)
+    sim = moving_draw_in_a_batch_as_alone(0, 5, 19.0)
     wide = False
     while not sim.done:
         sim.step()
@@ -107,20 +113,7 @@ def test_runs_that_wait_at_their_refuge_for_a_cart_beside_them_run_in_a_batch_as
     refuge waits for the cart beside it till it has passed (:meth:`.RobotMap.at_refuge`),
     one on its way there does not; each run of a batch keeps the bits it has alone (to 26 s,
     after the first has left its refuge)."""
-    from mitos_cli.sim.clutter import clutter
-
-    base = load_world(packaged_path("worlds", "moving.yaml"))
-    base_scene = prepare(base)
-    rng = np.random.default_rng(np.random.SeedSequence([6000, 3]).spawn(10)[9])
-    world = clutter(base, base_scene.static, base_scene.routes[0], rng, int(rng.integers(3, 7)))
-    world = dataclasses.replace(world, seed=base.seed + 9, time_limit=26.0)
-    planner = FuzzyPlanner(None, world.behavior)
-    seeds = [world.seed, world.seed + 1, world.seed + 2]
-    together = run_lockstep(world, planner, seeds, scene=base_scene)
-    alone = [simulate(world, planner, s, scene=base_scene) for s in seeds]
-    for a, b in zip(alone, together):
-        assert_same_run(a, b)
-    sim = Simulation(world, planner, seeds[0], scene=base_scene)
+    sim = moving_draw_in_a_batch_as_alone(6000, 9, 26.0)
     at = False
     while not sim.done:
         sim.step()
