@@ -193,13 +193,14 @@ class Frame:
     pyarrow Table (``column_names``)."""
 
     def __init__(self, names: list, rows: list, by: str = "keys") -> None:
+        self.names = list(names)
         self.data = {n: np.array([r[j] for r in rows]) for j, n in enumerate(names)}
         self.rows = np.array(rows, dtype=float)
         if by != "keys":
             setattr(self, by, list(names))
 
     def keys(self):
-        return list(self.data)
+        return self.names
 
     def __getitem__(self, name):
         return self.data[name]
@@ -233,6 +234,19 @@ def test_a_table_with_named_columns_is_read_by_name_not_by_position(by):
     with pytest.raises(InputError, match="unknown input `roads`") as info:
         rb.run(kind(["size", "position", "roads"], [[45.0, 4.0, 78.0]], by=by))
     assert "did you mean `road`" in str(info.value)
+
+
+def test_a_table_naming_an_input_twice_is_refused_in_words():
+    """A DataFrame with two `road` columns met "inputs must be numbers or 1-D arrays, not of
+    shape (1, 2)" (its df["road"] is both); a column that is no numbers was shown with its
+    index (a Series' repr: `0    a`)."""
+    rb = load_rulebase()
+    with pytest.raises(InputError, match="the table names `road` more than once"):
+        rb.run(Frame(["size", "road", "position", "road"], [[45.0, 78.0, 4.0, 1.0]]))
+    frame = Frame(["size", "road", "position"], [[45.0, 78.0, 4.0]])
+    frame.data["size"] = np.array(["a"], dtype=object)
+    with pytest.raises(InputError, match=r"input `size` must be a number, not `\['a'\]`"):
+        rb.run(frame)
 
 
 def test_one_sample_with_named_values_is_read_by_name():

@@ -5,6 +5,8 @@ under the mask); the rule base would evaluate them without a word."""
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+
 import numpy as np
 
 from ..errors import InputError
@@ -104,7 +106,14 @@ def named_columns(table: object) -> dict[str, object] | None:
         return None
     if not names or not all(isinstance(name, str) for name in names):
         return None
-    return {name: table[name] for name in names}  # type: ignore[index]  # checked: it names them
+    twice = sorted({name for name in names if names.count(name) > 1})
+    if twice:           # a DataFrame's df["road"] of two columns met "not of shape (1, 2)"
+        raise InputError("the table names " + ", ".join(f"`{n}`" for n in twice[:8])
+                         + " more than once", hint="give each input one column")
+    if isinstance(table, Mapping):
+        return {name: table[name] for name in names}
+    # a DataFrame's column as an array: a Series' repr ("0    a") put its index in messages
+    return {name: np.asarray(table[name]) for name in names}  # type: ignore[index]
 
 
 def _structured(what: str, value: object, dtype: np.dtype | None, many: bool) -> InputError:
