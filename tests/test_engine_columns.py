@@ -249,6 +249,19 @@ def test_a_table_naming_an_input_twice_is_refused_in_words():
         rb.run(frame)
 
 
+@pytest.mark.parametrize("call", ["run", "columns", "one"])
+def test_a_mapping_is_read_by_name_whatever_its_keys(call):
+    """A dict keyed 0, 1, 2 met a TypeError inside "did you mean" (`evaluate_one` of `{}` one
+    in float()): a mapping's keys are names, each checked as one."""
+    rb = load_rulebase()
+    run = {"run": rb.run, "columns": lambda X: evaluate_columns(rb.compiled, X),
+           "one": lambda X: evaluate_one(rb.compiled, X)}[call]
+    with pytest.raises(InputError, match="inputs are named by text, not `0`"):
+        run({0: 78.0, 1: 45.0, 2: 4.0})
+    with pytest.raises(InputError, match="missing input `road`, `size`, `position`"):
+        run({})
+
+
 def test_one_sample_with_named_values_is_read_by_name():
     """A pandas Series (``keys()``, values by name) of one sample, in its own order."""
     rb = load_rulebase()

@@ -99,6 +99,10 @@ def _check_names(compiled: CompiledRuleBase, columns: Mapping[str, object]) -> N
     from ..errors import unknown
 
     for name in columns:
+        if not isinstance(name, str):   # (a dict keyed 0, 1, 2 met a TypeError in did you mean)
+            raise InputError(f"inputs are named by text, not `{name!r:.40}`",
+                             expected="names among " + ", ".join(compiled.inputs),
+                             hint="give the values in order as a list or array, or by name")
         if name not in compiled.inputs:
             known = [v.name for v in compiled.variables.values() if v.role == "input"]
             if name in known:

@@ -5,6 +5,7 @@ under the mask); the rule base would evaluate them without a word."""
 
 from __future__ import annotations
 
+from collections import Counter
 from collections.abc import Mapping
 
 import numpy as np
@@ -83,11 +84,14 @@ def named_columns(table: object) -> dict[str, object] | None:
     """The columns of a table that names them, by name: a mapping or anything with ``keys()``
     (a pandas DataFrame or Series), a polars DataFrame (``columns``), a pyarrow Table
     (``column_names``), a structured NumPy array (its fields); ``None`` for anything else,
-    and for a table whose names are not all text (a DataFrame of an unnamed array, numbered
-    0, 1, ...: read by position). Read by position, a table whose columns come in another
-    order than the rule base's inputs gave the outputs of other inputs, without a word."""
+    and for a table other than a mapping whose names are not all text (a DataFrame of an
+    unnamed array, numbered 0, 1, ...: read by position). Read by position, a table whose
+    columns come in another order than the rule base's inputs gave the outputs of other
+    inputs, without a word."""
     if type(table) in (list, tuple) or table is None:                     # the usual calls
         return None
+    if isinstance(table, Mapping):      # whatever its keys: each is checked as a name
+        return dict(table)
     if isinstance(table, np.ndarray):
         names = table.dtype.names
         return None if not names else {name: table[name] for name in names}
@@ -106,12 +110,10 @@ def named_columns(table: object) -> dict[str, object] | None:
         return None
     if not names or not all(isinstance(name, str) for name in names):
         return None
-    twice = sorted({name for name in names if names.count(name) > 1})
+    twice = sorted(name for name, n in Counter(names).items() if n > 1)
     if twice:           # a DataFrame's df["road"] of two columns met "not of shape (1, 2)"
         raise InputError("the table names " + ", ".join(f"`{n}`" for n in twice[:8])
                          + " more than once", hint="give each input one column")
-    if isinstance(table, Mapping):
-        return {name: table[name] for name in names}
     # a DataFrame's column as an array: a Series' repr ("0    a") put its index in messages
     return {name: np.asarray(table[name]) for name in names}  # type: ignore[index]
 
