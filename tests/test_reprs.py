@@ -74,6 +74,24 @@ def test_many_runs_print_a_line_each_not_every_summary():
     assert repr(WorldRuns("none", ())) == "<WorldRuns 'none': 0 runs>"
 
 
+def test_no_runs_have_no_rate_nor_mean_and_say_so():
+    """A hand-built WorldRuns of no runs raised ZeroDivisionError for a rate and gave a NaN
+    mean with a RuntimeWarning."""
+    import pytest
+
+    from mitos_cli.errors import InputError
+    from mitos_cli.sim.runs import WorldRuns
+
+    none = WorldRuns("none", ())
+    for ask, words in ((lambda: none.rate("success"), "its rate of `success` is undefined"),
+                       (lambda: none.stat("time_s"), "its mean `time_s` is undefined"),
+                       (none.figures, "its rate of `success` is undefined")):
+        with pytest.raises(InputError, match="'none' holds no runs: " + words):
+            ask()
+    with pytest.raises(InputError, match="did you mean `success`"):
+        none.rate("sucess")
+
+
 def test_a_world_a_simulation_a_lockstep_and_their_ticks_print_a_line_each():
     """A World printed every field of every robot, sensor and obstacle (1,000-1,500
     characters; a grid's array summary with it), a Simulation and a Lockstep their address,

@@ -101,7 +101,15 @@ class WorldRuns:
         return sum(s["outcome"] == outcome for s in self.summaries)
 
     def rate(self, outcome: str) -> float:
-        return self.count(outcome) / len(self.summaries)
+        """The share of the runs that ended in ``outcome``; of no runs there is none, an
+        :class:`InputError` (it was a ``ZeroDivisionError``)."""
+        n = self.count(outcome)
+        self._some(f"rate of `{outcome}`")
+        return n / len(self.summaries)
+
+    def _some(self, what: str) -> None:
+        if not self.summaries:
+            raise InputError(f"{self.world!r} holds no runs: its {what} is undefined")
 
     def stat(self, key: str) -> tuple[float, float | None]:
         """The mean and sample standard deviation of figure ``key`` over the runs (``None``
@@ -113,6 +121,7 @@ class WorldRuns:
                    if self.summaries else list(METRICS))
         if not isinstance(key, str) or key not in figures:
             raise unknown("figure", f"{key!s:.40}", figures, cls=InputError)
+        self._some(f"mean `{key}`")
         x = np.array([s[key] for s in self.summaries], dtype=float)
         return float(x.mean()), float(x.std(ddof=1)) if len(x) > 1 else None
 
@@ -128,7 +137,8 @@ class WorldRuns:
 
     def figures(self) -> dict:
         """Each outcome's rate and each metric's mean and std over the runs (the std of one
-        run is undefined: ``None``, null in JSON, as `compare --json` says it)."""
+        run is undefined: ``None``, null in JSON, as `compare --json` says it); of no runs,
+        an :class:`InputError`."""
         row: dict[str, float | dict[str, float | None]] = {f"{o}_rate": self.rate(o)
                                                                 for o in self.outcomes}
         for key in METRICS:
