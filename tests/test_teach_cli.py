@@ -76,7 +76,7 @@ def test_lesson_stops_at_the_first_error_with_file_and_line(work):
     res = mitos("teach", "rb/mitos.rules", "--lesson", "syntax.lesson", cwd=work)
     assert res.returncode == 1
     assert "syntax.lesson:2:7: syntax error: unexpected `epoch`" in res.stderr
-    assert "expected `epochs`, `plot`, `rate` or `unconstrained`" in res.stderr
+    assert "expected `epochs`, `plot`, `rate`, `unconstrained` or the end of the line" in res.stderr
 
 
 def test_lesson_from_stdin(work):

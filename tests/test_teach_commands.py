@@ -136,6 +136,14 @@ def test_rule_lines_are_rules_of_the_rule_language():
      "did you mean `very`?"),
     ("r1: if road is vry WIDE then speed is SLOW", "unexpected `WIDE`", None,
      "(hedges: very, extremely, somewhat, more_or_less, seldom, intensely, any)"),
+    # adapt's options are named (`adapt 50` said only the list; after a number the merged
+    # LALR states said "expected `,`, `->` or a name")
+    ("adapt 50", "unexpected `50`", "`epochs`, `plot`, `rate`, `unconstrained` or the end of "
+     "the line", "adapt's options are named: `adapt epochs 50` (how many epochs)"),
+    ("adapt epochs 60 0.5", "unexpected `0.5`", "`unconstrained` or the end of the line",
+     "`adapt rate 0.5` (the learning rate)"),
+    ("adapt epochs 5 robot", "unexpected `robot`", "`epochs`, `plot`, `rate`, `unconstrained` "
+     "or the end of the line", None),
     # what to show: the one meant (it said only the list)
     ("show rule", "unexpected `rule`", "rules, terms", "did you mean `rules`?"),
     ("show Terms", "unexpected `Terms`", "rules, terms", "did you mean `terms`?"),

@@ -652,6 +652,9 @@ def _syntax_error(exc: UnexpectedInput, text: str, path: str) -> RuleSyntaxError
     before = text[:token.start_pos].split() if token.start_pos is not None else []
     if before[:1] == ["save"]:              # `save out dir.rules`: one file name, then the end
         expected = {"$END"}
+    if before[:1] == ["adapt"] and before[-1:] not in (["epochs"], ["rate"], ["plot"]):
+        # LALR's merged states: after `adapt epochs 50` it read "expected `,`, `->` or a name"
+        expected = {"EPOCHS", "RATE", "PLOT", "UNCONSTRAINED", "$END"}
     if before[:1] == ["simulate"]:          # LALR's merged states: no `adapt` option here
         expected -= {"EPOCHS", "RATE", "PLOT", "UNCONSTRAINED"}
         if "ROBOT" in expected and "seed" not in before:    # (`seed` is an anonymous token)
@@ -705,6 +708,11 @@ def _teach_hint(text: str, token: Token, before: list[str]) -> str | None:
     at = token.start_pos or 0
     if any(ord(c) > 127 for c in str(token.value)) or (at and ord(text[at - 1]) > 127):
         return "names are written in ASCII letters, digits, `_` and `-`"
+    if before[:1] == ["adapt"] and before[-1:] not in (["epochs"], ["rate"]) \
+            and re.fullmatch(r"[\d.]+", str(token.value)):     # `adapt 50`: options are named
+        option = "epochs" if str(token.value).isdigit() else "rate"
+        return (f"adapt's options are named: `adapt {option} {token.value}` "
+                + ("(how many epochs)" if option == "epochs" else "(the learning rate)"))
     if before == ["show"]:                  # `show rule`: which one was meant
         from ..errors import did_you_mean
 
