@@ -949,7 +949,14 @@ def test_learned_words_show_a_small_move_and_the_table_s_digits():
                  {"ST": 90.0, "RS": 109.97, "RM": 130.87, "RB": 150.0 + 1e-12})
     assert said == ["  o.RS: 110 -> 109.97 deg, toward ST",
                     "  o.RM: 130 -> 130.87 deg, toward RB",
-                    f"  o.RB: 150.0 -> {150.0 + 1e-12!r} deg"]      # never "150 -> 150"
+                    f"  o.RB: 150.0 -> {150.0 + 1e-12!r} deg, away from RM"]   # never "150 -> 150"
+
+
+def test_learned_words_say_which_neighbour_an_end_term_moved_away_from():
+    """`size.SMALL_SZ: 10 -> 7.36 in` said no direction, where every other move names the
+    neighbour it went toward."""
+    said = _said({"LO": 10.0, "MID": 30.0, "HI": 60.0}, {"LO": 5.0, "MID": 30.0, "HI": 64.0})
+    assert said == ["  o.LO: 10 -> 5 deg, away from MID", "  o.HI: 60 -> 64 deg, away from MID"]
 
 
 def test_learned_words_say_past_a_neighbour_not_a_share_over_the_whole_way():

@@ -79,6 +79,8 @@ def in_words(before: RuleBase, after: RuleBase, parameters: Parameters, rules: S
             text = f"  {name}.{t_new.name}: {before_} -> {after_}{unit}"
             if 0 <= j < len(order):
                 text += _toward(a, b, order[j].name, centre(order[j]), unit)
+            elif 0 <= 2 * i - j < len(order):      # an end term moved out: from its neighbour
+                text += f", away from {order[2 * i - j].name}"
             lines.append(text)
     if len(lines) == 1:
         lines.append("  no term moved" + (f"; only {_written_in(rules)} did (the table above)"
