@@ -179,6 +179,20 @@ def test_rules_as_text_take_a_width(capsys):
     assert code == 2 and "--width" in err
 
 
+def test_a_surface_told_less_draws_the_first_output_over_the_first_inputs(capsys):
+    """As MATLAB's gensurf(fis): `mitos plot surface` alone was "Missing option '--x'", and
+    without an OUTPUT "name the OUTPUT to draw"; each default is said in a note."""
+    code, out, err = run(["plot", "surface", "-n", "5"], capsys)
+    assert code == 0, err
+    assert "note: drawing `steering`, the first output (name another: speed); over `road` and " \
+           "`size`, the first inputs (--x and --y choose others)" in " ".join(err.split())
+    said = run(["plot", "surface", "steering", "--x", "road", "--y", "size", "-n", "5"], capsys)
+    assert said[0] == 0 and said[1] == out and "note: drawing" not in said[2]
+    code, curve, err = run(["plot", "surface", "--x", "road", "-n", "5"], capsys)
+    assert code == 0 and "note: drawing `steering`, the first output" in err
+    assert "over `road`" not in err and "road [in]  steering" in curve
+
+
 # ---------------------------------------------------------------- errors
 
 
@@ -186,7 +200,10 @@ def test_rules_as_text_take_a_width(capsys):
     (["terms", "-o", "x.pdf"], "`x.pdf` has extension .pdf; the picture formats are .png and "
                                ".svg"),
     (["terms", "-o", "picture"], "`picture` has no extension"),
-    (["surface", "--x", "road"], "name the OUTPUT to draw: one of steering, speed"),
+    (["surface", "--y", "road"], "--y needs --x: name the input on the x axis too"),
+    (["surface", "--style", "heatmap"], "--style chooses how a picture of two inputs is drawn"),
+    (["surface", "--x", "road", "--style", "heatmap", "-o", "s.png"],
+     "--style chooses how a picture of two inputs is drawn"),
     (["surface", "steering", "--x", "road=1"], "write NAME or NAME=LOW:HIGH"),
     (["surface", "steering", "--x", "road", "--fix", "size"], "write NAME=VALUE"),
     (["surface", "steering", "--x", "road", "--fix", "size=1", "--fix", "size=2"],
@@ -195,7 +212,6 @@ def test_rules_as_text_take_a_width(capsys):
     (["surface", "steering", "--x", "road", "--fix", "size=45", "position=4"],
      "`position=4` is not a rule base or an output; to hold several inputs, repeat --fix: "
      "--fix position=4"),
-    (["surface", "steering"], "Missing option '--x'"),
     (["rules"], "give one NAME=VALUE per input: road=... size=... position=..."),
     (["rules", "road=1", "road=2"], "input `road` is given twice"),
 ])

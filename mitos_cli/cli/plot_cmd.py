@@ -284,17 +284,41 @@ def _surface_args(args: list[str]) -> tuple[Optional[str], Optional[str]]:
     return None, None
 
 
+STYLE_NEEDS = ("--style chooses how a picture of two inputs is drawn: add --y and -o FILE.png "
+               "(or --show), or leave --style out")
+
+
+def _surface_defaults(rb: LoadedRuleBase, out_name: str | None, x: str | None,
+                      y: str | None) -> tuple[str, str, str | None]:
+    """What `mitos plot surface` draws when told less, as MATLAB's ``gensurf(fis)``: the
+    behavior's first output over its first two inputs, each default said in a note."""
+    chose = []
+    if out_name is None:
+        out_name = rb.outputs[0]
+        if len(rb.outputs) > 1:
+            chose.append(f"`{out_name}`, the first output (name another: "
+                         + ", ".join(rb.outputs[1:]) + ")")
+    if x is None:
+        x, y = rb.inputs[0], rb.inputs[1] if len(rb.inputs) > 1 else None
+        over = f"`{x}`" + (f" and `{y}`" if y is not None else "")
+        chose.append(f"over {over}, the first inputs (--x and --y choose others)")
+    if chose:
+        err("note: drawing " + "; ".join(chose))
+    return out_name, x, y
+
+
 def surface_command(
     args: Annotated[Optional[list[str]], typer.Argument(
         click_type=WORDS, metavar="[RULEBASE] OUTPUT",
         help="Rule file (default: the packaged MITOS rule base), then the output to draw "
-             "(may be left out when the rule base has one output).")] = None,
-    x: Annotated[str, typer.Option(
+             "(default: the behavior's first, with a note).")] = None,
+    x: Annotated[Optional[str], typer.Option(
         "--x", metavar="INPUT[=LOW:HIGH]",
-        help="Input on the x axis, optionally zoomed to LOW:HIGH.")] = ...,  # type: ignore[assignment]  # Typer: required
+        help="Input on the x axis, optionally zoomed to LOW:HIGH (default: the behavior's "
+             "first input, and its second on the y axis, as MATLAB's gensurf).")] = None,
     y: Annotated[Optional[str], typer.Option(
         "--y", metavar="INPUT[=LOW:HIGH]",
-        help="Input on the y axis (without it: a curve over --x).")] = None,
+        help="Input on the y axis (with --x alone: a curve over --x).")] = None,
     fix: Annotated[Optional[list[str]], typer.Option(
         "--fix", metavar="NAME=VALUE",
         help="Hold another input at a value (repeat; inputs not fixed are held at the "
@@ -319,15 +343,16 @@ def surface_command(
 
     style = choice(Style, style_name or Style.surface.value, "style")
     _one_way(output, show, title=title)
-    if style_name is not None and (y is None or not _wants_picture(output, show)):
-        raise typer.BadParameter("--style chooses how a picture of two inputs is drawn: add "
-                                 "--y and -o FILE.png (or --show), or leave --style out")
+    if x is None and y is not None:
+        raise typer.BadParameter("--y needs --x: name the input on the x axis too")
+    if style_name is not None and ((x is not None and y is None)
+                                   or not _wants_picture(output, show)):
+        raise typer.BadParameter(STYLE_NEEDS)
     path, out_name = _surface_args(args or [])
     rb = load_rulebase(path, behavior)
-    if out_name is None:
-        if len(rb.outputs) != 1:
-            raise typer.BadParameter("name the OUTPUT to draw: one of " + ", ".join(rb.outputs))
-        out_name = rb.outputs[0]
+    out_name, x, y = _surface_defaults(rb, out_name, x, y)
+    if style_name is not None and y is None:          # a behavior of one input: a curve
+        raise typer.BadParameter(STYLE_NEEDS)
     x_name, x_range = _axis(x, "'--x'")
     y_name, y_range = _axis(y, "'--y'") if y is not None else (None, None)
     fixed = parse_values(_fixed(fix or []))
