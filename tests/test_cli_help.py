@@ -223,7 +223,7 @@ def test_usage_writes_a_required_argument_by_its_bare_name(name):
 
 def test_usage_of_convert_and_compare():
     every = commands()
-    for name, expected in [("convert", "[OPTIONS] FILE"), ("export", "[OPTIONS] FILE"),
+    for name, expected in [("convert", "[OPTIONS] [FILE]"), ("export", "[OPTIONS] [FILE]"),
                            ("compare", "[OPTIONS] WORLDS...")]:
         cmd = every[name]
         ctx = cmd.make_context(f"mitos {name}", ["--help"], resilient_parsing=True)

@@ -813,3 +813,22 @@ def test_convert_to_rules_of_a_file_named_in_another_encoding(tmp_path: Path, ca
     assert code == 0, err
     assert (tmp_path / "ok.rules").read_text().startswith(
         "# main: written by `mitos convert` from t\ufffd.fis\n")
+
+
+def test_convert_and_export_without_a_file_take_the_packaged_rule_base(tmp_path: Path,
+                                                                      monkeypatch, capsys) -> None:
+    """As `eval`, `check`, `plot` and `simulate` do (the README: "a command that names no rule
+    file ... uses the packaged ones"); both said "Missing argument 'FILE'"."""
+    from mitos_cli.api import default_rulebase_path
+
+    monkeypatch.chdir(tmp_path)
+    packaged = str(default_rulebase_path())
+    for args, written in ((["convert", "--to", "fll", "-b", "cruise"], "Engine: cruise"),
+                          (["export", "--to", "python"], "def evaluate(")):
+        code, told_less = run_main(args, capsys)
+        assert code == 0, told_less
+        code, named = run_main([args[0], packaged, *args[1:]], capsys)
+        assert code == 0 and told_less == named and written in told_less
+    code, output = run_main(["convert", "--to", "rules"], capsys)
+    assert code == 0 and "wrote mitos.rules and mitos.terms.yaml" in output
+    assert (tmp_path / "mitos.rules").is_file()

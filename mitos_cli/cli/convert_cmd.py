@@ -31,8 +31,9 @@ class Dialect(str, Enum):
 
 
 def convert_command(
-    path: Annotated[Path, typer.Argument(
-        click_type=FILE, metavar="FILE", help="Rule base to convert (.rules, .fcl, .fis or .fll).")],
+    path: Annotated[Optional[Path], typer.Argument(
+        click_type=FILE, metavar="[FILE]", help="Rule base to convert (.rules, .fcl, .fis or .fll; "
+                                                "default: the packaged MITOS rule base).")] = None,
     to_name: Annotated[Optional[str], typer.Option(
         "--to", metavar=choices(Target), autocompletion=completer(Target),
         help="Format to write: rules (NAME.rules + NAME.terms.yaml), fcl, fis or fll "
@@ -57,7 +58,7 @@ def convert_command(
     Reading back what was written gives the same outputs; what the target format cannot say
     is refused with the reason.
     """
-    from ..api import read_rulebase
+    from ..api import default_rulebase_path, read_rulebase
     from ..interop import conversion_notes, parse_foreign, round_trip_difference, write_foreign
     from ..interop.common import atomic_write
 
@@ -68,6 +69,7 @@ def convert_command(
                                  f"has none (leave --dialect out)")
     if output is not None:
         check_suffix(output, f".{to.value}", f"--to {to.value}")
+    path = path if path is not None else default_rulebase_path()
     rb = read_rulebase(path)
     warn_notes(rb)
     if behavior is not None:

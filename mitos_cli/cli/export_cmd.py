@@ -22,8 +22,9 @@ SUFFIX = {Language.c: ".c", Language.python: ".py"}
 
 
 def export_command(
-    path: Annotated[Path, typer.Argument(
-        click_type=FILE, metavar="FILE", help="Rule base to export (.rules, .fcl, .fis or .fll).")],
+    path: Annotated[Optional[Path], typer.Argument(
+        click_type=FILE, metavar="[FILE]", help="Rule base to export (.rules, .fcl, .fis or .fll; "
+                                                "default: the packaged MITOS rule base).")] = None,
     to_name: Annotated[Optional[str], typer.Option(
         "--to", metavar=choices(Language), autocompletion=completer(Language),
         help="c: one C99 file (no allocation, only libm); python: a NumPy-only module "
@@ -46,7 +47,7 @@ def export_command(
     has `evaluate(X)` for a batch X (one row per sample). Both agree with `mitos eval` to
     rounding.
     """
-    from ..api import load_rulebase
+    from ..api import default_rulebase_path, load_rulebase
     from ..interop import left_out
     from ..interop.common import atomic_write
     from ..interop.export import ident, to_c, to_python
@@ -63,6 +64,7 @@ def export_command(
         raise typer.BadParameter(f"--prefix `{prefix}` is not a C identifier (letters, digits "
                                  f"and `_`, not starting with a digit)"
                                  + (f"; did you mean `{close}`?" if close.strip("_") else ""))
+    path = path if path is not None else default_rulebase_path()
     rb = load_rulebase(path, behavior)
     if output is not None:
         refuse_inputs([output], source_files(rb.rulebase, path))
