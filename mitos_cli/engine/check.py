@@ -82,11 +82,12 @@ from ..lang.model import (
     format_expr,
 )
 from ..lang.terms import TermSet, Variable
+from . import regions
 from .compile import CompiledRuleBase, compile_rulebase
 from .evaluation import BLOCK_CELLS, declares_nan, rule_dofs
 
 if TYPE_CHECKING:
-    from collections.abc import Iterator, Sequence
+    from collections.abc import Callable, Iterator, Sequence
 
     from ..lang.operators import Operators
     from ..lang.terms import Term
@@ -166,6 +167,9 @@ class GridInfo:
     #: `no-rule-fires` and `low-dof` may miss places between its samples
     skipped: tuple[str, ...] = ()
     corner_samples: float = 0.0            # the samples every corner point would take
+    #: `no-rule-fires` was decided exactly, with no grid (:mod:`.regions`): only `low-dof`
+    #: is sampled
+    exact: bool = False
 
 
 @dataclass(frozen=True)
@@ -201,13 +205,17 @@ def check_rulebase(rb: RuleBase, behavior: str | None = None, *, threshold: floa
     seen: set[tuple] = set()               # undersampled terms already reported
     for name in names:
         rb.behavior(name)                       # unknown behavior: did-you-mean error
+    compositions = _Compositions(rb)
+    for name in names:
         compiled = compile_rulebase(rb, name)
         findings += _rule_pairs(rb, name, compiled.operators)
         findings += _contradictions(rb, name)
         findings += _idle_settings(rb, name, compiled)
         findings += _undersampled(rb, name, compiled, seen)
         findings += _infinite_inverses(rb, name, compiled, seen)
-        grid_findings, info = _sampled(compiled, threshold, resolution)
+        grid_findings, info = _sampled(compiled, threshold, resolution,
+                                       compositions.in_use(name, compiled),
+                                       compositions.exact(name, compiled))
         findings += grid_findings
         grids.append(info)
     # the term sets' findings: with one behavior named, only about the variables it uses
@@ -588,8 +596,162 @@ def _first_names(names: list[str]) -> str:
     return ", ".join(names[:SHOWN_TERMS]) + (f" and {more:,} more" if more > 0 else "")
 
 
-def _sampled(compiled: CompiledRuleBase, threshold: float,
-             resolution: int) -> tuple[list[Finding], GridInfo]:
+# ---------------------------------------------------------------------------------------------
+# behaviors as they are used: compositions, judged with box algebra (regions.py)
+
+@dataclass(frozen=True)
+class InUse:
+    """Where a behavior that others ``use`` counts, output by output: the points of its own
+    inputs where, for some values of the other inputs, some chain of ``use ... when`` from a
+    behavior nothing uses (``users``) brings it in with a degree above 0 and no rule outside
+    it in that composition sets the output. There a gap of its own is the composition's, and
+    a low DOF of its own is at most the composition's; elsewhere it is not in use, or a
+    sibling sets the output."""
+
+    users: tuple[str, ...]
+    space: regions.Space                     # the behavior's own inputs
+    alone: dict[str, list[regions.Cube]]
+
+    def mask(self, output: str, X: np.ndarray) -> np.ndarray:
+        return self.space.contains(self.alone[output], X)
+
+    @property
+    def where(self) -> str:
+        return f"where {listed_names(self.users)} {'uses' if len(self.users) == 1 else 'use'} it"
+
+
+@dataclass(frozen=True)
+class Exact:
+    """Where no rule of a composition (a behavior that ``use``s others) sets each output,
+    as disjoint cubes: exact, with no grid."""
+
+    space: regions.Space
+    gaps: dict[str, list[regions.Cube]]
+
+
+@dataclass
+class _Composed:
+    compiled: CompiledRuleBase
+    space: regions.Space
+    chains: list[tuple]                      # each flattened rule's `use` chain
+    fires: list[list[regions.Cube]]          # where each rule's DOF is above 0
+    counting: np.ndarray
+
+
+class _Compositions:
+    """The behaviors of a rule base as the compositions a user evaluates: for each behavior
+    nothing ``use``s (a top level), where each of its rules fires (exactly, on atoms:
+    :mod:`.regions`). Anything :class:`.regions.NotExact` leaves the behavior judged on its
+    own, on its grid, as a behavior nobody uses is."""
+
+    def __init__(self, rb: RuleBase) -> None:
+        self.rb = rb
+        self.used_by: dict[str, set[str]] = {}
+        for b in rb.behaviors:
+            for u in b.uses:
+                self.used_by.setdefault(u.behavior, set()).add(b.name)
+        self.tops = [b.name for b in rb.behaviors if b.name not in self.used_by and b.uses]
+        self._composed: dict[str, _Composed | None] = {}
+
+    def _space(self, compiled: CompiledRuleBase) -> regions.Space:
+        rb = self.rb
+        return regions.Space([rb.variables[v] for v in compiled.inputs],
+                             [corner_points(compiled, i) for i in range(len(compiled.inputs))],
+                             compiled.operators.and_, compiled.operators.or_)
+
+    def composed(self, top: str) -> _Composed | None:
+        if top not in self._composed:
+            try:
+                compiled = compile_rulebase(self.rb, top)
+                space = self._space(compiled)
+                conditions: dict[int, list[regions.Cube]] = {}
+
+                def where(expr: Expr | None) -> list[regions.Cube]:
+                    if id(expr) not in conditions:
+                        conditions[id(expr)] = space.fires(expr)
+                    return conditions[id(expr)]
+
+                chains, fires = [], []
+                for _, rule, chain in flatten(self.rb, top):
+                    chains.append(chain)
+                    cubes = [] if rule.weight == 0 or any(u.weight == 0 for u in chain) \
+                        else where(rule.antecedent)
+                    for use in chain:
+                        if cubes and use.condition is not None:
+                            cubes = regions.intersect(cubes, where(use.condition))
+                    fires.append(cubes)
+                counting, _ = _counting(compiled)
+                self._composed[top] = _Composed(compiled, space, chains, fires, counting)
+            except regions.NotExact:
+                self._composed[top] = None
+        return self._composed[top]
+
+    def exact(self, name: str, compiled: CompiledRuleBase) -> Exact | None:
+        """A top level's gaps, per output; None for a behavior that uses none (judged on its
+        grid, exactly as before) or where there is no exact answer."""
+        if name not in self.tops:
+            return None
+        c = self.composed(name)
+        if c is None:
+            return None
+        try:
+            gaps = {}
+            for j, output in enumerate(c.compiled.outputs):
+                setting = [cube for r, cubes in enumerate(c.fires) if c.counting[r, j] > 0
+                           for cube in cubes]
+                gaps[output] = regions.subtract([c.space.full], regions.simplify(setting))
+        except regions.NotExact:
+            return None
+        return Exact(c.space, gaps)
+
+    def in_use(self, name: str, compiled: CompiledRuleBase) -> InUse | None:
+        """Where a behavior that others use counts (:class:`InUse`); None for one nobody
+        uses, or where there is no exact answer."""
+        if name not in self.used_by:
+            return None
+        alone: dict[str, list[regions.Cube]] = {o: [] for o in compiled.outputs}
+        users = []
+        try:
+            own = self._space(compiled)
+            for top in self.tops:
+                c = self.composed(top)
+                if c is None:
+                    return None
+                inside = [next((k for k, u in enumerate(chain) if u.behavior == name), -1)
+                          for chain in c.chains]
+                if all(k < 0 for k in inside):
+                    continue
+                users.append(top)
+                prefixes = {tuple(map(id, chain[:k + 1])): chain[:k + 1]
+                            for chain, k in zip(c.chains, inside) if k >= 0}
+                used: list[regions.Cube] = []
+                for prefix in prefixes.values():
+                    cubes = [] if any(u.weight == 0 for u in prefix) else [c.space.full]
+                    for use in prefix:
+                        if cubes and use.condition is not None:
+                            cubes = regions.intersect(cubes, c.space.fires(use.condition))
+                    used += cubes
+                keep = [c.space.names.index(v) for v in compiled.inputs]
+                for output in compiled.outputs:
+                    j = c.compiled.outputs.index(output)
+                    others = [cube for r, cubes in enumerate(c.fires)
+                              if inside[r] < 0 and c.counting[r, j] > 0 for cube in cubes]
+                    there = regions.subtract(regions.simplify(used), regions.simplify(others))
+                    alone[output] = regions.simplify(alone[output]
+                                                     + regions.project(there, keep))
+        except regions.NotExact:
+            return None
+        if not users:                  # used only by behaviors that are themselves unused
+            return None                # by any top level: judged on its own
+        return InUse(tuple(users), own, alone)
+
+
+def _sampled(compiled: CompiledRuleBase, threshold: float, resolution: int,
+             in_use: InUse | None = None,
+             exact: Exact | None = None) -> tuple[list[Finding], GridInfo]:
+    """The grid's findings: coverage and rules that never fire. ``in_use``: a behavior
+    others use counts only where it is in use and alone (:class:`InUse`); ``exact``: a
+    composition's gaps, decided with no grid (only its low DOF is sampled)."""
     every = list(range(len(compiled.inputs)))
     axes = grid_axes(compiled, resolution)
     shape = tuple(len(a) for a in axes)
@@ -598,7 +760,8 @@ def _sampled(compiled: CompiledRuleBase, threshold: float,
     dof = rule_dofs(compiled, X)                       # [n, R]
     skipped = skipped_corners(compiled, every, axes)
     info = GridInfo(compiled.behavior, tuple(zip(compiled.inputs, shape)), X.shape[0],
-                    skipped, _size([corner_points(compiled, i) for i in every]))
+                    skipped, _size([corner_points(compiled, i) for i in every]),
+                    exact is not None)
     thinned = (f" (on a grid that skipped corner points of {listed_names(skipped)}: there may "
                f"be more)" if skipped else "")
     out: list[Finding] = []
@@ -608,10 +771,18 @@ def _sampled(compiled: CompiledRuleBase, threshold: float,
     # coverage, per output (grouping outputs that share the same gap)
     counting, missed = _counting(compiled)
     total = dof @ counting                             # [n, m] total DOF per output
+    if in_use is not None:                   # where it is not in use, or not alone: no say
+        for j, o in enumerate(compiled.outputs):
+            total[~in_use.mask(o, X), j] = np.inf
     centres = None                                     # the same at the cells' centres
     reported: dict[tuple, list[str]] = {}
-    for kind, mask_of in (("no-rule-fires", lambda t: t <= 0.0),
-                          ("low-dof", lambda t: (t > 0.0) & (t < threshold))):
+    kinds: tuple[tuple[str, Callable[[np.ndarray], np.ndarray]], ...] = (
+             ("no-rule-fires", lambda t: t <= 0.0),
+             ("low-dof", lambda t: (t > 0.0) & (t < threshold)))
+    if exact is not None:
+        out += _exact_gaps(compiled, exact, span, missed)
+        kinds = kinds[1:]
+    for kind, mask_of in kinds:
         reported.clear()
         masks = {}
         for j, out_name in enumerate(compiled.outputs):
@@ -629,7 +800,7 @@ def _sampled(compiled: CompiledRuleBase, threshold: float,
             cells = None
             if inner and all(len(a) > 1 for a in axes):
                 if centres is None:
-                    centres = _centre_totals(compiled, axes, counting)
+                    centres = _centre_totals(compiled, axes, counting, in_use)
                 share = _unset_share(centres, axes, compiled.outputs.index(outs[0]))
                 unset = centres[:, [compiled.outputs.index(o) for o in outs]] <= 0.0
                 cells = unset.all(axis=1).reshape([len(a) - 1 for a in axes])
@@ -638,7 +809,7 @@ def _sampled(compiled: CompiledRuleBase, threshold: float,
             boxes, uncovered = boxes_of(mask.reshape(shape), axes, compiled.inputs,
                                         cells=cells)
             severity, message, hint = _coverage_words(compiled, kind, outs, share,
-                                                      has_default, threshold, thinned)
+                                                      has_default, threshold, thinned, in_use)
             if missed.intersection(outs):
                 message += (" (counting only the rules whose sets its sampling does not miss: "
                             "undersampled-term)")
@@ -653,6 +824,31 @@ def _sampled(compiled: CompiledRuleBase, threshold: float,
                    dtype=bool)
     out += _unreachable(compiled, np.flatnonzero(~fires & own), resolution)
     return out, info
+
+
+def _exact_gaps(compiled: CompiledRuleBase, exact: Exact, span: Span | None,
+                missed: set[str]) -> list[Finding]:
+    """A composition's ``no-rule-fires`` findings from its exact gaps (outputs with the same
+    gap in one finding), in the words and boxes of the sampled ones."""
+    groups: dict[tuple, list[str]] = {}
+    for j, out_name in enumerate(compiled.outputs):
+        gap = exact.gaps[out_name]
+        if not gap:
+            continue
+        has_default = not np.isnan(compiled.default[j]) or declares_nan(compiled, out_name)
+        groups.setdefault((tuple(sorted(gap)), has_default), []).append(out_name)
+    out = []
+    for (gap, has_default), outs in groups.items():
+        share = exact.space.volume(gap)
+        boxes = exact.space.boxes(list(gap))
+        severity, message, hint = _coverage_words(compiled, "no-rule-fires", outs, share,
+                                                  has_default, 0.0, "")
+        if missed.intersection(outs):
+            message += (" (counting only the rules whose sets its sampling does not miss: "
+                        "undersampled-term)")
+        out.append(Finding(severity, "no-rule-fires", message, span, compiled.behavior, hint,
+                           tuple(boxes[:MAX_BOXES]), max(0, len(boxes) - MAX_BOXES), share))
+    return out
 
 
 def _counting(compiled: CompiledRuleBase) -> tuple[np.ndarray, set[str]]:
@@ -672,22 +868,29 @@ def _counting(compiled: CompiledRuleBase) -> tuple[np.ndarray, set[str]]:
 
 
 def _coverage_words(compiled: CompiledRuleBase, kind: str, outs: list[str], share: float,
-                    has_default: bool, threshold: float, thinned: str) -> tuple[str, str, str]:
+                    has_default: bool, threshold: float, thinned: str,
+                    in_use: InUse | None = None) -> tuple[str, str, str]:
     """The severity, message and hint of a coverage finding (``no-rule-fires`` or
     ``low-dof``) of the outputs ``outs`` over ``share`` of the input space: no rule firing is
     an error only where the output has no default and is not a weighted sum (of nothing, 0;
-    with a default, the default applies there, as under the other inferences)."""
+    with a default, the default applies there, as under the other inferences). ``in_use``:
+    said of a behavior others use, where it is in use and nothing else sets the outputs."""
     name = compiled.behavior
     what = " and ".join(f"`{o}`" for o in outs)
+    who = f"behavior `{name}`"
+    space = "the input space"
+    if in_use is not None:
+        who += f", {in_use.where} and no other behavior sets {what} there"
+        space = "its input space"
     if kind != "no-rule-fires":
         return ("warning",
-                f"behavior `{name}`: the rules setting {what} fire with a total DOF below "
-                f"{threshold:g} in {_pct(share)} of the input space{thinned}",
+                f"{who}: the rules setting {what} fire with a total DOF below "
+                f"{threshold:g} in {_pct(share)} of {space}{thinned}",
                 "widen the terms or add rules, so that more than a trace of a rule fires")
     summed = compiled.operators.inference == "weighted_sum"
-    where = (f"in {_pct(share)} of the input space" if share > 0 else
-             "on lines or points of the input space (none of its volume)")
-    message = f"behavior `{name}`: no rule sets {what} {where}{thinned}"
+    where = (f"in {_pct(share)} of {space}" if share > 0 else
+             f"on lines or points of {space} (none of its volume)")
+    message = f"{who}: no rule sets {what} {where}{thinned}"
     if summed and not has_default:
         return ("warning", message + " (the weighted sum is 0 there)",
                 "add rules that cover these inputs")
@@ -774,12 +977,16 @@ def _fires_on(compiled: CompiledRuleBase, rules: np.ndarray, inputs: list[int],
 
 
 def _centre_totals(compiled: CompiledRuleBase, axes: list[np.ndarray],
-                   counting: np.ndarray) -> np.ndarray:
+                   counting: np.ndarray, in_use: InUse | None = None) -> np.ndarray:
     """``[cells, m]`` total DOF per output at the centre of each cell between neighbouring
-    samples (every axis has two or more)."""
+    samples (every axis has two or more); +inf where ``in_use`` says it has no say."""
     mesh = np.meshgrid(*(0.5 * (a[:-1] + a[1:]) for a in axes), indexing="ij")
     X = np.stack([m.reshape(-1) for m in mesh], axis=1) if axes else np.zeros((1, 0))
-    return rule_dofs(compiled, X) @ counting
+    total = rule_dofs(compiled, X) @ counting
+    if in_use is not None:
+        for j, o in enumerate(compiled.outputs):
+            total[~in_use.mask(o, X), j] = np.inf
+    return total
 
 
 def _unset_share(centres: np.ndarray, axes: list[np.ndarray], j: int) -> float:
