@@ -736,7 +736,8 @@ class _Compositions:
                     j = c.compiled.outputs.index(output)
                     others = [cube for r, cubes in enumerate(c.fires)
                               if inside[r] < 0 and c.counting[r, j] > 0 for cube in cubes]
-                    there = regions.subtract(regions.simplify(used), regions.simplify(others))
+                    there = regions.subtract(regions.disjoint(regions.simplify(used)),
+                                             regions.simplify(others))
                     alone[output] = regions.simplify(alone[output]
                                                      + regions.project(there, keep))
         except regions.NotExact:

@@ -268,13 +268,21 @@ def _minus(e: Cube, d: Cube) -> list[Cube]:
 
 
 def subtract(a: Sequence[Cube], b: Sequence[Cube]) -> list[Cube]:
-    """``a`` without every cube of ``b``; disjoint pieces when ``a``'s cubes are disjoint."""
+    """``a`` (disjoint cubes: :func:`disjoint`) without every cube of ``b``, as disjoint
+    cubes."""
     out = list(a)
-    for d in b:
-        out = _guard([piece for e in out for piece in _minus(e, d)])
+    for d in sorted(b, key=_size, reverse=True):      # the large ones first: fewer pieces
+        out = [piece for e in out for piece in _minus(e, d)]
+        if len(out) > 64:              # join pieces that differ in one input (still disjoint)
+            out = merged(out, disjoint=True)
+        _guard(out)
         if not out:
             break
     return out
+
+
+def _size(c: Cube) -> int:
+    return sum(bin(p).count("1") for p in c)
 
 
 def disjoint(cubes: Sequence[Cube]) -> list[Cube]:
@@ -300,10 +308,12 @@ def simplify(cubes: Sequence[Cube]) -> list[Cube]:
     return out
 
 
-def merged(cubes: Sequence[Cube]) -> list[Cube]:
+def merged(cubes: Sequence[Cube], disjoint: bool = False) -> list[Cube]:
     """Neighbouring cubes that differ in one input only joined into one (for the words: a
-    difference's pieces are many small boxes otherwise)."""
-    out = simplify(cubes)
+    difference's pieces are many small boxes otherwise). ``disjoint`` cubes stay disjoint,
+    and none can lie inside another: no need to look for such."""
+    tidy = (lambda c: list(dict.fromkeys(c))) if disjoint else simplify
+    out = tidy(cubes)
     changed = True
     while changed:
         changed = False
@@ -314,7 +324,7 @@ def merged(cubes: Sequence[Cube]) -> list[Cube]:
                 key = c[:i] + c[i + 1:]
                 groups[key] = groups.get(key, 0) | c[i]
             if len(groups) < len(out):
-                out = simplify([key[:i] + (bits,) + key[i:] for key, bits in groups.items()])
+                out = tidy([key[:i] + (bits,) + key[i:] for key, bits in groups.items()])
                 changed = True
     return out
 
