@@ -228,3 +228,34 @@ def test_in_use_agrees_with_a_dense_sample(rb):
     expected = {tuple(p) for p in points[alone][:, cols]}
     got = in_use.mask("y", points[:, cols])
     assert {tuple(p) for p in points[:, cols][got]} == expected
+
+
+def test_an_unused_term_the_coverage_needs_is_a_note(tmp_path):
+    # no rule reads z.B, but without it no term of z reaches 0.5 above z = 4: a note, with the
+    # complement it equals; x.HI is unused too, and x.LO covers nothing above 30 either
+    rb = rules(tmp_path, "r1: if z is not A then y is ONE\nr2: if z is A and x is LO then y is TWO\n"
+                         "r3: if x is not LO then y is ONE\n")
+    found = {f.message.split("`")[1]: f for f in check_rulebase(rb).findings
+             if f.code == "unused-term"}
+    assert found["z.B"].severity == "info"
+    assert found["z.B"].message == ("input term `z.B` is used by no rule, but no other term of "
+                                    "`z` reaches 0.5 for z in (4, 10]: it covers the universe "
+                                    "there")
+    assert found["z.B"].hint == ("keep it for the term set's coverage; `z is B` has the degree "
+                                 "of `z is not A`, which a rule may say instead")
+    assert found["x.HI"].severity == "info" and "x in (70, 100]" in found["x.HI"].message
+    assert "has the degree" not in found["x.HI"].hint          # HI is no complement of LO
+
+
+def test_an_unused_term_the_coverage_does_not_need_is_a_warning(tmp_path):
+    terms = TERMS.replace("      HI: {shape: right_shoulder, points: [60, 80]}",
+                          "      HI: {shape: right_shoulder, points: [20, 40]}\n"
+                          "      TOP: {shape: right_shoulder, points: [70, 90]}")
+    (tmp_path / "t.terms.yaml").write_text(terms, encoding="utf-8")
+    (tmp_path / "t.rules").write_text('terms "t.terms.yaml"\nr1: if x is LO then y is ONE\n'
+                                      "r2: if x is HI and z is A then y is TWO\n"
+                                      "r3: if z is B then y is TWO\n", encoding="utf-8")
+    (top,) = [f for f in check_rulebase(read_rulebase(tmp_path / "t.rules")).findings
+              if f.code == "unused-term"]
+    assert top.severity == "warning" and top.message == "input term `x.TOP` is used by no rule"
+    assert top.hint == "write a rule for it, or remove it from the term set"

@@ -1158,6 +1158,71 @@ def _terms_used(expr: Expr, out: set[tuple[str, str]]) -> None:
             _terms_used(item, out)
 
 
+def _unused_input_term(var: Variable, k: int, x: np.ndarray,
+                       top: tuple[np.ndarray, np.ndarray, np.ndarray]) -> Finding:
+    """An input term no rule reads: a warning, or a note where the term set needs it to
+    cover its universe (no other term reaches 0.5 where it does: removed, it would leave a
+    `coverage` finding, or a `term-gap`), as `nearest.ROOMY` beside `nearest.TIGHT`.
+    ``top``: the largest membership of any term at each point of ``x``, whose it is, and the
+    second largest (:func:`_top_two`). ``k``: the term's index in ``var.terms``."""
+    term = var.terms[k]
+    mine = term.membership(x)
+    best = np.where(top[1] == k, top[2], top[0])           # the other terms' largest
+    needed = (mine >= 0.5) & (best < 0.5)
+    if not needed.any():
+        return Finding("warning", "unused-term",
+                       f"input term `{var.name}.{term.name}` is used by no rule", term.span,
+                       None, hint="write a rule for it, or remove it from the term set")
+    stretch = " and ".join(_stretches(var.name, x, np.minimum(mine - 0.5, 0.5 - best), needed))
+    # its complement, if it has one, is the term that is largest where it is least
+    other = var.terms[int(top[1][int(np.argmin(mine))])]
+    hint = "keep it for the term set's coverage"
+    if other is not term and np.allclose(1.0 - other.membership(x), mine, rtol=0.0, atol=1e-12):
+        hint += (f"; `{var.name} is {term.name}` has the degree of `{var.name} is not "
+                 f"{other.name}`, which a rule may say instead")
+    return Finding("info", "unused-term",
+                   f"input term `{var.name}.{term.name}` is used by no rule, but no other term "
+                   f"of `{var.name}` reaches 0.5 for {stretch}: it covers the universe there",
+                   term.span, None, hint=hint)
+
+
+def _top_two(terms: Sequence[Term], x: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """At each point of ``x``: the largest membership of ``terms``, the index of the term
+    that has it, and the second largest; a few terms at a time (as :func:`_tops`)."""
+    first = np.full(len(x), -np.inf)
+    which = np.zeros(len(x), np.intp)
+    second = np.full(len(x), -np.inf)
+    step = max(1, BLOCK_CELLS // max(1, len(x)))
+    for i in range(0, len(terms), step):
+        mus = np.array([t.membership(x) for t in terms[i:i + step]])
+        for row, mu in enumerate(mus):          # a block of a few terms
+            higher = mu > first
+            second = np.where(higher, first, np.maximum(second, mu))
+            which = np.where(higher, i + row, which)
+            first = np.where(higher, mu, first)
+    return first, which, second
+
+
+def _stretches(name: str, x: np.ndarray, g: np.ndarray, inside: np.ndarray) -> list[str]:
+    """The runs of ``inside`` (the samples ``x`` where ``g`` is in the region) as ranges,
+    each end that lies between samples placed where ``g`` crosses 0 on a line between them
+    (exact for piecewise-linear terms, whose corners are among the samples) and left out."""
+    out = []
+    edges = np.flatnonzero(np.diff(np.concatenate([[False], inside, [False]]).astype(int)))
+    for start, stop in zip(edges[0::2], edges[1::2]):
+        lo, hi, open_lo, open_hi = x[start], x[stop - 1], False, False
+        if start > 0 and g[start] != g[start - 1]:
+            t = -g[start - 1] / (g[start] - g[start - 1])
+            lo, open_lo = x[start - 1] + t * (x[start] - x[start - 1]), True
+        if stop < len(x) and g[stop] != g[stop - 1]:
+            t = g[stop - 1] / (g[stop - 1] - g[stop])
+            hi, open_hi = x[stop - 1] + t * (x[stop] - x[stop - 1]), True
+        out.append(f"{name} = {_num(lo)}" if lo == hi else
+                   f"{name} in {'(' if open_lo else '['}{_num(lo)}, {_num(hi)}"
+                   f"{')' if open_hi else ']'}")
+    return out
+
+
 def _unused_terms(rb: RuleBase, scope: set[str] | None = None) -> list[Finding]:
     used: set[tuple[str, str]] = set()
     concluded: set[tuple[str, str]] = set()
@@ -1174,17 +1239,16 @@ def _unused_terms(rb: RuleBase, scope: set[str] | None = None) -> list[Finding]:
     out = []
     for var in _variables(rb, scope):
         if var.role == "input":
-            names = [t for t in var.terms if (var.name, t.name) not in used]
-            if len(names) == len(var.terms):
+            unused = [k for k, t in enumerate(var.terms) if (var.name, t.name) not in used]
+            if len(unused) == len(var.terms):
                 out.append(Finding("warning", "unused-term",
                                    f"input `{var.name}` is used by no rule", var.span, None,
                                    hint="write rules that use it, or remove it"))
                 continue
-            for t in names:
-                out.append(Finding("warning", "unused-term",
-                                   f"input term `{var.name}.{t.name}` is used by no rule",
-                                   t.span, None,
-                                   hint="write a rule for it, or remove it from the term set"))
+            if unused:
+                x = meaning.gap_points(var)
+                top = _top_two(var.terms, x)
+                out += [_unused_input_term(var, k, x, top) for k in unused]
         else:
             unconcluded = [t.name for t in var.terms if (var.name, t.name) not in concluded]
             if unconcluded and var.name in set_by_rules:
