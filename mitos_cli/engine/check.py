@@ -33,7 +33,8 @@ code                  severity    meaning
 ``term-outside``      warning     an input term that never reaches 1 inside the universe;
                                   a Mamdani output term (as a rule concludes it) that lies
                                   outside its output's range, or is 0 all over it
-``unused-term``       warning     an input term (or a whole input) that no rule uses
+``unused-term``       warning     an input term (or a whole input) that no rule uses (info
+                                  for a term no other covers: the term set needs it)
 ``unconcluded-term``  info        an output term that no rule concludes
 ``undersampled-term`` warning     a Mamdani output term (as a rule concludes it) whose largest
                                   membership over the output's sample points is below
@@ -56,6 +57,12 @@ corner point of its terms (where memberships start or stop being 0), capped at
 :func:`mitos_cli.engine.evaluation.evaluate`. With many inputs even the corner points are too
 many; the grid then skips some, and :attr:`GridInfo.skipped` names those inputs (the
 ``no-rule-fires`` and ``low-dof`` findings say so too: they may miss places between samples).
+A behavior that others ``use`` is judged where it is in use (:class:`InUse`): a sample of
+its grid counts in ``no-rule-fires`` and ``low-dof`` only where some ``use ... when`` chain
+from a behavior nothing uses brings it in and no rule outside it sets the output there. A
+behavior that uses others gets its ``no-rule-fires`` exactly, with no grid (:class:`Exact`,
+:mod:`.regions`); only its ``low-dof`` is sampled. Either falls back to the behavior's own
+grid where :mod:`.regions` has no exact answer (other operators or terms).
 Regions are reported as boxes of sampled values, e.g.
 ``road in [0, 40] and size in [70, 100]``; an input left out of a box may take any value.
 """
