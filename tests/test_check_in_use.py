@@ -259,3 +259,28 @@ def test_an_unused_term_the_coverage_does_not_need_is_a_warning(tmp_path):
               if f.code == "unused-term"]
     assert top.severity == "warning" and top.message == "input term `x.TOP` is used by no rule"
     assert top.hint == "write a rule for it, or remove it from the term set"
+
+
+def test_with_operators_that_have_no_exact_answer_each_behavior_is_judged_on_its_own(tmp_path):
+    # Lukasiewicz's `and` is 0 where both items are above 0 (zero divisors): no boxes; `part`
+    # and `top` get the sampled findings each would have alone
+    text = PART + "behavior top:\n  use part when x is LO\n  t1: if x is not LO then y is TWO\nend\n"
+    exact = check_rulebase(rules(tmp_path, text))
+    sampled = check_rulebase(rules(tmp_path, "operators: and = lukasiewicz\n" + text))
+    assert coverage(exact) == []
+    assert [f.behavior for f in coverage(sampled)] == ["part"]
+    assert "uses it" not in coverage(sampled)[0].message
+    assert [g.exact for g in sampled.grids] == [False, False]
+    assert [g.exact for g in exact.grids] == [False, True]
+    with pytest.raises(regions.NotExact, match="lukasiewicz"):
+        regions.Space([], [], "lukasiewicz", "max")
+
+
+def test_json_says_which_gaps_were_decided_exactly(tmp_path, capsys):
+    import json
+
+    rules(tmp_path, PART + "behavior top:\n  use part when z is A\nend\n")
+    with pytest.raises(SystemExit):
+        main(["check", str(tmp_path / "t.rules"), "--json"])
+    out = json.loads(capsys.readouterr().out)
+    assert {b["name"]: b["exact_gaps"] for b in out["behaviors"]} == {"part": False, "top": True}

@@ -109,7 +109,8 @@ def to_json(report: Report, trace_path: str) -> dict:
         "threshold": report.threshold,
         "behaviors": [{"name": g.behavior, "samples": g.samples,
                        "grid": {name: n for name, n in g.points},
-                       "skipped_corners": list(g.skipped)} for g in report.grids],
+                       "skipped_corners": list(g.skipped),
+                       "exact_gaps": g.exact} for g in report.grids],
         "summary": {s: report.count(s) for s in ("error", "warning", "info")},
         "findings": [_shown(f.to_json()) for f in report.findings],
     }

@@ -606,6 +606,11 @@ def _first_names(names: list[str]) -> str:
 # ---------------------------------------------------------------------------------------------
 # behaviors as they are used: compositions, judged with box algebra (regions.py)
 
+#: Most boxes a behavior's in-use region may have (each sample of its grid is tested against
+#: each: more and it is judged on its own, as before).
+MAX_IN_USE_BOXES = 256
+
+
 @dataclass(frozen=True)
 class InUse:
     """Where a behavior that others ``use`` counts, output by output: the points of its own
@@ -751,6 +756,9 @@ class _Compositions:
             return None
         if not users:                  # used only by behaviors that are themselves unused
             return None                # by any top level: judged on its own
+        alone = {o: regions.merged(cubes) for o, cubes in alone.items()}
+        if any(len(cubes) > MAX_IN_USE_BOXES for cubes in alone.values()):
+            return None                # each grid sample is tested against each box
         return InUse(tuple(users), own, alone)
 
 

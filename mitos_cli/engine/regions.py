@@ -240,8 +240,15 @@ def _guard(cubes: list[Cube]) -> list[Cube]:
     return cubes
 
 
+#: Most pairs of cubes one operation may look at (a rule base of thousands of rules in a
+#: composition has no exact answer in reasonable time: it is sampled instead).
+MAX_WORK = 2_000_000
+
+
 def intersect(a: Sequence[Cube], b: Sequence[Cube]) -> list[Cube]:
     """The cubes of ``a`` and ``b``'s intersection (empty ones dropped)."""
+    if len(a) * len(b) > MAX_WORK:
+        raise NotExact(f"{len(a):,} x {len(b):,} boxes")
     out = []
     for x in a:
         for y in b:
@@ -271,7 +278,11 @@ def subtract(a: Sequence[Cube], b: Sequence[Cube]) -> list[Cube]:
     """``a`` (disjoint cubes: :func:`disjoint`) without every cube of ``b``, as disjoint
     cubes."""
     out = list(a)
+    work = 0
     for d in sorted(b, key=_size, reverse=True):      # the large ones first: fewer pieces
+        work += len(out)
+        if work > MAX_WORK:
+            raise NotExact(f"more than {MAX_WORK:,} box differences")
         out = [piece for e in out for piece in _minus(e, d)]
         if len(out) > 64:              # join pieces that differ in one input (still disjoint)
             out = merged(out, disjoint=True)
@@ -287,6 +298,8 @@ def _size(c: Cube) -> int:
 
 def disjoint(cubes: Sequence[Cube]) -> list[Cube]:
     """The same set as disjoint cubes (each cube without those before it)."""
+    if len(cubes) ** 2 > MAX_WORK:
+        raise NotExact(f"{len(cubes):,} boxes to make disjoint")
     out: list[Cube] = []
     for c in cubes:
         out += subtract([c], out)
@@ -301,6 +314,8 @@ def _inside(x: Cube, y: Cube) -> bool:
 def simplify(cubes: Sequence[Cube]) -> list[Cube]:
     """``cubes`` without duplicates and without cubes inside another."""
     unique = sorted(set(cubes), key=lambda c: -sum(bin(p).count("1") for p in c))
+    if len(unique) ** 2 > MAX_WORK:     # too many to compare every two: duplicates only
+        return unique
     out: list[Cube] = []
     for c in unique:
         if not any(_inside(c, o) for o in out):
