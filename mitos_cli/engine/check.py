@@ -1181,9 +1181,13 @@ def _unused_input_term(var: Variable, k: int, x: np.ndarray,
     ``top``: the largest membership of any term at each point of ``x``, whose it is, and the
     second largest (:func:`_top_two`). ``k``: the term's index in ``var.terms``."""
     term = var.terms[k]
-    mine = term.membership(x)
-    best = np.where(top[1] == k, top[2], top[0])           # the other terms' largest
-    needed = (mine >= 0.5) & (best < 0.5)
+    first, which, second = top
+    alone = which[(first >= 0.5) & (second < 0.5)]     # where one term alone reaches 0.5
+    needed = np.zeros(len(x), bool)
+    if (alone == k).any():              # the only terms that can be needed: one membership
+        mine = term.membership(x)
+        best = np.where(which == k, second, first)          # the other terms' largest
+        needed = (mine >= 0.5) & (best < 0.5)
     if not needed.any():
         return Finding("warning", "unused-term",
                        f"input term `{var.name}.{term.name}` is used by no rule", term.span,
