@@ -284,3 +284,23 @@ def test_json_says_which_gaps_were_decided_exactly(tmp_path, capsys):
         main(["check", str(tmp_path / "t.rules"), "--json"])
     out = json.loads(capsys.readouterr().out)
     assert {b["name"]: b["exact_gaps"] for b in out["behaviors"]} == {"part": False, "top": True}
+
+
+def test_the_chain_of_uses_runs_to_every_behavior_nothing_uses(tmp_path):
+    # `part` reaches `top` through `mid` (when z is A, then when x is not HI) and is used by
+    # `other` too: its gap x in [40, 100] is in use where x is not HI (x < 80) in `top`, and
+    # wherever `other` uses it; the finding names both
+    text = (PART + "behavior mid:\n  use part when x is not HI\nend\n"
+            "behavior top:\n  use mid when z is A\n  t1: if z is B then y is TWO\nend\n"
+            "behavior other:\n  use part when z is A\n  o1: if z is B then y is TWO\nend\n")
+    (f,) = coverage(check_rulebase(rules(tmp_path, text)), "part")
+    assert f.message.startswith("behavior `part`, where `top` and `other` use it and no other "
+                                "behavior sets `y` there: no rule sets `y` in 60% of its input")
+    # used only through `mid` in `top`, the part of the gap where x is HI is out of use
+    text = (PART + "behavior mid:\n  use part when x is not HI\nend\n"
+            "behavior top:\n  use mid when z is A\n  t1: if z is B then y is TWO\nend\n")
+    report = check_rulebase(rules(tmp_path, text))
+    (f,) = coverage(report, "part")
+    assert [b.describe() for b in f.regions] == ["x in [40, 80)"]
+    assert f.share == pytest.approx(0.4)
+    assert [g.behavior for g in report.grids if g.exact] == ["top"]
