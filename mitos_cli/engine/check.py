@@ -856,7 +856,7 @@ def _exact_gaps(compiled: CompiledRuleBase, exact: Exact, span: Span | None,
     out = []
     for (gap, has_default), outs in groups.items():
         share = exact.space.volume(gap)
-        boxes = exact.space.boxes(list(gap))
+        boxes = [Box(ranges, ends) for ranges, ends in exact.space.boxes(list(gap))]
         severity, message, hint = _coverage_words(compiled, "no-rule-fires", outs, share,
                                                   has_default, 0.0, "")
         if missed.intersection(outs):

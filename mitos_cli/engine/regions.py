@@ -43,7 +43,6 @@ if TYPE_CHECKING:
     from collections.abc import Iterable, Sequence
 
     from ..lang.terms import Variable
-    from .check import Box
 
 #: T-norms with no zero divisors: ``T(a, b) > 0`` exactly where ``a > 0`` and ``b > 0``.
 EXACT_TNORMS = frozenset({"min", "product", "einstein", "hamacher"})
@@ -54,6 +53,8 @@ MAX_CUBES = 20_000
 
 #: A set of atoms per input (bit ``a`` of ``cube[i]``: atom ``a`` of input ``i``).
 Cube = tuple[int, ...]
+#: A box in words: ``((name, lo, hi), ...)`` and which ends are left out, ``((lo?, hi?), ...)``
+Ranges = tuple[tuple[tuple[str, float, float], ...], tuple[tuple[bool, bool], ...]]
 
 
 class NotExact(Exception):
@@ -181,12 +182,11 @@ class Space:
             inside |= hit
         return inside
 
-    def boxes(self, cubes: Sequence[Cube]) -> list[Box]:
+    def boxes(self, cubes: Sequence[Cube]) -> list[Ranges]:
         """``cubes`` as boxes of ranges (a cube whose atoms of one input are not one run
-        is several boxes), the largest first; an input a box spans whole is left out."""
-        from .check import Box
-
-        out: list[tuple[float, Box]] = []
+        is several boxes), the largest first; an input a box spans whole is left out. Each
+        is ``((name, lo, hi), ...)`` and, range by range, whether each end is left out."""
+        out: list[tuple[float, Ranges]] = []
         lengths = [a.lengths for a in self.atoms]
         for cube in merged(cubes):
             per_input = []
@@ -201,7 +201,7 @@ class Space:
                     ranges.append((self.names[i], float(c[lo // 2]), float(c[(hi + 1) // 2])))
                     ends.append((lo % 2 == 1, hi % 2 == 1))
                     v *= float(lengths[i][lo:hi + 1].sum())
-                out.append((v, Box(tuple(ranges), tuple(ends))))
+                out.append((v, (tuple(ranges), tuple(ends))))
         out.sort(key=lambda vb: -vb[0])
         return [b for _, b in out]
 
