@@ -304,3 +304,14 @@ def test_the_chain_of_uses_runs_to_every_behavior_nothing_uses(tmp_path):
     assert [b.describe() for b in f.regions] == ["x in [40, 80)"]
     assert f.share == pytest.approx(0.4)
     assert [g.behavior for g in report.grids if g.exact] == ["top"]
+
+
+def test_past_the_work_budget_the_composition_is_sampled_as_before(tmp_path, monkeypatch):
+    text = PART + "behavior top:\n  use part when x is LO\n  t1: if x is not LO then y is TWO\nend\n"
+    monkeypatch.setattr(regions, "MAX_WORK", 0)          # every box difference is too many
+    report = check_rulebase(rules(tmp_path, text))
+    assert [g.exact for g in report.grids] == [False, False]
+    (f,) = coverage(report)                   # `part` on its own, as with no composition
+    assert f.behavior == "part" and "uses it" not in f.message
+    with pytest.raises(regions.NotExact, match="more than 0 box differences"):
+        regions.subtract([(1,)], [(1,)])

@@ -713,6 +713,7 @@ class _Compositions:
                            for cube in cubes]
                 gaps[output] = regions.subtract([c.space.full], regions.simplify(setting))
         except regions.NotExact:
+            self._composed[name] = None        # too costly: the whole composition is sampled
             return None
         return Exact(c.space, gaps)
 
@@ -723,6 +724,7 @@ class _Compositions:
             return None
         alone: dict[str, list[regions.Cube]] = {o: [] for o in compiled.outputs}
         users = []
+        top = ""
         try:
             own = self._space(compiled)
             for top in self.tops:
@@ -753,6 +755,8 @@ class _Compositions:
                     alone[output] = regions.simplify(alone[output]
                                                      + regions.project(there, keep))
         except regions.NotExact:
+            if top in self._composed:          # too costly: every behavior it reaches, and
+                self._composed[top] = None     # it, are sampled (one budget spent, not many)
             return None
         if not users:                  # used only by behaviors that are themselves unused
             return None                # by any top level: judged on its own

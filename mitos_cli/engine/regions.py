@@ -242,7 +242,7 @@ def _guard(cubes: list[Cube]) -> list[Cube]:
 
 #: Most pairs of cubes one operation may look at (a rule base of thousands of rules in a
 #: composition has no exact answer in reasonable time: it is sampled instead).
-MAX_WORK = 2_000_000
+MAX_WORK = 100_000
 
 
 def intersect(a: Sequence[Cube], b: Sequence[Cube]) -> list[Cube]:
@@ -279,13 +279,15 @@ def subtract(a: Sequence[Cube], b: Sequence[Cube]) -> list[Cube]:
     cubes."""
     out = list(a)
     work = 0
+    joined = 32
     for d in sorted(b, key=_size, reverse=True):      # the large ones first: fewer pieces
         work += len(out)
         if work > MAX_WORK:
             raise NotExact(f"more than {MAX_WORK:,} box differences")
         out = [piece for e in out for piece in _minus(e, d)]
-        if len(out) > 64:              # join pieces that differ in one input (still disjoint)
-            out = merged(out, disjoint=True)
+        if len(out) > 2 * joined:      # join pieces that differ in one input (still disjoint),
+            out = merged(out, disjoint=True)         # each time they have doubled
+            joined = max(32, len(out))
         _guard(out)
         if not out:
             break
