@@ -25,8 +25,12 @@ So the set where a condition is above 0 is a union of *cubes*, each a set of ato
 input, and unions, intersections and differences of such sets are computed exactly
 (:func:`subtract` splits a cube by another into at most one piece per input). The volume of
 a cube is the product of its atoms' lengths. Only when the input terms are not
-piecewise-linear, or the operators are others, or the cubes grow past :data:`MAX_CUBES`, is
-there no exact answer (:class:`NotExact`); the caller then samples as before.
+piecewise-linear, or the operators are others, or the cubes grow past :data:`MAX_CUBES` (or
+the pairs of cubes looked at past :data:`MAX_WORK`), is there no exact answer
+(:class:`NotExact`); the caller then samples as before.
+
+Exact is meant of the formulas; in floating point a product of tiny degrees can underflow to 0
+and ``a + b - a * b`` round to 1 on a set of no volume, as the engine's own numbers do there.
 """
 
 from __future__ import annotations
