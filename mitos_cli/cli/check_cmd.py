@@ -94,10 +94,12 @@ def skipped_note(grid: GridInfo) -> str:
     `no-rule-fires` and `low-dof` findings, or their absence, claim no more than was seen."""
     from ..engine.check import MAX_SAMPLES, listed_names
 
+    missed = ("places where the DOF is low may be missed between them (where no rule fires "
+              "was decided exactly, with no grid)" if grid.exact else
+              "places where no rule fires, or the DOF is low, may be missed between them")
     return (f"note: `{grid.behavior}`'s grid skipped corner points of {listed_names(grid.skipped)} "
             f"(all of them would take {grid.corner_samples:.3g} samples, the grid at most "
-            f"{MAX_SAMPLES:,}): places where no rule fires, or the DOF is low, may be missed "
-            f"between them")
+            f"{MAX_SAMPLES:,}): {missed}")
 
 
 def to_json(report: Report, trace_path: str) -> dict:
@@ -107,7 +109,8 @@ def to_json(report: Report, trace_path: str) -> dict:
         "threshold": report.threshold,
         "behaviors": [{"name": g.behavior, "samples": g.samples,
                        "grid": {name: n for name, n in g.points},
-                       "skipped_corners": list(g.skipped)} for g in report.grids],
+                       "skipped_corners": list(g.skipped),
+                       "exact_gaps": g.exact} for g in report.grids],
         "summary": {s: report.count(s) for s in ("error", "warning", "info")},
         "findings": [_shown(f.to_json()) for f in report.findings],
     }

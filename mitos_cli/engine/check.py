@@ -33,7 +33,8 @@ code                  severity    meaning
 ``term-outside``      warning     an input term that never reaches 1 inside the universe;
                                   a Mamdani output term (as a rule concludes it) that lies
                                   outside its output's range, or is 0 all over it
-``unused-term``       warning     an input term (or a whole input) that no rule uses
+``unused-term``       warning     an input term (or a whole input) that no rule uses (info
+                                  for a term no other covers: the term set needs it)
 ``unconcluded-term``  info        an output term that no rule concludes
 ``undersampled-term`` warning     a Mamdani output term (as a rule concludes it) whose largest
                                   membership over the output's sample points is below
@@ -56,6 +57,12 @@ corner point of its terms (where memberships start or stop being 0), capped at
 :func:`mitos_cli.engine.evaluation.evaluate`. With many inputs even the corner points are too
 many; the grid then skips some, and :attr:`GridInfo.skipped` names those inputs (the
 ``no-rule-fires`` and ``low-dof`` findings say so too: they may miss places between samples).
+A behavior that others ``use`` is judged where it is in use (:class:`InUse`): a sample of
+its grid counts in ``no-rule-fires`` and ``low-dof`` only where some ``use ... when`` chain
+from a behavior nothing uses brings it in and no rule outside it sets the output there. A
+behavior that uses others gets its ``no-rule-fires`` exactly, with no grid (:class:`Exact`,
+:mod:`.regions`); only its ``low-dof`` is sampled. Either falls back to the behavior's own
+grid where :mod:`.regions` has no exact answer (other operators or terms).
 Regions are reported as boxes of sampled values, e.g.
 ``road in [0, 40] and size in [70, 100]``; an input left out of a box may take any value.
 """
@@ -82,11 +89,12 @@ from ..lang.model import (
     format_expr,
 )
 from ..lang.terms import TermSet, Variable
+from . import regions
 from .compile import CompiledRuleBase, compile_rulebase
 from .evaluation import BLOCK_CELLS, declares_nan, rule_dofs
 
 if TYPE_CHECKING:
-    from collections.abc import Iterator, Sequence
+    from collections.abc import Callable, Iterator, Sequence
 
     from ..lang.operators import Operators
     from ..lang.terms import Term
@@ -166,6 +174,9 @@ class GridInfo:
     #: `no-rule-fires` and `low-dof` may miss places between its samples
     skipped: tuple[str, ...] = ()
     corner_samples: float = 0.0            # the samples every corner point would take
+    #: `no-rule-fires` was decided exactly, with no grid (:mod:`.regions`): only `low-dof`
+    #: is sampled
+    exact: bool = False
 
 
 @dataclass(frozen=True)
@@ -201,13 +212,17 @@ def check_rulebase(rb: RuleBase, behavior: str | None = None, *, threshold: floa
     seen: set[tuple] = set()               # undersampled terms already reported
     for name in names:
         rb.behavior(name)                       # unknown behavior: did-you-mean error
+    compositions = _Compositions(rb)
+    for name in names:
         compiled = compile_rulebase(rb, name)
         findings += _rule_pairs(rb, name, compiled.operators)
         findings += _contradictions(rb, name)
         findings += _idle_settings(rb, name, compiled)
         findings += _undersampled(rb, name, compiled, seen)
         findings += _infinite_inverses(rb, name, compiled, seen)
-        grid_findings, info = _sampled(compiled, threshold, resolution)
+        grid_findings, info = _sampled(compiled, threshold, resolution,
+                                       compositions.in_use(name, compiled),
+                                       compositions.exact(name, compiled))
         findings += grid_findings
         grids.append(info)
     # the term sets' findings: with one behavior named, only about the variables it uses
@@ -588,8 +603,175 @@ def _first_names(names: list[str]) -> str:
     return ", ".join(names[:SHOWN_TERMS]) + (f" and {more:,} more" if more > 0 else "")
 
 
-def _sampled(compiled: CompiledRuleBase, threshold: float,
-             resolution: int) -> tuple[list[Finding], GridInfo]:
+# ---------------------------------------------------------------------------------------------
+# behaviors as they are used: compositions, judged with box algebra (regions.py)
+
+#: Most boxes a behavior's in-use region may have (each sample of its grid is tested against
+#: each: more and it is judged on its own, as before).
+MAX_IN_USE_BOXES = 256
+
+
+@dataclass(frozen=True)
+class InUse:
+    """Where a behavior that others ``use`` counts, output by output: the points of its own
+    inputs where, for some values of the other inputs, some chain of ``use ... when`` from a
+    behavior nothing uses (``users``) brings it in with a degree above 0 and no rule outside
+    it in that composition sets the output. There a gap of its own is the composition's, and
+    a low DOF of its own is at most the composition's; elsewhere it is not in use, or a
+    sibling sets the output."""
+
+    users: tuple[str, ...]
+    space: regions.Space                     # the behavior's own inputs
+    alone: dict[str, list[regions.Cube]]
+
+    def mask(self, output: str, X: np.ndarray) -> np.ndarray:
+        return self.space.contains(self.alone[output], X)
+
+    @property
+    def where(self) -> str:
+        return f"where {listed_names(self.users)} {'uses' if len(self.users) == 1 else 'use'} it"
+
+
+@dataclass(frozen=True)
+class Exact:
+    """Where no rule of a composition (a behavior that ``use``s others) sets each output,
+    as disjoint cubes: exact, with no grid."""
+
+    space: regions.Space
+    gaps: dict[str, list[regions.Cube]]
+
+
+@dataclass
+class _Composed:
+    compiled: CompiledRuleBase
+    space: regions.Space
+    chains: list[tuple]                      # each flattened rule's `use` chain
+    fires: list[list[regions.Cube]]          # where each rule's DOF is above 0
+    counting: np.ndarray
+
+
+class _Compositions:
+    """The behaviors of a rule base as the compositions a user evaluates: for each behavior
+    nothing ``use``s (a top level), where each of its rules fires (exactly, on atoms:
+    :mod:`.regions`). Anything :class:`.regions.NotExact` leaves the behavior judged on its
+    own, on its grid, as a behavior nobody uses is."""
+
+    def __init__(self, rb: RuleBase) -> None:
+        self.rb = rb
+        self.used_by: dict[str, set[str]] = {}
+        for b in rb.behaviors:
+            for u in b.uses:
+                self.used_by.setdefault(u.behavior, set()).add(b.name)
+        self.tops = [b.name for b in rb.behaviors if b.name not in self.used_by and b.uses]
+        self._composed: dict[str, _Composed | None] = {}
+
+    def _space(self, compiled: CompiledRuleBase) -> regions.Space:
+        rb = self.rb
+        return regions.Space([rb.variables[v] for v in compiled.inputs],
+                             [corner_points(compiled, i) for i in range(len(compiled.inputs))],
+                             compiled.operators.and_, compiled.operators.or_)
+
+    def composed(self, top: str) -> _Composed | None:
+        if top not in self._composed:
+            try:
+                compiled = compile_rulebase(self.rb, top)
+                space = self._space(compiled)
+                conditions: dict[int, list[regions.Cube]] = {}
+
+                def where(expr: Expr | None) -> list[regions.Cube]:
+                    if id(expr) not in conditions:
+                        conditions[id(expr)] = space.fires(expr)
+                    return conditions[id(expr)]
+
+                chains, fires = [], []
+                for _, rule, chain in flatten(self.rb, top):
+                    chains.append(chain)
+                    cubes = [] if rule.weight == 0 or any(u.weight == 0 for u in chain) \
+                        else where(rule.antecedent)
+                    for use in chain:
+                        if cubes and use.condition is not None:
+                            cubes = regions.intersect(cubes, where(use.condition))
+                    fires.append(cubes)
+                counting, _ = _counting(compiled)
+                self._composed[top] = _Composed(compiled, space, chains, fires, counting)
+            except regions.NotExact:
+                self._composed[top] = None
+        return self._composed[top]
+
+    def exact(self, name: str, compiled: CompiledRuleBase) -> Exact | None:
+        """A top level's gaps, per output; None for a behavior that uses none (judged on its
+        grid, exactly as before) or where there is no exact answer."""
+        if name not in self.tops:
+            return None
+        c = self.composed(name)
+        if c is None:
+            return None
+        try:
+            gaps = {}
+            for j, output in enumerate(c.compiled.outputs):
+                setting = [cube for r, cubes in enumerate(c.fires) if c.counting[r, j] > 0
+                           for cube in cubes]
+                gaps[output] = regions.subtract([c.space.full], regions.simplify(setting))
+        except regions.NotExact:
+            self._composed[name] = None        # too costly: the whole composition is sampled
+            return None
+        return Exact(c.space, gaps)
+
+    def in_use(self, name: str, compiled: CompiledRuleBase) -> InUse | None:
+        """Where a behavior that others use counts (:class:`InUse`); None for one nobody
+        uses, or where there is no exact answer."""
+        if name not in self.used_by:
+            return None
+        alone: dict[str, list[regions.Cube]] = {o: [] for o in compiled.outputs}
+        users = []
+        top = ""
+        try:
+            own = self._space(compiled)
+            for top in self.tops:
+                c = self.composed(top)
+                if c is None:
+                    return None
+                inside = [next((k for k, u in enumerate(chain) if u.behavior == name), -1)
+                          for chain in c.chains]
+                if all(k < 0 for k in inside):
+                    continue
+                users.append(top)
+                prefixes = {tuple(map(id, chain[:k + 1])): chain[:k + 1]
+                            for chain, k in zip(c.chains, inside) if k >= 0}
+                used: list[regions.Cube] = []
+                for prefix in prefixes.values():
+                    cubes = [] if any(u.weight == 0 for u in prefix) else [c.space.full]
+                    for use in prefix:
+                        if cubes and use.condition is not None:
+                            cubes = regions.intersect(cubes, c.space.fires(use.condition))
+                    used += cubes
+                keep = [c.space.names.index(v) for v in compiled.inputs]
+                for output in compiled.outputs:
+                    j = c.compiled.outputs.index(output)
+                    others = [cube for r, cubes in enumerate(c.fires)
+                              if inside[r] < 0 and c.counting[r, j] > 0 for cube in cubes]
+                    there = regions.subtract(regions.disjoint(regions.simplify(used)),
+                                             regions.simplify(others))
+                    alone[output] = regions.simplify(alone[output]
+                                                     + regions.project(there, keep))
+        except regions.NotExact:
+            if top in self._composed:          # too costly: every behavior it reaches, and
+                self._composed[top] = None     # it, are sampled (one budget spent, not many)
+            return None
+        if not users:                  # used only by behaviors that are themselves unused
+            return None                # by any top level: judged on its own
+        alone = {o: regions.merged(cubes) for o, cubes in alone.items()}
+        if any(len(cubes) > MAX_IN_USE_BOXES for cubes in alone.values()):
+            return None                # each grid sample is tested against each box
+        return InUse(tuple(users), own, alone)
+
+
+def _sampled(compiled: CompiledRuleBase, threshold: float, resolution: int,
+             in_use: InUse | None = None,
+             exact: Exact | None = None) -> tuple[list[Finding], GridInfo]:
+    """The grid's findings: coverage and rules that never fire. ``in_use``: a behavior
+    others use counts only where it is in use and alone (:class:`InUse`); ``exact``: a
+    composition's gaps, decided with no grid (only its low DOF is sampled)."""
     every = list(range(len(compiled.inputs)))
     axes = grid_axes(compiled, resolution)
     shape = tuple(len(a) for a in axes)
@@ -598,7 +780,8 @@ def _sampled(compiled: CompiledRuleBase, threshold: float,
     dof = rule_dofs(compiled, X)                       # [n, R]
     skipped = skipped_corners(compiled, every, axes)
     info = GridInfo(compiled.behavior, tuple(zip(compiled.inputs, shape)), X.shape[0],
-                    skipped, _size([corner_points(compiled, i) for i in every]))
+                    skipped, _size([corner_points(compiled, i) for i in every]),
+                    exact is not None)
     thinned = (f" (on a grid that skipped corner points of {listed_names(skipped)}: there may "
                f"be more)" if skipped else "")
     out: list[Finding] = []
@@ -608,10 +791,18 @@ def _sampled(compiled: CompiledRuleBase, threshold: float,
     # coverage, per output (grouping outputs that share the same gap)
     counting, missed = _counting(compiled)
     total = dof @ counting                             # [n, m] total DOF per output
+    if in_use is not None:                   # where it is not in use, or not alone: no say
+        for j, o in enumerate(compiled.outputs):
+            total[~in_use.mask(o, X), j] = np.inf
     centres = None                                     # the same at the cells' centres
     reported: dict[tuple, list[str]] = {}
-    for kind, mask_of in (("no-rule-fires", lambda t: t <= 0.0),
-                          ("low-dof", lambda t: (t > 0.0) & (t < threshold))):
+    kinds: tuple[tuple[str, Callable[[np.ndarray], np.ndarray]], ...] = (
+             ("no-rule-fires", lambda t: t <= 0.0),
+             ("low-dof", lambda t: (t > 0.0) & (t < threshold)))
+    if exact is not None:
+        out += _exact_gaps(compiled, exact, span, missed)
+        kinds = kinds[1:]
+    for kind, mask_of in kinds:
         reported.clear()
         masks = {}
         for j, out_name in enumerate(compiled.outputs):
@@ -629,7 +820,7 @@ def _sampled(compiled: CompiledRuleBase, threshold: float,
             cells = None
             if inner and all(len(a) > 1 for a in axes):
                 if centres is None:
-                    centres = _centre_totals(compiled, axes, counting)
+                    centres = _centre_totals(compiled, axes, counting, in_use)
                 share = _unset_share(centres, axes, compiled.outputs.index(outs[0]))
                 unset = centres[:, [compiled.outputs.index(o) for o in outs]] <= 0.0
                 cells = unset.all(axis=1).reshape([len(a) - 1 for a in axes])
@@ -638,7 +829,7 @@ def _sampled(compiled: CompiledRuleBase, threshold: float,
             boxes, uncovered = boxes_of(mask.reshape(shape), axes, compiled.inputs,
                                         cells=cells)
             severity, message, hint = _coverage_words(compiled, kind, outs, share,
-                                                      has_default, threshold, thinned)
+                                                      has_default, threshold, thinned, in_use)
             if missed.intersection(outs):
                 message += (" (counting only the rules whose sets its sampling does not miss: "
                             "undersampled-term)")
@@ -653,6 +844,31 @@ def _sampled(compiled: CompiledRuleBase, threshold: float,
                    dtype=bool)
     out += _unreachable(compiled, np.flatnonzero(~fires & own), resolution)
     return out, info
+
+
+def _exact_gaps(compiled: CompiledRuleBase, exact: Exact, span: Span | None,
+                missed: set[str]) -> list[Finding]:
+    """A composition's ``no-rule-fires`` findings from its exact gaps (outputs with the same
+    gap in one finding), in the words and boxes of the sampled ones."""
+    groups: dict[tuple, list[str]] = {}
+    for j, out_name in enumerate(compiled.outputs):
+        gap = exact.gaps[out_name]
+        if not gap:
+            continue
+        has_default = not np.isnan(compiled.default[j]) or declares_nan(compiled, out_name)
+        groups.setdefault((tuple(sorted(gap)), has_default), []).append(out_name)
+    out = []
+    for (gap, has_default), outs in groups.items():
+        share = exact.space.volume(gap)
+        boxes = [Box(ranges, ends) for ranges, ends in exact.space.boxes(list(gap))]
+        severity, message, hint = _coverage_words(compiled, "no-rule-fires", outs, share,
+                                                  has_default, 0.0, "")
+        if missed.intersection(outs):
+            message += (" (counting only the rules whose sets its sampling does not miss: "
+                        "undersampled-term)")
+        out.append(Finding(severity, "no-rule-fires", message, span, compiled.behavior, hint,
+                           tuple(boxes[:MAX_BOXES]), max(0, len(boxes) - MAX_BOXES), share))
+    return out
 
 
 def _counting(compiled: CompiledRuleBase) -> tuple[np.ndarray, set[str]]:
@@ -672,22 +888,29 @@ def _counting(compiled: CompiledRuleBase) -> tuple[np.ndarray, set[str]]:
 
 
 def _coverage_words(compiled: CompiledRuleBase, kind: str, outs: list[str], share: float,
-                    has_default: bool, threshold: float, thinned: str) -> tuple[str, str, str]:
+                    has_default: bool, threshold: float, thinned: str,
+                    in_use: InUse | None = None) -> tuple[str, str, str]:
     """The severity, message and hint of a coverage finding (``no-rule-fires`` or
     ``low-dof``) of the outputs ``outs`` over ``share`` of the input space: no rule firing is
     an error only where the output has no default and is not a weighted sum (of nothing, 0;
-    with a default, the default applies there, as under the other inferences)."""
+    with a default, the default applies there, as under the other inferences). ``in_use``:
+    said of a behavior others use, where it is in use and nothing else sets the outputs."""
     name = compiled.behavior
     what = " and ".join(f"`{o}`" for o in outs)
+    who = f"behavior `{name}`"
+    space = "the input space"
+    if in_use is not None:
+        who += f", {in_use.where} and no other behavior sets {what} there"
+        space = "its input space"
     if kind != "no-rule-fires":
         return ("warning",
-                f"behavior `{name}`: the rules setting {what} fire with a total DOF below "
-                f"{threshold:g} in {_pct(share)} of the input space{thinned}",
+                f"{who}: the rules setting {what} fire with a total DOF below "
+                f"{threshold:g} in {_pct(share)} of {space}{thinned}",
                 "widen the terms or add rules, so that more than a trace of a rule fires")
     summed = compiled.operators.inference == "weighted_sum"
-    where = (f"in {_pct(share)} of the input space" if share > 0 else
-             "on lines or points of the input space (none of its volume)")
-    message = f"behavior `{name}`: no rule sets {what} {where}{thinned}"
+    where = (f"in {_pct(share)} of {space}" if share > 0 else
+             f"on lines or points of {space} (none of its volume)")
+    message = f"{who}: no rule sets {what} {where}{thinned}"
     if summed and not has_default:
         return ("warning", message + " (the weighted sum is 0 there)",
                 "add rules that cover these inputs")
@@ -774,12 +997,16 @@ def _fires_on(compiled: CompiledRuleBase, rules: np.ndarray, inputs: list[int],
 
 
 def _centre_totals(compiled: CompiledRuleBase, axes: list[np.ndarray],
-                   counting: np.ndarray) -> np.ndarray:
+                   counting: np.ndarray, in_use: InUse | None = None) -> np.ndarray:
     """``[cells, m]`` total DOF per output at the centre of each cell between neighbouring
-    samples (every axis has two or more)."""
+    samples (every axis has two or more); +inf where ``in_use`` says it has no say."""
     mesh = np.meshgrid(*(0.5 * (a[:-1] + a[1:]) for a in axes), indexing="ij")
     X = np.stack([m.reshape(-1) for m in mesh], axis=1) if axes else np.zeros((1, 0))
-    return rule_dofs(compiled, X) @ counting
+    total = rule_dofs(compiled, X) @ counting
+    if in_use is not None:
+        for j, o in enumerate(compiled.outputs):
+            total[~in_use.mask(o, X), j] = np.inf
+    return total
 
 
 def _unset_share(centres: np.ndarray, axes: list[np.ndarray], j: int) -> float:
@@ -950,6 +1177,75 @@ def _terms_used(expr: Expr, out: set[tuple[str, str]]) -> None:
             _terms_used(item, out)
 
 
+def _unused_input_term(var: Variable, k: int, x: np.ndarray,
+                       top: tuple[np.ndarray, np.ndarray, np.ndarray]) -> Finding:
+    """An input term no rule reads: a warning, or a note where the term set needs it to
+    cover its universe (no other term reaches 0.5 where it does: removed, it would leave a
+    `coverage` finding, or a `term-gap`), as `nearest.ROOMY` beside `nearest.TIGHT`.
+    ``top``: the largest membership of any term at each point of ``x``, whose it is, and the
+    second largest (:func:`_top_two`). ``k``: the term's index in ``var.terms``."""
+    term = var.terms[k]
+    first, which, second = top
+    alone = which[(first >= 0.5) & (second < 0.5)]     # where one term alone reaches 0.5
+    needed = np.zeros(len(x), bool)
+    if (alone == k).any():              # the only terms that can be needed: one membership
+        mine = term.membership(x)
+        best = np.where(which == k, second, first)          # the other terms' largest
+        needed = (mine >= 0.5) & (best < 0.5)
+    if not needed.any():
+        return Finding("warning", "unused-term",
+                       f"input term `{var.name}.{term.name}` is used by no rule", term.span,
+                       None, hint="write a rule for it, or remove it from the term set")
+    stretch = " and ".join(_stretches(var.name, x, np.minimum(mine - 0.5, 0.5 - best), needed))
+    # its complement, if it has one, is the term that is largest where it is least
+    other = var.terms[int(top[1][int(np.argmin(mine))])]
+    hint = "keep it for the term set's coverage"
+    if other is not term and np.allclose(1.0 - other.membership(x), mine, rtol=0.0, atol=1e-12):
+        hint += (f"; `{var.name} is {term.name}` has the degree of `{var.name} is not "
+                 f"{other.name}`, which a rule may say instead")
+    return Finding("info", "unused-term",
+                   f"input term `{var.name}.{term.name}` is used by no rule, but no other term "
+                   f"of `{var.name}` reaches 0.5 for {stretch}: it covers the universe there",
+                   term.span, None, hint=hint)
+
+
+def _top_two(terms: Sequence[Term], x: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """At each point of ``x``: the largest membership of ``terms``, the index of the term
+    that has it, and the second largest; a few terms at a time (as :func:`_tops`)."""
+    first = np.full(len(x), -np.inf)
+    which = np.zeros(len(x), np.intp)
+    second = np.full(len(x), -np.inf)
+    step = max(1, BLOCK_CELLS // max(1, len(x)))
+    for i in range(0, len(terms), step):
+        mus = np.array([t.membership(x) for t in terms[i:i + step]])
+        for row, mu in enumerate(mus):          # a block of a few terms
+            higher = mu > first
+            second = np.where(higher, first, np.maximum(second, mu))
+            which = np.where(higher, i + row, which)
+            first = np.where(higher, mu, first)
+    return first, which, second
+
+
+def _stretches(name: str, x: np.ndarray, g: np.ndarray, inside: np.ndarray) -> list[str]:
+    """The runs of ``inside`` (the samples ``x`` where ``g`` is in the region) as ranges,
+    each end that lies between samples placed where ``g`` crosses 0 on a line between them
+    (exact for piecewise-linear terms, whose corners are among the samples) and left out."""
+    out = []
+    edges = np.flatnonzero(np.diff(np.concatenate([[False], inside, [False]]).astype(int)))
+    for start, stop in zip(edges[0::2], edges[1::2]):
+        lo, hi, open_lo, open_hi = x[start], x[stop - 1], False, False
+        if start > 0 and g[start] != g[start - 1]:
+            t = -g[start - 1] / (g[start] - g[start - 1])
+            lo, open_lo = x[start - 1] + t * (x[start] - x[start - 1]), True
+        if stop < len(x) and g[stop] != g[stop - 1]:
+            t = g[stop - 1] / (g[stop - 1] - g[stop])
+            hi, open_hi = x[stop - 1] + t * (x[stop] - x[stop - 1]), True
+        out.append(f"{name} = {_num(lo)}" if lo == hi else
+                   f"{name} in {'(' if open_lo else '['}{_num(lo)}, {_num(hi)}"
+                   f"{')' if open_hi else ']'}")
+    return out
+
+
 def _unused_terms(rb: RuleBase, scope: set[str] | None = None) -> list[Finding]:
     used: set[tuple[str, str]] = set()
     concluded: set[tuple[str, str]] = set()
@@ -966,17 +1262,16 @@ def _unused_terms(rb: RuleBase, scope: set[str] | None = None) -> list[Finding]:
     out = []
     for var in _variables(rb, scope):
         if var.role == "input":
-            names = [t for t in var.terms if (var.name, t.name) not in used]
-            if len(names) == len(var.terms):
+            unused = [k for k, t in enumerate(var.terms) if (var.name, t.name) not in used]
+            if len(unused) == len(var.terms):
                 out.append(Finding("warning", "unused-term",
                                    f"input `{var.name}` is used by no rule", var.span, None,
                                    hint="write rules that use it, or remove it"))
                 continue
-            for t in names:
-                out.append(Finding("warning", "unused-term",
-                                   f"input term `{var.name}.{t.name}` is used by no rule",
-                                   t.span, None,
-                                   hint="write a rule for it, or remove it from the term set"))
+            if unused:
+                x = meaning.gap_points(var)
+                top = _top_two(var.terms, x)
+                out += [_unused_input_term(var, k, x, top) for k in unused]
         else:
             unconcluded = [t.name for t in var.terms if (var.name, t.name) not in concluded]
             if unconcluded and var.name in set_by_rules:
