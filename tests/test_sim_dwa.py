@@ -6,9 +6,20 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import given as hgiven
+from hypothesis import settings
+from hypothesis import strategies as st
 
 from mitos_cli.sim import kinematics
-from mitos_cli.sim.dwa import DWAParams, DWAPlanner, dwa_command, echo_points, footprint_clearance, rollouts
+from mitos_cli.sim.dwa import (
+    DWAParams,
+    DWAPlanner,
+    Workspace,
+    dwa_command,
+    echo_points,
+    footprint_clearance,
+    rollouts,
+)
 from mitos_cli.sim.loop import simulate
 from mitos_cli.sim.world import Robot
 from mitos_cli.sim.worldfile import parse_world
@@ -87,6 +98,37 @@ def test_footprint_clearance_by_hand():
         seen[0, i] = True
         assert footprint_clearance(pose, pts, seen, 24.0, 18.0)[0, 0, 0] == pytest.approx(want)
     assert footprint_clearance(pose, pts, np.zeros((1, 4), bool), 24.0, 18.0)[0, 0, 0] == math.inf
+
+
+def _clearance_as_written(poses, points, seen, length, width):
+    """footprint_clearance as it was written before its arrays were reused (each a new one)."""
+    keep = seen.any(axis=0)
+    if not keep.any():
+        return np.full(poses.shape[:-1], np.inf)
+    far = np.where(seen[:, keep, None], points[:, keep], 1e6)
+    dx = far[:, None, None, :, 0] - poses[..., 0, None]
+    dy = far[:, None, None, :, 1] - poses[..., 1, None]
+    c, s = np.cos(poses[..., 2, None]), np.sin(poses[..., 2, None])
+    lx = np.maximum(np.abs(c * dx + s * dy) - length / 2, 0.0)
+    ly = np.maximum(np.abs(c * dy - s * dx) - width / 2, 0.0)
+    d = np.sqrt((lx * lx + ly * ly).min(axis=-1))
+    return np.where(d > 1e5, np.inf, d)
+
+
+@hgiven(st.integers(0, 2**32 - 1), st.lists(st.tuples(*[st.integers(1, 6)] * 4), min_size=1,
+                                             max_size=4))
+@settings(max_examples=60, deadline=None)
+def test_a_workspace_reused_across_shapes_gives_the_bits_of_new_arrays(seed, shapes):
+    """The clearances are computed in arrays one call hands to the next (fresh 2 MB arrays
+    each tick were half a DWA run's time, in page faults): the same bits as the expression
+    with new arrays, whatever shapes came before."""
+    rng = np.random.default_rng(seed)
+    work = Workspace()
+    for n, s, t, p in shapes:
+        poses = rng.normal(0.0, 30.0, (n, s, t, 3))
+        points, seen = rng.normal(0.0, 50.0, (n, p, 2)), rng.random((n, p)) < 0.7
+        got = footprint_clearance(poses, points, seen, 24.0, 18.0, work)
+        assert got.tobytes() == _clearance_as_written(poses, points, seen, 24.0, 18.0).tobytes()
 
 
 def test_echoes_spread_over_the_beams_share_and_misses_are_not_points():

@@ -155,21 +155,48 @@ def echo_points(ranges: np.ndarray, angles: np.ndarray, max_range: float,
     return np.stack([r * np.cos(a), r * np.sin(a)], axis=-1), seen
 
 
+class Workspace:
+    """Arrays one call hands to the next. The clearances of 75 rollouts of 10 poses to some
+    330 echo points are 2 MB an array, and glibc gives freed blocks that large back to the
+    system at once: fresh arrays every tick cost their page faults, half of a DWA run's
+    time in the kernel (slalom 4.2 s, 2.0 of them system time; 1.6 s reusing them)."""
+
+    def __init__(self) -> None:
+        self._flat = np.empty(0)
+
+    def arrays(self, shape: tuple[int, ...], count: int) -> list[np.ndarray]:
+        """``count`` arrays of ``shape``, their contents undefined."""
+        size = int(np.prod(shape))
+        if self._flat.size < count * size:
+            self._flat = np.empty(count * size)
+        return [self._flat[k * size:(k + 1) * size].reshape(shape) for k in range(count)]
+
+
 def footprint_clearance(poses: np.ndarray, points: np.ndarray, seen: np.ndarray,
-                        length: float, width: float) -> np.ndarray:
+                        length: float, width: float,
+                        work: Workspace | None = None) -> np.ndarray:
     """Distance ``[n, S, T]`` from a ``length`` x ``width`` footprint at each pose to the
-    nearest seen point (0 when a point is inside it; ``inf`` when nothing was seen)."""
+    nearest seen point (0 when a point is inside it; ``inf`` when nothing was seen); the
+    ``[n, S, T, P]`` arrays are ``work``'s (a new one's: ``None``), the same arithmetic in
+    the same order as ``max(|c dx + s dy| - length / 2, 0)`` and its twin written out."""
     keep = seen.any(axis=0)                     # points no robot saw are left out at once
     if not keep.any():
         return np.full(poses.shape[:-1], np.inf)
     far = np.where(seen[:, keep, None], points[:, keep], 1e6)          # [n, P, 2]
-    dx = far[:, None, None, :, 0] - poses[..., 0, None]                # [n, S, T, P]
-    dy = far[:, None, None, :, 1] - poses[..., 1, None]
+    dx, dy, lx, ly = (work or Workspace()).arrays(poses.shape[:-1] + far.shape[1:2], 4)
+    np.subtract(far[:, None, None, :, 0], poses[..., 0, None], out=dx)    # [n, S, T, P]
+    np.subtract(far[:, None, None, :, 1], poses[..., 1, None], out=dy)
     c, s = np.cos(poses[..., 2, None]), np.sin(poses[..., 2, None])
-    lx = np.maximum(np.abs(c * dx + s * dy) - length / 2, 0.0)
-    ly = np.maximum(np.abs(c * dy - s * dx) - width / 2, 0.0)
-    d = np.sqrt((lx * lx + ly * ly).min(axis=-1))
+    _side(np.add(np.multiply(c, dx, out=lx), np.multiply(s, dy, out=ly), out=lx), length)
+    _side(np.subtract(np.multiply(c, dy, out=ly), np.multiply(s, dx, out=dx), out=ly), width)
+    np.add(np.multiply(lx, lx, out=lx), np.multiply(ly, ly, out=ly), out=lx)
+    d = np.sqrt(lx.min(axis=-1))
     return np.where(d > 1e5, np.inf, d)
+
+
+def _side(x: np.ndarray, size: float) -> None:
+    """``x`` becomes ``max(|x| - size / 2, 0)``, in place: how far outside the footprint."""
+    np.maximum(np.subtract(np.abs(x, out=x), size / 2, out=x), 0.0, out=x)
 
 
 def _scaled(x: np.ndarray, ok: np.ndarray) -> np.ndarray:
@@ -221,9 +248,11 @@ def _obstacles(params: DWAParams, ranges: np.ndarray, angles: np.ndarray, max_ra
 def _command(params: DWAParams, target: np.ndarray, speed: np.ndarray, steering: np.ndarray,
              ranges: np.ndarray, angles: np.ndarray, max_range: float, robot: Robot, dt: float,
              memory: list[np.ndarray] | None,
-             path: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+             path: np.ndarray | None = None, work: Workspace | None = None
+             ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """:func:`dwa_command`, and which robots had no admissible trajectory (``path [n, K, 2]``:
-    the route's points ahead in each robot's frame, or None)."""
+    the route's points ahead in each robot's frame, or None; ``work``: arrays kept from the
+    call before)."""
     p = params
     n = len(speed)
     full = np.ones(n)
@@ -242,7 +271,7 @@ def _command(params: DWAParams, target: np.ndarray, speed: np.ndarray, steering:
     reach = vs[:, -1] * p.horizon_s + np.hypot(robot.length, robot.width) / 2 \
         + p.clearance_cap_in
     seen &= np.hypot(points[..., 0], points[..., 1]) <= reach[:, None]
-    clear = footprint_clearance(poses, points, seen, robot.length, robot.width)
+    clear = footprint_clearance(poses, points, seen, robot.length, robot.width, work)
     now = footprint_clearance(np.zeros((n, 1, 1, 3)), points, seen, robot.length,
                               robot.width)[:, 0, 0]                     # [n]
     limit = np.minimum(p.collision_in, np.maximum(now - 0.5, 0.0))[:, None, None]
@@ -346,6 +375,7 @@ class DWAPlanner:
         self.dt = float(dt)
         self.params = params or DWAParams()
         self._maps: dict[int, Costmap] = {}
+        self._work = Workspace()
 
     @classmethod
     def for_world(cls, world: World, params: DWAParams | None = None) -> DWAPlanner:
@@ -412,6 +442,6 @@ class DWAPlanner:
         out_s, out_v, stuck = _command(
             self.params, target, np.asarray(p.speed, float), steering,
             np.asarray(p.ranges, float), np.asarray(p.beam_angles, float), self.sensor_range,
-            self.robot, self.dt, self._memory(p), path)
+            self.robot, self.dt, self._memory(p), path, self._work)
         self._recover(p, stuck)
         return out_s, out_v
