@@ -156,8 +156,9 @@ def test_spaces_stacked_keep_and_look_up_the_beams_as_each_space_alone(seed, rin
     rng = np.random.default_rng(seed)
     robots, beams = 5, 8
     angles = np.deg2rad(np.arange(beams) * (45.0 if ring else 20.0) - (0.0 if ring else 70.0))
-    alone = [movers.FreeSpace.of(angles, ring, 0.05, 2.0) for _ in range(robots)]
-    spaces = [movers.FreeSpace.of(angles, ring, 0.05, 2.0) for _ in range(robots)]
+    # (each robot's sensor its own noise, as randomised runs draw theirs; a range of 60 in)
+    alone = [movers.FreeSpace.of(angles, ring, 0.05, 2.0, 0.5 * i, 60.0) for i in range(robots)]
+    spaces = [movers.FreeSpace.of(angles, ring, 0.05, 2.0, 0.5 * i, 60.0) for i in range(robots)]
     stack = movers.Spaces.stacked(spaces)
     assert stack is not None
     for k in range(ticks):
@@ -166,7 +167,7 @@ def test_spaces_stacked_keep_and_look_up_the_beams_as_each_space_alone(seed, rin
         heading = rng.uniform(-math.pi, math.pi, robots)
         dirs = np.stack([np.cos(heading[:, None] + angles), np.sin(heading[:, None] + angles)],
                         axis=2)
-        ranges = rng.uniform(5, 60, (robots, beams))
+        ranges = np.minimum(rng.uniform(5, 66, (robots, beams)), 60.0)
         for sp, p, d, r in zip(alone, at, dirs, ranges):
             sp.update(now, p, d, r)
         stack.update(now, at, dirs, ranges)
