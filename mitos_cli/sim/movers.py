@@ -470,7 +470,9 @@ class FreeSpace:
         """For echoes ``points [P, 2]`` (of beams ``dirs [P, 2]``), tested ``STEP`` beyond the
         echo against the beams kept from the last ``WINDOW`` s (before ``now``): which lie on
         the line of one (within ``near``: the robot's map clears a mark the same way), and
-        which of those lay short of its echo then (something came where nothing was)."""
+        which of those lay short of its echo then (something came where nothing was), or
+        close on the beams that ended on their line at ``MIN_SPEED`` or faster
+        (:func:`_closing`)."""
         return entered([self], now, points, dirs)
 
 
