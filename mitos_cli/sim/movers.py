@@ -592,26 +592,41 @@ def entered(spaces: Sequence[FreeSpace], now: float, points: np.ndarray, dirs: n
         noise = np.array([sp.noise for sp in spaces])[owner]
     came |= _closing(len(points), at // slots, reach - along + STEP,
                      np.broadcast_to(age, on.shape).reshape(-1)[at],
+                     dist.reshape(-1)[at] * np.sin(off.reshape(-1)[at]),
                      (reach < first.far) & ~passed.reshape(-1)[at], noise)
     return np.logical_or.reduce(on, axis=1), came
 
 
-def _closing(n: int, rows: np.ndarray, a: np.ndarray, t: np.ndarray, ok: np.ndarray,
-             noise: np.ndarray) -> np.ndarray:
+def _closing(n: int, rows: np.ndarray, a: np.ndarray, t: np.ndarray, side: np.ndarray,
+             ok: np.ndarray, noise: np.ndarray) -> np.ndarray:
     """Which of ``n`` echoes close on the robot's beams at ``MIN_SPEED`` or faster, ``SURE``
-    standard deviations of the sensor's noise beyond doubt: each echo (``rows``) came ``a``
-    in nearer along a beam cast ``t`` s before that ended on its line (``ok``: that beam
-    read an echo, and did not pass it), and the closing speed is the least-squares slope
-    through (0, 0) of ``a`` on ``t``, ``sum(a t) / sum(t t)``, whose standard deviation is
-    that of ``a`` (two readings: ``sqrt(2)`` times the sensor's ``noise [n]``) over
-    ``sqrt(sum(t t))``. A beam of a moment ago cannot tell a cart 15 in/s away from a box,
-    but the beams of the last half second along one line can: a standing object's echo
-    comes no nearer along it, however old the beam."""
+    standard deviations of the sensor's noise beyond doubt. Each echo (``rows``) lies ``a``
+    in nearer than a beam cast ``t`` s before that ended on its line, ``side`` in to one
+    side of it (``ok``: that beam read an echo, and did not pass it). A standing object's
+    echo comes no nearer along one line however the robot drives, but the lines are only
+    the same to within half a map cell: on a face the beams meet aslant (a box's side seen
+    at 13 deg, 4.3 in along for each inch across), a beam that passed 1 in to the side
+    ended 4 in farther on, and a robot that turns sweeps its beams across the face, so that
+    ``side``, and with it ``a``, grows with ``t``. So ``a`` is fitted through (0, 0) on both,
+    ``a = s t + c side``, and the closing speed ``s`` is what ``side`` does not explain:
+    ``(sum(a t) - sum(a side) k) / d``, ``k = sum(t side) / sum(side side)``, ``d = sum(t t)
+    - sum(t side) k``, its standard deviation that of ``a`` (two readings: ``sqrt(2)``
+    times the sensor's ``noise [n]``) over ``sqrt(d)``. Where the beams drifted across the
+    line as steadily as they aged, ``d`` is 0 and nothing is told; where they lay on it,
+    ``s = sum(a t) / sum(t t)``. A beam of a moment ago cannot tell a cart 15 in/s away from
+    a box, but the beams of the last half second along one line can."""
     w = np.where(ok, t, 0.0)
+    x = np.where(ok, side, 0.0)
     sat = np.bincount(rows, weights=a * w, minlength=n)
     stt = np.bincount(rows, weights=t * w, minlength=n)
-    doubt = SURE * math.sqrt(2.0) * noise * np.sqrt(stt)
-    return (stt > 0) & (sat - doubt >= MIN_SPEED * stt)
+    sas = np.bincount(rows, weights=a * x, minlength=n)
+    sts = np.bincount(rows, weights=t * x, minlength=n)
+    sss = np.bincount(rows, weights=side * x, minlength=n)
+    k = np.divide(sts, sss, out=np.zeros(n), where=sss > 0)
+    d = stt - sts * k
+    doubt = SURE * math.sqrt(2.0) * noise * np.sqrt(np.maximum(d, 0.0))
+    told = d > 1e-9 * stt            # (d is 0 but for rounding where side and t are in step)
+    return told & (sat - sas * k - doubt >= MIN_SPEED * d)
 
 
 Capsule = tuple[np.ndarray, np.ndarray, float]     # a segment's two ends and a radius
