@@ -113,6 +113,29 @@ def test_an_echo_that_closes_along_its_line_faster_than_the_robot_drives_came():
     assert closing(movers.MIN_SPEED * 1.2, young, noise=0.0) == [True]
 
 
+def test_an_echo_on_a_face_the_beams_meet_aslant_as_the_robot_turns_did_not_come():
+    """A box's side seen at 13 deg: a beam that passed 1 in to one side of the echo ended
+    cot(13 deg) = 4.3 in farther on. A robot turning at 2 deg/s sweeps its beams across
+    the line as steadily as they age, so the echo lies 0.7-3.4 in nearer than beams 0.05-0.25
+    s old saw, as a cart's at 14 in/s would; but that is what their side explains, and it is
+    not told a closing speed. The same nearings on the line itself are."""
+    (turned, angles), on_line = ring_free(noise=0.5), ring_free(noise=0.5)[0]
+    now, r, omega = 2.0, 90.0, math.radians(2.0)
+    for age in (0.25, 0.2, 0.15, 0.1, 0.05):
+        h = -omega * age                                   # the heading then
+        side = (r + movers.STEP) * math.sin(-h)            # how far the old beam 0 passes q
+        along = (r + movers.STEP) * math.cos(h)
+        nearer = side / math.tan(math.radians(13.0))
+        for space, heading in ((turned, h), (on_line, 0.0)):
+            dirs = np.stack([np.cos(angles + heading), np.sin(angles + heading)], axis=1)
+            ranges = np.full(36, 150.0)
+            ranges[0] = along - movers.STEP + nearer
+            space.update(now - age, np.zeros(2), dirs, ranges)
+    echo, east = np.array([[r, 0.0]]), np.array([[1.0, 0.0]])
+    assert entered(turned, now, echo, east) == [False]
+    assert entered(on_line, now, echo, east) == [True]
+
+
 def test_a_beam_that_read_nothing_in_its_range_says_nothing_of_how_fast_an_echo_closes():
     """Beams that saw nothing within their range end there whatever lies beyond: an echo
     just inside that range, 1-3 in short of their end, neither came (they did not pass it

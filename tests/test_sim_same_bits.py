@@ -1505,13 +1505,21 @@ def plain_sighting(free: movers.FreeSpace, now: float, origin, ranges, dirs, see
         reach = kept[np.arange(len(pose))[None, :], k]
         passed = on & (dist * np.cos(off) < reach - movers.SHORT)
         # the closing speed along the lines of the beams that echoed it and did not pass it
-        age = now - free.times[live]
+        # (a = s age + c side, fitted through (0, 0); s what the side does not explain)
+        age = np.broadcast_to(now - free.times[live], on.shape)
+        side = dist * np.sin(off)
         ok = on & ~passed & (reach < free.far)
         a = reach - dist * np.cos(off) + movers.STEP
-        sat = np.where(ok, a * age, 0.0).sum(axis=1)
-        stt = np.where(ok, age * age, 0.0).sum(axis=1)
-        closes = (stt > 0) & (sat - movers.SURE * math.sqrt(2.0) * free.noise * np.sqrt(stt)
-                              >= movers.MIN_SPEED * stt)
+        closes = np.zeros(len(idx), dtype=bool)
+        for e in range(len(idx)):
+            m = ok[e]
+            t, x, y = age[e][m], side[e][m], a[e][m]
+            stt, sts, sss = float(t @ t), float(t @ x), float(x @ x)
+            k = sts / sss if sss > 0 else 0.0
+            d = stt - sts * k
+            closes[e] = d > 1e-9 * stt and (float(y @ t) - float(y @ x) * k
+                                            - movers.SURE * math.sqrt(2.0) * free.noise
+                                            * math.sqrt(max(d, 0.0)) >= movers.MIN_SPEED * d)
         tested, entered = on.any(axis=1), passed.any(axis=1) | closes
     at = np.add.accumulate(seen, dtype=np.intp) - 1
     moved = [None if not (n := np.count_nonzero(tested[at[r]]))
