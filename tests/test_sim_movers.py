@@ -47,9 +47,10 @@ def test_an_object_across_the_first_beam_of_a_ring_is_one_object():
 
 # --- free space ----------------------------------------------------------------------------
 
-def ring_free(count: int = 36):
+def ring_free(count: int = 36, noise: float = 0.0):
     angles = np.deg2rad(np.arange(count) * (360.0 / count))
-    return movers.FreeSpace.of(angles, ring=True, dt=0.05, resolution=2.0), angles
+    return movers.FreeSpace.of(angles, ring=True, dt=0.05, resolution=2.0, noise=noise,
+                               far=150.0), angles
 
 
 def entered(free, now, points, dirs) -> list[bool | None]:
@@ -59,7 +60,7 @@ def entered(free, now, points, dirs) -> list[bool | None]:
 
 
 def test_an_echo_where_a_beam_passed_a_moment_ago_came_from_something_that_moved_there():
-    free, angles = ring_free()
+    free, angles = ring_free(noise=1.0)
     dirs = np.stack([np.cos(angles), np.sin(angles)], axis=1)
     ranges = np.full(36, 150.0)
     ranges[0] = 80.0                                          # east: a wall at 80 in
@@ -76,6 +77,82 @@ def test_an_echo_where_a_beam_passed_a_moment_ago_came_from_something_that_moved
     # long ago is not a moment ago, and the same tick is not before it
     assert entered(free, 1.0 + movers.WINDOW + 0.1, np.array([[40.0, 0.0]]), east) == [None]
     assert entered(free, 1.0, np.array([[40.0, 0.0]]), east) == [None]
+
+
+def closing(speed: float, ages: list[float], noise: float = 0.5, far: float = 150.0):
+    """The echo straight ahead of a robot driving east at 40 in/s (now at x = 0) of a face
+    that comes west at ``speed`` in/s and is 60 in off now, tested against the ring's beams
+    cast ``ages`` s before (noise-free readings of a sensor of ``noise``; ``far``: its range)."""
+    free, angles = ring_free(noise=noise)
+    now = 2.0
+    for age in sorted(ages, reverse=True):
+        p = np.array([-40.0 * age, 0.0])
+        dirs = np.stack([np.cos(angles), np.sin(angles)], axis=1)
+        ranges = np.full(36, far)
+        ranges[0] = min(60.0 + speed * age - p[0], far)     # the face where it was then
+        free.update(now - age, p, dirs, ranges)
+    return entered(free, now, np.array([[60.0, 0.0]]), np.array([[1.0, 0.0]]))
+
+
+def test_an_echo_that_closes_along_its_line_faster_than_the_robot_drives_came():
+    """A cart 15 in/s head-on comes 0.75-3.75 in nearer in the 0.05-0.25 s since the beams
+    before on its line were cast (``SHORT + STEP``, 6 in, asks more of each), but their ranges
+    shrink 15 in/s faster than the robot's own drive explains: a closing speed of 15 in/s,
+    ``SURE`` standard deviations of the sensor's noise (0.5 in) beyond ``MIN_SPEED``."""
+    young = [0.05, 0.1, 0.15, 0.2, 0.25]
+    assert closing(15.0, young) == [True]
+    assert closing(0.0, young) == [False]                # a box stands where it stood
+    assert closing(-15.0, young) == [False]              # a cart going away
+    # one beam of a moment ago cannot tell 15 in/s from the noise; the noisier the sensor,
+    # the more beams it takes
+    assert closing(15.0, [0.05]) == [False]
+    assert closing(15.0, young, noise=1.5) == [False]
+    assert closing(15.0, young + [0.3, 0.35, 0.4, 0.45, 0.5], noise=1.5) == [True]
+    # slower than MIN_SPEED is standing, however sure
+    assert closing(movers.MIN_SPEED * 0.8, young, noise=0.0) == [False]
+    assert closing(movers.MIN_SPEED * 1.2, young, noise=0.0) == [True]
+
+
+def test_an_echo_on_a_face_the_beams_meet_aslant_as_the_robot_turns_did_not_come():
+    """A box's side seen at 13 deg: a beam that passed 1 in to one side of the echo ended
+    cot(13 deg) = 4.3 in farther on. A robot turning at 2 deg/s sweeps its beams across
+    the line as steadily as they age, so the echo lies 0.7-3.4 in nearer than beams 0.05-0.25
+    s old saw, as a cart's at 14 in/s would; but that is what their side explains, and it is
+    not told a closing speed. The same nearings on the line itself are."""
+    (turned, angles), on_line = ring_free(noise=0.5), ring_free(noise=0.5)[0]
+    now, r, omega = 2.0, 90.0, math.radians(2.0)
+    for age in (0.25, 0.2, 0.15, 0.1, 0.05):
+        h = -omega * age                                   # the heading then
+        side = (r + movers.STEP) * math.sin(-h)            # how far the old beam 0 passes q
+        along = (r + movers.STEP) * math.cos(h)
+        nearer = side / math.tan(math.radians(13.0))
+        for space, heading in ((turned, h), (on_line, 0.0)):
+            dirs = np.stack([np.cos(angles + heading), np.sin(angles + heading)], axis=1)
+            ranges = np.full(36, 150.0)
+            ranges[0] = along - movers.STEP + nearer
+            space.update(now - age, np.zeros(2), dirs, ranges)
+    echo, east = np.array([[r, 0.0]]), np.array([[1.0, 0.0]])
+    assert entered(turned, now, echo, east) == [False]
+    assert entered(on_line, now, echo, east) == [True]
+
+
+def test_a_beam_that_read_nothing_in_its_range_says_nothing_of_how_fast_an_echo_closes():
+    """Beams that saw nothing within their range end there whatever lies beyond: an echo
+    just inside that range, 1-3 in short of their end, neither came (they did not pass it
+    by ``SHORT``) nor stood, and does not pull the closing speed of the beams that echoed
+    it down to 0."""
+    free, angles = ring_free(noise=0.5)
+    dirs = np.stack([np.cos(angles), np.sin(angles)], axis=1)
+    now = 3.0
+    for age in (1.3, 1.2, 1.1):                   # far back: the face out of range (150 in)
+        free.update(now - age, np.array([-40.0 * age, 0.0]), dirs, np.full(36, 150.0))
+    for age in (0.25, 0.2, 0.15, 0.1, 0.05):      # lately: the face coming at 15 in/s
+        ranges = np.full(36, 150.0)
+        ranges[0] = 100.0 + 15.0 * age + 40.0 * age
+        free.update(now - age, np.array([-40.0 * age, 0.0]), dirs, ranges)
+    echo = np.array([[100.0, 0.0]])
+    # (the far beams end 150 - 40 t, 1 to 2 in beyond the echo 1.1-1.3 s later)
+    assert entered(free, now, echo, np.array([[1.0, 0.0]])) == [True]
 
 
 @pytest.mark.parametrize("heading_deg", [90, 0, 170, 180, -170, -90])
@@ -102,8 +179,9 @@ def test_spaces_stacked_keep_and_look_up_the_beams_as_each_space_alone(seed, rin
     rng = np.random.default_rng(seed)
     robots, beams = 5, 8
     angles = np.deg2rad(np.arange(beams) * (45.0 if ring else 20.0) - (0.0 if ring else 70.0))
-    alone = [movers.FreeSpace.of(angles, ring, 0.05, 2.0) for _ in range(robots)]
-    spaces = [movers.FreeSpace.of(angles, ring, 0.05, 2.0) for _ in range(robots)]
+    # (each robot's sensor its own noise, as randomised runs draw theirs; a range of 60 in)
+    alone = [movers.FreeSpace.of(angles, ring, 0.05, 2.0, 0.5 * i, 60.0) for i in range(robots)]
+    spaces = [movers.FreeSpace.of(angles, ring, 0.05, 2.0, 0.5 * i, 60.0) for i in range(robots)]
     stack = movers.Spaces.stacked(spaces)
     assert stack is not None
     for k in range(ticks):
@@ -112,7 +190,7 @@ def test_spaces_stacked_keep_and_look_up_the_beams_as_each_space_alone(seed, rin
         heading = rng.uniform(-math.pi, math.pi, robots)
         dirs = np.stack([np.cos(heading[:, None] + angles), np.sin(heading[:, None] + angles)],
                         axis=2)
-        ranges = rng.uniform(5, 60, (robots, beams))
+        ranges = np.minimum(rng.uniform(5, 66, (robots, beams)), 60.0)
         for sp, p, d, r in zip(alone, at, dirs, ranges):
             sp.update(now, p, d, r)
         stack.update(now, at, dirs, ranges)

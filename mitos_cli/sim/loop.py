@@ -539,7 +539,8 @@ class Simulation:
         self._maps = [knowledge.RobotMap.of(grid, faces) for _ in range(n)]
         self._trackers = [movers.Tracker() for _ in range(n)]
         ring = self.world.sensors.layout == "ring"
-        self._free = [movers.FreeSpace.of(self.angles, ring, self.dt, grid.resolution)
+        self._free = [movers.FreeSpace.of(self.angles, ring, self.dt, grid.resolution,
+                                          self.world.sensors.noise, self.world.sensors.range)
                       for _ in range(n)]
         self._seen = [np.zeros(len(self.angles), dtype=bool) for _ in range(n)]
         self._odometer: list[np.ndarray] = []      # in each robot has driven, after each move

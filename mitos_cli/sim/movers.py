@@ -11,7 +11,11 @@ the centres it was seen at over the last ``WINDOW`` seconds (a Theil-Sen slope: 
 of a cart hop from one end of it to the other, and a median does not follow them).
 
 A track is a *mover* when most of its recent echoes came from space a beam had passed
-through a moment before (:class:`FreeSpace`: something came where nothing was), its centre
+through a moment before (:class:`FreeSpace`: something came where nothing was), or closed
+along the lines of the beams before that ended on them faster than a standing object's
+echo can (which comes no nearer along one line, however the robot drives: a cart coming
+head-on is echoed by one ray of a ring, each tick 1-2 in nearer than it was, too little
+for any one beam to tell but a closing speed to the beams of half a second), its centre
 travelled ``MIN_TRAVEL`` or more, it moves at ``MIN_SPEED`` to ``MAX_SPEED`` and it is no
 longer than ``MAX_EXTENT`` (a cart, a person, a robot: not a wall); :meth:`Tracker.movers`
 lists those that come toward the robot (within 60 deg of the robot's bearing from it,
@@ -65,6 +69,7 @@ SETTLE = 2.5         # s: a track followed this long has a heading to go by
 VOTE = 0.5           # s: the sightings a track's moving is voted over
 SHORT = 4.0          # in: a beam passes through what lies up to this short of its echo
 STEP = 2.0           # in: an echo is tested this far beyond it
+SURE = 2.0           # standard deviations: a closing speed is told from the sensor's noise
 
 
 @dataclass(frozen=True, eq=False)
@@ -432,6 +437,8 @@ class FreeSpace:
     ranges: np.ndarray = field(repr=False)    # [J, B] in
     near: float                 # in: how near a beam's line a point it passed lies
     slot: int = 0
+    noise: float = 0.0          # in: the standard deviation of a range (the sensor's)
+    far: float = math.inf       # in: the sensor's range (a beam that read it saw nothing)
     rows: np.ndarray = field(init=False, repr=False)   # [J] where each slot's ranges start
     # in ranges.reshape(-1)
 
@@ -439,13 +446,15 @@ class FreeSpace:
         self.rows = np.arange(len(self.times)) * self.ranges.shape[1]
 
     @classmethod
-    def of(cls, angles: np.ndarray, ring: bool, dt: float, resolution: float) -> FreeSpace:
+    def of(cls, angles: np.ndarray, ring: bool, dt: float, resolution: float,
+           noise: float = 0.0, far: float = math.inf) -> FreeSpace:
         """For beams at ``angles`` (rad from the heading), ticks of ``dt`` s and a map of
-        ``resolution`` (a beam passes through what lies within half a cell of its line)."""
+        ``resolution`` (a beam passes through what lies within half a cell of its line), of
+        a sensor with range ``far`` and Gaussian ``noise`` (in)."""
         keep = int(math.ceil(WINDOW / dt)) + 1
         step = float(angles[1] - angles[0]) if len(angles) > 1 else 0.0
         return cls(float(angles[0]), step, ring, np.full(keep, -np.inf), np.zeros((keep, 3)),
-                   np.zeros((keep, len(angles))), resolution / 2)
+                   np.zeros((keep, len(angles))), resolution / 2, noise=noise, far=far)
 
     def update(self, now: float, p: np.ndarray, dirs: np.ndarray, ranges: np.ndarray) -> None:
         """Keep the beams ``dirs [B, 2]`` cast from ``p`` at ``now`` and their ``ranges [B]``
@@ -461,7 +470,9 @@ class FreeSpace:
         """For echoes ``points [P, 2]`` (of beams ``dirs [P, 2]``), tested ``STEP`` beyond the
         echo against the beams kept from the last ``WINDOW`` s (before ``now``): which lie on
         the line of one (within ``near``: the robot's map clears a mark the same way), and
-        which of those lay short of its echo then (something came where nothing was)."""
+        which of those lay short of its echo then (something came where nothing was), or
+        close on the beams that ended on their line at ``MIN_SPEED`` or faster
+        (:func:`_closing`)."""
         return entered([self], now, points, dirs)
 
 
@@ -471,22 +482,23 @@ class Spaces(Sequence[FreeSpace]):
     in one write (:meth:`update`) and looked up by :func:`entered` where they lie."""
 
     def __init__(self, every: list[FreeSpace], times: np.ndarray, poses: np.ndarray,
-                 ranges: np.ndarray, rows: np.ndarray) -> None:
+                 ranges: np.ndarray, rows: np.ndarray, noise: np.ndarray) -> None:
         self.every, self.rows = every, rows
         self.times, self.poses, self.ranges = times, poses, ranges   # [R, J], [R, J, 3], [R, J, B]
+        self.noise = noise                                            # [R] in, each sensor's
 
     @classmethod
     def stacked(cls, spaces: list[FreeSpace]) -> Spaces | None:
         """``spaces`` (of one layout: ``None`` otherwise), their arrays copied into one stack
         each and each made a view of its row."""
         first = spaces[0]
-        if any((sp.a0, sp.step, sp.ring, sp.near, sp.ranges.shape)
-               != (first.a0, first.step, first.ring, first.near, first.ranges.shape)
+        if any((sp.a0, sp.step, sp.ring, sp.near, sp.far, sp.ranges.shape)
+               != (first.a0, first.step, first.ring, first.near, first.far, first.ranges.shape)
                for sp in spaces):
             return None
         out = cls(spaces, np.array([sp.times for sp in spaces]),
                   np.array([sp.poses for sp in spaces]), np.array([sp.ranges for sp in spaces]),
-                  np.arange(len(spaces)))
+                  np.arange(len(spaces)), np.array([sp.noise for sp in spaces]))
         for j, sp in enumerate(spaces):
             sp.times, sp.poses, sp.ranges = out.times[j], out.poses[j], out.ranges[j]
         return out
@@ -499,7 +511,7 @@ class Spaces(Sequence[FreeSpace]):
 
     def picked(self, rows: np.ndarray) -> Spaces:
         """The spaces ``rows`` (ascending) of :attr:`every`."""
-        return Spaces(self.every, self.times, self.poses, self.ranges, rows)
+        return Spaces(self.every, self.times, self.poses, self.ranges, rows, self.noise)
 
     def update(self, now: float, points: np.ndarray, dirs: np.ndarray,
                ranges: np.ndarray) -> None:
@@ -546,6 +558,7 @@ def entered(spaces: Sequence[FreeSpace], now: float, points: np.ndarray, dirs: n
         ranges = np.array([sp.ranges for sp in spaces])                       # [R, J, B]
         row = owner[:, None] * (slots * beams) + first.rows                   # [P, J]
     live = (times >= now - WINDOW) & (times < now)
+    age = now - times                                                         # [P or 1, J]
     q = points + dirs * STEP
     rel = q[:, None, :] - pose[..., :2]                                       # [P, J, 2]
     dist = np.hypot(rel[..., 0], rel[..., 1])
@@ -565,8 +578,55 @@ def entered(spaces: Sequence[FreeSpace], now: float, points: np.ndarray, dirs: n
     at = np.flatnonzero(on)
     passed = np.zeros(on.shape, dtype=bool)
     reach = ranges.reshape(-1)[(row + k).reshape(-1)[at]]
-    passed.reshape(-1)[at] = dist.reshape(-1)[at] * np.cos(off.reshape(-1)[at]) < reach - SHORT
-    return np.logical_or.reduce(on, axis=1), np.logical_or.reduce(passed, axis=1)
+    along = dist.reshape(-1)[at] * np.cos(off.reshape(-1)[at])
+    passed.reshape(-1)[at] = along < reach - SHORT
+    came = np.logical_or.reduce(passed, axis=1)
+    # how far the echo came nearer along each beam that ended on its line (an echo, not a
+    # beam that read nothing in its range), against that beam's age: the closing speed
+    # fitted through (0, 0) and the evidence for it, sum(a t) and sum(t t), row by row
+    if owner is None or len(spaces) == 1:
+        noise = np.full(len(points), first.noise)
+    elif isinstance(spaces, Spaces):
+        noise = spaces.noise[spaces.rows[owner]]
+    else:
+        noise = np.array([sp.noise for sp in spaces])[owner]
+    came |= _closing(len(points), at // slots, reach - along + STEP,
+                     np.broadcast_to(age, on.shape).reshape(-1)[at],
+                     dist.reshape(-1)[at] * np.sin(off.reshape(-1)[at]),
+                     (reach < first.far) & ~passed.reshape(-1)[at], noise)
+    return np.logical_or.reduce(on, axis=1), came
+
+
+def _closing(n: int, rows: np.ndarray, a: np.ndarray, t: np.ndarray, side: np.ndarray,
+             ok: np.ndarray, noise: np.ndarray) -> np.ndarray:
+    """Which of ``n`` echoes close on the robot's beams at ``MIN_SPEED`` or faster, ``SURE``
+    standard deviations of the sensor's noise beyond doubt. Each echo (``rows``) lies ``a``
+    in nearer than a beam cast ``t`` s before that ended on its line, ``side`` in to one
+    side of it (``ok``: that beam read an echo, and did not pass it). A standing object's
+    echo comes no nearer along one line however the robot drives, but the lines are only
+    the same to within half a map cell: on a face the beams meet aslant (a box's side seen
+    at 13 deg, 4.3 in along for each inch across), a beam that passed 1 in to the side
+    ended 4 in farther on, and a robot that turns sweeps its beams across the face, so that
+    ``side``, and with it ``a``, grows with ``t``. So ``a`` is fitted through (0, 0) on both,
+    ``a = s t + c side``, and the closing speed ``s`` is what ``side`` does not explain:
+    ``(sum(a t) - sum(a side) k) / d``, ``k = sum(t side) / sum(side side)``, ``d = sum(t t)
+    - sum(t side) k``, its standard deviation that of ``a`` (two readings: ``sqrt(2)``
+    times the sensor's ``noise [n]``) over ``sqrt(d)``. Where the beams drifted across the
+    line as steadily as they aged, ``d`` is 0 and nothing is told; where they lay on it,
+    ``s = sum(a t) / sum(t t)``. A beam of a moment ago cannot tell a cart 15 in/s away from
+    a box, but the beams of the last half second along one line can."""
+    w = np.where(ok, t, 0.0)
+    x = np.where(ok, side, 0.0)
+    sat = np.bincount(rows, weights=a * w, minlength=n)
+    stt = np.bincount(rows, weights=t * w, minlength=n)
+    sas = np.bincount(rows, weights=a * x, minlength=n)
+    sts = np.bincount(rows, weights=t * x, minlength=n)
+    sss = np.bincount(rows, weights=side * x, minlength=n)
+    k = np.divide(sts, sss, out=np.zeros(n), where=sss > 0)
+    d = stt - sts * k
+    doubt = SURE * math.sqrt(2.0) * noise * np.sqrt(np.maximum(d, 0.0))
+    told = d > 1e-9 * stt            # (d is 0 but for rounding where side and t are in step)
+    return told & (sat - sas * k - doubt >= MIN_SPEED * d)
 
 
 Capsule = tuple[np.ndarray, np.ndarray, float]     # a segment's two ends and a radius
