@@ -208,7 +208,7 @@ def test_a_surface_told_less_draws_the_first_output_over_the_first_inputs(capsys
     (["surface", "steering", "--x", "road", "--fix", "size"], "write NAME=VALUE"),
     (["surface", "steering", "--x", "road", "--fix", "size=1", "--fix", "size=2"],
      "`size` is fixed twice"),
-    (["surface", "a", "b", "c", "--x", "road"], "expected [RULEBASE] OUTPUT, got 3"),
+    (["surface", "a", "b", "c", "--x", "road"], "expected [RULEBASE] [OUTPUT], got 3"),
     (["surface", "steering", "--x", "road", "--fix", "size=45", "position=4"],
      "`position=4` is not a rule base or an output; to hold several inputs, repeat --fix: "
      "--fix position=4"),

@@ -264,7 +264,7 @@ def _fixed(items: list[str]) -> dict[str, str]:
 
 
 def _surface_args(args: list[str]) -> tuple[Optional[str], Optional[str]]:
-    """``[RULEBASE] OUTPUT`` -> (rule-base path, output name); a lone argument that names a
+    """``[RULEBASE] [OUTPUT]`` -> (rule-base path, output name); a lone argument that names a
     rule file is the rule base."""
     for arg in args:
         if "=" in arg:          # `--fix size=45 position=4`: the second value fell out of --fix
@@ -272,7 +272,7 @@ def _surface_args(args: list[str]) -> tuple[Optional[str], Optional[str]]:
                 f"`{arg}` is not a rule base or an output; to hold several inputs, repeat "
                 f"--fix: --fix {arg} (one --fix NAME=VALUE per input)")
     if len(args) > 2:
-        raise typer.BadParameter(f"expected [RULEBASE] OUTPUT, got {len(args)} arguments: "
+        raise typer.BadParameter(f"expected [RULEBASE] [OUTPUT], got {len(args)} arguments: "
                                  + " ".join(args))
     if len(args) == 2:
         return args[0], args[1]
@@ -309,7 +309,7 @@ def _surface_defaults(rb: LoadedRuleBase, out_name: str | None, x: str | None,
 
 def surface_command(
     args: Annotated[Optional[list[str]], typer.Argument(
-        click_type=WORDS, metavar="[RULEBASE] OUTPUT",
+        click_type=WORDS, metavar="[RULEBASE] [OUTPUT]",
         help="Rule file (default: the packaged MITOS rule base), then the output to draw "
              "(default: the behavior's first, with a note).")] = None,
     x: Annotated[Optional[str], typer.Option(
