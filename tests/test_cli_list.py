@@ -9,7 +9,7 @@ import json
 import pytest
 
 from mitos_cli.cli.app import main
-from mitos_cli.cli.list_cmd import catalogue, first_comment_line, first_sentence, shorten
+from mitos_cli.cli.list_cmd import catalogue, first_comment_line, first_sentence, render, shorten
 from mitos_cli.resources import packaged_names, resolve
 from mitos_cli.sim.worldfile import load_world, resolve_world_path
 
@@ -66,8 +66,8 @@ def test_first_comment_line(text, expected):
     assert first_comment_line(text) == expected
 
 
-def test_an_argument_is_a_usage_error(capsys):
-    code, out, err = run_main(["list", "worlds"], capsys)
+def test_a_second_argument_is_a_usage_error(capsys):
+    code, out, err = run_main(["list", "worlds", "lessons"], capsys)
     assert code == 2 and out == ""
     assert "unexpected extra argument" in err.lower()
 
@@ -108,3 +108,22 @@ def test_json_carries_whole_descriptions_and_the_text_cuts_them(capsys):
     line = next(ln for ln in out.splitlines() if ln.strip().startswith("figure4"))
     assert line.endswith(" ...") and "centre line" not in line
     assert "take_opening, mind_the_body, drive" in out      # a rule base's behaviors: whole
+
+
+@pytest.mark.parametrize("kind, key", [("worlds", "worlds"), ("world", "worlds"),
+                                       ("Rule-Bases", "rulebases"), ("rule base", "rulebases"),
+                                       ("termsets", "termsets"), ("lesson", "lessons")])
+def test_one_kind_alone(kind, key, capsys):
+    code, out, err = run_main(["list", kind, "--json"], capsys)
+    assert code in (0, None) and err == ""
+    assert json.loads(out) == {key: catalogue()[key]}
+    code, out, _ = run_main(["list", kind], capsys)
+    assert out.splitlines()[0] == render({key: []}).splitlines()[0]
+    assert len(out.splitlines()) == 1 + len(catalogue()[key])
+
+
+def test_an_unknown_kind_is_a_usage_error_with_the_kinds(capsys):
+    code, out, err = run_main(["list", "wrlds"], capsys)
+    assert code == 2 and out == ""
+    assert "unknown kind `wrlds`" in err and "did you mean `worlds`?" in err
+    assert "lessons, rulebases, termsets, worlds" in err

@@ -56,7 +56,8 @@ EXAMPLES: dict[str, tuple[tuple[str, str], ...]] = {
         ("mitos simulate slalom --planner dwa", "a baseline drives instead"),
     ),
     "list": (
-        ("mitos list", "the packaged worlds, rule bases and lessons"),
+        ("mitos list", "the packaged worlds, rule bases, term sets and lessons"),
+        ("mitos list worlds", "the worlds alone"),
         ("mitos list --json", "as JSON"),
     ),
     "plot terms": (

@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING, Annotated
 import typer
 
 from .output import emit, json_text
+from .params import WORDS
 
 if TYPE_CHECKING:
     from pathlib import Path
@@ -122,15 +123,16 @@ def _lesson(path: Path) -> dict:
             "description": first_sentence(path.read_text(encoding="utf-8"))}
 
 
-def catalogue() -> dict[str, list[dict]]:
-    """Every packaged world, rule base, term set and lesson, by section, in file-name order."""
+def catalogue(only: str | None = None) -> dict[str, list[dict]]:
+    """Every packaged world, rule base, term set and lesson, by section, in file-name order
+    (of the section ``only``, if given)."""
     from ..resources import packaged_names, packaged_path
 
     describe = {"worlds": _world, "rulebases": _rulebase, "termsets": _termset,
                 "lessons": _lesson}
     return {key: [describe[key](packaged_path(folder, filename))
                   for filename in packaged_names(folder, suffix)]
-            for key, (_, folder, suffix) in SECTIONS.items()}
+            for key, (_, folder, suffix) in SECTIONS.items() if only in (None, key)}
 
 
 def render(cat: dict[str, list[dict]]) -> str:
@@ -153,12 +155,30 @@ def render(cat: dict[str, list[dict]]) -> str:
     return "\n".join(lines)
 
 
+def section_of(kind: str) -> str:
+    """The section ``kind`` names: ``worlds``, ``rulebases``, ``termsets`` or ``lessons``, or
+    one of them in the singular, or with a space or dash (``rule-base``), in any case."""
+    from ..errors import UsageError, unknown
+
+    key = re.sub(r"[\s_-]+", "", kind.strip().lower())
+    if key in SECTIONS:
+        return key
+    if key + "s" in SECTIONS:
+        return key + "s"
+    raise unknown("kind", kind, list(SECTIONS), cls=UsageError)
+
+
 def list_command(
+    kind: Annotated[str | None, typer.Argument(
+        metavar="[KIND]", show_default=False, click_type=WORDS,
+        help="Only one kind: worlds, rulebases, termsets or lessons.")] = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
 ) -> None:
     """List the packaged worlds, rule bases, term sets and lessons, a line each.
 
-    Example: `mitos list`, then `mitos simulate slalom`.
+    Example: `mitos list`, then `mitos simulate slalom`; `mitos list worlds` for the worlds
+    alone.
     """
-    cat = catalogue()
+    only = None if kind is None else section_of(kind)
+    cat = catalogue(only)
     emit(json_text(cat) if as_json else render(cat))
