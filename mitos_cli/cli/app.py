@@ -21,6 +21,7 @@ import typer
 
 from ..errors import MitosError, WriteError
 from .help import epilog, paragraphs
+from .meant import MeantGroup
 from .params import OnceCommand
 from .streams import ClosedOutput, closed_streams, end_quietly, of_stdout, sane_widths, unencodable
 
@@ -64,6 +65,7 @@ def build_app(only: str | None = None) -> typer.Typer:
         add_completion=True,
         pretty_exceptions_enable=False,
         context_settings={"help_option_names": ["-h", "--help"]},
+        cls=MeantGroup,
     )
     app.callback()(_root)
     for name, (module, attr) in COMMANDS.items():

@@ -12,6 +12,7 @@ from typing import Any, TypeVar
 
 import typer
 from typer._click import Context, Parameter
+from typer._click.exceptions import NoSuchOption
 from typer._click.types import ParamType
 from typer.core import TyperCommand, TyperOption
 
@@ -157,10 +158,15 @@ class OnceCommand(TyperCommand):
 
     def parse_args(self, ctx: Any, args: list[str]) -> list[str]:   # (Click's Context)
         # not while completing a command line, nor when help is asked for
-        if not ctx.resilient_parsing and not set(args) & set(ctx.help_option_names):
-            _, _, order = self.make_parser(ctx).parse_args(args=list(args))
-            refuse_repeats(ctx, order)
-        return super().parse_args(ctx, args)
+        try:
+            if not ctx.resilient_parsing and not set(args) & set(ctx.help_option_names):
+                _, _, order = self.make_parser(ctx).parse_args(args=list(args))
+                refuse_repeats(ctx, order)
+            return super().parse_args(ctx, args)
+        except NoSuchOption as exc:
+            from .meant import option_meant
+
+            raise option_meant(ctx, args, exc) from None
 
     def collect_usage_pieces(self, ctx: Any) -> list[str]:
         """The usage line's pieces, a required argument written as its bare name (``mitos

@@ -21,6 +21,7 @@ from ..errors import UsageError
 from ..numbers import parse_number
 from .eval_cmd import parse_values, refuse_nan, split_args, unused_inputs
 from .help import epilog
+from .meant import MeantGroup
 from .output import emit, err, warn
 from .params import WORDS, OnceCommand, choice, choices, completer, named, not_a_directory_name
 
@@ -39,6 +40,7 @@ plot_app = typer.Typer(
          "(PNG/SVG with -o, a window with --show, else in the terminal).",
     no_args_is_help=True,
     context_settings={"help_option_names": ["-h", "--help"]},
+    cls=MeantGroup,
 )
 
 
