@@ -359,6 +359,15 @@ class Tick:
         a lockstep batch records a tick of each of its runs at once, and few are looked at)."""
         return dict(zip(perception.INPUTS, self.block))
 
+    @classmethod
+    def _of(cls, *values: Any) -> Tick:
+        """``Tick(*values)`` (every field, in order), its fields written at once: the frozen
+        ``__init__`` sets them one ``object.__setattr__`` at a time, twice the cost, and a
+        lockstep batch records a tick of each of its runs every tick."""
+        tick = object.__new__(cls)
+        tick.__dict__.update(zip(_TICK_FIELDS, values))
+        return tick
+
     def __repr__(self) -> str:   # the generated one printed every beam (840 characters a robot)
         n, beams = self.ranges.shape
         if n == 1:
@@ -368,6 +377,9 @@ class Tick:
         else:
             state = f"{plural(n, 'robot')} ({int(np.count_nonzero(self.active))} still driving)"
         return f"<Tick {self.k} (t = {self.t:g} s): {state}; {plural(beams, 'beam')} a robot>"
+
+
+_TICK_FIELDS = tuple(f.name for f in fields(Tick))
 
 
 @dataclass
@@ -1899,8 +1911,8 @@ class Batch:
                     *map(self._each, (book.clearance[i], book.active[i], book.progress[i])),
                     book.ticks):
             run._hit = mine
-            tick = Tick(run._k, s.t, tick_pose, speed, steering, command, ranges, block,
-                        clearance, s.where, active, progress)
+            tick = Tick._of(run._k, s.t, tick_pose, speed, steering, command, ranges, block,
+                            clearance, s.where, active, progress)
             run.record.append(tick)
             kept.append(tick)
         if np.count_nonzero(hit) == 0 and np.count_nonzero(driving) == len(driving):
