@@ -1757,8 +1757,8 @@ class Batch:
         for run, mine in zip(self.runs, self._hints[1]):
             run._s_hint = mine
         routes = [route for run in self.runs for route in run._routes]
-        return [perception.Aim(*aim) for aim in zip(routes, frames, self.at, near, self._radius,
-                                                    self._need)]
+        return list(map(perception.Aim, routes, frames, self.at, near, self._radius,
+                        self._need))
 
     def _may_replan(self, due: list[int]) -> list[int]:
         """The rows of ``due`` (a replanning check due) whose route
@@ -1791,12 +1791,6 @@ class Batch:
         return _sights(aims, self._robots, self.pose, got.dirs, got.ranges, expected,
                        self._spacing, self._threshold[:, 0], self._least, accounted, targets,
                        gaps, self._squeeze)
-
-    def beyond(self, cells: np.ndarray) -> None:
-        """:meth:`Simulation.beyond` of every run: ``cells [rows, B, 2]``."""
-        each = list(cells)
-        for run, s, (a, b) in zip(self.runs, self.ticks, self.spans):
-            run._beyond_at = (s, each[a:b])
 
     def conclude(self, inputs: dict[str, np.ndarray], targets: np.ndarray) -> None:
         """:meth:`Simulation.perceived` and :meth:`Simulation.conclude` of every run: the
