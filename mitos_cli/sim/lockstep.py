@@ -121,6 +121,9 @@ class Lockstep:
             batch.commanded(self._commands(live, batch.block, batch.active))
             batch.guard()
             moving = batch.verdict()
+            if moving is batch.runs:        # every run drives on: the batch moves them all,
+                batch.move()                # a tick on from the tick it just recorded
+                return
         else:
             seen = [run.observe() for run in live]
             commands = self._commands(live, np.concatenate([s.block for s in seen], axis=1),

@@ -1883,7 +1883,8 @@ class Batch:
     def verdict(self) -> list[Simulation]:
         """:meth:`Simulation.verdict` of every run, once the guard has had its say: the
         tick's fields written into a page of the batch's :class:`_Book`, each run's tick
-        recorded (views of its rows) and judged; the runs whose robots move now."""
+        recorded (views of its rows) and judged; the runs whose robots move now (:attr:`runs`
+        itself where all of them do)."""
         book, i = self._page()
         x, y, h = self._ticked()
         pose = book.pose[i]
@@ -1912,7 +1913,7 @@ class Batch:
         if np.count_nonzero(hit) == 0 and np.count_nonzero(driving) == len(driving):
             for run, s in zip(self.runs, self.ticks):      # (Simulation._judge: all drive on)
                 run._deciding = s
-            return list(self.runs)
+            return self.runs                                # (its own list: not to be changed)
         return [run for run, s, touch, drives in zip(self.runs, self.ticks, hit.tolist(),
                                                        driving.tolist())
                 if run._judge(s, touch, drives)]
