@@ -1930,9 +1930,10 @@ class Batch:
 
     def _back(self, trail: list[tuple[np.ndarray, np.ndarray]], ago: int,
               each: Callable[[Simulation], np.ndarray], axis: int = 0) -> np.ndarray:
-        """The runs' odometers (``axis`` 0) or least distances (``axis`` 1) ``ago`` moves
-        back, ``each`` run's: the batch's own where its :meth:`_trail_of` goes back so far,
-        else gathered from the runs."""
+        """The runs' odometers (``axis`` 0: ``[rows]``) or least distances (``axis`` 1:
+        ``[2, rows]``) ``ago`` moves back, ``each`` run's: the batch's own where its
+        :meth:`_trail_of` goes back so far (an entry holds the two in that order), else the
+        runs' joined along ``axis``."""
         if len(trail) >= ago:
             return trail[-ago][axis]
         return np.concatenate([each(run) for run in self.runs], axis=axis)
