@@ -1715,19 +1715,20 @@ class Batch:
         :meth:`seeing` (``learned``: whether each run's were): each run's watch kept, and the
         rows of the robots that follow something (those with tracks or news) with what
         :func:`.movers.sightings` looks at for them."""
-        flags = [False] * len(self._trackers)
+        follows = np.zeros(len(self._trackers), dtype=bool)
         if self._follows:
-            flags = (np.array([bool(t.tracks) for t in self._trackers])
-                     | np.logical_or.reduce(self._seen, axis=1)).tolist()
+            follows = (np.array([bool(t.tracks) for t in self._trackers])
+                       | np.logical_or.reduce(self._seen, axis=1))
+        flags = follows.tolist()
         if self._single:
             for run, s, mine, flag in zip(self.runs, self.ticks, learned, flags):
                 run._watched = (s, mine, [0] if flag else [])
         else:
             for run, s, (a, b), mine in zip(self.runs, self.ticks, self.spans, learned):
                 run._watched = (s, mine, [i for i in range(b - a) if flags[a + i]])
-        self._watching = rows = np.flatnonzero(flags)
+        self._watching = rows = np.flatnonzero(follows)
         self._news = (np.fromiter(itertools.chain.from_iterable(learned), bool, len(flags)),
-                      np.array(flags, dtype=bool))
+                      follows)
         got = self.got
         spaces = (self._kept.picked(rows) if self._kept is not None
                   else [self._spaces[i] for i in rows.tolist()])
