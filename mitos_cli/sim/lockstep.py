@@ -121,6 +121,9 @@ class Lockstep:
             batch.commanded(self._commands(live, batch.block, batch.active))
             batch.guard()
             moving = batch.verdict()
+            if moving is batch.runs:        # every run drives on: the batch moves them all,
+                batch.move()                # a tick on from the tick it just recorded
+                return
         else:
             seen = [run.observe() for run in live]
             commands = self._commands(live, np.concatenate([s.block for s in seen], axis=1),
@@ -223,8 +226,7 @@ def _observe_together(batch: Batch) -> None:
     knowledge.clear_all(maps, batch.at, got.dirs, got.ranges, world.sensors.range)
     beyond = knowledge.beyond_cells(maps, batch.at, got.dirs, got.ranges)
     learned = None
-    if beyond is not None:
-        batch.beyond(beyond)
+    if beyond is not None:        # (marked and looked up here: no run asks for its own)
         marked = knowledge.mark_all(maps, beyond, batch.seeing())
         learned = [marked[start:stop] for start, stop in spans]
     frames = perception.frames(*batch.framing())
@@ -235,8 +237,9 @@ def _observe_together(batch: Batch) -> None:
         batch.tracked(_watched_together(batch, learned))
     near = knowledge.near_all(maps, batch.at, batch.reaches, world.replan != "clearance")
     aims = batch.aims(frames, near)
-    targets = perception.pursuit_points(aims, fresh[0].settings)[1]
-    gaps = perception.route_gaps(aims)
+    padded = perception.padded_cells(aims) if len(aims) > 1 else None   # (for both)
+    targets = perception.pursuit_points(aims, fresh[0].settings, padded=padded)[1]
+    gaps = perception.route_gaps(aims, padded=padded)
     # (after the aims: a route planned again is planned round the cells marked by then)
     if world.replan == "clearance" and beyond is not None:
         accounted = knowledge.accounted_all(maps, beyond, kept=batch.dilations)

@@ -56,6 +56,8 @@ PROGRESS_TIME = 40.0    # s: a robot that came no nearer its goal by PROGRESS_DI
 PROGRESS_DISTANCE = 1.0  # in  straight line or along its route, in it is stuck
 BEHIND = 30.0           # in: a replanned route that starts this near behind the robot costs more
 NEAR_SLACK = 24.0       # in: a robot's set of nearby walls is gathered again after this move
+#: in^2: a squared move plainly within ``NEAR_SLACK`` (its rounding is some 1e-16 of it)
+_WITHIN_SLACK = (NEAR_SLACK * (1.0 - 1e-9)) ** 2
 #: in: the deepest contact the check between ticks may miss (:meth:`Simulation._between`)
 GRAZE = 0.01
 PATH_STEP = 4.0         # in: the spacing of the route points a planner is given (Percepts.path)
@@ -357,6 +359,15 @@ class Tick:
         a lockstep batch records a tick of each of its runs at once, and few are looked at)."""
         return dict(zip(perception.INPUTS, self.block))
 
+    @classmethod
+    def _of(cls, *values: Any) -> Tick:
+        """``Tick(*values)`` (every field, in order), its fields written at once: the frozen
+        ``__init__`` sets them one ``object.__setattr__`` at a time, twice the cost, and a
+        lockstep batch records a tick of each of its runs every tick."""
+        tick = object.__new__(cls)
+        tick.__dict__.update(zip(_TICK_FIELDS, values))
+        return tick
+
     def __repr__(self) -> str:   # the generated one printed every beam (840 characters a robot)
         n, beams = self.ranges.shape
         if n == 1:
@@ -366,6 +377,9 @@ class Tick:
         else:
             state = f"{plural(n, 'robot')} ({int(np.count_nonzero(self.active))} still driving)"
         return f"<Tick {self.k} (t = {self.t:g} s): {state}; {plural(beams, 'beam')} a robot>"
+
+
+_TICK_FIELDS = tuple(f.name for f in fields(Tick))
 
 
 @dataclass
@@ -1504,6 +1518,10 @@ class Batch:
         # among obstacles that stand still (sense_rows), and the sides of those obstacles
         self._keeps_rows = self._single and all(run._still is not None for run in runs)
         self._sensing: list[rows.SenseRow] = []
+        # where each run's robot had its walls gathered as the batch last saw it (the run's
+        # own tuple, and [rows, 2] of them): its walls stay while it is plainly near there
+        self._gathered: list[tuple[float, float]] = []
+        self._gathered_at = np.zeros((0, 2))
         self._sides = ([run._still[1][3] for run in runs if run._still is not None]
                        if self._keeps_rows else [])
         self._goal_x, self._goal_y, self._tol = (self._gather(name)
@@ -1515,6 +1533,12 @@ class Batch:
                                          self._each(self._recovery)):
             run._active, run._recovery = active, recovery
         self._straight = np.concatenate([run.limits.straight for run in runs])
+        # each robot's route length: the batch's array, each run's its view (Simulation.replanned
+        # writes it in place), and what the runs had driven after the batch's last moves
+        self._lengths = self._gather("_lengths")
+        for run, lengths in zip(runs, self._each(self._lengths)):
+            run._lengths = lengths
+        self._trail: list[tuple[np.ndarray, np.ndarray]] = []
         self.stacked: rows.Kept = {}        # what its last rows.sense stacked of the runs' rows
         self.maps = [m for run in runs for m in run._maps]
         self._plain = all(run._plain for run in runs)
@@ -1544,6 +1568,9 @@ class Batch:
         self._kept = movers.Spaces.stacked(self._spaces) if self._follows else None
         self._seen = np.zeros((0, 0), dtype=bool)
         self._watching = np.zeros(0, dtype=np.intp)         # the rows that follow something
+        # (aims) the tick's marks as watching() took them: whether each row's map was marked
+        # and whether it follows something, [rows] each; None where each run took its own
+        self._news: tuple[np.ndarray, np.ndarray] | None = None
         self._limits: kinematics.Limits | None = None
         self._fleet = safety.Fleet.joined([run._fleet for run in runs])
         # (_between) each row's swing and its run's drift; what move() moved from last, and
@@ -1602,19 +1629,39 @@ class Batch:
             return [part for run in self.runs for part in run.sense_rows()]
         if not self._sensing:
             self._sensing = [run.sense_rows()[0] for run in self.runs]
+            self._gathered = [run._near_at[0] for run in self.runs]
+            self._gathered_at = np.array(self._gathered)
             return self._sensing
-        x, y, h = (v.tolist() for v in self._state()[:3])
-        for run, row, sides, *at in zip(self.runs, self._sensing, self._sides, x, y, h):
-            walls = run._walls_near(0, at[0], at[1])
+        x, y, h = self._state()[:3]
+        may = self._may_gather(x, y).tolist()
+        x, y, h = x.tolist(), y.tolist(), h.tolist()
+        gathered = self._gathered
+        for j, (run, row, sides, far, *at) in enumerate(zip(self.runs, self._sensing,
+                                                            self._sides, may, x, y, h)):
             row.x, row.y, row.heading = at
-            row.walls, row.segments = walls, run._joined(0, walls, sides)
+            if far or run._near_at[0] is not gathered[j]:
+                walls = run._walls_near(0, at[0], at[1])
+                row.walls, row.segments = walls, run._joined(0, walls, sides)
+                gathered[j] = run._near_at[0]
+                self._gathered_at[j] = gathered[j]
         return self._sensing
+
+    def _may_gather(self, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+        """``[rows]``: whether each run's robot, at ``x, y``, may have moved ``NEAR_SLACK``
+        from where its walls were gathered (:meth:`Simulation._walls_near`), as the batch
+        last saw it: its squared distance not plainly within ``NEAR_SLACK`` (a margin far
+        above rounding), so every robot left out is one whose ``math.hypot`` is within it and
+        whose walls stay."""
+        dx = x - self._gathered_at[:, 0]
+        dy = y - self._gathered_at[:, 1]
+        return ~(dx * dx + dy * dy < _WITHIN_SLACK)
 
     def sensed(self, got: rows.Sensed) -> list[_Sensed]:
         """:meth:`Simulation.sensed` of every run from the rows of all (``got``): the tick's
         arrays made once, each run's :class:`_Sensed` views of them."""
         x, y, h, *drive = self._state()
         self._now, self._drive = (x, y, h), (drive[0], drive[1])
+        self._news = None
         pose = _columns(x, y, h)
         n = len(x)
         # a row per input, as alone, laid out a robot's inputs after another's: a run of one
@@ -1668,17 +1715,20 @@ class Batch:
         :meth:`seeing` (``learned``: whether each run's were): each run's watch kept, and the
         rows of the robots that follow something (those with tracks or news) with what
         :func:`.movers.sightings` looks at for them."""
-        flags = [False] * len(self._trackers)
+        follows = np.zeros(len(self._trackers), dtype=bool)
         if self._follows:
-            flags = (np.array([bool(t.tracks) for t in self._trackers])
-                     | np.logical_or.reduce(self._seen, axis=1)).tolist()
+            follows = (np.array([bool(t.tracks) for t in self._trackers])
+                       | np.logical_or.reduce(self._seen, axis=1))
+        flags = follows.tolist()
         if self._single:
             for run, s, mine, flag in zip(self.runs, self.ticks, learned, flags):
                 run._watched = (s, mine, [0] if flag else [])
         else:
             for run, s, (a, b), mine in zip(self.runs, self.ticks, self.spans, learned):
                 run._watched = (s, mine, [i for i in range(b - a) if flags[a + i]])
-        self._watching = rows = np.flatnonzero(flags)
+        self._watching = rows = np.flatnonzero(follows)
+        self._news = (np.fromiter(itertools.chain.from_iterable(learned), bool, len(flags)),
+                      follows)
         got = self.got
         spaces = (self._kept.picked(rows) if self._kept is not None
                   else [self._spaces[i] for i in rows.tolist()])
@@ -1698,7 +1748,8 @@ class Batch:
         routes planned again (:meth:`Simulation.replanned`, robot by robot), and each robot's
         aim from the batch's rows (``frames``, ``near``: of the batch's rows)."""
         frames = list(frames)
-        for row in knowledge.checks_due(self.maps, self.ticks[0].t, self._when):
+        for row in self._may_replan(knowledge.checks_due(self.maps, self.ticks[0].t,
+                                                         self._when)):
             j, i = self._rows[row]
             frames[row] = self.runs[j].replanned(self.ticks[j], i, frames[row])
         hint = np.array([f.s for f in frames])
@@ -1707,8 +1758,29 @@ class Batch:
         for run, mine in zip(self.runs, self._hints[1]):
             run._s_hint = mine
         routes = [route for run in self.runs for route in run._routes]
-        return [perception.Aim(*aim) for aim in zip(routes, frames, self.at, near, self._radius,
-                                                    self._need)]
+        return list(map(perception.Aim, routes, frames, self.at, near, self._radius,
+                        self._need))
+
+    def _may_replan(self, due: list[int]) -> list[int]:
+        """The rows of ``due`` (a replanning check due) whose route
+        :meth:`Simulation.replanned` may plan again, in order: its first checks for all of them
+        at once. A robot still driving whose map was marked this tick (:meth:`watching`), or
+        that follows something (a mover among its tracks, :meth:`Simulation._sweep`) or waits
+        at a refuge; the rest keep their routes. Most rows due are in none of these: a check
+        stays due until there is something to check. Every row of ``due`` where the tick's
+        marks were not taken here (each run marked its own)."""
+        news = self._news
+        if news is None or not due:
+            return due
+        learned, follows = news
+        rows = np.array(due, dtype=np.intp)
+        driving = self._active[rows]
+        rest = rows[driving & ~learned[rows]].tolist()
+        maybe = rows[driving & learned[rows]].tolist()
+        maybe += [row for row in rest
+                  if self.maps[row].refuge is not None
+                  or follows[row] and any(tr.mover for tr in self._trackers[row].tracks)]
+        return sorted(maybe)
 
     def aimed(self, aims: list[perception.Aim], targets: np.ndarray, gaps: list[float],
               accounted: np.ndarray) -> perception.Sights:
@@ -1720,12 +1792,6 @@ class Batch:
         return _sights(aims, self._robots, self.pose, got.dirs, got.ranges, expected,
                        self._spacing, self._threshold[:, 0], self._least, accounted, targets,
                        gaps, self._squeeze)
-
-    def beyond(self, cells: np.ndarray) -> None:
-        """:meth:`Simulation.beyond` of every run: ``cells [rows, B, 2]``."""
-        each = list(cells)
-        for run, s, (a, b) in zip(self.runs, self.ticks, self.spans):
-            run._beyond_at = (s, each[a:b])
 
     def conclude(self, inputs: dict[str, np.ndarray], targets: np.ndarray) -> None:
         """:meth:`Simulation.perceived` and :meth:`Simulation.conclude` of every run: the
@@ -1818,7 +1884,8 @@ class Batch:
     def verdict(self) -> list[Simulation]:
         """:meth:`Simulation.verdict` of every run, once the guard has had its say: the
         tick's fields written into a page of the batch's :class:`_Book`, each run's tick
-        recorded (views of its rows) and judged; the runs whose robots move now."""
+        recorded (views of its rows) and judged; the runs whose robots move now (:attr:`runs`
+        itself where all of them do)."""
         book, i = self._page()
         x, y, h = self._ticked()
         pose = book.pose[i]
@@ -1840,17 +1907,37 @@ class Batch:
                     *map(self._each, (book.clearance[i], book.active[i], book.progress[i])),
                     book.ticks):
             run._hit = mine
-            tick = Tick(run._k, s.t, tick_pose, speed, steering, command, ranges, block,
-                        clearance, s.where, active, progress)
+            tick = Tick._of(run._k, s.t, tick_pose, speed, steering, command, ranges, block,
+                            clearance, s.where, active, progress)
             run.record.append(tick)
             kept.append(tick)
         if np.count_nonzero(hit) == 0 and np.count_nonzero(driving) == len(driving):
             for run, s in zip(self.runs, self.ticks):      # (Simulation._judge: all drive on)
                 run._deciding = s
-            return list(self.runs)
+            return self.runs                                # (its own list: not to be changed)
         return [run for run, s, touch, drives in zip(self.runs, self.ticks, hit.tolist(),
                                                        driving.tolist())
                 if run._judge(s, touch, drives)]
+
+    def _trail_of(self) -> list[tuple[np.ndarray, np.ndarray]]:
+        """What the runs' odometers and least distances to their goals (``[rows]`` and
+        ``[2, rows]``) were after each of the batch's last moves, latest last, while every
+        run was moved by each of them (:meth:`move`): each run's last entries are then its
+        views of these (else none is kept)."""
+        moved = self._moved
+        if moved is None or not all(run._moved_by is moved[1] for run in self.runs):
+            self._trail = []
+        return self._trail
+
+    def _back(self, trail: list[tuple[np.ndarray, np.ndarray]], ago: int,
+              each: Callable[[Simulation], np.ndarray], axis: int = 0) -> np.ndarray:
+        """The runs' odometers (``axis`` 0: ``[rows]``) or least distances (``axis`` 1:
+        ``[2, rows]``) ``ago`` moves back, ``each`` run's: the batch's own where its
+        :meth:`_trail_of` goes back so far (an entry holds the two in that order), else the
+        runs' joined along ``axis``."""
+        if len(trail) >= ago:
+            return trail[-ago][axis]
+        return np.concatenate([each(run) for run in self.runs], axis=axis)
 
     def _page(self) -> tuple[_Book, int]:
         """The batch's :class:`_Book` with room for this tick's page, and the page: each run
@@ -1885,32 +1972,40 @@ class Batch:
         driven = np.hypot(after[0] - x, after[1] - y)         # (Simulation.move_to)
         ticks = len(runs[0]._odometer)
         assert all(len(run._odometer) == ticks for run in runs), "runs ticked together"
+        trail = self._trail_of()
         if ticks:
-            driven = np.concatenate([run._odometer[-1] for run in runs]) + driven
-        left = (np.concatenate([run._lengths for run in runs])
-                - np.concatenate([run._s_hint for run in runs]))
-        best = _nearer(np.concatenate([run._best[-1] for run in runs], axis=1), after[0],
-                       after[1], self._goal_x, self._goal_y, left)
+            driven = self._back(trail, 1, lambda run: run._odometer[-1]) + driven
+        hint, views = self._hints
+        if not (views and all(map(operator.is_, map(_HINT, runs), views))):
+            hint = self._gather("_s_hint")
+        best = _nearer(self._back(trail, 1, lambda run: run._best[-1], axis=1), after[0],
+                       after[1], self._goal_x, self._goal_y, self._lengths - hint)
         window, slow = runs[0]._stuck_window, runs[0]._progress_window  # (_check_stuck)
         stuck = None
         if ticks + 1 > window or ticks + 2 > slow:
             stuck = _stalled(
-                self.active, driven, (np.concatenate([run._odometer[-window] for run in runs])
+                self.active, driven, (self._back(trail, window, lambda run: run._odometer[-window])
                                       if ticks + 1 > window else None),
-                best, (np.concatenate([run._best[-slow] for run in runs], axis=1)
+                best, (self._back(trail, slow, lambda run: run._best[-slow], axis=1)
                        if ticks + 2 > slow else None))
             stuck_any = np.logical_or.reduceat(stuck, self._starts).tolist()
+        trail.append((driven, best))
+        if len(trail) > max(window, slow):
+            del trail[0]
         token = object()
+        bests = list(best.T[:, :, None]) if self._single else [best[:, a:b] for a, b in self.spans]
         for j, (run, (a, b), *state, gone, nearest) in enumerate(zip(
-                runs, self.spans, *map(self._each, after), self._each(driven),
-                self._each(best.T))):
+                runs, self.spans, *map(self._each, after), self._each(driven), bests)):
             run._x, run._y, run._h, run._v, run._steer = state
             run._moved_by = token
             run._came = _Came(motion, a, b)
             run._odometer.append(gone)
-            run._best.append(nearest.T)
+            run._best.append(nearest)
             run._k += 1
-            run._go_on(stuck is not None and stuck_any[j] and run._stuck(stuck[a:b]))
+            if stuck is not None and stuck_any[j]:
+                run._go_on(run._stuck(stuck[a:b]))
+            else:
+                run._done = run._k >= run.steps             # (run._go_on(False))
         self._moved = (after, token)
         self._came = motion
         self._now = None

@@ -307,6 +307,10 @@ class Tracker:
         """:meth:`follow` with the live tracks' distances to the objects ``apart`` (row-major
         ``[T * O]``, in the objects' gates) and their order, nearest first."""
         half = radii.tolist()
+        if len(half) == 1 == len(live) and apart[0] <= GATE:     # (most often: the one thing
+            self._sighted(live[0], now, centres[0], half[0], moved[0])   # it follows, again)
+            self.tracks = live
+            return
         used_t: set[int] = set()
         used_o: set[int] = set()
         for k in order:                                          # nearest first, each once

@@ -626,19 +626,23 @@ def pursuit_point(route: Route, f: Frame, p: np.ndarray, cells: np.ndarray, radi
 _FAR = 1e12
 
 
-def pursuit_points(aims: list[Aim], cfg: Settings) -> tuple[np.ndarray, np.ndarray]:
+def pursuit_points(aims: list[Aim], cfg: Settings, *,
+                   padded: tuple[np.ndarray, np.ndarray] | None = None
+                   ) -> tuple[np.ndarray, np.ndarray]:
     """:func:`pursuit_point` of every robot at once (runs in lockstep, each robot with its
     own route and cells): the lookaheads ``[R]`` and the points ``[R, 2]``. Only the cells
     near a robot's chords are measured (:func:`_near_chords`: mostly none, and then every
     chord is clear); they are padded far away and every product is written out
-    elementwise, so a robot gets the bits it gets alone, in any batch."""
+    elementwise, so a robot gets the bits it gets alone, in any batch. ``padded``: the
+    aims' :func:`padded_cells`, where the caller has them (runs in lockstep ask this and
+    :func:`route_gaps` of the same aims)."""
     ahead = _lookaheads(cfg)
     if len(aims) == 1:
         one, target = _pursuit_one(aims[0], ahead, cfg)
         return np.array([one]), target[None]
     out_ahead = np.full(len(aims), float(ahead[-1]))
     targets = np.empty((len(aims), 2))
-    sizes, cells = _with_cells(aims)
+    sizes, cells = padded_cells(aims) if padded is None else padded
     for i in np.flatnonzero(sizes == 0).tolist():
         targets[i] = target_point(aims[i].route, aims[i].f, cfg, float(ahead[-1]))
     have_i = np.flatnonzero(sizes)
@@ -759,14 +763,15 @@ def _route_gap(f: Frame, p: np.ndarray, cells: np.ndarray) -> float:
     return float(np.hypot(*(cells - c).T).min())
 
 
-def route_gaps(aims: list[Aim]) -> list[float]:
+def route_gaps(aims: list[Aim], *,
+               padded: tuple[np.ndarray, np.ndarray] | None = None) -> list[float]:
     """:func:`_route_gap` of every robot's :class:`Aim` at once (runs in lockstep together):
     the cells padded far away, the distances elementwise and their minima exact, so each
-    robot gets the bits it gets alone."""
+    robot gets the bits it gets alone. ``padded``: as :func:`pursuit_points` takes it."""
     if len(aims) == 1:
         return [_route_gap(aims[0].f, aims[0].p, aims[0].cells)]
     out = np.full(len(aims), math.inf)
-    sizes, cells = _with_cells(aims)
+    sizes, cells = padded_cells(aims) if padded is None else padded
     have_i = np.flatnonzero(sizes)
     if not len(have_i):
         return out.tolist()
@@ -778,7 +783,7 @@ def route_gaps(aims: list[Aim]) -> list[float]:
     return out.tolist()
 
 
-def _with_cells(aims: list[Aim]) -> tuple[np.ndarray, np.ndarray]:
+def padded_cells(aims: list[Aim]) -> tuple[np.ndarray, np.ndarray]:
     """How many cells each of ``aims`` has ``[R]``, and the cells of those with some
     ``[H, P, 2]``: each row's own, then padding :data:`_FAR` away (row by row: a slice
     costs less than a mask of them all)."""
