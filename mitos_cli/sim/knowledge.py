@@ -293,7 +293,6 @@ class RobotMap:
     checked_at: float = -math.inf  # s
     replans: int = 0
     refuge: Goal | None = None     # where it waits for a mover to pass, while it waits
-    swept: movers.Sweep | None = None   # where its movers would pass, when last drawn
     planned: np.ndarray | None = None   # the cells the route was last planned on (None: given)
     marks: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
     # the cells it marked (none given), as row * cols + col, ascending (row-major order)
@@ -1114,14 +1113,12 @@ def _past_movers(rmap: RobotMap, moving: movers.Sweep, plan: Planner, p: np.ndar
 
     While the robot is bound for a refuge and the movers it yields to sweep nothing (their
     heading not known yet, and the robot turned out of its lane for the refuge:
-    :func:`.movers.sweep`), it keeps clear of where they swept when last drawn
-    (``rmap.swept``): they come on all the same, and with nothing to keep clear of, the
-    nearest place out of their way is where the robot stands, in the lane it is leaving
-    (the same run: its refuge moved to its own place at 17.4 s, 61 in from the cart)."""
-    if moving.wide:
-        rmap.swept = moving
-    elif rmap.refuge is not None and rmap.swept is not None:        # nothing drawn now
-        moving = rmap.swept
+    :func:`.movers.sweep`), it keeps the refuge it holds while it can reach it, though what
+    stands there, better seen, leaves it less room than asked: the place was chosen clear of
+    where they were drawn to pass, nothing known since says where else is out of their way,
+    and with nothing to keep clear of, the nearest place out of it is where the robot
+    stands, in the lane it is leaving (the same run: its refuge moved to its own place at
+    17.4 s, 61 in from the cart)."""
     hole = max(clearance + 6.0, moving.wide + 6.0)
     occupied = rmap.occupied | _holed(rmap.grid, moving.cells, p, hole)
     new = None
@@ -1135,6 +1132,10 @@ def _past_movers(rmap: RobotMap, moving: movers.Sweep, plan: Planner, p: np.ndar
     if new is not None:
         rmap.refuge = None
         return new
+    if rmap.refuge is not None and not moving.wide:            # nothing drawn: keep it
+        new = plan(rmap.refuge, occupied)
+        if new is not None:
+            return new
     new = refuge(rmap, rmap.occupied | moving.cells, occupied, start, clearance, minimum,
                  sight, behind)
     if new is not None:
