@@ -385,6 +385,63 @@ def test_a_robot_squeezes_right_of_what_comes_down_its_lane_on_its_left(y, squee
         assert not (sw.left & ~sw.keep_right).any()         # keep_right without the room
 
 
+@pytest.mark.parametrize("y, right", [(-12.0, True), (-2.0, False), (12.0, False)])
+def test_what_comes_down_its_lane_on_its_right_gives_the_robots_right_side(y, right):
+    """A mover down the robot's lane half a body width or more on its right gives
+    ``Sweep.right``: the robot's right of the line to it, from ``HALF_WIDTH`` off it; one
+    dead ahead or on its left gives none."""
+    shape, res, origin = (40, 120), 2.0, (-20.0, -40.0)
+    m = movers.Mover(np.array([100.0, y]), np.array([-30.0, 0.0]), 5.0, settled=False)
+    sw = movers.sweep([m], np.array([0.0, 0.0]), 0.0, 24, 18, shape, res, origin, room=3.5)
+    assert sw is not None and (sw.right is not None) == right
+    if right:
+        assert sw.right is not None and sw.left is None
+        rows, cols = np.mgrid[0:shape[0], 0:shape[1]]
+        yy = origin[1] + (rows + 0.5) * res
+        xx = origin[0] + (cols + 0.5) * res
+        off = (yy * 100.0 - xx * y) / math.hypot(100.0, y)      # left of the line to it
+        between = (xx > 5) & (xx < 95)
+        assert sw.right[between & (off < -movers.HALF_WIDTH - 2) & (off > -30)].all()
+        assert not sw.right[off > -movers.HALF_WIDTH + 1].any()
+
+
+def _squeeze_below(right: bool) -> tuple[knowledge.RobotMap, object, object]:
+    """`moving`'s hall, the robot at (300, 3) heading along it, a cart 100 in ahead 11 in
+    on its right (unsettled: its way is the lane, straight at the robot) and a box above
+    the cart's way: the only way on is squeezed between the cart's way and the lower wall
+    (25 in for a robot that needs 11 in each side). ``right``: the sweep with its
+    ``Sweep.right`` (else without, as it was until night 17)."""
+    world, rmap, route, (asked, least) = corridor_map()
+    g = rmap.grid
+    box = np.array([[x, y] for x in np.arange(392.0, 410.0, 1.0)
+                    for y in np.arange(15.0, 33.0, 1.0)])
+    rmap.mark_cells(rmap.cell_indices(box))
+    p = np.array([300.0, 3.0])
+    cart = movers.Mover(np.array([400.0, -8.0]), np.array([-15.0, 0.0]), 5.0, settled=False)
+    sw = movers.sweep([cart], p, 0.0, 24, 18, rmap.occupied.shape, g.resolution, g.origin,
+                      room=asked - least, far=150)
+    assert sw is not None and sw.right is not None and sw.left is None
+    if not right:
+        sw = movers.Sweep(sw.cells, sw.wide, sw.keep_right, sw.left)
+    new = knowledge.replan(rmap, route, 270, p, world.agents[0].goal, 1.0, asked, least, 150,
+                           moving=sw)
+    return rmap, new, world.agents[0].goal
+
+
+def test_a_robot_does_not_squeeze_right_of_a_mover_coming_on_its_right():
+    """Seed 0's `moving+clutter6` of the navigation benchmark: with the way above the cart
+    shut by a box, the route squeezed below its echoes, across its way, and the robot
+    turned into the cart's lane (hit at 18.7 s). A mover on the robot's right is not
+    passed on the right without the room: it goes to a refuge."""
+    rmap, new, goal = _squeeze_below(right=False)
+    assert new is not None and rmap.refuge is None             # the squeeze, as it was
+    assert math.dist(new.goal, (goal.x, goal.y)) < 1e-9
+    assert min(float(new.point_at(u)[1]) for u in np.arange(0, 150, 3.0)) < -25
+    rmap, new, goal = _squeeze_below(right=True)
+    assert new is not None and rmap.refuge is not None         # a refuge instead
+    assert math.dist(new.goal, (rmap.refuge.x, rmap.refuge.y)) < 1e-9
+
+
 def test_two_robots_that_meet_do_not_swerve_across_each_others_way():
     """`multirobot` run 1006 of `--runs 100 --seed 1000`: the oncoming robot, unable to keep
     right of the other with room, planned its way across in front of it, and the two met
@@ -503,6 +560,36 @@ def test_a_robot_at_its_refuge_waits_while_a_mover_comes_whose_way_is_not_drawn(
                              moving=waiting)
     assert again is not None and math.dist(again.goal, place) < 1e-9
     assert rmap.refuge is not None
+
+
+def test_while_its_movers_sweep_nothing_it_keeps_the_refuge_it_holds():
+    """A robot bound for its refuge, turned out of its lane, is swept at by nothing (the
+    cart's heading not known yet) but still stands in the lane the cart was drawn down. The
+    refuge it holds, better seen, keeps less room than asked (a box by it); it keeps it all
+    the same, and is not sent to the nearest place out of nothing's way, where it stands
+    (seed 0's `moving+clutter6`: 61 in from the cart)."""
+    world, rmap, route, (asked, least) = corridor_map()
+    goal, p = world.agents[0].goal, np.array([300.0, -10.0])
+    g = rmap.grid
+    lane = movers.capsule_cells(rmap.occupied.shape, g.resolution, g.origin,
+                                np.array([420.0, -10.0]), p, 12.0)    # straight at it
+    coming = movers.Sweep(lane | across(rmap, 420, -60, 60).cells, 12.0)
+    to_refuge = knowledge.replan(rmap, route, 270, p, goal, 1.0, asked, least, 150,
+                                 moving=coming)
+    assert to_refuge is not None and rmap.refuge is not None
+    held = np.array([rmap.refuge.x, rmap.refuge.y])
+    rmap.mark_cells(rmap.cell_indices(held[None] + [[0.0, least + 2.5]]))   # a box by it
+    room = Clearance.of(rmap.occupied, g.resolution, g.origin, cap=asked + 10)
+    assert least <= room.at(held[None])[0] < asked
+    q = p + (held - p) * 0.3                                 # on its way, still in the lane
+    col, row = rmap.cell_indices(q[None])[0]
+    assert coming.cells[row, col]
+    nothing = movers.Sweep(np.zeros_like(coming.cells), 0.0)            # waiting, undrawn
+    again = knowledge.replan(rmap, to_refuge, 0, q, goal, 2.0, asked, least, 150,
+                             moving=nothing)
+    assert again is not None and rmap.refuge is not None
+    assert math.dist(again.goal, held) < 1e-9                # the refuge it held
+    assert math.dist((rmap.refuge.x, rmap.refuge.y), held) < 1e-9
 
 
 def test_a_robot_at_its_refuge_waits_till_a_cart_beside_it_has_passed():

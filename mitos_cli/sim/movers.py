@@ -97,6 +97,9 @@ class Sweep:
     # keep_right without the room, where a mover comes down the lane on the robot's left:
     # the robot squeezes past on its right rather than cross the mover's way
     left: np.ndarray | None = None          # bool [rows, cols]
+    # the robot's right of the movers down its lane on its right: where a route that cannot
+    # keep right of them with room does not go (it would squeeze across their way)
+    right: np.ndarray | None = None         # bool [rows, cols]
 
 
 @dataclass
@@ -672,8 +675,9 @@ def sweep(found: list[Mover], robot: np.ndarray, heading: float, length: float, 
     """The cells of a map (``shape``, ``resolution``, ``origin``) that the movers ``found``
     will sweep while the robot (see :func:`swept`) gets out of their way; ``None`` when
     none. With movers in its lane, :attr:`Sweep.keep_right` too: the same ways ``room``
-    wider, and the robot's left of those movers up to ``far``; and :attr:`Sweep.left`, the
-    robot's left alone, when one of them comes on its left (:func:`_on_left`). A robot
+    wider, and the robot's left of those movers up to ``far``; :attr:`Sweep.left`, the
+    robot's left alone, when one of them comes on its left (:func:`_on_left`); and
+    :attr:`Sweep.right`, the robot's right of those that come on its right. A robot
     ``waiting`` (bound for a refuge, or at it) waits while anything is ``found`` (an empty
     sweep): a mover whose heading is not
     known yet sweeps nothing once the robot has turned out of its lane for the refuge, and
@@ -681,6 +685,7 @@ def sweep(found: list[Mover], robot: np.ndarray, heading: float, length: float, 
     cells = np.zeros(shape, dtype=bool)
     roomy = np.zeros(shape, dtype=bool)
     left = np.zeros(shape, dtype=bool)
+    right = np.zeros(shape, dtype=bool)
     wide = 0.0
     for m in found:
         for a, b, radius in swept(m, robot, heading, length, width):
@@ -689,19 +694,23 @@ def sweep(found: list[Mover], robot: np.ndarray, heading: float, length: float, 
             wide = max(wide, radius)
         if lane(m, robot, heading, width):
             left |= left_cells(shape, resolution, origin, robot, m.centre, HALF_WIDTH, far)
+            if _on_left(m, robot, heading, width, side=-1.0):
+                right |= left_cells(shape, resolution, origin, robot, m.centre, HALF_WIDTH,
+                                    far, side=-1.0)
     if not wide and not (waiting and found):
         return None
     return Sweep(cells, wide, (left | roomy) if left.any() else None,
                  left if left.any() and any(_on_left(m, robot, heading, width) for m in found)
-                 else None)
+                 else None, right if right.any() else None)
 
 
-def _on_left(m: Mover, robot: np.ndarray, heading: float, width: float) -> bool:
-    """Whether ``m`` comes down the robot's lane on its left, half a body width or more off
-    its line: going left of it would cross its way."""
+def _on_left(m: Mover, robot: np.ndarray, heading: float, width: float,
+             side: float = 1.0) -> bool:
+    """Whether ``m`` comes down the robot's lane on its left (``side`` -1: on its right),
+    half a body width or more off its line: going that side of it would cross its way."""
     rel = m.centre - robot
     return (lane(m, robot, heading, width)
-            and math.cos(heading) * rel[1] - math.sin(heading) * rel[0] >= width / 2)
+            and side * (math.cos(heading) * rel[1] - math.sin(heading) * rel[0]) >= width / 2)
 
 
 def capsule_cells(shape: tuple[int, int], resolution: float, origin: tuple[float, float],
@@ -729,18 +738,19 @@ def capsule_cells(shape: tuple[int, int], resolution: float, origin: tuple[float
 
 
 def left_cells(shape: tuple[int, int], resolution: float, origin: tuple[float, float],
-               robot: np.ndarray, mover: np.ndarray, near: float, far: float) -> np.ndarray:
+               robot: np.ndarray, mover: np.ndarray, near: float, far: float,
+               side: float = 1.0) -> np.ndarray:
     """A boolean grid ``shape`` with the cells set that lie on the robot's left facing the
-    mover, between the two (along the line from ``robot`` to ``mover``), from ``near`` to
-    ``far`` inches off that line: where a robot keeping right does not go to let the mover
-    by."""
+    mover (``side`` -1: on its right), between the two (along the line from ``robot`` to
+    ``mover``), from ``near`` to ``far`` inches off that line: where a robot keeping right
+    does not go to let the mover by."""
     out = np.zeros(shape, dtype=bool)
     e = mover - robot
     length = float(np.hypot(*e))
     if length == 0:
         return out
     u = e / length
-    n = np.array([-u[1], u[0]])                          # the robot's left, facing the mover
+    n = side * np.array([-u[1], u[0]])          # the robot's left (right), facing the mover
     corners = np.array([robot + n * near, robot + n * far, mover + n * near, mover + n * far])
     ox, oy = origin
     rows, cols = shape
