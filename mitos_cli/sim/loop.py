@@ -382,6 +382,35 @@ class Tick:
 _TICK_FIELDS = tuple(f.name for f in fields(Tick))
 
 
+class _Paged(Tick):
+    """A :class:`Tick` a lockstep batch recorded in a page of its :class:`_Book`: its fields
+    the batch keeps in the page (:data:`_BOOKED`) are views of the run's rows of it, made
+    when first read (a batch records a tick of each of its runs every tick, and few of those
+    are read before :meth:`Simulation.result` copies the pages). Copied or pickled, it is a
+    plain :class:`Tick` of its own arrays."""
+
+    @classmethod
+    def _on(cls, k: int, t: float, obstacles: np.ndarray, page: tuple[_Book, int, int, int]
+            ) -> _Paged:
+        """The tick ``k`` (at ``t`` s, the obstacles at ``obstacles``) of the rows ``a:b`` of
+        page ``i`` of ``book`` (``page``: the four)."""
+        tick = object.__new__(cls)
+        tick.__dict__.update(k=k, t=t, obstacles=obstacles, _page=page)
+        return tick
+
+    def __getattr__(self, name: str) -> Any:         # (asked only where not made yet)
+        page = self.__dict__.get("_page")
+        if page is None or name not in _BOOKED:
+            raise AttributeError(f"'Tick' object has no attribute {name!r}")
+        book, i, a, b = page
+        got = getattr(book, name)[i, a:b]
+        got = self.__dict__[name] = got.T if name == "block" else got
+        return got
+
+    def __reduce__(self) -> tuple[type[Tick], tuple[Any, ...]]:
+        return Tick, tuple(getattr(self, name) for name in _TICK_FIELDS)
+
+
 @dataclass
 class _Sensed:
     """One tick's sensing and perception, filled stage by stage (rows are robots)."""
@@ -404,6 +433,34 @@ class _Sensed:
         n, beams = self.ranges.shape
         return (f"<observed tick (t = {self.t:g} s) of {plural(n, 'robot')}: .inputs (name -> [n]),"
                 f" .ranges [n, {beams}], .pose, .clearance>")
+
+
+#: The fields of a :class:`_Sensed` that a lockstep batch's tick holds for all its rows.
+_SENSED_ROWS = ("pose", "ranges", "targets", "clearance", "command", "block")
+
+
+class _RowsSensed(_Sensed):
+    """One run's :class:`_Sensed` of a lockstep batch's tick: its arrays (:data:`_SENSED_ROWS`)
+    views of the run's rows of the batch's, made when first read (most ticks, the batch
+    reads its own arrays and no run's)."""
+
+    @classmethod
+    def _on(cls, t: float, where: np.ndarray, arrays: tuple[np.ndarray, ...], a: int,
+            b: int) -> _RowsSensed:
+        """The tick at ``t`` s (the obstacles at ``where``) of the rows ``a:b`` of the
+        batch's ``arrays`` (:data:`_SENSED_ROWS`, ``block`` ``[inputs, rows]``)."""
+        s = object.__new__(cls)
+        s.__dict__.update(t=t, where=where, _rows=(arrays, a, b))
+        return s
+
+    def __getattr__(self, name: str) -> Any:         # (asked only where not made yet)
+        rows = self.__dict__.get("_rows")
+        if rows is None or name not in _SENSED_ROWS:
+            raise AttributeError(f"'_Sensed' object has no attribute {name!r}")
+        arrays, a, b = rows
+        got = arrays[_SENSED_ROWS.index(name)]
+        got = self.__dict__[name] = got[:, a:b] if name == "block" else got[a:b]
+        return got
 
 
 class Simulation:
@@ -1670,15 +1727,14 @@ class Batch:
         self.block = inputs.T
         self.targets, self.command = np.zeros((n, 2)), np.zeros((n, 2))
         dirs, static = list(got.dirs), list(got.static)
-        blocks = (list(inputs[:, :, None]) if self._single
-                  else [self.block[:, a:b] for a, b in self.spans])
+        arrays = (pose, got.ranges, self.targets, got.clearance, self.command, self.block)
         self.ticks = []
-        for run, (a, b), *each in zip(self.runs, self.spans, self._each(pose),
-                                      self._each(got.ranges), self._each(self.targets),
-                                      self._each(got.clearance), self._each(self.command),
-                                      blocks):
-            run._beams(each[0], dirs[a:b], static[a:b])
-            self.ticks.append(_Sensed(run.time, run._where, *each))
+        for run, (a, b) in zip(self.runs, self.spans):
+            if self._plain:                               # (Simulation._beams)
+                run._dirs, run._expected = dirs[a:b], static[a:b]
+            else:
+                run._beams(pose[a:b], dirs[a:b], static[a:b])
+            self.ticks.append(_RowsSensed._on(run.time, run._where, arrays, a, b))
         self.got, self.pose, self.at = got, pose, pose[:, :2].copy()
         return self.ticks
 
@@ -1895,20 +1951,12 @@ class Batch:
                                                               self.got.clearance)
         self._before = self.got.clearance
         book.block[i], book.active[i], book.progress[i] = self.block.T, self.active, self._hint
-        blocks = (list(book.block[i][:, :, None]) if self._single
-                  else [book.block[i, a:b].T for a, b in self.spans])
         hit = np.logical_or.reduceat(self.hit, self._starts)
         driving = np.logical_or.reduceat(self.active, self._starts)
-        for run, s, mine, tick_pose, speed, steering, command, ranges, block, clearance, \
-                active, progress, kept in zip(
-                    self.runs, self.ticks, self._each(self.hit),
-                    *map(self._each, (pose, book.speed[i], book.steering[i], book.command[i],
-                                      book.ranges[i])), blocks,
-                    *map(self._each, (book.clearance[i], book.active[i], book.progress[i])),
-                    book.ticks):
+        for run, s, mine, span, kept in zip(self.runs, self.ticks, self._each(self.hit),
+                                            self.spans, book.ticks):
             run._hit = mine
-            tick = Tick._of(run._k, s.t, tick_pose, speed, steering, command, ranges, block,
-                            clearance, s.where, active, progress)
+            tick = _Paged._on(run._k, s.t, s.where, (book, i, *span))
             run.record.append(tick)
             kept.append(tick)
         if np.count_nonzero(hit) == 0 and np.count_nonzero(driving) == len(driving):
