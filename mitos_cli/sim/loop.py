@@ -1628,6 +1628,7 @@ class Batch:
         # (aims) the tick's marks as watching() took them: whether each row's map was marked
         # and whether it follows something, [rows] each; None where each run took its own
         self._news: tuple[np.ndarray, np.ndarray] | None = None
+        self._learned: list[list[bool]] = []          # (watching) each run's, for _watch
         self._limits: kinematics.Limits | None = None
         self._fleet = safety.Fleet.joined([run._fleet for run in runs])
         # (_between) each row's swing and its run's drift; what move() moved from last, and
@@ -1745,10 +1746,7 @@ class Batch:
             expected = (self.got.static if self._plain else
                         np.array([e for run in self.runs for e in run._expected]))
         self._seen = seen = _news(self.got.ranges, expected, self._far, self._threshold)
-        rows_ = list(seen)
-        for run, (a, b) in zip(self.runs, self.spans):
-            run._seen = rows_[a:b]
-        return seen
+        return seen           # (no run's own: a run reads it only where it marks its map)
 
     def tracked(self, sighted: list[movers.Seen]) -> None:
         """:meth:`Simulation.tracked` of every run once they are :meth:`watching`
@@ -1768,22 +1766,17 @@ class Batch:
                  ) -> tuple[Sequence[movers.FreeSpace], np.ndarray, np.ndarray, np.ndarray,
                             np.ndarray, np.ndarray]:
         """:meth:`Simulation.watching` of every run at once, their maps marked by
-        :meth:`seeing` (``learned``: whether each run's were): each run's watch kept, and the
-        rows of the robots that follow something (those with tracks or news) with what
-        :func:`.movers.sightings` looks at for them."""
+        :meth:`seeing` (``learned``: whether each run's were): the rows of the robots that
+        follow something (those with tracks or news) with what :func:`.movers.sightings`
+        looks at for them. Each run's watch is kept for the runs :meth:`aims` asks to
+        replan (:meth:`_watch`), the only ones that read it."""
         follows = np.zeros(len(self._trackers), dtype=bool)
         if self._follows:
             follows = (np.array([bool(t.tracks) for t in self._trackers])
                        | np.logical_or.reduce(self._seen, axis=1))
-        flags = follows.tolist()
-        if self._single:
-            for run, s, mine, flag in zip(self.runs, self.ticks, learned, flags):
-                run._watched = (s, mine, [0] if flag else [])
-        else:
-            for run, s, (a, b), mine in zip(self.runs, self.ticks, self.spans, learned):
-                run._watched = (s, mine, [i for i in range(b - a) if flags[a + i]])
         self._watching = rows = np.flatnonzero(follows)
-        self._news = (np.fromiter(itertools.chain.from_iterable(learned), bool, len(flags)),
+        self._learned = learned
+        self._news = (np.fromiter(itertools.chain.from_iterable(learned), bool, len(follows)),
                       follows)
         got = self.got
         spaces = (self._kept.picked(rows) if self._kept is not None
@@ -1807,6 +1800,7 @@ class Batch:
         for row in self._may_replan(knowledge.checks_due(self.maps, self.ticks[0].t,
                                                          self._when)):
             j, i = self._rows[row]
+            self._watch(j)
             frames[row] = self.runs[j].replanned(self.ticks[j], i, frames[row])
         hint = np.array([f.s for f in frames])
         self._hint = hint.copy()             # (for the record: no view of a run's own)
@@ -1816,6 +1810,17 @@ class Batch:
         routes = [route for run in self.runs for route in run._routes]
         return list(map(perception.Aim, routes, frames, self.at, near, self._radius,
                         self._need))
+
+    def _watch(self, j: int) -> None:
+        """Run ``j``'s watch of the tick (:meth:`Simulation.watching`), where :meth:`watching`
+        marked its maps and saw for it: whether each of its robots' maps was marked, and
+        which of them follow something."""
+        run, s = self.runs[j], self.ticks[j]
+        if self._news is None or run._watched[0] is s:      # (each run watched for itself)
+            return
+        a, b = self.spans[j]
+        follows = self._news[1]
+        run._watched = (s, self._learned[j], [i for i in range(b - a) if follows[a + i]])
 
     def _may_replan(self, due: list[int]) -> list[int]:
         """The rows of ``due`` (a replanning check due) whose route
