@@ -528,6 +528,7 @@ class Simulation:
         self.seed = world.seed if seed is None else check_seed(seed)
         self._streams = [np.random.default_rng(s) for s in
                          np.random.SeedSequence(self.seed).spawn(1 + len(world.agents))]
+        self._noise = [sensors.Noise(rng) for rng in self._streams[1:]]   # each robot's
         if self.randomise:
             world = obs_mod.randomised(world, self._streams[0])
         self.world = world
@@ -896,7 +897,7 @@ class Simulation:
             walls = self._walls_near(i, xs[i], ys[i])
             out.append(rows.SenseRow(xs[i], ys[i], hs[i], self.robots[i],
                                      walls, self._joined(i, walls, others), boxes, discs,
-                                     centres, radii, sen.noise, self._streams[1 + i]))
+                                     centres, radii, sen.noise, self._noise[i]))
         return out
 
     def sensed(self, got: rows.Sensed) -> _Sensed:
@@ -1242,7 +1243,7 @@ class Simulation:
         walls = self.scene.static.near(px, py, reach)
         robot = self.robots[i]
         row = rows.SenseRow(px, py, float(h[i]), robot, walls, walls, boxes, rows.discs(boxes),
-                            centres, radii, 0.0, self._streams[1 + i])
+                            centres, radii, 0.0, self._noise[i])
         return min(float(rows.clearance([row])[0]),
                    reach - math.hypot(robot.length, robot.width) / 2)
 
