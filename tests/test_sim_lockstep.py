@@ -236,12 +236,12 @@ def test_a_batch_watches_what_each_run_watches_alone():
     quiet = [owner[row] for row in range(len(owner)) if not seen[row].any()]
     assert quiet and len(quiet) < len(batch.maps)
     quiet[0][0]._trackers[quiet[0][1]].tracks.append(movers.Track([0.0], [np.zeros(2)]))
-    learned = [[False] * run.n for run in runs]
+    learned = [False] * len(batch.maps)     # whether each row's map was marked
     spaces, follows, *looks = batch.watching(learned)
     for j in range(len(runs)):              # (kept for the runs whose robots aims() replans)
         batch._watch(j)
     together = [run._watched for run in runs]
-    alone = [run.watching(s, mine) for run, s, mine in zip(runs, sensed, learned)]
+    alone = [run.watching(s, learned[a:b]) for run, s, (a, b) in zip(runs, sensed, batch.spans)]
     assert [w[1:] for w in together] == [run._watched[1:] for run in runs]
     assert len(follows) == len(spaces) == sum(len(w[0]) for w in alone)
     assert len(follows) == len(batch.maps) - len(quiet) + 1

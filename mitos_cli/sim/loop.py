@@ -1629,7 +1629,7 @@ class Batch:
         # (aims) the tick's marks as watching() took them: whether each row's map was marked
         # and whether it follows something, [rows] each; None where each run took its own
         self._news: tuple[np.ndarray, np.ndarray] | None = None
-        self._learned: list[list[bool]] = []          # (watching) each run's, for _watch
+        self._learned: list[bool] = []          # (watching) each row's map marked, for _watch
         self._limits: kinematics.Limits | None = None
         self._fleet = safety.Fleet.joined([run._fleet for run in runs])
         # (_between) each row's swing and its run's drift; what move() moved from last, and
@@ -1763,11 +1763,11 @@ class Batch:
             self._kept.update(t, self.at, got.dirs, got.ranges)
         movers.follow_all([self._trackers[i] for i in self._watching.tolist()], t, sighted)
 
-    def watching(self, learned: list[list[bool]]
+    def watching(self, learned: list[bool]
                  ) -> tuple[Sequence[movers.FreeSpace], np.ndarray, np.ndarray, np.ndarray,
                             np.ndarray, np.ndarray]:
         """:meth:`Simulation.watching` of every run at once, their maps marked by
-        :meth:`seeing` (``learned``: whether each run's were): the rows of the robots that
+        :meth:`seeing` (``learned``: whether each row's was): the rows of the robots that
         follow something (those with tracks or news) with what :func:`.movers.sightings`
         looks at for them. Each run's watch is kept for the runs :meth:`aims` asks to
         replan (:meth:`_watch`), the only ones that read it."""
@@ -1777,8 +1777,7 @@ class Batch:
                        | np.logical_or.reduce(self._seen, axis=1))
         self._watching = rows = np.flatnonzero(follows)
         self._learned = learned
-        self._news = (np.fromiter(itertools.chain.from_iterable(learned), bool, len(follows)),
-                      follows)
+        self._news = (np.array(learned, dtype=bool), follows)
         got = self.got
         spaces = (self._kept.picked(rows) if self._kept is not None
                   else [self._spaces[i] for i in rows.tolist()])
@@ -1821,7 +1820,7 @@ class Batch:
             return
         a, b = self.spans[j]
         follows = self._news[1]
-        run._watched = (s, self._learned[j], [i for i in range(b - a) if follows[a + i]])
+        run._watched = (s, self._learned[a:b], [i for i in range(b - a) if follows[a + i]])
 
     def _may_replan(self, due: list[int]) -> list[int]:
         """The rows of ``due`` (a replanning check due) whose route
