@@ -1542,6 +1542,14 @@ _EPOCHS = itertools.count()
 
 #: A run's arc lengths (:meth:`Batch.framing` asks whether each run's are still the batch's).
 _HINT = operator.attrgetter("_s_hint")
+#: What moved a run last, and what it has driven after each move (:meth:`Batch.move`).
+_MOVED_BY, _ODOMETER = operator.attrgetter("_moved_by"), operator.attrgetter("_odometer")
+
+
+def _all_moved_by(runs: list[Simulation], token: object) -> bool:
+    """Whether every run of ``runs`` was moved last by the batch's move that left ``token``
+    (one pass in C: a batch asks it of a hundred runs a few times a tick)."""
+    return all(map(operator.is_, map(_MOVED_BY, runs), itertools.repeat(token)))
 
 
 def row_spans(runs: list[Simulation]) -> list[tuple[int, int]]:
@@ -1676,7 +1684,7 @@ class Batch:
         while every run still holds its views of them (a run moved alone or started again
         holds arrays of its own, :meth:`Simulation.move_to`), else gathered afresh. Neither
         is written into here."""
-        if self._moved is not None and all(run._moved_by is self._moved[1] for run in self.runs):
+        if self._moved is not None and _all_moved_by(self.runs, self._moved[1]):
             return self._moved[0]
         return tuple(self._gather(name) for name in ("_x", "_y", "_h", "_v", "_steer"))
 
@@ -1882,7 +1890,7 @@ class Batch:
         recorded or moved otherwise looks for itself."""
         runs, clearance, hit, moved = self.runs, self.got.clearance, self.hit, self._moved
         if (self._came is None or moved is None or len(self._before) != len(clearance)
-                or not all(run._moved_by is moved[1] for run in runs)):
+                or not _all_moved_by(runs, moved[1])):
             for run, c, touched in zip(runs, self._each(clearance), self._each(hit)):
                 run._between(c, touched)
             return
@@ -1978,7 +1986,7 @@ class Batch:
         run was moved by each of them (:meth:`move`): each run's last entries are then its
         views of these (else none is kept)."""
         moved = self._moved
-        if moved is None or not all(run._moved_by is moved[1] for run in self.runs):
+        if moved is None or not _all_moved_by(self.runs, moved[1]):
             self._trail = []
         return self._trail
 
@@ -2024,7 +2032,7 @@ class Batch:
         after = kinematics.step(*motion, self._limits, world.dt, world.substeps)
         driven = np.hypot(after[0] - x, after[1] - y)         # (Simulation.move_to)
         ticks = len(runs[0]._odometer)
-        assert all(len(run._odometer) == ticks for run in runs), "runs ticked together"
+        assert len(set(map(len, map(_ODOMETER, runs)))) == 1, "runs ticked together"
         trail = self._trail_of()
         if ticks:
             driven = self._back(trail, 1, lambda run: run._odometer[-1]) + driven
