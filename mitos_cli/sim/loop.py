@@ -390,22 +390,24 @@ class _Paged(Tick):
     plain :class:`Tick` of its own arrays."""
 
     @classmethod
-    def _on(cls, k: int, t: float, obstacles: np.ndarray, page: tuple[_Book, int, int, int]
-            ) -> _Paged:
+    def _on(cls, k: int, t: float, obstacles: np.ndarray, page: tuple[Any, ...], a: int,
+            b: int) -> _Paged:
         """The tick ``k`` (at ``t`` s, the obstacles at ``obstacles``) of the rows ``a:b`` of
-        page ``i`` of ``book`` (``page``: the four)."""
+        ``page``: its place in a :class:`_Book` and the book's arrays (:data:`_BOOKED`), not
+        the book: a tick holds nothing the garbage collector must go through (the book
+        would be a reference a tick, as long as the run is kept, through every collection)."""
         tick = object.__new__(cls)
-        tick.__dict__.update(k=k, t=t, obstacles=obstacles, _page=page)
+        tick.__dict__.update(k=k, t=t, obstacles=obstacles, _page=page, _a=a, _b=b)
         return tick
 
     def __getattr__(self, name: str) -> Any:         # (asked only where not made yet)
-        page = self.__dict__.get("_page")
-        if page is None or name not in _BOOKED:
+        kept = self.__dict__
+        if "_page" not in kept or name not in _BOOKED:
             raise AttributeError(f"'Tick' object has no attribute {name!r}")
-        book, i, a, b = page
-        got = getattr(book, name)[i, a:b]
-        got = self.__dict__[name] = got.T if name == "block" else got
-        return got
+        page = kept["_page"]
+        rows = page[1 + _BOOKED.index(name)][page[0], kept["_a"]:kept["_b"]]
+        kept[name] = rows = rows.T if name == "block" else rows
+        return rows
 
     def __reduce__(self) -> tuple[type[Tick], tuple[Any, ...]]:
         return Tick, tuple(getattr(self, name) for name in _TICK_FIELDS)
@@ -1966,10 +1968,11 @@ class Batch:
         book.block[i], book.active[i], book.progress[i] = self.block.T, self.active, self._hint
         hit = np.logical_or.reduceat(self.hit, self._starts)
         driving = np.logical_or.reduceat(self.active, self._starts)
+        page = (i, *(getattr(book, name) for name in _BOOKED))     # (_Paged: the runs' ticks)
         for run, s, mine, span, kept in zip(self.runs, self.ticks, self._each(self.hit),
                                             self.spans, book.ticks):
             run._hit = mine
-            tick = _Paged._on(run._k, s.t, s.where, (book, i, *span))
+            tick = _Paged._on(run._k, s.t, s.where, page, *span)
             run.record.append(tick)
             kept.append(tick)
         if np.count_nonzero(hit) == 0 and np.count_nonzero(driving) == len(driving):
