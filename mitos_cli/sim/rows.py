@@ -316,7 +316,8 @@ def _noisy(rows: list[SenseRow], ranges: np.ndarray, max_range: float) -> np.nda
     width = ranges.shape[1]
     z = _stacked([r.rng.standard_normal(width) if n else np.zeros(width)
                   for r, n in zip(rows, noisy)])
-    draws = 0.0 + np.array([r.noise for r in rows])[:, None] * z
+    sigma = rows[0].noise if len(rows) == 1 else np.array([r.noise for r in rows])[:, None]
+    draws = 0.0 + sigma * z
     out = np.where(ranges >= max_range, max_range, clip_arrays(ranges + draws, 0.0, max_range))
     return out if all(noisy) else np.where(np.array(noisy)[:, None], out, ranges)
 
