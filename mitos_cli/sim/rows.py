@@ -314,7 +314,7 @@ def _noisy(rows: list[SenseRow], ranges: np.ndarray, max_range: float) -> np.nda
     if not any(noisy):
         return ranges
     width = ranges.shape[1]
-    z = _stacked([r.rng.standard_normal(width) if n else np.zeros(width)
+    z = _stacked([np.asarray(r.rng.standard_normal(width)) if n else np.zeros(width)
                   for r, n in zip(rows, noisy)])
     sigma = rows[0].noise if len(rows) == 1 else np.array([r.noise for r in rows])[:, None]
     draws = 0.0 + sigma * z
