@@ -229,14 +229,19 @@ def test_a_batch_watches_what_each_run_watches_alone():
     ranges = np.where(rng.random((len(short), 1)) < 0.5, world.sensors.range, short)
     got = rows.Sensed(got.dirs, got.static, ranges, got.clearance)
     sensed = batch.sensed(got)
-    batch.seeing()
-    quiet = [(run, i) for run in runs for i in range(run.n) if not run._seen[i].any()]
+    seen = batch.seeing()
+    own = np.concatenate([run.seeing(s) for run, s in zip(runs, sensed)])   # each run's own
+    assert seen.tobytes() == own.tobytes()
+    owner = [(run, i) for run in runs for i in range(run.n)]
+    quiet = [owner[row] for row in range(len(owner)) if not seen[row].any()]
     assert quiet and len(quiet) < len(batch.maps)
     quiet[0][0]._trackers[quiet[0][1]].tracks.append(movers.Track([0.0], [np.zeros(2)]))
-    learned = [[False] * run.n for run in runs]
+    learned = [False] * len(batch.maps)     # whether each row's map was marked
     spaces, follows, *looks = batch.watching(learned)
+    for j in range(len(runs)):              # (kept for the runs whose robots aims() replans)
+        batch._watch(j)
     together = [run._watched for run in runs]
-    alone = [run.watching(s, mine) for run, s, mine in zip(runs, sensed, learned)]
+    alone = [run.watching(s, learned[a:b]) for run, s, (a, b) in zip(runs, sensed, batch.spans)]
     assert [w[1:] for w in together] == [run._watched[1:] for run in runs]
     assert len(follows) == len(spaces) == sum(len(w[0]) for w in alone)
     assert len(follows) == len(batch.maps) - len(quiet) + 1
@@ -408,6 +413,8 @@ def test_a_batch_aims_and_replans_each_robot_as_its_run_alone(monkeypatch):
     def checked(self, frames, near):
         if not loop.knowledge.checks_due(self.maps, self.ticks[0].t, self._when):
             return aims(self, frames, near)
+        for j in range(len(self.runs)):     # each run's watch, as alone (the batch keeps it
+            self._watch(j)                  # only for the runs it replans)
         runs, ticks, frames_, near_ = copy.deepcopy((self.runs, self.ticks, frames, near))
         got = aims(self, frames, near)
         want = [aim for run, s, (a, b) in zip(runs, ticks, self.spans)

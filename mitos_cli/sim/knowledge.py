@@ -621,10 +621,16 @@ def _divmod(a: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
     return q, a - q * n
 
 
+#: A map's grid (:func:`_alike` asks whether a batch's maps are all on one).
+_GRID = operator.attrgetter("grid")
+
+
 def _alike(maps: list[RobotMap]) -> Grid | None:
     """The first map's grid when every map's cells have its shape, size and origin (the runs
     of a world do), else ``None``."""
     grid = maps[0].grid
+    if all(map(operator.is_, map(_GRID, maps), itertools.repeat(grid))):   # (most calls)
+        return grid
     shape = grid.occupied.shape
     if any(m.grid is not grid and (m.grid.occupied.shape != shape
                                    or m.grid.resolution != grid.resolution

@@ -219,16 +219,15 @@ def _observe_together(batch: Batch) -> None:
     :func:`.perception.pursuit_points`, their inputs perceived in one
     :func:`.perception.perceive_all` (each row the bits of its robot alone) and checked in
     one :meth:`.Batch.conclude`; what else each robot's map and route need, run by run."""
-    fresh, spans, maps = batch.runs, batch.spans, batch.maps
+    fresh, maps = batch.runs, batch.maps
     world = fresh[0].world
     got = rows.sense(batch.sense_rows(), fresh[0].angles, world.sensors.range, batch.stacked)
     sensed = batch.sensed(got)
     knowledge.clear_all(maps, batch.at, got.dirs, got.ranges, world.sensors.range)
     beyond = knowledge.beyond_cells(maps, batch.at, got.dirs, got.ranges)
-    learned = None
+    learned = None                # (whether each row's map was marked)
     if beyond is not None:        # (marked and looked up here: no run asks for its own)
-        marked = knowledge.mark_all(maps, beyond, batch.seeing())
-        learned = [marked[start:stop] for start, stop in spans]
+        learned = knowledge.mark_all(maps, beyond, batch.seeing())
     frames = perception.frames(*batch.framing())
     if learned is None:
         for run, s, seen in zip(fresh, sensed, _sightings_together(fresh, sensed)):
@@ -250,9 +249,9 @@ def _observe_together(batch: Batch) -> None:
                    targets)
 
 
-def _watched_together(batch: Batch, learned: list[list[bool]]) -> list[movers.Seen]:
+def _watched_together(batch: Batch, learned: list[bool]) -> list[movers.Seen]:
     """What the robots of every run of ``batch`` that follow something see
-    (:meth:`.Batch.watching`: their maps marked, ``learned`` whether they were), seen in one
+    (:meth:`.Batch.watching`: their maps marked, ``learned`` whether each row's was), seen in one
     :func:`.movers.sightings`, in row order."""
     spaces, rows, *looks = batch.watching(learned)
     return movers.sightings(spaces, batch.ticks[0].t, *looks) if len(rows) else []

@@ -382,6 +382,37 @@ class Tick:
 _TICK_FIELDS = tuple(f.name for f in fields(Tick))
 
 
+class _Paged(Tick):
+    """A :class:`Tick` a lockstep batch recorded in a page of its :class:`_Book`: its fields
+    the batch keeps in the page (:data:`_BOOKED`) are views of the run's rows of it, made
+    when first read (a batch records a tick of each of its runs every tick, and few of those
+    are read before :meth:`Simulation.result` copies the pages). Copied or pickled, it is a
+    plain :class:`Tick` of its own arrays."""
+
+    @classmethod
+    def _on(cls, k: int, t: float, obstacles: np.ndarray, page: tuple[Any, ...], a: int,
+            b: int) -> _Paged:
+        """The tick ``k`` (at ``t`` s, the obstacles at ``obstacles``) of the rows ``a:b`` of
+        ``page``: its place in a :class:`_Book` and the book's arrays (:data:`_BOOKED`), not
+        the book: a tick holds nothing the garbage collector must go through (the book
+        would be a reference a tick, as long as the run is kept, through every collection)."""
+        tick = object.__new__(cls)
+        tick.__dict__.update(k=k, t=t, obstacles=obstacles, _page=page, _a=a, _b=b)
+        return tick
+
+    def __getattr__(self, name: str) -> Any:         # (asked only where not made yet)
+        kept = self.__dict__
+        if "_page" not in kept or name not in _BOOKED:
+            raise AttributeError(f"'Tick' object has no attribute {name!r}")
+        page = kept["_page"]
+        rows = page[1 + _BOOKED.index(name)][page[0], kept["_a"]:kept["_b"]]
+        kept[name] = rows = rows.T if name == "block" else rows
+        return rows
+
+    def __reduce__(self) -> tuple[type[Tick], tuple[Any, ...]]:
+        return Tick, tuple(getattr(self, name) for name in _TICK_FIELDS)
+
+
 @dataclass
 class _Sensed:
     """One tick's sensing and perception, filled stage by stage (rows are robots)."""
@@ -404,6 +435,34 @@ class _Sensed:
         n, beams = self.ranges.shape
         return (f"<observed tick (t = {self.t:g} s) of {plural(n, 'robot')}: .inputs (name -> [n]),"
                 f" .ranges [n, {beams}], .pose, .clearance>")
+
+
+#: The fields of a :class:`_Sensed` that a lockstep batch's tick holds for all its rows.
+_SENSED_ROWS = ("pose", "ranges", "targets", "clearance", "command", "block")
+
+
+class _RowsSensed(_Sensed):
+    """One run's :class:`_Sensed` of a lockstep batch's tick: its arrays (:data:`_SENSED_ROWS`)
+    views of the run's rows of the batch's, made when first read (most ticks, the batch
+    reads its own arrays and no run's)."""
+
+    @classmethod
+    def _on(cls, t: float, where: np.ndarray, arrays: tuple[np.ndarray, ...], a: int,
+            b: int) -> _RowsSensed:
+        """The tick at ``t`` s (the obstacles at ``where``) of the rows ``a:b`` of the
+        batch's ``arrays`` (:data:`_SENSED_ROWS`, ``block`` ``[inputs, rows]``)."""
+        s = object.__new__(cls)
+        s.__dict__.update(t=t, where=where, _rows=(arrays, a, b))
+        return s
+
+    def __getattr__(self, name: str) -> Any:         # (asked only where not made yet)
+        rows = self.__dict__.get("_rows")
+        if rows is None or name not in _SENSED_ROWS:
+            raise AttributeError(f"'_Sensed' object has no attribute {name!r}")
+        arrays, a, b = rows
+        got = arrays[_SENSED_ROWS.index(name)]
+        got = self.__dict__[name] = got[:, a:b] if name == "block" else got[a:b]
+        return got
 
 
 class Simulation:
@@ -471,6 +530,7 @@ class Simulation:
         self.seed = world.seed if seed is None else check_seed(seed)
         self._streams = [np.random.default_rng(s) for s in
                          np.random.SeedSequence(self.seed).spawn(1 + len(world.agents))]
+        self._noise = [sensors.Noise(rng) for rng in self._streams[1:]]   # each robot's
         if self.randomise:
             world = obs_mod.randomised(world, self._streams[0])
         self.world = world
@@ -839,7 +899,7 @@ class Simulation:
             walls = self._walls_near(i, xs[i], ys[i])
             out.append(rows.SenseRow(xs[i], ys[i], hs[i], self.robots[i],
                                      walls, self._joined(i, walls, others), boxes, discs,
-                                     centres, radii, sen.noise, self._streams[1 + i]))
+                                     centres, radii, sen.noise, self._noise[i]))
         return out
 
     def sensed(self, got: rows.Sensed) -> _Sensed:
@@ -1185,7 +1245,7 @@ class Simulation:
         walls = self.scene.static.near(px, py, reach)
         robot = self.robots[i]
         row = rows.SenseRow(px, py, float(h[i]), robot, walls, walls, boxes, rows.discs(boxes),
-                            centres, radii, 0.0, self._streams[1 + i])
+                            centres, radii, 0.0, self._noise[i])
         return min(float(rows.clearance([row])[0]),
                    reach - math.hypot(robot.length, robot.width) / 2)
 
@@ -1484,6 +1544,14 @@ _EPOCHS = itertools.count()
 
 #: A run's arc lengths (:meth:`Batch.framing` asks whether each run's are still the batch's).
 _HINT = operator.attrgetter("_s_hint")
+#: What moved a run last, and what it has driven after each move (:meth:`Batch.move`).
+_MOVED_BY, _ODOMETER = operator.attrgetter("_moved_by"), operator.attrgetter("_odometer")
+
+
+def _all_moved_by(runs: list[Simulation], token: object) -> bool:
+    """Whether every run of ``runs`` was moved last by the batch's move that left ``token``
+    (one pass in C: a batch asks it of a hundred runs a few times a tick)."""
+    return all(map(operator.is_, map(_MOVED_BY, runs), itertools.repeat(token)))
 
 
 def row_spans(runs: list[Simulation]) -> list[tuple[int, int]]:
@@ -1571,6 +1639,7 @@ class Batch:
         # (aims) the tick's marks as watching() took them: whether each row's map was marked
         # and whether it follows something, [rows] each; None where each run took its own
         self._news: tuple[np.ndarray, np.ndarray] | None = None
+        self._learned: list[bool] = []          # (watching) each row's map marked, for _watch
         self._limits: kinematics.Limits | None = None
         self._fleet = safety.Fleet.joined([run._fleet for run in runs])
         # (_between) each row's swing and its run's drift; what move() moved from last, and
@@ -1617,7 +1686,7 @@ class Batch:
         while every run still holds its views of them (a run moved alone or started again
         holds arrays of its own, :meth:`Simulation.move_to`), else gathered afresh. Neither
         is written into here."""
-        if self._moved is not None and all(run._moved_by is self._moved[1] for run in self.runs):
+        if self._moved is not None and _all_moved_by(self.runs, self._moved[1]):
             return self._moved[0]
         return tuple(self._gather(name) for name in ("_x", "_y", "_h", "_v", "_steer"))
 
@@ -1670,15 +1739,14 @@ class Batch:
         self.block = inputs.T
         self.targets, self.command = np.zeros((n, 2)), np.zeros((n, 2))
         dirs, static = list(got.dirs), list(got.static)
-        blocks = (list(inputs[:, :, None]) if self._single
-                  else [self.block[:, a:b] for a, b in self.spans])
+        arrays = (pose, got.ranges, self.targets, got.clearance, self.command, self.block)
         self.ticks = []
-        for run, (a, b), *each in zip(self.runs, self.spans, self._each(pose),
-                                      self._each(got.ranges), self._each(self.targets),
-                                      self._each(got.clearance), self._each(self.command),
-                                      blocks):
-            run._beams(each[0], dirs[a:b], static[a:b])
-            self.ticks.append(_Sensed(run.time, run._where, *each))
+        for run, (a, b) in zip(self.runs, self.spans):
+            if self._plain:                               # (Simulation._beams)
+                run._dirs, run._expected = dirs[a:b], static[a:b]
+            else:
+                run._beams(pose[a:b], dirs[a:b], static[a:b])
+            self.ticks.append(_RowsSensed._on(run.time, run._where, arrays, a, b))
         self.got, self.pose, self.at = got, pose, pose[:, :2].copy()
         return self.ticks
 
@@ -1689,10 +1757,7 @@ class Batch:
             expected = (self.got.static if self._plain else
                         np.array([e for run in self.runs for e in run._expected]))
         self._seen = seen = _news(self.got.ranges, expected, self._far, self._threshold)
-        rows_ = list(seen)
-        for run, (a, b) in zip(self.runs, self.spans):
-            run._seen = rows_[a:b]
-        return seen
+        return seen           # (no run's own: a run reads it only where it marks its map)
 
     def tracked(self, sighted: list[movers.Seen]) -> None:
         """:meth:`Simulation.tracked` of every run once they are :meth:`watching`
@@ -1708,27 +1773,21 @@ class Batch:
             self._kept.update(t, self.at, got.dirs, got.ranges)
         movers.follow_all([self._trackers[i] for i in self._watching.tolist()], t, sighted)
 
-    def watching(self, learned: list[list[bool]]
+    def watching(self, learned: list[bool]
                  ) -> tuple[Sequence[movers.FreeSpace], np.ndarray, np.ndarray, np.ndarray,
                             np.ndarray, np.ndarray]:
         """:meth:`Simulation.watching` of every run at once, their maps marked by
-        :meth:`seeing` (``learned``: whether each run's were): each run's watch kept, and the
-        rows of the robots that follow something (those with tracks or news) with what
-        :func:`.movers.sightings` looks at for them."""
+        :meth:`seeing` (``learned``: whether each row's was): the rows of the robots that
+        follow something (those with tracks or news) with what :func:`.movers.sightings`
+        looks at for them. Each run's watch is kept for the runs :meth:`aims` asks to
+        replan (:meth:`_watch`), the only ones that read it."""
         follows = np.zeros(len(self._trackers), dtype=bool)
         if self._follows:
             follows = (np.array([bool(t.tracks) for t in self._trackers])
                        | np.logical_or.reduce(self._seen, axis=1))
-        flags = follows.tolist()
-        if self._single:
-            for run, s, mine, flag in zip(self.runs, self.ticks, learned, flags):
-                run._watched = (s, mine, [0] if flag else [])
-        else:
-            for run, s, (a, b), mine in zip(self.runs, self.ticks, self.spans, learned):
-                run._watched = (s, mine, [i for i in range(b - a) if flags[a + i]])
         self._watching = rows = np.flatnonzero(follows)
-        self._news = (np.fromiter(itertools.chain.from_iterable(learned), bool, len(flags)),
-                      follows)
+        self._learned = learned
+        self._news = (np.array(learned, dtype=bool), follows)
         got = self.got
         spaces = (self._kept.picked(rows) if self._kept is not None
                   else [self._spaces[i] for i in rows.tolist()])
@@ -1751,6 +1810,7 @@ class Batch:
         for row in self._may_replan(knowledge.checks_due(self.maps, self.ticks[0].t,
                                                          self._when)):
             j, i = self._rows[row]
+            self._watch(j)
             frames[row] = self.runs[j].replanned(self.ticks[j], i, frames[row])
         hint = np.array([f.s for f in frames])
         self._hint = hint.copy()             # (for the record: no view of a run's own)
@@ -1760,6 +1820,17 @@ class Batch:
         routes = [route for run in self.runs for route in run._routes]
         return list(map(perception.Aim, routes, frames, self.at, near, self._radius,
                         self._need))
+
+    def _watch(self, j: int) -> None:
+        """Run ``j``'s watch of the tick (:meth:`Simulation.watching`), where :meth:`watching`
+        marked its maps and saw for it: whether each of its robots' maps was marked, and
+        which of them follow something."""
+        run, s = self.runs[j], self.ticks[j]
+        if self._news is None or run._watched[0] is s:      # (each run watched for itself)
+            return
+        a, b = self.spans[j]
+        follows = self._news[1]
+        run._watched = (s, self._learned[a:b], [i for i in range(b - a) if follows[a + i]])
 
     def _may_replan(self, due: list[int]) -> list[int]:
         """The rows of ``due`` (a replanning check due) whose route
@@ -1821,7 +1892,7 @@ class Batch:
         recorded or moved otherwise looks for itself."""
         runs, clearance, hit, moved = self.runs, self.got.clearance, self.hit, self._moved
         if (self._came is None or moved is None or len(self._before) != len(clearance)
-                or not all(run._moved_by is moved[1] for run in runs)):
+                or not _all_moved_by(runs, moved[1])):
             for run, c, touched in zip(runs, self._each(clearance), self._each(hit)):
                 run._between(c, touched)
             return
@@ -1895,20 +1966,13 @@ class Batch:
                                                               self.got.clearance)
         self._before = self.got.clearance
         book.block[i], book.active[i], book.progress[i] = self.block.T, self.active, self._hint
-        blocks = (list(book.block[i][:, :, None]) if self._single
-                  else [book.block[i, a:b].T for a, b in self.spans])
         hit = np.logical_or.reduceat(self.hit, self._starts)
         driving = np.logical_or.reduceat(self.active, self._starts)
-        for run, s, mine, tick_pose, speed, steering, command, ranges, block, clearance, \
-                active, progress, kept in zip(
-                    self.runs, self.ticks, self._each(self.hit),
-                    *map(self._each, (pose, book.speed[i], book.steering[i], book.command[i],
-                                      book.ranges[i])), blocks,
-                    *map(self._each, (book.clearance[i], book.active[i], book.progress[i])),
-                    book.ticks):
+        page = (i, *(getattr(book, name) for name in _BOOKED))     # (_Paged: the runs' ticks)
+        for run, s, mine, span, kept in zip(self.runs, self.ticks, self._each(self.hit),
+                                            self.spans, book.ticks):
             run._hit = mine
-            tick = Tick._of(run._k, s.t, tick_pose, speed, steering, command, ranges, block,
-                            clearance, s.where, active, progress)
+            tick = _Paged._on(run._k, s.t, s.where, page, *span)
             run.record.append(tick)
             kept.append(tick)
         if np.count_nonzero(hit) == 0 and np.count_nonzero(driving) == len(driving):
@@ -1925,7 +1989,7 @@ class Batch:
         run was moved by each of them (:meth:`move`): each run's last entries are then its
         views of these (else none is kept)."""
         moved = self._moved
-        if moved is None or not all(run._moved_by is moved[1] for run in self.runs):
+        if moved is None or not _all_moved_by(self.runs, moved[1]):
             self._trail = []
         return self._trail
 
@@ -1971,7 +2035,7 @@ class Batch:
         after = kinematics.step(*motion, self._limits, world.dt, world.substeps)
         driven = np.hypot(after[0] - x, after[1] - y)         # (Simulation.move_to)
         ticks = len(runs[0]._odometer)
-        assert all(len(run._odometer) == ticks for run in runs), "runs ticked together"
+        assert len(set(map(len, map(_ODOMETER, runs)))) == 1, "runs ticked together"
         trail = self._trail_of()
         if ticks:
             driven = self._back(trail, 1, lambda run: run._odometer[-1]) + driven

@@ -308,12 +308,9 @@ class Tracker:
                moved: list[bool | None], sight: np.ndarray, apart: list[float],
                order: list[int]) -> None:
         """:meth:`follow` with the live tracks' distances to the objects ``apart`` (row-major
-        ``[T * O]``, in the objects' gates) and their order, nearest first."""
+        ``[T * O]``, in the objects' gates) and their order, nearest first (one track and one
+        object in its gate, most often, are matched by :func:`follow_all` itself)."""
         half = radii.tolist()
-        if len(half) == 1 == len(live) and apart[0] <= GATE:     # (most often: the one thing
-            self._sighted(live[0], now, centres[0], half[0], moved[0])   # it follows, again)
-            self.tracks = live
-            return
         used_t: set[int] = set()
         used_o: set[int] = set()
         for k in order:                                          # nearest first, each once
@@ -391,12 +388,17 @@ def follow_all(trackers: Sequence[Tracker], now: float, seen: Sequence[Seen]) ->
     lives = [[tr for tr in t.tracks if now - tr.times[-1] <= MAX_MISS] for t in trackers]
     apart, order, pairs = _apart(lives, seen, now)
     start = 0
+    sighted = Tracker._sighted
     for tracker, live, (centres, radii, moved, sight), n in zip(trackers, lives, seen, pairs):
-        if not len(centres):
+        if n == 1 and apart[start] <= GATE:      # (most often: the one thing it follows,
+            sighted(live[0], now, centres[0], radii.item(0), moved[0])   # again: _match's)
+            tracker.tracks = live
+        elif not len(centres):
             tracker.tracks = live
             continue
-        tracker._match(now, live, centres, radii, moved, sight, apart[start:start + n],
-                       [k - start for k in order[start:start + n]])
+        else:
+            tracker._match(now, live, centres, radii, moved, sight, apart[start:start + n],
+                           [k - start for k in order[start:start + n]])
         start += n
 
 

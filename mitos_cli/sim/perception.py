@@ -1130,7 +1130,11 @@ def _own_frames(headings: list[float], rel: np.ndarray,
     A row's product is NumPy's matrix-vector product, whose every element is its own
     whatever the other rows, but a row of one point is a dot product, whose bits may differ:
     those few are worked out again as one (``tests/test_sim_perception.py``)."""
-    cs = np.array([(math.cos(h), math.sin(h), math.sin(h), -math.cos(h)) for h in headings])
+    n = len(headings)
+    cs = np.empty((n, 4))                       # cos, sin, sin, -cos of each heading (math's)
+    cs[:, 0] = cos = np.fromiter(map(math.cos, headings), float, n)
+    cs[:, 1] = cs[:, 2] = np.fromiter(map(math.sin, headings), float, n)
+    cs[:, 3] = -cos
     along = np.matmul(rel, cs[:, :2, None])[..., 0]                     # rel @ [c, s]
     across = np.matmul(rel, cs[:, 2:, None])[..., 0]                    # rel @ [s, -c]
     valid_along, valid_across = np.where(valid, along, 0.0), np.where(valid, across, 0.0)

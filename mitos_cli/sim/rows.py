@@ -30,6 +30,7 @@ from .geometry import (
     polygon_overlaps,
     polygon_segments,
 )
+from .sensors import Noise
 from .world import Robot
 
 T = TypeVar("T")
@@ -50,7 +51,7 @@ class SenseRow:
     centres: np.ndarray            # [C, 2] circles
     radii: np.ndarray              # [C]
     noise: float                   # in, standard deviation of its readings' noise
-    rng: np.random.Generator       # its own stream of noise
+    rng: Noise | np.random.Generator   # its own stream of noise (standard_normal(n))
 
 
 @dataclass
@@ -307,12 +308,16 @@ def _circles(stacks: _Stacks, origin: np.ndarray, dirs: np.ndarray,
 
 def _noisy(rows: list[SenseRow], ranges: np.ndarray, max_range: float) -> np.ndarray:
     """:func:`.sensors.add_noise` of every row, each from its own stream (rows without noise
-    keep their ranges as they are)."""
+    keep their ranges as they are): each row's ``rng.normal(0.0, noise, B)``, ``0.0 + noise
+    * z`` of its next ``B`` standard normal draws, the products made for all rows at once."""
     noisy = [r.noise > 0 for r in rows]
     if not any(noisy):
         return ranges
-    draws = _stacked([np.asarray(r.rng.normal(0.0, r.noise, ranges.shape[1])) if n
-                      else np.zeros(ranges.shape[1]) for r, n in zip(rows, noisy)])
+    width = ranges.shape[1]
+    z = _stacked([np.asarray(r.rng.standard_normal(width)) if n else np.zeros(width)
+                  for r, n in zip(rows, noisy)])
+    sigma = rows[0].noise if len(rows) == 1 else np.array([r.noise for r in rows])[:, None]
+    draws = 0.0 + sigma * z
     out = np.where(ranges >= max_range, max_range, clip_arrays(ranges + draws, 0.0, max_range))
     return out if all(noisy) else np.where(np.array(noisy)[:, None], out, ranges)
 

@@ -35,6 +35,35 @@ def cast(origin: np.ndarray, dirs: np.ndarray, walls: np.ndarray, sides: np.ndar
     return static, np.minimum(segments, ray_circles(origin, dirs, centres, radii, max_range))
 
 
+class Noise:
+    """One robot's stream of sensor noise: standard normal draws from its own generator
+    (``rng``), drawn :data:`BLOCK` at a time and handed out in order (a generator's draws are
+    one sequence, however many it is asked for at once: ``rng.normal(0.0, sigma, n)`` is
+    ``0.0 + sigma * z`` of the next ``n`` of them). A lockstep tick of a hundred robots drew
+    a hundred small arrays, 1.1 us each; a look-up here costs a third of that."""
+
+    BLOCK = 4096
+
+    def __init__(self, rng: np.random.Generator) -> None:
+        self.rng = rng
+        self._block = np.zeros(0)
+        self._at = 0
+
+    def __repr__(self) -> str:
+        return f"<Noise: {len(self._block) - self._at} standard normal draws ahead>"
+
+    def standard_normal(self, n: int) -> np.ndarray:
+        """The next ``n`` standard normal draws of the stream (a read-only view)."""
+        at = self._at
+        if at + n > len(self._block):
+            self._block = np.concatenate([self._block[at:],
+                                          self.rng.standard_normal(max(self.BLOCK, n))])
+            self._block.flags.writeable = False
+            at = 0
+        self._at = at + n
+        return self._block[at:at + n]
+
+
 def add_noise(ranges: np.ndarray, sigma: float, max_range: float,
               rng: np.random.Generator) -> np.ndarray:
     """Ranges with Gaussian noise, kept within [0, range]; a beam that saw nothing stays at
