@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from mitos_cli.sim import safety
+from mitos_cli.sim import barn, geometry, kinematics, safety
 from mitos_cli.sim.world import Robot
 
 ROBOT = Robot(wheelbase=16.0, length=24.0, width=18.0)
@@ -118,6 +118,26 @@ def test_the_guard_backs_out_on_the_other_lock_when_that_is_the_only_room():
         if backs:
             break
     assert backs and steer == ROBOT.steering_max
+
+
+def test_the_guard_backs_out_on_a_wheel_between_the_locks_when_only_that_has_room():
+    """Boxed in behind on both locks and straight (a mark behind the left rear corner, one
+    off the right), a wheel between them still has room: the robot backs out on the one
+    nearest the lock toward its route rather than stand held for good (BARN's ``barn-1070``,
+    seed 1000, wedged so where 75 deg had 50 in behind and the locks and straight 0-3 in)."""
+    cfg = safety.Settings()
+    wall = [[14.5, y] for y in np.arange(-20.0, 21.0, 2.0)]
+    b = body(wall + [[-13.0, -10.0], [-16.0, 9.0]])
+    locks = (ROBOT.steering_min, ROBOT.steering_straight, ROBOT.steering_max)
+    assert all(b.free(w, True, cfg) < cfg.back_room for w in locks)
+    assert b.free(45.0, True, cfg) >= cfg.back_room
+    rec = safety.Recovery()
+    backs, steer, speed = False, 90.0, 0.0
+    for _ in range(40):
+        (steer, speed), backs = safety.guard((90.0, 30.0), b, rec, 0.05, cfg)
+        if backs:
+            break
+    assert backs and steer == 45.0 and speed == -ROBOT.max_reverse and rec.wheel == 45.0
 
 
 def test_a_robot_that_drives_out_and_back_is_not_stuck():
@@ -275,6 +295,49 @@ def test_a_robot_rolling_back_inside_its_margin_keeps_the_arc_with_more_room():
     assert turned < kept <= cfg.margin
     (steer, _), _ = safety.guard((30.0, 10.0), rolling, safety.Recovery(), 0.05, cfg)
     assert steer == 90.0
+
+
+def _gap(pose: tuple[float, float, float], robot: Robot, pole: tuple[float, ...]) -> float:
+    """The signed distance (in) from the robot's body at ``pose`` to the pole (centre x, y,
+    half length, half width): minus the depth when they overlap."""
+    px, py, hl, hw = pole
+    body = geometry.rect_corners(pose[0] - px, pose[1] - py, pose[2], robot.length, robot.width)
+    return float(geometry.box_polygon_distance(hl, hw, body[None])[0])
+
+
+def test_a_robot_rolling_back_with_no_arc_free_keeps_its_wheel_off_the_pole_beside_it():
+    """BARN's ``barn-4026`` (seed 4000, the poles unknown) in round numbers: a backing-out
+    ends at 14 in/s where a noisy mark lies inside the robot's rear right corner, so every arc
+    ahead and behind reads 0 free, and the planner asks forward at full left lock. Braking,
+    the robot rolls on back 2.3 in; a wheel turned left as it rolls swings its nose right,
+    and its front right corner into the pole 0.35 in below its flank, which it had sensed
+    (its marks lie a cell below). Neither arc leaving room, the arc it is on is the one it
+    keeps: the wheel turns only toward more room while the robot cannot stop. Standing, it
+    turns."""
+    cfg, robot = safety.Settings(), barn.JACKAL
+    pole = (4.0, -11.925, 5.0, 3.075)                  # x -1 to 9, y -15 to -8.85
+    cells = np.array([[x, -10.2] for x in np.arange(-2.0, 10.5, 2.0)] + [[-10.6, -7.9]])
+    limits, rec = kinematics.Limits.of([robot]), safety.Recovery()
+    x, y, h, v, wheel = 0.0, 0.0, 0.0, -14.0, 90.0
+    start = safety.Body(robot, (x, y, h), wheel, cells, 1.0, 0.0, 50.0, v)
+    assert all(start.free(w, back, cfg) == 0.0 for w in (30.0, 81.0, 90.0) for back in (True, False))
+    assert _gap((x, y, h), robot, pole) == pytest.approx(0.35)
+    least, ticks = math.inf, 0
+    while v != 0.0:
+        body = safety.Body(robot, (x, y, h), wheel, cells, 1.0, 0.0, 50.0, v)
+        (steer, speed), backs = safety.guard((30.0, 20.0), body, rec, 0.05, cfg)
+        assert speed == 0.0 and not backs
+        if ticks == 0:
+            assert steer == 90.0
+        moved = kinematics.step(*(np.array([q]) for q in (x, y, h, v, wheel, steer, speed)),
+                                limits, 0.05, 4)
+        x, y, h, v, wheel = (float(q[0]) for q in moved)
+        least, ticks = min(least, _gap((x, y, h), robot, pole)), ticks + 1
+    assert ticks == 7 and x == pytest.approx(-2.35, abs=0.01)
+    assert least > 0.2                    # the wheel turned on to the lock: -0.40 (a contact)
+    standing = safety.Body(robot, (x, y, h), wheel, cells, 1.0, 0.0, 50.0, 0.0)
+    (steer, _), _ = safety.guard((30.0, 20.0), standing, rec, 0.05, cfg)
+    assert steer == 30.0
 
 
 def _first_touch(cells, radius, pose, robot, delta, backward, reach, fine=0.002, deeper=0.0):

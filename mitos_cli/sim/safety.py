@@ -20,9 +20,10 @@ them away, as the paper's robot had none):
   measured the way it rolls, not the way it is told to go (:func:`_rolling`).
 - **backing out** (:class:`Recovery`): held by the brake for ``patience`` seconds while its
   planner wants to go on, the robot backs out for ``back_time`` seconds on the opposite lock
-  (which swings its nose toward the side its route lies on), as far as the way behind is
-  free, then hands back to its planner. A tricycle cannot turn on the spot; this is how it
-  turns in a pocket (ROS's ``move_base`` recovers the same way: clear, back up, try again).
+  (which swings its nose toward the side its route lies on), else straight, else the other
+  lock, else on the wheel between them nearest that lock with room behind, as far as the
+  way behind is free, then hands back to its planner. A tricycle cannot turn on the spot;
+  this is how it turns in a pocket (ROS's ``move_base`` recovers the same way: clear, back up, try again).
 
 The sweep (:func:`free_travel`) moves the footprint along the exact arc about the rear axle.
 """
@@ -634,7 +635,8 @@ def guard(command: tuple[float, float], body: Body, rec: Recovery, dt: float,
     back out now, from its planner's ``command``: a backing-out under way goes on while the
     way behind is free; otherwise the brake holds the speed to what the arc the wheel will be
     on allows, and a robot held ``patience`` seconds against its planner's wish backs out
-    (on the lock that swings its nose toward its route, else straight), if it has the room.
+    (on the lock that swings its nose toward its route, else straight, else the other lock,
+    else on a wheel between them, 15 deg apart from that lock's side), if it has the room.
     ``rec`` is updated. ``known``: the first sweep already measured (wheel, backward, free
     travel: :func:`first_sweep`'s for ``command``, ``body`` and ``rec``, measured with other
     robots' by :meth:`Fleet.guard`), whose wheel is not worked out again."""
@@ -675,11 +677,25 @@ def guard(command: tuple[float, float], body: Body, rec: Recovery, dt: float,
         return (steer, speed), False
     lock, other = ((robot.steering_min, robot.steering_max) if body.route_side > 0 else
                    (robot.steering_max, robot.steering_min))
-    for wheel in (lock, robot.steering_straight, other):    # the last rather than stay put
+    between = _wheels_between(lock, other, robot.steering_straight)
+    for wheel in (lock, robot.steering_straight, other) + between:   # rather than stay put
         if free(wheel, True) >= cfg.back_room:
             rec.left, rec.wheel, rec.held = cfg.back_time, wheel, 0.0
             return (wheel, -robot.max_reverse), True
     return (steer, speed), False
+
+
+def _wheels_between(lock: float, other: float, straight: float,
+                    step: float = 15.0) -> tuple[float, ...]:
+    """The wheels between the locks, ``step`` apart, from ``lock``'s side to ``other``'s, but
+    straight (which is tried before): a robot held where the two locks and straight have no
+    room behind may still back out on a wheel between them (BARN's ``barn-1070``, seed 1000,
+    kept its wheel while it rolled back, then wedged where 75 deg had 50 in behind and the
+    three wheels 0-3 in). Tried only where those three have none, so no backing-out that
+    started before goes another way."""
+    way = math.copysign(step, other - lock)
+    wheels = (lock + way * k for k in range(1, int(abs(other - lock) // step)))
+    return tuple(w for w in wheels if w != straight)
 
 
 def _rolling(steer: float, limit: float, wheel: float, want: float, slowest: float, body: Body,
@@ -688,16 +704,19 @@ def _rolling(steer: float, limit: float, wheel: float, want: float, slowest: flo
     """The steer and speed limit of a robot that still rolls against its command (backing
     out just ended, the way ahead of it free again): braking, it rolls on the old way, on
     the arc its wheel turns to, before it can go the new. Where that arc leaves less room
-    than the roll needs and the arc it is on leaves more, the wheel stays where it is (and
-    the limit is the new way's on that arc): measured along the new way alone, a rear
-    swung into a pole while the robot still rolled back at 7.6 in/s. The room is compared,
-    not the speeds it allows: inside the margin both allow none, and the arc with more
-    room is still the one that stays clear longer."""
+    than the roll needs and the arc it is on leaves as much or more, the wheel stays where
+    it is (and the limit is the new way's on that arc): measured along the new way alone, a
+    rear swung into a pole while the robot still rolled back at 7.6 in/s. The room is
+    compared, not the speeds it allows: inside the margin both allow none, and the arc with
+    more room is still the one that stays clear longer. Where neither leaves any (a mark
+    inside the body shuts every arc), the wheel stays too: turning it as the robot rolls
+    swings the far end of the body sideways, and a BARN robot rolling back 2.2 in from 14
+    in/s so turned its front corner into a pole it had sensed (``barn-4026``, seed 4000)."""
     robot, back = body.robot, body.speed < 0
     turned = free(wheel, back)
     if brake(turned, robot.acceleration, cfg.margin, dt) >= slowest:
         return steer, limit
-    if free(body.wheel, back) <= turned:
+    if free(body.wheel, back) < turned:
         return steer, limit
     return body.wheel, brake(free(body.wheel, want < 0), robot.acceleration, cfg.margin, dt)
 
