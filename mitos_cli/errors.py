@@ -414,3 +414,27 @@ def unknown(what: str, name: str, candidates: Iterable[str], *, span: Span | Non
     expected = f"one of {listing}" if pool else None
     of = f" of `{owner}`" if owner else ""
     return cls(f"unknown {what} `{name}`{of}", span=span, expected=expected, hint=hint)
+
+
+#: The name MITOS is installed under (``pip list``, ``pip show``). Not ``mitos``: on PyPI that
+#: is another project, which ``pip install mitos`` (or ``-U``) would put in MITOS's place.
+DISTRIBUTION = "mitos-planner"
+
+#: What each optional extra of :data:`DISTRIBUTION` installs, as pyproject.toml's
+#: ``[project.optional-dependencies]`` says (``tests/test_errors.py`` holds the two alike).
+EXTRAS = {
+    "plot": ("matplotlib>=3.6",),
+    "maps": ("Pillow>=9",),
+    "dask": ("dask[distributed]>=2024.1", "cryptography>=41"),
+    "gym": ("gymnasium>=1.0",),
+}
+
+
+def install_hint(extra: str) -> str:
+    """How to install what an optional extra holds: its packages by name, which works however
+    MITOS was installed (from a checkout, a wheel), where ``pip install 'mitos[plot]'`` took
+    another project's ``mitos`` from PyPI."""
+    import shlex
+
+    packages = " ".join(shlex.quote(p) for p in EXTRAS[extra])
+    return f"pip install {packages} (the `{extra}` extra of {DISTRIBUTION})"

@@ -1,4 +1,4 @@
-"""Gymnasium environments of the simulator (``pip install 'mitos[gym]'``).
+"""Gymnasium environments of the simulator (the ``gym`` extra: ``pip install 'gymnasium>=1.0'``).
 
 Importing this module registers ``mitos/World-v0`` (any world file: ``gymnasium.make(
 "mitos/World-v0", world="path.yaml")``) and one environment per packaged single-robot world,
@@ -55,10 +55,10 @@ try:
     import gymnasium
     from gymnasium import spaces
 except ImportError as exc:  # pragma: no cover - the extra is missing
-    from .errors import MitosError
+    from .errors import MitosError, install_hint
 
     raise MitosError("the Gymnasium environments need gymnasium, which is not installed",
-                     hint="pip install 'mitos[gym]'") from exc
+                     hint=install_hint("gym")) from exc
 
 from .errors import CommandError, InputError, WorldError, closest, unknown
 from .sim.world import World

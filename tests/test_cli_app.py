@@ -51,7 +51,9 @@ def test_version_is_the_package_version() -> None:
     assert 'dynamic = ["version"]' in pyproject          # one source: mitos_cli/_version.py
     from importlib.metadata import version
 
-    assert version("mitos") == __version__              # what pip installed says the same
+    from mitos_cli.errors import DISTRIBUTION
+
+    assert version(DISTRIBUTION) == __version__         # what pip installed says the same
 
 
 def test_a_value_outside_an_options_names_is_a_mistake_in_a_value(capsys) -> None:

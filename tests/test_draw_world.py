@@ -48,7 +48,7 @@ def test_plot_without_matplotlib_says_how_to_install(tmp_path, monkeypatch, caps
     err = capsys.readouterr().err
     assert info.value.code == 1, err
     assert "drawing pictures needs matplotlib, which is not installed" in err
-    assert "pip install 'mitos[plot]'" in err and "Traceback" not in err
+    assert "pip install 'matplotlib>=3.6' (the `plot` extra of mitos-planner)" in err and "Traceback" not in err
     assert not (tmp_path / "run.png").exists()
 
 

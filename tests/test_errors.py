@@ -951,3 +951,26 @@ def test_a_short_name_one_letter_off_gets_a_did_you_mean(name, pool, hint):
     from mitos_cli.errors import closest
 
     assert closest(name, pool) == hint
+
+
+def test_each_extras_hint_names_what_pyproject_installs_for_it() -> None:
+    """The hints say the packages of each extra by name (``pip install 'mitos[plot]'`` took
+    another project's ``mitos`` from PyPI in MITOS's place): the same packages as the
+    installed distribution's metadata, read from pyproject.toml."""
+    import re as _re
+    from importlib.metadata import metadata
+
+    from mitos_cli.errors import DISTRIBUTION, EXTRAS, install_hint
+
+    def canonical(requirement: str) -> str:
+        name, rest = _re.match(r"([A-Za-z0-9._-]+)(.*)", requirement).groups()  # type: ignore[union-attr]
+        return _re.sub(r"[-_.]+", "-", name).lower() + rest.replace(" ", "")
+
+    declared: dict[str, set[str]] = {}
+    for line in metadata(DISTRIBUTION).get_all("Requires-Dist") or []:
+        if (found := _re.fullmatch(r"(.+?); extra == '([a-z]+)'", line)) is not None:
+            declared.setdefault(found[2], set()).add(canonical(found[1]))
+    for extra, packages in EXTRAS.items():
+        assert {canonical(p) for p in packages} == declared[extra], extra
+        assert install_hint(extra).startswith("pip install ") and "mitos[" not in install_hint(extra)
+    assert install_hint("plot") == "pip install 'matplotlib>=3.6' (the `plot` extra of mitos-planner)"

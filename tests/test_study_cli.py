@@ -394,7 +394,7 @@ def test_without_matplotlib_the_report_has_no_plots(tiny, tmp_path, compare, mon
     r = compare(tiny, "--and", "min", "--planner", "fuzzy", "--runs", 1, "-o", out, "-j", 1)
     assert r.exit_code == 0, r.output
     assert "matplotlib is not installed: report.md has no plots" in r.stderr
-    assert "pip install 'mitos[plot]'" in r.stderr
+    assert "pip install 'matplotlib>=3.6' (the `plot` extra" in r.stderr
     assert (out / "report.md").is_file() and not (out / "success.png").exists()
 
 
@@ -471,7 +471,8 @@ def test_dask_not_installed_is_said_before_anything_is_written(tiny, tmp_path, c
     r = compare(tiny, "--and", "min", "--planner", "fuzzy", "--runs", 2, "-o", out,
                 "--executor", "dask")
     assert r.exit_code == 1 and words in r.stderr
-    assert "pip install 'mitos[dask]', or use --executor local" in r.stderr
+    assert ("pip install 'dask[distributed]>=2024.1' 'cryptography>=41' (the `dask` extra of "
+            "mitos-planner), or use --executor local") in r.stderr
     assert "runs (dask)" not in r.stderr and not out.exists()
 
 

@@ -936,7 +936,7 @@ def test_dask_missing_says_how_to_install(monkeypatch):
     monkeypatch.setitem(sys.modules, "distributed", None)     # import distributed -> ImportError
     with pytest.raises(StudyError) as exc:
         dask_client(None, 2)
-    assert "needs dask.distributed" in exc.value.message and "mitos[dask]" in exc.value.hint
+    assert "needs dask.distributed" in exc.value.message and "'dask[distributed]>=2024.1'" in exc.value.hint
 
 
 @pytest.mark.parametrize("changes, says", [

@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING, Annotated, Optional
 
 import typer
 
-from ..errors import UsageError, unknown
+from ..errors import UsageError, install_hint, unknown
 from ..words import plural
 from . import complete
 from .output import emit, err, json_text, warn
@@ -222,8 +222,7 @@ def _report(outcome: Outcome, out: str, plots: bool) -> Path:
     try:
         return write_report(outcome, out, plots=plots)
     except ImportError:
-        warn("matplotlib is not installed: report.md has no plots "
-             "(pip install 'mitos[plot]')")
+        warn(f"matplotlib is not installed: report.md has no plots ({install_hint('plot')})")
         return write_report(outcome, out, plots=False)
 
 

@@ -12,7 +12,7 @@ import os
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from ..errors import MitosError
+from ..errors import MitosError, install_hint
 
 if TYPE_CHECKING:
     from types import ModuleType
@@ -63,7 +63,7 @@ def _matplotlib() -> ModuleType:
         import matplotlib
     except ImportError:
         raise DrawError("drawing pictures needs matplotlib, which is not installed",
-                        hint="pip install 'mitos[plot]' (or pip install matplotlib)") from None
+                        hint=install_hint("plot")) from None
     except ValueError:              # its import reads MPLBACKEND, and refuses a name it lacks
         raise _bad_backend(os.environ.get("MPLBACKEND", "")) from None
     return matplotlib

@@ -9,7 +9,7 @@ maps often draw walls in unknown grey. Image rows run top to bottom, so they are
 row 0 at the bottom. Metres become inches.
 
 The image is a PGM (read here, no dependency) or anything Pillow reads (PNG, BMP, TIFF, ...;
-Pillow is the optional extra ``mitos[maps]``, which matplotlib already brings): a colour
+Pillow is the optional extra ``maps``, which matplotlib already brings): a colour
 pixel is the mean of its channels, as map_server reads it (:func:`shade`; an alpha channel
 averaged in with the colours in the default ``trinary`` mode, as map_server does);
 ``mode: raw`` reads pixel values (0 to 255) as occupancy percentages (:data:`MODES`).
@@ -27,7 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import MitosError, Span, WorldError, unknown
+from ..errors import MitosError, Span, WorldError, install_hint, unknown
 from ..fileio import unreadable
 from ..lang import yamlpos
 from ..resources import exists
@@ -193,7 +193,7 @@ def read_image(path: Path) -> tuple[np.ndarray, int]:
         from PIL import Image, UnidentifiedImageError
     except ImportError:
         raise ImportError("reading a map image other than PGM needs Pillow: "
-                          "pip install 'mitos[maps]' (or convert the image to PGM)") from None
+                          f"{install_hint('maps')}, or convert the image to PGM") from None
     try:
         with warnings.catch_warnings():     # (Pillow's own warning of a large image: refused)
             warnings.simplefilter("ignore", Image.DecompressionBombWarning)

@@ -16,6 +16,7 @@ from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
+from ..errors import install_hint
 from .spec import Task
 from .store import StudyError
 
@@ -122,10 +123,10 @@ def require_dask(scheduler: str | None) -> None:
 
     if find_spec("distributed") is None:
         raise StudyError("the Dask executor needs dask.distributed, which is not installed",
-                         hint="pip install 'mitos[dask]', or use --executor local")
+                         hint=f"{install_hint('dask')}, or use --executor local")
     if scheduler is None and find_spec("cryptography") is None:
         raise StudyError("the local Dask cluster needs `cryptography` for its TLS certificates",
-                         hint="pip install 'mitos[dask]', or use --executor local")
+                         hint=f"{install_hint('dask')}, or use --executor local")
 
 
 def dask_client(scheduler: str | None, workers: int, timeout: str = "10s") -> Client:
@@ -135,7 +136,7 @@ def dask_client(scheduler: str | None, workers: int, timeout: str = "10s") -> Cl
         from distributed import Client
     except ImportError:
         raise StudyError("the Dask executor needs dask.distributed, which is not installed",
-                         hint="pip install 'mitos[dask]', or use --executor local") from None
+                         hint=f"{install_hint('dask')}, or use --executor local") from None
     if scheduler:
         try:
             return Client(scheduler, timeout=timeout)
@@ -177,7 +178,7 @@ def local_cluster(workers: int) -> LocalCluster:
         security = Security.temporary()
     except ImportError:
         raise StudyError("the local Dask cluster needs `cryptography` for its TLS certificates",
-                         hint="pip install 'mitos[dask]', or use --executor local") from None
+                         hint=f"{install_hint('dask')}, or use --executor local") from None
     scratch = tempfile.mkdtemp(prefix="mitos-dask-")
     try:
         with interrupts_ignored_by_children():
