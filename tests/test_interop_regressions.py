@@ -561,6 +561,40 @@ def test_matlabs_step_smf_zmf_and_pimf_are_1_at_the_step(mf: str, inside, outsid
     assert (again.membership(x) == lo.membership(x)).all()
 
 
+@pytest.mark.parametrize("mf", ["'linsmf',[6 2]", "'linzmf',[6 2]"])
+def test_matlabs_linsmf_and_linzmf_with_feet_reversed_are_refused(mf: str):
+    """`linsmf [a b]` rises from its foot a to its shoulder b and `linzmf [a b]` falls from a to
+    b; MATLAB defines them for a <= b. With a > b the reader read `linsmf [6 2]` as a ramp
+    *falling* from 1 at 2 to 0 at 6 (fuzzylite's `Ramp 6 2`) and `linzmf [6 2]` as a rising
+    one: the opposite of what the MF's name says, without a word."""
+    text = STEP_FIS.format(mfs=f"MF1='lo':{mf}\nMF2='hi':'trimf',[0 10 20]")
+    with pytest.raises(MitosError) as exc:
+        parse_fis(text, "r.fis")
+    assert exc.value.span is not None and exc.value.span.line == 17
+    assert f"{mf.split(',')[0][1:-1]} takes [a b] with a <= b" in str(exc.value)
+    assert "write the smaller end first: `linsmf [2 6]` rises" in str(exc.value)
+
+
+def test_matlabs_linzmf_step_is_refused_by_name():
+    """`linzmf [a a]` is 0 at a itself, where a `binary` step (zmf [a a]) is 1: refused,
+    where it was refused for "start and end must differ"."""
+    text = STEP_FIS.format(mfs="MF1='lo':'linzmf',[4 4]\nMF2='hi':'trimf',[0 10 20]")
+    with pytest.raises(MitosError, match=r"`linzmf \[4 4\]` is MATLAB's step 1 below 4 and 0 "
+                                         r"from 4 on, which no MITOS shape computes exactly"):
+        parse_fis(text, "z.fis")
+
+
+@pytest.mark.parametrize("mf, ones", [("'linsmf',[4 4]", (4.0, 4.001, 10.0)),
+                                      ("'linsmf',[3 5]", (5.0, 7.0))])
+def test_matlabs_linsmf_rises_and_its_step_is_read(mf: str, ones):
+    """`linsmf [a a]` is MATLAB's step, 0 below a and 1 from a on (its documentation), as
+    `smf [a a]` is: it was refused ("start and end must differ")."""
+    text = STEP_FIS.format(mfs=f"MF1='lo':{mf}\nMF2='hi':'trimf',[0 10 20]")
+    lo = parse_fis(text, "s.fis").variables["x"].term("lo")
+    assert (lo.membership(np.array(ones)) == 1.0).all()
+    assert (lo.membership(np.array([0.0, 2.0, 2.999])) == 0.0).all()
+
+
 def test_converting_matlabs_som_to_fuzzylites_says_that_it_moves():
     from mitos_cli.interop import conversion_notes, write_foreign
 
