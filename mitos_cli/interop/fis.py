@@ -664,28 +664,30 @@ def _var_lines(v: Variable, mfs: list[str]) -> list[str]:
             f"NumMFs={len(mfs)}"] + [f"MF{i}={m}" for i, m in enumerate(mfs, 1)]
 
 
-INVERSE = {shape: (mf, order) for mf, (shape, _, order) in MF_TYPES.items() if mf != "linzmf"}
+INVERSE = {shape: (mf, order) for mf, (shape, _, order) in MF_TYPES.items()
+           if mf not in ("linsmf", "linzmf")}        # a ramp is written as a trapmf
 
 
 def _mf_text(t: Term, v: Variable) -> str:
     shape, p = t.shape, t.params
-    if shape in ("left_shoulder", "right_shoulder", "triangle_pw", "triangle_plr", "rectangle"):
+    if shape in ("left_shoulder", "right_shoulder", "ramp", "triangle_pw", "triangle_plr",
+                 "rectangle"):
         corners = t.corners
-        assert corners is not None             # these five shapes are piecewise linear
+        assert corners is not None             # these six shapes are piecewise linear
         a, b, c, d = corners
         lo, hi = v.universe
-        # a shoulder's open end: feet just outside the universe (inputs are clamped to it and
-        # outputs sampled inside it, so nothing computed changes); the feet were taken from
-        # the other infinite corner before, and written as `-inf`
+        # an open end (a shoulder's, a ramp's): feet outside the universe, 1 and 2 past it
+        # (inputs are clamped to it and outputs sampled inside it, so nothing computed
+        # changes). Apart, since Octave's toolkit refuses a trapmf whose feet meet (`[-1 -1 40
+        # 70]`: "trapmf's second argument must be a parameter vector"); a ramp went out as
+        # `linsmf` / `linzmf`, which only MATLAB R2022a on reads (not fuzzylite 6, Octave)
         if a == b == -math.inf:
-            a = b = min(lo, c) - 1.0
+            a, b = min(lo, c) - 2.0, min(lo, c) - 1.0
         if c == d == math.inf:
-            c = d = max(hi, b) + 1.0
+            c, d = max(hi, b) + 1.0, max(hi, b) + 2.0
         if shape in ("triangle_pw", "triangle_plr"):
             return f"'{t.name}':'trimf',[{fmt_number(a)} {fmt_number(b)} {fmt_number(d)}]"
         return f"'{t.name}':'trapmf',[{' '.join(fmt_number(x) for x in (a, b, c, d))}]"
-    if shape == "ramp" and p[0] > p[1]:
-        return f"'{t.name}':'linzmf',[{fmt_number(p[1])} {fmt_number(p[0])}]"
     if shape == "binary" and math.isinf(p[1]):      # MATLAB's step: smf or zmf [s s]
         mf = "smf" if p[1] > 0 else "zmf"
         return f"'{t.name}':'{mf}',[{fmt_number(p[0])} {fmt_number(p[0])}]"
