@@ -820,3 +820,36 @@ def test_an_empty_mamdani_method_that_changes_the_number_is_refused(tmp_path, ca
         one = path.read_text(encoding="utf-8").replace("NumRules=3", "NumRules=1").replace(
             "2 0, 2 (1) : 1\n", "").replace("3 2, 3 (1) : 2\n", "")
         assert [r.label for r in parse_fis(one, "one.fis").behaviors[0].rules] == ["r1"]
+
+
+SPACED_FLL = """\
+Engine : dimmer
+InputVariable : Ambient
+  range : 0 1
+  term : DARK Triangle 0 0.25 0.5
+  term : BRIGHT Triangle 0.5 0.75 1
+OutputVariable : Power
+  range : 0 1
+  aggregation : Maximum
+  defuzzifier : Centroid 100
+  default : nan
+  term : LOW Triangle 0 0.25 0.5
+  term : HIGH Triangle 0.5 0.75 1
+RuleBlock : b
+  implication : Minimum
+  rule : if Ambient is DARK then Power is HIGH
+  rule : if Ambient is BRIGHT then Power is LOW
+"""
+
+
+def test_fll_keys_spaced_from_their_colon_read_as_fuzzylite_reads_them():
+    """`range : 0 1` is read by fuzzylite 6 (the `fuzzylite` binary) and pyfuzzylite, which
+    trim the key; MITOS refused it as "unknown InputVariable key `range `" with the hint "did
+    you mean `range`?"."""
+    spaced = parse_fll(SPACED_FLL, "s.fll")
+    plain = parse_fll(SPACED_FLL.replace(" :", ":"), "p.fll")
+    assert spaced.variables["Ambient"].universe == (0.0, 1.0)
+    for x in (0.1, 0.3, 0.6, 0.9):
+        assert outputs(spaced, Ambient=x) == outputs(plain, Ambient=x)
+    assert outputs(spaced, Ambient=0.3)["Power"] == pytest.approx(0.75, abs=1e-12)
+

@@ -197,10 +197,11 @@ def _sections(text: str, path: str | None) -> tuple[list[_Var], list[_Block], Sp
         if not line.strip():
             continue
         indent = len(line) - len(line.lstrip())
-        key, sep, value = line.strip().partition(":")
+        written, sep, value = line.strip().partition(":")
+        key = written.rstrip()       # `range : 0 1`, as fuzzylite 6 and pyfuzzylite read it
         col = indent + 1
         span = Span.in_text(text, path, lineno, col, col + len(key))
-        vcol = indent + len(key) + 2 + (len(value) - len(value.lstrip()))
+        vcol = indent + len(written) + 2 + (len(value) - len(value.lstrip()))
         value = value.strip()
         vspan = Span.in_text(text, path, lineno, vcol, vcol + max(1, len(value)))
         if not sep:
