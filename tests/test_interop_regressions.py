@@ -853,3 +853,34 @@ def test_fll_keys_spaced_from_their_colon_read_as_fuzzylite_reads_them():
         assert outputs(spaced, Ambient=x) == outputs(plain, Ambient=x)
     assert outputs(spaced, Ambient=0.3)["Power"] == pytest.approx(0.75, abs=1e-12)
 
+
+PLAIN_FLL = SPACED_FLL.replace(" :", ":")
+
+
+@pytest.mark.parametrize("text", [
+    PLAIN_FLL.replace("  implication: Minimum\n", ""),
+    PLAIN_FLL.replace("implication: Minimum", "implication: none")])
+def test_a_mamdani_rule_block_without_implication_is_refused(text: str):
+    """fuzzylite (6 and 8) stops on a Mamdani rule block without an implication ("implication
+    operator needed to activate"); MITOS read it as min without a word, as the .fis reader
+    did `ImpMethod=''` until it refused it."""
+    with pytest.raises(MitosError) as exc:
+        parse_fll(text, "i.fll")
+    assert "the rule block has no implication, but rule r1 concludes `Power`" in str(exc.value)
+    assert exc.value.span is not None
+    assert exc.value.span.source_line.strip() == "rule: if Ambient is DARK then Power is HIGH"
+
+
+@pytest.mark.parametrize("text", [
+    PLAIN_FLL.replace("  aggregation: Maximum\n", ""),
+    PLAIN_FLL.replace("aggregation: Maximum", "aggregation: none")])
+def test_a_mamdani_output_two_rules_set_without_aggregation_is_refused(text: str):
+    """Two rules setting `Power` join their sets by its aggregation, which the file leaves out:
+    fuzzylite stops ("expected an aggregation operator"), MITOS took max without a word. One
+    rule per output needs none (its set is itself under any S-norm) and still loads."""
+    with pytest.raises(MitosError) as exc:
+        parse_fll(text, "a.fll")
+    assert "output `Power` has no aggregation, but rules r1 and r2 both set it" in str(exc.value)
+    assert exc.value.span is not None and exc.value.span.line == 6
+    one = text.replace("  rule: if Ambient is BRIGHT then Power is LOW\n", "")
+    assert outputs(parse_fll(one, "o.fll"), Ambient=0.3)["Power"] == pytest.approx(0.75, abs=1e-12)
