@@ -884,3 +884,12 @@ def test_a_mamdani_output_two_rules_set_without_aggregation_is_refused(text: str
     assert exc.value.span is not None and exc.value.span.line == 6
     one = text.replace("  rule: if Ambient is BRIGHT then Power is LOW\n", "")
     assert outputs(parse_fll(one, "o.fll"), Ambient=0.3)["Power"] == pytest.approx(0.75, abs=1e-12)
+
+
+def test_a_mamdani_output_without_defuzzifier_is_refused():
+    """fuzzylite stops on an output its rules set without a defuzzifier ("defuzzifier needed
+    to defuzzify output variable"); MITOS took the centroid without a word."""
+    with pytest.raises(MitosError) as exc:
+        parse_fll(PLAIN_FLL.replace("  defuzzifier: Centroid 100\n", ""), "d.fll")
+    assert "output `Power` has no defuzzifier, but rule r1 sets it" in str(exc.value)
+    assert exc.value.span is not None and exc.value.span.line == 6

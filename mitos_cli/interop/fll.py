@@ -278,11 +278,12 @@ def _check_outputs(variables: list[_Var], rules: list[Rule], settings: Settings)
 
 
 def _check_unset(variables: list[_Var], rules: list[Rule], settings: Settings) -> None:
-    """A Mamdani rule block without an `implication` (or `implication: none`), and an output
-    two of its rules set without an `aggregation`: fuzzylite stops there ("implication
-    operator needed", "expected an aggregation operator"), as the .fis reader does for
-    `ImpMethod=''` and `AggMethod=''`. They were read as MITOS's defaults, min and max,
-    without a word. One rule's set joined with nothing is itself under any S-norm."""
+    """A Mamdani rule block without an `implication` (or `implication: none`), an output its
+    rules set without a `defuzzifier`, and one two of its rules set without an `aggregation`:
+    fuzzylite stops there ("implication operator needed", "defuzzifier needed", "expected an
+    aggregation operator"), as the .fis reader does for `ImpMethod=''` and `AggMethod=''`.
+    They were read as MITOS's defaults (min, centroid, max) without a word. One rule's set
+    joined with nothing is itself under any S-norm."""
     if settings.implication is None and rules:
         rule = rules[0]
         raise FormatError(f"the rule block has no implication, but rule {rule.label} concludes "
@@ -290,19 +291,24 @@ def _check_unset(variables: list[_Var], rules: list[Rule], settings: Settings) -
                           f"implication, and fuzzylite stops without one", span=rule.span,
                           hint="add `implication: Minimum` (or another T-norm) to the "
                                "RuleBlock")
-    if settings.aggregation is None:
-        first: dict[str, Rule] = {}
-        for rule in rules:
-            for c in rule.consequents:
-                if c.var in first and first[c.var] is not rule:
-                    v = next(x for x in variables if x.name == c.var)
-                    raise FormatError(
-                        f"output `{c.var}` has no aggregation, but rules {first[c.var].label} "
-                        f"and {rule.label} both set it: a Mamdani output joins their sets "
-                        f"with its aggregation, and fuzzylite stops without one", span=v.span,
-                        hint="add `aggregation: Maximum` (or another S-norm) to the "
-                             "OutputVariable")
-                first.setdefault(c.var, rule)
+    first: dict[str, Rule] = {}
+    for rule in rules:
+        for c in rule.consequents:
+            v = next(x for x in variables if x.name == c.var)
+            written = {entry[0] for entry in v.record}
+            if "defuzzify" not in written:
+                raise FormatError(f"output `{c.var}` has no defuzzifier, but rule {rule.label} "
+                                  f"sets it: fuzzylite stops without one", span=v.span,
+                                  hint="add `defuzzifier: Centroid` (or another) to the "
+                                       "OutputVariable")
+            if c.var in first and first[c.var] is not rule and "aggregation" not in written:
+                raise FormatError(
+                    f"output `{c.var}` has no aggregation, but rules {first[c.var].label} "
+                    f"and {rule.label} both set it: a Mamdani output joins their sets "
+                    f"with its aggregation, and fuzzylite stops without one", span=v.span,
+                    hint="add `aggregation: Maximum` (or another S-norm) to the "
+                         "OutputVariable")
+            first.setdefault(c.var, rule)
 
 
 def _variable_key(v: _Var, key: str, value: str, span: Span, vspan: Span,
