@@ -893,3 +893,15 @@ def test_a_mamdani_output_without_defuzzifier_is_refused():
         parse_fll(PLAIN_FLL.replace("  defuzzifier: Centroid 100\n", ""), "d.fll")
     assert "output `Power` has no defuzzifier, but rule r1 sets it" in str(exc.value)
     assert exc.value.span is not None and exc.value.span.line == 6
+
+
+def test_an_output_without_aggregation_does_not_borrow_another_outputs():
+    """`Power` has `aggregation: Maximum`, `Fan` none and two rules: the check read the rule
+    base's merged operators, where Power's Maximum stood for both."""
+    text = PLAIN_FLL.replace("RuleBlock: b", "OutputVariable: Fan\n  range: 0 1\n"
+                             "  defuzzifier: Centroid 100\n  term: OFF Triangle 0 0 1\n"
+                             "RuleBlock: b").replace(
+        "then Power is HIGH", "then Power is HIGH and Fan is OFF").replace(
+        "then Power is LOW", "then Power is LOW and Fan is OFF")
+    with pytest.raises(MitosError, match="output `Fan` has no aggregation, but rules r1 and r2"):
+        parse_fll(text, "f.fll")
