@@ -706,9 +706,10 @@ def test_a_term_repeated_thousands_of_times_is_checked_in_little_memory(tmp_path
 
     path = tmp_path / "many.fll"
     path.write_text("Engine: e\nInputVariable: x\n  range: 0 1\n  term: A Triangle 0 0.5 1\n"
-                    "OutputVariable: y\n  range: 0 1\n  default: 0.5\n"
+                    "OutputVariable: y\n  range: 0 1\n  defuzzifier: Centroid\n  default: 0.5\n"
                     + "  term: A Triangle 0 0.5 1\n" * 3000
-                    + "RuleBlock: r\n  rule: if x is A then y is A\n", encoding="utf-8")
+                    + "RuleBlock: r\n  implication: Minimum\n  rule: if x is A then y is A\n",
+                    encoding="utf-8")
     code, out, _ = run(["check", str(path)], capsys)
     assert code == 0 and "are hard to tell apart (similarity 1.00 > 0.5) [indistinct]" in out
     rb = read_rulebase(path)

@@ -561,6 +561,40 @@ def test_matlabs_step_smf_zmf_and_pimf_are_1_at_the_step(mf: str, inside, outsid
     assert (again.membership(x) == lo.membership(x)).all()
 
 
+@pytest.mark.parametrize("mf", ["'linsmf',[6 2]", "'linzmf',[6 2]"])
+def test_matlabs_linsmf_and_linzmf_with_feet_reversed_are_refused(mf: str):
+    """`linsmf [a b]` rises from its foot a to its shoulder b and `linzmf [a b]` falls from a to
+    b; MATLAB defines them for a <= b. With a > b the reader read `linsmf [6 2]` as a ramp
+    *falling* from 1 at 2 to 0 at 6 (fuzzylite's `Ramp 6 2`) and `linzmf [6 2]` as a rising
+    one: the opposite of what the MF's name says, without a word."""
+    text = STEP_FIS.format(mfs=f"MF1='lo':{mf}\nMF2='hi':'trimf',[0 10 20]")
+    with pytest.raises(MitosError) as exc:
+        parse_fis(text, "r.fis")
+    assert exc.value.span is not None and exc.value.span.line == 17
+    assert f"{mf.split(',')[0][1:-1]} takes [a b] with a <= b" in str(exc.value)
+    assert "write the smaller end first: `linsmf [2 6]` rises" in str(exc.value)
+
+
+def test_matlabs_linzmf_step_is_refused_by_name():
+    """`linzmf [a a]` is 0 at a itself, where a `binary` step (zmf [a a]) is 1: refused,
+    where it was refused for "start and end must differ"."""
+    text = STEP_FIS.format(mfs="MF1='lo':'linzmf',[4 4]\nMF2='hi':'trimf',[0 10 20]")
+    with pytest.raises(MitosError, match=r"`linzmf \[4 4\]` is MATLAB's step 1 below 4 and 0 "
+                                         r"from 4 on, which no MITOS shape computes exactly"):
+        parse_fis(text, "z.fis")
+
+
+@pytest.mark.parametrize("mf, ones", [("'linsmf',[4 4]", (4.0, 4.001, 10.0)),
+                                      ("'linsmf',[3 5]", (5.0, 7.0))])
+def test_matlabs_linsmf_rises_and_its_step_is_read(mf: str, ones):
+    """`linsmf [a a]` is MATLAB's step, 0 below a and 1 from a on (its documentation), as
+    `smf [a a]` is: it was refused ("start and end must differ")."""
+    text = STEP_FIS.format(mfs=f"MF1='lo':{mf}\nMF2='hi':'trimf',[0 10 20]")
+    lo = parse_fis(text, "s.fis").variables["x"].term("lo")
+    assert (lo.membership(np.array(ones)) == 1.0).all()
+    assert (lo.membership(np.array([0.0, 2.0, 2.999])) == 0.0).all()
+
+
 def test_converting_matlabs_som_to_fuzzylites_says_that_it_moves():
     from mitos_cli.interop import conversion_notes, write_foreign
 
@@ -786,3 +820,88 @@ def test_an_empty_mamdani_method_that_changes_the_number_is_refused(tmp_path, ca
         one = path.read_text(encoding="utf-8").replace("NumRules=3", "NumRules=1").replace(
             "2 0, 2 (1) : 1\n", "").replace("3 2, 3 (1) : 2\n", "")
         assert [r.label for r in parse_fis(one, "one.fis").behaviors[0].rules] == ["r1"]
+
+
+SPACED_FLL = """\
+Engine : dimmer
+InputVariable : Ambient
+  range : 0 1
+  term : DARK Triangle 0 0.25 0.5
+  term : BRIGHT Triangle 0.5 0.75 1
+OutputVariable : Power
+  range : 0 1
+  aggregation : Maximum
+  defuzzifier : Centroid 100
+  default : nan
+  term : LOW Triangle 0 0.25 0.5
+  term : HIGH Triangle 0.5 0.75 1
+RuleBlock : b
+  implication : Minimum
+  rule : if Ambient is DARK then Power is HIGH
+  rule : if Ambient is BRIGHT then Power is LOW
+"""
+
+
+def test_fll_keys_spaced_from_their_colon_read_as_fuzzylite_reads_them():
+    """`range : 0 1` is read by fuzzylite 6 (the `fuzzylite` binary) and pyfuzzylite, which
+    trim the key; MITOS refused it as "unknown InputVariable key `range `" with the hint "did
+    you mean `range`?"."""
+    spaced = parse_fll(SPACED_FLL, "s.fll")
+    plain = parse_fll(SPACED_FLL.replace(" :", ":"), "p.fll")
+    assert spaced.variables["Ambient"].universe == (0.0, 1.0)
+    for x in (0.1, 0.3, 0.6, 0.9):
+        assert outputs(spaced, Ambient=x) == outputs(plain, Ambient=x)
+    assert outputs(spaced, Ambient=0.3)["Power"] == pytest.approx(0.75, abs=1e-12)
+
+
+PLAIN_FLL = SPACED_FLL.replace(" :", ":")
+
+
+@pytest.mark.parametrize("text", [
+    PLAIN_FLL.replace("  implication: Minimum\n", ""),
+    PLAIN_FLL.replace("implication: Minimum", "implication: none")])
+def test_a_mamdani_rule_block_without_implication_is_refused(text: str):
+    """fuzzylite (6 and 8) stops on a Mamdani rule block without an implication ("implication
+    operator needed to activate"); MITOS read it as min without a word, as the .fis reader
+    did `ImpMethod=''` until it refused it."""
+    with pytest.raises(MitosError) as exc:
+        parse_fll(text, "i.fll")
+    assert "the rule block has no implication, but rule r1 concludes `Power`" in str(exc.value)
+    assert exc.value.span is not None
+    assert exc.value.span.source_line.strip() == "rule: if Ambient is DARK then Power is HIGH"
+
+
+@pytest.mark.parametrize("text", [
+    PLAIN_FLL.replace("  aggregation: Maximum\n", ""),
+    PLAIN_FLL.replace("aggregation: Maximum", "aggregation: none")])
+def test_a_mamdani_output_two_rules_set_without_aggregation_is_refused(text: str):
+    """Two rules setting `Power` join their sets by its aggregation, which the file leaves out:
+    fuzzylite stops ("expected an aggregation operator"), MITOS took max without a word. One
+    rule per output needs none (its set is itself under any S-norm) and still loads."""
+    with pytest.raises(MitosError) as exc:
+        parse_fll(text, "a.fll")
+    assert "output `Power` has no aggregation, but rules r1 and r2 both set it" in str(exc.value)
+    assert exc.value.span is not None and exc.value.span.line == 6
+    one = text.replace("  rule: if Ambient is BRIGHT then Power is LOW\n", "")
+    assert outputs(parse_fll(one, "o.fll"), Ambient=0.3)["Power"] == pytest.approx(0.75, abs=1e-12)
+
+
+def test_a_mamdani_output_without_defuzzifier_is_refused():
+    """fuzzylite stops on an output its rules set without a defuzzifier ("defuzzifier needed
+    to defuzzify output variable"); MITOS took the centroid without a word."""
+    with pytest.raises(MitosError) as exc:
+        parse_fll(PLAIN_FLL.replace("  defuzzifier: Centroid 100\n", ""), "d.fll")
+    assert "output `Power` has no defuzzifier, but rule r1 sets it" in str(exc.value)
+    assert exc.value.span is not None and exc.value.span.line == 6
+
+
+def test_an_output_without_aggregation_does_not_borrow_another_outputs():
+    """`Power` has `aggregation: Maximum`, `Fan` none and two rules: the check read the rule
+    base's merged operators, where Power's Maximum stood for both."""
+    text = PLAIN_FLL.replace("RuleBlock: b", "OutputVariable: Fan\n  range: 0 1\n"
+                             "  defuzzifier: Centroid 100\n  term: OFF Triangle 0 0 1\n"
+                             "RuleBlock: b").replace(
+        "then Power is HIGH", "then Power is HIGH and Fan is OFF").replace(
+        "then Power is LOW", "then Power is LOW and Fan is OFF")
+    with pytest.raises(MitosError, match="output `Fan` has no aggregation, but rules r1 and r2"):
+        parse_fll(text, "f.fll")

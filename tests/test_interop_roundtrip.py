@@ -96,7 +96,7 @@ def test_mitos_rules_through_fis_back_to_rules(tmp_path: Path) -> None:
     back as a term set MITOS refused (`point must be a finite number, not -inf`)."""
     rb = read_rulebase(ROOT / "rulebases" / "mitos.rules")
     fis = write_foreign(rb, "fis")
-    assert "inf" not in fis and "'NARROW':'trapmf',[-1 -1 40 70]" in fis   # feet outside
+    assert "inf" not in fis and "'NARROW':'trapmf',[-2 -1 40 70]" in fis   # feet outside
     (tmp_path / "m.fis").write_text(fis)
     via_fis = read_rulebase(tmp_path / "m.fis")
     back = write_and_read(via_fis, "rules", tmp_path)
@@ -135,12 +135,78 @@ def test_a_crisp_consequent_converts_with_the_same_outputs(fmt: str, tmp_path: P
                                rtol=0, atol=1e-9)
 
 
+def _trapmfs(fis: str) -> list[list[float]]:
+    import re
+
+    return [[float(x) for x in m.split()] for m in re.findall(r"'trapmf',\[([^]]*)\]", fis)]
+
+
+def _octave_takes_trapmf(p: list[float]) -> bool:
+    """Octave's toolkit (0.4.6, `are_mf_params.m`) reads a trapmf with a < b <= c < d only."""
+    return p[0] < p[1] <= p[2] < p[3]
+
+
+def test_written_shoulders_have_feet_apart_as_octave_reads_them() -> None:
+    """The packaged rule base's shoulders went into .fis as `trapmf [-1 -1 40 70]`, which
+    Octave's `readfis` takes and its `evalfis` stops on ("trapmf's second argument must be a
+    parameter vector": it wants a < b <= c < d). With `[-2 -1 40 70]` Octave gives the paper's
+    65.411255411 / 32.424242424 at road=78, size=45, position=4, as MITOS does."""
+    fis = write_foreign(read_rulebase(ROOT / "rulebases" / "mitos.rules"), "fis")
+    shapes = _trapmfs(fis)
+    assert len(shapes) == 6 and all(_octave_takes_trapmf(p) for p in shapes), shapes
+
+
+RAMPS_FLL = """\
+Engine: ramps
+InputVariable: obstacle
+  range: 0 1
+  term: left Ramp 1 0
+  term: right Ramp 0.2 1
+OutputVariable: steer
+  range: 0 1
+  aggregation: Maximum
+  defuzzifier: Centroid 100
+  default: nan
+  term: left Ramp 1 0
+  term: right Ramp 0 0.8
+RuleBlock: b
+  conjunction: none
+  disjunction: none
+  implication: Minimum
+  rule: if obstacle is left then steer is right
+  rule: if obstacle is right then steer is left
+"""
+
+
+def test_ramps_are_written_to_fis_as_trapezoids_that_every_reader_takes(tmp_path: Path):
+    """fuzzylite's `Ramp` went into .fis as `linsmf` / `linzmf`, MF types MATLAB has only
+    since R2022a and which fuzzylite 6 ("constructor of Term <linzmf> not registered") and
+    Octave's toolkit do not read: `mitos convert ObstacleAvoidance.fll --to fis` wrote a file
+    that fuzzylite, which shipped the engine, could not load. They are written as `trapmf`
+    with the flat end's feet 1 and 2 outside the range, as shoulders are: the same numbers."""
+    (tmp_path / "r.fll").write_text(RAMPS_FLL)
+    rb = read_rulebase(tmp_path / "r.fll")
+    text = write_foreign(rb, "fis")
+    assert "linsmf" not in text and "linzmf" not in text
+    assert "MF1='left':'trapmf',[-2 -1 0 1]" in text
+    assert "MF2='right':'trapmf',[0.2 1 2 3]" in text
+    assert "MF2='right':'trapmf',[0 0.8 2 3]" in text
+    assert all(_octave_takes_trapmf(p) for p in _trapmfs(text))
+    back = write_and_read(rb, "fis", tmp_path)
+    X = np.linspace(0.0, 1.0, 1001)[:, None]
+    for name in ("obstacle", "steer"):
+        for term in rb.variables[name].terms:
+            np.testing.assert_array_equal(
+                back.variables[name].term(term.name).membership(X[:, 0]),
+                term.membership(X[:, 0]))
+
+
 def test_fis_reader_takes_infinite_feet_as_shoulders(tmp_path: Path) -> None:
     """A .fis written with `trapmf [-inf -inf c d]` (MITOS before it wrote finite feet) reads
     as the shoulder, as FLL's `Trapezoid -inf -inf c d` does, so it converts to a term set."""
     text = write_foreign(read_rulebase(ROOT / "rulebases" / "mitos.rules"), "fis")
-    text = text.replace("[-1 -1 40 70]", "[-inf -inf 40 70]").replace(
-        "[70 100 161 161]", "[70 100 inf inf]")
+    text = text.replace("[-2 -1 40 70]", "[-inf -inf 40 70]").replace(
+        "[70 100 161 162]", "[70 100 inf inf]")
     (tmp_path / "old.fis").write_text(text)
     road = read_rulebase(tmp_path / "old.fis").variables["road"]
     assert road.term("NARROW").shape == "left_shoulder" and \

@@ -705,8 +705,9 @@ def test_edges_too_narrow_for_a_float_slope_give_numbers_not_warnings(recwarn):
     assert shapes.gaussian(np.array([0.0, 1.0]), 0.0, 2.1e-321).tolist() == [1.0, 0.0]
     assert shapes.cosine(np.array([-15.0, 0.0]), -15.0, 3.01e-318).tolist() == [1.0, 0.0]
     rb = parse_fll("InputVariable: a\n  range: -45 45\n  term: ahead Triangle -20 0 1e-320\n"
-                   "OutputVariable: t\n  range: 0 1\n  term: hi Triangle 0 1 1\n"
-                   "RuleBlock: main\n  rule: if a is ahead then t is hi\n", "narrow.fll")
+                   "OutputVariable: t\n  range: 0 1\n  defuzzifier: Centroid\n"
+                   "  term: hi Triangle 0 1 1\nRuleBlock: main\n  implication: Minimum\n"
+                   "  rule: if a is ahead then t is hi\n", "narrow.fll")
     from mitos_cli.engine.evaluation import evaluate
 
     res = evaluate(compile_rulebase(rb), np.array([[0.0], [-10.0], [1.0]]), strict=False)
@@ -716,7 +717,8 @@ def test_edges_too_narrow_for_a_float_slope_give_numbers_not_warnings(recwarn):
     check_rulebase(parse_fll(       # its partition checks take the edge as a vertical one
         "InputVariable: a\n  range: -45 45\n  term: ahead Triangle -20 0 1e-320\n"
         "  term: left Triangle -45 -20 0\nOutputVariable: t\n  range: 0 1\n"
-        "  term: hi Triangle 0 1 1\nRuleBlock: main\n  rule: if a is ahead then t is hi\n"
+        "  aggregation: Maximum\n  defuzzifier: Centroid\n  term: hi Triangle 0 1 1\n"
+        "RuleBlock: main\n  implication: Minimum\n  rule: if a is ahead then t is hi\n"
         "  rule: if a is left then t is hi\n", "narrow.fll"))
     assert not [w for w in recwarn if issubclass(w.category, RuntimeWarning)]
 
@@ -1143,8 +1145,9 @@ def test_reading_many_fll_variables_is_linear():
     def text(n):
         out = ["Engine: many"] + [x for i in range(n) for x in (
             f"InputVariable: x{i}", "  range: 0 1", "  term: A Triangle 0 0.5 1")]
-        out += ["OutputVariable: y", "  range: 0 1", "  term: A Triangle 0 0.5 1",
-                "RuleBlock: main"] + [f"  rule: if x{i} is A then y is A" for i in range(n)]
+        out += ["OutputVariable: y", "  range: 0 1", "  aggregation: Maximum",
+                "  defuzzifier: Centroid", "  term: A Triangle 0 0.5 1", "RuleBlock: main",
+                "  implication: Minimum"] + [f"  rule: if x{i} is A then y is A" for i in range(n)]
         return "\n".join(out) + "\n"
 
     small_text, large_text = text(750), text(6000)

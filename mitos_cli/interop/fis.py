@@ -438,6 +438,7 @@ def _mf(value: str, vspan: Span, role: str, kind: str, n_inputs: int) -> Term:
     if len(params) != count:
         raise FormatError(f"MF `{name}`: {mf} takes {plural(count, 'number')}, not {len(params)}",
                           span=vspan)
+    _check_linear_saturation(name, mf, params, vspan)
     step = _step(mf, params)
     if step is not None:
         return common.make_term(name, *step, vspan)
@@ -445,11 +446,39 @@ def _mf(value: str, vspan: Span, role: str, kind: str, n_inputs: int) -> Term:
                             vspan)
 
 
+def _check_linear_saturation(name: str, mf: str, params: list[float], span: Span) -> None:
+    """MATLAB's ``linsmf [a b]`` rises from its foot ``a`` to its shoulder ``b`` and ``linzmf
+    [a b]`` falls from ``a`` to ``b``, both defined for ``a <= b``. With ``a > b`` they were
+    read as fuzzylite's ``Ramp``, whose direction is the order of its ends: a ``linsmf`` that
+    falls, a ``linzmf`` that rises. ``linzmf [a a]``, MATLAB's step 1 below ``a`` and 0 from
+    ``a`` on, has no MITOS shape (``binary`` is 1 at its own point)."""
+    if mf not in ("linsmf", "linzmf"):
+        return
+    a, b = params
+    if a > b:
+        raise FormatError(f"MF `{name}`: {mf} takes [a b] with a <= b (it "
+                          f"{'rises' if mf == 'linsmf' else 'falls'} from a to b), not "
+                          f"[{fmt_number(a)} {fmt_number(b)}]", span=span,
+                          hint=f"write the smaller end first: `linsmf [{fmt_number(b)} "
+                               f"{fmt_number(a)}]` rises from {fmt_number(b)} to "
+                               f"{fmt_number(a)}, `linzmf [{fmt_number(b)} {fmt_number(a)}]` "
+                               f"falls")
+    if mf == "linzmf" and a == b:
+        raise FormatError(f"MF `{name}`: `linzmf [{fmt_number(a)} {fmt_number(b)}]` is MATLAB's "
+                          f"step 1 below {fmt_number(a)} and 0 from {fmt_number(a)} on, which no "
+                          f"MITOS shape computes exactly (a `binary` step is 1 at its own point)",
+                          span=span, hint=f"write `zmf [{fmt_number(a)} {fmt_number(a)}]`, the "
+                                          f"step 1 up to and at {fmt_number(a)}, if that is meant")
+
+
 def _step(mf: str, params: list[float]) -> tuple[str, tuple[float, ...]] | None:
     """MATLAB's ``smf`` and ``zmf`` whose feet meet or cross (``a >= b``) are a step at their
     midpoint, ``x >= (a + b) / 2`` and ``x <= (a + b) / 2`` (its ``fisSMf``, ``fisZMf``): 1 at
     the midpoint itself, where fuzzylite's S and Z shapes give 0 and 1. ``pimf`` is their
-    product, a closed rectangle when both are steps. None for the other MFs."""
+    product, a closed rectangle when both are steps. ``linsmf [a a]`` is the step ``x >= a``
+    (MATLAB's documentation). None for the other MFs."""
+    if mf == "linsmf" and params[0] == params[1]:
+        return "binary", (params[0], math.inf)
     if mf in ("smf", "zmf") and params[0] >= params[1]:
         return "binary", ((params[0] + params[1]) / 2, math.inf if mf == "smf" else -math.inf)
     if mf == "pimf" and params[0] >= params[1] and params[2] >= params[3]:
@@ -635,28 +664,30 @@ def _var_lines(v: Variable, mfs: list[str]) -> list[str]:
             f"NumMFs={len(mfs)}"] + [f"MF{i}={m}" for i, m in enumerate(mfs, 1)]
 
 
-INVERSE = {shape: (mf, order) for mf, (shape, _, order) in MF_TYPES.items() if mf != "linzmf"}
+INVERSE = {shape: (mf, order) for mf, (shape, _, order) in MF_TYPES.items()
+           if mf not in ("linsmf", "linzmf")}        # a ramp is written as a trapmf
 
 
 def _mf_text(t: Term, v: Variable) -> str:
     shape, p = t.shape, t.params
-    if shape in ("left_shoulder", "right_shoulder", "triangle_pw", "triangle_plr", "rectangle"):
+    if shape in ("left_shoulder", "right_shoulder", "ramp", "triangle_pw", "triangle_plr",
+                 "rectangle"):
         corners = t.corners
-        assert corners is not None             # these five shapes are piecewise linear
+        assert corners is not None             # these six shapes are piecewise linear
         a, b, c, d = corners
         lo, hi = v.universe
-        # a shoulder's open end: feet just outside the universe (inputs are clamped to it and
-        # outputs sampled inside it, so nothing computed changes); the feet were taken from
-        # the other infinite corner before, and written as `-inf`
+        # an open end (a shoulder's, a ramp's): feet outside the universe, 1 and 2 past it
+        # (inputs are clamped to it and outputs sampled inside it, so nothing computed
+        # changes). Apart, since Octave's toolkit refuses a trapmf whose feet meet (`[-1 -1 40
+        # 70]`: "trapmf's second argument must be a parameter vector"); a ramp went out as
+        # `linsmf` / `linzmf`, which only MATLAB R2022a on reads (not fuzzylite 6, Octave)
         if a == b == -math.inf:
-            a = b = min(lo, c) - 1.0
+            a, b = min(lo, c) - 2.0, min(lo, c) - 1.0
         if c == d == math.inf:
-            c = d = max(hi, b) + 1.0
+            c, d = max(hi, b) + 1.0, max(hi, b) + 2.0
         if shape in ("triangle_pw", "triangle_plr"):
             return f"'{t.name}':'trimf',[{fmt_number(a)} {fmt_number(b)} {fmt_number(d)}]"
         return f"'{t.name}':'trapmf',[{' '.join(fmt_number(x) for x in (a, b, c, d))}]"
-    if shape == "ramp" and p[0] > p[1]:
-        return f"'{t.name}':'linzmf',[{fmt_number(p[1])} {fmt_number(p[0])}]"
     if shape == "binary" and math.isinf(p[1]):      # MATLAB's step: smf or zmf [s s]
         mf = "smf" if p[1] > 0 else "zmf"
         return f"'{t.name}':'{mf}',[{fmt_number(p[0])} {fmt_number(p[0])}]"

@@ -159,6 +159,9 @@ def parse_fll(text: str, path: str | None = None) -> RuleBase:
                              if at is not None}
     rb = common.assemble_blocks(path, built, groups, DEFAULT_RESOLUTION, engine_span, notes,
                                 places)
+    for _, rules, settings in groups:      # after the errors that say more (a term's, ...)
+        if not settings.sugeno:
+            _check_unset(variables, rules, settings)
     return _input_ranges(dataclasses.replace(rb, notes=tuple(notes)), variables)
 
 
@@ -197,10 +200,11 @@ def _sections(text: str, path: str | None) -> tuple[list[_Var], list[_Block], Sp
         if not line.strip():
             continue
         indent = len(line) - len(line.lstrip())
-        key, sep, value = line.strip().partition(":")
+        written, sep, value = line.strip().partition(":")
+        key = written.rstrip()       # `range : 0 1`, as fuzzylite 6 and pyfuzzylite read it
         col = indent + 1
         span = Span.in_text(text, path, lineno, col, col + len(key))
-        vcol = indent + len(key) + 2 + (len(value) - len(value.lstrip()))
+        vcol = indent + len(written) + 2 + (len(value) - len(value.lstrip()))
         value = value.strip()
         vspan = Span.in_text(text, path, lineno, vcol, vcol + max(1, len(value)))
         if not sep:
@@ -271,6 +275,40 @@ def _check_outputs(variables: list[_Var], rules: list[Rule], settings: Settings)
             raise FormatError(f"`lock-range: true` on the Takagi-Sugeno output `{v.name}` "
                               f"(clipping the output to its range) is not supported",
                               span=v.lock_range, hint="set `lock-range: false`")
+
+
+def _check_unset(variables: list[_Var], rules: list[Rule], settings: Settings) -> None:
+    """A Mamdani rule block without an `implication` (or `implication: none`), an output its
+    rules set without a `defuzzifier`, and one two of its rules set without an `aggregation`:
+    fuzzylite stops there ("implication operator needed", "defuzzifier needed", "expected an
+    aggregation operator"), as the .fis reader does for `ImpMethod=''` and `AggMethod=''`.
+    They were read as MITOS's defaults (min, centroid, max) without a word. One rule's set
+    joined with nothing is itself under any S-norm."""
+    if settings.implication is None and rules:
+        rule = rules[0]
+        raise FormatError(f"the rule block has no implication, but rule {rule.label} concludes "
+                          f"`{rule.consequents[0].var}`: a Mamdani rule's set is cut by the "
+                          f"implication, and fuzzylite stops without one", span=rule.span,
+                          hint="add `implication: Minimum` (or another T-norm) to the "
+                               "RuleBlock")
+    first: dict[str, Rule] = {}
+    for rule in rules:
+        for c in rule.consequents:
+            v = next(x for x in variables if x.name == c.var)
+            written = {entry[0] for entry in v.record}
+            if "defuzzify" not in written:
+                raise FormatError(f"output `{c.var}` has no defuzzifier, but rule {rule.label} "
+                                  f"sets it: fuzzylite stops without one", span=v.span,
+                                  hint="add `defuzzifier: Centroid` (or another) to the "
+                                       "OutputVariable")
+            if c.var in first and first[c.var] is not rule and "aggregation" not in written:
+                raise FormatError(
+                    f"output `{c.var}` has no aggregation, but rules {first[c.var].label} "
+                    f"and {rule.label} both set it: a Mamdani output joins their sets "
+                    f"with its aggregation, and fuzzylite stops without one", span=v.span,
+                    hint="add `aggregation: Maximum` (or another S-norm) to the "
+                         "OutputVariable")
+            first.setdefault(c.var, rule)
 
 
 def _variable_key(v: _Var, key: str, value: str, span: Span, vspan: Span,
