@@ -402,6 +402,31 @@ def test_simulation_corrections_name_the_robot():
         s.run("simulate multirobot robot oncomin")
 
 
+def test_a_robot_is_named_as_its_world_names_it(tmp_path, monkeypatch):
+    """A world's robot may be named with a space or in digits (`name: "cart 2"`, as `mitos
+    simulate` reads it): `robot NAME` takes it quoted, where it was a syntax error. An unknown
+    robot is marked at its own name: where the name was also a word before it (the world's
+    name), the caret stood under the world."""
+    from mitos_cli.teach.prompt import at_prompt
+    from mitos_cli.teach.session import Session
+    from mitos_cli.teach.simulation import world_path
+
+    monkeypatch.chdir(tmp_path)
+    text = world_path("multirobot").read_text()
+    (tmp_path / "two.yaml").write_text(text.replace("name: oncoming", 'name: "cart 2"'))
+    said = []
+    s = Session(default_rulebase_path(), out=said.append)
+    s.run("use drive")
+    s.run('simulate two.yaml robot "cart 2"')
+    assert "two (robot cart 2) with behavior drive" in said[-1]
+    line = "simulate multirobot seed 3 robot multirobot"
+    with pytest.raises(LessonError) as info:
+        s.run(line, "<prompt>", 4)
+    assert at_prompt(info.value, line, 4).render().splitlines()[:3] == [
+        "<prompt>:4:34: command error: unknown robot `multirobot` of `multirobot`",
+        "    " + line, " " * 37 + "^" * 10]
+
+
 def test_a_robot_that_stopped_is_corrected_only_up_to_its_stop():
     """In a world of several robots, one that reached its goal stands still while the others
     drive on: its window (and its verdict) are its own, not the world's."""

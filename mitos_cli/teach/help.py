@@ -64,7 +64,8 @@ Outputs you leave out are not corrected.""",
     "simulate": """\
 simulate WORLD [seed N] [robot NAME]
 Drive the active behavior through a world file (a path, or the name of a packaged world) and
-keep the recorded run, so that `at` can correct it (robot NAME's run; default the first).""",
+keep the recorded run, so that `at` can correct it (robot NAME's run; default the first;
+a name that is no bare name is quoted, as `robot "cart 2"`).""",
     "at": """\
 at 12.5s steering=55          one example: what the robot perceived at 12.5 s, and the output
                               it should have chosen

@@ -792,7 +792,7 @@ class Session:
         seed = _seed(c.seed) if c.seed is not None else None
         self.compiled()
         self.simulation = run_world(c.world, self.rulebase, self.state.active, seed, self.base,
-                                    c.robot)
+                                    c.robot, c.robot_span)
         self.journal.append("simulate", line=line, world=str(world_path(c.world, self.base)),
                             behavior=self.state.active, seed=seed, robot=c.robot,
                             run=self.simulation.fingerprint, verdict=self.simulation.verdict)

@@ -159,9 +159,10 @@ class Recording:
 
 
 def run_world(name: str, rulebase: RuleBase, behavior: str, seed: int | None = None,
-              base: Path | None = None, robot: str | None = None) -> Recording:
+              base: Path | None = None, robot: str | None = None,
+              robot_span: Span | None = None) -> Recording:
     """Drive ``behavior`` of ``rulebase`` through the world ``name``; ``at`` then corrects
-    ``robot`` (a name of the world's robots; default the first)."""
+    ``robot`` (a name of the world's robots, written at ``robot_span``; default the first)."""
     from ..sim.loop import simulate
     from ..sim.planner import FuzzyPlanner
     from ..sim.worldfile import load_world
@@ -172,7 +173,8 @@ def run_world(name: str, rulebase: RuleBase, behavior: str, seed: int | None = N
     if robot is not None and robot not in names:
         from ..errors import unknown
 
-        raise unknown(f"robot of {Path(name).name}", robot, names, cls=LessonError)
+        raise unknown("robot", robot, names, span=robot_span, cls=LessonError,
+                      owner=Path(name).stem)
     index = names.index(robot) if robot is not None else 0
     try:
         planner = FuzzyPlanner(rulebase, behavior)
