@@ -591,3 +591,20 @@ def test_save_as_into_a_missing_path_is_refused_before_the_lesson_runs(work):
     assert "lesson error: cannot save `nope/deeper/x.rules`: the directory `nope` does not " \
            "exist" in res.stderr
     assert not (work / ".mitos").exists() and not (work / "nope").exists()
+
+
+def test_a_lesson_whose_save_as_cannot_be_written_at_its_end_says_how_to_go_on(work):
+    """The save a lesson makes at its end for `--save-as` (the place passed the checks before
+    the lesson; the write failed after it) was hinted `save ~/x.rules`, a command of the
+    prompt, with no session to give it in: the hint says how to continue the session."""
+    (work / "l.lesson").write_text("correct road=78 size=45 position=4 -> steering=60\n")
+    (work / "in").mkdir()
+    (work / "in" / "x.mitos.terms.yaml").mkdir()      # no file can be written where it goes
+    (work / "in" / "x.rules").write_text('terms "x.mitos.terms.yaml"\n')
+    res = mitos("teach", "rb/mitos.rules", "--lesson", "l.lesson", "--save-as", "in/x.rules",
+                cwd=work)
+    assert res.returncode == 1
+    session = next((work / ".mitos" / "teach").iterdir()).name
+    assert res.stderr.splitlines()[-1] == (
+        f"hint: every change is in the session's journal: `mitos teach --resume --session "
+        f"{session}`, then `save PATH` where you can write")

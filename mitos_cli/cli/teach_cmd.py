@@ -13,6 +13,7 @@ from .params import WORDS, named
 if TYPE_CHECKING:
     from collections.abc import Callable
 
+    from ..lang.model import RuleBase
     from ..teach.session import Session
 
 
@@ -136,9 +137,7 @@ def _resumed(session_name: str | None, recover: bool, save_as: str | None,
         exc.kind = "session error"
         raise
     if save_as is not None:
-        from ..teach.save import check_save_target
-
-        check_save_target(session.original, Path(save_as))
+        _check_save_as(session.original, save_as)
         session.save_as = Path(save_as)
     err(f"resumed session {journal.directory.name}: {plural(len(journal.active()), 'change')}, "
         f"{plural(len(session.state.examples), 'example')}, behavior {session.state.active}"
@@ -196,15 +195,27 @@ def _new_session(rules: str | None, behavior: str | None, lesson: str | None, sa
                         "prompt (`simulate WORLD`)")
         raise
     if save_as is not None:         # refused now, not when the lesson ends and saves
-        from ..teach.save import check_save_target
-
-        check_save_target(loaded.rulebase, Path(save_as))
+        _check_save_as(loaded.rulebase, save_as)
     lesson_text = read_lesson(lesson) if lesson is not None else None
     journal = Journal.create(new_session_dir(path.stem))
     session = Session(path, behavior, journal, save_as, out=out, progress=epoch_progress)
     err(f"session {journal.directory.name} (journal in {journal.directory.as_posix()}; "
         f"`mitos teach --resume` continues it)")
     return session, lesson_text
+
+
+def _check_save_as(rulebase: RuleBase, save_as: str) -> None:
+    """Refuse ``--save-as`` where a save cannot be made (a read-only directory, a term set there
+    that is not its own, ...) before a session starts, not once the lesson has run."""
+    from ..errors import LessonError
+    from ..teach.save import check_save_target
+
+    try:
+        check_save_target(rulebase, Path(save_as))
+    except LessonError as exc:
+        exc.hint = exc.hint or (f"give --save-as a place you can write (`--save-as "
+                                f"~/{Path(save_as).name}`)")
+        raise
 
 
 def _ended_open(session: Session, text: str, name: str) -> None:
@@ -259,6 +270,13 @@ def _teach_lesson(session: Session, lesson: str, lesson_text: tuple[str, str] | 
     if session.save_as is not None and session.unsaved:
         if transcript is not None:
             transcript.command("save (the lesson ended with unsaved changes)")
-        session.run("save")
+        try:
+            session.run("save")
+        except MitosError as exc:   # no prompt to `save ~/...` at: how to go on
+            if exc.message.startswith(("cannot save", "cannot create")):
+                exc.hint = (f"every change is in the session's journal: `mitos teach --resume "
+                            f"--session {directory.name}`, then `save PATH` where you can "
+                            f"write")
+            raise
     if transcript is not None:
         emit(transcript.to_json(directory, session))

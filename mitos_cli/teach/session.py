@@ -1016,7 +1016,8 @@ class Session:
             # a Ctrl-C once the files are written waits for what the session knows of them:
             # the next save over them was refused as if another program had changed them
             with held_interrupt():
-                saved = save_rulebase(self.original, self.rulebase, target, self.sources)
+                saved = save_rulebase(self.original, self.rulebase, target, self.sources,
+                                      LESSON_SAVE_HINT if self.confined is not None else None)
                 if over:
                     self.files_seen = files_digest(self.original)
                 written = (saved.rules,) + saved.termsets
@@ -1194,6 +1195,13 @@ def _is_dir(path: Path) -> bool:
         return path.is_dir()
     except OSError:
         return False
+
+
+#: where a lesson's `save` that could not be written may go instead (not `~/`: a lesson
+#: writes below the working directory only, :func:`_check_below`)
+LESSON_SAVE_HINT = ("a lesson saves below the working directory: save where you can write "
+                    "there, or give the place with `--save-as PATH`; the session keeps every "
+                    "change")
 
 
 def _check_below(written: str, root: Path | None, example: str = "taught.rules") -> None:
