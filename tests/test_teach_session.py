@@ -400,6 +400,17 @@ def test_simulate_and_at_and_their_mistakes(rules, tmp_path):
     assert at_prompt(info.value, "show terms plot t.txt", 3).render().splitlines()[:3] == [
         "<prompt>:3:17: command error: cannot write `t.txt`: unknown picture format `txt`",
         "    show terms plot t.txt", "                    ^^^^^"]
+    # a plot into a directory that is not there is refused at its name, before the table
+    # (it printed every term, then "cannot write `nodir/t-road.png`" under the command word)
+    out.clear()
+    line = f"show terms plot {tmp_path / 'nodir' / 't.png'}"
+    with pytest.raises(MitosError) as info:
+        s.run(line, "<prompt>", 4)
+    assert out == []
+    assert at_prompt(info.value, line, 4).render().splitlines()[:3] == [
+        f"<prompt>:4:17: command error: cannot write `{tmp_path / 'nodir' / 't.png'}`: No "
+        f"such file or directory", "    " + line,
+        " " * 20 + "^" * len(str(tmp_path / "nodir" / "t.png"))]
 
 
 def test_a_hedge_or_time_that_cannot_be_used_is_refused_at_its_own_word(rules):

@@ -954,10 +954,12 @@ class Session:
         elif c.what == "terms":
             if c.plot is not None:      # the name given, not the first one made from it
                 from ..draw.output import check_format
+                from ..fileio import check_writable
 
-                with _drawing():
+                with _drawing():        # (and before the table, which said it all first)
                     check_format(c.plot)
-                _check_below(c.plot, self.confined, "terms.png")
+                    _check_below(c.plot, self.confined, "terms.png")
+                    check_writable(c.plot)
             self.out(text.terms_table(self.original, self.rulebase, self._shownvariables()))
             if c.plot is not None:
                 self._plot_terms(self.original, self.rulebase, c.plot)
