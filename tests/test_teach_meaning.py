@@ -315,6 +315,16 @@ def test_unknown_instruction_says_did_you_mean_and_lists_them():
     assert "`turn harder`" in info.value.expected and "`keep right`" in info.value.expected
 
 
+def test_two_instructions_joined_by_and_are_said_one_per_line():
+    """`at 12s to 13s make a wider turn and slow down` offered only `make a wider turn`, as if
+    the rest were a typo: each instruction is its own `at` line."""
+    with pytest.raises(LessonError) as info:
+        instruction(("make", "a", "wider", "turn", "and", "slow", "down"))
+    assert info.value.message == "unknown instruction `make a wider turn and slow down`"
+    assert info.value.hint == ("one instruction per `at` line: `at ... make a wider turn`, "
+                               "then `at ... slow down` (same window)")
+
+
 def test_scale_centre_is_the_mirror_point():
     assert scale_of(PAPER.variables["steering"]).centre == 3.0       # ST
 
