@@ -37,6 +37,18 @@ def say(s, out, line):
     return "\n".join(out)
 
 
+def test_a_wrapped_rule_is_one_line_of_the_history_and_of_undo(rules):
+    """A rule told over several lines was listed by `show history` (and said by `undo`) as
+    typed: its next lines at the left margin, outside the numbered list."""
+    s, out = session(rules)
+    s.run("if road is NARROW\n   and size is SMALL_SZ\n   then speed is SLOW")
+    assert say(s, out, "show history").splitlines()[1] == \
+        "   2  if road is NARROW and size is SMALL_SZ then speed is SLOW"
+    assert say(s, out, "undo") == "undone: if road is NARROW and size is SMALL_SZ then speed is SLOW"
+    assert say(s, out, "show history").splitlines()[1:] == [
+        "   2  if road is NARROW and size is SMALL_SZ then speed is SLOW  (undone)", "   3  undo"]
+
+
 def test_a_told_rule_is_answered_as_understood_with_conflicts(rules):
     s, out = session(rules)
     text = say(s, out, "if road is  WIDE and size is SMALL_SZ and position is LEFT "

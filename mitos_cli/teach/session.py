@@ -984,7 +984,7 @@ class Session:
         last = active[-1]
         self.journal.append("undo", of=last["seq"], line=line)
         self.replay(checked=False)
-        self.out(f"undone: {last.get('line') or last['op']}")
+        self.out(f"undone: {text.one_line(last.get('line') or '') or last['op']}")
 
     def _save(self, c: cmd.Save, line: str) -> None:
         from .save import save_rulebase
