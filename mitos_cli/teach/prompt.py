@@ -33,6 +33,7 @@ class Completer:
     def __init__(self, session: Session) -> None:
         self.session = session
         self.matches: list[str] = []
+        self._robots: dict[str, list[str]] = {}        # world -> its robots' names
 
     def words(self, line: str) -> list[str]:
         rb = self.session.rulebase
@@ -50,10 +51,17 @@ class Completer:
         if first == "use":
             return [b.name for b in rb.behaviors] + ["when", "with"]
         if first == "adapt":
-            return ["epochs", "rate", "plot"]
+            return ["epochs", "rate", "plot", "unconstrained"]
+        terms = [f"{v.name}.{t}" for v in rb.variables.values() for t in v.term_names]
         if first == "frozen":
             b = rb.behavior(self.session.focus)
-            return [r.label for r in b.rules if r.label]
+            return [r.label for r in b.rules if r.label] + terms
+        if first == "unfrozen":
+            return terms
+        if first == "simulate":
+            return self.simulate_words(line, tokens)
+        if first in ("save", "undo", "end", "quit", "exit"):
+            return []                   # (a file name, or nothing: no word of the language)
         if first in ("eval", "correct", "at"):
             inputs = [f"{v.name}=" for v in rb.variables.values() if v.role == "input"]
             outputs = [v.name for v in rb.variables.values() if v.role == "output"]
@@ -68,6 +76,39 @@ class Completer:
             terms = list(rb.variables[var].term_names) if var else []
             return terms + ["not", *HEDGES]
         return list(rb.variables) + ["is", "and", "or", "not", "then", "with"]
+
+    def simulate_words(self, line: str, tokens: list[str]) -> list[str]:
+        """After `simulate`: the packaged worlds, then `seed` and `robot`, and after `robot`
+        the robots of the world named (quoted where a name is no bare word)."""
+        back = tokens if line.endswith(" ") else tokens[:-1]
+        if len(back) == 1:
+            from ..resources import packaged_names
+
+            return [n.removesuffix(".yaml") for n in packaged_names("worlds", ".yaml")]
+        if back[-1] == "seed" or "robot" in back[:-1]:
+            return []                                   # a number, or the end of the line
+        if back[-1] == "robot":
+            return self.robots(back[1])
+        return (["seed"] if "seed" not in back else []) + ["robot"]
+
+    def robots(self, world: str) -> list[str]:
+        """The robots of ``world`` by their names, as `simulate ... robot` takes them."""
+        import re
+
+        from ..errors import MitosError
+        from .simulation import world_path
+
+        if world not in self._robots:
+            try:
+                from ..sim.worldfile import load_world
+
+                names = [a.name for a in load_world(world_path(world, self.session.base)).agents]
+            except (MitosError, OSError):
+                names = []
+            self._robots[world] = [n if re.fullmatch(r"[A-Za-z_][\w\-]*", n) and
+                                   not n.endswith("-") else '"' + n.replace('"', '\\"') + '"'
+                                   for n in names]
+        return self._robots[world]
 
     def target_words(self, line: str, tokens: list[str], outputs: list[str]) -> list[str]:
         """The words that go on a target (``correct ... ->`` or ``at TIME``): an output's
