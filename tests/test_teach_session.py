@@ -49,6 +49,27 @@ def test_a_wrapped_rule_is_one_line_of_the_history_and_of_undo(rules):
         "   2  if road is NARROW and size is SMALL_SZ then speed is SLOW  (undone)", "   3  undo"]
 
 
+def test_advice_to_use_a_behavior_while_one_is_open_closes_it_first(rules):
+    """While a behavior is open, `use NAME` is one of its lines (a blend), not a recall: the
+    notes that said "`use b1` before `adapt`" led to "`b1` uses `b1`: a cycle" (b1 open again
+    after `undo` of its `end`), or blended `drive` into the open behavior without a word."""
+    s, out = session(rules)
+    for line in ("behavior b1", "use drive", "end", "simulate figure4", "undo"):
+        s.run(line)                                         # `undo`: b1 is open again
+    text = say(s, out, "at 3s steering=50")
+    assert "; `end` (it then becomes the active behavior) before `adapt`" in text
+    with pytest.raises(LessonError) as info:
+        s.run("adapt epochs 1")
+    assert info.value.hint == ("the examples given so far correct b1: `end` (it then becomes "
+                               "the active behavior) to adapt it")
+    s.run("end")
+    s.run("behavior b2")
+    text = say(s, out, "simulate figure4")                  # b1 drives; the world's own: drive
+    assert text.endswith("(`mitos simulate` drives figure4 with behavior drive: `end` (`use` "
+                         "in the open behavior `b2` blends `drive` into it), then `use drive` "
+                         "to drive it so here)")
+
+
 def test_a_told_rule_is_answered_as_understood_with_conflicts(rules):
     s, out = session(rules)
     text = say(s, out, "if road is  WIDE and size is SMALL_SZ and position is LEFT "

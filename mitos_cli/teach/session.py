@@ -350,7 +350,8 @@ class Session:
             self.out(f"warning: the last run ({last.get('line', 'simulate')}) cannot be driven "
                      f"again: {exc.message}; `simulate` it again to correct it")
             return
-        self.out(f"the last run is recorded again: {self.simulation.describe()}")
+        self.out(f"the last run is recorded again: "
+                 f"{self.simulation.describe(self.use_advice)}")
         if last.get("run") not in (None, self.simulation.fingerprint):   # (older journals: none)
             self.out(f"warning: this is not the run recorded before ({last.get('verdict')}, "
                      f"now {self.simulation.verdict}): `{Path(last['world']).name}` or a file "
@@ -528,8 +529,8 @@ class Session:
                       if o.name != b.name and any(r.label == label for r in o.rules)]
             own = "" if labels else f"`{b.name}` has no rules of its own; "
             if owners:
-                exc.hint = (f"{own}`{label}` is a rule of `{owners[0]}`: `use {owners[0]}`, "
-                            f"then `frozen {label}`")
+                exc.hint = (f"{own}`{label}` is a rule of `{owners[0]}`: "
+                            f"{self.use_advice(owners[0])}, then `frozen {label}`")
             elif own:
                 exc.hint = own.rstrip("; ")
         return exc
@@ -747,6 +748,17 @@ class Session:
         self._add_window(compiled, rec, rows[keep], [inputs[i] for i in keep],
                          [{ins.output: float(wanted[i])} for i in keep], line)
 
+    def use_advice(self, name: str) -> str:
+        """How to make behavior ``name`` the active one now: `use NAME`, but while a behavior
+        is open a `use` line is one of its lines (a blend), so it is closed first."""
+        block = self.state.block
+        if block is None:
+            return f"`use {name}`"
+        if block == name:
+            return "`end` (it then becomes the active behavior)"
+        return (f"`end` (`use` in the open behavior `{block}` blends `{name}` into it), then "
+                f"`use {name}`")
+
     def _recording(self) -> Recording:
         if self.simulation is None:
             raise LessonError("no simulation to correct yet",
@@ -774,9 +786,9 @@ class Session:
             self._noted = (id(rec), self.state.active)      # once per run and active behavior
             self.out(f"note: {rec.name} was driven by `{rec.behavior}`, so this corrects "
                      f"{rec.behavior} (the rules that produced the motion, with the behaviors "
-                     f"it uses), not the active `{self.state.active}`; `use {rec.behavior}` "
-                     f"before `adapt` (to teach `{self.state.active}` from a run, `simulate` "
-                     "with it active)")
+                     f"it uses), not the active `{self.state.active}`; "
+                     f"{self.use_advice(rec.behavior)} before `adapt` (to teach "
+                     f"`{self.state.active}` from a run, `simulate` with it active)")
         return self.compiled(rec.behavior)
 
     def _outputs(self, compiled: CompiledRuleBase, inputs: list[dict]) -> list[dict]:
@@ -796,7 +808,7 @@ class Session:
         self.journal.append("simulate", line=line, world=str(world_path(c.world, self.base)),
                             behavior=self.state.active, seed=seed, robot=c.robot,
                             run=self.simulation.fingerprint, verdict=self.simulation.verdict)
-        self.out(self.simulation.describe())
+        self.out(self.simulation.describe(self.use_advice))
 
     def _at(self, c: cmd.At, line: str) -> None:
         rec = self._recording()
@@ -834,8 +846,8 @@ class Session:
             example = ("correct road=78 size=45 position=4 -> steering=60"
                        if tuple(compiled.inputs) == ("road", "size", "position") else
                        f"correct {shown} -> {compiled.outputs[0]}=...")
-            hint = (f"the examples given so far correct {', '.join(others)}: `use "
-                    f"{others[0]}` to adapt it" if others else
+            hint = (f"the examples given so far correct {', '.join(others)}: "
+                    f"{self.use_advice(others[0])} to adapt it" if others else
                     f"give corrections: `{example}` (every input of `{compiled.behavior}`), "
                     f"or `simulate WORLD` then `at 12.5s {compiled.outputs[0]}=55`")
             raise LessonError(f"no examples for behavior `{compiled.behavior}` to learn from",
