@@ -402,6 +402,11 @@ def test_save_as_names_a_rules_file(work):
                     stdin="")
         assert res.returncode == 2 and "is only the ending, give it a name" in res.stderr
         assert "does not end in" not in res.stderr
+    # an empty one is refused as every command's empty file name is (it said "ending in
+    # `.rules`, not ``")
+    res = mitos("teach", "rb/mitos.rules", "--save-as", "", "--lesson", "-", cwd=work, stdin="")
+    assert res.returncode == 2 and "must name something, not be empty" in res.stderr
+    assert "not ``" not in res.stderr
 
 
 def test_a_rule_file_lesson_or_world_that_is_a_link_to_nothing_is_said_so(work):

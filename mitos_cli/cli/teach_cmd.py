@@ -59,7 +59,7 @@ def teach_command(
         help="Run the commands of a lesson file (- for stdin) instead of the prompt; stop at "
              "the first error (exit 1).")] = None,
     save_as: Annotated[str | None, typer.Option(
-        "--save-as", "-o", metavar="OUT.rules",
+        "--save-as", "-o", metavar="OUT.rules", callback=named,
         help="Where `save` writes: OUT.rules and its term set beside it, OUT.terms.yaml (a "
              "rule file with several term sets, as the packaged one: OUT.<each term set's "
              "name>, e.g. OUT.mitos.terms.yaml and OUT.drive.terms.yaml); a lesson saves there "
