@@ -613,3 +613,30 @@ def test_a_lesson_whose_save_as_cannot_be_written_at_its_end_says_how_to_go_on(w
     assert res.stderr.splitlines()[-1] == (
         f"hint: every change is in the session's journal: `mitos teach --resume --session "
         f"{session}`, then `save PATH` where you can write")
+
+
+def test_the_way_back_to_a_session_names_it_when_resume_alone_would_not_find_it(work):
+    """Leaving a session with unsaved changes said "`mitos teach --resume` (session A)
+    continues", also for a session that is not the newest here (`--resume` alone picks the
+    newest, B) and for one resumed from another directory (`--resume` alone looks in this
+    one's `.mitos/teach/`): the command given is the one that continues this session."""
+    mitos("teach", "rb/mitos.rules", cwd=work, stdin="if road is NARROW then speed is SLOW\n")
+    first = sorted((work / ".mitos" / "teach").iterdir())[0]
+    time.sleep(1.1)                                         # a second session, the newest
+    mitos("teach", "rb/mitos.rules", cwd=work, stdin="if road is WIDE then speed is SLOW\n")
+    res = mitos("teach", "--resume", "--session", first.name, cwd=work,
+                stdin="if road is MEDIUM then speed is SLOW\n")
+    assert res.returncode == 0, res.stderr
+    assert res.stderr.splitlines()[-1] == (
+        f"unsaved changes are kept in the journal; `mitos teach --resume --session "
+        f"{first.name}` continues, `save PATH` writes them")
+    elsewhere = work / "elsewhere"
+    elsewhere.mkdir()
+    res = mitos("teach", "--resume", "--session", str(first), cwd=elsewhere,
+                stdin="behavior b\nif road is WIDE then speed is FAST\n")
+    assert res.returncode == 0, res.stderr
+    assert res.stderr.splitlines()[-2:] == [
+        f"behavior `b` is still open; `mitos teach --resume --session {first.as_posix()}` "
+        f"keeps it open, `end` closes it",
+        f"unsaved changes are kept in the journal; `mitos teach --resume --session "
+        f"{first.as_posix()}` continues, `save PATH` writes them"]

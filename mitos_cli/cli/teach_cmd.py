@@ -228,7 +228,9 @@ def _ended_open(session: Session, text: str, name: str) -> None:
     from .output import err
 
     where = session.opened_at or lesson_end(text, name)
-    resume = f"mitos teach --resume --session {session.journal.directory.name}"
+    from ..teach.journal import resume_command
+
+    resume = resume_command(session.journal.directory)
     if session.save_as is not None:
         raise LessonError(f"the lesson ended with behavior `{session.state.block}` still open, "
                           f"so it cannot be saved to {session.save_as}", span=where,
@@ -262,8 +264,10 @@ def _teach_lesson(session: Session, lesson: str, lesson_text: tuple[str, str] | 
             err(f"session {directory.name} removed: the lesson stopped before any change")
         raise
     except KeyboardInterrupt:
-        err(f"interrupted: every change so far is in the journal; `mitos teach --resume "
-            f"--session {directory.name}` continues")
+        from ..teach.journal import resume_command
+
+        err(f"interrupted: every change so far is in the journal; `{resume_command(directory)}` "
+            f"continues")
         raise typer.Exit(130) from None
     if session.state.block is not None:
         _ended_open(session, text, name)
@@ -274,8 +278,10 @@ def _teach_lesson(session: Session, lesson: str, lesson_text: tuple[str, str] | 
             session.run("save")
         except MitosError as exc:   # no prompt to `save ~/...` at: how to go on
             if exc.message.startswith(("cannot save", "cannot create")):
-                exc.hint = (f"every change is in the session's journal: `mitos teach --resume "
-                            f"--session {directory.name}`, then `save PATH` where you can "
+                from ..teach.journal import resume_command
+
+                exc.hint = (f"every change is in the session's journal: "
+                            f"`{resume_command(directory)}`, then `save PATH` where you can "
                             f"write")
             raise
     if transcript is not None:

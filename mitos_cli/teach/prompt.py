@@ -249,10 +249,12 @@ def interact(session: Session, history: Path | None = None) -> None:
                 session.out("")
                 break
     finally:
+        from .journal import resume_command
+
+        resume = resume_command(session.journal.directory)
         if session.state.block is not None:
-            print(f"behavior `{session.state.block}` is still open; `mitos teach --resume` "
-                  f"keeps it open, `end` closes it", file=err)
+            print(f"behavior `{session.state.block}` is still open; `{resume}` keeps it open, "
+                  f"`end` closes it", file=err)
         if session.unsaved:
-            where = session.journal.directory.name
-            print(f"unsaved changes are kept in the journal; `mitos teach --resume` "
-                  f"(session {where}) continues, `save PATH` writes them", file=err)
+            print(f"unsaved changes are kept in the journal; `{resume}` continues, `save PATH` "
+                  f"writes them", file=err)
