@@ -856,6 +856,11 @@ def test_frozen_or_unfrozen_that_changes_nothing_is_no_unsaved_change(rules):
     say(s, out, "undo")                                 # takes back the AHEAD freeze only
     assert say(s, out, "undo") == "undone: frozen heading.LEFT"
     assert not s.unsaved
+    # several at once are "them" ("keeps steering.LM, road.MEDIUM as they are (`unfrozen`
+    # lets it move ...)")
+    assert say(s, out, "frozen steering.LM, road.MEDIUM") == (
+        "adaptation keeps steering.LM, road.MEDIUM as they are (`unfrozen` lets them move; "
+        "`save` writes `frozen: true`)")
 
 
 def test_a_comma_between_values_is_named_and_a_hedge_past_the_scale_is_noted(rules):

@@ -553,8 +553,9 @@ class Session:
         if new:
             self.change("freeze", line, terms=new)
             self.out("adaptation keeps " + ", ".join(f"{v}.{t}" for v, t in new)
-                     + (" as it is" if len(new) == 1 else " as they are")
-                     + " (`unfrozen` lets it move; `save` writes `frozen: true`)")
+                     + (" as it is (`unfrozen` lets it move" if len(new) == 1 else
+                        " as they are (`unfrozen` lets them move")
+                     + "; `save` writes `frozen: true`)")
         if already:
             self.out(", ".join(already) + (" is" if len(already) == 1 else " are")
                      + " frozen already: adaptation keeps "
