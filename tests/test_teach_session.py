@@ -468,6 +468,11 @@ def test_a_hedge_or_time_that_cannot_be_used_is_refused_at_its_own_word(rules):
     assert place("at 5s to 2s steering is LB") == (4, 4, 12)
     assert place("at 5s to 2s steering=50") == (4, 4, 12)
     assert place("at 5s to 5.01s steering is very seldom LB") == (4, 33, 39)
+    # an instruction this run cannot take is marked at the instruction (it stood at column 1)
+    assert place("at 1s to 2s make a wider turn") == (4, 13, 30)           # it went straight
+    s.run("use avoid_obstacle")
+    s.run("simulate figure4")                               # no gap_left, gap_right here
+    assert place("at 0s to 2s keep further from the wall") == (4, 13, 39)
 
 
 def test_a_world_driven_with_another_behavior_than_its_own_says_so(rules):

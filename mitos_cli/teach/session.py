@@ -737,11 +737,16 @@ class Session:
         window = Window({o: np.array([y[o] for y in now]) for o in compiled.outputs},
                         {k: np.array([x[k] for x in inputs]) for k in compiled.inputs},
                         compiled.variables)
-        wanted = targets(ins, window)
+        try:                            # (what this run cannot take: at the instruction)
+            wanted = targets(ins, window)
+        except LessonError as exc:
+            exc.span = exc.span or c.span
+            raise
         keep = np.flatnonzero(np.isfinite(wanted))
         if keep.size == 0:
             raise LessonError(f"`{ins.words}`: the robot went straight {rec.when(rows)}, so "
-                              "there is no turn to change", hint="name the window of a turn")
+                              "there is no turn to change", span=c.span,
+                              hint="name the window of a turn")
         first = keep[0]
         did = float(window.outputs[ins.output][first])
         self.out(f"{ins.words}: {ins.meaning} ({ins.output} {text.num(did)} -> "
