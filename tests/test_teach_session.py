@@ -792,6 +792,31 @@ def test_a_resumed_session_says_when_the_run_driven_again_is_another(tmp_path, m
                        "since; `at` corrects the run driven now")
 
 
+def test_a_world_simulated_by_a_relative_path_is_driven_again_from_another_directory(
+        tmp_path, monkeypatch):
+    """`simulate corridor.yaml` (a copy of the packaged world, its seed changed) was journaled
+    as `corridor.yaml`, relative: `--resume --session DIR` from another directory drove the
+    packaged `corridor` instead (another run, the warning blaming the world file), or a file
+    of that name there. The world's path is kept absolute, as `save`'s is."""
+    from mitos_cli.teach.simulation import world_path
+
+    here, elsewhere = tmp_path / "here", tmp_path / "elsewhere"
+    here.mkdir()
+    elsewhere.mkdir()
+    monkeypatch.chdir(here)
+    text = world_path("corridor").read_text()
+    (here / "corridor.yaml").write_text(text.replace("seed: 1\n", "seed: 77\n", 1))
+    s = Session(default_rulebase_path(), journal=Journal.create(here / "j"), out=[].append)
+    s.run("use drive")
+    s.run("simulate corridor.yaml")
+    assert s.journal.entries[-1]["world"] == str(here / "corridor.yaml")
+    monkeypatch.chdir(elsewhere)
+    said: list[str] = []
+    again = Session.resume(Journal.open(here / "j"), out=said.append)
+    assert len(said) == 1 and said[0].startswith("the last run is recorded again")
+    assert again.simulation.fingerprint == s.simulation.fingerprint
+
+
 @pytest.mark.parametrize("line, message, column", [
     ("frozen road.NARROWW", "unknown term `NARROWW` of `road`", 13),
     ("frozen roadd.NARROW", "unknown variable `roadd`", 8),

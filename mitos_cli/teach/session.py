@@ -811,7 +811,10 @@ class Session:
         self.compiled()
         self.simulation = run_world(c.world, self.rulebase, self.state.active, seed, self.base,
                                     c.robot, c.robot_span)
-        self.journal.append("simulate", line=line, world=str(world_path(c.world, self.base)),
+        # the path as it names the world from anywhere (`--resume --session DIR` elsewhere
+        # drove the packaged world of a relative path's name, or a file of that name there)
+        self.journal.append("simulate", line=line,
+                            world=os.path.abspath(world_path(c.world, self.base)),
                             behavior=self.state.active, seed=seed, robot=c.robot,
                             run=self.simulation.fingerprint, verdict=self.simulation.verdict)
         self.out(self.simulation.describe(self.use_advice))
