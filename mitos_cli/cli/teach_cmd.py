@@ -180,7 +180,8 @@ def _new_session(rules: str | None, behavior: str | None, lesson: str | None, sa
         link = broken_link("rule file", path)       # a dangling link, a loop: as eval says it
         raise RuleBaseError(link or (f"`{path}` is a directory, not a rule file" if path.is_dir()
                                      else f"rule file `{path}` not found"),
-                            hint=None if path.is_dir() or link else rule_file_not_found_hint(path))
+                            hint=None if path.is_dir() or link else
+                            (rules and _a_lesson(rules)) or rule_file_not_found_hint(path))
     try:
         loaded = load_rulebase(path, behavior)
     except MitosError as exc:           # a .fis, .fcl or .fll (by its name or not): convert it
@@ -202,6 +203,19 @@ def _new_session(rules: str | None, behavior: str | None, lesson: str | None, sa
     err(f"session {journal.directory.name} (journal in {journal.directory.as_posix()}; "
         f"`mitos teach --resume` continues it)")
     return session, lesson_text
+
+
+def _a_lesson(given: str) -> str | None:
+    """Where a lesson goes, for one named where the rule base goes that is not there: a
+    packaged lesson by the name `--lesson` takes (`mitos teach wider-turn`), or a `.lesson`
+    file (it said "rule file not found", and `mitos list` shows the packaged rule bases)."""
+    from ..resources import resolve
+
+    packaged = resolve("rulebases/lessons", given, ".lesson") is not None
+    if not packaged and not given.lower().endswith(".lesson"):
+        return None
+    return (f"`{given}` is {'a packaged lesson' if packaged else 'a lesson'}, not a rule base: "
+            f"a lesson is run with --lesson (`mitos teach [RULEBASE] --lesson {given}`)")
 
 
 def _check_save_as(rulebase: RuleBase, save_as: str) -> None:
