@@ -640,3 +640,30 @@ def test_the_way_back_to_a_session_names_it_when_resume_alone_would_not_find_it(
         f"keeps it open, `end` closes it",
         f"unsaved changes are kept in the journal; `mitos teach --resume --session "
         f"{first.as_posix()}` continues, `save PATH` writes them"]
+
+
+@pytest.mark.parametrize("encoding", ["utf-8", None])
+def test_the_prompt_reads_a_byte_that_is_not_utf8_as_a_mistake_of_its_line(work, encoding):
+    """Piped into the prompt, a byte that is not UTF-8 ended the session in a traceback
+    (`PYTHONIOENCODING=utf-8`: UnicodeDecodeError, the lines read with it lost), or was said
+    as `\\udce9W` with the caret beside it (the C locale's decoding); a byte-order mark at the
+    input's start made its first command "unexpected `\\ufeffif`". A lesson says the first as
+    "not UTF-8 text" and takes the second."""
+    env = dict(os.environ, COLUMNS="120")
+    env.pop("PYTHONIOENCODING", None)
+    if encoding:
+        env["PYTHONIOENCODING"] = encoding
+    stdin = (b"\xef\xbb\xbfif road is NARROW then speed is SLOW\r\n"
+             b"if road is NARR\xe9W then speed is SLOW\nshow history\n")
+    res = subprocess.run([sys.executable, "-m", "mitos_cli", "teach", "rb/mitos.rules"],
+                         cwd=work, input=stdin, capture_output=True, env=env, timeout=120)
+    out, err = res.stdout.decode(), res.stderr.decode()
+    assert res.returncode == 0, err
+    assert "Traceback" not in err and "\\udc" not in err and "\\ufeff" not in err
+    assert "r27: if road is NARROW then speed is SLOW" in out
+    assert "   2  if road is NARROW then speed is SLOW" in out        # `show history` ran
+    lines = err.splitlines()
+    at = lines.index("<prompt>:2:16: syntax error: the line is not UTF-8 text (byte 0xe9 at "
+                     "column 16)")
+    assert lines[at + 1:at + 3] == ["    if road is NARR\ufffdW then speed is SLOW",
+                                    "                   ^"]

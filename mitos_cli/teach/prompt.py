@@ -196,6 +196,32 @@ def at_prompt(exc: MitosError, line: str, lineno: int) -> MitosError:
     return exc
 
 
+def _undecoded(line: str, lineno: int) -> MitosError | None:
+    """A line holding a byte the input's encoding could not read (kept as a lone surrogate),
+    said as a lesson says it ("not UTF-8 text"), the byte shown as U+FFFD under the caret."""
+    from ..errors import RuleSyntaxError
+
+    at = next((i for i, c in enumerate(line) if "\udc80" <= c <= "\udcff"), None)
+    if at is None:
+        return None
+    try:                                # (a stderr that cannot write U+FFFD: `?`)
+        "\ufffd".encode(getattr(sys.stderr, "encoding", None) or "utf-8")
+        mark = "\ufffd"
+    except (UnicodeEncodeError, LookupError):
+        mark = "?"
+    shown = "".join(mark if "\udc80" <= c <= "\udcff" else c for c in line)
+    row = line.count("\n", 0, at) + 1
+    column = at - (line.rfind("\n", 0, at) + 1) + 1
+    byte = ord(line[at]) - 0xDC00
+    encoding = str(getattr(sys.stdin, "encoding", None) or "utf-8")
+    encoding = "UTF-8" if encoding.lower().replace("_", "-") in ("utf-8", "utf8") else encoding
+    return RuleSyntaxError(f"the line is not {encoding} text (byte 0x{byte:02x} at column "
+                           f"{column})",
+                           span=Span.in_text("\n" * (lineno - 1) + shown, PROMPT,
+                                             lineno + row - 1, column, column + 1),
+                           hint="names are written in ASCII letters, digits, `_` and `-`")
+
+
 def interact(session: Session, history: Path | None = None) -> None:
     """Read and run commands until ``quit`` or end of input.
 
@@ -206,6 +232,10 @@ def interact(session: Session, history: Path | None = None) -> None:
     readline = _setup_readline(session, history) if tty else None
     err = sys.stderr
     lines_read = 0
+    # a byte the input's encoding cannot read is the line's mistake, said at its place: read
+    # strictly (`PYTHONIOENCODING=utf-8`) it was a traceback, the lines read with it lost
+    with contextlib.suppress(AttributeError, ValueError, OSError):   # (not a text file)
+        sys.stdin.reconfigure(errors="surrogateescape")     # type: ignore[union-attr]
     session.out("MITOS teaching prompt: tell rules, correct, adapt, save. `help` lists the "
                 "commands; Ctrl-D or `quit` leaves (nothing is lost).")
     try:
@@ -231,7 +261,13 @@ def interact(session: Session, history: Path | None = None) -> None:
             except KeyboardInterrupt:
                 print("^C  (the line is dropped; `quit` or Ctrl-D leaves)", file=err)
                 continue
+            if lineno == 1:                      # a file piped in, written with a BOM
+                line = line.removeprefix("\ufeff")
             if not line.strip() or line.lstrip().startswith("#"):
+                continue
+            bad = _undecoded(line, lineno)
+            if bad is not None:
+                print(bad.render(), file=err)
                 continue
             try:                                 # Ctrl-C anywhere here keeps the session
                 if readline is not None and history is not None:
