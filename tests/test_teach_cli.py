@@ -667,3 +667,29 @@ def test_the_prompt_reads_a_byte_that_is_not_utf8_as_a_mistake_of_its_line(work,
                      "column 16)")
     assert lines[at + 1:at + 3] == ["    if road is NARR\ufffdW then speed is SLOW",
                                     "                   ^"]
+
+
+@pytest.mark.parametrize("encoding", ["utf-8", None])
+def test_a_lesson_on_stdin_is_read_as_a_lesson_file_is(work, encoding):
+    """`--lesson -` read stdin as text: a byte that is not UTF-8 was a UnicodeDecodeError
+    traceback (`PYTHONIOENCODING=utf-8`) or "unexpected `\\udce9W`", and a byte-order mark
+    "unexpected `\\ufeffif`", where the same lesson in a file is "not UTF-8 text" at its byte,
+    or read."""
+    env = dict(os.environ, COLUMNS="120")
+    env.pop("PYTHONIOENCODING", None)
+    if encoding:
+        env["PYTHONIOENCODING"] = encoding
+
+    def lesson(data):
+        res = subprocess.run([sys.executable, "-m", "mitos_cli", "teach", "rb/mitos.rules",
+                              "--lesson", "-"], cwd=work, input=data, capture_output=True,
+                             env=env, timeout=120)
+        return res.returncode, res.stdout.decode(), res.stderr.decode()
+
+    code, out, err = lesson(b"\xef\xbb\xbfif road is NARROW then speed is SLOW\r\n")
+    assert code == 0, err
+    assert "r27: if road is NARROW then speed is SLOW" in out
+    code, out, err = lesson(b"use drive\nif road is NARR\xe9W then speed is SLOW\n")
+    assert code == 1 and "Traceback" not in err and out == ""
+    assert err.splitlines()[-1] == ("<stdin>:2:16: lesson error: cannot read lesson `<stdin>`: "
+                                    "it is not UTF-8 text (byte 0xe9 at line 2, column 16)")
