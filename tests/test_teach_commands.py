@@ -98,6 +98,10 @@ def test_rule_lines_are_rules_of_the_rule_language():
     ("simulate figure4 seed 2x", "unexpected `x`", None, "a seed is a whole number"),
     ("simulate figure4 seed x", "unexpected `x`", "a seed", "a seed is a whole number"),
     ("simulate my world.yaml", "unexpected `world`", "`robot` or `seed`", "is quoted"),
+    # a mistyped option after the world's name was taken for a name with a space in it
+    ("simulate figure4 sed 3", "unexpected `sed`", "`robot` or `seed`", "did you mean `seed`?"),
+    ("simulate multirobot robt oncoming", "unexpected `robt`", "`robot` or `seed`",
+     "did you mean `robot`?"),
     ("simulate figure4 seed 3 robo x", "unexpected `robo`", "`robot`",
      "did you mean `robot`?"),
     # the end of a `simulate` line after `seed` or `robot` said "name a world file"

@@ -738,6 +738,12 @@ def _teach_hint(text: str, token: Token, before: list[str]) -> str | None:
     if before[:1] == ["simulate"] and (before[-1:] == ["seed"]                  # `seed x`
                                        or before[-2:-1] == ["seed"] and glued):  # `seed 2x`
         return "a seed is a whole number written in digits (such as 42)"
+    if before[:1] == ["simulate"] and len(before) == 2:   # `sed 3`: an option, mistyped
+        from ..errors import did_you_mean
+
+        close = did_you_mean(str(token.value), ["seed", "robot"])
+        if close is not None:
+            return close
     if (before[:1] == ["save"] or before[:1] == ["simulate"] and len(before) == 2
             or before[-2:-1] == ["plot"]):                      # just after the file name
         return 'a file name with a space in it is quoted: "my file.rules"'
