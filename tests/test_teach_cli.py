@@ -548,7 +548,7 @@ def test_a_packaged_lesson_is_shown_by_its_name_in_the_repository(work):
     (work / "w.lesson").write_text("use drve\n")
     res = mitos("teach", "--lesson", "w.lesson", cwd=work)
     assert res.returncode == 1 and res.stdout.startswith("w.lesson:1> use drve")
-    assert "w.lesson:1:1: name error: unknown behavior `drve`" in res.stderr
+    assert "w.lesson:1:5: name error: unknown behavior `drve`" in res.stderr
     res = mitos("teach", "--lesson", "wider-turn", cwd=work)
     assert res.returncode == 0, res.stderr
     assert res.stdout.startswith("rulebases/lessons/wider-turn.lesson:16> use drive\n")

@@ -70,6 +70,24 @@ def test_advice_to_use_a_behavior_while_one_is_open_closes_it_first(rules):
                          "to drive it so here)")
 
 
+def test_an_unknown_behavior_is_marked_at_its_name(rules):
+    """`use driv` was marked from `use` to the end of the line, where every other unknown
+    name (a term, a variable, a world, a label) is marked at itself."""
+    from mitos_cli.teach.prompt import at_prompt
+
+    s, _ = session(rules)
+    for line, caret in (("use driv", "    ^^^^"), ("behavior b", None),
+                        ("use drve when road is WIDE", "    ^^^^")):
+        if caret is None:
+            s.run(line)
+            continue
+        with pytest.raises(NameError_) as info:
+            s.run(line, "<prompt>", 3)
+        rendered = at_prompt(info.value, line, 3).render().splitlines()
+        assert rendered[0].startswith("<prompt>:3:5: name error: unknown behavior `dr")
+        assert rendered[2] == "    " + caret
+
+
 def test_a_told_rule_is_answered_as_understood_with_conflicts(rules):
     s, out = session(rules)
     text = say(s, out, "if road is  WIDE and size is SMALL_SZ and position is LEFT "

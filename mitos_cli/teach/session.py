@@ -475,7 +475,8 @@ class Session:
         use = c.use
         names = [b.name for b in self.rulebase.behaviors]
         if use.behavior not in names:
-            raise unknown("behavior", use.behavior, names, span=use.span)
+            raise unknown("behavior", use.behavior, names,
+                          span=use.span and use.span.naming(use.behavior))
         if self.state.block is None:
             if use.condition is not None or use.weight != 1.0:
                 raise LessonError("`use B when C` blends behaviors and belongs inside a "
