@@ -88,6 +88,19 @@ def test_an_unknown_behavior_is_marked_at_its_name(rules):
         assert rendered[2] == "    " + caret
 
 
+def test_a_label_another_behavior_has_adds_a_rule_here_and_says_so(rules):
+    """`r25: if ...` with `drive` active added a rule r25 to drive without a word, where the
+    instructor most likely meant to replace avoid_obstacle's r25 (the paper's rule)."""
+    s, out = session(rules)
+    s.run("use drive")
+    assert say(s, out, "r25: if road is NARROW then speed is SLOW").splitlines() == [
+        "r25: if road is NARROW then speed is SLOW", "  added to drive (1 rule)",
+        "  note: avoid_obstacle has a rule r25 too, which stays as it was (`use "
+        "avoid_obstacle` to replace that one)"]
+    assert "note" not in say(s, out, "r25: if road is WIDE then speed is SLOW")   # replaced
+    assert "note" not in say(s, out, "r77: if road is WIDE then speed is FAST")
+
+
 def test_a_told_rule_is_answered_as_understood_with_conflicts(rules):
     s, out = session(rules)
     text = say(s, out, "if road is  WIDE and size is SMALL_SZ and position is LEFT "

@@ -426,6 +426,11 @@ class Session:
         head = f"{format_rule(rule)}"
         if before is None:
             self.out(f"{head}\n  added to {b.name} ({plural(len(b.rules) + 1, 'rule')})")
+            elsewhere = [o.name for o in self.rulebase.behaviors if o.name != b.name
+                         and c.rule.label and rule.label in self._index(o).position]
+            if elsewhere:                   # (the one the instructor meant to replace?)
+                self.out(f"  note: {elsewhere[0]} has a rule {rule.label} too, which stays as "
+                         f"it was ({self.use_advice(elsewhere[0])} to replace that one)")
         else:
             self.out(f"{head}\n  replaces {format_rule(before)}")
         after = self.rulebase.behavior(b.name).rules
