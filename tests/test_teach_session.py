@@ -405,6 +405,8 @@ def test_every_command_of_the_table_has_help():
     for word in COMMAND_WORDS:
         assert help_text(word)
     assert "operators: and = product" in SUMMARY
+    # every option of `simulate` and `adapt` (`robot NAME` and `unconstrained` were left out)
+    assert "[seed N] [robot NAME]" in SUMMARY and "[plot FILE] [unconstrained]" in SUMMARY
 
 
 def test_help_on_an_instruction_or_a_target_is_the_help_that_holds_it():
