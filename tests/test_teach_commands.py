@@ -112,6 +112,9 @@ def test_rule_lines_are_rules_of_the_rule_language():
     # a robot's name that is no plain word, and the options in the other order
     ("simulate two.yaml robot cart 2", "unexpected `2`", "the end of the line",
      'quoted: `robot "cart 2"`'),
+    # (a world's path holding the word `robot` is not where the robot's name begins)
+    ("simulate robots/two.yaml robot cart 2", "unexpected `2`", "the end of the line",
+     'quoted: `robot "cart 2"`'),
     ("simulate multirobot robot oncoming seed 2", "unexpected `seed`", "the end of the line",
      "the seed comes before the robot: `simulate multirobot seed 2 robot oncoming`"),
     # a relative instruction where a target goes: it needs a window of the recorded run

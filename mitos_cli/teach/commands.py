@@ -778,7 +778,8 @@ def _robot_hint(text: str, token: Token, before: list[str]) -> str:
         seed = text[token.end_pos:].split()[:1] or ["42"]
         return ("the seed comes before the robot: `" + " ".join(
             before[:robot] + ["seed", seed[0]] + before[robot:]) + "`")
-    name = text[text.index("robot", len(before[0])) + len("robot"):].strip()
+    said = list(re.finditer(r"(?<=\s)robot\s+", text[:token.start_pos or len(text)]))
+    name = text[said[-1].end():].strip() if said else ""    # (the keyword, not `robots/`)
     name = name.split(" seed ")[0].strip() or "NAME"
     quoted = name if name.startswith('"') else '"' + name.replace('"', '\\"') + '"'
     return (f"a robot's name that is no bare name (a space, a dot, digits alone) is quoted: "
